@@ -1,0 +1,45 @@
+# Two entry points on a fresh machine: `make demo` and `make test` (see README).
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.installed
+DEVSTAMP := $(VENV)/.installed-dev
+DEMO_OUT ?= demo_output
+
+.PHONY: demo test lint typecheck pytest bench samples clean
+
+$(BIN)/python:
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+
+$(STAMP): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e .
+	touch $@
+
+$(DEVSTAMP): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	touch $@ $(STAMP)
+
+demo: $(STAMP)
+	$(BIN)/python -m ertools.demo $(DEMO_OUT)
+
+lint: $(DEVSTAMP)
+	$(BIN)/ruff check ertools tests benchmarks
+	$(BIN)/ruff format --check ertools tests benchmarks
+
+typecheck: $(DEVSTAMP)
+	$(BIN)/mypy ertools
+
+pytest: $(DEVSTAMP)
+	$(BIN)/python -m pytest -q
+
+test: lint typecheck pytest
+
+bench: $(STAMP)
+	$(BIN)/python benchmarks/run.py
+
+samples: $(STAMP)
+	$(BIN)/python -m ertools.samples sample_bags
+
+clean:
+	rm -rf $(VENV) build $(DEMO_OUT) .mypy_cache .ruff_cache .pytest_cache

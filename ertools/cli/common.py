@@ -1,0 +1,90 @@
+"""Options and output handling shared by the commands."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from ertools.benchmarks.base import BenchmarkResult, jsonable
+
+
+def add_output_options(
+    parser: argparse.ArgumentParser,
+    formats: tuple[str, ...] = ("yaml", "json"),
+    *,
+    report: bool = True,
+    plot: bool = True,
+) -> None:
+    """``--format``, ``--output``, and where the benchmark has them ``--report``/``--plot``."""
+    parser.add_argument(
+        "--format",
+        choices=formats,
+        default=formats[0],
+        help=f"output format on stdout (default {formats[0]})",
+    )
+    parser.add_argument(
+        "-o", "--output", type=Path, help="write the output to this file instead of stdout"
+    )
+    if report:
+        parser.add_argument(
+            "--report",
+            type=Path,
+            metavar="DIR",
+            help="write a self-contained report folder (index.html, score.yaml/json, CSV, plots)",
+        )
+    if plot:
+        parser.add_argument(
+            "--plot", type=Path, metavar="DIR", help="write the benchmark's figures (PNG) here"
+        )
+
+
+def write_text(text: str, output: Path | None) -> None:
+    """Text to ``output`` (a file) or stdout."""
+    if output is None:
+        sys.stdout.write(text if text.endswith("\n") else text + "\n")
+    else:
+        output.parent.mkdir(parents=True, exist_ok=True)
+        output.write_text(text if text.endswith("\n") else text + "\n", encoding="utf-8")
+        note(f"wrote {output}")
+
+
+def note(message: str) -> None:
+    """A human note on stderr (stdout stays parseable)."""
+    print(f"ertools: {message}", file=sys.stderr)
+
+
+def dump_json(data: Any) -> str:
+    return json.dumps(jsonable(data), indent=2, allow_nan=False)
+
+
+def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[Path]) -> int:
+    """Print a result in the chosen format, write its plots and report, return the exit code.
+
+    Warnings and deviations from the 2015 node go to stderr, so a referee sees them even when
+    stdout is redirected to a file.
+    """
+    fmt = getattr(args, "format", "yaml")
+    text = result.to_yaml() if fmt == "yaml" else dump_json(result.to_dict())
+    write_text(text, getattr(args, "output", None))
+    for warning in result.warnings:
+        note(f"warning: {warning}")
+    for deviation in result.deviations:
+        note(f"differs from 2015: {deviation}")
+    plot_dir: Path | None = getattr(args, "plot", None)
+    if plot_dir is not None:
+        from ertools.report.figures import figure_specs, save_figures
+
+        paths = save_figures(figure_specs(result), plot_dir)
+        note(f"wrote {len(paths)} figure(s) to {plot_dir}/")
+    report_dir: Path | None = getattr(args, "report", None)
+    if report_dir is not None:
+        from ertools.report.folder import write_report
+
+        index = write_report(result, report_dir, inputs=inputs, argv=sys.argv)
+        note(f"wrote report {index}")
+    for failure in result.failures:
+        note(f"error: {failure}")
+    return 1 if result.failures else 0

@@ -1,0 +1,35 @@
+"""Command groups (``score``, ``acquire``): a second level of lazy dispatch."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ertools.cli.main import Command
+
+
+def add_group_arguments(parser: argparse.ArgumentParser, members: dict[str, Command]) -> None:
+    """The group's parser takes the member name and leaves the rest to the member's parser."""
+    lines = ["members:"]
+    width = max(len(n) for n in members)
+    for name, cmd in members.items():
+        lines.append(f"  {name:<{width}}  {cmd.summary}")
+        lines.append(f"  {'':<{width}}    e.g. {cmd.example}")
+    parser.epilog = "\n".join(lines)
+    parser.add_argument(
+        "member", choices=list(members), metavar="NAME", help="one of the members below"
+    )
+    parser.add_argument("rest", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
+
+
+def run_group(group: str, members: dict[str, Command], args: argparse.Namespace) -> int:
+    """Run the member's own parser on the remaining arguments."""
+    from ertools.cli.main import run_command
+
+    extra = ["-v"] * args.verbose + (["--debug"] if args.debug else [])
+    member: str = args.member
+    rest: list[str] = list(args.rest)
+    if member not in members:  # argparse checked already; keeps mypy honest
+        print(f"ertools: error: unknown {group} {member!r}", file=sys.stderr)
+        return 2
+    return run_command(f"ertools {group} {member}", members[member].module, extra + rest)

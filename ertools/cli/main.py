@@ -1,0 +1,174 @@
+"""``ertools`` entry point: lazy dispatch so that ``ertools --help`` answers instantly."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass
+from importlib import import_module
+
+from ertools import __version__
+
+
+@dataclass(frozen=True)
+class Command:
+    """A command: the module that implements it, a summary and an example."""
+
+    module: str
+    summary: str
+    example: str
+
+
+COMMANDS: dict[str, Command] = {
+    "info": Command("ertools.cli.info", "describe bags like `rosbag info`", "ertools info run.bag"),
+    "timeline": Command(
+        "ertools.cli.timeline",
+        "order bags from many machines by time; overlaps, gaps, GT pairing",
+        "ertools timeline bags/ --plot timeline.png",
+    ),
+    "score": Command(
+        "ertools.cli.score",
+        "recompute a benchmark score (fbm1h, fbm1w, fbm2h, fbm3w, trajectory)",
+        "ertools score fbm3w run.bag --config configs/fbm3w.yaml",
+    ),
+    "noise": Command(
+        "ertools.cli.noise",
+        "mocap noise statistics of a stationary marker set, suggested d_min",
+        "ertools noise stationary.bag --topic /fbm3w/robot_at_work/pose",
+    ),
+    "acquire": Command(
+        "ertools.cli.acquire",
+        "offline acquisition of marker-to-robot transforms and FBM1 items",
+        "ertools acquire transform run.bag --team homer",
+    ),
+    "audit": Command(
+        "ertools.cli.audit",
+        "reconstruct a benchmark from its state topics and check it",
+        "ertools audit fbm2h.bag --report audit/",
+    ),
+    "report": Command(
+        "ertools.cli.report",
+        "combine several results into one HTML page",
+        "ertools report results/*/score.json --out competition/",
+    ),
+    "record": Command(
+        "ertools.cli.record",
+        "record OptiTrack NatNet mocap data to MCAP, no ROS needed",
+        "ertools record --config mocap.yaml --out logs/",
+    ),
+    "monitor": Command(
+        "ertools.cli.monitor",
+        "watch the log being written and warn when it stops growing",
+        "ertools monitor logs/ --bell",
+    ),
+    "clock": Command(
+        "ertools.cli.clock",
+        "query an NTP server and report the local clock offset",
+        "ertools clock --server 192.168.1.1",
+    ),
+}
+
+
+def _top_level_help() -> str:
+    width = max(len(name) for name in COMMANDS)
+    lines = [
+        "usage: ertools [-h] [--version] COMMAND [ARGS...]",
+        "",
+        "Re-score ERL / RoCKIn benchmarks from their logs, with no ROS installed.",
+        "",
+        "commands:",
+    ]
+    for name, cmd in COMMANDS.items():
+        lines.append(f"  {name:<{width}}  {cmd.summary}")
+        lines.append(f"  {'':<{width}}    e.g. {cmd.example}")
+    lines += [
+        "",
+        "`ertools COMMAND --help` shows a command's options with examples.",
+        "Exit status: 0 success, 1 unusable data or config, 2 usage error.",
+    ]
+    return "\n".join(lines)
+
+
+def build_parser(prog: str, module_name: str) -> tuple[argparse.ArgumentParser, object]:
+    """The parser of one command module (imported only now)."""
+    module = import_module(module_name)
+    description = (module.__doc__ or "").strip()
+    epilog = getattr(module, "EPILOG", None)
+    parser = argparse.ArgumentParser(
+        prog=prog,
+        description=description,
+        epilog=epilog,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "-v", "--verbose", action="count", default=0, help="more detail on stderr (-vv: debug)"
+    )
+    parser.add_argument(
+        "--debug", action="store_true", help="show the traceback of an unexpected error"
+    )
+    module.add_arguments(parser)
+    return parser, module
+
+
+def _configure_logging(verbose: int) -> None:
+    level = logging.WARNING if verbose == 0 else logging.INFO if verbose == 1 else logging.DEBUG
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("ertools: %(levelname)s: %(message)s"))
+    root = logging.getLogger("ertools")
+    root.handlers[:] = [handler]
+    root.setLevel(level)
+    root.propagate = False
+
+
+def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
+    """Parse ``argv`` for one command module and run it, mapping errors to exit codes."""
+    from ertools.errors import ErtoolsError
+
+    parser, module = build_parser(prog, module_name)
+    args = parser.parse_args(list(argv))
+    _configure_logging(args.verbose)
+    try:
+        code: int = module.run(args)  # type: ignore[attr-defined]
+    except ErtoolsError as err:
+        print(f"ertools: error: {err}", file=sys.stderr)
+        return err.exit_code
+    except KeyboardInterrupt:
+        print("ertools: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        return 0
+    except Exception as err:  # a bug: still one line unless --debug
+        if args.debug:
+            raise
+        print(
+            f"ertools: error: unexpected {type(err).__name__}: {err} "
+            "(this is a bug in ertools; re-run with --debug for the traceback)",
+            file=sys.stderr,
+        )
+        return 1
+    return code
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Console entry point."""
+    args = list(sys.argv[1:] if argv is None else argv)
+    if not args or args[0] in ("-h", "--help"):
+        print(_top_level_help())
+        return 0 if args else 2
+    if args[0] == "--version":
+        print(f"ertools {__version__}")
+        return 0
+    name = args[0]
+    if name not in COMMANDS:
+        print(
+            f"ertools: error: unknown command {name!r}; choose from {', '.join(COMMANDS)}",
+            file=sys.stderr,
+        )
+        return 2
+    return run_command(f"ertools {name}", COMMANDS[name].module, args[1:])
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

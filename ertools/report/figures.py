@@ -1,0 +1,60 @@
+"""Figures as data: a benchmark says what to draw, this module decides where it goes.
+
+Drawing functions take a matplotlib ``Axes``; nothing here selects a backend or uses pyplot,
+so importing ertools never changes matplotlib's global state.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from importlib import import_module
+from pathlib import Path
+from typing import Any
+
+# Benchmark name -> module with ``figure_specs(result) -> list[FigureSpec]``.
+PLOT_MODULES: dict[str, str] = {
+    "fbm1h": "ertools.report.plots_fbm1",
+    "fbm1w": "ertools.report.plots_fbm1",
+    "fbm2h": "ertools.report.plots_fbm2h",
+    "fbm3w": "ertools.report.plots_fbm3w",
+    "trajectory": "ertools.report.plots_trajectory",
+    "noise": "ertools.report.plots_noise",
+}
+
+
+@dataclass(frozen=True)
+class FigureSpec:
+    """One figure: a file stem, a title, a size and a function drawing on one Axes."""
+
+    name: str
+    title: str
+    draw: Callable[[Any], None]
+    size: tuple[float, float] = (7.0, 5.0)
+
+
+def figure_specs(result: Any) -> list[FigureSpec]:
+    """The figures of a result, from the plot module registered for its benchmark."""
+    module_name = PLOT_MODULES.get(result.name)
+    if module_name is None:
+        return []
+    specs: list[FigureSpec] = import_module(module_name).figure_specs(result)
+    return specs
+
+
+def save_figures(specs: Sequence[FigureSpec], outdir: Path, fmt: str = "png") -> list[Path]:
+    """Draw every spec into its own file in ``outdir``; returns the paths written."""
+    from matplotlib.figure import Figure
+
+    outdir.mkdir(parents=True, exist_ok=True)
+    written: list[Path] = []
+    for spec in specs:
+        fig = Figure(figsize=spec.size, layout="constrained")
+        ax = fig.add_subplot()
+        spec.draw(ax)
+        if spec.title:
+            ax.set_title(spec.title)
+        path = outdir / f"{spec.name}.{fmt}"
+        fig.savefig(path, dpi=110)
+        written.append(path)
+    return written

@@ -1,0 +1,229 @@
+"""Streams: frozen dataclasses of NumPy arrays, the currency between IO and computation.
+
+Readers produce them, scorers consume them; nothing here touches a file.
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+import numpy.typing as npt
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+I64 = npt.NDArray[np.int64]
+F64 = npt.NDArray[np.float64]
+U8 = npt.NDArray[np.uint8]
+
+
+def _window_slice(t_ns: I64, start_ns: int | None, end_ns: int | None) -> slice:
+    """Index range of sorted ``t_ns`` inside [start_ns, end_ns] (both ends inclusive)."""
+    lo = 0 if start_ns is None else int(np.searchsorted(t_ns, start_ns, side="left"))
+    hi = len(t_ns) if end_ns is None else int(np.searchsorted(t_ns, end_ns, side="right"))
+    return slice(lo, max(lo, hi))
+
+
+@dataclass(frozen=True, eq=False)
+class PoseStream:
+    """A time series of 6-DoF poses of ``child_frame_id`` in ``frame_id``.
+
+    Attributes:
+        t_ns: (N,) int64 nanoseconds since the epoch, non-decreasing.
+        xyz: (N, 3) float64 positions in metres.
+        quat_xyzw: (N, 4) float64 unit quaternions, scalar last.
+        frame_id: parent frame (``world`` for mocap), "" when the message has none.
+        child_frame_id: the tracked body, "" when unknown.
+        source: where it came from, e.g. ``file.bag:/fbm3w/robot_at_work/pose``.
+    """
+
+    t_ns: I64
+    xyz: F64
+    quat_xyzw: F64
+    frame_id: str = ""
+    child_frame_id: str = ""
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        n = self.t_ns.shape[0]
+        if self.t_ns.shape != (n,) or self.xyz.shape != (n, 3) or self.quat_xyzw.shape != (n, 4):
+            raise ValueError(
+                f"PoseStream shapes disagree: t_ns {self.t_ns.shape}, xyz {self.xyz.shape}, "
+                f"quat_xyzw {self.quat_xyzw.shape}"
+            )
+
+    def __len__(self) -> int:
+        return int(self.t_ns.shape[0])
+
+    @property
+    def start_ns(self) -> int:
+        """First time stamp (raises IndexError when empty)."""
+        return int(self.t_ns[0])
+
+    @property
+    def end_ns(self) -> int:
+        """Last time stamp (raises IndexError when empty)."""
+        return int(self.t_ns[-1])
+
+    @property
+    def yaw(self) -> F64:
+        """(N,) yaw angles in radians, in [-pi, pi]."""
+        from ertools.geometry import yaw_from_quat
+
+        return yaw_from_quat(self.quat_xyzw)
+
+    def take(self, index: slice | npt.NDArray[np.bool_] | npt.NDArray[np.intp]) -> PoseStream:
+        """A new stream with the selected samples (slice, boolean mask or indices)."""
+        return PoseStream(
+            self.t_ns[index],
+            self.xyz[index],
+            self.quat_xyzw[index],
+            self.frame_id,
+            self.child_frame_id,
+            self.source,
+        )
+
+    def window(self, start_ns: int | None, end_ns: int | None) -> PoseStream:
+        """Samples with start_ns <= t <= end_ns (None leaves that side open)."""
+        return self.take(_window_slice(self.t_ns, start_ns, end_ns))
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """x, y, z, qx, qy, qz, qw, yaw indexed by a UTC DatetimeIndex named ``time``."""
+        import pandas as pd
+
+        index = pd.DatetimeIndex(pd.to_datetime(self.t_ns, unit="ns", utc=True), name="time")
+        data = np.column_stack([self.xyz, self.quat_xyzw, self.yaw])
+        return pd.DataFrame(
+            data, index=index, columns=["x", "y", "z", "qx", "qy", "qz", "qw", "yaw"]
+        )
+
+    @staticmethod
+    def empty(frame_id: str = "", child_frame_id: str = "", source: str = "") -> PoseStream:
+        """A stream with no samples."""
+        return PoseStream(
+            np.empty(0, np.int64),
+            np.empty((0, 3)),
+            np.empty((0, 4)),
+            frame_id,
+            child_frame_id,
+            source,
+        )
+
+
+class Machine(enum.Enum):
+    """The three 2015 benchmark state machines (seed 6.2)."""
+
+    BMBOX = "bmbox"
+    REFBOX = "refbox"
+    CLIENT = "client"
+
+
+@dataclass(frozen=True, eq=False)
+class StateStream:
+    """The messages of one state topic: (t_ns, state, payload) per message.
+
+    Attributes:
+        machine: which state machine published it.
+        t_ns: (N,) int64 record times (the state messages carry no header).
+        state: (N,) uint8 state codes (see :mod:`ertools.states` for the enums).
+        payload: N payload strings.
+        topic: the topic name.
+        source: the file it was read from.
+    """
+
+    machine: Machine
+    t_ns: I64
+    state: U8
+    payload: tuple[str, ...]
+    topic: str = ""
+    source: str = ""
+
+    def __len__(self) -> int:
+        return int(self.t_ns.shape[0])
+
+    def take(self, index: slice | npt.NDArray[np.intp]) -> StateStream:
+        """A new stream with the selected messages."""
+        if isinstance(index, slice):
+            payload = self.payload[index]
+        else:
+            payload = tuple(self.payload[int(i)] for i in index)
+        return StateStream(
+            self.machine, self.t_ns[index], self.state[index], payload, self.topic, self.source
+        )
+
+    def window(self, start_ns: int | None, end_ns: int | None) -> StateStream:
+        """Messages with start_ns <= t <= end_ns (None leaves that side open)."""
+        return self.take(_window_slice(self.t_ns, start_ns, end_ns))
+
+    def changes(self) -> StateStream:
+        """Only the messages where the state or the payload differs from the previous one.
+
+        The 2015 machines re-published their state at 10 Hz; a transition is the first message
+        of each run of equal (state, payload).
+        """
+        n = len(self)
+        if n == 0:
+            return self
+        keep = np.ones(n, dtype=bool)
+        keep[1:] = self.state[1:] != self.state[:-1]
+        payload_changed = np.fromiter(
+            (self.payload[i] != self.payload[i - 1] for i in range(1, n)), dtype=bool, count=n - 1
+        )
+        keep[1:] |= payload_changed
+        return self.take(np.flatnonzero(keep))
+
+    def to_dataframe(self) -> pd.DataFrame:
+        """state (int), state_name and payload, indexed by a UTC DatetimeIndex named ``time``."""
+        import pandas as pd
+
+        from ertools.states import state_name
+
+        index = pd.DatetimeIndex(pd.to_datetime(self.t_ns, unit="ns", utc=True), name="time")
+        return pd.DataFrame(
+            {
+                "state": self.state.astype(int),
+                "state_name": [state_name(self.machine, int(s)) for s in self.state],
+                "payload": list(self.payload),
+            },
+            index=index,
+        )
+
+
+@dataclass(frozen=True)
+class Interval:
+    """A closed time interval [start_ns, end_ns]."""
+
+    start_ns: int
+    end_ns: int
+
+    @property
+    def duration_ns(self) -> int:
+        return self.end_ns - self.start_ns
+
+
+@dataclass(frozen=True)
+class Provenance:
+    """What a result was computed from, for reports and audits."""
+
+    inputs: tuple[str, ...] = ()
+    parameters: tuple[tuple[str, str], ...] = ()
+    deviations_from_2015: tuple[str, ...] = field(default_factory=tuple)
+
+
+def concatenate_poses(streams: Sequence[PoseStream]) -> PoseStream:
+    """Join streams end to end (no sorting: see ``ertools.io.merge`` for time-ordered merges)."""
+    if not streams:
+        return PoseStream.empty()
+    first = streams[0]
+    return PoseStream(
+        np.concatenate([s.t_ns for s in streams]),
+        np.concatenate([s.xyz for s in streams]),
+        np.concatenate([s.quat_xyzw for s in streams]),
+        first.frame_id,
+        first.child_frame_id,
+        ";".join(dict.fromkeys(s.source for s in streams)),
+    )
