@@ -1,0 +1,1 @@
+"""The seed's YAML formats, one module per format, each validated into frozen dataclasses."""
