@@ -1,0 +1,29 @@
+"""A minimal BenchmarkResult for tests that must not depend on a real scorer."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from ertools.benchmarks.base import Rows, dump_yaml
+from ertools.streams import Provenance
+
+
+@dataclass(frozen=True)
+class FakeResult:
+    name: str
+    data: dict[str, Any]
+    table: dict[str, Rows] = field(default_factory=dict)
+    warnings: tuple[str, ...] = ()
+    deviations: tuple[str, ...] = ()
+    failures: tuple[str, ...] = ()
+    provenance: Provenance = field(default_factory=Provenance)
+
+    def to_dict(self) -> dict[str, Any]:
+        return self.data
+
+    def to_yaml(self) -> str:
+        return dump_yaml(self.data)
+
+    def tables(self) -> dict[str, Rows]:
+        return self.table

@@ -1,0 +1,123 @@
+"""Live vs recomputed scores: alignment, tolerance and explanations on hand-made scores."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from audit_streams import heartbeat
+from fake_results import FakeResult
+
+from ertools.audit import audit_states
+from ertools.audit_score import attach, compare_scores, flatten
+from ertools.states import BmBoxState as B
+from ertools.streams import Machine, Provenance
+
+WRAP_DEV = "orientation errors are wrapped to [0, pi] (2015 used the unwrapped difference)"
+
+
+def _fbm2h(orient1: float, dist0: float) -> FakeResult:
+    return FakeResult(
+        "fbm2h",
+        {
+            "position_accuracy": 0.2,
+            "orientation_accuracy": 0.1,
+            "details": {
+                "segments_details": {
+                    "0": {"dinstance_error": dist0, "orientation_error": 0.05},
+                    "1": {"dinstance_error": 0.3, "orientation_error": orient1},
+                }
+            },
+        },
+        deviations=(WRAP_DEV,),
+        provenance=Provenance(parameters=(("transform", "identity"), ("d_min", "0.001"))),
+    )
+
+
+def test_flatten_paths() -> None:
+    assert flatten({"a": {"b": [1, {"c": 2}]}, "d": {}}) == {"a.b.0": 1, "a.b.1.c": 2, "d": {}}
+
+
+def test_one_based_live_segments_are_aligned_and_differences_explained() -> None:
+    # The 2015 node numbered segments from 1. Segment 2 (live) = segment 1 (ertools): its
+    # unwrapped yaw difference was 2*pi - 0.4 rad, so 2015's atan2(sin, cos) gave -0.4.
+    live = {
+        "position_accuracy": 0.2,
+        "orientation_accuracy": 0.1 + 5e-7,  # within the 1e-6 tolerance
+        "details": {
+            "segments_details": {
+                1: {"dinstance_error": 0.1, "orientation_error": 0.05},
+                2: {"dinstance_error": 0.3, "orientation_error": -0.4},
+            }
+        },
+    }
+    cmp = compare_scores(live, _fbm2h(0.4, 0.1 + 2e-3))
+    by_key = {line.key: line for line in cmp.lines}
+    assert any("numbers from 1" in n for n in cmp.notes)
+    assert by_key["orientation_accuracy"].status == "same"
+    seg1 = by_key["details.segments_details.1.orientation_error"]
+    assert seg1.status == "differs"
+    assert seg1.difference == pytest.approx(0.8, abs=1e-12)
+    assert "negative of the recomputed" in seg1.explanation
+    assert "ertools differs from 2015: " + WRAP_DEV in seg1.explanation
+    assert "transform=identity" in seg1.explanation
+    seg0 = by_key["details.segments_details.0.dinstance_error"]
+    assert seg0.status == "differs" and seg0.difference == pytest.approx(2e-3, abs=1e-12)
+    assert "interpolates" in seg0.explanation
+    assert "d_min" not in seg0.explanation  # not a parameter of a waypoint error
+    assert [line.key for line in cmp.differences] == [
+        "details.segments_details.0.dinstance_error",
+        "details.segments_details.1.orientation_error",
+    ]
+    assert cmp.same == 4
+
+
+def test_keys_only_on_one_side() -> None:
+    cmp = compare_scores({"position_accuracy": 0.2, "hits": 3}, _fbm2h(0.4, 0.1))
+    status = {line.key: line.status for line in cmp.lines}
+    assert status["hits"] == "only live"
+    assert status["details.segments_details.1.dinstance_error"] == "only recomputed"
+    assert status["position_accuracy"] == "same"
+
+
+def test_no_live_score() -> None:
+    cmp = compare_scores(None, _fbm2h(0.4, 0.1))
+    assert cmp.lines == () and cmp.notes
+
+
+def test_fbm3w_distance_error_names_d_min() -> None:
+    rec = FakeResult(
+        "fbm3w",
+        {"best_distance_error": 0.0102, "runs_details": {"0": {"distance_error": 0.0102}}},
+        provenance=Provenance(parameters=(("d_min", "0.001 m"), ("topic", "/fbm3w/x/pose2d"))),
+    )
+    cmp = compare_scores(
+        {"best_distance_error": 0.0131, "runs_details": {0: {"distance_error": 0.0131}}}, rec
+    )
+    line = cmp.differences[1]
+    assert line.key == "runs_details.0.distance_error"
+    assert "d_min=0.001 m" in line.explanation and "topic=/fbm3w/x/pose2d" in line.explanation
+    assert math.isclose(line.difference or 0.0, -0.0029, abs_tol=1e-12)
+
+
+def test_attach_to_audit() -> None:
+    score = "position_accuracy: 0.25\n"
+    bm = heartbeat(
+        Machine.BMBOX,
+        [
+            (0.0, B.START, ""),
+            (0.5, B.WAITING_CLIENT, ""),
+            (1.0, B.READY, ""),
+            (1.5, B.TRANSMITTING_SCORE, score),
+            (2.0, B.END, ""),
+        ],
+        2.0,
+    )
+    rec = FakeResult("fbm2h", {"position_accuracy": 0.2}, failures=("segment 3: no GT",))
+    audit = attach(audit_states(bm), rec)
+    assert audit.recomputed is rec
+    assert audit.comparison is not None and len(audit.comparison.differences) == 1
+    assert audit.failures == ("segment 3: no GT",)
+    assert audit.findings == 1
+    assert audit.tables()["score_comparison"][0]["live"] == 0.25
+    assert audit.to_dict()["recomputed"]["position_accuracy"] == 0.2
