@@ -1,0 +1,366 @@
+"""FBM2@Home (navigation, seed 7.2): load -> find reached moments -> score -> result.
+
+``score_fbm2h(paths, options)`` is what ``ertools score fbm2h`` runs; :func:`compute` is the
+pure part (streams and configs in, result out) that tests and notebooks can call directly.
+
+How 2015 scored (``scripts/fbm2h`` of ``benchmark_and_scoring_fbm``, final 2015 version): for
+each waypoint i (segment i, from 0), ``start_segment_time`` when the goal had been sent,
+``end_segment_time`` when the Client's result arrived, ``segment_time`` their difference;
+the robot pose was the tf ``world -> robot_at_home`` composed with the team's
+``marker_to_robot_transform`` and reduced to (x, y, yaw); ``dinstance_error`` the planar
+distance to the waypoint; ``orientation_error = atan2(sin|dtheta|, cos|dtheta|)`` with
+``dtheta`` the unwrapped yaw difference; ``position_accuracy = sum(distance) / N``,
+``orientation_accuracy = atan2(sum sin|dtheta|, sum cos|dtheta|)``, ``execution_time`` the
+sum of the segment times.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ertools.benchmarks.fbm2h_result import Fbm2hResult, SegmentResult
+from ertools.benchmarks.fbm2h_score import robot_poses_at, segment_errors
+from ertools.benchmarks.fbm2h_segments import ReachedMoments, StopParams
+from ertools.configs.goal import GoalList
+from ertools.configs.transform import MarkerTransform
+from ertools.errors import ConfigError, SegmentationError
+from ertools.streams import PoseStream, Provenance
+from ertools.timeutil import ns_to_s, s_to_ns
+
+log = logging.getLogger("ertools.benchmarks.fbm2h")
+
+DEFAULT_TOPIC = "/fbm2h/robot_at_home/pose"
+DEFAULT_MAX_GAP_S = 0.1
+# Figures need the path, not every 120 Hz sample.
+PATH_POINTS = 3000
+
+DEVIATION_WRAP = (
+    "orientation errors are the yaw difference wrapped to [0, pi] before sin/cos; 2015 used "
+    "the unwrapped |dtheta|, wrong across +-pi (use --orientation-2015 for the 2015 numbers)"
+)
+DEVIATION_POSE = (
+    "robot pose interpolated (linear + SLERP) at the logged reached moment; 2015 took the "
+    "latest tf available when its node processed the result"
+)
+DEVIATION_FORMAT = (
+    "segments_details nested under details as in Listing 13 (the 2015 node wrote it at the top "
+    "level); poses as {x, y, theta} (2015 wrote yaml dumps of Pose2D objects); segment times "
+    "from the log's clock (2015: the BmBox machine's time.time())"
+)
+
+
+@dataclass(frozen=True)
+class Fbm2hOptions:
+    """Everything ``ertools score fbm2h`` can be told.
+
+    Attributes:
+        goal: Listing 10 goal list file; None = the goal payload in the state topics.
+        transform: Listing 11 file; None with ``team``+``transforms_dir`` = DIR/transform-TEAM.yaml;
+            None otherwise = identity (said in the warnings).
+        topic / tf_frame: where the marker set's poses are (PoseStamped/Pose2D topic, or a /tf
+            child frame of ``world``).
+        time_source: ``header`` (mocap stamp) or ``record`` (bag time).
+        reached: ``states``, ``timing``, ``auto`` or None (states when present).
+        timing: the timing file for ``reached == "timing"``.
+        max_gap_s: a reached moment needs a GT sample this close.
+        hits: the referee's count of hits.
+        orientation_2015: compute orientation errors as 2015 did (unwrapped).
+        namespace: the benchmark namespace of the state topics.
+        stops: thresholds for ``auto``.
+    """
+
+    goal: Path | None = None
+    transform: Path | None = None
+    team: str | None = None
+    transforms_dir: Path | None = None
+    topic: str | None = None
+    tf_frame: str | None = None
+    time_source: str = "header"
+    reached: str | None = None
+    timing: Path | None = None
+    max_gap_s: float = DEFAULT_MAX_GAP_S
+    hits: int | None = None
+    orientation_2015: bool = False
+    namespace: str = "fbm2h"
+    stops: StopParams = field(default_factory=StopParams)
+
+
+def _decimate(stream: PoseStream, points: int) -> PoseStream:
+    step = max(1, math.ceil(len(stream) / points))
+    return stream.take(slice(0, len(stream), step))
+
+
+def compute(
+    goal: GoalList,
+    transform: MarkerTransform,
+    marker: PoseStream,
+    moments: ReachedMoments,
+    *,
+    max_gap_s: float = DEFAULT_MAX_GAP_S,
+    hits: int | None = None,
+    orientation_2015: bool = False,
+    unreached: Sequence[str] = (),
+    warnings: Sequence[str] = (),
+    provenance: Provenance | None = None,
+) -> Fbm2hResult:
+    """Score the segments of ``moments`` against ``goal`` (pure: no file is read).
+
+    ``moments`` may have fewer segments than waypoints only when ``unreached`` says why; the
+    missing segments are then failures. More moments than waypoints is an error.
+    """
+    n = len(goal)
+    k = len(moments)
+    if k > n or (k < n and not unreached):
+        raise SegmentationError(
+            f"{k} reached moments ({moments.method}) for {n} waypoints ({goal.source}); "
+            "each waypoint needs exactly one"
+        )
+    if hits is not None and hits < 0:
+        raise ConfigError(f"--hits must be >= 0, got {hits}")
+    t_mr = transform.arrays()
+    poses = robot_poses_at(marker, t_mr, moments.end_ns, s_to_ns(max_gap_s))
+    target = goal.as_array()
+    errs = segment_errors(poses.xyyaw[:k], target[:k], orientation_2015=orientation_2015)
+    failures: list[str] = []
+    segments: list[SegmentResult] = []
+    t_rel0 = int(moments.start_ns[0]) if k else 0
+    for i in range(n):
+        tgt = (float(target[i, 0]), float(target[i, 1]), float(target[i, 2]))
+        if i >= k:
+            reason = unreached[i - k] if i - k < len(unreached) else f"segment {i}: not reached"
+            failures.append(reason)
+            segments.append(SegmentResult(i, tgt, "unreached", timeout="timeout" in reason.lower()))
+            continue
+        start, end = int(moments.start_ns[i]), int(moments.end_ns[i])
+        common = {
+            "start_ns": start,
+            "end_ns": end,
+            "gt_offset_ns": int(poses.nearest_ns[i]),
+            "result_payload": moments.payloads[i],
+        }
+        if not poses.ok[i]:
+            gap = poses.nearest_ns[i]
+            nearest = (
+                "no GT sample at all"
+                if gap == np.iinfo(np.int64).max
+                else (f"nearest GT sample {gap / 1e9:.3f} s away")
+            )
+            failures.append(
+                f"segment {i}: no ground truth within --max-gap {max_gap_s} s of the reached "
+                f"moment {ns_to_s(end - t_rel0):.3f} s after the first segment start "
+                f"({nearest}; tracking lost?) in {marker.source or 'the pose stream'}"
+            )
+            segments.append(SegmentResult(i, tgt, "no_gt", **common))  # type: ignore[arg-type]
+            continue
+        xyyaw = poses.xyyaw[i]
+        segments.append(
+            SegmentResult(
+                i,
+                tgt,
+                "ok",
+                robot=(float(xyyaw[0]), float(xyyaw[1]), float(xyyaw[2])),
+                distance_error=float(errs.distance[i]),
+                orientation_error=float(errs.orientation[i]),
+                dtheta=float(errs.dtheta[i]),
+                **common,  # type: ignore[arg-type]
+            )
+        )
+    scored = all(s.status == "ok" for s in segments)
+    execution_time = sum(s.segment_time or 0.0 for s in segments)
+    all_warnings = list(warnings)
+    if transform.is_identity:
+        all_warnings.append(
+            "identity marker-to-robot transform: the marker set is taken to sit on the robot's "
+            "odometric centre (give --transform or --team/--transforms otherwise)"
+        )
+    deviations = [DEVIATION_POSE, DEVIATION_FORMAT]
+    if orientation_2015:
+        all_warnings.append(
+            "--orientation-2015: orientation errors use the unwrapped |dtheta| as 2015 did "
+            "(negative or wrong when the yaw difference crosses +-pi)"
+        )
+    else:
+        deviations.insert(0, DEVIATION_WRAP)
+    if moments.method != "states":
+        all_warnings.append(
+            f"reached moments from {moments.method!r}, not from the benchmark state topics: "
+            "segment times are only as good as those moments"
+        )
+    path = _decimate(marker, PATH_POINTS)
+    if len(path):
+        rt, rq = t_mr
+        from ertools.geometry import compose, yaw_from_quat
+
+        pt, pq = compose(
+            path.xyz,
+            path.quat_xyzw,
+            np.broadcast_to(rt, path.xyz.shape).copy(),
+            np.broadcast_to(rq, path.quat_xyzw.shape).copy(),
+        )
+        path_xyyaw = np.column_stack([pt[:, 0], pt[:, 1], yaw_from_quat(pq)])
+    else:
+        path_xyyaw = np.empty((0, 3))
+    return Fbm2hResult(
+        segments=tuple(segments),
+        position_accuracy=errs.position_accuracy if scored else None,
+        orientation_accuracy=errs.orientation_accuracy if scored else None,
+        execution_time=execution_time,
+        hits=hits,
+        timeout_segments=sum(1 for s in segments if s.timeout),
+        transform=transform,
+        goal=goal,
+        reached_method=moments.method,
+        orientation_2015=orientation_2015,
+        path_t_ns=path.t_ns,
+        path_xyyaw=path_xyyaw,
+        notes=moments.notes,
+        warnings=tuple(all_warnings),
+        deviations=tuple(deviations),
+        failures=tuple(failures),
+        provenance=provenance or Provenance(),
+    )
+
+
+def _load_transform(options: Fbm2hOptions) -> MarkerTransform:
+    from ertools.configs.transform import identity_transform, load_transform, team_transform_path
+
+    if options.transform is not None:
+        if options.team is not None or options.transforms_dir is not None:
+            raise ConfigError("give either --transform FILE or --team NAME --transforms DIR")
+        return load_transform(options.transform)
+    if (options.team is None) != (options.transforms_dir is None):
+        raise ConfigError("--team and --transforms go together (DIR/transform-TEAM.yaml)")
+    if options.team is not None and options.transforms_dir is not None:
+        return load_transform(team_transform_path(options.transforms_dir, options.team))
+    return identity_transform()
+
+
+def _pose_source(options: Fbm2hOptions) -> object:
+    from ertools.io import PoseSource
+
+    if options.topic is not None and options.tf_frame is not None:
+        raise ConfigError("give either --topic or --tf-frame, not both")
+    if options.tf_frame is not None:
+        return PoseSource(topic=None, frame=options.tf_frame, time_source=options.time_source)
+    return PoseSource(topic=options.topic or DEFAULT_TOPIC, time_source=options.time_source)
+
+
+def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
+    """Read the bags and configs, find the reached moments and score them."""
+    from ertools.benchmarks import fbm2h_segments as seg
+    from ertools.configs.goal import goal_from_payload, load_goal
+    from ertools.io import read_benchmark_states, read_pose_source, summary
+
+    if not paths:
+        raise ConfigError("no bag given")
+    if options.max_gap_s <= 0:
+        raise ConfigError(f"--max-gap must be > 0 s, got {options.max_gap_s}")
+    transform = _load_transform(options)
+    goal = load_goal(options.goal) if options.goal is not None else None
+    marker = read_pose_source(list(paths), _pose_source(options))  # type: ignore[arg-type]
+    if len(marker) == 0:
+        raise SegmentationError(f"{marker.source or paths[0]}: the marker set pose stream is empty")
+    warnings: list[str] = []
+    unreached: tuple[str, ...] = ()
+    reached = options.reached
+    states = None
+    if reached in (None, "states"):
+        states = read_benchmark_states(list(paths), options.namespace)
+        if states.bmbox is None:
+            if reached == "states":
+                raise SegmentationError(
+                    f"{paths[0]}: no /{options.namespace}/bmbox_state topic; "
+                    "use --reached timing FILE or --reached auto"
+                )
+            raise SegmentationError(
+                f"{paths[0]}: no benchmark state topics to find the reached moments; "
+                "use --reached timing FILE (a reached-waypoint timing file) or --reached auto"
+            )
+        reached = "states"
+    if reached == "states":
+        assert states is not None and states.bmbox is not None
+        moments = seg.from_states(states.bmbox, states.client, states.refbox)
+        if goal is None:
+            if moments.goal_payload is None:
+                raise ConfigError(
+                    "no --goal given and the first TRANSMITTING_GOAL has no goal payload"
+                )
+            goal = goal_from_payload(moments.goal_payload, f"{states.bmbox.topic} payload")
+        elif moments.goal_payload:
+            logged = goal_from_payload(moments.goal_payload, f"{states.bmbox.topic} payload")
+            if not np.allclose(logged.as_array().shape, goal.as_array().shape) or not np.allclose(
+                logged.as_array(), goal.as_array(), atol=1e-9
+            ):
+                warnings.append(
+                    f"the goal list given ({goal.source}) differs from the one the BmBox sent "
+                    "in the log; scoring against the one given"
+                )
+        unreached = seg.unreached_reasons(moments, len(goal), states.refbox)
+    elif reached == "timing":
+        from ertools.configs.timing import load_timing
+
+        if options.timing is None:
+            raise ConfigError("--reached timing needs the timing FILE")
+        if goal is None:
+            raise ConfigError("--reached timing needs --goal FILE (Listing 10)")
+        timing = load_timing(options.timing)
+        infos = [summary(p) for p in paths]
+        t = timing.resolve(min(i.start_ns for i in infos), max(i.end_ns for i in infos))
+        if len(t) - 1 != len(goal):
+            raise SegmentationError(
+                f"{options.timing}: {len(t)} moments close {len(t) - 1} segments, but "
+                f"{goal.source} has {len(goal)} waypoints (p0 starts, p(k+1) closes segment k)"
+            )
+        moments = seg.from_timing(t, timing.labels)
+    elif reached == "auto":
+        if goal is None:
+            raise ConfigError("--reached auto needs --goal FILE (Listing 10)")
+        from ertools.geometry import compose, yaw_from_quat
+
+        rt, rq = transform.arrays()
+        pt, pq = compose(
+            marker.xyz,
+            marker.quat_xyzw,
+            np.broadcast_to(rt, marker.xyz.shape).copy(),
+            np.broadcast_to(rq, marker.quat_xyzw.shape).copy(),
+        )
+        moments, missing = seg.from_stops(
+            marker.t_ns,
+            pt[:, :2],
+            yaw_from_quat(pq),
+            goal.as_array()[:, :2],
+            options.stops,
+            s_to_ns(options.max_gap_s),
+        )
+        unreached = missing
+    else:
+        raise ConfigError(f"--reached must be states, timing FILE or auto, not {reached!r}")
+    provenance = Provenance(
+        inputs=tuple(str(p) for p in paths)
+        + tuple(str(p) for p in (options.goal, options.transform, options.timing) if p),
+        parameters=(
+            ("reached", moments.method),
+            ("pose_source", marker.source),
+            ("max_gap_s", str(options.max_gap_s)),
+            ("transform", transform.source),
+            ("orientation_2015", str(options.orientation_2015)),
+        ),
+    )
+    return compute(
+        goal,
+        transform,
+        marker,
+        moments,
+        max_gap_s=options.max_gap_s,
+        hits=options.hits,
+        orientation_2015=options.orientation_2015,
+        unreached=unreached,
+        warnings=warnings,
+        provenance=provenance,
+    )

@@ -1,0 +1,202 @@
+"""The FBM2@Home result: per-segment details and the Listing 13 score."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.configs.goal import GoalList
+from ertools.configs.transform import MarkerTransform
+from ertools.streams import Provenance
+from ertools.timeutil import ns_to_s
+
+Pose2 = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class SegmentResult:
+    """One segment: from the previous waypoint (or the start) to waypoint ``index``.
+
+    Attributes:
+        index: waypoint number, from 0.
+        target: the waypoint (x, y, theta).
+        status: ``ok``, ``no_gt`` (tracking lost at the reached moment) or ``unreached``.
+        start_ns, end_ns: segment start and reached moment (None when unreached).
+        robot: robot (x, y, yaw) at the reached moment (None unless ``ok``).
+        distance_error: metres (None unless ``ok``).
+        orientation_error: radians, as reported (None unless ``ok``).
+        dtheta: robot yaw minus target theta, unwrapped (None unless ``ok``).
+        gt_offset_ns: time from the reached moment to the nearest GT sample.
+        result_payload: the Client's COMPLETED_GOAL payload ("" when none).
+        timeout: the segment ended by a RefBox timeout.
+    """
+
+    index: int
+    target: Pose2
+    status: str
+    start_ns: int | None = None
+    end_ns: int | None = None
+    robot: Pose2 | None = None
+    distance_error: float | None = None
+    orientation_error: float | None = None
+    dtheta: float | None = None
+    gt_offset_ns: int | None = None
+    result_payload: str = ""
+    timeout: bool = False
+
+    @property
+    def segment_time(self) -> float | None:
+        if self.start_ns is None or self.end_ns is None:
+            return None
+        return ns_to_s(self.end_ns - self.start_ns)
+
+
+def _pose_map(p: Pose2 | None) -> dict[str, float] | None:
+    if p is None:
+        return None
+    return {"x": float(p[0]), "y": float(p[1]), "theta": float(p[2])}
+
+
+def _payload_value(payload: str) -> Any:
+    """The payload as data when it is a YAML mapping, ``{}`` when empty, else the text."""
+    text = payload.strip()
+    if not text:
+        return {}
+    import yaml
+
+    try:
+        value = yaml.safe_load(text)
+    except yaml.YAMLError:
+        return payload
+    return value if isinstance(value, dict) else payload
+
+
+def _num(x: float | None) -> float | None:
+    return None if x is None or (isinstance(x, float) and math.isnan(x)) else float(x)
+
+
+@dataclass(frozen=True, eq=False)
+class Fbm2hResult:
+    """A scored FBM2@Home run (implements ``BenchmarkResult``).
+
+    Attributes:
+        segments: one per waypoint.
+        position_accuracy: mean distance error, metres (None when a segment failed).
+        orientation_accuracy: atan2(sum sin, sum cos) of the orientation errors (None idem).
+        execution_time: sum of the segment times, seconds.
+        hits: the referee's count, None when not given.
+        timeout_segments: segments ended by a timeout.
+        transform: the marker-to-robot transform used.
+        goal: the goal list.
+        reached_method: ``states``, ``timing`` or ``auto``.
+        orientation_2015: True when errors were computed the 2015 way (unwrapped).
+        path_t_ns, path_xyyaw: the robot's path (decimated) for the figures.
+        notes: how the reached moments were found.
+    """
+
+    segments: tuple[SegmentResult, ...]
+    position_accuracy: float | None
+    orientation_accuracy: float | None
+    execution_time: float
+    hits: int | None
+    timeout_segments: int
+    transform: MarkerTransform
+    goal: GoalList
+    reached_method: str
+    orientation_2015: bool
+    path_t_ns: npt.NDArray[np.int64]
+    path_xyyaw: npt.NDArray[np.float64]
+    notes: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
+    deviations: tuple[str, ...] = ()
+    failures: tuple[str, ...] = ()
+    provenance: Provenance = field(default_factory=Provenance)
+    name: str = "fbm2h"
+
+    def _segment_listing(self, seg: SegmentResult) -> dict[str, Any]:
+        # Keys and order of Listing 13 (the 2015 node wrote "dinstance_error" so, typo included).
+        return {
+            "dinstance_error": _num(seg.distance_error),
+            "end_segment_time": None if seg.end_ns is None else ns_to_s(seg.end_ns),
+            "orientation_error": _num(seg.orientation_error),
+            "refbox_timeout": bool(seg.timeout),
+            "result_payload": _payload_value(seg.result_payload),
+            "robot_pose": _pose_map(seg.robot),
+            "segment_time": seg.segment_time,
+            "start_segment_time": None if seg.start_ns is None else ns_to_s(seg.start_ns),
+            "target_pose": _pose_map(seg.target),
+            "timeout": bool(seg.timeout),
+        }
+
+    def _listing(self, string_keys: bool) -> dict[str, Any]:
+        details = {
+            (str(s.index) if string_keys else s.index): self._segment_listing(s)
+            for s in self.segments
+        }
+        return {
+            "position_accuracy": _num(self.position_accuracy),
+            "orientation_accuracy": _num(self.orientation_accuracy),
+            "execution_time": float(self.execution_time),
+            "hits": self.hits,
+            "timeout_segments": int(self.timeout_segments),
+            "details": {
+                "marker-robot transform": self.transform.as_listing(),
+                "segments_details": details,
+            },
+        }
+
+    def to_yaml(self) -> str:
+        """The Listing 13 score."""
+        return dump_yaml(jsonable(self._listing(string_keys=False)))
+
+    def to_dict(self) -> dict[str, Any]:
+        """Same structure as the YAML, segment indices as string keys."""
+        data: dict[str, Any] = jsonable(self._listing(string_keys=True))
+        return data
+
+    def tables(self) -> dict[str, Rows]:
+        """``segments`` (one row per waypoint) and ``summary``."""
+        t0 = next((s.start_ns for s in self.segments if s.start_ns is not None), None)
+
+        def rel(t: int | None) -> float | None:
+            return None if t is None or t0 is None else ns_to_s(t - t0)
+
+        rows: Rows = []
+        for s in self.segments:
+            rows.append(
+                {
+                    "segment": s.index,
+                    "status": s.status,
+                    "start_s": rel(s.start_ns),
+                    "reached_s": rel(s.end_ns),
+                    "segment_time_s": s.segment_time,
+                    "target_x": s.target[0],
+                    "target_y": s.target[1],
+                    "target_theta": s.target[2],
+                    "robot_x": None if s.robot is None else s.robot[0],
+                    "robot_y": None if s.robot is None else s.robot[1],
+                    "robot_theta": None if s.robot is None else s.robot[2],
+                    "distance_error_m": _num(s.distance_error),
+                    "orientation_error_rad": _num(s.orientation_error),
+                    "dtheta_unwrapped_rad": _num(s.dtheta),
+                    "gt_offset_ms": None if s.gt_offset_ns is None else s.gt_offset_ns / 1e6,
+                }
+            )
+        summary: Rows = [
+            {
+                "position_accuracy_m": _num(self.position_accuracy),
+                "orientation_accuracy_rad": _num(self.orientation_accuracy),
+                "execution_time_s": self.execution_time,
+                "hits": self.hits,
+                "timeout_segments": self.timeout_segments,
+                "reached": self.reached_method,
+                "transform": self.transform.robot_info or self.transform.source,
+                "orientation_mode": "2015" if self.orientation_2015 else "wrapped",
+            }
+        ]
+        return {"segments": rows, "summary": summary}
