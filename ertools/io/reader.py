@@ -1,0 +1,347 @@
+"""The public reading functions: pose, tf and state streams, raw messages, topics.
+
+Every function takes one path or a list (a logger's split files), reads each file, and merges
+the results in time order. Pose topics go through the bulk NumPy decoder where the format and
+type allow it (:mod:`ertools.io.fastdecode`) and through rosbags' deserializer otherwise.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from ertools.errors import TopicError
+from ertools.io.files import BagFile, open_bag
+from ertools.io.formats import bag_paths
+from ertools.io.merge import merge_poses, sort_poses
+from ertools.io.model import (
+    POSE_TYPES,
+    TF_TYPES,
+    BenchmarkStates,
+    Conn,
+    PoseSource,
+    RawMessage,
+)
+from ertools.io.posebatch import PoseBatch, batch_from_messages, concat_batches
+from ertools.io.tf import Edge, chain_pose, frame_key
+from ertools.io.typestore import Deserializer
+from ertools.states import MSG_TYPES, STATE_TOPIC_SUFFIXES
+from ertools.streams import Machine, PoseStream, StateStream
+
+log = logging.getLogger("ertools.io.reader")
+
+PathsLike = str | Path | Sequence[str | Path]
+
+# Header stamps of mocap messages trail or lead the record time by milliseconds; a window on
+# header time reads the records of this much more on each side, then cuts on the stamps.
+HEADER_WINDOW_MARGIN_NS = 60 * 1_000_000_000
+
+TF_TOPICS = ("/tf", "/tf_static")
+
+
+def _paths(paths: PathsLike) -> list[Path]:
+    if isinstance(paths, (str, Path)):
+        return bag_paths(paths)
+    return bag_paths(list(paths))
+
+
+def topics(paths: PathsLike) -> dict[str, str]:
+    """topic -> message type (``pkg/Type``) over all files, sorted by topic."""
+    out: dict[str, str] = {}
+    for p in _paths(paths):
+        with open_bag(p) as bag:
+            for c in bag.connections:
+                out.setdefault(c.topic, c.msgtype)
+    return dict(sorted(out.items()))
+
+
+def _pose_topic_list(found: dict[str, str]) -> str:
+    names = [t for t, ty in found.items() if ty in POSE_TYPES]
+    return ", ".join(names) if names else "none"
+
+
+def _topic_error(paths: list[Path], topic: str, what: str = "pose topic") -> TopicError:
+    found = topics(paths)
+    where = str(paths[0]) if len(paths) == 1 else f"{len(paths)} files ({paths[0]}...)"
+    return TopicError(
+        f"{what} {topic} not in {where}; pose topics there: {_pose_topic_list(found)}"
+    )
+
+
+def load_pose_batch(
+    bag: BagFile, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
+) -> PoseBatch:
+    """Pose rows of ``conns`` with record time in [start_ns, end_ns], in reference order.
+
+    Tries the bulk decoder first; falls back to rosbags per message (logged at INFO).
+    """
+    from ertools.io.fastdecode import try_fast_batch
+
+    fast = try_fast_batch(bag, conns, start_ns, end_ns)
+    if fast is not None:
+        return fast
+    return slow_pose_batch(bag, conns, start_ns, end_ns)
+
+
+def slow_pose_batch(
+    bag: BagFile, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
+) -> PoseBatch:
+    """The reference decoder: rosbags' deserializer, one message at a time."""
+    deser = Deserializer(conns, bag.path)
+    batches = []
+    types = {c.msgtype for c in conns}
+    for msgtype in sorted(types):
+        records = [
+            (t, deser(raw, conn))
+            for conn, t, raw in bag.raw(conns, start_ns, end_ns)
+            if conn.msgtype == msgtype
+        ]
+        batches.append(batch_from_messages(msgtype, records))
+    return concat_batches(batches)
+
+
+def _check_pose_conns(conns: list[Conn], topic: str, path: Path) -> str:
+    types = sorted({c.msgtype for c in conns})
+    if len(types) != 1:
+        raise TopicError(f"topic {topic} carries several types ({', '.join(types)})", path=path)
+    msgtype = types[0]
+    if msgtype not in POSE_TYPES:
+        raise TopicError(
+            f"topic {topic} has type {msgtype}, not a pose type "
+            f"({', '.join(t for t in POSE_TYPES)})",
+            path=path,
+        )
+    return msgtype
+
+
+def _batch_to_stream(batch: PoseBatch, msgtype: str, time_source: str, source: str) -> PoseStream:
+    use_header = time_source == "header" and msgtype != "geometry_msgs/Pose2D"
+    t = batch.t_header if use_header else batch.t_record
+    frames = batch.frame_names()
+    children = batch.child_names()
+    frame = str(frames[0]) if len(frames) else ""
+    child = str(children[0]) if len(children) else ""
+    if len(frames) and (np.any(frames != frame) or np.any(children != child)):
+        log.warning(
+            "%s: frame ids change within the topic (%s); using the first, %r -> %r",
+            source,
+            ", ".join(sorted(set(map(str, frames)) | set(map(str, children)))),
+            frame,
+            child,
+        )
+    return PoseStream(t, batch.xyz, batch.quat_xyzw, frame, child, source)
+
+
+def read_poses(
+    paths: PathsLike,
+    topic: str,
+    *,
+    time_source: str = "header",
+    start_ns: int | None = None,
+    end_ns: int | None = None,
+) -> PoseStream:
+    """The poses of one pose topic, merged over all files, time-ordered.
+
+    Args:
+        paths: one bag or a logger's split files.
+        topic: a ``PoseStamped``, ``Pose2D``, ``TransformStamped``, ``Odometry`` or single-child
+            TF topic.
+        time_source: ``header`` (message stamp, default) or ``record`` (bag record time).
+            ``Pose2D`` has no header and always uses the record time.
+        start_ns, end_ns: keep samples with start_ns <= t <= end_ns (t as chosen above).
+
+    Raises:
+        BagError: missing or unreadable file.
+        TopicError: topic absent from every file (the message lists the pose topics there are),
+            or not a pose type.
+    """
+    if time_source not in ("header", "record"):
+        raise ValueError(f"time_source must be 'header' or 'record', not {time_source!r}")
+    plist = _paths(paths)
+    margin = HEADER_WINDOW_MARGIN_NS if time_source == "header" else 0
+    lo = None if start_ns is None else start_ns - margin
+    hi = None if end_ns is None else end_ns + margin
+    streams = []
+    for p in plist:
+        with open_bag(p) as bag:
+            conns = bag.topic_conns(topic)
+            if not conns:
+                continue
+            msgtype = _check_pose_conns(conns, topic, p)
+            batch = load_pose_batch(bag, conns, lo, hi)
+        source = f"{p}:{topic}"
+        stream = sort_poses(_batch_to_stream(batch, msgtype, time_source, source), source)
+        streams.append(stream.window(start_ns, end_ns))
+    if not streams:
+        raise _topic_error(plist, topic)
+    return merge_poses(streams, topic)
+
+
+def _tf_edges(
+    plist: list[Path], start_ns: int | None, end_ns: int | None
+) -> dict[tuple[str, str], Edge]:
+    per_edge: dict[tuple[str, str], list[PoseStream]] = {}
+    static_edges: set[tuple[str, str]] = set()
+    for p in plist:
+        with open_bag(p) as bag:
+            for topic in TF_TOPICS:
+                conns = [c for c in bag.topic_conns(topic) if c.msgtype in TF_TYPES]
+                if not conns:
+                    continue
+                static = topic == "/tf_static"
+                window = (None, None) if static else (start_ns, end_ns)
+                batch = load_pose_batch(bag, conns, *window)
+                frames = np.asarray([frame_key(f) for f in batch.frames], dtype=np.str_)
+                pairs = batch.frame_idx.astype(np.int64) * len(frames) + batch.child_idx
+                for code in np.unique(pairs):
+                    rows = np.flatnonzero(pairs == code)
+                    key = (str(frames[code // len(frames)]), str(frames[code % len(frames)]))
+                    sub = batch.take(rows)
+                    s = PoseStream(sub.t_header, sub.xyz, sub.quat_xyzw, key[0], key[1], str(p))
+                    per_edge.setdefault(key, []).append(sort_poses(s, f"{p}:{topic} {key}"))
+                    if static or (any(c.latching for c in conns) and len(rows) == 1):
+                        static_edges.add(key)
+    edges = {}
+    for key, parts in per_edge.items():
+        merged = merge_poses(parts, f"tf {key[0]} -> {key[1]}")
+        edges[key] = Edge(merged, key in static_edges or len(merged) == 1)
+    return edges
+
+
+def read_tf(
+    paths: PathsLike,
+    parent: str,
+    child: str,
+    *,
+    start_ns: int | None = None,
+    end_ns: int | None = None,
+) -> PoseStream:
+    """Pose of ``child`` in ``parent`` from ``/tf`` and ``/tf_static``, chains composed.
+
+    Accepts ``tf/tfMessage`` and ``tf2_msgs/TFMessage``; times are the transforms' header
+    stamps. Frame names match with or without a leading slash. A chain (e.g. origin <- world ->
+    ref_board) is sampled at the times of its link into ``child`` and the other links are
+    interpolated there (see :mod:`ertools.io.tf` for the exact rule).
+
+    Raises:
+        TopicError: no tf topic, an unknown frame, or no chain between the frames.
+    """
+    plist = _paths(paths)
+    lo = None if start_ns is None else start_ns - HEADER_WINDOW_MARGIN_NS
+    hi = None if end_ns is None else end_ns + HEADER_WINDOW_MARGIN_NS
+    edges = _tf_edges(plist, lo, hi)
+    if not edges:
+        raise _topic_error(plist, "/tf", "tf topic")
+    source = f"{plist[0]}:/tf" if len(plist) == 1 else f"{len(plist)} files:/tf"
+    try:
+        stream = chain_pose(edges, parent, child, source)
+    except TopicError as err:
+        raise TopicError(f"{err.message} (in {source})") from err
+    return stream.window(start_ns, end_ns)
+
+
+def read_pose_source(
+    paths: PathsLike,
+    source: PoseSource,
+    *,
+    start_ns: int | None = None,
+    end_ns: int | None = None,
+) -> PoseStream:
+    """A pose topic, or a tf frame when ``source.topic`` is None or a tf topic."""
+    if source.topic is not None and source.topic not in TF_TOPICS:
+        return read_poses(
+            paths, source.topic, time_source=source.time_source, start_ns=start_ns, end_ns=end_ns
+        )
+    if not source.frame:
+        raise TopicError("a tf pose source needs a frame (the tf child frame)")
+    return read_tf(paths, source.parent, source.frame, start_ns=start_ns, end_ns=end_ns)
+
+
+def read_messages(
+    paths: PathsLike, topic: str, *, start_ns: int | None = None, end_ns: int | None = None
+) -> list[RawMessage]:
+    """Every message of ``topic`` deserialized by rosbags, with record times, time-ordered.
+
+    The general fallback for any type (one Python object per message: not for long pose
+    streams; use :func:`read_poses` there).
+    """
+    plist = _paths(paths)
+    out: list[RawMessage] = []
+    found = False
+    for p in plist:
+        with open_bag(p) as bag:
+            conns = bag.topic_conns(topic)
+            if not conns:
+                continue
+            found = True
+            deser = Deserializer(conns, p)
+            out.extend(
+                RawMessage(t, deser(raw, c), topic, c.msgtype)
+                for c, t, raw in bag.raw(conns, start_ns, end_ns)
+            )
+    if not found:
+        raise _topic_error(plist, topic, "topic")
+    times = np.array([m.t_ns for m in out], dtype=np.int64)
+    if len(times) > 1 and np.any(times[1:] < times[:-1]):
+        log.warning("%s: messages from several files out of time order; sorted", topic)
+        out = [out[i] for i in np.argsort(times, kind="stable")]
+    return out
+
+
+def _machine_of(topic: str, msgtype: str) -> Machine | None:
+    for machine, name in MSG_TYPES.items():
+        if msgtype == name:
+            return machine
+    leaf = topic.rstrip("/").rsplit("/", 1)[-1]
+    for machine, suffixes in STATE_TOPIC_SUFFIXES.items():
+        if leaf in suffixes:
+            return machine
+    return None
+
+
+def read_states(paths: PathsLike, topic: str) -> StateStream:
+    """A BmBox/RefBox/Client state topic as (record time, state code, payload), time-ordered.
+
+    The machine comes from the message type (``rockin_scoring/BmBoxState`` ...) or, failing
+    that, from the topic name (``.../bmbox_state``).
+
+    Raises:
+        TopicError: topic absent, or not a state topic (no ``state``/``payload`` fields).
+    """
+    plist = _paths(paths)
+    msgs = read_messages(plist, topic)
+    msgtype = msgs[0].msgtype if msgs else topics(plist).get(topic, "")
+    machine = _machine_of(topic, msgtype)
+    if machine is None:
+        raise TopicError(
+            f"topic {topic} ({msgtype}) is not a benchmark state topic "
+            "(bmbox_state, refbox_state, client_state)"
+        )
+    if msgs and not (hasattr(msgs[0].msg, "state") and hasattr(msgs[0].msg, "payload")):
+        raise TopicError(f"topic {topic}: type {msgtype} has no state/payload fields")
+    t = np.fromiter((m.t_ns for m in msgs), dtype=np.int64, count=len(msgs))
+    state = np.fromiter((int(m.msg.state) for m in msgs), dtype=np.uint8, count=len(msgs))
+    payload = tuple(str(m.msg.payload) for m in msgs)
+    src = str(plist[0]) if len(plist) == 1 else ";".join(map(str, plist))
+    return StateStream(machine, t, state, payload, topic, src)
+
+
+def read_benchmark_states(paths: PathsLike, namespace: str) -> BenchmarkStates:
+    """The BmBox, RefBox and Client state streams of ``namespace`` (e.g. ``fbm3w``).
+
+    A machine whose topic is in none of the files is None. The BmBox topic is looked up as
+    ``bmbox_state`` and as the seed's misspelt ``bbbox_state``.
+    """
+    plist = _paths(paths)
+    present = topics(plist)
+    ns = "/" + namespace.strip("/")
+    found: dict[Machine, StateStream | None] = {}
+    for machine, suffixes in STATE_TOPIC_SUFFIXES.items():
+        topic = next((f"{ns}/{s}" for s in suffixes if f"{ns}/{s}" in present), None)
+        found[machine] = None if topic is None else read_states(plist, topic)
+    if all(v is None for v in found.values()):
+        log.info("no state topics of %s in %s", ns, plist[0])
+    return BenchmarkStates(found[Machine.BMBOX], found[Machine.REFBOX], found[Machine.CLIENT])

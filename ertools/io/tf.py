@@ -1,0 +1,131 @@
+"""tf trees from ``/tf`` and ``/tf_static``: the pose of any frame in any other, chains composed.
+
+A chain such as origin <- world -> ref_board (mocap publishes ``world -> origin`` and
+``world -> ref_board``) gives ``origin -> ref_board`` as ``inv(T_world_origin) *
+T_world_ref_board``.
+
+Time base of a chain: the samples of the link that ends in the requested child frame (the
+requested link), so a chain has as many samples as that link has inside the others' spans.
+Every other link is interpolated at those times with :func:`ertools.geometry.interpolate_poses`
+(linear in position, SLERP in rotation), in its stored direction, and inverted afterwards when
+the chain walks it backwards. A static link (from ``/tf_static`` or with a single sample) holds
+its value at all times; a moving link contributes only inside its own time span (times before
+its first or after its last sample are dropped, never extrapolated). When the requested link
+is static the most frequent moving link of the chain gives the time base instead.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from ertools.errors import TopicError
+from ertools.streams import PoseStream
+
+
+def frame_key(name: str) -> str:
+    """Frame names as tf2 compares them (no leading slash)."""
+    return name.lstrip("/")
+
+
+@dataclass(frozen=True)
+class Edge:
+    """One parent -> child link as published, with whether it is static."""
+
+    stream: PoseStream
+    static: bool
+
+
+@dataclass(frozen=True)
+class _Step:
+    edge: Edge
+    inverted: bool
+
+
+def find_chain(edges: dict[tuple[str, str], Edge], parent: str, child: str) -> list[_Step]:
+    """The shortest chain of links from ``parent`` to ``child`` (breadth-first).
+
+    Raises:
+        TopicError: no chain connects the two frames.
+    """
+    adjacency: dict[str, list[tuple[str, _Step]]] = {}
+    for (p, c), edge in edges.items():
+        adjacency.setdefault(p, []).append((c, _Step(edge, False)))
+        adjacency.setdefault(c, []).append((p, _Step(edge, True)))
+    if parent not in adjacency or child not in adjacency:
+        missing = [f for f in (parent, child) if f not in adjacency]
+        raise TopicError(
+            f"tf frame(s) {', '.join(missing)} not in /tf or /tf_static; frames there: "
+            f"{', '.join(sorted(adjacency)) or 'none'}"
+        )
+    previous: dict[str, tuple[str, _Step] | None] = {parent: None}
+    queue = deque([parent])
+    while queue:
+        node = queue.popleft()
+        if node == child:
+            break
+        for nxt, step in adjacency[node]:
+            if nxt not in previous:
+                previous[nxt] = (node, step)
+                queue.append(nxt)
+    if child not in previous:
+        raise TopicError(f"no tf chain connects {parent} to {child}")
+    steps: list[_Step] = []
+    node = child
+    while (link := previous[node]) is not None:
+        node, step = link
+        steps.append(step)
+    return steps[::-1]
+
+
+def _time_base(steps: list[_Step]) -> int:
+    if not steps[-1].edge.static:
+        return len(steps) - 1
+    moving = [i for i, s in enumerate(steps) if not s.edge.static]
+    if not moving:
+        return len(steps) - 1
+    return max(moving, key=lambda i: len(steps[i].edge.stream))
+
+
+def compose_chain(steps: list[_Step], parent: str, child: str, source: str) -> PoseStream:
+    """The poses of ``child`` in ``parent`` along ``steps`` (see the module docstring)."""
+    from ertools.geometry import compose, interpolate_poses, invert
+
+    base = steps[_time_base(steps)].edge.stream
+    t = base.t_ns
+    keep = np.ones(len(t), dtype=bool)
+    parts = []
+    for step in steps:
+        stream = step.edge.stream
+        if len(stream) == 0:
+            return PoseStream.empty(parent, child, source)
+        if stream is base:
+            xyz, quat = stream.xyz, stream.quat_xyzw
+        else:
+            at = interpolate_poses(stream, t, "linear")
+            xyz, quat = at.xyz, at.quat_xyzw
+            if not step.edge.static and len(stream) > 1:
+                keep &= at.inside
+        if step.inverted:
+            xyz, quat = invert(xyz, quat)
+        parts.append((xyz, quat))
+    xyz, quat = parts[0]
+    for nxt_xyz, nxt_quat in parts[1:]:
+        xyz, quat = compose(xyz, quat, nxt_xyz, nxt_quat)
+    return PoseStream(t[keep], xyz[keep], quat[keep], parent, child, source)
+
+
+def chain_pose(
+    edges: dict[tuple[str, str], Edge], parent: str, child: str, source: str = ""
+) -> PoseStream:
+    """Pose stream of ``child`` in ``parent`` from tf links keyed by (parent, child)."""
+    p, c = frame_key(parent), frame_key(child)
+    if p == c:
+        raise TopicError(f"tf parent and child are the same frame {p!r}")
+    steps = find_chain(edges, p, c)
+    if len(steps) == 1 and not steps[0].inverted:
+        s = steps[0].edge.stream
+        return PoseStream(s.t_ns, s.xyz, s.quat_xyzw, p, c, source)
+    return compose_chain(steps, p, c, source)

@@ -1,0 +1,82 @@
+"""Deserializers built from the message definitions stored in each file (never a fixed store).
+
+The 2015 custom messages (``rockin_scoring/BmBoxState`` ...) decode this way with no ROS and
+no hand-written type table: their definitions travel inside the bag.
+"""
+
+from __future__ import annotations
+
+import struct
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from ertools.errors import BagError
+from ertools.io.model import Conn, long_msgtype
+
+_IDL_SEP = "=" * 80 + "\n"
+
+
+class Deserializer:
+    """Deserialize raw messages of some connections with their stored definitions."""
+
+    def __init__(self, conns: Sequence[Conn], path: Path) -> None:
+        from rosbags.typesys import (
+            Stores,
+            TypesysError,
+            get_types_from_idl,
+            get_types_from_msg,
+            get_typestore,
+        )
+
+        self.path = path
+        types: dict[str, Any] = {}
+        for conn in conns:
+            if not conn.msgdef.strip() and conn.msgtype.split("/")[-1] != "Empty":
+                raise BagError(
+                    f"topic {conn.topic}: type {conn.msgtype} has no stored message definition, "
+                    "so it cannot be decoded without ROS; re-record with definitions stored",
+                    path=path,
+                )
+            try:
+                if conn.msgdef_format == "idl":
+                    if conn.msgdef.startswith(f"{_IDL_SEP}IDL: "):
+                        for part in conn.msgdef.split(_IDL_SEP)[1:]:
+                            types.update(get_types_from_idl(part.split("\n", 1)[1]))
+                    else:
+                        types.update(get_types_from_idl(conn.msgdef))
+                else:
+                    types.update(get_types_from_msg(conn.msgdef, long_msgtype(conn.msgtype)))
+            except (TypesysError, ValueError, IndexError) as err:
+                raise BagError(
+                    f"topic {conn.topic}: stored definition of {conn.msgtype} does not parse "
+                    f"({err})",
+                    path=path,
+                ) from err
+        self.typestore = get_typestore(Stores.EMPTY)
+        try:
+            self.typestore.register(types)
+        except TypesysError as err:
+            raise BagError(f"conflicting stored message definitions ({err})", path=path) from err
+
+    def __call__(self, raw: bytes | memoryview, conn: Conn) -> Any:
+        """The message object of ``raw`` (a rosbags dataclass instance)."""
+        from rosbags.serde import SerdeError
+
+        try:
+            if conn.encoding == "ros1":
+                return self.typestore.deserialize_ros1(raw, long_msgtype(conn.msgtype))
+            return self.typestore.deserialize_cdr(raw, long_msgtype(conn.msgtype))
+        except (
+            SerdeError,
+            ValueError,
+            IndexError,
+            KeyError,
+            struct.error,
+            UnicodeDecodeError,
+        ) as err:
+            raise BagError(
+                f"topic {conn.topic}: message of type {conn.msgtype} does not decode with its "
+                f"stored definition ({type(err).__name__}: {err})",
+                path=self.path,
+            ) from err
