@@ -152,7 +152,8 @@ class Fbm2hResult:
 
     def to_yaml(self) -> str:
         """The Listing 13 score."""
-        return dump_yaml(jsonable(self._listing(string_keys=False)))
+        # Not through jsonable(): it would turn the integer segment keys into strings.
+        return dump_yaml(self._listing(string_keys=False))
 
     def to_dict(self) -> dict[str, Any]:
         """Same structure as the YAML, segment indices as string keys."""

@@ -1,0 +1,153 @@
+"""Recompute an FBM2@Home (navigation) score from the logs (seed 7.2, Listing 13).
+
+Per waypoint: the robot pose when it was reached (ground-truth marker pose interpolated at that
+moment, composed with the team's marker-to-robot transform), its distance and orientation
+error, the segment time; then position_accuracy, orientation_accuracy and execution_time.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ertools.cli.common import add_output_options, emit_result, note
+
+EPILOG = """examples:
+  ertools score fbm2h run.bag --team homer --transforms transforms/
+  ertools score fbm2h run.bag --goal configs/fbm2h.yaml --transform transform-homer.yaml
+  ertools score fbm2h log.bag --goal goal.yaml --transform configs/transform-identity.yaml \\
+      --reached timing log_reached_waypoint_timing.yaml
+  ertools score fbm2h log.bag --goal goal.yaml --reached auto --format json
+
+--reached: states (default when the bag has /fbm2h/bmbox_state): segment i starts when the
+BmBox has sent the goal and ends at the Client's COMPLETED_GOAL; timing FILE: a reached-waypoint
+timing file (p0 starts, p(k+1) closes segment k, seconds from the bag's first message); auto:
+stops detected in the ground truth, assigned to the waypoints in order.
+Orientation errors are wrapped to [0, pi]; --orientation-2015 reproduces the 2015 numbers."""
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="log file(s)")
+    parser.add_argument(
+        "--goal", type=Path, metavar="FILE", help="goal list (Listing 10); default: from the log"
+    )
+    parser.add_argument(
+        "--transform", type=Path, metavar="FILE", help="marker-to-robot transform (Listing 11)"
+    )
+    parser.add_argument("--team", metavar="NAME", help="with --transforms: DIR/transform-NAME.yaml")
+    parser.add_argument(
+        "--transforms", type=Path, metavar="DIR", help="folder of transform-<team>.yaml files"
+    )
+    parser.add_argument(
+        "--topic",
+        metavar="TOPIC",
+        help="marker set pose topic, PoseStamped or Pose2D (default /fbm2h/robot_at_home/pose)",
+    )
+    parser.add_argument(
+        "--tf-frame", metavar="FRAME", help="take the marker set from /tf world -> FRAME instead"
+    )
+    parser.add_argument(
+        "--time-source",
+        choices=("header", "record"),
+        default="header",
+        help="pose time: header stamp (mocap time, default) or bag record time",
+    )
+    parser.add_argument(
+        "--reached",
+        nargs="+",
+        metavar="MODE",
+        help="states | timing FILE | auto (default: states when the log has them)",
+    )
+    parser.add_argument(
+        "--max-gap",
+        type=float,
+        default=0.1,
+        metavar="S",
+        help="a reached moment needs a GT sample within S seconds (default 0.1)",
+    )
+    parser.add_argument("--hits", type=int, metavar="N", help="the referee's count of hits")
+    parser.add_argument(
+        "--orientation-2015",
+        action="store_true",
+        help="orientation errors as 2015 computed them (unwrapped |dtheta|; wrong across +-pi)",
+    )
+    parser.add_argument(
+        "--namespace", default="fbm2h", help="benchmark namespace of the state topics"
+    )
+    auto = parser.add_argument_group("--reached auto (stop detection)")
+    auto.add_argument("--stop-speed", type=float, default=0.02, metavar="M_S")
+    auto.add_argument("--stop-yaw-rate", type=float, default=0.05, metavar="RAD_S")
+    auto.add_argument("--stop-min-duration", type=float, default=1.0, metavar="S")
+    auto.add_argument(
+        "--stop-radius",
+        type=float,
+        default=0.5,
+        metavar="M",
+        help="a stop counts for a waypoint only this close to it (default 0.5 m)",
+    )
+    add_output_options(parser)
+
+
+def _reached(values: list[str] | None) -> tuple[str | None, Path | None]:
+    from ertools.errors import UsageError
+
+    if not values:
+        return None, None
+    mode, rest = values[0], values[1:]
+    if mode == "timing":
+        if len(rest) != 1:
+            raise UsageError("--reached timing needs exactly one FILE")
+        return mode, Path(rest[0])
+    if mode in ("states", "auto") and not rest:
+        return mode, None
+    raise UsageError(f"--reached: expected states, timing FILE or auto, got {' '.join(values)}")
+
+
+def run(args: argparse.Namespace) -> int:
+    from ertools.benchmarks.fbm2h import Fbm2hOptions, score_fbm2h
+    from ertools.benchmarks.fbm2h_segments import StopParams
+
+    mode, timing = _reached(args.reached)
+    options = Fbm2hOptions(
+        goal=args.goal,
+        transform=args.transform,
+        team=args.team,
+        transforms_dir=args.transforms,
+        topic=args.topic,
+        tf_frame=args.tf_frame,
+        time_source=args.time_source,
+        reached=mode,
+        timing=timing,
+        max_gap_s=args.max_gap,
+        hits=args.hits,
+        orientation_2015=args.orientation_2015,
+        namespace=args.namespace,
+        stops=StopParams(
+            speed=args.stop_speed,
+            yaw_rate=args.stop_yaw_rate,
+            min_duration_s=args.stop_min_duration,
+            radius=args.stop_radius,
+        ),
+    )
+    result = score_fbm2h(args.bags, options)
+    if args.verbose:
+        for line in result.notes:
+            note(line)
+    _print_table(result)
+    return emit_result(result, args, list(args.bags))
+
+
+def _print_table(result: object) -> None:
+    from ertools.benchmarks.fbm2h_result import Fbm2hResult
+
+    assert isinstance(result, Fbm2hResult)
+    note(f"reached moments: {result.reached_method}; transform: {result.transform.source}")
+    for row in result.tables()["segments"]:
+        if row["status"] != "ok":
+            note(f"  segment {row['segment']}: {row['status']}")
+            continue
+        note(
+            f"  segment {row['segment']}: reached {row['reached_s']:.3f} s, "
+            f"time {row['segment_time_s']:.3f} s, distance {row['distance_error_m']:.4f} m, "
+            f"orientation {row['orientation_error_rad']:.4f} rad"
+        )
