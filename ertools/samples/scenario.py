@@ -103,6 +103,17 @@ def load_scenario(name: str) -> Generate:
     return generate
 
 
+def log_name(kind: str, start_ns: int, *, index: int = 0, suffix: str = ".bag") -> str:
+    """The 2015 logger's file name: ``log_<kind>_<YYYY-mm-dd-HH-MM-SS>_<index><suffix>`` (UTC).
+
+    E.g. ``log_name("fbm3w_mocap", EPOCH_2015)`` -> ``log_fbm3w_mocap_2015-11-20-10-00-00_0.bag``.
+    """
+    import datetime as dt
+
+    stamp = dt.datetime.fromtimestamp(start_ns // 1_000_000_000, tz=dt.UTC)
+    return f"log_{kind}_{stamp:%Y-%m-%d-%H-%M-%S}_{index}{suffix}"
+
+
 def answers_path(log: Path) -> Path:
     """``x.bag`` / ``x.mcap`` / rosbag2 dir ``x`` -> ``x.answers.yaml`` in the same folder."""
     name = log.name
