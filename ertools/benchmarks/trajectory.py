@@ -1,0 +1,707 @@
+"""Robot log vs mocap ground truth: the 2015 offline trajectory benchmark, with a clock audit.
+
+The 2015 ``rockin_offline_trajectory_benchmark`` compared every pose a robot logged for its own
+marker set (``/rockin/<team>/marker_pose``) with the mocap pose of that marker set: for each
+robot pose it took the GT pose pair (p1, p2) with p1.t <= t <= p2.t, skipped the robot pose when
+p1 and p2 had the same position (Motive repeats the last pose when tracking is lost), compared
+with p1 ("hold") and reported the mean 3D distance and atan2(sum sin|dyaw|, sum cos|dyaw|).
+
+Shape: load (robot stream, GT files selected by time overlap, read as one stream) -> associate
+(hold | nearest | linear, max-gap, tracking lost, coverage) -> metrics -> frozen
+:class:`TrajectoryResult`. The clock audit (:mod:`ertools.benchmarks.clock_offset`) runs every
+time. :func:`score_streams` is pure; :func:`score` is the IO edge.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from itertools import pairwise
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.clock_offset import OffsetEstimate, estimate_offset
+from ertools.errors import ClockError, ScoringError, TopicError
+from ertools.geometry import Association, interpolate_poses, wrap_angle, yaw_from_quat
+from ertools.streams import PoseStream, Provenance
+from ertools.timeutil import NS_PER_S, iso_utc, ns_to_s
+
+if TYPE_CHECKING:
+    from ertools.io import BagSummary
+
+log = logging.getLogger("ertools.benchmarks.trajectory")
+
+F64 = npt.NDArray[np.float64]
+I64 = npt.NDArray[np.int64]
+U8 = npt.NDArray[np.uint8]
+
+ASSOCIATIONS: tuple[Association, ...] = ("linear", "nearest", "hold")
+PERCENTILES = (50.0, 90.0, 95.0, 99.0)
+
+# Per-pose status codes of the association.
+COMPARED, GAP, TRACKING_LOST, UNCOVERED = 0, 1, 2, 3
+STATUS_NAMES = ("compared", "gap", "tracking_lost", "uncovered")
+
+
+@dataclass(frozen=True)
+class TrajectoryConfig:
+    """How to compare.
+
+    Attributes:
+        association: ``linear`` (default), ``nearest`` or ``hold`` (2015).
+        max_gap_ns: robot poses whose surrounding GT poses are further apart are not compared.
+        offset_ns: added to the robot stamps before comparing (``--offset S``).
+        auto_offset: ``--offset auto``: estimate the offset (always done for the audit).
+        apply_offset: with ``auto_offset``, score with the estimate.
+        offset_range_ns: the audit searches offsets within +- this.
+        allow_partial: score the covered part when robot poses lie outside the GT.
+    """
+
+    association: Association = "linear"
+    max_gap_ns: int = NS_PER_S // 10
+    offset_ns: int = 0
+    auto_offset: bool = False
+    apply_offset: bool = False
+    offset_range_ns: int = 5 * NS_PER_S
+    allow_partial: bool = False
+
+    def __post_init__(self) -> None:
+        from ertools.errors import ConfigError
+
+        if self.association not in ASSOCIATIONS:
+            raise ConfigError(
+                f"association {self.association!r} unknown; choose from {', '.join(ASSOCIATIONS)}"
+            )
+        if self.max_gap_ns <= 0:
+            raise ConfigError(f"--max-gap must be positive, not {self.max_gap_ns / NS_PER_S} s")
+        if self.offset_range_ns <= 0:
+            raise ConfigError("--offset-range must be positive")
+
+
+@dataclass(frozen=True, eq=False)
+class Matched:
+    """Robot poses and their GT counterparts.
+
+    Attributes:
+        t_ns: (N,) robot times on the GT clock (stamps + offset).
+        status: (N,) COMPARED, GAP, TRACKING_LOST or UNCOVERED.
+        gt_xyz, gt_yaw: GT at each robot time (NaN unless compared).
+        position_error: (N,) 3D distance, metres (NaN unless compared).
+        yaw_error: (N,) |wrap(yaw_robot - yaw_gt)|, radians (NaN unless compared).
+        yaw_diff_raw: (N,) yaw_robot - yaw_gt unwrapped, as 2015 used it (NaN unless compared).
+        exact_ties: robot poses stamped exactly at a GT sample.
+    """
+
+    t_ns: I64
+    status: U8
+    gt_xyz: F64
+    gt_yaw: F64
+    position_error: F64
+    yaw_error: F64
+    yaw_diff_raw: F64
+    exact_ties: int
+
+    def count(self, status: int) -> int:
+        return int(np.count_nonzero(self.status == status))
+
+
+def associate(robot: PoseStream, gt: PoseStream, method: Association, max_gap_ns: int) -> Matched:
+    """Pair every robot pose with the GT pose at its time.
+
+    Rules, in this order: a robot pose before the first or after the last GT pose is
+    UNCOVERED; one whose surrounding GT poses (the last at or before and the first at or after
+    it) are more than ``max_gap_ns`` apart is a GAP; one whose GT pair (the first GT pose at or
+    after it and the one before that, the 2015 pair) has the same position is TRACKING_LOST;
+    every other pose is COMPARED against the GT pose given by ``method``.
+    """
+    if len(gt) == 0:
+        raise ScoringError("the GT stream is empty")
+    n_gt = len(gt)
+    q = robot.t_ns
+    interp = interpolate_poses(gt, q, method)
+    status = np.full(len(q), COMPARED, dtype=np.uint8)
+    status[~interp.inside] = UNCOVERED
+    gap = interp.inside & (interp.gap_ns > max_gap_ns)
+    status[gap] = GAP
+    second = interp.hi  # first GT sample at or after the robot time
+    first = second - 1
+    has_pair = (first >= 0) & (second < n_gt)
+    fi, si = np.clip(first, 0, n_gt - 1), np.clip(second, 0, n_gt - 1)
+    same = has_pair & np.all(gt.xyz[fi] == gt.xyz[si], axis=1)
+    status[(status == COMPARED) & same] = TRACKING_LOST
+    ok = status == COMPARED
+
+    nan3 = np.full((len(q), 3), np.nan)
+    gt_xyz = np.where(ok[:, None], interp.xyz, nan3)
+    gt_yaw = np.where(ok, yaw_from_quat(interp.quat_xyzw), np.nan)
+    robot_yaw = yaw_from_quat(robot.quat_xyzw)
+    pos_err = np.where(ok, np.linalg.norm(robot.xyz - interp.xyz, axis=1), np.nan)
+    raw = np.where(ok, robot_yaw - gt_yaw, np.nan)
+    yaw_err = np.abs(wrap_angle(raw))
+    ties = int(np.count_nonzero(interp.inside & (interp.lo == interp.hi)))
+    return Matched(q, status, gt_xyz, gt_yaw, pos_err, yaw_err, raw, ties)
+
+
+@dataclass(frozen=True)
+class Metrics:
+    """Errors over the compared poses.
+
+    Attributes:
+        position_error: mean 3D distance (the 2015 score), metres.
+        orientation_error: atan2(sum sin|dyaw|, sum cos|dyaw|) with dyaw wrapped (2015 form).
+        rmse, median, max: of the 3D distances, metres.
+        percentiles: (percent, value) of the 3D distances.
+        orientation_error_2015: the same with dyaw not wrapped, as the 2015 script computed it.
+    """
+
+    position_error: float
+    orientation_error: float
+    rmse: float
+    median: float
+    max: float
+    percentiles: tuple[tuple[float, float], ...]
+    orientation_error_2015: float
+
+
+def metrics(m: Matched) -> Metrics | None:
+    """The error statistics of the compared poses, None when none was compared."""
+    ok = m.status == COMPARED
+    if not ok.any():
+        return None
+    d = m.position_error[ok]
+    dyaw = m.yaw_error[ok]
+    raw = np.abs(m.yaw_diff_raw[ok])
+    pct = np.percentile(d, PERCENTILES)
+    return Metrics(
+        position_error=float(d.mean()),
+        orientation_error=float(np.arctan2(np.sin(dyaw).sum(), np.cos(dyaw).sum())),
+        rmse=float(np.sqrt(np.mean(d * d))),
+        median=float(np.median(d)),
+        max=float(d.max()),
+        percentiles=tuple((p, float(v)) for p, v in zip(PERCENTILES, pct, strict=True)),
+        orientation_error_2015=float(np.arctan2(np.sin(raw).sum(), np.cos(raw).sum())),
+    )
+
+
+def _spans(t_ns: I64, mask: npt.NDArray[np.bool_]) -> list[tuple[int, int]]:
+    """(first, last) times of each run of consecutive True in ``mask``."""
+    idx = np.flatnonzero(mask)
+    if idx.size == 0:
+        return []
+    breaks = np.flatnonzero(np.diff(idx) > 1)
+    starts = np.concatenate([[idx[0]], idx[breaks + 1]])
+    ends = np.concatenate([idx[breaks], [idx[-1]]])
+    return [(int(t_ns[a]), int(t_ns[b])) for a, b in zip(starts, ends, strict=True)]
+
+
+@dataclass(frozen=True, eq=False)
+class TrajectoryResult:
+    """A scored robot log (implements ``BenchmarkResult``).
+
+    Attributes:
+        robot_file, robot_topic, gt_topic: what was compared.
+        gt_files: the GT files used, by start time.
+        config: the comparison settings.
+        offset_ns: the offset applied to the robot stamps.
+        metrics: None when no pose could be compared.
+        matched: the per-pose association (the error series of the figures).
+        robot: the robot stream (stamps on the robot clock).
+        gt_path: the GT positions, decimated to at most a few thousand points, for figures.
+        audit: the clock-offset estimate.
+        uncovered_spans: robot-time spans outside the GT, (start_ns, end_ns) on the GT clock.
+    """
+
+    robot_file: str
+    robot_topic: str
+    gt_topic: str
+    gt_files: tuple[str, ...]
+    config: TrajectoryConfig
+    offset_ns: int
+    metrics: Metrics | None
+    matched: Matched
+    robot: PoseStream
+    gt_path: PoseStream
+    audit: OffsetEstimate
+    uncovered_spans: tuple[tuple[int, int], ...] = ()
+    warnings: tuple[str, ...] = ()
+    deviations: tuple[str, ...] = ()
+    failures: tuple[str, ...] = ()
+    provenance: Provenance = field(default_factory=Provenance)
+    name: str = "trajectory"
+
+    @property
+    def compared(self) -> int:
+        return self.matched.count(COMPARED)
+
+    @property
+    def gaps(self) -> int:
+        return self.matched.count(GAP)
+
+    @property
+    def tracking_lost(self) -> int:
+        return self.matched.count(TRACKING_LOST)
+
+    @property
+    def uncovered(self) -> int:
+        return self.matched.count(UNCOVERED)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Scores, counts and the clock audit (the keys scripts depend on come first)."""
+        m = self.metrics
+        a = self.audit
+        data: dict[str, Any] = {
+            "position_error": None if m is None else m.position_error,
+            "orientation_error": None if m is None else m.orientation_error,
+            "rmse": None if m is None else m.rmse,
+            "median": None if m is None else m.median,
+            "max": None if m is None else m.max,
+            "compared": self.compared,
+            "gaps": self.gaps,
+            "tracking_lost": self.tracking_lost,
+            "gt_files": list(self.gt_files),
+            "association": self.config.association,
+            "offset": ns_to_s(self.offset_ns),
+            "percentiles": None if m is None else {f"p{p:g}": v for p, v in m.percentiles},
+            "orientation_error_2015": None if m is None else m.orientation_error_2015,
+            "uncovered": self.uncovered,
+            "robot_poses": len(self.matched.t_ns),
+            "partial": self.uncovered > 0,
+            "uncovered_spans": [[ns_to_s(s), ns_to_s(e)] for s, e in self.uncovered_spans],
+            "max_gap": ns_to_s(self.config.max_gap_ns),
+            "robot_file": self.robot_file,
+            "robot_topic": self.robot_topic,
+            "gt_topic": self.gt_topic,
+            "clock_audit": {
+                "estimated_offset": a.offset_s,
+                "uncertainty": a.uncertainty_s,
+                "applied": self.config.auto_offset and self.config.apply_offset,
+                "residual": None if a.offset_ns is None else ns_to_s(a.offset_ns - self.offset_ns),
+                "search_range": ns_to_s(a.search_range_ns),
+                "poses_used": a.poses_used,
+                "mean_error_at_estimate": a.mean_error,
+                "mean_error_at_zero": a.mean_error_at_zero,
+                "method": a.method,
+                "note": a.note,
+            },
+            "warnings": list(self.warnings),
+            "deviations": list(self.deviations),
+        }
+        out: dict[str, Any] = jsonable(data)
+        return out
+
+    def to_yaml(self) -> str:
+        """The same as :meth:`to_dict` as YAML (the 2015 script printed two text lines)."""
+        return dump_yaml(self.to_dict())
+
+    def tables(self) -> dict[str, Rows]:
+        """``samples`` (one row per robot pose: the error series) and ``summary``."""
+        mt = self.matched
+        t0 = int(mt.t_ns[0]) if len(mt.t_ns) else 0
+        ryaw = self.robot.yaw
+        rows: Rows = [
+            {
+                "t": ns_to_s(int(t)),
+                "t_rel_s": (int(t) - t0) / NS_PER_S,
+                "status": STATUS_NAMES[int(s)],
+                "robot_x": float(r[0]),
+                "robot_y": float(r[1]),
+                "robot_z": float(r[2]),
+                "robot_yaw": float(ry),
+                "gt_x": _f(g[0]),
+                "gt_y": _f(g[1]),
+                "gt_z": _f(g[2]),
+                "gt_yaw": _f(gy),
+                "position_error": _f(e),
+                "yaw_error": _f(ye),
+            }
+            for t, s, r, ry, g, gy, e, ye in zip(
+                mt.t_ns.tolist(),
+                mt.status.tolist(),
+                self.robot.xyz,
+                ryaw.tolist(),
+                mt.gt_xyz,
+                mt.gt_yaw.tolist(),
+                mt.position_error.tolist(),
+                mt.yaw_error.tolist(),
+                strict=True,
+            )
+        ]
+        d = self.to_dict()
+        summary = {
+            k: d[k]
+            for k in (
+                "position_error",
+                "orientation_error",
+                "rmse",
+                "median",
+                "max",
+                "compared",
+                "gaps",
+                "tracking_lost",
+                "uncovered",
+                "association",
+                "offset",
+            )
+        }
+        summary["estimated_offset"] = d["clock_audit"]["estimated_offset"]
+        summary["offset_uncertainty"] = d["clock_audit"]["uncertainty"]
+        return {"samples": rows, "summary": [summary]}
+
+
+def _f(x: float) -> float | None:
+    return None if np.isnan(x) else float(x)
+
+
+# --- pure scoring ----------------------------------------------------------------------------
+
+
+def check_increasing(robot: PoseStream, where: str) -> None:
+    """Raise when the robot stamps (in recording order) do not strictly increase."""
+    if len(robot) < 2:
+        return
+    bad = np.flatnonzero(robot.t_ns[1:] <= robot.t_ns[:-1])
+    if bad.size:
+        i = int(bad[0]) + 1
+        raise ScoringError(
+            f"{where}: robot stamps do not increase: message {i} is stamped "
+            f"{iso_utc(int(robot.t_ns[i]))}, not after message {i - 1} at "
+            f"{iso_utc(int(robot.t_ns[i - 1]))} ({bad.size} such place(s)); "
+            "fix the robot's clock or use --robot-time record"
+        )
+
+
+def _decimate(stream: PoseStream, limit: int = 5000) -> PoseStream:
+    step = max(1, len(stream) // limit)
+    return stream.take(slice(None, None, step))
+
+
+def score_streams(
+    robot: PoseStream,
+    gt: PoseStream,
+    config: TrajectoryConfig,
+    *,
+    robot_file: str = "",
+    robot_topic: str = "",
+    gt_topic: str = "",
+    gt_files: Sequence[str] = (),
+    warnings: Sequence[str] = (),
+) -> TrajectoryResult:
+    """Compare a robot stream (stamps on the robot clock, recording order) with GT.
+
+    Raises:
+        ScoringError: robot stamps not strictly increasing, or empty streams.
+        ClockError: robot poses outside the GT without ``allow_partial``, or no overlap at all.
+    """
+    where = f"{robot_file}:{robot_topic}" if robot_file else "robot log"
+    if len(robot) == 0:
+        raise ScoringError(f"{where}: no robot poses")
+    if len(gt) < 2:
+        raise ScoringError(f"GT {gt_topic}: {len(gt)} pose(s) in the robot log's span")
+    check_increasing(robot, where)
+    audit = estimate_offset(
+        robot, gt, search_range_ns=config.offset_range_ns, max_gap_ns=config.max_gap_ns
+    )
+    offset_ns = config.offset_ns
+    notes = list(warnings)
+    if config.auto_offset and config.apply_offset:
+        if audit.offset_ns is None:
+            raise ClockError(f"{where}: cannot apply the estimated clock offset: {audit.note}")
+        offset_ns = audit.offset_ns
+    shifted = PoseStream(
+        robot.t_ns + offset_ns,
+        robot.xyz,
+        robot.quat_xyzw,
+        robot.frame_id,
+        robot.child_frame_id,
+        robot.source,
+    )
+    matched = associate(shifted, gt, config.association, config.max_gap_ns)
+    outside = matched.status == UNCOVERED
+    spans = _spans(matched.t_ns, outside)
+    n_out = int(outside.sum())
+    if n_out == len(matched.t_ns):
+        raise ClockError(
+            f"{where}: no robot pose lies within the GT ({iso_utc(gt.start_ns)} to "
+            f"{iso_utc(gt.end_ns)}); robot poses span {iso_utc(int(shifted.t_ns[0]))} to "
+            f"{iso_utc(int(shifted.t_ns[-1]))} (offset {ns_to_s(offset_ns):+.3f} s)"
+        )
+    if n_out:
+        text = ", ".join(
+            f"{iso_utc(a)} to {iso_utc(b)} ({ns_to_s(b - a):.1f} s)" for a, b in spans[:3]
+        )
+        more = f" and {len(spans) - 3} more" if len(spans) > 3 else ""
+        msg = f"{n_out} of {len(matched.t_ns)} robot poses lie outside the GT: {text}{more}"
+        if not config.allow_partial:
+            raise ClockError(f"{where}: {msg}; give the missing GT files or --allow-partial")
+        notes.append(f"partial: {msg}; only the covered part is scored")
+
+    m = metrics(matched)
+    failures: list[str] = []
+    if m is None:
+        failures.append(
+            f"no robot pose could be compared ({matched.count(GAP)} in GT gaps, "
+            f"{matched.count(TRACKING_LOST)} while tracking was lost)"
+        )
+    if matched.count(GAP):
+        notes.append(
+            f"{matched.count(GAP)} robot pose(s) fall in GT gaps longer than "
+            f"{ns_to_s(config.max_gap_ns):g} s and are not compared"
+        )
+    if matched.count(TRACKING_LOST):
+        notes.append(
+            f"{matched.count(TRACKING_LOST)} robot pose(s) fall where mocap tracking was lost "
+            "(repeated GT poses) and are not compared"
+        )
+    notes.extend(_audit_warnings(audit, offset_ns))
+    result = TrajectoryResult(
+        robot_file=robot_file,
+        robot_topic=robot_topic,
+        gt_topic=gt_topic,
+        gt_files=tuple(gt_files),
+        config=config,
+        offset_ns=offset_ns,
+        metrics=m,
+        matched=matched,
+        robot=robot,
+        gt_path=_decimate(gt),
+        audit=audit,
+        uncovered_spans=tuple(spans),
+        warnings=tuple(notes),
+        deviations=tuple(_deviations(config, matched, m)),
+        failures=tuple(failures),
+        provenance=Provenance(
+            inputs=(robot_file, *gt_files),
+            parameters=(
+                ("robot_topic", robot_topic),
+                ("gt_topic", gt_topic),
+                ("association", config.association),
+                ("max_gap", f"{ns_to_s(config.max_gap_ns):g}"),
+                ("offset", f"{ns_to_s(offset_ns):g}"),
+            ),
+        ),
+    )
+    return result
+
+
+def _audit_warnings(audit: OffsetEstimate, applied_ns: int) -> list[str]:
+    if audit.offset_ns is None:
+        return [f"clock audit: no offset estimate ({audit.note})"]
+    out = []
+    residual = audit.offset_ns - applied_ns
+    sigma = audit.uncertainty_ns or 0
+    # Worth a warning when the residual is both significant (3 sigma) and large enough to
+    # matter for the score (10 ms: 5 mm at a typical 0.5 m/s).
+    if abs(residual) > max(3 * sigma, 10_000_000):
+        out.append(
+            f"clock audit: the robot stamps fit the GT best shifted by "
+            f"{ns_to_s(audit.offset_ns):+.3f} +- {ns_to_s(sigma):.3f} s, but the score uses "
+            f"{ns_to_s(applied_ns):+.3f} s; check the clocks, or re-run with "
+            "--offset auto --apply-offset"
+        )
+    if audit.note:
+        out.append(f"clock audit: {audit.note}")
+    return out
+
+
+def _deviations(config: TrajectoryConfig, m: Matched, metr: Metrics | None) -> list[str]:
+    out = []
+    if config.association != "hold":
+        out.append(
+            f"association {config.association} (2015: hold, the GT pose before the robot pose); "
+            "--association hold reproduces 2015"
+        )
+    elif m.exact_ties:
+        out.append(
+            f"{m.exact_ties} robot pose(s) stamped exactly at a GT sample use that sample "
+            "(2015 used the one before it)"
+        )
+    if m.count(GAP):
+        out.append(
+            f"{m.count(GAP)} robot pose(s) in GT gaps > {ns_to_s(config.max_gap_ns):g} s not "
+            "compared (2015 compared them and only warned)"
+        )
+    wrapped = int(np.count_nonzero(np.abs(m.yaw_diff_raw[m.status == COMPARED]) > np.pi))
+    if wrapped and metr is not None:
+        out.append(
+            f"yaw differences wrapped to [-pi, pi] ({wrapped} pose(s) crossed +-pi; 2015 did "
+            f"not wrap: its orientation error would be {metr.orientation_error_2015:.4f} rad)"
+        )
+    return out
+
+
+# --- the IO edge -------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Inputs:
+    """Selected inputs: the robot stream in recording order and the GT files to read."""
+
+    robot: PoseStream
+    robot_file: str
+    robot_topic: str
+    gt_files: tuple[str, ...]
+    gt_topic: str
+    warnings: tuple[str, ...]
+
+
+def _pose_topics(s: BagSummary) -> list[str]:
+    from ertools.io.model import POSE_TYPES
+
+    return [
+        t.name for t in s.topics if t.msgtype in POSE_TYPES and t.name not in ("/tf", "/tf_static")
+    ]
+
+
+def _pick_robot_topic(s: BagSummary, topic: str | None) -> str:
+    if topic is not None:
+        if s.topic(topic) is None:
+            raise TopicError(
+                f"robot topic {topic} not in {s.path}; pose topics there: "
+                f"{', '.join(_pose_topics(s)) or 'none'}"
+            )
+        return topic
+    cands = [
+        t.name
+        for t in s.topics
+        if t.name.startswith("/rockin/") and t.name.endswith("/marker_pose")
+    ]
+    if len(cands) == 1:
+        return cands[0]
+    raise TopicError(
+        f"{s.path}: give --robot-topic (found {len(cands)} /rockin/*/marker_pose topics; "
+        f"pose topics there: {', '.join(_pose_topics(s)) or 'none'})"
+    )
+
+
+def read_robot(path: str, topic: str, time_source: str) -> PoseStream:
+    """The robot's poses in recording order (not sorted: non-increasing stamps are errors)."""
+    from ertools.io.files import open_bag
+    from ertools.io.reader import load_pose_batch
+
+    with open_bag(path) as bag:
+        conns = bag.topic_conns(topic)
+        types = {c.msgtype for c in conns}
+        if types != {"geometry_msgs/PoseStamped"} and time_source == "header":
+            raise TopicError(
+                f"robot topic {topic} has type {', '.join(sorted(types))}; "
+                "a geometry_msgs/PoseStamped topic is needed (or --robot-time record)",
+                path=path,
+            )
+        batch = load_pose_batch(bag, conns, None, None)
+    t = batch.t_header if time_source == "header" else batch.t_record
+    return PoseStream(t, batch.xyz, batch.quat_xyzw, source=f"{path}:{topic}")
+
+
+def select_gt(
+    summaries: Sequence[BagSummary],
+    start_ns: int,
+    end_ns: int,
+    gt_topic: str | None,
+) -> tuple[list[BagSummary], str, list[str]]:
+    """GT files overlapping [start, end] that hold the GT topic, by start time.
+
+    Returns the files, the topic (guessed when None and unambiguous) and warnings.
+    """
+    overlapping = sorted(
+        (s for s in summaries if s.message_count and s.start_ns <= end_ns and s.end_ns >= start_ns),
+        key=lambda s: (s.start_ns, s.path),
+    )
+    if not overlapping:
+        spans = "; ".join(
+            f"{Path(s.path).name} {iso_utc(s.start_ns)} to {iso_utc(s.end_ns)}"
+            for s in sorted(summaries, key=lambda s: s.start_ns)[:4]
+        )
+        raise ClockError(
+            f"no GT file overlaps the robot log ({iso_utc(start_ns)} to {iso_utc(end_ns)}); "
+            f"GT files: {spans or 'none'}{' ...' if len(summaries) > 4 else ''}"
+        )
+    if gt_topic is None:
+        cands = sorted(
+            {
+                t.name
+                for s in overlapping
+                for t in s.topics
+                if t.msgtype == "geometry_msgs/PoseStamped" and not t.name.startswith("/rockin/")
+            }
+        )
+        if len(cands) != 1:
+            raise TopicError(
+                f"give --gt-topic: the overlapping GT files hold {len(cands)} PoseStamped "
+                f"topics ({', '.join(cands) or 'none'})"
+            )
+        gt_topic = cands[0]
+    with_topic = [s for s in overlapping if s.topic(gt_topic) is not None]
+    if not with_topic:
+        topics = sorted({n for s in overlapping for n in _pose_topics(s)})
+        raise TopicError(
+            f"GT topic {gt_topic} is in none of the {len(overlapping)} GT file(s) overlapping "
+            f"the robot log ({Path(overlapping[0].path).name}...); pose topics there: "
+            f"{', '.join(topics) or 'none'}"
+        )
+    warnings = []
+    for a, b in pairwise(with_topic):
+        if b.start_ns < a.end_ns:
+            warnings.append(
+                f"GT files {Path(a.path).name} and {Path(b.path).name} overlap in time "
+                f"({ns_to_s(a.end_ns - b.start_ns):.1f} s); their poses are merged in time order"
+            )
+    return with_topic, gt_topic, warnings
+
+
+def score(
+    robot_bag: str | Path,
+    gt_paths: Sequence[str | Path],
+    config: TrajectoryConfig | None = None,
+    *,
+    robot_topic: str | None = None,
+    gt_topic: str | None = None,
+    robot_time: str = "header",
+) -> TrajectoryResult:
+    """Score a robot log against the GT files (or folders of them) that cover it.
+
+    Raises:
+        BagError, TopicError: unreadable files, missing topics.
+        ClockError: no GT overlapping the robot log, poses outside the GT.
+        ScoringError: non-increasing robot stamps.
+    """
+    from ertools.io import read_poses, summary
+    from ertools.timeline_scan import find_bags
+
+    cfg = config or TrajectoryConfig()
+    robot_path = str(robot_bag)
+    rs = summary(robot_path)
+    topic = _pick_robot_topic(rs, robot_topic)
+    robot = read_robot(robot_path, topic, robot_time)
+    if len(robot) == 0:
+        raise ScoringError(f"{robot_path}: robot topic {topic} has no messages")
+    # The robot's span on the GT clock, widened by the clock audit's search range.
+    lo = int(robot.t_ns.min()) + cfg.offset_ns
+    hi = int(robot.t_ns.max()) + cfg.offset_ns
+    margin = max(cfg.offset_range_ns, NS_PER_S)
+    found = find_bags([Path(p) for p in gt_paths])
+    if not found.bags:
+        raise ClockError(
+            f"no GT bags found in {', '.join(map(str, gt_paths))}"
+            + (f" ({found.problems[0].problem})" if found.problems else "")
+        )
+    gt_summaries = [
+        summary(p) for p in found.bags if Path(p).resolve() != Path(robot_path).resolve()
+    ]
+    chosen, gtopic, warnings = select_gt(gt_summaries, lo - margin, hi + margin, gt_topic)
+    files = [s.path for s in chosen]
+    gt = read_poses(files, gtopic, start_ns=lo - margin, end_ns=hi + margin)
+    return score_streams(
+        robot,
+        gt,
+        cfg,
+        robot_file=robot_path,
+        robot_topic=topic,
+        gt_topic=gtopic,
+        gt_files=files,
+        warnings=warnings,
+    )

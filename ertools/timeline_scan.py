@@ -1,0 +1,202 @@
+"""The IO edge of the timeline: find bags, summarise them, check their clocks.
+
+Everything read here goes through :mod:`ertools.io`: summaries come from each file's index
+(never its message data), and the clock check decodes only the first second of one pose topic
+per bag with a windowed read. :func:`scan` returns the pure :class:`~ertools.timeline.Timeline`.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import sys
+import time
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, TextIO
+
+from ertools.timeline import ClockCheck, Timeline, TimelineConfig, Unreadable, build_timeline
+from ertools.timeutil import NS_PER_S
+
+if TYPE_CHECKING:
+    from ertools.io import BagSummary
+
+log = logging.getLogger("ertools.timeline_scan")
+
+BAG_SUFFIXES = (".bag", ".bag.active", ".mcap")
+# Types whose header stamp the clock check compares with the record time, best first: the
+# mocap node's own poses, then tf (whose static transforms may be stamped in the future).
+CLOCK_TYPES = (
+    "geometry_msgs/PoseStamped",
+    "geometry_msgs/TransformStamped",
+    "nav_msgs/Odometry",
+    "tf2_msgs/TFMessage",
+    "tf/tfMessage",
+)
+CLOCK_WINDOW_NS = NS_PER_S  # the first second of the topic: ~120 mocap messages
+CLOCK_MAX_SAMPLES = 50
+
+
+@dataclass(frozen=True)
+class Found:
+    """Bags found under the given paths (sorted), and paths that gave none."""
+
+    bags: tuple[Path, ...]
+    problems: tuple[Unreadable, ...]
+
+
+def _is_rosbag2_dir(path: Path) -> bool:
+    return (path / "metadata.yaml").is_file() or any(path.glob("*.db3"))
+
+
+def _is_bag_file(name: str) -> bool:
+    return name.endswith(BAG_SUFFIXES)
+
+
+def find_bags(paths: Iterable[Path]) -> Found:
+    """Bags under ``paths``: ``.bag``, ``.bag.active``, ``.mcap`` files and rosbag2 folders.
+
+    A file named explicitly is taken whatever its name (the reader then says whether it is a
+    bag); directories are walked recursively, and a rosbag2 folder counts as one bag.
+    """
+    bags: list[Path] = []
+    problems: list[Unreadable] = []
+    for root in paths:
+        if not root.exists():
+            problems.append(Unreadable(str(root), "no such file or directory"))
+            continue
+        if root.is_file() or _is_rosbag2_dir(root):
+            bags.append(root)
+            continue
+        before = len(bags)
+        for dirpath, dirnames, filenames in os.walk(root):
+            here = Path(dirpath)
+            keep = []
+            for d in sorted(dirnames):
+                if _is_rosbag2_dir(here / d):
+                    bags.append(here / d)
+                else:
+                    keep.append(d)
+            dirnames[:] = keep  # do not descend into rosbag2 folders
+            bags.extend(here / f for f in sorted(filenames) if _is_bag_file(f))
+        if len(bags) == before:
+            problems.append(
+                Unreadable(str(root), "no bags here (.bag, .bag.active, .mcap or rosbag2)")
+            )
+    unique = sorted(dict.fromkeys(bags), key=str)
+    return Found(tuple(unique), tuple(problems))
+
+
+def clock_check(s: BagSummary, window_ns: int = CLOCK_WINDOW_NS) -> ClockCheck | None:
+    """Median record time minus header stamp over the first messages of one pose topic.
+
+    None when the bag has no header-stamped pose topic or could not be read (the summary has
+    already said what is wrong with it then).
+    """
+    from ertools.io.files import open_bag
+    from ertools.io.reader import load_pose_batch
+
+    rank = {t: i for i, t in enumerate(CLOCK_TYPES)}
+    cands = sorted(
+        (t for t in s.topics if t.msgtype in rank and t.count and t.first_ns is not None),
+        key=lambda t: (rank[t.msgtype], t.name == "/tf_static", t.name),
+    )
+    cands = [t for t in cands if t.name != "/tf_static"]
+    if not cands:
+        return None
+    topic = cands[0]
+    assert topic.first_ns is not None
+    try:
+        with open_bag(s.path) as bag:
+            conns = bag.topic_conns(topic.name)
+            batch = load_pose_batch(bag, conns, topic.first_ns, topic.first_ns + window_ns)
+    except Exception as err:  # the check is advisory: a damaged bag is reported by summary
+        log.debug("clock check of %s skipped: %s", s.path, err)
+        return None
+    if len(batch) == 0:
+        return None
+    diff = (batch.t_record - batch.t_header)[:CLOCK_MAX_SAMPLES]
+    import numpy as np
+
+    return ClockCheck(str(s.path), topic.name, int(np.median(diff)), len(diff))
+
+
+class Progress:
+    """``scanning 12/1000`` on a terminal's stderr, shown only once a scan takes a moment."""
+
+    def __init__(self, total: int, stream: TextIO | None = None, delay_s: float = 0.5) -> None:
+        self.total = total
+        self.stream = stream if stream is not None else sys.stderr
+        self.enabled = self.stream.isatty()
+        self.start = time.monotonic()
+        self.delay_s = delay_s
+        self.shown = False
+
+    def __call__(self, done: int) -> None:
+        if not self.enabled or time.monotonic() - self.start < self.delay_s:
+            return
+        self.shown = True
+        width = 30
+        filled = width * done // max(self.total, 1)
+        bar = "#" * filled + "-" * (width - filled)
+        self.stream.write(f"\rertools: scanning [{bar}] {done}/{self.total}")
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.shown:
+            self.stream.write("\r" + " " * 60 + "\r")
+            self.stream.flush()
+
+
+def summarise(
+    bags: Sequence[Path], on_progress: Callable[[int], None] | None = None
+) -> tuple[list[BagSummary], list[Unreadable]]:
+    """Summaries of the readable bags and one line for each unreadable one."""
+    from ertools.errors import ErtoolsError
+    from ertools.io import summary
+
+    good: list[BagSummary] = []
+    bad: list[Unreadable] = []
+    for i, path in enumerate(bags):
+        try:
+            good.append(summary(path))
+        except ErtoolsError as err:
+            bad.append(Unreadable(str(path), err.message))
+        except Exception as err:  # a reader bug on one odd file must not hide the others
+            log.debug("summary of %s failed", path, exc_info=True)
+            bad.append(Unreadable(str(path), f"unreadable ({type(err).__name__}: {err})"))
+        if on_progress is not None:
+            on_progress(i + 1)
+    return good, bad
+
+
+def scan(
+    paths: Sequence[str | Path],
+    config: TimelineConfig | None = None,
+    *,
+    check_clocks: bool = True,
+    progress: bool = False,
+) -> Timeline:
+    """Find, summarise and clock-check the bags under ``paths`` and build their timeline.
+
+    Args:
+        paths: files and folders.
+        config: thresholds.
+        check_clocks: compare header stamps with record times (reads a second per bag).
+        progress: show a progress bar on stderr when it is a terminal.
+    """
+    found = find_bags(Path(p) for p in paths)
+    bar = Progress(len(found.bags) * (2 if check_clocks else 1)) if progress else None
+    summaries, unreadable = summarise(found.bags, bar)
+    checks: list[ClockCheck] = []
+    if check_clocks:
+        for i, s in enumerate(summaries):
+            c = clock_check(s)
+            if c is not None:
+                checks.append(c)
+            if bar is not None:
+                bar(len(found.bags) + i + 1)
+    if bar is not None:
+        bar.close()
+    return build_timeline(summaries, [*found.problems, *unreadable], checks, config)
