@@ -1,0 +1,434 @@
+"""FBM1@Home and FBM1@Work (object perception, seed 7.1): load -> find runs -> score -> result.
+
+For each run the referee placed the reference board carrying one item on the FBM1 table; the
+robot answered the item's class, instance and pose (x, y in metres, theta in degrees) in the
+table frame. The ground truth is T_origin_item = T_world_origin^-1 * T_world_board *
+T_board_item (``fbm1_gt``); the 2015 rules are in ``fbm1_score``; runs come from the state
+topics (``fbm1_runs``); answers from the Client payloads or a results file (``fbm1_answers``).
+
+``score_fbm1`` is the pure computation on streams; ``score_fbm1_bag`` reads a log through
+:mod:`ertools.io` and calls it. Both benchmarks share everything: ``benchmark`` only decides
+where the item's name is read first and the 2015 defaults of the legacy switches.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ertools.benchmarks.fbm1_answers import (
+    Answer,
+    ResultsFile,
+    answer_from_mapping,
+    parse_answer_payload,
+    parse_results,
+)
+from ertools.benchmarks.fbm1_gt import (
+    GroundTruthError,
+    GtOptions,
+    board_motion,
+    measure_ground_truth,
+)
+from ertools.benchmarks.fbm1_result import Fbm1Result, Fbm1RunResult
+from ertools.benchmarks.fbm1_runs import Fbm1Run, RunsFound, find_runs
+from ertools.benchmarks.fbm1_score import (
+    ScoreRules,
+    names_match,
+    pose_errors,
+    totals,
+)
+from ertools.configs.items import Item, ItemList
+from ertools.errors import ConfigError, ScoringError, SegmentationError
+from ertools.streams import PoseStream, Provenance
+from ertools.timeutil import NS_PER_S
+
+log = logging.getLogger("ertools.benchmarks.fbm1")
+
+BENCHMARKS = ("fbm1h", "fbm1w")
+
+
+@dataclass(frozen=True)
+class Fbm1Options:
+    """Everything that changes an FBM1 score besides the inputs.
+
+    Attributes:
+        benchmark: ``fbm1h`` or ``fbm1w``.
+        gt: how the ground truth is measured (see :class:`GtOptions`).
+        rules: which 2015 quirks to reproduce (see :class:`ScoreRules`).
+        moved_warn_m: warn when the board moved more than this (metres, table plane) between
+            the goal and the result, i.e. while the robot was looking.
+    """
+
+    benchmark: str = "fbm1h"
+    gt: GtOptions = field(default_factory=GtOptions)
+    rules: ScoreRules = field(default_factory=ScoreRules)
+    moved_warn_m: float = 0.01
+
+    @staticmethod
+    def as_2015(benchmark: str) -> Fbm1Options:
+        """The 2015 node's behaviour: every quirk, and its single tf lookup."""
+        gt = GtOptions(method="goal" if benchmark == "fbm1h" else "result")
+        return Fbm1Options(benchmark, gt, ScoreRules.all_2015())
+
+
+def _resolve_item(run: Fbm1Run, items: ItemList) -> tuple[Item, list[str]]:
+    """The item a run presented; ScoringError when nothing or an unknown item is named."""
+    where = f"run {run.index}"
+    ref = run.item
+    if ref is None:
+        raise ScoringError(
+            f"{where}: no item named (empty manual-operation payload); give --items-order"
+        )
+    warnings: list[str] = []
+    if ref.item_id is not None:
+        item = items.by_id(ref.item_id)
+        if item is None:
+            raise ScoringError(
+                f"{where}: item id {ref.item_id} ({ref.source} {ref.text!r}) is not in "
+                f"{items.source or 'the item list'}"
+            )
+        if ref.instance and ref.instance.strip() != item.instance.strip():
+            warnings.append(
+                f"{where}: {ref.source} names instance {ref.instance!r} but item {item.id} is "
+                f"{item.instance!r} in the item list; using the id"
+            )
+        return item, warnings
+    assert ref.instance is not None
+    item = items.by_instance(ref.instance)
+    if item is None:
+        raise ScoringError(
+            f"{where}: item {ref.instance!r} ({ref.source}) is not in "
+            f"{items.source or 'the item list'}"
+        )
+    return item, warnings
+
+
+def _answer_for(run: Fbm1Run, item: Item | None, results: ResultsFile | None) -> Answer | None:
+    where = f"run {run.index}"
+    if results is not None:
+        entry = results.by_run.get(run.index)
+        if entry is None and item is not None:
+            entry = results.by_item.get(item.id)
+        if entry is not None:
+            return answer_from_mapping(entry, where, results.source)
+    if run.answer_payload is None:
+        return None
+    return parse_answer_payload(run.answer_payload, where)
+
+
+def _execution_time(run: Fbm1Run) -> float | None:
+    start = run.executing_ns if run.executing_ns is not None else run.goal_ns
+    if start is None or run.result_ns is None:
+        return None
+    return (run.result_ns - start) / NS_PER_S
+
+
+def score_run(
+    run: Fbm1Run,
+    items: ItemList,
+    origin: PoseStream,
+    board: PoseStream,
+    options: Fbm1Options,
+    results: ResultsFile | None = None,
+    t0_ns: int = 0,
+) -> Fbm1RunResult:
+    """Score one run; a run that cannot be scored comes back with status ``failed``."""
+    where = f"run {run.index}"
+    text = run.item.text if run.item else ""
+    base: dict[str, Any] = {
+        "index": run.index,
+        "item_text": text,
+        "goal_ns": run.goal_ns,
+        "result_ns": run.result_ns,
+        "ended_by": run.ended_by,
+    }
+    if run.goal_ns is None:
+        return Fbm1RunResult(status="aborted", **base)
+    item: Item | None = None
+    warnings: list[str] = []
+    try:
+        item, warnings = _resolve_item(run, items)
+        answer = _answer_for(run, item, results)
+    except ScoringError as err:
+        return Fbm1RunResult(status="failed", item=item, error=err.message, **base)
+    exec_time = _execution_time(run)
+    if exec_time is None:
+        warnings.append(f"{where}: no result time in the log; execution time unknown")
+    if answer is None:
+        # 2015: a timed-out run counted with no positives and pose score 0; a stopped run's
+        # time was not added.
+        counted_time = exec_time if run.ended_by != "stop" else 0.0
+        return Fbm1RunResult(
+            status="no_answer",
+            item=item,
+            class_ok=False,
+            instance_ok=False,
+            execution_time_s=counted_time,
+            warnings=tuple(warnings),
+            **base,
+        )
+    start = run.placed_ns if run.placed_ns is not None else run.start_ns
+    try:
+        gt, gt_warnings = measure_ground_truth(
+            origin,
+            board,
+            item,
+            search_start_ns=start,
+            goal_ns=run.goal_ns,
+            result_ns=run.result_ns,
+            options=options.gt,
+            t0_ns=t0_ns,
+        )
+    except GroundTruthError as err:
+        return Fbm1RunResult(
+            status="failed",
+            item=item,
+            answer=answer,
+            error=f"{where}: {err}",
+            warnings=tuple(warnings),
+            **base,
+        )
+    warnings += [f"{where}: {w}" for w in gt_warnings]
+    if run.result_ns is not None:
+        max_gap = round(options.gt.max_gap_s * NS_PER_S)
+        moved = board_motion(origin, board, gt.board_xy, run.goal_ns, run.result_ns, max_gap)
+        if moved is not None and moved > options.moved_warn_m:
+            warnings.append(
+                f"{where}: the board moved {moved * 1000:.0f} mm while the robot was looking"
+            )
+    errors = pose_errors(
+        answer.x, answer.y, answer.theta_deg, gt.x, gt.y, gt.yaw_deg, options.rules
+    )
+    return Fbm1RunResult(
+        status="scored",
+        item=item,
+        answer=answer,
+        gt=gt,
+        errors=errors,
+        class_ok=names_match(answer.item_class, item.item_class, options.rules),
+        instance_ok=names_match(answer.item_instance, item.instance, options.rules),
+        execution_time_s=exec_time,
+        warnings=tuple(warnings),
+        **base,
+    )
+
+
+def _deviations(runs: Sequence[Fbm1RunResult], options: Fbm1Options) -> list[str]:
+    """Where this result deliberately differs from the 2015 node, with the switch back."""
+    out: list[str] = []
+    rules, gt = options.rules, options.gt
+    scored = [r for r in runs if r.errors is not None]
+    if gt.method == "window":
+        home = options.benchmark == "fbm1h"
+        used = "just before the goal" if home else "~1 s after the result"
+        flag = "--gt goal" if home else "--gt result"
+        out.append(
+            "ground truth = mean over the stationary window (up to "
+            f"{gt.max_window_s:g} s) before each goal, spread reported; 2015 took one tf lookup "
+            f"of the latest sample {used} ({flag})"
+        )
+    differ = [str(r.index) for r in scored if r.errors is not None and r.errors.legacy_differs]
+    if not (rules.legacy_clip and rules.legacy_wrap):
+        affected = f"run(s) {', '.join(differ)} differ" if differ else "no run affected"
+        out.append(
+            "translation term clipped at 1 m and theta errors fully wrapped to [-180, 180] deg; "
+            "2015 set only errors above sqrt(2) m to 1 (1..1.41 m stayed unclipped) and wrapped "
+            f"by a single 360 ({affected}; --legacy-clip --legacy-wrap)"
+        )
+    if not rules.legacy_names:
+        out.append(
+            "class and instance compared without surrounding blanks; 2015 compared exactly "
+            "(--legacy-names)"
+        )
+    if not rules.legacy_totals:
+        out.append(
+            "accuracies and pose score divided by the runs whose goal was sent; 2015 also "
+            "counted a run aborted before its goal, and the @Home node divided the accuracies "
+            "by 10 whatever the number of runs (--legacy-totals)"
+        )
+    return out
+
+
+def score_fbm1(
+    origin: PoseStream,
+    board: PoseStream,
+    found: RunsFound,
+    items: ItemList,
+    options: Fbm1Options | None = None,
+    *,
+    results: ResultsFile | None = None,
+    t0_ns: int = 0,
+    provenance: Provenance | None = None,
+) -> Fbm1Result:
+    """Score every run (pure: streams and configs in, frozen result out).
+
+    A run that cannot be scored is reported in ``failures`` (one line naming the run) and left
+    out of the totals; the other runs are still scored.
+    """
+    opts = options or Fbm1Options()
+    if opts.benchmark not in BENCHMARKS:
+        raise ConfigError(f"unknown FBM1 benchmark {opts.benchmark!r}; use fbm1h or fbm1w")
+    if not found.runs:
+        raise SegmentationError(
+            f"no FBM1 run in the state log (no BmBox WAITING_MANUAL_OPERATION or goal); "
+            f"is this an {opts.benchmark} log?"
+        )
+    runs = tuple(score_run(run, items, origin, board, opts, results, t0_ns) for run in found.runs)
+    counted = [r for r in runs if r.status in ("scored", "no_answer")]
+    tot = totals(
+        [bool(r.class_ok) for r in counted],
+        [bool(r.instance_ok) for r in counted],
+        [r.pose_score or 0.0 for r in counted],
+        [r.execution_time_s or 0.0 for r in counted],
+        aborted=sum(r.status == "aborted" for r in runs),
+        benchmark=opts.benchmark,
+        rules=opts.rules,
+    )
+    warnings = list(found.warnings)
+    for r in runs:
+        warnings.extend(r.warnings)
+    failures = [r.error for r in runs if r.error]
+    return Fbm1Result(
+        name=opts.benchmark,
+        runs=runs,
+        totals=tot,
+        logged_score=_parse_logged(found.logged_score),
+        t0_ns=t0_ns,
+        warnings=tuple(warnings),
+        deviations=tuple(_deviations(runs, opts)),
+        failures=tuple(failures),
+        provenance=provenance or Provenance(),
+    )
+
+
+def _parse_logged(payload: str | None) -> dict[str, Any] | None:
+    """The 2015 node's own score payload, when it was logged and is a YAML mapping."""
+    if not payload:
+        return None
+    from ertools.configs._yaml import parse_yaml
+
+    try:
+        data = parse_yaml(payload, "BmBox TRANSMITTING_SCORE payload")
+    except ConfigError:
+        log.warning("the logged 2015 score payload is not YAML: %.60r", payload)
+        return None
+    return data if isinstance(data, dict) else None
+
+
+@dataclass(frozen=True)
+class BodySources:
+    """Where the table and board poses come from (the 2015 topics when None)."""
+
+    origin: Any = None  # ertools.io.PoseSource
+    board: Any = None
+
+
+def _read_body(
+    paths: Sequence[Path], source: Any, default_topic: str, frame: str, window: tuple[int, int]
+) -> PoseStream:
+    """A body's poses: the given source, else the 2015 topic, else its /tf frame."""
+    from ertools.errors import TopicError
+    from ertools.io import PoseSource, read_pose_source
+
+    start, end = window
+    if source is not None:
+        stream: PoseStream = read_pose_source(paths, source, start_ns=start, end_ns=end)
+        return stream
+    try:
+        return read_pose_source(paths, PoseSource(topic=default_topic), start_ns=start, end_ns=end)
+    except TopicError as topic_err:
+        try:
+            stream = read_pose_source(paths, PoseSource(frame=frame), start_ns=start, end_ns=end)
+        except TopicError:
+            raise TopicError(
+                f"{topic_err.message}; no /tf frame {frame!r} either "
+                f"(choose the {frame} body with --{frame.replace('_', '-')}-topic or "
+                f"--{frame.replace('_', '-')}-frame)"
+            ) from topic_err
+        log.info("%s: using /tf frame %s (no %s)", paths[0], frame, default_topic)
+        return stream
+
+
+def score_fbm1_bag(
+    paths: Sequence[str | Path],
+    items_path: str | Path,
+    *,
+    options: Fbm1Options | None = None,
+    results_path: str | Path | None = None,
+    items_order: Sequence[str] | None = None,
+    sources: BodySources | None = None,
+) -> Fbm1Result:
+    """Recompute an FBM1 score from a log (one bag or a split log's files).
+
+    Args:
+        paths: the log file(s).
+        items_path: the item list (Listing 9).
+        options: benchmark and rules.
+        results_path: answers kept outside the log (replaces the Client payloads it covers).
+        items_order: item ids or instances per run (overrides the payloads).
+        sources: origin/board pose sources; the 2015 topics ``/<ns>/origin/pose`` and
+            ``/<ns>/ref_board/pose`` (falling back to the /tf frames) by default.
+
+    Raises:
+        BagError, TopicError: unreadable log, missing state or body topics.
+        ConfigError: bad item list or results file.
+        SegmentationError: no run in the log.
+    """
+    from ertools.configs._yaml import load_yaml
+    from ertools.configs.items import load_items
+    from ertools.io import read_benchmark_states, summary
+
+    opts = options or Fbm1Options()
+    plist = [Path(p) for p in paths]
+    ns = opts.benchmark
+    items = load_items(items_path)
+    results = None
+    if results_path is not None:
+        results = parse_results(load_yaml(results_path, "results file"), str(results_path))
+    states = read_benchmark_states(plist, ns)
+    if states.bmbox is None or len(states.bmbox) == 0:
+        raise SegmentationError(
+            f"no /{ns}/bmbox_state messages: the runs cannot be found "
+            f"(is this an {ns} log? `ertools info` lists its topics)",
+            path=plist[0],
+        )
+    found = find_runs(
+        states.bmbox, states.refbox, states.client, benchmark=ns, items_order=items_order
+    )
+    if states.client is None and results is None:
+        found = RunsFound(
+            found.runs,
+            (*found.warnings, f"no /{ns}/client_state: no answers in the log; give --results"),
+            found.logged_score,
+        )
+    t0 = min(summary(p).start_ns for p in plist)
+    # Read the bodies only around the runs (windowed reads touch only those chunks).
+    pad = round((opts.gt.max_window_s + opts.gt.max_gap_s + 2.0) * NS_PER_S)
+    lo = min(r.start_ns for r in found.runs) - pad
+    hi = max(r.end_ns for r in found.runs) + pad
+    src = sources or BodySources()
+    origin = _read_body(plist, src.origin, f"/{ns}/origin/pose", "origin", (lo, hi))
+    board = _read_body(plist, src.board, f"/{ns}/ref_board/pose", "ref_board", (lo, hi))
+    gt = opts.gt
+    provenance = Provenance(
+        inputs=tuple(str(p) for p in plist)
+        + (str(items_path),)
+        + ((str(results_path),) if results_path is not None else ()),
+        parameters=(
+            ("benchmark", ns),
+            ("origin", origin.source),
+            ("ref_board", board.source),
+            ("gt_method", gt.method),
+            ("max_window_s", f"{gt.max_window_s:g}"),
+            ("still_m", f"{gt.still_m:g}"),
+            ("still_deg", f"{gt.still_deg:g}"),
+            ("max_gap_s", f"{gt.max_gap_s:g}"),
+            ("legacy", ",".join(k for k, v in vars(opts.rules).items() if v) or "none"),
+        ),
+    )
+    return score_fbm1(
+        origin, board, found, items, opts, results=results, t0_ns=t0, provenance=provenance
+    )

@@ -1,0 +1,284 @@
+"""FBM1 ground truth: the item's pose in the table frame from the two mocap bodies.
+
+T_origin_item = T_world_origin^-1 * T_world_board * T_board_item, where ``origin`` is the
+marker set on the FBM1 table (its frame is the table frame the robot answers in),
+``ref_board`` the marker set on the reference board and T_board_item the item's transform from
+the item list (Listing 9).
+
+The 2015 node took one tf lookup (the latest sample) right before sending the goal (@Home,
+newest script) or about one second after the result (@Work and the older @Home script).
+ertools averages the samples of the stationary window that ends when the goal is sent and
+reports their spread; ``method="goal"`` / ``"result"`` reproduce the single 2015 lookups.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from ertools.configs.items import Item
+from ertools.geometry import compose, interpolate_poses, invert, mean_pose, yaw_from_quat
+from ertools.streams import PoseStream
+from ertools.timeutil import NS_PER_S
+
+GtMethod = Literal["window", "goal", "result"]
+
+# The 2015 node looked the item up ~1 s after the result arrived (two 0.5 s sleeps).
+RESULT_LOOKUP_DELAY_NS = NS_PER_S
+
+
+@dataclass(frozen=True)
+class GtOptions:
+    """How the ground truth of a run is measured.
+
+    Attributes:
+        method: ``window`` (mean over the stationary window before the goal), ``goal`` (the
+            last sample at the goal, 2015 @Home) or ``result`` (the last sample 1 s after the
+            result, 2015 @Work).
+        max_window_s: longest stationary window averaged.
+        still_m: a board sample further than this from the board's pose at the goal ends the
+            stationary window (metres; mocap noise is ~0.1 mm, a placement moves centimetres).
+        still_deg: the same for the rotation, degrees.
+        min_still_s: a shorter window is used but warned about (the board was still moving).
+        max_gap_s: a gap longer than this in either body's samples means tracking was lost.
+    """
+
+    method: GtMethod = "window"
+    max_window_s: float = 5.0
+    still_m: float = 0.005
+    still_deg: float = 1.0
+    min_still_s: float = 0.5
+    max_gap_s: float = 0.5
+
+
+@dataclass(frozen=True)
+class GroundTruth:
+    """The item's pose in the table frame for one run.
+
+    Attributes:
+        x: metres.
+        y: metres.
+        z: metres (not scored; a large value means a wrong item transform or board).
+        yaw: radians in [-pi, pi].
+        quat_xyzw: full orientation.
+        board_xy: the board's position in the table frame (for plots).
+        position_spread_m: RMS distance of the averaged samples from their mean.
+        angle_spread_deg: RMS rotation of the averaged samples from their mean.
+        samples: number of samples averaged (1 for the 2015 single lookups).
+        start_ns: first sample used.
+        end_ns: last sample used.
+        method: how it was measured.
+    """
+
+    x: float
+    y: float
+    z: float
+    yaw: float
+    quat_xyzw: tuple[float, float, float, float]
+    board_xy: tuple[float, float]
+    position_spread_m: float
+    angle_spread_deg: float
+    samples: int
+    start_ns: int
+    end_ns: int
+    method: str
+
+    @property
+    def yaw_deg(self) -> float:
+        return math.degrees(self.yaw)
+
+
+class GroundTruthError(Exception):
+    """A run whose ground truth cannot be measured (the caller adds the run's name)."""
+
+
+def board_in_table(origin: PoseStream, board: PoseStream, max_gap_ns: int) -> PoseStream:
+    """T_origin_board at each board sample where the origin is known (interpolated).
+
+    Board samples outside the origin's time span, or inside an origin gap longer than
+    ``max_gap_ns``, are dropped.
+    """
+    if len(origin) == 0 or len(board) == 0:
+        return PoseStream.empty("origin", "ref_board")
+    at = interpolate_poses(origin, board.t_ns, "linear")
+    ok = at.inside & (at.gap_ns <= max_gap_ns)
+    inv_t, inv_q = invert(at.xyz[ok], at.quat_xyzw[ok])
+    xyz, quat = compose(inv_t, inv_q, board.xyz[ok], board.quat_xyzw[ok])
+    return PoseStream(board.t_ns[ok], xyz, quat, "origin", "ref_board", board.source)
+
+
+def coverage_problem(
+    stream: PoseStream, name: str, start_ns: int, end_ns: int, max_gap_ns: int, t0_ns: int = 0
+) -> str | None:
+    """Why ``stream`` does not cover [start_ns, end_ns] within ``max_gap_ns``, or None."""
+    t = stream.t_ns
+    if len(t) == 0:
+        return f"no {name} pose in the log"
+    inside = t[(t >= start_ns) & (t <= end_ns)]
+    lo = np.searchsorted(t, start_ns, side="right") - 1
+    hi = np.searchsorted(t, end_ns, side="left")
+    # Samples bracketing the interval count too: tracking ending 2 ms before is fine.
+    edges = [t[lo]] if lo >= 0 else []
+    after = [t[hi]] if hi < len(t) else []
+    pts = np.concatenate([np.asarray(edges, np.int64), inside, np.asarray(after, np.int64)])
+    if len(pts) == 0 or pts[0] > start_ns + max_gap_ns or pts[-1] < end_ns - max_gap_ns:
+        first, last = (pts[0], pts[-1]) if len(pts) else (t[0], t[-1])
+        if last < start_ns or first > end_ns:
+            return (
+                f"{name} not tracked (no pose between {_s(start_ns - t0_ns)} "
+                f"and {_s(end_ns - t0_ns)})"
+            )
+        return (
+            f"{name} lost (poses cover {_s(first - t0_ns)}..{_s(last - t0_ns)}, "
+            f"needed {_s(start_ns - t0_ns)}..{_s(end_ns - t0_ns)})"
+        )
+    clipped = np.clip(pts, start_ns, end_ns)
+    gaps = np.diff(clipped)
+    if len(gaps) and int(gaps.max()) > max_gap_ns:
+        k = int(np.argmax(gaps))
+        return (
+            f"{name} lost for {gaps[k] / NS_PER_S:.2f} s from {_s(int(clipped[k]) - t0_ns)} "
+            f"(longer than {max_gap_ns / NS_PER_S:g} s)"
+        )
+    return None
+
+
+def _s(ns: int) -> str:
+    """Seconds with ms (times in messages are relative to the log's start)."""
+    return f"t={ns / NS_PER_S:.3f} s"
+
+
+def _item_poses(rel: PoseStream, item: Item) -> tuple[np.ndarray, np.ndarray]:
+    assert item.trans is not None and item.rot is not None
+    n = len(rel)
+    t_item = np.broadcast_to(np.asarray(item.trans, dtype=np.float64), (n, 3))
+    q_item = np.broadcast_to(np.asarray(item.rot, dtype=np.float64), (n, 4))
+    return compose(rel.xyz, rel.quat_xyzw, t_item, q_item)
+
+
+def stationary_tail(rel: PoseStream, still_m: float, still_deg: float) -> PoseStream:
+    """The samples at the end of ``rel`` that stay within tolerance of its final pose.
+
+    The final pose is the mean of the last 0.2 s, so one noisy last sample does not decide.
+    """
+    from scipy.spatial.transform import Rotation
+
+    if len(rel) == 0:
+        return rel
+    last = rel.window(rel.end_ns - NS_PER_S // 5, None)
+    ref = mean_pose(last.xyz, last.quat_xyzw)
+    dist = np.linalg.norm(rel.xyz - ref.xyz, axis=1)
+    ang = (Rotation.from_quat(ref.quat_xyzw).inv() * Rotation.from_quat(rel.quat_xyzw)).magnitude()
+    moving = np.flatnonzero((dist > still_m) | (ang > math.radians(still_deg)))
+    start = int(moving[-1]) + 1 if len(moving) else 0
+    return rel.take(slice(start, None))
+
+
+def measure_ground_truth(
+    origin: PoseStream,
+    board: PoseStream,
+    item: Item,
+    *,
+    search_start_ns: int,
+    goal_ns: int,
+    result_ns: int | None,
+    options: GtOptions,
+    t0_ns: int = 0,
+) -> tuple[GroundTruth, list[str]]:
+    """The item's ground truth for one run, and warnings.
+
+    Args:
+        origin: T_world_origin samples.
+        board: T_world_board samples.
+        item: the presented item (with its transform).
+        search_start_ns: earliest time the board may stand in its final place (the referee was
+            asked to place the item).
+        goal_ns: the goal was sent.
+        result_ns: the result came back (``result`` method only).
+        options: method and tolerances.
+        t0_ns: times in messages are given relative to this (the log's start).
+
+    Raises:
+        GroundTruthError: a body missing or lost where the measurement needs it.
+    """
+    max_gap = round(options.max_gap_s * NS_PER_S)
+    warnings: list[str] = []
+    if options.method == "window":
+        start = max(search_start_ns, goal_ns - round(options.max_window_s * NS_PER_S))
+        end = goal_ns
+    else:
+        if options.method == "result":
+            if result_ns is None:
+                raise GroundTruthError("no result time for the 2015 after-result lookup")
+            end = result_ns + RESULT_LOOKUP_DELAY_NS
+        else:
+            end = goal_ns
+        # A single lookup: the bodies must be tracked just before it.
+        start = end - max_gap
+    for stream, name in ((origin, "origin"), (board, "ref_board")):
+        problem = coverage_problem(stream, name, start, end, max_gap, t0_ns)
+        if problem:
+            raise GroundTruthError(problem)
+    rel = board_in_table(
+        origin.window(start - max_gap, end + max_gap), board.window(start, end), max_gap
+    )
+    if len(rel) == 0:
+        raise GroundTruthError(
+            f"no ref_board sample with a known origin in {_s(start - t0_ns)}..{_s(end - t0_ns)}"
+        )
+    if options.method == "window":
+        used = stationary_tail(rel, options.still_m, options.still_deg)
+        span = (used.end_ns - used.start_ns) / NS_PER_S
+        if span < options.min_still_s:
+            warnings.append(
+                f"board still for only {span:.2f} s before the goal "
+                f"({len(used)} sample(s) averaged; moved more than {options.still_m * 1000:g} mm "
+                f"or {options.still_deg:g} deg before)"
+            )
+    else:
+        used = rel.take(slice(len(rel) - 1, None))
+    t_item, q_item = _item_poses(used, item)
+    mean = mean_pose(t_item, q_item)
+    board_mean = used.xyz.mean(axis=0)
+    q = mean.quat_xyzw
+    gt = GroundTruth(
+        x=float(mean.xyz[0]),
+        y=float(mean.xyz[1]),
+        z=float(mean.xyz[2]),
+        yaw=float(yaw_from_quat(q)),
+        quat_xyzw=(float(q[0]), float(q[1]), float(q[2]), float(q[3])),
+        board_xy=(float(board_mean[0]), float(board_mean[1])),
+        position_spread_m=mean.position_std,
+        angle_spread_deg=math.degrees(mean.angle_std),
+        samples=mean.count,
+        start_ns=used.start_ns,
+        end_ns=used.end_ns,
+        method=options.method,
+    )
+    return gt, warnings
+
+
+def board_motion(
+    origin: PoseStream,
+    board: PoseStream,
+    board_xy: tuple[float, float],
+    start_ns: int,
+    end_ns: int,
+    max_gap_ns: int,
+) -> float | None:
+    """Largest distance (m, in the table plane) of the board from ``board_xy`` in a window.
+
+    Used to warn when the board was moved while the robot was looking at it; None when the
+    bodies were not tracked then.
+    """
+    rel = board_in_table(
+        origin.window(start_ns - max_gap_ns, end_ns + max_gap_ns),
+        board.window(start_ns, end_ns),
+        max_gap_ns,
+    )
+    if len(rel) == 0:
+        return None
+    return float(np.hypot(rel.xyz[:, 0] - board_xy[0], rel.xyz[:, 1] - board_xy[1]).max())

@@ -1,0 +1,260 @@
+"""FBM1 runs from the three state topics: when each item was presented, asked for and answered.
+
+Per run the 2015 BmBox went ``READY -> WAITING_MANUAL_OPERATION`` (payload ``Place item <id>
+(<instance>) on the table`` at @Home) ``-> COMPLETED_MANUAL_OPERATION -> TRANSMITTING_GOAL ->
+EXECUTING_GOAL -> WAITING_RESULT -> READY``. The node measured its execution time from the
+moment ``SendGoal`` returned (BmBox in ``EXECUTING_GOAL``) to the moment ``WaitResult``
+returned (BmBox leaving ``WAITING_RESULT``); the answer is the Client's ``COMPLETED_GOAL``
+payload. At @Work the Referee Box chose the item: its ``EXECUTING_MANUAL_OPERATION`` payload
+names it. A RefBox ``END`` with a ``timeout`` payload ends a run without answer; ``stop`` or
+``halt`` ends the benchmark.
+
+The states were re-published at 10 Hz, so a state shorter than 100 ms may be missing from the
+log: each moment is the first message of the first state at or past it.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+from ertools.states import BmBoxState, ClientState, RefBoxState
+from ertools.streams import StateStream
+
+_GOAL_STATES = (BmBoxState.TRANSMITTING_GOAL, BmBoxState.EXECUTING_GOAL, BmBoxState.WAITING_RESULT)
+_EXECUTING_STATES = (BmBoxState.EXECUTING_GOAL, BmBoxState.WAITING_RESULT)
+
+_PLACE_RE = re.compile(r"^\s*place\s+item\s+(\d+)\s*\((.*)\)\s*on\s+the\s+table\s*$", re.I)
+
+
+@dataclass(frozen=True)
+class ItemRef:
+    """What a run's manual-operation payload (or ``--items-order``) says was presented."""
+
+    item_id: int | None
+    instance: str | None
+    text: str
+    source: str  # "bmbox payload", "refbox payload", "--items-order"
+
+
+@dataclass(frozen=True)
+class Fbm1Run:
+    """One presented item, with the moments the 2015 node acted on (int64 ns).
+
+    Attributes:
+        index: 1-based, in the order the node counted its runs.
+        start_ns: the manual operation was requested (or the goal sent, without one).
+        end_ns: the next run's start, or the last state message.
+        placed_ns: the referee confirmed the item was placed (COMPLETED_MANUAL_OPERATION).
+        goal_ns: the goal was sent (first goal state); None for a run that never got there.
+        executing_ns: the robot acknowledged the goal (2015 ``start_time``).
+        result_ns: the BmBox stopped waiting for the result (2015 ``end_time``).
+        item: which item was presented, None when nothing names it.
+        answer_payload: the Client's COMPLETED_GOAL payload, None without answer.
+        answer_ns: when the Client completed the goal.
+        ended_by: ``timeout`` or ``stop`` when the RefBox ended the run without answer.
+    """
+
+    index: int
+    start_ns: int
+    end_ns: int
+    placed_ns: int | None = None
+    goal_ns: int | None = None
+    executing_ns: int | None = None
+    result_ns: int | None = None
+    item: ItemRef | None = None
+    answer_payload: str | None = None
+    answer_ns: int | None = None
+    ended_by: str | None = None
+
+    @property
+    def status(self) -> str:
+        """``answered``, ``no_answer`` (goal sent, nothing came back) or ``aborted``."""
+        if self.goal_ns is None:
+            return "aborted"
+        return "answered" if self.answer_payload is not None else "no_answer"
+
+
+@dataclass(frozen=True)
+class RunsFound:
+    """The runs of a benchmark and what the state log said besides."""
+
+    runs: tuple[Fbm1Run, ...]
+    warnings: tuple[str, ...] = ()
+    logged_score: str | None = None  # the BmBox TRANSMITTING_SCORE payload
+
+
+def parse_item_ref(text: str, source: str) -> ItemRef | None:
+    """``Place item 3 (a3) on the table`` -> id 3, instance a3; a bare id or instance too.
+
+    The 2015 @Work RefBox sent the bare instance name; the @Home BmBox the full sentence.
+    """
+    stripped = text.strip()
+    if not stripped:
+        return None
+    match = _PLACE_RE.match(stripped)
+    if match:
+        return ItemRef(int(match.group(1)), match.group(2).strip(), stripped, source)
+    if stripped.isdigit():
+        return ItemRef(int(stripped), None, stripped, source)
+    return ItemRef(None, stripped, stripped, source)
+
+
+def _end_reason(payload: str) -> str | None:
+    low = payload.lower()
+    if "timeout" in low:
+        return "timeout"
+    if "stop" in low or "halt" in low:
+        return "stop"
+    return None
+
+
+def _bmbox_runs(bmbox: StateStream) -> tuple[list[Fbm1Run], str | None]:
+    """Split the BmBox transitions into runs (a small state machine over ~100 transitions)."""
+    changes = bmbox.changes()
+    runs: list[Fbm1Run] = []
+    logged_score: str | None = None
+    prev_state: int | None = None
+    for t, state, payload in zip(
+        changes.t_ns.tolist(), changes.state.tolist(), changes.payload, strict=True
+    ):
+        cur = runs[-1] if runs else None
+        # A READY lasting less than one 10 Hz heartbeat may be missing: any state that is not
+        # "still executing this goal" closes the open run.
+        new_goal = state == BmBoxState.TRANSMITTING_GOAL and prev_state in _EXECUTING_STATES
+        if (
+            cur is not None
+            and cur.goal_ns is not None
+            and cur.result_ns is None
+            and (state not in _GOAL_STATES or new_goal)
+        ):
+            cur = runs[-1] = replace(cur, result_ns=t)
+        if state == BmBoxState.WAITING_MANUAL_OPERATION:
+            if prev_state != BmBoxState.WAITING_MANUAL_OPERATION:
+                item = parse_item_ref(payload, "bmbox payload")
+                runs.append(Fbm1Run(len(runs) + 1, t, t, item=item))
+        elif state in _GOAL_STATES:
+            after_manual = prev_state in (
+                BmBoxState.WAITING_MANUAL_OPERATION,
+                BmBoxState.COMPLETED_MANUAL_OPERATION,
+            )
+            if (
+                cur is None
+                or cur.result_ns is not None
+                or (cur.goal_ns is None and not after_manual)
+            ):
+                # A goal without a manual operation before it (a log cut, or a run without
+                # the table operation): still a run.
+                cur = Fbm1Run(len(runs) + 1, t, t)
+                runs.append(cur)
+            if cur.goal_ns is None:
+                cur = runs[-1] = replace(cur, goal_ns=t)
+            if state in _EXECUTING_STATES and cur.executing_ns is None:
+                runs[-1] = replace(cur, executing_ns=t)
+        elif state == BmBoxState.COMPLETED_MANUAL_OPERATION:
+            if cur is not None and cur.placed_ns is None and cur.goal_ns is None:
+                runs[-1] = replace(cur, placed_ns=t)
+        elif state == BmBoxState.TRANSMITTING_SCORE:
+            logged_score = payload
+        prev_state = state
+    last_ns = int(bmbox.t_ns[-1]) if len(bmbox) else 0
+    for k, run in enumerate(runs):
+        end = runs[k + 1].start_ns if k + 1 < len(runs) else max(last_ns, run.start_ns)
+        runs[k] = replace(run, end_ns=end)
+    return runs, logged_score
+
+
+def find_runs(
+    bmbox: StateStream,
+    refbox: StateStream | None,
+    client: StateStream | None,
+    *,
+    benchmark: str = "fbm1h",
+    items_order: Sequence[str] | None = None,
+) -> RunsFound:
+    """The runs of one FBM1 execution.
+
+    Args:
+        bmbox: the BmBox state topic (required: it delimits the runs).
+        refbox: the RefBox state topic (@Work item names, timeouts); None when absent.
+        client: the Client state topic (answers); None when absent (then ``--results``).
+        benchmark: ``fbm1h`` (item from the BmBox payload first) or ``fbm1w`` (RefBox first).
+        items_order: item ids or instance names per run, overriding the payloads.
+    """
+    warnings: list[str] = []
+    runs, logged_score = _bmbox_runs(bmbox)
+    ref_changes = refbox.changes() if refbox is not None else None
+    cli_changes = client.changes() if client is not None else None
+    out: list[Fbm1Run] = []
+    for k, run in enumerate(runs):
+        lo: int | None = None
+        if k > 0:
+            prev = runs[k - 1]
+            lo = prev.goal_ns if prev.goal_ns is not None else prev.start_ns
+        hi = run.goal_ns if run.goal_ns is not None else run.end_ns
+        refbox_item = _refbox_item(ref_changes, lo, hi)
+        # @Work the RefBox chose the item; @Home the BmBox did. Each falls back on the other.
+        first, second = (refbox_item, run.item) if benchmark == "fbm1w" else (run.item, refbox_item)
+        item = first or second
+        answer_payload: str | None = None
+        answer_ns: int | None = None
+        ended_by: str | None = None
+        if run.goal_ns is not None:
+            nxt = runs[k + 1].start_ns if k + 1 < len(runs) else None
+            if cli_changes is not None:
+                done = cli_changes.window(run.goal_ns, nxt)
+                hits = [
+                    i for i, s in enumerate(done.state.tolist()) if s == ClientState.COMPLETED_GOAL
+                ]
+                if hits:
+                    answer_payload = done.payload[hits[0]]
+                    answer_ns = int(done.t_ns[hits[0]])
+            if ref_changes is not None:
+                ended = ref_changes.window(run.goal_ns, nxt)
+                for s, p, t in zip(
+                    ended.state.tolist(), ended.payload, ended.t_ns.tolist(), strict=True
+                ):
+                    if s == RefBoxState.END and (answer_ns is None or t < answer_ns):
+                        ended_by = _end_reason(p) or "stop"
+                        break
+            if ended_by is not None and answer_ns is not None:
+                # The RefBox ended the run before the robot answered: 2015 ignored the answer.
+                answer_payload = answer_ns = None
+        out.append(
+            replace(
+                run,
+                item=item,
+                answer_payload=answer_payload,
+                answer_ns=answer_ns,
+                ended_by=ended_by,
+            )
+        )
+    if items_order is not None:
+        out = _apply_order(out, items_order, warnings)
+    return RunsFound(tuple(out), tuple(warnings), logged_score)
+
+
+def _refbox_item(changes: StateStream | None, lo: int | None, hi: int) -> ItemRef | None:
+    """The last non-empty RefBox EXECUTING_MANUAL_OPERATION payload in (lo, hi]."""
+    if changes is None:
+        return None
+    window = changes.window(None if lo is None else lo + 1, hi)
+    found: ItemRef | None = None
+    for s, p in zip(window.state.tolist(), window.payload, strict=True):
+        if s == RefBoxState.EXECUTING_MANUAL_OPERATION:
+            found = parse_item_ref(p, "refbox payload") or found
+    return found
+
+
+def _apply_order(runs: list[Fbm1Run], order: Sequence[str], warnings: list[str]) -> list[Fbm1Run]:
+    if len(order) != len(runs):
+        warnings.append(
+            f"--items-order names {len(order)} item(s) but the log has {len(runs)} run(s); "
+            "runs are matched in order"
+        )
+    out = []
+    for k, run in enumerate(runs):
+        ref = parse_item_ref(order[k], "--items-order") if k < len(order) else None
+        out.append(replace(run, item=ref))
+    return out
