@@ -9,8 +9,12 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING, cast
 
 from ertools.cli.common import add_output_options, emit_result, note
+
+if TYPE_CHECKING:
+    from ertools.benchmarks.base import BenchmarkResult
 
 EPILOG = """examples:
   ertools score fbm2h run.bag --team homer --transforms transforms/
@@ -134,7 +138,8 @@ def run(args: argparse.Namespace) -> int:
         for line in result.notes:
             note(line)
     _print_table(result)
-    return emit_result(result, args, list(args.bags))
+    # A frozen dataclass has read-only fields; the Protocol declares plain attributes.
+    return emit_result(cast("BenchmarkResult", result), args, list(args.bags))
 
 
 def _print_table(result: object) -> None:
