@@ -1,0 +1,128 @@
+"""Scenarios: the stationary log's answers hold for the bag, regeneration is byte-identical."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from ertools.samples.__main__ import main
+from ertools.samples.scenario import (
+    SCENARIOS,
+    ScenarioMissingError,
+    answers_path,
+    load_scenario,
+    log_name,
+)
+
+REPO = Path(__file__).resolve().parents[2]
+SAMPLE_BAGS = REPO / "sample_bags"
+
+
+def _files(root: Path) -> dict[str, bytes]:
+    return {
+        str(p.relative_to(root)): p.read_bytes()
+        for p in sorted(root.rglob("*"))
+        if p.is_file() and p.name != "README.md"
+    }
+
+
+def test_stationary_answers_match_the_bag(tmp_path: Path) -> None:
+    from rosbags.highlevel import AnyReader
+
+    paths = load_scenario("stationary")(tmp_path, seed=11)
+    bag = next(p for p in paths if p.suffix == ".bag")
+    answers = yaml.safe_load(answers_path(bag).read_text())
+    assert answers_path(bag) in paths
+    assert list(answers) == ["benchmark", "bag", "generator", "truth", "expected", "tolerance"]
+    assert answers["bag"] == bag.name and answers["generator"]["seed"] == 11
+    topic = answers["generator"]["parameters"]["topic"]
+    xyz = []
+    with AnyReader([bag]) as reader:
+        conns = [c for c in reader.connections if c.topic == topic]
+        for _, _, raw in reader.messages(connections=conns):
+            p = reader.deserialize(raw, "geometry_msgs/msg/PoseStamped").pose.position
+            xyz.append((p.x, p.y, p.z))
+    pos = np.array(xyz)
+    exp, tol = answers["expected"], answers["tolerance"]
+    assert len(pos) == exp["samples"]
+    d = np.diff(pos, axis=0)
+    moved = np.any(d != 0, axis=1)
+    assert int((~moved).sum()) == exp["repeats"] == 3 + 5 + 4  # the scenario's LOSSES
+    assert exp["dropped"] == 12 + 30
+    epsilon = float(np.linalg.norm(d[moved], axis=1).mean())
+    assert epsilon == pytest.approx(exp["epsilon"], abs=tol["epsilon"]["abs"])
+    # The formula 4*sigma/sqrt(pi), written out here independently of the scenario.
+    sigma = answers["generator"]["parameters"]["sigma_m"]
+    assert exp["epsilon_formula"] == pytest.approx(4 * sigma / math.sqrt(math.pi), rel=1e-12)
+    assert epsilon == pytest.approx(exp["epsilon_formula"], abs=tol["epsilon_formula"]["abs"])
+    assert pos.std(axis=0, ddof=1) == pytest.approx(exp["sigma_xyz"], abs=1e-12)
+    truth = np.array(answers["truth"]["position"])
+    assert np.all(np.abs(pos.mean(axis=0) - truth) < tol["mean_position_vs_truth"]["abs"])
+    w = answers["truth"]["window"]
+    assert w["start"] == pytest.approx(w["start_ns"] / 1e9) and w["end_ns"] > w["start_ns"]
+    assert bag.stat().st_size < 2_600_000
+
+
+def test_stationary_is_byte_identical_on_rerun(tmp_path: Path) -> None:
+    assert main([str(tmp_path / "a"), "--only", "stationary"]) == 0
+    assert main([str(tmp_path / "b"), "--only", "stationary"]) == 0
+    a, b = _files(tmp_path / "a"), _files(tmp_path / "b")
+    assert len(a) == 2 and a == b
+    # A different seed changes the noise, so the comparison above can fail.
+    assert main([str(tmp_path / "c"), "--only", "stationary", "--seed", "3"]) == 0
+    assert _files(tmp_path / "c") != a
+
+
+def test_rerun_replaces_a_scenario_folder(tmp_path: Path) -> None:
+    assert main([str(tmp_path), "--only", "stationary"]) == 0
+    (tmp_path / "stationary" / "stale.txt").write_text("old")
+    assert main([str(tmp_path), "--only", "stationary"]) == 0
+    assert not (tmp_path / "stationary" / "stale.txt").exists()
+    assert not list(tmp_path.glob(".*partial"))
+
+
+def test_missing_scenario_module_is_an_error_naming_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.setitem(SCENARIOS, "ghost", "ertools.samples.no_such_module:generate")
+    with pytest.raises(ScenarioMissingError, match="no_such_module"):
+        load_scenario("ghost")
+    monkeypatch.setitem(SCENARIOS, "ghost", "ertools.samples.stationary:nope")
+    assert main([str(tmp_path), "--only", "stationary"]) == 0
+    # argparse choices were built from SCENARIOS at call time, so "ghost" is accepted.
+    assert main([str(tmp_path / "x"), "--only", "ghost", "stationary"]) == 1
+    err = capsys.readouterr().err
+    assert "ghost" in err and "nope" in err
+    assert not (tmp_path / "x" / "stationary").exists()  # nothing written
+
+
+def test_log_name_is_the_2015_logger_pattern() -> None:
+    assert (
+        log_name("fbm3w_mocap", 1_448_013_600 * 10**9)
+        == "log_fbm3w_mocap_2015-11-20-10-00-00_0.bag"
+    )
+    assert answers_path(Path("d/x.bag")) == Path("d/x.answers.yaml")
+    assert answers_path(Path("d/x_rosbag2")) == Path("d/x_rosbag2.answers.yaml")
+
+
+def test_sample_bags_folder_regenerates_byte_identically(tmp_path: Path) -> None:
+    missing = []
+    for name in SCENARIOS:
+        try:
+            load_scenario(name)
+        except ScenarioMissingError as exc:
+            missing.append(exc.message)
+    if missing:
+        pytest.skip("; ".join(missing))
+    assert SAMPLE_BAGS.is_dir(), "sample_bags/ missing: run python -m ertools.samples sample_bags"
+    assert main([str(tmp_path)]) == 0
+    committed, fresh = _files(SAMPLE_BAGS), _files(tmp_path)
+    assert sorted(committed) == sorted(fresh)
+    differ = [name for name in fresh if fresh[name] != committed[name]]
+    assert not differ, f"regenerated files differ from sample_bags/: {differ}"
+    total = sum(len(b) for b in fresh.values())
+    assert total < 15_500_000, f"sample_bags/ is {total} bytes"
