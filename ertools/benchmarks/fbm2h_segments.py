@@ -246,12 +246,13 @@ def from_stops(
     """Assign detected stops to waypoints in order; returns moments and unassigned waypoints.
 
     Waypoint k takes the first stop after the one given to waypoint k-1 that lies within
-    ``radius`` of it; the reached moment is when that stop began. Segment 0 starts when the
+    ``radius`` of it; the reached moment is when that stop began (plus half the speed window).
+    Segment 0 starts when the
     robot first moves (the end of an initial stop) or at the first sample.
     """
     runs = detect_stops(stream_t_ns, xy, yaw, params, max_gap_ns)
     notes = [
-        f"stop {i}: {ns_to_s(stream_t_ns[s] - stream_t_ns[0]):.3f} s to "
+        f"stop {i} (from the first pose sample): {ns_to_s(stream_t_ns[s] - stream_t_ns[0]):.3f} s to "
         f"{ns_to_s(stream_t_ns[e] - stream_t_ns[0]):.3f} s at "
         f"({xy[s : e + 1, 0].mean():.3f}, {xy[s : e + 1, 1].mean():.3f})"
         for i, (s, e) in enumerate(runs)
@@ -278,7 +279,10 @@ def from_stops(
                 f"{params.radius} m of waypoint {k} after the previous waypoint"
             )
             break
-        ends.append(int(stream_t_ns[runs[chosen][0]]))
+        # The first still sample's window is centred on it: the robot may still creep during
+        # the window's second half, so the reached moment is the window's end.
+        s, e = runs[chosen]
+        ends.append(min(int(stream_t_ns[s]) + int(params.window_s * 5e8), int(stream_t_ns[e])))
         next_run = chosen + 1
     end_arr = np.asarray(ends, dtype=np.int64)
     start_arr = np.concatenate([[t_start0], end_arr[:-1]]).astype(np.int64)[: len(end_arr)]
