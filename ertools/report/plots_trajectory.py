@@ -1,0 +1,91 @@
+"""Figures of a trajectory result: the error over time and the two paths overlaid.
+
+Each drawing function takes a matplotlib ``Axes`` and the result; nothing global is touched.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from ertools.report.figures import FigureSpec
+
+if TYPE_CHECKING:
+    from ertools.benchmarks.trajectory import TrajectoryResult
+
+
+def draw_error_over_time(ax: Any, result: TrajectoryResult) -> None:
+    """Position error (cm) per robot pose; gaps and tracking losses marked on the time axis."""
+    from ertools.benchmarks.trajectory import GAP, TRACKING_LOST, UNCOVERED
+
+    m = result.matched
+    if len(m.t_ns) == 0:
+        return
+    t = (m.t_ns - m.t_ns[0]) / 1e9
+    ax.plot(t, m.position_error * 100.0, lw=0.8, color="C0", label="position error")
+    for code, color, label in (
+        (GAP, "C1", "GT gap"),
+        (TRACKING_LOST, "C3", "tracking lost"),
+        (UNCOVERED, "0.5", "no GT"),
+    ):
+        sel = m.status == code
+        if sel.any():
+            ax.plot(t[sel], np.zeros(int(sel.sum())), "|", ms=10, color=color, label=label)
+    if result.metrics is not None:
+        ax.axhline(
+            result.metrics.position_error * 100.0,
+            color="C2",
+            lw=0.8,
+            ls="--",
+            label=f"mean {result.metrics.position_error * 100:.2f} cm",
+        )
+    ax.set_xlabel("time since the first robot pose (s)")
+    ax.set_ylabel("position error (cm)")
+    ax.legend(loc="upper right", fontsize="small")
+    ax.grid(True, alpha=0.3)
+
+
+def draw_paths(ax: Any, result: TrajectoryResult) -> None:
+    """The robot's estimate and the GT, seen from above (x, y in metres)."""
+    gt = result.gt_path
+    ax.plot(gt.xyz[:, 0], gt.xyz[:, 1], lw=1.0, color="0.4", label="ground truth")
+    r = result.robot.xyz
+    ax.plot(r[:, 0], r[:, 1], ".", ms=2.5, color="C0", label="robot estimate")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.legend(loc="best", fontsize="small")
+    ax.grid(True, alpha=0.3)
+
+
+def draw_yaw_error(ax: Any, result: TrajectoryResult) -> None:
+    """Wrapped yaw error (degrees) per robot pose."""
+    m = result.matched
+    if len(m.t_ns) == 0:
+        return
+    t = (m.t_ns - m.t_ns[0]) / 1e9
+    ax.plot(t, np.degrees(m.yaw_error), lw=0.8, color="C4")
+    ax.set_xlabel("time since the first robot pose (s)")
+    ax.set_ylabel("|yaw error| (deg)")
+    ax.grid(True, alpha=0.3)
+
+
+def figure_specs(result: TrajectoryResult) -> list[FigureSpec]:
+    """The figures of ``ertools score trajectory --plot DIR``."""
+    off = result.offset_ns / 1e9
+    return [
+        FigureSpec(
+            "trajectory_error",
+            f"Robot vs GT position error ({result.config.association}, offset {off:+.3f} s)",
+            lambda ax: draw_error_over_time(ax, result),
+            (8.0, 4.0),
+        ),
+        FigureSpec("trajectory_paths", "Robot estimate and GT", lambda ax: draw_paths(ax, result)),
+        FigureSpec(
+            "trajectory_yaw_error",
+            "Robot vs GT yaw error",
+            lambda ax: draw_yaw_error(ax, result),
+            (8.0, 3.5),
+        ),
+    ]
