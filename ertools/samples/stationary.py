@@ -16,6 +16,11 @@ Answers (``expected``):
 - ``epsilon``: the same mean measured on the simulated noise, over consecutive pairs of
   messages whose positions differ (repeats excluded; pairs across a gap count, the body is
   still). A scorer reading the bag must find this value up to float rounding.
+- ``epsilon_xy`` / ``epsilon_xy_formula``: the same in the (x, y) plane, the distance the
+  2015 ``mocap_noise_statistics`` tool histogrammed: chi with 2 degrees of freedom has mean
+  ``sqrt(pi/2)``, so ``E|d_xy| = sigma*sqrt(2)*sqrt(pi/2) = sigma*sqrt(pi)``.
+- ``pairs``: consecutive message pairs (``samples - 1``); ``lost``: pairs with identical poses
+  (= ``repeats``, what the 2015 tool counted as lost).
 - ``sigma_xyz``: the sample standard deviation of the published positions per axis.
 """
 
@@ -78,9 +83,14 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     dist = np.linalg.norm(diffs[moved], axis=1)
     epsilon = float(dist.mean())
     epsilon_formula = SIGMA_M * math.sqrt(2.0) * 2.0 * math.sqrt(2.0 / math.pi)
-    # Standard error of the mean distance: sd of |d| is s*sqrt(3 - 8/pi) with s = sigma*sqrt(2);
-    # consecutive differences share a sample (correlated), so allow 6 standard errors.
-    stderr = SIGMA_M * math.sqrt(2.0) * math.sqrt(3.0 - 8.0 / math.pi) / math.sqrt(dist.size)
+    dist_xy = np.hypot(diffs[moved, 0], diffs[moved, 1])
+    epsilon_xy_formula = SIGMA_M * math.sqrt(2.0) * math.sqrt(math.pi / 2.0)
+    # Standard error of the mean distance: sd of |d| is s*sqrt(k - mean_chi_k^2) with
+    # s = sigma*sqrt(2) (k = 3: 3 - 8/pi; k = 2: 2 - pi/2); consecutive differences share a
+    # sample (correlated), so allow 6 standard errors.
+    s_diff = SIGMA_M * math.sqrt(2.0)
+    stderr = s_diff * math.sqrt(3.0 - 8.0 / math.pi) / math.sqrt(dist.size)
+    stderr_xy = s_diff * math.sqrt(2.0 - math.pi / 2.0) / math.sqrt(dist.size)
     sigma_xyz = pub.xyz.std(axis=0, ddof=1)
 
     answers = write_answers(
@@ -108,11 +118,15 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         },
         expected={
             "samples": len(pub),
+            "pairs": len(pub) - 1,
+            "lost": int((~moved).sum()),
             "repeats": int(pub.repeated.sum()),
             "dropped": pub.dropped,
             "moving_pairs": int(dist.size),
             "epsilon": epsilon,
             "epsilon_formula": epsilon_formula,
+            "epsilon_xy": float(dist_xy.mean()),
+            "epsilon_xy_formula": epsilon_xy_formula,
             "sigma_xyz": sigma_xyz,
             "mean_position": pub.xyz.mean(axis=0),
         },
@@ -123,6 +137,10 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
                 6 * stderr,
                 f"sampling error of a mean over {dist.size} pairs: 6 standard errors "
                 "(consecutive differences are correlated)",
+            ),
+            "epsilon_xy": tol(1e-12, "same samples as the bag"),
+            "epsilon_xy_formula": tol(
+                6 * stderr_xy, f"sampling error of a mean over {dist.size} pairs: 6 standard errors"
             ),
             "sigma_xyz": tol(1e-12, "same samples as the bag"),
             "mean_position": tol(1e-12, "same samples as the bag"),

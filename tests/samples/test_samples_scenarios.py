@@ -59,6 +59,12 @@ def test_stationary_answers_match_the_bag(tmp_path: Path) -> None:
     sigma = answers["generator"]["parameters"]["sigma_m"]
     assert exp["epsilon_formula"] == pytest.approx(4 * sigma / math.sqrt(math.pi), rel=1e-12)
     assert epsilon == pytest.approx(exp["epsilon_formula"], abs=tol["epsilon_formula"]["abs"])
+    # The 2015 tool's (x, y) distance; chi-2 mean sqrt(pi/2) -> sigma*sqrt(pi).
+    eps_xy = float(np.hypot(d[moved, 0], d[moved, 1]).mean())
+    assert eps_xy == pytest.approx(exp["epsilon_xy"], abs=1e-12)
+    assert exp["epsilon_xy_formula"] == pytest.approx(sigma * math.sqrt(math.pi), rel=1e-12)
+    assert eps_xy == pytest.approx(exp["epsilon_xy_formula"], abs=tol["epsilon_xy_formula"]["abs"])
+    assert exp["lost"] == exp["repeats"] and exp["pairs"] == len(pos) - 1
     assert pos.std(axis=0, ddof=1) == pytest.approx(exp["sigma_xyz"], abs=1e-12)
     truth = np.array(answers["truth"]["position"])
     assert np.all(np.abs(pos.mean(axis=0) - truth) < tol["mean_position_vs_truth"]["abs"])
