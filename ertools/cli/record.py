@@ -186,8 +186,8 @@ def run(args: argparse.Namespace) -> int:
     try:
         summary = recorder.run()
     finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)  # type: ignore[arg-type]
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)  # type: ignore[arg-type]
         if sim_thread is not None:
             motive.stop.set()
             sim_thread.join(timeout=2.0)

@@ -1,0 +1,84 @@
+"""Watch the log folder while recording and warn when the log stops growing (seed 5.2).
+
+Every --interval seconds: the newest file being written, its growth and, for MCAP files, the
+rate of every pose topic. Warnings (stderr, with a terminal bell under --bell as the 2015
+log_monitor): no file being written, several at once, growth below --min-growth, a pose topic
+whose rate fell below --drop-fraction of its best or below --min-rate.
+
+Runs until Ctrl-C; --once looks twice one interval apart and exits, --duration S stops after S
+seconds. With --once or --duration the exit status is 1 when any warning was given.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+EPILOG = """examples:
+  ertools monitor logs/ --bell
+  ertools monitor logs/ --interval 2 --min-growth 20000 --min-rate 100
+  ertools monitor logs/ --once          # scripted check: exit 1 on any warning
+"""
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from pathlib import Path
+
+    parser.add_argument("directory", type=Path, metavar="DIR", help="the recorder's --out folder")
+    parser.add_argument(
+        "--interval", type=float, default=5.0, metavar="S", help="seconds between looks (5)"
+    )
+    parser.add_argument(
+        "--min-growth",
+        type=float,
+        default=10_000.0,
+        metavar="BYTES_PER_S",
+        help="least acceptable growth of the file being written (10000 B/s)",
+    )
+    parser.add_argument(
+        "--stale",
+        type=float,
+        metavar="S",
+        help="a file not modified for S s is not being written (default 3 intervals, >= 5 s)",
+    )
+    parser.add_argument(
+        "--drop-fraction",
+        type=float,
+        default=0.5,
+        help="warn when a pose topic's rate falls below this fraction of its best (0.5)",
+    )
+    parser.add_argument("--min-rate", type=float, metavar="HZ", help="least pose rate per topic")
+    parser.add_argument("--bell", action="store_true", help="ring the terminal bell on warnings")
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument("--once", action="store_true", help="look once (after one interval), exit")
+    group.add_argument("--duration", type=float, metavar="S", help="stop after S seconds")
+
+
+def run(args: argparse.Namespace) -> int:
+    import sys
+    import time
+
+    from ertools.errors import UsageError
+    from ertools.live.monitor import MonitorOptions, watch
+
+    if args.interval <= 0 or args.min_growth < 0 or not 0 <= args.drop_fraction <= 1:
+        raise UsageError("--interval must be > 0, --min-growth >= 0, --drop-fraction in [0, 1]")
+    if not args.directory.is_dir():
+        raise UsageError(f"{args.directory} is not a folder")
+    options = MonitorOptions(
+        directory=args.directory,
+        interval_s=args.interval,
+        min_growth_bps=args.min_growth,
+        stale_s=args.stale,
+        drop_fraction=args.drop_fraction,
+        min_rate_hz=args.min_rate,
+    )
+
+    def status(line: str) -> None:
+        print(f"{time.strftime('%H:%M:%S')} {line}", flush=True)
+
+    def warn(line: str) -> None:
+        bell = "\a" if args.bell else ""
+        print(f"{bell}ertools: monitor: WARNING: {line}", file=sys.stderr, flush=True)
+
+    warnings = watch(options, duration_s=args.duration, once=args.once, status=status, warn=warn)
+    return 1 if warnings and (args.once or args.duration is not None) else 0
