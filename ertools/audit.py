@@ -259,6 +259,68 @@ class Audit:
     def to_yaml(self) -> str:
         return dump_yaml(jsonable(self.to_dict()))
 
+    def to_text(self) -> str:
+        """A referee's reading: findings first, then runs, the score comparison, the timeline."""
+        lines = [
+            f"audit of {self.benchmark or '(unknown benchmark)'}: "
+            + (
+                f"{iso_utc(self.start_ns)}, {ns_to_s(self.end_ns - self.start_ns):.1f} s"
+                if self.timeline
+                else "no state messages"
+            ),
+            "  topics: " + ", ".join(f"{t} ({n})" for _, t, n in self.topics),
+            f"  BmBox transitions checked: {self.transitions_checked}, illegal: "
+            f"{len(self.illegal_transitions)}",
+            f"  silences > {ns_to_s(self.max_silence_ns):g} s: {len(self.silences)}",
+            "  ended by the RefBox: "
+            + (
+                ", ".join(f"{e.reason} at {self._rel(e.t_ns):.1f} s" for e in self.early_ends)
+                or "no"
+            ),
+        ]
+        for x in self.illegal_transitions:
+            lines.append(f"  ILLEGAL {self._rel(x.t_ns):9.3f} s  {x.from_state} -> {x.to_state}")
+        for g in self.silences:
+            lines.append(
+                f"  SILENCE {self._rel(g.start_ns):9.3f} s  {g.topic or g.machine.value} "
+                f"{ns_to_s(g.duration_ns):.2f} s in {g.state_name}"
+            )
+        lines.append(f"runs: {len(self.runs)}")
+        for r in self.runs:
+            what = _one_line(r.manual_operation or r.goal)
+            lines.append(
+                f"  {r.index:3d} {self._rel(r.start_ns):9.3f} s +{ns_to_s(r.duration_ns):7.3f} s  "
+                f"{r.outcome:<10} {what}" + (f"  result: {_one_line(r.result)}" if r.result else "")
+            )
+        if self.comparison is not None:
+            cmp = self.comparison
+            lines.append(
+                f"live vs recomputed score: {cmp.same} same, {len(cmp.differences)} differ "
+                f"(tolerance {cmp.abs_tol:g})"
+            )
+            lines += [f"  note: {n}" for n in cmp.notes]
+            width = max((len(line.key) for line in cmp.lines), default=10)
+            for line in cmp.lines:
+                lines.append(
+                    f"  {line.key:<{width}}  {_short(line.live):>14}  "
+                    f"{_short(line.recomputed):>14}  {line.status}"
+                )
+                if line.explanation:
+                    lines.append(f"  {'':<{width}}    why: {line.explanation}")
+        elif self.live_score_text is not None:
+            lines.append("score sent live:")
+            lines += [f"  {line}" for line in self.live_score_text.splitlines()]
+        lines.append("timeline:")
+        for e in self.timeline:
+            lines.append(
+                f"  {self._rel(e.start_ns):9.3f} s {e.machine.value:<6} {e.state_name:<27} "
+                f"{ns_to_s(e.duration_ns):8.3f} s  {_one_line(e.payload)}"
+            )
+        if self.warnings:
+            lines.append("warnings:")
+            lines += [f"  {w}" for w in self.warnings]
+        return "\n".join(lines) + "\n"
+
     def tables(self) -> dict[str, Rows]:
         """``timeline``, ``runs``, ``illegal_transitions``, ``silences``, ``early_ends``
         and, after a re-score, ``score_comparison``."""
@@ -317,6 +379,17 @@ class Audit:
         if self.comparison is not None:
             tables["score_comparison"] = self.comparison.rows()
         return tables
+
+
+def _one_line(text: str, width: int = 60) -> str:
+    flat = " ".join(text.split())
+    return flat if len(flat) <= width else flat[: width - 3] + "..."
+
+
+def _short(value: Any) -> str:
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    return _one_line("" if value is None else str(value), 14)
 
 
 # --------------------------------------------------------------------------------------------

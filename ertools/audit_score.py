@@ -15,8 +15,10 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Any
+from collections.abc import Sequence
+from dataclasses import dataclass, fields, replace
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, cast
 
 from ertools.benchmarks.base import Rows, jsonable
 
@@ -121,6 +123,31 @@ def _int_keys(d: dict[Any, Any]) -> list[int] | None:
         return sorted(int(str(k)) for k in d)
     except ValueError:
         return None
+
+
+def _renest(live: dict[Any, Any], recomputed: dict[str, Any], notes: list[str]) -> dict[Any, Any]:
+    """Move a top-level live key into the recomputed mapping that holds it one level down.
+
+    The 2015 FBM2 node wrote ``segments_details`` at the top level; Listing 13 and ertools
+    nest it under ``details``.
+    """
+    out = dict(live)
+    for key in list(live):
+        k = str(key)
+        if k in recomputed:
+            continue
+        holders = [p for p, v in recomputed.items() if isinstance(v, dict) and k in v]
+        if len(holders) != 1:
+            continue
+        parent = holders[0]
+        existing = out.get(parent)
+        if existing is not None and not isinstance(existing, dict):
+            continue
+        merged = dict(existing or {})
+        merged[k] = out.pop(key)
+        out[parent] = merged
+        notes.append(f"the live score has {k} at the top level; compared with {parent}.{k}")
+    return out
 
 
 def _align_indices(live: Any, recomputed: Any, notes: list[str], path: str = "") -> Any:
@@ -312,8 +339,14 @@ def compare_scores(
         notes.append(f"the live score is not a mapping but {type(live).__name__}")
         live_flat = {"(live score)": live}
     else:
-        live_flat = flatten(_align_indices(live, recomputed, notes))
+        live_flat = flatten(_align_indices(_renest(live, recomputed, notes), recomputed, notes))
     rec_flat = flatten(recomputed)
+    if live_flat and not set(live_flat) & set(rec_flat):
+        notes.append(
+            "the live score has no key in common with the recomputed score: it is shown as "
+            "sent, beside the recomputed headline values"
+        )
+        rec_flat = {k: v for k, v in rec_flat.items() if "." not in k}
     lines: list[ScoreLine] = []
     keys = list(rec_flat) + [k for k in live_flat if k not in rec_flat]
     for key in keys:
@@ -365,3 +398,118 @@ def attach(audit: Audit, result: BenchmarkResult) -> Audit:
         deviations=tuple(result.deviations),
         failures=tuple(result.failures),
     )
+
+
+# --------------------------------------------------------------------------------------------
+# Recomputing
+
+
+@dataclass(frozen=True)
+class ScoreInputs:
+    """The scoring inputs an audit passes through to the benchmark's scorer.
+
+    Each scorer uses the ones it knows (``goal``/``transform``/``team``/``transforms``/``hits``
+    for fbm2h, ``items``/``results`` for fbm1, ``config``/``d_min`` for fbm3w, ``topic`` for
+    all); :func:`rescore` says which ones it ignored.
+    """
+
+    goal: Path | None = None
+    transform: Path | None = None
+    team: str | None = None
+    transforms: Path | None = None
+    config: Path | None = None
+    items: Path | None = None
+    results: Path | None = None
+    topic: str | None = None
+    d_min: float | None = None
+    hits: int | None = None
+
+    def given(self) -> set[str]:
+        return {f.name for f in fields(self) if getattr(self, f.name) is not None}
+
+
+# What each benchmark's scorer uses of ScoreInputs.
+USES: dict[str, frozenset[str]] = {
+    "fbm2h": frozenset({"goal", "transform", "team", "transforms", "topic", "hits"}),
+    "fbm1h": frozenset({"items", "results"}),
+    "fbm1w": frozenset({"items", "results"}),
+    "fbm3w": frozenset({"config", "d_min", "topic"}),
+}
+
+
+def rescore(
+    benchmark: str, paths: Sequence[Path], inputs: ScoreInputs
+) -> tuple[BenchmarkResult, tuple[str, ...]]:
+    """Recompute ``benchmark``'s score from ``paths`` with the scorer of ``ertools.benchmarks``.
+
+    Returns:
+        The result, and notes about inputs the scorer does not use.
+
+    Raises:
+        ScoringError: no scorer for that benchmark (yet).
+        ErtoolsError: whatever the scorer raises for bad input.
+    """
+    from ertools.errors import ConfigError, ScoringError
+
+    if benchmark not in USES:
+        raise ScoringError(f"no scorer to recompute {benchmark!r} from an audit")
+    ignored = sorted(inputs.given() - USES[benchmark])
+    notes = tuple(f"--{name.replace('_', '-')} is not used by {benchmark}" for name in ignored)
+    plist = [Path(p) for p in paths]
+    result: BenchmarkResult
+    if benchmark == "fbm2h":
+        from ertools.benchmarks.fbm2h import Fbm2hOptions, score_fbm2h
+
+        result = cast(  # frozen results vs the protocol's settable attributes
+            "BenchmarkResult",
+            score_fbm2h(
+                plist,
+                Fbm2hOptions(
+                    goal=inputs.goal,
+                    transform=inputs.transform,
+                    team=inputs.team,
+                    transforms_dir=inputs.transforms,
+                    topic=inputs.topic,
+                    hits=inputs.hits,
+                    namespace=benchmark,
+                ),
+            ),
+        )
+    elif benchmark in ("fbm1h", "fbm1w"):
+        from ertools.benchmarks.fbm1 import Fbm1Options, score_fbm1_bag
+
+        if inputs.items is None:
+            raise ConfigError(f"recomputing {benchmark} needs the item list: give --items FILE")
+        result = cast(
+            "BenchmarkResult",
+            score_fbm1_bag(
+                plist,
+                inputs.items,
+                options=Fbm1Options(benchmark=benchmark),
+                results_path=inputs.results,
+            ),
+        )
+    else:
+        result = _rescore_fbm3w(plist, inputs)
+    return result, notes
+
+
+def _rescore_fbm3w(paths: list[Path], inputs: ScoreInputs) -> BenchmarkResult:
+    from importlib import import_module
+
+    from ertools.errors import ScoringError
+
+    try:
+        module = import_module("ertools.benchmarks.fbm3w")
+    except ImportError as err:
+        raise ScoringError(f"the fbm3w scorer is not available: {err}") from err
+    options_cls = module.Fbm3wOptions
+    names = {f.name for f in fields(options_cls)}
+    kwargs: dict[str, Any] = {}
+    for name, value in (("config", inputs.config), ("d_min", inputs.d_min)):
+        if value is not None and name in names:
+            kwargs[name] = value
+    if inputs.topic is not None and "topic" in names:
+        kwargs["topic"] = inputs.topic
+    result: BenchmarkResult = module.score_fbm3w(paths, options_cls(**kwargs))
+    return result

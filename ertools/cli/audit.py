@@ -1,0 +1,159 @@
+"""Reconstruct a benchmark from its state topics and check it.
+
+The timeline of the BmBox, RefBox and Client states (durations and payloads: goals, manual
+operations, results, the score sent live, timeout/halt reasons); BmBox transitions the 2015
+implementation did not allow; silences in the 10 Hz state heartbeat; runs ended by timeout or
+halt. Where a scorer exists, the score is recomputed from the same bag and shown beside the
+live score, each difference explained.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+EPILOG = """examples:
+  ertools audit fbm2h.bag
+  ertools audit fbm2h.bag --transform transform-homer.yaml --report audit/
+  ertools audit fbm1h.bag --items configs/fbm1h.yaml --format json
+  ertools audit fbm3w.bag --config configs/fbm3w.yaml --max-silence 0.5 --no-rescore
+
+The benchmark is the namespace of the state topics (/fbm2h/bmbox_state -> fbm2h); give
+--benchmark when a bag holds several. Scoring inputs (--goal, --transform, --items, --config...)
+are passed to the benchmark's scorer as `ertools score NAME` takes them.
+Exit status: 0 (findings are reported, not errors; --strict makes them exit 1), 1 when the bag
+has no state topics or cannot be read, or the recomputed score has failures."""
+
+BENCHMARKS = ("fbm1h", "fbm1w", "fbm2h", "fbm3w")
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="benchmark log(s)")
+    parser.add_argument(
+        "--benchmark", choices=BENCHMARKS, help="namespace of the state topics (default: inferred)"
+    )
+    parser.add_argument(
+        "--max-silence",
+        type=float,
+        default=1.0,
+        metavar="S",
+        help="report heartbeat gaps longer than S seconds (default 1; the beat is 0.1 s)",
+    )
+    parser.add_argument(
+        "--no-rescore", action="store_true", help="do not recompute the score (timeline only)"
+    )
+    parser.add_argument(
+        "--strict",
+        action="store_true",
+        help="exit 1 when anything is found (illegal transition, silence, early end, difference)",
+    )
+    scoring = parser.add_argument_group("scoring inputs (passed to the benchmark's scorer)")
+    scoring.add_argument("--goal", type=Path, metavar="FILE", help="fbm2h goal list")
+    scoring.add_argument("--transform", type=Path, metavar="FILE", help="fbm2h transform")
+    scoring.add_argument("--team", metavar="NAME", help="fbm2h: with --transforms")
+    scoring.add_argument("--transforms", type=Path, metavar="DIR", help="fbm2h transforms folder")
+    scoring.add_argument("--hits", type=int, metavar="N", help="fbm2h: the referee's hits")
+    scoring.add_argument("--items", type=Path, metavar="FILE", help="fbm1 item list")
+    scoring.add_argument("--results", type=Path, metavar="FILE", help="fbm1 answers file")
+    scoring.add_argument("--config", type=Path, metavar="FILE", help="fbm3w config")
+    scoring.add_argument("--d-min", type=float, metavar="M", help="fbm3w d_min in metres")
+    scoring.add_argument("--topic", metavar="TOPIC", help="pose topic of the scorer")
+    from ertools.cli.common import add_output_options
+
+    add_output_options(parser, ("text", "yaml", "json"), plot=False)
+
+
+def infer_benchmark(bags: list[Path]) -> str:
+    """The namespace of the state topics in ``bags``; errors when none or several."""
+    from ertools.errors import BagError, UsageError
+    from ertools.io import topics
+    from ertools.states import STATE_TOPIC_SUFFIXES
+
+    suffixes = {s for group in STATE_TOPIC_SUFFIXES.values() for s in group}
+    found = sorted(
+        {
+            t.strip("/").split("/")[0]
+            for t in topics(bags)
+            if t.count("/") == 2 and t.rsplit("/", 1)[1] in suffixes
+        }
+    )
+    if not found:
+        raise BagError(
+            "no benchmark state topics (/<benchmark>/bmbox_state, refbox_state, client_state): "
+            "nothing to audit; score such logs with `ertools score NAME ... --reached timing`",
+            path=bags[0],
+        )
+    if len(found) > 1:
+        raise UsageError(
+            f"state topics of several benchmarks ({', '.join(found)}): give --benchmark"
+        )
+    return found[0]
+
+
+def run(args: argparse.Namespace) -> int:
+    from ertools.audit import audit_states
+    from ertools.audit_score import ScoreInputs, attach, rescore
+    from ertools.cli.common import emit_result, note, write_text
+    from ertools.errors import BagError, ConfigError, ErtoolsError
+    from ertools.io import read_benchmark_states
+    from ertools.timeutil import s_to_ns
+
+    bags: list[Path] = list(args.bags)
+    for bag in bags:
+        if not bag.exists():
+            raise BagError("no such file or directory", path=bag)
+    if args.max_silence <= 0:
+        raise ConfigError(f"--max-silence must be > 0 s, got {args.max_silence}")
+    benchmark = args.benchmark or infer_benchmark(bags)
+    states = read_benchmark_states(bags, benchmark)
+    if states.bmbox is None and states.refbox is None and states.client is None:
+        raise BagError(f"no /{benchmark} state topics: nothing to audit", path=bags[0])
+    audit = audit_states(
+        states.bmbox,
+        states.refbox,
+        states.client,
+        benchmark=benchmark,
+        max_silence_ns=s_to_ns(args.max_silence),
+        inputs=tuple(str(b) for b in bags),
+    )
+    if not args.no_rescore:
+        inputs = ScoreInputs(
+            goal=args.goal,
+            transform=args.transform,
+            team=args.team,
+            transforms=args.transforms,
+            config=args.config,
+            items=args.items,
+            results=args.results,
+            topic=args.topic,
+            d_min=args.d_min,
+            hits=args.hits,
+        )
+        try:
+            result, notes = rescore(benchmark, bags, inputs)
+        except ErtoolsError as err:
+            # The timeline is worth having even when the score cannot be recomputed.
+            note(f"warning: score not recomputed: {err}")
+        else:
+            for line in notes:
+                note(f"warning: {line}")
+            audit = attach(audit, result)
+    if args.format != "text":
+        code = emit_result(audit, args, bags)  # type: ignore[arg-type]
+    else:
+        write_text(audit.to_text(), args.output)
+        for deviation in audit.deviations:
+            note(f"differs from 2015: {deviation}")
+        if args.report is not None:
+            from ertools.report.folder import write_report
+
+            index = write_report(audit, args.report, inputs=bags, argv=sys.argv)  # type: ignore[arg-type]
+            note(f"wrote report {index}")
+        for failure in audit.failures:
+            note(f"error: {failure}")
+        code = 1 if audit.failures else 0
+    if args.strict and audit.findings and code == 0:
+        note(f"{audit.findings} finding(s) and --strict: exit 1")
+        return 1
+    return code

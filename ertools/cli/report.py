@@ -1,0 +1,38 @@
+"""Combine several results (a competition's runs) into one HTML page.
+
+RESULTS are report folders written with `--report DIR`, their result.json, or score.json
+files. The page has one table per benchmark, one row per result (team, headline numbers,
+warnings, failures, audit findings) and links to each report.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+EPILOG = """examples:
+  ertools score fbm3w run1.bag --report results/team-a-run1
+  ertools score fbm3w run2.bag --report results/team-b-run1
+  ertools report results/*/ --out competition/
+  ertools report results/*/score.json --out competition/ --title "Lisbon 2015"
+"""
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "results", nargs="+", type=Path, metavar="RESULT", help="report folder or its JSON"
+    )
+    parser.add_argument(
+        "--out", type=Path, required=True, metavar="DIR", help="where to write index.html"
+    )
+    parser.add_argument("--title", default="Competition results", help="the page's title")
+
+
+def run(args: argparse.Namespace) -> int:
+    from ertools.cli.common import note
+    from ertools.report.combine import combine
+
+    index = combine(list(args.results), args.out, title=args.title)
+    note(f"combined {len(args.results)} result(s) into {index}")
+    print(index)
+    return 0

@@ -1,0 +1,532 @@
+"""A self-contained report folder a referee can open, archive and check.
+
+``write_report(result, outdir, inputs=..., argv=...)`` writes:
+
+- ``index.html``: score table, every figure of the benchmark, the audit timeline when the
+  bag has state topics, warnings, deviations from the 2015 node, and the provenance needed to
+  reproduce the score (inputs with SHA-256, configs, parameters, command line, version);
+  no network needed: inline CSS, figures as PNG files beside it;
+- ``score.yaml`` (the seed's listing), ``score.json``;
+- one CSV per table of the result (``runs.csv``, ``segments.csv``...), ``audit_*.csv``;
+- ``figures/*.png``;
+- ``result.json``: the metadata ``ertools report`` combines (benchmark, team, inputs, the
+  headline numbers and the whole score).
+
+An :class:`~ertools.audit.Audit` is accepted as well: its recomputed score (when there is one)
+becomes the score of the folder, and ``audit.yaml``/``audit.json`` are added.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import json
+import logging
+import platform
+import re
+import shlex
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+from ertools import __version__
+from ertools.benchmarks.base import BenchmarkResult, Rows, jsonable
+from ertools.report import html as h
+
+log = logging.getLogger("ertools.report.folder")
+
+NAMESPACES = ("fbm1h", "fbm1w", "fbm2h", "fbm3w")
+CONFIG_MAX_BYTES = 64 * 1024  # configs up to this size are shown in the page
+TABLE_MAX_ROWS = 200  # longer tables are in the CSV only
+_CHUNK = 1 << 20
+_EPOCH_COLUMNS = ("time", "from_time", "start_time")
+
+
+@dataclass(frozen=True)
+class FileRecord:
+    """An input or config file as the report records it."""
+
+    name: str
+    path: str
+    sha256: str
+    size: int
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"name": self.name, "path": self.path, "sha256": self.sha256, "size": self.size}
+
+
+def sha256_file(path: Path) -> str:
+    """SHA-256 of a file, read in chunks (bags are large); of a directory (rosbag2), the
+    SHA-256 of the sorted list of '<relative path> <sha256 of that file>' lines."""
+    if path.is_dir():
+        lines = [
+            f"{p.relative_to(path).as_posix()} {sha256_file(p)}\n"
+            for p in sorted(path.rglob("*"))
+            if p.is_file()
+        ]
+        return hashlib.sha256("".join(lines).encode()).hexdigest()
+    digest = hashlib.sha256()
+    with path.open("rb") as fh:
+        while chunk := fh.read(_CHUNK):
+            digest.update(chunk)
+    return digest.hexdigest()
+
+
+def file_record(path: Path) -> FileRecord:
+    size = (
+        sum(p.stat().st_size for p in path.rglob("*") if p.is_file())
+        if path.is_dir()
+        else path.stat().st_size
+    )
+    return FileRecord(path.name, str(path), sha256_file(path), size)
+
+
+def write_report(
+    result: BenchmarkResult,
+    outdir: Path,
+    *,
+    inputs: list[Path],
+    argv: list[str],
+    audit: Any = None,
+    team: str | None = None,
+) -> Path:
+    """Write the report folder of ``result`` into ``outdir``; returns the ``index.html`` path.
+
+    Args:
+        result: any benchmark result, or an :class:`ertools.audit.Audit`.
+        outdir: the folder (created; files of the same names are overwritten).
+        inputs: the bags the result was computed from (hashed, not modified).
+        argv: the command line (shown; file arguments that are not inputs are the configs).
+        audit: an audit to include; by default, when ``result`` is a benchmark score whose
+            bags have its state topics, they are audited here.
+        team: the team, when the caller knows it (else from ``--team``, the parameters or a
+            ``transform-<team>.yaml`` argument).
+    """
+    from ertools.audit import Audit
+
+    outdir.mkdir(parents=True, exist_ok=True)
+    score: BenchmarkResult | None
+    if isinstance(result, Audit):
+        audit, score = result, result.recomputed
+    else:
+        score = result
+        if audit is None:
+            audit = _audit_inputs(result.name, inputs)
+    benchmark = score.name if score is not None else (audit.benchmark or "audit")
+    inputs = [Path(p) for p in inputs]
+    input_records = [file_record(p) for p in inputs if p.exists()]
+    configs = _configs(argv, inputs, score)
+    team = team or _team(argv, score, configs)
+
+    written: list[str] = []
+    if score is not None:
+        _write(outdir / "score.yaml", score.to_yaml())
+        _write(outdir / "score.json", json.dumps(jsonable(score.to_dict()), indent=2))
+        written += ["score.yaml", "score.json"]
+        written += _write_tables(outdir, score.tables(), prefix="")
+    if audit is not None:
+        _write(outdir / "audit.yaml", audit.to_yaml())
+        _write(outdir / "audit.json", json.dumps(jsonable(audit.to_dict()), indent=2))
+        written += ["audit.yaml", "audit.json"]
+        audit_tables = {k: v for k, v in audit.tables().items() if k != "score_comparison"}
+        written += _write_tables(outdir, audit_tables, prefix="audit_")
+        if audit.comparison is not None:
+            written += _write_tables(
+                outdir, {"score_comparison": audit.comparison.rows()}, prefix=""
+            )
+    figures, figure_problems = _figures(score, audit, outdir / "figures")
+
+    generated = datetime.now(UTC).isoformat(timespec="seconds")
+    meta = {
+        "benchmark": benchmark,
+        "team": team,
+        "generated": generated,
+        "ertools_version": __version__,
+        "argv": list(argv),
+        "inputs": [r.to_dict() for r in input_records],
+        "configs": [r.to_dict() for r, _ in configs],
+        "headline": headline(score.to_dict()) if score is not None else {},
+        "score": jsonable(score.to_dict()) if score is not None else None,
+        "warnings": list(_warnings(score, audit)),
+        "failures": list(score.failures if score is not None else ()),
+        "audit": _audit_summary(audit),
+        "files": [*written, "index.html", *(f"figures/{p.name}" for p, _ in figures)],
+    }
+    _write(outdir / "result.json", json.dumps(jsonable(meta), indent=2))
+    page = _page(
+        score, audit, meta, input_records, configs, figures, figure_problems, written, outdir
+    )
+    index = outdir / "index.html"
+    _write(index, page)
+    return index
+
+
+# --------------------------------------------------------------------------------------------
+# Gathering
+
+
+def _write(path: Path, text: str) -> None:
+    path.write_text(text if text.endswith("\n") else text + "\n", encoding="utf-8")
+
+
+def _audit_inputs(name: str, inputs: list[Path]) -> Any:
+    """The audit of the bags' state topics, or None (no namespace, no topics, unreadable)."""
+    if name not in NAMESPACES or not inputs:
+        return None
+    from ertools.audit import audit_states
+    from ertools.errors import ErtoolsError
+    from ertools.io import read_benchmark_states
+
+    try:
+        states = read_benchmark_states([Path(p) for p in inputs], name)
+    except ErtoolsError as err:
+        log.info("no audit in the report: %s", err)
+        return None
+    if states.bmbox is None and states.refbox is None and states.client is None:
+        return None
+    return audit_states(
+        states.bmbox,
+        states.refbox,
+        states.client,
+        benchmark=name,
+        inputs=tuple(str(p) for p in inputs),
+    )
+
+
+def _configs(
+    argv: list[str], inputs: list[Path], score: BenchmarkResult | None
+) -> list[tuple[FileRecord, str | None]]:
+    """Files named on the command line or in the provenance that are not inputs: configs.
+
+    The text is kept (to show) when small and UTF-8.
+    """
+    seen = {p.resolve() for p in inputs if p.exists()}
+    candidates: list[Path] = []
+    for token in argv[1:]:
+        value = token.split("=", 1)[1] if token.startswith("--") and "=" in token else token
+        if value.startswith("-"):
+            continue
+        candidates.append(Path(value))
+    if score is not None:
+        candidates += [Path(p) for p in score.provenance.inputs]
+    out: list[tuple[FileRecord, str | None]] = []
+    for path in candidates:
+        try:
+            if not path.is_file() or path.resolve() in seen:
+                continue
+        except OSError:
+            continue
+        seen.add(path.resolve())
+        record = file_record(path)
+        text: str | None = None
+        if record.size <= CONFIG_MAX_BYTES:
+            try:
+                text = path.read_text(encoding="utf-8")
+            except (UnicodeDecodeError, OSError):
+                text = None
+        out.append((record, text))
+    return out
+
+
+def _team(
+    argv: list[str],
+    score: BenchmarkResult | None,
+    configs: list[tuple[FileRecord, str | None]],
+) -> str | None:
+    for i, token in enumerate(argv):
+        if token == "--team" and i + 1 < len(argv):
+            return argv[i + 1]
+        if token.startswith("--team="):
+            return token.split("=", 1)[1]
+    if score is not None:
+        for name, value in score.provenance.parameters:
+            if name.lower() in ("team", "robot_info") and value not in ("", "identity"):
+                return value
+    for record, _ in configs:
+        m = re.fullmatch(r"transform-(.+)\.ya?ml", record.name)
+        if m and m.group(1) != "identity":
+            return m.group(1)
+    return None
+
+
+def headline(score: dict[str, Any]) -> dict[str, Any]:
+    """The top-level scalar values of a score (``position_accuracy``, ``best_run``...)."""
+    return {k: v for k, v in score.items() if v is None or isinstance(v, bool | int | float | str)}
+
+
+def _warnings(score: BenchmarkResult | None, audit: Any) -> tuple[str, ...]:
+    items = list(score.warnings) if score is not None else []
+    if audit is not None:
+        items += [w for w in audit.warnings if w not in items]
+    return tuple(items)
+
+
+def _audit_summary(audit: Any) -> dict[str, Any] | None:
+    if audit is None:
+        return None
+    return {
+        "runs": len(audit.runs),
+        "illegal_transitions": len(audit.illegal_transitions),
+        "silences": len(audit.silences),
+        "early_ends": [e.reason for e in audit.early_ends],
+        "live_score": jsonable(audit.live_score),
+        "differences": len(audit.comparison.differences) if audit.comparison else None,
+    }
+
+
+def _csv_cell(value: Any) -> Any:
+    value = jsonable(value)
+    if isinstance(value, dict | list):
+        return json.dumps(value)
+    return "" if value is None else value
+
+
+def _write_tables(outdir: Path, tables: dict[str, Rows], *, prefix: str) -> list[str]:
+    names = []
+    for name, rows in tables.items():
+        safe = re.sub(r"[^A-Za-z0-9_.-]+", "_", f"{prefix}{name}")
+        columns = list(dict.fromkeys(k for row in rows for k in row))
+        with (outdir / f"{safe}.csv").open("w", newline="", encoding="utf-8") as fh:
+            writer = csv.writer(fh)
+            writer.writerow(columns)
+            for row in rows:
+                writer.writerow([_csv_cell(row.get(c)) for c in columns])
+        names.append(f"{safe}.csv")
+    return names
+
+
+def _figures(
+    score: BenchmarkResult | None, audit: Any, figdir: Path
+) -> tuple[list[tuple[Path, str]], list[str]]:
+    """Draw every figure, one at a time, so that one failing plot does not lose the others."""
+    from ertools.report import plots_audit
+    from ertools.report.figures import FigureSpec, figure_specs, save_figures
+
+    specs: list[FigureSpec] = []
+    problems: list[str] = []
+    if score is not None:
+        try:
+            specs += figure_specs(score)
+        except ImportError as err:
+            problems.append(f"no figures for {score.name}: {err}")
+    if audit is not None:
+        specs += plots_audit.figure_specs(audit)
+    out: list[tuple[Path, str]] = []
+    for spec in specs:
+        try:
+            out += [(p, spec.title or spec.name) for p in save_figures([spec], figdir)]
+        except Exception as err:  # a plotting bug must not cost the referee the report
+            log.warning("figure %s failed: %s", spec.name, err)
+            problems.append(f"figure {spec.name} could not be drawn: {err}")
+    return out, problems
+
+
+# --------------------------------------------------------------------------------------------
+# The page
+
+
+def _page(
+    score: BenchmarkResult | None,
+    audit: Any,
+    meta: dict[str, Any],
+    input_records: list[FileRecord],
+    configs: list[tuple[FileRecord, str | None]],
+    figures: list[tuple[Path, str]],
+    figure_problems: list[str],
+    written: list[str],
+    outdir: Path,
+) -> str:
+    sections: list[tuple[str, str, str]] = []
+    status = []
+    failures = list(score.failures) if score is not None else []
+    if failures:
+        status.append(h.badge(f"{len(failures)} failure(s)", "bad"))
+    if meta["warnings"]:
+        status.append(h.badge(f"{len(meta['warnings'])} warning(s)", "warn"))
+    if not failures and not meta["warnings"]:
+        status.append(h.badge("no warnings", "ok"))
+
+    if score is not None:
+        body = "<p>" + "".join(status) + "</p>"
+        head = meta["headline"]
+        if head:
+            body += h.table([{"metric": k, "value": v} for k, v in head.items()], caption="Score")
+        body += h.notes(f"failure: {f}" for f in failures)
+        body += "<h3>score.yaml (the seed's format)</h3>" + h.pre(score.to_yaml())
+        sections.append(("score", "Score", body))
+        tables = score.tables()
+        if tables:
+            parts = []
+            for name, rows in tables.items():
+                parts.append(f"<h3>{h.esc(name)}</h3>")
+                parts.append(h.table(rows, max_rows=TABLE_MAX_ROWS) if rows else "<p>(empty)</p>")
+                parts.append(f'<p class="muted">{h.link(f"{name}.csv", f"{name}.csv")}</p>')
+            sections.append(("tables", "Tables", "".join(parts)))
+    if figures or figure_problems:
+        body = "".join(h.figure(p.relative_to(outdir).as_posix(), title) for p, title in figures)
+        body += h.notes(figure_problems)
+        sections.append(("figures", "Figures", body))
+    if audit is not None:
+        sections.append(("audit", "Audit", _audit_html(audit)))
+    notes_body = ""
+    if meta["warnings"]:
+        notes_body += "<h3>Warnings</h3>" + h.notes(meta["warnings"])
+    deviations = _deviations(score, audit)
+    notes_body += "<h3>Where ertools deliberately differs from the 2015 node</h3>"
+    notes_body += h.notes(deviations) if deviations else "<p>(none declared)</p>"
+    sections.append(("notes", "Warnings and deviations", notes_body))
+    sections.append(
+        (
+            "provenance",
+            "Provenance",
+            _provenance_html(score, audit, meta, input_records, configs, written),
+        )
+    )
+    title = f"ertools report: {meta['benchmark']}"
+    if meta["team"]:
+        title += f" \u2014 {meta['team']}"
+    subtitle = f"generated {meta['generated']} by ertools {meta['ertools_version']}"
+    if input_records:
+        subtitle += " from " + ", ".join(r.name for r in input_records)
+    return h.page(title, subtitle, sections)
+
+
+def _deviations(score: BenchmarkResult | None, audit: Any) -> list[str]:
+    items: list[str] = []
+    sources: list[Any] = [score] if score is not None else []
+    if audit is not None:
+        sources.append(audit)
+    for src in sources:
+        for d in (*src.deviations, *src.provenance.deviations_from_2015):
+            if d not in items:
+                items.append(d)
+    return items
+
+
+def _audit_html(audit: Any) -> str:
+    from ertools.timeutil import iso_utc, ns_to_s
+
+    parts = [
+        h.definitions(
+            [
+                ("benchmark", audit.benchmark or "(unknown)"),
+                ("first state message", iso_utc(audit.start_ns) if audit.timeline else None),
+                ("duration [s]", ns_to_s(audit.end_ns - audit.start_ns)),
+                ("BmBox transitions checked", audit.transitions_checked),
+                ("illegal transitions", len(audit.illegal_transitions)),
+                (f"silences > {ns_to_s(audit.max_silence_ns):g} s", len(audit.silences)),
+                ("ended by the RefBox", ", ".join(e.reason for e in audit.early_ends) or "no"),
+            ]
+        )
+    ]
+    if audit.topics:
+        parts.append(
+            h.table(
+                [{"machine": m, "topic": t, "messages": n} for m, t, n in audit.topics],
+                caption="State topics",
+            )
+        )
+    tables = audit.tables()
+    for key, caption in (
+        ("illegal_transitions", "Illegal BmBox transitions"),
+        ("silences", "Heartbeat silences"),
+        ("early_ends", "Benchmark ended by the RefBox"),
+    ):
+        if tables[key]:
+            # Epoch columns stay in the CSV; the page shows seconds from the first message.
+            columns = [c for c in tables[key][0] if c not in _EPOCH_COLUMNS]
+            parts.append(h.table(tables[key], columns=columns, caption=caption))
+    if audit.comparison is not None:
+        cmp = audit.comparison
+        parts.append("<h3>Live score vs recomputed score</h3>")
+        parts.append(
+            f"<p>{cmp.same} value(s) agree within {cmp.abs_tol:g}, "
+            f"{len(cmp.differences)} differ.</p>"
+        )
+        parts.append(h.notes(cmp.notes))
+        parts.append(
+            h.table(
+                tables.get("score_comparison", cmp.rows()),
+                columns=["key", "live", "recomputed", "difference", "status", "explanation"],
+                row_class="status",
+            )
+        )
+    elif audit.live_score_text is not None:
+        parts.append("<h3>Score sent live (TRANSMITTING_SCORE)</h3>" + h.pre(audit.live_score_text))
+    if tables["runs"]:
+        parts.append("<h3>Runs</h3>")
+        parts.append(
+            h.table(
+                tables["runs"],
+                columns=[
+                    "run",
+                    "start",
+                    "end",
+                    "duration",
+                    "outcome",
+                    "states",
+                    "manual_operation",
+                    "goal",
+                    "result",
+                ],
+            )
+        )
+    if tables["timeline"]:
+        parts.append("<h3>Timeline</h3>")
+        parts.append(
+            h.table(
+                tables["timeline"],
+                columns=["start", "machine", "state", "duration", "kind", "payload"],
+                max_rows=TABLE_MAX_ROWS,
+            )
+        )
+    return "".join(parts)
+
+
+def _provenance_html(
+    score: BenchmarkResult | None,
+    audit: Any,
+    meta: dict[str, Any],
+    input_records: list[FileRecord],
+    configs: list[tuple[FileRecord, str | None]],
+    written: list[str],
+) -> str:
+    parts = ["<h3>Inputs</h3>"]
+    parts.append(
+        h.table([r.to_dict() for r in input_records], columns=["name", "size", "sha256", "path"])
+        if input_records
+        else "<p>(none given)</p>"
+    )
+    if configs:
+        parts.append("<h3>Configs</h3>")
+        parts.append(
+            h.table([r.to_dict() for r, _ in configs], columns=["name", "size", "sha256", "path"])
+        )
+        for record, text in configs:
+            if text is not None:
+                parts.append(f'<p class="muted">{h.esc(record.name)}</p>' + h.pre(text))
+    params: list[tuple[str, Any]] = []
+    if score is not None:
+        params += list(score.provenance.parameters)
+    if audit is not None:
+        params += [(f"audit {k}", v) for k, v in audit.provenance.parameters]
+    parts.append("<h3>Parameters</h3>")
+    parts.append(h.definitions(params) if params else "<p>(none)</p>")
+    parts.append("<h3>Software</h3>")
+    parts.append(
+        h.definitions(
+            [
+                ("ertools", meta["ertools_version"]),
+                ("python", platform.python_version()),
+                ("platform", platform.platform()),
+                ("generated", meta["generated"]),
+                ("command line", shlex.join(meta["argv"]) if meta["argv"] else None),
+            ]
+        )
+    )
+    parts.append("<h3>Files of this report</h3>")
+    parts.append(
+        '<p class="muted">' + " ".join(h.link(f, f) for f in ["result.json", *written]) + "</p>"
+    )
+    return "".join(parts)
