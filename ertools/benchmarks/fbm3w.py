@@ -1,0 +1,355 @@
+"""FBM3@Work trajectory following (seed 7.3): load -> find runs -> score -> result.
+
+:func:`score_fbm3w` reads bags through :mod:`ertools.io` and calls :func:`score_runs`, which
+is pure (pose stream + run windows + config -> :class:`Fbm3wResult`). The scoring itself is in
+:mod:`ertools.benchmarks.fbm3w_path`, run finding in :mod:`ertools.benchmarks.fbm3w_runs`.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ertools.benchmarks.fbm3w_path import score_path
+from ertools.benchmarks.fbm3w_result import Fbm3wResult, RunResult
+from ertools.benchmarks.fbm3w_runs import (
+    RunWindow,
+    find_auto,
+    find_states,
+    find_windows,
+    with_specs,
+)
+from ertools.benchmarks.noise import DEFAULT_C, NoiseResult, identical_poses, noise_from_stream
+from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
+from ertools.configs.shapes import Shape
+from ertools.errors import ConfigError, ErtoolsError, ScoringError, TopicError
+from ertools.streams import PoseStream, Provenance
+
+log = logging.getLogger("ertools.benchmarks.fbm3w")
+
+NAMESPACE = "fbm3w"
+DEFAULT_TOPIC = "/fbm3w/robot_at_work/pose2d"
+FALLBACK_TOPIC = "/fbm3w/robot_at_work/pose"
+DEFAULT_FRAME = "robot_at_work"
+RUN_MODES = ("states", "windows", "auto")
+# The reference pose is the last sample at or before the reference time; older than this, the
+# marker set was probably not tracked at that moment.
+STALE_REFERENCE_S = 0.5
+# Below this reference-start distance the run frame's direction is uncertain (1 mm of noise
+# turns a 1 cm baseline by ~0.1 rad).
+SHORT_BASELINE_M = 0.01
+
+Window = tuple[str, float, float, float]
+F64 = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Fbm3wOptions:
+    """How to score (the CLI's options, as data).
+
+    Attributes:
+        runs: ``states``, ``windows``, ``auto``, or None (windows when given, else states when
+            the BmBox topic exists, else auto).
+        windows: explicit runs (spec, reference, start, end) in seconds (bag-relative or epoch).
+        d_min: overrides the config's d_min.
+        sweep: d_min values to score every run with (``--d-min-sweep``).
+        topic, frame: the pose source (default: the pose2d topic, then pose, then tf frame).
+        time_source: ``record`` (default: the 2015 node received poses live) or ``header``.
+        still_speed, min_still_s: stationary detection (auto runs and the noise estimate).
+        noise_c: factor of the suggested d_min (c * epsilon).
+    """
+
+    runs: str | None = None
+    windows: tuple[Window, ...] = ()
+    d_min: float | None = None
+    sweep: tuple[float, ...] = ()
+    topic: str | None = None
+    frame: str | None = None
+    time_source: str = "record"
+    still_speed: float | None = None
+    min_still_s: float | None = None
+    noise_c: float = DEFAULT_C
+
+
+def read_fbm3w_poses(paths: Sequence[Path], options: Fbm3wOptions) -> PoseStream:
+    """The end-effector poses: ``--topic``/``--frame``, else pose2d, pose, tf ``robot_at_work``.
+
+    Raises:
+        TopicError: none of them is in the bags (the message lists the pose topics there are).
+    """
+    from ertools.io import PoseSource, read_pose_source, topics
+
+    if options.topic is not None:
+        source = PoseSource(topic=options.topic, time_source=options.time_source)
+    elif options.frame is not None:
+        source = PoseSource(frame=options.frame)
+    else:
+        present = topics(paths)
+        if DEFAULT_TOPIC in present:
+            source = PoseSource(topic=DEFAULT_TOPIC, time_source=options.time_source)
+        elif FALLBACK_TOPIC in present:
+            log.warning("%s absent; using %s", DEFAULT_TOPIC, FALLBACK_TOPIC)
+            source = PoseSource(topic=FALLBACK_TOPIC, time_source=options.time_source)
+        elif "/tf" in present:
+            log.warning("%s absent; using the /tf frame %s", DEFAULT_TOPIC, DEFAULT_FRAME)
+            source = PoseSource(frame=DEFAULT_FRAME)
+        else:
+            pose_types = ("Pose2D", "PoseStamped", "TransformStamped", "Odometry", "TFMessage")
+            found = [t for t, ty in present.items() if ty.rsplit("/", 1)[-1] in pose_types]
+            raise TopicError(
+                f"no end-effector poses: {DEFAULT_TOPIC}, {FALLBACK_TOPIC} and /tf are absent "
+                f"(pose topics there: {', '.join(found) or 'none'}); choose one with --topic",
+                path=paths[0],
+            )
+    poses = read_pose_source(paths, source)
+    if len(poses) == 0:
+        raise TopicError(f"{poses.source or source.topic}: no pose messages", path=paths[0])
+    return poses
+
+
+def score_fbm3w(
+    paths: Sequence[Path], config: Fbm3wConfig, options: Fbm3wOptions = Fbm3wOptions()
+) -> Fbm3wResult:
+    """Score an FBM3@Work benchmark from its bag(s).
+
+    Raises:
+        ErtoolsError: unreadable bags, no poses, no runs (a single run's problem is a failure
+            inside the result instead).
+    """
+    from ertools.io import read_benchmark_states, summary, topics
+
+    plist = [Path(p) for p in paths]
+    if options.runs is not None and options.runs not in RUN_MODES:
+        raise ConfigError(f"--runs must be one of {', '.join(RUN_MODES)}, not {options.runs!r}")
+    poses = read_fbm3w_poses(plist, options)
+    bag_start = min(summary(p).start_ns for p in plist)
+    mode = options.runs
+    if mode is None:
+        if options.windows:
+            mode = "windows"
+        else:
+            bmbox_topics = {f"/{NAMESPACE}/bmbox_state", f"/{NAMESPACE}/bbbox_state"}
+            mode = "states" if bmbox_topics & set(topics(plist)) else "auto"
+            if mode == "auto":
+                log.info("no /fbm3w state topics: finding the runs from motion (--runs auto)")
+    if mode == "windows":
+        if not options.windows:
+            raise ConfigError("--runs windows needs --run SPEC:REF_T:START_T:END_T or --runs-file")
+        windows = find_windows(options.windows, bag_start)
+    elif mode == "states":
+        windows = find_states(read_benchmark_states(plist, NAMESPACE))
+    else:
+        windows = find_auto(poses, config, **_still(options))
+    return score_runs(
+        poses,
+        windows,
+        config,
+        options=options,
+        bag_start_ns=bag_start,
+        inputs=tuple(str(p) for p in plist),
+    )
+
+
+def _still(options: Fbm3wOptions) -> dict[str, float]:
+    out = {}
+    if options.still_speed is not None:
+        out["still_speed"] = options.still_speed
+    if options.min_still_s is not None:
+        out["min_still_s"] = options.min_still_s
+    return out
+
+
+def score_runs(
+    poses: PoseStream,
+    windows: Sequence[RunWindow],
+    config: Fbm3wConfig,
+    *,
+    options: Fbm3wOptions = Fbm3wOptions(),
+    bag_start_ns: int | None = None,
+    inputs: tuple[str, ...] = (),
+) -> Fbm3wResult:
+    """Score every run of ``windows`` on ``poses`` (pure; no file access)."""
+    cfg = config if options.d_min is None else config.with_d_min(options.d_min)
+    start_ns = poses.start_ns if bag_start_ns is None else bag_start_ns
+    runs_in, warnings = with_specs(list(windows), cfg)
+    noise = _noise(poses, options, warnings)
+    same = identical_poses(poses)
+    results: list[RunResult] = []
+    failures: list[str] = []
+    for window in runs_in:
+        run = _score_one(poses, same, window, cfg, options.sweep, start_ns, warnings)
+        results.append(run)
+        if run.error is not None:
+            failures.append(f"run {window.index} ({run.spec}): {run.error}")
+    if noise is not None and noise.distances.size and cfg.d_min < noise.suggested_d_min:
+        frac = float(np.mean(noise.distances >= cfg.d_min)) if noise.distances.size else 0.0
+        warnings.append(
+            f"d_min {cfg.d_min * 1000:.3g} mm is below the mocap noise measured in this bag "
+            f"(epsilon {noise.epsilon * 1000:.3g} mm over {noise.duration_s:.1f} s of "
+            f"stationary phases; {frac:.1%} of still steps exceed d_min, inflating L): "
+            f"suggested d_min {noise.suggested_d_min:.5f} m ({noise.c:g} * epsilon); see "
+            "--d-min-sweep"
+        )
+    mode = runs_in[0].mode if runs_in else (options.runs or "states")
+    return Fbm3wResult(
+        runs=tuple(results),
+        d_min=cfg.d_min,
+        noise=noise,
+        sweep_values=tuple(options.sweep),
+        warnings=tuple(warnings),
+        deviations=tuple(_deviations(cfg, results, mode, poses)),
+        failures=tuple(failures),
+        provenance=Provenance(
+            inputs=inputs or (poses.source,),
+            parameters=(
+                ("config", cfg.source),
+                ("d_min", repr(cfg.d_min)),
+                ("runs", mode),
+                ("poses", poses.source),
+            ),
+        ),
+    )
+
+
+def _noise(poses: PoseStream, options: Fbm3wOptions, warnings: list[str]) -> NoiseResult | None:
+    try:
+        return noise_from_stream(
+            poses,
+            stationary=True,
+            c=options.noise_c,
+            still_speed=options.still_speed,
+            min_still_s=options.min_still_s,
+        )
+    except ScoringError:
+        warnings.append(
+            "no stationary phase in the poses: the mocap noise (and whether d_min is above it) "
+            "could not be estimated"
+        )
+        return None
+
+
+def _score_one(
+    poses: PoseStream,
+    same: npt.NDArray[np.bool_],
+    window: RunWindow,
+    cfg: Fbm3wConfig,
+    sweep: Sequence[float],
+    bag_start_ns: int,
+    warnings: list[str],
+) -> RunResult:
+    spec = window.spec or ""
+
+    def result(error: str | None, **kw: Any) -> RunResult:
+        base: dict[str, Any] = {
+            "window": window,
+            "spec": spec or "?",
+            "score": None,
+            "error": error,
+            "samples": 0,
+            "tracking_losses": 0,
+            "reference_xy": None,
+            "target_length": None,
+            "d_min": cfg.d_min,
+            "bag_start_ns": bag_start_ns,
+        }
+        base.update(kw)
+        return RunResult(**base)
+
+    if not spec:
+        return result("no spec for this run (the config lists fewer runs); add it to the config")
+    try:
+        shape = cfg.shape(spec)
+    except ConfigError as err:
+        return result(err.message)
+    target_length = shape.length()
+    if window.status in ("interrupted", "timeout", "stopped"):
+        return result(None, target_length=target_length)  # reported, not scored (as 2015)
+    if window.status == "incomplete":
+        return result("the log ends during the run; no complete path to score")
+    if window.start_ns is None or window.end_ns is None or window.ref_ns is None:
+        return result("no reference time or path window was found for this run")
+    lo = int(np.searchsorted(poses.t_ns, window.start_ns, side="left"))
+    hi = int(np.searchsorted(poses.t_ns, window.end_ns, side="right"))
+    xy = poses.xyz[lo:hi, :2]
+    losses = int(np.sum(same[lo : max(lo, hi - 1)])) if hi - lo > 1 else 0
+    common: dict[str, Any] = {
+        "samples": hi - lo,
+        "tracking_losses": losses,
+        "target_length": target_length,
+    }
+    rel = (window.start_ns - bag_start_ns) / 1e9, (window.end_ns - bag_start_ns) / 1e9
+    if hi - lo < 2:
+        return result(
+            f"{hi - lo} pose sample(s) in the path window {rel[0]:.3f}-{rel[1]:.3f} s; "
+            "at least 2 are needed (tracking lost, or wrong window?)",
+            **common,
+        )
+    ref_i = int(np.searchsorted(poses.t_ns, window.ref_ns, side="right")) - 1
+    ref_rel = (window.ref_ns - bag_start_ns) / 1e9
+    if ref_i < 0:
+        return result(f"no pose at or before the reference time {ref_rel:.3f} s", **common)
+    age = (window.ref_ns - int(poses.t_ns[ref_i])) / 1e9
+    if age > STALE_REFERENCE_S:
+        warnings.append(
+            f"run {window.index}: the reference pose is {age:.2f} s older than the reference "
+            f"time {ref_rel:.3f} s (tracking lost then?)"
+        )
+    ref_xy = poses.xyz[ref_i, :2].copy()
+    common["reference_xy"] = (float(ref_xy[0]), float(ref_xy[1]))
+    try:
+        score = score_path(xy, ref_xy, shape, cfg.d_min)
+    except ScoringError as err:
+        return result(err.message, **common)
+    baseline = float(np.hypot(*(xy[0] - ref_xy)))
+    if baseline < SHORT_BASELINE_M:
+        warnings.append(
+            f"run {window.index}: the reference and starting positions are only "
+            f"{baseline * 1000:.1f} mm apart; the run frame's direction is uncertain"
+        )
+    swept = tuple((d, _try_score(xy, ref_xy, shape, d)) for d in sweep)
+    return result(None, score=score, sweep=swept, frame_xy=score.frame.to_frame(xy), **common)
+
+
+def _try_score(xy: F64, ref_xy: F64, shape: Shape, d_min: float) -> float | None:
+    try:
+        return score_path(xy, ref_xy, shape, d_min).distance_error
+    except ErtoolsError:
+        return None
+
+
+def _deviations(
+    cfg: Fbm3wConfig, runs: Sequence[RunResult], mode: str, poses: PoseStream
+) -> list[str]:
+    out = []
+    if mode == "states":
+        out.append(
+            "reference = last logged pose at or before COMPLETED_MANUAL_OPERATION and "
+            "execution_time from the BmBox state messages' record times; 2015 read the live tf "
+            "and its own wall clock at the same transitions"
+        )
+    elif mode == "windows":
+        out.append("runs from explicit windows; the 2015 node only had its state machine")
+    else:
+        out.append("runs found from motion (--runs auto); the 2015 node only had its state machine")
+    if not poses.source.endswith(DEFAULT_TOPIC):
+        out.append(f"poses from {poses.source.rsplit(':', 1)[-1]}; 2015 used {DEFAULT_TOPIC}")
+    if not math.isclose(cfg.d_min, DEFAULT_D_MIN, rel_tol=0, abs_tol=1e-12):
+        out.append(f"d_min = {cfg.d_min} m; the 2015 script used {DEFAULT_D_MIN} m")
+    custom = sorted(
+        {r.spec for r in runs if r.spec in cfg.shapes and not cfg.shapes[r.spec].builtin}
+    )
+    if custom:
+        out.append(f"user-defined shape(s) {', '.join(custom)}; 2015 had only its built-in shapes")
+    if any(r.window.status in ("timeout", "stopped") for r in runs):
+        out.append(
+            "a timed-out or stopped run is listed with its spec and time and no distance_error; "
+            "the 2015 node counted its time and wrote no details for it"
+        )
+    return out
