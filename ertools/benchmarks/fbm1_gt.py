@@ -154,8 +154,8 @@ def _s(ns: int) -> str:
 def _item_poses(rel: PoseStream, item: Item) -> tuple[np.ndarray, np.ndarray]:
     assert item.trans is not None and item.rot is not None
     n = len(rel)
-    t_item = np.broadcast_to(np.asarray(item.trans, dtype=np.float64), (n, 3))
-    q_item = np.broadcast_to(np.asarray(item.rot, dtype=np.float64), (n, 4))
+    t_item = np.tile(np.asarray(item.trans, dtype=np.float64), (n, 1))
+    q_item = np.tile(np.asarray(item.rot, dtype=np.float64), (n, 1))
     return compose(rel.xyz, rel.quat_xyzw, t_item, q_item)
 
 
