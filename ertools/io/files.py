@@ -217,5 +217,9 @@ def open_bag(path: str | Path) -> BagFile:
     if fmt == "mcap":
         return McapFile(p)
     if fmt == "ros1-active":
-        raise BagError("unindexed .bag.active file: reading it needs the scanner", path=p)
+        fmt = "ros1"
+    if fmt == "ros1":
+        from ertools.io.ros1_index import Ros1Bag
+
+        return Ros1Bag(p)
     return RosbagsFile(p, fmt)

@@ -78,7 +78,7 @@ def load_pose_batch(
 
     Tries the bulk decoder first; falls back to rosbags per message (logged at INFO).
     """
-    from ertools.io.fastdecode import try_fast_batch
+    from ertools.io.bulk import try_fast_batch
 
     fast = try_fast_batch(bag, conns, start_ns, end_ns)
     if fast is not None:

@@ -1,0 +1,463 @@
+"""ROS1 bags read through their own index: connections, chunk infos and index-data records.
+
+Opening costs a few reads at the end of the file (the index section), whatever the bag's size;
+no per-message Python objects are made. Bags without a usable index (``.bag.active`` files
+still being recorded, truncated copies) are scanned record by record instead, and say so in
+``problems``.
+"""
+
+from __future__ import annotations
+
+import bz2
+import logging
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from struct import error as struct_error
+from typing import BinaryIO
+
+import numpy as np
+import numpy.typing as npt
+
+from ertools.errors import BagError
+from ertools.io.files import BagFile, RawRecord
+from ertools.io.model import Conn, short_msgtype
+from ertools.io.ros1_records import (
+    MAGIC_LEN,
+    OP_BAG_HEADER,
+    OP_CHUNK,
+    OP_CHUNK_INFO,
+    OP_CONNECTION,
+    OP_INDEX,
+    OP_MSG,
+    Record,
+    RecordError,
+    chunk_info,
+    connection_fields,
+    parse_fields,
+    read_record,
+    time_ns,
+    u32,
+    u64,
+)
+
+log = logging.getLogger("ertools.io.ros1_index")
+
+I64 = npt.NDArray[np.int64]
+U8 = npt.NDArray[np.uint8]
+
+INDEX_DTYPE = np.dtype([("sec", "<u4"), ("nsec", "<u4"), ("off", "<u4")])
+# The message-data record header rosbag and rosbags write: conn (4), op (1), time (8) fields.
+MSG_HEADER_LEN = 4 + len("conn=") + 4 + 4 + len("op=") + 1 + 4 + len("time=") + 8
+
+
+@dataclass
+class Ros1Chunk:
+    """One chunk: where it is, its time span and per-connection counts.
+
+    ``entries`` (conn -> (record times, offsets in the uncompressed chunk)) is filled when the
+    index-data records after the chunk are read (or by a scan).
+    """
+
+    pos: int
+    start_ns: int
+    end_ns: int
+    counts: dict[int, int]
+    compression: str = ""
+    data_pos: int = -1
+    data_len: int = -1
+    entries: dict[int, tuple[I64, I64]] | None = None
+
+
+@dataclass
+class Ros1Layout:
+    """The index of a ROS1 bag (read or rebuilt by a scan)."""
+
+    path: Path
+    size: int
+    indexed: bool
+    conns: list[Conn]
+    chunks: list[Ros1Chunk]
+    problems: list[str] = field(default_factory=list)
+
+
+def _conn(cid: int, topic: str, fields: dict[str, bytes]) -> Conn:
+    def text(name: str) -> str:
+        return fields.get(name, b"").decode("utf-8", "replace")
+
+    return Conn(
+        cid,
+        topic or text("topic"),
+        short_msgtype(text("type")),
+        text("message_definition"),
+        "msg" if text("message_definition") else "",
+        "ros1",
+        text("latching") not in ("", "0"),
+        text("md5sum"),
+    )
+
+
+def _entries_from_index(data: bytes) -> tuple[I64, I64]:
+    arr = np.frombuffer(data, dtype=INDEX_DTYPE)
+    t = arr["sec"].astype(np.int64) * 1_000_000_000 + arr["nsec"].astype(np.int64)
+    return t, arr["off"].astype(np.int64)
+
+
+def read_layout(path: Path) -> Ros1Layout:
+    """The index of the bag at ``path``; scans when the index is missing or damaged.
+
+    Raises:
+        BagError: not even the bag header is readable.
+    """
+    size = path.stat().st_size
+    with path.open("rb") as f:
+        try:
+            head, _ = read_record(f, MAGIC_LEN, size)
+            if head.op != OP_BAG_HEADER:
+                raise RecordError("first record is not the bag header", MAGIC_LEN)
+            index_pos = u64(head.fields, "index_pos")
+            conn_count = u32(head.fields, "conn_count")
+            chunk_count = u32(head.fields, "chunk_count")
+        except (RecordError, KeyError, struct_error) as err:
+            raise BagError(f"unreadable ROS1 bag header ({err}); not a bag?", path=path) from err
+        if index_pos == 0:
+            return scan_layout(f, path, size, head.end, "not indexed (recording not closed)")
+        if index_pos >= size:
+            return scan_layout(
+                f,
+                path,
+                size,
+                head.end,
+                f"truncated: the index at byte {index_pos} lies past the end ({size} bytes)",
+            )
+        try:
+            conns = []
+            pos = index_pos
+            for _ in range(conn_count):
+                rec, data = read_record(f, pos, size, with_data=True)
+                if rec.op != OP_CONNECTION:
+                    raise RecordError("expected a connection record", pos)
+                cid, topic, fields = connection_fields(rec, data)
+                conns.append(_conn(cid, topic, fields))
+                pos = rec.end
+            chunks = []
+            for _ in range(chunk_count):
+                rec, data = read_record(f, pos, size, with_data=True)
+                if rec.op != OP_CHUNK_INFO:
+                    raise RecordError("expected a chunk-info record", pos)
+                cpos, start, end, counts = chunk_info(rec, data)
+                if cpos >= size:
+                    raise RecordError(f"chunk position {cpos} past the end of the file", pos)
+                chunks.append(Ros1Chunk(cpos, start, end, counts))
+                pos = rec.end
+        except (RecordError, KeyError, struct_error) as err:
+            return scan_layout(f, path, size, head.end, f"damaged index ({err})")
+    return Ros1Layout(path, size, True, conns, chunks)
+
+
+def decompress(compression: str, data: bytes, where: str) -> bytes:
+    """Uncompressed chunk bytes."""
+    try:
+        if compression == "none":
+            return data
+        if compression == "bz2":
+            return bz2.decompress(data)
+        if compression == "lz4":
+            import lz4.frame
+
+            return bytes(lz4.frame.decompress(data))
+    except (OSError, ValueError, RuntimeError, EOFError) as err:
+        raise BagError(f"corrupt {compression} chunk {where} ({err})") from err
+    raise BagError(f"unsupported chunk compression {compression!r} {where}")
+
+
+def _walk_chunk(buf: bytes, base: int) -> Iterator[tuple[int, dict[str, bytes], int, int]]:
+    """(offset, header fields, data offset, data length) of each record inside a chunk."""
+    pos = 0
+    n = len(buf)
+    while pos + 4 <= n:
+        hlen = int.from_bytes(buf[pos : pos + 4], "little")
+        if pos + 8 + hlen > n:
+            raise RecordError("record cut off inside chunk", base + pos)
+        fields = parse_fields(buf[pos + 4 : pos + 4 + hlen], base + pos + 4)
+        dlen = int.from_bytes(buf[pos + 4 + hlen : pos + 8 + hlen], "little")
+        dpos = pos + 8 + hlen
+        if dpos + dlen > n:
+            raise RecordError("record data cut off inside chunk", base + pos)
+        yield pos, fields, dpos, dlen
+        pos = dpos + dlen
+
+
+def scan_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ros1Layout:
+    """Rebuild the index by walking every record (and every record inside every chunk)."""
+    log.info("%s: %s; scanning the whole file", path, why)
+    problems = [why]
+    conns: dict[int, Conn] = {}
+    chunks: list[Ros1Chunk] = []
+    while pos < size:
+        try:
+            rec, data = read_record(f, pos, size, with_data=True)
+        except RecordError as err:
+            problems.append(f"truncated: last record incomplete ({err}); read up to byte {pos}")
+            break
+        if rec.op == OP_CHUNK:
+            compression = rec.fields.get("compression", b"none").decode("ascii", "replace")
+            try:
+                buf = decompress(compression, data, f"at byte {pos}")
+                per: dict[int, tuple[list[int], list[int]]] = {}
+                for off, fields, dpos, dlen in _walk_chunk(buf, rec.data_pos):
+                    op = fields["op"][0]
+                    if op == OP_CONNECTION:
+                        cid = u32(fields, "conn")
+                        cfields = parse_fields(buf[dpos : dpos + dlen])
+                        topic = fields.get("topic", b"").decode("utf-8", "replace")
+                        conns.setdefault(cid, _conn(cid, topic, cfields))
+                    elif op == OP_MSG:
+                        ts, offs = per.setdefault(u32(fields, "conn"), ([], []))
+                        ts.append(time_ns(fields, "time"))
+                        offs.append(off)
+            except (BagError, RecordError, KeyError, IndexError) as err:
+                problems.append(f"corrupt chunk at byte {pos} skipped ({err})")
+                pos = rec.end
+                continue
+            entries = {
+                cid: (np.array(ts, dtype=np.int64), np.array(offs, dtype=np.int64))
+                for cid, (ts, offs) in per.items()
+            }
+            times = [t for t, _ in entries.values() if len(t)]
+            start = min(int(t.min()) for t in times) if times else 0
+            end = max(int(t.max()) for t in times) if times else 0
+            chunks.append(
+                Ros1Chunk(
+                    pos,
+                    start,
+                    end,
+                    {cid: len(t) for cid, (t, _) in entries.items()},
+                    compression,
+                    rec.data_pos,
+                    rec.data_len,
+                    entries,
+                )
+            )
+        elif rec.op == OP_CONNECTION:
+            cid, topic, cfields = connection_fields(rec, data)
+            conns.setdefault(cid, _conn(cid, topic, cfields))
+        elif rec.op not in (OP_INDEX, OP_CHUNK_INFO, OP_MSG):
+            problems.append(f"unknown record op {rec.op} at byte {pos}")
+        pos = rec.end
+    return Ros1Layout(
+        path, size, False, sorted(conns.values(), key=lambda c: c.id), chunks, problems
+    )
+
+
+class Ros1Bag(BagFile):
+    """A ROS1 bag read through its index (or a scan): raw messages and chunk access."""
+
+    def __init__(self, path: Path, layout: Ros1Layout | None = None) -> None:
+        self.path = path
+        self.layout = layout if layout is not None else read_layout(path)
+        active = path.name.endswith(".active")
+        self.format = "ros1-active" if active else "ros1"
+        problems = self.layout.problems
+        if problems and not active:
+            # A closed bag without a sound index was cut short or damaged: reading what is
+            # left would give a silently shorter stream.
+            raise BagError(
+                f"{'; '.join(problems)}; re-copy the file or run `rosbag reindex` on a copy",
+                path=path,
+            )
+        if problems:
+            log.warning("%s: %s; reading what the scan found", path, "; ".join(problems))
+        self.connections = tuple(self.layout.conns)
+        self._f: BinaryIO | None = path.open("rb")
+
+    def close(self) -> None:
+        if self._f is not None:
+            self._f.close()
+            self._f = None
+
+    @property
+    def file(self) -> BinaryIO:
+        if self._f is None:
+            raise BagError("bag already closed", path=self.path)
+        return self._f
+
+    def _where(self, chunk: Ros1Chunk) -> str:
+        return f"in {self.path} at byte {chunk.pos}"
+
+    def _chunk_record(self, chunk: Ros1Chunk) -> Record:
+        try:
+            rec, _ = read_record(self.file, chunk.pos, self.layout.size)
+        except RecordError as err:
+            raise BagError(f"damaged chunk record ({err})", path=self.path) from err
+        if rec.op != OP_CHUNK:
+            raise BagError(f"expected a chunk record at byte {chunk.pos}", path=self.path)
+        chunk.compression = rec.fields.get("compression", b"none").decode("ascii", "replace")
+        chunk.data_pos, chunk.data_len = rec.data_pos, rec.data_len
+        return rec
+
+    def compressions(self) -> list[str]:
+        """The compression of every chunk (reads each chunk's record header)."""
+        out = []
+        for chunk in self.layout.chunks:
+            if not chunk.compression:
+                self._chunk_record(chunk)
+            out.append(chunk.compression)
+        return out
+
+    def chunk_entries(self, chunk: Ros1Chunk) -> dict[int, tuple[I64, I64]]:
+        """conn -> (record times, record offsets) of one chunk, from its index-data records."""
+        if chunk.entries is not None:
+            return chunk.entries
+        rec = self._chunk_record(chunk)
+        pos = rec.end
+        entries: dict[int, tuple[I64, I64]] = {}
+        try:
+            for _ in range(len(chunk.counts)):
+                irec, data = read_record(self.file, pos, self.layout.size, with_data=True)
+                if irec.op != OP_INDEX:
+                    raise RecordError("expected an index-data record", pos)
+                if u32(irec.fields, "ver") != 1:
+                    raise RecordError("index-data version not 1", pos)
+                count = u32(irec.fields, "count")
+                if len(data) != 12 * count:
+                    raise RecordError("index-data size disagrees with its count", pos)
+                entries[u32(irec.fields, "conn")] = _entries_from_index(data)
+                pos = irec.end
+        except (RecordError, KeyError) as err:
+            raise BagError(
+                f"damaged index data after chunk at byte {chunk.pos} ({err})", path=self.path
+            ) from err
+        chunk.entries = entries
+        return entries
+
+    def chunk_bytes(self, chunk: Ros1Chunk) -> bytes:
+        """The uncompressed data of one chunk."""
+        if chunk.data_pos < 0:
+            self._chunk_record(chunk)
+        self.file.seek(chunk.data_pos)
+        data = self.file.read(chunk.data_len)
+        if len(data) != chunk.data_len:
+            raise BagError(f"chunk at byte {chunk.pos} cut off by end of file", path=self.path)
+        try:
+            return decompress(chunk.compression, data, self._where(chunk))
+        except BagError as err:
+            raise BagError(err.message, path=None) from err
+
+    def select(
+        self, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
+    ) -> tuple[list[int], I64, I64, I64, I64]:
+        """Messages of ``conns`` in [start_ns, end_ns], in the reference order.
+
+        Returns (chunk indices touched, chunk index per message, conn rank per message, record
+        time per message, record offset per message); only chunks whose span overlaps the
+        window and that hold one of ``conns`` are read.
+        """
+        rank = {c.id: i for i, c in enumerate(conns)}
+        ck, rk, tt, oo = [], [], [], []
+        touched = []
+        for ci, chunk in enumerate(self.layout.chunks):
+            if not any(cid in chunk.counts for cid in rank):
+                continue
+            if start_ns is not None and chunk.end_ns < start_ns:
+                continue
+            if end_ns is not None and chunk.start_ns > end_ns:
+                continue
+            entries = self.chunk_entries(chunk)
+            used = False
+            for cid, r in rank.items():
+                if cid not in entries:
+                    continue
+                t, off = entries[cid]
+                keep = np.ones(len(t), dtype=bool)
+                if start_ns is not None:
+                    keep &= t >= start_ns
+                if end_ns is not None:
+                    keep &= t <= end_ns
+                if not keep.any():
+                    continue
+                used = True
+                tt.append(t[keep])
+                oo.append(off[keep])
+                ck.append(np.full(int(keep.sum()), ci, dtype=np.int64))
+                rk.append(np.full(int(keep.sum()), r, dtype=np.int64))
+            if used:
+                touched.append(ci)
+        if not tt:
+            e = np.empty(0, np.int64)
+            return [], e, e, e, e
+        t_all = np.concatenate(tt)
+        c_all = np.concatenate(ck)
+        r_all = np.concatenate(rk)
+        o_all = np.concatenate(oo)
+        # rosbags: per connection sorted by time (stable over chunk and index order), then a
+        # heap merge over connections in the order given (ties: the earlier connection).
+        seq = np.arange(len(t_all))
+        order = np.lexsort((seq, r_all, t_all))
+        return touched, c_all[order], r_all[order], t_all[order], o_all[order]
+
+    def spans(self, buf: U8, offsets: I64, where: str) -> tuple[I64, I64]:
+        """(data start, data length) of the message records at ``offsets`` of a chunk.
+
+        Vectorised for the standard 38-byte message header; other records (a connection
+        record before the message, odd header layouts) are resolved one by one.
+        """
+        n = len(buf)
+        if len(offsets) and (offsets.min() < 0 or offsets.max() + 8 > n):
+            raise BagError(f"index points outside its chunk {where}")
+        idx4 = offsets[:, None] + np.arange(4)
+        hlen = buf[idx4].view("<u4").reshape(-1).astype(np.int64)
+        dpos = offsets + 8 + hlen
+        odd = hlen != MSG_HEADER_LEN
+        ok = ~odd
+        if ok.any() and dpos[ok].max() > n:
+            raise BagError(f"message record cut off inside its chunk {where}")
+        dlen = np.zeros(len(offsets), dtype=np.int64)
+        if ok.any():
+            dl_idx = (dpos[ok] - 4)[:, None] + np.arange(4)
+            dlen[ok] = buf[dl_idx].view("<u4").reshape(-1)
+        for i in np.flatnonzero(odd):
+            dpos[i], dlen[i] = self._resolve(bytes(buf), int(offsets[i]), where)
+        if len(offsets) and (dpos + dlen).max() > n:
+            raise BagError(f"message data cut off inside its chunk {where}")
+        return dpos, dlen
+
+    @staticmethod
+    def _resolve(buf: bytes, off: int, where: str) -> tuple[int, int]:
+        pos = off
+        while True:
+            if pos + 4 > len(buf):
+                raise BagError(f"message record cut off inside its chunk {where}")
+            hlen = int.from_bytes(buf[pos : pos + 4], "little")
+            try:
+                fields = parse_fields(buf[pos + 4 : pos + 4 + hlen], pos + 4)
+            except RecordError as err:
+                raise BagError(f"damaged message record in chunk {where} ({err})") from err
+            dlen = int.from_bytes(buf[pos + 4 + hlen : pos + 8 + hlen], "little")
+            op = fields.get("op", b"\x00")[0]
+            if op == OP_MSG:
+                return pos + 8 + hlen, dlen
+            if op != OP_CONNECTION:
+                raise BagError(f"index points at a record of op {op}, not a message, {where}")
+            pos = pos + 8 + hlen + dlen
+
+    def raw(
+        self, conns: Sequence[Conn], start_ns: int | None = None, end_ns: int | None = None
+    ) -> Iterator[RawRecord]:
+        if not conns:
+            return
+        _, chunk_of, rank_of, t_of, off_of = self.select(conns, start_ns, end_ns)
+        cur = -1
+        buf = np.empty(0, np.uint8)
+        raw_bytes = b""
+        for i in range(len(t_of)):
+            ci = int(chunk_of[i])
+            if ci != cur:
+                chunk = self.layout.chunks[ci]
+                raw_bytes = self.chunk_bytes(chunk)
+                buf = np.frombuffer(raw_bytes, dtype=np.uint8)
+                cur = ci
+            where = self._where(self.layout.chunks[ci])
+            dpos, dlen = self.spans(buf, off_of[i : i + 1], where)
+            d0, d1 = int(dpos[0]), int(dpos[0] + dlen[0])
+            yield conns[int(rank_of[i])], int(t_of[i]), raw_bytes[d0:d1]
