@@ -120,9 +120,11 @@ def parse_reply(
         raise ClockError(f"{where} refused the request (kiss-o'-death {code!r}); retry later")
     if leap == LEAP_ALARM:
         raise ClockError(f"{where} says its own clock is not synchronised (leap indicator 3)")
-    t2 = ntp_to_ns(words[6], words[7])
-    t3 = ntp_to_ns(words[8], words[9])
-    if words[8] == 0 and words[9] == 0:
+    # Words after the 4 leading bytes: root delay, root dispersion, reference ID, reference
+    # (3-4), originate (5-6), receive (7-8) and transmit (9-10) timestamps.
+    t2 = ntp_to_ns(words[7], words[8])
+    t3 = ntp_to_ns(words[9], words[10])
+    if words[9] == 0 and words[10] == 0:
         raise ClockError(f"{where} sent no transmit timestamp")
     offset_ns = ((t2 - t1_ns) + (t3 - t4_ns)) / 2
     delay_ns = (t4_ns - t1_ns) - (t3 - t2)
