@@ -151,7 +151,10 @@ def _early_end_reason(refbox: StateStream | None, after_ns: int) -> str | None:
     if i is None:
         return None
     payload = rb.payload[i].strip()
-    return f"RefBox END{f' ({payload})' if payload else ''}"
+    # A normal END (after the score) has no payload; timeout/halt end the benchmark early.
+    if not any(word in payload.lower() for word in ("timeout", "halt", "stop", "abort")):
+        return None
+    return f"RefBox END ({payload})"
 
 
 def unreached_reasons(
@@ -161,7 +164,9 @@ def unreached_reasons(
     if len(moments) >= n_waypoints:
         return ()
     after = int(moments.end_ns[-1]) if len(moments) else 0
-    reason = _early_end_reason(refbox, after) or "not completed"
+    reason = _early_end_reason(refbox, after)
+    if reason is None:
+        return ()  # not an early end: the count mismatch is an error (see compute)
     return tuple(
         f"segment {k}: waypoint never reached ({reason})" for k in range(len(moments), n_waypoints)
     )

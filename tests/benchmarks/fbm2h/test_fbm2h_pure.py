@@ -3,17 +3,19 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
 
 from ertools.benchmarks.fbm2h import compute
 from ertools.benchmarks.fbm2h_score import segment_errors
-from ertools.benchmarks.fbm2h_segments import ReachedMoments
+from ertools.benchmarks.fbm2h_segments import ReachedMoments, from_states, unreached_reasons
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform, identity_transform
 from ertools.errors import SegmentationError
-from ertools.streams import PoseStream
+from ertools.states import BmBoxState, ClientState, RefBoxState
+from ertools.streams import Machine, PoseStream, StateStream
 
 S = 1_000_000_000
 T0 = 1_445_609_740 * S
@@ -136,3 +138,63 @@ def test_count_mismatch_is_an_error() -> None:
     goal = GoalList(((0.0, 0.0, 0.0),), source="g")
     with pytest.raises(SegmentationError, match="2 reached moments"):
         compute(goal, identity_transform(), marker, _moments([0.0, 0.2], [0.2, 0.4]))
+
+
+def _states(machine: Any, events: list[tuple[float, int, str]]) -> StateStream:
+    return StateStream(
+        machine,
+        np.array([T0 + round(t * S) for t, _, _ in events], dtype=np.int64),
+        np.array([s for _, s, _ in events], dtype=np.uint8),
+        tuple(p for _, _, p in events),
+        "/fbm2h/x",
+        "test",
+    )
+
+
+def test_states_segments_and_refbox_timeout() -> None:
+    bm = _states(
+        Machine.BMBOX,
+        [
+            (0.0, BmBoxState.READY, ""),
+            (1.0, BmBoxState.TRANSMITTING_GOAL, "waypoints: []"),
+            (1.2, BmBoxState.EXECUTING_GOAL, ""),
+            (1.21, BmBoxState.WAITING_RESULT, ""),
+            (4.0, BmBoxState.READY, ""),
+            (5.0, BmBoxState.TRANSMITTING_GOAL, ""),
+            (5.3, BmBoxState.EXECUTING_GOAL, ""),
+            (5.31, BmBoxState.WAITING_RESULT, ""),
+            (9.0, BmBoxState.END, ""),
+        ],
+    )
+    cl = _states(
+        Machine.CLIENT,
+        [
+            (0.0, ClientState.WAITING_GOAL, ""),
+            (1.1, ClientState.EXECUTING_GOAL, ""),
+            (3.9, ClientState.COMPLETED_GOAL, "{}"),
+            (4.1, ClientState.WAITING_GOAL, ""),
+            (5.2, ClientState.EXECUTING_GOAL, ""),
+        ],
+    )
+    rb = _states(
+        Machine.REFBOX,
+        [(0.0, RefBoxState.EXECUTING_GOAL, ""), (8.9, RefBoxState.END, "reason: timeout")],
+    )
+    moments = from_states(bm, cl, rb)
+    # Segment 0: from the BmBox EXECUTING_GOAL (1.2 s) to the Client COMPLETED_GOAL (3.9 s).
+    assert (moments.start_ns - T0).tolist() == [1_200_000_000]
+    assert (moments.end_ns - T0).tolist() == [3_900_000_000]
+    assert moments.goal_payload == "waypoints: []"
+    unreached = unreached_reasons(moments, 3, rb)
+    assert len(unreached) == 2 and "timeout" in unreached[0]
+    marker = _stream([0.0, 10.0], [[0, 0, 0], [0, 0, 0]], [0.0, 0.0])
+    goal = GoalList(((0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (2.0, 0.0, 0.0)), source="g")
+    result = compute(
+        goal, identity_transform(), marker, moments, max_gap_s=20.0, unreached=unreached
+    )
+    assert [s.status for s in result.segments] == ["ok", "unreached", "unreached"]
+    assert result.timeout_segments == 2 and len(result.failures) == 2
+    assert result.execution_time == pytest.approx(2.7, abs=1e-9)
+    # Without a timeout END the missing segment is an inconsistency, not a timeout.
+    rb_normal = _states(Machine.REFBOX, [(8.9, RefBoxState.END, "")])
+    assert unreached_reasons(moments, 3, rb_normal) == ()
