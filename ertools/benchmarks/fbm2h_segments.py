@@ -257,7 +257,7 @@ def from_stops(
     """
     runs = detect_stops(stream_t_ns, xy, yaw, params, max_gap_ns)
     notes = [
-        f"stop {i} (from the first pose sample): {ns_to_s(stream_t_ns[s] - stream_t_ns[0]):.3f} s to "
+        f"stop {i} (from the first pose): {ns_to_s(stream_t_ns[s] - stream_t_ns[0]):.3f} s to "
         f"{ns_to_s(stream_t_ns[e] - stream_t_ns[0]):.3f} s at "
         f"({xy[s : e + 1, 0].mean():.3f}, {xy[s : e + 1, 1].mean():.3f})"
         for i, (s, e) in enumerate(runs)
