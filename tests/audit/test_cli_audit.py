@@ -1,0 +1,96 @@
+"""``ertools audit`` end to end on a bag written from hand-built state streams."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from audit_streams import T0_NS, heartbeat
+from test_audit import BMBOX, CLIENT, REFBOX
+
+from ertools.cli.main import main
+from ertools.streams import Machine, StateStream
+
+
+def _write_bag(path: Path, streams: list[StateStream]) -> Path:
+    from ertools.samples.writer import BagWriter
+
+    with BagWriter(path, "ros1") as bag:
+        for s in streams:
+            bag.write_state(s.machine, s.topic, s.t_ns, [int(x) for x in s.state], list(s.payload))
+    return path
+
+
+@pytest.fixture
+def bag(tmp_path: Path) -> Path:
+    return _write_bag(
+        tmp_path / "fbm2h_states.bag",
+        [
+            heartbeat(Machine.BMBOX, BMBOX, 20.0, drop=(5.0, 7.0), topic="/fbm2h/bmbox_state"),
+            heartbeat(Machine.REFBOX, REFBOX, 20.0, topic="/fbm2h/refbox_state"),
+            heartbeat(Machine.CLIENT, CLIENT, 20.0, topic="/fbm2h/client_state"),
+        ],
+    )
+
+
+def test_audit_json_from_bag(bag: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(["audit", str(bag), "--format", "json", "--no-rescore"])
+    out = capsys.readouterr()
+    assert code == 0, out.err
+    data = json.loads(out.out)
+    assert data["benchmark"] == "fbm2h"  # inferred from the topics' namespace
+    assert data["start"] == pytest.approx(T0_NS / 1e9, abs=1e-6)
+    assert [(x["from"], x["to"]) for x in data["illegal_transitions"]] == [
+        ("EXECUTING_GOAL", "TRANSMITTING_GOAL")
+    ]
+    assert data["silences"][0]["duration"] == pytest.approx(2.0, abs=1e-9)
+    assert data["early_ends"][0]["reason"] == "timeout"
+    assert [r["outcome"] for r in data["runs"].values()] == ["completed", "timeout"]
+
+
+def test_audit_text_report_and_strict(
+    bag: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    report = tmp_path / "report"
+    code = main(["audit", str(bag), "--no-rescore", "--report", str(report), "--strict"])
+    out = capsys.readouterr()
+    assert code == 1  # 3 findings with --strict
+    assert "ILLEGAL" in out.out and "SILENCE" in out.out
+    assert "3 finding(s)" in out.err
+    assert (report / "index.html").exists() and (report / "audit_timeline.csv").exists()
+    meta = json.loads((report / "result.json").read_text())
+    assert meta["audit"]["illegal_transitions"] == 1 and meta["audit"]["silences"] == 1
+
+
+def test_max_silence_option(bag: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["audit", str(bag), "--format", "json", "--no-rescore", "--max-silence", "3"]) == 0
+    assert json.loads(capsys.readouterr().out)["silences"] == []
+
+
+def test_rescore_failure_keeps_the_audit(bag: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # The bag has no mocap poses: the fbm2h scorer fails, the audit is still printed.
+    code = main(["audit", str(bag), "--format", "yaml"])
+    out = capsys.readouterr()
+    assert code == 0
+    assert "score not recomputed" in out.err
+    assert "illegal_transitions" in out.out
+
+
+def test_bag_without_states_is_one_line_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from ertools.samples.writer import BagWriter
+
+    path = tmp_path / "poses.bag"
+    with BagWriter(path, "ros1") as bag:
+        bag.write_string("/rosout_text", T0_NS, "hello")
+    code = main(["audit", str(path)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 1
+    assert len(err) == 1 and "no benchmark state topics" in err[0]
+
+
+def test_missing_bag(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["audit", str(tmp_path / "nope.bag")]) == 1
+    assert "no such file" in capsys.readouterr().err

@@ -1,0 +1,56 @@
+"""Results for report tests: a minimal BenchmarkResult with a hostile payload in it."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from ertools.benchmarks.base import Rows, dump_yaml
+from ertools.streams import Provenance
+
+EVIL = "<script>alert('x')</script>"
+EVIL_IMG = '<img src=x onerror="alert(1)">'
+
+
+@dataclass(frozen=True)
+class FakeResult:
+    name: str
+    data: dict[str, Any]
+    table: dict[str, Rows] = field(default_factory=dict)
+    warnings: tuple[str, ...] = ()
+    deviations: tuple[str, ...] = ()
+    failures: tuple[str, ...] = ()
+    provenance: Provenance = field(default_factory=Provenance)
+
+    def to_dict(self) -> dict[str, Any]:
+        return self.data
+
+    def to_yaml(self) -> str:
+        return dump_yaml(self.data)
+
+    def tables(self) -> dict[str, Rows]:
+        return self.table
+
+
+def fbm3w_like(best: float = 0.0123, team_param: str | None = None) -> FakeResult:
+    params: tuple[tuple[str, str], ...] = (("d_min", "0.00033 m"), ("topic", EVIL_IMG))
+    if team_param is not None:
+        params += (("team", team_param),)
+    return FakeResult(
+        "fbm3w",
+        {
+            "best_distance_error": best,
+            "best_run": 1,
+            "execution_time": 41.5,
+            "runs_details": {"0": {"spec": "line", "distance_error": best + 0.001}},
+        },
+        table={
+            "runs": [
+                {"run": 0, "spec": EVIL, "distance_error": best + 0.001, "start_time": 1.4e9},
+                {"run": 1, "spec": "spline", "distance_error": best, "start_time": 1.4e9 + 30.5},
+            ],
+        },
+        warnings=(f"warning with {EVIL}",),
+        deviations=("ertools estimates the noise", EVIL),
+        provenance=Provenance(parameters=params),
+    )

@@ -1,0 +1,137 @@
+"""The report page in a real browser: headless Chromium opens index.html from disk.
+
+Skipped, saying why, where Chromium is not installed (Debian: ``apt-get install chromium``).
+"""
+
+from __future__ import annotations
+
+import base64
+import shutil
+import subprocess
+import sys
+from html.parser import HTMLParser
+from pathlib import Path
+
+import numpy as np
+import pytest
+from report_fakes import EVIL, fbm3w_like
+
+from ertools.report.folder import write_report
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "audit"))
+from audit_streams import heartbeat
+from test_audit import BMBOX, CLIENT, REFBOX
+
+pytestmark = pytest.mark.browser
+
+BROWSER = next(
+    (shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)),
+    None,
+)
+FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--hide-scrollbars",
+]
+# EXECUTING_GOAL in the timeline figure (ertools.report.plots_audit): its presence in the
+# screenshot proves the PNG beside the page was loaded and painted.
+EXECUTING_GOAL_RGB = (0x5F, 0xAE, 0x6E)
+
+
+class _Dom(HTMLParser):
+    def __init__(self) -> None:
+        super().__init__()
+        self.imgs: list[str] = []
+        self.tables = 0
+        self.cells: list[str] = []
+        self.scripts = 0
+        self._in_cell = False
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        if tag == "img":
+            self.imgs.append(dict(attrs).get("src") or "")
+        elif tag == "table":
+            self.tables += 1
+        elif tag == "script":
+            self.scripts += 1
+        elif tag in ("td", "th"):
+            self._in_cell = True
+            self.cells.append("")
+
+    def handle_endtag(self, tag: str) -> None:
+        if tag in ("td", "th"):
+            self._in_cell = False
+
+    def handle_data(self, data: str) -> None:
+        if self._in_cell:
+            self.cells[-1] += data
+
+
+def _chromium(tmp_path: Path, url: str, *extra: str) -> subprocess.CompletedProcess[str]:
+    profile = tmp_path / f"profile{len(list(tmp_path.glob('profile*')))}"
+    return subprocess.run(
+        [BROWSER or "chromium", *FLAGS, f"--user-data-dir={profile}", *extra, url],
+        capture_output=True,
+        text=True,
+        timeout=90,
+        check=False,
+    )
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    from ertools.audit import audit_states
+    from ertools.audit_score import attach
+    from ertools.streams import Machine
+
+    tmp = tmp_path_factory.mktemp("browser")
+    audit = audit_states(
+        heartbeat(Machine.BMBOX, BMBOX, 20.0, drop=(5.0, 7.0)),
+        heartbeat(Machine.REFBOX, REFBOX, 20.0),
+        heartbeat(Machine.CLIENT, CLIENT, 20.0),
+        benchmark="fbm3w",
+    )
+    audit = attach(audit, fbm3w_like())
+    return write_report(audit, tmp / "report", inputs=[], argv=["ertools", "audit"])  # type: ignore[arg-type]
+
+
+@pytest.mark.skipif(BROWSER is None, reason="chromium not installed (apt-get install chromium)")
+def test_dom_has_tables_and_images(report: Path, tmp_path: Path) -> None:
+    proc = _chromium(tmp_path, report.as_uri(), "--dump-dom")
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    dom = _Dom()
+    dom.feed(proc.stdout)
+    assert dom.scripts == 0  # the hostile payloads stayed text
+    assert EVIL in dom.cells  # ...shown as text in the runs table
+    assert dom.tables >= 5  # score, runs, comparison, audit tables, timeline
+    assert "best_distance_error" in dom.cells and "0.0123" in dom.cells
+    assert dom.imgs, "no figure in the page"
+    for src in dom.imgs:
+        if src.startswith("data:"):
+            assert base64.b64decode(src.split(",", 1)[1])[:8] == b"\x89PNG\r\n\x1a\n"
+        else:
+            assert (report.parent / src).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", src
+
+
+@pytest.mark.skipif(BROWSER is None, reason="chromium not installed (apt-get install chromium)")
+def test_screenshot_shows_the_page_and_its_figure(report: Path, tmp_path: Path) -> None:
+    from matplotlib.image import imread
+
+    shot = tmp_path / "shot.png"
+    proc = _chromium(tmp_path, report.as_uri(), f"--screenshot={shot}", "--window-size=1280,2400")
+    assert proc.returncode == 0 and shot.exists(), proc.stderr[-2000:]
+    pixels = (imread(shot)[..., :3] * 255).round().astype(int)
+    assert pixels.shape[:2] == (2400, 1280)
+    # Not blank: the dark header, white body and many colours of the tables and figure.
+    packed = (pixels[..., 0] << 16) | (pixels[..., 1] << 8) | pixels[..., 2]
+    assert np.unique(packed).size > 200
+    header = pixels[:40, :, :].mean(axis=(0, 1))
+    assert header.max() < 80  # #14233c
+    close = np.abs(pixels - np.array(EXECUTING_GOAL_RGB)).max(axis=2) <= 3
+    assert close.sum() > 500, "the timeline figure was not painted"
