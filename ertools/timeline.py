@@ -190,11 +190,16 @@ class TimelineConfig:
             records its own messages a few ms late, a robot over Wi-Fi some tens of ms.
         gap_tolerance_ns: largest pause between consecutive split files of one logger.
             Default 1 s: rosbag opens the next split file at once, so anything longer means
-            the logger stopped.
+            the logger stopped. Bags at most this far apart also chain into one session, so that a
+            logger's hourly split files (which touch but do not overlap) stay one session.
+        coverage_join_ns: GT files at most this far apart cover the time between them (default
+            0.1 s, the trajectory scorer's max gap): consecutive split files leave one frame
+            period (8 ms at 120 Hz) between them, which is no hole in the GT.
     """
 
     clock_tolerance_ns: int = NS_PER_S // 2
     gap_tolerance_ns: int = NS_PER_S
+    coverage_join_ns: int = NS_PER_S // 10
 
 
 @dataclass(frozen=True)
@@ -357,11 +362,11 @@ def classify(topics: Iterable[TopicLike]) -> Kind:
 # --- intervals -------------------------------------------------------------------------------
 
 
-def union_spans(spans: Iterable[tuple[int, int]]) -> list[tuple[int, int]]:
-    """Merge closed intervals into disjoint ones, sorted."""
+def union_spans(spans: Iterable[tuple[int, int]], join_ns: int = 0) -> list[tuple[int, int]]:
+    """Merge closed intervals (and those at most ``join_ns`` apart) into disjoint ones."""
     merged: list[tuple[int, int]] = []
     for start, end in sorted(spans):
-        if merged and start <= merged[-1][1]:
+        if merged and start - merged[-1][1] <= join_ns:
             if end > merged[-1][1]:
                 merged[-1] = (merged[-1][0], end)
         else:
@@ -370,14 +375,17 @@ def union_spans(spans: Iterable[tuple[int, int]]) -> list[tuple[int, int]]:
 
 
 def coverage(
-    start_ns: int, end_ns: int, covers: Iterable[tuple[int, int]]
+    start_ns: int, end_ns: int, covers: Iterable[tuple[int, int]], join_ns: int = 0
 ) -> tuple[float, list[tuple[int, int]]]:
-    """Percent of [start, end] inside the union of ``covers``, and the uncovered spans."""
+    """Percent of [start, end] inside the union of ``covers``, and the uncovered spans.
+
+    Covers at most ``join_ns`` apart count as one (the pause between them is covered).
+    """
     uncovered: list[tuple[int, int]] = []
     cursor = start_ns
     covered_ns = 0
     point_covered = False
-    for a, b in union_spans(covers):
+    for a, b in union_spans(covers, join_ns):
         if b < start_ns or a > end_ns:
             continue
         if a <= start_ns <= b:
@@ -470,7 +478,7 @@ def build_timeline(
                 "clocks not synchronised?)"
             )
 
-    sessions, session_of = _sessions(base)
+    sessions, session_of = _sessions(base, cfg.gap_tolerance_ns)
     entries = [
         BagEntry(
             b.path,
@@ -500,15 +508,22 @@ def build_timeline(
     ]
     by_path = {e.path: e for e in entries}
     sessions = [
-        Session(s.index, s.start_ns, s.end_ns, s.paths, _pairings([by_path[p] for p in s.paths]))
+        Session(
+            s.index,
+            s.start_ns,
+            s.end_ns,
+            s.paths,
+            _pairings([by_path[p] for p in s.paths], cfg.coverage_join_ns),
+        )
         for s in sessions
     ]
     flat = [Problem(e.path, p) for e in entries for p in e.problems]
     return Timeline(tuple(entries), tuple(sessions), tuple(flat), cfg)
 
 
-def _sessions(entries: Sequence[BagEntry]) -> tuple[list[Session], dict[str, int]]:
-    """Chains of overlapping bags: a bag starting at or before the chain's end joins it."""
+def _sessions(entries: Sequence[BagEntry], join_ns: int) -> tuple[list[Session], dict[str, int]]:
+    """Chains of overlapping bags: a bag starting at most ``join_ns`` after the chain's end
+    joins it."""
     sessions: list[Session] = []
     session_of: dict[str, int] = {}
     current: list[BagEntry] = []
@@ -525,7 +540,7 @@ def _sessions(entries: Sequence[BagEntry]) -> tuple[list[Session], dict[str, int
 
     for bag in entries:
         assert bag.start_ns is not None and bag.end_ns is not None
-        if current and bag.start_ns <= end:
+        if current and bag.start_ns <= end + join_ns:
             current.append(bag)
             end = max(end, bag.end_ns)
         else:
@@ -536,7 +551,7 @@ def _sessions(entries: Sequence[BagEntry]) -> tuple[list[Session], dict[str, int
     return sessions, session_of
 
 
-def _pairings(entries: Sequence[BagEntry]) -> tuple[Pairing, ...]:
+def _pairings(entries: Sequence[BagEntry], join_ns: int) -> tuple[Pairing, ...]:
     gt = [e for e in entries if e.kind == "gt"]
     pairings: list[Pairing] = []
     for e in entries:
@@ -556,7 +571,7 @@ def _pairings(entries: Sequence[BagEntry]) -> tuple[Pairing, ...]:
             for g in covering
             if g.start_ns is not None and g.end_ns is not None
         ]
-        pct, uncovered = coverage(e.start_ns, e.end_ns, spans)
+        pct, uncovered = coverage(e.start_ns, e.end_ns, spans, join_ns)
         pairings.append(
             Pairing(e.path, e.kind, tuple(g.path for g in covering), pct, tuple(uncovered))
         )
