@@ -170,7 +170,9 @@ def score_run(
             warnings=tuple(warnings),
             **base,
         )
-    start = run.placed_ns if run.placed_ns is not None else run.start_ns
+    # The board may settle any time after the referee was asked to place it; the stationary
+    # tail before the goal decides (capped at max_window_s).
+    start = run.start_ns
     try:
         gt, gt_warnings = measure_ground_truth(
             origin,
@@ -326,8 +328,12 @@ class BodySources:
     board: Any = None
 
 
-def _read_body(
-    paths: Sequence[Path], source: Any, default_topic: str, frame: str, window: tuple[int, int]
+def read_body(
+    paths: Sequence[Path],
+    source: Any,
+    default_topic: str,
+    frame: str,
+    window: tuple[int | None, int | None] = (None, None),
 ) -> PoseStream:
     """A body's poses: the given source, else the 2015 topic, else its /tf frame."""
     from ertools.errors import TopicError
@@ -410,8 +416,8 @@ def score_fbm1_bag(
     lo = min(r.start_ns for r in found.runs) - pad
     hi = max(r.end_ns for r in found.runs) + pad
     src = sources or BodySources()
-    origin = _read_body(plist, src.origin, f"/{ns}/origin/pose", "origin", (lo, hi))
-    board = _read_body(plist, src.board, f"/{ns}/ref_board/pose", "ref_board", (lo, hi))
+    origin = read_body(plist, src.origin, f"/{ns}/origin/pose", "origin", (lo, hi))
+    board = read_body(plist, src.board, f"/{ns}/ref_board/pose", "ref_board", (lo, hi))
     gt = opts.gt
     provenance = Provenance(
         inputs=tuple(str(p) for p in plist)

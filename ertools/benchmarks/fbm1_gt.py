@@ -146,6 +146,25 @@ def coverage_problem(
     return None
 
 
+def tracked_problem(
+    stream: PoseStream, name: str, at_ns: int, max_gap_ns: int, t0_ns: int = 0
+) -> str | None:
+    """Why ``stream`` was not tracked at ``at_ns`` (no sample in the max_gap before it)."""
+    t = stream.t_ns
+    if len(t) == 0:
+        return f"no {name} pose in the log"
+    k = int(np.searchsorted(t, at_ns, side="right")) - 1
+    if k < 0:
+        return f"{name} not tracked yet at {_s(at_ns - t0_ns)} (first pose {_s(int(t[0]) - t0_ns)})"
+    age = at_ns - int(t[k])
+    if age > max_gap_ns:
+        return (
+            f"{name} lost at {_s(at_ns - t0_ns)} (last pose {age / NS_PER_S:.2f} s before, "
+            f"at {_s(int(t[k]) - t0_ns)})"
+        )
+    return None
+
+
 def _s(ns: int) -> str:
     """Seconds with ms (times in messages are relative to the log's start)."""
     return f"t={ns / NS_PER_S:.3f} s"
@@ -159,10 +178,13 @@ def _item_poses(rel: PoseStream, item: Item) -> tuple[np.ndarray, np.ndarray]:
     return compose(rel.xyz, rel.quat_xyzw, t_item, q_item)
 
 
-def stationary_tail(rel: PoseStream, still_m: float, still_deg: float) -> PoseStream:
+def stationary_tail(
+    rel: PoseStream, still_m: float, still_deg: float, max_gap_ns: int | None = None
+) -> PoseStream:
     """The samples at the end of ``rel`` that stay within tolerance of its final pose.
 
     The final pose is the mean of the last 0.2 s, so one noisy last sample does not decide.
+    A tracking gap longer than ``max_gap_ns`` ends the tail too: nobody saw the board then.
     """
     from scipy.spatial.transform import Rotation
 
@@ -172,9 +194,35 @@ def stationary_tail(rel: PoseStream, still_m: float, still_deg: float) -> PoseSt
     ref = mean_pose(last.xyz, last.quat_xyzw)
     dist = np.linalg.norm(rel.xyz - ref.xyz, axis=1)
     ang = (Rotation.from_quat(ref.quat_xyzw).inv() * Rotation.from_quat(rel.quat_xyzw)).magnitude()
-    moving = np.flatnonzero((dist > still_m) | (ang > math.radians(still_deg)))
+    breaks = (dist > still_m) | (ang > math.radians(still_deg))
+    if max_gap_ns is not None:
+        # A sample after a long gap starts a new tail (the break is the sample before it).
+        breaks[:-1] |= np.diff(rel.t_ns) > max_gap_ns
+    moving = np.flatnonzero(breaks)
     start = int(moving[-1]) + 1 if len(moving) else 0
     return rel.take(slice(start, None))
+
+
+def settled(tail: PoseStream) -> PoseStream:
+    """Drop the samples of a stationary tail that are still settling into place.
+
+    The tail tolerance (millimetres) must be loose against mocap noise, so the last moments
+    of the board's approach can pass it and bias the mean. Samples further from the median
+    than 3x the median distance (about 4.6 sigma of isotropic noise; at least 0.5 mm and
+    0.05 deg) are dropped.
+    """
+    from scipy.spatial.transform import Rotation
+
+    if len(tail) < 5:
+        return tail
+    med = np.median(tail.xyz, axis=0)
+    dist = np.linalg.norm(tail.xyz - med, axis=1)
+    rot = Rotation.from_quat(tail.quat_xyzw)
+    ang = (rot.mean().inv() * rot).magnitude()
+    keep = (dist <= max(3.0 * float(np.median(dist)), 5e-4)) & (
+        ang <= max(3.0 * float(np.median(ang)), math.radians(0.05))
+    )
+    return tail.take(keep) if keep.sum() >= 3 else tail
 
 
 def measure_ground_truth(
@@ -219,7 +267,8 @@ def measure_ground_truth(
         # A single lookup: the bodies must be tracked just before it.
         start = end - max_gap
     for stream, name in ((origin, "origin"), (board, "ref_board")):
-        problem = coverage_problem(stream, name, start, end, max_gap, t0_ns)
+        # Both bodies must be seen at the lookup; before it the stationary tail stops at gaps.
+        problem = tracked_problem(stream, name, end, max_gap, t0_ns)
         if problem:
             raise GroundTruthError(problem)
     rel = board_in_table(
@@ -230,7 +279,7 @@ def measure_ground_truth(
             f"no ref_board sample with a known origin in {_s(start - t0_ns)}..{_s(end - t0_ns)}"
         )
     if options.method == "window":
-        used = stationary_tail(rel, options.still_m, options.still_deg)
+        used = settled(stationary_tail(rel, options.still_m, options.still_deg, max_gap))
         span = (used.end_ns - used.start_ns) / NS_PER_S
         if span < options.min_still_s:
             warnings.append(

@@ -1,0 +1,122 @@
+"""Acquire FBM1 item transforms from a mocap log (seed 7.1.4) and write Listing 9.
+
+For each item of a vanilla list (ids, classes, instances; no or identity trans/rot) the item
+stood on the reference board at the table origin for a while; its transform in the board
+frame is ref_board^-1 * origin averaged over that window. Windows are given (--windows) or
+found as the consecutive still phases of the board near the origin, one per item, in order.
+The list is written in the Listing 9 format, each item with the spread of its measurement.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+from ertools.cli.common import note, write_text
+
+EPILOG = """examples:
+  ertools acquire items items.bag --items fbm1h-vanilla.yaml -o fbm1h.yaml
+  ertools acquire items items.bag --items fbm1w-vanilla.yaml --namespace fbm1w \\
+      --windows 12.0:15.5,21:24,30.2:33
+
+--windows: START:END per item in list order, seconds from the log's first message (values
+above 1e9 are epoch seconds). Without it the board's still phases near the origin are used
+(--min-still, --max-distance); their number must equal the number of items.
+Exit status 1 when an item could not be acquired (it is written unchanged and named on stderr)."""
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="log file(s)")
+    parser.add_argument(
+        "--items", type=Path, required=True, metavar="FILE", help="vanilla item list"
+    )
+    parser.add_argument(
+        "--windows", metavar="S:E,...", help="one START:END window per item (see below)"
+    )
+    parser.add_argument(
+        "--namespace",
+        default="fbm1h",
+        choices=("fbm1h", "fbm1w"),
+        help="topic namespace of origin and ref_board (default fbm1h)",
+    )
+    parser.add_argument("--origin-topic", metavar="TOPIC", help="origin pose topic")
+    parser.add_argument("--ref-board-topic", metavar="TOPIC", help="ref_board pose topic")
+    parser.add_argument(
+        "--min-still", type=float, default=2.0, metavar="S", help="shortest placement (2 s)"
+    )
+    parser.add_argument(
+        "--max-distance",
+        type=float,
+        default=0.5,
+        metavar="M",
+        help="a placement has the board within M of the origin (0.5 m)",
+    )
+    parser.add_argument(
+        "--still", type=float, default=0.002, metavar="M", help="still: < M per 0.25 s (0.002)"
+    )
+    parser.add_argument(
+        "-o", "--output", type=Path, help="write the list to this file instead of stdout"
+    )
+
+
+def _windows(text: str | None) -> list[tuple[float, float]] | None:
+    from ertools.errors import UsageError
+
+    if text is None:
+        return None
+    out = []
+    for part in text.split(","):
+        a, sep, b = part.strip().partition(":")
+        try:
+            start, end = float(a), float(b)
+        except ValueError:
+            raise UsageError(f"--windows: {part!r} is not START:END in seconds") from None
+        if not sep or not (math.isfinite(start) and math.isfinite(end)):
+            raise UsageError(f"--windows: {part!r} is not START:END in seconds")
+        out.append((start, end))
+    return out
+
+
+def run(args: argparse.Namespace) -> int:
+    from ertools.benchmarks.fbm1_acquire import AcquireOptions, acquire_items_bag
+    from ertools.configs.items import items_to_yaml
+    from ertools.io import PoseSource
+
+    origin = PoseSource(topic=args.origin_topic) if args.origin_topic else None
+    board = PoseSource(topic=args.ref_board_topic) if args.ref_board_topic else None
+    options = AcquireOptions(
+        min_still_s=args.min_still, still_m=args.still, max_distance_m=args.max_distance
+    )
+    result = acquire_items_bag(
+        args.bags,
+        args.items,
+        namespace=args.namespace,
+        windows_s=_windows(args.windows),
+        options=options,
+        sources=(origin, board),
+    )
+    write_text(items_to_yaml(result.items), args.output)
+    note(
+        f"{'id':>3} {'instance':<16} {'window s':>17} {'n':>5} {'x m':>8} {'y m':>8} "
+        f"{'yaw deg':>8} {'spread mm':>9} {'deg':>6}"
+    )
+    for item in result.items:
+        s = item.spread
+        if s is None or item.trans is None or item.rot is None:
+            note(f"{item.id:>3} {item.instance[:16]:<16}  not acquired")
+            continue
+        x, y, z, w = item.rot
+        yaw = math.degrees(math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
+        note(
+            f"{item.id:>3} {item.instance[:16]:<16} {s.start_s:8.2f}:{s.end_s:<8.2f} "
+            f"{s.samples:>5} {item.trans[0]:8.4f} {item.trans[1]:8.4f} {yaw:8.2f} "
+            f"{s.position_m * 1000:9.3f} {s.angle_deg:6.3f}"
+        )
+    for warning in result.warnings:
+        note(f"warning: {warning}")
+    for deviation in result.deviations:
+        note(f"differs from 2015: {deviation}")
+    for failure in result.failures:
+        note(f"error: {failure}")
+    return 1 if result.failures else 0
