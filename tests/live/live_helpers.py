@@ -93,7 +93,9 @@ def read_mcap(path: Path) -> tuple[list[tuple[str, int, Any]], bool]:
     with open(path, "rb") as f:
         reader = NonSeekingReader(f)
         try:
-            for schema, channel, message in reader.iter_messages():
+            # log_time_order=False: the default sorts everything first, so the exception at
+            # the cut would lose every message.
+            for schema, channel, message in reader.iter_messages(log_time_order=False):
                 msg = store.deserialize_cdr(message.data, schema.name)
                 out.append((channel.topic, message.log_time, msg))
         except Exception:  # the truncated tail
