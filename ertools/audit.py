@@ -299,8 +299,14 @@ class Audit:
                 f"(tolerance {cmp.abs_tol:g})"
             )
             lines += [f"  note: {n}" for n in cmp.notes]
-            width = max((len(line.key) for line in cmp.lines), default=10)
-            for line in cmp.lines:
+            # Keys only ertools computes (sample counts, detected times...) are extra detail,
+            # not disagreements: counted here, listed in the JSON and CSV.
+            shown = [line for line in cmp.lines if line.status != "only recomputed"]
+            extra = len(cmp.lines) - len(shown)
+            if extra:
+                lines.append(f"  ({extra} more key(s) only in the recomputed score)")
+            width = max((len(line.key) for line in shown), default=10)
+            for line in shown:
                 lines.append(
                     f"  {line.key:<{width}}  {_short(line.live):>14}  "
                     f"{_short(line.recomputed):>14}  {line.status}"

@@ -495,21 +495,9 @@ def rescore(
 
 
 def _rescore_fbm3w(paths: list[Path], inputs: ScoreInputs) -> BenchmarkResult:
-    from importlib import import_module
+    from ertools.benchmarks.fbm3w import Fbm3wOptions, score_fbm3w
+    from ertools.configs.fbm3w import load_fbm3w_config
 
-    from ertools.errors import ScoringError
-
-    try:
-        module = import_module("ertools.benchmarks.fbm3w")
-    except ImportError as err:
-        raise ScoringError(f"the fbm3w scorer is not available: {err}") from err
-    options_cls = module.Fbm3wOptions
-    names = {f.name for f in fields(options_cls)}
-    kwargs: dict[str, Any] = {}
-    for name, value in (("config", inputs.config), ("d_min", inputs.d_min)):
-        if value is not None and name in names:
-            kwargs[name] = value
-    if inputs.topic is not None and "topic" in names:
-        kwargs["topic"] = inputs.topic
-    result: BenchmarkResult = module.score_fbm3w(paths, options_cls(**kwargs))
-    return result
+    config = load_fbm3w_config(inputs.config)
+    options = Fbm3wOptions(d_min=inputs.d_min, topic=inputs.topic)
+    return cast("BenchmarkResult", score_fbm3w(paths, config, options))

@@ -445,9 +445,16 @@ def _audit_html(audit: Any) -> str:
             f"{len(cmp.differences)} differ.</p>"
         )
         parts.append(h.notes(cmp.notes))
+        rows = [r for r in cmp.rows() if r["status"] != "only recomputed"]
+        extra = len(cmp.lines) - len(rows)
+        if extra:
+            parts.append(
+                f'<p class="muted">{extra} more key(s) only in the recomputed score: '
+                f"{h.link('score_comparison.csv', 'score_comparison.csv')}</p>"
+            )
         parts.append(
             h.table(
-                tables.get("score_comparison", cmp.rows()),
+                rows,
                 columns=["key", "live", "recomputed", "difference", "status", "explanation"],
                 row_class="status",
             )
