@@ -108,6 +108,7 @@ def compute(
     unreached: Sequence[str] = (),
     warnings: Sequence[str] = (),
     provenance: Provenance | None = None,
+    origin_ns: int | None = None,
 ) -> Fbm2hResult:
     """Score the segments of ``moments`` against ``goal`` (pure: no file is read).
 
@@ -220,6 +221,7 @@ def compute(
         path_t_ns=path.t_ns,
         path_xyyaw=path_xyyaw,
         notes=moments.notes,
+        origin_ns=origin_ns,
         warnings=tuple(all_warnings),
         deviations=tuple(deviations),
         failures=tuple(failures),
@@ -266,6 +268,8 @@ def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
     marker = read_pose_source(list(paths), _pose_source(options))  # type: ignore[arg-type]
     if len(marker) == 0:
         raise SegmentationError(f"{marker.source or paths[0]}: the marker set pose stream is empty")
+    infos = [summary(p) for p in paths]
+    bag_start, bag_end = min(i.start_ns for i in infos), max(i.end_ns for i in infos)
     warnings: list[str] = []
     unreached: tuple[str, ...] = ()
     reached = options.reached
@@ -310,8 +314,7 @@ def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
         if goal is None:
             raise ConfigError("--reached timing needs --goal FILE (Listing 10)")
         timing = load_timing(options.timing)
-        infos = [summary(p) for p in paths]
-        t = timing.resolve(min(i.start_ns for i in infos), max(i.end_ns for i in infos))
+        t = timing.resolve(bag_start, bag_end)
         if len(t) - 1 != len(goal):
             raise SegmentationError(
                 f"{options.timing}: {len(t)} moments close {len(t) - 1} segments, but "
@@ -363,4 +366,5 @@ def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
         unreached=unreached,
         warnings=warnings,
         provenance=provenance,
+        origin_ns=bag_start,
     )

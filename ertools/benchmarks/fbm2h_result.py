@@ -97,6 +97,8 @@ class Fbm2hResult:
         orientation_2015: True when errors were computed the 2015 way (unwrapped).
         path_t_ns, path_xyyaw: the robot's path (decimated) for the figures.
         notes: how the reached moments were found.
+        origin_ns: the log's first message; table times count from it (from the first
+            segment start when None).
     """
 
     segments: tuple[SegmentResult, ...]
@@ -112,6 +114,7 @@ class Fbm2hResult:
     path_t_ns: npt.NDArray[np.int64]
     path_xyyaw: npt.NDArray[np.float64]
     notes: tuple[str, ...] = ()
+    origin_ns: int | None = None
     warnings: tuple[str, ...] = ()
     deviations: tuple[str, ...] = ()
     failures: tuple[str, ...] = ()
@@ -162,7 +165,9 @@ class Fbm2hResult:
 
     def tables(self) -> dict[str, Rows]:
         """``segments`` (one row per waypoint) and ``summary``."""
-        t0 = next((s.start_ns for s in self.segments if s.start_ns is not None), None)
+        t0 = self.origin_ns
+        if t0 is None:
+            t0 = next((s.start_ns for s in self.segments if s.start_ns is not None), None)
 
         def rel(t: int | None) -> float | None:
             return None if t is None or t0 is None else ns_to_s(t - t0)

@@ -190,17 +190,18 @@ class StopParams:
 
     Attributes:
         speed: m/s; the robot counts as stopped below it (mocap jitter on a still marker set
-            gives ~1 mm over the window, i.e. a few mm/s).
+            gives ~1 mm over the window, i.e. a few mm/s; the 2015 test robot crept at a few
+            cm/s while "standing" at its waypoints).
         yaw_rate: rad/s; also required, so a robot turning on the spot is not "stopped".
-        min_duration_s: a stop lasts at least this long.
+        min_duration_s: a stop lasts at least this long (the 2015 robot paused 0.7 to 3 s).
         window_s: speeds are displacements over this window (per-sample differences of 120 Hz
             mocap are dominated by jitter).
         radius: metres; a stop is assigned to a waypoint only if it lies this close to it.
     """
 
-    speed: float = 0.02
-    yaw_rate: float = 0.05
-    min_duration_s: float = 1.0
+    speed: float = 0.05
+    yaw_rate: float = 0.1
+    min_duration_s: float = 0.5
     window_s: float = 0.5
     radius: float = 0.5
 
@@ -251,7 +252,7 @@ def from_stops(
     """Assign detected stops to waypoints in order; returns moments and unassigned waypoints.
 
     Waypoint k takes the first stop after the one given to waypoint k-1 that lies within
-    ``radius`` of it; the reached moment is when that stop began (plus half the speed window).
+    ``radius`` of it; the reached moment is one speed window after that stop began.
     Segment 0 starts when the
     robot first moves (the end of an initial stop) or at the first sample.
     """
@@ -284,10 +285,11 @@ def from_stops(
                 f"{params.radius} m of waypoint {k} after the previous waypoint"
             )
             break
-        # The first still sample's window is centred on it: the robot may still creep during
-        # the window's second half, so the reached moment is the window's end.
+        # The first still sample's window is centred on it, so the robot may still creep (by
+        # less than speed * window) during the next half window: one full window later it is
+        # at rest, which is also when a Client would report the waypoint reached.
         s, e = runs[chosen]
-        ends.append(min(int(stream_t_ns[s]) + int(params.window_s * 5e8), int(stream_t_ns[e])))
+        ends.append(min(int(stream_t_ns[s]) + int(params.window_s * 1e9), int(stream_t_ns[e])))
         next_run = chosen + 1
     end_arr = np.asarray(ends, dtype=np.int64)
     start_arr = np.concatenate([[t_start0], end_arr[:-1]]).astype(np.int64)[: len(end_arr)]

@@ -79,9 +79,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--namespace", default="fbm2h", help="benchmark namespace of the state topics"
     )
     auto = parser.add_argument_group("--reached auto (stop detection)")
-    auto.add_argument("--stop-speed", type=float, default=0.02, metavar="M_S")
-    auto.add_argument("--stop-yaw-rate", type=float, default=0.05, metavar="RAD_S")
-    auto.add_argument("--stop-min-duration", type=float, default=1.0, metavar="S")
+    auto.add_argument(
+        "--stop-speed", type=float, default=0.05, metavar="M_S", help="(default 0.05 m/s)"
+    )
+    auto.add_argument(
+        "--stop-yaw-rate", type=float, default=0.1, metavar="RAD_S", help="(default 0.1 rad/s)"
+    )
+    auto.add_argument(
+        "--stop-min-duration", type=float, default=0.5, metavar="S", help="(default 0.5 s)"
+    )
     auto.add_argument(
         "--stop-radius",
         type=float,
@@ -146,7 +152,10 @@ def _print_table(result: object) -> None:
     from ertools.benchmarks.fbm2h_result import Fbm2hResult
 
     assert isinstance(result, Fbm2hResult)
-    note(f"reached moments: {result.reached_method}; transform: {result.transform.source}")
+    note(
+        f"reached moments: {result.reached_method}; transform: {result.transform.source}; "
+        "times from the log's first message"
+    )
     for row in result.tables()["segments"]:
         if row["status"] != "ok":
             note(f"  segment {row['segment']}: {row['status']}")
