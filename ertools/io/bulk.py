@@ -76,6 +76,27 @@ def _mcap(
     return _ordered(parts)
 
 
+def _sqlite(
+    bag: BagFile, conns: Sequence[Conn], msgtype: str, lo: int | None, hi: int | None
+) -> PoseBatch | None:
+    from ertools.io.rosbag2 import sqlite_rows
+
+    batches = sqlite_rows(bag.path, conns, lo, hi)
+    if batches is None:
+        return None
+    parts = []
+    done = 0
+    for buf, start, length, t_rec in batches:
+        dec = decode(msgtype, conns[0].encoding == "cdr", buf, start, length)
+        parts.append((done + dec.msg_index, to_batch(buf, dec, t_rec)))
+        done += len(start)
+    batch = concat_batches([p[1] for p in parts])
+    t = batch.t_record
+    if len(t) > 1 and np.any(t[1:] < t[:-1]):  # several storage files: merge by time
+        batch = batch.take(np.argsort(t, kind="stable"))
+    return batch
+
+
 def try_fast_batch(
     bag: BagFile, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
 ) -> PoseBatch | None:
@@ -93,7 +114,11 @@ def try_fast_batch(
     try:
         if bag.format in ("ros1", "ros1-active"):
             return _ros1(bag, conns, msgtype, start_ns, end_ns)
-        if bag.format in ("mcap", "rosbag2-mcap", "rosbag2-sqlite3"):
+        if bag.format == "rosbag2-sqlite3":
+            result = _sqlite(bag, conns, msgtype, start_ns, end_ns)
+            if result is not None:
+                return result
+        if bag.format in ("mcap", "rosbag2-mcap"):
             result = _mcap(bag, conns, msgtype, start_ns, end_ns)
             if result is not None:
                 return result

@@ -1,27 +1,200 @@
-"""MCAP files read through their summary section: chunk indexes and message indexes."""
+"""MCAP files read through their summary section: chunk indexes and message indexes.
+
+Opening reads the footer and the summary section only (schemas, channels, chunk indexes,
+statistics). Messages of some channels are located from the message-index records that follow
+each chunk, read for every chunk overlapping the window before any chunk data, so the
+reference order (log time, then chunk, then position, as the ``mcap`` library yields them) is
+known up front; then the chunks are decompressed one at a time.
+"""
 
 from __future__ import annotations
 
+import logging
+import struct
 from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, BinaryIO
 
 import numpy as np
 import numpy.typing as npt
 
+from ertools.errors import BagError
 from ertools.io.files import BagFile
 from ertools.io.model import Conn
+
+log = logging.getLogger("ertools.io.mcap_index")
 
 I64 = npt.NDArray[np.int64]
 U8 = npt.NDArray[np.uint8]
 
+OP_MESSAGE = 0x05
+OP_CHUNK = 0x06
+OP_MESSAGE_INDEX = 0x07
+MESSAGE_FIXED = 2 + 4 + 8 + 8  # channel id, sequence, log time, publish time
+PAIR = np.dtype([("t", "<u8"), ("off", "<u8")])
+
+
+def read_summary(f: BinaryIO, path: Path) -> Any:
+    """The ``mcap`` library's Summary of an open MCAP file, None when it has none."""
+    from mcap.exceptions import McapError
+    from mcap.reader import make_reader
+
+    try:
+        return make_reader(f).get_summary()
+    except (McapError, ValueError, EOFError, OSError, struct.error, KeyError) as err:
+        raise BagError(f"unreadable MCAP summary ({type(err).__name__}: {err})", path=path) from err
+
+
+def decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
+    """Uncompressed MCAP chunk records."""
+    try:
+        if compression == "":
+            return data
+        if compression == "zstd":
+            import zstandard
+
+            return bytes(zstandard.ZstdDecompressor().decompress(data, max_output_size=size))
+        if compression == "lz4":
+            import lz4.frame
+
+            return bytes(lz4.frame.decompress(data))
+    except Exception as err:
+        # zstandard and lz4 raise their own error classes on corrupt input.
+        raise BagError(f"corrupt {compression} MCAP chunk {where} ({err})") from err
+    raise BagError(f"unsupported MCAP chunk compression {compression!r} {where}")
+
+
+@dataclass
+class _Sel:
+    chunk: int
+    t: I64
+    off: I64
+
 
 class McapIndex:
-    """Placeholder until the MCAP bulk reader lands."""
+    """Chunk-level access to one or more MCAP files (a rosbag2 directory may hold several)."""
+
+    def __init__(self, files: list[Path]) -> None:
+        self.files = files
 
     @staticmethod
     def of(bag: BagFile) -> McapIndex | None:
+        """The index of an MCAP file or a rosbag2-mcap directory, None for other formats."""
+        if bag.format == "mcap":
+            return McapIndex([bag.path])
+        if bag.format == "rosbag2-mcap":
+            return McapIndex(sorted(bag.path.glob("*.mcap")))
         return None
 
     def message_runs(
         self, conns: Sequence[Conn], lo: int | None, hi: int | None
     ) -> Iterator[tuple[I64, U8, I64, I64, I64]]:
-        return iter(())
+        """Per chunk: (reference positions, chunk bytes, data starts, data lengths, log times).
+
+        Raises:
+            BagError: damaged chunk or index.
+            LayoutMismatchError: a file has chunks without message indexes (caller falls back).
+        """
+        from ertools.io.fastdecode import LayoutMismatchError
+
+        topics = {c.topic for c in conns}
+        sels: list[tuple[int, int, int, I64, I64]] = []  # file, chunk idx, chunk offset, t, off
+        plans: list[tuple[Path, list[Any]]] = []
+        for fi, path in enumerate(self.files):
+            with path.open("rb") as f:
+                summary = read_summary(f, path)
+                if summary is None or not summary.chunk_indexes:
+                    raise LayoutMismatchError("MCAP file without chunk indexes")
+                channels = {cid for cid, ch in summary.channels.items() if ch.topic in topics}
+                chunks = summary.chunk_indexes
+                plans.append((path, chunks))
+                for ci, chunk in enumerate(chunks):
+                    if lo is not None and chunk.message_end_time < lo:
+                        continue
+                    if hi is not None and chunk.message_start_time > hi:
+                        continue
+                    wanted = [c for c in channels if c in chunk.message_index_offsets]
+                    if not wanted:
+                        if chunk.message_index_length == 0 and chunk.uncompressed_size:
+                            raise LayoutMismatchError("MCAP chunk without message indexes")
+                        continue
+                    for cid in wanted:
+                        t, off = self._message_index(f, path, chunk.message_index_offsets[cid], cid)
+                        keep = np.ones(len(t), dtype=bool)
+                        if lo is not None:
+                            keep &= t >= lo
+                        if hi is not None:
+                            keep &= t <= hi
+                        if keep.any():
+                            sels.append((fi, ci, int(chunk.chunk_start_offset), t[keep], off[keep]))
+        if not sels:
+            return
+        t_all = np.concatenate([s[3] for s in sels])
+        off_all = np.concatenate([s[4] for s in sels])
+        file_all = np.concatenate([np.full(len(s[3]), s[0], np.int64) for s in sels])
+        chunk_all = np.concatenate([np.full(len(s[3]), s[1], np.int64) for s in sels])
+        cstart_all = np.concatenate([np.full(len(s[3]), s[2], np.int64) for s in sels])
+        order = np.lexsort((off_all, cstart_all, file_all, t_all))
+        pos_of = np.empty(len(order), dtype=np.int64)
+        pos_of[order] = np.arange(len(order))
+        key = file_all * (1 << 32) + chunk_all
+        for k in np.unique(key):
+            rows = np.flatnonzero(key == k)
+            rows = rows[np.argsort(pos_of[rows], kind="stable")]
+            fi, ci = int(k >> 32), int(k & 0xFFFFFFFF)
+            path, chunks = plans[fi]
+            buf = self._chunk_bytes(path, chunks[ci])
+            start, length = self._spans(
+                buf, off_all[rows], f"in {path} at byte {chunks[ci].chunk_start_offset}"
+            )
+            yield pos_of[rows], buf, start, length, t_all[rows]
+
+    @staticmethod
+    def _message_index(f: BinaryIO, path: Path, pos: int, cid: int) -> tuple[I64, I64]:
+        f.seek(pos)
+        head = f.read(1 + 8 + 2 + 4)
+        if len(head) < 15 or head[0] != OP_MESSAGE_INDEX:
+            raise BagError(f"no message index at byte {pos}", path=path)
+        _, _length, channel, nbytes = struct.unpack("<BQHI", head)
+        if channel != cid or nbytes % 16:
+            raise BagError(f"damaged message index at byte {pos}", path=path)
+        data = f.read(nbytes)
+        if len(data) != nbytes:
+            raise BagError(f"message index at byte {pos} cut off by end of file", path=path)
+        arr = np.frombuffer(data, dtype=PAIR)
+        return arr["t"].astype(np.int64), arr["off"].astype(np.int64)
+
+    @staticmethod
+    def _chunk_bytes(path: Path, chunk: Any) -> U8:
+        where = f"in {path} at byte {chunk.chunk_start_offset}"
+        with path.open("rb") as f:
+            f.seek(chunk.chunk_start_offset)
+            head = f.read(1 + 8 + 8 + 8 + 8 + 4 + 4)
+            if len(head) < 41 or head[0] != OP_CHUNK:
+                raise BagError(f"no chunk record {where}")
+            _, _rlen, _t0, _t1, usize, _crc, clen = struct.unpack("<BQQQQII", head)
+            compression = f.read(clen).decode("ascii", "replace")
+            (nbytes,) = struct.unpack("<Q", f.read(8))
+            data = f.read(nbytes)
+        if len(data) != nbytes:
+            raise BagError(f"chunk cut off by end of file {where}")
+        raw = decompress(compression, data, int(usize), where)
+        if len(raw) != usize:
+            raise BagError(f"chunk decompresses to {len(raw)} bytes, not {usize}, {where}")
+        return np.frombuffer(raw, dtype=np.uint8)
+
+    @staticmethod
+    def _spans(buf: U8, off: I64, where: str) -> tuple[I64, I64]:
+        from ertools.io.fastdecode import gather
+
+        if len(off) and (int(off.min()) < 0 or int(off.max()) + 9 + MESSAGE_FIXED > len(buf)):
+            raise BagError(f"message index points outside its chunk {where}")
+        if np.any(buf[off] != OP_MESSAGE):
+            raise BagError(f"message index points at a record that is no message {where}")
+        rlen = gather(buf, off + 1, 8).view("<u8").reshape(-1).astype(np.int64)
+        start = off + 9 + MESSAGE_FIXED
+        length = rlen - MESSAGE_FIXED
+        if len(off) and (int((start + length).max()) > len(buf) or int(length.min()) < 0):
+            raise BagError(f"message record cut off inside its chunk {where}")
+        return start, length

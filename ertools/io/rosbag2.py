@@ -1,0 +1,96 @@
+"""rosbag2 directories: ``metadata.yaml`` (the summary) and bulk row access to sqlite3 storage."""
+
+from __future__ import annotations
+
+import sqlite3
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ertools.errors import BagError
+from ertools.io.model import Conn
+
+I64 = npt.NDArray[np.int64]
+U8 = npt.NDArray[np.uint8]
+
+ROWS_PER_BATCH = 100_000
+
+
+def read_metadata(path: Path) -> dict[str, Any]:
+    """``rosbag2_bagfile_information`` of a rosbag2 directory."""
+    import yaml
+
+    meta = path / "metadata.yaml"
+    try:
+        data = yaml.safe_load(meta.read_text(encoding="utf-8"))
+        info = data["rosbag2_bagfile_information"]
+    except (OSError, yaml.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
+        raise BagError(f"unreadable metadata.yaml ({err})", path=path) from err
+    if not isinstance(info, dict):
+        raise BagError("metadata.yaml has no rosbag2_bagfile_information", path=path)
+    return info
+
+
+def storage_files(path: Path, info: dict[str, Any]) -> list[Path]:
+    """The storage files the metadata lists (relative to the directory)."""
+    rel = info.get("relative_file_paths") or [f["path"] for f in info.get("files", [])]
+    return [path / str(r) for r in rel]
+
+
+def _connect(db: Path) -> sqlite3.Connection:
+    # Read-only: an input file is never modified (not even a journal is created).
+    return sqlite3.connect(f"{db.resolve().as_uri()}?mode=ro", uri=True)
+
+
+def sqlite_rows(
+    path: Path, conns: Sequence[Conn], lo: int | None, hi: int | None
+) -> Iterator[tuple[U8, I64, I64, I64]] | None:
+    """Batches of (bytes, data starts, data lengths, timestamps) ordered by time, or None
+    when the bag is compressed (then rosbags reads it)."""
+    info = read_metadata(path)
+    if info.get("compression_format") or info.get("compression_mode"):
+        return None
+    files = [f for f in storage_files(path, info) if f.suffix == ".db3"]
+    topics = sorted({c.topic for c in conns})
+    return _rows(files, topics, lo, hi)
+
+
+def _rows(
+    files: list[Path], topics: list[str], lo: int | None, hi: int | None
+) -> Iterator[tuple[U8, I64, I64, I64]]:
+    for db in files:
+        try:
+            con = _connect(db)
+        except sqlite3.Error as err:
+            raise BagError(f"cannot open sqlite3 storage ({err})", path=db) from err
+        try:
+            marks = ",".join("?" * len(topics))
+            ids = [
+                r[0] for r in con.execute(f"SELECT id FROM topics WHERE name IN ({marks})", topics)
+            ]
+            if not ids:
+                continue
+            marks = ",".join("?" * len(ids))
+            query = f"SELECT timestamp, data FROM messages WHERE topic_id IN ({marks})"
+            args: list[int] = list(ids)
+            if lo is not None:
+                query += " AND timestamp >= ?"
+                args.append(lo)
+            if hi is not None:
+                query += " AND timestamp <= ?"
+                args.append(hi)
+            cur = con.execute(query + " ORDER BY timestamp, id", args)
+            while rows := cur.fetchmany(ROWS_PER_BATCH):
+                t = np.fromiter((r[0] for r in rows), dtype=np.int64, count=len(rows))
+                lengths = np.fromiter((len(r[1]) for r in rows), dtype=np.int64, count=len(rows))
+                starts = np.zeros(len(rows), dtype=np.int64)
+                np.cumsum(lengths[:-1], out=starts[1:])
+                buf = np.frombuffer(b"".join(r[1] for r in rows), dtype=np.uint8)
+                yield buf, starts, lengths, t
+        except sqlite3.Error as err:
+            raise BagError(f"damaged sqlite3 storage ({err})", path=db) from err
+        finally:
+            con.close()
