@@ -1,0 +1,109 @@
+"""Audits of the sample benchmark logs, against the generator's truth and answers."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+import yaml
+from sample_logs import answers, sample_dir
+
+from ertools.audit import Audit, audit_states
+from ertools.audit_score import ScoreInputs, attach, rescore
+
+
+def _audit(folder: Path, ns: str) -> Audit:
+    from ertools.io import read_benchmark_states
+
+    (bag,) = folder.glob("*.bag")
+    st = read_benchmark_states([bag], ns)
+    return audit_states(st.bmbox, st.refbox, st.client, benchmark=ns)
+
+
+@pytest.fixture(scope="module")
+def fbm3w(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return sample_dir("fbm3w", tmp_path_factory)
+
+
+@pytest.fixture(scope="module")
+def fbm1h(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return sample_dir("fbm1h", tmp_path_factory)
+
+
+@pytest.fixture(scope="module")
+def fbm2h(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    return sample_dir("fbm2h", tmp_path_factory)
+
+
+def test_fbm3w_runs_and_live_score(fbm3w: Path) -> None:
+    ans = answers(fbm3w)
+    audit = _audit(fbm3w, "fbm3w")
+    truth = ans["truth"]["runs"]
+    assert audit.illegal_transitions == () and audit.silences == ()
+    assert len(audit.runs) == len(truth) == 5
+    for run, t in zip(audit.runs, truth, strict=True):
+        # Transition times are exact in the generated bag: the path starts at EXECUTING_GOAL
+        # and ends when the BmBox leaves WAITING_RESULT.
+        assert run.executing_ns == t["start_ns"]
+        assert run.end_ns == t["end_ns"]
+        assert run.outcome == t["status"]
+    assert [e.reason for e in audit.early_ends] == ["timeout"]
+    assert audit.early_ends[0].run == 4
+    # The live score the generator put in TRANSMITTING_SCORE is its expected top-level score.
+    expected = {
+        k: ans["expected"][k] for k in ("best_distance_error", "best_run", "execution_time")
+    }
+    assert audit.live_score == pytest.approx(expected, abs=1e-12)
+
+
+def test_fbm3w_recomputed_beside_live(fbm3w: Path) -> None:
+    (bag,) = fbm3w.glob("*.bag")
+    result, notes = rescore("fbm3w", [bag], ScoreInputs())
+    assert notes == ()
+    audit = attach(_audit(fbm3w, "fbm3w"), result)
+    assert audit.comparison is not None
+    line = next(x for x in audit.comparison.lines if x.key == "best_distance_error")
+    assert line.live == pytest.approx(audit.live_score["best_distance_error"], abs=0)
+    assert line.recomputed == pytest.approx(result.to_dict()["best_distance_error"], abs=0)
+    if line.status == "differs":
+        assert "d_min" in line.explanation
+    exec_line = next(x for x in audit.comparison.lines if x.key == "execution_time")
+    assert exec_line.status == "same"  # 24.55 s both: transition times are exact
+
+
+def test_fbm1h_live_is_the_2015_totals(fbm1h: Path) -> None:
+    ans = answers(fbm1h)
+    audit = _audit(fbm1h, "fbm1h")
+    assert audit.live_score == pytest.approx(ans["expected"]["totals_2015"], abs=1e-12)
+    assert [r.outcome for r in audit.runs].count("timeout") == 1
+    order = ans["truth"]["order"]
+    for run, item in zip(audit.runs, order, strict=True):
+        assert run.manual_operation.startswith(f"Place item {item} (")
+    (bag,) = fbm1h.glob("*.bag")
+    result, _ = rescore("fbm1h", [bag], ScoreInputs(items=fbm1h / "fbm1h.yaml"))
+    audit = attach(audit, result)
+    assert audit.comparison is not None
+    by_key = {x.key: x for x in audit.comparison.lines}
+    total = ans["expected"]["totals"]
+    tol = ans["tolerance"]["pose_score"]["abs"]
+    assert by_key["pose_score"].recomputed == pytest.approx(total["pose_score"], abs=tol)
+    assert by_key["class_accuracy"].status == "same"
+    # ertools' pose score divides by the runs whose goal was sent; 2015 counted all ten.
+    assert by_key["pose_score"].status == "differs"
+    assert "runs" in by_key["pose_score"].explanation
+
+
+def test_fbm2h_goal_and_results_in_the_runs(fbm2h: Path) -> None:
+    ans = answers(fbm2h)
+    audit = _audit(fbm2h, "fbm2h")
+    goal = yaml.safe_load((fbm2h / ans["generator"]["parameters"]["goal"]).read_text())
+    assert len(audit.runs) == len(ans["truth"]["segments"]) == 5
+    sent = yaml.safe_load(audit.runs[0].goal)
+    sent = sent.get("goal", sent)  # Listing 10 with or without its top-level key
+    assert sent["waypoints"] == pytest.approx(goal["goal"]["waypoints"], abs=1e-12)
+    for k, (run, seg) in enumerate(zip(audit.runs, ans["truth"]["segments"], strict=True)):
+        assert run.outcome == "completed"
+        assert run.executing_ns == seg["start_ns"]
+        assert run.result_ns == seg["end_ns"]
+        assert yaml.safe_load(run.result) == {"waypoint": k}
+    assert audit.early_ends == ()
