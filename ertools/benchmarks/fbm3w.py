@@ -45,6 +45,9 @@ STALE_REFERENCE_S = 0.5
 # Below this reference-start distance the run frame's direction is uncertain (1 mm of noise
 # turns a 1 cm baseline by ~0.1 rad).
 SHORT_BASELINE_M = 0.01
+# Samples of the noiseless robot used for shape_floor, and the floor worth a warning.
+FLOOR_SAMPLES = 10_001
+FLOOR_WARN_M = 0.0005
 
 Window = tuple[str, float, float, float]
 F64 = npt.NDArray[np.float64]
@@ -64,6 +67,8 @@ class Fbm3wOptions:
         time_source: ``record`` (default: the 2015 node received poses live) or ``header``.
         still_speed, min_still_s: stationary detection (auto runs and the noise estimate).
         noise_c: factor of the suggested d_min (c * epsilon).
+        arc_length: compare at equal fractions of the target's arc length instead of the
+            shape's own parameter (2015); removes the floor of shapes such as ``sine``.
     """
 
     runs: str | None = None
@@ -76,6 +81,7 @@ class Fbm3wOptions:
     still_speed: float | None = None
     min_still_s: float | None = None
     noise_c: float = DEFAULT_C
+    arc_length: bool = False
 
 
 def read_fbm3w_poses(paths: Sequence[Path], options: Fbm3wOptions) -> PoseStream:
@@ -184,7 +190,7 @@ def score_runs(
     results: list[RunResult] = []
     failures: list[str] = []
     for window in runs_in:
-        run = _score_one(poses, same, window, cfg, options.sweep, start_ns, warnings)
+        run = _score_one(poses, same, window, cfg, options, start_ns, warnings)
         results.append(run)
         if run.error is not None:
             failures.append(f"run {window.index} ({run.spec}): {run.error}")
@@ -204,7 +210,7 @@ def score_runs(
         noise=noise,
         sweep_values=tuple(options.sweep),
         warnings=tuple(warnings),
-        deviations=tuple(_deviations(cfg, results, mode, poses)),
+        deviations=tuple(_deviations(cfg, results, mode, poses, options)),
         failures=tuple(failures),
         provenance=Provenance(
             inputs=inputs or (poses.source,),
@@ -240,7 +246,7 @@ def _score_one(
     same: npt.NDArray[np.bool_],
     window: RunWindow,
     cfg: Fbm3wConfig,
-    sweep: Sequence[float],
+    options: Fbm3wOptions,
     bag_start_ns: int,
     warnings: list[str],
 ) -> RunResult:
@@ -268,6 +274,8 @@ def _score_one(
         shape = cfg.shape(spec)
     except ConfigError as err:
         return result(err.message)
+    if options.arc_length:
+        shape = shape.by_arc_length()
     target_length = shape.length()
     if window.status in ("interrupted", "timeout", "stopped"):
         return result(None, target_length=target_length)  # reported, not scored (as 2015)
@@ -313,8 +321,36 @@ def _score_one(
             f"run {window.index}: the reference and starting positions are only "
             f"{baseline * 1000:.1f} mm apart; the run frame's direction is uncertain"
         )
-    swept = tuple((d, _try_score(xy, ref_xy, shape, d)) for d in sweep)
-    return result(None, score=score, sweep=swept, frame_xy=score.frame.to_frame(xy), **common)
+    swept = tuple((d, _try_score(xy, ref_xy, shape, d)) for d in options.sweep)
+    floor = shape_floor(shape, cfg.d_min)
+    if floor > FLOOR_WARN_M and not any(spec in w and "floor" in w for w in warnings):
+        warnings.append(
+            f"shape {spec!r} is not parametrised by arc length: a robot exactly on it scores "
+            f"{floor * 1000:.2f} mm with the 2015 formula (shape_floor); --arc-length compares "
+            "at equal fractions of the target's length instead"
+        )
+    return result(
+        None,
+        score=score,
+        sweep=swept,
+        frame_xy=score.frame.to_frame(xy),
+        shape_floor=floor,
+        **common,
+    )
+
+
+def shape_floor(shape: Shape, d_min: float) -> float:
+    """distance_error of a noiseless robot exactly on ``shape`` (1e4 samples), metres.
+
+    0 up to the d_min quantisation for shapes parametrised by arc length; 8.4 mm for the 2015
+    ``sine``, whose parameter is proportional to x, not to the length travelled.
+    """
+    pts = shape(np.linspace(0.0, 1.0, FLOOR_SAMPLES))
+    reference = np.array([-0.05, 0.0])  # run frame = world frame
+    try:
+        return score_path(pts, reference, shape, d_min).distance_error
+    except ErtoolsError:
+        return math.nan
 
 
 def _try_score(xy: F64, ref_xy: F64, shape: Shape, d_min: float) -> float | None:
@@ -325,7 +361,11 @@ def _try_score(xy: F64, ref_xy: F64, shape: Shape, d_min: float) -> float | None
 
 
 def _deviations(
-    cfg: Fbm3wConfig, runs: Sequence[RunResult], mode: str, poses: PoseStream
+    cfg: Fbm3wConfig,
+    runs: Sequence[RunResult],
+    mode: str,
+    poses: PoseStream,
+    options: Fbm3wOptions,
 ) -> list[str]:
     out = []
     if mode == "states":
@@ -347,6 +387,11 @@ def _deviations(
     )
     if custom:
         out.append(f"user-defined shape(s) {', '.join(custom)}; 2015 had only its built-in shapes")
+    if options.arc_length:
+        out.append(
+            "targets compared at equal fractions of their arc length (--arc-length); 2015 "
+            "evaluated each shape at its own parameter"
+        )
     if any(r.window.status in ("timeout", "stopped") for r in runs):
         out.append(
             "a timed-out or stopped run is listed with its spec and time and no distance_error; "

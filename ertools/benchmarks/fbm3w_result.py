@@ -47,6 +47,7 @@ class RunResult:
     sweep: tuple[tuple[float, float | None], ...] = ()
     bag_start_ns: int = 0
     frame_xy: Any = None
+    shape_floor: float | None = None
 
     @property
     def index(self) -> int:
@@ -87,6 +88,8 @@ class RunResult:
             out["raw_path_length"] = self.score.raw_length
         if self.target_length is not None:
             out["target_length"] = self.target_length
+        if self.shape_floor is not None:
+            out["shape_floor"] = self.shape_floor
         out["tracking_losses"] = self.tracking_losses
         out["run_finding"] = self.window.mode
         out["reference_time"] = self._rel(self.window.ref_ns)

@@ -79,6 +79,41 @@ class Shape:
         pts = self.dense(n)
         return float(np.sum(np.hypot(*np.diff(pts, axis=0).T)))
 
+    def arc_length_gap(self) -> float:
+        """Largest distance between t(l) and the point at fraction l of the arc length, metres.
+
+        0 for shapes parametrised by arc length (line, semi_ellipse); the 2015 formula compares
+        the robot at fraction l of its length with t(l), so a shape with a large gap (``sine``)
+        penalises even a robot exactly on it.
+        """
+        uu = np.linspace(0.0, 1.0, _DENSE)
+        pts = self.curve(uu)
+        by_arc = self.by_arc_length().curve(uu)
+        return float(np.max(np.hypot(*(pts - by_arc).T)))
+
+    def by_arc_length(self) -> Shape:
+        """The same curve reparametrised so that l is the fraction of its arc length."""
+        return Shape(
+            self.name,
+            _arc_length_curve(self.curve),
+            f"{self.definition} (by arc length)",
+            self.builtin,
+        )
+
+
+def _arc_length_curve(curve: Curve) -> Curve:
+    """``curve`` reparametrised by normalised arc length (dense polyline, linear lookup)."""
+    uu = np.linspace(0.0, 1.0, _DENSE)
+    dense = curve(uu)
+    s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(dense, axis=0).T))])
+    if s[-1] > 0:
+        s /= s[-1]
+
+    def reparametrised(ll: F64) -> F64:
+        return curve(np.interp(np.clip(ll, 0.0, 1.0), s, uu))
+
+    return reparametrised
+
 
 # --- the 2015 built-ins (seed Listing 15) -------------------------------------------------
 
@@ -277,20 +312,18 @@ def _points_shape(name: str, points: Any, where: str) -> Shape:
     u = np.concatenate([[0.0], np.cumsum(chord)])
     u /= u[-1]
     if len(pts) == 2:
-        spline: Callable[[F64], F64] = lambda uu: pts[0] + np.outer(uu, pts[1] - pts[0])  # noqa: E731
+
+        def spline(uu: F64) -> F64:
+            return np.asarray(pts[0] + np.outer(uu, pts[1] - pts[0]), dtype=np.float64)
     else:
-        spline = CubicSpline(u, pts, axis=0, bc_type="natural")
-    # Reparametrise by normalised arc length, so that l means "fraction of the target's
-    # length" as it means "fraction of the robot's length" on the measured side.
-    uu = np.linspace(0.0, 1.0, _DENSE)
-    dense = np.asarray(spline(uu))
-    s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(dense, axis=0).T))])
-    s /= s[-1]
+        cubic = CubicSpline(u, pts, axis=0, bc_type="natural")
 
-    def curve(ll: F64) -> F64:
-        return np.asarray(spline(np.interp(np.clip(ll, 0.0, 1.0), s, uu)), dtype=np.float64)
+        def spline(uu: F64) -> F64:
+            return np.asarray(cubic(uu), dtype=np.float64)
 
-    return Shape(name, curve, f"spline through {len(pts)} points")
+    # Parametrised by normalised arc length, so that l means "fraction of the target's length"
+    # as it means "fraction of the robot's length" on the measured side.
+    return Shape(name, _arc_length_curve(spline), f"spline through {len(pts)} points")
 
 
 def parse_shape(name: str, spec: Any, *, source: str = "<config>") -> Shape:
