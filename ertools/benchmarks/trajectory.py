@@ -375,6 +375,26 @@ def check_increasing(robot: PoseStream, where: str) -> None:
         )
 
 
+def drop_duplicates(gt: PoseStream) -> tuple[PoseStream, int]:
+    """GT without samples identical to the previous one in time and pose.
+
+    Two loggers recording the same mocap topic (overlapping GT files) store every message
+    twice; kept, each pair would look like Motive's tracking-loss repeat. A real repeat has a
+    fresh stamp, so it is not dropped.
+    """
+    if len(gt) < 2:
+        return gt, 0
+    same = (
+        (gt.t_ns[1:] == gt.t_ns[:-1])
+        & np.all(gt.xyz[1:] == gt.xyz[:-1], axis=1)
+        & np.all(gt.quat_xyzw[1:] == gt.quat_xyzw[:-1], axis=1)
+    )
+    if not same.any():
+        return gt, 0
+    keep = np.concatenate([[True], ~same])
+    return gt.take(keep), int(same.sum())
+
+
 def _decimate(stream: PoseStream, limit: int = 5000) -> PoseStream:
     step = max(1, len(stream) // limit)
     return stream.take(slice(None, None, step))
@@ -403,11 +423,14 @@ def score_streams(
     if len(gt) < 2:
         raise ScoringError(f"GT {gt_topic}: {len(gt)} pose(s) in the robot log's span")
     check_increasing(robot, where)
+    gt, dropped = drop_duplicates(gt)
+    notes = list(warnings)
+    if dropped:
+        notes.append(f"{dropped} GT sample(s) recorded twice (overlapping GT files) were used once")
     audit = estimate_offset(
         robot, gt, search_range_ns=config.offset_range_ns, max_gap_ns=config.max_gap_ns
     )
     offset_ns = config.offset_ns
-    notes = list(warnings)
     if config.auto_offset and config.apply_offset:
         if audit.offset_ns is None:
             raise ClockError(f"{where}: cannot apply the estimated clock offset: {audit.note}")

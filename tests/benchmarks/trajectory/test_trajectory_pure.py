@@ -1,0 +1,176 @@
+"""Association, metrics and the clock-offset estimate on hand-made arrays."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from ertools.benchmarks.clock_offset import estimate_offset
+from ertools.benchmarks.trajectory import (
+    COMPARED,
+    GAP,
+    TRACKING_LOST,
+    UNCOVERED,
+    TrajectoryConfig,
+    associate,
+    check_increasing,
+    drop_duplicates,
+    metrics,
+    score_streams,
+)
+from ertools.errors import ClockError, ConfigError, ScoringError
+from ertools.geometry import quat_from_yaw
+from ertools.streams import PoseStream
+
+MS = 1_000_000
+T0 = 1_448_013_600 * 1_000_000_000
+
+
+def stream(t_ms: list[float], x: list[float], yaw: list[float] | None = None) -> PoseStream:
+    t = T0 + np.round(np.asarray(t_ms) * MS).astype(np.int64)
+    xyz = np.column_stack([x, np.zeros(len(x)), np.zeros(len(x))])
+    yaws = np.zeros(len(x)) if yaw is None else np.asarray(yaw)
+    return PoseStream(t, xyz, quat_from_yaw(yaws))
+
+
+GT = stream([0, 100, 200, 300], [0.0, 1.0, 2.0, 3.0])
+
+
+@pytest.mark.parametrize(
+    ("method", "at_50", "at_160"),
+    [
+        ("hold", 0.0, 1.0),  # the last GT pose at or before
+        ("nearest", 0.0, 2.0),  # 50 ms is halfway: the earlier one wins the tie
+        ("linear", 0.5, 1.6),
+    ],
+)
+def test_association_modes_by_hand(method: str, at_50: float, at_160: float) -> None:
+    robot = stream([50, 160], [0.0, 0.0])
+    m = associate(robot, GT, method, 100 * MS)  # type: ignore[arg-type]
+    assert m.status.tolist() == [COMPARED, COMPARED]
+    assert m.gt_xyz[:, 0] == pytest.approx([at_50, at_160], abs=1e-12)
+    assert m.position_error == pytest.approx([at_50, at_160], abs=1e-12)
+
+
+def test_gap_tracking_lost_and_uncovered() -> None:
+    # GT: a repeat (tracking lost) between 100 and 200 ms, then 300 ms of nothing.
+    gt = stream([0, 100, 200, 500, 600], [0.0, 1.0, 1.0, 4.0, 5.0])
+    robot = stream([-10, 50, 150, 200, 350, 550, 610], [0.0] * 7)
+    m = associate(robot, gt, "linear", 100 * MS)
+    assert m.status.tolist() == [
+        UNCOVERED,  # before the first GT pose
+        COMPARED,
+        TRACKING_LOST,  # between two identical GT poses
+        TRACKING_LOST,  # exactly on the repeat: its pair (100, 200) is identical
+        GAP,  # GT poses around it are 300 ms apart > 100 ms
+        COMPARED,
+        UNCOVERED,  # after the last
+    ]
+    assert m.position_error[5] == pytest.approx(4.5, abs=1e-12)
+    assert np.isnan(m.position_error[2])
+
+
+def test_max_gap_is_inclusive() -> None:
+    # Two GT poses exactly max_gap apart still bracket a comparable robot pose.
+    m = associate(stream([50], [0.0]), GT, "linear", 100 * MS)
+    assert m.status.tolist() == [COMPARED]
+    m = associate(stream([50], [0.0]), GT, "linear", 100 * MS - 1)
+    assert m.status.tolist() == [GAP]
+
+
+def test_orientation_error_wraps_the_yaw_difference() -> None:
+    # Robot yaw 3.1, GT yaw -3.1: 0.0832 rad apart across +-pi, not 6.2.
+    gt = stream([0, 100], [0.0, 0.001], [-3.1, -3.1])
+    robot = stream([50, 60], [0.0, 0.0], [3.1, 3.1])
+    m = metrics(associate(robot, gt, "hold", 100 * MS))
+    assert m is not None
+    expected = 2 * math.pi - 6.2
+    assert m.orientation_error == pytest.approx(expected, abs=1e-9)
+    # 2015: sin|6.2| < 0, so atan2 lands at -expected (it did not wrap).
+    assert m.orientation_error_2015 == pytest.approx(-expected, abs=1e-9)
+
+
+def test_metrics_by_hand() -> None:
+    # Position errors 0.5, 0.4 (linear): mean 0.45, rmse sqrt((0.25+0.16)/2), max 0.5.
+    robot = stream([50, 160], [0.0, 1.2])
+    m = metrics(associate(robot, GT, "linear", 100 * MS))
+    assert m is not None
+    assert m.position_error == pytest.approx(0.45, abs=1e-12)
+    assert m.rmse == pytest.approx(math.sqrt((0.25 + 0.16) / 2), abs=1e-12)
+    assert m.median == pytest.approx(0.45, abs=1e-12)
+    assert m.max == pytest.approx(0.5, abs=1e-12)
+
+
+def test_non_increasing_robot_stamps_raise() -> None:
+    with pytest.raises(ScoringError, match="do not increase: message 2"):
+        check_increasing(stream([0, 100, 100, 300], [0.0] * 4), "r.bag")
+
+
+def test_duplicates_from_overlapping_files_are_dropped_once() -> None:
+    doubled = GT.take(np.array([0, 1, 1, 2, 2, 3]))
+    clean, dropped = drop_duplicates(doubled)
+    assert dropped == 2
+    assert clean.t_ns.tolist() == GT.t_ns.tolist()
+
+
+def test_uncovered_robot_poses_need_allow_partial() -> None:
+    robot = stream([50, 150, 250, 350, 450], [0.0] * 5)
+    with pytest.raises(ClockError, match="2 of 5 robot poses lie outside the GT"):
+        score_streams(robot, GT, TrajectoryConfig())
+    result = score_streams(robot, GT, TrajectoryConfig(allow_partial=True))
+    assert (result.compared, result.uncovered) == (3, 2)
+    assert any("partial" in w for w in result.warnings)
+
+
+def test_config_rejects_unknown_association() -> None:
+    with pytest.raises(ConfigError):
+        TrajectoryConfig(association="spline")  # type: ignore[arg-type]
+
+
+def _moving(offset_ns: int, seed: int) -> tuple[PoseStream, PoseStream]:
+    """GT at 120 Hz on a Lissajous path; robot at 10 Hz, 3 mm noise, stamps shifted."""
+    rng = np.random.default_rng(seed)
+    tg = T0 + np.arange(0, 120 * 120) * 8_333_333
+
+    def path(t: np.ndarray) -> np.ndarray:
+        s = (t - T0) / 1e9
+        return np.column_stack([2 * np.cos(0.2 * s), 1.5 * np.sin(0.3 * s), 0 * s + 0.4])
+
+    gt = PoseStream(tg, path(tg), quat_from_yaw(np.zeros(len(tg))))
+    tr = T0 + 5 * 10**9 + np.arange(1000) * 10**8 + rng.integers(0, 2 * MS, 1000)
+    xyz = path(tr) + rng.normal(0, 0.003, (1000, 3))
+    robot = PoseStream(tr - offset_ns, xyz, quat_from_yaw(np.zeros(1000)))
+    return robot, gt
+
+
+@pytest.mark.parametrize("offset_ms", [-1234.5, 0.0, 350.0, 4000.0])
+def test_offset_estimate_recovers_a_known_offset(offset_ms: float) -> None:
+    robot, gt = _moving(round(offset_ms * MS), seed=3)
+    est = estimate_offset(robot, gt)
+    assert est.offset_ns is not None and est.uncertainty_ns is not None
+    # 3 mm white noise over 1000 poses at ~0.4 m/s: sd ~ 3e-3 / (0.4 * sqrt(3000)) ~ 0.14 ms.
+    # 2 ms leaves room for the speed varying along the path.
+    assert est.offset_ns / MS == pytest.approx(offset_ms, abs=2.0)
+    assert 0 < est.uncertainty_ns < 5 * MS
+
+
+def test_offset_of_a_robot_standing_still_is_not_observable() -> None:
+    # Mocap noise 0.2 mm (reads as 3 cm/s between 120 Hz samples), robot noise 3 mm.
+    rng = np.random.default_rng(5)
+    n = 300
+    g = n * 12 + 240
+    gt = PoseStream(
+        T0 + np.arange(g) * 8_333_333,
+        1 + rng.normal(0, 2e-4, (g, 3)),
+        quat_from_yaw(np.zeros(g)),
+    )
+    robot = PoseStream(
+        T0 + 10**9 + np.arange(n) * 10**8,
+        1 + rng.normal(0, 3e-3, (n, 3)),
+        quat_from_yaw(np.zeros(n)),
+    )
+    est = estimate_offset(robot, gt)
+    assert est.offset_ns is None
+    assert "barely moved" in est.note
