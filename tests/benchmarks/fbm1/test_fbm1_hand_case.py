@@ -1,0 +1,125 @@
+"""A hand-computed FBM1 benchmark: rotated and translated table and board, two items.
+
+Table (origin) at world (2, 1, 0.75) turned +90 deg. Run 1: board at (0.3, 0.2) in the table
+turned 30 deg, item 1 sits 0.1 m along the board's x: the item is at
+(0.3 + 0.1 cos 30, 0.2 + 0.1 sin 30) = (0.386603, 0.25), yaw 30 deg. Run 2: board at
+(-0.1, 0.5) turned -45 deg, item 2 sits 0.2 m along the board's y turned +90 deg: the item is
+at (-0.1 + 0.2 sin 45, 0.5 + 0.2 cos 45) = (0.041421, 0.641421), yaw 45 deg.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+from fbm1_testkit import ANSWER_S, EXEC_S, RunSpec, bodies, state_streams, write_bag, write_items
+
+from ertools.benchmarks.fbm1 import Fbm1Options, score_fbm1
+from ertools.benchmarks.fbm1_gt import GtOptions
+from ertools.benchmarks.fbm1_runs import find_runs
+from ertools.benchmarks.fbm1_score import ScoreRules
+from ertools.cli.main import main
+from ertools.configs.items import parse_items
+from ertools.configs._yaml import parse_yaml
+from ertools.streams import Machine
+
+RUNS = [
+    RunSpec(
+        "Place item 1 (a1) on the table",
+        "{item_class: a, item_instance: a1, x: 0.4, y: 0.25, theta: 35}",
+        (0.3, 0.2, 0.03),
+        30.0,
+    ),
+    RunSpec(
+        "Place item 2 (b1) on the table",
+        "{item_class: b, item_instance: b9, x: 0.04, y: 0.7, theta: -130}",
+        (-0.1, 0.5, 0.03),
+        -45.0,
+    ),
+]
+
+# Ground truth by hand (see the module docstring).
+GT1 = (0.3 + 0.1 * math.cos(math.radians(30)), 0.2 + 0.1 * math.sin(math.radians(30)), 30.0)
+GT2 = (-0.1 + 0.2 * math.sin(math.radians(45)), 0.5 + 0.2 * math.cos(math.radians(45)), 45.0)
+# Run 1: t = |(0.4, 0.25) - GT1|, dtheta = 5 deg.
+T1 = math.hypot(0.4 - GT1[0], 0.25 - GT1[1])
+SCORE1 = 1 - T1 / 2 - (5 / 180) / 2
+# Run 2: t = |(0.04, 0.7) - GT2|, dtheta = -130 - 45 = -175 deg.
+T2 = math.hypot(0.04 - GT2[0], 0.7 - GT2[1])
+SCORE2 = 1 - T2 / 2 - (175 / 180) / 2
+# Noiseless mocap and exact transforms: only float rounding (1e-12) separates the numbers.
+TOL = 1e-9
+
+
+def _items() -> object:
+    from fbm1_testkit import ITEMS_YAML
+
+    return parse_items(parse_yaml(ITEMS_YAML), "items.yaml")
+
+
+def _score(options: Fbm1Options | None = None) -> object:
+    streams = state_streams(RUNS)
+    found = find_runs(streams[Machine.BMBOX], streams[Machine.REFBOX], streams[Machine.CLIENT])
+    origin, board = bodies(RUNS)
+    return score_fbm1(origin, board, found, _items(), options)  # type: ignore[arg-type]
+
+
+def test_hand_computed_ground_truth_and_scores() -> None:
+    result = _score()
+    r1, r2 = result.runs  # type: ignore[attr-defined]
+    assert (r1.gt.x, r1.gt.y, r1.gt.yaw_deg) == pytest.approx(GT1, abs=TOL)
+    assert (r2.gt.x, r2.gt.y, r2.gt.yaw_deg) == pytest.approx(GT2, abs=TOL)
+    assert r1.errors.theta_error_deg == pytest.approx(5.0, abs=TOL)
+    assert r2.errors.theta_error_deg == pytest.approx(-175.0, abs=TOL)
+    assert r1.pose_score == pytest.approx(SCORE1, abs=TOL)
+    assert r2.pose_score == pytest.approx(SCORE2, abs=TOL)
+    assert (r1.class_ok, r1.instance_ok, r2.class_ok, r2.instance_ok) == (True, True, True, False)
+    totals = result.totals  # type: ignore[attr-defined]
+    assert totals.class_accuracy == 1.0
+    assert totals.instance_accuracy == 0.5
+    assert totals.pose_score == pytest.approx((SCORE1 + SCORE2) / 2, abs=TOL)
+    # 2015 execution time: goal acknowledged (EXECUTING_GOAL) -> BmBox back to READY.
+    assert totals.execution_time == pytest.approx(2 * (6.1 - EXEC_S), abs=1e-9)
+    assert not result.failures  # type: ignore[attr-defined]
+
+
+@pytest.mark.parametrize("method", ["goal", "result"])
+def test_2015_single_lookup_methods_agree_on_a_still_board(method: str) -> None:
+    result = _score(Fbm1Options(gt=GtOptions(method=method)))  # type: ignore[arg-type]
+    r1 = result.runs[0]  # type: ignore[attr-defined]
+    assert r1.gt.samples == 1
+    assert (r1.gt.x, r1.gt.y, r1.gt.yaw_deg) == pytest.approx(GT1, abs=TOL)
+
+
+def test_legacy_totals_divide_accuracy_by_ten_at_home() -> None:
+    result = _score(Fbm1Options(rules=ScoreRules(legacy_totals=True)))
+    totals = result.totals  # type: ignore[attr-defined]
+    assert totals.class_accuracy == pytest.approx(2 / 10)
+    assert totals.instance_accuracy == pytest.approx(1 / 10)
+    assert totals.pose_score == pytest.approx((SCORE1 + SCORE2) / 2, abs=TOL)
+
+
+def test_hand_case_through_a_bag_and_the_cli(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bag = write_bag(tmp_path / "hand.bag", RUNS)
+    items = write_items(tmp_path / "items.yaml")
+    code = main(["score", "fbm1h", str(bag), "--items", str(items), "--format", "json"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    import json
+
+    data = json.loads(out)
+    assert data["benchmark"] == "fbm1h"
+    # Through the bag the poses pass float64 serialisation and the 0.3 ms record latency;
+    # the board is still, so the numbers stay exact to float rounding.
+    assert data["runs"]["1"]["ground_truth"]["x"] == pytest.approx(GT1[0], abs=TOL)
+    assert data["runs"]["2"]["ground_truth"]["theta"] == pytest.approx(GT2[2], abs=TOL)
+    assert data["pose_score"] == pytest.approx((SCORE1 + SCORE2) / 2, abs=TOL)
+    assert data["instance_accuracy"] == 0.5
+    # The state messages of the bag are recorded at the transition times exactly.
+    assert data["execution_time"] == pytest.approx(2 * (6.1 - EXEC_S), abs=1e-6)
+    assert data["logged_2015_score"] == {"class_accuracy": 0.5}
+    assert "pose" in err and "  1 1:a1" in err  # the per-run table is on stderr
+    assert ANSWER_S < 6.1
