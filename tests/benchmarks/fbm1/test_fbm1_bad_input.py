@@ -166,7 +166,7 @@ def test_results_file_replaces_payloads_and_bad_entry_fails_its_run(
         "- {item: 3, item_class: b, item_instance: b2, x: 0.35, y: 0.25}\n",
         encoding="utf-8",
     )
-    code, out, err = _cli(tmp_path, capsys, bag, "--results", str(results))
+    code, out, _err = _cli(tmp_path, capsys, bag, "--results", str(results))
     assert code == 1
     data = json.loads(out)
     # Run 1: item 1 sits at (0.4, 0.2) (0.1 m along the unrotated board at (0.3, 0.2)).

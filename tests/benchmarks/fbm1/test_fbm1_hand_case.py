@@ -20,8 +20,8 @@ from ertools.benchmarks.fbm1_gt import GtOptions
 from ertools.benchmarks.fbm1_runs import find_runs
 from ertools.benchmarks.fbm1_score import ScoreRules
 from ertools.cli.main import main
-from ertools.configs.items import parse_items
 from ertools.configs._yaml import parse_yaml
+from ertools.configs.items import parse_items
 from ertools.streams import Machine
 
 RUNS = [

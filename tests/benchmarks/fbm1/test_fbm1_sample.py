@@ -23,10 +23,8 @@ def sample(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
 
 
 def _score(sample: dict[str, Any], capsys: pytest.CaptureFixture[str], *extra: str) -> Any:
-    code = main(
-        ["score", "fbm1h", str(sample["bag"]), "--items", str(sample["items"]), "--format", "json"]
-        + list(extra)
-    )
+    bag, items = str(sample["bag"]), str(sample["items"])
+    code = main(["score", "fbm1h", bag, "--items", items, "--format", "json", *extra])
     out, err = capsys.readouterr()
     assert code == 0, err
     return json.loads(out), err
