@@ -501,3 +501,93 @@ def _rescore_fbm3w(paths: list[Path], inputs: ScoreInputs) -> BenchmarkResult:
     config = load_fbm3w_config(inputs.config)
     options = Fbm3wOptions(d_min=inputs.d_min, topic=inputs.topic)
     return cast("BenchmarkResult", score_fbm3w(paths, config, options))
+
+
+# --------------------------------------------------------------------------------------------
+# The library function behind `ertools audit`
+
+
+def infer_benchmark(paths: Sequence[Path]) -> str:
+    """The namespace of the state topics in ``paths`` (``/fbm2h/bmbox_state`` -> ``fbm2h``).
+
+    Raises:
+        BagError: no state topic at all.
+        UsageError: state topics of several benchmarks.
+    """
+    from ertools.errors import BagError, UsageError
+    from ertools.io import topics
+    from ertools.states import STATE_TOPIC_SUFFIXES
+
+    suffixes = {s for group in STATE_TOPIC_SUFFIXES.values() for s in group}
+    found = sorted(
+        {
+            t.strip("/").split("/")[0]
+            for t in topics(list(paths))
+            if t.count("/") == 2 and t.rsplit("/", 1)[1] in suffixes
+        }
+    )
+    if not found:
+        raise BagError(
+            "no benchmark state topics (/<benchmark>/bmbox_state, refbox_state, client_state): "
+            "nothing to audit; score such logs with `ertools score NAME ... --reached timing`",
+            path=paths[0],
+        )
+    if len(found) > 1:
+        raise UsageError(
+            f"state topics of several benchmarks ({', '.join(found)}): give --benchmark"
+        )
+    return found[0]
+
+
+def audit_bag(
+    paths: Sequence[Path],
+    *,
+    benchmark: str | None = None,
+    max_silence_ns: int | None = None,
+    inputs: ScoreInputs | None = None,
+    recompute: bool = True,
+) -> tuple[Audit, tuple[str, ...]]:
+    """Audit the benchmark logged in ``paths`` and, where a scorer exists, re-score it.
+
+    Args:
+        paths: the log file(s).
+        benchmark: the namespace; inferred from the state topics when None.
+        max_silence_ns: heartbeat gaps longer than this are findings (default 1 s).
+        inputs: scoring inputs for the re-score.
+        recompute: False = the timeline and checks only.
+
+    Returns:
+        The audit (with the comparison when re-scored) and notes for the user: inputs the
+        scorer ignored, or why the score could not be recomputed.
+
+    Raises:
+        BagError: unreadable logs or no state topics.
+    """
+    from ertools.audit import DEFAULT_MAX_SILENCE_NS, audit_states
+    from ertools.errors import BagError, ErtoolsError
+    from ertools.io import read_benchmark_states
+
+    plist = [Path(p) for p in paths]
+    for path in plist:
+        if not path.exists():
+            raise BagError("no such file or directory", path=path)
+    ns = benchmark or infer_benchmark(plist)
+    states = read_benchmark_states(plist, ns)
+    if states.bmbox is None and states.refbox is None and states.client is None:
+        raise BagError(f"no /{ns} state topics: nothing to audit", path=plist[0])
+    audit = audit_states(
+        states.bmbox,
+        states.refbox,
+        states.client,
+        benchmark=ns,
+        max_silence_ns=DEFAULT_MAX_SILENCE_NS if max_silence_ns is None else max_silence_ns,
+        inputs=tuple(str(p) for p in plist),
+    )
+    if not recompute:
+        return audit, ()
+    try:
+        result, notes = rescore(ns, plist, inputs or ScoreInputs())
+    except ErtoolsError as err:
+        # The timeline is worth having even when the score cannot be recomputed.
+        return audit, (f"score not recomputed: {err}",)
+    return attach(audit, result), notes

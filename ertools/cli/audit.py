@@ -64,81 +64,36 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_output_options(parser, ("text", "yaml", "json"), plot=False)
 
 
-def infer_benchmark(bags: list[Path]) -> str:
-    """The namespace of the state topics in ``bags``; errors when none or several."""
-    from ertools.errors import BagError, UsageError
-    from ertools.io import topics
-    from ertools.states import STATE_TOPIC_SUFFIXES
-
-    suffixes = {s for group in STATE_TOPIC_SUFFIXES.values() for s in group}
-    found = sorted(
-        {
-            t.strip("/").split("/")[0]
-            for t in topics(bags)
-            if t.count("/") == 2 and t.rsplit("/", 1)[1] in suffixes
-        }
-    )
-    if not found:
-        raise BagError(
-            "no benchmark state topics (/<benchmark>/bmbox_state, refbox_state, client_state): "
-            "nothing to audit; score such logs with `ertools score NAME ... --reached timing`",
-            path=bags[0],
-        )
-    if len(found) > 1:
-        raise UsageError(
-            f"state topics of several benchmarks ({', '.join(found)}): give --benchmark"
-        )
-    return found[0]
-
-
 def run(args: argparse.Namespace) -> int:
-    from ertools.audit import audit_states
-    from ertools.audit_score import ScoreInputs, attach, rescore
+    from ertools.audit_score import ScoreInputs, audit_bag
     from ertools.cli.common import emit_result, note, write_text
-    from ertools.errors import BagError, ConfigError, ErtoolsError
-    from ertools.io import read_benchmark_states
+    from ertools.errors import ConfigError
     from ertools.timeutil import s_to_ns
 
     bags: list[Path] = list(args.bags)
-    for bag in bags:
-        if not bag.exists():
-            raise BagError("no such file or directory", path=bag)
     if args.max_silence <= 0:
         raise ConfigError(f"--max-silence must be > 0 s, got {args.max_silence}")
-    benchmark = args.benchmark or infer_benchmark(bags)
-    states = read_benchmark_states(bags, benchmark)
-    if states.bmbox is None and states.refbox is None and states.client is None:
-        raise BagError(f"no /{benchmark} state topics: nothing to audit", path=bags[0])
-    audit = audit_states(
-        states.bmbox,
-        states.refbox,
-        states.client,
-        benchmark=benchmark,
-        max_silence_ns=s_to_ns(args.max_silence),
-        inputs=tuple(str(b) for b in bags),
+    inputs = ScoreInputs(
+        goal=args.goal,
+        transform=args.transform,
+        team=args.team,
+        transforms=args.transforms,
+        config=args.config,
+        items=args.items,
+        results=args.results,
+        topic=args.topic,
+        d_min=args.d_min,
+        hits=args.hits,
     )
-    if not args.no_rescore:
-        inputs = ScoreInputs(
-            goal=args.goal,
-            transform=args.transform,
-            team=args.team,
-            transforms=args.transforms,
-            config=args.config,
-            items=args.items,
-            results=args.results,
-            topic=args.topic,
-            d_min=args.d_min,
-            hits=args.hits,
-        )
-        try:
-            result, notes = rescore(benchmark, bags, inputs)
-        except ErtoolsError as err:
-            # The timeline is worth having even when the score cannot be recomputed.
-            note(f"warning: score not recomputed: {err}")
-        else:
-            for line in notes:
-                note(f"warning: {line}")
-            audit = attach(audit, result)
+    audit, notes = audit_bag(
+        bags,
+        benchmark=args.benchmark,
+        max_silence_ns=s_to_ns(args.max_silence),
+        inputs=inputs,
+        recompute=not args.no_rescore,
+    )
+    for line in notes:
+        note(f"warning: {line}")
     if args.format != "text":
         code = emit_result(audit, args, bags)  # type: ignore[arg-type]
     else:

@@ -308,8 +308,9 @@ def _figures(
     if score is not None:
         try:
             specs += figure_specs(score)
-        except ImportError as err:
-            problems.append(f"no figures for {score.name}: {err}")
+        except Exception as err:  # a missing or broken plot module must not lose the report
+            log.warning("no figures for %s: %s", score.name, err)
+            problems.append(f"no figures for {score.name}: {type(err).__name__}: {err}")
     if audit is not None:
         specs += plots_audit.figure_specs(audit)
     out: list[tuple[Path, str]] = []
