@@ -26,7 +26,7 @@ import numpy.typing as npt
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.benchmarks.clock_offset import OffsetEstimate, estimate_offset
-from ertools.errors import ClockError, ScoringError, TopicError
+from ertools.errors import ClockError, ErtoolsError, ScoringError, TopicError
 from ertools.geometry import Association, interpolate_poses, wrap_angle, yaw_from_quat
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import NS_PER_S, iso_utc, ns_to_s
@@ -712,10 +712,21 @@ def score(
             f"no GT bags found in {', '.join(map(str, gt_paths))}"
             + (f" ({found.problems[0].problem})" if found.problems else "")
         )
-    gt_summaries = [
-        summary(p) for p in found.bags if Path(p).resolve() != Path(robot_path).resolve()
-    ]
+    explicit = {Path(p) for p in gt_paths if Path(p).is_file()}
+    skipped: list[str] = []
+    gt_summaries = []
+    for p in found.bags:
+        if Path(p).resolve() == Path(robot_path).resolve():
+            continue
+        try:
+            gt_summaries.append(summary(p))
+        except ErtoolsError as err:
+            if Path(p) in explicit:
+                raise
+            # A broken bag elsewhere in a GT folder must not stop the scoring: say so.
+            skipped.append(f"skipped unreadable file in the GT folder: {p}: {err.message}")
     chosen, gtopic, warnings = select_gt(gt_summaries, lo - margin, hi + margin, gt_topic)
+    warnings = skipped + warnings
     files = [s.path for s in chosen]
     gt = read_poses(files, gtopic, start_ns=lo - margin, end_ns=hi + margin)
     return score_streams(
