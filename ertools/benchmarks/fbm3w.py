@@ -335,6 +335,7 @@ def _score_one(
         sweep=swept,
         frame_xy=score.frame.to_frame(xy),
         shape_floor=floor,
+        target_dense=shape.dense(501),
         **common,
     )
 

@@ -33,6 +33,8 @@ class RunResult:
         sweep: (d_min, distance_error or None) for ``--d-min-sweep``.
         bag_start_ns: the bag's first message, for relative times.
         frame_xy: (N, 2) every sample of the window in the run frame (plots).
+        shape_floor: distance_error of a noiseless robot exactly on the target.
+        target_dense: (M, 2) the target curve, densely sampled (plots).
     """
 
     window: RunWindow
@@ -48,6 +50,7 @@ class RunResult:
     bag_start_ns: int = 0
     frame_xy: Any = None
     shape_floor: float | None = None
+    target_dense: Any = None
 
     @property
     def index(self) -> int:

@@ -11,8 +11,12 @@ from __future__ import annotations
 import argparse
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING, cast
 
 from ertools.cli.common import add_output_options, emit_result, note
+
+if TYPE_CHECKING:
+    from ertools.benchmarks.base import BenchmarkResult
 
 EPILOG = """examples:
   ertools score fbm3w log_fbm3w_mocap.bag
@@ -160,4 +164,4 @@ def run(args: argparse.Namespace) -> int:
         note("distance_error of every run over d_min (--d-min-sweep):")
         for line in result.sweep_text().splitlines():
             note("  " + line)
-    return emit_result(result, args, list(args.bags))
+    return emit_result(cast("BenchmarkResult", result), args, list(args.bags))
