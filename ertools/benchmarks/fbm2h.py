@@ -21,6 +21,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -32,6 +33,9 @@ from ertools.configs.transform import MarkerTransform
 from ertools.errors import ConfigError, SegmentationError
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import ns_to_s, s_to_ns
+
+if TYPE_CHECKING:
+    from ertools.io import PoseSource
 
 log = logging.getLogger("ertools.benchmarks.fbm2h")
 
@@ -243,7 +247,7 @@ def _load_transform(options: Fbm2hOptions) -> MarkerTransform:
     return identity_transform()
 
 
-def _pose_source(options: Fbm2hOptions) -> object:
+def _pose_source(options: Fbm2hOptions) -> PoseSource:
     from ertools.io import PoseSource
 
     if options.topic is not None and options.tf_frame is not None:
@@ -251,6 +255,23 @@ def _pose_source(options: Fbm2hOptions) -> object:
     if options.tf_frame is not None:
         return PoseSource(topic=None, frame=options.tf_frame, time_source=options.time_source)
     return PoseSource(topic=options.topic or DEFAULT_TOPIC, time_source=options.time_source)
+
+
+def _compare_goal(goal: GoalList, payload: str, topic: str) -> str | None:
+    """A warning when the goal list given differs from the one the BmBox sent (or is unreadable)."""
+    from ertools.configs.goal import goal_from_payload
+
+    try:
+        logged = goal_from_payload(payload, f"{topic} payload")
+    except ConfigError as err:
+        return f"the goal payload in the log is not a goal list ({err}); using {goal.source}"
+    a, b = logged.as_array(), goal.as_array()
+    if a.shape != b.shape or not np.allclose(a, b, atol=1e-9):
+        return (
+            f"the goal list given ({goal.source}) differs from the one the BmBox sent in the "
+            "log; scoring against the one given"
+        )
+    return None
 
 
 def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
@@ -265,7 +286,7 @@ def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
         raise ConfigError(f"--max-gap must be > 0 s, got {options.max_gap_s}")
     transform = _load_transform(options)
     goal = load_goal(options.goal) if options.goal is not None else None
-    marker = read_pose_source(list(paths), _pose_source(options))  # type: ignore[arg-type]
+    marker = read_pose_source(list(paths), _pose_source(options))
     if len(marker) == 0:
         raise SegmentationError(f"{marker.source or paths[0]}: the marker set pose stream is empty")
     infos = [summary(p) for p in paths]
@@ -297,14 +318,9 @@ def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
                 )
             goal = goal_from_payload(moments.goal_payload, f"{states.bmbox.topic} payload")
         elif moments.goal_payload:
-            logged = goal_from_payload(moments.goal_payload, f"{states.bmbox.topic} payload")
-            if not np.allclose(logged.as_array().shape, goal.as_array().shape) or not np.allclose(
-                logged.as_array(), goal.as_array(), atol=1e-9
-            ):
-                warnings.append(
-                    f"the goal list given ({goal.source}) differs from the one the BmBox sent "
-                    "in the log; scoring against the one given"
-                )
+            warning = _compare_goal(goal, moments.goal_payload, states.bmbox.topic)
+            if warning:
+                warnings.append(warning)
         unreached = seg.unreached_reasons(moments, len(goal), states.refbox)
     elif reached == "timing":
         from ertools.configs.timing import load_timing

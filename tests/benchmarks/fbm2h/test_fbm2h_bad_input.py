@@ -191,3 +191,26 @@ def test_missing_bag(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None
     code, _, err = _run(capsys, str(tmp_path / "none.bag"))
     assert code == 1
     _one_error_line(err, "none.bag")
+
+
+def test_goal_differing_from_the_logged_one_warns(
+    fbm2h_sample: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    goal = yaml.safe_load(fbm2h_sample.goal.read_text())
+    goal["goal"]["waypoints"][0] = [0.0, 0.0, 0.0]
+    path = tmp_path / "goal.yaml"
+    path.write_text(yaml.safe_dump(goal))
+    code, out, err = _run(
+        capsys,
+        str(fbm2h_sample.bag),
+        "--goal",
+        str(path),
+        "--transform",
+        str(fbm2h_sample.transform),
+    )
+    assert code == 0
+    assert "differs from the one the BmBox sent" in err
+    # Scored against the file: waypoint 0 is now the origin, the robot stopped at truth's pose.
+    seg0 = yaml.safe_load(out)["details"]["segments_details"][0]
+    x, y, _ = fbm2h_sample.answers["truth"]["stop_poses"][0]
+    assert seg0["dinstance_error"] == pytest.approx((x**2 + y**2) ** 0.5, abs=0.002)
