@@ -66,6 +66,10 @@ def detect_format(path: str | Path) -> str:
         raise BagError(f"cannot open: {err.strerror}", path=p) from err
     if not head:
         raise BagError("empty file (0 bytes): not a bag", path=p)
+    if len(head) < len(ROS1_MAGIC) and (ROS1_MAGIC.startswith(head) or MCAP_MAGIC.startswith(head)):
+        raise BagError(
+            f"truncated: the file ends after {len(head)} bytes, inside its magic", path=p
+        )
     if head.startswith(ROS1_MAGIC):
         return "ros1-active" if p.name.endswith(".active") else "ros1"
     if head.startswith(b"#ROSBAG V"):

@@ -198,3 +198,27 @@ class McapIndex:
         if len(off) and (int((start + length).max()) > len(buf) or int(length.min()) < 0):
             raise BagError(f"message record cut off inside its chunk {where}")
         return start, length
+
+
+def verify_mcap(path: Path) -> None:
+    """Decompress every chunk of an MCAP file, check its CRC and its message indexes.
+
+    Raises:
+        BagError: the first damaged chunk, with its byte offset.
+    """
+    import zlib
+
+    with path.open("rb") as f:
+        summary = read_summary(f, path)
+        if summary is None:
+            raise BagError("no summary section to check against", path=path)
+        for chunk in summary.chunk_indexes:
+            where = f"in {path} at byte {chunk.chunk_start_offset}"
+            f.seek(chunk.chunk_start_offset + 1 + 8 + 8 + 8 + 8)
+            (crc,) = struct.unpack("<I", f.read(4))
+            buf = McapIndex._chunk_bytes(path, chunk)
+            if crc and zlib.crc32(buf.tobytes()) != crc:
+                raise BagError(f"corrupt MCAP chunk {where}: CRC mismatch")
+            for cid, offset in chunk.message_index_offsets.items():
+                _t, off = McapIndex._message_index(f, path, offset, cid)
+                McapIndex._spans(buf, off, where)

@@ -49,6 +49,7 @@ U8 = npt.NDArray[np.uint8]
 INDEX_DTYPE = np.dtype([("sec", "<u4"), ("nsec", "<u4"), ("off", "<u4")])
 # The message-data record header rosbag and rosbags write: conn (4), op (1), time (8) fields.
 MSG_HEADER_LEN = 4 + len("conn=") + 4 + 4 + len("op=") + 1 + 4 + len("time=") + 8
+_OP_MSG_FIELD = np.frombuffer(b"\x04\x00\x00\x00op=\x02", dtype=np.uint8)
 
 
 @dataclass
@@ -461,3 +462,32 @@ class Ros1Bag(BagFile):
             dpos, dlen = self.spans(buf, off_of[i : i + 1], where)
             d0, d1 = int(dpos[0]), int(dpos[0] + dlen[0])
             yield conns[int(rank_of[i])], int(t_of[i]), raw_bytes[d0:d1]
+
+    def verify(self) -> None:
+        """Decompress every chunk and check that every indexed record is a message record.
+
+        Raises:
+            BagError: the first damaged chunk, with its byte offset.
+        """
+        from ertools.io.fastdecode import gather
+
+        for chunk in self.layout.chunks:
+            where = self._where(chunk)
+            buf = np.frombuffer(self.chunk_bytes(chunk), dtype=np.uint8)
+            for cid, (_t, off) in self.chunk_entries(chunk).items():
+                dpos, _dlen = self.spans(buf, off, where)
+                std = np.flatnonzero(dpos - off == 8 + MSG_HEADER_LEN)
+                if not len(std):
+                    continue
+                head = gather(buf, off[std] + 4, MSG_HEADER_LEN)
+                # The op field (len 4, "op=", 0x02) sits after 0, 1 or 2 of the other fields.
+                ok = np.zeros(len(std), dtype=bool)
+                for at in (0, 13, 17, 30):
+                    ok |= np.all(head[:, at : at + 8] == _OP_MSG_FIELD, axis=1)
+                if not ok.all():
+                    bad = int(off[std][~ok][0])
+                    raise BagError(
+                        f"corrupt chunk at byte {chunk.pos}: connection {cid}'s index points at "
+                        f"byte {bad} of the chunk, which holds no message record",
+                        path=self.path,
+                    )

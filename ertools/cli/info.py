@@ -1,0 +1,161 @@
+"""Describe bags like `rosbag info`: format, times, size, compression, topics with rates.
+
+Works on ROS1 bags (.bag, .bag.active), rosbag2 folders (sqlite3, mcap) and .mcap files.
+Only each file's index is read (no message data), so it answers in milliseconds even for
+hour-long bags; --check also decompresses every chunk to find corrupted data. A folder that
+is not a rosbag2 bag is searched for bags.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from ertools.io.info import BagInfo
+
+EPILOG = """examples:
+  ertools info run.bag                       # table, like `rosbag info`
+  ertools info gt_0.bag gt_1.bag --format json
+  ertools info logs/ --format yaml           # every bag under logs/
+  ertools info run.bag --check               # also decompress and check every chunk
+
+Rates are the median of the intervals between record times, from the index records.
+JSON/YAML layout: {"bags": [{"path", "format", "version", "start", "start_iso", "end",
+"end_iso", "duration", "size_bytes", "compression", "messages", "indexed", "checked",
+"problems", "topics": [{"name", "type", "count", "connections", "first", "last",
+"median_rate_hz"}]}], "problems": [{"path", "problem"}]}; times in epoch seconds.
+Exit status 1 when any bag is unreadable, truncated or (with --check) corrupt.
+"""
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "paths", type=Path, nargs="+", metavar="BAG", help="bags, rosbag2 folders or folders"
+    )
+    parser.add_argument(
+        "--format",
+        choices=("table", "json", "yaml"),
+        default="table",
+        help="output on stdout (default table)",
+    )
+    parser.add_argument("-o", "--output", type=Path, help="write the output to this file")
+    parser.add_argument(
+        "--check",
+        action="store_true",
+        help="decompress every chunk and check every indexed message (reads the whole file)",
+    )
+
+
+def _size(n: int) -> str:
+    value = float(n)
+    for unit in ("B", "KiB", "MiB", "GiB"):
+        if value < 1024 or unit == "GiB":
+            return f"{value:.1f} {unit}" if unit != "B" else f"{n} B"
+        value /= 1024
+    return f"{n} B"
+
+
+def _rate(hz: float | None) -> str:
+    if hz is None:
+        return "-"
+    return f"{hz:.3g} Hz" if hz < 1000 else f"{hz:.0f} Hz"
+
+
+def table(info: BagInfo) -> str:
+    """`rosbag info`-like text of one bag."""
+    from ertools.timeutil import iso_utc, ns_to_s
+
+    s = info.summary
+    lines = [
+        f"path:        {s.path}",
+        f"format:      {s.format} (version {s.version or 'unknown'})"
+        + ("" if s.indexed else "  NOT INDEXED: scanned"),
+    ]
+    if s.message_count:
+        lines += [
+            f"start:       {iso_utc(s.start_ns)}  ({ns_to_s(s.start_ns):.6f})",
+            f"end:         {iso_utc(s.end_ns)}  ({ns_to_s(s.end_ns):.6f})",
+            f"duration:    {ns_to_s(s.duration_ns):.3f} s",
+        ]
+    else:
+        lines.append("start/end:   - (no messages)")
+    lines += [
+        f"size:        {_size(s.size_bytes)} ({s.size_bytes} bytes)",
+        f"compression: {s.compression}",
+        f"messages:    {s.message_count}",
+    ]
+    if info.checked:
+        lines.append("check:       every chunk decompressed and every indexed record found")
+    for problem in s.problems:
+        lines.append(f"problem:     {problem}")
+    rows = [
+        (
+            t.name,
+            t.msgtype,
+            str(t.count),
+            _rate(info.median_rate_hz.get(t.name)),
+            f"{t.connections} conn" if t.connections > 1 else "",
+        )
+        for t in s.topics
+    ]
+    if rows:
+        widths = [max(len(r[i]) for r in rows) for i in range(5)]
+        header = ("topic", "type", "count", "median rate", "")
+        widths = [max(w, len(h)) for w, h in zip(widths, header, strict=True)]
+        lines.append("topics:")
+        lines.append(
+            "  " + "  ".join(h.ljust(w) for h, w in zip(header, widths, strict=True)).rstrip()
+        )
+        for r in rows:
+            cells = [r[0].ljust(widths[0]), r[1].ljust(widths[1]), r[2].rjust(widths[2])]
+            cells += [r[3].rjust(widths[3]), r[4]]
+            lines.append("  " + "  ".join(cells).rstrip())
+    else:
+        lines.append("topics:      none")
+    return "\n".join(lines)
+
+
+def _fatal_problem(info: BagInfo) -> str | None:
+    """A problem that makes the bag unusable (truncated, damaged); None for a mere .active."""
+    bad = [p for p in info.summary.problems if not p.startswith("not indexed")]
+    return "; ".join(bad) if bad else None
+
+
+def run(args: argparse.Namespace) -> int:
+    from ertools.cli.common import dump_json, note, write_text
+    from ertools.errors import BagError
+    from ertools.io.info import describe, expand
+
+    paths = expand(list(args.paths))
+    infos: list[BagInfo] = []
+    problems: list[dict[str, str]] = []
+    for path in paths:
+        try:
+            info = describe(path, check=args.check)
+        except BagError as err:
+            problems.append({"path": str(path), "problem": err.message})
+            continue
+        infos.append(info)
+        fatal = _fatal_problem(info)
+        if fatal is not None:
+            problems.append({"path": str(path), "problem": fatal})
+        elif not info.summary.indexed:
+            note(f"warning: {path}: not indexed (still recording?); counts come from a scan")
+    if args.format == "table":
+        text = "\n\n".join(table(i) for i in infos)
+    else:
+        data: dict[str, Any] = {"bags": [i.to_dict() for i in infos], "problems": problems}
+        if args.format == "json":
+            text = dump_json(data)
+        else:
+            import yaml
+
+            text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
+    if text:
+        write_text(text, args.output)
+    for p in problems:
+        print(f"ertools: error: {p['path']}: {p['problem']}", file=sys.stderr)
+    return 1 if problems else 0

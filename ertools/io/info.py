@@ -1,0 +1,166 @@
+"""``ertools info``'s library function: a bag's summary with per-topic rates, and checks.
+
+Rates are medians of the intervals between consecutive record times of each topic, read from
+the index records (ROS1 index data, MCAP message indexes, rosbag2 time stamps), never from the
+message data. ``check=True`` additionally reads every chunk, decompresses it and checks that
+every indexed message record is where the index says (the only way to find a corrupted chunk).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ertools.errors import BagError
+from ertools.io.model import BagSummary
+from ertools.timeutil import iso_utc, ns_to_s
+
+BAG_SUFFIXES = (".bag", ".mcap", ".active")
+
+
+@dataclass(frozen=True)
+class BagInfo:
+    """A summary plus the median message rate of every topic (None with < 2 messages)."""
+
+    summary: BagSummary
+    median_rate_hz: dict[str, float | None]
+    checked: bool = False
+
+    def to_dict(self) -> dict[str, Any]:
+        s = self.summary
+        empty = s.message_count == 0
+        return {
+            "path": s.path,
+            "format": s.format,
+            "version": s.version,
+            "start": None if empty else ns_to_s(s.start_ns),
+            "start_iso": None if empty else iso_utc(s.start_ns),
+            "end": None if empty else ns_to_s(s.end_ns),
+            "end_iso": None if empty else iso_utc(s.end_ns),
+            "duration": ns_to_s(s.duration_ns),
+            "size_bytes": s.size_bytes,
+            "compression": s.compression,
+            "messages": s.message_count,
+            "indexed": s.indexed,
+            "checked": self.checked,
+            "problems": list(s.problems),
+            "topics": [
+                {
+                    "name": t.name,
+                    "type": t.msgtype,
+                    "count": t.count,
+                    "connections": t.connections,
+                    "first": None if t.first_ns is None else ns_to_s(t.first_ns),
+                    "last": None if t.last_ns is None else ns_to_s(t.last_ns),
+                    "median_rate_hz": self.median_rate_hz.get(t.name),
+                }
+                for t in s.topics
+            ],
+        }
+
+
+def median_rate(t_ns: np.ndarray[Any, np.dtype[np.int64]]) -> float | None:
+    """1 / median interval of sorted record times, in Hz (None with < 2 distinct times)."""
+    if len(t_ns) < 2:
+        return None
+    dt = float(np.median(np.diff(t_ns)))
+    return 1e9 / dt if dt > 0 else None
+
+
+def find_bags(folder: Path) -> list[Path]:
+    """Bags under a folder (not itself a rosbag2 bag), walked recursively, sorted."""
+    out: list[Path] = []
+    for p in sorted(folder.rglob("*")):
+        if any(parent in out for parent in p.parents):
+            continue
+        if p.is_dir() and (p / "metadata.yaml").is_file():
+            out.append(p)
+        elif p.is_file() and p.name.endswith((".bag", ".bag.active", ".mcap")):
+            out.append(p)
+    return out
+
+
+def expand(paths: list[Path]) -> list[Path]:
+    """Files and rosbag2 directories as given; other directories replaced by the bags inside.
+
+    Raises:
+        BagError: a path is missing, or a directory holds no bag.
+    """
+    out: list[Path] = []
+    for p in paths:
+        if not p.exists():
+            raise BagError("no such file or directory", path=p)
+        if p.is_dir() and not (p / "metadata.yaml").is_file():
+            found = find_bags(p)
+            if not found:
+                raise BagError(
+                    "directory holds no bags (.bag, .bag.active, .mcap or rosbag2 folders)",
+                    path=p,
+                )
+            out.extend(found)
+        else:
+            out.append(p)
+    return out
+
+
+def describe(path: str | Path, *, check: bool = False) -> BagInfo:
+    """Summary (exact per-topic times), median rates, and with ``check`` a full chunk check.
+
+    Raises:
+        BagError: unreadable bag, or (with ``check``) a damaged chunk.
+    """
+    from ertools.io.summary import record_times, summary
+
+    s = summary(path, exact=True)
+    try:
+        times = record_times(path)
+    except BagError:
+        if s.indexed:
+            raise
+        times = {}  # a damaged unindexed file: the scan's counts are all there is
+    rates = {name: median_rate(t) for name, t in times.items()}
+    if check:
+        verify(Path(path))
+    return BagInfo(s, rates, check)
+
+
+def verify(path: Path) -> None:
+    """Read every chunk and check every indexed message record.
+
+    Raises:
+        BagError: naming the file and the byte offset of the first damaged chunk.
+    """
+    from ertools.io.formats import detect_format
+
+    fmt = detect_format(path)
+    if fmt in ("ros1", "ros1-active"):
+        from ertools.io.ros1_index import Ros1Bag
+
+        bag = Ros1Bag(path)
+        try:
+            bag.verify()
+        finally:
+            bag.close()
+    elif fmt in ("mcap", "rosbag2-mcap"):
+        from ertools.io.mcap_index import verify_mcap
+
+        for file in [path] if fmt == "mcap" else sorted(path.glob("*.mcap")):
+            verify_mcap(file)
+    else:
+        import sqlite3
+
+        from ertools.io.rosbag2 import _connect, read_metadata, storage_files
+
+        for db in storage_files(path, read_metadata(path)):
+            con = _connect(db)
+            try:
+                result = con.execute("PRAGMA quick_check").fetchone()[0]
+            except sqlite3.Error as err:
+                raise BagError(f"damaged sqlite3 storage ({err})", path=db) from err
+            finally:
+                con.close()
+            if result != "ok":
+                raise BagError(f"sqlite3 storage fails its integrity check ({result})", path=db)

@@ -1,0 +1,147 @@
+"""`ertools info`: output on every format, and one stderr line + exit 1 on every bad input."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from conftest import DT, Scene
+from io_bagmaker import write
+
+from ertools.cli.main import main
+
+POSE = "/fbm3w/robot_at_work/pose"
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    code = main(["info", *argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_info_json_every_format(
+    capsys: pytest.CaptureFixture[str], scene: Scene, scene_bag: tuple[str, Path]
+) -> None:
+    fmt, path = scene_bag
+    code, out, err = run(capsys, str(path), "--format", "json")
+    assert code == 0, err
+    data = json.loads(out)
+    assert data["problems"] == []
+    (bag,) = data["bags"]
+    topics = {t["name"]: t for t in bag["topics"]}
+    assert topics[POSE]["count"] == scene.n
+    assert topics[POSE]["type"] == "geometry_msgs/PoseStamped"
+    # record times are exactly DT apart: the median rate is 1e9 / DT (float division only)
+    assert topics[POSE]["median_rate_hz"] == pytest.approx(1e9 / DT, rel=1e-12)
+    assert topics["/chatter"]["count"] == 0 and topics["/chatter"]["median_rate_hz"] is None
+    assert bag["start"] == pytest.approx(scene.t_rec[0] / 1e9, abs=1e-6)
+    assert bag["start_iso"].startswith("2015-10-23T14:15:40")
+    assert bag["format"] == {
+        "ros1-lz4": "ros1",
+        "ros1-bz2": "ros1",
+        "mcap-cdr": "mcap",
+        "mcap-ros1": "mcap",
+    }.get(fmt, fmt)
+
+
+def test_info_table_and_yaml(
+    capsys: pytest.CaptureFixture[str], scene: Scene, tmp_path: Path
+) -> None:
+    path = write(tmp_path / "t.bag", "ros1-lz4", scene.spec, chunk_bytes=2000)
+    code, out, _ = run(capsys, str(path), "--check")
+    assert code == 0
+    line = next(x for x in out.splitlines() if x.strip().startswith(POSE))
+    assert line.split()[1:4] == ["geometry_msgs/PoseStamped", str(scene.n), "120"]
+    assert "compression: lz4" in out and "duration:" in out
+    code, out, _ = run(capsys, str(tmp_path), "--format", "yaml")  # a folder of bags
+    assert code == 0
+    data = yaml.safe_load(out)
+    assert [b["path"] for b in data["bags"]] == [str(path)]
+
+
+def one_error_line(err: str, *needles: str) -> None:
+    lines = [x for x in err.splitlines() if x.strip()]
+    assert len(lines) == 1, err
+    assert lines[0].startswith("ertools: error: ")
+    for needle in needles:
+        assert needle in lines[0], lines[0]
+    assert "Traceback" not in err
+
+
+def test_empty_random_missing_and_empty_dir(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    empty = tmp_path / "empty.bag"
+    empty.write_bytes(b"")
+    code, _, err = run(capsys, str(empty))
+    assert code == 1
+    one_error_line(err, "empty.bag", "empty")
+    junk = tmp_path / "junk.bag"
+    junk.write_bytes(np.random.default_rng(1).bytes(4096))
+    code, _, err = run(capsys, str(junk))
+    assert code == 1
+    one_error_line(err, "junk.bag", "not a ROS1 bag")
+    code, _, err = run(capsys, str(tmp_path / "nope.bag"))
+    assert code == 1
+    one_error_line(err, "nope.bag", "no such file")
+    folder = tmp_path / "nobags"
+    folder.mkdir()
+    (folder / "notes.txt").write_text("x")
+    code, _, err = run(capsys, str(folder))
+    assert code == 1
+    one_error_line(err, "nobags", "holds no bags")
+
+
+@pytest.mark.parametrize("fmt", ["ros1", "ros1-bz2", "mcap-cdr"])
+def test_truncated_anywhere(
+    capsys: pytest.CaptureFixture[str], scene: Scene, tmp_path: Path, fmt: str
+) -> None:
+    suffix = ".mcap" if fmt.startswith("mcap") else ".bag"
+    good = write(tmp_path / f"good{suffix}", fmt, scene.spec, chunk_bytes=2000)
+    data = good.read_bytes()
+    rng = np.random.default_rng(7)
+    cuts = [1, 5, 12, 20, 100, 4100, *rng.integers(4200, len(data) - 1, 8).tolist(), len(data) - 1]
+    for cut in cuts:
+        bad = tmp_path / f"cut{cut}{suffix}"
+        bad.write_bytes(data[:cut])
+        code, _, err = run(capsys, str(bad))
+        assert code == 1, f"cut at {cut}: {err}"
+        one_error_line(err, bad.name)
+
+
+def test_corrupted_chunk(capsys: pytest.CaptureFixture[str], scene: Scene, tmp_path: Path) -> None:
+    good = write(tmp_path / "good.bag", "ros1-lz4", scene.spec, chunk_bytes=2000)
+    data = bytearray(good.read_bytes())
+    # Overwrite the middle of the second chunk's compressed payload.
+    first = data.index(b"compression=lz4")
+    second = data.index(b"compression=lz4", first + 1)
+    at = second + 60
+    data[at : at + 200] = bytes(200)
+    bad = tmp_path / "corrupt.bag"
+    bad.write_bytes(bytes(data))
+    code, _, err = run(capsys, str(bad), "--check")
+    assert code == 1
+    one_error_line(err, "corrupt.bag", "chunk")
+    # Reading the damaged chunk's poses fails the same way (never a silently short stream).
+    from ertools.errors import BagError
+    from ertools.io import read_poses
+
+    with pytest.raises(BagError, match="corrupt"):
+        read_poses(bad, POSE)
+
+
+def test_good_and_bad_together(
+    capsys: pytest.CaptureFixture[str], scene: Scene, tmp_path: Path
+) -> None:
+    good = write(tmp_path / "good.bag", "ros1", scene.spec)
+    bad = tmp_path / "bad.bag"
+    bad.write_bytes(b"#ROSBAG V2.0\n\x00")
+    code, out, err = run(capsys, str(good), str(bad), "--format", "json")
+    assert code == 1
+    data = json.loads(out)
+    assert [b["path"] for b in data["bags"]] == [str(good)]
+    assert data["problems"][0]["path"] == str(bad)
+    one_error_line(err, "bad.bag")
