@@ -76,9 +76,7 @@ def find_bags(folder: Path) -> list[Path]:
     for p in sorted(folder.rglob("*")):
         if any(parent in out for parent in p.parents):
             continue
-        if p.is_dir() and (p / "metadata.yaml").is_file():
-            out.append(p)
-        elif p.is_file() and p.name.endswith((".bag", ".bag.active", ".mcap")):
+        if (p.is_dir() and (p / "metadata.yaml").is_file()) or (p.is_file() and p.name.endswith((".bag", ".bag.active", ".mcap"))):
             out.append(p)
     return out
 
