@@ -76,7 +76,8 @@ def find_bags(folder: Path) -> list[Path]:
     for p in sorted(folder.rglob("*")):
         if any(parent in out for parent in p.parents):
             continue
-        if (p.is_dir() and (p / "metadata.yaml").is_file()) or (p.is_file() and p.name.endswith((".bag", ".bag.active", ".mcap"))):
+        rosbag2 = p.is_dir() and (p / "metadata.yaml").is_file()
+        if rosbag2 or (p.is_file() and p.name.endswith((".bag", ".bag.active", ".mcap"))):
             out.append(p)
     return out
 
