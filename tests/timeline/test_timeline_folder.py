@@ -1,0 +1,204 @@
+"""`ertools timeline` on the generated folder vs its answers, output formats, bad input."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from ertools.cli.main import main
+from ertools.timeline_scan import Progress, find_bags, scan
+
+
+def rel(root: Path, path: str) -> str:
+    return str(Path(path).relative_to(root))
+
+
+def test_scan_matches_the_answers(folder: dict[str, Any]) -> None:
+    root, ans = folder["root"], folder["answers"]
+    tl = scan([root])
+    exp, truth = ans["expected"], ans["truth"]
+    tol = ans["tolerance"]["times"]["abs"]
+    readable = {rel(root, b.path): b for b in tl.bags if b.readable}
+    assert tl.readable_count == exp["readable"] == len(readable)
+    for name, b in readable.items():
+        t = truth["bags"][name]
+        assert b.start_ns / 1e9 == pytest.approx(t["start"], abs=tol), name
+        assert b.end_ns / 1e9 == pytest.approx(t["end"], abs=tol), name
+        assert b.kind == t["kind"], name
+        assert sorted(rel(root, o) for o in b.overlaps) == exp["overlaps"][name], name
+    starts = [b.start_ns for b in tl.bags if b.readable]
+    assert starts == sorted(starts)
+    sessions = [sorted(rel(root, p) for p in s.paths) for s in tl.sessions]
+    assert sessions == exp["sessions"]
+
+
+def test_pairings_match_the_answers(folder: dict[str, Any]) -> None:
+    root, ans = folder["root"], folder["answers"]
+    tl = scan([root])
+    pairs = {rel(root, p.path): p for p in tl.pairings}
+    assert set(pairs) == set(ans["expected"]["pairings"])
+    for name, exp in ans["expected"]["pairings"].items():
+        p = pairs[name]
+        assert sorted(rel(root, g) for g in p.gt) == exp["gt"]
+        # 1 ms grid in the answers: tolerance from the answers file.
+        assert p.coverage == pytest.approx(exp["coverage"], abs=ans["tolerance"]["coverage"]["abs"])
+        got = [[a / 1e9, b / 1e9] for a, b in p.uncovered]
+        assert len(got) == len(exp["uncovered"])
+        for g, e in zip(got, exp["uncovered"], strict=True):
+            assert g == pytest.approx(e, abs=2e-3)  # grid step 1 ms, both ends
+
+
+def test_problems_match_the_answers(folder: dict[str, Any]) -> None:
+    root, ans = folder["root"], folder["answers"]
+    tl = scan([root])
+    by_path: dict[str, list[str]] = {}
+    for p in tl.problems:
+        by_path.setdefault(rel(root, p.path), []).append(p.problem)
+    for name, word in ans["expected"]["problems"].items():
+        assert name in by_path, name
+        if word != "any":
+            assert any(word in text.lower() for text in by_path[name]), (name, by_path[name])
+    # Nothing else is flagged.
+    assert set(by_path) == set(ans["expected"]["problems"])
+    gap = next(
+        t
+        for t in by_path[next(k for k, v in ans["expected"]["problems"].items() if v == "gap")]
+        if "gap of" in t
+    )
+    assert f"gap of {ans['expected']['split_gap_s']:.3f} s" in gap
+    clock = next(
+        t for k, v in ans["expected"]["problems"].items() if v == "clock" for t in by_path[k]
+    )
+    assert f"{ans['expected']['clock_offset_s']:+.3f} s" in clock
+
+
+def test_cli_json_layout(folder: dict[str, Any], capsys: pytest.CaptureFixture[str]) -> None:
+    root, ans = folder["root"], folder["answers"]
+    assert main(["timeline", str(root), "--format", "json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert list(d) == ["bags", "sessions", "problems"]
+    keys = ["path", "format", "start", "end", "duration", "kind", "overlaps", "problems"]
+    for b in d["bags"]:
+        assert list(b) == keys
+        assert isinstance(b["overlaps"], list) and isinstance(b["problems"], list)
+    trunc = next(b for b in d["bags"] if rel(root, b["path"]) == ans["truth"]["truncated"])
+    if trunc["start"] is None:  # unreadable: listed with start null and under problems
+        assert trunc["kind"] == "unreadable"
+    assert any(rel(root, p["path"]) == ans["truth"]["truncated"] for p in d["problems"])
+    assert all(set(p) == {"path", "problem"} for p in d["problems"])
+    gt0 = next(b for b in d["bags"] if b["path"].endswith("_0.bag") and "gtlogger/" in b["path"])
+    assert gt0["start"] == pytest.approx(
+        ans["truth"]["bags"][rel(root, gt0["path"])]["start"], abs=1e-6
+    )
+    assert gt0["format"] == "ros1"
+
+
+def test_cli_csv_and_table(folder: dict[str, Any], capsys: pytest.CaptureFixture[str]) -> None:
+    root = folder["root"]
+    assert main(["timeline", str(root), "--format", "csv"]) == 0
+    rows = list(csv.DictReader(io.StringIO(capsys.readouterr().out)))
+    assert len(rows) == 9
+    assert {"start", "end", "duration", "kind", "path", "overlaps", "problems"} <= set(rows[0])
+    assert main(["timeline", str(root)]) == 0
+    out = capsys.readouterr().out
+    assert "\033[" not in out  # captured stdout is no terminal: no colour
+    assert "sessions:" in out and "GT coverage" in out and "problems (" in out
+
+
+def test_cli_plot(
+    folder: dict[str, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    for name in ("t.png", "t.svg"):
+        assert main(["timeline", str(folder["root"]), "--plot", str(tmp_path / name)]) == 0
+        assert (tmp_path / name).stat().st_size > 1000
+    assert (tmp_path / "t.svg").read_text(encoding="utf-8").lstrip().startswith("<?xml")
+    assert main(["timeline", str(folder["root"]), "--plot", str(tmp_path / "t.pdf")]) == 2
+
+
+def test_progress_bar_only_on_a_terminal() -> None:
+    class Tty(io.StringIO):
+        def isatty(self) -> bool:
+            return True
+
+    tty, pipe = Tty(), io.StringIO()
+    for stream in (tty, pipe):
+        bar = Progress(10, stream, delay_s=0.0)
+        bar(5)
+        bar.close()
+    assert "5/10" in tty.getvalue()
+    assert pipe.getvalue() == ""
+    quiet = Tty()
+    bar = Progress(10, quiet, delay_s=60.0)  # a quick scan shows nothing
+    bar(5)
+    assert quiet.getvalue() == ""
+
+
+def test_find_bags_walks_and_takes_rosbag2_folders(tmp_path: Path) -> None:
+    (tmp_path / "a" / "b").mkdir(parents=True)
+    (tmp_path / "a" / "x.bag").write_bytes(b"")
+    (tmp_path / "a" / "b" / "y.bag.active").write_bytes(b"")
+    (tmp_path / "a" / "z.mcap").write_bytes(b"")
+    (tmp_path / "a" / "notes.txt").write_text("no")
+    r2 = tmp_path / "a" / "ros2bag"
+    r2.mkdir()
+    (r2 / "metadata.yaml").write_text("x: 1")
+    (r2 / "ros2bag_0.mcap").write_bytes(b"")
+    found = find_bags([tmp_path, tmp_path / "missing"])
+    assert [str(p.relative_to(tmp_path)) for p in found.bags] == [
+        "a/b/y.bag.active",
+        "a/ros2bag",
+        "a/x.bag",
+        "a/z.mcap",
+    ]
+    assert [p.problem for p in found.problems] == ["no such file or directory"]
+
+
+def test_bad_files_are_listed_and_the_rest_still_read(
+    folder: dict[str, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import random
+
+    (tmp_path / "empty.bag").write_bytes(b"")
+    (tmp_path / "random.bag").write_bytes(random.Random(0).randbytes(3000))
+    good = next(folder["root"].glob("gtlogger/*_0.bag"))
+    args = ["timeline", str(tmp_path), str(good), str(tmp_path / "missing"), "--format", "json"]
+    assert main(args) == 0  # one bag was readable
+    d = json.loads(capsys.readouterr().out)
+    problems = {Path(p["path"]).name: p["problem"] for p in d["problems"]}
+    assert "empty" in problems["empty.bag"]
+    assert "random.bag" in problems and "missing" in problems
+    assert [b["path"] for b in d["bags"] if b["start"] is not None] == [str(good)]
+
+
+@pytest.mark.parametrize("case", ["empty_dir", "junk_only", "missing"])
+def test_nothing_readable_exits_1(
+    case: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    target = tmp_path / "x"
+    if case == "empty_dir":
+        target.mkdir()
+    elif case == "junk_only":
+        target.mkdir()
+        (target / "a.bag").write_bytes(b"#ROSBAG V2.0\n" + b"\x00" * 20)
+    assert main(["timeline", str(target)]) == 1
+    err = capsys.readouterr().err
+    assert err.count("ertools: error:") == 1 and "no readable bag" in err
+    assert "Traceback" not in err
+
+
+def test_real_2015_bag() -> None:
+    real = Path(__file__).resolve().parents[2] / ".." / "shared" / "real_bags"
+    if not real.is_dir():
+        pytest.skip("../shared/real_bags not present")
+    tl = scan([real])
+    (b,) = tl.bags
+    assert b.kind == "gt"  # pose, pose2d, tf, map, rosout: a GT logger (README)
+    assert b.duration_ns is not None
+    assert b.duration_ns / 1e9 == pytest.approx(57.6, abs=0.05)  # README: 57.6 s
+    # The mocap node and the recorder ran on one machine: no clock problem, no other problem.
+    assert b.problems == ()
