@@ -65,11 +65,9 @@ def test_problems_match_the_answers(folder: dict[str, Any]) -> None:
             assert any(word in text.lower() for text in by_path[name]), (name, by_path[name])
     # Nothing else is flagged.
     assert set(by_path) == set(ans["expected"]["problems"])
-    gap = next(
-        t
-        for t in by_path[next(k for k, v in ans["expected"]["problems"].items() if v == "gap")]
-        if "gap of" in t
-    )
+    words = ans["expected"]["problems"]
+    gap_file = next(k for k, v in words.items() if v == "gap")
+    gap = next(t for t in by_path[gap_file] if "gap of" in t)
     assert f"gap of {ans['expected']['split_gap_s']:.3f} s" in gap
     clock = next(
         t for k, v in ans["expected"]["problems"].items() if v == "clock" for t in by_path[k]
