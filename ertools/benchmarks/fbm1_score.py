@@ -55,7 +55,7 @@ class PoseErrors:
         trans_term: the translation term t of the score (clipped).
         rot_term: the rotation term r of the score (clipped).
         pose_score: 1 - t/2 - r/2.
-        legacy_differs: the 2015 rules would give a different pose score.
+        legacy_differs: the 2015 and the fixed rules give different pose scores here.
     """
 
     dx: float
@@ -112,8 +112,9 @@ def pose_errors(
     t = trans_term(dist, legacy=rules.legacy_clip)
     r = rot_term(dtheta)
     score = 1.0 - t / 2.0 - r / 2.0
-    other = 1.0 - trans_term(dist, legacy=True) / 2.0 - rot_term(wrap_deg(raw, legacy=True)) / 2.0
-    return PoseErrors(dx, dy, dist, dtheta, t, r, score, abs(other - score) > 1e-12)
+    old = 1.0 - trans_term(dist, legacy=True) / 2.0 - rot_term(wrap_deg(raw, legacy=True)) / 2.0
+    new = 1.0 - trans_term(dist) / 2.0 - rot_term(wrap_deg(raw)) / 2.0
+    return PoseErrors(dx, dy, dist, dtheta, t, r, score, abs(old - new) > 1e-12)
 
 
 def names_match(answer: str, truth: str, rules: ScoreRules) -> bool:

@@ -1,0 +1,128 @@
+"""Finding FBM1 runs in the state topics (@Home, @Work, short states, timeouts, orders)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from fbm1_testkit import RunSpec, ns, state_streams
+
+from ertools.benchmarks.fbm1_runs import find_runs, parse_item_ref
+from ertools.states import BmBoxState as B
+from ertools.states import ClientState as C
+from ertools.states import RefBoxState as R
+from ertools.streams import Machine, StateStream
+
+
+def _stream(machine: Machine, rows: list[tuple[float, int, str]]) -> StateStream:
+    return StateStream(
+        machine,
+        np.array([ns(t) for t, _, _ in rows], dtype=np.int64),
+        np.array([s for _, s, _ in rows], dtype=np.uint8),
+        tuple(p for _, _, p in rows),
+    )
+
+
+@pytest.mark.parametrize(
+    ("text", "item_id", "instance"),
+    [
+        ("Place item 3 (a3) on the table", 3, "a3"),
+        ("place item 12 (Bearing Boxes AX-16) on the table ", 12, "Bearing Boxes AX-16"),
+        ("7", 7, None),
+        ("EM-01", None, "EM-01"),
+    ],
+)
+def test_parse_item_ref(text: str, item_id: int | None, instance: str | None) -> None:
+    ref = parse_item_ref(text, "bmbox payload")
+    assert ref is not None and (ref.item_id, ref.instance) == (item_id, instance)
+
+
+def test_home_runs_with_moments_and_answers() -> None:
+    runs = [
+        RunSpec("Place item 1 (a1) on the table", "{x: 1}"),
+        RunSpec("Place item 2 (b1) on the table", None, timeout=True),
+    ]
+    s = state_streams(runs)
+    found = find_runs(s[Machine.BMBOX], s[Machine.REFBOX], s[Machine.CLIENT])
+    r1, r2 = found.runs
+    assert (r1.start_ns, r1.placed_ns, r1.goal_ns) == (ns(10.0), ns(13.02), ns(14.0))
+    assert (r1.executing_ns, r1.result_ns) == (ns(14.1), ns(16.1))
+    assert r1.item is not None and r1.item.item_id == 1
+    assert r1.answer_payload == "{x: 1}" and r1.status == "answered"
+    assert r2.status == "no_answer" and r2.ended_by == "timeout"
+    assert found.logged_score == "{class_accuracy: 0.5}"
+
+
+def test_work_item_from_refbox_payload() -> None:
+    runs = [RunSpec("", "{x: 1}", refbox_payload="EM-01")]
+    s = state_streams(runs)
+    found = find_runs(s[Machine.BMBOX], s[Machine.REFBOX], s[Machine.CLIENT], benchmark="fbm1w")
+    ref = found.runs[0].item
+    assert ref is not None and ref.instance == "EM-01" and ref.source == "refbox payload"
+
+
+def test_home_prefers_bmbox_payload_work_prefers_refbox() -> None:
+    runs = [RunSpec("Place item 1 (a1) on the table", "{x: 1}", refbox_payload="b1")]
+    s = state_streams(runs)
+    home = find_runs(s[Machine.BMBOX], s[Machine.REFBOX], s[Machine.CLIENT])
+    work = find_runs(s[Machine.BMBOX], s[Machine.REFBOX], s[Machine.CLIENT], benchmark="fbm1w")
+    assert home.runs[0].item.item_id == 1  # type: ignore[union-attr]
+    assert work.runs[0].item.instance == "b1"  # type: ignore[union-attr]
+
+
+def test_missing_short_ready_still_closes_the_run() -> None:
+    # The READY between runs lasted less than one heartbeat and was never published.
+    bm = _stream(
+        Machine.BMBOX,
+        [
+            (1.0, B.READY, ""),
+            (2.0, B.WAITING_MANUAL_OPERATION, "Place item 1 (a1) on the table"),
+            (3.0, B.COMPLETED_MANUAL_OPERATION, ""),
+            (4.0, B.TRANSMITTING_GOAL, ""),
+            (4.1, B.EXECUTING_GOAL, ""),
+            (4.2, B.WAITING_RESULT, ""),
+            (6.0, B.WAITING_MANUAL_OPERATION, "Place item 2 (b1) on the table"),
+            (7.0, B.COMPLETED_MANUAL_OPERATION, ""),
+            # TRANSMITTING_GOAL and EXECUTING_GOAL missing too.
+            (8.2, B.WAITING_RESULT, ""),
+            (9.0, B.READY, ""),
+        ],
+    )
+    cl = _stream(
+        Machine.CLIENT,
+        [
+            (5.9, C.COMPLETED_GOAL, "{a: 1}"),
+            (6.5, C.WAITING_GOAL, ""),
+            (8.9, C.COMPLETED_GOAL, "{a: 2}"),
+        ],
+    )
+    found = find_runs(bm, None, cl)
+    r1, r2 = found.runs
+    assert r1.result_ns == ns(6.0) and r1.answer_payload == "{a: 1}"
+    assert (r2.goal_ns, r2.executing_ns, r2.result_ns) == (ns(8.2), ns(8.2), ns(9.0))
+    assert r2.answer_payload == "{a: 2}"
+
+
+def test_aborted_run_and_stop() -> None:
+    bm = _stream(
+        Machine.BMBOX,
+        [
+            (1.0, B.READY, ""),
+            (2.0, B.WAITING_MANUAL_OPERATION, "Place item 1 (a1) on the table"),
+            (3.0, B.READY, ""),
+            (4.0, B.END, ""),
+        ],
+    )
+    rb = _stream(Machine.REFBOX, [(1.0, R.READY, ""), (2.9, R.END, "reason: stop")])
+    found = find_runs(bm, rb, None)
+    assert [r.status for r in found.runs] == ["aborted"]
+
+
+def test_items_order_overrides_and_warns_on_count() -> None:
+    runs = [RunSpec("Place item 1 (a1) on the table", "{x: 1}")] * 2
+    s = state_streams(runs)
+    found = find_runs(
+        s[Machine.BMBOX], s[Machine.REFBOX], s[Machine.CLIENT], items_order=["3", "b1", "2"]
+    )
+    assert found.runs[0].item.item_id == 3  # type: ignore[union-attr]
+    assert found.runs[1].item.instance == "b1"  # type: ignore[union-attr]
+    assert found.warnings and "3 item(s)" in found.warnings[0]
