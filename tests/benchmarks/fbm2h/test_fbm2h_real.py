@@ -162,3 +162,55 @@ def test_real_bag_without_states_needs_reached(
     err = capsys.readouterr().err
     assert code == 1
     assert err.count("\n") == 1 and "--reached timing FILE" in err
+
+
+def test_real_bag_auto_stops(real: dict[str, Any], capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(
+        ["score", "fbm2h", str(BAG), "--goal", str(GOAL), "--reached", "auto", "--format", "json"]
+    )
+    out = capsys.readouterr()
+    assert code == 0, out.err
+    segs = json.loads(out.out)["details"]["segments_details"]
+    for k, target in enumerate(real["goal"]):
+        s = segs[str(k)]
+        moment = round(s["end_segment_time"] * 1e9)
+        # The operator confirmed each waypoint after the robot had stopped (measured 0 to
+        # 0.9 s later): the detected stop comes first, by at most 1.5 s.
+        confirmed = real["start"] + round(real["p"][k + 1] * 1e9)
+        assert -1.5e9 <= moment - confirmed <= 0.05e9
+        x, y, _ = _hand_pose(real, moment)
+        # end_segment_time is printed as float epoch seconds (~0.2 us of rounding): at the
+        # robot's standstill speed (< 5 cm/s) that moves the pose by far less than 1e-6 m.
+        assert s["dinstance_error"] == pytest.approx(
+            math.hypot(x - target[0], y - target[1]), abs=1e-6
+        )
+
+
+def test_real_bag_pose2d_topic(real: dict[str, Any], capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(
+        [
+            "score",
+            "fbm2h",
+            str(BAG),
+            "--goal",
+            str(GOAL),
+            "--reached",
+            "timing",
+            str(TIMING),
+            "--topic",
+            "/fbm2h/robot_at_home/pose2d",
+            "--format",
+            "json",
+        ]
+    )
+    out = capsys.readouterr()
+    assert code == 0, out.err
+    segs = json.loads(out.out)["details"]["segments_details"]
+    for k, target in enumerate(real["goal"]):
+        moment = real["start"] + round(real["p"][k + 1] * 1e9)
+        x, y, _ = _hand_pose(real, moment)
+        # Pose2D carries the same x, y but only record times (~0.3 ms after the header stamp):
+        # at < 0.4 m/s that shifts the pose by < 0.2 mm.
+        assert segs[str(k)]["dinstance_error"] == pytest.approx(
+            math.hypot(x - target[0], y - target[1]), abs=2e-4
+        )
