@@ -7,7 +7,9 @@ How 2015 scored (``scripts/fbm2h`` of ``benchmark_and_scoring_fbm``, final 2015 
 each waypoint i (segment i, from 0), ``start_segment_time`` when the goal had been sent,
 ``end_segment_time`` when the Client's result arrived, ``segment_time`` their difference;
 the robot pose was the tf ``world -> robot_at_home`` composed with the team's
-``marker_to_robot_transform`` and reduced to (x, y, yaw); ``dinstance_error`` the planar
+``marker_to_robot_transform`` (broadcast as a child frame stamped ``now``, the ROS time just
+after the result arrived, so tf interpolated the marker pose at that moment) and reduced to
+(x, y, yaw); ``dinstance_error`` the planar
 distance to the waypoint; ``orientation_error = atan2(sin|dtheta|, cos|dtheta|)`` with
 ``dtheta`` the unwrapped yaw difference; ``position_accuracy = sum(distance) / N``,
 ``orientation_accuracy = atan2(sum sin|dtheta|, sum cos|dtheta|)``, ``execution_time`` the
@@ -49,8 +51,8 @@ DEVIATION_WRAP = (
     "the unwrapped |dtheta|, wrong across +-pi (use --orientation-2015 for the 2015 numbers)"
 )
 DEVIATION_POSE = (
-    "robot pose interpolated (linear + SLERP) at the logged reached moment; 2015 took the "
-    "latest tf available when its node processed the result"
+    "robot pose interpolated (linear + SLERP) at the logged reached moment; 2015's tf lookup "
+    "interpolated at the ROS time its node handled the result, a few ms later"
 )
 DEVIATION_FORMAT = (
     "segments_details nested under details as in Listing 13 (the 2015 node wrote it at the top "
