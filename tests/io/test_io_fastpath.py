@@ -55,3 +55,79 @@ def fast_batch(path: Path, topic: str, lo: int | None = None, hi: int | None = N
 def test_fast_equals_rosbags(scene_bag: tuple[str, Path], topic: str) -> None:
     _fmt, path = scene_bag
     assert_same(fast_batch(path, topic), reference_batch(path, topic))
+
+
+REPO = Path(__file__).resolve().parents[2]
+REAL_BAG = REPO / ".." / "shared" / "real_bags" / "log_fbm2h_mocap_2015-10-23-16-15-40_0.bag"
+
+
+def _sample_bags() -> list[Path]:
+    from ertools.io.info import find_bags
+
+    folder = REPO / "sample_bags"
+    return find_bags(folder) if folder.is_dir() else []
+
+
+def test_fast_equals_rosbags_on_sample_bags() -> None:
+    from ertools.io import summary
+    from ertools.io.model import POSE_TYPES
+
+    bags = _sample_bags()
+    if not bags:
+        pytest.skip("sample_bags/ is empty (run `make samples`)")
+    checked = 0
+    for path in bags:
+        for topic in summary(path).topics:
+            if topic.msgtype in POSE_TYPES and topic.count:
+                assert_same(fast_batch(path, topic.name), reference_batch(path, topic.name))
+                checked += 1
+    assert checked > 0
+
+
+@pytest.mark.real
+def test_fast_equals_rosbags_on_real_bag() -> None:
+    if not REAL_BAG.exists():
+        pytest.skip("../shared/real_bags not present")
+    for topic in ("/fbm2h/robot_at_home/pose", "/fbm2h/robot_at_home/pose2d", "/tf"):
+        assert_same(fast_batch(REAL_BAG, topic), reference_batch(REAL_BAG, topic))
+
+
+@pytest.mark.real
+def test_real_bag_end_to_end() -> None:
+    """Topics, counts, start/end and first pose, checked against rosbags' AnyReader directly."""
+    if not REAL_BAG.exists():
+        pytest.skip("../shared/real_bags not present")
+    from rosbags.highlevel import AnyReader
+
+    import ertools.io as eio
+
+    with AnyReader([REAL_BAG]) as reader:
+        start, end = reader.start_time, reader.end_time - 1  # rosbags' end is exclusive
+        conns = [c for c in reader.connections if c.topic == "/fbm2h/robot_at_home/pose"]
+        _, t_first, raw = next(reader.messages(connections=conns))
+        first = reader.deserialize(raw, conns[0].msgtype)
+    found = eio.topics(REAL_BAG)
+    assert found == {
+        "/fbm2h/map": "nav_msgs/OccupancyGrid",
+        "/fbm2h/map_metadata": "nav_msgs/MapMetaData",
+        "/fbm2h/robot_at_home/pose": "geometry_msgs/PoseStamped",
+        "/fbm2h/robot_at_home/pose2d": "geometry_msgs/Pose2D",
+        "/rosout": "rosgraph_msgs/Log",
+        "/tf": "tf2_msgs/TFMessage",
+    }
+    s = eio.summary(REAL_BAG)
+    assert (s.start_ns, s.end_ns) == (start, end)
+    pose = eio.read_poses(REAL_BAG, "/fbm2h/robot_at_home/pose")
+    rec = eio.read_poses(REAL_BAG, "/fbm2h/robot_at_home/pose", time_source="record")
+    assert len(pose) == 6887 and rec.t_ns[0] == t_first
+    p, q = first.pose.position, first.pose.orientation
+    assert pose.t_ns[0] == first.header.stamp.sec * 10**9 + first.header.stamp.nanosec
+    np.testing.assert_array_equal(pose.xyz[0], [p.x, p.y, p.z])
+    np.testing.assert_array_equal(pose.quat_xyzw[0], [q.x, q.y, q.z, q.w])
+    assert pose.frame_id == first.header.frame_id == "world"
+    assert len(eio.read_poses(REAL_BAG, "/fbm2h/robot_at_home/pose2d")) == 6887
+    tf = eio.read_tf(REAL_BAG, "world", "robot_at_home")
+    assert len(tf) == 6887
+    np.testing.assert_array_equal(tf.xyz[0], pose.xyz[0])  # the mocap node publishes both
+    static = eio.read_tf(REAL_BAG, "world", "map")
+    assert len(static) == 573
