@@ -55,7 +55,8 @@ def test_2015_style_transform_file_with_extra_keys() -> None:
 
 def test_transform_yaml_round_trip() -> None:
     q = Rotation.from_euler("xyz", [0.02, 0.0, -2.9]).as_quat()
-    tr = MarkerTransform("homer", "2015-11-20_10:00:00", (0.1, -0.2, -0.7), tuple(q), "x")  # type: ignore[arg-type]
+    quat = (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
+    tr = MarkerTransform("homer", "2015-11-20_10:00:00", (0.1, -0.2, -0.7), quat, "x")
     text = transform_yaml(tr)
     back = parse_transform(parse_yaml(text), "t.yaml")  # also checks the inverse written
     assert back.translation == pytest.approx(tr.translation, abs=1e-15)

@@ -48,9 +48,10 @@ def _moments(start_s: list[float], end_s: list[float]) -> ReachedMoments:
 # Marker at yaw +90 deg; robot 0.2 m ahead of the marker along the marker's x, 0.5 m below it,
 # turned -90 deg: by hand, robot = marker + Rz(90)(0.2, 0, -0.5) = marker + (0, 0.2, -0.5),
 # robot yaw = 90 - 90 = 0.
+_Q = _quat_yaw(-math.pi / 2)
 TRANSFORM = MarkerTransform(
-    "team", "2015-10-23_16:15:40", (0.2, 0.0, -0.5), tuple(_quat_yaw(-math.pi / 2)), "test"
-)  # type: ignore[arg-type]
+    "team", "2015-10-23_16:15:40", (0.2, 0.0, -0.5), (_Q[0], _Q[1], _Q[2], _Q[3]), "test"
+)
 
 
 def test_non_identity_transform_hand_computed() -> None:
