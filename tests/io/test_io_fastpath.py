@@ -24,11 +24,13 @@ POSE_TOPICS = (
 def reference_batch(
     path: Path, topic: str, lo: int | None = None, hi: int | None = None
 ) -> PoseBatch:
-    """rosbags' own reader and deserializer (rosbag1/rosbag2 Reader) or mcap + rosbags."""
+    """rosbags' own reader and deserializer (rosbag1/rosbag2 Reader), or for files rosbags
+    does not open (standalone MCAP, unindexed .bag.active) their per-message raw records
+    deserialized by rosbags."""
     from ertools.io.formats import detect_format
 
     fmt = detect_format(path)
-    bag = RosbagsFile(path, fmt) if fmt != "mcap" else open_bag(path)
+    bag = RosbagsFile(path, fmt) if fmt not in ("mcap", "ros1-active") else open_bag(path)
     with bag:
         return slow_pose_batch(bag, bag.topic_conns(topic), lo, hi)
 

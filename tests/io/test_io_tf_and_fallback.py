@@ -28,7 +28,7 @@ def q_yaw(yaw: float) -> tuple[float, float, float, float]:
 @pytest.mark.parametrize("fmt", ["ros1", "mcap-cdr"])
 @pytest.mark.parametrize("tf_type", ["tf/tfMessage", "tf2_msgs/TFMessage"])
 def test_origin_to_ref_board(tmp_path: Path, fmt: str, tf_type: str) -> None:
-    """world->origin (static, on /tf_static) and world->ref_board (moving) give origin->ref_board."""
+    """world->origin (static, /tf_static) and world->ref_board (moving) give origin->ref_board."""
     s = Spec()
     static = s.conn("/tf_static", tf_type)
     moving = s.conn("/tf", tf_type)
