@@ -54,6 +54,7 @@ class MonitorCheck:
     growth_bps: float | None
     rates_hz: dict[str, float]
     warnings: tuple[str, ...]
+    window_end_ns: int | None = None  # log time of the newest message (rates end there)
 
     def status_line(self) -> str:
         if self.newest is None:
@@ -74,6 +75,7 @@ class _Followed:
     tail: McapTail | None
     times: dict[str, deque[int]] = field(default_factory=dict)
     best: dict[str, float] = field(default_factory=dict)
+    latest_ns: int | None = None
 
 
 class Monitor:
@@ -150,7 +152,8 @@ class Monitor:
             if f.tail is not None:
                 self._update_rates(f, rates)
                 warnings += self._rate_warnings(f, rates)
-        return MonitorCheck(tuple(active), path, size, growth, rates, tuple(warnings))
+        end = f.latest_ns if rates else None
+        return MonitorCheck(tuple(active), path, size, growth, rates, tuple(warnings), end)
 
     def _update_rates(self, f: _Followed, rates: dict[str, float]) -> None:
         """Per pose topic: messages in the last interval of log time, divided by it.
@@ -170,6 +173,7 @@ class Monitor:
         latest = max((d[-1] for d in f.times.values() if d), default=None)
         if latest is None:
             return
+        f.latest_ns = latest
         for topic, d in f.times.items():
             while d and d[0] <= latest - window_ns:
                 d.popleft()

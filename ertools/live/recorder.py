@@ -197,6 +197,7 @@ class Recorder:
             bodies={b.body_id: BodyCounters(name=b.name) for b in config.bodies}
         )
         self.stop_event = threading.Event()
+        self.ready = threading.Event()  # set once the first file is open and listening
         self.files: list[Path] = []
         self._sock: socket.socket | None = None
         self._file: LogFile | None = None
@@ -224,6 +225,7 @@ class Recorder:
         t0 = time.monotonic()
         index = 0
         self._open_file(index)
+        self.ready.set()
         file_t0 = last_flush = last_health = t0
         try:
             while not self.stop_event.is_set():
@@ -313,6 +315,15 @@ class Recorder:
             },
         )
         self._file.add_metadata("ertools.clock", self._clock_metadata())
+        # Channels (and their schemas) up front: every file lists every configured topic, and
+        # the first frame is not delayed by building schemas.
+        for route in self._routes.values():
+            if route.pose_topic:
+                self._channel(route.pose_topic, POSE_STAMPED)
+            if route.pose2d_topic:
+                self._channel(route.pose2d_topic, POSE_2D)
+            if route.tf:
+                self._channel("/tf", TF_MESSAGE)
         self._file_base = self._counts()
         self._report(f"writing {path}")
 

@@ -50,6 +50,7 @@ def run_recording(
     result: list[RecordSummary] = []
     thread = threading.Thread(target=lambda: result.append(recorder.run()), daemon=True)
     thread.start()
+    assert recorder.ready.wait(5)
     target = (group or "127.0.0.1", port)
     motive = SimulatedMotive(
         target=target,
