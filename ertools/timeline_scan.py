@@ -16,7 +16,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
-from ertools.timeline import ClockCheck, Timeline, TimelineConfig, Unreadable, build_timeline
+from ertools.timeline import (
+    ClockCheck,
+    Timeline,
+    TimelineConfig,
+    Unreadable,
+    build_timeline,
+    split_name,
+)
 from ertools.timeutil import NS_PER_S
 
 if TYPE_CHECKING:
@@ -122,6 +129,42 @@ def clock_check(s: BagSummary, window_ns: int = CLOCK_WINDOW_NS) -> ClockCheck |
     return ClockCheck(str(s.path), topic.name, int(np.median(diff)), len(diff))
 
 
+def check_recordings(
+    summaries: Sequence[BagSummary],
+    tolerance_ns: int,
+    on_progress: Callable[[int], None] | None = None,
+) -> list[ClockCheck]:
+    """Clock checks, one per recording unless it finds a problem.
+
+    A machine's clock offset does not change between the split files of one recording, so
+    only the first file of each (``split_name`` group) is read; when it is off by more than
+    ``tolerance_ns`` the other files of that recording are checked too, so every flagged
+    file was measured. Files that are not split files are each checked.
+    """
+    groups: dict[str, list[tuple[int, BagSummary]]] = {}
+    for s in summaries:
+        split = split_name(s.path)
+        key, index = (split[0], split[1]) if split is not None else (str(s.path), 0)
+        groups.setdefault(key, []).append((index, s))
+    checks: list[ClockCheck] = []
+    done = 0
+    for members in groups.values():
+        members.sort(key=lambda m: m[0])
+        first = clock_check(members[0][1])
+        done += 1
+        if on_progress is not None:
+            on_progress(done)
+        if first is None:
+            continue
+        checks.append(first)
+        if abs(first.offset_ns) > tolerance_ns:
+            for _, s in members[1:]:
+                c = clock_check(s)
+                if c is not None:
+                    checks.append(c)
+    return checks
+
+
 class Progress:
     """``scanning 12/1000`` on a terminal's stderr, shown only once a scan takes a moment."""
 
@@ -187,16 +230,20 @@ def scan(
         progress: show a progress bar on stderr when it is a terminal.
     """
     found = find_bags(Path(p) for p in paths)
-    bar = Progress(len(found.bags) * (2 if check_clocks else 1)) if progress else None
+    bar = Progress(len(found.bags)) if progress else None
     summaries, unreadable = summarise(found.bags, bar)
     checks: list[ClockCheck] = []
     if check_clocks:
-        for i, s in enumerate(summaries):
-            c = clock_check(s)
-            if c is not None:
-                checks.append(c)
+        tolerance = (config or TimelineConfig()).clock_tolerance_ns
+        done = len(found.bags)
+        if bar is not None:  # one check per recording (see check_recordings)
+            bar.total = done + len({(split_name(s.path) or (s.path, 0))[0] for s in summaries})
+
+        def tick(n: int) -> None:
             if bar is not None:
-                bar(len(found.bags) + i + 1)
+                bar(done + n)
+
+        checks = check_recordings(summaries, tolerance, tick)
     if bar is not None:
         bar.close()
     return build_timeline(summaries, [*found.problems, *unreadable], checks, config)

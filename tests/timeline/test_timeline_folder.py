@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -200,3 +201,31 @@ def test_real_2015_bag() -> None:
     assert b.duration_ns / 1e9 == pytest.approx(57.6, abs=0.05)  # README: 57.6 s
     # The mocap node and the recorder ran on one machine: no clock problem, no other problem.
     assert b.problems == ()
+
+
+def test_clock_checked_once_per_recording_unless_off(monkeypatch: pytest.MonkeyPatch) -> None:
+    import ertools.timeline_scan as ts
+    from ertools.timeline import ClockCheck
+
+    @dataclass(frozen=True)
+    class S:
+        path: str
+
+    calls: list[str] = []
+    offsets = {"log_a_2015-11-20-10-00-00": 0, "log_b_2015-11-20-10-00-00": 5_000_000_000}
+
+    def fake(s: Any) -> ClockCheck:
+        calls.append(Path(s.path).name)
+        return ClockCheck(s.path, "/p", offsets[Path(s.path).name.rsplit("_", 1)[0]], 10)
+
+    monkeypatch.setattr(ts, "clock_check", fake)
+    files = [S(f"log_{x}_2015-11-20-10-00-00_{i}.bag") for x in "ab" for i in (2, 0, 1)]
+    checks = ts.check_recordings(files, 500_000_000)  # type: ignore[arg-type]
+    # a: in sync, only its first file is read; b: off by 5 s, all three are read.
+    assert calls == [
+        "log_a_2015-11-20-10-00-00_0.bag",
+        "log_b_2015-11-20-10-00-00_0.bag",
+        "log_b_2015-11-20-10-00-00_1.bag",
+        "log_b_2015-11-20-10-00-00_2.bag",
+    ]
+    assert len(checks) == 4
