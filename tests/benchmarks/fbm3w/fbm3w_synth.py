@@ -38,6 +38,8 @@ def one_run(
     baseline: float = 0.05,
     still: int = 30,
     spec: str = "line",
+    t0: int = T0,
+    index: int = 0,
 ) -> tuple[PoseStream, RunWindow]:
     """Reference (still), start (still), the path, end (still); one state-like window."""
     ref_frame = np.array([[-baseline, 0.0]])
@@ -49,9 +51,9 @@ def one_run(
             np.repeat(path_frame[-1:], still, axis=0),
         ]
     )
-    stream = stream_of(place(pts, origin, yaw))
+    stream = stream_of(place(pts, origin, yaw), t0)
     t = stream.t_ns
     window = RunWindow(
-        0, spec, int(t[still // 2]), int(t[still]), int(t[-1]), "completed", "windows"
+        index, spec, int(t[still // 2]), int(t[still]), int(t[-1]), "completed", "windows"
     )
     return stream, window

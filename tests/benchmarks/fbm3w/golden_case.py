@@ -1,0 +1,39 @@
+"""The deterministic benchmark behind the Listing 16 golden file (no bag, no randomness)."""
+
+from __future__ import annotations
+
+import numpy as np
+from fbm3w_synth import T0, one_run
+
+from ertools.benchmarks.fbm3w import score_runs
+from ertools.benchmarks.fbm3w_result import Fbm3wResult
+from ertools.benchmarks.fbm3w_runs import RunWindow
+from ertools.configs.fbm3w import Fbm3wConfig
+from ertools.configs.shapes import builtin_shapes
+from ertools.streams import concatenate_poses
+
+S = 1_000_000_000
+
+
+def golden_result() -> Fbm3wResult:
+    """A line 2 mm off, a semi-ellipse 1 mm off, and a line ended by a timeout."""
+    shapes = builtin_shapes()
+    u = np.linspace(0.0, 1.0, 600)
+    bump = np.sin(np.pi * u)[:, None] * np.array([[0.0, 1.0]])
+    runs = [("line", 0.002, (1.0, 2.0), 0.3), ("semi_ellipse", 0.001, (1.5, 2.5), -0.2)]
+    streams, windows = [], []
+    for i, (name, amp, origin, yaw) in enumerate(runs):
+        stream, window = one_run(
+            shapes[name](u) + amp * bump,
+            origin=origin,
+            yaw=yaw,
+            spec=name,
+            t0=T0 + i * 20 * S,
+            index=i,
+        )
+        streams.append(stream)
+        windows.append(window)
+    end = windows[-1].end_ns
+    assert end is not None
+    windows.append(RunWindow(2, "line", None, end + 1 * S, end + 4 * S, "timeout", "states"))
+    return score_runs(concatenate_poses(streams), windows, Fbm3wConfig(), bag_start_ns=T0 - S // 2)

@@ -1,0 +1,67 @@
+"""The score layout of seed Listing 16, against golden files (regen_golden.py rewrites them)."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+from golden_case import golden_result
+
+from ertools.cli.common import dump_json
+
+GOLDEN = Path(__file__).resolve().parent / "golden"
+NUMBER = re.compile(r"-?\d+\.\d+(e-?\d+)?")
+
+
+def _close(a: Any, b: Any, path: str = "") -> None:
+    """Same nesting and key order; numbers equal within 1e-12 (float formatting may differ)."""
+    assert type(a) is type(b) or {type(a), type(b)} <= {int, float}, path
+    if isinstance(a, dict):
+        assert list(a) == list(b), path
+        for key in a:
+            _close(a[key], b[key], f"{path}.{key}")
+    elif isinstance(a, list):
+        assert len(a) == len(b), path
+        for i, (x, y) in enumerate(zip(a, b, strict=True)):
+            _close(x, y, f"{path}[{i}]")
+    elif isinstance(a, float):
+        assert a == pytest.approx(b, abs=1e-12), path
+    else:
+        assert a == b, path
+
+
+def test_yaml_matches_golden() -> None:
+    text = golden_result().to_yaml()
+    golden = (GOLDEN / "score.yaml").read_text(encoding="utf-8")
+    # the text layout (keys, nesting, nulls, lists) is identical; digits may differ in the
+    # last place between NumPy/libm builds, so numbers are compared as values
+    assert NUMBER.sub("<n>", text) == NUMBER.sub("<n>", golden)
+    _close(yaml.safe_load(text), yaml.safe_load(golden))
+
+
+def test_json_matches_golden() -> None:
+    data = json.loads(dump_json(golden_result().to_dict()))
+    _close(data, json.loads((GOLDEN / "score.json").read_text(encoding="utf-8")))
+
+
+def test_listing_16_keys() -> None:
+    score = yaml.safe_load((GOLDEN / "score.yaml").read_text(encoding="utf-8"))
+    assert list(score) == ["best_distance_error", "best_run", "execution_time", "runs_details"]
+    assert list(score["runs_details"]) == [0, 1, 2]  # integer run indices, as 2015's yaml.dump
+    for run in score["runs_details"].values():
+        assert list(run)[:3] == ["spec", "distance_error", "execution_time"]
+    data = json.loads((GOLDEN / "score.json").read_text(encoding="utf-8"))
+    assert list(data["runs_details"]) == ["0", "1", "2"]  # JSON: string keys
+    # best = the smaller error; execution_time = sum of the runs, the timed-out one included
+    details = score["runs_details"]
+    assert score["best_run"] == 1
+    assert score["best_distance_error"] == details[1]["distance_error"]
+    assert score["execution_time"] == pytest.approx(
+        sum(r["execution_time"] for r in details.values()), abs=1e-9
+    )
+    assert details[2]["status"] == "timeout"
+    assert details[2]["distance_error"] is None
