@@ -290,6 +290,12 @@ def score_fbm1(
         rules=opts.rules,
     )
     warnings = list(found.warnings)
+    if items.is_vanilla:
+        warnings.append(
+            f"{items.source or 'the item list'} has identity transforms only (a vanilla list): "
+            "the ground truth is the board's own frame; measure the items with "
+            "`ertools acquire items`"
+        )
     for r in runs:
         warnings.extend(r.warnings)
     failures = [r.error for r in runs if r.error]

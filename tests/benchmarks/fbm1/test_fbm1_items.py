@@ -11,19 +11,20 @@ import yaml
 from ertools.configs.items import Item, ItemSpread, items_to_yaml, load_items, parse_items
 from ertools.errors import ConfigError
 
-# Seed Listing 9, verbatim.
+# The Listing 9 layout (rosparam dump: keys alphabetical, numbers as flow lists), rounded
+# quaternions as people type them.
 LISTING_9 = """
 items:
 - class: a
   id: 1
   instance: a1
-  rot: [-0.00751, 0.00246, -0.00631, 0.99994]
-  trans: [0.01410, -0.25499, -0.01289]
+  rot: [-0.00512, 0.00311, -0.00402, 0.99997]
+  trans: [0.02120, -0.24310, -0.01105]
 - class: a
   id: 2
   instance: a2
-  rot: [-0.00642, 0.00193, -0.00176, 0.99997]
-  trans: [0.01642, -0.25131, -0.01429]
+  rot: [0.00204, -0.00150, 0.38268, 0.92388]
+  trans: [0.01733, -0.26012, -0.01321]
 """
 
 
@@ -34,10 +35,10 @@ def test_listing_9(tmp_path: Path) -> None:
     assert len(items) == 2 and not items.is_vanilla
     a1 = items.by_id(1)
     assert a1 is not None and (a1.item_class, a1.instance) == ("a", "a1")
-    assert a1.trans == (0.01410, -0.25499, -0.01289)
-    # The listing's quaternion is rounded to 5 decimals: normalised on load.
+    assert a1.trans == (0.02120, -0.24310, -0.01105)
+    # The quaternion is rounded to 5 decimals: normalised on load (norm 1 + ~1e-5).
     assert a1.rot is not None and math.isclose(sum(c * c for c in a1.rot), 1.0)
-    assert a1.rot[3] == pytest.approx(0.99994, abs=1e-5)
+    assert a1.rot[3] == pytest.approx(0.99997, abs=2e-5)
     assert items.by_instance(" a2 ") is items.by_id(2)
 
 
@@ -92,3 +93,12 @@ def test_write_and_read_back(tmp_path: Path) -> None:
     assert back.items[0] == items[0]
     # An item without transform is written with the 2015 placeholders.
     assert back.items[1].trans == (0.0, 0.0, 0.0) and back.items[1].rot == (0.0, 0.0, 0.0, 1.0)
+
+
+@pytest.mark.parametrize("name", ["fbm1h", "fbm1w"])
+def test_shipped_lists_are_vanilla_listing_9(name: str) -> None:
+    path = Path(__file__).resolve().parents[3] / "configs" / f"{name}.yaml"
+    items = load_items(path)  # identity placeholders count as transforms: loads for scoring
+    assert items.is_vanilla
+    ids = [i.id for i in items.items]
+    assert ids == list(range(1, len(ids) + 1))
