@@ -67,22 +67,23 @@ def compose(t1: F64, q1: F64, t2: F64, q2: F64) -> tuple[F64, F64]:
 
     With T_a_b the pose of frame b in frame a, ``compose(T_a_b, T_b_c)`` is T_a_c.
     """
-    r1 = Rotation.from_quat(np.asarray(q1, dtype=np.float64))
-    r2 = Rotation.from_quat(np.asarray(q2, dtype=np.float64))
-    t = np.asarray(t1, dtype=np.float64) + r1.apply(np.asarray(t2, dtype=np.float64))
+    # np.array copies: scipy's Rotation refuses read-only inputs such as broadcast views.
+    r1 = Rotation.from_quat(np.array(q1, dtype=np.float64))
+    r2 = Rotation.from_quat(np.array(q2, dtype=np.float64))
+    t = np.array(t1, dtype=np.float64) + r1.apply(np.array(t2, dtype=np.float64))
     return t, (r1 * r2).as_quat()
 
 
 def invert(t: F64, q: F64) -> tuple[F64, F64]:
     """T^-1 for a transform given as translation and quaternion."""
-    r_inv = Rotation.from_quat(np.asarray(q, dtype=np.float64)).inv()
-    return -r_inv.apply(np.asarray(t, dtype=np.float64)), r_inv.as_quat()
+    r_inv = Rotation.from_quat(np.array(q, dtype=np.float64)).inv()
+    return -r_inv.apply(np.array(t, dtype=np.float64)), r_inv.as_quat()
 
 
 def transform_points(t: F64, q: F64, points: F64) -> F64:
     """Apply the transform (t, q) to points (..., 3)."""
-    r = Rotation.from_quat(np.asarray(q, dtype=np.float64))
-    return np.asarray(np.asarray(t) + r.apply(np.asarray(points, dtype=np.float64)))
+    r = Rotation.from_quat(np.array(q, dtype=np.float64))
+    return np.asarray(np.asarray(t) + r.apply(np.array(points, dtype=np.float64)))
 
 
 @dataclass(frozen=True, eq=False)

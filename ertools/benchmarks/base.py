@@ -24,11 +24,21 @@ class BenchmarkResult(Protocol):
         provenance: inputs and parameters.
     """
 
-    name: str
-    warnings: tuple[str, ...]
-    deviations: tuple[str, ...]
-    failures: tuple[str, ...]
-    provenance: Provenance
+    # Read-only properties, so that frozen dataclasses with these fields satisfy the protocol.
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def warnings(self) -> tuple[str, ...]: ...
+
+    @property
+    def deviations(self) -> tuple[str, ...]: ...
+
+    @property
+    def failures(self) -> tuple[str, ...]: ...
+
+    @property
+    def provenance(self) -> Provenance: ...
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-able structure (same nesting as the YAML; run indices as string keys)."""

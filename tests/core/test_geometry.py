@@ -146,3 +146,12 @@ def test_mean_pose_spread() -> None:
     assert m.position_std == pytest.approx(1.0)
     assert float(yaw_from_quat(m.quat_xyzw)) == pytest.approx(0.0, abs=1e-12)
     assert m.angle_std == pytest.approx(0.1, abs=1e-9)
+
+
+def test_compose_accepts_read_only_inputs() -> None:
+    q = np.broadcast_to(quat_from_yaw(math.pi / 2), (3, 4))
+    t = np.broadcast_to(np.array([1.0, 0, 0]), (3, 3))
+    tc, _ = compose(t, q, t, q)
+    np.testing.assert_allclose(tc, np.tile([1.0, 1.0, 0.0], (3, 1)), atol=1e-12)
+    ti, _ = invert(t, q)
+    np.testing.assert_allclose(ti, np.tile([0.0, 1.0, 0.0], (3, 1)), atol=1e-12)
