@@ -1,0 +1,177 @@
+"""``ertools score fbm3w``: outputs, options and every bad input of the issue, in-process."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from fbm3w_kit import Sample
+from fbm3w_synth import one_run
+
+from ertools.cli.main import main
+from ertools.configs.shapes import builtin_shapes
+from ertools.samples.writer import BagWriter
+
+
+def score(*args: str) -> int:
+    return main(["score", "fbm3w", *map(str, args)])
+
+
+def one_line_error(err: str) -> str:
+    lines = [ln for ln in err.splitlines() if ln.startswith("ertools: error:")]
+    assert len(lines) >= 1, err
+    assert "Traceback" not in err
+    return lines[0]
+
+
+def test_default_yaml_and_json(fbm3w_sample: Sample, capsys: pytest.CaptureFixture[str]) -> None:
+    assert score(fbm3w_sample.bag) == 0
+    out = yaml.safe_load(capsys.readouterr().out)
+    assert list(out) == ["best_distance_error", "best_run", "execution_time", "runs_details"]
+    assert out["best_run"] == fbm3w_sample.answers["expected"]["best_run"]
+    assert score(fbm3w_sample.bag, "--format", "json") == 0
+    data = json.loads(capsys.readouterr().out)
+    assert list(data["runs_details"]) == ["0", "1", "2", "3", "4"]
+    assert data["runs_details"]["4"]["status"] == "timeout"
+
+
+def test_sweep_plot_and_notes(
+    fbm3w_sample: Sample, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    plots = tmp_path / "plots"
+    assert score(fbm3w_sample.bag, "--d-min-sweep", "0.0002:0.0008:3", "--plot", plots) == 0
+    err = capsys.readouterr().err
+    assert "d_min [mm]" in err and "0.5000" in err  # the middle value of the sweep, in mm
+    assert "differs from 2015" in err
+    names = sorted(p.name for p in plots.iterdir())
+    assert names == [
+        "fbm3w_d_min_sweep.png",
+        *(f"fbm3w_run{i}.png" for i in range(4)),
+        "fbm3w_runs.png",
+    ]
+
+
+def test_explicit_windows_and_auto_notes(
+    fbm3w_sample: Sample, capsys: pytest.CaptureFixture[str]
+) -> None:
+    runs = [f"--run={s}:{r}:{a}:{b}" for s, r, a, b in fbm3w_sample.windows()]
+    assert score(fbm3w_sample.bag, *runs) == 0
+    out = yaml.safe_load(capsys.readouterr().out)
+    assert [d["run_finding"] for d in out["runs_details"].values()] == ["windows"] * 4
+    assert score(fbm3w_sample.bag, "--runs", "auto") == 0
+    err = capsys.readouterr().err
+    assert "run 0 (line) found at reference" in err
+
+
+def test_bad_runs_fail_alone(fbm3w_sample: Sample, capsys: pytest.CaptureFixture[str]) -> None:
+    good = fbm3w_sample.windows()[0]
+    args = [
+        f"--run={good[0]}:{good[1]}:{good[2]}:{good[3]}",
+        "--run=line:0.1:0.2:0.21",  # before the mocap starts: no sample
+        "--run=line:1.0:1.2:1.8",  # the robot stands still at the reference: zero length
+        f"--run=nope:{good[1]}:{good[2]}:{good[3]}",  # unknown shape
+    ]
+    assert score(fbm3w_sample.bag, *args) == 1
+    captured = capsys.readouterr()
+    out = yaml.safe_load(captured.out)
+    details = out["runs_details"]
+    assert details[0]["status"] == "scored"
+    assert out["best_run"] == 0
+    assert [details[i]["status"] for i in (1, 2, 3)] == ["failed"] * 3
+    assert "0 pose sample(s)" in details[1]["error"]
+    assert "zero length" in details[2]["error"]
+    assert "unknown shape 'nope'" in details[3]["error"]
+    errors = [ln for ln in captured.err.splitlines() if ln.startswith("ertools: error:")]
+    assert len(errors) == 3 and "Traceback" not in captured.err
+
+
+def test_forbidden_shape_expression(
+    fbm3w_sample: Sample, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cfg = tmp_path / "evil.yaml"
+    cfg.write_text(
+        "runs_specifications: [evil, spline, line, spline, line]\n"
+        "shapes:\n  evil: {x: \"__import__('os')\", y: '0'}\n",
+        encoding="utf-8",
+    )
+    assert score(fbm3w_sample.bag, "--config", cfg) == 1
+    captured = capsys.readouterr()
+    out = yaml.safe_load(captured.out)
+    assert out["runs_details"][0]["status"] == "failed"
+    assert "not allowed" in out["runs_details"][0]["error"]
+    assert all(out["runs_details"][i]["status"] == "scored" for i in (1, 2, 3))
+    assert "run 0 (evil)" in one_line_error(captured.err)
+
+
+def test_user_shape_scores_like_the_builtin(
+    fbm3w_sample: Sample, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cfg = tmp_path / "mine.yaml"
+    # the line of Listing 15 written as a user expression must give the same numbers
+    cfg.write_text(
+        "runs_specifications: [myline, spline, line, spline, line]\n"
+        "shapes:\n  myline: {x: '0.15*l', y: '0.045*l'}\n",
+        encoding="utf-8",
+    )
+    assert score(fbm3w_sample.bag, "--config", cfg, "--format", "json") == 0
+    mine = json.loads(capsys.readouterr().out)["runs_details"]["0"]
+    assert score(fbm3w_sample.bag, "--format", "json") == 0
+    builtin = json.loads(capsys.readouterr().out)["runs_details"]["0"]
+    assert mine["distance_error"] == pytest.approx(builtin["distance_error"], abs=1e-15)
+
+
+@pytest.mark.parametrize(
+    ("args", "code", "message"),
+    [
+        (["--topic", "/nope"], 1, "/nope"),
+        (["--d-min-sweep", "a:b"], 2, "START:STOP:N"),
+        (["--d-min-sweep", "0.1:0.2:0"], 2, "between 1 and 500"),
+        (["--d-min", "-1"], 1, ">= 0"),
+        (["--run", "line:1:2"], 1, "SPEC:REF_T:START_T:END_T"),
+        (["--run", "line:1:5:2"], 1, "before START_T"),
+        (["--run", "line:1:2:3", "--runs", "states"], 2, "contradict"),
+        (["--runs", "windows"], 1, "needs --run"),
+    ],
+)
+def test_bad_command_lines(
+    fbm3w_sample: Sample,
+    args: list[str],
+    code: int,
+    message: str,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    assert score(fbm3w_sample.bag, *args) == code
+    assert message in one_line_error(capsys.readouterr().err)
+
+
+def test_bad_files(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert score(tmp_path / "missing.bag") == 1
+    one_line_error(capsys.readouterr().err)
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("runs_specifications: [line\n", encoding="utf-8")
+    mocap_only = _mocap_only_bag(tmp_path / "only.bag")
+    assert score(mocap_only, "--config", bad) == 1
+    assert "malformed" in one_line_error(capsys.readouterr().err)
+    assert score(mocap_only, "--runs", "states") == 1
+    assert "bmbox_state" in one_line_error(capsys.readouterr().err)
+    empty = tmp_path / "empty.bag"
+    with BagWriter(empty, "ros1") as bag:
+        bag.write_string("/chatter", [1_448_020_800_000_000_000], "hello")
+    assert score(empty) == 1
+    assert "no end-effector poses" in one_line_error(capsys.readouterr().err)
+
+
+def _mocap_only_bag(path: Path) -> Path:
+    stream, _ = one_run(builtin_shapes()["line"](np.linspace(0, 1, 200)))
+    with BagWriter(path, "ros1") as bag:
+        bag.write_pose2d(
+            "/fbm3w/robot_at_work/pose2d",
+            stream.t_ns,
+            stream.xyz[:, 0],
+            stream.xyz[:, 1],
+            np.zeros(len(stream)),
+        )
+    return path
