@@ -221,11 +221,9 @@ class Recorder:
             self.open()
         assert self._sock is not None
         opts = self.options
-        self._start_s = time.time()
         t0 = time.monotonic()
         index = 0
-        self._open_file(index)
-        self.ready.set()
+        self.start_file()
         file_t0 = last_flush = last_health = t0
         try:
             while not self.stop_event.is_set():
@@ -250,10 +248,23 @@ class Recorder:
                     continue
                 self.handle_datagram(data, self._clock())
         finally:
-            self._close_file()
+            self.finish()
+        return self.summary()
+
+    def start_file(self) -> Path:
+        """Open the first file (``run`` does; tests feeding ``handle_datagram`` call it)."""
+        self.options.out_dir.mkdir(parents=True, exist_ok=True)
+        self._start_s = time.time()
+        self._open_file(0)
+        self.ready.set()
+        return self.files[-1]
+
+    def finish(self) -> None:
+        """Close the file being written and the socket."""
+        self._close_file()
+        if self._sock is not None:
             self._sock.close()
             self._sock = None
-        return self.summary()
 
     def summary(self) -> RecordSummary:
         s = self.stats
