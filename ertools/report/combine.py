@@ -134,7 +134,8 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
     flat: list[dict[str, Any]] = []
     for bench in sorted(by_benchmark):
         group = sorted(by_benchmark[bench], key=lambda e: (e.team, e.inputs, str(e.source)))
-        keys = list(dict.fromkeys(k for e in group for k in e.headline))
+        # The benchmark is the table's title, not a column.
+        keys = list(dict.fromkeys(k for e in group for k in e.headline if k != "benchmark"))
         rows = []
         links = []
         for e in group:
