@@ -256,19 +256,19 @@ def measure_ground_truth(
     warnings: list[str] = []
     if options.method == "window":
         start = max(search_start_ns, goal_ns - round(options.max_window_s * NS_PER_S))
-        end = goal_ns
+        end = check = goal_ns
+    elif options.method == "result":
+        if result_ns is None:
+            raise GroundTruthError("no result time for the 2015 after-result lookup")
+        # tf's latest sample ~1 s after the result; tracking must hold at the result.
+        check = result_ns
+        start, end = result_ns - max_gap, result_ns + RESULT_LOOKUP_DELAY_NS
     else:
-        if options.method == "result":
-            if result_ns is None:
-                raise GroundTruthError("no result time for the 2015 after-result lookup")
-            end = result_ns + RESULT_LOOKUP_DELAY_NS
-        else:
-            end = goal_ns
-        # A single lookup: the bodies must be tracked just before it.
-        start = end - max_gap
+        start, end = goal_ns - max_gap, goal_ns
+        check = goal_ns
     for stream, name in ((origin, "origin"), (board, "ref_board")):
         # Both bodies must be seen at the lookup; before it the stationary tail stops at gaps.
-        problem = tracked_problem(stream, name, end, max_gap, t0_ns)
+        problem = tracked_problem(stream, name, check, max_gap, t0_ns)
         if problem:
             raise GroundTruthError(problem)
     rel = board_in_table(
