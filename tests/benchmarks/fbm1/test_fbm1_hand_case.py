@@ -123,3 +123,32 @@ def test_hand_case_through_a_bag_and_the_cli(
     assert data["logged_2015_score"] == {"class_accuracy": 0.5}
     assert "pose" in err and "  1 1:a1" in err  # the per-run table is on stderr
     assert ANSWER_S < 6.1
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_moving_the_whole_world_changes_nothing(seed: int) -> None:
+    """A rigid motion of the mocap world (both bodies) leaves every table-frame number as is."""
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    from ertools.streams import PoseStream
+
+    rng = np.random.default_rng(seed)
+    rot = Rotation.from_rotvec(rng.normal(0, 1.0, 3))
+    shift = rng.uniform(-5, 5, 3)
+
+    def moved(s: PoseStream) -> PoseStream:
+        r = rot * Rotation.from_quat(s.quat_xyzw)
+        return PoseStream(s.t_ns, rot.apply(s.xyz) + shift, r.as_quat(), s.frame_id)
+
+    streams = state_streams(RUNS)
+    found = find_runs(streams[Machine.BMBOX], streams[Machine.REFBOX], streams[Machine.CLIENT])
+    origin, board = bodies(RUNS)
+    base = score_fbm1(origin, board, found, _items())  # type: ignore[arg-type]
+    other = score_fbm1(moved(origin), moved(board), found, _items())  # type: ignore[arg-type]
+    for a, b in zip(base.runs, other.runs, strict=True):
+        # Float rounding through one more rotation: 1e-9 m / deg.
+        assert (b.gt.x, b.gt.y, b.gt.yaw_deg) == pytest.approx(
+            (a.gt.x, a.gt.y, a.gt.yaw_deg), abs=1e-9
+        )
+    assert other.totals.pose_score == pytest.approx(base.totals.pose_score, abs=1e-9)
