@@ -130,7 +130,8 @@ def _measure(rel: PoseStream, item: Item, win: Interval, t0_ns: int) -> tuple[It
         end_s=(part.end_ns - t0_ns) / NS_PER_S,
     )
     trans = (float(mean.xyz[0]), float(mean.xyz[1]), float(mean.xyz[2]))
-    q = mean.quat_xyzw
+    # q and -q are the same rotation: write the one with w >= 0, as people expect to read.
+    q = -mean.quat_xyzw if mean.quat_xyzw[3] < 0 else mean.quat_xyzw
     rot = (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
     warnings = []
     if spread.position_m > 0.002 or spread.angle_deg > 0.5:
