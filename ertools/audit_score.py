@@ -252,9 +252,11 @@ def explain(
     benchmark: str,
     parameters: tuple[tuple[str, str], ...],
     deviations: tuple[str, ...],
+    warnings: tuple[str, ...] = (),
 ) -> str:
     """Why ``live`` and ``recomputed`` differ at ``key``: rules, recognised patterns,
-    matching deviations from 2015 and the relevant parameters."""
+    matching deviations from 2015, the scorer's warnings about the same parameters (d_min
+    below the noise...) and the relevant parameter values."""
     leaf = key.rsplit(".", 1)[-1].lower()
     parts: list[str] = []
     wanted: list[str] = []
@@ -274,6 +276,9 @@ def explain(
     for dev in deviations:
         if words & set(_WORDS.findall(dev.lower())):
             parts.append(f"ertools differs from 2015: {dev}")
+    for warning in warnings:
+        if any(frag in warning.lower() for frag in wanted if len(frag) > 3):
+            parts.append(f"the scorer warned: {warning}")
     shown = [
         f"{name}={value}"
         for name, value in parameters
@@ -369,7 +374,15 @@ def compare_scores(
         expl = (
             ""
             if same
-            else explain(key, lv, rv, benchmark=result.name, parameters=params, deviations=devs)
+            else explain(
+                key,
+                lv,
+                rv,
+                benchmark=result.name,
+                parameters=params,
+                deviations=devs,
+                warnings=tuple(result.warnings),
+            )
         )
         lines.append(ScoreLine(key, lv, rv, diff, "same" if same else "differs", expl))
     return ScoreComparison(

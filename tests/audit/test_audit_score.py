@@ -90,6 +90,7 @@ def test_fbm3w_distance_error_names_d_min() -> None:
         "fbm3w",
         {"best_distance_error": 0.0102, "runs_details": {"0": {"distance_error": 0.0102}}},
         provenance=Provenance(parameters=(("d_min", "0.001 m"), ("topic", "/fbm3w/x/pose2d"))),
+        warnings=("d_min 1 mm is below the noise", "an unrelated warning"),
     )
     cmp = compare_scores(
         {"best_distance_error": 0.0131, "runs_details": {0: {"distance_error": 0.0131}}}, rec
@@ -97,6 +98,8 @@ def test_fbm3w_distance_error_names_d_min() -> None:
     line = cmp.differences[1]
     assert line.key == "runs_details.0.distance_error"
     assert "d_min=0.001 m" in line.explanation and "topic=/fbm3w/x/pose2d" in line.explanation
+    assert "the scorer warned: d_min 1 mm is below the noise" in line.explanation
+    assert "unrelated" not in line.explanation
     assert math.isclose(line.difference or 0.0, -0.0029, abs_tol=1e-12)
 
 
@@ -121,3 +124,23 @@ def test_attach_to_audit() -> None:
     assert audit.findings == 1
     assert audit.tables()["score_comparison"][0]["live"] == 0.25
     assert audit.to_dict()["recomputed"]["position_accuracy"] == 0.2
+
+
+def test_top_level_segments_are_renested() -> None:
+    # The 2015 FBM2 node wrote segments_details at the top level, numbered from 1.
+    live = {"segments_details": {1: {"dinstance_error": 0.1}, 2: {"dinstance_error": 0.3}}}
+    cmp = compare_scores(live, _fbm2h(0.4, 0.1))
+    status = {line.key: line.status for line in cmp.lines}
+    assert status["details.segments_details.0.dinstance_error"] == "same"
+    assert status["details.segments_details.1.dinstance_error"] == "same"
+    assert any("top level" in n for n in cmp.notes) and any("from 1" in n for n in cmp.notes)
+
+
+def test_no_common_key_shows_the_payload_beside_the_headline() -> None:
+    cmp = compare_scores({"score": "see the answers file"}, _fbm2h(0.4, 0.1))
+    assert [(x.key, x.status) for x in cmp.lines] == [
+        ("position_accuracy", "only recomputed"),
+        ("orientation_accuracy", "only recomputed"),
+        ("score", "only live"),
+    ]
+    assert any("no key in common" in n for n in cmp.notes)
