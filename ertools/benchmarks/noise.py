@@ -258,11 +258,15 @@ def noise_from_stream(
     warnings: list[str] = []
     if result.distances.size == 0:
         warnings.append("no two consecutive measurements differ: epsilon is undefined")
-    elif not stationary and result.percentiles["99"] > 0.005:
-        warnings.append(
-            f"1% of the steps are longer than {result.percentiles['99'] * 1000:.1f} mm: the "
-            "marker set probably moved; use --stationary auto to keep only the still phases"
-        )
+    elif not stationary:
+        still = stationary_phases(poses.t_ns, xy)
+        covered = sum(p.last - p.first for p in still) / max(len(poses) - 1, 1)
+        if covered < 0.9:
+            warnings.append(
+                f"the marker set moved during {1 - covered:.0%} of the recording (speed above "
+                f"{DEFAULT_STILL_SPEED * 1000:g} mm/s): the statistics include motion; use "
+                "--stationary auto to keep only the still phases"
+            )
     return replace(
         result,
         warnings=tuple(warnings),

@@ -101,8 +101,10 @@ def test_stationary_auto_on_a_benchmark_bag(
     assert data["epsilon"] == pytest.approx(noise["epsilon"], abs=tol)
     # the whole bag (robot moving) would be far off: the motion dominates the steps
     assert main(["noise", str(bag), "--format", "json"]) == 0
-    whole = json.loads(capsys.readouterr().out)
+    captured = capsys.readouterr()
+    whole = json.loads(captured.out)
     assert whole["epsilon"] > 2 * noise["epsilon"]
+    assert "use --stationary auto" in captured.err
 
 
 def test_bad_inputs(
