@@ -162,17 +162,24 @@ def _coarse_scan(
     grid_ok = ((t[hi] - t[hi - 1]) <= max_gap_ns) | (t[hi] == grid_t)  # exact hits are fine
     del hi, grid_t
     base = np.rint((robot_t - t[0]) / step).astype(np.int64)
+    shifts = np.rint(offsets / step).astype(np.int64)
+    n = len(grid_ok)
+    pos = robot_xyz.astype(np.float32)
     costs = np.full(len(offsets), np.inf)
     counts = np.zeros(len(offsets), dtype=np.int64)
-    n = len(grid_ok)
-    for i, off in enumerate(offsets):  # a loop over offsets, each vectorised over poses
-        idx = base + round(int(off) / step)
-        ok = (idx >= 0) & (idx < n)
-        ok[ok] = grid_ok[idx[ok]]
-        if ok.any():
-            d = robot_xyz[ok] - grid_xyz[idx[ok]]
-            costs[i] = float(np.sqrt(np.einsum("ij,ij->i", d, d)).mean())
-            counts[i] = int(ok.sum())
+    block = max(1, 200_000 // max(len(base), 1))  # ~2.4 MB of float32 per block
+    for lo in range(0, len(offsets), block):  # blocks of offsets x all poses, vectorised
+        idx = shifts[lo : lo + block, None] + base[None, :]
+        inside = (idx >= 0) & (idx < n)
+        idx = np.clip(idx, 0, n - 1)
+        ok = inside & grid_ok[idx]
+        d = grid_xyz[idx] - pos[None, :, :]
+        dist = np.sqrt(np.einsum("bij,bij->bi", d, d))
+        cnt = ok.sum(axis=1)
+        total = np.where(ok, dist, 0.0).sum(axis=1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            costs[lo : lo + block] = np.where(cnt > 0, total / np.maximum(cnt, 1), np.inf)
+        counts[lo : lo + block] = cnt
     enough = counts >= max(MIN_POSES, int(0.5 * counts.max()))
     return np.where(enough, costs, np.inf)
 
