@@ -446,6 +446,7 @@ def build_timeline(
         path = str(s.path)
         if s.start_ns is None or s.end_ns is None or s.message_count == 0:
             broken.append(BagEntry(path, s.format, None, None, "unreadable", logger_name(path)))
+            problems[path].extend(s.problems)
             problems[path].append("no messages: no start or end time")
             continue
         base.append(
