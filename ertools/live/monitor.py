@@ -165,7 +165,7 @@ class Monitor:
         assert f.tail is not None
         window_ns = int(self.options.interval_s * 1e9)
         suffix = self.options.rate_topic_suffix
-        for m in f.tail.poll():
+        for m in f.tail.poll(window_ns=window_ns):
             if m.topic.endswith(suffix):
                 f.times.setdefault(m.topic, deque()).append(m.log_time_ns)
         if f.tail.corrupt:

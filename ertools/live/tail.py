@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import struct
 from dataclasses import dataclass, field
-from io import BytesIO
 from pathlib import Path
 
 MAGIC = b"\x89MCAP0\r\n"
@@ -45,9 +44,35 @@ class TailMessage:
     data: bytes
 
 
+_U16 = struct.Struct("<H")
+_U32 = struct.Struct("<I")
+_U64 = struct.Struct("<Q")
+_CHUNK_HEAD = struct.Struct("<QQQI")  # start time, end time, uncompressed size, crc
+_MESSAGE_HEAD = struct.Struct("<HIQQ")  # channel id, sequence, log time, publish time
+
+
+def _decompress(compression: str, data: bytes, size: int) -> bytes:
+    if compression == "zstd":
+        import zstandard
+
+        return bytes(zstandard.ZstdDecompressor().decompress(data, max_output_size=size))
+    if compression == "lz4":
+        import lz4.frame
+
+        return bytes(lz4.frame.decompress(data))
+    if compression == "":
+        return data
+    raise ValueError(f"unsupported chunk compression {compression!r}")
+
+
 @dataclass
 class McapTail:
-    """Incremental reader of one MCAP file (see the module doc)."""
+    """Incremental reader of one MCAP file (see the module doc).
+
+    Records are walked with ``struct`` directly: a monitor that starts next to an hour-long
+    file reads its hundreds of thousands of messages once, and building an object per message
+    (what ``mcap``'s readers do) would take many seconds.
+    """
 
     path: Path
     offset: int = 0
@@ -55,12 +80,14 @@ class McapTail:
     finished: bool = False
     corrupt: str = ""
 
-    def poll(self, *, keep_data: bool = False) -> list[TailMessage]:
-        """Messages of the records completed since the last poll (data kept on request)."""
-        from mcap.data_stream import ReadDataStream
-        from mcap.records import Channel, Chunk, Message
-        from mcap.stream_reader import breakup_chunk
+    def poll(self, *, keep_data: bool = False, window_ns: int | None = None) -> list[TailMessage]:
+        """Messages of the records completed since the last poll.
 
+        Args:
+            keep_data: keep each message's serialized data (else ``b""``).
+            window_ns: only return messages within this much log time of the newest chunk
+                among the new records (the monitor's rate window); channels are always read.
+        """
         out: list[TailMessage] = []
         if self.finished or self.corrupt:
             return out
@@ -75,45 +102,85 @@ class McapTail:
                 self.corrupt = "not an MCAP file (bad magic)"
                 return out
             pos = len(MAGIC)
+        # Pass 1: complete records only, and the newest chunk end time among them.
+        spans: list[tuple[int, int, int]] = []
+        newest = 0
         while pos + _RECORD_HEAD.size <= len(data):
             opcode, length = _RECORD_HEAD.unpack_from(data, pos)
             if length > MAX_RECORD:
                 self.corrupt = f"record of {length} bytes at offset {self.offset + pos}"
                 break
-            end = pos + _RECORD_HEAD.size + length
-            if end > len(data):
+            body = pos + _RECORD_HEAD.size
+            if body + length > len(data):
                 break  # still being written (or cut short by a crash)
-            content = data[pos + _RECORD_HEAD.size : end]
-            records: list[object] = []
-            if opcode == OP_CHUNK:
-                try:
-                    chunk = Chunk.read(ReadDataStream(BytesIO(content)))
-                    records = list(breakup_chunk(chunk))
-                except Exception as err:  # a corrupt chunk: stop here, say where
-                    self.corrupt = f"unreadable chunk at offset {self.offset + pos}: {err}"
-                    break
-            elif opcode == OP_CHANNEL:
-                records = [Channel.read(ReadDataStream(BytesIO(content)))]
-            elif opcode == OP_MESSAGE:
-                records = [Message.read(ReadDataStream(BytesIO(content)), length)]
-            elif opcode == OP_FOOTER:
+            if opcode == OP_CHUNK and length >= _CHUNK_HEAD.size:
+                newest = max(newest, _CHUNK_HEAD.unpack_from(data, body)[1])
+            spans.append((opcode, body, body + length))
+            pos = body + length
+            if opcode == OP_FOOTER:
                 self.finished = True
-            for rec in records:
-                if isinstance(rec, Channel):
-                    self.channels[rec.id] = rec.topic
-                elif isinstance(rec, Message):
-                    out.append(
-                        TailMessage(
-                            self.channels.get(rec.channel_id, f"<channel {rec.channel_id}>"),
-                            int(rec.log_time),
-                            bytes(rec.data) if keep_data else b"",
-                        )
-                    )
-            pos = end
-            if self.finished:
+                break
+        cutoff = newest - window_ns if window_ns is not None else None
+        # Pass 2: channels and messages.
+        for opcode, body, end in spans:
+            try:
+                if opcode == OP_CHUNK:
+                    self._chunk(data, body, cutoff, keep_data, out)
+                elif opcode == OP_CHANNEL:
+                    self._channel(data, body)
+                elif opcode == OP_MESSAGE:
+                    self._message(data, body, end, cutoff, keep_data, out)
+            except (struct.error, ValueError, UnicodeDecodeError) as err:
+                self.corrupt = f"unreadable record at offset {self.offset + body - 9}: {err}"
+                pos = body - _RECORD_HEAD.size
                 break
         self.offset += pos
         return out
+
+    def _channel(self, data: bytes, pos: int) -> None:
+        (cid,) = _U16.unpack_from(data, pos)
+        (n,) = _U32.unpack_from(data, pos + 4)
+        self.channels[cid] = data[pos + 8 : pos + 8 + n].decode("utf-8")
+
+    def _message(
+        self,
+        data: bytes,
+        pos: int,
+        end: int,
+        cutoff: int | None,
+        keep: bool,
+        out: list[TailMessage],
+    ) -> None:
+        cid, _seq, log_time, _pub = _MESSAGE_HEAD.unpack_from(data, pos)
+        if cutoff is not None and log_time < cutoff:
+            return
+        topic = self.channels.get(cid, f"<channel {cid}>")
+        payload = data[pos + _MESSAGE_HEAD.size : end] if keep else b""
+        out.append(TailMessage(topic, int(log_time), payload))
+
+    def _chunk(
+        self, data: bytes, pos: int, cutoff: int | None, keep: bool, out: list[TailMessage]
+    ) -> None:
+        _start, end_time, size, _crc = _CHUNK_HEAD.unpack_from(data, pos)
+        p = pos + _CHUNK_HEAD.size
+        (n,) = _U32.unpack_from(data, p)
+        compression = data[p + 4 : p + 4 + n].decode("utf-8")
+        p += 4 + n
+        (length,) = _U64.unpack_from(data, p)
+        p += 8
+        records = _decompress(compression, data[p : p + length], size)
+        skip_messages = cutoff is not None and end_time < cutoff
+        q = 0
+        while q + _RECORD_HEAD.size <= len(records):
+            opcode, rlen = _RECORD_HEAD.unpack_from(records, q)
+            body = q + _RECORD_HEAD.size
+            if body + rlen > len(records):
+                raise ValueError("record overruns its chunk")
+            if opcode == OP_CHANNEL:
+                self._channel(records, body)
+            elif opcode == OP_MESSAGE and not skip_messages:
+                self._message(records, body, body + rlen, cutoff, keep, out)
+            q = body + rlen
 
 
 @dataclass(frozen=True)
