@@ -7,6 +7,7 @@ the 2015 robots answered in degrees, although the seed's 7.1 says radians).
 
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -48,8 +49,12 @@ def answer_from_mapping(data: Any, where: str, source: str) -> Answer:
     numbers: dict[str, float] = {}
     for key in ("x", "y", "theta"):
         value = data[key]
+        if isinstance(value, str):
+            # YAML 1.1 reads "1e-3" (no dot) as text; a robot meant a number.
+            with contextlib.suppress(ValueError):
+                value = float(value)
         if isinstance(value, bool) or not isinstance(value, int | float):
-            raise ScoringError(f"{where}: answer {key}={value!r} is not a number ({source})")
+            raise ScoringError(f"{where}: answer {key}={data[key]!r} is not a number ({source})")
         if not math.isfinite(value):
             raise ScoringError(f"{where}: answer {key} is {value} ({source})")
         numbers[key] = float(value)

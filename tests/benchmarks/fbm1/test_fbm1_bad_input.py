@@ -194,3 +194,12 @@ def test_bad_item_list_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture
     out, err = capsys.readouterr()
     assert code == 1 and out == ""
     assert err.count("\n") == 1 and "missing 'trans'" in err and "acquire items" in err
+
+
+def test_numbers_yaml_reads_as_text_are_accepted() -> None:
+    from ertools.benchmarks.fbm1_answers import parse_answer_payload
+
+    a = parse_answer_payload(
+        "{item_class: a, item_instance: a1, x: 4e-1, y: '0.2', theta: 1e1}", "run 1"
+    )
+    assert (a.x, a.y, a.theta_deg) == (0.4, 0.2, 10.0)
