@@ -18,7 +18,7 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, cast
+from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Rows, jsonable
 
@@ -474,19 +474,16 @@ def rescore(
     if benchmark == "fbm2h":
         from ertools.benchmarks.fbm2h import Fbm2hOptions, score_fbm2h
 
-        result = cast(  # frozen results vs the protocol's settable attributes
-            "BenchmarkResult",
-            score_fbm2h(
-                plist,
-                Fbm2hOptions(
-                    goal=inputs.goal,
-                    transform=inputs.transform,
-                    team=inputs.team,
-                    transforms_dir=inputs.transforms,
-                    topic=inputs.topic,
-                    hits=inputs.hits,
-                    namespace=benchmark,
-                ),
+        result = score_fbm2h(
+            plist,
+            Fbm2hOptions(
+                goal=inputs.goal,
+                transform=inputs.transform,
+                team=inputs.team,
+                transforms_dir=inputs.transforms,
+                topic=inputs.topic,
+                hits=inputs.hits,
+                namespace=benchmark,
             ),
         )
     elif benchmark in ("fbm1h", "fbm1w"):
@@ -494,14 +491,11 @@ def rescore(
 
         if inputs.items is None:
             raise ConfigError(f"recomputing {benchmark} needs the item list: give --items FILE")
-        result = cast(
-            "BenchmarkResult",
-            score_fbm1_bag(
-                plist,
-                inputs.items,
-                options=Fbm1Options(benchmark=benchmark),
-                results_path=inputs.results,
-            ),
+        result = score_fbm1_bag(
+            plist,
+            inputs.items,
+            options=Fbm1Options(benchmark=benchmark),
+            results_path=inputs.results,
         )
     else:
         result = _rescore_fbm3w(plist, inputs)
@@ -514,7 +508,7 @@ def _rescore_fbm3w(paths: list[Path], inputs: ScoreInputs) -> BenchmarkResult:
 
     config = load_fbm3w_config(inputs.config)
     options = Fbm3wOptions(d_min=inputs.d_min, topic=inputs.topic)
-    return cast("BenchmarkResult", score_fbm3w(paths, config, options))
+    return score_fbm3w(paths, config, options)
 
 
 # --------------------------------------------------------------------------------------------

@@ -95,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
     for line in notes:
         note(f"warning: {line}")
     if args.format != "text":
-        code = emit_result(audit, args, bags)  # type: ignore[arg-type]
+        code = emit_result(audit, args, bags)
     else:
         write_text(audit.to_text(), args.output)
         for deviation in audit.deviations:
@@ -103,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
         if args.report is not None:
             from ertools.report.folder import write_report
 
-            index = write_report(audit, args.report, inputs=bags, argv=sys.argv)  # type: ignore[arg-type]
+            index = write_report(audit, args.report, inputs=bags, argv=sys.argv)
             note(f"wrote report {index}")
         for failure in audit.failures:
             note(f"error: {failure}")
