@@ -17,7 +17,7 @@ import logging
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.fbm1_answers import (
     Answer,
@@ -44,6 +44,9 @@ from ertools.configs.items import Item, ItemList
 from ertools.errors import ConfigError, ScoringError, SegmentationError
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import NS_PER_S
+
+if TYPE_CHECKING:
+    from ertools.io import PoseSource
 
 log = logging.getLogger("ertools.benchmarks.fbm1")
 
@@ -330,13 +333,13 @@ def _parse_logged(payload: str | None) -> dict[str, Any] | None:
 class BodySources:
     """Where the table and board poses come from (the 2015 topics when None)."""
 
-    origin: Any = None  # ertools.io.PoseSource
-    board: Any = None
+    origin: PoseSource | None = None
+    board: PoseSource | None = None
 
 
 def read_body(
     paths: Sequence[Path],
-    source: Any,
+    source: PoseSource | None,
     default_topic: str,
     frame: str,
     window: tuple[int | None, int | None] = (None, None),

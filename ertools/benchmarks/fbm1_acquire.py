@@ -15,6 +15,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -24,6 +25,9 @@ from ertools.errors import SegmentationError
 from ertools.geometry import invert, mean_pose
 from ertools.streams import Interval, PoseStream, Provenance
 from ertools.timeutil import NS_PER_S
+
+if TYPE_CHECKING:
+    from ertools.io import PoseSource
 
 # The look-ahead over which a still board must not move (long against mocap noise, short
 # against a referee's hand).
@@ -222,7 +226,7 @@ def acquire_items_bag(
     namespace: str = "fbm1h",
     windows_s: Sequence[tuple[float, float]] | None = None,
     options: AcquireOptions | None = None,
-    sources: tuple[object, object] | None = None,
+    sources: tuple[PoseSource | None, PoseSource | None] | None = None,
 ) -> AcquireResult:
     """Read a log and a vanilla list, then :func:`acquire_items`.
 
