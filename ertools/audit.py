@@ -95,8 +95,9 @@ class Silence:
     machine: Machine
     topic: str
     start_ns: int  # the last message before the gap
-    end_ns: int  # the first message after it
+    end_ns: int  # the first message after it (the end of the log when ``trailing``)
     state_name: str  # the state published before the gap
+    trailing: bool = False  # the topic stopped before the log ended, not in END
 
     @property
     def duration_ns(self) -> int:
@@ -210,6 +211,7 @@ class Audit:
                     "to": self._rel(s.end_ns),
                     "duration": ns_to_s(s.duration_ns),
                     "state": s.state_name,
+                    "until_log_end": s.trailing,
                 }
                 for s in self.silences
             ],
@@ -284,6 +286,7 @@ class Audit:
             lines.append(
                 f"  SILENCE {self._rel(g.start_ns):9.3f} s  {g.topic or g.machine.value} "
                 f"{ns_to_s(g.duration_ns):.2f} s in {g.state_name}"
+                + (" (never resumed before the log ended)" if g.trailing else "")
             )
         lines.append(f"runs: {len(self.runs)}")
         for r in self.runs:
@@ -366,6 +369,7 @@ class Audit:
                     "to": self._rel(s.end_ns),
                     "duration": ns_to_s(s.duration_ns),
                     "state": s.state_name,
+                    "until_log_end": s.trailing,
                 }
                 for s in self.silences
             ],
@@ -447,7 +451,9 @@ def audit_states(
 
     bm = changes.get(Machine.BMBOX)
     illegal, checked = _check_transitions(bm) if bm is not None else ((), 0)
-    silences = tuple(s for m, st in nonempty.items() for s in _silences(m, st, max_silence_ns))
+    silences = tuple(
+        s for m, st in nonempty.items() for s in _silences(m, st, max_silence_ns, end_ns)
+    )
     silences = tuple(sorted(silences, key=lambda s: s.start_ns))
     runs = _runs(bm, changes.get(Machine.REFBOX), changes.get(Machine.CLIENT))
     early = _early_ends(changes.get(Machine.REFBOX), bm, runs)
@@ -470,7 +476,7 @@ def audit_states(
     for s in silences:
         warnings.append(
             f"{s.topic or s.machine.value} silent for {ns_to_s(s.duration_ns):.2f} s "
-            f"(in {s.state_name})"
+            f"(in {s.state_name})" + (" until the end of the log" if s.trailing else "")
         )
     for e in early:
         where = f"during run {e.run}" if e.run is not None else f"in BmBox {e.bmbox_state}"
@@ -555,11 +561,10 @@ def _check_transitions(bm: StateStream) -> tuple[tuple[IllegalTransition, ...], 
     return tuple(out), checked
 
 
-def _silences(machine: Machine, stream: StateStream, max_ns: int) -> list[Silence]:
-    if len(stream) < 2:
-        return []
-    gaps = np.flatnonzero(np.diff(stream.t_ns) > max_ns)
-    return [
+def _silences(machine: Machine, stream: StateStream, max_ns: int, log_end_ns: int) -> list[Silence]:
+    """Heartbeat gaps, and a topic that fell silent before the log's end without reaching END
+    (a node that died: the 2015 machines stopped publishing only after END)."""
+    out = [
         Silence(
             machine=machine,
             topic=stream.topic,
@@ -567,8 +572,13 @@ def _silences(machine: Machine, stream: StateStream, max_ns: int) -> list[Silenc
             end_ns=int(stream.t_ns[i + 1]),
             state_name=state_name(machine, int(stream.state[i])),
         )
-        for i in gaps
+        for i in np.flatnonzero(np.diff(stream.t_ns) > max_ns)
     ]
+    last = int(stream.t_ns[-1])
+    final = state_name(machine, int(stream.state[-1]))
+    if log_end_ns - last > max_ns and final != "END":
+        out.append(Silence(machine, stream.topic, last, log_end_ns, final, trailing=True))
+    return out
 
 
 def _first_in(ch: StateStream | None, state: int, lo: int, hi: int) -> tuple[str, int] | None:

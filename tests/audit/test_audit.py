@@ -231,3 +231,21 @@ def test_unparsable_live_score_is_kept_as_text() -> None:
     audit = audit_states(bm)
     assert audit.live_score is None and audit.live_score_text == "a: [unclosed"
     assert any("not YAML" in w for w in audit.warnings)
+
+
+def test_topic_that_stops_before_the_log_ends() -> None:
+    # The Client's node dies at 12.0 s in EXECUTING_GOAL; the BmBox goes on until 20.0 s.
+    bm = heartbeat(Machine.BMBOX, BMBOX, 20.0)
+    cl = heartbeat(Machine.CLIENT, CLIENT[:-1], 12.0)
+    audit = audit_states(bm, None, cl)
+    (s,) = audit.silences
+    assert (s.machine, s.start_ns, s.end_ns, s.trailing) == (
+        Machine.CLIENT,
+        _ns(12.0),
+        _ns(20.0),
+        True,
+    )
+    assert s.state_name == "EXECUTING_GOAL"
+    # A machine silent after END is not a silence: the 2015 nodes stopped publishing then.
+    cl_end = heartbeat(Machine.CLIENT, [*CLIENT[:-1], (12.0, C.END, "")], 12.0)
+    assert audit_states(bm, None, cl_end).silences == ()
