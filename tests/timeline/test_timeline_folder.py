@@ -229,3 +229,32 @@ def test_clock_checked_once_per_recording_unless_off(monkeypatch: pytest.MonkeyP
         "log_b_2015-11-20-10-00-00_2.bag",
     ]
     assert len(checks) == 4
+
+
+@pytest.mark.parametrize("fmt", ["mcap", "rosbag2-mcap", "rosbag2-sqlite3"])
+def test_other_formats_are_found_and_classified(fmt: str, tmp_path: Path) -> None:
+    import numpy as np
+
+    from ertools.geometry import quat_from_yaw
+    from ertools.samples.writer import BagWriter
+
+    t0 = 1_448_013_600 * 1_000_000_000
+    t = t0 + np.arange(240, dtype=np.int64) * 8_333_333
+    name = "gt.mcap" if fmt == "mcap" else "gt_ros2"
+    sub = tmp_path / "logs"
+    sub.mkdir()
+    with BagWriter(sub / name, fmt) as bag:  # type: ignore[arg-type]
+        bag.write_pose_stamped(
+            "/fbm3w/robot_at_work/pose",
+            t + 300_000,
+            t,
+            "world",
+            np.zeros((240, 3)),
+            quat_from_yaw(np.zeros(240)),
+        )
+    tl = scan([tmp_path])
+    (b,) = tl.bags
+    assert Path(b.path).name == name
+    assert (b.format, b.kind) == (fmt, "gt")
+    assert (b.start_ns, b.end_ns) == (int(t[0]) + 300_000, int(t[-1]) + 300_000)
+    assert b.problems == ()  # 0.3 ms between stamp and record: no clock problem

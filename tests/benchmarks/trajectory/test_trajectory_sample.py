@@ -185,3 +185,34 @@ def test_overlapping_gt_files(
     # The bridge fills the split gap: fewer gaps than with the two split files alone.
     assert out["gaps"] < robotlog["answers"]["expected"]["offset_true"]["linear"]["gaps"]
     assert len(out["gt_files"]) == 4
+
+
+def test_robot_record_time(
+    robotlog: dict[str, Any], robot_cli: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The generator's robot recorder stores each pose 2 ms after its stamp (robotlog.py).
+    assert (
+        main([*robot_cli, "--robot-time", "record", "--offset", "-0.35", "--format", "json"]) == 0
+    )
+    out = json.loads(capsys.readouterr().out)
+    rt, rxyz, rq = read_back(robotlog["robot"], ROBOT_TOPIC)
+    gt_t: list[int] = []
+    gt_x: list[list[float]] = []
+    gt_q: list[list[float]] = []
+    for f in robotlog["gt"]:
+        t, x, q = read_back(f, GT_TOPIC)
+        gt_t += t
+        gt_x += x
+        gt_q += q
+    exp = expected_scores(
+        [t + 2_000_000 for t in rt],
+        rxyz,
+        [yaw(q) for q in rq],
+        gt_t,
+        gt_x,
+        gt_q,
+        "linear",
+        -350_000_000,
+        100_000_000,
+    )
+    check(out, exp, robotlog["answers"])
