@@ -414,10 +414,11 @@ def score_fbm1_bag(
         states.bmbox, states.refbox, states.client, benchmark=ns, items_order=items_order
     )
     if states.client is None and results is None:
-        found = RunsFound(
-            found.runs,
-            (*found.warnings, f"no /{ns}/client_state: no answers in the log; give --results"),
-            found.logged_score,
+        # Scoring every run as unanswered would be a silent wrong score.
+        raise SegmentationError(
+            f"no /{ns}/client_state in the log: the robot's answers are unknown; "
+            "give them with --results FILE",
+            path=plist[0],
         )
     t0 = min(summary(p).start_ns for p in plist)
     # Read the bodies only around the runs (windowed reads touch only those chunks).

@@ -169,18 +169,23 @@ def write_bag(
     namespace: str = "fbm1h",
     drop: Sequence[tuple[str, float, float]] = (),
     omit: Sequence[str] = (),
+    no_client: bool = False,
 ) -> Path:
     """A ROS1 bag of the runs: states with 10 Hz heartbeats, both bodies on their topics.
 
     drop: (body, from_s, to_s) windows with no mocap message of that body (tracking lost).
-    omit: bodies not recorded at all.
+    omit: bodies not recorded at all. no_client: no /<ns>/client_state topic.
     """
     from ertools.samples.mocap import MocapNoise, publish_mocap, simulate_mocap
     from ertools.samples.statemachine import Transition, publish_states
     from ertools.samples.writer import BagWriter
 
     origin, board = bodies(runs, table)
-    tr = [Transition(ns(s), m, st, p) for m, s, st, p in transitions(runs)]
+    tr = [
+        Transition(ns(s), m, st, p)
+        for m, s, st, p in transitions(runs)
+        if not (no_client and m is Machine.CLIENT)
+    ]
     no_noise = MocapNoise(
         sigma_m=0.0, sigma_rad=0.0, header_jitter_ns=0, latency_jitter_ns=0, latency_spike_prob=0
     )

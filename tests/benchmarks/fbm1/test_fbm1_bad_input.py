@@ -203,3 +203,17 @@ def test_numbers_yaml_reads_as_text_are_accepted() -> None:
         "{item_class: a, item_instance: a1, x: 4e-1, y: '0.2', theta: 1e1}", "run 1"
     )
     assert (a.x, a.y, a.theta_deg) == (0.4, 0.2, 10.0)
+
+
+def test_no_client_topic_needs_results(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bag = write_bag(tmp_path / "noclient.bag", [GOOD], no_client=True)
+    code, out, err = _cli(tmp_path, capsys, bag)
+    assert code == 1 and out == "" and err.count("\n") == 1
+    assert "no /fbm1h/client_state" in err and "--results" in err
+    results = tmp_path / "r.yaml"
+    results.write_text(
+        "- {run: 1, item_class: b, item_instance: b2, x: 0.35, y: 0.25, theta: 0}\n", "utf-8"
+    )
+    code, out, err = _cli(tmp_path, capsys, bag, "--results", str(results))
+    assert code == 0, err
+    assert json.loads(out)["pose_score"] == pytest.approx(GOOD_SCORE, abs=1e-9)
