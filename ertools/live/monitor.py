@@ -27,6 +27,20 @@ from ertools.live.tail import McapTail, is_finished
 PATTERNS = ("*.mcap", "*.bag.active")
 
 
+def _mtime(path: Path) -> float:
+    try:
+        return path.stat().st_mtime
+    except OSError:
+        return float("-inf")
+
+
+def _size(path: Path) -> int:
+    try:
+        return path.stat().st_size
+    except OSError:
+        return 0
+
+
 @dataclass(frozen=True)
 class MonitorOptions:
     """What counts as healthy (see the module doc)."""
@@ -86,9 +100,15 @@ class Monitor:
         self._followed: _Followed | None = None
 
     def _files(self) -> list[Path]:
+        """Log files, oldest first; one removed or renamed meanwhile (a split) is left out."""
         d = self.options.directory
-        files = {p for pattern in PATTERNS for p in d.glob(pattern) if p.is_file()}
-        return sorted(files, key=lambda p: (p.stat().st_mtime, p.name))
+        stamped = []
+        for path in {p for pattern in PATTERNS for p in d.glob(pattern)}:
+            try:
+                stamped.append((path.stat().st_mtime, path.name, path))
+            except OSError:
+                continue
+        return [p for _, _, p in sorted(stamped)]
 
     def _is_active(self, path: Path, wall: float) -> bool:
         try:
@@ -115,7 +135,7 @@ class Monitor:
         if not active:
             if files:
                 newest = files[-1]
-                age = wall - newest.stat().st_mtime
+                age = wall - _mtime(newest)
                 closed = "closed" if is_finished(newest) else "unfinished"
                 warnings.append(
                     f"no log file is being written in {opts.directory} (newest: {newest.name}, "
@@ -125,11 +145,11 @@ class Monitor:
                 warnings.append(f"no log file in {opts.directory}")
             self._followed = None
             newest_path = files[-1] if files else None
-            size = newest_path.stat().st_size if newest_path else 0
+            size = _size(newest_path) if newest_path else 0
             return MonitorCheck(tuple(active), newest_path, size, None, {}, tuple(warnings))
 
         path = active[-1]
-        size = path.stat().st_size
+        size = _size(path)
         f = self._followed
         growth: float | None = None
         rates: dict[str, float] = {}

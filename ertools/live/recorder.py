@@ -20,6 +20,7 @@ flushing, splitting and health lines happen on time even when no data arrives.
 
 from __future__ import annotations
 
+import contextlib
 import socket
 import threading
 import time
@@ -28,7 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ertools.configs.mocap import MocapConfig, RigidBodyConfig, normalize_namespace
-from ertools.errors import ConfigError, ErtoolsError
+from ertools.errors import BagError, ConfigError, ErtoolsError
 from ertools.live.logfile import LogFile, log_file_name
 from ertools.live.natnet import (
     HEADER,
@@ -246,9 +247,24 @@ class Recorder:
                     data = self._sock.recv(65536)
                 except TimeoutError:
                     continue
+                except OSError as err:  # e.g. the interface went down: keep trying
+                    self._report(f"warning: receive failed: {err.strerror or err}")
+                    self.stop_event.wait(0.5)
+                    continue
                 self.handle_datagram(data, self._clock())
-        finally:
             self.finish()
+        except OSError as err:
+            where = self._file.path if self._file is not None else opts.out_dir
+            with contextlib.suppress(OSError):  # already failing: keep what was flushed
+                self.finish()
+            raise BagError(
+                f"cannot write the log: {err.strerror or err} (disk full? permissions?)",
+                path=where,
+            ) from err
+        except BaseException:
+            with contextlib.suppress(OSError):
+                self.finish()
+            raise
         return self.summary()
 
     def start_file(self) -> Path:

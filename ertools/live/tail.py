@@ -91,9 +91,12 @@ class McapTail:
         out: list[TailMessage] = []
         if self.finished or self.corrupt:
             return out
-        with open(self.path, "rb") as f:
-            f.seek(self.offset)
-            data = f.read()
+        try:
+            with open(self.path, "rb") as f:
+                f.seek(self.offset)
+                data = f.read()
+        except OSError:
+            return out  # removed or renamed meanwhile: nothing new to read
         pos = 0
         if self.offset == 0:
             if len(data) < len(MAGIC):
