@@ -158,8 +158,16 @@ def score_run(
     except ScoringError as err:
         return Fbm1RunResult(status="failed", item=item, error=err.message, **base)
     exec_time = _execution_time(run)
-    if exec_time is None:
+    if exec_time is None and answer is not None:
         warnings.append(f"{where}: no result time in the log; execution time unknown")
+    if answer is None and run.result_ns is None and run.ended_by is None:
+        # The log ends while the robot works on it: the 2015 node never finished this run.
+        return Fbm1RunResult(
+            status="unfinished",
+            item=item,
+            warnings=(f"{where}: the log ends before the run did; not counted",),
+            **base,
+        )
     if answer is None:
         # 2015: a timed-out run counted with no positives and pose score 0; a stopped run's
         # time was not added.

@@ -22,7 +22,8 @@ class Fbm1RunResult:
     Attributes:
         index: 1-based run number.
         status: ``scored``, ``no_answer`` (timeout/stop: counted with score 0), ``aborted``
-            (the goal was never sent: not counted) or ``failed`` (cannot be scored: see error).
+            (the goal was never sent: not counted), ``unfinished`` (the log ends during the
+            run: not counted) or ``failed`` (cannot be scored: see error).
         item: the presented item, None when unknown.
         item_text: the text that named it (payload or ``--items-order``).
         answer: the robot's answer, None without one.

@@ -126,3 +126,27 @@ def test_items_order_overrides_and_warns_on_count() -> None:
     assert found.runs[0].item.item_id == 3  # type: ignore[union-attr]
     assert found.runs[1].item.instance == "b1"  # type: ignore[union-attr]
     assert found.warnings and "3 item(s)" in found.warnings[0]
+
+
+def test_log_cut_during_a_run_is_not_counted() -> None:
+    from fbm1_testkit import ITEMS_YAML, bodies
+
+    from ertools.benchmarks.fbm1 import score_fbm1
+    from ertools.configs._yaml import parse_yaml
+    from ertools.configs.items import parse_items
+
+    runs = [
+        RunSpec(
+            "Place item 1 (a1) on the table",
+            "{item_class: a, item_instance: a1, x: 0.4, y: 0.2, theta: 0}",
+        )
+    ]
+    s = state_streams(runs)
+    # Cut the BmBox and Client logs at 15 s: the run's goal was sent at 14 s, no result.
+    bm, cl = s[Machine.BMBOX].window(None, ns(15.0)), s[Machine.CLIENT].window(None, ns(15.0))
+    found = find_runs(bm, s[Machine.REFBOX].window(None, ns(15.0)), cl)
+    origin, board = bodies(runs)
+    result = score_fbm1(origin, board, found, parse_items(parse_yaml(ITEMS_YAML)))
+    assert [r.status for r in result.runs] == ["unfinished"]
+    assert result.totals.pose_score is None and not result.failures
+    assert "log ends before the run did" in result.warnings[0]
