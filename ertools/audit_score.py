@@ -321,6 +321,7 @@ def compare_scores(
     *,
     abs_tol: float = DEFAULT_ABS_TOL,
     rel_tol: float = DEFAULT_REL_TOL,
+    as_2015: BenchmarkResult | None = None,
 ) -> ScoreComparison:
     """Compare the live score (parsed payload) with a recomputed result, key by key.
 
@@ -329,6 +330,9 @@ def compare_scores(
         result: the recomputed result of the same benchmark execution.
         abs_tol: numbers closer than this are the same.
         rel_tol: ...or closer than this relative to the live value.
+        as_2015: the same execution recomputed with the 2015 node's rules (see
+            :func:`rescore_2015`); a difference that it reproduces is one of ertools'
+            deliberate deviations, one it does not lies in the data or the inputs.
 
     Returns:
         Every leaf of either score, in the recomputed score's order, with an explanation for
@@ -347,6 +351,7 @@ def compare_scores(
     else:
         live_flat = flatten(_align_indices(_renest(live, recomputed, notes), recomputed, notes))
     rec_flat = flatten(recomputed)
+    flat_2015 = flatten(jsonable(as_2015.to_dict())) if as_2015 is not None else {}
     if live_flat and not set(live_flat) & set(rec_flat):
         notes.append(
             "the live score has no key in common with the recomputed score: it is shown as "
@@ -384,6 +389,8 @@ def compare_scores(
                 warnings=tuple(result.warnings),
             )
         )
+        if not same and as_2015 is not None and key in flat_2015:
+            expl = _check_2015(lv, flat_2015[key]) + "; " + expl
         lines.append(ScoreLine(key, lv, rv, diff, "same" if same else "differs", expl))
     return ScoreComparison(
         benchmark=result.name,
@@ -395,9 +402,31 @@ def compare_scores(
     )
 
 
-def attach(audit: Audit, result: BenchmarkResult) -> Audit:
+# A value recomputed with the 2015 rules "reproduces" the live one within this: far above the
+# mocap noise on a recomputed score (~1e-5 relative), far below the effect of a rule (>1%).
+REPRODUCED_REL_TOL = 1e-3
+
+
+def _check_2015(live: Any, value: Any) -> str:
+    if _is_number(live) and _is_number(value):
+        lv, v = float(live), float(value)
+        if abs(v - lv) <= max(DEFAULT_ABS_TOL, REPRODUCED_REL_TOL * abs(lv)):
+            return (
+                f"recomputed with the 2015 rules: {v:.6g}, the live value (within "
+                f"{REPRODUCED_REL_TOL:.1%}): the difference is a deliberate deviation of ertools"
+            )
+        return (
+            f"recomputed with the 2015 rules: {v:.6g}, still not the live value: the cause "
+            "is in the data or the inputs, not in ertools' deviations"
+        )
+    if str(live) == str(value):
+        return "recomputed with the 2015 rules: the live value (a deliberate deviation)"
+    return f"recomputed with the 2015 rules: {value!r}, still not the live value"
+
+
+def attach(audit: Audit, result: BenchmarkResult, as_2015: BenchmarkResult | None = None) -> Audit:
     """The audit with the recomputed result and its comparison with the live score."""
-    comparison = compare_scores(audit.live_score, result)
+    comparison = compare_scores(audit.live_score, result, as_2015=as_2015)
     warnings = list(audit.warnings)
     if comparison.differences:
         warnings.append(
@@ -502,6 +531,40 @@ def rescore(
     return result, notes
 
 
+def rescore_2015(
+    benchmark: str, paths: Sequence[Path], inputs: ScoreInputs
+) -> BenchmarkResult | None:
+    """The score recomputed with every 2015 quirk the scorer can reproduce, or None when its
+    default already is the 2015 computation (fbm3w: d_min 0.33 mm, no arc length)."""
+    plist = [Path(p) for p in paths]
+    if benchmark == "fbm2h":
+        from ertools.benchmarks.fbm2h import Fbm2hOptions, score_fbm2h
+
+        return score_fbm2h(
+            plist,
+            Fbm2hOptions(
+                goal=inputs.goal,
+                transform=inputs.transform,
+                team=inputs.team,
+                transforms_dir=inputs.transforms,
+                topic=inputs.topic,
+                hits=inputs.hits,
+                namespace=benchmark,
+                orientation_2015=True,
+            ),
+        )
+    if benchmark in ("fbm1h", "fbm1w") and inputs.items is not None:
+        from ertools.benchmarks.fbm1 import Fbm1Options, score_fbm1_bag
+
+        return score_fbm1_bag(
+            plist,
+            inputs.items,
+            options=Fbm1Options.as_2015(benchmark),
+            results_path=inputs.results,
+        )
+    return None
+
+
 def _rescore_fbm3w(paths: list[Path], inputs: ScoreInputs) -> BenchmarkResult:
     from ertools.benchmarks.fbm3w import Fbm3wOptions, score_fbm3w
     from ertools.configs.fbm3w import load_fbm3w_config
@@ -554,6 +617,7 @@ def audit_bag(
     max_silence_ns: int | None = None,
     inputs: ScoreInputs | None = None,
     recompute: bool = True,
+    check_2015: bool = True,
 ) -> tuple[Audit, tuple[str, ...]]:
     """Audit the benchmark logged in ``paths`` and, where a scorer exists, re-score it.
 
@@ -563,6 +627,8 @@ def audit_bag(
         max_silence_ns: heartbeat gaps longer than this are findings (default 1 s).
         inputs: scoring inputs for the re-score.
         recompute: False = the timeline and checks only.
+        check_2015: when the scores differ, recompute once more with the 2015 rules to tell
+            ertools' deliberate deviations from differences in the data.
 
     Returns:
         The audit (with the comparison when re-scored) and notes for the user: inputs the
@@ -593,9 +659,19 @@ def audit_bag(
     )
     if not recompute:
         return audit, ()
+    given = inputs or ScoreInputs()
     try:
-        result, notes = rescore(ns, plist, inputs or ScoreInputs())
+        result, notes = rescore(ns, plist, given)
     except ErtoolsError as err:
         # The timeline is worth having even when the score cannot be recomputed.
         return audit, (f"score not recomputed: {err}",)
-    return attach(audit, result), notes
+    attached = attach(audit, result)
+    if not check_2015 or attached.comparison is None or not attached.comparison.differences:
+        return attached, notes
+    try:
+        as_2015 = rescore_2015(ns, plist, given)
+    except ErtoolsError as err:
+        return attached, (*notes, f"not recomputed with the 2015 rules: {err}")
+    if as_2015 is None:
+        return attached, notes
+    return attach(audit, result, as_2015), notes

@@ -44,6 +44,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "--no-rescore", action="store_true", help="do not recompute the score (timeline only)"
     )
     parser.add_argument(
+        "--no-2015-check",
+        action="store_true",
+        help="when the scores differ, do not recompute with the 2015 rules to explain why",
+    )
+    parser.add_argument(
         "--strict",
         action="store_true",
         help="exit 1 when anything is found (illegal transition, silence, early end, difference)",
@@ -91,6 +96,7 @@ def run(args: argparse.Namespace) -> int:
         max_silence_ns=s_to_ns(args.max_silence),
         inputs=inputs,
         recompute=not args.no_rescore,
+        check_2015=not args.no_2015_check,
     )
     for line in notes:
         note(f"warning: {line}")

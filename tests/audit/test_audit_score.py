@@ -144,3 +144,23 @@ def test_no_common_key_shows_the_payload_beside_the_headline() -> None:
         ("score", "only live"),
     ]
     assert any("no key in common" in n for n in cmp.notes)
+
+
+def test_rules_2015_tell_deviations_from_data() -> None:
+    # Segment 1's orientation: the 2015 rules give the live -0.4 back (a deliberate deviation);
+    # segment 0's distance: the 2015 rules still give 0.102, not the live 0.1 (the data).
+    live = {
+        "details": {
+            "segments_details": {
+                "0": {"dinstance_error": 0.1, "orientation_error": 0.05},
+                "1": {"dinstance_error": 0.3, "orientation_error": -0.4},
+            }
+        }
+    }
+    as_2015 = _fbm2h(-0.4 + 1e-5, 0.102)  # 1e-5 rad of noise: within the 0.1 % reproduction
+    cmp = compare_scores(live, _fbm2h(0.4, 0.102), as_2015=as_2015)
+    by_key = {line.key: line for line in cmp.lines}
+    orient = by_key["details.segments_details.1.orientation_error"].explanation
+    assert orient.startswith("recomputed with the 2015 rules: -0.39999, the live value")
+    dist = by_key["details.segments_details.0.dinstance_error"].explanation
+    assert dist.startswith("recomputed with the 2015 rules: 0.102, still not the live value")

@@ -92,6 +92,14 @@ def test_fbm1h_live_is_the_2015_totals(fbm1h: Path) -> None:
     # ertools' pose score divides by the runs whose goal was sent; 2015 counted all ten.
     assert by_key["pose_score"].status == "differs"
     assert "runs" in by_key["pose_score"].explanation
+    # The 2015 rules reproduce the live pose score (within 0.1 %): a deliberate deviation.
+    from ertools.audit_score import audit_bag
+
+    audited, _ = audit_bag([bag], inputs=ScoreInputs(items=fbm1h / "fbm1h.yaml"))
+    assert audited.comparison is not None
+    (line,) = audited.comparison.differences
+    assert line.key == "pose_score"
+    assert "the live value (within 0.1%)" in line.explanation
 
 
 def test_fbm2h_goal_and_results_in_the_runs(fbm2h: Path) -> None:
