@@ -96,7 +96,11 @@ class LogFile:
 
     def flush(self) -> None:
         """Close the chunk in progress and hand everything to the OS (and disk with fsync)."""
-        self._writer.flush()
+        if hasattr(self._writer, "flush"):  # mcap >= 1.6
+            self._writer.flush()
+        else:  # older mcap: the same steps through the private chunk finaliser
+            self._writer._Writer__finalize_chunk()
+            self._stream.flush()
         if self._fsync:
             os.fsync(self._stream.fileno())
 
