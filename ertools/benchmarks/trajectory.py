@@ -604,11 +604,18 @@ def _pick_robot_topic(s: BagSummary, topic: str | None) -> str:
 def read_robot(path: str, topic: str, time_source: str) -> PoseStream:
     """The robot's poses in recording order (not sorted: non-increasing stamps are errors)."""
     from ertools.io.files import open_bag
+    from ertools.io.model import POSE_TYPES
     from ertools.io.reader import load_pose_batch
 
     with open_bag(path) as bag:
         conns = bag.topic_conns(topic)
         types = {c.msgtype for c in conns}
+        if not types or not types <= set(POSE_TYPES):
+            raise TopicError(
+                f"robot topic {topic} has type {', '.join(sorted(types)) or 'unknown'}, "
+                "not a pose type (geometry_msgs/PoseStamped expected)",
+                path=path,
+            )
         if types != {"geometry_msgs/PoseStamped"} and time_source == "header":
             raise TopicError(
                 f"robot topic {topic} has type {', '.join(sorted(types))}; "

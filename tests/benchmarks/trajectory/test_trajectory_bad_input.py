@@ -99,3 +99,14 @@ def test_broken_bag_in_a_gt_folder_is_skipped_with_a_warning(
     assert main(args) == 0
     err = capsys.readouterr().err
     assert "skipped unreadable file in the GT folder" in err and "junk.bag" in err
+
+
+def test_robot_topic_of_a_non_pose_type(
+    robotlog: dict[str, Any], capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The generated robot log also holds /rockin/homer/command (std_msgs/String).
+    line = run(
+        [str(robotlog["robot"]), str(robotlog["dir"]), "--robot-topic", "/rockin/homer/command"],
+        capsys,
+    )
+    assert "std_msgs/String" in line and "not a pose type" in line
