@@ -152,3 +152,20 @@ def test_moving_the_whole_world_changes_nothing(seed: int) -> None:
             (a.gt.x, a.gt.y, a.gt.yaw_deg), abs=1e-9
         )
     assert other.totals.pose_score == pytest.approx(base.totals.pose_score, abs=1e-9)
+
+
+def test_result_protocol_and_formats() -> None:
+    import yaml
+
+    from ertools.benchmarks.base import BenchmarkResult
+
+    result = _score()
+    assert isinstance(result, BenchmarkResult)
+    data = yaml.safe_load(result.to_yaml())  # type: ignore[attr-defined]
+    assert data == result.to_dict()  # type: ignore[attr-defined]
+    # The 2015 score first, in the order its node's yaml.dump wrote it.
+    assert list(data)[:4] == ["class_accuracy", "execution_time", "instance_accuracy", "pose_score"]
+    rows = result.tables()["runs"]  # type: ignore[attr-defined]
+    assert [r["run"] for r in rows] == [1, 2]
+    assert rows[1]["pose_score"] == pytest.approx(SCORE2, abs=TOL)
+    assert rows[0]["gt_theta_deg"] == pytest.approx(30.0, abs=TOL)
