@@ -113,6 +113,7 @@ class ClockCheck:
     topic: str
     offset_ns: int
     samples: int
+    error: str = ""  # the first messages could not be read (damaged data)
 
 
 @dataclass(frozen=True)
@@ -472,7 +473,11 @@ def build_timeline(
     _check_duplicates([b.path for b in base + broken], problems)
     _check_split_gaps(base, cfg, problems)
     for check in clock_checks:
-        if abs(check.offset_ns) > cfg.clock_tolerance_ns:
+        if check.error:
+            problems[check.path].append(
+                f"cannot read the first messages of {check.topic}: {check.error}"
+            )
+        elif abs(check.offset_ns) > cfg.clock_tolerance_ns:
             problems[check.path].append(
                 f"record times differ from header stamps on {check.topic} by "
                 f"{check.offset_ns / NS_PER_S:+.3f} s (median of {check.samples} messages; "

@@ -98,8 +98,8 @@ def find_bags(paths: Iterable[Path]) -> Found:
 def clock_check(s: BagSummary, window_ns: int = CLOCK_WINDOW_NS) -> ClockCheck | None:
     """Median record time minus header stamp over the first messages of one pose topic.
 
-    None when the bag has no header-stamped pose topic or could not be read (the summary has
-    already said what is wrong with it then).
+    None when the bag has no header-stamped pose topic. When the data cannot be read (a damaged
+    chunk the index does not reveal), the check carries the reader's message in ``error``.
     """
     from ertools.io.files import open_bag
     from ertools.io.reader import load_pose_batch
@@ -118,9 +118,12 @@ def clock_check(s: BagSummary, window_ns: int = CLOCK_WINDOW_NS) -> ClockCheck |
         with open_bag(s.path) as bag:
             conns = bag.topic_conns(topic.name)
             batch = load_pose_batch(bag, conns, topic.first_ns, topic.first_ns + window_ns)
-    except Exception as err:  # the check is advisory: a damaged bag is reported by summary
-        log.debug("clock check of %s skipped: %s", s.path, err)
-        return None
+    except Exception as err:  # damaged data the index did not show: report it, go on
+        from ertools.errors import ErtoolsError
+
+        text = err.message if isinstance(err, ErtoolsError) else f"{type(err).__name__}: {err}"
+        log.debug("clock check of %s failed: %s", s.path, text)
+        return ClockCheck(str(s.path), topic.name, 0, 0, error=text)
     if len(batch) == 0:
         return None
     diff = (batch.t_record - batch.t_header)[:CLOCK_MAX_SAMPLES]

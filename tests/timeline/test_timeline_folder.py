@@ -258,3 +258,21 @@ def test_other_formats_are_found_and_classified(fmt: str, tmp_path: Path) -> Non
     assert (b.format, b.kind) == (fmt, "gt")
     assert (b.start_ns, b.end_ns) == (int(t[0]) + 300_000, int(t[-1]) + 300_000)
     assert b.problems == ()  # 0.3 ms between stamp and record: no clock problem
+
+
+def test_corrupted_chunk_is_reported_by_the_clock_check(
+    folder: dict[str, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # A bz2 GT bag with bytes overwritten in the middle of its (only) chunk: the index is
+    # intact, so the summary is fine; decoding the first messages is not.
+    src = next(folder["root"].glob("gtlogger/*_0.bag"))
+    data = bytearray(src.read_bytes())
+    mid = len(data) // 2
+    data[mid : mid + 64] = b"\xff" * 64
+    bad = tmp_path / src.name
+    bad.write_bytes(bytes(data))
+    assert main(["timeline", str(bad), "--format", "json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    (problem,) = d["problems"]
+    assert problem["path"] == str(bad)
+    assert "cannot read the first messages of /fbm2h/robot_at_home/pose" in problem["problem"]
