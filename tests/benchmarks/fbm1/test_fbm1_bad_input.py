@@ -13,7 +13,7 @@ from ertools.benchmarks.fbm1 import score_fbm1
 from ertools.benchmarks.fbm1_runs import find_runs
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
-from ertools.configs.items import parse_items
+from ertools.configs.items import ItemList, parse_items
 from ertools.streams import Machine
 
 GOOD = RunSpec(
@@ -55,7 +55,7 @@ BAD_CASES = {
 }
 
 
-def _items() -> object:
+def _items() -> ItemList:
     return parse_items(parse_yaml(ITEMS_YAML), "items.yaml")
 
 
@@ -66,7 +66,7 @@ def test_bad_run_fails_alone(case: str) -> None:
     streams = state_streams(runs)
     found = find_runs(streams[Machine.BMBOX], streams[Machine.REFBOX], streams[Machine.CLIENT])
     origin, board = bodies(runs)
-    result = score_fbm1(origin, board, found, _items())  # type: ignore[arg-type]
+    result = score_fbm1(origin, board, found, _items())
     assert len(result.failures) == 1
     assert result.failures[0].startswith("run 1: ")
     assert message in result.failures[0]

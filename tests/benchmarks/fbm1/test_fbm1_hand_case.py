@@ -17,11 +17,12 @@ from fbm1_testkit import ANSWER_S, EXEC_S, RunSpec, bodies, state_streams, write
 
 from ertools.benchmarks.fbm1 import Fbm1Options, score_fbm1
 from ertools.benchmarks.fbm1_gt import GtOptions
+from ertools.benchmarks.fbm1_result import Fbm1Result
 from ertools.benchmarks.fbm1_runs import find_runs
 from ertools.benchmarks.fbm1_score import ScoreRules
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
-from ertools.configs.items import parse_items
+from ertools.configs.items import ItemList, parse_items
 from ertools.streams import Machine
 
 RUNS = [
@@ -52,22 +53,22 @@ SCORE2 = 1 - T2 / 2 - (175 / 180) / 2
 TOL = 1e-9
 
 
-def _items() -> object:
+def _items() -> ItemList:
     from fbm1_testkit import ITEMS_YAML
 
     return parse_items(parse_yaml(ITEMS_YAML), "items.yaml")
 
 
-def _score(options: Fbm1Options | None = None) -> object:
+def _score(options: Fbm1Options | None = None) -> Fbm1Result:
     streams = state_streams(RUNS)
     found = find_runs(streams[Machine.BMBOX], streams[Machine.REFBOX], streams[Machine.CLIENT])
     origin, board = bodies(RUNS)
-    return score_fbm1(origin, board, found, _items(), options)  # type: ignore[arg-type]
+    return score_fbm1(origin, board, found, _items(), options)
 
 
 def test_hand_computed_ground_truth_and_scores() -> None:
     result = _score()
-    r1, r2 = result.runs  # type: ignore[attr-defined]
+    r1, r2 = result.runs
     assert (r1.gt.x, r1.gt.y, r1.gt.yaw_deg) == pytest.approx(GT1, abs=TOL)
     assert (r2.gt.x, r2.gt.y, r2.gt.yaw_deg) == pytest.approx(GT2, abs=TOL)
     assert r1.errors.theta_error_deg == pytest.approx(5.0, abs=TOL)
@@ -75,26 +76,26 @@ def test_hand_computed_ground_truth_and_scores() -> None:
     assert r1.pose_score == pytest.approx(SCORE1, abs=TOL)
     assert r2.pose_score == pytest.approx(SCORE2, abs=TOL)
     assert (r1.class_ok, r1.instance_ok, r2.class_ok, r2.instance_ok) == (True, True, True, False)
-    totals = result.totals  # type: ignore[attr-defined]
+    totals = result.totals
     assert totals.class_accuracy == 1.0
     assert totals.instance_accuracy == 0.5
     assert totals.pose_score == pytest.approx((SCORE1 + SCORE2) / 2, abs=TOL)
     # 2015 execution time: goal acknowledged (EXECUTING_GOAL) -> BmBox back to READY.
     assert totals.execution_time == pytest.approx(2 * (6.1 - EXEC_S), abs=1e-9)
-    assert not result.failures  # type: ignore[attr-defined]
+    assert not result.failures
 
 
 @pytest.mark.parametrize("method", ["goal", "result"])
 def test_2015_single_lookup_methods_agree_on_a_still_board(method: str) -> None:
-    result = _score(Fbm1Options(gt=GtOptions(method=method)))  # type: ignore[arg-type]
-    r1 = result.runs[0]  # type: ignore[attr-defined]
+    result = _score(Fbm1Options(gt=GtOptions(method=method)))
+    r1 = result.runs[0]
     assert r1.gt.samples == 1
     assert (r1.gt.x, r1.gt.y, r1.gt.yaw_deg) == pytest.approx(GT1, abs=TOL)
 
 
 def test_legacy_totals_divide_accuracy_by_ten_at_home() -> None:
     result = _score(Fbm1Options(rules=ScoreRules(legacy_totals=True)))
-    totals = result.totals  # type: ignore[attr-defined]
+    totals = result.totals
     assert totals.class_accuracy == pytest.approx(2 / 10)
     assert totals.instance_accuracy == pytest.approx(1 / 10)
     assert totals.pose_score == pytest.approx((SCORE1 + SCORE2) / 2, abs=TOL)
@@ -144,8 +145,8 @@ def test_moving_the_whole_world_changes_nothing(seed: int) -> None:
     streams = state_streams(RUNS)
     found = find_runs(streams[Machine.BMBOX], streams[Machine.REFBOX], streams[Machine.CLIENT])
     origin, board = bodies(RUNS)
-    base = score_fbm1(origin, board, found, _items())  # type: ignore[arg-type]
-    other = score_fbm1(moved(origin), moved(board), found, _items())  # type: ignore[arg-type]
+    base = score_fbm1(origin, board, found, _items())
+    other = score_fbm1(moved(origin), moved(board), found, _items())
     for a, b in zip(base.runs, other.runs, strict=True):
         # Float rounding through one more rotation: 1e-9 m / deg.
         assert (b.gt.x, b.gt.y, b.gt.yaw_deg) == pytest.approx(
@@ -161,11 +162,11 @@ def test_result_protocol_and_formats() -> None:
 
     result = _score()
     assert isinstance(result, BenchmarkResult)
-    data = yaml.safe_load(result.to_yaml())  # type: ignore[attr-defined]
-    assert data == result.to_dict()  # type: ignore[attr-defined]
+    data = yaml.safe_load(result.to_yaml())
+    assert data == result.to_dict()
     # The 2015 score first, in the order its node's yaml.dump wrote it.
     assert list(data)[:4] == ["class_accuracy", "execution_time", "instance_accuracy", "pose_score"]
-    rows = result.tables()["runs"]  # type: ignore[attr-defined]
+    rows = result.tables()["runs"]
     assert [r["run"] for r in rows] == [1, 2]
     assert rows[1]["pose_score"] == pytest.approx(SCORE2, abs=TOL)
     assert rows[0]["gt_theta_deg"] == pytest.approx(30.0, abs=TOL)
