@@ -647,8 +647,10 @@ def select_gt(
             for s in sorted(summaries, key=lambda s: s.start_ns)[:4]
         )
         raise ClockError(
-            f"no GT file overlaps the robot log ({iso_utc(start_ns)} to {iso_utc(end_ns)}); "
-            f"GT files: {spans or 'none'}{' ...' if len(summaries) > 4 else ''}"
+            f"no GT file overlaps the robot log ({iso_utc(start_ns)} to {iso_utc(end_ns)}, "
+            "search margin included); "
+            f"GT files: {spans or 'none'}{' ...' if len(summaries) > 4 else ''}; "
+            "if the robot's clock was far off, give --offset S"
         )
     if gt_topic is None:
         cands = sorted(
