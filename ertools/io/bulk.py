@@ -16,29 +16,87 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 
-from ertools.io.fastdecode import FAST_TYPES, LayoutMismatchError, decode, to_batch
+from ertools.errors import BagError
+from ertools.io.fastdecode import FAST_TYPES, Decoded, LayoutMismatchError, decode, to_batch
 from ertools.io.files import BagFile
-from ertools.io.model import Conn
+from ertools.io.model import TF_TYPES, Conn
 from ertools.io.posebatch import PoseBatch, concat_batches
 
 log = logging.getLogger("ertools.io.bulk")
 
+# Uncompressed bytes decoded in one go (chunks are ~768 KiB): large enough that the per-call
+# overhead of NumPy vanishes, small enough to keep memory bounded.
+GROUP_BYTES = 4 * 1024 * 1024
+
 I64 = npt.NDArray[np.int64]
+U8 = npt.NDArray[np.uint8]
 
 
-def _ordered(parts: list[tuple[I64, PoseBatch]]) -> PoseBatch:
-    """Join per-chunk batches and put rows back in the reference order.
+class _Assembler:
+    """Collects per-chunk decoded rows into one batch in the reference order.
 
-    Each part carries, per row, the position of its message in the reference order; TF rows of
-    one message keep their order (stable sort).
+    Types with one pose per message are written straight into preallocated arrays at their
+    reference positions (no concatenation, no sort); TF messages, which may hold several
+    transforms, are collected and ordered at the end.
     """
-    if not parts:
-        return PoseBatch.empty()
-    batch = concat_batches([p[1] for p in parts])
-    pos = np.concatenate([p[0] for p in parts])
-    if len(pos) > 1 and np.any(pos[1:] < pos[:-1]):
-        batch = batch.take(np.argsort(pos, kind="stable"))
-    return batch
+
+    def __init__(self, msgtype: str, t_record: I64) -> None:
+        self.t_record = t_record
+        self.multi = msgtype in TF_TYPES
+        n = 0 if self.multi else len(t_record)
+        self.t_header = np.empty(n, dtype=np.int64)
+        self.xyz = np.empty((n, 3))
+        self.quat = np.empty((n, 4))
+        self.frame_idx = np.zeros(n, dtype=np.int32)
+        self.child_idx = np.zeros(n, dtype=np.int32)
+        self.frames: dict[str, int] = {"": 0}
+        self.parts: list[tuple[I64, PoseBatch]] = []
+
+    def add(self, pos: I64, buf: U8, dec: Decoded) -> None:
+        """Rows decoded from messages at reference positions ``pos``."""
+        batch = to_batch(buf, dec, self.t_record[pos])
+        if self.multi:
+            self.parts.append((pos[dec.msg_index], batch))
+            return
+        remap = np.array(
+            [self.frames.setdefault(f, len(self.frames)) for f in batch.frames], np.int32
+        )
+        self.t_header[pos] = batch.t_header
+        self.xyz[pos] = batch.xyz
+        self.quat[pos] = batch.quat_xyzw
+        self.frame_idx[pos] = remap[batch.frame_idx]
+        self.child_idx[pos] = remap[batch.child_idx]
+
+    def result(self) -> PoseBatch:
+        if not self.multi:
+            return PoseBatch(
+                self.t_record,
+                self.t_header,
+                self.xyz,
+                self.quat,
+                self.frame_idx,
+                self.child_idx,
+                tuple(self.frames),
+            )
+        if not self.parts:
+            return PoseBatch.empty()
+        batch = concat_batches([p[1] for p in self.parts])
+        pos = np.concatenate([p[0] for p in self.parts])
+        if len(pos) > 1 and np.any(pos[1:] < pos[:-1]):
+            batch = batch.take(np.argsort(pos, kind="stable"))
+        return batch
+
+
+def _groups(keys: I64) -> list[tuple[int, I64]]:
+    """(key, positions) for each distinct key, positions ascending (one sort, not N scans)."""
+    if len(keys) == 0:
+        return []
+    order = np.argsort(keys, kind="stable")
+    sorted_keys = keys[order]
+    cuts = np.flatnonzero(sorted_keys[1:] != sorted_keys[:-1]) + 1
+    starts = np.concatenate([[0], cuts])
+    ends = np.concatenate([cuts, [len(keys)]])
+    return [(int(sorted_keys[a]), order[a:b]) for a, b in zip(starts, ends, strict=True)]
 
 
 def _ros1(
@@ -48,16 +106,35 @@ def _ros1(
 
     assert isinstance(bag, Ros1Bag)
     touched, chunk_of, _rank, t_of, off_of = bag.select(conns, lo, hi)
-    parts = []
-    for ci in touched:
-        sel = np.flatnonzero(chunk_of == ci)
-        chunk = bag.layout.chunks[ci]
-        buf = np.frombuffer(bag.chunk_bytes(chunk), dtype=np.uint8)
-        start, length = bag.spans(buf, off_of[sel], f"in {bag.path} at byte {chunk.pos}")
-        dec = decode(msgtype, False, buf, start, length)
-        batch = to_batch(buf, dec, t_of[sel])
-        parts.append((sel[dec.msg_index], batch))
-    return _ordered(parts)
+    out = _Assembler(msgtype, t_of)
+    groups = dict(_groups(chunk_of))
+    # Several chunks are decoded together (fewer NumPy calls per message), up to GROUP_BYTES
+    # of uncompressed data at a time so memory stays bounded.
+    batch: list[int] = []
+    size = 0
+    for i, ci in enumerate(touched):
+        batch.append(ci)
+        size += max(bag.layout.chunks[ci].data_len, 0) * (
+            1 if bag.layout.chunks[ci].compression == "none" else 4
+        )
+        if size < GROUP_BYTES and i + 1 < len(touched):
+            continue
+        chunks = [bag.layout.chunks[c] for c in batch]
+        datas = bag.chunks_bytes(chunks)
+        base = np.cumsum([0] + [len(d) for d in datas])
+        buf = np.frombuffer(b"".join(datas) if len(datas) > 1 else datas[0], dtype=np.uint8)
+        sel = np.concatenate([groups[c] for c in batch])
+        which = np.concatenate([np.full(len(groups[c]), k) for k, c in enumerate(batch)])
+        where = f"in {bag.path} in chunks at bytes {chunks[0].pos}..{chunks[-1].pos}"
+        offsets = off_of[sel]
+        if np.any(offsets + 8 > (base[1:] - base[:-1])[which]):
+            raise BagError(f"index points outside its chunk {where}")
+        start, length = bag.spans(buf, offsets + base[which], where)
+        if np.any(start + length > base[which + 1]):
+            raise BagError(f"message record runs past the end of its chunk {where}")
+        out.add(sel, buf, decode(msgtype, False, buf, start, length))
+        batch, size = [], 0
+    return out.result()
 
 
 def _mcap(
@@ -69,11 +146,11 @@ def _mcap(
     if index is None:
         return None
     cdr = conns[0].encoding == "cdr"
-    parts = []
-    for sel, buf, start, length, t_rec in index.message_runs(conns, lo, hi):
-        dec = decode(msgtype, cdr, buf, start, length)
-        parts.append((sel[dec.msg_index], to_batch(buf, dec, t_rec)))
-    return _ordered(parts)
+    plan = index.plan(conns, lo, hi)
+    out = _Assembler(msgtype, plan.t_record)
+    for pos, buf, start, length in index.chunks_of(plan):
+        out.add(pos, buf, decode(msgtype, cdr, buf, start, length))
+    return out.result()
 
 
 def _sqlite(
@@ -84,13 +161,11 @@ def _sqlite(
     batches = sqlite_rows(bag.path, conns, lo, hi)
     if batches is None:
         return None
-    parts = []
-    done = 0
-    for buf, start, length, t_rec in batches:
-        dec = decode(msgtype, conns[0].encoding == "cdr", buf, start, length)
-        parts.append((done + dec.msg_index, to_batch(buf, dec, t_rec)))
-        done += len(start)
-    batch = concat_batches([p[1] for p in parts])
+    parts = [
+        to_batch(buf, decode(msgtype, conns[0].encoding == "cdr", buf, start, length), t_rec)
+        for buf, start, length, t_rec in batches
+    ]
+    batch = concat_batches(parts)
     t = batch.t_record
     if len(t) > 1 and np.any(t[1:] < t[:-1]):  # several storage files: merge by time
         batch = batch.take(np.argsort(t, kind="stable"))

@@ -46,7 +46,10 @@ def gather(buf: U8, pos: I64, width: int) -> U8:
         return np.empty((0, width), np.uint8)
     if int(pos.min()) < 0 or int(pos.max()) + width > len(buf):
         raise LayoutMismatchError("field past the end of the buffer")
-    out: U8 = buf[pos[:, None] + np.arange(width, dtype=np.int64)]
+    # Rows of a sliding-window view (every byte starts a row of ``width`` bytes): the index
+    # array is (N,), not (N, width).
+    windows = np.ndarray((len(buf) - width + 1, width), dtype=np.uint8, buffer=buf, strides=(1, 1))
+    out: U8 = windows[pos]
     return out
 
 
@@ -112,6 +115,12 @@ def decode_strings(buf: U8, start: I64, length: I64) -> tuple[I32, tuple[str, ..
     """Codes into a table of distinct strings, grouping messages by string length."""
     codes = np.zeros(len(start), dtype=np.int32)
     names: dict[str, int] = {}
+    if len(length) and np.all(length == length[0]):
+        # The usual case, one frame name for the whole topic: compare every row with the first.
+        n = int(length[0])
+        rows = gather(buf, start, n)
+        if n == 0 or np.array_equal(rows, np.broadcast_to(rows[0], rows.shape)):
+            return codes, (bytes(rows[0]).decode("utf-8") if n else "",)
     for n in np.unique(length):
         sel = np.flatnonzero(length == n)
         if n == 0:

@@ -65,11 +65,21 @@ def decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
     raise BagError(f"unsupported MCAP chunk compression {compression!r} {where}")
 
 
-@dataclass
-class _Sel:
-    chunk: int
-    t: I64
-    off: I64
+def _workers() -> int:
+    import os
+
+    return max(1, min(8, os.cpu_count() or 1))
+
+
+@dataclass(frozen=True, eq=False)
+class McapPlan:
+    """Messages located from the message indexes, in the reference order."""
+
+    t_record: I64
+    offset: I64
+    key: I64  # file << 32 | chunk index
+    file: I64
+    chunks: list[list[Any]]
 
 
 class McapIndex:
@@ -87,20 +97,18 @@ class McapIndex:
             return McapIndex(sorted(bag.path.glob("*.mcap")))
         return None
 
-    def message_runs(
-        self, conns: Sequence[Conn], lo: int | None, hi: int | None
-    ) -> Iterator[tuple[I64, U8, I64, I64, I64]]:
-        """Per chunk: (reference positions, chunk bytes, data starts, data lengths, log times).
+    def plan(self, conns: Sequence[Conn], lo: int | None, hi: int | None) -> McapPlan:
+        """Locate the messages of ``conns`` in [lo, hi] from the message indexes (no chunk data).
 
         Raises:
-            BagError: damaged chunk or index.
+            BagError: damaged index.
             LayoutMismatchError: a file has chunks without message indexes (caller falls back).
         """
         from ertools.io.fastdecode import LayoutMismatchError
 
         topics = {c.topic for c in conns}
         sels: list[tuple[int, int, int, I64, I64]] = []  # file, chunk idx, chunk offset, t, off
-        plans: list[tuple[Path, list[Any]]] = []
+        chunks_per_file: list[list[Any]] = []
         for fi, path in enumerate(self.files):
             with path.open("rb") as f:
                 summary = read_summary(f, path)
@@ -108,7 +116,7 @@ class McapIndex:
                     raise LayoutMismatchError("MCAP file without chunk indexes")
                 channels = {cid for cid, ch in summary.channels.items() if ch.topic in topics}
                 chunks = summary.chunk_indexes
-                plans.append((path, chunks))
+                chunks_per_file.append(chunks)
                 for ci, chunk in enumerate(chunks):
                     if lo is not None and chunk.message_end_time < lo:
                         continue
@@ -120,35 +128,61 @@ class McapIndex:
                             raise LayoutMismatchError("MCAP chunk without message indexes")
                         continue
                     for cid in wanted:
-                        t, off = self._message_index(f, path, chunk.message_index_offsets[cid], cid)
+                        offset = chunk.message_index_offsets[cid]
+                        t, off = self._message_index(f, path, offset, cid)
                         keep = np.ones(len(t), dtype=bool)
                         if lo is not None:
                             keep &= t >= lo
                         if hi is not None:
                             keep &= t <= hi
                         if keep.any():
-                            sels.append((fi, ci, int(chunk.chunk_start_offset), t[keep], off[keep]))
+                            start = int(chunk.chunk_start_offset)
+                            sels.append((fi, ci, start, t[keep], off[keep]))
         if not sels:
-            return
+            e = np.empty(0, np.int64)
+            return McapPlan(e, e, e, e, chunks_per_file)
         t_all = np.concatenate([s[3] for s in sels])
         off_all = np.concatenate([s[4] for s in sels])
         file_all = np.concatenate([np.full(len(s[3]), s[0], np.int64) for s in sels])
         chunk_all = np.concatenate([np.full(len(s[3]), s[1], np.int64) for s in sels])
         cstart_all = np.concatenate([np.full(len(s[3]), s[2], np.int64) for s in sels])
+        # the mcap library's order: log time, then file, chunk position, record position
         order = np.lexsort((off_all, cstart_all, file_all, t_all))
-        pos_of = np.empty(len(order), dtype=np.int64)
-        pos_of[order] = np.arange(len(order))
         key = file_all * (1 << 32) + chunk_all
-        for k in np.unique(key):
-            rows = np.flatnonzero(key == k)
-            rows = rows[np.argsort(pos_of[rows], kind="stable")]
-            fi, ci = int(k >> 32), int(k & 0xFFFFFFFF)
-            path, chunks = plans[fi]
-            buf = self._chunk_bytes(path, chunks[ci])
-            start, length = self._spans(
-                buf, off_all[rows], f"in {path} at byte {chunks[ci].chunk_start_offset}"
+        return McapPlan(t_all[order], off_all[order], key[order], file_all[order], chunks_per_file)
+
+    def chunks_of(self, plan: McapPlan) -> Iterator[tuple[I64, U8, I64, I64]]:
+        """Per chunk: (reference positions, chunk bytes, data starts, data lengths)."""
+        from ertools.io.bulk import _groups
+
+        groups = _groups(plan.key)
+        # Decompress a few chunks at a time on all cores (zstd and lz4 release the GIL).
+        step = 2 * _workers()
+        for g in range(0, len(groups), step):
+            part = groups[g : g + step]
+            jobs = [(self.files[k >> 32], plan.chunks[k >> 32][k & 0xFFFFFFFF]) for k, _ in part]
+            for (_k, rows), (path, chunk), buf in zip(part, jobs, self._many(jobs), strict=True):
+                where = f"in {path} at byte {chunk.chunk_start_offset}"
+                start, length = self._spans(buf, plan.offset[rows], where)
+                yield rows, buf, start, length
+
+    @staticmethod
+    def _many(jobs: list[tuple[Path, Any]]) -> list[U8]:
+        raws = [McapIndex._chunk_raw(path, chunk) for path, chunk in jobs]
+        if len(jobs) == 1 or _workers() == 1:
+            return [
+                McapIndex._inflate(path, chunk, raw)
+                for (path, chunk), raw in zip(jobs, raws, strict=True)
+            ]
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(_workers()) as pool:
+            return list(
+                pool.map(
+                    lambda a: McapIndex._inflate(*a),
+                    [(p, c, r) for (p, c), r in zip(jobs, raws, strict=True)],
+                )
             )
-            yield pos_of[rows], buf, start, length, t_all[rows]
 
     @staticmethod
     def _message_index(f: BinaryIO, path: Path, pos: int, cid: int) -> tuple[I64, I64]:
@@ -167,6 +201,20 @@ class McapIndex:
 
     @staticmethod
     def _chunk_bytes(path: Path, chunk: Any) -> U8:
+        return McapIndex._inflate(path, chunk, McapIndex._chunk_raw(path, chunk))
+
+    @staticmethod
+    def _inflate(path: Path, chunk: Any, raw: tuple[str, bytes, int]) -> U8:
+        where = f"in {path} at byte {chunk.chunk_start_offset}"
+        compression, data, usize = raw
+        out = decompress(compression, data, usize, where)
+        if len(out) != usize:
+            raise BagError(f"chunk decompresses to {len(out)} bytes, not {usize}, {where}")
+        return np.frombuffer(out, dtype=np.uint8)
+
+    @staticmethod
+    def _chunk_raw(path: Path, chunk: Any) -> tuple[str, bytes, int]:
+        """(compression, compressed records, uncompressed size) of a chunk record."""
         where = f"in {path} at byte {chunk.chunk_start_offset}"
         with path.open("rb") as f:
             f.seek(chunk.chunk_start_offset)
@@ -179,10 +227,7 @@ class McapIndex:
             data = f.read(nbytes)
         if len(data) != nbytes:
             raise BagError(f"chunk cut off by end of file {where}")
-        raw = decompress(compression, data, int(usize), where)
-        if len(raw) != usize:
-            raise BagError(f"chunk decompresses to {len(raw)} bytes, not {usize}, {where}")
-        return np.frombuffer(raw, dtype=np.uint8)
+        return compression, data, int(usize)
 
     @staticmethod
     def _spans(buf: U8, off: I64, where: str) -> tuple[I64, I64]:

@@ -120,15 +120,15 @@ def _check_pose_conns(conns: list[Conn], topic: str, path: Path) -> str:
 def _batch_to_stream(batch: PoseBatch, msgtype: str, time_source: str, source: str) -> PoseStream:
     use_header = time_source == "header" and msgtype != "geometry_msgs/Pose2D"
     t = batch.t_header if use_header else batch.t_record
-    frames = batch.frame_names()
-    children = batch.child_names()
-    frame = str(frames[0]) if len(frames) else ""
-    child = str(children[0]) if len(children) else ""
-    if len(frames) and (np.any(frames != frame) or np.any(children != child)):
+    fi, ci = batch.frame_idx, batch.child_idx
+    frame = batch.frames[fi[0]] if len(fi) else ""
+    child = batch.frames[ci[0]] if len(ci) else ""
+    if len(fi) and (np.any(fi != fi[0]) or np.any(ci != ci[0])):
+        used = {batch.frames[i] for i in np.unique(np.concatenate([fi, ci]))}
         log.warning(
             "%s: frame ids change within the topic (%s); using the first, %r -> %r",
             source,
-            ", ".join(sorted(set(map(str, frames)) | set(map(str, children)))),
+            ", ".join(sorted(used)),
             frame,
             child,
         )

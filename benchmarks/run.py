@@ -1,0 +1,322 @@
+"""`make bench`: ertools' reader and commands measured side by side with rosbags and evo.
+
+Generates (once, cached in build/bench/) an hour of 120 Hz mocap GT written like the 2015
+loggers (PoseStamped + Pose2D + /tf, 1.33 M messages) as uncompressed, lz4 and bz2 ROS1 bags
+and as MCAP (zstd), a 10 Hz robot log of the same hour, and 1000 one-second GT bags. Every
+command runs several times as a whole process (page cache warm); the table shows the median
+wall time and the peak RSS of the process (``os.wait4``), then the ratios of issue 3.
+
+    .venv/bin/python benchmarks/run.py [--runs N] [--quick] [--json FILE]
+
+Nothing here is a test: `make test` never runs it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import os
+import platform
+import shutil
+import statistics
+import subprocess
+import sys
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent
+sys.path.insert(0, str(HERE))
+
+from data import GT_TOPIC, ROBOT_TOPIC, generate  # noqa: E402
+
+PY = sys.executable
+BIN = Path(sys.executable).parent
+
+
+@dataclass
+class Measure:
+    name: str
+    wall_s: float
+    inside_s: float | None
+    rss_mib: float
+    runs: int
+    ok: bool
+    note: str = ""
+
+
+def run_once(argv: list[str]) -> tuple[float, float, int, str]:
+    """(wall s, peak RSS MiB, exit status, stdout) of one whole process."""
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=REPO)
+    out = proc.stdout.read() if proc.stdout else b""
+    err = proc.stderr.read() if proc.stderr else b""
+    _pid, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - t0
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    if proc.returncode != 0:
+        sys.stderr.write(err.decode(errors="replace")[-2000:])
+    return wall, usage.ru_maxrss / 1024.0, proc.returncode, out.decode(errors="replace")
+
+
+def measure(name: str, argv: list[str], runs: int) -> Measure:
+    walls, rss, inside = [], [], []
+    ok = True
+    for _ in range(runs):
+        wall, peak, code, out = run_once(argv)
+        ok &= code == 0
+        walls.append(wall)
+        rss.append(peak)
+        with contextlib.suppress(ValueError, KeyError, IndexError):
+            inside.append(float(json.loads(out.strip().splitlines()[-1])["inside_s"]))
+    m = Measure(
+        name,
+        statistics.median(walls),
+        statistics.median(inside) if inside else None,
+        max(rss),
+        runs,
+        ok,
+    )
+    inside_txt = f"{m.inside_s:8.3f}" if m.inside_s is not None else "       -"
+    print(
+        f"  {name:<58} {m.wall_s:8.3f} {inside_txt} {m.rss_mib:9.1f}  {'' if ok else 'FAILED'}",
+        flush=True,
+    )
+    return m
+
+
+def machine() -> dict[str, str]:
+    cpu = "unknown"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    mem = "unknown"
+    try:
+        kb = int(Path("/proc/meminfo").read_text().split()[1])
+        mem = f"{kb / 1024 / 1024:.1f} GiB"
+    except (OSError, ValueError, IndexError):
+        pass
+    return {
+        "nproc": str(os.cpu_count()),
+        "cpu": cpu,
+        "memory": mem,
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+    }
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--runs", type=int, default=5, help="runs per fast command (default 5)")
+    parser.add_argument(
+        "--slow-runs", type=int, default=3, help="runs per slow baseline (default 3)"
+    )
+    parser.add_argument("--quick", action="store_true", help="skip the slow rosbags/evo baselines")
+    parser.add_argument("--json", type=Path, default=REPO / "build" / "bench" / "results.json")
+    args = parser.parse_args()
+
+    folder = REPO / "build" / "bench"
+    print(f"data: {folder} (generated once, then reused)", flush=True)
+    t0 = time.perf_counter()
+    paths = generate(folder)
+    print(f"  ready in {time.perf_counter() - t0:.1f} s", flush=True)
+    sizes = {
+        k: (p.stat().st_size if p.is_file() else sum(f.stat().st_size for f in p.iterdir()))
+        for k, p in paths.items()
+    }
+    info = machine()
+    print(
+        f"machine: {info['nproc']} cores, {info['cpu']}, {info['memory']}, Python {info['python']}"
+    )
+    title = "command (whole process, page cache warm)"
+    print(f"  {title:<58} {'wall s':>8} {'inside':>8} {'peak MiB':>9}")
+    ertools = [str(BIN / "ertools")]
+    results: dict[str, Measure] = {}
+
+    def go(key: str, name: str, argv: list[str], runs: int) -> Measure:
+        results[key] = measure(name, argv, runs)
+        return results[key]
+
+    ex = [PY, str(HERE / "extract.py")]
+    for fmt in ("gt", "gt_lz4", "gt_bz2", "gt_mcap"):
+        p = str(paths[fmt])
+        label = {"gt": "ROS1", "gt_lz4": "ROS1 lz4", "gt_bz2": "ROS1 bz2", "gt_mcap": "MCAP zstd"}[
+            fmt
+        ]
+        go(
+            f"bytes_{fmt}",
+            f"read the file's bytes ({label}, {sizes[fmt] / 2**20:.0f} MiB)",
+            [*ex, "bytes", p],
+            args.runs,
+        )
+        go(
+            f"extract_{fmt}",
+            f"ertools: pose topic -> arrays ({label})",
+            [*ex, "ertools", p, GT_TOPIC],
+            args.runs,
+        )
+        if not args.quick and fmt in ("gt", "gt_mcap"):
+            go(
+                f"rosbags_{fmt}",
+                f"rosbags AnyReader per message ({label})",
+                [*ex, "rosbags", p, GT_TOPIC],
+                args.slow_runs,
+            )
+    go("info_hour", "ertools info (hour bag)", [*ertools, "info", str(paths["gt"])], args.runs)
+    go(
+        "info_small",
+        "ertools info (1 s bag)",
+        [*ertools, "info", str(next(iter(sorted(paths["small"].iterdir()))))],
+        args.runs,
+    )
+    go(
+        "info_1000",
+        "ertools info (1000 bags)",
+        [*ertools, "info", str(paths["small"]), "--format", "json"],
+        args.runs,
+    )
+    tl = go(
+        "timeline_1000",
+        "ertools timeline (1000 bags, summaries only)",
+        [*ertools, "timeline", str(paths["small"]), "--no-clock-check", "--format", "json"],
+        args.runs,
+    )
+    if not tl.ok:
+        tl.note = "ertools timeline failed or is not available"
+    traj = [
+        *ertools,
+        "score",
+        "trajectory",
+        str(paths["robot"]),
+        str(paths["gt"]),
+        "--robot-topic",
+        ROBOT_TOPIC,
+        "--gt-topic",
+        GT_TOPIC,
+        "--format",
+        "json",
+    ]
+    probe = subprocess.run(
+        [*ertools, "score", "trajectory", "--help"], capture_output=True, cwd=REPO, check=False
+    )
+    if probe.returncode == 0:
+        go("trajectory", "ertools score trajectory (robot hour + GT hour)", traj, args.runs)
+        comb = [
+            *ertools,
+            "score",
+            "trajectory",
+            str(paths["combined"]),
+            str(paths["combined"]),
+            "--robot-topic",
+            ROBOT_TOPIC,
+            "--gt-topic",
+            GT_TOPIC,
+            "--format",
+            "json",
+        ]
+        go(
+            "trajectory_combined",
+            "ertools score trajectory (both topics in one bag)",
+            comb,
+            args.runs,
+        )
+    else:
+        print("  ertools score trajectory: not available yet, skipped")
+    evo_traj, evo_ape = (
+        shutil.which("evo_traj", path=str(BIN)),
+        shutil.which("evo_ape", path=str(BIN)),
+    )
+    if args.quick:
+        print("  evo: skipped (--quick)")
+    elif evo_traj and evo_ape:
+        go(
+            "evo_traj",
+            "evo_traj bag (GT topic)",
+            [evo_traj, "bag", str(paths["gt"]), GT_TOPIC],
+            args.slow_runs,
+        )
+        go(
+            "evo_ape",
+            "evo_ape bag (GT + robot topic, one bag)",
+            [evo_ape, "bag", str(paths["combined"]), GT_TOPIC, ROBOT_TOPIC],
+            args.slow_runs,
+        )
+    else:
+        print("  evo: not installed (pip install 'ertools[bench]'), skipped")
+
+    print("\nratios (targets of issue 3):")
+    ratios: dict[str, float] = {}
+
+    def ratio(key: str, text: str, a: str, b: str, target: str) -> None:
+        if a in results and b in results and results[a].ok and results[b].ok:
+            ratios[key] = results[a].wall_s / results[b].wall_s
+            print(f"  {text:<62} {ratios[key]:7.2f}x   (target {target})")
+
+    for fmt, label in (
+        ("gt", "ROS1"),
+        ("gt_lz4", "ROS1 lz4"),
+        ("gt_bz2", "ROS1 bz2"),
+        ("gt_mcap", "MCAP zstd"),
+    ):
+        ratio(
+            f"extract_vs_bytes_{fmt}",
+            f"pose extraction / reading the bytes, {label}",
+            f"extract_{fmt}",
+            f"bytes_{fmt}",
+            "<= 3x",
+        )
+    for fmt in ("gt", "gt_mcap"):
+        ratio(
+            f"rosbags_vs_ertools_{fmt}",
+            f"rosbags per message / ertools, {fmt}",
+            f"rosbags_{fmt}",
+            f"extract_{fmt}",
+            "-",
+        )
+    ratio(
+        "evo_ape_vs_trajectory",
+        "evo_ape bag / ertools score trajectory (same data)",
+        "evo_ape",
+        "trajectory_combined",
+        ">= 30x",
+    )
+    ratio(
+        "evo_traj_vs_extract",
+        "evo_traj bag / ertools pose extraction",
+        "evo_traj",
+        "extract_gt",
+        "-",
+    )
+    for key in ("info_1000", "timeline_1000"):
+        if key in results:
+            print(f"  {results[key].name:<62} {results[key].wall_s:7.2f} s   (target <= 3 s)")
+    if "trajectory" in results:
+        label = "peak memory of ertools score trajectory"
+        peak = results["trajectory"].rss_mib
+        print(f"  {label:<62} {peak:7.1f} MiB (target <= 150 MiB)")
+    args.json.parent.mkdir(parents=True, exist_ok=True)
+    args.json.write_text(
+        json.dumps(
+            {
+                "machine": info,
+                "sizes_bytes": sizes,
+                "results": {k: asdict(v) for k, v in results.items()},
+                "ratios": ratios,
+            },
+            indent=2,
+        )
+    )
+    print(f"\nwrote {args.json}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
