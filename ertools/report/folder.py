@@ -39,6 +39,7 @@ log = logging.getLogger("ertools.report.folder")
 NAMESPACES = ("fbm1h", "fbm1w", "fbm2h", "fbm3w")
 CONFIG_MAX_BYTES = 64 * 1024  # configs up to this size are shown in the page
 TABLE_MAX_ROWS = 200  # longer tables are in the CSV only
+TABLE_OPEN_ROWS = 30  # longer tables are folded in the page
 _CHUNK = 1 << 20
 _EPOCH_COLUMNS = ("time", "from_time", "start_time")
 
@@ -356,20 +357,30 @@ def _page(
         body += h.notes(f"failure: {f}" for f in failures)
         body += "<h3>score.yaml (the seed's format)</h3>" + h.pre(score.to_yaml())
         sections.append(("score", "Score", body))
-        tables = score.tables()
-        if tables:
-            parts = []
-            for name, rows in tables.items():
-                parts.append(f"<h3>{h.esc(name)}</h3>")
-                parts.append(h.table(rows, max_rows=TABLE_MAX_ROWS) if rows else "<p>(empty)</p>")
-                parts.append(f'<p class="muted">{h.link(f"{name}.csv", f"{name}.csv")}</p>')
-            sections.append(("tables", "Tables", "".join(parts)))
     if figures or figure_problems:
         body = "".join(h.figure(p.relative_to(outdir).as_posix(), title) for p, title in figures)
         body += h.notes(figure_problems)
         sections.append(("figures", "Figures", body))
     if audit is not None:
         sections.append(("audit", "Audit", _audit_html(audit)))
+    tables = score.tables() if score is not None else {}
+    if tables:
+        parts = []
+        for name, rows in tables.items():
+            link = h.link(f"{name}.csv", f"{name}.csv")
+            if not rows:
+                parts.append(f"<h3>{h.esc(name)}</h3><p>(empty) {link}</p>")
+                continue
+            table = h.table(rows, max_rows=TABLE_MAX_ROWS)
+            if len(rows) > TABLE_OPEN_ROWS:
+                # Per-sample tables are long: folded (no script needed), the CSV has them all.
+                parts.append(
+                    f"<details><summary><b>{h.esc(name)}</b>: {len(rows)} rows "
+                    f"({link})</summary>{table}</details>"
+                )
+            else:
+                parts.append(f'<h3>{h.esc(name)}</h3>{table}<p class="muted">{link}</p>')
+        sections.append(("tables", "Tables", "".join(parts)))
     notes_body = ""
     if meta["warnings"]:
         notes_body += "<h3>Warnings</h3>" + h.notes(meta["warnings"])
@@ -481,13 +492,15 @@ def _audit_html(audit: Any) -> str:
             )
         )
     if tables["timeline"]:
-        parts.append("<h3>Timeline</h3>")
+        timeline = h.table(
+            tables["timeline"],
+            columns=["start", "machine", "state", "duration", "kind", "payload"],
+            max_rows=TABLE_MAX_ROWS,
+        )
         parts.append(
-            h.table(
-                tables["timeline"],
-                columns=["start", "machine", "state", "duration", "kind", "payload"],
-                max_rows=TABLE_MAX_ROWS,
-            )
+            f"<details><summary><b>Timeline</b>: {len(tables['timeline'])} state changes "
+            f"({h.link('audit_timeline.csv', 'audit_timeline.csv')})</summary>"
+            f"{timeline}</details>"
         )
     return "".join(parts)
 

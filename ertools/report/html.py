@@ -54,6 +54,7 @@ figcaption { font-size: 13px; color: var(--muted); }
 dl { display: grid; grid-template-columns: max-content auto; gap: 2px 16px; font-size: 13px; }
 dt { font-weight: 600; } dd { margin: 0; word-break: break-all; }
 tr.differs td { background: #fff6e5; }
+details { margin: 8px 0; } summary { cursor: pointer; padding: 4px 0; }
 td.long { min-width: 320px; max-width: 640px; }
 tr.same td.status { color: var(--good); }
 """
