@@ -83,6 +83,11 @@ def run(args: argparse.Namespace) -> int:
     from ertools.configs.items import items_to_yaml
     from ertools.io import PoseSource
 
+    from ertools.errors import UsageError
+
+    for name in ("min_still", "max_distance", "still"):
+        if not getattr(args, name) > 0:
+            raise UsageError(f"--{name.replace('_', '-')} must be positive")
     origin = PoseSource(topic=args.origin_topic) if args.origin_topic else None
     board = PoseSource(topic=args.ref_board_topic) if args.ref_board_topic else None
     options = AcquireOptions(
