@@ -81,9 +81,8 @@ def _windows(text: str | None) -> list[tuple[float, float]] | None:
 def run(args: argparse.Namespace) -> int:
     from ertools.benchmarks.fbm1_acquire import AcquireOptions, acquire_items_bag
     from ertools.configs.items import items_to_yaml
-    from ertools.io import PoseSource
-
     from ertools.errors import UsageError
+    from ertools.io import PoseSource
 
     for name in ("min_still", "max_distance", "still"):
         if not getattr(args, name) > 0:
