@@ -101,7 +101,10 @@ class NoiseResult:
             for e, c in zip(edges, counts, strict=True)
         ]
         rows.append({"from_m": float(HISTOGRAM_ROWS * self.bin), "to_m": None, "count": overflow})
-        return {"histogram": rows, "summary": [jsonable(self.to_dict()) | {"pairs": self.pairs}]}
+        summary = jsonable(self.to_dict())
+        pct = summary.pop("percentiles")
+        summary |= {f"p{k}": v for k, v in pct.items()} | {"pairs": self.pairs}
+        return {"histogram": rows, "summary": [summary]}
 
     def to_text(self, width: int = 60) -> str:
         """A summary and a text histogram (the 2015 tool printed one on the terminal)."""

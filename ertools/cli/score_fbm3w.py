@@ -118,7 +118,7 @@ def parse_sweep(text: str) -> tuple[float, ...]:
     if n == 1:
         return (start,)
     step = (stop - start) / (n - 1)
-    return tuple(start + i * step for i in range(n))
+    return tuple(round(start + i * step, 12) for i in range(n))  # no 0.00039999999999999996
 
 
 def run(args: argparse.Namespace) -> int:
