@@ -358,7 +358,10 @@ def _page(
         body += "<h3>score.yaml (the seed's format)</h3>" + h.pre(score.to_yaml())
         sections.append(("score", "Score", body))
     if figures or figure_problems:
-        body = "".join(h.figure(p.relative_to(outdir).as_posix(), title) for p, title in figures)
+        body = h.figures(
+            h.figure(p.relative_to(outdir).as_posix(), title, wide=p.stem == "audit_timeline")
+            for p, title in figures
+        )
         body += h.notes(figure_problems)
         sections.append(("figures", "Figures", body))
     if audit is not None:

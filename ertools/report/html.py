@@ -48,8 +48,11 @@ td pre { margin: 0; padding: 4px; max-height: 160px; }
 .bad { background: #fde4e1; color: var(--bad); }
 .muted { color: var(--muted); font-size: 13px; }
 ul.notes li { margin: 3px 0; }
-figure { display: inline-block; margin: 8px 16px 16px 0; vertical-align: top; }
-figure img { max-width: 560px; width: 100%; border: 1px solid var(--line); }
+.figs { display: grid; grid-template-columns: repeat(auto-fill, minmax(440px, 1fr));
+        gap: 16px; }
+figure { margin: 0; }
+figure img { width: 100%; border: 1px solid var(--line); }
+figure.wide { grid-column: 1 / -1; }
 figcaption { font-size: 13px; color: var(--muted); }
 dl { display: grid; grid-template-columns: max-content auto; gap: 2px 16px; font-size: 13px; }
 dt { font-weight: 600; } dd { margin: 0; word-break: break-all; }
@@ -152,12 +155,21 @@ def badge(text: str, level: str) -> str:
     return f'<span class="badge {esc(level)}">{esc(text)}</span>'
 
 
-def figure(src: str, caption: str) -> str:
-    """An image beside the page (relative path) or a data URI, with its caption."""
+def figure(src: str, caption: str, *, wide: bool = False) -> str:
+    """An image beside the page (relative path) or a data URI, with its caption.
+
+    Figures go in a :func:`figures` grid; ``wide`` ones (timelines) span its width.
+    """
+    cls = ' class="wide"' if wide else ""
     return (
-        f'<figure><img src="{esc(src)}" alt="{esc(caption)}" loading="eager">'
+        f'<figure{cls}><img src="{esc(src)}" alt="{esc(caption)}" loading="eager">'
         f"<figcaption>{esc(caption)}</figcaption></figure>"
     )
+
+
+def figures(items: Iterable[str]) -> str:
+    """A responsive grid of :func:`figure` elements."""
+    return '<div class="figs">' + "".join(items) + "</div>"
 
 
 def link(href: str, text: str) -> str:
