@@ -20,7 +20,7 @@ off (wrapped: -170); run 8 a translation error of 1.2 m (between 1 m and sqrt(2)
 clip gives t = 1, the 2015 node left 1.2); run 9 theta answered 363 deg past the truth
 (wrapped: 3 deg); run 10 no answer (timeout).
 
-Written beside the bag: ``fbm1h_items.yaml`` (seed Listing 9, the 11 items with their transforms in
+Written beside the bag: ``fbm1h.yaml`` (seed Listing 9, the 11 items with their transforms in
 the board frame, as the 2015 list had) and the answers.
 
 Answers (``expected``), computed here from the noiseless truth with 4x4 matrices (not with the
@@ -345,7 +345,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
             bag, NAMESPACE, start, end, bag_name=bag_path.name, bodies=["origin", "ref_board"]
         )
 
-    items_path = outdir / "fbm1h_items.yaml"
+    items_path = outdir / "fbm1h.yaml"
     items_path.write_text(
         yaml.safe_dump({"items": items}, sort_keys=False, default_flow_style=None, width=100),
         encoding="utf-8",

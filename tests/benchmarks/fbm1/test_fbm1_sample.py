@@ -19,7 +19,7 @@ def sample(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     paths = generate(out, seed=2017)
     bag = next(p for p in paths if p.suffix == ".bag")
     answers = yaml.safe_load(next(p for p in paths if p.name.endswith(".answers.yaml")).read_text())
-    return {"bag": bag, "items": out / "fbm1h_items.yaml", "answers": answers}
+    return {"bag": bag, "items": out / "fbm1h.yaml", "answers": answers}
 
 
 def _score(sample: dict[str, Any], capsys: pytest.CaptureFixture[str], *extra: str) -> Any:
