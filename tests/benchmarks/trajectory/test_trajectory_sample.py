@@ -216,3 +216,33 @@ def test_robot_record_time(
         100_000_000,
     )
     check(out, exp, robotlog["answers"])
+
+
+def test_windowed_gt_read_equals_one_read(
+    robotlog: dict[str, Any],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    import ertools.benchmarks.trajectory as tr
+    from ertools.io import read_poses
+
+    gt0, gt1 = robotlog["gt"]
+    copy = tmp_path / gt1.name
+    shutil.copyfile(gt1, copy)
+    files = [str(gt0), str(gt1), str(copy)]
+    whole = read_poses(files, GT_TOPIC)
+    lo, hi = int(whole.t_ns[0]), int(whole.t_ns[-1])
+    monkeypatch.setattr(tr, "GT_WINDOW_NS", 5_000_000_000)  # 9 windows over the 43 s
+    windowed = tr.read_gt(files, GT_TOPIC, lo, hi)
+    assert np.array_equal(windowed.t_ns, whole.t_ns)
+    assert np.array_equal(windowed.xyz, whole.xyz)
+    assert np.array_equal(windowed.quat_xyzw, whole.quat_xyzw)
+
+    # Through the CLI: the reader's warnings (the files overlap) appear once, not once per
+    # window.
+    capsys.readouterr()
+    args = ["score", "trajectory", str(robotlog["robot"]), *files, "--offset", "-0.35"]
+    assert main(args) == 0
+    logged = [ln for ln in capsys.readouterr().err.splitlines() if "WARNING" in ln]
+    assert logged and len(logged) == len(set(logged))
