@@ -154,6 +154,7 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
         body += '<p class="muted">Reports: ' + " &middot; ".join(links) + "</p>"
         teams = len({e.team for e in group})
         sections.append((f"b-{bench}", f"{bench} ({len(group)} result(s), {teams} team(s))", body))
+    sections.append(("teams", "By team", _by_team(entries, outdir)))
     (outdir / "results.json").write_text(json.dumps(flat, indent=2) + "\n", encoding="utf-8")
     columns = list(dict.fromkeys(k for row in flat for k in row))
     with (outdir / "results.csv").open("w", newline="", encoding="utf-8") as fh:
@@ -164,3 +165,31 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
     index = outdir / "index.html"
     index.write_text(h.page(title, subtitle, sections), encoding="utf-8")
     return index
+
+
+def _by_team(entries: list[Entry], outdir: Path) -> str:
+    """One table per team: its results in every benchmark, headline values as text."""
+    from ertools.report.html import fmt
+
+    teams: dict[str, list[Entry]] = {}
+    for e in entries:
+        teams.setdefault(e.team or "(unknown)", []).append(e)
+    parts = []
+    for team in sorted(teams):
+        rows = []
+        for e in sorted(teams[team], key=lambda e: (e.benchmark, str(e.source))):
+            target = e.index or e.source
+            rows.append(
+                {
+                    "benchmark": e.benchmark,
+                    "score": ", ".join(
+                        f"{k} {fmt(v)}" for k, v in e.headline.items() if k != "benchmark"
+                    ),
+                    "warnings": e.warnings,
+                    "failures": e.failures,
+                    "audit findings": e.findings,
+                    "report": os.path.relpath(target.resolve(), outdir.resolve()),
+                }
+            )
+        parts.append(h.table(rows, caption=team))
+    return "".join(parts)

@@ -45,7 +45,8 @@ def test_combined_page(
     assert float(rows[1]["best_distance_error"]) == 0.0087
     assert json.loads((out / "results.json").read_text())[2]["best_run"] == 1
     page = (out / "index.html").read_text(encoding="utf-8")
-    assert page.count("<table>") == 2  # one table per benchmark
+    assert page.count("<table>") == 2 + 3  # one table per benchmark, one per team
+    assert "best_distance_error 0.0123, best_run 1, execution_time 41.5" in page  # tripod
     assert "b&lt;it&gt;bots" in page and "<it>" not in page
     assert "Lisbon &lt;2015&gt;" in page
     assert 'href="../results/fbm3w-0.0123/index.html"' in page
