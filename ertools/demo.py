@@ -81,7 +81,7 @@ def steps(samples: Path, out: Path) -> Iterator[Step]:
             "fbm1h",
             str(fbm1_bag),
             "--items",
-            str(_first(fbm1, "*items*.yaml")),
+            str(_first(fbm1, "fbm1h.yaml")),
             "--report",
             str(out / "fbm1h"),
         ],
