@@ -42,6 +42,7 @@ TABLE_MAX_ROWS = 200  # longer tables are in the CSV only
 TABLE_OPEN_ROWS = 30  # longer tables are folded in the page
 _CHUNK = 1 << 20
 _EPOCH_COLUMNS = ("time", "from_time", "start_time")
+_OUTPUT_OPTIONS = frozenset({"-o", "--output", "--report", "--plot", "--out"})
 
 
 @dataclass(frozen=True)
@@ -204,7 +205,16 @@ def _configs(
     """
     seen = {p.resolve() for p in inputs if p.exists()}
     candidates: list[Path] = []
+    skip_next = False
     for token in argv[1:]:
+        if skip_next:  # the value of an output option: written by ertools, not read
+            skip_next = False
+            continue
+        if token in _OUTPUT_OPTIONS:
+            skip_next = True
+            continue
+        if token.split("=", 1)[0] in _OUTPUT_OPTIONS:
+            continue
         value = token.split("=", 1)[1] if token.startswith("--") and "=" in token else token
         if value.startswith("-"):
             continue

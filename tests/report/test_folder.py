@@ -34,7 +34,10 @@ def test_folder_contents(bag: Path, tmp_path: Path) -> None:
     config.write_text(f"runs_specifications: ['line']  # {EVIL}\n", encoding="utf-8")
     result = fbm3w_like()
     out = tmp_path / "report"
+    output = tmp_path / "in" / "score-out.yaml"  # written by ertools before the report
+    output.write_text("best_run: 1\n", encoding="utf-8")
     argv = ["ertools", "score", "fbm3w", str(bag), "--config", str(config), "--team", "b<it>"]
+    argv += ["-o", str(output), f"--plot={output}"]
     index = write_report(result, out, inputs=[bag], argv=argv)
     assert index == out / "index.html"
     names = {p.name for p in out.iterdir()}
@@ -52,7 +55,7 @@ def test_folder_contents(bag: Path, tmp_path: Path) -> None:
     assert meta["inputs"] == [
         {"name": "run.bag", "path": str(bag), "sha256": expected_sha, "size": len(BAG_BYTES)}
     ]
-    assert meta["configs"][0]["name"] == "fbm3w.yaml"
+    assert [c["name"] for c in meta["configs"]] == ["fbm3w.yaml"]  # not the -o output
     assert meta["configs"][0]["sha256"] == hashlib.sha256(config.read_bytes()).hexdigest()
     assert meta["team"] == "b<it>"
     assert meta["benchmark"] == "fbm3w"
