@@ -17,15 +17,18 @@ BmBox returns to READY, transmits the score and ends. One tracking loss (3 repea
 dropped) happens during run 1's path.
 
 Written as a ROS1 bag and, with the same messages, as a rosbag2 directory with MCAP storage;
-one answers file lists both.
+one answers file lists both. ``fbm3w.yaml`` beside them is the config (Listing 14, d_min).
 
 Answers (``expected``), from the noiseless truth at the 120 Hz frames, with the seed's
 formulas (7.3.1-7.3.2) written out in :func:`eq1` as a plain loop (no ertools scorer code):
 per run ``distance_error`` with ``D_MIN`` = 0.00033 m, ``execution_time`` = BmBox leaving
 WAITING_RESULT - entering EXECUTING_GOAL, ``status``; ``best_run``, ``best_distance_error``,
 ``execution_time`` (sum over every run, the timed-out one included); ``noise`` for the
-stationary phases (epsilon = sigma*sqrt(pi) in the plane). ``truth.runs`` has the windows (ns
-and seconds from the bag's first message) and ``truth.phases`` the stationary phases.
+stationary phases (epsilon = sigma*sqrt(pi) in the plane). ``expected.published`` is what the
+live node computed from the noisy Pose2D messages it received (the same loop on the published
+arrays), also the BmBox score payload; a ``states`` scorer must match it to float rounding.
+``truth.runs`` has the windows (ns and seconds from the bag's first message) and
+``truth.phases`` the stationary phases.
 """
 
 from __future__ import annotations
@@ -38,6 +41,7 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+import yaml
 
 from ertools.geometry import quat_from_yaw
 from ertools.samples.mocap import (
@@ -295,11 +299,45 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         if v["distance_error"] is not None
     }
     best = min(scored, key=lambda k: scored[k])
-    last_rec = int(pub.t_record_ns[-1]) + 50_000_000
-    score_yaml = (
-        f"best_distance_error: {scored[best]}\nbest_run: {best}\n"
-        f"execution_time: {sum(v['execution_time'] for v in expected_runs.values())}\n"
+
+    # What the live 2015 node computed: the same formula on the *published* Pose2D messages
+    # it received between the transitions (record times; pose2d is recorded 20 us after the
+    # pose), the reference being the last one before COMPLETED_MANUAL_OPERATION. A scorer
+    # reading the bag in `states` mode must find these numbers up to float rounding.
+    t_pose2d = pub.t_record_ns + 20_000
+    xy_pub = pub.xyz[:, :2]
+    published: dict[int, dict[str, Any]] = {}
+    for k, run in enumerate(runs_truth):
+        entry: dict[str, Any] = {"spec": run["spec"]}
+        if run["status"] == "completed":
+            m = (t_pose2d >= run["start_ns"]) & (t_pose2d <= run["end_ns"])
+            ref_i = int(np.searchsorted(t_pose2d, run["reference_ns"], side="right")) - 1
+            err, kept, length = eq1(xy_pub[ref_i], xy_pub[m], run["spec"], D_MIN)
+            entry |= {"distance_error": err, "execution_time": expected_runs[k]["execution_time"]}
+            entry |= {"kept_samples": kept, "path_length": length}
+        published[k] = entry
+    live = {k: v["distance_error"] for k, v in published.items() if "distance_error" in v}
+    live_best = min(live, key=lambda k: live[k])
+    total_time = sum(v["execution_time"] for v in expected_runs.values())
+    # The score payload as the 2015 node dumped it (yaml.dump sorts keys; a timed-out run
+    # keeps only its spec).
+    score_yaml = yaml.safe_dump(
+        {
+            "best_distance_error": live[live_best],
+            "best_run": live_best,
+            "execution_time": total_time,
+            "runs_details": {
+                k: {
+                    kk: vv
+                    for kk, vv in v.items()
+                    if kk in ("spec", "distance_error", "execution_time")
+                }
+                for k, v in published.items()
+            },
+        },
+        default_flow_style=False,
     )
+    last_rec = int(pub.t_record_ns[-1]) + 50_000_000
     tr = [
         x
         if x.state != BmBoxState.TRANSMITTING_SCORE or x.machine is not Machine.BMBOX
@@ -317,6 +355,13 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
                 bag, NAMESPACE, start, last_rec, bag_name=path_out.name, bodies=[BODY]
             )
 
+    # The config the benchmark ran with (seed Listing 14 and the 2015 D_MIN).
+    config = outdir / "fbm3w.yaml"
+    config.write_text(
+        "# FBM3@Work config of this simulated benchmark (seed Listing 14, 2015 D_MIN)\n"
+        + yaml.safe_dump({"runs_specifications": list(SPECS), "d_min": D_MIN}, sort_keys=False),
+        encoding="utf-8",
+    )
     phases = _still_phases(t, xy)
     eps_formula = SIGMA_M * math.sqrt(math.pi)
     for run in runs_truth:
@@ -354,6 +399,11 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
             "execution_time": sum(v["execution_time"] for v in expected_runs.values()),
             "runs_details": expected_runs,
             "tracking_losses": {loss_run: reps},
+            "published": {
+                "best_distance_error": live[live_best],
+                "best_run": live_best,
+                "runs_details": published,
+            },
             "noise": {"epsilon": eps_formula, "suggested_d_min": 3 * eps_formula},
         },
         tolerance={
@@ -370,12 +420,17 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
                 "straight segment over 9 frames): 0.03 mm; other runs agree to 1e-12",
             ),
             "execution_time": tol(1e-6, "state transitions are recorded at their exact times"),
+            "published": tol(
+                1e-12,
+                "the same Pose2D messages and windows as a states-mode scorer reads from the "
+                "bag; only float summation order differs",
+            ),
             "noise.epsilon": tol(
                 2.5e-5, "sampling error of the mean over ~2000 stationary pairs (6 std errors)"
             ),
         },
     )
-    return [*paths, answers]
+    return [*paths, config, answers]
 
 
 def _still_phases(t: npt.NDArray[np.int64], xy: F64) -> list[tuple[int, int]]:

@@ -15,6 +15,7 @@ import ertools.samples.fbm3w as scenario
 class Sample:
     bag: Path
     mcap: Path
+    config: Path
     answers: dict[str, Any]
 
     def expected_run(self, index: int) -> dict[str, Any]:
@@ -36,7 +37,7 @@ def generate_sample(out: Path, seed: int, *, sigma: float | None = None) -> Samp
     if sigma is not None:
         scenario.SIGMA_M = sigma
     try:
-        bag, mcap, answers = scenario.generate(out, seed=seed)
+        bag, mcap, config, answers = scenario.generate(out, seed=seed)
     finally:
         scenario.SIGMA_M = saved
-    return Sample(bag, mcap, yaml.safe_load(answers.read_text()))
+    return Sample(bag, mcap, config, yaml.safe_load(answers.read_text()))

@@ -28,7 +28,7 @@ def one_line_error(err: str) -> str:
 
 
 def test_default_yaml_and_json(fbm3w_sample: Sample, capsys: pytest.CaptureFixture[str]) -> None:
-    assert score(fbm3w_sample.bag) == 0
+    assert score(fbm3w_sample.bag, "--config", fbm3w_sample.config) == 0
     out = yaml.safe_load(capsys.readouterr().out)
     assert list(out) == ["best_distance_error", "best_run", "execution_time", "runs_details"]
     assert out["best_run"] == fbm3w_sample.answers["expected"]["best_run"]
@@ -52,6 +52,47 @@ def test_sweep_plot_and_notes(
         *(f"fbm3w_run{i}.png" for i in range(4)),
         "fbm3w_runs.png",
     ]
+
+
+def test_runs_file(
+    fbm3w_sample: Sample, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    runs = [
+        {"spec": s, "reference": r, "start": a, "end": b} for s, r, a, b in fbm3w_sample.windows()
+    ]
+    runs_file = tmp_path / "runs.yaml"
+    runs_file.write_text(yaml.safe_dump(runs), encoding="utf-8")
+    assert score(fbm3w_sample.bag, "--runs-file", runs_file, "--format", "json") == 0
+    data = json.loads(capsys.readouterr().out)
+    for key, run in data["runs_details"].items():
+        exp = fbm3w_sample.expected_run(int(key))
+        # same windows as the states mode: the answers' tolerance (frame from noisy samples)
+        tol = fbm3w_sample.answers["tolerance"]["distance_error"]["abs"]
+        assert run["distance_error"] == pytest.approx(exp["distance_error"], abs=tol)
+    runs_file.write_text("- {spec: line, start: 1}\n", encoding="utf-8")
+    assert score(fbm3w_sample.bag, "--runs-file", runs_file) == 1
+    assert "missing key(s) reference, end" in one_line_error(capsys.readouterr().err)
+
+
+@pytest.mark.parametrize(
+    "source", [["--topic", "/fbm3w/robot_at_work/pose"], ["--frame", "robot_at_work"]]
+)
+def test_other_pose_sources(
+    fbm3w_sample: Sample, source: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert score(fbm3w_sample.bag, "--format", "json") == 0
+    pose2d = json.loads(capsys.readouterr().out)["runs_details"]
+    assert score(fbm3w_sample.bag, *source, "--format", "json") == 0
+    captured = capsys.readouterr()
+    other = json.loads(captured.out)["runs_details"]
+    assert "2015 used /fbm3w/robot_at_work/pose2d" in captured.err
+    for key in ("0", "1", "2", "3"):
+        # same positions; the record/header times differ by 20-300 us, so a window edge may
+        # take or drop one stationary sample: at most the start sample's noise (0.07 mm)
+        # moves the frame origin
+        assert other[key]["distance_error"] == pytest.approx(
+            pose2d[key]["distance_error"], abs=2e-4
+        )
 
 
 def test_explicit_windows_and_auto_notes(

@@ -31,6 +31,21 @@ def test_each_run_matches_the_answers(fbm3w_sample: Sample, mode: str) -> None:
     assert result.best_run == fbm3w_sample.answers["expected"]["best_run"]
 
 
+def test_states_mode_equals_the_live_node(fbm3w_sample: Sample) -> None:
+    """The scenario recomputes what the 2015 node saw (the published Pose2D messages)."""
+    result = score_fbm3w([fbm3w_sample.bag], Fbm3wConfig())
+    live = fbm3w_sample.answers["expected"]["published"]
+    tol = _tol(fbm3w_sample, "published")
+    for run in result.runs[:4]:
+        exp = live["runs_details"][str(run.index)]
+        assert run.distance_error == pytest.approx(exp["distance_error"], abs=tol)
+        assert run.score is not None
+        assert len(run.score.kept) == exp["kept_samples"]
+        assert run.score.path_length == pytest.approx(exp["path_length"], abs=tol)
+    assert result.best_run == live["best_run"]
+    assert result.best_distance_error == pytest.approx(live["best_distance_error"], abs=tol)
+
+
 def test_states_mode_times_and_timeout(fbm3w_sample: Sample) -> None:
     result = score_fbm3w([fbm3w_sample.bag], Fbm3wConfig())
     assert len(result.runs) == 5

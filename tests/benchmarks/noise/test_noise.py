@@ -25,7 +25,7 @@ def stationary(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str
 
 @pytest.fixture(scope="module")
 def fbm3w_bag(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:
-    bag, _, answers = fbm3w.generate(tmp_path_factory.mktemp("fbm3w_for_noise"), seed=2015)
+    bag, _, _, answers = fbm3w.generate(tmp_path_factory.mktemp("fbm3w_for_noise"), seed=2015)
     return bag, yaml.safe_load(answers.read_text())
 
 
