@@ -4,7 +4,7 @@
 Here one loop does all three without ROS: receive a datagram, decode its rigid bodies, write a
 ``PoseStamped``, a ``Pose2D`` and a ``tf2_msgs/TFMessage`` per configured, tracked body, stamped
 with the host clock at receipt (the 2015 node stamped ``ros::Time::now()``; NTP keeps the host
-clock on the Referee Box's).
+clock on the Referee Box's). On Linux the kernel's arrival stamp is used (SO_TIMESTAMPNS).
 
 Differences from 2015, on purpose:
 * a body whose tracking-valid flag is off is not written (mocap_optitrack republished whatever
@@ -21,7 +21,10 @@ flushing, splitting and health lines happen on time even when no data arrives.
 from __future__ import annotations
 
 import contextlib
+import platform
 import socket
+import struct
+import sys
 import threading
 import time
 from collections.abc import Callable
@@ -128,6 +131,39 @@ class _Route:
     tf: bool
 
 
+# SO_TIMESTAMPNS (Linux, asm-generic and x86 value; Python's socket module lacks the name): the
+# kernel stamps each datagram with CLOCK_REALTIME on arrival, so a recorder busy flushing, splitting
+# or querying NTP does not shift the stamps of the datagrams waiting in the socket.
+SO_TIMESTAMPNS = 35
+_TIMESPEC = struct.Struct("@qq")
+_KERNEL_STAMP_MACHINES = ("x86_64", "amd64", "i386", "i686", "aarch64", "arm64", "riscv64")
+
+
+def enable_kernel_timestamps(sock: socket.socket) -> bool:
+    """Ask the kernel to stamp arrivals; False where that is not known to work."""
+    if sys.platform != "linux" or platform.machine().lower() not in _KERNEL_STAMP_MACHINES:
+        return False
+    try:
+        sock.setsockopt(socket.SOL_SOCKET, SO_TIMESTAMPNS, 1)
+    except OSError:
+        return False
+    return True
+
+
+def receive(
+    sock: socket.socket, kernel_stamps: bool, clock: Callable[[], int]
+) -> tuple[bytes, int]:
+    """One datagram and its arrival time (kernel stamp, else the host clock now)."""
+    if not kernel_stamps:
+        return sock.recv(65536), clock()
+    data, ancillary, _flags, _addr = sock.recvmsg(65536, socket.CMSG_SPACE(_TIMESPEC.size))
+    for level, kind, payload in ancillary:
+        if level == socket.SOL_SOCKET and kind == SO_TIMESTAMPNS and len(payload) >= 16:
+            sec, nsec = _TIMESPEC.unpack_from(payload)
+            return data, sec * 1_000_000_000 + nsec
+    return data, clock()
+
+
 def open_socket(group: str | None, port: int, interface: str) -> socket.socket:
     """A UDP socket receiving NatNet data: joined to ``group`` or bound for unicast.
 
@@ -201,6 +237,7 @@ class Recorder:
         self.ready = threading.Event()  # set once the first file is open and listening
         self.files: list[Path] = []
         self._sock: socket.socket | None = None
+        self._kernel_stamps = False
         self._file: LogFile | None = None
         self._channels: dict[str, int] = {}
         self._file_base: dict[str, int] = {}
@@ -213,6 +250,7 @@ class Recorder:
         """Bind the socket (before the sender starts); returns the bound port."""
         self.options.out_dir.mkdir(parents=True, exist_ok=True)
         self._sock = open_socket(self.options.group, self.options.port, self.options.interface)
+        self._kernel_stamps = enable_kernel_timestamps(self._sock)
         self.port = int(self._sock.getsockname()[1])
         return self.port
 
@@ -244,14 +282,14 @@ class Recorder:
                     self._health(now - last_health)
                     last_health = now
                 try:
-                    data = self._sock.recv(65536)
+                    data, t_ns = receive(self._sock, self._kernel_stamps, self._clock)
                 except TimeoutError:
                     continue
                 except OSError as err:  # e.g. the interface went down: keep trying
                     self._report(f"warning: receive failed: {err.strerror or err}")
                     self.stop_event.wait(0.5)
                     continue
-                self.handle_datagram(data, self._clock())
+                self.handle_datagram(data, t_ns)
             self.finish()
         except OSError as err:
             where = self._file.path if self._file is not None else opts.out_dir
@@ -338,7 +376,11 @@ class Recorder:
                 "file_index": str(index),
                 "split_s": f"{opts.split_s:g}",
                 "flush_interval_s": f"{opts.flush_interval_s:g}",
-                "time_source": "host clock (Unix ns) at datagram receipt",
+                "time_source": (
+                    "kernel receive time of the datagram (SO_TIMESTAMPNS, host realtime clock)"
+                    if self._kernel_stamps
+                    else "host clock (Unix ns) when the datagram was read"
+                ),
             },
         )
         self._file.add_metadata("ertools.clock", self._clock_metadata())

@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import math
+import platform
+import sys
 import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -239,3 +242,35 @@ def test_unsupported_version_is_counted_not_fatal(tmp_path: Path) -> None:
     )
     assert summary.frames == 0 and summary.undecodable == 20
     assert sum("undecodable NatNet packet" in line for line in lines) == 1  # said once
+
+
+@pytest.mark.skipif(
+    sys.platform != "linux" or platform.machine() not in ("x86_64", "aarch64"),
+    reason="kernel receive timestamps (SO_TIMESTAMPNS) are used on Linux x86_64/aarch64",
+)
+def test_stamps_are_kernel_arrival_times(tmp_path: Path) -> None:
+    """Frames that wait in the socket keep the time they arrived, not the time they are read."""
+    options = RecordOptions(
+        out_dir=tmp_path,
+        name="k",
+        group=None,
+        port=0,
+        interface="127.0.0.1",
+        duration_s=0.5,
+        namespace="/fbm2h",
+    )
+    recorder = Recorder(CONFIG, options, clock=lambda: 42)  # 42: a read-time stamp would show
+    port = recorder.open()
+    # 20 frames at 100 Hz sent before the recorder reads anything: they queue in the socket.
+    motive = SimulatedMotive(("127.0.0.1", port), (SimulatedBody(6),), n_frames=20, rate_hz=100.0)
+    sent_from = time.time_ns()
+    motive.run()
+    sent_to = time.time_ns()
+    summary = recorder.run()
+    messages, _ = read_mcap(summary.files[0])
+    stamps = [t for topic, t, _ in messages if topic == "/fbm2h/origin/pose"]
+    assert len(stamps) == 20
+    # Arrival times lie inside the sending window (loopback delivery takes microseconds), and
+    # span the 0.19 s of pacing although all were read within a few milliseconds.
+    assert sent_from <= stamps[0] and stamps[-1] <= sent_to
+    assert stamps[-1] - stamps[0] >= 150_000_000
