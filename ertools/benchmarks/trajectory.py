@@ -395,6 +395,19 @@ def drop_duplicates(gt: PoseStream) -> tuple[PoseStream, int]:
     return gt.take(keep), int(same.sum())
 
 
+def drop_invalid(stream: PoseStream) -> tuple[PoseStream, int]:
+    """The stream without samples whose position or orientation is not usable.
+
+    NaN or infinite values, or a zero quaternion (a node publishing "no pose"), cannot be
+    compared; dropping them (and saying how many) beats a NaN score.
+    """
+    norm = np.linalg.norm(stream.quat_xyzw, axis=1)
+    ok = np.all(np.isfinite(stream.xyz), axis=1) & np.isfinite(norm) & (norm > 1e-9)
+    if ok.all():
+        return stream, 0
+    return stream.take(ok), int((~ok).sum())
+
+
 def _decimate(stream: PoseStream, limit: int = 5000) -> PoseStream:
     step = max(1, len(stream) // limit)
     return stream.take(slice(None, None, step))
@@ -427,6 +440,14 @@ def score_streams(
     notes = list(warnings)
     if dropped:
         notes.append(f"{dropped} GT sample(s) recorded twice (overlapping GT files) were used once")
+    gt, bad_gt = drop_invalid(gt)
+    robot, bad_robot = drop_invalid(robot)
+    if bad_gt:
+        notes.append(f"{bad_gt} GT sample(s) with NaN or zero-norm poses ignored")
+    if bad_robot:
+        notes.append(f"{bad_robot} robot pose(s) with NaN or zero-norm poses ignored")
+    if len(robot) == 0 or len(gt) < 2:
+        raise ScoringError(f"{where}: no valid poses left to compare (NaN or zero quaternions)")
     audit = estimate_offset(
         robot, gt, search_range_ns=config.offset_range_ns, max_gap_ns=config.max_gap_ns
     )

@@ -174,3 +174,17 @@ def test_offset_of_a_robot_standing_still_is_not_observable() -> None:
     est = estimate_offset(robot, gt)
     assert est.offset_ns is None
     assert "barely moved" in est.note
+
+
+def test_nan_and_zero_quaternion_poses_are_ignored_and_counted() -> None:
+    gt = stream([0, 100, 200, 300], [0.0, 1.0, 2.0, 3.0])
+    gt.xyz[2, 1] = np.nan  # GT sample at 200 ms unusable: 100..300 is then a 200 ms gap
+    robot = stream([50, 160, 250], [0.0, 0.0, 0.0])
+    robot.quat_xyzw[1] = 0.0  # "no pose" from the robot
+    r = score_streams(robot, gt, TrajectoryConfig(max_gap_ns=250 * MS))
+    assert (r.compared, r.gaps) == (2, 0)
+    assert r.metrics is not None
+    # 50 ms -> x 0.5; 250 ms between 100 (x 1) and 300 (x 3) -> x 2.5
+    assert r.metrics.position_error == pytest.approx((0.5 + 2.5) / 2, abs=1e-12)
+    assert any("1 GT sample(s) with NaN" in w for w in r.warnings)
+    assert any("1 robot pose(s) with NaN" in w for w in r.warnings)
