@@ -53,3 +53,18 @@ def test_counters_follow_the_frame_numbers(tmp_path: Path) -> None:
     # Stamps are the receive times handed in; positions in order, the duplicate once.
     assert xs == [(t, 1.0), (t + 10_000_000, 2.0), (t + 30_000_000, 3.0), (t + 80_000_000, 4.0)]
     assert any("rigid body ID 9 is streamed but not configured" in line for line in lines)
+
+
+def test_record_function_without_data(tmp_path: Path) -> None:
+    """The library call: no sender, a short duration: one closed, empty-but-valid file."""
+    from ertools.live.recorder import record
+    from ertools.live.tail import is_finished, read_complete
+
+    options = RecordOptions(
+        out_dir=tmp_path / "new", group=None, port=0, interface="127.0.0.1", duration_s=0.3
+    )
+    summary = record(CONFIG, options)
+    (path,) = summary.files
+    assert path.parent == tmp_path / "new" and is_finished(path)
+    assert (summary.frames, summary.undecodable, summary.natnet_version) == (0, 0, "unknown")
+    assert read_complete(path).messages == ()
