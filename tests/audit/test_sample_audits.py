@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from sample_logs import answers, sample_dir
+from audit_samples import answers, sample_dir
 
 from ertools.audit import Audit, audit_states
 from ertools.audit_score import ScoreInputs, attach, rescore
