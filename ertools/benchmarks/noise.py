@@ -185,6 +185,7 @@ def noise_statistics(
     step = np.hypot(*np.diff(pts, axis=0).T)
     same = (step == 0.0) if identical is None else np.asarray(identical, dtype=bool)
     use = np.ones(n - 1, dtype=bool) if pair_mask is None else np.asarray(pair_mask, dtype=bool)
+    use = use & np.isfinite(step)  # a NaN pose (no measurement) says nothing about the noise
     if not use.any():
         raise ScoringError("no stationary phase found: nothing to measure the noise on")
     lost = int(np.sum(use & same))
