@@ -15,7 +15,7 @@ import argparse
 
 EPILOG = """examples:
   ertools monitor logs/ --bell
-  ertools monitor logs/ --interval 2 --min-growth 20000 --min-rate 100
+  ertools monitor logs/ --interval 5 --min-growth 20000 --min-rate 100
   ertools monitor logs/ --once          # scripted check: exit 1 on any warning
 """
 
@@ -25,14 +25,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
     parser.add_argument("directory", type=Path, metavar="DIR", help="the recorder's --out folder")
     parser.add_argument(
-        "--interval", type=float, default=5.0, metavar="S", help="seconds between looks (5)"
+        "--interval", type=float, default=2.0, metavar="S", help="seconds between looks (2)"
     )
     parser.add_argument(
         "--min-growth",
         type=float,
-        default=10_000.0,
+        default=2_000.0,
         metavar="BYTES_PER_S",
-        help="least acceptable growth of the file being written (10000 B/s)",
+        help="least acceptable growth of the file being written (2000 B/s; one body at 120 Hz "
+        "writes about 12000 B/s)",
     )
     parser.add_argument(
         "--stale",

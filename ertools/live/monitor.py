@@ -5,7 +5,7 @@ Every ``interval_s`` the monitor looks at the log folder and warns when
 * no file is being written (none unfinished and recently modified);
 * several files are being written at once (two recorders on one folder);
 * the file being written grew less than ``min_growth_bps`` bytes per second (2015:
-  ``log_size_growth``, a fixed growth per check);
+  ``log_size_growth = 50 * 1000`` bytes per 2-second check of a ROS 1 bag);
 * a pose topic's rate fell below ``drop_fraction`` of the best rate it had, or below
   ``min_rate_hz`` (MCAP files only: the monitor reads the records added since the last check).
 
@@ -46,8 +46,8 @@ class MonitorOptions:
     """What counts as healthy (see the module doc)."""
 
     directory: Path
-    interval_s: float = 5.0
-    min_growth_bps: float = 10_000.0
+    interval_s: float = 2.0  # the 2015 script looked every 2 s
+    min_growth_bps: float = 2_000.0
     stale_s: float | None = None  # default: 3 intervals, at least 5 s
     drop_fraction: float = 0.5
     min_rate_hz: float | None = None
