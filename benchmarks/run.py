@@ -209,25 +209,6 @@ def main() -> int:
     )
     if probe.returncode == 0:
         go("trajectory", "ertools score trajectory (robot hour + GT hour)", traj, args.runs)
-        comb = [
-            *ertools,
-            "score",
-            "trajectory",
-            str(paths["combined"]),
-            str(paths["combined"]),
-            "--robot-topic",
-            ROBOT_TOPIC,
-            "--gt-topic",
-            GT_TOPIC,
-            "--format",
-            "json",
-        ]
-        go(
-            "trajectory_combined",
-            "ertools score trajectory (both topics in one bag)",
-            comb,
-            args.runs,
-        )
     else:
         print("  ertools score trajectory: not available yet, skipped")
     evo_traj, evo_ape = (
@@ -285,7 +266,7 @@ def main() -> int:
         "evo_ape_vs_trajectory",
         "evo_ape bag / ertools score trajectory (same data)",
         "evo_ape",
-        "trajectory_combined",
+        "trajectory",
         ">= 30x",
     )
     ratio(

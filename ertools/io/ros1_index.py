@@ -335,7 +335,7 @@ class Ros1Bag(BagFile):
             raise BagError(
                 f"damaged index data after chunk at byte {chunk.pos} ({err})", path=self.path
             ) from err
-        chunk.entries = entries
+        # Not kept on the chunk: an hour bag's index entries are ~20 MB, needed once per read.
         return entries
 
     def chunk_bytes(self, chunk: Ros1Chunk) -> bytes:

@@ -259,6 +259,7 @@ def _rosbag2(path: Path, fmt: str, exact: bool) -> BagSummary:
     if missing:
         problems.append(f"storage file(s) listed in metadata.yaml missing: {', '.join(missing)}")
     topics: dict[str, tuple[str, int, int | None, int | None, int]] = {}
+    inner: set[str] = set()
     if fmt == "rosbag2-mcap" and not missing:
         from ertools.io.mcap_index import read_summary
 
@@ -268,7 +269,8 @@ def _rosbag2(path: Path, fmt: str, exact: bool) -> BagSummary:
             if summary is None:
                 problems.append(f"{file.name}: no MCAP summary section")
                 continue
-            part, _ = _mcap_topics(file, summary, exact)
+            part, chunk_compressions = _mcap_topics(file, summary, exact)
+            inner |= chunk_compressions - {"none"}
             for name, (msgtype, count, first, last, _n) in part.items():
                 _merge_topic(topics, name, msgtype, count, first, last)
         topics = {k: (v[0], v[1], v[2], v[3], 1) for k, v in topics.items()}
@@ -289,6 +291,8 @@ def _rosbag2(path: Path, fmt: str, exact: bool) -> BagSummary:
     compression = str(info.get("compression_format") or "none")
     if info.get("compression_mode"):
         compression += f" ({str(info['compression_mode']).lower()})"
+    if inner and compression == "none":
+        compression = "/".join(sorted(inner)) + " (mcap chunks)"
     return _build(path, fmt, str(info.get("version", "")), compression, True, topics, problems)
 
 
