@@ -16,6 +16,7 @@ import argparse
 EPILOG = """examples:
   ertools monitor logs/ --bell
   ertools monitor logs/ --interval 5 --min-growth 20000 --min-rate 100
+  ertools monitor logs/ --prefix log_fbm2h_mocap    # only the @Home logger's files
   ertools monitor logs/ --once          # scripted check: exit 1 on any warning
 """
 
@@ -48,6 +49,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="warn when a pose topic's rate falls below this fraction of its best (0.5)",
     )
     parser.add_argument("--min-rate", type=float, metavar="HZ", help="least pose rate per topic")
+    parser.add_argument(
+        "--prefix",
+        default="",
+        help="only files whose name starts with this, e.g. log_fbm2h_mocap (the 2015 script's "
+        "log_prefix: two loggers writing into one folder)",
+    )
     parser.add_argument("--bell", action="store_true", help="ring the terminal bell on warnings")
     group = parser.add_mutually_exclusive_group()
     group.add_argument("--once", action="store_true", help="look once (after one interval), exit")
@@ -72,6 +79,7 @@ def run(args: argparse.Namespace) -> int:
         stale_s=args.stale,
         drop_fraction=args.drop_fraction,
         min_rate_hz=args.min_rate,
+        prefix=args.prefix,
     )
 
     def status(line: str) -> None:

@@ -52,6 +52,7 @@ class MonitorOptions:
     drop_fraction: float = 0.5
     min_rate_hz: float | None = None
     rate_topic_suffix: str = "/pose"
+    prefix: str = ""  # only files whose name starts with it (two loggers, one folder)
 
     @property
     def stale_after_s(self) -> float:
@@ -103,7 +104,7 @@ class Monitor:
         """Log files, oldest first; one removed or renamed meanwhile (a split) is left out."""
         d = self.options.directory
         stamped = []
-        for path in {p for pattern in PATTERNS for p in d.glob(pattern)}:
+        for path in {p for pattern in PATTERNS for p in d.glob(self.options.prefix + pattern)}:
             try:
                 stamped.append((path.stat().st_mtime, path.name, path))
             except OSError:

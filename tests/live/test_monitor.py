@@ -139,6 +139,9 @@ def test_several_files_and_no_file(unfinished: Path, tmp_path: Path) -> None:
     shutil.copy(unfinished, other)
     check = Monitor(MonitorOptions(unfinished.parent)).check()
     assert any("several files are being written at once" in w for w in check.warnings)
+    # Two loggers in one folder, one monitor each (the 2015 log_prefix).
+    only_x = Monitor(MonitorOptions(unfinished.parent, prefix="log_x_")).check()
+    assert only_x.warnings == () and only_x.active == (unfinished,)
     empty = tmp_path / "empty"
     empty.mkdir()
     assert Monitor(MonitorOptions(empty)).check().warnings == (f"no log file in {empty}",)
