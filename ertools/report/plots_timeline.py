@@ -42,11 +42,17 @@ def draw_gantt(ax: Any, timeline: Timeline) -> None:
         value: float = mdates.date2num(np.datetime64(ns, "ns").astype("datetime64[us]"))
         return value
 
+    spans = [(b.start_ns, b.end_ns) for b in timeline.bags if b.start_ns is not None]
+    # A minute-long bag on a day-long axis would be invisible: every bar gets at least 0.4 %
+    # of the axis (the true span is in the table and the JSON).
+    lo = min((a for a, _ in spans), default=0)
+    hi = max((e for _, e in spans if e is not None), default=0)
+    min_width = 0.004 * max(num(hi) - num(lo), 1e-9) if spans else 1e-9
     for b in timeline.bags:
         if b.start_ns is None or b.end_ns is None:
             continue
         x0 = num(b.start_ns)
-        width = max(num(b.end_ns) - x0, 1e-9)
+        width = max(num(b.end_ns) - x0, min_width)
         problem = bool(b.problems)
         ax.barh(
             row[b.logger],
@@ -72,7 +78,7 @@ def draw_gantt(ax: Any, timeline: Timeline) -> None:
             Patch(facecolor="white", edgecolor="#c44e52", hatch="//", label="has problems")
         )
     if handles:
-        ax.legend(handles=handles, loc="upper right", fontsize="small")
+        ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
 
 
 def save_gantt(timeline: Timeline, path: Path) -> Path:
