@@ -1,8 +1,8 @@
 """Order bags from many machines by time: overlaps, sessions, GT pairing, problems.
 
 The 2015 rockin_bags_timeliner, done right: folders are walked for .bag, .bag.active, .mcap and
-rosbag2 bags; only each file's index is read (plus one second of one pose topic per bag for the
-clock check). Unreadable files are listed with the reason; the exit status is 1 only when no
+rosbag2 bags; only each file's index is read (plus one second of one pose topic per recording for
+the clock check). Unreadable files are listed with the reason; the exit status is 1 only when no
 file at all could be read.
 """
 
