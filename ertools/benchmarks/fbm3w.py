@@ -48,6 +48,8 @@ SHORT_BASELINE_M = 0.01
 # Samples of the noiseless robot used for shape_floor, and the floor worth a warning.
 FLOOR_SAMPLES = 10_001
 FLOOR_WARN_M = 0.0005
+# A kept path this much longer than the target is suspicious (the sample's runs: 1.00-1.01).
+LONG_PATH_RATIO = 1.15
 
 Window = tuple[str, float, float, float]
 F64 = npt.NDArray[np.float64]
@@ -320,6 +322,13 @@ def _score_one(
         warnings.append(
             f"run {window.index}: the reference and starting positions are only "
             f"{baseline * 1000:.1f} mm apart; the run frame's direction is uncertain"
+        )
+    ratio = score.path_length / target_length
+    if ratio > LONG_PATH_RATIO:
+        warnings.append(
+            f"run {window.index}: the kept path is {ratio - 1:.0%} longer than the target "
+            f"({score.path_length:.4f} vs {target_length:.4f} m): jitter passing d_min or a "
+            "detour inflates L and shifts l/L; see --d-min-sweep"
         )
     swept = tuple((d, _try_score(xy, ref_xy, shape, d)) for d in options.sweep)
     floor = shape_floor(shape, cfg.d_min)

@@ -144,3 +144,18 @@ def test_bad_paths() -> None:
         score_path(np.array([[0.0, 0.0], [np.nan, 1.0]]), np.array([-0.1, 0.0]), line, 0.0)
     with pytest.raises(ScoringError, match="coincide"):
         run_frame(np.array([1.0, 1.0]), np.array([1.0, 1.0]))
+
+
+def test_long_path_is_warned() -> None:
+    u = np.linspace(0.0, 1.0, 3000)
+    # a 5 mm zigzag of 20 periods along the 157 mm line: about 60% longer than the target
+    zigzag = builtin_shapes()["line"](u) + 0.005 * np.column_stack(
+        [np.zeros_like(u), np.sin(40 * np.pi * u)]
+    )
+    stream, window = one_run(zigzag)
+    result = score_runs(stream, [window], Fbm3wConfig())
+    run = result.runs[0]
+    assert run.score is not None and run.target_length is not None
+    ratio = run.score.path_length / run.target_length
+    assert ratio > 1.5
+    assert any(f"{ratio - 1:.0%} longer than the target" in w for w in result.warnings)
