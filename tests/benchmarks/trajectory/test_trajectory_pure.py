@@ -188,3 +188,13 @@ def test_nan_and_zero_quaternion_poses_are_ignored_and_counted() -> None:
     assert r.metrics.position_error == pytest.approx((0.5 + 2.5) / 2, abs=1e-12)
     assert any("1 GT sample(s) with NaN" in w for w in r.warnings)
     assert any("1 robot pose(s) with NaN" in w for w in r.warnings)
+
+
+def test_nothing_comparable_is_a_failure() -> None:
+    # GT repeats one pose (tracking lost) for the whole robot log.
+    gt = stream([0, 100, 200, 300], [1.0, 1.0, 1.0, 1.0])
+    r = score_streams(stream([50, 150, 250], [0.0] * 3), gt, TrajectoryConfig())
+    assert r.metrics is None and r.tracking_lost == 3
+    assert r.failures and "no robot pose could be compared" in r.failures[0]
+    d = r.to_dict()
+    assert d["position_error"] is None and d["compared"] == 0
