@@ -39,14 +39,14 @@ class Fbm3wConfig:
         d_min: subsampling threshold in metres.
         shapes: usable shapes by name (built-ins plus valid user shapes).
         shape_errors: user shapes that could not be built: name -> one-line error.
-        source: the file it came from ("<built-in>" for the defaults).
+        source: the file it came from ("the built-in 2015 config" for the defaults).
     """
 
     runs_specifications: tuple[str, ...] = DEFAULT_RUNS
     d_min: float = DEFAULT_D_MIN
     shapes: dict[str, Shape] = field(default_factory=builtin_shapes)
     shape_errors: dict[str, str] = field(default_factory=dict)
-    source: str = "<built-in>"
+    source: str = "the built-in 2015 config"
 
     def shape(self, name: str) -> Shape:
         """The shape named ``name``.
