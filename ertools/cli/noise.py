@@ -61,17 +61,21 @@ def _poses(args: argparse.Namespace) -> PoseStream:
     from ertools.io import read_poses, topics
 
     opts = Fbm3wOptions(topic=args.topic, frame=args.frame, time_source="header")
-    try:
+    if args.topic is not None or args.frame is not None:
         return read_fbm3w_poses(args.bags, opts)
-    except TopicError:
-        if args.topic is not None or args.frame is not None:
-            raise
-        kinds = ("Pose2D", "PoseStamped", "TransformStamped", "Odometry")
-        found = [t for t, ty in topics(args.bags).items() if ty.rsplit("/", 1)[-1] in kinds]
-        if len(found) != 1:
-            raise
+    present = topics(args.bags)
+    if "/fbm3w/robot_at_work/pose2d" in present or "/fbm3w/robot_at_work/pose" in present:
+        return read_fbm3w_poses(args.bags, opts)
+    kinds = ("Pose2D", "PoseStamped", "TransformStamped", "Odometry")
+    found = [t for t, ty in present.items() if ty.rsplit("/", 1)[-1] in kinds]
+    if len(found) == 1:
         note(f"using the only pose topic {found[0]}")
         return read_poses(args.bags, found[0])
+    raise TopicError(
+        f"no /fbm3w/robot_at_work pose topic; pose topics there: {', '.join(found) or 'none'}; "
+        "choose one with --topic (or a tf frame with --frame)",
+        path=args.bags[0],
+    )
 
 
 def run(args: argparse.Namespace) -> int:
