@@ -48,8 +48,6 @@ def steps(samples: Path, out: Path) -> Iterator[Step]:
             "score",
             "fbm3w",
             str(fbm3_bag),
-            "--config",
-            str(_first(fbm3, "fbm3w*.yaml")),
             "--report",
             str(out / "fbm3w"),
         ],
@@ -88,7 +86,7 @@ def steps(samples: Path, out: Path) -> Iterator[Step]:
         "fbm1h_score.yaml",
     )
     robot = samples / "robotlog"
-    robot_bag = _first(robot, "*robot*.bag")
+    robot_bag = _first(robot, "FBM2H_*.bag")
     yield Step(
         "robot log vs ground truth",
         ["score", "trajectory", str(robot_bag), str(robot), "--report", str(out / "trajectory")],
