@@ -59,6 +59,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="local address to join the group on / bind to (default 0.0.0.0: any)",
     )
     net.add_argument(
+        "--source",
+        metavar="ADDR",
+        help="accept datagrams from this sender only (Motive's address; others are counted)",
+    )
+    net.add_argument(
         "--natnet-version",
         default="auto",
         help="the stream's NatNet version, e.g. 3.1, 4.0, 4.1 (default auto: from the first frame)",
@@ -151,6 +156,7 @@ def run(args: argparse.Namespace) -> int:
         health_interval_s=args.health,
         fsync=args.fsync,
         compression=args.compression,
+        source=args.source,
     )
     recorder = Recorder(config, options, report=lambda line: note(f"record: {line}"))
     bound = recorder.open()

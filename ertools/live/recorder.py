@@ -15,7 +15,9 @@ Differences from 2015, on purpose:
   opened, and at close the file's counters (frames, drops, undecodable packets, untracked).
 
 The loop is single-threaded and never blocks longer than the socket timeout (0.1 s), so
-flushing, splitting and health lines happen on time even when no data arrives.
+flushing, splitting and health lines happen on time even when no data arrives; only the NTP
+query at a split blocks longer (at most ``ntp_timeout_s``), while datagrams wait in the socket
+buffer with their kernel arrival stamps.
 """
 
 from __future__ import annotations
@@ -75,6 +77,8 @@ class RecordOptions:
         health_interval_s: period of the health line.
         fsync: fsync at every flush (survives power loss, costs a disk round trip).
         compression: MCAP chunk compression (zstd, lz4, none).
+        source: accept datagrams from this sender address only (None: any). Several Motive
+            instances may stream on one group (seed 4.2); the frames do not say which sent them.
     """
 
     out_dir: Path
@@ -94,6 +98,7 @@ class RecordOptions:
     health_interval_s: float = 5.0
     fsync: bool = False
     compression: str = "zstd"
+    source: str | None = None
 
     def validate(self) -> None:
         if self.split_s <= 0 or self.flush_interval_s <= 0 or self.health_interval_s <= 0:
@@ -152,16 +157,17 @@ def enable_kernel_timestamps(sock: socket.socket) -> bool:
 
 def receive(
     sock: socket.socket, kernel_stamps: bool, clock: Callable[[], int]
-) -> tuple[bytes, int]:
-    """One datagram and its arrival time (kernel stamp, else the host clock now)."""
+) -> tuple[bytes, int, str]:
+    """One datagram, its arrival time (kernel stamp, else the host clock now) and sender."""
     if not kernel_stamps:
-        return sock.recv(65536), clock()
-    data, ancillary, _flags, _addr = sock.recvmsg(65536, socket.CMSG_SPACE(_TIMESPEC.size))
+        data, addr = sock.recvfrom(65536)
+        return data, clock(), str(addr[0])
+    data, ancillary, _flags, addr = sock.recvmsg(65536, socket.CMSG_SPACE(_TIMESPEC.size))
     for level, kind, payload in ancillary:
         if level == socket.SOL_SOCKET and kind == SO_TIMESTAMPNS and len(payload) >= 16:
             sec, nsec = _TIMESPEC.unpack_from(payload)
-            return data, sec * 1_000_000_000 + nsec
-    return data, clock()
+            return data, sec * 1_000_000_000 + nsec, str(addr[0])
+    return data, clock(), str(addr[0])
 
 
 def open_socket(group: str | None, port: int, interface: str) -> socket.socket:
@@ -238,6 +244,7 @@ class Recorder:
         self.files: list[Path] = []
         self._sock: socket.socket | None = None
         self._kernel_stamps = False
+        self._foreign_seen: set[str] = set()
         self._file: LogFile | None = None
         self._channels: dict[str, int] = {}
         self._file_base: dict[str, int] = {}
@@ -282,12 +289,15 @@ class Recorder:
                     self._health(now - last_health)
                     last_health = now
                 try:
-                    data, t_ns = receive(self._sock, self._kernel_stamps, self._clock)
+                    data, t_ns, sender = receive(self._sock, self._kernel_stamps, self._clock)
                 except TimeoutError:
                     continue
                 except OSError as err:  # e.g. the interface went down: keep trying
                     self._report(f"warning: receive failed: {err.strerror or err}")
                     self.stop_event.wait(0.5)
+                    continue
+                if opts.source is not None and sender != opts.source:
+                    self._foreign(sender)
                     continue
                 self.handle_datagram(data, t_ns)
             self.finish()
@@ -369,7 +379,7 @@ class Recorder:
                 "config": self.config.source,
                 "namespace": normalize_namespace(opts.namespace),
                 "bodies": ",".join(f"{b.body_id}:{b.name}" for b in self.config.bodies),
-                "source": source,
+                "source": source + (f" from {opts.source} only" if opts.source else ""),
                 "host": socket.gethostname(),
                 "natnet_version": str(opts.natnet_version or "auto"),
                 "up_axis": opts.up_axis,
@@ -410,6 +420,13 @@ class Recorder:
         meta["scope"] = "counts of this file"
         self._file.close({"ertools.recorder.stats": meta})
         self._report(f"closed {self._file.path} ({self._file.messages} messages)")
+
+    def _foreign(self, sender: str) -> None:
+        """A datagram from another host than --source (e.g. a second Motive on the group)."""
+        self.stats.foreign += 1
+        if sender not in self._foreign_seen:
+            self._foreign_seen.add(sender)
+            self._report(f"ignoring datagrams from {sender} (not --source {self.options.source})")
 
     def _health(self, window_s: float) -> None:
         f = self._file

@@ -33,6 +33,7 @@ class RecorderStats:
     other_messages: int = 0  # well-formed NatNet messages that are not frames
     duplicates: int = 0  # frames received twice (same frame number back to back)
     restarts: int = 0  # frame number went backwards (Motive restarted)
+    foreign: int = 0  # datagrams from another sender than --source
     unconfigured: set[int] = field(default_factory=set)  # streamed IDs absent from the config
     last_frame_number: int | None = None
     last_error: str = ""
@@ -64,6 +65,8 @@ class RecorderStats:
         ]
         if self.duplicates or self.restarts:
             parts[-1] += f" duplicates {self.duplicates} restarts {self.restarts}"
+        if self.foreign:
+            parts[-1] += f" foreign {self.foreign}"
         parts.append(", ".join(b.as_text(window_s) for b in self.bodies.values()))
         self.window_frames = 0
         for b in self.bodies.values():
@@ -79,6 +82,7 @@ class RecorderStats:
             "other_messages": str(self.other_messages),
             "duplicates": str(self.duplicates),
             "restarts": str(self.restarts),
+            "foreign": str(self.foreign),
             "unconfigured_ids": ",".join(str(i) for i in sorted(self.unconfigured)),
         }
         for bid, b in self.bodies.items():

@@ -274,3 +274,34 @@ def test_stamps_are_kernel_arrival_times(tmp_path: Path) -> None:
     # span the 0.19 s of pacing although all were read within a few milliseconds.
     assert sent_from <= stamps[0] and stamps[-1] <= sent_to
     assert stamps[-1] - stamps[0] >= 150_000_000
+
+
+def test_source_filter_ignores_a_second_motive(tmp_path: Path) -> None:
+    import socket
+
+    from ertools.live.natnet import encode_frame
+    from ertools.live.simulate import make_frame
+
+    options = RecordOptions(
+        out_dir=tmp_path, name="src", group=None, port=0, interface="127.0.0.1",
+        source="127.0.0.1", duration_s=0.6, namespace="/fbm2h",
+    )  # fmt: skip
+    lines: list[str] = []
+    recorder = Recorder(CONFIG, options, report=lines.append)
+    port = recorder.open()
+    # Another "Motive" on 127.0.0.2 streams the same body ID 6 at another place.
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as other:
+        other.bind(("127.0.0.2", 0))
+        far = (SimulatedBody(6, center=(50.0, 50.0)),)
+        for k in range(5):
+            packet = encode_frame(make_frame(5000 + k, 0.0, far, {}), NatNetVersion(4, 1))
+            other.sendto(packet, ("127.0.0.1", port))
+    motive = SimulatedMotive(("127.0.0.1", port), (SimulatedBody(6),), n_frames=10, rate_hz=200.0)
+    motive.run()
+    summary = recorder.run()
+    assert recorder.stats.foreign == 5
+    assert summary.frames == 10 and summary.written[6] == 10
+    messages, _ = read_mcap(summary.files[0])
+    xs = [m.pose.position.x for topic, _, m in messages if topic == "/fbm2h/origin/pose"]
+    assert xs == [rb.position[0] for rb in expected_poses(motive, 6)]  # none near x = 50
+    assert sum("ignoring datagrams from 127.0.0.2" in line for line in lines) == 1
