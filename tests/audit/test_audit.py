@@ -249,3 +249,19 @@ def test_topic_that_stops_before_the_log_ends() -> None:
     # A machine silent after END is not a silence: the 2015 nodes stopped publishing then.
     cl_end = heartbeat(Machine.CLIENT, [*CLIENT[:-1], (12.0, C.END, "")], 12.0)
     assert audit_states(bm, None, cl_end).silences == ()
+
+
+def test_halt_between_runs() -> None:
+    # The referee halts the benchmark at 2.5 s, after READY and before any run started.
+    bm = heartbeat(Machine.BMBOX, [*BMBOX[:3], (2.6, B.END, "")], 3.0)
+    rb = heartbeat(Machine.REFBOX, [(0.0, R.START, ""), (2.5, R.END, "emergency halt")], 3.0)
+    audit = audit_states(bm, rb, None)
+    (end,) = audit.early_ends
+    assert (end.reason, end.payload, end.run, end.bmbox_state) == (
+        "halt",
+        "emergency halt",
+        None,
+        "READY",
+    )
+    assert audit.runs == ()
+    assert not any("without sending a score" in w for w in audit.warnings)  # it was halted

@@ -94,3 +94,22 @@ def test_bag_without_states_is_one_line_error(
 def test_missing_bag(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["audit", str(tmp_path / "nope.bag")]) == 1
     assert "no such file" in capsys.readouterr().err
+
+
+def test_several_benchmarks_need_benchmark_option(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bag = _write_bag(
+        tmp_path / "two.bag",
+        [
+            heartbeat(Machine.BMBOX, BMBOX, 20.0, topic="/fbm2h/bmbox_state"),
+            heartbeat(Machine.BMBOX, BMBOX[:4], 5.0, topic="/fbm3w/bmbox_state"),
+        ],
+    )
+    assert main(["audit", str(bag), "--no-rescore"]) == 2  # a usage error
+    assert "several benchmarks (fbm2h, fbm3w): give --benchmark" in capsys.readouterr().err
+    assert (
+        main(["audit", str(bag), "--benchmark", "fbm3w", "--no-rescore", "--format", "json"]) == 0
+    )
+    data = json.loads(capsys.readouterr().out)
+    assert data["benchmark"] == "fbm3w" and data["transitions_checked"] == 3
