@@ -11,7 +11,8 @@ INFO, visible with ``-v``).
 from __future__ import annotations
 
 import logging
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
@@ -40,10 +41,12 @@ class _Assembler:
     transforms, are collected and ordered at the end.
     """
 
-    def __init__(self, msgtype: str, t_record: I64) -> None:
-        self.t_record = t_record
-        self.multi = msgtype in TF_TYPES
-        n = 0 if self.multi else len(t_record)
+    def __init__(self, msgtype: str, count: int | None) -> None:
+        self.multi = msgtype in TF_TYPES or count is None
+        # sqlite rows of several storage files come file by file: merged by time at the end
+        self.by_time = count is None
+        n = 0 if self.multi or count is None else count
+        self.t_record = np.empty(n, dtype=np.int64)
         self.t_header = np.empty(n, dtype=np.int64)
         self.xyz = np.empty((n, 3))
         self.quat = np.empty((n, 4))
@@ -52,15 +55,16 @@ class _Assembler:
         self.frames: dict[str, int] = {"": 0}
         self.parts: list[tuple[I64, PoseBatch]] = []
 
-    def add(self, pos: I64, buf: U8, dec: Decoded) -> None:
-        """Rows decoded from messages at reference positions ``pos``."""
-        batch = to_batch(buf, dec, self.t_record[pos])
+    def add(self, pos: I64, buf: U8, dec: Decoded, t_record: I64) -> None:
+        """Rows decoded from messages at reference positions ``pos`` (record times given)."""
+        batch = to_batch(buf, dec, t_record)
         if self.multi:
             self.parts.append((pos[dec.msg_index], batch))
             return
         remap = np.array(
             [self.frames.setdefault(f, len(self.frames)) for f in batch.frames], np.int32
         )
+        self.t_record[pos] = t_record
         self.t_header[pos] = batch.t_header
         self.xyz[pos] = batch.xyz
         self.quat[pos] = batch.quat_xyzw
@@ -84,6 +88,9 @@ class _Assembler:
         pos = np.concatenate([p[0] for p in self.parts])
         if len(pos) > 1 and np.any(pos[1:] < pos[:-1]):
             batch = batch.take(np.argsort(pos, kind="stable"))
+        t = batch.t_record
+        if self.by_time and len(t) > 1 and np.any(t[1:] < t[:-1]):
+            batch = batch.take(np.argsort(t, kind="stable"))
         return batch
 
 
@@ -99,77 +106,111 @@ def _groups(keys: I64) -> list[tuple[int, I64]]:
     return [(int(sorted_keys[a]), order[a:b]) for a, b in zip(starts, ends, strict=True)]
 
 
-def _ros1(
-    bag: BagFile, conns: Sequence[Conn], msgtype: str, lo: int | None, hi: int | None
-) -> PoseBatch:
+# One run of messages: (reference positions, buffer, data starts, data lengths, record times).
+Run = tuple[I64, U8, I64, I64, I64]
+
+
+@dataclass(frozen=True)
+class Located:
+    """Messages of some connections located from a file's index, in the reference order.
+
+    ``count`` is the number of messages when the index tells it up front (ROS1, MCAP), None
+    otherwise (sqlite rows come as they are fetched); ``runs`` reads the data a few chunks at
+    a time.
+    """
+
+    count: int | None
+    runs: Iterator[Run]
+
+
+def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None) -> Located:
     from ertools.io.ros1_index import Ros1Bag
 
     assert isinstance(bag, Ros1Bag)
     touched, chunk_of, _rank, t_of, off_of = bag.select(conns, lo, hi)
-    out = _Assembler(msgtype, t_of)
-    groups = dict(_groups(chunk_of))
-    # Several chunks are decoded together (fewer NumPy calls per message), up to GROUP_BYTES
-    # of uncompressed data at a time so memory stays bounded.
-    batch: list[int] = []
-    size = 0
-    for i, ci in enumerate(touched):
-        batch.append(ci)
-        size += max(bag.layout.chunks[ci].data_len, 0) * (
-            1 if bag.layout.chunks[ci].compression == "none" else 4
-        )
-        if size < GROUP_BYTES and i + 1 < len(touched):
-            continue
-        chunks = [bag.layout.chunks[c] for c in batch]
-        datas = bag.chunks_bytes(chunks)
-        base = np.cumsum([0] + [len(d) for d in datas])
-        buf = np.frombuffer(b"".join(datas) if len(datas) > 1 else datas[0], dtype=np.uint8)
-        sel = np.concatenate([groups[c] for c in batch])
-        which = np.concatenate([np.full(len(groups[c]), k) for k, c in enumerate(batch)])
-        where = f"in {bag.path} in chunks at bytes {chunks[0].pos}..{chunks[-1].pos}"
-        offsets = off_of[sel]
-        if np.any(offsets + 8 > (base[1:] - base[:-1])[which]):
-            raise BagError(f"index points outside its chunk {where}")
-        start, length = bag.spans(buf, offsets + base[which], where)
-        if np.any(start + length > base[which + 1]):
-            raise BagError(f"message record runs past the end of its chunk {where}")
-        out.add(sel, buf, decode(msgtype, False, buf, start, length))
-        batch, size = [], 0
-    return out.result()
+
+    def runs() -> Iterator[Run]:
+        groups = dict(_groups(chunk_of))
+        # Several chunks are decoded together (fewer NumPy calls per message), up to
+        # GROUP_BYTES of uncompressed data at a time so memory stays bounded.
+        batch: list[int] = []
+        size = 0
+        for i, ci in enumerate(touched):
+            batch.append(ci)
+            chunk = bag.layout.chunks[ci]
+            size += max(chunk.data_len, 0) * (1 if chunk.compression == "none" else 4)
+            if size < GROUP_BYTES and i + 1 < len(touched):
+                continue
+            chunks = [bag.layout.chunks[c] for c in batch]
+            datas = bag.chunks_bytes(chunks)
+            base = np.cumsum([0] + [len(d) for d in datas])
+            buf = np.frombuffer(b"".join(datas) if len(datas) > 1 else datas[0], dtype=np.uint8)
+            sel = np.concatenate([groups[c] for c in batch])
+            which = np.concatenate([np.full(len(groups[c]), k) for k, c in enumerate(batch)])
+            where = f"in {bag.path} in chunks at bytes {chunks[0].pos}..{chunks[-1].pos}"
+            offsets = off_of[sel]
+            if np.any(offsets + 8 > (base[1:] - base[:-1])[which]):
+                raise BagError(f"index points outside its chunk {where}")
+            start, length = bag.spans(buf, offsets + base[which], where)
+            if np.any(start + length > base[which + 1]):
+                raise BagError(f"message record runs past the end of its chunk {where}")
+            yield sel, buf, start, length, t_of[sel]
+            batch, size = [], 0
+
+    return Located(len(t_of), runs())
 
 
-def _mcap(
-    bag: BagFile, conns: Sequence[Conn], msgtype: str, lo: int | None, hi: int | None
-) -> PoseBatch | None:
+def _mcap_runs(
+    bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None
+) -> Located | None:
     from ertools.io.mcap_index import McapIndex
 
     index = McapIndex.of(bag)
     if index is None:
         return None
-    cdr = conns[0].encoding == "cdr"
     plan = index.plan(conns, lo, hi)
-    out = _Assembler(msgtype, plan.t_record)
-    for pos, buf, start, length in index.chunks_of(plan):
-        out.add(pos, buf, decode(msgtype, cdr, buf, start, length))
-    return out.result()
+
+    def runs() -> Iterator[Run]:
+        for pos, buf, start, length in index.chunks_of(plan):
+            yield pos, buf, start, length, plan.t_record[pos]
+
+    return Located(len(plan.t_record), runs())
 
 
-def _sqlite(
-    bag: BagFile, conns: Sequence[Conn], msgtype: str, lo: int | None, hi: int | None
-) -> PoseBatch | None:
+def _sqlite_runs(
+    bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None
+) -> Located | None:
     from ertools.io.rosbag2 import sqlite_rows
 
     batches = sqlite_rows(bag.path, conns, lo, hi)
     if batches is None:
         return None
-    parts = [
-        to_batch(buf, decode(msgtype, conns[0].encoding == "cdr", buf, start, length), t_rec)
-        for buf, start, length, t_rec in batches
-    ]
-    batch = concat_batches(parts)
-    t = batch.t_record
-    if len(t) > 1 and np.any(t[1:] < t[:-1]):  # several storage files: merge by time
-        batch = batch.take(np.argsort(t, kind="stable"))
-    return batch
+
+    def runs() -> Iterator[Run]:
+        done = 0
+        for buf, start, length, t_rec in batches:
+            yield np.arange(done, done + len(start), dtype=np.int64), buf, start, length, t_rec
+            done += len(start)
+
+    return Located(None, runs())
+
+
+def locate(
+    bag: BagFile, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
+) -> Located | None:
+    """The messages of ``conns`` with record time in [start_ns, end_ns], or None when the
+    format has no bulk access (then the caller reads per message).
+
+    Raises:
+        LayoutMismatchError: the file lacks the index records the bulk path needs.
+    """
+    if bag.format in ("ros1", "ros1-active"):
+        return _ros1_runs(bag, conns, start_ns, end_ns)
+    if bag.format == "rosbag2-sqlite3":
+        return _sqlite_runs(bag, conns, start_ns, end_ns)
+    if bag.format in ("mcap", "rosbag2-mcap"):
+        return _mcap_runs(bag, conns, start_ns, end_ns)
+    return None
 
 
 def try_fast_batch(
@@ -186,17 +227,14 @@ def try_fast_batch(
         )
         return None
     msgtype = next(iter(types))
+    cdr = conns[0].encoding == "cdr"
     try:
-        if bag.format in ("ros1", "ros1-active"):
-            return _ros1(bag, conns, msgtype, start_ns, end_ns)
-        if bag.format == "rosbag2-sqlite3":
-            result = _sqlite(bag, conns, msgtype, start_ns, end_ns)
-            if result is not None:
-                return result
-        if bag.format in ("mcap", "rosbag2-mcap"):
-            result = _mcap(bag, conns, msgtype, start_ns, end_ns)
-            if result is not None:
-                return result
+        found = locate(bag, conns, start_ns, end_ns)
+        if found is not None:
+            out = _Assembler(msgtype, found.count)
+            for pos, buf, start, length, t_rec in found.runs:
+                out.add(pos, buf, decode(msgtype, cdr, buf, start, length), t_rec)
+            return out.result()
     except LayoutMismatchError as err:
         log.info(
             "%s: %s on %s not in the standard layout (%s); decoding per message",

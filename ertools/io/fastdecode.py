@@ -267,3 +267,54 @@ def to_batch(buf: U8, dec: Decoded, t_record: I64) -> PoseBatch:
     t_rec = t_record[dec.msg_index]
     t_hdr = dec.t_header if dec.has_header else t_rec.copy()
     return PoseBatch(t_rec, t_hdr, dec.xyz, dec.quat_xyzw, frame_idx, child_idx, frames)
+
+
+def is_state_definition(msgdef: str) -> bool:
+    """True when a stored definition is the 2015 state layout: ``uint8 state``, ``string payload``
+    (constants and comments aside), so the bulk state decoder applies."""
+    fields = []
+    for line in msgdef.split("\n"):
+        text = line.split("#", 1)[0].strip()
+        if text.startswith("==="):
+            break
+        if not text or "=" in text:
+            continue
+        fields.append(tuple(text.split()))
+    return fields == [("uint8", "state"), ("string", "payload")]
+
+
+def decode_states(buf: U8, start: I64, length: I64, cdr: bool) -> tuple[U8, list[str]]:
+    """(state codes, payloads) of state messages (``uint8 state``, ``string payload``).
+
+    Raises:
+        LayoutMismatchError: the bytes do not have that layout.
+    """
+    n = len(start)
+    if n == 0:
+        return np.empty(0, np.uint8), []
+    end = start + length
+    if cdr:
+        head = gather(buf, start, 2)
+        if np.any(head[:, 1] != 1) or np.any(head[:, 0] != 0):
+            raise LayoutMismatchError("not little-endian plain CDR")
+        origin = start + 4
+        state = gather(buf, origin, 1)[:, 0]
+        size = gather(buf, origin + 4, 4).view("<u4").reshape(-1).astype(np.int64)
+        text = origin + 8
+        if np.any(size < 1):
+            raise LayoutMismatchError("CDR string without terminator")
+        tail = end - (text + size)
+        if np.any(tail < 0) or np.any(tail > 3):  # up to 3 bytes of final padding
+            raise LayoutMismatchError("state messages longer or shorter than their layout")
+        size = size - 1
+    else:
+        state = gather(buf, start, 1)[:, 0]
+        size = gather(buf, start + 1, 4).view("<u4").reshape(-1).astype(np.int64)
+        text = start + 5
+        if not np.array_equal(text + size, end):
+            raise LayoutMismatchError("state messages longer or shorter than their layout")
+    raw = buf.tobytes()
+    payloads = [
+        raw[a : a + b].decode("utf-8") for a, b in zip(text.tolist(), size.tolist(), strict=True)
+    ]
+    return np.ascontiguousarray(state), payloads

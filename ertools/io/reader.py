@@ -10,6 +10,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -302,31 +303,100 @@ def _machine_of(topic: str, msgtype: str) -> Machine | None:
     return None
 
 
+def _bulk_states(
+    bag: BagFile, conns: list[Conn]
+) -> (
+    tuple[np.ndarray[Any, np.dtype[np.int64]], np.ndarray[Any, np.dtype[np.uint8]], list[str]]
+    | None
+):
+    """(record times, states, payloads) decoded in bulk, None when the layout is not the 2015
+    one or the format has no bulk access."""
+    from ertools.io.bulk import locate
+    from ertools.io.fastdecode import LayoutMismatchError, decode_states, is_state_definition
+
+    if len({c.encoding for c in conns}) != 1 or not all(
+        is_state_definition(c.msgdef) for c in conns
+    ):
+        return None
+    try:
+        found = locate(bag, conns, None, None)
+        if found is None:
+            return None
+        pos_parts, t_parts, s_parts, payloads = [], [], [], []
+        for pos, buf, start, length, t_rec in found.runs:
+            state, text = decode_states(buf, start, length, conns[0].encoding == "cdr")
+            pos_parts.append(pos)
+            t_parts.append(t_rec)
+            s_parts.append(state)
+            payloads.extend(text)
+    except LayoutMismatchError as err:
+        log.info("%s: %s not in the 2015 state layout (%s)", bag.path, conns[0].topic, err)
+        return None
+    if not pos_parts:
+        return np.empty(0, np.int64), np.empty(0, np.uint8), []
+    pos = np.concatenate(pos_parts)
+    order = np.argsort(pos, kind="stable")
+    t = np.concatenate(t_parts)[order]
+    if len(t) > 1 and np.any(t[1:] < t[:-1]):
+        order = order[np.argsort(t, kind="stable")]
+        t = np.concatenate(t_parts)[order]
+    return t, np.concatenate(s_parts)[order], [payloads[i] for i in order.tolist()]
+
+
 def read_states(paths: PathsLike, topic: str) -> StateStream:
     """A BmBox/RefBox/Client state topic as (record time, state code, payload), time-ordered.
 
     The machine comes from the message type (``rockin_scoring/BmBoxState`` ...) or, failing
-    that, from the topic name (``.../bmbox_state``).
+    that, from the topic name (``.../bmbox_state``). Messages in the 2015 layout (``uint8
+    state``, ``string payload``) are decoded in bulk; anything else goes through rosbags.
 
     Raises:
         TopicError: topic absent, or not a state topic (no ``state``/``payload`` fields).
     """
     plist = _paths(paths)
-    msgs = read_messages(plist, topic)
-    msgtype = msgs[0].msgtype if msgs else topics(plist).get(topic, "")
+    t_parts, s_parts, payloads = [], [], []
+    msgtype = ""
+    for p in plist:
+        with open_bag(p) as bag:
+            conns = bag.topic_conns(topic)
+            if not conns:
+                continue
+            msgtype = msgtype or conns[0].msgtype
+            if _machine_of(topic, conns[0].msgtype) is None:
+                raise TopicError(
+                    f"topic {topic} ({conns[0].msgtype}) is not a benchmark state topic "
+                    "(bmbox_state, refbox_state, client_state)",
+                    path=p,
+                )
+            bulk = _bulk_states(bag, conns)
+            if bulk is None:
+                deser = Deserializer(conns, p)
+                msgs = [(t, deser(raw, c)) for c, t, raw in bag.raw(conns)]
+                if msgs and not (hasattr(msgs[0][1], "state") and hasattr(msgs[0][1], "payload")):
+                    raise TopicError(
+                        f"topic {topic}: type {conns[0].msgtype} has no state/payload fields",
+                        path=p,
+                    )
+                bulk = (
+                    np.fromiter((t for t, _ in msgs), dtype=np.int64, count=len(msgs)),
+                    np.fromiter((int(m.state) for _, m in msgs), dtype=np.uint8, count=len(msgs)),
+                    [str(m.payload) for _, m in msgs],
+                )
+        t_parts.append(bulk[0])
+        s_parts.append(bulk[1])
+        payloads.extend(bulk[2])
+    if not t_parts:
+        raise _topic_error(plist, topic, "state topic")
     machine = _machine_of(topic, msgtype)
-    if machine is None:
-        raise TopicError(
-            f"topic {topic} ({msgtype}) is not a benchmark state topic "
-            "(bmbox_state, refbox_state, client_state)"
-        )
-    if msgs and not (hasattr(msgs[0].msg, "state") and hasattr(msgs[0].msg, "payload")):
-        raise TopicError(f"topic {topic}: type {msgtype} has no state/payload fields")
-    t = np.fromiter((m.t_ns for m in msgs), dtype=np.int64, count=len(msgs))
-    state = np.fromiter((int(m.msg.state) for m in msgs), dtype=np.uint8, count=len(msgs))
-    payload = tuple(str(m.msg.payload) for m in msgs)
+    assert machine is not None
+    t = np.concatenate(t_parts)
+    state = np.concatenate(s_parts)
+    if len(t) > 1 and np.any(t[1:] < t[:-1]):
+        log.warning("%s: messages from several files out of time order; sorted", topic)
+        order = np.argsort(t, kind="stable")
+        t, state, payloads = t[order], state[order], [payloads[i] for i in order.tolist()]
     src = str(plist[0]) if len(plist) == 1 else ";".join(map(str, plist))
-    return StateStream(machine, t, state, payload, topic, src)
+    return StateStream(machine, t, state, tuple(payloads), topic, src)
 
 
 def read_benchmark_states(paths: PathsLike, namespace: str) -> BenchmarkStates:

@@ -475,23 +475,27 @@ class Ros1Bag(BagFile):
     def raw(
         self, conns: Sequence[Conn], start_ns: int | None = None, end_ns: int | None = None
     ) -> Iterator[RawRecord]:
+        """Raw messages in the reference order, located in bulk (chunks read a few at a time;
+        the requested messages' bytes are held until yielded in order)."""
         if not conns:
             return
-        _, chunk_of, rank_of, t_of, off_of = self.select(conns, start_ns, end_ns)
-        cur = -1
-        buf = np.empty(0, np.uint8)
-        raw_bytes = b""
-        for i in range(len(t_of)):
-            ci = int(chunk_of[i])
-            if ci != cur:
-                chunk = self.layout.chunks[ci]
-                raw_bytes = self.chunk_bytes(chunk)
-                buf = np.frombuffer(raw_bytes, dtype=np.uint8)
-                cur = ci
-            where = self._where(self.layout.chunks[ci])
-            dpos, dlen = self.spans(buf, off_of[i : i + 1], where)
-            d0, d1 = int(dpos[0]), int(dpos[0] + dlen[0])
-            yield conns[int(rank_of[i])], int(t_of[i]), raw_bytes[d0:d1]
+        from ertools.io.bulk import locate
+
+        _touched, _chunk_of, rank_of, _t, _off = self.select(conns, start_ns, end_ns)
+        found = locate(self, conns, start_ns, end_ns)
+        assert found is not None
+        out: list[tuple[int, int, bytes]] = []
+        for pos, buf, start, length, t_rec in found.runs:
+            data = buf.tobytes()
+            out.extend(
+                (p, t, data[a : a + n])
+                for p, t, a, n in zip(
+                    pos.tolist(), t_rec.tolist(), start.tolist(), length.tolist(), strict=True
+                )
+            )
+        out.sort(key=lambda x: x[0])
+        for p, t, data in out:
+            yield conns[int(rank_of[p])], t, data
 
     def verify(self) -> None:
         """Decompress every chunk and check that every indexed record is a message record.

@@ -133,3 +133,80 @@ def test_real_bag_end_to_end() -> None:
     np.testing.assert_array_equal(tf.xyz[0], pose.xyz[0])  # the mocap node publishes both
     static = eio.read_tf(REAL_BAG, "world", "map")
     assert len(static) == 573
+
+
+STATE_TOPICS = ("/fbm3w/bmbox_state", "/fbm3w/refbox_state")
+
+
+def reference_states(path: Path, topic: str) -> tuple[list[int], list[int], list[str]]:
+    """States deserialized one by one by rosbags' own readers."""
+    from ertools.io.formats import detect_format
+    from ertools.io.typestore import Deserializer
+
+    fmt = detect_format(path)
+    bag = RosbagsFile(path, fmt) if fmt not in ("mcap", "ros1-active") else open_bag(path)
+    with bag:
+        conns = bag.topic_conns(topic)
+        deser = Deserializer(conns, path)
+        msgs = [(t, deser(raw, c)) for c, t, raw in bag.raw(conns)]
+    return [t for t, _ in msgs], [m.state for _, m in msgs], [m.payload for _, m in msgs]
+
+
+@pytest.mark.parametrize("topic", STATE_TOPICS)
+def test_bulk_states_equal_rosbags(scene_bag: tuple[str, Path], topic: str) -> None:
+    from ertools.io.reader import _bulk_states
+
+    _fmt, path = scene_bag
+    with open_bag(path) as bag:
+        bulk = _bulk_states(bag, bag.topic_conns(topic))
+    assert bulk is not None, "bulk state decoder did not apply"
+    t, state, payload = reference_states(path, topic)
+    assert bulk[0].tolist() == t and bulk[1].tolist() == state and bulk[2] == payload
+
+
+def test_bulk_states_on_sample_and_real_bags() -> None:
+    from ertools.io import summary
+    from ertools.io.reader import _bulk_states
+
+    bags = _sample_bags()
+    if not bags:
+        pytest.skip("sample_bags/ is empty (run `make samples`)")
+    checked = 0
+    for path in bags:
+        for topic in summary(path).topics:
+            if topic.msgtype.startswith("rockin_scoring/") and topic.count:
+                with open_bag(path) as bag:
+                    bulk = _bulk_states(bag, bag.topic_conns(topic.name))
+                assert bulk is not None
+                t, state, payload = reference_states(path, topic.name)
+                assert bulk[0].tolist() == t and bulk[1].tolist() == state and bulk[2] == payload
+                checked += 1
+    assert checked > 0
+
+
+def test_other_state_layout_falls_back(tmp_path: Path) -> None:
+    """A state type with an extra field is still read, through rosbags."""
+    from rosbags.rosbag1 import Writer
+
+    import ertools.io as eio
+
+    path = tmp_path / "odd.bag"
+    definition = "uint8 state\nstring payload\nuint32 extra\n"
+    with Writer(path) as w:
+        c = w.add_connection(
+            "/fbm1h/bmbox_state",
+            "rockin_scoring/msg/BmBoxState",
+            msgdef=definition,
+            md5sum="0" * 32,
+        )
+        for i in range(3):
+            payload = f"p{i}".encode()
+            raw = (
+                bytes([i])
+                + len(payload).to_bytes(4, "little")
+                + payload
+                + (7).to_bytes(4, "little")
+            )
+            w.write(c, 10**18 + i, raw)
+    s = eio.read_states(path, "/fbm1h/bmbox_state")
+    assert s.state.tolist() == [0, 1, 2] and s.payload == ("p0", "p1", "p2")
