@@ -293,10 +293,15 @@ def _csv_cell(value: Any) -> Any:
     return "" if value is None else value
 
 
+def csv_stem(name: str) -> str:
+    """A table name as a safe file stem (the table names come from the scorers)."""
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip(".") or "table"
+
+
 def _write_tables(outdir: Path, tables: dict[str, Rows], *, prefix: str) -> list[str]:
     names = []
     for name, rows in tables.items():
-        safe = re.sub(r"[^A-Za-z0-9_.-]+", "_", f"{prefix}{name}")
+        safe = csv_stem(f"{prefix}{name}")
         columns = list(dict.fromkeys(k for row in rows for k in row))
         with (outdir / f"{safe}.csv").open("w", newline="", encoding="utf-8") as fh:
             writer = csv.writer(fh)
@@ -380,7 +385,7 @@ def _page(
     if tables:
         parts = []
         for name, rows in tables.items():
-            link = h.link(f"{name}.csv", f"{name}.csv")
+            link = h.link(f"{csv_stem(name)}.csv", f"{csv_stem(name)}.csv")
             if not rows:
                 parts.append(f"<h3>{h.esc(name)}</h3><p>(empty) {link}</p>")
                 continue
