@@ -431,7 +431,16 @@ class Recorder:
     def _health(self, window_s: float) -> None:
         f = self._file
         name, size = (f.path.name, f.size) if f is not None else ("-", 0)
+        silent = self.stats.window_frames == 0
         self._report("health: " + self.stats.health_line(window_s, name, size))
+        if silent:
+            opts = self.options
+            where = f"group {opts.group}" if opts.group else "unicast"
+            self._report(
+                f"warning: no NatNet frame in the last {window_s:.1f} s on {where} port "
+                f"{self.port} (interface {opts.interface}): is streaming switched on in Motive "
+                "(seed 4.1)? check --group, --interface and --port"
+            )
 
     # ------------------------------------------------------------------ data
 

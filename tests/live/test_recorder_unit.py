@@ -61,10 +61,15 @@ def test_record_function_without_data(tmp_path: Path) -> None:
     from ertools.live.tail import is_finished, read_complete
 
     options = RecordOptions(
-        out_dir=tmp_path / "new", group=None, port=0, interface="127.0.0.1", duration_s=0.3
-    )
-    summary = record(CONFIG, options)
+        out_dir=tmp_path / "new", group=None, port=0, interface="127.0.0.1", duration_s=0.35,
+        health_interval_s=0.2,
+    )  # fmt: skip
+    lines: list[str] = []
+    summary = record(CONFIG, options, report=lines.append)
     (path,) = summary.files
     assert path.parent == tmp_path / "new" and is_finished(path)
     assert (summary.frames, summary.undecodable, summary.natnet_version) == (0, 0, "unknown")
     assert read_complete(path).messages == ()
+    # The health line after 0.2 s says nothing came, and what to check.
+    assert any(x.startswith("warning: no NatNet frame in the last 0.2 s") for x in lines)
+    assert any("is streaming switched on in Motive" in x for x in lines)
