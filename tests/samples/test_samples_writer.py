@@ -285,3 +285,20 @@ def test_bulk_write_speed(tmp_path: Path) -> None:
     # plus object construction) gone quadratic.
     assert elapsed < 10.0
     assert (tmp_path / "big.bag").stat().st_size > n * 85
+
+
+def test_write_many_keeps_call_order_for_equal_times(tmp_path: Path) -> None:
+    from rosbags.highlevel import AnyReader
+
+    path = tmp_path / "m.bag"
+    with BagWriter(path) as bag:
+        conn = bag.connection("/s", "std_msgs/String")
+        cls = bag.msgclass("std_msgs/String")
+        bag.write_many(conn, [T0 + 2, T0, T0], [cls(data="c"), cls(data="a"), cls(data="b")])
+        bag.write(conn, T0 + 1, cls(data="between"))
+        with pytest.raises(UsageError, match="2 times for 1"):
+            bag.write_many(conn, [T0, T0], [cls(data="x")])
+    with AnyReader([path]) as reader:
+        got = [(t, reader.deserialize(raw, c.msgtype).data) for c, t, raw in reader.messages()]
+    # Sorted by record time; the two messages at T0 stay in the order they were written.
+    assert got == [(T0, "a"), (T0, "b"), (T0 + 1, "between"), (T0 + 2, "c")]
