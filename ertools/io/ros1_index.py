@@ -195,19 +195,71 @@ def _walk_chunk(buf: bytes, base: int) -> Iterator[tuple[int, dict[str, bytes], 
         pos = dpos + dlen
 
 
+def _scanned_chunk(
+    pos: int,
+    compression: str,
+    data_pos: int,
+    data_len: int,
+    per: dict[int, tuple[list[int], list[int]]],
+) -> Ros1Chunk:
+    entries = {
+        cid: (np.array(ts, dtype=np.int64), np.array(offs, dtype=np.int64))
+        for cid, (ts, offs) in per.items()
+    }
+    times = [t for t, _ in entries.values() if len(t)]
+    return Ros1Chunk(
+        pos,
+        min(int(t.min()) for t in times) if times else 0,
+        max(int(t.max()) for t in times) if times else 0,
+        {cid: len(t) for cid, (t, _) in entries.items()},
+        compression,
+        data_pos,
+        data_len,
+        entries,
+    )
+
+
 def scan_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ros1Layout:
-    """Rebuild the index by walking every record (and every record inside every chunk)."""
+    """Rebuild the index by walking every record (and every record inside every chunk).
+
+    A recorder writes the chunk it is filling straight into the file, after a chunk header
+    whose size is only set when the chunk is closed; in an ``.active`` file those messages
+    appear as records outside any chunk. They are gathered into a pseudo-chunk (uncompressed,
+    covering that stretch of the file) so they are read like the others.
+    """
     log.info("%s: %s; scanning the whole file", path, why)
     problems = [why]
     conns: dict[int, Conn] = {}
     chunks: list[Ros1Chunk] = []
+    loose: dict[int, tuple[list[int], list[int]]] = {}
+    loose_start = loose_end = -1
+
+    def flush() -> None:
+        nonlocal loose, loose_start
+        if loose:
+            chunks.append(
+                _scanned_chunk(loose_start, "none", loose_start, loose_end - loose_start, loose)
+            )
+        loose, loose_start = {}, -1
+
     while pos < size:
         try:
             rec, data = read_record(f, pos, size, with_data=True)
         except RecordError as err:
             problems.append(f"truncated: last record incomplete ({err}); read up to byte {pos}")
             break
-        if rec.op == OP_CHUNK:
+        if rec.op == OP_MSG:
+            if loose_start < 0:
+                loose_start = rec.pos
+            ts, offs = loose.setdefault(u32(rec.fields, "conn"), ([], []))
+            ts.append(time_ns(rec.fields, "time"))
+            offs.append(rec.pos - loose_start)
+            loose_end = rec.end
+        elif rec.op == OP_CONNECTION:
+            cid, topic, cfields = connection_fields(rec, data)
+            conns.setdefault(cid, _conn(cid, topic, cfields))
+        elif rec.op == OP_CHUNK:
+            flush()
             compression = rec.fields.get("compression", b"none").decode("ascii", "replace")
             try:
                 buf = decompress(compression, data, f"at byte {pos}")
@@ -227,31 +279,14 @@ def scan_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ros1L
                 problems.append(f"corrupt chunk at byte {pos} skipped ({err})")
                 pos = rec.end
                 continue
-            entries = {
-                cid: (np.array(ts, dtype=np.int64), np.array(offs, dtype=np.int64))
-                for cid, (ts, offs) in per.items()
-            }
-            times = [t for t, _ in entries.values() if len(t)]
-            start = min(int(t.min()) for t in times) if times else 0
-            end = max(int(t.max()) for t in times) if times else 0
-            chunks.append(
-                Ros1Chunk(
-                    pos,
-                    start,
-                    end,
-                    {cid: len(t) for cid, (t, _) in entries.items()},
-                    compression,
-                    rec.data_pos,
-                    rec.data_len,
-                    entries,
-                )
-            )
-        elif rec.op == OP_CONNECTION:
-            cid, topic, cfields = connection_fields(rec, data)
-            conns.setdefault(cid, _conn(cid, topic, cfields))
-        elif rec.op not in (OP_INDEX, OP_CHUNK_INFO, OP_MSG):
+            if per:
+                chunks.append(_scanned_chunk(pos, compression, rec.data_pos, rec.data_len, per))
+        elif rec.op in (OP_INDEX, OP_CHUNK_INFO):
+            flush()
+        else:
             problems.append(f"unknown record op {rec.op} at byte {pos}")
         pos = rec.end
+    flush()
     return Ros1Layout(
         path, size, False, sorted(conns.values(), key=lambda c: c.id), chunks, problems
     )
@@ -260,20 +295,24 @@ def scan_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ros1L
 class Ros1Bag(BagFile):
     """A ROS1 bag read through its index (or a scan): raw messages and chunk access."""
 
-    def __init__(self, path: Path, layout: Ros1Layout | None = None) -> None:
+    def __init__(
+        self, path: Path, layout: Ros1Layout | None = None, *, strict: bool = True
+    ) -> None:
+        """Open ``path`` (its index, or a scan). With ``strict`` (reading), a closed bag whose
+        index was missing or damaged is refused; summaries pass ``strict=False``."""
         self.path = path
         self.layout = layout if layout is not None else read_layout(path)
         active = path.name.endswith(".active")
         self.format = "ros1-active" if active else "ros1"
         problems = self.layout.problems
-        if problems and not active:
+        if problems and not active and strict:
             # A closed bag without a sound index was cut short or damaged: reading what is
             # left would give a silently shorter stream.
             raise BagError(
                 f"{'; '.join(problems)}; re-copy the file or run `rosbag reindex` on a copy",
                 path=path,
             )
-        if problems:
+        if problems and strict:
             log.warning("%s: %s; reading what the scan found", path, "; ".join(problems))
         self.connections = tuple(self.layout.conns)
         self._f: BinaryIO | None = path.open("rb")
@@ -292,7 +331,8 @@ class Ros1Bag(BagFile):
     def _where(self, chunk: Ros1Chunk) -> str:
         return f"in {self.path} at byte {chunk.pos}"
 
-    def _chunk_record(self, chunk: Ros1Chunk) -> Record:
+    def chunk_record(self, chunk: Ros1Chunk) -> Record:
+        """The record header of a chunk (sets its compression and where its data lies)."""
         try:
             rec, _ = read_record(self.file, chunk.pos, self.layout.size)
         except RecordError as err:
@@ -308,7 +348,7 @@ class Ros1Bag(BagFile):
         out = []
         for chunk in self.layout.chunks:
             if not chunk.compression:
-                self._chunk_record(chunk)
+                self.chunk_record(chunk)
             out.append(chunk.compression)
         return out
 
@@ -316,7 +356,7 @@ class Ros1Bag(BagFile):
         """conn -> (record times, record offsets) of one chunk, from its index-data records."""
         if chunk.entries is not None:
             return chunk.entries
-        rec = self._chunk_record(chunk)
+        rec = self.chunk_record(chunk)
         pos = rec.end
         entries: dict[int, tuple[I64, I64]] = {}
         try:
@@ -341,7 +381,7 @@ class Ros1Bag(BagFile):
     def chunk_bytes(self, chunk: Ros1Chunk) -> bytes:
         """The uncompressed data of one chunk."""
         if chunk.data_pos < 0:
-            self._chunk_record(chunk)
+            self.chunk_record(chunk)
         self.file.seek(chunk.data_pos)
         data = self.file.read(chunk.data_len)
         if len(data) != chunk.data_len:
@@ -357,7 +397,7 @@ class Ros1Bag(BagFile):
         raw = []
         for chunk in chunks:
             if chunk.data_pos < 0:
-                self._chunk_record(chunk)
+                self.chunk_record(chunk)
             self.file.seek(chunk.data_pos)
             data = self.file.read(chunk.data_len)
             if len(data) != chunk.data_len:

@@ -105,13 +105,12 @@ def _ros1(path: Path, fmt: str, exact: bool) -> BagSummary:
     counts: dict[int, int] = defaultdict(int)
     if layout.chunks:
         # Ros1Bag refuses damaged closed bags for reading; the summary wants what is there.
-        bag = Ros1Bag.__new__(Ros1Bag)
-        bag.path, bag.layout, bag._f = path, layout, path.open("rb")
+        bag = Ros1Bag(path, layout, strict=False)
         try:
             chunks = layout.chunks if exact or not layout.indexed else layout.chunks[:1]
             for chunk in chunks:
                 if not chunk.compression:
-                    bag._chunk_record(chunk)
+                    bag.chunk_record(chunk)
                 compressions.add(chunk.compression)
             for chunk in layout.chunks:
                 if exact or chunk.entries is not None:
@@ -344,8 +343,7 @@ def record_times(path: str | Path) -> dict[str, I64]:
         from ertools.io.ros1_index import Ros1Bag, read_layout
 
         layout = read_layout(p)
-        bag = Ros1Bag.__new__(Ros1Bag)
-        bag.path, bag.layout, bag._f = p, layout, p.open("rb")
+        bag = Ros1Bag(p, layout, strict=False)
         topic_of = {c.id: c.topic for c in layout.conns}
         try:
             for chunk in layout.chunks:

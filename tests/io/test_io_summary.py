@@ -117,3 +117,22 @@ def test_real_bag_summary() -> None:
     assert s.format == "ros1" and s.compression == "none" and s.indexed
     # 57.6 s long (README)
     assert abs(s.duration_ns / 1e9 - 57.6) < 0.05
+
+
+def test_active_bag_with_open_chunk(tmp_path: Path, scene: Scene) -> None:
+    """The chunk a recorder is filling has a placeholder size of 0 and its records follow it
+    outside any chunk: they are read too."""
+    good = write(tmp_path / "g.bag", "ros1", scene.spec, chunk_bytes=2000)
+    from ertools.io.ros1_index import read_layout
+
+    data = bytearray(make_active(good, tmp_path / "tmp.bag.active").read_bytes())
+    last = read_layout(good).chunks[-1].pos
+    (hlen,) = struct.unpack_from("<I", data, last)
+    (dlen,) = struct.unpack_from("<I", data, last + 4 + hlen)
+    struct.pack_into("<I", data, last + 4 + hlen, 0)  # the size a recorder leaves: 0
+    active = tmp_path / "open.bag.active"
+    active.write_bytes(bytes(data[: last + 8 + hlen + dlen]))  # no index records after it
+    s = eio.summary(active)
+    assert s.format == "ros1-active" and not s.indexed
+    assert s.message_count == sum(expected_counts(scene).values())
+    np.testing.assert_array_equal(eio.read_poses(active, POSE).xyz, scene.xyz)
