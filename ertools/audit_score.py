@@ -160,6 +160,17 @@ def _align_indices(live: Any, recomputed: Any, notes: list[str], path: str = "")
     if not isinstance(live, dict) or not isinstance(recomputed, dict):
         return live
     lk, rk = _int_keys(live), _int_keys(recomputed)
+    if lk and not rk:
+        # An early 2015 FBM2 node put the segments straight under ``details``; ertools nests
+        # them one level deeper (``details.segments_details``): descend into that mapping.
+        holders = [k for k, v in recomputed.items() if isinstance(v, dict) and _int_keys(v)]
+        if len(holders) == 1:
+            notes.append(
+                f"{path or 'score'}: the live score has the indexed entries directly; "
+                f"compared with {path + '.' if path else ''}{holders[0]}"
+            )
+            live = {holders[0]: live}
+            lk = None
     if lk and rk and len(lk) == len(rk) and lk == [k + 1 for k in rk]:
         notes.append(
             f"{path or 'score'}: the live score numbers from 1, ertools from 0; "

@@ -164,3 +164,13 @@ def test_rules_2015_tell_deviations_from_data() -> None:
     assert orient.startswith("recomputed with the 2015 rules: -0.39999, the live value")
     dist = by_key["details.segments_details.0.dinstance_error"].explanation
     assert dist.startswith("recomputed with the 2015 rules: 0.102, still not the live value")
+
+
+def test_segments_straight_under_details_are_found() -> None:
+    # The early 2015 FBM2 node: score['details'] = segments_detail, numbered from 1.
+    live = {"details": {1: {"dinstance_error": 0.1}, 2: {"dinstance_error": 0.3}}}
+    cmp = compare_scores(live, _fbm2h(0.4, 0.1))
+    status = {line.key: line.status for line in cmp.lines}
+    assert status["details.segments_details.0.dinstance_error"] == "same"
+    assert status["details.segments_details.1.dinstance_error"] == "same"
+    assert "only live" not in status.values()
