@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import ast
 import math
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from ertools.configs.fbm3w import DEFAULT_RUNS, load_fbm3w_config, parse_fbm3w_config
 from ertools.configs.shapes import builtin_shapes, compile_expression, parse_shape
@@ -145,3 +148,60 @@ def test_bad_shape_fails_only_its_runs() -> None:
 def test_bad_configs(data: object, message: str) -> None:
     with pytest.raises(ConfigError, match=message):
         parse_fbm3w_config(data, "cfg.yaml")
+
+
+# --- property: the compiled closures evaluate like NumPy on the same text --------------------
+
+_FUNCS1 = ("sin", "cos", "tan", "exp", "sqrt", "abs", "log", "atan", "floor", "tanh")
+_FUNCS2 = ("atan2", "hypot", "min", "max")
+_NUMPY_NAMES = {
+    "sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "sqrt": np.sqrt,
+    "abs": np.abs, "log": np.log, "atan": np.arctan, "floor": np.floor, "tanh": np.tanh,
+    "atan2": np.arctan2, "hypot": np.hypot, "min": np.minimum, "max": np.maximum,
+    "pi": np.pi, "e": np.e, "tau": 2 * np.pi,
+}  # fmt: skip
+
+
+def _expressions() -> st.SearchStrategy[str]:
+    leaves = st.one_of(
+        st.sampled_from(["l", "pi", "e", "tau"]),
+        st.floats(0.0, 10.0, allow_nan=False).map(lambda v: repr(round(v, 3))),
+        st.integers(0, 5).map(str),
+    )
+
+    def extend(inner: st.SearchStrategy[str]) -> st.SearchStrategy[str]:
+        return st.one_of(
+            st.tuples(inner, st.sampled_from(["+", "-", "*", "/", "**", "%"]), inner).map(
+                lambda t: f"({t[0]} {t[1]} {t[2]})"
+            ),
+            st.tuples(st.sampled_from(["-", "+"]), inner).map(lambda t: f"{t[0]}{t[1]}"),
+            st.tuples(st.sampled_from(_FUNCS1), inner).map(lambda t: f"{t[0]}({t[1]})"),
+            st.tuples(st.sampled_from(_FUNCS2), inner, inner).map(
+                lambda t: f"{t[0]}({t[1]}, {t[2]})"
+            ),
+        )
+
+    return st.recursive(leaves, extend, max_leaves=8)
+
+
+class _FloatConstants(ast.NodeTransformer):
+    """Numbers -> np.float64(number): NumPy semantics (inf/nan, no ZeroDivisionError)."""
+
+    def visit_Constant(self, node: ast.Constant) -> ast.AST:
+        call = ast.Call(ast.Name("F", ast.Load()), [node], [])
+        return ast.copy_location(call, node)
+
+
+@pytest.mark.filterwarnings("ignore::hypothesis.errors.HypothesisWarning")
+@settings(max_examples=150, deadline=None)
+@given(text=_expressions())
+def test_compiled_expression_equals_numpy_evaluation(text: str) -> None:
+    ll = np.linspace(0.0, 1.0, 7)
+    # the test's own reference: Python evaluates its *generated* text on NumPy objects
+    tree = ast.fix_missing_locations(_FloatConstants().visit(ast.parse(text, mode="eval")))
+    code = compile(tree, "<generated>", "eval")
+    with np.errstate(all="ignore"):
+        expected = eval(code, {"__builtins__": {}}, {**_NUMPY_NAMES, "l": ll, "F": np.float64})
+    expected = np.broadcast_to(np.asarray(expected, dtype=float), ll.shape)
+    got = compile_expression(text)(ll)
+    np.testing.assert_allclose(got, expected.astype(float), rtol=1e-12, atol=0, equal_nan=True)
