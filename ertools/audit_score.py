@@ -424,14 +424,15 @@ def _check_2015(live: Any, value: Any) -> str:
         if abs(v - lv) <= max(DEFAULT_ABS_TOL, REPRODUCED_REL_TOL * abs(lv)):
             return (
                 f"recomputed with the 2015 rules: {v:.6g}, the live value (within "
-                f"{REPRODUCED_REL_TOL:.1%}): the difference is a deliberate deviation of ertools"
+                f"{REPRODUCED_REL_TOL:.1%}): the difference comes from ertools' deliberate "
+                "deviations or the options of this re-score, not from the data"
             )
         return (
             f"recomputed with the 2015 rules: {v:.6g}, still not the live value: the cause "
             "is in the data or the inputs, not in ertools' deviations"
         )
     if str(live) == str(value):
-        return "recomputed with the 2015 rules: the live value (a deliberate deviation)"
+        return "recomputed with the 2015 rules: the live value (a deviation or an option)"
     return f"recomputed with the 2015 rules: {value!r}, still not the live value"
 
 
@@ -545,9 +546,16 @@ def rescore(
 def rescore_2015(
     benchmark: str, paths: Sequence[Path], inputs: ScoreInputs
 ) -> BenchmarkResult | None:
-    """The score recomputed with every 2015 quirk the scorer can reproduce, or None when its
-    default already is the 2015 computation (fbm3w: d_min 0.33 mm, no arc length)."""
+    """The score recomputed with every 2015 quirk the scorer can reproduce (fbm2h: unwrapped
+    orientation; fbm1: ``Fbm1Options.as_2015``; fbm3w: the hard-coded d_min of 0.33 mm and no
+    arc-length parametrisation), or None when there is nothing to recompute."""
     plist = [Path(p) for p in paths]
+    if benchmark == "fbm3w":
+        from ertools.benchmarks.fbm3w import Fbm3wOptions, score_fbm3w
+        from ertools.configs.fbm3w import DEFAULT_D_MIN, load_fbm3w_config
+
+        options = Fbm3wOptions(d_min=DEFAULT_D_MIN, topic=inputs.topic, arc_length=False)
+        return score_fbm3w(plist, load_fbm3w_config(inputs.config), options)
     if benchmark == "fbm2h":
         from ertools.benchmarks.fbm2h import Fbm2hOptions, score_fbm2h
 

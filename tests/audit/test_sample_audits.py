@@ -119,3 +119,16 @@ def test_fbm2h_goal_and_results_in_the_runs(fbm2h: Path) -> None:
         assert run.result_ns == seg["end_ns"]
         assert yaml.safe_load(run.result) == {"waypoint": k}
     assert audit.early_ends == ()
+
+
+def test_fbm3w_other_d_min_is_explained_by_the_2015_rules(fbm3w: Path) -> None:
+    from ertools.audit_score import audit_bag
+
+    (bag,) = fbm3w.glob("*.bag")
+    audit, _ = audit_bag([bag], inputs=ScoreInputs(d_min=0.0005))
+    assert audit.comparison is not None
+    line = next(x for x in audit.comparison.differences if x.key == "best_distance_error")
+    # d_min 0.5 mm moves the score; the 2015 d_min (0.33 mm) gives the live value back.
+    assert line.explanation.startswith("recomputed with the 2015 rules:")
+    assert "the live value (within 0.1%)" in line.explanation
+    assert "d_min=0.0005" in line.explanation
