@@ -470,26 +470,39 @@ class Ros1Bag(BagFile):
     def spans(self, buf: U8, offsets: I64, where: str) -> tuple[I64, I64]:
         """(data start, data length) of the message records at ``offsets`` of a chunk.
 
-        Vectorised for the standard 38-byte message header; other records (a connection
-        record before the message, odd header layouts) are resolved one by one.
+        Vectorised for the standard 38-byte message header (conn, op, time fields in any
+        order), checking its op field; other records (a connection record before the message,
+        odd header layouts) are resolved one by one.
         """
+        from ertools.io.fastdecode import LayoutMismatchError, gather
+
         n = len(buf)
-        if len(offsets) and (offsets.min() < 0 or offsets.max() + 8 > n):
+        if len(offsets) == 0:
+            return offsets.copy(), offsets.copy()
+        if offsets.min() < 0 or offsets.max() + 8 > n:
             raise BagError(f"index points outside its chunk {where}")
-        idx4 = offsets[:, None] + np.arange(4)
-        hlen = buf[idx4].view("<u4").reshape(-1).astype(np.int64)
+        hlen = gather(buf, offsets, 4).view("<u4").reshape(-1).astype(np.int64)
         dpos = offsets + 8 + hlen
-        odd = hlen != MSG_HEADER_LEN
-        ok = ~odd
-        if ok.any() and dpos[ok].max() > n:
-            raise BagError(f"message record cut off inside its chunk {where}")
+        ok = (hlen == MSG_HEADER_LEN) & (dpos <= n)
+        if ok.any():
+            try:
+                head = gather(buf, offsets[ok] + 4, MSG_HEADER_LEN)
+            except LayoutMismatchError as err:
+                raise BagError(f"message record cut off inside its chunk {where}") from err
+            # The op field (len 4, "op=", 0x02) sits after 0, 1 or 2 of the other fields.
+            is_msg = np.zeros(len(head), dtype=bool)
+            for at in (0, 13, 17, 30):
+                is_msg |= np.all(head[:, at : at + 8] == _OP_MSG_FIELD, axis=1)
+            ok[np.flatnonzero(ok)[~is_msg]] = False
         dlen = np.zeros(len(offsets), dtype=np.int64)
         if ok.any():
-            dl_idx = (dpos[ok] - 4)[:, None] + np.arange(4)
-            dlen[ok] = buf[dl_idx].view("<u4").reshape(-1)
-        for i in np.flatnonzero(odd):
-            dpos[i], dlen[i] = self._resolve(bytes(buf), int(offsets[i]), where)
-        if len(offsets) and (dpos + dlen).max() > n:
+            dlen[ok] = gather(buf, dpos[ok] - 4, 4).view("<u4").reshape(-1)
+        odd = np.flatnonzero(~ok)
+        if len(odd):
+            raw = buf.tobytes()
+            for i in odd:
+                dpos[i], dlen[i] = self._resolve(raw, int(offsets[i]), where)
+        if (dpos + dlen).max() > n:
             raise BagError(f"message data cut off inside its chunk {where}")
         return dpos, dlen
 
@@ -543,25 +556,14 @@ class Ros1Bag(BagFile):
         Raises:
             BagError: the first damaged chunk, with its byte offset.
         """
-        from ertools.io.fastdecode import gather
-
         for chunk in self.layout.chunks:
             where = self._where(chunk)
             buf = np.frombuffer(self.chunk_bytes(chunk), dtype=np.uint8)
             for cid, (_t, off) in self.chunk_entries(chunk).items():
-                dpos, _dlen = self.spans(buf, off, where)
-                std = np.flatnonzero(dpos - off == 8 + MSG_HEADER_LEN)
-                if not len(std):
-                    continue
-                head = gather(buf, off[std] + 4, MSG_HEADER_LEN)
-                # The op field (len 4, "op=", 0x02) sits after 0, 1 or 2 of the other fields.
-                ok = np.zeros(len(std), dtype=bool)
-                for at in (0, 13, 17, 30):
-                    ok |= np.all(head[:, at : at + 8] == _OP_MSG_FIELD, axis=1)
-                if not ok.all():
-                    bad = int(off[std][~ok][0])
+                try:
+                    self.spans(buf, off, where)
+                except BagError as err:
                     raise BagError(
-                        f"corrupt chunk at byte {chunk.pos}: connection {cid}'s index points at "
-                        f"byte {bad} of the chunk, which holds no message record",
+                        f"corrupt chunk at byte {chunk.pos}: connection {cid}: {err.message}",
                         path=self.path,
-                    )
+                    ) from err
