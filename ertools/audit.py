@@ -622,7 +622,8 @@ def _runs(
         window_end = times[spans[k + 1][0]] if k + 1 < len(spans) else stream_end + 1
         visited = tuple(
             dict.fromkeys(
-                state_name(Machine.BMBOX, states[j]) for j in range(a, b if b else len(states))
+                state_name(Machine.BMBOX, states[j])
+                for j in range(a, b if b is not None else len(states))
             )
         )
         manual = ""
@@ -640,12 +641,11 @@ def _runs(
             # @Work the RefBox names the item (FBM1w); keep the BmBox text when it has one.
             manual = manual or ref_manual[0]
         result = _first_in(client, ClientState.COMPLETED_GOAL, times[a], window_end)
-        closer = states[b] if b is not None else None
-        if closer is None:
+        if b is None:
             outcome = "unfinished"
-        elif closer == BmBoxState.END:
+        elif states[b] == BmBoxState.END:
             outcome = "aborted"
-        elif states[b - 1] == BmBoxState.WAITING_MANUAL_OPERATION:  # type: ignore[operator]
+        elif states[b - 1] == BmBoxState.WAITING_MANUAL_OPERATION:
             outcome = "cancelled"
         else:
             outcome = "completed"
