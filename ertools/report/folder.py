@@ -105,9 +105,28 @@ def write_report(
         team: the team, when the caller knows it (else from ``--team``, the parameters or a
             ``transform-<team>.yaml`` argument).
     """
+    from ertools.errors import ConfigError
+
+    try:
+        outdir.mkdir(parents=True, exist_ok=True)
+        return _write_report(result, outdir, inputs, argv, audit, team)
+    except OSError as err:
+        raise ConfigError(
+            f"cannot write the report folder ({err.strerror or err}): choose another --report DIR",
+            path=outdir,
+        ) from err
+
+
+def _write_report(
+    result: BenchmarkResult,
+    outdir: Path,
+    inputs: list[Path],
+    argv: list[str],
+    audit: Any,
+    team: str | None,
+) -> Path:
     from ertools.audit import Audit
 
-    outdir.mkdir(parents=True, exist_ok=True)
     score: BenchmarkResult | None
     if isinstance(result, Audit):
         audit, score = result, result.recomputed
@@ -148,7 +167,7 @@ def write_report(
         "argv": list(argv),
         "inputs": [r.to_dict() for r in input_records],
         "configs": [r.to_dict() for r, _ in configs],
-        "headline": headline(score.to_dict()) if score is not None else {},
+        "headline": headline(jsonable(score.to_dict())) if score is not None else {},
         "score": jsonable(score.to_dict()) if score is not None else None,
         "warnings": list(_warnings(score, audit)),
         "failures": list(score.failures if score is not None else ()),

@@ -136,3 +136,13 @@ def test_report_of_score_bag_includes_its_audit(tmp_path: Path) -> None:
     meta = json.loads((out / "result.json").read_text())
     assert meta["audit"]["illegal_transitions"] == 1 and meta["audit"]["runs"] == 2
     assert (out / "figures" / "audit_timeline.png").exists()
+
+
+def test_report_dir_that_is_a_file(tmp_path: Path) -> None:
+    from ertools.errors import ConfigError
+
+    target = tmp_path / "taken"
+    target.write_text("not a folder")
+    with pytest.raises(ConfigError, match="cannot write the report folder"):
+        write_report(fbm3w_like(), target, inputs=[], argv=[])
+    assert target.read_text() == "not a folder"
