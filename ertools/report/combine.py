@@ -125,7 +125,10 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
     if not paths:
         raise ConfigError("no results given: pass report folders, result.json or score.json")
     entries = [load_entry(Path(p)) for p in paths]
-    outdir.mkdir(parents=True, exist_ok=True)
+    try:
+        outdir.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise ConfigError(f"cannot write here ({err.strerror or err})", path=outdir) from err
     by_benchmark: dict[str, list[Entry]] = {}
     for e in entries:
         by_benchmark.setdefault(e.benchmark, []).append(e)
