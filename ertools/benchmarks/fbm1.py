@@ -410,7 +410,7 @@ def score_fbm1_bag(
     items = load_items(items_path)
     results = None
     if results_path is not None:
-        results = parse_results(load_yaml(results_path, "results file"), str(results_path))
+        results = parse_results(load_yaml(results_path, "results"), str(results_path))
     states = read_benchmark_states(plist, ns)
     if states.bmbox is None or len(states.bmbox) == 0:
         raise SegmentationError(

@@ -32,7 +32,7 @@ from ertools.benchmarks.fbm2h_score import robot_poses_at, segment_errors
 from ertools.benchmarks.fbm2h_segments import ReachedMoments, StopParams
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
-from ertools.errors import ConfigError, SegmentationError
+from ertools.errors import ConfigError, ScoringError, SegmentationError
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import ns_to_s, s_to_ns
 
@@ -130,13 +130,21 @@ def compute(
         )
     if hits is not None and hits < 0:
         raise ConfigError(f"--hits must be >= 0, got {hits}")
+    from ertools.benchmarks.trajectory import drop_invalid
+
+    marker, invalid = drop_invalid(marker)
+    all_warnings = list(warnings)
+    if invalid:
+        all_warnings.append(invalid_warning(invalid, marker.source))
     t_mr = transform.arrays()
     poses = robot_poses_at(marker, t_mr, moments.end_ns, s_to_ns(max_gap_s))
     target = goal.as_array()
     errs = segment_errors(poses.xyyaw[:k], target[:k], orientation_2015=orientation_2015)
     failures: list[str] = []
     segments: list[SegmentResult] = []
-    t_rel0 = int(moments.start_ns[0]) if k else 0
+    # Failure messages count time as the table does: from the log's first message when known.
+    t_rel0 = origin_ns if origin_ns is not None else int(moments.start_ns[0]) if k else 0
+    since = "the log's first message" if origin_ns is not None else "the first segment start"
     for i in range(n):
         tgt = (float(target[i, 0]), float(target[i, 1]), float(target[i, 2]))
         if i >= k:
@@ -160,7 +168,7 @@ def compute(
             )
             failures.append(
                 f"segment {i}: no ground truth within --max-gap {max_gap_s} s of the reached "
-                f"moment {ns_to_s(end - t_rel0):.3f} s after the first segment start "
+                f"moment {ns_to_s(end - t_rel0):.3f} s after {since} "
                 f"({nearest}; tracking lost?) in {marker.source or 'the pose stream'}"
             )
             segments.append(SegmentResult(i, tgt, "no_gt", **common))  # type: ignore[arg-type]
@@ -180,7 +188,6 @@ def compute(
         )
     scored = all(s.status == "ok" for s in segments)
     execution_time = sum(s.segment_time or 0.0 for s in segments)
-    all_warnings = list(warnings)
     if transform.is_identity:
         all_warnings.append(
             "identity marker-to-robot transform: the marker set is taken to sit on the robot's "
@@ -232,6 +239,14 @@ def compute(
         deviations=tuple(deviations),
         failures=tuple(failures),
         provenance=provenance or Provenance(),
+    )
+
+
+def invalid_warning(count: int, source: str) -> str:
+    """The warning for marker poses dropped because they are NaN or zero quaternions."""
+    return (
+        f"{count} marker set pose(s) with NaN or zero-quaternion values ignored "
+        f"({source or 'the pose stream'}): reached moments near them may have no ground truth"
     )
 
 
@@ -291,9 +306,18 @@ def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
     marker = read_pose_source(list(paths), _pose_source(options))
     if len(marker) == 0:
         raise SegmentationError(f"{marker.source or paths[0]}: the marker set pose stream is empty")
+    from ertools.benchmarks.trajectory import drop_invalid
+
+    total = len(marker)
+    marker, invalid = drop_invalid(marker)
+    if len(marker) == 0:
+        raise ScoringError(
+            f"{marker.source or paths[0]}: all {total} marker set poses are NaN or have a zero "
+            "quaternion: nothing to score (was the body tracked?)"
+        )
     infos = [summary(p) for p in paths]
     bag_start, bag_end = min(i.start_ns for i in infos), max(i.end_ns for i in infos)
-    warnings: list[str] = []
+    warnings: list[str] = [invalid_warning(invalid, marker.source)] if invalid else []
     unreached: tuple[str, ...] = ()
     reached = options.reached
     states = None

@@ -72,6 +72,8 @@ def robot_poses_at(
         xyz, quat, np.broadcast_to(t_mr, xyz.shape).copy(), np.broadcast_to(q_mr, quat.shape).copy()
     )
     xyyaw = np.column_stack([rob_t[:, 0], rob_t[:, 1], yaw_from_quat(rob_q)])
+    # A NaN sample (or a NaN transform) must never become a score: such a moment has no GT.
+    ok = ok & np.all(np.isfinite(xyyaw), axis=1)
     xyyaw[~ok] = np.nan
     return PosesAt(xyyaw, ok, np.minimum(d_lo, d_hi).astype(np.int64), both)
 

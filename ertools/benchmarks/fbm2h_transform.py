@@ -83,27 +83,45 @@ def acquire_transform(
     window: Interval | None = None,
     params: StopParams | None = None,
     max_gap_ns: int = 100_000_000,
+    origin_ns: int | None = None,
 ) -> TransformAcquisition:
-    """T_marker_robot from the marker poses of a robot standing on the testbed origin."""
+    """T_marker_robot from the marker poses of a robot standing on the testbed origin.
+
+    ``origin_ns`` is time zero of the messages (the log's first message, as ``--at`` counts);
+    the first pose when None. Poses with NaN values or a zero quaternion are left out (a NaN
+    must never reach the transform file); a window holding some is warned about.
+    """
     from datetime import UTC, datetime
+
+    from ertools.benchmarks.trajectory import drop_invalid
 
     check_team_name(team)
     if len(marker) == 0:
         raise SegmentationError(f"{marker.source}: no marker set poses")
+    total = len(marker)
+    t_first = marker.start_ns if origin_ns is None else origin_ns
+    since = "the first pose" if origin_ns is None else "the log's first message"
+    marker, invalid = drop_invalid(marker)
+    if len(marker) == 0:
+        raise SegmentationError(
+            f"{marker.source}: all {total} marker set poses are NaN or have a zero quaternion "
+            "(was the marker set tracked?)"
+        )
     detected = window is None
     win = (
         window if window is not None else _longest_stop(marker, params or StopParams(), max_gap_ns)
     )
     part = marker.window(win.start_ns, win.end_ns)
-    t_first = marker.start_ns
     where = (
         f"{ns_to_s(win.start_ns - t_first):.3f} s to {ns_to_s(win.end_ns - t_first):.3f} s "
-        "after the first pose"
+        f"after {since}"
     )
     if len(part) < MIN_SAMPLES:
         raise SegmentationError(
             f"{marker.source}: only {len(part)} marker poses from {where}; need at least "
-            f"{MIN_SAMPLES} (is the window inside the log?)"
+            f"{MIN_SAMPLES} (is the window inside the log?"
+            + (f" {invalid} NaN or zero-quaternion poses were left out" if invalid else "")
+            + ")"
         )
     mean = mean_pose(part.xyz, part.quat_xyzw)
     t_mr, q_mr = invert(mean.xyz, mean.quat_xyzw)
@@ -116,6 +134,11 @@ def acquire_transform(
         source=marker.source,
     )
     warnings = []
+    if invalid:
+        warnings.append(
+            f"{invalid} marker set pose(s) with NaN or zero-quaternion values left out "
+            f"({marker.source})"
+        )
     if mean.position_std > SPREAD_WARN_M or mean.angle_std > SPREAD_WARN_RAD:
         warnings.append(
             f"the marker set moved during the window ({where}): spread "

@@ -446,8 +446,15 @@ def score_streams(
         notes.append(f"{bad_gt} GT sample(s) with NaN or zero-norm poses ignored")
     if bad_robot:
         notes.append(f"{bad_robot} robot pose(s) with NaN or zero-norm poses ignored")
-    if len(robot) == 0 or len(gt) < 2:
-        raise ScoringError(f"{where}: no valid poses left to compare (NaN or zero quaternions)")
+    if len(robot) == 0:
+        raise ScoringError(
+            f"{where}: no valid robot poses left to compare (NaN or zero quaternions)"
+        )
+    if len(gt) < 2:
+        raise ScoringError(
+            f"GT {gt_topic} in {', '.join(gt_files) or 'the GT files'}: {len(gt)} valid pose(s) "
+            "left in the robot log's span (the others are NaN or zero quaternions)"
+        )
     audit = estimate_offset(
         robot, gt, search_range_ns=config.offset_range_ns, max_gap_ns=config.max_gap_ns
     )

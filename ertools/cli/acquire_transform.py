@@ -63,21 +63,21 @@ def run(args: argparse.Namespace) -> int:
         else PoseSource(topic=args.topic or DEFAULT_TOPIC)
     )
     window = None
+    # Times in messages count from the log's first message, as --at does.
+    bag_start = min(summary(p).start_ns for p in args.bags)
     if args.at is not None:
-        bag_start = min(summary(p).start_ns for p in args.bags)
         start = resolve_time(args.at, bag_start)
         window = Interval(start, start + s_to_ns(args.duration))
     marker = read_pose_source(list(args.bags), source)
-    acq = acquire_transform(marker, team, window=window)
+    acq = acquire_transform(marker, team, window=window, origin_ns=bag_start)
     text = transform_yaml(acq.transform)
     out.parent.mkdir(parents=True, exist_ok=True)
     write_text(text, None)
     out.write_text(text, encoding="utf-8")
-    first = marker.start_ns
     how = "detected" if acq.detected else "given"
     note(
-        f"window ({how}): {(acq.window.start_ns - first) / 1e9:.3f} s to "
-        f"{(acq.window.end_ns - first) / 1e9:.3f} s after the first pose, "
+        f"window ({how}): {(acq.window.start_ns - bag_start) / 1e9:.3f} s to "
+        f"{(acq.window.end_ns - bag_start) / 1e9:.3f} s after the log's first message, "
         f"{acq.marker.count} poses"
     )
     note(

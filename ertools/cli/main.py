@@ -140,7 +140,10 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
     except BrokenPipeError:
         return 0
     except Exception as err:  # a bug: still one line unless --debug
-        if args.debug:
+        # A group member's own --debug re-raises through the group's run_command, whose
+        # parser left --debug in the member's arguments: the mark keeps the traceback.
+        if args.debug or getattr(err, "ertools_debug", False):
+            err.ertools_debug = True  # type: ignore[attr-defined]
             raise
         print(
             f"ertools: error: unexpected {type(err).__name__}: {err} "

@@ -157,7 +157,8 @@ def _print_table(result: object) -> None:
         "times from the log's first message"
     )
     for row in result.tables()["segments"]:
-        if row["status"] != "ok":
+        values = ("reached_s", "segment_time_s", "distance_error_m", "orientation_error_rad")
+        if row["status"] != "ok" or any(row[k] is None for k in values):
             note(f"  segment {row['segment']}: {row['status']}")
             continue
         note(

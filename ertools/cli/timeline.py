@@ -101,8 +101,19 @@ def run(args: argparse.Namespace) -> int:
         note(f"wrote {save_gantt(timeline, args.plot)}")
     if timeline.readable_count == 0:
         where = ", ".join(map(str, args.paths))
-        print(f"ertools: error: no readable bag in {where}", file=sys.stderr)
+        # Say why on the one error line: the reasons are otherwise only in the table on stdout.
+        reasons = [f"{p.path}: {p.problem}" for p in timeline.problems]
+        why = "; ".join(reasons[:3]) + (f"; {len(reasons) - 3} more" if len(reasons) > 3 else "")
+        print(
+            f"ertools: error: no readable bag in {where}" + (f" ({why})" if why else ""),
+            file=sys.stderr,
+        )
         return 1
+    for path in args.paths:
+        # A mistyped path among good ones still exits 0 (the others are read), but say it where
+        # a referee redirecting stdout to a file sees it.
+        if not path.exists():
+            note(f"warning: {path}: no such file or directory")
     return 0
 
 
