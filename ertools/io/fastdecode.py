@@ -15,6 +15,7 @@ give up, and the caller falls back to rosbags' deserializer.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -40,16 +41,26 @@ class LayoutMismatchError(ValueError):
     """The bytes do not have the layout of the standard message definition."""
 
 
+def read_at(buf: U8, pos: I64, dtype: np.dtype[Any]) -> npt.NDArray[Any]:
+    """One value of ``dtype`` (any alignment) starting at each ``pos`` of ``buf``.
+
+    ``buf`` is viewed as a run of overlapping ``dtype`` items, one starting at every byte
+    (stride 1), and indexed once: NumPy copies whole items, with no per-byte index array.
+    """
+    size = dtype.itemsize
+    if len(pos) and (int(pos.min()) < 0 or int(pos.max()) + size > len(buf)):
+        raise LayoutMismatchError("field past the end of the buffer")
+    if len(buf) < size:
+        return np.empty((0, *dtype.shape), dtype=dtype.base)
+    items = np.ndarray((len(buf) - size + 1,), dtype=dtype, buffer=buf, strides=(1,))
+    return items[pos]
+
+
 def gather(buf: U8, pos: I64, width: int) -> U8:
     """(N, width) bytes starting at each ``pos``."""
-    if len(pos) == 0:
-        return np.empty((0, width), np.uint8)
-    if int(pos.min()) < 0 or int(pos.max()) + width > len(buf):
-        raise LayoutMismatchError("field past the end of the buffer")
-    # Rows of a sliding-window view (every byte starts a row of ``width`` bytes): the index
-    # array is (N,), not (N, width).
-    windows = np.ndarray((len(buf) - width + 1, width), dtype=np.uint8, buffer=buf, strides=(1, 1))
-    out: U8 = windows[pos]
+    if len(pos) == 0 or width == 0:
+        return np.empty((len(pos), width), np.uint8)
+    out: U8 = read_at(buf, pos, np.dtype((np.void, width))).view(np.uint8).reshape(-1, width)
     return out
 
 
@@ -73,13 +84,13 @@ class Cursor:
 
     def u32(self) -> I64:
         self._align(4)
-        v = gather(self.buf, self.pos, 4).view("<u4").reshape(-1).astype(np.int64)
+        v = read_at(self.buf, self.pos, np.dtype("<u4")).astype(np.int64)
         self.pos = self.pos + 4
         return v
 
     def i32(self) -> I64:
         self._align(4)
-        v = gather(self.buf, self.pos, 4).view("<i4").reshape(-1).astype(np.int64)
+        v = read_at(self.buf, self.pos, np.dtype("<i4")).astype(np.int64)
         self.pos = self.pos + 4
         return v
 
@@ -96,7 +107,7 @@ class Cursor:
 
     def f64(self, count: int) -> F64:
         self._align(8)
-        v = gather(self.buf, self.pos, 8 * count).view("<f8").reshape(-1, count)
+        v = read_at(self.buf, self.pos, np.dtype(("<f8", (count,)))).reshape(-1, count)
         self.pos = self.pos + 8 * count
         return np.asarray(v, dtype=np.float64)
 
@@ -299,7 +310,7 @@ def decode_states(buf: U8, start: I64, length: I64, cdr: bool) -> tuple[U8, list
             raise LayoutMismatchError("not little-endian plain CDR")
         origin = start + 4
         state = gather(buf, origin, 1)[:, 0]
-        size = gather(buf, origin + 4, 4).view("<u4").reshape(-1).astype(np.int64)
+        size = read_at(buf, origin + 4, np.dtype("<u4")).astype(np.int64)
         text = origin + 8
         if np.any(size < 1):
             raise LayoutMismatchError("CDR string without terminator")
@@ -309,7 +320,7 @@ def decode_states(buf: U8, start: I64, length: I64, cdr: bool) -> tuple[U8, list
         size = size - 1
     else:
         state = gather(buf, start, 1)[:, 0]
-        size = gather(buf, start + 1, 4).view("<u4").reshape(-1).astype(np.int64)
+        size = read_at(buf, start + 1, np.dtype("<u4")).astype(np.int64)
         text = start + 5
         if not np.array_equal(text + size, end):
             raise LayoutMismatchError("state messages longer or shorter than their layout")

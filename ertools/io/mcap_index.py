@@ -231,13 +231,13 @@ class McapIndex:
 
     @staticmethod
     def _spans(buf: U8, off: I64, where: str) -> tuple[I64, I64]:
-        from ertools.io.fastdecode import gather
+        from ertools.io.fastdecode import read_at
 
         if len(off) and (int(off.min()) < 0 or int(off.max()) + 9 + MESSAGE_FIXED > len(buf)):
             raise BagError(f"message index points outside its chunk {where}")
         if np.any(buf[off] != OP_MESSAGE):
             raise BagError(f"message index points at a record that is no message {where}")
-        rlen = gather(buf, off + 1, 8).view("<u8").reshape(-1).astype(np.int64)
+        rlen = read_at(buf, off + 1, np.dtype("<u8")).astype(np.int64)
         start = off + 9 + MESSAGE_FIXED
         length = rlen - MESSAGE_FIXED
         if len(off) and (int((start + length).max()) > len(buf) or int(length.min()) < 0):

@@ -474,14 +474,14 @@ class Ros1Bag(BagFile):
         order), checking its op field; other records (a connection record before the message,
         odd header layouts) are resolved one by one.
         """
-        from ertools.io.fastdecode import LayoutMismatchError, gather
+        from ertools.io.fastdecode import LayoutMismatchError, gather, read_at
 
         n = len(buf)
         if len(offsets) == 0:
             return offsets.copy(), offsets.copy()
         if offsets.min() < 0 or offsets.max() + 8 > n:
             raise BagError(f"index points outside its chunk {where}")
-        hlen = gather(buf, offsets, 4).view("<u4").reshape(-1).astype(np.int64)
+        hlen = read_at(buf, offsets, np.dtype("<u4")).astype(np.int64)
         dpos = offsets + 8 + hlen
         ok = (hlen == MSG_HEADER_LEN) & (dpos <= n)
         if ok.any():
@@ -496,7 +496,7 @@ class Ros1Bag(BagFile):
             ok[np.flatnonzero(ok)[~is_msg]] = False
         dlen = np.zeros(len(offsets), dtype=np.int64)
         if ok.any():
-            dlen[ok] = gather(buf, dpos[ok] - 4, 4).view("<u4").reshape(-1)
+            dlen[ok] = read_at(buf, dpos[ok] - 4, np.dtype("<u4"))
         odd = np.flatnonzero(~ok)
         if len(odd):
             raw = buf.tobytes()
