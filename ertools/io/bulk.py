@@ -10,9 +10,11 @@ INFO, visible with ``-v``).
 
 from __future__ import annotations
 
+import itertools
 import logging
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -142,22 +144,48 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
             if size < GROUP_BYTES and i + 1 < len(touched):
                 continue
             chunks = [bag.layout.chunks[c] for c in batch]
-            datas = bag.chunks_bytes(chunks)
-            base = np.cumsum([0] + [len(d) for d in datas])
-            buf = np.frombuffer(b"".join(datas) if len(datas) > 1 else datas[0], dtype=np.uint8)
+            buf, base, sizes = _chunk_group(bag, chunks)
             sel = np.concatenate([groups[c] for c in batch])
             which = np.concatenate([np.full(len(groups[c]), k) for k, c in enumerate(batch)])
             where = f"in {bag.path} in chunks at bytes {chunks[0].pos}..{chunks[-1].pos}"
             offsets = off_of[sel]
-            if np.any(offsets + 8 > (base[1:] - base[:-1])[which]):
+            if np.any(offsets + 8 > sizes[which]):
                 raise BagError(f"index points outside its chunk {where}")
             start, length = bag.spans(buf, offsets + base[which], where)
-            if np.any(start + length > base[which + 1]):
+            if np.any(start + length > base[which] + sizes[which]):
                 raise BagError(f"message record runs past the end of its chunk {where}")
             yield sel, buf, start, length, t_of[sel]
             batch, size = [], 0
 
     return Located(len(t_of), runs())
+
+
+def _chunk_group(bag: BagFile, chunks: list[Any]) -> tuple[U8, I64, I64]:
+    """(bytes, where each chunk's data starts in them, each chunk's size) of ROS1 chunks.
+
+    Uncompressed chunks that follow each other in the file are read with one read of the
+    stretch they span (the index records between them come along, unused); others are
+    decompressed and joined.
+    """
+    from ertools.io.ros1_index import Ros1Bag
+
+    assert isinstance(bag, Ros1Bag)
+    if all(c.compression == "none" and c.data_pos >= 0 for c in chunks):
+        first = chunks[0].data_pos
+        span = chunks[-1].data_pos + chunks[-1].data_len - first
+        if all(b.data_pos > a.data_pos for a, b in itertools.pairwise(chunks)):
+            bag.file.seek(first)
+            data = bag.file.read(span)
+            if len(data) != span:
+                raise BagError(f"chunks cut off by end of file at byte {first}", path=bag.path)
+            base = np.array([c.data_pos - first for c in chunks], dtype=np.int64)
+            sizes = np.array([c.data_len for c in chunks], dtype=np.int64)
+            return np.frombuffer(data, dtype=np.uint8), base, sizes
+    datas = bag.chunks_bytes(chunks)
+    sizes = np.array([len(d) for d in datas], dtype=np.int64)
+    base = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
+    buf = np.frombuffer(b"".join(datas) if len(datas) > 1 else datas[0], dtype=np.uint8)
+    return buf, base, sizes
 
 
 def _mcap_runs(
