@@ -111,15 +111,9 @@ def describe(path: str | Path, *, check: bool = False) -> BagInfo:
     Raises:
         BagError: unreadable bag, or (with ``check``) a damaged chunk.
     """
-    from ertools.io.summary import record_times, summary
+    from ertools.io.summary import summary_and_times
 
-    s = summary(path, exact=True)
-    try:
-        times = record_times(path)
-    except BagError:
-        if s.indexed:
-            raise
-        times = {}  # a damaged unindexed file: the scan's counts are all there is
+    s, times = summary_and_times(path)
     rates = {name: median_rate(t) for name, t in times.items()}
     if check:
         verify(Path(path))

@@ -96,13 +96,17 @@ def _merge_topic(
     )
 
 
-def _ros1(path: Path, fmt: str, exact: bool) -> BagSummary:
+Times = dict[str, list[I64]]
+
+
+def _ros1(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagSummary:
     from ertools.io.ros1_index import Ros1Bag, read_layout
 
     layout = read_layout(path)
     compressions: set[str] = set()
     spans: dict[int, list[int]] = {}
     counts: dict[int, int] = defaultdict(int)
+    topic_of = {c.id: c.topic for c in layout.conns}
     if layout.chunks:
         # Ros1Bag refuses damaged closed bags for reading; the summary wants what is there.
         bag = Ros1Bag(path, layout, strict=False)
@@ -115,6 +119,8 @@ def _ros1(path: Path, fmt: str, exact: bool) -> BagSummary:
             for chunk in layout.chunks:
                 if exact or chunk.entries is not None:
                     for cid, (t, _off) in bag.chunk_entries(chunk).items():
+                        if times is not None:
+                            times.setdefault(topic_of.get(cid, f"conn {cid}"), []).append(t)
                         if len(t):
                             s = spans.setdefault(cid, [int(t.min()), int(t.max())])
                             s[0], s[1] = min(s[0], int(t.min())), max(s[1], int(t.max()))
@@ -188,7 +194,7 @@ def _mcap_scan(path: Path, why: str) -> BagSummary:
 
 
 def _mcap_topics(
-    path: Path, summary: Any, exact: bool
+    path: Path, summary: Any, exact: bool, times: Times | None = None
 ) -> tuple[dict[str, tuple[str, int, int | None, int | None, int]], set[str]]:
     spans: dict[int, list[int]] = {}
     compressions = set()
@@ -204,6 +210,8 @@ def _mcap_topics(
                     from ertools.io.mcap_index import McapIndex
 
                     t, _ = McapIndex._message_index(f, path, offset, cid)
+                    if times is not None:
+                        times.setdefault(summary.channels[cid].topic, []).append(t)
                     if need_counts:
                         counts[cid] = counts.get(cid, 0) + len(t)
                     if not len(t):
@@ -227,7 +235,7 @@ def _mcap_topics(
     return topics, compressions
 
 
-def _mcap(path: Path, exact: bool) -> BagSummary:
+def _mcap(path: Path, exact: bool, times: Times | None = None) -> BagSummary:
     from ertools.io.mcap_index import read_summary
 
     with path.open("rb") as f:
@@ -243,12 +251,12 @@ def _mcap(path: Path, exact: bool) -> BagSummary:
         return _mcap_scan(path, "no summary section (recording not finished?)")
     if not summary.chunk_indexes and summary.statistics and summary.statistics.message_count:
         return _mcap_scan(path, "no chunk indexes")
-    topics, compressions = _mcap_topics(path, summary, exact)
+    topics, compressions = _mcap_topics(path, summary, exact, times)
     version = f"mcap0 profile {header.profile or 'none'} ({header.library})"
     return _build(path, "mcap", version, "/".join(sorted(compressions)) or "none", True, topics, [])
 
 
-def _rosbag2(path: Path, fmt: str, exact: bool) -> BagSummary:
+def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagSummary:
     from ertools.io.rosbag2 import read_metadata, storage_files
 
     info = read_metadata(path)
@@ -268,7 +276,7 @@ def _rosbag2(path: Path, fmt: str, exact: bool) -> BagSummary:
             if summary is None:
                 problems.append(f"{file.name}: no MCAP summary section")
                 continue
-            part, chunk_compressions = _mcap_topics(file, summary, exact)
+            part, chunk_compressions = _mcap_topics(file, summary, exact, times)
             inner |= chunk_compressions - {"none"}
             for name, (msgtype, count, first, last, _n) in part.items():
                 _merge_topic(topics, name, msgtype, count, first, last)
@@ -332,6 +340,23 @@ def summary(path: str | Path, *, exact: bool = False) -> BagSummary:
     if fmt == "mcap":
         return _mcap(p, exact)
     return _rosbag2(p, fmt, exact)
+
+
+def summary_and_times(path: str | Path) -> tuple[BagSummary, dict[str, I64]]:
+    """The exact summary and every topic's sorted record times, from one pass over the index
+    records (what ``ertools info`` shows)."""
+    p = Path(path)
+    fmt = detect_format(p)
+    times: Times = {}
+    if fmt in ("ros1", "ros1-active"):
+        s = _ros1(p, fmt, True, times)
+    elif fmt == "mcap":
+        s = _mcap(p, True, times)
+    elif fmt == "rosbag2-mcap":
+        s = _rosbag2(p, fmt, True, times)
+    else:
+        return _rosbag2(p, fmt, True), record_times(p)
+    return s, {k: np.sort(np.concatenate(v)) for k, v in times.items()}
 
 
 def record_times(path: str | Path) -> dict[str, I64]:
