@@ -73,11 +73,14 @@ def median_rate(t_ns: np.ndarray[Any, np.dtype[np.int64]]) -> float | None:
 def find_bags(folder: Path) -> list[Path]:
     """Bags under a folder (not itself a rosbag2 bag), walked recursively, sorted."""
     out: list[Path] = []
+    rosbag2_dirs: set[Path] = set()
     for p in sorted(folder.rglob("*")):
-        if any(parent in out for parent in p.parents):
-            continue
-        rosbag2 = p.is_dir() and (p / "metadata.yaml").is_file()
-        if rosbag2 or (p.is_file() and p.name.endswith((".bag", ".bag.active", ".mcap"))):
+        if any(parent in rosbag2_dirs for parent in p.parents):
+            continue  # a storage file inside a rosbag2 folder already listed
+        if p.is_dir() and (p / "metadata.yaml").is_file():
+            rosbag2_dirs.add(p)
+            out.append(p)
+        elif p.is_file() and p.name.endswith((".bag", ".bag.active", ".mcap")):
             out.append(p)
     return out
 
