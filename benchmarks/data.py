@@ -21,7 +21,7 @@ NS_BODY = "/fbm3w/robot_at_work"
 GT_TOPIC = f"{NS_BODY}/pose"
 ROBOT_TOPIC = "/rockin/homer/marker_pose"
 PS, P2D, TFM = "geometry_msgs/PoseStamped", "geometry_msgs/Pose2D", "tf2_msgs/TFMessage"
-VERSION = 3  # bump to regenerate the cache
+VERSION = 4  # bump to regenerate the cache
 
 
 def trajectory(t_s: F64) -> tuple[F64, F64]:
@@ -91,6 +91,33 @@ def robot_topics(start_ns: int, seconds: float, seed: int) -> list[Topic]:
     ]
 
 
+def check_readback(path: Path, topics: list[Topic], first: int = 3000) -> None:
+    """rosbags reads the file back identically: message counts, record times and the raw
+    bytes of the first messages of every connection, and a deserialized first pose."""
+    from itertools import islice
+
+    from rosbags.highlevel import AnyReader
+
+    with AnyReader([path]) as reader:
+        expected = sum(len(t.t_ns) for t in topics)
+        if reader.message_count != expected:
+            raise SystemExit(f"{path}: rosbags counts {reader.message_count}, wrote {expected}")
+        conns = [c for c in reader.connections]
+        for topic in topics:
+            # connections of one topic are told apart by their message count
+            conn = next(c for c in conns if c.topic == topic.name and c.msgcount == len(topic.t_ns))
+            for i, (_c, t, raw) in enumerate(islice(reader.messages([conn]), first)):
+                if t != topic.t_ns[i] or bytes(raw) != topic.data[i].tobytes():
+                    raise SystemExit(f"{path}: {topic.name} message {i} reads back differently")
+            if topic.msgtype == PS:
+                _c, _t, raw = next(reader.messages([conn]))
+                msg = reader.deserialize(raw, conn.msgtype)
+                got = np.frombuffer(topic.data[0][-56:].tobytes(), "<f8")
+                p, q = msg.pose.position, msg.pose.orientation
+                if not np.array_equal(got, [p.x, p.y, p.z, q.x, q.y, q.z, q.w]):
+                    raise SystemExit(f"{path}: {topic.name} first pose deserializes differently")
+
+
 def generate(folder: Path, small_bags: int = 1000) -> dict[str, Path]:
     """Write (or reuse) every benchmark file; returns name -> path."""
     folder.mkdir(parents=True, exist_ok=True)
@@ -116,11 +143,15 @@ def generate(folder: Path, small_bags: int = 1000) -> dict[str, Path]:
     robot = robot_topics(T0, 3600, seed=2)
     write_ros1(paths["robot"], robot)
     write_ros1(paths["combined"], [*hour, *robot])
+    for key in ("gt", "gt_lz4", "gt_bz2"):
+        check_readback(paths[key], hour)
+    check_readback(paths["robot"], robot)
     del hour
     hour2 = gt_topics(T0, 3600, seed=1, ros1=False)
     ts2 = typestore(False)
     schemas = {t.msgtype: msgdef(ts2, t.msgtype, False)[0] for t in hour2}
     write_mcap(paths["gt_mcap"], hour2, schemas, "zstd")
+    check_readback(paths["gt_mcap"], hour2)
     del hour2
     small = paths["small"]
     small.mkdir(exist_ok=True)

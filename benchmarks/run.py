@@ -102,7 +102,9 @@ def machine() -> dict[str, str]:
         mem = f"{kb / 1024 / 1024:.1f} GiB"
     except (OSError, ValueError, IndexError):
         pass
+    load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
     return {
+        "load_average_at_start": load,
         "nproc": str(os.cpu_count()),
         "cpu": cpu,
         "memory": mem,
@@ -134,7 +136,8 @@ def main() -> int:
     }
     info = machine()
     print(
-        f"machine: {info['nproc']} cores, {info['cpu']}, {info['memory']}, Python {info['python']}"
+        f"machine: {info['nproc']} cores, {info['cpu']}, {info['memory']}, "
+        f"Python {info['python']}, load average {info['load_average_at_start']}"
     )
     title = "command (whole process, page cache warm)"
     print(f"  {title:<58} {'wall s':>8} {'inside':>8} {'peak MiB':>9}")
