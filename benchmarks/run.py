@@ -48,17 +48,21 @@ class Measure:
 
 
 def run_once(argv: list[str]) -> tuple[float, float, int, str]:
-    """(wall s, peak RSS MiB, exit status, stdout) of one whole process."""
-    t0 = time.perf_counter()
-    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=REPO)
-    out = proc.stdout.read() if proc.stdout else b""
-    err = proc.stderr.read() if proc.stderr else b""
-    _pid, status, usage = os.wait4(proc.pid, 0)
-    wall = time.perf_counter() - t0
-    proc.returncode = os.waitstatus_to_exitcode(status)
-    if proc.returncode != 0:
-        sys.stderr.write(err.decode(errors="replace")[-2000:])
-    return wall, usage.ru_maxrss / 1024.0, proc.returncode, out.decode(errors="replace")
+    """(wall s, peak RSS MiB, exit status, last stdout line) of one whole process, started
+    by the small launcher ``measure.py`` (see there why)."""
+    done = subprocess.run(
+        [PY, str(HERE / "measure.py"), *argv],
+        capture_output=True,
+        cwd=REPO,
+        check=False,
+    )
+    if done.returncode != 0 or not done.stdout.strip():
+        sys.stderr.write(done.stderr.decode(errors="replace")[-2000:])
+        return float("nan"), float("nan"), 1, ""
+    report = json.loads(done.stdout.decode().strip().splitlines()[-1])
+    if report["exit"] != 0:
+        sys.stderr.write(done.stderr.decode(errors="replace")[-2000:])
+    return report["wall_s"], report["maxrss_kib"] / 1024.0, report["exit"], report["last_line"]
 
 
 def measure(name: str, argv: list[str], runs: int) -> Measure:
@@ -69,7 +73,7 @@ def measure(name: str, argv: list[str], runs: int) -> Measure:
         ok &= code == 0
         walls.append(wall)
         rss.append(peak)
-        with contextlib.suppress(ValueError, KeyError, IndexError):
+        with contextlib.suppress(ValueError, KeyError, IndexError, TypeError):
             inside.append(float(json.loads(out.strip().splitlines()[-1])["inside_s"]))
     m = Measure(
         name,

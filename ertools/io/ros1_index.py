@@ -49,7 +49,7 @@ U8 = npt.NDArray[np.uint8]
 INDEX_DTYPE = np.dtype([("sec", "<u4"), ("nsec", "<u4"), ("off", "<u4")])
 # The message-data record header rosbag and rosbags write: conn (4), op (1), time (8) fields.
 MSG_HEADER_LEN = 4 + len("conn=") + 4 + 4 + len("op=") + 1 + 4 + len("time=") + 8
-_OP_MSG_FIELD = np.frombuffer(b"\x04\x00\x00\x00op=\x02", dtype=np.uint8)
+_OP_MSG_WORD = int.from_bytes(b"\x04\x00\x00\x00op=\x02", "little")
 
 
 @dataclass
@@ -474,7 +474,7 @@ class Ros1Bag(BagFile):
         order), checking its op field; other records (a connection record before the message,
         odd header layouts) are resolved one by one.
         """
-        from ertools.io.fastdecode import LayoutMismatchError, gather, read_at
+        from ertools.io.fastdecode import LayoutMismatchError, read_at
 
         n = len(buf)
         if len(offsets) == 0:
@@ -485,14 +485,15 @@ class Ros1Bag(BagFile):
         dpos = offsets + 8 + hlen
         ok = (hlen == MSG_HEADER_LEN) & (dpos <= n)
         if ok.any():
+            head = offsets[ok] + 4
+            # The op field (len 4, "op=", 0x02: one 8-byte word) sits after 0, 1 or 2 of the
+            # other fields (conn: 13 bytes, time: 17 bytes).
+            is_msg = np.zeros(len(head), dtype=bool)
             try:
-                head = gather(buf, offsets[ok] + 4, MSG_HEADER_LEN)
+                for at in (0, 13, 17, 30):
+                    is_msg |= read_at(buf, head + at, np.dtype("<u8")) == _OP_MSG_WORD
             except LayoutMismatchError as err:
                 raise BagError(f"message record cut off inside its chunk {where}") from err
-            # The op field (len 4, "op=", 0x02) sits after 0, 1 or 2 of the other fields.
-            is_msg = np.zeros(len(head), dtype=bool)
-            for at in (0, 13, 17, 30):
-                is_msg |= np.all(head[:, at : at + 8] == _OP_MSG_FIELD, axis=1)
             ok[np.flatnonzero(ok)[~is_msg]] = False
         dlen = np.zeros(len(offsets), dtype=np.int64)
         if ok.any():

@@ -145,3 +145,18 @@ def test_good_and_bad_together(
     assert [b["path"] for b in data["bags"]] == [str(good)]
     assert data["problems"][0]["path"] == str(bad)
     one_error_line(err, "bad.bag")
+
+
+def test_corrupted_record_in_uncompressed_chunk(
+    capsys: pytest.CaptureFixture[str], scene: Scene, tmp_path: Path
+) -> None:
+    good = write(tmp_path / "good.bag", "ros1", scene.spec, chunk_bytes=2000)
+    data = bytearray(good.read_bytes())
+    hits = [i for i in range(len(data)) if data[i : i + 4] == b"op=\x02"]
+    at = hits[len(hits) // 2]
+    data[at + 3] = 0x09  # a message record's op byte: no longer a message
+    bad = tmp_path / "badop.bag"
+    bad.write_bytes(bytes(data))
+    code, _, err = run(capsys, str(bad), "--check")
+    assert code == 1
+    one_error_line(err, "badop.bag", "corrupt chunk")
