@@ -240,15 +240,27 @@ def acquire_items_bag(
 
     plist = [Path(p) for p in paths]
     items = load_items(items_path, require_transforms=False)
-    t0 = min(summary(p).start_ns for p in plist)
+    infos = [summary(p) for p in plist]
+    t0 = min(i.start_ns for i in infos)
+    t_end = max(i.end_ns for i in infos)
     windows = None
     if windows_s is not None:
+        from ertools.errors import ConfigError
+
         windows = [Interval(resolve_time(a, t0), resolve_time(b, t0)) for a, b in windows_s]
         bad = [k + 1 for k, w in enumerate(windows) if w.end_ns <= w.start_ns]
         if bad:
-            from ertools.errors import ConfigError
-
             raise ConfigError(f"--windows: window(s) {bad} end before they start")
+        # Every window outside the log is a wrong time base (epoch vs log seconds), not
+        # untracked items: say it once rather than once per item. One stray window stays a
+        # failure of its item (the others are still acquired).
+        outside = [w for w in windows if w.end_ns < t0 or w.start_ns > t_end]
+        if windows and len(outside) == len(windows):
+            raise ConfigError(
+                f"--windows: every window lies outside the log ({plist[0]}: 0 to "
+                f"{(t_end - t0) / NS_PER_S:.1f} s from its first message); give seconds from "
+                "the log's first message or epoch seconds"
+            )
     src_origin, src_board = sources if sources is not None else (None, None)
     origin = read_body(plist, src_origin, f"/{namespace}/origin/pose", "origin")
     board = read_body(plist, src_board, f"/{namespace}/ref_board/pose", "ref_board")

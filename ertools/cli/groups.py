@@ -19,7 +19,7 @@ def add_group_arguments(parser: argparse.ArgumentParser, members: dict[str, Comm
     parser.add_argument(
         "member", choices=list(members), metavar="NAME", help="one of the members below"
     )
-    parser.add_argument("rest", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
+    parser.add_argument("rest", nargs=argparse.REMAINDER, metavar="ARGS", help=argparse.SUPPRESS)
 
 
 def run_group(group: str, members: dict[str, Command], args: argparse.Namespace) -> int:

@@ -8,6 +8,7 @@ import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib import import_module
+from typing import NoReturn
 
 from ertools import __version__
 
@@ -91,12 +92,19 @@ def _top_level_help() -> str:
     return "\n".join(lines)
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with the house error format: one ``ertools: error:`` line, exit status 2."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"ertools: error: {self.prog}: {message} (`{self.prog} --help` shows how)\n")
+
+
 def build_parser(prog: str, module_name: str) -> tuple[argparse.ArgumentParser, object]:
     """The parser of one command module (imported only now)."""
     module = import_module(module_name)
     description = (module.__doc__ or "").strip()
     epilog = getattr(module, "EPILOG", None)
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog=prog,
         description=description,
         epilog=epilog,
@@ -127,7 +135,10 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
     from ertools.errors import ErtoolsError
 
     parser, module = build_parser(prog, module_name)
-    args = parser.parse_args(list(argv))
+    try:
+        args = parser.parse_args(list(argv))
+    except SystemExit as stop:  # --help (0) or a usage error (2), already printed
+        return stop.code if isinstance(stop.code, int) else 2
     _configure_logging(args.verbose)
     try:
         code: int = module.run(args)  # type: ignore[attr-defined]

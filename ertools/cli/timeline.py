@@ -109,12 +109,20 @@ def run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 1
-    for path in args.paths:
-        # A mistyped path among good ones still exits 0 (the others are read), but say it where
-        # a referee redirecting stdout to a file sees it.
-        if not path.exists():
-            note(f"warning: {path}: no such file or directory")
+    # Unreadable, truncated or mistyped files do not stop the others being read (exit 0), but
+    # each is said on stderr too, where a referee redirecting stdout to a file still sees it.
+    by_path: dict[str, list[str]] = {}
+    for pr in timeline.problems:
+        by_path.setdefault(pr.path, []).append(pr.problem)
+    for shown, (path, problems) in enumerate(by_path.items()):
+        if shown == MAX_PROBLEM_NOTES:
+            note(f"warning: {len(by_path) - shown} more file(s) with problems: see the output")
+            break
+        note(f"warning: {path}: {'; '.join(problems)}")
     return 0
+
+
+MAX_PROBLEM_NOTES = 10
 
 
 def to_csv(timeline: Timeline) -> str:
