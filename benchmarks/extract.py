@@ -1,4 +1,5 @@
-"""One measured job, run as its own process by run.py: prints JSON with the in-process time.
+"""One measured job, run as its own process by run.py: prints JSON with the in-process time
+(``inside_s``: the work itself, after the imports, which are timed apart as ``import_s``).
 
 python benchmarks/extract.py bytes PATH              read the file's bytes
 python benchmarks/extract.py ertools PATH TOPIC      ertools.io.read_poses -> arrays
@@ -15,6 +16,12 @@ from pathlib import Path
 
 def main() -> None:
     mode, path = sys.argv[1], Path(sys.argv[2])
+    t_import = time.perf_counter()
+    if mode == "ertools":
+        from ertools.io import read_poses
+    elif mode == "rosbags":
+        import numpy as np
+        from rosbags.highlevel import AnyReader
     t0 = time.perf_counter()
     if mode == "bytes":
         n = 0
@@ -22,13 +29,8 @@ def main() -> None:
             while block := f.read(16 << 20):
                 n += len(block)
     elif mode == "ertools":
-        from ertools.io import read_poses
-
         n = len(read_poses(path, sys.argv[3]))
     elif mode == "rosbags":
-        import numpy as np
-        from rosbags.highlevel import AnyReader
-
         rows = []
         with AnyReader([path]) as reader:
             conns = [c for c in reader.connections if c.topic == sys.argv[3]]
@@ -40,7 +42,8 @@ def main() -> None:
         n = len(np.array(rows))
     else:
         raise SystemExit(f"unknown mode {mode}")
-    print(json.dumps({"n": n, "inside_s": time.perf_counter() - t0}))
+    done = time.perf_counter()
+    print(json.dumps({"n": n, "inside_s": done - t0, "import_s": t0 - t_import}))
 
 
 if __name__ == "__main__":

@@ -109,6 +109,7 @@ def _groups(keys: I64) -> list[tuple[int, I64]]:
 
 
 # One run of messages: (reference positions, buffer, data starts, data lengths, record times).
+# The buffer is only valid until the next run is asked for (it may be reused).
 Run = tuple[I64, U8, I64, I64, I64]
 
 
@@ -133,6 +134,7 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
 
     def runs() -> Iterator[Run]:
         groups = dict(_groups(chunk_of))
+        scratch: list[bytearray] = []
         # Several chunks are decoded together (fewer NumPy calls per message), up to
         # GROUP_BYTES of uncompressed data at a time so memory stays bounded.
         batch: list[int] = []
@@ -144,7 +146,7 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
             if size < GROUP_BYTES and i + 1 < len(touched):
                 continue
             chunks = [bag.layout.chunks[c] for c in batch]
-            buf, base, sizes = _chunk_group(bag, chunks)
+            buf, base, sizes = _chunk_group(bag, chunks, scratch)
             sel = np.concatenate([groups[c] for c in batch])
             which = np.concatenate([np.full(len(groups[c]), k) for k, c in enumerate(batch)])
             where = f"in {bag.path} in chunks at bytes {chunks[0].pos}..{chunks[-1].pos}"
@@ -160,12 +162,15 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
     return Located(len(t_of), runs())
 
 
-def _chunk_group(bag: BagFile, chunks: list[Any]) -> tuple[U8, I64, I64]:
+def _chunk_group(
+    bag: BagFile, chunks: list[Any], scratch: list[bytearray]
+) -> tuple[U8, I64, I64]:
     """(bytes, where each chunk's data starts in them, each chunk's size) of ROS1 chunks.
 
     Uncompressed chunks that follow each other in the file are read with one read of the
-    stretch they span (the index records between them come along, unused); others are
-    decompressed and joined.
+    stretch they span (the index records between them come along, unused) into ``scratch``,
+    a buffer reused from one group to the next (the decoders copy what they keep); others
+    are decompressed and joined.
     """
     from ertools.io.ros1_index import Ros1Bag
 
@@ -174,13 +179,15 @@ def _chunk_group(bag: BagFile, chunks: list[Any]) -> tuple[U8, I64, I64]:
         first = chunks[0].data_pos
         span = chunks[-1].data_pos + chunks[-1].data_len - first
         if all(b.data_pos > a.data_pos for a, b in itertools.pairwise(chunks)):
+            if not scratch or len(scratch[0]) < span:
+                scratch[:] = [bytearray(span)]
             bag.file.seek(first)
-            data = bag.file.read(span)
-            if len(data) != span:
+            got = bag.file.readinto(memoryview(scratch[0])[:span])
+            if got != span:
                 raise BagError(f"chunks cut off by end of file at byte {first}", path=bag.path)
             base = np.array([c.data_pos - first for c in chunks], dtype=np.int64)
             sizes = np.array([c.data_len for c in chunks], dtype=np.int64)
-            return np.frombuffer(data, dtype=np.uint8), base, sizes
+            return np.frombuffer(scratch[0], dtype=np.uint8, count=span), base, sizes
     datas = bag.chunks_bytes(chunks)
     sizes = np.array([len(d) for d in datas], dtype=np.int64)
     base = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)

@@ -12,6 +12,7 @@ import bz2
 import logging
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
+from io import BufferedReader
 from pathlib import Path
 from struct import error as struct_error
 from typing import BinaryIO
@@ -315,7 +316,7 @@ class Ros1Bag(BagFile):
         if problems and strict:
             log.warning("%s: %s; reading what the scan found", path, "; ".join(problems))
         self.connections = tuple(self.layout.conns)
-        self._f: BinaryIO | None = path.open("rb")
+        self._f: BufferedReader | None = path.open("rb")
 
     def close(self) -> None:
         if self._f is not None:
@@ -323,7 +324,7 @@ class Ros1Bag(BagFile):
             self._f = None
 
     @property
-    def file(self) -> BinaryIO:
+    def file(self) -> BufferedReader:
         if self._f is None:
             raise BagError("bag already closed", path=self.path)
         return self._f
