@@ -34,7 +34,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--topic", metavar="TOPIC", help=f"marker set pose topic (default {DEFAULT_TOPIC})"
     )
-    parser.add_argument("--tf-frame", metavar="FRAME", help="take /tf world -> FRAME instead")
+    parser.add_argument(
+        "--tf-frame",
+        "--frame",
+        dest="tf_frame",
+        metavar="FRAME",
+        help="take /tf world -> FRAME instead",
+    )
     parser.add_argument(
         "--out", type=Path, default=Path("."), metavar="DIR", help="where to write (default .)"
     )

@@ -31,7 +31,9 @@ Orientation errors are wrapped to [0, pi]; --orientation-2015 reproduces the 201
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="log file(s)")
+    # nargs="*": `--reached timing FILE log.bag` (option first) leaves the bag inside --reached's
+    # values; run() takes it back from there (see _reached), else one BAG is required.
+    parser.add_argument("bags", nargs="*", type=Path, metavar="BAG", help="log file(s)")
     parser.add_argument(
         "--goal", type=Path, metavar="FILE", help="goal list (Listing 10); default: from the log"
     )
@@ -48,7 +50,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="marker set pose topic, PoseStamped or Pose2D (default /fbm2h/robot_at_home/pose)",
     )
     parser.add_argument(
-        "--tf-frame", metavar="FRAME", help="take the marker set from /tf world -> FRAME instead"
+        "--tf-frame",
+        "--frame",
+        dest="tf_frame",
+        metavar="FRAME",
+        help="take the marker set from /tf world -> FRAME instead",
     )
     parser.add_argument(
         "--time-source",
@@ -98,18 +104,33 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_output_options(parser)
 
 
-def _reached(values: list[str] | None) -> tuple[str | None, Path | None]:
+NO_BAG = "give at least one BAG (the log file); `ertools score fbm2h --help` shows how"
+
+
+def _reached(
+    values: list[str] | None, bags: list[Path]
+) -> tuple[str | None, Path | None, list[Path]]:
+    """Mode, timing file and bags. With no BAG before the options, the values --reached
+    swallowed after its own (``--reached timing FILE log.bag``) are the bags."""
     from ertools.errors import UsageError
 
     if not values:
-        return None, None
+        if not bags:
+            raise UsageError(NO_BAG)
+        return None, None, bags
     mode, rest = values[0], values[1:]
+    need = 1 if mode == "timing" else 0
+    if not bags and len(rest) > need:
+        bags = [Path(v) for v in rest[need:]]
+        rest = rest[:need]
+    if not bags:
+        raise UsageError(NO_BAG)
     if mode == "timing":
         if len(rest) != 1:
             raise UsageError("--reached timing needs exactly one FILE")
-        return mode, Path(rest[0])
+        return mode, Path(rest[0]), bags
     if mode in ("states", "auto") and not rest:
-        return mode, None
+        return mode, None, bags
     raise UsageError(f"--reached: expected states, timing FILE or auto, got {' '.join(values)}")
 
 
@@ -117,7 +138,8 @@ def run(args: argparse.Namespace) -> int:
     from ertools.benchmarks.fbm2h import Fbm2hOptions, score_fbm2h
     from ertools.benchmarks.fbm2h_segments import StopParams
 
-    mode, timing = _reached(args.reached)
+    mode, timing, bags = _reached(args.reached, list(args.bags))
+    args.bags = bags
     options = Fbm2hOptions(
         goal=args.goal,
         transform=args.transform,

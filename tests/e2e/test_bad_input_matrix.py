@@ -822,6 +822,16 @@ def test_unknown_option(argv: list[str], capsys: pytest.CaptureFixture[str]) -> 
     _check_error(result, 2, "--no-such-option", "required", "invalid choice")
 
 
+def test_fbm2h_reached_before_the_bag(inputs: Inputs, capsys: pytest.CaptureFixture[str]) -> None:
+    """`--reached timing FILE BAG` (option first) scores as `BAG --reached timing FILE`."""
+    common = ["--goal", str(inputs.goal), "--transform", str(inputs.transform), "--format", "json"]
+    first = _run(["score", "fbm2h", str(inputs.fbm2h), "--reached", "timing", str(inputs.timing),
+                  *common], capsys)  # fmt: skip
+    second = _run(["score", "fbm2h", "--reached", "timing", str(inputs.timing), str(inputs.fbm2h),
+                   *common], capsys)  # fmt: skip
+    assert first.code == second.code == 0 and first.out == second.out
+
+
 # ---------------------------------------------------------------------------------------------
 # 8. Help: every command and member answers --help with its options and an example.
 
