@@ -8,6 +8,7 @@ import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib import import_module
+from pathlib import Path
 from typing import NoReturn
 
 from ertools import __version__
@@ -130,6 +131,34 @@ def _configure_logging(verbose: int) -> None:
     root.propagate = False
 
 
+# Options naming what a command writes; every other path option or argument is an input.
+OUTPUT_OPTIONS = {"output": "-o/--output", "report": "--report", "plot": "--plot", "out": "--out"}
+
+
+def _refuse_overwriting_inputs(args: argparse.Namespace) -> None:
+    """A UsageError when an output path is one of the input files (`-o run.bag`)."""
+    import os
+
+    from ertools.errors import UsageError
+
+    inputs: list[Path] = []
+    for name, value in vars(args).items():
+        if name in OUTPUT_OPTIONS:
+            continue
+        for v in value if isinstance(value, list | tuple) else [value]:
+            if isinstance(v, Path) and v.is_file():
+                inputs.append(v)
+    for name, flag in OUTPUT_OPTIONS.items():
+        out = getattr(args, name, None)
+        if not isinstance(out, Path) or not out.exists():
+            continue
+        for p in inputs:
+            if os.path.samefile(p, out):
+                raise UsageError(
+                    f"{flag} {out}: that is an input file; ertools never overwrites its inputs"
+                )
+
+
 def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
     """Parse ``argv`` for one command module and run it, mapping errors to exit codes."""
     from ertools.errors import ErtoolsError
@@ -141,6 +170,7 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
         return stop.code if isinstance(stop.code, int) else 2
     _configure_logging(args.verbose)
     try:
+        _refuse_overwriting_inputs(args)
         code: int = module.run(args)  # type: ignore[attr-defined]
     except ErtoolsError as err:
         print(f"ertools: error: {err}", file=sys.stderr)

@@ -822,6 +822,49 @@ def test_unknown_option(argv: list[str], capsys: pytest.CaptureFixture[str]) -> 
     _check_error(result, 2, "--no-such-option", "required", "invalid choice")
 
 
+OUTPUT_IS_INPUT: dict[str, Callable[[Inputs], tuple[list[str], Path]]] = {
+    "info -o BAG": lambda i: (["info", str(i.fbm2h), "-o", str(i.fbm2h)], i.fbm2h),
+    "timeline -o BAG": lambda i: (["timeline", str(i.fbm2h), "-o", str(i.fbm2h)], i.fbm2h),
+    "score fbm2h -o BAG": lambda i: (
+        ["score", "fbm2h", str(i.fbm2h), "--transform", str(i.transform), "-o", str(i.fbm2h)],
+        i.fbm2h,
+    ),
+    "score fbm2h -o TRANSFORM": lambda i: (
+        ["score", "fbm2h", str(i.fbm2h), "--transform", str(i.transform), "-o", str(i.transform)],
+        i.transform,
+    ),
+    "score fbm1h --report BAG": lambda i: (
+        ["score", "fbm1h", str(i.fbm1h), "--items", str(i.items), "--report", str(i.fbm1h)],
+        i.fbm1h,
+    ),
+    "score fbm3w --plot BAG": lambda i: (
+        ["score", "fbm3w", str(i.fbm3w), "--plot", str(i.fbm3w)],
+        i.fbm3w,
+    ),
+    "score trajectory -o GT": lambda i: (
+        ["score", "trajectory", str(i.robot), *_gt(i), "-o", str(i.gt[1])],
+        i.gt[1],
+    ),
+    "noise -o BAG": lambda i: (["noise", str(i.fbm3w), "-o", str(i.fbm3w)], i.fbm3w),
+    "acquire items -o ITEMS": lambda i: (
+        ["acquire", "items", str(i.fbm1h), "--items", str(i.items), "-o", str(i.items)],
+        i.items,
+    ),
+    "audit -o BAG": lambda i: (["audit", str(i.fbm2h), "-o", str(i.fbm2h)], i.fbm2h),
+}
+
+
+@pytest.mark.parametrize("case", list(OUTPUT_IS_INPUT))
+def test_output_onto_an_input_is_refused(
+    case: str, inputs: Inputs, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`-o run.bag` used to replace the bag with the score; the input must survive."""
+    argv, victim = OUTPUT_IS_INPUT[case](inputs)
+    result = _run(argv, capsys)  # _run also checks every input's bytes and mtime
+    line = _check_error(result, 2, victim.name)
+    assert "input" in line
+
+
 def test_fbm2h_reached_before_the_bag(inputs: Inputs, capsys: pytest.CaptureFixture[str]) -> None:
     """`--reached timing FILE BAG` (option first) scores as `BAG --reached timing FILE`."""
     common = ["--goal", str(inputs.goal), "--transform", str(inputs.transform), "--format", "json"]
