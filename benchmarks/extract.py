@@ -22,6 +22,10 @@ def main() -> None:
     elif mode == "rosbags":
         import numpy as np
         from rosbags.highlevel import AnyReader
+    elif mode == "inflate":
+        from ertools.io.files import open_bag
+        from ertools.io.mcap_index import McapIndex, read_summary
+        from ertools.io.ros1_index import Ros1Bag
     t0 = time.perf_counter()
     if mode == "bytes":
         n = 0
@@ -40,6 +44,21 @@ def main() -> None:
                 stamp = msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
                 rows.append((stamp, p.x, p.y, p.z, q.x, q.y, q.z, q.w))
         n = len(np.array(rows))
+    elif mode == "inflate":
+        n = 0
+        if path.suffix == ".mcap":
+            with path.open("rb") as f:
+                chunks = read_summary(f, path).chunk_indexes
+            for i in range(0, len(chunks), 4):
+                jobs = [(path, c) for c in chunks[i : i + 4]]
+                n += sum(len(b) for b in McapIndex._many(jobs))
+        else:
+            bag = open_bag(path)
+            assert isinstance(bag, Ros1Bag)
+            chunks = bag.layout.chunks
+            for i in range(0, len(chunks), 4):
+                n += sum(len(b) for b in bag.chunks_bytes(chunks[i : i + 4]))
+            bag.close()
     else:
         raise SystemExit(f"unknown mode {mode}")
     done = time.perf_counter()

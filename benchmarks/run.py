@@ -171,6 +171,13 @@ def main() -> int:
             [*ex, "bytes", p],
             args.runs,
         )
+        if fmt != "gt":
+            go(
+                f"inflate_{fmt}",
+                f"read + decompress every chunk ({label})",
+                [*ex, "inflate", p],
+                args.runs,
+            )
         go(
             f"extract_{fmt}",
             f"ertools: pose topic -> arrays ({label})",
@@ -279,6 +286,12 @@ def main() -> int:
             ratios[f"inside_extract_vs_bytes_{fmt}"] = a.inside_s / b.inside_s
             text = f"same, inside the process (after imports), {label}"
             print(f"  {text:<62} {a.inside_s / b.inside_s:7.2f}x   (target <= 3x)")
+    for fmt, label in (("gt_lz4", "ROS1 lz4"), ("gt_bz2", "ROS1 bz2"), ("gt_mcap", "MCAP zstd")):
+        a, b = results.get(f"extract_{fmt}"), results.get(f"inflate_{fmt}")
+        if a and b and a.inside_s and b.inside_s:
+            ratios[f"inside_extract_vs_inflate_{fmt}"] = a.inside_s / b.inside_s
+            text = f"inside: extraction / decompressing the chunks, {label}"
+            print(f"  {text:<62} {a.inside_s / b.inside_s:7.2f}x   (-)")
     for fmt in ("gt", "gt_mcap"):
         ratio(
             f"rosbags_vs_ertools_{fmt}",
