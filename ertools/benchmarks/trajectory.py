@@ -26,7 +26,7 @@ import numpy.typing as npt
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.benchmarks.clock_offset import OffsetEstimate, estimate_offset
-from ertools.errors import ClockError, ErtoolsError, ScoringError, TopicError
+from ertools.errors import BagError, ClockError, ErtoolsError, ScoringError, TopicError
 from ertools.geometry import Association, interpolate_poses, wrap_angle, yaw_from_quat
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import NS_PER_S, iso_utc, ns_to_s
@@ -797,28 +797,50 @@ def score(
         )
     explicit = {Path(p) for p in gt_paths if Path(p).is_file()}
     skipped: list[str] = []
+    for problem in found.problems:
+        if not Path(problem.path).exists():
+            # A mistyped GT path must not pass unnoticed behind the other GT files.
+            raise BagError(f"GT path: {problem.problem}", path=problem.path)
+        skipped.append(f"GT path {problem.path}: {problem.problem}")
     gt_summaries = []
+    broken: list[str] = []
     for p in found.bags:
         if Path(p).resolve() == Path(robot_path).resolve():
             continue
         try:
-            gt_summaries.append(summary(p))
+            s = summary(p)
         except ErtoolsError as err:
             if Path(p) in explicit:
                 raise
             # A broken bag elsewhere in a GT folder must not stop the scoring: say so.
             skipped.append(f"skipped unreadable file in the GT folder: {p}: {err.message}")
+            continue
+        gt_summaries.append(s)
+        damaged = [pr for pr in s.problems if not pr.startswith("not indexed")]
+        if damaged:
+            # Read up to the damage: GT poses past it are missing, which the coverage check
+            # then reports; say why here.
+            skipped.append(f"GT file {p} is damaged: {'; '.join(damaged)}")
+            broken.append(str(p))
     chosen, gtopic, warnings = select_gt(gt_summaries, lo - margin, hi + margin, gt_topic)
     warnings = skipped + warnings
     files = [s.path for s in chosen]
     gt = read_gt(files, gtopic, lo - margin, hi + margin)
-    return score_streams(
-        robot,
-        gt,
-        cfg,
-        robot_file=robot_path,
-        robot_topic=topic,
-        gt_topic=gtopic,
-        gt_files=files,
-        warnings=warnings,
-    )
+    try:
+        return score_streams(
+            robot,
+            gt,
+            cfg,
+            robot_file=robot_path,
+            robot_topic=topic,
+            gt_topic=gtopic,
+            gt_files=files,
+            warnings=warnings,
+        )
+    except ClockError as err:
+        if not broken:
+            raise
+        # The warnings die with the error: name the damaged GT file where the user looks.
+        raise ClockError(
+            f"{err}; damaged GT file(s), read only up to the damage: {', '.join(broken)}"
+        ) from err

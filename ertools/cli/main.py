@@ -159,6 +159,26 @@ def _refuse_overwriting_inputs(args: argparse.Namespace) -> None:
                 )
 
 
+# The largest magnitude a number option may have: seconds up to it (epoch seconds included)
+# still fit int64 nanoseconds with room to spare; no metre, radian or rate option comes near.
+MAX_OPTION_VALUE = 4.6e9
+
+
+def _check_numbers(args: argparse.Namespace) -> None:
+    """A UsageError for a NaN, infinite or absurdly large number option (`--max-gap nan`)."""
+    import math
+
+    from ertools.errors import UsageError
+
+    for name, value in vars(args).items():
+        for v in value if isinstance(value, list | tuple) else [value]:
+            if isinstance(v, float) and not (math.isfinite(v) and abs(v) < MAX_OPTION_VALUE):
+                flag = "--" + name.replace("_", "-")
+                raise UsageError(
+                    f"{flag} {v}: give a finite number smaller than {MAX_OPTION_VALUE:g} in size"
+                )
+
+
 def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
     """Parse ``argv`` for one command module and run it, mapping errors to exit codes."""
     from ertools.errors import ErtoolsError
@@ -170,6 +190,7 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
         return stop.code if isinstance(stop.code, int) else 2
     _configure_logging(args.verbose)
     try:
+        _check_numbers(args)
         _refuse_overwriting_inputs(args)
         code: int = module.run(args)  # type: ignore[attr-defined]
     except ErtoolsError as err:

@@ -768,6 +768,23 @@ def test_unsynchronised_clocks(
     _check_error(result, 1, *names)
 
 
+def test_mistyped_gt_path_among_good_ones(
+    inputs: Inputs, capsys: pytest.CaptureFixture[str]
+) -> None:
+    missing = inputs.root / "log_fbm2h_mocap_typo.bag"
+    argv = ["score", "trajectory", str(inputs.robot), *_gt(inputs), str(missing)]
+    _check_error(_run(argv, capsys), 1, missing.name)
+
+
+def test_damaged_gt_file_is_named(inputs: Inputs, capsys: pytest.CaptureFixture[str]) -> None:
+    # The second GT file cut in its middle: the robot poses after the first file are then
+    # outside the GT (the error), and the damaged file is named in that error.
+    cut = inputs.truncated(inputs.gt[1], 0.66)
+    argv = ["score", "trajectory", str(inputs.robot), str(inputs.gt[0]), str(cut)]
+    line = _check_error(_run(argv, capsys), 1, cut.name)
+    assert "outside the GT" in line and "damaged" in line
+
+
 def test_small_clock_offset_is_never_silent(
     inputs: Inputs, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -873,6 +890,41 @@ def test_fbm2h_reached_before_the_bag(inputs: Inputs, capsys: pytest.CaptureFixt
     second = _run(["score", "fbm2h", "--reached", "timing", str(inputs.timing), str(inputs.fbm2h),
                    *common], capsys)  # fmt: skip
     assert first.code == second.code == 0 and first.out == second.out
+
+
+# Every number option refuses NaN, infinities and values no unit of ertools reaches (they used
+# to end in "unexpected OverflowError" or, for fbm1's --still nan, in a score).
+NUMBER_OPTIONS: dict[str, Callable[[Inputs], list[str]]] = {
+    "timeline --clock-tolerance": lambda i: ["timeline", str(i.fbm2h), "--clock-tolerance"],
+    "fbm2h --max-gap": lambda i: ["score", "fbm2h", str(i.fbm2h), "--max-gap"],
+    "fbm2h --stop-speed": lambda i: ["score", "fbm2h", str(i.fbm2h), "--stop-speed"],
+    "fbm1h --still": lambda i: ["score", "fbm1h", str(i.fbm1h), "--items", str(i.items), "--still"],
+    "fbm1h --max-window": lambda i: [
+        "score", "fbm1h", str(i.fbm1h), "--items", str(i.items), "--max-window"
+    ],
+    "fbm3w --d-min": lambda i: ["score", "fbm3w", str(i.fbm3w), "--d-min"],
+    "trajectory --offset": lambda i: ["score", "trajectory", str(i.robot), *_gt(i), "--offset"],
+    "trajectory --offset-range": lambda i: [
+        "score", "trajectory", str(i.robot), *_gt(i), "--offset-range"
+    ],
+    "noise --bin": lambda i: ["noise", str(i.fbm3w), "--bin"],
+    "acquire transform --at": lambda i: [
+        "acquire", "transform", str(i.fbm2h), "--team", "qa", "--out", str(i.root / "tr"), "--at"
+    ],
+    "acquire items --min-still": lambda i: [
+        "acquire", "items", str(i.fbm1h), "--items", str(i.items), "--min-still"
+    ],
+    "audit --max-silence": lambda i: ["audit", str(i.fbm2h), "--max-silence"],
+}  # fmt: skip
+
+
+@pytest.mark.parametrize("value", ["nan", "inf", "-inf", "1e300"])
+@pytest.mark.parametrize("option", list(NUMBER_OPTIONS))
+def test_non_finite_number_option(
+    option: str, value: str, inputs: Inputs, capsys: pytest.CaptureFixture[str]
+) -> None:
+    result = _run([*NUMBER_OPTIONS[option](inputs), value], capsys)
+    _check_error(result, 2, option.rsplit(maxsplit=1)[-1])
 
 
 # ---------------------------------------------------------------------------------------------
