@@ -76,6 +76,14 @@ def parse_timing(data: Any, source: str = "<timing>") -> ReachedTiming:
                 f"{KEY}[{i}]: expected one 'pK: seconds' entry, got {entry!r}", path=source
             )
         ((label, value),) = entry.items()
+        if str(label) != f"p{i}":
+            # p(k+1) closes segment k: a label out of its place means an edited or merged
+            # file whose moments would close the wrong segments.
+            raise ConfigError(
+                f"{KEY}[{i}]: labelled {label!r}, expected 'p{i}' (entries are p0, p1, ... in "
+                "order: p0 starts, p(k+1) closes segment k)",
+                path=source,
+            )
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise ConfigError(f"{KEY}[{i}] {label}: {value!r} is not a number", path=source)
         if not math.isfinite(float(value)):

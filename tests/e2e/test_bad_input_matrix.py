@@ -431,6 +431,27 @@ def test_audit_bad_config_is_refused_unexecuted_even_when_only_warned(
     assert "Traceback" not in result.err and "evil.yaml" in result.err
 
 
+def test_mislabelled_timing_file(inputs: Inputs, capsys: pytest.CaptureFixture[str]) -> None:
+    # p0 twice, p1 missing: read by order this would silently close the wrong segments.
+    bad = inputs.root / "mislabelled_timing.yaml"
+    labels = ["p0", "p0", "p2", "p3", "p4", "p5"]
+    bad.write_text(
+        "reached_waypoint_timing:\n" + "".join(f"- {k}: {2 + i}.5\n" for i, k in enumerate(labels))
+    )
+    argv = CONFIG_OPTIONS["fbm2h--reached-timing"](inputs, bad)
+    line = _check_error(_run(argv, capsys), 1, bad.name)
+    assert "'p1'" in line
+
+
+def test_bad_quaternion_is_printed_as_numbers(
+    inputs: Inputs, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bad = inputs.root / "transform-zero-quaternion.yaml"
+    bad.write_text("marker_to_robot_transform:\n- [0.1, 0.0, 0.0]\n- [0, 0, 0, 0]\n")
+    line = _check_error(_run(CONFIG_OPTIONS["fbm2h--transform"](inputs, bad), capsys), 1, bad.name)
+    assert "[0.0, 0.0, 0.0, 0.0]" in line and "np." not in line
+
+
 # ---------------------------------------------------------------------------------------------
 # 3. Topics and frames that are not in the log.
 
