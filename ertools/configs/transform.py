@@ -117,8 +117,8 @@ def _pair(data: dict[str, Any], key: str, source: str) -> tuple[Vec3, Quat]:
     norm = float(np.linalg.norm(q))
     if abs(norm - 1.0) > QUAT_NORM_TOLERANCE:
         raise ConfigError(
-            f"{key}: quaternion {[float(x) for x in q]} has norm {norm:.6f}, not 1 (order is qx, qy, qz, qw); "
-            "fix or re-acquire the transform",
+            f"{key}: quaternion {[float(x) for x in q]} has norm {norm:.6f}, not 1 (order is "
+            "qx, qy, qz, qw); fix or re-acquire the transform",
             path=source,
         )
     return _vec3(t), _quat(q / norm)
