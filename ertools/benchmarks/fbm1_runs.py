@@ -249,12 +249,18 @@ def _refbox_item(changes: StateStream | None, lo: int | None, hi: int) -> ItemRe
 
 def _apply_order(runs: list[Fbm1Run], order: Sequence[str], warnings: list[str]) -> list[Fbm1Run]:
     if len(order) != len(runs):
+        beyond = (
+            " (runs after them keep the item their payload names)" if len(order) < len(runs) else ""
+        )
         warnings.append(
             f"--items-order names {len(order)} item(s) but the log has {len(runs)} run(s); "
-            "runs are matched in order"
+            f"runs are matched in order{beyond}"
         )
     out = []
     for k, run in enumerate(runs):
-        ref = parse_item_ref(order[k], "--items-order") if k < len(order) else None
-        out.append(replace(run, item=ref))
+        # Past the end of the order a run keeps its payload's item: a short --items-order
+        # (fixing the first runs) must not erase what the log says of the others.
+        out.append(
+            replace(run, item=parse_item_ref(order[k], "--items-order")) if k < len(order) else run
+        )
     return out

@@ -14,6 +14,7 @@ Cases run in-process through ``ertools.cli.main.main`` with ``capsys``.
 from __future__ import annotations
 
 import hashlib
+import json
 import random
 import re
 import shutil
@@ -429,6 +430,26 @@ def test_audit_bad_config_is_refused_unexecuted_even_when_only_warned(
     result = _run(["audit", str(inputs.fbm2h), "--goal", str(inputs.evil_yaml)], capsys)
     assert not (inputs.root / SENTINEL_NAME).exists()
     assert "Traceback" not in result.err and "evil.yaml" in result.err
+
+
+def test_short_items_order_keeps_the_payloads_of_later_runs(
+    inputs: Inputs, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`--items-order 10` fixes run 1 only (the sample shows item 10 first): the totals are
+    the answers file's, not nine 'no item named' failures."""
+    import yaml
+
+    answers = yaml.safe_load(next((SAMPLES / "fbm1h").glob("*.answers.yaml")).read_text())
+    first = answers["expected"]["runs"][0]
+    argv = ["score", "fbm1h", str(inputs.fbm1h), "--items", str(inputs.items), "--format", "json"]
+    result = _run([*argv, "--items-order", str(first["item_id"])], capsys)
+    assert result.code == 0, result.err
+    assert "keep the item their payload names" in result.err
+    got = json.loads(result.out)
+    for key, value in answers["expected"]["totals"].items():
+        # The answers' own tolerance for the pose score (mocap noise); the rest are exact.
+        tol = answers["tolerance"].get(key, {}).get("abs", 1e-9)
+        assert abs(got[key] - value) <= tol, key
 
 
 def test_mislabelled_timing_file(inputs: Inputs, capsys: pytest.CaptureFixture[str]) -> None:
