@@ -309,6 +309,8 @@ def score_fbm1(
         )
     for r in runs:
         warnings.extend(r.warnings)
+    if results is not None:
+        warnings.extend(_unused_results(results, runs))
     failures = [r.error for r in runs if r.error]
     return Fbm1Result(
         name=opts.benchmark,
@@ -321,6 +323,26 @@ def score_fbm1(
         failures=tuple(failures),
         provenance=provenance or Provenance(),
     )
+
+
+def _unused_results(results: ResultsFile, runs: Sequence[Fbm1RunResult]) -> list[str]:
+    """Warnings for answers of the results file that no run used (a wrong run or item)."""
+    run_numbers = {r.index for r in runs}
+    item_ids = {r.item.id for r in runs if r.item is not None}
+    out = []
+    unused_runs = sorted(k for k in results.by_run if k not in run_numbers)
+    if unused_runs:
+        out.append(
+            f"{results.source}: answer(s) for run(s) {unused_runs} not used: the log has runs "
+            f"1 to {max(run_numbers)}"
+        )
+    unused_items = sorted(k for k in results.by_item if k not in item_ids)
+    if unused_items:
+        out.append(
+            f"{results.source}: answer(s) for item(s) {unused_items} not used: no run "
+            "presented them"
+        )
+    return out
 
 
 def _parse_logged(payload: str | None) -> dict[str, Any] | None:

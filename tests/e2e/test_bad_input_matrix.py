@@ -452,6 +452,21 @@ def test_short_items_order_keeps_the_payloads_of_later_runs(
         assert abs(got[key] - value) <= tol, key
 
 
+def test_results_for_runs_and_items_not_in_the_log_are_said(
+    inputs: Inputs, capsys: pytest.CaptureFixture[str]
+) -> None:
+    results = inputs.root / "results_elsewhere.yaml"
+    results.write_text(
+        "- {run: 99, item_class: a, item_instance: a1, x: 0, y: 0, theta: 0}\n"
+        "- {item: 77, item_class: a, item_instance: a1, x: 0, y: 0, theta: 0}\n"
+    )
+    argv = CONFIG_OPTIONS["fbm1h--results"](inputs, results)
+    result = _run(argv, capsys)
+    warnings = [ln for ln in result.err.splitlines() if results.name in ln]
+    assert result.code == 0 and len(warnings) == 2, result.err
+    assert "[99]" in warnings[0] and "[77]" in warnings[1]
+
+
 def test_mislabelled_timing_file(inputs: Inputs, capsys: pytest.CaptureFixture[str]) -> None:
     # p0 twice, p1 missing: read by order this would silently close the wrong segments.
     bad = inputs.root / "mislabelled_timing.yaml"
