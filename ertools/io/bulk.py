@@ -96,7 +96,7 @@ class _Assembler:
         return batch
 
 
-def _groups(keys: I64) -> list[tuple[int, I64]]:
+def group_positions(keys: I64) -> list[tuple[int, I64]]:
     """(key, positions) for each distinct key, positions ascending (one sort, not N scans)."""
     if len(keys) == 0:
         return []
@@ -133,7 +133,7 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
     touched, chunk_of, _rank, t_of, off_of = bag.select(conns, lo, hi)
 
     def runs() -> Iterator[Run]:
-        groups = dict(_groups(chunk_of))
+        groups = dict(group_positions(chunk_of))
         scratch: list[bytearray] = []
         # Several chunks are decoded together (fewer NumPy calls per message), up to
         # GROUP_BYTES of uncompressed data at a time so memory stays bounded.

@@ -153,9 +153,9 @@ class McapIndex:
 
     def chunks_of(self, plan: McapPlan) -> Iterator[tuple[I64, U8, I64, I64]]:
         """Per chunk: (reference positions, chunk bytes, data starts, data lengths)."""
-        from ertools.io.bulk import _groups
+        from ertools.io.bulk import group_positions
 
-        groups = _groups(plan.key)
+        groups = group_positions(plan.key)
         # Decompress a few chunks at a time on all cores (zstd and lz4 release the GIL).
         step = 2 * _workers()
         for g in range(0, len(groups), step):

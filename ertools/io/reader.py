@@ -65,11 +65,15 @@ def _pose_topic_list(found: dict[str, str]) -> str:
 
 
 def _topic_error(paths: list[Path], topic: str, what: str = "pose topic") -> TopicError:
+    """The unknown-topic error: lists the pose topics there are (or all topics when the
+    caller was not after poses)."""
     found = topics(paths)
     where = str(paths[0]) if len(paths) == 1 else f"{len(paths)} files ({paths[0]}...)"
-    return TopicError(
-        f"{what} {topic} not in {where}; pose topics there: {_pose_topic_list(found)}"
-    )
+    if what in ("pose topic", "tf topic"):
+        listing = f"pose topics there: {_pose_topic_list(found)}"
+    else:
+        listing = f"topics there: {', '.join(found) or 'none'}"
+    return TopicError(f"{what} {topic} not in {where}; {listing}")
 
 
 def load_pose_batch(
@@ -184,6 +188,8 @@ def read_poses(
 def _tf_edges(
     plist: list[Path], start_ns: int | None, end_ns: int | None
 ) -> dict[tuple[str, str], Edge]:
+    from ertools.io.bulk import group_positions
+
     per_edge: dict[tuple[str, str], list[PoseStream]] = {}
     static_edges: set[tuple[str, str]] = set()
     for p in plist:
@@ -197,8 +203,7 @@ def _tf_edges(
                 batch = load_pose_batch(bag, conns, *window)
                 frames = np.asarray([frame_key(f) for f in batch.frames], dtype=np.str_)
                 pairs = batch.frame_idx.astype(np.int64) * len(frames) + batch.child_idx
-                for code in np.unique(pairs):
-                    rows = np.flatnonzero(pairs == code)
+                for code, rows in group_positions(pairs):
                     key = (str(frames[code // len(frames)]), str(frames[code % len(frames)]))
                     sub = batch.take(rows)
                     s = PoseStream(sub.t_header, sub.xyz, sub.quat_xyzw, key[0], key[1], str(p))
