@@ -136,7 +136,7 @@ OUTPUT_OPTIONS = {"output": "-o/--output", "report": "--report", "plot": "--plot
 
 
 def _refuse_overwriting_inputs(args: argparse.Namespace) -> None:
-    """A UsageError when an output path is one of the input files (`-o run.bag`)."""
+    """A UsageError when an output path is one of the inputs (`-o run.bag`)."""
     import os
 
     from ertools.errors import UsageError
@@ -146,8 +146,8 @@ def _refuse_overwriting_inputs(args: argparse.Namespace) -> None:
         if name in OUTPUT_OPTIONS:
             continue
         for v in value if isinstance(value, list | tuple) else [value]:
-            if isinstance(v, Path) and v.is_file():
-                inputs.append(v)
+            if isinstance(v, Path) and v.exists():
+                inputs.append(v)  # files, and folders read as a whole (`report DIR --out DIR`)
     for name, flag in OUTPUT_OPTIONS.items():
         out = getattr(args, name, None)
         if not isinstance(out, Path) or not out.exists():
@@ -155,7 +155,7 @@ def _refuse_overwriting_inputs(args: argparse.Namespace) -> None:
         for p in inputs:
             if os.path.samefile(p, out):
                 raise UsageError(
-                    f"{flag} {out}: that is an input file; ertools never overwrites its inputs"
+                    f"{flag} {out}: that is an input; ertools never overwrites its inputs"
                 )
 
 

@@ -939,6 +939,17 @@ def test_output_onto_an_input_is_refused(
     assert "input" in line
 
 
+def test_report_onto_its_own_result_folder_is_refused(
+    inputs: Inputs, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`report DIR --out DIR` used to replace the result's own index.html."""
+    folder = tmp_path / "fbm2h-report"
+    argv = ["score", "fbm2h", str(inputs.fbm2h), "--transform", str(inputs.transform)]
+    assert _run([*argv, "--report", str(folder)], capsys).code == 0
+    result = _run(["report", str(folder), "--out", str(folder)], capsys)  # snapshot: whole folder
+    assert "input" in _check_error(result, 2, folder.name)
+
+
 def test_fbm2h_reached_before_the_bag(inputs: Inputs, capsys: pytest.CaptureFixture[str]) -> None:
     """`--reached timing FILE BAG` (option first) scores as `BAG --reached timing FILE`."""
     common = ["--goal", str(inputs.goal), "--transform", str(inputs.transform), "--format", "json"]
