@@ -162,9 +162,7 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
     return Located(len(t_of), runs())
 
 
-def _chunk_group(
-    bag: BagFile, chunks: list[Any], scratch: list[bytearray]
-) -> tuple[U8, I64, I64]:
+def _chunk_group(bag: BagFile, chunks: list[Any], scratch: list[bytearray]) -> tuple[U8, I64, I64]:
     """(bytes, where each chunk's data starts in them, each chunk's size) of ROS1 chunks.
 
     Uncompressed chunks that follow each other in the file are read with one read of the
@@ -230,6 +228,25 @@ def _sqlite_runs(
     return Located(None, runs())
 
 
+def _scanned_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None) -> Located:
+    """Messages of a file read by a scan (an unfinished MCAP), joined into one buffer per
+    batch of messages so the same decoders apply."""
+    records = list(bag.raw(conns, lo, hi))
+
+    def runs() -> Iterator[Run]:
+        step = 100_000
+        for a in range(0, len(records), step):
+            part = records[a : a + step]
+            lengths = np.fromiter((len(r[2]) for r in part), dtype=np.int64, count=len(part))
+            starts = np.zeros(len(part), dtype=np.int64)
+            np.cumsum(lengths[:-1], out=starts[1:])
+            buf = np.frombuffer(b"".join(r[2] for r in part), dtype=np.uint8)
+            t = np.fromiter((r[1] for r in part), dtype=np.int64, count=len(part))
+            yield np.arange(a, a + len(part), dtype=np.int64), buf, starts, lengths, t
+
+    return Located(len(records), runs())
+
+
 def locate(
     bag: BagFile, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
 ) -> Located | None:
@@ -243,6 +260,8 @@ def locate(
         return _ros1_runs(bag, conns, start_ns, end_ns)
     if bag.format == "rosbag2-sqlite3":
         return _sqlite_runs(bag, conns, start_ns, end_ns)
+    if getattr(bag, "unfinished", False):
+        return _scanned_runs(bag, conns, start_ns, end_ns)
     if bag.format in ("mcap", "rosbag2-mcap"):
         return _mcap_runs(bag, conns, start_ns, end_ns)
     return None

@@ -130,61 +130,117 @@ class RosbagsFile(BagFile):
             self._reader = None
 
 
+def _conn_from_channel(channel: Any, schema: Any) -> Conn:
+    name = schema.name if schema is not None else ""
+    enc = schema.encoding if schema is not None else ""
+    data = schema.data.decode("utf-8", "replace") if schema is not None else ""
+    return Conn(
+        int(channel.id),
+        channel.topic,
+        short_msgtype(name),
+        data,
+        "idl" if enc == "ros2idl" else ("msg" if data else ""),
+        "ros1" if channel.message_encoding == "ros1" else "cdr",
+        "transient_local" in channel.metadata.get("offered_qos_profiles", ""),
+        "",
+    )
+
+
+# What the mcap library raises on damaged or cut-short files.
+def _mcap_errors() -> tuple[type[BaseException], ...]:
+    import struct
+
+    from mcap.exceptions import McapError
+
+    return (McapError, ValueError, EOFError, OSError, struct.error, KeyError)
+
+
 class McapFile(BagFile):
-    """A standalone MCAP file (ROS 2 ``cdr`` or ``ros1`` message encoding) via ``mcap``."""
+    """A standalone MCAP file (ROS 2 ``cdr`` or ``ros1`` message encoding) via ``mcap``.
+
+    A file without a summary section (a recorder that was killed, a file cut short) is read
+    as far as its records are complete, like a ROS1 ``.bag.active``: ``unfinished`` is True
+    and a warning says so.
+    """
 
     def __init__(self, path: Path) -> None:
-        from mcap.exceptions import McapError
         from mcap.reader import make_reader
 
         self.path = path
         self.format = "mcap"
+        self.unfinished = False
+        self._scanned: list[tuple[int, int, int, bytes]] = []  # log time, position, channel, data
         self._f = path.open("rb")
         try:
             self._reader = make_reader(self._f)
             summary = self._reader.get_summary()
-            if summary is None:
-                raise BagError(
-                    "MCAP file has no summary section (unfinished recording?)", path=path
-                )
-            channels = summary.channels
-            schemas = summary.schemas
-        except (McapError, ValueError, EOFError, OSError) as err:
+        except _mcap_errors():
+            summary = None
+        if summary is None:
+            self.connections = self._scan()
+            return
+        self.connections = tuple(
+            _conn_from_channel(
+                summary.channels[cid], summary.schemas.get(summary.channels[cid].schema_id)
+            )
+            for cid in sorted(summary.channels)
+        )
+
+    def _scan(self) -> tuple[Conn, ...]:
+        """Read every complete record of an unfinished file (no summary to seek with)."""
+        from mcap.records import Channel, Message, Schema
+        from mcap.stream_reader import StreamReader
+
+        self.unfinished = True
+        schemas: dict[int, Any] = {}
+        conns: dict[int, Conn] = {}
+        self._f.seek(0)
+        reader = StreamReader(self._f, skip_magic=False, emit_chunks=False)
+        where = "the end"
+        try:
+            for i, record in enumerate(reader.records):
+                if isinstance(record, Schema):
+                    schemas[record.id] = record
+                elif isinstance(record, Channel):
+                    conns.setdefault(
+                        record.id, _conn_from_channel(record, schemas.get(record.schema_id))
+                    )
+                elif isinstance(record, Message):
+                    self._scanned.append(
+                        (record.log_time, i, record.channel_id, bytes(record.data))
+                    )
+        except _mcap_errors() as err:
+            where = f"byte {self._f.tell()} ({type(err).__name__})"
+        if not conns:
             self._f.close()
             raise BagError(
-                f"unreadable MCAP file ({type(err).__name__}: {err})", path=path
-            ) from err
-        except BagError:
-            self._f.close()
-            raise
-        conns = []
-        for cid in sorted(channels):
-            ch = channels[cid]
-            schema = schemas.get(ch.schema_id)
-            name = schema.name if schema is not None else ""
-            enc = schema.encoding if schema is not None else ""
-            data = schema.data.decode("utf-8", "replace") if schema is not None else ""
-            conns.append(
-                Conn(
-                    int(cid),
-                    ch.topic,
-                    short_msgtype(name),
-                    data,
-                    "idl" if enc == "ros2idl" else ("msg" if data else ""),
-                    "ros1" if ch.message_encoding == "ros1" else "cdr",
-                    "transient_local" in ch.metadata.get("offered_qos_profiles", ""),
-                    "",
-                )
+                f"unreadable MCAP file: no summary section and no complete channel record "
+                f"before {where}",
+                path=self.path,
             )
-        self.connections = tuple(conns)
+        log.warning(
+            "%s: MCAP file has no summary section (recording not finished, or cut short); "
+            "read the %d complete messages up to %s",
+            self.path,
+            len(self._scanned),
+            where,
+        )
+        self._scanned.sort(key=lambda m: (m[0], m[1]))
+        return tuple(conns[c] for c in sorted(conns))
 
     def raw(
         self, conns: Sequence[Conn], start_ns: int | None = None, end_ns: int | None = None
     ) -> Iterator[RawRecord]:
-        from mcap.exceptions import McapError
-
         by_id = {c.id: c for c in conns}
         if not by_id:
+            return
+        if self.unfinished:
+            for t, _i, cid, data in self._scanned:
+                conn = by_id.get(cid)
+                if conn is None:
+                    continue
+                if (start_ns is None or t >= start_ns) and (end_ns is None or t <= end_ns):
+                    yield conn, int(t), data
             return
         topics = sorted({c.topic for c in conns})
         try:
@@ -197,7 +253,7 @@ class McapFile(BagFile):
                 conn = by_id.get(channel.id)
                 if conn is not None:
                     yield conn, int(message.log_time), bytes(message.data)
-        except (McapError, ValueError, EOFError, OSError) as err:
+        except _mcap_errors() as err:
             raise BagError(
                 f"damaged MCAP data ({type(err).__name__}: {err})", path=self.path
             ) from err

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import struct
 from pathlib import Path
 
@@ -91,7 +92,7 @@ def test_truncated_bag(tmp_path: Path, scene: Scene) -> None:
         eio.read_poses(cut, POSE)
 
 
-def test_truncated_mcap(tmp_path: Path, scene: Scene) -> None:
+def test_truncated_mcap(tmp_path: Path, scene: Scene, caplog: pytest.LogCaptureFixture) -> None:
     good = write(tmp_path / "g.mcap", "mcap-cdr", scene.spec, chunk_bytes=2000)
     data = good.read_bytes()
     cut = tmp_path / "cut.mcap"
@@ -99,6 +100,15 @@ def test_truncated_mcap(tmp_path: Path, scene: Scene) -> None:
     s = eio.summary(cut)
     assert not s.indexed and s.problems
     assert 0 < s.message_count < sum(expected_counts(scene).values())
+    # A recorder killed mid-file leaves no summary: the complete messages are read, with a
+    # warning (like a ROS1 .bag.active).
+    with caplog.at_level(logging.WARNING, logger="ertools"):
+        poses = eio.read_poses(cut, POSE)
+    assert "no summary section" in caplog.text
+    k = len(poses)
+    assert 0 < k < scene.n
+    np.testing.assert_array_equal(poses.xyz, scene.xyz[:k])
+    np.testing.assert_array_equal(poses.t_ns, scene.t_hdr[:k])
 
 
 def test_real_bag_summary() -> None:
