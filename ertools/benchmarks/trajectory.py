@@ -795,7 +795,8 @@ def score(
             f"no GT bags found in {', '.join(map(str, gt_paths))}"
             + (f" ({found.problems[0].problem})" if found.problems else "")
         )
-    explicit = {Path(p) for p in gt_paths if Path(p).is_file()}
+    # Named on the command line (a file or a rosbag2 folder): unreadable is an error, not a skip.
+    explicit = {Path(p) for p in gt_paths}
     skipped: list[str] = []
     for problem in found.problems:
         if not Path(problem.path).exists():
@@ -822,7 +823,12 @@ def score(
             # then reports; say why here.
             skipped.append(f"GT file {p} is damaged: {'; '.join(damaged)}")
             broken.append(str(p))
-    chosen, gtopic, warnings = select_gt(gt_summaries, lo - margin, hi + margin, gt_topic)
+    try:
+        chosen, gtopic, warnings = select_gt(gt_summaries, lo - margin, hi + margin, gt_topic)
+    except ClockError as err:
+        if not skipped:
+            raise
+        raise ClockError(f"{err}; also: {'; '.join(skipped)}") from err
     warnings = skipped + warnings
     files = [s.path for s in chosen]
     gt = read_gt(files, gtopic, lo - margin, hi + margin)

@@ -179,6 +179,11 @@ def _check_numbers(args: argparse.Namespace) -> None:
                 )
 
 
+def _one_line(message: str) -> str:
+    """The message on one line: wrapped third-party texts (a YAML parser's) span several."""
+    return " ".join(message.split())
+
+
 def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
     """Parse ``argv`` for one command module and run it, mapping errors to exit codes."""
     from ertools.errors import ErtoolsError
@@ -194,7 +199,7 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
         _refuse_overwriting_inputs(args)
         code: int = module.run(args)  # type: ignore[attr-defined]
     except ErtoolsError as err:
-        print(f"ertools: error: {err}", file=sys.stderr)
+        print(f"ertools: error: {_one_line(str(err))}", file=sys.stderr)
         return err.exit_code
     except KeyboardInterrupt:
         print("ertools: interrupted", file=sys.stderr)
@@ -208,7 +213,7 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
             err.ertools_debug = True  # type: ignore[attr-defined]
             raise
         print(
-            f"ertools: error: unexpected {type(err).__name__}: {err} "
+            f"ertools: error: unexpected {type(err).__name__}: {_one_line(str(err))} "
             "(this is a bug in ertools; re-run with --debug for the traceback)",
             file=sys.stderr,
         )

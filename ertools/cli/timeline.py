@@ -102,7 +102,7 @@ def run(args: argparse.Namespace) -> int:
     if timeline.readable_count == 0:
         where = ", ".join(map(str, args.paths))
         # Say why on the one error line: the reasons are otherwise only in the table on stdout.
-        reasons = [f"{p.path}: {p.problem}" for p in timeline.problems]
+        reasons = [" ".join(f"{p.path}: {p.problem}".split()) for p in timeline.problems]
         why = "; ".join(reasons[:3]) + (f"; {len(reasons) - 3} more" if len(reasons) > 3 else "")
         print(
             f"ertools: error: no readable bag in {where}" + (f" ({why})" if why else ""),
@@ -118,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
         if shown == MAX_PROBLEM_NOTES:
             note(f"warning: {len(by_path) - shown} more file(s) with problems: see the output")
             break
-        note(f"warning: {path}: {'; '.join(problems)}")
+        note(" ".join(f"warning: {path}: {'; '.join(problems)}".split()))  # one line each
     return 0
 
 
