@@ -9,6 +9,7 @@ directions, with the acquisition time. The spread of the averaged poses is repor
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 
 from ertools.cli.common import note, write_text
@@ -88,7 +89,9 @@ def run(args: argparse.Namespace) -> int:
     )
     note(
         f"spread: position {acq.marker.position_std * 1000:.2f} mm RMS, "
-        f"orientation {acq.marker.angle_std * 1000:.2f} mrad RMS"
+        # degrees as in the warnings (and `acquire items`), mrad beside them
+        f"orientation {math.degrees(acq.marker.angle_std):.2f} deg "
+        f"({acq.marker.angle_std * 1000:.2f} mrad) RMS"
     )
     for warning in acq.warnings:
         note(f"warning: {warning}")
