@@ -122,6 +122,14 @@ class Cursor:
         return sub
 
 
+def _utf8(raw: bytes) -> str:
+    """Text of a string field; bytes that are not UTF-8 are no standard message (fall back)."""
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise LayoutMismatchError(f"string field is not UTF-8 ({err})") from err
+
+
 def decode_strings(buf: U8, start: I64, length: I64) -> tuple[I32, tuple[str, ...]]:
     """Codes into a table of distinct strings, grouping messages by string length."""
     codes = np.zeros(len(start), dtype=np.int32)
@@ -131,7 +139,7 @@ def decode_strings(buf: U8, start: I64, length: I64) -> tuple[I32, tuple[str, ..
         n = int(length[0])
         rows = gather(buf, start, n)
         if n == 0 or np.array_equal(rows, np.broadcast_to(rows[0], rows.shape)):
-            return codes, (bytes(rows[0]).decode("utf-8") if n else "",)
+            return codes, (_utf8(bytes(rows[0])) if n else "",)
     for n in np.unique(length):
         sel = np.flatnonzero(length == n)
         if n == 0:
@@ -142,7 +150,7 @@ def decode_strings(buf: U8, start: I64, length: I64) -> tuple[I32, tuple[str, ..
             rows.view(np.dtype((np.void, int(n)))).reshape(-1), return_inverse=True
         )
         table = np.array(
-            [names.setdefault(bytes(u).decode("utf-8"), len(names)) for u in uniq], dtype=np.int32
+            [names.setdefault(_utf8(bytes(u)), len(names)) for u in uniq], dtype=np.int32
         )
         codes[sel] = table[inverse.reshape(-1)]
     return codes, tuple(names)
@@ -325,7 +333,5 @@ def decode_states(buf: U8, start: I64, length: I64, cdr: bool) -> tuple[U8, list
         if not np.array_equal(text + size, end):
             raise LayoutMismatchError("state messages longer or shorter than their layout")
     raw = buf.tobytes()
-    payloads = [
-        raw[a : a + b].decode("utf-8") for a, b in zip(text.tolist(), size.tolist(), strict=True)
-    ]
+    payloads = [_utf8(raw[a : a + b]) for a, b in zip(text.tolist(), size.tolist(), strict=True)]
     return np.ascontiguousarray(state), payloads

@@ -152,7 +152,17 @@ def _mcap_errors() -> tuple[type[BaseException], ...]:
 
     from mcap.exceptions import McapError
 
-    return (McapError, ValueError, EOFError, OSError, struct.error, KeyError)
+    # lz4/zstd raise RuntimeError on corrupt chunks; absurd record lengths can MemoryError.
+    return (
+        McapError,
+        ValueError,
+        EOFError,
+        OSError,
+        struct.error,
+        KeyError,
+        RuntimeError,
+        MemoryError,
+    )
 
 
 class McapFile(BagFile):

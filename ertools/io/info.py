@@ -146,17 +146,9 @@ def verify(path: Path) -> None:
         for file in [path] if fmt == "mcap" else sorted(path.glob("*.mcap")):
             verify_mcap(file)
     else:
-        import sqlite3
-
-        from ertools.io.rosbag2 import _connect, read_metadata, storage_files
+        from ertools.io.rosbag2 import query, read_metadata, storage_files
 
         for db in storage_files(path, read_metadata(path)):
-            con = _connect(db)
-            try:
-                result = con.execute("PRAGMA quick_check").fetchone()[0]
-            except sqlite3.Error as err:
-                raise BagError(f"damaged sqlite3 storage ({err})", path=db) from err
-            finally:
-                con.close()
+            result = query(db, "PRAGMA quick_check")[0][0]
             if result != "ok":
                 raise BagError(f"sqlite3 storage fails its integrity check ({result})", path=db)

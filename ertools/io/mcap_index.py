@@ -42,7 +42,16 @@ def read_summary(f: BinaryIO, path: Path) -> Any:
 
     try:
         return make_reader(f).get_summary()
-    except (McapError, ValueError, EOFError, OSError, struct.error, KeyError) as err:
+    except (
+        McapError,
+        ValueError,
+        EOFError,
+        OSError,
+        struct.error,
+        KeyError,
+        RuntimeError,
+        MemoryError,
+    ) as err:
         raise BagError(f"unreadable MCAP summary ({type(err).__name__}: {err})", path=path) from err
 
 
@@ -63,6 +72,12 @@ def decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
         # zstandard and lz4 raise their own error classes on corrupt input.
         raise BagError(f"corrupt {compression} MCAP chunk {where} ({err})") from err
     raise BagError(f"unsupported MCAP chunk compression {compression!r} {where}")
+
+
+def _file_size(f: BinaryIO) -> int:
+    import os
+
+    return os.fstat(f.fileno()).st_size
 
 
 def _workers() -> int:
@@ -186,12 +201,15 @@ class McapIndex:
 
     @staticmethod
     def _message_index(f: BinaryIO, path: Path, pos: int, cid: int) -> tuple[I64, I64]:
+        size = _file_size(f)
+        if not 0 <= pos < size:
+            raise BagError(f"message index offset {pos} outside the file ({size} bytes)", path=path)
         f.seek(pos)
         head = f.read(1 + 8 + 2 + 4)
         if len(head) < 15 or head[0] != OP_MESSAGE_INDEX:
             raise BagError(f"no message index at byte {pos}", path=path)
         _, _length, channel, nbytes = struct.unpack("<BQHI", head)
-        if channel != cid or nbytes % 16:
+        if channel != cid or nbytes % 16 or pos + 15 + nbytes > size:
             raise BagError(f"damaged message index at byte {pos}", path=path)
         data = f.read(nbytes)
         if len(data) != nbytes:
@@ -217,13 +235,22 @@ class McapIndex:
         """(compression, compressed records, uncompressed size) of a chunk record."""
         where = f"in {path} at byte {chunk.chunk_start_offset}"
         with path.open("rb") as f:
-            f.seek(chunk.chunk_start_offset)
+            size = _file_size(f)
+            start = int(chunk.chunk_start_offset)
+            if not 0 <= start < size:
+                raise BagError(f"chunk offset outside the file ({size} bytes) {where}")
+            f.seek(start)
             head = f.read(1 + 8 + 8 + 8 + 8 + 4 + 4)
             if len(head) < 41 or head[0] != OP_CHUNK:
                 raise BagError(f"no chunk record {where}")
             _, _rlen, _t0, _t1, usize, _crc, clen = struct.unpack("<BQQQQII", head)
+            if start + 41 + clen + 8 > size:
+                raise BagError(f"damaged chunk record {where}")
             compression = f.read(clen).decode("ascii", "replace")
             (nbytes,) = struct.unpack("<Q", f.read(8))
+            # a chunk larger than the file, or inflating to more than 1000x, is damage
+            if f.tell() + nbytes > size or usize > 1000 * max(nbytes, 1) + (1 << 20):
+                raise BagError(f"damaged chunk record (sizes {nbytes}/{usize}) {where}")
             data = f.read(nbytes)
         if len(data) != nbytes:
             raise BagError(f"chunk cut off by end of file {where}")

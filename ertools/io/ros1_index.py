@@ -152,7 +152,7 @@ def read_layout(path: Path) -> Ros1Layout:
                     raise RecordError(f"chunk position {cpos} past the end of the file", pos)
                 chunks.append(Ros1Chunk(cpos, start, end, counts))
                 pos = rec.end
-        except (RecordError, KeyError, struct_error) as err:
+        except (RecordError, KeyError, struct_error, IndexError) as err:
             return scan_layout(f, path, size, head.end, f"damaged index ({err})")
     return Ros1Layout(path, size, True, conns, chunks)
 
@@ -249,16 +249,22 @@ def scan_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ros1L
         except RecordError as err:
             problems.append(f"truncated: last record incomplete ({err}); read up to byte {pos}")
             break
-        if rec.op == OP_MSG:
-            if loose_start < 0:
-                loose_start = rec.pos
-            ts, offs = loose.setdefault(u32(rec.fields, "conn"), ([], []))
-            ts.append(time_ns(rec.fields, "time"))
-            offs.append(rec.pos - loose_start)
-            loose_end = rec.end
-        elif rec.op == OP_CONNECTION:
-            cid, topic, cfields = connection_fields(rec, data)
-            conns.setdefault(cid, _conn(cid, topic, cfields))
+        if rec.op in (OP_MSG, OP_CONNECTION):
+            try:
+                if rec.op == OP_MSG:
+                    cid, t = u32(rec.fields, "conn"), time_ns(rec.fields, "time")
+                    if loose_start < 0:
+                        loose_start = rec.pos
+                    ts, offs = loose.setdefault(cid, ([], []))
+                    ts.append(t)
+                    offs.append(rec.pos - loose_start)
+                    loose_end = rec.end
+                else:
+                    cid, topic, cfields = connection_fields(rec, data)
+                    conns.setdefault(cid, _conn(cid, topic, cfields))
+            except (RecordError, KeyError, struct_error, IndexError) as err:
+                problems.append(f"damaged record at byte {pos} ({err}); scan stopped there")
+                break
         elif rec.op == OP_CHUNK:
             flush()
             compression = rec.fields.get("compression", b"none").decode("ascii", "replace")
@@ -276,7 +282,7 @@ def scan_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ros1L
                         ts, offs = per.setdefault(u32(fields, "conn"), ([], []))
                         ts.append(time_ns(fields, "time"))
                         offs.append(off)
-            except (BagError, RecordError, KeyError, IndexError) as err:
+            except (BagError, RecordError, KeyError, IndexError, struct_error) as err:
                 problems.append(f"corrupt chunk at byte {pos} skipped ({err})")
                 pos = rec.end
                 continue
@@ -372,7 +378,7 @@ class Ros1Bag(BagFile):
                     raise RecordError("index-data size disagrees with its count", pos)
                 entries[u32(irec.fields, "conn")] = _entries_from_index(data)
                 pos = irec.end
-        except (RecordError, KeyError) as err:
+        except (RecordError, KeyError, struct_error, IndexError) as err:
             raise BagError(
                 f"damaged index data after chunk at byte {chunk.pos} ({err})", path=self.path
             ) from err

@@ -45,6 +45,24 @@ def _connect(db: Path) -> sqlite3.Connection:
     return sqlite3.connect(f"{db.resolve().as_uri()}?mode=ro", uri=True)
 
 
+def query(db: Path, sql: str) -> list[Any]:
+    """All rows of one read-only query on a storage file.
+
+    Raises:
+        BagError: the file is not a readable sqlite3 database.
+    """
+    try:
+        con = _connect(db)
+    except sqlite3.Error as err:
+        raise BagError(f"cannot open sqlite3 storage ({err})", path=db) from err
+    try:
+        return con.execute(sql).fetchall()
+    except (sqlite3.Error, UnicodeDecodeError) as err:
+        raise BagError(f"damaged sqlite3 storage ({err})", path=db) from err
+    finally:
+        con.close()
+
+
 def sqlite_rows(
     path: Path, conns: Sequence[Conn], lo: int | None, hi: int | None
 ) -> Iterator[tuple[U8, I64, I64, I64]] | None:
@@ -90,7 +108,7 @@ def _rows(
                 np.cumsum(lengths[:-1], out=starts[1:])
                 buf = np.frombuffer(b"".join(r[1] for r in rows), dtype=np.uint8)
                 yield buf, starts, lengths, t
-        except sqlite3.Error as err:
+        except (sqlite3.Error, UnicodeDecodeError) as err:
             raise BagError(f"damaged sqlite3 storage ({err})", path=db) from err
         finally:
             con.close()

@@ -173,7 +173,16 @@ def _mcap_scan(path: Path, why: str) -> BagSummary:
                     s[0] += 1
                     s[1] = min(s[1], record.log_time)
                     s[2] = max(s[2], record.log_time)
-        except (McapError, EOFError, ValueError, struct.error, OSError) as err:
+        except (
+            McapError,
+            EOFError,
+            ValueError,
+            struct.error,
+            OSError,
+            KeyError,
+            RuntimeError,
+            MemoryError,
+        ) as err:
             problems.append(
                 f"truncated or damaged at byte {f.tell()} ({type(err).__name__}: {err})"
             )
@@ -304,18 +313,15 @@ def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> B
 
 
 def _sqlite_spans(files: list[Path]) -> dict[str, tuple[int, int]]:
-    from ertools.io.rosbag2 import _connect
+    from ertools.io.rosbag2 import query
 
     out: dict[str, tuple[int, int]] = {}
     for db in files:
-        con = _connect(db)
-        try:
-            rows = con.execute(
-                "SELECT topics.name, MIN(timestamp), MAX(timestamp) FROM messages "
-                "JOIN topics ON topics.id = messages.topic_id GROUP BY topics.name"
-            ).fetchall()
-        finally:
-            con.close()
+        rows = query(
+            db,
+            "SELECT topics.name, MIN(timestamp), MAX(timestamp) FROM messages "
+            "JOIN topics ON topics.id = messages.topic_id GROUP BY topics.name",
+        )
         for name, lo, hi in rows:
             old = out.get(name)
             out[name] = (min(lo, old[0]), max(hi, old[1])) if old else (int(lo), int(hi))
@@ -390,17 +396,14 @@ def record_times(path: str | Path) -> dict[str, I64]:
                         t, _ = McapIndex._message_index(f, file, offset, cid)
                         parts[summ.channels[cid].topic].append(t)
     else:
-        from ertools.io.rosbag2 import _connect, read_metadata, storage_files
+        from ertools.io.rosbag2 import query, read_metadata, storage_files
 
         for db in storage_files(p, read_metadata(p)):
-            con = _connect(db)
-            try:
-                rows = con.execute(
-                    "SELECT topics.name, timestamp FROM messages "
-                    "JOIN topics ON topics.id = messages.topic_id"
-                ).fetchall()
-            finally:
-                con.close()
+            rows = query(
+                db,
+                "SELECT topics.name, timestamp FROM messages "
+                "JOIN topics ON topics.id = messages.topic_id",
+            )
             by: dict[str, list[int]] = defaultdict(list)
             for name, t in rows:
                 by[name].append(t)
