@@ -160,3 +160,16 @@ def test_corrupted_record_in_uncompressed_chunk(
     code, _, err = run(capsys, str(bad), "--check")
     assert code == 1
     one_error_line(err, "badop.bag", "corrupt chunk")
+
+
+def test_active_bag_warns_and_exits_0(
+    capsys: pytest.CaptureFixture[str], scene: Scene, tmp_path: Path
+) -> None:
+    from test_io_summary import make_active
+
+    good = write(tmp_path / "g.bag", "ros1", scene.spec, chunk_bytes=2000)
+    active = make_active(good, tmp_path / "rec.bag.active")
+    code, out, err = run(capsys, str(active))
+    assert code == 0
+    assert "NOT INDEXED" in out and "ros1-active" in out
+    assert "warning" in err and "rec.bag.active" in err and "Traceback" not in err
