@@ -95,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
     else:
         color = args.output is None and sys.stdout.isatty()
         write_text(to_table(timeline, color=color), args.output)
-    if args.plot is not None:
+    if args.plot is not None and timeline.readable_count > 0:  # no empty chart on failure
         from ertools.report.plots_timeline import save_gantt
 
         note(f"wrote {save_gantt(timeline, args.plot)}")

@@ -367,6 +367,15 @@ def test_bad_bag(
     assert not (inputs.root / SENTINEL_NAME).exists(), "a YAML python tag was executed"
 
 
+def test_timeline_writes_no_chart_when_nothing_is_readable(
+    inputs: Inputs, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    chart = tmp_path / "timeline.png"
+    result = _run(["timeline", str(inputs.random), "--plot", str(chart)], capsys)
+    _check_error(result, 1, inputs.random.name)
+    assert not chart.exists()
+
+
 # ---------------------------------------------------------------------------------------------
 # 2. Configs: malformed YAML, YAML of the wrong shape, a python tag (never run), missing file.
 
