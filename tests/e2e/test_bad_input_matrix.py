@@ -367,6 +367,38 @@ def test_bad_bag(
     assert not (inputs.root / SENTINEL_NAME).exists(), "a YAML python tag was executed"
 
 
+@pytest.mark.parametrize(
+    "bad", ["missing", "empty", "random", "truncated-json", "wrong-shape-json", "plain-folder"]
+)
+def test_report_bad_result(
+    bad: str, inputs: Inputs, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`report` reads result files and folders: each bad one named on one line, exit 1."""
+    path = {
+        "missing": tmp_path / "no_such_result.json",
+        "empty": inputs.empty,
+        "random": inputs.random,
+        "truncated-json": tmp_path / "truncated.json",
+        "wrong-shape-json": tmp_path / "list.json",
+        "plain-folder": tmp_path / "not_a_report",
+    }[bad]
+    if bad == "truncated-json":
+        path.write_text('{"name": "fbm2h", "position_accuracy": 0.1')
+    elif bad == "wrong-shape-json":
+        path.write_text("[1, 2]")
+    elif bad == "plain-folder":
+        path.mkdir()
+    result = _run(["report", str(path), "--out", str(tmp_path / "page")], capsys)
+    _check_error(result, 1, path.name)
+    assert not (tmp_path / "page" / "index.html").exists()
+
+
+def test_monitor_missing_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    # monitor treats its folder as a usage matter (exit 2), unlike the reading commands (1).
+    missing = tmp_path / "no_such_logs"
+    _check_error(_run(["monitor", str(missing), "--once"], capsys), 2, missing.name)
+
+
 def test_timeline_writes_no_chart_when_nothing_is_readable(
     inputs: Inputs, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
