@@ -95,11 +95,14 @@ def find_bags(paths: Iterable[Path]) -> Found:
     return Found(tuple(unique), tuple(problems))
 
 
-def clock_check(s: BagSummary, window_ns: int = CLOCK_WINDOW_NS) -> ClockCheck | None:
+def clock_check(
+    s: BagSummary, window_ns: int = CLOCK_WINDOW_NS, topic_name: str | None = None
+) -> ClockCheck | None:
     """Median record time minus header stamp over the first messages of one pose topic.
 
-    None when the bag has no header-stamped pose topic. When the data cannot be read (a damaged
-    chunk the index does not reveal), the check carries the reader's message in ``error``.
+    The topic is ``topic_name``, else the best header-stamped pose topic of the bag. None when
+    there is none. When the data cannot be read (a damaged chunk the index does not reveal),
+    the check carries the reader's message in ``error``.
     """
     from ertools.io.files import open_bag
     from ertools.io.reader import load_pose_batch
@@ -109,15 +112,26 @@ def clock_check(s: BagSummary, window_ns: int = CLOCK_WINDOW_NS) -> ClockCheck |
         (t for t in s.topics if t.msgtype in rank and t.count and t.first_ns is not None),
         key=lambda t: (rank[t.msgtype], t.name == "/tf_static", t.name),
     )
-    cands = [t for t in cands if t.name != "/tf_static"]
+    cands = [
+        t
+        for t in cands
+        if (t.name == topic_name if topic_name is not None else t.name != "/tf_static")
+    ]
     if not cands:
         return None
     topic = cands[0]
-    assert topic.first_ns is not None
+    assert topic.first_ns is not None and topic.last_ns is not None
     try:
         with open_bag(s.path) as bag:
             conns = bag.topic_conns(topic.name)
-            batch = load_pose_batch(bag, conns, topic.first_ns, topic.first_ns + window_ns)
+            # The summary's first time is the start of the topic's first chunk, which may hold
+            # seconds of other topics first: widen the window until messages come.
+            window = window_ns
+            while True:
+                batch = load_pose_batch(bag, conns, topic.first_ns, topic.first_ns + window)
+                if len(batch) or topic.first_ns + window >= topic.last_ns:
+                    break
+                window *= 8
     except Exception as err:  # damaged data the index did not show: report it, go on
         from ertools.errors import ErtoolsError
 
