@@ -129,9 +129,14 @@ def run(args: argparse.Namespace) -> int:
     from ertools.errors import BagError
     from ertools.io.info import describe, expand
 
-    paths = expand(list(args.paths))
     infos: list[BagInfo] = []
     problems: list[dict[str, str]] = []
+    paths: list[Path] = []
+    for given in args.paths:
+        try:
+            paths.extend(expand([given]))
+        except BagError as err:  # a missing path or an empty folder: the others still run
+            problems.append({"path": str(given), "problem": err.message})
     for path in paths:
         try:
             info = describe(path, check=args.check)

@@ -173,3 +173,14 @@ def test_active_bag_warns_and_exits_0(
     assert code == 0
     assert "NOT INDEXED" in out and "ros1-active" in out
     assert "warning" in err and "rec.bag.active" in err and "Traceback" not in err
+
+
+def test_missing_path_among_others(
+    capsys: pytest.CaptureFixture[str], scene: Scene, tmp_path: Path
+) -> None:
+    good = write(tmp_path / "good.bag", "ros1", scene.spec)
+    code, out, err = run(capsys, str(tmp_path / "gone.bag"), str(good), "--format", "json")
+    assert code == 1
+    data = json.loads(out)
+    assert [b["path"] for b in data["bags"]] == [str(good)]  # the good bag is still described
+    one_error_line(err, "gone.bag", "no such file")
