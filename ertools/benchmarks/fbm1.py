@@ -458,6 +458,11 @@ def score_fbm1_bag(
     src = sources or BodySources()
     origin = read_body(plist, src.origin, f"/{ns}/origin/pose", "origin", (lo, hi))
     board = read_body(plist, src.board, f"/{ns}/ref_board/pose", "ref_board", (lo, hi))
+    from ertools.benchmarks.clock_offset import check_header_clock
+
+    for body, source in ((origin, src.origin), (board, src.board)):
+        if source is None or source.time_source == "header":
+            check_header_clock(plist, body, "state messages")
     gt = opts.gt
     provenance = Provenance(
         inputs=tuple(str(p) for p in plist)

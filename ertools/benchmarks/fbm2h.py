@@ -386,6 +386,11 @@ def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
         unreached = missing
     else:
         raise ConfigError(f"--reached must be states, timing FILE or auto, not {reached!r}")
+    if moments.method != "auto" and options.time_source == "header":
+        from ertools.benchmarks.clock_offset import check_header_clock
+
+        what = "state messages" if moments.method == "states" else "timing file's moments"
+        check_header_clock(paths, marker, what)
     provenance = Provenance(
         inputs=tuple(str(p) for p in paths)
         + tuple(str(p) for p in (options.goal, options.transform, options.timing) if p),

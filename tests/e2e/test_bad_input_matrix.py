@@ -69,6 +69,17 @@ class Inputs:
     robot_20s: Path
     robot_stamps_1h: Path
 
+    def mocap_clock_off(self, which: str, shift_s: float) -> Path:
+        """The fbm1h/fbm2h log with the mocap poses' header stamps moved by ``shift_s``."""
+        out = self.root / f"{which}_mocap_clock_{shift_s:+g}.bag"
+        if not out.exists():
+            src, topics = {
+                "fbm2h": (self.fbm2h, ("/fbm2h/robot_at_home/pose",)),
+                "fbm1h": (self.fbm1h, ("/fbm1h/origin/pose", "/fbm1h/ref_board/pose")),
+            }[which]
+            _shifted_copy(src, out, round(shift_s * 1e9), record_too=False, topics=topics)
+        return out
+
     def truncated(self, source: Path, where: float) -> Path:
         """A copy of ``source`` cut at ``where`` (a fraction, or negative: bytes off the end)."""
         out = self.root / "truncated" / f"{source.stem}_{where}{source.suffix}"
@@ -107,20 +118,28 @@ def _pose_bag(path: Path, topic: str, t0_ns: int, n: int, rate_hz: float, nan: A
     return path
 
 
-def _shifted_copy(src: Path, dst: Path, shift_ns: int, *, record_too: bool) -> Path:
-    """``src`` with every header stamp (and, with ``record_too``, record time) moved."""
+def _shifted_copy(
+    src: Path, dst: Path, shift_ns: int, *, record_too: bool, topics: tuple[str, ...] = ()
+) -> Path:
+    """``src`` with the header stamps (of ``topics``, else all) and, with ``record_too``, the
+    record times moved by ``shift_ns``."""
     from rosbags.highlevel import AnyReader
     from rosbags.rosbag1 import Writer
-    from rosbags.typesys import Stores, get_typestore
 
-    ts = get_typestore(Stores.ROS1_NOETIC)
-    Time = ts.types["builtin_interfaces/msg/Time"]
     with AnyReader([src]) as reader, Writer(dst) as w:
-        conns = {
-            c.id: w.add_connection(c.topic, c.msgtype, typestore=ts) for c in reader.connections
+        ts = reader.typestore  # the bag's own definitions (the 2015 state messages too)
+        Time = ts.types["builtin_interfaces/msg/Time"]
+        conns = {  # one per ROS1 connection: /rosout and /tf have several publishers
+            c.id: w.add_connection(
+                c.topic, c.msgtype, typestore=ts, callerid=getattr(c.ext, "callerid", None)
+            )
+            for c in reader.connections
         }
         for c, t, raw in reader.messages():
             t_out = t + shift_ns if record_too else t
+            if topics and c.topic not in topics:
+                w.write(conns[c.id], t_out, raw)
+                continue
             msg = reader.deserialize(raw, c.msgtype)
             if not hasattr(msg, "header"):
                 w.write(conns[c.id], t_out, raw)
@@ -930,6 +949,41 @@ def test_damaged_gt_file_is_named(inputs: Inputs, capsys: pytest.CaptureFixture[
     argv = ["score", "trajectory", str(inputs.robot), str(inputs.gt[0]), str(cut)]
     line = _check_error(_run(argv, capsys), 1, cut.name)
     assert "outside the GT" in line and "damaged" in line
+
+
+@pytest.mark.parametrize(
+    "which,shift_s", [("fbm2h", 3.0), ("fbm2h", -0.4), ("fbm1h", -2.0), ("fbm1h", 0.5)]
+)
+def test_mocap_clock_off_the_logger_clock(
+    which: str, shift_s: float, inputs: Inputs, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Poses stamped by a mocap clock seconds off the logger's, states in record time: the
+    pose taken at each state moment is another moment's (fbm2h scored 0.398 m instead of
+    0.097 m at +3 s, exit 0). Refused, naming the topic and --time-source record."""
+    bag = inputs.mocap_clock_off(which, shift_s)
+    extra = (
+        ["--transform", str(inputs.transform)]
+        if which == "fbm2h"
+        else ["--items", str(inputs.items)]
+    )
+    result = _run(["score", which, str(bag), *extra], capsys)
+    line = _check_error(result, 1, bag.name)
+    assert f"{shift_s:+.3f} s" in line and "--time-source record" in line
+    if which == "fbm2h":
+        # ... and the way out scores as the answers file says (its 2 mm tolerance).
+        import yaml
+
+        answers = yaml.safe_load(next((SAMPLES / "fbm2h").glob("*.answers.yaml")).read_text())
+        again = _run(
+            ["score", which, str(bag), *extra, "--time-source", "record", "--format", "json"],
+            capsys,
+        )
+        assert again.code == 0
+        got = json.loads(again.out)["position_accuracy"]
+        assert (
+            abs(got - answers["expected"]["position_accuracy"])
+            <= answers["tolerance"]["distance_error"]["abs"]
+        )
 
 
 def test_small_clock_offset_is_never_silent(
