@@ -852,7 +852,6 @@ NAN_CASES: dict[str, tuple[Callable[[Inputs, Path], list[str]], str]] = {
         lambda i, b: ["score", "trajectory", str(i.robot), str(b)],
         "/fbm2h/robot_at_home/pose",
     ),
-    "noise--topic": (lambda i, b: ["noise", str(b), "--topic", "/fbm2h/robot_at_home/pose"], ""),
 }
 
 
@@ -865,8 +864,6 @@ NAN_VALUE = re.compile(r"(\.nan\b)|(:\s*nan\b)", re.IGNORECASE)
 def test_nan_poses(
     case: str, which: str, inputs: Inputs, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    if case == "noise--topic":
-        pytest.skip("noise: see test_nan_poses_noise (all NaN) and the part-NaN case below")
     if case == "trajectory-gt" and which == "nan_part":
         pytest.skip("part-NaN GT is scored on the valid part: see test_nan_gt_part_is_said")
     if case == "fbm2h--reached-timing" and which == "nan_part":
@@ -901,6 +898,24 @@ def test_nan_gt_part_is_said(inputs: Inputs, capsys: pytest.CaptureFixture[str])
     result = _run(["score", "trajectory", str(inputs.nan_robot), str(inputs.nan_part)], capsys)
     # The robot's poses are all NaN: that is the error, not the GT.
     _check_error(result, 1, "nan_robot.bag")
+
+
+def test_nan_part_noise_ignores_the_nan_steps(
+    inputs: Inputs, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = [
+        "noise",
+        str(inputs.nan_part),
+        "--topic",
+        "/fbm2h/robot_at_home/pose",
+        "--format",
+        "json",
+    ]
+    result = _run(argv, capsys)
+    assert result.code == 0 and "Traceback" not in result.err
+    # 700 valid samples 1 mm apart (x = 0.001 i) except across the NaN stretch: epsilon 1 mm.
+    got = json.loads(result.out)
+    assert got["samples"] == 700 and abs(got["epsilon"] - 0.001) < 1e-9
 
 
 @pytest.mark.xfail(
