@@ -206,6 +206,15 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
         return 130
     except BrokenPipeError:
         return 0
+    except OSError as err:  # mostly an output path that cannot be written (-o, --plot...)
+        if args.debug:
+            raise
+        where = f"{err.filename}: " if err.filename else ""
+        print(
+            _one_line(f"ertools: error: {where}{err.strerror or err}: cannot read or write there"),
+            file=sys.stderr,
+        )
+        return 1
     except Exception as err:  # a bug: still one line unless --debug
         # A group member's own --debug re-raises through the group's run_command, whose
         # parser left --debug in the member's arguments: the mark keeps the traceback.

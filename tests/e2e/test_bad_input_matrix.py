@@ -1098,6 +1098,34 @@ def test_output_onto_an_input_is_refused(
     assert "input" in line
 
 
+UNWRITABLE_OUTPUT: dict[str, Callable[[Inputs], tuple[list[str], Path]]] = {
+    "score fbm2h -o BAG/x.yaml": lambda i: (
+        ["score", "fbm2h", str(i.fbm2h), "--transform", str(i.transform)],
+        Path("-o"),
+    ),
+    "score fbm2h --plot BAG/plots": lambda i: (
+        ["score", "fbm2h", str(i.fbm2h), "--transform", str(i.transform)],
+        Path("--plot"),
+    ),
+    "timeline --plot BAG/t.png": lambda i: (["timeline", str(i.fbm2h)], Path("--plot")),
+    "noise --plot BAG/n.png": lambda i: (["noise", str(i.fbm3w)], Path("--plot")),
+    "info -o BAG/x.txt": lambda i: (["info", str(i.fbm2h)], Path("-o")),
+}
+
+
+@pytest.mark.parametrize("case", list(UNWRITABLE_OUTPUT))
+def test_unwritable_output_path(
+    case: str, inputs: Inputs, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An output under a file (not a folder): one line naming it, exit 1, not "a bug"."""
+    argv, flag = UNWRITABLE_OUTPUT[case](inputs)
+    blocker = inputs.root / "a_file_not_a_folder.txt"
+    blocker.write_text("x")
+    target = blocker / case.rsplit("/", 1)[-1]
+    result = _run([*argv, str(flag), str(target)], capsys)
+    _check_error(result, 1, blocker.name)
+
+
 def test_report_onto_its_own_result_folder_is_refused(
     inputs: Inputs, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
