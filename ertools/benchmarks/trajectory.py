@@ -795,6 +795,12 @@ def score(
             f"no GT bags found in {', '.join(map(str, gt_paths))}"
             + (f" ({found.problems[0].problem})" if found.problems else "")
         )
+    robot_real = Path(robot_path).resolve()
+    if all(Path(b).resolve() == robot_real for b in found.bags):
+        raise ClockError(
+            f"the only bag in GT_PATH ({', '.join(map(str, gt_paths))}) is the robot log "
+            "itself: give the mocap GT files or their folder"
+        )
     # Named on the command line (a file or a rosbag2 folder): unreadable is an error, not a skip.
     explicit = {Path(p) for p in gt_paths}
     skipped: list[str] = []

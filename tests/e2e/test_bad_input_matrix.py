@@ -957,6 +957,11 @@ def test_mistyped_gt_path_among_good_ones(
     _check_error(_run(argv, capsys), 1, missing.name)
 
 
+def test_robot_log_given_as_its_own_gt(inputs: Inputs, capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ["score", "trajectory", str(inputs.robot), str(inputs.robot)]
+    assert "robot log itself" in _check_error(_run(argv, capsys), 1, inputs.robot.name)
+
+
 def test_damaged_gt_file_is_named(inputs: Inputs, capsys: pytest.CaptureFixture[str]) -> None:
     # The second GT file cut in its middle: the robot poses after the first file are then
     # outside the GT (the error), and the damaged file is named in that error.
