@@ -197,8 +197,11 @@ def to_table(timeline: Timeline, *, color: bool = False) -> str:
             f"  {s.index:>3}  {_when(s.start_ns)} to {_when(s.end_ns)} "
             f"({s.duration_ns / 1e9:.1f} s), {len(s.paths)} bag(s)"
         )
+        names = [Path(pairing.path).name for pairing in s.pairings]
         for pairing in s.pairings:
-            lines.append(_pairing_line(pairing, paint))
+            # the same name twice (a copy on a USB stick): show the paths to tell them apart
+            full = names.count(Path(pairing.path).name) > 1
+            lines.append(_pairing_line(pairing, paint, full_path=full))
     if timeline.problems:
         lines += ["", paint(f"problems ({len(timeline.problems)}):", "bold")]
         for pr in timeline.problems:
@@ -206,10 +209,10 @@ def to_table(timeline: Timeline, *, color: bool = False) -> str:
     return "\n".join(lines)
 
 
-def _pairing_line(p: Any, paint: _Paint) -> str:
+def _pairing_line(p: Any, paint: _Paint, *, full_path: bool = False) -> str:
     from ertools.timeline import KIND_LABELS
 
-    name = Path(p.path).name
+    name = str(p.path) if full_path else Path(p.path).name
     if not p.gt:
         return paint(f"       {KIND_LABELS[p.kind]} {name}: no GT file covers it", "error")
     gts = ", ".join(Path(g).name for g in p.gt)
