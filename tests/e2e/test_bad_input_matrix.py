@@ -425,7 +425,7 @@ def test_timeline_pairings_of_same_named_bags_are_told_apart(
     if not folder.is_dir():
         pytest.skip("sample_bags/ not generated (make samples)")
     result = _run(["timeline", str(folder), "--no-clock-check"], capsys)  # bags are not changed
-    pairings = [ln for ln in result.out.splitlines() if "FBM2H_201511201500_homer.bag:" in ln]
+    pairings = [ln for ln in result.out.splitlines() if "homer.bag: GT coverage" in ln]
     # the robot log and its copy on the USB stick (sample_bags/README.md): two distinct lines
     assert len(pairings) == 2 and pairings[0] != pairings[1]
     assert any("usb_stick" in ln for ln in pairings) and any("robots" in ln for ln in pairings)
