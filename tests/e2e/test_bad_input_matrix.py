@@ -321,7 +321,7 @@ BAD_BAGS = [
 ROSBAG2 = next((SAMPLES / "fbm3w").glob("*_mcap"))
 INFO_MULTILINE = (
     "info prints the YAML parser's multi-line message of a malformed rosbag2 metadata.yaml "
-    "as is: its own error lines (ertools/cli/info.py run(), the problems loop) are not "
+    "as is: its own error lines (ertools/cli/info.py:164-165, the problems loop) are not "
     "collapsed to one line like the CLI frame's; the message comes from "
     "ertools/io/formats.py:36 (`{err}` of a yaml.YAMLError)"
 )
@@ -500,7 +500,7 @@ AUDIT_CONFIG_OPTIONS: dict[str, ConfArgv] = {
     "audit--config": lambda i, y: ["audit", str(i.fbm3w), "--config", str(y)],
 }
 AUDIT_XFAIL = (
-    "audit_score.audit_bag (ertools/audit_score.py:684) turns the scorer's ErtoolsError into "
+    "audit_score.audit_bag (ertools/audit_score.py:684-686) turns the scorer's ErtoolsError into "
     "a 'score not recomputed' warning: a config the user named that is malformed or absent "
     "exits 0"
 )
@@ -719,7 +719,7 @@ def test_wrong_topic(case: str, inputs: Inputs, capsys: pytest.CaptureFixture[st
 @pytest.mark.xfail(
     strict=True,
     reason="audit --topic of a topic not in the log exits 0 with 'score not recomputed' "
-    "(ertools/audit_score.py:684)",
+    "(ertools/audit_score.py:684-686)",
 )
 def test_wrong_topic_audit(inputs: Inputs, capsys: pytest.CaptureFixture[str]) -> None:
     result = _run(["audit", str(inputs.fbm2h), "--topic", "/no/such/topic"], capsys)
@@ -935,7 +935,7 @@ def test_nan_part_noise_ignores_the_nan_steps(
     strict=True,
     reason="noise on a stream of all-NaN poses says 'no stationary phase found: nothing to "
     "measure the noise on', naming neither the file nor the topic, nor that every pose is NaN "
-    "(ertools/benchmarks/noise.py, noise_from_stream)",
+    "(ertools/benchmarks/noise.py:190, noise_from_stream)",
 )
 def test_nan_poses_noise(inputs: Inputs, capsys: pytest.CaptureFixture[str]) -> None:
     argv = ["noise", str(inputs.nan_all), "--topic", "/fbm2h/robot_at_home/pose"]
