@@ -158,7 +158,9 @@ _NUMPY_NAMES = {
     "sin": np.sin, "cos": np.cos, "tan": np.tan, "exp": np.exp, "sqrt": np.sqrt,
     "abs": np.abs, "log": np.log, "atan": np.arctan, "floor": np.floor, "tanh": np.tanh,
     "atan2": np.arctan2, "hypot": np.hypot, "min": np.minimum, "max": np.maximum,
-    "pi": np.pi, "e": np.e, "tau": 2 * np.pi,
+    # np.float64 constants, so that `pi / (pi - pi)` gives inf as NumPy does, not a
+    # ZeroDivisionError from Python floats in the test's own reference.
+    "pi": np.float64(np.pi), "e": np.float64(np.e), "tau": np.float64(2 * np.pi),
 }  # fmt: skip
 
 
