@@ -5,8 +5,6 @@ from __future__ import annotations
 import math
 from typing import Any, Protocol, runtime_checkable
 
-import yaml
-
 from ertools.streams import Provenance
 
 Rows = list[dict[str, Any]]
@@ -55,6 +53,8 @@ class BenchmarkResult(Protocol):
 
 def dump_yaml(data: Any) -> str:
     """YAML as the 2015 nodes dumped it (block style, keys in insertion order)."""
+    import yaml
+
     return yaml.safe_dump(data, default_flow_style=False, sort_keys=False, allow_unicode=True)
 
 
