@@ -382,6 +382,7 @@ def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
             goal.as_array()[:, :2],
             options.stops,
             s_to_ns(options.max_gap_s),
+            origin_ns=bag_start,
         )
         unreached = missing
     else:

@@ -248,18 +248,23 @@ def from_stops(
     waypoints_xy: F64,
     params: StopParams,
     max_gap_ns: int,
+    origin_ns: int | None = None,
 ) -> tuple[ReachedMoments, tuple[str, ...]]:
     """Assign detected stops to waypoints in order; returns moments and unassigned waypoints.
 
     Waypoint k takes the first stop after the one given to waypoint k-1 that lies within
     ``radius`` of it; the reached moment is one speed window after that stop began.
     Segment 0 starts when the
-    robot first moves (the end of an initial stop) or at the first sample.
+    robot first moves (the end of an initial stop) or at the first sample. The notes count
+    time from ``origin_ns`` (the log's first message, as the score's table), else from the
+    first pose.
     """
     runs = detect_stops(stream_t_ns, xy, yaw, params, max_gap_ns)
+    t0 = int(stream_t_ns[0]) if origin_ns is None else origin_ns
+    since = "from the first pose" if origin_ns is None else "from the log's first message"
     notes = [
-        f"stop {i} (from the first pose): {ns_to_s(stream_t_ns[s] - stream_t_ns[0]):.3f} s to "
-        f"{ns_to_s(stream_t_ns[e] - stream_t_ns[0]):.3f} s at "
+        f"stop {i} ({since}): {ns_to_s(int(stream_t_ns[s]) - t0):.3f} s to "
+        f"{ns_to_s(int(stream_t_ns[e]) - t0):.3f} s at "
         f"({xy[s : e + 1, 0].mean():.3f}, {xy[s : e + 1, 1].mean():.3f})"
         for i, (s, e) in enumerate(runs)
     ]
