@@ -109,7 +109,9 @@ def run(args: argparse.Namespace) -> int:
         if args.report is not None:
             from ertools.report.folder import write_report
 
-            index = write_report(audit, args.report, inputs=bags, argv=sys.argv)
+            index = write_report(
+                audit, args.report, inputs=bags, argv=getattr(args, "command_line", sys.argv)
+            )
             note(f"wrote report {index}")
         for failure in audit.failures:
             note(f"error: {failure}")

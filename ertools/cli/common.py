@@ -83,7 +83,9 @@ def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[
     if report_dir is not None:
         from ertools.report.folder import write_report
 
-        index = write_report(result, report_dir, inputs=inputs, argv=sys.argv)
+        index = write_report(
+            result, report_dir, inputs=inputs, argv=getattr(args, "command_line", sys.argv)
+        )
         note(f"wrote report {index}")
     for failure in result.failures:
         note(f"error: {failure}")

@@ -193,6 +193,8 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
         args = parser.parse_args(list(argv))
     except SystemExit as stop:  # --help (0) or a usage error (2), already printed
         return stop.code if isinstance(stop.code, int) else 2
+    # The command as run, for report provenance (sys.argv is wrong when called in-process).
+    args.command_line = [*prog.split(), *argv]
     _configure_logging(args.verbose)
     try:
         _check_numbers(args)
