@@ -655,6 +655,9 @@ def audit_bag(
 
     Raises:
         BagError: unreadable logs or no state topics.
+        ErtoolsError: the scorer's error when the user gave a scoring input it uses (a bad
+            ``--goal``/``--items``/``--config``/``--topic``/``--hits``...); without explicit
+            inputs a score that cannot be recomputed is a note, not an error.
     """
     from ertools.audit import DEFAULT_MAX_SILENCE_NS, audit_states
     from ertools.errors import BagError, ErtoolsError
@@ -682,6 +685,10 @@ def audit_bag(
     try:
         result, notes = rescore(ns, plist, given)
     except ErtoolsError as err:
+        if given.given() & USES.get(ns, frozenset()):
+            # The user named a scoring input: when it (or what it points at) is bad, that is
+            # their error to fix, not a score that merely cannot be recomputed from the log.
+            raise
         # The timeline is worth having even when the score cannot be recomputed.
         return audit, (f"score not recomputed: {err}",)
     attached = attach(audit, result)

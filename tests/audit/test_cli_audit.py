@@ -77,6 +77,56 @@ def test_rescore_failure_keeps_the_audit(bag: Path, capsys: pytest.CaptureFixtur
     assert "illegal_transitions" in out.out
 
 
+SAMPLE_FBM2H = (
+    Path(__file__).resolve().parents[2]
+    / "sample_bags"
+    / "fbm2h"
+    / "log_fbm2h_mocap_2015-11-20-12-00-00_0.bag"
+)
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "named"),
+    [
+        # A value the scorer refuses, and a topic the log does not have.
+        ("--hits", "-5", "--hits must be >= 0, got -5"),
+        ("--topic", "/no/such/topic", "/no/such/topic"),
+    ],
+)
+def test_bad_explicit_input_is_an_error(
+    option: str, value: str, named: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The sample log can be re-scored (exit 0 without the option); with a bad input the user
+    # named, the scorer's error is theirs to fix: one line and exit 1, not a warning.
+    code = main(["audit", str(SAMPLE_FBM2H), "--format", "yaml", option, value])
+    err = capsys.readouterr().err
+    assert code == 1
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("ertools: error:") and named in lines[0], err
+    assert "score not recomputed" not in err
+
+
+def test_explicit_input_on_a_log_without_poses_is_an_error(
+    bag: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The states-only bag of test_rescore_failure_keeps_the_audit: without inputs a warning,
+    # with an input the user named (here a valid one) the scorer's error stands.
+    code = main(["audit", str(bag), "--format", "yaml", "--hits", "2"])
+    err = capsys.readouterr().err
+    assert code == 1 and err.startswith("ertools: error:") and "pose topic" in err, err
+
+
+def test_input_of_another_benchmark_keeps_the_warning(
+    bag: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # --items is not an fbm2h input: it is said to be unused, and the score that cannot be
+    # recomputed from the log stays a warning (exit 0).
+    code = main(["audit", str(bag), "--format", "yaml", "--items", str(bag)])
+    err = capsys.readouterr().err
+    assert code == 0
+    assert "--items is not used by fbm2h" in err or "score not recomputed" in err
+
+
 def test_bag_without_states_is_one_line_error(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -493,19 +493,13 @@ CONFIG_OPTIONS: dict[str, ConfArgv] = {
     "record--config": lambda i, y: ["record", "--config", str(y), "--out", str(y.parent / "rec")],
 }
 # audit passes the same files to the scorer; a bad file given explicitly must not end in
-# exit 0 with "score not recomputed" (see the xfail below).
+# exit 0 with "score not recomputed": it is the scorer's one-line error and exit 1.
 AUDIT_CONFIG_OPTIONS: dict[str, ConfArgv] = {
     "audit--goal": lambda i, y: ["audit", str(i.fbm2h), "--goal", str(y)],
     "audit--transform": lambda i, y: ["audit", str(i.fbm2h), "--transform", str(y)],
     "audit--items": lambda i, y: ["audit", str(i.fbm1h), "--items", str(y)],
     "audit--config": lambda i, y: ["audit", str(i.fbm3w), "--config", str(y)],
 }
-AUDIT_XFAIL = (
-    "audit_score.audit_bag (ertools/audit_score.py:684-686) turns the scorer's ErtoolsError into "
-    "a 'score not recomputed' warning: a config the user named that is malformed or absent "
-    "exits 0"
-)
-
 BAD_CONFIGS = ["malformed", "wrong-shape", "python-tag", "missing"]
 
 
@@ -537,7 +531,6 @@ def test_bad_config(
     _check_config_case(CONFIG_OPTIONS[option], kind, inputs, capsys)
 
 
-@pytest.mark.xfail(strict=True, reason=AUDIT_XFAIL)
 @pytest.mark.parametrize("kind", BAD_CONFIGS)
 @pytest.mark.parametrize("option", list(AUDIT_CONFIG_OPTIONS))
 def test_bad_config_audit(
@@ -549,7 +542,7 @@ def test_bad_config_audit(
 def test_audit_bad_config_is_refused_unexecuted_even_when_only_warned(
     inputs: Inputs, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """What audit does today (exit 0): at least the tag is refused, named, and never run."""
+    """The tag is refused, named, and never run (and the audit exits 1: see above)."""
     result = _run(["audit", str(inputs.fbm2h), "--goal", str(inputs.evil_yaml)], capsys)
     assert not (inputs.root / SENTINEL_NAME).exists()
     assert "Traceback" not in result.err and "evil.yaml" in result.err
@@ -717,11 +710,6 @@ def test_wrong_topic(case: str, inputs: Inputs, capsys: pytest.CaptureFixture[st
     )
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="audit --topic of a topic not in the log exits 0 with 'score not recomputed' "
-    "(ertools/audit_score.py:684-686)",
-)
 def test_wrong_topic_audit(inputs: Inputs, capsys: pytest.CaptureFixture[str]) -> None:
     result = _run(["audit", str(inputs.fbm2h), "--topic", "/no/such/topic"], capsys)
     _check_error(result, 1, "/no/such/topic")
