@@ -229,7 +229,12 @@ def noise_from_stream(
     still_speed: float | None = None,
     min_still_s: float | None = None,
 ) -> NoiseResult:
-    """Noise statistics of a pose stream, optionally restricted to its stationary phases."""
+    """Noise statistics of a pose stream, optionally restricted to its stationary phases.
+
+    Raises:
+        ScoringError: every pose is NaN (named with the stream's source), or as
+            :func:`noise_statistics`.
+    """
     from ertools.benchmarks.fbm3w_motion import (
         DEFAULT_MIN_STILL_S,
         DEFAULT_STILL_SPEED,
@@ -238,6 +243,14 @@ def noise_from_stream(
     )
 
     xy = poses.xyz[:, :2]
+    if len(poses) and not np.isfinite(xy).all(axis=1).any():
+        # Said here, where the file and topic are known: noise_statistics would only find
+        # "no usable pair" without saying why.
+        where = poses.source or "the pose stream"
+        raise ScoringError(
+            f"{where}: all {len(poses)} poses are NaN (the mocap logged no measurement): "
+            "nothing to measure the noise on; check the marker set was tracked, or give --topic"
+        )
     mask = None
     spans: tuple[tuple[int, int], ...] = ()
     if stationary:

@@ -118,3 +118,24 @@ def test_bad_inputs(
     assert "/nope" in capsys.readouterr().err
     assert main(["noise", str(tmp_path / "missing.bag")]) == 1
     assert "ertools: error:" in capsys.readouterr().err
+
+
+def test_all_nan_stream_is_named() -> None:
+    from ertools.benchmarks.noise import noise_from_stream
+    from ertools.errors import ScoringError
+    from ertools.streams import PoseStream
+
+    n = 5
+    nan = np.full((n, 3), np.nan)
+    quat = np.tile([0.0, 0.0, 0.0, 1.0], (n, 1))
+    poses = PoseStream(
+        t_ns=np.arange(n, dtype=np.int64) * 10_000_000,
+        xyz=nan,
+        quat_xyzw=quat,
+        source="lost.bag:/fbm3w/robot_at_work/pose",
+    )
+    with pytest.raises(ScoringError) as err:
+        noise_from_stream(poses)
+    msg = str(err.value)
+    assert "lost.bag:/fbm3w/robot_at_work/pose" in msg and f"all {n} poses are NaN" in msg
+    assert "\n" not in msg
