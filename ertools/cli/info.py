@@ -118,6 +118,12 @@ def table(info: BagInfo) -> str:
     return "\n".join(lines)
 
 
+def _one_line(text: str) -> str:
+    """``text`` with its whitespace runs (newlines of wrapped third-party messages) as one
+    space: every problem is one stderr line and one YAML/JSON string."""
+    return " ".join(text.split())
+
+
 def _fatal_problem(info: BagInfo) -> str | None:
     """A problem that makes the bag unusable (truncated, damaged); None for a mere .active."""
     bad = [p for p in info.summary.problems if not p.startswith("not indexed")]
@@ -141,12 +147,12 @@ def run(args: argparse.Namespace) -> int:
         try:
             info = describe(path, check=args.check)
         except BagError as err:
-            problems.append({"path": str(path), "problem": err.message})
+            problems.append({"path": str(path), "problem": _one_line(err.message)})
             continue
         infos.append(info)
         fatal = _fatal_problem(info)
         if fatal is not None:
-            problems.append({"path": str(path), "problem": fatal})
+            problems.append({"path": str(path), "problem": _one_line(fatal)})
         elif not info.summary.indexed:
             note(f"warning: {path}: not indexed (still recording?); counts come from a scan")
     if args.format == "table":

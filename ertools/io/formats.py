@@ -33,8 +33,10 @@ def _rosbag2_storage(path: Path) -> str:
             data = yaml.safe_load(meta.read_text(encoding="utf-8"))
             storage = str(data["rosbag2_bagfile_information"]["storage_identifier"])
         except (yaml.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
+            # The YAML parser's message spans several lines (mark, caret): one line here.
+            why = " ".join(str(err).split())
             raise BagError(
-                f"unreadable rosbag2 metadata.yaml ({err}); re-create it with `ros2 bag reindex`",
+                f"unreadable rosbag2 metadata.yaml ({why}); re-create it with `ros2 bag reindex`",
                 path=path,
             ) from err
         if storage in ("sqlite3", "mcap"):

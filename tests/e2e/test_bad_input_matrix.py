@@ -320,12 +320,6 @@ BAD_BAGS = [
     "mcap-truncated",
 ]
 ROSBAG2 = next((SAMPLES / "fbm3w").glob("*_mcap"))
-INFO_MULTILINE = (
-    "info prints the YAML parser's multi-line message of a malformed rosbag2 metadata.yaml "
-    "as is: its own error lines (ertools/cli/info.py:164-165, the problems loop) are not "
-    "collapsed to one line like the CLI frame's; the message comes from "
-    "ertools/io/formats.py:36 (`{err}` of a yaml.YAMLError)"
-)
 
 
 def _bad_rosbag2(inputs: Inputs, kind: str) -> Path:
@@ -354,7 +348,6 @@ def test_bad_bag(
     inputs: Inputs,
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
-    request: pytest.FixtureRequest,
 ) -> None:
     argv_of, which = BAG_COMMANDS[command]
     if bad == "missing":
@@ -363,8 +356,6 @@ def test_bad_bag(
         bag = inputs.truncated(_good_bag(inputs, which), float(bad.split("@")[1]))
     elif bad.startswith("rosbag2-"):
         bag = _bad_rosbag2(inputs, bad)
-        if command == "info" and "metadata" in bad:
-            request.applymarker(pytest.mark.xfail(strict=True, reason=INFO_MULTILINE))
     elif bad == "mcap-truncated":
         (mcap,) = ROSBAG2.glob("*.mcap")
         bag = inputs.truncated(mcap, 0.4)

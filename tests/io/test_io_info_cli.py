@@ -184,3 +184,20 @@ def test_missing_path_among_others(
     data = json.loads(out)
     assert [b["path"] for b in data["bags"]] == [str(good)]  # the good bag is still described
     one_error_line(err, "gone.bag", "no such file")
+
+
+def test_malformed_rosbag2_metadata_is_one_line(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    # yaml's own message spans several lines (problem, mark, caret); info says it in one, in
+    # the YAML problems list as well as on stderr.
+    bag = tmp_path / "broken_rosbag2"
+    bag.mkdir()
+    (bag / "metadata.yaml").write_text("rosbag2_bagfile_information: [unclosed\n  x: {\n")
+    code, out, err = run(capsys, str(bag), "--format", "yaml")
+    assert code == 1
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("ertools: error:"), err
+    assert "broken_rosbag2" in lines[0] and "metadata.yaml" in lines[0]
+    (problem,) = yaml.safe_load(out)["problems"]
+    assert "\n" not in problem["problem"] and "metadata.yaml" in problem["problem"]
