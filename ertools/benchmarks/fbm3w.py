@@ -155,6 +155,14 @@ def score_fbm3w(
         windows = find_states(read_benchmark_states(plist, NAMESPACE))
     else:
         windows = find_auto(poses, config, **_still(options))
+    if mode != "auto" and options.time_source == "header":
+        # State messages and --run windows are timed by record time: header-stamped poses
+        # from a mocap clock seconds off would be cut at other moments (a wrong score that
+        # looks right). Runs found from motion are in the poses' own time: nothing to check.
+        from ertools.benchmarks.clock_offset import check_header_clock
+
+        what = "state messages" if mode == "states" else "run windows (times from the log start)"
+        check_header_clock(plist, poses, what)
     return score_runs(
         poses,
         windows,
