@@ -131,7 +131,7 @@ def run(args: argparse.Namespace) -> int:
     config = load_fbm3w_config(args.config)
     windows = [parse_run_spec(text, i) for i, text in enumerate(args.run)]
     if args.runs_file is not None:
-        windows += parse_runs_file(load_yaml(args.runs_file, "runs file"), str(args.runs_file))
+        windows += parse_runs_file(load_yaml(args.runs_file, "run list"), str(args.runs_file))
     if windows and args.runs not in (None, "windows"):
         raise UsageError(
             f"--run/--runs-file give explicit windows; they contradict --runs {args.runs}"

@@ -75,6 +75,30 @@ def test_runs_file(
 
 
 @pytest.mark.parametrize(
+    ("content", "expected"),
+    [
+        (None, "run list file not found"),
+        ("- [unclosed\n", "malformed run list at line"),
+    ],
+)
+def test_runs_file_messages(
+    fbm3w_sample: Sample,
+    tmp_path: Path,
+    content: str | None,
+    expected: str,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    # load_yaml appends " file" itself: the message must not read "runs file file not found".
+    runs_file = tmp_path / "runs.yaml"
+    if content is not None:
+        runs_file.write_text(content, encoding="utf-8")
+    assert score(fbm3w_sample.bag, "--runs-file", runs_file) == 1
+    line = one_line_error(capsys.readouterr().err)
+    assert expected in line and "runs.yaml" in line
+    assert "file file" not in line
+
+
+@pytest.mark.parametrize(
     "source", [["--topic", "/fbm3w/robot_at_work/pose"], ["--frame", "robot_at_work"]]
 )
 def test_other_pose_sources(
