@@ -123,8 +123,17 @@ def build_parser(prog: str, module_name: str) -> tuple[argparse.ArgumentParser, 
 
 def _configure_logging(verbose: int) -> None:
     level = logging.WARNING if verbose == 0 else logging.INFO if verbose == 1 else logging.DEBUG
+
+    class _LowerLevel(logging.Formatter):
+        # "ertools: warning: ..." like the CLI's own notes (cli/common.note), not "WARNING";
+        # the record itself is left as is (other handlers may see it).
+        def format(self, record: logging.LogRecord) -> str:
+            text = super().format(record)
+            head = f"ertools: {record.levelname}:"
+            return text.replace(head, head.lower(), 1)
+
     handler = logging.StreamHandler(sys.stderr)
-    handler.setFormatter(logging.Formatter("ertools: %(levelname)s: %(message)s"))
+    handler.setFormatter(_LowerLevel("ertools: %(levelname)s: %(message)s"))
     root = logging.getLogger("ertools")
     root.handlers[:] = [handler]
     root.setLevel(level)

@@ -42,3 +42,26 @@ def test_help_is_instant_and_imports_nothing_heavy() -> None:
     assert out.stdout.strip() == ""
     # Generous bound: interpreter start-up alone is ~30 ms; heavy imports would add ~1 s.
     assert time.perf_counter() - start < 3.0
+
+
+def test_library_warnings_read_like_the_cli_notes(capsys: pytest.CaptureFixture[str]) -> None:
+    # Logged warnings and cli.common.note warnings share one wording: "ertools: warning: ...".
+    import logging
+
+    from ertools.cli.common import note
+    from ertools.cli.main import _configure_logging
+
+    root = logging.getLogger("ertools")
+    saved = (root.handlers[:], root.level, root.propagate)
+    try:
+        _configure_logging(1)
+        logging.getLogger("ertools.somewhere").warning("%d files overlap", 2)
+        logging.getLogger("ertools.somewhere").info("reading")
+        note("warning: a note")
+    finally:
+        root.handlers[:], root.level, root.propagate = saved
+    assert capsys.readouterr().err.splitlines() == [
+        "ertools: warning: 2 files overlap",
+        "ertools: info: reading",
+        "ertools: warning: a note",
+    ]
