@@ -87,33 +87,31 @@ def still_phases(rel: PoseStream, options: AcquireOptions) -> list[Interval]:
     A sample is still when the pose 0.25 s later is within tolerance; phases are runs of
     still samples; phases shorter than ``min_still_s`` are dropped, the others trimmed.
     """
-    from scipy.spatial.transform import Rotation
+    from ertools import motion
 
     n = len(rel)
     if n < 2:
         return []
     t = rel.t_ns
-    ahead = np.searchsorted(t, t + LOOKAHEAD_NS, side="left")
-    valid = ahead < n
-    j = np.minimum(ahead, n - 1)
-    dist = np.linalg.norm(rel.xyz[j] - rel.xyz, axis=1)
-    r = Rotation.from_quat(rel.quat_xyzw)
-    ang = (r.inv() * Rotation.from_quat(rel.quat_xyzw[j])).magnitude()
-    near = np.linalg.norm(rel.xyz, axis=1) <= options.max_distance_m
-    still = valid & (dist <= options.still_m) & (ang <= math.radians(options.still_deg)) & near
-    edges = np.diff(np.concatenate([[0], still.astype(np.int8), [0]]))
-    starts = np.flatnonzero(edges == 1)
-    stops = np.flatnonzero(edges == -1)  # one past the last still sample
+    window_s = LOOKAHEAD_NS / NS_PER_S
+    still = motion.still_mask(
+        t,
+        rel.xyz,
+        window_s=window_s,
+        max_move=options.still_m,
+        quat_xyzw=rel.quat_xyzw,
+        max_turn=math.radians(options.still_deg),
+        kind="ahead",
+        inclusive=True,
+    )
+    still &= np.linalg.norm(rel.xyz, axis=1) <= options.max_distance_m
+    # The last still sample was compared with the one 0.25 s later: still until then.
+    _, ahead, _ = motion.window_ends(t, window_s, kind="ahead")
+    runs = motion.still_runs(
+        t, still, min_duration_ns=round(options.min_still_s * NS_PER_S), reach=ahead
+    )
     trim = round(options.trim_s * NS_PER_S)
-    min_len = round(options.min_still_s * NS_PER_S)
-    out: list[Interval] = []
-    for a, b in zip(starts.tolist(), stops.tolist(), strict=True):
-        # The last still sample was compared with the one 0.25 s later: still until then.
-        start_ns = int(t[a]) + trim
-        end_ns = int(t[int(j[b - 1])]) - trim
-        if end_ns - start_ns >= min_len - 2 * trim:
-            out.append(Interval(start_ns, end_ns))
-    return out
+    return [Interval(int(t[a]) + trim, int(t[int(ahead[b])]) - trim) for a, b in runs]
 
 
 def _measure(rel: PoseStream, item: Item, win: Interval, t0_ns: int) -> tuple[Item, list[str]]:

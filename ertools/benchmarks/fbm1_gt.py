@@ -19,6 +19,7 @@ from typing import Literal
 
 import numpy as np
 
+from ertools import motion
 from ertools.configs.items import Item
 from ertools.geometry import compose, interpolate_poses, invert, mean_pose, yaw_from_quat
 from ertools.streams import PoseStream
@@ -194,12 +195,12 @@ def stationary_tail(
     ref = mean_pose(last.xyz, last.quat_xyzw)
     dist = np.linalg.norm(rel.xyz - ref.xyz, axis=1)
     ang = (Rotation.from_quat(ref.quat_xyzw).inv() * Rotation.from_quat(rel.quat_xyzw)).magnitude()
-    breaks = (dist > still_m) | (ang > math.radians(still_deg))
-    if max_gap_ns is not None:
-        # A sample after a long gap starts a new tail (the break is the sample before it).
-        breaks[:-1] |= np.diff(rel.t_ns) > max_gap_ns
-    moving = np.flatnonzero(breaks)
-    start = int(moving[-1]) + 1 if len(moving) else 0
+    # "not beyond" rather than "within": a NaN sample does not end the tail
+    still = ~((dist > still_m) | (ang > math.radians(still_deg)))
+    # A sample after a long gap starts a new tail.
+    runs = motion.still_runs(rel.t_ns, still, max_gap_ns=max_gap_ns)
+    n = len(rel)
+    start = runs[-1][0] if runs and runs[-1][1] == n - 1 else n
     return rel.take(slice(start, None))
 
 

@@ -210,35 +210,15 @@ def detect_stops(
     t_ns: I64, xy: F64, yaw: F64, params: StopParams, max_gap_ns: int
 ) -> list[tuple[int, int]]:
     """(first, last) sample index of every stationary run lasting >= ``min_duration_s``."""
-    from ertools.geometry import wrap_angle
+    from ertools import motion
 
-    n = len(t_ns)
-    if n < 2:
-        return []
-    half = int(params.window_s * 5e8)
-    lo = np.searchsorted(t_ns, t_ns - half, side="left")
-    hi = np.clip(np.searchsorted(t_ns, t_ns + half, side="right") - 1, 0, n - 1)
-    dt = (t_ns[hi] - t_ns[lo]).astype(np.float64) / 1e9
-    with np.errstate(invalid="ignore", divide="ignore"):
-        speed = np.linalg.norm(xy[hi] - xy[lo], axis=1) / dt
-        rate = np.abs(wrap_angle(yaw[hi] - yaw[lo])) / dt
-    still = (dt > 0) & (speed < params.speed) & (rate < params.yaw_rate)
+    still = motion.still_mask(
+        t_ns, xy, window_s=params.window_s, speed=params.speed, yaw=yaw, yaw_rate=params.yaw_rate
+    )
     # A tracking gap breaks a run: nothing is known about the robot in between.
-    breaks = np.diff(t_ns) > max_gap_ns
-    edges = np.diff(np.concatenate([[0], still.astype(np.int8), [0]]))
-    run_starts = np.flatnonzero(edges == 1)
-    run_ends = np.flatnonzero(edges == -1) - 1
-    gap_idx = np.flatnonzero(breaks)
-    runs: list[tuple[int, int]] = []
-    min_ns = int(params.min_duration_s * 1e9)
-    for a, b in zip(run_starts, run_ends, strict=True):
-        cuts = gap_idx[(gap_idx >= a) & (gap_idx < b)]
-        bounds = [int(a), *[int(c) + 1 for c in cuts]]
-        stops = [*[int(c) for c in cuts], int(b)]
-        for s, e in zip(bounds, stops, strict=True):
-            if t_ns[e] - t_ns[s] >= min_ns:
-                runs.append((s, e))
-    return runs
+    return motion.still_runs(
+        t_ns, still, min_duration_ns=int(params.min_duration_s * 1e9), max_gap_ns=max_gap_ns
+    )
 
 
 def from_stops(
