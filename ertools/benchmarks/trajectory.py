@@ -713,50 +713,16 @@ def select_gt(
     return with_topic, gt_topic, warnings
 
 
-GT_WINDOW_NS = 10 * 60 * NS_PER_S
-
-
-class _EachWarningOnce(logging.Filter):
-    """Lets each warning template through once (windowed reads repeat the reader's)."""
-
-    def __init__(self) -> None:
-        super().__init__()
-        self.seen: set[object] = set()
-
-    def filter(self, record: logging.LogRecord) -> bool:
-        key = (record.name, record.msg)
-        if key in self.seen:
-            return False
-        self.seen.add(key)
-        return True
-
-
 def read_gt(files: Sequence[str], topic: str, start_ns: int, end_ns: int) -> PoseStream:
-    """GT poses with header stamps in [start_ns, end_ns], read in 10-minute windows.
+    """GT poses with header stamps in [start_ns, end_ns], in one read of all the files.
 
-    One hour of 120 Hz GT is 28 MB of arrays, but the reader's transient buffers for one
-    read of the hour are several times that; windows keep them to one window's worth (the
-    whole process stays ~30 MB lower) at the same speed. Windows are disjoint and ordered,
-    so the concatenation is time-ordered.
+    The reader streams a ROS1 bag's chunks into preallocated arrays: one read of an hour of
+    120 Hz GT peaks at ~85 MiB (measured, docs/performance.md), so the 10-minute windows this
+    once took (each re-reading 60 s of extra chunks at both ends) only cost time.
     """
     from ertools.io import read_poses
-    from ertools.streams import concatenate_poses
 
-    if end_ns - start_ns <= GT_WINDOW_NS:
-        return read_poses(files, topic, start_ns=start_ns, end_ns=end_ns)
-    edges = [*range(start_ns, end_ns, GT_WINDOW_NS), end_ns + 1]
-    once = _EachWarningOnce()
-    io_log = logging.getLogger("ertools.io")
-    handlers = [h for lg in (io_log, logging.getLogger("ertools")) for h in lg.handlers]
-    for h in handlers:
-        h.addFilter(once)
-    try:
-        parts = [read_poses(files, topic, start_ns=a, end_ns=b - 1) for a, b in pairwise(edges)]
-    finally:
-        for h in handlers:
-            h.removeFilter(once)
-    kept = [p for p in parts if len(p)] or parts[:1]
-    return concatenate_poses(kept)
+    return read_poses(files, topic, start_ns=start_ns, end_ns=end_ns)
 
 
 def score(

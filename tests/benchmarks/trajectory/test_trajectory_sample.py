@@ -218,13 +218,14 @@ def test_robot_record_time(
     check(out, exp, robotlog["answers"])
 
 
-def test_windowed_gt_read_equals_one_read(
+def test_gt_read_is_one_read_equal_to_the_whole_cut(
     robotlog: dict[str, Any],
     tmp_path: Path,
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     import ertools.benchmarks.trajectory as tr
+    import ertools.io
     from ertools.io import read_poses
 
     gt0, gt1 = robotlog["gt"]
@@ -232,15 +233,33 @@ def test_windowed_gt_read_equals_one_read(
     shutil.copyfile(gt1, copy)
     files = [str(gt0), str(gt1), str(copy)]
     whole = read_poses(files, GT_TOPIC)
-    lo, hi = int(whole.t_ns[0]), int(whole.t_ns[-1])
-    monkeypatch.setattr(tr, "GT_WINDOW_NS", 5_000_000_000)  # 9 windows over the 43 s
-    windowed = tr.read_gt(files, GT_TOPIC, lo, hi)
-    assert np.array_equal(windowed.t_ns, whole.t_ns)
-    assert np.array_equal(windowed.xyz, whole.xyz)
-    assert np.array_equal(windowed.quat_xyzw, whole.quat_xyzw)
+    # A span inside the GT (both ends cut): read_gt must return exactly the poses of the
+    # whole read whose stamps fall in [lo, hi], overlapping files merged alike.
+    n = len(whole)
+    lo, hi = int(whole.t_ns[n // 4]), int(whole.t_ns[3 * n // 4])
+    keep = (whole.t_ns >= lo) & (whole.t_ns <= hi)
+    calls: list[tuple[int | None, int | None]] = []
 
-    # Through the CLI: the reader's warnings (the files overlap) appear once, not once per
-    # window.
+    def counting(*args: Any, **kwargs: Any) -> Any:
+        calls.append((kwargs.get("start_ns"), kwargs.get("end_ns")))
+        return read_poses(*args, **kwargs)
+
+    monkeypatch.setattr(ertools.io, "read_poses", counting)
+    cut = tr.read_gt(files, GT_TOPIC, lo, hi)
+    # A span of hours (an hour-long robot log): still one read, not 10-minute windows that
+    # each re-read a minute of chunks at both ends; it holds every pose.
+    hour = 3600 * 1_000_000_000
+    first, last = int(whole.t_ns[0]), int(whole.t_ns[-1])
+    long = tr.read_gt(files, GT_TOPIC, first - hour, last + hour)
+    monkeypatch.undo()
+    assert calls == [(lo, hi), (first - hour, last + hour)]
+    assert np.array_equal(long.t_ns, whole.t_ns) and np.array_equal(long.xyz, whole.xyz)
+    assert 0 < len(cut) < n
+    assert np.array_equal(cut.t_ns, whole.t_ns[keep])
+    assert np.array_equal(cut.xyz, whole.xyz[keep])
+    assert np.array_equal(cut.quat_xyzw, whole.quat_xyzw[keep])
+
+    # Through the CLI: the reader's warnings (the files overlap) appear once each.
     capsys.readouterr()
     args = ["score", "trajectory", str(robotlog["robot"]), *files, "--offset", "-0.35"]
     assert main(args) == 0
