@@ -9,6 +9,8 @@ A sample is *still* when the speed of the smoothed position is below ``speed`` (
 (default 0.5 s). Smoothing over ``window`` (0.2 s) first makes the test blind to mocap jitter:
 0.1 mm of noise per sample at 120 Hz moves a 0.2 s average by ~0.03 mm, i.e. ~0.2 mm/s, far
 below the threshold, while an end effector following a path moves at centimetres per second.
+The detection itself is :mod:`ertools.motion` (its ``samples`` window); this module keeps the
+FBM3 defaults and the :class:`Phase` records.
 """
 
 from __future__ import annotations
