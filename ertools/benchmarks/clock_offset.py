@@ -160,23 +160,33 @@ def _coarse_scan(
     for k in range(3):
         grid_xyz[:, k] = np.interp(rel_g, rel_t, gt.xyz[:, k])
     del rel_t, rel_g
-    hi = np.clip(np.searchsorted(t, grid_t, side="left"), 1, len(t) - 1)
-    grid_ok = ((t[hi] - t[hi - 1]) <= max_gap_ns) | (t[hi] == grid_t)  # exact hits are fine
-    del hi, grid_t
+    # Grid points strictly inside a GT gap longer than max_gap_ns are invalid: mark them per
+    # gap (a handful) instead of locating every grid point in the GT. The first grid point
+    # is the first GT sample; it is judged by the first GT interval, as it always was.
+    gaps = np.flatnonzero(np.diff(t) > max_gap_ns)
+    marks = np.zeros(len(grid_t) + 1, dtype=np.int64)
+    np.add.at(marks, np.searchsorted(grid_t, t[gaps], side="right"), 1)
+    np.add.at(marks, np.searchsorted(grid_t, t[gaps + 1], side="left"), -1)
+    grid_ok = np.cumsum(marks[:-1]) == 0
+    grid_ok[0] = (t[1] - t[0]) <= max_gap_ns or t[1] == t[0]
+    del marks, gaps
     base = np.rint((robot_t - t[0]) / step).astype(np.int64)
     shifts = np.rint(offsets / step).astype(np.int64)
-    n = len(grid_ok)
+    # Invalid points become NaN and the grid is padded with NaN beyond both ends, so every
+    # shifted index is in range and one gather gives both the position and its validity.
+    pad = int(max(0, -(shifts.min() + base.min()), shifts.max() + base.max() - len(grid_t) + 1))
+    padded = np.full((len(grid_t) + 2 * pad, 3), np.nan, dtype=np.float32)
+    padded[pad : pad + len(grid_t)] = np.where(grid_ok[:, None], grid_xyz, np.nan)
+    del grid_xyz, grid_ok, grid_t
+    base += pad
     pos = robot_xyz.astype(np.float32)
     costs = np.full(len(offsets), np.inf)
     counts = np.zeros(len(offsets), dtype=np.int64)
     block = max(1, 200_000 // max(len(base), 1))  # ~2.4 MB of float32 per block
     for lo in range(0, len(offsets), block):  # blocks of offsets x all poses, vectorised
-        idx = shifts[lo : lo + block, None] + base[None, :]
-        inside = (idx >= 0) & (idx < n)
-        idx = np.clip(idx, 0, n - 1)
-        ok = inside & grid_ok[idx]
-        d = grid_xyz[idx] - pos[None, :, :]
+        d = padded[shifts[lo : lo + block, None] + base[None, :]] - pos[None, :, :]
         dist = np.sqrt(np.einsum("bij,bij->bi", d, d))
+        ok = ~np.isnan(dist)
         cnt = ok.sum(axis=1)
         total = np.where(ok, dist, 0.0).sum(axis=1)
         with np.errstate(invalid="ignore", divide="ignore"):
