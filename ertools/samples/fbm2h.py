@@ -25,19 +25,29 @@ BmBox EXECUTING_GOAL / Client COMPLETED_GOAL times and ``segment_time``; then
 of the orientation errors, ``execution_time`` = sum of the segment times; and
 ``orientation_error_2015`` = atan2(sin|d|, cos|d|) of the unwrapped difference ``d``.
 ``truth.stops`` gives when the robot stood still at each waypoint (for ``--reached auto``).
+
+The BmBox's TRANSMITTING_SCORE payload is the score the live 2015 node sent, computed here as
+it did (see :func:`_live_score`), from the noisy published poses and not by ertools' scorer,
+and recorded as ``expected.published``: keys sorted, ``segments_details`` at the top level and
+numbered from 0, the ``dinstance_error`` spelling, the unwrapped orientation formula (waypoint
+2 crosses +-pi: its live ``orientation_error`` is negative), poses as Python 2 yaml dumps of
+``Pose2D`` objects (text, never loaded), wall-clock segment times and ``hits`` as a string.
 """
 
 from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-from scipy.spatial.transform import Rotation
+import yaml
+from scipy.spatial.transform import Rotation, Slerp
 
 from ertools.samples.mocap import (
     MocapNoise,
+    MocapPublished,
     TrackingLoss,
     frame_times,
     pose_topic,
@@ -156,6 +166,87 @@ def _transform_yaml(t: F64, q: F64, t_inv: F64, q_inv: F64, stamp: str) -> str:
     )
 
 
+# The 2015 node handled the Client's result this long after the Client's COMPLETED_GOAL was
+# recorded (message delivery, its loop): its tf lookup and its time.time() are that late.
+LIVE_HANDLE_NS = 3_000_000
+TF_STAMP_AFTER_HEADER_NS = 5_000  # publish_mocap stamps /tf 5 us after the pose header
+
+
+def _tf_pose(pub: MocapPublished, at_ns: int) -> tuple[F64, Rotation]:
+    """The marker pose tf gave for ``at_ns``: the two published /tf samples around it,
+    position linear and orientation SLERP (tf's own interpolation)."""
+    stamps = pub.t_header_ns + TF_STAMP_AFTER_HEADER_NS
+    hi = int(np.searchsorted(stamps, at_ns, side="left"))
+    lo = hi - 1
+    frac = (at_ns - stamps[lo]) / (stamps[hi] - stamps[lo])
+    xyz = pub.xyz[lo] + frac * (pub.xyz[hi] - pub.xyz[lo])
+    pair = Rotation.from_quat(pub.quat_xyzw[[lo, hi]])
+    rot = Slerp([0.0, 1.0], pair)([frac])[0]
+    return np.asarray(xyz), rot
+
+
+def _pose2d_dump(x: float, y: float, theta: float) -> str:
+    # Python 2's yaml.dump of a geometry_msgs Pose2D object, as the 2015 node stored it.
+    tag = "!!python/object:geometry_msgs.msg._Pose2D.Pose2D"
+    return f"{tag} {{theta: {theta!r}, x: {x!r}, y: {y!r}}}\n"
+
+
+def _live_score(
+    pub: MocapPublished,
+    m2r_t: F64,
+    m2r_quat: F64,
+    seg_start: list[int],
+    seg_end: list[int],
+) -> dict[str, Any]:
+    """The score the live 2015 node sent, computed as it did and not by ertools' scorer.
+
+    For each segment: tf ``world -> actual_robot`` (the marker pose composed with the team's
+    ``marker_to_robot_transform``) at the ROS time it handled the result, reduced to (x, y,
+    yaw) like ``euler_from_quaternion``; ``dinstance_error`` = planar distance;
+    ``orientation_error`` = atan2(sin|d|, cos|d|) of the *unwrapped* d = yaw - theta; segment
+    times from its wall clock (start when it went EXECUTING_GOAL, end when it handled the
+    result). Then ``position_accuracy`` = sum / N, ``orientation_accuracy`` = atan2 of the sums
+    of the unwrapped sines and cosines, ``execution_time`` = sum of the segment times.
+    """
+    m2r_rot = Rotation.from_quat(m2r_quat)
+    details: dict[int, dict[str, Any]] = {}
+    sum_d = sum_sin = sum_cos = execution_time = 0.0
+    for k, (x_t, y_t, th_t) in enumerate(WAYPOINTS):
+        now = seg_end[k] + LIVE_HANDLE_NS
+        marker_xyz, marker_rot = _tf_pose(pub, now)
+        robot_xyz = marker_xyz + marker_rot.apply(m2r_t)
+        yaw = float((marker_rot * m2r_rot).as_euler("xyz")[2])
+        x_r, y_r = float(robot_xyz[0]), float(robot_xyz[1])
+        d = math.hypot(x_r - x_t, y_r - y_t)
+        sin_e, cos_e = math.sin(abs(yaw - th_t)), math.cos(abs(yaw - th_t))
+        start_s, end_s = seg_start[k] / 1e9, now / 1e9
+        sum_d, sum_sin, sum_cos = sum_d + d, sum_sin + sin_e, sum_cos + cos_e
+        execution_time += end_s - start_s
+        details[k] = {
+            "dinstance_error": d,
+            "end_segment_time": end_s,
+            "orientation_error": math.atan2(sin_e, cos_e),
+            "refbox_timeout": False,
+            "result_payload": {"waypoint": k},
+            "robot_pose": _pose2d_dump(x_r, y_r, yaw),
+            "segment_time": end_s - start_s,
+            "start_segment_time": start_s,
+            "target_pose": _pose2d_dump(x_t, y_t, th_t),
+            "timeout": False,
+        }
+    return {
+        "details": {
+            "marker-robot transform": [[float(v) for v in m2r_t], [float(v) for v in m2r_quat]]
+        },
+        "execution_time": execution_time,
+        "hits": "0",  # typed by the referee: a string
+        "orientation_accuracy": math.atan2(sum_sin, sum_cos),
+        "position_accuracy": sum_d / len(WAYPOINTS),
+        "segments_details": details,
+        "timeout_segments": 0,
+    }
+
+
 def generate(outdir: Path, *, seed: int) -> list[Path]:
     """Write the FBM2@Home log, its configs, timing file and answers into ``outdir``."""
     rng = np.random.default_rng(seed)
@@ -248,7 +339,9 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         losses=[loss],
     )
 
-    score_text = "score: see the answers file\n"
+    # What the live node sent (yaml.dump: keys sorted, block style), from the noisy poses.
+    published = _live_score(pub, m2r_t, m2r_rot.as_quat(), seg_start, seg_end)
+    score_text = yaml.safe_dump(published, default_flow_style=False)
     tr += [
         Transition(t_score, Machine.BMBOX, BmBoxState.TRANSMITTING_SCORE, score_text),
         Transition(t_score + 100_000_000, Machine.REFBOX, RefBoxState.RECEIVED_SCORE),
@@ -347,6 +440,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
             ),
             "execution_time": float(seg_time.sum()),
             "timeout_segments": 0,
+            "published": published,
         },
         tolerance={
             "distance_error": tol(
@@ -358,6 +452,12 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
             "segment_time": tol(1e-6, "state transition times are exact in the bag"),
             "auto_reached": tol(
                 0.6, "stop detection uses a 0.5 s window; the robot comes to rest smoothly"
+            ),
+            "published": tol(
+                1e-12,
+                "the score payload in the bag is this mapping dumped with yaml (repr floats): "
+                "read back it is equal; against the truth it differs by the mocap noise (see "
+                "distance_error, orientation_error) and its times by the node's 3 ms delay",
             ),
         },
     )

@@ -132,3 +132,62 @@ def test_fbm3w_other_d_min_is_explained_by_the_2015_rules(fbm3w: Path) -> None:
     assert line.explanation.startswith("recomputed with the 2015 rules:")
     assert "the live value (within 0.1%)" in line.explanation
     assert "d_min=0.0005" in line.explanation
+
+
+def test_fbm2h_live_score_beside_the_recomputed_one(
+    fbm2h: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The sample's BmBox sends the score the 2015 node would have (answers:
+    expected.published); the audit shows it beside ertools' score, differences explained."""
+    from ertools.audit_score import audit_bag
+    from ertools.cli.main import main
+
+    ans = answers(fbm2h)
+    exp, tols = ans["expected"], ans["tolerance"]
+    (bag,) = fbm2h.glob("*.bag")
+    transform = fbm2h / ans["generator"]["parameters"]["transform"]
+    audit, _ = audit_bag([bag], inputs=ScoreInputs(transform=transform))
+
+    # The live payload is the published mapping (string segment keys in the answers file).
+    live, published = flatten(audit.live_score), flatten(exp["published"])
+    assert set(live) == set(published)
+    for key, value in published.items():
+        assert live[key] == (pytest.approx(value, abs=1e-12) if isinstance(value, float) else value)
+    # ... and it is the 2015 node's computation on noisy poses: each live distance is the
+    # truth within the answers' noise tolerance, the live orientation is the 2015 formula's
+    # (negative for waypoint 2, the +-pi seam), the wrapped one is the truth's.
+    for k, seg in enumerate(exp["segments"]):
+        got = exp["published"]["segments_details"][str(k)]
+        assert abs(got["dinstance_error"] - seg["distance_error"]) <= tols["distance_error"]["abs"]
+        want_2015 = seg["orientation_error_2015"]
+        assert abs(got["orientation_error"] - want_2015) <= tols["orientation_error"]["abs"]
+    assert exp["published"]["segments_details"]["2"]["orientation_error"] < 0
+
+    assert audit.comparison is not None
+    by_key = {x.key: x for x in audit.comparison.lines}
+    assert any("segments_details at the top level" in n for n in audit.comparison.notes)
+    for k, seg in enumerate(exp["segments"]):
+        line = by_key[f"details.segments_details.{k}.dinstance_error"]
+        # Side by side: live from the payload, recomputed by ertools; the two read the same
+        # noisy poses 3 ms apart, so they agree within twice the single-sample tolerance.
+        sent = exp["published"]["segments_details"][str(k)]["dinstance_error"]
+        assert line.live == pytest.approx(sent, abs=1e-12)
+        assert abs(line.recomputed - sent) <= 2 * tols["distance_error"]["abs"]
+        assert abs(line.recomputed - seg["distance_error"]) <= tols["distance_error"]["abs"]
+        timing = by_key[f"details.segments_details.{k}.segment_time"]
+        assert timing.status == "differs" and "time.time()" in timing.explanation
+        # The node handled the result 3 ms after COMPLETED_GOAL: its wall-clock segment is
+        # 3 ms longer (float seconds: 1e-6 s).
+        assert timing.live - timing.recomputed == pytest.approx(0.003, abs=1e-6)
+    wrap = by_key["details.segments_details.2.orientation_error"]
+    assert wrap.status == "differs" and wrap.live < 0 < wrap.recomputed
+    assert abs(wrap.live + wrap.recomputed) <= 2 * tols["orientation_error"]["abs"]
+    assert "unwrapped" in wrap.explanation and "--orientation-2015" in wrap.explanation
+    assert by_key["details.marker-robot transform.0.0"].status == "same"
+
+    # Through the CLI: the comparison table with the live and the recomputed column.
+    assert main(["audit", str(bag), "--transform", str(transform)]) == 0
+    out = capsys.readouterr().out
+    assert "live vs recomputed score:" in out
+    row = next(ln for ln in out.splitlines() if "segments_details.2.orientation_error" in ln)
+    assert row.split()[1].startswith("-0.060") and row.split()[2].startswith("0.060")
