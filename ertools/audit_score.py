@@ -416,6 +416,10 @@ def compare_scores(
 # A value recomputed with the 2015 rules "reproduces" the live one within this: far above the
 # mocap noise on a recomputed score (~1e-5 relative), far below the effect of a rule (>1%).
 REPRODUCED_REL_TOL = 1e-3
+# Within this, a remaining difference is what the live node's timing explains: it read the
+# mocap stream a few ms after the logged moment, which moves a pose by ~0.3 % of a typical
+# FBM2 distance error at walking speed; a wrong input or rule moves it by far more.
+TIMING_REL_TOL = 1e-2
 
 
 def _check_2015(live: Any, value: Any) -> str:
@@ -426,6 +430,12 @@ def _check_2015(live: Any, value: Any) -> str:
                 f"recomputed with the 2015 rules: {v:.6g}, the live value (within "
                 f"{REPRODUCED_REL_TOL:.1%}): the difference comes from ertools' deliberate "
                 "deviations or the options of this re-score, not from the data"
+            )
+        if abs(v - lv) <= TIMING_REL_TOL * abs(lv):
+            return (
+                f"recomputed with the 2015 rules: {v:.6g}, within {TIMING_REL_TOL:.0%} of the "
+                "live value: the live node read the mocap stream a few ms after the logged "
+                "moment (mocap noise and motion in between), not a deviation or a data problem"
             )
         return (
             f"recomputed with the 2015 rules: {v:.6g}, still not the live value: the cause "
