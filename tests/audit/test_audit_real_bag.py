@@ -32,7 +32,7 @@ def test_audit_says_there_is_nothing_to_audit(
 
 
 def test_report_of_the_real_bag_hashes_it_and_has_no_audit(bag: Path, tmp_path: Path) -> None:
-    from audit_fakes import FakeResult
+    from fakes import FakeResult
 
     from ertools.report.folder import write_report
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 import math
 
 import pytest
-from audit_fakes import FakeResult
 from audit_streams import heartbeat
+from fakes import FakeResult
 
 from ertools.audit import audit_states
 from ertools.audit_score import attach, compare_scores, flatten

@@ -2,34 +2,12 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Any
+from fakes import FakeResult
 
-from ertools.benchmarks.base import Rows, dump_yaml
 from ertools.streams import Provenance
 
 EVIL = "<script>alert('x')</script>"
 EVIL_IMG = '<img src=x onerror="alert(1)">'
-
-
-@dataclass(frozen=True)
-class FakeResult:
-    name: str
-    data: dict[str, Any]
-    table: dict[str, Rows] = field(default_factory=dict)
-    warnings: tuple[str, ...] = ()
-    deviations: tuple[str, ...] = ()
-    failures: tuple[str, ...] = ()
-    provenance: Provenance = field(default_factory=Provenance)
-
-    def to_dict(self) -> dict[str, Any]:
-        return self.data
-
-    def to_yaml(self) -> str:
-        return dump_yaml(self.data)
-
-    def tables(self) -> dict[str, Rows]:
-        return self.table
 
 
 def fbm3w_like(best: float = 0.0123, team_param: str | None = None) -> FakeResult:
