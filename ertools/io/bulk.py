@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import itertools
 import logging
+import os
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -24,6 +25,7 @@ from ertools.io.fastdecode import FAST_TYPES, Decoded, LayoutMismatchError, deco
 from ertools.io.files import BagFile
 from ertools.io.model import TF_TYPES, Conn
 from ertools.io.posebatch import PoseBatch, concat_batches
+from ertools.io.uniform import decode_uniform
 
 log = logging.getLogger("ertools.io.bulk")
 
@@ -66,6 +68,17 @@ class _Assembler:
         remap = np.array(
             [self.frames.setdefault(f, len(self.frames)) for f in batch.frames], np.int32
         )
+        if len(pos) and int(pos[-1]) - int(pos[0]) == len(pos) - 1 and _ascending(pos):
+            # One connection read in order: a run of consecutive rows, written as a slice
+            # (a block copy, not a scatter).
+            at = slice(int(pos[0]), int(pos[-1]) + 1)
+            self.t_record[at] = t_record
+            self.t_header[at] = batch.t_header
+            self.xyz[at] = batch.xyz
+            self.quat[at] = batch.quat_xyzw
+            self.frame_idx[at] = remap[batch.frame_idx]
+            self.child_idx[at] = remap[batch.child_idx]
+            return
         self.t_record[pos] = t_record
         self.t_header[pos] = batch.t_header
         self.xyz[pos] = batch.xyz
@@ -96,11 +109,18 @@ class _Assembler:
         return batch
 
 
+def _ascending(a: I64) -> bool:
+    return bool(np.all(a[1:] > a[:-1]))
+
+
 def group_positions(keys: I64) -> list[tuple[int, I64]]:
     """(key, positions) for each distinct key, positions ascending (one sort, not N scans)."""
     if len(keys) == 0:
         return []
-    order = np.argsort(keys, kind="stable")
+    if bool(np.all(keys[1:] >= keys[:-1])):
+        order = np.arange(len(keys), dtype=np.int64)  # already grouped (one connection)
+    else:
+        order = np.argsort(keys, kind="stable")
     sorted_keys = keys[order]
     cuts = np.flatnonzero(sorted_keys[1:] != sorted_keys[:-1]) + 1
     starts = np.concatenate([[0], cuts])
@@ -132,9 +152,7 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
     assert isinstance(bag, Ros1Bag)
     touched, chunk_of, _rank, t_of, off_of = bag.select(conns, lo, hi)
 
-    def runs() -> Iterator[Run]:
-        groups = dict(group_positions(chunk_of))
-        scratch: list[bytearray] = []
+    def batches() -> Iterator[list[int]]:
         # Several chunks are decoded together (fewer NumPy calls per message), up to
         # GROUP_BYTES of uncompressed data at a time so memory stays bounded.
         batch: list[int] = []
@@ -143,10 +161,14 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
             batch.append(ci)
             chunk = bag.layout.chunks[ci]
             size += max(chunk.data_len, 0) * (1 if chunk.compression == "none" else 4)
-            if size < GROUP_BYTES and i + 1 < len(touched):
-                continue
+            if size >= GROUP_BYTES or i + 1 == len(touched):
+                yield batch
+                batch, size = [], 0
+
+    def runs() -> Iterator[Run]:
+        groups = dict(group_positions(chunk_of))
+        for batch, (buf, base, sizes) in _prefetched(bag, list(batches())):
             chunks = [bag.layout.chunks[c] for c in batch]
-            buf, base, sizes = _chunk_group(bag, chunks, scratch)
             sel = np.concatenate([groups[c] for c in batch])
             which = np.concatenate([np.full(len(groups[c]), k) for k, c in enumerate(batch)])
             where = f"in {bag.path} in chunks at bytes {chunks[0].pos}..{chunks[-1].pos}"
@@ -157,9 +179,56 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
             if np.any(start + length > base[which] + sizes[which]):
                 raise BagError(f"message record runs past the end of its chunk {where}")
             yield sel, buf, start, length, t_of[sel]
-            batch, size = [], 0
 
     return Located(len(t_of), runs())
+
+
+def _prefetched(
+    bag: BagFile, batches: list[list[int]]
+) -> Iterator[tuple[list[int], tuple[U8, I64, I64]]]:
+    """Each batch of chunks with its bytes, the next batch read (or decompressed) by a
+    second thread while the caller decodes the current one: file reads and decompression
+    release the GIL, so on two cores reading costs little beyond decoding.
+
+    Two scratch buffers alternate, so a batch's bytes stay valid until the next is asked for.
+    """
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ertools.io.ros1_index import Ros1Bag
+
+    assert isinstance(bag, Ros1Bag)
+    if not batches:
+        return
+    scratches: list[list[bytearray]] = [[], []]
+
+    def load(k: int) -> tuple[U8, I64, I64]:
+        return _chunk_group(bag, [bag.layout.chunks[c] for c in batches[k]], scratches[k % 2])
+
+    if len(batches) == 1 or _workers() == 1:
+        for k, batch in enumerate(batches):
+            yield batch, load(k)
+        return
+    with ThreadPoolExecutor(1) as pool:
+        ahead = pool.submit(load, 0)
+        for k, batch in enumerate(batches):
+            got = ahead.result()
+            if k + 1 < len(batches):
+                ahead = pool.submit(load, k + 1)
+            yield batch, got
+
+
+def _workers() -> int:
+    return os.cpu_count() or 1
+
+
+def _read_at(fd: int, into: memoryview, offset: int) -> int:
+    """Read into ``into`` from ``offset`` without moving the file position, so a reading
+    thread and the decoding one never race over it."""
+    if hasattr(os, "preadv"):
+        return os.preadv(fd, [into], offset)
+    data = os.pread(fd, len(into), offset)  # no preadv (Windows, older macOS): one copy more
+    into[: len(data)] = data
+    return len(data)
 
 
 def _chunk_group(bag: BagFile, chunks: list[Any], scratch: list[bytearray]) -> tuple[U8, I64, I64]:
@@ -179,8 +248,7 @@ def _chunk_group(bag: BagFile, chunks: list[Any], scratch: list[bytearray]) -> t
         if all(b.data_pos > a.data_pos for a, b in itertools.pairwise(chunks)):
             if not scratch or len(scratch[0]) < span:
                 scratch[:] = [bytearray(span)]
-            bag.file.seek(first)
-            got = bag.file.readinto(memoryview(scratch[0])[:span])
+            got = _read_at(bag.file.fileno(), memoryview(scratch[0])[:span], first)
             if got != span:
                 raise BagError(f"chunks cut off by end of file at byte {first}", path=bag.path)
             base = np.array([c.data_pos - first for c in chunks], dtype=np.int64)
@@ -287,7 +355,10 @@ def try_fast_batch(
         if found is not None:
             out = _Assembler(msgtype, found.count)
             for pos, buf, start, length, t_rec in found.runs:
-                out.add(pos, buf, decode(msgtype, cdr, buf, start, length), t_rec)
+                dec = decode_uniform(msgtype, cdr, buf, start, length)
+                if dec is None:
+                    dec = decode(msgtype, cdr, buf, start, length)
+                out.add(pos, buf, dec, t_rec)
             return out.result()
     except LayoutMismatchError as err:
         log.info(

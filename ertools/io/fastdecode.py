@@ -167,6 +167,9 @@ class Decoded:
     frame: tuple[I64, I64]
     child: tuple[I64, I64] | None
     has_header: bool = True
+    # Set when every row has the same names (the uniform decoder checked them): no string pass.
+    frame_text: str | None = None
+    child_text: str | None = None
 
 
 def _header(cur: Cursor) -> tuple[I64, tuple[I64, I64]]:
@@ -266,6 +269,8 @@ def _tf(cur: Cursor, idx: I64) -> Decoded:
 
 def to_batch(buf: U8, dec: Decoded, t_record: I64) -> PoseBatch:
     """A :class:`PoseBatch` from decoded columns; ``t_record`` is per message."""
+    if dec.frame_text is not None:
+        return _uniform_batch(dec, t_record)
     starts = [dec.frame[0]]
     lens = [dec.frame[1]]
     if dec.child is not None:
@@ -286,6 +291,23 @@ def to_batch(buf: U8, dec: Decoded, t_record: I64) -> PoseBatch:
     t_rec = t_record[dec.msg_index]
     t_hdr = dec.t_header if dec.has_header else t_rec.copy()
     return PoseBatch(t_rec, t_hdr, dec.xyz, dec.quat_xyzw, frame_idx, child_idx, frames)
+
+
+def _uniform_batch(dec: Decoded, t_record: I64) -> PoseBatch:
+    n = len(dec.msg_index)
+    names: dict[str, int] = {"": 0}
+    frame = names.setdefault(dec.frame_text or "", len(names))
+    child = names.setdefault(dec.child_text or "", len(names))
+    t_rec = t_record[dec.msg_index]
+    return PoseBatch(
+        t_rec,
+        dec.t_header if dec.has_header else t_rec.copy(),
+        dec.xyz,
+        dec.quat_xyzw,
+        np.full(n, frame, dtype=np.int32),
+        np.full(n, child, dtype=np.int32),
+        tuple(names),
+    )
 
 
 def is_state_definition(msgdef: str) -> bool:

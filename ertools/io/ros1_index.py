@@ -9,8 +9,12 @@ still being recorded, truncated copies) are scanned record by record instead, an
 from __future__ import annotations
 
 import bz2
+import contextlib
+import functools
 import logging
-from collections.abc import Iterator, Sequence
+import mmap
+import struct
+from collections.abc import Collection, Iterator, Sequence
 from dataclasses import dataclass, field
 from io import BufferedReader
 from pathlib import Path
@@ -50,6 +54,16 @@ U8 = npt.NDArray[np.uint8]
 INDEX_DTYPE = np.dtype([("sec", "<u4"), ("nsec", "<u4"), ("off", "<u4")])
 # The message-data record header rosbag and rosbags write: conn (4), op (1), time (8) fields.
 MSG_HEADER_LEN = 4 + len("conn=") + 4 + 4 + len("op=") + 1 + 4 + len("time=") + 8
+_U32 = struct.Struct("<I")
+_OP_AT = (0, 13, 17, 30)  # where the op field can sit in a standard message-record header
+
+
+def _op_word(buf: U8, pos: I64) -> npt.NDArray[np.uint64]:
+    from ertools.io.fastdecode import read_at
+
+    return read_at(buf, pos, np.dtype("<u8"))
+
+
 _OP_MSG_WORD = int.from_bytes(b"\x04\x00\x00\x00op=\x02", "little")
 
 
@@ -103,6 +117,25 @@ def _entries_from_index(data: bytes) -> tuple[I64, I64]:
     arr = np.frombuffer(data, dtype=INDEX_DTYPE)
     t = arr["sec"].astype(np.int64) * 1_000_000_000 + arr["nsec"].astype(np.int64)
     return t, arr["off"].astype(np.int64)
+
+
+def _joined_entries(parts: list[bytes | tuple[I64, I64]]) -> tuple[I64, I64]:
+    """(times, offsets) of one connection's entries over several chunks."""
+    if all(isinstance(p, bytes) for p in parts):
+        return _entries_from_index(b"".join(p for p in parts if isinstance(p, bytes)))
+    pairs = [_entries_from_index(p) if isinstance(p, bytes) else p for p in parts]
+    return np.concatenate([p[0] for p in pairs]), np.concatenate([p[1] for p in pairs])
+
+
+@functools.lru_cache(maxsize=4096)
+def _index_header(header: bytes) -> tuple[int, int, int, int] | None:
+    """(op, ver, conn, count) of an index-data record header, None when malformed. Cached:
+    an hour bag repeats the same few headers (one per connection and usual count)."""
+    try:
+        fields = parse_fields(header)
+        return fields["op"][0], u32(fields, "ver"), u32(fields, "conn"), u32(fields, "count")
+    except (RecordError, KeyError, IndexError, struct_error):
+        return None
 
 
 def read_layout(path: Path) -> Ros1Layout:
@@ -323,8 +356,18 @@ class Ros1Bag(BagFile):
             log.warning("%s: %s; reading what the scan found", path, "; ".join(problems))
         self.connections = tuple(self.layout.conns)
         self._f: BufferedReader | None = path.open("rb")
+        self._mm: mmap.mmap | None = None
+
+    def _unmap(self) -> None:
+        if self._mm is not None:
+            # Only bytes copies leave the mapping; should a view be alive, it stays mapped
+            # until that view is collected.
+            with contextlib.suppress(BufferError):
+                self._mm.close()
+            self._mm = None
 
     def close(self) -> None:
+        self._unmap()
         if self._f is not None:
             self._f.close()
             self._f = None
@@ -359,31 +402,56 @@ class Ros1Bag(BagFile):
             out.append(chunk.compression)
         return out
 
-    def chunk_entries(self, chunk: Ros1Chunk) -> dict[int, tuple[I64, I64]]:
-        """conn -> (record times, record offsets) of one chunk, from its index-data records."""
-        if chunk.entries is not None:
-            return chunk.entries
-        rec = self.chunk_record(chunk)
-        pos = rec.end
-        entries: dict[int, tuple[I64, I64]] = {}
+    def _mapped(self) -> mmap.mmap:
+        """The file mapped read-only: index records are read where they lie, without a
+        system call per record (only the pages touched are read)."""
+        if self._mm is None:
+            self._mm = mmap.mmap(self.file.fileno(), 0, access=mmap.ACCESS_READ)
+        return self._mm
+
+    def _index_data(self, chunk: Ros1Chunk, wanted: Collection[int] | None) -> dict[int, bytes]:
+        """conn -> raw (sec, nsec, offset) entries of one chunk, for the ``wanted`` connections
+        (all when None), from the index-data records that follow the chunk."""
+        if chunk.data_pos < 0:
+            self.chunk_record(chunk)
+        mm = self._mapped()
+        size = min(len(mm), self.layout.size)
+        pos = chunk.data_pos + chunk.data_len
+        out: dict[int, bytes] = {}
         try:
             for _ in range(len(chunk.counts)):
-                irec, data = read_record(self.file, pos, self.layout.size, with_data=True)
-                if irec.op != OP_INDEX:
+                if pos + 8 > size:
+                    raise RecordError("index data cut off by end of file", pos)
+                (hlen,) = _U32.unpack_from(mm, pos)
+                if pos + 8 + hlen > size:
+                    raise RecordError("index data cut off by end of file", pos)
+                head = _index_header(mm[pos + 4 : pos + 4 + hlen])
+                if head is None:
+                    raise RecordError("malformed index-data record header", pos)
+                op, ver, cid, count = head
+                if op != OP_INDEX:
                     raise RecordError("expected an index-data record", pos)
-                if u32(irec.fields, "ver") != 1:
+                if ver != 1:
                     raise RecordError("index-data version not 1", pos)
-                count = u32(irec.fields, "count")
-                if len(data) != 12 * count:
+                (dlen,) = _U32.unpack_from(mm, pos + 4 + hlen)
+                data_pos = pos + 8 + hlen
+                if dlen != 12 * count or data_pos + dlen > size:
                     raise RecordError("index-data size disagrees with its count", pos)
-                entries[u32(irec.fields, "conn")] = _entries_from_index(data)
-                pos = irec.end
+                if wanted is None or cid in wanted:
+                    out[cid] = mm[data_pos : data_pos + dlen]
+                pos = data_pos + dlen
         except (RecordError, KeyError, struct_error, IndexError) as err:
             raise BagError(
                 f"damaged index data after chunk at byte {chunk.pos} ({err})", path=self.path
             ) from err
+        return out
+
+    def chunk_entries(self, chunk: Ros1Chunk) -> dict[int, tuple[I64, I64]]:
+        """conn -> (record times, record offsets) of one chunk, from its index-data records."""
+        if chunk.entries is not None:
+            return chunk.entries
         # Not kept on the chunk: an hour bag's index entries are ~20 MB, needed once per read.
-        return entries
+        return {cid: _entries_from_index(d) for cid, d in self._index_data(chunk, None).items()}
 
     def chunk_bytes(self, chunk: Ros1Chunk) -> bytes:
         """The uncompressed data of one chunk."""
@@ -430,8 +498,8 @@ class Ros1Bag(BagFile):
         window and that hold one of ``conns`` are read.
         """
         rank = {c.id: i for i, c in enumerate(conns)}
-        ck, rk, tt, oo = [], [], [], []
-        touched = []
+        raw: dict[int, list[bytes | tuple[I64, I64]]] = {cid: [] for cid in rank}
+        where: dict[int, list[tuple[int, int]]] = {cid: [] for cid in rank}
         for ci, chunk in enumerate(self.layout.chunks):
             if not any(cid in chunk.counts for cid in rank):
                 continue
@@ -439,35 +507,51 @@ class Ros1Bag(BagFile):
                 continue
             if end_ns is not None and chunk.start_ns > end_ns:
                 continue
-            entries = self.chunk_entries(chunk)
-            used = False
-            for cid, r in rank.items():
-                if cid not in entries:
-                    continue
-                t, off = entries[cid]
+            if chunk.entries is not None:  # a scanned bag: entries already decoded
+                for cid, (t, off) in chunk.entries.items():
+                    if cid in rank:
+                        raw[cid].append((t, off))
+                        where[cid].append((ci, len(t)))
+                continue
+            for cid, data in self._index_data(chunk, rank).items():
+                raw[cid].append(data)
+                where[cid].append((ci, len(data) // INDEX_DTYPE.itemsize))
+        self._unmap()  # the index pages touched would otherwise stay in this process's RSS
+        tt, oo, ck, rk = [], [], [], []
+        for cid, r in rank.items():
+            if not raw[cid]:
+                continue
+            t, off = _joined_entries(raw[cid])
+            c = np.repeat(
+                np.array([w[0] for w in where[cid]], dtype=np.int64),
+                np.array([w[1] for w in where[cid]], dtype=np.int64),
+            )
+            if start_ns is not None or end_ns is not None:
                 keep = np.ones(len(t), dtype=bool)
                 if start_ns is not None:
                     keep &= t >= start_ns
                 if end_ns is not None:
                     keep &= t <= end_ns
-                if not keep.any():
-                    continue
-                used = True
-                tt.append(t[keep])
-                oo.append(off[keep])
-                ck.append(np.full(int(keep.sum()), ci, dtype=np.int64))
-                rk.append(np.full(int(keep.sum()), r, dtype=np.int64))
-            if used:
-                touched.append(ci)
-        if not tt:
+                t, off, c = t[keep], off[keep], c[keep]
+            tt.append(t)
+            oo.append(off)
+            ck.append(c)
+            rk.append(np.full(len(t), r, dtype=np.int64))
+        if not tt or not sum(len(t) for t in tt):
             e = np.empty(0, np.int64)
             return [], e, e, e, e
         t_all = np.concatenate(tt)
         c_all = np.concatenate(ck)
         r_all = np.concatenate(rk)
         o_all = np.concatenate(oo)
+        if start_ns is None and end_ns is None:
+            touched = sorted({ci for w in where.values() for ci, k in w if k})
+        else:
+            touched = np.unique(c_all).tolist()
         # rosbags: per connection sorted by time (stable over chunk and index order), then a
         # heap merge over connections in the order given (ties: the earlier connection).
+        # Entries are gathered connection by connection, each in chunk and index order, so
+        # ``seq`` keeps that order among equal times of one connection.
         if len(rank) == 1 and np.all(t_all[1:] >= t_all[:-1]):
             return touched, c_all, r_all, t_all, o_all  # one connection, already in order
         seq = np.arange(len(t_all))
@@ -494,11 +578,18 @@ class Ros1Bag(BagFile):
         if ok.any():
             head = offsets[ok] + 4
             # The op field (len 4, "op=", 0x02: one 8-byte word) sits after 0, 1 or 2 of the
-            # other fields (conn: 13 bytes, time: 17 bytes).
-            is_msg = np.zeros(len(head), dtype=bool)
+            # other fields (conn: 13 bytes, time: 17 bytes). A writer puts it at the same place
+            # in every record: look there first, elsewhere only for records that differ.
             try:
-                for at in (0, 13, 17, 30):
-                    is_msg |= read_at(buf, head + at, np.dtype("<u8")) == _OP_MSG_WORD
+                first = next(
+                    (at for at in _OP_AT if _op_word(buf, head[:1] + at)[0] == _OP_MSG_WORD), 0
+                )
+                is_msg = _op_word(buf, head + first) == _OP_MSG_WORD
+                for at in _OP_AT:
+                    rest = np.flatnonzero(~is_msg)
+                    if at == first or not len(rest):
+                        continue
+                    is_msg[rest] = _op_word(buf, head[rest] + at) == _OP_MSG_WORD
             except LayoutMismatchError as err:
                 raise BagError(f"message record cut off inside its chunk {where}") from err
             ok[np.flatnonzero(ok)[~is_msg]] = False
