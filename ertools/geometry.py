@@ -40,10 +40,30 @@ def circular_mean(angles: F64) -> float:
     return float(np.arctan2(np.sin(a).sum(), np.cos(a).sum()))
 
 
+def row_sqnorm(v: F64) -> F64:
+    """Sums of squares over the last axis, added in the order ``np.linalg.norm`` adds them.
+
+    Component by component, so ``np.sqrt`` of it is bit for bit ``np.linalg.norm(v, axis=-1)``;
+    without the norm's (N, k) temporary and its slow reduction over a short axis it is ~4x
+    faster on (N, 3) arrays.
+    """
+    a = np.asarray(v, dtype=np.float64)
+    total = np.square(a[..., 0], out=np.empty(a.shape[:-1]))  # out: stays an array when 0-d
+    for k in range(1, a.shape[-1]):
+        total += np.square(a[..., k])
+    return total
+
+
+def row_norm(v: F64) -> F64:
+    """Euclidean norms over the last axis, bit for bit ``np.linalg.norm(v, axis=-1)``."""
+    total = row_sqnorm(v)
+    return np.sqrt(total, out=total)
+
+
 def normalize_quat(quat_xyzw: F64) -> F64:
     """Unit quaternions (raises ValueError on a zero or non-finite quaternion)."""
     q = np.asarray(quat_xyzw, dtype=np.float64)
-    norm = np.linalg.norm(q, axis=-1, keepdims=True)
+    norm = row_norm(q)[..., None]
     if not np.all(np.isfinite(norm)) or np.any(norm == 0.0):
         raise ValueError("quaternion with zero or non-finite norm")
     return np.asarray(q / norm, dtype=np.float64)
@@ -64,8 +84,8 @@ def quat_from_yaw(yaw: F64 | float) -> F64:
 
 
 def _unit(q: F64) -> F64:
-    q = np.array(q, dtype=np.float64)
-    return np.asarray(q / np.linalg.norm(q, axis=-1, keepdims=True), dtype=np.float64)
+    q = np.asarray(q, dtype=np.float64)
+    return np.asarray(q / row_norm(q)[..., None], dtype=np.float64)
 
 
 def quat_multiply(q1: F64, q2: F64) -> F64:

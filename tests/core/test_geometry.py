@@ -18,6 +18,7 @@ from ertools.geometry import (
     invert,
     mean_pose,
     quat_from_yaw,
+    row_norm,
     transform_points,
     wrap_angle,
     yaw_from_quat,
@@ -33,6 +34,18 @@ quat = arrays(np.float64, (4,), elements=st.floats(-1, 1)).filter(
 
 def unit(q: np.ndarray) -> np.ndarray:
     return q / np.linalg.norm(q)
+
+
+def test_row_norm_by_hand_and_bit_for_bit_numpys_norm() -> None:
+    v = np.array([[3.0, 4.0, 0.0], [1.0, 2.0, 2.0], [0.0, 0.0, 0.0]])
+    assert row_norm(v).tolist() == [5.0, 3.0, 0.0]
+    assert float(row_norm(np.array([1.0, 1.0, 1.0, 1.0]))) == 2.0
+    # The scorers' results must not move: the same sums in the same order as numpy's norm.
+    rng = np.random.default_rng(3)
+    for k in (3, 4):
+        a = rng.normal(size=(5000, k)) * 10 ** rng.uniform(-3, 3, (5000, 1))
+        assert np.array_equal(row_norm(a), np.linalg.norm(a, axis=1))
+        assert np.array_equal(row_norm(a[::3]), np.linalg.norm(a[::3], axis=1))
 
 
 def test_compose_by_hand() -> None:

@@ -17,6 +17,7 @@ from ertools.benchmarks.trajectory import (
     associate,
     check_increasing,
     drop_duplicates,
+    drop_invalid,
     metrics,
     score_streams,
 )
@@ -188,6 +189,20 @@ def test_nan_and_zero_quaternion_poses_are_ignored_and_counted() -> None:
     assert r.metrics.position_error == pytest.approx((0.5 + 2.5) / 2, abs=1e-12)
     assert any("1 GT sample(s) with NaN" in w for w in r.warnings)
     assert any("1 robot pose(s) with NaN" in w for w in r.warnings)
+
+
+def test_drop_invalid_keeps_tiny_quaternions_and_drops_unusable_ones() -> None:
+    s = stream([0, 10, 20, 30, 40, 50, 60], [0.0] * 7)
+    s.quat_xyzw[1] = [0.0, 0.0, 0.0, 2e-9]  # norm 2e-9: small but a rotation, kept
+    s.quat_xyzw[2] = [0.0, 0.0, 5e-10, 5e-10]  # norm 7.1e-10 <= 1e-9: "no pose"
+    s.quat_xyzw[3] = [0.0, 0.0, 0.0, np.inf]
+    s.quat_xyzw[4] = [0.0, 0.0, 1e200, 1e200]  # its norm overflows to inf
+    s.xyz[5, 2] = -np.inf
+    kept, dropped = drop_invalid(s)
+    assert dropped == 4
+    assert ((kept.t_ns - T0) // MS).tolist() == [0, 10, 60]
+    clean, none = drop_invalid(stream([0, 10], [1.0, 2.0]))
+    assert none == 0 and len(clean) == 2
 
 
 def test_nothing_comparable_is_a_failure() -> None:
