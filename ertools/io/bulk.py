@@ -24,6 +24,7 @@ from ertools.errors import BagError
 from ertools.io.fastdecode import FAST_TYPES, Decoded, LayoutMismatchError, decode, to_batch
 from ertools.io.files import BagFile
 from ertools.io.model import TF_TYPES, Conn
+from ertools.io.pipeline import Group, joined, prefetched, read_at, scratch_view
 from ertools.io.posebatch import PoseBatch, concat_batches
 from ertools.io.uniform import decode_uniform
 
@@ -167,7 +168,12 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
 
     def runs() -> Iterator[Run]:
         groups = dict(group_positions(chunk_of))
-        for batch, (buf, base, sizes) in _prefetched(bag, list(batches())):
+        todo = list(batches())
+
+        def load(k: int, scratch: list[bytearray]) -> Group:
+            return _chunk_group(bag, [bag.layout.chunks[c] for c in todo[k]], scratch)
+
+        for batch, (buf, base, sizes) in zip(todo, prefetched(len(todo), load), strict=True):
             chunks = [bag.layout.chunks[c] for c in batch]
             sel = np.concatenate([groups[c] for c in batch])
             which = np.concatenate([np.full(len(groups[c]), k) for k, c in enumerate(batch)])
@@ -183,82 +189,37 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
     return Located(len(t_of), runs())
 
 
-def _prefetched(
-    bag: BagFile, batches: list[list[int]]
-) -> Iterator[tuple[list[int], tuple[U8, I64, I64]]]:
-    """Each batch of chunks with its bytes, the next batch read (or decompressed) by a
-    second thread while the caller decodes the current one: file reads and decompression
-    release the GIL, so on two cores reading costs little beyond decoding.
-
-    Two scratch buffers alternate, so a batch's bytes stay valid until the next is asked for.
-    """
-    from concurrent.futures import ThreadPoolExecutor
-
-    from ertools.io.ros1_index import Ros1Bag
-
-    assert isinstance(bag, Ros1Bag)
-    if not batches:
-        return
-    scratches: list[list[bytearray]] = [[], []]
-
-    def load(k: int) -> tuple[U8, I64, I64]:
-        return _chunk_group(bag, [bag.layout.chunks[c] for c in batches[k]], scratches[k % 2])
-
-    if len(batches) == 1 or _workers() == 1:
-        for k, batch in enumerate(batches):
-            yield batch, load(k)
-        return
-    with ThreadPoolExecutor(1) as pool:
-        ahead = pool.submit(load, 0)
-        for k, batch in enumerate(batches):
-            got = ahead.result()
-            if k + 1 < len(batches):
-                ahead = pool.submit(load, k + 1)
-            yield batch, got
-
-
-def _workers() -> int:
-    return os.cpu_count() or 1
-
-
-def _read_at(fd: int, into: memoryview, offset: int) -> int:
-    """Read into ``into`` from ``offset`` without moving the file position, so a reading
-    thread and the decoding one never race over it."""
-    if hasattr(os, "preadv"):
-        return os.preadv(fd, [into], offset)
-    data = os.pread(fd, len(into), offset)  # no preadv (Windows, older macOS): one copy more
-    into[: len(data)] = data
-    return len(data)
-
-
-def _chunk_group(bag: BagFile, chunks: list[Any], scratch: list[bytearray]) -> tuple[U8, I64, I64]:
-    """(bytes, where each chunk's data starts in them, each chunk's size) of ROS1 chunks.
+def _chunk_group(bag: BagFile, chunks: list[Any], scratch: list[bytearray]) -> Group:
+    """(bytes, where each chunk's data starts in them, each chunk's size) of ROS1 chunks,
+    loaded into ``scratch`` (runs on a loading thread: positional reads only).
 
     Uncompressed chunks that follow each other in the file are read with one read of the
-    stretch they span (the index records between them come along, unused) into ``scratch``,
-    a buffer reused from one group to the next (the decoders copy what they keep); others
-    are decompressed and joined.
+    stretch they span (the index records between them come along, unused); others are read
+    and decompressed one by one and joined.
     """
-    from ertools.io.ros1_index import Ros1Bag
+    from ertools.io.ros1_index import Ros1Bag, decompress
 
     assert isinstance(bag, Ros1Bag)
-    if all(c.compression == "none" and c.data_pos >= 0 for c in chunks):
+    fd = bag.file.fileno()
+    if all(c.compression == "none" and c.data_pos >= 0 for c in chunks) and all(
+        b.data_pos > a.data_pos for a, b in itertools.pairwise(chunks)
+    ):
         first = chunks[0].data_pos
         span = chunks[-1].data_pos + chunks[-1].data_len - first
-        if all(b.data_pos > a.data_pos for a, b in itertools.pairwise(chunks)):
-            if not scratch or len(scratch[0]) < span:
-                scratch[:] = [bytearray(span)]
-            got = _read_at(bag.file.fileno(), memoryview(scratch[0])[:span], first)
-            if got != span:
-                raise BagError(f"chunks cut off by end of file at byte {first}", path=bag.path)
-            base = np.array([c.data_pos - first for c in chunks], dtype=np.int64)
-            sizes = np.array([c.data_len for c in chunks], dtype=np.int64)
-            return np.frombuffer(scratch[0], dtype=np.uint8, count=span), base, sizes
-    datas = bag.chunks_bytes(chunks)
-    sizes = np.array([len(d) for d in datas], dtype=np.int64)
-    base = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
-    buf = np.frombuffer(b"".join(datas) if len(datas) > 1 else datas[0], dtype=np.uint8)
-    return buf, base, sizes
+        view = scratch_view(scratch, span)
+        if read_at(fd, view, first) != span:
+            raise BagError(f"chunks cut off by end of file at byte {first}", path=bag.path)
+        base = np.array([c.data_pos - first for c in chunks], dtype=np.int64)
+        sizes = np.array([c.data_len for c in chunks], dtype=np.int64)
+        return np.frombuffer(view, dtype=np.uint8), base, sizes
+    parts = []
+    for chunk in chunks:
+        where = f"in {bag.path} at byte {chunk.pos}"
+        data = os.pread(fd, chunk.data_len, chunk.data_pos)
+        if len(data) != chunk.data_len:
+            raise BagError(f"chunk at byte {chunk.pos} cut off by end of file", path=bag.path)
+        parts.append(decompress(chunk.compression, data, where))
+    return joined(parts, scratch)
 
 
 def _mcap_runs(

@@ -80,12 +80,6 @@ def _file_size(f: BinaryIO) -> int:
     return os.fstat(f.fileno()).st_size
 
 
-def _workers() -> int:
-    import os
-
-    return max(1, min(8, os.cpu_count() or 1))
-
-
 @dataclass(frozen=True, eq=False)
 class McapPlan:
     """Messages located from the message indexes, in the reference order."""
@@ -167,37 +161,52 @@ class McapIndex:
         return McapPlan(t_all[order], off_all[order], key[order], file_all[order], chunks_per_file)
 
     def chunks_of(self, plan: McapPlan) -> Iterator[tuple[I64, U8, I64, I64]]:
-        """Per chunk: (reference positions, chunk bytes, data starts, data lengths)."""
-        from ertools.io.bulk import group_positions
+        """Per group of chunks: (reference positions, bytes, data starts, data lengths).
+
+        Chunks are decompressed ahead on worker threads (:mod:`ertools.io.pipeline`), a group
+        of up to ``GROUP_BYTES`` uncompressed bytes at a time.
+        """
+        from ertools.io.bulk import GROUP_BYTES, group_positions
+        from ertools.io.pipeline import Group, joined, prefetched
 
         groups = group_positions(plan.key)
-        # Decompress a few chunks at a time on all cores (zstd and lz4 release the GIL).
-        step = 2 * _workers()
-        for g in range(0, len(groups), step):
-            part = groups[g : g + step]
-            jobs = [(self.files[k >> 32], plan.chunks[k >> 32][k & 0xFFFFFFFF]) for k, _ in part]
-            for (_k, rows), (path, chunk), buf in zip(part, jobs, self._many(jobs), strict=True):
-                where = f"in {path} at byte {chunk.chunk_start_offset}"
-                start, length = self._spans(buf, plan.offset[rows], where)
-                yield rows, buf, start, length
+        todo: list[list[tuple[int, I64]]] = []
+        size = 0
+        for key, rows in groups:
+            if not todo or size >= GROUP_BYTES:
+                todo.append([])
+                size = 0
+            todo[-1].append((key, rows))
+            size += int(plan.chunks[key >> 32][key & 0xFFFFFFFF].uncompressed_size)
+
+        def chunk_of(key: int) -> tuple[Path, Any]:
+            return self.files[key >> 32], plan.chunks[key >> 32][key & 0xFFFFFFFF]
+
+        def load(k: int, scratch: list[bytearray]) -> Group:
+            return joined([self._inflated_bytes(*chunk_of(key)) for key, _ in todo[k]], scratch)
+
+        for part, (buf, base, sizes) in zip(todo, prefetched(len(todo), load), strict=True):
+            rows = np.concatenate([r for _k, r in part])
+            which = np.concatenate([np.full(len(r), i) for i, (_k, r) in enumerate(part)])
+            path, first = chunk_of(part[0][0])
+            where = f"in {path} in chunks from byte {first.chunk_start_offset}"
+            offsets = plan.offset[rows]
+            if np.any(offsets + 9 + MESSAGE_FIXED > sizes[which]):
+                raise BagError(f"message index points outside its chunk {where}")
+            start, length = self._spans(buf, offsets + base[which], where)
+            if np.any(start + length > base[which] + sizes[which]):
+                raise BagError(f"message record cut off inside its chunk {where}")
+            yield rows, buf, start, length
 
     @staticmethod
-    def _many(jobs: list[tuple[Path, Any]]) -> list[U8]:
-        raws = [McapIndex._chunk_raw(path, chunk) for path, chunk in jobs]
-        if len(jobs) == 1 or _workers() == 1:
-            return [
-                McapIndex._inflate(path, chunk, raw)
-                for (path, chunk), raw in zip(jobs, raws, strict=True)
-            ]
-        from concurrent.futures import ThreadPoolExecutor
-
-        with ThreadPoolExecutor(_workers()) as pool:
-            return list(
-                pool.map(
-                    lambda a: McapIndex._inflate(*a),
-                    [(p, c, r) for (p, c), r in zip(jobs, raws, strict=True)],
-                )
-            )
+    def _inflated_bytes(path: Path, chunk: Any) -> bytes:
+        """A chunk's records, decompressed (and its size checked)."""
+        where = f"in {path} at byte {chunk.chunk_start_offset}"
+        compression, data, usize = McapIndex._chunk_raw(path, chunk)
+        out = decompress(compression, data, usize, where)
+        if len(out) != usize:
+            raise BagError(f"chunk decompresses to {len(out)} bytes, not {usize}, {where}")
+        return out
 
     @staticmethod
     def _message_index(f: BinaryIO, path: Path, pos: int, cid: int) -> tuple[I64, I64]:
@@ -219,16 +228,7 @@ class McapIndex:
 
     @staticmethod
     def _chunk_bytes(path: Path, chunk: Any) -> U8:
-        return McapIndex._inflate(path, chunk, McapIndex._chunk_raw(path, chunk))
-
-    @staticmethod
-    def _inflate(path: Path, chunk: Any, raw: tuple[str, bytes, int]) -> U8:
-        where = f"in {path} at byte {chunk.chunk_start_offset}"
-        compression, data, usize = raw
-        out = decompress(compression, data, usize, where)
-        if len(out) != usize:
-            raise BagError(f"chunk decompresses to {len(out)} bytes, not {usize}, {where}")
-        return np.frombuffer(out, dtype=np.uint8)
+        return np.frombuffer(McapIndex._inflated_bytes(path, chunk), dtype=np.uint8)
 
     @staticmethod
     def _chunk_raw(path: Path, chunk: Any) -> tuple[str, bytes, int]:

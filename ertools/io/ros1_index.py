@@ -190,12 +190,6 @@ def read_layout(path: Path) -> Ros1Layout:
     return Ros1Layout(path, size, True, conns, chunks)
 
 
-def _workers() -> int:
-    import os
-
-    return max(1, min(8, os.cpu_count() or 1))
-
-
 def decompress(compression: str, data: bytes, where: str) -> bytes:
     """Uncompressed chunk bytes."""
     try:
@@ -465,28 +459,6 @@ class Ros1Bag(BagFile):
             return decompress(chunk.compression, data, self._where(chunk))
         except BagError as err:
             raise BagError(err.message, path=None) from err
-
-    def chunks_bytes(self, chunks: Sequence[Ros1Chunk]) -> list[bytes]:
-        """The uncompressed data of several chunks; decompression runs on all cores (bz2 and
-        lz4 release the GIL), file reads stay sequential."""
-        raw = []
-        for chunk in chunks:
-            if chunk.data_pos < 0:
-                self.chunk_record(chunk)
-            self.file.seek(chunk.data_pos)
-            data = self.file.read(chunk.data_len)
-            if len(data) != chunk.data_len:
-                raise BagError(f"chunk at byte {chunk.pos} cut off by end of file", path=self.path)
-            raw.append(data)
-        if all(c.compression == "none" for c in chunks):
-            return raw
-        jobs = [(c.compression, d, self._where(c)) for c, d in zip(chunks, raw, strict=True)]
-        if len(jobs) == 1 or _workers() == 1:
-            return [decompress(*job) for job in jobs]
-        from concurrent.futures import ThreadPoolExecutor
-
-        with ThreadPoolExecutor(_workers()) as pool:
-            return list(pool.map(lambda job: decompress(*job), jobs))
 
     def select(
         self, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None

@@ -1,0 +1,88 @@
+"""Groups of chunks loaded ahead, on worker threads, into rotating buffers.
+
+Reading a pose topic is three steps per group of chunks: read the bytes, decompress them, and
+decode the messages. File reads and lz4/zstd/bz2 decompression release the GIL, so worker
+threads load the next groups while the calling thread decodes the current one: on two cores a
+topic costs about the larger of decompressing and decoding, not their sum.
+
+Each group is loaded whole into one buffer (its chunks end to end) that is reused once the
+caller has moved on, so memory stays at a few groups whatever the size of the file, and fresh
+pages are not faulted in for every chunk.
+"""
+
+from __future__ import annotations
+
+import os
+from collections import deque
+from collections.abc import Callable, Iterator, Sequence
+from typing import TypeVar
+
+import numpy as np
+import numpy.typing as npt
+
+I64 = npt.NDArray[np.int64]
+U8 = npt.NDArray[np.uint8]
+
+T = TypeVar("T")
+
+# A group: (bytes of its chunks end to end, where each chunk starts in them, chunk sizes).
+Group = tuple[U8, I64, I64]
+
+
+def workers() -> int:
+    """Threads that load ahead of the decoder (one per core; none on a single core)."""
+    return os.cpu_count() or 1
+
+
+def prefetched(count: int, load: Callable[[int, list[bytearray]], T]) -> Iterator[T]:
+    """``load(k, scratch)`` for k in 0..count-1, in order, computed ahead on worker threads.
+
+    ``scratch`` is a one-element list holding the bytearray ``load`` may fill (and grow); a
+    result is valid until the next one is asked for, after which its buffer is reused.
+    """
+    ahead = min(workers(), count)
+    if ahead <= 1:
+        scratch: list[bytearray] = []
+        for k in range(count):
+            yield load(k, scratch)
+        return
+    from concurrent.futures import ThreadPoolExecutor
+
+    # ahead groups in flight plus the one the caller holds: none shares a buffer.
+    slots: list[list[bytearray]] = [[] for _ in range(ahead + 1)]
+    with ThreadPoolExecutor(ahead) as pool:
+        pending = deque(pool.submit(load, k, slots[k % len(slots)]) for k in range(ahead))
+        for k in range(count):
+            got = pending.popleft().result()
+            if k + ahead < count:
+                pending.append(pool.submit(load, k + ahead, slots[(k + ahead) % len(slots)]))
+            yield got
+
+
+def scratch_view(scratch: list[bytearray], size: int) -> memoryview:
+    """The first ``size`` bytes of the reused buffer (grown when too small)."""
+    if not scratch or len(scratch[0]) < size:
+        scratch[:] = [bytearray(size)]
+    return memoryview(scratch[0])[:size]
+
+
+def joined(parts: Sequence[bytes], scratch: list[bytearray]) -> Group:
+    """Chunks' uncompressed bytes copied end to end into the reused buffer."""
+    sizes = np.array([len(p) for p in parts], dtype=np.int64)
+    base = np.zeros(len(parts), dtype=np.int64)
+    np.cumsum(sizes[:-1], out=base[1:])
+    total = int(sizes.sum())
+    view = scratch_view(scratch, total)
+    for at, part in zip(base.tolist(), parts, strict=True):
+        view[at : at + len(part)] = part
+    return np.frombuffer(view, dtype=np.uint8), base, sizes
+
+
+def read_at(fd: int, into: memoryview, offset: int) -> int:
+    """Read into ``into`` from ``offset`` without moving the file position, so loading
+    threads never race over it."""
+    if hasattr(os, "preadv"):
+        return os.preadv(fd, [into], offset)
+    data = os.pread(fd, len(into), offset)  # no preadv (Windows, older macOS): one copy more
+    into[: len(data)] = data
+    return len(data)
