@@ -21,7 +21,7 @@ NS_BODY = "/fbm3w/robot_at_work"
 GT_TOPIC = f"{NS_BODY}/pose"
 ROBOT_TOPIC = "/rockin/homer/marker_pose"
 PS, P2D, TFM = "geometry_msgs/PoseStamped", "geometry_msgs/Pose2D", "tf2_msgs/TFMessage"
-VERSION = 4  # bump to regenerate the cache
+VERSION = 5  # bump to regenerate the cache
 
 
 def trajectory(t_s: F64) -> tuple[F64, F64]:
@@ -127,6 +127,7 @@ def generate(folder: Path, small_bags: int = 1000) -> dict[str, Path]:
         "gt_lz4": folder / "gt_hour_lz4.bag",
         "gt_bz2": folder / "gt_hour_bz2.bag",
         "gt_mcap": folder / "gt_hour.mcap",
+        "gt_mcap_none": folder / "gt_hour_uncompressed.mcap",
         "robot": folder / "robot_hour.bag",
         "combined": folder / "gt_and_robot_hour.bag",
         "small": folder / "small_bags",
@@ -151,7 +152,9 @@ def generate(folder: Path, small_bags: int = 1000) -> dict[str, Path]:
     ts2 = typestore(False)
     schemas = {t.msgtype: msgdef(ts2, t.msgtype, False)[0] for t in hour2}
     write_mcap(paths["gt_mcap"], hour2, schemas, "zstd")
+    write_mcap(paths["gt_mcap_none"], hour2, schemas, "none")
     check_readback(paths["gt_mcap"], hour2)
+    check_readback(paths["gt_mcap_none"], hour2)
     del hour2
     small = paths["small"]
     small.mkdir(exist_ok=True)

@@ -4,6 +4,7 @@
 python benchmarks/extract.py bytes PATH              read the file's bytes
 python benchmarks/extract.py ertools PATH TOPIC      ertools.io.read_poses -> arrays
 python benchmarks/extract.py rosbags PATH TOPIC      rosbags AnyReader, one message at a time
+python benchmarks/extract.py inflate PATH            read and decompress every chunk, no decoding
 """
 
 from __future__ import annotations
@@ -23,9 +24,8 @@ def main() -> None:
         import numpy as np
         from rosbags.highlevel import AnyReader
     elif mode == "inflate":
+        from ertools.io.bulk import load_all_chunks
         from ertools.io.files import open_bag
-        from ertools.io.mcap_index import McapIndex, read_summary
-        from ertools.io.ros1_index import Ros1Bag
     t0 = time.perf_counter()
     if mode == "bytes":
         n = 0
@@ -45,20 +45,8 @@ def main() -> None:
                 rows.append((stamp, p.x, p.y, p.z, q.x, q.y, q.z, q.w))
         n = len(np.array(rows))
     elif mode == "inflate":
-        n = 0
-        if path.suffix == ".mcap":
-            with path.open("rb") as f:
-                chunks = read_summary(f, path).chunk_indexes
-            for i in range(0, len(chunks), 4):
-                jobs = [(path, c) for c in chunks[i : i + 4]]
-                n += sum(len(b) for b in McapIndex._many(jobs))
-        else:
-            bag = open_bag(path)
-            assert isinstance(bag, Ros1Bag)
-            chunks = bag.layout.chunks
-            for i in range(0, len(chunks), 4):
-                n += sum(len(b) for b in bag.chunks_bytes(chunks[i : i + 4]))
-            bag.close()
+        with open_bag(path) as bag:
+            n = load_all_chunks(bag)
     else:
         raise SystemExit(f"unknown mode {mode}")
     done = time.perf_counter()

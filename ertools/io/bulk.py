@@ -296,6 +296,43 @@ def locate(
     return None
 
 
+def load_all_chunks(bag: BagFile) -> int:
+    """Uncompressed bytes of every chunk of a ROS1 or MCAP file, loaded through the same
+    pipeline as a topic read but not decoded: the floor of any read of that file (what the
+    benchmark compares the extraction with on compressed files)."""
+    from ertools.io.mcap_index import McapIndex
+    from ertools.io.ros1_index import Ros1Bag
+
+    total = 0
+    if isinstance(bag, Ros1Bag):
+        chunks = bag.layout.chunks
+        for chunk in chunks:
+            if chunk.data_pos < 0:
+                bag.chunk_record(chunk)
+        step = max(1, GROUP_BYTES // max(1, max((c.data_len for c in chunks), default=1) * 4))
+        todo = [chunks[i : i + step] for i in range(0, len(chunks), step)]
+
+        def load(k: int, scratch: list[bytearray]) -> Group:
+            return _chunk_group(bag, todo[k], scratch)
+
+        for _buf, _base, sizes in prefetched(len(todo), load):
+            total += int(sizes.sum())
+        return total
+    index = McapIndex.of(bag)
+    if index is None:
+        raise BagError(f"no chunks to load in a {bag.format} file", path=bag.path)
+    jobs = index.all_chunks()
+    step = 4
+
+    def load_mcap(k: int, scratch: list[bytearray]) -> Group:
+        part = jobs[k * step : (k + 1) * step]
+        return joined([index.inflated_bytes(path, chunk) for path, chunk in part], scratch)
+
+    for buf, _base, _sizes in prefetched((len(jobs) + step - 1) // step, load_mcap):
+        total += len(buf)
+    return total
+
+
 def try_fast_batch(
     bag: BagFile, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
 ) -> PoseBatch | None:

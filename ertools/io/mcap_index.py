@@ -80,6 +80,21 @@ def _file_size(f: BinaryIO) -> int:
     return os.fstat(f.fileno()).st_size
 
 
+def _in_order(*keys: I64) -> bool:
+    """Whether rows are already sorted by ``keys`` (the first the most significant)."""
+    if len(keys[0]) < 2:
+        return True
+    undecided = np.ones(len(keys[0]) - 1, dtype=bool)
+    for k in keys:
+        step = k[1:] - k[:-1]
+        if np.any(undecided & (step < 0)):
+            return False
+        undecided &= step == 0
+        if not undecided.any():
+            return True
+    return True
+
+
 @dataclass(frozen=True, eq=False)
 class McapPlan:
     """Messages located from the message indexes, in the reference order."""
@@ -155,10 +170,23 @@ class McapIndex:
         file_all = np.concatenate([np.full(len(s[3]), s[0], np.int64) for s in sels])
         chunk_all = np.concatenate([np.full(len(s[3]), s[1], np.int64) for s in sels])
         cstart_all = np.concatenate([np.full(len(s[3]), s[2], np.int64) for s in sels])
-        # the mcap library's order: log time, then file, chunk position, record position
-        order = np.lexsort((off_all, cstart_all, file_all, t_all))
         key = file_all * (1 << 32) + chunk_all
+        # the mcap library's order: log time, then file, chunk position, record position. One
+        # channel logged in time order is in that order already: no sort.
+        if _in_order(t_all, file_all, cstart_all, off_all):
+            return McapPlan(t_all, off_all, key, file_all, chunks_per_file)
+        order = np.lexsort((off_all, cstart_all, file_all, t_all))
         return McapPlan(t_all[order], off_all[order], key[order], file_all[order], chunks_per_file)
+
+    def all_chunks(self) -> list[tuple[Path, Any]]:
+        """(file, chunk index record) of every chunk, in file order."""
+        out: list[tuple[Path, Any]] = []
+        for path in self.files:
+            with path.open("rb") as f:
+                summary = read_summary(f, path)
+            if summary is not None:
+                out.extend((path, c) for c in summary.chunk_indexes)
+        return out
 
     def chunks_of(self, plan: McapPlan) -> Iterator[tuple[I64, U8, I64, I64]]:
         """Per group of chunks: (reference positions, bytes, data starts, data lengths).
@@ -183,7 +211,7 @@ class McapIndex:
             return self.files[key >> 32], plan.chunks[key >> 32][key & 0xFFFFFFFF]
 
         def load(k: int, scratch: list[bytearray]) -> Group:
-            return joined([self._inflated_bytes(*chunk_of(key)) for key, _ in todo[k]], scratch)
+            return joined([self.inflated_bytes(*chunk_of(key)) for key, _ in todo[k]], scratch)
 
         for part, (buf, base, sizes) in zip(todo, prefetched(len(todo), load), strict=True):
             rows = np.concatenate([r for _k, r in part])
@@ -199,7 +227,7 @@ class McapIndex:
             yield rows, buf, start, length
 
     @staticmethod
-    def _inflated_bytes(path: Path, chunk: Any) -> bytes:
+    def inflated_bytes(path: Path, chunk: Any) -> bytes:
         """A chunk's records, decompressed (and its size checked)."""
         where = f"in {path} at byte {chunk.chunk_start_offset}"
         compression, data, usize = McapIndex._chunk_raw(path, chunk)
@@ -228,7 +256,7 @@ class McapIndex:
 
     @staticmethod
     def _chunk_bytes(path: Path, chunk: Any) -> U8:
-        return np.frombuffer(McapIndex._inflated_bytes(path, chunk), dtype=np.uint8)
+        return np.frombuffer(McapIndex.inflated_bytes(path, chunk), dtype=np.uint8)
 
     @staticmethod
     def _chunk_raw(path: Path, chunk: Any) -> tuple[str, bytes, int]:
