@@ -12,12 +12,16 @@ $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 
+# Byte-compiled on install, as a wheel install would be: where PYTHONDONTWRITEBYTECODE is set,
+# every command would otherwise compile the package again at start-up.
 $(STAMP): pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e .
+	$(BIN)/python -m compileall -q ertools
 	touch $@
 
 $(DEVSTAMP): pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	$(BIN)/python -m compileall -q ertools
 	touch $@ $(STAMP)
 
 demo: $(STAMP)
@@ -36,6 +40,7 @@ pytest: $(DEVSTAMP)
 test: lint typecheck pytest
 
 bench: $(STAMP)
+	$(BIN)/python -m compileall -q ertools
 	$(BIN)/python benchmarks/run.py
 
 samples: $(STAMP)

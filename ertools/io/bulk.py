@@ -21,7 +21,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.errors import BagError
-from ertools.io.fastdecode import FAST_TYPES, Decoded, LayoutMismatchError, decode, to_batch
+from ertools.io.fastdecode import FAST_TYPES, LayoutMismatchError, decode, to_batch
 from ertools.io.files import BagFile
 from ertools.io.model import TF_TYPES, Conn
 from ertools.io.pipeline import Group, joined, prefetched, read_at, scratch_view
@@ -60,11 +60,10 @@ class _Assembler:
         self.frames: dict[str, int] = {"": 0}
         self.parts: list[tuple[I64, PoseBatch]] = []
 
-    def add(self, pos: I64, buf: U8, dec: Decoded, t_record: I64) -> None:
-        """Rows decoded from messages at reference positions ``pos`` (record times given)."""
-        batch = to_batch(buf, dec, t_record)
+    def add(self, pos: I64, batch: PoseBatch) -> None:
+        """Decoded rows and the reference position of the message of each row."""
         if self.multi:
-            self.parts.append((pos[dec.msg_index], batch))
+            self.parts.append((pos, batch))
             return
         remap = np.array(
             [self.frames.setdefault(f, len(self.frames)) for f in batch.frames], np.int32
@@ -73,14 +72,14 @@ class _Assembler:
             # One connection read in order: a run of consecutive rows, written as a slice
             # (a block copy, not a scatter).
             at = slice(int(pos[0]), int(pos[-1]) + 1)
-            self.t_record[at] = t_record
+            self.t_record[at] = batch.t_record
             self.t_header[at] = batch.t_header
             self.xyz[at] = batch.xyz
             self.quat[at] = batch.quat_xyzw
             self.frame_idx[at] = remap[batch.frame_idx]
             self.child_idx[at] = remap[batch.child_idx]
             return
-        self.t_record[pos] = t_record
+        self.t_record[pos] = batch.t_record
         self.t_header[pos] = batch.t_header
         self.xyz[pos] = batch.xyz
         self.quat[pos] = batch.quat_xyzw
@@ -166,27 +165,25 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
                 yield batch
                 batch, size = [], 0
 
-    def runs() -> Iterator[Run]:
-        groups = dict(group_positions(chunk_of))
-        todo = list(batches())
+    groups = dict(group_positions(chunk_of))
+    todo = list(batches())
 
-        def load(k: int, scratch: list[bytearray]) -> Group:
-            return _chunk_group(bag, [bag.layout.chunks[c] for c in todo[k]], scratch)
+    def load_run(k: int, scratch: list[bytearray]) -> Run:
+        batch = todo[k]
+        chunks = [bag.layout.chunks[c] for c in batch]
+        buf, base, sizes = _chunk_group(bag, chunks, scratch)
+        sel = np.concatenate([groups[c] for c in batch])
+        which = np.concatenate([np.full(len(groups[c]), k) for k, c in enumerate(batch)])
+        where = f"in {bag.path} in chunks at bytes {chunks[0].pos}..{chunks[-1].pos}"
+        offsets = off_of[sel]
+        if np.any(offsets + 8 > sizes[which]):
+            raise BagError(f"index points outside its chunk {where}")
+        start, length = bag.spans(buf, offsets + base[which], where)
+        if np.any(start + length > base[which] + sizes[which]):
+            raise BagError(f"message record runs past the end of its chunk {where}")
+        return sel, buf, start, length, t_of[sel]
 
-        for batch, (buf, base, sizes) in zip(todo, prefetched(len(todo), load), strict=True):
-            chunks = [bag.layout.chunks[c] for c in batch]
-            sel = np.concatenate([groups[c] for c in batch])
-            which = np.concatenate([np.full(len(groups[c]), k) for k, c in enumerate(batch)])
-            where = f"in {bag.path} in chunks at bytes {chunks[0].pos}..{chunks[-1].pos}"
-            offsets = off_of[sel]
-            if np.any(offsets + 8 > sizes[which]):
-                raise BagError(f"index points outside its chunk {where}")
-            start, length = bag.spans(buf, offsets + base[which], where)
-            if np.any(start + length > base[which] + sizes[which]):
-                raise BagError(f"message record runs past the end of its chunk {where}")
-            yield sel, buf, start, length, t_of[sel]
-
-    return Located(len(t_of), runs())
+    return Located(len(t_of), prefetched(len(todo), load_run))
 
 
 def _chunk_group(bag: BagFile, chunks: list[Any], scratch: list[bytearray]) -> Group:
@@ -231,12 +228,13 @@ def _mcap_runs(
     if index is None:
         return None
     plan = index.plan(conns, lo, hi)
+    count, load = index.run_loader(plan)
 
-    def runs() -> Iterator[Run]:
-        for pos, buf, start, length in index.chunks_of(plan):
-            yield pos, buf, start, length, plan.t_record[pos]
+    def load_run(k: int, scratch: list[bytearray]) -> Run:
+        pos, buf, start, length = load(k, scratch)
+        return pos, buf, start, length, plan.t_record[pos]
 
-    return Located(len(plan.t_record), runs())
+    return Located(len(plan.t_record), prefetched(count, load_run))
 
 
 def _sqlite_runs(
@@ -351,12 +349,19 @@ def try_fast_batch(
     try:
         found = locate(bag, conns, start_ns, end_ns)
         if found is not None:
-            out = _Assembler(msgtype, found.count)
-            for pos, buf, start, length, t_rec in found.runs:
+
+            def decoded(run: Run) -> tuple[I64, PoseBatch]:
+                pos, buf, start, length, t_rec = run
                 dec = decode_uniform(msgtype, cdr, buf, start, length)
                 if dec is None:
                     dec = decode(msgtype, cdr, buf, start, length)
-                out.add(pos, buf, dec, t_rec)
+                return pos[dec.msg_index], to_batch(buf, dec, t_rec)
+
+            # Decoded here, not on the loading threads: its many small NumPy calls hold the
+            # GIL, and two threads decoding were slower than one (measured).
+            out = _Assembler(msgtype, found.count)
+            for pos, batch in map(decoded, found.runs):
+                out.add(pos, batch)
             return out.result()
     except LayoutMismatchError as err:
         log.info(

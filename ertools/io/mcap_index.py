@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import logging
 import struct
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, BinaryIO
@@ -188,19 +188,19 @@ class McapIndex:
                 out.extend((path, c) for c in summary.chunk_indexes)
         return out
 
-    def chunks_of(self, plan: McapPlan) -> Iterator[tuple[I64, U8, I64, I64]]:
-        """Per group of chunks: (reference positions, bytes, data starts, data lengths).
-
-        Chunks are decompressed ahead on worker threads (:mod:`ertools.io.pipeline`), a group
-        of up to ``GROUP_BYTES`` uncompressed bytes at a time.
-        """
+    def run_loader(
+        self, plan: McapPlan
+    ) -> tuple[int, Callable[[int, list[bytearray]], tuple[I64, U8, I64, I64]]]:
+        """(number of groups, load) where ``load(k, scratch)`` decompresses the k-th group of
+        chunks (up to ``GROUP_BYTES`` uncompressed) into ``scratch`` and gives (reference
+        positions, bytes, data starts, data lengths) of the planned messages in it. ``load``
+        may run on a worker thread (it opens the file itself)."""
         from ertools.io.bulk import GROUP_BYTES, group_positions
-        from ertools.io.pipeline import Group, joined, prefetched
+        from ertools.io.pipeline import joined
 
-        groups = group_positions(plan.key)
         todo: list[list[tuple[int, I64]]] = []
         size = 0
-        for key, rows in groups:
+        for key, rows in group_positions(plan.key):
             if not todo or size >= GROUP_BYTES:
                 todo.append([])
                 size = 0
@@ -210,10 +210,11 @@ class McapIndex:
         def chunk_of(key: int) -> tuple[Path, Any]:
             return self.files[key >> 32], plan.chunks[key >> 32][key & 0xFFFFFFFF]
 
-        def load(k: int, scratch: list[bytearray]) -> Group:
-            return joined([self.inflated_bytes(*chunk_of(key)) for key, _ in todo[k]], scratch)
-
-        for part, (buf, base, sizes) in zip(todo, prefetched(len(todo), load), strict=True):
+        def load(k: int, scratch: list[bytearray]) -> tuple[I64, U8, I64, I64]:
+            part = todo[k]
+            buf, base, sizes = joined(
+                [self.inflated_bytes(*chunk_of(key)) for key, _ in part], scratch
+            )
             rows = np.concatenate([r for _k, r in part])
             which = np.concatenate([np.full(len(r), i) for i, (_k, r) in enumerate(part)])
             path, first = chunk_of(part[0][0])
@@ -224,7 +225,9 @@ class McapIndex:
             start, length = self._spans(buf, offsets + base[which], where)
             if np.any(start + length > base[which] + sizes[which]):
                 raise BagError(f"message record cut off inside its chunk {where}")
-            yield rows, buf, start, length
+            return rows, buf, start, length
+
+        return len(todo), load
 
     @staticmethod
     def inflated_bytes(path: Path, chunk: Any) -> bytes:
