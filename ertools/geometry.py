@@ -183,6 +183,24 @@ class Interpolated:
     inside: npt.NDArray[np.bool_]
 
 
+def bracket(t_ns: I64, query_ns: I64, right: IntArr | None = None) -> tuple[IntArr, IntArr]:
+    """The samples around each query in sorted ``t_ns``: (lo, hi).
+
+    ``lo`` is the last index at or before the query (-1 before the first), ``hi`` the first at
+    or after it (``len(t_ns)`` after the last): ``searchsorted`` right minus one and left. One
+    binary search instead of two (none when ``right``, the right-side search, is given): they
+    differ only where a query hits a stamp exactly.
+    """
+    if right is None:
+        right = np.searchsorted(t_ns, query_ns, side="right")
+    lo = right - 1
+    hit = np.flatnonzero(t_ns.take(np.maximum(lo, 0)) == query_ns)  # lo -1: t[0] > query
+    if hit.size:
+        right = right.copy()  # the caller's array stays as it was
+        right[hit] = np.searchsorted(t_ns, query_ns[hit], side="left")
+    return lo, right
+
+
 def interpolate_poses(
     stream: PoseStream, query_ns: I64, method: Association = "linear"
 ) -> Interpolated:
@@ -198,14 +216,12 @@ def interpolate_poses(
     if n == 0:
         raise ValueError("cannot interpolate an empty pose stream")
     q_ns = np.asarray(query_ns, dtype=np.int64)
-    hi = np.searchsorted(t, q_ns, side="left")
-    # lo: last sample <= query; an exact hit makes lo == hi.
-    lo = np.searchsorted(t, q_ns, side="right") - 1
+    lo, hi = bracket(t, q_ns)  # an exact hit makes lo == hi
     inside = (lo >= 0) & (hi < n)
     lo_c = np.clip(lo, 0, n - 1)
     hi_c = np.clip(hi, 0, n - 1)
-    t_lo = t[lo_c]
-    t_hi = t[hi_c]
+    t_lo = t.take(lo_c)
+    t_hi = t.take(hi_c)
     gap = np.where(inside, t_hi - t_lo, np.iinfo(np.int64).max)
     span = (t_hi - t_lo).astype(np.float64)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -214,19 +230,25 @@ def interpolate_poses(
     if method == "hold":
         pick = np.where(lo >= 0, lo_c, hi_c)
         return Interpolated(
-            stream.xyz[pick], stream.quat_xyzw[pick], lo, hi, gap.astype(np.int64), inside
+            _rows(stream.xyz, pick), _rows(stream.quat_xyzw, pick), lo, hi, gap, inside
         )
     if method == "nearest":
         pick = np.where(alpha <= 0.5, lo_c, hi_c)
         pick = np.where(lo < 0, hi_c, np.where(hi >= n, lo_c, pick))
         return Interpolated(
-            stream.xyz[pick], stream.quat_xyzw[pick], lo, hi, gap.astype(np.int64), inside
+            _rows(stream.xyz, pick), _rows(stream.quat_xyzw, pick), lo, hi, gap, inside
         )
     # Outside the stream, clamp to the end sample.
     alpha = np.where(lo < 0, 1.0, np.where(hi >= n, 0.0, alpha))
-    xyz = stream.xyz[lo_c] + alpha[:, None] * (stream.xyz[hi_c] - stream.xyz[lo_c])
-    quat = slerp(stream.quat_xyzw[lo_c], stream.quat_xyzw[hi_c], alpha)
-    return Interpolated(xyz, quat, lo, hi, gap.astype(np.int64), inside)
+    xyz_lo = _rows(stream.xyz, lo_c)
+    xyz = xyz_lo + alpha[:, None] * (_rows(stream.xyz, hi_c) - xyz_lo)
+    quat = slerp(_rows(stream.quat_xyzw, lo_c), _rows(stream.quat_xyzw, hi_c), alpha)
+    return Interpolated(xyz, quat, lo, hi, gap, inside)
+
+
+def _rows(a: F64, index: IntArr) -> F64:
+    """``a[index]`` for a 2D array: ``take`` gathers whole rows about twice as fast."""
+    return np.take(a, index, axis=0)
 
 
 @dataclass(frozen=True)

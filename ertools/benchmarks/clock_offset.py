@@ -30,21 +30,25 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
+from ertools.geometry import bracket, row_norm
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
 
 F64 = npt.NDArray[np.float64]
 I64 = npt.NDArray[np.int64]
+IntArr = npt.NDArray[np.intp]
 
 COARSE_STEP_NS = 20_000_000  # 20 ms: at 1 m/s a 2 cm change of the cost, well resolved
 FINE_STEP_NS = 1_000_000
 GRID_NS = COARSE_STEP_NS // 2
 GRID_MAX_POINTS = 1_000_000  # 12 MB of grid positions at most; a longer GT gets a coarser grid
+GRID_CHUNK = 1 << 15  # grid points per np.interp call
 COARSE_MAX_POSES = 3000
 MIN_POSES = 20
 MIN_RMS_SPEED = 0.02  # m/s: below this the robot stood still and no offset is observable
 BOOTSTRAP_DRAWS = 500
 BLOCK_NS = 5 * NS_PER_S
+MAX_NS = np.iinfo(np.int64).max
 
 
 @dataclass(frozen=True)
@@ -82,11 +86,22 @@ class OffsetEstimate:
 
 @dataclass(frozen=True, eq=False)
 class _Eval:
-    """GT positions and velocities at shifted robot times, and which of them are usable."""
+    """GT positions at shifted robot times, where they are usable.
+
+    Attributes:
+        valid: (N,) which queries have a usable GT position.
+        gt_xyz: (valid.sum(), 3) the GT positions at the valid queries only.
+        lo, hi: (valid.sum(),) the GT samples around each valid query.
+        diff: (valid.sum(), 3) GT position at ``hi`` minus at ``lo``.
+        span_ns: (valid.sum(),) GT time at ``hi`` minus at ``lo``.
+    """
 
     valid: npt.NDArray[np.bool_]
     gt_xyz: F64
-    gt_vel: F64
+    lo: IntArr
+    hi: IntArr
+    diff: F64
+    span_ns: I64
 
 
 def drop_repeats(gt: PoseStream) -> PoseStream:
@@ -98,43 +113,88 @@ def drop_repeats(gt: PoseStream) -> PoseStream:
     """
     if len(gt) < 2:
         return gt
+    # Axis by axis: the same test as any(!=) over each row, without an (N, 3) temporary and a
+    # reduction over its short axis (4x faster on an hour of 120 Hz GT).
+    p = gt.xyz
+    moved = p[1:, 0] != p[:-1, 0]
+    for k in range(1, p.shape[1]):
+        moved |= p[1:, k] != p[:-1, k]
+    if moved.all():
+        return gt
     keep = np.ones(len(gt), dtype=bool)
-    keep[1:] = np.any(gt.xyz[1:] != gt.xyz[:-1], axis=1)
-    return gt if keep.all() else gt.take(keep)
+    keep[1:] = moved
+    return gt.take(keep)
 
 
-def _evaluate(gt: PoseStream, query_ns: I64, max_gap_ns: int) -> _Eval:
+def _evaluate(
+    gt: PoseStream,
+    query_ns: I64,
+    max_gap_ns: int,
+    around: tuple[IntArr, IntArr] | None = None,
+) -> _Eval:
+    """GT at the queries (``around``: their :func:`~ertools.geometry.bracket`, if known)."""
     t = gt.t_ns
     n = len(t)
-    hi = np.searchsorted(t, query_ns, side="left")
-    lo = np.searchsorted(t, query_ns, side="right") - 1
+    lo, hi = bracket(t, query_ns) if around is None else around
     inside = (lo >= 0) & (hi < n)
     lo_c = np.clip(lo, 0, n - 1)
     hi_c = np.clip(hi, 0, n - 1)
-    # Velocity of the segment around the query; at an exact hit, of the segment after it.
-    seg_lo = np.clip(lo_c, 0, max(n - 2, 0))
-    seg_hi = np.minimum(seg_lo + 1, n - 1)
-    span = t[hi_c] - t[lo_c]
+    t_lo = t.take(lo_c)
+    span = t.take(hi_c) - t_lo
     valid = inside & (span <= max_gap_ns)
-    dt = (t[seg_hi] - t[seg_lo]).astype(np.float64) / NS_PER_S
+    q = query_ns
+    if not valid.all():  # only the usable queries are worth interpolating
+        keep = np.flatnonzero(valid)
+        lo_c, hi_c, t_lo, span, q = lo_c[keep], hi_c[keep], t_lo[keep], span[keep], q[keep]
     with np.errstate(invalid="ignore", divide="ignore"):
-        vel = np.where(dt[:, None] > 0, (gt.xyz[seg_hi] - gt.xyz[seg_lo]) / dt[:, None], 0.0)
-        alpha = np.where(span > 0, (query_ns - t[lo_c]).astype(np.float64) / span, 0.0)
+        alpha = np.where(span > 0, (q - t_lo).astype(np.float64) / span, 0.0)
     alpha = np.clip(alpha, 0.0, 1.0)
-    xyz = gt.xyz[lo_c] + alpha[:, None] * (gt.xyz[hi_c] - gt.xyz[lo_c])
-    # Segments longer than the max gap give no usable velocity either.
-    seg_ok = (t[seg_hi] - t[seg_lo]) <= max_gap_ns
-    return _Eval(valid, xyz, np.where(seg_ok[:, None], vel, 0.0))
+    x_lo = np.take(gt.xyz, lo_c, axis=0)  # take: whole rows, twice as fast as x[i]
+    diff = np.take(gt.xyz, hi_c, axis=0) - x_lo
+    return _Eval(valid, x_lo + alpha[:, None] * diff, lo_c, hi_c, diff, span)
+
+
+def _velocity(gt: PoseStream, ev: _Eval, max_gap_ns: int) -> F64:
+    """(valid.sum(), 3) GT velocity at the valid queries, m/s.
+
+    Of the segment around the query; at an exact hit, of the segment after it. Segments
+    longer than the max gap (or of no duration) give no usable velocity: 0.
+    """
+    n = len(gt)
+    seg_lo = np.minimum(ev.lo, max(n - 2, 0))
+    seg_hi = np.minimum(seg_lo + 1, n - 1)
+    # Between two samples the segment is (lo, hi), already subtracted: only exact hits need
+    # other samples.
+    num, seg_ns = ev.diff, ev.span_ns
+    other = np.flatnonzero((seg_lo != ev.lo) | (seg_hi != ev.hi))
+    if other.size:
+        a, b = seg_lo[other], seg_hi[other]
+        num, seg_ns = num.copy(), seg_ns.copy()
+        num[other] = gt.xyz[b] - gt.xyz[a]
+        seg_ns[other] = gt.t_ns[b] - gt.t_ns[a]
+    dt = seg_ns.astype(np.float64) / NS_PER_S
+    with np.errstate(invalid="ignore", divide="ignore"):
+        vel = num / dt[:, None]
+    unusable = ~((dt > 0) & (seg_ns <= max_gap_ns))
+    if unusable.any():
+        vel[unusable] = 0.0
+    return np.asarray(vel, dtype=np.float64)
+
+
+def _valid_rows(xyz: F64, ev: _Eval) -> F64:
+    """The rows of ``xyz`` at the evaluation's valid queries (no copy when all are valid)."""
+    return xyz if len(ev.gt_xyz) == len(xyz) else xyz[ev.valid]
 
 
 def _mean_error(
     robot_t: I64, robot_xyz: F64, gt: PoseStream, offset_ns: int, max_gap_ns: int
 ) -> tuple[float, int]:
     ev = _evaluate(gt, robot_t + offset_ns, max_gap_ns)
-    if not ev.valid.any():
+    used = len(ev.gt_xyz)
+    if used == 0:
         return float("inf"), 0
-    d = np.linalg.norm(robot_xyz[ev.valid] - ev.gt_xyz[ev.valid], axis=1)
-    return float(d.mean()), int(ev.valid.sum())
+    d = row_norm(_valid_rows(robot_xyz, ev) - ev.gt_xyz)
+    return float(d.mean()), used
 
 
 def _coarse_scan(
@@ -152,40 +212,29 @@ def _coarse_scan(
     t = gt.t_ns
     span = int(t[-1] - t[0])
     step = max(GRID_NS, span // GRID_MAX_POINTS + 1)
-    grid_t = t[0] + np.arange(span // step + 1, dtype=np.int64) * step
-    rel_t = (t - t[0]).astype(np.float64)
-    rel_g = (grid_t - t[0]).astype(np.float64)
-    # float32 grid: 0.1 um resolution at 10 m, and half the memory of an hour's grid.
-    grid_xyz = np.empty((len(grid_t), 3), dtype=np.float32)
-    for k in range(3):
-        grid_xyz[:, k] = np.interp(rel_g, rel_t, gt.xyz[:, k])
-    del rel_t, rel_g
-    # Grid points strictly inside a GT gap longer than max_gap_ns are invalid: mark them per
-    # gap (a handful) instead of locating every grid point in the GT. The first grid point
-    # is the first GT sample; it is judged by the first GT interval, as it always was.
-    gaps = np.flatnonzero(np.diff(t) > max_gap_ns)
-    marks = np.zeros(len(grid_t) + 1, dtype=np.int64)
-    np.add.at(marks, np.searchsorted(grid_t, t[gaps], side="right"), 1)
-    np.add.at(marks, np.searchsorted(grid_t, t[gaps + 1], side="left"), -1)
-    grid_ok = np.cumsum(marks[:-1]) == 0
-    grid_ok[0] = (t[1] - t[0]) <= max_gap_ns or t[1] == t[0]
-    del marks, gaps
+    n_grid = span // step + 1
     base = np.rint((robot_t - t[0]) / step).astype(np.int64)
     shifts = np.rint(offsets / step).astype(np.int64)
-    # Invalid points become NaN and the grid is padded with NaN beyond both ends, so every
+    # Invalid points are NaN and the grid is padded with NaN beyond both ends, so every
     # shifted index is in range and one gather gives both the position and its validity.
-    pad = int(max(0, -(shifts.min() + base.min()), shifts.max() + base.max() - len(grid_t) + 1))
-    padded = np.full((len(grid_t) + 2 * pad, 3), np.nan, dtype=np.float32)
-    padded[pad : pad + len(grid_t)] = np.where(grid_ok[:, None], grid_xyz, np.nan)
-    del grid_xyz, grid_ok, grid_t
+    pad = int(max(0, -(shifts.min() + base.min()), shifts.max() + base.max() - n_grid + 1))
+    grid = _grid(gt, step, n_grid, max_gap_ns, pad)
     base += pad
-    pos = robot_xyz.astype(np.float32)
+    # One axis at a time: 1D gathers from contiguous rows are ~5x faster than gathering
+    # 12-byte (x, y, z) rows, and the squares add up in einsum's order (x^2 + y^2) + z^2.
+    pos = robot_xyz.T.astype(np.float32)
     costs = np.full(len(offsets), np.inf)
     counts = np.zeros(len(offsets), dtype=np.int64)
-    block = max(1, 200_000 // max(len(base), 1))  # ~2.4 MB of float32 per block
+    block = max(1, 200_000 // max(len(base), 1))  # ~0.8 MB of float32 per axis and block
     for lo in range(0, len(offsets), block):  # blocks of offsets x all poses, vectorised
-        d = padded[shifts[lo : lo + block, None] + base[None, :]] - pos[None, :, :]
-        dist = np.sqrt(np.einsum("bij,bij->bi", d, d))
+        idx = shifts[lo : lo + block, None] + base[None, :]
+        sq = np.zeros(idx.shape, dtype=np.float32)
+        for k in range(3):
+            d = grid[k].take(idx)
+            d -= pos[k]
+            d *= d
+            sq += d
+        dist = np.sqrt(sq, out=sq)
         ok = ~np.isnan(dist)
         cnt = ok.sum(axis=1)
         total = np.where(ok, dist, 0.0).sum(axis=1)
@@ -196,18 +245,89 @@ def _coarse_scan(
     return np.where(enough, costs, np.inf)
 
 
+def _grid(
+    gt: PoseStream, step: int, n_grid: int, max_gap_ns: int, pad: int
+) -> npt.NDArray[np.float32]:
+    """(3, pad + n_grid + pad) GT positions every ``step`` ns from the first GT sample.
+
+    float32: 0.1 um resolution at 10 m, and half the memory of an hour's grid. NaN in the
+    padding and at grid points strictly inside a GT gap longer than ``max_gap_ns``.
+    """
+    t = gt.t_ns
+    grid = np.full((3, n_grid + 2 * pad), np.nan, dtype=np.float32)
+    # Chunk by chunk, each against the GT samples around it: the temporaries stay small and
+    # in cache (an hour's whole-grid np.interp allocated ~30 MB). Every grid point gets the
+    # same two samples and the same arithmetic as in one call over everything.
+    starts = np.arange(0, n_grid, GRID_CHUNK, dtype=np.int64)
+    ends = np.minimum(starts + GRID_CHUNK, n_grid)
+    first = np.searchsorted(t, t[0] + starts * step, side="right") - 1
+    after = np.searchsorted(t, t[0] + (ends - 1) * step, side="right") + 1
+    chunks = zip(starts.tolist(), ends.tolist(), first.tolist(), after.tolist(), strict=True)
+    for g0, g1, a, b in chunks:
+        rel_t = (t[a:b] - t[0]).astype(np.float64)
+        rel_g = np.arange(g0, g1, dtype=np.float64) * step  # exact: whole ns below 2**53
+        for k in range(3):
+            grid[k, pad + g0 : pad + g1] = np.interp(rel_g, rel_t, gt.xyz[a:b, k])
+    # Mark the invalid points per gap (a handful) instead of locating every grid point in
+    # the GT. The first grid point is the first GT sample; it is judged by the first GT
+    # interval, as it always was.
+    gaps = np.flatnonzero(np.diff(t) > max_gap_ns)
+    if gaps.size:
+        grid_t = t[0] + np.arange(n_grid, dtype=np.int64) * step
+        marks = np.zeros(n_grid + 1, dtype=np.int64)
+        np.add.at(marks, np.searchsorted(grid_t, t[gaps], side="right"), 1)
+        np.add.at(marks, np.searchsorted(grid_t, t[gaps + 1], side="left"), -1)
+        grid_ok = np.cumsum(marks[:-1]) == 0
+    else:
+        grid_ok = np.ones(n_grid, dtype=bool)
+    grid_ok[0] = (t[1] - t[0]) <= max_gap_ns or t[1] == t[0]
+    grid[:, pad + np.flatnonzero(~grid_ok)] = np.nan
+    return grid
+
+
 def _scan(
     robot_t: I64, robot_xyz: F64, gt: PoseStream, offsets: I64, max_gap_ns: int
 ) -> tuple[F64, I64]:
-    costs = np.empty(len(offsets))
-    counts = np.empty(len(offsets), dtype=np.int64)
-    for i, off in enumerate(offsets):  # a loop over offsets, each vectorised over poses
-        costs[i], counts[i] = _mean_error(robot_t, robot_xyz, gt, int(off), max_gap_ns)
+    """Mean distance at each offset with exact interpolation, all offsets in one evaluation."""
+    shape = (len(offsets), len(robot_t))
+    queries = (offsets[:, None] + robot_t[None, :]).ravel()  # offset-major
+    ev = _evaluate(gt, queries, max_gap_ns, _around_window(gt.t_ns, robot_t, offsets))
+    if len(ev.gt_xyz) == queries.size:
+        dist = row_norm(robot_xyz - ev.gt_xyz.reshape(*shape, 3))
+    else:
+        dist = np.full(shape, np.nan)
+        pose = np.flatnonzero(ev.valid) % len(robot_t)
+        dist.ravel()[ev.valid] = row_norm(np.take(robot_xyz, pose, axis=0) - ev.gt_xyz)
+    valid = ev.valid.reshape(shape)
+    counts = valid.sum(axis=1)
+    costs = np.full(len(offsets), np.inf)
+    for i in np.flatnonzero(counts):
+        # Each offset's mean over its own compared poses, summed as one array of them.
+        costs[i] = float(dist[i][valid[i]].mean())
     # An offset that leaves few poses inside the GT could win by chance: require at least
     # half of the best coverage any offset achieves.
     enough = counts >= max(MIN_POSES, int(0.5 * counts.max()))
-    costs = np.where(enough, costs, np.inf)
-    return costs, counts
+    return np.where(enough, costs, np.inf), counts
+
+
+def _around_window(t: I64, robot_t: I64, offsets: I64) -> tuple[IntArr, IntArr] | None:
+    """:func:`~ertools.geometry.bracket` of ``offsets[:, None] + robot_t[None, :]``, flattened.
+
+    The offsets span a few tens of ms, so each pose's queries fall among a handful of GT
+    samples: counting the ones at or before each query there is ~5x cheaper than a binary
+    search per query. None when a window holds too many samples for that to pay.
+    """
+    first = np.searchsorted(t, robot_t + offsets.min(), side="right")
+    width = np.searchsorted(t, robot_t + offsets.max(), side="right") - first
+    if width.max() > 16:
+        return None
+    queries = offsets[:, None] + robot_t[None, :]
+    right = np.broadcast_to(first, queries.shape).copy()
+    for w in range(int(width.max())):
+        # Beyond its window a pose counts nothing (those samples lie after every query).
+        cand = np.where(w < width, t.take(np.minimum(first + w, len(t) - 1)), MAX_NS)
+        right += cand <= queries
+    return bracket(t, queries.ravel(), right.ravel())
 
 
 def estimate_offset(
@@ -268,8 +388,8 @@ def estimate_offset(
     # 3. Gauss-Newton on the squared distances
     for _ in range(5):
         ev = _evaluate(gt, robot.t_ns + round(offset), max_gap_ns)
-        v = ev.gt_vel[ev.valid]
-        r = robot.xyz[ev.valid] - ev.gt_xyz[ev.valid]
+        v = _velocity(gt, ev, max_gap_ns)
+        r = _valid_rows(robot.xyz, ev) - ev.gt_xyz
         vv = float(np.sum(v * v))
         if vv <= 0:
             break
@@ -279,20 +399,21 @@ def estimate_offset(
             break
     offset_ns = round(offset)
     ev = _evaluate(gt, robot.t_ns + offset_ns, max_gap_ns)
-    used = int(ev.valid.sum())
+    used = len(ev.gt_xyz)
     if used < MIN_POSES:
         return none("too few robot poses overlap the GT at the estimated offset", used)
-    v = ev.gt_vel[ev.valid]
-    r = robot.xyz[ev.valid] - ev.gt_xyz[ev.valid]
-    rms_speed = _rms_speed(robot.t_ns[ev.valid], ev.gt_xyz[ev.valid])
+    v = _velocity(gt, ev, max_gap_ns)
+    r = _valid_rows(robot.xyz, ev) - ev.gt_xyz
+    t_used = robot.t_ns[ev.valid]
+    rms_speed = _rms_speed(t_used, ev.gt_xyz)
     if rms_speed < MIN_RMS_SPEED:
         return none(
             f"the robot barely moved (RMS speed {rms_speed * 100:.1f} cm/s): "
             "no clock offset is observable",
             used,
         )
-    mean_err = float(np.mean(np.linalg.norm(r, axis=1)))
-    sigma = _bootstrap_sigma(robot.t_ns[ev.valid], r, v, seed)
+    mean_err = float(np.mean(row_norm(r)))
+    sigma = _bootstrap_sigma(t_used, r, v, seed)
     return OffsetEstimate(
         offset_ns, round(sigma * NS_PER_S), search_range_ns, used, mean_err, zero, "; ".join(notes)
     )
@@ -307,7 +428,7 @@ def _rms_speed(t_ns: I64, xyz: F64) -> float:
     if len(t_ns) < 2:
         return 0.0
     dt = np.diff(t_ns).astype(np.float64) / NS_PER_S
-    step = np.linalg.norm(np.diff(xyz, axis=0), axis=1)
+    step = row_norm(np.diff(xyz, axis=0))
     ok = dt > 0
     return float(np.sqrt(np.mean((step[ok] / dt[ok]) ** 2))) if ok.any() else 0.0
 

@@ -12,6 +12,7 @@ from hypothesis.extra.numpy import arrays
 
 from ertools.geometry import (
     angle_error,
+    bracket,
     circular_mean,
     compose,
     interpolate_poses,
@@ -46,6 +47,23 @@ def test_row_norm_by_hand_and_bit_for_bit_numpys_norm() -> None:
         a = rng.normal(size=(5000, k)) * 10 ** rng.uniform(-3, 3, (5000, 1))
         assert np.array_equal(row_norm(a), np.linalg.norm(a, axis=1))
         assert np.array_equal(row_norm(a[::3]), np.linalg.norm(a[::3], axis=1))
+
+
+def test_bracket_by_hand_and_against_both_binary_searches() -> None:
+    t = np.array([0, 10, 10, 20], dtype=np.int64)
+    q = np.array([-5, 0, 5, 10, 15, 20, 25], dtype=np.int64)
+    lo, hi = bracket(t, q)
+    # An exact hit on the doubled stamp 10: lo is the last sample at it, hi the first.
+    assert lo.tolist() == [-1, 0, 0, 2, 2, 3, 3]
+    assert hi.tolist() == [0, 0, 1, 1, 3, 3, 4]
+    rng = np.random.default_rng(4)
+    t = np.sort(rng.integers(0, 500, 300))
+    q = np.concatenate([rng.integers(-10, 510, 400), t[::7]])
+    right = np.searchsorted(t, q, side="right")
+    for lo, hi in (bracket(t, q), bracket(t, q, right)):
+        assert np.array_equal(lo, right - 1)
+        assert np.array_equal(hi, np.searchsorted(t, q, side="left"))
+    assert np.array_equal(right, np.searchsorted(t, q, side="right"))  # left as it was
 
 
 def test_compose_by_hand() -> None:

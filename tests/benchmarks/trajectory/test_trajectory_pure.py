@@ -261,3 +261,47 @@ def test_coarse_scan_equals_a_direct_nearest_grid_computation() -> None:
     # 5 mm error the nearest-grid lookup itself allows.
     fin = np.isfinite(want)
     assert np.max(np.abs(got[fin] - want[fin])) < 1e-6
+
+
+def test_fine_scan_window_search_equals_binary_searches() -> None:
+    """The fine scan counts GT samples inside each pose's window instead of searching: the
+    same indices as two binary searches, with exact hits, doubled stamps and windows running
+    past both ends of the GT; a window too dense to pay falls back (None)."""
+    from ertools.benchmarks.clock_offset import _around_window
+
+    t = np.array([0, 8, 17, 25, 25, 33, 42, 50, 58], dtype=np.int64) * MS
+    robot_t = np.array([-30, 0, 12, 25, 41, 57, 70], dtype=np.int64) * MS
+    offsets = np.arange(-20, 21, dtype=np.int64) * MS
+    around = _around_window(t, robot_t, offsets)
+    assert around is not None
+    q = (offsets[:, None] + robot_t[None, :]).ravel()
+    assert np.array_equal(around[0], np.searchsorted(t, q, side="right") - 1)
+    assert np.array_equal(around[1], np.searchsorted(t, q, side="left"))
+    dense = np.arange(0, 100, dtype=np.int64) * MS  # 1 kHz: 41 samples per 40 ms window
+    assert _around_window(dense, robot_t, offsets) is None
+
+
+def test_coarse_grid_in_chunks_equals_one_interpolation(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Grid chunks of 97 points (boundaries everywhere, exact hits included) against one
+    np.interp over the whole GT: the same float32 values; NaN in the padding and strictly
+    inside the gap."""
+    from ertools.benchmarks import clock_offset
+
+    _, gt = _moving(0, seed=6)
+    keep = np.ones(len(gt), dtype=bool)
+    keep[2000:2030] = False  # 258 ms without GT after sample 1999
+    gt = gt.take(keep)
+    monkeypatch.setattr(clock_offset, "GRID_CHUNK", 97)
+    t, t0, step = gt.t_ns, int(gt.t_ns[0]), 10 * MS
+    n_grid = (int(t[-1]) - t0) // step + 1
+    grid = clock_offset._grid(gt, step, n_grid, 100 * MS, pad=3)
+    rel_g = np.arange(n_grid) * float(step)
+    want = np.vstack(
+        [np.interp(rel_g, (t - t0).astype(np.float64), gt.xyz[:, k]) for k in range(3)]
+    ).astype(np.float32)
+    inner = grid[:, 3:-3]
+    gap = (t0 + np.arange(n_grid) * step > t[1999]) & (t0 + np.arange(n_grid) * step < t[2000])
+    assert gap.sum() == 26  # 16.6583 s to 16.9167 s: grid points 16.66 to 16.91 s
+    assert np.isnan(grid[:, :3]).all() and np.isnan(grid[:, -3:]).all()
+    assert np.isnan(inner[:, gap]).all()
+    assert np.array_equal(inner[:, ~gap], want[:, ~gap])
