@@ -40,18 +40,27 @@ def circular_mean(angles: F64) -> float:
     return float(np.arctan2(np.sin(a).sum(), np.cos(a).sum()))
 
 
-def row_sqnorm(v: F64) -> F64:
-    """Sums of squares over the last axis, added in the order ``np.linalg.norm`` adds them.
+def row_dot(a: F64, b: F64) -> F64:
+    """Dot products over a short last axis (points, quaternions), in numpy's order.
 
-    Component by component, so ``np.sqrt`` of it is bit for bit ``np.linalg.norm(v, axis=-1)``;
-    without the norm's (N, k) temporary and its slow reduction over a short axis it is ~4x
-    faster on (N, 3) arrays.
+    Component by component: bit for bit ``np.sum(a * b, axis=-1)`` (numpy adds fewer than 8
+    terms one after the other), without its (N, k) temporary and its slow reduction over a
+    short axis: ~4x faster on (N, 3) arrays.
     """
-    a = np.asarray(v, dtype=np.float64)
-    total = np.square(a[..., 0], out=np.empty(a.shape[:-1]))  # out: stays an array when 0-d
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    shape = np.broadcast_shapes(a.shape, b.shape)[:-1]
+    # out: the result stays an array when 0-d
+    total = np.multiply(a[..., 0], b[..., 0], out=np.empty(shape))
     for k in range(1, a.shape[-1]):
-        total += np.square(a[..., k])
+        total += a[..., k] * b[..., k]
     return total
+
+
+def row_sqnorm(v: F64) -> F64:
+    """Sums of squares over the last axis: ``np.sqrt`` of it is ``np.linalg.norm(v, axis=-1)``
+    bit for bit (the norm adds the squares in the same order)."""
+    return row_dot(v, v)
 
 
 def row_norm(v: F64) -> F64:
@@ -150,7 +159,7 @@ def slerp(q0: F64, q1: F64, alpha: F64) -> F64:
     q0 = _unit(q0)
     q1 = _unit(q1)
     a = np.asarray(alpha, dtype=np.float64)[..., None]
-    dot = np.sum(q0 * q1, axis=-1, keepdims=True)
+    dot = row_dot(q0, q1)[..., None]
     q1 = np.where(dot < 0.0, -q1, q1)
     dot = np.abs(dot)
     theta = np.arccos(np.clip(dot, -1.0, 1.0))

@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
-from ertools.geometry import bracket, row_norm
+from ertools.geometry import bracket, row_dot, row_norm
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
 
@@ -137,8 +137,9 @@ def _evaluate(
     n = len(t)
     lo, hi = bracket(t, query_ns) if around is None else around
     inside = (lo >= 0) & (hi < n)
-    lo_c = np.clip(lo, 0, n - 1)
-    hi_c = np.clip(hi, 0, n - 1)
+    all_inside = bool(inside.all())
+    lo_c = lo if all_inside else np.clip(lo, 0, n - 1)
+    hi_c = hi if all_inside else np.clip(hi, 0, n - 1)
     t_lo = t.take(lo_c)
     span = t.take(hi_c) - t_lo
     valid = inside & (span <= max_gap_ns)
@@ -148,7 +149,8 @@ def _evaluate(
         lo_c, hi_c, t_lo, span, q = lo_c[keep], hi_c[keep], t_lo[keep], span[keep], q[keep]
     with np.errstate(invalid="ignore", divide="ignore"):
         alpha = np.where(span > 0, (q - t_lo).astype(np.float64) / span, 0.0)
-    alpha = np.clip(alpha, 0.0, 1.0)
+    # No clip to [0, 1]: a valid query lies between its two samples, and the rounded
+    # quotient of 0 <= a <= b stays in [0, 1].
     x_lo = np.take(gt.xyz, lo_c, axis=0)  # take: whole rows, twice as fast as x[i]
     diff = np.take(gt.xyz, hi_c, axis=0) - x_lo
     return _Eval(valid, x_lo + alpha[:, None] * diff, lo_c, hi_c, diff, span)
@@ -220,29 +222,42 @@ def _coarse_scan(
     pad = int(max(0, -(shifts.min() + base.min()), shifts.max() + base.max() - n_grid + 1))
     grid = _grid(gt, step, n_grid, max_gap_ns, pad)
     base += pad
-    # One axis at a time: 1D gathers from contiguous rows are ~5x faster than gathering
-    # 12-byte (x, y, z) rows, and the squares add up in einsum's order (x^2 + y^2) + z^2.
     pos = robot_xyz.T.astype(np.float32)
     costs = np.full(len(offsets), np.inf)
     counts = np.zeros(len(offsets), dtype=np.int64)
     block = max(1, 200_000 // max(len(base), 1))  # ~0.8 MB of float32 per axis and block
     for lo in range(0, len(offsets), block):  # blocks of offsets x all poses, vectorised
         idx = shifts[lo : lo + block, None] + base[None, :]
-        sq = np.zeros(idx.shape, dtype=np.float32)
-        for k in range(3):
-            d = grid[k].take(idx)
-            d -= pos[k]
-            d *= d
-            sq += d
-        dist = np.sqrt(sq, out=sq)
-        ok = ~np.isnan(dist)
-        cnt = ok.sum(axis=1)
-        total = np.where(ok, dist, 0.0).sum(axis=1)
+        dist = _squared_distances(grid, idx, pos)
+        np.sqrt(dist, out=dist)
+        missing = np.isnan(dist)
+        cnt = idx.shape[1] - np.count_nonzero(missing, axis=1)
+        dist[missing] = 0.0
+        total = dist.sum(axis=1)
         with np.errstate(invalid="ignore", divide="ignore"):
             costs[lo : lo + block] = np.where(cnt > 0, total / np.maximum(cnt, 1), np.inf)
         counts[lo : lo + block] = cnt
     enough = counts >= max(MIN_POSES, int(0.5 * counts.max()))
     return np.where(enough, costs, np.inf)
+
+
+def _squared_distances(
+    grid: npt.NDArray[np.float32], idx: I64, pos: npt.NDArray[np.float32]
+) -> npt.NDArray[np.float32]:
+    """Squared distances from ``pos[:, j]`` to the grid points ``idx[i, j]``, axis by axis.
+
+    1D gathers from contiguous rows are ~5x faster than gathering 12-byte (x, y, z) rows, and
+    the squares add up in the order einsum added them: (x^2 + y^2) + z^2.
+    """
+    sq: npt.NDArray[np.float32] = grid[0].take(idx)
+    sq -= pos[0]
+    sq *= sq
+    for k in (1, 2):
+        d = grid[k].take(idx)
+        d -= pos[k]
+        d *= d
+        sq += d
+    return sq
 
 
 def _grid(
@@ -444,8 +459,8 @@ def _bootstrap_sigma(t_ns: I64, r: F64, v: F64, seed: int) -> float:
     block_ns = max(BLOCK_NS, span // 20)
     block = ((t_ns - t_ns[0]) // max(block_ns, 1)).astype(np.intp)
     nb = int(block.max()) + 1
-    a = np.bincount(block, weights=np.sum(r * v, axis=1), minlength=nb)
-    b = np.bincount(block, weights=np.sum(v * v, axis=1), minlength=nb)
+    a = np.bincount(block, weights=row_dot(r, v), minlength=nb)
+    b = np.bincount(block, weights=row_dot(v, v), minlength=nb)
     if nb < 5:
         # Too few blocks to resample: the independent-errors standard error, which the
         # autocorrelation makes optimistic; inflate it by the poses per block.

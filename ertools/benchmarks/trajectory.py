@@ -138,7 +138,7 @@ def associate(robot: PoseStream, gt: PoseStream, method: Association, max_gap_ns
     first = second - 1
     has_pair = (first >= 0) & (second < n_gt)
     fi, si = np.clip(first, 0, n_gt - 1), np.clip(second, 0, n_gt - 1)
-    same = has_pair & np.all(gt.xyz[fi] == gt.xyz[si], axis=1)
+    same = has_pair & _same_rows(gt.xyz, fi, si)
     status[(status == COMPARED) & same] = TRACKING_LOST
     ok = status == COMPARED
 
@@ -151,6 +151,16 @@ def associate(robot: PoseStream, gt: PoseStream, method: Association, max_gap_ns
     yaw_err = np.abs(wrap_angle(raw))
     ties = int(np.count_nonzero(interp.inside & (interp.lo == interp.hi)))
     return Matched(q, status, gt_xyz, gt_yaw, pos_err, yaw_err, raw, ties)
+
+
+def _same_rows(a: F64, i: npt.NDArray[np.intp], j: npt.NDArray[np.intp]) -> npt.NDArray[np.bool_]:
+    """``np.all(a[i] == a[j], axis=1)``: whole rows gathered by ``take``, compared by column."""
+    ai = np.take(a, i, axis=0)
+    aj = np.take(a, j, axis=0)
+    same: npt.NDArray[np.bool_] = ai[:, 0] == aj[:, 0]
+    for k in range(1, a.shape[1]):
+        same &= ai[:, k] == aj[:, k]
+    return same
 
 
 @dataclass(frozen=True)
@@ -404,18 +414,33 @@ def drop_duplicates(gt: PoseStream) -> tuple[PoseStream, int]:
     return gt.take(keep), int(at.size)
 
 
+CHECK_ROWS = 1 << 14  # rows per chunk of the all-valid check: its buffers stay in cache
+
+
+def _all_valid(stream: PoseStream) -> bool:
+    """Whether :func:`drop_invalid` keeps every sample, shown cheaply or not at all.
+
+    Squared quaternion norms by einsum far from both limits (NaN fails the comparisons too)
+    and finite positions, chunk by chunk so that the temporaries stay in cache. False sends
+    the stream to the exact per-sample test.
+    """
+    q, xyz = stream.quat_xyzw, stream.xyz
+    buf = np.empty(min(len(q), CHECK_ROWS))
+    for a in range(0, len(q), CHECK_ROWS):
+        rows = slice(a, a + CHECK_ROWS)
+        sq = np.einsum("ij,ij->i", q[rows], q[rows], out=buf[: len(q[rows])])
+        if not (np.isfinite(xyz[rows]).all() and sq.min() > 1e-17 and sq.max() < 1e300):
+            return False
+    return True
+
+
 def drop_invalid(stream: PoseStream) -> tuple[PoseStream, int]:
     """The stream without samples whose position or orientation is not usable.
 
     NaN or infinite values, or a zero quaternion (a node publishing "no pose"), cannot be
     compared; dropping them (and saying how many) beats a NaN score.
     """
-    if len(stream) == 0:
-        return stream, 0
-    # Usually nothing is dropped: show that in two cheap passes (squared norms by einsum, far
-    # from both limits: NaN fails the comparisons too); anything else gets the exact test.
-    sq = np.einsum("ij,ij->i", stream.quat_xyzw, stream.quat_xyzw)
-    if np.isfinite(stream.xyz).all() and sq.min() > 1e-17 and sq.max() < 1e300:
+    if _all_valid(stream):
         return stream, 0
     with np.errstate(over="ignore"):  # an overflowing norm is not finite: dropped below
         norm = row_norm(stream.quat_xyzw)

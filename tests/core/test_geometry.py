@@ -19,6 +19,7 @@ from ertools.geometry import (
     invert,
     mean_pose,
     quat_from_yaw,
+    row_dot,
     row_norm,
     transform_points,
     wrap_angle,
@@ -47,6 +48,17 @@ def test_row_norm_by_hand_and_bit_for_bit_numpys_norm() -> None:
         a = rng.normal(size=(5000, k)) * 10 ** rng.uniform(-3, 3, (5000, 1))
         assert np.array_equal(row_norm(a), np.linalg.norm(a, axis=1))
         assert np.array_equal(row_norm(a[::3]), np.linalg.norm(a[::3], axis=1))
+
+
+def test_row_dot_by_hand_and_bit_for_bit_numpys_sum() -> None:
+    a = np.array([[1.0, 2.0, 3.0], [0.5, -1.0, 4.0]])
+    b = np.array([[4.0, 5.0, 6.0], [2.0, 2.0, 0.25]])
+    assert row_dot(a, b).tolist() == [32.0, 0.0]
+    rng = np.random.default_rng(5)
+    for k in (3, 4):
+        x = rng.normal(size=(5000, k)) * 10 ** rng.uniform(-3, 3, (5000, 1))
+        y = rng.normal(size=(5000, k))
+        assert np.array_equal(row_dot(x, y), np.sum(x * y, axis=1))
 
 
 def test_bracket_by_hand_and_against_both_binary_searches() -> None:
