@@ -21,12 +21,12 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.errors import BagError
-from ertools.io.fastdecode import FAST_TYPES, LayoutMismatchError, decode, to_batch
+from ertools.io.fastdecode import FAST_TYPES, Decoded, LayoutMismatchError, decode, to_batch
 from ertools.io.files import BagFile
 from ertools.io.model import TF_TYPES, Conn
 from ertools.io.pipeline import Group, joined, prefetched, read_at, scratch_view
 from ertools.io.posebatch import PoseBatch, concat_batches
-from ertools.io.uniform import decode_uniform
+from ertools.io.uniform import Rows, decode_uniform
 
 log = logging.getLogger("ertools.io.bulk")
 
@@ -60,6 +60,28 @@ class _Assembler:
         self.frames: dict[str, int] = {"": 0}
         self.parts: list[tuple[I64, PoseBatch]] = []
 
+    def run_slice(self, pos: I64) -> slice | None:
+        """The rows at ``pos`` as a slice when they are consecutive and ascending (one
+        connection read in order): written as a block, or decoded in place."""
+        if self.multi or not len(pos):
+            return None
+        if int(pos[-1]) - int(pos[0]) == len(pos) - 1 and _ascending(pos):
+            return slice(int(pos[0]), int(pos[-1]) + 1)
+        return None
+
+    def rows(self, at: slice) -> Rows:
+        """Where a decoder may write the rows ``at`` itself."""
+        return Rows(self.t_header[at], self.xyz[at], self.quat[at])
+
+    def wrote(self, at: slice, t_record: I64, dec: Decoded) -> None:
+        """Rows ``at`` were decoded in place (see :meth:`rows`): their record times and
+        frame names (types without a header are timed by record time, as in ``to_batch``)."""
+        self.t_record[at] = t_record
+        if not dec.has_header:
+            self.t_header[at] = t_record
+        self.frame_idx[at] = self.frames.setdefault(dec.frame_text or "", len(self.frames))
+        self.child_idx[at] = self.frames.setdefault(dec.child_text or "", len(self.frames))
+
     def add(self, pos: I64, batch: PoseBatch) -> None:
         """Decoded rows and the reference position of the message of each row."""
         if self.multi:
@@ -68,10 +90,8 @@ class _Assembler:
         remap = np.array(
             [self.frames.setdefault(f, len(self.frames)) for f in batch.frames], np.int32
         )
-        if len(pos) and int(pos[-1]) - int(pos[0]) == len(pos) - 1 and _ascending(pos):
-            # One connection read in order: a run of consecutive rows, written as a slice
-            # (a block copy, not a scatter).
-            at = slice(int(pos[0]), int(pos[-1]) + 1)
+        at = self.run_slice(pos)
+        if at is not None:
             self.t_record[at] = batch.t_record
             self.t_header[at] = batch.t_header
             self.xyz[at] = batch.xyz
@@ -349,19 +369,21 @@ def try_fast_batch(
     try:
         found = locate(bag, conns, start_ns, end_ns)
         if found is not None:
-
-            def decoded(run: Run) -> tuple[I64, PoseBatch]:
-                pos, buf, start, length, t_rec = run
-                dec = decode_uniform(msgtype, cdr, buf, start, length)
-                if dec is None:
-                    dec = decode(msgtype, cdr, buf, start, length)
-                return pos[dec.msg_index], to_batch(buf, dec, t_rec)
-
             # Decoded here, not on the loading threads: its many small NumPy calls hold the
             # GIL, and two threads decoding were slower than one (measured).
             out = _Assembler(msgtype, found.count)
-            for pos, batch in map(decoded, found.runs):
-                out.add(pos, batch)
+            for pos, buf, start, length, t_rec in found.runs:
+                at = out.run_slice(pos)
+                if at is not None:
+                    # The usual case: decoded straight into the result (no second copy).
+                    dec = decode_uniform(msgtype, cdr, buf, start, length, into=out.rows(at))
+                    if dec is not None and dec.frame_text is not None:
+                        out.wrote(at, t_rec, dec)
+                        continue
+                dec = decode_uniform(msgtype, cdr, buf, start, length)
+                if dec is None:
+                    dec = decode(msgtype, cdr, buf, start, length)
+                out.add(pos[dec.msg_index], to_batch(buf, dec, t_rec))
             return out.result()
     except LayoutMismatchError as err:
         log.info(

@@ -47,6 +47,15 @@ class Layout:
     child: str | None
 
 
+@dataclass(frozen=True, eq=False)
+class Rows:
+    """Preallocated result rows a decoder writes into (header stamps, positions, orientations)."""
+
+    t_header: I64
+    xyz: npt.NDArray[np.float64]
+    quat: npt.NDArray[np.float64]
+
+
 class _Probe:
     """A read position in one message (the first), moved field by field like
     :class:`ertools.io.fastdecode.Cursor`, recording which bytes may vary between messages."""
@@ -174,9 +183,15 @@ def _same_bytes(rows: U8, a: int, b: int) -> bool:
     return True
 
 
-def decode_uniform(msgtype: str, cdr: bool, buf: U8, start: I64, length: I64) -> Decoded | None:
+def decode_uniform(
+    msgtype: str, cdr: bool, buf: U8, start: I64, length: I64, into: Rows | None = None
+) -> Decoded | None:
     """Every message (``start``, ``length`` into ``buf``) decoded at once when all share the
-    first one's layout; None otherwise (the caller then decodes field by field)."""
+    first one's layout; None otherwise (the caller then decodes field by field).
+
+    With ``into``, stamps and poses are written there (no intermediate arrays) and the
+    returned columns are views of it.
+    """
     n = len(start)
     if n < 2:
         return None
@@ -189,26 +204,34 @@ def decode_uniform(msgtype: str, cdr: bool, buf: U8, start: I64, length: I64) ->
     rows = gather(buf, start, lay.size)
     if not all(_same_bytes(rows, a, b) for a, b in lay.fixed):
         return None
-    values = np.array(_column(rows, lay.values_at, "<f8", lay.values), dtype=np.float64)
-    idx = np.arange(n, dtype=np.int64)
+    out = (
+        into
+        if into is not None
+        else Rows(np.empty(n, np.int64), np.empty((n, 3)), np.empty((n, 4)))
+    )
+    values = _column(rows, lay.values_at, "<f8", lay.values)
     if lay.stamp is not None:
         sec_at, nsec_at, sec_type = lay.stamp
-        t_header = _column(rows, sec_at, sec_type).astype(np.int64) * 1_000_000_000
-        t_header += _column(rows, nsec_at, "<u4").astype(np.int64)
-        xyz, quat = values[:, :3], values[:, 3:]
+        np.multiply(
+            _column(rows, sec_at, sec_type), 1_000_000_000, out=out.t_header, dtype=np.int64
+        )
+        np.add(out.t_header, _column(rows, nsec_at, "<u4"), out=out.t_header)
+        out.xyz[...] = values[:, :3]
+        out.quat[...] = values[:, 3:]
     else:
         from ertools.geometry import quat_from_yaw
 
-        t_header = np.zeros(n, dtype=np.int64)
-        xyz = np.column_stack([values[:, 0], values[:, 1], np.zeros(n)])
-        quat = quat_from_yaw(values[:, 2]).reshape(n, 4)
+        out.t_header[...] = 0
+        out.xyz[:, :2] = values[:, :2]
+        out.xyz[:, 2] = 0.0
+        out.quat[...] = quat_from_yaw(np.array(values[:, 2], dtype=np.float64)).reshape(n, 4)
     empty = np.zeros(n, dtype=np.int64)
     child = None if lay.child is None else (empty, empty)
     return Decoded(
-        idx,
-        t_header,
-        xyz,
-        quat,
+        np.arange(n, dtype=np.int64),
+        out.t_header,
+        out.xyz,
+        out.quat,
         (empty, empty),
         child,
         has_header=lay.stamp is not None,

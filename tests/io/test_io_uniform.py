@@ -139,8 +139,8 @@ def test_uniform_decoder_is_used_on_standard_topics(
     used: list[str] = []
     real = bulk.decode_uniform
 
-    def spy(msgtype: str, *args: Any) -> Any:
-        out = real(msgtype, *args)
+    def spy(msgtype: str, *args: Any, **kwargs: Any) -> Any:
+        out = real(msgtype, *args, **kwargs)
         if out is not None:
             used.append(msgtype)
         return out
