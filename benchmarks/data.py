@@ -38,8 +38,11 @@ def quat(yaw: F64) -> F64:
     return np.column_stack([z, z, np.sin(yaw / 2), np.cos(yaw / 2)])
 
 
-def gt_topics(start_ns: int, seconds: float, seed: int, ros1: bool = True) -> list[Topic]:
-    """PoseStamped + Pose2D + /tf (mocap, 120 Hz) and the static world->map on /tf (10 Hz)."""
+def gt_topics(
+    start_ns: int, seconds: float, seed: int, ros1: bool = True, body: str = NS_BODY
+) -> list[Topic]:
+    """PoseStamped + Pose2D + /tf (mocap, 120 Hz) of ``body`` (a namespace) and the static
+    world->map on /tf (10 Hz)."""
     rng = np.random.default_rng(seed)
     ts = typestore(ros1)
     n = int(seconds * RATE_HZ)
@@ -56,13 +59,13 @@ def gt_topics(start_ns: int, seconds: float, seed: int, ros1: bool = True) -> li
     out = []
     pose2d = np.column_stack([xyz[:, :2], yaw])
     for name, msgtype, t, data in (
-        (GT_TOPIC, "geometry_msgs/PoseStamped", rec, build(ts, PS, stamp, pose7, ros1=ros1)),
-        (f"{NS_BODY}/pose2d", P2D, rec + 50_000, build(ts, P2D, stamp, pose2d, ros1=ros1)),
+        (f"{body}/pose", PS, rec, build(ts, PS, stamp, pose7, ros1=ros1)),
+        (f"{body}/pose2d", P2D, rec + 50_000, build(ts, P2D, stamp, pose2d, ros1=ros1)),
         (
             "/tf",
             TFM,
             rec + 100_000,
-            build(ts, TFM, stamp, pose7, child="robot_at_work", ros1=ros1),
+            build(ts, TFM, stamp, pose7, child=body.rsplit("/", 1)[-1], ros1=ros1),
         ),
     ):
         text, md5 = msgdef(ts, msgtype, ros1)
