@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import itertools
 import logging
-import os
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -24,7 +23,7 @@ from ertools.errors import BagError
 from ertools.io.fastdecode import FAST_TYPES, Decoded, LayoutMismatchError, decode, to_batch
 from ertools.io.files import BagFile
 from ertools.io.model import TF_TYPES, Conn
-from ertools.io.pipeline import Group, joined, prefetched, read_at, scratch_view
+from ertools.io.pipeline import Group, joined, pread, prefetched, read_at, scratch_view
 from ertools.io.posebatch import PoseBatch, concat_batches
 from ertools.io.uniform import Rows, decode_uniform
 
@@ -232,7 +231,7 @@ def _chunk_group(bag: BagFile, chunks: list[Any], scratch: list[bytearray]) -> G
     parts = []
     for chunk in chunks:
         where = f"in {bag.path} at byte {chunk.pos}"
-        data = os.pread(fd, chunk.data_len, chunk.data_pos)
+        data = pread(fd, chunk.data_len, chunk.data_pos)
         if len(data) != chunk.data_len:
             raise BagError(f"chunk at byte {chunk.pos} cut off by end of file", path=bag.path)
         parts.append(decompress(chunk.compression, data, where))

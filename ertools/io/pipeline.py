@@ -13,6 +13,7 @@ pages are not faulted in for every chunk.
 from __future__ import annotations
 
 import os
+import threading
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
 from typing import TypeVar
@@ -78,11 +79,31 @@ def joined(parts: Sequence[bytes], scratch: list[bytearray]) -> Group:
     return np.frombuffer(view, dtype=np.uint8), base, sizes
 
 
+_SEEK_LOCK = threading.Lock()
+
+
 def read_at(fd: int, into: memoryview, offset: int) -> int:
-    """Read into ``into`` from ``offset`` without moving the file position, so loading
-    threads never race over it."""
+    """Read into ``into`` from ``offset`` without racing other threads over the file
+    position: a positional read where the system has one, else seek + read under a lock
+    (Windows). Returns the bytes read (fewer at the end of the file)."""
     if hasattr(os, "preadv"):
         return os.preadv(fd, [into], offset)
-    data = os.pread(fd, len(into), offset)  # no preadv (Windows, older macOS): one copy more
+    data = pread(fd, len(into), offset)
     into[: len(data)] = data
     return len(data)
+
+
+def pread(fd: int, size: int, offset: int) -> bytes:
+    """``size`` bytes from ``offset`` (fewer at the end of the file), thread-safe."""
+    if hasattr(os, "pread"):
+        return os.pread(fd, size, offset)
+    with _SEEK_LOCK:
+        os.lseek(fd, offset, os.SEEK_SET)
+        parts = []
+        while size > 0:
+            part = os.read(fd, size)
+            if not part:
+                break
+            parts.append(part)
+            size -= len(part)
+        return b"".join(parts)
