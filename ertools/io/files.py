@@ -181,10 +181,13 @@ class McapFile(BagFile):
         self.unfinished = False
         self._scanned: list[tuple[int, int, int, bytes]] = []  # log time, position, channel, data
         self._f = path.open("rb")
+        from ertools.io.mcap_index import read_summary
+
+        unreadable: tuple[type[BaseException], ...] = (BagError, *_mcap_errors())
         try:
             self._reader = make_reader(self._f)
-            summary = self._reader.get_summary()
-        except _mcap_errors():
+            summary = read_summary(self._f, path)  # parsed once, reused by the bulk reader
+        except unreadable:
             summary = None
         if summary is None:
             self.connections = self._scan()

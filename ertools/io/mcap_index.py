@@ -10,6 +10,7 @@ known up front; then the chunks are decompressed one at a time.
 from __future__ import annotations
 
 import logging
+import os
 import struct
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -22,6 +23,7 @@ import numpy.typing as npt
 from ertools.errors import BagError
 from ertools.io.files import BagFile
 from ertools.io.model import Conn
+from ertools.io.pipeline import Group, joined, pread, read_at, scratch_view
 
 log = logging.getLogger("ertools.io.mcap_index")
 
@@ -35,12 +37,33 @@ MESSAGE_FIXED = 2 + 4 + 8 + 8  # channel id, sequence, log time, publish time
 PAIR = np.dtype([("t", "<u8"), ("off", "<u8")])
 
 
+# Summaries parsed, by file identity: opening a file and planning a read need the same one.
+_SUMMARIES: dict[tuple[int, int, int, int], Any] = {}
+
+
 def read_summary(f: BinaryIO, path: Path) -> Any:
-    """The ``mcap`` library's Summary of an open MCAP file, None when it has none."""
+    """The ``mcap`` library's Summary of an open MCAP file, None when it has none.
+
+    Kept per file (device, inode, size, modification time), so a file changed since is read
+    again; the Summary is shared, never modified.
+    """
+    st = os.fstat(f.fileno())
+    key = (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+    if key in _SUMMARIES:
+        return _SUMMARIES[key]
+    summary = _parse_summary(f, path)
+    if len(_SUMMARIES) >= 64:
+        _SUMMARIES.clear()
+    _SUMMARIES[key] = summary
+    return summary
+
+
+def _parse_summary(f: BinaryIO, path: Path) -> Any:
     from mcap.exceptions import McapError
     from mcap.reader import make_reader
 
     try:
+        f.seek(0)
         return make_reader(f).get_summary()
     except (
         McapError,
@@ -196,7 +219,6 @@ class McapIndex:
         positions, bytes, data starts, data lengths) of the planned messages in it. ``load``
         may run on a worker thread (it opens the file itself)."""
         from ertools.io.bulk import GROUP_BYTES, group_positions
-        from ertools.io.pipeline import joined
 
         todo: list[list[tuple[int, I64]]] = []
         size = 0
@@ -212,9 +234,7 @@ class McapIndex:
 
         def load(k: int, scratch: list[bytearray]) -> tuple[I64, U8, I64, I64]:
             part = todo[k]
-            buf, base, sizes = joined(
-                [self.inflated_bytes(*chunk_of(key)) for key, _ in part], scratch
-            )
+            buf, base, sizes = self._group_bytes([chunk_of(key) for key, _ in part], scratch)
             rows = np.concatenate([r for _k, r in part])
             which = np.concatenate([np.full(len(r), i) for i, (_k, r) in enumerate(part)])
             path, first = chunk_of(part[0][0])
@@ -228,6 +248,31 @@ class McapIndex:
             return rows, buf, start, length
 
         return len(todo), load
+
+    @staticmethod
+    def _group_bytes(chunks: list[tuple[Path, Any]], scratch: list[bytearray]) -> Group:
+        """The records of several chunks end to end in ``scratch``: uncompressed chunks are
+        read straight into it, compressed ones decompressed and copied in."""
+        heads = []
+        for path, chunk in chunks:
+            with path.open("rb") as f:
+                heads.append(McapIndex._chunk_head(f.fileno(), path, chunk))
+        if any(h[0] for h in heads):
+            return joined([McapIndex.inflated_bytes(p, c) for p, c in chunks], scratch)
+        sizes = np.array([h[2] for h in heads], dtype=np.int64)
+        base = np.zeros(len(heads), dtype=np.int64)
+        np.cumsum(sizes[:-1], out=base[1:])
+        view = scratch_view(scratch, int(sizes.sum()))
+        for (path, chunk), (_c, at, nbytes, usize), b in zip(
+            chunks, heads, base.tolist(), strict=True
+        ):
+            where = f"in {path} at byte {chunk.chunk_start_offset}"
+            if nbytes != usize:
+                raise BagError(f"uncompressed chunk of {nbytes} bytes claims {usize} {where}")
+            with path.open("rb") as f:
+                if read_at(f.fileno(), view[b : b + nbytes], at) != nbytes:
+                    raise BagError(f"chunk cut off by end of file {where}")
+        return np.frombuffer(view, dtype=np.uint8), base, sizes
 
     @staticmethod
     def inflated_bytes(path: Path, chunk: Any) -> bytes:
@@ -266,26 +311,35 @@ class McapIndex:
         """(compression, compressed records, uncompressed size) of a chunk record."""
         where = f"in {path} at byte {chunk.chunk_start_offset}"
         with path.open("rb") as f:
-            size = _file_size(f)
-            start = int(chunk.chunk_start_offset)
-            if not 0 <= start < size:
-                raise BagError(f"chunk offset outside the file ({size} bytes) {where}")
-            f.seek(start)
-            head = f.read(1 + 8 + 8 + 8 + 8 + 4 + 4)
-            if len(head) < 41 or head[0] != OP_CHUNK:
-                raise BagError(f"no chunk record {where}")
-            _, _rlen, _t0, _t1, usize, _crc, clen = struct.unpack("<BQQQQII", head)
-            if start + 41 + clen + 8 > size:
-                raise BagError(f"damaged chunk record {where}")
-            compression = f.read(clen).decode("ascii", "replace")
-            (nbytes,) = struct.unpack("<Q", f.read(8))
-            # a chunk larger than the file, or inflating to more than 1000x, is damage
-            if f.tell() + nbytes > size or usize > 1000 * max(nbytes, 1) + (1 << 20):
-                raise BagError(f"damaged chunk record (sizes {nbytes}/{usize}) {where}")
-            data = f.read(nbytes)
+            compression, at, nbytes, usize = McapIndex._chunk_head(f.fileno(), path, chunk)
+            data = pread(f.fileno(), nbytes, at)
         if len(data) != nbytes:
             raise BagError(f"chunk cut off by end of file {where}")
-        return compression, data, int(usize)
+        return compression, data, usize
+
+    @staticmethod
+    def _chunk_head(fd: int, path: Path, chunk: Any) -> tuple[str, int, int, int]:
+        """(compression, where the records start, their stored size, uncompressed size) of a
+        chunk record, from its header (positional reads: may run on a loading thread)."""
+        where = f"in {path} at byte {chunk.chunk_start_offset}"
+        size = os.fstat(fd).st_size
+        start = int(chunk.chunk_start_offset)
+        if not 0 <= start < size:
+            raise BagError(f"chunk offset outside the file ({size} bytes) {where}")
+        head = pread(fd, 1 + 8 + 8 + 8 + 8 + 4 + 4, start)
+        if len(head) < 41 or head[0] != OP_CHUNK:
+            raise BagError(f"no chunk record {where}")
+        _, _rlen, _t0, _t1, usize, _crc, clen = struct.unpack("<BQQQQII", head)
+        if start + 41 + clen + 8 > size:
+            raise BagError(f"damaged chunk record {where}")
+        tail = pread(fd, clen + 8, start + 41)
+        compression = tail[:clen].decode("ascii", "replace")
+        (nbytes,) = struct.unpack("<Q", tail[clen:])
+        at = start + 41 + clen + 8
+        # a chunk larger than the file, or inflating to more than 1000x, is damage
+        if at + nbytes > size or usize > 1000 * max(nbytes, 1) + (1 << 20):
+            raise BagError(f"damaged chunk record (sizes {nbytes}/{usize}) {where}")
+        return compression, at, int(nbytes), int(usize)
 
     @staticmethod
     def _spans(buf: U8, off: I64, where: str) -> tuple[I64, I64]:

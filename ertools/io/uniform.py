@@ -167,17 +167,16 @@ def _column(rows: U8, offset: int, dtype: str, count: int = 1) -> npt.NDArray[np
 def _same_bytes(rows: U8, a: int, b: int) -> bool:
     """Whether bytes [a, b) of every row equal those of the first row.
 
-    Compared eight bytes at a time (overlapping the last word when the range is not a
-    multiple of eight), so the cost is a few strided reads per row, not one per byte.
+    Compared a word at a time (8 bytes, or 4, 2, 1 for shorter ranges; the last word
+    overlaps the one before when the range is not a multiple of it), so the cost is a few
+    strided reads per row, not one per byte.
     """
-    if b - a < 8:
-        part = rows[:, a:b]
-        return bool(np.array_equal(part, np.broadcast_to(part[0], part.shape)))
-    starts = list(range(a, b - 7, 8))
-    if starts[-1] != b - 8:
-        starts.append(b - 8)
+    width = next(w for w in (8, 4, 2, 1) if w <= b - a)
+    starts = list(range(a, b - width + 1, width))
+    if starts[-1] != b - width:
+        starts.append(b - width)  # the last word overlaps the one before
     for at in starts:
-        col = _column(rows, at, "<u8")
+        col = _column(rows, at, f"<u{width}")
         if not bool(np.all(col == col[0])):
             return False
     return True
