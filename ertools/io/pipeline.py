@@ -73,10 +73,11 @@ def joined(parts: Sequence[bytes], scratch: list[bytearray]) -> Group:
     base = np.zeros(len(parts), dtype=np.int64)
     np.cumsum(sizes[:-1], out=base[1:])
     total = int(sizes.sum())
-    view = scratch_view(scratch, total)
+    out = np.frombuffer(scratch_view(scratch, total), dtype=np.uint8)
     for at, part in zip(base.tolist(), parts, strict=True):
-        view[at : at + len(part)] = part
-    return np.frombuffer(view, dtype=np.uint8), base, sizes
+        # a NumPy copy releases the GIL (a memoryview copy holds it): the decoder runs meanwhile
+        out[at : at + len(part)] = np.frombuffer(part, dtype=np.uint8)
+    return out, base, sizes
 
 
 _SEEK_LOCK = threading.Lock()
