@@ -21,7 +21,7 @@ NS_BODY = "/fbm3w/robot_at_work"
 GT_TOPIC = f"{NS_BODY}/pose"
 ROBOT_TOPIC = "/rockin/homer/marker_pose"
 PS, P2D, TFM = "geometry_msgs/PoseStamped", "geometry_msgs/Pose2D", "tf2_msgs/TFMessage"
-VERSION = 5  # bump to regenerate the cache
+VERSION = 6  # bump to regenerate the cache
 
 
 def trajectory(t_s: F64) -> tuple[F64, F64]:
@@ -94,6 +94,31 @@ def robot_topics(start_ns: int, seconds: float, seed: int) -> list[Topic]:
     ]
 
 
+def camera_topic(start_ns: int, seconds: float, size: int = 16 * 1024) -> Topic:
+    """A 10 Hz ``sensor_msgs/Image`` of ``size`` bytes of pixels (all frames alike): the heavy
+    topic a robot's own log carries next to its pose, never decoded by the pose reader."""
+    ts = typestore(True)
+    t = ts.types
+    n = int(seconds * 10)
+    msg = t["sensor_msgs/msg/Image"](
+        header=t["std_msgs/msg/Header"](
+            seq=0, stamp=t["builtin_interfaces/msg/Time"](sec=0, nanosec=0), frame_id="camera"
+        ),
+        height=64,
+        width=size // 64,
+        encoding="mono8",
+        is_bigendian=0,
+        step=size // 64,
+        data=np.zeros(size, dtype=np.uint8),
+    )
+    raw = np.frombuffer(bytes(ts.serialize_ros1(msg, "sensor_msgs/msg/Image")), dtype=np.uint8)
+    stamp = start_ns + np.arange(n, dtype=np.int64) * NS // 10 + 20_000_000
+    text, md5 = msgdef(ts, "sensor_msgs/Image")
+    return Topic(
+        "/homer/camera/image", "sensor_msgs/Image", text, md5, stamp, np.tile(raw, (n, 1)), "/homer"
+    )
+
+
 def check_readback(path: Path, topics: list[Topic], first: int = 3000) -> None:
     """rosbags reads the file back identically: message counts, record times and the raw
     bytes of the first messages of every connection, and a deserialized first pose."""
@@ -132,6 +157,7 @@ def generate(folder: Path, small_bags: int = 1000) -> dict[str, Path]:
         "gt_mcap": folder / "gt_hour.mcap",
         "gt_mcap_none": folder / "gt_hour_uncompressed.mcap",
         "robot": folder / "robot_hour.bag",
+        "robot_fat": folder / "robot_hour_with_camera.bag",
         "combined": folder / "gt_and_robot_hour.bag",
         "small": folder / "small_bags",
     }
@@ -146,6 +172,7 @@ def generate(folder: Path, small_bags: int = 1000) -> dict[str, Path]:
     write_ros1(paths["gt_bz2"], hour, "bz2")
     robot = robot_topics(T0, 3600, seed=2)
     write_ros1(paths["robot"], robot)
+    write_ros1(paths["robot_fat"], [*robot, camera_topic(T0, 3600)])
     write_ros1(paths["combined"], [*hour, *robot])
     for key in ("gt", "gt_lz4", "gt_bz2"):
         check_readback(paths[key], hour)

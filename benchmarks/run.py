@@ -259,6 +259,14 @@ def main() -> int:
                 [*ex, "rosbags", p, GT_TOPIC],
                 args.slow_runs,
             )
+    for key, label in (("robot", "robot hour"), ("robot_fat", "robot hour + 16 KiB camera")):
+        p = paths[key]
+        go(
+            f"extract_{key}",
+            f"ertools: robot pose topic -> arrays ({label}, {p.stat().st_size >> 20} MiB)",
+            [*ex, "ertools", str(p), ROBOT_TOPIC],
+            args.runs,
+        )
     go("info_hour", "ertools info (hour bag)", [*ertools, "info", str(paths["gt"])], args.runs)
     go(
         "info_small",
@@ -384,6 +392,12 @@ def main() -> int:
         "extract_gt",
         "-",
     )
+    a, b = results.get("extract_robot_fat"), results.get("extract_robot")
+    if a and b and a.inside_s and b.inside_s:
+        ratios["robot_fat_vs_plain_inside"] = a.inside_s / b.inside_s
+        size = sizes["robot_fat"] / sizes["robot"]
+        text = f"same 36,000 poses in a {size:.0f}x larger bag (camera), inside"
+        print(f"  {text:<62} {a.inside_s / b.inside_s:7.2f}x   (cost ~ messages, not bytes)")
     for scenario in FBM_SCENARIOS:
         a, b = results.get(f"fbm_{scenario}"), results.get(f"fbm_{scenario}_extract")
         if a and b and a.ok and b.ok:

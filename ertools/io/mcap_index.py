@@ -232,7 +232,7 @@ class McapIndex:
         def chunk_of(key: int) -> tuple[Path, Any]:
             return self.files[key >> 32], plan.chunks[key >> 32][key & 0xFFFFFFFF]
 
-        def load(k: int, scratch: list[bytearray]) -> tuple[I64, U8, I64, I64]:
+        def load(k: int, scratch: list[Any]) -> tuple[I64, U8, I64, I64]:
             part = todo[k]
             buf, base, sizes = self._group_bytes([chunk_of(key) for key, _ in part], scratch)
             rows = np.concatenate([r for _k, r in part])
@@ -250,7 +250,7 @@ class McapIndex:
         return len(todo), load
 
     @staticmethod
-    def _group_bytes(chunks: list[tuple[Path, Any]], scratch: list[bytearray]) -> Group:
+    def _group_bytes(chunks: list[tuple[Path, Any]], scratch: list[Any]) -> Group:
         """The records of several chunks end to end in ``scratch``: uncompressed chunks are
         read straight into it, compressed ones decompressed and copied in."""
         heads = []

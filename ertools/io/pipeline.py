@@ -12,11 +12,13 @@ pages are not faulted in for every chunk.
 
 from __future__ import annotations
 
+import contextlib
+import mmap
 import os
 import threading
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -35,22 +37,23 @@ def workers() -> int:
     return os.cpu_count() or 1
 
 
-def prefetched(count: int, load: Callable[[int, list[bytearray]], T]) -> Iterator[T]:
+def prefetched(count: int, load: Callable[[int, list[Any]], T]) -> Iterator[T]:
     """``load(k, scratch)`` for k in 0..count-1, in order, computed ahead on worker threads.
 
-    ``scratch`` is a one-element list holding the bytearray ``load`` may fill (and grow); a
-    result is valid until the next one is asked for, after which its buffer is reused.
+    ``scratch`` is a slot: a list holding the bytearray ``load`` may fill (and grow, see
+    :func:`scratch_view`) and maps it read through (:func:`keep`); a result is valid until the
+    next one is asked for, after which its slot is reused.
     """
     ahead = min(workers(), count)
     if ahead <= 1:
-        scratch: list[bytearray] = []
+        scratch: list[Any] = []
         for k in range(count):
             yield load(k, scratch)
         return
     from concurrent.futures import ThreadPoolExecutor
 
     # ahead groups in flight plus the one the caller holds: none shares a buffer.
-    slots: list[list[bytearray]] = [[] for _ in range(ahead + 1)]
+    slots: list[list[Any]] = [[] for _ in range(ahead + 1)]
     with ThreadPoolExecutor(ahead) as pool:
         pending = deque(pool.submit(load, k, slots[k % len(slots)]) for k in range(ahead))
         for k in range(count):
@@ -60,14 +63,36 @@ def prefetched(count: int, load: Callable[[int, list[bytearray]], T]) -> Iterato
             yield got
 
 
-def scratch_view(scratch: list[bytearray], size: int) -> memoryview:
-    """The first ``size`` bytes of the reused buffer (grown when too small)."""
-    if not scratch or len(scratch[0]) < size:
-        scratch[:] = [bytearray(size)]
+def scratch_view(scratch: list[Any], size: int) -> memoryview:
+    """The first ``size`` bytes of the reused buffer (grown when too small).
+
+    A slot is ``[bytearray, *maps]``: maps a load read through (``keep``) are released here,
+    when the slot is reused.
+    """
+    release(scratch)
+    if not scratch:
+        scratch.append(bytearray(size))
+    elif len(scratch[0]) < size:
+        scratch[0] = bytearray(size)
     return memoryview(scratch[0])[:size]
 
 
-def joined(parts: Sequence[bytes], scratch: list[bytearray]) -> Group:
+def keep(scratch: list[Any], mapping: mmap.mmap) -> None:
+    """Hold ``mapping`` in the slot until the slot is reused."""
+    release(scratch)
+    if not scratch:
+        scratch.append(bytearray(0))
+    scratch.append(mapping)
+
+
+def release(scratch: list[Any]) -> None:
+    for old in scratch[1:]:
+        with contextlib.suppress(BufferError):  # a view still alive keeps it until collected
+            old.close()
+    del scratch[1:]
+
+
+def joined(parts: Sequence[bytes], scratch: list[Any]) -> Group:
     """Chunks' uncompressed bytes copied end to end into the reused buffer."""
     sizes = np.array([len(p) for p in parts], dtype=np.int64)
     base = np.zeros(len(parts), dtype=np.int64)

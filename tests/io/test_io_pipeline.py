@@ -195,3 +195,54 @@ def test_default_groups_equal_small_groups(scene_bag: tuple[str, Path]) -> None:
         assert_same(fast_batch(path, "/fbm3w/robot_at_work/pose"), whole)
     finally:
         mp.undo()
+
+
+def _pose_between_blobs(tmp_path: Path, blob_bytes: int) -> Path:
+    from io_bagmaker import Spec
+
+    s = Spec()
+    pose = s.conn("/robot/pose", "geometry_msgs/PoseStamped")
+    blob = s.conn("/robot/camera", "std_msgs/String")
+    t0 = 1_445_609_740_000_000_000
+    for i in range(120):
+        t = t0 + i * 100_000_000
+        s.add(pose, t, stamp=t - 1000, frame="map", xyz=(0.1 * i, 0.2, 0.0), q=(0, 0, 0, 1))
+        s.add(blob, t + 50_000_000, data="x" * blob_bytes)
+    return write(tmp_path / f"blobs{blob_bytes}.bag", "ros1", s, chunk_bytes=200_000)
+
+
+@pytest.mark.parametrize(("blob_bytes", "mapped"), [(40_000, True), (200, False)])
+def test_pose_topic_between_big_messages_is_read_in_place(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, blob_bytes: int, mapped: bool
+) -> None:
+    """Records far apart (a pose topic between camera frames) are read through a map of
+    their chunks, close together with the chunks: the same values as rosbags either way."""
+    path = _pose_between_blobs(tmp_path, blob_bytes)
+    calls: list[int] = []
+    real = bulk._mapped_group
+
+    def spy(bag: object, chunks: list[object], scratch: list[object]) -> object:
+        calls.append(len(chunks))
+        return real(bag, chunks, scratch)
+
+    monkeypatch.setattr(bulk, "_mapped_group", spy)
+    monkeypatch.setattr(bulk, "GROUP_BYTES", 30_000)  # several groups, on worker threads
+    monkeypatch.setattr(pipeline, "workers", lambda: 2)
+    assert_same(fast_batch(path, "/robot/pose"), reference_batch(path, "/robot/pose"))
+    assert bool(calls) is mapped
+    if mapped:
+        assert len(calls) > 1
+
+
+def test_a_reused_slot_releases_its_map(tmp_path: Path) -> None:
+    import mmap
+
+    path = tmp_path / "f.bin"
+    path.write_bytes(b"\0" * 100_000)
+    with path.open("rb") as f:
+        mm = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
+    slot: list[object] = []
+    pipeline.keep(slot, mm)
+    assert slot[1] is mm and not mm.closed
+    pipeline.scratch_view(slot, 10)  # the slot is reused for a plain read
+    assert mm.closed and len(slot) == 1
