@@ -90,21 +90,15 @@ class _Assembler:
         remap = np.array(
             [self.frames.setdefault(f, len(self.frames)) for f in batch.frames], np.int32
         )
-        at = self.run_slice(pos)
-        if at is not None:
-            self.t_record[at] = batch.t_record
-            self.t_header[at] = batch.t_header
-            self.xyz[at] = batch.xyz
-            self.quat[at] = batch.quat_xyzw
-            self.frame_idx[at] = remap[batch.frame_idx]
-            self.child_idx[at] = remap[batch.child_idx]
-            return
-        self.t_record[pos] = batch.t_record
-        self.t_header[pos] = batch.t_header
-        self.xyz[pos] = batch.xyz
-        self.quat[pos] = batch.quat_xyzw
-        self.frame_idx[pos] = remap[batch.frame_idx]
-        self.child_idx[pos] = remap[batch.child_idx]
+        run = self.run_slice(pos)
+        # consecutive rows are written as a block (a copy, not a scatter)
+        at: slice | I64 = run if run is not None else pos
+        self.t_record[at] = batch.t_record
+        self.t_header[at] = batch.t_header
+        self.xyz[at] = batch.xyz
+        self.quat[at] = batch.quat_xyzw
+        self.frame_idx[at] = remap[batch.frame_idx]
+        self.child_idx[at] = remap[batch.child_idx]
 
     def result(self) -> PoseBatch:
         if not self.multi:
