@@ -209,7 +209,8 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
             raise BagError(f"message record runs past the end of its chunk {where}")
         return sel, buf, start, length, t_of[sel]
 
-    return Located(len(t_of), prefetched(len(todo), load_run))
+    compressed = any(bag.layout.chunks[ci].compression != "none" for ci in touched)
+    return Located(len(t_of), prefetched(len(todo), load_run, parallel=compressed))
 
 
 # Wanted records further apart than this on average are read in place (mapped) rather than
@@ -297,12 +298,13 @@ def _mcap_runs(
         return None
     plan = index.plan(conns, lo, hi)
     count, load = index.run_loader(plan)
+    compressed = any(c.compression for chunks in plan.chunks for c in chunks)
 
     def load_run(k: int, scratch: list[Any]) -> Run:
         pos, buf, start, length = load(k, scratch)
         return pos, buf, start, length, plan.t_record[pos]
 
-    return Located(len(plan.t_record), prefetched(count, load_run))
+    return Located(len(plan.t_record), prefetched(count, load_run, parallel=compressed))
 
 
 def _sqlite_runs(

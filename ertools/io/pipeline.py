@@ -37,14 +37,18 @@ def workers() -> int:
     return os.cpu_count() or 1
 
 
-def prefetched(count: int, load: Callable[[int, list[Any]], T]) -> Iterator[T]:
+def prefetched(
+    count: int, load: Callable[[int, list[Any]], T], *, parallel: bool = True
+) -> Iterator[T]:
     """``load(k, scratch)`` for k in 0..count-1, in order, computed ahead on worker threads.
 
     ``scratch`` is a slot: a list holding the bytearray ``load`` may fill (and grow, see
     :func:`scratch_view`) and maps it read through (:func:`keep`); a result is valid until the
-    next one is asked for, after which its slot is reused.
+    next one is asked for, after which its slot is reused. Without ``parallel`` (reads with
+    nothing to decompress: a second thread only competes with the decoder, measured) the
+    loads run in turn on the calling thread.
     """
-    ahead = min(workers(), count)
+    ahead = min(workers(), count) if parallel else 1
     if ahead <= 1:
         scratch: list[Any] = []
         for k in range(count):

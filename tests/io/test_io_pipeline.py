@@ -1,8 +1,9 @@
-"""The loading pipeline: chunk groups read and decompressed ahead on worker threads.
+"""The loading pipeline: chunk groups read, and decompressed ahead on worker threads.
 
 The scene bags are small (one group of chunks by default), so these tests shrink the group
-size until every read goes through several groups, the worker threads and the rotating
-buffers, and compare the result bit for bit with rosbags.
+size until every read goes through several groups (on the worker threads and their rotating
+buffers for the compressed formats, in turn for the others), and compare the result bit for
+bit with rosbags.
 """
 
 from __future__ import annotations
@@ -226,7 +227,7 @@ def test_pose_topic_between_big_messages_is_read_in_place(
         return real(bag, chunks, scratch)
 
     monkeypatch.setattr(bulk, "_mapped_group", spy)
-    monkeypatch.setattr(bulk, "GROUP_BYTES", 30_000)  # several groups, on worker threads
+    monkeypatch.setattr(bulk, "GROUP_BYTES", 30_000)  # several groups (and maps released)
     monkeypatch.setattr(pipeline, "workers", lambda: 2)
     assert_same(fast_batch(path, "/robot/pose"), reference_batch(path, "/robot/pose"))
     assert bool(calls) is mapped
