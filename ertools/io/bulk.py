@@ -15,7 +15,7 @@ import logging
 import mmap
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -27,6 +27,9 @@ from ertools.io.model import TF_TYPES, Conn
 from ertools.io.pipeline import Group, joined, keep, pread, prefetched, read_at, scratch_view
 from ertools.io.posebatch import PoseBatch, concat_batches
 from ertools.io.uniform import Rows, decode_uniform
+
+if TYPE_CHECKING:
+    from ertools.io.ros1_index import Ros1Bag, Ros1Chunk
 
 log = logging.getLogger("ertools.io.bulk")
 
@@ -167,7 +170,7 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
     touched, chunk_of, _rank, t_of, off_of = bag.select(conns, lo, hi)
 
     groups = dict(group_positions(chunk_of))
-    sparse = _sparse_chunks(bag, touched, groups, off_of)
+    sparse = _sparse_chunks(bag, touched, groups)
 
     def batches() -> Iterator[list[int]]:
         # Several chunks are decoded together (fewer NumPy calls per message), up to
@@ -199,7 +202,7 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
         else:
             buf, base, sizes = _chunk_group(bag, chunks, scratch)
         sel = np.concatenate([groups[c] for c in batch])
-        which = np.concatenate([np.full(len(groups[c]), k) for k, c in enumerate(batch)])
+        which = np.concatenate([np.full(len(groups[c]), i) for i, c in enumerate(batch)])
         where = f"in {bag.path} in chunks at bytes {chunks[0].pos}..{chunks[-1].pos}"
         offsets = off_of[sel]
         if np.any(offsets + 8 > sizes[which]):
@@ -222,9 +225,7 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
 SPARSE_GAP = 12 * 1024
 
 
-def _sparse_chunks(
-    bag: Any, touched: list[int], groups: dict[int, I64], off_of: I64
-) -> dict[int, int]:
+def _sparse_chunks(bag: Ros1Bag, touched: list[int], groups: dict[int, I64]) -> dict[int, int]:
     """Uncompressed chunks whose wanted records are sparse -> bytes of the pages they touch."""
     out = {}
     page = mmap.PAGESIZE
@@ -236,7 +237,7 @@ def _sparse_chunks(
     return out
 
 
-def _mapped_group(bag: Any, chunks: list[Any], scratch: list[Any]) -> Group:
+def _mapped_group(bag: Ros1Bag, chunks: list[Ros1Chunk], scratch: list[Any]) -> Group:
     """Chunks read in place through a read-only map of the stretch they span: the pages
     holding wanted records are read (with the kernel's usual read-ahead), the rest never.
 

@@ -213,7 +213,7 @@ class McapIndex:
 
     def run_loader(
         self, plan: McapPlan
-    ) -> tuple[int, Callable[[int, list[bytearray]], tuple[I64, U8, I64, I64]]]:
+    ) -> tuple[int, Callable[[int, list[Any]], tuple[I64, U8, I64, I64]]]:
         """(number of groups, load) where ``load(k, scratch)`` decompresses the k-th group of
         chunks (up to ``GROUP_BYTES`` uncompressed) into ``scratch`` and gives (reference
         positions, bytes, data starts, data lengths) of the planned messages in it. ``load``
@@ -253,24 +253,19 @@ class McapIndex:
     def _group_bytes(chunks: list[tuple[Path, Any]], scratch: list[Any]) -> Group:
         """The records of several chunks end to end in ``scratch``: uncompressed chunks are
         read straight into it, compressed ones decompressed and copied in."""
-        heads = []
-        for path, chunk in chunks:
-            with path.open("rb") as f:
-                heads.append(McapIndex._chunk_head(f.fileno(), path, chunk))
-        if any(h[0] for h in heads):
+        if any(chunk.compression for _path, chunk in chunks):
             return joined([McapIndex.inflated_bytes(p, c) for p, c in chunks], scratch)
-        sizes = np.array([h[2] for h in heads], dtype=np.int64)
-        base = np.zeros(len(heads), dtype=np.int64)
+        sizes = np.array([int(c.uncompressed_size) for _p, c in chunks], dtype=np.int64)
+        base = np.zeros(len(chunks), dtype=np.int64)
         np.cumsum(sizes[:-1], out=base[1:])
         view = scratch_view(scratch, int(sizes.sum()))
-        for (path, chunk), (_c, at, nbytes, usize), b in zip(
-            chunks, heads, base.tolist(), strict=True
-        ):
+        for (path, chunk), b, n in zip(chunks, base.tolist(), sizes.tolist(), strict=True):
             where = f"in {path} at byte {chunk.chunk_start_offset}"
-            if nbytes != usize:
-                raise BagError(f"uncompressed chunk of {nbytes} bytes claims {usize} {where}")
             with path.open("rb") as f:
-                if read_at(f.fileno(), view[b : b + nbytes], at) != nbytes:
+                compression, at, nbytes, usize = McapIndex._chunk_head(f.fileno(), path, chunk)
+                if compression or nbytes != n or usize != n:
+                    raise BagError(f"chunk record disagrees with the summary's index {where}")
+                if read_at(f.fileno(), view[b : b + n], at) != n:
                     raise BagError(f"chunk cut off by end of file {where}")
         return np.frombuffer(view, dtype=np.uint8), base, sizes
 
