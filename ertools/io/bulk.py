@@ -424,14 +424,13 @@ def try_fast_batch(
             # GIL, and two threads decoding were slower than one (measured).
             out = _Assembler(msgtype, found.count)
             for pos, buf, start, length, t_rec in found.runs:
+                # The usual case, consecutive rows: decoded straight into the result.
                 at = out.run_slice(pos)
-                if at is not None:
-                    # The usual case: decoded straight into the result (no second copy).
-                    dec = decode_uniform(msgtype, cdr, buf, start, length, into=out.rows(at))
-                    if dec is not None and dec.frame_text is not None:
-                        out.wrote(at, t_rec, dec)
-                        continue
-                dec = decode_uniform(msgtype, cdr, buf, start, length)
+                into = out.rows(at) if at is not None else None
+                dec = decode_uniform(msgtype, cdr, buf, start, length, into=into)
+                if dec is not None and at is not None:
+                    out.wrote(at, t_rec, dec)
+                    continue
                 if dec is None:
                     dec = decode(msgtype, cdr, buf, start, length)
                 out.add(pos[dec.msg_index], to_batch(buf, dec, t_rec))
