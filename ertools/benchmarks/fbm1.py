@@ -407,8 +407,8 @@ def _deviations(runs: Sequence[Fbm1RunResult], options: Fbm1Options) -> list[Dev
         n_abort = sum(r.status == "aborted" for r in runs)
         out.append(
             RULE_ABORTED.deviation(
-                "totals over the runs whose goal was sent; 2015 also counted a run stopped "
-                f"before its goal ({n_abort} such run(s) here)"
+                "accuracies and pose score over the runs whose goal was sent; 2015 also counted "
+                f"a run stopped before its goal ({n_abort} such run(s) here)"
             )
         )
     return out
