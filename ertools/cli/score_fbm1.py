@@ -153,6 +153,8 @@ def _options(args: argparse.Namespace) -> object:
             raise UsageError(f"--{name.replace('_', '-')} must be positive")
     for old_flag, now in DEPRECATED.items():
         if getattr(args, old_flag[2:].replace("-", "_")):
+            if old_flag == "--legacy-totals" and args.benchmark == "fbm1w":
+                now = "--count-aborted (the 2015 @Work node's divisors)"
             note(f"{old_flag} is deprecated: it now means {now}")
     gt = GtOptions(
         max_window_s=args.max_window,
