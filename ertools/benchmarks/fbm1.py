@@ -252,6 +252,25 @@ def _execution_time(run: Fbm1Run) -> float | None:
     return (run.result_ns - start) / NS_PER_S
 
 
+def item_broadcast(run: Fbm1Run, method: str, item_tf: PoseStream | None) -> int | None:
+    """The stamp of the node's item broadcast on /tf that its lookup used, when logged.
+
+    The 2015 nodes broadcast ``item`` once per answered run, after the result (between the goal
+    and the next run); the 2016-17 node once per run, before the goal. ``now`` of that
+    broadcast is the lookup's moment (tf answered ``Time(0)`` at it).
+    """
+    if item_tf is None or len(item_tf) == 0 or run.goal_ns is None:
+        return None
+    t = item_tf.t_ns
+    if method == "result":
+        after = t[(t > run.goal_ns) & (t <= run.end_ns)]
+        return int(after[0]) if len(after) else None
+    if method == "placed":
+        before = t[(t >= run.start_ns) & (t <= run.goal_ns)]
+        return int(before[-1]) if len(before) else None
+    return None
+
+
 def score_run(
     run: Fbm1Run,
     items: ItemList,
@@ -260,8 +279,13 @@ def score_run(
     options: Fbm1Options,
     results: ResultsFile | None = None,
     t0_ns: int = 0,
+    item_tf: PoseStream | None = None,
 ) -> Fbm1RunResult:
-    """Score one run; a run that cannot be scored comes back with status ``failed``."""
+    """Score one run; a run that cannot be scored comes back with status ``failed``.
+
+    ``item_tf``: the node's broadcasts of ``ref_board -> item`` on /tf, when logged: their
+    stamps are the exact moments of the node's lookups.
+    """
     where = f"run {run.index}"
     text = run.item.text if run.item else ""
     base: dict[str, Any] = {
@@ -318,6 +342,7 @@ def score_run(
             options=options.gt,
             t0_ns=t0_ns,
             placed_ns=run.placed_ns,
+            at_ns=item_broadcast(run, options.gt.method, item_tf),
         )
     except GroundTruthError as err:
         return Fbm1RunResult(
@@ -424,11 +449,13 @@ def score_fbm1(
     results: ResultsFile | None = None,
     t0_ns: int = 0,
     provenance: Provenance | None = None,
+    item_tf: PoseStream | None = None,
 ) -> Fbm1Result:
     """Score every run (pure: streams and configs in, frozen result out).
 
     A run that cannot be scored is reported in ``failures`` (one line naming the run) and left
-    out of the totals; the other runs are still scored.
+    out of the totals; the other runs are still scored. ``item_tf``: the node's item
+    broadcasts (``ref_board -> item`` on /tf), when logged: the exact lookup moments.
     """
     opts = options or Fbm1Options()
     if opts.benchmark not in BENCHMARKS:
@@ -438,7 +465,9 @@ def score_fbm1(
             f"no FBM1 run in the state log (no BmBox WAITING_MANUAL_OPERATION or goal); "
             f"is this an {opts.benchmark} log?"
         )
-    runs = tuple(score_run(run, items, origin, board, opts, results, t0_ns) for run in found.runs)
+    runs = tuple(
+        score_run(run, items, origin, board, opts, results, t0_ns, item_tf) for run in found.runs
+    )
     counted = [r for r in runs if r.status in ("scored", "no_answer")]
     tot = totals(
         [bool(r.class_ok) for r in counted],
@@ -612,6 +641,15 @@ def score_fbm1_bag(
     for body, source in ((origin, src.origin), (board, src.board)):
         if source is None or source.time_source == "header":
             check_header_clock(plist, body, "state messages")
+    item_tf = None
+    if opts.gt.method != "window":
+        from ertools.errors import TopicError
+        from ertools.io import read_tf
+
+        try:
+            item_tf = read_tf(plist, "ref_board", "item", start_ns=lo, end_ns=hi)
+        except TopicError:
+            item_tf = None  # not logged: the state messages give the moments
     gt = opts.gt
     provenance = Provenance(
         inputs=tuple(str(p) for p in plist)
@@ -631,5 +669,13 @@ def score_fbm1_bag(
         ),
     )
     return score_fbm1(
-        origin, board, found, items, opts, results=results, t0_ns=t0, provenance=provenance
+        origin,
+        board,
+        found,
+        items,
+        opts,
+        results=results,
+        t0_ns=t0,
+        provenance=provenance,
+        item_tf=item_tf,
     )

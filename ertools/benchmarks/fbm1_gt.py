@@ -75,8 +75,11 @@ class GroundTruth:
         angle_spread_deg: RMS rotation of the averaged samples from their mean.
         samples: number of samples averaged (1 for the 2015 single lookups).
         start_ns: first sample used.
-        end_ns: last sample used.
+        end_ns: last sample used (for a lookup: its moment, as ``start_ns``).
         method: how it was measured.
+        moment: for a lookup, where its moment came from: ``item tf stamp`` (the node's own
+            broadcast of the item, logged on /tf: exact) or ``state message`` (the BmBox state
+            that the node acted on; its own clock read up to one 10 Hz heartbeat earlier).
     """
 
     x: float
@@ -91,6 +94,7 @@ class GroundTruth:
     start_ns: int
     end_ns: int
     method: str
+    moment: str = ""
 
     @property
     def yaw_deg(self) -> float:
@@ -279,6 +283,7 @@ def measure_ground_truth(
     options: GtOptions,
     t0_ns: int = 0,
     placed_ns: int | None = None,
+    at_ns: int | None = None,
 ) -> tuple[GroundTruth, list[str]]:
     """The item's ground truth for one run, and warnings.
 
@@ -293,18 +298,24 @@ def measure_ground_truth(
         options: method and tolerances.
         t0_ns: times in messages are given relative to this (the log's start).
         placed_ns: the referee confirmed the placement (``placed``; the goal when None).
+        at_ns: the lookup's moment when known better than the state messages (the stamp of the
+            node's item broadcast on /tf); ignored by ``window``.
 
     Raises:
         GroundTruthError: a body missing or lost where the measurement needs it.
     """
     max_gap = round(options.max_gap_s * NS_PER_S)
     warnings: list[str] = []
+    moment = ""
     if options.method != "window":
-        if options.method == "result":
+        if at_ns is not None:
+            at, moment = at_ns, "item tf stamp"
+        elif options.method == "result":
             if result_ns is None:
                 raise GroundTruthError("no result time for the 2015 lookup when the result came")
-            at = result_ns
+            at, moment = result_ns, "state message"
         else:
+            moment = "state message"
             at = placed_ns if options.method == "placed" and placed_ns is not None else goal_ns
         used = lookup_at(
             origin.window(at - max_gap, at + max_gap),
@@ -353,6 +364,7 @@ def measure_ground_truth(
         start_ns=used.start_ns,
         end_ns=used.end_ns,
         method=options.method,
+        moment=moment,
     )
     return gt, warnings
 

@@ -96,6 +96,8 @@ class Fbm1RunResult:
                 "spread_deg": g.angle_spread_deg,
                 "window_s": [(g.start_ns - t0_ns) / NS_PER_S, (g.end_ns - t0_ns) / NS_PER_S],
             }
+            if g.moment:
+                out["ground_truth"]["moment_from"] = g.moment
         if self.errors is not None:
             e = self.errors
             out["error"] = {

@@ -17,8 +17,9 @@ rockin-robot-challenge/benchmark_and_scoring_fbm, 2015 at 117a5d0, 2016-17 at 40
 - 2016-17 (@Home): the lookup at ``now`` when the manual operation completed, before the goal;
   accuracies divided by ``BENCHMARK_RUNS`` = 10, the pose score by ``runs``.
 
-The moments ``now`` are taken from the logged states, as ertools does: the first BmBox message
-past ``WAITING_RESULT`` (2015) and the first ``COMPLETED_MANUAL_OPERATION`` message (2016).
+The moment ``now`` is the stamp of the node's item broadcast on /tf when the log has it (it is
+the node's own ``now``); else the logged state the node acted on: the first BmBox message past
+``WAITING_RESULT`` (2015) or the first ``COMPLETED_MANUAL_OPERATION`` message (2016).
 """
 
 from __future__ import annotations
@@ -48,6 +49,7 @@ class Log:
     states: dict[str, list[tuple[int, int, str]]]  # machine -> (record ns, state, payload)
     poses: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]  # body -> t, xyz, xyzw
     t0: int
+    item_stamps: list[int]  # the node's broadcasts of ref_board -> item on /tf
 
 
 def read_log(bag: Path, ns: str) -> Log:
@@ -73,7 +75,12 @@ def read_log(bag: Path, ns: str) -> Log:
             a = np.array(rows, dtype=np.float64)
             poses[body] = (np.array([r[0] for r in rows], dtype=np.int64), a[:, 1:4], a[:, 4:8])
         t0 = reader.start_time
-    return Log(states, poses, t0)
+        stamps = []
+        for c, _t, raw in reader.messages([c for c in reader.connections if c.topic == "/tf"]):
+            for tr in reader.deserialize(raw, c.msgtype).transforms:
+                if tr.child_frame_id.lstrip("/") == "item":
+                    stamps.append(tr.header.stamp.sec * 1_000_000_000 + tr.header.stamp.nanosec)
+    return Log(states, poses, t0, sorted(stamps))
 
 
 # ----------------------------------------------------------------------------- tf, by hand
@@ -171,8 +178,10 @@ def node(log: Log, items: list[dict[str, Any]], *, rules: str, benchmark: str) -
             # ManualOperation returned with the benchmark stopped: break (runs counted).
             break
         placed = next(m[0] for m in episode if m[1] == BmBoxState.COMPLETED_MANUAL_OPERATION)
+        next_start = bm[end_k][0] if end_k < len(bm) else 2**62
         if rules == "2016":
-            gt = tf_lookup(log, item, placed)
+            now = [t for t in log.item_stamps if episode[0][0] <= t <= goal[0][0]]
+            gt = tf_lookup(log, item, now[-1] if now else placed)
         start_time = next(m[0] for m in episode if m[1] == BmBoxState.EXECUTING_GOAL)
         waiting = [i for i, m in enumerate(episode) if m[1] == BmBoxState.WAITING_RESULT]
         end_time = next(m[0] for m in episode[waiting[0] :] if m[1] != BmBoxState.WAITING_RESULT)
@@ -192,7 +201,8 @@ def node(log: Log, items: list[dict[str, Any]], *, rules: str, benchmark: str) -
         class_pos += c_ok
         inst_pos += i_ok
         if rules == "2015":
-            gt = tf_lookup(log, item, end_time)
+            now = [t for t in log.item_stamps if goal[0][0] < t < next_start]
+            gt = tf_lookup(log, item, now[0] if now else end_time)
         x_err = result["x"] - gt[0]
         y_err = result["y"] - gt[1]
         w_err = result["theta"] - gt[2]
@@ -361,10 +371,17 @@ ITEMS = """items:
 S = 1_000_000_000
 
 
-def _edge_bag(path: Path, ns: str) -> tuple[Path, list[dict[str, Any]]]:
+def _edge_bag(
+    path: Path, ns: str, broadcast: str | None = None
+) -> tuple[Path, list[dict[str, Any]]]:
     """Runs: theta across +-180 (single wrap fine), 1.2 m off, theta 550 deg off (one wrap is
     not enough), then a run the RefBox stops during the manual operation. (A timeout is in the
-    sample: the RefBox stops publishing at its first END, so one log cannot hold both.)"""
+    sample: the RefBox stops publishing at its first END, so one log cannot hold both.)
+
+    ``broadcast``: also log the node's item broadcasts on /tf, as the 2015 node (``2015``: 7 ms
+    after the BmBox left WAITING_RESULT) or the 2016-17 node (``2016``: 7 ms after the
+    placement was confirmed) made them.
+    """
     from scipy.spatial.transform import Rotation
 
     from ertools.samples.mocap import MocapNoise, publish_mocap, simulate_mocap
@@ -389,6 +406,7 @@ def _edge_bag(path: Path, ns: str) -> tuple[Path, list[dict[str, Any]]]:
         Transition(t0 + 3 * S + S // 2, Machine.CLIENT, ClientState.WAITING_GOAL),
     ]
     order = [1, 2, 3, 4]
+    casts: list[tuple[int, dict[str, Any]]] = []
     t = t0 + np.arange(0, 62 * S, S // 100, dtype=np.int64)
     rel = np.tile([-0.5, -0.5, 0.0, 0.0], (t.size, 1))
     secs = (t - t0) / S
@@ -444,6 +462,10 @@ def _edge_bag(path: Path, ns: str) -> tuple[Path, list[dict[str, Any]]]:
             Transition(wmo + 6 * S + S // 5, Machine.CLIENT, ClientState.WAITING_GOAL),
         ]
         tr.append(Transition(wmo + 6 * S + S // 10, Machine.BMBOX, BmBoxState.READY))
+        if broadcast == "2015":
+            casts.append((wmo + 6 * S + S // 10 + 7_000_000, item))
+        elif broadcast == "2016":
+            casts.append((wmo + 3 * S + S // 50 + 7_000_000, item))
     end = t0 + 55 * S
     tr += [
         Transition(end, Machine.BMBOX, BmBoxState.TRANSMITTING_SCORE, "{class_accuracy: 0}"),
@@ -461,20 +483,38 @@ def _edge_bag(path: Path, ns: str) -> tuple[Path, list[dict[str, Any]]]:
             pub = simulate_mocap(t, xyz, q, rng=rng, noise=MocapNoise())
             publish_mocap(bag, ns, body, pub)
         publish_states(bag, ns, tr, validate=False)
+        for t_cast, item in casts:
+            bag.write_tf(
+                np.array([t_cast + 300_000]),
+                np.array([t_cast]),
+                "ref_board",
+                "item",
+                np.array([item["trans"]], dtype=float),
+                np.array([item["rot"]], dtype=float),
+                callerid=f"/{ns}/benchmark",
+            )
     return path, items
 
 
-@pytest.mark.parametrize("ns", ["fbm1h", "fbm1w"])
+@pytest.mark.parametrize(("ns", "broadcast"), [("fbm1h", None), ("fbm1w", None), ("fbm1h", "2015")])
 def test_edge_cases_rules_2015_is_the_2015_node(
-    ns: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    ns: str, broadcast: str | None, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    bag, items = _edge_bag(tmp_path / f"{ns}.bag", ns)
+    bag, items = _edge_bag(tmp_path / f"{ns}.bag", ns, broadcast)
     items_path = tmp_path / "items.yaml"
     items_path.write_text(ITEMS, encoding="utf-8")
     log = read_log(bag, ns)
     ref = node(log, items, rules="2015", benchmark=ns)
     data, _ = ertools_score(bag, items_path, ns, ["--rules", "2015"], capsys)
     assert_same(data, ref)
+    moment = "item tf stamp" if broadcast else "state message"
+    assert data["runs"]["1"]["ground_truth"]["moment_from"] == moment
+    if broadcast:
+        # The node's own `now` is 7 ms after the state message: 14 um of drift, far above 1e-12.
+        log = read_log(bag, ns)
+        log.item_stamps = []
+        late = node(log, items, rules="2015", benchmark=ns)
+        assert abs(late["runs"][1]["gt"][0] - ref["runs"][1]["gt"][0]) > 1e-6
     # What the edge cases exercise, in the node's own numbers:
     runs = ref["runs"]
     assert abs(runs[1]["err"][2]) < 20  # the answer wrapped across +-180: one 360 suffices
@@ -551,3 +591,18 @@ def test_rules_2016_at_work_is_a_usage_error(
     out, err = capsys.readouterr()
     assert code == 2 and out == ""
     assert err.count("\n") == 1 and "no 2016-17 FBM1@Work node" in err
+
+
+def test_edge_cases_rules_2016_uses_the_logged_broadcast(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bag, items = _edge_bag(tmp_path / "fbm1h.bag", "fbm1h", "2016")
+    items_path = tmp_path / "items.yaml"
+    items_path.write_text(ITEMS, encoding="utf-8")
+    ref = node(read_log(bag, "fbm1h"), items, rules="2016", benchmark="fbm1h")
+    data, _ = ertools_score(bag, items_path, "fbm1h", ["--rules", "2016"], capsys)
+    assert_same(data, ref)
+    assert data["runs"]["2"]["ground_truth"]["moment_from"] == "item tf stamp"
+    # A 2016-17 log asked for the 2015 lookup has no broadcast after the result: states decide.
+    data15, _ = ertools_score(bag, items_path, "fbm1h", ["--rules", "2015"], capsys)
+    assert data15["runs"]["2"]["ground_truth"]["moment_from"] == "state message"
