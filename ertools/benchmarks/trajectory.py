@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from itertools import pairwise
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
@@ -215,6 +215,51 @@ RULE_YAW_WRAP = Rule(
         "dyaw wrapped to [-pi, pi] in orientation_error (a pose crossing +-pi otherwise counts "
         "a ~2pi difference); every run also reports 2015's value as orientation_error_2015, so "
         "no option is needed"
+    ),
+    option="",
+)
+RULE_GT_OVERLAP = Rule(
+    key="trajectory.gt-overlap",
+    benchmark="trajectory",
+    title="GT files overlapping in time",
+    rulebook=_SEED,
+    node_2015=(
+        "chained the GT files sorted by start time and scanned them in that order, warning "
+        "'poses out of order: result may be invalid' (rockin_trajectory_benchmark.py)"
+    ),
+    ertools=(
+        "poses merged in time order, a message recorded twice used once; no option: 2015's "
+        "result there depends on where its scan stood, a defect rather than a rule"
+    ),
+    option="",
+)
+RULE_INVALID_POSES = Rule(
+    key="trajectory.invalid-poses",
+    benchmark="trajectory",
+    title="NaN poses and zero quaternions",
+    rulebook=_SEED,
+    node_2015=(
+        "used as they were: a NaN made the score NaN, a zero quaternion gave tf's identity, a "
+        "yaw of 0 (rockin_trajectory_benchmark.py, Error.update)"
+    ),
+    ertools=(
+        "ignored and counted in a warning; no option: a NaN score is no score, and a zero "
+        "quaternion is a node publishing 'no pose'"
+    ),
+    option="",
+)
+RULE_ROBOT_STAMPS = Rule(
+    key="trajectory.robot-stamps",
+    benchmark="trajectory",
+    title="robot stamps that go back in time",
+    rulebook=_SEED,
+    node_2015=(
+        "its GT scan only moves forward: a robot pose stamped before the previous one was "
+        "compared with the GT pose of the previous one (rockin_trajectory_benchmark.py)"
+    ),
+    ertools=(
+        "an error naming the message; no option: the 2015 pairing there is not the GT at the "
+        "robot's time (--robot-time record scores by the robot bag's record times instead)"
     ),
     option="",
 )
@@ -692,12 +737,20 @@ def score_streams(
     check_increasing(robot, where)
     gt, dropped = drop_duplicates(gt)
     notes = list(warnings)
+    invalid: list[Deviation] = []
     if dropped:
         notes.append(f"{dropped} GT sample(s) recorded twice (overlapping GT files) were used once")
     gt, bad_gt = drop_invalid(gt)
     robot, bad_robot = drop_invalid(robot)
     if bad_gt:
         notes.append(f"{bad_gt} GT sample(s) with NaN or zero-norm poses ignored")
+    if bad_gt or bad_robot:
+        invalid.append(
+            RULE_INVALID_POSES.deviation(
+                f"{bad_gt} GT and {bad_robot} robot pose(s) with NaN or zero-norm quaternions "
+                "ignored (2015 used them: a NaN score, or a yaw of 0)"
+            )
+        )
     if bad_robot:
         notes.append(f"{bad_robot} robot pose(s) with NaN or zero-norm poses ignored")
     if len(robot) == 0:
@@ -804,7 +857,7 @@ def score_streams(
         audit=audit,
         uncovered_spans=tuple(spans),
         warnings=tuple(notes),
-        deviations=tuple(_deviations(config, matched, m)),
+        deviations=(*_deviations(config, matched, m), *invalid),
         failures=tuple(failures),
         provenance=Provenance(
             inputs=(robot_file, *gt_files),
@@ -1104,7 +1157,7 @@ def score(
     files = [s.path for s in chosen]
     gt = read_gt(files, gtopic, lo - margin, hi + margin)
     try:
-        return score_streams(
+        result = score_streams(
             robot,
             gt,
             cfg,
@@ -1121,3 +1174,12 @@ def score(
         raise ClockError(
             f"{err}; damaged GT file(s), read only up to the damage: {', '.join(broken)}"
         ) from err
+    overlaps = sum(1 for a, b in pairwise(chosen) if b.start_ns < a.end_ns)
+    if overlaps:
+        dev = RULE_GT_OVERLAP.deviation(
+            f"{overlaps} pair(s) of GT files overlap in time: their poses are merged in time "
+            "order, a message recorded twice used once (2015 chained the files by start time "
+            "and scanned the poses out of order)"
+        )
+        result = replace(result, deviations=(*result.deviations, dev))
+    return result

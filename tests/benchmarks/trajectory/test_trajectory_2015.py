@@ -366,3 +366,34 @@ def test_2015_options_that_agree_are_accepted(
     a = _cli_json([*hand, "--2015"], capsys)
     b = _cli_json([*hand, "--2015", "--association", "hold", "--ties", "before"], capsys)
     assert a["position_error"] == b["position_error"] == pytest.approx(0.26, abs=1e-12)
+
+
+# --- 2015 behaviours no option restores: said in the deviations --------------------------------
+
+
+def test_invalid_poses_are_ignored_where_2015_gave_a_nan_score() -> None:
+    gt = _gt([0, 10, 20, 30, 40], [0.0, 0.1, 0.2, 0.3, 0.4])
+    robot = _gt([15.0, 25.0, 35.0], [0.0] * 3)
+    robot[1] = (robot[1][0], (math.nan, 0.0, 0.0), robot[1][2])
+    node = score_2015(robot, [gt])
+    assert node.position_error is not None and math.isnan(node.position_error)
+    r = _run(robot, gt)
+    d = math.sqrt(1.25)  # held GT x 0.1 and 0.3, y = x / 2, z equal
+    assert r.to_dict()["position_error"] == pytest.approx((0.1 * d + 0.3 * d) / 2, abs=1e-12)
+    assert any(dev.endswith("[trajectory.invalid-poses]") for dev in r.deviations)
+
+
+def test_overlapping_gt_files_are_a_deviation(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    t = EPOCH + np.arange(0, 1000, 10, dtype=np.int64) * MS
+    xyz = np.column_stack([np.linspace(0, 1, len(t)), np.zeros((len(t), 2))])
+    a = write_gt(tmp_path / "gt_a.bag", t[:60], xyz[:60], GT_TOPIC)
+    b = write_gt(tmp_path / "gt_b.bag", t[40:], xyz[40:], GT_TOPIC)  # 20 messages twice
+    robot = write_robot(tmp_path / "robot.bag", t[5:95:10] + 5 * MS, np.zeros((9, 3)), ROBOT_TOPIC)
+    ours = _cli_json([str(robot), str(a), str(b), "--2015"], capsys)
+    assert ours["tracking_lost"] == 0  # the duplicates are used once
+    assert any(
+        d.startswith("1 pair(s) of GT files overlap") and d.endswith("[trajectory.gt-overlap]")
+        for d in ours["deviations"]
+    )
