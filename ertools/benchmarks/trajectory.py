@@ -391,13 +391,18 @@ def yaw_tf(quat_xyzw: F64) -> F64:
     """
     q = np.asarray(quat_xyzw, dtype=np.float64)
     x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
-    n = x * x + y * y + z * z + w * w
-    with np.errstate(invalid="ignore", divide="ignore"):
-        m00 = 1.0 - 2.0 * (y * y + z * z) / n
-        m10 = 2.0 * (x * y + z * w) / n
+    n = np.einsum("...i,...i->...", q, q)
+    with np.errstate(invalid="ignore", divide="ignore"):  # a zero quaternion: set to 0 below
+        s = 2.0 / n
+        m00 = 1.0 - (y * y + z * z) * s
+        m10 = (x * y + z * w) * s
     out = np.arctan2(m10, m00)
-    flat = (n < _TF_EPS) | (np.hypot(m00, m10) <= _TF_EPS)
-    return np.asarray(np.where(flat, 0.0, out), dtype=np.float64)
+    # tf: identity below _EPS of squared norm; yaw 0 where cos(pitch) (the norm of the
+    # matrix's first column in x, y) is at most _EPS. Squares compared: no square root.
+    flat = (n < _TF_EPS) | (m00 * m00 + m10 * m10 <= _TF_EPS * _TF_EPS)
+    if flat.any():
+        out = np.where(flat, 0.0, out)
+    return np.asarray(out, dtype=np.float64)
 
 
 def _rows(a: F64, index: npt.NDArray[np.intp]) -> F64:

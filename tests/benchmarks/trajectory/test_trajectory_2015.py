@@ -397,3 +397,22 @@ def test_overlapping_gt_files_are_a_deviation(
         d.startswith("1 pair(s) of GT files overlap") and d.endswith("[trajectory.gt-overlap]")
         for d in ours["deviations"]
     )
+
+
+def test_yaw_tf_equals_tf_s_arithmetic() -> None:
+    from ertools.benchmarks.trajectory import yaw_tf
+
+    rng = np.random.default_rng(3)
+    q = rng.normal(size=(2000, 4)) * rng.uniform(0.5, 2.0, (2000, 1))  # any norm, any pitch
+    special = np.array(
+        [
+            [0.0, 0.0, 0.0, 0.0],  # tf: identity, yaw 0
+            [0.0, math.sqrt(0.5), 0.0, math.sqrt(0.5)],  # pitch +90 degrees: tf gives yaw 0
+            [0.0, 0.0, 1.0, 1e-17],  # yaw pi
+            [0.0, 0.0, -1.0, 1e-17],  # yaw -pi
+        ]
+    )
+    q = np.vstack([q, special])
+    ours = yaw_tf(q)
+    want = [tf_yaw(row.tolist()) for row in q]
+    assert ours == pytest.approx(want, abs=1e-12, rel=0)
