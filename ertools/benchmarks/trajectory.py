@@ -586,6 +586,7 @@ class TrajectoryResult:
                 "t": ns_to_s(int(t)),
                 "t_rel_s": (int(t) - t0) / NS_PER_S,
                 "status": STATUS_NAMES[int(s)],
+                "in_gt_gap": bool(g_),
                 "robot_x": float(r[0]),
                 "robot_y": float(r[1]),
                 "robot_z": float(r[2]),
@@ -597,9 +598,10 @@ class TrajectoryResult:
                 "position_error": _f(e),
                 "yaw_error": _f(ye),
             }
-            for t, s, r, ry, g, gy, e, ye in zip(
+            for t, s, g_, r, ry, g, gy, e, ye in zip(
                 mt.t_ns.tolist(),
                 mt.status.tolist(),
+                mt.across_gap.tolist(),
                 self.robot.xyz,
                 ryaw.tolist(),
                 mt.gt_xyz,
@@ -624,6 +626,8 @@ class TrajectoryResult:
                 "uncovered",
                 "association",
                 "offset",
+                "orientation_error_2015",
+                "gaps_compared",
             )
         }
         summary["estimated_offset"] = d["clock_audit"]["estimated_offset"]

@@ -156,7 +156,11 @@ def test_robot_poses_in_a_gt_gap_are_compared_with_the_held_pose() -> None:
     ours, node = _both(robot, gt)
     assert_same(ours, node)
     assert node.gap_compared == 3 and ours["gaps_compared"] == 3  # 250, 400 and 790 ms
-    matched = _run(robot, gt).matched
+    result = _run(robot, gt)
+    matched = result.matched
+    rows = result.tables()["samples"]
+    assert [r["in_gt_gap"] for r in rows] == [False, True, True, True, False]
+    assert {r["status"] for r in rows} == {"compared"}
     held = np.asarray(gt[24][1])  # the last GT pose before the hole
     assert np.array_equal(matched.gt_xyz[1:4], np.tile(held, (3, 1)))
     assert matched.position_error[1:4] == pytest.approx([math.dist((0.0, 0.0, 0.1), held)] * 3)
