@@ -5,6 +5,8 @@ marker set (``/rockin/<team>/marker_pose``) with the mocap pose of that marker s
 robot pose it took the GT pose pair (p1, p2) with p1.t <= t <= p2.t, skipped the robot pose when
 p1 and p2 had the same position (Motive repeats the last pose when tracking is lost), compared
 with p1 ("hold") and reported the mean 3D distance and atan2(sum sin|dyaw|, sum cos|dyaw|).
+Where ertools' default differs, one option restores each 2015 behaviour (the ``RULE_*``
+constants) and :meth:`TrajectoryConfig.of_2015` (``--2015``) all of them at once.
 
 Shape: load (robot stream, GT files selected by time overlap, read as one stream) -> associate
 (hold | nearest | linear, max-gap, tracking lost, coverage) -> metrics -> frozen
@@ -15,10 +17,11 @@ time. :func:`score_streams` is pure; :func:`score` is the IO edge.
 from __future__ import annotations
 
 import logging
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from itertools import pairwise
 from pathlib import Path
+from types import MappingProxyType
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
@@ -128,13 +131,11 @@ class TrajectoryConfig:
         return cls(**{**SETTINGS_2015, **overrides})
 
 
-# What ``--2015`` selects: each is one option on its own (docs/trajectory.md, RULES_2015).
-SETTINGS_2015: dict[str, Any] = {
-    "association": "hold",
-    "ties": "before",
-    "gaps": "compare",
-    "before_gt": "first",
-}
+# What ``--2015`` selects: each is one option on its own (docs/trajectory.md, the RULE_*
+# constants below). Read-only: the CLI and of_2015 copy it.
+SETTINGS_2015: Mapping[str, str] = MappingProxyType(
+    {"association": "hold", "ties": "before", "gaps": "compare", "before_gt": "first"}
+)
 
 # The rules of the 2015 script where ertools' default differs (docs/fidelity.md). The 2015
 # script is rockin_trajectory_benchmark.py of rockin_offline_trajectory_benchmark (seed
