@@ -105,8 +105,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=_positive,
         default=0.1,
         metavar="S",
-        help="do not compare robot poses whose surrounding GT poses are further apart "
-        "(default 0.1 s)",
+        help="a robot pose whose surrounding GT poses are further apart is in a GT gap "
+        "(default 0.1 s; see --gaps)",
     )
     parser.add_argument(
         "--offset",
