@@ -1,5 +1,5 @@
 """``ertools export``: any pose source, or the robot/GT pair of the trajectory benchmark, as files
-other tools read (TUM and KITTI for evo, CSV for Foxglove, pandas and spreadsheets).
+other tools read (TUM and KITTI for evo, CSV for pandas, spreadsheets and plotting tools).
 
 Two library functions, one per mode of the command:
 

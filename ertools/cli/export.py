@@ -1,4 +1,4 @@
-"""Write poses as TUM, KITTI or CSV for evo, Foxglove and other tools.
+"""Write poses as TUM, KITTI or CSV for evo, pandas and other tools.
 
 One source: a pose topic (--topic) or a tf frame (--tf PARENT:CHILD) of BAG... to -o FILE
 (stdout without -o). The pair: with --out-dir, the first BAG is the robot log and the rest are

@@ -1,4 +1,4 @@
-"""Pose streams as text for other tools: TUM, KITTI and CSV (evo, Foxglove, spreadsheets).
+"""Pose streams as text for other tools: TUM, KITTI and CSV (evo, pandas, spreadsheets).
 
 The ``format_*`` functions are pure (a :class:`PoseStream` in, text out); :func:`write_poses`
 is the thin file writer. Every number is written so that reading it back gives the same
@@ -126,7 +126,7 @@ def format_csv(stream: PoseStream) -> str:
     """CSV with a header: ``t_ns, t_s, x, y, z, qx, qy, qz, qw, frame_id``.
 
     ``t_ns`` is the exact int64 stamp, ``t_s`` the same in seconds (9 decimals) for tools
-    that want seconds (Foxglove's CSV import, spreadsheets, pandas ``read_csv``).
+    that want seconds (spreadsheets, plotting tools, pandas ``read_csv``).
     """
     n = len(stream)
     cols = [list(map(str, stream.t_ns.tolist())), seconds_text(stream.t_ns)]
