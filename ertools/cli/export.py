@@ -160,6 +160,8 @@ def _run_one(args: argparse.Namespace) -> int:
         raise UsageError("--times needs -o FILE (the poses and their times go to two files)")
     outputs = [p for p in (args.output, args.times) if p is not None]
     refuse_inputs(outputs, list(args.bags))
+    if args.tf is not None and args.time_source != "header":
+        raise UsageError("--time-source record is for --topic; tf poses carry their own stamps")
     if args.tf is not None:
         parent, child = args.tf
         source = PoseSource(topic=None, frame=child, parent=parent)

@@ -81,6 +81,7 @@ def test_refuses_to_overwrite_an_input(tmp_path: Path, capsys: pytest.CaptureFix
         ([str(GT_BAG)], "give --topic TOPIC or --tf PARENT:CHILD"),
         ([str(GT_BAG), "--topic", GT_TOPIC, "--tf", "world:a"], "not allowed with"),
         ([str(GT_BAG), "--tf", "world"], "PARENT:CHILD"),
+        ([str(GT_BAG), "--tf", "world:a", "--time-source", "record"], "is for --topic"),
         ([str(GT_BAG), "--topic", GT_TOPIC, "--times", "t.txt"], "--times is for --format kitti"),
         ([str(GT_BAG), "--topic", GT_TOPIC, "--format", "kitti", "--times", "t.txt"], "needs -o"),
         ([str(GT_BAG), "--topic", GT_TOPIC, "--matched"], "--matched: pair options"),
