@@ -9,6 +9,7 @@ nanoseconds.
 
 from __future__ import annotations
 
+import math
 from decimal import Decimal
 from pathlib import Path
 
@@ -20,7 +21,13 @@ from hypothesis import strategies as st
 
 from ertools.cli.main import main
 from ertools.errors import BagError
-from ertools.io.export import format_csv, format_tum, rotation_matrices, seconds_text
+from ertools.io.export import (
+    format_csv,
+    format_tum,
+    rotation_matrices,
+    seconds_text,
+    write_poses,
+)
 from ertools.streams import PoseStream
 
 POSE = "/fbm3w/robot_at_work/pose"
@@ -198,3 +205,20 @@ def test_kitti_refuses_a_zero_quaternion() -> None:
         BagError, match=r"2 pose\(s\) have a zero or NaN quaternion \(first at index 1\)"
     ):
         rotation_matrices(q, "x.bag:/pose")
+
+
+def test_write_poses_creates_the_folder(tmp_path: Path) -> None:
+    s = PoseStream(
+        np.array([1_448_020_800_000_000_001, 1_448_020_800_008_333_334], np.int64),
+        np.array([[1.0, 2.0, 3.0], [0.1, 0.2, 0.3]]),
+        np.array([[0, 0, 0, 1.0], [0, 0, math.sin(0.5), math.cos(0.5)]]),
+        "world",
+    )
+    out = write_poses(s, tmp_path / "a" / "b.tum", "tum")
+    assert out.read_text() == (
+        "1448020800.000000001 1.0 2.0 3.0 0.0 0.0 0.0 1.0\n"
+        f"1448020800.008333334 0.1 0.2 0.3 0.0 0.0 {math.sin(0.5)!r} {math.cos(0.5)!r}\n"
+    )
+    with pytest.raises(ValueError, match="unknown export format 'g2o'"):
+        write_poses(s, tmp_path / "c.g2o", "g2o")  # type: ignore[arg-type]
+    assert not (tmp_path / "c.g2o").exists()
