@@ -247,6 +247,18 @@ BAG_COMMANDS: dict[str, tuple[Argv, str]] = {
         "fbm1h",
     ),
     "audit": (lambda i, b, d: ["audit", str(b)], "fbm2h"),
+    "export": (
+        lambda i, b, d: ["export", str(b), "--topic", "/fbm3w/robot_at_work/pose", "-o", str(d)],
+        "fbm3w",
+    ),
+    "export-pair-robot": (
+        lambda i, b, d: ["export", str(b), *_gt(i), "--out-dir", str(d)],
+        "robot",
+    ),
+    "export-pair-gt": (
+        lambda i, b, d: ["export", str(i.robot), str(b), "--out-dir", str(d), "--matched"],
+        "gt",
+    ),
 }
 
 
@@ -1044,6 +1056,7 @@ USAGE_COMMANDS = [
     ["acquire", "no_such_member"],
     ["audit"],
     ["report", "x.json"],  # --out is required
+    ["export"],
     ["record"],
     ["monitor"],
     ["clock"],
@@ -1092,6 +1105,10 @@ OUTPUT_IS_INPUT: dict[str, Callable[[Inputs], tuple[list[str], Path]]] = {
         i.items,
     ),
     "audit -o BAG": lambda i: (["audit", str(i.fbm2h), "-o", str(i.fbm2h)], i.fbm2h),
+    "export -o BAG": lambda i: (
+        ["export", str(i.fbm3w), "--topic", "/fbm3w/robot_at_work/pose", "-o", str(i.fbm3w)],
+        i.fbm3w,
+    ),
 }
 
 
