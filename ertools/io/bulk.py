@@ -327,7 +327,7 @@ def _sqlite_runs(
 
 
 def _scanned_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None) -> Located:
-    """Messages of a file read by a scan (an unfinished MCAP), joined into one buffer per
+    """Messages of a file read by a scan (an MCAP its indexes do not cover), joined into one buffer per
     batch of messages so the same decoders apply."""
     records = list(bag.raw(conns, lo, hi))
 
@@ -358,7 +358,7 @@ def locate(
         return _ros1_runs(bag, conns, start_ns, end_ns)
     if bag.format == "rosbag2-sqlite3":
         return _sqlite_runs(bag, conns, start_ns, end_ns)
-    if getattr(bag, "unfinished", False):
+    if getattr(bag, "scanned", False):
         return _scanned_runs(bag, conns, start_ns, end_ns)
     if bag.format in ("mcap", "rosbag2-mcap"):
         return _mcap_runs(bag, conns, start_ns, end_ns)
