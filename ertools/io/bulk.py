@@ -327,8 +327,8 @@ def _sqlite_runs(
 
 
 def _scanned_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None) -> Located:
-    """Messages of a file read by a scan (an MCAP its indexes do not cover), joined into one buffer per
-    batch of messages so the same decoders apply."""
+    """Messages of a file read by a scan (an MCAP its indexes do not cover), joined into one
+    buffer per batch of messages so the same decoders apply."""
     records = list(bag.raw(conns, lo, hi))
 
     def runs() -> Iterator[Run]:

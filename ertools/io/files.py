@@ -189,10 +189,11 @@ class McapFile(BagFile):
         self.scanned = False
         self._scanned: list[tuple[int, int, int, bytes]] = []  # log time, position, channel, data
         self._f = path.open("rb")
+        unreadable: tuple[type[BaseException], ...] = (BagError, *_mcap_errors())
         try:
             layout = mcap_layout(path)
             self._reader = make_reader(self._f)
-        except (BagError, *_mcap_errors()) as err:
+        except unreadable as err:
             self._f.close()
             raise BagError(f"unreadable MCAP file ({err})", path=path) from err
         if layout.index == SCAN:

@@ -162,7 +162,7 @@ class McapIndex:
             layout = mcap_layout(path)
             if layout.index == SCAN:
                 raise LayoutMismatchError(f"MCAP file {path.name}: {layout.why}")
-            summary = layout.summary
+            summary: Any = layout.summary
             with path.open("rb") as f:
                 channels = {cid for cid, ch in layout.channels.items() if ch.topic in topics}
                 chunks = summary.chunk_indexes
@@ -374,7 +374,7 @@ def verify_mcap(path: Path) -> None:
             raise BagError(found.problem, path=path)
         return
     with path.open("rb") as f:
-        summary = layout.summary
+        summary: Any = layout.summary
         for chunk in summary.chunk_indexes:
             where = f"in {path} at byte {chunk.chunk_start_offset}"
             f.seek(chunk.chunk_start_offset + 1 + 8 + 8 + 8 + 8)

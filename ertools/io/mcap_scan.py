@@ -53,7 +53,7 @@ _U64 = struct.Struct("<Q")
 MESSAGE_FIXED = 2 + 4 + 8 + 8
 
 
-class _Cut(Exception):
+class _CutError(Exception):
     """A record runs past the end of what holds it (file or chunk)."""
 
 
@@ -101,7 +101,7 @@ def _string(buf: Any, at: int, end: int) -> tuple[str, int]:
     (n,) = _U32.unpack_from(buf, at)
     at += 4
     if at + n > end:
-        raise _Cut
+        raise _CutError
     return bytes(buf[at : at + n]).decode("utf-8"), at + n
 
 
@@ -113,7 +113,7 @@ def _schema(buf: Any, at: int, end: int) -> Any:
     encoding, at = _string(buf, at, end)
     (n,) = _U32.unpack_from(buf, at)
     if at + 4 + n > end:
-        raise _Cut
+        raise _CutError
     return Schema(id=sid, name=name, encoding=encoding, data=bytes(buf[at + 4 : at + 4 + n]))
 
 
@@ -127,7 +127,7 @@ def _channel(buf: Any, at: int, end: int) -> Any:
     at += 4
     stop = at + n
     if stop > end:
-        raise _Cut
+        raise _CutError
     metadata = {}
     while at < stop:
         key, at = _string(buf, at, stop)
@@ -146,15 +146,15 @@ def _walk(buf: Any, pos: int, end: int, sink: _Sink, top: bool) -> int:
     message = _MESSAGE.unpack_from
     while pos < end:
         if pos + 9 > end:
-            raise _Cut
+            raise _CutError
         op, n = head(buf, pos)
-        body = pos + 9
-        stop = body + n
+        body: int = pos + 9
+        stop: int = body + n
         if stop > end or stop < body:
-            raise _Cut
+            raise _CutError
         if op == OP_MESSAGE:
             if n < MESSAGE_FIXED:
-                raise _Cut
+                raise _CutError
             cid, _seq, t = message(buf, body)
             sink.cids.append(cid)
             sink.times.append(t)
@@ -185,7 +185,7 @@ def _chunk(buf: Any, at: int, end: int, sink: _Sink) -> None:
     (nbytes,) = _U64.unpack_from(buf, at + clen)
     at += clen + 8
     if at + nbytes > end or usize > 1000 * max(nbytes, 1) + (1 << 20):
-        raise _Cut
+        raise _CutError
     where = f"in {sink.path} at byte {at}"
     inner = decompress(compression, bytes(buf[at : at + nbytes]), usize, where)
     if len(inner) != usize:
@@ -195,7 +195,7 @@ def _chunk(buf: Any, at: int, end: int, sink: _Sink) -> None:
     sink.compressions.add(compression or "none")
     sink.chunks += 1
     if _walk(inner, 0, len(inner), sink, top=False) != len(inner):
-        raise _Cut
+        raise _CutError
 
 
 def scan_mcap(path: Path, *, keep_data: bool = False, check_crc: bool = False) -> McapRecords:
@@ -228,7 +228,7 @@ def _scan(buf: memoryview, size: int, path: Path, keep_data: bool, check_crc: bo
             problem = f"truncated: no footer record (the records end at byte {stop})"
         elif stop != end or end == size:
             problem = f"bytes after the footer record at byte {stop}"
-    except (_Cut, struct.error, UnicodeDecodeError) as err:
+    except (_CutError, struct.error, UnicodeDecodeError) as err:
         why = "a record runs past the end of the file or of its chunk"
         if isinstance(err, UnicodeDecodeError):
             why = "a name that is not UTF-8"
@@ -318,7 +318,7 @@ def _layout(path: Path) -> McapLayout:
             part = f.read(b - a)
             try:
                 at = _walk_loose(part, sink)
-            except (_Cut, struct.error, UnicodeDecodeError):
+            except (_CutError, struct.error, UnicodeDecodeError):
                 at = -1
             if at != len(part):
                 return _scan_layout(summary, f"records between chunks that do not fit at byte {a}")
@@ -341,9 +341,9 @@ def _walk_loose(part: bytes, sink: _Sink) -> int:
     pos = 0
     while pos < len(part):
         op, n = _HEAD.unpack_from(part, pos)
-        stop = pos + 9 + n
+        stop: int = pos + 9 + n
         if stop > len(part):
-            raise _Cut
+            raise _CutError
         if op == OP_MESSAGE:
             sink.cids.append(0)
             return stop

@@ -20,7 +20,6 @@ per-message record times, for rates.
 from __future__ import annotations
 
 import logging
-import struct
 from collections import defaultdict
 from pathlib import Path
 from typing import Any
@@ -28,7 +27,6 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.errors import BagError
 from ertools.io.formats import detect_format
 from ertools.io.model import BagSummary, TopicSummary, short_msgtype
 
@@ -268,9 +266,7 @@ def _mcap(path: Path, exact: bool, times: Times | None = None) -> BagSummary:
     topics, compressions, problems, index = _mcap_file(path, exact, times)
     compression = "/".join(sorted(compressions)) or "none"
     indexed = index != "scan"
-    return _build(
-        path, "mcap", _mcap_version(path), compression, indexed, topics, problems, index
-    )
+    return _build(path, "mcap", _mcap_version(path), compression, indexed, topics, problems, index)
 
 
 def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagSummary:
