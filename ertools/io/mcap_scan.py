@@ -320,11 +320,15 @@ def _layout(path: Path) -> McapLayout:
                 at = _walk_loose(part, sink)
             except (_CutError, struct.error, UnicodeDecodeError):
                 at = -1
+            if sink.cids or sink.chunks:
+                what = (
+                    "chunks the summary does not index"
+                    if sink.chunks
+                    else "messages outside chunks"
+                )
+                return _scan_layout(summary, what)
             if at != len(part):
                 return _scan_layout(summary, f"records between chunks that do not fit at byte {a}")
-            if sink.cids or sink.chunks:
-                where = "chunks the summary does not index" if sink.chunks else "chunks"
-                return _scan_layout(summary, f"messages outside {where}")
     channels = {**sink.channels, **summary.channels}
     schemas = {**sink.schemas, **summary.schemas}
     indexed = {cid for c in chunks for cid in c.message_index_offsets}

@@ -142,7 +142,8 @@ def test_api_summary_and_messages(path: Path | None) -> None:
             assert (s.start_ns, s.end_ns) == (want.first, want.last)
     for t in eio.summary(path, exact=True).topics:
         if t.count:
-            assert (t.first_ns, t.last_ns) == (want.per_topic[t.name][0], want.per_topic[t.name][-1])
+            mine = want.per_topic[t.name]
+            assert (t.first_ns, t.last_ns) == (mine[0], mine[-1])
     times = record_times(path)
     assert {k: v.tolist() for k, v in times.items() if len(v)} == want.per_topic
     # the message read: every message of every channel, in log-time order
