@@ -6,7 +6,8 @@ expected messages (count, per-topic counts, first and last log time, per-topic l
 computed here from those records alone and must come out exactly, with exit status 0: every
 file is a valid, complete MCAP file in one of the layouts the specification allows.
 
-Without ``../shared`` the tests skip and say why; in CI (``CI`` set) they fail instead.
+The suite is looked for in ``../shared/mcap_conformance`` (or ``$ERTOOLS_MCAP_CONFORMANCE``).
+Without it the tests skip and say why; in CI (``CI`` set) they fail instead.
 """
 
 from __future__ import annotations
@@ -25,7 +26,10 @@ from ertools.cli.main import main
 from ertools.io.files import open_bag
 from ertools.io.summary import record_times
 
-SUITE = Path(__file__).resolve().parents[2].parent / "shared" / "mcap_conformance"
+SUITE = Path(
+    os.environ.get("ERTOOLS_MCAP_CONFORMANCE")
+    or Path(__file__).resolve().parents[2].parent / "shared" / "mcap_conformance"
+)
 FILES = sorted(SUITE.glob("*/*.mcap")) if SUITE.is_dir() else []
 # The suite as copied from foxglove/mcap tests/conformance/data (see its README).
 SUITE_SIZE = 416
