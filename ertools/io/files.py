@@ -27,6 +27,8 @@ from ertools.io.model import Conn, short_msgtype
 log = logging.getLogger("ertools.io.files")
 
 RawRecord = tuple[Conn, int, bytes]
+# (reference positions, bytes, data starts, data lengths, log times, channel ids)
+ScannedRun = tuple[Any, Any, Any, Any, Any, Any]
 
 
 class BagFile(AbstractContextManager["BagFile"]):
@@ -187,7 +189,6 @@ class McapFile(BagFile):
         self.format = "mcap"
         self.unfinished = False
         self.scanned = False
-        self._scanned: list[tuple[int, int, int, bytes]] = []  # log time, position, channel, data
         self._f = path.open("rb")
         unreadable: tuple[type[BaseException], ...] = (BagError, *_mcap_errors())
         try:
@@ -211,7 +212,7 @@ class McapFile(BagFile):
         self.scanned = True
         log.info("%s: %s; reading the file record by record", self.path, why)
         try:
-            found = scan_mcap(self.path, keep_data=True)
+            found = scan_mcap(self.path)
         except BagError:
             self._f.close()
             raise
@@ -234,13 +235,47 @@ class McapFile(BagFile):
                 found.problem,
                 len(found.log_time),
             )
-        # the reference order: log time, then position in the file
-        order = np.lexsort((np.arange(len(found.log_time)), found.log_time))
-        cids, times = found.channel_id, found.log_time
-        self._scanned = [
-            (int(times[i]), i, int(cids[i]), found.payloads[i]) for i in order.tolist()
-        ]
         return tuple(conns[c] for c in sorted(conns))
+
+    def scanned_runs(
+        self, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
+    ) -> Iterator[ScannedRun]:
+        """The messages of ``conns`` in [start_ns, end_ns] of a file read record by record, as
+        runs of (reference positions, bytes, data starts, data lengths, log times, channel
+        ids): one more pass over the records that copies only these messages' bytes."""
+        from ertools.io.mcap_scan import scan_mcap
+
+        found = scan_mcap(self.path, keep=frozenset(c.id for c in conns))
+        if not found.payloads:
+            return
+        ordinal = np.concatenate([r[3] for r in found.payloads])
+        t = found.log_time[ordinal]
+        inside = np.ones(len(t), dtype=bool)
+        if start_ns is not None:
+            inside &= t >= start_ns
+        if end_ns is not None:
+            inside &= t <= end_ns
+        # the reference order: log time, then position in the file
+        order = np.lexsort((ordinal[inside], t[inside]))
+        rank = np.empty(len(order), dtype=np.int64)
+        rank[order] = np.arange(len(order), dtype=np.int64)
+        done = kept = 0
+        for buf, start, length, ords in found.payloads:
+            mine = inside[done : done + len(ords)]
+            n = int(mine.sum())
+            if n:
+                o = ords[mine]
+                cid = found.channel_id[o]
+                yield (
+                    rank[kept : kept + n],
+                    buf,
+                    start[mine],
+                    length[mine],
+                    t[done : done + len(ords)][mine],
+                    cid,
+                )
+            done += len(ords)
+            kept += n
 
     def raw(
         self, conns: Sequence[Conn], start_ns: int | None = None, end_ns: int | None = None
@@ -249,12 +284,17 @@ class McapFile(BagFile):
         if not by_id:
             return
         if self.scanned:
-            for t, _i, cid, data in self._scanned:
-                conn = by_id.get(cid)
-                if conn is None:
-                    continue
-                if (start_ns is None or t >= start_ns) and (end_ns is None or t <= end_ns):
-                    yield conn, int(t), data
+            runs = list(self.scanned_runs(conns, start_ns, end_ns))
+            if not runs:
+                return
+            rank = np.concatenate([r[0] for r in runs])
+            which = np.concatenate([np.full(len(r[0]), k) for k, r in enumerate(runs)])
+            row = np.concatenate([np.arange(len(r[0])) for r in runs])
+            order = np.argsort(rank)
+            for k, i in zip(which[order].tolist(), row[order].tolist(), strict=True):
+                _rank, buf, start, length, t, cid = runs[k]
+                a = int(start[i])
+                yield by_id[int(cid[i])], int(t[i]), buf[a : a + int(length[i])].tobytes()
             return
         topics = sorted({c.topic for c in conns})
         try:

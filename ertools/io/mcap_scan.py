@@ -13,6 +13,7 @@ is exact for any layout the specification allows and for files cut short.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import mmap
 import os
@@ -26,10 +27,12 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.errors import BagError
+from ertools.io.fastdecode import read_at
 
 log = logging.getLogger("ertools.io.mcap_scan")
 
 I64 = npt.NDArray[np.int64]
+U8 = npt.NDArray[np.uint8]
 
 MAGIC = b"\x89MCAP0\r\n"
 OP_FOOTER = 0x02
@@ -57,6 +60,10 @@ class _CutError(Exception):
     """A record runs past the end of what holds it (file or chunk)."""
 
 
+# One run of kept message payloads: (bytes, data starts, data lengths, message ordinals).
+PayloadRun = tuple[U8, I64, I64, I64]
+
+
 @dataclass(frozen=True, eq=False)
 class McapRecords:
     """What a record-by-record read of an MCAP file found.
@@ -66,7 +73,8 @@ class McapRecords:
         channels: channel id -> ``mcap.records.Channel``.
         channel_id: channel of every message, in file order (int64).
         log_time: log time of every message, in file order (int64 ns).
-        payloads: every message's data in file order, when asked for (else empty).
+        payloads: the data of the messages of the channels asked for, as runs of
+            (bytes, starts, lengths, ordinals into ``channel_id``), in file order.
         compressions: chunk compressions met (``none`` for uncompressed chunks).
         complete: the file ends with its footer and magic.
         problem: why the read stopped early ("" when it read to the end).
@@ -76,7 +84,7 @@ class McapRecords:
     channels: dict[int, Any]
     channel_id: I64
     log_time: I64
-    payloads: list[bytes]
+    payloads: list[PayloadRun]
     compressions: frozenset[str]
     complete: bool
     problem: str
@@ -84,17 +92,40 @@ class McapRecords:
 
 @dataclass
 class _Sink:
-    keep_data: bool
+    keep: frozenset[int]
     check_crc: bool
     path: Path
     schemas: dict[int, Any] = field(default_factory=dict)
     channels: dict[int, Any] = field(default_factory=dict)
-    cids: list[int] = field(default_factory=list)
-    times: list[int] = field(default_factory=list)
-    payloads: list[bytes] = field(default_factory=list)
+    cids: list[I64] = field(default_factory=list)
+    times: list[I64] = field(default_factory=list)
+    count: int = 0
+    payloads: list[PayloadRun] = field(default_factory=list)
     compressions: set[str] = field(default_factory=set)
     footer: bool = False
     chunks: int = 0
+
+    def messages(self, buf: U8, at: I64) -> None:
+        """Message records starting at ``at`` (vectorised)."""
+        if not len(at):
+            return
+        length = read_at(buf, at + 1, np.dtype("<u8")).astype(np.int64)
+        if int(length.min()) < MESSAGE_FIXED:
+            raise _CutError
+        cids = read_at(buf, at + 9, np.dtype("<u2")).astype(np.int64)
+        self.cids.append(cids)
+        self.times.append(read_at(buf, at + 15, np.dtype("<u8")).astype(np.int64))
+        if self.keep:
+            mine = np.flatnonzero(np.isin(cids, list(self.keep)))
+            if len(mine):
+                start = at[mine] + 9 + MESSAGE_FIXED
+                size = length[mine] - MESSAGE_FIXED
+                # only the kept bytes are copied, not the chunk or window around them
+                base = np.zeros(len(mine), dtype=np.int64)
+                np.cumsum(size[:-1], out=base[1:])
+                idx = np.repeat(start - base, size) + np.arange(int(size.sum()), dtype=np.int64)
+                self.payloads.append((buf[idx], base, size, mine + self.count))
+        self.count += len(at)
 
 
 def _string(buf: Any, at: int, end: int) -> tuple[str, int]:
@@ -136,15 +167,83 @@ def _channel(buf: Any, at: int, end: int) -> Any:
     return Channel(id=cid, schema_id=sid, topic=topic, message_encoding=encoding, metadata=metadata)
 
 
+# Bytes searched for record starts at a time: bounded memory for the candidate arrays.
+WINDOW = 4 << 20
+# Message records read one by one in a row before the rest of the stretch is read in bulk:
+# a few big records (chunks between their message indexes) are cheaper one at a time.
+RUN_TO_BULK = 16
+
+
+def _chain(buf: U8, pos: int, stop: int, end: int) -> tuple[I64, int]:
+    """Starts of the records that follow each other from ``pos`` (a record start) within
+    ``buf[pos:stop]``, and where the chain leaves that stretch; vectorised.
+
+    Candidates are the bytes holding a known opcode (0x01-0x0F) followed by a length under
+    1 TiB that stays inside ``end``; each points at the candidate after it. The true records
+    are those reached from ``pos``, listed with pointer doubling (tables of 2^k-th
+    successors): O(n log n) NumPy work for n candidates, not a Python step per record. The
+    chain ends at a record of an unknown opcode, which the caller steps over.
+    """
+    last = min(stop, end - 9 + 1)
+    if last <= pos + 1:
+        return np.empty(0, np.int64), pos
+    head = buf[pos:last]
+    mask = np.less(head - np.uint8(1), np.uint8(0x0F))
+    for k in (6, 7, 8):  # the three high bytes of the little-endian length
+        mask &= buf[pos + k : last + k] == 0
+    cand = pos + np.flatnonzero(mask)
+    if not len(cand) or cand[0] != pos:
+        return np.empty(0, np.int64), pos
+    nxt = cand + 9 + read_at(buf, cand + 1, np.dtype("<u8")).astype(np.int64)
+    ok = nxt <= end
+    if not ok[0]:
+        return np.empty(0, np.int64), pos
+    cand, nxt = cand[ok], nxt[ok]
+    n = len(cand)
+    at = np.searchsorted(cand, nxt)
+    hit = at < n
+    hit[hit] = cand[at[hit]] == nxt[hit]
+    jumps = [np.append(np.where(hit & (nxt < stop), at, n), n)]
+    while (1 << len(jumps)) <= n:
+        j = jumps[-1]
+        jumps.append(j[j])
+    # the k-th record after the first, for k < 2^(b+1), from those for k < 2^b: one gather
+    # per level, O(n) in all
+    path = np.zeros(1, dtype=np.int64)
+    for j in jumps:
+        if path[-1] == n:
+            break
+        path = np.concatenate([path, j[path]])
+    found = path[: int(np.searchsorted(path, n))]
+    return cand[found], int(nxt[found[-1]])
+
+
 def _walk(buf: Any, pos: int, end: int, sink: _Sink, top: bool) -> int:
     """Read the records in ``buf[pos:end]``, chunks included; returns where it stopped.
 
-    A Python step per record: this is the path for layouts the indexes cannot answer, not
-    for the usual chunked-and-indexed files.
+    Records are read one at a time until messages come in a row; then the rest of the
+    stretch (up to ``WINDOW`` bytes) is read in bulk from the chain of record starts, its
+    messages as arrays and its few other records (schemas, channels, chunks) one by one.
     """
     head = _HEAD.unpack_from
-    message = _MESSAGE.unpack_from
+    run = 0
     while pos < end:
+        if run >= RUN_TO_BULK:
+            starts, after = _chain(buf, pos, min(end, pos + WINDOW), end)
+            if len(starts) > 1:
+                ops = buf[starts]
+                other = np.flatnonzero(ops != OP_MESSAGE)
+                done = 0
+                for i in other.tolist():
+                    sink.messages(buf, starts[done:i])
+                    done = i + 1
+                    rec_end = int(starts[i + 1]) if i + 1 < len(starts) else after
+                    if _record(buf, int(ops[i]), int(starts[i]) + 9, rec_end, sink, top):
+                        return rec_end
+                sink.messages(buf, starts[done:])
+                pos = after
+                continue
+            run = 0
         if pos + 9 > end:
             raise _CutError
         op, n = head(buf, pos)
@@ -153,27 +252,31 @@ def _walk(buf: Any, pos: int, end: int, sink: _Sink, top: bool) -> int:
         if stop > end or stop < body:
             raise _CutError
         if op == OP_MESSAGE:
-            if n < MESSAGE_FIXED:
-                raise _CutError
-            cid, _seq, t = message(buf, body)
-            sink.cids.append(cid)
-            sink.times.append(t)
-            if sink.keep_data:
-                sink.payloads.append(bytes(buf[body + MESSAGE_FIXED : stop]))
-        elif op == OP_CHANNEL:
-            ch = _channel(buf, body, stop)
-            sink.channels.setdefault(ch.id, ch)
-        elif op == OP_SCHEMA:
-            sc = _schema(buf, body, stop)
-            if sc.id:
-                sink.schemas.setdefault(sc.id, sc)
-        elif op == OP_CHUNK:
-            _chunk(buf, body, stop, sink)
-        elif op == OP_FOOTER and top:
-            sink.footer = True
-            return stop
+            sink.messages(buf, np.array([pos], dtype=np.int64))
+            run += 1
+        else:
+            run = 0
+            if _record(buf, op, body, stop, sink, top):
+                return stop
         pos = stop
     return pos
+
+
+def _record(buf: Any, op: int, body: int, stop: int, sink: _Sink, top: bool) -> bool:
+    """One record other than a message; True when it is the footer (the end of the file)."""
+    if op == OP_CHANNEL:
+        ch = _channel(buf, body, stop)
+        sink.channels.setdefault(ch.id, ch)
+    elif op == OP_SCHEMA:
+        sc = _schema(buf, body, stop)
+        if sc.id:
+            sink.schemas.setdefault(sc.id, sc)
+    elif op == OP_CHUNK:
+        _chunk(buf, body, stop, sink)
+    elif op == OP_FOOTER and top:
+        sink.footer = True
+        return True
+    return False
 
 
 def _chunk(buf: Any, at: int, end: int, sink: _Sink) -> None:
@@ -187,18 +290,23 @@ def _chunk(buf: Any, at: int, end: int, sink: _Sink) -> None:
     if at + nbytes > end or usize > 1000 * max(nbytes, 1) + (1 << 20):
         raise _CutError
     where = f"in {sink.path} at byte {at}"
-    inner = decompress(compression, bytes(buf[at : at + nbytes]), usize, where)
+    stored = buf[at : at + nbytes]
+    # an uncompressed chunk is read in place (no copy); the decompressors take any buffer
+    inner = stored if compression == "" else decompress(compression, stored, usize, where)
     if len(inner) != usize:
         raise BagError(f"chunk decompresses to {len(inner)} bytes, not {usize}, {where}")
     if sink.check_crc and crc and zlib.crc32(inner) != crc:
         raise BagError(f"corrupt MCAP chunk {where}: CRC mismatch")
     sink.compressions.add(compression or "none")
     sink.chunks += 1
-    if _walk(inner, 0, len(inner), sink, top=False) != len(inner):
+    records = np.frombuffer(inner, dtype=np.uint8)
+    if _walk(records, 0, len(records), sink, top=False) != len(records):
         raise _CutError
 
 
-def scan_mcap(path: Path, *, keep_data: bool = False, check_crc: bool = False) -> McapRecords:
+def scan_mcap(
+    path: Path, *, keep: frozenset[int] = frozenset(), check_crc: bool = False
+) -> McapRecords:
     """Every record of an MCAP file in turn, chunks decompressed, as far as they are whole.
 
     Raises:
@@ -208,19 +316,22 @@ def scan_mcap(path: Path, *, keep_data: bool = False, check_crc: bool = False) -
         size = os.fstat(f.fileno()).st_size
         if size < len(MAGIC):
             raise BagError("truncated: the file ends inside its magic", path=path)
-        with mmap.mmap(f.fileno(), size, access=mmap.ACCESS_READ) as mm:
-            buf = memoryview(mm)
-            try:
-                return _scan(buf, size, path, keep_data, check_crc)
-            finally:
-                buf.release()
+        mm = mmap.mmap(f.fileno(), size, access=mmap.ACCESS_READ)
+    try:
+        return _scan(np.frombuffer(mm, dtype=np.uint8), path, keep, check_crc)
+    finally:
+        # everything handed out is a copy; a view still alive (an exception's frames) keeps
+        # the map until it goes
+        with contextlib.suppress(BufferError):
+            mm.close()
 
 
-def _scan(buf: memoryview, size: int, path: Path, keep_data: bool, check_crc: bool) -> McapRecords:
-    if bytes(buf[: len(MAGIC)]) != MAGIC:
+def _scan(buf: U8, path: Path, keep: frozenset[int], check_crc: bool) -> McapRecords:
+    size = len(buf)
+    if buf[: len(MAGIC)].tobytes() != MAGIC:
         raise BagError("no MCAP magic at the start", path=path)
-    sink = _Sink(keep_data, check_crc, path)
-    end = size - len(MAGIC) if bytes(buf[size - len(MAGIC) :]) == MAGIC else size
+    sink = _Sink(keep, check_crc, path)
+    end = size - len(MAGIC) if buf[size - len(MAGIC) :].tobytes() == MAGIC else size
     problem = ""
     try:
         stop = _walk(buf, len(MAGIC), end, sink, top=True)
@@ -232,13 +343,13 @@ def _scan(buf: memoryview, size: int, path: Path, keep_data: bool, check_crc: bo
         why = "a record runs past the end of the file or of its chunk"
         if isinstance(err, UnicodeDecodeError):
             why = "a name that is not UTF-8"
-        done = len(sink.times)
-        problem = f"truncated or damaged after {done} whole messages ({why})"
+        problem = f"truncated or damaged after {sink.count} whole messages ({why})"
+    e = np.empty(0, np.int64)
     return McapRecords(
         sink.schemas,
         sink.channels,
-        np.asarray(sink.cids, dtype=np.int64),
-        np.asarray(sink.times, dtype=np.uint64).astype(np.int64),
+        np.concatenate(sink.cids) if sink.cids else e,
+        np.concatenate(sink.times) if sink.times else e,
         sink.payloads,
         frozenset(sink.compressions),
         sink.footer and not problem,
@@ -312,7 +423,7 @@ def _layout(path: Path) -> McapLayout:
         gaps = _gaps(chunks, data_end)
         if gaps is None:
             return _scan_layout(summary, "chunk indexes that overlap or point outside the data")
-        sink = _Sink(False, False, path)
+        sink = _Sink(frozenset(), False, path)
         for a, b in gaps:
             f.seek(a)
             part = f.read(b - a)
@@ -320,7 +431,7 @@ def _layout(path: Path) -> McapLayout:
                 at = _walk_loose(part, sink)
             except (_CutError, struct.error, UnicodeDecodeError):
                 at = -1
-            if sink.cids or sink.chunks:
+            if sink.count or sink.chunks:
                 what = (
                     "chunks the summary does not index"
                     if sink.chunks
@@ -349,13 +460,13 @@ def _walk_loose(part: bytes, sink: _Sink) -> int:
         if stop > len(part):
             raise _CutError
         if op == OP_MESSAGE:
-            sink.cids.append(0)
+            sink.count += 1
             return stop
         if op == OP_CHUNK:
             sink.chunks += 1
             return stop
         if op in (OP_SCHEMA, OP_CHANNEL):
-            _walk(part, pos, stop, sink, top=False)
+            _walk(np.frombuffer(part, dtype=np.uint8), pos, stop, sink, top=False)
         pos = stop
     return pos
 
