@@ -62,7 +62,7 @@ class BagSummary:
         problems: what is wrong with the file (unindexed, truncated...), one line each.
         index: which of the file's indexes answered (MCAP: ``summary+message-indexes``,
             ``summary`` or ``scan``; ROS1: ``index-records`` or ``scan``; rosbag2:
-            ``metadata.yaml``).
+            ``metadata.yaml``, plus what its MCAP files used).
     """
 
     path: str

@@ -280,9 +280,11 @@ def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> B
         problems.append(f"storage file(s) listed in metadata.yaml missing: {', '.join(missing)}")
     topics: dict[str, tuple[str, int, int | None, int | None, int]] = {}
     inner: set[str] = set()
+    used: set[str] = set()
     if fmt == "rosbag2-mcap" and not missing:
         for file in files:
-            part, chunk_compressions, file_problems, _index = _mcap_file(file, exact, times)
+            part, chunk_compressions, file_problems, file_index = _mcap_file(file, exact, times)
+            used.add(file_index)
             problems.extend(f"{file.name}: {p}" for p in file_problems)
             inner |= chunk_compressions - {"none"}
             for name, (msgtype, count, first, last, _n) in part.items():
@@ -307,7 +309,11 @@ def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> B
         compression += f" ({str(info['compression_mode']).lower()})"
     if inner and compression == "none":
         compression = "/".join(sorted(inner)) + " (mcap chunks)"
-    return _build(path, fmt, str(info.get("version", "")), compression, True, topics, problems)
+    # the MCAP storage files' own indexes (or scans) gave the counts and times
+    index = "+".join(["metadata.yaml", *sorted(used)])
+    return _build(
+        path, fmt, str(info.get("version", "")), compression, True, topics, problems, index
+    )
 
 
 def _sqlite_spans(files: list[Path]) -> dict[str, tuple[int, int]]:
