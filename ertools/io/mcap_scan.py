@@ -425,10 +425,8 @@ def _layout(path: Path) -> McapLayout:
             return _scan_layout(summary, "chunk indexes that overlap or point outside the data")
         sink = _Sink(frozenset(), False, path)
         for a, b in gaps:
-            f.seek(a)
-            part = f.read(b - a)
             try:
-                at = _walk_loose(part, sink)
+                at = _walk_loose(f.fileno(), a, b, sink)
             except (_CutError, struct.error, UnicodeDecodeError):
                 at = -1
             if sink.count or sink.chunks:
@@ -438,7 +436,7 @@ def _layout(path: Path) -> McapLayout:
                     else "messages outside chunks"
                 )
                 return _scan_layout(summary, what)
-            if at != len(part):
+            if at != b:
                 return _scan_layout(summary, f"records between chunks that do not fit at byte {a}")
     channels = {**sink.channels, **summary.channels}
     schemas = {**sink.schemas, **summary.schemas}
@@ -450,14 +448,17 @@ def _layout(path: Path) -> McapLayout:
     return McapLayout(summary, INDEXED, "", channels, schemas)
 
 
-def _walk_loose(part: bytes, sink: _Sink) -> int:
-    """Walk records outside the indexed chunks, stopping at the first message or chunk (the
-    file is then scanned anyway): never decompresses anything."""
-    pos = 0
-    while pos < len(part):
-        op, n = _HEAD.unpack_from(part, pos)
+def _walk_loose(fd: int, pos: int, end: int, sink: _Sink) -> int:
+    """Walk the records in bytes [pos, end) of the file outside the indexed chunks, reading
+    only record headers and the schema and channel records; stops at the first message or
+    chunk (the file is then read record by record anyway). Returns where it stopped."""
+    while pos < end:
+        head = os.pread(fd, 9, pos)
+        if len(head) < 9:
+            raise _CutError
+        op, n = _HEAD.unpack(head)
         stop: int = pos + 9 + n
-        if stop > len(part):
+        if stop > end:
             raise _CutError
         if op == OP_MESSAGE:
             sink.count += 1
@@ -466,7 +467,10 @@ def _walk_loose(part: bytes, sink: _Sink) -> int:
             sink.chunks += 1
             return stop
         if op in (OP_SCHEMA, OP_CHANNEL):
-            _walk(np.frombuffer(part, dtype=np.uint8), pos, stop, sink, top=False)
+            record = np.frombuffer(os.pread(fd, 9 + n, pos), dtype=np.uint8)
+            if len(record) != 9 + n:
+                raise _CutError
+            _walk(record, 0, len(record), sink, top=False)
         pos = stop
     return pos
 
