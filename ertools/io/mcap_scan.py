@@ -307,23 +307,39 @@ def _chunk(buf: Any, at: int, end: int, sink: _Sink) -> None:
 def scan_mcap(
     path: Path, *, keep: frozenset[int] = frozenset(), check_crc: bool = False
 ) -> McapRecords:
-    """Every record of an MCAP file in turn, chunks decompressed, as far as they are whole.
+    """Every record of an MCAP file in turn, chunks decompressed, as far as they are whole;
+    the bytes of the messages of the channels in ``keep`` are copied out.
+
+    A read without ``keep`` is kept for the file's version (device, inode, size, modification
+    time): opening a file, summarising it and listing its channels share one read.
 
     Raises:
         BagError: not an MCAP file (no magic), or a corrupt compressed chunk.
     """
     with path.open("rb") as f:
-        size = os.fstat(f.fileno()).st_size
+        st = os.fstat(f.fileno())
+        key = (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+        if not keep and not check_crc and key in _SCANS:
+            return _SCANS[key]
+        size = st.st_size
         if size < len(MAGIC):
             raise BagError("truncated: the file ends inside its magic", path=path)
         mm = mmap.mmap(f.fileno(), size, access=mmap.ACCESS_READ)
     try:
-        return _scan(np.frombuffer(mm, dtype=np.uint8), path, keep, check_crc)
+        found = _scan(np.frombuffer(mm, dtype=np.uint8), path, keep, check_crc)
     finally:
         # everything handed out is a copy; a view still alive (an exception's frames) keeps
         # the map until it goes
         with contextlib.suppress(BufferError):
             mm.close()
+    if not keep:
+        if len(_SCANS) >= 4:  # 16 bytes a message: a few hour-long files at most
+            _SCANS.clear()
+        _SCANS[key] = found
+    return found
+
+
+_SCANS: dict[tuple[int, int, int, int], McapRecords] = {}
 
 
 def _scan(buf: U8, path: Path, keep: frozenset[int], check_crc: bool) -> McapRecords:
