@@ -156,7 +156,10 @@ def _mcap_errors() -> tuple[type[BaseException], ...]:
 
     from mcap.exceptions import McapError
 
-    # lz4/zstd raise RuntimeError on corrupt chunks; absurd record lengths can MemoryError.
+    # lz4 raises RuntimeError on corrupt chunks, zstandard its ZstdError; absurd record
+    # lengths can MemoryError, or OverflowError where they become slice bounds.
+    from zstandard import ZstdError
+
     return (
         McapError,
         ValueError,
@@ -166,6 +169,8 @@ def _mcap_errors() -> tuple[type[BaseException], ...]:
         KeyError,
         RuntimeError,
         MemoryError,
+        OverflowError,
+        ZstdError,
     )
 
 
@@ -229,10 +234,11 @@ class McapFile(BagFile):
         if found.problem:
             self.unfinished = True
             log.warning(
-                "%s: MCAP file %s (no summary section: recording not finished, or cut "
-                "short?); read the %d complete messages",
+                "%s: MCAP file %s (%s: recording not finished, or cut short?); read the %d "
+                "complete messages",
                 self.path,
                 found.problem,
+                why,
                 len(found.log_time),
             )
         return tuple(conns[c] for c in sorted(conns))

@@ -496,10 +496,14 @@ def _gaps(chunks: list[Any], data_end: int) -> list[tuple[int, int]] | None:
     when the chunk indexes overlap or point past the data section."""
     if data_end == 0:
         return None
-    start = np.array([int(c.chunk_start_offset) for c in chunks], dtype=np.int64)
-    stop = start + np.array(
-        [int(c.chunk_length) + int(c.message_index_length) for c in chunks], dtype=np.int64
-    )
+    spans = [
+        (int(c.chunk_start_offset), int(c.chunk_length), int(c.message_index_length))
+        for c in chunks
+    ]
+    if any(a + b + m > data_end for a, b, m in spans):
+        return None  # (also keeps absurd uint64 values out of int64 arrays)
+    start = np.array([a for a, _b, _m in spans], dtype=np.int64)
+    stop = start + np.array([b + m for _a, b, m in spans], dtype=np.int64)
     order = np.argsort(start, kind="stable")
     start, stop = start[order], stop[order]
     lo = np.concatenate([[len(MAGIC)], stop])
