@@ -424,6 +424,10 @@ def _layout(path: Path) -> McapLayout:
     from ertools.io.mcap_index import read_summary
 
     with path.open("rb") as f:
+        size = os.fstat(f.fileno()).st_size
+        if size < 2 * len(MAGIC) + FOOTER_SIZE or os.pread(f.fileno(), 8, size - 8) != MAGIC:
+            # no footer to find a summary with: a recording not finished, or a copy cut short
+            return _scan_layout(None, "no summary section (the file does not end with its magic)")
         try:
             summary = read_summary(f, path)
         except BagError as err:
@@ -433,7 +437,6 @@ def _layout(path: Path) -> McapLayout:
         chunks = summary.chunk_indexes
         if any(not c.message_index_offsets and c.uncompressed_size for c in chunks):
             return _scan_layout(summary, "chunks without message indexes")
-        size = os.fstat(f.fileno()).st_size
         f.seek(size - len(MAGIC) - FOOTER_SIZE)
         (data_end,) = _U64.unpack_from(f.read(FOOTER_SIZE), 9)
         gaps = _gaps(chunks, data_end)
