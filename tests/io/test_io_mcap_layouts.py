@@ -254,3 +254,29 @@ def test_scan_finds_every_record(
     kept = np.concatenate([r[3] for r in found.payloads])
     assert set(found.channel_id[kept].tolist()) == {1}
     assert len(kept) == int((found.channel_id == 1).sum())
+
+
+def test_verbose_says_why_a_file_is_read_record_by_record(
+    tmp_path: Path, scene: Scene, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = write(tmp_path / "r.mcap", "mcap-cdr", scene.spec, repeat_channels=False)
+    assert main(["info", "-v", str(path)]) == 0
+    err = capsys.readouterr().err
+    assert "channels written only inside chunks; reading the file record by record" in err
+    indexed = write(tmp_path / "i.mcap", "mcap-cdr", scene.spec)
+    assert main(["info", "-v", str(indexed)]) == 0
+    assert "record by record" not in capsys.readouterr().err
+
+
+def test_rosbag2_mcap_storage_without_summary(tmp_path: Path, scene: Scene) -> None:
+    folder = write(tmp_path / "r2", "rosbag2-mcap", scene.spec)
+    (storage,) = folder.glob("*.mcap")
+    without_summary(storage, tmp_path / "bare.mcap").replace(storage)
+    s = eio.summary(folder, exact=True)
+    assert s.index == "metadata.yaml+scan" and s.problems == ()
+    assert {t.name: t.count for t in s.topics if t.count} == expected_counts(scene)
+    t_all = all_times(scene)
+    assert (s.start_ns, s.end_ns) == (int(t_all.min()), int(t_all.max()))
+    poses = eio.read_poses(folder, POSE)  # rosbags' reader, as the fast path steps aside
+    np.testing.assert_array_equal(poses.xyz, scene.xyz)
+    np.testing.assert_array_equal(poses.t_ns, scene.t_hdr)
