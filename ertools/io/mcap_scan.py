@@ -14,7 +14,6 @@ is exact for any layout the specification allows and for files cut short.
 from __future__ import annotations
 
 import contextlib
-import logging
 import mmap
 import os
 import struct
@@ -29,8 +28,6 @@ import numpy.typing as npt
 from ertools.errors import BagError
 from ertools.io.fastdecode import read_at
 
-log = logging.getLogger("ertools.io.mcap_scan")
-
 I64 = npt.NDArray[np.int64]
 U8 = npt.NDArray[np.uint8]
 
@@ -40,7 +37,6 @@ OP_SCHEMA = 0x03
 OP_CHANNEL = 0x04
 OP_MESSAGE = 0x05
 OP_CHUNK = 0x06
-OP_DATA_END = 0x0F
 FOOTER_SIZE = 1 + 8 + 8 + 8 + 4
 
 # What the summary-only check of a file and the record scan report as the index used.
@@ -48,7 +44,6 @@ INDEXED = "summary+message-indexes"
 SCAN = "scan"
 
 _HEAD = struct.Struct("<BQ")
-_MESSAGE = struct.Struct("<HIQ")  # channel id, sequence, log time (publish time follows)
 _CHUNK = struct.Struct("<QQQII")  # start, end, uncompressed size, crc, compression length
 _U16 = struct.Struct("<H")
 _U32 = struct.Struct("<I")
