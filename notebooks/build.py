@@ -35,9 +35,8 @@ pd.set_option("display.max_columns", 30)"""
 PARAMETERS_HEADER = """\
 # Parameters: edit them here, or run the notebook with papermill
 #   papermill notebooks/NAME.ipynb out.ipynb --cwd notebooks -p NAME VALUE ...
-# (docs/notebooks.md). Relative paths are from notebooks/; the defaults are the sample logs
-# of `make samples`. `answers`: the sample generator's truth, None for your own logs.
-
+# (`papermill --help-notebook notebooks/NAME.ipynb` lists them; docs/notebooks.md). Relative
+# paths are from notebooks/; the defaults are the sample logs of `make samples`.
 """
 
 # Turns the parameters into paths and reads the answers (None: a real log).
@@ -97,8 +96,9 @@ else:
 
 
 def parameters(**values: tuple[Any, str]) -> str:
-    """The parameters cell: a ``# comment`` line and a ``name = literal`` line per input."""
-    lines = [f"# {comment}\n{name} = {value!r}" for name, (value, comment) in values.items()]
+    """The parameters cell: one ``name = literal  # help`` line per input (the line comment is
+    the help `papermill --help-notebook` shows)."""
+    lines = [f"{name} = {value!r}  # {comment}" for name, (value, comment) in values.items()]
     return PARAMETERS_HEADER + "\n".join(lines)
 
 
@@ -130,7 +130,10 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
                     "runs' specifications and d_min (seed Listing 14); None: the seed's",
                 ),
                 d_mins=([0.00033, 0.0005, 0.001, 0.002, 0.004], "the d_min sweep [m]"),
-                answers=(sample(f"{FBM3W_LOG}.answers.yaml"), "None for your own logs"),
+                answers=(
+                    sample(f"{FBM3W_LOG}.answers.yaml"),
+                    "the sample generator's truth; None for a real log",
+                ),
             ),
         ),
         ("code", LOAD_BAGS + "\nconfig_path = Path(config) if config else None"),
@@ -219,7 +222,10 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
                     "reached-waypoint timing file; None: none",
                 ),
                 reached=("states", "the reached moments: 'states', 'timing' or 'auto'"),
-                answers=(sample(f"{FBM2H_LOG}.answers.yaml"), "None for your own logs"),
+                answers=(
+                    sample(f"{FBM2H_LOG}.answers.yaml"),
+                    "the sample generator's truth; None for a real log",
+                ),
             ),
         ),
         (
@@ -314,7 +320,10 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
                     None,
                     "live vs 2015 rules tolerance; None: the answers' pose-score one, or 1e-6",
                 ),
-                answers=(sample(f"{FBM1H_LOG}.answers.yaml"), "None for your own logs"),
+                answers=(
+                    sample(f"{FBM1H_LOG}.answers.yaml"),
+                    "the sample generator's truth; None for a real log",
+                ),
             ),
         ),
         (
@@ -386,7 +395,7 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
                 gt_topic=("/fbm2h/robot_at_home/pose", "the GT pose topic"),
                 answers=(
                     sample("robotlog/FBM2H_201511201200_homer.answers.yaml"),
-                    "None for your own logs",
+                    "the sample generator's truth; None for a real log",
                 ),
             ),
         ),
@@ -446,7 +455,10 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
             "params",
             parameters(
                 folder=(sample("timeline/bags"), "the folder of bags (searched recursively)"),
-                answers=(sample("timeline/timeline.answers.yaml"), "None for your own logs"),
+                answers=(
+                    sample("timeline/timeline.answers.yaml"),
+                    "the sample generator's truth; None for a real log",
+                ),
             ),
         ),
         (
