@@ -109,8 +109,12 @@ EDGE_SMOOTH_S = 0.05
 _EDGE_SIGMAS = 4.0
 _EDGE_FLOOR_M = 0.0005
 # Two still phases less than this apart (and the path between them never further) are one:
-# the protocol's moves are centimetres, a glitch is not.
+# the protocol's moves are centimetres, a glitch is not (a tracking loss that repeats one
+# noisy pose for 300 ms looks like a few mm/s of speed to the window). At least this many
+# noise sigmas: a smoothed position wanders up to ~4 of its (smaller) sigmas, a single
+# repeated pose ~4 sigmas.
 MIN_MOVE_M = 0.002
+_MIN_MOVE_SIGMAS = 6.0
 # ... when they are at most this far apart in time (a longer gap may hide a whole run).
 _JOIN_WITHIN_S = 2.0
 
@@ -244,7 +248,7 @@ def protocol_track(
     keep = below[firsts] & deep & (t[lasts] - t[firsts] >= math.ceil(min_duration_s * 1e9))
     runs = [(int(a), int(b)) for a, b in zip(firsts[keep], lasts[keep], strict=True)]
     smooth = motion.moving_mean(p, max(1, round(EDGE_SMOOTH_S * rate)))
-    runs = _join_small_moves(runs, p, smooth, t)
+    runs = _join_small_moves(runs, p, smooth, t, max(MIN_MOVE_M, _MIN_MOVE_SIGMAS * sigma))
     still_xy = (
         np.array([np.nanmean(p[a : b + 1], axis=0) for a, b in runs]) if runs else empty
     )
@@ -275,9 +279,9 @@ def protocol_track(
 
 
 def _join_small_moves(
-    runs: list[tuple[int, int]], p: F64, smooth: F64, t: I64
+    runs: list[tuple[int, int]], p: F64, smooth: F64, t: I64, min_move: float
 ) -> list[tuple[int, int]]:
-    """Join neighbouring phases when the body never went :data:`MIN_MOVE_M` from the first
+    """Join neighbouring phases when the body never went ``min_move`` from the first
     (a glitch or a wobble of the noise window, not one of the protocol's moves)."""
     out: list[tuple[int, int]] = []
     for a, b in runs:
@@ -288,7 +292,7 @@ def _join_small_moves(
                 between = smooth[b0 : a + 1]
                 far = np.nanmax(np.hypot(*(between - centre).T)) if len(between) else 0.0
                 end = np.nanmean(p[a : b + 1], axis=0)
-                if far < MIN_MOVE_M and float(np.hypot(*(end - centre))) < MIN_MOVE_M:
+                if far < min_move and float(np.hypot(*(end - centre))) < min_move:
                     out[-1] = (a0, b)
                     continue
         out.append((a, b))
