@@ -103,11 +103,13 @@ _SPEED_NOISE_FRACTION = 1 / 6
 # A half window needs this fraction of its expected samples (a dropout leaves fewer).
 _MIN_FILL = 0.25
 # Smoothing (half-length, s) of the positions used to place the edges of a move.
-EDGE_SMOOTH_S = 0.05
+EDGE_SMOOTH_S = 0.15
 # A move is under way once the smoothed position is this many noise sigmas (and at least
 # _EDGE_FLOOR_M) from the still position; its edge is where it was last within that.
 _EDGE_SIGMAS = 4.0
 _EDGE_FLOOR_M = 0.0005
+# Longest extrapolation of an edge (ns).
+_MAX_LEAD_NS = 100_000_000
 # Two still phases less than this apart (and the path between them never further) are one:
 # the protocol's moves are centimetres, a glitch is not (a tracking loss that repeats one
 # noisy pose for 300 ms looks like a few mm/s of speed to the window). At least this many
@@ -131,6 +133,8 @@ class Track:
         onsets, arrivals: per move i (between phases i and i+1), the sample index where the
             robot left phase i and where it reached phase i+1.
         still_xy: (P, 2) mean position of each phase.
+        onset_ns, arrival_ns: per move, when the robot set off and stopped (the edge samples
+            extrapolated back and forward, see :func:`protocol_track`).
     """
 
     phases: tuple[Phase, ...]
@@ -140,6 +144,8 @@ class Track:
     onsets: tuple[int, ...]
     arrivals: tuple[int, ...]
     still_xy: F64
+    onset_ns: tuple[int, ...]
+    arrival_ns: tuple[int, ...]
 
 
 def noise_sigma(t_ns: I64, xy: F64) -> float:
@@ -232,7 +238,7 @@ def protocol_track(
     half = _half_window(sigma, rate, speed)
     empty = np.empty((0, 2))
     if n < 3:
-        return Track((), sigma, half, rate, (), (), empty)
+        return Track((), sigma, half, rate, (), (), empty, (), ())
     v = window_speed(t, p, half, rate)
     below = ~(v >= speed)  # NaN (unknown) continues a stretch
     gap = np.zeros(n, dtype=bool)
@@ -248,14 +254,18 @@ def protocol_track(
     keep = below[firsts] & deep & (t[lasts] - t[firsts] >= math.ceil(min_duration_s * 1e9))
     runs = [(int(a), int(b)) for a, b in zip(firsts[keep], lasts[keep], strict=True)]
     smooth = motion.moving_mean(p, max(1, round(EDGE_SMOOTH_S * rate)))
-    runs = _join_small_moves(runs, p, smooth, t, max(MIN_MOVE_M, _MIN_MOVE_SIGMAS * sigma))
+    min_move = max(MIN_MOVE_M, _MIN_MOVE_SIGMAS * sigma)
+    runs = _join_small_moves(runs, p, smooth, t, min_move)
     still_xy = (
         np.array([np.nanmean(p[a : b + 1], axis=0) for a, b in runs]) if runs else empty
     )
     # noise of a smoothed position (per axis) sets the edge radius
     n_smooth = 2 * max(1, round(EDGE_SMOOTH_S * rate)) + 1
     radius = max(_EDGE_FLOOR_M, _EDGE_SIGMAS * sigma * math.sqrt(2.0 / n_smooth))
-    onsets, arrivals = [], []
+    onsets: list[int] = []
+    arrivals: list[int] = []
+    onset_ns: list[int] = []
+    arrival_ns: list[int] = []
     for i in range(len(runs) - 1):
         (a0, b0), (a1, b1) = runs[i], runs[i + 1]
         mid0, mid1 = (a0 + b0) // 2, (a1 + b1) // 2
@@ -264,18 +274,37 @@ def protocol_track(
         d1 = np.hypot(*(seg - still_xy[i + 1]).T)
         near0 = np.flatnonzero(d0 <= radius)
         near1 = np.flatnonzero(d1 <= radius)
-        far0 = np.flatnonzero(d0 > 2 * radius)
+        # "away" is as far as a move must go: a glitch inside a (joined) phase is not
+        far0 = np.flatnonzero(d0 > max(2 * radius, min_move))
         first_far = int(far0[0]) if far0.size else len(seg) - 1
         before = near0[near0 < first_far]
         onset = mid0 + (int(before[-1]) if before.size else 0)
-        far1 = np.flatnonzero(d1 > 2 * radius)
+        far1 = np.flatnonzero(d1 > max(2 * radius, min_move))
         last_far = int(far1[-1]) if far1.size else 0
         after = near1[near1 > last_far]
-        arrival = mid0 + (int(after[0]) if after.size else len(seg) - 1)
+        arrival = max(mid0 + (int(after[0]) if after.size else len(seg) - 1), onset)
         onsets.append(onset)
-        arrivals.append(max(arrival, onset))
+        arrivals.append(arrival)
+        # the robot set off before it was `radius` away: back by the time it took from
+        # radius to 2 radius (exact at constant speed, short while it accelerates)
+        out0 = np.flatnonzero(d0[onset - mid0 :] > 2 * radius)
+        out1 = np.flatnonzero(d1[: arrival - mid0 + 1] > 2 * radius)
+        lead = int(t[onset + int(out0[0])]) - int(t[onset]) if out0.size else 0
+        lag = int(t[arrival]) - int(t[mid0 + int(out1[-1])]) if out1.size else 0
+        onset_ns.append(int(t[onset]) - min(max(lead, 0), _MAX_LEAD_NS))
+        arrival_ns.append(int(t[arrival]) + min(max(lag, 0), _MAX_LEAD_NS))
     phases = tuple(Phase(a, b, int(t[a]), int(t[b])) for a, b in runs)
-    return Track(phases, sigma, half, rate, tuple(onsets), tuple(arrivals), still_xy)
+    return Track(
+        phases,
+        sigma,
+        half,
+        rate,
+        tuple(onsets),
+        tuple(arrivals),
+        still_xy,
+        tuple(onset_ns),
+        tuple(arrival_ns),
+    )
 
 
 def _join_small_moves(

@@ -53,7 +53,7 @@ EARLY_END = {"timeout": "timeout", "halt": "stopped", "stop": "stopped", "stoppe
 # Still time kept at each side of an auto-detected path: the edge of a move is where the
 # smoothed position left the still one by 4 noise sigmas (>= 0.5 mm), which a robot
 # accelerating over half a second reaches about 0.4 s after it set off.
-AUTO_MARGIN_S = 0.4
+AUTO_MARGIN_S = 0.3
 # A move is a run's path when Eq. (1) after the best rotation about the start is at most this
 # fraction of the target's length: a straight move 30% shorter or longer than a line fails,
 # and so does any other shape; a robot's wobble of a few mm passes.
@@ -381,11 +381,11 @@ def find_auto(
     margin = round(AUTO_MARGIN_S * 1e9)
     for k, cand in enumerate(chosen):
         ref_p, start_p, end_p = phases[cand.first - 1], phases[cand.first], phases[cand.last + 1]
-        onset = int(t[track.onsets[cand.first]])
-        arrival = int(t[track.arrivals[cand.last]])
-        start_ns = max(start_p.start_ns, onset - margin)
-        end_ns = min(end_p.end_ns, arrival + margin)
-        ref_ns = (ref_p.start_ns + ref_p.end_ns) // 2
+        onset = track.onset_ns[cand.first]
+        arrival = track.arrival_ns[cand.last]
+        start_ns = _between(poses.t_ns, max(start_p.start_ns, onset - margin), first=True)
+        end_ns = _between(poses.t_ns, min(end_p.end_ns, arrival + margin), first=False)
+        ref_ns = _between(poses.t_ns, (ref_p.start_ns + ref_p.end_ns) // 2, first=False)
         shape = shapes[specs[k]]
         fit = (
             f"; matches the shape to {cand.e_free * 1000:.1f} mm (best rotation), "
@@ -467,6 +467,22 @@ def _assign(
         out.append(found)
         m = back
     return out[::-1]
+
+
+def _between(t_all: npt.NDArray[np.int64], t_ns: int, *, first: bool) -> int:
+    """A time halfway between two samples that keeps the same samples as ``t_ns``.
+
+    ``first``: the window starts at t_ns (the first sample at or after it is in); else it
+    ends there (the last sample at or before it is in; also the reference sample). Reports
+    print times to the microsecond: a time on a sample would, given back with ``--run``,
+    take or drop that sample; half a frame away it keeps them all.
+    """
+    n = len(t_all)
+    if first:
+        i = int(np.searchsorted(t_all, t_ns, side="left"))
+        return t_ns if i <= 0 or i >= n else (int(t_all[i - 1]) + int(t_all[i])) // 2 + 1
+    i = int(np.searchsorted(t_all, t_ns, side="right")) - 1
+    return t_ns if i < 0 or i + 1 >= n else (int(t_all[i]) + int(t_all[i + 1])) // 2
 
 
 def _rel(t_ns: int, poses: PoseStream) -> float:

@@ -1,0 +1,193 @@
+"""``--runs auto`` on logs written from the protocol (protocol_logs.py), through the CLI.
+
+Every shape of configs/fbm3w.yaml (the built-ins it names and its two example user shapes),
+single- and multi-run logs, approach moves of 1-20 cm in any direction, still phases of
+2-10 s, white mocap noise of 0.3-1.3 mm (sigma per axis, per frame at 120 Hz: 0.5-2.3 mm
+from frame to frame), 1-4 dropouts of 50-300 ms, a robot's wobble and heading error. The
+generator knows when each phase began and ended; the detector must find each path within
+0.5 s and take its reference inside the reference phase, and its scores must be the
+windows-mode scores.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from protocol_logs import SHAPES, Log, by_arc_length, generate, write_bag, write_config
+
+from ertools.cli.main import main
+
+EDGE_TOLERANCE_S = 0.5
+
+
+def _cli(capsys: pytest.CaptureFixture[str], *args: object) -> tuple[int, str, str]:
+    code = main(["score", "fbm3w", *map(str, args)])
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def _details(capsys: pytest.CaptureFixture[str], *args: object) -> list[dict[str, float]]:
+    code, out, err = _cli(capsys, *args, "--format", "json")
+    assert code == 0, err
+    runs = json.loads(out)["runs_details"]
+    return [runs[k] for k in sorted(runs, key=int)]
+
+
+def _cases() -> list[tuple[int, list[str]]]:
+    """Seeded: each shape alone (twice) and in multi-run logs in the config's order."""
+    cases = []
+    for i, shape in enumerate(SHAPES):
+        cases.append((100 + i, [shape]))
+        cases.append((200 + i, [shape]))
+        rot = [*SHAPES[i:], *SHAPES[:i]]
+        cases.append((300 + i, rot[: 2 + i % 3]))
+    return cases
+
+
+def _rel(log: Log, t_s: float) -> int:
+    """Index of the first sample at or after ``t_s`` from the first pose."""
+    return int(np.searchsorted(log.t_ns, log.t_ns[0] + round(t_s * 1e9), side="left"))
+
+
+def _ref_index(log: Log, t_s: float) -> int:
+    return int(np.searchsorted(log.t_ns, log.t_ns[0] + round(t_s * 1e9), side="right")) - 1
+
+
+def _score_bound(log: Log, spec: str, a: dict[str, float], b: dict[str, float]) -> float:
+    """How far two windows-mode scores of one run can be apart (m), from the logged samples.
+
+    Both windows hold the whole move; they differ in the reference sample and the first
+    sample (both still, so by the noise) and in a few still samples at the ends. Eq. (1)
+    with d_min above the noise: the origin moves by |dp0| (every error by at most that), the
+    x axis turns by dtheta (a point r from the origin by at most r * dtheta), and the kept
+    points differ only near the ends, shifting l/L by a few d_min over L (the target moves
+    by at most that times its length over L, i.e. a few d_min).
+    """
+    p0a, p0b = log.xy[_rel(log, a["start_time"])], log.xy[_rel(log, b["start_time"])]
+    ra, rb = log.xy[_ref_index(log, a["reference_time"])], log.xy[_ref_index(log, b["reference_time"])]
+    ya = math.atan2(*(p0a - ra)[::-1])
+    yb = math.atan2(*(p0b - rb)[::-1])
+    dtheta = abs(math.remainder(ya - yb, math.tau))
+    lo, hi = _rel(log, a["start_time"]), _rel(log, a["end_time"])
+    reach = float(np.max(np.hypot(*(log.xy[lo:hi] - p0a).T)))
+    d_min = a["d_min"]
+    return float(np.hypot(*(p0a - p0b))) + reach * dtheta + 5 * d_min
+
+
+@pytest.mark.parametrize(("seed", "specs"), _cases())
+def test_auto_finds_the_generated_runs(
+    seed: int, specs: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    rng = np.random.default_rng(seed)
+    log = generate(rng, specs)
+    bag = write_bag(log, tmp_path / "run.bag")
+    # the config may list more runs than the log holds (a benchmark cut short): a prefix
+    listed = specs if seed % 2 else [*specs, "line"]
+    config = write_config(listed, tmp_path / "fbm3w.yaml")
+    # d_min above the noise (3 epsilon, epsilon = sigma * sqrt(pi), the mean distance
+    # between two frames of white noise), as `ertools noise` suggests
+    d_min = 3 * log.truth.sigma * math.sqrt(math.pi)
+    common = ("--config", config, "--d-min", f"{d_min:.6f}")
+    auto = _details(capsys, bag, *common, "--runs", "auto")
+    truth = log.truth
+    assert [r["spec"] for r in auto] == specs
+    for k, run in enumerate(auto):
+        path_a, path_b = truth.path[k]
+        assert run["start_time"] == pytest.approx(path_a, abs=EDGE_TOLERANCE_S), k
+        assert run["end_time"] == pytest.approx(path_b, abs=EDGE_TOLERANCE_S), k
+        ref_a, ref_b = truth.ref_phase[k]
+        assert ref_a < run["reference_time"] < ref_b, k
+    # the same windows given by hand score the same, to the last digit
+    given = [
+        f"--run={r['spec']}:{r['reference_time']!r}:{r['start_time']!r}:{r['end_time']!r}"
+        for r in auto
+    ]
+    same = _details(capsys, bag, *common, "--runs", "windows", *given)
+    assert [r["distance_error"] for r in same] == [r["distance_error"] for r in auto]
+    # the generator's own windows (reference: the middle of its reference phase)
+    mine = [
+        f"--run={s}:{(ra + rb) / 2!r}:{pa!r}:{pb!r}"
+        for s, (ra, rb), (pa, pb) in zip(specs, truth.ref_phase, truth.path, strict=True)
+    ]
+    gen = _details(capsys, bag, *common, "--runs", "windows", *mine)
+    for k, (a, g) in enumerate(zip(auto, gen, strict=True)):
+        bound = _score_bound(log, specs[k], a, g)
+        print("BOUND", abs(a["distance_error"] - g["distance_error"]), bound, a["distance_error"])
+        assert abs(a["distance_error"] - g["distance_error"]) <= bound, (k, bound)
+    # and the runs are the shapes: scored against the target, each run is within a few mm
+    # (wobble <= 4 mm, heading <= 4 degrees over the shape's reach, the noise's effect)
+    for k, run in enumerate(gen):
+        _, length = by_arc_length(specs[k], np.array([0.0]))
+        assert run["distance_error"] < 0.004 + math.radians(4) * length + 4 * log.truth.sigma
+
+
+def test_the_users_semicircle(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 15: still ~6 s, a 3 cm approach, still ~4 s, ~10 cm of shape over ~14 s, still
+    until the log ends; windows mode scored it, auto mode refused it."""
+    rng = np.random.default_rng(15)
+    log = generate(
+        rng, ["semi"], sigma=0.5e-3, approach=0.03, still=(4.0, 6.0), path_s=14.0, dropouts=2
+    )
+    bag = write_bag(log, tmp_path / "semicircle.bag")
+    config = write_config(["semi"], tmp_path / "fbm3w.yaml")
+    (auto,) = _details(capsys, bag, "--config", config, "--runs", "auto")
+    (pa, pb), (ra, rb) = log.truth.path[0], log.truth.ref_phase[0]
+    assert auto["start_time"] == pytest.approx(pa, abs=EDGE_TOLERANCE_S)
+    assert auto["end_time"] == pytest.approx(pb, abs=EDGE_TOLERANCE_S)
+    assert ra < auto["reference_time"] < rb
+    run = f"--run=semi:{auto['reference_time']!r}:{auto['start_time']!r}:{auto['end_time']!r}"
+    (windows,) = _details(capsys, bag, "--config", config, run)
+    assert windows["distance_error"] == auto["distance_error"]
+
+
+def test_a_log_without_an_end_phase_says_what_it_found(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The log stops during the path: the error names the still phases and the missing end."""
+    rng = np.random.default_rng(7)
+    log = generate(rng, ["line"], sigma=0.5e-3, approach=0.05, still=(3.0, 3.0), dropouts=0)
+    cut = _rel(log, (log.truth.path[0][0] + log.truth.path[0][1]) / 2)
+    short = Log(log.t_ns[:cut], log.xy[:cut], log.truth)
+    bag = write_bag(short, tmp_path / "cut.bag")
+    config = write_config(["line"], tmp_path / "fbm3w.yaml")
+    code, _, err = _cli(capsys, bag, "--config", config, "--runs", "auto")
+    assert code == 1
+    lines = [ln for ln in err.splitlines() if ln.startswith("ertools: error:")]
+    assert len(lines) == 1 and "Traceback" not in err
+    line = lines[0]
+    assert "found 2 still phase(s)" in line
+    ref_a, ref_b = log.truth.ref_phase[0]
+    start_a, start_b = log.truth.start_phase[0]
+    # the two phases found, with their times from the first pose: reference and start
+    listed = line.split("still phase(s) (")[1].split(";")[0].replace(" s", "").split(", ")
+    found = [tuple(float(v) for v in span.split("-")) for span in listed]
+    expected = [(ref_a, ref_b), (start_a, start_b)]
+    assert np.allclose(found, expected, atol=EDGE_TOLERANCE_S), (found, expected)
+    assert "no end phase: the log ends during a move" in line
+    last = (short.t_ns[-1] - short.t_ns[0]) / 1e9
+    assert f"last pose at {last:.2f} s" in line
+
+
+def test_no_move_matches_the_shape(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A line drawn where the config says semi_ellipse: the error lists the moves and how far
+    each is from the shape."""
+    rng = np.random.default_rng(8)
+    log = generate(rng, ["line"], sigma=0.5e-3, approach=0.05, still=(3.0, 3.0), dropouts=0)
+    bag = write_bag(log, tmp_path / "line.bag")
+    config = write_config(["semi_ellipse"], tmp_path / "fbm3w.yaml")
+    code, _, err = _cli(capsys, bag, "--config", config, "--runs", "auto")
+    assert code == 1
+    line = next(ln for ln in err.splitlines() if ln.startswith("ertools: error:"))
+    assert "matches run 0's shape 'semi_ellipse'" in line
+    assert "still phases 0.00-" in line
+    pa, pb = log.truth.path[0]
+    # the path move is listed with its times (edges within the 0.5 s of the detector)
+    assert "off the shape by" in line
+    assert "no still phase before it for the reference" in line  # the approach (move 0)
+    assert line.count(" cm") == 2
+    assert abs(float(line.split("moves ")[1].split(";")[1].split("-")[0]) - pa) < 0.5
+    assert pb > pa
