@@ -256,9 +256,7 @@ def protocol_track(
     smooth = motion.moving_mean(p, max(1, round(EDGE_SMOOTH_S * rate)))
     min_move = max(MIN_MOVE_M, _MIN_MOVE_SIGMAS * sigma)
     runs = _join_small_moves(runs, p, smooth, t, min_move)
-    still_xy = (
-        np.array([np.nanmean(p[a : b + 1], axis=0) for a, b in runs]) if runs else empty
-    )
+    still_xy = np.array([np.nanmean(p[a : b + 1], axis=0) for a, b in runs]) if runs else empty
     # noise of a smoothed position (per axis) sets the edge radius
     n_smooth = 2 * max(1, round(EDGE_SMOOTH_S * rate)) + 1
     radius = max(_EDGE_FLOOR_M, _EDGE_SIGMAS * sigma * math.sqrt(2.0 / n_smooth))

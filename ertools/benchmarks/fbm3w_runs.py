@@ -276,9 +276,7 @@ class _Candidate:
     cost: float
 
 
-def _match(
-    path: F64, start: F64, ref: F64, shape: Shape, d_det: float
-) -> tuple[float, float]:
+def _match(path: F64, start: F64, ref: F64, shape: Shape, d_det: float) -> tuple[float, float]:
     """(e_free, e_frame): Eq. (1) of ``path`` (smoothed, world) against ``shape``.
 
     The protocol fixes the start at t(0) and the x axis along reference -> start; the run is

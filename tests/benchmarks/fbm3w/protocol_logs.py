@@ -97,9 +97,12 @@ class Truth:
 
 @dataclass
 class Log:
+    """The logged samples, and the same samples without the mocap noise (``clean``)."""
+
     t_ns: I64
     xy: F64
     truth: Truth
+    clean: F64
 
 
 class _Timeline:
@@ -169,6 +172,7 @@ def generate(
     n = len(xy)
     t_ns = T0_NS + np.round(np.arange(n) * (1e9 / RATE_HZ)).astype(np.int64)
     truth.sigma = sigma if sigma is not None else rng.uniform(0.3e-3, 1.3e-3)
+    clean = xy.copy()
     xy = xy + rng.normal(0.0, truth.sigma, xy.shape)
     keep = np.ones(n, dtype=bool)
     for _ in range(dropouts if dropouts is not None else int(rng.integers(1, 5))):
@@ -178,7 +182,8 @@ def generate(
             keep[a:b] = False  # no message
         else:
             xy[a:b] = xy[a - 1]  # the mocap node repeats the last pose
-    return Log(t_ns[keep], xy[keep], truth)
+            clean[a:b] = clean[a - 1]
+    return Log(t_ns[keep], xy[keep], truth, clean[keep])
 
 
 def _path(
@@ -204,17 +209,16 @@ def _path(
     yaw = heading + math.radians(rng.uniform(-3, 3))
     yaw_t = yaw + math.radians(1.0) * np.sin(2 * math.pi * rng.uniform(0.2, 1) * frac)
     c, s = np.cos(yaw_t), np.sin(yaw_t)
-    return start + np.column_stack(
-        [c * pts[:, 0] - s * pts[:, 1], s * pts[:, 0] + c * pts[:, 1]]
-    )
+    return start + np.column_stack([c * pts[:, 0] - s * pts[:, 1], s * pts[:, 0] + c * pts[:, 1]])
 
 
-def write_bag(log: Log, path: Path) -> Path:
-    """The log as a ROS1 bag of geometry_msgs/Pose2D on the 2015 topic."""
+def write_bag(log: Log, path: Path, *, clean: bool = False) -> Path:
+    """The log (or its noiseless twin) as a ROS1 bag of geometry_msgs/Pose2D, 2015 topic."""
     from ertools.samples.writer import BagWriter
 
+    xy = log.clean if clean else log.xy
     with BagWriter(path, "ros1") as bag:
-        bag.write_pose2d(TOPIC, log.t_ns, log.xy[:, 0], log.xy[:, 1], np.zeros(len(log.t_ns)))
+        bag.write_pose2d(TOPIC, log.t_ns, xy[:, 0], xy[:, 1], np.zeros(len(log.t_ns)))
     return path
 
 
