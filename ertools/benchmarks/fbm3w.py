@@ -137,7 +137,9 @@ def score_fbm3w(
     if options.runs is not None and options.runs not in RUN_MODES:
         raise ConfigError(f"--runs must be one of {', '.join(RUN_MODES)}, not {options.runs!r}")
     poses = read_fbm3w_poses(plist, options)
-    bag_start = min(summary(p).start_ns for p in plist)
+    summaries = [summary(p) for p in plist]
+    bag_start = min(x.start_ns for x in summaries)
+    bag_end = max(x.end_ns for x in summaries)
     mode = options.runs
     if mode is None:
         if options.windows:
@@ -150,7 +152,7 @@ def score_fbm3w(
     if mode == "windows":
         if not options.windows:
             raise ConfigError("--runs windows needs --run SPEC:REF_T:START_T:END_T or --runs-file")
-        windows = find_windows(options.windows, bag_start)
+        windows = find_windows(options.windows, bag_start, bag_end)
     elif mode == "states":
         windows = find_states(read_benchmark_states(plist, NAMESPACE))
     else:

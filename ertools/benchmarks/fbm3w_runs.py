@@ -248,14 +248,32 @@ def parse_runs_file(data: Any, source: str) -> list[tuple[str, float, float, flo
 
 
 def find_windows(
-    specs: Sequence[tuple[str, float, float, float]], bag_start_ns: int
+    specs: Sequence[tuple[str, float, float, float]],
+    bag_start_ns: int,
+    bag_end_ns: int | None = None,
 ) -> list[RunWindow]:
-    """Explicit runs; times resolved against the bag's first message (or epoch)."""
+    """Explicit runs; times resolved against the bag's first message (or epoch).
+
+    Raises:
+        ConfigError: END_T before START_T, or (``bag_end_ns`` given) a time outside the log:
+            a window cut by the end of the log would be scored on the part left, a wrong
+            score that looks right.
+    """
     runs = []
     for i, (spec, ref, start, end) in enumerate(specs):
         r, s, e = (resolve_time(v, bag_start_ns) for v in (ref, start, end))
         if e < s:
             raise ConfigError(f"run {i} ({spec}): END_T {end} is before START_T {start}")
+        if bag_end_ns is not None and (min(r, s) < bag_start_ns or max(r, e) > bag_end_ns):
+            span = (bag_end_ns - bag_start_ns) / 1e9
+            rel = [(v - bag_start_ns) / 1e9 for v in (r, s, e)]
+            where = "before the start" if min(r, s) < bag_start_ns else "past the end"
+            raise ConfigError(
+                f"run {i} ({spec}): the window reaches {where} of the log (reference "
+                f"{rel[0]:.3f} s, path {rel[1]:.3f}-{rel[2]:.3f} s from the first message; "
+                f"the log covers 0-{span:.3f} s): check the times (seconds from the log start, "
+                "or epoch seconds)"
+            )
         runs.append(
             RunWindow(i, spec, r, s, e, "completed", "windows", "given on the command line")
         )
