@@ -858,9 +858,9 @@ def test_nan_poses(
     case: str, which: str, inputs: Inputs, capsys: pytest.CaptureFixture[str]
 ) -> None:
     if case == "trajectory-gt" and which == "nan_part":
-        pytest.skip("part-NaN GT is scored on the valid part: see test_nan_gt_part_is_said")
+        pytest.skip("n/a: part-NaN GT is scored on the valid part: see test_nan_gt_part_is_said")
     if case == "fbm2h--reached-timing" and which == "nan_part":
-        pytest.skip("one error per failed segment: see test_nan_part_fbm2h_warns_and_fails...")
+        pytest.skip("n/a: one error per failed segment: see test_nan_part_fbm2h_warns_and_fails...")
     argv_of, name = NAN_CASES[case]
     bag = getattr(inputs, which)
     result = _run(argv_of(inputs, bag), capsys)
