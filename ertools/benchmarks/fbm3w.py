@@ -197,6 +197,16 @@ def score_runs(
     cfg = config if options.d_min is None else config.with_d_min(options.d_min)
     start_ns = poses.start_ns if bag_start_ns is None else bag_start_ns
     runs_in, warnings = with_specs(list(windows), cfg)
+    specs = cfg.runs_specifications
+    if runs_in and runs_in[0].mode == "auto" and len(runs_in) < len(specs):
+        last = runs_in[-1]
+        after = "" if last.end_ns is None else f" after {(last.end_ns - start_ns) / 1e9:.2f} s"
+        warnings.append(
+            f"--runs auto found {len(runs_in)} of the {len(specs)} runs the config lists: no "
+            f"move{after} (the end of run {last.index}'s path) matches run {len(runs_in)}'s "
+            f"shape {specs[len(runs_in)]!r} between still phases; the log ends there or the "
+            "rest need --runs windows"
+        )
     noise = _noise(poses, options, warnings)
     same = identical_poses(poses)
     results: list[RunResult] = []

@@ -39,10 +39,14 @@ def _cli(capsys: pytest.CaptureFixture[str], *args: object) -> tuple[int, str, s
 
 
 def _details(capsys: pytest.CaptureFixture[str], *args: object) -> list[dict[str, float]]:
+    return _run(capsys, *args)[0]
+
+
+def _run(capsys: pytest.CaptureFixture[str], *args: object) -> tuple[list[dict[str, float]], str]:
     code, out, err = _cli(capsys, *args, "--format", "json")
     assert code == 0, err
     runs = json.loads(out)["runs_details"]
-    return [runs[k] for k in sorted(runs, key=int)]
+    return [runs[k] for k in sorted(runs, key=int)], err
 
 
 def _cases() -> list[tuple[int, list[str]]]:
@@ -102,8 +106,18 @@ def test_auto_finds_the_generated_runs(
     # between two frames of white noise), as `ertools noise` suggests
     d_min = 3 * log.truth.sigma * math.sqrt(math.pi)
     common = ("--config", config, "--d-min", f"{d_min:.6f}")
-    auto = _details(capsys, bag, *common, "--runs", "auto")
+    auto, err = _run(capsys, bag, *common, "--runs", "auto")
     truth = log.truth
+    if len(listed) > len(specs):
+        end = truth.path[-1][1]
+        said = next(ln for ln in err.splitlines() if "--runs auto found" in ln)
+        assert f"found {len(specs)} of the {len(listed)} runs" in said
+        assert f"matches run {len(specs)}'s shape 'line'" in said
+        # the time is the detected end of the last path, within the 0.5 s of the edges
+        at = float(said.split(" after ")[1].split(" s ")[0])
+        assert at == pytest.approx(end, abs=EDGE_TOLERANCE_S)
+    else:
+        assert "--runs auto found" not in err
     assert [r["spec"] for r in auto] == specs
     for k, run in enumerate(auto):
         path_a, path_b = truth.path[k]
