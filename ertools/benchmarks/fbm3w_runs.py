@@ -339,7 +339,8 @@ def find_auto(
     at most :data:`AUTO_MATCH` of the target's length. The runs are then assigned in the
     config's order to candidates in time order, at least two moves apart (the next run's
     approach lies between), taking as many runs as the log holds and, among those
-    assignments, the least total error (best-rotation plus protocol-frame error).
+    assignments, the least total error: best-rotation error plus protocol-frame error, the
+    latter at most :data:`AUTO_MATCH` of the target's length.
 
     Window of a run: the reference time is the middle of the still phase before the
     approach; the path runs from :data:`AUTO_MARGIN_S` before the robot left the start to
@@ -465,7 +466,11 @@ def _assign(
                     if not e_free <= AUTO_MATCH * length:
                         continue
                     # a joined span pays for each pause, so a whole single move wins a tie
-                    cost = (e_free + e_frame) / length + AUTO_SPAN_PENALTY * (last - j)
+                    # the protocol frame speaks for a run drawn in it (the usual case); for a
+                    # robot that drew its shape turned from the approach every frame is off,
+                    # so the error counts only up to the acceptance limit
+                    frame = min(e_frame, AUTO_MATCH * length)
+                    cost = (e_free + frame) / length + AUTO_SPAN_PENALTY * (last - j)
                     cand = _Candidate(j, last, e_free, e_frame, cost)
                 total = base + cand.cost
                 if total < row[last][0]:

@@ -144,8 +144,13 @@ def generate(
     still: tuple[float, float] = (2.0, 10.0),
     path_s: float | None = None,
     dropouts: int | None = None,
+    turn: float = 0.0,
 ) -> Log:
-    """One log of ``len(specs)`` runs (random everything not given)."""
+    """One log of ``len(specs)`` runs (random everything not given).
+
+    ``turn`` (rad): the robot draws the shape turned by this from the protocol's frame (an
+    approach that does not come along the shape's heading).
+    """
     truth = Truth(specs=list(specs))
     tl = _Timeline(rng, rng.uniform(-1.0, 1.0, 2))
     end_phase = (0.0, 0.0)
@@ -166,7 +171,7 @@ def generate(
         start = ref + length * np.array([math.cos(heading), math.sin(heading)])
         tl.move(start, rng.uniform(0.02, 0.05))
         truth.start_phase.append(tl.still(rng.uniform(*still)))
-        truth.path.append(tl.draw(_path(rng, spec, start, heading, path_s)))
+        truth.path.append(tl.draw(_path(rng, spec, start, heading + turn, path_s)))
         end_phase = tl.still(rng.uniform(*still))
     xy = np.vstack([np.atleast_2d(p) for p in tl.pieces])
     n = len(xy)

@@ -98,9 +98,33 @@ def test_auto_finds_the_generated_runs(
 ) -> None:
     rng = np.random.default_rng(seed)
     log = generate(rng, specs)
-    bag = write_bag(log, tmp_path / "run.bag")
     # the config may list more runs than the log holds (a benchmark cut short): a prefix
     listed = specs if seed % 2 else [*specs, "line"]
+    _check(log, specs, listed, tmp_path, capsys, on_shape=True)
+
+
+@pytest.mark.parametrize("spec", SHAPES)
+def test_a_shape_turned_from_the_approach_is_found(
+    spec: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The robot draws the shape 57-126 degrees off the reference -> start direction: the
+    2015 frame scores it badly, but it is still the run (matched after the best rotation)."""
+    rng = np.random.default_rng(500 + SHAPES.index(spec))
+    turn = float(rng.uniform(1.0, 2.2) * rng.choice([-1.0, 1.0]))
+    log = generate(rng, [spec], turn=turn)
+    _check(log, [spec], [spec], tmp_path, capsys, on_shape=False)
+
+
+def _check(
+    log: Log,
+    specs: list[str],
+    listed: list[str],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    *,
+    on_shape: bool,
+) -> None:
+    bag = write_bag(log, tmp_path / "run.bag")
     config = write_config(listed, tmp_path / "fbm3w.yaml")
     # d_min above the noise (3 epsilon, epsilon = sigma * sqrt(pi), the mean distance
     # between two frames of white noise), as `ertools noise` suggests
@@ -151,7 +175,7 @@ def test_auto_finds_the_generated_runs(
     # parameter and its arc length (the 2015 formula's floor, 8.4 mm for the sine) of its
     # target
     u = np.linspace(0.0, 1.0, 2001)
-    for k, run in enumerate(gen):
+    for k, run in enumerate(gen if on_shape else []):
         by_arc, _ = by_arc_length(specs[k], u)
         reach = float(np.max(np.hypot(*by_arc.T)))
         gap = float(np.max(np.hypot(*(shape_curve(specs[k], u) - by_arc).T)))
