@@ -114,6 +114,16 @@ def test_auto_mode_reports_detected_times(fbm3w_sample: Sample) -> None:
             (motion["end_ns"] - start_ns) / 1e9 + 0.2, abs=0.15
         )
         assert details["run_finding"] == "auto"
+    # the printed times, given back as windows, select the same samples: the same scores
+    given = tuple(
+        (r.spec, r.details()["reference_time"], r.details()["start_time"], r.details()["end_time"])
+        for r in result.runs
+    )
+    again = score_fbm3w(
+        [fbm3w_sample.bag], Fbm3wConfig(), Fbm3wOptions(runs="windows", windows=given)
+    )
+    assert [r.distance_error for r in again.runs] == [r.distance_error for r in result.runs]
+    assert all(r.distance_error is not None for r in again.runs)
 
 
 def test_d_min_below_noise_is_warned(fbm3w_sample: Sample) -> None:
