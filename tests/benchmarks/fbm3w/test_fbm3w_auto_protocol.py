@@ -103,6 +103,15 @@ def test_auto_finds_the_generated_runs(
     _check(log, specs, listed, tmp_path, capsys, on_shape=True)
 
 
+def test_the_hardest_corner(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """1 cm approaches, the most noise (1.3 mm), the shortest still phases (2-2.5 s) and 4
+    dropouts, in a 3-run log."""
+    rng = np.random.default_rng(600)
+    specs = ["hook", "semi", "line"]
+    log = generate(rng, specs, sigma=1.3e-3, approach=0.01, still=(2.0, 2.5), dropouts=4)
+    _check(log, specs, specs, tmp_path, capsys, on_shape=True)
+
+
 @pytest.mark.parametrize("spec", SHAPES)
 def test_a_shape_turned_from_the_approach_is_found(
     spec: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
