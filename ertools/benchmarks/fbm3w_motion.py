@@ -230,9 +230,11 @@ def protocol_track(
     A sample belongs to a still phase when it lies in a stretch of window speeds below
     ``speed`` (or unknown, inside a dropout) that somewhere drops below ``speed / 2`` and lasts
     ``min_duration_s``; a data gap over :data:`MAX_GAP_S` ends a stretch. Neighbouring phases
-    closer than :data:`MIN_MOVE_M` (with nothing further between) are joined. Each move's
-    edges are placed on positions smoothed over ±:data:`EDGE_SMOOTH_S`: the last sample within
-    4 noise sigmas (at least 0.5 mm) of the still position before it leaves for good.
+    closer than max(:data:`MIN_MOVE_M`, 6 sigma) (with nothing further between) are joined.
+    Each move's edges are placed on positions smoothed over ±:data:`EDGE_SMOOTH_S`: the last
+    sample within 4 sigmas of that smoothing (at least 0.5 mm) of the still position before
+    the robot goes as far as a move must, extrapolated by the time it then took to double
+    that distance (at most 0.1 s); the arrival likewise.
     """
     t = np.asarray(t_ns, dtype=np.int64)
     p = np.asarray(xy, dtype=np.float64)
