@@ -152,4 +152,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    # Run as ``-m`` this file is ``__main__``, whose Rule class is not the one the benchmark
+    # modules import: the catalogue must come from the imported module.
+    from ertools.fidelity import main as _main
+
+    raise SystemExit(_main())
