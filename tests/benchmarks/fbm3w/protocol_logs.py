@@ -145,11 +145,13 @@ def generate(
     path_s: float | None = None,
     dropouts: int | None = None,
     turn: float = 0.0,
+    pause: float = 0.0,
 ) -> Log:
     """One log of ``len(specs)`` runs (random everything not given).
 
     ``turn`` (rad): the robot draws the shape turned by this from the protocol's frame (an
-    approach that does not come along the shape's heading).
+    approach that does not come along the shape's heading). ``pause`` (s): the robot stops
+    this long halfway along each path (the arc length splits there).
     """
     truth = Truth(specs=list(specs))
     tl = _Timeline(rng, rng.uniform(-1.0, 1.0, 2))
@@ -171,7 +173,15 @@ def generate(
         start = ref + length * np.array([math.cos(heading), math.sin(heading)])
         tl.move(start, rng.uniform(0.02, 0.05))
         truth.start_phase.append(tl.still(rng.uniform(*still)))
-        truth.path.append(tl.draw(_path(rng, spec, start, heading + turn, path_s)))
+        drawn = _path(rng, spec, start, heading + turn, path_s)
+        if pause > 0:
+            half = len(drawn) // 2
+            a, _ = tl.draw(drawn[: half + 1])
+            tl.still(pause)  # holding the halfway point
+            _, b = tl.draw(drawn[half:])
+            truth.path.append((a, b))
+        else:
+            truth.path.append(tl.draw(drawn))
         end_phase = tl.still(rng.uniform(*still))
     xy = np.vstack([np.atleast_2d(p) for p in tl.pieces])
     n = len(xy)

@@ -112,6 +112,18 @@ def test_the_hardest_corner(tmp_path: Path, capsys: pytest.CaptureFixture[str]) 
     _check(log, specs, specs, tmp_path, capsys, on_shape=True)
 
 
+@pytest.mark.parametrize("pause", [0.8, 2.5])
+def test_a_robot_pausing_halfway_along_its_path(
+    pause: float, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A stop mid-path long enough to be a still phase splits the path in two moves: the run
+    is the two joined (the window spans both)."""
+    rng = np.random.default_rng(700 + round(pause * 10))
+    specs = ["semi_ellipse", "hook", "spline"]
+    log = generate(rng, specs, pause=pause)
+    _check(log, specs, specs, tmp_path, capsys, on_shape=True)
+
+
 @pytest.mark.parametrize("spec", SHAPES)
 def test_a_shape_turned_from_the_approach_is_found(
     spec: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
