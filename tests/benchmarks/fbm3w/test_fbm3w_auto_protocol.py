@@ -186,8 +186,9 @@ def _check(
         for s, (ra, rb), (pa, pb) in zip(specs, truth.ref_phase, truth.path, strict=True)
     ]
     config_2015 = ("--config", config)  # the 2015 d_min: nothing to filter
-    gen = _details(capsys, clean, *config_2015, "--runs", "windows", *mine)
-    found = _details(capsys, clean, *config_2015, "--runs", "windows", *given)
+    # one command, the generator's windows then the detected ones
+    both = _details(capsys, clean, *config_2015, "--runs", "windows", *mine, *given)
+    gen, found = both[: len(mine)], both[len(mine) :]
     for k, (f, g) in enumerate(zip(found, gen, strict=True)):
         bound = _cut_bound(log, k, auto[k])
         assert abs(f["distance_error"] - g["distance_error"]) <= bound, (k, bound)
