@@ -558,7 +558,10 @@ def _no_match(
         if j == 0:
             what += ", no still phase before it for the reference"
         elif shape is not None and (spec, j, j) in matches:
-            what += f", off the shape by {matches[spec, j, j][0] / shape.length():.0%}"
+            err = matches[spec, j, j][0]
+            what += (
+                f", off the shape by {err * 1000:.1f} mm ({err / shape.length():.0%} of its length)"
+            )
         moves.append(what)
     if len(moves) > 8:
         moves = [*moves[:7], "...", moves[-1]]
