@@ -57,9 +57,10 @@ def problem_numbers(timeline: Timeline) -> dict[str, int]:
 
 
 def _num(ns: int) -> float:
-    import matplotlib.dates as mdates
+    import matplotlib.dates as _mdates
     import numpy as np
 
+    mdates: Any = _mdates  # partly untyped module
     value: float = mdates.date2num(np.datetime64(ns, "ns").astype("datetime64[us]"))
     return value
 

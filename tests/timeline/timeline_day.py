@@ -114,12 +114,13 @@ def day_timeline() -> Timeline:
 
 
 def many_bags(n: int = 1000) -> Timeline:
-    """``n`` robot logs of 10 s, 20 loggers, over six hours (the page's performance case)."""
+    """``n`` robot logs of 10 s by 20 teams (rockin_logger names: one lane per team), over six
+    hours (the page's performance case)."""
     step = 6 * 3600 / n
     return build_timeline(
         [
             Summary(
-                f"robots/r{i % 20:02d}/run_{i}.bag",
+                f"robots/FBM2H_{201511200000 + i}_team{i % 20:02d}.bag",
                 at(0, i * step),
                 at(0, i * step + 10),
                 robot(i + 1),
