@@ -224,12 +224,17 @@ def _legend(timeline: Timeline) -> str:
         f"{_esc(KIND_LABELS[k])}</li>"
         for k in kinds
     ]
-    items.append(
-        '<li><span class="sw sw-problem"></span>has problems (hatched, outlined, '
-        '<span class="mk">!</span>; hover for the reason)</li>'
-    )
-    items.append('<li><span class="sw sw-copy"></span>copy of another file (hollow)</li>')
-    items.append('<li><span class="sw sw-uncov"></span>span of a log no GT file covers</li>')
+    readable = [b for b in timeline.bags if b.readable]
+    # only what the chart shows: a legend entry with no bar to match is noise
+    if any(b.problems for b in readable):
+        items.append(
+            '<li><span class="sw sw-problem"></span>has problems (hatched, outlined, '
+            '<span class="mk">!</span>; hover for the reason)</li>'
+        )
+    if any(b.copy_of for b in readable):
+        items.append('<li><span class="sw sw-copy"></span>copy of another file (hollow)</li>')
+    if any(p.uncovered for p in timeline.pairings):
+        items.append('<li><span class="sw sw-uncov"></span>span of a log no GT file covers</li>')
     items.append('<li><span class="sw sw-session"></span>session</li>')
     return '<ul class="legend">' + "".join(items) + "</ul>"
 
@@ -456,6 +461,7 @@ SCRIPT = r"""
   var box = document.getElementById("tl-chart");
   var NS = svg.namespaceURI;
   var LW = 20, TOP = 44, ROWH = 20, PAD = 6, RIGHT = 14, MINSPAN = 0.005;
+  var CHAR = 7.0;  // width of a bold 11 px character, generously (labels must not collide)
   var bags = D.bags, sessions = D.sessions;
   var W = 800, H = 0, v0 = 0, v1 = 1, sel = null, hover = null;
   var dayS = Infinity, dayE = -Infinity;
@@ -505,13 +511,14 @@ SCRIPT = r"""
   var gGrid = el("g", {"class": "grid"}, plot);
   var gBars = el("g", {"class": "bars"}, plot);
   var gLinks = el("g", {"class": "links"}, plot);
+  var gLabels = el("g", {"class": "slabels"}, plot);  // above every band, never covered
   var dayLabel = el("text", {"class": "tick-label", x: 6, y: 14}, svg);
 
   var bands = sessions.map(function (s) {
     var r = el("rect", {"class": "band", y: TOP - 18, height: H - TOP + 18,
                         "data-session": s.index}, gBands);
     title(r, s.label);
-    var t = el("text", {"class": "slabel", y: TOP - 6, "data-session": s.index}, gBands);
+    var t = el("text", {"class": "slabel", y: TOP - 6, "data-session": s.index}, gLabels);
     return {rect: r, text: t, s: s};
   });
   var barEls = bags.map(function (b, i) {
@@ -581,8 +588,8 @@ SCRIPT = r"""
       var xs = place(b.rect, b.s.s, b.s.e, 3);
       var lo = Math.max(xs[0], LW), hi = Math.min(xs[1], LW + W);
       var mid = (lo + hi) / 2;
-      var text = hi - lo >= b.s.label.length * 6.2 + 8 ? b.s.label : "S" + b.s.index;
-      var w = text.length * 6.2;
+      var text = hi - lo >= b.s.label.length * CHAR + 8 ? b.s.label : "S" + b.s.index;
+      var w = text.length * CHAR;
       var x0 = Math.max(LW + 2, Math.min(mid - w / 2, LW + W - w - 2));
       if (hi <= lo || x0 < right + 4) { b.text.textContent = ""; return; }
       b.text.textContent = text;
