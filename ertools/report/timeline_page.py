@@ -562,6 +562,7 @@ SCRIPT = r"""
   }
 
   function render() {
+    var began = window.performance.now();
     var span = v1 - v0;
     svg.setAttribute("data-view-start", (D.t0 + v0).toFixed(6));
     svg.setAttribute("data-view-end", (D.t0 + v1).toFixed(6));
@@ -612,6 +613,7 @@ SCRIPT = r"""
     var ro = document.getElementById("tl-readout");
     ro.textContent = iso(v0).slice(0, 23).replace("T", " ") + " to " +
       iso(v1).slice(11, 23) + " UTC (" + fmtSpan(span) + " shown)";
+    svg.setAttribute("data-render-ms", (window.performance.now() - began).toFixed(2));
   }
   function fmtSpan(s) {
     if (s >= 7200) { return (s / 3600).toFixed(1) + " h"; }
