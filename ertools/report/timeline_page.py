@@ -542,10 +542,12 @@ SCRIPT = r"""
   });
 
   var STEPS = [0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10, 15, 30,
-               60, 120, 300, 600, 900, 1800, 3600, 7200, 10800, 21600, 43200, 86400];
+               60, 120, 300, 600, 900, 1800, 3600, 7200, 10800, 21600, 43200, 86400,
+               172800, 604800, 1209600, 2592000, 7776000, 31536000];
   function iso(t) { return new Date(Math.round((D.t0 + t) * 1000)).toISOString(); }
   function tickText(t, step) {
     var s = iso(t);
+    if (step >= 86400) { return s.slice(0, 10); }
     if (step >= 60) { return s.slice(11, 16); }
     if (step >= 1) { return s.slice(11, 19); }
     return s.slice(11, 23);
@@ -573,14 +575,17 @@ SCRIPT = r"""
     for (var i = 0; i < STEPS.length; i++) { if (STEPS[i] >= want) { step = STEPS[i]; break; } }
     var base = step >= 1 ? D.t0 % step : 0;
     var first = Math.ceil((v0 + base) / step) * step - base;
-    var lastDay = iso(v0).slice(0, 10);
+    var lastDay = iso(v0).slice(0, 10), labelEnd = -Infinity;
     for (var t = first, n = 0; t <= v1 && n < 200; t = first + (++n) * step) {
       var x = X(t);
       el("line", {"class": "tick", x1: x, x2: x, y1: 18, y2: H}, gGrid);
       var label = tickText(t, step), day = iso(t).slice(0, 10);
-      if (day !== lastDay) { label = day + " " + label; lastDay = day; }
-      if (x + 3 + label.length * 6.2 > LW + W) { continue; }  // would be cut at the edge
+      if (day !== lastDay && step < 86400) { label = day + " " + label; }
+      lastDay = day;
+      // no label cut at the edge or over the previous one (the line is still drawn)
+      if (x + 3 + label.length * 6.2 > LW + W || x < labelEnd + 6) { continue; }
       el("text", {"class": "tick-label", x: x + 3, y: 14}, gGrid).textContent = label;
+      labelEnd = x + 3 + label.length * 6.2;
     }
     dayLabel.textContent = iso(v0).slice(0, 10) + " UTC";
     // session bands and their labels (the full label where it fits, "S3" where only that does)
@@ -611,11 +616,14 @@ SCRIPT = r"""
     });
     drawLinks();
     var ro = document.getElementById("tl-readout");
-    ro.textContent = iso(v0).slice(0, 23).replace("T", " ") + " to " +
-      iso(v1).slice(11, 23) + " UTC (" + fmtSpan(span) + " shown)";
+    var a = iso(v0), b = iso(v1);
+    ro.textContent = a.slice(0, 23).replace("T", " ") + " to " +
+      (a.slice(0, 10) === b.slice(0, 10) ? b.slice(11, 23) : b.slice(0, 23).replace("T", " ")) +
+      " UTC (" + fmtSpan(span) + " shown)";
     svg.setAttribute("data-render-ms", (window.performance.now() - began).toFixed(2));
   }
   function fmtSpan(s) {
+    if (s >= 172800) { return (s / 86400).toFixed(1) + " days"; }
     if (s >= 7200) { return (s / 3600).toFixed(1) + " h"; }
     if (s >= 120) { return (s / 60).toFixed(1) + " min"; }
     if (s >= 1) { return s.toFixed(1) + " s"; }

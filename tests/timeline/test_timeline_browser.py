@@ -59,6 +59,8 @@ class Dom(HTMLParser):
         self.bands: list[dict[str, str]] = []
         self.clip: dict[str, str] = {}
         self.titles: list[str] = []
+        self.ticks: list[str] = []
+        self._tick: str | None = None
         self.tags: list[str] = []
         self.scripts = 0
         self._stack: list[str] = []
@@ -82,11 +84,16 @@ class Dom(HTMLParser):
             self.clip = a
         elif tag == "title":
             self._title = ""
+        elif tag == "text" and "tick-label" in cls:
+            self._tick = ""
         elif tag == "script":
             self.scripts += 1
 
     def handle_endtag(self, tag: str) -> None:
-        if tag == "clippath":
+        if tag == "text" and self._tick is not None:
+            self.ticks.append(self._tick)
+            self._tick = None
+        elif tag == "clippath":
             self._in_clip = False
         elif tag == "title" and self._title is not None:
             self.titles.append(self._title)
@@ -95,6 +102,8 @@ class Dom(HTMLParser):
     def handle_data(self, data: str) -> None:
         if self._title is not None:
             self._title += data
+        if self._tick is not None:
+            self._tick += data
 
 
 def dump(tmp_path: Path, url: str) -> tuple[Dom, str]:
@@ -178,6 +187,10 @@ def test_fragment_zooms_to_the_session(day: tuple[Timeline, Path], tmp_path: Pat
     assert float(gt["width"]) == pytest.approx(8.0 * px_per_s, abs=0.02)
     assert float(robot["x"]) - float(gt["x"]) == pytest.approx(1.0 * px_per_s, abs=0.02)
     assert float(robot["width"]) == pytest.approx(6.0 * px_per_s, abs=0.02)
+    # tick labels on whole seconds of the session (last: the date in the corner)
+    assert dom.ticks[-1] == "2015-11-20 UTC"
+    assert dom.ticks[:-1] == [f"10:30:0{i}" for i in range(len(dom.ticks) - 1)]
+    assert len(dom.ticks) - 1 >= 8  # 10:30:00 to 10:30:08 at least every second
     # the other sessions' bars are out of view (hours away)
     for path, b in bars.items():
         if path not in (
@@ -200,3 +213,39 @@ def test_sample_folder_page_in_the_browser(tmp_path: Path) -> None:
     assert sum("problem" in b.get("class", "") for b in dom.bars) == 4  # + 1 unreadable
     start, end = float(dom.svg["data-view-start"]), float(dom.svg["data-view-end"])
     assert start <= 1448031600.0 and end >= 1448031634.0 and end - start < 40.0
+
+
+REAL = Path(__file__).resolve().parents[2] / ".." / "shared" / "real_bags"
+
+
+@needs_browser
+@pytest.mark.real
+@pytest.mark.skipif(not REAL.is_dir(), reason=f"real 2015 bags not found at {REAL}")
+def test_real_and_simulated_logs_in_one_page(tmp_path: Path) -> None:
+    """The issue's acceptance: real and simulated logs, every session and problem shown."""
+    sample = Path(__file__).resolve().parents[2] / "sample_bags" / "timeline" / "bags"
+    tl = scan([REAL, sample])
+    page = write_timeline_page(tl, tmp_path / "mixed.html")
+    dom, stderr = dump(tmp_path, page.as_uri())
+    no_script_errors(stderr)
+    # the real GT bag (one session of its own, 2015-10-23) and the sample's 8 readable bags
+    # in its 2 sessions (answers file)
+    assert len(dom.bars) == 1 + 8
+    assert len(dom.bands) == 3 == len(tl.sessions)
+    labels = [t for t in dom.titles if t.startswith("session ")]
+    assert labels[0] == "session 1, 14:15:40-14:16:37, 1 bag"
+    assert labels[1:] == [
+        "session 2, 15:00:00-15:00:34, 6 bags",
+        "session 3, 15:00:40-15:00:46, 1 bag",
+    ]
+    tips = "\n".join(dom.titles)
+    for b in tl.bags:
+        if b.readable:
+            for problem in b.problems:
+                assert problem in tips, problem
+    start, end = float(dom.svg["data-view-start"]), float(dom.svg["data-view-end"])
+    assert start <= 1445609740.0 and end >= 1448031646.0  # fit day: October to November
+    # a month across: tick labels are dates, not times, and none repeats
+    dates = dom.ticks[:-1]
+    assert dates and all(len(d) == 10 and d.startswith("2015-1") for d in dates)
+    assert len(set(dates)) == len(dates)

@@ -178,6 +178,7 @@ def test_page_of_the_sample_folder() -> None:
     assert len(json.loads(page.script_text[0])["bags"]) == 8  # readable, the copy included
 
 
+@pytest.mark.real
 @pytest.mark.skipif(not REAL_BAG.exists(), reason=f"real 2015 bags not found at {REAL}")
 def test_page_of_the_real_bag() -> None:
     tl = scan([REAL])
