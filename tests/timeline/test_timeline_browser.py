@@ -60,6 +60,7 @@ class Dom(HTMLParser):
         self.clip: dict[str, str] = {}
         self.titles: list[str] = []
         self.ticks: list[str] = []
+        self.links = 0
         self._tick: str | None = None
         self.tags: list[str] = []
         self.scripts = 0
@@ -84,6 +85,8 @@ class Dom(HTMLParser):
             self.clip = a
         elif tag == "title":
             self._title = ""
+        elif tag == "line" and "link" in cls:
+            self.links += 1
         elif tag == "text" and "tick-label" in cls:
             self._tick = ""
         elif tag == "script":
@@ -199,6 +202,27 @@ def test_fragment_zooms_to_the_session(day: tuple[Timeline, Path], tmp_path: Pat
         ):
             x, w = float(b["x"]), float(b["width"])
             assert x + w <= left or x >= left + width, path
+
+
+@needs_browser
+def test_selecting_a_log_links_its_gt_files(day: tuple[Timeline, Path], tmp_path: Path) -> None:
+    tl, page = day
+    readable = [b.path for b in tl.bags if b.readable]
+    robot = readable.index("robots/FBM2H_201511201200_homer.bag")
+    dom, stderr = dump(tmp_path, page.as_uri() + f"#bag={robot}")
+    no_script_errors(stderr)
+    by_class = {
+        c: sorted(readable[int(b["data-i"])] for b in dom.bars if c in b["class"].split())
+        for c in ("sel", "linked")
+    }
+    assert by_class["sel"] == ["robots/FBM2H_201511201200_homer.bag"]
+    # the layout: the robot log (50-150 s) overlaps both split files around the GT gap
+    assert by_class["linked"] == [
+        "gt/log_fbm2h_mocap_2015-11-20-12-00-00_0.bag",
+        "gt/log_fbm2h_mocap_2015-11-20-12-00-00_1.bag",
+    ]
+    assert dom.links == 2  # a dashed line to each
+    assert "selecting" in dom.svg["class"]
 
 
 @needs_browser
