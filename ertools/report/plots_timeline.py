@@ -155,7 +155,7 @@ def draw_session(
     ax.set_xlim(x_lo, x_hi)
     ax.set_ylim(len(names) - 0.5, -0.5)
     ax.set_yticks(range(len(names)), labels=names, fontsize="small")
-    locator = mdates.AutoDateLocator(minticks=4, maxticks=10)
+    locator = mdates.AutoDateLocator(minticks=5, maxticks=12)
     ax.xaxis.set_major_locator(locator)
     ax.xaxis.set_major_formatter(mdates.ConciseDateFormatter(locator, show_offset=False))
     ax.tick_params(axis="x", labelsize="small")
@@ -248,7 +248,7 @@ def timeline_figure(timeline: Timeline) -> Any:
         ax.text(
             0.0,
             1.0,
-            "Problems\n" + "\n".join(lines),
+            ("Problems\n" if numbers else "") + "\n".join(lines),
             va="top",
             ha="left",
             fontsize=8,
