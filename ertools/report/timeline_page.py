@@ -727,7 +727,8 @@ SCRIPT = r"""
   var drag = null;
   svg.addEventListener("pointerdown", function (ev) {
     drag = {x: ev.clientX, a: v0, b: v1, moved: false};
-    svg.setPointerCapture(ev.pointerId);
+    // keep the drag when the pointer leaves the chart (not possible for every pointer)
+    try { svg.setPointerCapture(ev.pointerId); } catch (e) { /* drag without capture */ }
   });
   svg.addEventListener("pointermove", function (ev) {
     if (!drag) {

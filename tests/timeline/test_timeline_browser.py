@@ -64,6 +64,7 @@ class Dom(HTMLParser):
         self._tick: str | None = None
         self.tags: list[str] = []
         self.scripts = 0
+        self.body: dict[str, str] = {}
         self._stack: list[str] = []
         self._title: str | None = None
         self._in_clip = False
@@ -73,7 +74,9 @@ class Dom(HTMLParser):
         a = {k: v or "" for k, v in attrs}
         self.tags.append(tag)
         cls = a.get("class", "").split()
-        if tag == "svg" and a.get("id") == "tl-svg":
+        if tag == "body":
+            self.body = a
+        elif tag == "svg" and a.get("id") == "tl-svg":
             self.svg = a
         elif tag == "rect" and "bar" in cls:
             self.bars.append(a)
@@ -202,6 +205,65 @@ def test_fragment_zooms_to_the_session(day: tuple[Timeline, Path], tmp_path: Pat
         ):
             x, w = float(b["x"]), float(b["width"])
             assert x + w <= left or x >= left + width, path
+
+
+# Synthetic input, dispatched after the page's script ran: the chart's own handlers react to
+# it as to a mouse. What the view was before, and where the pointer is, go into the DOM.
+INPUT = """<script>
+(function () {
+  var svg = document.getElementById("tl-svg"), r = svg.getBoundingClientRect();
+  var clip = document.querySelector("#tl-clip rect");
+  var x = Math.round(r.left + (+clip.getAttribute("x")) + 0.25 * (+clip.getAttribute("width")));
+  var y = Math.round(r.top + 60);
+  document.body.setAttribute("data-before", [svg.getAttribute("data-view-start"),
+    svg.getAttribute("data-view-end"), x - r.left, svg.getAttribute("data-px-per-s")].join(","));
+  function send(type, cls, dx, extra) {
+    var init = {clientX: x + dx, clientY: y, bubbles: true, cancelable: true, pointerId: 1,
+                isPrimary: true, pointerType: "mouse", button: 0, buttons: 1};
+    for (var k in extra) { init[k] = extra[k]; }
+    svg.dispatchEvent(new cls(type, init));
+  }
+  %s
+  // the handlers redraw on the next animation frame, which a page being dumped may never
+  // get: a resize redraws at once, from the view the handlers set
+  window.dispatchEvent(new Event("resize"));
+})();
+</script>"""
+WHEEL = 'send("wheel", WheelEvent, 0, {deltaY: -400, deltaMode: 0});'
+DRAG = (
+    'send("pointerdown", PointerEvent, 0, {}); send("pointermove", PointerEvent, 60, {});'
+    'send("pointermove", PointerEvent, 120, {}); send("pointerup", PointerEvent, 120, {});'
+)
+
+
+@needs_browser
+@pytest.mark.parametrize("gesture", ["wheel", "drag"])
+def test_wheel_zooms_and_drag_pans(
+    day: tuple[Timeline, Path], tmp_path: Path, gesture: str
+) -> None:
+    _, page = day
+    html = page.read_text(encoding="utf-8")
+    code = INPUT % (WHEEL if gesture == "wheel" else DRAG)
+    test_page = tmp_path / f"{gesture}.html"
+    test_page.write_text(html.replace("</body>", code + "</body>"), encoding="utf-8")
+    dom, stderr = dump(tmp_path, test_page.as_uri())
+    no_script_errors(stderr)
+    start0, end0, pointer_px, px_per_s0 = map(float, dom.body["data-before"].split(","))
+    start, end = float(dom.svg["data-view-start"]), float(dom.svg["data-view-end"])
+    left = float(dom.clip["x"])
+    # the time under the pointer, before and after (pixels from the chart's left edge)
+    t_before = start0 + (pointer_px - left) / px_per_s0
+    px_per_s = float(dom.svg["data-px-per-s"])
+    if gesture == "wheel":
+        assert end - start < 0.9 * (end0 - start0)  # zoomed in
+        t_after = start + (pointer_px - left) / px_per_s
+        # zoomed around the pointer: the same time stays under it (1 ms on a 6 h view)
+        assert t_after == pytest.approx(t_before, abs=1e-3)
+    else:
+        # dragged 120 px to the right: the view moved 120 px worth of time to the left
+        assert end - start == pytest.approx(end0 - start0, rel=1e-9)
+        assert start == pytest.approx(start0 - 120 / px_per_s0, abs=1e-3)
+        assert dom.svg.get("class", "") == ""  # a drag is no click: nothing selected
 
 
 @needs_browser
