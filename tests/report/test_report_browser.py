@@ -39,9 +39,10 @@ FLAGS = [
     "--disable-sync",
     "--hide-scrollbars",
 ]
-# EXECUTING_GOAL in the timeline figure (ertools.report.plots_audit): its presence in the
-# screenshot proves the PNG beside the page was loaded and painted.
-EXECUTING_GOAL_RGB = (0x5F, 0xAE, 0x6E)
+# EXECUTING_GOAL in the timeline figure (ertools.report.plots_audit: Okabe-Ito's bluish
+# green, #009E73): its presence in the screenshot proves the PNG beside the page was loaded
+# and painted.
+EXECUTING_GOAL_RGB = (0x00, 0x9E, 0x73)
 
 
 class _Dom(HTMLParser):
