@@ -13,7 +13,7 @@ from ertools.streams import Machine
 from ertools.timeutil import ns_to_s
 
 _LANES = (Machine.CLIENT, Machine.REFBOX, Machine.BMBOX)  # bottom to top
-# Okabe & Ito's colour-blind-safe palette (2008) and three greys that differ in lightness.
+# Okabe & Ito's colour-blind-safe palette (2008), plus two greys that differ in lightness.
 OKABE_ITO = {
     "orange": "#E69F00",
     "sky blue": "#56B4E9",
@@ -23,7 +23,7 @@ OKABE_ITO = {
     "vermillion": "#D55E00",
     "reddish purple": "#CC79A7",
     "light grey": "#DDDDDD",
-    "grey": "#888888",
+    "dark grey": "#555555",
     "black": "#000000",
 }
 _P = OKABE_ITO
@@ -41,7 +41,7 @@ STATE_COLOURS: dict[Machine, dict[str, str]] = {
         "TRANSMITTING_GOAL": _P["reddish purple"],
         "EXECUTING_GOAL": _P["bluish green"],
         "WAITING_RESULT": _P["vermillion"],
-        "TRANSMITTING_SCORE": _P["grey"],
+        "TRANSMITTING_SCORE": _P["dark grey"],
         "END": _P["black"],
     },
     Machine.REFBOX: {
@@ -50,7 +50,7 @@ STATE_COLOURS: dict[Machine, dict[str, str]] = {
         "READY": _P["blue"],
         "EXECUTING_MANUAL_OPERATION": _P["yellow"],
         "EXECUTING_GOAL": _P["bluish green"],
-        "RECEIVED_SCORE": _P["grey"],
+        "RECEIVED_SCORE": _P["dark grey"],
         "END": _P["black"],
     },
     Machine.CLIENT: {
