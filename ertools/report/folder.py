@@ -560,7 +560,14 @@ def _provenance_context(
     configs: list[tuple[FileRecord, str | None]],
     written: list[str],
 ) -> dict[str, Any]:
-    file_columns = ["name", "size", "sha256", "path"]
+    file_columns = ["name", "size (bytes)", "sha256", "path"]
+
+    def files(records: list[FileRecord]) -> list[dict[str, Any]]:
+        return [
+            {"name": r.name, "size (bytes)": r.size, "sha256": r.sha256, "path": r.path}
+            for r in records
+        ]
+
     params: list[tuple[str, Any]] = []
     if score is not None:
         params += list(score.provenance.parameters)
@@ -574,10 +581,8 @@ def _provenance_context(
         ("command line", shlex.join(meta["argv"]) if meta["argv"] else None),
     ]
     return {
-        "inputs": h.table([r.to_dict() for r in input_records], columns=file_columns)
-        if input_records
-        else None,
-        "configs": h.table([r.to_dict() for r, _ in configs], columns=file_columns)
+        "inputs": h.table(files(input_records), columns=file_columns) if input_records else None,
+        "configs": h.table(files([r for r, _ in configs]), columns=file_columns)
         if configs
         else None,
         "config_texts": [(r.name, text) for r, text in configs if text is not None],

@@ -37,7 +37,8 @@ _LENGTH_M = (
     "distance_error best_distance_error d_min path_length raw_path_length target_length "
     "shape_floor x y dx dy target_x target_y robot_x robot_y robot_z gt_x gt_y gt_z error "
     "trans_error_m position_error rmse median max position_accuracy position_accuracy_m "
-    "distance_error_m epsilon suggested_d_min p50 p90 p95 p99 from_m to_m max_position_error"
+    "distance_error_m epsilon suggested_d_min p50 p90 p95 p99 from_m to_m max_position_error "
+    "dinstance_error translation spread_m"  # dinstance: the seed's spelling (Listing 13)
 )
 _ANGLE_RAD = (
     "target_theta robot_theta orientation_error_rad dtheta_unwrapped_rad orientation_accuracy "
@@ -48,7 +49,7 @@ _ANGLE_DEG = "theta_deg gt_theta_deg gt_spread_deg theta_error_deg"
 _TIME_S = (
     "execution_time execution_time_s segment_time_s start_s reached_s goal_s t_rel_s "
     "reference_time start_time end_time start end duration t from to offset estimated_offset "
-    "offset_uncertainty max_gap"
+    "offset_uncertainty max_gap segment_time start_segment_time end_segment_time result_s"
 )
 COLUMNS: dict[str, tuple[str, str]] = {
     **{k: ("length", "m") for k in _LENGTH_M.split()},
@@ -57,6 +58,14 @@ COLUMNS: dict[str, tuple[str, str]] = {
     **{k: ("angle", "deg") for k in _ANGLE_DEG.split()},
     **{k: ("time", "s") for k in _TIME_S.split()},
     "gt_offset_ms": ("time", "ms"),
+    "spread_deg": ("angle", "deg"),
+    # ``theta`` is radians in FBM2@Home's poses and degrees in FBM1's (as in 2015): the
+    # dotted key of a score says which.
+    "robot_pose.theta": ("angle", "rad"),
+    "target_pose.theta": ("angle", "rad"),
+    "answer.theta": ("angle", "deg"),
+    "ground_truth.theta": ("angle", "deg"),
+    "error.theta": ("angle", "deg"),
 }
 # Columns named by pattern: the d_min sweep's ``run_<i>`` (distance_error of run i).
 _PATTERNS: tuple[tuple[re.Pattern[str], tuple[str, str]], ...] = (
@@ -68,8 +77,12 @@ _SUFFIX = re.compile(r"_(m|mm|cm|rad|deg|s|ms)$")
 def quantity_of(name: str) -> tuple[str, str] | None:
     """(quantity, stored unit) of a column or key, or None for counts, ratios and text.
 
-    A dotted key (``runs_details.0.distance_error``) is looked up by its last part.
+    A dotted key (``runs_details.0.distance_error``) is looked up by its last two parts
+    (``robot_pose.theta``), then its last part.
     """
+    last_two = ".".join(name.rsplit(".", 2)[-2:])
+    if last_two in COLUMNS:
+        return COLUMNS[last_two]
     key = name.rsplit(".", 1)[-1]
     if key in COLUMNS:
         return COLUMNS[key]
