@@ -68,13 +68,25 @@ def _draw_errors(result: Any) -> Any:
         trans_mm = [r.errors.trans_error_m * units.factor("length", "m") for r in runs]
         theta = [abs(r.errors.theta_error_deg) for r in runs]
         width = 0.4
-        ax.bar([x - width / 2 for x in xs], trans_mm, width, color="#7570b3", label="|dxy| mm")
+        ax.bar(
+            [x - width / 2 for x in xs],
+            trans_mm,
+            width,
+            color="#7570b3",
+            label=units.label("|dxy|", "length"),
+        )
         ax.set_xlabel("run")
         ax.set_ylabel(units.label("translation error", "length"))
         ax.set_yscale("symlog", linthresh=10.0)
         ax.set_xticks([r.index for r in result.runs])
         twin = ax.twinx()
-        twin.bar([x + width / 2 for x in xs], theta, width, color="#e7298a", label="|dtheta| deg")
+        twin.bar(
+            [x + width / 2 for x in xs],
+            theta,
+            width,
+            color="#e7298a",
+            label=units.label("|dtheta|", "angle"),
+        )
         twin.set_ylabel(units.label("theta error", "angle"))
         twin.set_ylim(0, max([180.0 * 1.05, *theta]) if any(t > 20 for t in theta) else 20.0)
         lines = ax.get_legend_handles_labels()
