@@ -35,6 +35,12 @@ def fmt(value: Any) -> str:
     return str(value)
 
 
+def _utc(seconds: float) -> str:
+    from ertools.timeutil import iso_utc, s_to_ns
+
+    return iso_utc(s_to_ns(seconds)).replace("+00:00", "Z")
+
+
 @dataclass(frozen=True)
 class Cell:
     text: str
@@ -86,13 +92,17 @@ def table(
     shown = rows if max_rows is None else rows[:max_rows]
     # A unit only where the column holds numbers (fbm1's ``error`` is a message, not metres).
     numeric = {c for c in columns if any(units.is_number(r.get(c)) for r in rows)}
-    headers = tuple(units.header(c) if c in numeric else c for c in columns)
+    # Instants (epoch seconds, e.g. the trajectory's ``t``) read as UTC times, not 1.448e+09.
+    epoch = {c for c in numeric if units.is_epoch(c, [r.get(c) for r in rows])}
+    headers = tuple(
+        f"{c} (UTC)" if c in epoch else units.header(c) if c in numeric else c for c in columns
+    )
     out: list[Row] = []
     for row in shown:
         cells = []
         for col in columns:
             value = units.display(col, row.get(col))
-            text = fmt(value)
+            text = _utc(value) if col in epoch and units.is_number(value) else fmt(value)
             css = ["num"] if units.is_number(value) else []
             if col == "status":
                 css.append("status")

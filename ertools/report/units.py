@@ -96,6 +96,16 @@ def is_number(value: Any) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
 
+def is_epoch(name: str, values: list[Any]) -> bool:
+    """A time column of instants: every number in it is epoch seconds (after 2001)."""
+    from ertools.timeutil import EPOCH_THRESHOLD_S
+
+    if quantity_of(name) != ("time", "s"):
+        return False
+    numbers = [v for v in values if is_number(v) and not math.isnan(v)]
+    return bool(numbers) and all(v > EPOCH_THRESHOLD_S for v in numbers)
+
+
 def factor(quantity: str, stored: str) -> float:
     """What a value stored in ``stored`` units is multiplied by to show it."""
     return QUANTITIES[quantity].factors[stored]

@@ -233,3 +233,30 @@ def test_layout_is_fluid(reports: dict[str, Path], name: str) -> None:
     assert "max-width" not in rules[".figs"]
     assert "width: 100%" in rules["figure img"]
     assert "overflow-x: auto" in rules[".wrap"]  # wide tables scroll in their box
+
+
+def test_instants_read_as_utc(tmp_path: Path) -> None:
+    from datetime import UTC, datetime
+
+    from report_fakes import fbm3w_like
+
+    from ertools.report.folder import write_report
+
+    index = write_report(fbm3w_like(), tmp_path / "r", inputs=[], argv=[])
+    page = _page(index.parent)
+    runs = _table(page, "run", "start_time (UTC)")
+    # fbm3w_like's start times: 1.4e9 s and 1.4e9 + 30.5 s after the epoch.
+    expected = [
+        datetime.fromtimestamp(t, tz=UTC).strftime("%Y-%m-%dT%H:%M:%S.%fZ")
+        for t in (1.4e9, 1.4e9 + 30.5)
+    ]
+    assert (
+        _column(runs, "start_time (UTC)")
+        == expected
+        == [
+            "2014-05-13T16:53:20.000000Z",
+            "2014-05-13T16:53:50.500000Z",
+        ]
+    )
+    with (index.parent / "runs.csv").open(newline="") as fh:  # the CSV keeps epoch seconds
+        assert [float(r["start_time"]) for r in csv.DictReader(fh)] == [1.4e9, 1.4e9 + 30.5]
