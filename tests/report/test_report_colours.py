@@ -77,3 +77,37 @@ def test_a_phase_keeps_its_colour_across_lanes() -> None:
     assert bm["TRANSMITTING_GOAL"] == cl["WAITING_GOAL"]
     assert bm["WAITING_MANUAL_OPERATION"] == ref["EXECUTING_MANUAL_OPERATION"]
     assert bm["TRANSMITTING_SCORE"] == ref["RECEIVED_SCORE"]
+
+
+def test_timeline_bars_are_drawn_in_their_state_colour() -> None:
+    import sys
+    from pathlib import Path
+
+    from matplotlib.colors import to_rgba
+    from matplotlib.figure import Figure
+
+    from ertools.audit import audit_states
+    from ertools.report.plots_audit import draw_timeline
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "audit"))
+    from audit_streams import heartbeat
+    from test_audit import BMBOX, CLIENT, REFBOX
+
+    audit = audit_states(
+        heartbeat(Machine.BMBOX, BMBOX, 20.0),
+        heartbeat(Machine.REFBOX, REFBOX, 20.0),
+        heartbeat(Machine.CLIENT, CLIENT, 20.0),
+        benchmark="fbm2h",
+    )
+    ax = Figure().add_subplot()
+    draw_timeline(ax, audit)
+    bars = ax.collections[: len(audit.timeline)]
+    assert len(audit.timeline) >= 10
+    for bar, e in zip(bars, audit.timeline, strict=True):
+        expected = to_rgba(STATE_COLOURS[e.machine][e.state_name])
+        assert tuple(bar.get_facecolor()[0]) == pytest.approx(expected), e
+    # The legend: one entry per colour drawn, each naming its state(s).
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    drawn = {(e.machine, e.state_name) for e in audit.timeline}
+    assert len(labels) == len({STATE_COLOURS[m][s] for m, s in drawn})
+    assert any("EXECUTING_GOAL" in label for label in labels)
