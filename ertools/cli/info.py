@@ -87,8 +87,10 @@ def table(info: BagInfo) -> str:
         f"compression: {s.compression}",
         f"messages:    {s.message_count}",
     ]
-    if info.checked:
+    if info.checked and not info.check_problems:
         lines.append("check:       every chunk decompressed and every indexed record found")
+    for problem in info.check_problems:
+        lines.append(f"check:       {problem}")
     for problem in s.problems:
         lines.append(f"problem:     {problem}")
     rows = [
@@ -155,6 +157,8 @@ def run(args: argparse.Namespace) -> int:
             problems.append({"path": str(path), "problem": _one_line(fatal)})
         elif not info.summary.indexed:
             note(f"warning: {path}: not indexed (still recording?); counts come from a scan")
+        # each disagreement --check found is a line of its own
+        problems.extend({"path": str(path), "problem": _one_line(p)} for p in info.check_problems)
     if args.format == "table":
         text = "\n\n".join(table(i) for i in infos)
     else:
