@@ -188,3 +188,57 @@ def test_noise_topic_option_takes_a_covariance_pose(
     out = json.loads(capsys.readouterr().out)
     assert code == 0
     assert out["samples"] == N
+
+
+# --- the summary against the official readers -------------------------------------------------
+
+
+def official_summary(path: Path) -> tuple[dict[str, tuple[str, int, int, int]], int, int]:
+    """topic -> (type, count, first, last) and the bag's (start, end) by the official reader
+    of the format: rosbags for ROS1 and rosbag2, the mcap library for bare MCAP files."""
+    from ertools.io.model import short_msgtype
+
+    topics: dict[str, tuple[str, int, int, int]] = {}
+    if path.suffix == ".mcap":
+        from mcap.reader import make_reader
+
+        with path.open("rb") as f:
+            reader = make_reader(f)
+            summary = reader.get_summary()
+            assert summary is not None and summary.statistics is not None
+            stats = summary.statistics
+            times: dict[int, list[int]] = {}
+            for _schema, channel, message in reader.iter_messages():
+                times.setdefault(channel.id, []).append(message.log_time)
+            for cid, channel in summary.channels.items():
+                schema = summary.schemas[channel.schema_id]
+                ts = times.get(cid, [])
+                assert stats.channel_message_counts.get(cid, 0) == len(ts)
+                topics[channel.topic] = (short_msgtype(schema.name), len(ts), min(ts), max(ts))
+            return topics, stats.message_start_time, stats.message_end_time
+    from rosbags.highlevel import AnyReader
+
+    with AnyReader([path]) as reader:
+        seen: dict[str, list[int]] = {}
+        for conn, t, _raw in reader.messages():
+            seen.setdefault(conn.topic, []).append(t)
+        for conn in reader.connections:
+            ts = seen[conn.topic]
+            topics[conn.topic] = (short_msgtype(conn.msgtype), len(ts), min(ts), max(ts))
+        return topics, reader.start_time, reader.end_time - 1  # rosbags' end is exclusive
+
+
+def test_summary_matches_the_official_reader(typed_bag: Path) -> None:
+    from ertools.io.info import describe
+
+    path = typed_bag
+    topics, start, end = official_summary(path)
+    exact = describe(path).summary
+    assert (exact.start_ns, exact.end_ns) == (start, end)
+    assert exact.message_count == sum(v[1] for v in topics.values())
+    assert {t.name: (t.msgtype, t.count, t.first_ns, t.last_ns) for t in exact.topics} == topics
+    quick = eio.summary(path)  # from the chunk bounds: bag start and end still exact
+    assert (quick.start_ns, quick.end_ns) == (start, end)
+    assert {t.name: (t.msgtype, t.count) for t in quick.topics} == {
+        k: v[:2] for k, v in topics.items()
+    }
