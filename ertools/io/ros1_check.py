@@ -20,7 +20,7 @@ from __future__ import annotations
 import struct
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import BinaryIO
+from typing import TYPE_CHECKING, BinaryIO
 
 import numpy as np
 import numpy.typing as npt
@@ -43,6 +43,10 @@ from ertools.io.ros1_records import (
     u32,
     u64,
 )
+
+if TYPE_CHECKING:
+    from ertools.io.model import Conn
+    from ertools.io.ros1_index import Ros1Layout
 
 I64 = npt.NDArray[np.int64]
 U8 = npt.NDArray[np.uint8]
@@ -424,3 +428,78 @@ def _compare_chunk(
                 f"{tag}: {int(np.count_nonzero(missed))} message records not in the index "
                 f"data (first at chunk offset {_first(missed, off)})"
             )
+
+
+def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ros1Layout:
+    """The layout of a closed bag rebuilt from its records, for a reader that stopped trusting
+    the index: record times and offsets come from the message records themselves; the
+    index-data offsets only say where to look first (:func:`chunk_records`), so the cost is
+    one decompression per chunk and a few NumPy passes, not a Python step per message.
+    Falls back to :func:`ertools.io.ros1_index.scan_layout` (record by record) for anything
+    but chunks, index data and index records at the top level.
+    """
+    from ertools.io.ros1_index import (
+        Ros1Chunk,
+        Ros1Layout,
+        _conn,
+        _entries_from_index,
+        decompress,
+        scan_layout,
+    )
+
+    start = pos
+    conns: dict[int, Conn] = {}
+    found: list[tuple[int, str, int, int, bytes, list[I64]]] = []
+    problems = [why]
+    try:
+        while pos < size:
+            rec, data = read_record(f, pos, size, with_data=True)
+            if rec.op == OP_CHUNK:
+                compression = rec.fields.get("compression", b"none").decode("ascii", "replace")
+                found.append((pos, compression, rec.data_pos, rec.data_len, data, []))
+            elif rec.op == OP_INDEX and found:
+                found[-1][5].append(_entries_from_index(data[: 12 * (len(data) // 12)])[1])
+            elif rec.op == OP_CONNECTION:
+                cid, topic, cf = connection_fields(rec, data)
+                conns.setdefault(cid, _conn(cid, topic, cf))
+            elif rec.op != OP_CHUNK_INFO:
+                raise RecordError(f"record of op {rec.op} outside a chunk", pos)
+            pos = rec.end
+    except (RecordError, KeyError, IndexError, struct.error):
+        return scan_layout(f, path, size, start, why)
+    chunks = []
+    for cpos, compression, data_pos, data_len, data, hints in found:
+        try:
+            buf = np.frombuffer(decompress(compression, data, f"at byte {cpos}"), np.uint8)
+        except BagError as err:
+            problems.append(f"corrupt chunk at byte {cpos} skipped ({err.message})")
+            continue
+        recs = chunk_records(
+            buf, np.concatenate(hints) if hints else np.empty(0, np.int64), data_pos
+        )
+        if recs.problems:
+            return scan_layout(f, path, size, start, why)
+        for cid, (topic, msgtype, md5) in recs.conns.items():
+            fields = {"type": msgtype.encode(), "md5sum": md5.encode()}
+            conns.setdefault(cid, _conn(cid, topic, fields))
+        if not len(recs.msg_off):
+            continue
+        entries = {
+            int(cid): (recs.msg_time[recs.msg_conn == cid], recs.msg_off[recs.msg_conn == cid])
+            for cid in np.unique(recs.msg_conn)
+        }
+        chunks.append(
+            Ros1Chunk(
+                cpos,
+                int(recs.msg_time.min()),
+                int(recs.msg_time.max()),
+                {cid: len(t) for cid, (t, _o) in entries.items()},
+                compression,
+                data_pos,
+                data_len,
+                entries,
+            )
+        )
+    return Ros1Layout(
+        path, size, False, sorted(conns.values(), key=lambda c: c.id), chunks, problems
+    )

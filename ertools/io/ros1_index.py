@@ -617,8 +617,12 @@ class Ros1Bag(BagFile):
             self.path,
             why,
         )
+        from ertools.io.ros1_check import rebuild_layout
+
         self._unmap()
-        self.layout = scan_layout(self.file, self.path, self.layout.size, _first_record(self), why)
+        self.layout = rebuild_layout(
+            self.file, self.path, self.layout.size, _first_record(self), why
+        )
 
     def spans(self, buf: U8, offsets: I64, where: str) -> tuple[I64, I64]:
         """(data start, data length) of the message records at ``offsets`` of a chunk.

@@ -264,3 +264,31 @@ def test_fast_path_on_a_sound_bag_warns_nothing(
         rec = eio.read_poses(path, "/pose", time_source="record")
     np.testing.assert_array_equal(rec.t_ns, truth_record_times())
     assert not [r for r in caplog.records if r.levelno >= logging.WARNING]
+
+
+@pytest.mark.parametrize("fmt", ["ros1", "ros1-lz4"])
+def test_rebuilt_layout_equals_the_record_by_record_scan(tmp_path: Path, fmt: str) -> None:
+    from ertools.io.ros1_check import rebuild_layout
+    from ertools.io.ros1_index import scan_layout
+
+    path = two_topic_bag(tmp_path / "b.bag", fmt)
+    size = path.stat().st_size
+    first = records(path.read_bytes())[0]
+    header_end = first[3] + first[4]
+    with path.open("rb") as f:
+        fast = rebuild_layout(f, path, size, header_end, "test")
+        slow = scan_layout(f, path, size, header_end, "test")
+    assert [c.id for c in fast.conns] == [c.id for c in slow.conns] == [0, 1]
+    assert [(c.topic, c.msgtype, c.msgdef) for c in fast.conns] == [
+        (c.topic, c.msgtype, c.msgdef) for c in slow.conns
+    ]
+    assert len(fast.chunks) == len(slow.chunks) > 3
+    for a, b in zip(fast.chunks, slow.chunks, strict=True):
+        assert (a.pos, a.start_ns, a.end_ns, a.counts) == (b.pos, b.start_ns, b.end_ns, b.counts)
+        assert a.entries is not None and b.entries is not None
+        for cid in b.entries:
+            np.testing.assert_array_equal(a.entries[cid][0], b.entries[cid][0])
+            np.testing.assert_array_equal(a.entries[cid][1], b.entries[cid][1])
+    # and the total is what was written: N poses, one Pose2D every third
+    assert sum(c.counts.get(0, 0) for c in fast.chunks) == N
+    assert sum(c.counts.get(1, 0) for c in fast.chunks) == N // 3
