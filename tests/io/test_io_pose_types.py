@@ -242,3 +242,20 @@ def test_summary_matches_the_official_reader(typed_bag: Path) -> None:
     assert {t.name: (t.msgtype, t.count) for t in quick.topics} == {
         k: v[:2] for k, v in topics.items()
     }
+
+
+def test_trajectory_robot_topic_of_several_tf_bodies_is_refused(tmp_path: Path) -> None:
+    from ertools.benchmarks.trajectory import read_robot
+    from ertools.errors import TopicError
+
+    s = Spec()
+    c = s.conn("/tf", "tf2_msgs/TFMessage")
+    for i in range(3):
+        tfs = [
+            dict(stamp=T0 + i, frame="map", child=child, xyz=(i, 0, 0), q=(0, 0, 0, 1))
+            for child in ("base_link", "arm")
+        ]
+        s.add(c, T0 + i, transforms=tfs)
+    path = write(tmp_path / "tf.bag", "ros1", s)
+    with pytest.raises(TopicError, match=r"several frames \(map -> arm, map -> base_link\)"):
+        read_robot(str(path), "/tf", "header")
