@@ -188,9 +188,10 @@ def chunk_records(buf: U8, hints: I64, base: int) -> ChunkRecords:
             break
         try:
             if op == OP_MSG:
+                cid, when = u32(fields, "conn"), time_ns(fields, "time")  # both, or neither
                 offs.append(np.array([pos], dtype=np.int64))
-                conns.append(np.array([u32(fields, "conn")], dtype=np.int64))
-                times.append(np.array([time_ns(fields, "time")], dtype=np.int64))
+                conns.append(np.array([cid], dtype=np.int64))
+                times.append(np.array([when], dtype=np.int64))
             elif op == OP_CONNECTION:
                 cf = parse_fields(raw[dpos : dpos + dlen], base + dpos)
                 topic = fields.get("topic", cf.get("topic", b""))

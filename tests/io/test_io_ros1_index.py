@@ -292,3 +292,19 @@ def test_rebuilt_layout_equals_the_record_by_record_scan(tmp_path: Path, fmt: st
     # and the total is what was written: N poses, one Pose2D every third
     assert sum(c.counts.get(0, 0) for c in fast.chunks) == N
     assert sum(c.counts.get(1, 0) for c in fast.chunks) == N // 3
+
+
+def test_message_record_without_its_conn_field(tmp_path: Path) -> None:
+    """A renamed header field: the record is reported unreadable and the index entry and
+    chunk-info count that still call it a message disagree (regression: no crash)."""
+    good = two_topic_bag(tmp_path / "good.bag")
+    raw = bytearray(good.read_bytes())
+    chunk = of_op(bytes(raw), 0x05)[1]
+    at = raw.index(b"conn=", chunk[3] + 200)  # a message record's header inside chunk 2
+    raw[at + 3] = ord("X")
+    bad = tmp_path / "noconn.bag"
+    bad.write_bytes(bytes(raw))
+    lines = check_ros1(bad)
+    assert lines[0].startswith(f"chunk at byte {chunk[0]}: unreadable record at chunk offset")
+    assert any("index entries point at no message record" in x for x in lines[1:])
+    assert any("chunk info counts" in x for x in lines[1:])
