@@ -164,8 +164,9 @@ def read_layout(path: Path) -> Ros1Layout:
             raise BagError(f"unreadable ROS1 bag header ({err}); not a bag?", path=path) from err
         if index_pos == 0:
             return scan_layout(f, path, size, head.end, "not indexed (recording not closed)")
-        if index_pos == size and conn_count == 0 and chunk_count == 0:
-            # What a recorder leaves when nothing arrived: the header and an empty index.
+        if head.end == index_pos == size and conn_count == 0 and chunk_count == 0:
+            # What a recorder leaves when nothing arrived: the header, then an empty index
+            # (nothing between them; records there would mean a damaged header: scanned).
             return Ros1Layout(path, size, True, [], [])
         if index_pos >= size:
             return scan_layout(

@@ -308,3 +308,18 @@ def test_message_record_without_its_conn_field(tmp_path: Path) -> None:
     assert lines[0].startswith(f"chunk at byte {chunk[0]}: unreadable record at chunk offset")
     assert any("index entries point at no message record" in x for x in lines[1:])
     assert any("chunk info counts" in x for x in lines[1:])
+
+
+def test_a_header_claiming_an_empty_index_over_chunks_is_not_an_empty_bag(tmp_path: Path) -> None:
+    """Only a header followed by nothing is an empty bag: chunks after a header that says
+    "no connections, no chunks, index at the end" are scanned and flagged."""
+    raw = bytearray(two_topic_bag(tmp_path / "b.bag").read_bytes())
+    _pos, _op, fields, _dpos, _dlen = records(bytes(raw))[0]
+    struct.pack_into("<Q", raw, fields["index_pos"][0], len(raw))
+    struct.pack_into("<I", raw, fields["conn_count"][0], 0)
+    struct.pack_into("<I", raw, fields["chunk_count"][0], 0)
+    path = tmp_path / "liar.bag"
+    path.write_bytes(bytes(raw))
+    s = eio.summary(path)
+    assert (s.message_count, s.indexed) == (N + N // 3, False)
+    assert s.problems
