@@ -109,8 +109,9 @@ def read_fbm3w_poses(paths: Sequence[Path], options: Fbm3wOptions) -> PoseStream
             log.warning("%s absent; using the /tf frame %s", DEFAULT_TOPIC, DEFAULT_FRAME)
             source = PoseSource(frame=DEFAULT_FRAME)
         else:
-            pose_types = ("Pose2D", "PoseStamped", "TransformStamped", "Odometry", "TFMessage")
-            found = [t for t, ty in present.items() if ty.rsplit("/", 1)[-1] in pose_types]
+            from ertools.io.model import POSE_TYPES
+
+            found = [t for t, ty in present.items() if ty in POSE_TYPES]
             raise TopicError(
                 f"no end-effector poses: {DEFAULT_TOPIC}, {FALLBACK_TOPIC} and /tf are absent "
                 f"(pose topics there: {', '.join(found) or 'none'}); choose one with --topic",

@@ -47,7 +47,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--topic",
         metavar="TOPIC",
-        help="marker set pose topic, PoseStamped or Pose2D (default /fbm2h/robot_at_home/pose)",
+        help="marker set pose topic, any pose type (default /fbm2h/robot_at_home/pose)",
     )
     parser.add_argument(
         "--tf-frame",

@@ -152,8 +152,8 @@ def read_poses(
 
     Args:
         paths: one bag or a logger's split files.
-        topic: a ``PoseStamped``, ``Pose2D``, ``TransformStamped``, ``Odometry`` or single-child
-            TF topic.
+        topic: a ``PoseStamped``, ``Pose2D``, ``TransformStamped``,
+            ``PoseWithCovarianceStamped``, ``Odometry`` or single-child TF topic.
         time_source: ``header`` (message stamp, default) or ``record`` (bag record time).
             ``Pose2D`` has no header and always uses the record time.
         start_ns, end_ns: keep samples with start_ns <= t <= end_ns (t as chosen above).
