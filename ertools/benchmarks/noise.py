@@ -220,6 +220,72 @@ def identical_poses(poses: PoseStream) -> Bool:
     return np.asarray(same_xyz & same_q)
 
 
+# Identical poses lasting longer than this around a scored moment are reported. Real mocap
+# measurements never repeat all 7 float64 exactly (0.05 mm of noise is ~1e11 float64 steps),
+# so a repeat is Motive re-sending the last pose after losing the rigid body; at 120 Hz
+# 0.1 s is 12 frames, the FBM2H --max-gap default: a frozen stretch that long is a gap of the
+# size ertools refuses, disguised as data.
+FROZEN_MIN_S = 0.1
+
+
+@dataclass(frozen=True)
+class FrozenSpan:
+    """A run of identical poses (position and orientation repeated exactly).
+
+    Attributes:
+        start_ns: the last real measurement (the pose that was then repeated).
+        end_ns: the last repetition.
+        samples: poses in the run, the first included.
+    """
+
+    start_ns: int
+    end_ns: int
+    samples: int
+
+    @property
+    def duration_s(self) -> float:
+        return (self.end_ns - self.start_ns) / 1e9
+
+
+def frozen_around(
+    poses: PoseStream, query_ns: npt.ArrayLike, min_s: float = FROZEN_MIN_S
+) -> list[FrozenSpan | None]:
+    """For each moment, the frozen run (longer than ``min_s``) its pose comes from, or None.
+
+    The pose at a moment is taken from the samples just before and just after it (held or
+    interpolated); the moment is *frozen* when either of them belongs to a run of identical
+    poses (:func:`identical_poses`) spanning more than ``min_s``: the ground truth there is
+    the repeated last pose of a lost rigid body, not a measurement.
+    """
+    q = np.asarray(query_ns, dtype=np.int64).reshape(-1)
+    out: list[FrozenSpan | None] = [None] * len(q)
+    same = identical_poses(poses)
+    if not same.any() or not len(q):
+        return out
+    n = len(poses)
+    t = poses.t_ns
+    # Sample k is in a run when it repeats its predecessor or is repeated by its successor.
+    prev_same = np.concatenate([[False], same])
+    next_same = np.concatenate([same, [False]])
+    in_run = prev_same | next_same
+    first = in_run & ~prev_same
+    run_id = np.cumsum(first) - 1
+    starts = np.flatnonzero(first)
+    ends = np.flatnonzero(in_run & ~next_same)
+    long_run = (t[ends] - t[starts]) > round(min_s * 1e9)
+    if not long_run.any():
+        return out
+    before = np.searchsorted(t, q, side="right") - 1
+    for k, i in enumerate(before.tolist()):
+        for j in (i, i + 1):
+            if 0 <= j < n and in_run[j] and long_run[run_id[j]]:
+                r = int(run_id[j])
+                a, b = int(starts[r]), int(ends[r])
+                out[k] = FrozenSpan(int(t[a]), int(t[b]), b - a + 1)
+                break
+    return out
+
+
 def noise_from_stream(
     poses: PoseStream,
     *,
