@@ -10,7 +10,7 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -26,11 +26,17 @@ from ertools.benchmarks.fbm3w_runs import (
     find_windows,
     with_specs,
 )
-from ertools.benchmarks.noise import DEFAULT_C, NoiseResult, identical_poses, noise_from_stream
+from ertools.benchmarks.noise import (
+    DEFAULT_C,
+    NoiseResult,
+    frozen_around,
+    identical_poses,
+    noise_from_stream,
+)
 from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
 from ertools.configs.shapes import Shape
 from ertools.errors import ConfigError, ErtoolsError, ScoringError, TopicError
-from ertools.streams import PoseStream, Provenance
+from ertools.streams import PoseStream, Provenance, frame_change_warning
 
 log = logging.getLogger("ertools.benchmarks.fbm3w")
 
@@ -50,6 +56,19 @@ FLOOR_SAMPLES = 10_001
 FLOOR_WARN_M = 0.0005
 # A kept path this much longer than the target is suspicious (the sample's runs: 1.00-1.01).
 LONG_PATH_RATIO = 1.15
+
+# What ertools does differently from the 2015 node with runs the RefBox ended (2015:
+# ``if benchmark.Timeout(): execution_time += ...`` before ``if not benchmark.Running():
+# continue``, in rockin_scoring/scripts/fbm3w).
+DEVIATION_TIMEOUT_RUNS = (
+    "a run the RefBox timed out is listed with its time and no distance_error and cannot be "
+    "the best run; the 2015 node scored it on the path it had covered and it could be the best "
+    "run (use --timeout-runs 2015)"
+)
+DEVIATION_STOPPED_RUNS = (
+    "a run the RefBox stopped counts in execution_time; the 2015 node treated it as aborted and "
+    "left its time out (use --stopped-runs 2015)"
+)
 
 Window = tuple[str, float, float, float]
 F64 = npt.NDArray[np.float64]
@@ -71,6 +90,11 @@ class Fbm3wOptions:
         noise_c: factor of the suggested d_min (c * epsilon).
         arc_length: compare at equal fractions of the target's arc length instead of the
             shape's own parameter (2015); removes the floor of shapes such as ``sine``.
+        timeout_runs: ``unscored`` (default: a run the RefBox timed out is listed without a
+            distance_error) or ``2015`` (scored on the path it covered and eligible as best
+            run, as the 2015 node did).
+        stopped_runs: ``counted`` (default: a run the RefBox stopped counts in
+            execution_time) or ``2015`` (its time left out, as the 2015 node did).
     """
 
     runs: str | None = None
@@ -84,6 +108,31 @@ class Fbm3wOptions:
     min_still_s: float | None = None
     noise_c: float = DEFAULT_C
     arc_length: bool = False
+    timeout_runs: str = "unscored"
+    stopped_runs: str = "counted"
+
+
+TIMEOUT_RUNS = ("unscored", "2015")
+STOPPED_RUNS = ("counted", "2015")
+
+
+def options_2015(options: Fbm3wOptions) -> Fbm3wOptions:
+    """``options`` with every FBM3W 2015 behaviour on (``--2015``).
+
+    Timed-out runs scored and eligible, stopped runs' time left out, the shapes at their own
+    parameter, and the script's hard-coded D_MIN unless ``--d-min`` says otherwise.
+
+    Raises:
+        ConfigError: ``--arc-length`` asked for as well (it is not 2015).
+    """
+    if options.arc_length:
+        raise ConfigError("--2015 and --arc-length contradict each other (2015 had no arc length)")
+    return replace(
+        options,
+        timeout_runs="2015",
+        stopped_runs="2015",
+        d_min=DEFAULT_D_MIN if options.d_min is None else options.d_min,
+    )
 
 
 def read_fbm3w_poses(paths: Sequence[Path], options: Fbm3wOptions) -> PoseStream:
@@ -136,6 +185,11 @@ def score_fbm3w(
     plist = [Path(p) for p in paths]
     if options.runs is not None and options.runs not in RUN_MODES:
         raise ConfigError(f"--runs must be one of {', '.join(RUN_MODES)}, not {options.runs!r}")
+    if options.timeout_runs not in TIMEOUT_RUNS or options.stopped_runs not in STOPPED_RUNS:
+        raise ConfigError(
+            f"--timeout-runs must be one of {', '.join(TIMEOUT_RUNS)} and --stopped-runs one "
+            f"of {', '.join(STOPPED_RUNS)}"
+        )
     poses = read_fbm3w_poses(plist, options)
     bag_start = min(summary(p).start_ns for p in plist)
     mode = options.runs
@@ -197,6 +251,9 @@ def score_runs(
     runs_in, warnings = with_specs(list(windows), cfg)
     noise = _noise(poses, options, warnings)
     same = identical_poses(poses)
+    frames = frame_change_warning(poses, start_ns)
+    if frames:
+        warnings.append(frames)
     results: list[RunResult] = []
     failures: list[str] = []
     for window in runs_in:
@@ -213,6 +270,7 @@ def score_runs(
             f"suggested d_min {noise.suggested_d_min:.5f} m ({noise.c:g} * epsilon); see "
             "--d-min-sweep"
         )
+    warnings.extend(_frozen_warnings(poses, runs_in, start_ns))
     mode = runs_in[0].mode if runs_in else (options.runs or "states")
     return Fbm3wResult(
         runs=tuple(results),
@@ -229,9 +287,40 @@ def score_runs(
                 ("d_min", repr(cfg.d_min)),
                 ("runs", mode),
                 ("poses", poses.source),
+                ("timeout_runs", options.timeout_runs),
+                ("stopped_runs", options.stopped_runs),
             ),
         ),
+        count_stopped=options.stopped_runs != "2015",
     )
+
+
+def _frozen_warnings(poses: PoseStream, runs: Sequence[RunWindow], origin_ns: int) -> list[str]:
+    """A warning per run whose reference, start or end pose is a frozen (repeated) pose.
+
+    The reference and starting positions set the run frame: a pose repeated for longer than
+    :data:`~ertools.benchmarks.noise.FROZEN_MIN_S` there is the last pose before a tracking
+    loss, not where the marker set was.
+    """
+    moments: list[tuple[int, str, int]] = []
+    for w in runs:
+        for what, t in (("reference", w.ref_ns), ("start", w.start_ns), ("end", w.end_ns)):
+            if t is not None:
+                moments.append((w.index, what, t))
+    if not moments:
+        return []
+    spans = frozen_around(poses, [m[2] for m in moments])
+    out = []
+    for (index, what, t), span in zip(moments, spans, strict=True):
+        if span is None:
+            continue
+        out.append(
+            f"run {index}: the pose at its {what} time {(t - origin_ns) / 1e9:.3f} s is frozen: "
+            f"{span.samples} identical poses over {span.duration_s:.3f} s "
+            f"({(span.start_ns - origin_ns) / 1e9:.3f}-{(span.end_ns - origin_ns) / 1e9:.3f} s "
+            "from the log's first message; tracking lost, or a noiseless recording)"
+        )
+    return out
 
 
 def _noise(poses: PoseStream, options: Fbm3wOptions, warnings: list[str]) -> NoiseResult | None:
@@ -287,8 +376,9 @@ def _score_one(
     if options.arc_length:
         shape = shape.by_arc_length()
     target_length = shape.length()
-    if window.status in ("interrupted", "timeout", "stopped"):
-        return result(None, target_length=target_length)  # reported, not scored (as 2015)
+    partial = window.status == "timeout" and options.timeout_runs == "2015"
+    if window.status in ("interrupted", "timeout", "stopped") and not partial:
+        return result(None, target_length=target_length)  # reported, not scored
     if window.status == "incomplete":
         return result("the log ends during the run; no complete path to score")
     if window.start_ns is None or window.end_ns is None or window.ref_ns is None:
@@ -330,6 +420,12 @@ def _score_one(
         warnings.append(
             f"run {window.index}: the reference and starting positions are only "
             f"{baseline * 1000:.1f} mm apart; the run frame's direction is uncertain"
+        )
+    if partial:
+        warnings.append(
+            f"run {window.index} was ended by a RefBox timeout: scored on the "
+            f"{score.path_length:.4f} m of path it covered (target {target_length:.4f} m), "
+            "normalised by its own length, and eligible as best run (--timeout-runs 2015)"
         )
     ratio = score.path_length / target_length
     if ratio > LONG_PATH_RATIO:
@@ -410,9 +506,8 @@ def _deviations(
             "targets compared at equal fractions of their arc length (--arc-length); 2015 "
             "evaluated each shape at its own parameter"
         )
-    if any(r.window.status in ("timeout", "stopped") for r in runs):
-        out.append(
-            "a timed-out or stopped run is listed with its spec and time and no distance_error; "
-            "the 2015 node counted its time and wrote no details for it"
-        )
+    if options.timeout_runs != "2015" and any(r.window.status == "timeout" for r in runs):
+        out.append(DEVIATION_TIMEOUT_RUNS)
+    if options.stopped_runs != "2015" and any(r.window.status == "stopped" for r in runs):
+        out.append(DEVIATION_STOPPED_RUNS)
     return out
