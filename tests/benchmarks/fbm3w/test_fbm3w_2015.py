@@ -321,3 +321,24 @@ def test_2015_and_arc_length_contradict(
     assert main(["score", "fbm3w", str(fbm3w_sample.bag), "--2015", "--arc-length"]) == 2
     err = capsys.readouterr().err
     assert err.startswith("ertools: error:") and "--arc-length" in err
+
+
+def test_frozen_reference_pose_is_warned() -> None:
+    common = {"path_s": 3.0, "origin": (0.3, 0.2), "yaw": 0.5}
+    runs = [{"spec": "line", "track": {"reach": 1.0, "offset": 0.0, **common}}]
+    poses, states, _, _ = _scenario(runs, None, seed=11)
+    windows = find_states(states)
+    assert windows[0].ref_ns == 2 * S  # COMPLETED_MANUAL_OPERATION at 2.0 s
+    # The marker set is lost from 1.5 s to 2.5 s: Motive repeats the pose of 1.5 s.
+    a, b = np.searchsorted(poses.t_ns, [round(1.5 * S), round(2.5 * S)])
+    xyz = poses.xyz.copy()
+    xyz[a:b] = xyz[a]
+    frozen = PoseStream(poses.t_ns, xyz, poses.quat_xyzw, "world", "robot_at_work", "sim")
+    result = score_runs(frozen, windows, Fbm3wConfig(), bag_start_ns=0)
+    lines = [w for w in result.warnings if "frozen" in w]
+    assert len(lines) == 1
+    assert lines[0].startswith("run 0: the pose at its reference time 2.000 s is frozen")
+    assert f"{b - a} identical poses" in lines[0] and "(1.500-2.492 s" in lines[0]
+    # Unfrozen, nothing is said.
+    plain = score_runs(poses, windows, Fbm3wConfig(), bag_start_ns=0)
+    assert not [w for w in plain.warnings if "frozen" in w]
