@@ -44,5 +44,5 @@ def test_between_samples_and_only_position_repeated() -> None:
     spans = frozen_around(moved, [s.t_ns[12], s.t_ns[38]])
     assert spans == [
         FrozenSpan(int(s.t_ns[10]), int(s.t_ns[24]), 15),
-        FrozenSpan(int(s.t_ns[25]), int(s.t_ns[40]), 16),
+        FrozenSpan(int(s.t_ns[26]), int(s.t_ns[40]), 15),
     ]
