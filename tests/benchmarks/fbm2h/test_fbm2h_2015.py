@@ -383,3 +383,15 @@ def test_frame_id_change_is_warned_in_output_and_report(
     assert "frame_id 'world' -> 'optitrack' at 3.000 s" in line
     texts = [p.read_text(errors="replace") for p in report.rglob("*") if p.is_file()]
     assert any("'world' -> 'optitrack'" in t for t in texts)
+
+
+def test_lost_gt_is_still_a_failure_with_2015() -> None:
+    run = _run(2, "timeout", seed=12)
+    m = run["marker"]
+    # No sample from 9.5 s to 10.5 s: segment 1's reached moment (10.0 s) has no ground truth.
+    keep = (m.t_ns < T0 + round(9.5 * S)) | (m.t_ns > T0 + round(10.5 * S))
+    run["marker"] = m.take(keep)
+    result = _compute(run, orientation_2015=True, unscored_2015=True)
+    assert result.segments[1].status == "no_gt"
+    assert result.position_accuracy is None and result.orientation_accuracy is None
+    assert len(result.failures) == 1 and "segment 1: no ground truth" in result.failures[0]

@@ -342,3 +342,21 @@ def test_frozen_reference_pose_is_warned() -> None:
     # Unfrozen, nothing is said.
     plain = score_runs(poses, windows, Fbm3wConfig(), bag_start_ns=0)
     assert not [w for w in plain.warnings if "frozen" in w]
+
+
+def test_2015_uses_the_script_d_min_over_the_config(
+    fbm3w_sample: Sample, tmp_path: Any, capsys: pytest.CaptureFixture[str]
+) -> None:
+    config = tmp_path / "fbm3w.yaml"
+    config.write_text("runs_specifications: [line, spline, line, spline, line]\nd_min: 0.001\n")
+    argv = ["score", "fbm3w", str(fbm3w_sample.bag), "--config", str(config), "--format", "json"]
+    assert main(argv) == 0
+    assert json.loads(capsys.readouterr().out)["runs_details"]["0"]["d_min"] == 0.001
+    assert main([*argv, "--2015"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert {r["d_min"] for r in out["runs_details"].values()} == {D_MIN}
+    # --d-min still wins, and is then a deviation.
+    assert main([*argv, "--2015", "--d-min", "0.0005"]) == 0
+    captured = capsys.readouterr()
+    assert json.loads(captured.out)["runs_details"]["0"]["d_min"] == 0.0005
+    assert "differs from 2015: d_min = 0.0005 m" in captured.err
