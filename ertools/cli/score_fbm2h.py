@@ -196,6 +196,15 @@ def _print_table(result: object) -> None:
         f"reached moments: {result.reached_method}; transform: {result.transform.source}; "
         "times from the log's first message"
     )
+    n = len(result.segments)
+    scored = sum(s.status == "ok" for s in result.segments)
+    if result.position_accuracy is None:
+        averaged = "none (a segment is not scored: see the warnings)"
+    elif result.unscored_2015:
+        averaged = f"sum over the {scored} scored segment(s) / N = {n} (2015)"
+    else:
+        averaged = f"mean over all {n} segments"
+    note(f"accuracies: {averaged}")
     for row in result.tables()["segments"]:
         values = ("reached_s", "segment_time_s", "distance_error_m", "orientation_error_rad")
         if row["status"] != "ok" or any(row[k] is None for k in values):

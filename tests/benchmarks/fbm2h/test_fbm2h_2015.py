@@ -145,7 +145,11 @@ def test_sample_bag_2015_equals_the_node(
     folder = str(fbm2h_sample.folder)
     argv = ["score", "fbm2h", str(bag), "--team", "simbot", "--transforms", folder]
     assert main([*argv, "--2015", "--format", "json"]) == 0
-    _check(json.loads(capsys.readouterr().out), node)
+    captured = capsys.readouterr()
+    _check(json.loads(captured.out), node)
+    assert "accuracies: sum over the 5 scored segment(s) / N = 5 (2015)" in captured.err
+    assert main([*argv, "--format", "json"]) == 0
+    assert "accuracies: mean over all 5 segments" in capsys.readouterr().err
     # --orientation-2015 --unscored-segments 2015 is the same as --2015.
     both = ["--orientation-2015", "--unscored-segments", "2015", "--format", "json"]
     assert main([*argv, *both]) == 0
