@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 DEVSTAMP := $(VENV)/.installed-dev
 DEMO_OUT ?= demo_output
 
-.PHONY: demo test lint typecheck pytest bench samples clean
+.PHONY: demo test lint typecheck pytest bench samples notebooks clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -42,6 +42,11 @@ test: lint typecheck pytest
 bench: $(STAMP)
 	$(BIN)/python -m compileall -q ertools
 	$(BIN)/python benchmarks/run.py
+
+# JupyterLab in the project's venv, then the notebooks open in it.
+notebooks: $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[notebooks]'
+	$(BIN)/jupyter lab notebooks/
 
 samples: $(STAMP)
 	$(BIN)/python -m ertools.samples sample_bags

@@ -240,7 +240,8 @@ _RULES: tuple[_Rule, ...] = (
         r"(pose_score|x_error|y_error|theta_error|position|orientation)$",
         ("fbm1h", "fbm1w"),
         "the ground truth is averaged over the window in which the board stood still "
-        "(the 2015 node used the latest board pose); theta is in degrees",
+        "(the 2015 node interpolated one tf lookup when the result arrived); theta is in "
+        "degrees",
         ("window", "source", "topic", "items"),
     ),
     _Rule(

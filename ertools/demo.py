@@ -89,7 +89,17 @@ def steps(samples: Path, out: Path) -> Iterator[Step]:
     robot_bag = _first(robot, "FBM2H_*.bag")
     yield Step(
         "robot log vs ground truth",
-        ["score", "trajectory", str(robot_bag), str(robot), "--report", str(out / "trajectory")],
+        [
+            "score",
+            "trajectory",
+            str(robot_bag),
+            str(robot),
+            "--offset",
+            "auto",
+            "--apply-offset",
+            "--report",
+            str(out / "trajectory"),
+        ],
         "trajectory_score.yaml",
     )
     yield Step(

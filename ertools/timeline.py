@@ -6,6 +6,14 @@ session, what each bag is (GT logger, benchmark log, robot log), which GT files 
 benchmark or robot log and how much of it, and what is wrong (gaps between split files of one
 logger, duplicated names, unsynchronised clocks, unreadable or unindexed files).
 
+Two things are decided by content, not by time or name. A benchmark or robot log is paired with
+the GT files of *its* benchmark (the ``/fbm2h/...`` namespace of the topics, or the
+``FBM2H_<date>_<team>`` name the 2015 rockin_logger gave robot logs); a GT logger of another
+benchmark recording at the same time is named but not paired. And a recording copied to another
+name, folder or format (same topics, message counts, first and last message) is one recording:
+its copies are listed under it and left out of overlaps, sessions and pairings, so a folder of
+1,000 copies gives one recording with 999 copies, not a million overlaps.
+
 Pure: it takes bag summaries (``ertools.io.BagSummary`` or anything with the same attributes),
 never opens a file. :mod:`ertools.timeline_scan` is the IO edge that produces its inputs.
 """
@@ -54,6 +62,12 @@ STATE_SUFFIXES = ("/bmbox_state", "/bbbox_state", "/refbox_state", "/client_stat
 _SPLIT_RE = re.compile(r"^(?P<group>.+)_(?P<index>\d+)$")
 _DATE_RE = re.compile(r"_?\d{4}-\d{2}-\d{2}-\d{2}-\d{2}-\d{2}$")
 _SUFFIXES = (".bag.active", ".bag", ".mcap", ".db3")
+# The benchmark namespaces of the 2015 topics (/fbm2h/..., /tbm1h/...) and robot log names
+# (rockin_logger: ${BENCHMARK}_${DATE}_${TEAMNAME}.bag, BENCHMARK written FBM2H or FBMH2).
+_NAMESPACE_RE = re.compile(r"^[ft]bm\d[hw]$", re.IGNORECASE)
+_ROBOT_LOG_RE = re.compile(
+    r"^(?P<kind>[FT]BM)(?:(?P<n>\d)(?P<hw>[HW])|(?P<hw2>[HW])(?P<n2>\d))_", re.IGNORECASE
+)
 
 
 class TopicLike(Protocol):
@@ -129,6 +143,9 @@ class BagEntry:
     overlaps: tuple[str, ...] = ()
     problems: tuple[str, ...] = ()
     session: int | None = None
+    benchmarks: tuple[str, ...] = ()  # namespaces of its topics / name (``fbm2h``)
+    copy_of: str | None = None  # the recording this file is a copy of
+    copies: tuple[str, ...] = ()  # the files that are copies of this one
 
     @property
     def duration_ns(self) -> int | None:
@@ -148,9 +165,12 @@ class Pairing:
     Attributes:
         path: the benchmark or robot log.
         kind: its kind.
-        gt: the GT files overlapping it, by start time.
+        gt: the GT files of its benchmark overlapping it, by start time.
         coverage: percent of the log's span covered by the union of the GT files' spans.
         uncovered: the spans of the log no GT file covers, (start_ns, end_ns).
+        basis: ``content`` when the log and every paired GT file name the same benchmark;
+            ``time`` when one of them names none, so overlap in time was all there was to go on.
+        other_benchmark: GT files overlapping it in time that record another benchmark.
     """
 
     path: str
@@ -158,6 +178,8 @@ class Pairing:
     gt: tuple[str, ...]
     coverage: float
     uncovered: tuple[tuple[int, int], ...]
+    basis: Literal["content", "time"] = "content"
+    other_benchmark: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -231,8 +253,11 @@ class Timeline:
                     "end": _s(b.end_ns),
                     "duration": _s(b.duration_ns),
                     "kind": b.kind,
+                    "benchmarks": list(b.benchmarks),
                     "overlaps": list(b.overlaps),
                     "problems": list(b.problems),
+                    "copy_of": b.copy_of,
+                    "copies": list(b.copies),
                 }
                 for b in self.bags
             ],
@@ -250,6 +275,8 @@ class Timeline:
                             "gt": list(p.gt),
                             "coverage": p.coverage,
                             "uncovered": [[ns_to_s(a), ns_to_s(b)] for a, b in p.uncovered],
+                            "basis": p.basis,
+                            "other_benchmark": list(p.other_benchmark),
                         }
                         for p in s.pairings
                     ],
@@ -271,6 +298,7 @@ class Timeline:
                 "session": "" if b.session is None else b.session,
                 "logger": b.logger,
                 "path": b.path,
+                "copy_of": b.copy_of or "",
                 "overlaps": ";".join(b.overlaps),
                 "problems": "; ".join(b.problems),
             }
@@ -360,6 +388,29 @@ def classify(topics: Iterable[TopicLike]) -> Kind:
     return "other"
 
 
+def benchmark_names(topics: Iterable[TopicLike], path: str | Path = "") -> tuple[str, ...]:
+    """The benchmarks a bag belongs to: its topics' namespaces (``/fbm2h/...`` -> ``fbm2h``)
+    and, for a robot log, the benchmark its rockin_logger name gives (``FBM2H_...``)."""
+    names = {
+        t.name.split("/")[1].lower()
+        for t in topics
+        if t.name.count("/") >= 2 and _NAMESPACE_RE.match(t.name.split("/")[1])
+    }
+    match = _ROBOT_LOG_RE.match(Path(path).name) if path else None
+    if match is not None:
+        number = match.group("n") or match.group("n2")
+        arena = match.group("hw") or match.group("hw2")
+        names.add(f"{match.group('kind')}{number}{arena}".lower())
+    return tuple(sorted(names))
+
+
+def recording_key(summary: SummaryLike) -> tuple[object, ...]:
+    """What one recording looks like whatever its file name, folder or format: its topics
+    (ROS 1 and ROS 2 type spellings alike), their message counts, first and last message."""
+    topics = sorted((t.name, _norm_type(t.msgtype), t.count) for t in summary.topics)
+    return (summary.start_ns, summary.end_ns, summary.message_count, tuple(topics))
+
+
 # --- intervals -------------------------------------------------------------------------------
 
 
@@ -443,6 +494,7 @@ def build_timeline(
     problems: dict[str, list[str]] = defaultdict(list)
     base: list[BagEntry] = []
     broken: list[BagEntry] = []
+    keys: dict[str, tuple[object, ...]] = {}
     for s in summaries:
         path = str(s.path)
         if s.start_ns is None or s.end_ns is None or s.message_count == 0:
@@ -458,8 +510,10 @@ def build_timeline(
                 int(s.end_ns),
                 classify(s.topics),
                 logger_name(path),
+                benchmarks=benchmark_names(s.topics, path),
             )
         )
+        keys[path] = recording_key(s)
         problems[path].extend(s.problems)
         if not s.indexed and not any("index" in p for p in s.problems):
             problems[path].append("unindexed (still being recorded?): read by scanning")
@@ -468,9 +522,19 @@ def build_timeline(
         problems[u.path].append(u.problem)
 
     base.sort(key=lambda b: (b.start_ns, b.end_ns, b.path))
+    copy_of = _copies(base, keys)
+    copies: dict[str, list[str]] = defaultdict(list)
+    for copy, original in copy_of.items():
+        copies[original].append(copy)
+        problems[copy].append(
+            f"same recording as {original} (same topics, message counts, first and last "
+            "message): a copy, left out of overlaps, sessions and pairings"
+        )
+    copied = [b for b in base if b.path in copy_of]
+    base = [b for b in base if b.path not in copy_of]
     overlaps = _overlaps(base)
 
-    _check_duplicates([b.path for b in base + broken], problems)
+    _check_duplicates([b.path for b in base + copied + broken], problems, copy_of)
     _check_split_gaps(base, cfg, problems)
     for check in clock_checks:
         if check.error:
@@ -496,9 +560,28 @@ def build_timeline(
             tuple(overlaps[b.path]),
             tuple(dict.fromkeys(problems[b.path])),
             session_of[b.path],
+            b.benchmarks,
+            copies=tuple(copies[b.path]),
         )
         for b in base
     ]
+    entries += [
+        BagEntry(
+            b.path,
+            b.format,
+            b.start_ns,
+            b.end_ns,
+            b.kind,
+            b.logger,
+            (),
+            tuple(dict.fromkeys(problems[b.path])),
+            session_of[copy_of[b.path]],
+            b.benchmarks,
+            copy_of=copy_of[b.path],
+        )
+        for b in copied
+    ]
+    entries.sort(key=lambda b: (b.start_ns, b.end_ns, b.path))
     entries += [
         BagEntry(
             b.path,
@@ -512,7 +595,7 @@ def build_timeline(
         )
         for b in broken
     ]
-    by_path = {e.path: e for e in entries}
+    by_path = {e.path: e for e in entries if e.copy_of is None}
     sessions = [
         Session(
             s.index,
@@ -564,7 +647,7 @@ def _pairings(entries: Sequence[BagEntry], join_ns: int) -> tuple[Pairing, ...]:
         if e.kind not in ("benchmark", "robot"):
             continue
         assert e.start_ns is not None and e.end_ns is not None
-        covering = [
+        overlapping = [
             g
             for g in gt
             if g.start_ns is not None
@@ -572,6 +655,12 @@ def _pairings(entries: Sequence[BagEntry], join_ns: int) -> tuple[Pairing, ...]:
             and g.start_ns <= e.end_ns
             and g.end_ns >= e.start_ns
         ]
+        # A GT logger of another benchmark at the same time (a second arena) is not this
+        # log's ground truth; one that names no benchmark can only be judged by time.
+        mine = set(e.benchmarks)
+        other = [g for g in overlapping if mine and g.benchmarks and not mine & set(g.benchmarks)]
+        covering = [g for g in overlapping if g not in other]
+        by_time = not mine or any(not g.benchmarks for g in covering)
         spans = [
             (g.start_ns, g.end_ns)
             for g in covering
@@ -579,17 +668,40 @@ def _pairings(entries: Sequence[BagEntry], join_ns: int) -> tuple[Pairing, ...]:
         ]
         pct, uncovered = coverage(e.start_ns, e.end_ns, spans, join_ns)
         pairings.append(
-            Pairing(e.path, e.kind, tuple(g.path for g in covering), pct, tuple(uncovered))
+            Pairing(
+                e.path,
+                e.kind,
+                tuple(g.path for g in covering),
+                pct,
+                tuple(uncovered),
+                "time" if by_time else "content",
+                tuple(g.path for g in other),
+            )
         )
     return tuple(pairings)
 
 
-def _check_duplicates(paths: Sequence[str], problems: Mapping[str, list[str]]) -> None:
+def _copies(entries: Sequence[BagEntry], keys: Mapping[str, tuple[object, ...]]) -> dict[str, str]:
+    """copy -> original for recordings found more than once (the first by start, then path,
+    is the original: the order is the caller's)."""
+    first: dict[tuple[object, ...], str] = {}
+    copy_of: dict[str, str] = {}
+    for e in entries:
+        original = first.setdefault(keys[e.path], e.path)
+        if original != e.path:
+            copy_of[e.path] = original
+    return copy_of
+
+
+def _check_duplicates(
+    paths: Sequence[str], problems: Mapping[str, list[str]], copy_of: Mapping[str, str]
+) -> None:
+    """One name for different files; copies of one recording are said once, as copies."""
     by_name: dict[str, list[str]] = defaultdict(list)
     for p in paths:
         by_name[Path(p).name].append(p)
     for same in by_name.values():
-        if len(same) < 2:
+        if len({copy_of.get(p, p) for p in same}) < 2:
             continue
         for p in same:
             others = ", ".join(o for o in same if o != p)

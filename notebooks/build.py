@@ -3,9 +3,12 @@
     python notebooks/build.py          # rewrites notebooks/*.ipynb (no outputs)
     python notebooks/build.py --check  # exit 1 if a committed notebook differs from this file
 
-The notebooks call the ertools library only; every number they show comes from it. They read
-``sample_bags/`` (``make samples``) or the folder named by the environment variable
-``ERTOOLS_SAMPLES``. Cell ids are fixed so that a rebuild is byte-identical.
+The notebooks call the ertools library only; every number they show comes from it. Every input
+is in one cell tagged ``parameters`` (papermill's convention: ``papermill -p NAME VALUE``
+overrides it in a cell tagged ``injected-parameters`` inserted after it); its defaults are the
+sample logs of ``make samples`` (``sample_bags/``, relative to ``notebooks/``). ``answers`` is
+the sample generator's truth; it is None for a real log, and the cells that compare with it
+then say so and skip. Cell ids are fixed so that a rebuild is byte-identical.
 """
 
 from __future__ import annotations
@@ -16,9 +19,10 @@ from pathlib import Path
 from typing import Any
 
 HERE = Path(__file__).resolve().parent
+# The folder the parameters' defaults point into, as seen from notebooks/ (the kernel's cwd).
+SAMPLES = "../sample_bags"
 
 SETUP = """\
-import os
 from pathlib import Path
 
 import matplotlib.pyplot as plt
@@ -26,14 +30,43 @@ import pandas as pd
 import yaml
 
 pd.set_option("display.width", 160)
-pd.set_option("display.max_columns", 30)
-# The sample logs: `make samples` writes sample_bags/; ERTOOLS_SAMPLES points elsewhere.
-SAMPLES = Path(os.environ.get("ERTOOLS_SAMPLES", "../sample_bags")).resolve()
-FOLDER = SAMPLES / "{scenario}"
-assert FOLDER.is_dir(), f"{{FOLDER}} is missing: run `make samples` first"
-# What the sample generator says a correct scorer must find (none for your own logs).
-answers = sorted(FOLDER.glob("*.answers.yaml"))
-ANSWERS = yaml.safe_load(answers[0].read_text()) if answers else {{}}"""
+pd.set_option("display.max_columns", 30)"""
+
+PARAMETERS_HEADER = """\
+# Parameters: edit them here, or run the notebook with papermill
+#   papermill notebooks/NAME.ipynb out.ipynb --cwd notebooks -p NAME VALUE ...
+# (`papermill --help-notebook notebooks/NAME.ipynb` lists them; docs/notebooks.md). Relative
+# paths are from notebooks/; the defaults are the sample logs of `make samples`.
+"""
+
+# Turns the parameters into paths and reads the answers (None: a real log).
+LOAD_ANSWERS = """\
+# What the sample generator says a correct scorer must find: only samples have it.
+ANSWERS = yaml.safe_load(Path(answers).read_text()) if answers else None
+if ANSWERS is None:
+    print("no answers file (a real log): the comparisons with the generator's truth are skipped")"""
+
+LOAD_BAGS = (
+    """\
+paths = [Path(bags)] if isinstance(bags, str) else [Path(b) for b in bags]
+missing = [str(p) for p in paths if not p.exists()]
+assert not missing, f"missing: {missing} (the sample logs: run `make samples`)"
+"""
+    + LOAD_ANSWERS
+)
+
+# The benchmark state topics of the log (none in a ground-truth-only log such as the real 2015
+# FBM2@Home test run): the audit, the timeline and the live score need them.
+TOPICS = """\
+from ertools.io import summary, topics
+from ertools.states import STATE_TOPIC_SUFFIXES
+
+suffixes = {s for group in STATE_TOPIC_SUFFIXES.values() for s in group}
+state_topics = [t for t in topics(paths) if t.rsplit("/", 1)[-1] in suffixes]
+print("benchmark state topics:", ", ".join(state_topics) or "none")
+s = summary(paths[0])
+pd.DataFrame([(t.name, t.msgtype, t.count) for t in s.topics],
+             columns=["topic", "type", "messages"])"""
 
 FIGURES = """\
 from ertools.report.figures import figure_specs
@@ -47,14 +80,35 @@ plt.show()"""
 TIMELINE = """\
 from ertools.report.plots_audit import draw_timeline
 
-fig, ax = plt.subplots(figsize=(12, 4), layout="constrained")
-draw_timeline(ax, audit)
-plt.show()"""
+if audit is not None:
+    fig, ax = plt.subplots(figsize=(12, 4), layout="constrained")
+    draw_timeline(ax, audit)
+    plt.show()"""
 
 COMPARISON = """\
-comparison = pd.DataFrame(audit.comparison.rows())
-print("\\n".join(audit.comparison.notes))
-comparison[comparison.status != "only recomputed"]"""
+if audit is None:
+    print("no live score: the log has no benchmark state topics")
+else:
+    print(audit.live_score_text)
+    comparison = pd.DataFrame(audit.comparison.rows())
+    print("\\n".join(audit.comparison.notes))
+    display(comparison[comparison.status != "only recomputed"])"""
+
+
+def parameters(**values: tuple[Any, str]) -> str:
+    """The parameters cell: one ``name = literal  # help`` line per input (the line comment is
+    the help `papermill --help-notebook` shows)."""
+    lines = [f"{name} = {value!r}  # {comment}" for name, (value, comment) in values.items()]
+    return PARAMETERS_HEADER + "\n".join(lines)
+
+
+def sample(path: str) -> str:
+    return f"{SAMPLES}/{path}"
+
+
+FBM2H_LOG = "fbm2h/log_fbm2h_mocap_2015-11-20-12-00-00_0"
+FBM3W_LOG = "fbm3w/log_fbm3w_mocap_2015-11-20-12-00-00_0"
+FBM1H_LOG = "fbm1h/log_fbm1h_2015-11-20-12-00-00_0"
 
 NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
     "fbm3w": [
@@ -63,22 +117,32 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
             "# FBM3@Work (trajectory following): audit a benchmark log\n\n"
             "Load a log, reconstruct the benchmark from its state topics, recompute the score "
             "(seed 7.3, Eq. 1 with the d_min subsampling), plot the runs, compare with the score "
-            "the 2015 node sent live, and see how the score depends on d_min.",
+            "the 2015 node sent live, and see how the score depends on d_min. The runs' windows "
+            "come from the state topics: a log without them cannot be scored.",
         ),
-        ("code", SETUP.format(scenario="fbm3w")),
+        ("code", SETUP),
         (
-            "code",
-            "from ertools.io import summary\n\n"
-            'bag = next(FOLDER.glob("*.bag"))\n'
-            "s = summary(bag)\n"
-            "pd.DataFrame([(t.name, t.msgtype, t.count) for t in s.topics], "
-            'columns=["topic", "type", "messages"])',
+            "params",
+            parameters(
+                bags=([sample(f"{FBM3W_LOG}.bag")], "the log (a split log: its parts in order)"),
+                config=(
+                    sample("fbm3w/fbm3w.yaml"),
+                    "runs' specifications and d_min (seed Listing 14); None: the seed's",
+                ),
+                d_mins=([0.00033, 0.0005, 0.001, 0.002, 0.004], "the d_min sweep [m]"),
+                answers=(
+                    sample(f"{FBM3W_LOG}.answers.yaml"),
+                    "the sample generator's truth; None for a real log",
+                ),
+            ),
         ),
+        ("code", LOAD_BAGS + "\nconfig_path = Path(config) if config else None"),
+        ("code", TOPICS),
         ("md", "## What happened: the state machines' timeline"),
         (
             "code",
-            "from ertools.audit_score import audit_bag\n\n"
-            "audit, notes = audit_bag([bag])\n"
+            "from ertools.audit_score import ScoreInputs, audit_bag\n\n"
+            "audit, notes = audit_bag(paths, inputs=ScoreInputs(config=config_path))\n"
             "print(*notes, sep='\\n')\n"
             "print(audit.to_text()[:2500])",
         ),
@@ -102,30 +166,32 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         (
             "md",
             "## How the score depends on d_min\n\n2015 hard-coded d_min = 0.33 mm; below the "
-            "mocap noise the path length (and so the error) picks up jitter.",
+            "mocap noise the path length (and so the error) picks up jitter. On a sample log "
+            "the generator's noiseless truth is the last row.",
         ),
         (
             "code",
             "from ertools.benchmarks.fbm3w import Fbm3wOptions, score_fbm3w\n"
             "from ertools.configs.fbm3w import load_fbm3w_config\n\n"
-            "config = load_fbm3w_config(None)\n"
+            "course = load_fbm3w_config(config_path)\n"
             "rows = []\n"
-            "for d_min in (0.00033, 0.0005, 0.001, 0.002, 0.004):\n"
-            "    r = score_fbm3w([bag], config, Fbm3wOptions(d_min=d_min)).to_dict()\n"
+            "for d_min in d_mins:\n"
+            "    r = score_fbm3w(paths, course, Fbm3wOptions(d_min=d_min)).to_dict()\n"
             "    row = {'d_min': d_min, 'best_distance_error': r['best_distance_error']}\n"
             "    row.update({f'run {k}': v.get('distance_error') "
             "for k, v in r['runs_details'].items()})\n"
             "    rows.append(row)\n"
             "sweep = pd.DataFrame(rows).set_index('d_min')\n"
-            "truth = {f'run {k}': v['distance_error'] "
+            "if ANSWERS is not None:\n"
+            "    truth = {f'run {k}': v['distance_error'] "
             "for k, v in ANSWERS['expected']['runs_details'].items()}\n"
-            "sweep.loc['generator truth'] = pd.Series(truth)\n"
+            "    sweep.loc['generator truth'] = pd.Series(truth)\n"
             "sweep",
         ),
         (
             "code",
-            "ax = sweep.drop(index='generator truth').drop(columns='best_distance_error')"
-            ".plot(marker='o', logx=True, figsize=(8, 4))\n"
+            "ax = sweep.drop(index='generator truth', errors='ignore')"
+            ".drop(columns='best_distance_error').plot(marker='o', logx=True, figsize=(8, 4))\n"
             "ax.set_ylabel('distance_error [m]')\n"
             "plt.show()",
         ),
@@ -134,56 +200,102 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         (
             "md",
             "# FBM2@Home (navigation): audit a benchmark log\n\n"
-            "Reconstruct the segments from the state topics, recompute the waypoint errors "
-            "(seed 7.2, Listing 13), plot them, compare with the live score, and see how the "
-            "choice of reached moments and the orientation wrap change the result.",
+            "Recompute the waypoint errors (seed 7.2, Listing 13), plot them, compare with the "
+            "live score, and see how the choice of reached moments and the orientation wrap "
+            "change the result. A log without benchmark state topics (the real 2015 test run "
+            "holds only the mocap ground truth) is scored from a reached-waypoint timing file "
+            "(`reached = 'timing'`) or from the stops in the ground truth (`'auto'`); it has no "
+            "timeline and no live score.",
         ),
-        ("code", SETUP.format(scenario="fbm2h")),
+        ("code", SETUP),
+        (
+            "params",
+            parameters(
+                bags=([sample(f"{FBM2H_LOG}.bag")], "the log (a split log: its parts in order)"),
+                goal=(sample("fbm2h/fbm2h_goal.yaml"), "the waypoints (seed Listing 10)"),
+                transform=(
+                    sample("fbm2h/transform-simbot.yaml"),
+                    "marker-to-robot (Listing 12); None: identity",
+                ),
+                timing=(
+                    sample(f"{FBM2H_LOG}_reached_waypoint_timing.yaml"),
+                    "reached-waypoint timing file; None: none",
+                ),
+                reached=("states", "the reached moments: 'states', 'timing' or 'auto'"),
+                answers=(
+                    sample(f"{FBM2H_LOG}.answers.yaml"),
+                    "the sample generator's truth; None for a real log",
+                ),
+            ),
+        ),
+        (
+            "code",
+            LOAD_BAGS + "\n"
+            "goal_path = Path(goal)\n"
+            "transform_path = Path(transform) if transform else None\n"
+            "timing_path = Path(timing) if timing else None",
+        ),
+        ("code", TOPICS),
+        ("md", "## What happened: the state machines' timeline"),
         (
             "code",
             "from ertools.audit_score import ScoreInputs, audit_bag\n\n"
-            'bag = next(FOLDER.glob("*.bag"))\n'
-            "params = ANSWERS['generator']['parameters']\n"
-            "goal, transform = FOLDER / params['goal'], FOLDER / params['transform']\n"
-            "audit, notes = audit_bag([bag], inputs=ScoreInputs(goal=goal, transform=transform))\n"
-            "print(*notes, sep='\\n')\n"
-            "print(audit.to_text()[:2000])",
+            "audit = None\n"
+            "if state_topics:\n"
+            "    inputs = ScoreInputs(goal=goal_path, transform=transform_path)\n"
+            "    audit, notes = audit_bag(paths, inputs=inputs)\n"
+            "    print(*notes, sep='\\n')\n"
+            "    print(audit.to_text()[:2000])\n"
+            "else:\n"
+            "    print('no benchmark state topics: no timeline and no live score in this log')",
         ),
         ("code", TIMELINE),
         ("md", "## The recomputed segments"),
         (
             "code",
+            "from ertools.benchmarks.fbm2h import Fbm2hOptions, score_fbm2h\n"
             "from ertools.report.frames import result_to_dataframes\n\n"
-            "result = audit.recomputed\n"
+            "options = Fbm2hOptions(goal=goal_path, transform=transform_path, reached=reached,\n"
+            "                       timing=timing_path)\n"
+            "result = score_fbm2h(paths, options)\n"
+            "score = result.to_dict()\n"
+            "print(f'reached moments: {reached}')\n"
+            "for key in ('position_accuracy', 'orientation_accuracy', 'execution_time'):\n"
+            "    print(f'{key}: {score[key]!r}')\n"
+            "print(*result.warnings, *result.deviations, sep='\\n')\n"
             'result_to_dataframes(result)["segments"]',
         ),
         ("code", FIGURES),
         ("md", "## Live score vs recomputed score"),
-        ("code", "print(audit.live_score_text)\n" + COMPARISON),
+        ("code", COMPARISON),
         (
             "md",
             "## When was each waypoint reached? And the orientation wrap\n\n"
-            "`states`: the Client's COMPLETED_GOAL; `timing`: the reached-waypoint timing file; "
-            "`auto`: stops detected in the ground truth. `orientation_2015` reproduces the "
-            "unwrapped 2015 formula.",
+            "`states`: the Client's COMPLETED_GOAL (only in a log with state topics); "
+            "`timing`: the reached-waypoint timing file (when given); `auto`: stops detected "
+            "in the ground truth. `orientation_2015` reproduces the unwrapped 2015 formula.",
         ),
         (
             "code",
-            "from ertools.benchmarks.fbm2h import Fbm2hOptions, score_fbm2h\n\n"
+            "sources = [('states', None)] if state_topics else []\n"
+            "if timing_path is not None:\n"
+            "    sources.append(('timing', timing_path))\n"
+            "sources.append(('auto', None))\n"
             "rows = []\n"
-            "for reached, timing in (('states', None), "
-            "('timing', FOLDER / params['timing']), ('auto', None)):\n"
+            "for source, timing_file in sources:\n"
             "    for wrap_2015 in (False, True):\n"
-            "        options = Fbm2hOptions(goal=goal, transform=transform, reached=reached,\n"
-            "                               timing=timing, orientation_2015=wrap_2015)\n"
-            "        r = score_fbm2h([bag], options).to_dict()\n"
-            "        rows.append({'reached': reached, 'orientation_2015': wrap_2015,\n"
+            "        choice = Fbm2hOptions(goal=goal_path, transform=transform_path,\n"
+            "                              reached=source, timing=timing_file,\n"
+            "                              orientation_2015=wrap_2015)\n"
+            "        r = score_fbm2h(paths, choice).to_dict()\n"
+            "        rows.append({'reached': source, 'orientation_2015': wrap_2015,\n"
             "                     'position_accuracy': r['position_accuracy'],\n"
             "                     'orientation_accuracy': r['orientation_accuracy'],\n"
             "                     'execution_time': r['execution_time']})\n"
             "choices = pd.DataFrame(rows)\n"
-            "expected = ANSWERS['expected']\n"
-            "print('generator truth:', expected['position_accuracy'], "
+            "if ANSWERS is not None:\n"
+            "    expected = ANSWERS['expected']\n"
+            "    print('generator truth:', expected['position_accuracy'], "
             "expected['orientation_accuracy'], expected['orientation_accuracy_2015'])\n"
             "choices",
         ),
@@ -194,15 +306,37 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
             "# FBM1@Home (object perception): audit a benchmark log\n\n"
             "Find the runs (which item, the robot's answer) in the state topics, recompute the "
             "ground truth and the score (seed 7.1), compare with the live score, and check "
-            "that the 2015 rules reproduce it.",
+            "that the 2015 rules reproduce it. The runs come from the state topics: a log "
+            "without them cannot be scored.",
         ),
-        ("code", SETUP.format(scenario="fbm1h")),
+        ("code", SETUP),
+        (
+            "params",
+            parameters(
+                bags=([sample(f"{FBM1H_LOG}.bag")], "the log (a split log: its parts in order)"),
+                items=(sample("fbm1h/fbm1h.yaml"), "the item list"),
+                results=(None, "the robot's results file; None: from the log"),
+                abs_tol=(
+                    None,
+                    "live vs 2015 rules tolerance; None: the answers' pose-score one, or 1e-6",
+                ),
+                answers=(
+                    sample(f"{FBM1H_LOG}.answers.yaml"),
+                    "the sample generator's truth; None for a real log",
+                ),
+            ),
+        ),
+        (
+            "code",
+            LOAD_BAGS + "\n"
+            "items_path = Path(items)\n"
+            "results_path = Path(results) if results else None",
+        ),
         (
             "code",
             "from ertools.audit_score import ScoreInputs, audit_bag\n\n"
-            'bag = next(FOLDER.glob("*.bag"))\n'
-            'items = next(FOLDER.glob("fbm1h*.yaml"))\n'
-            "audit, notes = audit_bag([bag], inputs=ScoreInputs(items=items))\n"
+            "inputs = ScoreInputs(items=items_path, results=results_path)\n"
+            "audit, notes = audit_bag(paths, inputs=inputs)\n"
             "print(*notes, sep='\\n')\n"
             "pd.DataFrame(audit.tables()['runs'])"
             "[['run', 'start', 'duration', 'outcome', 'manual_operation', 'result']]",
@@ -228,14 +362,17 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ),
         (
             "code",
-            "from ertools.audit_score import compare_scores\n"
+            "from ertools.audit_score import DEFAULT_ABS_TOL, compare_scores\n"
             "from ertools.benchmarks.fbm1 import Fbm1Options, score_fbm1_bag\n\n"
-            "as_2015 = score_fbm1_bag([bag], items, options=Fbm1Options.as_2015('fbm1h'))\n"
-            "# Mocap noise moves a recomputed pose score by ~1e-5: compare within the\n"
-            "# tolerance the sample's answers state for it.\n"
-            "tol = ANSWERS['tolerance']['pose_score']['abs']\n"
+            "as_2015 = score_fbm1_bag(paths, items_path, options=Fbm1Options.as_2015('fbm1h'),\n"
+            "                         results_path=results_path)\n"
+            "# Mocap noise moves a recomputed pose score by ~1e-5: a sample's answers state the\n"
+            "# tolerance for it.\n"
+            "tol = abs_tol\n"
+            "if tol is None:\n"
+            "    tol = ANSWERS['tolerance']['pose_score']['abs'] if ANSWERS else DEFAULT_ABS_TOL\n"
             "check = compare_scores(audit.live_score, as_2015, abs_tol=tol)\n"
-            "print(f'{check.same} same, {len(check.differences)} differ')\n"
+            "print(f'{check.same} same, {len(check.differences)} differ (tolerance {tol})')\n"
             "pd.DataFrame(check.rows()).query(\"status != 'only recomputed'\")",
         ),
     ],
@@ -245,16 +382,32 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
             "# Robot log vs ground truth\n\n"
             "Compare the pose a robot logged for its marker set with the mocap ground truth, "
             "try the three association choices, and look at the clock-offset audit. This "
-            "benchmark was offline in 2015: there is no live score to compare with.",
+            "benchmark was offline in 2015: there is no live score to compare with. It needs "
+            "a robot's own log beside the ground truth.",
         ),
-        ("code", SETUP.format(scenario="robotlog")),
+        ("code", SETUP),
+        (
+            "params",
+            parameters(
+                robot_bag=(sample("robotlog/FBM2H_201511201200_homer.bag"), "the robot's log"),
+                gt=([sample("robotlog")], "the GT bags, or folders of them, that cover it"),
+                robot_topic=("/rockin/homer/marker_pose", "the robot's pose topic"),
+                gt_topic=("/fbm2h/robot_at_home/pose", "the GT pose topic"),
+                answers=(
+                    sample("robotlog/FBM2H_201511201200_homer.answers.yaml"),
+                    "the sample generator's truth; None for a real log",
+                ),
+            ),
+        ),
         (
             "code",
             "from ertools.benchmarks.trajectory import TrajectoryConfig, score\n\n"
-            "params = ANSWERS['generator']['parameters']\n"
-            "robot_bag = next(FOLDER.glob('FBM2H_*.bag'))\n"
-            "kwargs = dict(robot_topic=params['robot_topic'], gt_topic=params['gt_topic'])\n"
-            "result = score(robot_bag, [FOLDER], TrajectoryConfig(), **kwargs)\n"
+            "robot_path = Path(robot_bag)\n"
+            "gt_paths = [Path(gt)] if isinstance(gt, str) else [Path(g) for g in gt]\n"
+            + LOAD_ANSWERS
+            + "\n"
+            "kwargs = dict(robot_topic=robot_topic, gt_topic=gt_topic)\n"
+            "result = score(robot_path, gt_paths, TrajectoryConfig(), **kwargs)\n"
             "print(result.to_yaml()[:800])",
         ),
         ("md", "## Association: hold (2015), nearest, linear"),
@@ -262,19 +415,20 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
             "code",
             "rows = []\n"
             "for association in ('hold', 'nearest', 'linear'):\n"
-            "    d = score(robot_bag, [FOLDER], TrajectoryConfig(association=association), "
+            "    d = score(robot_path, gt_paths, TrajectoryConfig(association=association), "
             "**kwargs).to_dict()\n"
             "    rows.append({k: d[k] for k in ('association', 'position_error', "
             "'orientation_error', 'rmse', 'compared', 'gaps', 'tracking_lost')})\n"
             "pd.DataFrame(rows).set_index('association')",
         ),
-        ("md", "## The clock audit\n\nThe robot's clock was set ahead of the GT logger's."),
+        ("md", "## The clock audit\n\nThe sample robot's clock was set ahead of the GT logger's."),
         (
             "code",
-            "audited = score(robot_bag, [FOLDER], "
+            "audited = score(robot_path, gt_paths, "
             "TrajectoryConfig(auto_offset=True, apply_offset=True), **kwargs)\n"
             "print('estimated:', audited.to_dict()['clock_audit'])\n"
-            "print('generator truth offset [s]:', ANSWERS['truth']['offset_s'])\n"
+            "if ANSWERS is not None:\n"
+            "    print('generator truth offset [s]:', ANSWERS['truth']['offset_s'])\n"
             "print('position error with the estimate applied:', "
             "audited.to_dict()['position_error'])",
         ),
@@ -293,15 +447,31 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
             "md",
             "# A competition folder: timeline and audits\n\n"
             "Order every bag of a folder by time (which logger, which session, which GT files "
-            "cover which benchmark), then audit every benchmark log found there.",
+            "cover which benchmark), then audit every benchmark log found there (a folder of "
+            "ground-truth logs only has none).",
         ),
-        ("code", SETUP.format(scenario="timeline")),
+        ("code", SETUP),
+        (
+            "params",
+            parameters(
+                folder=(sample("timeline/bags"), "the folder of bags (searched recursively)"),
+                answers=(
+                    sample("timeline/timeline.answers.yaml"),
+                    "the sample generator's truth; None for a real log",
+                ),
+            ),
+        ),
         (
             "code",
             "from ertools.timeline_scan import scan\n\n"
-            "timeline = scan([FOLDER / 'bags'])\n"
+            "root = Path(folder)\n"
+            "assert root.is_dir(), f'{root}: no such folder (the samples: run `make samples`)'\n"
+            + LOAD_ANSWERS
+            + "\n"
+            "timeline = scan([root])\n"
             "bags = pd.DataFrame(timeline.to_dict()['bags'])\n"
-            "bags['path'] = bags['path'].map(lambda p: str(Path(p).relative_to(FOLDER)))\n"
+            "bags['path'] = bags['path'].map(lambda p: str(Path(p).relative_to(root)))\n"
+            "print(f'{len(bags)} bags, {len(timeline.to_dict()[\"sessions\"])} sessions')\n"
             "bags[['path', 'kind', 'start', 'duration', 'problems']]",
         ),
         (
@@ -312,14 +482,24 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
             "plt.show()",
         ),
         ("code", "pd.DataFrame(timeline.to_dict()['problems'])"),
+        (
+            "code",
+            "if ANSWERS is not None:\n"
+            "    # Each bag's kind against the generator's truth.\n"
+            "    truth = {p: t['kind'] for p, t in ANSWERS['truth']['bags'].items()}\n"
+            "    kinds = bags.set_index('path')['kind']\n"
+            "    check = pd.DataFrame({'found': kinds, 'truth': pd.Series(truth)})\n"
+            "    print(f'{(check.found == check.truth).sum()} of {len(truth)} kinds as the "
+            "generator made them')\n"
+            "    display(check)",
+        ),
         ("md", "## Every benchmark log of the folder, audited"),
         (
             "code",
             "from ertools.audit_score import audit_bag\n\n"
+            "benchmark_logs = [b for b in timeline.bags if b.kind == 'benchmark' and b.readable]\n"
             "rows = []\n"
-            "for b in timeline.bags:\n"
-            "    if b.kind != 'benchmark' or not b.readable:\n"
-            "        continue\n"
+            "for b in benchmark_logs:\n"
             "    audit, _ = audit_bag([Path(b.path)], recompute=False)\n"
             "    rows.append({'bag': Path(b.path).name, 'benchmark': audit.benchmark,\n"
             "                 'runs': len(audit.runs),\n"
@@ -327,15 +507,15 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
             "                 'silences': len(audit.silences),\n"
             "                 'ended by': ', '.join(e.reason for e in audit.early_ends),\n"
             "                 'live score': audit.live_score})\n"
+            "if not rows:\n"
+            "    print('no benchmark log (state topics) in this folder: nothing to audit')\n"
             "pd.DataFrame(rows)",
         ),
         (
             "code",
             "from ertools.report.plots_audit import draw_timeline\n\n"
-            "if rows:\n"
-            "    last = next(b for b in reversed(timeline.bags) if b.kind == 'benchmark' "
-            "and b.readable)\n"
-            "    audit, _ = audit_bag([Path(last.path)], recompute=False)\n"
+            "if benchmark_logs:\n"
+            "    audit, _ = audit_bag([Path(benchmark_logs[-1].path)], recompute=False)\n"
             "    fig, ax = plt.subplots(figsize=(12, 4), layout='constrained')\n"
             "    draw_timeline(ax, audit)\n"
             "    plt.show()",
@@ -345,7 +525,10 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
 
 
 def build_notebook(cells: list[tuple[str, str]]) -> Any:
-    """A notebook (nbformat v4, no outputs) from (kind, source) pairs, with fixed cell ids."""
+    """A notebook (nbformat v4, no outputs) from (kind, source) pairs, with fixed cell ids.
+
+    Kind ``params`` is the code cell tagged ``parameters`` (papermill's convention).
+    """
     import nbformat
 
     nb = nbformat.v4.new_notebook()
@@ -358,6 +541,8 @@ def build_notebook(cells: list[tuple[str, str]]) -> Any:
             cell = nbformat.v4.new_markdown_cell(source)
         else:
             cell = nbformat.v4.new_code_cell(source)
+        if kind == "params":
+            cell.metadata["tags"] = ["parameters"]
         cell["id"] = f"cell-{i:02d}"
         nb.cells.append(cell)
     return nb

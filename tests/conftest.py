@@ -1,2 +1,25 @@
 """Test-suite root: its presence puts ``tests/`` on ``sys.path`` (pytest's prepend import
 mode), so helpers shared by several test folders live in one module, ``tests/fakes.py``."""
+
+import os
+
+import pytest
+
+# A skip says "this machine cannot run it". CI's machine can run everything (it has ../shared
+# beside the clone and .ci/run installs Chromium), so in CI a skip means a missing install step
+# that would otherwise look like success. Skips that are not about the machine (a case covered
+# elsewhere) say so with a reason starting "n/a:" and stay skips.
+NOT_APPLICABLE = "n/a:"
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) -> object:
+    outcome = yield
+    report = outcome.get_result()  # type: ignore[attr-defined]
+    if not (os.environ.get("CI") and report.skipped) or hasattr(report, "wasxfail"):
+        return
+    reason = report.longrepr[2] if isinstance(report.longrepr, tuple) else str(report.longrepr)
+    if reason.removeprefix("Skipped: ").startswith(NOT_APPLICABLE):
+        return
+    report.outcome = "failed"
+    report.longrepr = f"skipped in CI, where the machine must provide it: {reason}"

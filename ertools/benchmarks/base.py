@@ -55,7 +55,13 @@ def dump_yaml(data: Any) -> str:
     """YAML as the 2015 nodes dumped it (block style, keys in insertion order)."""
     import yaml
 
-    return yaml.safe_dump(data, default_flow_style=False, sort_keys=False, allow_unicode=True)
+    class Dumper(yaml.SafeDumper):
+        """The safe dumper, taking ``str`` subclasses (``fidelity.Deviation``) as plain text."""
+
+    Dumper.add_multi_representer(str, yaml.SafeDumper.represent_str)
+    return yaml.dump(
+        data, Dumper=Dumper, default_flow_style=False, sort_keys=False, allow_unicode=True
+    )
 
 
 def jsonable(value: Any) -> Any:

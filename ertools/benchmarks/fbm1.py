@@ -8,7 +8,12 @@ topics (``fbm1_runs``); answers from the Client payloads or a results file (``fb
 
 ``score_fbm1`` is the pure computation on streams; ``score_fbm1_bag`` reads a log through
 :mod:`ertools.io` and calls it. Both benchmarks share everything: ``benchmark`` only decides
-where the item's name is read first and the 2015 defaults of the legacy switches.
+where the item's name is read first and which nodes exist to reproduce.
+
+Three references (``Fbm1Options.for_rules``): ``ertools`` (the default), ``2015`` (the 2015
+nodes ``scripts/fbm1h`` and ``scripts/fbm1w``) and ``2016`` (the later @Home node, used in
+2016-17). The ``RULE_*`` constants are the catalogue rows (:mod:`ertools.fidelity`) of every
+place where the default differs from the 2015 nodes.
 """
 
 from __future__ import annotations
@@ -35,6 +40,7 @@ from ertools.benchmarks.fbm1_gt import (
 from ertools.benchmarks.fbm1_result import Fbm1Result, Fbm1RunResult
 from ertools.benchmarks.fbm1_runs import Fbm1Run, RunsFound, find_runs
 from ertools.benchmarks.fbm1_score import (
+    MAX_POSE_ERROR_2015,
     ScoreRules,
     names_match,
     pose_errors,
@@ -42,6 +48,7 @@ from ertools.benchmarks.fbm1_score import (
 )
 from ertools.configs.items import Item, ItemList
 from ertools.errors import ConfigError, ScoringError, SegmentationError
+from ertools.fidelity import Deviation, Rule
 from ertools.streams import PoseStream, Provenance, frame_change_warning
 from ertools.timeutil import NS_PER_S
 
@@ -52,6 +59,85 @@ log = logging.getLogger("ertools.benchmarks.fbm1")
 
 BENCHMARKS = ("fbm1h", "fbm1w")
 
+# The nodes ertools can reproduce: (--rules value, what it is, the file the arithmetic is in).
+NODE_2015 = (
+    "2015 node (rockin-robot-challenge/benchmark_and_scoring_fbm scripts/fbm1h at 117a5d0; "
+    "scripts/fbm1w as in svenschneider/benchmark_and_scoring_fbm): totals over runs played + "
+    "aborted, ground truth looked up when the result arrived"
+)
+NODE_2016 = (
+    "2016-17 @Home node (rockin-robot-challenge/benchmark_and_scoring_fbm scripts/fbm1h at "
+    "40ba68b): accuracies over 10, pose score over runs played + aborted, ground truth looked "
+    "up when the placement was confirmed, before the goal"
+)
+RULE_SETS = ("ertools", "2015", "2016")
+
+_NODE_SRC = "scripts/fbm1h, scripts/fbm1w (2015)"
+RULE_GT_MOMENT = Rule(
+    key="fbm1.ground-truth",
+    benchmark="fbm1",
+    title="ground-truth moment",
+    rulebook="BMmanager combines the table, board and item transforms (seed 7.1); no moment",
+    node_2015=(
+        f"{_NODE_SRC}: one tf lookup, `lookupTransform('/origin', '/item', "
+        "rospy.Time(0))`, at the stamp of the item transform broadcast once when the result had "
+        "arrived (the 2016-17 @Home node: when the placement was confirmed, `--gt placed`)"
+    ),
+    ertools=(
+        "mean over the stationary window before the goal, spread reported: one sample carries "
+        "the mocap noise, and the board may be touched while the robot looks"
+    ),
+    option="--gt result",
+)
+RULE_TRANS_CLIP = Rule(
+    key="fbm1.translation-clip",
+    benchmark="fbm1",
+    title="translation term clip",
+    rulebook="pose score 1 - t/2 - r/2 with both terms in [0, 1] (score listing, seed 7.1)",
+    node_2015=(
+        f"{_NODE_SRC}: `if pose_err_trans > max_pose_error : pose_err_trans = 1` with "
+        "max_pose_error = sqrt(2) m: errors of 1..1.41 m stay unclipped (score down to -0.21)"
+    ),
+    ertools="t = min(error, 1 m), so a pose score stays in [0, 1]",
+    option="--clip-above-diagonal",
+)
+RULE_THETA_WRAP = Rule(
+    key="fbm1.theta-wrap",
+    benchmark="fbm1",
+    title="theta error wrap",
+    rulebook="the error of the 2D pose; theta in [-180, 180] deg",
+    node_2015=(
+        f"{_NODE_SRC}: `if w_err > 180: w_err = w_err - 360` and `if w_err < -180: w_err = "
+        "w_err + 360`: one step, answers beyond +-540 deg keep r = 1"
+    ),
+    ertools="wrapped fully to [-180, 180)",
+    option="--single-wrap",
+)
+RULE_NAMES = Rule(
+    key="fbm1.names",
+    benchmark="fbm1",
+    title="class and instance comparison",
+    rulebook="object class and instance names [string] (seed 7.1)",
+    node_2015=(
+        f"{_NODE_SRC}: `result['item_class'] == item['class']`, exact: the 2015 fbm1w.yaml "
+        'class `"Bearing Boxes "` (trailing blank) matched no answer'
+    ),
+    ertools="compared without surrounding blanks",
+    option="--exact-names",
+)
+RULE_ABORTED = Rule(
+    key="fbm1.aborted-runs",
+    benchmark="fbm1",
+    title="run stopped before its goal",
+    rulebook="repeated until time runs out or 10 objects have been processed (seed 7.1)",
+    node_2015=(
+        f"{_NODE_SRC}: `runs = runs + 1` before the manual operation, then `break` when the "
+        "benchmark stopped: the run counts in every divisor with no positive and pose score 0"
+    ),
+    ertools="totals over the runs whose goal was sent (a run never asked is not a failed one)",
+    option="--count-aborted",
+)
+
 
 @dataclass(frozen=True)
 class Fbm1Options:
@@ -60,7 +146,7 @@ class Fbm1Options:
     Attributes:
         benchmark: ``fbm1h`` or ``fbm1w``.
         gt: how the ground truth is measured (see :class:`GtOptions`).
-        rules: which 2015 quirks to reproduce (see :class:`ScoreRules`).
+        rules: which node behaviours to reproduce (see :class:`ScoreRules`).
         moved_warn_m: warn when the board moved more than this (metres, table plane) between
             the goal and the result, i.e. while the robot was looking.
     """
@@ -71,10 +157,47 @@ class Fbm1Options:
     moved_warn_m: float = 0.01
 
     @staticmethod
+    def for_rules(benchmark: str, rules: str, gt: GtOptions | None = None) -> Fbm1Options:
+        """Every behaviour of one reference: ``ertools``, ``2015`` or ``2016`` (@Home only).
+
+        ``gt`` gives the tolerances of the window (its method is replaced by the node's).
+
+        Raises:
+            ConfigError: an unknown reference, or ``2016`` for @Work (no later @Work node is
+                known).
+        """
+        from dataclasses import replace
+
+        base = gt or GtOptions()
+        if rules == "ertools":
+            return Fbm1Options(benchmark, base, ScoreRules())
+        if rules == "2015":
+            return Fbm1Options(benchmark, replace(base, method="result"), ScoreRules.node_2015())
+        if rules == "2016" and benchmark == "fbm1h":
+            return Fbm1Options(benchmark, replace(base, method="placed"), ScoreRules.node_2016())
+        if rules == "2016":
+            raise ConfigError(
+                "no 2016-17 FBM1@Work node is known (only the 2015 scripts/fbm1w); use 2015"
+            )
+        raise ConfigError(f"unknown FBM1 rules {rules!r}; use {', '.join(RULE_SETS)}")
+
+    @staticmethod
     def as_2015(benchmark: str) -> Fbm1Options:
-        """The 2015 node's behaviour: every quirk, and its single tf lookup."""
-        gt = GtOptions(method="goal" if benchmark == "fbm1h" else "result")
-        return Fbm1Options(benchmark, gt, ScoreRules.all_2015())
+        """The 2015 node's behaviour: every rule of it, and its single tf lookup."""
+        return Fbm1Options.for_rules(benchmark, "2015")
+
+    @property
+    def reference(self) -> str:
+        """Which reference these options reproduce: ertools, a node, or a mixture."""
+        refs = (("ertools", "ertools default"), ("2015", NODE_2015), ("2016", NODE_2016))
+        for name, text in refs:
+            try:
+                ref = Fbm1Options.for_rules(self.benchmark, name, self.gt)
+            except ConfigError:
+                continue
+            if ref.rules == self.rules and ref.gt.method == self.gt.method:
+                return text
+        return "ertools with some node behaviours (see the rules)"
 
 
 def _resolve_item(run: Fbm1Run, items: ItemList) -> tuple[Item, list[str]]:
@@ -129,6 +252,25 @@ def _execution_time(run: Fbm1Run) -> float | None:
     return (run.result_ns - start) / NS_PER_S
 
 
+def item_broadcast(run: Fbm1Run, method: str, item_tf: PoseStream | None) -> int | None:
+    """The stamp of the node's item broadcast on /tf that its lookup used, when logged.
+
+    The 2015 nodes broadcast ``item`` once per answered run, after the result (between the goal
+    and the next run); the 2016-17 node once per run, before the goal. ``now`` of that
+    broadcast is the lookup's moment (tf answered ``Time(0)`` at it).
+    """
+    if item_tf is None or len(item_tf) == 0 or run.goal_ns is None:
+        return None
+    t = item_tf.t_ns
+    if method == "result":
+        after = t[(t > run.goal_ns) & (t <= run.end_ns)]
+        return int(after[0]) if len(after) else None
+    if method == "placed":
+        before = t[(t >= run.start_ns) & (t <= run.goal_ns)]
+        return int(before[-1]) if len(before) else None
+    return None
+
+
 def score_run(
     run: Fbm1Run,
     items: ItemList,
@@ -137,8 +279,13 @@ def score_run(
     options: Fbm1Options,
     results: ResultsFile | None = None,
     t0_ns: int = 0,
+    item_tf: PoseStream | None = None,
 ) -> Fbm1RunResult:
-    """Score one run; a run that cannot be scored comes back with status ``failed``."""
+    """Score one run; a run that cannot be scored comes back with status ``failed``.
+
+    ``item_tf``: the node's broadcasts of ``ref_board -> item`` on /tf, when logged: their
+    stamps are the exact moments of the node's lookups.
+    """
     where = f"run {run.index}"
     text = run.item.text if run.item else ""
     base: dict[str, Any] = {
@@ -194,6 +341,8 @@ def score_run(
             result_ns=run.result_ns,
             options=options.gt,
             t0_ns=t0_ns,
+            placed_ns=run.placed_ns,
+            at_ns=item_broadcast(run, options.gt.method, item_tf),
         )
     except GroundTruthError as err:
         return Fbm1RunResult(
@@ -229,38 +378,63 @@ def score_run(
     )
 
 
-def _deviations(runs: Sequence[Fbm1RunResult], options: Fbm1Options) -> list[str]:
-    """Where this result deliberately differs from the 2015 node, with the switch back."""
-    out: list[str] = []
+def _deviations(runs: Sequence[Fbm1RunResult], options: Fbm1Options) -> list[Deviation]:
+    """Where this result deliberately differs from the 2015 node, each with its rule."""
+    out: list[Deviation] = []
     rules, gt = options.rules, options.gt
     scored = [r for r in runs if r.errors is not None]
-    if gt.method == "window":
-        home = options.benchmark == "fbm1h"
-        used = "just before the goal" if home else "~1 s after the result"
-        flag = "--gt goal" if home else "--gt result"
+    if gt.method != "result":
+        used = {
+            "window": f"the mean over the stationary window (up to {gt.max_window_s:g} s) "
+            "before each goal, spread reported",
+            "placed": "one lookup when the placement was confirmed (the 2016-17 node)",
+            "goal": "one lookup when the goal was sent",
+        }[gt.method]
         out.append(
-            "ground truth = mean over the stationary window (up to "
-            f"{gt.max_window_s:g} s) before each goal, spread reported; 2015 took one tf lookup "
-            f"of the latest sample {used} ({flag})"
+            RULE_GT_MOMENT.deviation(
+                f"ground truth = {used}; 2015 looked it up in tf when the result had arrived"
+            )
         )
-    differ = [str(r.index) for r in scored if r.errors is not None and r.errors.legacy_differs]
-    if not (rules.legacy_clip and rules.legacy_wrap):
-        affected = f"run(s) {', '.join(differ)} differ" if differ else "no run affected"
+    if not rules.clip_above_diagonal:
+        n = [
+            str(r.index)
+            for r in scored
+            if r.errors is not None and 1.0 < r.errors.trans_error_m <= MAX_POSE_ERROR_2015
+        ]
+        affected = f"run(s) {', '.join(n)} affected" if n else "no run affected"
         out.append(
-            "translation term clipped at 1 m and theta errors fully wrapped to [-180, 180] deg; "
-            "2015 set only errors above sqrt(2) m to 1 (1..1.41 m stayed unclipped) and wrapped "
-            f"by a single 360 ({affected}; --legacy-clip --legacy-wrap)"
+            RULE_TRANS_CLIP.deviation(
+                "translation term clipped at 1 m; 2015 set only errors above sqrt(2) m to 1 "
+                f"({affected})"
+            )
         )
-    if not rules.legacy_names:
+    if not rules.single_wrap:
+        n = [
+            str(r.index)
+            for r in scored
+            if r.answer is not None
+            and r.gt is not None
+            and abs(r.answer.theta_deg - r.gt.yaw_deg) > 540.0
+        ]
+        affected = f"run(s) {', '.join(n)} affected" if n else "no run affected"
         out.append(
-            "class and instance compared without surrounding blanks; 2015 compared exactly "
-            "(--legacy-names)"
+            RULE_THETA_WRAP.deviation(
+                f"theta errors wrapped fully to [-180, 180) deg; 2015 by a single 360 ({affected})"
+            )
         )
-    if not rules.legacy_totals:
+    if not rules.exact_names:
         out.append(
-            "accuracies and pose score divided by the runs whose goal was sent; 2015 also "
-            "counted a run aborted before its goal, and the @Home node divided the accuracies "
-            "by 10 whatever the number of runs (--legacy-totals)"
+            RULE_NAMES.deviation(
+                "class and instance compared without surrounding blanks; 2015 compared exactly"
+            )
+        )
+    if not rules.count_aborted:
+        n_abort = sum(r.status == "aborted" for r in runs)
+        out.append(
+            RULE_ABORTED.deviation(
+                "accuracies and pose score over the runs whose goal was sent; 2015 also counted "
+                f"a run stopped before its goal ({n_abort} such run(s) here)"
+            )
         )
     return out
 
@@ -275,11 +449,13 @@ def score_fbm1(
     results: ResultsFile | None = None,
     t0_ns: int = 0,
     provenance: Provenance | None = None,
+    item_tf: PoseStream | None = None,
 ) -> Fbm1Result:
     """Score every run (pure: streams and configs in, frozen result out).
 
     A run that cannot be scored is reported in ``failures`` (one line naming the run) and left
-    out of the totals; the other runs are still scored.
+    out of the totals; the other runs are still scored. ``item_tf``: the node's item
+    broadcasts (``ref_board -> item`` on /tf), when logged: the exact lookup moments.
     """
     opts = options or Fbm1Options()
     if opts.benchmark not in BENCHMARKS:
@@ -289,7 +465,9 @@ def score_fbm1(
             f"no FBM1 run in the state log (no BmBox WAITING_MANUAL_OPERATION or goal); "
             f"is this an {opts.benchmark} log?"
         )
-    runs = tuple(score_run(run, items, origin, board, opts, results, t0_ns) for run in found.runs)
+    runs = tuple(
+        score_run(run, items, origin, board, opts, results, t0_ns, item_tf) for run in found.runs
+    )
     counted = [r for r in runs if r.status in ("scored", "no_answer")]
     tot = totals(
         [bool(r.class_ok) for r in counted],
@@ -297,7 +475,6 @@ def score_fbm1(
         [r.pose_score or 0.0 for r in counted],
         [r.execution_time_s or 0.0 for r in counted],
         aborted=sum(r.status == "aborted" for r in runs),
-        benchmark=opts.benchmark,
         rules=opts.rules,
     )
     warnings = list(found.warnings)
@@ -324,6 +501,7 @@ def score_fbm1(
         deviations=tuple(_deviations(runs, opts)),
         failures=tuple(failures),
         provenance=provenance or Provenance(),
+        reference=opts.reference,
     )
 
 
@@ -465,6 +643,15 @@ def score_fbm1_bag(
     for body, source in ((origin, src.origin), (board, src.board)):
         if source is None or source.time_source == "header":
             check_header_clock(plist, body, "state messages")
+    item_tf = None
+    if opts.gt.method != "window":
+        from ertools.errors import TopicError
+        from ertools.io import read_tf
+
+        try:
+            item_tf = read_tf(plist, "ref_board", "item", start_ns=lo, end_ns=hi)
+        except TopicError:
+            item_tf = None  # not logged: the state messages give the moments
     gt = opts.gt
     provenance = Provenance(
         inputs=tuple(str(p) for p in plist)
@@ -479,9 +666,18 @@ def score_fbm1_bag(
             ("still_m", f"{gt.still_m:g}"),
             ("still_deg", f"{gt.still_deg:g}"),
             ("max_gap_s", f"{gt.max_gap_s:g}"),
-            ("legacy", ",".join(k for k, v in vars(opts.rules).items() if v) or "none"),
+            ("reference", opts.reference),
+            ("node_rules", ",".join(k for k, v in vars(opts.rules).items() if v) or "none"),
         ),
     )
     return score_fbm1(
-        origin, board, found, items, opts, results=results, t0_ns=t0, provenance=provenance
+        origin,
+        board,
+        found,
+        items,
+        opts,
+        results=results,
+        t0_ns=t0,
+        provenance=provenance,
+        item_tf=item_tf,
     )

@@ -22,6 +22,7 @@ import numpy as np
 from ertools.benchmarks.fbm1_gt import board_in_table, coverage_problem
 from ertools.configs.items import Item, ItemList, ItemSpread
 from ertools.errors import SegmentationError
+from ertools.fidelity import Rule
 from ertools.geometry import invert, mean_pose
 from ertools.streams import Interval, PoseStream, Provenance
 from ertools.timeutil import NS_PER_S
@@ -32,6 +33,22 @@ if TYPE_CHECKING:
 # The look-ahead over which a still board must not move (long against mocap noise, short
 # against a referee's hand).
 LOOKAHEAD_NS = NS_PER_S // 4
+
+RULE_ACQUIRE_WINDOW = Rule(
+    key="fbm1.acquire-items",
+    benchmark="fbm1",
+    title="item transform acquisition",
+    rulebook="the transform from the board to each item is acquired with the mocap (seed 7.1.4)",
+    node_2015=(
+        "scripts/acquire_items (2015): one tf lookup of ref_board -> origin when the operator "
+        "pressed ENTER"
+    ),
+    ertools=(
+        "the mean over the item's still window, spread written beside it; no option: the "
+        "moments ENTER was pressed are not in the log"
+    ),
+    option="",
+)
 
 
 @dataclass(frozen=True)
@@ -202,8 +219,10 @@ def acquire_items(
         out_items.append(acquired)
         warnings.extend(item_warnings)
     deviations = (
-        "each transform is the mean over the item's still window, spread written beside it; "
-        "the 2015 acquire_items took one tf lookup when ENTER was pressed",
+        RULE_ACQUIRE_WINDOW.deviation(
+            "each transform is the mean over the item's still window, spread written beside "
+            "it; the 2015 acquire_items took one tf lookup when ENTER was pressed"
+        ),
     )
     return AcquireResult(
         tuple(out_items),

@@ -5,10 +5,16 @@ marker set on the FBM1 table (its frame is the table frame the robot answers in)
 ``ref_board`` the marker set on the reference board and T_board_item the item's transform from
 the item list (Listing 9).
 
-The 2015 node took one tf lookup (the latest sample) right before sending the goal (@Home,
-newest script) or about one second after the result (@Work and the older @Home script).
-ertools averages the samples of the stationary window that ends when the goal is sent and
-reports their spread; ``method="goal"`` / ``"result"`` reproduce the single 2015 lookups.
+The nodes took one tf lookup: ``lookupTransform("/origin", "/item", rospy.Time(0))`` right
+after broadcasting the item's transform (``item`` under ``ref_board``) once, stamped ``now``.
+tf answers ``Time(0)`` at the latest time common to the chain, and the item link has the one
+stamp ``now``: the ground truth is origin and board interpolated (linear, slerp) at ``now``.
+The 2015 nodes (``fbm1h``, ``fbm1w``) broadcast it when the result had arrived
+(``method="result"``: the BmBox leaving ``WAITING_RESULT``); the 2016-17 @Home node when the
+referee had confirmed the placement, before the goal (``method="placed"``: BmBox
+``COMPLETED_MANUAL_OPERATION``). The log's state messages give those moments to within the
+node's processing time (milliseconds). ertools averages the samples of the stationary window that
+ends when the goal is sent and reports their spread (``method="window"``).
 """
 
 from __future__ import annotations
@@ -25,10 +31,8 @@ from ertools.geometry import compose, interpolate_poses, invert, mean_pose, yaw_
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
 
-GtMethod = Literal["window", "goal", "result"]
-
-# The 2015 node looked the item up ~1 s after the result arrived (two 0.5 s sleeps).
-RESULT_LOOKUP_DELAY_NS = NS_PER_S
+GtMethod = Literal["window", "placed", "goal", "result"]
+GT_METHODS: tuple[str, ...] = ("window", "placed", "goal", "result")
 
 
 @dataclass(frozen=True)
@@ -36,9 +40,10 @@ class GtOptions:
     """How the ground truth of a run is measured.
 
     Attributes:
-        method: ``window`` (mean over the stationary window before the goal), ``goal`` (the
-            last sample at the goal, 2015 @Home) or ``result`` (the last sample 1 s after the
-            result, 2015 @Work).
+        method: ``window`` (mean over the stationary window before the goal), or one lookup
+            interpolated at a moment: ``result`` (the result arrived: the 2015 nodes),
+            ``placed`` (the placement confirmed: the 2016-17 @Home node), ``goal`` (the goal
+            was sent).
         max_window_s: longest stationary window averaged.
         still_m: a board sample further than this from the board's pose at the goal ends the
             stationary window (metres; mocap noise is ~0.1 mm, a placement moves centimetres).
@@ -70,8 +75,11 @@ class GroundTruth:
         angle_spread_deg: RMS rotation of the averaged samples from their mean.
         samples: number of samples averaged (1 for the 2015 single lookups).
         start_ns: first sample used.
-        end_ns: last sample used.
+        end_ns: last sample used (for a lookup: its moment, as ``start_ns``).
         method: how it was measured.
+        moment: for a lookup, where its moment came from: ``item tf stamp`` (the node's own
+            broadcast of the item, logged on /tf: exact) or ``state message`` (the BmBox state
+            that the node acted on; its own clock read up to one 10 Hz heartbeat earlier).
     """
 
     x: float
@@ -86,6 +94,7 @@ class GroundTruth:
     start_ns: int
     end_ns: int
     method: str
+    moment: str = ""
 
     @property
     def yaw_deg(self) -> float:
@@ -205,12 +214,15 @@ def stationary_tail(
 
 
 def settled(tail: PoseStream) -> PoseStream:
-    """Drop the samples of a stationary tail that are still settling into place.
+    """Drop the first samples of a stationary tail, those still settling into place.
 
     The tail tolerance (millimetres) must be loose against mocap noise, so the last moments
-    of the board's approach can pass it and bias the mean. Samples further from the median
+    of the board's approach can pass it and bias the mean. A sample further from the median
     than 3x the median distance (about 4.6 sigma of isotropic noise; at least 0.5 mm and
-    0.05 deg) are dropped.
+    0.05 deg) is settling; the tail starts at the first of three consecutive samples that are
+    not. Only a leading stretch is dropped: the samples used are exactly those of the reported
+    window, so anyone can average the same samples (a noisy sample later on stays, as any
+    mocap sample of a still board).
     """
     from scipy.spatial.transform import Rotation
 
@@ -220,10 +232,44 @@ def settled(tail: PoseStream) -> PoseStream:
     dist = np.linalg.norm(tail.xyz - med, axis=1)
     rot = Rotation.from_quat(tail.quat_xyzw)
     ang = (rot.mean().inv() * rot).magnitude()
-    keep = (dist <= max(3.0 * float(np.median(dist)), 5e-4)) & (
+    ok = (dist <= max(3.0 * float(np.median(dist)), 5e-4)) & (
         ang <= max(3.0 * float(np.median(ang)), math.radians(0.05))
     )
-    return tail.take(keep) if keep.sum() >= 3 else tail
+    three = ok[:-2] & ok[1:-1] & ok[2:]
+    if not three.any():
+        return tail
+    start = int(np.argmax(three))
+    return tail.take(slice(start, None)) if len(tail) - start >= 3 else tail
+
+
+def lookup_at(
+    origin: PoseStream, board: PoseStream, at_ns: int, max_gap_ns: int, t0_ns: int = 0
+) -> PoseStream:
+    """T_origin_board at ``at_ns`` as tf's lookup gave it: both bodies interpolated there.
+
+    tf interpolates each link between the samples around the moment (translation linearly,
+    rotation by slerp) and waits for a sample past it: a body not seen within ``max_gap_ns``
+    on either side is lost (the node's lookup raised and it stopped).
+
+    Raises:
+        GroundTruthError: a body not tracked around ``at_ns``.
+    """
+    at = np.array([at_ns], dtype=np.int64)
+    poses = []
+    for stream, name in ((origin, "origin"), (board, "ref_board")):
+        if len(stream) == 0:
+            raise GroundTruthError(f"no {name} pose in the log")
+        got = interpolate_poses(stream, at, "linear")
+        if not bool(got.inside[0]) or int(got.gap_ns[0]) > max_gap_ns:
+            problem = tracked_problem(stream, name, at_ns, max_gap_ns, t0_ns)
+            raise GroundTruthError(
+                problem or f"{name} not tracked on both sides of {_s(at_ns - t0_ns)}"
+            )
+        poses.append(got)
+    o, b = poses
+    inv_t, inv_q = invert(o.xyz, o.quat_xyzw)
+    xyz, quat = compose(inv_t, inv_q, b.xyz, b.quat_xyzw)
+    return PoseStream(at, xyz, quat, "origin", "ref_board", board.source)
 
 
 def measure_ground_truth(
@@ -236,6 +282,8 @@ def measure_ground_truth(
     result_ns: int | None,
     options: GtOptions,
     t0_ns: int = 0,
+    placed_ns: int | None = None,
+    at_ns: int | None = None,
 ) -> tuple[GroundTruth, list[str]]:
     """The item's ground truth for one run, and warnings.
 
@@ -249,37 +297,48 @@ def measure_ground_truth(
         result_ns: the result came back (``result`` method only).
         options: method and tolerances.
         t0_ns: times in messages are given relative to this (the log's start).
+        placed_ns: the referee confirmed the placement (``placed``; the goal when None).
+        at_ns: the lookup's moment when known better than the state messages (the stamp of the
+            node's item broadcast on /tf); ignored by ``window``.
 
     Raises:
         GroundTruthError: a body missing or lost where the measurement needs it.
     """
     max_gap = round(options.max_gap_s * NS_PER_S)
     warnings: list[str] = []
-    if options.method == "window":
-        start = max(search_start_ns, goal_ns - round(options.max_window_s * NS_PER_S))
-        end = check = goal_ns
-    elif options.method == "result":
-        if result_ns is None:
-            raise GroundTruthError("no result time for the 2015 after-result lookup")
-        # tf's latest sample ~1 s after the result; tracking must hold at the result.
-        check = result_ns
-        start, end = result_ns - max_gap, result_ns + RESULT_LOOKUP_DELAY_NS
-    else:
-        start, end = goal_ns - max_gap, goal_ns
-        check = goal_ns
-    for stream, name in ((origin, "origin"), (board, "ref_board")):
-        # Both bodies must be seen at the lookup; before it the stationary tail stops at gaps.
-        problem = tracked_problem(stream, name, check, max_gap, t0_ns)
-        if problem:
-            raise GroundTruthError(problem)
-    rel = board_in_table(
-        origin.window(start - max_gap, end + max_gap), board.window(start, end), max_gap
-    )
-    if len(rel) == 0:
-        raise GroundTruthError(
-            f"no ref_board sample with a known origin in {_s(start - t0_ns)}..{_s(end - t0_ns)}"
+    moment = ""
+    if options.method != "window":
+        if at_ns is not None:
+            at, moment = at_ns, "item tf stamp"
+        elif options.method == "result":
+            if result_ns is None:
+                raise GroundTruthError("no result time for the 2015 lookup when the result came")
+            at, moment = result_ns, "state message"
+        else:
+            moment = "state message"
+            at = placed_ns if options.method == "placed" and placed_ns is not None else goal_ns
+        used = lookup_at(
+            origin.window(at - max_gap, at + max_gap),
+            board.window(at - max_gap, at + max_gap),
+            at,
+            max_gap,
+            t0_ns,
         )
-    if options.method == "window":
+    else:
+        start = max(search_start_ns, goal_ns - round(options.max_window_s * NS_PER_S))
+        end = goal_ns
+        for stream, name in ((origin, "origin"), (board, "ref_board")):
+            # Both bodies must be seen at the goal; before it the stationary tail stops at gaps.
+            problem = tracked_problem(stream, name, goal_ns, max_gap, t0_ns)
+            if problem:
+                raise GroundTruthError(problem)
+        rel = board_in_table(
+            origin.window(start - max_gap, end + max_gap), board.window(start, end), max_gap
+        )
+        if len(rel) == 0:
+            raise GroundTruthError(
+                f"no ref_board sample with a known origin in {_s(start - t0_ns)}..{_s(end - t0_ns)}"
+            )
         used = settled(stationary_tail(rel, options.still_m, options.still_deg, max_gap))
         span = (used.end_ns - used.start_ns) / NS_PER_S
         if span < options.min_still_s:
@@ -288,8 +347,6 @@ def measure_ground_truth(
                 f"({len(used)} sample(s) averaged; moved more than {options.still_m * 1000:g} mm "
                 f"or {options.still_deg:g} deg before)"
             )
-    else:
-        used = rel.take(slice(len(rel) - 1, None))
     t_item, q_item = _item_poses(used, item)
     mean = mean_pose(t_item, q_item)
     board_mean = used.xyz.mean(axis=0)
@@ -307,6 +364,7 @@ def measure_ground_truth(
         start_ns=used.start_ns,
         end_ns=used.end_ns,
         method=options.method,
+        moment=moment,
     )
     return gt, warnings
 

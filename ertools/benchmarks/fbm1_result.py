@@ -11,6 +11,7 @@ from ertools.benchmarks.fbm1_answers import Answer
 from ertools.benchmarks.fbm1_gt import GroundTruth
 from ertools.benchmarks.fbm1_score import PoseErrors, Totals
 from ertools.configs.items import Item
+from ertools.fidelity import Deviation
 from ertools.streams import Provenance
 from ertools.timeutil import NS_PER_S
 
@@ -95,6 +96,8 @@ class Fbm1RunResult:
                 "spread_deg": g.angle_spread_deg,
                 "window_s": [(g.start_ns - t0_ns) / NS_PER_S, (g.end_ns - t0_ns) / NS_PER_S],
             }
+            if g.moment:
+                out["ground_truth"]["moment_from"] = g.moment
         if self.errors is not None:
             e = self.errors
             out["error"] = {
@@ -170,6 +173,8 @@ class Fbm1Result:
         deviations: where ertools deliberately differs from the 2015 node.
         failures: runs that could not be scored (one line each, naming the run).
         provenance: inputs and parameters.
+        reference: which reference the rules reproduce (ertools, the 2015 node, the 2016-17
+            node).
     """
 
     name: str
@@ -178,9 +183,10 @@ class Fbm1Result:
     logged_score: dict[str, Any] | None = None
     t0_ns: int = 0
     warnings: tuple[str, ...] = ()
-    deviations: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
+    reference: str = "ertools default"
 
     def score(self) -> dict[str, Any]:
         """The four keys of the 2015 score payload, in the order ``yaml.dump`` sorted them."""
@@ -194,6 +200,7 @@ class Fbm1Result:
 
     def to_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {**self.score(), "benchmark": self.name}
+        out["reference"] = self.reference
         out["counted_runs"] = {
             "accuracy": self.totals.accuracy_runs,
             "pose": self.totals.pose_runs,

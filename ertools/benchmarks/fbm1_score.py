@@ -6,16 +6,19 @@ r = |dtheta| / 180 clipped at 1; pose_score = 1 - t/2 - r/2. Class and instance 
 the names match. Totals: class_accuracy and instance_accuracy = positives / runs, pose_score =
 mean over the runs, execution_time = sum of the runs' goal-to-result times (seconds).
 
-2015 quirks, reproduced by the ``legacy`` switches:
+The nodes' behaviours, each restored by one :class:`ScoreRules` field (named for what it
+restores; ``Fbm1Options.for_rules`` selects those of one node):
 
-- ``clip``: the node compared t with the table diagonal sqrt(2) m and set larger errors to 1,
-  leaving errors between 1 and 1.41 m unclipped, so a pose score could drop below 0.
-- ``wrap``: theta errors were wrapped by a single +-360, so answers beyond +-540 deg kept a
-  rotation term of 1 however close they were.
-- ``names``: classes and instances were compared exactly; the 2015 ``fbm1w.yaml`` has the class
-  ``"Bearing Boxes "`` with a trailing blank that no robot answer matched.
-- ``totals``: the newest @Home node divided the accuracies by 10 (its number of runs) even when
-  fewer runs were played, and both nodes counted a run aborted before its goal.
+- ``clip_above_diagonal``: both nodes compared t with the table diagonal sqrt(2) m and set only
+  larger errors to 1, leaving errors between 1 and 1.41 m unclipped (a pose score below 0).
+- ``single_wrap``: both nodes wrapped theta errors by a single +-360, so answers beyond +-540 deg
+  kept a rotation term of 1 however close they were.
+- ``exact_names``: both nodes compared classes and instances exactly; the 2015 ``fbm1w.yaml``
+  has the class ``"Bearing Boxes "`` with a trailing blank that no robot answer matched.
+- ``count_aborted``: both nodes counted a run the benchmark stopped before its goal in their
+  divisor (``runs`` was incremented before the manual operation).
+- ``accuracy_over_10``: the 2016-17 @Home node divided the accuracies by ``BENCHMARK_RUNS`` (10)
+  even when fewer runs were played; the 2015 nodes divided them by ``runs``.
 """
 
 from __future__ import annotations
@@ -23,24 +26,31 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-# The 2015 @Home node played at most this many runs and divided the accuracies by it.
-BENCHMARK_RUNS_2015 = 10
+# The @Home nodes played at most this many runs; the 2016-17 one divided the accuracies by it.
+BENCHMARK_RUNS_HOME = 10
 # The 2015 "maximum pose error": the diagonal of a 1 m x 1 m table.
 MAX_POSE_ERROR_2015 = math.sqrt(2.0)
 
 
 @dataclass(frozen=True)
 class ScoreRules:
-    """Which 2015 quirks to reproduce (all False: the fixed rules)."""
+    """Which node behaviours to reproduce (all False: ertools' rules; see the module doc)."""
 
-    legacy_clip: bool = False
-    legacy_wrap: bool = False
-    legacy_names: bool = False
-    legacy_totals: bool = False
+    clip_above_diagonal: bool = False
+    single_wrap: bool = False
+    exact_names: bool = False
+    count_aborted: bool = False
+    accuracy_over_10: bool = False
 
     @staticmethod
-    def all_2015() -> ScoreRules:
-        return ScoreRules(True, True, True, True)
+    def node_2015() -> ScoreRules:
+        """The 2015 nodes (``fbm1h`` and ``fbm1w``): divisor ``runs`` for every total."""
+        return ScoreRules(True, True, True, True, False)
+
+    @staticmethod
+    def node_2016() -> ScoreRules:
+        """The 2016-17 @Home node: as 2015, accuracies divided by 10."""
+        return ScoreRules(True, True, True, True, True)
 
 
 @dataclass(frozen=True)
@@ -108,8 +118,8 @@ def pose_errors(
     dy = y - gt_y
     dist = math.hypot(dx, dy)
     raw = theta_deg - gt_yaw_deg
-    dtheta = wrap_deg(raw, legacy=rules.legacy_wrap)
-    t = trans_term(dist, legacy=rules.legacy_clip)
+    dtheta = wrap_deg(raw, legacy=rules.single_wrap)
+    t = trans_term(dist, legacy=rules.clip_above_diagonal)
     r = rot_term(dtheta)
     score = 1.0 - t / 2.0 - r / 2.0
     old = 1.0 - trans_term(dist, legacy=True) / 2.0 - rot_term(wrap_deg(raw, legacy=True)) / 2.0
@@ -118,8 +128,8 @@ def pose_errors(
 
 
 def names_match(answer: str, truth: str, rules: ScoreRules) -> bool:
-    """Class or instance equality; blanks around names are ignored unless ``legacy_names``."""
-    return answer == truth if rules.legacy_names else answer.strip() == truth.strip()
+    """Class or instance equality; blanks around names are ignored unless ``exact_names``."""
+    return answer == truth if rules.exact_names else answer.strip() == truth.strip()
 
 
 @dataclass(frozen=True)
@@ -141,19 +151,16 @@ def totals(
     execution_times: list[float],
     *,
     aborted: int,
-    benchmark: str,
     rules: ScoreRules,
 ) -> Totals:
     """Totals over the counted runs (every list has one entry per run that reached its goal).
 
-    Runs without answer enter with False, False and pose score 0, as in 2015.
+    Runs without answer enter with False, False and pose score 0, as in 2015. ``aborted``:
+    runs the benchmark stopped before their goal (counted by the nodes' ``runs``).
     """
     played = len(class_ok)
-    acc_runs = played
-    pose_runs = played
-    if rules.legacy_totals:
-        pose_runs = played + aborted
-        acc_runs = BENCHMARK_RUNS_2015 if benchmark == "fbm1h" else pose_runs
+    pose_runs = played + aborted if rules.count_aborted else played
+    acc_runs = BENCHMARK_RUNS_HOME if rules.accuracy_over_10 else pose_runs
 
     def ratio(num: float, den: int) -> float | None:
         return num / den if den else None

@@ -191,7 +191,9 @@ def score_fbm3w(
             f"of {', '.join(STOPPED_RUNS)}"
         )
     poses = read_fbm3w_poses(plist, options)
-    bag_start = min(summary(p).start_ns for p in plist)
+    summaries = [summary(p) for p in plist]
+    bag_start = min(x.start_ns for x in summaries)
+    bag_end = max(x.end_ns for x in summaries)
     mode = options.runs
     if mode is None:
         if options.windows:
@@ -204,7 +206,7 @@ def score_fbm3w(
     if mode == "windows":
         if not options.windows:
             raise ConfigError("--runs windows needs --run SPEC:REF_T:START_T:END_T or --runs-file")
-        windows = find_windows(options.windows, bag_start)
+        windows = find_windows(options.windows, bag_start, bag_end)
     elif mode == "states":
         windows = find_states(read_benchmark_states(plist, NAMESPACE))
     else:
@@ -249,6 +251,16 @@ def score_runs(
     cfg = config if options.d_min is None else config.with_d_min(options.d_min)
     start_ns = poses.start_ns if bag_start_ns is None else bag_start_ns
     runs_in, warnings = with_specs(list(windows), cfg)
+    specs = cfg.runs_specifications
+    if runs_in and runs_in[0].mode == "auto" and len(runs_in) < len(specs):
+        last = runs_in[-1]
+        after = "" if last.end_ns is None else f" after {(last.end_ns - start_ns) / 1e9:.2f} s"
+        warnings.append(
+            f"--runs auto found {len(runs_in)} of the {len(specs)} runs the config lists: no "
+            f"move{after} (the end of run {last.index}'s path) matches run {len(runs_in)}'s "
+            f"shape {specs[len(runs_in)]!r} between still phases; the log ends there or the "
+            "rest need --runs windows"
+        )
     noise = _noise(poses, options, warnings)
     same = identical_poses(poses)
     frames = frame_change_warning(poses, start_ns)

@@ -5,6 +5,8 @@ marker set (``/rockin/<team>/marker_pose``) with the mocap pose of that marker s
 robot pose it took the GT pose pair (p1, p2) with p1.t <= t <= p2.t, skipped the robot pose when
 p1 and p2 had the same position (Motive repeats the last pose when tracking is lost), compared
 with p1 ("hold") and reported the mean 3D distance and atan2(sum sin|dyaw|, sum cos|dyaw|).
+Where ertools' default differs, one option restores each 2015 behaviour (the ``RULE_*``
+constants) and :meth:`TrajectoryConfig.of_2015` (``--2015``) all of them at once.
 
 Shape: load (robot stream, GT files selected by time overlap, read as one stream) -> associate
 (hold | nearest | linear, max-gap, tracking lost, coverage) -> metrics -> frozen
@@ -15,11 +17,12 @@ time. :func:`score_streams` is pure; :func:`score` is the IO edge.
 from __future__ import annotations
 
 import logging
-from collections.abc import Sequence
-from dataclasses import dataclass, field
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, replace
 from itertools import pairwise
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 import numpy.typing as npt
@@ -27,6 +30,7 @@ import numpy.typing as npt
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.benchmarks.clock_offset import OffsetEstimate, estimate_offset
 from ertools.errors import BagError, ClockError, ErtoolsError, ScoringError, TopicError
+from ertools.fidelity import Deviation, Rule
 from ertools.geometry import (
     Association,
     interpolate_poses,
@@ -54,18 +58,32 @@ COMPARED, GAP, TRACKING_LOST, UNCOVERED = 0, 1, 2, 3
 STATUS_NAMES = ("compared", "gap", "tracking_lost", "uncovered")
 
 
+Ties = Literal["at", "before"]
+Gaps = Literal["skip", "compare"]
+BeforeGt = Literal["uncovered", "first"]
+TIES: tuple[Ties, ...] = ("at", "before")
+GAPS: tuple[Gaps, ...] = ("skip", "compare")
+BEFORE_GT: tuple[BeforeGt, ...] = ("uncovered", "first")
+
+
 @dataclass(frozen=True)
 class TrajectoryConfig:
     """How to compare.
 
     Attributes:
         association: ``linear`` (default), ``nearest`` or ``hold`` (2015).
-        max_gap_ns: robot poses whose surrounding GT poses are further apart are not compared.
+        max_gap_ns: robot poses whose surrounding GT poses are further apart are in a GT gap.
         offset_ns: added to the robot stamps before comparing (``--offset S``).
         auto_offset: ``--offset auto``: estimate the offset (always done for the audit).
         apply_offset: with ``auto_offset``, score with the estimate.
         offset_range_ns: the audit searches offsets within +- this.
         allow_partial: score the covered part when robot poses lie outside the GT.
+        ties: with ``hold``, a robot pose stamped exactly at a GT sample is compared with that
+            sample (``at``) or with the one before it (``before``, 2015).
+        gaps: robot poses in GT gaps are not compared (``skip``) or compared with the GT pose
+            given by the association, counted and warned about (``compare``, 2015).
+        before_gt: robot poses before the first GT pose are uncovered (``uncovered``) or
+            compared with the first GT pose (``first``, 2015).
     """
 
     association: Association = "linear"
@@ -75,6 +93,9 @@ class TrajectoryConfig:
     apply_offset: bool = False
     offset_range_ns: int = 5 * NS_PER_S
     allow_partial: bool = False
+    ties: Ties = "at"
+    gaps: Gaps = "skip"
+    before_gt: BeforeGt = "uncovered"
 
     def __post_init__(self) -> None:
         from ertools.errors import ConfigError
@@ -83,10 +104,166 @@ class TrajectoryConfig:
             raise ConfigError(
                 f"association {self.association!r} unknown; choose from {', '.join(ASSOCIATIONS)}"
             )
+        for name, value, allowed in (
+            ("ties", self.ties, TIES),
+            ("gaps", self.gaps, GAPS),
+            ("before-gt", self.before_gt, BEFORE_GT),
+        ):
+            if value not in allowed:
+                raise ConfigError(f"--{name} {value!r} unknown; choose from {', '.join(allowed)}")
+        if self.ties == "before" and self.association != "hold":
+            # Only the held pose depends on the tie rule: linear and nearest give the sample at
+            # the robot time whichever pair brackets it.
+            raise ConfigError(f"--ties before needs --association hold (not {self.association})")
         if self.max_gap_ns <= 0:
             raise ConfigError(f"--max-gap must be positive, not {self.max_gap_ns / NS_PER_S} s")
         if self.offset_range_ns <= 0:
             raise ConfigError("--offset-range must be positive")
+
+    @classmethod
+    def of_2015(cls, **overrides: Any) -> TrajectoryConfig:
+        """Every 2015 behaviour of ``rockin_trajectory_benchmark.py`` at once (``--2015``).
+
+        Hold association with 2015's tie rule, GT gaps compared against the held pose, robot
+        poses before the first GT pose compared with it. ``overrides`` set the other fields
+        (offset, max-gap, allow-partial).
+        """
+        return cls(**{**SETTINGS_2015, **overrides})
+
+
+# What ``--2015`` selects: each is one option on its own (docs/trajectory.md, the RULE_*
+# constants below). Read-only: the CLI and of_2015 copy it.
+SETTINGS_2015: Mapping[str, str] = MappingProxyType(
+    {"association": "hold", "ties": "before", "gaps": "compare", "before_gt": "first"}
+)
+
+# The rules of the 2015 script where ertools' default differs (docs/fidelity.md). The 2015
+# script is rockin_trajectory_benchmark.py of rockin_offline_trajectory_benchmark (seed
+# footnote 15); the seed says only that it compares the GT with the trajectory the robot logged.
+_SEED = (
+    "seed footnote 15: rockin_offline_trajectory_benchmark compares the GT with the trajectory "
+    "logged by the robot; section 4: NTP time makes the association 'straightforward'; no rule "
+    "given"
+)
+RULE_ASSOCIATION = Rule(
+    key="trajectory.association",
+    benchmark="trajectory",
+    title="GT pose at a robot time",
+    rulebook=_SEED,
+    node_2015=(
+        "the GT pose before the first GT pose at or after the robot stamp, not interpolated "
+        "(rockin_trajectory_benchmark.py: interpolate() 'not used', returns mocap_pose_1)"
+    ),
+    ertools=(
+        "linear between the GT poses around the robot time (SLERP for orientation): holding "
+        "adds up to one GT period of motion (8 ms at 120 Hz, 4 mm at 0.5 m/s) to the error"
+    ),
+    option="--association hold",
+)
+RULE_TIES = Rule(
+    key="trajectory.ties",
+    benchmark="trajectory",
+    title="robot pose stamped exactly at a GT sample",
+    rulebook=_SEED,
+    node_2015=(
+        "seek_mocap_pose_at stops at the first pair with p2.t >= t and uses p1: on a tie, the "
+        "GT pose before the robot's (rockin_trajectory_benchmark.py)"
+    ),
+    ertools="with --association hold, the GT sample at the robot time: the GT pose at that time",
+    option="--ties before",
+)
+RULE_GAPS = Rule(
+    key="trajectory.gaps",
+    benchmark="trajectory",
+    title="robot poses in GT gaps",
+    rulebook=_SEED,
+    node_2015=(
+        "compared with the pose held across the gap, only warned: 'consecutive mocap poses very "
+        "distant in time, used to calculate the error (result may be invalid)' when t2 - t1 > "
+        "0.1 s (rockin_trajectory_benchmark.py)"
+    ),
+    ertools=(
+        "not compared, counted as gaps (--max-gap, default 0.1 s): the held pose may be "
+        "seconds old and the error then measures the gap, not the robot"
+    ),
+    option="--gaps compare",
+)
+RULE_BEFORE_GT = Rule(
+    key="trajectory.before-gt",
+    benchmark="trajectory",
+    title="robot poses before the first GT pose",
+    rulebook=_SEED,
+    node_2015=(
+        "compared with the first GT pose after printing '[ERROR] ... This should never "
+        "happen' (rockin_trajectory_benchmark.py, seek_mocap_pose_at)"
+    ),
+    ertools=(
+        "uncovered: an error naming the span (GT files missing or clocks apart), or not "
+        "scored with --allow-partial"
+    ),
+    option="--before-gt first",
+)
+RULE_YAW_WRAP = Rule(
+    key="trajectory.yaw-wrap",
+    benchmark="trajectory",
+    title="orientation error across +-pi",
+    rulebook=_SEED,
+    node_2015=(
+        "atan2(sum sin|dyaw|, sum cos|dyaw|) with dyaw = r_theta - m_theta not wrapped, yaws "
+        "from tf euler_from_quaternion (rockin_trajectory_benchmark.py, Error.update)"
+    ),
+    ertools=(
+        "dyaw wrapped to [-pi, pi] in orientation_error (a pose crossing +-pi otherwise counts "
+        "a ~2pi difference); every run also reports 2015's value as orientation_error_2015, so "
+        "no option is needed"
+    ),
+    option="",
+)
+RULE_GT_OVERLAP = Rule(
+    key="trajectory.gt-overlap",
+    benchmark="trajectory",
+    title="GT files overlapping in time",
+    rulebook=_SEED,
+    node_2015=(
+        "chained the GT files sorted by start time and scanned them in that order, warning "
+        "'poses out of order: result may be invalid' (rockin_trajectory_benchmark.py)"
+    ),
+    ertools=(
+        "poses merged in time order, a message recorded twice used once; no option: 2015's "
+        "result there depends on where its scan stood, a defect rather than a rule"
+    ),
+    option="",
+)
+RULE_INVALID_POSES = Rule(
+    key="trajectory.invalid-poses",
+    benchmark="trajectory",
+    title="NaN poses and zero quaternions",
+    rulebook=_SEED,
+    node_2015=(
+        "used as they were: a NaN made the score NaN, a zero quaternion gave tf's identity, a "
+        "yaw of 0 (rockin_trajectory_benchmark.py, Error.update)"
+    ),
+    ertools=(
+        "ignored and counted in a warning; no option: a NaN score is no score, and a zero "
+        "quaternion is a node publishing 'no pose'"
+    ),
+    option="",
+)
+RULE_ROBOT_STAMPS = Rule(
+    key="trajectory.robot-stamps",
+    benchmark="trajectory",
+    title="robot stamps that go back in time",
+    rulebook=_SEED,
+    node_2015=(
+        "its GT scan only moves forward: a robot pose stamped before the previous one was "
+        "compared with the GT pose of the previous one (rockin_trajectory_benchmark.py)"
+    ),
+    ertools=(
+        "an error naming the message; no option: the 2015 pairing there is not the GT at the "
+        "robot's time (--robot-time record scores by the robot bag's record times instead)"
+    ),
+    option="",
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -99,8 +276,12 @@ class Matched:
         gt_xyz, gt_yaw: GT at each robot time (NaN unless compared).
         position_error: (N,) 3D distance, metres (NaN unless compared).
         yaw_error: (N,) |wrap(yaw_robot - yaw_gt)|, radians (NaN unless compared).
-        yaw_diff_raw: (N,) yaw_robot - yaw_gt unwrapped, as 2015 used it (NaN unless compared).
+        yaw_diff_raw: (N,) yaw_robot - yaw_gt unwrapped, both yaws by tf's arithmetic, as
+            2015 used it (NaN unless compared).
         exact_ties: robot poses stamped exactly at a GT sample.
+        across_gap: (N,) the robot pose lies in a GT gap longer than the max gap (compared
+            or not, as the ``gaps`` setting says).
+        before_gt: robot poses before the first GT pose.
     """
 
     t_ns: I64
@@ -111,46 +292,123 @@ class Matched:
     yaw_error: F64
     yaw_diff_raw: F64
     exact_ties: int
+    across_gap: npt.NDArray[np.bool_]
+    before_gt: int
 
     def count(self, status: int) -> int:
         return int(np.count_nonzero(self.status == status))
 
+    @property
+    def gaps_compared(self) -> int:
+        """Robot poses compared with a GT pose across a GT gap (``gaps`` ``compare``)."""
+        return int(np.count_nonzero(self.across_gap & (self.status == COMPARED)))
 
-def associate(robot: PoseStream, gt: PoseStream, method: Association, max_gap_ns: int) -> Matched:
+
+def associate(
+    robot: PoseStream,
+    gt: PoseStream,
+    method: Association,
+    max_gap_ns: int,
+    *,
+    ties: Ties = "at",
+    gaps: Gaps = "skip",
+    before_gt: BeforeGt = "uncovered",
+) -> Matched:
     """Pair every robot pose with the GT pose at its time.
 
-    Rules, in this order: a robot pose before the first or after the last GT pose is
-    UNCOVERED; one whose surrounding GT poses (the last at or before and the first at or after
-    it) are more than ``max_gap_ns`` apart is a GAP; one whose GT pair (the first GT pose at or
-    after it and the one before that, the 2015 pair) has the same position is TRACKING_LOST;
-    every other pose is COMPARED against the GT pose given by ``method``.
+    Rules, in this order: a robot pose after the last GT pose is UNCOVERED, and so is one
+    before the first unless ``before_gt`` is ``first`` (then it is held at the first GT pose,
+    as 2015 did). One whose surrounding GT poses are more than ``max_gap_ns`` apart lies in a
+    GT gap: a GAP, not compared, unless ``gaps`` is ``compare`` (2015). One whose GT pair
+    (the first GT pose at or after it and the one before that, the 2015 pair) has the same
+    position is TRACKING_LOST; every other pose is COMPARED against the GT pose given by
+    ``method``.
+
+    The surrounding GT poses are the last at or before and the first at or after the robot
+    time (one sample on an exact tie); with ``ties`` ``before`` (hold only) they are the 2015
+    pair on ties too, and ``hold`` takes the first of the pair: the pose before the tie.
     """
     if len(gt) == 0:
         raise ScoringError("the GT stream is empty")
     n_gt = len(gt)
     q = robot.t_ns
     interp = interpolate_poses(gt, q, method)
-    status = np.full(len(q), COMPARED, dtype=np.uint8)
-    status[~interp.inside] = UNCOVERED
-    gap = interp.inside & (interp.gap_ns > max_gap_ns)
-    status[gap] = GAP
-    second = interp.hi  # first GT sample at or after the robot time
+    before = interp.hi == 0  # the first GT pose is at or after the robot time
+    early = before & (q < gt.t_ns[0])
+    # The 2015 pair (GT[k-1], GT[k]): k the first GT pose at or after the robot time; the
+    # 2015 script started its scan at the pair (GT[0], GT[1]), so k is at least 1 there.
+    second = interp.hi
+    if ties == "before" or before_gt == "first":
+        widen = early if ties == "at" else before
+        second = np.where(widen, 1, second)
     first = second - 1
     has_pair = (first >= 0) & (second < n_gt)
     fi, si = np.clip(first, 0, n_gt - 1), np.clip(second, 0, n_gt - 1)
+    inside = interp.inside | (early if before_gt == "first" else False)
+    if ties == "before":
+        pair_gap = gt.t_ns.take(si) - gt.t_ns.take(fi)
+        gap_ns = np.where(has_pair, pair_gap, np.iinfo(np.int64).max)
+        gt_xyz_at = _rows(gt.xyz, fi)
+        gt_quat_at = _rows(gt.quat_xyzw, fi)
+    else:
+        gap_ns = interp.gap_ns
+        if before_gt == "first" and n_gt > 1:
+            # Held at the first GT pose: the pair around it is (GT[0], GT[1]), as in 2015.
+            gap_ns = np.where(early, int(gt.t_ns[1] - gt.t_ns[0]), gap_ns)
+        gt_xyz_at, gt_quat_at = interp.xyz, interp.quat_xyzw
+    status = np.full(len(q), COMPARED, dtype=np.uint8)
+    status[~inside] = UNCOVERED
+    across = inside & (gap_ns > max_gap_ns)
+    if gaps == "skip":
+        status[across] = GAP
     same = has_pair & _same_rows(gt.xyz, fi, si)
     status[(status == COMPARED) & same] = TRACKING_LOST
     ok = status == COMPARED
 
     nan3 = np.full((len(q), 3), np.nan)
-    gt_xyz = np.where(ok[:, None], interp.xyz, nan3)
-    gt_yaw = np.where(ok, yaw_from_quat(interp.quat_xyzw), np.nan)
+    gt_xyz = np.where(ok[:, None], gt_xyz_at, nan3)
+    gt_yaw = np.where(ok, yaw_from_quat(gt_quat_at), np.nan)
     robot_yaw = yaw_from_quat(robot.quat_xyzw)
-    pos_err = np.where(ok, row_norm(robot.xyz - interp.xyz), np.nan)
-    raw = np.where(ok, robot_yaw - gt_yaw, np.nan)
-    yaw_err = np.abs(wrap_angle(raw))
-    ties = int(np.count_nonzero(interp.inside & (interp.lo == interp.hi)))
-    return Matched(q, status, gt_xyz, gt_yaw, pos_err, yaw_err, raw, ties)
+    pos_err = np.where(ok, row_norm(robot.xyz - gt_xyz_at), np.nan)
+    yaw_err = np.abs(wrap_angle(np.where(ok, robot_yaw - gt_yaw, np.nan)))
+    raw = np.where(ok, yaw_tf(robot.quat_xyzw) - yaw_tf(gt_quat_at), np.nan)
+    ties_n = int(np.count_nonzero(interp.inside & (interp.lo == interp.hi)))
+    return Matched(
+        q, status, gt_xyz, gt_yaw, pos_err, yaw_err, raw, ties_n, across, int(early.sum())
+    )
+
+
+# tf.transformations' ``_EPS`` (4 machine epsilons): its gimbal-lock and zero-norm thresholds.
+_TF_EPS = float(np.finfo(np.float64).eps) * 4.0
+
+
+def yaw_tf(quat_xyzw: F64) -> F64:
+    """Yaw as ``tf.transformations.euler_from_quaternion(q)[2]`` computes it (2015's scripts).
+
+    tf normalises the quaternion inside its rotation matrix, so a quaternion slightly off unit
+    norm gives the yaw of its unit quaternion: atan2(2(xy + zw), w^2 + x^2 - y^2 - z^2), which
+    is :func:`ertools.geometry.yaw_from_quat` for a unit quaternion. At gimbal lock (pitch
+    +-90 degrees) and for a zero quaternion tf returns a yaw of 0.
+    """
+    q = np.asarray(quat_xyzw, dtype=np.float64)
+    x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    n = np.einsum("...i,...i->...", q, q)
+    with np.errstate(invalid="ignore", divide="ignore"):  # a zero quaternion: set to 0 below
+        s = 2.0 / n
+        m00 = 1.0 - (y * y + z * z) * s
+        m10 = (x * y + z * w) * s
+    out = np.arctan2(m10, m00)
+    # tf: identity below _EPS of squared norm; yaw 0 where cos(pitch) (the norm of the
+    # matrix's first column in x, y) is at most _EPS. Squares compared: no square root.
+    flat = (n < _TF_EPS) | (m00 * m00 + m10 * m10 <= _TF_EPS * _TF_EPS)
+    if flat.any():
+        out = np.where(flat, 0.0, out)
+    return np.asarray(out, dtype=np.float64)
+
+
+def _rows(a: F64, index: npt.NDArray[np.intp]) -> F64:
+    """``a[index]`` for a 2D array (``take`` gathers whole rows)."""
+    return np.take(a, index, axis=0)
 
 
 def _same_rows(a: F64, i: npt.NDArray[np.intp], j: npt.NDArray[np.intp]) -> npt.NDArray[np.bool_]:
@@ -245,7 +503,7 @@ class TrajectoryResult:
     audit: OffsetEstimate
     uncovered_spans: tuple[tuple[int, int], ...] = ()
     warnings: tuple[str, ...] = ()
-    deviations: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
     name: str = "trajectory"
@@ -285,6 +543,11 @@ class TrajectoryResult:
             "percentiles": None if m is None else {f"p{p:g}": v for p, v in m.percentiles},
             "orientation_error_2015": None if m is None else m.orientation_error_2015,
             "uncovered": self.uncovered,
+            "gaps_compared": self.matched.gaps_compared,
+            "before_gt": self.matched.before_gt,
+            "ties": self.config.ties,
+            "gap_poses": self.config.gaps,
+            "before_gt_poses": self.config.before_gt,
             "robot_poses": len(self.matched.t_ns),
             "partial": self.uncovered > 0,
             "uncovered_spans": [[ns_to_s(s), ns_to_s(e)] for s, e in self.uncovered_spans],
@@ -324,6 +587,7 @@ class TrajectoryResult:
                 "t": ns_to_s(int(t)),
                 "t_rel_s": (int(t) - t0) / NS_PER_S,
                 "status": STATUS_NAMES[int(s)],
+                "in_gt_gap": bool(g_),
                 "robot_x": float(r[0]),
                 "robot_y": float(r[1]),
                 "robot_z": float(r[2]),
@@ -335,9 +599,10 @@ class TrajectoryResult:
                 "position_error": _f(e),
                 "yaw_error": _f(ye),
             }
-            for t, s, r, ry, g, gy, e, ye in zip(
+            for t, s, g_, r, ry, g, gy, e, ye in zip(
                 mt.t_ns.tolist(),
                 mt.status.tolist(),
+                mt.across_gap.tolist(),
                 self.robot.xyz,
                 ryaw.tolist(),
                 mt.gt_xyz,
@@ -362,6 +627,8 @@ class TrajectoryResult:
                 "uncovered",
                 "association",
                 "offset",
+                "orientation_error_2015",
+                "gaps_compared",
             )
         }
         summary["estimated_offset"] = d["clock_audit"]["estimated_offset"]
@@ -481,12 +748,20 @@ def score_streams(
     notes = list(warnings)
     notes.extend(w for w in (frame_change_warning(gt), frame_change_warning(robot)) if w)
     gt, dropped = drop_duplicates(gt)
+    invalid: list[Deviation] = []
     if dropped:
         notes.append(f"{dropped} GT sample(s) recorded twice (overlapping GT files) were used once")
     gt, bad_gt = drop_invalid(gt)
     robot, bad_robot = drop_invalid(robot)
     if bad_gt:
         notes.append(f"{bad_gt} GT sample(s) with NaN or zero-norm poses ignored")
+    if bad_gt or bad_robot:
+        invalid.append(
+            RULE_INVALID_POSES.deviation(
+                f"{bad_gt} GT and {bad_robot} robot pose(s) with NaN or zero-norm quaternions "
+                "ignored (2015 used them: a NaN score, or a yaw of 0)"
+            )
+        )
     if bad_robot:
         notes.append(f"{bad_robot} robot pose(s) with NaN or zero-norm poses ignored")
     if len(robot) == 0:
@@ -514,7 +789,15 @@ def score_streams(
         robot.child_frame_id,
         robot.source,
     )
-    matched = associate(shifted, gt, config.association, config.max_gap_ns)
+    matched = associate(
+        shifted,
+        gt,
+        config.association,
+        config.max_gap_ns,
+        ties=config.ties,
+        gaps=config.gaps,
+        before_gt=config.before_gt,
+    )
     outside = matched.status == UNCOVERED
     spans = _spans(matched.t_ns, outside)
     n_out = int(outside.sum())
@@ -531,7 +814,14 @@ def score_streams(
         more = f" and {len(spans) - 3} more" if len(spans) > 3 else ""
         msg = f"{n_out} of {len(matched.t_ns)} robot poses lie outside the GT: {text}{more}"
         if not config.allow_partial:
-            raise ClockError(f"{where}: {msg}; give the missing GT files or --allow-partial")
+            early = int(np.count_nonzero(outside & (matched.t_ns < gt.t_ns[0])))
+            hint = (
+                f" ({early} lie before the first GT pose: 2015 compared them with it, "
+                "--before-gt first)"
+                if early
+                else ""
+            )
+            raise ClockError(f"{where}: {msg}; give the missing GT files or --allow-partial{hint}")
         notes.append(f"partial: {msg}; only the covered part is scored")
 
     m = metrics(matched)
@@ -545,6 +835,18 @@ def score_streams(
         notes.append(
             f"{matched.count(GAP)} robot pose(s) fall in GT gaps longer than "
             f"{ns_to_s(config.max_gap_ns):g} s and are not compared"
+        )
+    if matched.gaps_compared:
+        notes.append(
+            f"{matched.gaps_compared} robot pose(s) fall in GT gaps longer than "
+            f"{ns_to_s(config.max_gap_ns):g} s and are compared with the GT pose "
+            f"{'held' if config.association == 'hold' else 'bridging'} across the gap "
+            "(--gaps compare; 2015: 'result may be invalid')"
+        )
+    if config.before_gt == "first" and matched.before_gt:
+        notes.append(
+            f"{matched.before_gt} robot pose(s) before the first GT pose are compared with "
+            "the first GT pose (--before-gt first; 2015 printed an error and went on)"
         )
     if matched.count(TRACKING_LOST):
         notes.append(
@@ -566,7 +868,7 @@ def score_streams(
         audit=audit,
         uncovered_spans=tuple(spans),
         warnings=tuple(notes),
-        deviations=tuple(_deviations(config, matched, m)),
+        deviations=(*_deviations(config, matched, m), *invalid),
         failures=tuple(failures),
         provenance=Provenance(
             inputs=(robot_file, *gt_files),
@@ -574,6 +876,9 @@ def score_streams(
                 ("robot_topic", robot_topic),
                 ("gt_topic", gt_topic),
                 ("association", config.association),
+                ("ties", config.ties),
+                ("gaps", config.gaps),
+                ("before_gt", config.before_gt),
                 ("max_gap", f"{ns_to_s(config.max_gap_ns):g}"),
                 ("offset", f"{ns_to_s(offset_ns):g}"),
             ),
@@ -602,28 +907,43 @@ def _audit_warnings(audit: OffsetEstimate, applied_ns: int) -> list[str]:
     return out
 
 
-def _deviations(config: TrajectoryConfig, m: Matched, metr: Metrics | None) -> list[str]:
+def _deviations(config: TrajectoryConfig, m: Matched, metr: Metrics | None) -> list[Deviation]:
     out = []
     if config.association != "hold":
         out.append(
-            f"association {config.association} (2015: hold, the GT pose before the robot pose); "
-            "--association hold reproduces 2015"
+            RULE_ASSOCIATION.deviation(
+                f"association {config.association} (2015: hold, the GT pose before the robot pose)"
+            )
         )
-    elif m.exact_ties:
+    elif config.ties == "at" and m.exact_ties:
         out.append(
-            f"{m.exact_ties} robot pose(s) stamped exactly at a GT sample use that sample "
-            "(2015 used the one before it)"
+            RULE_TIES.deviation(
+                f"{m.exact_ties} robot pose(s) stamped exactly at a GT sample use that sample "
+                "(2015 used the one before it)"
+            )
         )
     if m.count(GAP):
         out.append(
-            f"{m.count(GAP)} robot pose(s) in GT gaps > {ns_to_s(config.max_gap_ns):g} s not "
-            "compared (2015 compared them and only warned)"
+            RULE_GAPS.deviation(
+                f"{m.count(GAP)} robot pose(s) in GT gaps > {ns_to_s(config.max_gap_ns):g} s "
+                "not compared (2015 compared them with the held pose and only warned)"
+            )
+        )
+    if config.before_gt == "uncovered" and m.before_gt:
+        out.append(
+            RULE_BEFORE_GT.deviation(
+                f"{m.before_gt} robot pose(s) before the first GT pose not scored (2015 compared "
+                "them with the first GT pose)"
+            )
         )
     wrapped = int(np.count_nonzero(np.abs(m.yaw_diff_raw[m.status == COMPARED]) > np.pi))
     if wrapped and metr is not None:
         out.append(
-            f"yaw differences wrapped to [-pi, pi] ({wrapped} pose(s) crossed +-pi; 2015 did "
-            f"not wrap: its orientation error would be {metr.orientation_error_2015:.4f} rad)"
+            RULE_YAW_WRAP.deviation(
+                f"yaw differences wrapped to [-pi, pi] ({wrapped} pose(s) crossed +-pi; 2015 did "
+                f"not wrap: its orientation error, orientation_error_2015, is "
+                f"{metr.orientation_error_2015:.4f} rad)"
+            )
         )
     return out
 
@@ -848,7 +1168,7 @@ def score(
     files = [s.path for s in chosen]
     gt = read_gt(files, gtopic, lo - margin, hi + margin)
     try:
-        return score_streams(
+        result = score_streams(
             robot,
             gt,
             cfg,
@@ -865,3 +1185,12 @@ def score(
         raise ClockError(
             f"{err}; damaged GT file(s), read only up to the damage: {', '.join(broken)}"
         ) from err
+    overlaps = sum(1 for a, b in pairwise(chosen) if b.start_ns < a.end_ns)
+    if overlaps:
+        dev = RULE_GT_OVERLAP.deviation(
+            f"{overlaps} pair(s) of GT files overlap in time: their poses are merged in time "
+            "order, a message recorded twice used once (2015 chained the files by start time "
+            "and scanned the poses out of order)"
+        )
+        result = replace(result, deviations=(*result.deviations, dev))
+    return result

@@ -24,8 +24,8 @@ EPILOG = """examples:
 
 Rates are the median of the intervals between record times, from the index records.
 JSON/YAML layout: {"bags": [{"path", "format", "version", "start", "start_iso", "end",
-"end_iso", "duration", "size_bytes", "compression", "messages", "indexed", "checked",
-"problems", "topics": [{"name", "type", "count", "connections", "first", "last",
+"end_iso", "duration", "size_bytes", "compression", "messages", "indexed", "index",
+"checked", "problems", "topics": [{"name", "type", "count", "connections", "first", "last",
 "median_rate_hz"}]}], "problems": [{"path", "problem"}]}; times in epoch seconds.
 Exit status 1 when any bag is unreadable, truncated or (with --check) corrupt.
 """
@@ -85,6 +85,7 @@ def table(info: BagInfo) -> str:
     lines += [
         f"size:        {_size(s.size_bytes)} ({s.size_bytes} bytes)",
         f"compression: {s.compression}",
+        f"index:       {s.index}",
         f"messages:    {s.message_count}",
     ]
     if info.checked:
@@ -153,7 +154,8 @@ def run(args: argparse.Namespace) -> int:
         fatal = _fatal_problem(info)
         if fatal is not None:
             problems.append({"path": str(path), "problem": _one_line(fatal)})
-        elif not info.summary.indexed:
+        elif not info.summary.indexed and info.summary.problems:
+            # a complete file read record by record (an MCAP without summary) is no warning
             note(f"warning: {path}: not indexed (still recording?); counts come from a scan")
     if args.format == "table":
         text = "\n\n".join(table(i) for i in infos)

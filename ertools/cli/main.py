@@ -35,6 +35,11 @@ COMMANDS: dict[str, Command] = {
         "recompute a benchmark score (fbm1h, fbm1w, fbm2h, fbm3w, trajectory)",
         "ertools score fbm3w run.bag --config configs/fbm3w.yaml",
     ),
+    "export": Command(
+        "ertools.cli.export",
+        "poses as TUM, KITTI or CSV for evo and other tools; the robot/GT pair",
+        "ertools export run.bag --topic /fbm3w/robot_at_work/pose -o poses.tum",
+    ),
     "noise": Command(
         "ertools.cli.noise",
         "mocap noise statistics of a stationary marker set, suggested d_min",

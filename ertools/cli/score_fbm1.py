@@ -21,7 +21,8 @@ EPILOG = """examples:
   ertools score fbm1h run.bag --items configs/fbm1h.yaml
   ertools score fbm1w run.bag --items configs/fbm1w.yaml --items-order 3,7,1,2
   ertools score fbm1h run.bag --items fbm1h.yaml --results answers.yaml --format json
-  ertools score fbm1h run.bag --items fbm1h.yaml --2015      # the 2015 node's numbers
+  ertools score fbm1h run.bag --items fbm1h.yaml --rules 2015   # the 2015 node's numbers
+  ertools score fbm1h run.bag --items fbm1h.yaml --rules 2016   # the 2016-17 @Home node's
 
 --results FILE: a YAML list of answers, each {run: N or item: ID, item_class, item_instance,
 x, y, theta} (theta in degrees), used instead of the Client payloads it covers.
@@ -65,10 +66,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     gt = parser.add_argument_group("ground truth")
     gt.add_argument(
         "--gt",
-        choices=("window", "goal", "result"),
+        choices=GT_CHOICES,
         default=None,
-        help="window: mean over the stationary window before the goal (default); goal: last "
-        "sample at the goal (2015 @Home); result: last sample 1 s after the result (2015 @Work)",
+        help="window: mean over the stationary window before the goal (default); or one tf "
+        "lookup interpolated at a moment: result: when the result arrived (2015 nodes), "
+        "placed: when the placement was confirmed (2016-17 @Home node), goal: when the goal "
+        "was sent",
     )
     gt.add_argument("--max-window", type=float, default=5.0, metavar="S", help="default 5")
     gt.add_argument(
@@ -84,58 +87,105 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="S",
         help="longer mocap gaps mean the body was lost (default 0.5 s)",
     )
-    legacy = parser.add_argument_group("2015 behaviour (each fix can be undone)")
-    legacy.add_argument(
-        "--legacy-clip",
+    nodes = parser.add_argument_group(
+        "node rules (each option restores one behaviour of the 2015 / 2016-17 nodes)"
+    )
+    nodes.add_argument(
+        "--rules",
+        choices=RULE_SETS,
+        default=None,
+        help="every behaviour of one reference at once: ertools (default), 2015 (the 2015 "
+        "nodes), 2016 (the 2016-17 @Home node); single options below add to it",
+    )
+    nodes.add_argument(
+        "--2015", dest="rules", action="store_const", const="2015", help="= --rules 2015"
+    )
+    nodes.add_argument(
+        "--2016", dest="rules", action="store_const", const="2016", help="= --rules 2016"
+    )
+    nodes.add_argument(
+        "--clip-above-diagonal",
         action="store_true",
-        help="translation term 1 only above sqrt(2) m (2015: 1..1.41 m unclipped)",
+        help="translation term 1 only above sqrt(2) m (1..1.41 m stay unclipped)",
     )
-    legacy.add_argument(
-        "--legacy-wrap", action="store_true", help="theta error wrapped by a single 360"
+    nodes.add_argument(
+        "--single-wrap", action="store_true", help="theta error wrapped by a single 360"
     )
-    legacy.add_argument(
-        "--legacy-names", action="store_true", help="names compared exactly (blanks count)"
+    nodes.add_argument(
+        "--exact-names", action="store_true", help="names compared exactly (blanks count)"
     )
-    legacy.add_argument(
-        "--legacy-totals",
+    nodes.add_argument(
+        "--count-aborted",
         action="store_true",
-        help="count runs aborted before their goal; @Home accuracies divided by 10",
+        help="a run stopped before its goal counts in every divisor (both nodes)",
     )
-    legacy.add_argument(
-        "--2015",
-        dest="all_2015",
+    nodes.add_argument(
+        "--accuracy-over-10",
         action="store_true",
-        help="all of the above and the 2015 single-sample ground truth",
+        help="class and instance accuracies divided by 10 whatever the runs (2016-17 @Home)",
     )
+    for old_flag in DEPRECATED:
+        nodes.add_argument(old_flag, action="store_true", help=argparse.SUPPRESS)
     add_output_options(parser)
 
 
+GT_CHOICES = ("window", "placed", "goal", "result")
+RULE_SETS = ("ertools", "2015", "2016")
+# Old spellings: what each now means (one note on stderr when used).
+DEPRECATED = {
+    "--legacy-clip": "--clip-above-diagonal",
+    "--legacy-wrap": "--single-wrap",
+    "--legacy-names": "--exact-names",
+    "--legacy-totals": "--count-aborted --accuracy-over-10 (the 2016-17 @Home node's divisors; "
+    "the 2015 node's are --count-aborted alone)",
+}
+
+
 def _options(args: argparse.Namespace) -> object:
+    from dataclasses import replace
+
     from ertools.benchmarks.fbm1 import Fbm1Options
     from ertools.benchmarks.fbm1_gt import GtOptions
-    from ertools.benchmarks.fbm1_score import ScoreRules
-    from ertools.errors import UsageError
+    from ertools.errors import ConfigError, UsageError
 
-    base = Fbm1Options.as_2015(args.benchmark) if args.all_2015 else None
-    method = args.gt or (base.gt.method if base else "window")
     for name in ("max_window", "still", "still_deg", "max_gap"):
         if getattr(args, name) <= 0:
             raise UsageError(f"--{name.replace('_', '-')} must be positive")
+    for old_flag, now in DEPRECATED.items():
+        if getattr(args, old_flag[2:].replace("-", "_")):
+            if old_flag == "--legacy-totals" and args.benchmark == "fbm1w":
+                now = "--count-aborted (the 2015 @Work node's divisors)"
+            note(f"{old_flag} is deprecated: it now means {now}")
     gt = GtOptions(
-        method=method,
         max_window_s=args.max_window,
         still_m=args.still,
         still_deg=args.still_deg,
         max_gap_s=args.max_gap,
     )
-    every = bool(args.all_2015)
-    rules = ScoreRules(
-        legacy_clip=every or args.legacy_clip,
-        legacy_wrap=every or args.legacy_wrap,
-        legacy_names=every or args.legacy_names,
-        legacy_totals=every or args.legacy_totals,
+    try:
+        base = Fbm1Options.for_rules(args.benchmark, args.rules or "ertools", gt)
+    except ConfigError as err:
+        raise UsageError(f"--rules {args.rules}: {err.message}") from err
+    old_totals = bool(args.legacy_totals)
+    r = base.rules
+    rules = replace(
+        r,
+        clip_above_diagonal=r.clip_above_diagonal or args.clip_above_diagonal or args.legacy_clip,
+        single_wrap=r.single_wrap or args.single_wrap or args.legacy_wrap,
+        exact_names=r.exact_names or args.exact_names or args.legacy_names,
+        count_aborted=r.count_aborted or args.count_aborted or old_totals,
+        accuracy_over_10=r.accuracy_over_10
+        or args.accuracy_over_10
+        or (old_totals and args.benchmark == "fbm1h"),
     )
-    return Fbm1Options(args.benchmark, gt, rules)
+    method = args.gt or base.gt.method
+    options = Fbm1Options(args.benchmark, replace(base.gt, method=method), rules)
+    if args.gt == "goal":
+        note(
+            "--gt goal looks the ground truth up when the goal was sent; the 2016-17 node "
+            "did it when the placement was confirmed (--gt placed)"
+        )
+    return options
 
 
 def _sources(args: argparse.Namespace) -> object:
@@ -173,6 +223,7 @@ def run(args: argparse.Namespace) -> int:
         items_order=order,
         sources=sources,
     )
+    note(f"reproducing: {result.reference}")
     print_table(result)
     # A frozen dataclass satisfies the protocol at run time; mypy wants settable attributes.
     return emit_result(cast("BenchmarkResult", result), args, [*args.bags, args.items])

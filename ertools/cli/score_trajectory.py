@@ -14,7 +14,8 @@ from typing import cast
 EPILOG = """examples:
   ertools score trajectory robot.bag gt/ --robot-topic /rockin/homer/marker_pose \\
       --gt-topic /fbm2h/robot_at_home/pose
-  ertools score trajectory robot.bag gt/ --association hold        # reproduce 2015
+  ertools score trajectory robot.bag gt/ --2015        # what the 2015 script computed
+  ertools score trajectory robot.bag gt/ --association hold --gaps compare
   ertools score trajectory robot.bag gt/ --offset auto --apply-offset --format json
   ertools score trajectory robot.bag gt/log_0.bag gt/log_1.bag --offset -0.35 --plot figs/
 
@@ -44,6 +45,12 @@ def _positive(text: str) -> float:
     return value
 
 
+def _2015_options() -> str:
+    from ertools.benchmarks.trajectory import SETTINGS_2015
+
+    return " ".join(f"--{k.replace('_', '-')} {v}" for k, v in SETTINGS_2015.items())
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from ertools.cli.common import add_output_options
 
@@ -61,17 +68,45 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--association",
         choices=("linear", "nearest", "hold"),
-        default="linear",
-        help="GT pose at a robot time: interpolated (default), nearest, or the last before "
-        "(hold, 2015)",
+        default=None,
+        help="GT pose at a robot time: interpolated (linear, default), nearest, or the last "
+        "before (hold, 2015)",
+    )
+    parser.add_argument(
+        "--ties",
+        choices=("at", "before"),
+        default=None,
+        help="with --association hold, a robot pose stamped exactly at a GT sample is "
+        "compared with that sample (at, default) or the one before it (before, 2015)",
+    )
+    parser.add_argument(
+        "--gaps",
+        choices=("skip", "compare"),
+        default=None,
+        help="robot poses in GT gaps longer than --max-gap: not compared (skip, default) or "
+        "compared with the GT pose across the gap and counted (compare, 2015)",
+    )
+    parser.add_argument(
+        "--before-gt",
+        choices=("uncovered", "first"),
+        default=None,
+        help="robot poses before the first GT pose: uncovered (default: an error, or not "
+        "scored with --allow-partial) or compared with the first GT pose (first, 2015)",
+    )
+    parser.add_argument(
+        "--2015",
+        dest="as_2015",
+        action="store_true",
+        help="compute what the 2015 script did: --association hold --ties before --gaps "
+        "compare --before-gt first (2015's orientation error is orientation_error_2015)",
     )
     parser.add_argument(
         "--max-gap",
         type=_positive,
         default=0.1,
         metavar="S",
-        help="do not compare robot poses whose surrounding GT poses are further apart "
-        "(default 0.1 s)",
+        help="a robot pose whose surrounding GT poses are further apart is in a GT gap "
+        "(default 0.1 s; see --gaps)",
     )
     parser.add_argument(
         "--offset",
@@ -108,7 +143,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ertools.benchmarks.base import BenchmarkResult
-    from ertools.benchmarks.trajectory import TrajectoryConfig, score
+    from ertools.benchmarks.trajectory import SETTINGS_2015, TrajectoryConfig, score
     from ertools.cli.common import emit_result
     from ertools.errors import UsageError
     from ertools.timeutil import s_to_ns
@@ -116,8 +151,24 @@ def run(args: argparse.Namespace) -> int:
     auto = args.offset == "auto"
     if args.apply_offset and not auto:
         raise UsageError("--apply-offset needs --offset auto")
+    chosen = {
+        "association": args.association,
+        "ties": args.ties,
+        "gaps": args.gaps,
+        "before_gt": args.before_gt,
+    }
+    settings = {k: v for k, v in chosen.items() if v is not None}
+    if args.as_2015:
+        clash = [
+            f"--{k.replace('_', '-')} {v}" for k, v in settings.items() if SETTINGS_2015[k] != v
+        ]
+        if clash:
+            raise UsageError(f"--2015 sets {_2015_options()}; it cannot take {', '.join(clash)}")
+        settings = dict(SETTINGS_2015)
+    if settings.get("ties") == "before" and settings.get("association") != "hold":
+        raise UsageError("--ties before needs --association hold")
     config = TrajectoryConfig(
-        association=args.association,
+        **settings,
         max_gap_ns=s_to_ns(args.max_gap),
         offset_ns=0 if auto else s_to_ns(float(args.offset)),
         auto_offset=auto,

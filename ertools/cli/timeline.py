@@ -22,9 +22,9 @@ EPILOG = """examples:
   ertools timeline bags/ --plot timeline.png     # Gantt chart, one lane per logger
   ertools timeline bags/ --clock-tolerance 0.2 --format csv -o timeline.csv
 
-JSON layout: {"bags": [{"path", "format", "start", "end", "duration", "kind", "overlaps",
-"problems"}], "sessions": [{"index", "start", "end", "duration", "bags", "pairings"}],
-"problems": [{"path", "problem"}]}, times in epoch seconds.
+JSON layout: {"bags": [{"path", "format", "start", "end", "duration", "kind", "benchmarks",
+"overlaps", "problems", "copy_of", "copies"}], "sessions": [{"index", "start", "end",
+"duration", "bags", "pairings"}], "problems": [{"path", "problem"}]}, times in epoch seconds.
 """
 
 
@@ -188,6 +188,8 @@ def to_table(timeline: Timeline, *, color: bool = False) -> str:
         lines.append(paint(row, style) if style else row)
         if b.overlaps:
             lines.append(paint(f"{'':>77}overlaps: {', '.join(b.overlaps)}", "dim"))
+        if b.copies:
+            lines.append(paint(f"{'':>77}{len(b.copies)} copy(ies) of this recording", "dim"))
         for p in b.problems:
             lines.append(paint(f"{'':>77}! {p}", "warn" if b.readable else "error"))
     if timeline.sessions:
@@ -213,10 +215,18 @@ def _pairing_line(p: Any, paint: _Paint, *, full_path: bool = False) -> str:
     from ertools.timeline import KIND_LABELS
 
     name = str(p.path) if full_path else Path(p.path).name
+    other = ""
+    if p.other_benchmark:
+        names = ", ".join(Path(g).name for g in p.other_benchmark)
+        other = f"; not paired, another benchmark: {names}"
     if not p.gt:
-        return paint(f"       {KIND_LABELS[p.kind]} {name}: no GT file covers it", "error")
+        return paint(f"       {KIND_LABELS[p.kind]} {name}: no GT file covers it{other}", "error")
     gts = ", ".join(Path(g).name for g in p.gt)
-    text = f"       {KIND_LABELS[p.kind]} {name}: GT coverage {p.coverage:.1f} % ({gts})"
+    by_time = " by time only (no benchmark named)" if p.basis == "time" else ""
+    text = (
+        f"       {KIND_LABELS[p.kind]} {name}: GT coverage {p.coverage:.1f} % ({gts}){by_time}"
+        f"{other}"
+    )
     if p.uncovered:
         spans = "; ".join(
             f"{_when(a)[11:]}-{_when(b)[11:]} ({(b - a) / 1e9:.1f} s)" for a, b in p.uncovered

@@ -327,22 +327,14 @@ def _sqlite_runs(
 
 
 def _scanned_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None) -> Located:
-    """Messages of a file read by a scan (an unfinished MCAP), joined into one buffer per
-    batch of messages so the same decoders apply."""
-    records = list(bag.raw(conns, lo, hi))
+    """Messages of an MCAP file its indexes do not cover, read record by record: the runs
+    of copied message bytes the scan gives, so the same decoders apply."""
+    from ertools.io.files import McapFile
 
-    def runs() -> Iterator[Run]:
-        step = 100_000
-        for a in range(0, len(records), step):
-            part = records[a : a + step]
-            lengths = np.fromiter((len(r[2]) for r in part), dtype=np.int64, count=len(part))
-            starts = np.zeros(len(part), dtype=np.int64)
-            np.cumsum(lengths[:-1], out=starts[1:])
-            buf = np.frombuffer(b"".join(r[2] for r in part), dtype=np.uint8)
-            t = np.fromiter((r[1] for r in part), dtype=np.int64, count=len(part))
-            yield np.arange(a, a + len(part), dtype=np.int64), buf, starts, lengths, t
-
-    return Located(len(records), runs())
+    assert isinstance(bag, McapFile)
+    runs = list(bag.scanned_runs(conns, lo, hi))
+    count = sum(len(r[0]) for r in runs)
+    return Located(count, iter([r[:5] for r in runs]))
 
 
 def locate(
@@ -358,7 +350,7 @@ def locate(
         return _ros1_runs(bag, conns, start_ns, end_ns)
     if bag.format == "rosbag2-sqlite3":
         return _sqlite_runs(bag, conns, start_ns, end_ns)
-    if getattr(bag, "unfinished", False):
+    if getattr(bag, "scanned", False):
         return _scanned_runs(bag, conns, start_ns, end_ns)
     if bag.format in ("mcap", "rosbag2-mcap"):
         return _mcap_runs(bag, conns, start_ns, end_ns)

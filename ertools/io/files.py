@@ -18,6 +18,8 @@ from pathlib import Path
 from types import TracebackType
 from typing import Any
 
+import numpy as np
+
 from ertools.errors import BagError
 from ertools.io.formats import detect_format
 from ertools.io.model import Conn, short_msgtype
@@ -25,6 +27,8 @@ from ertools.io.model import Conn, short_msgtype
 log = logging.getLogger("ertools.io.files")
 
 RawRecord = tuple[Conn, int, bytes]
+# (reference positions, bytes, data starts, data lengths, log times, channel ids)
+ScannedRun = tuple[Any, Any, Any, Any, Any, Any]
 
 
 class BagFile(AbstractContextManager["BagFile"]):
@@ -152,7 +156,10 @@ def _mcap_errors() -> tuple[type[BaseException], ...]:
 
     from mcap.exceptions import McapError
 
-    # lz4/zstd raise RuntimeError on corrupt chunks; absurd record lengths can MemoryError.
+    # lz4 raises RuntimeError on corrupt chunks, zstandard its ZstdError; absurd record
+    # lengths can MemoryError, or OverflowError where they become slice bounds.
+    from zstandard import ZstdError
+
     return (
         McapError,
         ValueError,
@@ -162,84 +169,119 @@ def _mcap_errors() -> tuple[type[BaseException], ...]:
         KeyError,
         RuntimeError,
         MemoryError,
+        OverflowError,
+        ZstdError,
     )
 
 
 class McapFile(BagFile):
     """A standalone MCAP file (ROS 2 ``cdr`` or ``ros1`` message encoding) via ``mcap``.
 
-    A file without a summary section (a recorder that was killed, a file cut short) is read
-    as far as its records are complete, like a ROS1 ``.bag.active``: ``unfinished`` is True
-    and a warning says so.
+    Read through the summary's indexes when they answer for every message
+    (:func:`ertools.io.mcap_scan.mcap_layout`), else record by record (``scanned`` is True,
+    and INFO says why): no summary section, chunks without message indexes, channels or
+    schemas only inside chunks, messages outside chunks. A file cut short (a recorder that was
+    killed) is read as far as its records are complete, like a ROS1 ``.bag.active``:
+    ``unfinished`` is True and a warning says so.
     """
 
     def __init__(self, path: Path) -> None:
         from mcap.reader import make_reader
 
+        from ertools.io.mcap_scan import SCAN, mcap_layout
+
         self.path = path
         self.format = "mcap"
         self.unfinished = False
-        self._scanned: list[tuple[int, int, int, bytes]] = []  # log time, position, channel, data
+        self.scanned = False
         self._f = path.open("rb")
-        from ertools.io.mcap_index import read_summary
-
         unreadable: tuple[type[BaseException], ...] = (BagError, *_mcap_errors())
         try:
+            layout = mcap_layout(path)
             self._reader = make_reader(self._f)
-            summary = read_summary(self._f, path)  # parsed once, reused by the bulk reader
-        except unreadable:
-            summary = None
-        if summary is None:
-            self.connections = self._scan()
+        except unreadable as err:
+            self._f.close()
+            raise BagError(f"unreadable MCAP file ({err})", path=path) from err
+        if layout.index == SCAN:
+            self.connections = self._scan(layout.why)
             return
         self.connections = tuple(
-            _conn_from_channel(
-                summary.channels[cid], summary.schemas.get(summary.channels[cid].schema_id)
-            )
-            for cid in sorted(summary.channels)
+            _conn_from_channel(ch, layout.schemas.get(ch.schema_id))
+            for _cid, ch in sorted(layout.channels.items())
         )
 
-    def _scan(self) -> tuple[Conn, ...]:
-        """Read every complete record of an unfinished file (no summary to seek with)."""
-        from mcap.records import Channel, Message, Schema
-        from mcap.stream_reader import StreamReader
+    def _scan(self, why: str) -> tuple[Conn, ...]:
+        """Read every complete record (the summary's indexes do not answer for them all)."""
+        from ertools.io.mcap_scan import scan_mcap
 
-        self.unfinished = True
-        schemas: dict[int, Any] = {}
-        conns: dict[int, Conn] = {}
-        self._f.seek(0)
-        reader = StreamReader(self._f, skip_magic=False, emit_chunks=False)
-        where = "the end"
+        self.scanned = True
+        log.info("%s: %s; reading the file record by record", self.path, why)
         try:
-            for i, record in enumerate(reader.records):
-                if isinstance(record, Schema):
-                    schemas[record.id] = record
-                elif isinstance(record, Channel):
-                    conns.setdefault(
-                        record.id, _conn_from_channel(record, schemas.get(record.schema_id))
-                    )
-                elif isinstance(record, Message):
-                    self._scanned.append(
-                        (record.log_time, i, record.channel_id, bytes(record.data))
-                    )
-        except _mcap_errors() as err:
-            where = f"byte {self._f.tell()} ({type(err).__name__})"
-        if not conns:
+            found = scan_mcap(self.path)
+        except BagError:
+            self._f.close()
+            raise
+        conns = {
+            cid: _conn_from_channel(ch, found.schemas.get(ch.schema_id))
+            for cid, ch in found.channels.items()
+        }
+        if not conns and not found.complete:
             self._f.close()
             raise BagError(
-                f"unreadable MCAP file: no summary section and no complete channel record "
-                f"before {where}",
+                f"unreadable MCAP file: no complete channel record ({found.problem})",
                 path=self.path,
             )
-        log.warning(
-            "%s: MCAP file has no summary section (recording not finished, or cut short); "
-            "read the %d complete messages up to %s",
-            self.path,
-            len(self._scanned),
-            where,
-        )
-        self._scanned.sort(key=lambda m: (m[0], m[1]))
+        if found.problem:
+            self.unfinished = True
+            log.warning(
+                "%s: MCAP file %s (%s: recording not finished, or cut short?); read the %d "
+                "complete messages",
+                self.path,
+                found.problem,
+                why,
+                len(found.log_time),
+            )
         return tuple(conns[c] for c in sorted(conns))
+
+    def scanned_runs(
+        self, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
+    ) -> Iterator[ScannedRun]:
+        """The messages of ``conns`` in [start_ns, end_ns] of a file read record by record, as
+        runs of (reference positions, bytes, data starts, data lengths, log times, channel
+        ids): one more pass over the records that copies only these messages' bytes."""
+        from ertools.io.mcap_scan import scan_mcap
+
+        found = scan_mcap(self.path, keep=frozenset(c.id for c in conns))
+        if not found.payloads:
+            return
+        ordinal = np.concatenate([r[3] for r in found.payloads])
+        t = found.log_time[ordinal]
+        inside = np.ones(len(t), dtype=bool)
+        if start_ns is not None:
+            inside &= t >= start_ns
+        if end_ns is not None:
+            inside &= t <= end_ns
+        # the reference order: log time, then position in the file
+        order = np.lexsort((ordinal[inside], t[inside]))
+        rank = np.empty(len(order), dtype=np.int64)
+        rank[order] = np.arange(len(order), dtype=np.int64)
+        done = kept = 0
+        for buf, start, length, ords in found.payloads:
+            mine = inside[done : done + len(ords)]
+            n = int(mine.sum())
+            if n:
+                o = ords[mine]
+                cid = found.channel_id[o]
+                yield (
+                    rank[kept : kept + n],
+                    buf,
+                    start[mine],
+                    length[mine],
+                    t[done : done + len(ords)][mine],
+                    cid,
+                )
+            done += len(ords)
+            kept += n
 
     def raw(
         self, conns: Sequence[Conn], start_ns: int | None = None, end_ns: int | None = None
@@ -247,13 +289,18 @@ class McapFile(BagFile):
         by_id = {c.id: c for c in conns}
         if not by_id:
             return
-        if self.unfinished:
-            for t, _i, cid, data in self._scanned:
-                conn = by_id.get(cid)
-                if conn is None:
-                    continue
-                if (start_ns is None or t >= start_ns) and (end_ns is None or t <= end_ns):
-                    yield conn, int(t), data
+        if self.scanned:
+            runs = list(self.scanned_runs(conns, start_ns, end_ns))
+            if not runs:
+                return
+            rank = np.concatenate([r[0] for r in runs])
+            which = np.concatenate([np.full(len(r[0]), k) for k, r in enumerate(runs)])
+            row = np.concatenate([np.arange(len(r[0])) for r in runs])
+            order = np.argsort(rank)
+            for k, i in zip(which[order].tolist(), row[order].tolist(), strict=True):
+                _rank, buf, start, length, t, cid = runs[k]
+                a = int(start[i])
+                yield by_id[int(cid[i])], int(t[i]), buf[a : a + int(length[i])].tobytes()
             return
         topics = sorted({c.topic for c in conns})
         try:

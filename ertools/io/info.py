@@ -45,6 +45,7 @@ class BagInfo:
             "compression": s.compression,
             "messages": s.message_count,
             "indexed": s.indexed,
+            "index": s.index,
             "checked": self.checked,
             "problems": list(s.problems),
             "topics": [

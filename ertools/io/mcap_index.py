@@ -149,19 +149,22 @@ class McapIndex:
 
         Raises:
             BagError: damaged index.
-            LayoutMismatchError: a file has chunks without message indexes (caller falls back).
+            LayoutMismatchError: a file's indexes do not answer for every message (no summary,
+                no message indexes, channels only inside chunks...): the caller falls back.
         """
         from ertools.io.fastdecode import LayoutMismatchError
+        from ertools.io.mcap_scan import SCAN, mcap_layout
 
         topics = {c.topic for c in conns}
         sels: list[tuple[int, int, int, I64, I64]] = []  # file, chunk idx, chunk offset, t, off
         chunks_per_file: list[list[Any]] = []
         for fi, path in enumerate(self.files):
+            layout = mcap_layout(path)
+            if layout.index == SCAN:
+                raise LayoutMismatchError(f"MCAP file {path.name}: {layout.why}")
+            summary: Any = layout.summary
             with path.open("rb") as f:
-                summary = read_summary(f, path)
-                if summary is None or not summary.chunk_indexes:
-                    raise LayoutMismatchError("MCAP file without chunk indexes")
-                channels = {cid for cid, ch in summary.channels.items() if ch.topic in topics}
+                channels = {cid for cid, ch in layout.channels.items() if ch.topic in topics}
                 chunks = summary.chunk_indexes
                 chunks_per_file.append(chunks)
                 for ci, chunk in enumerate(chunks):
@@ -353,17 +356,25 @@ class McapIndex:
 
 
 def verify_mcap(path: Path) -> None:
-    """Decompress every chunk of an MCAP file, check its CRC and its message indexes.
+    """Decompress every chunk of an MCAP file, check its CRC and its message indexes (a file
+    read record by record: every record and every chunk CRC).
 
     Raises:
         BagError: the first damaged chunk, with its byte offset.
     """
     import zlib
 
+    from ertools.io.mcap_scan import SCAN, mcap_layout, scan_mcap
+
+    layout = mcap_layout(path)
+    if layout.index == SCAN:
+        # no indexes to check against: every record read, every chunk's CRC checked
+        found = scan_mcap(path, check_crc=True)
+        if found.problem:
+            raise BagError(found.problem, path=path)
+        return
     with path.open("rb") as f:
-        summary = read_summary(f, path)
-        if summary is None:
-            raise BagError("no summary section to check against", path=path)
+        summary: Any = layout.summary
         for chunk in summary.chunk_indexes:
             where = f"in {path} at byte {chunk.chunk_start_offset}"
             f.seek(chunk.chunk_start_offset + 1 + 8 + 8 + 8 + 8)

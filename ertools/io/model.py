@@ -60,6 +60,9 @@ class BagSummary:
         indexed: False when the file had no usable index and was scanned.
         topics: per-topic summaries, sorted by name.
         problems: what is wrong with the file (unindexed, truncated...), one line each.
+        index: which of the file's indexes answered (MCAP: ``summary+message-indexes``,
+            ``summary`` or ``scan``; ROS1: ``index-records`` or ``scan``; rosbag2:
+            ``metadata.yaml``, plus what its MCAP files used).
     """
 
     path: str
@@ -74,6 +77,7 @@ class BagSummary:
     indexed: bool
     topics: tuple[TopicSummary, ...]
     problems: tuple[str, ...] = ()
+    index: str = ""
 
     def topic(self, name: str) -> TopicSummary | None:
         """The summary of one topic, None when absent."""

@@ -4,8 +4,11 @@
   position (plus the first chunk's record header for its compression). A bag with no index
   (``.bag.active``) or a damaged or truncated one is scanned record by record instead and
   flagged (``indexed=False``, ``problems``).
-- MCAP: the summary section (statistics, channels, schemas, chunk indexes). A file without one
-  (unfinished, truncated) is scanned and flagged.
+- MCAP: the summary section (statistics, channels, schemas, chunk indexes, message indexes)
+  where it answers for every message (:func:`ertools.io.mcap_scan.mcap_layout`); any other
+  layout the specification allows (no summary, no statistics, no message indexes, channels
+  only inside chunks, messages outside chunks) is read record by record, exactly
+  (``index="scan"``, ``indexed=False``); only a file cut short is flagged in ``problems``.
 - rosbag2: ``metadata.yaml`` (plus the MCAP summaries of its files for per-topic times).
 
 Per-topic first/last times come from the chunk bounds (exact to the chunk) unless
@@ -17,7 +20,6 @@ per-message record times, for rates.
 from __future__ import annotations
 
 import logging
-import struct
 from collections import defaultdict
 from pathlib import Path
 from typing import Any
@@ -25,7 +27,6 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.errors import BagError
 from ertools.io.formats import detect_format
 from ertools.io.model import BagSummary, TopicSummary, short_msgtype
 
@@ -48,7 +49,11 @@ def _build(
     indexed: bool,
     topics: dict[str, tuple[str, int, int | None, int | None, int]],
     problems: list[str],
+    index: str = "",
 ) -> BagSummary:
+    if not index:
+        index = {"ros1": "index-records", "ros1-active": "index-records"}.get(fmt, "metadata.yaml")
+        index = index if indexed else "scan"
     tops = tuple(
         TopicSummary(name, msgtype, count, first, last, nconn)
         for name, (msgtype, count, first, last, nconn) in sorted(topics.items())
@@ -70,6 +75,7 @@ def _build(
         indexed,
         tops,
         tuple(problems),
+        index,
     )
 
 
@@ -147,82 +153,60 @@ def _ros1(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagS
     )
 
 
-def _mcap_scan(path: Path, why: str) -> BagSummary:
-    """Walk an MCAP file without a summary, record by record, as far as it goes."""
-    from mcap.exceptions import McapError
-    from mcap.records import Channel, Chunk, Message, Schema
-    from mcap.stream_reader import StreamReader
+def _mcap_scanned(
+    path: Path, why: str, times: Times | None = None
+) -> tuple[dict[str, tuple[str, int, int | None, int | None, int]], set[str], list[str]]:
+    """Topics of an MCAP file read record by record (chunks decompressed): the path for
+    layouts the summary cannot answer for alone, exact for all of them."""
+    from ertools.io.mcap_scan import scan_mcap
 
-    log.info("%s: %s; scanning the whole file", path, why)
-    problems = [why]
-    schemas: dict[int, str] = {}
-    channels: dict[int, tuple[str, int]] = {}
-    stats: dict[int, list[int]] = {}
-    compressions: set[str] = set()
-    with path.open("rb") as f:
-        try:
-            for record in StreamReader(f, skip_magic=False, emit_chunks=False).records:
-                if isinstance(record, Schema):
-                    schemas[record.id] = record.name
-                elif isinstance(record, Channel):
-                    channels[record.id] = (record.topic, record.schema_id)
-                elif isinstance(record, Chunk):
-                    compressions.add(record.compression or "none")
-                elif isinstance(record, Message):
-                    s = stats.setdefault(record.channel_id, [0, record.log_time, record.log_time])
-                    s[0] += 1
-                    s[1] = min(s[1], record.log_time)
-                    s[2] = max(s[2], record.log_time)
-        except (
-            McapError,
-            EOFError,
-            ValueError,
-            struct.error,
-            OSError,
-            KeyError,
-            RuntimeError,
-            MemoryError,
-        ) as err:
-            problems.append(
-                f"truncated or damaged at byte {f.tell()} ({type(err).__name__}: {err})"
-            )
+    log.info("%s: %s; reading the file record by record", path, why)
+    found = scan_mcap(path)
+    problems = [found.problem] if found.problem else []
+    cids, t = found.channel_id, found.log_time
+    orphans = sorted(set(np.unique(cids).tolist()) - set(found.channels))
+    if orphans:
+        n = int(np.isin(cids, orphans).sum())
+        problems.append(f"{n} messages on channel ids without a channel record: {orphans}")
     topics: dict[str, tuple[str, int, int | None, int | None, int]] = {}
-    for cid, (topic, sid) in channels.items():
-        st = stats.get(cid)
+    for cid, ch in sorted(found.channels.items()):
+        mine = t[cids == cid]
+        schema = found.schemas.get(ch.schema_id)
+        if times is not None and len(mine):
+            times.setdefault(ch.topic, []).append(mine)
         _merge_topic(
             topics,
-            topic,
-            short_msgtype(schemas.get(sid, "")),
-            st[0] if st else 0,
-            st[1] if st else None,
-            st[2] if st else None,
+            ch.topic,
+            short_msgtype(schema.name if schema else ""),
+            len(mine),
+            int(mine.min()) if len(mine) else None,
+            int(mine.max()) if len(mine) else None,
         )
-    return _build(
-        path, "mcap", "", "/".join(sorted(compressions)) or "none", False, topics, problems
-    )
+    return topics, set(found.compressions), problems
 
 
-def _mcap_topics(
-    path: Path, summary: Any, exact: bool, times: Times | None = None
-) -> tuple[dict[str, tuple[str, int, int | None, int | None, int]], set[str]]:
+def _mcap_indexed(
+    path: Path, layout: Any, exact: bool, times: Times | None = None
+) -> tuple[dict[str, tuple[str, int, int | None, int | None, int]], set[str], list[str], str]:
+    """Topics from the summary: counts from the statistics, or from the message indexes when
+    ``exact`` or when the summary has no statistics (then every message is counted)."""
+    from ertools.io.mcap_index import McapIndex
+
+    summary = layout.summary
     spans: dict[int, list[int]] = {}
     compressions = set()
-    counts: dict[int, int] = (
-        dict(summary.statistics.channel_message_counts) if summary.statistics else {}
-    )
-    need_counts = summary.statistics is None
+    stats = summary.statistics
+    read_indexes = exact or stats is None
+    counts: dict[int, int] = {} if read_indexes else dict(stats.channel_message_counts)
     with path.open("rb") as f:
         for chunk in summary.chunk_indexes:
             compressions.add(chunk.compression or "none")
             for cid, offset in chunk.message_index_offsets.items():
-                if exact or need_counts:
-                    from ertools.io.mcap_index import McapIndex
-
+                if read_indexes:
                     t, _ = McapIndex._message_index(f, path, offset, cid)
                     if times is not None:
-                        times.setdefault(summary.channels[cid].topic, []).append(t)
-                    if need_counts:
-                        counts[cid] = counts.get(cid, 0) + len(t)
+                        times.setdefault(layout.channels[cid].topic, []).append(t)
+                    counts[cid] = counts.get(cid, 0) + len(t)
                     if not len(t):
                         continue
                     lo, hi = int(t.min()), int(t.max())
@@ -230,9 +214,15 @@ def _mcap_topics(
                     lo, hi = int(chunk.message_start_time), int(chunk.message_end_time)
                 s = spans.setdefault(cid, [lo, hi])
                 s[0], s[1] = min(s[0], lo), max(s[1], hi)
+    problems = []
+    if read_indexes and stats is not None and stats.message_count != sum(counts.values()):
+        problems.append(
+            f"the statistics record counts {stats.message_count} messages, the message "
+            f"indexes {sum(counts.values())}"
+        )
     topics: dict[str, tuple[str, int, int | None, int | None, int]] = {}
-    for cid, ch in sorted(summary.channels.items()):
-        schema = summary.schemas.get(ch.schema_id)
+    for cid, ch in sorted(layout.channels.items()):
+        schema = layout.schemas.get(ch.schema_id)
         span = spans.get(cid)
         _merge_topic(
             topics,
@@ -241,28 +231,42 @@ def _mcap_topics(
             int(counts.get(cid, 0)),
             *(span or (None, None)),
         )
-    return topics, compressions
+    index = "summary+message-indexes" if read_indexes and summary.chunk_indexes else "summary"
+    return topics, compressions, problems, index
+
+
+def _mcap_file(
+    path: Path, exact: bool, times: Times | None = None
+) -> tuple[dict[str, tuple[str, int, int | None, int | None, int]], set[str], list[str], str]:
+    """(topics, chunk compressions, problems, index used) of one MCAP file, through its
+    indexes where they answer for every message, else record by record."""
+    from ertools.io.mcap_scan import SCAN, mcap_layout
+
+    layout = mcap_layout(path)
+    if layout.index == SCAN:
+        topics, compressions, problems = _mcap_scanned(path, layout.why, times)
+        return topics, compressions, problems, SCAN
+    return _mcap_indexed(path, layout, exact, times)
+
+
+def _mcap_version(path: Path) -> str:
+    from mcap.reader import make_reader
+
+    from ertools.io.files import _mcap_errors
+
+    try:
+        with path.open("rb") as f:
+            header = make_reader(f).get_header()
+    except _mcap_errors():
+        return ""
+    return f"mcap0 profile {header.profile or 'none'} ({header.library})"
 
 
 def _mcap(path: Path, exact: bool, times: Times | None = None) -> BagSummary:
-    from ertools.io.mcap_index import read_summary
-
-    with path.open("rb") as f:
-        try:
-            summary = read_summary(f, path)
-        except BagError as err:
-            return _mcap_scan(path, f"no readable summary section ({err.message})")
-        from mcap.reader import make_reader
-
-        f.seek(0)
-        header = make_reader(f).get_header()
-    if summary is None:
-        return _mcap_scan(path, "no summary section (recording not finished?)")
-    if not summary.chunk_indexes and summary.statistics and summary.statistics.message_count:
-        return _mcap_scan(path, "no chunk indexes")
-    topics, compressions = _mcap_topics(path, summary, exact, times)
-    version = f"mcap0 profile {header.profile or 'none'} ({header.library})"
-    return _build(path, "mcap", version, "/".join(sorted(compressions)) or "none", True, topics, [])
+    topics, compressions, problems, index = _mcap_file(path, exact, times)
+    compression = "/".join(sorted(compressions)) or "none"
+    indexed = index != "scan"
+    return _build(path, "mcap", _mcap_version(path), compression, indexed, topics, problems, index)
 
 
 def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagSummary:
@@ -276,16 +280,12 @@ def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> B
         problems.append(f"storage file(s) listed in metadata.yaml missing: {', '.join(missing)}")
     topics: dict[str, tuple[str, int, int | None, int | None, int]] = {}
     inner: set[str] = set()
+    used: set[str] = set()
     if fmt == "rosbag2-mcap" and not missing:
-        from ertools.io.mcap_index import read_summary
-
         for file in files:
-            with file.open("rb") as f:
-                summary = read_summary(f, file)
-            if summary is None:
-                problems.append(f"{file.name}: no MCAP summary section")
-                continue
-            part, chunk_compressions = _mcap_topics(file, summary, exact, times)
+            part, chunk_compressions, file_problems, file_index = _mcap_file(file, exact, times)
+            used.add(file_index)
+            problems.extend(f"{file.name}: {p}" for p in file_problems)
             inner |= chunk_compressions - {"none"}
             for name, (msgtype, count, first, last, _n) in part.items():
                 _merge_topic(topics, name, msgtype, count, first, last)
@@ -309,7 +309,11 @@ def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> B
         compression += f" ({str(info['compression_mode']).lower()})"
     if inner and compression == "none":
         compression = "/".join(sorted(inner)) + " (mcap chunks)"
-    return _build(path, fmt, str(info.get("version", "")), compression, True, topics, problems)
+    # the MCAP storage files' own indexes (or scans) gave the counts and times
+    index = "+".join(["metadata.yaml", *sorted(used)])
+    return _build(
+        path, fmt, str(info.get("version", "")), compression, True, topics, problems, index
+    )
 
 
 def _sqlite_spans(files: list[Path]) -> dict[str, tuple[int, int]]:
@@ -366,7 +370,8 @@ def summary_and_times(path: str | Path) -> tuple[BagSummary, dict[str, I64]]:
 
 
 def record_times(path: str | Path) -> dict[str, I64]:
-    """topic -> sorted record times of its messages, from index records only (for rates)."""
+    """topic -> sorted record times of its messages, from index records only (for rates);
+    an MCAP file whose indexes do not cover every message is read record by record."""
     p = Path(path)
     fmt = detect_format(p)
     parts: dict[str, list[I64]] = defaultdict(list)
@@ -383,18 +388,10 @@ def record_times(path: str | Path) -> dict[str, I64]:
         finally:
             bag.close()
     elif fmt in ("mcap", "rosbag2-mcap"):
-        from ertools.io.mcap_index import McapIndex, read_summary
-
-        files = [p] if fmt == "mcap" else sorted(p.glob("*.mcap"))
-        for file in files:
-            with file.open("rb") as f:
-                summ = read_summary(f, file)
-                if summ is None:
-                    continue
-                for chunk in summ.chunk_indexes:
-                    for cid, offset in chunk.message_index_offsets.items():
-                        t, _ = McapIndex._message_index(f, file, offset, cid)
-                        parts[summ.channels[cid].topic].append(t)
+        # the same choice as the summary: message indexes where they cover every message,
+        # else the records themselves
+        for file in [p] if fmt == "mcap" else sorted(p.glob("*.mcap")):
+            _mcap_file(file, True, parts)
     else:
         from ertools.io.rosbag2 import query, read_metadata, storage_files
 

@@ -8,7 +8,7 @@ Layout (times in seconds after :data:`T0`, the record times of each bag's first/
     gtlogger/log_fbm2h_mocap_<date>_3.bag.active   GT logger, 30.0 - 34.0, unindexed (recording)
     bmmanager/log_fbm2h_<date>_0.bag               benchmark log (state topics + mocap), 3 - 12
     robots/homer/FBM2H_<date>_homer.bag            robot log (/rockin/homer/...), 13 - 26
-    usb_stick/FBM2H_<date>_homer.bag               the same robot log copied: duplicated name
+    usb_stick/FBM2H_<date>_homer.bag               the same robot log copied: one recording, a copy
     gtlogger_work/log_fbm3w_mocap_<date>_0.bag     GT logger whose mocap node's clock was 3.2 s
                                                    behind the recorder's, 40 - 46
     old/log_fbm2h_mocap_<date>_0.bag               a GT bag truncated at 55 % of its bytes
@@ -273,16 +273,19 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     (root / trunc).write_bytes(raw[: int(len(raw) * TRUNCATE_AT)])
 
     spans = {k: (int(v.min()), int(v.max())) for k, v in times.items()}
+    # The byte copy is the robot log's recording again: it leaves overlaps, sessions, pairings.
+    originals = {k: v for k, v in spans.items() if k != dup}
     gt_files = [k for k, v in kinds.items() if v == "gt"]
     pairings = {}
     for k, kind in sorted(kinds.items()):
-        if kind not in ("benchmark", "robot"):
+        if kind not in ("benchmark", "robot") or k == dup:
             continue
         over = sorted(
             g for g in gt_files if spans[g][0] <= spans[k][1] and spans[k][0] <= spans[g][1]
         )
         pct, holes = _coverage(spans[k], [spans[g] for g in over])
-        pairings[k] = {"gt": over, "coverage": pct, "uncovered": holes}
+        # Every log here and its GT files name fbm2h (topics /fbm2h/..., FBM2H_... robot log).
+        pairings[k] = {"gt": over, "coverage": pct, "uncovered": holes, "basis": "content"}
     answers = write_answers(
         outdir / "timeline.bag",  # names the answers file timeline.answers.yaml
         benchmark="timeline",
@@ -305,14 +308,14 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         },
         expected={
             "readable": len(spans),
-            "overlaps": _overlaps(spans),
-            "sessions": _sessions(spans, round(GAP_TOLERANCE_S * NS)),
+            "overlaps": _overlaps(originals),
+            "sessions": _sessions(originals, round(GAP_TOLERANCE_S * NS)),
+            "copies": {dup: robot},
             "pairings": pairings,
             "problems": {
                 gt[2]: "gap",
                 active: "index",
-                robot: "duplicated",
-                dup: "duplicated",
+                dup: "same recording",
                 unsync: "clock",
                 trunc: "any",
             },

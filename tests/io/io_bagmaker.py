@@ -125,8 +125,13 @@ def build(ts: Any, ros1: bool, msgtype: str, v: dict[str, Any], seq: int) -> Any
     raise ValueError(msgtype)
 
 
-def write(path: Path, fmt: str, spec: Spec, chunk_bytes: int | None = None) -> Path:
-    """Write ``spec`` as ``fmt`` (see FORMATS) at ``path``; returns the bag path."""
+def write(
+    path: Path, fmt: str, spec: Spec, chunk_bytes: int | None = None, **mcap_options: Any
+) -> Path:
+    """Write ``spec`` as ``fmt`` (see FORMATS) at ``path``; returns the bag path.
+
+    ``mcap_options`` go to the ``mcap`` Writer of standalone MCAP files (``use_statistics``,
+    ``repeat_channels``, ``use_chunking``, ``index_types``, ``compression``...)."""
     ros1 = fmt.startswith("ros1") or fmt == "mcap-ros1"
     ts = typestore(ros1)
     if fmt.startswith("ros1"):
@@ -170,7 +175,8 @@ def write(path: Path, fmt: str, spec: Spec, chunk_bytes: int | None = None) -> P
     from mcap.writer import Writer as McapWriter
 
     with path.open("wb") as f:
-        mw = McapWriter(f, chunk_size=chunk_bytes or 1024 * 1024, compression=CompressionType.LZ4)
+        options = {"compression": CompressionType.LZ4, **mcap_options}
+        mw = McapWriter(f, chunk_size=chunk_bytes or 1024 * 1024, **options)
         mw.start(profile="ros1" if ros1 else "ros2", library="ertools-tests")
         schema_ids: dict[str, int] = {}
         channels = []

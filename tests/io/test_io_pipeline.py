@@ -145,7 +145,7 @@ def test_load_all_chunks_counts_every_uncompressed_byte(
 ) -> None:
     fmt, path = scene_bag
     if fmt.startswith("rosbag2-sqlite") or fmt == "rosbag2-mcap":
-        pytest.skip("chunk floor measured on single-file ROS1 and MCAP")
+        pytest.skip("n/a: chunk floor measured on single-file ROS1 and MCAP")
     from ertools.io.files import open_bag
 
     with open_bag(path) as bag:

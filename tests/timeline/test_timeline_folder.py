@@ -26,12 +26,17 @@ def test_scan_matches_the_answers(folder: dict[str, Any]) -> None:
     tol = ans["tolerance"]["times"]["abs"]
     readable = {rel(root, b.path): b for b in tl.bags if b.readable}
     assert tl.readable_count == exp["readable"] == len(readable)
+    copies = {rel(root, b.path): rel(root, b.copy_of) for b in tl.bags if b.copy_of}
+    assert copies == exp["copies"]
     for name, b in readable.items():
         t = truth["bags"][name]
         assert b.start_ns / 1e9 == pytest.approx(t["start"], abs=tol), name
         assert b.end_ns / 1e9 == pytest.approx(t["end"], abs=tol), name
         assert b.kind == t["kind"], name
-        assert sorted(rel(root, o) for o in b.overlaps) == exp["overlaps"][name], name
+        assert sorted(rel(root, o) for o in b.overlaps) == exp["overlaps"].get(name, []), name
+        assert sorted(rel(root, c) for c in b.copies) == sorted(
+            c for c, original in exp["copies"].items() if original == name
+        )
     starts = [b.start_ns for b in tl.bags if b.readable]
     assert starts == sorted(starts)
     sessions = [sorted(rel(root, p) for p in s.paths) for s in tl.sessions]
@@ -46,6 +51,7 @@ def test_pairings_match_the_answers(folder: dict[str, Any]) -> None:
     for name, exp in ans["expected"]["pairings"].items():
         p = pairs[name]
         assert sorted(rel(root, g) for g in p.gt) == exp["gt"]
+        assert p.basis == exp["basis"] and p.other_benchmark == ()
         # 1 ms grid in the answers: tolerance from the answers file.
         assert p.coverage == pytest.approx(exp["coverage"], abs=ans["tolerance"]["coverage"]["abs"])
         got = [[a / 1e9, b / 1e9] for a, b in p.uncovered]
@@ -81,7 +87,19 @@ def test_cli_json_layout(folder: dict[str, Any], capsys: pytest.CaptureFixture[s
     assert main(["timeline", str(root), "--format", "json"]) == 0
     d = json.loads(capsys.readouterr().out)
     assert list(d) == ["bags", "sessions", "problems"]
-    keys = ["path", "format", "start", "end", "duration", "kind", "overlaps", "problems"]
+    keys = [
+        "path",
+        "format",
+        "start",
+        "end",
+        "duration",
+        "kind",
+        "benchmarks",
+        "overlaps",
+        "problems",
+        "copy_of",
+        "copies",
+    ]
     for b in d["bags"]:
         assert list(b) == keys
         assert isinstance(b["overlaps"], list) and isinstance(b["problems"], list)

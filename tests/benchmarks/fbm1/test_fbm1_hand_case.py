@@ -93,8 +93,8 @@ def test_2015_single_lookup_methods_agree_on_a_still_board(method: str) -> None:
     assert (r1.gt.x, r1.gt.y, r1.gt.yaw_deg) == pytest.approx(GT1, abs=TOL)
 
 
-def test_legacy_totals_divide_accuracy_by_ten_at_home() -> None:
-    result = _score(Fbm1Options(rules=ScoreRules(legacy_totals=True)))
+def test_accuracy_over_10_divides_accuracy_by_ten_at_home() -> None:
+    result = _score(Fbm1Options(rules=ScoreRules(accuracy_over_10=True)))
     totals = result.totals
     assert totals.class_accuracy == pytest.approx(2 / 10)
     assert totals.instance_accuracy == pytest.approx(1 / 10)

@@ -19,7 +19,7 @@ from ertools.benchmarks.fbm1_score import (
 )
 
 FIXED = ScoreRules()
-LEGACY = ScoreRules.all_2015()
+LEGACY = ScoreRules.node_2015()
 
 
 @pytest.mark.parametrize(
@@ -94,21 +94,22 @@ def test_names() -> None:
 
 def test_totals_fixed_and_2015() -> None:
     args = ([True, False, True], [True, False, False], [0.9, 0.0, 0.6], [3.0, 5.0, 2.0])
-    t = totals(*args, aborted=1, benchmark="fbm1h", rules=FIXED)
+    t = totals(*args, aborted=1, rules=FIXED)
     assert (t.class_accuracy, t.instance_accuracy) == pytest.approx((2 / 3, 1 / 3))
     assert t.pose_score == pytest.approx(1.5 / 3)
     assert t.execution_time == pytest.approx(10.0)
-    # 2015 @Home: accuracies over 10, pose over the runs counted including the aborted one.
-    old = totals(*args, aborted=1, benchmark="fbm1h", rules=LEGACY)
-    assert (old.class_accuracy, old.instance_accuracy) == pytest.approx((0.2, 0.1))
+    # 2016-17 @Home: accuracies over 10, pose over the runs counted including the aborted one.
+    later = totals(*args, aborted=1, rules=ScoreRules.node_2016())
+    assert (later.class_accuracy, later.instance_accuracy) == pytest.approx((0.2, 0.1))
+    assert later.pose_score == pytest.approx(1.5 / 4)
+    # 2015 (@Home and @Work): everything over the runs counted including the aborted one.
+    old = totals(*args, aborted=1, rules=LEGACY)
+    assert (old.class_accuracy, old.instance_accuracy) == pytest.approx((0.5, 0.25))
     assert old.pose_score == pytest.approx(1.5 / 4)
-    # 2015 @Work: everything over the runs counted including the aborted one.
-    work = totals(*args, aborted=1, benchmark="fbm1w", rules=LEGACY)
-    assert (work.class_accuracy, work.pose_score) == pytest.approx((0.5, 1.5 / 4))
 
 
 def test_totals_with_no_counted_run() -> None:
-    t = totals([], [], [], [], aborted=0, benchmark="fbm1h", rules=FIXED)
+    t = totals([], [], [], [], aborted=0, rules=FIXED)
     assert t.class_accuracy is None and t.pose_score is None and t.execution_time == 0.0
 
 

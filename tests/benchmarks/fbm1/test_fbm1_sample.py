@@ -96,5 +96,5 @@ def test_sample_fixed_rules_say_what_differs(
 ) -> None:
     data, err = _score(sample, capsys)
     clip = [d for d in data["deviations"] if "clipped at 1 m" in d]
-    assert clip and "run(s) 8 differ" in clip[0]
-    assert "differs from 2015: ground truth = mean" in err
+    assert clip and "run(s) 8 affected" in clip[0] and "[fbm1.translation-clip]" in clip[0]
+    assert "differs from 2015: ground truth = the mean" in err

@@ -240,3 +240,39 @@ def _mocap_only_bag(path: Path) -> Path:
             np.zeros(len(stream)),
         )
     return path
+
+
+@pytest.mark.parametrize(
+    ("window", "where"),
+    [
+        ("end + 5", "past the end"),  # the path window runs 5 s past the last message
+        ("ref - 100", "before the start"),  # a reference before the first message
+    ],
+)
+def test_window_outside_the_log_is_an_error(
+    window: str, where: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Issue 15 (4): a window cut by the log's end was scored from what was left."""
+    from protocol_logs import generate, write_bag, write_config
+
+    log = generate(np.random.default_rng(4), ["line"], sigma=0.5e-3, approach=0.05)
+    bag = write_bag(log, tmp_path / "run.bag")
+    config = write_config(["line"], tmp_path / "fbm3w.yaml")
+    (ref_a, ref_b), (pa, pb) = log.truth.ref_phase[0], log.truth.path[0]
+    span = (log.t_ns[-1] - log.t_ns[0]) / 1e9
+    ref, start, end = (ref_a + ref_b) / 2, pa, pb
+    if window == "end + 5":
+        end = span + 5
+    else:
+        ref = -100.0
+    # inside the log: scored
+    assert score(bag, "--config", config, f"--run=line:{(ref_a + ref_b) / 2}:{pa}:{pb}") == 0
+    capsys.readouterr()
+    assert score(bag, "--config", config, f"--run=line:{ref}:{start}:{end}") == 1
+    captured = capsys.readouterr()
+    line = one_line_error(captured.err)
+    assert len([ln for ln in captured.err.splitlines() if ln.startswith("ertools:")]) == 1
+    assert captured.out == ""  # no score printed
+    assert f"reaches {where} of the log" in line
+    assert f"reference {ref:.3f} s, path {start:.3f}-{end:.3f} s" in line
+    assert f"the log covers 0-{span:.3f} s" in line

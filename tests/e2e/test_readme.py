@@ -1,0 +1,75 @@
+"""The README's console blocks, pasted as printed into one shell after the set-up commands.
+
+Every ``$ `` line (with its ``\\`` continuations) runs in one bash session, in order, from a
+folder laid out as a clone is (``sample_bags/``, ``.venv``, ``../shared``) so that nothing is
+written into the repository; the output lines the README shows must appear in that order.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+SHARED = ROOT.parent / "shared"
+BLOCK = re.compile(r"^```console\n(.*?)^```", re.MULTILINE | re.DOTALL)
+
+
+def console_blocks(text: str) -> list[tuple[list[str], list[str]]]:
+    """(commands, shown output lines) of each ``console`` block; ``...`` elides output."""
+    blocks = []
+    for body in BLOCK.findall(text):
+        commands: list[str] = []
+        shown: list[str] = []
+        continued = False
+        for line in body.splitlines():
+            if continued:
+                commands[-1] += "\n" + line
+            elif line.startswith("$ "):
+                commands.append(line[2:])
+            elif line.strip() and line.strip() != "...":
+                shown.append(line.strip())
+            continued = line.endswith("\\") and bool(commands)
+        blocks.append((commands, shown))
+    return blocks
+
+
+def test_console_blocks_parse_commands_continuations_and_output() -> None:
+    text = "```console\n$ a \\\n   --b\nout: 1\n...\n$ c\n```\n"
+    assert console_blocks(text) == [(["a \\\n   --b", "c"], ["out: 1"])]
+
+
+def test_readme_tour_runs_as_printed(tmp_path: Path) -> None:
+    if not SHARED.is_dir():
+        pytest.skip("../shared not present: the tour scores its real bag")
+    blocks = console_blocks((ROOT / "README.md").read_text(encoding="utf-8"))
+    assert len(blocks) >= 2, "the README lost its tour"
+    work = tmp_path / "clone"
+    work.mkdir()
+    (work / "sample_bags").symlink_to(ROOT / "sample_bags")
+    (work / ".venv").symlink_to(Path(sys.prefix))
+    (tmp_path / "shared").symlink_to(SHARED)
+    script = "set -euo pipefail\n" + "\n".join(cmd for cmds, _ in blocks for cmd in cmds)
+    env = {k: v for k, v in os.environ.items() if k not in ("VIRTUAL_ENV", "PYTHONPATH")}
+    # The shell of a fresh terminal: ertools is on PATH only through the tour's activation.
+    env["PATH"] = "/usr/local/bin:/usr/bin:/bin"
+    proc = subprocess.run(
+        ["bash", "-c", script],
+        cwd=work,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    out = [line.strip() for line in proc.stdout.splitlines()]
+    position = 0
+    for expected in (line for _, shown in blocks for line in shown):
+        assert expected in out[position:], f"the README shows {expected!r}; the tour printed other"
+        position = out.index(expected, position) + 1

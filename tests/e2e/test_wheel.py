@@ -1,0 +1,42 @@
+"""The package as a user installs it: a wheel built from the tree, into a fresh Python."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import zipfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _run(*argv: str | Path, cwd: Path) -> str:
+    proc = subprocess.run(
+        [str(a) for a in argv], cwd=cwd, capture_output=True, text=True, timeout=300, check=False
+    )
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    return proc.stdout
+
+
+def test_wheel_installs_on_a_fresh_python_and_answers_version(tmp_path: Path) -> None:
+    _run(
+        sys.executable, "-m", "pip", "wheel", "--no-deps", "-q",
+        "-w", tmp_path / "dist", ROOT, cwd=tmp_path,
+    )  # fmt: skip
+    (wheel,) = (tmp_path / "dist").glob("ertools-*.whl")
+    names = zipfile.ZipFile(wheel).namelist()
+    # Typed for users' mypy; the simulator travels (``python -m ertools.samples``), tests do not.
+    assert "ertools/py.typed" in names
+    assert "ertools/samples/__main__.py" in names
+    assert not any(n.startswith(("tests/", "sample_bags/", "bench")) for n in names)
+    # A Python that never saw the source tree; --no-deps: `--version` needs no dependency
+    # (the CLI imports NumPy and the readers only for the command it runs).
+    _run(sys.executable, "-m", "venv", "--without-pip", tmp_path / "fresh", cwd=tmp_path)
+    bin_dir = tmp_path / "fresh" / "bin"
+    _run(
+        sys.executable, "-m", "pip", "--python", bin_dir / "python", "install", "-q",
+        "--no-deps", wheel, cwd=tmp_path,
+    )  # fmt: skip
+    version = _run(bin_dir / "ertools", "--version", cwd=tmp_path)
+    expected = _run(sys.executable, "-m", "ertools.cli.main", "--version", cwd=ROOT)
+    assert version.strip() == expected.strip() != ""
