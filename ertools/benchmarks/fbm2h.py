@@ -34,6 +34,7 @@ from ertools.benchmarks.fbm2h_segments import ReachedMoments, StopParams
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
 from ertools.errors import ConfigError, ScoringError, SegmentationError
+from ertools.fidelity import Deviation, Rule
 from ertools.streams import PoseStream, Provenance, frame_change_warning
 from ertools.timeutil import ns_to_s, s_to_ns
 
@@ -47,23 +48,66 @@ DEFAULT_MAX_GAP_S = 0.1
 # Figures need the path, not every 120 Hz sample.
 PATH_POINTS = 3000
 
-DEVIATION_WRAP = (
-    "orientation errors are the yaw difference wrapped to [0, pi] before sin/cos; 2015 used "
-    "the unwrapped |dtheta|, wrong across +-pi (use --orientation-2015 for the 2015 numbers)"
+_NODE = "rockin_scoring/scripts/fbm2h (2015)"
+# The catalogue rows (ertools.fidelity) of every way FBM2@Home differs from the 2015 node.
+RULE_ORIENTATION_WRAP = Rule(
+    key="fbm2h.orientation-wrap",
+    benchmark="fbm2h",
+    title="orientation error across +-pi",
+    rulebook="orientation error of the robot pose at each waypoint (RoCKIn@Home rulebook 5.2.7)",
+    node_2015=(
+        f"{_NODE}: `sin(fabs(rp.theta - tp.theta))` and `cos(...)` of the unwrapped yaw "
+        "difference: a robot at -3.07 rad for theta = pi scored -0.073 rad"
+    ),
+    ertools="the yaw difference wrapped to [0, pi] before sin/cos (the angle between headings)",
+    option="--orientation-2015",
 )
-DEVIATION_POSE = (
-    "robot pose interpolated (linear + SLERP) at the logged reached moment; 2015's tf lookup "
-    "interpolated at the ROS time its node handled the result, a few ms later"
+RULE_POSE_MOMENT = Rule(
+    key="fbm2h.pose-moment",
+    benchmark="fbm2h",
+    title="robot pose moment",
+    rulebook="the robot pose when it reaches the waypoint (seed 7.2.1)",
+    node_2015=(
+        f"{_NODE}: tf `world -> actual_robot` at the ROS time `now` the node took just after "
+        "`WaitResult()` returned, a few ms after the result"
+    ),
+    ertools=(
+        "the marker pose interpolated (linear + SLERP, as tf) at the logged reached moment; no "
+        "option: the moment the node handled the result is not in the log"
+    ),
+    option="",
 )
-DEVIATION_UNSCORED = (
-    "position_accuracy and orientation_accuracy are null when a segment is not scored (timed "
-    "out, never reached, no ground truth); 2015 divided the sum over the scored segments by N, "
-    "the number of waypoints, counting the others as 0 (use --unscored-segments 2015)"
+RULE_UNSCORED = Rule(
+    key="fbm2h.unscored-segments",
+    benchmark="fbm2h",
+    title="segments not scored",
+    rulebook="accuracy over the waypoints reached; a waypoint not reached in time scores no "
+    "points on that path (seed 7.2, RoCKIn@Home rulebook 5.2.7)",
+    node_2015=(
+        f"{_NODE}: `if benchmark.Timeout(): execution_time += segment_time; continue`, then "
+        "`position_accuracy = sum_d / N`, N = the number of waypoints: a timed-out or "
+        "unreached segment adds 0 to the sums but counts in N"
+    ),
+    ertools=(
+        "null accuracies and exit 1 when a segment is not scored (a sum over fewer segments "
+        "divided by N rewards reaching fewer waypoints), with a warning naming them"
+    ),
+    option="--unscored-segments 2015",
 )
-DEVIATION_FORMAT = (
-    "segments_details nested under details as in Listing 13 (the 2015 node wrote it at the top "
-    "level); poses as {x, y, theta} (2015 wrote yaml dumps of Pose2D objects); segment times "
-    "from the log's clock (2015: the BmBox machine's time.time())"
+RULE_SCORE_FORMAT = Rule(
+    key="fbm2h.score-format",
+    benchmark="fbm2h",
+    title="score layout",
+    rulebook="Listing 13: segments_details under details, poses per segment",
+    node_2015=(
+        f"{_NODE}: `yaml.dump` of segments_details at the top level, poses as dumps of Pose2D "
+        "objects, times from the BmBox machine's time.time()"
+    ),
+    ertools=(
+        "Listing 13 nesting, poses as {x, y, theta}, times from the log's clock; no option: "
+        "the numbers are the same, only the layout differs"
+    ),
+    option="",
 )
 
 
@@ -236,16 +280,40 @@ def compute(
             "identity marker-to-robot transform: the marker set is taken to sit on the robot's "
             "odometric centre (give --transform or --team/--transforms otherwise)"
         )
-    deviations = [DEVIATION_POSE, DEVIATION_FORMAT]
+    deviations: list[Deviation] = [
+        RULE_POSE_MOMENT.deviation(
+            "robot pose interpolated (linear + SLERP) at the logged reached moment; 2015's tf "
+            "lookup interpolated at the ROS time its node handled the result, a few ms later"
+        ),
+        RULE_SCORE_FORMAT.deviation(
+            "segments_details nested under details as in Listing 13 (the 2015 node wrote it at "
+            "the top level); poses as {x, y, theta} (2015 wrote yaml dumps of Pose2D objects); "
+            "segment times from the log's clock (2015: the BmBox machine's time.time())"
+        ),
+    ]
     if not unscored_2015 and not scored:
-        deviations.insert(0, DEVIATION_UNSCORED)
+        unscored = sum(s.status != "ok" for s in segments)
+        deviations.insert(
+            0,
+            RULE_UNSCORED.deviation(
+                f"position_accuracy and orientation_accuracy are null: {unscored} of {n} "
+                "segments not scored; 2015 divided the sums over the scored segments by N = "
+                f"{n}, counting the others as 0"
+            ),
+        )
     if orientation_2015:
         all_warnings.append(
             "--orientation-2015: orientation errors use the unwrapped |dtheta| as 2015 did "
             "(negative or wrong when the yaw difference crosses +-pi)"
         )
     else:
-        deviations.insert(0, DEVIATION_WRAP)
+        deviations.insert(
+            0,
+            RULE_ORIENTATION_WRAP.deviation(
+                "orientation errors are the yaw difference wrapped to [0, pi] before sin/cos; "
+                "2015 used the unwrapped |dtheta|, wrong across +-pi"
+            ),
+        )
     if moments.method != "states":
         all_warnings.append(
             f"reached moments from {moments.method!r}, not from the benchmark state topics: "

@@ -12,6 +12,7 @@ import numpy.typing as npt
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
+from ertools.fidelity import Deviation
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
 
@@ -120,7 +121,7 @@ class Fbm2hResult:
     origin_ns: int | None = None
     unscored_2015: bool = False
     warnings: tuple[str, ...] = ()
-    deviations: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
     name: str = "fbm2h"

@@ -36,6 +36,7 @@ from ertools.benchmarks.noise import (
 from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
 from ertools.configs.shapes import Shape
 from ertools.errors import ConfigError, ErtoolsError, ScoringError, TopicError
+from ertools.fidelity import Deviation, Rule
 from ertools.streams import PoseStream, Provenance, frame_change_warning
 
 log = logging.getLogger("ertools.benchmarks.fbm3w")
@@ -57,17 +58,100 @@ FLOOR_WARN_M = 0.0005
 # A kept path this much longer than the target is suspicious (the sample's runs: 1.00-1.01).
 LONG_PATH_RATIO = 1.15
 
-# What ertools does differently from the 2015 node with runs the RefBox ended (2015:
-# ``if benchmark.Timeout(): execution_time += ...`` before ``if not benchmark.Running():
-# continue``, in rockin_scoring/scripts/fbm3w).
-DEVIATION_TIMEOUT_RUNS = (
-    "a run the RefBox timed out is listed with its time and no distance_error and cannot be "
-    "the best run; the 2015 node scored it on the path it had covered and it could be the best "
-    "run (use --timeout-runs 2015)"
+_NODE = "rockin_scoring/scripts/fbm3w (2015)"
+# The catalogue rows (ertools.fidelity) of every way FBM3@Work differs from the 2015 node.
+RULE_TIMEOUT_RUNS = Rule(
+    key="fbm3w.timeout-runs",
+    benchmark="fbm3w",
+    title="timed-out runs",
+    rulebook="the RefBox ends a benchmark with END and payload timeout (seed 6.2.3); seed 7.3 "
+    "does not say how such a run is scored",
+    node_2015=(
+        f"{_NODE}: `if benchmark.Timeout(): ... execution_time = execution_time + (end_time - "
+        "start_time)` before the `not Running()` check; the final Lisbon node scored the run on "
+        "the path it had covered and it could be the best run (issue 15)"
+    ),
+    ertools=(
+        "listed with its time and no distance_error, never the best run: a partial path "
+        "compared with the whole target at l/L says nothing about following it"
+    ),
+    option="--timeout-runs 2015",
 )
-DEVIATION_STOPPED_RUNS = (
-    "a run the RefBox stopped counts in execution_time; the 2015 node treated it as aborted and "
-    "left its time out (use --stopped-runs 2015)"
+RULE_STOPPED_RUNS = Rule(
+    key="fbm3w.stopped-runs",
+    benchmark="fbm3w",
+    title="stopped runs' time",
+    rulebook="the RefBox ends a benchmark with END and payload halt/stop (seed 6.2.3)",
+    node_2015=(
+        f"{_NODE}: `if not benchmark.Running(): continue` comes before the time is added: a "
+        "stopped run was aborted, no score and no time"
+    ),
+    ertools="no score, its time counted in execution_time (the robot did spend it)",
+    option="--stopped-runs 2015",
+)
+RULE_LIVE_CLOCK = Rule(
+    key="fbm3w.live-clock",
+    benchmark="fbm3w",
+    title="reference pose and run times",
+    rulebook="reference acquired when the manual operation completes; execution time of each "
+    "run (seed 7.3.3, Listing 16)",
+    node_2015=f"{_NODE}: the live tf and the node's own wall clock at the transitions",
+    ertools=(
+        "the last logged pose at or before COMPLETED_MANUAL_OPERATION and the state messages' "
+        "record times; no option: the live tf and wall clock are not in the log"
+    ),
+    option="",
+)
+RULE_RUN_FINDING = Rule(
+    key="fbm3w.run-finding",
+    benchmark="fbm3w",
+    title="finding the runs",
+    rulebook="the BmBox state machine delimits each run (seed 7.3.3)",
+    node_2015=f"{_NODE}: its state machine only",
+    ertools=(
+        "the BmBox states when logged; also explicit windows (--run) or motion (--runs auto) "
+        "for bags without them"
+    ),
+    option="--runs states",
+)
+RULE_POSE_TOPIC = Rule(
+    key="fbm3w.pose-topic",
+    benchmark="fbm3w",
+    title="pose source",
+    rulebook="the end effector's marker set from the mocap (seed 7.3.3)",
+    node_2015=f"{_NODE}: subscribed to {DEFAULT_TOPIC}",
+    ertools=f"{DEFAULT_TOPIC}, else {FALLBACK_TOPIC}, else the tf frame {DEFAULT_FRAME}",
+    option=f"--topic {DEFAULT_TOPIC}",
+)
+RULE_D_MIN = Rule(
+    key="fbm3w.d-min",
+    benchmark="fbm3w",
+    title="subsampling threshold d_min",
+    rulebook="d_min = c * epsilon, c chosen experimentally (seed 7.3.2, 7.3.5)",
+    node_2015=f"{_NODE}: `D_MIN` hard-coded (0.00033 m in the seed)",
+    ertools="the config's d_min (default 0.00033 m), warned when below the bag's own noise",
+    option="--d-min 0.00033",
+)
+RULE_USER_SHAPES = Rule(
+    key="fbm3w.user-shapes",
+    benchmark="fbm3w",
+    title="target shapes",
+    rulebook="mathematically defined curves hard-coded in the script (seed 7.3.7, Listing 15)",
+    node_2015=f"{_NODE}: line_path, semi_ellipse, sine (= spline_path) only",
+    ertools="the built-in shapes plus user shapes from the config; no option: a user shape is "
+    "the user's choice, said in the output",
+    option="",
+)
+RULE_ARC_LENGTH = Rule(
+    key="fbm3w.arc-length",
+    benchmark="fbm3w",
+    title="target parameter",
+    rulebook="t(l) with l the normalised length (seed 7.3.1)",
+    node_2015=f"{_NODE}: each shape evaluated at its own parameter (the sine's is not its "
+    "length: 8.36 mm for a robot exactly on it)",
+    ertools="the same by default (shape_floor reported); --arc-length compares at equal "
+    "fractions of the target's arc length instead, on request only",
+    option="",
 )
 
 Window = tuple[str, float, float, float]
@@ -492,34 +576,69 @@ def _deviations(
     mode: str,
     poses: PoseStream,
     options: Fbm3wOptions,
-) -> list[str]:
+) -> list[Deviation]:
     out = []
     if mode == "states":
         out.append(
-            "reference = last logged pose at or before COMPLETED_MANUAL_OPERATION and "
-            "execution_time from the BmBox state messages' record times; 2015 read the live tf "
-            "and its own wall clock at the same transitions"
+            RULE_LIVE_CLOCK.deviation(
+                "reference = last logged pose at or before COMPLETED_MANUAL_OPERATION and "
+                "execution_time from the BmBox state messages' record times; 2015 read the live "
+                "tf and its own wall clock at the same transitions"
+            )
         )
     elif mode == "windows":
-        out.append("runs from explicit windows; the 2015 node only had its state machine")
+        out.append(
+            RULE_RUN_FINDING.deviation(
+                "runs from explicit windows; the 2015 node only had its state machine"
+            )
+        )
     else:
-        out.append("runs found from motion (--runs auto); the 2015 node only had its state machine")
+        out.append(
+            RULE_RUN_FINDING.deviation(
+                "runs found from motion (--runs auto); the 2015 node only had its state machine"
+            )
+        )
     if not poses.source.endswith(DEFAULT_TOPIC):
-        out.append(f"poses from {poses.source.rsplit(':', 1)[-1]}; 2015 used {DEFAULT_TOPIC}")
+        out.append(
+            RULE_POSE_TOPIC.deviation(
+                f"poses from {poses.source.rsplit(':', 1)[-1]}; 2015 used {DEFAULT_TOPIC}"
+            )
+        )
     if not math.isclose(cfg.d_min, DEFAULT_D_MIN, rel_tol=0, abs_tol=1e-12):
-        out.append(f"d_min = {cfg.d_min} m; the 2015 script used {DEFAULT_D_MIN} m")
+        out.append(
+            RULE_D_MIN.deviation(f"d_min = {cfg.d_min} m; the 2015 script used {DEFAULT_D_MIN} m")
+        )
     custom = sorted(
         {r.spec for r in runs if r.spec in cfg.shapes and not cfg.shapes[r.spec].builtin}
     )
     if custom:
-        out.append(f"user-defined shape(s) {', '.join(custom)}; 2015 had only its built-in shapes")
+        out.append(
+            RULE_USER_SHAPES.deviation(
+                f"user-defined shape(s) {', '.join(custom)}; 2015 had only its built-in shapes"
+            )
+        )
     if options.arc_length:
         out.append(
-            "targets compared at equal fractions of their arc length (--arc-length); 2015 "
-            "evaluated each shape at its own parameter"
+            RULE_ARC_LENGTH.deviation(
+                "targets compared at equal fractions of their arc length (--arc-length); 2015 "
+                "evaluated each shape at its own parameter"
+            )
         )
-    if options.timeout_runs != "2015" and any(r.window.status == "timeout" for r in runs):
-        out.append(DEVIATION_TIMEOUT_RUNS)
-    if options.stopped_runs != "2015" and any(r.window.status == "stopped" for r in runs):
-        out.append(DEVIATION_STOPPED_RUNS)
+    timed_out = [str(r.index) for r in runs if r.window.status == "timeout"]
+    if options.timeout_runs != "2015" and timed_out:
+        out.append(
+            RULE_TIMEOUT_RUNS.deviation(
+                f"a run the RefBox timed out (run {', '.join(timed_out)}) is listed with its "
+                "time and no distance_error and cannot be the best run; the 2015 node scored it "
+                "on the path it had covered and it could be the best run"
+            )
+        )
+    stopped = [str(r.index) for r in runs if r.window.status == "stopped"]
+    if options.stopped_runs != "2015" and stopped:
+        out.append(
+            RULE_STOPPED_RUNS.deviation(
+                f"a run the RefBox stopped (run {', '.join(stopped)}) counts in execution_time; "
+                "the 2015 node treated it as aborted and left its time out"
+            )
+        )
     return out

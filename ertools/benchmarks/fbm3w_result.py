@@ -10,6 +10,7 @@ from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.benchmarks.fbm3w_path import PathScore
 from ertools.benchmarks.fbm3w_runs import RunWindow
 from ertools.benchmarks.noise import NoiseResult
+from ertools.fidelity import Deviation
 from ertools.streams import Provenance
 
 # Listing 16 keys of one run, in the listing's order; ertools' extra keys follow them.
@@ -120,7 +121,7 @@ class Fbm3wResult:
     sweep_values: tuple[float, ...] = ()
     name: str = "fbm3w"
     warnings: tuple[str, ...] = ()
-    deviations: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
     count_stopped: bool = True

@@ -31,6 +31,7 @@ from ertools.cli.main import main
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.geometry import quat_from_yaw
 from ertools.io import BenchmarkStates, read_benchmark_states, read_poses
+from ertools.samples.writer import BagWriter
 from ertools.states import BmBoxState as B
 from ertools.states import RefBoxState as R
 from ertools.streams import Machine, PoseStream
@@ -360,3 +361,40 @@ def test_2015_uses_the_script_d_min_over_the_config(
     captured = capsys.readouterr()
     assert json.loads(captured.out)["runs_details"]["0"]["d_min"] == 0.0005
     assert "differs from 2015: d_min = 0.0005 m" in captured.err
+
+
+def test_stopped_run_from_a_bag_with_the_cli(
+    tmp_path: Any, capsys: pytest.CaptureFixture[str]
+) -> None:
+    common = {"path_s": 4.0, "origin": (0.9, -0.3), "yaw": -1.2}
+    runs = [
+        {"spec": "line", "track": {"reach": 1.0, "offset": 0.002, **common}},
+        {"spec": "spline", "track": {"reach": 0.4, "offset": 0.0, **common}, "end_at": 19.5},
+    ]
+    poses, states, bm, rb = _scenario(runs, (19.5, "stop"), seed=13)
+    assert states.bmbox is not None and states.refbox is not None
+    bag = tmp_path / "stopped.bag"
+    epoch = 1_448_020_800 * S  # the log's clock: the scenario's seconds from this epoch
+    with BagWriter(bag) as w:
+        w.write_pose2d(
+            "/fbm3w/robot_at_work/pose2d",
+            poses.t_ns + epoch,
+            poses.xyz[:, 0],
+            poses.xyz[:, 1],
+            np.zeros(len(poses)),
+        )
+        for s, topic in ((states.bmbox, "bmbox_state"), (states.refbox, "refbox_state")):
+            w.write_state(
+                s.machine, f"/fbm3w/{topic}", s.t_ns + epoch, list(s.state), list(s.payload)
+            )
+    node = _node(poses, bm, rb, ["line", "spline"])
+    argv = ["score", "fbm3w", str(bag), "--format", "json"]
+    assert main([*argv, "--stopped-runs", "2015"]) == 0
+    captured = capsys.readouterr()
+    _check(json.loads(captured.out), node)
+    assert "fbm3w.stopped-runs" not in captured.err
+    assert main(argv) == 0
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    assert out["execution_time"] == pytest.approx(node["execution_time"] + (19.6 - 16.0), abs=1e-9)
+    assert "[fbm3w.stopped-runs]" in captured.err and "--stopped-runs 2015 restores" in captured.err
