@@ -38,7 +38,7 @@ from ertools.geometry import (
     wrap_angle,
     yaw_from_quat,
 )
-from ertools.streams import PoseStream, Provenance
+from ertools.streams import PoseStream, Provenance, frame_change_warning
 from ertools.timeutil import NS_PER_S, iso_utc, ns_to_s
 
 if TYPE_CHECKING:
@@ -745,8 +745,9 @@ def score_streams(
     if len(gt) < 2:
         raise ScoringError(f"GT {gt_topic}: {len(gt)} pose(s) in the robot log's span")
     check_increasing(robot, where)
-    gt, dropped = drop_duplicates(gt)
     notes = list(warnings)
+    notes.extend(w for w in (frame_change_warning(gt), frame_change_warning(robot)) if w)
+    gt, dropped = drop_duplicates(gt)
     invalid: list[Deviation] = []
     if dropped:
         notes.append(f"{dropped} GT sample(s) recorded twice (overlapping GT files) were used once")
