@@ -1,0 +1,234 @@
+"""`make fuzz`: mutate ROS1 and MCAP seed files and judge ertools' readers on every mutant.
+
+    .venv/bin/python fuzz/run.py [--cases N] [--seed S] [--jobs J] [--timeout SEC]
+    .venv/bin/python fuzz/run.py --seed S --case K [--keep FILE]   # one case, in full
+
+Case K of seed S is fully determined by (S, K): its seed file is ``SEED_NAMES[K % 10]`` and
+its mutation is drawn from ``numpy.random.default_rng([S, K])``. Every case runs in a worker
+process that the parent watches: a case that gives no verdict within ``--timeout`` seconds
+(default 20; a case takes ~50 ms) is a hang, its worker is killed and a new one takes the
+next case. A watchdog process rather than SIGALRM, because an alarm cannot interrupt a long
+call inside C code (a decompressor, a huge allocation) and would miss exactly those hangs.
+Workers also run with a 3 GiB address-space limit, so an absurd length that makes a reader
+allocate fails with MemoryError (a traceback, reported) instead of swapping the machine.
+
+The last line is the summary, e.g.
+``fuzz: 10000 cases, 9000 agreements (800 partial reads), 1000 clear refusals,
+0 disagreements, 0 tracebacks, 0 hangs (seed 1)``; the exit status is 1 when any case is a
+disagreement, a traceback or a hang.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import logging
+import os
+import select
+import subprocess
+import sys
+import tempfile
+import time
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent
+if str(REPO) not in sys.path:
+    sys.path.insert(0, str(REPO))
+
+from fuzz.seeds import SEEDS  # noqa: E402
+
+SEED_NAMES = tuple(SEEDS)
+CLI_EVERY = 25  # one case in CLI_EVERY also runs `ertools info` and `ertools noise`
+
+
+def run_case(seed: int, index: int, workdir: Path, keep: Path | None = None) -> dict[str, Any]:
+    """Mutate, read with both readers, judge. Returns the verdict record of the case."""
+    import numpy as np
+
+    from fuzz.judge import PARTS, cli_check, ertools_answer, judge_part, official_answer, worst
+    from fuzz.mutate import mutate
+    from fuzz.seeds import seed_bytes, suffix
+
+    name = SEED_NAMES[index % len(SEED_NAMES)]
+    rng = np.random.default_rng([seed, index])
+    data, what = mutate(seed_bytes(name), rng)
+    path = keep or workdir / f"case{suffix(name)}"
+    path.write_bytes(data)
+    truth = _truth(name, workdir)
+    ert = ertools_answer(path)
+    off = official_answer(path)
+    parts = {p: judge_part(p, ert[p], off[p], truth[p]) for p in PARTS}
+    verdict = worst([v for v, _ in parts.values()])
+    cli = cli_check(path) if index % CLI_EVERY == 0 else ""
+    if cli:
+        verdict = "traceback" if "unexpected" in cli or "Traceback" in cli else "disagree"
+    return {
+        "index": index,
+        "seed_file": name,
+        "mutation": what,
+        "verdict": verdict,
+        "parts": {p: v for p, (v, _d) in parts.items()},
+        "details": {p: d for p, (v, d) in parts.items() if v not in ("agree",)},
+        "cli": cli,
+    }
+
+
+_TRUTH: dict[str, Any] = {}
+
+
+def _truth(name: str, workdir: Path) -> Any:
+    """The official answer on the undamaged seed file (what a partial read must stay within)."""
+    from fuzz.judge import official_answer
+    from fuzz.seeds import seed_bytes, suffix
+
+    if name not in _TRUTH:
+        path = workdir / f"seed{suffix(name)}"
+        path.write_bytes(seed_bytes(name))
+        _TRUTH[name] = official_answer(path)
+        path.unlink()
+    return _TRUTH[name]
+
+
+def worker() -> None:
+    """Read case indices on stdin, answer one JSON line each on stdout."""
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))
+    logging.disable(logging.CRITICAL)  # readers warn about damage; the verdict is what counts
+    out = sys.stdout
+    sys.stdout = sys.stderr  # stray prints must not break the protocol
+    with tempfile.TemporaryDirectory(prefix="ertools-fuzz-") as tmp:
+        for line in sys.stdin:
+            seed, index = map(int, line.split())
+            try:
+                rec = run_case(seed, index, Path(tmp))
+            except Exception as err:  # the harness itself failed: report, do not hide
+                rec = {"index": index, "verdict": "traceback", "harness": repr(err)}
+            out.write(json.dumps(rec) + "\n")
+            out.flush()
+
+
+@dataclass
+class Worker:
+    proc: subprocess.Popen[str]
+    index: int | None = None
+    started: float = 0.0
+    lines: list[str] = field(default_factory=list)
+
+
+def _spawn() -> Worker:
+    proc = subprocess.Popen(
+        [sys.executable, str(Path(__file__).resolve()), "--worker"],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+        bufsize=1,
+    )
+    return Worker(proc)
+
+
+def run_cases(
+    seed: int, indices: list[int], jobs: int = 2, timeout: float = 20.0, progress: bool = False
+) -> list[dict[str, Any]]:
+    """Verdict records of the given cases, run in ``jobs`` watched worker processes."""
+    todo = list(reversed(indices))
+    results: list[dict[str, Any]] = []
+    workers = [_spawn() for _ in range(max(1, min(jobs, len(indices))))]
+    start_up = 60.0  # the first case of a worker also imports rosbags, mcap, NumPy
+    try:
+        while todo or any(w.index is not None for w in workers):
+            for w in workers:
+                if w.index is None and todo:
+                    w.index = todo.pop()
+                    w.started = time.monotonic()
+                    assert w.proc.stdin is not None
+                    w.proc.stdin.write(f"{seed} {w.index}\n")
+                    w.proc.stdin.flush()
+            busy = [w for w in workers if w.index is not None]
+            ready, _, _ = select.select([w.proc.stdout for w in busy], [], [], 0.5)
+            now = time.monotonic()
+            for i, w in enumerate(workers):
+                if w.index is None:
+                    continue
+                assert w.proc.stdout is not None
+                if w.proc.stdout in ready:
+                    line = w.proc.stdout.readline()
+                    if line:
+                        results.append(json.loads(line))
+                        w.index = None
+                        if progress and len(results) % 500 == 0:
+                            print(f"fuzz: {len(results)} cases done", file=sys.stderr)
+                        continue
+                    # the worker died (a crash in C code, or killed by the memory limit)
+                    results.append({"index": w.index, "verdict": "traceback", "harness": "worker died"})
+                elif now - w.started < (timeout + (start_up if not w.lines else 0)):
+                    continue
+                else:
+                    results.append({"index": w.index, "verdict": "hang", "harness": f"no verdict in {timeout} s"})
+                w.proc.kill()
+                w.proc.wait()
+                workers[i] = _spawn()
+                w = workers[i]
+            for w in workers:
+                if w.index is None:
+                    w.lines.append("")  # mark: past its first case (start-up allowance spent)
+    finally:
+        for w in workers:
+            w.proc.kill()
+            w.proc.wait()
+    return sorted(results, key=lambda r: r["index"])
+
+
+def summary_line(results: list[dict[str, Any]], seed: int) -> str:
+    c = Counter(r["verdict"] for r in results)
+    return (
+        f"fuzz: {len(results)} cases, {c['agree'] + c['salvaged']} agreements "
+        f"({c['salvaged']} partial reads of files the official reader refuses), "
+        f"{c['refused']} clear refusals, {c['disagree']} disagreements, "
+        f"{c['traceback']} tracebacks, {c['hang']} hangs (seed {seed})"
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--cases", type=int, default=10_000)
+    ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--timeout", type=float, default=20.0, help="seconds per case before a hang")
+    ap.add_argument("--case", type=int, help="run this one case in this process and show it")
+    ap.add_argument("--keep", type=Path, help="with --case: write the mutant here")
+    ap.add_argument("--json", type=Path, help="write every case's verdict record here")
+    ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.worker:
+        worker()
+        return 0
+    if args.case is not None:
+        with tempfile.TemporaryDirectory(prefix="ertools-fuzz-") as tmp:
+            rec = run_case(args.seed, args.case, Path(tmp), args.keep)
+        print(json.dumps(rec, indent=2))
+        return 0 if rec["verdict"] in ("agree", "salvaged", "refused") else 1
+    print(f"fuzz: {args.cases} cases, seed {args.seed}, {args.jobs} workers", file=sys.stderr)
+    t0 = time.monotonic()
+    results = run_cases(args.seed, list(range(args.cases)), args.jobs, args.timeout, True)
+    bad = [r for r in results if r["verdict"] in ("disagree", "traceback", "hang")]
+    for r in bad:
+        print(json.dumps(r), file=sys.stderr)
+    if args.json:
+        args.json.write_text(json.dumps(results, indent=1))
+    by_seed = Counter((r.get("seed_file", "?"), r["verdict"]) for r in results)
+    for name in SEED_NAMES:
+        row = ", ".join(f"{v} {by_seed[(name, v)]}" for v in ("agree", "salvaged", "refused", "disagree", "traceback") if by_seed[(name, v)])
+        print(f"  {name}: {row}", file=sys.stderr)
+    print(f"fuzz: {time.monotonic() - t0:.0f} s; reproduce a case: python fuzz/run.py --seed {args.seed} --case K", file=sys.stderr)
+    print(summary_line(results, args.seed))
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
