@@ -147,12 +147,14 @@ def _conn_from_channel(channel: Any, schema: Any) -> Conn:
 
 
 # What the mcap library raises on damaged or cut-short files.
-def _mcap_errors() -> tuple[type[BaseException], ...]:
+def mcap_errors() -> tuple[type[BaseException], ...]:
     import struct
 
+    import zstandard
     from mcap.exceptions import McapError
 
-    # lz4/zstd raise RuntimeError on corrupt chunks; absurd record lengths can MemoryError.
+    # lz4 raises RuntimeError on corrupt chunks, zstandard its own ZstdError (found by
+    # fuzzing: it escaped as a traceback); absurd record lengths can MemoryError.
     return (
         McapError,
         ValueError,
@@ -162,6 +164,7 @@ def _mcap_errors() -> tuple[type[BaseException], ...]:
         KeyError,
         RuntimeError,
         MemoryError,
+        zstandard.ZstdError,
     )
 
 
@@ -183,7 +186,7 @@ class McapFile(BagFile):
         self._f = path.open("rb")
         from ertools.io.mcap_index import read_summary
 
-        unreadable: tuple[type[BaseException], ...] = (BagError, *_mcap_errors())
+        unreadable: tuple[type[BaseException], ...] = (BagError, *mcap_errors())
         try:
             self._reader = make_reader(self._f)
             summary = read_summary(self._f, path)  # parsed once, reused by the bulk reader
@@ -222,7 +225,7 @@ class McapFile(BagFile):
                     self._scanned.append(
                         (record.log_time, i, record.channel_id, bytes(record.data))
                     )
-        except _mcap_errors() as err:
+        except mcap_errors() as err:
             where = f"byte {self._f.tell()} ({type(err).__name__})"
         if not conns:
             self._f.close()
@@ -266,7 +269,7 @@ class McapFile(BagFile):
                 conn = by_id.get(channel.id)
                 if conn is not None:
                     yield conn, int(message.log_time), bytes(message.data)
-        except _mcap_errors() as err:
+        except mcap_errors() as err:
             raise BagError(
                 f"damaged MCAP data ({type(err).__name__}: {err})", path=self.path
             ) from err

@@ -59,22 +59,14 @@ def read_summary(f: BinaryIO, path: Path) -> Any:
 
 
 def _parse_summary(f: BinaryIO, path: Path) -> Any:
-    from mcap.exceptions import McapError
     from mcap.reader import make_reader
+
+    from ertools.io.files import mcap_errors
 
     try:
         f.seek(0)
         return make_reader(f).get_summary()
-    except (
-        McapError,
-        ValueError,
-        EOFError,
-        OSError,
-        struct.error,
-        KeyError,
-        RuntimeError,
-        MemoryError,
-    ) as err:
+    except mcap_errors() as err:
         raise BagError(f"unreadable MCAP summary ({type(err).__name__}: {err})", path=path) from err
 
 

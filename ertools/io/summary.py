@@ -149,9 +149,10 @@ def _ros1(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagS
 
 def _mcap_scan(path: Path, why: str) -> BagSummary:
     """Walk an MCAP file without a summary, record by record, as far as it goes."""
-    from mcap.exceptions import McapError
     from mcap.records import Channel, Chunk, Message, Schema
     from mcap.stream_reader import StreamReader
+
+    from ertools.io.files import mcap_errors
 
     log.info("%s: %s; scanning the whole file", path, why)
     problems = [why]
@@ -173,16 +174,7 @@ def _mcap_scan(path: Path, why: str) -> BagSummary:
                     s[0] += 1
                     s[1] = min(s[1], record.log_time)
                     s[2] = max(s[2], record.log_time)
-        except (
-            McapError,
-            EOFError,
-            ValueError,
-            struct.error,
-            OSError,
-            KeyError,
-            RuntimeError,
-            MemoryError,
-        ) as err:
+        except mcap_errors() as err:
             problems.append(
                 f"truncated or damaged at byte {f.tell()} ({type(err).__name__}: {err})"
             )
