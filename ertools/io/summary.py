@@ -17,7 +17,6 @@ per-message record times, for rates.
 from __future__ import annotations
 
 import logging
-import struct
 from collections import defaultdict
 from pathlib import Path
 from typing import Any
