@@ -206,6 +206,12 @@ def _mcap_topics(
         for chunk in summary.chunk_indexes:
             compressions.add(chunk.compression or "none")
             for cid, offset in chunk.message_index_offsets.items():
+                if cid not in summary.channels:
+                    raise BagError(
+                        f"chunk index at byte {chunk.chunk_start_offset} names channel {cid}, "
+                        "which the summary section does not declare",
+                        path=path,
+                    )
                 if exact or need_counts:
                     from ertools.io.mcap_index import McapIndex
 
@@ -245,15 +251,28 @@ def _mcap(path: Path, exact: bool, times: Times | None = None) -> BagSummary:
             return _mcap_scan(path, f"no readable summary section ({err.message})")
         from mcap.reader import make_reader
 
+        from ertools.io.files import mcap_errors
+
         f.seek(0)
-        header = make_reader(f).get_header()
+        try:
+            header = make_reader(f).get_header()
+        except mcap_errors() as err:
+            # Only the version text comes from the header record; the summary is still right.
+            header = None
+            problems = [f"unreadable header record ({type(err).__name__}: {err})"]
     if summary is None:
         return _mcap_scan(path, "no summary section (recording not finished?)")
     if not summary.chunk_indexes and summary.statistics and summary.statistics.message_count:
         return _mcap_scan(path, "no chunk indexes")
     topics, compressions = _mcap_topics(path, summary, exact, times)
-    version = f"mcap0 profile {header.profile or 'none'} ({header.library})"
-    return _build(path, "mcap", version, "/".join(sorted(compressions)) or "none", True, topics, [])
+    if header is None:
+        version = "mcap0"
+    else:
+        version = f"mcap0 profile {header.profile or 'none'} ({header.library})"
+        problems = []
+    return _build(
+        path, "mcap", version, "/".join(sorted(compressions)) or "none", True, topics, problems
+    )
 
 
 def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagSummary:
@@ -385,6 +404,12 @@ def record_times(path: str | Path) -> dict[str, I64]:
                 for chunk in summ.chunk_indexes:
                     for cid, offset in chunk.message_index_offsets.items():
                         t, _ = McapIndex._message_index(f, file, offset, cid)
+                        if cid not in summ.channels:
+                            raise BagError(
+                                f"chunk index names channel {cid}, which the summary section "
+                                "does not declare",
+                                path=file,
+                            )
                         parts[summ.channels[cid].topic].append(t)
     else:
         from ertools.io.rosbag2 import query, read_metadata, storage_files
