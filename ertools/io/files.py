@@ -164,6 +164,7 @@ def mcap_errors() -> tuple[type[BaseException], ...]:
         KeyError,
         RuntimeError,
         MemoryError,
+        OverflowError,  # a length near 2**64 handed to read() or a buffer
         zstandard.ZstdError,
     )
 
