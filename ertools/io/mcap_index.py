@@ -237,6 +237,15 @@ class McapIndex:
             start, length = self._spans(buf, offsets + base[which], where)
             if np.any(start + length > base[which] + sizes[which]):
                 raise BagError(f"message record cut off inside its chunk {where}")
+            # The record's own log time must be the index's: a damaged index entry would
+            # otherwise give another record's data (or a wrong time) without a word.
+            from ertools.io.fastdecode import read_at
+
+            log_time = read_at(buf, start - 16, np.dtype("<u8")).astype(np.int64)
+            if np.any(log_time != plan.t_record[rows]):
+                raise BagError(
+                    f"message index disagrees with the message records' log times {where}"
+                )
             return rows, buf, start, length
 
         return len(todo), load
@@ -247,6 +256,21 @@ class McapIndex:
         read straight into it, compressed ones decompressed and copied in."""
         if any(chunk.compression for _path, chunk in chunks):
             return joined([McapIndex.inflated_bytes(p, c) for p, c in chunks], scratch)
+        for path, chunk in chunks:
+            # sizes from the summary are checked before they size a buffer (a flipped high
+            # bit made an int64 overflow); the chunk record itself is checked below
+            if int(chunk.uncompressed_size) != int(chunk.compressed_size):
+                raise BagError(
+                    f"uncompressed chunk with compressed size {chunk.compressed_size} != "
+                    f"uncompressed size {chunk.uncompressed_size} in the summary's chunk index",
+                    path=path,
+                )
+            if int(chunk.uncompressed_size) > path.stat().st_size:
+                raise BagError(
+                    f"chunk index gives a chunk of {chunk.uncompressed_size} bytes, more than "
+                    "the file holds",
+                    path=path,
+                )
         sizes = np.array([int(c.uncompressed_size) for _p, c in chunks], dtype=np.int64)
         base = np.zeros(len(chunks), dtype=np.int64)
         np.cumsum(sizes[:-1], out=base[1:])
