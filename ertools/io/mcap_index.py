@@ -304,8 +304,10 @@ class McapIndex:
         head = f.read(1 + 8 + 2 + 4)
         if len(head) < 15 or head[0] != OP_MESSAGE_INDEX:
             raise BagError(f"no message index at byte {pos}", path=path)
-        _, _length, channel, nbytes = struct.unpack("<BQHI", head)
-        if channel != cid or nbytes % 16 or pos + 15 + nbytes > size:
+        _, length, channel, nbytes = struct.unpack("<BQHI", head)
+        # the record's length and its array's must agree: a damaged array length would read
+        # the next records as (time, offset) pairs
+        if channel != cid or nbytes % 16 or length != 6 + nbytes or pos + 15 + nbytes > size:
             raise BagError(f"damaged message index at byte {pos}", path=path)
         data = f.read(nbytes)
         if len(data) != nbytes:
