@@ -223,6 +223,13 @@ def _mcap_topics(
                     if not len(t):
                         continue
                     lo, hi = int(t.min()), int(t.max())
+                    if lo < chunk.message_start_time or hi > chunk.message_end_time:
+                        # a damaged index entry: its time is outside its own chunk's span
+                        raise BagError(
+                            f"message index of channel {cid} at byte {offset} has times "
+                            f"outside its chunk's (chunk at byte {chunk.chunk_start_offset})",
+                            path=path,
+                        )
                 else:
                     lo, hi = int(chunk.message_start_time), int(chunk.message_end_time)
                 s = spans.setdefault(cid, [lo, hi])
