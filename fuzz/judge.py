@@ -271,6 +271,12 @@ def _rows_within(a: Rows, truth: Rows) -> bool:
     return True
 
 
+def _union(rows: list[Rows]) -> Rows:
+    if not rows:
+        return np.empty(0, np.int64), np.empty((0, 7))
+    return np.concatenate([r[0] for r in rows]), np.concatenate([r[1] for r in rows])
+
+
 def _summary_within(a: Summary, truth: Summary) -> bool:
     for topic, (ty, n, first, last) in a.items():
         if topic not in truth:
@@ -285,8 +291,12 @@ def _summary_within(a: Summary, truth: Summary) -> bool:
     return True
 
 
-def judge_part(part: str, ert: Outcome | str, off: Outcome, truth: Outcome) -> tuple[str, str]:
-    """(verdict, detail) of one part."""
+def judge_part(
+    part: str, ert: Outcome | str, off: Outcome, truths: list[Outcome]
+) -> tuple[str, str]:
+    """(verdict, detail) of one part. ``truths``: the official answers on the undamaged file
+    and, for a mutant of several changes, on the file with each change alone (one damaged
+    byte can break the official reader while another changes a pose it would read)."""
     if isinstance(ert, str):
         return "traceback", ert
     if not ert.ok:
@@ -298,11 +308,13 @@ def judge_part(part: str, ert: Outcome | str, off: Outcome, truth: Outcome) -> t
         if same:
             return "agree", ""
         return "disagree", f"ertools {_show(ert.value)} != official {_show(off.value)}"
-    within = (
-        _summary_within(ert.value, truth.value)
-        if part == "summary"
-        else _rows_within(ert.value, truth.value)
-    )
+    good = [t.value for t in truths if t.ok]
+    if part == "summary":
+        within = all(
+            any(_summary_within({k: v}, g) for g in good) for k, v in ert.value.items()
+        )
+    else:
+        within = _rows_within(ert.value, _union(good))
     if within:
         return "salvaged", f"official failed ({off.why})"
     return "disagree", f"official failed ({off.why}); ertools answered {_show(ert.value)}, not in the undamaged file"

@@ -223,18 +223,25 @@ def _change_field(buf: bytearray, site: Site, rng: np.random.Generator) -> str:
     return f"{value} -> {new}"
 
 
-def mutate(data: bytes, rng: np.random.Generator) -> tuple[bytes, str]:
-    """One mutant of ``data`` and a one-line description of the mutation."""
+@dataclass(frozen=True)
+class Mutant:
+    data: bytes
+    what: str  # one line
+    edits: tuple[tuple[int, bytes], ...] = ()  # (offset, new bytes) of each change; () for a cut
+
+
+def mutate(data: bytes, rng: np.random.Generator) -> Mutant:
+    """One mutant of ``data``, with a one-line description of the mutation."""
     lay = layout(data)
     kind = float(rng.random())
     if kind < 0.1:
         cut = int(rng.choice(lay.boundaries[1:-1]))
         cut += int(rng.choice([0, 0, 0, -1, 1]))
         cut = min(max(cut, 1), len(data) - 1)
-        return data[:cut], f"truncated at record boundary byte {cut} of {len(data)}"
+        return Mutant(data[:cut], f"truncated at record boundary byte {cut} of {len(data)}")
     if kind < 0.2:
         cut = int(rng.integers(1, len(data)))
-        return data[:cut], f"truncated at byte {cut} of {len(data)}"
+        return Mutant(data[:cut], f"truncated at byte {cut} of {len(data)}")
     buf = bytearray(data)
     if kind < 0.85:
         present = [c for c in CATEGORIES if any(s.category == c for s in lay.sites)]
@@ -242,9 +249,11 @@ def mutate(data: bytes, rng: np.random.Generator) -> tuple[bytes, str]:
         pool = [s for s in lay.sites if s.category == cat]
         site = pool[int(rng.integers(0, len(pool)))]
         what = _change_field(buf, site, rng)
-        return bytes(buf), f"{cat} field {site.name} at byte {site.offset}: {what}"
+        edit = (site.offset, bytes(buf[site.offset : site.offset + site.length]))
+        return Mutant(bytes(buf), f"{cat} field {site.name} at byte {site.offset}: {what}", (edit,))
     n = int(rng.integers(1, 9))
     at = sorted(int(x) for x in rng.integers(0, len(buf), n))
     for a in at:
         buf[a] = int(rng.integers(0, 256))
-    return bytes(buf), f"random bytes at {at}"
+    edits = tuple((a, bytes(buf[a : a + 1])) for a in sorted(set(at)))
+    return Mutant(bytes(buf), f"random bytes at {at}", edits)
