@@ -161,6 +161,19 @@ class McapIndex:
                         continue
                     if hi is not None and chunk.message_start_time > hi:
                         continue
+                    if not 0 <= chunk.chunk_start_offset < _file_size(f):
+                        raise BagError(
+                            f"chunk index gives a chunk at byte {chunk.chunk_start_offset}, "
+                            "outside the file",
+                            path=path,
+                        )
+                    if any(c not in summary.channels for c in chunk.message_index_offsets):
+                        # a damaged channel id: the messages it stood for would be skipped
+                        raise BagError(
+                            f"chunk index of the chunk at byte {chunk.chunk_start_offset} "
+                            "names a channel the summary section does not declare",
+                            path=path,
+                        )
                     wanted = [c for c in channels if c in chunk.message_index_offsets]
                     if not wanted:
                         if chunk.message_index_length == 0 and chunk.uncompressed_size:
