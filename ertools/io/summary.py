@@ -198,10 +198,15 @@ def _mcap_topics(
 ) -> tuple[dict[str, tuple[str, int, int | None, int | None, int]], set[str]]:
     spans: dict[int, list[int]] = {}
     compressions = set()
-    counts: dict[int, int] = (
-        dict(summary.statistics.channel_message_counts) if summary.statistics else {}
-    )
-    need_counts = summary.statistics is None
+    stats = summary.statistics
+    if stats is not None and stats.channel_message_counts:
+        if sum(stats.channel_message_counts.values()) != stats.message_count:
+            # damaged statistics (a per-channel count that is no longer part of the total):
+            # count from the message indexes instead, as for a file without statistics
+            log.warning("%s: MCAP statistics do not add up; counting from the indexes", path)
+            stats = None
+    counts: dict[int, int] = dict(stats.channel_message_counts) if stats else {}
+    need_counts = stats is None
     with path.open("rb") as f:
         for chunk in summary.chunk_indexes:
             compressions.add(chunk.compression or "none")
