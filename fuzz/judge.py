@@ -176,10 +176,17 @@ def _summary_of(
     return out
 
 
+# typestores by schema (name, text), kept across cases: rosbags compiles a deserializer per
+# type and typestore, which costs far more than reading these small files
+_STORES: dict[str, Any] = {}
+
+
 def _mcap_decoder(schemas: dict[int, Any]) -> Callable[[Any, str], Any]:
     from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
-    stores: dict[str, Any] = {}
+    stores = _STORES
+    if len(stores) > 256:
+        stores.clear()
 
     def decode(item: Any, _ty: str) -> Any:
         schema, encoding, raw = item

@@ -10,6 +10,7 @@ The same generator state gives the same mutant.
 
 from __future__ import annotations
 
+import functools
 import struct
 from dataclasses import dataclass
 
@@ -178,6 +179,7 @@ def _mcap_records(data: bytes, pos: int, end: int, prefix: str, out: list[Site],
     bounds.append(min(pos, end))
 
 
+@functools.lru_cache(maxsize=32)
 def layout(data: bytes) -> Layout:
     """The fields and record boundaries of a ROS1 or MCAP file."""
     out: list[Site] = []
