@@ -109,7 +109,10 @@ def _pose_row(msg: Any) -> list[float]:
 
 def _tf_rows(msg: Any, t: list[int], v: list[list[float]]) -> None:
     for tr in msg.transforms:
-        if tr.header.frame_id.lstrip("/") == TF_PARENT and tr.child_frame_id.lstrip("/") == TF_CHILD:
+        if (
+            tr.header.frame_id.lstrip("/") == TF_PARENT
+            and tr.child_frame_id.lstrip("/") == TF_CHILD
+        ):
             s = tr.header.stamp
             t.append(int(s.sec) * 1_000_000_000 + int(s.nanosec))
             a, q = tr.transform.translation, tr.transform.rotation
@@ -166,9 +169,7 @@ def _official_ros1(path: Path) -> dict[str, Outcome]:
     return {"summary": Outcome(True, summary), **decoded}
 
 
-def _summary_of(
-    conns: list[tuple[str, str]], msgs: list[tuple[str, str, int, Any]]
-) -> Summary:
+def _summary_of(conns: list[tuple[str, str]], msgs: list[tuple[str, str, int, Any]]) -> Summary:
     out: Summary = {}
     for topic, ty in conns:
         ts = [t for tp, _ty, t, _raw in msgs if tp == topic]
@@ -213,7 +214,12 @@ def _official_mcap(path: Path) -> dict[str, Outcome]:
         with path.open("rb") as f:
             reader = make_reader(f)
             items = [
-                (ch.topic, _short(sc.name) if sc else "", int(m.log_time), (sc, ch.message_encoding, m.data))
+                (
+                    ch.topic,
+                    _short(sc.name) if sc else "",
+                    int(m.log_time),
+                    (sc, ch.message_encoding, m.data),
+                )
                 for sc, ch, m in reader.iter_messages(log_time_order=True)
             ]
             summ = reader.get_summary()
@@ -317,14 +323,16 @@ def judge_part(
         return "disagree", f"ertools {_show(ert.value)} != official {_show(off.value)}"
     good = [t.value for t in truths if t.ok]
     if part == "summary":
-        within = all(
-            any(_summary_within({k: v}, g) for g in good) for k, v in ert.value.items()
-        )
+        within = all(any(_summary_within({k: v}, g) for g in good) for k, v in ert.value.items())
     else:
         within = _rows_within(ert.value, _union(good))
     if within:
         return "salvaged", f"official failed ({off.why})"
-    return "disagree", f"official failed ({off.why}); ertools answered {_show(ert.value)}, not in the undamaged file"
+    return (
+        "disagree",
+        f"official failed ({off.why}); ertools answered {_show(ert.value)}, "
+        "not in the undamaged file",
+    )
 
 
 def _show(value: Any) -> str:
@@ -355,6 +363,11 @@ def cli_check(path: Path) -> str:
         errors = [x for x in lines if x.startswith("ertools: error:")]
         if code == 0:
             continue
-        if code != 1 or len(errors) != 1 or "unexpected" in errors[0] or "Traceback" in err.getvalue():
+        if (
+            code != 1
+            or len(errors) != 1
+            or "unexpected" in errors[0]
+            or "Traceback" in err.getvalue()
+        ):
             problems.append(f"`ertools {argv[0]}` exit {code}, stderr {err.getvalue()!r}")
     return "; ".join(problems)

@@ -39,7 +39,15 @@ class Layout:
 
 # ROS1 ---------------------------------------------------------------------------------------
 
-ROS1_OPS = {0: "?", 2: "message", 3: "bag_header", 4: "index_data", 5: "chunk", 6: "chunk_info", 7: "connection"}
+ROS1_OPS = {
+    0: "?",
+    2: "message",
+    3: "bag_header",
+    4: "index_data",
+    5: "chunk",
+    6: "chunk_info",
+    7: "connection",
+}
 ROS1_FIELD_CATEGORY = {
     "op": "op",
     "conn": "header",
@@ -58,7 +66,9 @@ ROS1_FIELD_CATEGORY = {
 }
 
 
-def _ros1_records(data: bytes, pos: int, end: int, prefix: str, out: list[Site], bounds: list[int]) -> None:
+def _ros1_records(
+    data: bytes, pos: int, end: int, prefix: str, out: list[Site], bounds: list[int]
+) -> None:
     while pos + 4 <= end:
         bounds.append(pos)
         (hlen,) = struct.unpack_from("<I", data, pos)
@@ -90,7 +100,11 @@ def _ros1_records(data: bytes, pos: int, end: int, prefix: str, out: list[Site],
         out.append(Site(hend, 4, "length", f"{prefix}{kind}.data_len"))
         dstart, dend = hend + 4, min(hend + 4 + dlen, end)
         if kind == "chunk":
-            comp = data[fields["compression"][0] : sum(fields["compression"])] if "compression" in fields else b""
+            comp = (
+                data[fields["compression"][0] : sum(fields["compression"])]
+                if "compression" in fields
+                else b""
+            )
             if comp == b"none":
                 _ros1_records(data, dstart, dend, "chunk.", out, bounds)
             elif dend > dstart:
@@ -115,15 +129,91 @@ def _ros1_records(data: bytes, pos: int, end: int, prefix: str, out: list[Site],
 # length + bytes), b8 (u64 length + bytes), m (u32 byte length + entries), rest (to the end).
 MCAP_RECORDS: dict[int, tuple[str, list[tuple[str, str, str]]]] = {
     0x01: ("header", [("profile", "str", "header"), ("library", "str", "header")]),
-    0x02: ("footer", [("summary_start", "u64", "summary"), ("summary_offset_start", "u64", "summary"), ("summary_crc", "u32", "summary")]),
-    0x03: ("schema", [("id", "u16", "header"), ("name", "str", "header"), ("encoding", "str", "header"), ("data", "b4", "data")]),
-    0x04: ("channel", [("id", "u16", "header"), ("schema_id", "u16", "header"), ("topic", "str", "header"), ("message_encoding", "str", "header"), ("metadata", "m", "header")]),
-    0x05: ("message", [("channel_id", "u16", "header"), ("sequence", "u32", "header"), ("log_time", "u64", "header"), ("publish_time", "u64", "header"), ("data", "rest", "data")]),
-    0x06: ("chunk", [("message_start_time", "u64", "chunk_info"), ("message_end_time", "u64", "chunk_info"), ("uncompressed_size", "u64", "compression"), ("uncompressed_crc", "u32", "compression"), ("compression", "str", "compression"), ("records", "b8", "data")]),
+    0x02: (
+        "footer",
+        [
+            ("summary_start", "u64", "summary"),
+            ("summary_offset_start", "u64", "summary"),
+            ("summary_crc", "u32", "summary"),
+        ],
+    ),
+    0x03: (
+        "schema",
+        [
+            ("id", "u16", "header"),
+            ("name", "str", "header"),
+            ("encoding", "str", "header"),
+            ("data", "b4", "data"),
+        ],
+    ),
+    0x04: (
+        "channel",
+        [
+            ("id", "u16", "header"),
+            ("schema_id", "u16", "header"),
+            ("topic", "str", "header"),
+            ("message_encoding", "str", "header"),
+            ("metadata", "m", "header"),
+        ],
+    ),
+    0x05: (
+        "message",
+        [
+            ("channel_id", "u16", "header"),
+            ("sequence", "u32", "header"),
+            ("log_time", "u64", "header"),
+            ("publish_time", "u64", "header"),
+            ("data", "rest", "data"),
+        ],
+    ),
+    0x06: (
+        "chunk",
+        [
+            ("message_start_time", "u64", "chunk_info"),
+            ("message_end_time", "u64", "chunk_info"),
+            ("uncompressed_size", "u64", "compression"),
+            ("uncompressed_crc", "u32", "compression"),
+            ("compression", "str", "compression"),
+            ("records", "b8", "data"),
+        ],
+    ),
     0x07: ("message_index", [("channel_id", "u16", "index"), ("records", "m", "index")]),
-    0x08: ("chunk_index", [("message_start_time", "u64", "chunk_info"), ("message_end_time", "u64", "chunk_info"), ("chunk_start_offset", "u64", "chunk_info"), ("chunk_length", "u64", "chunk_info"), ("message_index_offsets", "m", "chunk_info"), ("message_index_length", "u64", "chunk_info"), ("compression", "str", "compression"), ("compressed_size", "u64", "compression"), ("uncompressed_size", "u64", "compression")]),
-    0x0B: ("statistics", [("message_count", "u64", "summary"), ("schema_count", "u16", "summary"), ("channel_count", "u32", "summary"), ("attachment_count", "u32", "summary"), ("metadata_count", "u32", "summary"), ("chunk_count", "u32", "summary"), ("message_start_time", "u64", "summary"), ("message_end_time", "u64", "summary"), ("channel_message_counts", "m", "summary")]),
-    0x0E: ("summary_offset", [("group_opcode", "u8", "summary"), ("group_start", "u64", "summary"), ("group_length", "u64", "summary")]),
+    0x08: (
+        "chunk_index",
+        [
+            ("message_start_time", "u64", "chunk_info"),
+            ("message_end_time", "u64", "chunk_info"),
+            ("chunk_start_offset", "u64", "chunk_info"),
+            ("chunk_length", "u64", "chunk_info"),
+            ("message_index_offsets", "m", "chunk_info"),
+            ("message_index_length", "u64", "chunk_info"),
+            ("compression", "str", "compression"),
+            ("compressed_size", "u64", "compression"),
+            ("uncompressed_size", "u64", "compression"),
+        ],
+    ),
+    0x0B: (
+        "statistics",
+        [
+            ("message_count", "u64", "summary"),
+            ("schema_count", "u16", "summary"),
+            ("channel_count", "u32", "summary"),
+            ("attachment_count", "u32", "summary"),
+            ("metadata_count", "u32", "summary"),
+            ("chunk_count", "u32", "summary"),
+            ("message_start_time", "u64", "summary"),
+            ("message_end_time", "u64", "summary"),
+            ("channel_message_counts", "m", "summary"),
+        ],
+    ),
+    0x0E: (
+        "summary_offset",
+        [
+            ("group_opcode", "u8", "summary"),
+            ("group_start", "u64", "summary"),
+            ("group_length", "u64", "summary"),
+        ],
+    ),
     0x0F: ("data_end", [("data_section_crc", "u32", "summary")]),
 }
 SIZES = {"u8": 1, "u16": 2, "u32": 4, "u64": 8}
@@ -135,7 +225,9 @@ MAP_ENTRY = {
 }
 
 
-def _mcap_records(data: bytes, pos: int, end: int, prefix: str, out: list[Site], bounds: list[int]) -> None:
+def _mcap_records(
+    data: bytes, pos: int, end: int, prefix: str, out: list[Site], bounds: list[int]
+) -> None:
     while pos + 9 <= end:
         bounds.append(pos)
         op = data[pos]
@@ -218,7 +310,11 @@ def _change_field(buf: bytearray, site: Site, rng: np.random.Generator) -> str:
     elif how == 4:
         new = (value - 1) & top
     elif how == 5:
-        new = int(rng.integers(0, top, endpoint=True, dtype=np.uint64)) if n == 8 else int(rng.integers(0, top + 1))
+        new = (
+            int(rng.integers(0, top, endpoint=True, dtype=np.uint64))
+            if n == 8
+            else int(rng.integers(0, top + 1))
+        )
     else:  # a plausible wrong value: a small number, or the value scaled
         new = int(rng.choice([1, 2, 3, 7, 255, 4096, value * 2, value // 2, value + 100])) & top
     buf[a : a + n] = new.to_bytes(n, "little")

@@ -23,7 +23,6 @@ from __future__ import annotations
 import argparse
 import json
 import logging
-import os
 import select
 import subprocess
 import sys
@@ -101,7 +100,9 @@ ROS1_INDEX_FIELDS = ("index_data.", "chunk_info.", "connection.", "bag_header.",
 MCAP_INDEX_FIELDS = ("message_index.", "chunk_index.", "statistics.", "summary_offset.", "footer.")
 
 
-def owner_of(name: str, mutant: Any, parts: dict[str, tuple[str, str]], ert: Any, truth: Any) -> str:
+def owner_of(
+    name: str, mutant: Any, parts: dict[str, tuple[str, str]], ert: Any, truth: Any
+) -> str:
     """Which work a disagreement belongs to: ``mcap-layout``, ``ros1-index``, ``mcap-index``
     (the index and the records disagree; ertools answered from the index) or ``fuzz`` (none:
     a reader bug to fix here)."""
@@ -130,11 +131,12 @@ def owner_of(name: str, mutant: Any, parts: dict[str, tuple[str, str]], ert: Any
     # ertools gave exactly the undamaged file's answer where it disagrees: it read the file
     # through its index, while the official reader lost records to the damage
     same_as_truth = all(
-        v != "disagree" or (not isinstance(ert[p], str) and ert[p].ok and _equal(p, ert[p].value, truth[p]))
+        v != "disagree"
+        or (not isinstance(ert[p], str) and ert[p].ok and _equal(p, ert[p].value, truth[p]))
         for p, (v, _d) in parts.items()
     )
     if same_as_truth:
-        return f"{name.split('-')[0]}-index"
+        return f"{name.split('-', maxsplit=1)[0]}-index"
     return "fuzz"
 
 
@@ -234,11 +236,19 @@ def run_cases(
                             print(f"fuzz: {len(results)} cases done", file=sys.stderr)
                         continue
                     # the worker died (a crash in C code, or killed by the memory limit)
-                    results.append({"index": w.index, "verdict": "traceback", "harness": "worker died"})
+                    results.append(
+                        {"index": w.index, "verdict": "traceback", "harness": "worker died"}
+                    )
                 elif now - w.started < (timeout + (start_up if not w.lines else 0)):
                     continue
                 else:
-                    results.append({"index": w.index, "verdict": "hang", "harness": f"no verdict in {timeout} s"})
+                    results.append(
+                        {
+                            "index": w.index,
+                            "verdict": "hang",
+                            "harness": f"no verdict in {timeout} s",
+                        }
+                    )
                 w.proc.kill()
                 w.proc.wait()
                 workers[i] = _spawn()
@@ -295,9 +305,17 @@ def main(argv: list[str] | None = None) -> int:
         print(f"fuzz: disagreements by owner: {dict(owners)}", file=sys.stderr)
     by_seed = Counter((r.get("seed_file", "?"), r["verdict"]) for r in results)
     for name in SEED_NAMES:
-        row = ", ".join(f"{v} {by_seed[(name, v)]}" for v in ("agree", "salvaged", "refused", "disagree", "traceback") if by_seed[(name, v)])
+        row = ", ".join(
+            f"{v} {by_seed[(name, v)]}"
+            for v in ("agree", "salvaged", "refused", "disagree", "traceback")
+            if by_seed[(name, v)]
+        )
         print(f"  {name}: {row}", file=sys.stderr)
-    print(f"fuzz: {time.monotonic() - t0:.0f} s; reproduce a case: python fuzz/run.py --seed {args.seed} --case K", file=sys.stderr)
+    print(
+        f"fuzz: {time.monotonic() - t0:.0f} s; reproduce a case: "
+        f"python fuzz/run.py --seed {args.seed} --case K",
+        file=sys.stderr,
+    )
     print(summary_line(results, args.seed))
     return 1 if bad else 0
 

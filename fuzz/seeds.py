@@ -87,7 +87,9 @@ def messages(ts: Any, ros1: bool) -> list[tuple[str, int, Any]]:
             (
                 POSE_TOPIC,
                 t,
-                T["geometry_msgs/msg/PoseStamped"](header=header(t - 2_000_001, "map", i), pose=pose),
+                T["geometry_msgs/msg/PoseStamped"](
+                    header=header(t - 2_000_001, "map", i), pose=pose
+                ),
             )
         )
         tf = T["geometry_msgs/msg/TransformStamped"](
@@ -153,7 +155,11 @@ def _mcap(path: Any, container: str, compression: str, opts: dict[str, Any]) -> 
         for seq, (topic, t, msg) in enumerate(messages(ts, ros1)):
             ser = ts.serialize_ros1 if ros1 else ts.serialize_cdr
             w.add_message(
-                channels[topic], log_time=t, data=ser(msg, TYPES[topic]), publish_time=t, sequence=seq
+                channels[topic],
+                log_time=t,
+                data=ser(msg, TYPES[topic]),
+                publish_time=t,
+                sequence=seq,
             )
         w.finish()
 

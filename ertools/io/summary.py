@@ -199,12 +199,15 @@ def _mcap_topics(
     spans: dict[int, list[int]] = {}
     compressions = set()
     stats = summary.statistics
-    if stats is not None and stats.channel_message_counts:
-        if sum(stats.channel_message_counts.values()) != stats.message_count:
-            # damaged statistics (a per-channel count that is no longer part of the total):
-            # count from the message indexes instead, as for a file without statistics
-            log.warning("%s: MCAP statistics do not add up; counting from the indexes", path)
-            stats = None
+    if (
+        stats is not None
+        and stats.channel_message_counts
+        and sum(stats.channel_message_counts.values()) != stats.message_count
+    ):
+        # damaged statistics (a per-channel count that is no longer part of the total):
+        # count from the message indexes instead, as for a file without statistics
+        log.warning("%s: MCAP statistics do not add up; counting from the indexes", path)
+        stats = None
     counts: dict[int, int] = dict(stats.channel_message_counts) if stats else {}
     need_counts = stats is None
     with path.open("rb") as f:

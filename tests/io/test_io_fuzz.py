@@ -114,12 +114,14 @@ def test_the_judge_flags_wrong_answers() -> None:
     assert judge_part("summary", Outcome(True, {"/a": ("pkg/T", 4, 10, 30)}), summ, [summ])[0] == (
         "disagree"
     )
-    assert judge_part("summary", Outcome(True, {"/a": ("pkg/T", 2, 10, 20)}), failed, [summ])[
-        0
-    ] == "salvaged"
-    assert judge_part("summary", Outcome(True, {"/a": ("pkg/T", 2, 5, 20)}), failed, [summ])[
-        0
-    ] == "disagree"
+    assert (
+        judge_part("summary", Outcome(True, {"/a": ("pkg/T", 2, 10, 20)}), failed, [summ])[0]
+        == "salvaged"
+    )
+    assert (
+        judge_part("summary", Outcome(True, {"/a": ("pkg/T", 2, 5, 20)}), failed, [summ])[0]
+        == "disagree"
+    )
 
 
 def test_500_mutants() -> None:
