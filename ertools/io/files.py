@@ -26,6 +26,8 @@ log = logging.getLogger("ertools.io.files")
 
 RawRecord = tuple[Conn, int, bytes]
 
+INT64_MAX = (1 << 63) - 1
+
 
 class BagFile(AbstractContextManager["BagFile"]):
     """An open bag: ``connections`` and :meth:`raw` messages. Use as a context manager."""
@@ -223,6 +225,9 @@ class McapFile(BagFile):
                         record.id, _conn_from_channel(record, schemas.get(record.schema_id))
                     )
                 elif isinstance(record, Message):
+                    if record.log_time > INT64_MAX:
+                        # beyond 2262: a damaged record (times are int64 ns from here on)
+                        raise ValueError(f"message log time {record.log_time} out of range")
                     self._scanned.append(
                         (record.log_time, i, record.channel_id, bytes(record.data))
                     )
@@ -269,6 +274,8 @@ class McapFile(BagFile):
             ):
                 conn = by_id.get(channel.id)
                 if conn is not None:
+                    if message.log_time > INT64_MAX:
+                        raise ValueError(f"message log time {message.log_time} out of range")
                     yield conn, int(message.log_time), bytes(message.data)
         except mcap_errors() as err:
             raise BagError(
