@@ -12,6 +12,7 @@ from __future__ import annotations
 import logging
 import os
 import struct
+import zlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -259,6 +260,14 @@ class McapIndex:
                 raise BagError(
                     f"message index disagrees with the message records' log times {where}"
                 )
+            # Each record must end where its chunk ends or another record (schema, channel,
+            # message: all a chunk may hold) begins; a damaged record length would give a
+            # message with bytes that are not its own, where the mcap library loses the rest
+            # of the chunk.
+            end = start + length
+            inside = end < base[which] + sizes[which]
+            if np.any(inside) and not np.all(np.isin(buf[end[inside]], (3, 4, 5))):
+                raise BagError(f"message record length runs into no record {where}")
             return rows, buf, start, length
 
         return len(todo), load
@@ -291,7 +300,9 @@ class McapIndex:
         for (path, chunk), b, n in zip(chunks, base.tolist(), sizes.tolist(), strict=True):
             where = f"in {path} at byte {chunk.chunk_start_offset}"
             with path.open("rb") as f:
-                compression, at, nbytes, usize = McapIndex._chunk_head(f.fileno(), path, chunk)
+                compression, at, nbytes, usize, _crc = McapIndex._chunk_head(
+                    f.fileno(), path, chunk
+                )
                 if compression or nbytes != n or usize != n:
                     raise BagError(f"chunk record disagrees with the summary's index {where}")
                 if read_at(f.fileno(), view[b : b + n], at) != n:
@@ -302,10 +313,15 @@ class McapIndex:
     def inflated_bytes(path: Path, chunk: Any) -> bytes:
         """A chunk's records, decompressed (and its size checked)."""
         where = f"in {path} at byte {chunk.chunk_start_offset}"
-        compression, data, usize = McapIndex._chunk_raw(path, chunk)
+        compression, data, usize, crc = McapIndex._chunk_raw(path, chunk)
         out = decompress(compression, data, usize, where)
         if len(out) != usize:
             raise BagError(f"chunk decompresses to {len(out)} bytes, not {usize}, {where}")
+        # lz4 and zstd frames as MCAP writers make them carry no checksum of their own: a
+        # damaged compressed chunk inflates to other bytes without an error (fuzzing: poses
+        # changed, records lost). The chunk's CRC (0: not computed) finds it.
+        if crc and zlib.crc32(out) != crc:
+            raise BagError(f"chunk fails its CRC check (damaged) {where}")
         return out
 
     @staticmethod
@@ -333,20 +349,20 @@ class McapIndex:
         return np.frombuffer(McapIndex.inflated_bytes(path, chunk), dtype=np.uint8)
 
     @staticmethod
-    def _chunk_raw(path: Path, chunk: Any) -> tuple[str, bytes, int]:
-        """(compression, compressed records, uncompressed size) of a chunk record."""
+    def _chunk_raw(path: Path, chunk: Any) -> tuple[str, bytes, int, int]:
+        """(compression, compressed records, uncompressed size, CRC) of a chunk record."""
         where = f"in {path} at byte {chunk.chunk_start_offset}"
         with path.open("rb") as f:
-            compression, at, nbytes, usize = McapIndex._chunk_head(f.fileno(), path, chunk)
+            compression, at, nbytes, usize, crc = McapIndex._chunk_head(f.fileno(), path, chunk)
             data = pread(f.fileno(), nbytes, at)
         if len(data) != nbytes:
             raise BagError(f"chunk cut off by end of file {where}")
-        return compression, data, usize
+        return compression, data, usize, crc
 
     @staticmethod
-    def _chunk_head(fd: int, path: Path, chunk: Any) -> tuple[str, int, int, int]:
-        """(compression, where the records start, their stored size, uncompressed size) of a
-        chunk record, from its header (positional reads: may run on a loading thread)."""
+    def _chunk_head(fd: int, path: Path, chunk: Any) -> tuple[str, int, int, int, int]:
+        """(compression, where the records start, their stored size, uncompressed size, CRC)
+        of a chunk record, from its header (positional reads: may run on a loading thread)."""
         where = f"in {path} at byte {chunk.chunk_start_offset}"
         size = os.fstat(fd).st_size
         start = int(chunk.chunk_start_offset)
@@ -355,7 +371,7 @@ class McapIndex:
         head = pread(fd, 1 + 8 + 8 + 8 + 8 + 4 + 4, start)
         if len(head) < 41 or head[0] != OP_CHUNK:
             raise BagError(f"no chunk record {where}")
-        _, _rlen, _t0, _t1, usize, _crc, clen = struct.unpack("<BQQQQII", head)
+        _, _rlen, _t0, _t1, usize, crc, clen = struct.unpack("<BQQQQII", head)
         if start + 41 + clen + 8 > size:
             raise BagError(f"damaged chunk record {where}")
         tail = pread(fd, clen + 8, start + 41)
@@ -365,7 +381,7 @@ class McapIndex:
         # a chunk larger than the file, or inflating to more than 1000x, is damage
         if at + nbytes > size or usize > 1000 * max(nbytes, 1) + (1 << 20):
             raise BagError(f"damaged chunk record (sizes {nbytes}/{usize}) {where}")
-        return compression, at, int(nbytes), int(usize)
+        return compression, at, int(nbytes), int(usize), int(crc)
 
     @staticmethod
     def _spans(buf: U8, off: I64, where: str) -> tuple[I64, I64]:
