@@ -214,7 +214,8 @@ class McapFile(BagFile):
         schemas: dict[int, Any] = {}
         conns: dict[int, Conn] = {}
         self._f.seek(0)
-        reader = StreamReader(self._f, skip_magic=False, emit_chunks=False)
+        # CRCs checked: lz4 and zstd chunks inflate damaged bytes without an error of their own
+        reader = StreamReader(self._f, skip_magic=False, emit_chunks=False, validate_crcs=True)
         where = "the end"
         try:
             for i, record in enumerate(reader.records):

@@ -161,7 +161,9 @@ def _mcap_scan(path: Path, why: str) -> BagSummary:
     compressions: set[str] = set()
     with path.open("rb") as f:
         try:
-            for record in StreamReader(f, skip_magic=False, emit_chunks=False).records:
+            # CRCs checked: lz4 and zstd chunks inflate damaged bytes without an error
+            scan = StreamReader(f, skip_magic=False, emit_chunks=False, validate_crcs=True)
+            for record in scan.records:
                 if isinstance(record, Schema):
                     schemas[record.id] = record.name
                 elif isinstance(record, Channel):
