@@ -208,7 +208,7 @@ class McapFile(BagFile):
     def _scan(self) -> tuple[Conn, ...]:
         """Read every complete record of an unfinished file (no summary to seek with)."""
         from mcap.records import Channel, Message, Schema
-        from mcap.stream_reader import StreamReader
+        from mcap.stream_reader import CRCValidationError, StreamReader
 
         self.unfinished = True
         schemas: dict[int, Any] = {}
@@ -232,6 +232,13 @@ class McapFile(BagFile):
                     self._scanned.append(
                         (record.log_time, i, record.channel_id, bytes(record.data))
                     )
+        except CRCValidationError as err:
+            # a damaged chunk or data section, not the end of an unfinished recording
+            at = self._f.tell()
+            self._f.close()
+            raise BagError(
+                f"MCAP data fails its CRC check before byte {at} (damaged file)", path=self.path
+            ) from err
         except mcap_errors() as err:
             where = f"byte {self._f.tell()} ({type(err).__name__})"
         if not conns:

@@ -149,7 +149,7 @@ def _ros1(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagS
 def _mcap_scan(path: Path, why: str) -> BagSummary:
     """Walk an MCAP file without a summary, record by record, as far as it goes."""
     from mcap.records import Channel, Chunk, Message, Schema
-    from mcap.stream_reader import StreamReader
+    from mcap.stream_reader import CRCValidationError, StreamReader
 
     from ertools.io.files import mcap_errors
 
@@ -175,6 +175,11 @@ def _mcap_scan(path: Path, why: str) -> BagSummary:
                     s[0] += 1
                     s[1] = min(s[1], record.log_time)
                     s[2] = max(s[2], record.log_time)
+        except CRCValidationError as err:
+            # a damaged chunk or data section, not the end of an unfinished recording
+            raise BagError(
+                f"MCAP data fails its CRC check before byte {f.tell()} (damaged file)", path=path
+            ) from err
         except mcap_errors() as err:
             problems.append(
                 f"truncated or damaged at byte {f.tell()} ({type(err).__name__}: {err})"
