@@ -23,13 +23,14 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import os
 import select
 import subprocess
 import sys
 import tempfile
 import time
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -196,6 +197,8 @@ def worker() -> None:
     with tempfile.TemporaryDirectory(prefix="ertools-fuzz-") as tmp:
         for line in sys.stdin:
             seed, index = map(int, line.split())
+            if os.environ.get("ERTOOLS_FUZZ_STALL") == str(index):
+                time.sleep(3600)  # the watchdog's own test: this case hangs
             try:
                 rec = run_case(seed, index, Path(tmp))
             except Exception as err:  # the harness itself failed: report, do not hide
@@ -209,7 +212,7 @@ class Worker:
     proc: subprocess.Popen[str]
     index: int | None = None
     started: float = 0.0
-    lines: list[str] = field(default_factory=list)
+    warm: bool = False  # past its first case (whose start-up imports get extra time)
 
 
 def _spawn() -> Worker:
@@ -253,6 +256,7 @@ def run_cases(
                     if line:
                         results.append(json.loads(line))
                         w.index = None
+                        w.warm = True
                         if progress and len(results) % 500 == 0:
                             print(f"fuzz: {len(results)} cases done", file=sys.stderr)
                         continue
@@ -260,7 +264,7 @@ def run_cases(
                     results.append(
                         {"index": w.index, "verdict": "traceback", "harness": "worker died"}
                     )
-                elif now - w.started < (timeout + (start_up if not w.lines else 0)):
+                elif now - w.started < timeout + (0 if w.warm else start_up):
                     continue
                 else:
                     results.append(
@@ -273,10 +277,6 @@ def run_cases(
                 w.proc.kill()
                 w.proc.wait()
                 workers[i] = _spawn()
-                w = workers[i]
-            for w in workers:
-                if w.index is None:
-                    w.lines.append("")  # mark: past its first case (start-up allowance spent)
     finally:
         for w in workers:
             w.proc.kill()

@@ -141,3 +141,11 @@ def test_500_mutants() -> None:
     assert set(seeds) == set(SEED_NAMES)
     unowned = [r for r in results if r["verdict"] == "disagree" and r["owner"] == "fuzz"]
     assert not unowned, unowned[:3]
+
+
+def test_a_stalled_case_is_a_hang_and_the_next_case_runs(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("ERTOOLS_FUZZ_STALL", "1")
+    results = run_cases(seed=1, indices=[0, 1, 2], jobs=1, timeout=3.0)
+    assert [r["index"] for r in results] == [0, 1, 2]
+    assert results[1]["verdict"] == "hang"
+    assert results[0]["verdict"] != "hang" and results[2]["verdict"] != "hang"
