@@ -66,9 +66,25 @@ def _parse_summary(f: BinaryIO, path: Path) -> Any:
 
     try:
         f.seek(0)
-        return make_reader(f).get_summary()
+        summary = make_reader(f).get_summary()
     except mcap_errors() as err:
         raise BagError(f"unreadable MCAP summary ({type(err).__name__}: {err})", path=path) from err
+    if summary is None:
+        return None
+    stats = summary.statistics
+    if (
+        stats is not None
+        and summary.chunk_indexes
+        and stats.chunk_count != len(summary.chunk_indexes)
+    ):
+        # a chunk index record lost to damage (the mcap library skips a record whose op code
+        # it does not know): reading through the others would silently skip a chunk
+        raise BagError(
+            f"damaged MCAP summary: statistics count {stats.chunk_count} chunks, the chunk "
+            f"indexes {len(summary.chunk_indexes)}",
+            path=path,
+        )
+    return summary
 
 
 def decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
