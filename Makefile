@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 DEVSTAMP := $(VENV)/.installed-dev
 DEMO_OUT ?= demo_output
 
-.PHONY: demo test lint typecheck pytest bench samples notebooks clean
+.PHONY: demo test lint typecheck pytest bench fuzz samples notebooks clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -28,8 +28,8 @@ demo: $(STAMP)
 	$(BIN)/python -m ertools.demo $(DEMO_OUT)
 
 lint: $(DEVSTAMP)
-	$(BIN)/ruff check ertools tests benchmarks
-	$(BIN)/ruff format --check ertools tests benchmarks
+	$(BIN)/ruff check ertools tests benchmarks fuzz
+	$(BIN)/ruff format --check ertools tests benchmarks fuzz
 
 typecheck: $(DEVSTAMP)
 	$(BIN)/mypy ertools
@@ -47,6 +47,14 @@ bench: $(STAMP)
 notebooks: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e '.[notebooks]'
 	$(BIN)/jupyter lab notebooks/
+
+# Mutation fuzzing of the ROS1 and MCAP readers against rosbags / mcap (docs/qa.md).
+# `make fuzz N=500 SEED=7 JOBS=1`; one case in full: `$(BIN)/python fuzz/run.py --seed S --case K`.
+N ?= 10000
+SEED ?= 1
+JOBS ?= 2
+fuzz: $(STAMP)
+	$(BIN)/python fuzz/run.py --cases $(N) --seed $(SEED) --jobs $(JOBS)
 
 samples: $(STAMP)
 	$(BIN)/python -m ertools.samples sample_bags

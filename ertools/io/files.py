@@ -30,6 +30,8 @@ RawRecord = tuple[Conn, int, bytes]
 # (reference positions, bytes, data starts, data lengths, log times, channel ids)
 ScannedRun = tuple[Any, Any, Any, Any, Any, Any]
 
+INT64_MAX = (1 << 63) - 1
+
 
 class BagFile(AbstractContextManager["BagFile"]):
     """An open bag: ``connections`` and :meth:`raw` messages. Use as a context manager."""
@@ -151,15 +153,14 @@ def _conn_from_channel(channel: Any, schema: Any) -> Conn:
 
 
 # What the mcap library raises on damaged or cut-short files.
-def _mcap_errors() -> tuple[type[BaseException], ...]:
+def mcap_errors() -> tuple[type[BaseException], ...]:
     import struct
 
+    import zstandard
     from mcap.exceptions import McapError
 
-    # lz4 raises RuntimeError on corrupt chunks, zstandard its ZstdError; absurd record
-    # lengths can MemoryError, or OverflowError where they become slice bounds.
-    from zstandard import ZstdError
-
+    # lz4 raises RuntimeError on corrupt chunks, zstandard its own ZstdError (found by
+    # fuzzing: it escaped as a traceback); absurd record lengths can MemoryError.
     return (
         McapError,
         ValueError,
@@ -169,8 +170,8 @@ def _mcap_errors() -> tuple[type[BaseException], ...]:
         KeyError,
         RuntimeError,
         MemoryError,
-        OverflowError,
-        ZstdError,
+        OverflowError,  # a length near 2**64 handed to read() or a buffer
+        zstandard.ZstdError,
     )
 
 
@@ -195,7 +196,7 @@ class McapFile(BagFile):
         self.unfinished = False
         self.scanned = False
         self._f = path.open("rb")
-        unreadable: tuple[type[BaseException], ...] = (BagError, *_mcap_errors())
+        unreadable: tuple[type[BaseException], ...] = (BagError, *mcap_errors())
         try:
             layout = mcap_layout(path)
             self._reader = make_reader(self._f)
@@ -312,8 +313,10 @@ class McapFile(BagFile):
             ):
                 conn = by_id.get(channel.id)
                 if conn is not None:
+                    if message.log_time > INT64_MAX:
+                        raise ValueError(f"message log time {message.log_time} out of range")
                     yield conn, int(message.log_time), bytes(message.data)
-        except _mcap_errors() as err:
+        except mcap_errors() as err:
             raise BagError(
                 f"damaged MCAP data ({type(err).__name__}: {err})", path=self.path
             ) from err

@@ -12,6 +12,7 @@ from __future__ import annotations
 import logging
 import os
 import struct
+import zlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -59,23 +60,31 @@ def read_summary(f: BinaryIO, path: Path) -> Any:
 
 
 def _parse_summary(f: BinaryIO, path: Path) -> Any:
-    from mcap.exceptions import McapError
     from mcap.reader import make_reader
+
+    from ertools.io.files import mcap_errors
 
     try:
         f.seek(0)
-        return make_reader(f).get_summary()
-    except (
-        McapError,
-        ValueError,
-        EOFError,
-        OSError,
-        struct.error,
-        KeyError,
-        RuntimeError,
-        MemoryError,
-    ) as err:
+        summary = make_reader(f).get_summary()
+    except mcap_errors() as err:
         raise BagError(f"unreadable MCAP summary ({type(err).__name__}: {err})", path=path) from err
+    if summary is None:
+        return None
+    stats = summary.statistics
+    if (
+        stats is not None
+        and summary.chunk_indexes
+        and stats.chunk_count != len(summary.chunk_indexes)
+    ):
+        # a chunk index record lost to damage (the mcap library skips a record whose op code
+        # it does not know): reading through the others would silently skip a chunk
+        raise BagError(
+            f"damaged MCAP summary: statistics count {stats.chunk_count} chunks, the chunk "
+            f"indexes {len(summary.chunk_indexes)}",
+            path=path,
+        )
+    return summary
 
 
 def decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
@@ -172,6 +181,19 @@ class McapIndex:
                         continue
                     if hi is not None and chunk.message_start_time > hi:
                         continue
+                    if not 0 <= chunk.chunk_start_offset < _file_size(f):
+                        raise BagError(
+                            f"chunk index gives a chunk at byte {chunk.chunk_start_offset}, "
+                            "outside the file",
+                            path=path,
+                        )
+                    if any(c not in summary.channels for c in chunk.message_index_offsets):
+                        # a damaged channel id: the messages it stood for would be skipped
+                        raise BagError(
+                            f"chunk index of the chunk at byte {chunk.chunk_start_offset} "
+                            "names a channel the summary section does not declare",
+                            path=path,
+                        )
                     wanted = [c for c in channels if c in chunk.message_index_offsets]
                     if not wanted:
                         if chunk.message_index_length == 0 and chunk.uncompressed_size:
@@ -248,6 +270,23 @@ class McapIndex:
             start, length = self._spans(buf, offsets + base[which], where)
             if np.any(start + length > base[which] + sizes[which]):
                 raise BagError(f"message record cut off inside its chunk {where}")
+            # The record's own log time must be the index's: a damaged index entry would
+            # otherwise give another record's data (or a wrong time) without a word.
+            from ertools.io.fastdecode import read_at
+
+            log_time = read_at(buf, start - 16, np.dtype("<u8")).astype(np.int64)
+            if np.any(log_time != plan.t_record[rows]):
+                raise BagError(
+                    f"message index disagrees with the message records' log times {where}"
+                )
+            # Each record must end where its chunk ends or another record (schema, channel,
+            # message: all a chunk may hold) begins; a damaged record length would give a
+            # message with bytes that are not its own, where the mcap library loses the rest
+            # of the chunk.
+            end = start + length
+            inside = end < base[which] + sizes[which]
+            if np.any(inside) and not np.all(np.isin(buf[end[inside]], (3, 4, 5))):
+                raise BagError(f"message record length runs into no record {where}")
             return rows, buf, start, length
 
         return len(todo), load
@@ -258,6 +297,21 @@ class McapIndex:
         read straight into it, compressed ones decompressed and copied in."""
         if any(chunk.compression for _path, chunk in chunks):
             return joined([McapIndex.inflated_bytes(p, c) for p, c in chunks], scratch)
+        for path, chunk in chunks:
+            # sizes from the summary are checked before they size a buffer (a flipped high
+            # bit made an int64 overflow); the chunk record itself is checked below
+            if int(chunk.uncompressed_size) != int(chunk.compressed_size):
+                raise BagError(
+                    f"uncompressed chunk with compressed size {chunk.compressed_size} != "
+                    f"uncompressed size {chunk.uncompressed_size} in the summary's chunk index",
+                    path=path,
+                )
+            if int(chunk.uncompressed_size) > path.stat().st_size:
+                raise BagError(
+                    f"chunk index gives a chunk of {chunk.uncompressed_size} bytes, more than "
+                    "the file holds",
+                    path=path,
+                )
         sizes = np.array([int(c.uncompressed_size) for _p, c in chunks], dtype=np.int64)
         base = np.zeros(len(chunks), dtype=np.int64)
         np.cumsum(sizes[:-1], out=base[1:])
@@ -265,7 +319,9 @@ class McapIndex:
         for (path, chunk), b, n in zip(chunks, base.tolist(), sizes.tolist(), strict=True):
             where = f"in {path} at byte {chunk.chunk_start_offset}"
             with path.open("rb") as f:
-                compression, at, nbytes, usize = McapIndex._chunk_head(f.fileno(), path, chunk)
+                compression, at, nbytes, usize, _crc = McapIndex._chunk_head(
+                    f.fileno(), path, chunk
+                )
                 if compression or nbytes != n or usize != n:
                     raise BagError(f"chunk record disagrees with the summary's index {where}")
                 if read_at(f.fileno(), view[b : b + n], at) != n:
@@ -276,10 +332,15 @@ class McapIndex:
     def inflated_bytes(path: Path, chunk: Any) -> bytes:
         """A chunk's records, decompressed (and its size checked)."""
         where = f"in {path} at byte {chunk.chunk_start_offset}"
-        compression, data, usize = McapIndex._chunk_raw(path, chunk)
+        compression, data, usize, crc = McapIndex._chunk_raw(path, chunk)
         out = decompress(compression, data, usize, where)
         if len(out) != usize:
             raise BagError(f"chunk decompresses to {len(out)} bytes, not {usize}, {where}")
+        # lz4 and zstd frames as MCAP writers make them carry no checksum of their own: a
+        # damaged compressed chunk inflates to other bytes without an error (fuzzing: poses
+        # changed, records lost). The chunk's CRC (0: not computed) finds it.
+        if crc and zlib.crc32(out) != crc:
+            raise BagError(f"chunk fails its CRC check (damaged) {where}")
         return out
 
     @staticmethod
@@ -291,8 +352,11 @@ class McapIndex:
         head = f.read(1 + 8 + 2 + 4)
         if len(head) < 15 or head[0] != OP_MESSAGE_INDEX:
             raise BagError(f"no message index at byte {pos}", path=path)
-        _, _length, channel, nbytes = struct.unpack("<BQHI", head)
-        if channel != cid or nbytes % 16 or pos + 15 + nbytes > size:
+        _, length, channel, nbytes = struct.unpack("<BQHI", head)
+        # the array must lie inside its record (a damaged array length would read the next
+        # records as (time, offset) pairs); the record may be longer: the specification
+        # lets writers pad records
+        if channel != cid or nbytes % 16 or length < 6 + nbytes or pos + 15 + nbytes > size:
             raise BagError(f"damaged message index at byte {pos}", path=path)
         data = f.read(nbytes)
         if len(data) != nbytes:
@@ -305,20 +369,20 @@ class McapIndex:
         return np.frombuffer(McapIndex.inflated_bytes(path, chunk), dtype=np.uint8)
 
     @staticmethod
-    def _chunk_raw(path: Path, chunk: Any) -> tuple[str, bytes, int]:
-        """(compression, compressed records, uncompressed size) of a chunk record."""
+    def _chunk_raw(path: Path, chunk: Any) -> tuple[str, bytes, int, int]:
+        """(compression, compressed records, uncompressed size, CRC) of a chunk record."""
         where = f"in {path} at byte {chunk.chunk_start_offset}"
         with path.open("rb") as f:
-            compression, at, nbytes, usize = McapIndex._chunk_head(f.fileno(), path, chunk)
+            compression, at, nbytes, usize, crc = McapIndex._chunk_head(f.fileno(), path, chunk)
             data = pread(f.fileno(), nbytes, at)
         if len(data) != nbytes:
             raise BagError(f"chunk cut off by end of file {where}")
-        return compression, data, usize
+        return compression, data, usize, crc
 
     @staticmethod
-    def _chunk_head(fd: int, path: Path, chunk: Any) -> tuple[str, int, int, int]:
-        """(compression, where the records start, their stored size, uncompressed size) of a
-        chunk record, from its header (positional reads: may run on a loading thread)."""
+    def _chunk_head(fd: int, path: Path, chunk: Any) -> tuple[str, int, int, int, int]:
+        """(compression, where the records start, their stored size, uncompressed size, CRC)
+        of a chunk record, from its header (positional reads: may run on a loading thread)."""
         where = f"in {path} at byte {chunk.chunk_start_offset}"
         size = os.fstat(fd).st_size
         start = int(chunk.chunk_start_offset)
@@ -327,7 +391,7 @@ class McapIndex:
         head = pread(fd, 1 + 8 + 8 + 8 + 8 + 4 + 4, start)
         if len(head) < 41 or head[0] != OP_CHUNK:
             raise BagError(f"no chunk record {where}")
-        _, _rlen, _t0, _t1, usize, _crc, clen = struct.unpack("<BQQQQII", head)
+        _, _rlen, _t0, _t1, usize, crc, clen = struct.unpack("<BQQQQII", head)
         if start + 41 + clen + 8 > size:
             raise BagError(f"damaged chunk record {where}")
         tail = pread(fd, clen + 8, start + 41)
@@ -337,7 +401,7 @@ class McapIndex:
         # a chunk larger than the file, or inflating to more than 1000x, is damage
         if at + nbytes > size or usize > 1000 * max(nbytes, 1) + (1 << 20):
             raise BagError(f"damaged chunk record (sizes {nbytes}/{usize}) {where}")
-        return compression, at, int(nbytes), int(usize)
+        return compression, at, int(nbytes), int(usize), int(crc)
 
     @staticmethod
     def _spans(buf: U8, off: I64, where: str) -> tuple[I64, I64]:

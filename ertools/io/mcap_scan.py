@@ -108,8 +108,12 @@ class _Sink:
         if int(length.min()) < MESSAGE_FIXED:
             raise _CutError
         cids = read_at(buf, at + 9, np.dtype("<u2")).astype(np.int64)
+        times = read_at(buf, at + 15, np.dtype("<u8"))
+        if int(times.max()) > np.iinfo(np.int64).max:
+            # beyond the year 2262: a damaged record, not a time (times are int64 ns here on)
+            raise BagError(f"a message log time {int(times.max())} out of range", path=self.path)
         self.cids.append(cids)
-        self.times.append(read_at(buf, at + 15, np.dtype("<u8")).astype(np.int64))
+        self.times.append(times.astype(np.int64))
         if self.keep:
             mine = np.flatnonzero(np.isin(cids, list(self.keep)))
             if len(mine):
@@ -300,13 +304,15 @@ def _chunk(buf: Any, at: int, end: int, sink: _Sink) -> None:
 
 
 def scan_mcap(
-    path: Path, *, keep: frozenset[int] = frozenset(), check_crc: bool = False
+    path: Path, *, keep: frozenset[int] = frozenset(), check_crc: bool = True
 ) -> McapRecords:
     """Every record of an MCAP file in turn, chunks decompressed, as far as they are whole;
     the bytes of the messages of the channels in ``keep`` are copied out.
 
     A read without ``keep`` is kept for the file's version (device, inode, size, modification
-    time): opening a file, summarising it and listing its channels share one read.
+    time): opening a file, summarising it and listing its channels share one read. Chunk CRCs
+    are checked by default: lz4 and zstd inflate a damaged chunk into other messages without
+    an error of their own (found by fuzzing).
 
     Raises:
         BagError: not an MCAP file (no magic), or a corrupt compressed chunk.
@@ -314,7 +320,7 @@ def scan_mcap(
     with path.open("rb") as f:
         st = os.fstat(f.fileno())
         key = (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
-        if not keep and not check_crc and key in _SCANS:
+        if not keep and check_crc and key in _SCANS:
             return _SCANS[key]
         size = st.st_size
         if size < len(MAGIC):
@@ -327,7 +333,7 @@ def scan_mcap(
         # the map until it goes
         with contextlib.suppress(BufferError):
             mm.close()
-    if not keep:
+    if not keep and check_crc:
         if len(_SCANS) >= 4:  # 16 bytes a message: a few hour-long files at most
             _SCANS.clear()
         _SCANS[key] = found
@@ -354,6 +360,14 @@ def _scan(buf: U8, path: Path, keep: frozenset[int], check_crc: bool) -> McapRec
         why = "a record runs past the end of the file or of its chunk"
         if isinstance(err, UnicodeDecodeError):
             why = "a name that is not UTF-8"
+        if end != size:
+            # The file ends with its closing magic: its writer finished it, so this is damage
+            # inside, not a recording cut short; what follows cannot be trusted or skipped.
+            raise BagError(
+                f"damaged MCAP file: {why} after {sink.count} whole messages, yet the file "
+                "ends with its closing magic (not cut short)",
+                path=path,
+            ) from err
         problem = f"truncated or damaged after {sink.count} whole messages ({why})"
     e = np.empty(0, np.int64)
     return McapRecords(

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.errors import TopicError
+from ertools.errors import BagError, TopicError
 from ertools.io.files import BagFile, open_bag
 from ertools.io.formats import bag_paths
 from ertools.io.merge import merge_poses, sort_poses
@@ -105,7 +105,15 @@ def slow_pose_batch(
             for conn, t, raw in bag.raw(conns, start_ns, end_ns)
             if conn.msgtype == msgtype
         ]
-        batches.append(batch_from_messages(msgtype, records))
+        try:
+            batches.append(batch_from_messages(msgtype, records))
+        except AttributeError as err:
+            # the stored definition names the type but not its fields (a damaged or foreign
+            # definition): the messages decode without the fields a pose needs
+            raise BagError(
+                f"{conns[0].topic}: stored definition of {msgtype} lacks a pose field ({err})",
+                path=bag.path,
+            ) from err
     return concat_batches(batches)
 
 

@@ -314,13 +314,23 @@ def scan_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ros1L
                     if op == OP_CONNECTION:
                         cid = u32(fields, "conn")
                         cfields = parse_fields(buf[dpos : dpos + dlen])
-                        topic = fields.get("topic", b"").decode("utf-8", "replace")
+                        # strict, as for the index's connection records: a name that is not
+                        # UTF-8 is damage, never a topic or type with replacement characters
+                        topic = fields.get("topic", b"").decode("utf-8")
+                        cfields.get("type", b"").decode("utf-8")
                         conns.setdefault(cid, _conn(cid, topic, cfields))
                     elif op == OP_MSG:
                         ts, offs = per.setdefault(u32(fields, "conn"), ([], []))
                         ts.append(time_ns(fields, "time"))
                         offs.append(off)
-            except (BagError, RecordError, KeyError, IndexError, struct_error) as err:
+            except (
+                BagError,
+                RecordError,
+                KeyError,
+                IndexError,
+                struct_error,
+                UnicodeDecodeError,
+            ) as err:
                 problems.append(f"corrupt chunk at byte {pos} skipped ({err})")
                 pos = rec.end
                 continue

@@ -130,7 +130,13 @@ def read_record(
 def connection_fields(record: Record, data: bytes) -> tuple[int, str, dict[str, bytes]]:
     """(conn id, topic, connection-header fields) of a connection record."""
     fields = parse_fields(data, record.data_pos)
-    topic = record.fields.get("topic", fields.get("topic", b"")).decode("utf-8", "replace")
+    try:
+        # Names that are not UTF-8 are damage (rosbags refuses them too); decoded with
+        # replacement characters they became topics and types the bag never had.
+        topic = record.fields.get("topic", fields.get("topic", b"")).decode("utf-8")
+        fields.get("type", b"").decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise RecordError(f"connection topic or type is not UTF-8 ({err})", record.pos) from err
     return u32(record.fields, "conn"), topic, fields
 
 

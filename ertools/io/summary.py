@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ertools.errors import BagError
 from ertools.io.formats import detect_format
 from ertools.io.model import BagSummary, TopicSummary, short_msgtype
 
@@ -195,13 +196,28 @@ def _mcap_indexed(
     summary = layout.summary
     spans: dict[int, list[int]] = {}
     compressions = set()
-    stats = summary.statistics
+    recorded = stats = summary.statistics
+    if (
+        stats is not None
+        and stats.channel_message_counts
+        and sum(stats.channel_message_counts.values()) != stats.message_count
+    ):
+        # damaged statistics (a per-channel count that is no longer part of the total):
+        # count from the message indexes instead, as for a file without statistics
+        log.warning("%s: MCAP statistics do not add up; counting from the indexes", path)
+        stats = None
     read_indexes = exact or stats is None
     counts: dict[int, int] = {} if read_indexes else dict(stats.channel_message_counts)
     with path.open("rb") as f:
         for chunk in summary.chunk_indexes:
             compressions.add(chunk.compression or "none")
             for cid, offset in chunk.message_index_offsets.items():
+                if cid not in layout.channels:
+                    raise BagError(
+                        f"chunk index at byte {chunk.chunk_start_offset} names channel {cid}, "
+                        "which the file does not declare",
+                        path=path,
+                    )
                 if read_indexes:
                     t, _ = McapIndex._message_index(f, path, offset, cid)
                     if times is not None:
@@ -210,14 +226,21 @@ def _mcap_indexed(
                     if not len(t):
                         continue
                     lo, hi = int(t.min()), int(t.max())
+                    if lo < chunk.message_start_time or hi > chunk.message_end_time:
+                        # a damaged index entry: its time is outside its own chunk's span
+                        raise BagError(
+                            f"message index of channel {cid} at byte {offset} has times "
+                            f"outside its chunk's (chunk at byte {chunk.chunk_start_offset})",
+                            path=path,
+                        )
                 else:
                     lo, hi = int(chunk.message_start_time), int(chunk.message_end_time)
                 s = spans.setdefault(cid, [lo, hi])
                 s[0], s[1] = min(s[0], lo), max(s[1], hi)
     problems = []
-    if read_indexes and stats is not None and stats.message_count != sum(counts.values()):
+    if read_indexes and recorded is not None and recorded.message_count != sum(counts.values()):
         problems.append(
-            f"the statistics record counts {stats.message_count} messages, the message "
+            f"the statistics record counts {recorded.message_count} messages, the message "
             f"indexes {sum(counts.values())}"
         )
     topics: dict[str, tuple[str, int, int | None, int | None, int]] = {}
@@ -252,12 +275,12 @@ def _mcap_file(
 def _mcap_version(path: Path) -> str:
     from mcap.reader import make_reader
 
-    from ertools.io.files import _mcap_errors
+    from ertools.io.files import mcap_errors
 
     try:
         with path.open("rb") as f:
             header = make_reader(f).get_header()
-    except _mcap_errors():
+    except mcap_errors():
         return ""
     return f"mcap0 profile {header.profile or 'none'} ({header.library})"
 

@@ -66,7 +66,7 @@ class Deserializer:
             except (TypesysError, ValueError, IndexError) as err:
                 raise BagError(
                     f"topic {conn.topic}: stored definition of {conn.msgtype} does not parse "
-                    f"({err})",
+                    f"({_first_line(err)})",
                     path=path,
                 ) from err
         self.typestore = get_typestore(Stores.EMPTY)
@@ -96,3 +96,9 @@ class Deserializer:
                 f"stored definition ({type(err).__name__}: {err})",
                 path=self.path,
             ) from err
+
+
+def _first_line(err: Exception, limit: int = 160) -> str:
+    """The parser's message without the definition text it quotes (dozens of lines)."""
+    line = str(err).strip().split("\n", 1)[0]
+    return line if len(line) <= limit else line[:limit] + "..."
