@@ -25,6 +25,7 @@ from fuzz.mutate import CATEGORIES, layout, mutate  # noqa: E402
 from fuzz.run import SEED_NAMES, run_cases  # noqa: E402
 from fuzz.seeds import N_POSES, POSE_TOPIC, SEEDS, T0_NS, seed_bytes, suffix  # noqa: E402
 
+
 @pytest.mark.parametrize("name", list(SEEDS))
 def test_seed_files_read_the_same(
     tmp_path: Path, name: str, caplog: pytest.LogCaptureFixture
