@@ -28,6 +28,7 @@ import numpy as np
 import yaml
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.fidelity import Deviation
 from ertools.states import (
     BMBOX_TRANSITIONS,
     BmBoxState,
@@ -166,7 +167,7 @@ class Audit:
     end_ns: int
     topics: tuple[tuple[str, str, int], ...]  # (machine, topic, message count)
     warnings: tuple[str, ...] = ()
-    deviations: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
     recomputed: BenchmarkResult | None = None

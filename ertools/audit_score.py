@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Rows, jsonable
+from ertools.fidelity import Deviation
 
 if TYPE_CHECKING:
     from ertools.audit import Audit
@@ -52,7 +53,7 @@ class ScoreComparison:
     lines: tuple[ScoreLine, ...]
     abs_tol: float
     parameters: tuple[tuple[str, str], ...]
-    deviations: tuple[str, ...]
+    deviations: tuple[Deviation, ...]
     notes: tuple[str, ...] = ()
 
     @property

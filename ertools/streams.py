@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import enum
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -238,7 +238,6 @@ class Provenance:
 
     inputs: tuple[str, ...] = ()
     parameters: tuple[tuple[str, str], ...] = ()
-    deviations_from_2015: tuple[str, ...] = field(default_factory=tuple)
 
 
 def concatenate_poses(streams: Sequence[PoseStream]) -> PoseStream:

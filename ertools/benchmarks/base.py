@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from typing import Any, Protocol, runtime_checkable
 
+from ertools.fidelity import Deviation
 from ertools.streams import Provenance
 
 Rows = list[dict[str, Any]]
@@ -30,7 +31,7 @@ class BenchmarkResult(Protocol):
     def warnings(self) -> tuple[str, ...]: ...
 
     @property
-    def deviations(self) -> tuple[str, ...]: ...
+    def deviations(self) -> tuple[Deviation, ...]: ...
 
     @property
     def failures(self) -> tuple[str, ...]: ...

@@ -22,7 +22,7 @@ import numpy as np
 from ertools.benchmarks.fbm1_gt import board_in_table, coverage_problem
 from ertools.configs.items import Item, ItemList, ItemSpread
 from ertools.errors import SegmentationError
-from ertools.fidelity import Rule
+from ertools.fidelity import Deviation, Rule
 from ertools.geometry import invert, mean_pose
 from ertools.streams import Interval, PoseStream, Provenance
 from ertools.timeutil import NS_PER_S
@@ -93,7 +93,7 @@ class AcquireResult:
     found_phases: tuple[Interval, ...] = ()
     t0_ns: int = 0
     warnings: tuple[str, ...] = ()
-    deviations: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
 

@@ -22,6 +22,7 @@ import numpy.typing as npt
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.errors import ScoringError
+from ertools.fidelity import Deviation
 from ertools.streams import PoseStream, Provenance
 
 F64 = npt.NDArray[np.float64]
@@ -65,7 +66,7 @@ class NoiseResult:
     duration_s: float = 0.0
     name: str = "noise"
     warnings: tuple[str, ...] = ()
-    deviations: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
 

@@ -446,7 +446,7 @@ def _deviations(score: BenchmarkResult | None, audit: Any) -> list[str]:
     if audit is not None:
         sources.append(audit)
     for src in sources:
-        for d in (*src.deviations, *src.provenance.deviations_from_2015):
+        for d in src.deviations:
             if d not in items:
                 items.append(d)
     return items

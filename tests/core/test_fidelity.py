@@ -98,3 +98,59 @@ def test_rule_modules_exist_and_declare_rules_at_module_level() -> None:
 
     for name in RULE_MODULES:
         importlib.import_module(name)
+
+
+SAMPLES = ROOT / "sample_bags"
+FBM3W = str(SAMPLES / "fbm3w" / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag")
+FBM2H = str(SAMPLES / "fbm2h" / "log_fbm2h_mocap_2015-11-20-12-00-00_0.bag")
+FBM2H_INPUTS = [
+    "--goal",
+    str(SAMPLES / "fbm2h" / "fbm2h_goal.yaml"),
+    "--transform",
+    str(SAMPLES / "fbm2h" / "transform-simbot.yaml"),
+]
+FBM1H = [
+    str(SAMPLES / "fbm1h" / "log_fbm1h_2015-11-20-12-00-00_0.bag"),
+    "--items",
+    str(SAMPLES / "fbm1h" / "fbm1h.yaml"),
+]
+ROBOT = [str(SAMPLES / "robotlog" / "FBM2H_201511201200_homer.bag"), str(SAMPLES / "robotlog")]
+RUNS = {
+    "fbm3w": ["score", "fbm3w", FBM3W],
+    "fbm3w-auto-arc": ["score", "fbm3w", FBM3W, "--runs", "auto", "--arc-length"],
+    "fbm3w-d-min": ["score", "fbm3w", FBM3W, "--d-min", "0.001"],
+    "fbm3w-2015": ["score", "fbm3w", FBM3W, "--2015"],
+    "fbm2h": ["score", "fbm2h", FBM2H, *FBM2H_INPUTS],
+    "fbm2h-2015": ["score", "fbm2h", FBM2H, *FBM2H_INPUTS, "--2015"],
+    "fbm1h": ["score", "fbm1h", *FBM1H],
+    "fbm1h-2015": ["score", "fbm1h", *FBM1H, "--rules", "2015"],
+    "fbm1h-2016": ["score", "fbm1h", *FBM1H, "--rules", "2016"],
+    "trajectory": ["score", "trajectory", *ROBOT],
+    "trajectory-2015": ["score", "trajectory", *ROBOT, "--2015"],
+    "audit": ["audit", FBM2H, "--transform", str(SAMPLES / "fbm2h" / "transform-simbot.yaml")],
+}
+PRINTED = re.compile(r"^ertools: differs from 2015: .*\[(?P<key>[a-z0-9]+\.[a-z0-9-]+)\]$")
+
+
+@pytest.mark.parametrize("case", list(RUNS))
+def test_every_printed_deviation_has_a_rule(case: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """What the commands print on the samples under the default and the 2015 options: each
+    ``differs from 2015`` line names a rule of the catalogue (and so a row of the docs)."""
+    from ertools.cli.main import main
+
+    assert main(RUNS[case]) == 0
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if "differs from 2015" in ln]
+    by_key = {r.key: r for r in all_rules()}
+    printed = []
+    for line in lines:
+        match = PRINTED.match(line)
+        assert match is not None, f"a deviation without a rule key: {line}"
+        assert match.group("key") in by_key, line
+        printed.append(by_key[match.group("key")])
+    if case.endswith("-2015"):
+        # --2015 / --rules 2015 restore every behaviour an option can restore: what is still
+        # printed is what no log can restore (the rule says why)
+        assert [r.key for r in printed if r.option] == []
+    elif "-" not in case:
+        assert printed, "the defaults differ from 2015 on every sample: nothing was printed"
