@@ -125,13 +125,13 @@ def content(out: Collected, r: Fbm2hResult, *, limit: int) -> None:
                 "robot_theta": None if s.robot is None else s.robot[2],
             },
         )
-    if r.position_accuracy is not None and known:
+    if known:
         log(
             out,
             max(known),
             INFO,
-            f"position_accuracy {r.position_accuracy:.4f} m, orientation_accuracy "
-            f"{r.orientation_accuracy:.4f} rad, execution_time {r.execution_time:.3f} s",
+            f"position_accuracy {r.position_accuracy} m, orientation_accuracy "
+            f"{r.orientation_accuracy} rad, execution_time {r.execution_time:.3f} s",
             "fbm2h",
         )
     result_notes(out, r, "fbm2h")
