@@ -354,6 +354,11 @@ def test_audit_of_fbm2h(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> N
         assert (t - t0) / NS == pytest.approx(e["start"], abs=1e-6)
     assert len(fg.topics["/audit/runs"].messages) == len(data["runs"]) == 5
     assert fg.file_times == sorted(fg.file_times)
+    # The default text output writes the same file.
+    text = tmp_path / "audit_text.mcap"
+    assert main(["audit", str(FBM2H), *FBM2H_ARGS, "--foxglove", str(text)]) == 0
+    assert f"wrote {text}" in capsys.readouterr().err
+    assert read_back(text).counts == fg.counts
 
 
 # --- bad input --------------------------------------------------------------------------------
