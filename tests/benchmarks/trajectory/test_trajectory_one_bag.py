@@ -142,3 +142,39 @@ def test_one_bag_with_two_gt_candidates_asks_for_the_topic(
             )
     line = _one_error([str(path)], capsys)
     assert "give --gt-topic" in line and GT_TOPIC in line and "/other/pose" in line
+
+
+def test_one_bag_agrees_with_evo_bag_mode(bags: dict[str, Path]) -> None:
+    """evo (an independent implementation, dev extra) reads both topics from the same bag.
+
+    evo's default association (nearest stamp within 0.01 s) keeps the poses ertools leaves out
+    (GT gaps, tracking lost); on the poses ertools compared with ``--association nearest`` its
+    APE (translation, no alignment) is ertools' position error to 1e-9 m.
+    """
+    if bags["both"].suffix != ".bag":
+        pytest.skip("n/a: evo reads ROS1 bags and rosbag2 folders, not plain MCAP files")
+    pytest.importorskip("evo", reason="evo is in the dev extra: `make test` installs it")
+    from evo.core import metrics, sync
+    from evo.tools import file_interface
+    from rosbags.rosbag1 import Reader
+
+    from ertools.benchmarks.trajectory import COMPARED
+
+    with Reader(bags["both"]) as reader:
+        ref = file_interface.read_bag_trajectory(reader, GT_TOPIC)
+        est = file_interface.read_bag_trajectory(reader, ROBOT_TOPIC)
+    ref, est = sync.associate_trajectories(ref, est)
+    ape = metrics.APE(metrics.PoseRelation.translation_part)
+    ape.process_data((ref, est))
+    r = score(bags["both"], [], TrajectoryConfig(association="nearest"))
+    assert len(ape.error) > r.compared  # evo also pairs the gap and tracking-lost poses
+    compared_s = r.matched.t_ns[r.matched.status == COMPARED] / 1e9
+    # Robot stamps are ~100 ms apart: 10 us picks each one out of evo's float seconds (whose
+    # resolution at epoch 1.4e9 s is 0.24 us).
+    near = np.abs(est.timestamps[:, None] - compared_s[None, :]).min(axis=1)
+    scored = near < 1e-5
+    assert int(scored.sum()) == r.compared
+    assert r.metrics is not None
+    errors = ape.error[scored]
+    assert float(np.mean(errors)) == pytest.approx(r.metrics.position_error, abs=1e-9)
+    assert float(np.max(errors)) == pytest.approx(r.metrics.max, abs=1e-9)
