@@ -86,9 +86,6 @@ class Collected:
         text = json.dumps(jsonable(dict(data)), allow_nan=False, separators=(",", ":"))
         self.messages.append((int(t_ns), topic, text.encode("utf-8")))
 
-    def count(self, topic: str) -> int:
-        return sum(1 for _, t, _ in self.messages if t == topic)
-
     @property
     def first_ns(self) -> int:
         """The earliest log time so far (0 when empty): where file-wide notes are logged."""
