@@ -558,14 +558,15 @@ def rescore_2015(
     benchmark: str, paths: Sequence[Path], inputs: ScoreInputs
 ) -> BenchmarkResult | None:
     """The score recomputed with every 2015 quirk the scorer can reproduce (fbm2h: unwrapped
-    orientation; fbm1: ``Fbm1Options.as_2015``; fbm3w: the hard-coded d_min of 0.33 mm and no
-    arc-length parametrisation), or None when there is nothing to recompute."""
+    orientation and unscored segments over N; fbm1: ``Fbm1Options.as_2015``; fbm3w:
+    ``--2015``: the hard-coded d_min of 0.33 mm, no arc-length parametrisation, timed-out runs
+    scored, stopped runs' time left out), or None when there is nothing to recompute."""
     plist = [Path(p) for p in paths]
     if benchmark == "fbm3w":
-        from ertools.benchmarks.fbm3w import Fbm3wOptions, score_fbm3w
-        from ertools.configs.fbm3w import DEFAULT_D_MIN, load_fbm3w_config
+        from ertools.benchmarks.fbm3w import Fbm3wOptions, options_2015, score_fbm3w
+        from ertools.configs.fbm3w import load_fbm3w_config
 
-        options = Fbm3wOptions(d_min=DEFAULT_D_MIN, topic=inputs.topic, arc_length=False)
+        options = options_2015(Fbm3wOptions(topic=inputs.topic))
         return score_fbm3w(plist, load_fbm3w_config(inputs.config), options)
     if benchmark == "fbm2h":
         from ertools.benchmarks.fbm2h import Fbm2hOptions, score_fbm2h
@@ -581,6 +582,7 @@ def rescore_2015(
                 hits=inputs.hits,
                 namespace=benchmark,
                 orientation_2015=True,
+                unscored_2015=True,
             ),
         )
     if benchmark in ("fbm1h", "fbm1w") and inputs.items is not None:

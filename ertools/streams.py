@@ -28,6 +28,27 @@ def _window_slice(t_ns: I64, start_ns: int | None, end_ns: int | None) -> slice:
     return slice(lo, max(lo, hi))
 
 
+@dataclass(frozen=True)
+class FrameChange:
+    """The parent or child frame name of a pose topic changing between two messages.
+
+    Attributes:
+        t_ns: time of the first message with the new name.
+        field: ``frame_id`` or ``child_frame_id``.
+        old, new: the names before and after.
+    """
+
+    t_ns: int
+    field: str
+    old: str
+    new: str
+
+
+# A stream keeps at most this many changes (a topic alternating frames every message would
+# otherwise carry one object per message); the warning says when there were more.
+MAX_FRAME_CHANGES = 100
+
+
 @dataclass(frozen=True, eq=False)
 class PoseStream:
     """A time series of 6-DoF poses of ``child_frame_id`` in ``frame_id``.
@@ -39,6 +60,8 @@ class PoseStream:
         frame_id: parent frame (``world`` for mocap), "" when the message has none.
         child_frame_id: the tracked body, "" when unknown.
         source: where it came from, e.g. ``file.bag:/fbm3w/robot_at_work/pose``.
+        frame_changes: where the messages' frame names changed (``frame_id`` and
+            ``child_frame_id`` above are the first ones); empty for a consistent topic.
     """
 
     t_ns: I64
@@ -47,6 +70,7 @@ class PoseStream:
     frame_id: str = ""
     child_frame_id: str = ""
     source: str = ""
+    frame_changes: tuple[FrameChange, ...] = ()
 
     def __post_init__(self) -> None:
         n = self.t_ns.shape[0]
@@ -85,6 +109,9 @@ class PoseStream:
             self.frame_id,
             self.child_frame_id,
             self.source,
+            # Absolute times: still true of the subset (a change outside it is still a change
+            # of the topic the subset came from).
+            self.frame_changes,
         )
 
     def window(self, start_ns: int | None, end_ns: int | None) -> PoseStream:
@@ -219,6 +246,20 @@ def concatenate_poses(streams: Sequence[PoseStream]) -> PoseStream:
     if not streams:
         return PoseStream.empty()
     first = streams[0]
+    changes: list[FrameChange] = [c for s in streams for c in s.frame_changes]
+    last = first
+    for s in streams[1:]:
+        if not len(s):
+            continue
+        # A split file whose messages name other frames changes the topic's frames too.
+        for name, old, new in (
+            ("frame_id", last.frame_id, s.frame_id),
+            ("child_frame_id", last.child_frame_id, s.child_frame_id),
+        ):
+            if old != new:
+                changes.append(FrameChange(s.start_ns, name, old, new))
+        last = s
+    changes.sort(key=lambda c: c.t_ns)
     return PoseStream(
         np.concatenate([s.t_ns for s in streams]),
         np.concatenate([s.xyz for s in streams]),
@@ -226,4 +267,37 @@ def concatenate_poses(streams: Sequence[PoseStream]) -> PoseStream:
         first.frame_id,
         first.child_frame_id,
         ";".join(dict.fromkeys(s.source for s in streams)),
+        tuple(changes[:MAX_FRAME_CHANGES]),
+    )
+
+
+def frame_change_warning(stream: PoseStream, origin_ns: int | None = None) -> str | None:
+    """One warning line when the stream's frame names change mid-log, else None.
+
+    A ground-truth topic whose ``frame_id`` changes (the mocap re-published in another frame,
+    two publishers on one topic) mixes poses of different frames: every number computed
+    across the change compares coordinates that do not belong together.
+
+    Args:
+        stream: the pose stream.
+        origin_ns: times are printed relative to it (the log's first message) when given,
+            else as UTC.
+    """
+    if not stream.frame_changes:
+        return None
+    from ertools.timeutil import iso_utc
+
+    def when(t: int) -> str:
+        return f"{(t - origin_ns) / 1e9:.3f} s" if origin_ns is not None else iso_utc(t)
+
+    shown = stream.frame_changes[:3]
+    listed = "; ".join(f"{c.field} {c.old!r} -> {c.new!r} at {when(c.t_ns)}" for c in shown)
+    more = len(stream.frame_changes) - len(shown)
+    many = " (and more)" if len(stream.frame_changes) >= MAX_FRAME_CHANGES else ""
+    extra = f"; {more} more change(s){many}" if more > 0 else ""
+    since = " from the log's first message" if origin_ns is not None else ""
+    return (
+        f"{stream.source or 'the pose stream'}: the frame names change in the middle of the "
+        f"log ({listed}{extra}; times{since}): poses on either side may be in different frames "
+        "and numbers computed across the change mix them"
     )

@@ -37,6 +37,7 @@ BAG_SUFFIXES = (".bag", ".bag.active", ".mcap")
 CLOCK_TYPES = (
     "geometry_msgs/PoseStamped",
     "geometry_msgs/TransformStamped",
+    "geometry_msgs/PoseWithCovarianceStamped",
     "nav_msgs/Odometry",
     "tf2_msgs/TFMessage",
     "tf/tfMessage",

@@ -478,8 +478,15 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
             "code",
             "from ertools.report.plots_timeline import draw_gantt\n\n"
             "fig, ax = plt.subplots(figsize=(12, 4), layout='constrained')\n"
-            "draw_gantt(ax, timeline)\n"
+            "draw_gantt(ax, timeline)  # the whole folder on one time axis\n"
             "plt.show()",
+        ),
+        (
+            "code",
+            "from ertools.report.plots_timeline import timeline_figure\n\n"
+            "# one panel per session (its own time axis), problems numbered and listed\n"
+            "# (`ertools timeline FOLDER --plot day.html` writes the zoomable page)\n"
+            "timeline_figure(timeline)",
         ),
         ("code", "pd.DataFrame(timeline.to_dict()['problems'])"),
         (

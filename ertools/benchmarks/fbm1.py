@@ -49,7 +49,7 @@ from ertools.benchmarks.fbm1_score import (
 from ertools.configs.items import Item, ItemList
 from ertools.errors import ConfigError, ScoringError, SegmentationError
 from ertools.fidelity import Deviation, Rule
-from ertools.streams import PoseStream, Provenance
+from ertools.streams import PoseStream, Provenance, frame_change_warning
 from ertools.timeutil import NS_PER_S
 
 if TYPE_CHECKING:
@@ -478,6 +478,8 @@ def score_fbm1(
         rules=opts.rules,
     )
     warnings = list(found.warnings)
+    # A GT body whose frame_id changes mid-log mixes frames (ertools.streams).
+    warnings += [w for w in (frame_change_warning(b, t0_ns or None) for b in (origin, board)) if w]
     if items.is_vanilla:
         warnings.append(
             f"{items.source or 'the item list'} has identity transforms only (a vanilla list): "

@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 
 from ertools.benchmarks.fbm2h_result import Fbm2hResult, SegmentResult
 from ertools.benchmarks.fbm2h_score import robot_poses_at, segment_errors
@@ -33,7 +34,8 @@ from ertools.benchmarks.fbm2h_segments import ReachedMoments, StopParams
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
 from ertools.errors import ConfigError, ScoringError, SegmentationError
-from ertools.streams import PoseStream, Provenance
+from ertools.fidelity import Deviation, Rule
+from ertools.streams import PoseStream, Provenance, frame_change_warning
 from ertools.timeutil import ns_to_s, s_to_ns
 
 if TYPE_CHECKING:
@@ -46,18 +48,66 @@ DEFAULT_MAX_GAP_S = 0.1
 # Figures need the path, not every 120 Hz sample.
 PATH_POINTS = 3000
 
-DEVIATION_WRAP = (
-    "orientation errors are the yaw difference wrapped to [0, pi] before sin/cos; 2015 used "
-    "the unwrapped |dtheta|, wrong across +-pi (use --orientation-2015 for the 2015 numbers)"
+_NODE = "rockin_scoring/scripts/fbm2h (2015)"
+# The catalogue rows (ertools.fidelity) of every way FBM2@Home differs from the 2015 node.
+RULE_ORIENTATION_WRAP = Rule(
+    key="fbm2h.orientation-wrap",
+    benchmark="fbm2h",
+    title="orientation error across +-pi",
+    rulebook="orientation error of the robot pose at each waypoint (RoCKIn@Home rulebook 5.2.7)",
+    node_2015=(
+        f"{_NODE}: `sin(fabs(rp.theta - tp.theta))` and `cos(...)` of the unwrapped yaw "
+        "difference: a robot at -3.07 rad for theta = pi scored -0.073 rad"
+    ),
+    ertools="the yaw difference wrapped to [0, pi] before sin/cos (the angle between headings)",
+    option="--orientation-2015",
 )
-DEVIATION_POSE = (
-    "robot pose interpolated (linear + SLERP) at the logged reached moment; 2015's tf lookup "
-    "interpolated at the ROS time its node handled the result, a few ms later"
+RULE_POSE_MOMENT = Rule(
+    key="fbm2h.pose-moment",
+    benchmark="fbm2h",
+    title="robot pose moment",
+    rulebook="the robot pose when it reaches the waypoint (seed 7.2.1)",
+    node_2015=(
+        f"{_NODE}: tf `world -> actual_robot` at the ROS time `now` the node took just after "
+        "`WaitResult()` returned, a few ms after the result"
+    ),
+    ertools=(
+        "the marker pose interpolated (linear + SLERP, as tf) at the logged reached moment; no "
+        "option: the moment the node handled the result is not in the log"
+    ),
+    option="",
 )
-DEVIATION_FORMAT = (
-    "segments_details nested under details as in Listing 13 (the 2015 node wrote it at the top "
-    "level); poses as {x, y, theta} (2015 wrote yaml dumps of Pose2D objects); segment times "
-    "from the log's clock (2015: the BmBox machine's time.time())"
+RULE_UNSCORED = Rule(
+    key="fbm2h.unscored-segments",
+    benchmark="fbm2h",
+    title="segments not scored",
+    rulebook="accuracy over the waypoints reached; a waypoint not reached in time scores no "
+    "points on that path (seed 7.2, RoCKIn@Home rulebook 5.2.7)",
+    node_2015=(
+        f"{_NODE}: `if benchmark.Timeout(): execution_time += segment_time; continue`, then "
+        "`position_accuracy = sum_d / N`, N = the number of waypoints: a timed-out or "
+        "unreached segment adds 0 to the sums but counts in N"
+    ),
+    ertools=(
+        "null accuracies and exit 1 when a segment is not scored (a sum over fewer segments "
+        "divided by N rewards reaching fewer waypoints), with a warning naming them"
+    ),
+    option="--unscored-segments 2015",
+)
+RULE_SCORE_FORMAT = Rule(
+    key="fbm2h.score-format",
+    benchmark="fbm2h",
+    title="score layout",
+    rulebook="Listing 13: segments_details under details, poses per segment",
+    node_2015=(
+        f"{_NODE}: `yaml.dump` of segments_details at the top level, poses as dumps of Pose2D "
+        "objects, times from the BmBox machine's time.time()"
+    ),
+    ertools=(
+        "Listing 13 nesting, poses as {x, y, theta}, times from the log's clock; no option: "
+        "the numbers are the same, only the layout differs"
+    ),
+    option="",
 )
 
 
@@ -77,6 +127,9 @@ class Fbm2hOptions:
         max_gap_s: a reached moment needs a GT sample this close.
         hits: the referee's count of hits.
         orientation_2015: compute orientation errors as 2015 did (unwrapped).
+        unscored_2015: accuracies as 2015 computed them when segments are not scored: the
+            sums over the scored segments divided by N (the waypoints), the segment the RefBox
+            timed out counted in execution_time (``--unscored-segments 2015``).
         namespace: the benchmark namespace of the state topics.
         stops: thresholds for ``auto``.
     """
@@ -93,6 +146,7 @@ class Fbm2hOptions:
     max_gap_s: float = DEFAULT_MAX_GAP_S
     hits: int | None = None
     orientation_2015: bool = False
+    unscored_2015: bool = False
     namespace: str = "fbm2h"
     stops: StopParams = field(default_factory=StopParams)
 
@@ -111,6 +165,7 @@ def compute(
     max_gap_s: float = DEFAULT_MAX_GAP_S,
     hits: int | None = None,
     orientation_2015: bool = False,
+    unscored_2015: bool = False,
     unreached: Sequence[str] = (),
     warnings: Sequence[str] = (),
     provenance: Provenance | None = None,
@@ -119,7 +174,8 @@ def compute(
     """Score the segments of ``moments`` against ``goal`` (pure: no file is read).
 
     ``moments`` may have fewer segments than waypoints only when ``unreached`` says why; the
-    missing segments are then failures. More moments than waypoints is an error.
+    missing segments are then failures (with ``unscored_2015``: counted as 2015 did, with a
+    warning). More moments than waypoints is an error.
     """
     n = len(goal)
     k = len(moments)
@@ -140,6 +196,11 @@ def compute(
     poses = robot_poses_at(marker, t_mr, moments.end_ns, s_to_ns(max_gap_s))
     target = goal.as_array()
     errs = segment_errors(poses.xyyaw[:k], target[:k], orientation_2015=orientation_2015)
+    all_warnings.extend(_frozen_warnings(marker, moments, poses.ok[:k], max_gap_s, origin_ns))
+    frames = frame_change_warning(marker, origin_ns)
+    if frames:
+        all_warnings.append(frames)
+    early = moments.early_end
     failures: list[str] = []
     segments: list[SegmentResult] = []
     # Failure messages count time as the table does: from the log's first message when known.
@@ -149,8 +210,22 @@ def compute(
         tgt = (float(target[i, 0]), float(target[i, 1]), float(target[i, 2]))
         if i >= k:
             reason = unreached[i - k] if i - k < len(unreached) else f"segment {i}: not reached"
-            failures.append(reason)
-            segments.append(SegmentResult(i, tgt, "unreached", timeout="timeout" in reason.lower()))
+            timed_out = "timeout" in reason.lower()
+            if not unscored_2015:
+                failures.append(reason)
+                segments.append(SegmentResult(i, tgt, "unreached", timeout=timed_out))
+                continue
+            all_warnings.append(f"{reason}: counted in N with no error, as 2015 did")
+            if early is not None and early.segment == i and early.is_timeout:
+                # 2015 added the time of the segment the RefBox timed out (``if
+                # benchmark.Timeout(): execution_time += segment_time``); a halt added nothing.
+                segments.append(
+                    SegmentResult(
+                        i, tgt, "unreached", early.start_ns, early.end_ns, timeout=timed_out
+                    )
+                )
+            else:
+                segments.append(SegmentResult(i, tgt, "unreached", timeout=timed_out))
             continue
         start, end = int(moments.start_ns[i]), int(moments.end_ns[i])
         common = {
@@ -188,19 +263,57 @@ def compute(
         )
     scored = all(s.status == "ok" for s in segments)
     execution_time = sum(s.segment_time or 0.0 for s in segments)
+    position, orientation = _accuracies(
+        segments, poses.xyyaw, target, n, orientation_2015, unscored_2015
+    )
+    if position is None:
+        missing = [s.index for s in segments if s.status != "ok"]
+        all_warnings.append(
+            f"position_accuracy and orientation_accuracy are null: segment(s) "
+            f"{', '.join(map(str, missing))} of {n} not scored and ertools averages only when "
+            "every segment is (see the failures; --unscored-segments 2015 divides the sum over "
+            f"the {n - len(missing)} scored by N = {n} as 2015 did, when the missing ones were "
+            "not lost by tracking)"
+        )
     if transform.is_identity:
         all_warnings.append(
             "identity marker-to-robot transform: the marker set is taken to sit on the robot's "
             "odometric centre (give --transform or --team/--transforms otherwise)"
         )
-    deviations = [DEVIATION_POSE, DEVIATION_FORMAT]
+    deviations: list[Deviation] = [
+        RULE_POSE_MOMENT.deviation(
+            "robot pose interpolated (linear + SLERP) at the logged reached moment; 2015's tf "
+            "lookup interpolated at the ROS time its node handled the result, a few ms later"
+        ),
+        RULE_SCORE_FORMAT.deviation(
+            "segments_details nested under details as in Listing 13 (the 2015 node wrote it at "
+            "the top level); poses as {x, y, theta} (2015 wrote yaml dumps of Pose2D objects); "
+            "segment times from the log's clock (2015: the BmBox machine's time.time())"
+        ),
+    ]
+    if not unscored_2015 and not scored:
+        unscored = sum(s.status != "ok" for s in segments)
+        deviations.insert(
+            0,
+            RULE_UNSCORED.deviation(
+                f"position_accuracy and orientation_accuracy are null: {unscored} of {n} "
+                "segments not scored; 2015 divided the sums over the scored segments by N = "
+                f"{n}, counting the others as 0"
+            ),
+        )
     if orientation_2015:
         all_warnings.append(
             "--orientation-2015: orientation errors use the unwrapped |dtheta| as 2015 did "
             "(negative or wrong when the yaw difference crosses +-pi)"
         )
     else:
-        deviations.insert(0, DEVIATION_WRAP)
+        deviations.insert(
+            0,
+            RULE_ORIENTATION_WRAP.deviation(
+                "orientation errors are the yaw difference wrapped to [0, pi] before sin/cos; "
+                "2015 used the unwrapped |dtheta|, wrong across +-pi"
+            ),
+        )
     if moments.method != "states":
         all_warnings.append(
             f"reached moments from {moments.method!r}, not from the benchmark state topics: "
@@ -222,8 +335,8 @@ def compute(
         path_xyyaw = np.empty((0, 3))
     return Fbm2hResult(
         segments=tuple(segments),
-        position_accuracy=errs.position_accuracy if scored else None,
-        orientation_accuracy=errs.orientation_accuracy if scored else None,
+        position_accuracy=position,
+        orientation_accuracy=orientation,
         execution_time=execution_time,
         hits=hits,
         timeout_segments=sum(1 for s in segments if s.timeout),
@@ -231,6 +344,7 @@ def compute(
         goal=goal,
         reached_method=moments.method,
         orientation_2015=orientation_2015,
+        unscored_2015=unscored_2015,
         path_t_ns=path.t_ns,
         path_xyyaw=path_xyyaw,
         notes=moments.notes,
@@ -240,6 +354,67 @@ def compute(
         failures=tuple(failures),
         provenance=provenance or Provenance(),
     )
+
+
+def _accuracies(
+    segments: Sequence[SegmentResult],
+    xyyaw: npt.NDArray[np.float64],
+    target: npt.NDArray[np.float64],
+    n: int,
+    orientation_2015: bool,
+    unscored_2015: bool,
+) -> tuple[float | None, float | None]:
+    """(position_accuracy, orientation_accuracy), None when there is no honest number.
+
+    By default both are means over the segments, and only when every segment was scored. With
+    ``unscored_2015`` the 2015 node's arithmetic: ``sum_d / N`` and ``atan2(sum_sin,
+    sum_cos)`` where the sums run over the scored segments only (a timed-out or unreached
+    segment added nothing) and N is the number of waypoints; a segment whose ground truth was
+    lost still gives None (2015 waited for tf: the pose it got cannot be known).
+    """
+    ok = np.array([s.status == "ok" for s in segments], dtype=bool)
+    if any(s.status == "no_gt" for s in segments) or (not unscored_2015 and not ok.all()):
+        return None, None
+    idx = np.flatnonzero(ok)
+    errs = segment_errors(xyyaw[idx], target[idx], orientation_2015=orientation_2015)
+    if not unscored_2015:
+        return errs.position_accuracy, errs.orientation_accuracy
+    if not idx.size:
+        return 0.0, 0.0  # 2015: sum_d = 0.0 over N, atan2(0.0, 0.0)
+    return float(errs.distance.sum()) / n, errs.orientation_accuracy
+
+
+def _frozen_warnings(
+    marker: PoseStream,
+    moments: ReachedMoments,
+    ok: npt.NDArray[np.bool_],
+    max_gap_s: float,
+    origin_ns: int | None,
+) -> list[str]:
+    """A warning per scored reached moment whose ground truth is a frozen (repeated) pose.
+
+    The threshold is ``--max-gap``: a frozen stretch longer than the gap ertools accepts hides
+    a tracking loss of the size it refuses (see :data:`ertools.benchmarks.noise.FROZEN_MIN_S`).
+    """
+    from ertools.benchmarks.noise import frozen_around
+
+    if not len(moments):
+        return []
+    t0 = origin_ns if origin_ns is not None else int(moments.start_ns[0])
+    since = "the log's first message" if origin_ns is not None else "the first segment start"
+    out = []
+    for i, span in enumerate(frozen_around(marker, moments.end_ns, max_gap_s)):
+        if span is None or not ok[i]:
+            continue
+        at = int(moments.end_ns[i])
+        out.append(
+            f"segment {i}: the ground truth at the reached moment {ns_to_s(at - t0):.3f} s is "
+            f"frozen: {span.samples} identical poses over {span.duration_s:.3f} s "
+            f"({ns_to_s(span.start_ns - t0):.3f}-{ns_to_s(span.end_ns - t0):.3f} s; tracking "
+            f"lost?), so the pose scored was last measured {ns_to_s(at - span.start_ns):.3f} s "
+            f"before (times from {since})"
+        )
+    return out
 
 
 def invalid_warning(count: int, source: str) -> str:
@@ -401,6 +576,7 @@ def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
             ("max_gap_s", str(options.max_gap_s)),
             ("transform", transform.source),
             ("orientation_2015", str(options.orientation_2015)),
+            ("unscored_segments", "2015" if options.unscored_2015 else "null"),
         ),
     )
     return compute(
@@ -411,6 +587,7 @@ def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
         max_gap_s=options.max_gap_s,
         hits=options.hits,
         orientation_2015=options.orientation_2015,
+        unscored_2015=options.unscored_2015,
         unreached=unreached,
         warnings=warnings,
         provenance=provenance,

@@ -12,6 +12,7 @@ import numpy.typing as npt
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
+from ertools.fidelity import Deviation
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
 
@@ -95,6 +96,9 @@ class Fbm2hResult:
         goal: the goal list.
         reached_method: ``states``, ``timing`` or ``auto``.
         orientation_2015: True when errors were computed the 2015 way (unwrapped).
+        unscored_2015: True when unscored segments were counted as 2015 did; the listing then
+            also follows Listing 13's ``timeout_segments: 0`` / ``timeout: false`` (2015 never
+            set them) and flags ``refbox_timeout`` on the segment the RefBox ended only.
         path_t_ns, path_xyyaw: the robot's path (decimated) for the figures.
         notes: how the reached moments were found.
         origin_ns: the log's first message; table times count from it (from the first
@@ -115,8 +119,9 @@ class Fbm2hResult:
     path_xyyaw: npt.NDArray[np.float64]
     notes: tuple[str, ...] = ()
     origin_ns: int | None = None
+    unscored_2015: bool = False
     warnings: tuple[str, ...] = ()
-    deviations: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
     name: str = "fbm2h"
@@ -127,13 +132,14 @@ class Fbm2hResult:
             "dinstance_error": _num(seg.distance_error),
             "end_segment_time": None if seg.end_ns is None else ns_to_s(seg.end_ns),
             "orientation_error": _num(seg.orientation_error),
-            "refbox_timeout": bool(seg.timeout),
+            "refbox_timeout": bool(seg.timeout)
+            and (not self.unscored_2015 or seg.start_ns is not None),
             "result_payload": _payload_value(seg.result_payload),
             "robot_pose": _pose_map(seg.robot),
             "segment_time": seg.segment_time,
             "start_segment_time": None if seg.start_ns is None else ns_to_s(seg.start_ns),
             "target_pose": _pose_map(seg.target),
-            "timeout": bool(seg.timeout),
+            "timeout": bool(seg.timeout) and not self.unscored_2015,
         }
 
     def _listing(self, string_keys: bool) -> dict[str, Any]:
@@ -146,7 +152,7 @@ class Fbm2hResult:
             "orientation_accuracy": _num(self.orientation_accuracy),
             "execution_time": float(self.execution_time),
             "hits": self.hits,
-            "timeout_segments": int(self.timeout_segments),
+            "timeout_segments": 0 if self.unscored_2015 else int(self.timeout_segments),
             "details": {
                 "marker-robot transform": self.transform.as_listing(),
                 "segments_details": details,

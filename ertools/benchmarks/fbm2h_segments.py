@@ -26,6 +26,27 @@ I64 = npt.NDArray[np.int64]
 F64 = npt.NDArray[np.float64]
 
 
+@dataclass(frozen=True)
+class EarlyEnd:
+    """A segment the RefBox ended: started at ``start_ns``, ended by END at ``end_ns``.
+
+    Attributes:
+        segment: the segment's index.
+        start_ns: when its goal had been sent (the BmBox in EXECUTING_GOAL).
+        end_ns: the RefBox END message.
+        payload: END's payload (``timeout``, ``halt``...).
+    """
+
+    segment: int
+    start_ns: int
+    end_ns: int
+    payload: str
+
+    @property
+    def is_timeout(self) -> bool:
+        return "timeout" in self.payload.lower()
+
+
 @dataclass(frozen=True, eq=False)
 class ReachedMoments:
     """Start and reached (end) time of each segment that was driven.
@@ -39,6 +60,8 @@ class ReachedMoments:
         unreached: reasons for the segments after the K-th that were never completed (the
             RefBox ended the benchmark early); empty when all were reached.
         notes: what was detected, for the referee.
+        early_end: the segment that was started and never completed because the RefBox ended
+            the benchmark (states only), None otherwise.
     """
 
     method: str
@@ -48,6 +71,7 @@ class ReachedMoments:
     goal_payload: str | None = None
     unreached: tuple[str, ...] = ()
     notes: tuple[str, ...] = field(default_factory=tuple)
+    early_end: EarlyEnd | None = None
 
     def __len__(self) -> int:
         return int(self.end_ns.shape[0])
@@ -83,6 +107,7 @@ def from_states(
     ends: list[int] = []
     payloads: list[str] = []
     notes: list[str] = []
+    early: EarlyEnd | None = None
     goal_payload = bm.payload[int(goals[0])] or None
     t_goals = bm.t_ns[goals]
     for k, g in enumerate(goals):
@@ -117,7 +142,10 @@ def from_states(
                 if cl is None:
                     notes.append(f"segment {k}: end from BmBox READY (no Client topic)")
         if t_end is None:
-            reason = _early_end_reason(refbox, t_start)
+            end = _early_end(refbox, t_start)
+            reason = None if end is None else f"RefBox END ({end[1]})"
+            if end is not None:
+                early = EarlyEnd(k, t_start, end[0], end[1])
             if reason is None:
                 raise SegmentationError(
                     f"{bm.topic}: segment {k} (goal sent at "
@@ -137,11 +165,12 @@ def from_states(
         tuple(payloads),
         goal_payload=goal_payload,
         notes=tuple(notes),
+        early_end=early,
     )
 
 
-def _early_end_reason(refbox: StateStream | None, after_ns: int) -> str | None:
-    """``RefBox END (timeout)`` and the like, when the RefBox ended the benchmark early."""
+def _early_end(refbox: StateStream | None, after_ns: int) -> tuple[int, str] | None:
+    """(time, payload) of the RefBox END that ended the benchmark early, if any."""
     from ertools.states import RefBoxState
 
     if refbox is None or len(refbox) == 0:
@@ -154,7 +183,13 @@ def _early_end_reason(refbox: StateStream | None, after_ns: int) -> str | None:
     # A normal END (after the score) has no payload; timeout/halt end the benchmark early.
     if not any(word in payload.lower() for word in ("timeout", "halt", "stop", "abort")):
         return None
-    return f"RefBox END ({payload})"
+    return int(rb.t_ns[i]), payload
+
+
+def _early_end_reason(refbox: StateStream | None, after_ns: int) -> str | None:
+    """``RefBox END (timeout)`` and the like, when the RefBox ended the benchmark early."""
+    end = _early_end(refbox, after_ns)
+    return None if end is None else f"RefBox END ({end[1]})"
 
 
 def unreached_reasons(

@@ -10,7 +10,7 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -26,11 +26,18 @@ from ertools.benchmarks.fbm3w_runs import (
     find_windows,
     with_specs,
 )
-from ertools.benchmarks.noise import DEFAULT_C, NoiseResult, identical_poses, noise_from_stream
+from ertools.benchmarks.noise import (
+    DEFAULT_C,
+    NoiseResult,
+    frozen_around,
+    identical_poses,
+    noise_from_stream,
+)
 from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
 from ertools.configs.shapes import Shape
 from ertools.errors import ConfigError, ErtoolsError, ScoringError, TopicError
-from ertools.streams import PoseStream, Provenance
+from ertools.fidelity import Deviation, Rule
+from ertools.streams import PoseStream, Provenance, frame_change_warning
 
 log = logging.getLogger("ertools.benchmarks.fbm3w")
 
@@ -50,6 +57,102 @@ FLOOR_SAMPLES = 10_001
 FLOOR_WARN_M = 0.0005
 # A kept path this much longer than the target is suspicious (the sample's runs: 1.00-1.01).
 LONG_PATH_RATIO = 1.15
+
+_NODE = "rockin_scoring/scripts/fbm3w (2015)"
+# The catalogue rows (ertools.fidelity) of every way FBM3@Work differs from the 2015 node.
+RULE_TIMEOUT_RUNS = Rule(
+    key="fbm3w.timeout-runs",
+    benchmark="fbm3w",
+    title="timed-out runs",
+    rulebook="the RefBox ends a benchmark with END and payload timeout (seed 6.2.3); seed 7.3 "
+    "does not say how such a run is scored",
+    node_2015=(
+        f"{_NODE}: `if benchmark.Timeout(): ... execution_time = execution_time + (end_time - "
+        "start_time)` before the `not Running()` check; the final Lisbon node scored the run on "
+        "the path it had covered and it could be the best run (issue 15)"
+    ),
+    ertools=(
+        "listed with its time and no distance_error, never the best run: a partial path "
+        "compared with the whole target at l/L says nothing about following it"
+    ),
+    option="--timeout-runs 2015",
+)
+RULE_STOPPED_RUNS = Rule(
+    key="fbm3w.stopped-runs",
+    benchmark="fbm3w",
+    title="stopped runs' time",
+    rulebook="the RefBox ends a benchmark with END and payload halt/stop (seed 6.2.3)",
+    node_2015=(
+        f"{_NODE}: `if not benchmark.Running(): continue` comes before the time is added: a "
+        "stopped run was aborted, no score and no time"
+    ),
+    ertools="no score, its time counted in execution_time (the robot did spend it)",
+    option="--stopped-runs 2015",
+)
+RULE_LIVE_CLOCK = Rule(
+    key="fbm3w.live-clock",
+    benchmark="fbm3w",
+    title="reference pose and run times",
+    rulebook="reference acquired when the manual operation completes; execution time of each "
+    "run (seed 7.3.3, Listing 16)",
+    node_2015=f"{_NODE}: the live tf and the node's own wall clock at the transitions",
+    ertools=(
+        "the last logged pose at or before COMPLETED_MANUAL_OPERATION and the state messages' "
+        "record times; no option: the live tf and wall clock are not in the log"
+    ),
+    option="",
+)
+RULE_RUN_FINDING = Rule(
+    key="fbm3w.run-finding",
+    benchmark="fbm3w",
+    title="finding the runs",
+    rulebook="the BmBox state machine delimits each run (seed 7.3.3)",
+    node_2015=f"{_NODE}: its state machine only",
+    ertools=(
+        "the BmBox states when logged; also explicit windows (--run) or motion (--runs auto) "
+        "for bags without them"
+    ),
+    option="--runs states",
+)
+RULE_POSE_TOPIC = Rule(
+    key="fbm3w.pose-topic",
+    benchmark="fbm3w",
+    title="pose source",
+    rulebook="the end effector's marker set from the mocap (seed 7.3.3)",
+    node_2015=f"{_NODE}: subscribed to {DEFAULT_TOPIC}",
+    ertools=f"{DEFAULT_TOPIC}, else {FALLBACK_TOPIC}, else the tf frame {DEFAULT_FRAME}",
+    option=f"--topic {DEFAULT_TOPIC}",
+)
+RULE_D_MIN = Rule(
+    key="fbm3w.d-min",
+    benchmark="fbm3w",
+    title="subsampling threshold d_min",
+    rulebook="d_min = c * epsilon, c chosen experimentally (seed 7.3.2, 7.3.5)",
+    node_2015=f"{_NODE}: `D_MIN` hard-coded (0.00033 m in the seed)",
+    ertools="the config's d_min (default 0.00033 m), warned when below the bag's own noise",
+    option="--d-min 0.00033",
+)
+RULE_USER_SHAPES = Rule(
+    key="fbm3w.user-shapes",
+    benchmark="fbm3w",
+    title="target shapes",
+    rulebook="mathematically defined curves hard-coded in the script (seed 7.3.7, Listing 15)",
+    node_2015=f"{_NODE}: line_path, semi_ellipse, sine (= spline_path) only",
+    ertools="the built-in shapes plus user shapes from the config; no option: a user shape is "
+    "the user's choice, said in the output",
+    option="",
+)
+RULE_ARC_LENGTH = Rule(
+    key="fbm3w.arc-length",
+    benchmark="fbm3w",
+    title="target parameter",
+    rulebook="t(l) with l the normalised length (seed 7.3.1)",
+    node_2015=f"{_NODE}: each shape evaluated at its own parameter (the sine's is not its "
+    "length: 8.36 mm for a robot exactly on it)",
+    ertools="the same by default (shape_floor reported); --arc-length compares at equal "
+    "fractions of the target's arc length instead, on request only",
+    option="",
+)
 
 Window = tuple[str, float, float, float]
 F64 = npt.NDArray[np.float64]
@@ -71,6 +174,11 @@ class Fbm3wOptions:
         noise_c: factor of the suggested d_min (c * epsilon).
         arc_length: compare at equal fractions of the target's arc length instead of the
             shape's own parameter (2015); removes the floor of shapes such as ``sine``.
+        timeout_runs: ``unscored`` (default: a run the RefBox timed out is listed without a
+            distance_error) or ``2015`` (scored on the path it covered and eligible as best
+            run, as the 2015 node did).
+        stopped_runs: ``counted`` (default: a run the RefBox stopped counts in
+            execution_time) or ``2015`` (its time left out, as the 2015 node did).
     """
 
     runs: str | None = None
@@ -84,6 +192,31 @@ class Fbm3wOptions:
     min_still_s: float | None = None
     noise_c: float = DEFAULT_C
     arc_length: bool = False
+    timeout_runs: str = "unscored"
+    stopped_runs: str = "counted"
+
+
+TIMEOUT_RUNS = ("unscored", "2015")
+STOPPED_RUNS = ("counted", "2015")
+
+
+def options_2015(options: Fbm3wOptions) -> Fbm3wOptions:
+    """``options`` with every FBM3W 2015 behaviour on (``--2015``).
+
+    Timed-out runs scored and eligible, stopped runs' time left out, the shapes at their own
+    parameter, and the script's hard-coded D_MIN unless ``--d-min`` says otherwise.
+
+    Raises:
+        ConfigError: ``--arc-length`` asked for as well (it is not 2015).
+    """
+    if options.arc_length:
+        raise ConfigError("--2015 and --arc-length contradict each other (2015 had no arc length)")
+    return replace(
+        options,
+        timeout_runs="2015",
+        stopped_runs="2015",
+        d_min=DEFAULT_D_MIN if options.d_min is None else options.d_min,
+    )
 
 
 def read_fbm3w_poses(paths: Sequence[Path], options: Fbm3wOptions) -> PoseStream:
@@ -109,8 +242,9 @@ def read_fbm3w_poses(paths: Sequence[Path], options: Fbm3wOptions) -> PoseStream
             log.warning("%s absent; using the /tf frame %s", DEFAULT_TOPIC, DEFAULT_FRAME)
             source = PoseSource(frame=DEFAULT_FRAME)
         else:
-            pose_types = ("Pose2D", "PoseStamped", "TransformStamped", "Odometry", "TFMessage")
-            found = [t for t, ty in present.items() if ty.rsplit("/", 1)[-1] in pose_types]
+            from ertools.io.model import POSE_TYPES
+
+            found = [t for t, ty in present.items() if ty in POSE_TYPES]
             raise TopicError(
                 f"no end-effector poses: {DEFAULT_TOPIC}, {FALLBACK_TOPIC} and /tf are absent "
                 f"(pose topics there: {', '.join(found) or 'none'}); choose one with --topic",
@@ -136,6 +270,11 @@ def score_fbm3w(
     plist = [Path(p) for p in paths]
     if options.runs is not None and options.runs not in RUN_MODES:
         raise ConfigError(f"--runs must be one of {', '.join(RUN_MODES)}, not {options.runs!r}")
+    if options.timeout_runs not in TIMEOUT_RUNS or options.stopped_runs not in STOPPED_RUNS:
+        raise ConfigError(
+            f"--timeout-runs must be one of {', '.join(TIMEOUT_RUNS)} and --stopped-runs one "
+            f"of {', '.join(STOPPED_RUNS)}"
+        )
     poses = read_fbm3w_poses(plist, options)
     summaries = [summary(p) for p in plist]
     bag_start = min(x.start_ns for x in summaries)
@@ -209,6 +348,9 @@ def score_runs(
         )
     noise = _noise(poses, options, warnings)
     same = identical_poses(poses)
+    frames = frame_change_warning(poses, start_ns)
+    if frames:
+        warnings.append(frames)
     results: list[RunResult] = []
     failures: list[str] = []
     for window in runs_in:
@@ -225,6 +367,7 @@ def score_runs(
             f"suggested d_min {noise.suggested_d_min:.5f} m ({noise.c:g} * epsilon); see "
             "--d-min-sweep"
         )
+    warnings.extend(_frozen_warnings(poses, runs_in, start_ns))
     mode = runs_in[0].mode if runs_in else (options.runs or "states")
     return Fbm3wResult(
         runs=tuple(results),
@@ -241,9 +384,40 @@ def score_runs(
                 ("d_min", repr(cfg.d_min)),
                 ("runs", mode),
                 ("poses", poses.source),
+                ("timeout_runs", options.timeout_runs),
+                ("stopped_runs", options.stopped_runs),
             ),
         ),
+        count_stopped=options.stopped_runs != "2015",
     )
+
+
+def _frozen_warnings(poses: PoseStream, runs: Sequence[RunWindow], origin_ns: int) -> list[str]:
+    """A warning per run whose reference, start or end pose is a frozen (repeated) pose.
+
+    The reference and starting positions set the run frame: a pose repeated for longer than
+    :data:`~ertools.benchmarks.noise.FROZEN_MIN_S` there is the last pose before a tracking
+    loss, not where the marker set was.
+    """
+    moments: list[tuple[int, str, int]] = []
+    for w in runs:
+        for what, t in (("reference", w.ref_ns), ("start", w.start_ns), ("end", w.end_ns)):
+            if t is not None:
+                moments.append((w.index, what, t))
+    if not moments:
+        return []
+    spans = frozen_around(poses, [m[2] for m in moments])
+    out = []
+    for (index, what, t), span in zip(moments, spans, strict=True):
+        if span is None:
+            continue
+        out.append(
+            f"run {index}: the pose at its {what} time {(t - origin_ns) / 1e9:.3f} s is frozen: "
+            f"{span.samples} identical poses over {span.duration_s:.3f} s "
+            f"({(span.start_ns - origin_ns) / 1e9:.3f}-{(span.end_ns - origin_ns) / 1e9:.3f} s "
+            "from the log's first message; tracking lost, or a noiseless recording)"
+        )
+    return out
 
 
 def _noise(poses: PoseStream, options: Fbm3wOptions, warnings: list[str]) -> NoiseResult | None:
@@ -299,8 +473,9 @@ def _score_one(
     if options.arc_length:
         shape = shape.by_arc_length()
     target_length = shape.length()
-    if window.status in ("interrupted", "timeout", "stopped"):
-        return result(None, target_length=target_length)  # reported, not scored (as 2015)
+    partial = window.status == "timeout" and options.timeout_runs == "2015"
+    if window.status in ("interrupted", "timeout", "stopped") and not partial:
+        return result(None, target_length=target_length)  # reported, not scored
     if window.status == "incomplete":
         return result("the log ends during the run; no complete path to score")
     if window.start_ns is None or window.end_ns is None or window.ref_ns is None:
@@ -342,6 +517,12 @@ def _score_one(
         warnings.append(
             f"run {window.index}: the reference and starting positions are only "
             f"{baseline * 1000:.1f} mm apart; the run frame's direction is uncertain"
+        )
+    if partial:
+        warnings.append(
+            f"run {window.index} was ended by a RefBox timeout: scored on the "
+            f"{score.path_length:.4f} m of path it covered (target {target_length:.4f} m), "
+            "normalised by its own length, and eligible as best run (--timeout-runs 2015)"
         )
     ratio = score.path_length / target_length
     if ratio > LONG_PATH_RATIO:
@@ -397,35 +578,69 @@ def _deviations(
     mode: str,
     poses: PoseStream,
     options: Fbm3wOptions,
-) -> list[str]:
+) -> list[Deviation]:
     out = []
     if mode == "states":
         out.append(
-            "reference = last logged pose at or before COMPLETED_MANUAL_OPERATION and "
-            "execution_time from the BmBox state messages' record times; 2015 read the live tf "
-            "and its own wall clock at the same transitions"
+            RULE_LIVE_CLOCK.deviation(
+                "reference = last logged pose at or before COMPLETED_MANUAL_OPERATION and "
+                "execution_time from the BmBox state messages' record times; 2015 read the live "
+                "tf and its own wall clock at the same transitions"
+            )
         )
     elif mode == "windows":
-        out.append("runs from explicit windows; the 2015 node only had its state machine")
+        out.append(
+            RULE_RUN_FINDING.deviation(
+                "runs from explicit windows; the 2015 node only had its state machine"
+            )
+        )
     else:
-        out.append("runs found from motion (--runs auto); the 2015 node only had its state machine")
+        out.append(
+            RULE_RUN_FINDING.deviation(
+                "runs found from motion (--runs auto); the 2015 node only had its state machine"
+            )
+        )
     if not poses.source.endswith(DEFAULT_TOPIC):
-        out.append(f"poses from {poses.source.rsplit(':', 1)[-1]}; 2015 used {DEFAULT_TOPIC}")
+        out.append(
+            RULE_POSE_TOPIC.deviation(
+                f"poses from {poses.source.rsplit(':', 1)[-1]}; 2015 used {DEFAULT_TOPIC}"
+            )
+        )
     if not math.isclose(cfg.d_min, DEFAULT_D_MIN, rel_tol=0, abs_tol=1e-12):
-        out.append(f"d_min = {cfg.d_min} m; the 2015 script used {DEFAULT_D_MIN} m")
+        out.append(
+            RULE_D_MIN.deviation(f"d_min = {cfg.d_min} m; the 2015 script used {DEFAULT_D_MIN} m")
+        )
     custom = sorted(
         {r.spec for r in runs if r.spec in cfg.shapes and not cfg.shapes[r.spec].builtin}
     )
     if custom:
-        out.append(f"user-defined shape(s) {', '.join(custom)}; 2015 had only its built-in shapes")
+        out.append(
+            RULE_USER_SHAPES.deviation(
+                f"user-defined shape(s) {', '.join(custom)}; 2015 had only its built-in shapes"
+            )
+        )
     if options.arc_length:
         out.append(
-            "targets compared at equal fractions of their arc length (--arc-length); 2015 "
-            "evaluated each shape at its own parameter"
+            RULE_ARC_LENGTH.deviation(
+                "targets compared at equal fractions of their arc length (--arc-length); 2015 "
+                "evaluated each shape at its own parameter"
+            )
         )
-    if any(r.window.status in ("timeout", "stopped") for r in runs):
+    timed_out = [str(r.index) for r in runs if r.window.status == "timeout"]
+    if options.timeout_runs != "2015" and timed_out:
         out.append(
-            "a timed-out or stopped run is listed with its spec and time and no distance_error; "
-            "the 2015 node counted its time and wrote no details for it"
+            RULE_TIMEOUT_RUNS.deviation(
+                f"a run the RefBox timed out (run {', '.join(timed_out)}) is listed with its "
+                "time and no distance_error and cannot be the best run; the 2015 node scored it "
+                "on the path it had covered and it could be the best run"
+            )
+        )
+    stopped = [str(r.index) for r in runs if r.window.status == "stopped"]
+    if options.stopped_runs != "2015" and stopped:
+        out.append(
+            RULE_STOPPED_RUNS.deviation(
+                f"a run the RefBox stopped (run {', '.join(stopped)}) counts in execution_time; "
+                "the 2015 node treated it as aborted and left its time out"
+            )
         )
     return out

@@ -10,6 +10,7 @@ from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.benchmarks.fbm3w_path import PathScore
 from ertools.benchmarks.fbm3w_runs import RunWindow
 from ertools.benchmarks.noise import NoiseResult
+from ertools.fidelity import Deviation
 from ertools.streams import Provenance
 
 # Listing 16 keys of one run, in the listing's order; ertools' extra keys follow them.
@@ -62,7 +63,10 @@ class RunResult:
     def status(self) -> str:
         if self.error is not None:
             return "failed"
-        return "scored" if self.score is not None else self.window.status
+        if self.score is not None:
+            # --timeout-runs 2015 scores a timed-out run on its partial path: say so.
+            return "timeout_scored" if self.window.status == "timeout" else "scored"
+        return self.window.status
 
     @property
     def distance_error(self) -> float | None:
@@ -119,9 +123,10 @@ class Fbm3wResult:
     sweep_values: tuple[float, ...] = ()
     name: str = "fbm3w"
     warnings: tuple[str, ...] = ()
-    deviations: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
+    count_stopped: bool = True
 
     @property
     def best_run(self) -> int | None:
@@ -144,8 +149,19 @@ class Fbm3wResult:
 
     @property
     def execution_time(self) -> float:
-        """Sum of the run times, timed-out runs included (as the 2015 node added them)."""
-        return float(sum(r.execution_time for r in self.runs if r.execution_time is not None))
+        """Sum of the run times, timed-out runs included (as the 2015 node added them).
+
+        Stopped runs are included unless ``count_stopped`` is False (``--stopped-runs 2015``:
+        the 2015 node skipped them before adding the time).
+        """
+        return float(
+            sum(
+                r.execution_time
+                for r in self.runs
+                if r.execution_time is not None
+                and (self.count_stopped or r.window.status != "stopped")
+            )
+        )
 
     def _score(self) -> dict[str, Any]:
         return {

@@ -38,7 +38,7 @@ from ertools.geometry import (
     wrap_angle,
     yaw_from_quat,
 )
-from ertools.streams import PoseStream, Provenance
+from ertools.streams import PoseStream, Provenance, frame_change_warning
 from ertools.timeutil import NS_PER_S, iso_utc, ns_to_s
 
 if TYPE_CHECKING:
@@ -745,8 +745,9 @@ def score_streams(
     if len(gt) < 2:
         raise ScoringError(f"GT {gt_topic}: {len(gt)} pose(s) in the robot log's span")
     check_increasing(robot, where)
-    gt, dropped = drop_duplicates(gt)
     notes = list(warnings)
+    notes.extend(w for w in (frame_change_warning(gt), frame_change_warning(robot)) if w)
+    gt, dropped = drop_duplicates(gt)
     invalid: list[Deviation] = []
     if dropped:
         notes.append(f"{dropped} GT sample(s) recorded twice (overlapping GT files) were used once")
@@ -994,7 +995,7 @@ def _pick_robot_topic(s: BagSummary, topic: str | None) -> str:
 def read_robot(path: str, topic: str, time_source: str) -> PoseStream:
     """The robot's poses in recording order (not sorted: non-increasing stamps are errors)."""
     from ertools.io.files import open_bag
-    from ertools.io.model import POSE_TYPES
+    from ertools.io.model import POSE_TYPES, TF_TYPES
     from ertools.io.reader import load_pose_batch
 
     with open_bag(path) as bag:
@@ -1003,16 +1004,32 @@ def read_robot(path: str, topic: str, time_source: str) -> PoseStream:
         if not types or not types <= set(POSE_TYPES):
             raise TopicError(
                 f"robot topic {topic} has type {', '.join(sorted(types)) or 'unknown'}, "
-                "not a pose type (geometry_msgs/PoseStamped expected)",
+                f"not a pose type ({', '.join(POSE_TYPES)})",
                 path=path,
             )
-        if types != {"geometry_msgs/PoseStamped"} and time_source == "header":
+        if "geometry_msgs/Pose2D" in types and time_source == "header":
             raise TopicError(
-                f"robot topic {topic} has type {', '.join(sorted(types))}; "
-                "a geometry_msgs/PoseStamped topic is needed (or --robot-time record)",
+                f"robot topic {topic} has type geometry_msgs/Pose2D, which has no header "
+                "stamp; give --robot-time record",
                 path=path,
             )
         batch = load_pose_batch(bag, conns, None, None)
+    if (
+        types & set(TF_TYPES)
+        and len(batch)
+        and (
+            np.any(batch.child_idx != batch.child_idx[0])
+            or np.any(batch.frame_idx != batch.frame_idx[0])
+        )
+    ):
+        # A tf topic with several transforms: rows of different bodies, not one trajectory.
+        names = zip(batch.frame_names(), batch.child_names(), strict=True)
+        pairs = sorted({f"{a} -> {b}" for a, b in names})
+        raise TopicError(
+            f"robot topic {topic} holds the poses of several frames ({', '.join(pairs[:4])}"
+            f"{' ...' if len(pairs) > 4 else ''}); give a topic with one body's poses",
+            path=path,
+        )
     t = batch.t_header if time_source == "header" else batch.t_record
     return PoseStream(t, batch.xyz, batch.quat_xyzw, source=f"{path}:{topic}")
 

@@ -88,8 +88,10 @@ def table(info: BagInfo) -> str:
         f"index:       {s.index}",
         f"messages:    {s.message_count}",
     ]
-    if info.checked:
+    if info.checked and not info.check_problems:
         lines.append("check:       every chunk decompressed and every indexed record found")
+    for problem in info.check_problems:
+        lines.append(f"check:       {problem}")
     for problem in s.problems:
         lines.append(f"problem:     {problem}")
     rows = [
@@ -157,6 +159,8 @@ def run(args: argparse.Namespace) -> int:
         elif not info.summary.indexed and info.summary.problems:
             # a complete file read record by record (an MCAP without summary) is no warning
             note(f"warning: {path}: not indexed (still recording?); counts come from a scan")
+        # each disagreement --check found is a line of its own
+        problems.extend({"path": str(path), "problem": _one_line(p)} for p in info.check_problems)
     if args.format == "table":
         text = "\n\n".join(table(i) for i in infos)
     else:

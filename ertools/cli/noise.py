@@ -66,8 +66,9 @@ def _poses(args: argparse.Namespace) -> PoseStream:
     present = topics(args.bags)
     if "/fbm3w/robot_at_work/pose2d" in present or "/fbm3w/robot_at_work/pose" in present:
         return read_fbm3w_poses(args.bags, opts)
-    kinds = ("Pose2D", "PoseStamped", "TransformStamped", "Odometry")
-    found = [t for t, ty in present.items() if ty.rsplit("/", 1)[-1] in kinds]
+    from ertools.io.model import POSE_TYPES, TF_TYPES
+
+    found = [t for t, ty in present.items() if ty in POSE_TYPES and ty not in TF_TYPES]
     if len(found) == 1:
         note(f"using the only pose topic {found[0]}")
         return read_poses(args.bags, found[0])

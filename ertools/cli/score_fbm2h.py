@@ -27,7 +27,9 @@ EPILOG = """examples:
 BmBox has sent the goal and ends at the Client's COMPLETED_GOAL; timing FILE: a reached-waypoint
 timing file (p0 starts, p(k+1) closes segment k, seconds from the bag's first message); auto:
 stops detected in the ground truth, assigned to the waypoints in order.
-Orientation errors are wrapped to [0, pi]; --orientation-2015 reproduces the 2015 numbers."""
+Orientation errors are wrapped to [0, pi]; --orientation-2015 reproduces the 2015 numbers.
+Accuracies are null (exit 1) when a segment is not scored; --unscored-segments 2015 divides
+the sum over the scored segments by N as 2015 did. --2015: every 2015 behaviour at once."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -47,7 +49,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--topic",
         metavar="TOPIC",
-        help="marker set pose topic, PoseStamped or Pose2D (default /fbm2h/robot_at_home/pose)",
+        help="marker set pose topic, any pose type (default /fbm2h/robot_at_home/pose)",
     )
     parser.add_argument(
         "--tf-frame",
@@ -76,10 +78,25 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="a reached moment needs a GT sample within S seconds (default 0.1)",
     )
     parser.add_argument("--hits", type=int, metavar="N", help="the referee's count of hits")
-    parser.add_argument(
+    legacy = parser.add_argument_group("2015 behaviour (each difference can be undone)")
+    legacy.add_argument(
         "--orientation-2015",
         action="store_true",
         help="orientation errors as 2015 computed them (unwrapped |dtheta|; wrong across +-pi)",
+    )
+    legacy.add_argument(
+        "--unscored-segments",
+        choices=("null", "2015"),
+        default="null",
+        help="segments not scored (RefBox timeout, never reached): null accuracies and exit 1 "
+        "(default), or 2015: sums over the scored segments divided by N, the timed-out "
+        "segment's time counted",
+    )
+    legacy.add_argument(
+        "--2015",
+        dest="all_2015",
+        action="store_true",
+        help="every 2015 behaviour above (--orientation-2015 --unscored-segments 2015)",
     )
     parser.add_argument(
         "--namespace", default="fbm2h", help="benchmark namespace of the state topics"
@@ -152,7 +169,8 @@ def run(args: argparse.Namespace) -> int:
         timing=timing,
         max_gap_s=args.max_gap,
         hits=args.hits,
-        orientation_2015=args.orientation_2015,
+        orientation_2015=args.orientation_2015 or args.all_2015,
+        unscored_2015=args.unscored_segments == "2015" or args.all_2015,
         namespace=args.namespace,
         stops=StopParams(
             speed=args.stop_speed,
@@ -178,6 +196,15 @@ def _print_table(result: object) -> None:
         f"reached moments: {result.reached_method}; transform: {result.transform.source}; "
         "times from the log's first message"
     )
+    n = len(result.segments)
+    scored = sum(s.status == "ok" for s in result.segments)
+    if result.position_accuracy is None:
+        averaged = "none (a segment is not scored: see the warnings)"
+    elif result.unscored_2015:
+        averaged = f"sum over the {scored} scored segment(s) / N = {n} (2015)"
+    else:
+        averaged = f"mean over all {n} segments"
+    note(f"accuracies: {averaged}")
     for row in result.tables()["segments"]:
         values = ("reached_s", "segment_time_s", "distance_error_m", "orientation_error_rad")
         if row["status"] != "ok" or any(row[k] is None for k in values):

@@ -83,6 +83,28 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="compare at equal fractions of the target's arc length (not 2015)",
     )
+    legacy = parser.add_argument_group("2015 behaviour (each difference can be undone)")
+    legacy.add_argument(
+        "--timeout-runs",
+        choices=("unscored", "2015"),
+        default="unscored",
+        help="a run the RefBox timed out: listed without distance_error (default), or 2015: "
+        "scored on the path it covered and eligible as best run",
+    )
+    legacy.add_argument(
+        "--stopped-runs",
+        choices=("counted", "2015"),
+        default="counted",
+        help="a run the RefBox stopped: its time counted in execution_time (default), or "
+        "2015: left out",
+    )
+    legacy.add_argument(
+        "--2015",
+        dest="all_2015",
+        action="store_true",
+        help="every 2015 behaviour: --timeout-runs 2015 --stopped-runs 2015, d_min 0.00033 "
+        "unless --d-min is given, no --arc-length",
+    )
     parser.add_argument(
         "--still-speed",
         type=float,
@@ -122,7 +144,7 @@ def parse_sweep(text: str) -> tuple[float, ...]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.benchmarks.fbm3w import Fbm3wOptions, score_fbm3w
+    from ertools.benchmarks.fbm3w import Fbm3wOptions, options_2015, score_fbm3w
     from ertools.benchmarks.fbm3w_runs import parse_run_spec, parse_runs_file
     from ertools.configs._yaml import load_yaml
     from ertools.configs.fbm3w import check_d_min, load_fbm3w_config
@@ -151,7 +173,15 @@ def run(args: argparse.Namespace) -> int:
         still_speed=args.still_speed,
         min_still_s=args.still_min,
         arc_length=args.arc_length,
+        timeout_runs=args.timeout_runs,
+        stopped_runs=args.stopped_runs,
     )
+    if args.all_2015:
+        if args.arc_length:
+            raise UsageError(
+                "--2015 and --arc-length contradict each other (2015 had no arc length)"
+            )
+        options = options_2015(options)
     result = score_fbm3w(args.bags, config, options)
     for r in result.runs:
         if r.window.mode == "auto":

@@ -19,7 +19,8 @@ if TYPE_CHECKING:
 EPILOG = """examples:
   ertools timeline bags/                         # table of every bag under bags/
   ertools timeline gt/ robots/ --format json > timeline.json
-  ertools timeline bags/ --plot timeline.png     # Gantt chart, one lane per logger
+  ertools timeline bags/ --plot day.html         # interactive page: zoom, sessions, problems
+  ertools timeline bags/ --plot day.png          # one panel per session, problems numbered
   ertools timeline bags/ --clock-tolerance 0.2 --format csv -o timeline.csv
 
 JSON layout: {"bags": [{"path", "format", "start", "end", "duration", "kind", "benchmarks",
@@ -48,7 +49,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("-o", "--output", type=Path, help="write the output to this file")
     parser.add_argument(
-        "--plot", type=Path, metavar="FILE", help="write a Gantt chart (FILE.png or FILE.svg)"
+        "--plot",
+        type=Path,
+        action="append",
+        metavar="FILE",
+        help="write a picture, by suffix: .html an interactive page (zoom, sessions, problems "
+        "on hover), .png/.svg one panel per session; repeat for several",
     )
     parser.add_argument(
         "--clock-tolerance",
@@ -77,10 +83,12 @@ def run(args: argparse.Namespace) -> int:
     from ertools.timeline_scan import scan
     from ertools.timeutil import s_to_ns
 
-    if args.plot is not None and args.plot.suffix.lower() not in (".png", ".svg"):
-        from ertools.errors import UsageError
+    plots: list[Path] = args.plot or []
+    for plot in plots:  # refused before the scan, not after minutes of reading
+        if plot.suffix.lower() not in (".png", ".svg", ".html", ".htm"):
+            from ertools.errors import UsageError
 
-        raise UsageError(f"--plot {args.plot}: give a .png or .svg file name")
+            raise UsageError(f"--plot {plot}: give a .png, .svg or .html file name")
     config = TimelineConfig(
         clock_tolerance_ns=s_to_ns(args.clock_tolerance),
         gap_tolerance_ns=s_to_ns(args.gap_tolerance),
@@ -95,10 +103,11 @@ def run(args: argparse.Namespace) -> int:
     else:
         color = args.output is None and sys.stdout.isatty()
         write_text(to_table(timeline, color=color), args.output)
-    if args.plot is not None and timeline.readable_count > 0:  # no empty chart on failure
-        from ertools.report.plots_timeline import save_gantt
+    if plots and timeline.readable_count > 0:  # no empty chart on failure
+        from ertools.report.plots_timeline import save_timeline_plot
 
-        note(f"wrote {save_gantt(timeline, args.plot)}")
+        for plot in plots:
+            note(f"wrote {save_timeline_plot(timeline, plot)}")
     if timeline.readable_count == 0:
         where = ", ".join(map(str, args.paths))
         # Say why on the one error line: the reasons are otherwise only in the table on stdout.

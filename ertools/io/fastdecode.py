@@ -5,9 +5,10 @@ each field is read for all messages at once: fixed-size parts with strided gathe
 length strings (``frame_id``, ``child_frame_id``) by reading their length fields vectorised
 and moving every message's cursor by its own length. There is no Python loop over messages.
 
-Handled: ``geometry_msgs/PoseStamped``, ``Pose2D``, ``TransformStamped``, ``nav_msgs/Odometry``
-and ``tf/tfMessage`` / ``tf2_msgs/TFMessage`` (any number of transforms per message), in ROS1
-encoding and in little-endian CDR (ROS 2, with its alignment rules). A message whose length
+Handled: ``geometry_msgs/PoseStamped``, ``Pose2D``, ``TransformStamped``,
+``PoseWithCovarianceStamped``, ``nav_msgs/Odometry`` and ``tf/tfMessage`` /
+``tf2_msgs/TFMessage`` (any number of transforms per message), in ROS1 encoding and in
+little-endian CDR (ROS 2, with its alignment rules). A message whose length
 disagrees with the layout (a non-standard definition under a standard name) makes the decoder
 give up, and the caller falls back to rosbags' deserializer.
 """
@@ -31,6 +32,7 @@ FAST_TYPES = (
     "geometry_msgs/PoseStamped",
     "geometry_msgs/Pose2D",
     "geometry_msgs/TransformStamped",
+    "geometry_msgs/PoseWithCovarianceStamped",
     "nav_msgs/Odometry",
     "tf/tfMessage",
     "tf2_msgs/TFMessage",
@@ -206,6 +208,11 @@ def decode(msgtype: str, cdr: bool, buf: U8, start: I64, length: I64) -> Decoded
     if msgtype == "geometry_msgs/PoseStamped":
         t, frame = _header(cur)
         v = cur.f64(7)
+        result = Decoded(idx, t, v[:, :3], v[:, 3:], frame, None)
+    elif msgtype == "geometry_msgs/PoseWithCovarianceStamped":
+        t, frame = _header(cur)
+        v = cur.f64(7)
+        cur.skip_f64(36)  # pose covariance
         result = Decoded(idx, t, v[:, :3], v[:, 3:], frame, None)
     elif msgtype == "geometry_msgs/Pose2D":
         v = cur.f64(3)

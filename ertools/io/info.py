@@ -28,6 +28,8 @@ class BagInfo:
     summary: BagSummary
     median_rate_hz: dict[str, float | None]
     checked: bool = False
+    # What --check found (index against records, damaged chunks), one line each.
+    check_problems: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         s = self.summary
@@ -47,7 +49,7 @@ class BagInfo:
             "indexed": s.indexed,
             "index": s.index,
             "checked": self.checked,
-            "problems": list(s.problems),
+            "problems": [*s.problems, *self.check_problems],
             "topics": [
                 {
                     "name": t.name,
@@ -119,13 +121,16 @@ def describe(path: str | Path, *, check: bool = False) -> BagInfo:
 
     s, times = summary_and_times(path)
     rates = {name: median_rate(t) for name, t in times.items()}
-    if check:
-        verify(Path(path))
-    return BagInfo(s, rates, check)
+    found = verify(Path(path)) if check else []
+    return BagInfo(s, rates, check, tuple(found))
 
 
-def verify(path: Path) -> None:
+def verify(path: Path) -> list[str]:
     """Read every chunk and check every indexed message record.
+
+    Returns:
+        For ROS1 bags, every disagreement between the index and the records, one line each
+        (:mod:`ertools.io.ros1_check`); other formats raise at the first damage.
 
     Raises:
         BagError: naming the file and the byte offset of the first damaged chunk.
@@ -133,7 +138,11 @@ def verify(path: Path) -> None:
     from ertools.io.formats import detect_format
 
     fmt = detect_format(path)
-    if fmt in ("ros1", "ros1-active"):
+    if fmt == "ros1":
+        from ertools.io.ros1_check import check_ros1
+
+        return check_ros1(path)
+    if fmt == "ros1-active":
         from ertools.io.ros1_index import Ros1Bag
 
         bag = Ros1Bag(path)
@@ -153,3 +162,4 @@ def verify(path: Path) -> None:
             result = query(db, "PRAGMA quick_check")[0][0]
             if result != "ok":
                 raise BagError(f"sqlite3 storage fails its integrity check ({result})", path=db)
+    return []

@@ -14,6 +14,7 @@ POSE_TYPES = (
     "geometry_msgs/PoseStamped",
     "geometry_msgs/Pose2D",
     "geometry_msgs/TransformStamped",
+    "geometry_msgs/PoseWithCovarianceStamped",
     "nav_msgs/Odometry",
     "tf/tfMessage",
     "tf2_msgs/TFMessage",
@@ -89,7 +90,8 @@ class PoseSource:
     """Where a pose stream comes from: a pose topic, or a tf frame.
 
     Attributes:
-        topic: a pose topic (PoseStamped, Pose2D, TransformStamped, Odometry); None to use tf.
+        topic: a pose topic (PoseStamped, Pose2D, TransformStamped, PoseWithCovarianceStamped,
+            Odometry); None to use tf.
         frame: the tf child frame when ``topic`` is None (or ``/tf``).
         parent: the tf parent frame (default ``world``, the mocap frame).
         time_source: ``header`` (message stamp) or ``record`` (bag record time).
@@ -146,9 +148,15 @@ class Conn:
 
 
 def short_msgtype(msgtype: str) -> str:
-    """``geometry_msgs/msg/PoseStamped`` -> ``geometry_msgs/PoseStamped``."""
+    """``geometry_msgs/msg/PoseStamped`` -> ``geometry_msgs/PoseStamped``.
+
+    Only ``msg`` is dropped: rosbag2's service events (``pkg/srv/Name_Event``) and action
+    topics (``pkg/action/Name_FeedbackMessage``) keep their kind, which is part of the name
+    (a ``pkg/Name_Event`` message type is another type, and the definitions are looked up
+    by the full name).
+    """
     parts = msgtype.split("/")
-    if len(parts) == 3 and parts[1] in ("msg", "srv", "action"):
+    if len(parts) == 3 and parts[1] == "msg":
         return f"{parts[0]}/{parts[2]}"
     return msgtype
 

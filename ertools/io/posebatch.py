@@ -23,6 +23,7 @@ F64 = npt.NDArray[np.float64]
 STAMPED_TYPES = (
     "geometry_msgs/PoseStamped",
     "geometry_msgs/TransformStamped",
+    "geometry_msgs/PoseWithCovarianceStamped",
     "nav_msgs/Odometry",
     "tf/tfMessage",
     "tf2_msgs/TFMessage",
@@ -147,6 +148,9 @@ def batch_from_messages(msgtype: str, records: Sequence[tuple[int, Any]]) -> Pos
         elif kind == "nav_msgs/Odometry":
             p, q = msg.pose.pose.position, msg.pose.pose.orientation
             entries = [(msg.header, msg.child_frame_id, p, q)]
+        elif kind == "geometry_msgs/PoseWithCovarianceStamped":
+            p, q = msg.pose.pose.position, msg.pose.pose.orientation
+            entries = [(msg.header, "", p, q)]
         elif kind in ("tf/tfMessage", "tf2_msgs/TFMessage"):
             entries = [
                 (x.header, x.child_frame_id, x.transform.translation, x.transform.rotation)

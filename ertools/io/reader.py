@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from ertools.errors import TopicError
 from ertools.io.files import BagFile, open_bag
@@ -30,7 +31,7 @@ from ertools.io.posebatch import PoseBatch, batch_from_messages, concat_batches
 from ertools.io.tf import Edge, chain_pose, frame_key
 from ertools.io.typestore import Deserializer
 from ertools.states import MSG_TYPES, STATE_TOPIC_SUFFIXES
-from ertools.streams import Machine, PoseStream, StateStream
+from ertools.streams import MAX_FRAME_CHANGES, FrameChange, Machine, PoseStream, StateStream
 
 log = logging.getLogger("ertools.io.reader")
 
@@ -128,7 +129,9 @@ def _batch_to_stream(batch: PoseBatch, msgtype: str, time_source: str, source: s
     fi, ci = batch.frame_idx, batch.child_idx
     frame = batch.frames[fi[0]] if len(fi) else ""
     child = batch.frames[ci[0]] if len(ci) else ""
+    changes: tuple[FrameChange, ...] = ()
     if len(fi) and (np.any(fi != fi[0]) or np.any(ci != ci[0])):
+        changes = _frame_changes(batch, t)
         used = {batch.frames[i] for i in np.unique(np.concatenate([fi, ci]))}
         log.warning(
             "%s: frame ids change within the topic (%s); using the first, %r -> %r",
@@ -137,7 +140,25 @@ def _batch_to_stream(batch: PoseBatch, msgtype: str, time_source: str, source: s
             frame,
             child,
         )
-    return PoseStream(t, batch.xyz, batch.quat_xyzw, frame, child, source)
+    return PoseStream(t, batch.xyz, batch.quat_xyzw, frame, child, source, changes)
+
+
+def _frame_changes(batch: PoseBatch, t: npt.NDArray[np.int64]) -> tuple[FrameChange, ...]:
+    """Where the frame names change, in time order (only called when they do change)."""
+    order = np.argsort(t, kind="stable")
+    ts = t[order]
+    out: list[FrameChange] = []
+    for name, codes in (
+        ("frame_id", batch.frame_idx[order]),
+        ("child_frame_id", batch.child_idx[order]),
+    ):
+        at = np.flatnonzero(codes[1:] != codes[:-1])[:MAX_FRAME_CHANGES] + 1
+        out.extend(
+            FrameChange(int(ts[k]), name, batch.frames[codes[k - 1]], batch.frames[codes[k]])
+            for k in at.tolist()
+        )
+    out.sort(key=lambda c: c.t_ns)
+    return tuple(out[:MAX_FRAME_CHANGES])
 
 
 def read_poses(
@@ -152,8 +173,8 @@ def read_poses(
 
     Args:
         paths: one bag or a logger's split files.
-        topic: a ``PoseStamped``, ``Pose2D``, ``TransformStamped``, ``Odometry`` or single-child
-            TF topic.
+        topic: a ``PoseStamped``, ``Pose2D``, ``TransformStamped``,
+            ``PoseWithCovarianceStamped``, ``Odometry`` or single-child TF topic.
         time_source: ``header`` (message stamp, default) or ``record`` (bag record time).
             ``Pose2D`` has no header and always uses the record time.
         start_ns, end_ns: keep samples with start_ns <= t <= end_ns (t as chosen above).

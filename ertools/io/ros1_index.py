@@ -164,6 +164,10 @@ def read_layout(path: Path) -> Ros1Layout:
             raise BagError(f"unreadable ROS1 bag header ({err}); not a bag?", path=path) from err
         if index_pos == 0:
             return scan_layout(f, path, size, head.end, "not indexed (recording not closed)")
+        if head.end == index_pos == size and conn_count == 0 and chunk_count == 0:
+            # What a recorder leaves when nothing arrived: the header, then an empty index
+            # (nothing between them; records there would mean a damaged header: scanned).
+            return Ros1Layout(path, size, True, [], [])
         if index_pos >= size:
             return scan_layout(
                 f,
@@ -331,6 +335,47 @@ def scan_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ros1L
     return Ros1Layout(
         path, size, False, sorted(conns.values(), key=lambda c: c.id), chunks, problems
     )
+
+
+def _outside_chunk_info(
+    chunks: Sequence[Ros1Chunk], cid: int, t: I64, where: Sequence[tuple[int, int]]
+) -> str | None:
+    """Why the index-data times ``t`` of one connection (``where``: (chunk, count) of each
+    run of them, in order) do not all lie in their chunk's chunk-info [start, end], or None.
+
+    One min and one max per chunk (two passes over the times, no per-message gather): the
+    reads were planned from those spans, so a time outside one means the index contradicts
+    itself and a window may have skipped a chunk it needed.
+    """
+    counts = np.array([w[1] for w in where], dtype=np.int64)
+    nonempty = counts > 0
+    if not len(t) or not nonempty.any():
+        return None
+    cis = np.array([w[0] for w in where], dtype=np.int64)[nonempty]
+    at = (np.cumsum(counts) - counts)[nonempty]
+    lo = np.minimum.reduceat(t, at)
+    hi = np.maximum.reduceat(t, at)
+    start = np.array([chunks[i].start_ns for i in cis.tolist()], dtype=np.int64)
+    end = np.array([chunks[i].end_ns for i in cis.tolist()], dtype=np.int64)
+    bad = np.flatnonzero((lo < start) | (hi > end))
+    if not len(bad):
+        return None
+    k = int(bad[0])
+    chunk = chunks[int(cis[k])]
+    return (
+        f"index data of connection {cid} after the chunk at byte {chunk.pos} holds record "
+        f"times {int(lo[k])}..{int(hi[k])} ns outside its chunk info's "
+        f"{chunk.start_ns}..{chunk.end_ns} ns ({len(bad)} chunk(s) so)"
+    )
+
+
+def _first_record(bag: Ros1Bag) -> int:
+    """Where the records after the bag header start."""
+    try:
+        head, _ = read_record(bag.file, MAGIC_LEN, bag.layout.size)
+    except RecordError as err:
+        raise BagError(f"unreadable ROS1 bag header ({err})", path=bag.path) from err
+    return head.end
 
 
 def _standard_spans(buf: U8, offsets: I64) -> tuple[I64, I64] | None:
@@ -527,6 +572,11 @@ class Ros1Bag(BagFile):
             if not raw[cid]:
                 continue
             t, off = _joined_entries(raw[cid])
+            if self.layout.indexed:
+                outside = _outside_chunk_info(self.layout.chunks, cid, t, where[cid])
+                if outside is not None:
+                    self._rescan(outside)
+                    return self.select(conns, start_ns, end_ns)
             c = np.repeat(
                 np.array([w[0] for w in where[cid]], dtype=np.int64),
                 np.array([w[1] for w in where[cid]], dtype=np.int64),
@@ -558,6 +608,22 @@ class Ros1Bag(BagFile):
         seq = np.arange(len(t_all))
         order = np.lexsort((seq, r_all, t_all))
         return touched, c_all[order], r_all[order], t_all[order], o_all[order]
+
+    def _rescan(self, why: str) -> None:
+        """Distrust the index from now on: rebuild the layout from the records themselves."""
+        log.warning(
+            "%s: %s; reading by scanning every record instead of through the index "
+            "(`ertools info --check` lists every disagreement; `rosbag reindex` on a copy "
+            "repairs the index)",
+            self.path,
+            why,
+        )
+        from ertools.io.ros1_check import rebuild_layout
+
+        self._unmap()
+        self.layout = rebuild_layout(
+            self.file, self.path, self.layout.size, _first_record(self), why
+        )
 
     def spans(self, buf: U8, offsets: I64, where: str) -> tuple[I64, I64]:
         """(data start, data length) of the message records at ``offsets`` of a chunk.

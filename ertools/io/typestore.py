@@ -17,6 +17,22 @@ from ertools.io.model import Conn, long_msgtype
 _IDL_SEP = "=" * 80 + "\n"
 
 
+def _store_name(conn: Conn) -> str:
+    """The name rosbags registers a connection's type under.
+
+    rosbags files a ``.msg`` definition under ``pkg/msg/Name`` or ``pkg/action/Name`` and
+    puts ``msg`` into any other name (a rosbag2 service event ``pkg/srv/Name_Event`` becomes
+    ``pkg/srv/msg/Name_Event``); IDL definitions keep their module path.
+    """
+    name = long_msgtype(conn.msgtype)
+    if conn.msgdef_format == "idl":
+        return name
+    pkg, _, base = name.rpartition("/")
+    if pkg.rsplit("/", 1)[-1] in ("msg", "action"):
+        return name
+    return f"{pkg}/msg/{base}"
+
+
 class Deserializer:
     """Deserialize raw messages of some connections with their stored definitions."""
 
@@ -46,7 +62,7 @@ class Deserializer:
                     else:
                         types.update(get_types_from_idl(conn.msgdef))
                 else:
-                    types.update(get_types_from_msg(conn.msgdef, long_msgtype(conn.msgtype)))
+                    types.update(get_types_from_msg(conn.msgdef, _store_name(conn)))
             except (TypesysError, ValueError, IndexError) as err:
                 raise BagError(
                     f"topic {conn.topic}: stored definition of {conn.msgtype} does not parse "
@@ -65,8 +81,8 @@ class Deserializer:
 
         try:
             if conn.encoding == "ros1":
-                return self.typestore.deserialize_ros1(raw, long_msgtype(conn.msgtype))
-            return self.typestore.deserialize_cdr(raw, long_msgtype(conn.msgtype))
+                return self.typestore.deserialize_ros1(raw, _store_name(conn))
+            return self.typestore.deserialize_cdr(raw, _store_name(conn))
         except (
             SerdeError,
             ValueError,

@@ -27,6 +27,8 @@ U8 = npt.NDArray[np.uint8]
 
 # Odometry after its pose: pose covariance (36), twist (6), twist covariance (36) float64.
 _ODOM_TAIL = 36 + 6 + 36
+# PoseWithCovarianceStamped after its pose: the pose covariance.
+_COVARIANCE = 36
 
 
 @dataclass(frozen=True)
@@ -119,9 +121,11 @@ def layout_of(msgtype: str, cdr: bool, raw: bytes) -> Layout | None:
     child: str | None = None
     stamp: tuple[int, int, str] | None = None
     try:
-        if msgtype == "geometry_msgs/PoseStamped":
+        if msgtype in ("geometry_msgs/PoseStamped", "geometry_msgs/PoseWithCovarianceStamped"):
             stamp, frame = _header(p)
             values_at, values = p.floats(7), 7
+            if msgtype == "geometry_msgs/PoseWithCovarianceStamped":
+                p.floats(_COVARIANCE)
         elif msgtype == "geometry_msgs/Pose2D":
             frame = ""
             values_at, values = p.floats(3), 3

@@ -18,6 +18,7 @@ from typing import Any
 from ertools import __version__
 from ertools.errors import ConfigError
 from ertools.report import html as h
+from ertools.report import units
 
 # Keys that identify a benchmark's score when no result.json says which it is.
 _SIGNATURES: tuple[tuple[str, frozenset[str]], ...] = (
@@ -133,7 +134,7 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
     for e in entries:
         by_benchmark.setdefault(e.benchmark, []).append(e)
 
-    sections: list[tuple[str, str, str]] = []
+    benchmarks: list[dict[str, Any]] = []
     flat: list[dict[str, Any]] = []
     for bench in sorted(by_benchmark):
         group = sorted(by_benchmark[bench], key=lambda e: (e.team, e.inputs, str(e.source)))
@@ -152,12 +153,16 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
             flat.append({"benchmark": bench, **row, "source": str(e.source)})
             target = e.index or e.source
             rel = os.path.relpath(target.resolve(), outdir.resolve())
-            links.append(h.link(Path(rel).as_posix(), f"{e.team or '(unknown)'}: {rel}"))
-        body = h.table(rows)
-        body += '<p class="muted">Reports: ' + " &middot; ".join(links) + "</p>"
+            links.append((Path(rel).as_posix(), f"{e.team or '(unknown)'}: {rel}"))
         teams = len({e.team for e in group})
-        sections.append((f"b-{bench}", f"{bench} ({len(group)} result(s), {teams} team(s))", body))
-    sections.append(("teams", "By team", _by_team(entries, outdir)))
+        benchmarks.append(
+            {
+                "anchor": f"b-{bench}",
+                "title": f"{bench} ({len(group)} result(s), {teams} team(s))",
+                "table": h.table(rows),
+                "links": links,
+            }
+        )
     (outdir / "results.json").write_text(json.dumps(flat, indent=2) + "\n", encoding="utf-8")
     columns = list(dict.fromkeys(k for row in flat for k in row))
     with (outdir / "results.csv").open("w", newline="", encoding="utf-8") as fh:
@@ -166,18 +171,25 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
         writer.writerows(flat)
     subtitle = f"{len(entries)} result(s), combined by ertools {__version__}"
     index = outdir / "index.html"
-    index.write_text(h.page(title, subtitle, sections), encoding="utf-8")
+    nav = [(b["anchor"], b["title"]) for b in benchmarks] + [("teams", "By team")]
+    page = h.render(
+        "combined.html.j2",
+        title=title,
+        subtitle=subtitle,
+        nav=nav,
+        benchmarks=benchmarks,
+        teams=_by_team(entries, outdir),
+    )
+    index.write_text(page, encoding="utf-8")
     return index
 
 
-def _by_team(entries: list[Entry], outdir: Path) -> str:
+def _by_team(entries: list[Entry], outdir: Path) -> list[h.Table]:
     """One table per team: its results in every benchmark, headline values as text."""
-    from ertools.report.html import fmt
-
     teams: dict[str, list[Entry]] = {}
     for e in entries:
         teams.setdefault(e.team or "(unknown)", []).append(e)
-    parts = []
+    out = []
     for team in sorted(teams):
         rows = []
         for e in sorted(teams[team], key=lambda e: (e.benchmark, str(e.source))):
@@ -186,7 +198,7 @@ def _by_team(entries: list[Entry], outdir: Path) -> str:
                 {
                     "benchmark": e.benchmark,
                     "score": ", ".join(
-                        f"{k} {fmt(v)}" for k, v in e.headline.items() if k != "benchmark"
+                        _score_text(k, v) for k, v in e.headline.items() if k != "benchmark"
                     ),
                     "warnings": e.warnings,
                     "failures": e.failures,
@@ -194,5 +206,13 @@ def _by_team(entries: list[Entry], outdir: Path) -> str:
                     "report": os.path.relpath(target.resolve(), outdir.resolve()),
                 }
             )
-        parts.append(h.table(rows, caption=team))
-    return "".join(parts)
+        out.append(h.table(rows, caption=team))
+    return out
+
+
+def _score_text(key: str, value: Any) -> str:
+    """``best_distance_error 0.639 mm``: a headline value as text, in its display unit."""
+    spec = units.quantity_of(key)
+    if spec is None or not units.is_number(value):
+        return f"{key} {h.fmt(value)}"
+    return f"{key} {h.fmt(units.display(key, value))} {units.unit(spec[0])}"

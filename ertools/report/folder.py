@@ -33,6 +33,7 @@ from typing import Any
 from ertools import __version__
 from ertools.benchmarks.base import BenchmarkResult, Rows, jsonable
 from ertools.report import html as h
+from ertools.report import units
 
 log = logging.getLogger("ertools.report.folder")
 
@@ -373,72 +374,70 @@ def _page(
     written: list[str],
     outdir: Path,
 ) -> str:
-    sections: list[tuple[str, str, str]] = []
-    status = []
-    failures = list(score.failures) if score is not None else []
-    if failures:
-        status.append(h.badge(f"{len(failures)} failure(s)", "bad"))
-    if meta["warnings"]:
-        status.append(h.badge(f"{len(meta['warnings'])} warning(s)", "warn"))
-    if not failures and not meta["warnings"]:
-        status.append(h.badge("no warnings", "ok"))
-
+    nav: list[tuple[str, str]] = []
+    score_ctx: dict[str, Any] | None = None
     if score is not None:
-        body = "<p>" + "".join(status) + "</p>"
+        failures = list(score.failures)
+        badges = []
+        if failures:
+            badges.append((f"{len(failures)} failure(s)", "bad"))
+        if meta["warnings"]:
+            badges.append((f"{len(meta['warnings'])} warning(s)", "warn"))
+        if not failures and not meta["warnings"]:
+            badges.append(("no warnings", "ok"))
         head = meta["headline"]
-        if head:
-            body += h.table([{"metric": k, "value": v} for k, v in head.items()], caption="Score")
-        body += h.notes(f"failure: {f}" for f in failures)
-        body += "<h3>score.yaml (the seed's format)</h3>" + h.pre(score.to_yaml())
-        sections.append(("score", "Score", body))
-    if figures or figure_problems:
-        body = h.figures(
-            h.figure(p.relative_to(outdir).as_posix(), title, wide=p.stem == "audit_timeline")
-            for p, title in figures
-        )
-        body += h.notes(figure_problems)
-        sections.append(("figures", "Figures", body))
-    if audit is not None:
-        sections.append(("audit", "Audit", _audit_html(audit)))
-    tables = score.tables() if score is not None else {}
-    if tables:
-        parts = []
-        for name, rows in tables.items():
-            link = h.link(f"{csv_stem(name)}.csv", f"{csv_stem(name)}.csv")
-            if not rows:
-                parts.append(f"<h3>{h.esc(name)}</h3><p>(empty) {link}</p>")
-                continue
-            table = h.table(rows, max_rows=TABLE_MAX_ROWS)
-            if len(rows) > TABLE_OPEN_ROWS:
+        score_ctx = {
+            "badges": badges,
+            "headline": h.key_values(list(head.items()), caption="Score") if head else None,
+            "failures": [f"failure: {f}" for f in failures],
+            "yaml": score.to_yaml(),
+        }
+        nav.append(("score", "Score"))
+    figure_items = [
+        h.Figure(p.relative_to(outdir).as_posix(), title, wide=p.stem == "audit_timeline")
+        for p, title in figures
+    ]
+    if figure_items or figure_problems:
+        nav.append(("figures", "Figures"))
+    audit_ctx = _audit_context(audit) if audit is not None else None
+    if audit_ctx is not None:
+        nav.append(("audit", "Audit"))
+    tables = []
+    for name, rows in (score.tables() if score is not None else {}).items():
+        csv_name = f"{csv_stem(name)}.csv"
+        tables.append(
+            {
+                "name": name,
+                "csv": csv_name,
+                "count": len(rows),
                 # Per-sample tables are long: folded (no script needed), the CSV has them all.
-                parts.append(
-                    f"<details><summary><b>{h.esc(name)}</b>: {len(rows)} rows "
-                    f"({link})</summary>{table}</details>"
-                )
-            else:
-                parts.append(f'<h3>{h.esc(name)}</h3>{table}<p class="muted">{link}</p>')
-        sections.append(("tables", "Tables", "".join(parts)))
-    notes_body = ""
-    if meta["warnings"]:
-        notes_body += "<h3>Warnings</h3>" + h.notes(meta["warnings"])
-    deviations = _deviations(score, audit)
-    notes_body += "<h3>Where ertools deliberately differs from the 2015 node</h3>"
-    notes_body += h.notes(deviations) if deviations else "<p>(none declared)</p>"
-    sections.append(("notes", "Warnings and deviations", notes_body))
-    sections.append(
-        (
-            "provenance",
-            "Provenance",
-            _provenance_html(score, audit, meta, input_records, configs, written),
+                "folded": len(rows) > TABLE_OPEN_ROWS,
+                "table": h.table(rows, max_rows=TABLE_MAX_ROWS) if rows else None,
+            }
         )
-    )
+    if tables:
+        nav.append(("tables", "Tables"))
+    nav += [("notes", "Warnings and deviations"), ("provenance", "Provenance")]
     title = f"ertools report: {meta['benchmark']}"
     if meta["team"]:
         title += f" \u2014 {meta['team']}"
     subtitle = f"generated {meta['generated']} by ertools {meta['ertools_version']}"
     if input_records:
         subtitle += " from " + ", ".join(r.name for r in input_records)
-    return h.page(title, subtitle, sections)
+    return h.render(
+        "report.html.j2",
+        title=title,
+        subtitle=subtitle,
+        nav=nav,
+        score=score_ctx,
+        figures=figure_items,
+        figure_problems=figure_problems,
+        audit=audit_ctx,
+        tables=tables,
+        warnings=meta["warnings"],
+        deviations=_deviations(score, audit),
+        provenance=_provenance_context(score, audit, meta, input_records, configs, written),
+    )
 
 
 def _deviations(score: BenchmarkResult | None, audit: Any) -> list[str]:
@@ -453,24 +452,21 @@ def _deviations(score: BenchmarkResult | None, audit: Any) -> list[str]:
     return items
 
 
-def _audit_html(audit: Any) -> str:
+def _audit_context(audit: Any) -> dict[str, Any]:
     from ertools.timeutil import iso_utc, ns_to_s
 
-    parts = [
-        h.definitions(
-            [
-                ("benchmark", audit.benchmark or "(unknown)"),
-                ("first state message", iso_utc(audit.start_ns) if audit.timeline else None),
-                ("duration [s]", ns_to_s(audit.end_ns - audit.start_ns)),
-                ("BmBox transitions checked", audit.transitions_checked),
-                ("illegal transitions", len(audit.illegal_transitions)),
-                (f"silences > {ns_to_s(audit.max_silence_ns):g} s", len(audit.silences)),
-                ("ended by the RefBox", ", ".join(e.reason for e in audit.early_ends) or "no"),
-            ]
-        )
+    facts = [
+        ("benchmark", audit.benchmark or "(unknown)"),
+        ("first state message", iso_utc(audit.start_ns) if audit.timeline else None),
+        ("duration (s)", ns_to_s(audit.end_ns - audit.start_ns)),
+        ("BmBox transitions checked", audit.transitions_checked),
+        ("illegal transitions", len(audit.illegal_transitions)),
+        (f"silences > {ns_to_s(audit.max_silence_ns):g} s", len(audit.silences)),
+        ("ended by the RefBox", ", ".join(e.reason for e in audit.early_ends) or "no"),
     ]
+    found = []
     if audit.topics:
-        parts.append(
+        found.append(
             h.table(
                 [{"machine": m, "topic": t, "messages": n} for m, t, n in audit.topics],
                 caption="State topics",
@@ -485,106 +481,112 @@ def _audit_html(audit: Any) -> str:
         if tables[key]:
             # Epoch columns stay in the CSV; the page shows seconds from the first message.
             columns = [c for c in tables[key][0] if c not in _EPOCH_COLUMNS]
-            parts.append(h.table(tables[key], columns=columns, caption=caption))
+            found.append(h.table(tables[key], columns=columns, caption=caption))
+    comparison = None
     if audit.comparison is not None:
         cmp = audit.comparison
-        parts.append("<h3>Live score vs recomputed score</h3>")
-        parts.append(
-            f"<p>{cmp.same} value(s) agree within {cmp.abs_tol:g}, "
-            f"{len(cmp.differences)} differ.</p>"
-        )
-        parts.append(h.notes(cmp.notes))
-        rows = [r for r in cmp.rows() if r["status"] != "only recomputed"]
-        extra = len(cmp.lines) - len(rows)
-        if extra:
-            parts.append(
-                f'<p class="muted">{extra} more key(s) only in the recomputed score: '
-                f"{h.link('score_comparison.csv', 'score_comparison.csv')}</p>"
-            )
-        parts.append(
-            h.table(
+        rows = [_comparison_row(r) for r in cmp.rows() if r["status"] != "only recomputed"]
+        comparison = {
+            "summary": f"{cmp.same} value(s) agree within {cmp.abs_tol:g} (in the units of "
+            f"score.yaml), {len(cmp.differences)} differ.",
+            "notes": list(cmp.notes),
+            "extra": len(cmp.lines) - len(rows),
+            "table": h.table(
                 rows,
                 columns=["key", "live", "recomputed", "difference", "status", "explanation"],
                 row_class="status",
-            )
-        )
-    elif audit.live_score_text is not None:
-        parts.append("<h3>Score sent live (TRANSMITTING_SCORE)</h3>" + h.pre(audit.live_score_text))
+            ),
+        }
+    runs = None
     if tables["runs"]:
-        parts.append("<h3>Runs</h3>")
-        parts.append(
-            h.table(
-                tables["runs"],
-                columns=[
-                    "run",
-                    "start",
-                    "end",
-                    "duration",
-                    "outcome",
-                    "states",
-                    "manual_operation",
-                    "goal",
-                    "result",
-                ],
-            )
+        runs = h.table(
+            tables["runs"],
+            columns=[
+                "run",
+                "start",
+                "end",
+                "duration",
+                "outcome",
+                "states",
+                "manual_operation",
+                "goal",
+                "result",
+            ],
         )
+    timeline = None
     if tables["timeline"]:
         timeline = h.table(
             tables["timeline"],
             columns=["start", "machine", "state", "duration", "kind", "payload"],
             max_rows=TABLE_MAX_ROWS,
         )
-        parts.append(
-            f"<details><summary><b>Timeline</b>: {len(tables['timeline'])} state changes "
-            f"({h.link('audit_timeline.csv', 'audit_timeline.csv')})</summary>"
-            f"{timeline}</details>"
-        )
-    return "".join(parts)
+    return {
+        "facts": [(k, h.fmt(v)) for k, v in facts],
+        "tables": found,
+        "comparison": comparison,
+        "live_text": audit.live_score_text,
+        "runs": runs,
+        "timeline": timeline,
+        "timeline_count": len(tables["timeline"]),
+    }
 
 
-def _provenance_html(
+def _comparison_row(row: dict[str, Any]) -> dict[str, Any]:
+    """A live-vs-recomputed row in display units: the key names its unit, values converted.
+
+    The row's values are in the score's units; the quantity comes from the key's last part
+    (``runs_details.0.distance_error`` is a length).
+    """
+    key = str(row["key"])
+    spec = units.quantity_of(key)
+    if spec is None or not any(
+        units.is_number(row.get(c)) for c in ("live", "recomputed", "difference")
+    ):
+        return dict(row)
+    k = units.factor(*spec)
+    out = dict(row)
+    out["key"] = units.label(key, spec[0])
+    for col in ("live", "recomputed", "difference"):
+        if units.is_number(row.get(col)):
+            out[col] = float(row[col]) * k
+    return out
+
+
+def _provenance_context(
     score: BenchmarkResult | None,
     audit: Any,
     meta: dict[str, Any],
     input_records: list[FileRecord],
     configs: list[tuple[FileRecord, str | None]],
     written: list[str],
-) -> str:
-    parts = ["<h3>Inputs</h3>"]
-    parts.append(
-        h.table([r.to_dict() for r in input_records], columns=["name", "size", "sha256", "path"])
-        if input_records
-        else "<p>(none given)</p>"
-    )
-    if configs:
-        parts.append("<h3>Configs</h3>")
-        parts.append(
-            h.table([r.to_dict() for r, _ in configs], columns=["name", "size", "sha256", "path"])
-        )
-        for record, text in configs:
-            if text is not None:
-                parts.append(f'<p class="muted">{h.esc(record.name)}</p>' + h.pre(text))
+) -> dict[str, Any]:
+    file_columns = ["name", "size (bytes)", "sha256", "path"]
+
+    def files(records: list[FileRecord]) -> list[dict[str, Any]]:
+        return [
+            {"name": r.name, "size (bytes)": r.size, "sha256": r.sha256, "path": r.path}
+            for r in records
+        ]
+
     params: list[tuple[str, Any]] = []
     if score is not None:
         params += list(score.provenance.parameters)
     if audit is not None:
         params += [(f"audit {k}", v) for k, v in audit.provenance.parameters]
-    parts.append("<h3>Parameters</h3>")
-    parts.append(h.definitions(params) if params else "<p>(none)</p>")
-    parts.append("<h3>Software</h3>")
-    parts.append(
-        h.definitions(
-            [
-                ("ertools", meta["ertools_version"]),
-                ("python", platform.python_version()),
-                ("platform", platform.platform()),
-                ("generated", meta["generated"]),
-                ("command line", shlex.join(meta["argv"]) if meta["argv"] else None),
-            ]
-        )
-    )
-    parts.append("<h3>Files of this report</h3>")
-    parts.append(
-        '<p class="muted">' + " ".join(h.link(f, f) for f in ["result.json", *written]) + "</p>"
-    )
-    return "".join(parts)
+    software = [
+        ("ertools", meta["ertools_version"]),
+        ("python", platform.python_version()),
+        ("platform", platform.platform()),
+        ("generated", meta["generated"]),
+        ("command line", shlex.join(meta["argv"]) if meta["argv"] else None),
+    ]
+    return {
+        "inputs": h.table(files(input_records), columns=file_columns) if input_records else None,
+        "configs": h.table(files([r for r, _ in configs]), columns=file_columns)
+        if configs
+        else None,
+        "config_texts": [(r.name, text) for r, text in configs if text is not None],
+        "parameters": [(k, h.fmt(v)) for k, v in params],
+        "software": [(k, h.fmt(v)) for k, v in software],
+        "files": ["result.json", *written],
+    }

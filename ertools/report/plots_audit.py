@@ -7,28 +7,68 @@ from __future__ import annotations
 
 from typing import Any
 
+from ertools.report import units
 from ertools.report.figures import FigureSpec
 from ertools.streams import Machine
 from ertools.timeutil import ns_to_s
 
 _LANES = (Machine.CLIENT, Machine.REFBOX, Machine.BMBOX)  # bottom to top
-_COLOURS = {
-    "START": "#c9d1dc",
-    "WAITING_CLIENT": "#aab6c6",
-    "CONNECTING": "#aab6c6",
-    "READY": "#8fc1e3",
-    "WAITING_GOAL": "#8fc1e3",
-    "WAITING_MANUAL_OPERATION": "#f2c46d",
-    "EXECUTING_MANUAL_OPERATION": "#f2c46d",
-    "COMPLETED_MANUAL_OPERATION": "#e9a23b",
-    "TRANSMITTING_GOAL": "#b39ddb",
-    "EXECUTING_GOAL": "#5fae6e",
-    "WAITING_RESULT": "#2e7d4f",
-    "COMPLETED_GOAL": "#2e7d4f",
-    "TRANSMITTING_SCORE": "#d96c6c",
-    "RECEIVED_SCORE": "#d96c6c",
-    "END": "#555e6b",
+# Okabe & Ito's colour-blind-safe palette (2008), plus two greys that differ in lightness.
+OKABE_ITO = {
+    "orange": "#E69F00",
+    "sky blue": "#56B4E9",
+    "bluish green": "#009E73",
+    "yellow": "#F0E442",
+    "blue": "#0072B2",
+    "vermillion": "#D55E00",
+    "reddish purple": "#CC79A7",
+    "light grey": "#DDDDDD",
+    "dark grey": "#555555",
+    "black": "#000000",
 }
+_P = OKABE_ITO
+# One colour per state of each machine (the BmBox has ten states: every colour once). States
+# of one phase of a run share their colour across the lanes, so a run reads down the figure:
+# the client's WAITING_GOAL while the BmBox is TRANSMITTING_GOAL, the RefBox's
+# EXECUTING_MANUAL_OPERATION while the BmBox waits for it.
+STATE_COLOURS: dict[Machine, dict[str, str]] = {
+    Machine.BMBOX: {
+        "START": _P["light grey"],
+        "WAITING_CLIENT": _P["sky blue"],
+        "READY": _P["blue"],
+        "WAITING_MANUAL_OPERATION": _P["yellow"],
+        "COMPLETED_MANUAL_OPERATION": _P["orange"],
+        "TRANSMITTING_GOAL": _P["reddish purple"],
+        "EXECUTING_GOAL": _P["bluish green"],
+        "WAITING_RESULT": _P["vermillion"],
+        "TRANSMITTING_SCORE": _P["dark grey"],
+        "END": _P["black"],
+    },
+    Machine.REFBOX: {
+        "START": _P["light grey"],
+        "WAITING_CLIENT": _P["sky blue"],
+        "READY": _P["blue"],
+        "EXECUTING_MANUAL_OPERATION": _P["yellow"],
+        "EXECUTING_GOAL": _P["bluish green"],
+        "RECEIVED_SCORE": _P["dark grey"],
+        "END": _P["black"],
+    },
+    Machine.CLIENT: {
+        "START": _P["light grey"],
+        "CONNECTING": _P["sky blue"],
+        "READY": _P["blue"],
+        "WAITING_GOAL": _P["reddish purple"],
+        "EXECUTING_GOAL": _P["bluish green"],
+        "COMPLETED_GOAL": _P["vermillion"],
+        "END": _P["black"],
+    },
+}
+UNKNOWN_COLOUR = "#FFFFFF"  # UNKNOWN(<code>): white, outlined (no state has it)
+
+
+def state_colour(machine: Machine, state: str) -> str:
+    """The colour of one state of one machine."""
+    return STATE_COLOURS[machine].get(state, UNKNOWN_COLOUR)
 
 
 def figure_specs(audit: Any) -> list[FigureSpec]:
@@ -36,13 +76,14 @@ def figure_specs(audit: Any) -> list[FigureSpec]:
     if not audit.timeline:
         return []
     span_s = max(ns_to_s(audit.end_ns - audit.start_ns), 1.0)
-    width = min(16.0, max(9.0, span_s / 20.0))
+    # Spans the page's width (a wide figure): wide enough that its fonts stay small there.
+    width = min(18.0, max(13.0, span_s / 20.0))
     return [
         FigureSpec(
             "audit_timeline",
             "Benchmark state timeline",
             lambda ax: draw_timeline(ax, audit),
-            (width, 4.2),
+            (width, 5.0),
         )
     ]
 
@@ -55,18 +96,25 @@ def draw_timeline(ax: Any, audit: Any) -> None:
     """
     t0 = audit.start_ns
     lane = {m: i for i, m in enumerate(_LANES)}
-    seen: dict[str, Any] = {}
+    # Legend: one entry per colour, naming every state drawn in it (with its machine when
+    # the name is not the BmBox's).
+    seen: dict[str, tuple[Any, list[str]]] = {}
     for e in audit.timeline:
         y = lane[e.machine]
-        colour = _COLOURS.get(e.state_name, "#999999")
+        colour = state_colour(e.machine, e.state_name)
         bar = ax.broken_barh(
             [(ns_to_s(e.start_ns - t0), max(ns_to_s(e.duration_ns), 0.05))],
             (y - 0.35, 0.7),
             facecolors=colour,
-            edgecolors="white",
+            edgecolors="white" if colour != UNKNOWN_COLOUR else "#444444",
             linewidth=0.4,
         )
-        seen.setdefault(e.state_name, bar)
+        entry = seen.setdefault(colour, (bar, []))
+        name = e.state_name
+        if name not in STATE_COLOURS[Machine.BMBOX]:
+            name = f"{name} ({e.machine.value})"
+        if name not in entry[1]:
+            entry[1].append(name)
     for r in audit.runs:
         ax.axvspan(ns_to_s(r.start_ns - t0), ns_to_s(r.end_ns - t0), color="#000000", alpha=0.04)
         ax.text(
@@ -91,13 +139,13 @@ def draw_timeline(ax: Any, audit: Any) -> None:
         ax.text(ns_to_s(end.t_ns - t0), -0.75, end.reason, color="#b42318", fontsize=8)
     ax.set_yticks(range(len(_LANES)), [m.value for m in _LANES])
     ax.set_ylim(-0.9, len(_LANES) - 0.2)
-    ax.set_xlabel("time from the first state message [s]")
+    ax.set_xlabel(units.label("time from the first state message", "time"))
     ax.legend(
-        list(seen.values()),
-        list(seen),
+        [bar for bar, _ in seen.values()],
+        [" / ".join(names) for _, names in seen.values()],
         fontsize=7,
-        ncols=5,
+        ncols=3,
         loc="upper center",
-        bbox_to_anchor=(0.5, -0.25),
+        bbox_to_anchor=(0.5, -0.18),
         frameon=False,
     )

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from ertools.report import units
 from ertools.report.figures import FigureSpec
 
 # Colours by answer quality (colour-blind safe pairs).
@@ -64,17 +65,29 @@ def _draw_errors(result: Any) -> Any:
     def draw(ax: Any) -> None:
         runs = [r for r in result.runs if r.errors is not None]
         xs = [r.index for r in runs]
-        trans_mm = [r.errors.trans_error_m * 1000.0 for r in runs]
+        trans_mm = [r.errors.trans_error_m * units.factor("length", "m") for r in runs]
         theta = [abs(r.errors.theta_error_deg) for r in runs]
         width = 0.4
-        ax.bar([x - width / 2 for x in xs], trans_mm, width, color="#7570b3", label="|dxy| mm")
+        ax.bar(
+            [x - width / 2 for x in xs],
+            trans_mm,
+            width,
+            color="#7570b3",
+            label=units.label("|dxy|", "length"),
+        )
         ax.set_xlabel("run")
-        ax.set_ylabel("translation error (mm)")
+        ax.set_ylabel(units.label("translation error", "length"))
         ax.set_yscale("symlog", linthresh=10.0)
         ax.set_xticks([r.index for r in result.runs])
         twin = ax.twinx()
-        twin.bar([x + width / 2 for x in xs], theta, width, color="#e7298a", label="|dtheta| deg")
-        twin.set_ylabel("theta error (deg)")
+        twin.bar(
+            [x + width / 2 for x in xs],
+            theta,
+            width,
+            color="#e7298a",
+            label=units.label("|dtheta|", "angle"),
+        )
+        twin.set_ylabel(units.label("theta error", "angle"))
         twin.set_ylim(0, max([180.0 * 1.05, *theta]) if any(t > 20 for t in theta) else 20.0)
         lines = ax.get_legend_handles_labels()
         more = twin.get_legend_handles_labels()
@@ -115,8 +128,9 @@ def _draw_table(result: Any) -> Any:
         ax.plot([0, 0.1], [0, 0], color="r", lw=2)
         ax.plot([0, 0], [0, 0.1], color="g", lw=2)
         ax.set_aspect("equal", adjustable="datalim")
-        ax.set_xlabel("x in the table frame (m)")
-        ax.set_ylabel("y in the table frame (m)")
+        # Drawn in metres (the results' unit), read in mm like every length of the report.
+        units.set_axis(ax, "x", "x in the table frame", "length", "m")
+        units.set_axis(ax, "y", "y in the table frame", "length", "m")
         ax.grid(True, lw=0.3)
         from matplotlib.lines import Line2D
 

@@ -6,6 +6,7 @@ from typing import Any
 
 import numpy as np
 
+from ertools.report import units
 from ertools.report.figures import FigureSpec
 
 ARROW = 0.25  # metres: length of the heading arrows on the path figure
@@ -49,8 +50,9 @@ def draw_path(result: Any, ax: Any) -> None:
         sx, sy, _ = result.goal.starting_pose
         ax.scatter([sx], [sy], color="tab:green", marker="s", s=40, label="starting pose")
     ax.set_aspect("equal", adjustable="datalim")
-    ax.set_xlabel("x [m] (testbed frame)")
-    ax.set_ylabel("y [m]")
+    # Drawn in metres (the results' unit), read in mm like every length of the report.
+    units.set_axis(ax, "x", "x in the testbed frame", "length", "m")
+    units.set_axis(ax, "y", "y in the testbed frame", "length", "m")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize="small")
 
@@ -64,17 +66,19 @@ def draw_errors(result: Any, ax: Any) -> None:
     ori = np.array(
         [np.nan if s.orientation_error is None else s.orientation_error for s in result.segments]
     )
-    ax.bar(idx - 0.2, dist * 100.0, width=0.4, color="tab:blue", label="distance error")
+    mm = units.factor("length", "m")
+    deg = units.factor("angle", "rad")
+    ax.bar(idx - 0.2, dist * mm, width=0.4, color="tab:blue", label="distance error")
     ax.set_xlabel("waypoint")
-    ax.set_ylabel("distance error [cm]", color="tab:blue")
+    ax.set_ylabel(units.label("distance error", "length"), color="tab:blue")
     ax.set_xticks(idx)
     right = ax.twinx()
-    right.bar(idx + 0.2, np.degrees(ori), width=0.4, color="tab:orange", label="orientation error")
-    right.set_ylabel("orientation error [deg]", color="tab:orange")
+    right.bar(idx + 0.2, ori * deg, width=0.4, color="tab:orange", label="orientation error")
+    right.set_ylabel(units.label("orientation error", "angle"), color="tab:orange")
     if result.position_accuracy is not None:
-        ax.axhline(result.position_accuracy * 100.0, color="tab:blue", ls="--", lw=1)
+        ax.axhline(result.position_accuracy * mm, color="tab:blue", ls="--", lw=1)
     if result.orientation_accuracy is not None:
-        right.axhline(np.degrees(result.orientation_accuracy), color="tab:orange", ls="--", lw=1)
+        right.axhline(result.orientation_accuracy * deg, color="tab:orange", ls="--", lw=1)
     for i in idx[np.isnan(dist)]:
         ax.annotate("no score", (i, 0), ha="center", va="bottom", color="tab:red")
     ax.grid(True, axis="y", alpha=0.3)

@@ -7,9 +7,10 @@ from typing import Any
 
 import numpy as np
 
+from ertools.report import units
 from ertools.report.figures import FigureSpec
 
-MM = 1000.0
+MM = units.factor("length", "m")
 
 
 def draw_run(run: Any, ax: Any) -> None:
@@ -32,7 +33,7 @@ def draw_run(run: Any, ax: Any) -> None:
             zorder=3,
             label=f"kept samples ({len(k)}, d_min {run.d_min * MM:g} mm)",
         )
-        ax.figure.colorbar(dots, ax=ax, label="error [mm]", shrink=0.8)
+        ax.figure.colorbar(dots, ax=ax, label=units.label("error", "length"), shrink=0.8)
         # a few error vectors: each kept point is compared with the target at its l/L
         step = max(1, len(k) // 25)
         tg = score.target * MM
@@ -45,8 +46,11 @@ def draw_run(run: Any, ax: Any) -> None:
             ax.scatter(
                 ref[:, 0], ref[:, 1], marker="^", color="tab:red", s=30, zorder=4, label="reference"
             )
-    ax.set_xlabel("x [mm] (run frame: origin at the start, x along reference -> start)")
-    ax.set_ylabel("y [mm]")
+    ax.set_xlabel(
+        units.label("x in the run frame", "length")
+        + ": origin at the start, x along reference -> start"
+    )
+    ax.set_ylabel(units.label("y in the run frame", "length"))
     ax.set_aspect("equal", adjustable="datalim")
     ax.grid(True, lw=0.3)
     ax.legend(loc="best", fontsize="small")
@@ -83,7 +87,7 @@ def draw_runs(result: Any, ax: Any) -> None:
             )
     ax.set_xticks(idx)
     ax.set_xlabel("run")
-    ax.set_ylabel("distance_error [mm]")
+    ax.set_ylabel(units.label("distance_error", "length"))
     ax.margins(y=0.2)
     ax.grid(True, axis="y", lw=0.3)
 
@@ -105,8 +109,8 @@ def draw_sweep(result: Any, ax: Any) -> None:
             lw=1,
             label=f"suggested ({noise.c:g} eps)",
         )
-    ax.set_xlabel("d_min [mm]")
-    ax.set_ylabel("distance_error [mm]")
+    ax.set_xlabel(units.label("d_min", "length"))
+    ax.set_ylabel(units.label("distance_error", "length"))
     ax.grid(True, lw=0.3)
     ax.legend(loc="best", fontsize="small")
 

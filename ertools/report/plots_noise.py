@@ -6,9 +6,10 @@ from typing import Any
 
 import numpy as np
 
+from ertools.report import units
 from ertools.report.figures import FigureSpec
 
-MM = 1000.0
+MM = units.factor("length", "m")
 
 
 def draw_histogram(result: Any, ax: Any) -> None:
@@ -39,7 +40,7 @@ def draw_histogram(result: Any, ax: Any) -> None:
             lw=1.5,
             label=f"suggested d_min {result.suggested_d_min * MM:.3f} mm ({result.c:g} eps)",
         )
-    ax.set_xlabel("distance between consecutive measurements [mm]")
+    ax.set_xlabel(units.label("distance between consecutive measurements", "length"))
     ax.set_ylabel("pairs")
     ax.grid(True, lw=0.3)
     ax.legend(loc="best", fontsize="small")

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ertools.report import units
 from ertools.report.figures import FigureSpec
 
 if TYPE_CHECKING:
@@ -16,14 +17,15 @@ if TYPE_CHECKING:
 
 
 def draw_error_over_time(ax: Any, result: TrajectoryResult) -> None:
-    """Position error (cm) per robot pose; gaps and tracking losses marked on the time axis."""
+    """Position error (mm) per robot pose; gaps and tracking losses marked on the time axis."""
     from ertools.benchmarks.trajectory import GAP, TRACKING_LOST, UNCOVERED
 
     m = result.matched
     if len(m.t_ns) == 0:
         return
     t = (m.t_ns - m.t_ns[0]) / 1e9
-    ax.plot(t, m.position_error * 100.0, lw=0.8, color="C0", label="position error")
+    mm = units.factor("length", "m")
+    ax.plot(t, m.position_error * mm, lw=0.8, color="C0", label="position error")
     for code, color, label in (
         (GAP, "C1", "GT gap"),
         (TRACKING_LOST, "C3", "tracking lost"),
@@ -34,26 +36,26 @@ def draw_error_over_time(ax: Any, result: TrajectoryResult) -> None:
             ax.plot(t[sel], np.zeros(int(sel.sum())), "|", ms=10, color=color, label=label)
     if result.metrics is not None:
         ax.axhline(
-            result.metrics.position_error * 100.0,
+            result.metrics.position_error * mm,
             color="C2",
             lw=0.8,
             ls="--",
-            label=f"mean {result.metrics.position_error * 100:.2f} cm",
+            label=f"mean {result.metrics.position_error * mm:.1f} mm",
         )
-    ax.set_xlabel("time since the first robot pose (s)")
-    ax.set_ylabel("position error (cm)")
+    ax.set_xlabel(units.label("time since the first robot pose", "time"))
+    ax.set_ylabel(units.label("position error", "length"))
     ax.legend(loc="upper right", fontsize="small")
     ax.grid(True, alpha=0.3)
 
 
 def draw_paths(ax: Any, result: TrajectoryResult) -> None:
-    """The robot's estimate and the GT, seen from above (x, y in metres)."""
+    """The robot's estimate and the GT, seen from above (drawn in metres, read in mm)."""
     gt = result.gt_path
     ax.plot(gt.xyz[:, 0], gt.xyz[:, 1], lw=1.0, color="0.4", label="ground truth")
     r = result.robot.xyz
     ax.plot(r[:, 0], r[:, 1], ".", ms=2.5, color="C0", label="robot estimate")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
+    units.set_axis(ax, "x", "x", "length", "m")
+    units.set_axis(ax, "y", "y", "length", "m")
     ax.set_aspect("equal", adjustable="datalim")
     ax.legend(loc="best", fontsize="small")
     ax.grid(True, alpha=0.3)
@@ -65,9 +67,9 @@ def draw_yaw_error(ax: Any, result: TrajectoryResult) -> None:
     if len(m.t_ns) == 0:
         return
     t = (m.t_ns - m.t_ns[0]) / 1e9
-    ax.plot(t, np.degrees(m.yaw_error), lw=0.8, color="C4")
-    ax.set_xlabel("time since the first robot pose (s)")
-    ax.set_ylabel("|yaw error| (deg)")
+    ax.plot(t, m.yaw_error * units.factor("angle", "rad"), lw=0.8, color="C4")
+    ax.set_xlabel(units.label("time since the first robot pose", "time"))
+    ax.set_ylabel(units.label("|yaw error|", "angle"))
     ax.grid(True, alpha=0.3)
 
 

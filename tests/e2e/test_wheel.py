@@ -29,6 +29,21 @@ def test_wheel_installs_on_a_fresh_python_and_answers_version(tmp_path: Path) ->
     assert "ertools/py.typed" in names
     assert "ertools/samples/__main__.py" in names
     assert not any(n.startswith(("tests/", "sample_bags/", "bench")) for n in names)
+    # The report pages are rendered from templates: every one of the tree's is package data,
+    # and Jinja2 is a declared dependency.
+    templates = sorted(
+        p.relative_to(ROOT).as_posix() for p in (ROOT / "ertools/report/templates").glob("*.j2")
+    )
+    assert "ertools/report/templates/report.html.j2" in templates
+    assert sorted(n for n in names if n.startswith("ertools/report/templates/")) == templates
+    with zipfile.ZipFile(wheel) as zf:
+        (meta,) = [n for n in zf.namelist() if n.endswith(".dist-info/METADATA")]
+        requires = [
+            line
+            for line in zf.read(meta).decode().splitlines()
+            if line.startswith("Requires-Dist:")
+        ]
+    assert any(line.split()[1].lower().startswith("jinja2") for line in requires), requires
     # A Python that never saw the source tree; --no-deps: `--version` needs no dependency
     # (the CLI imports NumPy and the readers only for the command it runs).
     _run(sys.executable, "-m", "venv", "--without-pip", tmp_path / "fresh", cwd=tmp_path)

@@ -100,6 +100,17 @@ def build(ts: Any, ros1: bool, msgtype: str, v: dict[str, Any], seq: int) -> Any
         return _tfs(ts, ros1, v, seq)
     if msgtype in ("tf2_msgs/TFMessage", "tf/tfMessage"):
         return T[long](transforms=[_tfs(ts, ros1, x, seq) for x in v["transforms"]])
+    if msgtype == "geometry_msgs/PoseWithCovarianceStamped":
+        import numpy as np
+
+        # A covariance unlike any pose value: a decoder reading the wrong 56 bytes shows.
+        cov = np.linspace(-1e3, 1e3, 36) + seq
+        return T[long](
+            header=_header(ts, ros1, v["stamp"], v["frame"], seq),
+            pose=T["geometry_msgs/msg/PoseWithCovariance"](
+                pose=_pose(ts, v["xyz"], v["q"]), covariance=cov
+            ),
+        )
     if msgtype == "nav_msgs/Odometry":
         import numpy as np
 

@@ -39,9 +39,10 @@ FLAGS = [
     "--disable-sync",
     "--hide-scrollbars",
 ]
-# EXECUTING_GOAL in the timeline figure (ertools.report.plots_audit): its presence in the
-# screenshot proves the PNG beside the page was loaded and painted.
-EXECUTING_GOAL_RGB = (0x5F, 0xAE, 0x6E)
+# EXECUTING_GOAL in the timeline figure (ertools.report.plots_audit: Okabe-Ito's bluish
+# green, #009E73): its presence in the screenshot proves the PNG beside the page was loaded
+# and painted.
+EXECUTING_GOAL_RGB = (0x00, 0x9E, 0x73)
 
 
 class _Dom(HTMLParser):
@@ -110,7 +111,9 @@ def test_dom_has_tables_and_images(report: Path, tmp_path: Path) -> None:
     assert dom.scripts == 0  # the hostile payloads stayed text
     assert EVIL in dom.cells  # ...shown as text in the runs table
     assert dom.tables >= 5  # score, runs, comparison, audit tables, timeline
-    assert "best_distance_error" in dom.cells and "0.0123" in dom.cells
+    # The page shows lengths in mm: 0.0123 m (fbm3w_like) is 12.3 mm, with its unit.
+    assert "best_distance_error (mm)" in dom.cells and f"{0.0123 * 1000:.6g}" == "12.3"
+    assert "12.3" in dom.cells
     assert dom.imgs, "no figure in the page"
     for src in dom.imgs:
         if src.startswith("data:"):
@@ -135,3 +138,53 @@ def test_screenshot_shows_the_page_and_its_figure(report: Path, tmp_path: Path) 
     assert header.max() < 80  # #14233c
     close = np.abs(pixels - np.array(EXECUTING_GOAL_RGB)).max(axis=2) <= 3
     assert close.sum() > 500, "the timeline figure was not painted"
+
+
+# Measures the laid-out page: the widest figure or table, and the document's width (a page
+# wider than the window would scroll sideways). The report itself has no script (its CSP
+# forbids them); this copy of it, in the test's folder, gets one.
+_MEASURE = """<script>
+const widths = [...document.querySelectorAll("main img, main table")]
+  .map(e => e.getBoundingClientRect().width);
+document.body.setAttribute("data-widest", String(Math.max(0, ...widths)));
+document.body.setAttribute("data-page", String(document.documentElement.scrollWidth));
+document.body.setAttribute("data-window", String(window.innerWidth));
+</script>"""
+
+
+class _Body(HTMLParser):
+    def __init__(self) -> None:
+        super().__init__()
+        self.attrs: dict[str, str | None] = {}
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        if tag == "body":
+            self.attrs = dict(attrs)
+
+
+@pytest.mark.skipif(BROWSER is None, reason="chromium not installed (apt-get install chromium)")
+def test_report_uses_the_window_width(report: Path, tmp_path: Path) -> None:
+    import re
+    import shutil as sh
+
+    copy = tmp_path / "copy"
+    sh.copytree(report.parent, copy)
+    page = (copy / "index.html").read_text(encoding="utf-8")
+    page, n = re.subn(r'<meta http-equiv="Content-Security-Policy"[^>]*>', "", page)
+    assert n == 1
+    (copy / "index.html").write_text(page.replace("</body>", _MEASURE + "</body>"), "utf-8")
+    proc = _chromium(
+        tmp_path,
+        (copy / "index.html").as_uri(),
+        "--dump-dom",
+        "--window-size=1600,1000",
+        "--virtual-time-budget=5000",
+    )
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    body = _Body()
+    body.feed(proc.stdout)
+    window = float(body.attrs["data-window"] or 0)
+    assert window == 1600
+    # The timeline figure spans the main column: all but its 2 x 32 px padding.
+    assert float(body.attrs["data-widest"] or 0) > 1200
+    assert float(body.attrs["data-page"] or 0) <= window  # no sideways scrolling

@@ -46,7 +46,10 @@ def test_combined_page(
     assert json.loads((out / "results.json").read_text())[2]["best_run"] == 1
     page = (out / "index.html").read_text(encoding="utf-8")
     assert page.count("<table>") == 2 + 3  # one table per benchmark, one per team
-    assert "best_distance_error 0.0123, best_run 1, execution_time 41.5" in page  # tripod
+    # tripod, lengths in mm on the page (0.0123 m), times in s; results.csv keeps metres.
+    assert f"{0.0123 * 1000:.6g}" == "12.3"
+    assert "best_distance_error 12.3 mm, best_run 1, execution_time 41.5 s" in page
+    assert "<th>best_distance_error (mm)</th>" in page and '<td class="num">8.7</td>' in page
     assert "b&lt;it&gt;bots" in page and "<it>" not in page
     assert "Lisbon &lt;2015&gt;" in page
     assert 'href="../results/fbm3w-0.0123/index.html"' in page

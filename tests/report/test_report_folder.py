@@ -6,6 +6,7 @@ import csv
 import hashlib
 import json
 import sys
+from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
@@ -72,6 +73,24 @@ def test_folder_contents(bag: Path, tmp_path: Path) -> None:
     assert "0.1.0" in page  # the version
 
 
+class _Tags(HTMLParser):
+    def __init__(self) -> None:
+        super().__init__()
+        self.names: list[str] = []
+        self.attrs: list[str] = []
+        self.img_src: list[str] = []
+        self.text = ""
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        self.names.append(tag)
+        self.attrs += [k for k, _ in attrs]
+        if tag == "img":
+            self.img_src.append(dict(attrs).get("src") or "")
+
+    def handle_data(self, data: str) -> None:
+        self.text += data
+
+
 def test_hostile_content_is_escaped(bag: Path, tmp_path: Path) -> None:
     config = tmp_path / "in" / "c.yaml"
     config.write_text(EVIL, encoding="utf-8")
@@ -79,10 +98,20 @@ def test_hostile_content_is_escaped(bag: Path, tmp_path: Path) -> None:
     page = index.read_text(encoding="utf-8").lower()
     # No element from the data: no script at all, no injected img, no event handler.
     assert "<script" not in page
-    assert "onerror=" not in page.replace("onerror=&quot;", "")
+    # The quotes are escaped (Jinja2/markupsafe spell them &#34; and &#39;), so the
+    # attribute text stays inside the element's text.
+    assert "onerror=" not in page.replace("onerror=&#34;", "")
     assert "<img src=x" not in page
-    assert "&lt;script&gt;alert(&#x27;x&#x27;)&lt;/script&gt;" in page
+    assert "&lt;script&gt;alert(&#39;x&#39;)&lt;/script&gt;" in page
     assert page.count("&lt;script&gt;") >= 4  # table cell, warning, deviation, config text
+    # The same as a browser's parser sees it: no script element, no event handler
+    # attribute, every image a figure of the report; the payloads are text.
+    tags = _Tags()
+    tags.feed(index.read_text(encoding="utf-8"))
+    assert "script" not in tags.names
+    assert not [a for a in tags.attrs if a.startswith("on")]
+    assert all(src.startswith("figures/") for src in tags.img_src)
+    assert tags.text.count(EVIL) >= 4
 
 
 def test_sha256_of_a_rosbag2_directory(tmp_path: Path) -> None:

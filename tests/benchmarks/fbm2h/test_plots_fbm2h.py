@@ -43,8 +43,10 @@ def test_path_and_errors_figures(tmp_path: Path) -> None:
     fig2 = Figure()
     ax2 = fig2.add_subplot()
     specs[1].draw(ax2)
-    # Distance bars in cm: 0.1 m at waypoint 0 (robot at (1, 0)), 0 at waypoint 1.
+    # Distance bars in mm (every length of the report): 0.1 m = 100 mm at waypoint 0 (robot
+    # at (1, 0)), 0 at waypoint 1.
     heights = [p.get_height() for p in ax2.patches]
-    assert np.allclose(heights, [10.0, 0.0])
+    assert np.allclose(heights, [0.1 * 1000.0, 0.0])
+    assert ax2.get_ylabel() == "distance error (mm)"
     paths = save_figures(specs, tmp_path)
     assert all(p.stat().st_size > 1000 for p in paths)

@@ -1,0 +1,113 @@
+"""The audit timeline's state colours: one per state of each machine, told apart by
+colour-blind readers too."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from ertools.report.plots_audit import OKABE_ITO, STATE_COLOURS, UNKNOWN_COLOUR
+from ertools.states import STATE_ENUMS
+from ertools.streams import Machine
+
+# Machado, Oliveira & Fernandes (2009), "A physiologically-based model for simulation of
+# color vision deficiency", Table 1, severity 1.0: matrices on linear RGB.
+DICHROMACY = {
+    "protanopia": [
+        [0.152286, 1.052583, -0.204868],
+        [0.114503, 0.786281, 0.099216],
+        [-0.003882, -0.048116, 1.051998],
+    ],
+    "deuteranopia": [
+        [0.367322, 0.860646, -0.227968],
+        [0.280085, 0.672501, 0.047413],
+        [-0.011820, 0.042940, 0.968881],
+    ],
+    "tritanopia": [
+        [1.255528, -0.076749, -0.178779],
+        [-0.078411, 0.930809, 0.147602],
+        [0.004733, 0.691367, 0.303900],
+    ],
+    "normal": np.eye(3).tolist(),
+}
+# Smallest distance (sRGB, each channel 0..1) between two simulated state colours: about
+# 25/255 on one channel. The former palette had pairs at 0.041 for deuteranopes (EXECUTING_GOAL
+# vs TRANSMITTING_SCORE) and the same colour for four pairs of states.
+MIN_DISTANCE = 0.1
+
+
+def _linear(hex_colour: str) -> np.ndarray:
+    c = np.array([int(hex_colour[i : i + 2], 16) / 255.0 for i in (1, 3, 5)])
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+def _srgb(linear: np.ndarray) -> np.ndarray:
+    c = np.clip(linear, 0.0, 1.0)
+    return np.where(c <= 0.0031308, 12.92 * c, 1.055 * c ** (1 / 2.4) - 0.055)
+
+
+@pytest.mark.parametrize("machine", list(Machine))
+def test_every_state_has_its_own_colour(machine: Machine) -> None:
+    names = [s.name for s in STATE_ENUMS[machine]]
+    colours = STATE_COLOURS[machine]
+    assert sorted(colours) == sorted(names)  # every state of the seed's listing, no other
+    values = [colours[n].upper() for n in names]
+    assert len(set(values)) == len(values), colours
+    assert set(values) <= {c.upper() for c in OKABE_ITO.values()}
+    assert UNKNOWN_COLOUR.upper() not in values
+
+
+@pytest.mark.parametrize("vision", sorted(DICHROMACY))
+@pytest.mark.parametrize("machine", list(Machine))
+def test_state_colours_differ_for_colour_blind_readers(machine: Machine, vision: str) -> None:
+    matrix = np.array(DICHROMACY[vision])
+    seen = {n: _srgb(matrix @ _linear(c)) for n, c in STATE_COLOURS[machine].items()}
+    closest = min(
+        (float(np.linalg.norm(seen[a] - seen[b])), a, b) for a, b in itertools.combinations(seen, 2)
+    )
+    assert closest[0] >= MIN_DISTANCE, closest
+
+
+def test_a_phase_keeps_its_colour_across_lanes() -> None:
+    # The states of one moment of a run (seed 6.2) are drawn alike on the three lanes.
+    bm, ref, cl = (STATE_COLOURS[m] for m in (Machine.BMBOX, Machine.REFBOX, Machine.CLIENT))
+    assert bm["EXECUTING_GOAL"] == ref["EXECUTING_GOAL"] == cl["EXECUTING_GOAL"]
+    assert bm["TRANSMITTING_GOAL"] == cl["WAITING_GOAL"]
+    assert bm["WAITING_MANUAL_OPERATION"] == ref["EXECUTING_MANUAL_OPERATION"]
+    assert bm["TRANSMITTING_SCORE"] == ref["RECEIVED_SCORE"]
+
+
+def test_timeline_bars_are_drawn_in_their_state_colour() -> None:
+    import sys
+    from pathlib import Path
+
+    from matplotlib.colors import to_rgba
+    from matplotlib.figure import Figure
+
+    from ertools.audit import audit_states
+    from ertools.report.plots_audit import draw_timeline
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "audit"))
+    from audit_streams import heartbeat
+    from test_audit import BMBOX, CLIENT, REFBOX
+
+    audit = audit_states(
+        heartbeat(Machine.BMBOX, BMBOX, 20.0),
+        heartbeat(Machine.REFBOX, REFBOX, 20.0),
+        heartbeat(Machine.CLIENT, CLIENT, 20.0),
+        benchmark="fbm2h",
+    )
+    ax = Figure().add_subplot()
+    draw_timeline(ax, audit)
+    bars = ax.collections[: len(audit.timeline)]
+    assert len(audit.timeline) >= 10
+    for bar, e in zip(bars, audit.timeline, strict=True):
+        expected = to_rgba(STATE_COLOURS[e.machine][e.state_name])
+        assert tuple(bar.get_facecolor()[0]) == pytest.approx(expected), e
+    # The legend: one entry per colour drawn, each naming its state(s).
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    drawn = {(e.machine, e.state_name) for e in audit.timeline}
+    assert len(labels) == len({STATE_COLOURS[m][s] for m, s in drawn})
+    assert any("EXECUTING_GOAL" in label for label in labels)
