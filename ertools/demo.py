@@ -50,6 +50,8 @@ def steps(samples: Path, out: Path) -> Iterator[Step]:
             str(fbm3_bag),
             "--report",
             str(out / "fbm3w"),
+            "--foxglove",
+            str(out / "fbm3w.mcap"),
         ],
         "fbm3w_score.yaml",
     )
@@ -133,6 +135,7 @@ def run(out: Path, samples: Path = SAMPLES) -> int:
     for p in index:
         print(f"  {p}", file=sys.stderr)
     print(f"Open {out.resolve()}/fbm3w/index.html in a browser to start.", file=sys.stderr)
+    print(f"Open {out.resolve()}/fbm3w.mcap in Foxglove (docs/foxglove.md).", file=sys.stderr)
     return failed
 
 

@@ -544,6 +544,7 @@ def _score_one(
         score=score,
         sweep=swept,
         frame_xy=score.frame.to_frame(xy),
+        sample_t_ns=poses.t_ns[lo:hi],
         shape_floor=floor,
         target_dense=shape.dense(501),
         **common,

@@ -36,6 +36,7 @@ class RunResult:
         frame_xy: (N, 2) every sample of the window in the run frame (plots).
         shape_floor: distance_error of a noiseless robot exactly on the target.
         target_dense: (M, 2) the target curve, densely sampled (plots).
+        sample_t_ns: (N,) times of the samples of ``frame_xy`` (the Foxglove export).
     """
 
     window: RunWindow
@@ -52,6 +53,7 @@ class RunResult:
     frame_xy: Any = None
     shape_floor: float | None = None
     target_dense: Any = None
+    sample_t_ns: Any = None
 
     @property
     def index(self) -> int:

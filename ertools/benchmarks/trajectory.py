@@ -1104,36 +1104,59 @@ def read_gt(files: Sequence[str], topic: str, start_ns: int, end_ns: int) -> Pos
     return read_poses(files, topic, start_ns=start_ns, end_ns=end_ns)
 
 
-def score(
-    robot_bag: str | Path,
-    gt_paths: Sequence[str | Path],
-    config: TrajectoryConfig | None = None,
-    *,
-    robot_topic: str | None = None,
-    gt_topic: str | None = None,
-    robot_time: str = "header",
-) -> TrajectoryResult:
-    """Score a robot log against the GT files (or folders of them) that cover it.
+def same_bag(robot_bag: str | Path, gt_paths: Sequence[str | Path]) -> bool:
+    """Whether the GT is read from the robot log itself: no GT path, or only the robot log."""
+    robot_real = Path(robot_bag).resolve()
+    return all(Path(p).resolve() == robot_real for p in gt_paths)
 
-    Raises:
-        BagError, TopicError: unreadable files, missing topics.
-        ClockError: no GT overlapping the robot log, poses outside the GT.
-        ScoringError: non-increasing robot stamps.
-    """
+
+def _pick_gt_in_robot_bag(
+    s: BagSummary, gt_topic: str | None, robot_topic: str, gt_paths: Sequence[str | Path]
+) -> str:
+    """The GT topic in a robot log that holds both (evo's ``bag`` mode), or a one-line error."""
+    how = "the robot log itself" if gt_paths else "no GT_PATH given"
+    others = [n for n in _pose_topics(s) if n != robot_topic]
+    if gt_topic is not None:
+        if gt_topic == robot_topic:
+            raise TopicError(f"the GT topic {gt_topic} is the robot topic; give the mocap topic")
+        if s.topic(gt_topic) is None:
+            raise TopicError(
+                f"GT topic {gt_topic} is not in the robot log {s.path} (GT read from {how}); "
+                f"other pose topics there: {', '.join(others) or 'none'}; "
+                "give the GT files or their folder as GT_PATH"
+            )
+        return gt_topic
+    cands = [
+        t.name
+        for t in s.topics
+        if t.msgtype == "geometry_msgs/PoseStamped"
+        and not t.name.startswith("/rockin/")
+        and t.name != robot_topic
+    ]
+    if len(cands) == 1:
+        return cands[0]
+    if not cands:
+        raise TopicError(
+            f"{s.path}: the GT is read from {how}, but it holds no GT pose topic besides the "
+            f"robot topic {robot_topic}; give the mocap GT files or their folder as GT_PATH"
+        )
+    raise TopicError(
+        f"{s.path}: give --gt-topic (the GT is read from {how}; its PoseStamped topics: "
+        f"{', '.join(cands)})"
+    )
+
+
+def _gt_files(
+    robot_path: str,
+    gt_paths: Sequence[str | Path],
+    start_ns: int,
+    end_ns: int,
+    gt_topic: str | None,
+) -> tuple[list[BagSummary], str, list[str], list[str]]:
+    """The GT files of GT_PATH overlapping [start, end], their topic, warnings, damaged files."""
     from ertools.io import summary
     from ertools.timeline_scan import find_bags
 
-    cfg = config or TrajectoryConfig()
-    robot_path = str(robot_bag)
-    rs = summary(robot_path)
-    topic = _pick_robot_topic(rs, robot_topic)
-    robot = read_robot(robot_path, topic, robot_time)
-    if len(robot) == 0:
-        raise ScoringError(f"{robot_path}: robot topic {topic} has no messages")
-    # The robot's span on the GT clock, widened by the clock audit's search range.
-    lo = int(robot.t_ns.min()) + cfg.offset_ns
-    hi = int(robot.t_ns.max()) + cfg.offset_ns
-    margin = max(cfg.offset_range_ns, NS_PER_S)
     found = find_bags([Path(p) for p in gt_paths])
     if not found.bags:
         raise ClockError(
@@ -1175,12 +1198,55 @@ def score(
             skipped.append(f"GT file {p} is damaged: {'; '.join(damaged)}")
             broken.append(str(p))
     try:
-        chosen, gtopic, warnings = select_gt(gt_summaries, lo - margin, hi + margin, gt_topic)
+        chosen, gtopic, warnings = select_gt(gt_summaries, start_ns, end_ns, gt_topic)
     except ClockError as err:
         if not skipped:
             raise
         raise ClockError(f"{err}; also: {'; '.join(skipped)}") from err
-    warnings = skipped + warnings
+    return chosen, gtopic, skipped + warnings, broken
+
+
+def score(
+    robot_bag: str | Path,
+    gt_paths: Sequence[str | Path],
+    config: TrajectoryConfig | None = None,
+    *,
+    robot_topic: str | None = None,
+    gt_topic: str | None = None,
+    robot_time: str = "header",
+) -> TrajectoryResult:
+    """Score a robot log against the GT files (or folders of them) that cover it.
+
+    With no GT path, or the robot log itself as the only one, the GT topic is read from the
+    robot log (evo's ``bag`` mode: one bag recorded both topics).
+
+    Raises:
+        BagError, TopicError: unreadable files, missing topics.
+        ClockError: no GT overlapping the robot log, poses outside the GT.
+        ScoringError: non-increasing robot stamps.
+    """
+    from ertools.io import summary
+
+    cfg = config or TrajectoryConfig()
+    robot_path = str(robot_bag)
+    rs = summary(robot_path)
+    topic = _pick_robot_topic(rs, robot_topic)
+    robot = read_robot(robot_path, topic, robot_time)
+    if len(robot) == 0:
+        raise ScoringError(f"{robot_path}: robot topic {topic} has no messages")
+    # The robot's span on the GT clock, widened by the clock audit's search range.
+    lo = int(robot.t_ns.min()) + cfg.offset_ns
+    hi = int(robot.t_ns.max()) + cfg.offset_ns
+    margin = max(cfg.offset_range_ns, NS_PER_S)
+    if same_bag(robot_path, gt_paths):
+        # evo's `bag` mode: one bag holds both the robot's topic and the GT topic.
+        chosen, gtopic = [rs], _pick_gt_in_robot_bag(rs, gt_topic, topic, gt_paths)
+        warnings: list[str] = []
+        broken: list[str] = []
+    else:
+        chosen, gtopic, warnings, broken = _gt_files(
+            robot_path, gt_paths, lo - margin, hi + margin, gt_topic
+        )
     files = [s.path for s in chosen]
     gt = read_gt(files, gtopic, lo - margin, hi + margin)
     try:

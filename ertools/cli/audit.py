@@ -71,7 +71,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ertools.audit_score import ScoreInputs, audit_bag
-    from ertools.cli.common import emit_result, note, write_text
+    from ertools.cli.common import emit_result, note, write_foxglove_option, write_text
     from ertools.errors import ConfigError
     from ertools.timeutil import s_to_ns
 
@@ -113,6 +113,7 @@ def run(args: argparse.Namespace) -> int:
                 audit, args.report, inputs=bags, argv=getattr(args, "command_line", sys.argv)
             )
             note(f"wrote report {index}")
+        write_foxglove_option(audit, args, bags)
         for failure in audit.failures:
             note(f"error: {failure}")
         code = 1 if audit.failures else 0

@@ -17,8 +17,10 @@ def add_output_options(
     *,
     report: bool = True,
     plot: bool = True,
+    foxglove: bool = True,
 ) -> None:
-    """``--format``, ``--output``, and where the benchmark has them ``--report``/``--plot``."""
+    """``--format``, ``--output``, and where the benchmark has them ``--report``/``--plot``/
+    ``--foxglove``."""
     parser.add_argument(
         "--format",
         choices=formats,
@@ -38,6 +40,14 @@ def add_output_options(
     if plot:
         parser.add_argument(
             "--plot", type=Path, metavar="DIR", help="write the benchmark's figures (PNG) here"
+        )
+    if foxglove:
+        parser.add_argument(
+            "--foxglove",
+            type=Path,
+            metavar="FILE.mcap",
+            help="write what was scored (paths, targets, pairs, errors, states) as an MCAP "
+            "file for Foxglove (docs/foxglove.md)",
         )
 
 
@@ -87,6 +97,18 @@ def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[
             result, report_dir, inputs=inputs, argv=getattr(args, "command_line", sys.argv)
         )
         note(f"wrote report {index}")
+    write_foxglove_option(result, args, inputs)
     for failure in result.failures:
         note(f"error: {failure}")
     return 1 if result.failures else 0
+
+
+def write_foxglove_option(result: Any, args: argparse.Namespace, inputs: list[Path]) -> None:
+    """``--foxglove FILE.mcap``: the result's Foxglove file, when asked for."""
+    path: Path | None = getattr(args, "foxglove", None)
+    if path is None:
+        return
+    from ertools.report.foxglove import write_foxglove
+
+    written = write_foxglove(result, path, inputs=inputs)
+    note(f"wrote {written.path} ({written.messages} messages on {len(written.counts)} topics)")

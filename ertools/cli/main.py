@@ -146,7 +146,13 @@ def _configure_logging(verbose: int) -> None:
 
 
 # Options naming what a command writes; every other path option or argument is an input.
-OUTPUT_OPTIONS = {"output": "-o/--output", "report": "--report", "plot": "--plot", "out": "--out"}
+OUTPUT_OPTIONS = {
+    "output": "-o/--output",
+    "report": "--report",
+    "plot": "--plot",
+    "out": "--out",
+    "foxglove": "--foxglove",
+}
 
 
 def _refuse_overwriting_inputs(args: argparse.Namespace) -> None:

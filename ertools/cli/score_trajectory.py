@@ -1,7 +1,8 @@
 """Compare a robot's own pose log with the mocap ground truth (2015 offline trajectory benchmark).
 
 The GT files are picked from GT_PATH (bags or folders) by time overlap with the robot log and
-read as one stream. Every run also audits the clocks: it estimates the offset between the
+read as one stream; without GT_PATH the GT topic is read from the robot log itself (evo's
+``bag`` mode). Every run also audits the clocks: it estimates the offset between the
 robot's stamps and the GT clock and says when it matters.
 """
 
@@ -18,6 +19,8 @@ EPILOG = """examples:
   ertools score trajectory robot.bag gt/ --association hold --gaps compare
   ertools score trajectory robot.bag gt/ --offset auto --apply-offset --format json
   ertools score trajectory robot.bag gt/log_0.bag gt/log_1.bag --offset -0.35 --plot figs/
+  ertools score trajectory both.bag --robot-topic /rockin/homer/marker_pose \
+      --gt-topic /fbm2h/robot_at_home/pose     # one bag holding both topics (evo's bag mode)
 
 offset: seconds added to the robot's stamps to put them on the GT clock (negative when the
 robot's clock runs ahead). exit status: 0 scored, 1 unusable data, 2 usage error.
@@ -56,7 +59,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
     parser.add_argument("robot_bag", type=Path, metavar="ROBOT_BAG", help="the robot's log")
     parser.add_argument(
-        "gt_paths", type=Path, nargs="+", metavar="GT_PATH", help="GT bags or folders of them"
+        "gt_paths",
+        type=Path,
+        nargs="*",
+        metavar="GT_PATH",
+        help="GT bags or folders of them (none: the GT topic is in ROBOT_BAG itself)",
     )
     parser.add_argument(
         "--robot-topic",
@@ -185,6 +192,6 @@ def run(args: argparse.Namespace) -> int:
         robot_time=args.robot_time,
     )
     # cast: the frozen dataclass's fields are read-only, the Protocol declares plain attributes.
-    return emit_result(
-        cast("BenchmarkResult", result), args, [args.robot_bag, *map(Path, result.gt_files)]
-    )
+    # In evo's bag mode the robot log is also the GT file: listed once.
+    inputs = list(dict.fromkeys([args.robot_bag, *map(Path, result.gt_files)]))
+    return emit_result(cast("BenchmarkResult", result), args, inputs)

@@ -1047,7 +1047,7 @@ USAGE_COMMANDS = [
     ["score", "fbm1h", "x.bag"],  # --items is required
     ["score", "fbm2h"],
     ["score", "fbm3w"],
-    ["score", "trajectory", "robot.bag"],
+    ["score", "trajectory"],  # ROBOT_BAG is required (GT_PATH is not: evo's bag mode)
     ["score", "no_such_benchmark"],
     ["score"],
     ["noise"],

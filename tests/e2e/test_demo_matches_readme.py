@@ -10,7 +10,7 @@ from test_readme import ROOT, console_blocks
 from ertools.demo import steps
 
 # Where the output goes is the demo's business, not a scoring option.
-OUTPUT_OPTIONS = frozenset({"--report", "--format", "--plot", "--out", "-o"})
+OUTPUT_OPTIONS = frozenset({"--report", "--format", "--plot", "--out", "-o", "--foxglove"})
 
 
 def _options(argv: list[str]) -> frozenset[str]:
