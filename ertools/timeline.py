@@ -23,7 +23,7 @@ from __future__ import annotations
 import re
 from collections import defaultdict
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from itertools import pairwise
 from pathlib import Path
 from typing import Any, Literal, Protocol
@@ -550,51 +550,26 @@ def build_timeline(
 
     sessions, session_of = _sessions(base, cfg.gap_tolerance_ns)
     entries = [
-        BagEntry(
-            b.path,
-            b.format,
-            b.start_ns,
-            b.end_ns,
-            b.kind,
-            b.logger,
-            tuple(overlaps[b.path]),
-            tuple(dict.fromkeys(problems[b.path])),
-            session_of[b.path],
-            b.benchmarks,
+        replace(
+            b,
+            overlaps=tuple(overlaps[b.path]),
+            problems=tuple(dict.fromkeys(problems[b.path])),
+            session=session_of[b.path],
             copies=tuple(copies[b.path]),
         )
         for b in base
     ]
     entries += [
-        BagEntry(
-            b.path,
-            b.format,
-            b.start_ns,
-            b.end_ns,
-            b.kind,
-            b.logger,
-            (),
-            tuple(dict.fromkeys(problems[b.path])),
-            session_of[copy_of[b.path]],
-            b.benchmarks,
+        replace(
+            b,
+            problems=tuple(dict.fromkeys(problems[b.path])),
+            session=session_of[copy_of[b.path]],
             copy_of=copy_of[b.path],
         )
         for b in copied
     ]
     entries.sort(key=lambda b: (b.start_ns, b.end_ns, b.path))
-    entries += [
-        BagEntry(
-            b.path,
-            b.format,
-            None,
-            None,
-            b.kind,
-            b.logger,
-            (),
-            tuple(dict.fromkeys(problems[b.path])),
-        )
-        for b in broken
-    ]
+    entries += [replace(b, problems=tuple(dict.fromkeys(problems[b.path]))) for b in broken]
     by_path = {e.path: e for e in entries if e.copy_of is None}
     sessions = [
         Session(
