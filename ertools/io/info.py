@@ -31,6 +31,13 @@ class BagInfo:
     # What --check found (index against records, damaged chunks), one line each.
     check_problems: tuple[str, ...] = ()
 
+    @property
+    def fatal_problem(self) -> str | None:
+        """What makes the bag unusable (truncated, damaged, an index that contradicts
+        itself), one line; None for a sound bag or a mere ``.active`` still recording."""
+        bad = [p for p in self.summary.problems if not p.startswith("not indexed")]
+        return "; ".join(bad) if bad else None
+
     def to_dict(self) -> dict[str, Any]:
         s = self.summary
         empty = s.message_count == 0
