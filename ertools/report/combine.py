@@ -242,8 +242,8 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
         writer = csv.DictWriter(fh, fieldnames=columns)
         writer.writeheader()
         writer.writerows(flat)
-    merged = f" of {len(runs)} execution(s)" if len(runs) != len(entries) else ""
-    subtitle = f"{len(entries)} result(s){merged}, combined by ertools {__version__}"
+    of_runs = f" of {len(runs)} execution(s)" if len(runs) != len(entries) else ""
+    subtitle = f"{len(entries)} result(s){of_runs}, combined by ertools {__version__}"
     index = outdir / "index.html"
     nav = [(b["anchor"], b["title"]) for b in benchmarks] + [("teams", "By team")]
     page = h.render(

@@ -141,7 +141,7 @@ def _write_report(
     configs = _configs(argv, inputs, score)
     team_source: str | None = "explicit" if team else None
     if not team:
-        team, team_source = _team(argv, score, audit, configs)
+        team, team_source = _team(argv, inputs, score, audit, configs)
 
     written: list[str] = []
     if score is not None:
@@ -265,6 +265,7 @@ def _configs(
 
 def _team(
     argv: list[str],
+    inputs: list[Path],
     score: BenchmarkResult | None,
     audit: Any,
     configs: list[tuple[FileRecord, str | None]],
@@ -283,8 +284,8 @@ def _team(
             return argv[i + 1], "explicit"
         if token.startswith("--team="):
             return token.split("=", 1)[1], "explicit"
-    inputs = score.provenance.inputs if score is not None else ()
-    for path in (*inputs, *(getattr(getattr(audit, "provenance", None), "inputs", ()) or ())):
+    named = [*inputs, *(score.provenance.inputs if score is not None else ())]
+    for path in (*named, *(getattr(getattr(audit, "provenance", None), "inputs", ()) or ())):
         found = team_from_log_name(path)
         if found:
             return found, "log name"
