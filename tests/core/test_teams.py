@@ -200,6 +200,17 @@ def test_fbm2h_team_alone_keeps_the_identity_transform(
     err = capsys.readouterr().err
     assert "identity marker-to-robot transform" in err
     assert json.loads((tmp_path / "r" / "result.json").read_text())["team"] == "simbot"
+    # No --team, a mocap log's name: the transform file names the team (its robot_info).
+    (transform,) = folder.glob("transform-*.yaml")
+    expected = transform.name.removeprefix("transform-").removesuffix(".yaml")
+    t_report = tmp_path / "t"
+    assert (
+        main(["score", "fbm2h", str(bag), "--transform", str(transform), "--report", str(t_report)])
+        == 0
+    )
+    meta = json.loads((t_report / "result.json").read_text())
+    assert (meta["team"], meta["team_source"]) == (expected, "transform")
+    capsys.readouterr()
     code = main(["score", "fbm2h", str(bag), "--transforms", str(folder)])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 1 and len(err) == 1 and "--transforms DIR needs --team NAME" in err[0]
