@@ -119,6 +119,8 @@ class Fbm2hOptions:
         goal: Listing 10 goal list file; None = the goal payload in the state topics.
         transform: Listing 11 file; None with ``team``+``transforms_dir`` = DIR/transform-TEAM.yaml;
             None otherwise = identity (said in the warnings).
+        team: picks the transform with ``transforms_dir``; alone it changes nothing here (the
+            CLI keeps it as the result's team, see :mod:`ertools.teams`).
         topic / tf_frame: where the marker set's poses are (PoseStamped/Pose2D topic, or a /tf
             child frame of ``world``).
         time_source: ``header`` (mocap stamp) or ``record`` (bag time).
