@@ -239,7 +239,7 @@ def compute(
             nearest = (
                 "no GT sample at all"
                 if gap == np.iinfo(np.int64).max
-                else (f"nearest GT sample {gap / 1e9:.3f} s away")
+                else (f"nearest GT sample {gap / 1e9:.3g} s away")  # 3 digits, even below 1 ms
             )
             failures.append(
                 f"segment {i}: no ground truth within --max-gap {max_gap_s} s of the reached "
@@ -262,7 +262,14 @@ def compute(
             )
         )
     scored = all(s.status == "ok" for s in segments)
-    execution_time = sum(s.segment_time or 0.0 for s in segments)
+    # Summed in int64 ns: a sum of float seconds prints binary noise (41.199999999999996).
+    execution_time = ns_to_s(
+        sum(
+            s.end_ns - s.start_ns
+            for s in segments
+            if s.start_ns is not None and s.end_ns is not None
+        )
+    )
     position, orientation = _accuracies(
         segments, poses.xyyaw, target, n, orientation_2015, unscored_2015
     )

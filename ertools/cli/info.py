@@ -174,9 +174,9 @@ def run(args: argparse.Namespace) -> int:
         if args.format == "json":
             text = dump_json(data)
         else:
-            import yaml
+            from ertools.benchmarks.base import dump_yaml
 
-            text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
+            text = dump_yaml(data)  # rates without binary noise, as every ertools YAML
     if text:
         write_text(text, args.output)
     for p in problems:
