@@ -132,6 +132,8 @@ class Fbm2hOptions:
             timed out counted in execution_time (``--unscored-segments 2015``).
         namespace: the benchmark namespace of the state topics.
         stops: thresholds for ``auto``.
+        marker_transform: a transform already in hand (``ertools audit``: the one the live
+            score says the node used); None = from ``transform``/``team``, else identity.
     """
 
     goal: Path | None = None
@@ -149,6 +151,7 @@ class Fbm2hOptions:
     unscored_2015: bool = False
     namespace: str = "fbm2h"
     stops: StopParams = field(default_factory=StopParams)
+    marker_transform: MarkerTransform | None = None
 
 
 def _decimate(stream: PoseStream, points: int) -> PoseStream:
@@ -435,6 +438,10 @@ def invalid_warning(count: int, source: str) -> str:
 def _load_transform(options: Fbm2hOptions) -> MarkerTransform:
     from ertools.configs.transform import identity_transform, load_transform, team_transform_path
 
+    if options.marker_transform is not None:
+        if options.transform is not None or options.team is not None:
+            raise ConfigError("a transform in hand excludes --transform and --team")
+        return options.marker_transform
     if options.transform is not None:
         if options.team is not None or options.transforms_dir is not None:
             raise ConfigError("give either --transform FILE or --team NAME --transforms DIR")
