@@ -566,9 +566,10 @@ USES: dict[str, frozenset[str]] = {
 def _marker_transform(
     benchmark: str, inputs: ScoreInputs, live: Any
 ) -> tuple[MarkerTransform | None, tuple[str, ...]]:
-    """FBM2H without ``--transform``/``--team``: the transform the live score recorded, and a
-    note saying so; otherwise None (the inputs decide, identity when they say nothing)."""
-    if benchmark != "fbm2h" or inputs.given() & {"transform", "team", "transforms"}:
+    """FBM2H without ``--transform``/``--transforms``: the transform the live score recorded,
+    and a note saying so; otherwise None (the inputs decide, identity when they say nothing).
+    ``--team`` alone names the team and picks no transform."""
+    if benchmark != "fbm2h" or inputs.given() & {"transform", "transforms"}:
         return None, ()
     found = live_transform(live)
     if found is None:

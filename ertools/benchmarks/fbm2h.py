@@ -439,8 +439,8 @@ def _load_transform(options: Fbm2hOptions) -> MarkerTransform:
     from ertools.configs.transform import identity_transform, load_transform, team_transform_path
 
     if options.marker_transform is not None:
-        if options.transform is not None or options.team is not None:
-            raise ConfigError("a transform in hand excludes --transform and --team")
+        if options.transform is not None or options.transforms_dir is not None:
+            raise ConfigError("a transform in hand excludes --transform and --transforms")
         return options.marker_transform
     if options.transform is not None:
         if options.team is not None or options.transforms_dir is not None:
