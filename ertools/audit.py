@@ -298,8 +298,13 @@ class Audit:
             )
         if self.comparison is not None:
             cmp = self.comparison
+            title = (
+                f"live vs recomputed score ({cmp.caveat})"
+                if cmp.caveat
+                else ("live vs recomputed score")
+            )
             lines.append(
-                f"live vs recomputed score: {cmp.same} same, {len(cmp.differences)} differ "
+                f"{title}: {cmp.same} same, {len(cmp.differences)} differ "
                 f"(tolerance {cmp.abs_tol:g})"
             )
             lines += [f"  note: {n}" for n in cmp.notes]

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Rows, jsonable
+from ertools.configs.transform import MarkerTransform
 from ertools.fidelity import Deviation
 
 if TYPE_CHECKING:
@@ -55,6 +56,9 @@ class ScoreComparison:
     parameters: tuple[tuple[str, str], ...]
     deviations: tuple[Deviation, ...]
     notes: tuple[str, ...] = ()
+    # Why the two scores cannot agree whatever the data (an identity transform), shown in the
+    # comparison's title and beside every difference it causes; "" when they can.
+    caveat: str = ""
 
     @property
     def differences(self) -> tuple[ScoreLine, ...]:
@@ -81,6 +85,7 @@ class ScoreComparison:
     def to_dict(self) -> dict[str, Any]:
         return {
             "benchmark": self.benchmark,
+            "caveat": self.caveat or None,
             "tolerance": self.abs_tol,
             "same": self.same,
             "differences": len(self.differences),
@@ -328,6 +333,53 @@ def _is_number(value: Any) -> bool:
 # Comparing
 
 
+# The live FBM2H score records the transform its node used (seed Listing 13: details.marker-robot
+# transform, [[x, y, z], [qx, qy, qz, qw]]); an audit given none re-scores with it.
+LIVE_TRANSFORM_KEY = "marker-robot transform"
+IDENTITY_CAVEAT = "identity transform: recomputed scores are not comparable with the live ones"
+# Score keys that depend on the robot pose, hence on the marker-to-robot transform.
+POSE_KEYS = re.compile(
+    r"position|orientation|distance|dinstance|robot_pose|transform", re.IGNORECASE
+)  # "dinstance": the 2015 spelling (Listing 13)
+
+
+def live_transform(live: Any) -> MarkerTransform | None:
+    """The marker-to-robot transform the live FBM2H score says its node used, or None when the
+    payload has none (or not as ``[[x, y, z], [qx, qy, qz, qw]]``)."""
+    from ertools.configs.transform import parse_transform
+    from ertools.errors import ConfigError
+
+    if not isinstance(live, dict):
+        return None
+    details = live.get("details")
+    value = details.get(LIVE_TRANSFORM_KEY) if isinstance(details, dict) else None
+    if value is None:
+        value = live.get(LIVE_TRANSFORM_KEY)  # an early node wrote it at the top level
+    if value is None:
+        return None
+    try:
+        return parse_transform(
+            {
+                "robot_info": "live score",
+                "transform_timestamp": "0",
+                "marker_to_robot_transform": value,
+            },
+            source=f"the live score (details.{LIVE_TRANSFORM_KEY})",
+        )
+    except ConfigError:
+        return None
+
+
+def _identity_caveat(live: Any, result: BenchmarkResult) -> str:
+    """:data:`IDENTITY_CAVEAT` when ``result`` was computed with the identity transform and the
+    live score does not say its node used the identity too."""
+    transform = getattr(result, "transform", None)
+    if not isinstance(transform, MarkerTransform) or not transform.is_identity:
+        return ""
+    used = live_transform(live)
+    return "" if used is not None and used.is_identity else IDENTITY_CAVEAT
+
+
 def compare_scores(
     live: Any,
     result: BenchmarkResult,
@@ -354,7 +406,11 @@ def compare_scores(
     recomputed = jsonable(result.to_dict())
     params = tuple(result.provenance.parameters)
     devs = tuple(result.deviations)
+    caveat = _identity_caveat(live, result)
     notes: list[str] = []
+    transform = getattr(result, "transform", None)
+    if isinstance(transform, MarkerTransform) and transform.source.startswith("the live score"):
+        notes.append(f"transform taken from the live score (details.{LIVE_TRANSFORM_KEY})")
     if live is None:
         notes.append("no live score in the bag (no TRANSMITTING_SCORE payload, or unreadable)")
         live_flat: dict[str, Any] = {}
@@ -404,6 +460,8 @@ def compare_scores(
         )
         if not same and as_2015 is not None and key in flat_2015:
             expl = _check_2015(lv, flat_2015[key]) + "; " + expl
+        if not same and caveat and POSE_KEYS.search(key):
+            expl = f"{caveat}; {expl}"  # the reason first: nothing else can explain it away
         lines.append(ScoreLine(key, lv, rv, diff, "same" if same else "differs", expl))
     return ScoreComparison(
         benchmark=result.name,
@@ -412,6 +470,7 @@ def compare_scores(
         parameters=params,
         deviations=devs,
         notes=tuple(notes),
+        caveat=caveat,
     )
 
 
@@ -504,10 +563,32 @@ USES: dict[str, frozenset[str]] = {
 }
 
 
+def _marker_transform(
+    benchmark: str, inputs: ScoreInputs, live: Any
+) -> tuple[MarkerTransform | None, tuple[str, ...]]:
+    """FBM2H without ``--transform``/``--transforms``: the transform the live score recorded,
+    and a note saying so; otherwise None (the inputs decide, identity when they say nothing).
+    ``--team`` alone names the team and picks no transform."""
+    if benchmark != "fbm2h" or inputs.given() & {"transform", "transforms"}:
+        return None, ()
+    found = live_transform(live)
+    if found is None:
+        return None, ()
+    t = ", ".join(f"{v:g}" for v in found.translation)
+    q = ", ".join(f"{v:.6g}" for v in found.quat_xyzw)
+    return found, (
+        f"transform taken from the live score (details.{LIVE_TRANSFORM_KEY}: [[{t}], [{q}]]); "
+        "give --transform or --team/--transforms to use another",
+    )
+
+
 def rescore(
-    benchmark: str, paths: Sequence[Path], inputs: ScoreInputs
+    benchmark: str, paths: Sequence[Path], inputs: ScoreInputs, live: Any = None
 ) -> tuple[BenchmarkResult, tuple[str, ...]]:
     """Recompute ``benchmark``'s score from ``paths`` with the scorer of ``ertools.benchmarks``.
+
+    ``live`` (the parsed live score) gives FBM2H the transform its node used when the inputs
+    name none (:func:`live_transform`).
 
     Returns:
         The result, and notes about inputs the scorer does not use.
@@ -527,6 +608,8 @@ def rescore(
     if benchmark == "fbm2h":
         from ertools.benchmarks.fbm2h import Fbm2hOptions, score_fbm2h
 
+        marker, said = _marker_transform(benchmark, inputs, live)
+        notes += said
         result = score_fbm2h(
             plist,
             Fbm2hOptions(
@@ -537,6 +620,7 @@ def rescore(
                 topic=inputs.topic,
                 hits=inputs.hits,
                 namespace=benchmark,
+                marker_transform=marker,
             ),
         )
     elif benchmark in ("fbm1h", "fbm1w"):
@@ -556,7 +640,7 @@ def rescore(
 
 
 def rescore_2015(
-    benchmark: str, paths: Sequence[Path], inputs: ScoreInputs
+    benchmark: str, paths: Sequence[Path], inputs: ScoreInputs, live: Any = None
 ) -> BenchmarkResult | None:
     """The score recomputed with every 2015 quirk the scorer can reproduce (fbm2h: unwrapped
     orientation and unscored segments over N; fbm1: ``Fbm1Options.as_2015``; fbm3w:
@@ -584,6 +668,7 @@ def rescore_2015(
                 namespace=benchmark,
                 orientation_2015=True,
                 unscored_2015=True,
+                marker_transform=_marker_transform(benchmark, inputs, live)[0],
             ),
         )
     if benchmark in ("fbm1h", "fbm1w") and inputs.items is not None:
@@ -697,7 +782,7 @@ def audit_bag(
         return audit, ()
     given = inputs or ScoreInputs()
     try:
-        result, notes = rescore(ns, plist, given)
+        result, notes = rescore(ns, plist, given, audit.live_score)
     except ErtoolsError as err:
         if given.given() & USES.get(ns, frozenset()):
             # The user named a scoring input: when it (or what it points at) is bad, that is
@@ -709,7 +794,7 @@ def audit_bag(
     if not check_2015 or attached.comparison is None or not attached.comparison.differences:
         return attached, notes
     try:
-        as_2015 = rescore_2015(ns, plist, given)
+        as_2015 = rescore_2015(ns, plist, given, audit.live_score)
     except ErtoolsError as err:
         return attached, (*notes, f"not recomputed with the 2015 rules: {err}")
     if as_2015 is None:

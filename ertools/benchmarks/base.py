@@ -53,16 +53,11 @@ class BenchmarkResult(Protocol):
 
 
 def dump_yaml(data: Any) -> str:
-    """YAML as the 2015 nodes dumped it (block style, keys in insertion order)."""
-    import yaml
+    """YAML as the 2015 nodes dumped it (block style, keys in insertion order), floats
+    rounded to 9 decimal places (:mod:`ertools.yamlout`)."""
+    from ertools.yamlout import dump
 
-    class Dumper(yaml.SafeDumper):
-        """The safe dumper, taking ``str`` subclasses (``fidelity.Deviation``) as plain text."""
-
-    Dumper.add_multi_representer(str, yaml.SafeDumper.represent_str)
-    return yaml.dump(
-        data, Dumper=Dumper, default_flow_style=False, sort_keys=False, allow_unicode=True
-    )
+    return dump(data)
 
 
 def jsonable(value: Any) -> Any:

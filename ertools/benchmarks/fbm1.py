@@ -245,11 +245,11 @@ def _answer_for(run: Fbm1Run, item: Item | None, results: ResultsFile | None) ->
     return parse_answer_payload(run.answer_payload, where)
 
 
-def _execution_time(run: Fbm1Run) -> float | None:
+def _execution_time_ns(run: Fbm1Run) -> int | None:
     start = run.executing_ns if run.executing_ns is not None else run.goal_ns
     if start is None or run.result_ns is None:
         return None
-    return (run.result_ns - start) / NS_PER_S
+    return run.result_ns - start
 
 
 def item_broadcast(run: Fbm1Run, method: str, item_tf: PoseStream | None) -> int | None:
@@ -304,7 +304,7 @@ def score_run(
         answer = _answer_for(run, item, results)
     except ScoringError as err:
         return Fbm1RunResult(status="failed", item=item, error=err.message, **base)
-    exec_time = _execution_time(run)
+    exec_time = _execution_time_ns(run)
     if exec_time is None and answer is not None:
         warnings.append(f"{where}: no result time in the log; execution time unknown")
     if answer is None and run.result_ns is None and run.ended_by is None:
@@ -318,13 +318,13 @@ def score_run(
     if answer is None:
         # 2015: a timed-out run counted with no positives and pose score 0; a stopped run's
         # time was not added.
-        counted_time = exec_time if run.ended_by != "stop" else 0.0
+        counted_time = exec_time if run.ended_by != "stop" else 0
         return Fbm1RunResult(
             status="no_answer",
             item=item,
             class_ok=False,
             instance_ok=False,
-            execution_time_s=counted_time,
+            execution_time_ns=counted_time,
             warnings=tuple(warnings),
             **base,
         )
@@ -372,7 +372,7 @@ def score_run(
         errors=errors,
         class_ok=names_match(answer.item_class, item.item_class, options.rules),
         instance_ok=names_match(answer.item_instance, item.instance, options.rules),
-        execution_time_s=exec_time,
+        execution_time_ns=exec_time,
         warnings=tuple(warnings),
         **base,
     )
@@ -473,7 +473,7 @@ def score_fbm1(
         [bool(r.class_ok) for r in counted],
         [bool(r.instance_ok) for r in counted],
         [r.pose_score or 0.0 for r in counted],
-        [r.execution_time_s or 0.0 for r in counted],
+        [r.execution_time_ns or 0 for r in counted],
         aborted=sum(r.status == "aborted" for r in runs),
         rules=opts.rules,
     )

@@ -97,6 +97,12 @@ class AcquireResult:
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
 
+    @property
+    def nothing_scored(self) -> bool:
+        """Not one item acquired (each failed): the CLI prints only the failures, not the
+        vanilla list back (``ertools.cli.common.all_failed``)."""
+        return len(self.failures) >= len(self.items)
+
 
 def still_phases(rel: PoseStream, options: AcquireOptions) -> list[Interval]:
     """Maximal intervals where ``rel`` (board in the table frame) stays still, vectorised.

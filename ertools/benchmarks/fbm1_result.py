@@ -13,7 +13,7 @@ from ertools.benchmarks.fbm1_score import PoseErrors, Totals
 from ertools.configs.items import Item
 from ertools.fidelity import Deviation
 from ertools.streams import Provenance
-from ertools.timeutil import NS_PER_S
+from ertools.timeutil import NS_PER_S, ns_to_s
 
 
 @dataclass(frozen=True)
@@ -32,7 +32,8 @@ class Fbm1RunResult:
         errors: the pose errors and pose score, None unless scored.
         class_ok: class right (False for a run without answer), None when not counted.
         instance_ok: instance right, likewise.
-        execution_time_s: goal acknowledged -> result, seconds; None when unknown.
+        execution_time_ns: goal acknowledged -> result, int64 ns (totals are summed in ns,
+            so 0.572 + 0.787 s prints as 1.359, not 1.3590000000000002); None when unknown.
         goal_ns: the goal was sent.
         result_ns: the BmBox stopped waiting for the result.
         ended_by: ``timeout``/``stop`` when the RefBox ended the run.
@@ -49,12 +50,17 @@ class Fbm1RunResult:
     errors: PoseErrors | None = None
     class_ok: bool | None = None
     instance_ok: bool | None = None
-    execution_time_s: float | None = None
+    execution_time_ns: int | None = None
     goal_ns: int | None = None
     result_ns: int | None = None
     ended_by: str | None = None
     error: str | None = None
     warnings: tuple[str, ...] = ()
+
+    @property
+    def execution_time_s(self) -> float | None:
+        """The execution time in seconds (None when unknown)."""
+        return None if self.execution_time_ns is None else ns_to_s(self.execution_time_ns)
 
     @property
     def pose_score(self) -> float | None:
@@ -187,6 +193,12 @@ class Fbm1Result:
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
     reference: str = "ertools default"
+
+    @property
+    def nothing_scored(self) -> bool:
+        """No run counted (scored, or without answer with score 0): no total is a number, so
+        the CLI prints only the failures (``ertools.cli.common.all_failed``)."""
+        return not any(r.status in ("scored", "no_answer") for r in self.runs)
 
     def score(self) -> dict[str, Any]:
         """The four keys of the 2015 score payload, in the order ``yaml.dump`` sorted them."""

@@ -26,6 +26,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from ertools.timeutil import ns_to_s
+
 # The @Home nodes played at most this many runs; the 2016-17 one divided the accuracies by it.
 BENCHMARK_RUNS_HOME = 10
 # The 2015 "maximum pose error": the diagonal of a 1 m x 1 m table.
@@ -148,7 +150,7 @@ def totals(
     class_ok: list[bool],
     instance_ok: list[bool],
     pose_scores: list[float],
-    execution_times: list[float],
+    execution_times_ns: list[int],
     *,
     aborted: int,
     rules: ScoreRules,
@@ -169,7 +171,8 @@ def totals(
         ratio(sum(class_ok), acc_runs),
         ratio(sum(instance_ok), acc_runs),
         ratio(math.fsum(pose_scores), pose_runs),
-        math.fsum(execution_times),
+        # summed in int64 ns: a sum of float seconds prints binary noise (41.199999999999996)
+        ns_to_s(sum(execution_times_ns)),
         acc_runs,
         pose_runs,
     )

@@ -134,6 +134,8 @@ class Fbm2hOptions:
             timed out counted in execution_time (``--unscored-segments 2015``).
         namespace: the benchmark namespace of the state topics.
         stops: thresholds for ``auto``.
+        marker_transform: a transform already in hand (``ertools audit``: the one the live
+            score says the node used); None = from ``transform``/``team``, else identity.
     """
 
     goal: Path | None = None
@@ -151,6 +153,7 @@ class Fbm2hOptions:
     unscored_2015: bool = False
     namespace: str = "fbm2h"
     stops: StopParams = field(default_factory=StopParams)
+    marker_transform: MarkerTransform | None = None
 
 
 def _decimate(stream: PoseStream, points: int) -> PoseStream:
@@ -241,7 +244,7 @@ def compute(
             nearest = (
                 "no GT sample at all"
                 if gap == np.iinfo(np.int64).max
-                else (f"nearest GT sample {gap / 1e9:.3f} s away")
+                else (f"nearest GT sample {gap / 1e9:.3g} s away")  # 3 digits, even below 1 ms
             )
             failures.append(
                 f"segment {i}: no ground truth within --max-gap {max_gap_s} s of the reached "
@@ -264,7 +267,14 @@ def compute(
             )
         )
     scored = all(s.status == "ok" for s in segments)
-    execution_time = sum(s.segment_time or 0.0 for s in segments)
+    # Summed in int64 ns: a sum of float seconds prints binary noise (41.199999999999996).
+    execution_time = ns_to_s(
+        sum(
+            s.end_ns - s.start_ns
+            for s in segments
+            if s.start_ns is not None and s.end_ns is not None
+        )
+    )
     position, orientation = _accuracies(
         segments, poses.xyyaw, target, n, orientation_2015, unscored_2015
     )
@@ -430,6 +440,10 @@ def invalid_warning(count: int, source: str) -> str:
 def _load_transform(options: Fbm2hOptions) -> MarkerTransform:
     from ertools.configs.transform import identity_transform, load_transform, team_transform_path
 
+    if options.marker_transform is not None:
+        if options.transform is not None or options.transforms_dir is not None:
+            raise ConfigError("a transform in hand excludes --transform and --transforms")
+        return options.marker_transform
     # --team alone only names the team (every scoring command has it); with --transforms DIR
     # it also picks DIR/transform-TEAM.yaml, as the 2015 launch file's team_name argument did.
     if options.transform is not None:

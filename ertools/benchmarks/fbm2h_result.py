@@ -126,6 +126,12 @@ class Fbm2hResult:
     provenance: Provenance = field(default_factory=Provenance)
     name: str = "fbm2h"
 
+    @property
+    def nothing_scored(self) -> bool:
+        """Not one segment scored: the CLI prints only the failures
+        (``ertools.cli.common.all_failed``)."""
+        return not any(s.status == "ok" for s in self.segments)
+
     def _segment_listing(self, seg: SegmentResult) -> dict[str, Any]:
         # Keys and order of Listing 13 (the 2015 node wrote "dinstance_error" so, typo included).
         return {

@@ -12,6 +12,7 @@ from ertools.benchmarks.fbm3w_runs import RunWindow
 from ertools.benchmarks.noise import NoiseResult
 from ertools.fidelity import Deviation
 from ertools.streams import Provenance
+from ertools.timeutil import ns_to_s
 
 # Listing 16 keys of one run, in the listing's order; ertools' extra keys follow them.
 RUN_KEYS = ("spec", "distance_error", "execution_time")
@@ -129,6 +130,12 @@ class Fbm3wResult:
     count_stopped: bool = True
 
     @property
+    def nothing_scored(self) -> bool:
+        """Every run failed (none scored, timed out, stopped or interrupted): the CLI prints
+        only the failures (``ertools.cli.common.all_failed``)."""
+        return all(r.status == "failed" for r in self.runs)
+
+    @property
     def best_run(self) -> int | None:
         """The scored run with the smallest distance_error (the first on ties, as 2015)."""
         best: RunResult | None = None
@@ -154,13 +161,10 @@ class Fbm3wResult:
         Stopped runs are included unless ``count_stopped`` is False (``--stopped-runs 2015``:
         the 2015 node skipped them before adding the time).
         """
-        return float(
-            sum(
-                r.execution_time
-                for r in self.runs
-                if r.execution_time is not None
-                and (self.count_stopped or r.window.status != "stopped")
-            )
+        # Summed in int64 ns: a sum of float seconds prints binary noise (24.549999999999997).
+        w = [r.window for r in self.runs if self.count_stopped or r.window.status != "stopped"]
+        return ns_to_s(
+            sum(x.end_ns - x.start_ns for x in w if x.start_ns is not None and x.end_ns is not None)
         )
 
     def _score(self) -> dict[str, Any]:

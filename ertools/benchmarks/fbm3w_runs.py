@@ -44,7 +44,7 @@ from ertools.errors import ConfigError, SegmentationError
 from ertools.io.model import BenchmarkStates
 from ertools.states import BmBoxState, RefBoxState
 from ertools.streams import PoseStream, StateStream
-from ertools.timeutil import resolve_time
+from ertools.timeutil import ns_to_s, resolve_time
 
 F64 = npt.NDArray[np.float64]
 
@@ -96,7 +96,7 @@ class RunWindow:
     def execution_time_s(self) -> float | None:
         if self.start_ns is None or self.end_ns is None:
             return None
-        return (self.end_ns - self.start_ns) / 1e9
+        return ns_to_s(self.end_ns - self.start_ns)
 
 
 # --- states -------------------------------------------------------------------------------

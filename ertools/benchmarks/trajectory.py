@@ -509,6 +509,11 @@ class TrajectoryResult:
     name: str = "trajectory"
 
     @property
+    def nothing_scored(self) -> bool:
+        """No robot pose compared, so no metric: the CLI prints only the failure."""
+        return self.metrics is None
+
+    @property
     def compared(self) -> int:
         return self.matched.count(COMPARED)
 

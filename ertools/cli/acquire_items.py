@@ -13,7 +13,7 @@ import argparse
 import math
 from pathlib import Path
 
-from ertools.cli.common import note, write_text
+from ertools.cli.common import all_failed, note, write_text
 
 EPILOG = """examples:
   ertools acquire items items.bag --items fbm1h-vanilla.yaml -o fbm1h.yaml
@@ -100,6 +100,10 @@ def run(args: argparse.Namespace) -> int:
         options=options,
         sources=(origin, board),
     )
+    if all_failed(result):  # no item measured: only the errors, not the vanilla list back
+        for failure in result.failures:
+            note(f"error: {failure}")
+        return 1
     write_text(items_to_yaml(result.items), args.output)
     note(
         f"{'id':>3} {'instance':<16} {'window s':>17} {'n':>5} {'x m':>8} {'y m':>8} "

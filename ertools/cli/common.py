@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks.base import BenchmarkResult, jsonable
+from ertools.teams import with_team
 
 
 def add_output_options(
@@ -79,14 +80,25 @@ def dump_json(data: Any) -> str:
     return json.dumps(jsonable(data), indent=2, allow_nan=False)
 
 
+def all_failed(result: object) -> bool:
+    """True when a result has failures and no honest number at all (every run, segment or
+    pose failed: the result's ``nothing_scored``). Such a result is never printed: only its
+    failures, one ``ertools: error:`` line each on stderr, nothing on stdout, exit 1. A result
+    where some runs scored is printed, failed ones as null with their error on stderr."""
+    return bool(getattr(result, "failures", ())) and bool(getattr(result, "nothing_scored", False))
+
+
 def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[Path]) -> int:
     """Print a result in the chosen format, write its plots and report, return the exit code.
 
     Warnings and deviations from the 2015 node go to stderr, so a referee sees them even when
-    stdout is redirected to a file.
+    stdout is redirected to a file. A result with nothing scored (:func:`all_failed`) prints
+    its failures only and writes no output file, report, figure or Foxglove file.
     """
-    from ertools.teams import with_team
-
+    if all_failed(result):
+        for failure in result.failures:
+            note(f"error: {failure}")
+        return 1
     result = with_team(result, getattr(args, "team", None), inputs)
     fmt = getattr(args, "format", "yaml")
     text = result.to_yaml() if fmt == "yaml" else dump_json(result.to_dict())

@@ -22,11 +22,13 @@ EPILOG = """examples:
   ertools info logs/ --format yaml           # every bag under logs/
   ertools info run.bag --check               # also decompress and check every chunk
 
-Rates are the median of the intervals between record times, from the index records.
+Rates are the median of the intervals between record times, from the index records, stated
+for topics with at least 10 messages over at least 1 s; others show "n messages in s s".
 JSON/YAML layout: {"bags": [{"path", "format", "version", "start", "start_iso", "end",
 "end_iso", "duration", "size_bytes", "compression", "messages", "indexed", "index",
 "checked", "problems", "topics": [{"name", "type", "count", "connections", "first", "last",
-"median_rate_hz"}]}], "problems": [{"path", "problem"}]}; times in epoch seconds.
+"span_s", "median_rate_hz"}]}], "problems": [{"path", "problem"}]}; times in epoch seconds,
+median_rate_hz null where no rate is stated.
 Exit status 1 when any bag is unreadable, truncated or (with --check) corrupt.
 """
 
@@ -58,14 +60,18 @@ def _size(n: int) -> str:
     return f"{n} B"
 
 
-def _rate(hz: float | None) -> str:
-    if hz is None:
-        return "-"
-    return f"{hz:.3g} Hz" if hz < 1000 else f"{hz:.0f} Hz"
+def _rate(hz: float | None, count: int, span: float | None) -> str:
+    """The median rate, or where none is stated what the index knows: count and span."""
+    if hz is not None:
+        return f"{hz:.3g} Hz" if hz < 1000 else f"{hz:.0f} Hz"
+    if count < 2 or span is None:
+        return "-"  # the count column already says it all
+    return f"{count} messages in {span:.3g} s"
 
 
 def table(info: BagInfo) -> str:
     """`rosbag info`-like text of one bag."""
+    from ertools.io.info import span_s
     from ertools.timeutil import iso_utc, ns_to_s
 
     s = info.summary
@@ -99,7 +105,7 @@ def table(info: BagInfo) -> str:
             t.name,
             t.msgtype,
             str(t.count),
-            _rate(info.median_rate_hz.get(t.name)),
+            _rate(info.median_rate_hz.get(t.name), t.count, span_s(t.first_ns, t.last_ns)),
             f"{t.connections} conn" if t.connections > 1 else "",
         )
         for t in s.topics
@@ -162,9 +168,9 @@ def run(args: argparse.Namespace) -> int:
         if args.format == "json":
             text = dump_json(data)
         else:
-            import yaml
+            from ertools.benchmarks.base import dump_yaml
 
-            text = yaml.safe_dump(data, sort_keys=False, allow_unicode=True)
+            text = dump_yaml(data)  # rates without binary noise, as every ertools YAML
     if text:
         write_text(text, args.output)
     for p in problems:

@@ -15,7 +15,7 @@ import math
 from pathlib import Path
 from typing import cast
 
-from ertools.cli.common import add_output_options, emit_result, note
+from ertools.cli.common import add_output_options, all_failed, emit_result, note
 
 EPILOG = """examples:
   ertools score fbm1h run.bag --items configs/fbm1h.yaml
@@ -223,8 +223,9 @@ def run(args: argparse.Namespace) -> int:
         items_order=order,
         sources=sources,
     )
-    note(f"reproducing: {result.reference}")
-    print_table(result)
+    if not all_failed(result):  # nothing scored: only the errors (emit_result)
+        note(f"reproducing: {result.reference}")
+        print_table(result)
     # A frozen dataclass satisfies the protocol at run time; mypy wants settable attributes.
     return emit_result(cast("BenchmarkResult", result), args, [*args.bags, args.items])
 

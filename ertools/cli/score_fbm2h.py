@@ -11,7 +11,7 @@ import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING, cast
 
-from ertools.cli.common import add_output_options, emit_result, note
+from ertools.cli.common import add_output_options, all_failed, emit_result, note
 
 if TYPE_CHECKING:
     from ertools.benchmarks.base import BenchmarkResult
@@ -182,7 +182,8 @@ def run(args: argparse.Namespace) -> int:
     if args.verbose:
         for line in result.notes:
             note(line)
-    _print_table(result)
+    if not all_failed(result):  # nothing scored: only the errors (emit_result)
+        _print_table(result)
     # A frozen dataclass has read-only fields; the Protocol declares plain attributes.
     return emit_result(cast("BenchmarkResult", result), args, list(args.bags))
 

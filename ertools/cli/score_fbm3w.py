@@ -13,7 +13,7 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, cast
 
-from ertools.cli.common import add_output_options, emit_result, note
+from ertools.cli.common import add_output_options, all_failed, emit_result, note
 
 if TYPE_CHECKING:
     from ertools.benchmarks.base import BenchmarkResult
@@ -183,6 +183,8 @@ def run(args: argparse.Namespace) -> int:
             )
         options = options_2015(options)
     result = score_fbm3w(args.bags, config, options)
+    if all_failed(result):  # nothing scored: only the errors
+        return emit_result(cast("BenchmarkResult", result), args, list(args.bags))
     for r in result.runs:
         if r.window.mode == "auto":
             note(

@@ -244,19 +244,14 @@ def items_to_yaml(items: Sequence[Item], *, with_spread: bool = True) -> str:
     """Listing 9 text: block style, quaternion and translation as flow lists as in 2015."""
     import yaml
 
-    class _Dumper(yaml.SafeDumper):
-        pass
+    from ertools.yamlout import Dumper, dump
+
+    class _Dumper(Dumper):
+        """Floats to 9 decimals (ertools.yamlout), number lists in flow style."""
 
     def _flow_list(dumper: yaml.SafeDumper, data: list[Any]) -> yaml.Node:
         flow = all(isinstance(v, int | float) for v in data)
         return dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=flow)
 
     _Dumper.add_representer(list, _flow_list)
-    text: str = yaml.dump(
-        items_to_data(items, with_spread=with_spread),
-        Dumper=_Dumper,
-        default_flow_style=False,
-        sort_keys=False,
-        allow_unicode=True,
-    )
-    return text
+    return dump(items_to_data(items, with_spread=with_spread), Dumper=_Dumper)

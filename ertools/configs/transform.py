@@ -176,7 +176,9 @@ def team_transform_path(directory: str | Path, team: str) -> Path:
 
 
 def _flow(values: tuple[float, ...]) -> str:
-    return "[" + ", ".join(repr(float(v)) for v in values) + "]"
+    from ertools.yamlout import yaml_float  # 9 decimals, as every YAML ertools writes
+
+    return "[" + ", ".join(repr(yaml_float(float(v))) for v in values) + "]"
 
 
 def transform_yaml(tr: MarkerTransform) -> str:

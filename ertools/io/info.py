@@ -2,8 +2,11 @@
 
 Rates are medians of the intervals between consecutive record times of each topic, read from
 the index records (ROS1 index data, MCAP message indexes, rosbag2 time stamps), never from the
-message data. ``check=True`` additionally reads every chunk, decompresses it and checks that
-every indexed message record is where the index says (the only way to find a corrupted chunk).
+message data. A rate is stated only for a topic with at least :data:`MIN_RATE_MESSAGES`
+messages over at least :data:`MIN_RATE_SPAN_NS` (see :func:`median_rate`); other topics are
+described by their count and time span. ``check=True`` additionally reads every chunk,
+decompresses it and checks that every indexed message record is where the index says (the
+only way to find a corrupted chunk).
 """
 
 from __future__ import annotations
@@ -20,10 +23,19 @@ from ertools.timeutil import iso_utc, ns_to_s
 
 BAG_SUFFIXES = (".bag", ".mcap", ".active")
 
+# A median rate is stated only with at least 10 messages (9 intervals: the median is then not
+# decided by one or two intervals) over at least 1 s (a topic seen for less than a second, or
+# a burst such as four /rosout lines written 0.2 s apart, has no publishing rate to state: its
+# intervals say how fast a node wrote a burst). A 1 Hz topic needs 10 s to get a rate; below
+# that "n messages in s s" says everything the index knows.
+MIN_RATE_MESSAGES = 10
+MIN_RATE_SPAN_NS = 1_000_000_000
+
 
 @dataclass(frozen=True)
 class BagInfo:
-    """A summary plus the median message rate of every topic (None with < 2 messages)."""
+    """A summary plus the median message rate of every topic (None: too few messages or too
+    short a span to state one, see :func:`median_rate`)."""
 
     summary: BagSummary
     median_rate_hz: dict[str, float | None]
@@ -65,6 +77,7 @@ class BagInfo:
                     "connections": t.connections,
                     "first": None if t.first_ns is None else ns_to_s(t.first_ns),
                     "last": None if t.last_ns is None else ns_to_s(t.last_ns),
+                    "span_s": span_s(t.first_ns, t.last_ns),
                     "median_rate_hz": self.median_rate_hz.get(t.name),
                 }
                 for t in s.topics
@@ -72,9 +85,20 @@ class BagInfo:
         }
 
 
+def span_s(first_ns: int | None, last_ns: int | None) -> float | None:
+    """Seconds from a topic's first to its last message (difference taken in int64 ns)."""
+    if first_ns is None or last_ns is None:
+        return None
+    return ns_to_s(last_ns - first_ns)
+
+
 def median_rate(t_ns: np.ndarray[Any, np.dtype[np.int64]]) -> float | None:
-    """1 / median interval of sorted record times, in Hz (None with < 2 distinct times)."""
-    if len(t_ns) < 2:
+    """1 / median interval of sorted record times, in Hz.
+
+    None with fewer than :data:`MIN_RATE_MESSAGES` messages, a span (last - first) under
+    :data:`MIN_RATE_SPAN_NS`, or a zero median interval: no rate can honestly be stated.
+    """
+    if len(t_ns) < MIN_RATE_MESSAGES or int(t_ns[-1]) - int(t_ns[0]) < MIN_RATE_SPAN_NS:
         return None
     dt = float(np.median(np.diff(t_ns)))
     return 1e9 / dt if dt > 0 else None

@@ -440,6 +440,9 @@ def _page(
     title = f"ertools report: {meta['benchmark']}"
     if meta["team"]:
         title += f" \u2014 {meta['team']}"
+    caveat = getattr(getattr(audit, "comparison", None), "caveat", "")
+    if caveat:  # the recomputed score is no score of the run: say so where it is named
+        title += f" ({caveat})"
     subtitle = f"generated {meta['generated']} by ertools {meta['ertools_version']}"
     if input_records:
         subtitle += " from " + ", ".join(r.name for r in input_records)
@@ -506,7 +509,8 @@ def _audit_context(audit: Any) -> dict[str, Any]:
         cmp = audit.comparison
         rows = [_comparison_row(r) for r in cmp.rows() if r["status"] != "only recomputed"]
         comparison = {
-            "summary": f"{cmp.same} value(s) agree within {cmp.abs_tol:g} (in the units of "
+            "summary": (f"{cmp.caveat[0].upper()}{cmp.caveat[1:]}. " if cmp.caveat else "")
+            + f"{cmp.same} value(s) agree within {cmp.abs_tol:g} (in the units of "
             f"score.yaml), {len(cmp.differences)} differ.",
             "notes": list(cmp.notes),
             "extra": len(cmp.lines) - len(rows),

@@ -34,8 +34,9 @@ def test_info_json_every_format(
     topics = {t["name"]: t for t in bag["topics"]}
     assert topics[POSE]["count"] == scene.n
     assert topics[POSE]["type"] == "geometry_msgs/PoseStamped"
-    # record times are exactly DT apart: the median rate is 1e9 / DT (float division only)
-    assert topics[POSE]["median_rate_hz"] == pytest.approx(1e9 / DT, rel=1e-12)
+    # 50 records DT apart span 0.41 s, under the 1 s a rate needs: no rate, the exact span
+    assert topics[POSE]["median_rate_hz"] is None
+    assert topics[POSE]["span_s"] == (scene.n - 1) * DT / 1e9
     assert topics["/chatter"]["count"] == 0 and topics["/chatter"]["median_rate_hz"] is None
     assert bag["start"] == pytest.approx(scene.t_rec[0] / 1e9, abs=1e-6)
     assert bag["start_iso"].startswith("2015-10-23T14:15:40")
@@ -54,7 +55,17 @@ def test_info_table_and_yaml(
     code, out, _ = run(capsys, str(path), "--check")
     assert code == 0
     line = next(x for x in out.splitlines() if x.strip().startswith(POSE))
-    assert line.split()[1:4] == ["geometry_msgs/PoseStamped", str(scene.n), "120"]
+    # 49 intervals of 8.333333 ms = 0.408 s: too short for a rate (test_io_info_rates.py)
+    assert (scene.n - 1) * DT == 408_333_317
+    assert line.split()[1:] == [
+        "geometry_msgs/PoseStamped",
+        str(scene.n),
+        str(scene.n),
+        "messages",
+        "in",
+        "0.408",
+        "s",
+    ]
     assert "compression: lz4" in out and "duration:" in out
     code, out, _ = run(capsys, str(tmp_path), "--format", "yaml")  # a folder of bags
     assert code == 0

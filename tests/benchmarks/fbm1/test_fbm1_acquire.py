@@ -165,3 +165,23 @@ def test_acquire_window_without_tracking_fails_that_item(
     assert "ertools: error: item 3 (c1): origin not tracked" in err
     # Items 1 and 2 are still acquired and written; item 3 keeps its placeholders.
     assert out.count("spread:") == 2
+
+
+def test_acquire_no_item_measured_prints_only_the_errors(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bag, vanilla, out_file = tmp_path / "acq.bag", tmp_path / "vanilla.yaml", tmp_path / "o.yaml"
+    _write_log(bag, vanilla)
+    argv = ["acquire", "items", str(bag), "--items", str(vanilla), "-o", str(out_file)]
+    # the log ends at 16 s: the first window runs past it, the others lie after it (one
+    # window inside the log, so the list is not refused as a whole)
+    code = main([*argv, "--windows", "15.5:20,17:18,18:19"])
+    out, err = capsys.readouterr()
+    assert code == 1 and out == "" and not out_file.exists()  # not the vanilla list back
+    lines = err.splitlines()
+    assert [x.split(":")[2].strip() for x in lines] == [
+        "item 1 (a1)",
+        "item 2 (AX-16)",
+        "item 3 (c1)",
+    ]
+    assert all(x.startswith("ertools: error: ") for x in lines)
