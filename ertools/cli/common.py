@@ -62,7 +62,10 @@ def write_text(text: str, output: Path | None) -> None:
 
 
 def note(message: str) -> None:
-    """A human note on stderr (stdout stays parseable)."""
+    """A human note on stderr (stdout stays parseable), below any progress bar."""
+    from ertools.progress import clear_current
+
+    clear_current()
     print(f"ertools: {message}", file=sys.stderr)
 
 

@@ -146,9 +146,14 @@ def run(args: argparse.Namespace) -> int:
             paths.extend(expand([given]))
         except BagError as err:  # a missing path or an empty folder: the others still run
             problems.append({"path": str(given), "problem": err.message})
+    progress = args.progress
+    if progress is not None and not args.check:  # --check reports the bytes of each file
+        progress.task("reading indexes", len(paths), "bags")
     for path in paths:
+        if progress is not None and not args.check:
+            progress.advance(1)
         try:
-            info = describe(path, check=args.check)
+            info = describe(path, check=args.check, progress=progress)
         except BagError as err:
             problems.append({"path": str(path), "problem": _one_line(err.message)})
             continue
