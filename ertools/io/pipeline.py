@@ -60,16 +60,17 @@ def prefetched(
     With ``progress``, ``weights[k]`` (the bytes load k reads from the file) is reported as
     each load is handed over, on the calling thread: one call per group of chunks.
     """
-    tick = progress.advance if progress is not None and len(weights) == count else None
-    if progress is not None:
-        progress.task(label, sum(weights), "B")
+    # nothing to read (a window with no messages): no task, no bar flashing "0 B/0 B"
+    report = progress if count and len(weights) == count else None
+    if report is not None:
+        report.task(label, sum(weights), "B")
     ahead = min(workers(), count) if parallel else 1
     if ahead <= 1:
         scratch: list[Any] = []
         for k in range(count):
             got = load(k, scratch)
-            if tick is not None:
-                tick(weights[k])
+            if report is not None:
+                report.advance(weights[k])
             yield got
         return
     from concurrent.futures import ThreadPoolExecutor
@@ -82,8 +83,8 @@ def prefetched(
             got = pending.popleft().result()
             if k + ahead < count:
                 pending.append(pool.submit(load, k + ahead, slots[(k + ahead) % len(slots)]))
-            if tick is not None:
-                tick(weights[k])
+            if report is not None:
+                report.advance(weights[k])
             yield got
 
 
