@@ -238,8 +238,12 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
     try:
         _check_numbers(args)
         _refuse_overwriting_inputs(args)
-        with reporting(bar):
-            code: int = module.run(args)  # type: ignore[attr-defined]
+        try:
+            with reporting(bar):
+                code: int = module.run(args)  # type: ignore[attr-defined]
+        finally:  # wiped before any error line below, which would otherwise follow the bar
+            if bar is not None:
+                bar.close()
     except ErtoolsError as err:
         print(f"ertools: error: {_one_line(str(err))}", file=sys.stderr)
         return err.exit_code
@@ -269,9 +273,6 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
             file=sys.stderr,
         )
         return 1
-    finally:
-        if bar is not None:
-            bar.close()
     return code
 
 

@@ -326,3 +326,41 @@ def test_bar_appears_for_a_slow_read_only(scene: Scene, tmp_path: Path, small_gr
 
 def _steps(text: str) -> list[str]:
     return [s.removesuffix("\x1b[K") for s in text.split("\r") if s]
+
+
+def test_cli_notes_and_errors_start_on_a_wiped_line(
+    ros1_bag: Path,
+    no_delay: None,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    # the scene's one run is cut off by the log's end: reads, a run scored, warnings, deviation
+    # and error lines, all on a terminal that shows the bar
+    tty = Tty()
+    monkeypatch.setattr(sys, "stderr", tty)
+    assert main(["score", "fbm3w", str(ros1_bag)]) == 1
+    out = capsys.readouterr().out
+    assert out.startswith("best_distance_error: null") and "ertools" not in out  # the result
+    err = tty.getvalue()
+    assert "\rertools: scoring runs [" + "#" * 24 + "] 1/1 runs" in err
+    lines = err.split("\n")
+    assert lines[-1] == ""  # ends with a whole line
+    for line in lines[:-1]:  # what a terminal shows of each line: the text after its last \r
+        shown = line.split("\r")[-1].removeprefix("\x1b[K")
+        assert shown.startswith("ertools: ") and "[##" not in shown and "[--" not in shown, line
+    assert "ertools: error: run 0 (line):" in lines[-2]
+
+
+def test_cli_error_after_a_read_starts_on_a_wiped_line(
+    ros1_bag: Path, no_delay: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # the robot topic is read (bar drawn), then the GT topic is missing: an ErtoolsError
+    tty = Tty()
+    monkeypatch.setattr(sys, "stderr", tty)
+    argv = ["score", "trajectory", str(ros1_bag), "--robot-topic", "/odom", "--gt-topic", "/no"]
+    assert main(argv) == 1
+    err = tty.getvalue()
+    bar, error = err.rsplit("\r", 1)
+    assert f"\rertools: reading /odom from {ros1_bag.name} [{'#' * 24}]" in bar
+    assert error.startswith("\x1b[Kertools: error: GT topic /no is not in the robot log")
+    assert error.count("\n") == 1 and error.endswith("\n")
