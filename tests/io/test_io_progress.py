@@ -364,3 +364,19 @@ def test_cli_error_after_a_read_starts_on_a_wiped_line(
     assert f"\rertools: reading /odom from {ros1_bag.name} [{'#' * 24}]" in bar
     assert error.startswith("\x1b[Kertools: error: GT topic /no is not in the robot log")
     assert error.count("\n") == 1 and error.endswith("\n")
+
+
+@pytest.mark.parametrize("where", ["group", "member"])
+def test_cli_quiet_reaches_a_group_member(
+    ros1_bag: Path, no_delay: None, where: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # `ertools score -q fbm3w BAG` and `ertools score fbm3w BAG -q` both silence the bar
+    tty = Tty()
+    monkeypatch.setattr(sys, "stderr", tty)
+    argv = ["score", "-q", "fbm3w", str(ros1_bag)] if where == "group" else [
+        "score", "fbm3w", str(ros1_bag), "-q"
+    ]  # fmt: skip
+    assert main(argv) == 1  # the scene's run is cut off (see above)
+    err = tty.getvalue()
+    assert "ertools: error: run 0 (line)" in err
+    assert "\r" not in err and "\x1b" not in err
