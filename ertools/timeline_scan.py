@@ -230,7 +230,16 @@ def scan(
         check_clocks: compare header stamps with record times (reads a second per bag).
         progress: gets the bags summarised, then the recordings clock-checked.
     """
+    from ertools.progress import reporting
+
     found = find_bags(Path(p) for p in paths)
+    with reporting(None):  # counted by bag and recording: the reads inside do not report
+        return _scan(found, config, check_clocks, progress)
+
+
+def _scan(
+    found: Found, config: TimelineConfig | None, check_clocks: bool, progress: Reporter | None
+) -> Timeline:
     tick: Callable[[int], None] | None = None
     if progress is not None:
         progress.task("summarising", len(found.bags), "bags")

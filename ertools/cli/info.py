@@ -137,6 +137,7 @@ def run(args: argparse.Namespace) -> int:
     from ertools.cli.common import dump_json, note, write_text
     from ertools.errors import BagError
     from ertools.io.info import describe, expand
+    from ertools.progress import reporting
 
     infos: list[BagInfo] = []
     problems: list[dict[str, str]] = []
@@ -153,7 +154,8 @@ def run(args: argparse.Namespace) -> int:
         if progress is not None and not args.check:
             progress.advance(1)
         try:
-            info = describe(path, check=args.check, progress=progress)
+            with reporting(None):  # only --check's own counts: not the index reads inside
+                info = describe(path, check=args.check, progress=progress)
         except BagError as err:
             problems.append({"path": str(path), "problem": _one_line(err.message)})
             continue

@@ -380,3 +380,18 @@ def test_cli_quiet_reaches_a_group_member(
     err = tty.getvalue()
     assert "ertools: error: run 0 (line)" in err
     assert "\r" not in err and "\x1b" not in err
+
+
+def test_cli_info_counts_bags_not_the_reads_inside(
+    no_delay: None, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the timeline sample: 9 files; whatever describe reads inside, the bar counts bags
+    tty = Tty()
+    monkeypatch.setattr(sys, "stderr", tty)
+    folder = Path(__file__).resolve().parents[2] / "sample_bags/timeline/bags"
+    main(["info", str(folder)])
+    capsys.readouterr()
+    shown = _steps(tty.getvalue())
+    labels = {s.split(" [")[0] for s in shown if " [" in s}
+    assert labels == {"ertools: reading indexes"}
+    assert f"ertools: reading indexes [{'#' * 24}] 9/9 bags" in shown
