@@ -13,6 +13,8 @@ importing them alone costs 25 ms (tqdm) and 32 ms (rich.progress) here (docs/per
 
 from __future__ import annotations
 
+import io
+import os
 import sys
 import time
 from collections.abc import Callable, Iterator
@@ -73,6 +75,7 @@ class Bar:
     """
 
     WIDTH = 24
+    NARROW = 10  # the bar's width on a terminal too narrow for the whole line
 
     def __init__(
         self,
@@ -81,8 +84,10 @@ class Bar:
         delay_s: float | None = None,
         interval_s: float = 0.1,
         clock: Callable[[], float] = time.monotonic,
+        columns: int | None = None,
     ) -> None:
         self.stream = stream if stream is not None else sys.stderr
+        self.columns = columns
         self.enabled = self.stream.isatty()
         self.clock = clock
         self.start = clock()
@@ -119,22 +124,38 @@ class Bar:
             return
         self.drawn_at = now
         self.shown = True
-        self.stream.write("\r" + self.line(now) + "\x1b[K")
+        self.stream.write("\r" + self.line(now, self._columns()) + "\x1b[K")
         self.stream.flush()
 
-    def line(self, now: float) -> str:
-        """The text of the bar at time ``now``."""
-        total = max(self.total, 1)
-        filled = min(self.WIDTH, self.WIDTH * self.done // total)
-        bar = "#" * filled + "-" * (self.WIDTH - filled)
-        text = f"ertools: {self.label} [{bar}] {_amount(self.done, self.unit)}"
-        text += f"/{_amount(self.total, self.unit)}"
+    def line(self, now: float, columns: int = 1000) -> str:
+        """The text of the bar at time ``now``, fitted to ``columns``: on a narrow terminal
+        the rate goes first, then the bar narrows, then the label loses its middle."""
+        amounts = f"{_amount(self.done, self.unit)}/{_amount(self.total, self.unit)}"
         if self.unit != "B":
-            text += f" {self.unit}"
+            amounts += f" {self.unit}"
         elapsed = now - self.task_start
+        rate = ""
         if self.unit == "B" and elapsed > 0.2:
-            text += f"  {_amount(self.done / elapsed, 'B')}/s"
-        return text
+            rate = f"  {_amount(self.done / elapsed, 'B')}/s"
+        head = f"ertools: {self.label}"
+        for width, tail in ((self.WIDTH, rate), (self.WIDTH, ""), (self.NARROW, "")):
+            filled = min(width, width * self.done // max(self.total, 1))
+            text = f"{head} [{'#' * filled}{'-' * (width - filled)}] {amounts}{tail}"
+            if len(text) < columns:
+                break
+        return fit(text, columns)
+
+    def _columns(self) -> int:
+        """The terminal's width (asked at each redraw: a window may be resized)."""
+        if self.columns is not None:
+            return self.columns
+        try:
+            width = os.get_terminal_size(self.stream.fileno()).columns
+        except (AttributeError, ValueError, OSError, io.UnsupportedOperation):
+            width = 0
+        if width <= 0:  # not a real terminal (a test's stand-in) or one that gives no size
+            width = int(os.environ.get("COLUMNS", "") or 80)
+        return width
 
     def clear(self) -> None:
         """Remove the line, if drawn, so that other text starts at the left margin."""
@@ -147,6 +168,26 @@ class Bar:
     def close(self) -> None:
         self.clear()
         self.closed = True
+
+
+def fit(text: str, columns: int) -> str:
+    """``text`` cut to ``columns - 1`` characters: the middle of the label (between
+    ``ertools: `` and `` [``) goes first, else the end.
+
+    A line as wide as the terminal or wider wraps, and ``\r`` then returns to the start of
+    its last row only: every redraw would leave a row behind.
+    """
+    room = max(columns - 1, 10)
+    if len(text) <= room:
+        return text
+    head, sep, tail = text.partition(" [")
+    prefix = "ertools: " if head.startswith("ertools: ") else ""
+    label = head[len(prefix) :]
+    keep = room - len(prefix) - len(sep) - len(tail) - 3
+    if not sep or keep < 8:
+        return text[:room]
+    half = keep // 2
+    return prefix + label[:half] + "..." + label[len(label) - (keep - half) :] + sep + tail
 
 
 def clear_current() -> None:

@@ -7,7 +7,7 @@ import io
 
 import pytest
 
-from ertools.progress import Bar, clear_current, current, reporting
+from ertools.progress import Bar, clear_current, current, fit, reporting
 
 
 class Tty(io.StringIO):
@@ -102,3 +102,18 @@ def test_reporting_scope_is_restored_even_on_error() -> None:
         assert current() is bar
         raise RuntimeError
     assert current() is None
+
+
+def test_long_lines_are_cut_to_the_terminal_width() -> None:
+    """A line as wide as the terminal wraps, and each redraw would leave a row behind."""
+    clock, out = Clock(), Tty()
+    bar = Bar(out, delay_s=0.0, clock=clock, columns=60)
+    label = "reading /fbm3w/robot_at_work/pose2d from log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
+    bar.task(label, 1000, "B")
+    (drawn,) = [s.removesuffix("\x1b[K") for s in out.getvalue().split("\r") if s]
+    # too long with the 24-cell bar: 10 cells; then 59 - 9 ("ertools: ") - 2 (" [") - 22
+    # ("----------] 0 B/1.0 kB") - 3 ("...") = 23 characters of the label: 11 + 12
+    assert len(drawn) == 59
+    assert drawn == "ertools: " + label[:11] + "..." + label[-12:] + " [----------] 0 B/1.0 kB"
+    assert len(fit("x" * 300, 60)) == 59  # no bar to keep: cut
+    assert fit("short", 60) == "short"

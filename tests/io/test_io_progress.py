@@ -37,6 +37,12 @@ class Recorder:
         self.tasks[-1][3].append(n)
 
 
+@pytest.fixture(autouse=True)
+def wide(monkeypatch: pytest.MonkeyPatch) -> None:
+    # lines are cut to the terminal's width (tests/core/test_progress.py): these check labels
+    monkeypatch.setenv("COLUMNS", "200")
+
+
 @pytest.fixture
 def small_groups(monkeypatch: pytest.MonkeyPatch) -> None:
     # ~3 chunks of 2000 bytes per group: every read spans many groups (as in test_io_pipeline)
@@ -247,11 +253,14 @@ def test_cli_bar_on_a_terminal_unless_quiet(
     )  # wiped at the end: no bar left behind
 
 
-def test_cli_bar_through_a_real_pty(ros1_bag: Path, tmp_path: Path) -> None:
-    """The real thing: ``isatty`` answered by the system, output read off the terminal."""
+def _on_a_pty(argv: list[str], columns: int | None) -> tuple[int, bytes, str]:
+    """(exit status, stdout, what the terminal got on stderr) of ``ertools ARGV`` run with
+    stderr on a new pseudo-terminal (``columns`` wide, or of no size: the fallback 200)."""
+    import fcntl
     import os
     import pty
     import subprocess
+    import termios
 
     code = (
         "import sys, ertools.progress as p; p.DELAY_S = 0.0\n"
@@ -259,28 +268,20 @@ def test_cli_bar_through_a_real_pty(ros1_bag: Path, tmp_path: Path) -> None:
         "sys.exit(main(sys.argv[1:]))\n"
     )
     master, slave = pty.openpty()
+    if columns is not None:
+        fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, columns, 0, 0))
     try:
         proc = subprocess.run(
-            [
-                sys.executable,
-                "-c",
-                code,
-                "score",
-                "trajectory",
-                str(ros1_bag),
-                "--robot-topic",
-                "/odom",
-                "--gt-topic",
-                TOPIC,
-            ],
+            [sys.executable, "-c", code, *argv],
             stderr=slave,
             stdout=subprocess.PIPE,
+            env={**os.environ, "COLUMNS": "200"},  # used only when the terminal has no size
             timeout=120,
             check=False,
         )
     finally:
         os.close(slave)
-    chunks = []
+    chunks = []  # a few kB: the terminal's buffer holds them until the process is done
     while True:
         try:
             got = os.read(master, 65536)
@@ -290,9 +291,17 @@ def test_cli_bar_through_a_real_pty(ros1_bag: Path, tmp_path: Path) -> None:
             break
         chunks.append(got)
     os.close(master)
-    err = b"".join(chunks).decode()
-    assert proc.returncode == 0, err
-    assert b"ate" in proc.stdout  # the score itself, on stdout
+    return proc.returncode, proc.stdout, b"".join(chunks).decode()
+
+
+TRAJECTORY = ["score", "trajectory", "--robot-topic", "/odom", "--gt-topic", TOPIC]
+
+
+def test_cli_bar_through_a_real_pty(ros1_bag: Path) -> None:
+    """The real thing: ``isatty`` answered by the system, output read off the terminal."""
+    code, out, err = _on_a_pty([*TRAJECTORY, str(ros1_bag)], None)
+    assert code == 0, err
+    assert b"ate" in out  # the score itself, on stdout
     for topic in ("/odom", TOPIC):  # the robot's log, then the GT from it
         assert f"\rertools: reading {topic} from {ros1_bag.name} [" in err
     # the bar is wiped before the notes: after the last wipe, notes only, each on its line
@@ -395,3 +404,23 @@ def test_cli_info_counts_bags_not_the_reads_inside(
     labels = {s.split(" [")[0] for s in shown if " [" in s}
     assert labels == {"ertools: reading indexes"}
     assert f"ertools: reading indexes [{'#' * 24}] 9/9 bags" in shown
+
+
+def test_cli_bar_fits_a_narrow_terminal(ros1_bag: Path) -> None:
+    # 60 columns, asked of the terminal itself: every redraw fits in 59 (no wrapped rows);
+    # the rate goes first, then the middle of the label, the bar and amounts stay whole
+    code, _out, err = _on_a_pty([*TRAJECTORY, str(ros1_bag)], 60)
+    assert code == 0, err
+    drawn = [s.removesuffix("\x1b[K") for s in err.split("\r") if " [" in s and "] " in s]
+    assert len(drawn) >= 4  # two reads, each at its start and end
+    assert all(len(d) <= 59 for d in drawn), drawn
+    assert all(d.startswith("ertools: reading") and d.endswith(" kB") for d in drawn), drawn
+    # the GT topic's read done, its bytes counted here: with the 10-cell bar, 59 - 9
+    # ("ertools: ") - 2 (" [") - 27 ("##########] 17.4 kB/17.4 kB") - 3 ("...") = 18
+    # characters of the label, its first and last 9
+    size = f"{sum(_ros1_chunk_bytes(ros1_bag, TOPIC)) / 1000:.1f} kB"
+    tail = f"] {size}/{size}"
+    label = f"reading {TOPIC} from {ros1_bag.name}"
+    keep = 59 - 9 - 2 - (10 + len(tail)) - 3
+    done = f"ertools: {label[: keep // 2]}...{label[-(keep - keep // 2) :]} [{'#' * 10}{tail}"
+    assert done in drawn, drawn
