@@ -147,7 +147,7 @@ def run(args: argparse.Namespace) -> int:
             paths.extend(expand([given]))
         except BagError as err:  # a missing path or an empty folder: the others still run
             problems.append({"path": str(given), "problem": err.message})
-    progress = args.progress
+    progress = getattr(args, "progress", None)  # set by run_command
     if progress is not None and not args.check:  # --check reports the bytes of each file
         progress.task("reading indexes", len(paths), "bags")
     for path in paths:
