@@ -234,10 +234,17 @@ class Interval:
 
 @dataclass(frozen=True)
 class Provenance:
-    """What a result was computed from, for reports and audits."""
+    """What a result was computed from, for reports and audits.
+
+    ``team`` is who ran the benchmark and ``team_source`` where that name was found
+    (``explicit``, ``payload``, ``log name`` or ``transform``: see :mod:`ertools.teams`);
+    both None when no name was found.
+    """
 
     inputs: tuple[str, ...] = ()
     parameters: tuple[tuple[str, str], ...] = ()
+    team: str | None = None
+    team_source: str | None = None
 
 
 def concatenate_poses(streams: Sequence[PoseStream]) -> PoseStream:

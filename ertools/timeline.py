@@ -23,11 +23,12 @@ from __future__ import annotations
 import re
 from collections import defaultdict
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from itertools import pairwise
 from pathlib import Path
 from typing import Any, Literal, Protocol
 
+from ertools.teams import parse_robot_log_name
 from ertools.timeutil import NS_PER_S, ns_to_s
 
 Kind = Literal["gt", "benchmark", "robot", "other", "unreadable"]
@@ -65,9 +66,6 @@ _SUFFIXES = (".bag.active", ".bag", ".mcap", ".db3")
 # The benchmark namespaces of the 2015 topics (/fbm2h/..., /tbm1h/...) and robot log names
 # (rockin_logger: ${BENCHMARK}_${DATE}_${TEAMNAME}.bag, BENCHMARK written FBM2H or FBMH2).
 _NAMESPACE_RE = re.compile(r"^[ft]bm\d[hw]$", re.IGNORECASE)
-_ROBOT_LOG_RE = re.compile(
-    r"^(?P<kind>[FT]BM)(?:(?P<n>\d)(?P<hw>[HW])|(?P<hw2>[HW])(?P<n2>\d))_", re.IGNORECASE
-)
 
 
 class TopicLike(Protocol):
@@ -396,11 +394,9 @@ def benchmark_names(topics: Iterable[TopicLike], path: str | Path = "") -> tuple
         for t in topics
         if t.name.count("/") >= 2 and _NAMESPACE_RE.match(t.name.split("/")[1])
     }
-    match = _ROBOT_LOG_RE.match(Path(path).name) if path else None
-    if match is not None:
-        number = match.group("n") or match.group("n2")
-        arena = match.group("hw") or match.group("hw2")
-        names.add(f"{match.group('kind')}{number}{arena}".lower())
+    log_name = parse_robot_log_name(path) if path else None
+    if log_name is not None:
+        names.add(log_name.benchmark)
     return tuple(sorted(names))
 
 
@@ -550,51 +546,26 @@ def build_timeline(
 
     sessions, session_of = _sessions(base, cfg.gap_tolerance_ns)
     entries = [
-        BagEntry(
-            b.path,
-            b.format,
-            b.start_ns,
-            b.end_ns,
-            b.kind,
-            b.logger,
-            tuple(overlaps[b.path]),
-            tuple(dict.fromkeys(problems[b.path])),
-            session_of[b.path],
-            b.benchmarks,
+        replace(
+            b,
+            overlaps=tuple(overlaps[b.path]),
+            problems=tuple(dict.fromkeys(problems[b.path])),
+            session=session_of[b.path],
             copies=tuple(copies[b.path]),
         )
         for b in base
     ]
     entries += [
-        BagEntry(
-            b.path,
-            b.format,
-            b.start_ns,
-            b.end_ns,
-            b.kind,
-            b.logger,
-            (),
-            tuple(dict.fromkeys(problems[b.path])),
-            session_of[copy_of[b.path]],
-            b.benchmarks,
+        replace(
+            b,
+            problems=tuple(dict.fromkeys(problems[b.path])),
+            session=session_of[copy_of[b.path]],
             copy_of=copy_of[b.path],
         )
         for b in copied
     ]
     entries.sort(key=lambda b: (b.start_ns, b.end_ns, b.path))
-    entries += [
-        BagEntry(
-            b.path,
-            b.format,
-            None,
-            None,
-            b.kind,
-            b.logger,
-            (),
-            tuple(dict.fromkeys(problems[b.path])),
-        )
-        for b in broken
-    ]
+    entries += [replace(b, problems=tuple(dict.fromkeys(problems[b.path]))) for b in broken]
     by_path = {e.path: e for e in entries if e.copy_of is None}
     sessions = [
         Session(

@@ -71,12 +71,16 @@ def _rows(t: list[int], v: list[list[float]]) -> Rows:
 
 def ertools_answer(path: Path) -> dict[str, Outcome | str]:
     """Each part as an Outcome, or the text of a traceback (a bug)."""
-    from ertools.errors import ErtoolsError
+    from ertools.errors import BagError, ErtoolsError
     from ertools.io import read_poses, read_tf
     from ertools.io.info import describe
 
     def summary() -> Summary:
-        s = describe(path).summary
+        info = describe(path)
+        if info.fatal_problem is not None:
+            # what `ertools info` refuses with exit 1 and one line
+            raise BagError(info.fatal_problem)
+        s = info.summary
         return {t.name: (t.msgtype, t.count, t.first_ns, t.last_ns) for t in s.topics}
 
     def poses() -> Rows:

@@ -119,6 +119,8 @@ class Fbm2hOptions:
         goal: Listing 10 goal list file; None = the goal payload in the state topics.
         transform: Listing 11 file; None with ``team``+``transforms_dir`` = DIR/transform-TEAM.yaml;
             None otherwise = identity (said in the warnings).
+        team: picks the transform with ``transforms_dir``; alone it changes nothing here (the
+            CLI keeps it as the result's team, see :mod:`ertools.teams`).
         topic / tf_frame: where the marker set's poses are (PoseStamped/Pose2D topic, or a /tf
             child frame of ``world``).
         time_source: ``header`` (mocap stamp) or ``record`` (bag time).
@@ -428,13 +430,15 @@ def invalid_warning(count: int, source: str) -> str:
 def _load_transform(options: Fbm2hOptions) -> MarkerTransform:
     from ertools.configs.transform import identity_transform, load_transform, team_transform_path
 
+    # --team alone only names the team (every scoring command has it); with --transforms DIR
+    # it also picks DIR/transform-TEAM.yaml, as the 2015 launch file's team_name argument did.
     if options.transform is not None:
-        if options.team is not None or options.transforms_dir is not None:
+        if options.transforms_dir is not None:
             raise ConfigError("give either --transform FILE or --team NAME --transforms DIR")
         return load_transform(options.transform)
-    if (options.team is None) != (options.transforms_dir is None):
-        raise ConfigError("--team and --transforms go together (DIR/transform-TEAM.yaml)")
-    if options.team is not None and options.transforms_dir is not None:
+    if options.transforms_dir is not None:
+        if options.team is None:
+            raise ConfigError("--transforms DIR needs --team NAME (DIR/transform-NAME.yaml)")
         return load_transform(team_transform_path(options.transforms_dir, options.team))
     return identity_transform()
 

@@ -66,7 +66,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     scoring.add_argument("--topic", metavar="TOPIC", help="pose topic of the scorer")
     from ertools.cli.common import add_output_options
 
-    add_output_options(parser, ("text", "yaml", "json"), plot=False)
+    add_output_options(parser, ("text", "yaml", "json"), plot=False, team=False)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -18,9 +18,10 @@ def add_output_options(
     report: bool = True,
     plot: bool = True,
     foxglove: bool = True,
+    team: bool = True,
 ) -> None:
-    """``--format``, ``--output``, and where the benchmark has them ``--report``/``--plot``/
-    ``--foxglove``."""
+    """``--format``, ``--output``, ``--team``, and where the benchmark has them
+    ``--report``/``--plot``/``--foxglove``."""
     parser.add_argument(
         "--format",
         choices=formats,
@@ -48,6 +49,14 @@ def add_output_options(
             metavar="FILE.mcap",
             help="write what was scored (paths, targets, pairs, errors, states) as an MCAP "
             "file for Foxglove (docs/foxglove.md)",
+        )
+    if team:
+        parser.add_argument(
+            "--team",
+            metavar="NAME",
+            help="the team that ran it, kept in the result and report (default: a name in the "
+            "state payloads, else the rockin_logger log name <BENCHMARK>_<DATE>_<NAME>.bag, "
+            "else the FBM2H transform's team); fbm2h --transforms DIR: DIR/transform-NAME.yaml",
         )
 
 
@@ -83,6 +92,9 @@ def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[
     Warnings and deviations from the 2015 node go to stderr, so a referee sees them even when
     stdout is redirected to a file.
     """
+    from ertools.teams import with_team
+
+    result = with_team(result, getattr(args, "team", None), inputs)
     fmt = getattr(args, "format", "yaml")
     text = result.to_yaml() if fmt == "yaml" else dump_json(result.to_dict())
     write_text(text, getattr(args, "output", None))

@@ -127,12 +127,6 @@ def _one_line(text: str) -> str:
     return " ".join(text.split())
 
 
-def _fatal_problem(info: BagInfo) -> str | None:
-    """A problem that makes the bag unusable (truncated, damaged); None for a mere .active."""
-    bad = [p for p in info.summary.problems if not p.startswith("not indexed")]
-    return "; ".join(bad) if bad else None
-
-
 def run(args: argparse.Namespace) -> int:
     from ertools.cli.common import dump_json, note, write_text
     from ertools.errors import BagError
@@ -160,7 +154,7 @@ def run(args: argparse.Namespace) -> int:
             problems.append({"path": str(path), "problem": _one_line(err.message)})
             continue
         infos.append(info)
-        fatal = _fatal_problem(info)
+        fatal = info.fatal_problem
         if fatal is not None:
             problems.append({"path": str(path), "problem": _one_line(fatal)})
         elif not info.summary.indexed and info.summary.problems:

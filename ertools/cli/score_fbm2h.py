@@ -42,7 +42,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--transform", type=Path, metavar="FILE", help="marker-to-robot transform (Listing 11)"
     )
-    parser.add_argument("--team", metavar="NAME", help="with --transforms: DIR/transform-NAME.yaml")
     parser.add_argument(
         "--transforms", type=Path, metavar="DIR", help="folder of transform-<team>.yaml files"
     )

@@ -8,7 +8,7 @@ every indexed message record is where the index says (the only way to find a cor
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -33,6 +33,13 @@ class BagInfo:
     checked: bool = False
     # What --check found (index against records, damaged chunks), one line each.
     check_problems: tuple[str, ...] = ()
+
+    @property
+    def fatal_problem(self) -> str | None:
+        """What makes the bag unusable (truncated, damaged, an index that contradicts
+        itself), one line; None for a sound bag or a mere ``.active`` still recording."""
+        bad = [p for p in self.summary.problems if not p.startswith("not indexed")]
+        return "; ".join(bad) if bad else None
 
     def to_dict(self) -> dict[str, Any]:
         s = self.summary
@@ -121,11 +128,15 @@ def describe(path: str | Path, *, check: bool = False, progress: Reporter | None
     Raises:
         BagError: unreadable bag, or (with ``check``) a damaged chunk.
     """
-    from ertools.io.summary import summary_and_times
+    from ertools.io.summary import INDEX_SELF_CHECK, summary_and_times
 
     s, times = summary_and_times(path)
     rates = {name: median_rate(t) for name, t in times.items()}
     found = verify(Path(path), progress) if check else []
+    if check:
+        # the record-level check says each index disagreement exactly: not twice
+        kept = [p for p in s.problems if not p.endswith(INDEX_SELF_CHECK)]
+        s = replace(s, problems=type(s.problems)(kept))
     return BagInfo(s, rates, check, tuple(found))
 
 

@@ -22,12 +22,17 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.errors import BagError
+from ertools.io.fastdecode import read_at as gather_at
 from ertools.io.files import BagFile
 from ertools.io.model import Conn
 from ertools.io.pipeline import Group, joined, pread, read_at, scratch_view
 
 if TYPE_CHECKING:
     from ertools.progress import Reporter
+
+# Op codes a chunk may hold (schema 0x03, channel 0x04, message 0x05), as a lookup table.
+_RECORD_STARTS = np.zeros(256, dtype=bool)
+_RECORD_STARTS[[3, 4, 5]] = True
 
 log = logging.getLogger("ertools.io.mcap_index")
 
@@ -277,9 +282,7 @@ class McapIndex:
                 raise BagError(f"message record cut off inside its chunk {where}")
             # The record's own log time must be the index's: a damaged index entry would
             # otherwise give another record's data (or a wrong time) without a word.
-            from ertools.io.fastdecode import read_at
-
-            log_time = read_at(buf, start - 16, np.dtype("<u8")).astype(np.int64)
+            log_time = gather_at(buf, start - 16, np.dtype("<u8")).astype(np.int64)
             if np.any(log_time != plan.t_record[rows]):
                 raise BagError(
                     f"message index disagrees with the message records' log times {where}"
@@ -290,7 +293,7 @@ class McapIndex:
             # of the chunk.
             end = start + length
             inside = end < base[which] + sizes[which]
-            if np.any(inside) and not np.all(np.isin(buf[end[inside]], (3, 4, 5))):
+            if np.any(inside) and not np.all(_RECORD_STARTS[buf[end[inside]]]):
                 raise BagError(f"message record length runs into no record {where}")
             return rows, buf, start, length
 

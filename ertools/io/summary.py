@@ -114,6 +114,7 @@ def _ros1(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagS
     spans: dict[int, list[int]] = {}
     counts: dict[int, int] = defaultdict(int)
     topic_of = {c.id: c.topic for c in layout.conns}
+    index_problems: list[str] = []
     if layout.chunks:
         # Ros1Bag refuses damaged closed bags for reading; the summary wants what is there.
         bag = Ros1Bag(path, layout, strict=False)
@@ -125,7 +126,9 @@ def _ros1(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagS
                 compressions.add(chunk.compression)
             for chunk in layout.chunks:
                 if exact or chunk.entries is not None:
-                    for cid, (t, _off) in bag.chunk_entries(chunk).items():
+                    entries = bag.chunk_entries(chunk)
+                    index_problems.extend(_ros1_index_disagrees(chunk, entries))
+                    for cid, (t, _off) in entries.items():
                         if times is not None:
                             times.setdefault(topic_of.get(cid, f"conn {cid}"), []).append(t)
                         if len(t):
@@ -150,8 +153,38 @@ def _ros1(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagS
         "/".join(sorted(compressions)) or "none",
         layout.indexed,
         topics,
-        list(layout.problems),
+        [*layout.problems, *index_problems[:MAX_INDEX_PROBLEMS]],
     )
+
+
+# A wholly wrong index says so in a few lines, not one per chunk.
+MAX_INDEX_PROBLEMS = 5
+# Ends each such line: ``info --check`` replaces them by its record-level lines.
+INDEX_SELF_CHECK = "(damaged index; info --check reads the records)"
+
+
+def _ros1_index_disagrees(chunk: Any, entries: dict[int, tuple[I64, I64]]) -> list[str]:
+    """Where a chunk's two index records contradict each other: the chunk-info record's
+    per-connection counts and time span against the index-data records' entries. A summary
+    read from either alone would report counts or times no record holds (found by fuzzing:
+    one flipped count or time changed ``info`` with exit 0); ``info --check`` compares both
+    with the records themselves."""
+    out = []
+    where = f"chunk at byte {chunk.pos}"
+    for cid in sorted(set(entries) | set(chunk.counts)):
+        t = entries.get(cid, (np.empty(0, np.int64), None))[0]
+        said = chunk.counts.get(cid, 0)
+        if len(t) != said:
+            out.append(
+                f"{where}: connection {cid}: the chunk info counts {said} messages, the index "
+                f"data {len(t)} {INDEX_SELF_CHECK}"
+            )
+        elif len(t) and (int(t.min()) < chunk.start_ns or int(t.max()) > chunk.end_ns):
+            out.append(
+                f"{where}: connection {cid}: index-data times outside the chunk info's span "
+                + INDEX_SELF_CHECK
+            )
+    return out
 
 
 def _mcap_scanned(

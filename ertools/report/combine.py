@@ -4,6 +4,12 @@ Reads what :func:`ertools.report.folder.write_report` wrote: a report folder, it
 ``result.json`` or its ``score.json`` (then ``result.json`` beside it gives the benchmark, the
 team and the inputs; a lone ``score.json`` is recognised from its keys). Writes
 ``index.html``, ``results.json`` and ``results.csv`` into the output folder.
+
+Results of the same inputs (the same SHA-256 of every input file) are one execution scored
+several times (with and without ``--team``/``--transforms``, with a 2015 option...): they are
+merged into one row, whose team is the best-sourced name any of them found (``--team`` >
+payload > log name > transform, see :mod:`ertools.teams`), and whose other results are listed
+by their options. A result with no team takes the one its inputs' rockin_logger names give.
 """
 
 from __future__ import annotations
@@ -19,6 +25,13 @@ from ertools import __version__
 from ertools.errors import ConfigError
 from ertools.report import html as h
 from ertools.report import units
+from ertools.teams import team_from_log_name
+
+# Command-line options that choose where or how output is written, not what is scored.
+_OUTPUT_OPTIONS = frozenset({"-o", "--output", "--report", "--plot", "--foxglove", "--format"})
+_OUTPUT_FLAGS = frozenset({"-v", "--verbose", "-q", "--quiet"})
+# Team sources, best first (ertools.teams.resolve_team's precedence).
+_SOURCE_RANK = {"explicit": 0, "payload": 1, "log name": 2, "transform": 3}
 
 # Keys that identify a benchmark's score when no result.json says which it is.
 _SIGNATURES: tuple[tuple[str, frozenset[str]], ...] = (
@@ -43,6 +56,42 @@ class Entry:
     findings: int | None
     source: Path  # the result.json or score.json read
     index: Path | None  # the report's index.html, when it exists
+    team_source: str | None = None  # explicit, payload, log name, transform (ertools.teams)
+    sha256: tuple[str, ...] = ()  # of the inputs, sorted: same tuple = same execution
+    options: str = ""  # the scoring options of its command line ("" = the defaults)
+    generated: str = ""
+
+
+@dataclass(frozen=True)
+class Execution:
+    """The results of one execution (same inputs): ``main`` is shown, ``others`` listed."""
+
+    main: Entry
+    others: tuple[Entry, ...]
+    team: str
+    team_source: str | None
+
+
+def _options(argv: list[str], inputs: list[dict[str, Any]]) -> str:
+    """The scoring options of a command line: from its first option on, without output
+    options and input paths (``--team simbot --transforms sample_bags/fbm2h``)."""
+    paths = {str(i.get(k, "")) for i in inputs for k in ("path", "name")}
+    start = next((i for i, t in enumerate(argv) if t.startswith("-")), len(argv))
+    kept: list[str] = []
+    skip = False
+    for token in argv[start:]:
+        if skip:
+            skip = False
+            continue
+        if token in _OUTPUT_OPTIONS:
+            skip = True
+            continue
+        if token.split("=", 1)[0] in _OUTPUT_OPTIONS or token in _OUTPUT_FLAGS:
+            continue
+        if token in paths:
+            continue
+        kept.append(token)
+    return " ".join(kept)
 
 
 def _load_json(path: Path) -> Any:
@@ -88,11 +137,17 @@ def load_entry(path: Path) -> Entry:
                 + len(audit.get("early_ends") or [])
                 + int(audit.get("differences") or 0)
             )
-        inputs = tuple(str(i.get("name", "")) for i in meta.get("inputs") or [])
+        records = [i for i in meta.get("inputs") or [] if isinstance(i, dict)]
+        inputs = tuple(str(i.get("name", "")) for i in records)
         index = folder / "index.html"
+        argv = [str(t) for t in meta.get("argv") or []]
         return Entry(
             benchmark=str(meta.get("benchmark") or "unknown"),
             team=str(meta.get("team") or ""),
+            team_source=str(meta["team_source"]) if meta.get("team_source") else None,
+            sha256=tuple(sorted(str(i.get("sha256", "")) for i in records if i.get("sha256"))),
+            options=_options(argv, records),
+            generated=str(meta.get("generated") or ""),
             headline=dict(meta.get("headline") or {}),
             inputs=inputs,
             warnings=len(meta.get("warnings") or []),
@@ -130,31 +185,49 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
         outdir.mkdir(parents=True, exist_ok=True)
     except OSError as err:
         raise ConfigError(f"cannot write here ({err.strerror or err})", path=outdir) from err
-    by_benchmark: dict[str, list[Entry]] = {}
-    for e in entries:
-        by_benchmark.setdefault(e.benchmark, []).append(e)
+    runs = executions(entries)
+    by_benchmark: dict[str, list[Execution]] = {}
+    for ex in runs:
+        by_benchmark.setdefault(ex.main.benchmark, []).append(ex)
 
     benchmarks: list[dict[str, Any]] = []
     flat: list[dict[str, Any]] = []
     for bench in sorted(by_benchmark):
-        group = sorted(by_benchmark[bench], key=lambda e: (e.team, e.inputs, str(e.source)))
+        group = sorted(
+            by_benchmark[bench], key=lambda x: (x.team, x.main.inputs, str(x.main.source))
+        )
         # The benchmark is the table's title, not a column.
-        keys = list(dict.fromkeys(k for e in group for k in e.headline if k != "benchmark"))
+        keys = list(dict.fromkeys(k for x in group for k in x.main.headline if k != "benchmark"))
+        merged = any(x.others for x in group)
         rows = []
         links = []
-        for e in group:
-            row: dict[str, Any] = {"team": e.team or "(unknown)"}
+        for x in group:
+            e = x.main
+            row: dict[str, Any] = {"team": x.team or "(unknown)"}
             row.update({k: e.headline.get(k) for k in keys})
             row["warnings"] = e.warnings
             row["failures"] = e.failures
             row["audit findings"] = e.findings
             row["inputs"] = ", ".join(e.inputs)
+            if merged:
+                row["options"] = e.options or "(defaults)"
+                row["other results"] = "; ".join(_variant_text(o, e) for o in x.others)
             rows.append(row)
-            flat.append({"benchmark": bench, **row, "source": str(e.source)})
-            target = e.index or e.source
-            rel = os.path.relpath(target.resolve(), outdir.resolve())
-            links.append((Path(rel).as_posix(), f"{e.team or '(unknown)'}: {rel}"))
-        teams = len({e.team for e in group})
+            flat.append(
+                {
+                    "benchmark": bench,
+                    **row,
+                    "team_source": x.team_source,
+                    "source": str(e.source),
+                    "other sources": " ".join(str(o.source) for o in x.others),
+                }
+            )
+            for r in (e, *x.others):
+                target = r.index or r.source
+                rel = os.path.relpath(target.resolve(), outdir.resolve())
+                label = f" ({r.options or 'defaults'})" if x.others else ""
+                links.append((Path(rel).as_posix(), f"{x.team or '(unknown)'}{label}: {rel}"))
+        teams = len({x.team for x in group})
         benchmarks.append(
             {
                 "anchor": f"b-{bench}",
@@ -169,7 +242,8 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
         writer = csv.DictWriter(fh, fieldnames=columns)
         writer.writeheader()
         writer.writerows(flat)
-    subtitle = f"{len(entries)} result(s), combined by ertools {__version__}"
+    of_runs = f" of {len(runs)} execution(s)" if len(runs) != len(entries) else ""
+    subtitle = f"{len(entries)} result(s){of_runs}, combined by ertools {__version__}"
     index = outdir / "index.html"
     nav = [(b["anchor"], b["title"]) for b in benchmarks] + [("teams", "By team")]
     page = h.render(
@@ -178,21 +252,56 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
         subtitle=subtitle,
         nav=nav,
         benchmarks=benchmarks,
-        teams=_by_team(entries, outdir),
+        teams=_by_team(runs, outdir),
     )
     index.write_text(page, encoding="utf-8")
     return index
 
 
-def _by_team(entries: list[Entry], outdir: Path) -> list[h.Table]:
-    """One table per team: its results in every benchmark, headline values as text."""
-    teams: dict[str, list[Entry]] = {}
+def executions(entries: list[Entry]) -> list[Execution]:
+    """The entries grouped by execution: same benchmark and same input SHA-256s (an entry
+    without recorded inputs is an execution of its own), in the order first seen."""
+    groups: dict[object, list[Entry]] = {}
     for e in entries:
-        teams.setdefault(e.team or "(unknown)", []).append(e)
+        key: object = (e.benchmark, e.sha256) if e.sha256 else ("source", str(e.source))
+        groups.setdefault(key, []).append(e)
+    out = []
+    for group in groups.values():
+        # Best team source first, a named team before none, the newest result on ties.
+        ranked = sorted(group, key=lambda e: e.generated, reverse=True)
+        ranked.sort(key=lambda e: (not e.team, _SOURCE_RANK.get(e.team_source or "", 4)))
+        main = ranked[0]
+        team, source = main.team, main.team_source
+        if not team:
+            # Results written before teams were recorded: the inputs' names may still say.
+            found = next((t for e in group for i in e.inputs if (t := team_from_log_name(i))), None)
+            team, source = found or "", "log name" if found else None
+        out.append(Execution(main, tuple(ranked[1:]), team, source))
+    return out
+
+
+def _variant_text(other: Entry, main: Entry) -> str:
+    """``(defaults): position_accuracy 165.8 mm``: another result of the execution, by its
+    options, with the headline values that differ from the shown one."""
+    diffs = [
+        _score_text(k, v)
+        for k, v in other.headline.items()
+        if k != "benchmark" and main.headline.get(k) != v
+    ]
+    same = "same headline values" if not diffs else ", ".join(diffs)
+    return f"{other.options or '(defaults)'}: {same}"
+
+
+def _by_team(runs: list[Execution], outdir: Path) -> list[h.Table]:
+    """One table per team: its results in every benchmark, headline values as text."""
+    teams: dict[str, list[Execution]] = {}
+    for x in runs:
+        teams.setdefault(x.team or "(unknown)", []).append(x)
     out = []
     for team in sorted(teams):
         rows = []
-        for e in sorted(teams[team], key=lambda e: (e.benchmark, str(e.source))):
+        for x in sorted(teams[team], key=lambda x: (x.main.benchmark, str(x.main.source))):
+            e = x.main
             target = e.index or e.source
             rows.append(
                 {

@@ -139,7 +139,9 @@ def _write_report(
     inputs = [Path(p) for p in inputs]
     input_records = [file_record(p) for p in inputs if p.exists()]
     configs = _configs(argv, inputs, score)
-    team = team or _team(argv, score, configs)
+    team_source: str | None = "explicit" if team else None
+    if not team:
+        team, team_source = _team(argv, inputs, score, audit, configs)
 
     written: list[str] = []
     if score is not None:
@@ -163,6 +165,7 @@ def _write_report(
     meta = {
         "benchmark": benchmark,
         "team": team,
+        "team_source": team_source,
         "generated": generated,
         "ertools_version": __version__,
         "argv": list(argv),
@@ -262,23 +265,39 @@ def _configs(
 
 def _team(
     argv: list[str],
+    inputs: list[Path],
     score: BenchmarkResult | None,
+    audit: Any,
     configs: list[tuple[FileRecord, str | None]],
-) -> str | None:
+) -> tuple[str | None, str | None]:
+    """(team, where it was found): the result's own (``provenance.team``, set by the scoring
+    commands), else ``--team`` on the command line, a rockin_logger input name, a
+    ``team``/``robot_info`` parameter, a ``transform-<team>.yaml`` argument."""
+    from ertools.teams import team_from_log_name, team_from_transform_name
+
+    for holder in (score, audit):
+        provenance = getattr(holder, "provenance", None)
+        if provenance is not None and getattr(provenance, "team", None):
+            return provenance.team, provenance.team_source
     for i, token in enumerate(argv):
         if token == "--team" and i + 1 < len(argv):
-            return argv[i + 1]
+            return argv[i + 1], "explicit"
         if token.startswith("--team="):
-            return token.split("=", 1)[1]
+            return token.split("=", 1)[1], "explicit"
+    named = [*inputs, *(score.provenance.inputs if score is not None else ())]
+    for path in (*named, *(getattr(getattr(audit, "provenance", None), "inputs", ()) or ())):
+        found = team_from_log_name(path)
+        if found:
+            return found, "log name"
     if score is not None:
         for name, value in score.provenance.parameters:
             if name.lower() in ("team", "robot_info") and value not in ("", "identity"):
-                return value
+                return value, "transform" if name.lower() == "robot_info" else "explicit"
     for record, _ in configs:
-        m = re.fullmatch(r"transform-(.+)\.ya?ml", record.name)
-        if m and m.group(1) != "identity":
-            return m.group(1)
-    return None
+        found = team_from_transform_name(record.name)
+        if found:
+            return found, "transform"
+    return None, None
 
 
 def headline(score: dict[str, Any]) -> dict[str, Any]:
@@ -573,6 +592,11 @@ def _provenance_context(
         params += list(score.provenance.parameters)
     if audit is not None:
         params += [(f"audit {k}", v) for k, v in audit.provenance.parameters]
+    if meta["team"]:
+        from ertools.teams import SOURCE_TEXT
+
+        source = SOURCE_TEXT.get(meta["team_source"] or "", "the command line")
+        params.insert(0, ("team", f"{meta['team']} (from {source})"))
     software = [
         ("ertools", meta["ertools_version"]),
         ("python", platform.python_version()),

@@ -9,9 +9,8 @@ carry a marker.
 
 from __future__ import annotations
 
-import re
-
-from ertools.timeline import KIND_LABELS, BagEntry, bag_stem
+from ertools.teams import team_from_log_name
+from ertools.timeline import KIND_LABELS, BagEntry
 
 KIND_COLORS: dict[str, str] = {
     "gt": "#0072B2",  # blue
@@ -26,18 +25,16 @@ PROBLEM_EDGE = "#000000"
 MARKER_FILL = "#F0E442"  # yellow, behind a black "!" or number
 SESSION_FILL = "#E8ECF2"
 
-# rockin_logger named robot logs ${BENCHMARK}_${DATE}_${TEAMNAME}.bag: the date differs from
-# run to run, the team does not, so the team is the robot's lane.
-_ROBOT_LOG_RE = re.compile(r"^[FT]BM[0-9HW]{2}_\d{8,14}_(?P<team>.+)$", re.IGNORECASE)
-
 
 def lane_name(bag: BagEntry) -> str:
     """The lane of a bag: its logger, or ``robot <team>`` for a robot log named by the 2015
     rockin_logger (one lane per robot, whatever the benchmark and run)."""
+    # rockin_logger named robot logs ${BENCHMARK}_${DATE}_${TEAMNAME}.bag: the date differs
+    # from run to run, the team does not, so the team is the robot's lane.
     if bag.kind == "robot":
-        match = _ROBOT_LOG_RE.match(bag_stem(bag.path))
-        if match is not None:
-            return f"robot {match.group('team')}"
+        team = team_from_log_name(bag.path)
+        if team is not None:
+            return f"robot {team}"
     return bag.logger
 
 

@@ -77,3 +77,105 @@ def test_bad_result_path(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> 
     bad.write_text("{not json")
     assert main(["report", str(bad), "--out", str(tmp_path / "o")]) == 1
     assert "cannot read a result" in capsys.readouterr().err
+
+
+# --------------------------------------------------------------------------------------------
+# One execution, one row: results of the same inputs merged, teams never "(unknown)" when a
+# name can be found
+
+
+def _csv(out: Path) -> list[dict[str, str]]:
+    with (out / "results.csv").open(newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def test_same_inputs_are_one_execution(tmp_path: Path) -> None:
+    from ertools.streams import Provenance
+
+    log = tmp_path / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
+    log.write_bytes(b"one recording")
+    same = tmp_path / "copy" / log.name  # the same bytes elsewhere: the same execution
+    same.parent.mkdir()
+    same.write_bytes(b"one recording")
+    other = tmp_path / "FBM3W_201511201200_robox.bag"  # another execution, named by its logger
+    other.write_bytes(b"another recording")
+    runs = [
+        ("plain", log, Provenance(), 0.0123, ["ertools", "score", "fbm3w", str(log)]),
+        (
+            "named",
+            same,
+            Provenance(team="tripod", team_source="explicit"),
+            0.0125,
+            ["ertools", "score", "fbm3w", str(same), "--team", "tripod", "--format", "json"],
+        ),
+        ("robox", other, Provenance(), 0.02, ["ertools", "score", "fbm3w", str(other)]),
+    ]
+    folders = []
+    for name, bag, prov, best, argv in runs:
+        result = fbm3w_like(best)
+        result = type(result)(**{**result.__dict__, "provenance": prov})
+        write_report(result, tmp_path / name, inputs=[bag], argv=argv)
+        folders.append(str(tmp_path / name))
+    # A report written before team_source existed: no team recorded, the name still says.
+    meta_path = tmp_path / "robox" / "result.json"
+    meta = json.loads(meta_path.read_text())
+    assert (meta["team"], meta["team_source"]) == ("robox", "log name")
+    meta.pop("team_source")
+    meta["team"] = None
+    meta_path.write_text(json.dumps(meta))
+
+    out = tmp_path / "out"
+    assert main(["report", *folders, "--out", str(out)]) == 0
+    rows = _csv(out)
+    assert [(r["team"], r["team_source"]) for r in rows] == [
+        ("robox", "log name"),
+        ("tripod", "explicit"),
+    ]
+    tripod = rows[1]
+    # The named result is shown; the other is listed by its options (--format is output only).
+    assert float(tripod["best_distance_error"]) == 0.0125
+    assert tripod["options"] == "--team tripod"
+    assert tripod["other results"] == f"(defaults): best_distance_error {0.0123 * 1000:.6g} mm"
+    assert rows[0]["other results"] == ""
+    page = (out / "index.html").read_text(encoding="utf-8")
+    assert "(unknown)" not in page
+    assert "3 result(s) of 2 execution(s)" in page
+
+
+def test_the_fbm2h_sample_scored_twice_is_one_row(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Issue 19: the FBM2H log scored with the identity transform and with --team simbot
+    --transforms was listed twice, once as "(unknown)"; it is one execution of simbot."""
+    import yaml
+
+    folder = Path(__file__).resolve().parents[2] / "sample_bags" / "fbm2h"
+    if not folder.is_dir():
+        from ertools.samples.fbm2h import generate
+
+        generate(tmp_path / "fbm2h", seed=2016)
+        folder = tmp_path / "fbm2h"
+    (bag,) = folder.glob("log_fbm2h_*.bag")
+    (answers,) = folder.glob("*.answers.yaml")
+    truth = yaml.safe_load(answers.read_text())
+    score = ["score", "fbm2h", str(bag)]
+    assert main([*score, "--report", str(tmp_path / "identity")]) == 0
+    simbot = ["--team", "simbot", "--transforms", str(folder)]
+    assert main([*score, *simbot, "--report", str(tmp_path / "simbot")]) == 0
+    capsys.readouterr()
+    out = tmp_path / "out"
+    assert (
+        main(["report", str(tmp_path / "identity"), str(tmp_path / "simbot"), "--out", str(out)])
+        == 0
+    )
+    rows = _csv(out)
+    assert len(rows) == 1
+    row = rows[0]
+    assert (row["benchmark"], row["team"], row["team_source"]) == ("fbm2h", "simbot", "explicit")
+    # The shown numbers are simbot's (the transform it was scored with): the generator's truth.
+    tol = truth["tolerance"]["distance_error"]["abs"]
+    expected = truth["expected"]["position_accuracy"]
+    assert float(row["position_accuracy"]) == pytest.approx(expected, abs=tol)
+    assert row["options"] == f"--team simbot --transforms {folder}"
+    assert row["other results"].startswith("(defaults): position_accuracy ")
+    assert "(unknown)" not in (out / "index.html").read_text(encoding="utf-8")
