@@ -9,12 +9,10 @@ from __future__ import annotations
 
 import logging
 import os
-import sys
-import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, TextIO
+from typing import TYPE_CHECKING
 
 from ertools.timeline import (
     ClockCheck,
@@ -28,6 +26,7 @@ from ertools.timeutil import NS_PER_S
 
 if TYPE_CHECKING:
     from ertools.io import BagSummary
+    from ertools.progress import Reporter
 
 log = logging.getLogger("ertools.timeline_scan")
 
@@ -183,31 +182,15 @@ def check_recordings(
     return checks
 
 
-class Progress:
-    """``scanning 12/1000`` on a terminal's stderr, shown only once a scan takes a moment."""
+def _ticker(progress: Reporter) -> Callable[[int], None]:
+    """``on_progress(done)`` callbacks (a count so far) as the reporter's increments."""
+    last = [0]
 
-    def __init__(self, total: int, stream: TextIO | None = None, delay_s: float = 0.5) -> None:
-        self.total = total
-        self.stream = stream if stream is not None else sys.stderr
-        self.enabled = self.stream.isatty()
-        self.start = time.monotonic()
-        self.delay_s = delay_s
-        self.shown = False
+    def tick(done: int) -> None:
+        progress.advance(done - last[0])
+        last[0] = done
 
-    def __call__(self, done: int) -> None:
-        if not self.enabled or time.monotonic() - self.start < self.delay_s:
-            return
-        self.shown = True
-        width = 30
-        filled = width * done // max(self.total, 1)
-        bar = "#" * filled + "-" * (width - filled)
-        self.stream.write(f"\rertools: scanning [{bar}] {done}/{self.total}")
-        self.stream.flush()
-
-    def close(self) -> None:
-        if self.shown:
-            self.stream.write("\r" + " " * 60 + "\r")
-            self.stream.flush()
+    return tick
 
 
 def summarise(
@@ -237,7 +220,7 @@ def scan(
     config: TimelineConfig | None = None,
     *,
     check_clocks: bool = True,
-    progress: bool = False,
+    progress: Reporter | None = None,
 ) -> Timeline:
     """Find, summarise and clock-check the bags under ``paths`` and build their timeline.
 
@@ -245,23 +228,29 @@ def scan(
         paths: files and folders.
         config: thresholds.
         check_clocks: compare header stamps with record times (reads a second per bag).
-        progress: show a progress bar on stderr when it is a terminal.
+        progress: gets the bags summarised, then the recordings clock-checked.
     """
+    from ertools.progress import reporting
+
     found = find_bags(Path(p) for p in paths)
-    bar = Progress(len(found.bags)) if progress else None
-    summaries, unreadable = summarise(found.bags, bar)
+    with reporting(None):  # counted by bag and recording: the reads inside do not report
+        return _scan(found, config, check_clocks, progress)
+
+
+def _scan(
+    found: Found, config: TimelineConfig | None, check_clocks: bool, progress: Reporter | None
+) -> Timeline:
+    tick: Callable[[int], None] | None = None
+    if progress is not None:
+        progress.task("summarising", len(found.bags), "bags")
+        tick = _ticker(progress)
+    summaries, unreadable = summarise(found.bags, tick)
     checks: list[ClockCheck] = []
     if check_clocks:
         tolerance = (config or TimelineConfig()).clock_tolerance_ns
-        done = len(found.bags)
-        if bar is not None:  # one check per recording (see check_recordings)
-            bar.total = done + len({(split_name(s.path) or (s.path, 0))[0] for s in summaries})
-
-        def tick(n: int) -> None:
-            if bar is not None:
-                bar(done + n)
-
+        if progress is not None:  # one check per recording (see check_recordings)
+            recordings = {(split_name(s.path) or (s.path, 0))[0] for s in summaries}
+            progress.task("checking clocks", len(recordings), "recordings")
+            tick = _ticker(progress)
         checks = check_recordings(summaries, tolerance, tick)
-    if bar is not None:
-        bar.close()
     return build_timeline(summaries, [*found.problems, *unreadable], checks, config)

@@ -49,6 +49,7 @@ from ertools.benchmarks.fbm1_score import (
 from ertools.configs.items import Item, ItemList
 from ertools.errors import ConfigError, ScoringError, SegmentationError
 from ertools.fidelity import Deviation, Rule
+from ertools.progress import Reporter, current
 from ertools.streams import PoseStream, Provenance, frame_change_warning
 from ertools.timeutil import NS_PER_S
 
@@ -450,8 +451,10 @@ def score_fbm1(
     t0_ns: int = 0,
     provenance: Provenance | None = None,
     item_tf: PoseStream | None = None,
+    progress: Reporter | None = None,
 ) -> Fbm1Result:
-    """Score every run (pure: streams and configs in, frozen result out).
+    """Score every run (pure: streams and configs in, frozen result out), each reported to
+    ``progress`` when scored.
 
     A run that cannot be scored is reported in ``failures`` (one line naming the run) and left
     out of the totals; the other runs are still scored. ``item_tf``: the node's item
@@ -465,9 +468,14 @@ def score_fbm1(
             f"no FBM1 run in the state log (no BmBox WAITING_MANUAL_OPERATION or goal); "
             f"is this an {opts.benchmark} log?"
         )
-    runs = tuple(
-        score_run(run, items, origin, board, opts, results, t0_ns, item_tf) for run in found.runs
-    )
+    if progress is not None:
+        progress.task("scoring runs", len(found.runs), "runs")
+    scored = []
+    for run in found.runs:
+        scored.append(score_run(run, items, origin, board, opts, results, t0_ns, item_tf))
+        if progress is not None:
+            progress.advance(1)
+    runs = tuple(scored)
     counted = [r for r in runs if r.status in ("scored", "no_answer")]
     tot = totals(
         [bool(r.class_ok) for r in counted],
@@ -680,4 +688,5 @@ def score_fbm1_bag(
         t0_ns=t0,
         provenance=provenance,
         item_tf=item_tf,
+        progress=current(),
     )

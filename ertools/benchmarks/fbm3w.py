@@ -37,6 +37,7 @@ from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
 from ertools.configs.shapes import Shape
 from ertools.errors import ConfigError, ErtoolsError, ScoringError, TopicError
 from ertools.fidelity import Deviation, Rule
+from ertools.progress import Reporter, current
 from ertools.streams import PoseStream, Provenance, frame_change_warning
 
 log = logging.getLogger("ertools.benchmarks.fbm3w")
@@ -311,6 +312,7 @@ def score_fbm3w(
         options=options,
         bag_start_ns=bag_start,
         inputs=tuple(str(p) for p in plist),
+        progress=current(),
     )
 
 
@@ -331,8 +333,10 @@ def score_runs(
     options: Fbm3wOptions = Fbm3wOptions(),
     bag_start_ns: int | None = None,
     inputs: tuple[str, ...] = (),
+    progress: Reporter | None = None,
 ) -> Fbm3wResult:
-    """Score every run of ``windows`` on ``poses`` (pure; no file access)."""
+    """Score every run of ``windows`` on ``poses`` (pure; no file access), each run
+    reported to ``progress`` when scored."""
     cfg = config if options.d_min is None else config.with_d_min(options.d_min)
     start_ns = poses.start_ns if bag_start_ns is None else bag_start_ns
     runs_in, warnings = with_specs(list(windows), cfg)
@@ -353,8 +357,12 @@ def score_runs(
         warnings.append(frames)
     results: list[RunResult] = []
     failures: list[str] = []
+    if progress is not None:
+        progress.task("scoring runs", len(runs_in), "runs")
     for window in runs_in:
         run = _score_one(poses, same, window, cfg, options, start_ns, warnings)
+        if progress is not None:
+            progress.advance(1)
         results.append(run)
         if run.error is not None:
             failures.append(f"run {window.index} ({run.spec}): {run.error}")

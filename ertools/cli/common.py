@@ -62,8 +62,12 @@ def add_output_options(
 
 
 def write_text(text: str, output: Path | None) -> None:
-    """Text to ``output`` (a file) or stdout."""
+    """Text to ``output`` (a file) or stdout (below any progress bar: stdout and stderr may
+    be the same terminal)."""
     if output is None:
+        from ertools.progress import clear_current
+
+        clear_current()
         sys.stdout.write(text if text.endswith("\n") else text + "\n")
     else:
         output.parent.mkdir(parents=True, exist_ok=True)
@@ -72,7 +76,10 @@ def write_text(text: str, output: Path | None) -> None:
 
 
 def note(message: str) -> None:
-    """A human note on stderr (stdout stays parseable)."""
+    """A human note on stderr (stdout stays parseable), below any progress bar."""
+    from ertools.progress import clear_current
+
+    clear_current()
     print(f"ertools: {message}", file=sys.stderr)
 
 

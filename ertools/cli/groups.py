@@ -27,6 +27,7 @@ def run_group(group: str, members: dict[str, Command], args: argparse.Namespace)
     from ertools.cli.main import run_command
 
     extra = ["-v"] * args.verbose + (["--debug"] if args.debug else [])
+    extra += ["--quiet"] if args.quiet else []
     member: str = args.member
     rest: list[str] = list(args.rest)
     if member not in members:  # argparse checked already; keeps mypy honest

@@ -137,6 +137,7 @@ def run(args: argparse.Namespace) -> int:
     from ertools.cli.common import dump_json, note, write_text
     from ertools.errors import BagError
     from ertools.io.info import describe, expand
+    from ertools.progress import reporting
 
     infos: list[BagInfo] = []
     problems: list[dict[str, str]] = []
@@ -146,9 +147,15 @@ def run(args: argparse.Namespace) -> int:
             paths.extend(expand([given]))
         except BagError as err:  # a missing path or an empty folder: the others still run
             problems.append({"path": str(given), "problem": err.message})
+    progress = getattr(args, "progress", None)  # set by run_command
+    if progress is not None and not args.check:  # --check reports the bytes of each file
+        progress.task("reading indexes", len(paths), "bags")
     for path in paths:
+        if progress is not None and not args.check:
+            progress.advance(1)
         try:
-            info = describe(path, check=args.check)
+            with reporting(None):  # only --check's own counts: not the index reads inside
+                info = describe(path, check=args.check, progress=progress)
         except BagError as err:
             problems.append({"path": str(path), "problem": _one_line(err.message)})
             continue

@@ -9,9 +9,12 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib import import_module
 from pathlib import Path
-from typing import NoReturn
+from typing import TYPE_CHECKING, NoReturn
 
 from ertools import __version__
+
+if TYPE_CHECKING:
+    from ertools.progress import Bar
 
 
 @dataclass(frozen=True)
@@ -122,6 +125,12 @@ def build_parser(prog: str, module_name: str) -> tuple[argparse.ArgumentParser, 
     parser.add_argument(
         "--debug", action="store_true", help="show the traceback of an unexpected error"
     )
+    parser.add_argument(
+        "-q",
+        "--quiet",
+        action="store_true",
+        help="no progress bar (one is shown on a terminal's stderr for work that lasts)",
+    )
     module.add_arguments(parser)
     return parser, module
 
@@ -137,7 +146,15 @@ def _configure_logging(verbose: int) -> None:
             head = f"ertools: {record.levelname}:"
             return text.replace(head, head.lower(), 1)
 
-    handler = logging.StreamHandler(sys.stderr)
+    class _BelowTheBar(logging.StreamHandler):  # type: ignore[type-arg]
+        # a message logged while a progress bar is drawn starts on a line of its own
+        def emit(self, record: logging.LogRecord) -> None:
+            from ertools.progress import clear_current
+
+            clear_current()
+            super().emit(record)
+
+    handler = _BelowTheBar(sys.stderr)
     handler.setFormatter(_LowerLevel("ertools: %(levelname)s: %(message)s"))
     root = logging.getLogger("ertools")
     root.handlers[:] = [handler]
@@ -207,6 +224,7 @@ def _one_line(message: str) -> str:
 def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
     """Parse ``argv`` for one command module and run it, mapping errors to exit codes."""
     from ertools.errors import ErtoolsError
+    from ertools.progress import reporting
 
     parser, module = build_parser(prog, module_name)
     try:
@@ -216,10 +234,16 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
     # The command as run, for report provenance (sys.argv is wrong when called in-process).
     args.command_line = [*prog.split(), *argv]
     _configure_logging(args.verbose)
+    bar = _progress_bar(args)
     try:
         _check_numbers(args)
         _refuse_overwriting_inputs(args)
-        code: int = module.run(args)  # type: ignore[attr-defined]
+        try:
+            with reporting(bar):
+                code: int = module.run(args)  # type: ignore[attr-defined]
+        finally:  # wiped before any error line below, which would otherwise follow the bar
+            if bar is not None:
+                bar.close()
     except ErtoolsError as err:
         print(f"ertools: error: {_one_line(str(err))}", file=sys.stderr)
         return err.exit_code
@@ -250,6 +274,19 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
         )
         return 1
     return code
+
+
+def _progress_bar(args: argparse.Namespace) -> Bar | None:
+    """The command's progress bar (``args.progress``): only on a terminal and without
+    ``--quiet``; None otherwise, so nothing reports at all."""
+    from ertools.progress import Bar
+
+    args.progress = None
+    if getattr(args, "quiet", False) or not sys.stderr.isatty():
+        return None
+    bar = Bar(sys.stderr)
+    args.progress = bar
+    return bar
 
 
 def main(argv: Sequence[str] | None = None) -> int:

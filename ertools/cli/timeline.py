@@ -94,7 +94,10 @@ def run(args: argparse.Namespace) -> int:
         gap_tolerance_ns=s_to_ns(args.gap_tolerance),
     )
     timeline = scan(
-        args.paths, config, check_clocks=not args.no_clock_check, progress=sys.stderr.isatty()
+        args.paths,
+        config,
+        check_clocks=not args.no_clock_check,
+        progress=getattr(args, "progress", None),
     )
     if args.format == "json":
         write_text(dump_json(timeline.to_dict()), args.output)

@@ -30,6 +30,7 @@ from ertools.io.uniform import Rows, decode_uniform
 
 if TYPE_CHECKING:
     from ertools.io.ros1_index import Ros1Bag, Ros1Chunk
+    from ertools.progress import Reporter
 
 log = logging.getLogger("ertools.io.bulk")
 
@@ -163,7 +164,13 @@ class Located:
     runs: Iterator[Run]
 
 
-def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None) -> Located:
+def _ros1_runs(
+    bag: BagFile,
+    conns: Sequence[Conn],
+    lo: int | None,
+    hi: int | None,
+    progress: Reporter | None = None,
+) -> Located:
     from ertools.io.ros1_index import Ros1Bag
 
     assert isinstance(bag, Ros1Bag)
@@ -213,7 +220,21 @@ def _ros1_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | No
         return sel, buf, start, length, t_of[sel]
 
     compressed = any(bag.layout.chunks[ci].compression != "none" for ci in touched)
-    return Located(len(t_of), prefetched(len(todo), load_run, parallel=compressed))
+    weights = [sum(max(bag.layout.chunks[c].data_len, 0) for c in batch) for batch in todo]
+    runs = prefetched(
+        len(todo),
+        load_run,
+        parallel=compressed,
+        progress=progress,
+        weights=weights,
+        label=_label(bag, conns),
+    )
+    return Located(len(t_of), runs)
+
+
+def _label(bag: BagFile, conns: Sequence[Conn]) -> str:
+    topic = conns[0].topic if conns else "?"
+    return f"reading {topic} from {bag.path.name}"
 
 
 # Wanted records further apart than this on average are read in place (mapped) rather than
@@ -290,7 +311,11 @@ def _chunk_group(bag: BagFile, chunks: list[Any], scratch: list[Any]) -> Group:
 
 
 def _mcap_runs(
-    bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None
+    bag: BagFile,
+    conns: Sequence[Conn],
+    lo: int | None,
+    hi: int | None,
+    progress: Reporter | None = None,
 ) -> Located | None:
     from ertools.io.mcap_index import McapIndex
 
@@ -298,14 +323,22 @@ def _mcap_runs(
     if index is None:
         return None
     plan = index.plan(conns, lo, hi)
-    count, load = index.run_loader(plan)
+    count, load, weights = index.run_loader(plan)
     compressed = any(c.compression for chunks in plan.chunks for c in chunks)
 
     def load_run(k: int, scratch: list[Any]) -> Run:
         pos, buf, start, length = load(k, scratch)
         return pos, buf, start, length, plan.t_record[pos]
 
-    return Located(len(plan.t_record), prefetched(count, load_run, parallel=compressed))
+    runs = prefetched(
+        count,
+        load_run,
+        parallel=compressed,
+        progress=progress,
+        weights=weights,
+        label=_label(bag, conns),
+    )
+    return Located(len(plan.t_record), runs)
 
 
 def _sqlite_runs(
@@ -338,29 +371,41 @@ def _scanned_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int |
 
 
 def locate(
-    bag: BagFile, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
+    bag: BagFile,
+    conns: Sequence[Conn],
+    start_ns: int | None,
+    end_ns: int | None,
+    progress: Reporter | None = None,
 ) -> Located | None:
     """The messages of ``conns`` with record time in [start_ns, end_ns], or None when the
     format has no bulk access (then the caller reads per message).
 
+    ROS1 and MCAP reads report the bytes of each group of chunks to ``progress`` (default:
+    the reporter made current by :func:`ertools.progress.reporting`, if any).
+
     Raises:
         LayoutMismatchError: the file lacks the index records the bulk path needs.
     """
+    if progress is None:
+        from ertools.progress import current
+
+        progress = current()
     if bag.format in ("ros1", "ros1-active"):
-        return _ros1_runs(bag, conns, start_ns, end_ns)
+        return _ros1_runs(bag, conns, start_ns, end_ns, progress)
     if bag.format == "rosbag2-sqlite3":
         return _sqlite_runs(bag, conns, start_ns, end_ns)
     if getattr(bag, "scanned", False):
         return _scanned_runs(bag, conns, start_ns, end_ns)
     if bag.format in ("mcap", "rosbag2-mcap"):
-        return _mcap_runs(bag, conns, start_ns, end_ns)
+        return _mcap_runs(bag, conns, start_ns, end_ns, progress)
     return None
 
 
-def load_all_chunks(bag: BagFile) -> int:
+def load_all_chunks(bag: BagFile, progress: Reporter | None = None) -> int:
     """Uncompressed bytes of every chunk of a ROS1 or MCAP file, loaded through the same
     pipeline as a topic read but not decoded: the floor of any read of that file (what the
-    benchmark compares the extraction with on compressed files)."""
+    benchmark compares the extraction with on compressed files). The bytes read from the
+    file (compressed) are reported to ``progress`` group by group."""
     from ertools.io.mcap_index import McapIndex
     from ertools.io.ros1_index import Ros1Bag
 
@@ -376,7 +421,11 @@ def load_all_chunks(bag: BagFile) -> int:
         def load(k: int, scratch: list[Any]) -> Group:
             return _chunk_group(bag, todo[k], scratch)
 
-        for _buf, _base, sizes in prefetched(len(todo), load):
+        weights = [sum(c.data_len for c in part) for part in todo]
+        label = f"reading {bag.path.name}"
+        for _buf, _base, sizes in prefetched(
+            len(todo), load, progress=progress, weights=weights, label=label
+        ):
             total += int(sizes.sum())
         return total
     index = McapIndex.of(bag)
@@ -389,7 +438,15 @@ def load_all_chunks(bag: BagFile) -> int:
         part = jobs[k * step : (k + 1) * step]
         return joined([index.inflated_bytes(path, chunk) for path, chunk in part], scratch)
 
-    for buf, _base, _sizes in prefetched((len(jobs) + step - 1) // step, load_mcap):
+    count = (len(jobs) + step - 1) // step
+    weights = [
+        sum(int(c.compressed_size) for _p, c in jobs[k * step : (k + 1) * step])
+        for k in range(count)
+    ]
+    label = f"reading {bag.path.name}"
+    for buf, _base, _sizes in prefetched(
+        count, load_mcap, progress=progress, weights=weights, label=label
+    ):
         total += len(buf)
     return total
 

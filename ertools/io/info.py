@@ -13,13 +13,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ertools.errors import BagError
 from ertools.io.model import BagSummary
 from ertools.timeutil import iso_utc, ns_to_s
+
+if TYPE_CHECKING:
+    from ertools.progress import Reporter
 
 BAG_SUFFIXES = (".bag", ".mcap", ".active")
 
@@ -142,8 +145,9 @@ def expand(paths: list[Path]) -> list[Path]:
     return out
 
 
-def describe(path: str | Path, *, check: bool = False) -> BagInfo:
-    """Summary (exact per-topic times), median rates, and with ``check`` a full chunk check.
+def describe(path: str | Path, *, check: bool = False, progress: Reporter | None = None) -> BagInfo:
+    """Summary (exact per-topic times), median rates, and with ``check`` a full chunk check
+    (whose bytes are reported to ``progress``).
 
     Raises:
         BagError: unreadable bag, or (with ``check``) a damaged chunk.
@@ -152,7 +156,7 @@ def describe(path: str | Path, *, check: bool = False) -> BagInfo:
 
     s, times = summary_and_times(path)
     rates = {name: median_rate(t) for name, t in times.items()}
-    found = verify(Path(path)) if check else []
+    found = verify(Path(path), progress) if check else []
     if check:
         # the record-level check says each index disagreement exactly: not twice
         kept = [p for p in s.problems if not p.endswith(INDEX_SELF_CHECK)]
@@ -160,8 +164,9 @@ def describe(path: str | Path, *, check: bool = False) -> BagInfo:
     return BagInfo(s, rates, check, tuple(found))
 
 
-def verify(path: Path) -> list[str]:
-    """Read every chunk and check every indexed message record.
+def verify(path: Path, progress: Reporter | None = None) -> list[str]:
+    """Read every chunk and check every indexed message record, reporting the bytes read to
+    ``progress`` chunk by chunk (ROS1 and indexed MCAP).
 
     Returns:
         For ROS1 bags, every disagreement between the index and the records, one line each
@@ -176,20 +181,20 @@ def verify(path: Path) -> list[str]:
     if fmt == "ros1":
         from ertools.io.ros1_check import check_ros1
 
-        return check_ros1(path)
+        return check_ros1(path, progress)
     if fmt == "ros1-active":
         from ertools.io.ros1_index import Ros1Bag
 
         bag = Ros1Bag(path)
         try:
-            bag.verify()
+            bag.verify(progress)
         finally:
             bag.close()
     elif fmt in ("mcap", "rosbag2-mcap"):
         from ertools.io.mcap_index import verify_mcap
 
         for file in [path] if fmt == "mcap" else sorted(path.glob("*.mcap")):
-            verify_mcap(file)
+            verify_mcap(file, progress)
     else:
         from ertools.io.rosbag2 import query, read_metadata, storage_files
 

@@ -16,7 +16,7 @@ import zlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, BinaryIO
+from typing import TYPE_CHECKING, Any, BinaryIO
 
 import numpy as np
 import numpy.typing as npt
@@ -26,6 +26,9 @@ from ertools.io.fastdecode import read_at as gather_at
 from ertools.io.files import BagFile
 from ertools.io.model import Conn
 from ertools.io.pipeline import Group, joined, pread, read_at, scratch_view
+
+if TYPE_CHECKING:
+    from ertools.progress import Reporter
 
 # Op codes a chunk may hold (schema 0x03, channel 0x04, message 0x05), as a lookup table.
 _RECORD_STARTS = np.zeros(256, dtype=bool)
@@ -243,11 +246,13 @@ class McapIndex:
 
     def run_loader(
         self, plan: McapPlan
-    ) -> tuple[int, Callable[[int, list[Any]], tuple[I64, U8, I64, I64]]]:
-        """(number of groups, load) where ``load(k, scratch)`` decompresses the k-th group of
-        chunks (up to ``GROUP_BYTES`` uncompressed) into ``scratch`` and gives (reference
-        positions, bytes, data starts, data lengths) of the planned messages in it. ``load``
-        may run on a worker thread (it opens the file itself)."""
+    ) -> tuple[int, Callable[[int, list[Any]], tuple[I64, U8, I64, I64]], list[int]]:
+        """(number of groups, load, bytes) where ``load(k, scratch)`` decompresses the k-th
+        group of chunks (up to ``GROUP_BYTES`` uncompressed) into ``scratch`` and gives
+        (reference positions, bytes, data starts, data lengths) of the planned messages in
+        it, and ``bytes[k]`` is what that group reads from the file (its chunks' compressed
+        sizes, for progress). ``load`` may run on a worker thread (it opens the file
+        itself)."""
         from ertools.io.bulk import GROUP_BYTES, group_positions
 
         todo: list[list[tuple[int, I64]]] = []
@@ -292,7 +297,8 @@ class McapIndex:
                 raise BagError(f"message record length runs into no record {where}")
             return rows, buf, start, length
 
-        return len(todo), load
+        weights = [sum(int(chunk_of(key)[1].compressed_size) for key, _ in part) for part in todo]
+        return len(todo), load, weights
 
     @staticmethod
     def _group_bytes(chunks: list[tuple[Path, Any]], scratch: list[Any]) -> Group:
@@ -422,9 +428,10 @@ class McapIndex:
         return start, length
 
 
-def verify_mcap(path: Path) -> None:
+def verify_mcap(path: Path, progress: Reporter | None = None) -> None:
     """Decompress every chunk of an MCAP file, check its CRC and its message indexes (a file
-    read record by record: every record and every chunk CRC).
+    read record by record: every record and every chunk CRC). The chunks' bytes are
+    reported to ``progress`` (indexed files; an unindexed one is one scan, unreported).
 
     Raises:
         BagError: the first damaged chunk, with its byte offset.
@@ -442,7 +449,12 @@ def verify_mcap(path: Path) -> None:
         return
     with path.open("rb") as f:
         summary: Any = layout.summary
+        if progress is not None:
+            total = sum(int(c.compressed_size) for c in summary.chunk_indexes)
+            progress.task(f"checking {path.name}", total, "B")
         for chunk in summary.chunk_indexes:
+            if progress is not None:
+                progress.advance(int(chunk.compressed_size))
             where = f"in {path} at byte {chunk.chunk_start_offset}"
             f.seek(chunk.chunk_start_offset + 1 + 8 + 8 + 8 + 8)
             (crc,) = struct.unpack("<I", f.read(4))

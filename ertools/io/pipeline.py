@@ -18,13 +18,16 @@ import os
 import threading
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 import numpy.typing as npt
 
 I64 = npt.NDArray[np.int64]
 U8 = npt.NDArray[np.uint8]
+
+if TYPE_CHECKING:
+    from ertools.progress import Reporter
 
 T = TypeVar("T")
 
@@ -38,7 +41,13 @@ def workers() -> int:
 
 
 def prefetched(
-    count: int, load: Callable[[int, list[Any]], T], *, parallel: bool = True
+    count: int,
+    load: Callable[[int, list[Any]], T],
+    *,
+    parallel: bool = True,
+    progress: Reporter | None = None,
+    weights: Sequence[int] = (),
+    label: str = "reading",
 ) -> Iterator[T]:
     """``load(k, scratch)`` for k in 0..count-1, in order, computed ahead on worker threads.
 
@@ -47,12 +56,22 @@ def prefetched(
     next one is asked for, after which its slot is reused. Without ``parallel`` (reads with
     nothing to decompress: a second thread only competes with the decoder, measured) the
     loads run in turn on the calling thread.
+
+    With ``progress``, ``weights[k]`` (the bytes load k reads from the file) is reported as
+    each load is handed over, on the calling thread: one call per group of chunks.
     """
+    # nothing to read (a window with no messages): no task, no bar flashing "0 B/0 B"
+    report = progress if count and len(weights) == count else None
+    if report is not None:
+        report.task(label, sum(weights), "B")
     ahead = min(workers(), count) if parallel else 1
     if ahead <= 1:
         scratch: list[Any] = []
         for k in range(count):
-            yield load(k, scratch)
+            got = load(k, scratch)
+            if report is not None:
+                report.advance(weights[k])
+            yield got
         return
     from concurrent.futures import ThreadPoolExecutor
 
@@ -64,6 +83,8 @@ def prefetched(
             got = pending.popleft().result()
             if k + ahead < count:
                 pending.append(pool.submit(load, k + ahead, slots[(k + ahead) % len(slots)]))
+            if report is not None:
+                report.advance(weights[k])
             yield got
 
 

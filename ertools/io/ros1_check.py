@@ -47,6 +47,7 @@ from ertools.io.ros1_records import (
 if TYPE_CHECKING:
     from ertools.io.model import Conn
     from ertools.io.ros1_index import Ros1Layout
+    from ertools.progress import Reporter
 
 I64 = npt.NDArray[np.int64]
 U8 = npt.NDArray[np.uint8]
@@ -251,19 +252,22 @@ class _Report:
         return self.lines
 
 
-def check_ros1(path: Path) -> list[str]:
+def check_ros1(path: Path, progress: Reporter | None = None) -> list[str]:
     """Every disagreement between a ROS1 bag's index and its records, one line each (empty
     when the bag is consistent).
+
+    ``progress`` gets the bytes of the file as its records are read, then the bytes of the
+    chunks as they are decompressed and checked.
 
     Raises:
         BagError: the bag header itself is unreadable (not a bag).
     """
     size = path.stat().st_size
     with path.open("rb") as f:
-        return _check(f, path, size)
+        return _check(f, path, size, progress)
 
 
-def _check(f: BinaryIO, path: Path, size: int) -> list[str]:
+def _check(f: BinaryIO, path: Path, size: int, progress: Reporter | None) -> list[str]:
     from ertools.io.ros1_index import _entries_from_index, decompress
 
     rep = _Report()
@@ -281,6 +285,9 @@ def _check(f: BinaryIO, path: Path, size: int) -> list[str]:
     infos: list[tuple[int, int, int, int, dict[int, int]]] = []  # record pos, chunk pos, ...
     first_index_record = -1
     pos = head.end
+    if progress is not None:
+        progress.task(f"reading {path.name}", size, "B")
+        progress.advance(pos)
     while pos < size:
         try:
             rec, data = read_record(f, pos, size, with_data=True)
@@ -314,6 +321,8 @@ def _check(f: BinaryIO, path: Path, size: int) -> list[str]:
                 rep.add(f"record of unknown op {rec.op} at byte {pos}")
         except (RecordError, KeyError, IndexError, struct.error) as err:
             rep.add(f"unreadable record of op {rec.op} at byte {pos} ({err})")
+        if progress is not None:  # one call per top-level record: chunks, not messages
+            progress.advance(rec.end - pos)
         pos = rec.end
 
     # The bag header against the index section.
@@ -338,7 +347,11 @@ def _check(f: BinaryIO, path: Path, size: int) -> list[str]:
         rep.add(f"{len(chunks)} chunk records, {len(infos)} chunk-info records")
 
     used: set[int] = set()
+    if progress is not None:
+        progress.task(f"checking chunks of {path.name}", sum(len(c.data) for c in chunks), "B")
     for chunk in chunks:
+        if progress is not None:
+            progress.advance(len(chunk.data))
         where = f"chunk at byte {chunk.pos}"
         try:
             buf = np.frombuffer(

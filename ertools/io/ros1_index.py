@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from io import BufferedReader
 from pathlib import Path
 from struct import error as struct_error
-from typing import Any, BinaryIO
+from typing import TYPE_CHECKING, Any, BinaryIO
 
 import numpy as np
 import numpy.typing as npt
@@ -45,6 +45,9 @@ from ertools.io.ros1_records import (
     u32,
     u64,
 )
+
+if TYPE_CHECKING:
+    from ertools.progress import Reporter
 
 log = logging.getLogger("ertools.io.ros1_index")
 
@@ -729,15 +732,21 @@ class Ros1Bag(BagFile):
         for p, t, data in out:
             yield conns[int(rank_of[p])], t, data
 
-    def verify(self) -> None:
-        """Decompress every chunk and check that every indexed record is a message record.
+    def verify(self, progress: Reporter | None = None) -> None:
+        """Decompress every chunk and check that every indexed record is a message record
+        (the chunks' bytes reported to ``progress``).
 
         Raises:
             BagError: the first damaged chunk, with its byte offset.
         """
+        if progress is not None:
+            total = sum(max(c.data_len, 0) for c in self.layout.chunks)
+            progress.task(f"checking {self.path.name}", total, "B")
         for chunk in self.layout.chunks:
             where = self._where(chunk)
             buf = np.frombuffer(self.chunk_bytes(chunk), dtype=np.uint8)
+            if progress is not None:
+                progress.advance(max(chunk.data_len, 0))
             for cid, (_t, off) in self.chunk_entries(chunk).items():
                 try:
                     self.spans(buf, off, where)

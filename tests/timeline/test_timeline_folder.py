@@ -12,7 +12,8 @@ from typing import Any
 import pytest
 
 from ertools.cli.main import main
-from ertools.timeline_scan import Progress, find_bags, scan
+from ertools.progress import reporting
+from ertools.timeline_scan import find_bags, scan
 
 
 def rel(root: Path, path: str) -> str:
@@ -137,22 +138,27 @@ def test_cli_plot(
     assert main(["timeline", str(folder["root"]), "--plot", str(tmp_path / "t.pdf")]) == 2
 
 
-def test_progress_bar_only_on_a_terminal() -> None:
-    class Tty(io.StringIO):
-        def isatty(self) -> bool:
-            return True
+def test_scan_reports_bags_then_recordings(folder: dict[str, Any]) -> None:
+    class Recorder:
+        def __init__(self) -> None:
+            self.tasks: list[tuple[str, int, str, list[int]]] = []
 
-    tty, pipe = Tty(), io.StringIO()
-    for stream in (tty, pipe):
-        bar = Progress(10, stream, delay_s=0.0)
-        bar(5)
-        bar.close()
-    assert "5/10" in tty.getvalue()
-    assert pipe.getvalue() == ""
-    quiet = Tty()
-    bar = Progress(10, quiet, delay_s=60.0)  # a quick scan shows nothing
-    bar(5)
-    assert quiet.getvalue() == ""
+        def task(self, label: str, total: int, unit: str) -> None:
+            self.tasks.append((label, total, unit, []))
+
+        def advance(self, n: int) -> None:
+            self.tasks[-1][3].append(n)
+
+    rec = Recorder()
+    with reporting(rec):  # as on the command line: the clock checks' reads must not report
+        timeline = scan([folder["root"]], progress=rec)
+    # The scenario's 9 files: gtlogger/ holds one recording split in 4 files (_0.._3), the
+    # other 5 files (bmmanager, usb_stick, robots/homer, old, gtlogger_work) are one each.
+    assert len(find_bags([folder["root"]]).bags) == 9
+    summarising, clocks = rec.tasks
+    assert summarising == ("summarising", 9, "bags", [1] * 9)  # one bag at a time
+    assert clocks == ("checking clocks", 6, "recordings", [1] * 6)
+    assert len(timeline.bags) == 9  # the scan itself unchanged: every file listed
 
 
 def test_find_bags_walks_and_takes_rosbag2_folders(tmp_path: Path) -> None:
