@@ -48,7 +48,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=Path,
         nargs="+",
         metavar="BAG",
-        help="log file(s); with --out-dir: ROBOT_BAG GT_PATH... (GT bags or folders)",
+        help="log file(s); with --out-dir: ROBOT_BAG [GT_PATH...] (GT bags or folders; none when "
+        "the robot bag holds the GT topic too, as evo's bag mode)",
     )
     parser.add_argument("--format", choices=FORMATS, default="tum", help="file format (tum)")
     one = parser.add_argument_group("one pose source")
@@ -191,8 +192,6 @@ def _run_pair(args: argparse.Namespace) -> int:
     )
     from ertools.timeutil import ns_to_s, s_to_ns
 
-    if len(args.bags) < 2:
-        raise UsageError("with --out-dir give ROBOT_BAG and at least one GT_PATH")
     auto = args.offset == "auto"
     if args.apply_offset and not auto:
         raise UsageError("--apply-offset needs --offset auto")

@@ -178,3 +178,19 @@ def test_one_bag_agrees_with_evo_bag_mode(bags: dict[str, Path]) -> None:
     errors = ape.error[scored]
     assert float(np.mean(errors)) == pytest.approx(r.metrics.position_error, abs=1e-9)
     assert float(np.max(errors)) == pytest.approx(r.metrics.max, abs=1e-9)
+
+
+def test_export_pair_from_one_bag_equals_the_two_bag_export(
+    bags: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`ertools export ROBOT_BAG --out-dir DIR` with the GT topic in the robot bag: the pair
+    written is the two-bag pair (the GT read from the same bag, the same scored pairs)."""
+    common = ["--robot-topic", ROBOT_TOPIC, "--gt-topic", GT_TOPIC, "--matched"]
+    one, two = tmp_path / "one", tmp_path / "two"
+    assert main(["export", str(bags["both"]), "--out-dir", str(one), *common]) == 0
+    assert (
+        main(["export", str(bags["robot"]), str(bags["gt"]), "--out-dir", str(two), *common]) == 0
+    )
+    capsys.readouterr()
+    for name in ("robot.tum", "gt.tum"):
+        assert (one / name).read_text() == (two / name).read_text() != ""
