@@ -557,6 +557,13 @@ class Ros1Bag(BagFile):
         time per message, record offset per message); only chunks whose span overlaps the
         window and that hold one of ``conns`` are read.
         """
+        if self.layout.indexed:
+            # A chunk info naming a connection the bag does not have is damaged: the chunk
+            # would silently drop out of the plan of the connection it really holds.
+            known = {c.id for c in self.layout.conns}
+            unknown = sorted({cid for ch in self.layout.chunks for cid in ch.counts} - known)
+            if unknown:
+                self._rescan(f"chunk info names connection {unknown[0]}, which the bag lacks")
         rank = {c.id: i for i, c in enumerate(conns)}
         raw: dict[int, list[bytes | tuple[I64, I64]]] = {cid: [] for cid in rank}
         where: dict[int, list[tuple[int, int]]] = {cid: [] for cid in rank}

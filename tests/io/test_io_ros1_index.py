@@ -153,6 +153,9 @@ def damaged(tmp_path: Path, how: str) -> tuple[Path, dict[str, Any]]:
         add_u32(raw, at, -1)  # nsec - 1: the last message out
     elif how == "info-count":
         add_u32(raw, last_info[3] + 4, 1)  # data: (conn u32, count u32) pairs
+    elif how == "info-conn":
+        what["conn"] = struct.unpack_from("<I", raw, last_info[3])[0]
+        struct.pack_into("<I", raw, last_info[3], 725311778)  # a connection the bag lacks
     elif how == "index-time":
         pos, _op, fields, dpos, _dlen = index[0]
         add_u32(raw, dpos + 12 * 2 + 4, 1)  # third entry: sec, nsec (+1 ns), offset
@@ -240,6 +243,20 @@ def test_fast_path_distrusts_an_index_that_contradicts_itself(
     warnings = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
     assert len(warnings) == 1
     assert "outside its chunk info" in warnings[0] and "scanning every record" in warnings[0]
+
+
+def test_fast_path_distrusts_a_chunk_info_naming_an_unknown_connection(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """The last chunk info's first connection id damaged (found by fuzzing): planned from it,
+    the last chunk dropped out of its real connection's read without a word."""
+    path, _what = damaged(tmp_path, "info-conn")
+    with caplog.at_level(logging.WARNING, logger="ertools"):
+        rec = eio.read_poses(path, "/pose", time_source="record")
+    np.testing.assert_array_equal(rec.t_ns, truth_record_times())
+    np.testing.assert_array_equal(rec.xyz[:, 0], np.arange(N, dtype=np.float64))
+    warnings = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
+    assert len(warnings) == 1 and "connection 725311778, which the bag lacks" in warnings[0]
 
 
 @pytest.mark.parametrize("how", ["info-end", "info-start"])
