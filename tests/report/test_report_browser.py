@@ -6,7 +6,6 @@ Skipped, saying why, where Chromium is not installed (Debian: ``apt-get install 
 from __future__ import annotations
 
 import base64
-import shutil
 import subprocess
 import sys
 from html.parser import HTMLParser
@@ -20,25 +19,12 @@ from ertools.report.folder import write_report
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "audit"))
 from audit_streams import heartbeat
+from fakes import BROWSER, CHROMIUM_FLAGS
 from test_audit import BMBOX, CLIENT, REFBOX
 
 pytestmark = pytest.mark.browser
 
-BROWSER = next(
-    (shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)),
-    None,
-)
-FLAGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--hide-scrollbars",
-]
+FLAGS = list(CHROMIUM_FLAGS)
 # EXECUTING_GOAL in the timeline figure (ertools.report.plots_audit: Okabe-Ito's bluish
 # green, #009E73): its presence in the screenshot proves the PNG beside the page was loaded
 # and painted.

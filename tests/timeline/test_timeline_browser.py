@@ -9,12 +9,12 @@ Skipped, saying why, where Chromium is not installed (Debian: ``apt-get install 
 
 from __future__ import annotations
 
-import shutil
 import subprocess
 from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
+from fakes import BROWSER, CHROMIUM_FLAGS
 from test_timeline_pictures import expected_day
 from timeline_day import EVIL, EVIL_IMG, S, day_timeline
 
@@ -24,20 +24,8 @@ from ertools.timeline_scan import scan
 
 pytestmark = pytest.mark.browser
 
-BROWSER = next(
-    (shutil.which(n) for n in ("chromium", "chromium-browser", "google-chrome") if shutil.which(n)),
-    None,
-)
 FLAGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--hide-scrollbars",
+    *CHROMIUM_FLAGS,
     "--window-size=1400,900",
     # No proxy can be reached: anything the page tried to fetch would fail.
     "--proxy-server=127.0.0.1:9",

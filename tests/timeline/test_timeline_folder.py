@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from summaries import BAG_KEYS
 
 from ertools.cli.main import main
 from ertools.progress import reporting
@@ -88,19 +89,7 @@ def test_cli_json_layout(folder: dict[str, Any], capsys: pytest.CaptureFixture[s
     assert main(["timeline", str(root), "--format", "json"]) == 0
     d = json.loads(capsys.readouterr().out)
     assert list(d) == ["bags", "sessions", "problems"]
-    keys = [
-        "path",
-        "format",
-        "start",
-        "end",
-        "duration",
-        "kind",
-        "benchmarks",
-        "overlaps",
-        "problems",
-        "copy_of",
-        "copies",
-    ]
+    keys = BAG_KEYS
     for b in d["bags"]:
         assert list(b) == keys
         assert isinstance(b["overlaps"], list) and isinstance(b["problems"], list)

@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
 
 import pytest
+from summaries import BAG_KEYS, Summary, Topic
 
 from ertools.timeline import (
     ClockCheck,
@@ -21,25 +21,6 @@ from ertools.timeline import (
 
 S = 1_000_000_000
 T0 = 1_448_013_600 * S
-
-
-@dataclass(frozen=True)
-class Topic:
-    name: str
-    msgtype: str
-    count: int = 10
-
-
-@dataclass(frozen=True)
-class Summary:
-    path: str
-    start_ns: int
-    end_ns: int
-    topics: tuple[Topic, ...]
-    format: str = "ros1"
-    indexed: bool = True
-    problems: tuple[str, ...] = ()
-    message_count: int = 10
 
 
 GT_TOPICS = (
@@ -140,19 +121,7 @@ def test_clock_duplicates_unreadable_and_json_layout() -> None:
     tl = build_timeline(files, [Unreadable("bad.bag", "truncated")], checks, TimelineConfig())
     d = tl.to_dict()
     assert list(d) == ["bags", "sessions", "problems"]
-    keys = [
-        "path",
-        "format",
-        "start",
-        "end",
-        "duration",
-        "kind",
-        "benchmarks",
-        "overlaps",
-        "problems",
-        "copy_of",
-        "copies",
-    ]
+    keys = BAG_KEYS
     assert all(list(b) == keys for b in d["bags"])
     last = d["bags"][-1]
     assert (last["path"], last["start"], last["end"], last["kind"]) == (

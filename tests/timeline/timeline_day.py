@@ -9,7 +9,7 @@ below, not from the code: each session's bags are written down as such.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from summaries import Summary, Topic
 
 from ertools.timeline import Timeline, Unreadable, build_timeline
 
@@ -17,25 +17,6 @@ S = 1_000_000_000
 DAY0 = 1_448_010_000 * S  # 2015-11-20 09:00:00 UTC
 EVIL = "<script>alert('x')</script>"
 EVIL_IMG = '<img src=x onerror="alert(1)">'
-
-
-@dataclass(frozen=True)
-class Topic:
-    name: str
-    msgtype: str
-    count: int = 10
-
-
-@dataclass(frozen=True)
-class Summary:
-    path: str
-    start_ns: int
-    end_ns: int
-    topics: tuple[Topic, ...]
-    format: str = "ros1"
-    indexed: bool = True
-    problems: tuple[str, ...] = ()
-    message_count: int = 10
 
 
 def gt(ns: str) -> tuple[Topic, ...]:
