@@ -47,7 +47,7 @@ from ertools.benchmarks.fbm1_score import (
     totals,
 )
 from ertools.configs.items import Item, ItemList
-from ertools.errors import ConfigError, ScoringError, SegmentationError
+from ertools.errors import ConfigError, ScoringError, SegmentationError, TopicError
 from ertools.fidelity import Deviation, Rule
 from ertools.progress import Reporter, current
 from ertools.streams import PoseStream, Provenance, frame_change_warning
@@ -653,7 +653,6 @@ def score_fbm1_bag(
             check_header_clock(plist, body, "state messages")
     item_tf = None
     if opts.gt.method != "window":
-        from ertools.errors import TopicError
         from ertools.io import read_tf
 
         try:

@@ -34,6 +34,7 @@ from ertools import __version__
 from ertools.benchmarks.base import BenchmarkResult, Rows, jsonable
 from ertools.report import html as h
 from ertools.report import units
+from ertools.teams import SOURCE_TEXT
 
 log = logging.getLogger("ertools.report.folder")
 
@@ -597,8 +598,6 @@ def _provenance_context(
     if audit is not None:
         params += [(f"audit {k}", v) for k, v in audit.provenance.parameters]
     if meta["team"]:
-        from ertools.teams import SOURCE_TEXT
-
         source = SOURCE_TEXT.get(meta["team_source"] or "", "the command line")
         params.insert(0, ("team", f"{meta['team']} (from {source})"))
     software = [
