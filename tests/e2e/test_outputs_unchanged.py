@@ -1,0 +1,161 @@
+"""What users see stays put while the code moves: the JSON/YAML/CSV of every README and
+``make demo`` command, compared with the outputs recorded before the restructuring.
+
+The recorded files are in ``tests/e2e/golden/``. A case runs a command (in the current
+vocabulary: only the spelling of options may change, never the output) and compares its stdout
+and the data files of its report folder with the recording, byte for byte after two
+normalisations: the temporary folder becomes ``<OUT>``, the repository ``<ROOT>`` and a
+report's ``generated`` time ``<TIME>`` and its recorded command line ``<ARGV>``. Record
+again, only when an output is meant to change, with
+``ERTOOLS_RECORD_GOLDEN=1 pytest tests/e2e/test_outputs_unchanged.py`` and say why in the
+commit.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+SAMPLES = ROOT / "sample_bags"
+REAL = ROOT.parent / "shared" / "real_bags"
+GOLDEN = ROOT / "tests" / "e2e" / "golden"
+RECORD = os.environ.get("ERTOOLS_RECORD_GOLDEN") == "1"
+# Report files that are data (pictures and pages are checked elsewhere).
+DATA_SUFFIXES = (".json", ".yaml", ".csv", ".tum", ".txt")
+
+
+@dataclass(frozen=True)
+class Case:
+    name: str
+    argv: tuple[str, ...]
+    # A folder the command writes (``{out}`` in argv); its data files are compared too.
+    folder: str | None = None
+    needs_real: bool = False
+
+
+FBM3 = "{samples}/fbm3w/log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
+FBM2 = "{samples}/fbm2h/log_fbm2h_mocap_2015-11-20-12-00-00_0.bag"
+FBM2_INPUTS = (
+    "--goal",
+    "{samples}/fbm2h/fbm2h_goal.yaml",
+    "--transform",
+    "{samples}/fbm2h/transform-simbot.yaml",
+)
+FBM1 = "{samples}/fbm1h/log_fbm1h_2015-11-20-12-00-00_0.bag"
+FBM1_ITEMS = ("--items", "{samples}/fbm1h/fbm1h.yaml")
+ROBOT = "{samples}/robotlog/FBM2H_201511201200_homer.bag"
+STATIONARY = "{samples}/stationary/log_fbm3w_noise_2015-11-20-09-00-00_0.bag"
+TRAJ = ("score", "trajectory", ROBOT, "{samples}/robotlog/", "--offset", "auto", "--apply-offset")
+REAL_FBM2 = (
+    "score",
+    "fbm2h",
+    "{real}/log_fbm2h_mocap_2015-10-23-16-15-40_0.bag",
+    "--goal",
+    "{real}/fbm2h_test_optitrackless_goal.yaml",
+    "--reached",
+    "timing",
+    "{real}/log_fbm2h_mocap_2015-10-23-16-15-40_0_reached_waypoint_timing.yaml",
+)
+
+CASES = (
+    Case("timeline_json", ("timeline", "{samples}", "--format", "json")),
+    Case("timeline_csv", ("timeline", "{samples}", "--format", "csv")),
+    Case("info_fbm3w_json", ("info", FBM3, "--format", "json")),
+    Case("fbm3w_yaml", ("score", "fbm3w", FBM3)),
+    Case("fbm3w_json", ("score", "fbm3w", FBM3, "--format", "json")),
+    Case("fbm3w_report", ("score", "fbm3w", FBM3, "--report", "{out}/r"), folder="r"),
+    Case("fbm2h_yaml", ("score", "fbm2h", FBM2, *FBM2_INPUTS)),
+    Case("fbm2h_json", ("score", "fbm2h", FBM2, *FBM2_INPUTS, "--format", "json")),
+    Case("fbm2h_report", ("score", "fbm2h", FBM2, *FBM2_INPUTS, "--report", "{out}/r"), "r"),
+    Case("fbm1h_yaml", ("score", "fbm1h", FBM1, *FBM1_ITEMS)),
+    Case("fbm1h_json", ("score", "fbm1h", FBM1, *FBM1_ITEMS, "--format", "json")),
+    Case("fbm1h_report", ("score", "fbm1h", FBM1, *FBM1_ITEMS, "--report", "{out}/r"), "r"),
+    Case("trajectory_yaml", TRAJ),
+    Case("trajectory_json", (*TRAJ, "--format", "json")),
+    Case("trajectory_report", (*TRAJ, "--report", "{out}/r"), folder="r"),
+    Case(
+        "export_matched",
+        ("export", ROBOT, "{samples}/robotlog/", "--out-dir", "{out}/evo", "--matched"),
+        folder="evo",
+    ),
+    Case("noise_json", ("noise", STATIONARY, "--format", "json")),
+    Case("audit_json", ("audit", FBM2, "--format", "json")),
+    Case("audit_yaml", ("audit", FBM2, "--format", "yaml")),
+    Case("audit_report", ("audit", FBM2, "--report", "{out}/r"), folder="r"),
+    Case("real_fbm2h_yaml", REAL_FBM2, needs_real=True),
+    Case("real_fbm2h_json", (*REAL_FBM2, "--format", "json"), needs_real=True),
+)
+
+
+ENTRY = "import sys; from ertools.cli.main import main; sys.exit(main())"
+# The command line a report records is spelled as the case spells it; the rest must not move.
+ARGV = re.compile(r'"argv": \[[^\]]*\]')
+# The one field that changes from run to run: when a report was written.
+GENERATED = re.compile(r'"generated": "[^"]*"')
+
+
+def _normalise(text: str, out: Path) -> str:
+    text = GENERATED.sub('"generated": "<TIME>"', text)
+    text = ARGV.sub('"argv": "<ARGV>"', text)
+    return text.replace(str(out), "<OUT>").replace(str(ROOT), "<ROOT>")
+
+
+def _run(case: Case, out: Path) -> dict[str, str]:
+    """The case's outputs by name: ``stdout`` and ``<folder>/<relative path>`` data files."""
+    argv = [a.format(samples=SAMPLES, real=REAL, out=out) for a in case.argv]
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import sys; from ertools.cli.main import main; sys.exit(main())",
+            *argv,
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        check=False,
+        cwd=out,
+    )
+    assert proc.returncode in (0, 1), proc.stderr[-2000:]
+    outputs = {"stdout": _normalise(proc.stdout, out), "exit": str(proc.returncode)}
+    if case.folder is not None:
+        folder = out / case.folder
+        for path in sorted(folder.rglob("*")):
+            if path.is_file() and path.suffix in DATA_SUFFIXES:
+                key = f"{case.folder}/{path.relative_to(folder).as_posix()}"
+                outputs[key] = _normalise(path.read_text(encoding="utf-8"), out)
+    return outputs
+
+
+def _golden_files(case: Case) -> dict[str, str]:
+    base = GOLDEN / case.name
+    return {
+        p.relative_to(base).as_posix(): p.read_text(encoding="utf-8")
+        for p in sorted(base.rglob("*"))
+        if p.is_file()
+    }
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c.name for c in CASES])
+def test_outputs_equal_the_recording(case: Case, tmp_path: Path) -> None:
+    if case.needs_real and not REAL.is_dir():
+        pytest.skip("../shared/real_bags not present: the case scores a real 2015 log")
+    outputs = _run(case, tmp_path)
+    if RECORD:
+        base = GOLDEN / case.name
+        for key, text in outputs.items():
+            (base / key).parent.mkdir(parents=True, exist_ok=True)
+            (base / key).write_text(text, encoding="utf-8")
+        return
+    golden = _golden_files(case)
+    assert golden, f"no recording for {case.name}: record with ERTOOLS_RECORD_GOLDEN=1"
+    assert sorted(outputs) == sorted(golden), f"{case.name}: other files than recorded"
+    for key, text in outputs.items():
+        assert text == golden[key], f"{case.name}: {key} differs from the recording"
