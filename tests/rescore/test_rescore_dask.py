@@ -49,6 +49,9 @@ def cluster(tmp_path: Path) -> Iterator[str]:
         "PYTHONPATH": os.pathsep.join([str(HERE), os.environ.get("PYTHONPATH", "")]),
         # a task that kills its worker is given up after one death, not three (test time)
         "DASK_DISTRIBUTED__SCHEDULER__ALLOWED_FAILURES": "0",
+        # one task at a time per worker: a worker that dies holds no other task (by default a
+        # worker holds a second one, which the scheduler then counts as suspect too)
+        "DASK_DISTRIBUTED__SCHEDULER__WORKER_SATURATION": "1.0",
     }
     common = ["--no-dashboard"]
     logs = (tmp_path / "dask.log").open("w")
