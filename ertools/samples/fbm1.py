@@ -119,7 +119,7 @@ def _wrap_deg(a: float) -> float:
     return (a + 180.0) % 360.0 - 180.0
 
 
-def _item_list(rng: np.random.Generator) -> list[dict[str, Any]]:
+def item_list(rng: np.random.Generator) -> list[dict[str, Any]]:
     """Listing 9 items: transforms like the 2015 list (a few cm, rotated about z, tiny tilt)."""
     out = []
     for k, (cls, inst) in enumerate(ITEMS):
@@ -148,11 +148,13 @@ def simulate(
     *,
     start_ns: int = NOON_NS,
     answer_errors: tuple[tuple[bool, bool, float, float, float], ...] = ANSWER_ERRORS,
+    items: list[dict[str, Any]] | None = None,
 ) -> SimulatedRun:
     """One FBM1@Home execution whose recorder starts at ``start_ns`` (module docstring);
-    ``answer_errors`` (one per run but the last) are the robot's mistakes."""
+    ``answer_errors`` (one per run but the last) are the robot's mistakes; ``items`` the
+    item list of a whole competition (default: drawn from ``seed``)."""
     rng = np.random.default_rng(seed)
-    items = _item_list(rng)
+    items = item_list(rng) if items is None else items
     order = [int(i) + 1 for i in rng.permutation(len(ITEMS))[:RUNS]]
     boards = _board_poses(rng)
     answer_ms = rng.integers(400, 800, size=RUNS)  # the robot's thinking time, ms
