@@ -262,7 +262,10 @@ def generate_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path
                     "execution": slot.id,
                     "start_ns": r_start,
                     "end_ns": r_end,
-                    "header_minus_record_s": offset / NS,
+                    # the robot's recorder stores each pose 2 ms after the robot stamped it
+                    "header_minus_record_s": (offset - 2_000_000) / NS
+                    if slot.benchmark == "fbm2h"
+                    else None,
                 }
             )
         gt = [
@@ -297,7 +300,7 @@ def generate_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path
             "execution": None,
             "start_ns": TEST_DRIVE_NS,
             "end_ns": test_end,
-            "header_minus_record_s": 0.0,
+            "header_minus_record_s": -0.002,
         }
     )
 
