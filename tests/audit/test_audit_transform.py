@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 from audit_samples import answers, sample_dir
 
-from ertools.audit_score import (
+from ertools.audit.rescore import (
     IDENTITY_CAVEAT,
     POSE_KEYS,
     ScoreInputs,
