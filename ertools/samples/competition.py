@@ -88,7 +88,8 @@ class Slot:
 
     @property
     def id(self) -> str:
-        return f"{self.benchmark}-{self.team}-{self.at.replace(':', '')}"
+        """``<benchmark>-<team>-<start, UTC, %Y%m%dT%H%M%S>``, as ``ertools rescore`` names it."""
+        return f"{self.benchmark}-{self.team}-20151120T{self.at.replace(':', '')}"
 
 
 SCHEDULE: tuple[Slot, ...] = (
@@ -107,10 +108,10 @@ SCHEDULE: tuple[Slot, ...] = (
     Slot("13:21:33", "fbm2h", "socrob", 2),  # in the GT logger's .bag.active file
 )
 MISSING_TRANSFORM = "skuba"
-TRUNCATED = "fbm3w-b-it-bots-113715"
-CLOCK_OFF = "fbm2h-homer-120640"
-NO_ROBOT_LOG = "fbm3w-robotto-123105"
-COPIED = "fbm2h-homer-094112"
+TRUNCATED = "fbm3w-b-it-bots-20151120T113715"
+CLOCK_OFF = "fbm2h-homer-20151120T120640"
+NO_ROBOT_LOG = "fbm3w-robotto-20151120T123105"
+COPIED = "fbm2h-homer-20151120T094112"
 
 # Team knobs. FBM2H: stop errors scale and marker mount (t, rpy of T_marker_robot).
 FBM2H_TEAMS: dict[str, tuple[float, tuple[float, ...], tuple[float, ...]]] = {
@@ -322,19 +323,24 @@ def generate_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path
         "problems": [
             {"path": trunc, "kind": "truncated", "execution": TRUNCATED},
             {"path": str(active.relative_to(outdir)), "kind": "active"},
-            {"path": copy_rel, "kind": "copy", "of": copied},
+            {"path": copy_rel, "kind": "duplicate", "of": copied},
             {
                 "path": next(r for r in robot_logs if r["execution"] == CLOCK_OFF)["path"],
-                "kind": "clock",
+                "kind": "clock-offset",
                 "offset_s": CLOCK_OFF_S,
             },
             {"path": test_rel, "kind": "unpaired"},
             {
                 "path": f"configs/fbm2h/transforms/transform-{MISSING_TRANSFORM}.yaml",
-                "kind": "missing_transform",
+                "kind": "missing-input",
+                "input": "transform",
                 "team": MISSING_TRANSFORM,
             },
-            {"path": None, "kind": "no_robot_log", "execution": NO_ROBOT_LOG},
+            {
+                "path": next(e for e in executions if e["id"] == NO_ROBOT_LOG)["bmbox_log"],
+                "kind": "no-team",
+                "execution": NO_ROBOT_LOG,
+            },
         ],
     }
     out = outdir / "answers.json"
