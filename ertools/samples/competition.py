@@ -50,11 +50,13 @@ import numpy as np
 from ertools.samples import fbm1, fbm2h, fbm3w
 from ertools.samples.competition_files import (
     GtWindow,
+    robot_poses,
     write_benchmark_log,
     write_gt_file,
     write_robot_log,
 )
-from ertools.samples.competition_scores import expected_score
+from ertools.samples.competition_scores import expected_score, expected_trajectory
+from ertools.samples.mocap import pose_topic
 from ertools.samples.scenario import EPOCH_2015, log_name, to_plain
 from ertools.samples.simulated import SimulatedRun
 from ertools.samples.statemachine import state_messages
@@ -236,6 +238,13 @@ def generate_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path
     active = make_active(outdir / last)
     gt_spans[str(active.relative_to(outdir))] = gt_spans.pop(last)
     written += [outdir / r for r in gt_spans]
+    # file -> its [start, end) record-time window
+    gt_windows = dict(zip(gt_spans, ((w.start_ns, w.end_ns) for w in windows), strict=True))
+    fbm2h_gt = [s.bodies[fbm2h.BODY] for s in sims if s.benchmark == "fbm2h"]
+
+    def gt_over(a: int, b: int) -> list[str]:
+        """The GT files whose (closed) spans meet [a, b], as the timeline pairs them."""
+        return [rel for rel, (s0, s1) in gt_spans.items() if s0 <= b and a <= s1]
 
     # -- the benchmark manager's logs and the robots' logs
     executions: list[dict[str, Any]] = []
@@ -253,27 +262,34 @@ def generate_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path
             r_end = sim.end_ns + round(ROBOT_TAIL_S * NS)
             robot_rel = _robot_name(slot.benchmark, r_start, slot.team)
             offset = round(CLOCK_OFF_S * NS) if slot.id == CLOCK_OFF else 0
-            write_robot_log(outdir / robot_rel, sim, slot.team, r_start, r_end, offset, rlog_rng)
+            poses = robot_poses(sim, r_start, r_end, rlog_rng)
+            write_robot_log(outdir / robot_rel, slot.team, r_start, r_end, poses, offset)
             written.append(outdir / robot_rel)
-            robot_logs.append(
-                {
-                    "path": robot_rel,
-                    "team": slot.team,
-                    "benchmark": slot.benchmark,
-                    "execution": slot.id,
-                    "start_ns": r_start,
-                    "end_ns": r_end,
-                    # the robot's recorder stores each pose 2 ms after the robot stamped it
-                    "header_minus_record_s": (offset - 2_000_000) / NS
-                    if slot.benchmark == "fbm2h"
-                    else None,
+            entry: dict[str, Any] = {
+                "path": robot_rel,
+                "team": slot.team,
+                "benchmark": slot.benchmark,
+                "execution": slot.id,
+                "start_ns": r_start,
+                "end_ns": r_end,
+                "gt_files": gt_over(r_start, r_end),
+                # the robot's recorder stores each pose 2 ms after the robot stamped it
+                "header_minus_record_s": None if poses is None else (offset - 2_000_000) / NS,
+                "trajectory": None,
+            }
+            if poses is not None:
+                score, tolerance = expected_trajectory(
+                    poses, offset, fbm2h_gt, [gt_windows[g] for g in entry["gt_files"]]
+                )
+                entry["trajectory"] = {
+                    "robot_topic": f"/rockin/{slot.team}/marker_pose",
+                    "gt_topic": pose_topic(fbm2h.NAMESPACE, fbm2h.BODY),
+                    "offset_s": -offset / NS,
+                    "score": score,
+                    "tolerance": tolerance,
                 }
-            )
-        gt = [
-            w.rel if w.rel in gt_spans else str(active.relative_to(outdir))
-            for w in windows
-            if w.start_ns <= span[1] and span[0] < w.end_ns
-        ]
+            robot_logs.append(entry)
+        gt = gt_over(*span)
         executions.append(
             _execution_answer(
                 slot, sim, seeds[SCHEDULE.index(slot)], rel, span, gt, robot_rel, configs
@@ -291,7 +307,8 @@ def generate_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path
     written.append(outdir / copy_rel)
     test_rel = _robot_name("fbm2h", TEST_DRIVE_NS, "homer")
     test_end = TEST_DRIVE_NS + 110 * NS
-    write_robot_log(outdir / test_rel, None, "homer", TEST_DRIVE_NS, test_end, 0, rlog_rng)
+    test_poses = robot_poses(None, TEST_DRIVE_NS, test_end, rlog_rng)
+    write_robot_log(outdir / test_rel, "homer", TEST_DRIVE_NS, test_end, test_poses, 0)
     written.append(outdir / test_rel)
     robot_logs.append(
         {
@@ -301,7 +318,9 @@ def generate_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path
             "execution": None,
             "start_ns": TEST_DRIVE_NS,
             "end_ns": test_end,
+            "gt_files": gt_over(TEST_DRIVE_NS, test_end),
             "header_minus_record_s": -0.002,
+            "trajectory": None,  # no GT at all
         }
     )
 

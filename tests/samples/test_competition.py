@@ -218,3 +218,27 @@ def test_robot_logs_and_problems(competition: Path, answers: dict[str, Any]) -> 
     (clock,) = [p for p in answers["problems"] if p["kind"] == "clock-offset"]
     (robot,) = [r for r in answers["robot_logs"] if r["path"] == clock["path"]]
     assert robot["header_minus_record_s"] == pytest.approx(clock["offset_s"] - 0.002)
+
+
+@pytest.mark.parametrize("slot", [s.id for s in SCHEDULE if s.benchmark == "fbm2h"])
+def test_each_fbm2h_robot_log_scores_as_its_answers(
+    competition: Path, answers: dict[str, Any], slot: str
+) -> None:
+    # The robots' marker pose estimates against the GT hour files (ertools score trajectory,
+    # the robot's clock offset applied): the answers are the robotlog scenario's plain loop
+    # over the same arrays, so counts are exact and errors agree to float rounding.
+    from ertools.cli.main import main
+
+    (r,) = [x for x in answers["robot_logs"] if x["execution"] == slot]
+    traj = r["trajectory"]
+    args = ["score", "trajectory", str(competition / r["path"])]
+    args += [str(competition / g) for g in r["gt_files"]]
+    args += ["--robot-topic", traj["robot_topic"], "--gt-topic", traj["gt_topic"]]
+    args += ["--offset", repr(traj["offset_s"]), "--format", "json"]
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+        assert main(args) == 0
+    result = json.loads(out.getvalue())
+    assert traj["score"]["compared"] > 400
+    for field, want in traj["score"].items():
+        assert abs(result[field] - want) <= traj["tolerance"][field]["abs"], (slot, field)
