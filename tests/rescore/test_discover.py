@@ -15,7 +15,8 @@ import pytest
 from timeline.summaries import Summary, Topic
 
 from ertools.rescore.discover import Discovery, discover
-from ertools.samples.competition import NO_ROBOT_LOG, TRUNCATED, generate_competition
+from ertools.samples.competition import generate_competition
+from ertools.samples.competition_schedule import NO_ROBOT_LOG, TRUNCATED
 from ertools.timeline.build import Unreadable, build_timeline
 
 S = 1_000_000_000

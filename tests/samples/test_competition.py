@@ -22,12 +22,8 @@ from typing import Any
 
 import pytest
 
-from ertools.samples.competition import (
-    MISSING_TRANSFORM,
-    SCHEDULE,
-    TRUNCATED,
-    generate_competition,
-)
+from ertools.samples.competition import generate_competition
+from ertools.samples.competition_schedule import MISSING_TRANSFORM, SCHEDULE, TRUNCATED
 
 SEED = 2015_11_20
 UNSCOREABLE = sorted(
