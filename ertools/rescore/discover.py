@@ -1,7 +1,8 @@
 """Every benchmark execution in a timeline, with its team, GT files and robot log.
 
-Pure: it reads the :class:`~ertools.timeline.build.Timeline` that :func:`ertools.timeline_scan.scan`
-built (and, optionally, the teams the IO edge read from the state payloads), never a file.
+Pure: it reads the :class:`~ertools.timeline.build.Timeline` that
+:func:`ertools.timeline.scan.scan` built (and, optionally, the teams the IO edge read from the
+state payloads), never a file.
 
 - An **execution** is a benchmark log (a bag with state topics, ``kind == "benchmark"``) and
   one benchmark namespace of its topics (``/fbm2h/bmbox_state`` -> ``fbm2h``); its span is the
@@ -152,7 +153,7 @@ def discover(timeline: Timeline, payload_teams: Mapping[str, str] | None = None)
     """The benchmark executions of ``timeline`` and what is wrong (see the module docstring).
 
     Args:
-        timeline: from :func:`ertools.timeline_scan.scan` (or
+        timeline: from :func:`ertools.timeline.scan.scan` (or
             :func:`ertools.timeline.build.build_timeline`).
         payload_teams: benchmark log path -> the team its state payloads name, for the logs
             where the IO edge found one (:func:`ertools.benchmarks.common.teams.read_payload_team`).
