@@ -111,7 +111,8 @@ def _add_input(target: Any, declared: Input) -> None:
             kw["action"] = "append"
     target.add_argument(declared.option, **kw)
     for i, old in enumerate(declared.old_flags):
-        target.add_argument(old, **{**kw, "dest": f"old__{declared.name}__{i}"}, help=argparse.SUPPRESS)
+        old_kw = {**kw, "dest": f"old__{declared.name}__{i}", "help": argparse.SUPPRESS}
+        target.add_argument(old, **old_kw)
 
 
 def add_benchmark_arguments(parser: argparse.ArgumentParser, name: str) -> None:
