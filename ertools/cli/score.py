@@ -120,17 +120,21 @@ def add_benchmark_arguments(parser: argparse.ArgumentParser, name: str) -> None:
     options shared by every benchmark."""
     bench = registry.get(name)
     parser.set_defaults(benchmark=name)
-    metavar = bench.bags_metavar
     # A `with_file` choice takes words (`--reached timing FILE`): given before the bags it
     # swallows them, so none is required here and run() takes them back (see _bags).
     swallows = any(i.with_file for i in bench.inputs)
-    parser.add_argument(
-        "bags",
-        nargs="*" if swallows else "+",
-        type=Path,
-        metavar=metavar,
-        help=bench.bags_help,
-    )
+    if isinstance(bench.bags_metavar, str):
+        parser.add_argument(
+            "bags",
+            nargs="*" if swallows else "+",
+            type=Path,
+            metavar=bench.bags_metavar,
+            help=bench.bags_help,
+        )
+    else:  # the first bag, then any number of others (ROBOT_BAG [GT_PATH ...])
+        first, rest = bench.bags_metavar
+        parser.add_argument("bags", type=Path, metavar=first, help=bench.bags_help)
+        parser.add_argument("more_bags", type=Path, nargs="*", metavar=rest)
     groups: dict[str, Any] = {}
     for declared in bench.inputs:
         target: Any = parser
@@ -190,7 +194,8 @@ def run(args: argparse.Namespace) -> int:
         return run_group("score", _unread_members(), args)
     bench = registry.get(name)
     values = _values(bench, args)
-    bags = _bags(bench, values, args.bags)
+    given = args.bags if isinstance(args.bags, list) else [args.bags, *args.more_bags]
+    bags = _bags(bench, values, given)
     args.bags = bags
     options = bench.make_options(values)
     result = bench.score(bags, options)
