@@ -13,8 +13,12 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ertools.cli.common import note
+
+if TYPE_CHECKING:
+    from ertools.rescore.jobs import Outcome
 
 EPILOG = """examples:
   ertools rescore --config competition.yaml --out results/
@@ -92,19 +96,29 @@ def run(args: argparse.Namespace) -> int:
     if args.check:
         note(f"{args.config}: no problems ({len(manifest.executions)} listed executions)")
         return 0
-    executions = listed_executions(manifest)
-    if not executions:
-        note(f"error: {args.config} lists no executions and no logs were given")
+    scorings = listed_executions(manifest)
+    problems: list[dict[str, object]] = []
+    timeline = None
+    if args.paths:
+        from ertools.rescore.found import find, merge, write_timeline
+
+        found = find(args.paths, progress=args.progress)
+        scorings = merge(found.scorings, scorings)
+        problems = list(found.problems)
+        args.out.mkdir(parents=True, exist_ok=True)
+        timeline = write_timeline(found, args.out, manifest.title)
+    if not scorings:
+        where = ", ".join(map(str, args.paths)) or "no logs were given"
+        note(f"error: no benchmark execution found ({where}) and none listed in {args.config}")
         return 1
     workers = args.jobs if args.jobs is not None else default_jobs()
 
-    def tell(outcome: object) -> None:
-        status = getattr(outcome, "status", "")
-        if status != "scored":
-            note(f"error: {getattr(outcome, 'id', '')}: {status}: {getattr(outcome, 'reason', '')}")
+    def tell(outcome: Outcome) -> None:
+        if outcome.status != "scored" and outcome.error != "TopicError":
+            note(f"error: {outcome.id}: {outcome.status}: {outcome.reason}")
 
     doc = rescore(
-        executions,
+        scorings,
         manifest,
         args.out,
         workers=workers,
@@ -112,6 +126,8 @@ def run(args: argparse.Namespace) -> int:
         use_cache=not args.no_cache,
         reports=not args.no_reports,
         command=args.command_line,
+        problems=problems,
+        timeline=timeline,
         progress=args.progress,
         on_outcome=tell,
     )

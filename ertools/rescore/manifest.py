@@ -45,6 +45,8 @@ TOP_KEYS = ("version", "title", "benchmarks", "executions")
 BENCHMARK_KEYS = ("inputs", "teams")
 EXECUTION_KEYS = ("benchmark", "team", "bags", "start", "end", "inputs")
 PATH_KINDS = ("path", "paths")
+# A benchmark input of this name is its ``--team``: given the execution's team.
+TEAM_INPUT = "team"
 
 
 class ManifestError(ConfigError):
@@ -101,6 +103,9 @@ class Manifest:
             if team is not None:
                 values.update(entry.teams.get(team, {}))
         values.update(overrides or {})
+        declared_names = {d.name for d in self.declared.get(benchmark, ())}
+        if TEAM_INPUT in declared_names and values.get(TEAM_INPUT) is None and team:
+            values[TEAM_INPUT] = team  # the benchmark's own --team: the execution's team
         missing = [
             f"{benchmark}: no {declared.name} for team {team or '(unknown)'} in the manifest "
             f"(benchmarks.{benchmark}.teams.{team or 'TEAM'}.{declared.name})"

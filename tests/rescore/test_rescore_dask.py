@@ -9,7 +9,6 @@ import shutil
 import socket
 import subprocess
 import sys
-import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -115,7 +114,6 @@ def test_dask_cluster_gives_the_results_of_one_process(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, cluster: str
 ) -> None:
     use_toy_registry(monkeypatch)
-    start = time.perf_counter()
     extra = {
         "toy-alpha-20151120T110000": ("alpha", "2015-11-20T11:00:00Z", "1\nbad\n"),
         "toy-alpha-20151120T111000": ("alpha", "2015-11-20T11:10:00Z", "1\nboom\n"),
@@ -140,7 +138,6 @@ def test_dask_cluster_gives_the_results_of_one_process(
     assert [i for i, r in rows.items() if r["status"] == "scored"] == sorted(
         LOGS, key=lambda i: LOGS[i][1]
     )
-    assert time.perf_counter() - start < 30
 
 
 def test_local_cluster(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -9,7 +9,7 @@ import pytest
 from competition import LOGS, expected_value, make_competition, use_toy_registry
 
 from ertools.rescore.manifest import load_manifest
-from ertools.rescore.pipeline import Execution, leaderboards, listed_executions, rescore
+from ertools.rescore.pipeline import Scoring, leaderboards, listed_executions, rescore
 
 
 @pytest.fixture(autouse=True)
@@ -32,7 +32,7 @@ class Recorder:
 def test_a_team_without_its_transform_is_one_unscoreable_row(tmp_path: Path) -> None:
     comp = make_competition(tmp_path / "comp")
     manifest = load_manifest(comp.manifest)
-    found = Execution(
+    found = Scoring(
         benchmark="toy",
         team="gamma",  # found in the logs; the manifest has no transform for it
         bags=(comp.log("toy-beta-20151120T093000"),),

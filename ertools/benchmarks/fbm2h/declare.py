@@ -30,7 +30,9 @@ AUTO = "--reached auto (stop detection)"
 
 INPUTS = (
     Input("goal", "path", "goal list (Listing 10); default: from the log", metavar="FILE"),
-    Input("transform", "path", "marker-to-robot transform (Listing 11)", metavar="FILE"),
+    Input(
+        "transform", "path", "marker-to-robot transform (Listing 11)", metavar="FILE", per_team=True
+    ),
     Input("transforms", "path", "folder of transform-<team>.yaml files", metavar="DIR"),
     Input(
         "team",
