@@ -15,7 +15,7 @@ A YAML file (safe-loaded), documented in docs/rescore.md::
       - benchmark: fbm3w
         team: robotto
         bags: [bmmanager/log_fbm3w.bag, gtlogger/log_mocap_3.bag]
-        start: 2015-11-20T12:31:05Z              # optional (default: the bags' first message)
+        start: 2015-11-20T12:31:05Z              # optional (default: the first bag's span)
         inputs: {d_min: 0.0005}                  # optional: this execution's own values
 
 The keys a benchmark takes are exactly its registry declaration (:attr:`Benchmark.inputs`):
