@@ -1,0 +1,1 @@
+"""`ertools rescore`: a whole competition rescored, from folders of logs to one results site."""
