@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from ertools.benchmarks import document
 from ertools.benchmarks.base import BenchmarkResult, jsonable
 from ertools.benchmarks.common.teams import with_team
 
@@ -83,16 +84,13 @@ def note(message: str) -> None:
     print(f"ertools: {message}", file=sys.stderr)
 
 
+# One definition (ertools.benchmarks.document), shared with rescore; the score commands
+# import it from here.
+all_failed = document.all_failed
+
+
 def dump_json(data: Any) -> str:
     return json.dumps(jsonable(data), indent=2, allow_nan=False)
-
-
-def all_failed(result: object) -> bool:
-    """True when a result has failures and no honest number at all (every run, segment or
-    pose failed: the result's ``nothing_scored``). Such a result is never printed: only its
-    failures, one ``ertools: error:`` line each on stderr, nothing on stdout, exit 1. A result
-    where some runs scored is printed, failed ones as null with their error on stderr."""
-    return bool(getattr(result, "failures", ())) and bool(getattr(result, "nothing_scored", False))
 
 
 def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[Path]) -> int:
@@ -108,7 +106,7 @@ def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[
         return 1
     result = with_team(result, getattr(args, "team", None), inputs)
     fmt = getattr(args, "format", "yaml")
-    text = result.to_yaml() if fmt == "yaml" else dump_json(result.to_dict())
+    text = result.to_yaml() if fmt == "yaml" else dump_json(document.score_json(result))
     write_text(text, getattr(args, "output", None))
     for warning in result.warnings:
         note(f"warning: {warning}")

@@ -38,6 +38,11 @@ COMMANDS: dict[str, Command] = {
         "recompute a benchmark score (fbm1h, fbm1w, fbm2h, fbm3w, trajectory)",
         "ertools score fbm3w run.bag --config configs/fbm3w.yaml",
     ),
+    "rescore": Command(
+        "ertools.cli.rescore",
+        "score a whole competition from a manifest; results.json, reports, in parallel",
+        "ertools rescore logs/ --config competition.yaml --out results/",
+    ),
     "export": Command(
         "ertools.cli.export",
         "poses as TUM, KITTI or CSV for evo and other tools; the robot/GT pair",

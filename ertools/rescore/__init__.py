@@ -1,5 +1,11 @@
-"""``ertools rescore``: a whole competition, from folders of logs to scored and audited results.
+"""``ertools rescore``: a whole competition, from folders of logs to one results document.
 
-:mod:`ertools.rescore.discover` finds the benchmark executions in a timeline and pairs each
-with its team, its GT files and its robot's own log.
+The competition manifest (:mod:`~ertools.rescore.manifest`) names every benchmark's inputs and
+each team's; executions (listed in the manifest, or found in the logs by
+:mod:`ertools.rescore.discover`) become independent jobs (:mod:`~ertools.rescore.jobs`), scored
+through the benchmark registry only, in parallel (:mod:`~ertools.rescore.parallel`), skipped
+when the cache (:mod:`~ertools.rescore.cache`) already holds them, and gathered into
+``results.json``/``results.csv`` (:mod:`~ertools.rescore.pipeline`), from which
+:mod:`~ertools.rescore.site` renders the results page. The document's contract is
+docs/rescore.md.
 """

@@ -1,0 +1,186 @@
+"""One execution to score, as a worker receives it, and the scoring itself.
+
+A :class:`Job` is small and picklable: the benchmark's registry entry (``module:ATTR``), the
+paths of its bags and input files and its input values. Workers (local processes or Dask
+workers) read the logs by path from a shared file system; no bag bytes travel with the job.
+:func:`run_job` never raises for a problem of the execution itself: it returns an
+:class:`Outcome` saying ``scored``, ``unscoreable`` (an :class:`ErtoolsError`: the data or the
+inputs cannot be scored) or ``failed`` (anything else: a bug, one line), so one bad execution
+costs one row.
+"""
+
+from __future__ import annotations
+
+import time
+import traceback
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from importlib import import_module
+from pathlib import Path
+from typing import Any, Literal
+
+from ertools.benchmarks.base import Benchmark, jsonable
+from ertools.benchmarks.common.teams import with_team
+from ertools.benchmarks.document import all_failed, score_json
+from ertools.errors import ErtoolsError
+
+Status = Literal["scored", "unscoreable", "failed"]
+
+
+@dataclass(frozen=True)
+class Job:
+    """One execution to score.
+
+    Attributes:
+        id: the execution's stable id (``fbm3w-robotto-20151120T123105``).
+        benchmark: its registry name.
+        target: the registry entry (``module:ATTR``), imported by the worker: a worker needs
+            nothing but this job and the file system.
+        team: the team, when known (kept in the result as ``--team`` would).
+        bags: the logs, absolute paths.
+        values: the benchmark's input values by :attr:`Input.name` (paths absolute).
+        report_dir: where its report folder goes (None: no report).
+        argv: the equivalent ``ertools score`` command line, shown in the report.
+    """
+
+    id: str
+    benchmark: str
+    target: str
+    team: str | None
+    bags: tuple[str, ...]
+    values: Mapping[str, Any] = field(default_factory=dict)
+    report_dir: str | None = None
+    argv: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What scoring one job gave (everything JSON-able, for the cache and the row)."""
+
+    id: str
+    status: Status
+    reason: str | None = None
+    score: dict[str, Any] | None = None
+    rank_value: float | None = None
+    warnings: tuple[str, ...] = ()
+    deviations: tuple[str, ...] = ()
+    live_score: Any = None
+    live_differences: tuple[str, ...] = ()
+    report: str | None = None
+    seconds: float = 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "id": self.id,
+            "status": self.status,
+            "reason": self.reason,
+            "score": self.score,
+            "rank_value": self.rank_value,
+            "warnings": list(self.warnings),
+            "deviations": list(self.deviations),
+            "live_score": self.live_score,
+            "live_differences": list(self.live_differences),
+            "report": self.report,
+            "seconds": self.seconds,
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Outcome:
+        return cls(
+            id=str(data["id"]),
+            status=data["status"],
+            reason=data.get("reason"),
+            score=data.get("score"),
+            rank_value=data.get("rank_value"),
+            warnings=tuple(data.get("warnings", ())),
+            deviations=tuple(data.get("deviations", ())),
+            live_score=data.get("live_score"),
+            live_differences=tuple(data.get("live_differences", ())),
+            report=data.get("report"),
+            seconds=float(data.get("seconds", 0.0)),
+        )
+
+
+def one_line(text: str) -> str:
+    return " ".join(text.split())
+
+
+def load_benchmark(target: str) -> Benchmark[Any, Any, Any, Any]:
+    """The benchmark a registry entry names (``module:ATTR``)."""
+    module_name, _, attribute = target.partition(":")
+    benchmark: Benchmark[Any, Any, Any, Any] = getattr(import_module(module_name), attribute)
+    return benchmark
+
+
+def run_job(job: Job) -> Outcome:
+    """Score one job; every problem becomes the outcome's status and reason, never a raise."""
+    start = time.perf_counter()
+    try:
+        outcome = _score(job)
+    except ErtoolsError as err:
+        outcome = Outcome(job.id, "unscoreable", reason=one_line(str(err)))
+    except Exception as err:  # a bug in a scorer: this execution's row only
+        where = traceback.extract_tb(err.__traceback__)[-1] if err.__traceback__ else None
+        at = f" at {Path(where.filename).name}:{where.lineno}" if where else ""
+        outcome = Outcome(
+            job.id, "failed", reason=one_line(f"unexpected {type(err).__name__}: {err}{at}")
+        )
+    seconds = round(time.perf_counter() - start, 3)
+    return Outcome(**{**outcome.__dict__, "seconds": seconds})
+
+
+def _score(job: Job) -> Outcome:
+    benchmark = load_benchmark(job.target)
+    bags = [Path(p) for p in job.bags]
+    options = benchmark.make_options(dict(job.values))
+    result = benchmark.score(bags, options)
+    if all_failed(result):
+        return Outcome(job.id, "unscoreable", reason=one_line("; ".join(result.failures)))
+    result = with_team(result, job.team, bags)
+    warnings = tuple(str(w) for w in result.warnings)
+    warnings += tuple(f"error: {f}" for f in result.failures)  # runs that failed, others scored
+    audit = _live_audit(result, bags)
+    live_score = None
+    differences: tuple[str, ...] = ()
+    if audit is not None:
+        live_score = jsonable(audit.live_score)
+        if audit.comparison is not None:
+            differences = tuple(
+                f"{line.key}: live {line.live} vs recomputed {line.recomputed}"
+                for line in audit.comparison.differences
+            )
+    report = None
+    if job.report_dir is not None:
+        from ertools.report.folder import write_report
+
+        index = write_report(
+            result,
+            Path(job.report_dir),
+            inputs=bags,
+            argv=list(job.argv),
+            audit=audit,
+            team=job.team,
+        )
+        report = str(index)
+    rank = benchmark.ranking.key(result)
+    return Outcome(
+        job.id,
+        "scored",
+        score=score_json(result),
+        rank_value=None if rank is None else float(rank),
+        warnings=warnings,
+        deviations=tuple(str(d) for d in result.deviations),
+        live_score=live_score,
+        live_differences=differences,
+        report=report,
+    )
+
+
+def _live_audit(result: Any, bags: list[Path]) -> Any:
+    """The audit of the bags' state topics with its live-vs-recomputed comparison, or None
+    (a benchmark without state topics, or logs without them)."""
+    from ertools.audit.rescore import attach
+    from ertools.report.folder import _audit_inputs  # the report's own: one audit, shared
+
+    audit = _audit_inputs(result.name, bags)
+    return None if audit is None else attach(audit, result)

@@ -1,0 +1,187 @@
+"""Scoring jobs in parallel: local worker processes (``--jobs N``) or a Dask cluster
+(``--scheduler ADDRESS|local``).
+
+Each local worker is a process of its own holding one job at a time, so that when one dies
+(killed for memory, a crash in a native library) the job it held is known: that job's row
+says so and a new worker takes the rest. ``concurrent.futures`` cannot do that: a dead worker
+breaks its whole pool and every job still in it. Results come back in completion order through
+``on_done``; the caller orders them.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import multiprocessing
+import multiprocessing.connection
+import os
+import sys
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from ertools.errors import ConfigError
+from ertools.rescore.jobs import Job, Outcome, run_job
+
+OnDone = Callable[[Outcome], None]
+
+
+def default_jobs() -> int:
+    return os.cpu_count() or 1
+
+
+def run_jobs(jobs: Sequence[Job], *, workers: int, scheduler: str | None, on_done: OnDone) -> None:
+    """Score every job (by ``workers`` local processes, or the Dask ``scheduler``)."""
+    if not jobs:
+        return
+    if scheduler is not None:
+        run_dask(jobs, scheduler, workers=workers, on_done=on_done)
+    elif workers <= 1:
+        for job in jobs:  # in this process: the simplest path, and the reference for the others
+            on_done(run_job(job))
+    else:
+        run_local(jobs, workers=workers, on_done=on_done)
+
+
+def _worker(conn: multiprocessing.connection.Connection) -> None:
+    """A local worker: score the jobs it is sent until it is sent None."""
+    while True:
+        try:
+            job = conn.recv()
+        except EOFError:
+            return
+        if job is None:
+            return
+        conn.send(run_job(job))
+
+
+def _context() -> Any:
+    # fork: a worker starts in milliseconds with ertools already imported; elsewhere spawn
+    methods = multiprocessing.get_all_start_methods()
+    return multiprocessing.get_context("fork" if "fork" in methods else "spawn")
+
+
+class _Worker:
+    def __init__(self, ctx: Any) -> None:
+        self.conn, child = ctx.Pipe()
+        self.process = ctx.Process(target=_worker, args=(child,), daemon=True)
+        self.process.start()
+        child.close()
+        self.job: Job | None = None
+
+
+def run_local(jobs: Sequence[Job], *, workers: int, on_done: OnDone) -> None:
+    """Score ``jobs`` with ``workers`` local processes; a worker that dies costs its job."""
+    ctx = _context()
+    pending = list(reversed(jobs))
+    pool = [_Worker(ctx) for _ in range(min(workers, len(jobs)))]
+    try:
+        for worker in pool:
+            _assign(worker, pending)
+        while any(w.job is not None for w in pool):
+            busy = [w for w in pool if w.job is not None]
+            ready = multiprocessing.connection.wait(
+                [w.conn for w in busy] + [w.process.sentinel for w in busy]
+            )
+            for i, worker in enumerate(pool):
+                if worker.job is None:
+                    continue
+                if worker.conn in ready:
+                    try:
+                        outcome: Outcome = worker.conn.recv()
+                    except (EOFError, OSError):
+                        outcome = _died(worker)
+                        pool[i] = worker = _replace(worker, ctx)
+                    worker.job = None
+                    on_done(outcome)
+                    _assign(worker, pending)
+                elif worker.process.sentinel in ready:
+                    outcome = _died(worker)
+                    pool[i] = worker = _replace(worker, ctx)
+                    on_done(outcome)
+                    _assign(worker, pending)
+    finally:
+        for worker in pool:
+            with contextlib.suppress(OSError, ValueError):  # a worker already gone
+                worker.conn.send(None)
+        for worker in pool:
+            worker.process.join(timeout=5)
+            if worker.process.is_alive():
+                worker.process.kill()
+                worker.process.join()
+
+
+def _assign(worker: _Worker, pending: list[Job]) -> None:
+    if pending:
+        worker.job = pending.pop()
+        worker.conn.send(worker.job)
+
+
+def _died(worker: _Worker) -> Outcome:
+    worker.process.join(timeout=5)
+    code = worker.process.exitcode
+    assert worker.job is not None
+    return Outcome(
+        worker.job.id,
+        "failed",
+        reason=f"the worker scoring it died (exit code {code}); the other executions were scored",
+    )
+
+
+def _replace(worker: _Worker, ctx: Any) -> _Worker:
+    worker.conn.close()
+    return _Worker(ctx)
+
+
+def run_dask(jobs: Sequence[Job], address: str, *, workers: int, on_done: OnDone) -> None:
+    """Score ``jobs`` on a Dask cluster (``local``: a LocalCluster of ``workers`` processes).
+
+    Only the jobs (paths and values) go through the scheduler; workers read the logs from the
+    shared file system. A job whose worker died as often as the scheduler allows
+    (``distributed.scheduler.allowed-failures``) comes back as ``KilledWorker``: one row.
+    """
+    try:
+        # optional extra `ertools[dask]`: imported only when a scheduler is asked for
+        import distributed as _distributed
+    except ImportError:
+        raise ConfigError(
+            "--scheduler needs Dask distributed: pip install 'ertools[dask]'"
+        ) from None
+    distributed: Any = _distributed  # untyped calls: its API is checked by the Dask test
+    cluster = None
+    try:
+        if address == "local":
+            cluster = distributed.LocalCluster(
+                n_workers=max(workers, 1),
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+            )
+            client = distributed.Client(cluster)
+        else:
+            client = distributed.Client(address, timeout="10s")
+    except (OSError, TimeoutError) as err:
+        raise ConfigError(f"--scheduler {address}: cannot connect ({err})") from err
+    try:
+        futures = {
+            client.submit(run_job, job, key=f"rescore-{job.id}-{os.getpid()}", pure=False): job
+            for job in jobs
+        }
+        for future in distributed.as_completed(futures):
+            job = futures[future]
+            try:
+                outcome = future.result()
+            except distributed.KilledWorker:
+                outcome = Outcome(
+                    job.id,
+                    "failed",
+                    reason="the Dask worker scoring it died; the others were scored",
+                )
+            except Exception as err:  # lost connection, a worker without ertools...
+                text = " ".join(f"{type(err).__name__}: {err}".split())
+                outcome = Outcome(job.id, "failed", reason=f"Dask: {text}")
+            on_done(outcome)
+            future.release()
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+        sys.stderr.flush()

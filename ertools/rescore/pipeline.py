@@ -1,0 +1,455 @@
+"""The rescore pipeline: executions -> jobs -> outcomes (cached or scored) -> results document.
+
+:func:`rescore` is the one library function behind ``ertools rescore``: it plans one job per
+execution (values from the manifest, through the registry only), takes what the cache holds,
+scores the rest (:mod:`ertools.rescore.parallel`), and returns the ``results.json`` document
+(schema in docs/rescore.md) that :func:`write_results` writes with ``results.csv``.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import os
+import re
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+from ertools import __version__
+from ertools.benchmarks import registry
+from ertools.benchmarks.base import Benchmark
+from ertools.progress import Reporter
+from ertools.rescore.cache import Cache, FileHashes, job_key, records
+from ertools.rescore.jobs import Job, Outcome
+from ertools.rescore.manifest import Manifest
+from ertools.rescore.parallel import run_jobs
+from ertools.timeutil import NS_PER_S, iso_utc
+
+SCHEMA_VERSION = 1
+CSV_COLUMNS = (
+    "id",
+    "benchmark",
+    "team",
+    "start",
+    "end",
+    "status",
+    "reason",
+    "rank_value",
+    "report",
+)
+_UNSAFE = re.compile(r"[^A-Za-z0-9_.-]+")
+
+
+@dataclass(frozen=True)
+class Execution:
+    """One benchmark execution to score, wherever it was found (the manifest, the logs).
+
+    ``bags`` are what the benchmark reads; ``problems`` (one line each) make it unscoreable
+    before any scoring (a team without its transform).
+    """
+
+    benchmark: str
+    team: str | None
+    bags: tuple[Path, ...]
+    start_ns: int | None = None
+    end_ns: int | None = None
+    team_source: str | None = None
+    values: Mapping[str, Any] = field(default_factory=dict)
+    problems: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Planned:
+    """An execution, its job and its row's fixed part."""
+
+    execution: Execution
+    job: Job
+    title: str
+    missing: tuple[str, ...]
+
+
+def listed_executions(manifest: Manifest) -> list[Execution]:
+    """The executions the manifest lists by hand."""
+    return [
+        Execution(
+            benchmark=e.benchmark,
+            team=e.team,
+            bags=e.bags,
+            start_ns=e.start_ns,
+            end_ns=e.end_ns,
+            team_source="manifest",
+            values=e.values,
+        )
+        for e in manifest.executions
+    ]
+
+
+def _bags_span(bags: Sequence[Path]) -> tuple[int | None, int | None]:
+    """The first and last message time of the bags (None when unreadable: the scorer says why)."""
+    from ertools.errors import ErtoolsError
+    from ertools.io import summary
+
+    starts: list[int] = []
+    ends: list[int] = []
+    for bag in bags:
+        try:
+            s = summary(bag)
+        except (ErtoolsError, OSError, ValueError):
+            continue
+        if s.start_ns is not None and s.end_ns is not None:
+            starts.append(int(s.start_ns))
+            ends.append(int(s.end_ns))
+    return (min(starts) if starts else None, max(ends) if ends else None)
+
+
+def execution_id(benchmark: str, team: str | None, start_ns: int | None, n: int) -> str:
+    """``fbm3w-robotto-20151120T123105``: benchmark, team, start (UTC); without a start, the
+    execution's place in the list."""
+    when = (
+        datetime.fromtimestamp(start_ns / NS_PER_S, tz=UTC).strftime("%Y%m%dT%H%M%S")
+        if start_ns is not None
+        else f"{n + 1}"
+    )
+    return f"{benchmark}-{_UNSAFE.sub('_', team or 'unknown')}-{when}"
+
+
+def score_argv(
+    benchmark: Benchmark[Any, Any, Any, Any],
+    bags: Sequence[Path],
+    values: Mapping[str, Any],
+    team: str | None,
+) -> list[str]:
+    """The ``ertools score`` command line that scores the same execution (for the report)."""
+    argv = ["ertools", "score", benchmark.name, *(str(b) for b in bags)]
+    for declared in benchmark.inputs:
+        value = values.get(declared.name)
+        if value is None or value is False:
+            continue
+        if declared.kind == "flag":
+            argv.append(declared.option)
+            continue
+        items = value if isinstance(value, tuple | list) else (value,)
+        if declared.kind == "paths" and not declared.repeat:
+            argv += [declared.option, *(str(v) for v in items)]
+        else:
+            for item in items:
+                argv += [declared.option, str(item)]
+    if team:
+        argv += ["--team", team]
+    return argv
+
+
+def plan(
+    executions: Sequence[Execution], manifest: Manifest, out: Path, *, reports: bool = True
+) -> list[Planned]:
+    """One job per execution, in time order, with unique ids and the manifest's values."""
+    ordered = sorted(
+        enumerate(executions),
+        key=lambda ie: (ie[1].start_ns is None, ie[1].start_ns or 0, ie[0]),
+    )
+    planned: list[Planned] = []
+    seen: dict[str, int] = {}
+    for n, (_, execution) in enumerate(ordered):
+        benchmark = registry.get(execution.benchmark)
+        start_ns, end_ns = execution.start_ns, execution.end_ns
+        if start_ns is None or end_ns is None:
+            found_start, found_end = _bags_span(execution.bags)
+            start_ns = start_ns if start_ns is not None else found_start
+            end_ns = end_ns if end_ns is not None else found_end
+            execution = Execution(**{**execution.__dict__, "start_ns": start_ns, "end_ns": end_ns})
+        ident = execution_id(execution.benchmark, execution.team, start_ns, n)
+        seen[ident] = seen.get(ident, 0) + 1
+        if seen[ident] > 1:
+            ident = f"{ident}-{seen[ident]}"
+        values, missing = manifest.values_for(execution.benchmark, execution.team, execution.values)
+        values = {k: v for k, v in values.items() if v is not None}
+        job = Job(
+            id=ident,
+            benchmark=benchmark.name,
+            target=registry.REGISTRY[benchmark.name],
+            team=execution.team,
+            bags=tuple(str(b) for b in execution.bags),
+            values=values,
+            report_dir=str(out / "executions" / ident) if reports else None,
+            argv=tuple(score_argv(benchmark, execution.bags, values, execution.team)),
+        )
+        planned.append(Planned(execution, job, benchmark.title, (*execution.problems, *missing)))
+    return planned
+
+
+def rescore(
+    executions: Sequence[Execution],
+    manifest: Manifest,
+    out: Path,
+    *,
+    workers: int = 1,
+    scheduler: str | None = None,
+    use_cache: bool = True,
+    reports: bool = True,
+    command: Sequence[str] = (),
+    problems: Sequence[Mapping[str, Any]] = (),
+    timeline: Mapping[str, Any] | None = None,
+    progress: Reporter | None = None,
+    on_outcome: Callable[[Outcome], None] | None = None,
+) -> dict[str, Any]:
+    """Score every execution (cache first) and return the ``results.json`` document.
+
+    Args:
+        executions: what to score (the manifest's list, the logs' discoveries).
+        manifest: the validated manifest (values per benchmark and team).
+        out: the results folder (``cache/`` and ``executions/<id>/`` go in it).
+        workers: local worker processes (1: in this process); with ``scheduler``, the
+            LocalCluster's workers.
+        scheduler: a Dask scheduler address, ``local``, or None.
+        use_cache: False: score everything again (the cache is still refreshed).
+        reports: write each execution's report folder.
+        command: the command line, for provenance.
+        problems: problems found before scoring (the logs' discovery, the timeline).
+        timeline: the ``timeline`` entry of the document (figure, sessions).
+        progress: told of every execution done.
+        on_outcome: called with each outcome as it arrives (the CLI's stderr lines).
+    """
+    out.mkdir(parents=True, exist_ok=True)
+    cache_dir = out / "cache"
+    hashes = FileHashes(cache_dir / "hashes.json")
+    cache = Cache(cache_dir)
+    planned = plan(executions, manifest, out, reports=reports)
+    outcomes: dict[str, Outcome] = {}
+    cached: set[str] = set()
+    keys: dict[str, str] = {}
+    to_run: list[Job] = []
+    for p in planned:
+        if p.missing:
+            outcomes[p.job.id] = Outcome(p.job.id, "unscoreable", reason="; ".join(p.missing))
+            continue
+        try:
+            keys[p.job.id] = job_key(p.job, hashes)
+        except OSError as err:  # a bag gone between discovery and now
+            outcomes[p.job.id] = Outcome(
+                p.job.id, "unscoreable", reason=f"cannot read {err.filename}: {err.strerror}"
+            )
+            continue
+        hit = cache.get(keys[p.job.id], p.job) if use_cache else None
+        if hit is not None:
+            outcomes[p.job.id] = hit
+            cached.add(p.job.id)
+        else:
+            to_run.append(p.job)
+    hashes.save()
+
+    total = len(planned)
+    state = {"done": len(outcomes), "bad": sum(o.status != "scored" for o in outcomes.values())}
+
+    def tell() -> None:
+        if progress is not None:
+            label = "rescoring" + (f" ({state['bad']} not scored)" if state["bad"] else "")
+            progress.task(label, total, "executions")
+            progress.advance(state["done"])
+
+    for outcome in outcomes.values():
+        if on_outcome is not None:
+            on_outcome(outcome)
+    tell()
+
+    def done(outcome: Outcome) -> None:
+        outcomes[outcome.id] = outcome
+        cache.put(keys[outcome.id], outcome)
+        state["done"] += 1
+        state["bad"] += outcome.status != "scored"
+        if on_outcome is not None:
+            on_outcome(outcome)
+        tell()
+
+    run_jobs(to_run, workers=workers, scheduler=scheduler, on_done=done)
+    return document(
+        planned,
+        outcomes,
+        cached,
+        manifest,
+        out,
+        hashes,
+        command=command,
+        options={"jobs": workers, "scheduler": scheduler},
+        problems=problems,
+        timeline=timeline,
+    )
+
+
+def _rel(path: str | None, out: Path) -> str | None:
+    if path is None:
+        return None
+    try:
+        return Path(path).relative_to(out.resolve()).as_posix()
+    except ValueError:
+        try:
+            return Path(path).relative_to(out).as_posix()
+        except ValueError:
+            return path
+
+
+def document(
+    planned: Sequence[Planned],
+    outcomes: Mapping[str, Outcome],
+    cached: set[str],
+    manifest: Manifest,
+    out: Path,
+    hashes: FileHashes,
+    *,
+    command: Sequence[str],
+    options: Mapping[str, Any],
+    problems: Sequence[Mapping[str, Any]],
+    timeline: Mapping[str, Any] | None,
+) -> dict[str, Any]:
+    """The ``results.json`` document (docs/rescore.md)."""
+    rows: list[dict[str, Any]] = []
+    all_problems = [dict(p) for p in problems]
+    files: dict[str, Path] = {}
+    for p in planned:
+        e, job = p.execution, p.job
+        o = outcomes[job.id]
+        inputs = records(job.values, hashes)
+        for bag in e.bags:
+            files[str(bag)] = bag
+        for value in job.values.values():
+            for item in value if isinstance(value, tuple | list) else (value,):
+                if isinstance(item, Path):
+                    files[str(item)] = item
+        for line in p.missing:
+            all_problems.append(
+                {"kind": "missing-input", "path": None, "message": f"{job.id}: {line}"}
+            )
+        rows.append(
+            {
+                "id": job.id,
+                "benchmark": job.benchmark,
+                "title": p.title,
+                "team": e.team,
+                "team_source": e.team_source,
+                "start_ns": e.start_ns,
+                "end_ns": e.end_ns,
+                "start": iso_utc(e.start_ns) if e.start_ns is not None else None,
+                "end": iso_utc(e.end_ns) if e.end_ns is not None else None,
+                "bags": [str(b) for b in e.bags],
+                "inputs": inputs,
+                "status": o.status,
+                "reason": o.reason,
+                "score": o.score,
+                "rank_value": o.rank_value,
+                "warnings": list(o.warnings),
+                "deviations": list(o.deviations),
+                "live_score": o.live_score,
+                "live_differences": list(o.live_differences),
+                "report": _rel(o.report, out),
+                "cached": job.id in cached,
+                "seconds": o.seconds,
+            }
+        )
+    deviations = sorted({d for row in rows for d in row["deviations"]})
+    provenance = []
+    for name, path in sorted(files.items()):
+        try:
+            provenance.append(
+                {"path": name, "sha256": hashes.sha256(path), "size": hashes.size(path)}
+            )
+        except OSError:
+            provenance.append({"path": name, "sha256": None, "size": None})
+    hashes.save()
+    return {
+        "schema_version": SCHEMA_VERSION,
+        "ertools_version": __version__,
+        "generated": datetime.now(UTC).isoformat(timespec="seconds"),
+        "command": list(command),
+        "manifest": {
+            "path": str(manifest.path),
+            "sha256": manifest.sha256,
+            "title": manifest.title,
+        },
+        "options": dict(options),
+        "timeline": dict(timeline) if timeline is not None else None,
+        "executions": rows,
+        "leaderboards": leaderboards(rows),
+        "problems": all_problems,
+        "deviations_in_force": deviations,
+        "inputs": provenance,
+    }
+
+
+def leaderboards(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    """Per benchmark (registry order), each team's best scored execution by the benchmark's
+    own :class:`~ertools.benchmarks.base.Ranking`; equal values share a rank."""
+    boards: list[dict[str, Any]] = []
+    names = [n for n in registry.names() if any(r["benchmark"] == n for r in rows)]
+    names += sorted({str(r["benchmark"]) for r in rows} - set(names))
+    for name in names:
+        ranking = registry.get(name).ranking
+        sign = 1.0 if ranking.lower_is_better else -1.0
+        best: dict[str, Mapping[str, Any]] = {}
+        for row in rows:
+            if row["benchmark"] != name or row["status"] != "scored" or row["rank_value"] is None:
+                continue
+            team = str(row["team"])
+            if team not in best or sign * row["rank_value"] < sign * best[team]["rank_value"]:
+                best[team] = row
+        ordered = sorted(best.items(), key=lambda tr: (sign * tr[1]["rank_value"], tr[0]))
+        board_rows: list[dict[str, Any]] = []
+        for i, (team, row) in enumerate(ordered):
+            same = board_rows and board_rows[-1]["value"] == row["rank_value"]
+            board_rows.append(
+                {
+                    "rank": board_rows[-1]["rank"] if same else i + 1,
+                    "team": team,
+                    "value": row["rank_value"],
+                    "execution": row["id"],
+                }
+            )
+        title = next(str(r["title"]) for r in rows if r["benchmark"] == name)
+        boards.append(
+            {
+                "benchmark": name,
+                "title": title,
+                "rule": ranking.text,
+                "lower_is_better": ranking.lower_is_better,
+                "rows": board_rows,
+            }
+        )
+    return boards
+
+
+def csv_text(doc: Mapping[str, Any]) -> str:
+    buffer = io.StringIO()
+    writer = csv.DictWriter(
+        buffer, fieldnames=CSV_COLUMNS, extrasaction="ignore", lineterminator="\n"
+    )
+    writer.writeheader()
+    for row in doc["executions"]:
+        writer.writerow({k: "" if row.get(k) is None else row[k] for k in CSV_COLUMNS})
+    return buffer.getvalue()
+
+
+def write_results(doc: Mapping[str, Any], out: Path) -> list[Path]:
+    """``results.json``, ``results.csv`` and, when the ``site`` module is there, ``index.html``."""
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, text in (
+        ("results.json", json.dumps(doc, indent=2, allow_nan=False) + "\n"),
+        ("results.csv", csv_text(doc)),
+    ):
+        path = out / name
+        tmp = path.with_suffix(".tmp")
+        tmp.write_text(text, encoding="utf-8")
+        os.replace(tmp, path)
+        written.append(path)
+    # SITE CALL POINT: the results page is the `site` branch's
+    # (ertools.rescore.site.write_site(results, out) -> DIR/index.html), built from the document
+    # alone; called here once that module exists.
+    from importlib.util import find_spec
+
+    if find_spec("ertools.rescore.site") is not None:
+        from importlib import import_module
+
+        written.append(import_module("ertools.rescore.site").write_site(dict(doc), out))
+    return written
