@@ -197,7 +197,10 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
                 anchor=_anchor("lb", str(lb.get("benchmark"))),
                 title=str(lb.get("title") or lb.get("benchmark")),
                 rule=str(lb.get("rule") or ""),
-                direction="lower is better" if lower else "higher is better",
+                # Said once: the registry's rule texts may already end with the direction.
+                direction=""
+                if "better" in str(lb.get("rule") or "")
+                else ("lower is better" if lower else "higher is better"),
                 column=column,
                 rows=tuple(standings),
             )

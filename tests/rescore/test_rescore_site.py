@@ -50,6 +50,7 @@ def test_leaderboards_ranked_by_each_rule(tmp_path: Path) -> None:
     # The rule and its direction are stated on the page.
     assert "the best run's distance error (lower is better)" in page.rules["lb-fbm3w"]
     assert "class accuracy (higher is better)" in page.rules["lb-fbm1h"]
+    assert page.rules["lb-fbm2h"].count("better") == 1  # not said twice
     # Values in the display unit of the ranked key: 0.0081 m is 8.1 mm; the live 2015 value
     # (0.0095 m) beside it, and that row flagged.
     smart = page.boards["lb-fbm3w"][0]
