@@ -289,7 +289,7 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
     ]
     downloads = [Link(name, name) for name in ("results.json", "results.csv") if exists(name)]
     return {
-        "title": "Competition results",
+        "title": str(manifest.get("title") or "Competition results"),
         "subtitle": (
             f"{len(rows)} execution(s): {counts['scored']} scored, {counts['unscoreable']} "
             f"unscoreable, {counts['failed']} failed; rescored by ertools "

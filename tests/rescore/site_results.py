@@ -155,7 +155,7 @@ def results() -> dict[str, Any]:
         "ertools_version": "0.1.0",
         "generated": "2026-11-25T05:00:00+00:00",
         "command": ["ertools", "rescore", "logs/", "--config", "competition.yaml", "--out", "out"],
-        "manifest": {"path": "competition.yaml", "sha256": "cd" * 32},
+        "manifest": {"path": "competition.yaml", "sha256": "cd" * 32, "title": "Lisbon 2015"},
         "options": {"jobs": 2, "scheduler": None},
         "timeline": {"figure": "timeline.html", "sessions": 6},
         "executions": exs,

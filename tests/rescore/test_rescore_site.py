@@ -65,6 +65,7 @@ def test_problems_deviations_timeline_and_executions(tmp_path: Path) -> None:
     text = index.read_text(encoding="utf-8")
     page = Page(text)
     assert page.scripts == 0 and EVIL not in text  # hostile names stay text
+    assert "<title>Lisbon 2015</title>" in text  # the manifest's title
     for p in doc["problems"]:
         assert p["message"] in page.sections["problems"]
     for d in doc["deviations_in_force"]:
