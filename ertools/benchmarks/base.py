@@ -12,12 +12,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Generic, Literal, Protocol, TypeVar, runtime_checkable
+from typing import TYPE_CHECKING, Any, Generic, Literal, Protocol, TypeVar, runtime_checkable
 
-from ertools.fidelity import Deviation
-from ertools.streams import Provenance
+if TYPE_CHECKING:  # annotations only: the registry (and `ertools score --help`) stays light
+    from ertools.fidelity import Deviation
+    from ertools.streams import Provenance
 
 Rows = list[dict[str, Any]]
 
@@ -47,6 +48,8 @@ class Input:
         per_team: in a manifest, the value may differ per team (a marker-set transform).
         metavar: the placeholder in ``--help`` (default from ``unit`` or the kind).
         flag: the option's spelling when it is not derived from ``name``.
+        with_file: for a ``choice``: the choices followed by a FILE on the command line
+            (``--reached timing FILE``); the value is then ``(choice, path)``, else ``(choice,)``.
     """
 
     name: str
@@ -63,6 +66,7 @@ class Input:
     per_team: bool = False
     metavar: str = ""
     flag: str = ""
+    with_file: tuple[str, ...] = ()
 
     @property
     def option(self) -> str:
@@ -94,7 +98,7 @@ class BenchmarkResult(Protocol):
     """A frozen result of one benchmark execution.
 
     Attributes:
-        name: the benchmark (``fbm3w``...), a key of ``ertools.benchmarks.REGISTRY``.
+        name: the benchmark (``fbm3w``...), a key of ``ertools.benchmarks.registry.REGISTRY``.
         warnings: things a referee should know (d_min below the noise, identity transform...).
         deviations: every place where ertools deliberately differs from the 2015 node.
         failures: runs/segments/items that could not be scored (the CLI then exits 1).
@@ -128,6 +132,18 @@ class BenchmarkResult(Protocol):
     def tables(self) -> dict[str, Rows]:
         """CSV-ready tables by name (``runs``, ``segments``, ``items``, ``samples``...)."""
         ...
+
+
+def notice(message: str) -> None:
+    """A human note on stderr (``ertools: message``), below any progress bar: what a
+    benchmark's :attr:`Benchmark.make_options` says about the values it was given (a
+    deprecated spelling, a choice that differs from a node)."""
+    import sys
+
+    from ertools.progress import clear_current
+
+    clear_current()
+    print(f"ertools: {message}", file=sys.stderr)
 
 
 def dump_yaml(data: Any) -> str:
@@ -184,6 +200,18 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
         figures: ``module:function`` drawing the result's figures (imported only for a report:
             matplotlib is heavy), empty when it has none.
         foxglove: ``module:function`` giving its Foxglove content, empty when it has none.
+        files: bags, options, result -> the input files a report lists and hashes (default:
+            the bags; e.g. the item list too, or the GT files a folder held).
+        bags_metavar: the positional arguments' placeholder: one name (``BAG``: one or more
+            bags) or two (``ROBOT_BAG``, ``GT_PATH``: the first, then any number of others).
+        score_keys: keys of its ``score.json`` that say a score is this benchmark's (a
+            score.json read without its result.json, ``ertools report``).
+        state_topics: its RefBox/BmBox/Client state topics are logged under ``/NAME/``
+            (``ertools audit`` can reconstruct it).
+        values_2015: the :class:`Input` values that restore every 2015 behaviour (the audit
+            compares the live score with the score recomputed with them); empty: none.
+        from_live: the audit's hook: the values given and the live score (parsed) -> the
+            values to rescore with and notes saying what was taken from the live score.
     """
 
     name: str
@@ -202,11 +230,25 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
     notes: Callable[[ResultT], Sequence[str]] | None = None
     figures: str = ""
     foxglove: str = ""
+    files: Callable[[Sequence[Path], OptionsT, ResultT], Sequence[Path]] | None = None
+    bags_metavar: str | tuple[str, str] = "BAG"
+    score_keys: frozenset[str] = frozenset()
+    state_topics: bool = False
+    values_2015: Mapping[str, Any] = field(default_factory=dict)
+    from_live: (
+        Callable[[Mapping[str, Any], Any], tuple[Mapping[str, Any], tuple[str, ...]]] | None
+    ) = None
 
     def score(self, bags: Sequence[Path], options: OptionsT) -> ResultT:
         """The whole shape: load -> find runs -> score."""
         loaded = self.load(bags, options)
         return self.score_runs(loaded, self.find_runs(loaded, options), options)
+
+    def input_files(self, bags: Sequence[Path], options: OptionsT, result: ResultT) -> list[Path]:
+        """The files a report lists as this execution's inputs (:attr:`files`)."""
+        if self.files is None:
+            return list(bags)
+        return list(self.files(bags, options, result))
 
     def input(self, name: str) -> Input:
         """The declared input called ``name`` (KeyError when there is none)."""
@@ -214,3 +256,97 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
             if declared.name == name:
                 return declared
         raise KeyError(name)
+
+
+def _one_value(declared: Input, value: Any) -> Any:
+    """``value`` as ``declared`` types it; UsageError when it does not fit."""
+    from ertools.errors import UsageError
+
+    option = declared.option
+    kind = declared.kind
+    if kind == "flag":
+        if not isinstance(value, bool):
+            raise UsageError(f"{option} is a switch (true or false), got {value!r}")
+        return value
+    if kind in ("path", "paths"):
+        if not isinstance(value, str | Path):
+            raise UsageError(f"{option} must be a path, got {value!r}")
+        return Path(value)
+    if kind in ("str", "choice"):
+        if kind == "choice" and declared.with_file:
+            words = (value,) if isinstance(value, str) else tuple(map(str, value))
+            return _choice_words(declared, words)
+        if not isinstance(value, str):
+            raise UsageError(f"{option} must be text, got {value!r}")
+        if kind == "choice" and value not in declared.choices:
+            raise UsageError(
+                f"{option} {value!r}: choose from {', '.join(declared.choices)}"
+            )
+        return value
+    number: float
+    try:
+        if isinstance(value, bool):
+            raise ValueError
+        number = int(value) if kind == "int" else float(value)
+        if kind == "int" and float(value) != number:
+            raise ValueError
+    except (TypeError, ValueError):
+        what = "a whole number" if kind == "int" else "a number"
+        raise UsageError(f"{option} must be {what}, got {value!r}") from None
+    if not math.isfinite(number):
+        raise UsageError(f"{option} must be a finite number, got {value!r}")
+    unit = f" {declared.unit}" if declared.unit else ""
+    if declared.positive and number <= (declared.minimum or 0.0):
+        bound = "positive" if not declared.minimum else f"> {declared.minimum:g}{unit}"
+        raise UsageError(f"{option} must be {bound}, got {value}")
+    if declared.minimum is not None and number < declared.minimum:
+        raise UsageError(f"{option} must be >= {declared.minimum:g}{unit}, got {value}")
+    return number
+
+
+def _choice_words(declared: Input, words: tuple[str, ...]) -> tuple[str, ...]:
+    """``(choice,)`` or ``(choice, FILE)`` for a choice declared ``with_file``."""
+    from ertools.errors import UsageError
+
+    expected = " | ".join(c + " FILE" if c in declared.with_file else c for c in declared.choices)
+    if not words or words[0] not in declared.choices:
+        raise UsageError(f"{declared.option}: expected {expected}, got {' '.join(words)}")
+    need = 2 if words[0] in declared.with_file else 1
+    if len(words) != need:
+        if need == 2:
+            raise UsageError(f"{declared.option} {words[0]} needs exactly one FILE")
+        raise UsageError(f"{declared.option}: expected {expected}, got {' '.join(words)}")
+    return words
+
+
+def resolve_values(inputs: Sequence[Input], given: Mapping[str, Any]) -> dict[str, Any]:
+    """Every declared input's value: ``given`` (by :attr:`Input.name`) checked against its
+    declaration (kind, choices, minimum, positive), the others at their defaults. None
+    stands for "not given". The first half of every :attr:`Benchmark.make_options`.
+
+    Raises:
+        UsageError: an unknown name, or a value that does not fit its declaration.
+    """
+    from ertools.errors import UsageError
+
+    known = {i.name: i for i in inputs}
+    unknown = sorted(set(given) - set(known))
+    if unknown:
+        raise UsageError(
+            f"unknown input(s) {', '.join(unknown)}: expected some of {', '.join(known)}"
+        )
+    out: dict[str, Any] = {}
+    for name, declared in known.items():
+        value = given.get(name)
+        if value is None:
+            value = declared.default
+        if value is None and declared.kind == "flag":
+            value = False
+        if value is None:
+            out[name] = () if declared.repeat else None
+        elif declared.repeat or declared.kind == "paths":
+            values = [value] if isinstance(value, str | Path) else list(value)
+            out[name] = tuple(_one_value(declared, v) for v in values)
+        else:
+            out[name] = _one_value(declared, value)
+    return out

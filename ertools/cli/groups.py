@@ -10,16 +10,21 @@ from ertools.cli.main import Command
 
 def add_group_arguments(parser: argparse.ArgumentParser, members: dict[str, Command]) -> None:
     """The group's parser takes the member name and leaves the rest to the member's parser."""
+    parser.epilog = members_epilog(members)
+    parser.add_argument(
+        "member", choices=list(members), metavar="NAME", help="one of the members below"
+    )
+    parser.add_argument("rest", nargs=argparse.REMAINDER, metavar="ARGS", help=argparse.SUPPRESS)
+
+
+def members_epilog(members: dict[str, Command]) -> str:
+    """The ``--help`` list of a group's members, each with its summary and an example."""
     lines = ["members:"]
     width = max(len(n) for n in members)
     for name, cmd in members.items():
         lines.append(f"  {name:<{width}}  {cmd.summary}")
         lines.append(f"  {'':<{width}}    e.g. {cmd.example}")
-    parser.epilog = "\n".join(lines)
-    parser.add_argument(
-        "member", choices=list(members), metavar="NAME", help="one of the members below"
-    )
-    parser.add_argument("rest", nargs=argparse.REMAINDER, metavar="ARGS", help=argparse.SUPPRESS)
+    return "\n".join(lines)
 
 
 def run_group(group: str, members: dict[str, Command], args: argparse.Namespace) -> int:

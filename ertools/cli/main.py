@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
 from ertools import __version__
+from ertools.benchmarks.registry import names
 
 if TYPE_CHECKING:
     from ertools.progress import Bar
@@ -35,7 +36,7 @@ COMMANDS: dict[str, Command] = {
     ),
     "score": Command(
         "ertools.cli.score",
-        "recompute a benchmark score (fbm1h, fbm1w, fbm2h, fbm3w, trajectory)",
+        "recompute a benchmark score ({benchmarks})",
         "ertools score fbm3w run.bag --config configs/fbm3w.yaml",
     ),
     "rescore": Command(
@@ -96,7 +97,7 @@ def _top_level_help() -> str:
         "commands:",
     ]
     for name, cmd in COMMANDS.items():
-        lines.append(f"  {name:<{width}}  {cmd.summary}")
+        lines.append(f"  {name:<{width}}  {cmd.summary.format(benchmarks=', '.join(names()))}")
         lines.append(f"  {'':<{width}}    e.g. {cmd.example}")
     lines += [
         "",
@@ -118,6 +119,9 @@ def build_parser(prog: str, module_name: str) -> tuple[argparse.ArgumentParser, 
     module = import_module(module_name)
     description = (module.__doc__ or "").strip()
     epilog = getattr(module, "EPILOG", None)
+    describe = getattr(module, "describe", None)
+    if describe is not None:  # one module serving several commands (`score NAME`)
+        description, epilog = describe(prog)
     parser = _Parser(
         prog=prog,
         description=description,

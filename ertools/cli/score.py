@@ -1,47 +1,206 @@
 """Recompute a benchmark score from its logs.
 
-Each benchmark has its own options: `ertools score NAME --help`.
+Each benchmark has its own options: `ertools score NAME --help`. They are generated from the
+benchmark's declared inputs (:mod:`ertools.benchmarks.registry`), so every benchmark of the
+registry is a member here, with no code of its own in the CLI.
 """
 
 from __future__ import annotations
 
 import argparse
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
 
-from ertools.cli.groups import add_group_arguments, run_group
+from ertools.benchmarks import registry
+from ertools.benchmarks.base import Input
+from ertools.cli.common import add_output_options, all_failed, emit_result, note
+from ertools.cli.groups import add_group_arguments, members_epilog, run_group
 from ertools.cli.main import Command
+from ertools.errors import UsageError
 
-MEMBERS: dict[str, Command] = {
-    "fbm1h": Command(
-        "ertools.cli.score_fbm1",
-        "FBM1@Home object perception",
-        "ertools score fbm1h run.bag --items configs/fbm1h.yaml",
-    ),
-    "fbm1w": Command(
-        "ertools.cli.score_fbm1",
-        "FBM1@Work object perception",
-        "ertools score fbm1w run.bag --items configs/fbm1w.yaml",
-    ),
-    "fbm2h": Command(
-        "ertools.cli.score_fbm2h",
-        "FBM2@Home navigation: waypoint errors",
-        "ertools score fbm2h run.bag --goal goal.yaml --transform transform-homer.yaml",
-    ),
-    "fbm3w": Command(
-        "ertools.cli.score_fbm3w",
-        "FBM3@Work trajectory following: path error",
-        "ertools score fbm3w run.bag --config configs/fbm3w.yaml",
-    ),
-    "trajectory": Command(
-        "ertools.cli.score_trajectory",
-        "robot log vs mocap ground truth, with clock audit",
-        "ertools score trajectory robot.bag gt/ --robot-topic /rockin/homer/marker_pose",
-    ),
-}
+GROUP_PROG = "ertools score"
+# Number kinds -> argparse types (the values are checked again by make_options).
+_TYPES: dict[str, Any] = {"float": float, "int": int, "path": Path, "paths": Path, "str": str}
+
+
+def members() -> dict[str, Command]:
+    """Every registered benchmark, as a member of the ``score`` group (this module)."""
+    out = {}
+    for name in registry.names():
+        bench = registry.get(name)
+        out[name] = Command(__name__, bench.summary, bench.example)
+    return out
+
+
+def _unread_members() -> dict[str, Command]:
+    """The members by name only (summaries left empty: nothing imported)."""
+    return {name: Command(__name__, "", "") for name in registry.names()}
+
+
+def _member(prog: str) -> str | None:
+    """The benchmark a parser's prog names (``ertools score fbm3w`` -> ``fbm3w``)."""
+    words = prog.split()
+    if len(words) == 3 and words[:2] == GROUP_PROG.split():
+        return words[2]
+    return None
+
+
+def describe(prog: str) -> tuple[str, str | None]:
+    """The ``--help`` description and epilog: the group's, or the benchmark's."""
+    name = _member(prog)
+    if name is None:
+        return (__doc__ or "").strip(), None
+    bench = registry.get(name)
+    return bench.description, bench.epilog
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    add_group_arguments(parser, MEMBERS)
+    name = _member(parser.prog)
+    if name is None:
+        # The members' summaries import every declaration: only for --help, so that
+        # `ertools score NAME ...` imports only NAME's benchmark.
+        add_group_arguments(parser, _unread_members())
+        plain_help = parser.format_help
+
+        def format_help() -> str:
+            parser.epilog = members_epilog(members())
+            return plain_help()
+
+        parser.format_help = format_help  # type: ignore[method-assign]
+    else:
+        add_benchmark_arguments(parser, name)
+
+
+def _metavar(declared: Input) -> str | None:
+    if declared.metavar:
+        return declared.metavar
+    if declared.kind in ("float", "int"):
+        return declared.unit.upper() if declared.unit else "N"
+    if declared.kind in ("path", "paths"):
+        return "FILE"
+    return None
+
+
+def _help(declared: Input) -> str:
+    text = declared.help
+    if declared.old_flags:
+        text += f" (formerly {', '.join(declared.old_flags)})"
+    return text.replace("%", "%%")
+
+
+def _add_input(target: Any, declared: Input) -> None:
+    """One declared input as an argparse option (its values checked by make_options)."""
+    kw: dict[str, Any] = {"dest": declared.name, "help": _help(declared), "default": None}
+    if declared.kind == "flag":
+        kw["action"] = "store_true"
+    else:
+        metavar = _metavar(declared)
+        if metavar is not None:
+            kw["metavar"] = metavar
+        if declared.kind == "choice" and declared.with_file:
+            kw["nargs"] = "+"
+            kw.setdefault("metavar", "MODE")
+        elif declared.kind == "choice":
+            kw["choices"] = declared.choices
+        else:
+            kw["type"] = _TYPES[declared.kind]
+        if declared.kind == "paths":
+            kw["nargs"] = "+"
+        if declared.repeat:
+            kw["action"] = "append"
+    target.add_argument(declared.option, **kw)
+    for i, old in enumerate(declared.old_flags):
+        old_kw = {**kw, "dest": f"old__{declared.name}__{i}", "help": argparse.SUPPRESS}
+        target.add_argument(old, **old_kw)
+
+
+def add_benchmark_arguments(parser: argparse.ArgumentParser, name: str) -> None:
+    """BAG... and every declared input of ``name``, grouped as declared, then the output
+    options shared by every benchmark."""
+    bench = registry.get(name)
+    parser.set_defaults(benchmark=name)
+    # A `with_file` choice takes words (`--reached timing FILE`): given before the bags it
+    # swallows them, so none is required here and run() takes them back (see _bags).
+    swallows = any(i.with_file for i in bench.inputs)
+    if isinstance(bench.bags_metavar, str):
+        parser.add_argument(
+            "bags",
+            nargs="*" if swallows else "+",
+            type=Path,
+            metavar=bench.bags_metavar,
+            help=bench.bags_help,
+        )
+    else:  # the first bag, then any number of others (ROBOT_BAG [GT_PATH ...])
+        first, rest = bench.bags_metavar
+        parser.add_argument("bags", type=Path, metavar=first, help=bench.bags_help)
+        parser.add_argument("more_bags", type=Path, nargs="*", metavar=rest)
+    groups: dict[str, Any] = {}
+    for declared in bench.inputs:
+        target: Any = parser
+        if declared.group:
+            if declared.group not in groups:
+                groups[declared.group] = parser.add_argument_group(declared.group)
+            target = groups[declared.group]
+        _add_input(target, declared)
+    names = {i.name for i in bench.inputs}
+    add_output_options(parser, team="team" not in names)
+
+
+def _values(bench: registry.AnyBenchmark, args: argparse.Namespace) -> dict[str, Any]:
+    """The values given, by input name; an old spelling is said on stderr."""
+    values: dict[str, Any] = {}
+    for declared in bench.inputs:
+        value = getattr(args, declared.name)
+        for i, old in enumerate(declared.old_flags):
+            old_value = getattr(args, f"old__{declared.name}__{i}")
+            if old_value is None or old_value is False:
+                continue
+            note(f"{old} is deprecated: it now means {declared.option}")
+            if not value:
+                value = old_value
+        if declared.kind == "flag" and not value:
+            value = None  # not given: make_options applies the default
+        values[declared.name] = value
+    return values
+
+
+def _bags(
+    bench: registry.AnyBenchmark, values: dict[str, Any], bags: Sequence[Path]
+) -> list[Path]:
+    """The bags, taken back from a ``with_file`` choice that swallowed them when it came
+    first (``--reached timing FILE log.bag``)."""
+    out = list(bags)
+    for declared in bench.inputs:
+        words = values.get(declared.name)
+        if not declared.with_file or not words or out:
+            continue
+        need = 2 if words[0] in declared.with_file else 1
+        if len(words) > need:
+            out = [Path(w) for w in words[need:]]
+            values[declared.name] = words[:need]
+    if not out:
+        first = bench.bags_metavar if isinstance(bench.bags_metavar, str) else bench.bags_metavar[0]
+        raise UsageError(
+            f"give at least one {first} (the log file); `ertools score {bench.name} --help` "
+            "shows how"
+        )
+    return out
 
 
 def run(args: argparse.Namespace) -> int:
-    return run_group("score", MEMBERS, args)
+    name: str | None = getattr(args, "benchmark", None)
+    if name is None:
+        return run_group("score", _unread_members(), args)
+    bench = registry.get(name)
+    values = _values(bench, args)
+    given = args.bags if isinstance(args.bags, list) else [args.bags, *args.more_bags]
+    bags = _bags(bench, values, given)
+    args.bags = bags
+    options = bench.make_options(values)
+    result = bench.score(bags, options)
+    if not all_failed(result):  # nothing scored: only the errors (emit_result)
+        for line in bench.notes(result) if bench.notes is not None else ():
+            note(line)
+    return emit_result(result, args, bench.input_files(bags, options, result))
+

@@ -1,7 +1,8 @@
 """Every benchmark execution in a timeline, with its team, GT files and robot log.
 
-Pure: it reads the :class:`~ertools.timeline.Timeline` that :func:`ertools.timeline_scan.scan`
-built (and, optionally, the teams the IO edge read from the state payloads), never a file.
+Pure: it reads the :class:`~ertools.timeline.build.Timeline` that
+:func:`ertools.timeline.scan.scan` built (and, optionally, the teams the IO edge read from the
+state payloads), never a file.
 
 - An **execution** is a benchmark log (a bag with state topics, ``kind == "benchmark"``) and
   one benchmark namespace of its topics (``/fbm2h/bmbox_state`` -> ``fbm2h``); its span is the
@@ -12,10 +13,10 @@ built (and, optionally, the teams the IO edge read from the state payloads), nev
   whose span overlaps the execution's the most. Each robot log belongs to at most one
   execution: the one it overlaps the most (a team's logger runs from before the benchmark
   starts to after it ends, so the next team's run overlaps it less, if at all).
-- Its **team**, by :func:`ertools.teams.resolve_team`: a team the state payloads name
-  (``payload_teams``, read by :func:`ertools.teams.read_payload_team`), else the robot log's
-  rockin_logger name (``FBM2H_<date>_<team>.bag``), else none (a problem: the manifest must
-  name it).
+- Its **team**, by :func:`ertools.benchmarks.common.teams.resolve_team`: a team the state
+  payloads name (``payload_teams``, read by
+  :func:`ertools.benchmarks.common.teams.read_payload_team`), else the robot log's rockin_logger
+  name (``FBM2H_<date>_<team>.bag``), else none (a problem: the manifest must name it).
 
 Problems (:class:`Problem`, one per file and kind): files nobody could read, truncated or
 unindexed files, copies, clock offsets, gaps between GT split files (from the timeline's
@@ -32,22 +33,23 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Literal
 
-from ertools.teams import TeamSource, resolve_team
-from ertools.timeline import BagEntry, Pairing, Timeline, bag_stem
+from ertools.benchmarks.common.teams import TeamSource, resolve_team
+from ertools.timeline.build import BagEntry, Pairing, Timeline, bag_stem
 from ertools.timeutil import NS_PER_S
 
+# Spelled as the ``problems[].kind`` of results.json (the rescore contract).
 ProblemKind = Literal[
     "unreadable",
     "truncated",
-    "unindexed",
-    "copy",
-    "clock",
+    "active",
+    "duplicate",
+    "clock-offset",
     "gap",
-    "duplicate name",
+    "duplicate-name",
     "unpaired",
-    "no team",
-    "no gt",
-    "partial gt",
+    "no-team",
+    "no-gt",
+    "partial-gt",
     "ambiguous",
     "file",
 ]
@@ -57,17 +59,17 @@ _BENCHMARK_LOG_RE = re.compile(
     r"^log_(?P<ns>[ft]bm\d[hw])(?:_mocap)?_(?P<date>\d{4}-\d{2}-\d{2}-\d{2}-\d{2}-\d{2})_\d+$",
     re.IGNORECASE,
 )
-# What the timeline's per-file problem lines say, by kind (ertools.timeline writes them).
+# What the timeline's per-file problem lines say, by kind (ertools.timeline.build writes them).
 _FILE_PROBLEMS: tuple[tuple[str, ProblemKind], ...] = (
     ("truncated", "truncated"),
-    ("same recording as", "copy"),
-    ("record times differ from header stamps", "clock"),
-    ("cannot read the first messages", "clock"),
-    ("not indexed", "unindexed"),
-    ("unindexed", "unindexed"),
+    ("same recording as", "duplicate"),
+    ("record times differ from header stamps", "clock-offset"),
+    ("cannot read the first messages", "clock-offset"),
+    ("not indexed", "active"),
+    ("unindexed", "active"),
     ("gap of", "gap"),
     ("missing before this one", "gap"),
-    ("duplicated file name", "duplicate name"),
+    ("duplicated file name", "duplicate-name"),
     ("no messages", "unreadable"),
 )
 
@@ -110,9 +112,9 @@ class Execution:
 
     @property
     def id(self) -> str:
-        """``<benchmark>-<team or unknown>-<HHMMSS UTC of the start>``: unique within a day."""
+        """``<benchmark>-<team or unknown>-<start, UTC, %Y%m%dT%H%M%S>``, as results.json's."""
         stamp = dt.datetime.fromtimestamp(self.start_ns // NS_PER_S, tz=dt.UTC)
-        return f"{self.benchmark}-{self.team or 'unknown'}-{stamp:%H%M%S}"
+        return f"{self.benchmark}-{self.team or 'unknown'}-{stamp:%Y%m%dT%H%M%S}"
 
 
 @dataclass(frozen=True)
@@ -151,10 +153,10 @@ def discover(timeline: Timeline, payload_teams: Mapping[str, str] | None = None)
     """The benchmark executions of ``timeline`` and what is wrong (see the module docstring).
 
     Args:
-        timeline: from :func:`ertools.timeline_scan.scan` (or
-            :func:`ertools.timeline.build_timeline`).
+        timeline: from :func:`ertools.timeline.scan.scan` (or
+            :func:`ertools.timeline.build.build_timeline`).
         payload_teams: benchmark log path -> the team its state payloads name, for the logs
-            where the IO edge found one (:func:`ertools.teams.read_payload_team`).
+            where the IO edge found one (:func:`ertools.benchmarks.common.teams.read_payload_team`).
     """
     payload_teams = payload_teams or {}
     problems: list[Problem] = []
@@ -234,18 +236,18 @@ def discover(timeline: Timeline, payload_teams: Mapping[str, str] | None = None)
         if team is None:
             text = "no team: no state payload or robot log names one (give it in the manifest)"
             notes.append(text)
-            problems.append(Problem(log.path, "no team", text))
+            problems.append(Problem(log.path, "no-team", text))
         pairing = pairings.get(log.path)
         gt = pairing.gt if pairing is not None else ()
         if not gt:
             text = "no GT file of its benchmark overlaps it"
             notes.append(text)
-            problems.append(Problem(log.path, "no gt", text))
+            problems.append(Problem(log.path, "no-gt", text))
         elif pairing is not None and pairing.coverage < 100.0:
             holes = ", ".join(f"{_utc(a)} to {_utc(b)}" for a, b in pairing.uncovered)
             text = f"GT covers {pairing.coverage:.1f} % of it (not: {holes})"
             notes.append(text)
-            problems.append(Problem(log.path, "partial gt", text))
+            problems.append(Problem(log.path, "partial-gt", text))
         for path in (log.path, *gt, *([paired.path] if paired is not None else [])):
             notes += [f"{path}: {p}" for p in by_path[path].problems]
         executions.append(

@@ -179,7 +179,7 @@ def _score(job: Job) -> Outcome:
 def _live_audit(result: Any, bags: list[Path]) -> Any:
     """The audit of the bags' state topics with its live-vs-recomputed comparison, or None
     (a benchmark without state topics, or logs without them)."""
-    from ertools.audit.rescore import attach
+    from ertools.audit.compare import attach
     from ertools.report.folder import _audit_inputs  # the report's own: one audit, shared
 
     audit = _audit_inputs(result.name, bags)

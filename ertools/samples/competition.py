@@ -41,20 +41,32 @@ from __future__ import annotations
 
 import json
 import shutil
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ertools.samples import fbm1, fbm2h, fbm3w
+from ertools.errors import UsageError
+from ertools.samples import fbm1, fbm2h
 from ertools.samples.competition_files import (
     GtWindow,
+    robot_poses,
     write_benchmark_log,
     write_gt_file,
     write_robot_log,
 )
-from ertools.samples.competition_scores import expected_score
+from ertools.samples.competition_schedule import (
+    CLOCK_OFF,
+    COPIED,
+    MISSING_TRANSFORM,
+    NO_ROBOT_LOG,
+    SCHEDULE,
+    TRUNCATED,
+    Slot,
+    simulate_slot,
+)
+from ertools.samples.competition_scores import expected_score, expected_trajectory
+from ertools.samples.mocap import pose_topic
 from ertools.samples.scenario import EPOCH_2015, log_name, to_plain
 from ertools.samples.simulated import SimulatedRun
 from ertools.samples.statemachine import state_messages
@@ -70,102 +82,6 @@ TRUNCATE_AT = 0.6
 ROBOT_LEAD_S = 15.0  # teams start their logger this long before the benchmark's recorder...
 ROBOT_TAIL_S = 8.0  # ... and stop it this long after
 TEST_DRIVE_NS = EPOCH_2015 - 90 * 60 * NS + 10 * NS  # 08:30:10, before the GT logger
-
-
-@dataclass(frozen=True)
-class Slot:
-    """One execution of the day's schedule."""
-
-    at: str  # HH:MM:SS UTC: the benchmark recorder's start
-    benchmark: str
-    team: str
-    attempt: int = 1
-
-    @property
-    def start_ns(self) -> int:
-        hh, mm, ss = (int(v) for v in self.at.split(":"))
-        return EPOCH_2015 + ((hh - 10) * 3600 + mm * 60 + ss) * NS
-
-    @property
-    def id(self) -> str:
-        return f"{self.benchmark}-{self.team}-{self.at.replace(':', '')}"
-
-
-SCHEDULE: tuple[Slot, ...] = (
-    Slot("09:10:05", "fbm1h", "socrob"),
-    Slot("09:24:30", "fbm3w", "b-it-bots"),
-    Slot("09:41:12", "fbm2h", "homer"),
-    Slot("09:59:31", "fbm2h", "socrob"),  # straddles the 09:59:58 split of the GT logger
-    Slot("10:18:44", "fbm3w", "robotto"),
-    Slot("10:36:02", "fbm1h", "homer"),
-    Slot("10:52:27", "fbm1h", "skuba"),
-    Slot("11:14:50", "fbm2h", "skuba"),  # no transform-skuba.yaml
-    Slot("11:37:15", "fbm3w", "b-it-bots", 2),  # benchmark log truncated
-    Slot("12:06:40", "fbm2h", "homer", 2),  # robot PC clock 4 s ahead
-    Slot("12:31:05", "fbm3w", "robotto", 2),  # no robot log (USB key lost)
-    Slot("12:58:50", "fbm1h", "socrob", 2),
-    Slot("13:21:33", "fbm2h", "socrob", 2),  # in the GT logger's .bag.active file
-)
-MISSING_TRANSFORM = "skuba"
-TRUNCATED = "fbm3w-b-it-bots-113715"
-CLOCK_OFF = "fbm2h-homer-120640"
-NO_ROBOT_LOG = "fbm3w-robotto-123105"
-COPIED = "fbm2h-homer-094112"
-
-# Team knobs. FBM2H: stop errors scale and marker mount (t, rpy of T_marker_robot).
-FBM2H_TEAMS: dict[str, tuple[float, tuple[float, ...], tuple[float, ...]]] = {
-    "homer": (0.6, (0.10, 0.03, -0.78), (0.0, 0.01, 0.45)),
-    "socrob": (1.0, fbm2h.MARKER_TO_ROBOT_T, fbm2h.MARKER_TO_ROBOT_RPY),
-    "skuba": (1.5, (-0.05, 0.0, -0.92), (0.015, 0.0, -1.2)),
-}
-# FBM1H: scale of the pose errors of runs 1-6 and the runs (1-based) answered with a wrong class.
-FBM1H_TEAMS: dict[str, tuple[float, tuple[int, ...]]] = {
-    "homer": (1.0, ()),
-    "socrob": (1.8, (2, 3)),
-    "skuba": (0.5, (1,)),
-}
-# FBM3W: path deviation amplitude scale per attempt.
-FBM3W_TEAMS: dict[str, tuple[float, float]] = {"b-it-bots": (1.1, 1.3), "robotto": (1.7, 2.2)}
-
-
-def _fbm1_errors(
-    scale: float, wrong: tuple[int, ...]
-) -> tuple[tuple[bool, bool, float, float, float], ...]:
-    """The default answers with runs 1-6's pose errors scaled and some classes wrong (runs 7-9
-    keep their seam and clip cases)."""
-    out = []
-    for k, (cls, inst, dx, dy, dth) in enumerate(fbm1.ANSWER_ERRORS):
-        if k < 6:
-            dx, dy, dth = dx * scale, dy * scale, dth * scale
-        if k + 1 in wrong:
-            cls = inst = False
-        out.append((cls, inst, dx, dy, dth))
-    return tuple(out)
-
-
-def simulate_slot(slot: Slot, seed: int, items: list[dict[str, Any]]) -> SimulatedRun:
-    """The execution of one schedule slot, by its benchmark's simulator and the team's knobs."""
-    if slot.benchmark == "fbm1h":
-        scale, wrong = FBM1H_TEAMS[slot.team]
-        return fbm1.simulate(
-            seed, start_ns=slot.start_ns, answer_errors=_fbm1_errors(scale, wrong), items=items
-        )
-    if slot.benchmark == "fbm2h":
-        scale, t, rpy = FBM2H_TEAMS[slot.team]
-        errors = tuple((dx * scale, dy * scale, dth * scale) for dx, dy, dth in fbm2h.STOP_ERRORS)
-        return fbm2h.simulate(
-            seed,
-            start_ns=slot.start_ns,
-            team=slot.team,
-            stop_errors=errors,
-            marker_to_robot_t=(t[0], t[1], t[2]),
-            marker_to_robot_rpy=(rpy[0], rpy[1], rpy[2]),
-            transform_stamp="2015-11-20_08:40:00",
-        )
-    scale = FBM3W_TEAMS[slot.team][slot.attempt - 1]
-    return fbm3w.simulate(
-        seed, start_ns=slot.start_ns, amplitude=tuple(a * scale for a in fbm3w.AMPLITUDE)
-    )
 
 
 def _gt_windows() -> list[GtWindow]:
@@ -201,7 +117,7 @@ def generate_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path
     """
     outdir.mkdir(parents=True, exist_ok=True)
     if any(outdir.iterdir()):
-        raise FileExistsError(f"{outdir} is not empty")
+        raise UsageError(f"{outdir} is not empty: the sample competition needs an empty folder")
     rng = np.random.default_rng(seed)
     seeds = [int(s) for s in rng.integers(0, 2**31 - 1, size=len(SCHEDULE) + 2)]
     items = fbm1.item_list(np.random.default_rng(seeds[-1]))
@@ -235,6 +151,13 @@ def generate_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path
     active = make_active(outdir / last)
     gt_spans[str(active.relative_to(outdir))] = gt_spans.pop(last)
     written += [outdir / r for r in gt_spans]
+    # file -> its [start, end) record-time window
+    gt_windows = dict(zip(gt_spans, ((w.start_ns, w.end_ns) for w in windows), strict=True))
+    fbm2h_gt = [s.bodies[fbm2h.BODY] for s in sims if s.benchmark == "fbm2h"]
+
+    def gt_over(a: int, b: int) -> list[str]:
+        """The GT files whose (closed) spans meet [a, b], as the timeline pairs them."""
+        return [rel for rel, (s0, s1) in gt_spans.items() if s0 <= b and a <= s1]
 
     # -- the benchmark manager's logs and the robots' logs
     executions: list[dict[str, Any]] = []
@@ -252,27 +175,34 @@ def generate_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path
             r_end = sim.end_ns + round(ROBOT_TAIL_S * NS)
             robot_rel = _robot_name(slot.benchmark, r_start, slot.team)
             offset = round(CLOCK_OFF_S * NS) if slot.id == CLOCK_OFF else 0
-            write_robot_log(outdir / robot_rel, sim, slot.team, r_start, r_end, offset, rlog_rng)
+            poses = robot_poses(sim, r_start, r_end, rlog_rng)
+            write_robot_log(outdir / robot_rel, slot.team, r_start, r_end, poses, offset)
             written.append(outdir / robot_rel)
-            robot_logs.append(
-                {
-                    "path": robot_rel,
-                    "team": slot.team,
-                    "benchmark": slot.benchmark,
-                    "execution": slot.id,
-                    "start_ns": r_start,
-                    "end_ns": r_end,
-                    # the robot's recorder stores each pose 2 ms after the robot stamped it
-                    "header_minus_record_s": (offset - 2_000_000) / NS
-                    if slot.benchmark == "fbm2h"
-                    else None,
+            entry: dict[str, Any] = {
+                "path": robot_rel,
+                "team": slot.team,
+                "benchmark": slot.benchmark,
+                "execution": slot.id,
+                "start_ns": r_start,
+                "end_ns": r_end,
+                "gt_files": gt_over(r_start, r_end),
+                # the robot's recorder stores each pose 2 ms after the robot stamped it
+                "header_minus_record_s": None if poses is None else (offset - 2_000_000) / NS,
+                "trajectory": None,
+            }
+            if poses is not None:
+                score, tolerance = expected_trajectory(
+                    poses, offset, fbm2h_gt, [gt_windows[g] for g in entry["gt_files"]]
+                )
+                entry["trajectory"] = {
+                    "robot_topic": f"/rockin/{slot.team}/marker_pose",
+                    "gt_topic": pose_topic(fbm2h.NAMESPACE, fbm2h.BODY),
+                    "offset_s": -offset / NS,
+                    "score": score,
+                    "tolerance": tolerance,
                 }
-            )
-        gt = [
-            w.rel if w.rel in gt_spans else str(active.relative_to(outdir))
-            for w in windows
-            if w.start_ns <= span[1] and span[0] < w.end_ns
-        ]
+            robot_logs.append(entry)
+        gt = gt_over(*span)
         executions.append(
             _execution_answer(
                 slot, sim, seeds[SCHEDULE.index(slot)], rel, span, gt, robot_rel, configs
@@ -290,7 +220,8 @@ def generate_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path
     written.append(outdir / copy_rel)
     test_rel = _robot_name("fbm2h", TEST_DRIVE_NS, "homer")
     test_end = TEST_DRIVE_NS + 110 * NS
-    write_robot_log(outdir / test_rel, None, "homer", TEST_DRIVE_NS, test_end, 0, rlog_rng)
+    test_poses = robot_poses(None, TEST_DRIVE_NS, test_end, rlog_rng)
+    write_robot_log(outdir / test_rel, "homer", TEST_DRIVE_NS, test_end, test_poses, 0)
     written.append(outdir / test_rel)
     robot_logs.append(
         {
@@ -300,7 +231,9 @@ def generate_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path
             "execution": None,
             "start_ns": TEST_DRIVE_NS,
             "end_ns": test_end,
+            "gt_files": gt_over(TEST_DRIVE_NS, test_end),
             "header_minus_record_s": -0.002,
+            "trajectory": None,  # no GT at all
         }
     )
 
@@ -322,19 +255,24 @@ def generate_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path
         "problems": [
             {"path": trunc, "kind": "truncated", "execution": TRUNCATED},
             {"path": str(active.relative_to(outdir)), "kind": "active"},
-            {"path": copy_rel, "kind": "copy", "of": copied},
+            {"path": copy_rel, "kind": "duplicate", "of": copied},
             {
                 "path": next(r for r in robot_logs if r["execution"] == CLOCK_OFF)["path"],
-                "kind": "clock",
+                "kind": "clock-offset",
                 "offset_s": CLOCK_OFF_S,
             },
             {"path": test_rel, "kind": "unpaired"},
             {
                 "path": f"configs/fbm2h/transforms/transform-{MISSING_TRANSFORM}.yaml",
-                "kind": "missing_transform",
+                "kind": "missing-input",
+                "input": "transform",
                 "team": MISSING_TRANSFORM,
             },
-            {"path": None, "kind": "no_robot_log", "execution": NO_ROBOT_LOG},
+            {
+                "path": next(e for e in executions if e["id"] == NO_ROBOT_LOG)["bmbox_log"],
+                "kind": "no-team",
+                "execution": NO_ROBOT_LOG,
+            },
         ],
     }
     out = outdir / "answers.json"

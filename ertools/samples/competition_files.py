@@ -115,20 +115,22 @@ def write_benchmark_log(path: Path, sim: SimulatedRun, *, chunk_size: int) -> tu
     return sim.start_ns, last
 
 
+RobotPoses = tuple[I64, npt.NDArray[np.float64], npt.NDArray[np.float64]]
+
+
 def write_robot_log(
     path: Path,
-    sim: SimulatedRun | None,
     team: str,
     start_ns: int,
     end_ns: int,
+    poses: RobotPoses | None,
     header_offset_ns: int,
-    rng: np.random.Generator,
 ) -> tuple[int, int]:
-    """A team's own log (rockin_logger): a 1 Hz status line and, in FBM2H, the robot's 10 Hz
-    estimate of its marker set's pose (truth + a bias + noise).
+    """A team's own log (rockin_logger): a 1 Hz status line and ``poses`` (true times, xyz,
+    quaternions: the robot's estimate of its marker set's pose, see :func:`robot_poses`).
 
-    Record times are the logging laptop's (synchronised); header stamps are the robot PC's,
-    ``header_offset_ns`` ahead. ``sim`` None: a test drive (a slow circle, no benchmark).
+    Record times are the logging laptop's (synchronised), 2 ms after the true time; header
+    stamps are the robot PC's, ``header_offset_ns`` ahead of the true time.
     """
     path.parent.mkdir(parents=True, exist_ok=True)
     caller = f"/rockin/{team}/logger"
@@ -142,9 +144,8 @@ def write_robot_log(
             ["running"] * len(t_status),
             callerid=caller,
         )
-        pose = _robot_poses(sim, start_ns, end_ns, rng)
-        if pose is not None:
-            t, xyz, quat = pose
+        if poses is not None:
+            t, xyz, quat = poses
             bag.write_pose_stamped(
                 f"/rockin/{team}/marker_pose",
                 t + 2_000_000,
@@ -157,10 +158,18 @@ def write_robot_log(
     return start_ns, end_ns
 
 
-def _robot_poses(
+def robot_poses(
     sim: SimulatedRun | None, start_ns: int, end_ns: int, rng: np.random.Generator
-) -> tuple[I64, npt.NDArray[np.float64], npt.NDArray[np.float64]] | None:
-    if sim is None:  # a test drive: a 1 m circle at 0.2 m/s
+) -> RobotPoses | None:
+    """The robot's 10 Hz estimate of its marker set's pose: (true times, xyz, quaternions).
+
+    FBM2H: the marker set's truth at every 12th fresh mocap frame, from 1 s after the mocap
+    starts to 1 s before it ends (so every pose has GT on both sides), plus a constant bias
+    (N(0, 1 cm) per axis) and white noise (:data:`ROBOT_NOISE_M`); the orientation is the
+    truth's. ``sim`` None: a test drive (a 1 m circle at 0.2 rad/s). Other benchmarks: None
+    (the robot logged no pose).
+    """
+    if sim is None:
         t = np.arange(start_ns + NS, end_ns - NS, ROBOT_RATE_NS, dtype=np.int64)
         s = (t - start_ns) / NS
         w = 0.2
@@ -170,7 +179,8 @@ def _robot_poses(
     if sim.benchmark != "fbm2h":
         return None
     (pub,) = sim.bodies.values()
-    fresh = np.flatnonzero(~pub.repeated)
+    inner = (pub.t_frame_ns >= pub.t_frame_ns[0] + NS) & (pub.t_frame_ns <= pub.t_frame_ns[-1] - NS)
+    fresh = np.flatnonzero(~pub.repeated & inner)
     keep = fresh[:: round(ROBOT_RATE_NS / 8_333_333)]  # every 12th mocap frame: 10 Hz
     bias = rng.normal(0.0, 0.01, size=3)
     xyz = pub.truth_xyz[keep] + bias + rng.normal(0.0, ROBOT_NOISE_M, size=(keep.size, 3))

@@ -8,12 +8,19 @@ tolerances: the measurement noise between the truth and what the GT logger recor
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
+import numpy as np
+import numpy.typing as npt
+
+from ertools.geometry import yaw_from_quat
+from ertools.samples.mocap import MocapPublished
+from ertools.samples.robotlog import expected_scores
 from ertools.samples.simulated import SimulatedRun
 
 Fields = dict[str, Any]
+MAX_GAP_NS = 100_000_000  # the trajectory scorer's default --max-gap
 
 
 def _tol(abs_: float, why: str) -> dict[str, Any]:
@@ -119,3 +126,40 @@ def _fbm3w(exp: Mapping[str, Any], tolerance: Mapping[str, Any]) -> tuple[Fields
             timing,
         )
     return score, tol
+
+
+def expected_trajectory(
+    poses: tuple[npt.NDArray[np.int64], npt.NDArray[np.float64], npt.NDArray[np.float64]],
+    header_offset_ns: int,
+    gt: Sequence[MocapPublished],
+    windows: Sequence[tuple[int, int]],
+) -> tuple[Fields, dict[str, dict[str, Any]]]:
+    """What ``ertools score trajectory ROBOT GT... --offset <-header_offset>`` must report for a
+    robot log: the plain per-pose loop of the ``robotlog`` scenario
+    (:func:`ertools.samples.robotlog.expected_scores`, linear association, 0.1 s max gap) over
+    the GT messages the GT files hold (every pub's messages recorded inside ``windows``, the
+    files' [start, end) record-time windows: other teams' runs in the same hour included)."""
+    t, xyz, quat = poses
+    parts = [
+        (p, np.any([(p.t_record_ns >= a) & (p.t_record_ns < b) for a, b in windows], axis=0))
+        for p in gt
+    ]
+    gt_t = np.concatenate([p.t_header_ns[m] for p, m in parts])
+    order = np.argsort(gt_t, kind="stable")
+    gt_xyz = np.concatenate([p.xyz[m] for p, m in parts])[order]
+    gt_q = np.concatenate([p.quat_xyzw[m] for p, m in parts])[order]
+    stamps = t + header_offset_ns
+    found = expected_scores(
+        stamps.tolist(),
+        xyz.tolist(),
+        yaw_from_quat(quat).tolist(),
+        gt_t[order].tolist(),
+        gt_xyz.tolist(),
+        gt_q.tolist(),
+        "linear",
+        -header_offset_ns,
+        MAX_GAP_NS,
+    )
+    exact = _tol(0, "counts are exact")
+    same = _tol(1e-9, "the same arrays as the bags; only summation order and SLERP form differ")
+    return found, {k: exact if isinstance(v, int) else same for k, v in found.items()}

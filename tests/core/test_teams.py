@@ -213,4 +213,4 @@ def test_fbm2h_team_alone_keeps_the_identity_transform(
     capsys.readouterr()
     code = main(["score", "fbm2h", str(bag), "--transforms", str(folder)])
     err = capsys.readouterr().err.strip().splitlines()
-    assert code == 1 and len(err) == 1 and "--transforms DIR needs --team NAME" in err[0]
+    assert code == 2 and len(err) == 1 and "--transforms DIR needs --team NAME" in err[0]

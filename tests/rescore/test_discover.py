@@ -15,8 +15,9 @@ import pytest
 from timeline.summaries import Summary, Topic
 
 from ertools.rescore.discover import Discovery, discover
-from ertools.samples.competition import NO_ROBOT_LOG, TRUNCATED, generate_competition
-from ertools.timeline import Unreadable, build_timeline
+from ertools.samples.competition import generate_competition
+from ertools.samples.competition_schedule import NO_ROBOT_LOG, TRUNCATED
+from ertools.timeline.build import Unreadable, build_timeline
 
 S = 1_000_000_000
 T0 = 1_448_013_600 * S  # 2015-11-20 10:00:00 UTC
@@ -27,7 +28,7 @@ T0 = 1_448_013_600 * S  # 2015-11-20 10:00:00 UTC
 
 @pytest.fixture(scope="module")
 def day(tmp_path_factory: pytest.TempPathFactory) -> tuple[Discovery, dict[str, Any]]:
-    from ertools.timeline_scan import scan
+    from ertools.timeline.scan import scan
 
     root = tmp_path_factory.mktemp("competition") / "day"
     generate_competition(root)
@@ -80,25 +81,26 @@ def test_planted_problems_are_found(day: tuple[Discovery, dict[str, Any]]) -> No
     kinds = {(p.path, p.kind) for p in found.problems}
     want = {p["kind"]: p for p in answers["problems"]}
     assert (want["truncated"]["path"], "truncated") in kinds
-    assert (want["active"]["path"], "unindexed") in kinds
-    assert (want["copy"]["path"], "copy") in kinds
-    assert (want["clock"]["path"], "clock") in kinds
+    assert (want["active"]["path"], "active") in kinds
+    assert (want["duplicate"]["path"], "duplicate") in kinds
+    assert (want["clock-offset"]["path"], "clock-offset") in kinds
     assert (want["unpaired"]["path"], "unpaired") in kinds
+    assert (want["no-team"]["path"], "no-team") in kinds
     (no_robot,) = [e for e in answers["executions"] if e["id"] == NO_ROBOT_LOG]
-    assert (no_robot["bmbox_log"], "no team") in kinds
+    assert want["no-team"]["path"] == no_robot["bmbox_log"]
     # nothing else is wrong with the day: one problem line per planted problem (the truncated
     # log has two lines, index and last record), no GT or pairing problems
     assert {k for _, k in kinds} == {
         "truncated",
-        "unindexed",
-        "copy",
-        "clock",
+        "active",
+        "duplicate",
+        "clock-offset",
         "unpaired",
-        "no team",
+        "no-team",
     }
     # the clock line gives the offset the answers know (header - record = 3.998 s)
-    (clock,) = [p for p in found.problems if p.kind == "clock"]
-    assert f"{-want['clock']['offset_s'] + 0.002:+.3f} s" in clock.message
+    (clock,) = [p for p in found.problems if p.kind == "clock-offset"]
+    assert f"{-want['clock-offset']['offset_s'] + 0.002:+.3f} s" in clock.message
     # execution-level lines carry their files' problems
     (trunc,) = [e for e in found.executions if e.id == TRUNCATED]
     assert any("truncated" in p for p in trunc.problems)
@@ -141,7 +143,10 @@ def test_each_robot_log_goes_to_the_execution_it_overlaps_most() -> None:
         ("alpha", "r/FBM2H_201511201000_alpha.bag"),
         ("beta", "r/FBM2H_201511201000_beta.bag"),
     ]
-    assert [e.id for e in found.executions] == ["fbm2h-alpha-100010", "fbm2h-beta-100105"]
+    assert [e.id for e in found.executions] == [
+        "fbm2h-alpha-20151120T100010",
+        "fbm2h-beta-20151120T100105",
+    ]
     assert found.problems == ()
 
 
@@ -196,9 +201,9 @@ def test_gt_coverage_and_missing_gt() -> None:
     assert any("GT covers 60.0 %" in p for p in first.problems)
     assert second.gt_files == ()
     kinds = [(p.path, p.kind) for p in found.problems]
-    assert ("bm/log_fbm2h_2015-11-20-10-00-10_0.bag", "partial gt") in kinds
-    assert ("bm/log_fbm2h_2015-11-20-10-05-00_0.bag", "no gt") in kinds
-    assert sum(k == "no team" for _, k in kinds) == 2
+    assert ("bm/log_fbm2h_2015-11-20-10-00-10_0.bag", "partial-gt") in kinds
+    assert ("bm/log_fbm2h_2015-11-20-10-05-00_0.bag", "no-gt") in kinds
+    assert sum(k == "no-team" for _, k in kinds) == 2
 
 
 def test_copies_and_lost_benchmark_logs() -> None:
@@ -211,7 +216,7 @@ def test_copies_and_lost_benchmark_logs() -> None:
     found = discover(tl)
     # the first by path is the original (the timeline decides); the copy is no execution
     assert [e.bmbox_log for e in found.executions] == [log.path]
-    by_kind = {p.kind: p for p in found.problems if p.kind in ("copy", "unreadable")}
-    assert by_kind["copy"].path == copy.path
+    by_kind = {p.kind: p for p in found.problems if p.kind in ("duplicate", "unreadable")}
+    assert by_kind["duplicate"].path == copy.path
     lost = [p for p in found.problems if "execution is missing" in p.message]
     assert len(lost) == 1 and "fbm3w execution started 2015-11-20 11:37:15" in lost[0].message

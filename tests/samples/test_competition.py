@@ -22,12 +22,8 @@ from typing import Any
 
 import pytest
 
-from ertools.samples.competition import (
-    MISSING_TRANSFORM,
-    SCHEDULE,
-    TRUNCATED,
-    generate_competition,
-)
+from ertools.samples.competition import generate_competition
+from ertools.samples.competition_schedule import MISSING_TRANSFORM, SCHEDULE, TRUNCATED
 
 SEED = 2015_11_20
 UNSCOREABLE = sorted(
@@ -92,7 +88,7 @@ def test_every_named_file_exists_and_every_file_is_named(
     competition: Path, answers: dict[str, Any]
 ) -> None:
     named: set[str] = {"answers.json"}
-    missing_transform = [p for p in answers["problems"] if p["kind"] == "missing_transform"]
+    missing_transform = [p for p in answers["problems"] if p["kind"] == "missing-input"]
     absent = {p["path"] for p in missing_transform}
     assert len(absent) == 1
     for e in answers["executions"]:
@@ -179,11 +175,12 @@ def test_each_scored_execution_scores_as_its_answers(
 
 def test_unscoreable_executions(competition: Path, answers: dict[str, Any]) -> None:
     bad = {e["id"]: e for e in answers["executions"] if e["status"] != "scored"}
-    assert sorted(bad) == UNSCOREABLE == ["fbm2h-skuba-111450", "fbm3w-b-it-bots-113715"]
-    skuba = bad["fbm2h-skuba-111450"]
+    skuba_id, trunc_id = "fbm2h-skuba-20151120T111450", "fbm3w-b-it-bots-20151120T113715"
+    assert sorted(bad) == UNSCOREABLE == [skuba_id, trunc_id]
+    skuba = bad[skuba_id]
     assert "transform" in skuba["reason"]
     assert not (competition / skuba["inputs"]["transform"]).exists()
-    trunc = bad["fbm3w-b-it-bots-113715"]
+    trunc = bad[trunc_id]
     assert trunc["truncated"] and "truncated" in trunc["reason"]
     # cut at 60 %: shorter than any complete FBM3W benchmark log of the day
     whole = [
@@ -196,7 +193,7 @@ def test_unscoreable_executions(competition: Path, answers: dict[str, Any]) -> N
 
 
 def test_robot_logs_and_problems(competition: Path, answers: dict[str, Any]) -> None:
-    from ertools.teams import parse_robot_log_name
+    from ertools.benchmarks.common.teams import parse_robot_log_name
 
     for r in answers["robot_logs"]:
         parsed = parse_robot_log_name(r["path"])
@@ -206,14 +203,38 @@ def test_robot_logs_and_problems(competition: Path, answers: dict[str, Any]) -> 
     assert kinds == {
         "truncated",
         "active",
-        "copy",
-        "clock",
+        "duplicate",
+        "clock-offset",
         "unpaired",
-        "missing_transform",
-        "no_robot_log",
+        "missing-input",
+        "no-team",
     }
     ((copy, original),) = answers["copies"].items()
     assert (competition / copy).read_bytes() == (competition / original).read_bytes()
-    (clock,) = [p for p in answers["problems"] if p["kind"] == "clock"]
+    (clock,) = [p for p in answers["problems"] if p["kind"] == "clock-offset"]
     (robot,) = [r for r in answers["robot_logs"] if r["path"] == clock["path"]]
     assert robot["header_minus_record_s"] == pytest.approx(clock["offset_s"] - 0.002)
+
+
+@pytest.mark.parametrize("slot", [s.id for s in SCHEDULE if s.benchmark == "fbm2h"])
+def test_each_fbm2h_robot_log_scores_as_its_answers(
+    competition: Path, answers: dict[str, Any], slot: str
+) -> None:
+    # The robots' marker pose estimates against the GT hour files (ertools score trajectory,
+    # the robot's clock offset applied): the answers are the robotlog scenario's plain loop
+    # over the same arrays, so counts are exact and errors agree to float rounding.
+    from ertools.cli.main import main
+
+    (r,) = [x for x in answers["robot_logs"] if x["execution"] == slot]
+    traj = r["trajectory"]
+    args = ["score", "trajectory", str(competition / r["path"])]
+    args += [str(competition / g) for g in r["gt_files"]]
+    args += ["--robot-topic", traj["robot_topic"], "--gt-topic", traj["gt_topic"]]
+    args += ["--offset", repr(traj["offset_s"]), "--format", "json"]
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+        assert main(args) == 0
+    result = json.loads(out.getvalue())
+    assert traj["score"]["compared"] > 400
+    for field, want in traj["score"].items():
+        assert abs(result[field] - want) <= traj["tolerance"][field]["abs"], (slot, field)

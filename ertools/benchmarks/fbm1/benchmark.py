@@ -47,6 +47,7 @@ from ertools.benchmarks.fbm1.score import (
     totals,
 )
 from ertools.configs.items import Item, ItemList
+from ertools.io.model import BenchmarkStates
 from ertools.errors import ConfigError, ScoringError, SegmentationError, TopicError
 from ertools.fidelity import Deviation, Rule
 from ertools.progress import Reporter, current
@@ -141,6 +142,14 @@ RULE_ABORTED = Rule(
 
 
 @dataclass(frozen=True)
+class BodySources:
+    """Where the table and board poses come from (the 2015 topics when None)."""
+
+    origin: PoseSource | None = None
+    board: PoseSource | None = None
+
+
+@dataclass(frozen=True)
 class Fbm1Options:
     """Everything that changes an FBM1 score besides the inputs.
 
@@ -150,12 +159,20 @@ class Fbm1Options:
         rules: which node behaviours to reproduce (see :class:`ScoreRules`).
         moved_warn_m: warn when the board moved more than this (metres, table plane) between
             the goal and the result, i.e. while the robot was looking.
+        items: the item list (Listing 9); required to score a log.
+        results: answers kept outside the log (replaces the Client payloads it covers).
+        items_order: item ids or instances per run (overrides the payloads).
+        sources: origin/board pose sources (the 2015 topics, else their /tf frames).
     """
 
     benchmark: str = "fbm1h"
     gt: GtOptions = field(default_factory=GtOptions)
     rules: ScoreRules = field(default_factory=ScoreRules)
     moved_warn_m: float = 0.01
+    items: Path | None = None
+    results: Path | None = None
+    items_order: tuple[str, ...] | None = None
+    sources: BodySources = BodySources()
 
     @staticmethod
     def for_rules(benchmark: str, rules: str, gt: GtOptions | None = None) -> Fbm1Options:
@@ -547,14 +564,6 @@ def _parse_logged(payload: str | None) -> dict[str, Any] | None:
     return data if isinstance(data, dict) else None
 
 
-@dataclass(frozen=True)
-class BodySources:
-    """Where the table and board poses come from (the 2015 topics when None)."""
-
-    origin: PoseSource | None = None
-    board: PoseSource | None = None
-
-
 def read_body(
     paths: Sequence[Path],
     source: PoseSource | None,
@@ -585,6 +594,142 @@ def read_body(
         return stream
 
 
+@dataclass(frozen=True, eq=False)
+class Fbm1Logs:
+    """What :func:`load` read: the log files, the item list, the answers file (if any), the
+    benchmark state streams and the log's first message time."""
+
+    paths: tuple[Path, ...]
+    items: ItemList
+    results: ResultsFile | None
+    states: BenchmarkStates
+    t0_ns: int
+
+
+@dataclass(frozen=True, eq=False)
+class Fbm1Runs:
+    """What :func:`locate_runs` found: the runs, and the table and board poses around them
+    (read only there), with the node's item broadcasts when the ground truth needs them."""
+
+    found: RunsFound
+    origin: PoseStream
+    board: PoseStream
+    item_tf: PoseStream | None
+
+
+def load(paths: Sequence[Path], options: Fbm1Options) -> Fbm1Logs:
+    """Read the item list, the answers file and the state topics.
+
+    Raises:
+        ConfigError: no item list, a bad item list or results file.
+        SegmentationError: no BmBox state messages.
+    """
+    from ertools.configs._yaml import load_yaml
+    from ertools.configs.items import load_items
+    from ertools.io import read_benchmark_states, summary
+
+    plist = tuple(Path(p) for p in paths)
+    ns = options.benchmark
+    if options.items is None:
+        raise ConfigError(f"scoring {ns} needs the item list: give --items FILE")
+    items = load_items(options.items)
+    results = None
+    if options.results is not None:
+        results = parse_results(load_yaml(options.results, "results"), str(options.results))
+    states = read_benchmark_states(list(plist), ns)
+    if states.bmbox is None or len(states.bmbox) == 0:
+        raise SegmentationError(
+            f"no /{ns}/bmbox_state messages: the runs cannot be found "
+            f"(is this an {ns} log? `ertools info` lists its topics)",
+            path=plist[0],
+        )
+    t0 = min(summary(p).start_ns for p in plist)
+    return Fbm1Logs(plist, items, results, states, t0)
+
+
+def locate_runs(logs: Fbm1Logs, options: Fbm1Options) -> Fbm1Runs:
+    """The runs from the states, then the table and board poses around them.
+
+    Raises:
+        SegmentationError: no Client states and no results file (the answers are unknown).
+        TopicError: a body's poses are nowhere.
+        ClockError: header-stamped poses on another clock than the state messages.
+    """
+    ns = options.benchmark
+    plist = list(logs.paths)
+    states = logs.states
+    assert states.bmbox is not None
+    found = find_runs(
+        states.bmbox,
+        states.refbox,
+        states.client,
+        benchmark=ns,
+        items_order=list(options.items_order) if options.items_order is not None else None,
+    )
+    if states.client is None and logs.results is None:
+        # Scoring every run as unanswered would be a silent wrong score.
+        raise SegmentationError(
+            f"no /{ns}/client_state in the log: the robot's answers are unknown; "
+            "give them with --results FILE",
+            path=plist[0],
+        )
+    # Read the bodies only around the runs (windowed reads touch only those chunks).
+    pad = round((options.gt.max_window_s + options.gt.max_gap_s + 2.0) * NS_PER_S)
+    lo = min(r.start_ns for r in found.runs) - pad
+    hi = max(r.end_ns for r in found.runs) + pad
+    src = options.sources
+    origin = read_body(plist, src.origin, f"/{ns}/origin/pose", "origin", (lo, hi))
+    board = read_body(plist, src.board, f"/{ns}/ref_board/pose", "ref_board", (lo, hi))
+    from ertools.benchmarks.common.clocks import check_header_clock
+
+    for body, source in ((origin, src.origin), (board, src.board)):
+        if source is None or source.time_source == "header":
+            check_header_clock(plist, body, "state messages")
+    item_tf = None
+    if options.gt.method != "window":
+        from ertools.io import read_tf
+
+        try:
+            item_tf = read_tf(plist, "ref_board", "item", start_ns=lo, end_ns=hi)
+        except TopicError:
+            item_tf = None  # not logged: the state messages give the moments
+    return Fbm1Runs(found, origin, board, item_tf)
+
+
+def score_found(logs: Fbm1Logs, runs: Fbm1Runs, options: Fbm1Options) -> Fbm1Result:
+    """Score every run found (:func:`score_fbm1`), with the provenance of the inputs."""
+    gt = options.gt
+    provenance = Provenance(
+        inputs=tuple(str(p) for p in logs.paths)
+        + (str(options.items),)
+        + ((str(options.results),) if options.results is not None else ()),
+        parameters=(
+            ("benchmark", options.benchmark),
+            ("origin", runs.origin.source),
+            ("ref_board", runs.board.source),
+            ("gt_method", gt.method),
+            ("max_window_s", f"{gt.max_window_s:g}"),
+            ("still_m", f"{gt.still_m:g}"),
+            ("still_deg", f"{gt.still_deg:g}"),
+            ("max_gap_s", f"{gt.max_gap_s:g}"),
+            ("reference", options.reference),
+            ("node_rules", ",".join(k for k, v in vars(options.rules).items() if v) or "none"),
+        ),
+    )
+    return score_fbm1(
+        runs.origin,
+        runs.board,
+        runs.found,
+        logs.items,
+        options,
+        results=logs.results,
+        t0_ns=logs.t0_ns,
+        provenance=provenance,
+        item_tf=runs.item_tf,
+        progress=current(),
+    )
+
+
 def score_fbm1_bag(
     paths: Sequence[str | Path],
     items_path: str | Path,
@@ -594,7 +739,8 @@ def score_fbm1_bag(
     items_order: Sequence[str] | None = None,
     sources: BodySources | None = None,
 ) -> Fbm1Result:
-    """Recompute an FBM1 score from a log (one bag or a split log's files).
+    """Recompute an FBM1 score from a log (one bag or a split log's files): load -> locate
+    the runs -> score them.
 
     Args:
         paths: the log file(s).
@@ -610,82 +756,15 @@ def score_fbm1_bag(
         ConfigError: bad item list or results file.
         SegmentationError: no run in the log.
     """
-    from ertools.configs._yaml import load_yaml
-    from ertools.configs.items import load_items
-    from ertools.io import read_benchmark_states, summary
+    from dataclasses import replace
 
-    opts = options or Fbm1Options()
+    opts = replace(
+        options or Fbm1Options(),
+        items=Path(items_path),
+        results=None if results_path is None else Path(results_path),
+        items_order=None if items_order is None else tuple(items_order),
+        sources=sources or BodySources(),
+    )
     plist = [Path(p) for p in paths]
-    ns = opts.benchmark
-    items = load_items(items_path)
-    results = None
-    if results_path is not None:
-        results = parse_results(load_yaml(results_path, "results"), str(results_path))
-    states = read_benchmark_states(plist, ns)
-    if states.bmbox is None or len(states.bmbox) == 0:
-        raise SegmentationError(
-            f"no /{ns}/bmbox_state messages: the runs cannot be found "
-            f"(is this an {ns} log? `ertools info` lists its topics)",
-            path=plist[0],
-        )
-    found = find_runs(
-        states.bmbox, states.refbox, states.client, benchmark=ns, items_order=items_order
-    )
-    if states.client is None and results is None:
-        # Scoring every run as unanswered would be a silent wrong score.
-        raise SegmentationError(
-            f"no /{ns}/client_state in the log: the robot's answers are unknown; "
-            "give them with --results FILE",
-            path=plist[0],
-        )
-    t0 = min(summary(p).start_ns for p in plist)
-    # Read the bodies only around the runs (windowed reads touch only those chunks).
-    pad = round((opts.gt.max_window_s + opts.gt.max_gap_s + 2.0) * NS_PER_S)
-    lo = min(r.start_ns for r in found.runs) - pad
-    hi = max(r.end_ns for r in found.runs) + pad
-    src = sources or BodySources()
-    origin = read_body(plist, src.origin, f"/{ns}/origin/pose", "origin", (lo, hi))
-    board = read_body(plist, src.board, f"/{ns}/ref_board/pose", "ref_board", (lo, hi))
-    from ertools.benchmarks.common.clocks import check_header_clock
-
-    for body, source in ((origin, src.origin), (board, src.board)):
-        if source is None or source.time_source == "header":
-            check_header_clock(plist, body, "state messages")
-    item_tf = None
-    if opts.gt.method != "window":
-        from ertools.io import read_tf
-
-        try:
-            item_tf = read_tf(plist, "ref_board", "item", start_ns=lo, end_ns=hi)
-        except TopicError:
-            item_tf = None  # not logged: the state messages give the moments
-    gt = opts.gt
-    provenance = Provenance(
-        inputs=tuple(str(p) for p in plist)
-        + (str(items_path),)
-        + ((str(results_path),) if results_path is not None else ()),
-        parameters=(
-            ("benchmark", ns),
-            ("origin", origin.source),
-            ("ref_board", board.source),
-            ("gt_method", gt.method),
-            ("max_window_s", f"{gt.max_window_s:g}"),
-            ("still_m", f"{gt.still_m:g}"),
-            ("still_deg", f"{gt.still_deg:g}"),
-            ("max_gap_s", f"{gt.max_gap_s:g}"),
-            ("reference", opts.reference),
-            ("node_rules", ",".join(k for k, v in vars(opts.rules).items() if v) or "none"),
-        ),
-    )
-    return score_fbm1(
-        origin,
-        board,
-        found,
-        items,
-        opts,
-        results=results,
-        t0_ns=t0,
-        provenance=provenance,
-        item_tf=item_tf,
-        progress=current(),
-    )
+    logs = load(plist, opts)
+    return score_found(logs, locate_runs(logs, opts), opts)

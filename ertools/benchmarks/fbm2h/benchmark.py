@@ -33,6 +33,7 @@ from ertools.benchmarks.fbm2h.score import robot_poses_at, segment_errors
 from ertools.benchmarks.fbm2h.segments import ReachedMoments, StopParams
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
+from ertools.io.model import BenchmarkStates
 from ertools.errors import ConfigError, ScoringError, SegmentationError
 from ertools.fidelity import Deviation, Rule
 from ertools.streams import PoseStream, Provenance, frame_change_warning
@@ -485,50 +486,102 @@ def _compare_goal(goal: GoalList, payload: str, topic: str) -> str | None:
     return None
 
 
-def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
-    """Read the bags and configs, find the reached moments and score them."""
-    from ertools.benchmarks.fbm2h import segments as seg
-    from ertools.configs.goal import goal_from_payload, load_goal
+@dataclass(frozen=True, eq=False)
+class Fbm2hLogs:
+    """What :func:`load` read: the bags, the transform, the goal list given (if any), the
+    marker set poses (invalid ones dropped), the log's span and, when the reached moments
+    come from them, the state streams."""
+
+    paths: tuple[Path, ...]
+    transform: MarkerTransform
+    goal: GoalList | None
+    marker: PoseStream
+    bag_start_ns: int
+    bag_end_ns: int
+    warnings: tuple[str, ...]
+    states: BenchmarkStates | None = None
+
+
+@dataclass(frozen=True)
+class Fbm2hRuns:
+    """What :func:`locate_runs` found: the reached moments, the goal list they close (given,
+    or the one the BmBox sent), the waypoints not reached and why, and warnings."""
+
+    moments: ReachedMoments
+    goal: GoalList
+    unreached: tuple[str, ...]
+    warnings: tuple[str, ...]
+
+
+def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
+    """Read the configs, the marker set poses and, for ``--reached states``, the states.
+
+    Raises:
+        ConfigError, SegmentationError, ScoringError: no bag, bad configs, no poses, no
+            state topics when the reached moments need them.
+    """
+    from ertools.benchmarks.trajectory.benchmark import drop_invalid
+    from ertools.configs.goal import load_goal
     from ertools.io import read_benchmark_states, read_pose_source, summary
 
     if not paths:
         raise ConfigError("no bag given")
-    if options.max_gap_s <= 0:
-        raise ConfigError(f"--max-gap must be > 0 s, got {options.max_gap_s}")
+    plist = tuple(Path(p) for p in paths)
     transform = _load_transform(options)
     goal = load_goal(options.goal) if options.goal is not None else None
-    marker = read_pose_source(list(paths), _pose_source(options))
+    marker = read_pose_source(list(plist), _pose_source(options))
     if len(marker) == 0:
-        raise SegmentationError(f"{marker.source or paths[0]}: the marker set pose stream is empty")
-    from ertools.benchmarks.trajectory.benchmark import drop_invalid
-
+        raise SegmentationError(f"{marker.source or plist[0]}: the marker set pose stream is empty")
     total = len(marker)
     marker, invalid = drop_invalid(marker)
     if len(marker) == 0:
         raise ScoringError(
-            f"{marker.source or paths[0]}: all {total} marker set poses are NaN or have a zero "
+            f"{marker.source or plist[0]}: all {total} marker set poses are NaN or have a zero "
             "quaternion: nothing to score (was the body tracked?)"
         )
-    infos = [summary(p) for p in paths]
-    bag_start, bag_end = min(i.start_ns for i in infos), max(i.end_ns for i in infos)
-    warnings: list[str] = [invalid_warning(invalid, marker.source)] if invalid else []
-    unreached: tuple[str, ...] = ()
-    reached = options.reached
+    infos = [summary(p) for p in plist]
     states = None
-    if reached in (None, "states"):
-        states = read_benchmark_states(list(paths), options.namespace)
+    if options.reached in (None, "states"):
+        states = read_benchmark_states(list(plist), options.namespace)
         if states.bmbox is None:
-            if reached == "states":
+            if options.reached == "states":
                 raise SegmentationError(
-                    f"{paths[0]}: no /{options.namespace}/bmbox_state topic; "
+                    f"{plist[0]}: no /{options.namespace}/bmbox_state topic; "
                     "use --reached timing FILE or --reached auto"
                 )
             raise SegmentationError(
-                f"{paths[0]}: no benchmark state topics to find the reached moments; "
+                f"{plist[0]}: no benchmark state topics to find the reached moments; "
                 "use --reached timing FILE (a reached-waypoint timing file) or --reached auto"
             )
-        reached = "states"
+    return Fbm2hLogs(
+        paths=plist,
+        transform=transform,
+        goal=goal,
+        marker=marker,
+        bag_start_ns=min(i.start_ns for i in infos),
+        bag_end_ns=max(i.end_ns for i in infos),
+        warnings=(invalid_warning(invalid, marker.source),) if invalid else (),
+        states=states,
+    )
+
+
+def locate_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
+    """The reached moments: from the states, a timing file or stops in the ground truth.
+
+    Raises:
+        ConfigError: a mode without the goal list or timing file it needs.
+        SegmentationError: moments that do not match the waypoints.
+        ClockError: header-stamped poses on another clock than the moments.
+    """
+    from ertools.benchmarks.fbm2h import segments as seg
+    from ertools.configs.goal import goal_from_payload
+
+    goal = logs.goal
+    warnings: list[str] = []
+    unreached: tuple[str, ...] = ()
+    reached = "states" if logs.states is not None else options.reached
     if reached == "states":
+        states = logs.states
         assert states is not None and states.bmbox is not None
         moments = seg.from_states(states.bmbox, states.client, states.refbox)
         if goal is None:
@@ -550,7 +603,7 @@ def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
         if goal is None:
             raise ConfigError("--reached timing needs --goal FILE (Listing 10)")
         timing = load_timing(options.timing)
-        t = timing.resolve(bag_start, bag_end)
+        t = timing.resolve(logs.bag_start_ns, logs.bag_end_ns)
         if len(t) - 1 != len(goal):
             raise SegmentationError(
                 f"{options.timing}: {len(t)} moments close {len(t) - 1} segments, but "
@@ -562,53 +615,64 @@ def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
             raise ConfigError("--reached auto needs --goal FILE (Listing 10)")
         from ertools.geometry import compose, yaw_from_quat
 
-        rt, rq = transform.arrays()
+        marker = logs.marker
+        rt, rq = logs.transform.arrays()
         pt, pq = compose(
             marker.xyz,
             marker.quat_xyzw,
             np.broadcast_to(rt, marker.xyz.shape).copy(),
             np.broadcast_to(rq, marker.quat_xyzw.shape).copy(),
         )
-        moments, missing = seg.from_stops(
+        moments, unreached = seg.from_stops(
             marker.t_ns,
             pt[:, :2],
             yaw_from_quat(pq),
             goal.as_array()[:, :2],
             options.stops,
             s_to_ns(options.max_gap_s),
-            origin_ns=bag_start,
+            origin_ns=logs.bag_start_ns,
         )
-        unreached = missing
     else:
         raise ConfigError(f"--reached must be states, timing FILE or auto, not {reached!r}")
     if moments.method != "auto" and options.time_source == "header":
         from ertools.benchmarks.common.clocks import check_header_clock
 
         what = "state messages" if moments.method == "states" else "timing file's moments"
-        check_header_clock(paths, marker, what)
+        check_header_clock(list(logs.paths), logs.marker, what)
+    return Fbm2hRuns(moments, goal, tuple(unreached), tuple(warnings))
+
+
+def score_found(logs: Fbm2hLogs, runs: Fbm2hRuns, options: Fbm2hOptions) -> Fbm2hResult:
+    """Score the reached moments (:func:`compute`), with the provenance of the inputs."""
     provenance = Provenance(
-        inputs=tuple(str(p) for p in paths)
+        inputs=tuple(str(p) for p in logs.paths)
         + tuple(str(p) for p in (options.goal, options.transform, options.timing) if p),
         parameters=(
-            ("reached", moments.method),
-            ("pose_source", marker.source),
+            ("reached", runs.moments.method),
+            ("pose_source", logs.marker.source),
             ("max_gap_s", str(options.max_gap_s)),
-            ("transform", transform.source),
+            ("transform", logs.transform.source),
             ("orientation_2015", str(options.orientation_2015)),
             ("unscored_segments", "2015" if options.unscored_2015 else "null"),
         ),
     )
     return compute(
-        goal,
-        transform,
-        marker,
-        moments,
+        runs.goal,
+        logs.transform,
+        logs.marker,
+        runs.moments,
         max_gap_s=options.max_gap_s,
         hits=options.hits,
         orientation_2015=options.orientation_2015,
         unscored_2015=options.unscored_2015,
-        unreached=unreached,
-        warnings=warnings,
+        unreached=runs.unreached,
+        warnings=[*logs.warnings, *runs.warnings],
         provenance=provenance,
-        origin_ns=bag_start,
+        origin_ns=logs.bag_start_ns,
     )
+
+
+def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
+    """Read the bags and configs, find the reached moments and score them."""
+    logs = load(paths, options)
+    return score_found(logs, locate_runs(logs, options), options)

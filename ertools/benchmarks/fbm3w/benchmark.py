@@ -39,6 +39,7 @@ from ertools.errors import ConfigError, ErtoolsError, ScoringError, TopicError
 from ertools.fidelity import Deviation, Rule
 from ertools.progress import Reporter, current
 from ertools.streams import PoseStream, Provenance, frame_change_warning
+from ertools.io.model import BenchmarkStates
 
 log = logging.getLogger("ertools.benchmarks.fbm3w.benchmark")
 
@@ -180,6 +181,10 @@ class Fbm3wOptions:
             run, as the 2015 node did).
         stopped_runs: ``counted`` (default: a run the RefBox stopped counts in
             execution_time) or ``2015`` (its time left out, as the 2015 node did).
+        config: runs_specifications, d_min and shapes (None: the 2015 values,
+            ``configs/fbm3w.yaml``); ``d_min`` above overrides its d_min.
+
+    The values are validated once, where they come in (:func:`ertools.benchmarks.fbm3w.declare.make_options`).
     """
 
     runs: str | None = None
@@ -195,6 +200,7 @@ class Fbm3wOptions:
     arc_length: bool = False
     timeout_runs: str = "unscored"
     stopped_runs: str = "counted"
+    config: Fbm3wConfig | None = None
 
 
 TIMEOUT_RUNS = ("unscored", "2015")
@@ -257,29 +263,33 @@ def read_fbm3w_poses(paths: Sequence[Path], options: Fbm3wOptions) -> PoseStream
     return poses
 
 
-def score_fbm3w(
-    paths: Sequence[Path], config: Fbm3wConfig, options: Fbm3wOptions = Fbm3wOptions()
-) -> Fbm3wResult:
-    """Score an FBM3@Work benchmark from its bag(s).
+@dataclass(frozen=True, eq=False)
+class Fbm3wLogs:
+    """What :func:`load` read: the bags, their end-effector poses, span and topics, the run
+    mode and, for ``states``, the benchmark state streams."""
+
+    paths: tuple[Path, ...]
+    poses: PoseStream
+    bag_start_ns: int
+    bag_end_ns: int
+    mode: str
+    states: BenchmarkStates | None = None
+
+
+def load(paths: Sequence[Path], options: Fbm3wOptions) -> Fbm3wLogs:
+    """Read the poses and, when the runs come from them, the state topics.
+
+    The run mode is settled here: explicit windows when given, else the BmBox states when the
+    log has them, else runs found from motion (``--runs auto``).
 
     Raises:
-        ErtoolsError: unreadable bags, no poses, no runs (a single run's problem is a failure
-            inside the result instead).
+        ErtoolsError: unreadable bags, no poses, no state topic for ``--runs states``.
     """
     from ertools.io import read_benchmark_states, summary, topics
 
-    plist = [Path(p) for p in paths]
-    if options.runs is not None and options.runs not in RUN_MODES:
-        raise ConfigError(f"--runs must be one of {', '.join(RUN_MODES)}, not {options.runs!r}")
-    if options.timeout_runs not in TIMEOUT_RUNS or options.stopped_runs not in STOPPED_RUNS:
-        raise ConfigError(
-            f"--timeout-runs must be one of {', '.join(TIMEOUT_RUNS)} and --stopped-runs one "
-            f"of {', '.join(STOPPED_RUNS)}"
-        )
+    plist = tuple(Path(p) for p in paths)
     poses = read_fbm3w_poses(plist, options)
     summaries = [summary(p) for p in plist]
-    bag_start = min(x.start_ns for x in summaries)
-    bag_end = max(x.end_ns for x in summaries)
     mode = options.runs
     if mode is None:
         if options.windows:
@@ -289,14 +299,35 @@ def score_fbm3w(
             mode = "states" if bmbox_topics & set(topics(plist)) else "auto"
             if mode == "auto":
                 log.info("no /fbm3w state topics: finding the runs from motion (--runs auto)")
+    states = read_benchmark_states(list(plist), NAMESPACE) if mode == "states" else None
+    return Fbm3wLogs(
+        paths=plist,
+        poses=poses,
+        bag_start_ns=min(x.start_ns for x in summaries),
+        bag_end_ns=max(x.end_ns for x in summaries),
+        mode=mode,
+        states=states,
+    )
+
+
+def locate_runs(logs: Fbm3wLogs, options: Fbm3wOptions) -> list[RunWindow]:
+    """The run windows: from explicit windows, the BmBox states or motion.
+
+    Raises:
+        ConfigError: ``--runs windows`` without windows.
+        SegmentationError: no run in the states.
+        ClockError: header-stamped poses on another clock than the state messages.
+    """
+    mode = logs.mode
     if mode == "windows":
         if not options.windows:
             raise ConfigError("--runs windows needs --run SPEC:REF_T:START_T:END_T or --runs-file")
-        windows = find_windows(options.windows, bag_start, bag_end)
+        windows = find_windows(options.windows, logs.bag_start_ns, logs.bag_end_ns)
     elif mode == "states":
-        windows = find_states(read_benchmark_states(plist, NAMESPACE))
+        assert logs.states is not None
+        windows = find_states(logs.states)
     else:
-        windows = find_auto(poses, config, **_still(options))
+        windows = find_auto(logs.poses, options.config or Fbm3wConfig(), **_still(options))
     if mode != "auto" and options.time_source == "header":
         # State messages and --run windows are timed by record time: header-stamped poses
         # from a mocap clock seconds off would be cut at other moments (a wrong score that
@@ -304,16 +335,36 @@ def score_fbm3w(
         from ertools.benchmarks.common.clocks import check_header_clock
 
         what = "state messages" if mode == "states" else "run windows (times from the log start)"
-        check_header_clock(plist, poses, what)
+        check_header_clock(list(logs.paths), logs.poses, what)
+    return windows
+
+
+def score_found(logs: Fbm3wLogs, windows: Sequence[RunWindow], options: Fbm3wOptions) -> Fbm3wResult:
+    """Score the runs found (:func:`score_runs` on the logs' poses)."""
     return score_runs(
-        poses,
+        logs.poses,
         windows,
-        config,
+        options.config or Fbm3wConfig(),
         options=options,
-        bag_start_ns=bag_start,
-        inputs=tuple(str(p) for p in plist),
+        bag_start_ns=logs.bag_start_ns,
+        inputs=tuple(str(p) for p in logs.paths),
         progress=current(),
     )
+
+
+def score_fbm3w(
+    paths: Sequence[Path], config: Fbm3wConfig, options: Fbm3wOptions = Fbm3wOptions()
+) -> Fbm3wResult:
+    """Score an FBM3@Work benchmark from its bag(s) with ``config``: load -> locate the runs
+    -> score them.
+
+    Raises:
+        ErtoolsError: unreadable bags, no poses, no runs (a single run's problem is a failure
+            inside the result instead).
+    """
+    opts = replace(options, config=config)
+    logs = load(paths, opts)
+    return score_found(logs, locate_runs(logs, opts), opts)
 
 
 def _still(options: Fbm3wOptions) -> dict[str, float]:

@@ -1211,6 +1211,123 @@ def _gt_files(
     return chosen, gtopic, skipped + warnings, broken
 
 
+@dataclass(frozen=True)
+class TrajectoryOptions:
+    """Everything ``ertools score trajectory`` can be told: how to compare (``config``) and
+    where the poses are.
+
+    Attributes:
+        config: association, gaps, offset, coverage (:class:`TrajectoryConfig`).
+        robot_topic: the robot's pose of its marker set (None: the one
+            ``/rockin/*/marker_pose``).
+        gt_topic: the mocap pose of that marker set (None: the one PoseStamped topic).
+        robot_time: ``header`` (message stamps) or ``record`` (the robot bag's record time).
+    """
+
+    config: TrajectoryConfig = field(default_factory=TrajectoryConfig)
+    robot_topic: str | None = None
+    gt_topic: str | None = None
+    robot_time: str = "header"
+
+
+@dataclass(frozen=True, eq=False)
+class TrajectoryLogs:
+    """What :func:`load` read: the robot stream and the GT stream read from the GT files
+    chosen (by time overlap), with their topics, warnings and damaged GT files."""
+
+    robot_path: str
+    robot_topic: str
+    robot: PoseStream
+    chosen: tuple[BagSummary, ...]
+    gt_topic: str
+    gt: PoseStream
+    warnings: tuple[str, ...]
+    broken: tuple[str, ...]
+
+
+def load(paths: Sequence[str | Path], options: TrajectoryOptions) -> TrajectoryLogs:
+    """The robot log (``paths[0]``) and the GT poses of ``paths[1:]`` (bags or folders) that
+    cover it; with no GT path, or the robot log itself as the only one, the GT topic is read
+    from the robot log (evo's ``bag`` mode: one bag recorded both topics).
+
+    Raises:
+        BagError, TopicError: unreadable files, missing topics.
+        ClockError: no GT overlapping the robot log.
+        ScoringError: no robot pose.
+    """
+    from ertools.io import summary
+
+    if not paths:
+        raise ScoringError("no robot log given")
+    cfg = options.config
+    robot_path, gt_paths = str(paths[0]), list(paths[1:])
+    rs = summary(robot_path)
+    topic = _pick_robot_topic(rs, options.robot_topic)
+    robot = read_robot(robot_path, topic, options.robot_time)
+    if len(robot) == 0:
+        raise ScoringError(f"{robot_path}: robot topic {topic} has no messages")
+    # The robot's span on the GT clock, widened by the clock audit's search range.
+    lo = int(robot.t_ns.min()) + cfg.offset_ns
+    hi = int(robot.t_ns.max()) + cfg.offset_ns
+    margin = max(cfg.offset_range_ns, NS_PER_S)
+    if same_bag(robot_path, gt_paths):
+        # evo's `bag` mode: one bag holds both the robot's topic and the GT topic.
+        chosen = [rs]
+        gtopic = _pick_gt_in_robot_bag(rs, options.gt_topic, topic, gt_paths)
+        warnings: list[str] = []
+        broken: list[str] = []
+    else:
+        chosen, gtopic, warnings, broken = _gt_files(
+            robot_path, gt_paths, lo - margin, hi + margin, options.gt_topic
+        )
+    gt = read_gt([s.path for s in chosen], gtopic, lo - margin, hi + margin)
+    return TrajectoryLogs(
+        robot_path, topic, robot, tuple(chosen), gtopic, gt, tuple(warnings), tuple(broken)
+    )
+
+
+def locate_runs(logs: TrajectoryLogs, options: TrajectoryOptions) -> None:
+    """Nothing to find: the whole robot log is the one run compared."""
+    return None
+
+
+def score_found(logs: TrajectoryLogs, runs: None, options: TrajectoryOptions) -> TrajectoryResult:
+    """Compare the robot stream with the GT stream (:func:`score_streams`).
+
+    Raises:
+        ClockError: robot poses outside the GT (naming damaged GT files).
+        ScoringError: non-increasing robot stamps.
+    """
+    files = [s.path for s in logs.chosen]
+    try:
+        result = score_streams(
+            logs.robot,
+            logs.gt,
+            options.config,
+            robot_file=logs.robot_path,
+            robot_topic=logs.robot_topic,
+            gt_topic=logs.gt_topic,
+            gt_files=files,
+            warnings=list(logs.warnings),
+        )
+    except ClockError as err:
+        if not logs.broken:
+            raise
+        # The warnings die with the error: name the damaged GT file where the user looks.
+        raise ClockError(
+            f"{err}; damaged GT file(s), read only up to the damage: {', '.join(logs.broken)}"
+        ) from err
+    overlaps = sum(1 for a, b in pairwise(logs.chosen) if b.start_ns < a.end_ns)
+    if overlaps:
+        dev = RULE_GT_OVERLAP.deviation(
+            f"{overlaps} pair(s) of GT files overlap in time: their poses are merged in time "
+            "order, a message recorded twice used once (2015 chained the files by start time "
+            "and scanned the poses out of order)"
+        )
+        result = replace(result, deviations=(*result.deviations, dev))
+    return result
+
+
 def score(
     robot_bag: str | Path,
     gt_paths: Sequence[str | Path],
@@ -1220,64 +1337,8 @@ def score(
     gt_topic: str | None = None,
     robot_time: str = "header",
 ) -> TrajectoryResult:
-    """Score a robot log against the GT files (or folders of them) that cover it.
-
-    With no GT path, or the robot log itself as the only one, the GT topic is read from the
-    robot log (evo's ``bag`` mode: one bag recorded both topics).
-
-    Raises:
-        BagError, TopicError: unreadable files, missing topics.
-        ClockError: no GT overlapping the robot log, poses outside the GT.
-        ScoringError: non-increasing robot stamps.
-    """
-    from ertools.io import summary
-
-    cfg = config or TrajectoryConfig()
-    robot_path = str(robot_bag)
-    rs = summary(robot_path)
-    topic = _pick_robot_topic(rs, robot_topic)
-    robot = read_robot(robot_path, topic, robot_time)
-    if len(robot) == 0:
-        raise ScoringError(f"{robot_path}: robot topic {topic} has no messages")
-    # The robot's span on the GT clock, widened by the clock audit's search range.
-    lo = int(robot.t_ns.min()) + cfg.offset_ns
-    hi = int(robot.t_ns.max()) + cfg.offset_ns
-    margin = max(cfg.offset_range_ns, NS_PER_S)
-    if same_bag(robot_path, gt_paths):
-        # evo's `bag` mode: one bag holds both the robot's topic and the GT topic.
-        chosen, gtopic = [rs], _pick_gt_in_robot_bag(rs, gt_topic, topic, gt_paths)
-        warnings: list[str] = []
-        broken: list[str] = []
-    else:
-        chosen, gtopic, warnings, broken = _gt_files(
-            robot_path, gt_paths, lo - margin, hi + margin, gt_topic
-        )
-    files = [s.path for s in chosen]
-    gt = read_gt(files, gtopic, lo - margin, hi + margin)
-    try:
-        result = score_streams(
-            robot,
-            gt,
-            cfg,
-            robot_file=robot_path,
-            robot_topic=topic,
-            gt_topic=gtopic,
-            gt_files=files,
-            warnings=warnings,
-        )
-    except ClockError as err:
-        if not broken:
-            raise
-        # The warnings die with the error: name the damaged GT file where the user looks.
-        raise ClockError(
-            f"{err}; damaged GT file(s), read only up to the damage: {', '.join(broken)}"
-        ) from err
-    overlaps = sum(1 for a, b in pairwise(chosen) if b.start_ns < a.end_ns)
-    if overlaps:
-        dev = RULE_GT_OVERLAP.deviation(
-            f"{overlaps} pair(s) of GT files overlap in time: their poses are merged in time "
-            "order, a message recorded twice used once (2015 chained the files by start time "
-            "and scanned the poses out of order)"
-        )
-        result = replace(result, deviations=(*result.deviations, dev))
-    return result
+    """Score a robot log against the GT files (or folders of them) that cover it: load ->
+    compare (see :func:`load`, :func:`score_found`)."""
+    options = TrajectoryOptions(config or TrajectoryConfig(), robot_topic, gt_topic, robot_time)
+    logs = load([robot_bag, *gt_paths], options)
+    return score_found(logs, locate_runs(logs, options), options)

@@ -1,0 +1,236 @@
+"""FBM2@Home as the registry sees it: its inputs (the options of ``ertools score fbm2h``, the
+manifest keys), how they become :class:`Fbm2hOptions`, and the load -> reached moments ->
+score stages.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from ertools.benchmarks.base import Benchmark, Input, Ranking, resolve_values
+from ertools.benchmarks.fbm2h.benchmark import (
+    DEFAULT_MAX_GAP_S,
+    Fbm2hLogs,
+    Fbm2hOptions,
+    Fbm2hRuns,
+    load,
+    locate_runs,
+    score_found,
+)
+from ertools.benchmarks.fbm2h.result import Fbm2hResult
+from ertools.benchmarks.fbm2h.segments import StopParams
+from ertools.errors import UsageError
+
+NAME = "fbm2h"
+LEGACY = "2015 behaviour (each difference can be undone)"
+AUTO = "--reached auto (stop detection)"
+
+INPUTS = (
+    Input("goal", "path", "goal list (Listing 10); default: from the log", metavar="FILE"),
+    Input("transform", "path", "marker-to-robot transform (Listing 11)", metavar="FILE"),
+    Input("transforms", "path", "folder of transform-<team>.yaml files", metavar="DIR"),
+    Input(
+        "team",
+        "str",
+        "the team that ran it, kept in the result and report (default: a name in the state "
+        "payloads, else the log name, else the transform's team); with --transforms DIR: "
+        "DIR/transform-NAME.yaml",
+        metavar="NAME",
+        per_team=True,
+    ),
+    Input(
+        "topic",
+        "str",
+        "marker set pose topic, any pose type (default /fbm2h/robot_at_home/pose)",
+        metavar="TOPIC",
+    ),
+    Input(
+        "tf_frame",
+        "str",
+        "take the marker set from /tf world -> FRAME instead",
+        metavar="FRAME",
+        old_flags=("--frame",),
+    ),
+    Input(
+        "time_source",
+        "choice",
+        "pose time: header stamp (mocap time, default) or bag record time",
+        default="header",
+        choices=("header", "record"),
+    ),
+    Input(
+        "reached",
+        "choice",
+        "states | timing FILE | auto (default: states when the log has them)",
+        choices=("states", "timing", "auto"),
+        with_file=("timing",),
+        metavar="MODE",
+    ),
+    Input(
+        "max_gap",
+        "float",
+        "a reached moment needs a GT sample within S seconds (default 0.1)",
+        default=DEFAULT_MAX_GAP_S,
+        unit="s",
+        positive=True,
+    ),
+    Input("hits", "int", "the referee's count of hits", minimum=0, metavar="N"),
+    Input(
+        "orientation_2015",
+        "flag",
+        "orientation errors as 2015 computed them (unwrapped |dtheta|; wrong across +-pi)",
+        group=LEGACY,
+    ),
+    Input(
+        "unscored_segments",
+        "choice",
+        "segments not scored (RefBox timeout, never reached): null accuracies and exit 1 "
+        "(default), or 2015: sums over the scored segments divided by N, the timed-out "
+        "segment's time counted",
+        default="null",
+        choices=("null", "2015"),
+        group=LEGACY,
+    ),
+    Input(
+        "all_2015",
+        "flag",
+        "every 2015 behaviour above (--orientation-2015 --unscored-segments 2015)",
+        flag="--2015",
+        group=LEGACY,
+    ),
+    Input("namespace", "str", "benchmark namespace of the state topics", default=NAME),
+    Input("stop_speed", "float", "(default 0.05 m/s)", default=0.05, unit="m/s", positive=True,
+          metavar="M_S", group=AUTO),  # fmt: skip
+    Input("stop_yaw_rate", "float", "(default 0.1 rad/s)", default=0.1, unit="rad/s",
+          positive=True, metavar="RAD_S", group=AUTO),  # fmt: skip
+    Input("stop_min_duration", "float", "(default 0.5 s)", default=0.5, unit="s", positive=True,
+          group=AUTO),  # fmt: skip
+    Input(
+        "stop_radius",
+        "float",
+        "a stop counts for a waypoint only this close to it (default 0.5 m)",
+        default=0.5,
+        unit="m",
+        positive=True,
+        group=AUTO,
+    ),
+)
+
+
+def make_options(given: Mapping[str, Any]) -> Fbm2hOptions:
+    """The values of :data:`INPUTS` -> :class:`Fbm2hOptions`.
+
+    Raises:
+        UsageError: a value out of range, or options that exclude each other (exit 2).
+    """
+    v = resolve_values(INPUTS, given)
+    if v["topic"] is not None and v["tf_frame"] is not None:
+        raise UsageError("give either --topic or --tf-frame, not both")
+    if v["transform"] is not None and v["transforms"] is not None:
+        raise UsageError("give either --transform FILE or --team NAME --transforms DIR")
+    if v["transforms"] is not None and v["team"] is None:
+        raise UsageError("--transforms DIR needs --team NAME (DIR/transform-NAME.yaml)")
+    reached = v["reached"] or (None,)
+    return Fbm2hOptions(
+        goal=v["goal"],
+        transform=v["transform"],
+        team=v["team"],
+        transforms_dir=v["transforms"],
+        topic=v["topic"],
+        tf_frame=v["tf_frame"],
+        time_source=v["time_source"],
+        reached=reached[0],
+        timing=Path(reached[1]) if len(reached) > 1 else None,
+        max_gap_s=v["max_gap"],
+        hits=None if v["hits"] is None else int(v["hits"]),
+        orientation_2015=v["orientation_2015"] or v["all_2015"],
+        unscored_2015=v["unscored_segments"] == "2015" or v["all_2015"],
+        namespace=v["namespace"],
+        stops=StopParams(
+            speed=v["stop_speed"],
+            yaw_rate=v["stop_yaw_rate"],
+            min_duration_s=v["stop_min_duration"],
+            radius=v["stop_radius"],
+        ),
+    )
+
+
+def notes(result: Fbm2hResult) -> list[str]:
+    """How the reached moments were found (with ``-v``) and the per-segment table."""
+    out = []
+    if logging.getLogger("ertools").isEnabledFor(logging.INFO):  # -v
+        out += list(result.notes)
+    out.append(
+        f"reached moments: {result.reached_method}; transform: {result.transform.source}; "
+        "times from the log's first message"
+    )
+    n = len(result.segments)
+    scored = sum(s.status == "ok" for s in result.segments)
+    if result.position_accuracy is None:
+        averaged = "none (a segment is not scored: see the warnings)"
+    elif result.unscored_2015:
+        averaged = f"sum over the {scored} scored segment(s) / N = {n} (2015)"
+    else:
+        averaged = f"mean over all {n} segments"
+    out.append(f"accuracies: {averaged}")
+    values = ("reached_s", "segment_time_s", "distance_error_m", "orientation_error_rad")
+    for row in result.tables()["segments"]:
+        if row["status"] != "ok" or any(row[k] is None for k in values):
+            out.append(f"  segment {row['segment']}: {row['status']}")
+            continue
+        out.append(
+            f"  segment {row['segment']}: reached {row['reached_s']:.3f} s, "
+            f"time {row['segment_time_s']:.3f} s, distance {row['distance_error_m']:.4f} m, "
+            f"orientation {row['orientation_error_rad']:.4f} rad"
+        )
+    return out
+
+
+EPILOG = """examples:
+  ertools score fbm2h run.bag --team homer --transforms transforms/
+  ertools score fbm2h run.bag --goal configs/fbm2h.yaml --transform transform-homer.yaml
+  ertools score fbm2h log.bag --goal goal.yaml --transform configs/transform-identity.yaml \\
+      --reached timing log_reached_waypoint_timing.yaml
+  ertools score fbm2h log.bag --goal goal.yaml --reached auto --format json
+
+--reached: states (default when the bag has /fbm2h/bmbox_state): segment i starts when the
+BmBox has sent the goal and ends at the Client's COMPLETED_GOAL; timing FILE: a reached-waypoint
+timing file (p0 starts, p(k+1) closes segment k, seconds from the bag's first message); auto:
+stops detected in the ground truth, assigned to the waypoints in order.
+Orientation errors are wrapped to [0, pi]; --orientation-2015 reproduces the 2015 numbers.
+Accuracies are null (exit 1) when a segment is not scored; --unscored-segments 2015 divides
+the sum over the scored segments by N as 2015 did. --2015: every 2015 behaviour at once."""
+
+BENCHMARK: Benchmark[Fbm2hOptions, Fbm2hLogs, Fbm2hRuns, Fbm2hResult] = Benchmark(
+    name=NAME,
+    title="FBM2@Home",
+    summary="FBM2@Home navigation: waypoint errors",
+    example="ertools score fbm2h run.bag --goal goal.yaml --transform transform-homer.yaml",
+    description="""Recompute an FBM2@Home (navigation) score from the logs (seed 7.2, Listing 13).
+
+Per waypoint: the robot pose when it was reached (ground-truth marker pose interpolated at that
+moment, composed with the team's marker-to-robot transform), its distance and orientation
+error, the segment time; then position_accuracy, orientation_accuracy and execution_time.""",
+    epilog=EPILOG,
+    bags_help="log file(s)",
+    inputs=INPUTS,
+    make_options=make_options,
+    load=load,
+    find_runs=locate_runs,
+    score_runs=score_found,
+    ranking=Ranking(
+        key=lambda r: r.position_accuracy,
+        lower_is_better=True,
+        text="position_accuracy (metres, the mean distance to the waypoints): lower is better",
+    ),
+    notes=notes,
+    figures="ertools.report.plots_fbm2h:figure_specs",
+    foxglove="ertools.report.foxglove.fbm2h:content",
+    score_keys=frozenset({"position_accuracy", "orientation_accuracy"}),
+    state_topics=True,
+    values_2015={"all_2015": True},
+)
+

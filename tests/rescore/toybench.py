@@ -1,0 +1,114 @@
+"""A toy benchmark registered only by the rescore tests: `ertools rescore` must score it with no
+change to ertools/rescore (adding a benchmark adds it to rescore).
+
+A toy "log" is a text file of numbers, one per line. The score of an execution is
+``mean(numbers) * scale + offset`` (``mode: max``: the largest number instead of the mean), the
+offset read from the team's per-team input (a YAML file ``{offset: X}``, like a marker-set
+transform). Words in a log make the scorer misbehave on purpose: ``bad`` (an unscoreable log:
+ScoringError), ``boom`` (a bug: RuntimeError), ``die`` (the worker process dies).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from ertools.benchmarks.base import Benchmark, Input, Ranking, Rows
+from ertools.errors import ConfigError, ScoringError, UsageError
+from ertools.fidelity import Deviation
+from ertools.streams import Provenance
+
+
+@dataclass(frozen=True)
+class ToyOptions:
+    transform: Path | None
+    scale: float
+    mode: str
+
+
+@dataclass(frozen=True)
+class ToyResult:
+    name: str
+    value: float
+    count: int
+    offset: float
+    warnings: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
+    failures: tuple[str, ...] = ()
+    provenance: Provenance = field(default_factory=Provenance)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"toy": {"value": self.value, "count": self.count, "offset": self.offset}}
+
+    def to_yaml(self) -> str:
+        return f"toy:\n  value: {self.value}\n"
+
+    def tables(self) -> dict[str, Rows]:
+        return {"values": [{"value": self.value}]}
+
+
+def make_options(values: Mapping[str, Any]) -> ToyOptions:
+    scale = float(values.get("scale", 1.0))
+    if scale <= 0:
+        raise UsageError(f"--scale {scale}: must be > 0")
+    transform = values.get("transform")
+    return ToyOptions(
+        transform=None if transform is None else Path(transform),
+        scale=scale,
+        mode=str(values.get("mode", "mean")),
+    )
+
+
+def load(bags: Sequence[Path], options: ToyOptions) -> list[float]:
+    numbers: list[float] = []
+    for bag in bags:
+        for line in Path(bag).read_text(encoding="utf-8").split():
+            if line == "bad":
+                raise ScoringError("no toy values can be scored here", path=bag)
+            if line == "boom":
+                raise RuntimeError("the toy scorer has a bug")
+            if line == "die":
+                os._exit(7)
+            numbers.append(float(line))
+    return numbers
+
+
+def find_runs(loaded: list[float], options: ToyOptions) -> list[float]:
+    return loaded
+
+
+def score_runs(loaded: list[float], runs: list[float], options: ToyOptions) -> ToyResult:
+    offset = 0.0
+    if options.transform is not None:
+        data = yaml.safe_load(options.transform.read_text(encoding="utf-8"))
+        if not isinstance(data, dict) or "offset" not in data:
+            raise ConfigError("expected {offset: X}", path=options.transform)
+        offset = float(data["offset"])
+    base = max(runs) if options.mode == "max" else sum(runs) / len(runs)
+    return ToyResult("toy", base * options.scale + offset, len(runs), offset)
+
+
+TOY = Benchmark(
+    name="toy",
+    title="Toy@Test",
+    summary="a toy benchmark for the rescore tests",
+    example="ertools score toy log.txt",
+    description="mean of the numbers times scale plus the team's offset",
+    epilog="",
+    bags_help="text files of numbers",
+    inputs=(
+        Input("transform", "path", "the team's offset file", per_team=True),
+        Input("scale", "float", "a factor", default=1.0, positive=True),
+        Input("mode", "choice", "mean or max", default="mean", choices=("mean", "max")),
+    ),
+    make_options=make_options,
+    load=load,
+    find_runs=find_runs,
+    score_runs=score_runs,
+    ranking=Ranking(key=lambda r: r.value, lower_is_better=True, text="the lowest value wins"),
+)
