@@ -40,6 +40,7 @@ pytest: $(DEVSTAMP)
 test: lint typecheck pytest
 
 bench: $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[dask]'  # the season's LocalCluster run
 	$(BIN)/python -m compileall -q ertools
 	$(BIN)/python bench/run.py
 

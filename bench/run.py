@@ -6,7 +6,11 @@ and as MCAP (zstd), a 10 Hz robot log of the same hour, and 1000 one-second GT b
 command runs several times as a whole process (page cache warm); the table shows the median
 wall time and the peak RSS of the process (``os.wait4``), then the ratios of issue 3.
 
-    .venv/bin/python bench/run.py [--runs N] [--quick] [--json FILE]
+Then (``--season yes``, the default) the `ertools rescore` season benchmark of
+bench/rescore_season.py: >= 100 executions cold with 1 and 2 workers, through a Dask
+LocalCluster and warm from the cache; ``--season only`` runs just that one.
+
+    .venv/bin/python bench/run.py [--runs N] [--quick] [--json FILE] [--season yes|no|only]
 
 Nothing here is a test: `make test` never runs it.
 """
@@ -197,7 +201,15 @@ def main() -> int:
     )
     parser.add_argument("--quick", action="store_true", help="skip the slow rosbags/evo baselines")
     parser.add_argument("--json", type=Path, default=REPO / "build" / "bench" / "results.json")
+    parser.add_argument(
+        "--season",
+        choices=("yes", "no", "only"),
+        default="yes",
+        help="the `ertools rescore` season benchmark after the others (bench/rescore_season.py)",
+    )
     args = parser.parse_args()
+    if args.season == "only":
+        return season()
 
     folder = REPO / "build" / "bench"
     print(f"data: {folder} (generated once, then reused)", flush=True)
@@ -425,7 +437,13 @@ def main() -> int:
         )
     )
     print(f"\nwrote {args.json}")
-    return 0
+    return season() if args.season == "yes" else 0
+
+
+def season() -> int:
+    """The season benchmark of `ertools rescore`, in its own process (its own data and table)."""
+    print("\nertools rescore over a generated season (bench/rescore_season.py):", flush=True)
+    return subprocess.run([PY, str(HERE / "rescore_season.py")], cwd=REPO, check=False).returncode
 
 
 if __name__ == "__main__":

@@ -5,6 +5,7 @@ each team's; executions (listed in the manifest, or found in the logs by
 :mod:`ertools.rescore.discover`) become independent jobs (:mod:`~ertools.rescore.jobs`), scored
 through the benchmark registry only, in parallel (:mod:`~ertools.rescore.parallel`), skipped
 when the cache (:mod:`~ertools.rescore.cache`) already holds them, and gathered into
-``results.json``/``results.csv`` (:mod:`~ertools.rescore.pipeline`). The document's contract is
+``results.json``/``results.csv`` (:mod:`~ertools.rescore.pipeline`), from which
+:mod:`~ertools.rescore.site` renders the results page. The document's contract is
 docs/rescore.md.
 """

@@ -1,0 +1,335 @@
+"""`make bench`, the season: `ertools rescore` on >= 100 executions, cold and warm, 1 and 2
+workers, local processes and a Dask LocalCluster (issue 18 item 6).
+
+The season (bench/season.py: 3 days x 36 executions by ten teams, each day's GT logger split
+every hour) is generated once into build/bench/season and never timed. Each configuration runs
+``ertools rescore`` as a whole process, with the page cache warm (one unmeasured read of every
+file first); "cold" means an empty results folder (no cache), "warm" a second run into the same
+folder (everything from the cache). A poller reads the peak RSS (``VmHWM``) of the command and
+of every process it starts (workers, Dask's nanny and scheduler) from /proc.
+
+    .venv/bin/python bench/rescore_season.py [--days 3] [--per-day 36] [--json FILE]
+
+Targets (on a 2-core machine): --jobs 2 at least 1.7x faster than --jobs 1; Dask within 15 % of
+--jobs 2; a warm rerun under 2 s; every process under 200 MiB; time linear in the executions
+(per-execution time of one day within 15 % of the whole season's).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import subprocess
+import sys
+import threading
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent
+sys.path.insert(0, str(HERE))
+
+from season import DAYS, SLOTS_PER_DAY, generate_season  # noqa: E402
+
+ERTOOLS = str(Path(sys.executable).parent / "ertools")
+FOLDER = REPO / "build" / "bench"
+# The manifest's input keys per benchmark that name a file (the sample competition's names).
+PER_TEAM = ("transform",)
+
+
+@dataclass
+class Run:
+    name: str
+    executions: int
+    wall_s: float
+    exit: int
+    peak_main_mib: float
+    peak_other_mib: float  # the largest other process: a worker, Dask's nanny or scheduler
+    processes: int
+    scored: int = 0
+    cached: int = 0
+    note: str = ""
+    peaks: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def per_execution_s(self) -> float:
+        return self.wall_s / self.executions
+
+
+def manifest_text(root: Path, season: dict[str, Any], days: set[int]) -> str:
+    """The competition manifest (docs/rescore.md) listing the executions of ``days``: each
+    benchmark's shared inputs once, each team's transform under its team."""
+    shared: dict[str, dict[str, str]] = {}
+    teams: dict[str, dict[str, dict[str, str]]] = {}
+    lines = ["version: 1", "title: Generated season (bench/season.py)", "benchmarks:"]
+    chosen = [e for e in season["executions"] if e["day"] in days]
+    for e in chosen:
+        for key, rel in e["inputs"].items():
+            path = str(root / rel)
+            if key in PER_TEAM:
+                teams.setdefault(e["benchmark"], {}).setdefault(e["team"], {})[key] = path
+            else:
+                shared.setdefault(e["benchmark"], {})[key] = path
+    for bench in sorted({e["benchmark"] for e in chosen}):
+        lines.append(f"  {bench}:")
+        if shared.get(bench):
+            lines.append("    inputs:")
+            lines += [f"      {k}: {json.dumps(v)}" for k, v in sorted(shared[bench].items())]
+        if teams.get(bench):
+            lines.append("    teams:")
+            for team, values in sorted(teams[bench].items()):
+                lines.append(f"      {json.dumps(team)}:")
+                lines += [f"        {k}: {json.dumps(v)}" for k, v in sorted(values.items())]
+    lines.append("executions:")
+    for e in chosen:
+        bags = [str(root / e["bmbox_log"]), *(str(root / g) for g in e["gt_files"])]
+        lines.append(f"  - benchmark: {e['benchmark']}")
+        lines.append(f"    team: {json.dumps(e['team'])}")
+        lines.append(f"    bags: {json.dumps(bags)}")
+    return "\n".join(lines) + "\n"
+
+
+def _tree(root: int) -> list[int]:
+    """``root`` and every process descended from it, from /proc."""
+    children: dict[int, list[int]] = {}
+    for entry in os.scandir("/proc"):
+        if not entry.name.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry.name}/stat", encoding="ascii", errors="replace") as fh:
+                stat = fh.read()
+        except OSError:
+            continue
+        ppid = int(stat.rsplit(")", 1)[1].split()[1])
+        children.setdefault(ppid, []).append(int(entry.name))
+    out, todo = [], [root]
+    while todo:
+        pid = todo.pop()
+        out.append(pid)
+        todo += children.get(pid, [])
+    return out
+
+
+def _hwm_kib(pid: int) -> tuple[int, str] | None:
+    try:
+        status = Path(f"/proc/{pid}/status").read_text(encoding="ascii", errors="replace")
+        cmd = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode()
+    except OSError:
+        return None
+    for line in status.splitlines():
+        if line.startswith("VmHWM:"):
+            return int(line.split()[1]), cmd.strip()
+    return None
+
+
+def timed(name: str, argv: list[str], executions: int) -> Run:
+    """Run ``argv`` once; wall time, exit status and the peak RSS of each process it started."""
+    peaks: dict[int, tuple[int, str]] = {}
+    t0 = time.perf_counter()
+    proc = subprocess.Popen(argv, cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    stop = threading.Event()
+
+    def poll() -> None:
+        while not stop.is_set():
+            for pid in _tree(proc.pid):
+                got = _hwm_kib(pid)
+                if got and got[0] > peaks.get(pid, (0, ""))[0]:
+                    peaks[pid] = got
+            stop.wait(0.05)
+
+    poller = threading.Thread(target=poll, daemon=True)
+    poller.start()
+    _, err = proc.communicate()
+    wall = time.perf_counter() - t0
+    stop.set()
+    poller.join()
+    main = peaks.get(proc.pid, (0, ""))[0] / 1024
+    others = {pid: v for pid, v in peaks.items() if pid != proc.pid}
+    other = max((v[0] for v in others.values()), default=0) / 1024
+    tail = err.decode(errors="replace").strip().splitlines()
+    run = Run(
+        name,
+        executions,
+        wall,
+        proc.returncode,
+        main,
+        other,
+        1 + len(others),
+        note=tail[-1] if tail else "",
+        peaks={f"{pid} {cmd[:80]}": kib / 1024 for pid, (kib, cmd) in peaks.items()},
+    )
+    if proc.returncode not in (0, 1):
+        sys.stderr.write("\n".join(tail[-10:]) + "\n")
+    return run
+
+
+def _counts(out: Path, run: Run) -> Run:
+    try:
+        doc = json.loads((out / "results.json").read_text(encoding="utf-8"))
+    except (OSError, json.JSONDecodeError):
+        return run
+    rows = doc.get("executions") or []
+    run.scored = sum(r.get("status") == "scored" for r in rows)
+    run.cached = sum(bool(r.get("cached")) for r in rows)
+    return run
+
+
+def _read_all(root: Path) -> None:
+    """Every file once, so that each measured run starts with the page cache warm."""
+    for path in sorted(root.rglob("*")):
+        if path.is_file():
+            with path.open("rb") as fh:
+                while fh.read(1 << 20):
+                    pass
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n", 1)[0])
+    parser.add_argument("--days", type=int, default=DAYS)
+    parser.add_argument("--per-day", type=int, default=SLOTS_PER_DAY)
+    parser.add_argument("--json", type=Path, default=FOLDER / "season_results.json")
+    parser.add_argument("--no-dask", action="store_true", help="skip the LocalCluster run")
+    args = parser.parse_args()
+
+    root = FOLDER / f"season-{args.days}x{args.per_day}"
+    t0 = time.perf_counter()
+    if not (root / "season.json").exists():
+        print(f"generating the season into {root} (once; not timed)...", flush=True)
+        generate_season(root, days=args.days, per_day=args.per_day)
+    season = json.loads((root / "season.json").read_text(encoding="utf-8"))
+    n = len(season["executions"])
+    size = sum(p.stat().st_size for p in root.rglob("*.bag"))
+    print(
+        f"season: {n} executions over {args.days} days, {size / 2**20:.0f} MiB of logs "
+        f"({len(season['gt_files'])} GT hour files), ready in {time.perf_counter() - t0:.1f} s"
+    )
+    work = FOLDER / "season_runs"
+    shutil.rmtree(work, ignore_errors=True)
+    work.mkdir(parents=True)
+    all_days = set(range(1, args.days + 1))
+    manifest = work / "season.yaml"
+    manifest.write_text(manifest_text(root, season, all_days), encoding="utf-8")
+    one_day = work / "day1.yaml"
+    one_day.write_text(manifest_text(root, season, {1}), encoding="utf-8")
+    n_day = sum(e["day"] == 1 for e in season["executions"])
+    _read_all(root)
+    load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
+    print(f"machine: {os.cpu_count()} cores, load average {load} at start")
+    print(
+        f"  {'ertools rescore ...':<44} {'execs':>5} {'wall s':>8} {'s/exec':>7} "
+        f"{'main MiB':>8} {'other MiB':>9} {'procs':>5}  scored/cached"
+    )
+
+    runs: dict[str, Run] = {}
+
+    def go(key: str, label: str, config: Path, out: Path, count: int, *extra: str) -> Run:
+        argv = [ERTOOLS, "rescore", str(root), "--config", str(config), "--out", str(out), *extra]
+        run = _counts(out, timed(label, argv, count))
+        runs[key] = run
+        print(
+            f"  {label:<44} {count:>5} {run.wall_s:8.2f} {run.per_execution_s:7.3f} "
+            f"{run.peak_main_mib:8.1f} {run.peak_other_mib:9.1f} {run.processes:>5}  "
+            f"{run.scored}/{run.cached}{'' if run.exit in (0, 1) else '  FAILED: ' + run.note}",
+            flush=True,
+        )
+        return run
+
+    go("jobs1", "--jobs 1, cold", manifest, work / "j1", n, "--jobs", "1")
+    go("jobs2", "--jobs 2, cold", manifest, work / "j2", n, "--jobs", "2")
+    if not args.no_dask:
+        go(
+            "dask",
+            "--scheduler local --jobs 2 (LocalCluster), cold",
+            manifest,
+            work / "dask",
+            n,
+            "--scheduler",
+            "local",
+            "--jobs",
+            "2",
+        )
+    go("warm", "--jobs 2, warm (second run, same folder)", manifest, work / "j2", n, "--jobs", "2")
+    go("day1", "--jobs 2, cold, day 1 only", one_day, work / "day1", n_day, "--jobs", "2")
+
+    print("\ntargets (issue 18 item 6):")
+    checks: dict[str, bool] = {}
+
+    def check(key: str, text: str, value: str, ok: bool) -> None:
+        checks[key] = ok
+        print(f"  {text:<56} {value:>14}  {'pass' if ok else 'FAIL'}")
+
+    j1, j2 = runs["jobs1"], runs["jobs2"]
+    speedup = j1.wall_s / j2.wall_s
+    check("speedup", "--jobs 2 vs --jobs 1 (>= 1.7x)", f"{speedup:.2f}x", speedup >= 1.7)
+    if "dask" in runs:
+        slower = runs["dask"].wall_s / j2.wall_s - 1
+        check(
+            "dask",
+            "Dask LocalCluster vs --jobs 2 (within 15 %)",
+            f"{slower:+.1%}",
+            abs(slower) <= 0.15,
+        )
+    warm = runs["warm"]
+    check(
+        "warm", "warm rerun (< 2 s)", f"{warm.wall_s:.2f} s", warm.wall_s < 2.0 and warm.cached == n
+    )
+    peak = max(max(r.peak_main_mib, r.peak_other_mib) for r in runs.values())
+    check("memory", "peak RSS of any process (< 200 MiB)", f"{peak:.0f} MiB", peak < 200)
+    lin = runs["day1"].per_execution_s / j2.per_execution_s
+    check(
+        "linear",
+        f"s/execution, {n_day} vs {n} executions (within 15 %)",
+        f"{lin:.2f}",
+        abs(lin - 1) <= 0.15,
+    )
+    everything = all(r.scored == r.executions for r in runs.values())
+    check("scored", "every execution scored in every run", f"{j2.scored}/{n}", everything)
+
+    # The 16-worker cluster by the same measure: the serial part (timeline, cache check,
+    # writing results: what a warm run does) plus the parallel part spread over 16 workers at
+    # the parallel efficiency measured with 2.
+    serial = warm.wall_s
+    per_exec = (j1.wall_s - serial) / n
+    efficiency = (j1.wall_s - serial) / (2 * max(j2.wall_s - serial, 1e-9))
+    projection = {w: serial + n * per_exec / (w * min(efficiency, 1.0)) for w in (1, 2, 16)}
+    print("\nextrapolation (measured per execution, Amdahl with the measured 2-worker efficiency):")
+    print(
+        f"  serial part (the warm run): {serial:.2f} s; per execution, one worker: "
+        f"{per_exec:.3f} s; 2-worker efficiency {efficiency:.2f}"
+    )
+    for w, t in projection.items():
+        print(
+            f"  {w:>2} worker(s): {t:8.1f} s for {n} executions "
+            f"({3600 / ((t - serial) / n) if t > serial else float('inf'):,.0f} executions/hour)"
+        )
+    args.json.parent.mkdir(parents=True, exist_ok=True)
+    args.json.write_text(
+        json.dumps(
+            {
+                "executions": n,
+                "days": args.days,
+                "bytes": size,
+                "load_average_at_start": load,
+                "runs": {k: asdict(v) for k, v in runs.items()},
+                "checks": checks,
+                "extrapolation": {
+                    "serial_s": serial,
+                    "per_execution_s": per_exec,
+                    "efficiency_2": efficiency,
+                    "seconds": projection,
+                },
+            },
+            indent=2,
+        )
+        + "\n"
+    )
+    print(f"\nwrote {args.json}")
+    return 0 if all(checks.values()) else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,118 @@
+"""The results site in a real browser: headless Chromium opens index.html from disk, offline.
+
+``--dump-dom`` gives the DOM as the browser built it (the leaderboards, problems, timeline
+frame and links are read from it); a screenshot shows that the framed timeline page loaded and
+its script drew the chart. Chromium's console lines (uncaught errors, refused loads) are
+errors. Skipped, saying why, where Chromium is not installed (``apt-get install chromium``).
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+from urllib.parse import unquote, urlsplit
+
+import numpy as np
+import pytest
+from fakes import BROWSER, CHROMIUM_FLAGS
+from site_results import EVIL, Page, expected_board, results, write_folder
+
+from ertools.report.timeline_page import write_timeline_page
+from ertools.report.timeline_style import KIND_COLORS
+from ertools.rescore.site import write_site
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "timeline"))
+from timeline_day import day_timeline
+
+pytestmark = [
+    pytest.mark.browser,
+    pytest.mark.skipif(BROWSER is None, reason="chromium not installed (apt-get install chromium)"),
+]
+
+FLAGS = [
+    *CHROMIUM_FLAGS,
+    "--window-size=1400,3000",
+    # No proxy can be reached: anything the page tried to fetch would fail.
+    "--proxy-server=127.0.0.1:9",
+    "--enable-logging=stderr",
+    "--v=0",
+]
+
+
+def chromium(tmp_path: Path, url: str, *extra: str) -> subprocess.CompletedProcess[str]:
+    profile = tmp_path / f"profile{len(list(tmp_path.glob('profile*')))}"
+    proc = subprocess.run(
+        [BROWSER or "chromium", *FLAGS, f"--user-data-dir={profile}", *extra, url],
+        capture_output=True,
+        text=True,
+        timeout=90,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    # Chromium logs uncaught exceptions and CSP refusals (of the page or its frame) as
+    # console lines.
+    bad = [
+        line
+        for line in proc.stderr.splitlines()
+        if "CONSOLE" in line or "Refused" in line or "Uncaught" in line
+    ]
+    assert not bad, bad
+    return proc
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, Any], Path]:
+    out = tmp_path_factory.mktemp("site")
+    doc = results()
+    write_folder(out, doc)
+    write_timeline_page(day_timeline(), out / "timeline.html")
+    return doc, write_site(doc, out)
+
+
+def test_dom_has_leaderboards_problems_and_timeline(
+    site: tuple[dict[str, Any], Path], tmp_path: Path
+) -> None:
+    doc, index = site
+    page = Page(chromium(tmp_path, index.as_uri(), "--dump-dom").stdout)
+    for bench in ("fbm3w", "fbm1h", "fbm2h"):
+        shown = [
+            (int(r[0]) if r[0] != "\u2014" else None, r[1]) for r in page.boards[f"lb-{bench}"]
+        ]
+        assert shown == expected_board(doc, bench), bench
+    assert page.scripts == 0  # the hostile team name stayed text...
+    assert EVIL in page.sections["lb-fbm3w"]  # ...shown as such
+    for p in doc["problems"]:
+        assert p["message"] in page.sections["problems"]
+    assert page.frames == ["timeline.html"]
+    assert page.executions.count("failed") == page.executions.count("unscoreable") == 1
+    for link in page.links:
+        parts = urlsplit(link)
+        assert not parts.scheme, link
+        if parts.path:
+            assert (index.parent / unquote(parts.path)).is_file(), link
+        if parts.fragment:
+            assert parts.fragment in page.ids, link
+
+
+def test_timeline_frame_draws_its_chart(site: tuple[dict[str, Any], Path], tmp_path: Path) -> None:
+    from matplotlib.image import imread
+
+    _, index = site
+    shot = tmp_path / "shot.png"
+    chromium(tmp_path, index.as_uri(), f"--screenshot={shot}", "--virtual-time-budget=5000")
+    pixels = (imread(shot)[..., :3] * 255).round().astype(int)
+    assert pixels.shape[:2] == (3000, 1400)
+
+    def rows_of(colour: str) -> np.ndarray:
+        rgb = np.array([int(colour[i : i + 2], 16) for i in (1, 3, 5)])
+        return np.unique(np.nonzero(np.abs(pixels - rgb).max(axis=2) <= 3)[0])
+
+    # The frame's page loaded: its dark header (#14233c) appears again below the site's own.
+    header = rows_of("#14233c")
+    assert header.min() == 0 and (header > 200).sum() > 20
+    # Its script drew the chart: GT-logger bars (blue) in several lanes, not only the
+    # legend's swatch (one line of ~10 px, which is static HTML).
+    gt = rows_of(KIND_COLORS["gt"])
+    assert gt.size and gt.max() - gt.min() > 40
