@@ -27,6 +27,7 @@ from ertools.rescore.cache import Cache, FileHashes, job_key, records
 from ertools.rescore.jobs import Job, Outcome
 from ertools.rescore.manifest import Manifest
 from ertools.rescore.parallel import run_jobs
+from ertools.rescore.site import write_site
 from ertools.timeutil import NS_PER_S, iso_utc
 
 SCHEMA_VERSION = 1
@@ -460,7 +461,7 @@ def csv_text(doc: Mapping[str, Any]) -> str:
 
 
 def write_results(doc: Mapping[str, Any], out: Path) -> list[Path]:
-    """``results.json``, ``results.csv`` and, when the ``site`` module is there, ``index.html``."""
+    """``results.json``, ``results.csv`` and the results page ``index.html``."""
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for name, text in (
@@ -472,13 +473,6 @@ def write_results(doc: Mapping[str, Any], out: Path) -> list[Path]:
         tmp.write_text(text, encoding="utf-8")
         os.replace(tmp, path)
         written.append(path)
-    # SITE CALL POINT: the results page is the `site` branch's
-    # (ertools.rescore.site.write_site(results, out) -> DIR/index.html), built from the document
-    # alone; called here once that module exists.
-    from importlib.util import find_spec
-
-    if find_spec("ertools.rescore.site") is not None:
-        from importlib import import_module
-
-        written.append(import_module("ertools.rescore.site").write_site(dict(doc), out))
+    # the results page, rebuilt from the document alone (ertools.rescore.site)
+    written.append(write_site(dict(doc), out))
     return written
