@@ -279,9 +279,7 @@ def _one_value(declared: Input, value: Any) -> Any:
         if not isinstance(value, str):
             raise UsageError(f"{option} must be text, got {value!r}")
         if kind == "choice" and value not in declared.choices:
-            raise UsageError(
-                f"{option} {value!r}: choose from {', '.join(declared.choices)}"
-            )
+            raise UsageError(f"{option} {value!r}: choose from {', '.join(declared.choices)}")
         return value
     number: float
     try:

@@ -25,6 +25,7 @@ EPILOG = """examples:
   ertools rescore logs/ --config competition.yaml --out results/ --jobs 8
   ertools rescore logs/ --config competition.yaml --out results/ --scheduler tcp://10.0.0.5:8786
   ertools rescore --config competition.yaml --check
+  ertools rescore logs/ --init competition.yaml
 
 --scheduler needs `pip install 'ertools[dask]'`; its workers must see the logs at the same paths
 (a shared file system): only paths and values go through the scheduler."""
@@ -41,6 +42,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="the competition manifest (YAML, docs/rescore.md)",
     )
     parser.add_argument("--out", type=Path, metavar="DIR", help="the results folder")
+    parser.add_argument(
+        "--init",
+        type=Path,
+        metavar="FILE",
+        help="draft the manifest FILE from the logs under PATH (every execution found, its "
+        "team, the inputs found and TODO lines for those missing); nothing is scored",
+    )
     parser.add_argument(
         "--check",
         action="store_true",
@@ -77,6 +85,8 @@ def run(args: argparse.Namespace) -> int:
     from ertools.rescore.parallel import default_jobs
     from ertools.rescore.pipeline import listed_executions, rescore, write_results
 
+    if args.init is not None:
+        return _init(args)
     if args.config is None:
         raise UsageError("--config FILE is needed: the competition manifest (docs/rescore.md)")
     if args.out is None and not args.check:
@@ -143,3 +153,29 @@ def run(args: argparse.Namespace) -> int:
         note(f"wrote {path}")
     sys.stdout.flush()
     return 0 if counts["scored"] == len(rows) else 1
+
+
+def _init(args: argparse.Namespace) -> int:
+    from ertools.errors import UsageError
+    from ertools.rescore.draft import draft_text
+    from ertools.rescore.found import find
+
+    if not args.paths:
+        raise UsageError("--init FILE drafts the manifest from logs: give the PATHs to scan")
+    if args.config is not None or args.out is not None:
+        raise UsageError("--init FILE only drafts the manifest: no --config or --out with it")
+    if args.init.exists():
+        raise UsageError(f"--init {args.init}: the file exists; ertools does not overwrite it")
+    for path in args.paths:
+        if not path.exists():
+            raise UsageError(f"{path}: no such file or folder")
+    found = find(args.paths, progress=args.progress)
+    text = draft_text(found, args.paths, args.init, args.command_line)
+    args.init.parent.mkdir(parents=True, exist_ok=True)
+    args.init.write_text(text, encoding="utf-8")
+    todo = sum("TODO" in line for line in text.splitlines())
+    note(
+        f"wrote {args.init}: {len(found.discovery.executions)} execution(s), {todo} TODO line(s) "
+        "to fill in"
+    )
+    return 0

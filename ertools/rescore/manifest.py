@@ -28,6 +28,7 @@ its transform) is found in one pass and reported together, one line each
 from __future__ import annotations
 
 import hashlib
+import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, date, datetime
@@ -298,7 +299,7 @@ class _Checker:
 
     def path(self, text: str, where: str) -> Path | Any:
         path = Path(text).expanduser()
-        path = path if path.is_absolute() else self.base / path
+        path = Path(os.path.normpath(path if path.is_absolute() else self.base / path))
         if not path.exists():
             self.problem(where, f"file not found: {path}")
             return _BAD

@@ -8,6 +8,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import os
 from pathlib import Path
 from typing import Any
 
@@ -170,3 +171,36 @@ def test_leaderboards_follow_each_benchmarks_rule(
                 )
         order = sorted(best, key=lambda t: best[t] if lower else -best[t])
         assert [row["team"] for row in board["rows"]] == order
+
+
+def test_init_drafts_the_manifest_from_the_logs(
+    day: tuple[Path, dict[str, Any], dict[str, Any]], tmp_path: Path
+) -> None:
+    from ertools.rescore.manifest import load_manifest
+
+    root, answers, _ = day
+    draft = tmp_path / "competition.yaml"
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        assert main(["rescore", str(root), "--init", str(draft), "--quiet"]) == 0
+    assert f"wrote {draft}: 13 execution(s)" in err.getvalue()
+    manifest = load_manifest(draft)  # the draft validates as it is
+    # every file input the answers name and that exists was found under its own name
+    for e in answers["executions"]:
+        for key, rel in e["inputs"].items():
+            entry = manifest.benchmarks[e["benchmark"]]
+            given = entry.teams.get(e["team"], {}) if key == "transform" else entry.values
+            if (root / rel).exists():
+                assert given[key] == (root / rel).resolve(), (e["id"], key)
+            else:  # skuba's transform: a TODO line, the team left out
+                assert e["team"] not in entry.teams
+    text = draft.read_text()
+    assert "# TODO: no transform-skuba.yaml found" in text
+    # the execution nobody named is a commented entry with its logs, to be given a team
+    (lost,) = [e for e in answers["executions"] if e["id"] == NO_TEAM]
+    bags = [os.path.relpath(root / p, tmp_path) for p in [lost["bmbox_log"], *lost["gt_files"]]]
+    assert f"#   bags: {json.dumps(bags)}" in text
+    assert manifest.executions == ()
+    # never overwritten
+    with contextlib.redirect_stderr(io.StringIO()):
+        assert main(["rescore", str(root), "--init", str(draft)]) == 2

@@ -319,9 +319,9 @@ while the board stood still before the goal), class/instance right, pose score
 instance_accuracy, pose_score, execution_time."""
 
 
-def _declare(name: str, title: str, summary: str) -> Benchmark[
-    Fbm1Options, Fbm1Logs, Fbm1Runs, Fbm1Result
-]:
+def _declare(
+    name: str, title: str, summary: str
+) -> Benchmark[Fbm1Options, Fbm1Logs, Fbm1Runs, Fbm1Result]:
     return Benchmark(
         name=name,
         title=title,

@@ -104,12 +104,35 @@ INPUTS = (
         group=LEGACY,
     ),
     Input("namespace", "str", "benchmark namespace of the state topics", default=NAME),
-    Input("stop_speed", "float", "(default 0.05 m/s)", default=0.05, unit="m/s", positive=True,
-          metavar="M_S", group=AUTO),  # fmt: skip
-    Input("stop_yaw_rate", "float", "(default 0.1 rad/s)", default=0.1, unit="rad/s",
-          positive=True, metavar="RAD_S", group=AUTO),  # fmt: skip
-    Input("stop_min_duration", "float", "(default 0.5 s)", default=0.5, unit="s", positive=True,
-          group=AUTO),  # fmt: skip
+    Input(
+        "stop_speed",
+        "float",
+        "(default 0.05 m/s)",
+        default=0.05,
+        unit="m/s",
+        positive=True,
+        metavar="M_S",
+        group=AUTO,
+    ),  # fmt: skip
+    Input(
+        "stop_yaw_rate",
+        "float",
+        "(default 0.1 rad/s)",
+        default=0.1,
+        unit="rad/s",
+        positive=True,
+        metavar="RAD_S",
+        group=AUTO,
+    ),  # fmt: skip
+    Input(
+        "stop_min_duration",
+        "float",
+        "(default 0.5 s)",
+        default=0.5,
+        unit="s",
+        positive=True,
+        group=AUTO,
+    ),  # fmt: skip
     Input(
         "stop_radius",
         "float",
@@ -235,4 +258,3 @@ error, the segment time; then position_accuracy, orientation_accuracy and execut
     state_topics=True,
     values_2015={"all_2015": True},
 )
-

@@ -339,7 +339,9 @@ def locate_runs(logs: Fbm3wLogs, options: Fbm3wOptions) -> list[RunWindow]:
     return windows
 
 
-def score_found(logs: Fbm3wLogs, windows: Sequence[RunWindow], options: Fbm3wOptions) -> Fbm3wResult:
+def score_found(
+    logs: Fbm3wLogs, windows: Sequence[RunWindow], options: Fbm3wOptions
+) -> Fbm3wResult:
     """Score the runs found (:func:`score_runs` on the logs' poses)."""
     return score_runs(
         logs.poses,

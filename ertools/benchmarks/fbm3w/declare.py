@@ -82,8 +82,7 @@ INPUTS = (
     Input(
         "stopped_runs",
         "choice",
-        "a run the RefBox stopped: its time counted in execution_time (default), or 2015: "
-        "left out",
+        "a run the RefBox stopped: its time counted in execution_time (default), or 2015: left out",
         default="counted",
         choices=("counted", "2015"),
         group=LEGACY,
