@@ -269,6 +269,8 @@ class _Checker:
             converted = [self.value(single, item, where) for item in items]
             return _BAD if any(c is _BAD for c in converted) else tuple(converted)
         kind = declared.kind
+        if kind == "choice" and declared.with_file:
+            return self.choice_with_file(declared, value, where)
         if kind == "path":
             if not isinstance(value, str) or not value:
                 self.problem(where, f"expected a file path, got {_kind_name(value)}")
@@ -296,6 +298,26 @@ class _Checker:
             self.problem(where, f"{value!r} is not one of {', '.join(declared.choices)}")
             return _BAD
         return str(value)
+
+    def choice_with_file(self, declared: Input, value: Any, where: str) -> Any:
+        """``states`` or ``[timing, FILE]``: a choice, with a file for those that take one."""
+        words = [value] if isinstance(value, str) else value
+        expected = " | ".join(
+            f"[{c}, FILE]" if c in declared.with_file else c for c in declared.choices
+        )
+        if (
+            not isinstance(words, list)
+            or not words
+            or not all(isinstance(w, str) for w in words)
+            or words[0] not in declared.choices
+            or len(words) != (2 if words[0] in declared.with_file else 1)
+        ):
+            self.problem(where, f"expected {expected}, got {value!r}")
+            return _BAD
+        if len(words) == 1:
+            return (words[0],)
+        path = self.path(words[1], where)
+        return _BAD if path is _BAD else (words[0], path)
 
     def path(self, text: str, where: str) -> Path | Any:
         path = Path(text).expanduser()

@@ -140,7 +140,7 @@ def score_argv(
             argv.append(declared.option)
             continue
         items = value if isinstance(value, tuple | list) else (value,)
-        if declared.kind == "paths" and not declared.repeat:
+        if (declared.kind == "paths" and not declared.repeat) or declared.with_file:
             argv += [declared.option, *(str(v) for v in items)]
         else:
             for item in items:
