@@ -145,8 +145,8 @@ def score_argv(
         else:
             for item in items:
                 argv += [declared.option, str(item)]
-    if team:
-        argv += ["--team", team]
+    if team and all(declared.option != "--team" for declared in benchmark.inputs):
+        argv += ["--team", team]  # the score commands' own --team (else a declared input)
     return argv
 
 
