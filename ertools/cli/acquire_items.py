@@ -13,6 +13,7 @@ import argparse
 import math
 from pathlib import Path
 
+from ertools.benchmarks.fbm1.benchmark import BENCHMARKS
 from ertools.cli.common import all_failed, note, write_text
 
 EPILOG = """examples:
@@ -36,9 +37,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--namespace",
-        default="fbm1h",
-        choices=("fbm1h", "fbm1w"),
-        help="topic namespace of origin and ref_board (default fbm1h)",
+        default=BENCHMARKS[0],
+        choices=BENCHMARKS,
+        help=f"topic namespace of origin and ref_board (default {BENCHMARKS[0]})",
     )
     parser.add_argument("--origin-topic", metavar="TOPIC", help="origin pose topic")
     parser.add_argument("--ref-board-topic", metavar="TOPIC", help="ref_board pose topic")

@@ -297,6 +297,17 @@ def files(bags: Sequence[Path], options: Fbm1Options, result: Fbm1Result) -> lis
     return [*bags, *([options.items] if options.items is not None else [])]
 
 
+def sampler(name: str) -> Callable[[Path], list[str] | None]:
+    """The sample log of ``fbm1h`` or ``fbm1w`` with its item list (``make demo``)."""
+
+    def sample(samples: Path) -> list[str] | None:
+        folder = samples / name
+        bags = sorted(folder.glob("*.bag"))
+        items = folder / f"{name}.yaml"
+        return [str(bags[0]), "--items", str(items)] if bags and items.is_file() else None
+
+    return sample
+
 EPILOG = """examples:
   ertools score {name} run.bag --items configs/{name}.yaml
   ertools score fbm1w run.bag --items configs/fbm1w.yaml --items-order 3,7,1,2
@@ -347,6 +358,7 @@ def _declare(name: str, title: str, summary: str) -> Benchmark[
         score_keys=frozenset({"class_accuracy", "instance_accuracy"}),
         state_topics=True,
         values_2015={"rules": "2015"},
+        sample=sampler(name),
     )
 
 
