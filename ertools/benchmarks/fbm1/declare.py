@@ -121,7 +121,12 @@ def inputs(name: str) -> tuple[Input, ...]:
             group=NODES,
         ),
         Input("all_2015", "flag", "= --rules 2015", flag="--2015", group=NODES),
-        Input("all_2016", "flag", "= --rules 2016", flag="--2016", group=NODES),
+        # No 2016-17 @Work node is known: @Work has no --2016 (--rules 2016 says why).
+        *(
+            [Input("all_2016", "flag", "= --rules 2016", flag="--2016", group=NODES)]
+            if name == "fbm1h"
+            else []
+        ),
         Input(
             "clip_above_diagonal",
             "flag",
@@ -167,7 +172,7 @@ def inputs(name: str) -> tuple[Input, ...]:
 def _rules_name(v: Mapping[str, Any]) -> str:
     chosen = {v["rules"]} - {None}
     chosen |= {"2015"} if v["all_2015"] else set()
-    chosen |= {"2016"} if v["all_2016"] else set()
+    chosen |= {"2016"} if v.get("all_2016") else set()
     if len(chosen) > 1:
         raise UsageError(f"--rules/--2015/--2016 name {len(chosen)} references; give one")
     return chosen.pop() if chosen else "ertools"
@@ -308,6 +313,7 @@ def sampler(name: str) -> Callable[[Path], list[str] | None]:
 
     return sample
 
+
 EPILOG = """examples:
   ertools score {name} run.bag --items configs/{name}.yaml
   ertools score fbm1w run.bag --items configs/fbm1w.yaml --items-order 3,7,1,2
@@ -330,9 +336,9 @@ while the board stood still before the goal), class/instance right, pose score
 instance_accuracy, pose_score, execution_time."""
 
 
-def _declare(name: str, title: str, summary: str) -> Benchmark[
-    Fbm1Options, Fbm1Logs, Fbm1Runs, Fbm1Result
-]:
+def _declare(
+    name: str, title: str, summary: str
+) -> Benchmark[Fbm1Options, Fbm1Logs, Fbm1Runs, Fbm1Result]:
     return Benchmark(
         name=name,
         title=title,
