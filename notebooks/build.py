@@ -362,7 +362,7 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ),
         (
             "code",
-            "from ertools.audit.rescore import DEFAULT_ABS_TOL, compare_scores\n"
+            "from ertools.audit.compare import DEFAULT_ABS_TOL, compare_scores\n"
             "from ertools.benchmarks.fbm1.benchmark import Fbm1Options, score_fbm1_bag\n\n"
             "as_2015 = score_fbm1_bag(paths, items_path, options=Fbm1Options.as_2015('fbm1h'),\n"
             "                         results_path=results_path)\n"

@@ -25,7 +25,7 @@ from ertools.errors import UsageError
 # adding its content to a Collected. Dotted names, not classes: nothing is imported until a
 # file is written.
 CONTENT: dict[str, str] = {
-    "ertools.audit.analyse.Audit": "ertools.report.foxglove.audit:content",
+    "ertools.audit.model.Audit": "ertools.report.foxglove.audit:content",
 }
 
 # Pose and error streams longer than this keep every k-th message, k = ceil(n / limit): an
