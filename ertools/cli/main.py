@@ -167,7 +167,9 @@ OUTPUT_OPTIONS = {
     "output": "-o/--output",
     "report": "--report",
     "plot": "--plot",
+    "plots": "--plots",
     "out": "--out",
+    "out_dir": "--out-dir",
     "foxglove": "--foxglove",
 }
 
