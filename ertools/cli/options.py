@@ -131,6 +131,11 @@ def _number(text: str) -> float:
     return value
 
 
+def finite(text: str) -> float:
+    """A finite number, any sign (argparse ``type=``)."""
+    return _number(text)
+
+
 def positive(text: str) -> float:
     """A finite number > 0 (argparse ``type=``: a bad one is a usage error, exit 2)."""
     value = _number(text)
@@ -144,6 +149,14 @@ def non_negative(text: str) -> float:
     value = _number(text)
     if value < 0:
         raise argparse.ArgumentTypeError(f"{text}: must be >= 0")
+    return value
+
+
+def fraction(text: str) -> float:
+    """A number in [0, 1] (argparse ``type=``)."""
+    value = _number(text)
+    if not 0 <= value <= 1:
+        raise argparse.ArgumentTypeError(f"{text}: must be in [0, 1]")
     return value
 
 
@@ -161,6 +174,35 @@ def positive_int(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"{text}: must be >= 1")
     return value
+
+
+def port(text: str) -> int:
+    """A UDP/TCP port, 1 to 65535 (argparse ``type=``)."""
+    value = positive_int(text)
+    if value > 65535:
+        raise argparse.ArgumentTypeError(f"{text}: a port is 1 to 65535")
+    return value
+
+
+def non_negative_int(text: str) -> int:
+    """An integer >= 0 (argparse ``type=``: a count)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{text}: must be >= 0")
+    return value
+
+
+def seconds_or_auto(text: str) -> str | float:
+    """Seconds (any sign: a clock offset) or ``auto`` (argparse ``type=``)."""
+    if text == "auto":
+        return text
+    try:
+        return _number(text)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"{text!r}: give seconds or 'auto'") from None
 
 
 def tf_pair(text: str) -> tuple[str, str]:
@@ -337,15 +379,18 @@ def add_report(
     )
 
 
-def plot_file(suffixes: Sequence[str] = PLOT_SUFFIXES) -> Callable[[str], Path]:
-    """argparse ``type=`` for ``--plot FILE``: the suffix must say the format (exit 2 if not)."""
+def plot_file(
+    suffixes: Sequence[str] = PLOT_SUFFIXES, *, folder: bool = False
+) -> Callable[[str], Path]:
+    """argparse ``type=`` for ``--plot FILE``: the suffix must say the format (exit 2 if not);
+    ``folder``: the command has ``--plots DIR`` too (the message says so)."""
 
     def value(text: str) -> Path:
         path = Path(text)
         if path.suffix.lower() not in suffixes:
             raise argparse.ArgumentTypeError(
-                f"{text}: the suffix picks the format; give one of {', '.join(suffixes)} "
-                "(--plots DIR writes one file per figure)"
+                f"{text}: the suffix picks the format; give one of {', '.join(suffixes)}"
+                + (" (--plots DIR writes one file per figure)" if folder else "")
             )
         return path
 

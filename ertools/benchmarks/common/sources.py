@@ -211,7 +211,11 @@ def read_source(
     chosen = choose_source(paths, spec, defaults, what=what, only_topic=only_topic, present=present)
     fallback = time_source_fallback(chosen, present)
     if fallback is not None:
-        log.warning("%s", fallback)
+        # A warning when the user chose the topic or the time: what they asked for is not
+        # what they get. A command's own default topic being Pose2D is the 2015 setup (the
+        # nodes read the pose2d topics live): said with -v only, not on every run.
+        loud = spec.topic is not None or spec.time_source_given
+        log.log(logging.WARNING if loud else logging.INFO, "%s", fallback)
     poses = read_pose_source(list(paths), chosen.to_io(), start_ns=start_ns, end_ns=end_ns)
     if len(poses) == 0:
         raise TopicError(f"{poses.source or chosen.describe()}: no pose messages", path=paths[0])
