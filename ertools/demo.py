@@ -111,7 +111,7 @@ def steps(samples: Path, out: Path) -> Iterator[Step]:
     )
     yield Step(
         "audit of the FBM2@Home benchmark",
-        ["audit", str(fbm2_bag), "--report", str(out / "audit_fbm2h")],
+        ["audit", str(fbm2_bag), "--format", "text", "--report", str(out / "audit_fbm2h")],
         "audit_fbm2h.txt",
     )
 

@@ -383,15 +383,24 @@ def add_output(
 
 
 def add_report(
-    parser: argparse.ArgumentParser | argparse._ActionsContainer, help: str = ""
+    parser: argparse.ArgumentParser | argparse._ActionsContainer,
+    help: str = "",
+    *,
+    required: bool = False,
+    old: Sequence[str] = (),
 ) -> None:
-    """``--report DIR``: a self-contained report folder."""
-    parser.add_argument(
+    """``--report DIR``: a self-contained report folder (``old``: former spellings)."""
+    # required with old spellings: a required group of the new and the old options, so that
+    # either satisfies argparse and a missing one is its usage error (exit 2, with --help)
+    where = parser.add_mutually_exclusive_group(required=True) if required else parser
+    where.add_argument(
         "--report",
         type=Path,
         metavar="DIR",
         help=help or "write a self-contained report folder (index.html, data files, figures)",
     )
+    for spelling in old:
+        deprecated(where, spelling, "--report", "report", convert=Path, metavar="DIR")
 
 
 def plot_file(
@@ -518,8 +527,10 @@ def add_out_dir(
     *,
     old: Sequence[str] = (),
     default: Path | None = None,
+    required: bool = False,
 ) -> None:
     """``--out-dir DIR``: a folder of several data files (not a report)."""
-    parser.add_argument("--out-dir", type=Path, metavar="DIR", default=default, help=help)
+    where = parser.add_mutually_exclusive_group(required=True) if required else parser
+    where.add_argument("--out-dir", type=Path, metavar="DIR", default=default, help=help)
     for spelling in old:
-        deprecated(parser, spelling, "--out-dir", "out_dir", convert=Path, metavar="DIR")
+        deprecated(where, spelling, "--out-dir", "out_dir", convert=Path, metavar="DIR")

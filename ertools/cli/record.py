@@ -42,7 +42,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from ertools.cli.options import add_out_dir, port, positive
 
     parser.add_argument("--config", type=Path, help="mocap YAML (seed Listing 2: rigid_bodies)")
-    add_out_dir(parser, "write the MCAP files into DIR (required)", old=("--out",))
+    add_out_dir(parser, "write the MCAP files into DIR", old=("--out",), required=True)
     parser.add_argument("--name", help="file name part (default <namespace>_mocap or mocap)")
     parser.add_argument(
         "--namespace", default="", help="prefix of the config's relative topics, e.g. /fbm2h"
@@ -118,8 +118,6 @@ def run(args: argparse.Namespace) -> int:
     from ertools.live.natnet import NatNetVersion
     from ertools.live.recorder import Recorder, RecordOptions
 
-    if args.out_dir is None:
-        raise UsageError("give --out-dir DIR: where to write the MCAP files")
     if args.config is None and not args.simulate:
         raise UsageError("--config is required (a mocap YAML as seed Listing 2)")
     config = (

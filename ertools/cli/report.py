@@ -22,20 +22,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "results", nargs="+", type=Path, metavar="RESULT", help="report folder or its JSON"
     )
-    from ertools.cli.options import add_report, deprecated
+    from ertools.cli.options import add_report
 
-    add_report(parser, "write the combined page here (DIR/index.html; required)")
-    deprecated(parser, "--out", "--report", "report", convert=Path, metavar="DIR")
+    add_report(
+        parser, "write the combined page here (DIR/index.html)", required=True, old=("--out",)
+    )
     parser.add_argument("--title", default="Competition results", help="the page's title")
 
 
 def run(args: argparse.Namespace) -> int:
     from ertools.cli.common import note
-    from ertools.errors import UsageError
     from ertools.report.combine import combine
 
-    if args.report is None:
-        raise UsageError("give --report DIR: where to write the combined page")
     index = combine(list(args.results), args.report, title=args.title)
     note(f"combined {len(args.results)} result(s) into {index}")
     print(index)
