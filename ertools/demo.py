@@ -72,7 +72,7 @@ def steps(samples: Path, out: Path) -> Iterator[Step]:
         if bench.state_topics:
             yield Step(
                 f"audit of the {bench.title} benchmark",
-                ["audit", sample[0], "--report", str(out / f"audit_{name}")],
+                ["audit", sample[0], "--format", "text", "--report", str(out / f"audit_{name}")],
                 f"audit_{name}.txt",
             )
 
