@@ -87,6 +87,19 @@ class Ranking:
     text: str
 
 
+@dataclass(frozen=True)
+class Explanation:
+    """Why a recomputed value may differ from the live one (``ertools audit``).
+
+    ``pattern`` is a regular expression on the last component of the differing key,
+    ``text`` the explanation, ``params`` fragments of parameter names worth showing beside it.
+    """
+
+    pattern: str
+    text: str
+    params: tuple[str, ...] = ()
+
+
 OptionsT = TypeVar("OptionsT")
 LoadedT = TypeVar("LoadedT")
 RunsT = TypeVar("RunsT")
@@ -210,8 +223,13 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
             (``ertools audit`` can reconstruct it).
         values_2015: the :class:`Input` values that restore every 2015 behaviour (the audit
             compares the live score with the score recomputed with them); empty: none.
-        from_live: the audit's hook: the values given and the live score (parsed) -> the
-            values to rescore with and notes saying what was taken from the live score.
+        from_live: the audit's hook: the options made from the values given and the live
+            score (parsed) -> the options to rescore with and notes saying what was taken
+            from the live score (FBM2H: the transform the node used).
+        explanations: why a recomputed value may differ from the live one, by key (the
+            audit's comparison shows the first that matches a differing key).
+        sample: the sample logs' folder (``sample_bags/``) -> the arguments scoring this
+            benchmark on them (``make demo``); None, or a None result: no sample.
     """
 
     name: str
@@ -235,9 +253,9 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
     score_keys: frozenset[str] = frozenset()
     state_topics: bool = False
     values_2015: Mapping[str, Any] = field(default_factory=dict)
-    from_live: (
-        Callable[[Mapping[str, Any], Any], tuple[Mapping[str, Any], tuple[str, ...]]] | None
-    ) = None
+    from_live: Callable[[OptionsT, Any], tuple[OptionsT, tuple[str, ...]]] | None = None
+    explanations: tuple[Explanation, ...] = ()
+    sample: Callable[[Path], Sequence[str] | None] | None = None
 
     def score(self, bags: Sequence[Path], options: OptionsT) -> ResultT:
         """The whole shape: load -> find runs -> score."""

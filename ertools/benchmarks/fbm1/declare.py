@@ -121,7 +121,12 @@ def inputs(name: str) -> tuple[Input, ...]:
             group=NODES,
         ),
         Input("all_2015", "flag", "= --rules 2015", flag="--2015", group=NODES),
-        Input("all_2016", "flag", "= --rules 2016", flag="--2016", group=NODES),
+        # No 2016-17 @Work node is known: @Work has no --2016 (--rules 2016 says why).
+        *(
+            [Input("all_2016", "flag", "= --rules 2016", flag="--2016", group=NODES)]
+            if name == "fbm1h"
+            else []
+        ),
         Input(
             "clip_above_diagonal",
             "flag",
@@ -167,7 +172,7 @@ def inputs(name: str) -> tuple[Input, ...]:
 def _rules_name(v: Mapping[str, Any]) -> str:
     chosen = {v["rules"]} - {None}
     chosen |= {"2015"} if v["all_2015"] else set()
-    chosen |= {"2016"} if v["all_2016"] else set()
+    chosen |= {"2016"} if v.get("all_2016") else set()
     if len(chosen) > 1:
         raise UsageError(f"--rules/--2015/--2016 name {len(chosen)} references; give one")
     return chosen.pop() if chosen else "ertools"
@@ -297,6 +302,18 @@ def files(bags: Sequence[Path], options: Fbm1Options, result: Fbm1Result) -> lis
     return [*bags, *([options.items] if options.items is not None else [])]
 
 
+def sampler(name: str) -> Callable[[Path], list[str] | None]:
+    """The sample log of ``fbm1h`` or ``fbm1w`` with its item list (``make demo``)."""
+
+    def sample(samples: Path) -> list[str] | None:
+        folder = samples / name
+        bags = sorted(folder.glob("*.bag"))
+        items = folder / f"{name}.yaml"
+        return [str(bags[0]), "--items", str(items)] if bags and items.is_file() else None
+
+    return sample
+
+
 EPILOG = """examples:
   ertools score {name} run.bag --items configs/{name}.yaml
   ertools score fbm1w run.bag --items configs/fbm1w.yaml --items-order 3,7,1,2
@@ -347,6 +364,7 @@ def _declare(
         score_keys=frozenset({"class_accuracy", "instance_accuracy"}),
         state_topics=True,
         values_2015={"rules": "2015"},
+        sample=sampler(name),
     )
 
 

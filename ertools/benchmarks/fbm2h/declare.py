@@ -214,6 +214,16 @@ def notes(result: Fbm2hResult) -> list[str]:
     return out
 
 
+def sample(samples: Path) -> list[str] | None:
+    """The FBM2@Home sample log with its goal list and transform (``make demo``)."""
+    folder = samples / NAME
+    bags = sorted(folder.glob("*.bag"))
+    goals = sorted(folder.glob("*goal*.yaml"))
+    transforms = sorted(folder.glob("transform-*.yaml"))
+    if not (bags and goals and transforms):
+        return None
+    return [str(bags[0]), "--goal", str(goals[0]), "--transform", str(transforms[0])]
+
 EPILOG = """examples:
   ertools score fbm2h run.bag --team homer --transforms transforms/
   ertools score fbm2h run.bag --goal configs/fbm2h.yaml --transform transform-homer.yaml
@@ -257,4 +267,5 @@ error, the segment time; then position_accuracy, orientation_accuracy and execut
     score_keys=frozenset({"position_accuracy", "orientation_accuracy"}),
     state_topics=True,
     values_2015={"all_2015": True},
+    sample=sample,
 )

@@ -8,6 +8,7 @@ the run windows and the switches that contradict each other.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks.base import Benchmark, Input, Ranking, resolve_values
@@ -210,6 +211,11 @@ def notes(result: Fbm3wResult) -> list[str]:
     return out
 
 
+def sample(samples: Path) -> list[str] | None:
+    """The FBM3@Work sample log (``make demo``)."""
+    bags = sorted((samples / "fbm3w").glob("*.bag"))
+    return [str(bags[0])] if bags else None
+
 EPILOG = """examples:
   ertools score fbm3w log_fbm3w_mocap.bag
   ertools score fbm3w run.bag --config configs/fbm3w.yaml --format json
@@ -256,4 +262,5 @@ best_run, best_distance_error and execution_time (sum of the run times).""",
     score_keys=frozenset({"best_distance_error", "runs_details"}),
     state_topics=True,
     values_2015={"all_2015": True},
+    sample=sample,
 )

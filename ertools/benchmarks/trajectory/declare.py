@@ -190,6 +190,15 @@ def files(bags: Sequence[Path], options: TrajectoryOptions, result: TrajectoryRe
     return list(dict.fromkeys([Path(bags[0]), *map(Path, result.gt_files)]))
 
 
+def sample(samples: Path) -> list[str] | None:
+    """The sample robot log against the GT folder beside it, clock offset estimated and
+    applied (``make demo``)."""
+    folder = samples / "robotlog"
+    robots = sorted(folder.glob("FBM2H_*.bag"))
+    if not robots:
+        return None
+    return [str(robots[0]), str(folder), "--offset", "auto", "--apply-offset"]
+
 EPILOG = """examples:
   ertools score trajectory robot.bag gt/ --robot-topic /rockin/homer/marker_pose \\
       --gt-topic /fbm2h/robot_at_home/pose
@@ -236,4 +245,5 @@ robot's stamps and the GT clock and says when it matters.""",
     bags_metavar=("ROBOT_BAG", "GT_PATH"),
     score_keys=frozenset({"position_error", "association"}),
     values_2015={"as_2015": True},
+    sample=sample,
 )
