@@ -24,6 +24,7 @@ from ertools.benchmarks.base import Benchmark, jsonable
 from ertools.benchmarks.common.teams import with_team
 from ertools.benchmarks.document import all_failed, score_json
 from ertools.errors import ErtoolsError
+from ertools.progress import reporting
 
 Status = Literal["scored", "unscoreable", "failed"]
 
@@ -127,7 +128,10 @@ def run_job(job: Job) -> Outcome:
     logger.handlers[:] = [captured]
     logger.propagate = False
     try:
-        outcome = _score(job)
+        # a worker forked from the command holds its progress bar: the bar is the parent's, and
+        # counts executions; the reads inside one report nothing
+        with reporting(None):
+            outcome = _score(job)
     except ErtoolsError as err:
         outcome = Outcome(
             job.id, "unscoreable", reason=one_line(str(err)), error=type(err).__name__
