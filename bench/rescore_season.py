@@ -18,8 +18,10 @@ Targets (on a 2-core machine): --jobs 2 at least 1.7x faster than --jobs 1; Dask
 from __future__ import annotations
 
 import argparse
+import datetime as dt
 import json
 import os
+import resource
 import shutil
 import subprocess
 import sys
@@ -35,10 +37,10 @@ sys.path.insert(0, str(HERE))
 
 from season import DAYS, SLOTS_PER_DAY, generate_season  # noqa: E402
 
+from ertools.benchmarks import registry  # noqa: E402
+
 ERTOOLS = str(Path(sys.executable).parent / "ertools")
 FOLDER = REPO / "build" / "bench"
-# The manifest's input keys per benchmark that name a file (the sample competition's names).
-PER_TEAM = ("transform",)
 
 
 @dataclass
@@ -50,6 +52,7 @@ class Run:
     peak_main_mib: float
     peak_other_mib: float  # the largest other process: a worker, Dask's nanny or scheduler
     processes: int
+    cpu_s: float  # user + system time of the command and every process it waited for
     scored: int = 0
     cached: int = 0
     note: str = ""
@@ -58,6 +61,10 @@ class Run:
     @property
     def per_execution_s(self) -> float:
         return self.wall_s / self.executions
+
+    @property
+    def cpu_per_execution_s(self) -> float:
+        return self.cpu_s / self.executions
 
 
 def manifest_text(root: Path, season: dict[str, Any], days: set[int]) -> str:
@@ -68,10 +75,18 @@ def manifest_text(root: Path, season: dict[str, Any], days: set[int]) -> str:
     lines = ["version: 1", "title: Generated season (bench/season.py)", "benchmarks:"]
     chosen = [e for e in season["executions"] if e["day"] in days]
     for e in chosen:
+        # Which inputs the registry declares per team (the transform, or the team's name with a
+        # shared folder of transform-<team>.yaml): the manifest follows the declarations.
+        per_team = {i.name for i in registry.get(e["benchmark"]).inputs if i.per_team}
+        mine = teams.setdefault(e["benchmark"], {}).setdefault(e["team"], {})
+        if "team" in per_team:
+            mine["team"] = e["team"]
         for key, rel in e["inputs"].items():
             path = str(root / rel)
-            if key in PER_TEAM:
-                teams.setdefault(e["benchmark"], {}).setdefault(e["team"], {})[key] = path
+            if key == "transform" and key not in per_team:
+                shared.setdefault(e["benchmark"], {})["transforms"] = str(Path(path).parent)
+            elif key in per_team:
+                mine[key] = path
             else:
                 shared.setdefault(e["benchmark"], {})[key] = path
     for bench in sorted({e["benchmark"] for e in chosen}):
@@ -79,9 +94,11 @@ def manifest_text(root: Path, season: dict[str, Any], days: set[int]) -> str:
         if shared.get(bench):
             lines.append("    inputs:")
             lines += [f"      {k}: {json.dumps(v)}" for k, v in sorted(shared[bench].items())]
-        if teams.get(bench):
+        if any(teams.get(bench, {}).values()):
             lines.append("    teams:")
             for team, values in sorted(teams[bench].items()):
+                if not values:
+                    continue
                 lines.append(f"      {json.dumps(team)}:")
                 lines += [f"        {k}: {json.dumps(v)}" for k, v in sorted(values.items())]
     lines.append("executions:")
@@ -90,6 +107,10 @@ def manifest_text(root: Path, season: dict[str, Any], days: set[int]) -> str:
         lines.append(f"  - benchmark: {e['benchmark']}")
         lines.append(f"    team: {json.dumps(e['team'])}")
         lines.append(f"    bags: {json.dumps(bags)}")
+        # The benchmark log's span, not the GT hour files' (the execution's id and times).
+        for key in ("start", "end"):
+            stamp = dt.datetime.fromtimestamp(e[f"{key}_ns"] / 1e9, tz=dt.UTC)
+            lines.append(f"    {key}: {stamp.isoformat(timespec='milliseconds')}")
     return "\n".join(lines) + "\n"
 
 
@@ -129,6 +150,7 @@ def _hwm_kib(pid: int) -> tuple[int, str] | None:
 def timed(name: str, argv: list[str], executions: int) -> Run:
     """Run ``argv`` once; wall time, exit status and the peak RSS of each process it started."""
     peaks: dict[int, tuple[int, str]] = {}
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     proc = subprocess.Popen(argv, cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     stop = threading.Event()
@@ -145,6 +167,8 @@ def timed(name: str, argv: list[str], executions: int) -> Run:
     poller.start()
     _, err = proc.communicate()
     wall = time.perf_counter() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     stop.set()
     poller.join()
     main = peaks.get(proc.pid, (0, ""))[0] / 1024
@@ -159,6 +183,7 @@ def timed(name: str, argv: list[str], executions: int) -> Run:
         main,
         other,
         1 + len(others),
+        cpu,
         note=tail[-1] if tail else "",
         peaks={f"{pid} {cmd[:80]}": kib / 1024 for pid, (kib, cmd) in peaks.items()},
     )
@@ -221,7 +246,7 @@ def main() -> int:
     print(f"machine: {os.cpu_count()} cores, load average {load} at start")
     print(
         f"  {'ertools rescore ...':<44} {'execs':>5} {'wall s':>8} {'s/exec':>7} "
-        f"{'main MiB':>8} {'other MiB':>9} {'procs':>5}  scored/cached"
+        f"{'CPU s':>7} {'main MiB':>8} {'other MiB':>9} {'procs':>5}  scored/cached"
     )
 
     runs: dict[str, Run] = {}
@@ -232,7 +257,8 @@ def main() -> int:
         runs[key] = run
         print(
             f"  {label:<44} {count:>5} {run.wall_s:8.2f} {run.per_execution_s:7.3f} "
-            f"{run.peak_main_mib:8.1f} {run.peak_other_mib:9.1f} {run.processes:>5}  "
+            f"{run.cpu_s:7.1f} {run.peak_main_mib:8.1f} {run.peak_other_mib:9.1f} "
+            f"{run.processes:>5}  "
             f"{run.scored}/{run.cached}{'' if run.exit in (0, 1) else '  FAILED: ' + run.note}",
             flush=True,
         )
@@ -289,22 +315,32 @@ def main() -> int:
     everything = all(r.scored == r.executions for r in runs.values())
     check("scored", "every execution scored in every run", f"{j2.scored}/{n}", everything)
 
-    # The 16-worker cluster by the same measure: the serial part (timeline, cache check,
-    # writing results: what a warm run does) plus the parallel part spread over 16 workers at
-    # the parallel efficiency measured with 2.
+    # A 16-worker cluster by the same measure (Amdahl): the serial part (manifest, hashes,
+    # cache check, writing results and the site: what a warm run does) plus the executions
+    # spread over the workers at the parallel efficiency measured with 2. Two per-execution
+    # figures: the wall time with one worker (this machine, as loaded) and the CPU time (what
+    # a worker with a core of its own spends: the figure for dedicated cluster nodes).
     serial = warm.wall_s
-    per_exec = (j1.wall_s - serial) / n
-    efficiency = (j1.wall_s - serial) / (2 * max(j2.wall_s - serial, 1e-9))
-    projection = {w: serial + n * per_exec / (w * min(efficiency, 1.0)) for w in (1, 2, 16)}
-    print("\nextrapolation (measured per execution, Amdahl with the measured 2-worker efficiency):")
+    wall_per_exec = (j1.wall_s - serial) / n
+    cpu_per_exec = (j1.cpu_s - warm.cpu_s) / n
+    efficiency = min((j1.wall_s - serial) / (2 * max(j2.wall_s - serial, 1e-9)), 1.0)
+    projection = {
+        f"{w}_{basis}": serial + n * per / (w * (efficiency if w > 1 else 1.0))
+        for w in (1, 2, 16)
+        for basis, per in (("wall", wall_per_exec), ("cpu", cpu_per_exec))
+    }
+    print("\nextrapolation (per execution measured here; Amdahl with the 2-worker efficiency):")
     print(
-        f"  serial part (the warm run): {serial:.2f} s; per execution, one worker: "
-        f"{per_exec:.3f} s; 2-worker efficiency {efficiency:.2f}"
+        f"  serial part (the warm run) {serial:.2f} s; per execution with one worker "
+        f"{wall_per_exec:.3f} s wall, {cpu_per_exec:.3f} s CPU; 2-worker efficiency "
+        f"{efficiency:.2f}"
     )
-    for w, t in projection.items():
+    for w in (1, 2, 16):
+        a, b = projection[f"{w}_wall"], projection[f"{w}_cpu"]
+        rate = 3600 * n / (b - serial)
         print(
-            f"  {w:>2} worker(s): {t:8.1f} s for {n} executions "
-            f"({3600 / ((t - serial) / n) if t > serial else float('inf'):,.0f} executions/hour)"
+            f"  {w:>2} worker(s), {n} executions: {a:8.1f} s by the wall time here, {b:8.1f} s "
+            f"by the CPU time ({rate:,.0f} executions/hour)"
         )
     args.json.parent.mkdir(parents=True, exist_ok=True)
     args.json.write_text(
@@ -318,7 +354,8 @@ def main() -> int:
                 "checks": checks,
                 "extrapolation": {
                     "serial_s": serial,
-                    "per_execution_s": per_exec,
+                    "wall_per_execution_s": wall_per_exec,
+                    "cpu_per_execution_s": cpu_per_exec,
                     "efficiency_2": efficiency,
                     "seconds": projection,
                 },

@@ -31,15 +31,16 @@ from typing import Any
 import numpy as np
 
 from ertools.samples import fbm1, fbm2h, fbm3w
-
-# The one helper the sample competition keeps private: its FBM1 answer errors per team.
-from ertools.samples.competition import _fbm1_errors
 from ertools.samples.competition_files import (
     GtWindow,
+    robot_poses,
     write_benchmark_log,
     write_gt_file,
     write_robot_log,
 )
+
+# The one helper the sample competition keeps private: its FBM1 answer errors per team.
+from ertools.samples.competition_schedule import _fbm1_errors
 from ertools.samples.scenario import EPOCH_2015, log_name
 from ertools.samples.simulated import SimulatedRun
 
@@ -184,7 +185,8 @@ def generate_season(
             r_end = sim.end_ns + round(ROBOT_TAIL_S * NS)
             robot_rel = _robot_rel(day_dir, slot.benchmark, r_start, slot.team)
             (partial / robot_rel).parent.mkdir(parents=True, exist_ok=True)
-            write_robot_log(partial / robot_rel, sim, slot.team, r_start, r_end, 0, rlog_rng)
+            poses = robot_poses(sim, r_start, r_end, rlog_rng)
+            write_robot_log(partial / robot_rel, slot.team, r_start, r_end, poses, 0)
             # The manifest's inputs, named as the sample competition's answers name them.
             inputs = {
                 ("transform" if n.startswith("transform-") else INPUT_KEY[slot.benchmark]): (

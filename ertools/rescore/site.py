@@ -178,7 +178,10 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
             key = _value_key(ex.get("score") if ex else None, value)
             keys.add(key)
             live = _scalars(ex.get("live_score") if ex else None)
-            differs = bool(ex and ex.get("live_differences"))
+            # Flagged when the ranked value itself differs from the live one (a difference in
+            # another field, e.g. a rounded execution_time, is in the live section).
+            lines = (ex.get("live_differences") or []) if ex else []
+            differs = key in _differing_fields(lines) if key else bool(lines)
             standings.append(
                 Standing(
                     rank=rank,
@@ -226,10 +229,11 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
                 }
             )
     live_table = h.table(live_rows, row_class="differs") if live_rows else None
+    # Per execution (collapsed on the page: nested fields make dozens of lines per execution).
     differences = [
-        (str(ex.get("id")), str(line))
+        (str(ex.get("id")), [str(line) for line in ex.get("live_differences") or []])
         for ex in executions
-        for line in ex.get("live_differences") or []
+        if ex.get("live_differences")
     ]
 
     rows = []
