@@ -22,7 +22,7 @@ from pathlib import Path
 
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Input
-from ertools.rescore.found import Found
+from ertools.rescore.found import Found, robot_benchmarks
 from ertools.timeutil import NS_PER_S
 
 CONFIG_SUFFIXES = (".yaml", ".yml")
@@ -150,6 +150,16 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
                 else:  # left out until found: its executions are unscoreable, saying why
                     lines.append(f"      # {_yaml(team)}:")
                     lines += entries
+    robot_logs = sum(e.robot_log is not None for e in executions)
+    for name in robot_benchmarks() if robot_logs else ():
+        bench = registry.get(name)
+        lines.append(f"  {name}:  # {bench.title}: the {robot_logs} robot log(s) against the GT")
+        lines.append("    inputs: {}")
+        text = (
+            f"e.g. {', '.join(i.name for i in bench.inputs)} (`ertools score {name} --help`: "
+            "the options; a GT topic when the GT files hold several)"
+        )
+        lines += [f"      # {part}" for part in textwrap.wrap(text, 88)]
     unnamed = [e for e in executions if e.team is None and e.benchmark in known]
     lines.append("executions:" + ("" if unnamed else " []"))
     for e in unnamed:
