@@ -297,9 +297,7 @@ def _one_value(declared: Input, value: Any) -> Any:
         if not isinstance(value, str):
             raise UsageError(f"{option} must be text, got {value!r}")
         if kind == "choice" and value not in declared.choices:
-            raise UsageError(
-                f"{option} {value!r}: choose from {', '.join(declared.choices)}"
-            )
+            raise UsageError(f"{option} {value!r}: choose from {', '.join(declared.choices)}")
         return value
     number: float
     try:
@@ -355,7 +353,7 @@ def resolve_values(inputs: Sequence[Input], given: Mapping[str, Any]) -> dict[st
         )
     out: dict[str, Any] = {}
     for name, declared in known.items():
-        value = given.get(name)
+        value: Any = given.get(name)
         if value is None:
             value = declared.default
         if value is None and declared.kind == "flag":
@@ -363,7 +361,7 @@ def resolve_values(inputs: Sequence[Input], given: Mapping[str, Any]) -> dict[st
         if value is None:
             out[name] = () if declared.repeat else None
         elif declared.repeat or declared.kind == "paths":
-            values = [value] if isinstance(value, str | Path) else list(value)
+            values: list[Any] = [value] if isinstance(value, str | Path) else list(value)
             out[name] = tuple(_one_value(declared, v) for v in values)
         else:
             out[name] = _one_value(declared, value)

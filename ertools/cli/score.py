@@ -165,9 +165,7 @@ def _values(bench: registry.AnyBenchmark, args: argparse.Namespace) -> dict[str,
     return values
 
 
-def _bags(
-    bench: registry.AnyBenchmark, values: dict[str, Any], bags: Sequence[Path]
-) -> list[Path]:
+def _bags(bench: registry.AnyBenchmark, values: dict[str, Any], bags: Sequence[Path]) -> list[Path]:
     """The bags, taken back from a ``with_file`` choice that swallowed them when it came
     first (``--reached timing FILE log.bag``)."""
     out = list(bags)
@@ -203,4 +201,3 @@ def run(args: argparse.Namespace) -> int:
         for line in bench.notes(result) if bench.notes is not None else ():
             note(line)
     return emit_result(result, args, bench.input_files(bags, options, result))
-

@@ -42,6 +42,7 @@ import numpy.typing as npt
 import yaml
 from scipy.spatial.transform import Rotation
 
+from ertools.benchmarks.fbm1.benchmark import BENCHMARKS
 from ertools.samples.mocap import (
     MocapNoise,
     frame_times,
@@ -60,7 +61,7 @@ F64 = npt.NDArray[np.float64]
 S = 1_000_000_000
 MS = 1_000_000
 
-NAMESPACE = "fbm1h"
+NAMESPACE = BENCHMARKS[0]
 SIGMA_M = 2.0e-4
 SIGMA_RAD = 5.0e-4
 RUNS = 10
@@ -354,7 +355,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     answers = write_answers(
         bag_path,
         benchmark=NAMESPACE,
-        scenario="fbm1h",
+        scenario=NAMESPACE,
         seed=seed,
         parameters={
             "namespace": NAMESPACE,

@@ -45,6 +45,7 @@ import numpy.typing as npt
 import yaml
 from scipy.spatial.transform import Rotation, Slerp
 
+from ertools.benchmarks.fbm2h.benchmark import NAMESPACE as FBM2H
 from ertools.samples.mocap import (
     MocapNoise,
     MocapPublished,
@@ -64,7 +65,7 @@ from ertools.streams import Machine
 F64 = npt.NDArray[np.float64]
 S = 1_000_000_000
 
-NAMESPACE = "fbm2h"
+NAMESPACE = FBM2H
 BODY = "robot_at_home"
 TEAM = "simbot"
 SIGMA_M = 2.0e-4
@@ -403,8 +404,8 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     ]
     answers = write_answers(
         bag_path,
-        benchmark="fbm2h",
-        scenario="fbm2h",
+        benchmark=NAMESPACE,
+        scenario=NAMESPACE,
         seed=seed,
         parameters={
             "namespace": NAMESPACE,

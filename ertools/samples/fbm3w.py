@@ -43,6 +43,7 @@ import numpy as np
 import numpy.typing as npt
 import yaml
 
+from ertools.benchmarks.fbm3w.benchmark import NAMESPACE as FBM3W
 from ertools.geometry import quat_from_yaw
 from ertools.samples.mocap import (
     MocapNoise,
@@ -62,7 +63,7 @@ F64 = npt.NDArray[np.float64]
 Motion = Callable[[F64], F64]  # time (s from the mocap start) -> (N, 2) world positions
 S = 1_000_000_000
 
-NAMESPACE = "fbm3w"
+NAMESPACE = FBM3W
 BODY = "robot_at_work"
 SIGMA_M = 5.0e-5
 D_MIN = 0.00033  # the 2015 script's D_MIN
@@ -370,8 +371,8 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
             run[f"{key}_s"] = (ns - start) / S  # seconds from the bag's first message
     answers = write_answers(
         paths,
-        benchmark="fbm3w",
-        scenario="fbm3w",
+        benchmark=NAMESPACE,
+        scenario=NAMESPACE,
         seed=seed,
         parameters={
             "namespace": NAMESPACE,

@@ -12,7 +12,14 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.base import Benchmark, Input, Ranking, notice, resolve_values
+from ertools.benchmarks.base import (
+    Benchmark,
+    Explanation,
+    Input,
+    Ranking,
+    notice,
+    resolve_values,
+)
 from ertools.benchmarks.fbm1.benchmark import (
     RULE_SETS,
     BodySources,
@@ -314,6 +321,23 @@ def sampler(name: str) -> Callable[[Path], list[str] | None]:
     return sample
 
 
+# Why an audit's recomputed value may differ from the live one.
+EXPLANATIONS = (
+    Explanation(
+        r"(pose_score|x_error|y_error|theta_error|position|orientation)$",
+        "the ground truth is averaged over the window in which the board stood still "
+        "(the 2015 node interpolated one tf lookup when the result arrived); theta is in "
+        "degrees",
+        ("window", "source", "topic", "items"),
+    ),
+    Explanation(
+        r"(class|instance)(_accuracy|_correct)?$",
+        "class and instance are compared as text with the item list",
+        ("items",),
+    ),
+)
+
+
 EPILOG = """examples:
   ertools score {name} run.bag --items configs/{name}.yaml
   ertools score fbm1w run.bag --items configs/fbm1w.yaml --items-order 3,7,1,2
@@ -326,7 +350,8 @@ x, y, theta}} (theta in degrees), used instead of the Client payloads it covers.
 The per-run table goes to stderr; stdout carries the score (YAML or JSON).
 Exit status 1 when any run could not be scored (each named on stderr); the others are scored."""
 
-DESCRIPTION = """Recompute an FBM1@Home / FBM1@Work (object perception) score from the log (seed 7.1).
+DESCRIPTION = """Recompute an FBM1@Home / FBM1@Work (object perception) score from the log
+(seed 7.1).
 
 Per run: the item shown (manual-operation payload), the robot's answer (Client COMPLETED_GOAL
 payload: item_class, item_instance, x, y in metres, theta in DEGREES, table frame), the
@@ -365,6 +390,7 @@ def _declare(
         state_topics=True,
         values_2015={"rules": "2015"},
         sample=sampler(name),
+        explanations=EXPLANATIONS,
     )
 
 

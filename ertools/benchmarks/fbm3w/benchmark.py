@@ -37,9 +37,9 @@ from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
 from ertools.configs.shapes import Shape
 from ertools.errors import ConfigError, ErtoolsError, ScoringError, TopicError
 from ertools.fidelity import Deviation, Rule
+from ertools.io.model import BenchmarkStates
 from ertools.progress import Reporter, current
 from ertools.streams import PoseStream, Provenance, frame_change_warning
-from ertools.io.model import BenchmarkStates
 
 log = logging.getLogger("ertools.benchmarks.fbm3w.benchmark")
 
@@ -184,7 +184,8 @@ class Fbm3wOptions:
         config: runs_specifications, d_min and shapes (None: the 2015 values,
             ``configs/fbm3w.yaml``); ``d_min`` above overrides its d_min.
 
-    The values are validated once, where they come in (:func:`ertools.benchmarks.fbm3w.declare.make_options`).
+    The values are validated once, where they come in
+    (:func:`ertools.benchmarks.fbm3w.declare.make_options`).
     """
 
     runs: str | None = None
@@ -339,7 +340,9 @@ def locate_runs(logs: Fbm3wLogs, options: Fbm3wOptions) -> list[RunWindow]:
     return windows
 
 
-def score_found(logs: Fbm3wLogs, windows: Sequence[RunWindow], options: Fbm3wOptions) -> Fbm3wResult:
+def score_found(
+    logs: Fbm3wLogs, windows: Sequence[RunWindow], options: Fbm3wOptions
+) -> Fbm3wResult:
     """Score the runs found (:func:`score_runs` on the logs' poses)."""
     return score_runs(
         logs.poses,

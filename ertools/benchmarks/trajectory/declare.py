@@ -199,6 +199,7 @@ def sample(samples: Path) -> list[str] | None:
         return None
     return [str(robots[0]), str(folder), "--offset", "auto", "--apply-offset"]
 
+
 EPILOG = """examples:
   ertools score trajectory robot.bag gt/ --robot-topic /rockin/homer/marker_pose \\
       --gt-topic /fbm2h/robot_at_home/pose
@@ -220,7 +221,8 @@ BENCHMARK: Benchmark[TrajectoryOptions, TrajectoryLogs, None, TrajectoryResult] 
     title="Offline trajectory benchmark",
     summary="robot log vs mocap ground truth, with clock audit",
     example="ertools score trajectory robot.bag gt/ --robot-topic /rockin/homer/marker_pose",
-    description="""Compare a robot's own pose log with the mocap ground truth (2015 offline trajectory benchmark).
+    description="""Compare a robot's own pose log with the mocap ground truth (2015 offline
+trajectory benchmark).
 
 The GT files are picked from GT_PATH (bags or folders) by time overlap with the robot log and
 read as one stream; without GT_PATH the GT topic is read from the robot log itself (evo's
