@@ -19,6 +19,7 @@ from ertools.benchmarks.base import (
     Ranking,
     notice,
     resolve_values,
+    tf_value,
 )
 from ertools.benchmarks.fbm1.benchmark import (
     RULE_SETS,
@@ -55,10 +56,11 @@ def inputs(name: str) -> tuple[Input, ...]:
                 group=BODIES,
             ),
             Input(
-                f"{body}_frame",
+                f"{body}_tf",
                 "str",
-                f"take {body} from /tf world -> FRAME (--{flag}-frame)",
-                metavar="FRAME",
+                f"take {body} from /tf PARENT -> CHILD (e.g. world:{body})",
+                metavar="PARENT:CHILD",
+                old_flags=(f"--{flag}-frame",),
                 group=BODIES,
             ),
         ]
@@ -189,15 +191,17 @@ def _sources(name: str, v: Mapping[str, Any]) -> BodySources:
     time_source = v["time_source"]
 
     def one(body: str) -> PoseSource | None:
-        topic, frame = v[f"{body}_topic"], v[f"{body}_frame"]
-        if topic is not None and frame is not None:
-            flag = body.replace("_", "-")
-            raise UsageError(f"give either --{flag}-topic or --{flag}-frame, not both")
-        if topic is None and frame is None:
+        flag = body.replace("_", "-")
+        topic, tf = v[f"{body}_topic"], tf_value(f"--{flag}-tf", v[f"{body}_tf"])
+        if topic is not None and tf is not None:
+            raise UsageError(f"give either --{flag}-topic or --{flag}-tf, not both")
+        if tf is not None:
+            return PoseSource(frame=tf[1], parent=tf[0], time_source=time_source)
+        if topic is None:
             if time_source == "header":
                 return None  # the 2015 topic, falling back on the /tf frame
             topic = f"/{name}/{body}/pose"
-        return PoseSource(topic=topic, frame=frame, time_source=time_source)
+        return PoseSource(topic=topic, time_source=time_source)
 
     return BodySources(one("origin"), one("ref_board"))
 
@@ -221,7 +225,7 @@ def options_maker(name: str) -> Callable[[Mapping[str, Any]], Fbm1Options]:
                 else "--count-aborted --accuracy-over-10 (the 2016-17 @Home node's divisors; "
                 "the 2015 node's are --count-aborted alone)"
             )
-            notice(f"--legacy-totals is deprecated: it now means {now}")
+            notice(f"note: --legacy-totals is deprecated, use {now}")
         gt = GtOptions(
             max_window_s=v["max_window"],
             still_m=v["still"],

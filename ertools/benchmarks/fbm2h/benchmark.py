@@ -146,6 +146,7 @@ class Fbm2hOptions:
     transforms_dir: Path | None = None
     topic: str | None = None
     tf_frame: str | None = None
+    tf_parent: str = "world"
     time_source: str = "header"
     reached: str | None = None
     timing: Path | None = None
@@ -466,7 +467,12 @@ def _pose_source(options: Fbm2hOptions) -> PoseSource:
     if options.topic is not None and options.tf_frame is not None:
         raise ConfigError("give either --topic or --tf-frame, not both")
     if options.tf_frame is not None:
-        return PoseSource(topic=None, frame=options.tf_frame, time_source=options.time_source)
+        return PoseSource(
+            topic=None,
+            frame=options.tf_frame,
+            parent=options.tf_parent,
+            time_source=options.time_source,
+        )
     return PoseSource(topic=options.topic or DEFAULT_TOPIC, time_source=options.time_source)
 
 

@@ -11,7 +11,14 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.base import Benchmark, Explanation, Input, Ranking, resolve_values
+from ertools.benchmarks.base import (
+    Benchmark,
+    Explanation,
+    Input,
+    Ranking,
+    resolve_values,
+    tf_value,
+)
 from ertools.benchmarks.fbm2h.benchmark import (
     DEFAULT_MAX_GAP_S,
     Fbm2hLogs,
@@ -50,11 +57,11 @@ INPUTS = (
         metavar="TOPIC",
     ),
     Input(
-        "tf_frame",
+        "tf",
         "str",
-        "take the marker set from /tf world -> FRAME instead",
-        metavar="FRAME",
-        old_flags=("--frame",),
+        "take the marker set from /tf PARENT -> CHILD instead (e.g. world:robot_at_home)",
+        metavar="PARENT:CHILD",
+        old_flags=("--tf-frame", "--frame"),
     ),
     Input(
         "time_source",
@@ -72,9 +79,10 @@ INPUTS = (
         metavar="MODE",
     ),
     Input(
-        "max_gap",
+        "gt_tolerance",
         "float",
         "a reached moment needs a GT sample within S seconds (default 0.1)",
+        old_flags=("--max-gap",),
         default=DEFAULT_MAX_GAP_S,
         unit="s",
         positive=True,
@@ -125,9 +133,10 @@ INPUTS = (
         group=AUTO,
     ),
     Input(
-        "stop_min_duration",
+        "stop_min",
         "float",
         "(default 0.5 s)",
+        old_flags=("--stop-min-duration",),
         default=0.5,
         unit="s",
         positive=True,
@@ -152,8 +161,9 @@ def make_options(given: Mapping[str, Any]) -> Fbm2hOptions:
         UsageError: a value out of range, or options that exclude each other (exit 2).
     """
     v = resolve_values(INPUTS, given)
-    if v["topic"] is not None and v["tf_frame"] is not None:
-        raise UsageError("give either --topic or --tf-frame, not both")
+    if v["topic"] is not None and v["tf"] is not None:
+        raise UsageError("give either --topic or --tf, not both")
+    tf = tf_value("--tf", v["tf"])
     if v["transform"] is not None and v["transforms"] is not None:
         raise UsageError("give either --transform FILE or --team NAME --transforms DIR")
     if v["transforms"] is not None and v["team"] is None:
@@ -165,11 +175,12 @@ def make_options(given: Mapping[str, Any]) -> Fbm2hOptions:
         team=v["team"],
         transforms_dir=v["transforms"],
         topic=v["topic"],
-        tf_frame=v["tf_frame"],
+        tf_frame=None if tf is None else tf[1],
+        tf_parent="world" if tf is None else tf[0],
         time_source=v["time_source"],
         reached=reached[0],
         timing=Path(str(reached[1])) if len(reached) > 1 else None,
-        max_gap_s=v["max_gap"],
+        max_gap_s=v["gt_tolerance"],
         hits=None if v["hits"] is None else int(v["hits"]),
         orientation_2015=v["orientation_2015"] or v["all_2015"],
         unscored_2015=v["unscored_segments"] == "2015" or v["all_2015"],
@@ -177,7 +188,7 @@ def make_options(given: Mapping[str, Any]) -> Fbm2hOptions:
         stops=StopParams(
             speed=v["stop_speed"],
             yaw_rate=v["stop_yaw_rate"],
-            min_duration_s=v["stop_min_duration"],
+            min_duration_s=v["stop_min"],
             radius=v["stop_radius"],
         ),
     )

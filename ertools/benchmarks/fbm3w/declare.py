@@ -11,7 +11,14 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.base import Benchmark, Explanation, Input, Ranking, resolve_values
+from ertools.benchmarks.base import (
+    Benchmark,
+    Explanation,
+    Input,
+    Ranking,
+    resolve_values,
+    tf_value,
+)
 from ertools.benchmarks.fbm3w.benchmark import (
     RUN_MODES,
     Fbm3wLogs,
@@ -58,7 +65,13 @@ INPUTS = (
         "end-effector pose topic (default /fbm3w/robot_at_work/pose2d, then .../pose)",
         metavar="TOPIC",
     ),
-    Input("frame", "str", "take the poses from /tf world -> FRAME", metavar="FRAME"),
+    Input(
+        "tf",
+        "str",
+        "take the poses from /tf PARENT -> CHILD (e.g. world:robot_at_work)",
+        metavar="PARENT:CHILD",
+        old_flags=("--frame",),
+    ),
     Input(
         "time_source",
         "choice",
@@ -171,8 +184,9 @@ def make_options(given: Mapping[str, Any]) -> Fbm3wOptions:
         )
     if v["all_2015"] and v["arc_length"]:
         raise UsageError("--2015 and --arc-length contradict each other (2015 had no arc length)")
-    if v["topic"] is not None and v["frame"] is not None:
-        raise UsageError("give either --topic or --frame, not both")
+    if v["topic"] is not None and v["tf"] is not None:
+        raise UsageError("give either --topic or --tf, not both")
+    tf = tf_value("--tf", v["tf"])
     d_min = None if v["d_min"] is None else _d_min(v["d_min"], "--d-min")
     sweep = () if v["d_min_sweep"] is None else parse_sweep(v["d_min_sweep"])
     for value in sweep:
@@ -183,7 +197,8 @@ def make_options(given: Mapping[str, Any]) -> Fbm3wOptions:
         d_min=d_min,
         sweep=sweep,
         topic=v["topic"],
-        frame=v["frame"],
+        frame=None if tf is None else tf[1],
+        tf_parent="world" if tf is None else tf[0],
         time_source=v["time_source"],
         still_speed=v["still_speed"],
         min_still_s=v["still_min"],

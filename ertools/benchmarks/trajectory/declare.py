@@ -117,9 +117,10 @@ INPUTS = (
         "score the covered part when robot poses lie outside the GT",
     ),
     Input(
-        "robot_time",
+        "robot_time_source",
         "choice",
         "robot pose time: message stamp (default) or the robot bag's record time",
+        old_flags=("--robot-time",),
         default="header",
         choices=("header", "record"),
     ),
@@ -181,7 +182,7 @@ def make_options(given: Mapping[str, Any]) -> TrajectoryOptions:
         )
     except ConfigError as err:
         raise UsageError(err.message) from None
-    return TrajectoryOptions(config, v["robot_topic"], v["gt_topic"], v["robot_time"])
+    return TrajectoryOptions(config, v["robot_topic"], v["gt_topic"], v["robot_time_source"])
 
 
 def files(bags: Sequence[Path], options: TrajectoryOptions, result: TrajectoryResult) -> list[Path]:

@@ -158,7 +158,17 @@ def test_score_takes_the_declared_inputs(toy: Path, capsys: pytest.CaptureFixtur
     assert "--scale" in shown and "--topic TOPIC" in shown and "Count the marker poses." in shown
     assert main(["score", "--help"]) == 0
     members = capsys.readouterr().out.split("members:")[1].split()
-    assert members[-9:] == "toy a toy benchmark e.g. ertools score toy run.bag".split()
+    assert members[-9:] == [
+        "toy",
+        "a",
+        "toy",
+        "benchmark",
+        "e.g.",
+        "ertools",
+        "score",
+        "toy",
+        "run.bag",
+    ]
 
 
 def test_report_folder_and_combined_page(
