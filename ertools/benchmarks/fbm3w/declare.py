@@ -75,9 +75,10 @@ INPUTS = (
     Input(
         "time_source",
         "choice",
-        "pose time: bag record time (default: the 2015 node received poses live) or header",
-        default="record",
-        choices=("record", "header"),
+        "pose time: header stamp (default; a Pose2D has none: its record time) or bag record "
+        "time (the 2015 node received the poses live)",
+        default="header",
+        choices=("header", "record"),
     ),
     Input(
         "arc_length",
