@@ -34,6 +34,14 @@ def members() -> dict[str, Command]:
     return out
 
 
+def __getattr__(name: str) -> Any:
+    """``MEMBERS``, as the other command groups have it, built on first use (it imports
+    every declaration)."""
+    if name == "MEMBERS":
+        return members()
+    raise AttributeError(name)
+
+
 def _unread_members() -> dict[str, Command]:
     """The members by name only (summaries left empty: nothing imported)."""
     return {name: Command(__name__, "", "") for name in registry.names()}

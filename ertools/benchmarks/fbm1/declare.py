@@ -217,7 +217,10 @@ def options_maker(name: str) -> Callable[[Mapping[str, Any]], Fbm1Options]:
         """
         v = resolve_values(inputs(name), given)
         if v["items"] is None:
-            raise UsageError("--items FILE is required (the item list, seed Listing 9)")
+            raise UsageError(
+                "--items FILE is required (the item list, seed Listing 9); "
+                f"`ertools score {name} --help` shows how"
+            )
         if v["legacy_totals"]:
             now = (
                 "--count-aborted (the 2015 @Work node's divisors)"

@@ -27,6 +27,8 @@ from ertools.benchmarks.trajectory.benchmark import (
 from ertools.errors import ConfigError, UsageError
 from ertools.timeutil import s_to_ns
 
+# Offsets beyond this (about 146 years) are not clock offsets; int64 nanoseconds hold them.
+MAX_OFFSET_S = 4.6e9
 LEGACY = "2015 behaviour (each difference can be undone)"
 
 INPUTS = (
@@ -141,8 +143,11 @@ def _offset(text: str) -> float | None:
         value = float(text)
     except ValueError:
         raise UsageError(f"--offset takes seconds or 'auto', not {text!r}") from None
-    if not math.isfinite(value):
-        raise UsageError(f"--offset takes a finite number of seconds or 'auto', not {text!r}")
+    if not (math.isfinite(value) and abs(value) < MAX_OFFSET_S):
+        raise UsageError(
+            f"--offset {text}: give a finite number smaller than {MAX_OFFSET_S:g} s in size "
+            "or 'auto'"
+        )
     return value
 
 
