@@ -335,6 +335,25 @@ def _choice_words(declared: Input, words: tuple[str, ...]) -> tuple[str, ...]:
     return words
 
 
+def tf_value(option: str, text: str | None) -> tuple[str, str] | None:
+    """A ``--tf``-style value as (parent, child): ``PARENT:CHILD``, or a bare ``FRAME`` (the
+    old ``--frame FRAME`` spelling) meaning ``world:FRAME``; None when not given.
+
+    Raises:
+        UsageError: not one or two non-empty frame names.
+    """
+    from ertools.errors import UsageError
+
+    if text is None:
+        return None
+    parent, sep, child = text.partition(":")
+    if not sep:
+        parent, child = "world", text
+    if not parent or not child or ":" in child:
+        raise UsageError(f"{option} {text!r}: give PARENT:CHILD, e.g. world:robot_at_work")
+    return parent, child
+
+
 def resolve_values(inputs: Sequence[Input], given: Mapping[str, Any]) -> dict[str, Any]:
     """Every declared input's value: ``given`` (by :attr:`Input.name`) checked against its
     declaration (kind, choices, minimum, positive), the others at their defaults. None
@@ -353,7 +372,7 @@ def resolve_values(inputs: Sequence[Input], given: Mapping[str, Any]) -> dict[st
         )
     out: dict[str, Any] = {}
     for name, declared in known.items():
-        value = given.get(name)
+        value: Any = given.get(name)
         if value is None:
             value = declared.default
         if value is None and declared.kind == "flag":
@@ -361,7 +380,7 @@ def resolve_values(inputs: Sequence[Input], given: Mapping[str, Any]) -> dict[st
         if value is None:
             out[name] = () if declared.repeat else None
         elif declared.repeat or declared.kind == "paths":
-            values = [value] if isinstance(value, str | Path) else list(value)
+            values: list[Any] = [value] if isinstance(value, str | Path) else list(value)
             out[name] = tuple(_one_value(declared, v) for v in values)
         else:
             out[name] = _one_value(declared, value)

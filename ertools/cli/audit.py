@@ -13,6 +13,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from ertools.benchmarks import registry
+
 EPILOG = """examples:
   ertools audit fbm2h.bag                       # YAML on stdout (--format text: a summary)
   ertools audit fbm2h.bag --transform transform-homer.yaml --report audit/
@@ -25,7 +27,8 @@ are passed to the benchmark's scorer as `ertools score NAME` takes them.
 Exit status: 0 (findings are reported, not errors; --strict makes them exit 1), 1 when the bag
 has no state topics or cannot be read, or the recomputed score has failures."""
 
-BENCHMARKS = ("fbm1h", "fbm1w", "fbm2h", "fbm3w")
+# Every registered benchmark (those without state topics say so when asked to audit).
+BENCHMARKS = registry.names()
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

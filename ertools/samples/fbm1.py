@@ -42,6 +42,7 @@ import numpy.typing as npt
 import yaml
 from scipy.spatial.transform import Rotation
 
+from ertools.benchmarks.fbm1.benchmark import BENCHMARKS
 from ertools.samples.mocap import (
     MocapNoise,
     frame_times,
@@ -61,7 +62,7 @@ F64 = npt.NDArray[np.float64]
 S = 1_000_000_000
 MS = 1_000_000
 
-NAMESPACE = "fbm1h"
+NAMESPACE = BENCHMARKS[0]
 ITEMS_FILE = "fbm1h.yaml"
 NOON_NS = EPOCH_2015 + 2 * 3600 * S
 SIGMA_M = 2.0e-4
@@ -410,7 +411,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     answers = write_answers(
         bag_path,
         benchmark=NAMESPACE,
-        scenario="fbm1h",
+        scenario=NAMESPACE,
         seed=seed,
         parameters=sim.parameters,
         truth=sim.truth,

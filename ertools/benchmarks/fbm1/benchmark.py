@@ -47,9 +47,9 @@ from ertools.benchmarks.fbm1.score import (
     totals,
 )
 from ertools.configs.items import Item, ItemList
-from ertools.io.model import BenchmarkStates
 from ertools.errors import ConfigError, ScoringError, SegmentationError, TopicError
 from ertools.fidelity import Deviation, Rule
+from ertools.io.model import BenchmarkStates
 from ertools.progress import Reporter, current
 from ertools.streams import PoseStream, Provenance, frame_change_warning
 from ertools.timeutil import NS_PER_S

@@ -33,9 +33,9 @@ from ertools.benchmarks.fbm2h.score import robot_poses_at, segment_errors
 from ertools.benchmarks.fbm2h.segments import ReachedMoments, StopParams
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
-from ertools.io.model import BenchmarkStates
 from ertools.errors import ConfigError, ScoringError, SegmentationError
 from ertools.fidelity import Deviation, Rule
+from ertools.io.model import BenchmarkStates
 from ertools.streams import PoseStream, Provenance, frame_change_warning
 from ertools.timeutil import ns_to_s, s_to_ns
 
@@ -44,6 +44,7 @@ if TYPE_CHECKING:
 
 log = logging.getLogger("ertools.benchmarks.fbm2h.benchmark")
 
+NAMESPACE = "fbm2h"  # of the state topics
 DEFAULT_TOPIC = "/fbm2h/robot_at_home/pose"
 DEFAULT_MAX_GAP_S = 0.1
 # Figures need the path, not every 120 Hz sample.
@@ -145,6 +146,7 @@ class Fbm2hOptions:
     transforms_dir: Path | None = None
     topic: str | None = None
     tf_frame: str | None = None
+    tf_parent: str = "world"
     time_source: str = "header"
     reached: str | None = None
     timing: Path | None = None
@@ -152,7 +154,7 @@ class Fbm2hOptions:
     hits: int | None = None
     orientation_2015: bool = False
     unscored_2015: bool = False
-    namespace: str = "fbm2h"
+    namespace: str = NAMESPACE
     stops: StopParams = field(default_factory=StopParams)
     marker_transform: MarkerTransform | None = None
 
@@ -465,7 +467,12 @@ def _pose_source(options: Fbm2hOptions) -> PoseSource:
     if options.topic is not None and options.tf_frame is not None:
         raise ConfigError("give either --topic or --tf-frame, not both")
     if options.tf_frame is not None:
-        return PoseSource(topic=None, frame=options.tf_frame, time_source=options.time_source)
+        return PoseSource(
+            topic=None,
+            frame=options.tf_frame,
+            parent=options.tf_parent,
+            time_source=options.time_source,
+        )
     return PoseSource(topic=options.topic or DEFAULT_TOPIC, time_source=options.time_source)
 
 

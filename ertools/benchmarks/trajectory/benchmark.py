@@ -1341,4 +1341,5 @@ def score(
     compare (see :func:`load`, :func:`score_found`)."""
     options = TrajectoryOptions(config or TrajectoryConfig(), robot_topic, gt_topic, robot_time)
     logs = load([robot_bag, *gt_paths], options)
-    return score_found(logs, locate_runs(logs, options), options)
+    locate_runs(logs, options)  # one run: the whole robot log
+    return score_found(logs, None, options)

@@ -27,6 +27,8 @@ from ertools.benchmarks.trajectory.benchmark import (
 from ertools.errors import ConfigError, UsageError
 from ertools.timeutil import s_to_ns
 
+# Offsets beyond this (about 146 years) are not clock offsets; int64 nanoseconds hold them.
+MAX_OFFSET_S = 4.6e9
 LEGACY = "2015 behaviour (each difference can be undone)"
 
 INPUTS = (
@@ -117,9 +119,10 @@ INPUTS = (
         "score the covered part when robot poses lie outside the GT",
     ),
     Input(
-        "robot_time",
+        "robot_time_source",
         "choice",
         "robot pose time: message stamp (default) or the robot bag's record time",
+        old_flags=("--robot-time",),
         default="header",
         choices=("header", "record"),
     ),
@@ -140,8 +143,11 @@ def _offset(text: str) -> float | None:
         value = float(text)
     except ValueError:
         raise UsageError(f"--offset takes seconds or 'auto', not {text!r}") from None
-    if not math.isfinite(value):
-        raise UsageError(f"--offset takes a finite number of seconds or 'auto', not {text!r}")
+    if not (math.isfinite(value) and abs(value) < MAX_OFFSET_S):
+        raise UsageError(
+            f"--offset {text}: give a finite number smaller than {MAX_OFFSET_S:g} s in size "
+            "or 'auto'"
+        )
     return value
 
 
@@ -181,7 +187,7 @@ def make_options(given: Mapping[str, Any]) -> TrajectoryOptions:
         )
     except ConfigError as err:
         raise UsageError(err.message) from None
-    return TrajectoryOptions(config, v["robot_topic"], v["gt_topic"], v["robot_time"])
+    return TrajectoryOptions(config, v["robot_topic"], v["gt_topic"], v["robot_time_source"])
 
 
 def files(bags: Sequence[Path], options: TrajectoryOptions, result: TrajectoryResult) -> list[Path]:
@@ -198,6 +204,7 @@ def sample(samples: Path) -> list[str] | None:
     if not robots:
         return None
     return [str(robots[0]), str(folder), "--offset", "auto", "--apply-offset"]
+
 
 EPILOG = """examples:
   ertools score trajectory robot.bag gt/ --robot-topic /rockin/homer/marker_pose \\
@@ -220,7 +227,8 @@ BENCHMARK: Benchmark[TrajectoryOptions, TrajectoryLogs, None, TrajectoryResult] 
     title="Offline trajectory benchmark",
     summary="robot log vs mocap ground truth, with clock audit",
     example="ertools score trajectory robot.bag gt/ --robot-topic /rockin/homer/marker_pose",
-    description="""Compare a robot's own pose log with the mocap ground truth (2015 offline trajectory benchmark).
+    description="""Compare a robot's own pose log with the mocap ground truth (2015 offline
+trajectory benchmark).
 
 The GT files are picked from GT_PATH (bags or folders) by time overlap with the robot log and
 read as one stream; without GT_PATH the GT topic is read from the robot log itself (evo's
