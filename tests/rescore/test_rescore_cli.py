@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from competition import (
+from rescore_competition import (
     LOGS,
     OFFSETS,
     expected_value,
@@ -131,7 +131,7 @@ def test_a_failure_costs_one_row(tmp_path: Path, capsys: pytest.CaptureFixture[s
     bad, boom, die = (rows[f"toy-alpha-20151120T11{m}000"] for m in ("0", "1", "2"))
     assert bad["status"] == "unscoreable" and "no toy values can be scored here" in bad["reason"]
     assert boom["status"] == "failed"
-    assert "RuntimeError: the toy scorer has a bug at toybench.py" in boom["reason"]
+    assert "RuntimeError: the toy scorer has a bug at rescore_toy.py" in boom["reason"]
     assert die["status"] == "failed" and "died (exit code 7)" in die["reason"]
     err = capsys.readouterr().err
     assert "6 executions: 3 scored, 1 unscoreable, 2 failed" in err

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from competition import LOGS, expected_value, make_competition, use_toy_registry
+from rescore_competition import LOGS, expected_value, make_competition, use_toy_registry
 
 from ertools.cli.main import main
 
@@ -44,7 +44,7 @@ def cluster(tmp_path: Path) -> Iterator[str]:
     address = f"tcp://127.0.0.1:{port}"
     env = {
         **os.environ,
-        # the workers import the toy benchmark the test registers (tests/rescore/toybench.py)
+        # the workers import the toy benchmark the test registers (tests/rescore/rescore_toy.py)
         "PYTHONPATH": os.pathsep.join([str(HERE), os.environ.get("PYTHONPATH", "")]),
     }
     common = ["--no-dashboard"]

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from competition import make_competition, use_toy_registry
+from rescore_competition import make_competition, use_toy_registry
 
 from ertools.cli.main import main
 from ertools.errors import ConfigError

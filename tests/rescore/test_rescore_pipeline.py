@@ -6,7 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from competition import LOGS, expected_value, make_competition, use_toy_registry
+from rescore_competition import LOGS, expected_value, make_competition, use_toy_registry
 
 from ertools.rescore.manifest import load_manifest
 from ertools.rescore.pipeline import Scoring, leaderboards, listed_executions, rescore
