@@ -74,9 +74,8 @@ def test_fbm2h_every_segment_without_ground_truth(capsys: pytest.CaptureFixture[
         "--transform", str(FBM2H / "transform-simbot.yaml"), "--gt-tolerance", "0.000001",
     )  # fmt: skip
     assert code == 1
-    only_errors(
-        out, err, *(f"segment {i}: no ground truth within --gt-tolerance" for i in range(5))
-    )
+    lines = [f"segment {i}: no ground truth within --gt-tolerance" for i in range(5)]
+    only_errors(out, err, *lines)
     # the nearest sample is under 1 ms away: said with 3 digits, never "0.000 s"
     assert all("0.000 s away" not in x for x in err)
 
