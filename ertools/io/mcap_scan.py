@@ -17,7 +17,6 @@ import contextlib
 import mmap
 import os
 import struct
-import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -26,6 +25,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.errors import BagError
+from ertools.io.crc import crc32
 from ertools.io.fastdecode import read_at
 
 I64 = npt.NDArray[np.int64]
@@ -294,7 +294,7 @@ def _chunk(buf: Any, at: int, end: int, sink: _Sink) -> None:
     inner = stored if compression == "" else decompress(compression, stored, usize, where)
     if len(inner) != usize:
         raise BagError(f"chunk decompresses to {len(inner)} bytes, not {usize}, {where}")
-    if sink.check_crc and crc and zlib.crc32(inner) != crc:
+    if sink.check_crc and crc and crc32(inner) != crc:
         raise BagError(f"corrupt MCAP chunk {where}: CRC mismatch")
     sink.compressions.add(compression or "none")
     sink.chunks += 1
