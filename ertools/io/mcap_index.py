@@ -79,6 +79,7 @@ def _parse_summary(f: BinaryIO, path: Path) -> Any:
         raise BagError(f"unreadable MCAP summary ({type(err).__name__}: {err})", path=path) from err
     if summary is None:
         return None
+    _check_summary_crc(f, path)
     stats = summary.statistics
     if (
         stats is not None
@@ -93,6 +94,27 @@ def _parse_summary(f: BinaryIO, path: Path) -> Any:
             path=path,
         )
     return summary
+
+
+def _check_summary_crc(f: BinaryIO, path: Path) -> None:
+    """Refuse a summary section that fails the CRC its footer gives (0: not computed).
+
+    The ``mcap`` library does not check it; a damaged summary (a chunk index's op code,
+    offsets or times, a channel's schema id) would otherwise direct every indexed read. The
+    section is what the library has just read, a small part of the file.
+    """
+    size = _file_size(f)
+    at = size - 8 - (1 + 8 + 8 + 8 + 4)
+    footer = pread(f.fileno(), 1 + 8 + 8 + 8 + 4, at)
+    if len(footer) < 29 or footer[0] != 0x02:
+        return  # no footer here: the library found none either
+    _, _len, start, _offsets, crc = struct.unpack("<BQQQI", footer)
+    if not crc or not 0 < start < at:
+        return
+    # from the first summary record through the footer's summary_offset_start field
+    covered = pread(f.fileno(), at + 1 + 8 + 8 + 8 - start, start)
+    if crc32(covered) != crc:
+        raise BagError("damaged MCAP summary section: it fails its CRC check", path=path)
 
 
 def decompress(compression: str, data: bytes, size: int, where: str) -> bytes:

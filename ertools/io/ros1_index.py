@@ -180,15 +180,21 @@ def read_layout(path: Path) -> Ros1Layout:
                 f"truncated: the index at byte {index_pos} lies past the end ({size} bytes)",
             )
         try:
-            conns = []
+            conns: list[Conn] = []
             pos = index_pos
             for _ in range(conn_count):
                 rec, data = read_record(f, pos, size, with_data=True)
                 if rec.op != OP_CONNECTION:
                     raise RecordError("expected a connection record", pos)
                 cid, topic, fields = connection_fields(rec, data)
+                if any(c.id == cid for c in conns):
+                    # a damaged id: one connection's messages would be read as another's
+                    raise RecordError(f"two connection records with id {cid}", pos)
                 conns.append(_conn(cid, topic, fields))
                 pos = rec.end
+            if chunk_count == 0 and conn_count and index_pos > head.end:
+                # records between the header and the index, but no chunk to find them by
+                raise RecordError("the bag header counts no chunks before its index", MAGIC_LEN)
             chunks = []
             for _ in range(chunk_count):
                 rec, data = read_record(f, pos, size, with_data=True)
@@ -382,6 +388,10 @@ def _outside_chunk_info(
     )
 
 
+def _nonzero(counts: dict[int, int]) -> dict[int, int]:
+    return {cid: n for cid, n in counts.items() if n}
+
+
 def _first_record(bag: Ros1Bag) -> int:
     """Where the records after the bag header start."""
     try:
@@ -491,9 +501,15 @@ class Ros1Bag(BagFile):
             self._mm = mmap.mmap(self.file.fileno(), 0, access=mmap.ACCESS_READ)
         return self._mm
 
-    def _index_data(self, chunk: Ros1Chunk, wanted: Collection[int] | None) -> dict[int, bytes]:
+    def _index_data(
+        self,
+        chunk: Ros1Chunk,
+        wanted: Collection[int] | None,
+        counts: dict[int, int] | None = None,
+    ) -> dict[int, bytes]:
         """conn -> raw (sec, nsec, offset) entries of one chunk, for the ``wanted`` connections
-        (all when None), from the index-data records that follow the chunk."""
+        (all when None), from the index-data records that follow the chunk; ``counts`` gets
+        every record's conn -> count (all connections)."""
         if chunk.data_pos < 0:
             self.chunk_record(chunk)
         mm = self._mapped()
@@ -519,6 +535,8 @@ class Ros1Bag(BagFile):
                 data_pos = pos + 8 + hlen
                 if dlen != 12 * count or data_pos + dlen > size:
                     raise RecordError("index-data size disagrees with its count", pos)
+                if counts is not None:
+                    counts[cid] = counts.get(cid, 0) + count
                 if wanted is None or cid in wanted:
                     out[cid] = mm[data_pos : data_pos + dlen]
                 pos = data_pos + dlen
@@ -568,8 +586,6 @@ class Ros1Bag(BagFile):
         raw: dict[int, list[bytes | tuple[I64, I64]]] = {cid: [] for cid in rank}
         where: dict[int, list[tuple[int, int]]] = {cid: [] for cid in rank}
         for ci, chunk in enumerate(self.layout.chunks):
-            if not any(cid in chunk.counts for cid in rank):
-                continue
             if start_ns is not None and chunk.end_ns < start_ns:
                 continue
             if end_ns is not None and chunk.start_ns > end_ns:
@@ -580,9 +596,20 @@ class Ros1Bag(BagFile):
                         raw[cid].append((t, off))
                         where[cid].append((ci, len(t)))
                 continue
-            for cid, data in self._index_data(chunk, rank).items():
+            # Every chunk's index-data headers are read, the planned chunks' and the others':
+            # their connection ids and counts must be the chunk info's, which chose the chunks
+            # (a damaged connection id or count there dropped a chunk from its connection's
+            # read, or read another connection's entries, without a word).
+            counts: dict[int, int] = {}
+            for cid, data in self._index_data(chunk, rank, counts).items():
                 raw[cid].append(data)
                 where[cid].append((ci, len(data) // INDEX_DTYPE.itemsize))
+            if _nonzero(counts) != _nonzero(chunk.counts):
+                self._rescan(
+                    f"chunk at byte {chunk.pos}: the chunk info and the index data give "
+                    "different connections or counts"
+                )
+                return self.select(conns, start_ns, end_ns)
         self._unmap()  # the index pages touched would otherwise stay in this process's RSS
         tt: list[I64] = []
         oo: list[I64] = []
