@@ -379,9 +379,29 @@ def ros1_index_evidence(path: Path, truth: Outcome) -> str:
         return ""
     walked = ros1_record_summary(path)
     want = {t: (n, a or 0, b or 0) for t, (_ty, n, a, b) in truth.value.items()}
-    if walked is None or walked != want:
+    if walked is not None and walked == want:
+        return "the records, read one by one, are the undamaged file's: only the index is damaged"
+    # or the other way round: rosbags' own index counts are the undamaged file's while the
+    # records it reads through that index say otherwise (a damaged record header)
+    try:
+        from rosbags.highlevel import AnyReader
+
+        with AnyReader([path]) as reader:
+            indexed: dict[str, int] = {}
+            for c in reader.connections:
+                indexed[c.topic] = indexed.get(c.topic, 0) + c.msgcount
+            read: dict[str, int] = {}
+            for c, _t, _raw in reader.messages():
+                read[c.topic] = read.get(c.topic, 0) + 1
+    except Exception:
         return ""
-    return "the records, read one by one, are the undamaged file's: only the index is damaged"
+    counts = {t: n for t, (_ty, n, _a, _b) in truth.value.items()}
+    if indexed == counts and {t: read.get(t, 0) for t in counts} != counts:
+        return (
+            "rosbags' own index counts are the undamaged file's, the records it reads "
+            "through them are not: a damaged record header"
+        )
+    return ""
 
 
 # judging ------------------------------------------------------------------------------------

@@ -174,7 +174,8 @@ def _ros1_runs(
     from ertools.io.ros1_index import Ros1Bag
 
     assert isinstance(bag, Ros1Bag)
-    touched, chunk_of, _rank, t_of, off_of = bag.select(conns, lo, hi)
+    touched, chunk_of, rank_of, t_of, off_of = bag.select(conns, lo, hi)
+    conn_of = np.array([c.id for c in conns], dtype=np.int64)[rank_of]
 
     groups = dict(group_positions(chunk_of))
     sparse = _sparse_chunks(bag, touched, groups)
@@ -217,6 +218,7 @@ def _ros1_runs(
         start, length = bag.spans(buf, offsets + base[which], where)
         if np.any(start + length > base[which] + sizes[which]):
             raise BagError(f"message record runs past the end of its chunk {where}")
+        bag.check_heads(buf, start, t_of[sel], conn_of[sel], where)
         return sel, buf, start, length, t_of[sel]
 
     compressed = any(bag.layout.chunks[ci].compression != "none" for ci in touched)

@@ -388,6 +388,39 @@ def _outside_chunk_info(
     )
 
 
+def _value_offsets(buf: U8, head: int) -> tuple[int, int] | None:
+    """(conn value, time value) offsets in the 38-byte message header at ``head``."""
+    try:
+        fields = bytes(buf[head : head + MSG_HEADER_LEN])
+        pos, found = 0, {}
+        while pos < len(fields):
+            (n,) = _U32.unpack_from(fields, pos)
+            name = fields[pos + 4 : pos + 4 + n].split(b"=", 1)[0]
+            found[name] = pos + 4 + len(name) + 1
+            pos += 4 + n
+    except struct_error:
+        return None
+    if b"conn" not in found or b"time" not in found:
+        return None
+    return found[b"conn"], found[b"time"]
+
+
+def _fields_before(buf: U8, data: int) -> tuple[int, int] | None:
+    """(conn, time ns) of the message record whose data starts at ``data``, from its header
+    (found by the standard 38-byte length; None when the header is not there or lacks them)."""
+    head = data - 4 - MSG_HEADER_LEN
+    if head < 4:
+        return None
+    try:
+        (hlen,) = _U32.unpack(bytes(buf[head - 4 : head]))
+        if hlen != MSG_HEADER_LEN:
+            return None
+        fields = parse_fields(bytes(buf[head : head + MSG_HEADER_LEN]))
+        return u32(fields, "conn"), time_ns(fields, "time")
+    except (RecordError, KeyError, struct_error):
+        return None
+
+
 def _nonzero(counts: dict[int, int]) -> dict[int, int]:
     return {cid: n for cid, n in counts.items() if n}
 
@@ -721,6 +754,38 @@ class Ros1Bag(BagFile):
         if (dpos + dlen).max() > n:
             raise BagError(f"message data cut off inside its chunk {where}")
         return dpos, dlen
+
+    @staticmethod
+    def check_heads(buf: U8, start: I64, t_ns: I64, conn: I64, where: str) -> None:
+        """Each message record (data at ``start``) carries the time and connection of the
+        index entry it was found by, as rosbags asserts: a damaged index entry, or a damaged
+        record header, would otherwise give a pose at a wrong time or on a wrong topic.
+
+        The record header is the 38 bytes before each data length; the first record tells
+        where its conn and time values sit, every record is read there at once, and only a
+        record that disagrees is parsed field by field (a writer may order fields otherwise).
+        """
+        from ertools.io.fastdecode import read_at
+
+        if not len(start):
+            return
+        head_at = start - 4 - MSG_HEADER_LEN
+        at = _value_offsets(buf, int(head_at[0]))
+        bad = np.ones(len(start), dtype=bool)
+        if at is not None and int(head_at.min()) >= 0:
+            conn_at, time_at = at
+            got_conn = read_at(buf, head_at + conn_at, np.dtype("<u4")).astype(np.int64)
+            tv = read_at(buf, head_at + time_at, np.dtype("<u8"))
+            got_t = (tv & 0xFFFFFFFF).astype(np.int64) * 1_000_000_000 + (tv >> 32).astype(np.int64)
+            bad = (got_conn != conn) | (got_t != t_ns)
+        for i in np.flatnonzero(bad).tolist():
+            # the header just before this record's data length, whatever its layout
+            found = _fields_before(buf, int(start[i]))
+            if found is None or found != (int(conn[i]), int(t_ns[i])):
+                raise BagError(
+                    "message record's connection or time differs from its index entry "
+                    f"(damaged index or record) {where}"
+                )
 
     @staticmethod
     def _resolve(buf: bytes, off: int, where: str) -> tuple[int, int]:
