@@ -701,9 +701,13 @@ class Ros1Bag(BagFile):
         from ertools.io.ros1_check import rebuild_layout
 
         self._unmap()
-        self.layout = rebuild_layout(
-            self.file, self.path, self.layout.size, _first_record(self), why
-        )
+        layout = rebuild_layout(self.file, self.path, self.layout.size, _first_record(self), why)
+        damage = [p for p in layout.problems if p != why]
+        if damage:
+            # A closed bag (it has an index) whose records do not all read is damaged, not cut
+            # short: reading around a skipped chunk would give fewer messages without a word.
+            raise BagError(f"damaged bag: {why}, and {damage[0]}", path=self.path)
+        self.layout = layout
 
     def spans(self, buf: U8, offsets: I64, where: str) -> tuple[I64, I64]:
         """(data start, data length) of the message records at ``offsets`` of a chunk.
