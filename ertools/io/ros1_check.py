@@ -495,11 +495,15 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
             return scan_layout(f, path, size, start, why)
         if len(hint_off) and len(recs.msg_off):
             # A record the index data points at must carry the entry's time (rosbags asserts
-            # it): where they differ, the index or the record is damaged and nothing tells
-            # which; the records alone would read a damaged time or chunk as sound.
+            # it). An entry whose time lies outside the span of the chunk's records is the
+            # damaged side (the records are read instead); one inside it leaves no way to
+            # tell which is damaged, and the records alone would read a damaged time or
+            # chunk (lz4 has no checksum here) as sound.
             k = np.minimum(np.searchsorted(recs.msg_off, hint_off), len(recs.msg_off) - 1)
             hit = recs.msg_off[k] == hint_off
-            if np.any(recs.msg_time[k[hit]] != hint_t[hit]):
+            differ = hint_t[hit][recs.msg_time[k[hit]] != hint_t[hit]]
+            lo, hi = int(recs.msg_time.min()), int(recs.msg_time.max())
+            if np.any((differ >= lo) & (differ <= hi)):
                 problems.append(
                     f"chunk at byte {cpos}: a message record's time differs from its index entry"
                 )
