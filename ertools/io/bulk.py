@@ -215,10 +215,12 @@ def _ros1_runs(
         offsets = off_of[sel]
         if np.any(offsets + 8 > sizes[which]):
             raise BagError(f"index points outside its chunk {where}")
-        start, length = bag.spans(buf, offsets + base[which], where)
+        # each record checked to carry its index entry's time and connection
+        start, length = bag.checked_spans(
+            buf, offsets + base[which], t_of[sel], conn_of[sel], where
+        )
         if np.any(start + length > base[which] + sizes[which]):
             raise BagError(f"message record runs past the end of its chunk {where}")
-        bag.check_heads(buf, start, t_of[sel], conn_of[sel], where)
         return sel, buf, start, length, t_of[sel]
 
     compressed = any(bag.layout.chunks[ci].compression != "none" for ci in touched)

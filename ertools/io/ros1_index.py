@@ -759,6 +759,55 @@ class Ros1Bag(BagFile):
             raise BagError(f"message data cut off inside its chunk {where}")
         return dpos, dlen
 
+    def checked_spans(
+        self, buf: U8, offsets: I64, t_ns: I64, conn: I64, where: str
+    ) -> tuple[I64, I64]:
+        """:meth:`spans`, each record also checked to carry the time and connection of its
+        index entry (:meth:`check_heads`). Records with the standard 38-byte header laid out
+        as the first one's (a writer's usual output) are read with one gather of their
+        heads, every field a strided column of it."""
+        n = len(offsets)
+        head = 4 + MSG_HEADER_LEN + 4  # header length, header, data length
+        fields = None
+        if n and int(offsets.min()) >= 0 and int(offsets.max()) + head <= len(buf):
+            fields = _value_offsets(buf, int(offsets[0]) + 4)
+        op_at = None
+        if fields is not None:
+            first = bytes(buf[int(offsets[0]) + 4 : int(offsets[0]) + 4 + MSG_HEADER_LEN])
+            op_at = next(
+                (at for at in _OP_AT if first[at : at + 8] == _OP_MSG_WORD.to_bytes(8, "little")),
+                None,
+            )
+        if fields is None or op_at is None:
+            start, length = self.spans(buf, offsets, where)
+            self.check_heads(buf, start, t_ns, conn, where)
+            return start, length
+        from ertools.io.fastdecode import gather
+
+        rows = gather(buf, offsets, head)
+
+        def col(offset: int, kind: str) -> npt.NDArray[Any]:
+            return np.ndarray((n,), kind, buffer=rows, offset=offset, strides=(head,))
+
+        conn_at, time_at = fields
+        standard = (col(0, "<u4") == MSG_HEADER_LEN) & (col(4 + op_at, "<u8") == _OP_MSG_WORD)
+        if not bool(standard.all()):
+            start, length = self.spans(buf, offsets, where)
+            self.check_heads(buf, start, t_ns, conn, where)
+            return start, length
+        start = offsets + head
+        length = col(head - 4, "<u4").astype(np.int64)
+        if int((start + length).max()) > len(buf):
+            raise BagError(f"message data cut off inside its chunk {where}")
+        got_t = np.multiply(col(4 + time_at, "<u4"), 1_000_000_000, dtype=np.int64)
+        got_t += col(4 + time_at + 4, "<u4")
+        bad = got_t != t_ns
+        bad |= col(4 + conn_at, "<u4") != conn
+        if bool(bad.any()):
+            idx = np.flatnonzero(bad)
+            self.check_heads(buf, start[idx], t_ns[idx], conn[idx], where)
+        return start, length
+
     @staticmethod
     def check_heads(buf: U8, start: I64, t_ns: I64, conn: I64, where: str) -> None:
         """Each message record (data at ``start``) carries the time and connection of the
@@ -769,19 +818,28 @@ class Ros1Bag(BagFile):
         where its conn and time values sit, every record is read there at once, and only a
         record that disagrees is parsed field by field (a writer may order fields otherwise).
         """
-        from ertools.io.fastdecode import read_at
+        from ertools.io.fastdecode import gather
 
-        if not len(start):
+        n = len(start)
+        if not n:
             return
         head_at = start - 4 - MSG_HEADER_LEN
         at = _value_offsets(buf, int(head_at[0]))
-        bad = np.ones(len(start), dtype=bool)
+        bad = np.ones(n, dtype=bool)
         if at is not None and int(head_at.min()) >= 0:
+            # one gather of the stretch holding both values, read as strided columns
             conn_at, time_at = at
-            got_conn = read_at(buf, head_at + conn_at, np.dtype("<u4")).astype(np.int64)
-            tv = read_at(buf, head_at + time_at, np.dtype("<u8"))
-            got_t = (tv & 0xFFFFFFFF).astype(np.int64) * 1_000_000_000 + (tv >> 32).astype(np.int64)
-            bad = (got_conn != conn) | (got_t != t_ns)
+            a = min(conn_at, time_at)
+            width = max(conn_at + 4, time_at + 8) - a
+            rows = gather(buf, head_at + a, width)
+
+            def col(offset: int) -> npt.NDArray[np.uint32]:
+                return np.ndarray((n,), "<u4", buffer=rows, offset=offset - a, strides=(width,))
+
+            got_t = np.multiply(col(time_at), 1_000_000_000, dtype=np.int64)
+            got_t += col(time_at + 4)
+            bad = got_t != t_ns
+            bad |= col(conn_at) != conn
         for i in np.flatnonzero(bad).tolist():
             # the header just before this record's data length, whatever its layout
             found = _fields_before(buf, int(start[i]))
