@@ -28,8 +28,8 @@ demo: $(STAMP)
 	$(BIN)/python -m ertools.demo $(DEMO_OUT)
 
 lint: $(DEVSTAMP)
-	$(BIN)/ruff check ertools tests benchmarks fuzz
-	$(BIN)/ruff format --check ertools tests benchmarks fuzz
+	$(BIN)/ruff check ertools tests bench fuzz
+	$(BIN)/ruff format --check ertools tests bench fuzz
 
 typecheck: $(DEVSTAMP)
 	$(BIN)/mypy ertools
@@ -41,7 +41,7 @@ test: lint typecheck pytest
 
 bench: $(STAMP)
 	$(BIN)/python -m compileall -q ertools
-	$(BIN)/python benchmarks/run.py
+	$(BIN)/python bench/run.py
 
 # JupyterLab in the project's venv, then the notebooks open in it.
 notebooks: $(STAMP)

@@ -17,11 +17,11 @@ from dataclasses import dataclass
 
 # Modules that declare Rule constants; the catalogue is what these hold, in this order.
 RULE_MODULES: tuple[str, ...] = (
-    "ertools.benchmarks.fbm1",
-    "ertools.benchmarks.fbm1_acquire",
-    "ertools.benchmarks.fbm2h",
-    "ertools.benchmarks.fbm3w",
-    "ertools.benchmarks.trajectory",
+    "ertools.benchmarks.fbm1.benchmark",
+    "ertools.benchmarks.fbm1.acquire",
+    "ertools.benchmarks.fbm2h.benchmark",
+    "ertools.benchmarks.fbm3w.benchmark",
+    "ertools.benchmarks.trajectory.benchmark",
 )
 
 

@@ -237,8 +237,8 @@ class Provenance:
     """What a result was computed from, for reports and audits.
 
     ``team`` is who ran the benchmark and ``team_source`` where that name was found
-    (``explicit``, ``payload``, ``log name`` or ``transform``: see :mod:`ertools.teams`);
-    both None when no name was found.
+    (``explicit``, ``payload``, ``log name`` or ``transform``: see
+    :mod:`ertools.benchmarks.common.teams`); both None when no name was found.
     """
 
     inputs: tuple[str, ...] = ()

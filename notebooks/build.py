@@ -141,7 +141,7 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ("md", "## What happened: the state machines' timeline"),
         (
             "code",
-            "from ertools.audit_score import ScoreInputs, audit_bag\n\n"
+            "from ertools.audit.rescore import ScoreInputs, audit_bag\n\n"
             "audit, notes = audit_bag(paths, inputs=ScoreInputs(config=config_path))\n"
             "print(*notes, sep='\\n')\n"
             "print(audit.to_text()[:2500])",
@@ -171,7 +171,7 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ),
         (
             "code",
-            "from ertools.benchmarks.fbm3w import Fbm3wOptions, score_fbm3w\n"
+            "from ertools.benchmarks.fbm3w.benchmark import Fbm3wOptions, score_fbm3w\n"
             "from ertools.configs.fbm3w import load_fbm3w_config\n\n"
             "course = load_fbm3w_config(config_path)\n"
             "rows = []\n"
@@ -239,7 +239,7 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ("md", "## What happened: the state machines' timeline"),
         (
             "code",
-            "from ertools.audit_score import ScoreInputs, audit_bag\n\n"
+            "from ertools.audit.rescore import ScoreInputs, audit_bag\n\n"
             "audit = None\n"
             "if state_topics:\n"
             "    inputs = ScoreInputs(goal=goal_path, transform=transform_path)\n"
@@ -253,7 +253,7 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ("md", "## The recomputed segments"),
         (
             "code",
-            "from ertools.benchmarks.fbm2h import Fbm2hOptions, score_fbm2h\n"
+            "from ertools.benchmarks.fbm2h.benchmark import Fbm2hOptions, score_fbm2h\n"
             "from ertools.report.frames import result_to_dataframes\n\n"
             "options = Fbm2hOptions(goal=goal_path, transform=transform_path, reached=reached,\n"
             "                       timing=timing_path)\n"
@@ -334,7 +334,7 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ),
         (
             "code",
-            "from ertools.audit_score import ScoreInputs, audit_bag\n\n"
+            "from ertools.audit.rescore import ScoreInputs, audit_bag\n\n"
             "inputs = ScoreInputs(items=items_path, results=results_path)\n"
             "audit, notes = audit_bag(paths, inputs=inputs)\n"
             "print(*notes, sep='\\n')\n"
@@ -362,8 +362,8 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ),
         (
             "code",
-            "from ertools.audit_score import DEFAULT_ABS_TOL, compare_scores\n"
-            "from ertools.benchmarks.fbm1 import Fbm1Options, score_fbm1_bag\n\n"
+            "from ertools.audit.compare import DEFAULT_ABS_TOL, compare_scores\n"
+            "from ertools.benchmarks.fbm1.benchmark import Fbm1Options, score_fbm1_bag\n\n"
             "as_2015 = score_fbm1_bag(paths, items_path, options=Fbm1Options.as_2015('fbm1h'),\n"
             "                         results_path=results_path)\n"
             "# Mocap noise moves a recomputed pose score by ~1e-5: a sample's answers state the\n"
@@ -401,7 +401,7 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ),
         (
             "code",
-            "from ertools.benchmarks.trajectory import TrajectoryConfig, score\n\n"
+            "from ertools.benchmarks.trajectory.benchmark import TrajectoryConfig, score\n\n"
             "robot_path = Path(robot_bag)\n"
             "gt_paths = [Path(gt)] if isinstance(gt, str) else [Path(g) for g in gt]\n"
             + LOAD_ANSWERS
@@ -463,7 +463,7 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ),
         (
             "code",
-            "from ertools.timeline_scan import scan\n\n"
+            "from ertools.timeline.scan import scan\n\n"
             "root = Path(folder)\n"
             "assert root.is_dir(), f'{root}: no such folder (the samples: run `make samples`)'\n"
             + LOAD_ANSWERS
@@ -503,7 +503,7 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ("md", "## Every benchmark log of the folder, audited"),
         (
             "code",
-            "from ertools.audit_score import audit_bag\n\n"
+            "from ertools.audit.rescore import audit_bag\n\n"
             "benchmark_logs = [b for b in timeline.bags if b.kind == 'benchmark' and b.readable]\n"
             "rows = []\n"
             "for b in benchmark_logs:\n"

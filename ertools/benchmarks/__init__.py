@@ -7,10 +7,10 @@ registers its storage plugins.
 from __future__ import annotations
 
 REGISTRY: dict[str, str] = {
-    "fbm1h": "ertools.benchmarks.fbm1",
-    "fbm1w": "ertools.benchmarks.fbm1",
-    "fbm2h": "ertools.benchmarks.fbm2h",
-    "fbm3w": "ertools.benchmarks.fbm3w",
-    "trajectory": "ertools.benchmarks.trajectory",
-    "noise": "ertools.benchmarks.noise",
+    "fbm1h": "ertools.benchmarks.fbm1.benchmark",
+    "fbm1w": "ertools.benchmarks.fbm1.benchmark",
+    "fbm2h": "ertools.benchmarks.fbm2h.benchmark",
+    "fbm3w": "ertools.benchmarks.fbm3w.benchmark",
+    "trajectory": "ertools.benchmarks.trajectory.benchmark",
+    "noise": "ertools.benchmarks.noise.benchmark",
 }

@@ -79,7 +79,7 @@ def _windows(text: str | None) -> list[tuple[float, float]] | None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.benchmarks.fbm1_acquire import AcquireOptions, acquire_items_bag
+    from ertools.benchmarks.fbm1.acquire import AcquireOptions, acquire_items_bag
     from ertools.configs.items import items_to_yaml
     from ertools.errors import UsageError
     from ertools.io import PoseSource

@@ -49,7 +49,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.benchmarks.fbm2h_transform import acquire_transform, check_team_name
+    from ertools.benchmarks.fbm2h.transform import acquire_transform, check_team_name
     from ertools.configs.transform import team_transform_path, transform_yaml
     from ertools.errors import ConfigError, UsageError
     from ertools.io import PoseSource, read_pose_source, summary

@@ -70,7 +70,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.audit_score import ScoreInputs, audit_bag
+    from ertools.audit.rescore import ScoreInputs, audit_bag
     from ertools.cli.common import emit_result, note, write_foxglove_option, write_text
     from ertools.errors import ConfigError
     from ertools.timeutil import s_to_ns

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks.base import BenchmarkResult, jsonable
-from ertools.teams import with_team
+from ertools.benchmarks.common.teams import with_team
 
 
 def add_output_options(

@@ -41,7 +41,7 @@ def _tf_pair(text: str) -> tuple[str, str]:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from ertools.cli.score_trajectory import _offset, _positive
-    from ertools.io.export import FORMATS
+    from ertools.export.formats import FORMATS
 
     parser.add_argument(
         "bags",
@@ -148,9 +148,9 @@ def run(args: argparse.Namespace) -> int:
 def _run_one(args: argparse.Namespace) -> int:
     from ertools.cli.common import note, write_text
     from ertools.errors import UsageError
-    from ertools.export import export_source, refuse_inputs
+    from ertools.export.formats import format_times
+    from ertools.export.pairs import export_source, refuse_inputs
     from ertools.io import PoseSource
-    from ertools.io.export import format_times
     from ertools.timeutil import iso_utc
 
     if args.topic is None and args.tf is None:
@@ -180,10 +180,10 @@ def _run_one(args: argparse.Namespace) -> int:
 
 
 def _run_pair(args: argparse.Namespace) -> int:
-    from ertools.benchmarks.trajectory import TrajectoryConfig
+    from ertools.benchmarks.trajectory.benchmark import TrajectoryConfig
     from ertools.cli.common import note
     from ertools.errors import UsageError
-    from ertools.export import (
+    from ertools.export.pairs import (
         KITTI_NEEDS_MATCHED,
         pair_paths,
         refuse_inputs,

@@ -56,7 +56,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _poses(args: argparse.Namespace) -> PoseStream:
-    from ertools.benchmarks.fbm3w import Fbm3wOptions, read_fbm3w_poses
+    from ertools.benchmarks.fbm3w.benchmark import Fbm3wOptions, read_fbm3w_poses
     from ertools.errors import TopicError
     from ertools.io import read_poses, topics
 
@@ -80,7 +80,7 @@ def _poses(args: argparse.Namespace) -> PoseStream:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.benchmarks.noise import noise_from_stream
+    from ertools.benchmarks.noise.benchmark import noise_from_stream
 
     poses = _poses(args)
     result = noise_from_stream(poses, stationary=args.stationary == "auto", bin=args.bin, c=args.c)

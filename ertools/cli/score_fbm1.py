@@ -144,8 +144,8 @@ DEPRECATED = {
 def _options(args: argparse.Namespace) -> object:
     from dataclasses import replace
 
-    from ertools.benchmarks.fbm1 import Fbm1Options
-    from ertools.benchmarks.fbm1_gt import GtOptions
+    from ertools.benchmarks.fbm1.benchmark import Fbm1Options
+    from ertools.benchmarks.fbm1.gt import GtOptions
     from ertools.errors import ConfigError, UsageError
 
     for name in ("max_window", "still", "still_deg", "max_gap"):
@@ -189,7 +189,7 @@ def _options(args: argparse.Namespace) -> object:
 
 
 def _sources(args: argparse.Namespace) -> object:
-    from ertools.benchmarks.fbm1 import BodySources
+    from ertools.benchmarks.fbm1.benchmark import BodySources
     from ertools.io import PoseSource
 
     def one(body: str, topic: str | None, frame: str | None) -> PoseSource | None:
@@ -207,7 +207,7 @@ def _sources(args: argparse.Namespace) -> object:
 
 def run(args: argparse.Namespace) -> int:
     from ertools.benchmarks.base import BenchmarkResult
-    from ertools.benchmarks.fbm1 import BodySources, Fbm1Options, score_fbm1_bag
+    from ertools.benchmarks.fbm1.benchmark import BodySources, Fbm1Options, score_fbm1_bag
 
     options = _options(args)
     sources = _sources(args)
@@ -240,7 +240,7 @@ def _fmt(value: object, spec: str) -> str:
 
 def print_table(result: object) -> None:
     """The per-run table on stderr (stdout keeps the parseable score)."""
-    from ertools.benchmarks.fbm1_result import Fbm1Result
+    from ertools.benchmarks.fbm1.result import Fbm1Result
 
     assert isinstance(result, Fbm1Result)
     head = (

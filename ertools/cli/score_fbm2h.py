@@ -151,8 +151,8 @@ def _reached(
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.benchmarks.fbm2h import Fbm2hOptions, score_fbm2h
-    from ertools.benchmarks.fbm2h_segments import StopParams
+    from ertools.benchmarks.fbm2h.benchmark import Fbm2hOptions, score_fbm2h
+    from ertools.benchmarks.fbm2h.segments import StopParams
 
     mode, timing, bags = _reached(args.reached, list(args.bags))
     args.bags = bags
@@ -189,7 +189,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _print_table(result: object) -> None:
-    from ertools.benchmarks.fbm2h_result import Fbm2hResult
+    from ertools.benchmarks.fbm2h.result import Fbm2hResult
 
     assert isinstance(result, Fbm2hResult)
     note(

@@ -144,8 +144,8 @@ def parse_sweep(text: str) -> tuple[float, ...]:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.benchmarks.fbm3w import Fbm3wOptions, options_2015, score_fbm3w
-    from ertools.benchmarks.fbm3w_runs import parse_run_spec, parse_runs_file
+    from ertools.benchmarks.fbm3w.benchmark import Fbm3wOptions, options_2015, score_fbm3w
+    from ertools.benchmarks.fbm3w.runs import parse_run_spec, parse_runs_file
     from ertools.configs._yaml import load_yaml
     from ertools.configs.fbm3w import check_d_min, load_fbm3w_config
     from ertools.errors import UsageError

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 if TYPE_CHECKING:
-    from ertools.timeline import Timeline
+    from ertools.timeline.build import Timeline
 
 EPILOG = """examples:
   ertools timeline bags/                         # table of every bag under bags/
@@ -79,8 +79,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ertools.cli.common import dump_json, note, write_text
-    from ertools.timeline import TimelineConfig
-    from ertools.timeline_scan import scan
+    from ertools.timeline.build import TimelineConfig
+    from ertools.timeline.scan import scan
     from ertools.timeutil import s_to_ns
 
     plots: list[Path] = args.plot or []
@@ -183,7 +183,7 @@ def _when(ns: int | None) -> str:
 
 def to_table(timeline: Timeline, *, color: bool = False) -> str:
     """The human table: bags by start, then sessions with their GT pairing, then problems."""
-    from ertools.timeline import KIND_LABELS
+    from ertools.timeline.build import KIND_LABELS
 
     paint = _Paint(color)
     lines: list[str] = []
@@ -224,7 +224,7 @@ def to_table(timeline: Timeline, *, color: bool = False) -> str:
 
 
 def _pairing_line(p: Any, paint: _Paint, *, full_path: bool = False) -> str:
-    from ertools.timeline import KIND_LABELS
+    from ertools.timeline.build import KIND_LABELS
 
     name = str(p.path) if full_path else Path(p.path).name
     other = ""

@@ -1,4 +1,4 @@
-"""The fast path: pose topics decoded chunk by chunk with :mod:`ertools.io.fastdecode`.
+"""The fast path: pose topics decoded chunk by chunk with :mod:`ertools.io.decode.fast`.
 
 Per format, the messages of the requested connections are located from the file's own index
 (ROS1 index-data records, MCAP message-index records, rosbag2 sqlite rows), in the same order
@@ -21,15 +21,15 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.errors import BagError
-from ertools.io.fastdecode import FAST_TYPES, Decoded, LayoutMismatchError, decode, to_batch
+from ertools.io.decode.fast import FAST_TYPES, Decoded, LayoutMismatchError, decode, to_batch
+from ertools.io.decode.posebatch import PoseBatch, concat_batches
+from ertools.io.decode.uniform import Rows, decode_uniform
 from ertools.io.files import BagFile
 from ertools.io.model import TF_TYPES, Conn
 from ertools.io.pipeline import Group, joined, keep, pread, prefetched, read_at, scratch_view
-from ertools.io.posebatch import PoseBatch, concat_batches
-from ertools.io.uniform import Rows, decode_uniform
 
 if TYPE_CHECKING:
-    from ertools.io.ros1_index import Ros1Bag, Ros1Chunk
+    from ertools.io.ros1.index import Ros1Bag, Ros1Chunk
     from ertools.progress import Reporter
 
 log = logging.getLogger("ertools.io.bulk")
@@ -171,7 +171,7 @@ def _ros1_runs(
     hi: int | None,
     progress: Reporter | None = None,
 ) -> Located:
-    from ertools.io.ros1_index import Ros1Bag
+    from ertools.io.ros1.index import Ros1Bag
 
     assert isinstance(bag, Ros1Bag)
     touched, chunk_of, rank_of, t_of, off_of = bag.select(conns, lo, hi)
@@ -289,7 +289,7 @@ def _chunk_group(bag: BagFile, chunks: list[Any], scratch: list[Any]) -> Group:
     stretch they span (the index records between them come along, unused); others are read
     and decompressed one by one and joined.
     """
-    from ertools.io.ros1_index import Ros1Bag, decompress
+    from ertools.io.ros1.index import Ros1Bag, decompress
 
     assert isinstance(bag, Ros1Bag)
     fd = bag.file.fileno()
@@ -321,7 +321,7 @@ def _mcap_runs(
     hi: int | None,
     progress: Reporter | None = None,
 ) -> Located | None:
-    from ertools.io.mcap_index import McapIndex
+    from ertools.io.mcap.index import McapIndex
 
     index = McapIndex.of(bag)
     if index is None:
@@ -348,7 +348,7 @@ def _mcap_runs(
 def _sqlite_runs(
     bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None
 ) -> Located | None:
-    from ertools.io.rosbag2 import sqlite_rows
+    from ertools.io.rosbag2.metadata import sqlite_rows
 
     batches = sqlite_rows(bag.path, conns, lo, hi)
     if batches is None:
@@ -410,8 +410,8 @@ def load_all_chunks(bag: BagFile, progress: Reporter | None = None) -> int:
     pipeline as a topic read but not decoded: the floor of any read of that file (what the
     benchmark compares the extraction with on compressed files). The bytes read from the
     file (compressed) are reported to ``progress`` group by group."""
-    from ertools.io.mcap_index import McapIndex
-    from ertools.io.ros1_index import Ros1Bag
+    from ertools.io.mcap.index import McapIndex
+    from ertools.io.ros1.index import Ros1Bag
 
     total = 0
     if isinstance(bag, Ros1Bag):

@@ -1,7 +1,7 @@
 """One open bag file of any format: its connections and its raw messages in record-time order.
 
-This is the general (per-message) path. The bulk NumPy decoders in :mod:`ertools.io.fastdecode`
-read the same files through :mod:`ertools.io.ros1_index` and :mod:`ertools.io.mcap_index`; this
+This is the general (per-message) path. The bulk NumPy decoders in :mod:`ertools.io.decode.fast`
+read the same files through :mod:`ertools.io.ros1.index` and :mod:`ertools.io.mcap.index`; this
 module is the reference they are tested against and the fallback for every other type.
 
 Order of messages (the reference order): by record time; ties keep the order of the
@@ -179,7 +179,7 @@ class McapFile(BagFile):
     """A standalone MCAP file (ROS 2 ``cdr`` or ``ros1`` message encoding) via ``mcap``.
 
     Read through the summary's indexes when they answer for every message
-    (:func:`ertools.io.mcap_scan.mcap_layout`), else record by record (``scanned`` is True,
+    (:func:`ertools.io.mcap.scan.mcap_layout`), else record by record (``scanned`` is True,
     and INFO says why): no summary section, chunks without message indexes, channels or
     schemas only inside chunks, messages outside chunks. A file cut short (a recorder that was
     killed) is read as far as its records are complete, like a ROS1 ``.bag.active``:
@@ -189,7 +189,7 @@ class McapFile(BagFile):
     def __init__(self, path: Path) -> None:
         from mcap.reader import make_reader
 
-        from ertools.io.mcap_scan import SCAN, mcap_layout
+        from ertools.io.mcap.scan import SCAN, mcap_layout
 
         self.path = path
         self.format = "mcap"
@@ -213,7 +213,7 @@ class McapFile(BagFile):
 
     def _scan(self, why: str) -> tuple[Conn, ...]:
         """Read every complete record (the summary's indexes do not answer for them all)."""
-        from ertools.io.mcap_scan import scan_mcap
+        from ertools.io.mcap.scan import scan_mcap
 
         self.scanned = True
         log.info("%s: %s; reading the file record by record", self.path, why)
@@ -250,7 +250,7 @@ class McapFile(BagFile):
         """The messages of ``conns`` in [start_ns, end_ns] of a file read record by record, as
         runs of (reference positions, bytes, data starts, data lengths, log times, channel
         ids): one more pass over the records that copies only these messages' bytes."""
-        from ertools.io.mcap_scan import scan_mcap
+        from ertools.io.mcap.scan import scan_mcap
 
         found = scan_mcap(self.path, keep=frozenset(c.id for c in conns))
         if not found.payloads:
@@ -338,7 +338,7 @@ def open_bag(path: str | Path) -> BagFile:
     if fmt == "ros1-active":
         fmt = "ros1"
     if fmt == "ros1":
-        from ertools.io.ros1_index import Ros1Bag
+        from ertools.io.ros1.index import Ros1Bag
 
         return Ros1Bag(p)
     return RosbagsFile(p, fmt)

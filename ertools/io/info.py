@@ -170,7 +170,7 @@ def verify(path: Path, progress: Reporter | None = None) -> list[str]:
 
     Returns:
         For ROS1 bags, every disagreement between the index and the records, one line each
-        (:mod:`ertools.io.ros1_check`); other formats raise at the first damage.
+        (:mod:`ertools.io.ros1.check`); other formats raise at the first damage.
 
     Raises:
         BagError: naming the file and the byte offset of the first damaged chunk.
@@ -179,11 +179,11 @@ def verify(path: Path, progress: Reporter | None = None) -> list[str]:
 
     fmt = detect_format(path)
     if fmt == "ros1":
-        from ertools.io.ros1_check import check_ros1
+        from ertools.io.ros1.check import check_ros1
 
         return check_ros1(path, progress)
     if fmt == "ros1-active":
-        from ertools.io.ros1_index import Ros1Bag
+        from ertools.io.ros1.index import Ros1Bag
 
         bag = Ros1Bag(path)
         try:
@@ -191,12 +191,12 @@ def verify(path: Path, progress: Reporter | None = None) -> list[str]:
         finally:
             bag.close()
     elif fmt in ("mcap", "rosbag2-mcap"):
-        from ertools.io.mcap_index import verify_mcap
+        from ertools.io.mcap.index import verify_mcap
 
         for file in [path] if fmt == "mcap" else sorted(path.glob("*.mcap")):
             verify_mcap(file, progress)
     else:
-        from ertools.io.rosbag2 import query, read_metadata, storage_files
+        from ertools.io.rosbag2.metadata import query, read_metadata, storage_files
 
         for db in storage_files(path, read_metadata(path)):
             result = query(db, "PRAGMA quick_check")[0][0]

@@ -2,7 +2,7 @@
 
 Every function takes one path or a list (a logger's split files), reads each file, and merges
 the results in time order. Pose topics go through the bulk NumPy decoder where the format and
-type allow it (:mod:`ertools.io.fastdecode`) and through rosbags' deserializer otherwise.
+type allow it (:mod:`ertools.io.decode.fast`) and through rosbags' deserializer otherwise.
 """
 
 from __future__ import annotations
@@ -16,6 +16,9 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.errors import BagError, TopicError
+from ertools.io.decode.posebatch import PoseBatch, batch_from_messages, concat_batches
+from ertools.io.decode.tf import Edge, chain_pose, frame_key
+from ertools.io.decode.typestore import Deserializer
 from ertools.io.files import BagFile, open_bag
 from ertools.io.formats import bag_paths
 from ertools.io.merge import merge_poses, sort_poses
@@ -27,9 +30,6 @@ from ertools.io.model import (
     PoseSource,
     RawMessage,
 )
-from ertools.io.posebatch import PoseBatch, batch_from_messages, concat_batches
-from ertools.io.tf import Edge, chain_pose, frame_key
-from ertools.io.typestore import Deserializer
 from ertools.states import MSG_TYPES, STATE_TOPIC_SUFFIXES
 from ertools.streams import MAX_FRAME_CHANGES, FrameChange, Machine, PoseStream, StateStream
 
@@ -259,7 +259,7 @@ def read_tf(
     Accepts ``tf/tfMessage`` and ``tf2_msgs/TFMessage``; times are the transforms' header
     stamps. Frame names match with or without a leading slash. A chain (e.g. origin <- world ->
     ref_board) is sampled at the times of its link into ``child`` and the other links are
-    interpolated there (see :mod:`ertools.io.tf` for the exact rule).
+    interpolated there (see :mod:`ertools.io.decode.tf` for the exact rule).
 
     Raises:
         TopicError: no tf topic, an unknown frame, or no chain between the frames.
@@ -346,7 +346,7 @@ def _bulk_states(
     """(record times, states, payloads) decoded in bulk, None when the layout is not the 2015
     one or the format has no bulk access."""
     from ertools.io.bulk import locate
-    from ertools.io.fastdecode import LayoutMismatchError, decode_states, is_state_definition
+    from ertools.io.decode.fast import LayoutMismatchError, decode_states, is_state_definition
 
     if len({c.encoding for c in conns}) != 1 or not all(
         is_state_definition(c.msgdef) for c in conns

@@ -5,7 +5,7 @@
   (``.bag.active``) or a damaged or truncated one is scanned record by record instead and
   flagged (``indexed=False``, ``problems``).
 - MCAP: the summary section (statistics, channels, schemas, chunk indexes, message indexes)
-  where it answers for every message (:func:`ertools.io.mcap_scan.mcap_layout`); any other
+  where it answers for every message (:func:`ertools.io.mcap.scan.mcap_layout`); any other
   layout the specification allows (no summary, no statistics, no message indexes, channels
   only inside chunks, messages outside chunks) is read record by record, exactly
   (``index="scan"``, ``indexed=False``); only a file cut short is flagged in ``problems``.
@@ -107,7 +107,7 @@ Times = dict[str, list[I64]]
 
 
 def _ros1(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagSummary:
-    from ertools.io.ros1_index import Ros1Bag, read_layout
+    from ertools.io.ros1.index import Ros1Bag, read_layout
 
     layout = read_layout(path)
     compressions: set[str] = set()
@@ -192,7 +192,7 @@ def _mcap_scanned(
 ) -> tuple[dict[str, tuple[str, int, int | None, int | None, int]], set[str], list[str]]:
     """Topics of an MCAP file read record by record (chunks decompressed): the path for
     layouts the summary cannot answer for alone, exact for all of them."""
-    from ertools.io.mcap_scan import scan_mcap
+    from ertools.io.mcap.scan import scan_mcap
 
     log.info("%s: %s; reading the file record by record", path, why)
     found = scan_mcap(path)
@@ -224,7 +224,7 @@ def _mcap_indexed(
 ) -> tuple[dict[str, tuple[str, int, int | None, int | None, int]], set[str], list[str], str]:
     """Topics from the summary: counts from the statistics, or from the message indexes when
     ``exact`` or when the summary has no statistics (then every message is counted)."""
-    from ertools.io.mcap_index import McapIndex
+    from ertools.io.mcap.index import McapIndex
 
     summary = layout.summary
     spans: dict[int, list[int]] = {}
@@ -314,7 +314,7 @@ def _check_ends(path: Path, ends: dict[int, dict[int, tuple[Any, int]]]) -> None
     """
     import struct
 
-    from ertools.io.mcap_index import McapIndex
+    from ertools.io.mcap.index import McapIndex
 
     chunks: dict[int, bytes] = {}
     for cid, found in ends.items():
@@ -340,7 +340,7 @@ def _mcap_file(
 ) -> tuple[dict[str, tuple[str, int, int | None, int | None, int]], set[str], list[str], str]:
     """(topics, chunk compressions, problems, index used) of one MCAP file, through its
     indexes where they answer for every message, else record by record."""
-    from ertools.io.mcap_scan import SCAN, mcap_layout
+    from ertools.io.mcap.scan import SCAN, mcap_layout
 
     layout = mcap_layout(path)
     if layout.index == SCAN:
@@ -370,7 +370,7 @@ def _mcap(path: Path, exact: bool, times: Times | None = None) -> BagSummary:
 
 
 def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagSummary:
-    from ertools.io.rosbag2 import read_metadata, storage_files
+    from ertools.io.rosbag2.metadata import read_metadata, storage_files
 
     info = read_metadata(path)
     problems = []
@@ -417,7 +417,7 @@ def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> B
 
 
 def _sqlite_spans(files: list[Path]) -> dict[str, tuple[int, int]]:
-    from ertools.io.rosbag2 import query
+    from ertools.io.rosbag2.metadata import query
 
     out: dict[str, tuple[int, int]] = {}
     for db in files:
@@ -476,7 +476,7 @@ def record_times(path: str | Path) -> dict[str, I64]:
     fmt = detect_format(p)
     parts: dict[str, list[I64]] = defaultdict(list)
     if fmt in ("ros1", "ros1-active"):
-        from ertools.io.ros1_index import Ros1Bag, read_layout
+        from ertools.io.ros1.index import Ros1Bag, read_layout
 
         layout = read_layout(p)
         bag = Ros1Bag(p, layout, strict=False)
@@ -493,7 +493,7 @@ def record_times(path: str | Path) -> dict[str, I64]:
         for file in [p] if fmt == "mcap" else sorted(p.glob("*.mcap")):
             _mcap_file(file, True, parts)
     else:
-        from ertools.io.rosbag2 import query, read_metadata, storage_files
+        from ertools.io.rosbag2.metadata import query, read_metadata, storage_files
 
         for db in storage_files(p, read_metadata(p)):
             rows = query(

@@ -8,8 +8,9 @@ team and the inputs; a lone ``score.json`` is recognised from its keys). Writes
 Results of the same inputs (the same SHA-256 of every input file) are one execution scored
 several times (with and without ``--team``/``--transforms``, with a 2015 option...): they are
 merged into one row, whose team is the best-sourced name any of them found (``--team`` >
-payload > log name > transform, see :mod:`ertools.teams`), and whose other results are listed
-by their options. A result with no team takes the one its inputs' rockin_logger names give.
+payload > log name > transform, see :mod:`ertools.benchmarks.common.teams`), and whose other
+results are listed by their options. A result with no team takes the one its inputs'
+rockin_logger names give.
 """
 
 from __future__ import annotations
@@ -22,15 +23,15 @@ from pathlib import Path
 from typing import Any
 
 from ertools import __version__
+from ertools.benchmarks.common.teams import team_from_log_name
 from ertools.errors import ConfigError
 from ertools.report import html as h
 from ertools.report import units
-from ertools.teams import team_from_log_name
 
 # Command-line options that choose where or how output is written, not what is scored.
 _OUTPUT_OPTIONS = frozenset({"-o", "--output", "--report", "--plot", "--foxglove", "--format"})
 _OUTPUT_FLAGS = frozenset({"-v", "--verbose", "-q", "--quiet"})
-# Team sources, best first (ertools.teams.resolve_team's precedence).
+# Team sources, best first (ertools.benchmarks.common.teams.resolve_team's precedence).
 _SOURCE_RANK = {"explicit": 0, "payload": 1, "log name": 2, "transform": 3}
 
 # Keys that identify a benchmark's score when no result.json says which it is.
@@ -56,7 +57,9 @@ class Entry:
     findings: int | None
     source: Path  # the result.json or score.json read
     index: Path | None  # the report's index.html, when it exists
-    team_source: str | None = None  # explicit, payload, log name, transform (ertools.teams)
+    team_source: str | None = (
+        None  # explicit, payload, log name, transform (ertools.benchmarks.common.teams)
+    )
     sha256: tuple[str, ...] = ()  # of the inputs, sorted: same tuple = same execution
     options: str = ""  # the scoring options of its command line ("" = the defaults)
     generated: str = ""

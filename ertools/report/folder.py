@@ -12,8 +12,8 @@
 - ``result.json``: the metadata ``ertools report`` combines (benchmark, team, inputs, the
   headline numbers and the whole score).
 
-An :class:`~ertools.audit.Audit` is accepted as well: its recomputed score (when there is one)
-becomes the score of the folder, and ``audit.yaml``/``audit.json`` are added.
+An :class:`~ertools.audit.model.Audit` is accepted as well: its recomputed score (when there
+is one) becomes the score of the folder, and ``audit.yaml``/``audit.json`` are added.
 """
 
 from __future__ import annotations
@@ -32,9 +32,9 @@ from typing import Any
 
 from ertools import __version__
 from ertools.benchmarks.base import BenchmarkResult, Rows, jsonable
+from ertools.benchmarks.common.teams import SOURCE_TEXT
 from ertools.report import html as h
 from ertools.report import units
-from ertools.teams import SOURCE_TEXT
 
 log = logging.getLogger("ertools.report.folder")
 
@@ -98,7 +98,7 @@ def write_report(
     """Write the report folder of ``result`` into ``outdir``; returns the ``index.html`` path.
 
     Args:
-        result: any benchmark result, or an :class:`ertools.audit.Audit`.
+        result: any benchmark result, or an :class:`ertools.audit.model.Audit`.
         outdir: the folder (created; files of the same names are overwritten).
         inputs: the bags the result was computed from (hashed, not modified).
         argv: the command line (shown; file arguments that are not inputs are the configs).
@@ -127,7 +127,7 @@ def _write_report(
     audit: Any,
     team: str | None,
 ) -> Path:
-    from ertools.audit import Audit
+    from ertools.audit.model import Audit
 
     score: BenchmarkResult | None
     if isinstance(result, Audit):
@@ -200,7 +200,7 @@ def _audit_inputs(name: str, inputs: list[Path]) -> Any:
     """The audit of the bags' state topics, or None (no namespace, no topics, unreadable)."""
     if name not in NAMESPACES or not inputs:
         return None
-    from ertools.audit import audit_states
+    from ertools.audit.analyse import audit_states
     from ertools.errors import ErtoolsError
     from ertools.io import read_benchmark_states
 
@@ -274,7 +274,7 @@ def _team(
     """(team, where it was found): the result's own (``provenance.team``, set by the scoring
     commands), else ``--team`` on the command line, a rockin_logger input name, a
     ``team``/``robot_info`` parameter, a ``transform-<team>.yaml`` argument."""
-    from ertools.teams import team_from_log_name, team_from_transform_name
+    from ertools.benchmarks.common.teams import team_from_log_name, team_from_transform_name
 
     for holder in (score, audit):
         provenance = getattr(holder, "provenance", None)

@@ -9,8 +9,8 @@ carry a marker.
 
 from __future__ import annotations
 
-from ertools.teams import team_from_log_name
-from ertools.timeline import KIND_LABELS, BagEntry
+from ertools.benchmarks.common.teams import team_from_log_name
+from ertools.timeline.build import KIND_LABELS, BagEntry
 
 KIND_COLORS: dict[str, str] = {
     "gt": "#0072B2",  # blue

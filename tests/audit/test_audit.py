@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from audit_streams import BEAT_NS, T0_NS, heartbeat
 
-from ertools.audit import audit_states, parse_payload
+from ertools.audit.analyse import audit_states, parse_payload
 from ertools.states import BmBoxState as B
 from ertools.states import ClientState as C
 from ertools.states import RefBoxState as R

@@ -9,8 +9,10 @@ import pytest
 import yaml
 from audit_samples import answers, sample_dir
 
-from ertools.audit import Audit, audit_states
-from ertools.audit_score import ScoreInputs, attach, flatten, rescore
+from ertools.audit.analyse import audit_states
+from ertools.audit.compare import attach, flatten
+from ertools.audit.model import Audit
+from ertools.audit.rescore import ScoreInputs, rescore
 
 
 def _audit(folder: Path, ns: str) -> Audit:
@@ -96,7 +98,7 @@ def test_fbm1h_live_is_the_2015_totals(fbm1h: Path) -> None:
     assert by_key["pose_score"].status == "differs"
     assert "runs" in by_key["pose_score"].explanation
     # The 2015 rules reproduce the live pose score (within 0.1 %): a deliberate deviation.
-    from ertools.audit_score import audit_bag
+    from ertools.audit.rescore import audit_bag
 
     audited, _ = audit_bag([bag], inputs=ScoreInputs(items=fbm1h / "fbm1h.yaml"))
     assert audited.comparison is not None
@@ -122,7 +124,7 @@ def test_fbm2h_goal_and_results_in_the_runs(fbm2h: Path) -> None:
 
 
 def test_fbm3w_other_d_min_is_explained_by_the_2015_rules(fbm3w: Path) -> None:
-    from ertools.audit_score import audit_bag
+    from ertools.audit.rescore import audit_bag
 
     (bag,) = fbm3w.glob("*.bag")
     audit, _ = audit_bag([bag], inputs=ScoreInputs(d_min=0.0005))
@@ -139,7 +141,7 @@ def test_fbm2h_live_score_beside_the_recomputed_one(
 ) -> None:
     """The sample's BmBox sends the score the 2015 node would have (answers:
     expected.published); the audit shows it beside ertools' score, differences explained."""
-    from ertools.audit_score import audit_bag
+    from ertools.audit.rescore import audit_bag
     from ertools.cli.main import main
 
     ans = answers(fbm2h)

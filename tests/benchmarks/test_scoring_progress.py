@@ -7,8 +7,8 @@ from pathlib import Path
 
 import yaml
 
-from ertools.benchmarks.fbm1 import score_fbm1_bag
-from ertools.benchmarks.fbm3w import score_fbm3w
+from ertools.benchmarks.fbm1.benchmark import score_fbm1_bag
+from ertools.benchmarks.fbm3w.benchmark import score_fbm3w
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.progress import reporting
 

@@ -1,4 +1,5 @@
-"""ertools.motion: still-phase detection on synthetic streams with hand-computed phases.
+"""ertools.benchmarks.common.motion: still-phase detection on synthetic streams with
+hand-computed phases.
 
 All streams are sampled at 10 Hz (100 ms, exact in ns) unless said, so the window ends are
 whole samples and the expected phases follow from the motion by hand (worked out in each
@@ -13,8 +14,7 @@ import math
 import numpy as np
 import pytest
 
-from ertools.geometry import quat_from_yaw
-from ertools.motion import (
+from ertools.benchmarks.common.motion import (
     rotation_angle,
     runs_mask,
     sample_half_window,
@@ -22,6 +22,7 @@ from ertools.motion import (
     still_mask,
     still_runs,
 )
+from ertools.geometry import quat_from_yaw
 from ertools.streams import Interval
 
 MS = 1_000_000  # ns

@@ -10,9 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from ertools.cli.main import main
-from ertools.streams import Machine, Provenance
-from ertools.teams import (
+from ertools.benchmarks.common.teams import (
     parse_robot_log_name,
     read_payload_team,
     resolve_team,
@@ -21,6 +19,8 @@ from ertools.teams import (
     team_from_transform_name,
     with_team,
 )
+from ertools.cli.main import main
+from ertools.streams import Machine, Provenance
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -72,7 +72,7 @@ def test_names_the_logger_did_not_give(name: str) -> None:
 
 
 def test_timeline_uses_the_same_helper() -> None:
-    from ertools.timeline import benchmark_names
+    from ertools.timeline.build import benchmark_names
 
     assert benchmark_names([], "FBMH2_201511201200_homer.bag") == ("fbm2h",)
     assert benchmark_names([], "robot.bag") == ()

@@ -1,4 +1,5 @@
-"""`ertools export` / ertools.io.export: files read back with NumPy give the written poses back.
+"""`ertools export` / ertools.export.formats: files read back with NumPy give the written
+poses back.
 
 The expected values are the generator's (conftest.make_scene: stamps, positions, quaternions
 written into every bag format) and, for the sample bag, the messages as rosbags reads them:
@@ -21,7 +22,7 @@ from hypothesis import strategies as st
 
 from ertools.cli.main import main
 from ertools.errors import BagError
-from ertools.io.export import (
+from ertools.export.formats import (
     format_csv,
     format_tum,
     rotation_matrices,

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from ertools.io.bulk import try_fast_batch
+from ertools.io.decode.posebatch import PoseBatch
 from ertools.io.files import RosbagsFile, open_bag
-from ertools.io.posebatch import PoseBatch
 from ertools.io.reader import slow_pose_batch
 
 POSE_TOPICS = (
@@ -140,8 +140,8 @@ STATE_TOPICS = ("/fbm3w/bmbox_state", "/fbm3w/refbox_state")
 
 def reference_states(path: Path, topic: str) -> tuple[list[int], list[int], list[str]]:
     """States deserialized one by one by rosbags' own readers."""
+    from ertools.io.decode.typestore import Deserializer
     from ertools.io.formats import detect_format
-    from ertools.io.typestore import Deserializer
 
     fmt = detect_format(path)
     bag = RosbagsFile(path, fmt) if fmt not in ("mcap", "ros1-active") else open_bag(path)

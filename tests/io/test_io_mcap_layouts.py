@@ -229,7 +229,7 @@ def test_scan_finds_every_record(
     scene: Scene,
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    from ertools.io import mcap_scan
+    from ertools.io.mcap import scan as mcap_scan
 
     # small windows (a few records) and early bulk reads: record chains cut at window edges
     monkeypatch.setattr(mcap_scan, "WINDOW", window)

@@ -23,7 +23,7 @@ from test_io_fastpath import POSE_TOPICS, assert_same, fast_batch, reference_bat
 import ertools.io as eio
 from ertools.errors import BagError, ErtoolsError
 from ertools.io import bulk, pipeline
-from ertools.io.mcap_index import _in_order
+from ertools.io.mcap.index import _in_order
 
 
 @pytest.fixture

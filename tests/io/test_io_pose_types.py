@@ -21,9 +21,9 @@ from io_bagmaker import FORMATS, Spec, bag_name, write
 from test_io_fastpath import assert_same, fast_batch, reference_batch
 
 import ertools.io as eio
-from ertools.io.fastdecode import decode
+from ertools.io.decode.fast import decode
+from ertools.io.decode.uniform import decode_uniform, layout_of
 from ertools.io.model import POSE_TYPES, PoseSource
-from ertools.io.uniform import decode_uniform, layout_of
 
 T0 = 1_700_000_000_000_000_000
 N = 40
@@ -163,7 +163,7 @@ def test_pwcs_layout_by_hand(cdr: bool) -> None:
 
 @pytest.mark.parametrize("topic", sorted(TOPICS))
 def test_trajectory_robot_topic_accepts_every_type(typed_bag: Path, topic: str) -> None:
-    from ertools.benchmarks.trajectory import read_robot
+    from ertools.benchmarks.trajectory.benchmark import read_robot
     from ertools.errors import TopicError
 
     _, t_rec, t_hdr, xyz, _quat = truth()
@@ -245,7 +245,7 @@ def test_summary_matches_the_official_reader(typed_bag: Path) -> None:
 
 
 def test_trajectory_robot_topic_of_several_tf_bodies_is_refused(tmp_path: Path) -> None:
-    from ertools.benchmarks.trajectory import read_robot
+    from ertools.benchmarks.trajectory.benchmark import read_robot
     from ertools.errors import TopicError
 
     s = Spec()

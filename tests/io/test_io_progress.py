@@ -18,7 +18,7 @@ from ertools.cli.main import main
 from ertools.io import bulk, pipeline
 from ertools.io.files import open_bag
 from ertools.io.info import describe
-from ertools.io.ros1_check import check_ros1
+from ertools.io.ros1.check import check_ros1
 from ertools.progress import reporting
 
 TOPIC = "/fbm3w/robot_at_work/pose"

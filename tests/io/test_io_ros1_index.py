@@ -19,7 +19,7 @@ from io_bagmaker import Spec, write
 
 import ertools.io as eio
 from ertools.cli.main import main
-from ertools.io.ros1_check import check_ros1
+from ertools.io.ros1.check import check_ros1
 
 T0 = 1_445_609_740_000_000_000
 DT = 10_000_000
@@ -291,8 +291,8 @@ def test_fast_path_on_a_sound_bag_warns_nothing(
 
 @pytest.mark.parametrize("fmt", ["ros1", "ros1-lz4"])
 def test_rebuilt_layout_equals_the_record_by_record_scan(tmp_path: Path, fmt: str) -> None:
-    from ertools.io.ros1_check import rebuild_layout
-    from ertools.io.ros1_index import scan_layout
+    from ertools.io.ros1.check import rebuild_layout
+    from ertools.io.ros1.index import scan_layout
 
     path = two_topic_bag(tmp_path / "b.bag", fmt)
     size = path.stat().st_size

@@ -15,9 +15,9 @@ from io_bagmaker import Spec, write
 
 import ertools.io as eio
 from ertools.errors import TopicError
+from ertools.io.decode.tf import Edge, chain_pose
 from ertools.io.files import open_bag
-from ertools.io.ros1_index import Ros1Bag
-from ertools.io.tf import Edge, chain_pose
+from ertools.io.ros1.index import Ros1Bag
 from ertools.streams import PoseStream
 
 

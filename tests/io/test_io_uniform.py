@@ -1,4 +1,4 @@
-"""The one-gather decoder (ertools.io.uniform): layouts worked out by hand from the ROS1 and
+"""The one-gather decoder (ertools.io.decode.uniform): layouts worked out by hand from the ROS1 and
 CDR serialization rules, exact values back, and a fallback whenever one message differs."""
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from io_bagmaker import FORMATS, Spec, bag_name, write
 from test_io_fastpath import assert_same, fast_batch, reference_batch
 
 from ertools.io import bulk
-from ertools.io.uniform import decode_uniform, layout_of
+from ertools.io.decode.uniform import decode_uniform, layout_of
 
 POSE = (1.5, -2.25, 0.125, 0.0, 0.0, 0.6, 0.8)
 

@@ -148,7 +148,7 @@ def test_fbm3w(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def test_fbm2h(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from ertools.benchmarks.fbm2h import Fbm2hOptions, score_fbm2h
+    from ertools.benchmarks.fbm2h.benchmark import Fbm2hOptions, score_fbm2h
 
     out = tmp_path / "fbm2h.mcap"
     score = run_json(["score", "fbm2h", str(FBM2H), *FBM2H_ARGS, "--foxglove", str(out)], capsys)
@@ -263,8 +263,8 @@ def _stamps(path: Path, topic: str) -> list[int]:
 
 
 def test_trajectory(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from ertools.benchmarks.trajectory import TrajectoryConfig
-    from ertools.benchmarks.trajectory import score as score_trajectory
+    from ertools.benchmarks.trajectory.benchmark import TrajectoryConfig
+    from ertools.benchmarks.trajectory.benchmark import score as score_trajectory
 
     out = tmp_path / "trajectory.mcap"
     argv = ["score", "trajectory", str(ROBOT), str(ROBOT.parent), "--offset", "auto"]
@@ -316,7 +316,7 @@ def test_trajectory(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def test_trajectory_streams_over_the_limit_are_decimated(tmp_path: Path) -> None:
-    from ertools.benchmarks.trajectory import score as score_trajectory
+    from ertools.benchmarks.trajectory.benchmark import score as score_trajectory
     from ertools.report.foxglove import write_foxglove
 
     result = score_trajectory(ROBOT, [ROBOT.parent])

@@ -73,8 +73,8 @@ def _chromium(tmp_path: Path, url: str, *extra: str) -> subprocess.CompletedProc
 
 @pytest.fixture(scope="module")
 def report(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    from ertools.audit import audit_states
-    from ertools.audit_score import attach
+    from ertools.audit.analyse import audit_states
+    from ertools.audit.compare import attach
     from ertools.streams import Machine
 
     tmp = tmp_path_factory.mktemp("browser")

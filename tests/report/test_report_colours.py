@@ -86,7 +86,7 @@ def test_timeline_bars_are_drawn_in_their_state_colour() -> None:
     from matplotlib.colors import to_rgba
     from matplotlib.figure import Figure
 
-    from ertools.audit import audit_states
+    from ertools.audit.analyse import audit_states
     from ertools.report.plots_audit import draw_timeline
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "audit"))

@@ -127,7 +127,7 @@ def test_sha256_of_a_rosbag2_directory(tmp_path: Path) -> None:
 
 
 def test_audit_report_has_timeline_figure(tmp_path: Path) -> None:
-    from ertools.audit import audit_states
+    from ertools.audit.analyse import audit_states
     from ertools.streams import Machine
 
     audit = audit_states(

@@ -35,7 +35,7 @@ def test_audit_tables_as_frames() -> None:
     from audit_streams import T0_NS, heartbeat
     from test_audit import BMBOX
 
-    from ertools.audit import audit_states
+    from ertools.audit.analyse import audit_states
     from ertools.streams import Machine
 
     frames = result_to_dataframes(audit_states(heartbeat(Machine.BMBOX, BMBOX, 20.0)))

@@ -14,7 +14,7 @@ from summaries import BAG_KEYS
 
 from ertools.cli.main import main
 from ertools.progress import reporting
-from ertools.timeline_scan import find_bags, scan
+from ertools.timeline.scan import find_bags, scan
 
 
 def rel(root: Path, path: str) -> str:
@@ -217,8 +217,8 @@ def test_real_2015_bag() -> None:
 
 
 def test_clock_checked_once_per_recording_unless_off(monkeypatch: pytest.MonkeyPatch) -> None:
-    import ertools.timeline_scan as ts
-    from ertools.timeline import ClockCheck
+    import ertools.timeline.scan as ts
+    from ertools.timeline.build import ClockCheck
 
     @dataclass(frozen=True)
     class S:

@@ -19,8 +19,8 @@ from timeline_day import DAY0, EVIL, EVIL_IMG, SESSIONS, UNREADABLE, S, day_time
 from ertools.cli.main import main
 from ertools.report.plots_timeline import timeline_figure
 from ertools.report.timeline_page import timeline_page
-from ertools.timeline import Timeline
-from ertools.timeline_scan import scan
+from ertools.timeline.build import Timeline
+from ertools.timeline.scan import scan
 
 REAL = Path(__file__).resolve().parents[2] / ".." / "shared" / "real_bags"
 REAL_BAG = REAL / "log_fbm2h_mocap_2015-10-23-16-15-40_0.bag"

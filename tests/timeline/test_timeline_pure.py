@@ -7,7 +7,7 @@ import json
 import pytest
 from summaries import BAG_KEYS, Summary, Topic
 
-from ertools.timeline import (
+from ertools.timeline.build import (
     ClockCheck,
     TimelineConfig,
     Unreadable,

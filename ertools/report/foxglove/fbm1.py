@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 
-from ertools.benchmarks.fbm1_result import Fbm1Result, Fbm1RunResult
+from ertools.benchmarks.fbm1.result import Fbm1Result, Fbm1RunResult
 from ertools.report.foxglove.messages import (
     BLUE,
     ERROR,

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ertools.benchmarks.fbm2h_result import Fbm2hResult
+from ertools.benchmarks.fbm2h.result import Fbm2hResult
 from ertools.report.foxglove.messages import (
     BLUE,
     ERROR,

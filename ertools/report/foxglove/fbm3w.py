@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from ertools.benchmarks.fbm3w_result import Fbm3wResult, RunResult
+from ertools.benchmarks.fbm3w.result import Fbm3wResult, RunResult
 from ertools.report.foxglove.messages import (
     BLUE,
     ERROR,

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ertools.benchmarks.trajectory import COMPARED, STATUS_NAMES, TrajectoryResult
+from ertools.benchmarks.trajectory.benchmark import COMPARED, STATUS_NAMES, TrajectoryResult
 from ertools.report.foxglove.messages import (
     INFO,
     RED,

@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 from fbm1_testkit import ITEMS_YAML, RunSpec, bodies, state_streams, write_bag, write_items
 
-from ertools.benchmarks.fbm1 import score_fbm1
-from ertools.benchmarks.fbm1_runs import find_runs
+from ertools.benchmarks.fbm1.benchmark import score_fbm1
+from ertools.benchmarks.fbm1.runs import find_runs
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import ItemList, parse_items
@@ -197,7 +197,7 @@ def test_bad_item_list_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture
 
 
 def test_numbers_yaml_reads_as_text_are_accepted() -> None:
-    from ertools.benchmarks.fbm1_answers import parse_answer_payload
+    from ertools.benchmarks.fbm1.answers import parse_answer_payload
 
     a = parse_answer_payload(
         "{item_class: a, item_instance: a1, x: 4e-1, y: '0.2', theta: 1e1}", "run 1"

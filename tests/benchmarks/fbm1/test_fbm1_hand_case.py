@@ -15,11 +15,11 @@ from pathlib import Path
 import pytest
 from fbm1_testkit import ANSWER_S, EXEC_S, RunSpec, bodies, state_streams, write_bag, write_items
 
-from ertools.benchmarks.fbm1 import Fbm1Options, score_fbm1
-from ertools.benchmarks.fbm1_gt import GtOptions
-from ertools.benchmarks.fbm1_result import Fbm1Result
-from ertools.benchmarks.fbm1_runs import find_runs
-from ertools.benchmarks.fbm1_score import ScoreRules
+from ertools.benchmarks.fbm1.benchmark import Fbm1Options, score_fbm1
+from ertools.benchmarks.fbm1.gt import GtOptions
+from ertools.benchmarks.fbm1.result import Fbm1Result
+from ertools.benchmarks.fbm1.runs import find_runs
+from ertools.benchmarks.fbm1.score import ScoreRules
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import ItemList, parse_items

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from fbm1_testkit import RunSpec, ns, state_streams
 
-from ertools.benchmarks.fbm1_runs import find_runs, parse_item_ref
+from ertools.benchmarks.fbm1.runs import find_runs, parse_item_ref
 from ertools.states import BmBoxState as B
 from ertools.states import ClientState as C
 from ertools.states import RefBoxState as R
@@ -131,7 +131,7 @@ def test_items_order_overrides_and_warns_on_count() -> None:
 def test_log_cut_during_a_run_is_not_counted() -> None:
     from fbm1_testkit import ITEMS_YAML, bodies
 
-    from ertools.benchmarks.fbm1 import score_fbm1
+    from ertools.benchmarks.fbm1.benchmark import score_fbm1
     from ertools.configs._yaml import parse_yaml
     from ertools.configs.items import parse_items
 

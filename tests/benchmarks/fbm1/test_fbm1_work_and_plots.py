@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 from fbm1_testkit import ITEMS_YAML, RunSpec, bodies, state_streams, write_bag, write_items
 
-from ertools.benchmarks.fbm1 import score_fbm1
-from ertools.benchmarks.fbm1_runs import find_runs
+from ertools.benchmarks.fbm1.benchmark import score_fbm1
+from ertools.benchmarks.fbm1.runs import find_runs
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import parse_items
@@ -64,7 +64,7 @@ def test_fbm1_figures_draw_the_answers() -> None:
     )
     origin, board = bodies(WORK_RUNS)
     items = parse_items(parse_yaml(ITEMS_YAML), "items.yaml")
-    from ertools.benchmarks.fbm1 import Fbm1Options
+    from ertools.benchmarks.fbm1.benchmark import Fbm1Options
 
     result = score_fbm1(origin, board, found, items, Fbm1Options(benchmark="fbm1w"))
     specs = {s.name: s for s in figure_specs(result)}

@@ -24,8 +24,8 @@ import pytest
 import yaml
 from scipy.spatial.transform import Rotation, Slerp
 
-from ertools.benchmarks.fbm2h import compute
-from ertools.benchmarks.fbm2h_segments import from_states, unreached_reasons
+from ertools.benchmarks.fbm2h.benchmark import compute
+from ertools.benchmarks.fbm2h.segments import from_states, unreached_reasons
 from ertools.cli.main import main
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform

@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from ertools.benchmarks.fbm2h import compute
-from ertools.benchmarks.fbm2h_segments import ReachedMoments
+from ertools.benchmarks.fbm2h.benchmark import compute
+from ertools.benchmarks.fbm2h.segments import ReachedMoments
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import identity_transform
 from ertools.report.figures import figure_specs, save_figures

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from ertools.benchmarks.fbm3w_runs import RunWindow
+from ertools.benchmarks.fbm3w.runs import RunWindow
 from ertools.geometry import quat_from_yaw
 from ertools.streams import PoseStream
 

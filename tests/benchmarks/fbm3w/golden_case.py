@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 from fbm3w_synth import T0, one_run
 
-from ertools.benchmarks.fbm3w import score_runs
-from ertools.benchmarks.fbm3w_result import Fbm3wResult
-from ertools.benchmarks.fbm3w_runs import RunWindow
+from ertools.benchmarks.fbm3w.benchmark import score_runs
+from ertools.benchmarks.fbm3w.result import Fbm3wResult
+from ertools.benchmarks.fbm3w.runs import RunWindow
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.configs.shapes import builtin_shapes
 from ertools.streams import concatenate_poses

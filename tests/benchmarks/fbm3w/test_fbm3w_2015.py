@@ -25,8 +25,8 @@ from fbm3w_kit import Sample
 from fbm3w_synth import place
 from test_fbm3w_runs import stream
 
-from ertools.benchmarks.fbm3w import Fbm3wOptions, options_2015, score_runs
-from ertools.benchmarks.fbm3w_runs import find_states
+from ertools.benchmarks.fbm3w.benchmark import Fbm3wOptions, options_2015, score_runs
+from ertools.benchmarks.fbm3w.runs import find_states
 from ertools.cli.main import main
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.geometry import quat_from_yaw

@@ -10,8 +10,8 @@ from fbm3w_synth import one_run, place
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ertools.benchmarks.fbm3w import Fbm3wOptions, score_runs
-from ertools.benchmarks.fbm3w_path import run_frame, score_path, subsample_d_min
+from ertools.benchmarks.fbm3w.benchmark import Fbm3wOptions, score_runs
+from ertools.benchmarks.fbm3w.path import run_frame, score_path, subsample_d_min
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.configs.shapes import builtin_shapes, parse_shape
 from ertools.errors import ScoringError

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ertools.benchmarks.fbm3w_runs import find_states, find_windows, with_specs
+from ertools.benchmarks.fbm3w.runs import find_states, find_windows, with_specs
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.errors import SegmentationError
 from ertools.io import BenchmarkStates

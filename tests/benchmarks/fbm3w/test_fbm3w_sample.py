@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 from fbm3w_kit import Sample
 
-from ertools.benchmarks.fbm3w import Fbm3wOptions, score_fbm3w
+from ertools.benchmarks.fbm3w.benchmark import Fbm3wOptions, score_fbm3w
 from ertools.configs.fbm3w import Fbm3wConfig
 
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import yaml
 
-from ertools.benchmarks.noise import noise_statistics
+from ertools.benchmarks.noise.benchmark import noise_statistics
 from ertools.cli.main import main
 from ertools.samples import fbm3w
 from ertools.samples.stationary import generate
@@ -121,7 +121,7 @@ def test_bad_inputs(
 
 
 def test_all_nan_stream_is_named() -> None:
-    from ertools.benchmarks.noise import noise_from_stream
+    from ertools.benchmarks.noise.benchmark import noise_from_stream
     from ertools.errors import ScoringError
     from ertools.streams import PoseStream
 

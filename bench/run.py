@@ -1,0 +1,432 @@
+"""`make bench`: ertools' reader and commands measured side by side with rosbags and evo.
+
+Generates (once, cached in build/bench/) an hour of 120 Hz mocap GT written like the 2015
+loggers (PoseStamped + Pose2D + /tf, 1.33 M messages) as uncompressed, lz4 and bz2 ROS1 bags
+and as MCAP (zstd), a 10 Hz robot log of the same hour, and 1000 one-second GT bags. Every
+command runs several times as a whole process (page cache warm); the table shows the median
+wall time and the peak RSS of the process (``os.wait4``), then the ratios of issue 3.
+
+    .venv/bin/python bench/run.py [--runs N] [--quick] [--json FILE]
+
+Nothing here is a test: `make test` never runs it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import os
+import platform
+import shutil
+import statistics
+import subprocess
+import sys
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parent
+sys.path.insert(0, str(HERE))
+
+from data import GT_TOPIC, ROBOT_TOPIC, generate  # noqa: E402
+from fbm_hour import FBM_SCENARIOS, hour_bag  # noqa: E402
+
+PY = sys.executable
+FORMATS = {
+    "gt": "ROS1",
+    "gt_lz4": "ROS1 lz4",
+    "gt_bz2": "ROS1 bz2",
+    "gt_mcap_none": "MCAP",
+    "gt_mcap": "MCAP zstd",
+}
+UNCOMPRESSED = ("gt", "gt_mcap_none")
+BIN = Path(sys.executable).parent
+
+
+@dataclass
+class Measure:
+    name: str
+    wall_s: float
+    inside_s: float | None
+    rss_mib: float
+    runs: int
+    ok: bool
+    note: str = ""
+
+
+def run_once(argv: list[str]) -> tuple[float, float, int, str]:
+    """(wall s, peak RSS MiB, exit status, last stdout line) of one whole process, started
+    by the small launcher ``measure.py`` (see there why)."""
+    done = subprocess.run(
+        [PY, str(HERE / "measure.py"), *argv],
+        capture_output=True,
+        cwd=REPO,
+        check=False,
+    )
+    if done.returncode != 0 or not done.stdout.strip():
+        sys.stderr.write(done.stderr.decode(errors="replace")[-2000:])
+        return float("nan"), float("nan"), 1, ""
+    report = json.loads(done.stdout.decode().strip().splitlines()[-1])
+    if report["exit"] != 0:
+        sys.stderr.write(done.stderr.decode(errors="replace")[-2000:])
+    return report["wall_s"], report["maxrss_kib"] / 1024.0, report["exit"], report["last_line"]
+
+
+def measure(name: str, argv: list[str], runs: int, warm_up: bool = True) -> Measure:
+    walls, rss, inside = [], [], []
+    ok = True
+    if warm_up:
+        # This VM reclaims idle page cache (kdamond): one unmeasured run brings the files back.
+        run_once(argv)
+    for _ in range(runs):
+        wall, peak, code, out = run_once(argv)
+        ok &= code == 0
+        walls.append(wall)
+        rss.append(peak)
+        with contextlib.suppress(ValueError, KeyError, IndexError, TypeError):
+            inside.append(float(json.loads(out.strip().splitlines()[-1])["inside_s"]))
+    m = Measure(
+        name,
+        statistics.median(walls),
+        statistics.median(inside) if inside else None,
+        max(rss),
+        runs,
+        ok,
+    )
+    inside_txt = f"{m.inside_s:8.3f}" if m.inside_s is not None else "       -"
+    print(
+        f"  {name:<58} {m.wall_s:8.3f} {inside_txt} {m.rss_mib:9.1f}  {'' if ok else 'FAILED'}",
+        flush=True,
+    )
+    return m
+
+
+def _leaves(d: object, path: str = "") -> dict[str, object]:
+    if isinstance(d, dict):
+        return {k: v for key, val in d.items() for k, v in _leaves(val, f"{path}.{key}").items()}
+    if isinstance(d, list):
+        return {k: v for i, val in enumerate(d) for k, v in _leaves(val, f"{path}[{i}]").items()}
+    return {path: d}
+
+
+def same_scores(short: dict[str, object], hour: dict[str, object]) -> str:
+    """'' when the hour log scores as the sample did; else what differs. Times counted from
+    the bag's first message move by one constant (the half hour of mocap logged before)."""
+    a, b = _leaves(short), _leaves(hour)
+    if a.keys() != b.keys():
+        return "different fields"
+    shifts = set()
+    for key in a:
+        if a[key] == b[key] or "file" in key or key.endswith(".bag"):
+            continue
+        relative = key.endswith(("_time", "_s")) or "_s[" in key
+        if relative and isinstance(a[key], float | int) and isinstance(b[key], float | int):
+            shifts.add(round(float(b[key]) - float(a[key]), 2))
+            continue
+        return f"{key}: {a[key]} vs {b[key]}"
+    return "" if len(shifts) <= 1 else f"times shift by {sorted(shifts)}"
+
+
+def fbm_scores(go: Any, runs: int, ex: list[str], ertools: list[str]) -> None:
+    """Each FBM scorer on an hour log (a sample benchmark inside an hour of mocap), against
+    the extraction of its pose topic; the scores must equal the sample's."""
+    folder = REPO / "build" / "bench" / "fbm"
+    for scenario, (_bodies, command, topic) in FBM_SCENARIOS.items():
+        bag, sample_dir = hour_bag(scenario, folder)
+        extra = [a.format(dir=sample_dir) for a in command]
+        score = [*ertools, *extra[:2], str(bag), *extra[2:], "--format", "json"]
+        m = go(
+            f"fbm_{scenario}",
+            f"ertools {' '.join(extra[:2])} (hour log, {bag.stat().st_size >> 20} MiB)",
+            score,
+            runs,
+        )
+        go(
+            f"fbm_{scenario}_extract",
+            f"  its pose topic -> arrays ({topic})",
+            [*ex, "ertools", str(bag), topic],
+            runs,
+        )
+        short_bag = next(p for p in sorted(sample_dir.glob("*.bag")))
+        short = [*ertools, *extra[:2], str(short_bag), *extra[2:], "--format", "json"]
+        outs = []
+        for argv in (short, score):
+            done = subprocess.run(argv, capture_output=True, cwd=REPO, check=False)
+            outs.append(json.loads(done.stdout) if done.returncode == 0 else {})
+        problem = same_scores(*outs) if all(outs) else "a score failed"
+        m.note = "; same scores as the sample" if not problem else f"; SCORES DIFFER: {problem}"
+        print(f"    hour log scores as the sample: {problem or 'yes'}")
+
+
+def machine() -> dict[str, str]:
+    cpu = "unknown"
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    mem = "unknown"
+    try:
+        kb = int(Path("/proc/meminfo").read_text().split()[1])
+        mem = f"{kb / 1024 / 1024:.1f} GiB"
+    except (OSError, ValueError, IndexError):
+        pass
+    load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
+    return {
+        "load_average_at_start": load,
+        "nproc": str(os.cpu_count()),
+        "cpu": cpu,
+        "memory": mem,
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+    }
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--runs", type=int, default=5, help="runs per fast command (default 5)")
+    parser.add_argument(
+        "--slow-runs", type=int, default=3, help="runs per slow baseline (default 3)"
+    )
+    parser.add_argument("--quick", action="store_true", help="skip the slow rosbags/evo baselines")
+    parser.add_argument("--json", type=Path, default=REPO / "build" / "bench" / "results.json")
+    args = parser.parse_args()
+
+    folder = REPO / "build" / "bench"
+    print(f"data: {folder} (generated once, then reused)", flush=True)
+    t0 = time.perf_counter()
+    paths = generate(folder)
+    print(f"  ready in {time.perf_counter() - t0:.1f} s", flush=True)
+    sizes = {
+        k: (p.stat().st_size if p.is_file() else sum(f.stat().st_size for f in p.iterdir()))
+        for k, p in paths.items()
+    }
+    info = machine()
+    print(
+        f"machine: {info['nproc']} cores, {info['cpu']}, {info['memory']}, "
+        f"Python {info['python']}, load average {info['load_average_at_start']}"
+    )
+    title = "command (whole process, page cache warm)"
+    print(f"  {title:<58} {'wall s':>8} {'inside':>8} {'peak MiB':>9}")
+    ertools = [str(BIN / "ertools")]
+    results: dict[str, Measure] = {}
+
+    def go(key: str, name: str, argv: list[str], runs: int) -> Measure:
+        # the slow baselines (rosbags, evo: seconds each) warm up in their first of 3 runs
+        results[key] = measure(name, argv, runs, warm_up=runs == args.runs)
+        return results[key]
+
+    ex = [PY, str(HERE / "extract.py")]
+    go("python", "python -c pass (interpreter start)", [PY, "-c", "pass"], args.runs)
+    go(
+        "numpy",
+        "python -c 'import numpy' (the floor of any NumPy tool)",
+        [PY, "-c", "import numpy"],
+        args.runs,
+    )
+    for fmt, label in FORMATS.items():
+        p = str(paths[fmt])
+        go(
+            f"bytes_{fmt}",
+            f"read the file's bytes ({label}, {sizes[fmt] / 2**20:.0f} MiB)",
+            [*ex, "bytes", p],
+            args.runs,
+        )
+        if fmt not in UNCOMPRESSED:
+            go(
+                f"inflate_{fmt}",
+                f"read + decompress every chunk ({label})",
+                [*ex, "inflate", p],
+                args.runs,
+            )
+        go(
+            f"extract_{fmt}",
+            f"ertools: pose topic -> arrays ({label})",
+            [*ex, "ertools", p, GT_TOPIC],
+            args.runs,
+        )
+        if not args.quick and fmt in ("gt", "gt_mcap_none"):
+            go(
+                f"rosbags_{fmt}",
+                f"rosbags AnyReader per message ({label})",
+                [*ex, "rosbags", p, GT_TOPIC],
+                args.slow_runs,
+            )
+    for key, label in (("robot", "robot hour"), ("robot_fat", "robot hour + 16 KiB camera")):
+        p = paths[key]
+        go(
+            f"extract_{key}",
+            f"ertools: robot pose topic -> arrays ({label}, {p.stat().st_size >> 20} MiB)",
+            [*ex, "ertools", str(p), ROBOT_TOPIC],
+            args.runs,
+        )
+    go("info_hour", "ertools info (hour bag)", [*ertools, "info", str(paths["gt"])], args.runs)
+    go(
+        "info_small",
+        "ertools info (1 s bag)",
+        [*ertools, "info", str(next(iter(sorted(paths["small"].iterdir()))))],
+        args.runs,
+    )
+    go(
+        "info_1000",
+        "ertools info (1000 bags)",
+        [*ertools, "info", str(paths["small"]), "--format", "json"],
+        args.runs,
+    )
+    tl = go(
+        "timeline_1000",
+        "ertools timeline (1000 bags, summaries only)",
+        [*ertools, "timeline", str(paths["small"]), "--no-clock-check", "--format", "json"],
+        args.runs,
+    )
+    if not tl.ok:
+        tl.note = "ertools timeline failed or is not available"
+    traj = [
+        *ertools,
+        "score",
+        "trajectory",
+        str(paths["robot"]),
+        str(paths["gt"]),
+        "--robot-topic",
+        ROBOT_TOPIC,
+        "--gt-topic",
+        GT_TOPIC,
+        "--format",
+        "json",
+    ]
+    probe = subprocess.run(
+        [*ertools, "score", "trajectory", "--help"], capture_output=True, cwd=REPO, check=False
+    )
+    if probe.returncode == 0:
+        go("trajectory", "ertools score trajectory (robot hour + GT hour)", traj, args.runs)
+    else:
+        print("  ertools score trajectory: not available yet, skipped")
+    fbm_scores(go, args.runs, ex, ertools)
+    evo_traj, evo_ape = (
+        shutil.which("evo_traj", path=str(BIN)),
+        shutil.which("evo_ape", path=str(BIN)),
+    )
+    if args.quick:
+        print("  evo: skipped (--quick)")
+    elif evo_traj and evo_ape:
+        go(
+            "evo_traj",
+            "evo_traj bag (GT topic)",
+            [evo_traj, "bag", str(paths["gt"]), GT_TOPIC],
+            args.slow_runs,
+        )
+        go(
+            "evo_ape",
+            "evo_ape bag (GT + robot topic, one bag)",
+            [evo_ape, "bag", str(paths["combined"]), GT_TOPIC, ROBOT_TOPIC],
+            args.slow_runs,
+        )
+    else:
+        print("  evo: not installed (pip install 'ertools[bench]'), skipped")
+
+    print("\nratios (targets of issue 3):")
+    ratios: dict[str, float] = {}
+
+    def ratio(key: str, text: str, a: str, b: str, target: str) -> None:
+        if a in results and b in results and results[a].ok and results[b].ok:
+            ratios[key] = results[a].wall_s / results[b].wall_s
+            print(f"  {text:<62} {ratios[key]:7.2f}x   (target {target})")
+
+    for fmt, label in FORMATS.items():
+        ratio(
+            f"extract_vs_bytes_{fmt}",
+            f"pose extraction / reading the bytes, {label}",
+            f"extract_{fmt}",
+            f"bytes_{fmt}",
+            "<= 3x",
+        )
+    for fmt, label in FORMATS.items():
+        a, b = results.get(f"extract_{fmt}"), results.get(f"bytes_{fmt}")
+        if a and b and a.inside_s and b.inside_s:
+            ratios[f"inside_extract_vs_bytes_{fmt}"] = a.inside_s / b.inside_s
+            text = f"same, inside the process (after imports), {label}"
+            print(f"  {text:<62} {a.inside_s / b.inside_s:7.2f}x   (target <= 3x)")
+    for fmt, label in FORMATS.items():
+        if fmt in UNCOMPRESSED:
+            continue
+        ratio(
+            f"inflate_vs_bytes_{fmt}",
+            f"read + decompress only (no decoding) / reading the bytes, {label}",
+            f"inflate_{fmt}",
+            f"bytes_{fmt}",
+            "the floor",
+        )
+        ratio(
+            f"extract_vs_inflate_{fmt}",
+            f"pose extraction / read + decompress only, {label}",
+            f"extract_{fmt}",
+            f"inflate_{fmt}",
+            "-",
+        )
+    for fmt in ("gt", "gt_mcap_none"):
+        ratio(
+            f"rosbags_vs_ertools_{fmt}",
+            f"rosbags per message / ertools, {fmt}",
+            f"rosbags_{fmt}",
+            f"extract_{fmt}",
+            "-",
+        )
+    ratio(
+        "evo_ape_vs_trajectory",
+        "evo_ape bag / ertools score trajectory (same data)",
+        "evo_ape",
+        "trajectory",
+        ">= 30x",
+    )
+    ratio(
+        "evo_traj_vs_extract",
+        "evo_traj bag / ertools pose extraction",
+        "evo_traj",
+        "extract_gt",
+        "-",
+    )
+    a, b = results.get("extract_robot_fat"), results.get("extract_robot")
+    if a and b and a.inside_s and b.inside_s:
+        ratios["robot_fat_vs_plain_inside"] = a.inside_s / b.inside_s
+        size = sizes["robot_fat"] / sizes["robot"]
+        text = f"same 36,000 poses in a {size:.0f}x larger bag (camera), inside"
+        print(f"  {text:<62} {a.inside_s / b.inside_s:7.2f}x   (cost ~ messages, not bytes)")
+    for scenario in FBM_SCENARIOS:
+        a, b = results.get(f"fbm_{scenario}"), results.get(f"fbm_{scenario}_extract")
+        if a and b and a.ok and b.ok:
+            extra = a.wall_s - b.wall_s
+            ratios[f"fbm_{scenario}_beyond_extraction_s"] = extra
+            text = f"ertools score {scenario} (hour log) beyond its pose extraction"
+            print(f"  {text:<62} {extra:7.2f} s   (target < 1 s){a.note}")
+    for key in ("info_1000", "timeline_1000"):
+        if key in results:
+            print(f"  {results[key].name:<62} {results[key].wall_s:7.2f} s   (target <= 3 s)")
+    if "trajectory" in results:
+        label = "peak memory of ertools score trajectory"
+        peak = results["trajectory"].rss_mib
+        print(f"  {label:<62} {peak:7.1f} MiB (target <= 150 MiB)")
+    args.json.parent.mkdir(parents=True, exist_ok=True)
+    args.json.write_text(
+        json.dumps(
+            {
+                "machine": info,
+                "sizes_bytes": sizes,
+                "results": {k: asdict(v) for k, v in results.items()},
+                "ratios": ratios,
+            },
+            indent=2,
+        )
+    )
+    print(f"\nwrote {args.json}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

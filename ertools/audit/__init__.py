@@ -1,0 +1,1 @@
+"""A benchmark reconstructed from its state topics: analyse the machines, rescore, compare."""

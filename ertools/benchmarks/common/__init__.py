@@ -1,0 +1,1 @@
+"""What every benchmark needs, written once: clocks, stillness, teams, pose hygiene and sources."""

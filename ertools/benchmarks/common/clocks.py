@@ -1,0 +1,517 @@
+"""Clock audit: estimate the constant offset between a robot's clock and the mocap clock.
+
+The robot stamps its own pose estimates with its clock; the mocap logger with the GT clock.
+When the two machines were not synchronised, every robot pose is compared with the GT pose of
+another moment and the trajectory error grows with the robot's speed. This module finds the
+offset ``d`` that, added to the robot stamps, best aligns the robot's positions with the GT:
+
+1. coarse scan: the mean 3D distance between robot positions and the GT positions at
+   ``t + d`` for ``d`` every 20 ms over ``[-range, +range]`` (on at most a few thousand robot
+   poses, evenly spread; the GT resampled once on a 10 ms grid, so each offset is a gather);
+2. fine scan: 1 ms steps around the best coarse value, with exact linear interpolation;
+3. refinement: Gauss-Newton steps on the sum of squared distances (the GT velocity is the
+   derivative of the GT position with respect to ``d``), to sub-millisecond resolution.
+
+Uncertainty: a block bootstrap of the final Gauss-Newton step. The robot's estimation error is
+strongly autocorrelated (a localisation bias lasts seconds), so a curvature-based standard
+error that treats every pose as independent would be far too optimistic; resampling blocks of
+several seconds keeps that correlation. The estimate includes any constant latency of the
+robot's estimator (it cannot be told apart from a clock offset), which the docs say.
+
+Pure NumPy: streams in, a frozen :class:`OffsetEstimate` out.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+
+from ertools.geometry import bracket, row_dot, row_norm
+from ertools.streams import PoseStream
+from ertools.timeutil import NS_PER_S
+
+F64 = npt.NDArray[np.float64]
+I64 = npt.NDArray[np.int64]
+IntArr = npt.NDArray[np.intp]
+
+COARSE_STEP_NS = 20_000_000  # 20 ms: at 1 m/s a 2 cm change of the cost, well resolved
+FINE_STEP_NS = 1_000_000
+GRID_NS = COARSE_STEP_NS // 2
+GRID_MAX_POINTS = 1_000_000  # 12 MB of grid positions at most; a longer GT gets a coarser grid
+GRID_CHUNK = 1 << 15  # grid points per np.interp call
+COARSE_MAX_POSES = 3000
+MIN_POSES = 20
+MIN_RMS_SPEED = 0.02  # m/s: below this the robot stood still and no offset is observable
+BOOTSTRAP_DRAWS = 500
+BLOCK_NS = 5 * NS_PER_S
+MAX_NS = np.iinfo(np.int64).max
+
+
+@dataclass(frozen=True)
+class OffsetEstimate:
+    """The clock audit of a robot log against GT.
+
+    Attributes:
+        offset_ns: seconds x 1e9 to add to the robot stamps to put them on the GT clock
+            (positive when the robot clock is behind), None when not observable.
+        uncertainty_ns: one standard deviation (block bootstrap), None with ``offset_ns``.
+        search_range_ns: the offsets searched were within +- this.
+        poses_used: robot poses compared at the estimate.
+        mean_error: mean 3D distance at the estimate, metres.
+        mean_error_at_zero: mean 3D distance with no offset (None when no pose compares).
+        note: why there is no estimate, or what to be careful about; "" when all is well.
+    """
+
+    offset_ns: int | None
+    uncertainty_ns: int | None
+    search_range_ns: int
+    poses_used: int
+    mean_error: float | None
+    mean_error_at_zero: float | None
+    note: str = ""
+    method: str = "min mean position error over offsets, Gauss-Newton, block bootstrap"
+
+    @property
+    def offset_s(self) -> float | None:
+        return None if self.offset_ns is None else self.offset_ns / NS_PER_S
+
+    @property
+    def uncertainty_s(self) -> float | None:
+        return None if self.uncertainty_ns is None else self.uncertainty_ns / NS_PER_S
+
+
+@dataclass(frozen=True, eq=False)
+class _Eval:
+    """GT positions at shifted robot times, where they are usable.
+
+    Attributes:
+        valid: (N,) which queries have a usable GT position.
+        gt_xyz: (valid.sum(), 3) the GT positions at the valid queries only.
+        lo, hi: (valid.sum(),) the GT samples around each valid query.
+        diff: (valid.sum(), 3) GT position at ``hi`` minus at ``lo``.
+        span_ns: (valid.sum(),) GT time at ``hi`` minus at ``lo``.
+    """
+
+    valid: npt.NDArray[np.bool_]
+    gt_xyz: F64
+    lo: IntArr
+    hi: IntArr
+    diff: F64
+    span_ns: I64
+
+
+def drop_repeats(gt: PoseStream) -> PoseStream:
+    """GT without the samples that repeat the previous position (mocap tracking lost).
+
+    Motive repeats the last pose while it has lost the rigid body; interpolating across the
+    repeated samples would pretend the body stood still. Dropping them turns the loss into a
+    gap, which the max-gap rule then excludes.
+    """
+    if len(gt) < 2:
+        return gt
+    # Axis by axis: the same test as any(!=) over each row, without an (N, 3) temporary and a
+    # reduction over its short axis (4x faster on an hour of 120 Hz GT).
+    p = gt.xyz
+    moved = p[1:, 0] != p[:-1, 0]
+    for k in range(1, p.shape[1]):
+        moved |= p[1:, k] != p[:-1, k]
+    if moved.all():
+        return gt
+    keep = np.ones(len(gt), dtype=bool)
+    keep[1:] = moved
+    return gt.take(keep)
+
+
+def _evaluate(
+    gt: PoseStream,
+    query_ns: I64,
+    max_gap_ns: int,
+    around: tuple[IntArr, IntArr] | None = None,
+) -> _Eval:
+    """GT at the queries (``around``: their :func:`~ertools.geometry.bracket`, if known)."""
+    t = gt.t_ns
+    n = len(t)
+    lo, hi = bracket(t, query_ns) if around is None else around
+    inside = (lo >= 0) & (hi < n)
+    all_inside = bool(inside.all())
+    lo_c = lo if all_inside else np.clip(lo, 0, n - 1)
+    hi_c = hi if all_inside else np.clip(hi, 0, n - 1)
+    t_lo = t.take(lo_c)
+    span = t.take(hi_c) - t_lo
+    valid = inside & (span <= max_gap_ns)
+    q = query_ns
+    if not valid.all():  # only the usable queries are worth interpolating
+        keep = np.flatnonzero(valid)
+        lo_c, hi_c, t_lo, span, q = lo_c[keep], hi_c[keep], t_lo[keep], span[keep], q[keep]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        alpha = np.where(span > 0, (q - t_lo).astype(np.float64) / span, 0.0)
+    # No clip to [0, 1]: a valid query lies between its two samples, and the rounded
+    # quotient of 0 <= a <= b stays in [0, 1].
+    x_lo = np.take(gt.xyz, lo_c, axis=0)  # take: whole rows, twice as fast as x[i]
+    diff = np.take(gt.xyz, hi_c, axis=0) - x_lo
+    return _Eval(valid, x_lo + alpha[:, None] * diff, lo_c, hi_c, diff, span)
+
+
+def _velocity(gt: PoseStream, ev: _Eval, max_gap_ns: int) -> F64:
+    """(valid.sum(), 3) GT velocity at the valid queries, m/s.
+
+    Of the segment around the query; at an exact hit, of the segment after it. Segments
+    longer than the max gap (or of no duration) give no usable velocity: 0.
+    """
+    n = len(gt)
+    seg_lo = np.minimum(ev.lo, max(n - 2, 0))
+    seg_hi = np.minimum(seg_lo + 1, n - 1)
+    # Between two samples the segment is (lo, hi), already subtracted: only exact hits need
+    # other samples.
+    num, seg_ns = ev.diff, ev.span_ns
+    other = np.flatnonzero((seg_lo != ev.lo) | (seg_hi != ev.hi))
+    if other.size:
+        a, b = seg_lo[other], seg_hi[other]
+        num, seg_ns = num.copy(), seg_ns.copy()
+        num[other] = gt.xyz[b] - gt.xyz[a]
+        seg_ns[other] = gt.t_ns[b] - gt.t_ns[a]
+    dt = seg_ns.astype(np.float64) / NS_PER_S
+    with np.errstate(invalid="ignore", divide="ignore"):
+        vel = num / dt[:, None]
+    unusable = ~((dt > 0) & (seg_ns <= max_gap_ns))
+    if unusable.any():
+        vel[unusable] = 0.0
+    return np.asarray(vel, dtype=np.float64)
+
+
+def _valid_rows(xyz: F64, ev: _Eval) -> F64:
+    """The rows of ``xyz`` at the evaluation's valid queries (no copy when all are valid)."""
+    return xyz if len(ev.gt_xyz) == len(xyz) else xyz[ev.valid]
+
+
+def _mean_error(
+    robot_t: I64, robot_xyz: F64, gt: PoseStream, offset_ns: int, max_gap_ns: int
+) -> tuple[float, int]:
+    ev = _evaluate(gt, robot_t + offset_ns, max_gap_ns)
+    used = len(ev.gt_xyz)
+    if used == 0:
+        return float("inf"), 0
+    d = row_norm(_valid_rows(robot_xyz, ev) - ev.gt_xyz)
+    return float(d.mean()), used
+
+
+def _coarse_scan(
+    robot_t: I64, robot_xyz: F64, gt: PoseStream, offsets: I64, max_gap_ns: int
+) -> F64:
+    """Mean distance at each offset, against the GT resampled on a uniform grid.
+
+    One ``np.interp`` per axis builds the grid (step :data:`GRID_NS`, half the coarse
+    step); each offset is then a gather of grid points, so the scan costs a few
+    microseconds per offset instead of an interpolation over the whole GT. Grid points
+    between GT samples more than ``max_gap_ns`` apart are invalid. Nearest-grid lookup errs
+    by at most half a grid step of travel (5 mm at 1 m/s): the coarse scan only has to find
+    the right 20 ms bin; the fine scan and Gauss-Newton use exact interpolation.
+    """
+    t = gt.t_ns
+    span = int(t[-1] - t[0])
+    step = max(GRID_NS, span // GRID_MAX_POINTS + 1)
+    n_grid = span // step + 1
+    base = np.rint((robot_t - t[0]) / step).astype(np.int64)
+    shifts = np.rint(offsets / step).astype(np.int64)
+    # Invalid points are NaN and the grid is padded with NaN beyond both ends, so every
+    # shifted index is in range and one gather gives both the position and its validity.
+    pad = int(max(0, -(shifts.min() + base.min()), shifts.max() + base.max() - n_grid + 1))
+    grid = _grid(gt, step, n_grid, max_gap_ns, pad)
+    base += pad
+    pos = robot_xyz.T.astype(np.float32)
+    costs = np.full(len(offsets), np.inf)
+    counts = np.zeros(len(offsets), dtype=np.int64)
+    block = max(1, 200_000 // max(len(base), 1))  # ~0.8 MB of float32 per axis and block
+    for lo in range(0, len(offsets), block):  # blocks of offsets x all poses, vectorised
+        idx = shifts[lo : lo + block, None] + base[None, :]
+        dist = _squared_distances(grid, idx, pos)
+        np.sqrt(dist, out=dist)
+        missing = np.isnan(dist)
+        cnt = idx.shape[1] - np.count_nonzero(missing, axis=1)
+        dist[missing] = 0.0
+        total = dist.sum(axis=1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            costs[lo : lo + block] = np.where(cnt > 0, total / np.maximum(cnt, 1), np.inf)
+        counts[lo : lo + block] = cnt
+    enough = counts >= max(MIN_POSES, int(0.5 * counts.max()))
+    return np.where(enough, costs, np.inf)
+
+
+def _squared_distances(
+    grid: npt.NDArray[np.float32], idx: I64, pos: npt.NDArray[np.float32]
+) -> npt.NDArray[np.float32]:
+    """Squared distances from ``pos[:, j]`` to the grid points ``idx[i, j]``, axis by axis.
+
+    1D gathers from contiguous rows are ~5x faster than gathering 12-byte (x, y, z) rows, and
+    the squares add up in the order einsum added them: (x^2 + y^2) + z^2.
+    """
+    sq: npt.NDArray[np.float32] = grid[0].take(idx)
+    sq -= pos[0]
+    sq *= sq
+    for k in (1, 2):
+        d = grid[k].take(idx)
+        d -= pos[k]
+        d *= d
+        sq += d
+    return sq
+
+
+def _grid(
+    gt: PoseStream, step: int, n_grid: int, max_gap_ns: int, pad: int
+) -> npt.NDArray[np.float32]:
+    """(3, pad + n_grid + pad) GT positions every ``step`` ns from the first GT sample.
+
+    float32: 0.1 um resolution at 10 m, and half the memory of an hour's grid. NaN in the
+    padding and at grid points strictly inside a GT gap longer than ``max_gap_ns``.
+    """
+    t = gt.t_ns
+    grid = np.full((3, n_grid + 2 * pad), np.nan, dtype=np.float32)
+    # Chunk by chunk, each against the GT samples around it: the temporaries stay small and
+    # in cache (an hour's whole-grid np.interp allocated ~30 MB). Every grid point gets the
+    # same two samples and the same arithmetic as in one call over everything.
+    starts = np.arange(0, n_grid, GRID_CHUNK, dtype=np.int64)
+    ends = np.minimum(starts + GRID_CHUNK, n_grid)
+    first = np.searchsorted(t, t[0] + starts * step, side="right") - 1
+    after = np.searchsorted(t, t[0] + (ends - 1) * step, side="right") + 1
+    chunks = zip(starts.tolist(), ends.tolist(), first.tolist(), after.tolist(), strict=True)
+    for g0, g1, a, b in chunks:
+        rel_t = (t[a:b] - t[0]).astype(np.float64)
+        rel_g = np.arange(g0, g1, dtype=np.float64) * step  # exact: whole ns below 2**53
+        for k in range(3):
+            grid[k, pad + g0 : pad + g1] = np.interp(rel_g, rel_t, gt.xyz[a:b, k])
+    # Mark the invalid points per gap (a handful) instead of locating every grid point in
+    # the GT. The first grid point is the first GT sample; it is judged by the first GT
+    # interval, as it always was.
+    gaps = np.flatnonzero(np.diff(t) > max_gap_ns)
+    if gaps.size:
+        grid_t = t[0] + np.arange(n_grid, dtype=np.int64) * step
+        marks = np.zeros(n_grid + 1, dtype=np.int64)
+        np.add.at(marks, np.searchsorted(grid_t, t[gaps], side="right"), 1)
+        np.add.at(marks, np.searchsorted(grid_t, t[gaps + 1], side="left"), -1)
+        grid_ok = np.cumsum(marks[:-1]) == 0
+    else:
+        grid_ok = np.ones(n_grid, dtype=bool)
+    grid_ok[0] = (t[1] - t[0]) <= max_gap_ns or t[1] == t[0]
+    grid[:, pad + np.flatnonzero(~grid_ok)] = np.nan
+    return grid
+
+
+def _scan(
+    robot_t: I64, robot_xyz: F64, gt: PoseStream, offsets: I64, max_gap_ns: int
+) -> tuple[F64, I64]:
+    """Mean distance at each offset with exact interpolation, all offsets in one evaluation."""
+    shape = (len(offsets), len(robot_t))
+    queries = (offsets[:, None] + robot_t[None, :]).ravel()  # offset-major
+    ev = _evaluate(gt, queries, max_gap_ns, _around_window(gt.t_ns, robot_t, offsets))
+    if len(ev.gt_xyz) == queries.size:
+        dist = row_norm(robot_xyz - ev.gt_xyz.reshape(*shape, 3))
+    else:
+        dist = np.full(shape, np.nan)
+        pose = np.flatnonzero(ev.valid) % len(robot_t)
+        dist.ravel()[ev.valid] = row_norm(np.take(robot_xyz, pose, axis=0) - ev.gt_xyz)
+    valid = ev.valid.reshape(shape)
+    counts = valid.sum(axis=1)
+    costs = np.full(len(offsets), np.inf)
+    for i in np.flatnonzero(counts):
+        # Each offset's mean over its own compared poses, summed as one array of them.
+        costs[i] = float(dist[i][valid[i]].mean())
+    # An offset that leaves few poses inside the GT could win by chance: require at least
+    # half of the best coverage any offset achieves.
+    enough = counts >= max(MIN_POSES, int(0.5 * counts.max()))
+    return np.where(enough, costs, np.inf), counts
+
+
+def _around_window(t: I64, robot_t: I64, offsets: I64) -> tuple[IntArr, IntArr] | None:
+    """:func:`~ertools.geometry.bracket` of ``offsets[:, None] + robot_t[None, :]``, flattened.
+
+    The offsets span a few tens of ms, so each pose's queries fall among a handful of GT
+    samples: counting the ones at or before each query there is ~5x cheaper than a binary
+    search per query. None when a window holds too many samples for that to pay.
+    """
+    first = np.searchsorted(t, robot_t + offsets.min(), side="right")
+    width = np.searchsorted(t, robot_t + offsets.max(), side="right") - first
+    if width.max() > 16:
+        return None
+    queries = offsets[:, None] + robot_t[None, :]
+    right = np.broadcast_to(first, queries.shape).copy()
+    for w in range(int(width.max())):
+        # Beyond its window a pose counts nothing (those samples lie after every query).
+        cand = np.where(w < width, t.take(np.minimum(first + w, len(t) - 1)), MAX_NS)
+        right += cand <= queries
+    return bracket(t, queries.ravel(), right.ravel())
+
+
+def estimate_offset(
+    robot: PoseStream,
+    gt: PoseStream,
+    *,
+    search_range_ns: int = 5 * NS_PER_S,
+    max_gap_ns: int = NS_PER_S // 10,
+    seed: int = 0,
+) -> OffsetEstimate:
+    """Estimate the offset to add to ``robot`` stamps to align them with ``gt``.
+
+    Args:
+        robot: the robot's own poses of its marker set (stamps on the robot clock).
+        gt: the mocap poses of the same marker set (stamps on the GT clock).
+        search_range_ns: search offsets within +- this.
+        max_gap_ns: GT samples further apart than this are not interpolated across.
+        seed: of the bootstrap's random generator (the result is deterministic).
+    """
+    gt = drop_repeats(gt)
+    at_zero = _mean_error(robot.t_ns, robot.xyz, gt, 0, max_gap_ns) if len(gt) >= 2 else None
+    zero = None if at_zero is None or at_zero[1] == 0 else at_zero[0]
+
+    def none(note: str, used: int = 0) -> OffsetEstimate:
+        return OffsetEstimate(None, None, search_range_ns, used, None, zero, note)
+
+    if len(gt) < 2 or len(robot) < MIN_POSES:
+        return none(f"too few poses to estimate a clock offset (robot {len(robot)}, GT {len(gt)})")
+
+    # 1. coarse scan on a subsample
+    step = max(1, len(robot) // COARSE_MAX_POSES)
+    sub_t, sub_xyz = robot.t_ns[::step], robot.xyz[::step]
+    n_coarse = int(search_range_ns // COARSE_STEP_NS)
+    coarse = np.arange(-n_coarse, n_coarse + 1, dtype=np.int64) * COARSE_STEP_NS
+    costs = _coarse_scan(sub_t, sub_xyz, gt, coarse, max_gap_ns)
+    if not np.isfinite(costs).any():
+        return none("the robot poses do not overlap the GT at any offset searched")
+    best = int(np.argmin(costs))
+    notes: list[str] = []
+    if best in (0, len(coarse) - 1):
+        notes.append("best offset at the edge of the search range: widen --offset-range")
+    # Another deep minimum far away means the motion repeats itself: say so.
+    far = np.abs(np.arange(len(coarse)) - best) > 10
+    local_min = np.zeros(len(coarse), dtype=bool)
+    local_min[1:-1] = (costs[1:-1] <= costs[:-2]) & (costs[1:-1] <= costs[2:])
+    rival = far & local_min & (costs <= costs[best] * 1.1 + 1e-3)
+    if rival.any():
+        other = coarse[np.flatnonzero(rival)[0]] / NS_PER_S
+        notes.append(f"ambiguous: another offset ({other:+.2f} s) fits almost as well")
+
+    # 2. fine scan, exact interpolation, on the subsample (Gauss-Newton then uses every pose)
+    fine = coarse[best] + np.arange(-COARSE_STEP_NS, COARSE_STEP_NS + 1, FINE_STEP_NS)
+    fine_costs, _ = _scan(sub_t, sub_xyz, gt, fine, max_gap_ns)
+    if not np.isfinite(fine_costs).any():
+        return none("the robot poses do not overlap the GT near the best coarse offset")
+    offset = float(fine[int(np.argmin(fine_costs))])
+
+    # 3. Gauss-Newton on the squared distances
+    for _ in range(5):
+        ev = _evaluate(gt, robot.t_ns + round(offset), max_gap_ns)
+        v = _velocity(gt, ev, max_gap_ns)
+        r = _valid_rows(robot.xyz, ev) - ev.gt_xyz
+        vv = float(np.sum(v * v))
+        if vv <= 0:
+            break
+        step_s = float(np.sum(r * v)) / vv
+        offset += step_s * NS_PER_S
+        if abs(step_s) < 1e-6:
+            break
+    offset_ns = round(offset)
+    ev = _evaluate(gt, robot.t_ns + offset_ns, max_gap_ns)
+    used = len(ev.gt_xyz)
+    if used < MIN_POSES:
+        return none("too few robot poses overlap the GT at the estimated offset", used)
+    v = _velocity(gt, ev, max_gap_ns)
+    r = _valid_rows(robot.xyz, ev) - ev.gt_xyz
+    t_used = robot.t_ns[ev.valid]
+    rms_speed = _rms_speed(t_used, ev.gt_xyz)
+    if rms_speed < MIN_RMS_SPEED:
+        return none(
+            f"the robot barely moved (RMS speed {rms_speed * 100:.1f} cm/s): "
+            "no clock offset is observable",
+            used,
+        )
+    mean_err = float(np.mean(row_norm(r)))
+    sigma = _bootstrap_sigma(t_used, r, v, seed)
+    return OffsetEstimate(
+        offset_ns, round(sigma * NS_PER_S), search_range_ns, used, mean_err, zero, "; ".join(notes)
+    )
+
+
+def _rms_speed(t_ns: I64, xyz: F64) -> float:
+    """RMS speed of the GT between consecutive robot poses.
+
+    Measured over the robot's sampling interval (~0.1 s), not between 120 Hz GT samples:
+    there a standing body's 0.2 mm noise alone reads as 3 cm/s.
+    """
+    if len(t_ns) < 2:
+        return 0.0
+    dt = np.diff(t_ns).astype(np.float64) / NS_PER_S
+    step = row_norm(np.diff(xyz, axis=0))
+    ok = dt > 0
+    return float(np.sqrt(np.mean((step[ok] / dt[ok]) ** 2))) if ok.any() else 0.0
+
+
+def _bootstrap_sigma(t_ns: I64, r: F64, v: F64, seed: int) -> float:
+    """Standard deviation (s) of the Gauss-Newton offset under a block bootstrap.
+
+    Near the optimum the offset is ``d + sum(r.v)/sum(|v|^2)``; resampling blocks of poses
+    (5 s, or a twentieth of the log when that is longer) with replacement and recomputing that
+    step gives the spread of the estimate including the autocorrelation of the robot's error.
+    """
+    span = int(t_ns[-1] - t_ns[0])
+    block_ns = max(BLOCK_NS, span // 20)
+    block = ((t_ns - t_ns[0]) // max(block_ns, 1)).astype(np.intp)
+    nb = int(block.max()) + 1
+    a = np.bincount(block, weights=row_dot(r, v), minlength=nb)
+    b = np.bincount(block, weights=row_dot(v, v), minlength=nb)
+    if nb < 5:
+        # Too few blocks to resample: the independent-errors standard error, which the
+        # autocorrelation makes optimistic; inflate it by the poses per block.
+        dof = max(3 * len(r) - 1, 1)
+        per_block = len(r) / max(nb, 1)
+        return float(np.sqrt(np.sum(r * r) / dof / np.sum(v * v) * per_block))
+    rng = np.random.default_rng(seed)
+    draws = rng.integers(0, nb, size=(BOOTSTRAP_DRAWS, nb))
+    num, den = a[draws].sum(axis=1), b[draws].sum(axis=1)
+    ok = den > 0
+    return float(np.std(num[ok] / den[ok]))
+
+
+# Record time minus header stamp of mocap poses is a few ms on one machine (0.3 ms in the real
+# 2015 log); a quarter second means two clocks disagree, enough to move a robot at 0.5 m/s by
+# 12 cm between the moment the states name and the pose taken for it.
+HEADER_CLOCK_TOLERANCE_NS = NS_PER_S // 4
+
+
+def check_header_clock(
+    paths: Sequence[str | Path],
+    poses: PoseStream,
+    states_what: str,
+    tolerance_ns: int = HEADER_CLOCK_TOLERANCE_NS,
+) -> None:
+    """Refuse poses timed by header stamps that disagree with the bag's record times.
+
+    Benchmark states (and timing files) are timed by record time; poses by default by their
+    header stamp. When the two clocks differ by more than ``tolerance_ns``, every pose taken
+    "at" a state moment is another moment's pose: a wrong score that looks right.
+
+    Raises:
+        ClockError: naming the file, the topic, the offset and the way out.
+    """
+    from ertools.errors import ClockError
+    from ertools.io import summary
+    from ertools.timeline.scan import clock_check
+
+    cut = poses.source.rfind(":/")
+    topic = poses.source[cut + 1 :] if cut >= 0 else ""
+    if not topic or topic in ("/tf", "/tf_static"):
+        return  # tf mixes publishers (static transforms are stamped otherwise): not checked
+    for path in paths:
+        check = clock_check(summary(path), topic_name=topic)
+        if check is None or check.error or not check.samples:
+            continue
+        if abs(check.offset_ns) > tolerance_ns:
+            ahead = -check.offset_ns / NS_PER_S
+            raise ClockError(
+                f"{path}:{topic}: header stamps are {ahead:+.3f} s off the record times "
+                f"(median of {check.samples} messages), but the {states_what} are timed by "
+                "record time: the mocap and logger clocks disagree; re-run with "
+                "--time-source record"
+            )

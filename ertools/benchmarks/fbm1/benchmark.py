@@ -1,0 +1,691 @@
+"""FBM1@Home and FBM1@Work (object perception, seed 7.1): load -> find runs -> score -> result.
+
+For each run the referee placed the reference board carrying one item on the FBM1 table; the
+robot answered the item's class, instance and pose (x, y in metres, theta in degrees) in the
+table frame. The ground truth is T_origin_item = T_world_origin^-1 * T_world_board *
+T_board_item (``fbm1_gt``); the 2015 rules are in ``fbm1_score``; runs come from the state
+topics (``fbm1_runs``); answers from the Client payloads or a results file (``fbm1_answers``).
+
+``score_fbm1`` is the pure computation on streams; ``score_fbm1_bag`` reads a log through
+:mod:`ertools.io` and calls it. Both benchmarks share everything: ``benchmark`` only decides
+where the item's name is read first and which nodes exist to reproduce.
+
+Three references (``Fbm1Options.for_rules``): ``ertools`` (the default), ``2015`` (the 2015
+nodes ``scripts/fbm1h`` and ``scripts/fbm1w``) and ``2016`` (the later @Home node, used in
+2016-17). The ``RULE_*`` constants are the catalogue rows (:mod:`ertools.fidelity`) of every
+place where the default differs from the 2015 nodes.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from ertools.benchmarks.fbm1.answers import (
+    Answer,
+    ResultsFile,
+    answer_from_mapping,
+    parse_answer_payload,
+    parse_results,
+)
+from ertools.benchmarks.fbm1.gt import (
+    GroundTruthError,
+    GtOptions,
+    board_motion,
+    measure_ground_truth,
+)
+from ertools.benchmarks.fbm1.result import Fbm1Result, Fbm1RunResult
+from ertools.benchmarks.fbm1.runs import Fbm1Run, RunsFound, find_runs
+from ertools.benchmarks.fbm1.score import (
+    MAX_POSE_ERROR_2015,
+    ScoreRules,
+    names_match,
+    pose_errors,
+    totals,
+)
+from ertools.configs.items import Item, ItemList
+from ertools.errors import ConfigError, ScoringError, SegmentationError, TopicError
+from ertools.fidelity import Deviation, Rule
+from ertools.progress import Reporter, current
+from ertools.streams import PoseStream, Provenance, frame_change_warning
+from ertools.timeutil import NS_PER_S
+
+if TYPE_CHECKING:
+    from ertools.io import PoseSource
+
+log = logging.getLogger("ertools.benchmarks.fbm1.benchmark")
+
+BENCHMARKS = ("fbm1h", "fbm1w")
+
+# The nodes ertools can reproduce: (--rules value, what it is, the file the arithmetic is in).
+NODE_2015 = (
+    "2015 node (rockin-robot-challenge/benchmark_and_scoring_fbm scripts/fbm1h at 117a5d0; "
+    "scripts/fbm1w as in svenschneider/benchmark_and_scoring_fbm): totals over runs played + "
+    "aborted, ground truth looked up when the result arrived"
+)
+NODE_2016 = (
+    "2016-17 @Home node (rockin-robot-challenge/benchmark_and_scoring_fbm scripts/fbm1h at "
+    "40ba68b): accuracies over 10, pose score over runs played + aborted, ground truth looked "
+    "up when the placement was confirmed, before the goal"
+)
+RULE_SETS = ("ertools", "2015", "2016")
+
+_NODE_SRC = "scripts/fbm1h, scripts/fbm1w (2015)"
+RULE_GT_MOMENT = Rule(
+    key="fbm1.ground-truth",
+    benchmark="fbm1",
+    title="ground-truth moment",
+    rulebook="BMmanager combines the table, board and item transforms (seed 7.1); no moment",
+    node_2015=(
+        f"{_NODE_SRC}: one tf lookup, `lookupTransform('/origin', '/item', "
+        "rospy.Time(0))`, at the stamp of the item transform broadcast once when the result had "
+        "arrived (the 2016-17 @Home node: when the placement was confirmed, `--gt placed`)"
+    ),
+    ertools=(
+        "mean over the stationary window before the goal, spread reported: one sample carries "
+        "the mocap noise, and the board may be touched while the robot looks"
+    ),
+    option="--gt result",
+)
+RULE_TRANS_CLIP = Rule(
+    key="fbm1.translation-clip",
+    benchmark="fbm1",
+    title="translation term clip",
+    rulebook="pose score 1 - t/2 - r/2 with both terms in [0, 1] (score listing, seed 7.1)",
+    node_2015=(
+        f"{_NODE_SRC}: `if pose_err_trans > max_pose_error : pose_err_trans = 1` with "
+        "max_pose_error = sqrt(2) m: errors of 1..1.41 m stay unclipped (score down to -0.21)"
+    ),
+    ertools="t = min(error, 1 m), so a pose score stays in [0, 1]",
+    option="--clip-above-diagonal",
+)
+RULE_THETA_WRAP = Rule(
+    key="fbm1.theta-wrap",
+    benchmark="fbm1",
+    title="theta error wrap",
+    rulebook="the error of the 2D pose; theta in [-180, 180] deg",
+    node_2015=(
+        f"{_NODE_SRC}: `if w_err > 180: w_err = w_err - 360` and `if w_err < -180: w_err = "
+        "w_err + 360`: one step, answers beyond +-540 deg keep r = 1"
+    ),
+    ertools="wrapped fully to [-180, 180)",
+    option="--single-wrap",
+)
+RULE_NAMES = Rule(
+    key="fbm1.names",
+    benchmark="fbm1",
+    title="class and instance comparison",
+    rulebook="object class and instance names [string] (seed 7.1)",
+    node_2015=(
+        f"{_NODE_SRC}: `result['item_class'] == item['class']`, exact: the 2015 fbm1w.yaml "
+        'class `"Bearing Boxes "` (trailing blank) matched no answer'
+    ),
+    ertools="compared without surrounding blanks",
+    option="--exact-names",
+)
+RULE_ABORTED = Rule(
+    key="fbm1.aborted-runs",
+    benchmark="fbm1",
+    title="run stopped before its goal",
+    rulebook="repeated until time runs out or 10 objects have been processed (seed 7.1)",
+    node_2015=(
+        f"{_NODE_SRC}: `runs = runs + 1` before the manual operation, then `break` when the "
+        "benchmark stopped: the run counts in every divisor with no positive and pose score 0"
+    ),
+    ertools="totals over the runs whose goal was sent (a run never asked is not a failed one)",
+    option="--count-aborted",
+)
+
+
+@dataclass(frozen=True)
+class Fbm1Options:
+    """Everything that changes an FBM1 score besides the inputs.
+
+    Attributes:
+        benchmark: ``fbm1h`` or ``fbm1w``.
+        gt: how the ground truth is measured (see :class:`GtOptions`).
+        rules: which node behaviours to reproduce (see :class:`ScoreRules`).
+        moved_warn_m: warn when the board moved more than this (metres, table plane) between
+            the goal and the result, i.e. while the robot was looking.
+    """
+
+    benchmark: str = "fbm1h"
+    gt: GtOptions = field(default_factory=GtOptions)
+    rules: ScoreRules = field(default_factory=ScoreRules)
+    moved_warn_m: float = 0.01
+
+    @staticmethod
+    def for_rules(benchmark: str, rules: str, gt: GtOptions | None = None) -> Fbm1Options:
+        """Every behaviour of one reference: ``ertools``, ``2015`` or ``2016`` (@Home only).
+
+        ``gt`` gives the tolerances of the window (its method is replaced by the node's).
+
+        Raises:
+            ConfigError: an unknown reference, or ``2016`` for @Work (no later @Work node is
+                known).
+        """
+        from dataclasses import replace
+
+        base = gt or GtOptions()
+        if rules == "ertools":
+            return Fbm1Options(benchmark, base, ScoreRules())
+        if rules == "2015":
+            return Fbm1Options(benchmark, replace(base, method="result"), ScoreRules.node_2015())
+        if rules == "2016" and benchmark == "fbm1h":
+            return Fbm1Options(benchmark, replace(base, method="placed"), ScoreRules.node_2016())
+        if rules == "2016":
+            raise ConfigError(
+                "no 2016-17 FBM1@Work node is known (only the 2015 scripts/fbm1w); use 2015"
+            )
+        raise ConfigError(f"unknown FBM1 rules {rules!r}; use {', '.join(RULE_SETS)}")
+
+    @staticmethod
+    def as_2015(benchmark: str) -> Fbm1Options:
+        """The 2015 node's behaviour: every rule of it, and its single tf lookup."""
+        return Fbm1Options.for_rules(benchmark, "2015")
+
+    @property
+    def reference(self) -> str:
+        """Which reference these options reproduce: ertools, a node, or a mixture."""
+        refs = (("ertools", "ertools default"), ("2015", NODE_2015), ("2016", NODE_2016))
+        for name, text in refs:
+            try:
+                ref = Fbm1Options.for_rules(self.benchmark, name, self.gt)
+            except ConfigError:
+                continue
+            if ref.rules == self.rules and ref.gt.method == self.gt.method:
+                return text
+        return "ertools with some node behaviours (see the rules)"
+
+
+def _resolve_item(run: Fbm1Run, items: ItemList) -> tuple[Item, list[str]]:
+    """The item a run presented; ScoringError when nothing or an unknown item is named."""
+    where = f"run {run.index}"
+    ref = run.item
+    if ref is None:
+        raise ScoringError(
+            f"{where}: no item named (empty manual-operation payload); give --items-order"
+        )
+    warnings: list[str] = []
+    if ref.item_id is not None:
+        item = items.by_id(ref.item_id)
+        if item is None:
+            raise ScoringError(
+                f"{where}: item id {ref.item_id} ({ref.source} {ref.text!r}) is not in "
+                f"{items.source or 'the item list'}"
+            )
+        if ref.instance and ref.instance.strip() != item.instance.strip():
+            warnings.append(
+                f"{where}: {ref.source} names instance {ref.instance!r} but item {item.id} is "
+                f"{item.instance!r} in the item list; using the id"
+            )
+        return item, warnings
+    assert ref.instance is not None
+    item = items.by_instance(ref.instance)
+    if item is None:
+        raise ScoringError(
+            f"{where}: item {ref.instance!r} ({ref.source}) is not in "
+            f"{items.source or 'the item list'}"
+        )
+    return item, warnings
+
+
+def _answer_for(run: Fbm1Run, item: Item | None, results: ResultsFile | None) -> Answer | None:
+    where = f"run {run.index}"
+    if results is not None:
+        entry = results.by_run.get(run.index)
+        if entry is None and item is not None:
+            entry = results.by_item.get(item.id)
+        if entry is not None:
+            return answer_from_mapping(entry, where, results.source)
+    if run.answer_payload is None:
+        return None
+    return parse_answer_payload(run.answer_payload, where)
+
+
+def _execution_time_ns(run: Fbm1Run) -> int | None:
+    start = run.executing_ns if run.executing_ns is not None else run.goal_ns
+    if start is None or run.result_ns is None:
+        return None
+    return run.result_ns - start
+
+
+def item_broadcast(run: Fbm1Run, method: str, item_tf: PoseStream | None) -> int | None:
+    """The stamp of the node's item broadcast on /tf that its lookup used, when logged.
+
+    The 2015 nodes broadcast ``item`` once per answered run, after the result (between the goal
+    and the next run); the 2016-17 node once per run, before the goal. ``now`` of that
+    broadcast is the lookup's moment (tf answered ``Time(0)`` at it).
+    """
+    if item_tf is None or len(item_tf) == 0 or run.goal_ns is None:
+        return None
+    t = item_tf.t_ns
+    if method == "result":
+        after = t[(t > run.goal_ns) & (t <= run.end_ns)]
+        return int(after[0]) if len(after) else None
+    if method == "placed":
+        before = t[(t >= run.start_ns) & (t <= run.goal_ns)]
+        return int(before[-1]) if len(before) else None
+    return None
+
+
+def score_run(
+    run: Fbm1Run,
+    items: ItemList,
+    origin: PoseStream,
+    board: PoseStream,
+    options: Fbm1Options,
+    results: ResultsFile | None = None,
+    t0_ns: int = 0,
+    item_tf: PoseStream | None = None,
+) -> Fbm1RunResult:
+    """Score one run; a run that cannot be scored comes back with status ``failed``.
+
+    ``item_tf``: the node's broadcasts of ``ref_board -> item`` on /tf, when logged: their
+    stamps are the exact moments of the node's lookups.
+    """
+    where = f"run {run.index}"
+    text = run.item.text if run.item else ""
+    base: dict[str, Any] = {
+        "index": run.index,
+        "item_text": text,
+        "goal_ns": run.goal_ns,
+        "result_ns": run.result_ns,
+        "ended_by": run.ended_by,
+    }
+    if run.goal_ns is None:
+        return Fbm1RunResult(status="aborted", **base)
+    item: Item | None = None
+    warnings: list[str] = []
+    try:
+        item, warnings = _resolve_item(run, items)
+        answer = _answer_for(run, item, results)
+    except ScoringError as err:
+        return Fbm1RunResult(status="failed", item=item, error=err.message, **base)
+    exec_time = _execution_time_ns(run)
+    if exec_time is None and answer is not None:
+        warnings.append(f"{where}: no result time in the log; execution time unknown")
+    if answer is None and run.result_ns is None and run.ended_by is None:
+        # The log ends while the robot works on it: the 2015 node never finished this run.
+        return Fbm1RunResult(
+            status="unfinished",
+            item=item,
+            warnings=(f"{where}: the log ends before the run did; not counted",),
+            **base,
+        )
+    if answer is None:
+        # 2015: a timed-out run counted with no positives and pose score 0; a stopped run's
+        # time was not added.
+        counted_time = exec_time if run.ended_by != "stop" else 0
+        return Fbm1RunResult(
+            status="no_answer",
+            item=item,
+            class_ok=False,
+            instance_ok=False,
+            execution_time_ns=counted_time,
+            warnings=tuple(warnings),
+            **base,
+        )
+    # The board may settle any time after the referee was asked to place it; the stationary
+    # tail before the goal decides (capped at max_window_s).
+    start = run.start_ns
+    try:
+        gt, gt_warnings = measure_ground_truth(
+            origin,
+            board,
+            item,
+            search_start_ns=start,
+            goal_ns=run.goal_ns,
+            result_ns=run.result_ns,
+            options=options.gt,
+            t0_ns=t0_ns,
+            placed_ns=run.placed_ns,
+            at_ns=item_broadcast(run, options.gt.method, item_tf),
+        )
+    except GroundTruthError as err:
+        return Fbm1RunResult(
+            status="failed",
+            item=item,
+            answer=answer,
+            error=f"{where}: {err}",
+            warnings=tuple(warnings),
+            **base,
+        )
+    warnings += [f"{where}: {w}" for w in gt_warnings]
+    if run.result_ns is not None:
+        max_gap = round(options.gt.max_gap_s * NS_PER_S)
+        moved = board_motion(origin, board, gt.board_xy, run.goal_ns, run.result_ns, max_gap)
+        if moved is not None and moved > options.moved_warn_m:
+            warnings.append(
+                f"{where}: the board moved {moved * 1000:.0f} mm while the robot was looking"
+            )
+    errors = pose_errors(
+        answer.x, answer.y, answer.theta_deg, gt.x, gt.y, gt.yaw_deg, options.rules
+    )
+    return Fbm1RunResult(
+        status="scored",
+        item=item,
+        answer=answer,
+        gt=gt,
+        errors=errors,
+        class_ok=names_match(answer.item_class, item.item_class, options.rules),
+        instance_ok=names_match(answer.item_instance, item.instance, options.rules),
+        execution_time_ns=exec_time,
+        warnings=tuple(warnings),
+        **base,
+    )
+
+
+def _deviations(runs: Sequence[Fbm1RunResult], options: Fbm1Options) -> list[Deviation]:
+    """Where this result deliberately differs from the 2015 node, each with its rule."""
+    out: list[Deviation] = []
+    rules, gt = options.rules, options.gt
+    scored = [r for r in runs if r.errors is not None]
+    if gt.method != "result":
+        used = {
+            "window": f"the mean over the stationary window (up to {gt.max_window_s:g} s) "
+            "before each goal, spread reported",
+            "placed": "one lookup when the placement was confirmed (the 2016-17 node)",
+            "goal": "one lookup when the goal was sent",
+        }[gt.method]
+        out.append(
+            RULE_GT_MOMENT.deviation(
+                f"ground truth = {used}; 2015 looked it up in tf when the result had arrived"
+            )
+        )
+    if not rules.clip_above_diagonal:
+        n = [
+            str(r.index)
+            for r in scored
+            if r.errors is not None and 1.0 < r.errors.trans_error_m <= MAX_POSE_ERROR_2015
+        ]
+        affected = f"run(s) {', '.join(n)} affected" if n else "no run affected"
+        out.append(
+            RULE_TRANS_CLIP.deviation(
+                "translation term clipped at 1 m; 2015 set only errors above sqrt(2) m to 1 "
+                f"({affected})"
+            )
+        )
+    if not rules.single_wrap:
+        n = [
+            str(r.index)
+            for r in scored
+            if r.answer is not None
+            and r.gt is not None
+            and abs(r.answer.theta_deg - r.gt.yaw_deg) > 540.0
+        ]
+        affected = f"run(s) {', '.join(n)} affected" if n else "no run affected"
+        out.append(
+            RULE_THETA_WRAP.deviation(
+                f"theta errors wrapped fully to [-180, 180) deg; 2015 by a single 360 ({affected})"
+            )
+        )
+    if not rules.exact_names:
+        out.append(
+            RULE_NAMES.deviation(
+                "class and instance compared without surrounding blanks; 2015 compared exactly"
+            )
+        )
+    if not rules.count_aborted:
+        n_abort = sum(r.status == "aborted" for r in runs)
+        out.append(
+            RULE_ABORTED.deviation(
+                "accuracies and pose score over the runs whose goal was sent; 2015 also counted "
+                f"a run stopped before its goal ({n_abort} such run(s) here)"
+            )
+        )
+    return out
+
+
+def score_fbm1(
+    origin: PoseStream,
+    board: PoseStream,
+    found: RunsFound,
+    items: ItemList,
+    options: Fbm1Options | None = None,
+    *,
+    results: ResultsFile | None = None,
+    t0_ns: int = 0,
+    provenance: Provenance | None = None,
+    item_tf: PoseStream | None = None,
+    progress: Reporter | None = None,
+) -> Fbm1Result:
+    """Score every run (pure: streams and configs in, frozen result out), each reported to
+    ``progress`` when scored.
+
+    A run that cannot be scored is reported in ``failures`` (one line naming the run) and left
+    out of the totals; the other runs are still scored. ``item_tf``: the node's item
+    broadcasts (``ref_board -> item`` on /tf), when logged: the exact lookup moments.
+    """
+    opts = options or Fbm1Options()
+    if opts.benchmark not in BENCHMARKS:
+        raise ConfigError(f"unknown FBM1 benchmark {opts.benchmark!r}; use fbm1h or fbm1w")
+    if not found.runs:
+        raise SegmentationError(
+            f"no FBM1 run in the state log (no BmBox WAITING_MANUAL_OPERATION or goal); "
+            f"is this an {opts.benchmark} log?"
+        )
+    if progress is not None:
+        progress.task("scoring runs", len(found.runs), "runs")
+    scored = []
+    for run in found.runs:
+        scored.append(score_run(run, items, origin, board, opts, results, t0_ns, item_tf))
+        if progress is not None:
+            progress.advance(1)
+    runs = tuple(scored)
+    counted = [r for r in runs if r.status in ("scored", "no_answer")]
+    tot = totals(
+        [bool(r.class_ok) for r in counted],
+        [bool(r.instance_ok) for r in counted],
+        [r.pose_score or 0.0 for r in counted],
+        [r.execution_time_ns or 0 for r in counted],
+        aborted=sum(r.status == "aborted" for r in runs),
+        rules=opts.rules,
+    )
+    warnings = list(found.warnings)
+    # A GT body whose frame_id changes mid-log mixes frames (ertools.streams).
+    warnings += [w for w in (frame_change_warning(b, t0_ns or None) for b in (origin, board)) if w]
+    if items.is_vanilla:
+        warnings.append(
+            f"{items.source or 'the item list'} has identity transforms only (a vanilla list): "
+            "the ground truth is the board's own frame; measure the items with "
+            "`ertools acquire items`"
+        )
+    for r in runs:
+        warnings.extend(r.warnings)
+    if results is not None:
+        warnings.extend(_unused_results(results, runs))
+    failures = [r.error for r in runs if r.error]
+    return Fbm1Result(
+        name=opts.benchmark,
+        runs=runs,
+        totals=tot,
+        logged_score=_parse_logged(found.logged_score),
+        t0_ns=t0_ns,
+        warnings=tuple(warnings),
+        deviations=tuple(_deviations(runs, opts)),
+        failures=tuple(failures),
+        provenance=provenance or Provenance(),
+        reference=opts.reference,
+    )
+
+
+def _unused_results(results: ResultsFile, runs: Sequence[Fbm1RunResult]) -> list[str]:
+    """Warnings for answers of the results file that no run used (a wrong run or item)."""
+    run_numbers = {r.index for r in runs}
+    item_ids = {r.item.id for r in runs if r.item is not None}
+    out = []
+    unused_runs = sorted(k for k in results.by_run if k not in run_numbers)
+    if unused_runs:
+        out.append(
+            f"{results.source}: answer(s) for run(s) {unused_runs} not used: the log has runs "
+            f"1 to {max(run_numbers)}"
+        )
+    unused_items = sorted(k for k in results.by_item if k not in item_ids)
+    if unused_items:
+        out.append(
+            f"{results.source}: answer(s) for item(s) {unused_items} not used: no run "
+            "presented them"
+        )
+    return out
+
+
+def _parse_logged(payload: str | None) -> dict[str, Any] | None:
+    """The 2015 node's own score payload, when it was logged and is a YAML mapping."""
+    if not payload:
+        return None
+    from ertools.configs._yaml import parse_yaml
+
+    try:
+        data = parse_yaml(payload, "BmBox TRANSMITTING_SCORE payload")
+    except ConfigError:
+        log.warning("the logged 2015 score payload is not YAML: %.60r", payload)
+        return None
+    return data if isinstance(data, dict) else None
+
+
+@dataclass(frozen=True)
+class BodySources:
+    """Where the table and board poses come from (the 2015 topics when None)."""
+
+    origin: PoseSource | None = None
+    board: PoseSource | None = None
+
+
+def read_body(
+    paths: Sequence[Path],
+    source: PoseSource | None,
+    default_topic: str,
+    frame: str,
+    window: tuple[int | None, int | None] = (None, None),
+) -> PoseStream:
+    """A body's poses: the given source, else the 2015 topic, else its /tf frame."""
+    from ertools.errors import TopicError
+    from ertools.io import PoseSource, read_pose_source
+
+    start, end = window
+    if source is not None:
+        stream: PoseStream = read_pose_source(paths, source, start_ns=start, end_ns=end)
+        return stream
+    try:
+        return read_pose_source(paths, PoseSource(topic=default_topic), start_ns=start, end_ns=end)
+    except TopicError as topic_err:
+        try:
+            stream = read_pose_source(paths, PoseSource(frame=frame), start_ns=start, end_ns=end)
+        except TopicError:
+            raise TopicError(
+                f"{topic_err.message}; no /tf frame {frame!r} either "
+                f"(choose the {frame} body with --{frame.replace('_', '-')}-topic or "
+                f"--{frame.replace('_', '-')}-frame)"
+            ) from topic_err
+        log.info("%s: using /tf frame %s (no %s)", paths[0], frame, default_topic)
+        return stream
+
+
+def score_fbm1_bag(
+    paths: Sequence[str | Path],
+    items_path: str | Path,
+    *,
+    options: Fbm1Options | None = None,
+    results_path: str | Path | None = None,
+    items_order: Sequence[str] | None = None,
+    sources: BodySources | None = None,
+) -> Fbm1Result:
+    """Recompute an FBM1 score from a log (one bag or a split log's files).
+
+    Args:
+        paths: the log file(s).
+        items_path: the item list (Listing 9).
+        options: benchmark and rules.
+        results_path: answers kept outside the log (replaces the Client payloads it covers).
+        items_order: item ids or instances per run (overrides the payloads).
+        sources: origin/board pose sources; the 2015 topics ``/<ns>/origin/pose`` and
+            ``/<ns>/ref_board/pose`` (falling back to the /tf frames) by default.
+
+    Raises:
+        BagError, TopicError: unreadable log, missing state or body topics.
+        ConfigError: bad item list or results file.
+        SegmentationError: no run in the log.
+    """
+    from ertools.configs._yaml import load_yaml
+    from ertools.configs.items import load_items
+    from ertools.io import read_benchmark_states, summary
+
+    opts = options or Fbm1Options()
+    plist = [Path(p) for p in paths]
+    ns = opts.benchmark
+    items = load_items(items_path)
+    results = None
+    if results_path is not None:
+        results = parse_results(load_yaml(results_path, "results"), str(results_path))
+    states = read_benchmark_states(plist, ns)
+    if states.bmbox is None or len(states.bmbox) == 0:
+        raise SegmentationError(
+            f"no /{ns}/bmbox_state messages: the runs cannot be found "
+            f"(is this an {ns} log? `ertools info` lists its topics)",
+            path=plist[0],
+        )
+    found = find_runs(
+        states.bmbox, states.refbox, states.client, benchmark=ns, items_order=items_order
+    )
+    if states.client is None and results is None:
+        # Scoring every run as unanswered would be a silent wrong score.
+        raise SegmentationError(
+            f"no /{ns}/client_state in the log: the robot's answers are unknown; "
+            "give them with --results FILE",
+            path=plist[0],
+        )
+    t0 = min(summary(p).start_ns for p in plist)
+    # Read the bodies only around the runs (windowed reads touch only those chunks).
+    pad = round((opts.gt.max_window_s + opts.gt.max_gap_s + 2.0) * NS_PER_S)
+    lo = min(r.start_ns for r in found.runs) - pad
+    hi = max(r.end_ns for r in found.runs) + pad
+    src = sources or BodySources()
+    origin = read_body(plist, src.origin, f"/{ns}/origin/pose", "origin", (lo, hi))
+    board = read_body(plist, src.board, f"/{ns}/ref_board/pose", "ref_board", (lo, hi))
+    from ertools.benchmarks.common.clocks import check_header_clock
+
+    for body, source in ((origin, src.origin), (board, src.board)):
+        if source is None or source.time_source == "header":
+            check_header_clock(plist, body, "state messages")
+    item_tf = None
+    if opts.gt.method != "window":
+        from ertools.io import read_tf
+
+        try:
+            item_tf = read_tf(plist, "ref_board", "item", start_ns=lo, end_ns=hi)
+        except TopicError:
+            item_tf = None  # not logged: the state messages give the moments
+    gt = opts.gt
+    provenance = Provenance(
+        inputs=tuple(str(p) for p in plist)
+        + (str(items_path),)
+        + ((str(results_path),) if results_path is not None else ()),
+        parameters=(
+            ("benchmark", ns),
+            ("origin", origin.source),
+            ("ref_board", board.source),
+            ("gt_method", gt.method),
+            ("max_window_s", f"{gt.max_window_s:g}"),
+            ("still_m", f"{gt.still_m:g}"),
+            ("still_deg", f"{gt.still_deg:g}"),
+            ("max_gap_s", f"{gt.max_gap_s:g}"),
+            ("reference", opts.reference),
+            ("node_rules", ",".join(k for k, v in vars(opts.rules).items() if v) or "none"),
+        ),
+    )
+    return score_fbm1(
+        origin,
+        board,
+        found,
+        items,
+        opts,
+        results=results,
+        t0_ns=t0,
+        provenance=provenance,
+        item_tf=item_tf,
+        progress=current(),
+    )

@@ -1,0 +1,235 @@
+"""The frozen FBM1 result: per-run details, the 2015 totals, and their YAML/JSON/CSV forms."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.fbm1.answers import Answer
+from ertools.benchmarks.fbm1.gt import GroundTruth
+from ertools.benchmarks.fbm1.score import PoseErrors, Totals
+from ertools.configs.items import Item
+from ertools.fidelity import Deviation
+from ertools.streams import Provenance
+from ertools.timeutil import NS_PER_S, ns_to_s
+
+
+@dataclass(frozen=True)
+class Fbm1RunResult:
+    """One run: what was shown, what the robot said, the ground truth and the score.
+
+    Attributes:
+        index: 1-based run number.
+        status: ``scored``, ``no_answer`` (timeout/stop: counted with score 0), ``aborted``
+            (the goal was never sent: not counted), ``unfinished`` (the log ends during the
+            run: not counted) or ``failed`` (cannot be scored: see error).
+        item: the presented item, None when unknown.
+        item_text: the text that named it (payload or ``--items-order``).
+        answer: the robot's answer, None without one.
+        gt: the measured ground truth, None when not measured.
+        errors: the pose errors and pose score, None unless scored.
+        class_ok: class right (False for a run without answer), None when not counted.
+        instance_ok: instance right, likewise.
+        execution_time_ns: goal acknowledged -> result, int64 ns (totals are summed in ns,
+            so 0.572 + 0.787 s prints as 1.359, not 1.3590000000000002); None when unknown.
+        goal_ns: the goal was sent.
+        result_ns: the BmBox stopped waiting for the result.
+        ended_by: ``timeout``/``stop`` when the RefBox ended the run.
+        error: why the run failed.
+        warnings: things to check in this run.
+    """
+
+    index: int
+    status: str
+    item: Item | None = None
+    item_text: str = ""
+    answer: Answer | None = None
+    gt: GroundTruth | None = None
+    errors: PoseErrors | None = None
+    class_ok: bool | None = None
+    instance_ok: bool | None = None
+    execution_time_ns: int | None = None
+    goal_ns: int | None = None
+    result_ns: int | None = None
+    ended_by: str | None = None
+    error: str | None = None
+    warnings: tuple[str, ...] = ()
+
+    @property
+    def execution_time_s(self) -> float | None:
+        """The execution time in seconds (None when unknown)."""
+        return None if self.execution_time_ns is None else ns_to_s(self.execution_time_ns)
+
+    @property
+    def pose_score(self) -> float | None:
+        """The run's pose score: 0 for a counted run without answer."""
+        if self.errors is not None:
+            return self.errors.pose_score
+        return 0.0 if self.status == "no_answer" else None
+
+    def to_dict(self, t0_ns: int) -> dict[str, Any]:
+        """The run's entry in the score YAML (angles in degrees, times from the log start)."""
+        out: dict[str, Any] = {"status": self.status}
+        if self.item is not None:
+            out["item"] = {
+                "id": self.item.id,
+                "class": self.item.item_class,
+                "instance": self.item.instance,
+            }
+        elif self.item_text:
+            out["item"] = {"named": self.item_text}
+        if self.answer is not None:
+            a = self.answer
+            out["answer"] = {
+                "item_class": a.item_class,
+                "item_instance": a.item_instance,
+                "x": a.x,
+                "y": a.y,
+                "theta": a.theta_deg,
+            }
+        if self.gt is not None:
+            g = self.gt
+            out["ground_truth"] = {
+                "x": g.x,
+                "y": g.y,
+                "theta": g.yaw_deg,
+                "z": g.z,
+                "method": g.method,
+                "samples": g.samples,
+                "spread_m": g.position_spread_m,
+                "spread_deg": g.angle_spread_deg,
+                "window_s": [(g.start_ns - t0_ns) / NS_PER_S, (g.end_ns - t0_ns) / NS_PER_S],
+            }
+            if g.moment:
+                out["ground_truth"]["moment_from"] = g.moment
+        if self.errors is not None:
+            e = self.errors
+            out["error"] = {
+                "x": e.dx,
+                "y": e.dy,
+                "translation": e.trans_error_m,
+                "theta": e.theta_error_deg,
+            }
+        if self.class_ok is not None:
+            out["class_correct"] = self.class_ok
+            out["instance_correct"] = self.instance_ok
+        if self.pose_score is not None:
+            out["pose_score"] = self.pose_score
+        if self.execution_time_s is not None:
+            out["execution_time"] = self.execution_time_s
+        if self.goal_ns is not None:
+            out["goal_s"] = (self.goal_ns - t0_ns) / NS_PER_S
+        if self.result_ns is not None:
+            out["result_s"] = (self.result_ns - t0_ns) / NS_PER_S
+        if self.ended_by:
+            out["ended_by"] = self.ended_by
+        if self.error:
+            out["failure"] = self.error
+        if self.warnings:
+            out["warnings"] = list(self.warnings)
+        return out
+
+    def row(self, t0_ns: int) -> dict[str, Any]:
+        """A flat CSV/terminal row."""
+        nan = math.nan
+        a, g, e, it = self.answer, self.gt, self.errors, self.item
+        return {
+            "run": self.index,
+            "status": self.status,
+            "item_id": it.id if it else None,
+            "class": it.item_class if it else None,
+            "instance": it.instance if it else None,
+            "answer_class": a.item_class if a else None,
+            "answer_instance": a.item_instance if a else None,
+            "class_correct": self.class_ok,
+            "instance_correct": self.instance_ok,
+            "x": a.x if a else nan,
+            "y": a.y if a else nan,
+            "theta_deg": a.theta_deg if a else nan,
+            "gt_x": g.x if g else nan,
+            "gt_y": g.y if g else nan,
+            "gt_theta_deg": g.yaw_deg if g else nan,
+            "gt_samples": g.samples if g else 0,
+            "gt_spread_mm": g.position_spread_m * 1000.0 if g else nan,
+            "gt_spread_deg": g.angle_spread_deg if g else nan,
+            "dx": e.dx if e else nan,
+            "dy": e.dy if e else nan,
+            "trans_error_m": e.trans_error_m if e else nan,
+            "theta_error_deg": e.theta_error_deg if e else nan,
+            "pose_score": self.pose_score if self.pose_score is not None else nan,
+            "execution_time_s": self.execution_time_s if self.execution_time_s is not None else nan,
+            "goal_s": (self.goal_ns - t0_ns) / NS_PER_S if self.goal_ns is not None else nan,
+            "error": self.error or "",
+        }
+
+
+@dataclass(frozen=True)
+class Fbm1Result:
+    """An FBM1@Home or FBM1@Work score (implements ``BenchmarkResult``).
+
+    Attributes:
+        name: ``fbm1h`` or ``fbm1w``.
+        runs: every run found, in order.
+        totals: the 2015 score's four numbers.
+        logged_score: the score the 2015 node sent (BmBox TRANSMITTING_SCORE), if logged.
+        t0_ns: the log's start; times in the output are seconds from it.
+        warnings: things a referee should check.
+        deviations: where ertools deliberately differs from the 2015 node.
+        failures: runs that could not be scored (one line each, naming the run).
+        provenance: inputs and parameters.
+        reference: which reference the rules reproduce (ertools, the 2015 node, the 2016-17
+            node).
+    """
+
+    name: str
+    runs: tuple[Fbm1RunResult, ...]
+    totals: Totals
+    logged_score: dict[str, Any] | None = None
+    t0_ns: int = 0
+    warnings: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
+    failures: tuple[str, ...] = ()
+    provenance: Provenance = field(default_factory=Provenance)
+    reference: str = "ertools default"
+
+    @property
+    def nothing_scored(self) -> bool:
+        """No run counted (scored, or without answer with score 0): no total is a number, so
+        the CLI prints only the failures (``ertools.cli.common.all_failed``)."""
+        return not any(r.status in ("scored", "no_answer") for r in self.runs)
+
+    def score(self) -> dict[str, Any]:
+        """The four keys of the 2015 score payload, in the order ``yaml.dump`` sorted them."""
+        t = self.totals
+        return {
+            "class_accuracy": t.class_accuracy,
+            "execution_time": t.execution_time,
+            "instance_accuracy": t.instance_accuracy,
+            "pose_score": t.pose_score,
+        }
+
+    def to_dict(self) -> dict[str, Any]:
+        out: dict[str, Any] = {**self.score(), "benchmark": self.name}
+        out["reference"] = self.reference
+        out["counted_runs"] = {
+            "accuracy": self.totals.accuracy_runs,
+            "pose": self.totals.pose_runs,
+        }
+        out["runs"] = {str(r.index): r.to_dict(self.t0_ns) for r in self.runs}
+        if self.logged_score is not None:
+            out["logged_2015_score"] = self.logged_score
+        for key in ("warnings", "deviations", "failures"):
+            values = getattr(self, key)
+            if values:
+                out[key] = list(values)
+        result: dict[str, Any] = jsonable(out)
+        return result
+
+    def to_yaml(self) -> str:
+        """The 2015 score (first four keys, as its node sent them) then the details."""
+        return dump_yaml(self.to_dict())
+
+    def tables(self) -> dict[str, Rows]:
+        return {"runs": [r.row(self.t0_ns) for r in self.runs]}

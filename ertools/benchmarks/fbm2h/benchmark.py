@@ -1,0 +1,614 @@
+"""FBM2@Home (navigation, seed 7.2): load -> find reached moments -> score -> result.
+
+``score_fbm2h(paths, options)`` is what ``ertools score fbm2h`` runs; :func:`compute` is the
+pure part (streams and configs in, result out) that tests and notebooks can call directly.
+
+How 2015 scored (``scripts/fbm2h`` of ``benchmark_and_scoring_fbm``, final 2015 version): for
+each waypoint i (segment i, from 0), ``start_segment_time`` when the goal had been sent,
+``end_segment_time`` when the Client's result arrived, ``segment_time`` their difference;
+the robot pose was the tf ``world -> robot_at_home`` composed with the team's
+``marker_to_robot_transform`` (broadcast as a child frame stamped ``now``, the ROS time just
+after the result arrived, so tf interpolated the marker pose at that moment) and reduced to
+(x, y, yaw); ``dinstance_error`` the planar
+distance to the waypoint; ``orientation_error = atan2(sin|dtheta|, cos|dtheta|)`` with
+``dtheta`` the unwrapped yaw difference; ``position_accuracy = sum(distance) / N``,
+``orientation_accuracy = atan2(sum sin|dtheta|, sum cos|dtheta|)``, ``execution_time`` the
+sum of the segment times.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+import numpy.typing as npt
+
+from ertools.benchmarks.fbm2h.result import Fbm2hResult, SegmentResult
+from ertools.benchmarks.fbm2h.score import robot_poses_at, segment_errors
+from ertools.benchmarks.fbm2h.segments import ReachedMoments, StopParams
+from ertools.configs.goal import GoalList
+from ertools.configs.transform import MarkerTransform
+from ertools.errors import ConfigError, ScoringError, SegmentationError
+from ertools.fidelity import Deviation, Rule
+from ertools.streams import PoseStream, Provenance, frame_change_warning
+from ertools.timeutil import ns_to_s, s_to_ns
+
+if TYPE_CHECKING:
+    from ertools.io import PoseSource
+
+log = logging.getLogger("ertools.benchmarks.fbm2h.benchmark")
+
+DEFAULT_TOPIC = "/fbm2h/robot_at_home/pose"
+DEFAULT_MAX_GAP_S = 0.1
+# Figures need the path, not every 120 Hz sample.
+PATH_POINTS = 3000
+
+_NODE = "rockin_scoring/scripts/fbm2h (2015)"
+# The catalogue rows (ertools.fidelity) of every way FBM2@Home differs from the 2015 node.
+RULE_ORIENTATION_WRAP = Rule(
+    key="fbm2h.orientation-wrap",
+    benchmark="fbm2h",
+    title="orientation error across +-pi",
+    rulebook="orientation error of the robot pose at each waypoint (RoCKIn@Home rulebook 5.2.7)",
+    node_2015=(
+        f"{_NODE}: `sin(fabs(rp.theta - tp.theta))` and `cos(...)` of the unwrapped yaw "
+        "difference: a robot at -3.07 rad for theta = pi scored -0.073 rad"
+    ),
+    ertools="the yaw difference wrapped to [0, pi] before sin/cos (the angle between headings)",
+    option="--orientation-2015",
+)
+RULE_POSE_MOMENT = Rule(
+    key="fbm2h.pose-moment",
+    benchmark="fbm2h",
+    title="robot pose moment",
+    rulebook="the robot pose when it reaches the waypoint (seed 7.2.1)",
+    node_2015=(
+        f"{_NODE}: tf `world -> actual_robot` at the ROS time `now` the node took just after "
+        "`WaitResult()` returned, a few ms after the result"
+    ),
+    ertools=(
+        "the marker pose interpolated (linear + SLERP, as tf) at the logged reached moment; no "
+        "option: the moment the node handled the result is not in the log"
+    ),
+    option="",
+)
+RULE_UNSCORED = Rule(
+    key="fbm2h.unscored-segments",
+    benchmark="fbm2h",
+    title="segments not scored",
+    rulebook="accuracy over the waypoints reached; a waypoint not reached in time scores no "
+    "points on that path (seed 7.2, RoCKIn@Home rulebook 5.2.7)",
+    node_2015=(
+        f"{_NODE}: `if benchmark.Timeout(): execution_time += segment_time; continue`, then "
+        "`position_accuracy = sum_d / N`, N = the number of waypoints: a timed-out or "
+        "unreached segment adds 0 to the sums but counts in N"
+    ),
+    ertools=(
+        "null accuracies and exit 1 when a segment is not scored (a sum over fewer segments "
+        "divided by N rewards reaching fewer waypoints), with a warning naming them"
+    ),
+    option="--unscored-segments 2015",
+)
+RULE_SCORE_FORMAT = Rule(
+    key="fbm2h.score-format",
+    benchmark="fbm2h",
+    title="score layout",
+    rulebook="Listing 13: segments_details under details, poses per segment",
+    node_2015=(
+        f"{_NODE}: `yaml.dump` of segments_details at the top level, poses as dumps of Pose2D "
+        "objects, times from the BmBox machine's time.time()"
+    ),
+    ertools=(
+        "Listing 13 nesting, poses as {x, y, theta}, times from the log's clock; no option: "
+        "the numbers are the same, only the layout differs"
+    ),
+    option="",
+)
+
+
+@dataclass(frozen=True)
+class Fbm2hOptions:
+    """Everything ``ertools score fbm2h`` can be told.
+
+    Attributes:
+        goal: Listing 10 goal list file; None = the goal payload in the state topics.
+        transform: Listing 11 file; None with ``team``+``transforms_dir`` = DIR/transform-TEAM.yaml;
+            None otherwise = identity (said in the warnings).
+        team: picks the transform with ``transforms_dir``; alone it changes nothing here (the
+            CLI keeps it as the result's team, see :mod:`ertools.benchmarks.common.teams`).
+        topic / tf_frame: where the marker set's poses are (PoseStamped/Pose2D topic, or a /tf
+            child frame of ``world``).
+        time_source: ``header`` (mocap stamp) or ``record`` (bag time).
+        reached: ``states``, ``timing``, ``auto`` or None (states when present).
+        timing: the timing file for ``reached == "timing"``.
+        max_gap_s: a reached moment needs a GT sample this close.
+        hits: the referee's count of hits.
+        orientation_2015: compute orientation errors as 2015 did (unwrapped).
+        unscored_2015: accuracies as 2015 computed them when segments are not scored: the
+            sums over the scored segments divided by N (the waypoints), the segment the RefBox
+            timed out counted in execution_time (``--unscored-segments 2015``).
+        namespace: the benchmark namespace of the state topics.
+        stops: thresholds for ``auto``.
+        marker_transform: a transform already in hand (``ertools audit``: the one the live
+            score says the node used); None = from ``transform``/``team``, else identity.
+    """
+
+    goal: Path | None = None
+    transform: Path | None = None
+    team: str | None = None
+    transforms_dir: Path | None = None
+    topic: str | None = None
+    tf_frame: str | None = None
+    time_source: str = "header"
+    reached: str | None = None
+    timing: Path | None = None
+    max_gap_s: float = DEFAULT_MAX_GAP_S
+    hits: int | None = None
+    orientation_2015: bool = False
+    unscored_2015: bool = False
+    namespace: str = "fbm2h"
+    stops: StopParams = field(default_factory=StopParams)
+    marker_transform: MarkerTransform | None = None
+
+
+def _decimate(stream: PoseStream, points: int) -> PoseStream:
+    step = max(1, math.ceil(len(stream) / points))
+    return stream.take(slice(0, len(stream), step))
+
+
+def compute(
+    goal: GoalList,
+    transform: MarkerTransform,
+    marker: PoseStream,
+    moments: ReachedMoments,
+    *,
+    max_gap_s: float = DEFAULT_MAX_GAP_S,
+    hits: int | None = None,
+    orientation_2015: bool = False,
+    unscored_2015: bool = False,
+    unreached: Sequence[str] = (),
+    warnings: Sequence[str] = (),
+    provenance: Provenance | None = None,
+    origin_ns: int | None = None,
+) -> Fbm2hResult:
+    """Score the segments of ``moments`` against ``goal`` (pure: no file is read).
+
+    ``moments`` may have fewer segments than waypoints only when ``unreached`` says why; the
+    missing segments are then failures (with ``unscored_2015``: counted as 2015 did, with a
+    warning). More moments than waypoints is an error.
+    """
+    n = len(goal)
+    k = len(moments)
+    if k > n or (k < n and not unreached):
+        raise SegmentationError(
+            f"{k} reached moments ({moments.method}) for {n} waypoints ({goal.source}); "
+            "each waypoint needs exactly one"
+        )
+    if hits is not None and hits < 0:
+        raise ConfigError(f"--hits must be >= 0, got {hits}")
+    from ertools.benchmarks.trajectory.benchmark import drop_invalid
+
+    marker, invalid = drop_invalid(marker)
+    all_warnings = list(warnings)
+    if invalid:
+        all_warnings.append(invalid_warning(invalid, marker.source))
+    t_mr = transform.arrays()
+    poses = robot_poses_at(marker, t_mr, moments.end_ns, s_to_ns(max_gap_s))
+    target = goal.as_array()
+    errs = segment_errors(poses.xyyaw[:k], target[:k], orientation_2015=orientation_2015)
+    all_warnings.extend(_frozen_warnings(marker, moments, poses.ok[:k], max_gap_s, origin_ns))
+    frames = frame_change_warning(marker, origin_ns)
+    if frames:
+        all_warnings.append(frames)
+    early = moments.early_end
+    failures: list[str] = []
+    segments: list[SegmentResult] = []
+    # Failure messages count time as the table does: from the log's first message when known.
+    t_rel0 = origin_ns if origin_ns is not None else int(moments.start_ns[0]) if k else 0
+    since = "the log's first message" if origin_ns is not None else "the first segment start"
+    for i in range(n):
+        tgt = (float(target[i, 0]), float(target[i, 1]), float(target[i, 2]))
+        if i >= k:
+            reason = unreached[i - k] if i - k < len(unreached) else f"segment {i}: not reached"
+            timed_out = "timeout" in reason.lower()
+            if not unscored_2015:
+                failures.append(reason)
+                segments.append(SegmentResult(i, tgt, "unreached", timeout=timed_out))
+                continue
+            all_warnings.append(f"{reason}: counted in N with no error, as 2015 did")
+            if early is not None and early.segment == i and early.is_timeout:
+                # 2015 added the time of the segment the RefBox timed out (``if
+                # benchmark.Timeout(): execution_time += segment_time``); a halt added nothing.
+                segments.append(
+                    SegmentResult(
+                        i, tgt, "unreached", early.start_ns, early.end_ns, timeout=timed_out
+                    )
+                )
+            else:
+                segments.append(SegmentResult(i, tgt, "unreached", timeout=timed_out))
+            continue
+        start, end = int(moments.start_ns[i]), int(moments.end_ns[i])
+        common = {
+            "start_ns": start,
+            "end_ns": end,
+            "gt_offset_ns": int(poses.nearest_ns[i]),
+            "result_payload": moments.payloads[i],
+        }
+        if not poses.ok[i]:
+            gap = poses.nearest_ns[i]
+            nearest = (
+                "no GT sample at all"
+                if gap == np.iinfo(np.int64).max
+                else (f"nearest GT sample {gap / 1e9:.3g} s away")  # 3 digits, even below 1 ms
+            )
+            failures.append(
+                f"segment {i}: no ground truth within --max-gap {max_gap_s} s of the reached "
+                f"moment {ns_to_s(end - t_rel0):.3f} s after {since} "
+                f"({nearest}; tracking lost?) in {marker.source or 'the pose stream'}"
+            )
+            segments.append(SegmentResult(i, tgt, "no_gt", **common))  # type: ignore[arg-type]
+            continue
+        xyyaw = poses.xyyaw[i]
+        segments.append(
+            SegmentResult(
+                i,
+                tgt,
+                "ok",
+                robot=(float(xyyaw[0]), float(xyyaw[1]), float(xyyaw[2])),
+                distance_error=float(errs.distance[i]),
+                orientation_error=float(errs.orientation[i]),
+                dtheta=float(errs.dtheta[i]),
+                **common,  # type: ignore[arg-type]
+            )
+        )
+    scored = all(s.status == "ok" for s in segments)
+    # Summed in int64 ns: a sum of float seconds prints binary noise (41.199999999999996).
+    execution_time = ns_to_s(
+        sum(
+            s.end_ns - s.start_ns
+            for s in segments
+            if s.start_ns is not None and s.end_ns is not None
+        )
+    )
+    position, orientation = _accuracies(
+        segments, poses.xyyaw, target, n, orientation_2015, unscored_2015
+    )
+    if position is None:
+        missing = [s.index for s in segments if s.status != "ok"]
+        all_warnings.append(
+            f"position_accuracy and orientation_accuracy are null: segment(s) "
+            f"{', '.join(map(str, missing))} of {n} not scored and ertools averages only when "
+            "every segment is (see the failures; --unscored-segments 2015 divides the sum over "
+            f"the {n - len(missing)} scored by N = {n} as 2015 did, when the missing ones were "
+            "not lost by tracking)"
+        )
+    if transform.is_identity:
+        all_warnings.append(
+            "identity marker-to-robot transform: the marker set is taken to sit on the robot's "
+            "odometric centre (give --transform or --team/--transforms otherwise)"
+        )
+    deviations: list[Deviation] = [
+        RULE_POSE_MOMENT.deviation(
+            "robot pose interpolated (linear + SLERP) at the logged reached moment; 2015's tf "
+            "lookup interpolated at the ROS time its node handled the result, a few ms later"
+        ),
+        RULE_SCORE_FORMAT.deviation(
+            "segments_details nested under details as in Listing 13 (the 2015 node wrote it at "
+            "the top level); poses as {x, y, theta} (2015 wrote yaml dumps of Pose2D objects); "
+            "segment times from the log's clock (2015: the BmBox machine's time.time())"
+        ),
+    ]
+    if not unscored_2015 and not scored:
+        unscored = sum(s.status != "ok" for s in segments)
+        deviations.insert(
+            0,
+            RULE_UNSCORED.deviation(
+                f"position_accuracy and orientation_accuracy are null: {unscored} of {n} "
+                "segments not scored; 2015 divided the sums over the scored segments by N = "
+                f"{n}, counting the others as 0"
+            ),
+        )
+    if orientation_2015:
+        all_warnings.append(
+            "--orientation-2015: orientation errors use the unwrapped |dtheta| as 2015 did "
+            "(negative or wrong when the yaw difference crosses +-pi)"
+        )
+    else:
+        deviations.insert(
+            0,
+            RULE_ORIENTATION_WRAP.deviation(
+                "orientation errors are the yaw difference wrapped to [0, pi] before sin/cos; "
+                "2015 used the unwrapped |dtheta|, wrong across +-pi"
+            ),
+        )
+    if moments.method != "states":
+        all_warnings.append(
+            f"reached moments from {moments.method!r}, not from the benchmark state topics: "
+            "segment times are only as good as those moments"
+        )
+    path = _decimate(marker, PATH_POINTS)
+    if len(path):
+        rt, rq = t_mr
+        from ertools.geometry import compose, yaw_from_quat
+
+        pt, pq = compose(
+            path.xyz,
+            path.quat_xyzw,
+            np.broadcast_to(rt, path.xyz.shape).copy(),
+            np.broadcast_to(rq, path.quat_xyzw.shape).copy(),
+        )
+        path_xyyaw = np.column_stack([pt[:, 0], pt[:, 1], yaw_from_quat(pq)])
+    else:
+        path_xyyaw = np.empty((0, 3))
+    return Fbm2hResult(
+        segments=tuple(segments),
+        position_accuracy=position,
+        orientation_accuracy=orientation,
+        execution_time=execution_time,
+        hits=hits,
+        timeout_segments=sum(1 for s in segments if s.timeout),
+        transform=transform,
+        goal=goal,
+        reached_method=moments.method,
+        orientation_2015=orientation_2015,
+        unscored_2015=unscored_2015,
+        path_t_ns=path.t_ns,
+        path_xyyaw=path_xyyaw,
+        notes=moments.notes,
+        origin_ns=origin_ns,
+        warnings=tuple(all_warnings),
+        deviations=tuple(deviations),
+        failures=tuple(failures),
+        provenance=provenance or Provenance(),
+    )
+
+
+def _accuracies(
+    segments: Sequence[SegmentResult],
+    xyyaw: npt.NDArray[np.float64],
+    target: npt.NDArray[np.float64],
+    n: int,
+    orientation_2015: bool,
+    unscored_2015: bool,
+) -> tuple[float | None, float | None]:
+    """(position_accuracy, orientation_accuracy), None when there is no honest number.
+
+    By default both are means over the segments, and only when every segment was scored. With
+    ``unscored_2015`` the 2015 node's arithmetic: ``sum_d / N`` and ``atan2(sum_sin,
+    sum_cos)`` where the sums run over the scored segments only (a timed-out or unreached
+    segment added nothing) and N is the number of waypoints; a segment whose ground truth was
+    lost still gives None (2015 waited for tf: the pose it got cannot be known).
+    """
+    ok = np.array([s.status == "ok" for s in segments], dtype=bool)
+    if any(s.status == "no_gt" for s in segments) or (not unscored_2015 and not ok.all()):
+        return None, None
+    idx = np.flatnonzero(ok)
+    errs = segment_errors(xyyaw[idx], target[idx], orientation_2015=orientation_2015)
+    if not unscored_2015:
+        return errs.position_accuracy, errs.orientation_accuracy
+    if not idx.size:
+        return 0.0, 0.0  # 2015: sum_d = 0.0 over N, atan2(0.0, 0.0)
+    return float(errs.distance.sum()) / n, errs.orientation_accuracy
+
+
+def _frozen_warnings(
+    marker: PoseStream,
+    moments: ReachedMoments,
+    ok: npt.NDArray[np.bool_],
+    max_gap_s: float,
+    origin_ns: int | None,
+) -> list[str]:
+    """A warning per scored reached moment whose ground truth is a frozen (repeated) pose.
+
+    The threshold is ``--max-gap``: a frozen stretch longer than the gap ertools accepts hides
+    a tracking loss of the size it refuses (see
+    :data:`ertools.benchmarks.noise.benchmark.FROZEN_MIN_S`).
+    """
+    from ertools.benchmarks.noise.benchmark import frozen_around
+
+    if not len(moments):
+        return []
+    t0 = origin_ns if origin_ns is not None else int(moments.start_ns[0])
+    since = "the log's first message" if origin_ns is not None else "the first segment start"
+    out = []
+    for i, span in enumerate(frozen_around(marker, moments.end_ns, max_gap_s)):
+        if span is None or not ok[i]:
+            continue
+        at = int(moments.end_ns[i])
+        out.append(
+            f"segment {i}: the ground truth at the reached moment {ns_to_s(at - t0):.3f} s is "
+            f"frozen: {span.samples} identical poses over {span.duration_s:.3f} s "
+            f"({ns_to_s(span.start_ns - t0):.3f}-{ns_to_s(span.end_ns - t0):.3f} s; tracking "
+            f"lost?), so the pose scored was last measured {ns_to_s(at - span.start_ns):.3f} s "
+            f"before (times from {since})"
+        )
+    return out
+
+
+def invalid_warning(count: int, source: str) -> str:
+    """The warning for marker poses dropped because they are NaN or zero quaternions."""
+    return (
+        f"{count} marker set pose(s) with NaN or zero-quaternion values ignored "
+        f"({source or 'the pose stream'}): reached moments near them may have no ground truth"
+    )
+
+
+def _load_transform(options: Fbm2hOptions) -> MarkerTransform:
+    from ertools.configs.transform import identity_transform, load_transform, team_transform_path
+
+    if options.marker_transform is not None:
+        if options.transform is not None or options.transforms_dir is not None:
+            raise ConfigError("a transform in hand excludes --transform and --transforms")
+        return options.marker_transform
+    # --team alone only names the team (every scoring command has it); with --transforms DIR
+    # it also picks DIR/transform-TEAM.yaml, as the 2015 launch file's team_name argument did.
+    if options.transform is not None:
+        if options.transforms_dir is not None:
+            raise ConfigError("give either --transform FILE or --team NAME --transforms DIR")
+        return load_transform(options.transform)
+    if options.transforms_dir is not None:
+        if options.team is None:
+            raise ConfigError("--transforms DIR needs --team NAME (DIR/transform-NAME.yaml)")
+        return load_transform(team_transform_path(options.transforms_dir, options.team))
+    return identity_transform()
+
+
+def _pose_source(options: Fbm2hOptions) -> PoseSource:
+    from ertools.io import PoseSource
+
+    if options.topic is not None and options.tf_frame is not None:
+        raise ConfigError("give either --topic or --tf-frame, not both")
+    if options.tf_frame is not None:
+        return PoseSource(topic=None, frame=options.tf_frame, time_source=options.time_source)
+    return PoseSource(topic=options.topic or DEFAULT_TOPIC, time_source=options.time_source)
+
+
+def _compare_goal(goal: GoalList, payload: str, topic: str) -> str | None:
+    """A warning when the goal list given differs from the one the BmBox sent (or is unreadable)."""
+    from ertools.configs.goal import goal_from_payload
+
+    try:
+        logged = goal_from_payload(payload, f"{topic} payload")
+    except ConfigError as err:
+        return f"the goal payload in the log is not a goal list ({err}); using {goal.source}"
+    a, b = logged.as_array(), goal.as_array()
+    if a.shape != b.shape or not np.allclose(a, b, atol=1e-9):
+        return (
+            f"the goal list given ({goal.source}) differs from the one the BmBox sent in the "
+            "log; scoring against the one given"
+        )
+    return None
+
+
+def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
+    """Read the bags and configs, find the reached moments and score them."""
+    from ertools.benchmarks.fbm2h import segments as seg
+    from ertools.configs.goal import goal_from_payload, load_goal
+    from ertools.io import read_benchmark_states, read_pose_source, summary
+
+    if not paths:
+        raise ConfigError("no bag given")
+    if options.max_gap_s <= 0:
+        raise ConfigError(f"--max-gap must be > 0 s, got {options.max_gap_s}")
+    transform = _load_transform(options)
+    goal = load_goal(options.goal) if options.goal is not None else None
+    marker = read_pose_source(list(paths), _pose_source(options))
+    if len(marker) == 0:
+        raise SegmentationError(f"{marker.source or paths[0]}: the marker set pose stream is empty")
+    from ertools.benchmarks.trajectory.benchmark import drop_invalid
+
+    total = len(marker)
+    marker, invalid = drop_invalid(marker)
+    if len(marker) == 0:
+        raise ScoringError(
+            f"{marker.source or paths[0]}: all {total} marker set poses are NaN or have a zero "
+            "quaternion: nothing to score (was the body tracked?)"
+        )
+    infos = [summary(p) for p in paths]
+    bag_start, bag_end = min(i.start_ns for i in infos), max(i.end_ns for i in infos)
+    warnings: list[str] = [invalid_warning(invalid, marker.source)] if invalid else []
+    unreached: tuple[str, ...] = ()
+    reached = options.reached
+    states = None
+    if reached in (None, "states"):
+        states = read_benchmark_states(list(paths), options.namespace)
+        if states.bmbox is None:
+            if reached == "states":
+                raise SegmentationError(
+                    f"{paths[0]}: no /{options.namespace}/bmbox_state topic; "
+                    "use --reached timing FILE or --reached auto"
+                )
+            raise SegmentationError(
+                f"{paths[0]}: no benchmark state topics to find the reached moments; "
+                "use --reached timing FILE (a reached-waypoint timing file) or --reached auto"
+            )
+        reached = "states"
+    if reached == "states":
+        assert states is not None and states.bmbox is not None
+        moments = seg.from_states(states.bmbox, states.client, states.refbox)
+        if goal is None:
+            if moments.goal_payload is None:
+                raise ConfigError(
+                    "no --goal given and the first TRANSMITTING_GOAL has no goal payload"
+                )
+            goal = goal_from_payload(moments.goal_payload, f"{states.bmbox.topic} payload")
+        elif moments.goal_payload:
+            warning = _compare_goal(goal, moments.goal_payload, states.bmbox.topic)
+            if warning:
+                warnings.append(warning)
+        unreached = seg.unreached_reasons(moments, len(goal), states.refbox)
+    elif reached == "timing":
+        from ertools.configs.timing import load_timing
+
+        if options.timing is None:
+            raise ConfigError("--reached timing needs the timing FILE")
+        if goal is None:
+            raise ConfigError("--reached timing needs --goal FILE (Listing 10)")
+        timing = load_timing(options.timing)
+        t = timing.resolve(bag_start, bag_end)
+        if len(t) - 1 != len(goal):
+            raise SegmentationError(
+                f"{options.timing}: {len(t)} moments close {len(t) - 1} segments, but "
+                f"{goal.source} has {len(goal)} waypoints (p0 starts, p(k+1) closes segment k)"
+            )
+        moments = seg.from_timing(t, timing.labels)
+    elif reached == "auto":
+        if goal is None:
+            raise ConfigError("--reached auto needs --goal FILE (Listing 10)")
+        from ertools.geometry import compose, yaw_from_quat
+
+        rt, rq = transform.arrays()
+        pt, pq = compose(
+            marker.xyz,
+            marker.quat_xyzw,
+            np.broadcast_to(rt, marker.xyz.shape).copy(),
+            np.broadcast_to(rq, marker.quat_xyzw.shape).copy(),
+        )
+        moments, missing = seg.from_stops(
+            marker.t_ns,
+            pt[:, :2],
+            yaw_from_quat(pq),
+            goal.as_array()[:, :2],
+            options.stops,
+            s_to_ns(options.max_gap_s),
+            origin_ns=bag_start,
+        )
+        unreached = missing
+    else:
+        raise ConfigError(f"--reached must be states, timing FILE or auto, not {reached!r}")
+    if moments.method != "auto" and options.time_source == "header":
+        from ertools.benchmarks.common.clocks import check_header_clock
+
+        what = "state messages" if moments.method == "states" else "timing file's moments"
+        check_header_clock(paths, marker, what)
+    provenance = Provenance(
+        inputs=tuple(str(p) for p in paths)
+        + tuple(str(p) for p in (options.goal, options.transform, options.timing) if p),
+        parameters=(
+            ("reached", moments.method),
+            ("pose_source", marker.source),
+            ("max_gap_s", str(options.max_gap_s)),
+            ("transform", transform.source),
+            ("orientation_2015", str(options.orientation_2015)),
+            ("unscored_segments", "2015" if options.unscored_2015 else "null"),
+        ),
+    )
+    return compute(
+        goal,
+        transform,
+        marker,
+        moments,
+        max_gap_s=options.max_gap_s,
+        hits=options.hits,
+        orientation_2015=options.orientation_2015,
+        unscored_2015=options.unscored_2015,
+        unreached=unreached,
+        warnings=warnings,
+        provenance=provenance,
+        origin_ns=bag_start,
+    )

@@ -1,0 +1,654 @@
+"""FBM3@Work trajectory following (seed 7.3): load -> find runs -> score -> result.
+
+:func:`score_fbm3w` reads bags through :mod:`ertools.io` and calls :func:`score_runs`, which
+is pure (pose stream + run windows + config -> :class:`Fbm3wResult`). The scoring itself is in
+:mod:`ertools.benchmarks.fbm3w.path`, run finding in :mod:`ertools.benchmarks.fbm3w.runs`.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ertools.benchmarks.fbm3w.path import score_path
+from ertools.benchmarks.fbm3w.result import Fbm3wResult, RunResult
+from ertools.benchmarks.fbm3w.runs import (
+    RunWindow,
+    find_auto,
+    find_states,
+    find_windows,
+    with_specs,
+)
+from ertools.benchmarks.noise.benchmark import (
+    DEFAULT_C,
+    NoiseResult,
+    frozen_around,
+    identical_poses,
+    noise_from_stream,
+)
+from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
+from ertools.configs.shapes import Shape
+from ertools.errors import ConfigError, ErtoolsError, ScoringError, TopicError
+from ertools.fidelity import Deviation, Rule
+from ertools.progress import Reporter, current
+from ertools.streams import PoseStream, Provenance, frame_change_warning
+
+log = logging.getLogger("ertools.benchmarks.fbm3w.benchmark")
+
+NAMESPACE = "fbm3w"
+DEFAULT_TOPIC = "/fbm3w/robot_at_work/pose2d"
+FALLBACK_TOPIC = "/fbm3w/robot_at_work/pose"
+DEFAULT_FRAME = "robot_at_work"
+RUN_MODES = ("states", "windows", "auto")
+# The reference pose is the last sample at or before the reference time; older than this, the
+# marker set was probably not tracked at that moment.
+STALE_REFERENCE_S = 0.5
+# Below this reference-start distance the run frame's direction is uncertain (1 mm of noise
+# turns a 1 cm baseline by ~0.1 rad).
+SHORT_BASELINE_M = 0.01
+# Samples of the noiseless robot used for shape_floor, and the floor worth a warning.
+FLOOR_SAMPLES = 10_001
+FLOOR_WARN_M = 0.0005
+# A kept path this much longer than the target is suspicious (the sample's runs: 1.00-1.01).
+LONG_PATH_RATIO = 1.15
+
+_NODE = "rockin_scoring/scripts/fbm3w (2015)"
+# The catalogue rows (ertools.fidelity) of every way FBM3@Work differs from the 2015 node.
+RULE_TIMEOUT_RUNS = Rule(
+    key="fbm3w.timeout-runs",
+    benchmark="fbm3w",
+    title="timed-out runs",
+    rulebook="the RefBox ends a benchmark with END and payload timeout (seed 6.2.3); seed 7.3 "
+    "does not say how such a run is scored",
+    node_2015=(
+        f"{_NODE}: `if benchmark.Timeout(): ... execution_time = execution_time + (end_time - "
+        "start_time)` before the `not Running()` check; the final Lisbon node scored the run on "
+        "the path it had covered and it could be the best run (issue 15)"
+    ),
+    ertools=(
+        "listed with its time and no distance_error, never the best run: a partial path "
+        "compared with the whole target at l/L says nothing about following it"
+    ),
+    option="--timeout-runs 2015",
+)
+RULE_STOPPED_RUNS = Rule(
+    key="fbm3w.stopped-runs",
+    benchmark="fbm3w",
+    title="stopped runs' time",
+    rulebook="the RefBox ends a benchmark with END and payload halt/stop (seed 6.2.3)",
+    node_2015=(
+        f"{_NODE}: `if not benchmark.Running(): continue` comes before the time is added: a "
+        "stopped run was aborted, no score and no time"
+    ),
+    ertools="no score, its time counted in execution_time (the robot did spend it)",
+    option="--stopped-runs 2015",
+)
+RULE_LIVE_CLOCK = Rule(
+    key="fbm3w.live-clock",
+    benchmark="fbm3w",
+    title="reference pose and run times",
+    rulebook="reference acquired when the manual operation completes; execution time of each "
+    "run (seed 7.3.3, Listing 16)",
+    node_2015=f"{_NODE}: the live tf and the node's own wall clock at the transitions",
+    ertools=(
+        "the last logged pose at or before COMPLETED_MANUAL_OPERATION and the state messages' "
+        "record times; no option: the live tf and wall clock are not in the log"
+    ),
+    option="",
+)
+RULE_RUN_FINDING = Rule(
+    key="fbm3w.run-finding",
+    benchmark="fbm3w",
+    title="finding the runs",
+    rulebook="the BmBox state machine delimits each run (seed 7.3.3)",
+    node_2015=f"{_NODE}: its state machine only",
+    ertools=(
+        "the BmBox states when logged; also explicit windows (--run) or motion (--runs auto) "
+        "for bags without them"
+    ),
+    option="--runs states",
+)
+RULE_POSE_TOPIC = Rule(
+    key="fbm3w.pose-topic",
+    benchmark="fbm3w",
+    title="pose source",
+    rulebook="the end effector's marker set from the mocap (seed 7.3.3)",
+    node_2015=f"{_NODE}: subscribed to {DEFAULT_TOPIC}",
+    ertools=f"{DEFAULT_TOPIC}, else {FALLBACK_TOPIC}, else the tf frame {DEFAULT_FRAME}",
+    option=f"--topic {DEFAULT_TOPIC}",
+)
+RULE_D_MIN = Rule(
+    key="fbm3w.d-min",
+    benchmark="fbm3w",
+    title="subsampling threshold d_min",
+    rulebook="d_min = c * epsilon, c chosen experimentally (seed 7.3.2, 7.3.5)",
+    node_2015=f"{_NODE}: `D_MIN` hard-coded (0.00033 m in the seed)",
+    ertools="the config's d_min (default 0.00033 m), warned when below the bag's own noise",
+    option="--d-min 0.00033",
+)
+RULE_USER_SHAPES = Rule(
+    key="fbm3w.user-shapes",
+    benchmark="fbm3w",
+    title="target shapes",
+    rulebook="mathematically defined curves hard-coded in the script (seed 7.3.7, Listing 15)",
+    node_2015=f"{_NODE}: line_path, semi_ellipse, sine (= spline_path) only",
+    ertools="the built-in shapes plus user shapes from the config; no option: a user shape is "
+    "the user's choice, said in the output",
+    option="",
+)
+RULE_ARC_LENGTH = Rule(
+    key="fbm3w.arc-length",
+    benchmark="fbm3w",
+    title="target parameter",
+    rulebook="t(l) with l the normalised length (seed 7.3.1)",
+    node_2015=f"{_NODE}: each shape evaluated at its own parameter (the sine's is not its "
+    "length: 8.36 mm for a robot exactly on it)",
+    ertools="the same by default (shape_floor reported); --arc-length compares at equal "
+    "fractions of the target's arc length instead, on request only",
+    option="",
+)
+
+Window = tuple[str, float, float, float]
+F64 = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Fbm3wOptions:
+    """How to score (the CLI's options, as data).
+
+    Attributes:
+        runs: ``states``, ``windows``, ``auto``, or None (windows when given, else states when
+            the BmBox topic exists, else auto).
+        windows: explicit runs (spec, reference, start, end) in seconds (bag-relative or epoch).
+        d_min: overrides the config's d_min.
+        sweep: d_min values to score every run with (``--d-min-sweep``).
+        topic, frame: the pose source (default: the pose2d topic, then pose, then tf frame).
+        time_source: ``record`` (default: the 2015 node received poses live) or ``header``.
+        still_speed, min_still_s: stationary detection (auto runs and the noise estimate).
+        noise_c: factor of the suggested d_min (c * epsilon).
+        arc_length: compare at equal fractions of the target's arc length instead of the
+            shape's own parameter (2015); removes the floor of shapes such as ``sine``.
+        timeout_runs: ``unscored`` (default: a run the RefBox timed out is listed without a
+            distance_error) or ``2015`` (scored on the path it covered and eligible as best
+            run, as the 2015 node did).
+        stopped_runs: ``counted`` (default: a run the RefBox stopped counts in
+            execution_time) or ``2015`` (its time left out, as the 2015 node did).
+    """
+
+    runs: str | None = None
+    windows: tuple[Window, ...] = ()
+    d_min: float | None = None
+    sweep: tuple[float, ...] = ()
+    topic: str | None = None
+    frame: str | None = None
+    time_source: str = "record"
+    still_speed: float | None = None
+    min_still_s: float | None = None
+    noise_c: float = DEFAULT_C
+    arc_length: bool = False
+    timeout_runs: str = "unscored"
+    stopped_runs: str = "counted"
+
+
+TIMEOUT_RUNS = ("unscored", "2015")
+STOPPED_RUNS = ("counted", "2015")
+
+
+def options_2015(options: Fbm3wOptions) -> Fbm3wOptions:
+    """``options`` with every FBM3W 2015 behaviour on (``--2015``).
+
+    Timed-out runs scored and eligible, stopped runs' time left out, the shapes at their own
+    parameter, and the script's hard-coded D_MIN unless ``--d-min`` says otherwise.
+
+    Raises:
+        ConfigError: ``--arc-length`` asked for as well (it is not 2015).
+    """
+    if options.arc_length:
+        raise ConfigError("--2015 and --arc-length contradict each other (2015 had no arc length)")
+    return replace(
+        options,
+        timeout_runs="2015",
+        stopped_runs="2015",
+        d_min=DEFAULT_D_MIN if options.d_min is None else options.d_min,
+    )
+
+
+def read_fbm3w_poses(paths: Sequence[Path], options: Fbm3wOptions) -> PoseStream:
+    """The end-effector poses: ``--topic``/``--frame``, else pose2d, pose, tf ``robot_at_work``.
+
+    Raises:
+        TopicError: none of them is in the bags (the message lists the pose topics there are).
+    """
+    from ertools.io import PoseSource, read_pose_source, topics
+
+    if options.topic is not None:
+        source = PoseSource(topic=options.topic, time_source=options.time_source)
+    elif options.frame is not None:
+        source = PoseSource(frame=options.frame)
+    else:
+        present = topics(paths)
+        if DEFAULT_TOPIC in present:
+            source = PoseSource(topic=DEFAULT_TOPIC, time_source=options.time_source)
+        elif FALLBACK_TOPIC in present:
+            log.warning("%s absent; using %s", DEFAULT_TOPIC, FALLBACK_TOPIC)
+            source = PoseSource(topic=FALLBACK_TOPIC, time_source=options.time_source)
+        elif "/tf" in present:
+            log.warning("%s absent; using the /tf frame %s", DEFAULT_TOPIC, DEFAULT_FRAME)
+            source = PoseSource(frame=DEFAULT_FRAME)
+        else:
+            from ertools.io.model import POSE_TYPES
+
+            found = [t for t, ty in present.items() if ty in POSE_TYPES]
+            raise TopicError(
+                f"no end-effector poses: {DEFAULT_TOPIC}, {FALLBACK_TOPIC} and /tf are absent "
+                f"(pose topics there: {', '.join(found) or 'none'}); choose one with --topic",
+                path=paths[0],
+            )
+    poses = read_pose_source(paths, source)
+    if len(poses) == 0:
+        raise TopicError(f"{poses.source or source.topic}: no pose messages", path=paths[0])
+    return poses
+
+
+def score_fbm3w(
+    paths: Sequence[Path], config: Fbm3wConfig, options: Fbm3wOptions = Fbm3wOptions()
+) -> Fbm3wResult:
+    """Score an FBM3@Work benchmark from its bag(s).
+
+    Raises:
+        ErtoolsError: unreadable bags, no poses, no runs (a single run's problem is a failure
+            inside the result instead).
+    """
+    from ertools.io import read_benchmark_states, summary, topics
+
+    plist = [Path(p) for p in paths]
+    if options.runs is not None and options.runs not in RUN_MODES:
+        raise ConfigError(f"--runs must be one of {', '.join(RUN_MODES)}, not {options.runs!r}")
+    if options.timeout_runs not in TIMEOUT_RUNS or options.stopped_runs not in STOPPED_RUNS:
+        raise ConfigError(
+            f"--timeout-runs must be one of {', '.join(TIMEOUT_RUNS)} and --stopped-runs one "
+            f"of {', '.join(STOPPED_RUNS)}"
+        )
+    poses = read_fbm3w_poses(plist, options)
+    summaries = [summary(p) for p in plist]
+    bag_start = min(x.start_ns for x in summaries)
+    bag_end = max(x.end_ns for x in summaries)
+    mode = options.runs
+    if mode is None:
+        if options.windows:
+            mode = "windows"
+        else:
+            bmbox_topics = {f"/{NAMESPACE}/bmbox_state", f"/{NAMESPACE}/bbbox_state"}
+            mode = "states" if bmbox_topics & set(topics(plist)) else "auto"
+            if mode == "auto":
+                log.info("no /fbm3w state topics: finding the runs from motion (--runs auto)")
+    if mode == "windows":
+        if not options.windows:
+            raise ConfigError("--runs windows needs --run SPEC:REF_T:START_T:END_T or --runs-file")
+        windows = find_windows(options.windows, bag_start, bag_end)
+    elif mode == "states":
+        windows = find_states(read_benchmark_states(plist, NAMESPACE))
+    else:
+        windows = find_auto(poses, config, **_still(options))
+    if mode != "auto" and options.time_source == "header":
+        # State messages and --run windows are timed by record time: header-stamped poses
+        # from a mocap clock seconds off would be cut at other moments (a wrong score that
+        # looks right). Runs found from motion are in the poses' own time: nothing to check.
+        from ertools.benchmarks.common.clocks import check_header_clock
+
+        what = "state messages" if mode == "states" else "run windows (times from the log start)"
+        check_header_clock(plist, poses, what)
+    return score_runs(
+        poses,
+        windows,
+        config,
+        options=options,
+        bag_start_ns=bag_start,
+        inputs=tuple(str(p) for p in plist),
+        progress=current(),
+    )
+
+
+def _still(options: Fbm3wOptions) -> dict[str, float]:
+    out = {}
+    if options.still_speed is not None:
+        out["still_speed"] = options.still_speed
+    if options.min_still_s is not None:
+        out["min_still_s"] = options.min_still_s
+    return out
+
+
+def score_runs(
+    poses: PoseStream,
+    windows: Sequence[RunWindow],
+    config: Fbm3wConfig,
+    *,
+    options: Fbm3wOptions = Fbm3wOptions(),
+    bag_start_ns: int | None = None,
+    inputs: tuple[str, ...] = (),
+    progress: Reporter | None = None,
+) -> Fbm3wResult:
+    """Score every run of ``windows`` on ``poses`` (pure; no file access), each run
+    reported to ``progress`` when scored."""
+    cfg = config if options.d_min is None else config.with_d_min(options.d_min)
+    start_ns = poses.start_ns if bag_start_ns is None else bag_start_ns
+    runs_in, warnings = with_specs(list(windows), cfg)
+    specs = cfg.runs_specifications
+    if runs_in and runs_in[0].mode == "auto" and len(runs_in) < len(specs):
+        last = runs_in[-1]
+        after = "" if last.end_ns is None else f" after {(last.end_ns - start_ns) / 1e9:.2f} s"
+        warnings.append(
+            f"--runs auto found {len(runs_in)} of the {len(specs)} runs the config lists: no "
+            f"move{after} (the end of run {last.index}'s path) matches run {len(runs_in)}'s "
+            f"shape {specs[len(runs_in)]!r} between still phases; the log ends there or the "
+            "rest need --runs windows"
+        )
+    noise = _noise(poses, options, warnings)
+    same = identical_poses(poses)
+    frames = frame_change_warning(poses, start_ns)
+    if frames:
+        warnings.append(frames)
+    results: list[RunResult] = []
+    failures: list[str] = []
+    if progress is not None:
+        progress.task("scoring runs", len(runs_in), "runs")
+    for window in runs_in:
+        run = _score_one(poses, same, window, cfg, options, start_ns, warnings)
+        if progress is not None:
+            progress.advance(1)
+        results.append(run)
+        if run.error is not None:
+            failures.append(f"run {window.index} ({run.spec}): {run.error}")
+    if noise is not None and noise.distances.size and cfg.d_min < noise.suggested_d_min:
+        frac = float(np.mean(noise.distances >= cfg.d_min)) if noise.distances.size else 0.0
+        warnings.append(
+            f"d_min {cfg.d_min * 1000:.3g} mm is below the mocap noise measured in this bag "
+            f"(epsilon {noise.epsilon * 1000:.3g} mm over {noise.duration_s:.1f} s of "
+            f"stationary phases; {frac:.1%} of still steps exceed d_min, inflating L): "
+            f"suggested d_min {noise.suggested_d_min:.5f} m ({noise.c:g} * epsilon); see "
+            "--d-min-sweep"
+        )
+    warnings.extend(_frozen_warnings(poses, runs_in, start_ns))
+    mode = runs_in[0].mode if runs_in else (options.runs or "states")
+    return Fbm3wResult(
+        runs=tuple(results),
+        d_min=cfg.d_min,
+        noise=noise,
+        sweep_values=tuple(options.sweep),
+        warnings=tuple(warnings),
+        deviations=tuple(_deviations(cfg, results, mode, poses, options)),
+        failures=tuple(failures),
+        provenance=Provenance(
+            inputs=inputs or (poses.source,),
+            parameters=(
+                ("config", cfg.source),
+                ("d_min", repr(cfg.d_min)),
+                ("runs", mode),
+                ("poses", poses.source),
+                ("timeout_runs", options.timeout_runs),
+                ("stopped_runs", options.stopped_runs),
+            ),
+        ),
+        count_stopped=options.stopped_runs != "2015",
+    )
+
+
+def _frozen_warnings(poses: PoseStream, runs: Sequence[RunWindow], origin_ns: int) -> list[str]:
+    """A warning per run whose reference, start or end pose is a frozen (repeated) pose.
+
+    The reference and starting positions set the run frame: a pose repeated for longer than
+    :data:`~ertools.benchmarks.noise.benchmark.FROZEN_MIN_S` there is the last pose before a
+    tracking loss, not where the marker set was.
+    """
+    moments: list[tuple[int, str, int]] = []
+    for w in runs:
+        for what, t in (("reference", w.ref_ns), ("start", w.start_ns), ("end", w.end_ns)):
+            if t is not None:
+                moments.append((w.index, what, t))
+    if not moments:
+        return []
+    spans = frozen_around(poses, [m[2] for m in moments])
+    out = []
+    for (index, what, t), span in zip(moments, spans, strict=True):
+        if span is None:
+            continue
+        out.append(
+            f"run {index}: the pose at its {what} time {(t - origin_ns) / 1e9:.3f} s is frozen: "
+            f"{span.samples} identical poses over {span.duration_s:.3f} s "
+            f"({(span.start_ns - origin_ns) / 1e9:.3f}-{(span.end_ns - origin_ns) / 1e9:.3f} s "
+            "from the log's first message; tracking lost, or a noiseless recording)"
+        )
+    return out
+
+
+def _noise(poses: PoseStream, options: Fbm3wOptions, warnings: list[str]) -> NoiseResult | None:
+    try:
+        return noise_from_stream(
+            poses,
+            stationary=True,
+            c=options.noise_c,
+            still_speed=options.still_speed,
+            min_still_s=options.min_still_s,
+        )
+    except ScoringError:
+        warnings.append(
+            "no stationary phase in the poses: the mocap noise (and whether d_min is above it) "
+            "could not be estimated"
+        )
+        return None
+
+
+def _score_one(
+    poses: PoseStream,
+    same: npt.NDArray[np.bool_],
+    window: RunWindow,
+    cfg: Fbm3wConfig,
+    options: Fbm3wOptions,
+    bag_start_ns: int,
+    warnings: list[str],
+) -> RunResult:
+    spec = window.spec or ""
+
+    def result(error: str | None, **kw: Any) -> RunResult:
+        base: dict[str, Any] = {
+            "window": window,
+            "spec": spec or "?",
+            "score": None,
+            "error": error,
+            "samples": 0,
+            "tracking_losses": 0,
+            "reference_xy": None,
+            "target_length": None,
+            "d_min": cfg.d_min,
+            "bag_start_ns": bag_start_ns,
+        }
+        base.update(kw)
+        return RunResult(**base)
+
+    if not spec:
+        return result("no spec for this run (the config lists fewer runs); add it to the config")
+    try:
+        shape = cfg.shape(spec)
+    except ConfigError as err:
+        return result(err.message)
+    if options.arc_length:
+        shape = shape.by_arc_length()
+    target_length = shape.length()
+    partial = window.status == "timeout" and options.timeout_runs == "2015"
+    if window.status in ("interrupted", "timeout", "stopped") and not partial:
+        return result(None, target_length=target_length)  # reported, not scored
+    if window.status == "incomplete":
+        return result("the log ends during the run; no complete path to score")
+    if window.start_ns is None or window.end_ns is None or window.ref_ns is None:
+        return result("no reference time or path window was found for this run")
+    lo = int(np.searchsorted(poses.t_ns, window.start_ns, side="left"))
+    hi = int(np.searchsorted(poses.t_ns, window.end_ns, side="right"))
+    xy = poses.xyz[lo:hi, :2]
+    losses = int(np.sum(same[lo : max(lo, hi - 1)])) if hi - lo > 1 else 0
+    common: dict[str, Any] = {
+        "samples": hi - lo,
+        "tracking_losses": losses,
+        "target_length": target_length,
+    }
+    rel = (window.start_ns - bag_start_ns) / 1e9, (window.end_ns - bag_start_ns) / 1e9
+    if hi - lo < 2:
+        return result(
+            f"{hi - lo} pose sample(s) in the path window {rel[0]:.3f}-{rel[1]:.3f} s; "
+            "at least 2 are needed (tracking lost, or wrong window?)",
+            **common,
+        )
+    ref_i = int(np.searchsorted(poses.t_ns, window.ref_ns, side="right")) - 1
+    ref_rel = (window.ref_ns - bag_start_ns) / 1e9
+    if ref_i < 0:
+        return result(f"no pose at or before the reference time {ref_rel:.3f} s", **common)
+    age = (window.ref_ns - int(poses.t_ns[ref_i])) / 1e9
+    if age > STALE_REFERENCE_S:
+        warnings.append(
+            f"run {window.index}: the reference pose is {age:.2f} s older than the reference "
+            f"time {ref_rel:.3f} s (tracking lost then?)"
+        )
+    ref_xy = poses.xyz[ref_i, :2].copy()
+    common["reference_xy"] = (float(ref_xy[0]), float(ref_xy[1]))
+    try:
+        score = score_path(xy, ref_xy, shape, cfg.d_min)
+    except ScoringError as err:
+        return result(err.message, **common)
+    baseline = float(np.hypot(*(xy[0] - ref_xy)))
+    if baseline < SHORT_BASELINE_M:
+        warnings.append(
+            f"run {window.index}: the reference and starting positions are only "
+            f"{baseline * 1000:.1f} mm apart; the run frame's direction is uncertain"
+        )
+    if partial:
+        warnings.append(
+            f"run {window.index} was ended by a RefBox timeout: scored on the "
+            f"{score.path_length:.4f} m of path it covered (target {target_length:.4f} m), "
+            "normalised by its own length, and eligible as best run (--timeout-runs 2015)"
+        )
+    ratio = score.path_length / target_length
+    if ratio > LONG_PATH_RATIO:
+        warnings.append(
+            f"run {window.index}: the kept path is {ratio - 1:.0%} longer than the target "
+            f"({score.path_length:.4f} vs {target_length:.4f} m): jitter passing d_min or a "
+            "detour inflates L and shifts l/L; see --d-min-sweep"
+        )
+    swept = tuple((d, _try_score(xy, ref_xy, shape, d)) for d in options.sweep)
+    floor = shape_floor(shape, cfg.d_min)
+    if floor > FLOOR_WARN_M and not any(spec in w and "floor" in w for w in warnings):
+        warnings.append(
+            f"shape {spec!r} is not parametrised by arc length: a robot exactly on it scores "
+            f"{floor * 1000:.2f} mm with the 2015 formula (shape_floor); --arc-length compares "
+            "at equal fractions of the target's length instead"
+        )
+    return result(
+        None,
+        score=score,
+        sweep=swept,
+        frame_xy=score.frame.to_frame(xy),
+        sample_t_ns=poses.t_ns[lo:hi],
+        shape_floor=floor,
+        target_dense=shape.dense(501),
+        **common,
+    )
+
+
+def shape_floor(shape: Shape, d_min: float) -> float:
+    """distance_error of a noiseless robot exactly on ``shape`` (1e4 samples), metres.
+
+    0 up to the d_min quantisation for shapes parametrised by arc length; 8.4 mm for the 2015
+    ``sine``, whose parameter is proportional to x, not to the length travelled.
+    """
+    pts = shape(np.linspace(0.0, 1.0, FLOOR_SAMPLES))
+    reference = np.array([-0.05, 0.0])  # run frame = world frame
+    try:
+        return score_path(pts, reference, shape, d_min).distance_error
+    except ErtoolsError:
+        return math.nan
+
+
+def _try_score(xy: F64, ref_xy: F64, shape: Shape, d_min: float) -> float | None:
+    try:
+        return score_path(xy, ref_xy, shape, d_min).distance_error
+    except ErtoolsError:
+        return None
+
+
+def _deviations(
+    cfg: Fbm3wConfig,
+    runs: Sequence[RunResult],
+    mode: str,
+    poses: PoseStream,
+    options: Fbm3wOptions,
+) -> list[Deviation]:
+    out = []
+    if mode == "states":
+        out.append(
+            RULE_LIVE_CLOCK.deviation(
+                "reference = last logged pose at or before COMPLETED_MANUAL_OPERATION and "
+                "execution_time from the BmBox state messages' record times; 2015 read the live "
+                "tf and its own wall clock at the same transitions"
+            )
+        )
+    elif mode == "windows":
+        out.append(
+            RULE_RUN_FINDING.deviation(
+                "runs from explicit windows; the 2015 node only had its state machine"
+            )
+        )
+    else:
+        out.append(
+            RULE_RUN_FINDING.deviation(
+                "runs found from motion (--runs auto); the 2015 node only had its state machine"
+            )
+        )
+    if not poses.source.endswith(DEFAULT_TOPIC):
+        out.append(
+            RULE_POSE_TOPIC.deviation(
+                f"poses from {poses.source.rsplit(':', 1)[-1]}; 2015 used {DEFAULT_TOPIC}"
+            )
+        )
+    if not math.isclose(cfg.d_min, DEFAULT_D_MIN, rel_tol=0, abs_tol=1e-12):
+        out.append(
+            RULE_D_MIN.deviation(f"d_min = {cfg.d_min} m; the 2015 script used {DEFAULT_D_MIN} m")
+        )
+    custom = sorted(
+        {r.spec for r in runs if r.spec in cfg.shapes and not cfg.shapes[r.spec].builtin}
+    )
+    if custom:
+        out.append(
+            RULE_USER_SHAPES.deviation(
+                f"user-defined shape(s) {', '.join(custom)}; 2015 had only its built-in shapes"
+            )
+        )
+    if options.arc_length:
+        out.append(
+            RULE_ARC_LENGTH.deviation(
+                "targets compared at equal fractions of their arc length (--arc-length); 2015 "
+                "evaluated each shape at its own parameter"
+            )
+        )
+    timed_out = [str(r.index) for r in runs if r.window.status == "timeout"]
+    if options.timeout_runs != "2015" and timed_out:
+        out.append(
+            RULE_TIMEOUT_RUNS.deviation(
+                f"a run the RefBox timed out (run {', '.join(timed_out)}) is listed with its "
+                "time and no distance_error and cannot be the best run; the 2015 node scored it "
+                "on the path it had covered and it could be the best run"
+            )
+        )
+    stopped = [str(r.index) for r in runs if r.window.status == "stopped"]
+    if options.stopped_runs != "2015" and stopped:
+        out.append(
+            RULE_STOPPED_RUNS.deviation(
+                f"a run the RefBox stopped (run {', '.join(stopped)}) counts in execution_time; "
+                "the 2015 node treated it as aborted and left its time out"
+            )
+        )
+    return out

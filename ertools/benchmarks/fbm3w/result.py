@@ -1,0 +1,248 @@
+"""The FBM3@Work result: per-run details and the score in the layout of seed Listing 16."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.fbm3w.path import PathScore
+from ertools.benchmarks.fbm3w.runs import RunWindow
+from ertools.benchmarks.noise.benchmark import NoiseResult
+from ertools.fidelity import Deviation
+from ertools.streams import Provenance
+from ertools.timeutil import ns_to_s
+
+# Listing 16 keys of one run, in the listing's order; ertools' extra keys follow them.
+RUN_KEYS = ("spec", "distance_error", "execution_time")
+
+
+@dataclass(frozen=True, eq=False)
+class RunResult:
+    """One run: where it was found, and its score or why it has none.
+
+    Attributes:
+        window: the run as found (times, status, mode).
+        spec: the shape name scored against.
+        score: Eq. (1) details, None when not scored.
+        error: why the run could not be scored (a failure), None otherwise.
+        samples: pose samples in the path window.
+        tracking_losses: consecutive identical poses in the window (Motive repeats).
+        reference_xy: the reference position (world), None when unknown.
+        target_length: arc length of the target shape, metres.
+        d_min: the threshold used.
+        sweep: (d_min, distance_error or None) for ``--d-min-sweep``.
+        bag_start_ns: the bag's first message, for relative times.
+        frame_xy: (N, 2) every sample of the window in the run frame (plots).
+        shape_floor: distance_error of a noiseless robot exactly on the target.
+        target_dense: (M, 2) the target curve, densely sampled (plots).
+        sample_t_ns: (N,) times of the samples of ``frame_xy`` (the Foxglove export).
+    """
+
+    window: RunWindow
+    spec: str
+    score: PathScore | None
+    error: str | None
+    samples: int
+    tracking_losses: int
+    reference_xy: tuple[float, float] | None
+    target_length: float | None
+    d_min: float
+    sweep: tuple[tuple[float, float | None], ...] = ()
+    bag_start_ns: int = 0
+    frame_xy: Any = None
+    shape_floor: float | None = None
+    target_dense: Any = None
+    sample_t_ns: Any = None
+
+    @property
+    def index(self) -> int:
+        return self.window.index
+
+    @property
+    def status(self) -> str:
+        if self.error is not None:
+            return "failed"
+        if self.score is not None:
+            # --timeout-runs 2015 scores a timed-out run on its partial path: say so.
+            return "timeout_scored" if self.window.status == "timeout" else "scored"
+        return self.window.status
+
+    @property
+    def distance_error(self) -> float | None:
+        return None if self.score is None else self.score.distance_error
+
+    @property
+    def execution_time(self) -> float | None:
+        return self.window.execution_time_s
+
+    def _rel(self, t_ns: int | None) -> float | None:
+        return None if t_ns is None else round((t_ns - self.bag_start_ns) / 1e9, 6)
+
+    def details(self) -> dict[str, Any]:
+        """Listing 16 keys, then ertools' extras."""
+        out: dict[str, Any] = {
+            "spec": self.spec,
+            "distance_error": self.distance_error,
+            "execution_time": self.execution_time,
+            "status": self.status,
+        }
+        if self.error is not None:
+            out["error"] = self.error
+        out["d_min"] = self.d_min
+        out["samples"] = self.samples
+        if self.score is not None:
+            out["kept_samples"] = len(self.score.kept)
+            out["path_length"] = self.score.path_length
+            out["raw_path_length"] = self.score.raw_length
+        if self.target_length is not None:
+            out["target_length"] = self.target_length
+        if self.shape_floor is not None:
+            out["shape_floor"] = self.shape_floor
+        out["tracking_losses"] = self.tracking_losses
+        out["run_finding"] = self.window.mode
+        out["reference_time"] = self._rel(self.window.ref_ns)
+        out["start_time"] = self._rel(self.window.start_ns)
+        out["end_time"] = self._rel(self.window.end_ns)
+        if self.reference_xy is not None:
+            out["reference_position"] = [self.reference_xy[0], self.reference_xy[1]]
+        if self.score is not None:
+            o = self.score.frame.origin
+            out["starting_position"] = [o[0], o[1]]
+            out["frame_yaw"] = self.score.frame.yaw
+        return out
+
+
+@dataclass(frozen=True, eq=False)
+class Fbm3wResult:
+    """Implements :class:`ertools.benchmarks.base.BenchmarkResult` for FBM3@Work."""
+
+    runs: tuple[RunResult, ...]
+    d_min: float
+    noise: NoiseResult | None = None
+    sweep_values: tuple[float, ...] = ()
+    name: str = "fbm3w"
+    warnings: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
+    failures: tuple[str, ...] = ()
+    provenance: Provenance = field(default_factory=Provenance)
+    count_stopped: bool = True
+
+    @property
+    def nothing_scored(self) -> bool:
+        """Every run failed (none scored, timed out, stopped or interrupted): the CLI prints
+        only the failures (``ertools.cli.common.all_failed``)."""
+        return all(r.status == "failed" for r in self.runs)
+
+    @property
+    def best_run(self) -> int | None:
+        """The scored run with the smallest distance_error (the first on ties, as 2015)."""
+        best: RunResult | None = None
+        for run in self.runs:
+            err = run.distance_error
+            if err is not None and (best is None or err < (best.distance_error or math.inf)):
+                best = run
+        return None if best is None else best.index
+
+    @property
+    def best_distance_error(self) -> float | None:
+        best = self.best_run
+        run = None if best is None else self._by_index(best)
+        return None if run is None else run.distance_error
+
+    def _by_index(self, index: int) -> RunResult | None:
+        return next((r for r in self.runs if r.index == index), None)
+
+    @property
+    def execution_time(self) -> float:
+        """Sum of the run times, timed-out runs included (as the 2015 node added them).
+
+        Stopped runs are included unless ``count_stopped`` is False (``--stopped-runs 2015``:
+        the 2015 node skipped them before adding the time).
+        """
+        # Summed in int64 ns: a sum of float seconds prints binary noise (24.549999999999997).
+        w = [r.window for r in self.runs if self.count_stopped or r.window.status != "stopped"]
+        return ns_to_s(
+            sum(x.end_ns - x.start_ns for x in w if x.start_ns is not None and x.end_ns is not None)
+        )
+
+    def _score(self) -> dict[str, Any]:
+        return {
+            "best_distance_error": self.best_distance_error,
+            "best_run": self.best_run,
+            "execution_time": self.execution_time,
+            "runs_details": {r.index: r.details() for r in self.runs},
+        }
+
+    def to_dict(self) -> dict[str, Any]:
+        """Listing 16 nesting with string run keys (JSON)."""
+        data: dict[str, Any] = jsonable(self._score())
+        return data
+
+    def to_yaml(self) -> str:
+        """Listing 16: best_distance_error, best_run, execution_time, runs_details {i: ...}."""
+        return dump_yaml(_plain(self._score()))
+
+    def tables(self) -> dict[str, Rows]:
+        runs: Rows = []
+        for r in self.runs:
+            row = {"run": r.index, **r.details()}
+            for key in ("reference_position", "starting_position"):
+                if key in row:
+                    row[key] = " ".join(f"{v:.6f}" for v in row[key])
+            runs.append(row)
+        points: Rows = []
+        for r in self.runs:
+            s = r.score
+            if s is None:
+                continue
+            for i in range(len(s.kept)):
+                points.append(
+                    {
+                        "run": r.index,
+                        "i": i,
+                        "sample": int(s.kept[i]),
+                        "x": float(s.kept_frame[i, 0]),
+                        "y": float(s.kept_frame[i, 1]),
+                        "l_norm": float(s.l_norm[i]),
+                        "target_x": float(s.target[i, 0]),
+                        "target_y": float(s.target[i, 1]),
+                        "error": float(s.errors[i]),
+                    }
+                )
+        out: dict[str, Rows] = {"runs": runs, "points": points}
+        if self.sweep_values:
+            out["d_min_sweep"] = [
+                {"d_min": d, **{f"run_{r.index}": e for r, (_, e) in _sweep_cells(self.runs, k)}}
+                for k, d in enumerate(self.sweep_values)
+            ]
+        if self.noise is not None:
+            out["noise"] = self.noise.tables()["summary"]
+        return out
+
+    def sweep_text(self) -> str:
+        """The d_min sweep as a table in millimetres (for the terminal)."""
+        if not self.sweep_values:
+            return ""
+        head = "d_min [mm]  " + "".join(f"run {r.index:<6d}" for r in self.runs)
+        lines = [head]
+        for k, d in enumerate(self.sweep_values):
+            cells = []
+            for _, (_, e) in _sweep_cells(self.runs, k):
+                cells.append(f"{e * 1000:<10.3f}" if e is not None else f"{'-':<10}")
+            lines.append(f"{d * 1000:<10.4f}  " + "".join(cells))
+        return "\n".join(lines) + "\n(distance_error in mm)\n"
+
+
+def _sweep_cells(
+    runs: tuple[RunResult, ...], k: int
+) -> list[tuple[RunResult, tuple[float, float | None]]]:
+    return [(r, r.sweep[k] if k < len(r.sweep) else (math.nan, None)) for r in runs]
+
+
+def _plain(value: Any) -> Any:
+    """JSON-able values but int keys kept (YAML's ``0:`` as in the 2015 score)."""
+    if isinstance(value, dict):
+        return {k if isinstance(k, int) else str(k): _plain(v) for k, v in value.items()}
+    return jsonable(value)

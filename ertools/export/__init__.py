@@ -1,0 +1,1 @@
+"""Poses out for other tools: TUM, KITTI and CSV writers, and the robot/GT pairs."""

@@ -1,0 +1,208 @@
+"""``ertools export``: any pose source, or the robot/GT pair of the trajectory benchmark, as files
+other tools read (TUM and KITTI for evo, CSV for pandas, spreadsheets and plotting tools).
+
+Two library functions, one per mode of the command:
+
+- :func:`export_source`: one pose source (a pose topic or a tf frame, read by
+  :func:`ertools.io.read_pose_source`) to one file.
+- :func:`trajectory_pair` + :func:`write_pair`: the two streams ``ertools score trajectory``
+  compares, as ``robot.<fmt>`` and ``gt.<fmt>`` for ``evo_ape``. Raw (default): the robot
+  poses with the applied clock offset added to their stamps and the GT ertools reads around
+  them, for evo to associate itself. ``matched``: only the pairs ertools scored, both files
+  stamped with the same times, the GT pose at each time given by ertools' association, so
+  evo's nearest-time association pairs them one to one and its APE (translation part, no
+  alignment) is ertools' position error.
+
+The formatting is in :mod:`ertools.export.formats` (pure); this module reads and selects.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ertools.errors import ScoringError, TopicError, UsageError
+from ertools.export.formats import SUFFIXES, ExportFormat, format_poses, format_times
+from ertools.streams import PoseStream
+
+if TYPE_CHECKING:
+    from ertools.benchmarks.trajectory.benchmark import TrajectoryConfig, TrajectoryResult
+    from ertools.io import PoseSource
+
+# GT read around the robot poses for the raw pair: evo's association only looks a few
+# max_diff (0.01 s by default) beyond the robot's span; a second covers any sensible setting.
+RAW_GT_MARGIN_NS = 1_000_000_000
+
+KITTI_NEEDS_MATCHED = (
+    "KITTI files have no time stamps: evo pairs robot and GT row by row, which only the "
+    "scored pairs allow; add --matched, or export as TUM"
+)
+
+
+def read_source(paths: Sequence[str | Path], source: PoseSource) -> PoseStream:
+    """The poses of one source, refusing an empty one (an empty file is a mistake, not data)."""
+    from ertools.io import read_pose_source
+
+    stream = read_pose_source([str(p) for p in paths], source)
+    if len(stream) == 0:
+        what = source.topic if source.topic else f"/tf {source.parent} -> {source.frame}"
+        raise TopicError(f"{what} has no poses in {', '.join(map(str, paths))}")
+    return stream
+
+
+def export_source(
+    paths: Sequence[str | Path],
+    source: PoseSource,
+    fmt: ExportFormat,
+) -> tuple[PoseStream, str]:
+    """Read one pose source and format it: (the stream, the text)."""
+    stream = read_source(paths, source)
+    return stream, format_poses(stream, fmt)
+
+
+@dataclass(frozen=True, eq=False)
+class PairExport:
+    """The robot and GT streams of a trajectory comparison, ready to write.
+
+    Attributes:
+        robot: the robot poses, stamps on the GT clock (the applied offset added).
+        gt: the GT poses (matched: one per robot pose, at the same stamps).
+        matched: True when ``robot`` and ``gt`` are the scored pairs.
+        result: what ``ertools score trajectory`` computed with the same settings.
+    """
+
+    robot: PoseStream
+    gt: PoseStream
+    matched: bool
+    result: TrajectoryResult
+
+
+def trajectory_pair(
+    robot_bag: str | Path,
+    gt_paths: Sequence[str | Path],
+    config: TrajectoryConfig,
+    *,
+    robot_topic: str | None = None,
+    gt_topic: str | None = None,
+    robot_time: str = "header",
+    matched: bool = False,
+) -> PairExport:
+    """The robot and GT streams ``score trajectory`` compares with these settings.
+
+    The scoring itself runs (:func:`ertools.benchmarks.trajectory.score`), so the files,
+    topics, offset and association are exactly the ones of the score; the GT is then read
+    again (the result keeps only a decimated copy) around the robot poses and cleaned the
+    same way (samples recorded twice, NaN or zero quaternions dropped).
+
+    Raises:
+        ScoringError: ``matched`` and no pose could be compared; the errors of ``score``.
+    """
+    from ertools.benchmarks.trajectory.benchmark import (
+        COMPARED,
+        drop_duplicates,
+        drop_invalid,
+        read_gt,
+        score,
+    )
+
+    result = score(
+        robot_bag,
+        gt_paths,
+        config,
+        robot_topic=robot_topic,
+        gt_topic=gt_topic,
+        robot_time=robot_time,
+    )
+    m = result.matched
+    robot = result.robot
+    shifted = PoseStream(
+        m.t_ns,  # the robot stamps plus the applied offset: the times ertools compared at
+        robot.xyz,
+        robot.quat_xyzw,
+        robot.frame_id,
+        robot.child_frame_id,
+        f"{result.robot_file}:{result.robot_topic}",
+    )
+    if matched:
+        ok = m.status == COMPARED
+        if not ok.any():
+            raise ScoringError(
+                f"{result.robot_file}: no robot pose could be compared, so there are no pairs "
+                f"to export ({'; '.join(result.failures)})"
+            )
+        shifted = shifted.take(ok)
+        # Every compared pose has GT samples around it within max_gap: this window holds them.
+        margin = config.max_gap_ns + RAW_GT_MARGIN_NS
+        lo, hi = shifted.start_ns - margin, shifted.end_ns + margin
+    else:
+        lo, hi = int(m.t_ns.min()) - RAW_GT_MARGIN_NS, int(m.t_ns.max()) + RAW_GT_MARGIN_NS
+    gt = read_gt(list(result.gt_files), result.gt_topic, lo, hi)
+    gt, _ = drop_duplicates(gt)
+    gt, _ = drop_invalid(gt)
+    if matched:
+        gt = _gt_at(gt, shifted.t_ns, config, m.gt_xyz[m.status == COMPARED])
+    return PairExport(robot=shifted, gt=gt, matched=matched, result=result)
+
+
+def _gt_at(
+    gt: PoseStream, t_ns: np.ndarray, config: TrajectoryConfig, scored_xyz: np.ndarray
+) -> PoseStream:
+    """GT poses at the robot times by the benchmark's association (the same function it uses).
+
+    The positions are checked against the ones the score used: the pairs written must be the
+    pairs scored, and a difference would mean the second read saw other GT than the first.
+    """
+    from ertools.geometry import interpolate_poses
+
+    at = interpolate_poses(gt, t_ns, config.association)
+    if not np.array_equal(at.xyz, scored_xyz):
+        raise RuntimeError("the re-read GT differs from the GT the score used")
+    return PoseStream(t_ns, at.xyz, at.quat_xyzw, gt.frame_id, gt.child_frame_id, gt.source)
+
+
+def pair_paths(out_dir: str | Path, fmt: ExportFormat) -> dict[str, Path]:
+    """The files :func:`write_pair` writes: ``robot`` and ``gt`` (and their KITTI times)."""
+    d = Path(out_dir)
+    paths = {"robot": d / f"robot{SUFFIXES[fmt]}", "gt": d / f"gt{SUFFIXES[fmt]}"}
+    if fmt == "kitti":
+        paths["robot_times"] = d / "robot_times.txt"
+        paths["gt_times"] = d / "gt_times.txt"
+    return paths
+
+
+def write_pair(pair: PairExport, out_dir: str | Path, fmt: ExportFormat) -> list[Path]:
+    """Write ``robot.<fmt>`` and ``gt.<fmt>`` into ``out_dir``; KITTI also gets the times.
+
+    Raises:
+        UsageError: KITTI without ``matched``: KITTI has no time stamps, readers pair the two
+            files row by row, which only the matched pairs allow.
+    """
+    if fmt == "kitti" and not pair.matched:
+        raise UsageError(KITTI_NEEDS_MATCHED)
+    paths = pair_paths(out_dir, fmt)
+    texts = {"robot": format_poses(pair.robot, fmt), "gt": format_poses(pair.gt, fmt)}
+    if fmt == "kitti":
+        # Both counted from the first robot pose: the same time has the same number.
+        t0 = pair.robot.start_ns
+        texts["robot_times"] = format_times(pair.robot, t0)
+        texts["gt_times"] = format_times(pair.gt, t0)
+    Path(out_dir).mkdir(parents=True, exist_ok=True)
+    for key, text in texts.items():
+        paths[key].write_text(text, encoding="utf-8", newline="\n")
+    return [paths[k] for k in texts]
+
+
+def refuse_inputs(outputs: Sequence[Path], inputs: Sequence[Path]) -> None:
+    """A UsageError when an output file is one of the inputs (ertools never overwrites them)."""
+    existing = [p for p in inputs if p.exists()]
+    for out in outputs:
+        if not out.exists():
+            continue
+        for p in existing:
+            if os.path.samefile(p, out):
+                raise UsageError(f"{out}: that is an input; ertools never overwrites its inputs")

@@ -1,0 +1,568 @@
+"""MCAP files read through their summary section: chunk indexes and message indexes.
+
+Opening reads the footer and the summary section only (schemas, channels, chunk indexes,
+statistics). Messages of some channels are located from the message-index records that follow
+each chunk, read for every chunk overlapping the window before any chunk data, so the
+reference order (log time, then chunk, then position, as the ``mcap`` library yields them) is
+known up front; then the chunks are decompressed one at a time.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import struct
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, BinaryIO
+
+import numpy as np
+import numpy.typing as npt
+
+from ertools.errors import BagError
+from ertools.io.decode.fast import gather
+from ertools.io.files import BagFile
+from ertools.io.mcap.crc import crc32
+from ertools.io.model import Conn
+from ertools.io.pipeline import Group, pread, read_at, scratch_view
+
+if TYPE_CHECKING:
+    from ertools.progress import Reporter
+
+# Op codes a chunk may hold (schema 0x03, channel 0x04, message 0x05), as a lookup table.
+_RECORD_STARTS = np.zeros(256, dtype=bool)
+_RECORD_STARTS[[3, 4, 5]] = True
+
+log = logging.getLogger("ertools.io.mcap.index")
+
+I64 = npt.NDArray[np.int64]
+U8 = npt.NDArray[np.uint8]
+
+OP_MESSAGE = 0x05
+OP_CHUNK = 0x06
+OP_MESSAGE_INDEX = 0x07
+MESSAGE_FIXED = 2 + 4 + 8 + 8  # channel id, sequence, log time, publish time
+PAIR = np.dtype([("t", "<u8"), ("off", "<u8")])
+
+
+# Summaries parsed, by file identity: opening a file and planning a read need the same one.
+_SUMMARIES: dict[tuple[int, int, int, int], Any] = {}
+
+
+def read_summary(f: BinaryIO, path: Path) -> Any:
+    """The ``mcap`` library's Summary of an open MCAP file, None when it has none.
+
+    Kept per file (device, inode, size, modification time), so a file changed since is read
+    again; the Summary is shared, never modified.
+    """
+    st = os.fstat(f.fileno())
+    key = (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+    if key in _SUMMARIES:
+        return _SUMMARIES[key]
+    summary = _parse_summary(f, path)
+    if len(_SUMMARIES) >= 64:
+        _SUMMARIES.clear()
+    _SUMMARIES[key] = summary
+    return summary
+
+
+def _parse_summary(f: BinaryIO, path: Path) -> Any:
+    from mcap.reader import make_reader
+
+    from ertools.io.files import mcap_errors
+
+    try:
+        f.seek(0)
+        summary = make_reader(f).get_summary()
+    except mcap_errors() as err:
+        raise BagError(f"unreadable MCAP summary ({type(err).__name__}: {err})", path=path) from err
+    if summary is None:
+        return None
+    _check_summary_crc(f, path)
+    stats = summary.statistics
+    if (
+        stats is not None
+        and summary.chunk_indexes
+        and stats.chunk_count != len(summary.chunk_indexes)
+    ):
+        # a chunk index record lost to damage (the mcap library skips a record whose op code
+        # it does not know): reading through the others would silently skip a chunk
+        raise BagError(
+            f"damaged MCAP summary: statistics count {stats.chunk_count} chunks, the chunk "
+            f"indexes {len(summary.chunk_indexes)}",
+            path=path,
+        )
+    return summary
+
+
+def _check_summary_crc(f: BinaryIO, path: Path) -> None:
+    """Refuse a summary section that fails the CRC its footer gives (0: not computed).
+
+    The ``mcap`` library does not check it; a damaged summary (a chunk index's op code,
+    offsets or times, a channel's schema id) would otherwise direct every indexed read. The
+    section is what the library has just read, a small part of the file.
+    """
+    size = _file_size(f)
+    at = size - 8 - (1 + 8 + 8 + 8 + 4)
+    footer = pread(f.fileno(), 1 + 8 + 8 + 8 + 4, at)
+    if len(footer) < 29 or footer[0] != 0x02:
+        return  # no footer here: the library found none either
+    _, _len, start, _offsets, crc = struct.unpack("<BQQQI", footer)
+    if not crc or not 0 < start < at:
+        return
+    # from the first summary record through the footer's summary_offset_start field
+    covered = pread(f.fileno(), at + 1 + 8 + 8 + 8 - start, start)
+    if crc32(covered) != crc:
+        raise BagError("damaged MCAP summary section: it fails its CRC check", path=path)
+
+
+def decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
+    """Uncompressed MCAP chunk records."""
+    try:
+        if compression == "":
+            return data
+        if compression == "zstd":
+            import zstandard
+
+            return bytes(zstandard.ZstdDecompressor().decompress(data, max_output_size=size))
+        if compression == "lz4":
+            import lz4.frame
+
+            return bytes(lz4.frame.decompress(data))
+    except Exception as err:
+        # zstandard and lz4 raise their own error classes on corrupt input.
+        raise BagError(f"corrupt {compression} MCAP chunk {where} ({err})") from err
+    raise BagError(f"unsupported MCAP chunk compression {compression!r} {where}")
+
+
+def _zstd_into(data: bytes, out: memoryview, where: str) -> None:
+    """Decompress one zstd chunk into ``out``, which must be exactly its uncompressed size."""
+    import zstandard
+
+    try:
+        reader = zstandard.ZstdDecompressor().stream_reader(data, read_across_frames=True)
+        got = 0
+        while got < len(out):
+            n = reader.readinto(out[got:])
+            if n == 0:
+                break
+            got += n
+        extra = reader.read(1)
+    except Exception as err:
+        # zstandard raises its own error class on corrupt input
+        raise BagError(f"corrupt zstd MCAP chunk {where} ({err})") from err
+    if got != len(out) or extra:
+        size = f"more than {len(out)}" if extra else f"{got}"
+        raise BagError(f"chunk decompresses to {size} bytes, not {len(out)}, {where}")
+
+
+def _file_size(f: BinaryIO) -> int:
+    import os
+
+    return os.fstat(f.fileno()).st_size
+
+
+def _in_order(*keys: I64) -> bool:
+    """Whether rows are already sorted by ``keys`` (the first the most significant)."""
+    if len(keys[0]) < 2:
+        return True
+    undecided = np.ones(len(keys[0]) - 1, dtype=bool)
+    for k in keys:
+        step = k[1:] - k[:-1]
+        if np.any(undecided & (step < 0)):
+            return False
+        undecided &= step == 0
+        if not undecided.any():
+            return True
+    return True
+
+
+@dataclass(frozen=True, eq=False)
+class McapPlan:
+    """Messages located from the message indexes, in the reference order."""
+
+    t_record: I64
+    offset: I64
+    key: I64  # file << 32 | chunk index
+    file: I64
+    chunks: list[list[Any]]
+
+
+class McapIndex:
+    """Chunk-level access to one or more MCAP files (a rosbag2 directory may hold several)."""
+
+    def __init__(self, files: list[Path]) -> None:
+        self.files = files
+
+    @staticmethod
+    def of(bag: BagFile) -> McapIndex | None:
+        """The index of an MCAP file or a rosbag2-mcap directory, None for other formats."""
+        if bag.format == "mcap":
+            return McapIndex([bag.path])
+        if bag.format == "rosbag2-mcap":
+            return McapIndex(sorted(bag.path.glob("*.mcap")))
+        return None
+
+    def plan(self, conns: Sequence[Conn], lo: int | None, hi: int | None) -> McapPlan:
+        """Locate the messages of ``conns`` in [lo, hi] from the message indexes (no chunk data).
+
+        Raises:
+            BagError: damaged index.
+            LayoutMismatchError: a file's indexes do not answer for every message (no summary,
+                no message indexes, channels only inside chunks...): the caller falls back.
+        """
+        from ertools.io.decode.fast import LayoutMismatchError
+        from ertools.io.mcap.scan import SCAN, mcap_layout
+
+        topics = {c.topic for c in conns}
+        sels: list[tuple[int, int, int, I64, I64]] = []  # file, chunk idx, chunk offset, t, off
+        chunks_per_file: list[list[Any]] = []
+        for fi, path in enumerate(self.files):
+            layout = mcap_layout(path)
+            if layout.index == SCAN:
+                raise LayoutMismatchError(f"MCAP file {path.name}: {layout.why}")
+            summary: Any = layout.summary
+            with path.open("rb") as f:
+                channels = {cid for cid, ch in layout.channels.items() if ch.topic in topics}
+                chunks = summary.chunk_indexes
+                chunks_per_file.append(chunks)
+                file_size = _file_size(f)
+                for ci, chunk in enumerate(chunks):
+                    if lo is not None and chunk.message_end_time < lo:
+                        continue
+                    if hi is not None and chunk.message_start_time > hi:
+                        continue
+                    if not 0 <= chunk.chunk_start_offset < file_size:
+                        raise BagError(
+                            f"chunk index gives a chunk at byte {chunk.chunk_start_offset}, "
+                            "outside the file",
+                            path=path,
+                        )
+                    if any(c not in summary.channels for c in chunk.message_index_offsets):
+                        # a damaged channel id: the messages it stood for would be skipped
+                        raise BagError(
+                            f"chunk index of the chunk at byte {chunk.chunk_start_offset} "
+                            "names a channel the summary section does not declare",
+                            path=path,
+                        )
+                    wanted = [c for c in channels if c in chunk.message_index_offsets]
+                    if not wanted:
+                        if chunk.message_index_length == 0 and chunk.uncompressed_size:
+                            raise LayoutMismatchError("MCAP chunk without message indexes")
+                        continue
+                    for cid in wanted:
+                        offset = chunk.message_index_offsets[cid]
+                        t, off = self._message_index(f, path, offset, cid, file_size)
+                        if lo is not None or hi is not None:
+                            keep = np.ones(len(t), dtype=bool)
+                            if lo is not None:
+                                keep &= t >= lo
+                            if hi is not None:
+                                keep &= t <= hi
+                            t, off = t[keep], off[keep]
+                        if len(t):
+                            sels.append((fi, ci, int(chunk.chunk_start_offset), t, off))
+        if not sels:
+            e = np.empty(0, np.int64)
+            return McapPlan(e, e, e, e, chunks_per_file)
+        t_all = np.concatenate([s[3] for s in sels])
+        off_all = np.concatenate([s[4] for s in sels])
+        # file, chunk and chunk offset of every row: one repeat each, not an array per chunk
+        counts = np.array([len(s[3]) for s in sels], dtype=np.int64)
+        file_all = np.repeat(np.array([s[0] for s in sels], dtype=np.int64), counts)
+        chunk_all = np.repeat(np.array([s[1] for s in sels], dtype=np.int64), counts)
+        cstart_all = np.repeat(np.array([s[2] for s in sels], dtype=np.int64), counts)
+        key = file_all * (1 << 32) + chunk_all
+        # the mcap library's order: log time, then file, chunk position, record position. One
+        # channel logged in time order is in that order already: no sort.
+        if _in_order(t_all, file_all, cstart_all, off_all):
+            return McapPlan(t_all, off_all, key, file_all, chunks_per_file)
+        order = np.lexsort((off_all, cstart_all, file_all, t_all))
+        return McapPlan(t_all[order], off_all[order], key[order], file_all[order], chunks_per_file)
+
+    def all_chunks(self) -> list[tuple[Path, Any]]:
+        """(file, chunk index record) of every chunk, in file order."""
+        out: list[tuple[Path, Any]] = []
+        for path in self.files:
+            with path.open("rb") as f:
+                summary = read_summary(f, path)
+            if summary is not None:
+                out.extend((path, c) for c in summary.chunk_indexes)
+        return out
+
+    def run_loader(
+        self, plan: McapPlan
+    ) -> tuple[int, Callable[[int, list[Any]], tuple[I64, U8, I64, I64]], list[int]]:
+        """(number of groups, load, bytes) where ``load(k, scratch)`` decompresses the k-th
+        group of chunks (up to ``GROUP_BYTES`` uncompressed) into ``scratch`` and gives
+        (reference positions, bytes, data starts, data lengths) of the planned messages in
+        it, and ``bytes[k]`` is what that group reads from the file (its chunks' compressed
+        sizes, for progress). ``load`` may run on a worker thread (it opens the file
+        itself)."""
+        from ertools.io.bulk import GROUP_BYTES, group_positions
+
+        todo: list[list[tuple[int, I64]]] = []
+        size = 0
+        for key, rows in group_positions(plan.key):
+            if not todo or size >= GROUP_BYTES:
+                todo.append([])
+                size = 0
+            todo[-1].append((key, rows))
+            size += int(plan.chunks[key >> 32][key & 0xFFFFFFFF].uncompressed_size)
+
+        def chunk_of(key: int) -> tuple[Path, Any]:
+            return self.files[key >> 32], plan.chunks[key >> 32][key & 0xFFFFFFFF]
+
+        def load(k: int, scratch: list[Any]) -> tuple[I64, U8, I64, I64]:
+            part = todo[k]
+            buf, base, sizes = self._group_bytes([chunk_of(key) for key, _ in part], scratch)
+            rows = np.concatenate([r for _k, r in part])
+            which = np.concatenate([np.full(len(r), i) for i, (_k, r) in enumerate(part)])
+            path, first = chunk_of(part[0][0])
+            where = f"in {path} in chunks from byte {first.chunk_start_offset}"
+            offsets = plan.offset[rows]
+            if np.any(offsets + 9 + MESSAGE_FIXED > sizes[which]):
+                raise BagError(f"message index points outside its chunk {where}")
+            limit = base[which] + sizes[which]
+            start, length, log_time = _checked_records(buf, offsets + base[which], limit, where)
+            # The record's own log time must be the index's: a damaged index entry would
+            # otherwise give another record's data (or a wrong time) without a word.
+            if np.any(log_time != plan.t_record[rows]):
+                raise BagError(
+                    f"message index disagrees with the message records' log times {where}"
+                )
+            return rows, buf, start, length
+
+        weights = [sum(int(chunk_of(key)[1].compressed_size) for key, _ in part) for part in todo]
+        return len(todo), load, weights
+
+    @staticmethod
+    def _group_bytes(chunks: list[tuple[Path, Any]], scratch: list[Any]) -> Group:
+        """The records of several chunks end to end in ``scratch``: uncompressed chunks are
+        read straight into it, compressed ones decompressed and copied in."""
+        if any(chunk.compression for _path, chunk in chunks):
+            return McapIndex._inflated_group(chunks, scratch)
+        for path, chunk in chunks:
+            # sizes from the summary are checked before they size a buffer (a flipped high
+            # bit made an int64 overflow); the chunk record itself is checked below
+            if int(chunk.uncompressed_size) != int(chunk.compressed_size):
+                raise BagError(
+                    f"uncompressed chunk with compressed size {chunk.compressed_size} != "
+                    f"uncompressed size {chunk.uncompressed_size} in the summary's chunk index",
+                    path=path,
+                )
+            if int(chunk.uncompressed_size) > path.stat().st_size:
+                raise BagError(
+                    f"chunk index gives a chunk of {chunk.uncompressed_size} bytes, more than "
+                    "the file holds",
+                    path=path,
+                )
+        sizes = np.array([int(c.uncompressed_size) for _p, c in chunks], dtype=np.int64)
+        base = np.zeros(len(chunks), dtype=np.int64)
+        np.cumsum(sizes[:-1], out=base[1:])
+        view = scratch_view(scratch, int(sizes.sum()))
+        for (path, chunk), b, n in zip(chunks, base.tolist(), sizes.tolist(), strict=True):
+            where = f"in {path} at byte {chunk.chunk_start_offset}"
+            with path.open("rb") as f:
+                compression, at, nbytes, usize, _crc = McapIndex._chunk_head(
+                    f.fileno(), path, chunk
+                )
+                if compression or nbytes != n or usize != n:
+                    raise BagError(f"chunk record disagrees with the summary's index {where}")
+                if read_at(f.fileno(), view[b : b + n], at) != n:
+                    raise BagError(f"chunk cut off by end of file {where}")
+        return np.frombuffer(view, dtype=np.uint8), base, sizes
+
+    @staticmethod
+    def _inflated_group(chunks: list[tuple[Path, Any]], scratch: list[Any]) -> Group:
+        """Compressed chunks decompressed end to end into ``scratch``, each checked against
+        its size and CRC. zstd chunks inflate straight into the reused buffer: a fresh
+        output object per chunk cost more CPU than the decompression itself (page faults
+        on new memory, then a copy), which is what pays for the CRC check."""
+        raw = [McapIndex._chunk_raw(path, chunk) for path, chunk in chunks]
+        sizes = np.array([usize for _c, _d, usize, _crc in raw], dtype=np.int64)
+        base = np.zeros(len(chunks), dtype=np.int64)
+        np.cumsum(sizes[:-1], out=base[1:])
+        view = scratch_view(scratch, int(sizes.sum()))
+        out = np.frombuffer(view, dtype=np.uint8)
+        for (path, chunk), (compression, data, usize, crc), b in zip(
+            chunks, raw, base.tolist(), strict=True
+        ):
+            where = f"in {path} at byte {chunk.chunk_start_offset}"
+            part = view[b : b + usize]
+            if compression == "zstd":
+                _zstd_into(data, part, where)
+            else:
+                got = decompress(compression, data, usize, where)
+                if len(got) != usize:
+                    raise BagError(f"chunk decompresses to {len(got)} bytes, not {usize}, {where}")
+                # a NumPy copy releases the GIL (a memoryview copy holds it)
+                out[b : b + usize] = np.frombuffer(got, dtype=np.uint8)
+            if crc and crc32(part) != crc:
+                raise BagError(f"chunk fails its CRC check (damaged) {where}")
+        return out, base, sizes
+
+    @staticmethod
+    def inflated_bytes(path: Path, chunk: Any) -> bytes:
+        """A chunk's records, decompressed (and its size checked)."""
+        where = f"in {path} at byte {chunk.chunk_start_offset}"
+        compression, data, usize, crc = McapIndex._chunk_raw(path, chunk)
+        out = decompress(compression, data, usize, where)
+        if len(out) != usize:
+            raise BagError(f"chunk decompresses to {len(out)} bytes, not {usize}, {where}")
+        # lz4 and zstd frames as MCAP writers make them carry no checksum of their own: a
+        # damaged compressed chunk inflates to other bytes without an error (fuzzing: poses
+        # changed, records lost). The chunk's CRC (0: not computed) finds it.
+        if crc and crc32(out) != crc:
+            raise BagError(f"chunk fails its CRC check (damaged) {where}")
+        return out
+
+    @staticmethod
+    def _message_index(
+        f: BinaryIO, path: Path, pos: int, cid: int, size: int | None = None
+    ) -> tuple[I64, I64]:
+        if size is None:
+            size = _file_size(f)
+        if not 0 <= pos < size:
+            raise BagError(f"message index offset {pos} outside the file ({size} bytes)", path=path)
+        f.seek(pos)
+        head = f.read(1 + 8 + 2 + 4)
+        if len(head) < 15 or head[0] != OP_MESSAGE_INDEX:
+            raise BagError(f"no message index at byte {pos}", path=path)
+        _, length, channel, nbytes = struct.unpack("<BQHI", head)
+        # the array must lie inside its record (a damaged array length would read the next
+        # records as (time, offset) pairs); the record may be longer: the specification
+        # lets writers pad records
+        if channel != cid or nbytes % 16 or length < 6 + nbytes or pos + 15 + nbytes > size:
+            raise BagError(f"damaged message index at byte {pos}", path=path)
+        data = f.read(nbytes)
+        if len(data) != nbytes:
+            raise BagError(f"message index at byte {pos} cut off by end of file", path=path)
+        arr = np.frombuffer(data, dtype=PAIR)
+        return arr["t"].astype(np.int64), arr["off"].astype(np.int64)
+
+    @staticmethod
+    def _chunk_bytes(path: Path, chunk: Any) -> U8:
+        return np.frombuffer(McapIndex.inflated_bytes(path, chunk), dtype=np.uint8)
+
+    @staticmethod
+    def _chunk_raw(path: Path, chunk: Any) -> tuple[str, bytes, int, int]:
+        """(compression, compressed records, uncompressed size, CRC) of a chunk record."""
+        where = f"in {path} at byte {chunk.chunk_start_offset}"
+        with path.open("rb") as f:
+            compression, at, nbytes, usize, crc = McapIndex._chunk_head(f.fileno(), path, chunk)
+            data = pread(f.fileno(), nbytes, at)
+        if len(data) != nbytes:
+            raise BagError(f"chunk cut off by end of file {where}")
+        return compression, data, usize, crc
+
+    @staticmethod
+    def _chunk_head(fd: int, path: Path, chunk: Any) -> tuple[str, int, int, int, int]:
+        """(compression, where the records start, their stored size, uncompressed size, CRC)
+        of a chunk record, from its header (positional reads: may run on a loading thread)."""
+        where = f"in {path} at byte {chunk.chunk_start_offset}"
+        size = os.fstat(fd).st_size
+        start = int(chunk.chunk_start_offset)
+        if not 0 <= start < size:
+            raise BagError(f"chunk offset outside the file ({size} bytes) {where}")
+        head = pread(fd, 1 + 8 + 8 + 8 + 8 + 4 + 4, start)
+        if len(head) < 41 or head[0] != OP_CHUNK:
+            raise BagError(f"no chunk record {where}")
+        _, _rlen, _t0, _t1, usize, crc, clen = struct.unpack("<BQQQQII", head)
+        if start + 41 + clen + 8 > size:
+            raise BagError(f"damaged chunk record {where}")
+        tail = pread(fd, clen + 8, start + 41)
+        compression = tail[:clen].decode("ascii", "replace")
+        (nbytes,) = struct.unpack("<Q", tail[clen:])
+        at = start + 41 + clen + 8
+        # a chunk larger than the file, or inflating to more than 1000x, is damage
+        if at + nbytes > size or usize > 1000 * max(nbytes, 1) + (1 << 20):
+            raise BagError(f"damaged chunk record (sizes {nbytes}/{usize}) {where}")
+        return compression, at, int(nbytes), int(usize), int(crc)
+
+    @staticmethod
+    def _spans(buf: U8, off: I64, where: str) -> tuple[I64, I64]:
+        from ertools.io.decode.fast import read_at
+
+        if len(off) and (int(off.min()) < 0 or int(off.max()) + 9 + MESSAGE_FIXED > len(buf)):
+            raise BagError(f"message index points outside its chunk {where}")
+        if np.any(buf[off] != OP_MESSAGE):
+            raise BagError(f"message index points at a record that is no message {where}")
+        rlen = read_at(buf, off + 1, np.dtype("<u8")).astype(np.int64)
+        start = off + 9 + MESSAGE_FIXED
+        length = rlen - MESSAGE_FIXED
+        if len(off) and (int((start + length).max()) > len(buf) or int(length.min()) < 0):
+            raise BagError(f"message record cut off inside its chunk {where}")
+        return start, length
+
+
+# A message record's head: op code (1), record length (8), channel id (2), sequence (4), log
+# time (8).
+_HEAD = 1 + 8 + 2 + 4 + 8
+
+
+def _checked_records(buf: U8, off: I64, limit: I64, where: str) -> tuple[I64, I64, I64]:
+    """(data start, data length, log time) of the message records at ``off``, each checked
+    to be a message record that ends at ``limit`` (its chunk's end) or where another record a
+    chunk may hold (schema, channel, message) begins: a damaged record length would give a
+    message bytes that are not its own, where the mcap library loses the rest of the chunk.
+
+    The heads are gathered once as raw bytes (one copy per record; a structured dtype
+    copies field by field, 4x slower) and the fields read as strided columns of them.
+    """
+    n = len(off)
+    if n and (int(off.min()) < 0 or int(off.max()) + _HEAD > len(buf)):
+        raise BagError(f"message index points outside its chunk {where}")
+    head = gather(buf, off, _HEAD)
+    if np.any(head[:, 0] != OP_MESSAGE):
+        raise BagError(f"message index points at a record that is no message {where}")
+    rlen = np.ndarray((n,), "<u8", buffer=head, offset=1, strides=(_HEAD,)).astype(np.int64)
+    start = off + 9 + MESSAGE_FIXED
+    length = rlen - MESSAGE_FIXED
+    end = start + length
+    if len(off) and (int(length.min()) < 0 or np.any(end > limit)):
+        raise BagError(f"message record cut off inside its chunk {where}")
+    # the byte after each record (clipped to the buffer: a record ending at its chunk's end,
+    # the buffer's last chunk included, needs no next record)
+    after = buf[np.minimum(end, len(buf) - 1)]
+    if not np.all(_RECORD_STARTS[after] | (end == limit)):
+        raise BagError(f"message record length runs into no record {where}")
+    log_time = np.ndarray((n,), "<u8", buffer=head, offset=15, strides=(_HEAD,))
+    return start, length, log_time.astype(np.int64)
+
+
+def verify_mcap(path: Path, progress: Reporter | None = None) -> None:
+    """Decompress every chunk of an MCAP file, check its CRC and its message indexes (a file
+    read record by record: every record and every chunk CRC). The chunks' bytes are
+    reported to ``progress`` (indexed files; an unindexed one is one scan, unreported).
+
+    Raises:
+        BagError: the first damaged chunk, with its byte offset.
+    """
+    from ertools.io.mcap.scan import SCAN, mcap_layout, scan_mcap
+
+    layout = mcap_layout(path)
+    if layout.index == SCAN:
+        # no indexes to check against: every record read, every chunk's CRC checked
+        found = scan_mcap(path, check_crc=True)
+        if found.problem:
+            raise BagError(found.problem, path=path)
+        return
+    with path.open("rb") as f:
+        summary: Any = layout.summary
+        if progress is not None:
+            total = sum(int(c.compressed_size) for c in summary.chunk_indexes)
+            progress.task(f"checking {path.name}", total, "B")
+        for chunk in summary.chunk_indexes:
+            if progress is not None:
+                progress.advance(int(chunk.compressed_size))
+            where = f"in {path} at byte {chunk.chunk_start_offset}"
+            f.seek(chunk.chunk_start_offset + 1 + 8 + 8 + 8 + 8)
+            (crc,) = struct.unpack("<I", f.read(4))
+            buf = McapIndex._chunk_bytes(path, chunk)
+            if crc and crc32(buf.tobytes()) != crc:
+                raise BagError(f"corrupt MCAP chunk {where}: CRC mismatch")
+            for cid, offset in chunk.message_index_offsets.items():
+                _t, off = McapIndex._message_index(f, path, offset, cid)
+                McapIndex._spans(buf, off, where)

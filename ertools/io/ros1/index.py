@@ -1,0 +1,918 @@
+"""ROS1 bags read through their own index: connections, chunk infos and index-data records.
+
+Opening costs a few reads at the end of the file (the index section), whatever the bag's size;
+no per-message Python objects are made. Bags without a usable index (``.bag.active`` files
+still being recorded, truncated copies) are scanned record by record instead, and say so in
+``problems``.
+"""
+
+from __future__ import annotations
+
+import bz2
+import contextlib
+import functools
+import logging
+import mmap
+import struct
+from collections.abc import Collection, Iterator, Sequence
+from dataclasses import dataclass, field
+from io import BufferedReader
+from pathlib import Path
+from struct import error as struct_error
+from typing import TYPE_CHECKING, Any, BinaryIO
+
+import numpy as np
+import numpy.typing as npt
+
+from ertools.errors import BagError
+from ertools.io.files import BagFile, RawRecord
+from ertools.io.model import Conn, short_msgtype
+from ertools.io.ros1.records import (
+    MAGIC_LEN,
+    OP_BAG_HEADER,
+    OP_CHUNK,
+    OP_CHUNK_INFO,
+    OP_CONNECTION,
+    OP_INDEX,
+    OP_MSG,
+    Record,
+    RecordError,
+    chunk_info,
+    connection_fields,
+    parse_fields,
+    read_record,
+    time_ns,
+    u32,
+    u64,
+)
+
+if TYPE_CHECKING:
+    from ertools.progress import Reporter
+
+log = logging.getLogger("ertools.io.ros1.index")
+
+I64 = npt.NDArray[np.int64]
+U8 = npt.NDArray[np.uint8]
+
+INDEX_DTYPE = np.dtype([("sec", "<u4"), ("nsec", "<u4"), ("off", "<u4")])
+# The message-data record header rosbag and rosbags write: conn (4), op (1), time (8) fields.
+MSG_HEADER_LEN = 4 + len("conn=") + 4 + 4 + len("op=") + 1 + 4 + len("time=") + 8
+_U32 = struct.Struct("<I")
+_OP_AT = (0, 13, 17, 30)  # where the op field can sit in a standard message-record header
+
+
+def _op_word(buf: U8, pos: I64) -> npt.NDArray[np.uint64]:
+    from ertools.io.decode.fast import read_at
+
+    return read_at(buf, pos, np.dtype("<u8"))
+
+
+_OP_MSG_WORD = int.from_bytes(b"\x04\x00\x00\x00op=\x02", "little")
+
+
+@dataclass
+class Ros1Chunk:
+    """One chunk: where it is, its time span and per-connection counts.
+
+    ``entries`` (conn -> (record times, offsets in the uncompressed chunk)) is filled when the
+    index-data records after the chunk are read (or by a scan).
+    """
+
+    pos: int
+    start_ns: int
+    end_ns: int
+    counts: dict[int, int]
+    compression: str = ""
+    data_pos: int = -1
+    data_len: int = -1
+    entries: dict[int, tuple[I64, I64]] | None = None
+
+
+@dataclass
+class Ros1Layout:
+    """The index of a ROS1 bag (read or rebuilt by a scan)."""
+
+    path: Path
+    size: int
+    indexed: bool
+    conns: list[Conn]
+    chunks: list[Ros1Chunk]
+    problems: list[str] = field(default_factory=list)
+
+
+def _conn(cid: int, topic: str, fields: dict[str, bytes]) -> Conn:
+    def text(name: str) -> str:
+        return fields.get(name, b"").decode("utf-8", "replace")
+
+    return Conn(
+        cid,
+        topic or text("topic"),
+        short_msgtype(text("type")),
+        text("message_definition"),
+        "msg" if text("message_definition") else "",
+        "ros1",
+        text("latching") not in ("", "0"),
+        text("md5sum"),
+    )
+
+
+def _entries_from_index(data: bytes) -> tuple[I64, I64]:
+    arr = np.frombuffer(data, dtype=INDEX_DTYPE)
+    # Computed in place: fresh memory is slow to fault in, and an hour's entries are 5 MB.
+    t = np.multiply(arr["sec"], 1_000_000_000, dtype=np.int64)
+    np.add(t, arr["nsec"], out=t)
+    return t, arr["off"].astype(np.int64)
+
+
+def _cat(parts: list[I64]) -> I64:
+    """Arrays end to end; one array as it is (no copy of an hour's entries)."""
+    return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
+
+def _joined_entries(parts: list[bytes | tuple[I64, I64]]) -> tuple[I64, I64]:
+    """(times, offsets) of one connection's entries over several chunks."""
+    if all(isinstance(p, bytes) for p in parts):
+        return _entries_from_index(b"".join(p for p in parts if isinstance(p, bytes)))
+    pairs = [_entries_from_index(p) if isinstance(p, bytes) else p for p in parts]
+    return np.concatenate([p[0] for p in pairs]), np.concatenate([p[1] for p in pairs])
+
+
+@functools.lru_cache(maxsize=4096)
+def _index_header(header: bytes) -> tuple[int, int, int, int] | None:
+    """(op, ver, conn, count) of an index-data record header, None when malformed. Cached:
+    an hour bag repeats the same few headers (one per connection and usual count)."""
+    try:
+        fields = parse_fields(header)
+        return fields["op"][0], u32(fields, "ver"), u32(fields, "conn"), u32(fields, "count")
+    except (RecordError, KeyError, IndexError, struct_error):
+        return None
+
+
+def read_layout(path: Path) -> Ros1Layout:
+    """The index of the bag at ``path``; scans when the index is missing or damaged.
+
+    Raises:
+        BagError: not even the bag header is readable.
+    """
+    size = path.stat().st_size
+    with path.open("rb") as f:
+        try:
+            head, _ = read_record(f, MAGIC_LEN, size)
+            if head.op != OP_BAG_HEADER:
+                raise RecordError("first record is not the bag header", MAGIC_LEN)
+            index_pos = u64(head.fields, "index_pos")
+            conn_count = u32(head.fields, "conn_count")
+            chunk_count = u32(head.fields, "chunk_count")
+        except (RecordError, KeyError, struct_error) as err:
+            raise BagError(f"unreadable ROS1 bag header ({err}); not a bag?", path=path) from err
+        if index_pos == 0:
+            return scan_layout(f, path, size, head.end, "not indexed (recording not closed)")
+        if head.end == index_pos == size and conn_count == 0 and chunk_count == 0:
+            # What a recorder leaves when nothing arrived: the header, then an empty index
+            # (nothing between them; records there would mean a damaged header: scanned).
+            return Ros1Layout(path, size, True, [], [])
+        if index_pos >= size:
+            return scan_layout(
+                f,
+                path,
+                size,
+                head.end,
+                f"truncated: the index at byte {index_pos} lies past the end ({size} bytes)",
+            )
+        try:
+            conns: list[Conn] = []
+            pos = index_pos
+            for _ in range(conn_count):
+                rec, data = read_record(f, pos, size, with_data=True)
+                if rec.op != OP_CONNECTION:
+                    raise RecordError("expected a connection record", pos)
+                cid, topic, fields = connection_fields(rec, data)
+                if any(c.id == cid for c in conns):
+                    # a damaged id: one connection's messages would be read as another's
+                    raise RecordError(f"two connection records with id {cid}", pos)
+                conns.append(_conn(cid, topic, fields))
+                pos = rec.end
+            if chunk_count == 0 and conn_count and index_pos > head.end:
+                # records between the header and the index, but no chunk to find them by
+                raise RecordError("the bag header counts no chunks before its index", MAGIC_LEN)
+            chunks = []
+            for _ in range(chunk_count):
+                rec, data = read_record(f, pos, size, with_data=True)
+                if rec.op != OP_CHUNK_INFO:
+                    raise RecordError("expected a chunk-info record", pos)
+                cpos, start, end, counts = chunk_info(rec, data)
+                if cpos >= size:
+                    raise RecordError(f"chunk position {cpos} past the end of the file", pos)
+                chunks.append(Ros1Chunk(cpos, start, end, counts))
+                pos = rec.end
+        except (RecordError, KeyError, struct_error, IndexError) as err:
+            return scan_layout(f, path, size, head.end, f"damaged index ({err})")
+    return Ros1Layout(path, size, True, conns, chunks)
+
+
+def decompress(compression: str, data: bytes, where: str) -> bytes:
+    """Uncompressed chunk bytes."""
+    try:
+        if compression == "none":
+            return data
+        if compression == "bz2":
+            return bz2.decompress(data)
+        if compression == "lz4":
+            import lz4.frame
+
+            return bytes(lz4.frame.decompress(data))
+    except (OSError, ValueError, RuntimeError, EOFError) as err:
+        raise BagError(f"corrupt {compression} chunk {where} ({err})") from err
+    raise BagError(f"unsupported chunk compression {compression!r} {where}")
+
+
+def _walk_chunk(buf: bytes, base: int) -> Iterator[tuple[int, dict[str, bytes], int, int]]:
+    """(offset, header fields, data offset, data length) of each record inside a chunk."""
+    pos = 0
+    n = len(buf)
+    while pos + 4 <= n:
+        hlen = int.from_bytes(buf[pos : pos + 4], "little")
+        if pos + 8 + hlen > n:
+            raise RecordError("record cut off inside chunk", base + pos)
+        fields = parse_fields(buf[pos + 4 : pos + 4 + hlen], base + pos + 4)
+        dlen = int.from_bytes(buf[pos + 4 + hlen : pos + 8 + hlen], "little")
+        dpos = pos + 8 + hlen
+        if dpos + dlen > n:
+            raise RecordError("record data cut off inside chunk", base + pos)
+        yield pos, fields, dpos, dlen
+        pos = dpos + dlen
+
+
+def _scanned_chunk(
+    pos: int,
+    compression: str,
+    data_pos: int,
+    data_len: int,
+    per: dict[int, tuple[list[int], list[int]]],
+) -> Ros1Chunk:
+    entries = {
+        cid: (np.array(ts, dtype=np.int64), np.array(offs, dtype=np.int64))
+        for cid, (ts, offs) in per.items()
+    }
+    times = [t for t, _ in entries.values() if len(t)]
+    return Ros1Chunk(
+        pos,
+        min(int(t.min()) for t in times) if times else 0,
+        max(int(t.max()) for t in times) if times else 0,
+        {cid: len(t) for cid, (t, _) in entries.items()},
+        compression,
+        data_pos,
+        data_len,
+        entries,
+    )
+
+
+def scan_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ros1Layout:
+    """Rebuild the index by walking every record (and every record inside every chunk).
+
+    A recorder writes the chunk it is filling straight into the file, after a chunk header
+    whose size is only set when the chunk is closed; in an ``.active`` file those messages
+    appear as records outside any chunk. They are gathered into a pseudo-chunk (uncompressed,
+    covering that stretch of the file) so they are read like the others.
+    """
+    log.info("%s: %s; scanning the whole file", path, why)
+    problems = [why]
+    conns: dict[int, Conn] = {}
+    chunks: list[Ros1Chunk] = []
+    loose: dict[int, tuple[list[int], list[int]]] = {}
+    loose_start = loose_end = -1
+
+    def flush() -> None:
+        nonlocal loose, loose_start
+        if loose:
+            chunks.append(
+                _scanned_chunk(loose_start, "none", loose_start, loose_end - loose_start, loose)
+            )
+        loose, loose_start = {}, -1
+
+    while pos < size:
+        try:
+            rec, data = read_record(f, pos, size, with_data=True)
+        except RecordError as err:
+            problems.append(f"truncated: last record incomplete ({err}); read up to byte {pos}")
+            break
+        if rec.op in (OP_MSG, OP_CONNECTION):
+            try:
+                if rec.op == OP_MSG:
+                    cid, t = u32(rec.fields, "conn"), time_ns(rec.fields, "time")
+                    if loose_start < 0:
+                        loose_start = rec.pos
+                    ts, offs = loose.setdefault(cid, ([], []))
+                    ts.append(t)
+                    offs.append(rec.pos - loose_start)
+                    loose_end = rec.end
+                else:
+                    cid, topic, cfields = connection_fields(rec, data)
+                    conns.setdefault(cid, _conn(cid, topic, cfields))
+            except (RecordError, KeyError, struct_error, IndexError) as err:
+                problems.append(f"damaged record at byte {pos} ({err}); scan stopped there")
+                break
+        elif rec.op == OP_CHUNK:
+            flush()
+            compression = rec.fields.get("compression", b"none").decode("ascii", "replace")
+            try:
+                buf = decompress(compression, data, f"at byte {pos}")
+                per: dict[int, tuple[list[int], list[int]]] = {}
+                for off, fields, dpos, dlen in _walk_chunk(buf, rec.data_pos):
+                    op = fields["op"][0]
+                    if op == OP_CONNECTION:
+                        cid = u32(fields, "conn")
+                        cfields = parse_fields(buf[dpos : dpos + dlen])
+                        # strict, as for the index's connection records: a name that is not
+                        # UTF-8 is damage, never a topic or type with replacement characters
+                        topic = fields.get("topic", b"").decode("utf-8")
+                        cfields.get("type", b"").decode("utf-8")
+                        conns.setdefault(cid, _conn(cid, topic, cfields))
+                    elif op == OP_MSG:
+                        ts, offs = per.setdefault(u32(fields, "conn"), ([], []))
+                        ts.append(time_ns(fields, "time"))
+                        offs.append(off)
+            except (
+                BagError,
+                RecordError,
+                KeyError,
+                IndexError,
+                struct_error,
+                UnicodeDecodeError,
+            ) as err:
+                problems.append(f"corrupt chunk at byte {pos} skipped ({err})")
+                pos = rec.end
+                continue
+            if per:
+                chunks.append(_scanned_chunk(pos, compression, rec.data_pos, rec.data_len, per))
+        elif rec.op in (OP_INDEX, OP_CHUNK_INFO):
+            flush()
+        else:
+            problems.append(f"unknown record op {rec.op} at byte {pos}")
+        pos = rec.end
+    flush()
+    return Ros1Layout(
+        path, size, False, sorted(conns.values(), key=lambda c: c.id), chunks, problems
+    )
+
+
+def _outside_chunk_info(
+    chunks: Sequence[Ros1Chunk], cid: int, t: I64, where: Sequence[tuple[int, int]]
+) -> str | None:
+    """Why the index-data times ``t`` of one connection (``where``: (chunk, count) of each
+    run of them, in order) do not all lie in their chunk's chunk-info [start, end], or None.
+
+    One min and one max per chunk (two passes over the times, no per-message gather): the
+    reads were planned from those spans, so a time outside one means the index contradicts
+    itself and a window may have skipped a chunk it needed.
+    """
+    counts = np.array([w[1] for w in where], dtype=np.int64)
+    nonempty = counts > 0
+    if not len(t) or not nonempty.any():
+        return None
+    cis = np.array([w[0] for w in where], dtype=np.int64)[nonempty]
+    at = (np.cumsum(counts) - counts)[nonempty]
+    lo = np.minimum.reduceat(t, at)
+    hi = np.maximum.reduceat(t, at)
+    start = np.array([chunks[i].start_ns for i in cis.tolist()], dtype=np.int64)
+    end = np.array([chunks[i].end_ns for i in cis.tolist()], dtype=np.int64)
+    bad = np.flatnonzero((lo < start) | (hi > end))
+    if not len(bad):
+        return None
+    k = int(bad[0])
+    chunk = chunks[int(cis[k])]
+    return (
+        f"index data of connection {cid} after the chunk at byte {chunk.pos} holds record "
+        f"times {int(lo[k])}..{int(hi[k])} ns outside its chunk info's "
+        f"{chunk.start_ns}..{chunk.end_ns} ns ({len(bad)} chunk(s) so)"
+    )
+
+
+def _value_offsets(buf: U8, head: int) -> tuple[int, int] | None:
+    """(conn value, time value) offsets in the 38-byte message header at ``head``."""
+    try:
+        fields = bytes(buf[head : head + MSG_HEADER_LEN])
+        pos, found = 0, {}
+        while pos < len(fields):
+            (n,) = _U32.unpack_from(fields, pos)
+            name = fields[pos + 4 : pos + 4 + n].split(b"=", 1)[0]
+            found[name] = pos + 4 + len(name) + 1
+            pos += 4 + n
+    except struct_error:
+        return None
+    if b"conn" not in found or b"time" not in found:
+        return None
+    return found[b"conn"], found[b"time"]
+
+
+def _fields_before(buf: U8, data: int) -> tuple[int, int] | None:
+    """(conn, time ns) of the message record whose data starts at ``data``, from its header
+    (found by the standard 38-byte length; None when the header is not there or lacks them)."""
+    head = data - 4 - MSG_HEADER_LEN
+    if head < 4:
+        return None
+    try:
+        (hlen,) = _U32.unpack(bytes(buf[head - 4 : head]))
+        if hlen != MSG_HEADER_LEN:
+            return None
+        fields = parse_fields(bytes(buf[head : head + MSG_HEADER_LEN]))
+        return u32(fields, "conn"), time_ns(fields, "time")
+    except (RecordError, KeyError, struct_error):
+        return None
+
+
+def _nonzero(counts: dict[int, int]) -> dict[int, int]:
+    return {cid: n for cid, n in counts.items() if n}
+
+
+def _first_record(bag: Ros1Bag) -> int:
+    """Where the records after the bag header start."""
+    try:
+        head, _ = read_record(bag.file, MAGIC_LEN, bag.layout.size)
+    except RecordError as err:
+        raise BagError(f"unreadable ROS1 bag header ({err})", path=bag.path) from err
+    return head.end
+
+
+def _standard_spans(buf: U8, offsets: I64) -> tuple[I64, I64] | None:
+    """(data start, data length) when every record has the standard 38-byte header with its op
+    field where the first one has it (a writer's usual output): three gathers and two
+    checks. None when any record differs (the caller then looks at each kind)."""
+    from ertools.io.decode.fast import read_at
+
+    n = len(buf)
+    if int(offsets.max()) + 8 + MSG_HEADER_LEN > n:
+        return None
+    if not bool(np.all(read_at(buf, offsets, np.dtype("<u4")) == MSG_HEADER_LEN)):
+        return None
+    first = next(
+        (at for at in _OP_AT if _op_word(buf, offsets[:1] + 4 + at)[0] == _OP_MSG_WORD), None
+    )
+    if first is None or not bool(np.all(_op_word(buf, offsets + 4 + first) == _OP_MSG_WORD)):
+        return None
+    start = offsets + (8 + MSG_HEADER_LEN)
+    length = read_at(buf, start - 4, np.dtype("<u4")).astype(np.int64)
+    if int((start + length).max()) > n:
+        return None
+    return start, length
+
+
+class Ros1Bag(BagFile):
+    """A ROS1 bag read through its index (or a scan): raw messages and chunk access."""
+
+    def __init__(
+        self, path: Path, layout: Ros1Layout | None = None, *, strict: bool = True
+    ) -> None:
+        """Open ``path`` (its index, or a scan). With ``strict`` (reading), a closed bag whose
+        index was missing or damaged is refused; summaries pass ``strict=False``."""
+        self.path = path
+        self.layout = layout if layout is not None else read_layout(path)
+        active = path.name.endswith(".active")
+        self.format = "ros1-active" if active else "ros1"
+        problems = self.layout.problems
+        if problems and not active and strict:
+            # A closed bag without a sound index was cut short or damaged: reading what is
+            # left would give a silently shorter stream.
+            raise BagError(
+                f"{'; '.join(problems)}; re-copy the file or run `rosbag reindex` on a copy",
+                path=path,
+            )
+        if problems and strict:
+            log.warning("%s: %s; reading what the scan found", path, "; ".join(problems))
+        self.connections = tuple(self.layout.conns)
+        self._f: BufferedReader | None = path.open("rb")
+        self._mm: mmap.mmap | None = None
+
+    def _unmap(self) -> None:
+        if self._mm is not None:
+            # Only bytes copies leave the mapping; should a view be alive, it stays mapped
+            # until that view is collected.
+            with contextlib.suppress(BufferError):
+                self._mm.close()
+            self._mm = None
+
+    def close(self) -> None:
+        self._unmap()
+        if self._f is not None:
+            self._f.close()
+            self._f = None
+
+    @property
+    def file(self) -> BufferedReader:
+        if self._f is None:
+            raise BagError("bag already closed", path=self.path)
+        return self._f
+
+    def _where(self, chunk: Ros1Chunk) -> str:
+        return f"in {self.path} at byte {chunk.pos}"
+
+    def chunk_record(self, chunk: Ros1Chunk) -> Record:
+        """The record header of a chunk (sets its compression and where its data lies)."""
+        try:
+            rec, _ = read_record(self.file, chunk.pos, self.layout.size)
+        except RecordError as err:
+            raise BagError(f"damaged chunk record ({err})", path=self.path) from err
+        if rec.op != OP_CHUNK:
+            raise BagError(f"expected a chunk record at byte {chunk.pos}", path=self.path)
+        chunk.compression = rec.fields.get("compression", b"none").decode("ascii", "replace")
+        chunk.data_pos, chunk.data_len = rec.data_pos, rec.data_len
+        return rec
+
+    def compressions(self) -> list[str]:
+        """The compression of every chunk (reads each chunk's record header)."""
+        out = []
+        for chunk in self.layout.chunks:
+            if not chunk.compression:
+                self.chunk_record(chunk)
+            out.append(chunk.compression)
+        return out
+
+    def _mapped(self) -> mmap.mmap:
+        """The file mapped read-only: index records are read where they lie, without a
+        system call per record (only the pages touched are read)."""
+        if self._mm is None:
+            self._mm = mmap.mmap(self.file.fileno(), 0, access=mmap.ACCESS_READ)
+        return self._mm
+
+    def _index_data(
+        self,
+        chunk: Ros1Chunk,
+        wanted: Collection[int] | None,
+        counts: dict[int, int] | None = None,
+    ) -> dict[int, bytes]:
+        """conn -> raw (sec, nsec, offset) entries of one chunk, for the ``wanted`` connections
+        (all when None), from the index-data records that follow the chunk; ``counts`` gets
+        every record's conn -> count (all connections)."""
+        if chunk.data_pos < 0:
+            self.chunk_record(chunk)
+        mm = self._mapped()
+        size = min(len(mm), self.layout.size)
+        pos = chunk.data_pos + chunk.data_len
+        out: dict[int, bytes] = {}
+        try:
+            for _ in range(len(chunk.counts)):
+                if pos + 8 > size:
+                    raise RecordError("index data cut off by end of file", pos)
+                (hlen,) = _U32.unpack_from(mm, pos)
+                if pos + 8 + hlen > size:
+                    raise RecordError("index data cut off by end of file", pos)
+                head = _index_header(mm[pos + 4 : pos + 4 + hlen])
+                if head is None:
+                    raise RecordError("malformed index-data record header", pos)
+                op, ver, cid, count = head
+                if op != OP_INDEX:
+                    raise RecordError("expected an index-data record", pos)
+                if ver != 1:
+                    raise RecordError("index-data version not 1", pos)
+                (dlen,) = _U32.unpack_from(mm, pos + 4 + hlen)
+                data_pos = pos + 8 + hlen
+                if dlen != 12 * count or data_pos + dlen > size:
+                    raise RecordError("index-data size disagrees with its count", pos)
+                if counts is not None:
+                    counts[cid] = counts.get(cid, 0) + count
+                if wanted is None or cid in wanted:
+                    out[cid] = mm[data_pos : data_pos + dlen]
+                pos = data_pos + dlen
+        except (RecordError, KeyError, struct_error, IndexError) as err:
+            raise BagError(
+                f"damaged index data after chunk at byte {chunk.pos} ({err})", path=self.path
+            ) from err
+        return out
+
+    def chunk_entries(self, chunk: Ros1Chunk) -> dict[int, tuple[I64, I64]]:
+        """conn -> (record times, record offsets) of one chunk, from its index-data records."""
+        if chunk.entries is not None:
+            return chunk.entries
+        # Not kept on the chunk: an hour bag's index entries are ~20 MB, needed once per read.
+        return {cid: _entries_from_index(d) for cid, d in self._index_data(chunk, None).items()}
+
+    def chunk_bytes(self, chunk: Ros1Chunk) -> bytes:
+        """The uncompressed data of one chunk."""
+        if chunk.data_pos < 0:
+            self.chunk_record(chunk)
+        self.file.seek(chunk.data_pos)
+        data = self.file.read(chunk.data_len)
+        if len(data) != chunk.data_len:
+            raise BagError(f"chunk at byte {chunk.pos} cut off by end of file", path=self.path)
+        try:
+            return decompress(chunk.compression, data, self._where(chunk))
+        except BagError as err:
+            raise BagError(err.message, path=None) from err
+
+    def select(
+        self, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
+    ) -> tuple[list[int], I64, npt.NDArray[np.integer[Any]], I64, I64]:
+        """Messages of ``conns`` in [start_ns, end_ns], in the reference order.
+
+        Returns (chunk indices touched, chunk index per message, conn rank per message, record
+        time per message, record offset per message); only chunks whose span overlaps the
+        window and that hold one of ``conns`` are read.
+        """
+        if self.layout.indexed:
+            # A chunk info naming a connection the bag does not have is damaged: the chunk
+            # would silently drop out of the plan of the connection it really holds.
+            known = {c.id for c in self.layout.conns}
+            unknown = sorted({cid for ch in self.layout.chunks for cid in ch.counts} - known)
+            if unknown:
+                self._rescan(f"chunk info names connection {unknown[0]}, which the bag lacks")
+        rank = {c.id: i for i, c in enumerate(conns)}
+        raw: dict[int, list[bytes | tuple[I64, I64]]] = {cid: [] for cid in rank}
+        where: dict[int, list[tuple[int, int]]] = {cid: [] for cid in rank}
+        for ci, chunk in enumerate(self.layout.chunks):
+            if start_ns is not None and chunk.end_ns < start_ns:
+                continue
+            if end_ns is not None and chunk.start_ns > end_ns:
+                continue
+            if chunk.entries is not None:  # a scanned bag: entries already decoded
+                for cid, (t, off) in chunk.entries.items():
+                    if cid in rank:
+                        raw[cid].append((t, off))
+                        where[cid].append((ci, len(t)))
+                continue
+            # Every chunk's index-data headers are read, the planned chunks' and the others':
+            # their connection ids and counts must be the chunk info's, which chose the chunks
+            # (a damaged connection id or count there dropped a chunk from its connection's
+            # read, or read another connection's entries, without a word).
+            counts: dict[int, int] = {}
+            for cid, data in self._index_data(chunk, rank, counts).items():
+                raw[cid].append(data)
+                where[cid].append((ci, len(data) // INDEX_DTYPE.itemsize))
+            if _nonzero(counts) != _nonzero(chunk.counts):
+                self._rescan(
+                    f"chunk at byte {chunk.pos}: the chunk info and the index data give "
+                    "different connections or counts"
+                )
+                return self.select(conns, start_ns, end_ns)
+        self._unmap()  # the index pages touched would otherwise stay in this process's RSS
+        tt: list[I64] = []
+        oo: list[I64] = []
+        ck: list[I64] = []
+        rk: list[npt.NDArray[np.integer[Any]]] = []
+        for cid, r in rank.items():
+            if not raw[cid]:
+                continue
+            t, off = _joined_entries(raw[cid])
+            if self.layout.indexed:
+                outside = _outside_chunk_info(self.layout.chunks, cid, t, where[cid])
+                if outside is not None:
+                    self._rescan(outside)
+                    return self.select(conns, start_ns, end_ns)
+            c = np.repeat(
+                np.array([w[0] for w in where[cid]], dtype=np.int64),
+                np.array([w[1] for w in where[cid]], dtype=np.int64),
+            )
+            if start_ns is not None or end_ns is not None:
+                keep = np.ones(len(t), dtype=bool)
+                if start_ns is not None:
+                    keep &= t >= start_ns
+                if end_ns is not None:
+                    keep &= t <= end_ns
+                t, off, c = t[keep], off[keep], c[keep]
+            tt.append(t)
+            oo.append(off)
+            ck.append(c)
+            rk.append(np.full(len(t), r, dtype=np.int8 if len(rank) < 128 else np.int64))
+        if not tt or not sum(len(t) for t in tt):
+            e = np.empty(0, np.int64)
+            return [], e, e, e, e
+        t_all, c_all, o_all = _cat(tt), _cat(ck), _cat(oo)
+        r_all = rk[0] if len(rk) == 1 else np.concatenate(rk)
+        # (np.unique would import numpy.ma, 10 ms of a whole command's start)
+        touched = np.flatnonzero(np.bincount(c_all, minlength=len(self.layout.chunks))).tolist()
+        # rosbags: per connection sorted by time (stable over chunk and index order), then a
+        # heap merge over connections in the order given (ties: the earlier connection).
+        # Entries are gathered connection by connection, each in chunk and index order, so
+        # ``seq`` keeps that order among equal times of one connection.
+        if len(rank) == 1 and np.all(t_all[1:] >= t_all[:-1]):
+            return touched, c_all, r_all, t_all, o_all  # one connection, already in order
+        seq = np.arange(len(t_all))
+        order = np.lexsort((seq, r_all, t_all))
+        return touched, c_all[order], r_all[order], t_all[order], o_all[order]
+
+    def _rescan(self, why: str) -> None:
+        """Distrust the index from now on: rebuild the layout from the records themselves."""
+        log.warning(
+            "%s: %s; reading by scanning every record instead of through the index "
+            "(`ertools info --check` lists every disagreement; `rosbag reindex` on a copy "
+            "repairs the index)",
+            self.path,
+            why,
+        )
+        from ertools.io.ros1.check import rebuild_layout
+
+        self._unmap()
+        layout = rebuild_layout(self.file, self.path, self.layout.size, _first_record(self), why)
+        damage = [p for p in layout.problems if p != why]
+        if damage:
+            # A closed bag (it has an index) whose records do not all read is damaged, not cut
+            # short: reading around a skipped chunk would give fewer messages without a word.
+            raise BagError(f"damaged bag: {why}, and {damage[0]}", path=self.path)
+        self.layout = layout
+
+    def spans(self, buf: U8, offsets: I64, where: str) -> tuple[I64, I64]:
+        """(data start, data length) of the message records at ``offsets`` of a chunk.
+
+        Vectorised for the standard 38-byte message header (conn, op, time fields in any
+        order), checking its op field; other records (a connection record before the message,
+        odd header layouts) are resolved one by one.
+        """
+        from ertools.io.decode.fast import LayoutMismatchError, read_at
+
+        n = len(buf)
+        if len(offsets) == 0:
+            return offsets.copy(), offsets.copy()
+        if offsets.min() < 0 or offsets.max() + 8 > n:
+            raise BagError(f"index points outside its chunk {where}")
+        fast = _standard_spans(buf, offsets)
+        if fast is not None:
+            return fast
+        hlen = read_at(buf, offsets, np.dtype("<u4")).astype(np.int64)
+        dpos = offsets + 8 + hlen
+        ok = (hlen == MSG_HEADER_LEN) & (dpos <= n)
+        if ok.any():
+            head = offsets[ok] + 4
+            # The op field (len 4, "op=", 0x02: one 8-byte word) sits after 0, 1 or 2 of the
+            # other fields (conn: 13 bytes, time: 17 bytes). A writer puts it at the same place
+            # in every record: look there first, elsewhere only for records that differ.
+            try:
+                first = next(
+                    (at for at in _OP_AT if _op_word(buf, head[:1] + at)[0] == _OP_MSG_WORD), 0
+                )
+                is_msg = _op_word(buf, head + first) == _OP_MSG_WORD
+                for at in _OP_AT:
+                    rest = np.flatnonzero(~is_msg)
+                    if at == first or not len(rest):
+                        continue
+                    is_msg[rest] = _op_word(buf, head[rest] + at) == _OP_MSG_WORD
+            except LayoutMismatchError as err:
+                raise BagError(f"message record cut off inside its chunk {where}") from err
+            ok[np.flatnonzero(ok)[~is_msg]] = False
+        dlen = np.zeros(len(offsets), dtype=np.int64)
+        if ok.any():
+            dlen[ok] = read_at(buf, dpos[ok] - 4, np.dtype("<u4"))
+        odd = np.flatnonzero(~ok)
+        if len(odd):
+            raw = buf.tobytes()
+            for i in odd:
+                dpos[i], dlen[i] = self._resolve(raw, int(offsets[i]), where)
+        if (dpos + dlen).max() > n:
+            raise BagError(f"message data cut off inside its chunk {where}")
+        return dpos, dlen
+
+    def checked_spans(
+        self, buf: U8, offsets: I64, t_ns: I64, conn: I64, where: str
+    ) -> tuple[I64, I64]:
+        """:meth:`spans`, each record also checked to carry the time and connection of its
+        index entry (:meth:`check_heads`). Records with the standard 38-byte header laid out
+        as the first one's (a writer's usual output) are read with one gather of their
+        heads, every field a strided column of it."""
+        n = len(offsets)
+        head = 4 + MSG_HEADER_LEN + 4  # header length, header, data length
+        fields = None
+        if n and int(offsets.min()) >= 0 and int(offsets.max()) + head <= len(buf):
+            fields = _value_offsets(buf, int(offsets[0]) + 4)
+        op_at = None
+        if fields is not None:
+            first = bytes(buf[int(offsets[0]) + 4 : int(offsets[0]) + 4 + MSG_HEADER_LEN])
+            op_at = next(
+                (at for at in _OP_AT if first[at : at + 8] == _OP_MSG_WORD.to_bytes(8, "little")),
+                None,
+            )
+        if fields is None or op_at is None:
+            start, length = self.spans(buf, offsets, where)
+            self.check_heads(buf, start, t_ns, conn, where)
+            return start, length
+        from ertools.io.decode.fast import gather
+
+        rows = gather(buf, offsets, head)
+
+        def col(offset: int, kind: str) -> npt.NDArray[Any]:
+            return np.ndarray((n,), kind, buffer=rows, offset=offset, strides=(head,))
+
+        conn_at, time_at = fields
+        standard = (col(0, "<u4") == MSG_HEADER_LEN) & (col(4 + op_at, "<u8") == _OP_MSG_WORD)
+        if not bool(standard.all()):
+            start, length = self.spans(buf, offsets, where)
+            self.check_heads(buf, start, t_ns, conn, where)
+            return start, length
+        start = offsets + head
+        length = col(head - 4, "<u4").astype(np.int64)
+        if int((start + length).max()) > len(buf):
+            raise BagError(f"message data cut off inside its chunk {where}")
+        got_t = np.multiply(col(4 + time_at, "<u4"), 1_000_000_000, dtype=np.int64)
+        got_t += col(4 + time_at + 4, "<u4")
+        bad = got_t != t_ns
+        bad |= col(4 + conn_at, "<u4") != conn
+        if bool(bad.any()):
+            idx = np.flatnonzero(bad)
+            self.check_heads(buf, start[idx], t_ns[idx], conn[idx], where)
+        return start, length
+
+    @staticmethod
+    def check_heads(buf: U8, start: I64, t_ns: I64, conn: I64, where: str) -> None:
+        """Each message record (data at ``start``) carries the time and connection of the
+        index entry it was found by, as rosbags asserts: a damaged index entry, or a damaged
+        record header, would otherwise give a pose at a wrong time or on a wrong topic.
+
+        The record header is the 38 bytes before each data length; the first record tells
+        where its conn and time values sit, every record is read there at once, and only a
+        record that disagrees is parsed field by field (a writer may order fields otherwise).
+        """
+        from ertools.io.decode.fast import gather
+
+        n = len(start)
+        if not n:
+            return
+        head_at = start - 4 - MSG_HEADER_LEN
+        at = _value_offsets(buf, int(head_at[0]))
+        bad = np.ones(n, dtype=bool)
+        if at is not None and int(head_at.min()) >= 0:
+            # one gather of the stretch holding both values, read as strided columns
+            conn_at, time_at = at
+            a = min(conn_at, time_at)
+            width = max(conn_at + 4, time_at + 8) - a
+            rows = gather(buf, head_at + a, width)
+
+            def col(offset: int) -> npt.NDArray[np.uint32]:
+                return np.ndarray((n,), "<u4", buffer=rows, offset=offset - a, strides=(width,))
+
+            got_t = np.multiply(col(time_at), 1_000_000_000, dtype=np.int64)
+            got_t += col(time_at + 4)
+            bad = got_t != t_ns
+            bad |= col(conn_at) != conn
+        for i in np.flatnonzero(bad).tolist():
+            # the header just before this record's data length, whatever its layout
+            found = _fields_before(buf, int(start[i]))
+            if found is None or found != (int(conn[i]), int(t_ns[i])):
+                raise BagError(
+                    "message record's connection or time differs from its index entry "
+                    f"(damaged index or record) {where}"
+                )
+
+    @staticmethod
+    def _resolve(buf: bytes, off: int, where: str) -> tuple[int, int]:
+        pos = off
+        while True:
+            if pos + 4 > len(buf):
+                raise BagError(f"message record cut off inside its chunk {where}")
+            hlen = int.from_bytes(buf[pos : pos + 4], "little")
+            try:
+                fields = parse_fields(buf[pos + 4 : pos + 4 + hlen], pos + 4)
+            except RecordError as err:
+                raise BagError(f"damaged message record in chunk {where} ({err})") from err
+            dlen = int.from_bytes(buf[pos + 4 + hlen : pos + 8 + hlen], "little")
+            op = fields.get("op", b"\x00")[0]
+            if op == OP_MSG:
+                return pos + 8 + hlen, dlen
+            if op != OP_CONNECTION:
+                raise BagError(f"index points at a record of op {op}, not a message, {where}")
+            pos = pos + 8 + hlen + dlen
+
+    def raw(
+        self, conns: Sequence[Conn], start_ns: int | None = None, end_ns: int | None = None
+    ) -> Iterator[RawRecord]:
+        """Raw messages in the reference order, located in bulk (chunks read a few at a time;
+        the requested messages' bytes are held until yielded in order)."""
+        if not conns:
+            return
+        from ertools.io.bulk import locate
+
+        _touched, _chunk_of, rank_of, _t, _off = self.select(conns, start_ns, end_ns)
+        found = locate(self, conns, start_ns, end_ns)
+        assert found is not None
+        out: list[tuple[int, int, bytes]] = []
+        for pos, buf, start, length, t_rec in found.runs:
+            data = buf.tobytes()
+            out.extend(
+                (p, t, data[a : a + n])
+                for p, t, a, n in zip(
+                    pos.tolist(), t_rec.tolist(), start.tolist(), length.tolist(), strict=True
+                )
+            )
+        out.sort(key=lambda x: x[0])
+        for p, t, data in out:
+            yield conns[int(rank_of[p])], t, data
+
+    def verify(self, progress: Reporter | None = None) -> None:
+        """Decompress every chunk and check that every indexed record is a message record
+        (the chunks' bytes reported to ``progress``).
+
+        Raises:
+            BagError: the first damaged chunk, with its byte offset.
+        """
+        if progress is not None:
+            total = sum(max(c.data_len, 0) for c in self.layout.chunks)
+            progress.task(f"checking {self.path.name}", total, "B")
+        for chunk in self.layout.chunks:
+            where = self._where(chunk)
+            buf = np.frombuffer(self.chunk_bytes(chunk), dtype=np.uint8)
+            if progress is not None:
+                progress.advance(max(chunk.data_len, 0))
+            for cid, (_t, off) in self.chunk_entries(chunk).items():
+                try:
+                    self.spans(buf, off, where)
+                except BagError as err:
+                    raise BagError(
+                        f"corrupt chunk at byte {chunk.pos}: connection {cid}: {err.message}",
+                        path=self.path,
+                    ) from err

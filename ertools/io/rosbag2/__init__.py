@@ -1,0 +1,1 @@
+"""rosbag2 folders: metadata.yaml and the sqlite3 / MCAP storage behind it."""

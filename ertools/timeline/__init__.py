@@ -1,0 +1,1 @@
+"""Bags from many machines ordered by time: scan the files, build the sessions, pair them."""

@@ -1,0 +1,257 @@
+"""The IO edge of the timeline: find bags, summarise them, check their clocks.
+
+Everything read here goes through :mod:`ertools.io`: summaries come from each file's index
+(never its message data), and the clock check decodes only the first second of one pose topic
+per bag with a windowed read. :func:`scan` returns the pure
+:class:`~ertools.timeline.build.Timeline`.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from ertools.timeline.build import (
+    ClockCheck,
+    Timeline,
+    TimelineConfig,
+    Unreadable,
+    build_timeline,
+    split_name,
+)
+from ertools.timeutil import NS_PER_S
+
+if TYPE_CHECKING:
+    from ertools.io import BagSummary
+    from ertools.progress import Reporter
+
+log = logging.getLogger("ertools.timeline.scan")
+
+BAG_SUFFIXES = (".bag", ".bag.active", ".mcap")
+# Types whose header stamp the clock check compares with the record time, best first: the
+# mocap node's own poses, then tf (whose static transforms may be stamped in the future).
+CLOCK_TYPES = (
+    "geometry_msgs/PoseStamped",
+    "geometry_msgs/TransformStamped",
+    "geometry_msgs/PoseWithCovarianceStamped",
+    "nav_msgs/Odometry",
+    "tf2_msgs/TFMessage",
+    "tf/tfMessage",
+)
+CLOCK_WINDOW_NS = NS_PER_S  # the first second of the topic: ~120 mocap messages
+CLOCK_MAX_SAMPLES = 50
+
+
+@dataclass(frozen=True)
+class Found:
+    """Bags found under the given paths (sorted), and paths that gave none."""
+
+    bags: tuple[Path, ...]
+    problems: tuple[Unreadable, ...]
+
+
+def _is_rosbag2_dir(path: Path) -> bool:
+    return (path / "metadata.yaml").is_file() or any(path.glob("*.db3"))
+
+
+def _is_bag_file(name: str) -> bool:
+    return name.endswith(BAG_SUFFIXES)
+
+
+def find_bags(paths: Iterable[Path]) -> Found:
+    """Bags under ``paths``: ``.bag``, ``.bag.active``, ``.mcap`` files and rosbag2 folders.
+
+    A file named explicitly is taken whatever its name (the reader then says whether it is a
+    bag); directories are walked recursively, and a rosbag2 folder counts as one bag.
+    """
+    bags: list[Path] = []
+    problems: list[Unreadable] = []
+    for root in paths:
+        if not root.exists():
+            problems.append(Unreadable(str(root), "no such file or directory"))
+            continue
+        if root.is_file() or _is_rosbag2_dir(root):
+            bags.append(root)
+            continue
+        before = len(bags)
+        for dirpath, dirnames, filenames in os.walk(root):
+            here = Path(dirpath)
+            keep = []
+            for d in sorted(dirnames):
+                if _is_rosbag2_dir(here / d):
+                    bags.append(here / d)
+                else:
+                    keep.append(d)
+            dirnames[:] = keep  # do not descend into rosbag2 folders
+            bags.extend(here / f for f in sorted(filenames) if _is_bag_file(f))
+        if len(bags) == before:
+            problems.append(
+                Unreadable(str(root), "no bags here (.bag, .bag.active, .mcap or rosbag2)")
+            )
+    unique = sorted(dict.fromkeys(bags), key=str)
+    return Found(tuple(unique), tuple(problems))
+
+
+def clock_check(
+    s: BagSummary, window_ns: int = CLOCK_WINDOW_NS, topic_name: str | None = None
+) -> ClockCheck | None:
+    """Median record time minus header stamp over the first messages of one pose topic.
+
+    The topic is ``topic_name``, else the best header-stamped pose topic of the bag. None when
+    there is none. When the data cannot be read (a damaged chunk the index does not reveal),
+    the check carries the reader's message in ``error``.
+    """
+    from ertools.io.files import open_bag
+    from ertools.io.reader import load_pose_batch
+
+    rank = {t: i for i, t in enumerate(CLOCK_TYPES)}
+    cands = sorted(
+        (t for t in s.topics if t.msgtype in rank and t.count and t.first_ns is not None),
+        key=lambda t: (rank[t.msgtype], t.name == "/tf_static", t.name),
+    )
+    cands = [
+        t
+        for t in cands
+        if (t.name == topic_name if topic_name is not None else t.name != "/tf_static")
+    ]
+    if not cands:
+        return None
+    topic = cands[0]
+    assert topic.first_ns is not None and topic.last_ns is not None
+    try:
+        with open_bag(s.path) as bag:
+            conns = bag.topic_conns(topic.name)
+            # The summary's first time is the start of the topic's first chunk, which may hold
+            # seconds of other topics first: widen the window until messages come.
+            window = window_ns
+            while True:
+                batch = load_pose_batch(bag, conns, topic.first_ns, topic.first_ns + window)
+                if len(batch) or topic.first_ns + window >= topic.last_ns:
+                    break
+                window *= 8
+    except Exception as err:  # damaged data the index did not show: report it, go on
+        from ertools.errors import ErtoolsError
+
+        text = err.message if isinstance(err, ErtoolsError) else f"{type(err).__name__}: {err}"
+        log.debug("clock check of %s failed: %s", s.path, text)
+        return ClockCheck(str(s.path), topic.name, 0, 0, error=text)
+    if len(batch) == 0:
+        return None
+    diff = (batch.t_record - batch.t_header)[:CLOCK_MAX_SAMPLES]
+    import numpy as np
+
+    return ClockCheck(str(s.path), topic.name, int(np.median(diff)), len(diff))
+
+
+def check_recordings(
+    summaries: Sequence[BagSummary],
+    tolerance_ns: int,
+    on_progress: Callable[[int], None] | None = None,
+) -> list[ClockCheck]:
+    """Clock checks, one per recording unless it finds a problem.
+
+    A machine's clock offset does not change between the split files of one recording, so
+    only the first file of each (``split_name`` group) is read; when it is off by more than
+    ``tolerance_ns`` the other files of that recording are checked too, so every flagged
+    file was measured. Files that are not split files are each checked.
+    """
+    groups: dict[str, list[tuple[int, BagSummary]]] = {}
+    for s in summaries:
+        split = split_name(s.path)
+        key, index = (split[0], split[1]) if split is not None else (str(s.path), 0)
+        groups.setdefault(key, []).append((index, s))
+    checks: list[ClockCheck] = []
+    done = 0
+    for members in groups.values():
+        members.sort(key=lambda m: m[0])
+        first = clock_check(members[0][1])
+        done += 1
+        if on_progress is not None:
+            on_progress(done)
+        if first is None:
+            continue
+        checks.append(first)
+        if abs(first.offset_ns) > tolerance_ns:
+            for _, s in members[1:]:
+                c = clock_check(s)
+                if c is not None:
+                    checks.append(c)
+    return checks
+
+
+def _ticker(progress: Reporter) -> Callable[[int], None]:
+    """``on_progress(done)`` callbacks (a count so far) as the reporter's increments."""
+    last = [0]
+
+    def tick(done: int) -> None:
+        progress.advance(done - last[0])
+        last[0] = done
+
+    return tick
+
+
+def summarise(
+    bags: Sequence[Path], on_progress: Callable[[int], None] | None = None
+) -> tuple[list[BagSummary], list[Unreadable]]:
+    """Summaries of the readable bags and one line for each unreadable one."""
+    from ertools.errors import ErtoolsError
+    from ertools.io import summary
+
+    good: list[BagSummary] = []
+    bad: list[Unreadable] = []
+    for i, path in enumerate(bags):
+        try:
+            good.append(summary(path))
+        except ErtoolsError as err:
+            bad.append(Unreadable(str(path), err.message))
+        except Exception as err:  # a reader bug on one odd file must not hide the others
+            log.debug("summary of %s failed", path, exc_info=True)
+            bad.append(Unreadable(str(path), f"unreadable ({type(err).__name__}: {err})"))
+        if on_progress is not None:
+            on_progress(i + 1)
+    return good, bad
+
+
+def scan(
+    paths: Sequence[str | Path],
+    config: TimelineConfig | None = None,
+    *,
+    check_clocks: bool = True,
+    progress: Reporter | None = None,
+) -> Timeline:
+    """Find, summarise and clock-check the bags under ``paths`` and build their timeline.
+
+    Args:
+        paths: files and folders.
+        config: thresholds.
+        check_clocks: compare header stamps with record times (reads a second per bag).
+        progress: gets the bags summarised, then the recordings clock-checked.
+    """
+    from ertools.progress import reporting
+
+    found = find_bags(Path(p) for p in paths)
+    with reporting(None):  # counted by bag and recording: the reads inside do not report
+        return _scan(found, config, check_clocks, progress)
+
+
+def _scan(
+    found: Found, config: TimelineConfig | None, check_clocks: bool, progress: Reporter | None
+) -> Timeline:
+    tick: Callable[[int], None] | None = None
+    if progress is not None:
+        progress.task("summarising", len(found.bags), "bags")
+        tick = _ticker(progress)
+    summaries, unreadable = summarise(found.bags, tick)
+    checks: list[ClockCheck] = []
+    if check_clocks:
+        tolerance = (config or TimelineConfig()).clock_tolerance_ns
+        if progress is not None:  # one check per recording (see check_recordings)
+            recordings = {(split_name(s.path) or (s.path, 0))[0] for s in summaries}
+            progress.task("checking clocks", len(recordings), "recordings")
+            tick = _ticker(progress)
+        checks = check_recordings(summaries, tolerance, tick)
+    return build_timeline(summaries, [*found.problems, *unreadable], checks, config)
