@@ -211,7 +211,7 @@ def find_gt_files(
 ) -> tuple[list[BagSummary], str, list[str], list[str]]:
     """The GT files of GT_PATH overlapping [start, end], their topic, warnings, damaged files."""
     from ertools.io import summary
-    from ertools.timeline.scan import find_bags
+    from ertools.io.formats import find_bags
 
     found = find_bags([Path(p) for p in gt_paths])
     if not found.bags:
