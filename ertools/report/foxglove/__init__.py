@@ -21,7 +21,7 @@ from ertools.errors import UsageError
 # ``module.Class`` of a result -> ``module:function`` adding its content to a Collected.
 # Dotted names, not classes: nothing is imported until a file is written.
 CONTENT: dict[str, str] = {
-    "ertools.benchmarks.trajectory.benchmark.TrajectoryResult": (
+    "ertools.benchmarks.trajectory.result.TrajectoryResult": (
         "ertools.report.foxglove.trajectory:content"
     ),
     "ertools.benchmarks.fbm3w.result.Fbm3wResult": "ertools.report.foxglove.fbm3w:content",
