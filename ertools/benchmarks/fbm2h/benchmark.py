@@ -194,7 +194,7 @@ def compute(
         )
     if hits is not None and hits < 0:
         raise ConfigError(f"--hits must be >= 0, got {hits}")
-    from ertools.benchmarks.trajectory.benchmark import drop_invalid
+    from ertools.benchmarks.common.hygiene import drop_invalid
 
     marker, invalid = drop_invalid(marker)
     all_warnings = list(warnings)
@@ -527,7 +527,7 @@ def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
         ConfigError, SegmentationError, ScoringError: no bag, bad configs, no poses, no
             state topics when the reached moments need them.
     """
-    from ertools.benchmarks.trajectory.benchmark import drop_invalid
+    from ertools.benchmarks.common.hygiene import drop_invalid
     from ertools.configs.goal import load_goal
     from ertools.io import read_benchmark_states, read_pose_source, summary
 
