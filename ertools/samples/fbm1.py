@@ -42,7 +42,6 @@ import numpy.typing as npt
 import yaml
 from scipy.spatial.transform import Rotation
 
-from ertools.benchmarks.fbm1.benchmark import BENCHMARKS
 from ertools.samples.mocap import (
     MocapNoise,
     frame_times,
@@ -62,7 +61,7 @@ F64 = npt.NDArray[np.float64]
 S = 1_000_000_000
 MS = 1_000_000
 
-NAMESPACE = BENCHMARKS[0]
+NAMESPACE = "fbm1h"
 ITEMS_FILE = "fbm1h.yaml"
 NOON_NS = EPOCH_2015 + 2 * 3600 * S
 SIGMA_M = 2.0e-4
@@ -411,7 +410,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     answers = write_answers(
         bag_path,
         benchmark=NAMESPACE,
-        scenario=NAMESPACE,
+        scenario="fbm1h",
         seed=seed,
         parameters=sim.parameters,
         truth=sim.truth,

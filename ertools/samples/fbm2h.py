@@ -45,7 +45,6 @@ import numpy.typing as npt
 import yaml
 from scipy.spatial.transform import Rotation, Slerp
 
-from ertools.benchmarks.fbm2h.benchmark import NAMESPACE as FBM2H
 from ertools.samples.mocap import (
     MocapNoise,
     MocapPublished,
@@ -66,7 +65,7 @@ from ertools.streams import Machine
 F64 = npt.NDArray[np.float64]
 S = 1_000_000_000
 
-NAMESPACE = FBM2H
+NAMESPACE = "fbm2h"
 BODY = "robot_at_home"
 TEAM = "simbot"
 NOON_NS = EPOCH_2015 + 2 * 3600 * S  # noon of the competition day
@@ -389,7 +388,7 @@ def simulate(
         for k in range(len(WAYPOINTS))
     ]
     return SimulatedRun(
-        benchmark=NAMESPACE,
+        benchmark="fbm2h",
         namespace=NAMESPACE,
         start_ns=start,
         end_ns=int(pub.t_record_ns[-1]) + 50_000_000,
@@ -484,8 +483,8 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     )
     answers = write_answers(
         bag_path,
-        benchmark=NAMESPACE,
-        scenario=NAMESPACE,
+        benchmark="fbm2h",
+        scenario="fbm2h",
         seed=seed,
         parameters={
             **sim.parameters,

@@ -43,7 +43,6 @@ import numpy as np
 import numpy.typing as npt
 import yaml
 
-from ertools.benchmarks.fbm3w.benchmark import NAMESPACE as FBM3W
 from ertools.geometry import quat_from_yaw
 from ertools.samples.mocap import (
     MocapNoise,
@@ -64,7 +63,7 @@ F64 = npt.NDArray[np.float64]
 Motion = Callable[[F64], F64]  # time (s from the mocap start) -> (N, 2) world positions
 S = 1_000_000_000
 
-NAMESPACE = FBM3W
+NAMESPACE = "fbm3w"
 CONFIG_FILE = "fbm3w.yaml"
 NOON_NS = EPOCH_2015 + 2 * 3600 * S
 BODY = "robot_at_work"
@@ -447,8 +446,8 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     config.write_text(sim.configs[CONFIG_FILE], encoding="utf-8")
     answers = write_answers(
         paths,
-        benchmark=NAMESPACE,
-        scenario=NAMESPACE,
+        benchmark="fbm3w",
+        scenario="fbm3w",
         seed=seed,
         parameters=sim.parameters,
         truth=sim.truth,

@@ -1184,7 +1184,7 @@ def test_fbm2h_reached_before_the_bag(inputs: Inputs, capsys: pytest.CaptureFixt
 # to end in "unexpected OverflowError" or, for fbm1's --still nan, in a score).
 NUMBER_OPTIONS: dict[str, Callable[[Inputs], list[str]]] = {
     "timeline --clock-tolerance": lambda i: ["timeline", str(i.fbm2h), "--clock-tolerance"],
-    "fbm2h --max-gap": lambda i: ["score", "fbm2h", str(i.fbm2h), "--max-gap"],
+    "fbm2h --gt-tolerance": lambda i: ["score", "fbm2h", str(i.fbm2h), "--gt-tolerance"],
     "fbm2h --stop-speed": lambda i: ["score", "fbm2h", str(i.fbm2h), "--stop-speed"],
     "fbm1h --still": lambda i: ["score", "fbm1h", str(i.fbm1h), "--items", str(i.items), "--still"],
     "fbm1h --max-window": lambda i: [

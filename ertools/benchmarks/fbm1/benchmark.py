@@ -588,7 +588,7 @@ def read_body(
             raise TopicError(
                 f"{topic_err.message}; no /tf frame {frame!r} either "
                 f"(choose the {frame} body with --{frame.replace('_', '-')}-topic or "
-                f"--{frame.replace('_', '-')}-frame)"
+                f"--{frame.replace('_', '-')}-tf PARENT:CHILD)"
             ) from topic_err
         log.info("%s: using /tf frame %s (no %s)", paths[0], frame, default_topic)
         return stream

@@ -194,7 +194,7 @@ def compute(
         )
     if hits is not None and hits < 0:
         raise ConfigError(f"--hits must be >= 0, got {hits}")
-    from ertools.benchmarks.trajectory.benchmark import drop_invalid
+    from ertools.benchmarks.common.hygiene import drop_invalid
 
     marker, invalid = drop_invalid(marker)
     all_warnings = list(warnings)
@@ -250,7 +250,7 @@ def compute(
                 else (f"nearest GT sample {gap / 1e9:.3g} s away")  # 3 digits, even below 1 ms
             )
             failures.append(
-                f"segment {i}: no ground truth within --max-gap {max_gap_s} s of the reached "
+                f"segment {i}: no ground truth within --gt-tolerance {max_gap_s} s of the reached "
                 f"moment {ns_to_s(end - t_rel0):.3f} s after {since} "
                 f"({nearest}; tracking lost?) in {marker.source or 'the pose stream'}"
             )
@@ -408,7 +408,7 @@ def _frozen_warnings(
 ) -> list[str]:
     """A warning per scored reached moment whose ground truth is a frozen (repeated) pose.
 
-    The threshold is ``--max-gap``: a frozen stretch longer than the gap ertools accepts hides
+    The threshold is ``--gt-tolerance``: a frozen stretch longer than the gap ertools accepts hides
     a tracking loss of the size it refuses (see
     :data:`ertools.benchmarks.noise.benchmark.FROZEN_MIN_S`).
     """
@@ -527,7 +527,7 @@ def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
         ConfigError, SegmentationError, ScoringError: no bag, bad configs, no poses, no
             state topics when the reached moments need them.
     """
-    from ertools.benchmarks.trajectory.benchmark import drop_invalid
+    from ertools.benchmarks.common.hygiene import drop_invalid
     from ertools.configs.goal import load_goal
     from ertools.io import read_benchmark_states, read_pose_source, summary
 

@@ -40,7 +40,11 @@ AUTO = "--reached auto (stop detection)"
 INPUTS = (
     Input("goal", "path", "goal list (Listing 10); default: from the log", metavar="FILE"),
     Input(
-        "transform", "path", "marker-to-robot transform (Listing 11)", metavar="FILE", per_team=True
+        "transform",
+        "path",
+        "marker-to-robot transform (Listing 11)",
+        metavar="FILE",
+        per_team=True,  # each team's robot carries its own marker set
     ),
     Input("transforms", "path", "folder of transform-<team>.yaml files", metavar="DIR"),
     Input(

@@ -11,19 +11,21 @@ from typing import Any
 
 from ertools.benchmarks.base import Benchmark, Input, Ranking, resolve_values
 from ertools.benchmarks.trajectory.benchmark import (
+    TrajectoryLogs,
+    TrajectoryOptions,
+    load,
+    locate_runs,
+    score_found,
+)
+from ertools.benchmarks.trajectory.config import (
     ASSOCIATIONS,
     BEFORE_GT,
     GAPS,
     SETTINGS_2015,
     TIES,
     TrajectoryConfig,
-    TrajectoryLogs,
-    TrajectoryOptions,
-    TrajectoryResult,
-    load,
-    locate_runs,
-    score_found,
 )
+from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.errors import ConfigError, UsageError
 from ertools.timeutil import s_to_ns
 

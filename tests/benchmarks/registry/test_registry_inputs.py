@@ -137,7 +137,7 @@ def _argv(declared: Input, value: Any) -> list[str]:
         ("fbm3w", {"d_min": -0.001}, "--d-min must be >= 0 m, got -0.001"),
         ("fbm3w", {"d_min": 0.2}, "larger than 5 cm"),
         ("fbm3w", {"still_speed": 0.0}, "--still-speed must be positive"),
-        ("fbm2h", {"max_gap": -1}, "--max-gap must be positive"),
+        ("fbm2h", {"gt_tolerance": -1}, "--gt-tolerance must be positive"),
         ("fbm2h", {"hits": 1.5}, "--hits must be a whole number"),
         ("fbm2h", {"reached": ("timing",)}, "--reached timing needs exactly one FILE"),
         ("trajectory", {"offset": "soon"}, "--offset takes seconds or 'auto'"),
