@@ -31,7 +31,8 @@ from ertools.export.formats import SUFFIXES, ExportFormat, format_poses, format_
 from ertools.streams import PoseStream
 
 if TYPE_CHECKING:
-    from ertools.benchmarks.trajectory.benchmark import TrajectoryConfig, TrajectoryResult
+    from ertools.benchmarks.trajectory.config import TrajectoryConfig
+    from ertools.benchmarks.trajectory.result import TrajectoryResult
     from ertools.io import PoseSource
 
 # GT read around the robot poses for the raw pair: evo's association only looks a few
@@ -102,13 +103,10 @@ def trajectory_pair(
     Raises:
         ScoringError: ``matched`` and no pose could be compared; the errors of ``score``.
     """
-    from ertools.benchmarks.trajectory.benchmark import (
-        COMPARED,
-        drop_duplicates,
-        drop_invalid,
-        read_gt,
-        score,
-    )
+    from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid
+    from ertools.benchmarks.trajectory.association import COMPARED
+    from ertools.benchmarks.trajectory.benchmark import score
+    from ertools.benchmarks.trajectory.inputs import read_gt
 
     result = score(
         robot_bag,
