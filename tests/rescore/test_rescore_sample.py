@@ -121,6 +121,8 @@ def test_every_execution_as_its_answers(day: tuple[Path, dict[str, Any], dict[st
                 assert abs(got - want) <= e["tolerance"][field]["abs"], (e["id"], field)
             else:
                 assert got == want, (e["id"], field)
+        # the score the live 2015 BmBox sent, as the logs hold it
+        assert row["live_score"] == e["live_score"], e["id"]
         # exactly the single command's JSON for the same inputs
         assert row["score"] == _cli_json(root, e, e["team"]), e["id"]
 
