@@ -171,7 +171,7 @@ def test_trajectory_robot_topic_accepts_every_type(typed_bag: Path, topic: str) 
     np.testing.assert_array_equal(rec.t_ns, t_rec)
     np.testing.assert_array_equal(rec.xyz[:, :2], xyz[:, :2])
     if TOPICS[topic][0] == "geometry_msgs/Pose2D":
-        with pytest.raises(TopicError, match="no header stamp; give --robot-time record"):
+        with pytest.raises(TopicError, match="no header stamp; give --robot-time-source record"):
             read_robot(str(typed_bag), topic, "header")
     else:
         np.testing.assert_array_equal(read_robot(str(typed_bag), topic, "header").t_ns, t_hdr)

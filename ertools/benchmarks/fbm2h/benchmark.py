@@ -465,7 +465,7 @@ def _pose_source(options: Fbm2hOptions) -> PoseSource:
     from ertools.io import PoseSource
 
     if options.topic is not None and options.tf_frame is not None:
-        raise ConfigError("give either --topic or --tf-frame, not both")
+        raise ConfigError("give either --topic or --tf, not both")
     if options.tf_frame is not None:
         return PoseSource(
             topic=None,

@@ -66,7 +66,7 @@ def read_robot(path: str, topic: str, time_source: str) -> PoseStream:
         if "geometry_msgs/Pose2D" in types and time_source == "header":
             raise TopicError(
                 f"robot topic {topic} has type geometry_msgs/Pose2D, which has no header "
-                "stamp; give --robot-time record",
+                "stamp; give --robot-time-source record",
                 path=path,
             )
         batch = load_pose_batch(bag, conns, None, None)

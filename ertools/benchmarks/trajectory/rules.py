@@ -129,7 +129,7 @@ RULE_ROBOT_STAMPS = Rule(
     ),
     ertools=(
         "an error naming the message; no option: the 2015 pairing there is not the GT at the "
-        "robot's time (--robot-time record scores by the robot bag's record times instead)"
+        "robot's time (--robot-time-source record scores by the robot bag's record times instead)"
     ),
     option="",
 )

@@ -51,7 +51,7 @@ def check_increasing(robot: PoseStream, where: str) -> None:
             f"{where}: robot stamps do not increase: message {i} is stamped "
             f"{iso_utc(int(robot.t_ns[i]))}, not after message {i - 1} at "
             f"{iso_utc(int(robot.t_ns[i - 1]))} ({bad.size} such place(s)); "
-            "fix the robot's clock or use --robot-time record"
+            "fix the robot's clock or use --robot-time-source record"
         )
 
 
