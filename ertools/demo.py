@@ -11,6 +11,7 @@ from contextlib import redirect_stdout
 from dataclasses import dataclass
 from pathlib import Path
 
+from ertools.benchmarks import registry
 from ertools.cli.main import main as ertools_main
 
 SAMPLES = Path(__file__).resolve().parent.parent / "sample_bags"
@@ -39,81 +40,41 @@ def steps(samples: Path, out: Path) -> Iterator[Step]:
         ["timeline", str(samples), "--plot", str(out / "timeline.png")],
         "timeline.txt",
     )
-    fbm3 = samples / "fbm3w"
-    fbm3_bag = _first(fbm3, "*.bag")
-    yield Step("info of the FBM3@Work bag", ["info", str(fbm3_bag)], "info_fbm3w.txt")
+    samples_by_name = {}
+    for name in registry.names():
+        bench = registry.get(name)
+        sample = bench.sample(samples) if bench.sample is not None else None
+        if sample is not None:
+            samples_by_name[name] = list(sample)
+    if not samples_by_name:
+        raise SystemExit(f"demo: no sample logs in {samples}: run `make samples` first")
+    first, first_sample = next(iter(samples_by_name.items()))
     yield Step(
-        "FBM3@Work score",
-        [
-            "score",
-            "fbm3w",
-            str(fbm3_bag),
-            "--report",
-            str(out / "fbm3w"),
-            "--foxglove",
-            str(out / "fbm3w.mcap"),
-        ],
-        "fbm3w_score.yaml",
+        f"info of the {registry.get(first).title} bag",
+        ["info", first_sample[0]],
+        f"info_{first}.txt",
     )
-    fbm2 = samples / "fbm2h"
-    fbm2_bag = _first(fbm2, "*.bag")
-    yield Step(
-        "FBM2@Home score",
-        [
-            "score",
-            "fbm2h",
-            str(fbm2_bag),
-            "--goal",
-            str(_first(fbm2, "*goal*.yaml")),
-            "--transform",
-            str(_first(fbm2, "transform-*.yaml")),
-            "--report",
-            str(out / "fbm2h"),
-        ],
-        "fbm2h_score.yaml",
-    )
-    fbm1 = samples / "fbm1h"
-    fbm1_bag = _first(fbm1, "*.bag")
-    yield Step(
-        "FBM1@Home score",
-        [
-            "score",
-            "fbm1h",
-            str(fbm1_bag),
-            "--items",
-            str(_first(fbm1, "fbm1h.yaml")),
-            "--report",
-            str(out / "fbm1h"),
-        ],
-        "fbm1h_score.yaml",
-    )
-    robot = samples / "robotlog"
-    robot_bag = _first(robot, "FBM2H_*.bag")
-    yield Step(
-        "robot log vs ground truth",
-        [
-            "score",
-            "trajectory",
-            str(robot_bag),
-            str(robot),
-            "--offset",
-            "auto",
-            "--apply-offset",
-            "--report",
-            str(out / "trajectory"),
-        ],
-        "trajectory_score.yaml",
-    )
+    for name, sample in samples_by_name.items():
+        bench = registry.get(name)
+        foxglove = ["--foxglove", str(out / f"{name}.mcap")] if bench.foxglove else []
+        yield Step(
+            f"{bench.title} score",
+            ["score", name, *sample, "--report", str(out / name), *foxglove],
+            f"{name}_score.yaml",
+        )
     yield Step(
         "noise of the stationary marker set",
         ["noise", str(_first(samples / "stationary", "*.bag")), "--format", "json"],
         "noise.json",
     )
-    yield Step(
-        "audit of the FBM2@Home benchmark",
-        ["audit", str(fbm2_bag), "--report", str(out / "audit_fbm2h")],
-        "audit_fbm2h.txt",
-    )
+    for name, sample in samples_by_name.items():
+        bench = registry.get(name)
+        if bench.state_topics:
+            yield Step(
+                f"audit of the {bench.title} benchmark",
+                ["audit", sample[0], "--format", "text", "--report", str(out / f"audit_{name}")],
+                f"audit_{name}.txt",
+            )
 
 
 def run(out: Path, samples: Path = SAMPLES) -> int:
@@ -134,8 +95,9 @@ def run(out: Path, samples: Path = SAMPLES) -> int:
     print("\nReports written:", file=sys.stderr)
     for p in index:
         print(f"  {p}", file=sys.stderr)
-    print(f"Open {out.resolve()}/fbm3w/index.html in a browser to start.", file=sys.stderr)
-    print(f"Open {out.resolve()}/fbm3w.mcap in Foxglove (docs/foxglove.md).", file=sys.stderr)
+    print("Open one in a browser to start.", file=sys.stderr)
+    for mcap in sorted(out.glob("*.mcap"))[:1]:
+        print(f"Open {mcap.resolve()} in Foxglove (docs/foxglove.md).", file=sys.stderr)
     return failed
 
 

@@ -80,8 +80,6 @@ STATE_TOPIC_SUFFIXES: dict[Machine, tuple[str, ...]] = {
     Machine.CLIENT: ("client_state",),
 }
 
-BENCHMARK_NAMESPACES = ("fbm1h", "fbm1w", "fbm2h", "fbm3w")
-
 # BmBox transitions the 2015 implementation allowed (issue 8 / seed Figure 6.2.1).
 BMBOX_TRANSITIONS: dict[BmBoxState, frozenset[BmBoxState]] = {
     BmBoxState.START: frozenset({BmBoxState.WAITING_CLIENT, BmBoxState.END}),

@@ -401,7 +401,8 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ),
         (
             "code",
-            "from ertools.benchmarks.trajectory.benchmark import TrajectoryConfig, score\n\n"
+            "from ertools.benchmarks.trajectory.benchmark import score\n"
+            "from ertools.benchmarks.trajectory.config import TrajectoryConfig\n\n"
             "robot_path = Path(robot_bag)\n"
             "gt_paths = [Path(gt)] if isinstance(gt, str) else [Path(g) for g in gt]\n"
             + LOAD_ANSWERS

@@ -16,12 +16,13 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 from ertools.audit.model import Audit, ScoreComparison, ScoreLine
-from ertools.benchmarks.base import jsonable
-from ertools.configs.transform import MarkerTransform
+from ertools.benchmarks import registry
+from ertools.benchmarks.base import Explanation, jsonable
+from ertools.configs.transform import LIVE_TRANSFORM_KEY, MarkerTransform, live_transform
 
 if TYPE_CHECKING:
     from ertools.benchmarks.base import BenchmarkResult
@@ -125,66 +126,14 @@ def _align_indices(live: Any, recomputed: Any, notes: list[str], path: str = "")
 # Explanations
 
 
-@dataclass(frozen=True)
-class _Rule:
-    pattern: str  # regex on the last key component
-    benchmarks: tuple[str, ...]  # () = every benchmark
-    text: str
-    params: tuple[str, ...] = ()  # parameter-name fragments worth showing
-
-
-_RULES: tuple[_Rule, ...] = (
-    _Rule(
-        r"distance_error$",
-        ("fbm3w",),
-        "the FBM3 path error depends on d_min (the 2015 node hard-coded 0.00033 m), on the "
-        "pose source and on which poses fall in the run window (the live node collected them "
-        "by callback while EXECUTING_GOAL/WAITING_RESULT; ertools takes the logged poses "
-        "between the logged state changes)",
-        ("d_min", "topic", "source", "frame", "runs"),
-    ),
-    _Rule(
-        r"^best_run$",
-        ("fbm3w",),
-        "the best run is the one with the smallest distance_error: it changes when the "
-        "per-run errors change",
-    ),
-    _Rule(
-        r"orientation_(error|accuracy)$",
-        ("fbm2h", "trajectory"),
-        "the 2015 node took sin and cos of the unwrapped |robot yaw - target yaw|; ertools "
-        "wraps the difference to [-pi, pi] first (identical unless the difference crosses "
-        "+-pi); the robot pose also depends on the marker-to-robot transform",
-        ("transform", "source", "topic", "reached"),
-    ),
-    _Rule(
-        r"(dinstance_error|distance_error|position_accuracy|position_error|robot_pose)$",
-        ("fbm2h", "trajectory"),
-        "the live node used the latest mocap pose when the result arrived; ertools "
-        "interpolates the logged ground truth at the logged moment the waypoint was reached "
-        "and applies the marker-to-robot transform as a full SE(3) composition",
-        ("transform", "source", "topic", "reached", "max_gap", "association"),
-    ),
-    _Rule(
+# Explanations every benchmark shares; a benchmark declares its own
+# (:attr:`ertools.benchmarks.base.Benchmark.explanations`), tried first.
+_GENERAL: tuple[Explanation, ...] = (
+    Explanation(
         r"(time|_time)$",
-        (),
         "the live node timed with its own wall clock (time.time()) as messages arrived; "
         "ertools uses the record times of the logged state messages (differences of a few "
         "milliseconds up to one 10 Hz heartbeat per transition)",
-    ),
-    _Rule(
-        r"(pose_score|x_error|y_error|theta_error|position|orientation)$",
-        ("fbm1h", "fbm1w"),
-        "the ground truth is averaged over the window in which the board stood still "
-        "(the 2015 node interpolated one tf lookup when the result arrived); theta is in "
-        "degrees",
-        ("window", "source", "topic", "items"),
-    ),
-    _Rule(
-        r"(class|instance)(_accuracy|_correct)?$",
-        ("fbm1h", "fbm1w"),
-        "class and instance are compared as text with the item list",
-        ("items",),
     ),
 )
 
@@ -212,9 +161,8 @@ def explain(
         pattern = _number_pattern(leaf, float(live), float(recomputed))
         if pattern:
             parts.append(pattern)
-    for rule in _RULES:
-        if rule.benchmarks and benchmark not in rule.benchmarks:
-            continue
+    own = registry.get(benchmark).explanations if benchmark in registry.names() else ()
+    for rule in (*own, *_GENERAL):
         if re.search(rule.pattern, leaf):
             parts.append(rule.text)
             wanted.extend(rule.params)
@@ -263,41 +211,11 @@ def _is_number(value: Any) -> bool:
 # Comparing
 
 
-# The live FBM2H score records the transform its node used (seed Listing 13: details.marker-robot
-# transform, [[x, y, z], [qx, qy, qz, qw]]); an audit given none re-scores with it.
-LIVE_TRANSFORM_KEY = "marker-robot transform"
 IDENTITY_CAVEAT = "identity transform: recomputed scores are not comparable with the live ones"
 # Score keys that depend on the robot pose, hence on the marker-to-robot transform.
 POSE_KEYS = re.compile(
     r"position|orientation|distance|dinstance|robot_pose|transform", re.IGNORECASE
 )  # "dinstance": the 2015 spelling (Listing 13)
-
-
-def live_transform(live: Any) -> MarkerTransform | None:
-    """The marker-to-robot transform the live FBM2H score says its node used, or None when the
-    payload has none (or not as ``[[x, y, z], [qx, qy, qz, qw]]``)."""
-    from ertools.configs.transform import parse_transform
-    from ertools.errors import ConfigError
-
-    if not isinstance(live, dict):
-        return None
-    details = live.get("details")
-    value = details.get(LIVE_TRANSFORM_KEY) if isinstance(details, dict) else None
-    if value is None:
-        value = live.get(LIVE_TRANSFORM_KEY)  # an early node wrote it at the top level
-    if value is None:
-        return None
-    try:
-        return parse_transform(
-            {
-                "robot_info": "live score",
-                "transform_timestamp": "0",
-                "marker_to_robot_transform": value,
-            },
-            source=f"the live score (details.{LIVE_TRANSFORM_KEY})",
-        )
-    except ConfigError:
-        return None
 
 
 def _identity_caveat(live: Any, result: BenchmarkResult) -> str:

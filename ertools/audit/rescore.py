@@ -10,9 +10,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ertools.audit.analyse import DEFAULT_MAX_SILENCE_NS, audit_states
-from ertools.audit.compare import LIVE_TRANSFORM_KEY, attach, live_transform
+from ertools.audit.compare import attach
 from ertools.audit.model import Audit
-from ertools.configs.transform import MarkerTransform
+from ertools.benchmarks import registry
 
 if TYPE_CHECKING:
     from ertools.benchmarks.base import BenchmarkResult
@@ -26,9 +26,10 @@ if TYPE_CHECKING:
 class ScoreInputs:
     """The scoring inputs an audit passes through to the benchmark's scorer.
 
-    Each scorer uses the ones it knows (``goal``/``transform``/``team``/``transforms``/``hits``
-    for fbm2h, ``items``/``results`` for fbm1, ``config``/``d_min`` for fbm3w, ``topic`` for
-    all); :func:`rescore` says which ones it ignored.
+    Each is the :class:`~ertools.benchmarks.base.Input` of the same name of the benchmark
+    audited, used when it declares one (``goal``, ``transform``, ``items``, ``config``,
+    ``d_min``, ``topic``...); :func:`rescore` says which ones it ignored. ``other`` holds
+    values for inputs outside this list (by input name).
     """
 
     goal: Path | None = None
@@ -41,147 +42,90 @@ class ScoreInputs:
     topic: str | None = None
     d_min: float | None = None
     hits: int | None = None
+    other: tuple[tuple[str, Any], ...] = ()
+
+    def values(self) -> dict[str, Any]:
+        """The inputs given, by name."""
+        out = {
+            f.name: getattr(self, f.name)
+            for f in fields(self)
+            if f.name != "other" and getattr(self, f.name) is not None
+        }
+        out.update(self.other)
+        return out
 
     def given(self) -> set[str]:
-        return {f.name for f in fields(self) if getattr(self, f.name) is not None}
+        return set(self.values())
 
 
-# What each benchmark's scorer uses of ScoreInputs.
-USES: dict[str, frozenset[str]] = {
-    "fbm2h": frozenset({"goal", "transform", "team", "transforms", "topic", "hits"}),
-    "fbm1h": frozenset({"items", "results"}),
-    "fbm1w": frozenset({"items", "results"}),
-    "fbm3w": frozenset({"config", "d_min", "topic"}),
-}
+def uses(benchmark: str) -> frozenset[str]:
+    """The inputs ``benchmark``'s scorer declares (none for an unknown name)."""
+    if benchmark not in registry.names():
+        return frozenset()
+    return frozenset(i.name for i in registry.get(benchmark).inputs)
 
 
-def _marker_transform(
-    benchmark: str, inputs: ScoreInputs, live: Any
-) -> tuple[MarkerTransform | None, tuple[str, ...]]:
-    """FBM2H without ``--transform``/``--transforms``: the transform the live score recorded,
-    and a note saying so; otherwise None (the inputs decide, identity when they say nothing).
-    ``--team`` alone names the team and picks no transform."""
-    if benchmark != "fbm2h" or inputs.given() & {"transform", "transforms"}:
-        return None, ()
-    found = live_transform(live)
-    if found is None:
-        return None, ()
-    t = ", ".join(f"{v:g}" for v in found.translation)
-    q = ", ".join(f"{v:.6g}" for v in found.quat_xyzw)
-    return found, (
-        f"transform taken from the live score (details.{LIVE_TRANSFORM_KEY}: [[{t}], [{q}]]); "
-        "give --transform or --team/--transforms to use another",
-    )
+def _scorer(benchmark: str) -> registry.AnyBenchmark:
+    """The registered benchmark an audit can recompute (its states are logged)."""
+    from ertools.errors import ScoringError
+
+    if benchmark not in registry.names() or not registry.get(benchmark).state_topics:
+        raise ScoringError(f"no scorer to recompute {benchmark!r} from an audit")
+    return registry.get(benchmark)
+
+
+def _options(
+    bench: registry.AnyBenchmark, values: dict[str, Any], live: Any
+) -> tuple[Any, tuple[str, ...]]:
+    """The benchmark's options from the values, adjusted from the live score
+    (:attr:`~ertools.benchmarks.base.Benchmark.from_live`)."""
+    options = bench.make_options(values)
+    if bench.from_live is None:
+        return options, ()
+    return bench.from_live(options, live)
 
 
 def rescore(
     benchmark: str, paths: Sequence[Path], inputs: ScoreInputs, live: Any = None
 ) -> tuple[BenchmarkResult, tuple[str, ...]]:
-    """Recompute ``benchmark``'s score from ``paths`` with the scorer of ``ertools.benchmarks``.
+    """Recompute ``benchmark``'s score from ``paths`` with its registered scorer.
 
-    ``live`` (the parsed live score) gives FBM2H the transform its node used when the inputs
-    name none (:func:`live_transform`).
+    ``live`` (the parsed live score) may complete the options (FBM2H: the transform its node
+    used when the inputs name none).
 
     Returns:
         The result, and notes about inputs the scorer does not use.
 
     Raises:
-        ScoringError: no scorer for that benchmark (yet).
+        ScoringError: no scorer for that benchmark.
         ErtoolsError: whatever the scorer raises for bad input.
     """
-    from ertools.errors import ConfigError, ScoringError
-
-    if benchmark not in USES:
-        raise ScoringError(f"no scorer to recompute {benchmark!r} from an audit")
-    ignored = sorted(inputs.given() - USES[benchmark])
+    bench = _scorer(benchmark)
+    declared = uses(benchmark)
+    given = inputs.values()
+    ignored = sorted(set(given) - declared)
     notes = tuple(f"--{name.replace('_', '-')} is not used by {benchmark}" for name in ignored)
+    values = {k: v for k, v in given.items() if k in declared}
+    options, said = _options(bench, values, live)
     plist = [Path(p) for p in paths]
-    result: BenchmarkResult
-    if benchmark == "fbm2h":
-        from ertools.benchmarks.fbm2h.benchmark import Fbm2hOptions, score_fbm2h
-
-        marker, said = _marker_transform(benchmark, inputs, live)
-        notes += said
-        result = score_fbm2h(
-            plist,
-            Fbm2hOptions(
-                goal=inputs.goal,
-                transform=inputs.transform,
-                team=inputs.team,
-                transforms_dir=inputs.transforms,
-                topic=inputs.topic,
-                hits=inputs.hits,
-                namespace=benchmark,
-                marker_transform=marker,
-            ),
-        )
-    elif benchmark in ("fbm1h", "fbm1w"):
-        from ertools.benchmarks.fbm1.benchmark import Fbm1Options, score_fbm1_bag
-
-        if inputs.items is None:
-            raise ConfigError(f"recomputing {benchmark} needs the item list: give --items FILE")
-        result = score_fbm1_bag(
-            plist,
-            inputs.items,
-            options=Fbm1Options(benchmark=benchmark),
-            results_path=inputs.results,
-        )
-    else:
-        result = _rescore_fbm3w(plist, inputs)
-    return result, notes
+    return bench.score(plist, options), notes + said
 
 
 def rescore_2015(
     benchmark: str, paths: Sequence[Path], inputs: ScoreInputs, live: Any = None
 ) -> BenchmarkResult | None:
-    """The score recomputed with every 2015 quirk the scorer can reproduce (fbm2h: unwrapped
-    orientation and unscored segments over N; fbm1: ``Fbm1Options.as_2015``; fbm3w:
-    ``--2015``: the hard-coded d_min of 0.33 mm, no arc-length parametrisation, timed-out runs
-    scored, stopped runs' time left out), or None when there is nothing to recompute."""
-    plist = [Path(p) for p in paths]
-    if benchmark == "fbm3w":
-        from ertools.benchmarks.fbm3w.benchmark import Fbm3wOptions, options_2015, score_fbm3w
-        from ertools.configs.fbm3w import load_fbm3w_config
-
-        options = options_2015(Fbm3wOptions(topic=inputs.topic))
-        return score_fbm3w(plist, load_fbm3w_config(inputs.config), options)
-    if benchmark == "fbm2h":
-        from ertools.benchmarks.fbm2h.benchmark import Fbm2hOptions, score_fbm2h
-
-        return score_fbm2h(
-            plist,
-            Fbm2hOptions(
-                goal=inputs.goal,
-                transform=inputs.transform,
-                team=inputs.team,
-                transforms_dir=inputs.transforms,
-                topic=inputs.topic,
-                hits=inputs.hits,
-                namespace=benchmark,
-                orientation_2015=True,
-                unscored_2015=True,
-                marker_transform=_marker_transform(benchmark, inputs, live)[0],
-            ),
-        )
-    if benchmark in ("fbm1h", "fbm1w") and inputs.items is not None:
-        from ertools.benchmarks.fbm1.benchmark import Fbm1Options, score_fbm1_bag
-
-        return score_fbm1_bag(
-            plist,
-            inputs.items,
-            options=Fbm1Options.as_2015(benchmark),
-            results_path=inputs.results,
-        )
-    return None
-
-
-def _rescore_fbm3w(paths: list[Path], inputs: ScoreInputs) -> BenchmarkResult:
-    from ertools.benchmarks.fbm3w.benchmark import Fbm3wOptions, score_fbm3w
-    from ertools.configs.fbm3w import load_fbm3w_config
-
-    config = load_fbm3w_config(inputs.config)
-    options = Fbm3wOptions(d_min=inputs.d_min, topic=inputs.topic)
-    return score_fbm3w(paths, config, options)
+    """The score recomputed with every 2015 behaviour the scorer can restore (the benchmark's
+    :attr:`~ertools.benchmarks.base.Benchmark.values_2015`: FBM2H unwrapped orientation and
+    unscored segments over N; FBM1 the 2015 node's rules; FBM3W ``--2015``), or None when it
+    declares none."""
+    bench = _scorer(benchmark)
+    if not bench.values_2015:
+        return None
+    declared = uses(benchmark)
+    values = {k: v for k, v in inputs.values().items() if k in declared}
+    options, _ = _options(bench, {**values, **bench.values_2015}, live)
+    result: BenchmarkResult = bench.score([Path(p) for p in paths], options)
+    return result
 
 
 # --------------------------------------------------------------------------------------------
@@ -275,7 +219,7 @@ def audit_bag(
     try:
         result, notes = rescore(ns, plist, given, audit.live_score)
     except ErtoolsError as err:
-        if given.given() & USES.get(ns, frozenset()):
+        if given.given() & uses(ns):
             # The user named a scoring input: when it (or what it points at) is bad, that is
             # their error to fix, not a score that merely cannot be recomputed from the log.
             raise

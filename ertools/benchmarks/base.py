@@ -87,6 +87,19 @@ class Ranking:
     text: str
 
 
+@dataclass(frozen=True)
+class Explanation:
+    """Why a recomputed value may differ from the live one (``ertools audit``).
+
+    ``pattern`` is a regular expression on the last component of the differing key,
+    ``text`` the explanation, ``params`` fragments of parameter names worth showing beside it.
+    """
+
+    pattern: str
+    text: str
+    params: tuple[str, ...] = ()
+
+
 OptionsT = TypeVar("OptionsT")
 LoadedT = TypeVar("LoadedT")
 RunsT = TypeVar("RunsT")
@@ -210,8 +223,13 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
             (``ertools audit`` can reconstruct it).
         values_2015: the :class:`Input` values that restore every 2015 behaviour (the audit
             compares the live score with the score recomputed with them); empty: none.
-        from_live: the audit's hook: the values given and the live score (parsed) -> the
-            values to rescore with and notes saying what was taken from the live score.
+        from_live: the audit's hook: the options made from the values given and the live
+            score (parsed) -> the options to rescore with and notes saying what was taken
+            from the live score (FBM2H: the transform the node used).
+        explanations: why a recomputed value may differ from the live one, by key (the
+            audit's comparison shows the first that matches a differing key).
+        sample: the sample logs' folder (``sample_bags/``) -> the arguments scoring this
+            benchmark on them (``make demo``); None, or a None result: no sample.
     """
 
     name: str
@@ -235,9 +253,9 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
     score_keys: frozenset[str] = frozenset()
     state_topics: bool = False
     values_2015: Mapping[str, Any] = field(default_factory=dict)
-    from_live: (
-        Callable[[Mapping[str, Any], Any], tuple[Mapping[str, Any], tuple[str, ...]]] | None
-    ) = None
+    from_live: Callable[[OptionsT, Any], tuple[OptionsT, tuple[str, ...]]] | None = None
+    explanations: tuple[Explanation, ...] = ()
+    sample: Callable[[Path], Sequence[str] | None] | None = None
 
     def score(self, bags: Sequence[Path], options: OptionsT) -> ResultT:
         """The whole shape: load -> find runs -> score."""
@@ -279,9 +297,7 @@ def _one_value(declared: Input, value: Any) -> Any:
         if not isinstance(value, str):
             raise UsageError(f"{option} must be text, got {value!r}")
         if kind == "choice" and value not in declared.choices:
-            raise UsageError(
-                f"{option} {value!r}: choose from {', '.join(declared.choices)}"
-            )
+            raise UsageError(f"{option} {value!r}: choose from {', '.join(declared.choices)}")
         return value
     number: float
     try:
@@ -319,6 +335,25 @@ def _choice_words(declared: Input, words: tuple[str, ...]) -> tuple[str, ...]:
     return words
 
 
+def tf_value(option: str, text: str | None) -> tuple[str, str] | None:
+    """A ``--tf``-style value as (parent, child): ``PARENT:CHILD``, or a bare ``FRAME`` (the
+    old ``--frame FRAME`` spelling) meaning ``world:FRAME``; None when not given.
+
+    Raises:
+        UsageError: not one or two non-empty frame names.
+    """
+    from ertools.errors import UsageError
+
+    if text is None:
+        return None
+    parent, sep, child = text.partition(":")
+    if not sep:
+        parent, child = "world", text
+    if not parent or not child or ":" in child:
+        raise UsageError(f"{option} {text!r}: give PARENT:CHILD, e.g. world:robot_at_work")
+    return parent, child
+
+
 def resolve_values(inputs: Sequence[Input], given: Mapping[str, Any]) -> dict[str, Any]:
     """Every declared input's value: ``given`` (by :attr:`Input.name`) checked against its
     declaration (kind, choices, minimum, positive), the others at their defaults. None
@@ -337,7 +372,7 @@ def resolve_values(inputs: Sequence[Input], given: Mapping[str, Any]) -> dict[st
         )
     out: dict[str, Any] = {}
     for name, declared in known.items():
-        value = given.get(name)
+        value: Any = given.get(name)
         if value is None:
             value = declared.default
         if value is None and declared.kind == "flag":
@@ -345,7 +380,7 @@ def resolve_values(inputs: Sequence[Input], given: Mapping[str, Any]) -> dict[st
         if value is None:
             out[name] = () if declared.repeat else None
         elif declared.repeat or declared.kind == "paths":
-            values = [value] if isinstance(value, str | Path) else list(value)
+            values: list[Any] = [value] if isinstance(value, str | Path) else list(value)
             out[name] = tuple(_one_value(declared, v) for v in values)
         else:
             out[name] = _one_value(declared, value)

@@ -12,8 +12,14 @@ from __future__ import annotations
 import argparse
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
+from ertools.benchmarks.fbm1.benchmark import BENCHMARKS
 from ertools.cli.common import all_failed, note, write_text
+
+if TYPE_CHECKING:
+    from ertools.benchmarks.common.sources import PoseSpec
+    from ertools.io import PoseSource
 
 EPILOG = """examples:
   ertools acquire items items.bag --items fbm1h-vanilla.yaml -o fbm1h.yaml
@@ -22,11 +28,19 @@ EPILOG = """examples:
 
 --windows: START:END per item in list order, seconds from the log's first message (values
 above 1e9 are epoch seconds). Without it the board's still phases near the origin are used
-(--min-still, --max-distance); their number must equal the number of items.
+(--still-min, --max-distance); their number must equal the number of items.
 Exit status 1 when an item could not be acquired (it is written unchanged and named on stderr)."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from ertools.cli.options import (
+        add_output,
+        add_pose_source,
+        add_time_source,
+        deprecated,
+        positive,
+    )
+
     parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="log file(s)")
     parser.add_argument(
         "--items", type=Path, required=True, metavar="FILE", help="vanilla item list"
@@ -36,28 +50,28 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--namespace",
-        default="fbm1h",
-        choices=("fbm1h", "fbm1w"),
-        help="topic namespace of origin and ref_board (default fbm1h)",
+        default=BENCHMARKS[0],
+        choices=BENCHMARKS,
+        help=f"topic namespace of origin and ref_board (default {BENCHMARKS[0]})",
     )
-    parser.add_argument("--origin-topic", metavar="TOPIC", help="origin pose topic")
-    parser.add_argument("--ref-board-topic", metavar="TOPIC", help="ref_board pose topic")
+    add_pose_source(parser, "origin-", what="the table origin", default="the namespace's")
+    add_pose_source(parser, "ref-board-", what="the reference board", default="the namespace's")
+    add_time_source(parser)
     parser.add_argument(
-        "--min-still", type=float, default=2.0, metavar="S", help="shortest placement (2 s)"
+        "--still-min", type=positive, default=2.0, metavar="S", help="shortest placement (2 s)"
     )
+    deprecated(parser, "--min-still", "--still-min", "still_min", convert=positive, metavar="S")
     parser.add_argument(
         "--max-distance",
-        type=float,
+        type=positive,
         default=0.5,
         metavar="M",
         help="a placement has the board within M of the origin (0.5 m)",
     )
     parser.add_argument(
-        "--still", type=float, default=0.002, metavar="M", help="still: < M per 0.25 s (0.002)"
+        "--still", type=positive, default=0.002, metavar="M", help="still: < M per 0.25 s (0.002)"
     )
-    parser.add_argument(
-        "-o", "--output", type=Path, help="write the list to this file instead of stdout"
-    )
+    add_output(parser, ("yaml",), out_help="write the list to FILE instead of stdout")
 
 
 def _windows(text: str | None) -> list[tuple[float, float]] | None:
@@ -78,19 +92,25 @@ def _windows(text: str | None) -> list[tuple[float, float]] | None:
     return out
 
 
+def _io(spec: PoseSpec, namespace: str, body: str) -> PoseSource | None:
+    """The reader's source; None for the scorer's default (the 2015 topic, else the /tf
+    frame), unless a time source was asked for: then the 2015 topic at that time."""
+    from dataclasses import replace
+
+    if not spec.given and spec.time_source_given:
+        spec = replace(spec, topic=f"/{namespace}/{body}/pose")
+    return spec.to_io() if spec.given else None
+
+
 def run(args: argparse.Namespace) -> int:
     from ertools.benchmarks.fbm1.acquire import AcquireOptions, acquire_items_bag
+    from ertools.cli.options import pose_spec
     from ertools.configs.items import items_to_yaml
-    from ertools.errors import UsageError
-    from ertools.io import PoseSource
 
-    for name in ("min_still", "max_distance", "still"):
-        if not getattr(args, name) > 0:
-            raise UsageError(f"--{name.replace('_', '-')} must be positive")
-    origin = PoseSource(topic=args.origin_topic) if args.origin_topic else None
-    board = PoseSource(topic=args.ref_board_topic) if args.ref_board_topic else None
+    origin = pose_spec(args, "origin-", time_prefix="")
+    board = pose_spec(args, "ref-board-", time_prefix="")
     options = AcquireOptions(
-        min_still_s=args.min_still, still_m=args.still, max_distance_m=args.max_distance
+        min_still_s=args.still_min, still_m=args.still, max_distance_m=args.max_distance
     )
     result = acquire_items_bag(
         args.bags,
@@ -98,13 +118,13 @@ def run(args: argparse.Namespace) -> int:
         namespace=args.namespace,
         windows_s=_windows(args.windows),
         options=options,
-        sources=(origin, board),
+        sources=(_io(origin, args.namespace, "origin"), _io(board, args.namespace, "ref_board")),
     )
     if all_failed(result):  # no item measured: only the errors, not the vanilla list back
         for failure in result.failures:
             note(f"error: {failure}")
         return 1
-    write_text(items_to_yaml(result.items), args.output)
+    write_text(items_to_yaml(result.items), args.out)
     note(
         f"{'id':>3} {'instance':<16} {'window s':>17} {'n':>5} {'x m':>8} {'y m':>8} "
         f"{'yaw deg':>8} {'spread mm':>9} {'deg':>6}"

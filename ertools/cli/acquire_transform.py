@@ -17,7 +17,7 @@ from ertools.cli.common import note, write_text
 EPILOG = """examples:
   ertools acquire transform robot_at_origin.bag --team homer
   ertools acquire transform robot_at_origin.bag --team homer --at 12.5 --duration 5 \\
-      --out transforms/
+      --out-dir transforms/
 
 --at: seconds from the bag's first message (or epoch seconds). The file is printed on stdout
 too; an existing file is only replaced with --force."""
@@ -25,57 +25,61 @@ too; an existing file is only replaced with --force."""
 DEFAULT_TOPIC = "/fbm2h/robot_at_home/pose"
 
 
+def _number(text: str) -> float:
+    from ertools.cli.options import finite
+
+    return finite(text)
+
+
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from ertools.cli.options import add_out_dir, add_pose_source, add_time_source, positive
+
     parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="log file(s)")
     parser.add_argument("--team", required=True, metavar="NAME", help="team name (file name)")
-    parser.add_argument("--at", type=float, metavar="T", help="start of the stationary window")
     parser.add_argument(
-        "--duration", type=float, default=5.0, metavar="S", help="window length with --at (5 s)"
+        "--at", type=_number, metavar="T", help="start of the stationary window (seconds)"
     )
     parser.add_argument(
-        "--topic", metavar="TOPIC", help=f"marker set pose topic (default {DEFAULT_TOPIC})"
+        "--duration", type=positive, default=5.0, metavar="S", help="window length with --at (5 s)"
     )
-    parser.add_argument(
-        "--tf-frame",
-        "--frame",
-        dest="tf_frame",
-        metavar="FRAME",
-        help="take /tf world -> FRAME instead",
+    add_pose_source(
+        parser,
+        what="the marker set",
+        default=DEFAULT_TOPIC,
+        old_frame=("--tf-frame", "--frame"),
     )
-    parser.add_argument(
-        "--out", type=Path, default=Path("."), metavar="DIR", help="where to write (default .)"
+    add_time_source(parser)
+    add_out_dir(
+        parser,
+        "write DIR/transform-NAME.yaml (default .)",
+        old=("--out",),
+        default=Path("."),
     )
     parser.add_argument("--force", action="store_true", help="replace an existing file")
 
 
 def run(args: argparse.Namespace) -> int:
+    from ertools.benchmarks.common.sources import read_source, topic
     from ertools.benchmarks.fbm2h.transform import acquire_transform, check_team_name
+    from ertools.cli.options import pose_spec
     from ertools.configs.transform import team_transform_path, transform_yaml
-    from ertools.errors import ConfigError, UsageError
-    from ertools.io import PoseSource, read_pose_source, summary
+    from ertools.errors import ConfigError
+    from ertools.io import summary
     from ertools.streams import Interval
     from ertools.timeutil import resolve_time, s_to_ns
 
     team = check_team_name(args.team)
-    out = team_transform_path(args.out, team)
+    out = team_transform_path(args.out_dir, team)
     if out.exists() and not args.force:
         raise ConfigError(f"{out} exists; use --force to replace it")
-    if args.topic and args.tf_frame:
-        raise UsageError("give either --topic or --tf-frame, not both")
-    if args.duration <= 0:
-        raise UsageError(f"--duration must be > 0, got {args.duration}")
-    source = (
-        PoseSource(topic=None, frame=args.tf_frame)
-        if args.tf_frame
-        else PoseSource(topic=args.topic or DEFAULT_TOPIC)
-    )
+    spec = pose_spec(args)
     window = None
     # Times in messages count from the log's first message, as --at does.
     bag_start = min(summary(p).start_ns for p in args.bags)
     if args.at is not None:
         start = resolve_time(args.at, bag_start)
         window = Interval(start, start + s_to_ns(args.duration))
-    marker = read_pose_source(list(args.bags), source)
+    marker = read_source(args.bags, spec, (topic(DEFAULT_TOPIC),), what="marker set poses")
     acq = acquire_transform(marker, team, window=window, origin_ns=bag_start)
     text = transform_yaml(acq.transform)
     out.parent.mkdir(parents=True, exist_ok=True)

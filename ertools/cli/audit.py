@@ -13,8 +13,10 @@ import argparse
 import sys
 from pathlib import Path
 
+from ertools.benchmarks import registry
+
 EPILOG = """examples:
-  ertools audit fbm2h.bag
+  ertools audit fbm2h.bag                       # YAML on stdout (--format text: a summary)
   ertools audit fbm2h.bag --transform transform-homer.yaml --report audit/
   ertools audit fbm1h.bag --items configs/fbm1h.yaml --format json
   ertools audit fbm3w.bag --config configs/fbm3w.yaml --max-silence 0.5 --no-rescore
@@ -25,17 +27,21 @@ are passed to the benchmark's scorer as `ertools score NAME` takes them.
 Exit status: 0 (findings are reported, not errors; --strict makes them exit 1), 1 when the bag
 has no state topics or cannot be read, or the recomputed score has failures."""
 
-BENCHMARKS = ("fbm1h", "fbm1w", "fbm2h", "fbm3w")
+# Every registered benchmark (those without state topics say so when asked to audit).
+BENCHMARKS = registry.names()
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from ertools.cli.common import add_output_options
+    from ertools.cli.options import non_negative_int, positive
+
     parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="benchmark log(s)")
     parser.add_argument(
         "--benchmark", choices=BENCHMARKS, help="namespace of the state topics (default: inferred)"
     )
     parser.add_argument(
         "--max-silence",
-        type=float,
+        type=positive,
         default=1.0,
         metavar="S",
         help="report heartbeat gaps longer than S seconds (default 1; the beat is 0.1 s)",
@@ -58,26 +64,32 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     scoring.add_argument("--transform", type=Path, metavar="FILE", help="fbm2h transform")
     scoring.add_argument("--team", metavar="NAME", help="fbm2h: with --transforms")
     scoring.add_argument("--transforms", type=Path, metavar="DIR", help="fbm2h transforms folder")
-    scoring.add_argument("--hits", type=int, metavar="N", help="fbm2h: the referee's hits")
+    scoring.add_argument(
+        "--hits", type=non_negative_int, metavar="N", help="fbm2h: the referee's hits"
+    )
     scoring.add_argument("--items", type=Path, metavar="FILE", help="fbm1 item list")
     scoring.add_argument("--results", type=Path, metavar="FILE", help="fbm1 answers file")
     scoring.add_argument("--config", type=Path, metavar="FILE", help="fbm3w config")
-    scoring.add_argument("--d-min", type=float, metavar="M", help="fbm3w d_min in metres")
+    scoring.add_argument("--d-min", type=positive, metavar="M", help="fbm3w d_min in metres")
     scoring.add_argument("--topic", metavar="TOPIC", help="pose topic of the scorer")
-    from ertools.cli.common import add_output_options
-
-    add_output_options(parser, ("text", "yaml", "json"), plot=False, team=False)
+    # YAML by default, as `ertools score`: an audit is a result (the recomputed score beside
+    # the live one); text is the referee's summary. --plot/--plots: the recomputed score's
+    # figures.
+    add_output_options(parser, ("yaml", "json", "text"), team=False)
 
 
 def run(args: argparse.Namespace) -> int:
     from ertools.audit.rescore import ScoreInputs, audit_bag
-    from ertools.cli.common import emit_result, note, write_foxglove_option, write_text
-    from ertools.errors import ConfigError
+    from ertools.cli.common import (
+        emit_result,
+        note,
+        write_foxglove_option,
+        write_plots_option,
+        write_text,
+    )
     from ertools.timeutil import s_to_ns
 
     bags: list[Path] = list(args.bags)
-    if args.max_silence <= 0:
-        raise ConfigError(f"--max-silence must be > 0 s, got {args.max_silence}")
     inputs = ScoreInputs(
         goal=args.goal,
         transform=args.transform,
@@ -103,7 +115,7 @@ def run(args: argparse.Namespace) -> int:
     if args.format != "text":
         code = emit_result(audit, args, bags)
     else:
-        write_text(audit.to_text(), args.output)
+        write_text(audit.to_text(), args.out)
         for deviation in audit.deviations:
             note(f"differs from 2015: {deviation}")
         if args.report is not None:
@@ -113,6 +125,7 @@ def run(args: argparse.Namespace) -> int:
                 audit, args.report, inputs=bags, argv=getattr(args, "command_line", sys.argv)
             )
             note(f"wrote report {index}")
+        write_plots_option(audit, args)
         write_foxglove_option(audit, args, bags)
         for failure in audit.failures:
             note(f"error: {failure}")

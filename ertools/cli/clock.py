@@ -13,35 +13,57 @@ EPILOG = """examples:
   ertools clock --server 192.168.1.1
   ertools clock --server 192.168.1.1 --tolerance 0.002
   ertools clock --server ntp.local --port 10123 --timeout 1
+  ertools clock --server 192.168.1.1 --format json     # offset, delay in seconds
 """
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from ertools.cli.options import add_output, port, positive, seconds
+
     parser.add_argument(
         "--server", required=True, help="NTP server host (the 2015 one: 192.168.1.1)"
     )
-    parser.add_argument("--port", type=int, default=123, help="UDP port (default 123)")
+    parser.add_argument("--port", type=port, default=123, help="UDP port (default 123)")
     parser.add_argument(
         "--tolerance",
-        type=float,
+        type=seconds,
         default=0.005,
         metavar="S",
         help="largest acceptable |offset| in seconds (default 0.005)",
     )
     parser.add_argument(
-        "--timeout", type=float, default=2.0, metavar="S", help="reply timeout (default 2 s)"
+        "--timeout", type=positive, default=2.0, metavar="S", help="reply timeout (default 2 s)"
     )
+    add_output(parser, ("text", "json", "yaml"))
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.errors import UsageError
+    from ertools.cli.common import dump_json, write_text
     from ertools.live.clock import query_sntp
 
-    if args.tolerance < 0 or args.timeout <= 0:
-        raise UsageError("--tolerance must be >= 0 and --timeout > 0")
     check = query_sntp(args.server, args.port, timeout_s=args.timeout)
-    if check.within(args.tolerance):
-        print(f"ok: {check.describe()}; within {args.tolerance:g} s")
-        return 0
-    print(f"outside tolerance: {check.describe()}; |offset| > {args.tolerance:g} s")
-    return 1
+    ok = check.within(args.tolerance)
+    if args.format == "text":
+        if ok:
+            text = f"ok: {check.describe()}; within {args.tolerance:g} s"
+        else:
+            text = f"outside tolerance: {check.describe()}; |offset| > {args.tolerance:g} s"
+    else:
+        data = {
+            "server": check.server,
+            "port": check.port,
+            "offset": check.offset_s,
+            "delay": check.delay_s,
+            "stratum": check.stratum,
+            "measured_at": check.measured_at_ns / 1e9,
+            "tolerance": args.tolerance,
+            "within_tolerance": ok,
+        }
+        if args.format == "json":
+            text = dump_json(data)
+        else:
+            from ertools.benchmarks.base import dump_yaml
+
+            text = dump_yaml(data)
+    write_text(text, args.out)
+    return 0 if ok else 1

@@ -22,28 +22,20 @@ def add_output_options(
     foxglove: bool = True,
     team: bool = True,
 ) -> None:
-    """``--format``, ``--output``, ``--team``, and where the benchmark has them
-    ``--report``/``--plot``/``--foxglove``."""
-    parser.add_argument(
-        "--format",
-        choices=formats,
-        default=formats[0],
-        help=f"output format on stdout (default {formats[0]})",
-    )
-    parser.add_argument(
-        "-o", "--output", type=Path, help="write the output to this file instead of stdout"
-    )
+    """``--format``, ``--out/-o``, ``--team``, and where the benchmark has them
+    ``--report``/``--plot``/``--plots``/``--foxglove``: the vocabulary of
+    :mod:`ertools.cli.options` (old spellings ``--output`` and ``--plot DIR`` still work, with
+    a deprecation note)."""
+    from ertools.cli.options import add_output, add_plots, add_report
+
+    add_output(parser, formats)
     if report:
-        parser.add_argument(
-            "--report",
-            type=Path,
-            metavar="DIR",
-            help="write a self-contained report folder (index.html, score.yaml/json, CSV, plots)",
+        add_report(
+            parser,
+            "write a self-contained report folder (index.html, score.yaml/json, CSV, plots)",
         )
     if plot:
-        parser.add_argument(
-            "--plot", type=Path, metavar="DIR", help="write the benchmark's figures (PNG) here"
-        )
+        add_plots(parser, what="the benchmark's figures (one panel each)")
     if foxglove:
         parser.add_argument(
             "--foxglove",
@@ -107,17 +99,12 @@ def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[
     result = with_team(result, getattr(args, "team", None), inputs)
     fmt = getattr(args, "format", "yaml")
     text = result.to_yaml() if fmt == "yaml" else dump_json(document.score_json(result))
-    write_text(text, getattr(args, "output", None))
+    write_text(text, getattr(args, "out", None))
     for warning in result.warnings:
         note(f"warning: {warning}")
     for deviation in result.deviations:
         note(f"differs from 2015: {deviation}")
-    plot_dir: Path | None = getattr(args, "plot", None)
-    if plot_dir is not None:
-        from ertools.report.figures import figure_specs, save_figures
-
-        paths = save_figures(figure_specs(result), plot_dir)
-        note(f"wrote {len(paths)} figure(s) to {plot_dir}/")
+    write_plots_option(result, args)
     report_dir: Path | None = getattr(args, "report", None)
     if report_dir is not None:
         from ertools.report.folder import write_report
@@ -130,6 +117,18 @@ def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[
     for failure in result.failures:
         note(f"error: {failure}")
     return 1 if result.failures else 0
+
+
+def write_plots_option(result: Any, args: argparse.Namespace) -> None:
+    """``--plot FILE`` / ``--plots DIR``: the result's figures (an audit's are those of its
+    recomputed score), when asked for."""
+    if getattr(args, "plot", None) is None and getattr(args, "plots", None) is None:
+        return
+    from ertools.cli.options import write_plots
+    from ertools.report.figures import figure_specs
+
+    scored = getattr(result, "recomputed", None)
+    write_plots(figure_specs(scored if scored is not None else result), args)
 
 
 def write_foxglove_option(result: Any, args: argparse.Namespace, inputs: list[Path]) -> None:

@@ -30,17 +30,14 @@ the GT is every GT pose within 1 s of the robot poses, for evo to associate itse
 exit status: 0 written, 1 unusable data, 2 usage error."""
 
 
-def _tf_pair(text: str) -> tuple[str, str]:
-    parent, sep, child = text.partition(":")
-    if not sep or not parent or not child or ":" in child:
-        raise argparse.ArgumentTypeError(
-            f"--tf takes PARENT:CHILD (e.g. world:robot), not {text!r}"
-        )
-    return parent, child
-
-
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from ertools.cli.score_trajectory import _offset, _positive
+    from ertools.cli.options import (
+        add_pose_source,
+        add_time_source,
+        deprecated,
+        positive,
+        seconds_or_auto,
+    )
     from ertools.export.formats import FORMATS
 
     parser.add_argument(
@@ -51,22 +48,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="log file(s); with --out-dir: ROBOT_BAG [GT_PATH...] (GT bags or folders; none when "
         "the robot bag holds the GT topic too, as evo's bag mode)",
     )
+    # A file format (what the file holds), not the printing format of the other commands.
     parser.add_argument("--format", choices=FORMATS, default="tum", help="file format (tum)")
     one = parser.add_argument_group("one pose source")
-    which = one.add_mutually_exclusive_group()
-    which.add_argument("--topic", help="a pose topic (PoseStamped, Pose2D, Odometry, ...)")
-    which.add_argument(
-        "--tf", type=_tf_pair, metavar="PARENT:CHILD", help="the /tf pose of CHILD in PARENT"
-    )
-    one.add_argument(
-        "--time-source",
-        choices=("header", "record"),
-        default="header",
-        help="pose time: message stamp (default) or the bag's record time",
-    )
-    one.add_argument(
-        "-o", "--output", type=Path, metavar="FILE", help="write here (default: stdout)"
-    )
+    add_pose_source(one, what="the poses")
+    add_time_source(one)
+    one.add_argument("-o", "--out", type=Path, metavar="FILE", help="write here (default: stdout)")
+    deprecated(one, "--output", "--out", "out", convert=Path, metavar="FILE")
     one.add_argument(
         "--times",
         type=Path,
@@ -82,8 +70,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="only the scored pairs, GT taken at the robot stamps by --association",
     )
-    pair.add_argument("--robot-topic", help="as in `score trajectory`")
-    pair.add_argument("--gt-topic", help="as in `score trajectory`")
+    pair.add_argument("--robot-topic", metavar="TOPIC", help="as in `score trajectory`")
+    pair.add_argument("--gt-topic", metavar="TOPIC", help="as in `score trajectory`")
     pair.add_argument(
         "--association",
         choices=("linear", "nearest", "hold"),
@@ -91,23 +79,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="GT pose at a robot time with --matched (default linear)",
     )
     pair.add_argument(
-        "--max-gap", type=_positive, default=0.1, metavar="S", help="as in `score trajectory`"
+        "--max-gap", type=positive, default=0.1, metavar="S", help="as in `score trajectory`"
     )
     pair.add_argument(
         "--offset",
-        type=_offset,
+        type=seconds_or_auto,
         default=0.0,
         metavar="S|auto",
         help="shift the robot stamps by S seconds (auto: with --apply-offset, the estimate)",
     )
     pair.add_argument("--apply-offset", action="store_true", help="as in `score trajectory`")
     pair.add_argument("--allow-partial", action="store_true", help="as in `score trajectory`")
-    pair.add_argument(
-        "--robot-time",
-        choices=("header", "record"),
-        default="header",
-        help="as in `score trajectory`",
-    )
+    add_time_source(pair, "robot-", old=("--robot-time",))
 
 
 # Pair options and their defaults: given without --out-dir they would be silently ignored.
@@ -120,7 +103,7 @@ PAIR_ONLY = {
     "offset": 0.0,
     "apply_offset": False,
     "allow_partial": False,
-    "robot_time": "header",
+    "robot_time_source": None,
 }
 
 
@@ -135,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
     for name, flag in (
         ("topic", "--topic"),
         ("tf", "--tf"),
-        ("output", "-o"),
+        ("out", "-o/--out"),
         ("times", "--times"),
     ):
         if getattr(args, name) is not None:
@@ -147,29 +130,24 @@ def run(args: argparse.Namespace) -> int:
 
 def _run_one(args: argparse.Namespace) -> int:
     from ertools.cli.common import note, write_text
+    from ertools.cli.options import pose_spec
     from ertools.errors import UsageError
     from ertools.export.formats import format_times
     from ertools.export.pairs import export_source, refuse_inputs
-    from ertools.io import PoseSource
     from ertools.timeutil import iso_utc
 
     if args.topic is None and args.tf is None:
         raise UsageError("give --topic TOPIC or --tf PARENT:CHILD (or --out-dir for the pair)")
     if args.times is not None and args.format != "kitti":
         raise UsageError(f"--times is for --format kitti ({args.format} files hold the times)")
-    if args.times is not None and args.output is None:
+    if args.times is not None and args.out is None:
         raise UsageError("--times needs -o FILE (the poses and their times go to two files)")
-    outputs = [p for p in (args.output, args.times) if p is not None]
+    outputs = [p for p in (args.out, args.times) if p is not None]
     refuse_inputs(outputs, list(args.bags))
-    if args.tf is not None and args.time_source != "header":
+    if args.tf is not None and args.time_source == "record":
         raise UsageError("--time-source record is for --topic; tf poses carry their own stamps")
-    if args.tf is not None:
-        parent, child = args.tf
-        source = PoseSource(topic=None, frame=child, parent=parent)
-    else:
-        source = PoseSource(topic=args.topic, time_source=args.time_source)
-    stream, text = export_source(list(args.bags), source, args.format)
-    write_text(text, args.output)
+    stream, text = export_source(list(args.bags), pose_spec(args), args.format)
+    write_text(text, args.out)
     if args.times is not None:
         write_text(format_times(stream), args.times)
         note(f"times count from the first pose, {iso_utc(stream.start_ns)}")
@@ -180,8 +158,9 @@ def _run_one(args: argparse.Namespace) -> int:
 
 
 def _run_pair(args: argparse.Namespace) -> int:
-    from ertools.benchmarks.trajectory.benchmark import TrajectoryConfig
+    from ertools.benchmarks.trajectory.config import TrajectoryConfig
     from ertools.cli.common import note
+    from ertools.cli.options import time_source
     from ertools.errors import UsageError
     from ertools.export.pairs import (
         KITTI_NEEDS_MATCHED,
@@ -213,7 +192,7 @@ def _run_pair(args: argparse.Namespace) -> int:
         config,
         robot_topic=args.robot_topic,
         gt_topic=args.gt_topic,
-        robot_time=args.robot_time,
+        robot_time=time_source(args, "robot-"),
         matched=bool(args.matched),
     )
     written = write_pair(pair, args.out_dir, args.format)

@@ -34,16 +34,12 @@ Exit status 1 when any bag is unreadable, truncated or (with --check) corrupt.
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from ertools.cli.options import add_output
+
     parser.add_argument(
         "paths", type=Path, nargs="+", metavar="BAG", help="bags, rosbag2 folders or folders"
     )
-    parser.add_argument(
-        "--format",
-        choices=("table", "json", "yaml"),
-        default="table",
-        help="output on stdout (default table)",
-    )
-    parser.add_argument("-o", "--output", type=Path, help="write the output to this file")
+    add_output(parser, ("text", "json", "yaml"), aliases={"table": "text"})
     parser.add_argument(
         "--check",
         action="store_true",
@@ -136,7 +132,8 @@ def _one_line(text: str) -> str:
 def run(args: argparse.Namespace) -> int:
     from ertools.cli.common import dump_json, note, write_text
     from ertools.errors import BagError
-    from ertools.io.info import describe, expand
+    from ertools.io.formats import expand
+    from ertools.io.info import describe
     from ertools.progress import reporting
 
     infos: list[BagInfo] = []
@@ -168,7 +165,7 @@ def run(args: argparse.Namespace) -> int:
             note(f"warning: {path}: not indexed (still recording?); counts come from a scan")
         # each disagreement --check found is a line of its own
         problems.extend({"path": str(path), "problem": _one_line(p)} for p in info.check_problems)
-    if args.format == "table":
+    if args.format == "text":
         text = "\n\n".join(table(i) for i in infos)
     else:
         data: dict[str, Any] = {"bags": [i.to_dict() for i in infos], "problems": problems}
@@ -179,7 +176,7 @@ def run(args: argparse.Namespace) -> int:
 
             text = dump_yaml(data)  # rates without binary noise, as every ertools YAML
     if text:
-        write_text(text, args.output)
+        write_text(text, args.out)
     for p in problems:
         print(f"ertools: error: {p['path']}: {p['problem']}", file=sys.stderr)
     return 1 if problems else 0

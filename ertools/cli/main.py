@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import re
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -111,6 +112,10 @@ class _Parser(argparse.ArgumentParser):
     """argparse with the house error format: one ``ertools: error:`` line, exit status 2."""
 
     def error(self, message: str) -> NoReturn:
+        # a required option with a hidden old spelling is a required group of one visible name
+        one = re.fullmatch(r"one of the arguments (\S+) is required", message)
+        if one is not None:
+            message = f"the following arguments are required: {one.group(1)}"
         self.exit(2, f"ertools: error: {self.prog}: {message} (`{self.prog} --help` shows how)\n")
 
 
@@ -176,7 +181,9 @@ OUTPUT_OPTIONS = {
     "output": "-o/--output",
     "report": "--report",
     "plot": "--plot",
+    "plots": "--plots",
     "out": "--out",
+    "out_dir": "--out-dir",
     "foxglove": "--foxglove",
 }
 

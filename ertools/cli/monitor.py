@@ -24,13 +24,17 @@ EPILOG = """examples:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from pathlib import Path
 
-    parser.add_argument("directory", type=Path, metavar="DIR", help="the recorder's --out folder")
+    from ertools.cli.options import fraction, non_negative, positive
+
     parser.add_argument(
-        "--interval", type=float, default=2.0, metavar="S", help="seconds between looks (2)"
+        "directory", type=Path, metavar="DIR", help="the recorder's --out-dir folder"
+    )
+    parser.add_argument(
+        "--interval", type=positive, default=2.0, metavar="S", help="seconds between looks (2)"
     )
     parser.add_argument(
         "--min-growth",
-        type=float,
+        type=non_negative,
         default=2_000.0,
         metavar="BYTES_PER_S",
         help="least acceptable growth of the file being written (2000 B/s; one body at 120 Hz "
@@ -38,17 +42,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--stale",
-        type=float,
+        type=positive,
         metavar="S",
         help="a file not modified for S s is not being written (default 3 intervals, >= 5 s)",
     )
     parser.add_argument(
         "--drop-fraction",
-        type=float,
+        type=fraction,
         default=0.5,
         help="warn when a pose topic's rate falls below this fraction of its best (0.5)",
     )
-    parser.add_argument("--min-rate", type=float, metavar="HZ", help="least pose rate per topic")
+    parser.add_argument("--min-rate", type=positive, metavar="HZ", help="least pose rate per topic")
     parser.add_argument(
         "--prefix",
         default="",
@@ -58,7 +62,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--bell", action="store_true", help="ring the terminal bell on warnings")
     group = parser.add_mutually_exclusive_group()
     group.add_argument("--once", action="store_true", help="look once (after one interval), exit")
-    group.add_argument("--duration", type=float, metavar="S", help="stop after S seconds")
+    group.add_argument("--duration", type=positive, metavar="S", help="stop after S seconds")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -68,8 +72,6 @@ def run(args: argparse.Namespace) -> int:
     from ertools.errors import UsageError
     from ertools.live.monitor import MonitorOptions, watch
 
-    if args.interval <= 0 or args.min_growth < 0 or not 0 <= args.drop_fraction <= 1:
-        raise UsageError("--interval must be > 0, --min-growth >= 0, --drop-fraction in [0, 1]")
     if not args.directory.is_dir():
         raise UsageError(f"{args.directory} is not a folder")
     options = MonitorOptions(

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ertools.cli.common import dump_json, note, write_text
+from ertools.cli.options import positive
 
 if TYPE_CHECKING:
     from ertools.streams import PoseStream
@@ -23,17 +24,25 @@ EPILOG = """examples:
   ertools noise log_fbm3w_mocap.bag --stationary auto --plot noise.png
   ertools noise still.bag --bin 0.0001 --c 4
 
-Poses: --topic, else /fbm3w/robot_at_work/pose2d, /fbm3w/robot_at_work/pose, /tf
-robot_at_work, else the bag's only pose topic. --stationary auto keeps only the phases where
-the marker set stood still (any bag, e.g. a benchmark run); the default takes the whole
+Poses: --topic TOPIC or --tf PARENT:CHILD, else /fbm3w/robot_at_work/pose2d,
+/fbm3w/robot_at_work/pose, /tf world:robot_at_work, else the bag's only pose topic.
+--stationary auto keeps only the phases where the marker set stood still (any bag, e.g. a
+benchmark run); the default takes the whole
 recording as stationary, as the 2015 tool did. JSON keys: samples, lost, epsilon, percentiles
 {"50", "95", "99"}, suggested_d_min (metres)."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from ertools.cli.options import add_output, add_plots, add_pose_source, add_time_source
+
     parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="log file(s)")
-    parser.add_argument("--topic", metavar="TOPIC", help="pose topic (Pose2D, PoseStamped...)")
-    parser.add_argument("--frame", metavar="FRAME", help="take the poses from /tf world -> FRAME")
+    add_pose_source(
+        parser,
+        what="the marker set",
+        default="the fbm3w pose2d, pose, tf world:robot_at_work, else the only pose topic",
+        old_frame=("--frame",),
+    )
+    add_time_source(parser)
     parser.add_argument(
         "--stationary",
         choices=("all", "auto"),
@@ -41,41 +50,30 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="all: the whole recording is stationary (2015); auto: detect the still phases",
     )
     parser.add_argument(
-        "--bin", type=float, default=0.00015, metavar="M", help="histogram bin (default 0.00015 m)"
+        "--bin",
+        type=positive,
+        default=0.00015,
+        metavar="M",
+        help="histogram bin (default 0.00015 m)",
     )
     parser.add_argument(
-        "--c", type=float, default=3.0, help="suggested d_min = C * epsilon (default 3)"
+        "--c", type=positive, default=3.0, help="suggested d_min = C * epsilon (default 3)"
     )
-    parser.add_argument(
-        "--format", choices=("text", "json"), default="text", help="output format (default text)"
-    )
-    parser.add_argument(
-        "-o", "--output", type=Path, help="write the output to this file instead of stdout"
-    )
-    parser.add_argument("--plot", type=Path, metavar="FILE", help="write a histogram figure (PNG)")
+    add_output(parser, ("text", "json", "yaml"))
+    add_plots(parser, what="the histogram")
 
 
 def _poses(args: argparse.Namespace) -> PoseStream:
-    from ertools.benchmarks.fbm3w.benchmark import Fbm3wOptions, read_fbm3w_poses
-    from ertools.errors import TopicError
-    from ertools.io import read_poses, topics
+    from ertools.benchmarks.common.sources import read_source, tf, topic
+    from ertools.benchmarks.fbm3w.benchmark import DEFAULT_FRAME, DEFAULT_TOPIC, FALLBACK_TOPIC
+    from ertools.cli.options import pose_spec
 
-    opts = Fbm3wOptions(topic=args.topic, frame=args.frame, time_source="header")
-    if args.topic is not None or args.frame is not None:
-        return read_fbm3w_poses(args.bags, opts)
-    present = topics(args.bags)
-    if "/fbm3w/robot_at_work/pose2d" in present or "/fbm3w/robot_at_work/pose" in present:
-        return read_fbm3w_poses(args.bags, opts)
-    from ertools.io.model import POSE_TYPES, TF_TYPES
-
-    found = [t for t, ty in present.items() if ty in POSE_TYPES and ty not in TF_TYPES]
-    if len(found) == 1:
-        note(f"using the only pose topic {found[0]}")
-        return read_poses(args.bags, found[0])
-    raise TopicError(
-        f"no /fbm3w/robot_at_work pose topic; pose topics there: {', '.join(found) or 'none'}; "
-        "choose one with --topic (or a tf frame with --frame)",
-        path=args.bags[0],
+    return read_source(
+        args.bags,
+        pose_spec(args),
+        (topic(DEFAULT_TOPIC), topic(FALLBACK_TOPIC), tf(DEFAULT_FRAME)),
+        what="marker set poses",
+        only_topic=True,
     )
 
 
@@ -84,21 +82,20 @@ def run(args: argparse.Namespace) -> int:
 
     poses = _poses(args)
     result = noise_from_stream(poses, stationary=args.stationary == "auto", bin=args.bin, c=args.c)
-    text = dump_json(result.to_dict()) if args.format == "json" else result.to_text()
-    write_text(text, args.output)
+    if args.format == "json":
+        text = dump_json(result.to_dict())
+    elif args.format == "yaml":
+        from ertools.benchmarks.base import dump_yaml
+
+        text = dump_yaml(result.to_dict())
+    else:
+        text = result.to_text()
+    write_text(text, args.out)
     for warning in result.warnings:
         note(f"warning: {warning}")
-    if args.plot is not None:
-        from matplotlib.figure import Figure
-
+    if args.plot is not None or args.plots is not None:
+        from ertools.cli.options import write_plots
         from ertools.report.plots_noise import figure_specs
 
-        spec = figure_specs(result)[0]
-        fig = Figure(figsize=spec.size, layout="constrained")
-        ax = fig.add_subplot()
-        spec.draw(ax)
-        ax.set_title(spec.title)
-        args.plot.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(args.plot, dpi=110)
-        note(f"wrote {args.plot}")
+        write_plots(figure_specs(result), args)
     return 0

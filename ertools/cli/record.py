@@ -15,11 +15,11 @@ from __future__ import annotations
 import argparse
 
 EPILOG = """examples:
-  ertools record --config configs/mocap_home.yaml --out logs/ --namespace /fbm2h
-  ertools record --config configs/mocap_work.yaml --out logs/ --namespace /fbm3w \\
+  ertools record --config configs/mocap_home.yaml --out-dir logs/ --namespace /fbm2h
+  ertools record --config configs/mocap_work.yaml --out-dir logs/ --namespace /fbm3w \\
       --interface 192.168.1.20 --ntp-server 192.168.1.1
-  ertools record --config mocap.yaml --out logs/ --unicast --interface 0.0.0.0 --port 1511
-  ertools record --simulate --out /tmp/demo --duration 10     # no Motive needed
+  ertools record --config mocap.yaml --out-dir logs/ --unicast --interface 0.0.0.0 --port 1511
+  ertools record --simulate --out-dir /tmp/demo --duration 10     # no Motive needed
 
 output files: log_<name>_<YYYY-MM-DD-HH-MM-SS>_<n>.mcap; --name defaults to <namespace>_mocap
 (log_fbm2h_mocap_2015-10-23-16-15-40_0 in 2015) or mocap.
@@ -39,8 +39,10 @@ rigid_bodies:
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from pathlib import Path
 
+    from ertools.cli.options import add_out_dir, port, positive
+
     parser.add_argument("--config", type=Path, help="mocap YAML (seed Listing 2: rigid_bodies)")
-    parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder")
+    add_out_dir(parser, "write the MCAP files into DIR", old=("--out",), required=True)
     parser.add_argument("--name", help="file name part (default <namespace>_mocap or mocap)")
     parser.add_argument(
         "--namespace", default="", help="prefix of the config's relative topics, e.g. /fbm2h"
@@ -52,7 +54,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     net.add_argument(
         "--unicast", action="store_true", help="receive unicast on --interface instead of a group"
     )
-    net.add_argument("--port", type=int, help="NatNet data port (default 1511)")
+    net.add_argument("--port", type=port, help="NatNet data port (default 1511)")
     net.add_argument(
         "--interface",
         default="0.0.0.0",
@@ -70,12 +72,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     out = parser.add_argument_group("files")
     out.add_argument(
-        "--split", type=float, default=3600.0, metavar="S", help="new file every S s (3600)"
+        "--split", type=positive, default=3600.0, metavar="S", help="new file every S s (3600)"
     )
-    out.add_argument("--duration", type=float, metavar="S", help="stop after S seconds")
+    out.add_argument("--duration", type=positive, metavar="S", help="stop after S seconds")
     out.add_argument(
         "--flush",
-        type=float,
+        type=positive,
         default=0.5,
         metavar="S",
         help="flush a chunk every S s: the most a crash loses (0.5)",
@@ -91,10 +93,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     mon = parser.add_argument_group("health and clock")
     mon.add_argument(
-        "--health", type=float, default=5.0, metavar="S", help="health line every S s (5)"
+        "--health", type=positive, default=5.0, metavar="S", help="health line every S s (5)"
     )
     mon.add_argument("--ntp-server", metavar="HOST", help="measure the clock offset at each file")
-    mon.add_argument("--ntp-port", type=int, default=123)
+    mon.add_argument("--ntp-port", type=port, default=123)
     parser.add_argument(
         "--simulate",
         action="store_true",
@@ -140,7 +142,7 @@ def run(args: argparse.Namespace) -> int:
         port = args.port if args.port is not None else 0
         duration = duration if duration is not None else 10.0
     options = RecordOptions(
-        out_dir=args.out,
+        out_dir=args.out_dir,
         name=name,
         namespace=ns,
         group=group,

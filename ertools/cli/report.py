@@ -13,8 +13,8 @@ from pathlib import Path
 EPILOG = """examples:
   ertools score fbm3w run1.bag --report results/team-a-run1
   ertools score fbm3w run2.bag --report results/team-b-run1
-  ertools report results/*/ --out competition/
-  ertools report results/*/score.json --out competition/ --title "Lisbon 2015"
+  ertools report results/*/ --report competition/
+  ertools report results/*/score.json --report competition/ --title "Lisbon 2015"
 """
 
 
@@ -22,8 +22,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "results", nargs="+", type=Path, metavar="RESULT", help="report folder or its JSON"
     )
-    parser.add_argument(
-        "--out", type=Path, required=True, metavar="DIR", help="where to write index.html"
+    from ertools.cli.options import add_report
+
+    add_report(
+        parser, "write the combined page here (DIR/index.html)", required=True, old=("--out",)
     )
     parser.add_argument("--title", default="Competition results", help="the page's title")
 
@@ -32,7 +34,7 @@ def run(args: argparse.Namespace) -> int:
     from ertools.cli.common import note
     from ertools.report.combine import combine
 
-    index = combine(list(args.results), args.out, title=args.title)
+    index = combine(list(args.results), args.report, title=args.title)
     note(f"combined {len(args.results)} result(s) into {index}")
     print(index)
     return 0

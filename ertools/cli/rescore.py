@@ -13,14 +13,19 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ertools.cli.common import note
+
+if TYPE_CHECKING:
+    from ertools.rescore.jobs import Outcome
 
 EPILOG = """examples:
   ertools rescore --config competition.yaml --out results/
   ertools rescore logs/ --config competition.yaml --out results/ --jobs 8
   ertools rescore logs/ --config competition.yaml --out results/ --scheduler tcp://10.0.0.5:8786
   ertools rescore --config competition.yaml --check
+  ertools rescore logs/ --init competition.yaml
 
 --scheduler needs `pip install 'ertools[dask]'`; its workers must see the logs at the same paths
 (a shared file system): only paths and values go through the scheduler."""
@@ -37,6 +42,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         help="the competition manifest (YAML, docs/rescore.md)",
     )
     parser.add_argument("--out", type=Path, metavar="DIR", help="the results folder")
+    parser.add_argument(
+        "--init",
+        type=Path,
+        metavar="FILE",
+        help="draft the manifest FILE from the logs under PATH (every execution found, its "
+        "team, the inputs found and TODO lines for those missing); nothing is scored",
+    )
     parser.add_argument(
         "--check",
         action="store_true",
@@ -73,6 +85,8 @@ def run(args: argparse.Namespace) -> int:
     from ertools.rescore.parallel import default_jobs
     from ertools.rescore.pipeline import listed_executions, rescore, write_results
 
+    if args.init is not None:
+        return _init(args)
     if args.config is None:
         raise UsageError("--config FILE is needed: the competition manifest (docs/rescore.md)")
     if args.out is None and not args.check:
@@ -92,19 +106,29 @@ def run(args: argparse.Namespace) -> int:
     if args.check:
         note(f"{args.config}: no problems ({len(manifest.executions)} listed executions)")
         return 0
-    executions = listed_executions(manifest)
-    if not executions:
-        note(f"error: {args.config} lists no executions and no logs were given")
+    scorings = listed_executions(manifest)
+    problems: list[dict[str, object]] = []
+    timeline = None
+    if args.paths:
+        from ertools.rescore.found import find, merge, write_timeline
+
+        found = find(args.paths, progress=args.progress)
+        scorings = merge(found.scorings, scorings)
+        problems = list(found.problems)
+        args.out.mkdir(parents=True, exist_ok=True)
+        timeline = write_timeline(found, args.out, manifest.title)
+    if not scorings:
+        where = ", ".join(map(str, args.paths)) or "no logs were given"
+        note(f"error: no benchmark execution found ({where}) and none listed in {args.config}")
         return 1
     workers = args.jobs if args.jobs is not None else default_jobs()
 
-    def tell(outcome: object) -> None:
-        status = getattr(outcome, "status", "")
-        if status != "scored":
-            note(f"error: {getattr(outcome, 'id', '')}: {status}: {getattr(outcome, 'reason', '')}")
+    def tell(outcome: Outcome) -> None:
+        if outcome.status != "scored" and outcome.error != "TopicError":
+            note(f"error: {outcome.id}: {outcome.status}: {outcome.reason}")
 
     doc = rescore(
-        executions,
+        scorings,
         manifest,
         args.out,
         workers=workers,
@@ -112,6 +136,8 @@ def run(args: argparse.Namespace) -> int:
         use_cache=not args.no_cache,
         reports=not args.no_reports,
         command=args.command_line,
+        problems=problems,
+        timeline=timeline,
         progress=args.progress,
         on_outcome=tell,
     )
@@ -127,3 +153,29 @@ def run(args: argparse.Namespace) -> int:
         note(f"wrote {path}")
     sys.stdout.flush()
     return 0 if counts["scored"] == len(rows) else 1
+
+
+def _init(args: argparse.Namespace) -> int:
+    from ertools.errors import UsageError
+    from ertools.rescore.draft import draft_text
+    from ertools.rescore.found import find
+
+    if not args.paths:
+        raise UsageError("--init FILE drafts the manifest from logs: give the PATHs to scan")
+    if args.config is not None or args.out is not None:
+        raise UsageError("--init FILE only drafts the manifest: no --config or --out with it")
+    if args.init.exists():
+        raise UsageError(f"--init {args.init}: the file exists; ertools does not overwrite it")
+    for path in args.paths:
+        if not path.exists():
+            raise UsageError(f"{path}: no such file or folder")
+    found = find(args.paths, progress=args.progress)
+    text = draft_text(found, args.paths, args.init, args.command_line)
+    args.init.parent.mkdir(parents=True, exist_ok=True)
+    args.init.write_text(text, encoding="utf-8")
+    todo = sum("TODO" in line for line in text.splitlines())
+    note(
+        f"wrote {args.init}: {len(found.discovery.executions)} execution(s), {todo} TODO line(s) "
+        "to fill in"
+    )
+    return 0

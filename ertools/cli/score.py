@@ -17,6 +17,7 @@ from ertools.benchmarks.base import Input
 from ertools.cli.common import add_output_options, all_failed, emit_result, note
 from ertools.cli.groups import add_group_arguments, members_epilog, run_group
 from ertools.cli.main import Command
+from ertools.cli.options import deprecation_note
 from ertools.errors import UsageError
 
 GROUP_PROG = "ertools score"
@@ -31,6 +32,14 @@ def members() -> dict[str, Command]:
         bench = registry.get(name)
         out[name] = Command(__name__, bench.summary, bench.example)
     return out
+
+
+def __getattr__(name: str) -> Any:
+    """``MEMBERS``, as the other command groups have it, built on first use (it imports
+    every declaration)."""
+    if name == "MEMBERS":
+        return members()
+    raise AttributeError(name)
 
 
 def _unread_members() -> dict[str, Command]:
@@ -89,6 +98,11 @@ def _help(declared: Input) -> str:
     return text.replace("%", "%%")
 
 
+def _old_dest(flag: str) -> str:
+    """Where an old spelling's value goes: its own name, so that errors name it as typed."""
+    return flag.lstrip("-").replace("-", "_")
+
+
 def _add_input(target: Any, declared: Input) -> None:
     """One declared input as an argparse option (its values checked by make_options)."""
     kw: dict[str, Any] = {"dest": declared.name, "help": _help(declared), "default": None}
@@ -110,8 +124,8 @@ def _add_input(target: Any, declared: Input) -> None:
         if declared.repeat:
             kw["action"] = "append"
     target.add_argument(declared.option, **kw)
-    for i, old in enumerate(declared.old_flags):
-        old_kw = {**kw, "dest": f"old__{declared.name}__{i}", "help": argparse.SUPPRESS}
+    for old in declared.old_flags:
+        old_kw = {**kw, "dest": _old_dest(old), "help": argparse.SUPPRESS}
         target.add_argument(old, **old_kw)
 
 
@@ -152,11 +166,13 @@ def _values(bench: registry.AnyBenchmark, args: argparse.Namespace) -> dict[str,
     values: dict[str, Any] = {}
     for declared in bench.inputs:
         value = getattr(args, declared.name)
-        for i, old in enumerate(declared.old_flags):
-            old_value = getattr(args, f"old__{declared.name}__{i}")
+        for old in declared.old_flags:
+            old_value = getattr(args, _old_dest(old))
             if old_value is None or old_value is False:
                 continue
-            note(f"{old} is deprecated: it now means {declared.option}")
+            # A bare frame of the old spellings is the child of the mocap frame.
+            frame = " world:FRAME" if declared.metavar == "PARENT:CHILD" else ""
+            deprecation_note(old, declared.option + frame)
             if not value:
                 value = old_value
         if declared.kind == "flag" and not value:
@@ -165,9 +181,7 @@ def _values(bench: registry.AnyBenchmark, args: argparse.Namespace) -> dict[str,
     return values
 
 
-def _bags(
-    bench: registry.AnyBenchmark, values: dict[str, Any], bags: Sequence[Path]
-) -> list[Path]:
+def _bags(bench: registry.AnyBenchmark, values: dict[str, Any], bags: Sequence[Path]) -> list[Path]:
     """The bags, taken back from a ``with_file`` choice that swallowed them when it came
     first (``--reached timing FILE log.bag``)."""
     out = list(bags)
@@ -203,4 +217,3 @@ def run(args: argparse.Namespace) -> int:
         for line in bench.notes(result) if bench.notes is not None else ():
             note(line)
     return emit_result(result, args, bench.input_files(bags, options, result))
-

@@ -22,6 +22,7 @@ EPILOG = """examples:
   ertools timeline bags/ --plot day.html         # interactive page: zoom, sessions, problems
   ertools timeline bags/ --plot day.png          # one panel per session, problems numbered
   ertools timeline bags/ --clock-tolerance 0.2 --format csv -o timeline.csv
+  ertools timeline bags/ --format yaml -o timeline.yaml
 
 JSON layout: {"bags": [{"path", "format", "start", "end", "duration", "kind", "benchmarks",
 "overlaps", "problems", "copy_of", "copies"}], "sessions": [{"index", "start", "end",
@@ -29,28 +30,18 @@ JSON layout: {"bags": [{"path", "format", "start", "end", "duration", "kind", "b
 """
 
 
-def _seconds(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a number of seconds: {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must not be negative: {value}")
-    return value
+# Suffixes ``--plot`` writes: an interactive page, or one panel per session.
+TIMELINE_PLOT_SUFFIXES = (".png", ".svg", ".html", ".htm")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from ertools.cli.options import add_output, plot_file, seconds
+
     parser.add_argument("paths", type=Path, nargs="+", metavar="PATH", help="bags or folders")
-    parser.add_argument(
-        "--format",
-        choices=("table", "csv", "json"),
-        default="table",
-        help="output on stdout (default table; coloured only on a terminal)",
-    )
-    parser.add_argument("-o", "--output", type=Path, help="write the output to this file")
+    add_output(parser, ("text", "json", "yaml", "csv"), aliases={"table": "text"})
     parser.add_argument(
         "--plot",
-        type=Path,
+        type=plot_file(TIMELINE_PLOT_SUFFIXES),
         action="append",
         metavar="FILE",
         help="write a picture, by suffix: .html an interactive page (zoom, sessions, problems "
@@ -58,14 +49,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--clock-tolerance",
-        type=_seconds,
+        type=seconds,
         default=0.5,
         metavar="S",
         help="flag bags whose header stamps and record times differ by more (default 0.5 s)",
     )
     parser.add_argument(
         "--gap-tolerance",
-        type=_seconds,
+        type=seconds,
         default=1.0,
         metavar="S",
         help="flag pauses longer than this between split files of a logger (default 1 s)",
@@ -83,12 +74,8 @@ def run(args: argparse.Namespace) -> int:
     from ertools.timeline.scan import scan
     from ertools.timeutil import s_to_ns
 
+    # a bad --plot suffix was refused by argparse (exit 2), not after minutes of reading
     plots: list[Path] = args.plot or []
-    for plot in plots:  # refused before the scan, not after minutes of reading
-        if plot.suffix.lower() not in (".png", ".svg", ".html", ".htm"):
-            from ertools.errors import UsageError
-
-            raise UsageError(f"--plot {plot}: give a .png, .svg or .html file name")
     config = TimelineConfig(
         clock_tolerance_ns=s_to_ns(args.clock_tolerance),
         gap_tolerance_ns=s_to_ns(args.gap_tolerance),
@@ -100,12 +87,16 @@ def run(args: argparse.Namespace) -> int:
         progress=getattr(args, "progress", None),
     )
     if args.format == "json":
-        write_text(dump_json(timeline.to_dict()), args.output)
+        write_text(dump_json(timeline.to_dict()), args.out)
+    elif args.format == "yaml":
+        from ertools.benchmarks.base import dump_yaml
+
+        write_text(dump_yaml(timeline.to_dict()), args.out)  # the JSON's keys, as YAML
     elif args.format == "csv":
-        write_text(to_csv(timeline), args.output)
+        write_text(to_csv(timeline), args.out)
     else:
-        color = args.output is None and sys.stdout.isatty()
-        write_text(to_table(timeline, color=color), args.output)
+        color = args.out is None and sys.stdout.isatty()
+        write_text(to_table(timeline, color=color), args.out)
     if plots and timeline.readable_count > 0:  # no empty chart on failure
         from ertools.report.plots_timeline import save_timeline_plot
 

@@ -194,3 +194,32 @@ def transform_yaml(tr: MarkerTransform) -> str:
         f"- {_flow(t_inv)}          # translation from robot to markerset\n"
         f"- {_flow(q_inv)} # orientation of markerset wrt robot\n"
     )
+
+
+# The live FBM2H score records the transform its node used (seed Listing 13: details.marker-robot
+# transform, [[x, y, z], [qx, qy, qz, qw]]); an audit given none re-scores with it.
+LIVE_TRANSFORM_KEY = "marker-robot transform"
+
+
+def live_transform(live: Any) -> MarkerTransform | None:
+    """The marker-to-robot transform the live FBM2H score says its node used, or None when the
+    payload has none (or not as ``[[x, y, z], [qx, qy, qz, qw]]``)."""
+    if not isinstance(live, dict):
+        return None
+    details = live.get("details")
+    value = details.get(LIVE_TRANSFORM_KEY) if isinstance(details, dict) else None
+    if value is None:
+        value = live.get(LIVE_TRANSFORM_KEY)  # an early node wrote it at the top level
+    if value is None:
+        return None
+    try:
+        return parse_transform(
+            {
+                "robot_info": "live score",
+                "transform_timestamp": "0",
+                "marker_to_robot_transform": value,
+            },
+            source=f"the live score (details.{LIVE_TRANSFORM_KEY})",
+        )
+    except ConfigError:
+        return None

@@ -4,7 +4,7 @@ other tools read (TUM and KITTI for evo, CSV for pandas, spreadsheets and plotti
 Two library functions, one per mode of the command:
 
 - :func:`export_source`: one pose source (a pose topic or a tf frame, read by
-  :func:`ertools.io.read_pose_source`) to one file.
+  :func:`ertools.benchmarks.common.sources.read_source`) to one file.
 - :func:`trajectory_pair` + :func:`write_pair`: the two streams ``ertools score trajectory``
   compares, as ``robot.<fmt>`` and ``gt.<fmt>`` for ``evo_ape``. Raw (default): the robot
   poses with the applied clock offset added to their stamps and the GT ertools reads around
@@ -26,13 +26,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ertools.errors import ScoringError, TopicError, UsageError
+from ertools.errors import ScoringError, UsageError
 from ertools.export.formats import SUFFIXES, ExportFormat, format_poses, format_times
 from ertools.streams import PoseStream
 
 if TYPE_CHECKING:
-    from ertools.benchmarks.trajectory.benchmark import TrajectoryConfig, TrajectoryResult
-    from ertools.io import PoseSource
+    from ertools.benchmarks.common.sources import PoseSpec
+    from ertools.benchmarks.trajectory.config import TrajectoryConfig
+    from ertools.benchmarks.trajectory.result import TrajectoryResult
 
 # GT read around the robot poses for the raw pair: evo's association only looks a few
 # max_diff (0.01 s by default) beyond the robot's span; a second covers any sensible setting.
@@ -44,24 +45,16 @@ KITTI_NEEDS_MATCHED = (
 )
 
 
-def read_source(paths: Sequence[str | Path], source: PoseSource) -> PoseStream:
-    """The poses of one source, refusing an empty one (an empty file is a mistake, not data)."""
-    from ertools.io import read_pose_source
-
-    stream = read_pose_source([str(p) for p in paths], source)
-    if len(stream) == 0:
-        what = source.topic if source.topic else f"/tf {source.parent} -> {source.frame}"
-        raise TopicError(f"{what} has no poses in {', '.join(map(str, paths))}")
-    return stream
-
-
 def export_source(
     paths: Sequence[str | Path],
-    source: PoseSource,
+    spec: PoseSpec,
     fmt: ExportFormat,
 ) -> tuple[PoseStream, str]:
-    """Read one pose source and format it: (the stream, the text)."""
-    stream = read_source(paths, source)
+    """Read one pose source (the one chooser, :func:`ertools.benchmarks.common.sources.
+    read_source`: an empty source is refused) and format it: (the stream, the text)."""
+    from ertools.benchmarks.common.sources import read_source
+
+    stream = read_source(paths, spec, what="poses to export")
     return stream, format_poses(stream, fmt)
 
 
@@ -102,13 +95,10 @@ def trajectory_pair(
     Raises:
         ScoringError: ``matched`` and no pose could be compared; the errors of ``score``.
     """
-    from ertools.benchmarks.trajectory.benchmark import (
-        COMPARED,
-        drop_duplicates,
-        drop_invalid,
-        read_gt,
-        score,
-    )
+    from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid
+    from ertools.benchmarks.trajectory.association import COMPARED
+    from ertools.benchmarks.trajectory.benchmark import score
+    from ertools.benchmarks.trajectory.inputs import read_gt
 
     result = score(
         robot_bag,

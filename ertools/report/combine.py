@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from ertools import __version__
+from ertools.benchmarks import registry
 from ertools.benchmarks.common.teams import team_from_log_name
 from ertools.errors import ConfigError
 from ertools.report import html as h
@@ -34,13 +35,10 @@ _OUTPUT_FLAGS = frozenset({"-v", "--verbose", "-q", "--quiet"})
 # Team sources, best first (ertools.benchmarks.common.teams.resolve_team's precedence).
 _SOURCE_RANK = {"explicit": 0, "payload": 1, "log name": 2, "transform": 3}
 
-# Keys that identify a benchmark's score when no result.json says which it is.
-_SIGNATURES: tuple[tuple[str, frozenset[str]], ...] = (
-    ("fbm3w", frozenset({"best_distance_error", "runs_details"})),
-    ("fbm2h", frozenset({"position_accuracy", "orientation_accuracy"})),
-    ("trajectory", frozenset({"position_error", "association"})),
+# Keys that identify a score that is no registered benchmark's (a benchmark declares its own:
+# :attr:`ertools.benchmarks.base.Benchmark.score_keys`) when no result.json says which it is.
+_OTHER_SIGNATURES: tuple[tuple[str, frozenset[str]], ...] = (
     ("noise", frozenset({"epsilon", "suggested_d_min"})),
-    ("fbm1", frozenset({"class_accuracy", "instance_accuracy"})),
 )
 
 
@@ -105,9 +103,15 @@ def _load_json(path: Path) -> Any:
 
 
 def _guess_benchmark(score: dict[str, Any]) -> str:
+    """The benchmark a score.json read alone belongs to: the name it states, else the first
+    whose declared keys it has."""
+    said = score.get("benchmark")
+    if isinstance(said, str) and said in registry.names():
+        return said
     keys = set(score)
-    for name, signature in _SIGNATURES:
-        if signature <= keys:
+    declared = [(name, registry.get(name).score_keys) for name in registry.names()]
+    for name, signature in (*declared, *_OTHER_SIGNATURES):
+        if signature and signature <= keys:
             return name
     return "unknown"
 

@@ -12,15 +12,11 @@ from importlib import import_module
 from pathlib import Path
 from typing import Any
 
-# Benchmark name -> module with ``figure_specs(result) -> list[FigureSpec]``.
-PLOT_MODULES: dict[str, str] = {
-    "fbm1h": "ertools.report.plots_fbm1",
-    "fbm1w": "ertools.report.plots_fbm1",
-    "fbm2h": "ertools.report.plots_fbm2h",
-    "fbm3w": "ertools.report.plots_fbm3w",
-    "trajectory": "ertools.report.plots_trajectory",
-    "noise": "ertools.report.plots_noise",
-}
+from ertools.benchmarks import registry
+
+# Results that are not a registered benchmark's -> ``module:function`` giving their figures
+# (a benchmark names its own: :attr:`ertools.benchmarks.base.Benchmark.figures`).
+OTHER_FIGURES: dict[str, str] = {"noise": "ertools.report.plots_noise:figure_specs"}
 
 
 @dataclass(frozen=True)
@@ -34,11 +30,13 @@ class FigureSpec:
 
 
 def figure_specs(result: Any) -> list[FigureSpec]:
-    """The figures of a result, from the plot module registered for its benchmark."""
-    module_name = PLOT_MODULES.get(result.name)
-    if module_name is None:
+    """The figures of a result, from the function its benchmark declares."""
+    name = str(result.name)
+    target = registry.get(name).figures if name in registry.names() else OTHER_FIGURES.get(name)
+    if not target:
         return []
-    specs: list[FigureSpec] = import_module(module_name).figure_specs(result)
+    module_name, _, function = target.partition(":")
+    specs: list[FigureSpec] = getattr(import_module(module_name), function)(result)
     return specs
 
 

@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from ertools import __version__
+from ertools.benchmarks import registry
 from ertools.benchmarks.base import BenchmarkResult, Rows, jsonable
 from ertools.benchmarks.common.teams import SOURCE_TEXT
 from ertools.report import html as h
@@ -38,7 +39,6 @@ from ertools.report import units
 
 log = logging.getLogger("ertools.report.folder")
 
-NAMESPACES = ("fbm1h", "fbm1w", "fbm2h", "fbm3w")
 CONFIG_MAX_BYTES = 64 * 1024  # configs up to this size are shown in the page
 TABLE_MAX_ROWS = 200  # longer tables are in the CSV only
 TABLE_OPEN_ROWS = 30  # longer tables are folded in the page
@@ -198,7 +198,7 @@ def _write(path: Path, text: str) -> None:
 
 def _audit_inputs(name: str, inputs: list[Path]) -> Any:
     """The audit of the bags' state topics, or None (no namespace, no topics, unreadable)."""
-    if name not in NAMESPACES or not inputs:
+    if name not in registry.names() or not registry.get(name).state_topics or not inputs:
         return None
     from ertools.audit.analyse import audit_states
     from ertools.errors import ErtoolsError

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from ertools.benchmarks import registry
 from ertools.report import units
 from ertools.report.figures import FigureSpec
 
@@ -149,7 +150,7 @@ def _draw_table(result: Any) -> Any:
 
 def figure_specs(result: Any) -> list[FigureSpec]:
     """The FBM1 figures of a result (``Fbm1Result``)."""
-    label = "FBM1@Home" if result.name == "fbm1h" else "FBM1@Work"
+    label = registry.get(result.name).title
     return [
         FigureSpec(
             f"{result.name}_pose_scores", f"{label}: pose score per run", _draw_scores(result)

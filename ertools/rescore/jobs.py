@@ -11,6 +11,7 @@ costs one row.
 
 from __future__ import annotations
 
+import logging
 import time
 import traceback
 from collections.abc import Mapping
@@ -23,6 +24,7 @@ from ertools.benchmarks.base import Benchmark, jsonable
 from ertools.benchmarks.common.teams import with_team
 from ertools.benchmarks.document import all_failed, score_json
 from ertools.errors import ErtoolsError
+from ertools.progress import reporting
 
 Status = Literal["scored", "unscoreable", "failed"]
 
@@ -68,6 +70,7 @@ class Outcome:
     live_differences: tuple[str, ...] = ()
     report: str | None = None
     seconds: float = 0.0
+    error: str | None = None  # the error's class (``TopicError``) when not scored
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -82,6 +85,7 @@ class Outcome:
             "live_differences": list(self.live_differences),
             "report": self.report,
             "seconds": self.seconds,
+            "error": self.error,
         }
 
     @classmethod
@@ -98,6 +102,7 @@ class Outcome:
             live_differences=tuple(data.get("live_differences", ())),
             report=data.get("report"),
             seconds=float(data.get("seconds", 0.0)),
+            error=data.get("error"),
         )
 
 
@@ -115,18 +120,50 @@ def load_benchmark(target: str) -> Benchmark[Any, Any, Any, Any]:
 def run_job(job: Job) -> Outcome:
     """Score one job; every problem becomes the outcome's status and reason, never a raise."""
     start = time.perf_counter()
+    logger = logging.getLogger("ertools")
+    handlers, propagate = logger.handlers[:], logger.propagate
+    captured = _Capture()
+    # what the readers log (a file not indexed...) belongs to this execution's row, not to
+    # stderr interleaved from several workers
+    logger.handlers[:] = [captured]
+    logger.propagate = False
     try:
-        outcome = _score(job)
+        # a worker forked from the command holds its progress bar: the bar is the parent's, and
+        # counts executions; the reads inside one report nothing
+        with reporting(None):
+            outcome = _score(job)
     except ErtoolsError as err:
-        outcome = Outcome(job.id, "unscoreable", reason=one_line(str(err)))
+        outcome = Outcome(
+            job.id, "unscoreable", reason=one_line(str(err)), error=type(err).__name__
+        )
     except Exception as err:  # a bug in a scorer: this execution's row only
         where = traceback.extract_tb(err.__traceback__)[-1] if err.__traceback__ else None
         at = f" at {Path(where.filename).name}:{where.lineno}" if where else ""
         outcome = Outcome(
-            job.id, "failed", reason=one_line(f"unexpected {type(err).__name__}: {err}{at}")
+            job.id,
+            "failed",
+            reason=one_line(f"unexpected {type(err).__name__}: {err}{at}"),
+            error=type(err).__name__,
         )
+    finally:
+        logger.handlers[:] = handlers
+        logger.propagate = propagate
     seconds = round(time.perf_counter() - start, 3)
-    return Outcome(**{**outcome.__dict__, "seconds": seconds})
+    logged = tuple(dict.fromkeys(captured.lines))
+    return Outcome(
+        **{**outcome.__dict__, "seconds": seconds, "warnings": (*logged, *outcome.warnings)}
+    )
+
+
+class _Capture(logging.Handler):
+    """Keeps the warnings logged while one job is scored."""
+
+    def __init__(self) -> None:
+        super().__init__(logging.WARNING)
+        self.lines: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.lines.append(one_line(record.getMessage()))
 
 
 def _score(job: Job) -> Outcome:
@@ -136,7 +173,8 @@ def _score(job: Job) -> Outcome:
     result = benchmark.score(bags, options)
     if all_failed(result):
         return Outcome(job.id, "unscoreable", reason=one_line("; ".join(result.failures)))
-    result = with_team(result, job.team, bags)
+    files = benchmark.input_files(bags, options, result)  # as the score command's report
+    result = with_team(result, job.team, files)
     warnings = tuple(str(w) for w in result.warnings)
     warnings += tuple(f"error: {f}" for f in result.failures)  # runs that failed, others scored
     audit = _live_audit(result, bags)
@@ -156,7 +194,7 @@ def _score(job: Job) -> Outcome:
         index = write_report(
             result,
             Path(job.report_dir),
-            inputs=bags,
+            inputs=files,
             argv=list(job.argv),
             audit=audit,
             team=job.team,

@@ -15,7 +15,7 @@ A YAML file (safe-loaded), documented in docs/rescore.md::
       - benchmark: fbm3w
         team: robotto
         bags: [bmmanager/log_fbm3w.bag, gtlogger/log_mocap_3.bag]
-        start: 2015-11-20T12:31:05Z              # optional (default: the bags' first message)
+        start: 2015-11-20T12:31:05Z              # optional (default: the first bag's span)
         inputs: {d_min: 0.0005}                  # optional: this execution's own values
 
 The keys a benchmark takes are exactly its registry declaration (:attr:`Benchmark.inputs`):
@@ -28,6 +28,7 @@ its transform) is found in one pass and reported together, one line each
 from __future__ import annotations
 
 import hashlib
+import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, date, datetime
@@ -45,6 +46,8 @@ TOP_KEYS = ("version", "title", "benchmarks", "executions")
 BENCHMARK_KEYS = ("inputs", "teams")
 EXECUTION_KEYS = ("benchmark", "team", "bags", "start", "end", "inputs")
 PATH_KINDS = ("path", "paths")
+# A benchmark input of this name is its ``--team``: given the execution's team.
+TEAM_INPUT = "team"
 
 
 class ManifestError(ConfigError):
@@ -101,6 +104,9 @@ class Manifest:
             if team is not None:
                 values.update(entry.teams.get(team, {}))
         values.update(overrides or {})
+        declared_names = {d.name for d in self.declared.get(benchmark, ())}
+        if TEAM_INPUT in declared_names and values.get(TEAM_INPUT) is None and team:
+            values[TEAM_INPUT] = team  # the benchmark's own --team: the execution's team
         missing = [
             f"{benchmark}: no {declared.name} for team {team or '(unknown)'} in the manifest "
             f"(benchmarks.{benchmark}.teams.{team or 'TEAM'}.{declared.name})"
@@ -263,6 +269,8 @@ class _Checker:
             converted = [self.value(single, item, where) for item in items]
             return _BAD if any(c is _BAD for c in converted) else tuple(converted)
         kind = declared.kind
+        if kind == "choice" and declared.with_file:
+            return self.choice_with_file(declared, value, where)
         if kind == "path":
             if not isinstance(value, str) or not value:
                 self.problem(where, f"expected a file path, got {_kind_name(value)}")
@@ -291,9 +299,29 @@ class _Checker:
             return _BAD
         return str(value)
 
+    def choice_with_file(self, declared: Input, value: Any, where: str) -> Any:
+        """``states`` or ``[timing, FILE]``: a choice, with a file for those that take one."""
+        words = [value] if isinstance(value, str) else value
+        expected = " | ".join(
+            f"[{c}, FILE]" if c in declared.with_file else c for c in declared.choices
+        )
+        if (
+            not isinstance(words, list)
+            or not words
+            or not all(isinstance(w, str) for w in words)
+            or words[0] not in declared.choices
+            or len(words) != (2 if words[0] in declared.with_file else 1)
+        ):
+            self.problem(where, f"expected {expected}, got {value!r}")
+            return _BAD
+        if len(words) == 1:
+            return (words[0],)
+        path = self.path(words[1], where)
+        return _BAD if path is _BAD else (words[0], path)
+
     def path(self, text: str, where: str) -> Path | Any:
         path = Path(text).expanduser()
-        path = path if path.is_absolute() else self.base / path
+        path = Path(os.path.normpath(path if path.is_absolute() else self.base / path))
         if not path.exists():
             self.problem(where, f"file not found: {path}")
             return _BAD

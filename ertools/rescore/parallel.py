@@ -14,6 +14,7 @@ import contextlib
 import multiprocessing
 import multiprocessing.connection
 import os
+import pickle
 import sys
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -51,6 +52,41 @@ def _worker(conn: multiprocessing.connection.Connection) -> None:
         if job is None:
             return
         conn.send(run_job(job))
+
+
+def run_job_forked(job: Job) -> Outcome:
+    """:func:`run_job` in a child forked for this job only: a scorer that crashes or is killed
+    (for memory) costs this job's row, never the Dask worker running it nor the other tasks that
+    worker holds (the scheduler would count those as suspects of its death). ``os.fork``, not
+    ``multiprocessing``: a Dask worker under a nanny is a daemonic process, which
+    ``multiprocessing`` forbids to have children. Where there is no fork, in this process."""
+    if not hasattr(os, "fork"):
+        return run_job(job)
+    read_fd, write_fd = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child: score, send the outcome, leave without running any cleanup
+        os.close(read_fd)
+        code = 0
+        try:
+            data = pickle.dumps(run_job(job))
+            with os.fdopen(write_fd, "wb") as out:
+                out.write(data)
+        except BaseException:
+            code = 1
+        os._exit(code)
+    os.close(write_fd)
+    with os.fdopen(read_fd, "rb") as fh:
+        data = fh.read()
+    _, status = os.waitpid(pid, 0)
+    if data:
+        outcome: Outcome = pickle.loads(data)  # from our own child: trusted
+        return outcome
+    code = os.waitstatus_to_exitcode(status)
+    return Outcome(
+        job.id,
+        "failed",
+        reason=f"the process scoring it died (exit code {code}); the other executions were scored",
+    )
 
 
 def _context() -> Any:
@@ -162,7 +198,9 @@ def run_dask(jobs: Sequence[Job], address: str, *, workers: int, on_done: OnDone
         raise ConfigError(f"--scheduler {address}: cannot connect ({err})") from err
     try:
         futures = {
-            client.submit(run_job, job, key=f"rescore-{job.id}-{os.getpid()}", pure=False): job
+            client.submit(
+                run_job_forked, job, key=f"rescore-{job.id}-{os.getpid()}", pure=False
+            ): job
             for job in jobs
         }
         for future in distributed.as_completed(futures):

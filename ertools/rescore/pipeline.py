@@ -14,7 +14,7 @@ import json
 import os
 import re
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -27,6 +27,7 @@ from ertools.rescore.cache import Cache, FileHashes, job_key, records
 from ertools.rescore.jobs import Job, Outcome
 from ertools.rescore.manifest import Manifest
 from ertools.rescore.parallel import run_jobs
+from ertools.rescore.site import write_site
 from ertools.timeutil import NS_PER_S, iso_utc
 
 SCHEMA_VERSION = 1
@@ -45,11 +46,14 @@ _UNSAFE = re.compile(r"[^A-Za-z0-9_.-]+")
 
 
 @dataclass(frozen=True)
-class Execution:
-    """One benchmark execution to score, wherever it was found (the manifest, the logs).
+class Scoring:
+    """One score to compute, wherever it was found (listed in the manifest, discovered in the
+    logs): a benchmark execution, or a robot's own log compared with the GT (``of``: the id of
+    the execution it belongs to).
 
-    ``bags`` are what the benchmark reads; ``problems`` (one line each) make it unscoreable
-    before any scoring (a team without its transform).
+    ``bags`` are what the benchmark reads; ``blockers`` (one line each) make it unscoreable
+    before any scoring (no team to take the inputs of); ``notes`` are discovery's remarks
+    about it (partial GT coverage...), kept with its warnings.
     """
 
     benchmark: str
@@ -59,23 +63,26 @@ class Execution:
     end_ns: int | None = None
     team_source: str | None = None
     values: Mapping[str, Any] = field(default_factory=dict)
-    problems: tuple[str, ...] = ()
+    blockers: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
+    of: str | None = None
 
 
 @dataclass(frozen=True)
 class Planned:
     """An execution, its job and its row's fixed part."""
 
-    execution: Execution
+    execution: Scoring
     job: Job
     title: str
     missing: tuple[str, ...]
+    of: str | None = None  # a robot-log comparison: its execution's id
 
 
-def listed_executions(manifest: Manifest) -> list[Execution]:
+def listed_executions(manifest: Manifest) -> list[Scoring]:
     """The executions the manifest lists by hand."""
     return [
-        Execution(
+        Scoring(
             benchmark=e.benchmark,
             team=e.team,
             bags=e.bags,
@@ -133,18 +140,18 @@ def score_argv(
             argv.append(declared.option)
             continue
         items = value if isinstance(value, tuple | list) else (value,)
-        if declared.kind == "paths" and not declared.repeat:
+        if (declared.kind == "paths" and not declared.repeat) or declared.with_file:
             argv += [declared.option, *(str(v) for v in items)]
         else:
             for item in items:
                 argv += [declared.option, str(item)]
-    if team:
-        argv += ["--team", team]
+    if team and all(declared.option != "--team" for declared in benchmark.inputs):
+        argv += ["--team", team]  # the score commands' own --team (else a declared input)
     return argv
 
 
 def plan(
-    executions: Sequence[Execution], manifest: Manifest, out: Path, *, reports: bool = True
+    executions: Sequence[Scoring], manifest: Manifest, out: Path, *, reports: bool = True
 ) -> list[Planned]:
     """One job per execution, in time order, with unique ids and the manifest's values."""
     ordered = sorted(
@@ -153,18 +160,21 @@ def plan(
     )
     planned: list[Planned] = []
     seen: dict[str, int] = {}
+    ids_by_log: dict[str, str] = {}  # a benchmark log -> its execution's id (for ``of``)
     for n, (_, execution) in enumerate(ordered):
         benchmark = registry.get(execution.benchmark)
         start_ns, end_ns = execution.start_ns, execution.end_ns
         if start_ns is None or end_ns is None:
-            found_start, found_end = _bags_span(execution.bags)
+            found_start, found_end = _bags_span(execution.bags[:1])  # its benchmark log
             start_ns = start_ns if start_ns is not None else found_start
             end_ns = end_ns if end_ns is not None else found_end
-            execution = Execution(**{**execution.__dict__, "start_ns": start_ns, "end_ns": end_ns})
+            execution = Scoring(**{**execution.__dict__, "start_ns": start_ns, "end_ns": end_ns})
         ident = execution_id(execution.benchmark, execution.team, start_ns, n)
         seen[ident] = seen.get(ident, 0) + 1
         if seen[ident] > 1:
             ident = f"{ident}-{seen[ident]}"
+        if execution.of is None and execution.bags:
+            ids_by_log.setdefault(str(execution.bags[0].resolve()), ident)
         values, missing = manifest.values_for(execution.benchmark, execution.team, execution.values)
         values = {k: v for k, v in values.items() if v is not None}
         job = Job(
@@ -177,12 +187,15 @@ def plan(
             report_dir=str(out / "executions" / ident) if reports else None,
             argv=tuple(score_argv(benchmark, execution.bags, values, execution.team)),
         )
-        planned.append(Planned(execution, job, benchmark.title, (*execution.problems, *missing)))
-    return planned
+        planned.append(Planned(execution, job, benchmark.title, (*execution.blockers, *missing)))
+    return [
+        replace(p, of=ids_by_log.get(p.execution.of)) if p.execution.of is not None else p
+        for p in planned
+    ]
 
 
 def rescore(
-    executions: Sequence[Execution],
+    executions: Sequence[Scoring],
     manifest: Manifest,
     out: Path,
     *,
@@ -308,9 +321,21 @@ def document(
     rows: list[dict[str, Any]] = []
     all_problems = [dict(p) for p in problems]
     files: dict[str, Path] = {}
+    # A robot log without the topics its comparison needs (most robots log no pose in an
+    # object perception benchmark) is no row: a line in its execution's warnings says so.
+    skipped: dict[str, list[str]] = {}
+    for p in planned:
+        o = outcomes[p.job.id]
+        if p.of is not None and _no_topics(o):
+            skipped.setdefault(p.of, []).append(
+                f"robot log {p.execution.bags[0]}: not compared with the GT by "
+                f"{p.job.benchmark} ({o.reason})"
+            )
     for p in planned:
         e, job = p.execution, p.job
         o = outcomes[job.id]
+        if p.of is not None and _no_topics(o):
+            continue
         inputs = records(job.values, hashes)
         for bag in e.bags:
             files[str(bag)] = bag
@@ -339,11 +364,12 @@ def document(
                 "reason": o.reason,
                 "score": o.score,
                 "rank_value": o.rank_value,
-                "warnings": list(o.warnings),
+                "warnings": [*o.warnings, *e.notes, *skipped.get(job.id, [])],
                 "deviations": list(o.deviations),
                 "live_score": o.live_score,
                 "live_differences": list(o.live_differences),
                 "report": _rel(o.report, out),
+                "of": p.of,
                 "cached": job.id in cached,
                 "seconds": o.seconds,
             }
@@ -376,6 +402,10 @@ def document(
         "deviations_in_force": deviations,
         "inputs": provenance,
     }
+
+
+def _no_topics(outcome: Outcome) -> bool:
+    return outcome.status == "unscoreable" and outcome.error == "TopicError"
 
 
 def leaderboards(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
@@ -431,7 +461,7 @@ def csv_text(doc: Mapping[str, Any]) -> str:
 
 
 def write_results(doc: Mapping[str, Any], out: Path) -> list[Path]:
-    """``results.json``, ``results.csv`` and, when the ``site`` module is there, ``index.html``."""
+    """``results.json``, ``results.csv`` and the results page ``index.html``."""
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for name, text in (
@@ -443,13 +473,6 @@ def write_results(doc: Mapping[str, Any], out: Path) -> list[Path]:
         tmp.write_text(text, encoding="utf-8")
         os.replace(tmp, path)
         written.append(path)
-    # SITE CALL POINT: the results page is the `site` branch's
-    # (ertools.rescore.site.write_site(results, out) -> DIR/index.html), built from the document
-    # alone; called here once that module exists.
-    from importlib.util import find_spec
-
-    if find_spec("ertools.rescore.site") is not None:
-        from importlib import import_module
-
-        written.append(import_module("ertools.rescore.site").write_site(dict(doc), out))
+    # the results page, rebuilt from the document alone (ertools.rescore.site)
+    written.append(write_site(dict(doc), out))
     return written

@@ -45,6 +45,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import yaml
 
 from ertools.errors import UsageError
 from ertools.samples import fbm1, fbm2h
@@ -71,6 +72,8 @@ from ertools.samples.scenario import EPOCH_2015, log_name, to_plain
 from ertools.samples.simulated import SimulatedRun
 from ertools.samples.statemachine import state_messages
 from ertools.samples.timeline_folder import make_active
+from ertools.states import BmBoxState
+from ertools.streams import Machine
 
 NS = 1_000_000_000
 DEFAULT_SEED = 2015_11_20
@@ -307,6 +310,14 @@ def _execution_answer(
         status, reason = "unscoreable", f"no marker-to-robot transform for team {slot.team}"
     states = _state_span(sim)
     score, tolerance = expected_score(sim)
+    # The score the live 2015 BmBox sent (its TRANSMITTING_SCORE payload), as a reader of the
+    # log finds it; a truncated log lost it with its end.
+    sent = [
+        t.payload
+        for t in sim.transitions
+        if t.machine is Machine.BMBOX and t.state == BmBoxState.TRANSMITTING_SCORE and t.payload
+    ]
+    live = yaml.safe_load(sent[0]) if sent and slot.id != TRUNCATED else None
     return {
         "id": slot.id,
         "benchmark": slot.benchmark,
@@ -326,5 +337,6 @@ def _execution_answer(
         "reason": reason,
         "score": score,
         "tolerance": tolerance,
+        "live_score": live,
         "parameters": sim.parameters,
     }

@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ertools.benchmarks.fbm2h.benchmark import NAMESPACE as FBM2H
 from ertools.geometry import quat_from_yaw
 from ertools.samples.mocap import (
     MocapNoise,
@@ -55,7 +56,7 @@ I64 = npt.NDArray[np.int64]
 
 NS = 1_000_000_000
 TEAM = "homer"
-NAMESPACE = "fbm2h"
+NAMESPACE = FBM2H
 BODY = "robot_at_home"
 ROBOT_TOPIC = f"/rockin/{TEAM}/marker_pose"
 GT_TOPIC = pose_topic(NAMESPACE, BODY)

@@ -52,6 +52,9 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from ertools.benchmarks.fbm1.benchmark import BENCHMARKS as FBM1
+from ertools.benchmarks.fbm2h.benchmark import NAMESPACE as FBM2H
+from ertools.benchmarks.fbm3w.benchmark import NAMESPACE as FBM3W
 from ertools.errors import UsageError
 
 # A Friday at the Lisbon 2015 RoCKIn competition (2015-11-20 10:00:00 UTC): the default
@@ -59,9 +62,9 @@ from ertools.errors import UsageError
 EPOCH_2015 = 1_448_013_600 * 1_000_000_000
 
 SCENARIOS: dict[str, str] = {
-    "fbm3w": "ertools.samples.fbm3w:generate",
-    "fbm2h": "ertools.samples.fbm2h:generate",
-    "fbm1h": "ertools.samples.fbm1:generate",
+    FBM3W: "ertools.samples.fbm3w:generate",
+    FBM2H: "ertools.samples.fbm2h:generate",
+    FBM1[0]: "ertools.samples.fbm1:generate",
     "robotlog": "ertools.samples.robotlog:generate",
     "stationary": "ertools.samples.stationary:generate",
     "timeline": "ertools.samples.timeline_folder:generate",

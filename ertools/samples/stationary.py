@@ -31,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ertools.benchmarks.fbm3w.benchmark import NAMESPACE as FBM3W
 from ertools.geometry import quat_from_yaw
 from ertools.samples.mocap import (
     MocapNoise,
@@ -46,7 +47,7 @@ from ertools.samples.mocap import (
 from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
 from ertools.samples.writer import BagWriter
 
-NAMESPACE = "fbm3w"
+NAMESPACE = FBM3W
 BODY = "robot_at_work"
 DURATION_S = 50.0
 SIGMA_M = 2.0e-4

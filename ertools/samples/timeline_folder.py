@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
+from ertools.benchmarks.fbm2h.benchmark import NAMESPACE as FBM2H
 from ertools.geometry import quat_from_yaw
 from ertools.samples.mocap import FRAME_NS
 from ertools.samples.scenario import EPOCH_2015, log_name, tol, write_answers
@@ -253,7 +254,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     times[active] = times.pop(gt[3])
     kinds[active] = kinds.pop(gt[3])
 
-    bench = f"bmmanager/{log_name('fbm2h', T0 + 2 * NS)}"
+    bench = f"bmmanager/{log_name(FBM2H, T0 + 2 * NS)}"
     times[bench] = _benchmark_bag(root / bench, 3, 12)
     kinds[bench] = "benchmark"
     robot = "robots/homer/FBM2H_201511201500_homer.bag"

@@ -188,7 +188,7 @@ def test_fbm2h_live_score_beside_the_recomputed_one(
     assert by_key["details.marker-robot transform.0.0"].status == "same"
 
     # Through the CLI: the comparison table with the live and the recomputed column.
-    assert main(["audit", str(bag), "--transform", str(transform)]) == 0
+    assert main(["audit", str(bag), "--transform", str(transform), "--format", "text"]) == 0
     out = capsys.readouterr().out
     assert "live vs recomputed score:" in out
     row = next(ln for ln in out.splitlines() if "segments_details.2.orientation_error" in ln)

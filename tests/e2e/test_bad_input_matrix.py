@@ -239,7 +239,7 @@ BAG_COMMANDS: dict[str, tuple[Argv, str]] = {
     "score-trajectory-gt": (lambda i, b, d: ["score", "trajectory", str(i.robot), str(b)], "gt"),
     "noise": (lambda i, b, d: ["noise", str(b)], "fbm3w"),
     "acquire-transform": (
-        lambda i, b, d: ["acquire", "transform", str(b), "--team", "qa", "--out", str(d)],
+        lambda i, b, d: ["acquire", "transform", str(b), "--team", "qa", "--out-dir", str(d)],
         "fbm2h",
     ),
     "acquire-items": (
@@ -411,7 +411,7 @@ def test_report_bad_result(
         path.write_text("[1, 2]")
     elif bad == "plain-folder":
         path.mkdir()
-    result = _run(["report", str(path), "--out", str(tmp_path / "page")], capsys)
+    result = _run(["report", str(path), "--report", str(tmp_path / "page")], capsys)
     _check_error(result, 1, path.name)
     assert not (tmp_path / "page" / "index.html").exists()
 
@@ -495,7 +495,13 @@ CONFIG_OPTIONS: dict[str, ConfArgv] = {
     "fbm3w--config": lambda i, y: ["score", "fbm3w", str(i.fbm3w), "--config", str(y)],
     "fbm3w--runs-file": lambda i, y: ["score", "fbm3w", str(i.fbm3w), "--runs-file", str(y)],
     "acquire-items--items": lambda i, y: ["acquire", "items", str(i.fbm1h), "--items", str(y)],
-    "record--config": lambda i, y: ["record", "--config", str(y), "--out", str(y.parent / "rec")],
+    "record--config": lambda i, y: [
+        "record",
+        "--config",
+        str(y),
+        "--out-dir",
+        str(y.parent / "rec"),
+    ],
 }
 # audit passes the same files to the scorer; a bad file given explicitly must not end in
 # exit 0 with "score not recomputed": it is the scorer's one-line error and exit 1.
@@ -676,7 +682,7 @@ TOPIC_CASES: dict[str, Callable[[Inputs], list[str]]] = {
         str(i.fbm2h),
         "--team",
         "qa",
-        "--out",
+        "--out-dir",
         str(i.root / "tr"),
         "--topic",
         "/no/such/topic",
@@ -747,7 +753,7 @@ WINDOW_CASES: dict[str, tuple[Callable[[Inputs], list[str]], tuple[str, ...]]] =
             str(i.fbm2h),
             "--team",
             "qa",
-            "--out",
+            "--out-dir",
             str(i.root / "tr"),
             "--at",
             "1000",
@@ -834,7 +840,7 @@ NAN_CASES: dict[str, tuple[Callable[[Inputs, Path], list[str]], str]] = {
             str(b),
             "--team",
             "qa",
-            "--out",
+            "--out-dir",
             str(i.root / "tr"),
             "--at",
             "4",
@@ -1055,7 +1061,7 @@ USAGE_COMMANDS = [
     ["acquire", "items", "x.bag"],
     ["acquire", "no_such_member"],
     ["audit"],
-    ["report", "x.json"],  # --out is required
+    ["report", "x.json"],  # --report is required
     ["export"],
     ["record"],
     ["monitor"],
@@ -1158,7 +1164,9 @@ def test_report_onto_its_own_result_folder_is_refused(
     folder = tmp_path / "fbm2h-report"
     argv = ["score", "fbm2h", str(inputs.fbm2h), "--transform", str(inputs.transform)]
     assert _run([*argv, "--report", str(folder)], capsys).code == 0
-    result = _run(["report", str(folder), "--out", str(folder)], capsys)  # snapshot: whole folder
+    result = _run(
+        ["report", str(folder), "--report", str(folder)], capsys
+    )  # snapshot: whole folder
     assert "input" in _check_error(result, 2, folder.name)
 
 
@@ -1176,7 +1184,7 @@ def test_fbm2h_reached_before_the_bag(inputs: Inputs, capsys: pytest.CaptureFixt
 # to end in "unexpected OverflowError" or, for fbm1's --still nan, in a score).
 NUMBER_OPTIONS: dict[str, Callable[[Inputs], list[str]]] = {
     "timeline --clock-tolerance": lambda i: ["timeline", str(i.fbm2h), "--clock-tolerance"],
-    "fbm2h --max-gap": lambda i: ["score", "fbm2h", str(i.fbm2h), "--max-gap"],
+    "fbm2h --gt-tolerance": lambda i: ["score", "fbm2h", str(i.fbm2h), "--gt-tolerance"],
     "fbm2h --stop-speed": lambda i: ["score", "fbm2h", str(i.fbm2h), "--stop-speed"],
     "fbm1h --still": lambda i: ["score", "fbm1h", str(i.fbm1h), "--items", str(i.items), "--still"],
     "fbm1h --max-window": lambda i: [
@@ -1189,10 +1197,11 @@ NUMBER_OPTIONS: dict[str, Callable[[Inputs], list[str]]] = {
     ],
     "noise --bin": lambda i: ["noise", str(i.fbm3w), "--bin"],
     "acquire transform --at": lambda i: [
-        "acquire", "transform", str(i.fbm2h), "--team", "qa", "--out", str(i.root / "tr"), "--at"
+        "acquire", "transform", str(i.fbm2h), "--team", "qa",
+        "--out-dir", str(i.root / "tr"), "--at"
     ],
-    "acquire items --min-still": lambda i: [
-        "acquire", "items", str(i.fbm1h), "--items", str(i.items), "--min-still"
+    "acquire items --still-min": lambda i: [
+        "acquire", "items", str(i.fbm1h), "--items", str(i.items), "--still-min"
     ],
     "audit --max-silence": lambda i: ["audit", str(i.fbm2h), "--max-silence"],
 }  # fmt: skip

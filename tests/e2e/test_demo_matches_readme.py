@@ -10,7 +10,9 @@ from test_readme import ROOT, console_blocks
 from ertools.demo import steps
 
 # Where the output goes is the demo's business, not a scoring option.
-OUTPUT_OPTIONS = frozenset({"--report", "--format", "--plot", "--out", "-o", "--foxglove"})
+OUTPUT_OPTIONS = frozenset(
+    {"--report", "--format", "--plot", "--plots", "--out", "-o", "--out-dir", "--foxglove"}
+)
 
 
 def _options(argv: list[str]) -> frozenset[str]:

@@ -71,10 +71,11 @@ def test_fbm2h_every_segment_without_ground_truth(capsys: pytest.CaptureFixture[
     code, out, err = run(
         capsys, "score", "fbm2h", str(FBM2H / "log_fbm2h_mocap_2015-11-20-12-00-00_0.bag"),
         "--goal", str(FBM2H / "fbm2h_goal.yaml"),
-        "--transform", str(FBM2H / "transform-simbot.yaml"), "--max-gap", "0.000001",
+        "--transform", str(FBM2H / "transform-simbot.yaml"), "--gt-tolerance", "0.000001",
     )  # fmt: skip
     assert code == 1
-    only_errors(out, err, *(f"segment {i}: no ground truth within --max-gap" for i in range(5)))
+    lines = [f"segment {i}: no ground truth within --gt-tolerance" for i in range(5)]
+    only_errors(out, err, *lines)
     # the nearest sample is under 1 ms away: said with 3 digits, never "0.000 s"
     assert all("0.000 s away" not in x for x in err)
 

@@ -88,7 +88,7 @@ CASES = (
     Case("noise_json", ("noise", STATIONARY, "--format", "json")),
     Case("audit_json", ("audit", FBM2, "--format", "json")),
     Case("audit_yaml", ("audit", FBM2, "--format", "yaml")),
-    Case("audit_report", ("audit", FBM2, "--report", "{out}/r"), folder="r"),
+    Case("audit_report", ("audit", FBM2, "--format", "text", "--report", "{out}/r"), folder="r"),
     Case("real_fbm2h_yaml", REAL_FBM2, needs_real=True),
     Case("real_fbm2h_json", (*REAL_FBM2, "--format", "json"), needs_real=True),
 )

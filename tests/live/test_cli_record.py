@@ -15,7 +15,7 @@ def test_simulate_demo_records_and_summarises(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     code = main(
-        ["record", "--simulate", "--out", str(tmp_path), "--duration", "1.5",
+        ["record", "--simulate", "--out-dir", str(tmp_path), "--duration", "1.5",
          "--health", "0.5", "--namespace", "/fbm2h"]
     )  # fmt: skip
     captured = capsys.readouterr()
@@ -37,16 +37,18 @@ def test_simulate_demo_records_and_summarises(
 
 
 def test_usage_and_config_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["record", "--out", str(tmp_path)]) == 2
+    assert main(["record", "--out-dir", str(tmp_path)]) == 2
     assert "--config is required" in capsys.readouterr().err
     bad = tmp_path / "bad.yaml"
     bad.write_text("rigid_bodies:\n'3':\n  pose: robot_at_home/pose\n")
-    assert main(["record", "--config", str(bad), "--out", str(tmp_path)]) == 1
+    assert main(["record", "--config", str(bad), "--out-dir", str(tmp_path)]) == 1
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "indent them under rigid_bodies" in err
     good = Path(__file__).resolve().parents[2] / "configs" / "mocap_home.yaml"
-    code = main(["record", "--config", str(good), "--out", str(tmp_path), "--natnet-version", "x"])
+    code = main(
+        ["record", "--config", str(good), "--out-dir", str(tmp_path), "--natnet-version", "x"]
+    )
     assert code == 2 and "MAJOR.MINOR" in capsys.readouterr().err
-    code = main(["record", "--config", str(good), "--out", str(tmp_path), "--split", "0"])
-    assert code == 1 and "must be > 0" in capsys.readouterr().err
+    code = main(["record", "--config", str(good), "--out-dir", str(tmp_path), "--split", "0"])
+    assert code == 2 and "must be > 0" in capsys.readouterr().err  # a usage error, at parse time
     assert not list(tmp_path.glob("*.mcap"))  # nothing written on a refused command line

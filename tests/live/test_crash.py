@@ -28,7 +28,7 @@ def killed_recording(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, in
     cmd = [
         sys.executable, "-m", "ertools.cli.main", "record",
         "--config", str(REPO / "configs" / "mocap_home.yaml"),
-        "--out", str(out), "--namespace", "/fbm2h",
+        "--out-dir", str(out), "--namespace", "/fbm2h",
         "--unicast", "--interface", "127.0.0.1", "--port", str(port),
         "--duration", "30", "--health", "100",
     ]  # fmt: skip

@@ -33,7 +33,7 @@ def test_combined_page(
     out = tmp_path / "competition"
     # Mixed ways of naming a result: folder, its result.json, its score.json.
     args = [str(results[0]), str(results[1] / "result.json"), str(results[2] / "score.json")]
-    assert main(["report", *args, "--out", str(out), "--title", "Lisbon <2015>"]) == 0
+    assert main(["report", *args, "--report", str(out), "--title", "Lisbon <2015>"]) == 0
     assert capsys.readouterr().out.strip() == str(out / "index.html")
     with (out / "results.csv").open(newline="") as fh:
         rows = list(csv.DictReader(fh))
@@ -70,12 +70,12 @@ def test_lone_score_json_is_recognised(tmp_path: Path) -> None:
 
 def test_bad_result_path(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     (tmp_path / "empty").mkdir()
-    assert main(["report", str(tmp_path / "empty"), "--out", str(tmp_path / "o")]) == 1
+    assert main(["report", str(tmp_path / "empty"), "--report", str(tmp_path / "o")]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "not a report folder" in err[0]
     bad = tmp_path / "score.json"
     bad.write_text("{not json")
-    assert main(["report", str(bad), "--out", str(tmp_path / "o")]) == 1
+    assert main(["report", str(bad), "--report", str(tmp_path / "o")]) == 1
     assert "cannot read a result" in capsys.readouterr().err
 
 
@@ -125,7 +125,7 @@ def test_same_inputs_are_one_execution(tmp_path: Path) -> None:
     meta_path.write_text(json.dumps(meta))
 
     out = tmp_path / "out"
-    assert main(["report", *folders, "--out", str(out)]) == 0
+    assert main(["report", *folders, "--report", str(out)]) == 0
     rows = _csv(out)
     assert [(r["team"], r["team_source"]) for r in rows] == [
         ("robox", "log name"),
@@ -165,7 +165,7 @@ def test_the_fbm2h_sample_scored_twice_is_one_row(
     capsys.readouterr()
     out = tmp_path / "out"
     assert (
-        main(["report", str(tmp_path / "identity"), str(tmp_path / "simbot"), "--out", str(out)])
+        main(["report", str(tmp_path / "identity"), str(tmp_path / "simbot"), "--report", str(out)])
         == 0
     )
     rows = _csv(out)

@@ -4,12 +4,15 @@ leaderboards, failure isolation, cache, exit codes."""
 from __future__ import annotations
 
 import csv
+import io
 import json
+import re
+import sys
 from pathlib import Path
 from typing import Any
 
 import pytest
-from competition import (
+from rescore_competition import (
     LOGS,
     OFFSETS,
     expected_value,
@@ -128,7 +131,7 @@ def test_a_failure_costs_one_row(tmp_path: Path, capsys: pytest.CaptureFixture[s
     bad, boom, die = (rows[f"toy-alpha-20151120T11{m}000"] for m in ("0", "1", "2"))
     assert bad["status"] == "unscoreable" and "no toy values can be scored here" in bad["reason"]
     assert boom["status"] == "failed"
-    assert "RuntimeError: the toy scorer has a bug at toybench.py" in boom["reason"]
+    assert "RuntimeError: the toy scorer has a bug at rescore_toy.py" in boom["reason"]
     assert die["status"] == "failed" and "died (exit code 7)" in die["reason"]
     err = capsys.readouterr().err
     assert "6 executions: 3 scored, 1 unscoreable, 2 failed" in err
@@ -226,3 +229,32 @@ def test_scheduler_without_dask_installed_is_one_line(
     assert err == [
         "ertools: error: --scheduler needs Dask distributed: pip install 'ertools[dask]'"
     ]
+
+
+class _Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_progress_bar_on_a_terminal(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    comp = make_competition(
+        tmp_path / "comp",
+        {
+            "toy-alpha-20151120T110000": ("alpha", "2015-11-20T11:00:00Z", "1\nsleep\n"),
+            "toy-alpha-20151120T111000": ("alpha", "2015-11-20T11:10:00Z", "1\nbad\n"),
+        },
+    )
+    terminal = _Terminal()
+    monkeypatch.setattr(sys, "stderr", terminal)
+    args = ["--config", str(comp.manifest), "--out", str(tmp_path / "out"), "--no-reports"]
+    assert rescore(*args, "--jobs", "1") == 1
+    text = terminal.getvalue()
+    # drawn after the bar's delay (the sleeping execution), counting executions and failures
+    assert "\rertools: rescoring (1 not scored) [" in text
+    assert re.search(r"\] [1-5]/5 executions", text)
+    assert "ertools: 5 executions: 4 scored, 1 unscoreable, 0 failed" in text
+    # -q: none
+    quiet = _Terminal()
+    monkeypatch.setattr(sys, "stderr", quiet)
+    assert rescore(*args, "--jobs", "1", "--no-cache", "-q") == 1
+    assert "\r" not in quiet.getvalue()

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from competition import make_competition, use_toy_registry
+from rescore_competition import make_competition, use_toy_registry
 
 from ertools.cli.main import main
 from ertools.errors import ConfigError
@@ -128,3 +128,30 @@ def test_missing_manifest_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixt
     assert (
         capsys.readouterr().err == f"ertools: error: {tmp_path / 'no.yaml'}: manifest not found\n"
     )
+
+
+def test_a_choice_that_takes_a_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """FBM2H's `--reached timing FILE`: `[timing, FILE]` in a manifest, the file checked."""
+    from ertools.benchmarks import registry
+
+    monkeypatch.setattr(
+        registry, "REGISTRY", {"fbm2h": "ertools.benchmarks.fbm2h.declare:BENCHMARK"}
+    )
+    (tmp_path / "timing.yaml").write_text("[]\n")
+    path = tmp_path / "competition.yaml"
+    path.write_text("benchmarks:\n  fbm2h:\n    inputs: {reached: [timing, timing.yaml]}\n")
+    assert load_manifest(path).benchmarks["fbm2h"].values == {
+        "reached": ("timing", tmp_path / "timing.yaml")
+    }
+    path.write_text("benchmarks:\n  fbm2h:\n    inputs: {reached: states}\n")
+    assert load_manifest(path).benchmarks["fbm2h"].values == {"reached": ("states",)}
+    for bad in ("[timing]", "[states, timing.yaml]", "sometimes", "[timing, nowhere.yaml]"):
+        path.write_text(f"benchmarks:\n  fbm2h:\n    inputs: {{reached: {bad}}}\n")
+        with pytest.raises(ManifestError) as caught:
+            load_manifest(path)
+        (problem,) = caught.value.problems
+        assert problem.startswith("benchmarks.fbm2h.inputs.reached: ")
+        if bad == "[timing, nowhere.yaml]":
+            assert problem.endswith(f"file not found: {tmp_path / 'nowhere.yaml'}")
+        else:
+            assert "expected states | [timing, FILE] | auto" in problem

@@ -6,10 +6,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from competition import LOGS, expected_value, make_competition, use_toy_registry
+from rescore_competition import LOGS, expected_value, make_competition, use_toy_registry
 
 from ertools.rescore.manifest import load_manifest
-from ertools.rescore.pipeline import Execution, leaderboards, listed_executions, rescore
+from ertools.rescore.pipeline import Scoring, leaderboards, listed_executions, rescore
 
 
 @pytest.fixture(autouse=True)
@@ -32,7 +32,7 @@ class Recorder:
 def test_a_team_without_its_transform_is_one_unscoreable_row(tmp_path: Path) -> None:
     comp = make_competition(tmp_path / "comp")
     manifest = load_manifest(comp.manifest)
-    found = Execution(
+    found = Scoring(
         benchmark="toy",
         team="gamma",  # found in the logs; the manifest has no transform for it
         bags=(comp.log("toy-beta-20151120T093000"),),
@@ -107,4 +107,41 @@ def test_leaderboard_ties_share_a_rank() -> None:
         (1, "a", "a2"),
         (1, "b", "b1"),
         (3, "c", "c1"),
+    ]
+
+
+def test_score_argv_is_the_score_command(tmp_path: Path) -> None:
+    """The command line a report shows: the score command's own options, from the declarations
+    (the team through FBM2H's own --team; a choice with its file as one option)."""
+    from ertools.benchmarks import registry
+    from ertools.rescore.pipeline import score_argv
+
+    bench = registry.get("toy")
+    argv = score_argv(bench, [Path("a.txt")], {"scale": 2.0, "transform": Path("t.yaml")}, "x")
+    assert argv == [
+        "ertools",
+        "score",
+        "toy",
+        "a.txt",
+        "--transform",
+        "t.yaml",
+        "--scale",
+        "2.0",
+        "--team",
+        "x",
+    ]
+    registry.REGISTRY["fbm2h"] = "ertools.benchmarks.fbm2h.declare:BENCHMARK"
+    fbm2h = registry.get("fbm2h")
+    values = {"reached": ("timing", Path("t.yaml")), "team": "homer", "orientation_2015": True}
+    assert score_argv(fbm2h, [Path("r.bag")], values, "homer") == [
+        "ertools",
+        "score",
+        "fbm2h",
+        "r.bag",
+        "--team",
+        "homer",
+        "--reached",
+        "timing",
+        "t.yaml",
+        "--orientation-2015",
     ]

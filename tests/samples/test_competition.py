@@ -171,6 +171,10 @@ def test_each_scored_execution_scores_as_its_answers(
             assert abs(got - want) <= tol, f"{slot} {field}: {got} vs {want} (+-{tol})"
         else:
             assert got == want, f"{slot} {field}: {got} vs {want}"
+    # the live 2015 score the BmBox sent, read back from the log (FBM1H reports it)
+    assert e["live_score"] is not None
+    if e["benchmark"] == "fbm1h":
+        assert result["logged_2015_score"] == e["live_score"]
 
 
 def test_unscoreable_executions(competition: Path, answers: dict[str, Any]) -> None:

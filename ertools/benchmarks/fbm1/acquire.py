@@ -196,7 +196,7 @@ def acquire_items(
             raise SegmentationError(
                 f"found {len(found)} still phase(s) of the board near the origin "
                 f"({listed or 'none'}) for {len(items)} item(s); give --windows START:END,... "
-                "(seconds from the log start) or tune --min-still/--max-distance"
+                "(seconds from the log start) or tune --still-min/--max-distance"
             )
         use: list[Interval] = found
     else:

@@ -47,9 +47,9 @@ from ertools.benchmarks.fbm1.score import (
     totals,
 )
 from ertools.configs.items import Item, ItemList
-from ertools.io.model import BenchmarkStates
 from ertools.errors import ConfigError, ScoringError, SegmentationError, TopicError
 from ertools.fidelity import Deviation, Rule
+from ertools.io.model import BenchmarkStates
 from ertools.progress import Reporter, current
 from ertools.streams import PoseStream, Provenance, frame_change_warning
 from ertools.timeutil import NS_PER_S
@@ -588,7 +588,7 @@ def read_body(
             raise TopicError(
                 f"{topic_err.message}; no /tf frame {frame!r} either "
                 f"(choose the {frame} body with --{frame.replace('_', '-')}-topic or "
-                f"--{frame.replace('_', '-')}-frame)"
+                f"--{frame.replace('_', '-')}-tf PARENT:CHILD)"
             ) from topic_err
         log.info("%s: using /tf frame %s (no %s)", paths[0], frame, default_topic)
         return stream

@@ -12,7 +12,15 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.base import Benchmark, Input, Ranking, notice, resolve_values
+from ertools.benchmarks.base import (
+    Benchmark,
+    Explanation,
+    Input,
+    Ranking,
+    notice,
+    resolve_values,
+    tf_value,
+)
 from ertools.benchmarks.fbm1.benchmark import (
     RULE_SETS,
     BodySources,
@@ -48,10 +56,11 @@ def inputs(name: str) -> tuple[Input, ...]:
                 group=BODIES,
             ),
             Input(
-                f"{body}_frame",
+                f"{body}_tf",
                 "str",
-                f"take {body} from /tf world -> FRAME (--{flag}-frame)",
-                metavar="FRAME",
+                f"take {body} from /tf PARENT -> CHILD (e.g. world:{body})",
+                metavar="PARENT:CHILD",
+                old_flags=(f"--{flag}-frame",),
                 group=BODIES,
             ),
         ]
@@ -121,7 +130,12 @@ def inputs(name: str) -> tuple[Input, ...]:
             group=NODES,
         ),
         Input("all_2015", "flag", "= --rules 2015", flag="--2015", group=NODES),
-        Input("all_2016", "flag", "= --rules 2016", flag="--2016", group=NODES),
+        # No 2016-17 @Work node is known: @Work has no --2016 (--rules 2016 says why).
+        *(
+            [Input("all_2016", "flag", "= --rules 2016", flag="--2016", group=NODES)]
+            if name == "fbm1h"
+            else []
+        ),
         Input(
             "clip_above_diagonal",
             "flag",
@@ -167,7 +181,7 @@ def inputs(name: str) -> tuple[Input, ...]:
 def _rules_name(v: Mapping[str, Any]) -> str:
     chosen = {v["rules"]} - {None}
     chosen |= {"2015"} if v["all_2015"] else set()
-    chosen |= {"2016"} if v["all_2016"] else set()
+    chosen |= {"2016"} if v.get("all_2016") else set()
     if len(chosen) > 1:
         raise UsageError(f"--rules/--2015/--2016 name {len(chosen)} references; give one")
     return chosen.pop() if chosen else "ertools"
@@ -177,15 +191,17 @@ def _sources(name: str, v: Mapping[str, Any]) -> BodySources:
     time_source = v["time_source"]
 
     def one(body: str) -> PoseSource | None:
-        topic, frame = v[f"{body}_topic"], v[f"{body}_frame"]
-        if topic is not None and frame is not None:
-            flag = body.replace("_", "-")
-            raise UsageError(f"give either --{flag}-topic or --{flag}-frame, not both")
-        if topic is None and frame is None:
+        flag = body.replace("_", "-")
+        topic, tf = v[f"{body}_topic"], tf_value(f"--{flag}-tf", v[f"{body}_tf"])
+        if topic is not None and tf is not None:
+            raise UsageError(f"give either --{flag}-topic or --{flag}-tf, not both")
+        if tf is not None:
+            return PoseSource(frame=tf[1], parent=tf[0], time_source=time_source)
+        if topic is None:
             if time_source == "header":
                 return None  # the 2015 topic, falling back on the /tf frame
             topic = f"/{name}/{body}/pose"
-        return PoseSource(topic=topic, frame=frame, time_source=time_source)
+        return PoseSource(topic=topic, time_source=time_source)
 
     return BodySources(one("origin"), one("ref_board"))
 
@@ -201,7 +217,10 @@ def options_maker(name: str) -> Callable[[Mapping[str, Any]], Fbm1Options]:
         """
         v = resolve_values(inputs(name), given)
         if v["items"] is None:
-            raise UsageError("--items FILE is required (the item list, seed Listing 9)")
+            raise UsageError(
+                "--items FILE is required (the item list, seed Listing 9); "
+                f"`ertools score {name} --help` shows how"
+            )
         if v["legacy_totals"]:
             now = (
                 "--count-aborted (the 2015 @Work node's divisors)"
@@ -209,7 +228,7 @@ def options_maker(name: str) -> Callable[[Mapping[str, Any]], Fbm1Options]:
                 else "--count-aborted --accuracy-over-10 (the 2016-17 @Home node's divisors; "
                 "the 2015 node's are --count-aborted alone)"
             )
-            notice(f"--legacy-totals is deprecated: it now means {now}")
+            notice(f"note: --legacy-totals is deprecated, use {now}")
         gt = GtOptions(
             max_window_s=v["max_window"],
             still_m=v["still"],
@@ -297,6 +316,35 @@ def files(bags: Sequence[Path], options: Fbm1Options, result: Fbm1Result) -> lis
     return [*bags, *([options.items] if options.items is not None else [])]
 
 
+def sampler(name: str) -> Callable[[Path], list[str] | None]:
+    """The sample log of ``fbm1h`` or ``fbm1w`` with its item list (``make demo``)."""
+
+    def sample(samples: Path) -> list[str] | None:
+        folder = samples / name
+        bags = sorted(folder.glob("*.bag"))
+        items = folder / f"{name}.yaml"
+        return [str(bags[0]), "--items", str(items)] if bags and items.is_file() else None
+
+    return sample
+
+
+# Why an audit's recomputed value may differ from the live one.
+EXPLANATIONS = (
+    Explanation(
+        r"(pose_score|x_error|y_error|theta_error|position|orientation)$",
+        "the ground truth is averaged over the window in which the board stood still "
+        "(the 2015 node interpolated one tf lookup when the result arrived); theta is in "
+        "degrees",
+        ("window", "source", "topic", "items"),
+    ),
+    Explanation(
+        r"(class|instance)(_accuracy|_correct)?$",
+        "class and instance are compared as text with the item list",
+        ("items",),
+    ),
+)
+
+
 EPILOG = """examples:
   ertools score {name} run.bag --items configs/{name}.yaml
   ertools score fbm1w run.bag --items configs/fbm1w.yaml --items-order 3,7,1,2
@@ -309,7 +357,8 @@ x, y, theta}} (theta in degrees), used instead of the Client payloads it covers.
 The per-run table goes to stderr; stdout carries the score (YAML or JSON).
 Exit status 1 when any run could not be scored (each named on stderr); the others are scored."""
 
-DESCRIPTION = """Recompute an FBM1@Home / FBM1@Work (object perception) score from the log (seed 7.1).
+DESCRIPTION = """Recompute an FBM1@Home / FBM1@Work (object perception) score from the log
+(seed 7.1).
 
 Per run: the item shown (manual-operation payload), the robot's answer (Client COMPLETED_GOAL
 payload: item_class, item_instance, x, y in metres, theta in DEGREES, table frame), the
@@ -319,9 +368,9 @@ while the board stood still before the goal), class/instance right, pose score
 instance_accuracy, pose_score, execution_time."""
 
 
-def _declare(name: str, title: str, summary: str) -> Benchmark[
-    Fbm1Options, Fbm1Logs, Fbm1Runs, Fbm1Result
-]:
+def _declare(
+    name: str, title: str, summary: str
+) -> Benchmark[Fbm1Options, Fbm1Logs, Fbm1Runs, Fbm1Result]:
     return Benchmark(
         name=name,
         title=title,
@@ -347,6 +396,8 @@ def _declare(name: str, title: str, summary: str) -> Benchmark[
         score_keys=frozenset({"class_accuracy", "instance_accuracy"}),
         state_topics=True,
         values_2015={"rules": "2015"},
+        sample=sampler(name),
+        explanations=EXPLANATIONS,
     )
 
 

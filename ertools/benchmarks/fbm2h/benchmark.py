@@ -33,9 +33,9 @@ from ertools.benchmarks.fbm2h.score import robot_poses_at, segment_errors
 from ertools.benchmarks.fbm2h.segments import ReachedMoments, StopParams
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
-from ertools.io.model import BenchmarkStates
 from ertools.errors import ConfigError, ScoringError, SegmentationError
 from ertools.fidelity import Deviation, Rule
+from ertools.io.model import BenchmarkStates
 from ertools.streams import PoseStream, Provenance, frame_change_warning
 from ertools.timeutil import ns_to_s, s_to_ns
 
@@ -44,6 +44,7 @@ if TYPE_CHECKING:
 
 log = logging.getLogger("ertools.benchmarks.fbm2h.benchmark")
 
+NAMESPACE = "fbm2h"  # of the state topics
 DEFAULT_TOPIC = "/fbm2h/robot_at_home/pose"
 DEFAULT_MAX_GAP_S = 0.1
 # Figures need the path, not every 120 Hz sample.
@@ -145,6 +146,7 @@ class Fbm2hOptions:
     transforms_dir: Path | None = None
     topic: str | None = None
     tf_frame: str | None = None
+    tf_parent: str = "world"
     time_source: str = "header"
     reached: str | None = None
     timing: Path | None = None
@@ -152,7 +154,7 @@ class Fbm2hOptions:
     hits: int | None = None
     orientation_2015: bool = False
     unscored_2015: bool = False
-    namespace: str = "fbm2h"
+    namespace: str = NAMESPACE
     stops: StopParams = field(default_factory=StopParams)
     marker_transform: MarkerTransform | None = None
 
@@ -192,7 +194,7 @@ def compute(
         )
     if hits is not None and hits < 0:
         raise ConfigError(f"--hits must be >= 0, got {hits}")
-    from ertools.benchmarks.trajectory.benchmark import drop_invalid
+    from ertools.benchmarks.common.hygiene import drop_invalid
 
     marker, invalid = drop_invalid(marker)
     all_warnings = list(warnings)
@@ -248,7 +250,7 @@ def compute(
                 else (f"nearest GT sample {gap / 1e9:.3g} s away")  # 3 digits, even below 1 ms
             )
             failures.append(
-                f"segment {i}: no ground truth within --max-gap {max_gap_s} s of the reached "
+                f"segment {i}: no ground truth within --gt-tolerance {max_gap_s} s of the reached "
                 f"moment {ns_to_s(end - t_rel0):.3f} s after {since} "
                 f"({nearest}; tracking lost?) in {marker.source or 'the pose stream'}"
             )
@@ -406,7 +408,7 @@ def _frozen_warnings(
 ) -> list[str]:
     """A warning per scored reached moment whose ground truth is a frozen (repeated) pose.
 
-    The threshold is ``--max-gap``: a frozen stretch longer than the gap ertools accepts hides
+    The threshold is ``--gt-tolerance``: a frozen stretch longer than the gap ertools accepts hides
     a tracking loss of the size it refuses (see
     :data:`ertools.benchmarks.noise.benchmark.FROZEN_MIN_S`).
     """
@@ -465,7 +467,12 @@ def _pose_source(options: Fbm2hOptions) -> PoseSource:
     if options.topic is not None and options.tf_frame is not None:
         raise ConfigError("give either --topic or --tf-frame, not both")
     if options.tf_frame is not None:
-        return PoseSource(topic=None, frame=options.tf_frame, time_source=options.time_source)
+        return PoseSource(
+            topic=None,
+            frame=options.tf_frame,
+            parent=options.tf_parent,
+            time_source=options.time_source,
+        )
     return PoseSource(topic=options.topic or DEFAULT_TOPIC, time_source=options.time_source)
 
 
@@ -520,7 +527,7 @@ def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
         ConfigError, SegmentationError, ScoringError: no bag, bad configs, no poses, no
             state topics when the reached moments need them.
     """
-    from ertools.benchmarks.trajectory.benchmark import drop_invalid
+    from ertools.benchmarks.common.hygiene import drop_invalid
     from ertools.configs.goal import load_goal
     from ertools.io import read_benchmark_states, read_pose_source, summary
 

@@ -7,10 +7,18 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Mapping
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.base import Benchmark, Input, Ranking, resolve_values
+from ertools.benchmarks.base import (
+    Benchmark,
+    Explanation,
+    Input,
+    Ranking,
+    resolve_values,
+    tf_value,
+)
 from ertools.benchmarks.fbm2h.benchmark import (
     DEFAULT_MAX_GAP_S,
     Fbm2hLogs,
@@ -22,6 +30,7 @@ from ertools.benchmarks.fbm2h.benchmark import (
 )
 from ertools.benchmarks.fbm2h.result import Fbm2hResult
 from ertools.benchmarks.fbm2h.segments import StopParams
+from ertools.configs.transform import LIVE_TRANSFORM_KEY, live_transform
 from ertools.errors import UsageError
 
 NAME = "fbm2h"
@@ -30,7 +39,13 @@ AUTO = "--reached auto (stop detection)"
 
 INPUTS = (
     Input("goal", "path", "goal list (Listing 10); default: from the log", metavar="FILE"),
-    Input("transform", "path", "marker-to-robot transform (Listing 11)", metavar="FILE"),
+    Input(
+        "transform",
+        "path",
+        "marker-to-robot transform (Listing 11)",
+        metavar="FILE",
+        per_team=True,  # each team's robot carries its own marker set
+    ),
     Input("transforms", "path", "folder of transform-<team>.yaml files", metavar="DIR"),
     Input(
         "team",
@@ -48,11 +63,11 @@ INPUTS = (
         metavar="TOPIC",
     ),
     Input(
-        "tf_frame",
+        "tf",
         "str",
-        "take the marker set from /tf world -> FRAME instead",
-        metavar="FRAME",
-        old_flags=("--frame",),
+        "take the marker set from /tf PARENT -> CHILD instead (e.g. world:robot_at_home)",
+        metavar="PARENT:CHILD",
+        old_flags=("--tf-frame", "--frame"),
     ),
     Input(
         "time_source",
@@ -70,9 +85,10 @@ INPUTS = (
         metavar="MODE",
     ),
     Input(
-        "max_gap",
+        "gt_tolerance",
         "float",
         "a reached moment needs a GT sample within S seconds (default 0.1)",
+        old_flags=("--max-gap",),
         default=DEFAULT_MAX_GAP_S,
         unit="s",
         positive=True,
@@ -102,12 +118,36 @@ INPUTS = (
         group=LEGACY,
     ),
     Input("namespace", "str", "benchmark namespace of the state topics", default=NAME),
-    Input("stop_speed", "float", "(default 0.05 m/s)", default=0.05, unit="m/s", positive=True,
-          metavar="M_S", group=AUTO),  # fmt: skip
-    Input("stop_yaw_rate", "float", "(default 0.1 rad/s)", default=0.1, unit="rad/s",
-          positive=True, metavar="RAD_S", group=AUTO),  # fmt: skip
-    Input("stop_min_duration", "float", "(default 0.5 s)", default=0.5, unit="s", positive=True,
-          group=AUTO),  # fmt: skip
+    Input(
+        "stop_speed",
+        "float",
+        "(default 0.05 m/s)",
+        default=0.05,
+        unit="m/s",
+        positive=True,
+        metavar="M_S",
+        group=AUTO,
+    ),
+    Input(
+        "stop_yaw_rate",
+        "float",
+        "(default 0.1 rad/s)",
+        default=0.1,
+        unit="rad/s",
+        positive=True,
+        metavar="RAD_S",
+        group=AUTO,
+    ),
+    Input(
+        "stop_min",
+        "float",
+        "(default 0.5 s)",
+        old_flags=("--stop-min-duration",),
+        default=0.5,
+        unit="s",
+        positive=True,
+        group=AUTO,
+    ),
     Input(
         "stop_radius",
         "float",
@@ -127,24 +167,26 @@ def make_options(given: Mapping[str, Any]) -> Fbm2hOptions:
         UsageError: a value out of range, or options that exclude each other (exit 2).
     """
     v = resolve_values(INPUTS, given)
-    if v["topic"] is not None and v["tf_frame"] is not None:
-        raise UsageError("give either --topic or --tf-frame, not both")
+    if v["topic"] is not None and v["tf"] is not None:
+        raise UsageError("give either --topic or --tf, not both")
+    tf = tf_value("--tf", v["tf"])
     if v["transform"] is not None and v["transforms"] is not None:
         raise UsageError("give either --transform FILE or --team NAME --transforms DIR")
     if v["transforms"] is not None and v["team"] is None:
         raise UsageError("--transforms DIR needs --team NAME (DIR/transform-NAME.yaml)")
-    reached = v["reached"] or (None,)
+    reached: tuple[str | None, ...] = v["reached"] or (None,)
     return Fbm2hOptions(
         goal=v["goal"],
         transform=v["transform"],
         team=v["team"],
         transforms_dir=v["transforms"],
         topic=v["topic"],
-        tf_frame=v["tf_frame"],
+        tf_frame=None if tf is None else tf[1],
+        tf_parent="world" if tf is None else tf[0],
         time_source=v["time_source"],
         reached=reached[0],
-        timing=Path(reached[1]) if len(reached) > 1 else None,
-        max_gap_s=v["max_gap"],
+        timing=Path(str(reached[1])) if len(reached) > 1 else None,
+        max_gap_s=v["gt_tolerance"],
         hits=None if v["hits"] is None else int(v["hits"]),
         orientation_2015=v["orientation_2015"] or v["all_2015"],
         unscored_2015=v["unscored_segments"] == "2015" or v["all_2015"],
@@ -152,7 +194,7 @@ def make_options(given: Mapping[str, Any]) -> Fbm2hOptions:
         stops=StopParams(
             speed=v["stop_speed"],
             yaw_rate=v["stop_yaw_rate"],
-            min_duration_s=v["stop_min_duration"],
+            min_duration_s=v["stop_min"],
             radius=v["stop_radius"],
         ),
     )
@@ -187,6 +229,52 @@ def notes(result: Fbm2hResult) -> list[str]:
             f"orientation {row['orientation_error_rad']:.4f} rad"
         )
     return out
+
+
+def sample(samples: Path) -> list[str] | None:
+    """The FBM2@Home sample log with its goal list and transform (``make demo``)."""
+    folder = samples / NAME
+    bags = sorted(folder.glob("*.bag"))
+    goals = sorted(folder.glob("*goal*.yaml"))
+    transforms = sorted(folder.glob("transform-*.yaml"))
+    if not (bags and goals and transforms):
+        return None
+    return [str(bags[0]), "--goal", str(goals[0]), "--transform", str(transforms[0])]
+
+
+def from_live(options: Fbm2hOptions, live: Any) -> tuple[Fbm2hOptions, tuple[str, ...]]:
+    """The audit's options: without ``--transform``/``--transforms``, the transform the live
+    score says the node used, and a note saying so (``--team`` alone picks no transform)."""
+    if options.transform is not None or options.transforms_dir is not None:
+        return options, ()
+    found = live_transform(live)
+    if found is None:
+        return options, ()
+    t = ", ".join(f"{v:g}" for v in found.translation)
+    q = ", ".join(f"{v:.6g}" for v in found.quat_xyzw)
+    return replace(options, marker_transform=found), (
+        f"transform taken from the live score (details.{LIVE_TRANSFORM_KEY}: [[{t}], [{q}]]); "
+        "give --transform or --team/--transforms to use another",
+    )
+
+
+# Why an audit's recomputed value may differ from the live one.
+EXPLANATIONS = (
+    Explanation(
+        r"orientation_(error|accuracy)$",
+        "the 2015 node took sin and cos of the unwrapped |robot yaw - target yaw|; ertools "
+        "wraps the difference to [-pi, pi] first (identical unless the difference crosses "
+        "+-pi); the robot pose also depends on the marker-to-robot transform",
+        ("transform", "source", "topic", "reached"),
+    ),
+    Explanation(
+        r"(dinstance_error|distance_error|position_accuracy|position_error|robot_pose)$",
+        "the live node used the latest mocap pose when the result arrived; ertools "
+        "interpolates the logged ground truth at the logged moment the waypoint was reached "
+        "and applies the marker-to-robot transform as a full SE(3) composition",
+        ("transform", "source", "topic", "reached", "max_gap", "association"),
+    ),
+)
 
 
 EPILOG = """examples:
@@ -232,5 +320,7 @@ error, the segment time; then position_accuracy, orientation_accuracy and execut
     score_keys=frozenset({"position_accuracy", "orientation_accuracy"}),
     state_topics=True,
     values_2015={"all_2015": True},
+    sample=sample,
+    from_live=from_live,
+    explanations=EXPLANATIONS,
 )
-

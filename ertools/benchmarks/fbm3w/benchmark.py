@@ -37,9 +37,9 @@ from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
 from ertools.configs.shapes import Shape
 from ertools.errors import ConfigError, ErtoolsError, ScoringError, TopicError
 from ertools.fidelity import Deviation, Rule
+from ertools.io.model import BenchmarkStates
 from ertools.progress import Reporter, current
 from ertools.streams import PoseStream, Provenance, frame_change_warning
-from ertools.io.model import BenchmarkStates
 
 log = logging.getLogger("ertools.benchmarks.fbm3w.benchmark")
 
@@ -171,6 +171,7 @@ class Fbm3wOptions:
         d_min: overrides the config's d_min.
         sweep: d_min values to score every run with (``--d-min-sweep``).
         topic, frame: the pose source (default: the pose2d topic, then pose, then tf frame).
+        tf_parent: the parent of ``frame`` in /tf (``world``, the mocap frame).
         time_source: ``record`` (default: the 2015 node received poses live) or ``header``.
         still_speed, min_still_s: stationary detection (auto runs and the noise estimate).
         noise_c: factor of the suggested d_min (c * epsilon).
@@ -184,7 +185,8 @@ class Fbm3wOptions:
         config: runs_specifications, d_min and shapes (None: the 2015 values,
             ``configs/fbm3w.yaml``); ``d_min`` above overrides its d_min.
 
-    The values are validated once, where they come in (:func:`ertools.benchmarks.fbm3w.declare.make_options`).
+    The values are validated once, where they come in
+    (:func:`ertools.benchmarks.fbm3w.declare.make_options`).
     """
 
     runs: str | None = None
@@ -193,6 +195,7 @@ class Fbm3wOptions:
     sweep: tuple[float, ...] = ()
     topic: str | None = None
     frame: str | None = None
+    tf_parent: str = "world"
     time_source: str = "record"
     still_speed: float | None = None
     min_still_s: float | None = None
@@ -237,7 +240,7 @@ def read_fbm3w_poses(paths: Sequence[Path], options: Fbm3wOptions) -> PoseStream
     if options.topic is not None:
         source = PoseSource(topic=options.topic, time_source=options.time_source)
     elif options.frame is not None:
-        source = PoseSource(frame=options.frame)
+        source = PoseSource(frame=options.frame, parent=options.tf_parent)
     else:
         present = topics(paths)
         if DEFAULT_TOPIC in present:
@@ -339,7 +342,9 @@ def locate_runs(logs: Fbm3wLogs, options: Fbm3wOptions) -> list[RunWindow]:
     return windows
 
 
-def score_found(logs: Fbm3wLogs, windows: Sequence[RunWindow], options: Fbm3wOptions) -> Fbm3wResult:
+def score_found(
+    logs: Fbm3wLogs, windows: Sequence[RunWindow], options: Fbm3wOptions
+) -> Fbm3wResult:
     """Score the runs found (:func:`score_runs` on the logs' poses)."""
     return score_runs(
         logs.poses,

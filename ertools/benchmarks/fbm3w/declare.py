@@ -8,9 +8,17 @@ the run windows and the switches that contradict each other.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.base import Benchmark, Input, Ranking, resolve_values
+from ertools.benchmarks.base import (
+    Benchmark,
+    Explanation,
+    Input,
+    Ranking,
+    resolve_values,
+    tf_value,
+)
 from ertools.benchmarks.fbm3w.benchmark import (
     RUN_MODES,
     Fbm3wLogs,
@@ -57,13 +65,20 @@ INPUTS = (
         "end-effector pose topic (default /fbm3w/robot_at_work/pose2d, then .../pose)",
         metavar="TOPIC",
     ),
-    Input("frame", "str", "take the poses from /tf world -> FRAME", metavar="FRAME"),
+    Input(
+        "tf",
+        "str",
+        "take the poses from /tf PARENT -> CHILD (e.g. world:robot_at_work)",
+        metavar="PARENT:CHILD",
+        old_flags=("--frame",),
+    ),
     Input(
         "time_source",
         "choice",
-        "pose time: bag record time (default: the 2015 node received poses live) or header",
-        default="record",
-        choices=("record", "header"),
+        "pose time: header stamp (default; a Pose2D has none: its record time) or bag record "
+        "time (the 2015 node received the poses live)",
+        default="header",
+        choices=("header", "record"),
     ),
     Input(
         "arc_length",
@@ -82,8 +97,7 @@ INPUTS = (
     Input(
         "stopped_runs",
         "choice",
-        "a run the RefBox stopped: its time counted in execution_time (default), or 2015: "
-        "left out",
+        "a run the RefBox stopped: its time counted in execution_time (default), or 2015: left out",
         default="counted",
         choices=("counted", "2015"),
         group=LEGACY,
@@ -171,8 +185,9 @@ def make_options(given: Mapping[str, Any]) -> Fbm3wOptions:
         )
     if v["all_2015"] and v["arc_length"]:
         raise UsageError("--2015 and --arc-length contradict each other (2015 had no arc length)")
-    if v["topic"] is not None and v["frame"] is not None:
-        raise UsageError("give either --topic or --frame, not both")
+    if v["topic"] is not None and v["tf"] is not None:
+        raise UsageError("give either --topic or --tf, not both")
+    tf = tf_value("--tf", v["tf"])
     d_min = None if v["d_min"] is None else _d_min(v["d_min"], "--d-min")
     sweep = () if v["d_min_sweep"] is None else parse_sweep(v["d_min_sweep"])
     for value in sweep:
@@ -183,7 +198,8 @@ def make_options(given: Mapping[str, Any]) -> Fbm3wOptions:
         d_min=d_min,
         sweep=sweep,
         topic=v["topic"],
-        frame=v["frame"],
+        frame=None if tf is None else tf[1],
+        tf_parent="world" if tf is None else tf[0],
         time_source=v["time_source"],
         still_speed=v["still_speed"],
         min_still_s=v["still_min"],
@@ -211,6 +227,29 @@ def notes(result: Fbm3wResult) -> list[str]:
     return out
 
 
+def sample(samples: Path) -> list[str] | None:
+    """The FBM3@Work sample log (``make demo``)."""
+    bags = sorted((samples / "fbm3w").glob("*.bag"))
+    return [str(bags[0])] if bags else None
+
+
+# Why an audit's recomputed value may differ from the live one.
+EXPLANATIONS = (
+    Explanation(
+        r"distance_error$",
+        "the FBM3 path error depends on d_min (the 2015 node hard-coded 0.00033 m), on the "
+        "pose source and on which poses fall in the run window (the live node collected them "
+        "by callback while EXECUTING_GOAL/WAITING_RESULT; ertools takes the logged poses "
+        "between the logged state changes)",
+        ("d_min", "topic", "source", "frame", "runs"),
+    ),
+    Explanation(
+        r"^best_run$",
+        "the best run is the one with the smallest distance_error: it changes when the "
+        "per-run errors change",
+    ),
+)
+
 EPILOG = """examples:
   ertools score fbm3w log_fbm3w_mocap.bag
   ertools score fbm3w run.bag --config configs/fbm3w.yaml --format json
@@ -233,7 +272,8 @@ BENCHMARK: Benchmark[Fbm3wOptions, Fbm3wLogs, Sequence[RunWindow], Fbm3wResult] 
     title="FBM3@Work",
     summary="FBM3@Work trajectory following: path error",
     example="ertools score fbm3w run.bag --config configs/fbm3w.yaml",
-    description="""Recompute an FBM3@Work (trajectory following) score from the logs (seed 7.3, Listing 16).
+    description="""Recompute an FBM3@Work (trajectory following) score from the logs
+(seed 7.3, Listing 16).
 
 Per run: the measured end-effector path subsampled with d_min, put in the run frame (origin at
 the starting position, x axis along reference -> start), compared with the target shape at
@@ -249,12 +289,16 @@ best_run, best_distance_error and execution_time (sum of the run times).""",
     ranking=Ranking(
         key=lambda r: r.best_distance_error,
         lower_is_better=True,
-        text="best_distance_error (metres, the best run's mean distance to the target): lower is better",
+        text="best_distance_error (metres, the best run's mean distance to the target): "
+        "lower is better",
     ),
     notes=notes,
     figures="ertools.report.plots_fbm3w:figure_specs",
     foxglove="ertools.report.foxglove.fbm3w:content",
     score_keys=frozenset({"best_distance_error", "runs_details"}),
     state_topics=True,
-    values_2015={"all_2015": True},
+    # The 2015 node's hard-coded d_min too, whatever d_min the audit was given.
+    values_2015={"all_2015": True, "d_min": None},
+    sample=sample,
+    explanations=EXPLANATIONS,
 )

@@ -11,22 +11,26 @@ from typing import Any
 
 from ertools.benchmarks.base import Benchmark, Input, Ranking, resolve_values
 from ertools.benchmarks.trajectory.benchmark import (
+    TrajectoryLogs,
+    TrajectoryOptions,
+    load,
+    locate_runs,
+    score_found,
+)
+from ertools.benchmarks.trajectory.config import (
     ASSOCIATIONS,
     BEFORE_GT,
     GAPS,
     SETTINGS_2015,
     TIES,
     TrajectoryConfig,
-    TrajectoryLogs,
-    TrajectoryOptions,
-    TrajectoryResult,
-    load,
-    locate_runs,
-    score_found,
 )
+from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.errors import ConfigError, UsageError
 from ertools.timeutil import s_to_ns
 
+# Offsets beyond this (about 146 years) are not clock offsets; int64 nanoseconds hold them.
+MAX_OFFSET_S = 4.6e9
 LEGACY = "2015 behaviour (each difference can be undone)"
 
 INPUTS = (
@@ -117,9 +121,10 @@ INPUTS = (
         "score the covered part when robot poses lie outside the GT",
     ),
     Input(
-        "robot_time",
+        "robot_time_source",
         "choice",
         "robot pose time: message stamp (default) or the robot bag's record time",
+        old_flags=("--robot-time",),
         default="header",
         choices=("header", "record"),
     ),
@@ -140,8 +145,11 @@ def _offset(text: str) -> float | None:
         value = float(text)
     except ValueError:
         raise UsageError(f"--offset takes seconds or 'auto', not {text!r}") from None
-    if not math.isfinite(value):
-        raise UsageError(f"--offset takes a finite number of seconds or 'auto', not {text!r}")
+    if not (math.isfinite(value) and abs(value) < MAX_OFFSET_S):
+        raise UsageError(
+            f"--offset {text}: give a finite number smaller than {MAX_OFFSET_S:g} s in size "
+            "or 'auto'"
+        )
     return value
 
 
@@ -181,13 +189,23 @@ def make_options(given: Mapping[str, Any]) -> TrajectoryOptions:
         )
     except ConfigError as err:
         raise UsageError(err.message) from None
-    return TrajectoryOptions(config, v["robot_topic"], v["gt_topic"], v["robot_time"])
+    return TrajectoryOptions(config, v["robot_topic"], v["gt_topic"], v["robot_time_source"])
 
 
 def files(bags: Sequence[Path], options: TrajectoryOptions, result: TrajectoryResult) -> list[Path]:
     """The robot log and the GT files a folder held (in evo's bag mode the robot log is also
     the GT file: listed once)."""
     return list(dict.fromkeys([Path(bags[0]), *map(Path, result.gt_files)]))
+
+
+def sample(samples: Path) -> list[str] | None:
+    """The sample robot log against the GT folder beside it, clock offset estimated and
+    applied (``make demo``)."""
+    folder = samples / "robotlog"
+    robots = sorted(folder.glob("FBM2H_*.bag"))
+    if not robots:
+        return None
+    return [str(robots[0]), str(folder), "--offset", "auto", "--apply-offset"]
 
 
 EPILOG = """examples:
@@ -211,7 +229,8 @@ BENCHMARK: Benchmark[TrajectoryOptions, TrajectoryLogs, None, TrajectoryResult] 
     title="Offline trajectory benchmark",
     summary="robot log vs mocap ground truth, with clock audit",
     example="ertools score trajectory robot.bag gt/ --robot-topic /rockin/homer/marker_pose",
-    description="""Compare a robot's own pose log with the mocap ground truth (2015 offline trajectory benchmark).
+    description="""Compare a robot's own pose log with the mocap ground truth (2015 offline
+trajectory benchmark).
 
 The GT files are picked from GT_PATH (bags or folders) by time overlap with the robot log and
 read as one stream; without GT_PATH the GT topic is read from the robot log itself (evo's
@@ -236,4 +255,5 @@ robot's stamps and the GT clock and says when it matters.""",
     bags_metavar=("ROBOT_BAG", "GT_PATH"),
     score_keys=frozenset({"position_error", "association"}),
     values_2015={"as_2015": True},
+    sample=sample,
 )

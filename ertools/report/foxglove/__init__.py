@@ -3,8 +3,10 @@
 Each result type has a small content function (a module beside this one) turning it into
 Foxglove messages: paths as ``foxglove.PoseInFrame`` / ``foxglove.PosesInFrame``, targets,
 pairs and errors as ``foxglove.SceneUpdate``, states and notes as ``foxglove.Log``, and the
-numbers Foxglove plots on JSON topics. :data:`CONTENT` maps the result's class to it, so no
-shared code switches over benchmark names. docs/foxglove.md lists every topic.
+numbers Foxglove plots on JSON topics. A benchmark names its own
+(:attr:`ertools.benchmarks.base.Benchmark.foxglove`); :data:`CONTENT` maps the class of the
+other results (the audit's) to theirs, so no shared code switches over benchmark names.
+docs/foxglove.md lists every topic.
 """
 
 from __future__ import annotations
@@ -16,17 +18,13 @@ from importlib import import_module
 from pathlib import Path
 from typing import Any
 
+from ertools.benchmarks import registry
 from ertools.errors import UsageError
 
-# ``module.Class`` of a result -> ``module:function`` adding its content to a Collected.
-# Dotted names, not classes: nothing is imported until a file is written.
+# ``module.Class`` of a result that is no registered benchmark's -> ``module:function``
+# adding its content to a Collected. Dotted names, not classes: nothing is imported until a
+# file is written.
 CONTENT: dict[str, str] = {
-    "ertools.benchmarks.trajectory.benchmark.TrajectoryResult": (
-        "ertools.report.foxglove.trajectory:content"
-    ),
-    "ertools.benchmarks.fbm3w.result.Fbm3wResult": "ertools.report.foxglove.fbm3w:content",
-    "ertools.benchmarks.fbm2h.result.Fbm2hResult": "ertools.report.foxglove.fbm2h:content",
-    "ertools.benchmarks.fbm1.result.Fbm1Result": "ertools.report.foxglove.fbm1:content",
     "ertools.audit.model.Audit": "ertools.report.foxglove.audit:content",
 }
 
@@ -48,10 +46,14 @@ class Written:
 
 
 def content_function(result: Any) -> Callable[..., None] | None:
-    """The content function registered for the result's class, None when there is none."""
+    """The content function the result's benchmark declares (or registered for its class),
+    None when there is none."""
     cls = type(result)
     target = CONTENT.get(f"{cls.__module__}.{cls.__qualname__}")
-    if target is None:
+    name = str(getattr(result, "name", ""))
+    if target is None and name in registry.names():
+        target = registry.get(name).foxglove
+    if not target:
         return None
     module, _, name = target.partition(":")
     fn: Callable[..., None] = getattr(import_module(module), name)

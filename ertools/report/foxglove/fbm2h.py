@@ -78,7 +78,7 @@ def content(out: Collected, r: Fbm2hResult, *, limit: int) -> None:
     for s in r.segments:
         t_end = s.end_ns if s.end_ns is not None else (s.start_ns or t0)
         if s.start_ns is not None:
-            log(out, s.start_ns, INFO, f"segment {s.index}: to waypoint {s.index}", "fbm2h")
+            log(out, s.start_ns, INFO, f"segment {s.index}: to waypoint {s.index}", r.name)
         if s.robot is not None and s.distance_error is not None:
             reached = Scene(t_end)
             e = reached.entity(f"reached {s.index}")
@@ -102,11 +102,11 @@ def content(out: Collected, r: Fbm2hResult, *, limit: int) -> None:
                 INFO,
                 f"segment {s.index}: reached, distance_error {s.distance_error:.4f} m, "
                 f"orientation_error {err_o:.4f} rad",
-                "fbm2h",
+                r.name,
             )
         else:
             level = ERROR if s.status != "ok" else WARNING
-            log(out, t_end, level, f"segment {s.index}: {s.status}", "fbm2h")
+            log(out, t_end, level, f"segment {s.index}: {s.status}", r.name)
         out.json(
             "/fbm2h/segments",
             t_end,
@@ -132,6 +132,6 @@ def content(out: Collected, r: Fbm2hResult, *, limit: int) -> None:
             INFO,
             f"position_accuracy {r.position_accuracy} m, orientation_accuracy "
             f"{r.orientation_accuracy} rad, execution_time {r.execution_time:.3f} s",
-            "fbm2h",
+            r.name,
         )
-    result_notes(out, r, "fbm2h")
+    result_notes(out, r, r.name)

@@ -97,14 +97,14 @@ def content(out: Collected, r: Fbm3wResult, *, limit: int) -> None:
                 "target_length": run.target_length,
             },
         )
-        log(out, t_start, INFO, f"run {run.index} ({run.spec}): path starts", "fbm3w")
+        log(out, t_start, INFO, f"run {run.index} ({run.spec}): path starts", r.name)
         if err is not None:
             text, level = f"run {run.index} ({run.spec}): distance_error {err * 1000:.4f} mm", INFO
         elif run.error is not None:
             text, level = f"run {run.index} ({run.spec}): not scored: {run.error}", ERROR
         else:
             text, level = f"run {run.index} ({run.spec}): {run.status}, not scored", WARNING
-        log(out, t_end, level, text, "fbm3w")
+        log(out, t_end, level, text, r.name)
     best = r.best_distance_error
     if best is not None and known:
         log(
@@ -113,9 +113,9 @@ def content(out: Collected, r: Fbm3wResult, *, limit: int) -> None:
             INFO,
             f"best run {r.best_run}: distance_error {best * 1000:.4f} mm; execution_time "
             f"{r.execution_time:.3f} s",
-            "fbm3w",
+            r.name,
         )
-    result_notes(out, r, "fbm3w")
+    result_notes(out, r, r.name)
 
 
 def _scene(out: Collected, run: RunResult, t_ns: int, lifetime_ns: int | None) -> None:

@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ertools.benchmarks.trajectory.benchmark import COMPARED, STATUS_NAMES, TrajectoryResult
+from ertools.benchmarks.trajectory.association import COMPARED, STATUS_NAMES
+from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.report.foxglove.messages import (
     INFO,
     RED,
@@ -106,7 +107,7 @@ def content(out: Collected, r: TrajectoryResult, *, limit: int) -> None:
             f"trajectory: position_error {r.metrics.position_error:.6f} m, orientation_error "
             f"{r.metrics.orientation_error:.6f} rad over {r.compared} compared pose(s) "
             f"({r.gaps} in GT gaps, {r.tracking_lost} tracking lost, {r.uncovered} uncovered)",
-            "trajectory",
+            r.name,
         )
     if len(ci) < len(ok) or len(ri) < len(m.t_ns):
         log(
@@ -115,6 +116,6 @@ def content(out: Collected, r: TrajectoryResult, *, limit: int) -> None:
             WARNING,
             f"streams decimated to at most {limit} messages: /trajectory/errors holds {len(ci)} "
             f"of {len(ok)} compared poses, so its mean is not the score exactly",
-            "trajectory",
+            r.name,
         )
-    result_notes(out, r, "trajectory")
+    result_notes(out, r, r.name)

@@ -138,7 +138,7 @@ def test_acquire_given_windows(tmp_path: Path, capsys: pytest.CaptureFixture[str
 def test_acquire_wrong_number_of_phases(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     bag, vanilla = tmp_path / "acq.bag", tmp_path / "vanilla.yaml"
     _write_log(bag, vanilla)
-    code = main(["acquire", "items", str(bag), "--items", str(vanilla), "--min-still", "3.5"])
+    code = main(["acquire", "items", str(bag), "--items", str(vanilla), "--still-min", "3.5"])
     out, err = capsys.readouterr()
     assert code == 1 and out == ""
     assert "found 0 still phase(s)" in err and "--windows" in err and err.count("\n") == 1

@@ -576,7 +576,7 @@ def test_old_spellings_still_work_and_say_what_they_mean(
     old_flags = ["--legacy-clip", "--legacy-wrap", "--legacy-names", "--legacy-totals"]
     old, err = ertools_score(bag, items_path, "fbm1h", ["--gt", "placed", *old_flags], capsys)
     for flag in old_flags:
-        assert f"ertools: {flag} is deprecated: it now means --" in err
+        assert f"ertools: note: {flag} is deprecated, use --" in err
     new, _ = ertools_score(bag, items_path, "fbm1h", ["--rules", "2016"], capsys)
     assert old == new
 

@@ -52,7 +52,9 @@ def _acquire(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, 
 
 
 def test_detected_window(origin_bag: Path, tmp_path: Path, capsys: Any) -> None:
-    code, out, err = _acquire(capsys, str(origin_bag), "--team", "homer", "--out", str(tmp_path))
+    code, out, err = _acquire(
+        capsys, str(origin_bag), "--team", "homer", "--out-dir", str(tmp_path)
+    )
     assert code == 0, err
     path = tmp_path / "transform-homer.yaml"
     assert out == path.read_text()
@@ -80,7 +82,7 @@ def test_given_window_on_motion_warns(origin_bag: Path, tmp_path: Path, capsys: 
         str(origin_bag),
         "--team",
         "homer",
-        "--out",
+        "--out-dir",
         str(tmp_path),
         "--at",
         "4.5",
@@ -93,11 +95,11 @@ def test_given_window_on_motion_warns(origin_bag: Path, tmp_path: Path, capsys: 
 
 def test_existing_file_needs_force(origin_bag: Path, tmp_path: Path, capsys: Any) -> None:
     (tmp_path / "transform-homer.yaml").write_text("keep me\n")
-    code, _, err = _acquire(capsys, str(origin_bag), "--team", "homer", "--out", str(tmp_path))
+    code, _, err = _acquire(capsys, str(origin_bag), "--team", "homer", "--out-dir", str(tmp_path))
     assert code == 1 and "--force" in err
     assert (tmp_path / "transform-homer.yaml").read_text() == "keep me\n"
 
 
 def test_bad_team_name(origin_bag: Path, tmp_path: Path, capsys: Any) -> None:
-    code, _, err = _acquire(capsys, str(origin_bag), "--team", "a b", "--out", str(tmp_path))
+    code, _, err = _acquire(capsys, str(origin_bag), "--team", "a b", "--out-dir", str(tmp_path))
     assert code == 1 and "team name" in err

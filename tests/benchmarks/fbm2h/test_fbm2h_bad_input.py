@@ -129,11 +129,11 @@ def test_no_gt_near_reached_moment(
         "--reached",
         "timing",
         str(timing),
-        "--max-gap",
+        "--gt-tolerance",
         "0.05",
     )
     assert code == 1
-    _one_error_line(err, "segment 2", "no ground truth within --max-gap 0.05 s")
+    _one_error_line(err, "segment 2", "no ground truth within --gt-tolerance 0.05 s")
     result = yaml.safe_load(out)
     assert result["details"]["segments_details"][2]["dinstance_error"] is None
     assert result["position_accuracy"] is None

@@ -194,7 +194,8 @@ def test_user_shape_scores_like_the_builtin(
         (["--topic", "/nope"], 1, "/nope"),
         (["--d-min-sweep", "a:b"], 2, "START:STOP:N"),
         (["--d-min-sweep", "0.1:0.2:0"], 2, "between 1 and 500"),
-        (["--d-min", "-1"], 1, ">= 0"),
+        (["--d-min", "-1"], 2, ">= 0"),  # a usage error: one home, make_options (issue 16)
+        (["--d-min", "-0.001"], 2, "--d-min must be >= 0 m, got -0.001"),
         (["--run", "line:1:2"], 1, "SPEC:REF_T:START_T:END_T"),
         (["--run", "line:1:5:2"], 1, "before START_T"),
         (["--run", "line:1:2:3", "--runs", "states"], 2, "contradict"),

@@ -5,12 +5,14 @@ A toy "log" is a text file of numbers, one per line. The score of an execution i
 ``mean(numbers) * scale + offset`` (``mode: max``: the largest number instead of the mean), the
 offset read from the team's per-team input (a YAML file ``{offset: X}``, like a marker-set
 transform). Words in a log make the scorer misbehave on purpose: ``bad`` (an unscoreable log:
-ScoringError), ``boom`` (a bug: RuntimeError), ``die`` (the worker process dies).
+ScoringError), ``boom`` (a bug: RuntimeError), ``die`` (the worker process dies); ``sleep``
+waits a second.
 """
 
 from __future__ import annotations
 
 import os
+import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -74,6 +76,9 @@ def load(bags: Sequence[Path], options: ToyOptions) -> list[float]:
                 raise RuntimeError("the toy scorer has a bug")
             if line == "die":
                 os._exit(7)
+            if line == "sleep":  # long enough for a progress bar to show
+                time.sleep(1.0)
+                continue
             numbers.append(float(line))
     return numbers
 
