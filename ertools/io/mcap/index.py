@@ -136,6 +136,26 @@ def decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
     raise BagError(f"unsupported MCAP chunk compression {compression!r} {where}")
 
 
+def _check_counts(path: Path, summary: Any, planned: dict[int, int]) -> None:
+    """A whole-file read finds as many messages of each channel in the message indexes as the
+    statistics count (when they add up): a message index whose array length was damaged to
+    fewer entries (the rest then reads as padding, which the specification allows) would
+    drop messages without a word."""
+    stats = summary.statistics
+    if stats is None or not stats.channel_message_counts:
+        return
+    counts = stats.channel_message_counts
+    if sum(counts.values()) != stats.message_count:
+        return  # damaged statistics: not a measure of anything
+    for cid, n in planned.items():
+        if n != counts.get(cid, 0):
+            raise BagError(
+                f"the message indexes hold {n} messages of channel {cid}, the statistics "
+                f"{counts.get(cid, 0)} (damaged index)",
+                path=path,
+            )
+
+
 def _zstd_into(data: bytes, out: memoryview, where: str) -> None:
     """Decompress one zstd chunk into ``out``, which must be exactly its uncompressed size."""
     import zstandard
@@ -228,6 +248,7 @@ class McapIndex:
                 chunks = summary.chunk_indexes
                 chunks_per_file.append(chunks)
                 file_size = _file_size(f)
+                planned = dict.fromkeys(channels, 0)  # messages per channel, for the statistics
                 for ci, chunk in enumerate(chunks):
                     if lo is not None and chunk.message_end_time < lo:
                         continue
@@ -261,8 +282,11 @@ class McapIndex:
                             if hi is not None:
                                 keep &= t <= hi
                             t, off = t[keep], off[keep]
+                        planned[cid] = planned.get(cid, 0) + len(t)
                         if len(t):
                             sels.append((fi, ci, int(chunk.chunk_start_offset), t, off))
+            if lo is None and hi is None:
+                _check_counts(path, summary, planned)
         if not sels:
             e = np.empty(0, np.int64)
             return McapPlan(e, e, e, e, chunks_per_file)
