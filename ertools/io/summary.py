@@ -140,6 +140,8 @@ def _ros1(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagS
                         s[0], s[1] = min(s[0], chunk.start_ns), max(s[1], chunk.end_ns)
                 for cid, n in chunk.counts.items():
                     counts[cid] += n
+            if exact and layout.indexed and not index_problems:
+                index_problems.extend(_ros1_check_ends(bag, layout.chunks, spans))
         finally:
             bag.close()
     topics: dict[str, tuple[str, int, int | None, int | None, int]] = {}
@@ -161,6 +163,33 @@ def _ros1(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagS
 MAX_INDEX_PROBLEMS = 5
 # Ends each such line: ``info --check`` replaces them by its record-level lines.
 INDEX_SELF_CHECK = "(damaged index; info --check reads the records)"
+
+
+def _ros1_check_ends(bag: Any, chunks: list[Any], spans: dict[int, list[int]]) -> list[str]:
+    """Each connection's first and last times, as its index data gives them, are its
+    records': the index entries of the chunks that start no later than a connection's
+    first time or end no earlier than its last (the chunks that could hold an earlier or
+    later message: one or two) are checked against their records (conn and time). A damaged
+    entry time elsewhere leaves counts and span as they were; one there would move the
+    topic's span (found by fuzzing). Decompresses those few chunks only."""
+    for chunk in chunks:
+        bounding = [
+            cid
+            for cid in chunk.counts
+            if cid in spans and (chunk.start_ns <= spans[cid][0] or chunk.end_ns >= spans[cid][1])
+        ]
+        if not bounding:
+            continue
+        where = f"in {bag.path} at byte {chunk.pos}"
+        try:
+            buf = np.frombuffer(bag.chunk_bytes(chunk), dtype=np.uint8)
+            entries = bag.chunk_entries(chunk)
+            for cid in bounding:
+                t, off = entries.get(cid, (np.empty(0, np.int64), np.empty(0, np.int64)))
+                bag.checked_spans(buf, off, t, np.full(len(t), cid, dtype=np.int64), where)
+        except BagError as err:
+            return [f"chunk at byte {chunk.pos}: {err.message} {INDEX_SELF_CHECK}"]
+    return []
 
 
 def _ros1_index_disagrees(chunk: Any, entries: dict[int, tuple[I64, I64]]) -> list[str]:
@@ -254,7 +283,7 @@ def _mcap_indexed(
                         path=path,
                     )
                 if read_indexes:
-                    t, _ = McapIndex._message_index(f, path, offset, cid)
+                    t, _ = McapIndex._message_index(f, path, offset, cid, padded=False)
                     if times is not None:
                         times.setdefault(layout.channels[cid].topic, []).append(t)
                     counts[cid] = counts.get(cid, 0) + len(t)
@@ -349,13 +378,25 @@ def _mcap_file(
 ) -> tuple[dict[str, tuple[str, int, int | None, int | None, int]], set[str], list[str], str]:
     """(topics, chunk compressions, problems, index used) of one MCAP file, through its
     indexes where they answer for every message, else record by record."""
+    from ertools.io.decode.fast import LayoutMismatchError
     from ertools.io.mcap.scan import SCAN, mcap_layout
 
     layout = mcap_layout(path)
-    if layout.index == SCAN:
-        topics, compressions, problems = _mcap_scanned(path, layout.why, times)
-        return topics, compressions, problems, SCAN
-    return _mcap_indexed(path, layout, exact, times)
+    if layout.index != SCAN:
+        mine: Times | None = None if times is None else {}
+        try:
+            found = _mcap_indexed(path, layout, exact, mine)
+        except LayoutMismatchError as err:
+            why = str(err)  # a padded message index: counted record by record
+        else:
+            if times is not None and mine is not None:
+                for topic, parts in mine.items():
+                    times.setdefault(topic, []).extend(parts)
+            return found
+    else:
+        why = layout.why
+    topics, compressions, problems = _mcap_scanned(path, why, times)
+    return topics, compressions, problems, SCAN
 
 
 def _mcap_version(path: Path) -> str:

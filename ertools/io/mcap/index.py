@@ -274,7 +274,7 @@ class McapIndex:
                         continue
                     for cid in wanted:
                         offset = chunk.message_index_offsets[cid]
-                        t, off = self._message_index(f, path, offset, cid, file_size)
+                        t, off = self._message_index(f, path, offset, cid, file_size, padded=False)
                         if lo is not None or hi is not None:
                             keep = np.ones(len(t), dtype=bool)
                             if lo is not None:
@@ -444,8 +444,22 @@ class McapIndex:
 
     @staticmethod
     def _message_index(
-        f: BinaryIO, path: Path, pos: int, cid: int, size: int | None = None
+        f: BinaryIO,
+        path: Path,
+        pos: int,
+        cid: int,
+        size: int | None = None,
+        padded: bool = True,
     ) -> tuple[I64, I64]:
+        """(log times, record offsets) of one message-index record.
+
+        Raises:
+            BagError: damaged record.
+            LayoutMismatchError: (``padded`` False) the record is longer than its array. The
+                specification lets writers pad records, but so does a damaged array length
+                look (fewer entries, the rest taken for padding): a read or count that
+                trusts the index then goes record by record instead (only padded files pay).
+        """
         if size is None:
             size = _file_size(f)
         if not 0 <= pos < size:
@@ -460,6 +474,10 @@ class McapIndex:
         # lets writers pad records
         if channel != cid or nbytes % 16 or length < 6 + nbytes or pos + 15 + nbytes > size:
             raise BagError(f"damaged message index at byte {pos}", path=path)
+        if not padded and length != 6 + nbytes:
+            from ertools.io.decode.fast import LayoutMismatchError
+
+            raise LayoutMismatchError(f"a message index at byte {pos} with padding")
         data = f.read(nbytes)
         if len(data) != nbytes:
             raise BagError(f"message index at byte {pos} cut off by end of file", path=path)
