@@ -140,6 +140,8 @@ def _ros1(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagS
                         s[0], s[1] = min(s[0], chunk.start_ns), max(s[1], chunk.end_ns)
                 for cid, n in chunk.counts.items():
                     counts[cid] += n
+            if exact and layout.indexed and not index_problems:
+                index_problems.extend(_ros1_check_ends(bag, layout.chunks, spans))
         finally:
             bag.close()
     topics: dict[str, tuple[str, int, int | None, int | None, int]] = {}
@@ -161,6 +163,33 @@ def _ros1(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagS
 MAX_INDEX_PROBLEMS = 5
 # Ends each such line: ``info --check`` replaces them by its record-level lines.
 INDEX_SELF_CHECK = "(damaged index; info --check reads the records)"
+
+
+def _ros1_check_ends(bag: Any, chunks: list[Any], spans: dict[int, list[int]]) -> list[str]:
+    """Each connection's first and last times, as its index data gives them, are its
+    records': the index entries of the chunks that start no later than a connection's
+    first time or end no earlier than its last (the chunks that could hold an earlier or
+    later message: one or two) are checked against their records (conn and time). A damaged
+    entry time elsewhere leaves counts and span as they were; one there would move the
+    topic's span (found by fuzzing). Decompresses those few chunks only."""
+    for chunk in chunks:
+        bounding = [
+            cid
+            for cid in chunk.counts
+            if cid in spans and (chunk.start_ns <= spans[cid][0] or chunk.end_ns >= spans[cid][1])
+        ]
+        if not bounding:
+            continue
+        where = f"in {bag.path} at byte {chunk.pos}"
+        try:
+            buf = np.frombuffer(bag.chunk_bytes(chunk), dtype=np.uint8)
+            entries = bag.chunk_entries(chunk)
+            for cid in bounding:
+                t, off = entries.get(cid, (np.empty(0, np.int64), np.empty(0, np.int64)))
+                bag.checked_spans(buf, off, t, np.full(len(t), cid, dtype=np.int64), where)
+        except BagError as err:
+            return [f"chunk at byte {chunk.pos}: {err.message} {INDEX_SELF_CHECK}"]
+    return []
 
 
 def _ros1_index_disagrees(chunk: Any, entries: dict[int, tuple[I64, I64]]) -> list[str]:
@@ -241,8 +270,8 @@ def _mcap_indexed(
         stats = None
     read_indexes = exact or stats is None
     counts: dict[int, int] = {} if read_indexes else dict(stats.channel_message_counts)
-    # channel -> time -> (chunk, record offset) of its earliest and latest index entries
-    ends: dict[int, dict[int, tuple[Any, int]]] = {}
+    # channel -> (chunk, message index offset) of every chunk holding it
+    located: dict[int, list[tuple[Any, int]]] = {}
     with path.open("rb") as f:
         for chunk in summary.chunk_indexes:
             compressions.add(chunk.compression or "none")
@@ -254,21 +283,14 @@ def _mcap_indexed(
                         path=path,
                     )
                 if read_indexes:
-                    t, off = McapIndex._message_index(f, path, offset, cid)
+                    t, _ = McapIndex._message_index(f, path, offset, cid, padded=False)
                     if times is not None:
                         times.setdefault(layout.channels[cid].topic, []).append(t)
                     counts[cid] = counts.get(cid, 0) + len(t)
                     if not len(t):
                         continue
                     lo, hi = int(t.min()), int(t.max())
-                    for when, at in ((lo, int(off[t.argmin()])), (hi, int(off[t.argmax()]))):
-                        e = ends.setdefault(cid, {})
-                        if when not in e:
-                            e[when] = (chunk, at)
-                    # only the earliest and latest entries are kept
-                    e = ends[cid]
-                    if len(e) > 2:
-                        ends[cid] = {k: e[k] for k in (min(e), max(e))}
+                    located.setdefault(cid, []).append((chunk, offset))
                     if lo < chunk.message_start_time or hi > chunk.message_end_time:
                         # a damaged index entry: its time is outside its own chunk's span
                         raise BagError(
@@ -280,7 +302,7 @@ def _mcap_indexed(
                     lo, hi = int(chunk.message_start_time), int(chunk.message_end_time)
                 s = spans.setdefault(cid, [lo, hi])
                 s[0], s[1] = min(s[0], lo), max(s[1], hi)
-    _check_ends(path, ends)
+    _check_ends(path, located, spans)
     problems = []
     if read_indexes and recorded is not None and recorded.message_count != sum(counts.values()):
         problems.append(
@@ -302,37 +324,53 @@ def _mcap_indexed(
     return topics, compressions, problems, index
 
 
-def _check_ends(path: Path, ends: dict[int, dict[int, tuple[Any, int]]]) -> None:
-    """The records the message indexes give as each channel's first and last message are
-    that channel's messages at those log times: a damaged index entry elsewhere leaves
-    counts, first and last times as they were, but one that became a first or last time
-    would be reported as the topic's span. Reads the few chunks holding them (each checked
-    against its CRC), not the file.
+def _check_ends(
+    path: Path, located: dict[int, list[tuple[Any, int]]], spans: dict[int, list[int]]
+) -> None:
+    """Each channel's first and last log times, as its message indexes give them, are its
+    records': every index entry of the channel is checked against its record in each chunk
+    that starts no later than the channel's first time or ends no earlier than its last
+    (the chunks that could hold an earlier or later message: one or two per channel). A
+    damaged entry elsewhere leaves counts and span as they were; one in those chunks would
+    move the topic's reported span. Reads those few chunks (each checked against its CRC).
 
     Raises:
         BagError: an index entry and its record disagree.
     """
-    import struct
-
+    from ertools.io.decode.fast import gather
     from ertools.io.mcap.index import McapIndex
 
-    chunks: dict[int, bytes] = {}
-    for cid, found in ends.items():
-        for when, (chunk, at) in found.items():
-            key = int(chunk.chunk_start_offset)
-            if key not in chunks:
-                chunks[key] = McapIndex.inflated_bytes(path, chunk)
-            buf = chunks[key]
-            ok = at >= 0 and at + 23 <= len(buf) and buf[at] == 0x05
-            if ok:
-                channel, _seq, log_time = struct.unpack_from("<HIQ", buf, at + 9)
-                ok = channel == cid and log_time == when
-            if not ok:
-                raise BagError(
-                    f"message index of channel {cid} disagrees with the record it points at "
-                    f"(chunk at byte {key}, offset {at}): damaged index or chunk",
-                    path=path,
-                )
+    chunks: dict[int, np.ndarray] = {}
+    with path.open("rb") as f:
+        for cid, where in located.items():
+            lo, hi = spans[cid]
+            for chunk, offset in where:
+                if chunk.message_start_time > lo and chunk.message_end_time < hi:
+                    continue
+                key = int(chunk.chunk_start_offset)
+                if key not in chunks:
+                    raw = McapIndex.inflated_bytes(path, chunk)
+                    chunks[key] = np.frombuffer(raw, dtype=np.uint8)
+                buf = chunks[key]
+                t, off = McapIndex._message_index(f, path, offset, cid)
+                head = 1 + 8 + 2 + 4 + 8  # op, length, channel, sequence, log time
+                ok = not len(off) or (int(off.min()) >= 0 and int(off.max()) + head <= len(buf))
+                if ok and len(off):
+                    rows = gather(buf, off, head)
+                    n = len(off)
+                    channel = np.ndarray((n,), "<u2", buffer=rows, offset=9, strides=(head,))
+                    log_time = np.ndarray((n,), "<u8", buffer=rows, offset=15, strides=(head,))
+                    ok = bool(
+                        np.all(rows[:, 0] == 0x05)
+                        and np.all(channel == cid)
+                        and np.all(log_time.astype(np.int64) == t)
+                    )
+                if not ok:
+                    raise BagError(
+                        f"message index of channel {cid} (chunk at byte {key}) disagrees with "
+                        "the records it points at: damaged index or chunk",
+                        path=path,
+                    )
 
 
 def _mcap_file(
@@ -340,13 +378,25 @@ def _mcap_file(
 ) -> tuple[dict[str, tuple[str, int, int | None, int | None, int]], set[str], list[str], str]:
     """(topics, chunk compressions, problems, index used) of one MCAP file, through its
     indexes where they answer for every message, else record by record."""
+    from ertools.io.decode.fast import LayoutMismatchError
     from ertools.io.mcap.scan import SCAN, mcap_layout
 
     layout = mcap_layout(path)
-    if layout.index == SCAN:
-        topics, compressions, problems = _mcap_scanned(path, layout.why, times)
-        return topics, compressions, problems, SCAN
-    return _mcap_indexed(path, layout, exact, times)
+    if layout.index != SCAN:
+        mine: Times | None = None if times is None else {}
+        try:
+            found = _mcap_indexed(path, layout, exact, mine)
+        except LayoutMismatchError as err:
+            why = str(err)  # a padded message index: counted record by record
+        else:
+            if times is not None and mine is not None:
+                for topic, parts in mine.items():
+                    times.setdefault(topic, []).extend(parts)
+            return found
+    else:
+        why = layout.why
+    topics, compressions, problems = _mcap_scanned(path, why, times)
+    return topics, compressions, problems, SCAN
 
 
 def _mcap_version(path: Path) -> str:

@@ -74,7 +74,13 @@ def expected(mcap: Path) -> Expected:
     # answer alone when every message is in an indexed chunk with message indexes and the
     # summary names its channel (and schema).
     features = set(doc["meta"]["variant"]["features"])
-    covers = {"ch", "chx", "mx", "rch"} <= features and ("rsh" in features or schemaless)
+    # Padded message indexes are counted record by record: a padded index and one whose
+    # array length was damaged to fewer entries are the same bytes (found by fuzzing).
+    covers = (
+        {"ch", "chx", "mx", "rch"} <= features
+        and ("rsh" in features or schemaless)
+        and "pad" not in features
+    )
     indexed = summary and (not messages or covers)
     return Expected(len(messages), {k: sorted(v) for k, v in per_topic.items()}, indexed)
 

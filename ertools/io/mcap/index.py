@@ -136,6 +136,26 @@ def decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
     raise BagError(f"unsupported MCAP chunk compression {compression!r} {where}")
 
 
+def _check_counts(path: Path, summary: Any, planned: dict[int, int]) -> None:
+    """A whole-file read finds as many messages of each channel in the message indexes as the
+    statistics count (when they add up): a message index whose array length was damaged to
+    fewer entries (the rest then reads as padding, which the specification allows) would
+    drop messages without a word."""
+    stats = summary.statistics
+    if stats is None or not stats.channel_message_counts:
+        return
+    counts = stats.channel_message_counts
+    if sum(counts.values()) != stats.message_count:
+        return  # damaged statistics: not a measure of anything
+    for cid, n in planned.items():
+        if n != counts.get(cid, 0):
+            raise BagError(
+                f"the message indexes hold {n} messages of channel {cid}, the statistics "
+                f"{counts.get(cid, 0)} (damaged index)",
+                path=path,
+            )
+
+
 def _zstd_into(data: bytes, out: memoryview, where: str) -> None:
     """Decompress one zstd chunk into ``out``, which must be exactly its uncompressed size."""
     import zstandard
@@ -228,6 +248,7 @@ class McapIndex:
                 chunks = summary.chunk_indexes
                 chunks_per_file.append(chunks)
                 file_size = _file_size(f)
+                planned = dict.fromkeys(channels, 0)  # messages per channel, for the statistics
                 for ci, chunk in enumerate(chunks):
                     if lo is not None and chunk.message_end_time < lo:
                         continue
@@ -253,7 +274,7 @@ class McapIndex:
                         continue
                     for cid in wanted:
                         offset = chunk.message_index_offsets[cid]
-                        t, off = self._message_index(f, path, offset, cid, file_size)
+                        t, off = self._message_index(f, path, offset, cid, file_size, padded=False)
                         if lo is not None or hi is not None:
                             keep = np.ones(len(t), dtype=bool)
                             if lo is not None:
@@ -261,8 +282,11 @@ class McapIndex:
                             if hi is not None:
                                 keep &= t <= hi
                             t, off = t[keep], off[keep]
+                        planned[cid] = planned.get(cid, 0) + len(t)
                         if len(t):
                             sels.append((fi, ci, int(chunk.chunk_start_offset), t, off))
+            if lo is None and hi is None:
+                _check_counts(path, summary, planned)
         if not sels:
             e = np.empty(0, np.int64)
             return McapPlan(e, e, e, e, chunks_per_file)
@@ -270,12 +294,14 @@ class McapIndex:
         off_all = np.concatenate([s[4] for s in sels])
         # file, chunk and chunk offset of every row: one repeat each, not an array per chunk
         counts = np.array([len(s[3]) for s in sels], dtype=np.int64)
-        file_all = np.repeat(np.array([s[0] for s in sels], dtype=np.int64), counts)
-        chunk_all = np.repeat(np.array([s[1] for s in sels], dtype=np.int64), counts)
-        cstart_all = np.repeat(np.array([s[2] for s in sels], dtype=np.int64), counts)
-        key = file_all * (1 << 32) + chunk_all
+        key = np.repeat(np.array([(s[0] << 32) + s[1] for s in sels], dtype=np.int64), counts)
+        file_all = key >> 32
         # the mcap library's order: log time, then file, chunk position, record position. One
-        # channel logged in time order is in that order already: no sort.
+        # channel logged in time order is in that order already: no sort (times that strictly
+        # increase need no other key).
+        if bool(np.all(t_all[1:] > t_all[:-1])):
+            return McapPlan(t_all, off_all, key, file_all, chunks_per_file)
+        cstart_all = np.repeat(np.array([s[2] for s in sels], dtype=np.int64), counts)
         if _in_order(t_all, file_all, cstart_all, off_all):
             return McapPlan(t_all, off_all, key, file_all, chunks_per_file)
         order = np.lexsort((off_all, cstart_all, file_all, t_all))
@@ -322,7 +348,8 @@ class McapIndex:
             path, first = chunk_of(part[0][0])
             where = f"in {path} in chunks from byte {first.chunk_start_offset}"
             offsets = plan.offset[rows]
-            if np.any(offsets + 9 + MESSAGE_FIXED > sizes[which]):
+            # a record inside its chunk: no earlier (here), no later (its end, checked below)
+            if len(offsets) and int(offsets.min()) < 0:
                 raise BagError(f"message index points outside its chunk {where}")
             limit = base[which] + sizes[which]
             start, length, log_time = _checked_records(buf, offsets + base[which], limit, where)
@@ -365,13 +392,14 @@ class McapIndex:
         for (path, chunk), b, n in zip(chunks, base.tolist(), sizes.tolist(), strict=True):
             where = f"in {path} at byte {chunk.chunk_start_offset}"
             with path.open("rb") as f:
-                compression, at, nbytes, usize, _crc = McapIndex._chunk_head(
-                    f.fileno(), path, chunk
-                )
+                compression, at, nbytes, usize, crc = McapIndex._chunk_head(f.fileno(), path, chunk)
                 if compression or nbytes != n or usize != n:
                     raise BagError(f"chunk record disagrees with the summary's index {where}")
                 if read_at(f.fileno(), view[b : b + n], at) != n:
                     raise BagError(f"chunk cut off by end of file {where}")
+                # a flipped bit in a pose's bytes reads as another pose: the CRC finds it
+                if crc and crc32(view[b : b + n]) != crc:
+                    raise BagError(f"chunk fails its CRC check (damaged) {where}")
         return np.frombuffer(view, dtype=np.uint8), base, sizes
 
     @staticmethod
@@ -420,8 +448,22 @@ class McapIndex:
 
     @staticmethod
     def _message_index(
-        f: BinaryIO, path: Path, pos: int, cid: int, size: int | None = None
+        f: BinaryIO,
+        path: Path,
+        pos: int,
+        cid: int,
+        size: int | None = None,
+        padded: bool = True,
     ) -> tuple[I64, I64]:
+        """(log times, record offsets) of one message-index record.
+
+        Raises:
+            BagError: damaged record.
+            LayoutMismatchError: (``padded`` False) the record is longer than its array. The
+                specification lets writers pad records, but so does a damaged array length
+                look (fewer entries, the rest taken for padding): a read or count that
+                trusts the index then goes record by record instead (only padded files pay).
+        """
         if size is None:
             size = _file_size(f)
         if not 0 <= pos < size:
@@ -436,6 +478,10 @@ class McapIndex:
         # lets writers pad records
         if channel != cid or nbytes % 16 or length < 6 + nbytes or pos + 15 + nbytes > size:
             raise BagError(f"damaged message index at byte {pos}", path=path)
+        if not padded and length != 6 + nbytes:
+            from ertools.io.decode.fast import LayoutMismatchError
+
+            raise LayoutMismatchError(f"a message index at byte {pos} with padding")
         data = f.read(nbytes)
         if len(data) != nbytes:
             raise BagError(f"message index at byte {pos} cut off by end of file", path=path)

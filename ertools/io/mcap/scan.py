@@ -37,6 +37,7 @@ OP_SCHEMA = 0x03
 OP_CHANNEL = 0x04
 OP_MESSAGE = 0x05
 OP_CHUNK = 0x06
+OP_DATA_END = 0x0F
 FOOTER_SIZE = 1 + 8 + 8 + 8 + 4
 _FOOTER_HEAD = bytes([OP_FOOTER]) + (FOOTER_SIZE - 9).to_bytes(8, "little")
 
@@ -103,11 +104,17 @@ class _Sink:
     footer: bool = False
     chunks: int = 0
     chunk_at: list[int] = field(default_factory=list)
+    data_end: bool = False
 
     def messages(self, buf: U8, at: I64) -> None:
         """Message records starting at ``at`` (vectorised)."""
         if not len(at):
             return
+        if self.data_end:
+            # the summary section holds no messages: a damaged record (a channel's op code)
+            raise BagError(
+                "a message record after the data section's end (damaged)", path=self.path
+            )
         length = read_at(buf, at + 1, np.dtype("<u8")).astype(np.int64)
         if int(length.min()) < MESSAGE_FIXED:
             raise _CutError
@@ -281,6 +288,8 @@ def _record(buf: Any, op: int, body: int, stop: int, sink: _Sink, top: bool) -> 
     elif op == OP_FOOTER and top:
         sink.footer = True
         return True
+    elif op == OP_DATA_END and top:
+        sink.data_end = True
     return False
 
 

@@ -8,6 +8,7 @@ A record is ``header_len u32, header, data_len u32, data``; a header is a run of
 
 from __future__ import annotations
 
+import re
 import struct
 from dataclasses import dataclass
 from typing import BinaryIO
@@ -127,6 +128,9 @@ def read_record(
     return Record(pos, op, fields, data_pos, dlen), data
 
 
+_TYPE_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*(/msg)?/[A-Za-z][A-Za-z0-9_]*")
+
+
 def connection_fields(record: Record, data: bytes) -> tuple[int, str, dict[str, bytes]]:
     """(conn id, topic, connection-header fields) of a connection record."""
     fields = parse_fields(data, record.data_pos)
@@ -134,9 +138,13 @@ def connection_fields(record: Record, data: bytes) -> tuple[int, str, dict[str, 
         # Names that are not UTF-8 are damage (rosbags refuses them too); decoded with
         # replacement characters they became topics and types the bag never had.
         topic = record.fields.get("topic", fields.get("topic", b"")).decode("utf-8")
-        fields.get("type", b"").decode("utf-8")
+        msgtype = fields.get("type", b"").decode("utf-8")
     except UnicodeDecodeError as err:
         raise RecordError(f"connection topic or type is not UTF-8 ({err})", record.pos) from err
+    if msgtype and not _TYPE_NAME.fullmatch(msgtype):
+        # ROS type names are package/Name, each starting with a letter: another name is a
+        # damaged byte (rosbags then fails on the definition), not a type the bag holds
+        raise RecordError(f"connection type {msgtype!r} is no ROS type name", record.pos)
     return u32(record.fields, "conn"), topic, fields
 
 
