@@ -39,7 +39,7 @@ from ertools.streams import PoseStream, Provenance, frame_change_warning
 from ertools.timeutil import ns_to_s, s_to_ns
 
 if TYPE_CHECKING:
-    from ertools.io import PoseSource
+    from ertools.benchmarks.common.sources import PoseSpec
 
 log = logging.getLogger("ertools.benchmarks.fbm2h.benchmark")
 
@@ -458,14 +458,17 @@ def _load_transform(options: Fbm2hOptions) -> MarkerTransform:
     return identity_transform()
 
 
-def _pose_source(options: Fbm2hOptions) -> PoseSource:
-    from ertools.io import PoseSource
+def _pose_spec(options: Fbm2hOptions) -> PoseSpec:
+    """The marker set's source for the one chooser (benchmarks/common/sources.py)."""
+    from ertools.benchmarks.common.sources import PoseSpec
 
     if options.topic is not None and options.tf_frame is not None:
         raise ConfigError("give either --topic or --tf-frame, not both")
-    if options.tf_frame is not None:
-        return PoseSource(topic=None, frame=options.tf_frame, time_source=options.time_source)
-    return PoseSource(topic=options.topic or DEFAULT_TOPIC, time_source=options.time_source)
+    return PoseSpec(
+        topic=options.topic,
+        tf=None if options.tf_frame is None else ("world", options.tf_frame),
+        time_source="record" if options.time_source == "record" else "header",
+    )
 
 
 def _compare_goal(goal: GoalList, payload: str, topic: str) -> str | None:
@@ -487,9 +490,10 @@ def _compare_goal(goal: GoalList, payload: str, topic: str) -> str | None:
 
 def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
     """Read the bags and configs, find the reached moments and score them."""
+    from ertools.benchmarks.common.sources import read_source, topic
     from ertools.benchmarks.fbm2h import segments as seg
     from ertools.configs.goal import goal_from_payload, load_goal
-    from ertools.io import read_benchmark_states, read_pose_source, summary
+    from ertools.io import read_benchmark_states, summary
 
     if not paths:
         raise ConfigError("no bag given")
@@ -497,7 +501,9 @@ def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
         raise ConfigError(f"--max-gap must be > 0 s, got {options.max_gap_s}")
     transform = _load_transform(options)
     goal = load_goal(options.goal) if options.goal is not None else None
-    marker = read_pose_source(list(paths), _pose_source(options))
+    marker = read_source(
+        paths, _pose_spec(options), (topic(DEFAULT_TOPIC),), what="marker set poses"
+    )
     if len(marker) == 0:
         raise SegmentationError(f"{marker.source or paths[0]}: the marker set pose stream is empty")
     from ertools.benchmarks.trajectory.benchmark import drop_invalid
