@@ -21,7 +21,7 @@ RULE_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm1.acquire",
     "ertools.benchmarks.fbm2h.benchmark",
     "ertools.benchmarks.fbm3w.benchmark",
-    "ertools.benchmarks.trajectory.benchmark",
+    "ertools.benchmarks.trajectory.rules",
 )
 
 

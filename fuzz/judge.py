@@ -22,11 +22,15 @@ Verdict of a part:
   of the undamaged file (topics and types as there, counts no larger, times inside the
   topic's true span; every pose row one of the true rows): a partial read, never made up;
 - ``refused``: ertools raises an ErtoolsError with a one-line message;
+- ``misread``: the official reader answers from bytes that fail a CRC the MCAP format
+  defines (:func:`mcap_crc_evidence`: ``mcap``'s own readers refuse them with CRC checks
+  on), and ertools' answer is exactly the undamaged file's: a judge error, not ertools',
+  counted on its own (never as an agreement);
 - ``disagree``: ertools answers and the answer is neither of the above (or refuses with a
   message of several lines);
 - ``traceback``: ertools raises anything else.
 
-A case is its worst part: traceback > disagree > refused > salvaged > agree.
+A case is its worst part: traceback > disagree > misread > refused > salvaged > agree.
 """
 
 from __future__ import annotations
@@ -44,7 +48,7 @@ import numpy as np
 from fuzz.seeds import POSE_TOPIC, TF_CHILD, TF_PARENT, TF_TOPIC
 
 PARTS = ("summary", "poses", "tf")
-ORDER = ("agree", "salvaged", "refused", "disagree", "traceback")
+ORDER = ("agree", "salvaged", "refused", "misread", "disagree", "traceback")
 POSE_TOL = 1e-9
 
 Summary = dict[str, tuple[str, int, int | None, int | None]]
@@ -265,6 +269,141 @@ def official_answer(path: Path) -> dict[str, Outcome]:
     return {"summary": Outcome(True, summary), **decoded}
 
 
+def mcap_crc_evidence(path: Path) -> str:
+    """Which CRC that the MCAP format defines the file fails ('' when none, or when the file
+    is not MCAP): every chunk and the data section as ``mcap``'s own linear reader checks
+    them (``validate_crcs=True``), and the summary section's CRC in the footer (the
+    specification's definition: from the first summary record through the footer's
+    ``summary_offset_start``; ``mcap``'s Python reader never checks it).
+
+    The seeking reader the judge asks (``validate_crcs`` off, its default) reads damaged
+    bytes as if they were sound: this is the evidence that its answer is a misreading.
+    """
+    import struct
+    import zlib
+
+    from mcap.stream_reader import CRCValidationError, StreamReader
+
+    data = path.read_bytes()
+    if not data.startswith(b"\x89MCAP"):
+        return ""
+    found = []
+    try:
+        with path.open("rb") as f:
+            for _record in StreamReader(f, validate_crcs=True).records:
+                pass
+    except CRCValidationError as err:
+        found.append(f"mcap's reader with validate_crcs=True: {err}")
+    except Exception:  # other damage stops the read first: no CRC verdict from it
+        pass
+    at = len(data) - 8 - 29
+    if at > 0 and data[at] == 0x02:
+        _op, _n, start, _offsets, crc = struct.unpack_from("<BQQQI", data, at)
+        if crc and 0 < start < at and zlib.crc32(data[start : at + 25]) != crc:
+            found.append("the summary section fails the footer's summary CRC")
+    return "; ".join(found)
+
+
+def _ros1_fields(head: bytes) -> dict[str, bytes]:
+    import struct
+
+    out, at = {}, 0
+    while at + 4 <= len(head):
+        (n,) = struct.unpack_from("<I", head, at)
+        name, _, value = head[at + 4 : at + 4 + n].partition(b"=")
+        out[name.decode("latin-1")] = value
+        at += 4 + n
+    return out
+
+
+def ros1_record_summary(path: Path) -> dict[str, tuple[int, int, int]] | None:
+    """topic -> (count, first, last record time) from the bag's records read one by one
+    (chunks decompressed, connection and message records inside them), the index never
+    consulted; None when the walk meets a record it cannot read. The judge's own walker (a
+    few lines from the format's description), not ertools' nor rosbags'."""
+    import bz2
+    import struct
+
+    import lz4.frame
+
+    data = path.read_bytes()
+    if not data.startswith(b"#ROSBAG V2.0\n"):
+        return None
+
+    def walk(
+        buf: bytes, at: int, inner: bool, topics: dict[int, str], times: dict[int, list[int]]
+    ) -> None:
+        while at < len(buf):
+            (hlen,) = struct.unpack_from("<I", buf, at)
+            head = buf[at + 4 : at + 4 + hlen]
+            (dlen,) = struct.unpack_from("<I", buf, at + 4 + hlen)
+            body = buf[at + 8 + hlen : at + 8 + hlen + dlen]
+            if len(head) != hlen or len(body) != dlen:
+                raise ValueError("record cut off")
+            f = _ros1_fields(head)
+            op = f["op"][0]
+            if op == 0x05 and not inner:
+                kind = f["compression"].decode()
+                raw = {"none": lambda b: b, "bz2": bz2.decompress, "lz4": lz4.frame.decompress}[
+                    kind
+                ](body)
+                walk(raw, 0, True, topics, times)
+            elif op == 0x07:
+                (cid,) = struct.unpack("<I", f["conn"])
+                topics.setdefault(cid, f["topic"].decode())
+            elif op == 0x02 and inner:
+                (cid,) = struct.unpack("<I", f["conn"])
+                sec, nsec = struct.unpack("<II", f["time"])
+                times.setdefault(cid, []).append(sec * 1_000_000_000 + nsec)
+            at += 8 + hlen + dlen
+
+    topics: dict[int, str] = {}
+    times: dict[int, list[int]] = {}
+    try:
+        walk(data, 13, False, topics, times)
+    except Exception:
+        return None
+    out: dict[str, list[int]] = {}
+    for cid, topic in topics.items():
+        out.setdefault(topic, []).extend(times.get(cid, []))
+    if set(times) - set(topics):
+        return None
+    return {t: (len(v), min(v, default=0), max(v, default=0)) for t, v in out.items()}
+
+
+def ros1_index_evidence(path: Path, truth: Outcome) -> str:
+    """'' unless the bag's records, read one by one, hold exactly the undamaged file's
+    messages (topics, counts, first and last times): then the damage is in the index only,
+    and an answer that differs from the undamaged file's was read from a damaged index."""
+    if not truth.ok:
+        return ""
+    walked = ros1_record_summary(path)
+    want = {t: (n, a or 0, b or 0) for t, (_ty, n, a, b) in truth.value.items()}
+    if walked is not None and walked == want:
+        return "the records, read one by one, are the undamaged file's: only the index is damaged"
+    # or the other way round: rosbags' own index counts are the undamaged file's while the
+    # records it reads through that index say otherwise (a damaged record header)
+    try:
+        from rosbags.highlevel import AnyReader
+
+        with AnyReader([path]) as reader:
+            indexed: dict[str, int] = {}
+            for c in reader.connections:
+                indexed[c.topic] = indexed.get(c.topic, 0) + c.msgcount
+            read: dict[str, int] = {}
+            for c, _t, _raw in reader.messages():
+                read[c.topic] = read.get(c.topic, 0) + 1
+    except Exception:
+        return ""
+    counts = {t: n for t, (_ty, n, _a, _b) in truth.value.items()}
+    if indexed == counts and {t: read.get(t, 0) for t in counts} != counts:
+        return (
+            "rosbags' own index counts are the undamaged file's, the records it reads "
+            "through them are not: a damaged record header"
+        )
+    return ""
+
+
 # judging ------------------------------------------------------------------------------------
 
 
@@ -343,6 +482,21 @@ def judge_part(
         f"official failed ({off.why}); ertools answered {_show(ert.value)}, "
         "not in the undamaged file",
     )
+
+
+def misread(
+    part: str, verdict: tuple[str, str], ert: Outcome | str, truth: Outcome, evidence: str
+) -> tuple[str, str]:
+    """A ``disagree`` turned ``misread`` when ``evidence`` (:func:`mcap_crc_evidence`) shows
+    the official reader read damaged bytes and ertools' answer is exactly the undamaged
+    file's (``truth``); every other verdict as it was."""
+    v, detail = verdict
+    if v != "disagree" or not evidence or isinstance(ert, str) or not ert.ok or not truth.ok:
+        return verdict
+    same = ert.value == truth.value if part == "summary" else _same_rows(ert.value, truth.value)
+    if not same:
+        return verdict
+    return "misread", f"official reader read damaged bytes ({evidence}): {detail}"
 
 
 def _show(value: Any) -> str:

@@ -49,7 +49,17 @@ def run_case(seed: int, index: int, workdir: Path, keep: Path | None = None) -> 
     """Mutate, read with both readers, judge. Returns the verdict record of the case."""
     import numpy as np
 
-    from fuzz.judge import PARTS, cli_check, ertools_answer, judge_part, official_answer, worst
+    from fuzz.judge import (
+        PARTS,
+        cli_check,
+        ertools_answer,
+        judge_part,
+        mcap_crc_evidence,
+        misread,
+        official_answer,
+        ros1_index_evidence,
+        worst,
+    )
     from fuzz.mutate import mutate
     from fuzz.seeds import seed_bytes, suffix
 
@@ -75,6 +85,14 @@ def run_case(seed: int, index: int, workdir: Path, keep: Path | None = None) -> 
         parts = {
             p: judge_part(p, ert[p], off[p], [truth[p], *(a[p] for a in alone)]) for p in PARTS
         }
+    if any(v == "disagree" for v, _ in parts.values()):
+        # the official reader read damaged bytes as sound (an MCAP CRC fails; a ROS1 index
+        # contradicts the bag's intact records) and ertools gave the undamaged answer
+        if name.startswith("mcap"):
+            evidence = mcap_crc_evidence(path)
+        else:
+            evidence = ros1_index_evidence(path, truth["summary"])
+        parts = {p: misread(p, parts[p], ert[p], truth[p], evidence) for p in PARTS}
     verdict = worst([v for v, _ in parts.values()])
     owner = ""
     if verdict == "disagree":
@@ -289,7 +307,9 @@ def summary_line(results: list[dict[str, Any]], seed: int) -> str:
     return (
         f"fuzz: {len(results)} cases, {c['agree'] + c['salvaged']} agreements "
         f"({c['salvaged']} partial reads of files the official reader refuses), "
-        f"{c['refused']} clear refusals, {c['disagree']} disagreements, "
+        f"{c['refused']} clear refusals, {c['misread']} official misreads (damaged bytes the "
+        f"official reader took as sound, ertools the undamaged answer), "
+        f"{c['disagree']} disagreements, "
         f"{c['traceback']} tracebacks, {c['hang']} hangs (seed {seed})"
     )
 
@@ -312,7 +332,7 @@ def main(argv: list[str] | None = None) -> int:
         with tempfile.TemporaryDirectory(prefix="ertools-fuzz-") as tmp:
             rec = run_case(args.seed, args.case, Path(tmp), args.keep)
         print(json.dumps(rec, indent=2))
-        return 0 if rec["verdict"] in ("agree", "salvaged", "refused") else 1
+        return 0 if rec["verdict"] in ("agree", "salvaged", "refused", "misread") else 1
     print(f"fuzz: {args.cases} cases, seed {args.seed}, {args.jobs} workers", file=sys.stderr)
     t0 = time.monotonic()
     results = run_cases(args.seed, list(range(args.cases)), args.jobs, args.timeout, True)
@@ -328,7 +348,7 @@ def main(argv: list[str] | None = None) -> int:
     for name in SEED_NAMES:
         row = ", ".join(
             f"{v} {by_seed[(name, v)]}"
-            for v in ("agree", "salvaged", "refused", "disagree", "traceback")
+            for v in ("agree", "salvaged", "refused", "misread", "disagree", "traceback")
             if by_seed[(name, v)]
         )
         print(f"  {name}: {row}", file=sys.stderr)

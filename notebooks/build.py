@@ -362,7 +362,7 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ),
         (
             "code",
-            "from ertools.audit.rescore import DEFAULT_ABS_TOL, compare_scores\n"
+            "from ertools.audit.compare import DEFAULT_ABS_TOL, compare_scores\n"
             "from ertools.benchmarks.fbm1.benchmark import Fbm1Options, score_fbm1_bag\n\n"
             "as_2015 = score_fbm1_bag(paths, items_path, options=Fbm1Options.as_2015('fbm1h'),\n"
             "                         results_path=results_path)\n"
@@ -401,7 +401,8 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ),
         (
             "code",
-            "from ertools.benchmarks.trajectory.benchmark import TrajectoryConfig, score\n\n"
+            "from ertools.benchmarks.trajectory.benchmark import score\n"
+            "from ertools.benchmarks.trajectory.config import TrajectoryConfig\n\n"
             "robot_path = Path(robot_bag)\n"
             "gt_paths = [Path(gt)] if isinstance(gt, str) else [Path(g) for g in gt]\n"
             + LOAD_ANSWERS

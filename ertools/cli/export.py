@@ -158,7 +158,7 @@ def _run_one(args: argparse.Namespace) -> int:
 
 
 def _run_pair(args: argparse.Namespace) -> int:
-    from ertools.benchmarks.trajectory.benchmark import TrajectoryConfig
+    from ertools.benchmarks.trajectory.config import TrajectoryConfig
     from ertools.cli.common import note
     from ertools.cli.options import time_source
     from ertools.errors import UsageError

@@ -132,7 +132,8 @@ def _one_line(text: str) -> str:
 def run(args: argparse.Namespace) -> int:
     from ertools.cli.common import dump_json, note, write_text
     from ertools.errors import BagError
-    from ertools.io.info import describe, expand
+    from ertools.io.formats import expand
+    from ertools.io.info import describe
     from ertools.progress import reporting
 
     infos: list[BagInfo] = []

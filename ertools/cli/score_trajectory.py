@@ -49,7 +49,7 @@ def _positive(text: str) -> float:
 
 
 def _2015_options() -> str:
-    from ertools.benchmarks.trajectory.benchmark import SETTINGS_2015
+    from ertools.benchmarks.trajectory.config import SETTINGS_2015
 
     return " ".join(f"--{k.replace('_', '-')} {v}" for k, v in SETTINGS_2015.items())
 
@@ -150,7 +150,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ertools.benchmarks.base import BenchmarkResult
-    from ertools.benchmarks.trajectory.benchmark import SETTINGS_2015, TrajectoryConfig, score
+    from ertools.benchmarks.trajectory.benchmark import score
+    from ertools.benchmarks.trajectory.config import SETTINGS_2015, TrajectoryConfig
     from ertools.cli.common import emit_result
     from ertools.errors import UsageError
     from ertools.timeutil import s_to_ns

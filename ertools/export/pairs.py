@@ -32,7 +32,8 @@ from ertools.streams import PoseStream
 
 if TYPE_CHECKING:
     from ertools.benchmarks.common.sources import PoseSpec
-    from ertools.benchmarks.trajectory.benchmark import TrajectoryConfig, TrajectoryResult
+    from ertools.benchmarks.trajectory.config import TrajectoryConfig
+    from ertools.benchmarks.trajectory.result import TrajectoryResult
 
 # GT read around the robot poses for the raw pair: evo's association only looks a few
 # max_diff (0.01 s by default) beyond the robot's span; a second covers any sensible setting.
@@ -94,13 +95,10 @@ def trajectory_pair(
     Raises:
         ScoringError: ``matched`` and no pose could be compared; the errors of ``score``.
     """
-    from ertools.benchmarks.trajectory.benchmark import (
-        COMPARED,
-        drop_duplicates,
-        drop_invalid,
-        read_gt,
-        score,
-    )
+    from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid
+    from ertools.benchmarks.trajectory.association import COMPARED
+    from ertools.benchmarks.trajectory.benchmark import score
+    from ertools.benchmarks.trajectory.inputs import read_gt
 
     result = score(
         robot_bag,

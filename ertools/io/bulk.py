@@ -174,7 +174,8 @@ def _ros1_runs(
     from ertools.io.ros1.index import Ros1Bag
 
     assert isinstance(bag, Ros1Bag)
-    touched, chunk_of, _rank, t_of, off_of = bag.select(conns, lo, hi)
+    touched, chunk_of, rank_of, t_of, off_of = bag.select(conns, lo, hi)
+    conn_of = np.array([c.id for c in conns], dtype=np.int64)[rank_of]
 
     groups = dict(group_positions(chunk_of))
     sparse = _sparse_chunks(bag, touched, groups)
@@ -214,7 +215,10 @@ def _ros1_runs(
         offsets = off_of[sel]
         if np.any(offsets + 8 > sizes[which]):
             raise BagError(f"index points outside its chunk {where}")
-        start, length = bag.spans(buf, offsets + base[which], where)
+        # each record checked to carry its index entry's time and connection
+        start, length = bag.checked_spans(
+            buf, offsets + base[which], t_of[sel], conn_of[sel], where
+        )
         if np.any(start + length > base[which] + sizes[which]):
             raise BagError(f"message record runs past the end of its chunk {where}")
         return sel, buf, start, length, t_of[sel]

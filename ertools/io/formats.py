@@ -1,17 +1,96 @@
-"""Format detection: ROS1 bag (indexed or ``.active``), rosbag2 directory, standalone MCAP.
+"""What is a bag: finding bags under paths, and format detection (ROS1 bag, indexed or
+``.active``; rosbag2 directory; standalone MCAP).
 
-Detection reads the first bytes (magic) and, for directories, ``metadata.yaml``; the file name
-is only used to tell a still-recording ``.bag.active`` from a closed bag.
+Finding goes by name (``.bag``, ``.bag.active``, ``.mcap`` files; a folder with
+``metadata.yaml`` or ``*.db3`` files is one rosbag2 bag); detection reads the first bytes
+(magic) and, for directories, ``metadata.yaml``; the file name is only used to tell a
+still-recording ``.bag.active`` from a closed bag.
 """
 
 from __future__ import annotations
 
+import os
+from collections.abc import Iterable
+from dataclasses import dataclass
 from pathlib import Path
 
 from ertools.errors import BagError
 
 ROS1_MAGIC = b"#ROSBAG V2.0\n"
 MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+BAG_SUFFIXES = (".bag", ".bag.active", ".mcap")
+NO_BAGS = "directory holds no bags (.bag, .bag.active, .mcap or rosbag2 folders)"
+
+
+@dataclass(frozen=True)
+class Unreadable:
+    """A path that gave no bag, or could not be summarised, with the one-line reason."""
+
+    path: str
+    problem: str
+
+
+@dataclass(frozen=True)
+class Found:
+    """Bags found under the given paths (sorted), and paths that gave none."""
+
+    bags: tuple[Path, ...]
+    problems: tuple[Unreadable, ...]
+
+
+def is_rosbag2_dir(path: Path) -> bool:
+    """A folder that is one rosbag2 bag: it holds ``metadata.yaml`` or sqlite3 storage files."""
+    return (path / "metadata.yaml").is_file() or any(path.glob("*.db3"))
+
+
+def find_bags(paths: Iterable[Path]) -> Found:
+    """Bags under ``paths``: ``.bag``, ``.bag.active``, ``.mcap`` files and rosbag2 folders.
+
+    A file named explicitly is taken whatever its name (the reader then says whether it is a
+    bag); directories are walked recursively, and a rosbag2 folder counts as one bag. A path
+    that does not exist, or a folder with no bag, is a problem, not an error: the caller
+    decides.
+    """
+    bags: list[Path] = []
+    problems: list[Unreadable] = []
+    for root in paths:
+        if not root.exists():
+            problems.append(Unreadable(str(root), "no such file or directory"))
+            continue
+        if root.is_file() or is_rosbag2_dir(root):
+            bags.append(root)
+            continue
+        before = len(bags)
+        for dirpath, dirnames, filenames in os.walk(root):
+            here = Path(dirpath)
+            keep = []
+            for d in sorted(dirnames):
+                if is_rosbag2_dir(here / d):
+                    bags.append(here / d)
+                else:
+                    keep.append(d)
+            dirnames[:] = keep  # do not descend into rosbag2 folders
+            bags.extend(here / f for f in sorted(filenames) if f.endswith(BAG_SUFFIXES))
+        if len(bags) == before:
+            problems.append(Unreadable(str(root), NO_BAGS))
+    unique = sorted(dict.fromkeys(bags), key=str)
+    return Found(tuple(unique), tuple(problems))
+
+
+def expand(paths: Iterable[Path]) -> list[Path]:
+    """Files and rosbag2 folders as given; other folders replaced by the bags inside.
+
+    Raises:
+        BagError: a path is missing, or a folder holds no bag.
+    """
+    out: list[Path] = []
+    for p in paths:
+        found = find_bags([p])
+        if found.problems:
+            raise BagError(found.problems[0].problem, path=p)
+        out.extend(found.bags)
+    return out
 
 
 def bag_paths(paths: str | Path | list[str | Path] | tuple[str | Path, ...]) -> list[Path]:

@@ -24,8 +24,6 @@ from ertools.timeutil import iso_utc, ns_to_s
 if TYPE_CHECKING:
     from ertools.progress import Reporter
 
-BAG_SUFFIXES = (".bag", ".mcap", ".active")
-
 # A median rate is stated only with at least 10 messages (9 intervals: the median is then not
 # decided by one or two intervals) over at least 1 s (a topic seen for less than a second, or
 # a burst such as four /rosout lines written 0.2 s apart, has no publishing rate to state: its
@@ -105,44 +103,6 @@ def median_rate(t_ns: np.ndarray[Any, np.dtype[np.int64]]) -> float | None:
         return None
     dt = float(np.median(np.diff(t_ns)))
     return 1e9 / dt if dt > 0 else None
-
-
-def find_bags(folder: Path) -> list[Path]:
-    """Bags under a folder (not itself a rosbag2 bag), walked recursively, sorted."""
-    out: list[Path] = []
-    rosbag2_dirs: set[Path] = set()
-    for p in sorted(folder.rglob("*")):
-        if any(parent in rosbag2_dirs for parent in p.parents):
-            continue  # a storage file inside a rosbag2 folder already listed
-        if p.is_dir() and (p / "metadata.yaml").is_file():
-            rosbag2_dirs.add(p)
-            out.append(p)
-        elif p.is_file() and p.name.endswith((".bag", ".bag.active", ".mcap")):
-            out.append(p)
-    return out
-
-
-def expand(paths: list[Path]) -> list[Path]:
-    """Files and rosbag2 directories as given; other directories replaced by the bags inside.
-
-    Raises:
-        BagError: a path is missing, or a directory holds no bag.
-    """
-    out: list[Path] = []
-    for p in paths:
-        if not p.exists():
-            raise BagError("no such file or directory", path=p)
-        if p.is_dir() and not (p / "metadata.yaml").is_file():
-            found = find_bags(p)
-            if not found:
-                raise BagError(
-                    "directory holds no bags (.bag, .bag.active, .mcap or rosbag2 folders)",
-                    path=p,
-                )
-            out.extend(found)
-        else:
-            out.append(p)
-    return out
 
 
 def describe(path: str | Path, *, check: bool = False, progress: Reporter | None = None) -> BagInfo:

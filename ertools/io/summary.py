@@ -241,6 +241,8 @@ def _mcap_indexed(
         stats = None
     read_indexes = exact or stats is None
     counts: dict[int, int] = {} if read_indexes else dict(stats.channel_message_counts)
+    # channel -> time -> (chunk, record offset) of its earliest and latest index entries
+    ends: dict[int, dict[int, tuple[Any, int]]] = {}
     with path.open("rb") as f:
         for chunk in summary.chunk_indexes:
             compressions.add(chunk.compression or "none")
@@ -252,13 +254,21 @@ def _mcap_indexed(
                         path=path,
                     )
                 if read_indexes:
-                    t, _ = McapIndex._message_index(f, path, offset, cid)
+                    t, off = McapIndex._message_index(f, path, offset, cid)
                     if times is not None:
                         times.setdefault(layout.channels[cid].topic, []).append(t)
                     counts[cid] = counts.get(cid, 0) + len(t)
                     if not len(t):
                         continue
                     lo, hi = int(t.min()), int(t.max())
+                    for when, at in ((lo, int(off[t.argmin()])), (hi, int(off[t.argmax()]))):
+                        e = ends.setdefault(cid, {})
+                        if when not in e:
+                            e[when] = (chunk, at)
+                    # only the earliest and latest entries are kept
+                    e = ends[cid]
+                    if len(e) > 2:
+                        ends[cid] = {k: e[k] for k in (min(e), max(e))}
                     if lo < chunk.message_start_time or hi > chunk.message_end_time:
                         # a damaged index entry: its time is outside its own chunk's span
                         raise BagError(
@@ -270,6 +280,7 @@ def _mcap_indexed(
                     lo, hi = int(chunk.message_start_time), int(chunk.message_end_time)
                 s = spans.setdefault(cid, [lo, hi])
                 s[0], s[1] = min(s[0], lo), max(s[1], hi)
+    _check_ends(path, ends)
     problems = []
     if read_indexes and recorded is not None and recorded.message_count != sum(counts.values()):
         problems.append(
@@ -289,6 +300,39 @@ def _mcap_indexed(
         )
     index = "summary+message-indexes" if read_indexes and summary.chunk_indexes else "summary"
     return topics, compressions, problems, index
+
+
+def _check_ends(path: Path, ends: dict[int, dict[int, tuple[Any, int]]]) -> None:
+    """The records the message indexes give as each channel's first and last message are
+    that channel's messages at those log times: a damaged index entry elsewhere leaves
+    counts, first and last times as they were, but one that became a first or last time
+    would be reported as the topic's span. Reads the few chunks holding them (each checked
+    against its CRC), not the file.
+
+    Raises:
+        BagError: an index entry and its record disagree.
+    """
+    import struct
+
+    from ertools.io.mcap.index import McapIndex
+
+    chunks: dict[int, bytes] = {}
+    for cid, found in ends.items():
+        for when, (chunk, at) in found.items():
+            key = int(chunk.chunk_start_offset)
+            if key not in chunks:
+                chunks[key] = McapIndex.inflated_bytes(path, chunk)
+            buf = chunks[key]
+            ok = at >= 0 and at + 23 <= len(buf) and buf[at] == 0x05
+            if ok:
+                channel, _seq, log_time = struct.unpack_from("<HIQ", buf, at + 9)
+                ok = channel == cid and log_time == when
+            if not ok:
+                raise BagError(
+                    f"message index of channel {cid} disagrees with the record it points at "
+                    f"(chunk at byte {key}, offset {at}): damaged index or chunk",
+                    path=path,
+                )
 
 
 def _mcap_file(

@@ -12,7 +12,7 @@
 - ``result.json``: the metadata ``ertools report`` combines (benchmark, team, inputs, the
   headline numbers and the whole score).
 
-An :class:`~ertools.audit.analyse.Audit` is accepted as well: its recomputed score (when there
+An :class:`~ertools.audit.model.Audit` is accepted as well: its recomputed score (when there
 is one) becomes the score of the folder, and ``audit.yaml``/``audit.json`` are added.
 """
 
@@ -98,7 +98,7 @@ def write_report(
     """Write the report folder of ``result`` into ``outdir``; returns the ``index.html`` path.
 
     Args:
-        result: any benchmark result, or an :class:`ertools.audit.analyse.Audit`.
+        result: any benchmark result, or an :class:`ertools.audit.model.Audit`.
         outdir: the folder (created; files of the same names are overwritten).
         inputs: the bags the result was computed from (hashed, not modified).
         argv: the command line (shown; file arguments that are not inputs are the configs).
@@ -127,7 +127,7 @@ def _write_report(
     audit: Any,
     team: str | None,
 ) -> Path:
-    from ertools.audit.analyse import Audit
+    from ertools.audit.model import Audit
 
     score: BenchmarkResult | None
     if isinstance(result, Audit):

@@ -1,7 +1,7 @@
 """The audit's figure: the three state machines over time, one lane each.
 
 Drawing only (an ``Axes`` in, nothing global); the data comes from
-:class:`ertools.audit.analyse.Audit`.
+:class:`ertools.audit.model.Audit`.
 """
 
 from __future__ import annotations

@@ -13,12 +13,12 @@ from ertools.report import units
 from ertools.report.figures import FigureSpec
 
 if TYPE_CHECKING:
-    from ertools.benchmarks.trajectory.benchmark import TrajectoryResult
+    from ertools.benchmarks.trajectory.result import TrajectoryResult
 
 
 def draw_error_over_time(ax: Any, result: TrajectoryResult) -> None:
     """Position error (mm) per robot pose; gaps and tracking losses marked on the time axis."""
-    from ertools.benchmarks.trajectory.benchmark import GAP, TRACKING_LOST, UNCOVERED
+    from ertools.benchmarks.trajectory.association import GAP, TRACKING_LOST, UNCOVERED
 
     m = result.matched
     if len(m.t_ns) == 0:

@@ -1,5 +1,9 @@
 """``python -m ertools.samples OUTDIR [--only NAME...] [--seed N]``: write the sample logs.
 
+``python -m ertools.samples --competition DIR [--seed N]`` writes the sample competition
+instead (:mod:`ertools.samples.competition`): one day of logs at one venue and its
+``answers.json``; DIR is replaced as a whole, like a scenario folder.
+
 Every registered scenario (:data:`ertools.samples.scenario.SCENARIOS`) is generated into
 ``OUTDIR/<name>/``, which is replaced as a whole (built in ``OUTDIR/.<name>.partial`` first,
 so a failure leaves the old folder in place). Without ``--seed`` each scenario uses its fixed
@@ -66,12 +70,26 @@ def main(argv: Sequence[str] | None = None) -> int:
         description="Write simulated 2015 benchmark logs with their answers.",
         epilog="example: python -m ertools.samples sample_bags --only stationary fbm3w",
     )
-    parser.add_argument("outdir", type=Path, help="folder to write into (OUTDIR/<scenario>/)")
+    parser.add_argument(
+        "outdir", type=Path, nargs="?", help="folder to write into (OUTDIR/<scenario>/)"
+    )
+    parser.add_argument(
+        "--competition",
+        type=Path,
+        metavar="DIR",
+        help="write the sample competition (a day of logs at one venue) into DIR instead",
+    )
     parser.add_argument(
         "--only", nargs="+", metavar="NAME", choices=list(SCENARIOS), help="scenarios to write"
     )
     parser.add_argument("--seed", type=int, help="one seed for all (default: fixed per scenario)")
     args = parser.parse_args(argv)
+    if args.competition is not None:
+        if args.outdir is not None or args.only:
+            parser.error("--competition DIR takes no OUTDIR and no --only")
+        return _competition(args.competition, args.seed)
+    if args.outdir is None:
+        parser.error("give OUTDIR (or --competition DIR)")
     names = list(args.only) if args.only else list(SCENARIOS)
     try:
         written = generate(args.outdir, names, args.seed)
@@ -83,6 +101,21 @@ def main(argv: Sequence[str] | None = None) -> int:
             size = _size(path)
             flag = "  (over the size budget)" if size > SIZE_BUDGET_BYTES else ""
             print(f"{name}\t{size:>10,d}\t{path}{flag}")
+    return 0
+
+
+def _competition(outdir: Path, seed: int | None) -> int:
+    from ertools.samples.competition import DEFAULT_SEED, generate_competition
+
+    partial = outdir.with_name(f".{outdir.name}.partial")
+    if partial.exists():
+        shutil.rmtree(partial)
+    paths = generate_competition(partial, seed=DEFAULT_SEED if seed is None else seed)
+    if outdir.exists():
+        shutil.rmtree(outdir)
+    partial.rename(outdir)
+    total = sum((outdir / p.relative_to(partial)).stat().st_size for p in paths)
+    print(f"competition\t{total:>10,d}\t{outdir}\t({len(paths)} files)")
     return 0
 
 

@@ -51,6 +51,7 @@ from ertools.samples.mocap import (
     simulate_mocap,
 )
 from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
+from ertools.samples.simulated import SimulatedRun
 from ertools.samples.statemachine import Transition, publish_states
 from ertools.samples.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, RefBoxState
@@ -61,6 +62,8 @@ S = 1_000_000_000
 MS = 1_000_000
 
 NAMESPACE = "fbm1h"
+ITEMS_FILE = "fbm1h.yaml"
+NOON_NS = EPOCH_2015 + 2 * 3600 * S
 SIGMA_M = 2.0e-4
 SIGMA_RAD = 5.0e-4
 RUNS = 10
@@ -116,7 +119,7 @@ def _wrap_deg(a: float) -> float:
     return (a + 180.0) % 360.0 - 180.0
 
 
-def _item_list(rng: np.random.Generator) -> list[dict[str, Any]]:
+def item_list(rng: np.random.Generator) -> list[dict[str, Any]]:
     """Listing 9 items: transforms like the 2015 list (a few cm, rotated about z, tiny tilt)."""
     out = []
     for k, (cls, inst) in enumerate(ITEMS):
@@ -140,15 +143,23 @@ def _board_poses(rng: np.random.Generator) -> list[tuple[F64, float]]:
     return out
 
 
-def generate(outdir: Path, *, seed: int) -> list[Path]:
-    """Write the FBM1@Home log, its item list and its answers into ``outdir``."""
+def simulate(
+    seed: int,
+    *,
+    start_ns: int = NOON_NS,
+    answer_errors: tuple[tuple[bool, bool, float, float, float], ...] = ANSWER_ERRORS,
+    items: list[dict[str, Any]] | None = None,
+) -> SimulatedRun:
+    """One FBM1@Home execution whose recorder starts at ``start_ns`` (module docstring);
+    ``answer_errors`` (one per run but the last) are the robot's mistakes; ``items`` the
+    item list of a whole competition (default: drawn from ``seed``)."""
     rng = np.random.default_rng(seed)
-    items = _item_list(rng)
+    items = item_list(rng) if items is None else items
     order = [int(i) + 1 for i in rng.permutation(len(ITEMS))[:RUNS]]
     boards = _board_poses(rng)
     answer_ms = rng.integers(400, 800, size=RUNS)  # the robot's thinking time, ms
 
-    start = EPOCH_2015 + 2 * 3600 * S
+    start = start_ns
     t0 = start + 500 * MS
     table_rot = Rotation.from_euler("xyz", TABLE_RPY)
     T_wt = _matrix(TABLE_XYZ, table_rot)
@@ -247,7 +258,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
             ]
             exp.update(class_correct=False, instance_correct=False, pose_score=0.0)
         else:
-            cls_ok, inst_ok, dx, dy, dth = ANSWER_ERRORS[k]
+            cls_ok, inst_ok, dx, dy, dth = answer_errors[k]
             other = items[order[(k + 1) % RUNS] - 1]
             a_cls = (
                 item["class"]
@@ -335,32 +346,24 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         tt_all, np.concatenate(board_xyz), np.concatenate(board_quat), rng=rng, noise=noise
     )
 
-    bag_path = outdir / log_name(NAMESPACE, start)
     end = t_score + 500 * MS
-    with BagWriter(bag_path, "ros1") as bag:
-        publish_mocap(bag, NAMESPACE, "origin", table_pub)
-        publish_mocap(bag, NAMESPACE, "ref_board", board_pub)
-        publish_states(bag, NAMESPACE, tr, end_ns=end)
-        publish_environment(
-            bag, NAMESPACE, start, end, bag_name=bag_path.name, bodies=["origin", "ref_board"]
-        )
-
-    items_path = outdir / "fbm1h.yaml"
-    items_path.write_text(
-        yaml.safe_dump({"items": items}, sort_keys=False, default_flow_style=None, width=100),
-        encoding="utf-8",
+    items_text = yaml.safe_dump(
+        {"items": items}, sort_keys=False, default_flow_style=None, width=100
     )
-
-    answers = write_answers(
-        bag_path,
+    return SimulatedRun(
         benchmark=NAMESPACE,
-        scenario="fbm1h",
-        seed=seed,
+        namespace=NAMESPACE,
+        start_ns=start,
+        end_ns=end,
+        transitions=tuple(tr),
+        state_end_ns=end,
+        bodies={"origin": table_pub, "ref_board": board_pub},
+        configs={ITEMS_FILE: items_text},
         parameters={
             "namespace": NAMESPACE,
             "origin_topic": pose_topic(NAMESPACE, "origin"),
             "ref_board_topic": pose_topic(NAMESPACE, "ref_board"),
-            "items": items_path.name,
+            "items": ITEMS_FILE,
             "sigma_m": SIGMA_M,
             "sigma_rad": SIGMA_RAD,
             "runs": RUNS,
@@ -383,5 +386,35 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
             "execution_time": tol(1e-6, "transition times are exact in the state topics"),
             "accuracy": tol(0, "counts are exact"),
         },
+    )
+
+
+def generate(outdir: Path, *, seed: int) -> list[Path]:
+    """Write the FBM1@Home log, its item list and its answers into ``outdir``."""
+    sim = simulate(seed)
+    bag_path = outdir / log_name(NAMESPACE, sim.start_ns)
+    with BagWriter(bag_path, "ros1") as bag:
+        for body, pub in sim.bodies.items():
+            publish_mocap(bag, NAMESPACE, body, pub)
+        publish_states(bag, NAMESPACE, sim.transitions, end_ns=sim.state_end_ns)
+        publish_environment(
+            bag,
+            NAMESPACE,
+            sim.start_ns,
+            sim.end_ns,
+            bag_name=bag_path.name,
+            bodies=list(sim.bodies),
+        )
+    items_path = outdir / ITEMS_FILE
+    items_path.write_text(sim.configs[ITEMS_FILE], encoding="utf-8")
+    answers = write_answers(
+        bag_path,
+        benchmark=NAMESPACE,
+        scenario="fbm1h",
+        seed=seed,
+        parameters=sim.parameters,
+        truth=sim.truth,
+        expected=sim.expected,
+        tolerance=sim.tolerance,
     )
     return [bag_path, items_path, answers]

@@ -56,6 +56,7 @@ from ertools.samples.mocap import (
     simulate_mocap,
 )
 from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
+from ertools.samples.simulated import SimulatedRun
 from ertools.samples.statemachine import Transition, publish_states
 from ertools.samples.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, RefBoxState
@@ -67,6 +68,7 @@ S = 1_000_000_000
 NAMESPACE = "fbm2h"
 BODY = "robot_at_home"
 TEAM = "simbot"
+NOON_NS = EPOCH_2015 + 2 * 3600 * S  # noon of the competition day
 SIGMA_M = 2.0e-4
 SIGMA_RAD = 5.0e-4
 STARTING_POSE = (0.0, 0.0, 0.0)
@@ -154,12 +156,12 @@ def _payload_yaml() -> str:
     )
 
 
-def _transform_yaml(t: F64, q: F64, t_inv: F64, q_inv: F64, stamp: str) -> str:
+def _transform_yaml(team: str, t: F64, q: F64, t_inv: F64, q_inv: F64, stamp: str) -> str:
     def flow(v: F64) -> str:
         return "[" + ", ".join(repr(float(x)) for x in v) + "]"
 
     return (
-        f"robot_info: {TEAM}\n"
+        f"robot_info: {team}\n"
         f"transform_timestamp: {stamp}\n"
         f"marker_to_robot_transform:\n- {flow(t)}\n- {flow(q)}\n"
         f"robot_to_marker_transform:\n- {flow(t_inv)}\n- {flow(q_inv)}\n"
@@ -247,17 +249,30 @@ def _live_score(
     }
 
 
-def generate(outdir: Path, *, seed: int) -> list[Path]:
-    """Write the FBM2@Home log, its configs, timing file and answers into ``outdir``."""
+def simulate(
+    seed: int,
+    *,
+    start_ns: int = NOON_NS,
+    team: str = TEAM,
+    stop_errors: tuple[tuple[float, float, float], ...] = STOP_ERRORS,
+    marker_to_robot_t: tuple[float, float, float] = MARKER_TO_ROBOT_T,
+    marker_to_robot_rpy: tuple[float, float, float] = MARKER_TO_ROBOT_RPY,
+    transform_stamp: str = "2015-11-20_11:50:00",
+) -> SimulatedRun:
+    """One FBM2@Home execution whose recorder starts at ``start_ns`` (see the module docstring).
+
+    ``team`` names the transform file; ``stop_errors`` (dx, dy, dyaw per waypoint) and the
+    marker mount make one team's run differ from another's.
+    """
     rng = np.random.default_rng(seed)
-    start = EPOCH_2015 + 2 * 3600 * S  # noon of the competition day
+    start = start_ns
     t_mocap0 = start + S // 2
     t0 = start + S  # BmBox START
 
     # -- the timeline: transitions and the robot's stop poses
     stops = [
         (w[0] + e[0], w[1] + e[1], float(_wrap(w[2] + e[2])))
-        for w, e in zip(WAYPOINTS, STOP_ERRORS, strict=True)
+        for w, e in zip(WAYPOINTS, stop_errors, strict=True)
     ]
     tr: list[Transition] = [
         Transition(t0, Machine.BMBOX, BmBoxState.START),
@@ -320,8 +335,8 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     robot_rot = Rotation.from_euler("z", pose[:, 2:3])
     robot_xyz = np.column_stack([pose[:, :2], np.zeros(frames.size)])
     # T_world_marker = T_world_robot * T_robot_marker, T_robot_marker = inv(T_marker_robot).
-    m2r_t = np.asarray(MARKER_TO_ROBOT_T)
-    m2r_rot = Rotation.from_euler("xyz", MARKER_TO_ROBOT_RPY)
+    m2r_t = np.asarray(marker_to_robot_t)
+    m2r_rot = Rotation.from_euler("xyz", marker_to_robot_rpy)
     r2m_rot = m2r_rot.inv()
     r2m_t = -r2m_rot.apply(m2r_t)
     marker_xyz = robot_xyz + robot_rot.apply(r2m_t)
@@ -349,36 +364,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         Transition(t_score + 350_000_000, Machine.REFBOX, RefBoxState.END),
         Transition(t_score + 400_000_000, Machine.CLIENT, ClientState.END),
     ]
-
-    bag_path = outdir / log_name(f"{NAMESPACE}_mocap", start)
-    with BagWriter(bag_path, "ros1") as bag:
-        publish_mocap(bag, NAMESPACE, BODY, pub)
-        publish_states(bag, NAMESPACE, tr)
-        publish_environment(
-            bag,
-            NAMESPACE,
-            start,
-            int(pub.t_record_ns[-1]) + 50_000_000,
-            bag_name=bag_path.name,
-            bodies=[BODY],
-        )
     bag_first_ns = start  # the recorder's first /rosout line is its first message
-
-    goal_path = outdir / "fbm2h_goal.yaml"
-    goal_path.write_text(_goal_yaml(), encoding="utf-8")
-    transform_path = outdir / f"transform-{TEAM}.yaml"
-    transform_path.write_text(
-        _transform_yaml(m2r_t, m2r_rot.as_quat(), r2m_t, r2m_rot.as_quat(), "2015-11-20_11:50:00"),
-        encoding="utf-8",
-    )
-    stem = bag_path.name.removesuffix(".bag")
-    timing_path = outdir / f"{stem}_reached_waypoint_timing.yaml"
-    moments = [seg_start[0], *seg_end]
-    timing_path.write_text(
-        "reached_waypoint_timing:\n"
-        + "".join(f"- p{i}: {(m - bag_first_ns) / 1e9:.9f}\n" for i, m in enumerate(moments)),
-        encoding="utf-8",
-    )
 
     # -- expected values, from the truth with the formulas of seed 7.2
     target = np.asarray(WAYPOINTS)
@@ -401,29 +387,35 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         }
         for k in range(len(WAYPOINTS))
     ]
-    answers = write_answers(
-        bag_path,
+    return SimulatedRun(
         benchmark="fbm2h",
-        scenario="fbm2h",
-        seed=seed,
+        namespace=NAMESPACE,
+        start_ns=start,
+        end_ns=int(pub.t_record_ns[-1]) + 50_000_000,
+        transitions=tuple(tr),
+        state_end_ns=None,
+        bodies={BODY: pub},
+        configs={
+            "fbm2h_goal.yaml": _goal_yaml(),
+            f"transform-{team}.yaml": _transform_yaml(
+                team, m2r_t, m2r_rot.as_quat(), r2m_t, r2m_rot.as_quat(), transform_stamp
+            ),
+        },
         parameters={
             "namespace": NAMESPACE,
             "body": BODY,
             "topic": pose_topic(NAMESPACE, BODY),
-            "team": TEAM,
+            "team": team,
             "sigma_m": SIGMA_M,
             "sigma_rad": SIGMA_RAD,
-            "marker_to_robot_t": list(MARKER_TO_ROBOT_T),
-            "marker_to_robot_rpy": list(MARKER_TO_ROBOT_RPY),
+            "marker_to_robot_t": list(marker_to_robot_t),
+            "marker_to_robot_rpy": list(marker_to_robot_rpy),
             "tracking_loss": {
                 "segment": seg,
                 "at": loss.t_ns / 1e9,
                 "repeat_frames": reps,
                 "gap_frames": gap,
             },
-            "goal": goal_path.name,
-            "transform": transform_path.name,
-            "timing": timing_path.name,
         },
         truth={
             "bag_first_ns": bag_first_ns,
@@ -461,5 +453,47 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
                 "distance_error, orientation_error) and its times by the node's 3 ms delay",
             ),
         },
+    )
+
+
+def generate(outdir: Path, *, seed: int) -> list[Path]:
+    """Write the FBM2@Home log, its configs, timing file and answers into ``outdir``."""
+    sim = simulate(seed)
+    pub = sim.bodies[BODY]
+    bag_path = outdir / log_name(f"{NAMESPACE}_mocap", sim.start_ns)
+    with BagWriter(bag_path, "ros1") as bag:
+        publish_mocap(bag, NAMESPACE, BODY, pub)
+        publish_states(bag, NAMESPACE, sim.transitions)
+        publish_environment(
+            bag, NAMESPACE, sim.start_ns, sim.end_ns, bag_name=bag_path.name, bodies=[BODY]
+        )
+    goal_path = outdir / "fbm2h_goal.yaml"
+    goal_path.write_text(sim.configs[goal_path.name], encoding="utf-8")
+    transform_path = outdir / f"transform-{TEAM}.yaml"
+    transform_path.write_text(sim.configs[transform_path.name], encoding="utf-8")
+    stem = bag_path.name.removesuffix(".bag")
+    timing_path = outdir / f"{stem}_reached_waypoint_timing.yaml"
+    segs = sim.truth["segments"]
+    moments = [segs[0]["start_ns"], *(s["end_ns"] for s in segs)]
+    first = sim.truth["bag_first_ns"]
+    timing_path.write_text(
+        "reached_waypoint_timing:\n"
+        + "".join(f"- p{i}: {(m - first) / 1e9:.9f}\n" for i, m in enumerate(moments)),
+        encoding="utf-8",
+    )
+    answers = write_answers(
+        bag_path,
+        benchmark="fbm2h",
+        scenario="fbm2h",
+        seed=seed,
+        parameters={
+            **sim.parameters,
+            "goal": goal_path.name,
+            "transform": transform_path.name,
+            "timing": timing_path.name,
+        },
+        truth=sim.truth,
+        expected=sim.expected,
+        tolerance=sim.tolerance,
     )
     return [bag_path, goal_path, transform_path, timing_path, answers]

@@ -53,6 +53,7 @@ from ertools.samples.mocap import (
     simulate_mocap,
 )
 from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
+from ertools.samples.simulated import SimulatedRun
 from ertools.samples.statemachine import Transition, publish_states
 from ertools.samples.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, RefBoxState
@@ -63,6 +64,8 @@ Motion = Callable[[F64], F64]  # time (s from the mocap start) -> (N, 2) world p
 S = 1_000_000_000
 
 NAMESPACE = "fbm3w"
+CONFIG_FILE = "fbm3w.yaml"
+NOON_NS = EPOCH_2015 + 2 * 3600 * S
 BODY = "robot_at_work"
 SIGMA_M = 5.0e-5
 D_MIN = 0.00033  # the 2015 script's D_MIN
@@ -95,9 +98,9 @@ def target(spec: str, l_norm: F64) -> F64:
     return np.column_stack([0.15 * ll, 0.075 * np.sin(12.5 * math.pi * 0.15 * ll)])
 
 
-def deviation(k: int, u: F64) -> F64:
+def deviation(k: int, u: F64, amplitude: tuple[float, ...] = AMPLITUDE) -> F64:
     """The robot's smooth deviation from the target in run k's frame (0 at the start)."""
-    a = AMPLITUDE[k]
+    a = amplitude[k]
     return a * np.column_stack(
         [0.3 * np.sin(2 * math.pi * u), np.sin(math.pi * u / 2) + 0.2 * np.sin(3 * math.pi * u)]
     )
@@ -153,10 +156,13 @@ def eq1(reference: F64, positions: F64, spec: str, d_min: float) -> tuple[float,
     return error_sum / len(kept), len(kept), total
 
 
-def generate(outdir: Path, *, seed: int) -> list[Path]:
-    """Write the FBM3@Work logs (ROS1 and rosbag2-MCAP) and their answers into ``outdir``."""
+def simulate(
+    seed: int, *, start_ns: int = NOON_NS, amplitude: tuple[float, ...] = AMPLITUDE
+) -> SimulatedRun:
+    """One FBM3@Work execution whose recorder starts at ``start_ns`` (module docstring);
+    ``amplitude`` (m, one per run) is how far the robot strays from each path."""
     rng = np.random.default_rng(seed)
-    start = EPOCH_2015 + 2 * 3600 * S
+    start = start_ns
     t0 = start + S // 2  # mocap starts half a second after the recorder
     tr: list[Transition] = []
 
@@ -211,7 +217,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         def path(k: int = k, spec: str = spec, t_a: float = p0, dur: float = path_s) -> Motion:
             def f(t: F64) -> F64:
                 u = min_jerk((t - t_a) / dur)
-                return to_world(k, target(spec, u) + deviation(k, u))
+                return to_world(k, target(spec, u) + deviation(k, u, amplitude))
 
             return f
 
@@ -228,7 +234,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
             status = "timeout"
         else:
             stop = p0 + path_s
-            end_xy = to_world(k, target(spec, np.ones(1)) + deviation(k, np.ones(1)))[0]
+            end_xy = to_world(k, target(spec, np.ones(1)) + deviation(k, np.ones(1), amplitude))[0]
             add(stop + 0.4, Machine.CLIENT, ClientState.COMPLETED_GOAL, "path following completed")
             add(stop + 0.45, Machine.REFBOX, RefBoxState.READY)
             done_ns = add(stop + DONE_AFTER, Machine.BMBOX, BmBoxState.READY)
@@ -250,7 +256,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
                 "reference_xy": ref,
                 "start_xy": start_xy,
                 "theta": theta,
-                "amplitude": AMPLITUDE[k],
+                "amplitude": amplitude[k],
             }
         )
         tau = tau + PATH_AT + path_s + RETURN_AFTER + RETURN_S
@@ -345,22 +351,9 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         for x in tr
     ]
 
-    stem = log_name(f"{NAMESPACE}_mocap", start, suffix="")
-    paths = [outdir / f"{stem}.bag", outdir / f"{stem}_mcap"]
-    for path_out, fmt in zip(paths, ("ros1", "rosbag2-mcap"), strict=True):
-        with BagWriter(path_out, fmt) as bag:  # type: ignore[arg-type]
-            publish_mocap(bag, NAMESPACE, BODY, pub)
-            publish_states(bag, NAMESPACE, tr, end_ns=last_rec)
-            publish_environment(
-                bag, NAMESPACE, start, last_rec, bag_name=path_out.name, bodies=[BODY]
-            )
-
-    # The config the benchmark ran with (seed Listing 14 and the 2015 D_MIN).
-    config = outdir / "fbm3w.yaml"
-    config.write_text(
+    config_text = (
         "# FBM3@Work config of this simulated benchmark (seed Listing 14, 2015 D_MIN)\n"
-        + yaml.safe_dump({"runs_specifications": list(SPECS), "d_min": D_MIN}, sort_keys=False),
-        encoding="utf-8",
+        + yaml.safe_dump({"runs_specifications": list(SPECS), "d_min": D_MIN}, sort_keys=False)
     )
     phases = _still_phases(t, xy)
     eps_formula = SIGMA_M * math.sqrt(math.pi)
@@ -368,11 +361,15 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         for key in ("reference", "start", "end"):
             ns = run[f"{key}_ns"]
             run[f"{key}_s"] = (ns - start) / S  # seconds from the bag's first message
-    answers = write_answers(
-        paths,
-        benchmark="fbm3w",
-        scenario="fbm3w",
-        seed=seed,
+    return SimulatedRun(
+        benchmark=NAMESPACE,
+        namespace=NAMESPACE,
+        start_ns=start,
+        end_ns=last_rec,
+        transitions=tuple(tr),
+        state_end_ns=last_rec,
+        bodies={BODY: pub},
+        configs={CONFIG_FILE: config_text},
         parameters={
             "namespace": NAMESPACE,
             "body": BODY,
@@ -429,6 +426,33 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
                 2.5e-5, "sampling error of the mean over ~2000 stationary pairs (6 std errors)"
             ),
         },
+    )
+
+
+def generate(outdir: Path, *, seed: int) -> list[Path]:
+    """Write the FBM3@Work logs (ROS1 and rosbag2-MCAP) and their answers into ``outdir``."""
+    sim = simulate(seed)
+    stem = log_name(f"{NAMESPACE}_mocap", sim.start_ns, suffix="")
+    paths = [outdir / f"{stem}.bag", outdir / f"{stem}_mcap"]
+    for path_out, fmt in zip(paths, ("ros1", "rosbag2-mcap"), strict=True):
+        with BagWriter(path_out, fmt) as bag:  # type: ignore[arg-type]
+            publish_mocap(bag, NAMESPACE, BODY, sim.bodies[BODY])
+            publish_states(bag, NAMESPACE, sim.transitions, end_ns=sim.state_end_ns)
+            publish_environment(
+                bag, NAMESPACE, sim.start_ns, sim.end_ns, bag_name=path_out.name, bodies=[BODY]
+            )
+    # The config the benchmark ran with (seed Listing 14 and the 2015 D_MIN).
+    config = outdir / CONFIG_FILE
+    config.write_text(sim.configs[CONFIG_FILE], encoding="utf-8")
+    answers = write_answers(
+        paths,
+        benchmark="fbm3w",
+        scenario="fbm3w",
+        seed=seed,
+        parameters=sim.parameters,
+        truth=sim.truth,
+        expected=sim.expected,
+        tolerance=sim.tolerance,
     )
     return [*paths, config, answers]
 

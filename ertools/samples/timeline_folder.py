@@ -92,7 +92,7 @@ def _gt_bag(
     return t
 
 
-def _make_active(path: Path) -> Path:
+def make_active(path: Path) -> Path:
     """Turn a closed ROS1 bag into what ``rosbag record`` leaves while still recording.
 
     rosbag writes the bag header with index_pos 0 and no connection/chunk counts first, and
@@ -248,7 +248,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     ):
         times[rel] = _gt_bag(root / rel, a, b)
         kinds[rel] = "gt"
-    active_path = _make_active(root / gt[3])
+    active_path = make_active(root / gt[3])
     active = str(active_path.relative_to(root))
     times[active] = times.pop(gt[3])
     kinds[active] = kinds.pop(gt[3])

@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any, Literal, Protocol
 
 from ertools.benchmarks.common.teams import parse_robot_log_name
+from ertools.io.formats import Unreadable
 from ertools.timeutil import NS_PER_S, ns_to_s
 
 Kind = Literal["gt", "benchmark", "robot", "other", "unreadable"]
@@ -107,14 +108,6 @@ class SummaryLike(Protocol):
 
     @property
     def problems(self) -> Sequence[str]: ...
-
-
-@dataclass(frozen=True)
-class Unreadable:
-    """A path that could not be summarised, with the one-line reason."""
-
-    path: str
-    problem: str
 
 
 @dataclass(frozen=True)

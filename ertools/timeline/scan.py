@@ -9,17 +9,15 @@ per bag with a windowed read. :func:`scan` returns the pure
 from __future__ import annotations
 
 import logging
-import os
-from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ertools.io.formats import Found, Unreadable, find_bags
 from ertools.timeline.build import (
     ClockCheck,
     Timeline,
     TimelineConfig,
-    Unreadable,
     build_timeline,
     split_name,
 )
@@ -31,7 +29,6 @@ if TYPE_CHECKING:
 
 log = logging.getLogger("ertools.timeline.scan")
 
-BAG_SUFFIXES = (".bag", ".bag.active", ".mcap")
 # Types whose header stamp the clock check compares with the record time, best first: the
 # mocap node's own poses, then tf (whose static transforms may be stamped in the future).
 CLOCK_TYPES = (
@@ -44,56 +41,6 @@ CLOCK_TYPES = (
 )
 CLOCK_WINDOW_NS = NS_PER_S  # the first second of the topic: ~120 mocap messages
 CLOCK_MAX_SAMPLES = 50
-
-
-@dataclass(frozen=True)
-class Found:
-    """Bags found under the given paths (sorted), and paths that gave none."""
-
-    bags: tuple[Path, ...]
-    problems: tuple[Unreadable, ...]
-
-
-def _is_rosbag2_dir(path: Path) -> bool:
-    return (path / "metadata.yaml").is_file() or any(path.glob("*.db3"))
-
-
-def _is_bag_file(name: str) -> bool:
-    return name.endswith(BAG_SUFFIXES)
-
-
-def find_bags(paths: Iterable[Path]) -> Found:
-    """Bags under ``paths``: ``.bag``, ``.bag.active``, ``.mcap`` files and rosbag2 folders.
-
-    A file named explicitly is taken whatever its name (the reader then says whether it is a
-    bag); directories are walked recursively, and a rosbag2 folder counts as one bag.
-    """
-    bags: list[Path] = []
-    problems: list[Unreadable] = []
-    for root in paths:
-        if not root.exists():
-            problems.append(Unreadable(str(root), "no such file or directory"))
-            continue
-        if root.is_file() or _is_rosbag2_dir(root):
-            bags.append(root)
-            continue
-        before = len(bags)
-        for dirpath, dirnames, filenames in os.walk(root):
-            here = Path(dirpath)
-            keep = []
-            for d in sorted(dirnames):
-                if _is_rosbag2_dir(here / d):
-                    bags.append(here / d)
-                else:
-                    keep.append(d)
-            dirnames[:] = keep  # do not descend into rosbag2 folders
-            bags.extend(here / f for f in sorted(filenames) if _is_bag_file(f))
-        if len(bags) == before:
-            problems.append(
-                Unreadable(str(root), "no bags here (.bag, .bag.active, .mcap or rosbag2)")
-            )
-    unique = sorted(dict.fromkeys(bags), key=str)
-    return Found(tuple(unique), tuple(problems))
 
 
 def clock_check(

@@ -9,7 +9,7 @@ from audit_streams import heartbeat
 from fakes import FakeResult
 
 from ertools.audit.analyse import audit_states
-from ertools.audit.rescore import attach, compare_scores, flatten
+from ertools.audit.compare import attach, compare_scores, flatten
 from ertools.states import BmBoxState as B
 from ertools.streams import Machine, Provenance
 

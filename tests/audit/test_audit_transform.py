@@ -13,14 +13,8 @@ from pathlib import Path
 import pytest
 from audit_samples import answers, sample_dir
 
-from ertools.audit.rescore import (
-    IDENTITY_CAVEAT,
-    POSE_KEYS,
-    ScoreInputs,
-    attach,
-    audit_bag,
-    rescore,
-)
+from ertools.audit.compare import IDENTITY_CAVEAT, POSE_KEYS, attach
+from ertools.audit.rescore import ScoreInputs, audit_bag, rescore
 from ertools.cli.main import main
 
 

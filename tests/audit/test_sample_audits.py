@@ -9,8 +9,10 @@ import pytest
 import yaml
 from audit_samples import answers, sample_dir
 
-from ertools.audit.analyse import Audit, audit_states
-from ertools.audit.rescore import ScoreInputs, attach, flatten, rescore
+from ertools.audit.analyse import audit_states
+from ertools.audit.compare import attach, flatten
+from ertools.audit.model import Audit
+from ertools.audit.rescore import ScoreInputs, rescore
 
 
 def _audit(folder: Path, ns: str) -> Audit:

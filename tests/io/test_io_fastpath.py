@@ -64,10 +64,10 @@ REAL_BAG = REPO / ".." / "shared" / "real_bags" / "log_fbm2h_mocap_2015-10-23-16
 
 
 def _sample_bags() -> list[Path]:
-    from ertools.io.info import find_bags
+    from ertools.io.formats import find_bags
 
     folder = REPO / "sample_bags"
-    return find_bags(folder) if folder.is_dir() else []
+    return list(find_bags([folder]).bags) if folder.is_dir() else []
 
 
 def test_fast_equals_rosbags_on_sample_bags() -> None:

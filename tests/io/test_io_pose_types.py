@@ -163,7 +163,7 @@ def test_pwcs_layout_by_hand(cdr: bool) -> None:
 
 @pytest.mark.parametrize("topic", sorted(TOPICS))
 def test_trajectory_robot_topic_accepts_every_type(typed_bag: Path, topic: str) -> None:
-    from ertools.benchmarks.trajectory.benchmark import read_robot
+    from ertools.benchmarks.trajectory.inputs import read_robot
     from ertools.errors import TopicError
 
     _, t_rec, t_hdr, xyz, _quat = truth()
@@ -245,7 +245,7 @@ def test_summary_matches_the_official_reader(typed_bag: Path) -> None:
 
 
 def test_trajectory_robot_topic_of_several_tf_bodies_is_refused(tmp_path: Path) -> None:
-    from ertools.benchmarks.trajectory.benchmark import read_robot
+    from ertools.benchmarks.trajectory.inputs import read_robot
     from ertools.errors import TopicError
 
     s = Spec()

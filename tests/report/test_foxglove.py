@@ -263,8 +263,8 @@ def _stamps(path: Path, topic: str) -> list[int]:
 
 
 def test_trajectory(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from ertools.benchmarks.trajectory.benchmark import TrajectoryConfig
     from ertools.benchmarks.trajectory.benchmark import score as score_trajectory
+    from ertools.benchmarks.trajectory.config import TrajectoryConfig
 
     out = tmp_path / "trajectory.mcap"
     argv = ["score", "trajectory", str(ROBOT), str(ROBOT.parent), "--offset", "auto"]

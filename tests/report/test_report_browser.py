@@ -74,7 +74,7 @@ def _chromium(tmp_path: Path, url: str, *extra: str) -> subprocess.CompletedProc
 @pytest.fixture(scope="module")
 def report(tmp_path_factory: pytest.TempPathFactory) -> Path:
     from ertools.audit.analyse import audit_states
-    from ertools.audit.rescore import attach
+    from ertools.audit.compare import attach
     from ertools.streams import Machine
 
     tmp = tmp_path_factory.mktemp("browser")

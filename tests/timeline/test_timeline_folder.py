@@ -13,8 +13,9 @@ import pytest
 from summaries import BAG_KEYS
 
 from ertools.cli.main import main
+from ertools.io.formats import find_bags
 from ertools.progress import reporting
-from ertools.timeline.scan import find_bags, scan
+from ertools.timeline.scan import scan
 
 
 def rel(root: Path, path: str) -> str:

@@ -7,10 +7,10 @@ import json
 import pytest
 from summaries import BAG_KEYS, Summary, Topic
 
+from ertools.io.formats import Unreadable
 from ertools.timeline.build import (
     ClockCheck,
     TimelineConfig,
-    Unreadable,
     benchmark_names,
     build_timeline,
     classify,

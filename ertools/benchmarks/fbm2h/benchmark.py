@@ -191,7 +191,7 @@ def compute(
         )
     if hits is not None and hits < 0:
         raise ConfigError(f"--hits must be >= 0, got {hits}")
-    from ertools.benchmarks.trajectory.benchmark import drop_invalid
+    from ertools.benchmarks.common.hygiene import drop_invalid
 
     marker, invalid = drop_invalid(marker)
     all_warnings = list(warnings)
@@ -506,7 +506,7 @@ def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
     )
     if len(marker) == 0:
         raise SegmentationError(f"{marker.source or paths[0]}: the marker set pose stream is empty")
-    from ertools.benchmarks.trajectory.benchmark import drop_invalid
+    from ertools.benchmarks.common.hygiene import drop_invalid
 
     total = len(marker)
     marker, invalid = drop_invalid(marker)

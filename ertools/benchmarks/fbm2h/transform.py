@@ -93,7 +93,7 @@ def acquire_transform(
     """
     from datetime import UTC, datetime
 
-    from ertools.benchmarks.trajectory.benchmark import drop_invalid
+    from ertools.benchmarks.common.hygiene import drop_invalid
 
     check_team_name(team)
     if len(marker) == 0:

@@ -12,7 +12,6 @@ from __future__ import annotations
 import logging
 import os
 import struct
-import zlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,10 +21,11 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.errors import BagError
-from ertools.io.decode.fast import read_at as gather_at
+from ertools.io.decode.fast import gather
 from ertools.io.files import BagFile
+from ertools.io.mcap.crc import crc32
 from ertools.io.model import Conn
-from ertools.io.pipeline import Group, joined, pread, read_at, scratch_view
+from ertools.io.pipeline import Group, pread, read_at, scratch_view
 
 if TYPE_CHECKING:
     from ertools.progress import Reporter
@@ -79,6 +79,7 @@ def _parse_summary(f: BinaryIO, path: Path) -> Any:
         raise BagError(f"unreadable MCAP summary ({type(err).__name__}: {err})", path=path) from err
     if summary is None:
         return None
+    _check_summary_crc(f, path)
     stats = summary.statistics
     if (
         stats is not None
@@ -93,6 +94,27 @@ def _parse_summary(f: BinaryIO, path: Path) -> Any:
             path=path,
         )
     return summary
+
+
+def _check_summary_crc(f: BinaryIO, path: Path) -> None:
+    """Refuse a summary section that fails the CRC its footer gives (0: not computed).
+
+    The ``mcap`` library does not check it; a damaged summary (a chunk index's op code,
+    offsets or times, a channel's schema id) would otherwise direct every indexed read. The
+    section is what the library has just read, a small part of the file.
+    """
+    size = _file_size(f)
+    at = size - 8 - (1 + 8 + 8 + 8 + 4)
+    footer = pread(f.fileno(), 1 + 8 + 8 + 8 + 4, at)
+    if len(footer) < 29 or footer[0] != 0x02:
+        return  # no footer here: the library found none either
+    _, _len, start, _offsets, crc = struct.unpack("<BQQQI", footer)
+    if not crc or not 0 < start < at:
+        return
+    # from the first summary record through the footer's summary_offset_start field
+    covered = pread(f.fileno(), at + 1 + 8 + 8 + 8 - start, start)
+    if crc32(covered) != crc:
+        raise BagError("damaged MCAP summary section: it fails its CRC check", path=path)
 
 
 def decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
@@ -112,6 +134,27 @@ def decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
         # zstandard and lz4 raise their own error classes on corrupt input.
         raise BagError(f"corrupt {compression} MCAP chunk {where} ({err})") from err
     raise BagError(f"unsupported MCAP chunk compression {compression!r} {where}")
+
+
+def _zstd_into(data: bytes, out: memoryview, where: str) -> None:
+    """Decompress one zstd chunk into ``out``, which must be exactly its uncompressed size."""
+    import zstandard
+
+    try:
+        reader = zstandard.ZstdDecompressor().stream_reader(data, read_across_frames=True)
+        got = 0
+        while got < len(out):
+            n = reader.readinto(out[got:])
+            if n == 0:
+                break
+            got += n
+        extra = reader.read(1)
+    except Exception as err:
+        # zstandard raises its own error class on corrupt input
+        raise BagError(f"corrupt zstd MCAP chunk {where} ({err})") from err
+    if got != len(out) or extra:
+        size = f"more than {len(out)}" if extra else f"{got}"
+        raise BagError(f"chunk decompresses to {size} bytes, not {len(out)}, {where}")
 
 
 def _file_size(f: BinaryIO) -> int:
@@ -184,12 +227,13 @@ class McapIndex:
                 channels = {cid for cid, ch in layout.channels.items() if ch.topic in topics}
                 chunks = summary.chunk_indexes
                 chunks_per_file.append(chunks)
+                file_size = _file_size(f)
                 for ci, chunk in enumerate(chunks):
                     if lo is not None and chunk.message_end_time < lo:
                         continue
                     if hi is not None and chunk.message_start_time > hi:
                         continue
-                    if not 0 <= chunk.chunk_start_offset < _file_size(f):
+                    if not 0 <= chunk.chunk_start_offset < file_size:
                         raise BagError(
                             f"chunk index gives a chunk at byte {chunk.chunk_start_offset}, "
                             "outside the file",
@@ -209,23 +253,26 @@ class McapIndex:
                         continue
                     for cid in wanted:
                         offset = chunk.message_index_offsets[cid]
-                        t, off = self._message_index(f, path, offset, cid)
-                        keep = np.ones(len(t), dtype=bool)
-                        if lo is not None:
-                            keep &= t >= lo
-                        if hi is not None:
-                            keep &= t <= hi
-                        if keep.any():
-                            start = int(chunk.chunk_start_offset)
-                            sels.append((fi, ci, start, t[keep], off[keep]))
+                        t, off = self._message_index(f, path, offset, cid, file_size)
+                        if lo is not None or hi is not None:
+                            keep = np.ones(len(t), dtype=bool)
+                            if lo is not None:
+                                keep &= t >= lo
+                            if hi is not None:
+                                keep &= t <= hi
+                            t, off = t[keep], off[keep]
+                        if len(t):
+                            sels.append((fi, ci, int(chunk.chunk_start_offset), t, off))
         if not sels:
             e = np.empty(0, np.int64)
             return McapPlan(e, e, e, e, chunks_per_file)
         t_all = np.concatenate([s[3] for s in sels])
         off_all = np.concatenate([s[4] for s in sels])
-        file_all = np.concatenate([np.full(len(s[3]), s[0], np.int64) for s in sels])
-        chunk_all = np.concatenate([np.full(len(s[3]), s[1], np.int64) for s in sels])
-        cstart_all = np.concatenate([np.full(len(s[3]), s[2], np.int64) for s in sels])
+        # file, chunk and chunk offset of every row: one repeat each, not an array per chunk
+        counts = np.array([len(s[3]) for s in sels], dtype=np.int64)
+        file_all = np.repeat(np.array([s[0] for s in sels], dtype=np.int64), counts)
+        chunk_all = np.repeat(np.array([s[1] for s in sels], dtype=np.int64), counts)
+        cstart_all = np.repeat(np.array([s[2] for s in sels], dtype=np.int64), counts)
         key = file_all * (1 << 32) + chunk_all
         # the mcap library's order: log time, then file, chunk position, record position. One
         # channel logged in time order is in that order already: no sort.
@@ -277,24 +324,14 @@ class McapIndex:
             offsets = plan.offset[rows]
             if np.any(offsets + 9 + MESSAGE_FIXED > sizes[which]):
                 raise BagError(f"message index points outside its chunk {where}")
-            start, length = self._spans(buf, offsets + base[which], where)
-            if np.any(start + length > base[which] + sizes[which]):
-                raise BagError(f"message record cut off inside its chunk {where}")
+            limit = base[which] + sizes[which]
+            start, length, log_time = _checked_records(buf, offsets + base[which], limit, where)
             # The record's own log time must be the index's: a damaged index entry would
             # otherwise give another record's data (or a wrong time) without a word.
-            log_time = gather_at(buf, start - 16, np.dtype("<u8")).astype(np.int64)
             if np.any(log_time != plan.t_record[rows]):
                 raise BagError(
                     f"message index disagrees with the message records' log times {where}"
                 )
-            # Each record must end where its chunk ends or another record (schema, channel,
-            # message: all a chunk may hold) begins; a damaged record length would give a
-            # message with bytes that are not its own, where the mcap library loses the rest
-            # of the chunk.
-            end = start + length
-            inside = end < base[which] + sizes[which]
-            if np.any(inside) and not np.all(_RECORD_STARTS[buf[end[inside]]]):
-                raise BagError(f"message record length runs into no record {where}")
             return rows, buf, start, length
 
         weights = [sum(int(chunk_of(key)[1].compressed_size) for key, _ in part) for part in todo]
@@ -305,7 +342,7 @@ class McapIndex:
         """The records of several chunks end to end in ``scratch``: uncompressed chunks are
         read straight into it, compressed ones decompressed and copied in."""
         if any(chunk.compression for _path, chunk in chunks):
-            return joined([McapIndex.inflated_bytes(p, c) for p, c in chunks], scratch)
+            return McapIndex._inflated_group(chunks, scratch)
         for path, chunk in chunks:
             # sizes from the summary are checked before they size a buffer (a flipped high
             # bit made an int64 overflow); the chunk record itself is checked below
@@ -338,6 +375,35 @@ class McapIndex:
         return np.frombuffer(view, dtype=np.uint8), base, sizes
 
     @staticmethod
+    def _inflated_group(chunks: list[tuple[Path, Any]], scratch: list[Any]) -> Group:
+        """Compressed chunks decompressed end to end into ``scratch``, each checked against
+        its size and CRC. zstd chunks inflate straight into the reused buffer: a fresh
+        output object per chunk cost more CPU than the decompression itself (page faults
+        on new memory, then a copy), which is what pays for the CRC check."""
+        raw = [McapIndex._chunk_raw(path, chunk) for path, chunk in chunks]
+        sizes = np.array([usize for _c, _d, usize, _crc in raw], dtype=np.int64)
+        base = np.zeros(len(chunks), dtype=np.int64)
+        np.cumsum(sizes[:-1], out=base[1:])
+        view = scratch_view(scratch, int(sizes.sum()))
+        out = np.frombuffer(view, dtype=np.uint8)
+        for (path, chunk), (compression, data, usize, crc), b in zip(
+            chunks, raw, base.tolist(), strict=True
+        ):
+            where = f"in {path} at byte {chunk.chunk_start_offset}"
+            part = view[b : b + usize]
+            if compression == "zstd":
+                _zstd_into(data, part, where)
+            else:
+                got = decompress(compression, data, usize, where)
+                if len(got) != usize:
+                    raise BagError(f"chunk decompresses to {len(got)} bytes, not {usize}, {where}")
+                # a NumPy copy releases the GIL (a memoryview copy holds it)
+                out[b : b + usize] = np.frombuffer(got, dtype=np.uint8)
+            if crc and crc32(part) != crc:
+                raise BagError(f"chunk fails its CRC check (damaged) {where}")
+        return out, base, sizes
+
+    @staticmethod
     def inflated_bytes(path: Path, chunk: Any) -> bytes:
         """A chunk's records, decompressed (and its size checked)."""
         where = f"in {path} at byte {chunk.chunk_start_offset}"
@@ -348,13 +414,16 @@ class McapIndex:
         # lz4 and zstd frames as MCAP writers make them carry no checksum of their own: a
         # damaged compressed chunk inflates to other bytes without an error (fuzzing: poses
         # changed, records lost). The chunk's CRC (0: not computed) finds it.
-        if crc and zlib.crc32(out) != crc:
+        if crc and crc32(out) != crc:
             raise BagError(f"chunk fails its CRC check (damaged) {where}")
         return out
 
     @staticmethod
-    def _message_index(f: BinaryIO, path: Path, pos: int, cid: int) -> tuple[I64, I64]:
-        size = _file_size(f)
+    def _message_index(
+        f: BinaryIO, path: Path, pos: int, cid: int, size: int | None = None
+    ) -> tuple[I64, I64]:
+        if size is None:
+            size = _file_size(f)
         if not 0 <= pos < size:
             raise BagError(f"message index offset {pos} outside the file ({size} bytes)", path=path)
         f.seek(pos)
@@ -428,6 +497,41 @@ class McapIndex:
         return start, length
 
 
+# A message record's head: op code (1), record length (8), channel id (2), sequence (4), log
+# time (8).
+_HEAD = 1 + 8 + 2 + 4 + 8
+
+
+def _checked_records(buf: U8, off: I64, limit: I64, where: str) -> tuple[I64, I64, I64]:
+    """(data start, data length, log time) of the message records at ``off``, each checked
+    to be a message record that ends at ``limit`` (its chunk's end) or where another record a
+    chunk may hold (schema, channel, message) begins: a damaged record length would give a
+    message bytes that are not its own, where the mcap library loses the rest of the chunk.
+
+    The heads are gathered once as raw bytes (one copy per record; a structured dtype
+    copies field by field, 4x slower) and the fields read as strided columns of them.
+    """
+    n = len(off)
+    if n and (int(off.min()) < 0 or int(off.max()) + _HEAD > len(buf)):
+        raise BagError(f"message index points outside its chunk {where}")
+    head = gather(buf, off, _HEAD)
+    if np.any(head[:, 0] != OP_MESSAGE):
+        raise BagError(f"message index points at a record that is no message {where}")
+    rlen = np.ndarray((n,), "<u8", buffer=head, offset=1, strides=(_HEAD,)).astype(np.int64)
+    start = off + 9 + MESSAGE_FIXED
+    length = rlen - MESSAGE_FIXED
+    end = start + length
+    if len(off) and (int(length.min()) < 0 or np.any(end > limit)):
+        raise BagError(f"message record cut off inside its chunk {where}")
+    # the byte after each record (clipped to the buffer: a record ending at its chunk's end,
+    # the buffer's last chunk included, needs no next record)
+    after = buf[np.minimum(end, len(buf) - 1)]
+    if not np.all(_RECORD_STARTS[after] | (end == limit)):
+        raise BagError(f"message record length runs into no record {where}")
+    log_time = np.ndarray((n,), "<u8", buffer=head, offset=15, strides=(_HEAD,))
+    return start, length, log_time.astype(np.int64)
+
+
 def verify_mcap(path: Path, progress: Reporter | None = None) -> None:
     """Decompress every chunk of an MCAP file, check its CRC and its message indexes (a file
     read record by record: every record and every chunk CRC). The chunks' bytes are
@@ -436,8 +540,6 @@ def verify_mcap(path: Path, progress: Reporter | None = None) -> None:
     Raises:
         BagError: the first damaged chunk, with its byte offset.
     """
-    import zlib
-
     from ertools.io.mcap.scan import SCAN, mcap_layout, scan_mcap
 
     layout = mcap_layout(path)
@@ -459,7 +561,7 @@ def verify_mcap(path: Path, progress: Reporter | None = None) -> None:
             f.seek(chunk.chunk_start_offset + 1 + 8 + 8 + 8 + 8)
             (crc,) = struct.unpack("<I", f.read(4))
             buf = McapIndex._chunk_bytes(path, chunk)
-            if crc and zlib.crc32(buf.tobytes()) != crc:
+            if crc and crc32(buf.tobytes()) != crc:
                 raise BagError(f"corrupt MCAP chunk {where}: CRC mismatch")
             for cid, offset in chunk.message_index_offsets.items():
                 _t, off = McapIndex._message_index(f, path, offset, cid)

@@ -17,7 +17,6 @@ import contextlib
 import mmap
 import os
 import struct
-import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -27,6 +26,7 @@ import numpy.typing as npt
 
 from ertools.errors import BagError
 from ertools.io.decode.fast import read_at
+from ertools.io.mcap.crc import crc32
 
 I64 = npt.NDArray[np.int64]
 U8 = npt.NDArray[np.uint8]
@@ -38,6 +38,7 @@ OP_CHANNEL = 0x04
 OP_MESSAGE = 0x05
 OP_CHUNK = 0x06
 FOOTER_SIZE = 1 + 8 + 8 + 8 + 4
+_FOOTER_HEAD = bytes([OP_FOOTER]) + (FOOTER_SIZE - 9).to_bytes(8, "little")
 
 # What the summary-only check of a file and the record scan report as the index used.
 INDEXED = "summary+message-indexes"
@@ -73,6 +74,7 @@ class McapRecords:
         compressions: chunk compressions met (``none`` for uncompressed chunks).
         complete: the file ends with its footer and magic.
         problem: why the read stopped early ("" when it read to the end).
+        chunk_starts: where the chunk records of the data section start.
     """
 
     schemas: dict[int, Any]
@@ -83,6 +85,7 @@ class McapRecords:
     compressions: frozenset[str]
     complete: bool
     problem: str
+    chunk_starts: frozenset[int] = frozenset()
 
 
 @dataclass
@@ -99,6 +102,7 @@ class _Sink:
     compressions: set[str] = field(default_factory=set)
     footer: bool = False
     chunks: int = 0
+    chunk_at: list[int] = field(default_factory=list)
 
     def messages(self, buf: U8, at: I64) -> None:
         """Message records starting at ``at`` (vectorised)."""
@@ -271,6 +275,8 @@ def _record(buf: Any, op: int, body: int, stop: int, sink: _Sink, top: bool) -> 
         if sc.id:
             sink.schemas.setdefault(sc.id, sc)
     elif op == OP_CHUNK:
+        if top:
+            sink.chunk_at.append(body - 9)
         _chunk(buf, body, stop, sink)
     elif op == OP_FOOTER and top:
         sink.footer = True
@@ -294,7 +300,7 @@ def _chunk(buf: Any, at: int, end: int, sink: _Sink) -> None:
     inner = stored if compression == "" else decompress(compression, stored, usize, where)
     if len(inner) != usize:
         raise BagError(f"chunk decompresses to {len(inner)} bytes, not {usize}, {where}")
-    if sink.check_crc and crc and zlib.crc32(inner) != crc:
+    if sink.check_crc and crc and crc32(inner) != crc:
         raise BagError(f"corrupt MCAP chunk {where}: CRC mismatch")
     sink.compressions.add(compression or "none")
     sink.chunks += 1
@@ -333,6 +339,20 @@ def scan_mcap(
         # the map until it goes
         with contextlib.suppress(BufferError):
             mm.close()
+    summary = mcap_layout(path).summary
+    if found.complete and summary is not None:
+        # The summary (its CRC checked) indexes chunks where the records read in turn found
+        # none: a chunk's op code is damaged, and skipping it as an unknown record, as the
+        # specification has readers do, would silently drop its messages.
+        lost = sorted(
+            {int(c.chunk_start_offset) for c in summary.chunk_indexes} - found.chunk_starts
+        )
+        if lost:
+            raise BagError(
+                f"damaged MCAP file: the summary indexes a chunk at byte {lost[0]}, where the "
+                "records hold no chunk",
+                path=path,
+            )
     if not keep and check_crc:
         if len(_SCANS) >= 4:  # 16 bytes a message: a few hour-long files at most
             _SCANS.clear()
@@ -349,13 +369,28 @@ def _scan(buf: U8, path: Path, keep: frozenset[int], check_crc: bool) -> McapRec
         raise BagError("no MCAP magic at the start", path=path)
     sink = _Sink(keep, check_crc, path)
     end = size - len(MAGIC) if buf[size - len(MAGIC) :].tobytes() == MAGIC else size
+    foot = size - len(MAGIC) - FOOTER_SIZE
+    if end == size and foot > len(MAGIC) and buf[foot : foot + 9].tobytes() == _FOOTER_HEAD:
+        # a footer record just before the last 8 bytes: the writer finished the file and only
+        # its closing magic is damaged; read it as finished (damage inside is then refused,
+        # not taken for a recording cut short)
+        end = size - len(MAGIC)
     problem = ""
     try:
         stop = _walk(buf, len(MAGIC), end, sink, top=True)
         if not sink.footer:
             problem = f"truncated: no footer record (the records end at byte {stop})"
-        elif stop != end or end == size:
-            problem = f"bytes after the footer record at byte {stop}"
+        elif stop == size:
+            problem = f"truncated inside its closing magic (the footer record ends at byte {stop})"
+        elif stop != end:
+            # a writer ends the file right after its footer; a recording cut short has none:
+            # records after a footer are damage (a chunk's op code read as a footer's), and
+            # reading only what comes before would drop the rest without a word
+            raise BagError(
+                f"damaged MCAP file: a footer record ends at byte {stop}, {size - stop} bytes "
+                "before the end of the file",
+                path=path,
+            )
     except (_CutError, struct.error, UnicodeDecodeError) as err:
         why = "a record runs past the end of the file or of its chunk"
         if isinstance(err, UnicodeDecodeError):
@@ -379,6 +414,7 @@ def _scan(buf: U8, path: Path, keep: frozenset[int], check_crc: bool) -> McapRec
         frozenset(sink.compressions),
         sink.footer and not problem,
         problem,
+        frozenset(sink.chunk_at),
     )
 
 

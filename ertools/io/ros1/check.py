@@ -463,7 +463,7 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
 
     start = pos
     conns: dict[int, Conn] = {}
-    found: list[tuple[int, str, int, int, bytes, list[I64]]] = []
+    found: list[tuple[int, str, int, int, bytes, list[tuple[I64, I64]]]] = []
     problems = [why]
     try:
         while pos < size:
@@ -472,7 +472,7 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
                 compression = rec.fields.get("compression", b"none").decode("ascii", "replace")
                 found.append((pos, compression, rec.data_pos, rec.data_len, data, []))
             elif rec.op == OP_INDEX and found:
-                found[-1][5].append(_entries_from_index(data[: 12 * (len(data) // 12)])[1])
+                found[-1][5].append(_entries_from_index(data[: 12 * (len(data) // 12)]))
             elif rec.op == OP_CONNECTION:
                 cid, topic, cf = connection_fields(rec, data)
                 conns.setdefault(cid, _conn(cid, topic, cf))
@@ -488,11 +488,25 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
         except BagError as err:
             problems.append(f"corrupt chunk at byte {cpos} skipped ({err.message})")
             continue
-        recs = chunk_records(
-            buf, np.concatenate(hints) if hints else np.empty(0, np.int64), data_pos
-        )
+        hint_t = np.concatenate([h[0] for h in hints]) if hints else np.empty(0, np.int64)
+        hint_off = np.concatenate([h[1] for h in hints]) if hints else np.empty(0, np.int64)
+        recs = chunk_records(buf, hint_off, data_pos)
         if recs.problems:
             return scan_layout(f, path, size, start, why)
+        if len(hint_off) and len(recs.msg_off):
+            # A record the index data points at must carry the entry's time (rosbags asserts
+            # it). An entry whose time lies outside the span of the chunk's records is the
+            # damaged side (the records are read instead); one inside it leaves no way to
+            # tell which is damaged, and the records alone would read a damaged time or
+            # chunk (lz4 has no checksum here) as sound.
+            k = np.minimum(np.searchsorted(recs.msg_off, hint_off), len(recs.msg_off) - 1)
+            hit = recs.msg_off[k] == hint_off
+            differ = hint_t[hit][recs.msg_time[k[hit]] != hint_t[hit]]
+            lo, hi = int(recs.msg_time.min()), int(recs.msg_time.max())
+            if np.any((differ >= lo) & (differ <= hi)):
+                problems.append(
+                    f"chunk at byte {cpos}: a message record's time differs from its index entry"
+                )
         for cid, (topic, msgtype, md5) in recs.conns.items():
             fields = {"type": msgtype.encode(), "md5sum": md5.encode()}
             conns.setdefault(cid, _conn(cid, topic, fields))

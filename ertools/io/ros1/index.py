@@ -180,15 +180,21 @@ def read_layout(path: Path) -> Ros1Layout:
                 f"truncated: the index at byte {index_pos} lies past the end ({size} bytes)",
             )
         try:
-            conns = []
+            conns: list[Conn] = []
             pos = index_pos
             for _ in range(conn_count):
                 rec, data = read_record(f, pos, size, with_data=True)
                 if rec.op != OP_CONNECTION:
                     raise RecordError("expected a connection record", pos)
                 cid, topic, fields = connection_fields(rec, data)
+                if any(c.id == cid for c in conns):
+                    # a damaged id: one connection's messages would be read as another's
+                    raise RecordError(f"two connection records with id {cid}", pos)
                 conns.append(_conn(cid, topic, fields))
                 pos = rec.end
+            if chunk_count == 0 and conn_count and index_pos > head.end:
+                # records between the header and the index, but no chunk to find them by
+                raise RecordError("the bag header counts no chunks before its index", MAGIC_LEN)
             chunks = []
             for _ in range(chunk_count):
                 rec, data = read_record(f, pos, size, with_data=True)
@@ -382,6 +388,43 @@ def _outside_chunk_info(
     )
 
 
+def _value_offsets(buf: U8, head: int) -> tuple[int, int] | None:
+    """(conn value, time value) offsets in the 38-byte message header at ``head``."""
+    try:
+        fields = bytes(buf[head : head + MSG_HEADER_LEN])
+        pos, found = 0, {}
+        while pos < len(fields):
+            (n,) = _U32.unpack_from(fields, pos)
+            name = fields[pos + 4 : pos + 4 + n].split(b"=", 1)[0]
+            found[name] = pos + 4 + len(name) + 1
+            pos += 4 + n
+    except struct_error:
+        return None
+    if b"conn" not in found or b"time" not in found:
+        return None
+    return found[b"conn"], found[b"time"]
+
+
+def _fields_before(buf: U8, data: int) -> tuple[int, int] | None:
+    """(conn, time ns) of the message record whose data starts at ``data``, from its header
+    (found by the standard 38-byte length; None when the header is not there or lacks them)."""
+    head = data - 4 - MSG_HEADER_LEN
+    if head < 4:
+        return None
+    try:
+        (hlen,) = _U32.unpack(bytes(buf[head - 4 : head]))
+        if hlen != MSG_HEADER_LEN:
+            return None
+        fields = parse_fields(bytes(buf[head : head + MSG_HEADER_LEN]))
+        return u32(fields, "conn"), time_ns(fields, "time")
+    except (RecordError, KeyError, struct_error):
+        return None
+
+
+def _nonzero(counts: dict[int, int]) -> dict[int, int]:
+    return {cid: n for cid, n in counts.items() if n}
+
+
 def _first_record(bag: Ros1Bag) -> int:
     """Where the records after the bag header start."""
     try:
@@ -491,9 +534,15 @@ class Ros1Bag(BagFile):
             self._mm = mmap.mmap(self.file.fileno(), 0, access=mmap.ACCESS_READ)
         return self._mm
 
-    def _index_data(self, chunk: Ros1Chunk, wanted: Collection[int] | None) -> dict[int, bytes]:
+    def _index_data(
+        self,
+        chunk: Ros1Chunk,
+        wanted: Collection[int] | None,
+        counts: dict[int, int] | None = None,
+    ) -> dict[int, bytes]:
         """conn -> raw (sec, nsec, offset) entries of one chunk, for the ``wanted`` connections
-        (all when None), from the index-data records that follow the chunk."""
+        (all when None), from the index-data records that follow the chunk; ``counts`` gets
+        every record's conn -> count (all connections)."""
         if chunk.data_pos < 0:
             self.chunk_record(chunk)
         mm = self._mapped()
@@ -519,6 +568,8 @@ class Ros1Bag(BagFile):
                 data_pos = pos + 8 + hlen
                 if dlen != 12 * count or data_pos + dlen > size:
                     raise RecordError("index-data size disagrees with its count", pos)
+                if counts is not None:
+                    counts[cid] = counts.get(cid, 0) + count
                 if wanted is None or cid in wanted:
                     out[cid] = mm[data_pos : data_pos + dlen]
                 pos = data_pos + dlen
@@ -568,8 +619,6 @@ class Ros1Bag(BagFile):
         raw: dict[int, list[bytes | tuple[I64, I64]]] = {cid: [] for cid in rank}
         where: dict[int, list[tuple[int, int]]] = {cid: [] for cid in rank}
         for ci, chunk in enumerate(self.layout.chunks):
-            if not any(cid in chunk.counts for cid in rank):
-                continue
             if start_ns is not None and chunk.end_ns < start_ns:
                 continue
             if end_ns is not None and chunk.start_ns > end_ns:
@@ -580,9 +629,20 @@ class Ros1Bag(BagFile):
                         raw[cid].append((t, off))
                         where[cid].append((ci, len(t)))
                 continue
-            for cid, data in self._index_data(chunk, rank).items():
+            # Every chunk's index-data headers are read, the planned chunks' and the others':
+            # their connection ids and counts must be the chunk info's, which chose the chunks
+            # (a damaged connection id or count there dropped a chunk from its connection's
+            # read, or read another connection's entries, without a word).
+            counts: dict[int, int] = {}
+            for cid, data in self._index_data(chunk, rank, counts).items():
                 raw[cid].append(data)
                 where[cid].append((ci, len(data) // INDEX_DTYPE.itemsize))
+            if _nonzero(counts) != _nonzero(chunk.counts):
+                self._rescan(
+                    f"chunk at byte {chunk.pos}: the chunk info and the index data give "
+                    "different connections or counts"
+                )
+                return self.select(conns, start_ns, end_ns)
         self._unmap()  # the index pages touched would otherwise stay in this process's RSS
         tt: list[I64] = []
         oo: list[I64] = []
@@ -641,9 +701,13 @@ class Ros1Bag(BagFile):
         from ertools.io.ros1.check import rebuild_layout
 
         self._unmap()
-        self.layout = rebuild_layout(
-            self.file, self.path, self.layout.size, _first_record(self), why
-        )
+        layout = rebuild_layout(self.file, self.path, self.layout.size, _first_record(self), why)
+        damage = [p for p in layout.problems if p != why]
+        if damage:
+            # A closed bag (it has an index) whose records do not all read is damaged, not cut
+            # short: reading around a skipped chunk would give fewer messages without a word.
+            raise BagError(f"damaged bag: {why}, and {damage[0]}", path=self.path)
+        self.layout = layout
 
     def spans(self, buf: U8, offsets: I64, where: str) -> tuple[I64, I64]:
         """(data start, data length) of the message records at ``offsets`` of a chunk.
@@ -694,6 +758,96 @@ class Ros1Bag(BagFile):
         if (dpos + dlen).max() > n:
             raise BagError(f"message data cut off inside its chunk {where}")
         return dpos, dlen
+
+    def checked_spans(
+        self, buf: U8, offsets: I64, t_ns: I64, conn: I64, where: str
+    ) -> tuple[I64, I64]:
+        """:meth:`spans`, each record also checked to carry the time and connection of its
+        index entry (:meth:`check_heads`). Records with the standard 38-byte header laid out
+        as the first one's (a writer's usual output) are read with one gather of their
+        heads, every field a strided column of it."""
+        n = len(offsets)
+        head = 4 + MSG_HEADER_LEN + 4  # header length, header, data length
+        fields = None
+        if n and int(offsets.min()) >= 0 and int(offsets.max()) + head <= len(buf):
+            fields = _value_offsets(buf, int(offsets[0]) + 4)
+        op_at = None
+        if fields is not None:
+            first = bytes(buf[int(offsets[0]) + 4 : int(offsets[0]) + 4 + MSG_HEADER_LEN])
+            op_at = next(
+                (at for at in _OP_AT if first[at : at + 8] == _OP_MSG_WORD.to_bytes(8, "little")),
+                None,
+            )
+        if fields is None or op_at is None:
+            start, length = self.spans(buf, offsets, where)
+            self.check_heads(buf, start, t_ns, conn, where)
+            return start, length
+        from ertools.io.decode.fast import gather
+
+        rows = gather(buf, offsets, head)
+
+        def col(offset: int, kind: str) -> npt.NDArray[Any]:
+            return np.ndarray((n,), kind, buffer=rows, offset=offset, strides=(head,))
+
+        conn_at, time_at = fields
+        standard = (col(0, "<u4") == MSG_HEADER_LEN) & (col(4 + op_at, "<u8") == _OP_MSG_WORD)
+        if not bool(standard.all()):
+            start, length = self.spans(buf, offsets, where)
+            self.check_heads(buf, start, t_ns, conn, where)
+            return start, length
+        start = offsets + head
+        length = col(head - 4, "<u4").astype(np.int64)
+        if int((start + length).max()) > len(buf):
+            raise BagError(f"message data cut off inside its chunk {where}")
+        got_t = np.multiply(col(4 + time_at, "<u4"), 1_000_000_000, dtype=np.int64)
+        got_t += col(4 + time_at + 4, "<u4")
+        bad = got_t != t_ns
+        bad |= col(4 + conn_at, "<u4") != conn
+        if bool(bad.any()):
+            idx = np.flatnonzero(bad)
+            self.check_heads(buf, start[idx], t_ns[idx], conn[idx], where)
+        return start, length
+
+    @staticmethod
+    def check_heads(buf: U8, start: I64, t_ns: I64, conn: I64, where: str) -> None:
+        """Each message record (data at ``start``) carries the time and connection of the
+        index entry it was found by, as rosbags asserts: a damaged index entry, or a damaged
+        record header, would otherwise give a pose at a wrong time or on a wrong topic.
+
+        The record header is the 38 bytes before each data length; the first record tells
+        where its conn and time values sit, every record is read there at once, and only a
+        record that disagrees is parsed field by field (a writer may order fields otherwise).
+        """
+        from ertools.io.decode.fast import gather
+
+        n = len(start)
+        if not n:
+            return
+        head_at = start - 4 - MSG_HEADER_LEN
+        at = _value_offsets(buf, int(head_at[0]))
+        bad = np.ones(n, dtype=bool)
+        if at is not None and int(head_at.min()) >= 0:
+            # one gather of the stretch holding both values, read as strided columns
+            conn_at, time_at = at
+            a = min(conn_at, time_at)
+            width = max(conn_at + 4, time_at + 8) - a
+            rows = gather(buf, head_at + a, width)
+
+            def col(offset: int) -> npt.NDArray[np.uint32]:
+                return np.ndarray((n,), "<u4", buffer=rows, offset=offset - a, strides=(width,))
+
+            got_t = np.multiply(col(time_at), 1_000_000_000, dtype=np.int64)
+            got_t += col(time_at + 4)
+            bad = got_t != t_ns
+            bad |= col(conn_at) != conn
+        for i in np.flatnonzero(bad).tolist():
+            # the header just before this record's data length, whatever its layout
+            found = _fields_before(buf, int(start[i]))
+            if found is None or found != (int(conn[i]), int(t_ns[i])):
+                raise BagError(
+                    "message record's connection or time differs from its index entry "
+                    f"(damaged index or record) {where}"
+                )
 
     @staticmethod
     def _resolve(buf: bytes, off: int, where: str) -> tuple[int, int]:

@@ -21,13 +21,13 @@ from ertools.errors import UsageError
 # ``module.Class`` of a result -> ``module:function`` adding its content to a Collected.
 # Dotted names, not classes: nothing is imported until a file is written.
 CONTENT: dict[str, str] = {
-    "ertools.benchmarks.trajectory.benchmark.TrajectoryResult": (
+    "ertools.benchmarks.trajectory.result.TrajectoryResult": (
         "ertools.report.foxglove.trajectory:content"
     ),
     "ertools.benchmarks.fbm3w.result.Fbm3wResult": "ertools.report.foxglove.fbm3w:content",
     "ertools.benchmarks.fbm2h.result.Fbm2hResult": "ertools.report.foxglove.fbm2h:content",
     "ertools.benchmarks.fbm1.result.Fbm1Result": "ertools.report.foxglove.fbm1:content",
-    "ertools.audit.analyse.Audit": "ertools.report.foxglove.audit:content",
+    "ertools.audit.model.Audit": "ertools.report.foxglove.audit:content",
 }
 
 # Pose and error streams longer than this keep every k-th message, k = ceil(n / limit): an

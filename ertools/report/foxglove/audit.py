@@ -12,7 +12,7 @@ Topics:
 
 from __future__ import annotations
 
-from ertools.audit.analyse import Audit
+from ertools.audit.model import Audit
 from ertools.report.foxglove.messages import (
     INFO,
     WARNING,

@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ertools.benchmarks.trajectory.benchmark import COMPARED, STATUS_NAMES, TrajectoryResult
+from ertools.benchmarks.trajectory.association import COMPARED, STATUS_NAMES
+from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.report.foxglove.messages import (
     INFO,
     RED,

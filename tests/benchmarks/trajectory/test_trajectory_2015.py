@@ -21,7 +21,8 @@ import pytest
 from node_2015 import EndOfBagError, Pose, score_2015, tf_yaw
 from trajectory_helpers import read_back, write_gt, write_robot
 
-from ertools.benchmarks.trajectory.benchmark import TrajectoryConfig, score_streams
+from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.scoring import score_streams
 from ertools.cli.main import main
 from ertools.errors import ClockError
 from ertools.streams import PoseStream
@@ -404,7 +405,7 @@ def test_overlapping_gt_files_are_a_deviation(
 
 
 def test_yaw_tf_equals_tf_s_arithmetic() -> None:
-    from ertools.benchmarks.trajectory.benchmark import yaw_tf
+    from ertools.benchmarks.trajectory.association import yaw_tf
 
     rng = np.random.default_rng(3)
     q = rng.normal(size=(2000, 4)) * rng.uniform(0.5, 2.0, (2000, 1))  # any norm, any pitch

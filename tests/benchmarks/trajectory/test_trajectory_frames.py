@@ -6,7 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ertools.benchmarks.trajectory.benchmark import TrajectoryConfig, score_streams
+from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.scoring import score_streams
 from ertools.geometry import quat_from_yaw
 from ertools.io import read_poses
 from ertools.samples.writer import BagWriter

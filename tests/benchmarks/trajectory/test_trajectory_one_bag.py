@@ -17,7 +17,8 @@ import pytest
 from test_trajectory_sample import check
 from trajectory_helpers import read_back
 
-from ertools.benchmarks.trajectory.benchmark import TrajectoryConfig, score
+from ertools.benchmarks.trajectory.benchmark import score
+from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
 from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC
@@ -158,7 +159,7 @@ def test_one_bag_agrees_with_evo_bag_mode(bags: dict[str, Path]) -> None:
     from evo.tools import file_interface
     from rosbags.rosbag1 import Reader
 
-    from ertools.benchmarks.trajectory.benchmark import COMPARED
+    from ertools.benchmarks.trajectory.association import COMPARED
 
     with Reader(bags["both"]) as reader:
         ref = file_interface.read_bag_trajectory(reader, GT_TOPIC)

@@ -8,19 +8,17 @@ import numpy as np
 import pytest
 
 from ertools.benchmarks.common.clocks import estimate_offset
-from ertools.benchmarks.trajectory.benchmark import (
+from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid
+from ertools.benchmarks.trajectory.association import (
     COMPARED,
     GAP,
     TRACKING_LOST,
     UNCOVERED,
-    TrajectoryConfig,
     associate,
-    check_increasing,
-    drop_duplicates,
-    drop_invalid,
-    metrics,
-    score_streams,
 )
+from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.metrics import metrics
+from ertools.benchmarks.trajectory.scoring import check_increasing, score_streams
 from ertools.errors import ClockError, ConfigError, ScoringError
 from ertools.geometry import quat_from_yaw
 from ertools.streams import PoseStream

@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 from trajectory_helpers import read_back, yaw
 
-from ertools.benchmarks.trajectory.benchmark import TrajectoryConfig, score
+from ertools.benchmarks.trajectory.benchmark import score
+from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.cli.main import main
 from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC, expected_scores, truth_at
 
@@ -224,7 +225,7 @@ def test_gt_read_is_one_read_equal_to_the_whole_cut(
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    import ertools.benchmarks.trajectory.benchmark as tr
+    import ertools.benchmarks.trajectory.inputs as tr
     import ertools.io
     from ertools.io import read_poses
 

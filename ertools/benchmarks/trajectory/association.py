@@ -1,0 +1,186 @@
+"""Each robot pose paired with the GT (hold | nearest | linear), with its status: compared, in a GT
+gap, while mocap tracking was lost (repeated GT poses), or outside the GT.
+
+Also :func:`yaw_tf`, the yaw as the 2015 script computed it (tf.transformations' arithmetic).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from ertools.benchmarks.trajectory.config import BeforeGt, Gaps, Ties
+from ertools.errors import ScoringError
+from ertools.geometry import (
+    Association,
+    interpolate_poses,
+    row_norm,
+    wrap_angle,
+    yaw_from_quat,
+)
+from ertools.streams import PoseStream
+
+F64 = npt.NDArray[np.float64]
+I64 = npt.NDArray[np.int64]
+U8 = npt.NDArray[np.uint8]
+
+# Per-pose status codes of the association.
+COMPARED, GAP, TRACKING_LOST, UNCOVERED = 0, 1, 2, 3
+STATUS_NAMES = ("compared", "gap", "tracking_lost", "uncovered")
+
+
+@dataclass(frozen=True, eq=False)
+class Matched:
+    """Robot poses and their GT counterparts.
+
+    Attributes:
+        t_ns: (N,) robot times on the GT clock (stamps + offset).
+        status: (N,) COMPARED, GAP, TRACKING_LOST or UNCOVERED.
+        gt_xyz, gt_yaw: GT at each robot time (NaN unless compared).
+        position_error: (N,) 3D distance, metres (NaN unless compared).
+        yaw_error: (N,) |wrap(yaw_robot - yaw_gt)|, radians (NaN unless compared).
+        yaw_diff_raw: (N,) yaw_robot - yaw_gt unwrapped, both yaws by tf's arithmetic, as
+            2015 used it (NaN unless compared).
+        exact_ties: robot poses stamped exactly at a GT sample.
+        across_gap: (N,) the robot pose lies in a GT gap longer than the max gap (compared
+            or not, as the ``gaps`` setting says).
+        before_gt: robot poses before the first GT pose.
+    """
+
+    t_ns: I64
+    status: U8
+    gt_xyz: F64
+    gt_yaw: F64
+    position_error: F64
+    yaw_error: F64
+    yaw_diff_raw: F64
+    exact_ties: int
+    across_gap: npt.NDArray[np.bool_]
+    before_gt: int
+
+    def count(self, status: int) -> int:
+        return int(np.count_nonzero(self.status == status))
+
+    @property
+    def gaps_compared(self) -> int:
+        """Robot poses compared with a GT pose across a GT gap (``gaps`` ``compare``)."""
+        return int(np.count_nonzero(self.across_gap & (self.status == COMPARED)))
+
+
+def associate(
+    robot: PoseStream,
+    gt: PoseStream,
+    method: Association,
+    max_gap_ns: int,
+    *,
+    ties: Ties = "at",
+    gaps: Gaps = "skip",
+    before_gt: BeforeGt = "uncovered",
+) -> Matched:
+    """Pair every robot pose with the GT pose at its time.
+
+    Rules, in this order: a robot pose after the last GT pose is UNCOVERED, and so is one
+    before the first unless ``before_gt`` is ``first`` (then it is held at the first GT pose,
+    as 2015 did). One whose surrounding GT poses are more than ``max_gap_ns`` apart lies in a
+    GT gap: a GAP, not compared, unless ``gaps`` is ``compare`` (2015). One whose GT pair
+    (the first GT pose at or after it and the one before that, the 2015 pair) has the same
+    position is TRACKING_LOST; every other pose is COMPARED against the GT pose given by
+    ``method``.
+
+    The surrounding GT poses are the last at or before and the first at or after the robot
+    time (one sample on an exact tie); with ``ties`` ``before`` (hold only) they are the 2015
+    pair on ties too, and ``hold`` takes the first of the pair: the pose before the tie.
+    """
+    if len(gt) == 0:
+        raise ScoringError("the GT stream is empty")
+    n_gt = len(gt)
+    q = robot.t_ns
+    interp = interpolate_poses(gt, q, method)
+    before = interp.hi == 0  # the first GT pose is at or after the robot time
+    early = before & (q < gt.t_ns[0])
+    # The 2015 pair (GT[k-1], GT[k]): k the first GT pose at or after the robot time; the
+    # 2015 script started its scan at the pair (GT[0], GT[1]), so k is at least 1 there.
+    second = interp.hi
+    if ties == "before" or before_gt == "first":
+        widen = early if ties == "at" else before
+        second = np.where(widen, 1, second)
+    first = second - 1
+    has_pair = (first >= 0) & (second < n_gt)
+    fi, si = np.clip(first, 0, n_gt - 1), np.clip(second, 0, n_gt - 1)
+    inside = interp.inside | (early if before_gt == "first" else False)
+    if ties == "before":
+        pair_gap = gt.t_ns.take(si) - gt.t_ns.take(fi)
+        gap_ns = np.where(has_pair, pair_gap, np.iinfo(np.int64).max)
+        gt_xyz_at = _rows(gt.xyz, fi)
+        gt_quat_at = _rows(gt.quat_xyzw, fi)
+    else:
+        gap_ns = interp.gap_ns
+        if before_gt == "first" and n_gt > 1:
+            # Held at the first GT pose: the pair around it is (GT[0], GT[1]), as in 2015.
+            gap_ns = np.where(early, int(gt.t_ns[1] - gt.t_ns[0]), gap_ns)
+        gt_xyz_at, gt_quat_at = interp.xyz, interp.quat_xyzw
+    status = np.full(len(q), COMPARED, dtype=np.uint8)
+    status[~inside] = UNCOVERED
+    across = inside & (gap_ns > max_gap_ns)
+    if gaps == "skip":
+        status[across] = GAP
+    same = has_pair & _same_rows(gt.xyz, fi, si)
+    status[(status == COMPARED) & same] = TRACKING_LOST
+    ok = status == COMPARED
+
+    nan3 = np.full((len(q), 3), np.nan)
+    gt_xyz = np.where(ok[:, None], gt_xyz_at, nan3)
+    gt_yaw = np.where(ok, yaw_from_quat(gt_quat_at), np.nan)
+    robot_yaw = yaw_from_quat(robot.quat_xyzw)
+    pos_err = np.where(ok, row_norm(robot.xyz - gt_xyz_at), np.nan)
+    yaw_err = np.abs(wrap_angle(np.where(ok, robot_yaw - gt_yaw, np.nan)))
+    raw = np.where(ok, yaw_tf(robot.quat_xyzw) - yaw_tf(gt_quat_at), np.nan)
+    ties_n = int(np.count_nonzero(interp.inside & (interp.lo == interp.hi)))
+    return Matched(
+        q, status, gt_xyz, gt_yaw, pos_err, yaw_err, raw, ties_n, across, int(early.sum())
+    )
+
+
+# tf.transformations' ``_EPS`` (4 machine epsilons): its gimbal-lock and zero-norm thresholds.
+_TF_EPS = float(np.finfo(np.float64).eps) * 4.0
+
+
+def yaw_tf(quat_xyzw: F64) -> F64:
+    """Yaw as ``tf.transformations.euler_from_quaternion(q)[2]`` computes it (2015's scripts).
+
+    tf normalises the quaternion inside its rotation matrix, so a quaternion slightly off unit
+    norm gives the yaw of its unit quaternion: atan2(2(xy + zw), w^2 + x^2 - y^2 - z^2), which
+    is :func:`ertools.geometry.yaw_from_quat` for a unit quaternion. At gimbal lock (pitch
+    +-90 degrees) and for a zero quaternion tf returns a yaw of 0.
+    """
+    q = np.asarray(quat_xyzw, dtype=np.float64)
+    x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    n = np.einsum("...i,...i->...", q, q)
+    with np.errstate(invalid="ignore", divide="ignore"):  # a zero quaternion: set to 0 below
+        s = 2.0 / n
+        m00 = 1.0 - (y * y + z * z) * s
+        m10 = (x * y + z * w) * s
+    out = np.arctan2(m10, m00)
+    # tf: identity below _EPS of squared norm; yaw 0 where cos(pitch) (the norm of the
+    # matrix's first column in x, y) is at most _EPS. Squares compared: no square root.
+    flat = (n < _TF_EPS) | (m00 * m00 + m10 * m10 <= _TF_EPS * _TF_EPS)
+    if flat.any():
+        out = np.where(flat, 0.0, out)
+    return np.asarray(out, dtype=np.float64)
+
+
+def _rows(a: F64, index: npt.NDArray[np.intp]) -> F64:
+    """``a[index]`` for a 2D array (``take`` gathers whole rows)."""
+    return np.take(a, index, axis=0)
+
+
+def _same_rows(a: F64, i: npt.NDArray[np.intp], j: npt.NDArray[np.intp]) -> npt.NDArray[np.bool_]:
+    """``np.all(a[i] == a[j], axis=1)``: whole rows gathered by ``take``, compared by column."""
+    ai = np.take(a, i, axis=0)
+    aj = np.take(a, j, axis=0)
+    same: npt.NDArray[np.bool_] = ai[:, 0] == aj[:, 0]
+    for k in range(1, a.shape[1]):
+        same &= ai[:, k] == aj[:, k]
+    return same

@@ -1,0 +1,198 @@
+"""The frozen result of a trajectory comparison (:class:`TrajectoryResult`) and its outputs:
+JSON/YAML/text and the CSV tables.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.common.clocks import OffsetEstimate
+from ertools.benchmarks.trajectory.association import (
+    COMPARED,
+    GAP,
+    STATUS_NAMES,
+    TRACKING_LOST,
+    UNCOVERED,
+    Matched,
+)
+from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.metrics import Metrics
+from ertools.fidelity import Deviation
+from ertools.streams import PoseStream, Provenance
+from ertools.timeutil import NS_PER_S, ns_to_s
+
+
+@dataclass(frozen=True, eq=False)
+class TrajectoryResult:
+    """A scored robot log (implements ``BenchmarkResult``).
+
+    Attributes:
+        robot_file, robot_topic, gt_topic: what was compared.
+        gt_files: the GT files used, by start time.
+        config: the comparison settings.
+        offset_ns: the offset applied to the robot stamps.
+        metrics: None when no pose could be compared.
+        matched: the per-pose association (the error series of the figures).
+        robot: the robot stream (stamps on the robot clock).
+        gt_path: the GT positions, decimated to at most a few thousand points, for figures.
+        audit: the clock-offset estimate.
+        uncovered_spans: robot-time spans outside the GT, (start_ns, end_ns) on the GT clock.
+    """
+
+    robot_file: str
+    robot_topic: str
+    gt_topic: str
+    gt_files: tuple[str, ...]
+    config: TrajectoryConfig
+    offset_ns: int
+    metrics: Metrics | None
+    matched: Matched
+    robot: PoseStream
+    gt_path: PoseStream
+    audit: OffsetEstimate
+    uncovered_spans: tuple[tuple[int, int], ...] = ()
+    warnings: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
+    failures: tuple[str, ...] = ()
+    provenance: Provenance = field(default_factory=Provenance)
+    name: str = "trajectory"
+
+    @property
+    def nothing_scored(self) -> bool:
+        """No robot pose compared, so no metric: the CLI prints only the failure."""
+        return self.metrics is None
+
+    @property
+    def compared(self) -> int:
+        return self.matched.count(COMPARED)
+
+    @property
+    def gaps(self) -> int:
+        return self.matched.count(GAP)
+
+    @property
+    def tracking_lost(self) -> int:
+        return self.matched.count(TRACKING_LOST)
+
+    @property
+    def uncovered(self) -> int:
+        return self.matched.count(UNCOVERED)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Scores, counts and the clock audit (the keys scripts depend on come first)."""
+        m = self.metrics
+        a = self.audit
+        data: dict[str, Any] = {
+            "position_error": None if m is None else m.position_error,
+            "orientation_error": None if m is None else m.orientation_error,
+            "rmse": None if m is None else m.rmse,
+            "median": None if m is None else m.median,
+            "max": None if m is None else m.max,
+            "compared": self.compared,
+            "gaps": self.gaps,
+            "tracking_lost": self.tracking_lost,
+            "gt_files": list(self.gt_files),
+            "association": self.config.association,
+            "offset": ns_to_s(self.offset_ns),
+            "percentiles": None if m is None else {f"p{p:g}": v for p, v in m.percentiles},
+            "orientation_error_2015": None if m is None else m.orientation_error_2015,
+            "uncovered": self.uncovered,
+            "gaps_compared": self.matched.gaps_compared,
+            "before_gt": self.matched.before_gt,
+            "ties": self.config.ties,
+            "gap_poses": self.config.gaps,
+            "before_gt_poses": self.config.before_gt,
+            "robot_poses": len(self.matched.t_ns),
+            "partial": self.uncovered > 0,
+            "uncovered_spans": [[ns_to_s(s), ns_to_s(e)] for s, e in self.uncovered_spans],
+            "max_gap": ns_to_s(self.config.max_gap_ns),
+            "robot_file": self.robot_file,
+            "robot_topic": self.robot_topic,
+            "gt_topic": self.gt_topic,
+            "clock_audit": {
+                "estimated_offset": a.offset_s,
+                "uncertainty": a.uncertainty_s,
+                "applied": self.config.auto_offset and self.config.apply_offset,
+                "residual": None if a.offset_ns is None else ns_to_s(a.offset_ns - self.offset_ns),
+                "search_range": ns_to_s(a.search_range_ns),
+                "poses_used": a.poses_used,
+                "mean_error_at_estimate": a.mean_error,
+                "mean_error_at_zero": a.mean_error_at_zero,
+                "method": a.method,
+                "note": a.note,
+            },
+            "warnings": list(self.warnings),
+            "deviations": list(self.deviations),
+        }
+        out: dict[str, Any] = jsonable(data)
+        return out
+
+    def to_yaml(self) -> str:
+        """The same as :meth:`to_dict` as YAML (the 2015 script printed two text lines)."""
+        return dump_yaml(self.to_dict())
+
+    def tables(self) -> dict[str, Rows]:
+        """``samples`` (one row per robot pose: the error series) and ``summary``."""
+        mt = self.matched
+        t0 = int(mt.t_ns[0]) if len(mt.t_ns) else 0
+        ryaw = self.robot.yaw
+        rows: Rows = [
+            {
+                "t": ns_to_s(int(t)),
+                "t_rel_s": (int(t) - t0) / NS_PER_S,
+                "status": STATUS_NAMES[int(s)],
+                "in_gt_gap": bool(g_),
+                "robot_x": float(r[0]),
+                "robot_y": float(r[1]),
+                "robot_z": float(r[2]),
+                "robot_yaw": float(ry),
+                "gt_x": _f(g[0]),
+                "gt_y": _f(g[1]),
+                "gt_z": _f(g[2]),
+                "gt_yaw": _f(gy),
+                "position_error": _f(e),
+                "yaw_error": _f(ye),
+            }
+            for t, s, g_, r, ry, g, gy, e, ye in zip(
+                mt.t_ns.tolist(),
+                mt.status.tolist(),
+                mt.across_gap.tolist(),
+                self.robot.xyz,
+                ryaw.tolist(),
+                mt.gt_xyz,
+                mt.gt_yaw.tolist(),
+                mt.position_error.tolist(),
+                mt.yaw_error.tolist(),
+                strict=True,
+            )
+        ]
+        d = self.to_dict()
+        summary = {
+            k: d[k]
+            for k in (
+                "position_error",
+                "orientation_error",
+                "rmse",
+                "median",
+                "max",
+                "compared",
+                "gaps",
+                "tracking_lost",
+                "uncovered",
+                "association",
+                "offset",
+                "orientation_error_2015",
+                "gaps_compared",
+            )
+        }
+        summary["estimated_offset"] = d["clock_audit"]["estimated_offset"]
+        summary["offset_uncertainty"] = d["clock_audit"]["uncertainty"]
+        return {"samples": rows, "summary": [summary]}
+
+
+def _f(x: float) -> float | None:
+    return None if np.isnan(x) else float(x)

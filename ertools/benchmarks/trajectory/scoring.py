@@ -1,0 +1,297 @@
+"""The pure scoring of a robot stream against a GT stream (:func:`score_streams`): checks and
+cleans both, runs the clock audit, applies the offset, associates, measures, and says where
+ertools differs from the 2015 script.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+from ertools.benchmarks.common.clocks import OffsetEstimate, estimate_offset
+from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid
+from ertools.benchmarks.trajectory.association import (
+    COMPARED,
+    GAP,
+    TRACKING_LOST,
+    UNCOVERED,
+    Matched,
+    associate,
+)
+from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.metrics import Metrics, metrics
+from ertools.benchmarks.trajectory.result import TrajectoryResult
+from ertools.benchmarks.trajectory.rules import (
+    RULE_ASSOCIATION,
+    RULE_BEFORE_GT,
+    RULE_GAPS,
+    RULE_INVALID_POSES,
+    RULE_TIES,
+    RULE_YAW_WRAP,
+)
+from ertools.errors import ClockError, ScoringError
+from ertools.fidelity import Deviation
+from ertools.streams import PoseStream, Provenance, frame_change_warning
+from ertools.timeutil import iso_utc, ns_to_s
+
+F64 = npt.NDArray[np.float64]
+I64 = npt.NDArray[np.int64]
+
+
+def check_increasing(robot: PoseStream, where: str) -> None:
+    """Raise when the robot stamps (in recording order) do not strictly increase."""
+    if len(robot) < 2:
+        return
+    bad = np.flatnonzero(robot.t_ns[1:] <= robot.t_ns[:-1])
+    if bad.size:
+        i = int(bad[0]) + 1
+        raise ScoringError(
+            f"{where}: robot stamps do not increase: message {i} is stamped "
+            f"{iso_utc(int(robot.t_ns[i]))}, not after message {i - 1} at "
+            f"{iso_utc(int(robot.t_ns[i - 1]))} ({bad.size} such place(s)); "
+            "fix the robot's clock or use --robot-time record"
+        )
+
+
+def _decimate(stream: PoseStream, limit: int = 5000) -> PoseStream:
+    step = max(1, len(stream) // limit)
+    return stream.take(slice(None, None, step))
+
+
+def score_streams(
+    robot: PoseStream,
+    gt: PoseStream,
+    config: TrajectoryConfig,
+    *,
+    robot_file: str = "",
+    robot_topic: str = "",
+    gt_topic: str = "",
+    gt_files: Sequence[str] = (),
+    warnings: Sequence[str] = (),
+) -> TrajectoryResult:
+    """Compare a robot stream (stamps on the robot clock, recording order) with GT.
+
+    Raises:
+        ScoringError: robot stamps not strictly increasing, or empty streams.
+        ClockError: robot poses outside the GT without ``allow_partial``, or no overlap at all.
+    """
+    where = f"{robot_file}:{robot_topic}" if robot_file else "robot log"
+    if len(robot) == 0:
+        raise ScoringError(f"{where}: no robot poses")
+    if len(gt) < 2:
+        raise ScoringError(f"GT {gt_topic}: {len(gt)} pose(s) in the robot log's span")
+    check_increasing(robot, where)
+    notes = list(warnings)
+    notes.extend(w for w in (frame_change_warning(gt), frame_change_warning(robot)) if w)
+    gt, dropped = drop_duplicates(gt)
+    invalid: list[Deviation] = []
+    if dropped:
+        notes.append(f"{dropped} GT sample(s) recorded twice (overlapping GT files) were used once")
+    gt, bad_gt = drop_invalid(gt)
+    robot, bad_robot = drop_invalid(robot)
+    if bad_gt:
+        notes.append(f"{bad_gt} GT sample(s) with NaN or zero-norm poses ignored")
+    if bad_gt or bad_robot:
+        invalid.append(
+            RULE_INVALID_POSES.deviation(
+                f"{bad_gt} GT and {bad_robot} robot pose(s) with NaN or zero-norm quaternions "
+                "ignored (2015 used them: a NaN score, or a yaw of 0)"
+            )
+        )
+    if bad_robot:
+        notes.append(f"{bad_robot} robot pose(s) with NaN or zero-norm poses ignored")
+    if len(robot) == 0:
+        raise ScoringError(
+            f"{where}: no valid robot poses left to compare (NaN or zero quaternions)"
+        )
+    if len(gt) < 2:
+        raise ScoringError(
+            f"GT {gt_topic} in {', '.join(gt_files) or 'the GT files'}: {len(gt)} valid pose(s) "
+            "left in the robot log's span (the others are NaN or zero quaternions)"
+        )
+    audit = estimate_offset(
+        robot, gt, search_range_ns=config.offset_range_ns, max_gap_ns=config.max_gap_ns
+    )
+    offset_ns = config.offset_ns
+    if config.auto_offset and config.apply_offset:
+        if audit.offset_ns is None:
+            raise ClockError(f"{where}: cannot apply the estimated clock offset: {audit.note}")
+        offset_ns = audit.offset_ns
+    shifted = PoseStream(
+        robot.t_ns + offset_ns,
+        robot.xyz,
+        robot.quat_xyzw,
+        robot.frame_id,
+        robot.child_frame_id,
+        robot.source,
+    )
+    matched = associate(
+        shifted,
+        gt,
+        config.association,
+        config.max_gap_ns,
+        ties=config.ties,
+        gaps=config.gaps,
+        before_gt=config.before_gt,
+    )
+    outside = matched.status == UNCOVERED
+    spans = _spans(matched.t_ns, outside)
+    n_out = int(outside.sum())
+    if n_out == len(matched.t_ns):
+        raise ClockError(
+            f"{where}: no robot pose lies within the GT ({iso_utc(gt.start_ns)} to "
+            f"{iso_utc(gt.end_ns)}); robot poses span {iso_utc(int(shifted.t_ns[0]))} to "
+            f"{iso_utc(int(shifted.t_ns[-1]))} (offset {ns_to_s(offset_ns):+.3f} s)"
+        )
+    if n_out:
+        text = ", ".join(
+            f"{iso_utc(a)} to {iso_utc(b)} ({ns_to_s(b - a):.1f} s)" for a, b in spans[:3]
+        )
+        more = f" and {len(spans) - 3} more" if len(spans) > 3 else ""
+        msg = f"{n_out} of {len(matched.t_ns)} robot poses lie outside the GT: {text}{more}"
+        if not config.allow_partial:
+            early = int(np.count_nonzero(outside & (matched.t_ns < gt.t_ns[0])))
+            hint = (
+                f" ({early} lie before the first GT pose: 2015 compared them with it, "
+                "--before-gt first)"
+                if early
+                else ""
+            )
+            raise ClockError(f"{where}: {msg}; give the missing GT files or --allow-partial{hint}")
+        notes.append(f"partial: {msg}; only the covered part is scored")
+
+    m = metrics(matched)
+    failures: list[str] = []
+    if m is None:
+        failures.append(
+            f"no robot pose could be compared ({matched.count(GAP)} in GT gaps, "
+            f"{matched.count(TRACKING_LOST)} while tracking was lost)"
+        )
+    if matched.count(GAP):
+        notes.append(
+            f"{matched.count(GAP)} robot pose(s) fall in GT gaps longer than "
+            f"{ns_to_s(config.max_gap_ns):g} s and are not compared"
+        )
+    if matched.gaps_compared:
+        notes.append(
+            f"{matched.gaps_compared} robot pose(s) fall in GT gaps longer than "
+            f"{ns_to_s(config.max_gap_ns):g} s and are compared with the GT pose "
+            f"{'held' if config.association == 'hold' else 'bridging'} across the gap "
+            "(--gaps compare; 2015: 'result may be invalid')"
+        )
+    if config.before_gt == "first" and matched.before_gt:
+        notes.append(
+            f"{matched.before_gt} robot pose(s) before the first GT pose are compared with "
+            "the first GT pose (--before-gt first; 2015 printed an error and went on)"
+        )
+    if matched.count(TRACKING_LOST):
+        notes.append(
+            f"{matched.count(TRACKING_LOST)} robot pose(s) fall where mocap tracking was lost "
+            "(repeated GT poses) and are not compared"
+        )
+    notes.extend(_audit_warnings(audit, offset_ns))
+    result = TrajectoryResult(
+        robot_file=robot_file,
+        robot_topic=robot_topic,
+        gt_topic=gt_topic,
+        gt_files=tuple(gt_files),
+        config=config,
+        offset_ns=offset_ns,
+        metrics=m,
+        matched=matched,
+        robot=robot,
+        gt_path=_decimate(gt),
+        audit=audit,
+        uncovered_spans=tuple(spans),
+        warnings=tuple(notes),
+        deviations=(*_deviations(config, matched, m), *invalid),
+        failures=tuple(failures),
+        provenance=Provenance(
+            inputs=(robot_file, *gt_files),
+            parameters=(
+                ("robot_topic", robot_topic),
+                ("gt_topic", gt_topic),
+                ("association", config.association),
+                ("ties", config.ties),
+                ("gaps", config.gaps),
+                ("before_gt", config.before_gt),
+                ("max_gap", f"{ns_to_s(config.max_gap_ns):g}"),
+                ("offset", f"{ns_to_s(offset_ns):g}"),
+            ),
+        ),
+    )
+    return result
+
+
+def _audit_warnings(audit: OffsetEstimate, applied_ns: int) -> list[str]:
+    if audit.offset_ns is None:
+        return [f"clock audit: no offset estimate ({audit.note})"]
+    out = []
+    residual = audit.offset_ns - applied_ns
+    sigma = audit.uncertainty_ns or 0
+    # Worth a warning when the residual is both significant (3 sigma) and large enough to
+    # matter for the score (10 ms: 5 mm at a typical 0.5 m/s).
+    if abs(residual) > max(3 * sigma, 10_000_000):
+        out.append(
+            f"clock audit: the robot stamps fit the GT best shifted by "
+            f"{ns_to_s(audit.offset_ns):+.3f} +- {ns_to_s(sigma):.3f} s, but the score uses "
+            f"{ns_to_s(applied_ns):+.3f} s; check the clocks, or re-run with "
+            "--offset auto --apply-offset"
+        )
+    if audit.note:
+        out.append(f"clock audit: {audit.note}")
+    return out
+
+
+def _deviations(config: TrajectoryConfig, m: Matched, metr: Metrics | None) -> list[Deviation]:
+    out = []
+    if config.association != "hold":
+        out.append(
+            RULE_ASSOCIATION.deviation(
+                f"association {config.association} (2015: hold, the GT pose before the robot pose)"
+            )
+        )
+    elif config.ties == "at" and m.exact_ties:
+        out.append(
+            RULE_TIES.deviation(
+                f"{m.exact_ties} robot pose(s) stamped exactly at a GT sample use that sample "
+                "(2015 used the one before it)"
+            )
+        )
+    if m.count(GAP):
+        out.append(
+            RULE_GAPS.deviation(
+                f"{m.count(GAP)} robot pose(s) in GT gaps > {ns_to_s(config.max_gap_ns):g} s "
+                "not compared (2015 compared them with the held pose and only warned)"
+            )
+        )
+    if config.before_gt == "uncovered" and m.before_gt:
+        out.append(
+            RULE_BEFORE_GT.deviation(
+                f"{m.before_gt} robot pose(s) before the first GT pose not scored (2015 compared "
+                "them with the first GT pose)"
+            )
+        )
+    wrapped = int(np.count_nonzero(np.abs(m.yaw_diff_raw[m.status == COMPARED]) > np.pi))
+    if wrapped and metr is not None:
+        out.append(
+            RULE_YAW_WRAP.deviation(
+                f"yaw differences wrapped to [-pi, pi] ({wrapped} pose(s) crossed +-pi; 2015 did "
+                f"not wrap: its orientation error, orientation_error_2015, is "
+                f"{metr.orientation_error_2015:.4f} rad)"
+            )
+        )
+    return out
+
+
+def _spans(t_ns: I64, mask: npt.NDArray[np.bool_]) -> list[tuple[int, int]]:
+    """(first, last) times of each run of consecutive True in ``mask``."""
+    idx = np.flatnonzero(mask)
+    if idx.size == 0:
+        return []
+    breaks = np.flatnonzero(np.diff(idx) > 1)
+    starts = np.concatenate([[idx[0]], idx[breaks + 1]])
+    ends = np.concatenate([idx[breaks], [idx[-1]]])
+    return [(int(t_ns[a]), int(t_ns[b])) for a, b in zip(starts, ends, strict=True)]
