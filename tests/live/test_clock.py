@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import json
 import re
 
 import pytest
+import yaml
 from live_helpers import fake_sntp_server, free_udp_port
 
 from ertools.cli.main import main
@@ -68,10 +70,6 @@ def test_cli_unreachable_is_one_line(capsys: pytest.CaptureFixture[str]) -> None
 
 
 def test_cli_json_and_yaml_give_the_numbers(capsys: pytest.CaptureFixture[str]) -> None:
-    import json
-
-    import yaml
-
     with fake_sntp_server(-0.25) as port:
         base = ["clock", "--server", "127.0.0.1", "--port", str(port), "--tolerance", "0.5"]
         assert main([*base, "--format", "json"]) == 0
