@@ -21,8 +21,13 @@ import logging
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Literal
 
+from ertools.benchmarks.common.spec import (
+    DEFAULT_PARENT,
+    DEFAULT_TIME_SOURCE,
+    TIME_SOURCES,
+    TimeSource,
+)
 from ertools.errors import TopicError, UsageError
 from ertools.io import PoseSource, read_pose_source, topics
 from ertools.io.model import POSE_TYPES, TF_TYPES
@@ -30,13 +35,6 @@ from ertools.streams import PoseStream
 
 log = logging.getLogger(__name__)
 
-TimeSource = Literal["header", "record"]
-TIME_SOURCES: tuple[TimeSource, ...] = ("header", "record")
-# One default for every command: the message stamp is the mocap's own clock, the same on
-# every machine that logged it; the record time is when one machine's recorder got it.
-DEFAULT_TIME_SOURCE: TimeSource = "header"
-# The parent frame a bare child frame is read in: the mocap frame of the 2015 arena.
-DEFAULT_PARENT = "world"
 # Message types with no header stamp: ``header`` falls back on the record time there.
 HEADERLESS_TYPES = ("geometry_msgs/Pose2D",)
 
@@ -105,19 +103,6 @@ def topic(name: str, time_source: TimeSource = DEFAULT_TIME_SOURCE) -> PoseSpec:
 def tf(child: str, parent: str = DEFAULT_PARENT) -> PoseSpec:
     """A tf default (for :func:`choose_source`'s ``defaults``)."""
     return PoseSpec(tf=(parent, child))
-
-
-def parse_tf(text: str) -> tuple[str, str]:
-    """``PARENT:CHILD`` as a pair of frame names.
-
-    Raises:
-        ValueError: not two non-empty names around one colon (argparse turns it into a usage
-            error, exit 2).
-    """
-    parent, sep, child = text.partition(":")
-    if not sep or not parent or not child or ":" in child:
-        raise ValueError(f"{text!r}: give PARENT:CHILD, e.g. world:robot_at_work")
-    return parent, child
 
 
 def pose_topics(present: Mapping[str, str]) -> list[str]:
