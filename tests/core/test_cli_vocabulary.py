@@ -15,12 +15,12 @@ import yaml
 from ertools.benchmarks.common.sources import (
     PoseSpec,
     choose_source,
-    parse_tf,
     read_source,
     tf,
     time_source_fallback,
     topic,
 )
+from ertools.benchmarks.common.spec import parse_tf
 from ertools.cli.main import build_parser, main
 from ertools.errors import TopicError, UsageError
 
