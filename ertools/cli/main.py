@@ -68,12 +68,12 @@ COMMANDS: dict[str, Command] = {
     "report": Command(
         "ertools.cli.report",
         "combine several results into one HTML page",
-        "ertools report results/*/score.json --out competition/",
+        "ertools report results/*/score.json --report competition/",
     ),
     "record": Command(
         "ertools.cli.record",
         "record OptiTrack NatNet mocap data to MCAP, no ROS needed",
-        "ertools record --config mocap.yaml --out logs/",
+        "ertools record --config mocap.yaml --out-dir logs/",
     ),
     "monitor": Command(
         "ertools.cli.monitor",

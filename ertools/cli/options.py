@@ -26,12 +26,19 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from ertools.benchmarks.common.spec import (
+    DEFAULT_PARENT,
+    DEFAULT_TIME_SOURCE,
+    TIME_SOURCES,
+    parse_tf,
+)
+
 if TYPE_CHECKING:
     from ertools.benchmarks.common.sources import PoseSpec
 
-# ``ertools.benchmarks.common.sources`` reads bags (numpy, rosbags): it is imported inside the
-# pose-source builders below, so that a command reading no poses (clock, record, report,
-# info, timeline) builds its parser without loading them (``ertools clock`` stays instant).
+# ``ertools.benchmarks.common.sources`` reads bags (numpy, rosbags): only :func:`pose_spec`
+# (run time, when poses are read anyway) imports it; the builders use the light
+# ``common.spec``, so that every parser, ``--help`` included, builds without the readers.
 
 FORMATS = ("text", "json", "yaml", "csv")
 # Suffixes ``--plot FILE`` can write with matplotlib (html is the timeline's own page).
@@ -206,8 +213,6 @@ def seconds_or_auto(text: str) -> str | float:
 
 def tf_pair(text: str) -> tuple[str, str]:
     """``PARENT:CHILD`` (argparse ``type=``)."""
-    from ertools.benchmarks.common.sources import parse_tf  # bag readers: see the top
-
     try:
         return parse_tf(text)
     except ValueError as err:
@@ -240,8 +245,6 @@ def add_pose_source(
             ``--tf world:FRAME`` with a deprecation note).
         old_topic: old spellings of the topic (``--robot-topic`` where the new name differs).
     """
-    from ertools.benchmarks.common.sources import DEFAULT_PARENT  # bag readers: see the top
-
     which = parser.add_mutually_exclusive_group()
     tail = f" (default: {default})" if default else ""
     which.add_argument(
@@ -281,11 +284,6 @@ def add_time_source(
     ``header`` is the message stamp (the mocap's clock); a type without a header
     (``geometry_msgs/Pose2D``) falls back on the record time with a warning on stderr.
     """
-    from ertools.benchmarks.common.sources import (  # bag readers: see the top
-        DEFAULT_TIME_SOURCE,
-        TIME_SOURCES,
-    )
-
     parser.add_argument(
         f"--{prefix}time-source",
         dest=_dest(prefix, "time_source"),
@@ -306,15 +304,13 @@ def add_time_source(
 
 
 def _time_source_value(text: str) -> str:
-    if text not in ("header", "record"):
+    if text not in TIME_SOURCES:
         raise ValueError(f"{text!r}: choose header or record")
     return text
 
 
 def time_source(args: argparse.Namespace, prefix: str = "") -> str:
     """The time source asked for, the common default when none was."""
-    from ertools.benchmarks.common.sources import DEFAULT_TIME_SOURCE  # bag readers: see the top
-
     value = getattr(args, _dest(prefix, "time_source"), None)
     return str(value) if value is not None else DEFAULT_TIME_SOURCE
 
@@ -327,10 +323,7 @@ def pose_spec(
     ``time_prefix`` names the time-source option's prefix when it differs from ``prefix``
     (default: the same; a command with one ``--time-source`` for two sources passes ``""``).
     """
-    from ertools.benchmarks.common.sources import (  # bag readers: see the top
-        DEFAULT_TIME_SOURCE,
-        PoseSpec,
-    )
+    from ertools.benchmarks.common.sources import PoseSpec  # bag readers: see the top
 
     tp = prefix if time_prefix is None else time_prefix
     given = getattr(args, _dest(tp, "time_source"), None)

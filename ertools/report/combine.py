@@ -30,7 +30,19 @@ from ertools.report import html as h
 from ertools.report import units
 
 # Command-line options that choose where or how output is written, not what is scored.
-_OUTPUT_OPTIONS = frozenset({"-o", "--output", "--report", "--plot", "--foxglove", "--format"})
+_OUTPUT_OPTIONS = frozenset(
+    {
+        "-o",
+        "--out",
+        "--output",
+        "--out-dir",
+        "--report",
+        "--plot",
+        "--plots",
+        "--foxglove",
+        "--format",
+    }
+)
 _OUTPUT_FLAGS = frozenset({"-v", "--verbose", "-q", "--quiet"})
 # Team sources, best first (ertools.benchmarks.common.teams.resolve_team's precedence).
 _SOURCE_RANK = {"explicit": 0, "payload": 1, "log name": 2, "transform": 3}

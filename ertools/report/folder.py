@@ -44,7 +44,9 @@ TABLE_MAX_ROWS = 200  # longer tables are in the CSV only
 TABLE_OPEN_ROWS = 30  # longer tables are folded in the page
 _CHUNK = 1 << 20
 _EPOCH_COLUMNS = ("time", "from_time", "start_time")
-_OUTPUT_OPTIONS = frozenset({"-o", "--output", "--report", "--plot", "--out"})
+_OUTPUT_OPTIONS = frozenset(
+    {"-o", "--output", "--report", "--plot", "--plots", "--out", "--out-dir", "--foxglove"}
+)
 
 
 @dataclass(frozen=True)

@@ -15,12 +15,12 @@ import yaml
 from ertools.benchmarks.common.sources import (
     PoseSpec,
     choose_source,
-    parse_tf,
     read_source,
     tf,
     time_source_fallback,
     topic,
 )
+from ertools.benchmarks.common.spec import parse_tf
 from ertools.cli.main import build_parser, main
 from ertools.errors import TopicError, UsageError
 
@@ -392,3 +392,19 @@ def test_time_source_fallback_is_said(
         [STATIONARY], PoseSpec(topic="/fbm3w/robot_at_work/pose2d", time_source="record")
     )
     assert (header.t_ns == record_poses.t_ns).all()
+
+
+def test_timeline_yaml_holds_what_its_json_holds(capsys: pytest.CaptureFixture[str]) -> None:
+    bags = SAMPLES / "fbm3w"
+    code, out_json, _ = run(capsys, "timeline", bags, "--format", "json", "--no-clock-check")
+    assert code == 0
+    code, out_yaml, _ = run(capsys, "timeline", bags, "--format", "yaml", "--no-clock-check")
+    assert code == 0
+    from_json, from_yaml = json.loads(out_json), yaml.safe_load(out_yaml)
+    assert from_yaml.keys() == from_json.keys() == {"bags", "sessions", "problems"}
+    assert [b["path"] for b in from_yaml["bags"]] == [b["path"] for b in from_json["bags"]]
+    # epoch seconds: YAML rounds floats to 9 decimals (1 ns), below a float's step at 1.4e9 s
+    # (2.4e-7 s), so the values agree to the nanosecond
+    for a, b in zip(from_yaml["bags"], from_json["bags"], strict=True):
+        assert a["start"] == pytest.approx(b["start"], abs=1e-9)
+        assert a["duration"] == pytest.approx(b["duration"], abs=1e-9)

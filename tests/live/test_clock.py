@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import json
 import re
 
 import pytest
+import yaml
 from live_helpers import fake_sntp_server, free_udp_port
 
 from ertools.cli.main import main
@@ -65,3 +67,17 @@ def test_cli_unreachable_is_one_line(capsys: pytest.CaptureFixture[str]) -> None
     err = capsys.readouterr().err.strip()
     assert code == 1
     assert err.count("\n") == 0 and "unreachable" in err and err.startswith("ertools: error:")
+
+
+def test_cli_json_and_yaml_give_the_numbers(capsys: pytest.CaptureFixture[str]) -> None:
+    with fake_sntp_server(-0.25) as port:
+        base = ["clock", "--server", "127.0.0.1", "--port", str(port), "--tolerance", "0.5"]
+        assert main([*base, "--format", "json"]) == 0
+        data = json.loads(capsys.readouterr().out)
+        assert main([*base, "--format", "yaml", "--tolerance", "0.01"]) == 1
+        outside = yaml.safe_load(capsys.readouterr().out)
+    for got in (data, outside):
+        assert abs(got["offset"] - -0.25) <= got["delay"] / 2 + 2e-6  # SNTP's bound
+        assert got["stratum"] == 2 and got["port"] == port
+    assert data["within_tolerance"] is True and data["tolerance"] == 0.5
+    assert outside["within_tolerance"] is False and outside["tolerance"] == 0.01

@@ -21,8 +21,13 @@ import logging
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Literal
 
+from ertools.benchmarks.common.spec import (
+    DEFAULT_PARENT,
+    DEFAULT_TIME_SOURCE,
+    TIME_SOURCES,
+    TimeSource,
+)
 from ertools.errors import TopicError, UsageError
 from ertools.io import PoseSource, read_pose_source, topics
 from ertools.io.model import POSE_TYPES, TF_TYPES
@@ -30,13 +35,6 @@ from ertools.streams import PoseStream
 
 log = logging.getLogger(__name__)
 
-TimeSource = Literal["header", "record"]
-TIME_SOURCES: tuple[TimeSource, ...] = ("header", "record")
-# One default for every command: the message stamp is the mocap's own clock, the same on
-# every machine that logged it; the record time is when one machine's recorder got it.
-DEFAULT_TIME_SOURCE: TimeSource = "header"
-# The parent frame a bare child frame is read in: the mocap frame of the 2015 arena.
-DEFAULT_PARENT = "world"
 # Message types with no header stamp: ``header`` falls back on the record time there.
 HEADERLESS_TYPES = ("geometry_msgs/Pose2D",)
 
@@ -75,6 +73,13 @@ class PoseSpec:
     def tf_text(self) -> str:
         return f"{self.tf[0]}:{self.tf[1]}" if self.tf is not None else ""
 
+    @property
+    def name(self) -> str:
+        """The source in messages: the topic, or ``tf PARENT:CHILD``."""
+        if self.topic is not None:
+            return self.topic
+        return f"tf {self.tf_text}" if self.tf is not None else "the default source"
+
     def describe(self) -> str:
         """How the user would spell it: ``--topic /x`` or ``--tf world:robot``."""
         if self.topic is not None:
@@ -100,19 +105,6 @@ def tf(child: str, parent: str = DEFAULT_PARENT) -> PoseSpec:
     return PoseSpec(tf=(parent, child))
 
 
-def parse_tf(text: str) -> tuple[str, str]:
-    """``PARENT:CHILD`` as a pair of frame names.
-
-    Raises:
-        ValueError: not two non-empty names around one colon (argparse turns it into a usage
-            error, exit 2).
-    """
-    parent, sep, child = text.partition(":")
-    if not sep or not parent or not child or ":" in child:
-        raise ValueError(f"{text!r}: give PARENT:CHILD, e.g. world:robot_at_work")
-    return parent, child
-
-
 def pose_topics(present: Mapping[str, str]) -> list[str]:
     """The topics of ``present`` (name -> type) that hold poses (tf topics excluded)."""
     return [t for t, ty in present.items() if ty in POSE_TYPES and ty not in TF_TYPES]
@@ -126,55 +118,66 @@ def choose_source(
     what: str = "poses",
     only_topic: bool = False,
     present: Mapping[str, str] | None = None,
+    flags: str = "--topic TOPIC or --tf PARENT:CHILD",
 ) -> PoseSpec:
-    """The pose source to read: ``spec`` when given, else the first default in the bags.
+    """The pose source to read: ``spec`` when given, else the first default in the bags
+    (a warning when it is not the first one).
 
     Args:
         paths: the bags (their indexes are read, no messages).
         spec: what the command line gave; its time source applies to a default topic too.
         defaults: the command's usual sources, best first (topics and tf pairs).
         what: what the poses are, for messages ("end-effector poses").
-        only_topic: with no default present, use the bags' only pose topic (with a note).
+        only_topic: with no default present, use the bags' only pose topic (with a warning).
         present: the bags' topics (name -> type) when the caller has them already.
+        flags: how the user names a source in this command (for the error message).
 
     Raises:
         TopicError: the given topic is not in the bags, or no default and no single pose topic.
     """
+    chosen, fallback = _choose(paths, spec, defaults, what, only_topic, present, flags)
+    if fallback is not None:
+        log.warning("%s", fallback)
+    return chosen
+
+
+def _choose(
+    paths: Sequence[str | Path],
+    spec: PoseSpec,
+    defaults: Sequence[PoseSpec],
+    what: str,
+    only_topic: bool,
+    present: Mapping[str, str] | None,
+    flags: str,
+) -> tuple[PoseSpec, str | None]:
+    """(the source, the warning to give when it is a fallback, else None)."""
     if present is None:
         present = topics(list(paths))
-    flag_hint = "choose one with --topic TOPIC or --tf PARENT:CHILD"
     if spec.topic is not None:
         if spec.topic not in present:
             there = ", ".join(pose_topics(present)) or "none"
             raise TopicError(
                 f"{spec.topic}: no such topic (pose topics there: {there})", path=paths[0]
             )
-        return spec
+        return spec, None
     if spec.tf is not None:
-        return spec
+        return spec, None
     for index, default in enumerate(defaults):
         found = default.tf is not None and any(t in present for t in ("/tf", "/tf_static"))
-        found = found or default.topic in present
-        if not found:
-            continue
-        chosen = replace(default, time_source=spec.time_source)
-        if index > 0:
-            log.warning(
-                "%s absent; %s: using %s",
-                defaults[0].describe().split(" ", 1)[1],
-                what,
-                chosen.describe().split(" ", 1)[1],
-            )
-        return chosen
+        if found or default.topic in present:
+            chosen = replace(default, time_source=spec.time_source)
+            if index == 0:
+                return chosen, None
+            return chosen, f"{defaults[0].name} absent; {what}: using {chosen.name}"
     found_topics = pose_topics(present)
     if only_topic and len(found_topics) == 1:
-        log.warning("%s: using the only pose topic %s", what, found_topics[0])
-        return PoseSpec(topic=found_topics[0], time_source=spec.time_source)
-    tried = ", ".join(d.describe().split(" ", 1)[1] for d in defaults)
+        only = PoseSpec(topic=found_topics[0], time_source=spec.time_source)
+        return only, f"{what}: using the only pose topic {found_topics[0]}"
+    tried = ", ".join(d.name for d in defaults)
     raise TopicError(
         f"no {what}"
         + (f": {tried} absent" if tried else "")
-        + f" (pose topics there: {', '.join(found_topics) or 'none'}); {flag_hint}",
+        + f" (pose topics there: {', '.join(found_topics) or 'none'}); choose one with {flags}",
         path=paths[0],
     )
 
@@ -201,22 +204,39 @@ def read_source(
     only_topic: bool = False,
     start_ns: int | None = None,
     end_ns: int | None = None,
+    flags: str = "--topic TOPIC or --tf PARENT:CHILD",
+    allow_empty: bool = False,
 ) -> PoseStream:
     """Choose the source (:func:`choose_source`) and read its poses, warning on a fallback.
 
+    ``allow_empty``: a window with no pose is the caller's to report (per run, say), not an
+    error of the source.
+
     Raises:
-        TopicError: no source, or the chosen one holds no pose.
+        TopicError: no source, or the chosen one holds no pose (unless ``allow_empty``).
     """
     present = topics(list(paths))
-    chosen = choose_source(paths, spec, defaults, what=what, only_topic=only_topic, present=present)
-    fallback = time_source_fallback(chosen, present)
+    chosen, fallback = _choose(paths, spec, defaults, what, only_topic, present, flags)
+    try:
+        poses = read_pose_source(list(paths), chosen.to_io(), start_ns=start_ns, end_ns=end_ns)
+    except TopicError as err:
+        if fallback is None:
+            raise
+        # the usual source is absent and the fallback fails too: one line saying both
+        raise TopicError(
+            f"no {what}: {defaults[0].name} absent and {chosen.name}: {err.message}; "
+            f"choose one with {flags}",
+            path=paths[0],
+        ) from err
     if fallback is not None:
+        log.warning("%s", fallback)
+    headerless = time_source_fallback(chosen, present)
+    if headerless is not None:
         # A warning when the user chose the topic or the time: what they asked for is not
         # what they get. A command's own default topic being Pose2D is the 2015 setup (the
         # nodes read the pose2d topics live): said with -v only, not on every run.
         loud = spec.topic is not None or spec.time_source_given
-        log.log(logging.WARNING if loud else logging.INFO, "%s", fallback)
-    poses = read_pose_source(list(paths), chosen.to_io(), start_ns=start_ns, end_ns=end_ns)
-    if len(poses) == 0:
+        log.log(logging.WARNING if loud else logging.INFO, "%s", headerless)
+    if len(poses) == 0 and not allow_empty:
         raise TopicError(f"{poses.source or chosen.describe()}: no pose messages", path=paths[0])
     return poses

@@ -571,27 +571,26 @@ def read_body(
     frame: str,
     window: tuple[int | None, int | None] = (None, None),
 ) -> PoseStream:
-    """A body's poses: the given source, else the 2015 topic, else its /tf frame."""
-    from ertools.errors import TopicError
-    from ertools.io import PoseSource, read_pose_source
+    """A body's poses: the given source, else the 2015 topic, else its /tf frame (the one
+    chooser, :func:`ertools.benchmarks.common.sources.read_source`)."""
+    from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
+    from ertools.io import read_pose_source
 
     start, end = window
     if source is not None:
         stream: PoseStream = read_pose_source(paths, source, start_ns=start, end_ns=end)
         return stream
-    try:
-        return read_pose_source(paths, PoseSource(topic=default_topic), start_ns=start, end_ns=end)
-    except TopicError as topic_err:
-        try:
-            stream = read_pose_source(paths, PoseSource(frame=frame), start_ns=start, end_ns=end)
-        except TopicError:
-            raise TopicError(
-                f"{topic_err.message}; no /tf frame {frame!r} either "
-                f"(choose the {frame} body with --{frame.replace('_', '-')}-topic or "
-                f"--{frame.replace('_', '-')}-tf PARENT:CHILD)"
-            ) from topic_err
-        log.info("%s: using /tf frame %s (no %s)", paths[0], frame, default_topic)
-        return stream
+    flag = frame.replace("_", "-")
+    return read_source(
+        paths,
+        PoseSpec(),
+        (topic(default_topic), tf(frame)),
+        what=f"{frame} poses",
+        start_ns=start,
+        end_ns=end,
+        flags=f"--{flag}-topic TOPIC or --{flag}-tf PARENT:CHILD",
+        allow_empty=True,  # a body lost around every run fails those runs, one by one
+    )
 
 
 @dataclass(frozen=True, eq=False)

@@ -40,7 +40,7 @@ from ertools.streams import PoseStream, Provenance, frame_change_warning
 from ertools.timeutil import ns_to_s, s_to_ns
 
 if TYPE_CHECKING:
-    from ertools.io import PoseSource
+    from ertools.benchmarks.common.sources import PoseSpec
 
 log = logging.getLogger("ertools.benchmarks.fbm2h.benchmark")
 
@@ -461,19 +461,17 @@ def _load_transform(options: Fbm2hOptions) -> MarkerTransform:
     return identity_transform()
 
 
-def _pose_source(options: Fbm2hOptions) -> PoseSource:
-    from ertools.io import PoseSource
+def _pose_spec(options: Fbm2hOptions) -> PoseSpec:
+    """The marker set's source for the one chooser (benchmarks/common/sources.py)."""
+    from ertools.benchmarks.common.sources import PoseSpec
 
     if options.topic is not None and options.tf_frame is not None:
         raise ConfigError("give either --topic or --tf, not both")
-    if options.tf_frame is not None:
-        return PoseSource(
-            topic=None,
-            frame=options.tf_frame,
-            parent=options.tf_parent,
-            time_source=options.time_source,
-        )
-    return PoseSource(topic=options.topic or DEFAULT_TOPIC, time_source=options.time_source)
+    return PoseSpec(
+        topic=options.topic,
+        tf=None if options.tf_frame is None else (options.tf_parent, options.tf_frame),
+        time_source="record" if options.time_source == "record" else "header",
+    )
 
 
 def _compare_goal(goal: GoalList, payload: str, topic: str) -> str | None:
@@ -528,15 +526,18 @@ def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
             state topics when the reached moments need them.
     """
     from ertools.benchmarks.common.hygiene import drop_invalid
+    from ertools.benchmarks.common.sources import read_source, topic
     from ertools.configs.goal import load_goal
-    from ertools.io import read_benchmark_states, read_pose_source, summary
+    from ertools.io import read_benchmark_states, summary
 
     if not paths:
         raise ConfigError("no bag given")
     plist = tuple(Path(p) for p in paths)
     transform = _load_transform(options)
     goal = load_goal(options.goal) if options.goal is not None else None
-    marker = read_pose_source(list(plist), _pose_source(options))
+    marker = read_source(
+        list(plist), _pose_spec(options), (topic(DEFAULT_TOPIC),), what="marker set poses"
+    )
     if len(marker) == 0:
         raise SegmentationError(f"{marker.source or plist[0]}: the marker set pose stream is empty")
     total = len(marker)

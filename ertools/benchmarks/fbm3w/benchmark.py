@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
 from ertools.benchmarks.fbm3w.path import score_path
 from ertools.benchmarks.fbm3w.result import Fbm3wResult, RunResult
 from ertools.benchmarks.fbm3w.runs import (
@@ -35,7 +36,7 @@ from ertools.benchmarks.noise.benchmark import (
 )
 from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
 from ertools.configs.shapes import Shape
-from ertools.errors import ConfigError, ErtoolsError, ScoringError, TopicError
+from ertools.errors import ConfigError, ErtoolsError, ScoringError
 from ertools.fidelity import Deviation, Rule
 from ertools.io.model import BenchmarkStates
 from ertools.progress import Reporter, current
@@ -235,35 +236,17 @@ def read_fbm3w_poses(paths: Sequence[Path], options: Fbm3wOptions) -> PoseStream
     Raises:
         TopicError: none of them is in the bags (the message lists the pose topics there are).
     """
-    from ertools.io import PoseSource, read_pose_source, topics
-
-    if options.topic is not None:
-        source = PoseSource(topic=options.topic, time_source=options.time_source)
-    elif options.frame is not None:
-        source = PoseSource(frame=options.frame, parent=options.tf_parent)
-    else:
-        present = topics(paths)
-        if DEFAULT_TOPIC in present:
-            source = PoseSource(topic=DEFAULT_TOPIC, time_source=options.time_source)
-        elif FALLBACK_TOPIC in present:
-            log.warning("%s absent; using %s", DEFAULT_TOPIC, FALLBACK_TOPIC)
-            source = PoseSource(topic=FALLBACK_TOPIC, time_source=options.time_source)
-        elif "/tf" in present:
-            log.warning("%s absent; using the /tf frame %s", DEFAULT_TOPIC, DEFAULT_FRAME)
-            source = PoseSource(frame=DEFAULT_FRAME)
-        else:
-            from ertools.io.model import POSE_TYPES
-
-            found = [t for t, ty in present.items() if ty in POSE_TYPES]
-            raise TopicError(
-                f"no end-effector poses: {DEFAULT_TOPIC}, {FALLBACK_TOPIC} and /tf are absent "
-                f"(pose topics there: {', '.join(found) or 'none'}); choose one with --topic",
-                path=paths[0],
-            )
-    poses = read_pose_source(paths, source)
-    if len(poses) == 0:
-        raise TopicError(f"{poses.source or source.topic}: no pose messages", path=paths[0])
-    return poses
+    # the one pose-source chooser (benchmarks/common/sources.py): the given source, else the
+    # first of pose2d, pose, the tf frame present, with a warning when not the first
+    spec = PoseSpec(
+        topic=options.topic,
+        tf=None
+        if options.topic is not None or options.frame is None
+        else (options.tf_parent, options.frame),
+        time_source="record" if options.time_source == "record" else "header",
+    )
+    defaults = (topic(DEFAULT_TOPIC), topic(FALLBACK_TOPIC), tf(DEFAULT_FRAME))
+    return read_source(paths, spec, defaults, what="end-effector poses")
 
 
 @dataclass(frozen=True, eq=False)

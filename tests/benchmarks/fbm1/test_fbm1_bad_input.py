@@ -152,7 +152,7 @@ def test_cli_body_missing_from_the_bag(
     assert code == 1 and out == ""
     lines = err.strip().splitlines()
     assert len(lines) == 1
-    assert f"/fbm1h/{body}/pose" in lines[0] and f"tf frame '{body}'" in lines[0]
+    assert f"/fbm1h/{body}/pose" in lines[0] and f"tf world:{body}" in lines[0]
 
 
 def test_results_file_replaces_payloads_and_bad_entry_fails_its_run(

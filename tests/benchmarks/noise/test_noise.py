@@ -111,7 +111,7 @@ def test_bad_inputs(
     stationary: tuple[Path, dict[str, Any]], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     bag, _ = stationary
-    assert main(["noise", str(bag), "--bin", "0"]) == 2  # a usage error (the vocabulary)
+    assert main(["noise", str(bag), "--bin", "0"]) == 2  # a usage error, refused by the parser
     err = capsys.readouterr().err
     assert "--bin" in err and "Traceback" not in err
     assert main(["noise", str(bag), "--topic", "/nope"]) == 1
