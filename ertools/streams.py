@@ -275,35 +275,3 @@ def concatenate_poses(streams: Sequence[PoseStream]) -> PoseStream:
         ";".join(dict.fromkeys(s.source for s in streams)),
         tuple(changes[:MAX_FRAME_CHANGES]),
     )
-
-
-def frame_change_warning(stream: PoseStream, origin_ns: int | None = None) -> str | None:
-    """One warning line when the stream's frame names change mid-log, else None.
-
-    A ground-truth topic whose ``frame_id`` changes (the mocap re-published in another frame,
-    two publishers on one topic) mixes poses of different frames: every number computed
-    across the change compares coordinates that do not belong together.
-
-    Args:
-        stream: the pose stream.
-        origin_ns: times are printed relative to it (the log's first message) when given,
-            else as UTC.
-    """
-    if not stream.frame_changes:
-        return None
-    from ertools.timeutil import iso_utc
-
-    def when(t: int) -> str:
-        return f"{(t - origin_ns) / 1e9:.3f} s" if origin_ns is not None else iso_utc(t)
-
-    shown = stream.frame_changes[:3]
-    listed = "; ".join(f"{c.field} {c.old!r} -> {c.new!r} at {when(c.t_ns)}" for c in shown)
-    more = len(stream.frame_changes) - len(shown)
-    many = " (and more)" if len(stream.frame_changes) >= MAX_FRAME_CHANGES else ""
-    extra = f"; {more} more change(s){many}" if more > 0 else ""
-    since = " from the log's first message" if origin_ns is not None else ""
-    return (
-        f"{stream.source or 'the pose stream'}: the frame names change in the middle of the "
-        f"log ({listed}{extra}; times{since}): poses on either side may be in different frames "
-        "and numbers computed across the change mix them"
-    )

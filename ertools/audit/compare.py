@@ -14,14 +14,13 @@ Pure: no file is read here. :func:`attach` puts a comparison into an
 
 from __future__ import annotations
 
-import math
 import re
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
+from ertools.audit.explain import explain, is_number
 from ertools.audit.model import Audit, ScoreComparison, ScoreLine
-from ertools.benchmarks import registry
-from ertools.benchmarks.base import Explanation, jsonable
+from ertools.benchmarks.base import jsonable
 from ertools.configs.transform import LIVE_TRANSFORM_KEY, MarkerTransform, live_transform
 
 if TYPE_CHECKING:
@@ -123,91 +122,6 @@ def _align_indices(live: Any, recomputed: Any, notes: list[str], path: str = "")
 
 
 # --------------------------------------------------------------------------------------------
-# Explanations
-
-
-# Explanations every benchmark shares; a benchmark declares its own
-# (:attr:`ertools.benchmarks.base.Benchmark.explanations`), tried first.
-_GENERAL: tuple[Explanation, ...] = (
-    Explanation(
-        r"(time|_time)$",
-        "the live node timed with its own wall clock (time.time()) as messages arrived; "
-        "ertools uses the record times of the logged state messages (differences of a few "
-        "milliseconds up to one 10 Hz heartbeat per transition)",
-    ),
-)
-
-_WORDS = re.compile(r"[a-z]+")
-_STOP_WORDS = frozenset({"error", "errors", "accuracy", "details", "best", "total", "value"})
-
-
-def explain(
-    key: str,
-    live: Any,
-    recomputed: Any,
-    *,
-    benchmark: str,
-    parameters: tuple[tuple[str, str], ...],
-    deviations: tuple[str, ...],
-    warnings: tuple[str, ...] = (),
-) -> str:
-    """Why ``live`` and ``recomputed`` differ at ``key``: rules, recognised patterns,
-    matching deviations from 2015, the scorer's warnings about the same parameters (d_min
-    below the noise...) and the relevant parameter values."""
-    leaf = key.rsplit(".", 1)[-1].lower()
-    parts: list[str] = []
-    wanted: list[str] = []
-    if _is_number(live) and _is_number(recomputed):
-        pattern = _number_pattern(leaf, float(live), float(recomputed))
-        if pattern:
-            parts.append(pattern)
-    own = registry.get(benchmark).explanations if benchmark in registry.names() else ()
-    for rule in (*own, *_GENERAL):
-        if re.search(rule.pattern, leaf):
-            parts.append(rule.text)
-            wanted.extend(rule.params)
-            break
-    # Deviations are matched by the key's own words; words every score uses say nothing.
-    words = {w for w in _WORDS.findall(leaf.replace("_", " ")) if len(w) > 3} - _STOP_WORDS
-    for dev in deviations:
-        if words & set(_WORDS.findall(dev.lower())):
-            parts.append(f"ertools differs from 2015: {dev}")
-    for warning in warnings:
-        if any(frag in warning.lower() for frag in wanted if len(frag) > 3):
-            parts.append(f"the scorer warned: {warning}")
-    shown = [
-        f"{name}={value}"
-        for name, value in parameters
-        if any(frag in name.lower() for frag in wanted)
-    ]
-    if shown:
-        parts.append("recomputed with " + ", ".join(shown))
-    if not parts:
-        parts.append(
-            "no specific cause known for this key: compare the parameters and the "
-            "deviations from 2015 listed with the comparison"
-        )
-    return "; ".join(parts)
-
-
-def _number_pattern(leaf: str, live: float, rec: float) -> str:
-    """Causes recognisable from the two numbers alone."""
-    if "orientation" in leaf and live < 0 <= rec and math.isclose(-live, rec, abs_tol=1e-6):
-        return (
-            "the live value is the negative of the recomputed one: the unwrapped yaw "
-            "difference of the 2015 node exceeded pi (orientation wrap), "
-            "so atan2(sin, cos) came out negative"
-        )
-    if "time" in leaf and abs(live - rec) > 1e8:
-        return "the two times use different origins (epoch vs seconds from the bag's start)"
-    return ""
-
-
-def _is_number(value: Any) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool)
-
-
-# --------------------------------------------------------------------------------------------
 # Comparing
 
 
@@ -288,7 +202,7 @@ def compare_scores(
             lines.append(ScoreLine(key, lv, rv, None, status, ""))
             continue
         diff: float | None = None
-        if _is_number(lv) and _is_number(rv):
+        if is_number(lv) and is_number(rv):
             diff = float(rv) - float(lv)
             same = abs(diff) <= max(abs_tol, rel_tol * abs(float(lv)))
         else:
@@ -332,7 +246,7 @@ TIMING_REL_TOL = 1e-2
 
 
 def _check_2015(live: Any, value: Any) -> str:
-    if _is_number(live) and _is_number(value):
+    if is_number(live) and is_number(value):
         lv, v = float(live), float(value)
         if abs(v - lv) <= max(DEFAULT_ABS_TOL, REPRODUCED_REL_TOL * abs(lv)):
             return (

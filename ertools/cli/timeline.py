@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 if TYPE_CHECKING:
-    from ertools.timeline.build import Timeline
+    from ertools.timeline.model import Timeline
 
 EPILOG = """examples:
   ertools timeline bags/                         # table of every bag under bags/
@@ -70,7 +70,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ertools.cli.common import dump_json, note, write_text
-    from ertools.timeline.build import TimelineConfig
+    from ertools.timeline.model import TimelineConfig
     from ertools.timeline.scan import scan
     from ertools.timeutil import s_to_ns
 
@@ -174,7 +174,7 @@ def _when(ns: int | None) -> str:
 
 def to_table(timeline: Timeline, *, color: bool = False) -> str:
     """The human table: bags by start, then sessions with their GT pairing, then problems."""
-    from ertools.timeline.build import KIND_LABELS
+    from ertools.timeline.model import KIND_LABELS
 
     paint = _Paint(color)
     lines: list[str] = []
@@ -215,7 +215,7 @@ def to_table(timeline: Timeline, *, color: bool = False) -> str:
 
 
 def _pairing_line(p: Any, paint: _Paint, *, full_path: bool = False) -> str:
-    from ertools.timeline.build import KIND_LABELS
+    from ertools.timeline.model import KIND_LABELS
 
     name = str(p.path) if full_path else Path(p.path).name
     other = ""

@@ -28,7 +28,7 @@ CACHE_VERSION = 1
 
 
 def _sha256_file(path: Path) -> str:
-    from ertools.report.folder import sha256_file
+    from ertools.report.records import sha256_file
 
     return sha256_file(path)
 

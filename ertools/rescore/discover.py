@@ -1,6 +1,6 @@
 """Every benchmark execution in a timeline, with its team, GT files and robot log.
 
-Pure: it reads the :class:`~ertools.timeline.build.Timeline` that
+Pure: it reads the :class:`~ertools.timeline.model.Timeline` that
 :func:`ertools.timeline.scan.scan` built (and, optionally, the teams the IO edge read from the
 state payloads), never a file.
 
@@ -34,7 +34,8 @@ from dataclasses import dataclass
 from typing import Literal
 
 from ertools.benchmarks.common.teams import TeamSource, resolve_team
-from ertools.timeline.build import BagEntry, Pairing, Timeline, bag_stem
+from ertools.timeline.build import bag_stem
+from ertools.timeline.model import BagEntry, Pairing, Timeline
 from ertools.timeutil import NS_PER_S
 
 # Spelled as the ``problems[].kind`` of results.json (the rescore contract).

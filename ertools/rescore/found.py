@@ -20,7 +20,7 @@ from ertools.benchmarks.common.teams import read_payload_team
 from ertools.progress import Reporter
 from ertools.rescore.discover import Discovery, discover
 from ertools.rescore.pipeline import Scoring
-from ertools.timeline.build import Timeline
+from ertools.timeline.model import Timeline
 from ertools.timeline.scan import scan
 
 ROBOT_BAG = "ROBOT_BAG"

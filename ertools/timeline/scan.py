@@ -3,7 +3,7 @@
 Everything read here goes through :mod:`ertools.io`: summaries come from each file's index
 (never its message data), and the clock check decodes only the first second of one pose topic
 per bag with a windowed read. :func:`scan` returns the pure
-:class:`~ertools.timeline.build.Timeline`.
+:class:`~ertools.timeline.model.Timeline`.
 """
 
 from __future__ import annotations
@@ -14,13 +14,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ertools.io.formats import Found, Unreadable, find_bags
-from ertools.timeline.build import (
-    ClockCheck,
-    Timeline,
-    TimelineConfig,
-    build_timeline,
-    split_name,
-)
+from ertools.timeline.build import build_timeline, split_name
+from ertools.timeline.model import ClockCheck, Timeline, TimelineConfig
 from ertools.timeutil import NS_PER_S
 
 if TYPE_CHECKING:

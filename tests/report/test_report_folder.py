@@ -13,7 +13,8 @@ import pytest
 import yaml
 from report_fakes import EVIL, fbm3w_like
 
-from ertools.report.folder import sha256_file, write_report
+from ertools.report.folder import write_report
+from ertools.report.records import sha256_file
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "audit"))
 from audit_streams import heartbeat

@@ -14,10 +14,11 @@ from typing import Any
 import pytest
 from timeline.summaries import Summary, Topic
 
+from ertools.io.formats import Unreadable
 from ertools.rescore.discover import Discovery, discover
 from ertools.samples.competition import generate_competition
 from ertools.samples.competition_schedule import NO_ROBOT_LOG, TRUNCATED
-from ertools.timeline.build import Unreadable, build_timeline
+from ertools.timeline.build import build_timeline
 
 S = 1_000_000_000
 T0 = 1_448_013_600 * S  # 2015-11-20 10:00:00 UTC

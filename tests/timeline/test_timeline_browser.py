@@ -19,7 +19,7 @@ from test_timeline_pictures import expected_day
 from timeline_day import EVIL, EVIL_IMG, S, day_timeline
 
 from ertools.report.timeline_page import write_timeline_page
-from ertools.timeline.build import Timeline
+from ertools.timeline.model import Timeline
 from ertools.timeline.scan import scan
 
 pytestmark = pytest.mark.browser

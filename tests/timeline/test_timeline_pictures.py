@@ -19,7 +19,7 @@ from timeline_day import DAY0, EVIL, EVIL_IMG, SESSIONS, UNREADABLE, S, day_time
 from ertools.cli.main import main
 from ertools.report.plots_timeline import timeline_figure
 from ertools.report.timeline_page import timeline_page
-from ertools.timeline.build import Timeline
+from ertools.timeline.model import Timeline
 from ertools.timeline.scan import scan
 
 REAL = Path(__file__).resolve().parents[2] / ".." / "shared" / "real_bags"

@@ -9,8 +9,6 @@ from summaries import BAG_KEYS, Summary, Topic
 
 from ertools.io.formats import Unreadable
 from ertools.timeline.build import (
-    ClockCheck,
-    TimelineConfig,
     benchmark_names,
     build_timeline,
     classify,
@@ -18,6 +16,7 @@ from ertools.timeline.build import (
     logger_name,
     split_name,
 )
+from ertools.timeline.model import ClockCheck, TimelineConfig
 
 S = 1_000_000_000
 T0 = 1_448_013_600 * S

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from ertools.benchmarks.common.hygiene import frame_change_warning
 from ertools.benchmarks.fbm1.answers import (
     Answer,
     ResultsFile,
@@ -51,7 +52,7 @@ from ertools.errors import ConfigError, ScoringError, SegmentationError, TopicEr
 from ertools.fidelity import Deviation, Rule
 from ertools.io.model import BenchmarkStates
 from ertools.progress import Reporter, current
-from ertools.streams import PoseStream, Provenance, frame_change_warning
+from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import NS_PER_S
 
 if TYPE_CHECKING:

@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
+from ertools.benchmarks.common.hygiene import frame_change_warning
 from ertools.benchmarks.fbm2h.result import Fbm2hResult, SegmentResult
 from ertools.benchmarks.fbm2h.score import robot_poses_at, segment_errors
 from ertools.benchmarks.fbm2h.segments import ReachedMoments, StopParams
@@ -36,7 +37,7 @@ from ertools.configs.transform import MarkerTransform
 from ertools.errors import ConfigError, ScoringError, SegmentationError
 from ertools.fidelity import Deviation, Rule
 from ertools.io.model import BenchmarkStates
-from ertools.streams import PoseStream, Provenance, frame_change_warning
+from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import ns_to_s, s_to_ns
 
 if TYPE_CHECKING:
@@ -410,9 +411,9 @@ def _frozen_warnings(
 
     The threshold is ``--gt-tolerance``: a frozen stretch longer than the gap ertools accepts hides
     a tracking loss of the size it refuses (see
-    :data:`ertools.benchmarks.noise.benchmark.FROZEN_MIN_S`).
+    :data:`ertools.benchmarks.common.hygiene.FROZEN_MIN_S`).
     """
-    from ertools.benchmarks.noise.benchmark import frozen_around
+    from ertools.benchmarks.common.hygiene import frozen_around
 
     if not len(moments):
         return []
@@ -642,11 +643,10 @@ def locate_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
         )
     else:
         raise ConfigError(f"--reached must be states, timing FILE or auto, not {reached!r}")
-    if moments.method != "auto" and options.time_source == "header":
-        from ertools.benchmarks.common.clocks import check_header_clock
+    from ertools.benchmarks.common.clocks import check_header_clock
 
-        what = "state messages" if moments.method == "states" else "timing file's moments"
-        check_header_clock(list(logs.paths), logs.marker, what)
+    what = {"states": "state messages", "auto": None}.get(moments.method, "timing file's moments")
+    check_header_clock(list(logs.paths), logs.marker, what, time_source=options.time_source)
     return Fbm2hRuns(moments, goal, tuple(unreached), tuple(warnings))
 
 

@@ -17,6 +17,11 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ertools.benchmarks.common.hygiene import (
+    frame_change_warning,
+    frozen_around,
+    identical_poses,
+)
 from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
 from ertools.benchmarks.fbm3w.path import score_path
 from ertools.benchmarks.fbm3w.result import Fbm3wResult, RunResult
@@ -30,8 +35,6 @@ from ertools.benchmarks.fbm3w.runs import (
 from ertools.benchmarks.noise.benchmark import (
     DEFAULT_C,
     NoiseResult,
-    frozen_around,
-    identical_poses,
     noise_from_stream,
 )
 from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
@@ -40,7 +43,7 @@ from ertools.errors import ConfigError, ErtoolsError, ScoringError
 from ertools.fidelity import Deviation, Rule
 from ertools.io.model import BenchmarkStates
 from ertools.progress import Reporter, current
-from ertools.streams import PoseStream, Provenance, frame_change_warning
+from ertools.streams import PoseStream, Provenance
 
 log = logging.getLogger("ertools.benchmarks.fbm3w.benchmark")
 
@@ -314,14 +317,14 @@ def locate_runs(logs: Fbm3wLogs, options: Fbm3wOptions) -> list[RunWindow]:
         windows = find_states(logs.states)
     else:
         windows = find_auto(logs.poses, options.config or Fbm3wConfig(), **_still(options))
-    if mode != "auto" and options.time_source == "header":
-        # State messages and --run windows are timed by record time: header-stamped poses
-        # from a mocap clock seconds off would be cut at other moments (a wrong score that
-        # looks right). Runs found from motion are in the poses' own time: nothing to check.
-        from ertools.benchmarks.common.clocks import check_header_clock
+    # State messages and --run windows are timed by record time: header-stamped poses from a
+    # mocap clock seconds off would be cut at other moments (a wrong score that looks right).
+    from ertools.benchmarks.common.clocks import check_header_clock
 
-        what = "state messages" if mode == "states" else "run windows (times from the log start)"
-        check_header_clock(list(logs.paths), logs.poses, what)
+    what = {"states": "state messages", "auto": None}.get(
+        mode, "run windows (times from the log start)"
+    )
+    check_header_clock(list(logs.paths), logs.poses, what, time_source=options.time_source)
     return windows
 
 
@@ -443,7 +446,7 @@ def _frozen_warnings(poses: PoseStream, runs: Sequence[RunWindow], origin_ns: in
     """A warning per run whose reference, start or end pose is a frozen (repeated) pose.
 
     The reference and starting positions set the run frame: a pose repeated for longer than
-    :data:`~ertools.benchmarks.noise.benchmark.FROZEN_MIN_S` there is the last pose before a
+    :data:`~ertools.benchmarks.common.hygiene.FROZEN_MIN_S` there is the last pose before a
     tracking loss, not where the marker set was.
     """
     moments: list[tuple[int, str, int]] = []

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from ertools.benchmarks.common.hygiene import same_rows
 from ertools.benchmarks.trajectory.config import BeforeGt, Gaps, Ties
 from ertools.errors import ScoringError
 from ertools.geometry import (
@@ -126,7 +127,7 @@ def associate(
     across = inside & (gap_ns > max_gap_ns)
     if gaps == "skip":
         status[across] = GAP
-    same = has_pair & _same_rows(gt.xyz, fi, si)
+    same = has_pair & same_rows(gt.xyz, fi, si)
     status[(status == COMPARED) & same] = TRACKING_LOST
     ok = status == COMPARED
 
@@ -174,13 +175,3 @@ def yaw_tf(quat_xyzw: F64) -> F64:
 def _rows(a: F64, index: npt.NDArray[np.intp]) -> F64:
     """``a[index]`` for a 2D array (``take`` gathers whole rows)."""
     return np.take(a, index, axis=0)
-
-
-def _same_rows(a: F64, i: npt.NDArray[np.intp], j: npt.NDArray[np.intp]) -> npt.NDArray[np.bool_]:
-    """``np.all(a[i] == a[j], axis=1)``: whole rows gathered by ``take``, compared by column."""
-    ai = np.take(a, i, axis=0)
-    aj = np.take(a, j, axis=0)
-    same: npt.NDArray[np.bool_] = ai[:, 0] == aj[:, 0]
-    for k in range(1, a.shape[1]):
-        same &= ai[:, k] == aj[:, k]
-    return same

@@ -11,7 +11,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.benchmarks.common.clocks import OffsetEstimate, estimate_offset
-from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid
+from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid, frame_change_warning
 from ertools.benchmarks.trajectory.association import (
     COMPARED,
     GAP,
@@ -33,7 +33,7 @@ from ertools.benchmarks.trajectory.rules import (
 )
 from ertools.errors import ClockError, ScoringError
 from ertools.fidelity import Deviation
-from ertools.streams import PoseStream, Provenance, frame_change_warning
+from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import iso_utc, ns_to_s
 
 F64 = npt.NDArray[np.float64]

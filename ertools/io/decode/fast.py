@@ -21,22 +21,15 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.io.decode.posebatch import PoseBatch
+from ertools.io.decode.posebatch import STAMPED_TYPES, PoseBatch
 
 I64 = npt.NDArray[np.int64]
 I32 = npt.NDArray[np.int32]
 F64 = npt.NDArray[np.float64]
 U8 = npt.NDArray[np.uint8]
 
-FAST_TYPES = (
-    "geometry_msgs/PoseStamped",
-    "geometry_msgs/Pose2D",
-    "geometry_msgs/TransformStamped",
-    "geometry_msgs/PoseWithCovarianceStamped",
-    "nav_msgs/Odometry",
-    "tf/tfMessage",
-    "tf2_msgs/TFMessage",
-)
+# The stamped pose types and Pose2D (which has no header).
+FAST_TYPES = ("geometry_msgs/Pose2D", *STAMPED_TYPES)
 
 
 class LayoutMismatchError(ValueError):
