@@ -30,6 +30,7 @@ demo: $(STAMP)
 lint: $(DEVSTAMP)
 	$(BIN)/ruff check ertools tests bench fuzz
 	$(BIN)/ruff format --check ertools tests bench fuzz
+	$(BIN)/lint-imports --no-cache
 
 typecheck: $(DEVSTAMP)
 	$(BIN)/mypy ertools

@@ -9,18 +9,33 @@ products, rotations and SLERP are closed-form NumPy (no Euler angles anywhere); 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, Protocol
 
 import numpy as np
 import numpy.typing as npt
-
-from ertools.streams import PoseStream
 
 F64 = npt.NDArray[np.float64]
 I64 = npt.NDArray[np.int64]
 IntArr = npt.NDArray[np.intp]
 
 Association = Literal["linear", "nearest", "hold"]
+
+
+class TimedPoses(Protocol):
+    """What interpolation needs of a pose stream (``ertools.streams.PoseStream`` is one).
+
+    A protocol, not the class: streams are built on this module's maths, so geometry stays
+    the bottom layer and imports nothing of ertools.
+    """
+
+    @property
+    def t_ns(self) -> I64: ...
+
+    @property
+    def xyz(self) -> F64: ...
+
+    @property
+    def quat_xyzw(self) -> F64: ...
 
 
 def wrap_angle(angle: F64 | float) -> F64:
@@ -211,7 +226,7 @@ def bracket(t_ns: I64, query_ns: I64, right: IntArr | None = None) -> tuple[IntA
 
 
 def interpolate_poses(
-    stream: PoseStream, query_ns: I64, method: Association = "linear"
+    stream: TimedPoses, query_ns: I64, method: Association = "linear"
 ) -> Interpolated:
     """Evaluate ``stream`` at ``query_ns``.
 

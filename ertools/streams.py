@@ -5,13 +5,15 @@ Readers produce them, scorers consume them; nothing here touches a file.
 
 from __future__ import annotations
 
-import enum
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
+
+from ertools.geometry import yaw_from_quat
+from ertools.states import Machine, state_name
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -96,8 +98,6 @@ class PoseStream:
     @property
     def yaw(self) -> F64:
         """(N,) yaw angles in radians, in [-pi, pi]."""
-        from ertools.geometry import yaw_from_quat
-
         return yaw_from_quat(self.quat_xyzw)
 
     def take(self, index: slice | npt.NDArray[np.bool_] | npt.NDArray[np.intp]) -> PoseStream:
@@ -139,14 +139,6 @@ class PoseStream:
             child_frame_id,
             source,
         )
-
-
-class Machine(enum.Enum):
-    """The three 2015 benchmark state machines (seed 6.2)."""
-
-    BMBOX = "bmbox"
-    REFBOX = "refbox"
-    CLIENT = "client"
 
 
 @dataclass(frozen=True, eq=False)
@@ -206,8 +198,6 @@ class StateStream:
     def to_dataframe(self) -> pd.DataFrame:
         """state (int), state_name and payload, indexed by a UTC DatetimeIndex named ``time``."""
         import pandas as pd
-
-        from ertools.states import state_name
 
         index = pd.DatetimeIndex(pd.to_datetime(self.t_ns, unit="ns", utc=True), name="time")
         return pd.DataFrame(

@@ -38,10 +38,11 @@ from ertools.states import (
     BMBOX_TRANSITIONS,
     BmBoxState,
     ClientState,
+    Machine,
     RefBoxState,
     state_name,
 )
-from ertools.streams import Machine, Provenance, StateStream
+from ertools.streams import Provenance, StateStream
 from ertools.timeutil import NS_PER_S, ns_to_s
 
 log = logging.getLogger("ertools.audit.analyse")

@@ -14,7 +14,8 @@ from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.fidelity import Deviation
-from ertools.streams import Machine, Provenance
+from ertools.states import Machine
+from ertools.streams import Provenance
 from ertools.timeutil import iso_utc, ns_to_s
 
 if TYPE_CHECKING:

@@ -5,12 +5,15 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks import document
 from ertools.benchmarks.base import BenchmarkResult, jsonable
 from ertools.benchmarks.common.teams import with_team
+from ertools.cli.options import add_output, add_plots, add_report
+from ertools.report.figures import figure_specs, save_figures, save_one_file
 
 
 def add_output_options(
@@ -26,8 +29,6 @@ def add_output_options(
     ``--report``/``--plot``/``--plots``/``--foxglove``: the vocabulary of
     :mod:`ertools.cli.options` (old spellings ``--output`` and ``--plot DIR`` still work, with
     a deprecation note)."""
-    from ertools.cli.options import add_output, add_plots, add_report
-
     add_output(parser, formats)
     if report:
         add_report(
@@ -124,9 +125,6 @@ def write_plots_option(result: Any, args: argparse.Namespace) -> None:
     recomputed score), when asked for."""
     if getattr(args, "plot", None) is None and getattr(args, "plots", None) is None:
         return
-    from ertools.cli.options import write_plots
-    from ertools.report.figures import figure_specs
-
     scored = getattr(result, "recomputed", None)
     write_plots(figure_specs(scored if scored is not None else result), args)
 
@@ -140,3 +138,18 @@ def write_foxglove_option(result: Any, args: argparse.Namespace, inputs: list[Pa
 
     written = write_foxglove(result, path, inputs=inputs)
     note(f"wrote {written.path} ({written.messages} messages on {len(written.counts)} topics)")
+
+
+def write_plots(specs: Sequence[Any], args: argparse.Namespace) -> list[Path]:
+    """Write ``--plot FILE`` and ``--plots DIR`` of ``specs`` (:class:`FigureSpec`), when asked."""
+    written: list[Path] = []
+    one: Path | None = getattr(args, "plot", None)
+    if one is not None:
+        written.append(save_one_file(specs, one))
+        note(f"wrote {one} ({len(specs)} figure(s))")
+    folder: Path | None = getattr(args, "plots", None)
+    if folder is not None:
+        paths = save_figures(specs, folder)
+        written.extend(paths)
+        note(f"wrote {len(paths)} figure(s) to {folder}/")
+    return written

@@ -94,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
     for warning in result.warnings:
         note(f"warning: {warning}")
     if args.plot is not None or args.plots is not None:
-        from ertools.cli.options import write_plots
+        from ertools.cli.common import write_plots
         from ertools.report.plots_noise import figure_specs
 
         write_plots(figure_specs(result), args)

@@ -8,7 +8,7 @@ The same idea has one spelling in every command (docs/cli.md lists them):
 - ``--format text|json|yaml|csv`` and ``--out/-o FILE``: :func:`add_output`;
 - ``--report DIR`` for a report folder: :func:`add_report`;
 - ``--plot FILE`` (the suffix picks the format, every figure in one file) and ``--plots DIR``
-  (one file per figure): :func:`add_plots`, written by :func:`write_plots`;
+  (one file per figure): :func:`add_plots`, written by :func:`ertools.cli.common.write_plots`;
 - durations are plain names in seconds (metavar ``S``): ``--max-gap``, ``--still-min``,
   ``--clock-tolerance``; never a ``-s``/``-duration`` suffix, never milliseconds;
 - an old spelling keeps working for one release and says so once on stderr
@@ -472,46 +472,6 @@ def add_plots(
             metavar="DIR",
             help="write one file per figure (PNG) into DIR",
         )
-
-
-def write_plots(specs: Sequence[Any], args: argparse.Namespace) -> list[Path]:
-    """Write ``--plot FILE`` and ``--plots DIR`` of ``specs`` (:class:`FigureSpec`), when asked."""
-    from ertools.cli.common import note
-
-    written: list[Path] = []
-    one: Path | None = getattr(args, "plot", None)
-    if one is not None:
-        written.append(save_one_file(specs, one))
-        note(f"wrote {one} ({len(specs)} figure(s))")
-    folder: Path | None = getattr(args, "plots", None)
-    if folder is not None:
-        from ertools.report.figures import save_figures
-
-        paths = save_figures(specs, folder)
-        written.extend(paths)
-        note(f"wrote {len(paths)} figure(s) to {folder}/")
-    return written
-
-
-def save_one_file(specs: Sequence[Any], path: Path) -> Path:
-    """Every spec as one panel of one figure, stacked top to bottom, in ``path`` (its suffix
-    picks the format)."""
-    from matplotlib.figure import Figure
-
-    width = max((s.size[0] for s in specs), default=6.0)
-    height = sum(s.size[1] for s in specs) or 4.0
-    fig = Figure(figsize=(width, height), layout="constrained")
-    axes = fig.subplots(max(len(specs), 1), 1, squeeze=False)[:, 0]
-    for spec, ax in zip(specs, axes, strict=False):
-        spec.draw(ax)
-        if spec.title:
-            ax.set_title(spec.title)
-    if not specs:
-        axes[0].text(0.5, 0.5, "no figure for this result", ha="center", va="center")
-        axes[0].set_axis_off()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    return path
 
 
 def add_out_dir(

@@ -10,33 +10,40 @@ INFO, visible with ``-v``).
 
 from __future__ import annotations
 
-import itertools
 import logging
-import mmap
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.errors import BagError
+from ertools.io import pipeline
+from ertools.io.bagfile import BagFile
 from ertools.io.decode.fast import FAST_TYPES, Decoded, LayoutMismatchError, decode, to_batch
 from ertools.io.decode.posebatch import PoseBatch, concat_batches
 from ertools.io.decode.uniform import Rows, decode_uniform
-from ertools.io.files import BagFile
+from ertools.io.mcap.index import McapIndex
 from ertools.io.model import TF_TYPES, Conn
-from ertools.io.pipeline import Group, joined, keep, pread, prefetched, read_at, scratch_view
+from ertools.io.pipeline import (
+    Group,
+    Located,
+    Run,
+    ascending,
+    joined,
+    prefetched,
+)
+from ertools.io.ros1.runs import chunk_group, ros1_runs
+from ertools.io.rosbag2.metadata import sqlite_rows
+from ertools.progress import current
 
 if TYPE_CHECKING:
-    from ertools.io.ros1.index import Ros1Bag, Ros1Chunk
+    # the readers call this module: their classes are annotations here, never imported
+    from ertools.io.files import McapFile
+    from ertools.io.ros1.index import Ros1Bag
     from ertools.progress import Reporter
 
 log = logging.getLogger("ertools.io.bulk")
-
-# Uncompressed bytes decoded in one go (chunks are ~768 KiB): large enough that the per-call
-# overhead of NumPy vanishes, small enough to keep memory bounded.
-GROUP_BYTES = 4 * 1024 * 1024
 
 I64 = npt.NDArray[np.int64]
 U8 = npt.NDArray[np.uint8]
@@ -69,7 +76,7 @@ class _Assembler:
         connection read in order): written as a block, or decoded in place."""
         if self.multi or not len(pos):
             return None
-        if int(pos[-1]) - int(pos[0]) == len(pos) - 1 and _ascending(pos):
+        if int(pos[-1]) - int(pos[0]) == len(pos) - 1 and ascending(pos):
             return slice(int(pos[0]), int(pos[-1]) + 1)
         return None
 
@@ -127,191 +134,9 @@ class _Assembler:
         return batch
 
 
-def _ascending(a: I64) -> bool:
-    return bool(np.all(a[1:] > a[:-1]))
-
-
-def group_positions(keys: I64) -> list[tuple[int, I64]]:
-    """(key, positions) for each distinct key, positions ascending (one sort, not N scans)."""
-    if len(keys) == 0:
-        return []
-    if bool(np.all(keys[1:] >= keys[:-1])):
-        order = np.arange(len(keys), dtype=np.int64)  # already grouped (one connection)
-    else:
-        order = np.argsort(keys, kind="stable")
-    sorted_keys = keys[order]
-    cuts = np.flatnonzero(sorted_keys[1:] != sorted_keys[:-1]) + 1
-    starts = np.concatenate([[0], cuts])
-    ends = np.concatenate([cuts, [len(keys)]])
-    return [(int(sorted_keys[a]), order[a:b]) for a, b in zip(starts, ends, strict=True)]
-
-
-# One run of messages: (reference positions, buffer, data starts, data lengths, record times).
-# The buffer is only valid until the next run is asked for (it may be reused).
-Run = tuple[I64, U8, I64, I64, I64]
-
-
-@dataclass(frozen=True)
-class Located:
-    """Messages of some connections located from a file's index, in the reference order.
-
-    ``count`` is the number of messages when the index tells it up front (ROS1, MCAP), None
-    otherwise (sqlite rows come as they are fetched); ``runs`` reads the data a few chunks at
-    a time.
-    """
-
-    count: int | None
-    runs: Iterator[Run]
-
-
-def _ros1_runs(
-    bag: BagFile,
-    conns: Sequence[Conn],
-    lo: int | None,
-    hi: int | None,
-    progress: Reporter | None = None,
-) -> Located:
-    from ertools.io.ros1.index import Ros1Bag
-
-    assert isinstance(bag, Ros1Bag)
-    touched, chunk_of, rank_of, t_of, off_of = bag.select(conns, lo, hi)
-    conn_of = np.array([c.id for c in conns], dtype=np.int64)[rank_of]
-
-    groups = dict(group_positions(chunk_of))
-    sparse = _sparse_chunks(bag, touched, groups)
-
-    def batches() -> Iterator[list[int]]:
-        # Several chunks are decoded together (fewer NumPy calls per message), up to
-        # GROUP_BYTES of uncompressed data at a time so memory stays bounded; a sparse chunk
-        # counts the pages its records touch, not its size.
-        batch: list[int] = []
-        size = 0
-        for i, ci in enumerate(touched):
-            if batch and (ci in sparse) != (batch[0] in sparse):
-                yield batch  # sparse and dense chunks are loaded differently
-                batch, size = [], 0
-            batch.append(ci)
-            chunk = bag.layout.chunks[ci]
-            if ci in sparse:
-                size += sparse[ci]
-            else:
-                size += max(chunk.data_len, 0) * (1 if chunk.compression == "none" else 4)
-            if size >= GROUP_BYTES or i + 1 == len(touched):
-                yield batch
-                batch, size = [], 0
-
-    todo = list(batches())
-
-    def load_run(k: int, scratch: list[Any]) -> Run:
-        batch = todo[k]
-        chunks = [bag.layout.chunks[c] for c in batch]
-        if batch[0] in sparse:
-            buf, base, sizes = _mapped_group(bag, chunks, scratch)
-        else:
-            buf, base, sizes = _chunk_group(bag, chunks, scratch)
-        sel = np.concatenate([groups[c] for c in batch])
-        which = np.concatenate([np.full(len(groups[c]), i) for i, c in enumerate(batch)])
-        where = f"in {bag.path} in chunks at bytes {chunks[0].pos}..{chunks[-1].pos}"
-        offsets = off_of[sel]
-        if np.any(offsets + 8 > sizes[which]):
-            raise BagError(f"index points outside its chunk {where}")
-        # each record checked to carry its index entry's time and connection
-        start, length = bag.checked_spans(
-            buf, offsets + base[which], t_of[sel], conn_of[sel], where
-        )
-        if np.any(start + length > base[which] + sizes[which]):
-            raise BagError(f"message record runs past the end of its chunk {where}")
-        return sel, buf, start, length, t_of[sel]
-
-    compressed = any(bag.layout.chunks[ci].compression != "none" for ci in touched)
-    weights = [sum(max(bag.layout.chunks[c].data_len, 0) for c in batch) for batch in todo]
-    runs = prefetched(
-        len(todo),
-        load_run,
-        parallel=compressed,
-        progress=progress,
-        weights=weights,
-        label=_label(bag, conns),
-    )
-    return Located(len(t_of), runs)
-
-
 def _label(bag: BagFile, conns: Sequence[Conn]) -> str:
     topic = conns[0].topic if conns else "?"
     return f"reading {topic} from {bag.path.name}"
-
-
-# Wanted records further apart than this on average are read in place (mapped) rather than
-# with their whole chunks: a pose topic next to camera images then costs its own messages (a
-# page or two each), not the images. Measured on an hour of 10 Hz poses between 16 KiB images:
-# 0.09 s mapped against 0.155 s reading the chunks, page cache warm (0.58 s against 0.49 s
-# cold: read-ahead favours whole chunks). Much closer together, every page holds a wanted
-# record and mapping only adds page faults.
-SPARSE_GAP = 12 * 1024
-
-
-def _sparse_chunks(bag: Ros1Bag, touched: list[int], groups: dict[int, I64]) -> dict[int, int]:
-    """Uncompressed chunks whose wanted records are sparse -> bytes of the pages they touch."""
-    out = {}
-    page = mmap.PAGESIZE
-    for ci in touched:
-        chunk = bag.layout.chunks[ci]
-        count = len(groups[ci])
-        if chunk.compression == "none" and chunk.data_len >= SPARSE_GAP * count:
-            out[ci] = count * 2 * page  # a record touches one or two pages
-    return out
-
-
-def _mapped_group(bag: Ros1Bag, chunks: list[Ros1Chunk], scratch: list[Any]) -> Group:
-    """Chunks read in place through a read-only map of the stretch they span: the pages
-    holding wanted records are read (with the kernel's usual read-ahead), the rest never.
-
-    The map is kept in ``scratch`` and released when that slot is next reused, so the
-    process holds one group's pages, not the file's.
-    """
-    first = chunks[0].data_pos
-    end = chunks[-1].data_pos + chunks[-1].data_len
-    start = first - first % mmap.ALLOCATIONGRANULARITY
-    if end > bag.layout.size:
-        raise BagError(f"chunks cut off by end of file at byte {first}", path=bag.path)
-    mm = mmap.mmap(bag.file.fileno(), end - start, offset=start, access=mmap.ACCESS_READ)
-    keep(scratch, mm)
-    base = np.array([c.data_pos - start for c in chunks], dtype=np.int64)
-    sizes = np.array([c.data_len for c in chunks], dtype=np.int64)
-    return np.frombuffer(mm, dtype=np.uint8), base, sizes
-
-
-def _chunk_group(bag: BagFile, chunks: list[Any], scratch: list[Any]) -> Group:
-    """(bytes, where each chunk's data starts in them, each chunk's size) of ROS1 chunks,
-    loaded into ``scratch`` (runs on a loading thread: positional reads only).
-
-    Uncompressed chunks that follow each other in the file are read with one read of the
-    stretch they span (the index records between them come along, unused); others are read
-    and decompressed one by one and joined.
-    """
-    from ertools.io.ros1.index import Ros1Bag, decompress
-
-    assert isinstance(bag, Ros1Bag)
-    fd = bag.file.fileno()
-    if all(c.compression == "none" and c.data_pos >= 0 for c in chunks) and all(
-        b.data_pos > a.data_pos for a, b in itertools.pairwise(chunks)
-    ):
-        first = chunks[0].data_pos
-        span = chunks[-1].data_pos + chunks[-1].data_len - first
-        view = scratch_view(scratch, span)
-        if read_at(fd, view, first) != span:
-            raise BagError(f"chunks cut off by end of file at byte {first}", path=bag.path)
-        base = np.array([c.data_pos - first for c in chunks], dtype=np.int64)
-        sizes = np.array([c.data_len for c in chunks], dtype=np.int64)
-        return np.frombuffer(view, dtype=np.uint8), base, sizes
-    parts = []
-    for chunk in chunks:
-        where = f"in {bag.path} at byte {chunk.pos}"
-        data = pread(fd, chunk.data_len, chunk.data_pos)
-        if len(data) != chunk.data_len:
-            raise BagError(f"chunk at byte {chunk.pos} cut off by end of file", path=bag.path)
-        parts.append(decompress(chunk.compression, data, where))
-    return joined(parts, scratch)
 
 
 def _mcap_runs(
@@ -321,8 +146,6 @@ def _mcap_runs(
     hi: int | None,
     progress: Reporter | None = None,
 ) -> Located | None:
-    from ertools.io.mcap.index import McapIndex
-
     index = McapIndex.of(bag)
     if index is None:
         return None
@@ -348,8 +171,6 @@ def _mcap_runs(
 def _sqlite_runs(
     bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None
 ) -> Located | None:
-    from ertools.io.rosbag2.metadata import sqlite_rows
-
     batches = sqlite_rows(bag.path, conns, lo, hi)
     if batches is None:
         return None
@@ -366,10 +187,7 @@ def _sqlite_runs(
 def _scanned_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None) -> Located:
     """Messages of an MCAP file its indexes do not cover, read record by record: the runs
     of copied message bytes the scan gives, so the same decoders apply."""
-    from ertools.io.files import McapFile
-
-    assert isinstance(bag, McapFile)
-    runs = list(bag.scanned_runs(conns, lo, hi))
+    runs = list(cast("McapFile", bag).scanned_runs(conns, lo, hi))  # only scanned MCAP files
     count = sum(len(r[0]) for r in runs)
     return Located(count, iter([r[:5] for r in runs]))
 
@@ -391,11 +209,9 @@ def locate(
         LayoutMismatchError: the file lacks the index records the bulk path needs.
     """
     if progress is None:
-        from ertools.progress import current
-
         progress = current()
     if bag.format in ("ros1", "ros1-active"):
-        return _ros1_runs(bag, conns, start_ns, end_ns, progress)
+        return ros1_runs(cast("Ros1Bag", bag), conns, start_ns, end_ns, progress)
     if bag.format == "rosbag2-sqlite3":
         return _sqlite_runs(bag, conns, start_ns, end_ns)
     if getattr(bag, "scanned", False):
@@ -410,20 +226,20 @@ def load_all_chunks(bag: BagFile, progress: Reporter | None = None) -> int:
     pipeline as a topic read but not decoded: the floor of any read of that file (what the
     benchmark compares the extraction with on compressed files). The bytes read from the
     file (compressed) are reported to ``progress`` group by group."""
-    from ertools.io.mcap.index import McapIndex
-    from ertools.io.ros1.index import Ros1Bag
-
     total = 0
-    if isinstance(bag, Ros1Bag):
-        chunks = bag.layout.chunks
+    if bag.format in ("ros1", "ros1-active"):
+        ros1 = cast("Ros1Bag", bag)
+        chunks = ros1.layout.chunks
         for chunk in chunks:
             if chunk.data_pos < 0:
-                bag.chunk_record(chunk)
-        step = max(1, GROUP_BYTES // max(1, max((c.data_len for c in chunks), default=1) * 4))
+                ros1.chunk_record(chunk)
+        step = max(
+            1, pipeline.GROUP_BYTES // max(1, max((c.data_len for c in chunks), default=1) * 4)
+        )
         todo = [chunks[i : i + step] for i in range(0, len(chunks), step)]
 
         def load(k: int, scratch: list[Any]) -> Group:
-            return _chunk_group(bag, todo[k], scratch)
+            return chunk_group(ros1, todo[k], scratch)
 
         weights = [sum(c.data_len for c in part) for part in todo]
         label = f"reading {bag.path.name}"

@@ -13,53 +13,25 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Iterator, Sequence
-from contextlib import AbstractContextManager
 from pathlib import Path
-from types import TracebackType
 from typing import Any
 
 import numpy as np
 
 from ertools.errors import BagError
+from ertools.io.bagfile import BagFile, RawRecord
 from ertools.io.formats import detect_format
+from ertools.io.mcap.scan import SCAN, mcap_layout, scan_mcap
+from ertools.io.mcap.summary import mcap_errors
 from ertools.io.model import Conn, short_msgtype
+from ertools.io.ros1.index import Ros1Bag
 
 log = logging.getLogger("ertools.io.files")
 
-RawRecord = tuple[Conn, int, bytes]
 # (reference positions, bytes, data starts, data lengths, log times, channel ids)
 ScannedRun = tuple[Any, Any, Any, Any, Any, Any]
 
 INT64_MAX = (1 << 63) - 1
-
-
-class BagFile(AbstractContextManager["BagFile"]):
-    """An open bag: ``connections`` and :meth:`raw` messages. Use as a context manager."""
-
-    path: Path
-    format: str
-    connections: tuple[Conn, ...]
-
-    def raw(
-        self, conns: Sequence[Conn], start_ns: int | None = None, end_ns: int | None = None
-    ) -> Iterator[RawRecord]:
-        """(conn, record time ns, raw bytes) of ``conns`` in [start_ns, end_ns], time-ordered."""
-        raise NotImplementedError
-
-    def close(self) -> None:
-        """Release the file."""
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()
-
-    def topic_conns(self, topic: str) -> list[Conn]:
-        """The connections of one topic, in file order."""
-        return [c for c in self.connections if c.topic == topic]
 
 
 def _conn_from_rosbags(c: Any) -> Conn:
@@ -152,29 +124,6 @@ def _conn_from_channel(channel: Any, schema: Any) -> Conn:
     )
 
 
-# What the mcap library raises on damaged or cut-short files.
-def mcap_errors() -> tuple[type[BaseException], ...]:
-    import struct
-
-    import zstandard
-    from mcap.exceptions import McapError
-
-    # lz4 raises RuntimeError on corrupt chunks, zstandard its own ZstdError (found by
-    # fuzzing: it escaped as a traceback); absurd record lengths can MemoryError.
-    return (
-        McapError,
-        ValueError,
-        EOFError,
-        OSError,
-        struct.error,
-        KeyError,
-        RuntimeError,
-        MemoryError,
-        OverflowError,  # a length near 2**64 handed to read() or a buffer
-        zstandard.ZstdError,
-    )
-
-
 class McapFile(BagFile):
     """A standalone MCAP file (ROS 2 ``cdr`` or ``ros1`` message encoding) via ``mcap``.
 
@@ -188,8 +137,6 @@ class McapFile(BagFile):
 
     def __init__(self, path: Path) -> None:
         from mcap.reader import make_reader
-
-        from ertools.io.mcap.scan import SCAN, mcap_layout
 
         self.path = path
         self.format = "mcap"
@@ -213,8 +160,6 @@ class McapFile(BagFile):
 
     def _scan(self, why: str) -> tuple[Conn, ...]:
         """Read every complete record (the summary's indexes do not answer for them all)."""
-        from ertools.io.mcap.scan import scan_mcap
-
         self.scanned = True
         log.info("%s: %s; reading the file record by record", self.path, why)
         try:
@@ -250,8 +195,6 @@ class McapFile(BagFile):
         """The messages of ``conns`` in [start_ns, end_ns] of a file read record by record, as
         runs of (reference positions, bytes, data starts, data lengths, log times, channel
         ids): one more pass over the records that copies only these messages' bytes."""
-        from ertools.io.mcap.scan import scan_mcap
-
         found = scan_mcap(self.path, keep=frozenset(c.id for c in conns))
         if not found.payloads:
             return
@@ -338,7 +281,5 @@ def open_bag(path: str | Path) -> BagFile:
     if fmt == "ros1-active":
         fmt = "ros1"
     if fmt == "ros1":
-        from ertools.io.ros1.index import Ros1Bag
-
         return Ros1Bag(p)
     return RosbagsFile(p, fmt)

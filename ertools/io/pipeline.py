@@ -18,6 +18,7 @@ import os
 import threading
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
@@ -158,3 +159,45 @@ def pread(fd: int, size: int, offset: int) -> bytes:
             parts.append(part)
             size -= len(part)
         return b"".join(parts)
+
+
+# Uncompressed bytes decoded in one go (chunks are ~768 KiB): large enough that the per-call
+# overhead of NumPy vanishes, small enough to keep memory bounded.
+GROUP_BYTES = 4 * 1024 * 1024
+
+
+def ascending(a: I64) -> bool:
+    return bool(np.all(a[1:] > a[:-1]))
+
+
+def group_positions(keys: I64) -> list[tuple[int, I64]]:
+    """(key, positions) for each distinct key, positions ascending (one sort, not N scans)."""
+    if len(keys) == 0:
+        return []
+    if bool(np.all(keys[1:] >= keys[:-1])):
+        order = np.arange(len(keys), dtype=np.int64)  # already grouped (one connection)
+    else:
+        order = np.argsort(keys, kind="stable")
+    sorted_keys = keys[order]
+    cuts = np.flatnonzero(sorted_keys[1:] != sorted_keys[:-1]) + 1
+    starts = np.concatenate([[0], cuts])
+    ends = np.concatenate([cuts, [len(keys)]])
+    return [(int(sorted_keys[a]), order[a:b]) for a, b in zip(starts, ends, strict=True)]
+
+
+# One run of messages: (reference positions, buffer, data starts, data lengths, record times).
+# The buffer is only valid until the next run is asked for (it may be reused).
+Run = tuple[I64, U8, I64, I64, I64]
+
+
+@dataclass(frozen=True)
+class Located:
+    """Messages of some connections located from a file's index, in the reference order.
+
+    ``count`` is the number of messages when the index tells it up front (ROS1, MCAP), None
+    otherwise (sqlite rows come as they are fetched); ``runs`` reads the data a few chunks at
+    a time.
+    """
+
+    count: int | None
+    runs: Iterator[Run]

@@ -16,10 +16,11 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.errors import BagError, TopicError
+from ertools.io.bagfile import BagFile
 from ertools.io.decode.posebatch import PoseBatch, batch_from_messages, concat_batches
 from ertools.io.decode.tf import Edge, chain_pose, frame_key
 from ertools.io.decode.typestore import Deserializer
-from ertools.io.files import BagFile, open_bag
+from ertools.io.files import open_bag
 from ertools.io.formats import bag_paths
 from ertools.io.merge import merge_poses, sort_poses
 from ertools.io.model import (
@@ -30,8 +31,8 @@ from ertools.io.model import (
     PoseSource,
     RawMessage,
 )
-from ertools.states import MSG_TYPES, STATE_TOPIC_SUFFIXES
-from ertools.streams import MAX_FRAME_CHANGES, FrameChange, Machine, PoseStream, StateStream
+from ertools.states import MSG_TYPES, STATE_TOPIC_SUFFIXES, Machine
+from ertools.streams import MAX_FRAME_CHANGES, FrameChange, PoseStream, StateStream
 
 log = logging.getLogger("ertools.io.reader")
 
@@ -217,7 +218,7 @@ def read_poses(
 def _tf_edges(
     plist: list[Path], start_ns: int | None, end_ns: int | None
 ) -> dict[tuple[str, str], Edge]:
-    from ertools.io.bulk import group_positions
+    from ertools.io.pipeline import group_positions
 
     per_edge: dict[tuple[str, str], list[PoseStream]] = {}
     static_edges: set[tuple[str, str]] = set()

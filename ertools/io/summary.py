@@ -30,6 +30,8 @@ import numpy.typing as npt
 from ertools.errors import BagError
 from ertools.io.formats import detect_format
 from ertools.io.model import BagSummary, TopicSummary, short_msgtype
+from ertools.io.ros1.index import Ros1Bag
+from ertools.io.ros1.layout import read_layout
 
 log = logging.getLogger("ertools.io.summary")
 
@@ -107,8 +109,6 @@ Times = dict[str, list[I64]]
 
 
 def _ros1(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagSummary:
-    from ertools.io.ros1.index import Ros1Bag, read_layout
-
     layout = read_layout(path)
     compressions: set[str] = set()
     spans: dict[int, list[int]] = {}
@@ -402,7 +402,7 @@ def _mcap_file(
 def _mcap_version(path: Path) -> str:
     from mcap.reader import make_reader
 
-    from ertools.io.files import mcap_errors
+    from ertools.io.mcap.summary import mcap_errors
 
     try:
         with path.open("rb") as f:
@@ -526,8 +526,6 @@ def record_times(path: str | Path) -> dict[str, I64]:
     fmt = detect_format(p)
     parts: dict[str, list[I64]] = defaultdict(list)
     if fmt in ("ros1", "ros1-active"):
-        from ertools.io.ros1.index import Ros1Bag, read_layout
-
         layout = read_layout(p)
         bag = Ros1Bag(p, layout, strict=False)
         topic_of = {c.id: c.topic for c in layout.conns}

@@ -56,3 +56,24 @@ def save_figures(specs: Sequence[FigureSpec], outdir: Path, fmt: str = "png") ->
         fig.savefig(path, dpi=110)
         written.append(path)
     return written
+
+
+def save_one_file(specs: Sequence[Any], path: Path) -> Path:
+    """Every spec as one panel of one figure, stacked top to bottom, in ``path`` (its suffix
+    picks the format)."""
+    from matplotlib.figure import Figure  # lazy: matplotlib only when a figure is drawn
+
+    width = max((s.size[0] for s in specs), default=6.0)
+    height = sum(s.size[1] for s in specs) or 4.0
+    fig = Figure(figsize=(width, height), layout="constrained")
+    axes = fig.subplots(max(len(specs), 1), 1, squeeze=False)[:, 0]
+    for spec, ax in zip(specs, axes, strict=False):
+        spec.draw(ax)
+        if spec.title:
+            ax.set_title(spec.title)
+    if not specs:
+        axes[0].text(0.5, 0.5, "no figure for this result", ha="center", va="center")
+        axes[0].set_axis_off()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    return path

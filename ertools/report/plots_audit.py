@@ -10,7 +10,7 @@ from typing import Any
 
 from ertools.report import units
 from ertools.report.figures import FigureSpec
-from ertools.streams import Machine
+from ertools.states import Machine
 from ertools.timeutil import ns_to_s
 
 _LANES = (Machine.CLIENT, Machine.REFBOX, Machine.BMBOX)  # bottom to top

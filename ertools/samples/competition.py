@@ -72,8 +72,7 @@ from ertools.samples.scenario import EPOCH_2015, log_name, to_plain
 from ertools.samples.simulated import SimulatedRun
 from ertools.samples.statemachine import state_messages
 from ertools.samples.timeline_folder import make_active
-from ertools.states import BmBoxState
-from ertools.streams import Machine
+from ertools.states import BmBoxState, Machine
 
 NS = 1_000_000_000
 DEFAULT_SEED = 2015_11_20

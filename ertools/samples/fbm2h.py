@@ -59,8 +59,7 @@ from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_an
 from ertools.samples.simulated import SimulatedRun
 from ertools.samples.statemachine import Transition, publish_states
 from ertools.samples.writer import BagWriter
-from ertools.states import BmBoxState, ClientState, RefBoxState
-from ertools.streams import Machine
+from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
 F64 = npt.NDArray[np.float64]
 S = 1_000_000_000

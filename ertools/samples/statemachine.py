@@ -27,8 +27,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.samples.writer import BagWriter
-from ertools.states import BMBOX_TRANSITIONS, STATE_ENUMS, BmBoxState, state_topic
-from ertools.streams import Machine
+from ertools.states import BMBOX_TRANSITIONS, STATE_ENUMS, BmBoxState, Machine, state_topic
 
 I64 = npt.NDArray[np.int64]
 

@@ -42,8 +42,7 @@ from ertools.geometry import quat_from_yaw
 from ertools.samples.mocap import FRAME_NS
 from ertools.samples.scenario import EPOCH_2015, log_name, tol, write_answers
 from ertools.samples.writer import BagWriter
-from ertools.states import BmBoxState, ClientState, RefBoxState
-from ertools.streams import Machine
+from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
 I64 = npt.NDArray[np.int64]
 NS = 1_000_000_000

@@ -47,8 +47,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.errors import UsageError
-from ertools.states import MSG_DEFINITIONS, MSG_TYPES
-from ertools.streams import Machine
+from ertools.states import MSG_DEFINITIONS, MSG_TYPES, Machine
 
 BagFormat = Literal["ros1", "rosbag2-mcap", "rosbag2-sqlite3", "mcap"]
 FORMATS: tuple[BagFormat, ...] = ("ros1", "rosbag2-mcap", "rosbag2-sqlite3", "mcap")

@@ -29,9 +29,9 @@ from pathlib import Path
 
 from ertools.benchmarks.common.teams import parse_robot_log_name
 from ertools.io.formats import Unreadable
+from ertools.io.model import ClockCheck
 from ertools.timeline.model import (
     BagEntry,
-    ClockCheck,
     Kind,
     Pairing,
     Problem,

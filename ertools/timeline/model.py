@@ -67,17 +67,6 @@ class SummaryLike(Protocol):
 
 
 @dataclass(frozen=True)
-class ClockCheck:
-    """Record time minus header stamp (median over a few messages) of one pose topic."""
-
-    path: str
-    topic: str
-    offset_ns: int
-    samples: int
-    error: str = ""  # the first messages could not be read (damaged data)
-
-
-@dataclass(frozen=True)
 class BagEntry:
     """One bag in the timeline (``start_ns`` is None when it could not be read)."""
 

@@ -13,80 +13,17 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ertools.io.clock import clock_check
 from ertools.io.formats import Found, Unreadable, find_bags
+from ertools.io.model import ClockCheck
 from ertools.timeline.build import build_timeline, split_name
-from ertools.timeline.model import ClockCheck, Timeline, TimelineConfig
-from ertools.timeutil import NS_PER_S
+from ertools.timeline.model import Timeline, TimelineConfig
 
 if TYPE_CHECKING:
     from ertools.io import BagSummary
     from ertools.progress import Reporter
 
 log = logging.getLogger("ertools.timeline.scan")
-
-# Types whose header stamp the clock check compares with the record time, best first: the
-# mocap node's own poses, then tf (whose static transforms may be stamped in the future).
-CLOCK_TYPES = (
-    "geometry_msgs/PoseStamped",
-    "geometry_msgs/TransformStamped",
-    "geometry_msgs/PoseWithCovarianceStamped",
-    "nav_msgs/Odometry",
-    "tf2_msgs/TFMessage",
-    "tf/tfMessage",
-)
-CLOCK_WINDOW_NS = NS_PER_S  # the first second of the topic: ~120 mocap messages
-CLOCK_MAX_SAMPLES = 50
-
-
-def clock_check(
-    s: BagSummary, window_ns: int = CLOCK_WINDOW_NS, topic_name: str | None = None
-) -> ClockCheck | None:
-    """Median record time minus header stamp over the first messages of one pose topic.
-
-    The topic is ``topic_name``, else the best header-stamped pose topic of the bag. None when
-    there is none. When the data cannot be read (a damaged chunk the index does not reveal),
-    the check carries the reader's message in ``error``.
-    """
-    from ertools.io.files import open_bag
-    from ertools.io.reader import load_pose_batch
-
-    rank = {t: i for i, t in enumerate(CLOCK_TYPES)}
-    cands = sorted(
-        (t for t in s.topics if t.msgtype in rank and t.count and t.first_ns is not None),
-        key=lambda t: (rank[t.msgtype], t.name == "/tf_static", t.name),
-    )
-    cands = [
-        t
-        for t in cands
-        if (t.name == topic_name if topic_name is not None else t.name != "/tf_static")
-    ]
-    if not cands:
-        return None
-    topic = cands[0]
-    assert topic.first_ns is not None and topic.last_ns is not None
-    try:
-        with open_bag(s.path) as bag:
-            conns = bag.topic_conns(topic.name)
-            # The summary's first time is the start of the topic's first chunk, which may hold
-            # seconds of other topics first: widen the window until messages come.
-            window = window_ns
-            while True:
-                batch = load_pose_batch(bag, conns, topic.first_ns, topic.first_ns + window)
-                if len(batch) or topic.first_ns + window >= topic.last_ns:
-                    break
-                window *= 8
-    except Exception as err:  # damaged data the index did not show: report it, go on
-        from ertools.errors import ErtoolsError
-
-        text = err.message if isinstance(err, ErtoolsError) else f"{type(err).__name__}: {err}"
-        log.debug("clock check of %s failed: %s", s.path, text)
-        return ClockCheck(str(s.path), topic.name, 0, 0, error=text)
-    if len(batch) == 0:
-        return None
-    diff = (batch.t_record - batch.t_header)[:CLOCK_MAX_SAMPLES]
-    import numpy as np
-
-    return ClockCheck(str(s.path), topic.name, int(np.median(diff)), len(diff))
 
 
 def check_recordings(

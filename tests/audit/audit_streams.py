@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ertools.streams import Machine, StateStream
+from ertools.states import Machine
+from ertools.streams import StateStream
 
 T0_NS = 1_445_000_000_000_000_000  # an epoch time in October 2015
 BEAT_NS = 100_000_000  # 10 Hz

@@ -11,7 +11,8 @@ from fakes import FakeResult
 from ertools.audit.analyse import audit_states
 from ertools.audit.compare import attach, compare_scores, flatten
 from ertools.states import BmBoxState as B
-from ertools.streams import Machine, Provenance
+from ertools.states import Machine
+from ertools.streams import Provenance
 
 WRAP_DEV = "orientation errors are wrapped to [0, pi] (2015 used the unwrapped difference)"
 

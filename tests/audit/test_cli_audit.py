@@ -10,7 +10,8 @@ from audit_streams import T0_NS, heartbeat
 from test_audit import BMBOX, CLIENT, REFBOX
 
 from ertools.cli.main import main
-from ertools.streams import Machine, StateStream
+from ertools.states import Machine
+from ertools.streams import StateStream
 
 
 def _write_bag(path: Path, streams: list[StateStream]) -> Path:

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ertools.states import BMBOX_TRANSITIONS, BmBoxState, state_name, state_topic
-from ertools.streams import Machine, PoseStream, StateStream
+from ertools.states import BMBOX_TRANSITIONS, BmBoxState, Machine, state_name, state_topic
+from ertools.streams import PoseStream, StateStream
 from ertools.timeutil import iso_utc, resolve_time
 
 

@@ -20,7 +20,8 @@ from ertools.benchmarks.common.teams import (
     with_team,
 )
 from ertools.cli.main import main
-from ertools.streams import Machine, Provenance
+from ertools.states import Machine
+from ertools.streams import Provenance
 
 REPO = Path(__file__).resolve().parents[2]
 

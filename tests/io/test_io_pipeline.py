@@ -24,12 +24,13 @@ import ertools.io as eio
 from ertools.errors import BagError, ErtoolsError
 from ertools.io import bulk, pipeline
 from ertools.io.mcap.index import _in_order
+from ertools.io.ros1 import runs as ros1_runs
 
 
 @pytest.fixture
 def small_groups(monkeypatch: pytest.MonkeyPatch) -> None:
     # ~3 chunks of 2000 bytes per group: the scene's bags span 20-60 groups.
-    monkeypatch.setattr(bulk, "GROUP_BYTES", 6000)
+    monkeypatch.setattr(pipeline, "GROUP_BYTES", 6000)
     monkeypatch.setattr(pipeline, "workers", lambda: 2)
 
 
@@ -191,7 +192,7 @@ def test_default_groups_equal_small_groups(scene_bag: tuple[str, Path]) -> None:
     whole = fast_batch(path, "/fbm3w/robot_at_work/pose")
     mp = pytest.MonkeyPatch()
     try:
-        mp.setattr(bulk, "GROUP_BYTES", 2500)
+        mp.setattr(pipeline, "GROUP_BYTES", 2500)
         mp.setattr(pipeline, "workers", lambda: 2)
         assert_same(fast_batch(path, "/fbm3w/robot_at_work/pose"), whole)
     finally:
@@ -220,14 +221,14 @@ def test_pose_topic_between_big_messages_is_read_in_place(
     their chunks, close together with the chunks: the same values as rosbags either way."""
     path = _pose_between_blobs(tmp_path, blob_bytes)
     calls: list[int] = []
-    real = bulk._mapped_group
+    real = ros1_runs.mapped_group
 
     def spy(bag: object, chunks: list[object], scratch: list[object]) -> object:
         calls.append(len(chunks))
         return real(bag, chunks, scratch)
 
-    monkeypatch.setattr(bulk, "_mapped_group", spy)
-    monkeypatch.setattr(bulk, "GROUP_BYTES", 30_000)  # several groups (and maps released)
+    monkeypatch.setattr(ros1_runs, "mapped_group", spy)
+    monkeypatch.setattr(pipeline, "GROUP_BYTES", 30_000)  # several groups (and maps released)
     monkeypatch.setattr(pipeline, "workers", lambda: 2)
     assert_same(fast_batch(path, "/robot/pose"), reference_batch(path, "/robot/pose"))
     assert bool(calls) is mapped

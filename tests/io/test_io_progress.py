@@ -46,7 +46,7 @@ def wide(monkeypatch: pytest.MonkeyPatch) -> None:
 @pytest.fixture
 def small_groups(monkeypatch: pytest.MonkeyPatch) -> None:
     # ~3 chunks of 2000 bytes per group: every read spans many groups (as in test_io_pipeline)
-    monkeypatch.setattr(bulk, "GROUP_BYTES", 6000)
+    monkeypatch.setattr(pipeline, "GROUP_BYTES", 6000)
     monkeypatch.setattr(pipeline, "workers", lambda: 2)
 
 

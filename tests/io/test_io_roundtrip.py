@@ -12,7 +12,7 @@ from io_bagmaker import Spec, bag_name, write
 
 import ertools.io as eio
 from ertools.errors import BagError, TopicError
-from ertools.streams import Machine
+from ertools.states import Machine
 
 POSE = "/fbm3w/robot_at_work/pose"
 

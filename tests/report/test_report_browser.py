@@ -75,7 +75,7 @@ def _chromium(tmp_path: Path, url: str, *extra: str) -> subprocess.CompletedProc
 def report(tmp_path_factory: pytest.TempPathFactory) -> Path:
     from ertools.audit.analyse import audit_states
     from ertools.audit.compare import attach
-    from ertools.streams import Machine
+    from ertools.states import Machine
 
     tmp = tmp_path_factory.mktemp("browser")
     audit = audit_states(

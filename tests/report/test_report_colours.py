@@ -9,8 +9,7 @@ import numpy as np
 import pytest
 
 from ertools.report.plots_audit import OKABE_ITO, STATE_COLOURS, UNKNOWN_COLOUR
-from ertools.states import STATE_ENUMS
-from ertools.streams import Machine
+from ertools.states import STATE_ENUMS, Machine
 
 # Machado, Oliveira & Fernandes (2009), "A physiologically-based model for simulation of
 # color vision deficiency", Table 1, severity 1.0: matrices on linear RGB.

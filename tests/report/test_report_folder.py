@@ -129,7 +129,7 @@ def test_sha256_of_a_rosbag2_directory(tmp_path: Path) -> None:
 
 def test_audit_report_has_timeline_figure(tmp_path: Path) -> None:
     from ertools.audit.analyse import audit_states
-    from ertools.streams import Machine
+    from ertools.states import Machine
 
     audit = audit_states(
         heartbeat(Machine.BMBOX, BMBOX, 20.0, drop=(5.0, 7.0)),
@@ -155,7 +155,7 @@ def test_report_of_score_bag_includes_its_audit(tmp_path: Path) -> None:
     """A score report whose bag has the state topics audits them by itself."""
     from test_cli_audit import _write_bag
 
-    from ertools.streams import Machine
+    from ertools.states import Machine
 
     bag = _write_bag(
         tmp_path / "fbm3w.bag",

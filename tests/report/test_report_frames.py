@@ -36,7 +36,7 @@ def test_audit_tables_as_frames() -> None:
     from test_audit import BMBOX
 
     from ertools.audit.analyse import audit_states
-    from ertools.streams import Machine
+    from ertools.states import Machine
 
     frames = result_to_dataframes(audit_states(heartbeat(Machine.BMBOX, BMBOX, 20.0)))
     tl = frames["timeline"]

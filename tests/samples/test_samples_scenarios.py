@@ -6,7 +6,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
-import re
 import subprocess
 import sys
 from pathlib import Path
@@ -15,6 +14,7 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
+from floats import FLOAT_ATOL, FLOAT_RTOL, same_text
 
 from ertools.samples.__main__ import main
 from ertools.samples.scenario import (
@@ -122,32 +122,10 @@ def test_log_name_is_the_2015_logger_pattern() -> None:
     assert answers_path(Path("d/x_rosbag2")) == Path("d/x_rosbag2.answers.yaml")
 
 
-# NumPy picks its sin/cos/exp code by CPU (AVX2, AVX-512, ...): results agree to a few ulp
-# (~1e-15 relative), not bit for bit. Any real change to a sample is far larger than this.
-FLOAT_RTOL = 1e-9
-FLOAT_ATOL = 1e-12
-
-
-_NUMBER = re.compile(r"([-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?)")
-
-
-def _same_text(a: str, b: str) -> bool:
-    """Equal text, numbers written in it compared as floats (state payloads carry scores)."""
-    pa, pb = _NUMBER.split(a), _NUMBER.split(b)
-    if len(pa) != len(pb):
-        return False
-    for i, (x, y) in enumerate(zip(pa, pb, strict=True)):
-        if i % 2 == 0 and x != y:
-            return False
-        if i % 2 and not math.isclose(float(x), float(y), rel_tol=FLOAT_RTOL, abs_tol=FLOAT_ATOL):
-            return False
-    return True
-
-
 def _close(a: Any, b: Any, where: str) -> list[str]:
     """Where two decoded values differ beyond float rounding (recursing into containers)."""
     if isinstance(a, str) and isinstance(b, str):
-        return [] if a == b or _same_text(a, b) else [where]
+        return [] if a == b or same_text(a, b) else [where]
     if isinstance(a, float) and isinstance(b, float):
         return [] if math.isclose(a, b, rel_tol=FLOAT_RTOL, abs_tol=FLOAT_ATOL) else [where]
     if isinstance(a, np.ndarray) and isinstance(b, np.ndarray):

@@ -9,8 +9,7 @@ import pytest
 
 from ertools.samples.statemachine import Transition, machine_messages, publish_states
 from ertools.samples.writer import BagWriter
-from ertools.states import BmBoxState, ClientState, RefBoxState
-from ertools.streams import Machine
+from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
 T0 = 1_448_013_600_000_000_000
 S = 1_000_000_000

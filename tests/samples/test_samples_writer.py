@@ -10,8 +10,7 @@ import pytest
 
 from ertools.errors import UsageError
 from ertools.samples.writer import FORMATS, BagWriter, pack_messages
-from ertools.states import MSG_TYPES, BmBoxState, ClientState
-from ertools.streams import Machine
+from ertools.states import MSG_TYPES, BmBoxState, ClientState, Machine
 
 T0 = 1_448_013_600_123_456_789
 

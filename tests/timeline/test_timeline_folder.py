@@ -219,7 +219,7 @@ def test_real_2015_bag() -> None:
 
 def test_clock_checked_once_per_recording_unless_off(monkeypatch: pytest.MonkeyPatch) -> None:
     import ertools.timeline.scan as ts
-    from ertools.timeline.model import ClockCheck
+    from ertools.io.model import ClockCheck
 
     @dataclass(frozen=True)
     class S:

@@ -23,9 +23,7 @@ Pure NumPy: streams in, a frozen :class:`OffsetEstimate` out.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import numpy.typing as npt
@@ -451,54 +449,3 @@ def _bootstrap_sigma(t_ns: I64, r: F64, v: F64, seed: int) -> float:
     num, den = a[draws].sum(axis=1), b[draws].sum(axis=1)
     ok = den > 0
     return float(np.std(num[ok] / den[ok]))
-
-
-# Record time minus header stamp of mocap poses is a few ms on one machine (0.3 ms in the real
-# 2015 log); a quarter second means two clocks disagree, enough to move a robot at 0.5 m/s by
-# 12 cm between the moment the states name and the pose taken for it.
-HEADER_CLOCK_TOLERANCE_NS = NS_PER_S // 4
-
-
-def check_header_clock(
-    paths: Sequence[str | Path],
-    poses: PoseStream,
-    states_what: str | None,
-    tolerance_ns: int = HEADER_CLOCK_TOLERANCE_NS,
-    *,
-    time_source: str = "header",
-) -> None:
-    """Refuse poses timed by header stamps that disagree with the bag's record times.
-
-    Benchmark states (and timing files) are timed by record time; poses by default by their
-    header stamp. When the two clocks differ by more than ``tolerance_ns``, every pose taken
-    "at" a state moment is another moment's pose: a wrong score that looks right.
-
-    The one guard of every benchmark: nothing to check when the poses are timed by record
-    time (``time_source`` "record") or when the moments come from the poses themselves
-    (``states_what`` None: runs found from motion are in the poses' own time).
-
-    Raises:
-        ClockError: naming the file, the topic, the offset and the way out.
-    """
-    from ertools.errors import ClockError
-    from ertools.io import summary
-    from ertools.timeline.scan import clock_check
-
-    if time_source != "header" or states_what is None:
-        return
-    cut = poses.source.rfind(":/")
-    topic = poses.source[cut + 1 :] if cut >= 0 else ""
-    if not topic or topic in ("/tf", "/tf_static"):
-        return  # tf mixes publishers (static transforms are stamped otherwise): not checked
-    for path in paths:
-        check = clock_check(summary(path), topic_name=topic)
-        if check is None or check.error or not check.samples:
-            continue
-        if abs(check.offset_ns) > tolerance_ns:
-            ahead = -check.offset_ns / NS_PER_S
-            raise ClockError(
-                f"{path}:{topic}: header stamps are {ahead:+.3f} s off the record times "
-                f"(median of {check.samples} messages), but the {states_what} are timed by "
-                "record time: the mocap and logger clocks disagree; re-run with "
-                "--time-source record"
-            )

@@ -680,7 +680,7 @@ def locate_runs(logs: Fbm1Logs, options: Fbm1Options) -> Fbm1Runs:
     src = options.sources
     origin = read_body(plist, src.origin, f"/{ns}/origin/pose", "origin", (lo, hi))
     board = read_body(plist, src.board, f"/{ns}/ref_board/pose", "ref_board", (lo, hi))
-    from ertools.benchmarks.common.clocks import check_header_clock
+    from ertools.io.clock import check_header_clock
 
     for body, source in ((origin, src.origin), (board, src.board)):
         if source is None or source.time_source == "header":

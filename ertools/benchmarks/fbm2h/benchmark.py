@@ -643,7 +643,7 @@ def locate_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
         )
     else:
         raise ConfigError(f"--reached must be states, timing FILE or auto, not {reached!r}")
-    from ertools.benchmarks.common.clocks import check_header_clock
+    from ertools.io.clock import check_header_clock
 
     what = {"states": "state messages", "auto": None}.get(moments.method, "timing file's moments")
     check_header_clock(list(logs.paths), logs.marker, what, time_source=options.time_source)

@@ -319,7 +319,7 @@ def locate_runs(logs: Fbm3wLogs, options: Fbm3wOptions) -> list[RunWindow]:
         windows = find_auto(logs.poses, options.config or Fbm3wConfig(), **_still(options))
     # State messages and --run windows are timed by record time: header-stamped poses from a
     # mocap clock seconds off would be cut at other moments (a wrong score that looks right).
-    from ertools.benchmarks.common.clocks import check_header_clock
+    from ertools.io.clock import check_header_clock
 
     what = {"states": "state messages", "auto": None}.get(
         mode, "run windows (times from the log start)"

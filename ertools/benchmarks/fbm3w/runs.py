@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.benchmarks.fbm3w.motion import (
+from ertools.benchmarks.common.phases import (
     DEFAULT_MIN_STILL_S,
     DEFAULT_STILL_SPEED,
     Phase,
@@ -332,7 +332,7 @@ def find_auto(
 
     A run is: still at the reference, a move to the start, still at the start, the path,
     still at the end. The still phases come from
-    :func:`~ertools.benchmarks.fbm3w.motion.protocol_track` (noise-sized window, hysteresis,
+    :func:`~ertools.benchmarks.common.phases.protocol_track` (noise-sized window, hysteresis,
     dropouts bridged). Every move j >= 1 (and up to :data:`AUTO_MAX_SPAN` moves joined across
     short pauses) is a candidate path for each run's shape, matched with Eq. (1) on the
     smoothed positions (see :func:`_match`); it is acceptable when its best-rotation error is
@@ -351,7 +351,7 @@ def find_auto(
             moves found (seconds from the first pose) and what is missing.
     """
     from ertools.benchmarks.common.motion import moving_mean
-    from ertools.benchmarks.fbm3w.motion import protocol_track
+    from ertools.benchmarks.common.phases import protocol_track
 
     # NaN poses (the mocap's "not tracked") carry no position: left out, as a dropout
     finite = np.all(np.isfinite(poses.xyz[:, :2]), axis=1)

@@ -22,6 +22,12 @@ import numpy.typing as npt
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.benchmarks.common.hygiene import identical_poses
+from ertools.benchmarks.common.phases import (
+    DEFAULT_MIN_STILL_S,
+    DEFAULT_STILL_SPEED,
+    phase_pairs,
+    stationary_phases,
+)
 from ertools.errors import ScoringError
 from ertools.fidelity import Deviation
 from ertools.streams import PoseStream, Provenance
@@ -228,13 +234,6 @@ def noise_from_stream(
         ScoringError: every pose is NaN (named with the stream's source), or as
             :func:`noise_statistics`.
     """
-    from ertools.benchmarks.fbm3w.motion import (
-        DEFAULT_MIN_STILL_S,
-        DEFAULT_STILL_SPEED,
-        phase_pairs,
-        stationary_phases,
-    )
-
     xy = poses.xyz[:, :2]
     if len(poses) and not np.isfinite(xy).all(axis=1).any():
         # Said here, where the file and topic are known: noise_statistics would only find

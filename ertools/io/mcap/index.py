@@ -21,11 +21,14 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.errors import BagError
+from ertools.io import pipeline
+from ertools.io.bagfile import BagFile
 from ertools.io.decode.fast import gather
-from ertools.io.files import BagFile
 from ertools.io.mcap.crc import crc32
+from ertools.io.mcap.scan import SCAN, mcap_layout, scan_mcap
+from ertools.io.mcap.summary import decompress, file_size, read_summary
 from ertools.io.model import Conn
-from ertools.io.pipeline import Group, pread, read_at, scratch_view
+from ertools.io.pipeline import Group, group_positions, pread, read_at, scratch_view
 
 if TYPE_CHECKING:
     from ertools.progress import Reporter
@@ -44,96 +47,6 @@ OP_CHUNK = 0x06
 OP_MESSAGE_INDEX = 0x07
 MESSAGE_FIXED = 2 + 4 + 8 + 8  # channel id, sequence, log time, publish time
 PAIR = np.dtype([("t", "<u8"), ("off", "<u8")])
-
-
-# Summaries parsed, by file identity: opening a file and planning a read need the same one.
-_SUMMARIES: dict[tuple[int, int, int, int], Any] = {}
-
-
-def read_summary(f: BinaryIO, path: Path) -> Any:
-    """The ``mcap`` library's Summary of an open MCAP file, None when it has none.
-
-    Kept per file (device, inode, size, modification time), so a file changed since is read
-    again; the Summary is shared, never modified.
-    """
-    st = os.fstat(f.fileno())
-    key = (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
-    if key in _SUMMARIES:
-        return _SUMMARIES[key]
-    summary = _parse_summary(f, path)
-    if len(_SUMMARIES) >= 64:
-        _SUMMARIES.clear()
-    _SUMMARIES[key] = summary
-    return summary
-
-
-def _parse_summary(f: BinaryIO, path: Path) -> Any:
-    from mcap.reader import make_reader
-
-    from ertools.io.files import mcap_errors
-
-    try:
-        f.seek(0)
-        summary = make_reader(f).get_summary()
-    except mcap_errors() as err:
-        raise BagError(f"unreadable MCAP summary ({type(err).__name__}: {err})", path=path) from err
-    if summary is None:
-        return None
-    _check_summary_crc(f, path)
-    stats = summary.statistics
-    if (
-        stats is not None
-        and summary.chunk_indexes
-        and stats.chunk_count != len(summary.chunk_indexes)
-    ):
-        # a chunk index record lost to damage (the mcap library skips a record whose op code
-        # it does not know): reading through the others would silently skip a chunk
-        raise BagError(
-            f"damaged MCAP summary: statistics count {stats.chunk_count} chunks, the chunk "
-            f"indexes {len(summary.chunk_indexes)}",
-            path=path,
-        )
-    return summary
-
-
-def _check_summary_crc(f: BinaryIO, path: Path) -> None:
-    """Refuse a summary section that fails the CRC its footer gives (0: not computed).
-
-    The ``mcap`` library does not check it; a damaged summary (a chunk index's op code,
-    offsets or times, a channel's schema id) would otherwise direct every indexed read. The
-    section is what the library has just read, a small part of the file.
-    """
-    size = _file_size(f)
-    at = size - 8 - (1 + 8 + 8 + 8 + 4)
-    footer = pread(f.fileno(), 1 + 8 + 8 + 8 + 4, at)
-    if len(footer) < 29 or footer[0] != 0x02:
-        return  # no footer here: the library found none either
-    _, _len, start, _offsets, crc = struct.unpack("<BQQQI", footer)
-    if not crc or not 0 < start < at:
-        return
-    # from the first summary record through the footer's summary_offset_start field
-    covered = pread(f.fileno(), at + 1 + 8 + 8 + 8 - start, start)
-    if crc32(covered) != crc:
-        raise BagError("damaged MCAP summary section: it fails its CRC check", path=path)
-
-
-def decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
-    """Uncompressed MCAP chunk records."""
-    try:
-        if compression == "":
-            return data
-        if compression == "zstd":
-            import zstandard
-
-            return bytes(zstandard.ZstdDecompressor().decompress(data, max_output_size=size))
-        if compression == "lz4":
-            import lz4.frame
-
-            return bytes(lz4.frame.decompress(data))
-    except Exception as err:
-        # zstandard and lz4 raise their own error classes on corrupt input.
-        raise BagError(f"corrupt {compression} MCAP chunk {where} ({err})") from err
-    raise BagError(f"unsupported MCAP chunk compression {compression!r} {where}")
 
 
 def _check_counts(path: Path, summary: Any, planned: dict[int, int]) -> None:
@@ -175,12 +88,6 @@ def _zstd_into(data: bytes, out: memoryview, where: str) -> None:
     if got != len(out) or extra:
         size = f"more than {len(out)}" if extra else f"{got}"
         raise BagError(f"chunk decompresses to {size} bytes, not {len(out)}, {where}")
-
-
-def _file_size(f: BinaryIO) -> int:
-    import os
-
-    return os.fstat(f.fileno()).st_size
 
 
 def _in_order(*keys: I64) -> bool:
@@ -233,7 +140,6 @@ class McapIndex:
                 no message indexes, channels only inside chunks...): the caller falls back.
         """
         from ertools.io.decode.fast import LayoutMismatchError
-        from ertools.io.mcap.scan import SCAN, mcap_layout
 
         topics = {c.topic for c in conns}
         sels: list[tuple[int, int, int, I64, I64]] = []  # file, chunk idx, chunk offset, t, off
@@ -247,14 +153,14 @@ class McapIndex:
                 channels = {cid for cid, ch in layout.channels.items() if ch.topic in topics}
                 chunks = summary.chunk_indexes
                 chunks_per_file.append(chunks)
-                file_size = _file_size(f)
+                total_size = file_size(f)
                 planned = dict.fromkeys(channels, 0)  # messages per channel, for the statistics
                 for ci, chunk in enumerate(chunks):
                     if lo is not None and chunk.message_end_time < lo:
                         continue
                     if hi is not None and chunk.message_start_time > hi:
                         continue
-                    if not 0 <= chunk.chunk_start_offset < file_size:
+                    if not 0 <= chunk.chunk_start_offset < total_size:
                         raise BagError(
                             f"chunk index gives a chunk at byte {chunk.chunk_start_offset}, "
                             "outside the file",
@@ -274,7 +180,7 @@ class McapIndex:
                         continue
                     for cid in wanted:
                         offset = chunk.message_index_offsets[cid]
-                        t, off = self._message_index(f, path, offset, cid, file_size, padded=False)
+                        t, off = self._message_index(f, path, offset, cid, total_size, padded=False)
                         if lo is not None or hi is not None:
                             keep = np.ones(len(t), dtype=bool)
                             if lo is not None:
@@ -326,12 +232,10 @@ class McapIndex:
         it, and ``bytes[k]`` is what that group reads from the file (its chunks' compressed
         sizes, for progress). ``load`` may run on a worker thread (it opens the file
         itself)."""
-        from ertools.io.bulk import GROUP_BYTES, group_positions
-
         todo: list[list[tuple[int, I64]]] = []
         size = 0
         for key, rows in group_positions(plan.key):
-            if not todo or size >= GROUP_BYTES:
+            if not todo or size >= pipeline.GROUP_BYTES:
                 todo.append([])
                 size = 0
             todo[-1].append((key, rows))
@@ -465,7 +369,7 @@ class McapIndex:
                 trusts the index then goes record by record instead (only padded files pay).
         """
         if size is None:
-            size = _file_size(f)
+            size = file_size(f)
         if not 0 <= pos < size:
             raise BagError(f"message index offset {pos} outside the file ({size} bytes)", path=path)
         f.seek(pos)
@@ -586,8 +490,6 @@ def verify_mcap(path: Path, progress: Reporter | None = None) -> None:
     Raises:
         BagError: the first damaged chunk, with its byte offset.
     """
-    from ertools.io.mcap.scan import SCAN, mcap_layout, scan_mcap
-
     layout = mcap_layout(path)
     if layout.index == SCAN:
         # no indexes to check against: every record read, every chunk's CRC checked

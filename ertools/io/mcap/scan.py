@@ -27,6 +27,7 @@ import numpy.typing as npt
 from ertools.errors import BagError
 from ertools.io.decode.fast import read_at
 from ertools.io.mcap.crc import crc32
+from ertools.io.mcap.summary import decompress, read_summary
 
 I64 = npt.NDArray[np.int64]
 U8 = npt.NDArray[np.uint8]
@@ -294,8 +295,6 @@ def _record(buf: Any, op: int, body: int, stop: int, sink: _Sink, top: bool) -> 
 
 
 def _chunk(buf: Any, at: int, end: int, sink: _Sink) -> None:
-    from ertools.io.mcap.index import decompress
-
     _t0, _t1, usize, crc, clen = _CHUNK.unpack_from(buf, at)
     at += _CHUNK.size
     compression = bytes(buf[at : at + clen]).decode("ascii", "replace")
@@ -475,8 +474,6 @@ def _scan_layout(summary: Any, why: str) -> McapLayout:
 
 
 def _layout(path: Path) -> McapLayout:
-    from ertools.io.mcap.index import read_summary
-
     with path.open("rb") as f:
         size = os.fstat(f.fileno()).st_size
         if size < 2 * len(MAGIC) + FOOTER_SIZE or os.pread(f.fileno(), 8, size - 8) != MAGIC:

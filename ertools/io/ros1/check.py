@@ -26,6 +26,14 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.errors import BagError
+from ertools.io.ros1.layout import (
+    Ros1Chunk,
+    Ros1Layout,
+    conn_record,
+    decompress,
+    entries_from_index,
+    scan_layout,
+)
 from ertools.io.ros1.records import (
     MAGIC_LEN,
     OP_BAG_HEADER,
@@ -46,7 +54,6 @@ from ertools.io.ros1.records import (
 
 if TYPE_CHECKING:
     from ertools.io.model import Conn
-    from ertools.io.ros1.index import Ros1Layout
     from ertools.progress import Reporter
 
 I64 = npt.NDArray[np.int64]
@@ -268,8 +275,6 @@ def check_ros1(path: Path, progress: Reporter | None = None) -> list[str]:
 
 
 def _check(f: BinaryIO, path: Path, size: int, progress: Reporter | None) -> list[str]:
-    from ertools.io.ros1.index import _entries_from_index, decompress
-
     rep = _Report()
     try:
         head, _ = read_record(f, MAGIC_LEN, size)
@@ -305,7 +310,7 @@ def _check(f: BinaryIO, path: Path, size: int, progress: Reporter | None) -> lis
                 elif not chunks:
                     rep.add(f"index data at byte {pos} before any chunk")
                 else:
-                    chunks[-1].index[cid] = _entries_from_index(data)
+                    chunks[-1].index[cid] = entries_from_index(data)
             elif rec.op == OP_CONNECTION:
                 cid, topic, cf = connection_fields(rec, data)
                 index_conns[cid] = _conn_text(topic.encode(), cf)
@@ -449,18 +454,9 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
     the index: record times and offsets come from the message records themselves; the
     index-data offsets only say where to look first (:func:`chunk_records`), so the cost is
     one decompression per chunk and a few NumPy passes, not a Python step per message.
-    Falls back to :func:`ertools.io.ros1.index.scan_layout` (record by record) for anything
+    Falls back to :func:`ertools.io.ros1.layout.scan_layout` (record by record) for anything
     but chunks, index data and index records at the top level.
     """
-    from ertools.io.ros1.index import (
-        Ros1Chunk,
-        Ros1Layout,
-        _conn,
-        _entries_from_index,
-        decompress,
-        scan_layout,
-    )
-
     start = pos
     conns: dict[int, Conn] = {}
     found: list[tuple[int, str, int, int, bytes, list[tuple[I64, I64]]]] = []
@@ -472,10 +468,10 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
                 compression = rec.fields.get("compression", b"none").decode("ascii", "replace")
                 found.append((pos, compression, rec.data_pos, rec.data_len, data, []))
             elif rec.op == OP_INDEX and found:
-                found[-1][5].append(_entries_from_index(data[: 12 * (len(data) // 12)]))
+                found[-1][5].append(entries_from_index(data[: 12 * (len(data) // 12)]))
             elif rec.op == OP_CONNECTION:
                 cid, topic, cf = connection_fields(rec, data)
-                conns.setdefault(cid, _conn(cid, topic, cf))
+                conns.setdefault(cid, conn_record(cid, topic, cf))
             elif rec.op != OP_CHUNK_INFO:
                 raise RecordError(f"record of op {rec.op} outside a chunk", pos)
             pos = rec.end
@@ -509,7 +505,7 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
                 )
         for cid, (topic, msgtype, md5) in recs.conns.items():
             fields = {"type": msgtype.encode(), "md5sum": md5.encode()}
-            conns.setdefault(cid, _conn(cid, topic, fields))
+            conns.setdefault(cid, conn_record(cid, topic, fields))
         if not len(recs.msg_off):
             continue
         entries = {

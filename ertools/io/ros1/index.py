@@ -8,43 +8,55 @@ still being recorded, truncated copies) are scanned record by record instead, an
 
 from __future__ import annotations
 
-import bz2
 import contextlib
-import functools
 import logging
 import mmap
-import struct
 from collections.abc import Collection, Iterator, Sequence
-from dataclasses import dataclass, field
 from io import BufferedReader
 from pathlib import Path
 from struct import error as struct_error
-from typing import TYPE_CHECKING, Any, BinaryIO
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.errors import BagError
-from ertools.io.files import BagFile, RawRecord
-from ertools.io.model import Conn, short_msgtype
+from ertools.io.bagfile import BagFile, RawRecord
+from ertools.io.model import Conn
+from ertools.io.ros1.check import rebuild_layout
+from ertools.io.ros1.layout import (
+    INDEX_DTYPE,
+    MSG_HEADER_LEN,
+    OP_AT,
+    OP_MSG_WORD,
+    U32,
+    Ros1Chunk,
+    Ros1Layout,
+    cat_arrays,
+    decompress,
+    entries_from_index,
+    fields_before,
+    index_header,
+    joined_entries,
+    nonzero_counts,
+    op_word,
+    outside_chunk_info,
+    read_layout,
+    value_offsets,
+)
 from ertools.io.ros1.records import (
     MAGIC_LEN,
-    OP_BAG_HEADER,
     OP_CHUNK,
-    OP_CHUNK_INFO,
     OP_CONNECTION,
     OP_INDEX,
     OP_MSG,
     Record,
     RecordError,
-    chunk_info,
-    connection_fields,
     parse_fields,
     read_record,
-    time_ns,
-    u32,
-    u64,
 )
+from ertools.io.ros1.runs import ros1_runs
+from ertools.progress import current
 
 if TYPE_CHECKING:
     from ertools.progress import Reporter
@@ -53,376 +65,6 @@ log = logging.getLogger("ertools.io.ros1.index")
 
 I64 = npt.NDArray[np.int64]
 U8 = npt.NDArray[np.uint8]
-
-INDEX_DTYPE = np.dtype([("sec", "<u4"), ("nsec", "<u4"), ("off", "<u4")])
-# The message-data record header rosbag and rosbags write: conn (4), op (1), time (8) fields.
-MSG_HEADER_LEN = 4 + len("conn=") + 4 + 4 + len("op=") + 1 + 4 + len("time=") + 8
-_U32 = struct.Struct("<I")
-_OP_AT = (0, 13, 17, 30)  # where the op field can sit in a standard message-record header
-
-
-def _op_word(buf: U8, pos: I64) -> npt.NDArray[np.uint64]:
-    from ertools.io.decode.fast import read_at
-
-    return read_at(buf, pos, np.dtype("<u8"))
-
-
-_OP_MSG_WORD = int.from_bytes(b"\x04\x00\x00\x00op=\x02", "little")
-
-
-@dataclass
-class Ros1Chunk:
-    """One chunk: where it is, its time span and per-connection counts.
-
-    ``entries`` (conn -> (record times, offsets in the uncompressed chunk)) is filled when the
-    index-data records after the chunk are read (or by a scan).
-    """
-
-    pos: int
-    start_ns: int
-    end_ns: int
-    counts: dict[int, int]
-    compression: str = ""
-    data_pos: int = -1
-    data_len: int = -1
-    entries: dict[int, tuple[I64, I64]] | None = None
-
-
-@dataclass
-class Ros1Layout:
-    """The index of a ROS1 bag (read or rebuilt by a scan)."""
-
-    path: Path
-    size: int
-    indexed: bool
-    conns: list[Conn]
-    chunks: list[Ros1Chunk]
-    problems: list[str] = field(default_factory=list)
-
-
-def _conn(cid: int, topic: str, fields: dict[str, bytes]) -> Conn:
-    def text(name: str) -> str:
-        return fields.get(name, b"").decode("utf-8", "replace")
-
-    return Conn(
-        cid,
-        topic or text("topic"),
-        short_msgtype(text("type")),
-        text("message_definition"),
-        "msg" if text("message_definition") else "",
-        "ros1",
-        text("latching") not in ("", "0"),
-        text("md5sum"),
-    )
-
-
-def _entries_from_index(data: bytes) -> tuple[I64, I64]:
-    arr = np.frombuffer(data, dtype=INDEX_DTYPE)
-    # Computed in place: fresh memory is slow to fault in, and an hour's entries are 5 MB.
-    t = np.multiply(arr["sec"], 1_000_000_000, dtype=np.int64)
-    np.add(t, arr["nsec"], out=t)
-    return t, arr["off"].astype(np.int64)
-
-
-def _cat(parts: list[I64]) -> I64:
-    """Arrays end to end; one array as it is (no copy of an hour's entries)."""
-    return parts[0] if len(parts) == 1 else np.concatenate(parts)
-
-
-def _joined_entries(parts: list[bytes | tuple[I64, I64]]) -> tuple[I64, I64]:
-    """(times, offsets) of one connection's entries over several chunks."""
-    if all(isinstance(p, bytes) for p in parts):
-        return _entries_from_index(b"".join(p for p in parts if isinstance(p, bytes)))
-    pairs = [_entries_from_index(p) if isinstance(p, bytes) else p for p in parts]
-    return np.concatenate([p[0] for p in pairs]), np.concatenate([p[1] for p in pairs])
-
-
-@functools.lru_cache(maxsize=4096)
-def _index_header(header: bytes) -> tuple[int, int, int, int] | None:
-    """(op, ver, conn, count) of an index-data record header, None when malformed. Cached:
-    an hour bag repeats the same few headers (one per connection and usual count)."""
-    try:
-        fields = parse_fields(header)
-        return fields["op"][0], u32(fields, "ver"), u32(fields, "conn"), u32(fields, "count")
-    except (RecordError, KeyError, IndexError, struct_error):
-        return None
-
-
-def read_layout(path: Path) -> Ros1Layout:
-    """The index of the bag at ``path``; scans when the index is missing or damaged.
-
-    Raises:
-        BagError: not even the bag header is readable.
-    """
-    size = path.stat().st_size
-    with path.open("rb") as f:
-        try:
-            head, _ = read_record(f, MAGIC_LEN, size)
-            if head.op != OP_BAG_HEADER:
-                raise RecordError("first record is not the bag header", MAGIC_LEN)
-            index_pos = u64(head.fields, "index_pos")
-            conn_count = u32(head.fields, "conn_count")
-            chunk_count = u32(head.fields, "chunk_count")
-        except (RecordError, KeyError, struct_error) as err:
-            raise BagError(f"unreadable ROS1 bag header ({err}); not a bag?", path=path) from err
-        if index_pos == 0:
-            return scan_layout(f, path, size, head.end, "not indexed (recording not closed)")
-        if head.end == index_pos == size and conn_count == 0 and chunk_count == 0:
-            # What a recorder leaves when nothing arrived: the header, then an empty index
-            # (nothing between them; records there would mean a damaged header: scanned).
-            return Ros1Layout(path, size, True, [], [])
-        if index_pos >= size:
-            return scan_layout(
-                f,
-                path,
-                size,
-                head.end,
-                f"truncated: the index at byte {index_pos} lies past the end ({size} bytes)",
-            )
-        try:
-            conns: list[Conn] = []
-            pos = index_pos
-            for _ in range(conn_count):
-                rec, data = read_record(f, pos, size, with_data=True)
-                if rec.op != OP_CONNECTION:
-                    raise RecordError("expected a connection record", pos)
-                cid, topic, fields = connection_fields(rec, data)
-                if any(c.id == cid for c in conns):
-                    # a damaged id: one connection's messages would be read as another's
-                    raise RecordError(f"two connection records with id {cid}", pos)
-                conns.append(_conn(cid, topic, fields))
-                pos = rec.end
-            if chunk_count == 0 and conn_count and index_pos > head.end:
-                # records between the header and the index, but no chunk to find them by
-                raise RecordError("the bag header counts no chunks before its index", MAGIC_LEN)
-            chunks = []
-            for _ in range(chunk_count):
-                rec, data = read_record(f, pos, size, with_data=True)
-                if rec.op != OP_CHUNK_INFO:
-                    raise RecordError("expected a chunk-info record", pos)
-                cpos, start, end, counts = chunk_info(rec, data)
-                if cpos >= size:
-                    raise RecordError(f"chunk position {cpos} past the end of the file", pos)
-                chunks.append(Ros1Chunk(cpos, start, end, counts))
-                pos = rec.end
-        except (RecordError, KeyError, struct_error, IndexError) as err:
-            return scan_layout(f, path, size, head.end, f"damaged index ({err})")
-    return Ros1Layout(path, size, True, conns, chunks)
-
-
-def decompress(compression: str, data: bytes, where: str) -> bytes:
-    """Uncompressed chunk bytes."""
-    try:
-        if compression == "none":
-            return data
-        if compression == "bz2":
-            return bz2.decompress(data)
-        if compression == "lz4":
-            import lz4.frame
-
-            return bytes(lz4.frame.decompress(data))
-    except (OSError, ValueError, RuntimeError, EOFError) as err:
-        raise BagError(f"corrupt {compression} chunk {where} ({err})") from err
-    raise BagError(f"unsupported chunk compression {compression!r} {where}")
-
-
-def _walk_chunk(buf: bytes, base: int) -> Iterator[tuple[int, dict[str, bytes], int, int]]:
-    """(offset, header fields, data offset, data length) of each record inside a chunk."""
-    pos = 0
-    n = len(buf)
-    while pos + 4 <= n:
-        hlen = int.from_bytes(buf[pos : pos + 4], "little")
-        if pos + 8 + hlen > n:
-            raise RecordError("record cut off inside chunk", base + pos)
-        fields = parse_fields(buf[pos + 4 : pos + 4 + hlen], base + pos + 4)
-        dlen = int.from_bytes(buf[pos + 4 + hlen : pos + 8 + hlen], "little")
-        dpos = pos + 8 + hlen
-        if dpos + dlen > n:
-            raise RecordError("record data cut off inside chunk", base + pos)
-        yield pos, fields, dpos, dlen
-        pos = dpos + dlen
-
-
-def _scanned_chunk(
-    pos: int,
-    compression: str,
-    data_pos: int,
-    data_len: int,
-    per: dict[int, tuple[list[int], list[int]]],
-) -> Ros1Chunk:
-    entries = {
-        cid: (np.array(ts, dtype=np.int64), np.array(offs, dtype=np.int64))
-        for cid, (ts, offs) in per.items()
-    }
-    times = [t for t, _ in entries.values() if len(t)]
-    return Ros1Chunk(
-        pos,
-        min(int(t.min()) for t in times) if times else 0,
-        max(int(t.max()) for t in times) if times else 0,
-        {cid: len(t) for cid, (t, _) in entries.items()},
-        compression,
-        data_pos,
-        data_len,
-        entries,
-    )
-
-
-def scan_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ros1Layout:
-    """Rebuild the index by walking every record (and every record inside every chunk).
-
-    A recorder writes the chunk it is filling straight into the file, after a chunk header
-    whose size is only set when the chunk is closed; in an ``.active`` file those messages
-    appear as records outside any chunk. They are gathered into a pseudo-chunk (uncompressed,
-    covering that stretch of the file) so they are read like the others.
-    """
-    log.info("%s: %s; scanning the whole file", path, why)
-    problems = [why]
-    conns: dict[int, Conn] = {}
-    chunks: list[Ros1Chunk] = []
-    loose: dict[int, tuple[list[int], list[int]]] = {}
-    loose_start = loose_end = -1
-
-    def flush() -> None:
-        nonlocal loose, loose_start
-        if loose:
-            chunks.append(
-                _scanned_chunk(loose_start, "none", loose_start, loose_end - loose_start, loose)
-            )
-        loose, loose_start = {}, -1
-
-    while pos < size:
-        try:
-            rec, data = read_record(f, pos, size, with_data=True)
-        except RecordError as err:
-            problems.append(f"truncated: last record incomplete ({err}); read up to byte {pos}")
-            break
-        if rec.op in (OP_MSG, OP_CONNECTION):
-            try:
-                if rec.op == OP_MSG:
-                    cid, t = u32(rec.fields, "conn"), time_ns(rec.fields, "time")
-                    if loose_start < 0:
-                        loose_start = rec.pos
-                    ts, offs = loose.setdefault(cid, ([], []))
-                    ts.append(t)
-                    offs.append(rec.pos - loose_start)
-                    loose_end = rec.end
-                else:
-                    cid, topic, cfields = connection_fields(rec, data)
-                    conns.setdefault(cid, _conn(cid, topic, cfields))
-            except (RecordError, KeyError, struct_error, IndexError) as err:
-                problems.append(f"damaged record at byte {pos} ({err}); scan stopped there")
-                break
-        elif rec.op == OP_CHUNK:
-            flush()
-            compression = rec.fields.get("compression", b"none").decode("ascii", "replace")
-            try:
-                buf = decompress(compression, data, f"at byte {pos}")
-                per: dict[int, tuple[list[int], list[int]]] = {}
-                for off, fields, dpos, dlen in _walk_chunk(buf, rec.data_pos):
-                    op = fields["op"][0]
-                    if op == OP_CONNECTION:
-                        cid = u32(fields, "conn")
-                        cfields = parse_fields(buf[dpos : dpos + dlen])
-                        # strict, as for the index's connection records: a name that is not
-                        # UTF-8 is damage, never a topic or type with replacement characters
-                        topic = fields.get("topic", b"").decode("utf-8")
-                        cfields.get("type", b"").decode("utf-8")
-                        conns.setdefault(cid, _conn(cid, topic, cfields))
-                    elif op == OP_MSG:
-                        ts, offs = per.setdefault(u32(fields, "conn"), ([], []))
-                        ts.append(time_ns(fields, "time"))
-                        offs.append(off)
-            except (
-                BagError,
-                RecordError,
-                KeyError,
-                IndexError,
-                struct_error,
-                UnicodeDecodeError,
-            ) as err:
-                problems.append(f"corrupt chunk at byte {pos} skipped ({err})")
-                pos = rec.end
-                continue
-            if per:
-                chunks.append(_scanned_chunk(pos, compression, rec.data_pos, rec.data_len, per))
-        elif rec.op in (OP_INDEX, OP_CHUNK_INFO):
-            flush()
-        else:
-            problems.append(f"unknown record op {rec.op} at byte {pos}")
-        pos = rec.end
-    flush()
-    return Ros1Layout(
-        path, size, False, sorted(conns.values(), key=lambda c: c.id), chunks, problems
-    )
-
-
-def _outside_chunk_info(
-    chunks: Sequence[Ros1Chunk], cid: int, t: I64, where: Sequence[tuple[int, int]]
-) -> str | None:
-    """Why the index-data times ``t`` of one connection (``where``: (chunk, count) of each
-    run of them, in order) do not all lie in their chunk's chunk-info [start, end], or None.
-
-    One min and one max per chunk (two passes over the times, no per-message gather): the
-    reads were planned from those spans, so a time outside one means the index contradicts
-    itself and a window may have skipped a chunk it needed.
-    """
-    counts = np.array([w[1] for w in where], dtype=np.int64)
-    nonempty = counts > 0
-    if not len(t) or not nonempty.any():
-        return None
-    cis = np.array([w[0] for w in where], dtype=np.int64)[nonempty]
-    at = (np.cumsum(counts) - counts)[nonempty]
-    lo = np.minimum.reduceat(t, at)
-    hi = np.maximum.reduceat(t, at)
-    start = np.array([chunks[i].start_ns for i in cis.tolist()], dtype=np.int64)
-    end = np.array([chunks[i].end_ns for i in cis.tolist()], dtype=np.int64)
-    bad = np.flatnonzero((lo < start) | (hi > end))
-    if not len(bad):
-        return None
-    k = int(bad[0])
-    chunk = chunks[int(cis[k])]
-    return (
-        f"index data of connection {cid} after the chunk at byte {chunk.pos} holds record "
-        f"times {int(lo[k])}..{int(hi[k])} ns outside its chunk info's "
-        f"{chunk.start_ns}..{chunk.end_ns} ns ({len(bad)} chunk(s) so)"
-    )
-
-
-def _value_offsets(buf: U8, head: int) -> tuple[int, int] | None:
-    """(conn value, time value) offsets in the 38-byte message header at ``head``."""
-    try:
-        fields = bytes(buf[head : head + MSG_HEADER_LEN])
-        pos, found = 0, {}
-        while pos < len(fields):
-            (n,) = _U32.unpack_from(fields, pos)
-            name = fields[pos + 4 : pos + 4 + n].split(b"=", 1)[0]
-            found[name] = pos + 4 + len(name) + 1
-            pos += 4 + n
-    except struct_error:
-        return None
-    if b"conn" not in found or b"time" not in found:
-        return None
-    return found[b"conn"], found[b"time"]
-
-
-def _fields_before(buf: U8, data: int) -> tuple[int, int] | None:
-    """(conn, time ns) of the message record whose data starts at ``data``, from its header
-    (found by the standard 38-byte length; None when the header is not there or lacks them)."""
-    head = data - 4 - MSG_HEADER_LEN
-    if head < 4:
-        return None
-    try:
-        (hlen,) = _U32.unpack(bytes(buf[head - 4 : head]))
-        if hlen != MSG_HEADER_LEN:
-            return None
-        fields = parse_fields(bytes(buf[head : head + MSG_HEADER_LEN]))
-        return u32(fields, "conn"), time_ns(fields, "time")
-    except (RecordError, KeyError, struct_error):
-        return None
-
-
-def _nonzero(counts: dict[int, int]) -> dict[int, int]:
-    return {cid: n for cid, n in counts.items() if n}
 
 
 def _first_record(bag: Ros1Bag) -> int:
@@ -445,10 +87,8 @@ def _standard_spans(buf: U8, offsets: I64) -> tuple[I64, I64] | None:
         return None
     if not bool(np.all(read_at(buf, offsets, np.dtype("<u4")) == MSG_HEADER_LEN)):
         return None
-    first = next(
-        (at for at in _OP_AT if _op_word(buf, offsets[:1] + 4 + at)[0] == _OP_MSG_WORD), None
-    )
-    if first is None or not bool(np.all(_op_word(buf, offsets + 4 + first) == _OP_MSG_WORD)):
+    first = next((at for at in OP_AT if op_word(buf, offsets[:1] + 4 + at)[0] == OP_MSG_WORD), None)
+    if first is None or not bool(np.all(op_word(buf, offsets + 4 + first) == OP_MSG_WORD)):
         return None
     start = offsets + (8 + MSG_HEADER_LEN)
     length = read_at(buf, start - 4, np.dtype("<u4")).astype(np.int64)
@@ -553,10 +193,10 @@ class Ros1Bag(BagFile):
             for _ in range(len(chunk.counts)):
                 if pos + 8 > size:
                     raise RecordError("index data cut off by end of file", pos)
-                (hlen,) = _U32.unpack_from(mm, pos)
+                (hlen,) = U32.unpack_from(mm, pos)
                 if pos + 8 + hlen > size:
                     raise RecordError("index data cut off by end of file", pos)
-                head = _index_header(mm[pos + 4 : pos + 4 + hlen])
+                head = index_header(mm[pos + 4 : pos + 4 + hlen])
                 if head is None:
                     raise RecordError("malformed index-data record header", pos)
                 op, ver, cid, count = head
@@ -564,7 +204,7 @@ class Ros1Bag(BagFile):
                     raise RecordError("expected an index-data record", pos)
                 if ver != 1:
                     raise RecordError("index-data version not 1", pos)
-                (dlen,) = _U32.unpack_from(mm, pos + 4 + hlen)
+                (dlen,) = U32.unpack_from(mm, pos + 4 + hlen)
                 data_pos = pos + 8 + hlen
                 if dlen != 12 * count or data_pos + dlen > size:
                     raise RecordError("index-data size disagrees with its count", pos)
@@ -584,7 +224,7 @@ class Ros1Bag(BagFile):
         if chunk.entries is not None:
             return chunk.entries
         # Not kept on the chunk: an hour bag's index entries are ~20 MB, needed once per read.
-        return {cid: _entries_from_index(d) for cid, d in self._index_data(chunk, None).items()}
+        return {cid: entries_from_index(d) for cid, d in self._index_data(chunk, None).items()}
 
     def chunk_bytes(self, chunk: Ros1Chunk) -> bytes:
         """The uncompressed data of one chunk."""
@@ -637,7 +277,7 @@ class Ros1Bag(BagFile):
             for cid, data in self._index_data(chunk, rank, counts).items():
                 raw[cid].append(data)
                 where[cid].append((ci, len(data) // INDEX_DTYPE.itemsize))
-            if _nonzero(counts) != _nonzero(chunk.counts):
+            if nonzero_counts(counts) != nonzero_counts(chunk.counts):
                 self._rescan(
                     f"chunk at byte {chunk.pos}: the chunk info and the index data give "
                     "different connections or counts"
@@ -651,9 +291,9 @@ class Ros1Bag(BagFile):
         for cid, r in rank.items():
             if not raw[cid]:
                 continue
-            t, off = _joined_entries(raw[cid])
+            t, off = joined_entries(raw[cid])
             if self.layout.indexed:
-                outside = _outside_chunk_info(self.layout.chunks, cid, t, where[cid])
+                outside = outside_chunk_info(self.layout.chunks, cid, t, where[cid])
                 if outside is not None:
                     self._rescan(outside)
                     return self.select(conns, start_ns, end_ns)
@@ -675,7 +315,7 @@ class Ros1Bag(BagFile):
         if not tt or not sum(len(t) for t in tt):
             e = np.empty(0, np.int64)
             return [], e, e, e, e
-        t_all, c_all, o_all = _cat(tt), _cat(ck), _cat(oo)
+        t_all, c_all, o_all = cat_arrays(tt), cat_arrays(ck), cat_arrays(oo)
         r_all = rk[0] if len(rk) == 1 else np.concatenate(rk)
         # (np.unique would import numpy.ma, 10 ms of a whole command's start)
         touched = np.flatnonzero(np.bincount(c_all, minlength=len(self.layout.chunks))).tolist()
@@ -698,8 +338,6 @@ class Ros1Bag(BagFile):
             self.path,
             why,
         )
-        from ertools.io.ros1.check import rebuild_layout
-
         self._unmap()
         layout = rebuild_layout(self.file, self.path, self.layout.size, _first_record(self), why)
         damage = [p for p in layout.problems if p != why]
@@ -736,14 +374,14 @@ class Ros1Bag(BagFile):
             # in every record: look there first, elsewhere only for records that differ.
             try:
                 first = next(
-                    (at for at in _OP_AT if _op_word(buf, head[:1] + at)[0] == _OP_MSG_WORD), 0
+                    (at for at in OP_AT if op_word(buf, head[:1] + at)[0] == OP_MSG_WORD), 0
                 )
-                is_msg = _op_word(buf, head + first) == _OP_MSG_WORD
-                for at in _OP_AT:
+                is_msg = op_word(buf, head + first) == OP_MSG_WORD
+                for at in OP_AT:
                     rest = np.flatnonzero(~is_msg)
                     if at == first or not len(rest):
                         continue
-                    is_msg[rest] = _op_word(buf, head[rest] + at) == _OP_MSG_WORD
+                    is_msg[rest] = op_word(buf, head[rest] + at) == OP_MSG_WORD
             except LayoutMismatchError as err:
                 raise BagError(f"message record cut off inside its chunk {where}") from err
             ok[np.flatnonzero(ok)[~is_msg]] = False
@@ -770,12 +408,12 @@ class Ros1Bag(BagFile):
         head = 4 + MSG_HEADER_LEN + 4  # header length, header, data length
         fields = None
         if n and int(offsets.min()) >= 0 and int(offsets.max()) + head <= len(buf):
-            fields = _value_offsets(buf, int(offsets[0]) + 4)
+            fields = value_offsets(buf, int(offsets[0]) + 4)
         op_at = None
         if fields is not None:
             first = bytes(buf[int(offsets[0]) + 4 : int(offsets[0]) + 4 + MSG_HEADER_LEN])
             op_at = next(
-                (at for at in _OP_AT if first[at : at + 8] == _OP_MSG_WORD.to_bytes(8, "little")),
+                (at for at in OP_AT if first[at : at + 8] == OP_MSG_WORD.to_bytes(8, "little")),
                 None,
             )
         if fields is None or op_at is None:
@@ -790,7 +428,7 @@ class Ros1Bag(BagFile):
             return np.ndarray((n,), kind, buffer=rows, offset=offset, strides=(head,))
 
         conn_at, time_at = fields
-        standard = (col(0, "<u4") == MSG_HEADER_LEN) & (col(4 + op_at, "<u8") == _OP_MSG_WORD)
+        standard = (col(0, "<u4") == MSG_HEADER_LEN) & (col(4 + op_at, "<u8") == OP_MSG_WORD)
         if not bool(standard.all()):
             start, length = self.spans(buf, offsets, where)
             self.check_heads(buf, start, t_ns, conn, where)
@@ -824,7 +462,7 @@ class Ros1Bag(BagFile):
         if not n:
             return
         head_at = start - 4 - MSG_HEADER_LEN
-        at = _value_offsets(buf, int(head_at[0]))
+        at = value_offsets(buf, int(head_at[0]))
         bad = np.ones(n, dtype=bool)
         if at is not None and int(head_at.min()) >= 0:
             # one gather of the stretch holding both values, read as strided columns
@@ -842,7 +480,7 @@ class Ros1Bag(BagFile):
             bad |= col(conn_at) != conn
         for i in np.flatnonzero(bad).tolist():
             # the header just before this record's data length, whatever its layout
-            found = _fields_before(buf, int(start[i]))
+            found = fields_before(buf, int(start[i]))
             if found is None or found != (int(conn[i]), int(t_ns[i])):
                 raise BagError(
                     "message record's connection or time differs from its index entry "
@@ -875,10 +513,8 @@ class Ros1Bag(BagFile):
         the requested messages' bytes are held until yielded in order)."""
         if not conns:
             return
-        from ertools.io.bulk import locate
-
         _touched, _chunk_of, rank_of, _t, _off = self.select(conns, start_ns, end_ns)
-        found = locate(self, conns, start_ns, end_ns)
+        found = ros1_runs(self, conns, start_ns, end_ns, current())
         assert found is not None
         out: list[tuple[int, int, bytes]] = []
         for pos, buf, start, length, t_rec in found.runs:

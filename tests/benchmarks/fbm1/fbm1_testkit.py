@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ertools.states import BmBoxState, ClientState, RefBoxState
-from ertools.streams import Machine, PoseStream, StateStream
+from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
+from ertools.streams import PoseStream, StateStream
 
 S = 1_000_000_000
 T0 = 1_448_020_000 * S  # a 2015 epoch start

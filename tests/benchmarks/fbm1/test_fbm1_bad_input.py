@@ -14,7 +14,7 @@ from ertools.benchmarks.fbm1.runs import find_runs
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import ItemList, parse_items
-from ertools.streams import Machine
+from ertools.states import Machine
 
 GOOD = RunSpec(
     "Place item 3 (b2) on the table",

@@ -23,7 +23,7 @@ from ertools.benchmarks.fbm1.score import ScoreRules
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import ItemList, parse_items
-from ertools.streams import Machine
+from ertools.states import Machine
 
 RUNS = [
     RunSpec(

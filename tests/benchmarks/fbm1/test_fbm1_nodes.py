@@ -387,7 +387,7 @@ def _edge_bag(
     from ertools.samples.mocap import MocapNoise, publish_mocap, simulate_mocap
     from ertools.samples.statemachine import Transition, publish_states
     from ertools.samples.writer import BagWriter
-    from ertools.streams import Machine
+    from ertools.states import Machine
 
     items = yaml.safe_load(ITEMS)["items"]
     t0 = 1_448_020_000 * S

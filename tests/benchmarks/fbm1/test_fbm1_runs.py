@@ -9,8 +9,9 @@ from fbm1_testkit import RunSpec, ns, state_streams
 from ertools.benchmarks.fbm1.runs import find_runs, parse_item_ref
 from ertools.states import BmBoxState as B
 from ertools.states import ClientState as C
+from ertools.states import Machine
 from ertools.states import RefBoxState as R
-from ertools.streams import Machine, StateStream
+from ertools.streams import StateStream
 
 
 def _stream(machine: Machine, rows: list[tuple[float, int, str]]) -> StateStream:

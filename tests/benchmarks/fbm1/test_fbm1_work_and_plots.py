@@ -13,7 +13,7 @@ from ertools.benchmarks.fbm1.runs import find_runs
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import parse_items
-from ertools.streams import Machine
+from ertools.states import Machine
 
 # Item 3 sits 5 cm along x and y of the board; the board at (0.3, 0.2) unrotated, so the item
 # is at (0.35, 0.25) yaw 0; item 1 (0.1 m along x) at (0.4, 0.2).

@@ -33,8 +33,9 @@ from ertools.io import read_benchmark_states, read_poses
 from ertools.samples.writer import BagWriter
 from ertools.states import BmBoxState as B
 from ertools.states import ClientState as C
+from ertools.states import Machine
 from ertools.states import RefBoxState as R
-from ertools.streams import Machine, PoseStream, StateStream
+from ertools.streams import PoseStream, StateStream
 
 S = 1_000_000_000
 T0 = 1_448_020_800 * S

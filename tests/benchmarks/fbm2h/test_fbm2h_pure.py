@@ -14,8 +14,8 @@ from ertools.benchmarks.fbm2h.segments import ReachedMoments, from_states, unrea
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform, identity_transform
 from ertools.errors import SegmentationError
-from ertools.states import BmBoxState, ClientState, RefBoxState
-from ertools.streams import Machine, PoseStream, StateStream
+from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
+from ertools.streams import PoseStream, StateStream
 
 S = 1_000_000_000
 T0 = 1_445_609_740 * S

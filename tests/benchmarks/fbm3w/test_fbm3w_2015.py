@@ -33,8 +33,9 @@ from ertools.geometry import quat_from_yaw
 from ertools.io import BenchmarkStates, read_benchmark_states, read_poses
 from ertools.samples.writer import BagWriter
 from ertools.states import BmBoxState as B
+from ertools.states import Machine
 from ertools.states import RefBoxState as R
-from ertools.streams import Machine, PoseStream
+from ertools.streams import PoseStream
 
 S = 1_000_000_000
 D_MIN = 0.00033  # seed 7.3.4: hard-coded in the 2015 script

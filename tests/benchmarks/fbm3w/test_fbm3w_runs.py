@@ -10,8 +10,9 @@ from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.errors import SegmentationError
 from ertools.io import BenchmarkStates
 from ertools.states import BmBoxState as B
+from ertools.states import Machine
 from ertools.states import RefBoxState as R
-from ertools.streams import Machine, StateStream
+from ertools.streams import StateStream
 
 S = 1_000_000_000
 
