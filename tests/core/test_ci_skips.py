@@ -56,3 +56,34 @@ def _run(tmp_path: Path, ci: bool) -> str:
 )
 def test_skips_fail_only_in_ci(tmp_path: Path, ci: bool, summary: str) -> None:
     assert _run(tmp_path, ci).startswith(summary)
+
+
+def test_a_module_skipped_at_collection_fails_in_ci(tmp_path: Path) -> None:
+    """``pytest.importorskip`` of an extra the install step forgot (the dask extra once):
+    a skip of the whole module at collection, which the per-test rule does not see."""
+    (tmp_path / "conftest.py").write_text(CONFTEST.read_text(encoding="utf-8"))
+    (tmp_path / "test_extra.py").write_text(
+        "import pytest\n"
+        "pytest.importorskip('no_such_extra_module', reason='needs the extra')\n"
+        "def test_uses_it():\n    pass\n"
+    )
+    (tmp_path / "test_other.py").write_text("def test_runs():\n    assert True\n")
+    outcome = {}
+    for ci in (True, False):
+        env = {k: v for k, v in os.environ.items() if k != "CI"}
+        if ci:
+            env["CI"] = "true"
+        proc = subprocess.run(
+            [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(tmp_path)],
+            cwd=tmp_path,
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=120,
+            check=False,
+        )
+        outcome[ci] = (proc.returncode, proc.stdout)
+    assert outcome[True][0] != 0
+    assert "skipped in CI, where the machine must provide it" in outcome[True][1]
+    assert outcome[False][0] == 0
+    assert "1 passed, 1 skipped" in outcome[False][1]
