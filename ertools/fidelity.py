@@ -14,6 +14,7 @@ import importlib
 import sys
 from collections.abc import Iterable
 from dataclasses import dataclass
+from pathlib import Path
 
 # Modules that declare Rule constants; the catalogue is what these hold, in this order.
 RULE_MODULES: tuple[str, ...] = (
@@ -133,7 +134,6 @@ def replace_table(document: str, table: str) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     """``python -m ertools.fidelity [--write]``: print or rewrite the generated tables."""
-    from pathlib import Path
 
     args = sys.argv[1:] if argv is None else argv
     rules = all_rules()

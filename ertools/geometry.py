@@ -14,9 +14,7 @@ from typing import Literal, Protocol
 import numpy as np
 import numpy.typing as npt
 
-F64 = npt.NDArray[np.float64]
-I64 = npt.NDArray[np.int64]
-IntArr = npt.NDArray[np.intp]
+from ertools.arrays import F64, I64, IntArr
 
 Association = Literal["linear", "nearest", "hold"]
 
@@ -296,6 +294,7 @@ class MeanPose:
 
 def mean_pose(xyz: F64, quat_xyzw: F64) -> MeanPose:
     """Average poses (positions arithmetically, rotations by the chordal L2 mean)."""
+    # lazy: scipy only where its rotations/statistics are needed (~0.3 s to import)
     from scipy.spatial.transform import Rotation
 
     if len(xyz) == 0:

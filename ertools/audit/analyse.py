@@ -21,6 +21,7 @@ The audit finds:
 from __future__ import annotations
 
 import logging
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -373,7 +374,6 @@ def _mark_early_ends(
 ) -> tuple[AuditRun, ...]:
     if not early:
         return runs
-    from dataclasses import replace
 
     by_run = {e.run: e.reason for e in early if e.run is not None}
     return tuple(replace(r, outcome=by_run[r.index]) if r.index in by_run else r for r in runs)

@@ -13,6 +13,9 @@ from ertools.audit.analyse import DEFAULT_MAX_SILENCE_NS, audit_states
 from ertools.audit.compare import attach
 from ertools.audit.model import Audit
 from ertools.benchmarks import registry
+from ertools.errors import BagError, ErtoolsError, ScoringError, UsageError
+from ertools.io import read_benchmark_states, topics
+from ertools.states import STATE_TOPIC_SUFFIXES
 
 if TYPE_CHECKING:
     from ertools.benchmarks.base import BenchmarkResult
@@ -67,7 +70,6 @@ def uses(benchmark: str) -> frozenset[str]:
 
 def _scorer(benchmark: str) -> registry.AnyBenchmark:
     """The registered benchmark an audit can recompute (its states are logged)."""
-    from ertools.errors import ScoringError
 
     if benchmark not in registry.names() or not registry.get(benchmark).state_topics:
         raise ScoringError(f"no scorer to recompute {benchmark!r} from an audit")
@@ -139,9 +141,6 @@ def infer_benchmark(paths: Sequence[Path]) -> str:
         BagError: no state topic at all.
         UsageError: state topics of several benchmarks.
     """
-    from ertools.errors import BagError, UsageError
-    from ertools.io import topics
-    from ertools.states import STATE_TOPIC_SUFFIXES
 
     suffixes = {s for group in STATE_TOPIC_SUFFIXES.values() for s in group}
     found = sorted(
@@ -194,8 +193,6 @@ def audit_bag(
             ``--goal``/``--items``/``--config``/``--topic``/``--hits``...); without explicit
             inputs a score that cannot be recomputed is a note, not an error.
     """
-    from ertools.errors import BagError, ErtoolsError
-    from ertools.io import read_benchmark_states
 
     plist = [Path(p) for p in paths]
     for path in plist:

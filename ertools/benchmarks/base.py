@@ -11,10 +11,17 @@ Every benchmark has the same shape: its bags and :class:`Input` values become ty
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Generic, Literal, Protocol, TypeVar, runtime_checkable
+
+import numpy as np
+
+from ertools.errors import UsageError
+from ertools.progress import clear_current
+from ertools.yamlout import dump
 
 if TYPE_CHECKING:  # annotations only: the registry (and `ertools score --help`) stays light
     from ertools.fidelity import Deviation
@@ -151,9 +158,6 @@ def notice(message: str) -> None:
     """A human note on stderr (``ertools: message``), below any progress bar: what a
     benchmark's :attr:`Benchmark.make_options` says about the values it was given (a
     deprecated spelling, a choice that differs from a node)."""
-    import sys
-
-    from ertools.progress import clear_current
 
     clear_current()
     print(f"ertools: {message}", file=sys.stderr)
@@ -162,14 +166,12 @@ def notice(message: str) -> None:
 def dump_yaml(data: Any) -> str:
     """YAML as the 2015 nodes dumped it (block style, keys in insertion order), floats
     rounded to 9 decimal places (:mod:`ertools.yamlout`)."""
-    from ertools.yamlout import dump
 
     return dump(data)
 
 
 def jsonable(value: Any) -> Any:
     """Convert NumPy scalars/arrays and tuples inside ``value`` to plain JSON types."""
-    import numpy as np
 
     if isinstance(value, dict):
         return {str(k): jsonable(v) for k, v in value.items()}
@@ -278,7 +280,6 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
 
 def _one_value(declared: Input, value: Any) -> Any:
     """``value`` as ``declared`` types it; UsageError when it does not fit."""
-    from ertools.errors import UsageError
 
     option = declared.option
     kind = declared.kind
@@ -322,7 +323,6 @@ def _one_value(declared: Input, value: Any) -> Any:
 
 def _choice_words(declared: Input, words: tuple[str, ...]) -> tuple[str, ...]:
     """``(choice,)`` or ``(choice, FILE)`` for a choice declared ``with_file``."""
-    from ertools.errors import UsageError
 
     expected = " | ".join(c + " FILE" if c in declared.with_file else c for c in declared.choices)
     if not words or words[0] not in declared.choices:
@@ -342,7 +342,6 @@ def tf_value(option: str, text: str | None) -> tuple[str, str] | None:
     Raises:
         UsageError: not one or two non-empty frame names.
     """
-    from ertools.errors import UsageError
 
     if text is None:
         return None
@@ -362,7 +361,6 @@ def resolve_values(inputs: Sequence[Input], given: Mapping[str, Any]) -> dict[st
     Raises:
         UsageError: an unknown name, or a value that does not fit its declaration.
     """
-    from ertools.errors import UsageError
 
     known = {i.name: i for i in inputs}
     unknown = sorted(set(given) - set(known))

@@ -9,10 +9,15 @@ import only what they run. Adding a benchmark is one package and one line here.
 from __future__ import annotations
 
 from importlib import import_module
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from ertools.benchmarks.base import Benchmark
 from ertools.errors import UsageError
+
+if TYPE_CHECKING:
+    # an annotation only: `ertools --help` lists the names without importing NumPy
+    from ertools.benchmarks.base import Benchmark
+
+    AnyBenchmark = Benchmark[Any, Any, Any, Any]
 
 REGISTRY: dict[str, str] = {
     "fbm1h": "ertools.benchmarks.fbm1.declare:FBM1H",
@@ -21,8 +26,6 @@ REGISTRY: dict[str, str] = {
     "fbm3w": "ertools.benchmarks.fbm3w.declare:BENCHMARK",
     "trajectory": "ertools.benchmarks.trajectory.declare:BENCHMARK",
 }
-
-AnyBenchmark = Benchmark[Any, Any, Any, Any]
 
 
 def names() -> tuple[str, ...]:

@@ -11,11 +11,23 @@ from __future__ import annotations
 
 import argparse
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ertools.benchmarks.fbm1.acquire import AcquireOptions, acquire_items_bag
 from ertools.benchmarks.fbm1.benchmark import BENCHMARKS
 from ertools.cli.common import all_failed, note, write_text
+from ertools.cli.options import (
+    add_output,
+    add_pose_source,
+    add_time_source,
+    deprecated,
+    pose_spec,
+    positive,
+)
+from ertools.configs.items import items_to_yaml
+from ertools.errors import UsageError
 
 if TYPE_CHECKING:
     from ertools.benchmarks.common.sources import PoseSpec
@@ -33,13 +45,6 @@ Exit status 1 when an item could not be acquired (it is written unchanged and na
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from ertools.cli.options import (
-        add_output,
-        add_pose_source,
-        add_time_source,
-        deprecated,
-        positive,
-    )
 
     parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="log file(s)")
     parser.add_argument(
@@ -75,7 +80,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _windows(text: str | None) -> list[tuple[float, float]] | None:
-    from ertools.errors import UsageError
 
     if text is None:
         return None
@@ -95,7 +99,6 @@ def _windows(text: str | None) -> list[tuple[float, float]] | None:
 def _io(spec: PoseSpec, namespace: str, body: str) -> PoseSource | None:
     """The reader's source; None for the scorer's default (the 2015 topic, else the /tf
     frame), unless a time source was asked for: then the 2015 topic at that time."""
-    from dataclasses import replace
 
     if not spec.given and spec.time_source_given:
         spec = replace(spec, topic=f"/{namespace}/{body}/pose")
@@ -103,9 +106,6 @@ def _io(spec: PoseSpec, namespace: str, body: str) -> PoseSource | None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.benchmarks.fbm1.acquire import AcquireOptions, acquire_items_bag
-    from ertools.cli.options import pose_spec
-    from ertools.configs.items import items_to_yaml
 
     origin = pose_spec(args, "origin-", time_prefix="")
     board = pose_spec(args, "ref-board-", time_prefix="")

@@ -12,7 +12,22 @@ import argparse
 import math
 from pathlib import Path
 
+from ertools.benchmarks.common.sources import read_source, topic
+from ertools.benchmarks.fbm2h.transform import acquire_transform, check_team_name
 from ertools.cli.common import note, write_text
+from ertools.cli.options import (
+    add_out_dir,
+    add_pose_source,
+    add_time_source,
+    finite,
+    pose_spec,
+    positive,
+)
+from ertools.configs.transform import team_transform_path, transform_yaml
+from ertools.errors import ConfigError
+from ertools.io import summary
+from ertools.streams import Interval
+from ertools.timeutil import resolve_time, s_to_ns
 
 EPILOG = """examples:
   ertools acquire transform robot_at_origin.bag --team homer
@@ -26,13 +41,11 @@ DEFAULT_TOPIC = "/fbm2h/robot_at_home/pose"
 
 
 def _number(text: str) -> float:
-    from ertools.cli.options import finite
 
     return finite(text)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from ertools.cli.options import add_out_dir, add_pose_source, add_time_source, positive
 
     parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="log file(s)")
     parser.add_argument("--team", required=True, metavar="NAME", help="team name (file name)")
@@ -59,14 +72,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.benchmarks.common.sources import read_source, topic
-    from ertools.benchmarks.fbm2h.transform import acquire_transform, check_team_name
-    from ertools.cli.options import pose_spec
-    from ertools.configs.transform import team_transform_path, transform_yaml
-    from ertools.errors import ConfigError
-    from ertools.io import summary
-    from ertools.streams import Interval
-    from ertools.timeutil import resolve_time, s_to_ns
 
     team = check_team_name(args.team)
     out = team_transform_path(args.out_dir, team)

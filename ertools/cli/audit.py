@@ -13,7 +13,19 @@ import argparse
 import sys
 from pathlib import Path
 
+from ertools.audit.rescore import ScoreInputs, audit_bag
 from ertools.benchmarks import registry
+from ertools.cli.common import (
+    add_output_options,
+    emit_result,
+    note,
+    write_foxglove_option,
+    write_plots_option,
+    write_text,
+)
+from ertools.cli.options import non_negative_int, positive
+from ertools.report.folder import write_report
+from ertools.timeutil import s_to_ns
 
 EPILOG = """examples:
   ertools audit fbm2h.bag                       # YAML on stdout (--format text: a summary)
@@ -32,8 +44,6 @@ BENCHMARKS = registry.names()
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from ertools.cli.common import add_output_options
-    from ertools.cli.options import non_negative_int, positive
 
     parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="benchmark log(s)")
     parser.add_argument(
@@ -79,15 +89,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.audit.rescore import ScoreInputs, audit_bag
-    from ertools.cli.common import (
-        emit_result,
-        note,
-        write_foxglove_option,
-        write_plots_option,
-        write_text,
-    )
-    from ertools.timeutil import s_to_ns
 
     bags: list[Path] = list(args.bags)
     inputs = ScoreInputs(
@@ -119,8 +120,6 @@ def run(args: argparse.Namespace) -> int:
         for deviation in audit.deviations:
             note(f"differs from 2015: {deviation}")
         if args.report is not None:
-            from ertools.report.folder import write_report
-
             index = write_report(
                 audit, args.report, inputs=bags, argv=getattr(args, "command_line", sys.argv)
             )

@@ -9,6 +9,11 @@ from __future__ import annotations
 
 import argparse
 
+from ertools.benchmarks.base import dump_yaml
+from ertools.cli.common import dump_json, write_text
+from ertools.cli.options import add_output, port, positive, seconds
+from ertools.live.clock import query_sntp
+
 EPILOG = """examples:
   ertools clock --server 192.168.1.1
   ertools clock --server 192.168.1.1 --tolerance 0.002
@@ -18,7 +23,6 @@ EPILOG = """examples:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from ertools.cli.options import add_output, port, positive, seconds
 
     parser.add_argument(
         "--server", required=True, help="NTP server host (the 2015 one: 192.168.1.1)"
@@ -38,8 +42,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.cli.common import dump_json, write_text
-    from ertools.live.clock import query_sntp
 
     check = query_sntp(args.server, args.port, timeout_s=args.timeout)
     ok = check.within(args.tolerance)
@@ -59,11 +61,6 @@ def run(args: argparse.Namespace) -> int:
             "tolerance": args.tolerance,
             "within_tolerance": ok,
         }
-        if args.format == "json":
-            text = dump_json(data)
-        else:
-            from ertools.benchmarks.base import dump_yaml
-
-            text = dump_yaml(data)
+        text = dump_json(data) if args.format == "json" else dump_yaml(data)
     write_text(text, args.out)
     return 0 if ok else 1

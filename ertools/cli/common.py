@@ -13,7 +13,10 @@ from ertools.benchmarks import document
 from ertools.benchmarks.base import BenchmarkResult, jsonable
 from ertools.benchmarks.common.teams import with_team
 from ertools.cli.options import add_output, add_plots, add_report
+from ertools.progress import clear_current
 from ertools.report.figures import figure_specs, save_figures, save_one_file
+from ertools.report.folder import write_report
+from ertools.report.foxglove import write_foxglove
 
 
 def add_output_options(
@@ -59,8 +62,6 @@ def write_text(text: str, output: Path | None) -> None:
     """Text to ``output`` (a file) or stdout (below any progress bar: stdout and stderr may
     be the same terminal)."""
     if output is None:
-        from ertools.progress import clear_current
-
         clear_current()
         sys.stdout.write(text if text.endswith("\n") else text + "\n")
     else:
@@ -71,7 +72,6 @@ def write_text(text: str, output: Path | None) -> None:
 
 def note(message: str) -> None:
     """A human note on stderr (stdout stays parseable), below any progress bar."""
-    from ertools.progress import clear_current
 
     clear_current()
     print(f"ertools: {message}", file=sys.stderr)
@@ -108,8 +108,6 @@ def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[
     write_plots_option(result, args)
     report_dir: Path | None = getattr(args, "report", None)
     if report_dir is not None:
-        from ertools.report.folder import write_report
-
         index = write_report(
             result, report_dir, inputs=inputs, argv=getattr(args, "command_line", sys.argv)
         )
@@ -134,7 +132,6 @@ def write_foxglove_option(result: Any, args: argparse.Namespace, inputs: list[Pa
     path: Path | None = getattr(args, "foxglove", None)
     if path is None:
         return
-    from ertools.report.foxglove import write_foxglove
 
     written = write_foxglove(result, path, inputs=inputs)
     note(f"wrote {written.path} ({written.messages} messages on {len(written.counts)} topics)")

@@ -15,6 +15,29 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.cli.common import note, write_text
+from ertools.cli.options import (
+    add_pose_source,
+    add_time_source,
+    deprecated,
+    pose_spec,
+    positive,
+    seconds_or_auto,
+    time_source,
+)
+from ertools.errors import UsageError
+from ertools.export.formats import FORMATS, format_times
+from ertools.export.pairs import (
+    KITTI_NEEDS_MATCHED,
+    export_source,
+    pair_paths,
+    refuse_inputs,
+    trajectory_pair,
+    write_pair,
+)
+from ertools.timeutil import iso_utc, ns_to_s, s_to_ns
+
 EPILOG = """examples:
   ertools export gt.bag --topic /fbm2h/robot_at_home/pose --format tum -o gt.tum
   ertools export run.bag --tf world:robot_at_work --format csv -o robot.csv
@@ -31,14 +54,6 @@ exit status: 0 written, 1 unusable data, 2 usage error."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from ertools.cli.options import (
-        add_pose_source,
-        add_time_source,
-        deprecated,
-        positive,
-        seconds_or_auto,
-    )
-    from ertools.export.formats import FORMATS
 
     parser.add_argument(
         "bags",
@@ -108,7 +123,6 @@ PAIR_ONLY = {
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.errors import UsageError
 
     if args.out_dir is None:
         given = [f"--{n.replace('_', '-')}" for n, d in PAIR_ONLY.items() if getattr(args, n) != d]
@@ -129,12 +143,6 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run_one(args: argparse.Namespace) -> int:
-    from ertools.cli.common import note, write_text
-    from ertools.cli.options import pose_spec
-    from ertools.errors import UsageError
-    from ertools.export.formats import format_times
-    from ertools.export.pairs import export_source, refuse_inputs
-    from ertools.timeutil import iso_utc
 
     if args.topic is None and args.tf is None:
         raise UsageError("give --topic TOPIC or --tf PARENT:CHILD (or --out-dir for the pair)")
@@ -158,18 +166,6 @@ def _run_one(args: argparse.Namespace) -> int:
 
 
 def _run_pair(args: argparse.Namespace) -> int:
-    from ertools.benchmarks.trajectory.config import TrajectoryConfig
-    from ertools.cli.common import note
-    from ertools.cli.options import time_source
-    from ertools.errors import UsageError
-    from ertools.export.pairs import (
-        KITTI_NEEDS_MATCHED,
-        pair_paths,
-        refuse_inputs,
-        trajectory_pair,
-        write_pair,
-    )
-    from ertools.timeutil import ns_to_s, s_to_ns
 
     auto = args.offset == "auto"
     if args.apply_offset and not auto:

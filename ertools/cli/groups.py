@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ertools.cli.main import Command
+from ertools.cli.main import Command, run_command
 
 
 def add_group_arguments(parser: argparse.ArgumentParser, members: dict[str, Command]) -> None:
@@ -29,7 +29,6 @@ def members_epilog(members: dict[str, Command]) -> str:
 
 def run_group(group: str, members: dict[str, Command], args: argparse.Namespace) -> int:
     """Run the member's own parser on the remaining arguments."""
-    from ertools.cli.main import run_command
 
     extra = ["-v"] * args.verbose + (["--debug"] if args.debug else [])
     extra += ["--quiet"] if args.quiet else []

@@ -13,6 +13,16 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from ertools.benchmarks.base import dump_yaml
+from ertools.cli.common import dump_json, note, write_text
+from ertools.cli.options import add_output
+from ertools.errors import BagError
+from ertools.io import info as bag_info
+from ertools.io.formats import expand
+from ertools.io.info import span_s
+from ertools.progress import reporting
+from ertools.timeutil import iso_utc, ns_to_s
+
 if TYPE_CHECKING:
     from ertools.io.info import BagInfo
 
@@ -34,7 +44,6 @@ Exit status 1 when any bag is unreadable, truncated or (with --check) corrupt.
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from ertools.cli.options import add_output
 
     parser.add_argument(
         "paths", type=Path, nargs="+", metavar="BAG", help="bags, rosbag2 folders or folders"
@@ -67,8 +76,6 @@ def _rate(hz: float | None, count: int, span: float | None) -> str:
 
 def table(info: BagInfo) -> str:
     """`rosbag info`-like text of one bag."""
-    from ertools.io.info import span_s
-    from ertools.timeutil import iso_utc, ns_to_s
 
     s = info.summary
     lines = [
@@ -130,11 +137,6 @@ def _one_line(text: str) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.cli.common import dump_json, note, write_text
-    from ertools.errors import BagError
-    from ertools.io.formats import expand
-    from ertools.io.info import describe
-    from ertools.progress import reporting
 
     infos: list[BagInfo] = []
     problems: list[dict[str, str]] = []
@@ -152,7 +154,7 @@ def run(args: argparse.Namespace) -> int:
             progress.advance(1)
         try:
             with reporting(None):  # only --check's own counts: not the index reads inside
-                info = describe(path, check=args.check, progress=progress)
+                info = bag_info.describe(path, check=args.check, progress=progress)
         except BagError as err:
             problems.append({"path": str(path), "problem": _one_line(err.message)})
             continue
@@ -169,12 +171,8 @@ def run(args: argparse.Namespace) -> int:
         text = "\n\n".join(table(i) for i in infos)
     else:
         data: dict[str, Any] = {"bags": [i.to_dict() for i in infos], "problems": problems}
-        if args.format == "json":
-            text = dump_json(data)
-        else:
-            from ertools.benchmarks.base import dump_yaml
-
-            text = dump_yaml(data)  # rates without binary noise, as every ertools YAML
+        # YAML: rates without binary noise, as every ertools YAML
+        text = dump_json(data) if args.format == "json" else dump_yaml(data)
     if text:
         write_text(text, args.out)
     for p in problems:

@@ -4,19 +4,20 @@ from __future__ import annotations
 
 import argparse
 import logging
+import math
+import os
 import re
 import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib import import_module
 from pathlib import Path
-from typing import TYPE_CHECKING, NoReturn
+from typing import NoReturn
 
 from ertools import __version__
 from ertools.benchmarks.registry import names
-
-if TYPE_CHECKING:
-    from ertools.progress import Bar
+from ertools.errors import ErtoolsError, UsageError
+from ertools.progress import Bar, clear_current, reporting
 
 
 @dataclass(frozen=True)
@@ -163,7 +164,6 @@ def _configure_logging(verbose: int) -> None:
     class _BelowTheBar(logging.StreamHandler):  # type: ignore[type-arg]
         # a message logged while a progress bar is drawn starts on a line of its own
         def emit(self, record: logging.LogRecord) -> None:
-            from ertools.progress import clear_current
 
             clear_current()
             super().emit(record)
@@ -190,9 +190,6 @@ OUTPUT_OPTIONS = {
 
 def _refuse_overwriting_inputs(args: argparse.Namespace) -> None:
     """A UsageError when an output path is one of the inputs (`-o run.bag`)."""
-    import os
-
-    from ertools.errors import UsageError
 
     inputs: list[Path] = []
     for name, value in vars(args).items():
@@ -219,9 +216,6 @@ MAX_OPTION_VALUE = 4.6e9
 
 def _check_numbers(args: argparse.Namespace) -> None:
     """A UsageError for a NaN, infinite or absurdly large number option (`--max-gap nan`)."""
-    import math
-
-    from ertools.errors import UsageError
 
     for name, value in vars(args).items():
         for v in value if isinstance(value, list | tuple) else [value]:
@@ -239,8 +233,6 @@ def _one_line(message: str) -> str:
 
 def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
     """Parse ``argv`` for one command module and run it, mapping errors to exit codes."""
-    from ertools.errors import ErtoolsError
-    from ertools.progress import reporting
 
     parser, module = build_parser(prog, module_name)
     try:
@@ -295,7 +287,6 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
 def _progress_bar(args: argparse.Namespace) -> Bar | None:
     """The command's progress bar (``args.progress``): only on a terminal and without
     ``--quiet``; None otherwise, so nothing reports at all."""
-    from ertools.progress import Bar
 
     args.progress = None
     if getattr(args, "quiet", False) or not sys.stderr.isatty():

@@ -12,6 +12,13 @@ seconds. With --once or --duration the exit status is 1 when any warning was giv
 from __future__ import annotations
 
 import argparse
+import sys
+import time
+from pathlib import Path
+
+from ertools.cli.options import fraction, non_negative, positive
+from ertools.errors import UsageError
+from ertools.live.monitor import MonitorOptions, watch
 
 EPILOG = """examples:
   ertools monitor logs/ --bell
@@ -22,9 +29,6 @@ EPILOG = """examples:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from pathlib import Path
-
-    from ertools.cli.options import fraction, non_negative, positive
 
     parser.add_argument(
         "directory", type=Path, metavar="DIR", help="the recorder's --out-dir folder"
@@ -66,11 +70,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import sys
-    import time
-
-    from ertools.errors import UsageError
-    from ertools.live.monitor import MonitorOptions, watch
 
     if not args.directory.is_dir():
         raise UsageError(f"{args.directory} is not a folder")

@@ -12,8 +12,20 @@ import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ertools.cli.common import dump_json, note, write_text
-from ertools.cli.options import positive
+from ertools.benchmarks.base import dump_yaml
+from ertools.benchmarks.common.sources import read_source, tf, topic
+from ertools.benchmarks.fbm3w.benchmark import DEFAULT_FRAME, DEFAULT_TOPIC, FALLBACK_TOPIC
+from ertools.benchmarks.noise.benchmark import noise_from_stream
+from ertools.cli.common import dump_json, note, write_plots, write_text
+from ertools.cli.options import (
+    add_output,
+    add_plots,
+    add_pose_source,
+    add_time_source,
+    pose_spec,
+    positive,
+)
+from ertools.report.plots_noise import figure_specs
 
 if TYPE_CHECKING:
     from ertools.streams import PoseStream
@@ -33,7 +45,6 @@ recording as stationary, as the 2015 tool did. JSON keys: samples, lost, epsilon
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from ertools.cli.options import add_output, add_plots, add_pose_source, add_time_source
 
     parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="log file(s)")
     add_pose_source(
@@ -64,9 +75,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _poses(args: argparse.Namespace) -> PoseStream:
-    from ertools.benchmarks.common.sources import read_source, tf, topic
-    from ertools.benchmarks.fbm3w.benchmark import DEFAULT_FRAME, DEFAULT_TOPIC, FALLBACK_TOPIC
-    from ertools.cli.options import pose_spec
 
     return read_source(
         args.bags,
@@ -78,15 +86,12 @@ def _poses(args: argparse.Namespace) -> PoseStream:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.benchmarks.noise.benchmark import noise_from_stream
 
     poses = _poses(args)
     result = noise_from_stream(poses, stationary=args.stationary == "auto", bin=args.bin, c=args.c)
     if args.format == "json":
         text = dump_json(result.to_dict())
     elif args.format == "yaml":
-        from ertools.benchmarks.base import dump_yaml
-
         text = dump_yaml(result.to_dict())
     else:
         text = result.to_text()
@@ -94,8 +99,5 @@ def run(args: argparse.Namespace) -> int:
     for warning in result.warnings:
         note(f"warning: {warning}")
     if args.plot is not None or args.plots is not None:
-        from ertools.cli.common import write_plots
-        from ertools.report.plots_noise import figure_specs
-
         write_plots(figure_specs(result), args)
     return 0

@@ -26,12 +26,14 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from ertools.benchmarks.common.sources import PoseSpec
 from ertools.benchmarks.common.spec import (
     DEFAULT_PARENT,
     DEFAULT_TIME_SOURCE,
     TIME_SOURCES,
     parse_tf,
 )
+from ertools.progress import clear_current
 
 if TYPE_CHECKING:
     from ertools.benchmarks.common.sources import PoseSpec
@@ -47,7 +49,6 @@ PLOT_SUFFIXES = (".png", ".svg", ".pdf")
 
 def deprecation_note(old: str, new: str) -> None:
     """The one stderr line an old spelling costs: ``ertools: note: OLD is deprecated, use NEW``."""
-    from ertools.progress import clear_current
 
     clear_current()
     print(f"ertools: note: {old} is deprecated, use {new}", file=sys.stderr)
@@ -323,7 +324,6 @@ def pose_spec(
     ``time_prefix`` names the time-source option's prefix when it differs from ``prefix``
     (default: the same; a command with one ``--time-source`` for two sources passes ``""``).
     """
-    from ertools.benchmarks.common.sources import PoseSpec  # bag readers: see the top
 
     tp = prefix if time_prefix is None else time_prefix
     given = getattr(args, _dest(tp, "time_source"), None)

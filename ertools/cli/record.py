@@ -13,6 +13,17 @@ and prints a summary on stdout.
 from __future__ import annotations
 
 import argparse
+import signal
+import threading
+from pathlib import Path
+
+from ertools.cli.common import note
+from ertools.cli.options import add_out_dir, port, positive
+from ertools.configs.mocap import load_mocap_config, normalize_namespace, parse_mocap_config
+from ertools.errors import UsageError
+from ertools.live.natnet import NatNetVersion
+from ertools.live.recorder import Recorder, RecordOptions
+from ertools.live.simulate import SimulatedBody, SimulatedMotive
 
 EPILOG = """examples:
   ertools record --config configs/mocap_home.yaml --out-dir logs/ --namespace /fbm2h
@@ -37,9 +48,6 @@ rigid_bodies:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from pathlib import Path
-
-    from ertools.cli.options import add_out_dir, port, positive
 
     parser.add_argument("--config", type=Path, help="mocap YAML (seed Listing 2: rigid_bodies)")
     add_out_dir(parser, "write the MCAP files into DIR", old=("--out",), required=True)
@@ -105,18 +113,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    import signal
-    import threading
-
-    from ertools.cli.common import note
-    from ertools.configs.mocap import (
-        load_mocap_config,
-        normalize_namespace,
-        parse_mocap_config,
-    )
-    from ertools.errors import UsageError
-    from ertools.live.natnet import NatNetVersion
-    from ertools.live.recorder import Recorder, RecordOptions
 
     if args.config is None and not args.simulate:
         raise UsageError("--config is required (a mocap YAML as seed Listing 2)")
@@ -171,8 +167,6 @@ def run(args: argparse.Namespace) -> int:
             previous[sig] = signal.signal(sig, lambda *_: recorder.stop_event.set())
     sim_thread = None
     if args.simulate:
-        from ertools.live.simulate import SimulatedBody, SimulatedMotive
-
         bodies = tuple(
             SimulatedBody(
                 b.body_id,

@@ -10,6 +10,10 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ertools.cli.common import note
+from ertools.cli.options import add_report
+from ertools.report.combine import combine
+
 EPILOG = """examples:
   ertools score fbm3w run1.bag --report results/team-a-run1
   ertools score fbm3w run2.bag --report results/team-b-run1
@@ -22,7 +26,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "results", nargs="+", type=Path, metavar="RESULT", help="report folder or its JSON"
     )
-    from ertools.cli.options import add_report
 
     add_report(
         parser, "write the combined page here (DIR/index.html)", required=True, old=("--out",)
@@ -31,8 +34,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.cli.common import note
-    from ertools.report.combine import combine
 
     index = combine(list(args.results), args.report, title=args.title)
     note(f"combined {len(args.results)} result(s) into {index}")

@@ -16,6 +16,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ertools.cli.common import note
+from ertools.errors import UsageError
+from ertools.rescore.draft import draft_text
+from ertools.rescore.found import find, merge, write_timeline
+from ertools.rescore.manifest import ManifestError, load_manifest
+from ertools.rescore.parallel import default_jobs
+from ertools.rescore.pipeline import listed_executions, rescore, write_results
 
 if TYPE_CHECKING:
     from ertools.rescore.jobs import Outcome
@@ -80,10 +86,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.errors import UsageError
-    from ertools.rescore.manifest import ManifestError, load_manifest
-    from ertools.rescore.parallel import default_jobs
-    from ertools.rescore.pipeline import listed_executions, rescore, write_results
 
     if args.init is not None:
         return _init(args)
@@ -110,8 +112,6 @@ def run(args: argparse.Namespace) -> int:
     problems: list[dict[str, object]] = []
     timeline = None
     if args.paths:
-        from ertools.rescore.found import find, merge, write_timeline
-
         found = find(args.paths, progress=args.progress)
         scorings = merge(found.scorings, scorings)
         problems = list(found.problems)
@@ -156,9 +156,6 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _init(args: argparse.Namespace) -> int:
-    from ertools.errors import UsageError
-    from ertools.rescore.draft import draft_text
-    from ertools.rescore.found import find
 
     if not args.paths:
         raise UsageError("--init FILE drafts the manifest from logs: give the PATHs to scan")

@@ -9,9 +9,19 @@ file at all could be read.
 from __future__ import annotations
 
 import argparse
+import csv
+import io
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
+
+from ertools.benchmarks.base import dump_yaml
+from ertools.cli.common import dump_json, note, write_text
+from ertools.cli.options import add_output, plot_file, seconds
+from ertools.report.plots_timeline import save_timeline_plot
+from ertools.timeline.model import KIND_LABELS, TimelineConfig
+from ertools.timeline.scan import scan
+from ertools.timeutil import iso_utc, s_to_ns
 
 if TYPE_CHECKING:
     from ertools.timeline.model import Timeline
@@ -35,7 +45,6 @@ TIMELINE_PLOT_SUFFIXES = (".png", ".svg", ".html", ".htm")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    from ertools.cli.options import add_output, plot_file, seconds
 
     parser.add_argument("paths", type=Path, nargs="+", metavar="PATH", help="bags or folders")
     add_output(parser, ("text", "json", "yaml", "csv"), aliases={"table": "text"})
@@ -69,10 +78,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ertools.cli.common import dump_json, note, write_text
-    from ertools.timeline.model import TimelineConfig
-    from ertools.timeline.scan import scan
-    from ertools.timeutil import s_to_ns
 
     # a bad --plot suffix was refused by argparse (exit 2), not after minutes of reading
     plots: list[Path] = args.plot or []
@@ -89,8 +94,6 @@ def run(args: argparse.Namespace) -> int:
     if args.format == "json":
         write_text(dump_json(timeline.to_dict()), args.out)
     elif args.format == "yaml":
-        from ertools.benchmarks.base import dump_yaml
-
         write_text(dump_yaml(timeline.to_dict()), args.out)  # the JSON's keys, as YAML
     elif args.format == "csv":
         write_text(to_csv(timeline), args.out)
@@ -98,8 +101,6 @@ def run(args: argparse.Namespace) -> int:
         color = args.out is None and sys.stdout.isatty()
         write_text(to_table(timeline, color=color), args.out)
     if plots and timeline.readable_count > 0:  # no empty chart on failure
-        from ertools.report.plots_timeline import save_timeline_plot
-
         for plot in plots:
             note(f"wrote {save_timeline_plot(timeline, plot)}")
     if timeline.readable_count == 0:
@@ -130,8 +131,6 @@ MAX_PROBLEM_NOTES = 10
 
 def to_csv(timeline: Timeline) -> str:
     """One row per bag (the 2015 timeliner's columns and more)."""
-    import csv
-    import io
 
     rows = timeline.rows()
     out = io.StringIO()
@@ -167,14 +166,12 @@ class _Paint:
 def _when(ns: int | None) -> str:
     if ns is None:
         return "-"
-    from ertools.timeutil import iso_utc
 
     return iso_utc(ns)[:23].replace("T", " ")
 
 
 def to_table(timeline: Timeline, *, color: bool = False) -> str:
     """The human table: bags by start, then sessions with their GT pairing, then problems."""
-    from ertools.timeline.model import KIND_LABELS
 
     paint = _Paint(color)
     lines: list[str] = []
@@ -215,7 +212,6 @@ def to_table(timeline: Timeline, *, color: bool = False) -> str:
 
 
 def _pairing_line(p: Any, paint: _Paint, *, full_path: bool = False) -> str:
-    from ertools.timeline.model import KIND_LABELS
 
     name = str(p.path) if full_path else Path(p.path).name
     other = ""

@@ -5,6 +5,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import yaml
+
 from ertools.errors import ConfigError
 
 
@@ -23,7 +25,6 @@ def load_yaml(path: str | Path, what: str = "config") -> Any:
 
 def parse_yaml(text: str, source: str = "<string>", what: str = "YAML") -> Any:
     """Parse YAML text (a payload, a config) with ``yaml.safe_load``."""
-    import yaml
 
     try:
         return yaml.safe_load(text)

@@ -17,8 +17,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import yaml
+
 from ertools.configs._yaml import load_yaml
 from ertools.errors import ConfigError
+from ertools.yamlout import Dumper, dump
 
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
@@ -242,9 +245,6 @@ def items_to_data(items: Sequence[Item], *, with_spread: bool = True) -> dict[st
 
 def items_to_yaml(items: Sequence[Item], *, with_spread: bool = True) -> str:
     """Listing 9 text: block style, quaternion and translation as flow lists as in 2015."""
-    import yaml
-
-    from ertools.yamlout import Dumper, dump
 
     class _Dumper(Dumper):
         """Floats to 9 decimals (ertools.yamlout), number lists in flow style."""

@@ -31,11 +31,10 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 
+from ertools.arrays import F64
 from ertools.errors import ConfigError
 
-F64 = npt.NDArray[np.float64]
 Curve = Callable[[F64], F64]
 
 # Longest expression accepted: a target path is a short formula; this bounds parse time and
@@ -296,6 +295,7 @@ def _expression_shape(name: str, spec: Mapping[str, Any], where: str) -> Shape:
 
 
 def _points_shape(name: str, points: Any, where: str) -> Shape:
+    # lazy: scipy only where its rotations/statistics are needed (~0.3 s to import)
     from scipy.interpolate import CubicSpline
 
     try:

@@ -21,6 +21,8 @@ import numpy.typing as npt
 
 from ertools.configs._yaml import load_yaml
 from ertools.errors import ConfigError
+from ertools.geometry import invert
+from ertools.yamlout import yaml_float
 
 log = logging.getLogger("ertools.configs.transform")
 
@@ -67,7 +69,6 @@ class MarkerTransform:
 
     def inverse(self) -> tuple[Vec3, Quat]:
         """T_robot_marker, the Listing 11 ``robot_to_marker_transform``."""
-        from ertools.geometry import invert
 
         t, q = invert(*self.arrays())
         return _vec3(t), _quat(q)
@@ -152,6 +153,7 @@ def parse_transform(data: Any, source: str = "<transform>") -> MarkerTransform:
 
 
 def _check_inverse(tr: MarkerTransform, t_inv: Vec3, q_inv: Quat, source: str) -> None:
+    # lazy: scipy only where its rotations/statistics are needed (~0.3 s to import)
     from scipy.spatial.transform import Rotation
 
     t_exp, q_exp = tr.inverse()
@@ -176,7 +178,6 @@ def team_transform_path(directory: str | Path, team: str) -> Path:
 
 
 def _flow(values: tuple[float, ...]) -> str:
-    from ertools.yamlout import yaml_float  # 9 decimals, as every YAML ertools writes
 
     return "[" + ", ".join(repr(yaml_float(float(v))) for v in values) + "]"
 

@@ -19,6 +19,7 @@ from typing import Literal
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import F64, I64
 from ertools.errors import BagError
 from ertools.streams import PoseStream
 
@@ -27,9 +28,6 @@ FORMATS: tuple[ExportFormat, ...] = ("tum", "kitti", "csv")
 # File name suffixes of the pair mode (evo reads any name; these say what is inside).
 SUFFIXES: dict[ExportFormat, str] = {"tum": ".tum", "kitti": ".kitti", "csv": ".csv"}
 CSV_COLUMNS = ("t_ns", "t_s", "x", "y", "z", "qx", "qy", "qz", "qw", "frame_id")
-
-I64 = npt.NDArray[np.int64]
-F64 = npt.NDArray[np.float64]
 
 
 def seconds_text(t_ns: I64) -> list[str]:
@@ -74,6 +72,7 @@ def rotation_matrices(quat_xyzw: F64, where: str = "") -> npt.NDArray[np.float64
     Raises:
         BagError: a zero or non-finite quaternion (it has no rotation matrix).
     """
+    # lazy: scipy only where its rotations/statistics are needed (~0.3 s to import)
     from scipy.spatial.transform import Rotation
 
     q = np.asarray(quat_xyzw, dtype=np.float64)

@@ -26,8 +26,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid
+from ertools.benchmarks.common.sources import read_source
+from ertools.benchmarks.trajectory.association import COMPARED
+from ertools.benchmarks.trajectory.benchmark import score
+from ertools.benchmarks.trajectory.inputs import read_gt
 from ertools.errors import ScoringError, UsageError
 from ertools.export.formats import SUFFIXES, ExportFormat, format_poses, format_times
+from ertools.geometry import interpolate_poses
 from ertools.streams import PoseStream
 
 if TYPE_CHECKING:
@@ -52,7 +58,6 @@ def export_source(
 ) -> tuple[PoseStream, str]:
     """Read one pose source (the one chooser, :func:`ertools.benchmarks.common.sources.
     read_source`: an empty source is refused) and format it: (the stream, the text)."""
-    from ertools.benchmarks.common.sources import read_source
 
     stream = read_source(paths, spec, what="poses to export")
     return stream, format_poses(stream, fmt)
@@ -95,10 +100,6 @@ def trajectory_pair(
     Raises:
         ScoringError: ``matched`` and no pose could be compared; the errors of ``score``.
     """
-    from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid
-    from ertools.benchmarks.trajectory.association import COMPARED
-    from ertools.benchmarks.trajectory.benchmark import score
-    from ertools.benchmarks.trajectory.inputs import read_gt
 
     result = score(
         robot_bag,
@@ -147,7 +148,6 @@ def _gt_at(
     The positions are checked against the ones the score used: the pairs written must be the
     pairs scored, and a difference would mean the second read saw other GT than the first.
     """
-    from ertools.geometry import interpolate_poses
 
     at = interpolate_poses(gt, t_ns, config.association)
     if not np.array_equal(at.xyz, scored_xyz):

@@ -15,8 +15,8 @@ from collections.abc import Iterator, Sequence
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
-import numpy.typing as npt
 
+from ertools.arrays import I64
 from ertools.errors import BagError
 from ertools.io import pipeline
 from ertools.io.bagfile import BagFile
@@ -44,9 +44,6 @@ if TYPE_CHECKING:
     from ertools.progress import Reporter
 
 log = logging.getLogger("ertools.io.bulk")
-
-I64 = npt.NDArray[np.int64]
-U8 = npt.NDArray[np.uint8]
 
 
 class _Assembler:

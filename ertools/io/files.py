@@ -35,6 +35,7 @@ INT64_MAX = (1 << 63) - 1
 
 
 def _conn_from_rosbags(c: Any) -> Conn:
+    # lazy: rosbags only on the per-message path (~0.1 s to import)
     from rosbags.interfaces import ConnectionExtRosbag1, MessageDefinitionFormat
 
     fmt = {MessageDefinitionFormat.MSG: "msg", MessageDefinitionFormat.IDL: "idl"}.get(
@@ -69,10 +70,12 @@ class RosbagsFile(BagFile):
         self.format = fmt
         try:
             if fmt == "ros1":
+                # lazy: rosbags only on the per-message path (~0.1 s to import)
                 from rosbags.rosbag1 import Reader as Reader1
 
                 self._reader: Any = Reader1(path)
             else:
+                # lazy: rosbags only on the per-message path (~0.1 s to import)
                 from rosbags.rosbag2 import Reader as Reader2
 
                 self._reader = Reader2(path)
@@ -136,7 +139,7 @@ class McapFile(BagFile):
     """
 
     def __init__(self, path: Path) -> None:
-        from mcap.reader import make_reader
+        from mcap.reader import make_reader  # lazy: the mcap library only when an MCAP file is read
 
         self.path = path
         self.format = "mcap"

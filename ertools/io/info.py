@@ -18,7 +18,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ertools.errors import BagError
+from ertools.io.formats import detect_format
+from ertools.io.mcap.index import verify_mcap
 from ertools.io.model import BagSummary
+from ertools.io.ros1.check import check_ros1
+from ertools.io.ros1.index import Ros1Bag
+from ertools.io.rosbag2.metadata import query, read_metadata, storage_files
+from ertools.io.summary import INDEX_SELF_CHECK, summary_and_times
 from ertools.timeutil import iso_utc, ns_to_s
 
 if TYPE_CHECKING:
@@ -112,7 +118,6 @@ def describe(path: str | Path, *, check: bool = False, progress: Reporter | None
     Raises:
         BagError: unreadable bag, or (with ``check``) a damaged chunk.
     """
-    from ertools.io.summary import INDEX_SELF_CHECK, summary_and_times
 
     s, times = summary_and_times(path)
     rates = {name: median_rate(t) for name, t in times.items()}
@@ -135,29 +140,20 @@ def verify(path: Path, progress: Reporter | None = None) -> list[str]:
     Raises:
         BagError: naming the file and the byte offset of the first damaged chunk.
     """
-    from ertools.io.formats import detect_format
 
     fmt = detect_format(path)
     if fmt == "ros1":
-        from ertools.io.ros1.check import check_ros1
-
         return check_ros1(path, progress)
     if fmt == "ros1-active":
-        from ertools.io.ros1.index import Ros1Bag
-
         bag = Ros1Bag(path)
         try:
             bag.verify(progress)
         finally:
             bag.close()
     elif fmt in ("mcap", "rosbag2-mcap"):
-        from ertools.io.mcap.index import verify_mcap
-
         for file in [path] if fmt == "mcap" else sorted(path.glob("*.mcap")):
             verify_mcap(file, progress)
     else:
-        from ertools.io.rosbag2.metadata import query, read_metadata, storage_files
-
         for db in storage_files(path, read_metadata(path)):
             result = query(db, "PRAGMA quick_check")[0][0]
             if result != "ok":

@@ -18,14 +18,13 @@ import os
 import threading
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
-import numpy.typing as npt
 
-I64 = npt.NDArray[np.int64]
-U8 = npt.NDArray[np.uint8]
+from ertools.arrays import I64, U8
 
 if TYPE_CHECKING:
     from ertools.progress import Reporter
@@ -74,7 +73,6 @@ def prefetched(
                 report.advance(weights[k])
             yield got
         return
-    from concurrent.futures import ThreadPoolExecutor
 
     # ahead groups in flight plus the one the caller holds: none shares a buffer.
     slots: list[list[Any]] = [[] for _ in range(ahead + 1)]

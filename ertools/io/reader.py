@@ -17,6 +17,8 @@ import numpy.typing as npt
 
 from ertools.errors import BagError, TopicError
 from ertools.io.bagfile import BagFile
+from ertools.io.bulk import locate, try_fast_batch
+from ertools.io.decode.fast import LayoutMismatchError, decode_states, is_state_definition
 from ertools.io.decode.posebatch import PoseBatch, batch_from_messages, concat_batches
 from ertools.io.decode.tf import Edge, chain_pose, frame_key
 from ertools.io.decode.typestore import Deserializer
@@ -31,6 +33,7 @@ from ertools.io.model import (
     PoseSource,
     RawMessage,
 )
+from ertools.io.pipeline import group_positions
 from ertools.states import MSG_TYPES, STATE_TOPIC_SUFFIXES, Machine
 from ertools.streams import MAX_FRAME_CHANGES, FrameChange, PoseStream, StateStream
 
@@ -85,7 +88,6 @@ def load_pose_batch(
 
     Tries the bulk decoder first; falls back to rosbags per message (logged at INFO).
     """
-    from ertools.io.bulk import try_fast_batch
 
     fast = try_fast_batch(bag, conns, start_ns, end_ns)
     if fast is not None:
@@ -218,7 +220,6 @@ def read_poses(
 def _tf_edges(
     plist: list[Path], start_ns: int | None, end_ns: int | None
 ) -> dict[tuple[str, str], Edge]:
-    from ertools.io.pipeline import group_positions
 
     per_edge: dict[tuple[str, str], list[PoseStream]] = {}
     static_edges: set[tuple[str, str]] = set()
@@ -346,8 +347,6 @@ def _bulk_states(
 ):
     """(record times, states, payloads) decoded in bulk, None when the layout is not the 2015
     one or the format has no bulk access."""
-    from ertools.io.bulk import locate
-    from ertools.io.decode.fast import LayoutMismatchError, decode_states, is_state_definition
 
     if len({c.encoding for c in conns}) != 1 or not all(
         is_state_definition(c.msgdef) for c in conns

@@ -25,17 +25,20 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 
+from ertools.arrays import I64
 from ertools.errors import BagError
+from ertools.io.decode.fast import LayoutMismatchError, gather
 from ertools.io.formats import detect_format
+from ertools.io.mcap.index import McapIndex
+from ertools.io.mcap.scan import SCAN, mcap_layout, scan_mcap
+from ertools.io.mcap.summary import mcap_errors
 from ertools.io.model import BagSummary, TopicSummary, short_msgtype
 from ertools.io.ros1.index import Ros1Bag
 from ertools.io.ros1.layout import read_layout
+from ertools.io.rosbag2.metadata import query, read_metadata, storage_files
 
 log = logging.getLogger("ertools.io.summary")
-
-I64 = npt.NDArray[np.int64]
 
 
 def _size(path: Path) -> int:
@@ -221,7 +224,6 @@ def _mcap_scanned(
 ) -> tuple[dict[str, tuple[str, int, int | None, int | None, int]], set[str], list[str]]:
     """Topics of an MCAP file read record by record (chunks decompressed): the path for
     layouts the summary cannot answer for alone, exact for all of them."""
-    from ertools.io.mcap.scan import scan_mcap
 
     log.info("%s: %s; reading the file record by record", path, why)
     found = scan_mcap(path)
@@ -253,7 +255,6 @@ def _mcap_indexed(
 ) -> tuple[dict[str, tuple[str, int, int | None, int | None, int]], set[str], list[str], str]:
     """Topics from the summary: counts from the statistics, or from the message indexes when
     ``exact`` or when the summary has no statistics (then every message is counted)."""
-    from ertools.io.mcap.index import McapIndex
 
     summary = layout.summary
     spans: dict[int, list[int]] = {}
@@ -337,8 +338,6 @@ def _check_ends(
     Raises:
         BagError: an index entry and its record disagree.
     """
-    from ertools.io.decode.fast import gather
-    from ertools.io.mcap.index import McapIndex
 
     chunks: dict[int, np.ndarray] = {}
     with path.open("rb") as f:
@@ -378,8 +377,6 @@ def _mcap_file(
 ) -> tuple[dict[str, tuple[str, int, int | None, int | None, int]], set[str], list[str], str]:
     """(topics, chunk compressions, problems, index used) of one MCAP file, through its
     indexes where they answer for every message, else record by record."""
-    from ertools.io.decode.fast import LayoutMismatchError
-    from ertools.io.mcap.scan import SCAN, mcap_layout
 
     layout = mcap_layout(path)
     if layout.index != SCAN:
@@ -400,9 +397,7 @@ def _mcap_file(
 
 
 def _mcap_version(path: Path) -> str:
-    from mcap.reader import make_reader
-
-    from ertools.io.mcap.summary import mcap_errors
+    from mcap.reader import make_reader  # lazy: the mcap library only when an MCAP file is read
 
     try:
         with path.open("rb") as f:
@@ -420,7 +415,6 @@ def _mcap(path: Path, exact: bool, times: Times | None = None) -> BagSummary:
 
 
 def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagSummary:
-    from ertools.io.rosbag2.metadata import read_metadata, storage_files
 
     info = read_metadata(path)
     problems = []
@@ -467,7 +461,6 @@ def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> B
 
 
 def _sqlite_spans(files: list[Path]) -> dict[str, tuple[int, int]]:
-    from ertools.io.rosbag2.metadata import query
 
     out: dict[str, tuple[int, int]] = {}
     for db in files:
@@ -541,8 +534,6 @@ def record_times(path: str | Path) -> dict[str, I64]:
         for file in [p] if fmt == "mcap" else sorted(p.glob("*.mcap")):
             _mcap_file(file, True, parts)
     else:
-        from ertools.io.rosbag2.metadata import query, read_metadata, storage_files
-
         for db in storage_files(p, read_metadata(p)):
             rows = query(
                 db,

@@ -23,6 +23,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from ertools.errors import ClockError
+from ertools.timeutil import iso_utc
 
 NTP_PORT = 123
 # Seconds from the NTP era 0 epoch (1900-01-01) to the Unix epoch (1970-01-01).
@@ -76,7 +77,6 @@ class ClockCheck:
 
     def to_metadata(self) -> dict[str, str]:
         """Key/value strings for an MCAP metadata record."""
-        from ertools.timeutil import iso_utc
 
         return {
             "ntp_server": f"{self.server}:{self.port}",

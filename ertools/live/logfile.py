@@ -16,6 +16,7 @@ import time
 from pathlib import Path
 from typing import IO, Any
 
+from ertools import __version__
 from ertools.errors import BagError
 from ertools.live.rosmsg import MESSAGE_ENCODING, SCHEMA_ENCODING, Ros2Serializer
 
@@ -44,9 +45,8 @@ class LogFile:
         fsync: bool = False,
         chunk_size: int = 256 * 1024,
     ) -> None:
+        # lazy: the mcap library only when an MCAP file is read
         from mcap.writer import CompressionType, Writer
-
-        from ertools import __version__
 
         if compression not in COMPRESSIONS:
             raise ValueError(f"compression {compression!r} not in {COMPRESSIONS}")

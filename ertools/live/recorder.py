@@ -33,8 +33,10 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ertools import __version__
 from ertools.configs.mocap import MocapConfig, RigidBodyConfig, normalize_namespace
 from ertools.errors import BagError, ConfigError, ErtoolsError
+from ertools.live.clock import query_sntp, unreachable_metadata
 from ertools.live.logfile import LogFile, log_file_name
 from ertools.live.natnet import (
     HEADER,
@@ -348,7 +350,6 @@ class Recorder:
         opts = self.options
         if not opts.ntp_server:
             return {"status": "not measured (no --ntp-server given)"}
-        from ertools.live.clock import query_sntp, unreachable_metadata
 
         try:
             check = query_sntp(opts.ntp_server, opts.ntp_port, timeout_s=opts.ntp_timeout_s)
@@ -359,7 +360,6 @@ class Recorder:
         return check.to_metadata()
 
     def _open_file(self, index: int) -> None:
-        from ertools import __version__
 
         opts = self.options
         path = opts.out_dir / log_file_name(opts.name, self._start_s, index)

@@ -53,11 +53,11 @@ _MESSAGE_HEAD = struct.Struct("<HIQQ")  # channel id, sequence, log time, publis
 
 def _decompress(compression: str, data: bytes, size: int) -> bytes:
     if compression == "zstd":
-        import zstandard
+        import zstandard  # lazy: a decompressor only for compressed chunks
 
         return bytes(zstandard.ZstdDecompressor().decompress(data, max_output_size=size))
     if compression == "lz4":
-        import lz4.frame
+        import lz4.frame  # lazy: a decompressor only for compressed chunks
 
         return bytes(lz4.frame.decompress(data))
     if compression == "":

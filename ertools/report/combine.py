@@ -28,6 +28,7 @@ from ertools.benchmarks.common.teams import team_from_log_name
 from ertools.errors import ConfigError
 from ertools.report import html as h
 from ertools.report import units
+from ertools.report.folder import headline
 
 # Command-line options that choose where or how output is written, not what is scored.
 _OUTPUT_OPTIONS = frozenset(
@@ -130,7 +131,6 @@ def _guess_benchmark(score: dict[str, Any]) -> str:
 
 def load_entry(path: Path) -> Entry:
     """A result from a report folder, a ``result.json`` or a ``score.json``."""
-    from ertools.report.folder import headline
 
     if not path.exists():
         raise ConfigError("no such file or folder", path=path)

@@ -26,9 +26,15 @@ from pathlib import Path
 from typing import Any
 
 from ertools import __version__
+from ertools.audit.analyse import audit_states
+from ertools.audit.model import Audit
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import BenchmarkResult, Rows, jsonable
-from ertools.report import folder_page
+from ertools.benchmarks.common.teams import team_from_log_name, team_from_transform_name
+from ertools.errors import ConfigError, ErtoolsError
+from ertools.io import read_benchmark_states
+from ertools.report import folder_page, plots_audit
+from ertools.report.figures import FigureSpec, figure_specs, save_figures
 from ertools.report.records import FileRecord, csv_stem, file_record
 
 log = logging.getLogger("ertools.report.folder")
@@ -60,7 +66,6 @@ def write_report(
         team: the team, when the caller knows it (else from ``--team``, the parameters or a
             ``transform-<team>.yaml`` argument).
     """
-    from ertools.errors import ConfigError
 
     try:
         outdir.mkdir(parents=True, exist_ok=True)
@@ -80,7 +85,6 @@ def _write_report(
     audit: Any,
     team: str | None,
 ) -> Path:
-    from ertools.audit.model import Audit
 
     score: BenchmarkResult | None
     if isinstance(result, Audit):
@@ -153,9 +157,6 @@ def _audit_inputs(name: str, inputs: list[Path]) -> Any:
     """The audit of the bags' state topics, or None (no namespace, no topics, unreadable)."""
     if name not in registry.names() or not registry.get(name).state_topics or not inputs:
         return None
-    from ertools.audit.analyse import audit_states
-    from ertools.errors import ErtoolsError
-    from ertools.io import read_benchmark_states
 
     try:
         states = read_benchmark_states([Path(p) for p in inputs], name)
@@ -227,7 +228,6 @@ def _team(
     """(team, where it was found): the result's own (``provenance.team``, set by the scoring
     commands), else ``--team`` on the command line, a rockin_logger input name, a
     ``team``/``robot_info`` parameter, a ``transform-<team>.yaml`` argument."""
-    from ertools.benchmarks.common.teams import team_from_log_name, team_from_transform_name
 
     for holder in (score, audit):
         provenance = getattr(holder, "provenance", None)
@@ -304,8 +304,6 @@ def _figures(
     score: BenchmarkResult | None, audit: Any, figdir: Path
 ) -> tuple[list[tuple[Path, str]], list[str]]:
     """Draw every figure, one at a time, so that one failing plot does not lose the others."""
-    from ertools.report import plots_audit
-    from ertools.report.figures import FigureSpec, figure_specs, save_figures
 
     specs: list[FigureSpec] = []
     problems: list[str] = []

@@ -14,6 +14,7 @@ from ertools.benchmarks.common.teams import SOURCE_TEXT
 from ertools.report import html as h
 from ertools.report import units
 from ertools.report.records import FileRecord, csv_stem
+from ertools.timeutil import iso_utc, ns_to_s
 
 TABLE_MAX_ROWS = 200  # longer tables are in the CSV only
 TABLE_OPEN_ROWS = 30  # longer tables are folded in the page
@@ -113,7 +114,6 @@ def _deviations(score: BenchmarkResult | None, audit: Any) -> list[str]:
 
 
 def _audit_context(audit: Any) -> dict[str, Any]:
-    from ertools.timeutil import iso_utc, ns_to_s
 
     facts = [
         ("benchmark", audit.benchmark or "(unknown)"),

@@ -17,6 +17,7 @@ from functools import cache
 from typing import TYPE_CHECKING, Any
 
 from ertools.report import units
+from ertools.timeutil import iso_utc, s_to_ns
 
 if TYPE_CHECKING:
     import jinja2
@@ -36,7 +37,6 @@ def fmt(value: Any) -> str:
 
 
 def _utc(seconds: float) -> str:
-    from ertools.timeutil import iso_utc, s_to_ns
 
     return iso_utc(s_to_ns(seconds)).replace("+00:00", "Z")
 
@@ -136,7 +136,7 @@ class Figure:
 @cache
 def environment() -> jinja2.Environment:
     """The templates' environment: autoescaping on, undefined names are errors."""
-    import jinja2
+    import jinja2  # lazy: Jinja2 only when an HTML page is written
 
     return jinja2.Environment(
         loader=jinja2.PackageLoader("ertools.report", "templates"),

@@ -28,6 +28,7 @@ def _colour(run: Any) -> str:
 
 
 def _legend(ax: Any) -> None:
+    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
     from matplotlib.patches import Patch
 
     ax.legend(
@@ -133,6 +134,7 @@ def _draw_table(result: Any) -> Any:
         units.set_axis(ax, "x", "x in the table frame", "length", "m")
         units.set_axis(ax, "y", "y in the table frame", "length", "m")
         ax.grid(True, lw=0.3)
+        # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
         from matplotlib.lines import Line2D
 
         ax.legend(

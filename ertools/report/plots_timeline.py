@@ -19,7 +19,15 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from ertools.report.timeline_page import display_names, lanes_and_rows, session_label
+import numpy as np
+
+from ertools.errors import UsageError
+from ertools.report.timeline_page import (
+    display_names,
+    lanes_and_rows,
+    session_label,
+    write_timeline_page,
+)
 from ertools.report.timeline_style import (
     KIND_COLORS,
     KIND_LABELS,
@@ -57,8 +65,8 @@ def problem_numbers(timeline: Timeline) -> dict[str, int]:
 
 
 def _num(ns: int) -> float:
+    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
     import matplotlib.dates as _mdates
-    import numpy as np
 
     mdates: Any = _mdates  # partly untyped module
     value: float = mdates.date2num(np.datetime64(ns, "ns").astype("datetime64[us]"))
@@ -90,6 +98,7 @@ def draw_session(
         session: the session.
         numbers: the problem number of each bag (default :func:`problem_numbers`).
     """
+    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
     import matplotlib.dates as _mdates
 
     mdates: Any = _mdates  # partly untyped module
@@ -169,6 +178,7 @@ def legend_handles(
     kinds: Sequence[str], *, problems: bool, copies: bool, uncovered: bool
 ) -> list[Any]:
     """Legend entries drawn exactly as the bars are."""
+    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
     from matplotlib.patches import Patch
 
     handles: list[Any] = [
@@ -219,6 +229,7 @@ def problem_lines(timeline: Timeline, numbers: Mapping[str, int], width: int = 1
 def timeline_figure(timeline: Timeline) -> Any:
     """The figure: a legend, one panel per session (at most :data:`MAX_PANELS`), the list of
     numbered problems. Returns a ``matplotlib.figure.Figure``."""
+    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
     from matplotlib.figure import Figure
 
     numbers = problem_numbers(timeline)
@@ -279,6 +290,7 @@ def draw_gantt(ax: Any, timeline: Timeline) -> None:
     Sessions of seconds are hairlines on a day-long axis: :func:`timeline_figure` draws one
     panel per session instead.
     """
+    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
     import matplotlib.dates as _mdates
 
     mdates: Any = _mdates  # partly untyped module
@@ -328,14 +340,11 @@ def draw_gantt(ax: Any, timeline: Timeline) -> None:
 def save_timeline_plot(timeline: Timeline, path: Path) -> Path:
     """Write ``path`` by its suffix: ``.png`` / ``.svg`` the per-session figure, ``.html`` /
     ``.htm`` the interactive page."""
-    from ertools.errors import UsageError
 
     suffix = path.suffix.lower()
     if suffix not in PLOT_SUFFIXES:
         raise UsageError(f"--plot {path}: give a .png, .svg or .html file name")
     if suffix in (".html", ".htm"):
-        from ertools.report.timeline_page import write_timeline_page
-
         return write_timeline_page(timeline, path)
     fig = timeline_figure(timeline)
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ertools.benchmarks.trajectory.association import GAP, TRACKING_LOST, UNCOVERED
 from ertools.report import units
 from ertools.report.figures import FigureSpec
 
@@ -18,7 +19,6 @@ if TYPE_CHECKING:
 
 def draw_error_over_time(ax: Any, result: TrajectoryResult) -> None:
     """Position error (mm) per robot pose; gaps and tracking losses marked on the time axis."""
-    from ertools.benchmarks.trajectory.association import GAP, TRACKING_LOST, UNCOVERED
 
     m = result.matched
     if len(m.t_ns) == 0:

@@ -14,6 +14,8 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
+from ertools.timeutil import EPOCH_THRESHOLD_S
+
 
 @dataclass(frozen=True)
 class Quantity:
@@ -98,7 +100,6 @@ def is_number(value: Any) -> bool:
 
 def is_epoch(name: str, values: list[Any]) -> bool:
     """A time column of instants: every number in it is epoch seconds (after 2001)."""
-    from ertools.timeutil import EPOCH_THRESHOLD_S
 
     if quantity_of(name) != ("time", "s"):
         return False
@@ -149,6 +150,7 @@ def set_axis(ax: Any, which: str, text: str, quantity: str, stored: str) -> None
         quantity: a key of :data:`QUANTITIES`.
         stored: the unit the data is drawn in.
     """
+    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
     from matplotlib.ticker import FuncFormatter
 
     k = factor(quantity, stored)

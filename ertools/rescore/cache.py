@@ -22,13 +22,13 @@ from pathlib import Path
 from typing import Any
 
 from ertools import __version__
+from ertools.report.records import sha256_file
 from ertools.rescore.jobs import Job, Outcome
 
 CACHE_VERSION = 1
 
 
 def _sha256_file(path: Path) -> str:
-    from ertools.report.records import sha256_file
 
     return sha256_file(path)
 

@@ -18,6 +18,7 @@ from typing import Any
 from ertools.benchmarks import registry
 from ertools.benchmarks.common.teams import read_payload_team
 from ertools.progress import Reporter
+from ertools.report.timeline_page import write_timeline_page
 from ertools.rescore.discover import Discovery, discover
 from ertools.rescore.pipeline import Scoring
 from ertools.timeline.model import Timeline
@@ -124,7 +125,6 @@ def find(paths: Sequence[Path], *, progress: Reporter | None = None) -> Found:
 
 def write_timeline(found: Found, out: Path, title: str) -> dict[str, Any]:
     """``DIR/timeline.html`` (the day's timeline figure) and results.json's ``timeline``."""
-    from ertools.report.timeline_page import write_timeline_page
 
     write_timeline_page(found.timeline, out / TIMELINE_PAGE, title=title or None)
     return {"figure": TIMELINE_PAGE, "sessions": len(found.timeline.sessions)}

@@ -20,11 +20,13 @@ from importlib import import_module
 from pathlib import Path
 from typing import Any, Literal
 
+from ertools.audit.compare import attach
 from ertools.benchmarks.base import Benchmark, jsonable
 from ertools.benchmarks.common.teams import with_team
 from ertools.benchmarks.document import all_failed, score_json
 from ertools.errors import ErtoolsError
 from ertools.progress import reporting
+from ertools.report.folder import _audit_inputs, write_report
 
 Status = Literal["scored", "unscoreable", "failed"]
 
@@ -189,8 +191,6 @@ def _score(job: Job) -> Outcome:
             )
     report = None
     if job.report_dir is not None:
-        from ertools.report.folder import write_report
-
         index = write_report(
             result,
             Path(job.report_dir),
@@ -217,8 +217,6 @@ def _score(job: Job) -> Outcome:
 def _live_audit(result: Any, bags: list[Path]) -> Any:
     """The audit of the bags' state topics with its live-vs-recomputed comparison, or None
     (a benchmark without state topics, or logs without them)."""
-    from ertools.audit.compare import attach
-    from ertools.report.folder import _audit_inputs  # the report's own: one audit, shared
 
     audit = _audit_inputs(result.name, bags)
     return None if audit is None else attach(audit, result)

@@ -176,7 +176,7 @@ def run_dask(jobs: Sequence[Job], address: str, *, workers: int, on_done: OnDone
     """
     try:
         # optional extra `ertools[dask]`: imported only when a scheduler is asked for
-        import distributed as _distributed
+        import distributed as _distributed  # lazy: the optional Dask extra (ertools[dask])
     except ImportError:
         raise ConfigError(
             "--scheduler needs Dask distributed: pip install 'ertools[dask]'"

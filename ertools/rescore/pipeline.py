@@ -22,6 +22,8 @@ from typing import Any
 from ertools import __version__
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Benchmark
+from ertools.errors import ErtoolsError
+from ertools.io import summary
 from ertools.progress import Reporter
 from ertools.rescore.cache import Cache, FileHashes, job_key, records
 from ertools.rescore.jobs import Job, Outcome
@@ -97,8 +99,6 @@ def listed_executions(manifest: Manifest) -> list[Scoring]:
 
 def _bags_span(bags: Sequence[Path]) -> tuple[int | None, int | None]:
     """The first and last message time of the bags (None when unreadable: the scorer says why)."""
-    from ertools.errors import ErtoolsError
-    from ertools.io import summary
 
     starts: list[int] = []
     ends: list[int] = []

@@ -20,6 +20,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ertools.errors import ErtoolsError
+from ertools.samples.competition import DEFAULT_SEED, generate_competition
 from ertools.samples.scenario import (
     DEFAULT_SEEDS,
     SCENARIOS,
@@ -105,7 +106,6 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _competition(outdir: Path, seed: int | None) -> int:
-    from ertools.samples.competition import DEFAULT_SEED, generate_competition
 
     partial = outdir.with_name(f".{outdir.name}.partial")
     if partial.exists():

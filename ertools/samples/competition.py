@@ -39,6 +39,7 @@ What goes wrong, on purpose (``answers.json`` ``problems``):
 
 from __future__ import annotations
 
+import datetime as dt
 import json
 import shutil
 from pathlib import Path
@@ -98,7 +99,6 @@ def _gt_windows() -> list[GtWindow]:
 
 
 def _robot_name(slot_or_bench: str, start_ns: int, team: str) -> str:
-    import datetime as dt
 
     stamp = dt.datetime.fromtimestamp(start_ns // NS, tz=dt.UTC)
     return f"robots/{team}/{slot_or_bench.upper()}_{stamp:%Y%m%d%H%M}_{team}.bag"

@@ -15,13 +15,13 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import I64
 from ertools.geometry import quat_from_yaw
 from ertools.samples.mocap import MocapPublished, publish_environment, publish_mocap
 from ertools.samples.simulated import SimulatedRun
 from ertools.samples.statemachine import publish_states
 from ertools.samples.writer import BagWriter
 
-I64 = npt.NDArray[np.int64]
 NS = 1_000_000_000
 TF_PERIOD_NS = 100_000_000  # the static world -> map at 10 Hz, as every 2015 logger had it
 GT_NAMESPACE = "mocap"  # the venue's logger: its map topics are /mocap/map...

@@ -42,6 +42,7 @@ import numpy.typing as npt
 import yaml
 from scipy.spatial.transform import Rotation
 
+from ertools.arrays import F64
 from ertools.samples.mocap import (
     MocapNoise,
     frame_times,
@@ -56,7 +57,6 @@ from ertools.samples.statemachine import Transition, publish_states
 from ertools.samples.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
-F64 = npt.NDArray[np.float64]
 S = 1_000_000_000
 MS = 1_000_000
 

@@ -41,10 +41,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 import yaml
 from scipy.spatial.transform import Rotation, Slerp
 
+from ertools.arrays import F64
 from ertools.samples.mocap import (
     MocapNoise,
     MocapPublished,
@@ -61,7 +61,6 @@ from ertools.samples.statemachine import Transition, publish_states
 from ertools.samples.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
-F64 = npt.NDArray[np.float64]
 S = 1_000_000_000
 
 NAMESPACE = "fbm2h"

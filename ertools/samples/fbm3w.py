@@ -43,6 +43,7 @@ import numpy as np
 import numpy.typing as npt
 import yaml
 
+from ertools.arrays import F64
 from ertools.geometry import quat_from_yaw
 from ertools.samples.mocap import (
     MocapNoise,
@@ -58,7 +59,6 @@ from ertools.samples.statemachine import Transition, publish_states
 from ertools.samples.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
-F64 = npt.NDArray[np.float64]
 Motion = Callable[[F64], F64]  # time (s from the mocap start) -> (N, 2) world positions
 S = 1_000_000_000
 

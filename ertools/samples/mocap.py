@@ -41,12 +41,9 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import F64, I64, Bool
 from ertools.geometry import normalize_quat, yaw_from_quat
 from ertools.samples.writer import BagWriter
-
-I64 = npt.NDArray[np.int64]
-F64 = npt.NDArray[np.float64]
-B = npt.NDArray[np.bool_]
 
 MOCAP_RATE_HZ = 120.0
 FRAME_NS = 8_333_333  # 1/120 s, as the 2015 Motive setup streamed
@@ -100,7 +97,7 @@ class MocapPublished:
     truth_xyz: F64
     truth_quat_xyzw: F64
     noise_xyz: F64
-    repeated: B
+    repeated: Bool
     dropped: int
 
     def __len__(self) -> int:

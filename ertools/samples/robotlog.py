@@ -34,8 +34,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 
+from ertools.arrays import F64, I64
 from ertools.benchmarks.fbm2h.benchmark import NAMESPACE as FBM2H
 from ertools.geometry import quat_from_yaw
 from ertools.samples.mocap import (
@@ -50,9 +50,6 @@ from ertools.samples.mocap import (
 )
 from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
 from ertools.samples.writer import BagWriter
-
-F64 = npt.NDArray[np.float64]
-I64 = npt.NDArray[np.int64]
 
 NS = 1_000_000_000
 TEAM = "homer"

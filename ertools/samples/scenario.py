@@ -45,12 +45,14 @@ epoch seconds *and* int64 ns so tests can compare either.
 
 from __future__ import annotations
 
+import datetime as dt
 import importlib
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, Protocol
 
 import numpy as np
+import yaml
 
 from ertools.benchmarks.fbm1.benchmark import BENCHMARKS as FBM1
 from ertools.benchmarks.fbm2h.benchmark import NAMESPACE as FBM2H
@@ -111,7 +113,6 @@ def log_name(kind: str, start_ns: int, *, index: int = 0, suffix: str = ".bag") 
 
     E.g. ``log_name("fbm3w_mocap", EPOCH_2015)`` -> ``log_fbm3w_mocap_2015-11-20-10-00-00_0.bag``.
     """
-    import datetime as dt
 
     stamp = dt.datetime.fromtimestamp(start_ns // 1_000_000_000, tz=dt.UTC)
     return f"log_{kind}_{stamp:%Y-%m-%d-%H-%M-%S}_{index}{suffix}"
@@ -175,7 +176,6 @@ def write_answers(
     Key order is fixed (the convention above) and mapping order is kept, so the file is
     byte-identical for identical inputs.
     """
-    import yaml
 
     logs = [log] if isinstance(log, Path) else list(log)
     if not logs:

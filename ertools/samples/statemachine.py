@@ -26,10 +26,9 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import I64
 from ertools.samples.writer import BagWriter
 from ertools.states import BMBOX_TRANSITIONS, STATE_ENUMS, BmBoxState, Machine, state_topic
-
-I64 = npt.NDArray[np.int64]
 
 HEARTBEAT_NS = 100_000_000  # 10 Hz
 

@@ -35,8 +35,8 @@ import struct
 from pathlib import Path
 
 import numpy as np
-import numpy.typing as npt
 
+from ertools.arrays import I64
 from ertools.benchmarks.fbm2h.benchmark import NAMESPACE as FBM2H
 from ertools.geometry import quat_from_yaw
 from ertools.samples.mocap import FRAME_NS
@@ -44,7 +44,6 @@ from ertools.samples.scenario import EPOCH_2015, log_name, tol, write_answers
 from ertools.samples.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
-I64 = npt.NDArray[np.int64]
 NS = 1_000_000_000
 T0 = EPOCH_2015 + 5 * 3600 * NS  # 15:00 UTC
 GT_TOPIC = "/fbm2h/robot_at_home/pose"

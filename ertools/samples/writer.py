@@ -46,15 +46,13 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import F64, I64, U8
 from ertools.errors import UsageError
 from ertools.states import MSG_DEFINITIONS, MSG_TYPES, Machine
 
 BagFormat = Literal["ros1", "rosbag2-mcap", "rosbag2-sqlite3", "mcap"]
 FORMATS: tuple[BagFormat, ...] = ("ros1", "rosbag2-mcap", "rosbag2-sqlite3", "mcap")
 
-I64 = npt.NDArray[np.int64]
-F64 = npt.NDArray[np.float64]
-U8 = npt.NDArray[np.uint8]
 
 # tf2_msgs/TFMessage is not in rosbags' Noetic store; its definition is one line.
 _TF_MESSAGE = "geometry_msgs/TransformStamped[] transforms\n"
@@ -72,6 +70,7 @@ def _typestore(ros2: bool) -> Any:
     cached = _STORES.get(key)
     if cached is not None:
         return cached
+    # lazy: rosbags only on the per-message path (~0.1 s to import)
     from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
     store = get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
@@ -543,6 +542,7 @@ class BagWriter:
     def _write_ros1(
         self, order: npt.NDArray[np.intp], times: I64, conns: npt.NDArray[np.int64], rows: list[Any]
     ) -> None:
+        # lazy: rosbags only on the per-message path (~0.1 s to import)
         from rosbags.rosbag1 import Writer
 
         writer = Writer(self.path)
@@ -568,7 +568,10 @@ class BagWriter:
     def _write_rosbag2(
         self, order: npt.NDArray[np.intp], times: I64, conns: npt.NDArray[np.int64], rows: list[Any]
     ) -> None:
+        # lazy: rosbags only on the per-message path (~0.1 s to import)
         from rosbags.rosbag2 import StoragePlugin, Writer
+
+        # lazy: rosbags only on the per-message path (~0.1 s to import)
         from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
 
         plugin = StoragePlugin.MCAP if self.fmt == "rosbag2-mcap" else StoragePlugin.SQLITE3
@@ -588,6 +591,7 @@ class BagWriter:
     def _write_mcap(
         self, order: npt.NDArray[np.intp], times: I64, conns: npt.NDArray[np.int64], rows: list[Any]
     ) -> None:
+        # lazy: the mcap library only when an MCAP file is read
         from mcap.writer import CompressionType, Writer
 
         ctype = {

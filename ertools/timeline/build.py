@@ -245,7 +245,7 @@ def build_timeline(
     Args:
         summaries: one per readable bag (a bag with no messages counts as unreadable).
         unreadable: paths that could not be summarised and why.
-        clock_checks: measured record-minus-header offsets (see ``timeline_scan``).
+        clock_checks: measured record-minus-header offsets (see :mod:`ertools.timeline.scan`).
         config: thresholds.
     """
     cfg = config or TimelineConfig()

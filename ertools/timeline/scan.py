@@ -13,9 +13,12 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ertools.errors import ErtoolsError
+from ertools.io import summary
 from ertools.io.clock import clock_check
 from ertools.io.formats import Found, Unreadable, find_bags
 from ertools.io.model import ClockCheck
+from ertools.progress import reporting
 from ertools.timeline.build import build_timeline, split_name
 from ertools.timeline.model import Timeline, TimelineConfig
 
@@ -77,8 +80,6 @@ def summarise(
     bags: Sequence[Path], on_progress: Callable[[int], None] | None = None
 ) -> tuple[list[BagSummary], list[Unreadable]]:
     """Summaries of the readable bags and one line for each unreadable one."""
-    from ertools.errors import ErtoolsError
-    from ertools.io import summary
 
     good: list[BagSummary] = []
     bad: list[Unreadable] = []
@@ -110,7 +111,6 @@ def scan(
         check_clocks: compare header stamps with record times (reads a second per bag).
         progress: gets the bags summarised, then the recordings clock-checked.
     """
-    from ertools.progress import reporting
 
     found = find_bags(Path(p) for p in paths)
     with reporting(None):  # counted by bag and recording: the reads inside do not report

@@ -28,14 +28,11 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import F64, I64, IntArr
 from ertools.benchmarks.common.hygiene import drop_repeats
 from ertools.geometry import bracket, row_dot, row_norm
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
-
-F64 = npt.NDArray[np.float64]
-I64 = npt.NDArray[np.int64]
-IntArr = npt.NDArray[np.intp]
 
 COARSE_STEP_NS = 20_000_000  # 20 ms: at 1 m/s a 2 cm change of the cost, well resolved
 FINE_STEP_NS = 1_000_000

@@ -13,12 +13,10 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import F64, Bool
 from ertools.geometry import row_norm
 from ertools.streams import MAX_FRAME_CHANGES, PoseStream
 from ertools.timeutil import iso_utc
-
-F64 = npt.NDArray[np.float64]
-Bool = npt.NDArray[np.bool_]
 
 
 def rows_equal(a: F64, b: F64) -> Bool:

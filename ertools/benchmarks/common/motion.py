@@ -28,13 +28,11 @@ from __future__ import annotations
 from typing import Literal
 
 import numpy as np
-import numpy.typing as npt
 
+from ertools.arrays import F64, I64, Bool
+from ertools.geometry import wrap_angle
 from ertools.streams import Interval
 
-F64 = npt.NDArray[np.float64]
-I64 = npt.NDArray[np.int64]
-Bool = npt.NDArray[np.bool_]
 WindowKind = Literal["centred", "samples", "ahead"]
 Run = tuple[int, int]
 
@@ -149,7 +147,6 @@ def still_mask(
         if yaw_rate is not None:
             if yaw is None:
                 raise ValueError("still_mask: yaw_rate needs yaw")
-            from ertools.geometry import wrap_angle
 
             y = np.asarray(yaw, dtype=np.float64)
             still &= below(np.abs(wrap_angle(y[hi] - y[lo])) / span_s, yaw_rate)

@@ -24,13 +24,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import numpy.typing as npt
 
+from ertools.arrays import F64, I64, Bool
 from ertools.benchmarks.common import motion
-
-F64 = npt.NDArray[np.float64]
-I64 = npt.NDArray[np.int64]
-Bool = npt.NDArray[np.bool_]
 
 DEFAULT_STILL_SPEED = 0.004  # m/s
 DEFAULT_MIN_STILL_S = 0.5

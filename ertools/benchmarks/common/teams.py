@@ -17,11 +17,17 @@ the rest works on names and texts.
 
 from __future__ import annotations
 
+import dataclasses
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
+
+import yaml
+
+from ertools.errors import ErtoolsError
+from ertools.io import read_benchmark_states
 
 TeamSource = Literal["explicit", "payload", "log name", "transform"]
 
@@ -107,7 +113,6 @@ def team_from_payloads(payloads: Iterable[str]) -> str | None:
     Payloads that are not YAML mappings (``timeout``, a free-text operation) are skipped;
     scanning stops at the first name found.
     """
-    import yaml
 
     for text in dict.fromkeys(payloads):  # 10 Hz state topics repeat each payload
         if ":" not in text or not any(k in text for k in PAYLOAD_KEYS):
@@ -170,8 +175,6 @@ def resolve_team(
 def read_payload_team(paths: Iterable[str | Path], namespace: str) -> str | None:
     """The team the state payloads of ``namespace`` (``fbm2h``...) in ``paths`` name, or None
     (no state topics, unreadable logs: the name is then looked for elsewhere)."""
-    from ertools.errors import ErtoolsError
-    from ertools.io import read_benchmark_states
 
     plist = [Path(p) for p in paths]
     if not plist or not namespace:
@@ -188,7 +191,6 @@ def with_team(result: Any, explicit: str | None, inputs: Iterable[str | Path]) -
     """``result`` (a frozen result dataclass) with ``provenance.team``/``team_source`` set by
     :func:`resolve_team` from ``explicit``, the logs' payloads and names and, for FBM2H, the
     transform used. A result with no team found is returned unchanged."""
-    import dataclasses
 
     logs = [Path(p) for p in inputs if Path(p).suffix.lower() not in (".yaml", ".yml")]
     payload_team = None

@@ -19,13 +19,16 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ertools.benchmarks.common import motion
+from ertools.benchmarks.fbm1.benchmark import read_body
 from ertools.benchmarks.fbm1.gt import board_in_table, coverage_problem
-from ertools.configs.items import Item, ItemList, ItemSpread
-from ertools.errors import SegmentationError
+from ertools.configs.items import Item, ItemList, ItemSpread, load_items
+from ertools.errors import ConfigError, SegmentationError
 from ertools.fidelity import Deviation, Rule
 from ertools.geometry import invert, mean_pose
+from ertools.io import summary
 from ertools.streams import Interval, PoseStream, Provenance
-from ertools.timeutil import NS_PER_S
+from ertools.timeutil import NS_PER_S, resolve_time
 
 if TYPE_CHECKING:
     from ertools.io import PoseSource
@@ -110,7 +113,6 @@ def still_phases(rel: PoseStream, options: AcquireOptions) -> list[Interval]:
     A sample is still when the pose 0.25 s later is within tolerance; phases are runs of
     still samples; phases shorter than ``min_still_s`` are dropped, the others trimmed.
     """
-    from ertools.benchmarks.common import motion
 
     n = len(rel)
     if n < 2:
@@ -256,10 +258,6 @@ def acquire_items_bag(
     ``windows_s``: (start, end) per item, seconds from the log's first message (or epoch
     seconds, see ``timeutil.resolve_time``).
     """
-    from ertools.benchmarks.fbm1.benchmark import read_body
-    from ertools.configs.items import load_items
-    from ertools.io import summary
-    from ertools.timeutil import resolve_time
 
     plist = [Path(p) for p in paths]
     items = load_items(items_path, require_transforms=False)
@@ -268,8 +266,6 @@ def acquire_items_bag(
     t_end = max(i.end_ns for i in infos)
     windows = None
     if windows_s is not None:
-        from ertools.errors import ConfigError
-
         windows = [Interval(resolve_time(a, t0), resolve_time(b, t0)) for a, b in windows_s]
         bad = [k + 1 for k, w in enumerate(windows) if w.end_ns <= w.start_ns]
         if bad:

@@ -20,11 +20,12 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.common.hygiene import frame_change_warning
+from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
 from ertools.benchmarks.fbm1.answers import (
     Answer,
     ResultsFile,
@@ -47,9 +48,12 @@ from ertools.benchmarks.fbm1.score import (
     pose_errors,
     totals,
 )
-from ertools.configs.items import Item, ItemList
+from ertools.configs._yaml import load_yaml, parse_yaml
+from ertools.configs.items import Item, ItemList, load_items
 from ertools.errors import ConfigError, ScoringError, SegmentationError, TopicError
 from ertools.fidelity import Deviation, Rule
+from ertools.io import read_benchmark_states, read_pose_source, read_tf, summary
+from ertools.io.clock import check_header_clock
 from ertools.io.model import BenchmarkStates
 from ertools.progress import Reporter, current
 from ertools.streams import PoseStream, Provenance
@@ -185,7 +189,6 @@ class Fbm1Options:
             ConfigError: an unknown reference, or ``2016`` for @Work (no later @Work node is
                 known).
         """
-        from dataclasses import replace
 
         base = gt or GtOptions()
         if rules == "ertools":
@@ -555,7 +558,6 @@ def _parse_logged(payload: str | None) -> dict[str, Any] | None:
     """The 2015 node's own score payload, when it was logged and is a YAML mapping."""
     if not payload:
         return None
-    from ertools.configs._yaml import parse_yaml
 
     try:
         data = parse_yaml(payload, "BmBox TRANSMITTING_SCORE payload")
@@ -574,8 +576,6 @@ def read_body(
 ) -> PoseStream:
     """A body's poses: the given source, else the 2015 topic, else its /tf frame (the one
     chooser, :func:`ertools.benchmarks.common.sources.read_source`)."""
-    from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
-    from ertools.io import read_pose_source
 
     start, end = window
     if source is not None:
@@ -624,9 +624,6 @@ def load(paths: Sequence[Path], options: Fbm1Options) -> Fbm1Logs:
         ConfigError: no item list, a bad item list or results file.
         SegmentationError: no BmBox state messages.
     """
-    from ertools.configs._yaml import load_yaml
-    from ertools.configs.items import load_items
-    from ertools.io import read_benchmark_states, summary
 
     plist = tuple(Path(p) for p in paths)
     ns = options.benchmark
@@ -680,15 +677,12 @@ def locate_runs(logs: Fbm1Logs, options: Fbm1Options) -> Fbm1Runs:
     src = options.sources
     origin = read_body(plist, src.origin, f"/{ns}/origin/pose", "origin", (lo, hi))
     board = read_body(plist, src.board, f"/{ns}/ref_board/pose", "ref_board", (lo, hi))
-    from ertools.io.clock import check_header_clock
 
     for body, source in ((origin, src.origin), (board, src.board)):
         if source is None or source.time_source == "header":
             check_header_clock(plist, body, "state messages")
     item_tf = None
     if options.gt.method != "window":
-        from ertools.io import read_tf
-
         try:
             item_tf = read_tf(plist, "ref_board", "item", start_ns=lo, end_ns=hi)
         except TopicError:
@@ -756,7 +750,6 @@ def score_fbm1_bag(
         ConfigError: bad item list or results file.
         SegmentationError: no run in the log.
     """
-    from dataclasses import replace
 
     opts = replace(
         options or Fbm1Options(),

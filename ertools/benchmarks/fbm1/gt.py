@@ -196,6 +196,7 @@ def stationary_tail(
     The final pose is the mean of the last 0.2 s, so one noisy last sample does not decide.
     A tracking gap longer than ``max_gap_ns`` ends the tail too: nobody saw the board then.
     """
+    # lazy: scipy only where its rotations/statistics are needed (~0.3 s to import)
     from scipy.spatial.transform import Rotation
 
     if len(rel) == 0:
@@ -224,6 +225,7 @@ def settled(tail: PoseStream) -> PoseStream:
     window, so anyone can average the same samples (a noisy sample later on stays, as any
     mocap sample of a still board).
     """
+    # lazy: scipy only where its rotations/statistics are needed (~0.3 s to import)
     from scipy.spatial.transform import Rotation
 
     if len(tail) < 5:

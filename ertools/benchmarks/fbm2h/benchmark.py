@@ -28,14 +28,25 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
-from ertools.benchmarks.common.hygiene import frame_change_warning
+from ertools.benchmarks.common.hygiene import drop_invalid, frame_change_warning, frozen_around
+from ertools.benchmarks.common.sources import PoseSpec, read_source, topic
+from ertools.benchmarks.fbm2h import segments as seg
 from ertools.benchmarks.fbm2h.result import Fbm2hResult, SegmentResult
 from ertools.benchmarks.fbm2h.score import robot_poses_at, segment_errors
 from ertools.benchmarks.fbm2h.segments import ReachedMoments, StopParams
-from ertools.configs.goal import GoalList
-from ertools.configs.transform import MarkerTransform
+from ertools.configs.goal import GoalList, goal_from_payload, load_goal
+from ertools.configs.timing import load_timing
+from ertools.configs.transform import (
+    MarkerTransform,
+    identity_transform,
+    load_transform,
+    team_transform_path,
+)
 from ertools.errors import ConfigError, ScoringError, SegmentationError
 from ertools.fidelity import Deviation, Rule
+from ertools.geometry import compose, yaw_from_quat
+from ertools.io import read_benchmark_states, summary
+from ertools.io.clock import check_header_clock
 from ertools.io.model import BenchmarkStates
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import ns_to_s, s_to_ns
@@ -195,7 +206,6 @@ def compute(
         )
     if hits is not None and hits < 0:
         raise ConfigError(f"--hits must be >= 0, got {hits}")
-    from ertools.benchmarks.common.hygiene import drop_invalid
 
     marker, invalid = drop_invalid(marker)
     all_warnings = list(warnings)
@@ -338,7 +348,6 @@ def compute(
     path = _decimate(marker, PATH_POINTS)
     if len(path):
         rt, rq = t_mr
-        from ertools.geometry import compose, yaw_from_quat
 
         pt, pq = compose(
             path.xyz,
@@ -413,7 +422,6 @@ def _frozen_warnings(
     a tracking loss of the size it refuses (see
     :data:`ertools.benchmarks.common.hygiene.FROZEN_MIN_S`).
     """
-    from ertools.benchmarks.common.hygiene import frozen_around
 
     if not len(moments):
         return []
@@ -443,7 +451,6 @@ def invalid_warning(count: int, source: str) -> str:
 
 
 def _load_transform(options: Fbm2hOptions) -> MarkerTransform:
-    from ertools.configs.transform import identity_transform, load_transform, team_transform_path
 
     if options.marker_transform is not None:
         if options.transform is not None or options.transforms_dir is not None:
@@ -464,7 +471,6 @@ def _load_transform(options: Fbm2hOptions) -> MarkerTransform:
 
 def _pose_spec(options: Fbm2hOptions) -> PoseSpec:
     """The marker set's source for the one chooser (benchmarks/common/sources.py)."""
-    from ertools.benchmarks.common.sources import PoseSpec
 
     if options.topic is not None and options.tf_frame is not None:
         raise ConfigError("give either --topic or --tf, not both")
@@ -477,7 +483,6 @@ def _pose_spec(options: Fbm2hOptions) -> PoseSpec:
 
 def _compare_goal(goal: GoalList, payload: str, topic: str) -> str | None:
     """A warning when the goal list given differs from the one the BmBox sent (or is unreadable)."""
-    from ertools.configs.goal import goal_from_payload
 
     try:
         logged = goal_from_payload(payload, f"{topic} payload")
@@ -526,10 +531,6 @@ def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
         ConfigError, SegmentationError, ScoringError: no bag, bad configs, no poses, no
             state topics when the reached moments need them.
     """
-    from ertools.benchmarks.common.hygiene import drop_invalid
-    from ertools.benchmarks.common.sources import read_source, topic
-    from ertools.configs.goal import load_goal
-    from ertools.io import read_benchmark_states, summary
 
     if not paths:
         raise ConfigError("no bag given")
@@ -582,8 +583,6 @@ def locate_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
         SegmentationError: moments that do not match the waypoints.
         ClockError: header-stamped poses on another clock than the moments.
     """
-    from ertools.benchmarks.fbm2h import segments as seg
-    from ertools.configs.goal import goal_from_payload
 
     goal = logs.goal
     warnings: list[str] = []
@@ -605,8 +604,6 @@ def locate_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
                 warnings.append(warning)
         unreached = seg.unreached_reasons(moments, len(goal), states.refbox)
     elif reached == "timing":
-        from ertools.configs.timing import load_timing
-
         if options.timing is None:
             raise ConfigError("--reached timing needs the timing FILE")
         if goal is None:
@@ -622,7 +619,6 @@ def locate_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
     elif reached == "auto":
         if goal is None:
             raise ConfigError("--reached auto needs --goal FILE (Listing 10)")
-        from ertools.geometry import compose, yaw_from_quat
 
         marker = logs.marker
         rt, rq = logs.transform.arrays()
@@ -643,7 +639,6 @@ def locate_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
         )
     else:
         raise ConfigError(f"--reached must be states, timing FILE or auto, not {reached!r}")
-    from ertools.io.clock import check_header_clock
 
     what = {"states": "state messages", "auto": None}.get(moments.method, "timing file's moments")
     check_header_clock(list(logs.paths), logs.marker, what, time_source=options.time_source)

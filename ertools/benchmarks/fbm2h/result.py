@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+import yaml
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.configs.goal import GoalList
@@ -68,7 +69,6 @@ def _payload_value(payload: str) -> Any:
     text = payload.strip()
     if not text:
         return {}
-    import yaml
 
     try:
         value = yaml.safe_load(text)

@@ -9,14 +9,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import numpy.typing as npt
 
+from ertools.arrays import F64, I64, Bool
 from ertools.geometry import angle_error, compose, interpolate_poses, yaw_from_quat
 from ertools.streams import PoseStream
-
-F64 = npt.NDArray[np.float64]
-I64 = npt.NDArray[np.int64]
-Mask = npt.NDArray[np.bool_]
 
 
 @dataclass(frozen=True, eq=False)
@@ -31,9 +27,9 @@ class PosesAt:
     """
 
     xyyaw: F64
-    ok: Mask
+    ok: Bool
     nearest_ns: I64
-    interpolated: Mask
+    interpolated: Bool
 
 
 def robot_poses_at(

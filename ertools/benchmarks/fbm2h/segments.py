@@ -18,12 +18,12 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import F64, I64
+from ertools.benchmarks.common import motion
 from ertools.errors import SegmentationError
+from ertools.states import BmBoxState, ClientState, RefBoxState
 from ertools.streams import StateStream
 from ertools.timeutil import ns_to_s
-
-I64 = npt.NDArray[np.int64]
-F64 = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -92,7 +92,6 @@ def from_states(
     refbox: StateStream | None = None,
 ) -> ReachedMoments:
     """Segments from the state topics (BmBox required, Client preferred for the end moment)."""
-    from ertools.states import BmBoxState, ClientState
 
     bm = bmbox.changes()
     goals = np.flatnonzero(bm.state == BmBoxState.TRANSMITTING_GOAL)
@@ -171,7 +170,6 @@ def from_states(
 
 def _early_end(refbox: StateStream | None, after_ns: int) -> tuple[int, str] | None:
     """(time, payload) of the RefBox END that ended the benchmark early, if any."""
-    from ertools.states import RefBoxState
 
     if refbox is None or len(refbox) == 0:
         return None
@@ -245,7 +243,6 @@ def detect_stops(
     t_ns: I64, xy: F64, yaw: F64, params: StopParams, max_gap_ns: int
 ) -> list[tuple[int, int]]:
     """(first, last) sample index of every stationary run lasting >= ``min_duration_s``."""
-    from ertools.benchmarks.common import motion
 
     still = motion.still_mask(
         t_ns, xy, window_s=params.window_s, speed=params.speed, yaw=yaw, yaw_rate=params.yaw_rate

@@ -13,9 +13,11 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from datetime import UTC, datetime
 
 import numpy as np
 
+from ertools.benchmarks.common.hygiene import drop_invalid
 from ertools.benchmarks.fbm2h.segments import StopParams, detect_stops
 from ertools.configs.transform import MarkerTransform
 from ertools.errors import ConfigError, SegmentationError
@@ -91,9 +93,6 @@ def acquire_transform(
     the first pose when None. Poses with NaN values or a zero quaternion are left out (a NaN
     must never reach the transform file); a window holding some is warned about.
     """
-    from datetime import UTC, datetime
-
-    from ertools.benchmarks.common.hygiene import drop_invalid
 
     check_team_name(team)
     if len(marker) == 0:

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import F64
 from ertools.benchmarks.common.hygiene import (
     frame_change_warning,
     frozen_around,
@@ -41,6 +42,8 @@ from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
 from ertools.configs.shapes import Shape
 from ertools.errors import ConfigError, ErtoolsError, ScoringError
 from ertools.fidelity import Deviation, Rule
+from ertools.io import read_benchmark_states, summary, topics
+from ertools.io.clock import check_header_clock
 from ertools.io.model import BenchmarkStates
 from ertools.progress import Reporter, current
 from ertools.streams import PoseStream, Provenance
@@ -161,7 +164,6 @@ RULE_ARC_LENGTH = Rule(
 )
 
 Window = tuple[str, float, float, float]
-F64 = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -274,7 +276,6 @@ def load(paths: Sequence[Path], options: Fbm3wOptions) -> Fbm3wLogs:
     Raises:
         ErtoolsError: unreadable bags, no poses, no state topic for ``--runs states``.
     """
-    from ertools.io import read_benchmark_states, summary, topics
 
     plist = tuple(Path(p) for p in paths)
     poses = read_fbm3w_poses(plist, options)
@@ -319,7 +320,6 @@ def locate_runs(logs: Fbm3wLogs, options: Fbm3wOptions) -> list[RunWindow]:
         windows = find_auto(logs.poses, options.config or Fbm3wConfig(), **_still(options))
     # State messages and --run windows are timed by record time: header-stamped poses from a
     # mocap clock seconds off would be cut at other moments (a wrong score that looks right).
-    from ertools.io.clock import check_header_clock
 
     what = {"states": "state messages", "auto": None}.get(
         mode, "run windows (times from the log start)"

@@ -7,6 +7,7 @@ the run windows and the switches that contradict each other.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -29,7 +30,9 @@ from ertools.benchmarks.fbm3w.benchmark import (
     score_found,
 )
 from ertools.benchmarks.fbm3w.result import Fbm3wResult
-from ertools.benchmarks.fbm3w.runs import RunWindow
+from ertools.benchmarks.fbm3w.runs import RunWindow, parse_run_spec, parse_runs_file
+from ertools.configs._yaml import load_yaml
+from ertools.configs.fbm3w import check_d_min, load_fbm3w_config
 from ertools.errors import ConfigError, UsageError
 
 LEGACY = "2015 behaviour (each difference can be undone)"
@@ -133,7 +136,6 @@ def parse_sweep(text: str) -> tuple[float, ...]:
     Raises:
         UsageError: not three fields, negative or infinite bounds, N outside 1..500.
     """
-    import math
 
     parts = text.split(":")
     try:
@@ -156,7 +158,6 @@ def parse_sweep(text: str) -> tuple[float, ...]:
 
 def _d_min(value: float, where: str) -> float:
     """A d_min in metres, refused (usage error) when it cannot be one."""
-    from ertools.configs.fbm3w import check_d_min
 
     try:
         return check_d_min(value, where)
@@ -171,9 +172,6 @@ def make_options(given: Mapping[str, Any]) -> Fbm3wOptions:
         UsageError: a value out of range, contradicting switches (exit 2).
         ConfigError: an unreadable config or runs file, a malformed run window (exit 1).
     """
-    from ertools.benchmarks.fbm3w.runs import parse_run_spec, parse_runs_file
-    from ertools.configs._yaml import load_yaml
-    from ertools.configs.fbm3w import load_fbm3w_config
 
     v = resolve_values(INPUTS, given)
     windows = [parse_run_spec(text, i) for i, text in enumerate(v["run"])]

@@ -18,13 +18,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import numpy.typing as npt
 
+from ertools.arrays import F64, IntArr
 from ertools.configs.shapes import Shape
 from ertools.errors import ScoringError
-
-F64 = npt.NDArray[np.float64]
-IntArr = npt.NDArray[np.intp]
 
 # Samples probed one by one after each kept point before switching to a vectorised search:
 # while the end effector moves, the next kept sample is usually within a few samples (cheap

@@ -31,11 +31,14 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import F64
+from ertools.benchmarks.common.motion import moving_mean
 from ertools.benchmarks.common.phases import (
     DEFAULT_MIN_STILL_S,
     DEFAULT_STILL_SPEED,
     Phase,
     Track,
+    protocol_track,
 )
 from ertools.benchmarks.fbm3w.path import subsample_d_min
 from ertools.configs.fbm3w import Fbm3wConfig
@@ -45,8 +48,6 @@ from ertools.io.model import BenchmarkStates
 from ertools.states import BmBoxState, RefBoxState
 from ertools.streams import PoseStream, StateStream
 from ertools.timeutil import ns_to_s, resolve_time
-
-F64 = npt.NDArray[np.float64]
 
 # RefBox END payloads that end a benchmark early, and the run status reported for them.
 EARLY_END = {"timeout": "timeout", "halt": "stopped", "stop": "stopped", "stopped": "stopped"}
@@ -350,8 +351,6 @@ def find_auto(
         SegmentationError: the first run is not found; the message lists the still phases and
             moves found (seconds from the first pose) and what is missing.
     """
-    from ertools.benchmarks.common.motion import moving_mean
-    from ertools.benchmarks.common.phases import protocol_track
 
     # NaN poses (the mocap's "not tracked") carry no position: left out, as a dropout
     finite = np.all(np.isfinite(poses.xyz[:, :2]), axis=1)

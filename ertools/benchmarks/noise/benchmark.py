@@ -18,8 +18,8 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 
+from ertools.arrays import F64, I64, Bool
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.benchmarks.common.hygiene import identical_poses
 from ertools.benchmarks.common.phases import (
@@ -31,10 +31,6 @@ from ertools.benchmarks.common.phases import (
 from ertools.errors import ScoringError
 from ertools.fidelity import Deviation
 from ertools.streams import PoseStream, Provenance
-
-F64 = npt.NDArray[np.float64]
-I64 = npt.NDArray[np.int64]
-Bool = npt.NDArray[np.bool_]
 
 DEFAULT_BIN = 0.00015  # the 2015 tool's D_INTERVAL
 DEFAULT_C = 3.0

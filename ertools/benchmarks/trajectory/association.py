@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import F64, I64, U8
 from ertools.benchmarks.common.hygiene import same_rows
 from ertools.benchmarks.trajectory.config import BeforeGt, Gaps, Ties
 from ertools.errors import ScoringError
@@ -22,10 +23,6 @@ from ertools.geometry import (
     yaw_from_quat,
 )
 from ertools.streams import PoseStream
-
-F64 = npt.NDArray[np.float64]
-I64 = npt.NDArray[np.int64]
-U8 = npt.NDArray[np.uint8]
 
 # Per-pose status codes of the association.
 COMPARED, GAP, TRACKING_LOST, UNCOVERED = 0, 1, 2, 3

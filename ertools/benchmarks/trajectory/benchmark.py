@@ -38,6 +38,7 @@ from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.benchmarks.trajectory.rules import RULE_GT_OVERLAP
 from ertools.benchmarks.trajectory.scoring import score_streams
 from ertools.errors import ClockError, ScoringError
+from ertools.io import summary
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
 
@@ -89,7 +90,6 @@ def load(paths: Sequence[str | Path], options: TrajectoryOptions) -> TrajectoryL
         ClockError: no GT overlapping the robot log.
         ScoringError: no robot pose.
     """
-    from ertools.io import summary
 
     if not paths:
         raise ScoringError("no robot log given")

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any, Literal
 
+from ertools.errors import ConfigError
 from ertools.geometry import (
     Association,
 )
@@ -56,7 +57,6 @@ class TrajectoryConfig:
     before_gt: BeforeGt = "uncovered"
 
     def __post_init__(self) -> None:
-        from ertools.errors import ConfigError
 
         if self.association not in ASSOCIATIONS:
             raise ConfigError(

@@ -5,6 +5,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -137,7 +138,6 @@ def _2015_options() -> str:
 
 def _offset(text: str) -> float | None:
     """Seconds, or None for ``auto``."""
-    import math
 
     if text == "auto":
         return None

@@ -12,6 +12,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ertools.errors import BagError, ClockError, ErtoolsError, TopicError
+from ertools.io import read_poses, summary
+from ertools.io.files import open_bag
+from ertools.io.formats import find_bags
+from ertools.io.model import POSE_TYPES, TF_TYPES
+from ertools.io.reader import load_pose_batch
 from ertools.streams import PoseStream
 from ertools.timeutil import iso_utc, ns_to_s
 
@@ -20,7 +25,6 @@ if TYPE_CHECKING:
 
 
 def _pose_topics(s: BagSummary) -> list[str]:
-    from ertools.io.model import POSE_TYPES
 
     return [
         t.name for t in s.topics if t.msgtype in POSE_TYPES and t.name not in ("/tf", "/tf_static")
@@ -50,9 +54,6 @@ def pick_robot_topic(s: BagSummary, topic: str | None) -> str:
 
 def read_robot(path: str, topic: str, time_source: str) -> PoseStream:
     """The robot's poses in recording order (not sorted: non-increasing stamps are errors)."""
-    from ertools.io.files import open_bag
-    from ertools.io.model import POSE_TYPES, TF_TYPES
-    from ertools.io.reader import load_pose_batch
 
     with open_bag(path) as bag:
         conns = bag.topic_conns(topic)
@@ -155,7 +156,6 @@ def read_gt(files: Sequence[str], topic: str, start_ns: int, end_ns: int) -> Pos
     120 Hz GT peaks at ~85 MiB (measured, docs/performance.md), so the 10-minute windows this
     once took (each re-reading 60 s of extra chunks at both ends) only cost time.
     """
-    from ertools.io import read_poses
 
     return read_poses(files, topic, start_ns=start_ns, end_ns=end_ns)
 
@@ -210,8 +210,6 @@ def find_gt_files(
     gt_topic: str | None,
 ) -> tuple[list[BagSummary], str, list[str], list[str]]:
     """The GT files of GT_PATH overlapping [start, end], their topic, warnings, damaged files."""
-    from ertools.io import summary
-    from ertools.io.formats import find_bags
 
     found = find_bags([Path(p) for p in gt_paths])
     if not found.bags:

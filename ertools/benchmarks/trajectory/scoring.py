@@ -10,6 +10,7 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import I64
 from ertools.benchmarks.common.clocks import OffsetEstimate, estimate_offset
 from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid, frame_change_warning
 from ertools.benchmarks.trajectory.association import (
@@ -35,9 +36,6 @@ from ertools.errors import ClockError, ScoringError
 from ertools.fidelity import Deviation
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import iso_utc, ns_to_s
-
-F64 = npt.NDArray[np.float64]
-I64 = npt.NDArray[np.int64]
 
 
 def check_increasing(robot: PoseStream, where: str) -> None:

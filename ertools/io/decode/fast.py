@@ -21,12 +21,9 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import F64, I32, I64, U8
+from ertools.geometry import quat_from_yaw
 from ertools.io.decode.posebatch import STAMPED_TYPES, PoseBatch
-
-I64 = npt.NDArray[np.int64]
-I32 = npt.NDArray[np.int32]
-F64 = npt.NDArray[np.float64]
-U8 = npt.NDArray[np.uint8]
 
 # The stamped pose types and Pose2D (which has no header).
 FAST_TYPES = ("geometry_msgs/Pose2D", *STAMPED_TYPES)
@@ -209,7 +206,6 @@ def decode(msgtype: str, cdr: bool, buf: U8, start: I64, length: I64) -> Decoded
         result = Decoded(idx, t, v[:, :3], v[:, 3:], frame, None)
     elif msgtype == "geometry_msgs/Pose2D":
         v = cur.f64(3)
-        from ertools.geometry import quat_from_yaw
 
         xyz = np.column_stack([v[:, 0], v[:, 1], np.zeros(n)])
         e = np.zeros(n, dtype=np.int64)

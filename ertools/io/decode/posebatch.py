@@ -14,11 +14,9 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import F64, I32, I64
+from ertools.geometry import quat_from_yaw
 from ertools.io.model import short_msgtype
-
-I64 = npt.NDArray[np.int64]
-I32 = npt.NDArray[np.int32]
-F64 = npt.NDArray[np.float64]
 
 STAMPED_TYPES = (
     "geometry_msgs/PoseStamped",
@@ -130,7 +128,6 @@ def batch_from_messages(msgtype: str, records: Sequence[tuple[int, Any]]) -> Pos
     Raises:
         ValueError: ``msgtype`` is not a pose type.
     """
-    from ertools.geometry import quat_from_yaw
 
     kind = short_msgtype(msgtype)
     t_rec: list[int] = []

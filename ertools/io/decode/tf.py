@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ertools.errors import TopicError
+from ertools.geometry import compose, interpolate_poses, invert
 from ertools.streams import PoseStream
 
 
@@ -91,7 +92,6 @@ def _time_base(steps: list[_Step]) -> int:
 
 def compose_chain(steps: list[_Step], parent: str, child: str, source: str) -> PoseStream:
     """The poses of ``child`` in ``parent`` along ``steps`` (see the module docstring)."""
-    from ertools.geometry import compose, interpolate_poses, invert
 
     base = steps[_time_base(steps)].edge.stream
     t = base.t_ns

@@ -20,10 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import I64, U8
+from ertools.geometry import quat_from_yaw
 from ertools.io.decode.fast import Decoded, gather
-
-I64 = npt.NDArray[np.int64]
-U8 = npt.NDArray[np.uint8]
 
 # Odometry after its pose: pose covariance (36), twist (6), twist covariance (36) float64.
 _ODOM_TAIL = 36 + 6 + 36
@@ -222,8 +221,6 @@ def decode_uniform(
         out.xyz[...] = values[:, :3]
         out.quat[...] = values[:, 3:]
     else:
-        from ertools.geometry import quat_from_yaw
-
         out.t_header[...] = 0
         out.xyz[:, :2] = values[:, :2]
         out.xyz[:, 2] = 0.0

@@ -18,12 +18,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, BinaryIO
 
 import numpy as np
-import numpy.typing as npt
 
+from ertools.arrays import I64, U8
 from ertools.errors import BagError
 from ertools.io import pipeline
 from ertools.io.bagfile import BagFile
-from ertools.io.decode.fast import gather
+from ertools.io.decode.fast import LayoutMismatchError, gather
+from ertools.io.decode.fast import read_at as read_fields
 from ertools.io.mcap.crc import crc32
 from ertools.io.mcap.scan import SCAN, mcap_layout, scan_mcap
 from ertools.io.mcap.summary import decompress, file_size, read_summary
@@ -39,8 +40,6 @@ _RECORD_STARTS[[3, 4, 5]] = True
 
 log = logging.getLogger("ertools.io.mcap.index")
 
-I64 = npt.NDArray[np.int64]
-U8 = npt.NDArray[np.uint8]
 
 OP_MESSAGE = 0x05
 OP_CHUNK = 0x06
@@ -71,7 +70,7 @@ def _check_counts(path: Path, summary: Any, planned: dict[int, int]) -> None:
 
 def _zstd_into(data: bytes, out: memoryview, where: str) -> None:
     """Decompress one zstd chunk into ``out``, which must be exactly its uncompressed size."""
-    import zstandard
+    import zstandard  # lazy: a decompressor only for compressed chunks
 
     try:
         reader = zstandard.ZstdDecompressor().stream_reader(data, read_across_frames=True)
@@ -139,7 +138,6 @@ class McapIndex:
             LayoutMismatchError: a file's indexes do not answer for every message (no summary,
                 no message indexes, channels only inside chunks...): the caller falls back.
         """
-        from ertools.io.decode.fast import LayoutMismatchError
 
         topics = {c.topic for c in conns}
         sels: list[tuple[int, int, int, I64, I64]] = []  # file, chunk idx, chunk offset, t, off
@@ -383,8 +381,6 @@ class McapIndex:
         if channel != cid or nbytes % 16 or length < 6 + nbytes or pos + 15 + nbytes > size:
             raise BagError(f"damaged message index at byte {pos}", path=path)
         if not padded and length != 6 + nbytes:
-            from ertools.io.decode.fast import LayoutMismatchError
-
             raise LayoutMismatchError(f"a message index at byte {pos} with padding")
         data = f.read(nbytes)
         if len(data) != nbytes:
@@ -433,13 +429,12 @@ class McapIndex:
 
     @staticmethod
     def _spans(buf: U8, off: I64, where: str) -> tuple[I64, I64]:
-        from ertools.io.decode.fast import read_at
 
         if len(off) and (int(off.min()) < 0 or int(off.max()) + 9 + MESSAGE_FIXED > len(buf)):
             raise BagError(f"message index points outside its chunk {where}")
         if np.any(buf[off] != OP_MESSAGE):
             raise BagError(f"message index points at a record that is no message {where}")
-        rlen = read_at(buf, off + 1, np.dtype("<u8")).astype(np.int64)
+        rlen = read_fields(buf, off + 1, np.dtype("<u8")).astype(np.int64)
         start = off + 9 + MESSAGE_FIXED
         length = rlen - MESSAGE_FIXED
         if len(off) and (int((start + length).max()) > len(buf) or int(length.min()) < 0):

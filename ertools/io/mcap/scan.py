@@ -22,15 +22,12 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
 
+from ertools.arrays import I64, U8
 from ertools.errors import BagError
 from ertools.io.decode.fast import read_at
 from ertools.io.mcap.crc import crc32
 from ertools.io.mcap.summary import decompress, read_summary
-
-I64 = npt.NDArray[np.int64]
-U8 = npt.NDArray[np.uint8]
 
 MAGIC = b"\x89MCAP0\r\n"
 OP_FOOTER = 0x02
@@ -148,7 +145,7 @@ def _string(buf: Any, at: int, end: int) -> tuple[str, int]:
 
 
 def _schema(buf: Any, at: int, end: int) -> Any:
-    from mcap.records import Schema
+    from mcap.records import Schema  # lazy: the mcap library only when an MCAP file is read
 
     (sid,) = _U16.unpack_from(buf, at)
     name, at = _string(buf, at + 2, end)
@@ -160,7 +157,7 @@ def _schema(buf: Any, at: int, end: int) -> Any:
 
 
 def _channel(buf: Any, at: int, end: int) -> Any:
-    from mcap.records import Channel
+    from mcap.records import Channel  # lazy: the mcap library only when an MCAP file is read
 
     cid, sid = struct.unpack_from("<HH", buf, at)
     topic, at = _string(buf, at + 4, end)

@@ -60,7 +60,7 @@ def read_summary(f: BinaryIO, path: Path) -> Any:
 
 
 def _parse_summary(f: BinaryIO, path: Path) -> Any:
-    from mcap.reader import make_reader
+    from mcap.reader import make_reader  # lazy: the mcap library only when an MCAP file is read
 
     try:
         f.seek(0)
@@ -113,11 +113,11 @@ def decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
         if compression == "":
             return data
         if compression == "zstd":
-            import zstandard
+            import zstandard  # lazy: a decompressor only for compressed chunks
 
             return bytes(zstandard.ZstdDecompressor().decompress(data, max_output_size=size))
         if compression == "lz4":
-            import lz4.frame
+            import lz4.frame  # lazy: a decompressor only for compressed chunks
 
             return bytes(lz4.frame.decompress(data))
     except Exception as err:

@@ -25,7 +25,10 @@ from typing import TYPE_CHECKING, BinaryIO
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import I64, U8
 from ertools.errors import BagError
+from ertools.io.decode.fast import gather
+from ertools.io.ros1 import records
 from ertools.io.ros1.layout import (
     Ros1Chunk,
     Ros1Layout,
@@ -42,22 +45,13 @@ from ertools.io.ros1.records import (
     OP_CONNECTION,
     OP_INDEX,
     OP_MSG,
-    RecordError,
-    chunk_info,
-    connection_fields,
-    parse_fields,
-    read_record,
-    time_ns,
-    u32,
-    u64,
 )
+from ertools.timeutil import iso_utc
 
 if TYPE_CHECKING:
     from ertools.io.model import Conn
     from ertools.progress import Reporter
 
-I64 = npt.NDArray[np.int64]
-U8 = npt.NDArray[np.uint8]
 
 # Disagreements reported per bag; past this the rest are counted in one last line (a bag whose
 # index is wrong throughout would otherwise print one line per chunk and connection).
@@ -109,7 +103,6 @@ def _standard(buf: U8, offs: I64) -> tuple[npt.NDArray[np.bool_], I64, I64, I64]
     fits = np.flatnonzero((offs >= 0) & (offs + 8 + _HEADER_LEN <= n))
     if not len(fits):
         return ok, conn, t, end
-    from ertools.io.decode.fast import gather
 
     rows = gather(buf, offs[fits], 8 + _HEADER_LEN)  # header length, header, data length
     todo = np.flatnonzero(rows[:, :4].view("<u4")[:, 0] == _HEADER_LEN)
@@ -184,9 +177,9 @@ def chunk_records(buf: U8, hints: I64, base: int) -> ChunkRecords:
             out.problems.append(f"record header cut off at chunk offset {pos}")
             break
         try:
-            fields = parse_fields(raw[pos + 4 : pos + 4 + hlen], pos + 4)
+            fields = records.parse_fields(raw[pos + 4 : pos + 4 + hlen], pos + 4)
             op = fields["op"][0]
-        except (RecordError, KeyError, IndexError) as err:
+        except (records.RecordError, KeyError, IndexError) as err:
             out.problems.append(f"unreadable record header at chunk offset {pos} ({err})")
             break
         dlen = int.from_bytes(raw[pos + 4 + hlen : pos + 8 + hlen], "little")
@@ -196,17 +189,20 @@ def chunk_records(buf: U8, hints: I64, base: int) -> ChunkRecords:
             break
         try:
             if op == OP_MSG:
-                cid, when = u32(fields, "conn"), time_ns(fields, "time")  # both, or neither
+                cid, when = (
+                    records.u32(fields, "conn"),
+                    records.time_ns(fields, "time"),
+                )  # both, or neither
                 offs.append(np.array([pos], dtype=np.int64))
                 conns.append(np.array([cid], dtype=np.int64))
                 times.append(np.array([when], dtype=np.int64))
             elif op == OP_CONNECTION:
-                cf = parse_fields(raw[dpos : dpos + dlen], base + dpos)
+                cf = records.parse_fields(raw[dpos : dpos + dlen], base + dpos)
                 topic = fields.get("topic", cf.get("topic", b""))
-                out.conns[u32(fields, "conn")] = _conn_text(topic, cf)
+                out.conns[records.u32(fields, "conn")] = _conn_text(topic, cf)
             else:
                 out.problems.append(f"record of op {op} inside the chunk at offset {pos}")
-        except (RecordError, KeyError, IndexError, struct.error) as err:
+        except (records.RecordError, KeyError, IndexError, struct.error) as err:
             out.problems.append(f"unreadable record at chunk offset {pos} ({err})")
         pos = dpos + dlen
     if offs:
@@ -233,7 +229,6 @@ class _Chunk:
 
 
 def _ns(t: int) -> str:
-    from ertools.timeutil import iso_utc
 
     return f"{t // 1_000_000_000}.{t % 1_000_000_000:09d} ({iso_utc(t)})"
 
@@ -277,13 +272,13 @@ def check_ros1(path: Path, progress: Reporter | None = None) -> list[str]:
 def _check(f: BinaryIO, path: Path, size: int, progress: Reporter | None) -> list[str]:
     rep = _Report()
     try:
-        head, _ = read_record(f, MAGIC_LEN, size)
+        head, _ = records.read_record(f, MAGIC_LEN, size)
         if head.op != OP_BAG_HEADER:
-            raise RecordError("first record is not the bag header", MAGIC_LEN)
-        index_pos = u64(head.fields, "index_pos")
-        conn_count = u32(head.fields, "conn_count")
-        chunk_count = u32(head.fields, "chunk_count")
-    except (RecordError, KeyError, struct.error) as err:
+            raise records.RecordError("first record is not the bag header", MAGIC_LEN)
+        index_pos = records.u64(head.fields, "index_pos")
+        conn_count = records.u32(head.fields, "conn_count")
+        chunk_count = records.u32(head.fields, "chunk_count")
+    except (records.RecordError, KeyError, struct.error) as err:
         raise BagError(f"unreadable ROS1 bag header ({err}); not a bag?", path=path) from err
     chunks: list[_Chunk] = []
     index_conns: dict[int, tuple[str, str, str]] = {}
@@ -295,8 +290,8 @@ def _check(f: BinaryIO, path: Path, size: int, progress: Reporter | None) -> lis
         progress.advance(pos)
     while pos < size:
         try:
-            rec, data = read_record(f, pos, size, with_data=True)
-        except RecordError as err:
+            rec, data = records.read_record(f, pos, size, with_data=True)
+        except records.RecordError as err:
             rep.add(f"unreadable record at byte {pos} ({err}); nothing after it was checked")
             break
         try:
@@ -304,27 +299,27 @@ def _check(f: BinaryIO, path: Path, size: int, progress: Reporter | None) -> lis
                 compression = rec.fields.get("compression", b"none").decode("ascii", "replace")
                 chunks.append(_Chunk(pos, compression, data, rec.data_pos))
             elif rec.op == OP_INDEX:
-                cid, count = u32(rec.fields, "conn"), u32(rec.fields, "count")
-                if u32(rec.fields, "ver") != 1 or len(data) != 12 * count:
+                cid, count = records.u32(rec.fields, "conn"), records.u32(rec.fields, "count")
+                if records.u32(rec.fields, "ver") != 1 or len(data) != 12 * count:
                     rep.add(f"index data at byte {pos}: version or size disagrees with count")
                 elif not chunks:
                     rep.add(f"index data at byte {pos} before any chunk")
                 else:
                     chunks[-1].index[cid] = entries_from_index(data)
             elif rec.op == OP_CONNECTION:
-                cid, topic, cf = connection_fields(rec, data)
+                cid, topic, cf = records.connection_fields(rec, data)
                 index_conns[cid] = _conn_text(topic.encode(), cf)
                 if first_index_record < 0:
                     first_index_record = pos
             elif rec.op == OP_CHUNK_INFO:
-                infos.append((pos, *chunk_info(rec, data)))
+                infos.append((pos, *records.chunk_info(rec, data)))
                 if first_index_record < 0:
                     first_index_record = pos
             elif rec.op == OP_MSG:
                 rep.add(f"message record at byte {pos} outside any chunk")
             else:
                 rep.add(f"record of unknown op {rec.op} at byte {pos}")
-        except (RecordError, KeyError, IndexError, struct.error) as err:
+        except (records.RecordError, KeyError, IndexError, struct.error) as err:
             rep.add(f"unreadable record of op {rec.op} at byte {pos} ({err})")
         if progress is not None:  # one call per top-level record: chunks, not messages
             progress.advance(rec.end - pos)
@@ -463,19 +458,19 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
     problems = [why]
     try:
         while pos < size:
-            rec, data = read_record(f, pos, size, with_data=True)
+            rec, data = records.read_record(f, pos, size, with_data=True)
             if rec.op == OP_CHUNK:
                 compression = rec.fields.get("compression", b"none").decode("ascii", "replace")
                 found.append((pos, compression, rec.data_pos, rec.data_len, data, []))
             elif rec.op == OP_INDEX and found:
                 found[-1][5].append(entries_from_index(data[: 12 * (len(data) // 12)]))
             elif rec.op == OP_CONNECTION:
-                cid, topic, cf = connection_fields(rec, data)
+                cid, topic, cf = records.connection_fields(rec, data)
                 conns.setdefault(cid, conn_record(cid, topic, cf))
             elif rec.op != OP_CHUNK_INFO:
-                raise RecordError(f"record of op {rec.op} outside a chunk", pos)
+                raise records.RecordError(f"record of op {rec.op} outside a chunk", pos)
             pos = rec.end
-    except (RecordError, KeyError, IndexError, struct.error):
+    except (records.RecordError, KeyError, IndexError, struct.error):
         return scan_layout(f, path, size, start, why)
     chunks = []
     for cpos, compression, data_pos, data_len, data, hints in found:

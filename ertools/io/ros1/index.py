@@ -20,8 +20,10 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import I64, U8
 from ertools.errors import BagError
 from ertools.io.bagfile import BagFile, RawRecord
+from ertools.io.decode.fast import LayoutMismatchError, gather, read_at
 from ertools.io.model import Conn
 from ertools.io.ros1.check import rebuild_layout
 from ertools.io.ros1.layout import (
@@ -63,9 +65,6 @@ if TYPE_CHECKING:
 
 log = logging.getLogger("ertools.io.ros1.index")
 
-I64 = npt.NDArray[np.int64]
-U8 = npt.NDArray[np.uint8]
-
 
 def _first_record(bag: Ros1Bag) -> int:
     """Where the records after the bag header start."""
@@ -80,7 +79,6 @@ def _standard_spans(buf: U8, offsets: I64) -> tuple[I64, I64] | None:
     """(data start, data length) when every record has the standard 38-byte header with its op
     field where the first one has it (a writer's usual output): three gathers and two
     checks. None when any record differs (the caller then looks at each kind)."""
-    from ertools.io.decode.fast import read_at
 
     n = len(buf)
     if int(offsets.max()) + 8 + MSG_HEADER_LEN > n:
@@ -354,7 +352,6 @@ class Ros1Bag(BagFile):
         order), checking its op field; other records (a connection record before the message,
         odd header layouts) are resolved one by one.
         """
-        from ertools.io.decode.fast import LayoutMismatchError, read_at
 
         n = len(buf)
         if len(offsets) == 0:
@@ -420,7 +417,6 @@ class Ros1Bag(BagFile):
             start, length = self.spans(buf, offsets, where)
             self.check_heads(buf, start, t_ns, conn, where)
             return start, length
-        from ertools.io.decode.fast import gather
 
         rows = gather(buf, offsets, head)
 
@@ -456,7 +452,6 @@ class Ros1Bag(BagFile):
         where its conn and time values sit, every record is read there at once, and only a
         record that disagrees is parsed field by field (a writer may order fields otherwise).
         """
-        from ertools.io.decode.fast import gather
 
         n = len(start)
         if not n:

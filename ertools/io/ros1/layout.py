@@ -16,12 +16,14 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from struct import error as struct_error
-from typing import TYPE_CHECKING, BinaryIO
+from typing import BinaryIO
 
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import I64, U8
 from ertools.errors import BagError
+from ertools.io.decode.fast import read_at
 from ertools.io.model import Conn, short_msgtype
 from ertools.io.ros1.records import (
     MAGIC_LEN,
@@ -41,13 +43,8 @@ from ertools.io.ros1.records import (
     u64,
 )
 
-if TYPE_CHECKING:
-    pass
-
 log = logging.getLogger("ertools.io.ros1.layout")
 
-I64 = npt.NDArray[np.int64]
-U8 = npt.NDArray[np.uint8]
 
 INDEX_DTYPE = np.dtype([("sec", "<u4"), ("nsec", "<u4"), ("off", "<u4")])
 # The message-data record header rosbag and rosbags write: conn (4), op (1), time (8) fields.
@@ -57,7 +54,6 @@ OP_AT = (0, 13, 17, 30)  # where the op field can sit in a standard message-reco
 
 
 def op_word(buf: U8, pos: I64) -> npt.NDArray[np.uint64]:
-    from ertools.io.decode.fast import read_at
 
     return read_at(buf, pos, np.dtype("<u8"))
 
@@ -213,7 +209,7 @@ def decompress(compression: str, data: bytes, where: str) -> bytes:
         if compression == "bz2":
             return bz2.decompress(data)
         if compression == "lz4":
-            import lz4.frame
+            import lz4.frame  # lazy: a decompressor only for compressed chunks
 
             return bytes(lz4.frame.decompress(data))
     except (OSError, ValueError, RuntimeError, EOFError) as err:

@@ -13,8 +13,8 @@ from collections.abc import Iterator, Sequence
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import numpy.typing as npt
 
+from ertools.arrays import I64
 from ertools.errors import BagError
 from ertools.io import pipeline
 from ertools.io.model import Conn
@@ -36,8 +36,6 @@ if TYPE_CHECKING:
     # the bag calls this module: its class is an annotation here, never imported
     from ertools.io.ros1.index import Ros1Bag
     from ertools.progress import Reporter
-
-I64 = npt.NDArray[np.int64]
 
 
 def ros1_runs(

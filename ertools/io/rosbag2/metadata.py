@@ -8,20 +8,17 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import numpy.typing as npt
+import yaml
 
+from ertools.arrays import I64, U8
 from ertools.errors import BagError
 from ertools.io.model import Conn
-
-I64 = npt.NDArray[np.int64]
-U8 = npt.NDArray[np.uint8]
 
 ROWS_PER_BATCH = 100_000
 
 
 def read_metadata(path: Path) -> dict[str, Any]:
     """``rosbag2_bagfile_information`` of a rosbag2 directory."""
-    import yaml
 
     meta = path / "metadata.yaml"
     try:

@@ -18,8 +18,12 @@ from importlib import import_module
 from pathlib import Path
 from typing import Any
 
+from ertools import __version__
 from ertools.benchmarks import registry
+from ertools.benchmarks.base import jsonable
 from ertools.errors import UsageError
+from ertools.report.foxglove.mcapout import refuse_inputs, write_mcap
+from ertools.report.foxglove.messages import Collected
 
 # ``module.Class`` of a result that is no registered benchmark's -> ``module:function``
 # adding its content to a Collected. Dotted names, not classes: nothing is imported until a
@@ -62,9 +66,6 @@ def content_function(result: Any) -> Callable[..., None] | None:
 
 def collect(result: Any, *, limit: int = STREAM_LIMIT) -> Any:
     """The result's Foxglove messages (a :class:`messages.Collected`), not yet written."""
-    from ertools import __version__
-    from ertools.benchmarks.base import jsonable
-    from ertools.report.foxglove.messages import Collected
 
     fn = content_function(result)
     if fn is None:
@@ -95,7 +96,6 @@ def write_foxglove(
             has no Foxglove export.
         OSError: the file cannot be written.
     """
-    from ertools.report.foxglove.mcapout import refuse_inputs, write_mcap
 
     out_path = Path(path)
     refuse_inputs(out_path, [*inputs, *result.provenance.inputs])

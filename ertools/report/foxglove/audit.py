@@ -13,6 +13,7 @@ Topics:
 from __future__ import annotations
 
 from ertools.audit.model import Audit
+from ertools.report.foxglove import content_function
 from ertools.report.foxglove.messages import (
     INFO,
     WARNING,
@@ -71,8 +72,6 @@ def content(out: Collected, a: Audit, *, limit: int) -> None:
         run = "between runs" if x.run is None else f"run {x.run}"
         log(out, x.t_ns, WARNING, f"RefBox ended {run} early: {x.reason}", "audit")
     if a.recomputed is not None:
-        from ertools.report.foxglove import content_function
-
         fn = content_function(a.recomputed)
         if fn is not None:
             fn(out, a.recomputed, limit=limit)

@@ -29,10 +29,8 @@ from foxglove_schemas_protobuf.SceneUpdate_pb2 import SceneUpdate
 from foxglove_schemas_protobuf.TextPrimitive_pb2 import TextPrimitive
 from google.protobuf.message import Message
 
+from ertools.arrays import F64, I64
 from ertools.benchmarks.base import jsonable
-
-F64 = npt.NDArray[np.float64]
-I64 = npt.NDArray[np.int64]
 
 WORLD = "world"  # the mocap frame every pose of a 2015 benchmark is in
 
@@ -104,6 +102,7 @@ def descriptor_set(desc: Any) -> bytes:
     """
     name = desc.full_name
     if name not in _DESCRIPTOR_SETS:
+        # lazy: protobuf only for --foxglove
         from google.protobuf.descriptor_pb2 import FileDescriptorSet
 
         fds = FileDescriptorSet()
