@@ -202,7 +202,7 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
         example: one command line shown under the summary.
         description: the ``ertools score NAME --help`` text.
         epilog: examples and notes after the options in ``--help``.
-        bags_help: what the positional ``BAG...`` arguments are.
+        bags_help: what the positional ``BAG...`` arguments are (default: log files).
         inputs: every value it takes besides its bags (see :class:`Input`).
         make_options: the values by :attr:`Input.name` (missing ones at their defaults) ->
             validated options; raises :class:`~ertools.errors.UsageError` (exit 2) or
@@ -240,7 +240,6 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
     example: str
     description: str
     epilog: str
-    bags_help: str
     inputs: tuple[Input, ...]
     make_options: Callable[[Mapping[str, Any]], OptionsT]
     load: Callable[[Sequence[Path], OptionsT], LoadedT]
@@ -258,6 +257,7 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
     from_live: Callable[[OptionsT, Any], tuple[OptionsT, tuple[str, ...]]] | None = None
     explanations: tuple[Explanation, ...] = ()
     sample: Callable[[Path], Sequence[str] | None] | None = None
+    bags_help: str = "log file(s)"
 
     def score(self, bags: Sequence[Path], options: OptionsT) -> ResultT:
         """The whole shape: load -> find runs -> score."""

@@ -378,7 +378,6 @@ def _declare(
         example=f"ertools score {name} run.bag --items configs/{name}.yaml",
         description=DESCRIPTION,
         epilog=EPILOG.format(name=name),
-        bags_help="log file(s)",
         inputs=inputs(name),
         make_options=options_maker(name),
         load=load,

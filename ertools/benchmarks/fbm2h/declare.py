@@ -303,7 +303,6 @@ Per waypoint: the robot pose when it was reached (ground-truth marker pose inter
 moment, composed with the team's marker-to-robot transform), its distance and orientation
 error, the segment time; then position_accuracy, orientation_accuracy and execution_time.""",
     epilog=EPILOG,
-    bags_help="log file(s)",
     inputs=INPUTS,
     make_options=make_options,
     load=load,

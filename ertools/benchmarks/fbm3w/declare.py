@@ -278,7 +278,6 @@ the starting position, x axis along reference -> start), compared with the targe
 each kept point's normalised path length; distance_error = the mean distance (Eq. 1). Then
 best_run, best_distance_error and execution_time (sum of the run times).""",
     epilog=EPILOG,
-    bags_help="log file(s)",
     inputs=INPUTS,
     make_options=make_options,
     load=load,

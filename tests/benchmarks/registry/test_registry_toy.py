@@ -98,7 +98,6 @@ BENCHMARK = Benchmark(
     example="ertools score toy run.bag",
     description="Count the marker poses.",
     epilog="examples:\\n  ertools score toy run.bag --scale 2",
-    bags_help="log file(s)",
     inputs=INPUTS,
     make_options=make_options,
     load=load,
