@@ -296,7 +296,7 @@ def test_fast_path_on_a_sound_bag_warns_nothing(
 @pytest.mark.parametrize("fmt", ["ros1", "ros1-lz4"])
 def test_rebuilt_layout_equals_the_record_by_record_scan(tmp_path: Path, fmt: str) -> None:
     from ertools.io.ros1.check import rebuild_layout
-    from ertools.io.ros1.index import scan_layout
+    from ertools.io.ros1.layout import scan_layout
 
     path = two_topic_bag(tmp_path / "b.bag", fmt)
     size = path.stat().st_size

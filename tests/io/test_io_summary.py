@@ -133,7 +133,7 @@ def test_active_bag_with_open_chunk(tmp_path: Path, scene: Scene) -> None:
     """The chunk a recorder is filling has a placeholder size of 0 and its records follow it
     outside any chunk: they are read too."""
     good = write(tmp_path / "g.bag", "ros1", scene.spec, chunk_bytes=2000)
-    from ertools.io.ros1.index import read_layout
+    from ertools.io.ros1.layout import read_layout
 
     data = bytearray(make_active(good, tmp_path / "tmp.bag.active").read_bytes())
     last = read_layout(good).chunks[-1].pos
