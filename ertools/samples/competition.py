@@ -14,6 +14,7 @@
     configs/fbm2h/fbm2h_goal.yaml                   the goal (Listing 10)
     configs/fbm2h/transforms/transform-<team>.yaml  marker-to-robot transforms (Listing 11)
     configs/fbm3w/fbm3w.yaml                        runs_specifications and d_min (Listing 14)
+    competition.yaml                                the organiser's manifest (docs/rescore.md)
     answers.json                                    what a correct rescoring must find
 
 :data:`SCHEDULE` lists the 13 executions (FBM1H, FBM2H, FBM3W by five teams) at times a real
@@ -52,6 +53,7 @@ from ertools.errors import UsageError
 from ertools.samples import fbm1, fbm2h
 from ertools.samples.competition_files import (
     GtWindow,
+    organiser_manifest,
     robot_poses,
     write_benchmark_log,
     write_gt_file,
@@ -85,6 +87,10 @@ TRUNCATE_AT = 0.6
 ROBOT_LEAD_S = 15.0  # teams start their logger this long before the benchmark's recorder...
 ROBOT_TAIL_S = 8.0  # ... and stop it this long after
 TEST_DRIVE_NS = EPOCH_2015 - 90 * 60 * NS + 10 * NS  # 08:30:10, before the GT logger
+
+
+# The organiser's manifest, written beside the logs (ertools rescore DIR --config DIR/MANIFEST).
+MANIFEST = "competition.yaml"
 
 
 def _gt_windows() -> list[GtWindow]:
@@ -254,6 +260,7 @@ def generate_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path
         "executions": executions,
         "robot_logs": robot_logs,
         "copies": {copy_rel: copied},
+        "manifest": MANIFEST,
         "problems": [
             {"path": trunc, "kind": "truncated", "execution": TRUNCATED},
             {"path": str(active.relative_to(outdir)), "kind": "active"},
@@ -277,6 +284,9 @@ def generate_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path
             },
         ],
     }
+    manifest = outdir / MANIFEST
+    manifest.write_text(organiser_manifest(executions, NO_ROBOT_LOG), encoding="utf-8")
+    written.append(manifest)
     out = outdir / "answers.json"
     out.write_text(json.dumps(to_plain(answers), indent=1) + "\n", encoding="utf-8")
     written.append(out)

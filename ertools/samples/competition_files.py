@@ -7,10 +7,12 @@ span without reading it back.
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -185,3 +187,38 @@ def robot_poses(
     bias = rng.normal(0.0, 0.01, size=3)
     xyz = pub.truth_xyz[keep] + bias + rng.normal(0.0, ROBOT_NOISE_M, size=(keep.size, 3))
     return pub.t_frame_ns[keep], xyz, pub.truth_quat_xyzw[keep]
+
+
+def organiser_manifest(executions: Sequence[dict[str, Any]], no_team: str) -> str:
+    """The manifest an organiser writes for the day (``ertools rescore --config``,
+    docs/rescore.md): each benchmark's config files, each FBM2H team's marker-to-robot
+    transform (a team whose file is missing is not listed: its execution stays unscoreable
+    with that reason), and the one execution nothing in the logs names the team of
+    (``no_team``: its benchmark log and GT files, named from the schedule).
+    """
+    shared: dict[str, dict[str, str]] = {}
+    teams: dict[str, dict[str, str]] = {}
+    for e in executions:
+        for key, rel in e["inputs"].items():
+            if key == "transform":
+                if e["status"] == "scored":
+                    teams[e["team"]] = {"transform": rel}
+            else:
+                shared.setdefault(e["benchmark"], {})[key] = rel
+    lines = ["version: 1", "title: Sample competition (Friday 2015-11-20)", "benchmarks:"]
+    for bench, values in sorted(shared.items()):
+        lines += [f"  {bench}:", "    inputs:"]
+        lines += [f"      {k}: {v}" for k, v in values.items()]
+        if bench == "fbm2h":
+            lines.append("    teams:")
+            for team, tv in sorted(teams.items()):
+                lines.append(f"      {team}: {{transform: {tv['transform']}}}")
+    (lost,) = [e for e in executions if e["id"] == no_team]
+    bags = ", ".join(json.dumps(p) for p in [lost["bmbox_log"], *lost["gt_files"]])
+    lines += [
+        "executions:",
+        f"  - benchmark: {lost['benchmark']}",
+        f"    team: {lost['team']}",
+        f"    bags: [{bags}]",
+    ]
+    return "\n".join(lines) + "\n"

@@ -87,7 +87,7 @@ def test_command_line_refuses_mixed_modes(
 def test_every_named_file_exists_and_every_file_is_named(
     competition: Path, answers: dict[str, Any]
 ) -> None:
-    named: set[str] = {"answers.json"}
+    named: set[str] = {"answers.json", answers["manifest"]}
     missing_transform = [p for p in answers["problems"] if p["kind"] == "missing-input"]
     absent = {p["path"] for p in missing_transform}
     assert len(absent) == 1

@@ -1,0 +1,99 @@
+"""What ``make demo`` publishes: the sample competition rescored (its own step of the demo)
+and its results site opened in headless Chromium, offline, from disk.
+
+The leaderboards, the problems and the timeline are on the page as Chromium built it, every
+link and frame resolves to a file the rescore wrote (or an anchor on the page), and the
+page's rows say what results.json says. The scores themselves are checked against the
+competition's answers in test_rescore_sample.py.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+from pathlib import Path
+from typing import Any
+from urllib.parse import unquote, urlsplit
+
+import pytest
+from fakes import BROWSER
+from site_results import Page, expected_board
+from test_rescore_site_browser import chromium
+
+from ertools.benchmarks import registry
+from ertools.cli.main import main
+from ertools.demo import competition_step, make_competition
+
+pytestmark = [
+    pytest.mark.browser,
+    pytest.mark.skipif(BROWSER is None, reason="chromium not installed (apt-get install chromium)"),
+]
+
+
+@pytest.fixture(scope="module")
+def demo_site(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any], Path]:
+    root = tmp_path_factory.mktemp("demo")
+    day = root / "competition"
+    make_competition(day)
+    step = competition_step(day, root / "rescore")
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        code = main([*step.argv, "--quiet"])
+    assert code == step.expected_exit == 1, err.getvalue()[-2000:]
+    answers = json.loads((day / "answers.json").read_text(encoding="utf-8"))
+    return root / "rescore" / "index.html", answers, day
+
+
+def test_the_demo_site_opens_with_its_boards_problems_and_timeline(
+    demo_site: tuple[Path, dict[str, Any], Path], tmp_path: Path
+) -> None:
+    index, answers, _ = demo_site
+    doc = json.loads((index.parent / "results.json").read_text(encoding="utf-8"))
+    page = Page(chromium(tmp_path, index.as_uri(), "--dump-dom").stdout)
+    # one leaderboard per benchmark the day held, in the benchmark's own ranking
+    held = {e["benchmark"] for e in answers["executions"]}
+    assert held <= set(registry.names())
+    for bench in sorted(held):
+        shown = [
+            (int(r[0]) if r[0] != "\u2014" else None, r[1]) for r in page.boards[f"lb-{bench}"]
+        ]
+        assert shown == expected_board(doc, bench), bench
+        assert shown, bench
+    # every execution of the answers is a row with the answers' status (robot logs besides)
+    statuses = {e["id"]: e["status"] for e in answers["executions"]}
+    rows = {r["id"]: r["status"] for r in doc["executions"]}
+    assert {k: rows[k] for k in statuses} == statuses
+    assert sorted(page.executions) == sorted(rows.values())
+    # the planted problems are listed, each with its file
+    problems = page.sections["problems"]
+    for p in doc["problems"]:
+        assert p["message"] in problems
+    for planted in ("truncated", "active", "duplicate"):
+        (path,) = [p["path"] for p in answers["problems"] if p["kind"] == planted]
+        assert Path(path).name in problems, planted
+    # the day's timeline, framed
+    assert page.frames == ["timeline.html"]
+    assert (index.parent / "timeline.html").is_file()
+    # every link resolves: to a file the rescore wrote, or an anchor of the page
+    assert len(page.links) > 20
+    for link in page.links:
+        parts = urlsplit(link)
+        assert not parts.scheme, link
+        if parts.path:
+            assert (index.parent / unquote(parts.path)).is_file(), link
+        if parts.fragment:
+            assert parts.fragment in page.ids, link
+
+
+def test_each_execution_links_its_report_folder(
+    demo_site: tuple[Path, dict[str, Any], Path],
+) -> None:
+    index, _, _ = demo_site
+    doc = json.loads((index.parent / "results.json").read_text(encoding="utf-8"))
+    links = Page(index.read_text(encoding="utf-8")).links
+    scored = [row for row in doc["executions"] if row["status"] == "scored"]
+    assert len(scored) == 12  # 13 executions and a robot log; 2 unscoreable as planted
+    for row in scored:
+        assert (index.parent / row["report"]).is_file(), row["id"]
+        assert row["report"] in links, row["id"]
