@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 from ertools.audit.explain import explain, is_number
 from ertools.audit.model import Audit, ScoreComparison, ScoreLine
+from ertools.benchmarks import registry
 from ertools.benchmarks.base import jsonable
 from ertools.configs.transform import LIVE_TRANSFORM_KEY, MarkerTransform, live_transform
 
@@ -191,10 +192,19 @@ def compare_scores(
         rec_flat = {k: v for k, v in rec_flat.items() if "." not in k}
     lines: list[ScoreLine] = []
     keys = list(rec_flat) + [k for k in live_flat if k not in rec_flat]
+    # A referee's input the score only echoes (FBM2H's hits): not given to the rescoring, it
+    # is not recomputed, and its live value is no difference in the data.
+    echoed = (
+        {i.name for i in registry.get(result.name).inputs}
+        if result.name in registry.names()
+        else set()
+    )
     for key in keys:
         has_live, has_rec = key in live_flat, key in rec_flat
         lv: Any = live_flat.get(key)
         rv: Any = rec_flat.get(key)
+        if key in echoed and rv is None:
+            has_rec = False
         if not has_live or not has_rec:
             if live is None:
                 continue  # nothing to compare with: listing every key says nothing

@@ -225,7 +225,13 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
                     "live 2015": _shown(key, value),
                     "recomputed": _shown(key, score.get(key)),
                     "unit": units.unit(q[0]) if (q := units.quantity_of(key)) else "",
-                    "differs": "DIFFERS" if key in flagged else "same",
+                    "differs": (
+                        "DIFFERS"
+                        if key in flagged
+                        else "not recomputed"
+                        if score.get(key) is None and value is not None
+                        else "same"
+                    ),
                 }
             )
     live_table = h.table(live_rows, row_class="differs") if live_rows else None
