@@ -226,7 +226,6 @@ def test_gt_read_is_one_read_equal_to_the_whole_cut(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     import ertools.benchmarks.trajectory.inputs as tr
-    import ertools.io
     from ertools.io import read_poses
 
     gt0, gt1 = robotlog["gt"]
@@ -245,7 +244,7 @@ def test_gt_read_is_one_read_equal_to_the_whole_cut(
         calls.append((kwargs.get("start_ns"), kwargs.get("end_ns")))
         return read_poses(*args, **kwargs)
 
-    monkeypatch.setattr(ertools.io, "read_poses", counting)
+    monkeypatch.setattr(tr, "read_poses", counting)  # the reader read_gt calls
     cut = tr.read_gt(files, GT_TOPIC, lo, hi)
     # A span of hours (an hour-long robot log): still one read, not 10-minute windows that
     # each re-read a minute of chunks at both ends; it holds every pose.
