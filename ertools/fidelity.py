@@ -18,10 +18,10 @@ from pathlib import Path
 
 # Modules that declare Rule constants; the catalogue is what these hold, in this order.
 RULE_MODULES: tuple[str, ...] = (
-    "ertools.benchmarks.fbm1.benchmark",
+    "ertools.benchmarks.fbm1.rules",
     "ertools.benchmarks.fbm1.acquire",
-    "ertools.benchmarks.fbm2h.benchmark",
-    "ertools.benchmarks.fbm3w.benchmark",
+    "ertools.benchmarks.fbm2h.rules",
+    "ertools.benchmarks.fbm3w.rules",
     "ertools.benchmarks.trajectory.rules",
 )
 

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ertools.benchmarks.fbm1.acquire import AcquireOptions, acquire_items_bag
-from ertools.benchmarks.fbm1.benchmark import BENCHMARKS
+from ertools.benchmarks.fbm1.config import BENCHMARKS
 from ertools.cli.common import all_failed, note, write_text
 from ertools.cli.options import (
     add_output,

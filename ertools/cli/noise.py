@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 from ertools.benchmarks.base import dump_yaml
 from ertools.benchmarks.common.sources import read_source, tf, topic
-from ertools.benchmarks.fbm3w.benchmark import DEFAULT_FRAME, DEFAULT_TOPIC, FALLBACK_TOPIC
+from ertools.benchmarks.fbm3w.config import DEFAULT_FRAME, DEFAULT_TOPIC, FALLBACK_TOPIC
 from ertools.benchmarks.noise.benchmark import noise_from_stream
 from ertools.cli.common import dump_json, note, write_plots, write_text
 from ertools.cli.options import (

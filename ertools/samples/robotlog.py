@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from ertools.arrays import F64, I64
-from ertools.benchmarks.fbm2h.benchmark import NAMESPACE as FBM2H
+from ertools.benchmarks.fbm2h.config import NAMESPACE as FBM2H
 from ertools.geometry import quat_from_yaw
 from ertools.samples.mocap import (
     MocapNoise,

@@ -54,9 +54,9 @@ from typing import Any, Protocol
 import numpy as np
 import yaml
 
-from ertools.benchmarks.fbm1.benchmark import BENCHMARKS as FBM1
-from ertools.benchmarks.fbm2h.benchmark import NAMESPACE as FBM2H
-from ertools.benchmarks.fbm3w.benchmark import NAMESPACE as FBM3W
+from ertools.benchmarks.fbm1.config import BENCHMARKS as FBM1
+from ertools.benchmarks.fbm2h.config import NAMESPACE as FBM2H
+from ertools.benchmarks.fbm3w.config import NAMESPACE as FBM3W
 from ertools.errors import UsageError
 
 # A Friday at the Lisbon 2015 RoCKIn competition (2015-11-20 10:00:00 UTC): the default

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ertools.benchmarks.fbm3w.benchmark import NAMESPACE as FBM3W
+from ertools.benchmarks.fbm3w.config import NAMESPACE as FBM3W
 from ertools.geometry import quat_from_yaw
 from ertools.samples.mocap import (
     MocapNoise,

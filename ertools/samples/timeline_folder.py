@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from ertools.arrays import I64
-from ertools.benchmarks.fbm2h.benchmark import NAMESPACE as FBM2H
+from ertools.benchmarks.fbm2h.config import NAMESPACE as FBM2H
 from ertools.geometry import quat_from_yaw
 from ertools.samples.mocap import FRAME_NS
 from ertools.samples.scenario import EPOCH_2015, log_name, tol, write_answers

@@ -148,7 +148,8 @@ def test_fbm3w(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def test_fbm2h(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from ertools.benchmarks.fbm2h.benchmark import Fbm2hOptions, score_fbm2h
+    from ertools.benchmarks.fbm2h.benchmark import score_fbm2h
+    from ertools.benchmarks.fbm2h.config import Fbm2hOptions
 
     out = tmp_path / "fbm2h.mcap"
     score = run_json(["score", "fbm2h", str(FBM2H), *FBM2H_ARGS, "--foxglove", str(out)], capsys)

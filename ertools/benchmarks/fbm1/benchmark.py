@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -33,17 +33,27 @@ from ertools.benchmarks.fbm1.answers import (
     parse_answer_payload,
     parse_results,
 )
+from ertools.benchmarks.fbm1.config import (
+    BENCHMARKS,
+    BodySources,
+    Fbm1Options,
+)
 from ertools.benchmarks.fbm1.gt import (
     GroundTruthError,
-    GtOptions,
     board_motion,
     measure_ground_truth,
 )
 from ertools.benchmarks.fbm1.result import Fbm1Result, Fbm1RunResult
+from ertools.benchmarks.fbm1.rules import (
+    RULE_ABORTED,
+    RULE_GT_MOMENT,
+    RULE_NAMES,
+    RULE_THETA_WRAP,
+    RULE_TRANS_CLIP,
+)
 from ertools.benchmarks.fbm1.runs import Fbm1Run, RunsFound, find_runs
 from ertools.benchmarks.fbm1.score import (
     MAX_POSE_ERROR_2015,
-    ScoreRules,
     names_match,
     pose_errors,
     totals,
@@ -51,7 +61,7 @@ from ertools.benchmarks.fbm1.score import (
 from ertools.configs._yaml import load_yaml, parse_yaml
 from ertools.configs.items import Item, ItemList, load_items
 from ertools.errors import ConfigError, ScoringError, SegmentationError, TopicError
-from ertools.fidelity import Deviation, Rule
+from ertools.fidelity import Deviation
 from ertools.io import read_benchmark_states, read_pose_source, read_tf, summary
 from ertools.io.clock import check_header_clock
 from ertools.io.model import BenchmarkStates
@@ -63,163 +73,6 @@ if TYPE_CHECKING:
     from ertools.io import PoseSource
 
 log = logging.getLogger("ertools.benchmarks.fbm1.benchmark")
-
-BENCHMARKS = ("fbm1h", "fbm1w")
-
-# The nodes ertools can reproduce: (--rules value, what it is, the file the arithmetic is in).
-NODE_2015 = (
-    "2015 node (rockin-robot-challenge/benchmark_and_scoring_fbm scripts/fbm1h at 117a5d0; "
-    "scripts/fbm1w as in svenschneider/benchmark_and_scoring_fbm): totals over runs played + "
-    "aborted, ground truth looked up when the result arrived"
-)
-NODE_2016 = (
-    "2016-17 @Home node (rockin-robot-challenge/benchmark_and_scoring_fbm scripts/fbm1h at "
-    "40ba68b): accuracies over 10, pose score over runs played + aborted, ground truth looked "
-    "up when the placement was confirmed, before the goal"
-)
-RULE_SETS = ("ertools", "2015", "2016")
-
-_NODE_SRC = "scripts/fbm1h, scripts/fbm1w (2015)"
-RULE_GT_MOMENT = Rule(
-    key="fbm1.ground-truth",
-    benchmark="fbm1",
-    title="ground-truth moment",
-    rulebook="BMmanager combines the table, board and item transforms (seed 7.1); no moment",
-    node_2015=(
-        f"{_NODE_SRC}: one tf lookup, `lookupTransform('/origin', '/item', "
-        "rospy.Time(0))`, at the stamp of the item transform broadcast once when the result had "
-        "arrived (the 2016-17 @Home node: when the placement was confirmed, `--gt placed`)"
-    ),
-    ertools=(
-        "mean over the stationary window before the goal, spread reported: one sample carries "
-        "the mocap noise, and the board may be touched while the robot looks"
-    ),
-    option="--gt result",
-)
-RULE_TRANS_CLIP = Rule(
-    key="fbm1.translation-clip",
-    benchmark="fbm1",
-    title="translation term clip",
-    rulebook="pose score 1 - t/2 - r/2 with both terms in [0, 1] (score listing, seed 7.1)",
-    node_2015=(
-        f"{_NODE_SRC}: `if pose_err_trans > max_pose_error : pose_err_trans = 1` with "
-        "max_pose_error = sqrt(2) m: errors of 1..1.41 m stay unclipped (score down to -0.21)"
-    ),
-    ertools="t = min(error, 1 m), so a pose score stays in [0, 1]",
-    option="--clip-above-diagonal",
-)
-RULE_THETA_WRAP = Rule(
-    key="fbm1.theta-wrap",
-    benchmark="fbm1",
-    title="theta error wrap",
-    rulebook="the error of the 2D pose; theta in [-180, 180] deg",
-    node_2015=(
-        f"{_NODE_SRC}: `if w_err > 180: w_err = w_err - 360` and `if w_err < -180: w_err = "
-        "w_err + 360`: one step, answers beyond +-540 deg keep r = 1"
-    ),
-    ertools="wrapped fully to [-180, 180)",
-    option="--single-wrap",
-)
-RULE_NAMES = Rule(
-    key="fbm1.names",
-    benchmark="fbm1",
-    title="class and instance comparison",
-    rulebook="object class and instance names [string] (seed 7.1)",
-    node_2015=(
-        f"{_NODE_SRC}: `result['item_class'] == item['class']`, exact: the 2015 fbm1w.yaml "
-        'class `"Bearing Boxes "` (trailing blank) matched no answer'
-    ),
-    ertools="compared without surrounding blanks",
-    option="--exact-names",
-)
-RULE_ABORTED = Rule(
-    key="fbm1.aborted-runs",
-    benchmark="fbm1",
-    title="run stopped before its goal",
-    rulebook="repeated until time runs out or 10 objects have been processed (seed 7.1)",
-    node_2015=(
-        f"{_NODE_SRC}: `runs = runs + 1` before the manual operation, then `break` when the "
-        "benchmark stopped: the run counts in every divisor with no positive and pose score 0"
-    ),
-    ertools="totals over the runs whose goal was sent (a run never asked is not a failed one)",
-    option="--count-aborted",
-)
-
-
-@dataclass(frozen=True)
-class BodySources:
-    """Where the table and board poses come from (the 2015 topics when None)."""
-
-    origin: PoseSource | None = None
-    board: PoseSource | None = None
-
-
-@dataclass(frozen=True)
-class Fbm1Options:
-    """Everything that changes an FBM1 score besides the inputs.
-
-    Attributes:
-        benchmark: ``fbm1h`` or ``fbm1w``.
-        gt: how the ground truth is measured (see :class:`GtOptions`).
-        rules: which node behaviours to reproduce (see :class:`ScoreRules`).
-        moved_warn_m: warn when the board moved more than this (metres, table plane) between
-            the goal and the result, i.e. while the robot was looking.
-        items: the item list (Listing 9); required to score a log.
-        results: answers kept outside the log (replaces the Client payloads it covers).
-        items_order: item ids or instances per run (overrides the payloads).
-        sources: origin/board pose sources (the 2015 topics, else their /tf frames).
-    """
-
-    benchmark: str = "fbm1h"
-    gt: GtOptions = field(default_factory=GtOptions)
-    rules: ScoreRules = field(default_factory=ScoreRules)
-    moved_warn_m: float = 0.01
-    items: Path | None = None
-    results: Path | None = None
-    items_order: tuple[str, ...] | None = None
-    sources: BodySources = BodySources()
-
-    @staticmethod
-    def for_rules(benchmark: str, rules: str, gt: GtOptions | None = None) -> Fbm1Options:
-        """Every behaviour of one reference: ``ertools``, ``2015`` or ``2016`` (@Home only).
-
-        ``gt`` gives the tolerances of the window (its method is replaced by the node's).
-
-        Raises:
-            ConfigError: an unknown reference, or ``2016`` for @Work (no later @Work node is
-                known).
-        """
-
-        base = gt or GtOptions()
-        if rules == "ertools":
-            return Fbm1Options(benchmark, base, ScoreRules())
-        if rules == "2015":
-            return Fbm1Options(benchmark, replace(base, method="result"), ScoreRules.node_2015())
-        if rules == "2016" and benchmark == "fbm1h":
-            return Fbm1Options(benchmark, replace(base, method="placed"), ScoreRules.node_2016())
-        if rules == "2016":
-            raise ConfigError(
-                "no 2016-17 FBM1@Work node is known (only the 2015 scripts/fbm1w); use 2015"
-            )
-        raise ConfigError(f"unknown FBM1 rules {rules!r}; use {', '.join(RULE_SETS)}")
-
-    @staticmethod
-    def as_2015(benchmark: str) -> Fbm1Options:
-        """The 2015 node's behaviour: every rule of it, and its single tf lookup."""
-        return Fbm1Options.for_rules(benchmark, "2015")
-
-    @property
-    def reference(self) -> str:
-        """Which reference these options reproduce: ertools, a node, or a mixture."""
-        refs = (("ertools", "ertools default"), ("2015", NODE_2015), ("2016", NODE_2016))
-        for name, text in refs:
-            try:
-                ref = Fbm1Options.for_rules(self.benchmark, name, self.gt)
-            except ConfigError:
-                continue
-            if ref.rules == self.rules and ref.gt.method == self.gt.method:
-                return text
-        return "ertools with some node behaviours (see the rules)"
 
 
 def _resolve_item(run: Fbm1Run, items: ItemList) -> tuple[Item, list[str]]:

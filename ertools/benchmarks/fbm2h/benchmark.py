@@ -21,7 +21,7 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -31,9 +31,20 @@ import numpy.typing as npt
 from ertools.benchmarks.common.hygiene import drop_invalid, frame_change_warning, frozen_around
 from ertools.benchmarks.common.sources import PoseSpec, read_source, topic
 from ertools.benchmarks.fbm2h import segments as seg
+from ertools.benchmarks.fbm2h.config import (
+    DEFAULT_MAX_GAP_S,
+    DEFAULT_TOPIC,
+    Fbm2hOptions,
+)
 from ertools.benchmarks.fbm2h.result import Fbm2hResult, SegmentResult
+from ertools.benchmarks.fbm2h.rules import (
+    RULE_ORIENTATION_WRAP,
+    RULE_POSE_MOMENT,
+    RULE_SCORE_FORMAT,
+    RULE_UNSCORED,
+)
 from ertools.benchmarks.fbm2h.score import robot_poses_at, segment_errors
-from ertools.benchmarks.fbm2h.segments import ReachedMoments, StopParams
+from ertools.benchmarks.fbm2h.segments import ReachedMoments
 from ertools.configs.goal import GoalList, goal_from_payload, load_goal
 from ertools.configs.timing import load_timing
 from ertools.configs.transform import (
@@ -43,7 +54,7 @@ from ertools.configs.transform import (
     team_transform_path,
 )
 from ertools.errors import ConfigError, ScoringError, SegmentationError
-from ertools.fidelity import Deviation, Rule
+from ertools.fidelity import Deviation
 from ertools.geometry import compose, yaw_from_quat
 from ertools.io import read_benchmark_states, summary
 from ertools.io.clock import check_header_clock
@@ -56,119 +67,8 @@ if TYPE_CHECKING:
 
 log = logging.getLogger("ertools.benchmarks.fbm2h.benchmark")
 
-NAMESPACE = "fbm2h"  # of the state topics
-DEFAULT_TOPIC = "/fbm2h/robot_at_home/pose"
-DEFAULT_MAX_GAP_S = 0.1
 # Figures need the path, not every 120 Hz sample.
 PATH_POINTS = 3000
-
-_NODE = "rockin_scoring/scripts/fbm2h (2015)"
-# The catalogue rows (ertools.fidelity) of every way FBM2@Home differs from the 2015 node.
-RULE_ORIENTATION_WRAP = Rule(
-    key="fbm2h.orientation-wrap",
-    benchmark="fbm2h",
-    title="orientation error across +-pi",
-    rulebook="orientation error of the robot pose at each waypoint (RoCKIn@Home rulebook 5.2.7)",
-    node_2015=(
-        f"{_NODE}: `sin(fabs(rp.theta - tp.theta))` and `cos(...)` of the unwrapped yaw "
-        "difference: a robot at -3.07 rad for theta = pi scored -0.073 rad"
-    ),
-    ertools="the yaw difference wrapped to [0, pi] before sin/cos (the angle between headings)",
-    option="--orientation-2015",
-)
-RULE_POSE_MOMENT = Rule(
-    key="fbm2h.pose-moment",
-    benchmark="fbm2h",
-    title="robot pose moment",
-    rulebook="the robot pose when it reaches the waypoint (seed 7.2.1)",
-    node_2015=(
-        f"{_NODE}: tf `world -> actual_robot` at the ROS time `now` the node took just after "
-        "`WaitResult()` returned, a few ms after the result"
-    ),
-    ertools=(
-        "the marker pose interpolated (linear + SLERP, as tf) at the logged reached moment; no "
-        "option: the moment the node handled the result is not in the log"
-    ),
-    option="",
-)
-RULE_UNSCORED = Rule(
-    key="fbm2h.unscored-segments",
-    benchmark="fbm2h",
-    title="segments not scored",
-    rulebook="accuracy over the waypoints reached; a waypoint not reached in time scores no "
-    "points on that path (seed 7.2, RoCKIn@Home rulebook 5.2.7)",
-    node_2015=(
-        f"{_NODE}: `if benchmark.Timeout(): execution_time += segment_time; continue`, then "
-        "`position_accuracy = sum_d / N`, N = the number of waypoints: a timed-out or "
-        "unreached segment adds 0 to the sums but counts in N"
-    ),
-    ertools=(
-        "null accuracies and exit 1 when a segment is not scored (a sum over fewer segments "
-        "divided by N rewards reaching fewer waypoints), with a warning naming them"
-    ),
-    option="--unscored-segments 2015",
-)
-RULE_SCORE_FORMAT = Rule(
-    key="fbm2h.score-format",
-    benchmark="fbm2h",
-    title="score layout",
-    rulebook="Listing 13: segments_details under details, poses per segment",
-    node_2015=(
-        f"{_NODE}: `yaml.dump` of segments_details at the top level, poses as dumps of Pose2D "
-        "objects, times from the BmBox machine's time.time()"
-    ),
-    ertools=(
-        "Listing 13 nesting, poses as {x, y, theta}, times from the log's clock; no option: "
-        "the numbers are the same, only the layout differs"
-    ),
-    option="",
-)
-
-
-@dataclass(frozen=True)
-class Fbm2hOptions:
-    """Everything ``ertools score fbm2h`` can be told.
-
-    Attributes:
-        goal: Listing 10 goal list file; None = the goal payload in the state topics.
-        transform: Listing 11 file; None with ``team``+``transforms_dir`` = DIR/transform-TEAM.yaml;
-            None otherwise = identity (said in the warnings).
-        team: picks the transform with ``transforms_dir``; alone it changes nothing here (the
-            CLI keeps it as the result's team, see :mod:`ertools.benchmarks.common.teams`).
-        topic / tf_frame: where the marker set's poses are (PoseStamped/Pose2D topic, or a /tf
-            child frame of ``world``).
-        time_source: ``header`` (mocap stamp) or ``record`` (bag time).
-        reached: ``states``, ``timing``, ``auto`` or None (states when present).
-        timing: the timing file for ``reached == "timing"``.
-        max_gap_s: a reached moment needs a GT sample this close.
-        hits: the referee's count of hits.
-        orientation_2015: compute orientation errors as 2015 did (unwrapped).
-        unscored_2015: accuracies as 2015 computed them when segments are not scored: the
-            sums over the scored segments divided by N (the waypoints), the segment the RefBox
-            timed out counted in execution_time (``--unscored-segments 2015``).
-        namespace: the benchmark namespace of the state topics.
-        stops: thresholds for ``auto``.
-        marker_transform: a transform already in hand (``ertools audit``: the one the live
-            score says the node used); None = from ``transform``/``team``, else identity.
-    """
-
-    goal: Path | None = None
-    transform: Path | None = None
-    team: str | None = None
-    transforms_dir: Path | None = None
-    topic: str | None = None
-    tf_frame: str | None = None
-    tf_parent: str = "world"
-    time_source: str = "header"
-    reached: str | None = None
-    timing: Path | None = None
-    max_gap_s: float = DEFAULT_MAX_GAP_S
-    hits: int | None = None
-    orientation_2015: bool = False
-    unscored_2015: bool = False
-    namespace: str = NAMESPACE
-    stops: StopParams = field(default_factory=StopParams)
-    marker_transform: MarkerTransform | None = None
 
 
 def _decimate(stream: PoseStream, points: int) -> PoseStream:

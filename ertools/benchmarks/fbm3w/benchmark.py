@@ -24,8 +24,25 @@ from ertools.benchmarks.common.hygiene import (
     identical_poses,
 )
 from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
+from ertools.benchmarks.fbm3w.config import (
+    DEFAULT_FRAME,
+    DEFAULT_TOPIC,
+    FALLBACK_TOPIC,
+    NAMESPACE,
+    Fbm3wOptions,
+)
 from ertools.benchmarks.fbm3w.path import score_path
 from ertools.benchmarks.fbm3w.result import Fbm3wResult, RunResult
+from ertools.benchmarks.fbm3w.rules import (
+    RULE_ARC_LENGTH,
+    RULE_D_MIN,
+    RULE_LIVE_CLOCK,
+    RULE_POSE_TOPIC,
+    RULE_RUN_FINDING,
+    RULE_STOPPED_RUNS,
+    RULE_TIMEOUT_RUNS,
+    RULE_USER_SHAPES,
+)
 from ertools.benchmarks.fbm3w.runs import (
     RunWindow,
     find_auto,
@@ -34,14 +51,13 @@ from ertools.benchmarks.fbm3w.runs import (
     with_specs,
 )
 from ertools.benchmarks.noise.benchmark import (
-    DEFAULT_C,
     NoiseResult,
     noise_from_stream,
 )
 from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
 from ertools.configs.shapes import Shape
 from ertools.errors import ConfigError, ErtoolsError, ScoringError
-from ertools.fidelity import Deviation, Rule
+from ertools.fidelity import Deviation
 from ertools.io import read_benchmark_states, summary, topics
 from ertools.io.clock import check_header_clock
 from ertools.io.model import BenchmarkStates
@@ -50,11 +66,6 @@ from ertools.streams import PoseStream, Provenance
 
 log = logging.getLogger("ertools.benchmarks.fbm3w.benchmark")
 
-NAMESPACE = "fbm3w"
-DEFAULT_TOPIC = "/fbm3w/robot_at_work/pose2d"
-FALLBACK_TOPIC = "/fbm3w/robot_at_work/pose"
-DEFAULT_FRAME = "robot_at_work"
-RUN_MODES = ("states", "windows", "auto")
 # The reference pose is the last sample at or before the reference time; older than this, the
 # marker set was probably not tracked at that moment.
 STALE_REFERENCE_S = 0.5
@@ -66,173 +77,6 @@ FLOOR_SAMPLES = 10_001
 FLOOR_WARN_M = 0.0005
 # A kept path this much longer than the target is suspicious (the sample's runs: 1.00-1.01).
 LONG_PATH_RATIO = 1.15
-
-_NODE = "rockin_scoring/scripts/fbm3w (2015)"
-# The catalogue rows (ertools.fidelity) of every way FBM3@Work differs from the 2015 node.
-RULE_TIMEOUT_RUNS = Rule(
-    key="fbm3w.timeout-runs",
-    benchmark="fbm3w",
-    title="timed-out runs",
-    rulebook="the RefBox ends a benchmark with END and payload timeout (seed 6.2.3); seed 7.3 "
-    "does not say how such a run is scored",
-    node_2015=(
-        f"{_NODE}: `if benchmark.Timeout(): ... execution_time = execution_time + (end_time - "
-        "start_time)` before the `not Running()` check; the final Lisbon node scored the run on "
-        "the path it had covered and it could be the best run (issue 15)"
-    ),
-    ertools=(
-        "listed with its time and no distance_error, never the best run: a partial path "
-        "compared with the whole target at l/L says nothing about following it"
-    ),
-    option="--timeout-runs 2015",
-)
-RULE_STOPPED_RUNS = Rule(
-    key="fbm3w.stopped-runs",
-    benchmark="fbm3w",
-    title="stopped runs' time",
-    rulebook="the RefBox ends a benchmark with END and payload halt/stop (seed 6.2.3)",
-    node_2015=(
-        f"{_NODE}: `if not benchmark.Running(): continue` comes before the time is added: a "
-        "stopped run was aborted, no score and no time"
-    ),
-    ertools="no score, its time counted in execution_time (the robot did spend it)",
-    option="--stopped-runs 2015",
-)
-RULE_LIVE_CLOCK = Rule(
-    key="fbm3w.live-clock",
-    benchmark="fbm3w",
-    title="reference pose and run times",
-    rulebook="reference acquired when the manual operation completes; execution time of each "
-    "run (seed 7.3.3, Listing 16)",
-    node_2015=f"{_NODE}: the live tf and the node's own wall clock at the transitions",
-    ertools=(
-        "the last logged pose at or before COMPLETED_MANUAL_OPERATION and the state messages' "
-        "record times; no option: the live tf and wall clock are not in the log"
-    ),
-    option="",
-)
-RULE_RUN_FINDING = Rule(
-    key="fbm3w.run-finding",
-    benchmark="fbm3w",
-    title="finding the runs",
-    rulebook="the BmBox state machine delimits each run (seed 7.3.3)",
-    node_2015=f"{_NODE}: its state machine only",
-    ertools=(
-        "the BmBox states when logged; also explicit windows (--run) or motion (--runs auto) "
-        "for bags without them"
-    ),
-    option="--runs states",
-)
-RULE_POSE_TOPIC = Rule(
-    key="fbm3w.pose-topic",
-    benchmark="fbm3w",
-    title="pose source",
-    rulebook="the end effector's marker set from the mocap (seed 7.3.3)",
-    node_2015=f"{_NODE}: subscribed to {DEFAULT_TOPIC}",
-    ertools=f"{DEFAULT_TOPIC}, else {FALLBACK_TOPIC}, else the tf frame {DEFAULT_FRAME}",
-    option=f"--topic {DEFAULT_TOPIC}",
-)
-RULE_D_MIN = Rule(
-    key="fbm3w.d-min",
-    benchmark="fbm3w",
-    title="subsampling threshold d_min",
-    rulebook="d_min = c * epsilon, c chosen experimentally (seed 7.3.2, 7.3.5)",
-    node_2015=f"{_NODE}: `D_MIN` hard-coded (0.00033 m in the seed)",
-    ertools="the config's d_min (default 0.00033 m), warned when below the bag's own noise",
-    option="--d-min 0.00033",
-)
-RULE_USER_SHAPES = Rule(
-    key="fbm3w.user-shapes",
-    benchmark="fbm3w",
-    title="target shapes",
-    rulebook="mathematically defined curves hard-coded in the script (seed 7.3.7, Listing 15)",
-    node_2015=f"{_NODE}: line_path, semi_ellipse, sine (= spline_path) only",
-    ertools="the built-in shapes plus user shapes from the config; no option: a user shape is "
-    "the user's choice, said in the output",
-    option="",
-)
-RULE_ARC_LENGTH = Rule(
-    key="fbm3w.arc-length",
-    benchmark="fbm3w",
-    title="target parameter",
-    rulebook="t(l) with l the normalised length (seed 7.3.1)",
-    node_2015=f"{_NODE}: each shape evaluated at its own parameter (the sine's is not its "
-    "length: 8.36 mm for a robot exactly on it)",
-    ertools="the same by default (shape_floor reported); --arc-length compares at equal "
-    "fractions of the target's arc length instead, on request only",
-    option="",
-)
-
-Window = tuple[str, float, float, float]
-
-
-@dataclass(frozen=True)
-class Fbm3wOptions:
-    """How to score (the CLI's options, as data).
-
-    Attributes:
-        runs: ``states``, ``windows``, ``auto``, or None (windows when given, else states when
-            the BmBox topic exists, else auto).
-        windows: explicit runs (spec, reference, start, end) in seconds (bag-relative or epoch).
-        d_min: overrides the config's d_min.
-        sweep: d_min values to score every run with (``--d-min-sweep``).
-        topic, frame: the pose source (default: the pose2d topic, then pose, then tf frame).
-        tf_parent: the parent of ``frame`` in /tf (``world``, the mocap frame).
-        time_source: ``record`` (default: the 2015 node received poses live) or ``header``.
-        still_speed, min_still_s: stationary detection (auto runs and the noise estimate).
-        noise_c: factor of the suggested d_min (c * epsilon).
-        arc_length: compare at equal fractions of the target's arc length instead of the
-            shape's own parameter (2015); removes the floor of shapes such as ``sine``.
-        timeout_runs: ``unscored`` (default: a run the RefBox timed out is listed without a
-            distance_error) or ``2015`` (scored on the path it covered and eligible as best
-            run, as the 2015 node did).
-        stopped_runs: ``counted`` (default: a run the RefBox stopped counts in
-            execution_time) or ``2015`` (its time left out, as the 2015 node did).
-        config: runs_specifications, d_min and shapes (None: the 2015 values,
-            ``configs/fbm3w.yaml``); ``d_min`` above overrides its d_min.
-
-    The values are validated once, where they come in
-    (:func:`ertools.benchmarks.fbm3w.declare.make_options`).
-    """
-
-    runs: str | None = None
-    windows: tuple[Window, ...] = ()
-    d_min: float | None = None
-    sweep: tuple[float, ...] = ()
-    topic: str | None = None
-    frame: str | None = None
-    tf_parent: str = "world"
-    time_source: str = "record"
-    still_speed: float | None = None
-    min_still_s: float | None = None
-    noise_c: float = DEFAULT_C
-    arc_length: bool = False
-    timeout_runs: str = "unscored"
-    stopped_runs: str = "counted"
-    config: Fbm3wConfig | None = None
-
-
-TIMEOUT_RUNS = ("unscored", "2015")
-STOPPED_RUNS = ("counted", "2015")
-
-
-def options_2015(options: Fbm3wOptions) -> Fbm3wOptions:
-    """``options`` with every FBM3W 2015 behaviour on (``--2015``).
-
-    Timed-out runs scored and eligible, stopped runs' time left out, the shapes at their own
-    parameter, and the script's hard-coded D_MIN unless ``--d-min`` says otherwise.
-
-    Raises:
-        ConfigError: ``--arc-length`` asked for as well (it is not 2015).
-    """
-    if options.arc_length:
-        raise ConfigError("--2015 and --arc-length contradict each other (2015 had no arc length)")
-    return replace(
-        options,
-        timeout_runs="2015",
-        stopped_runs="2015",
-        d_min=DEFAULT_D_MIN if options.d_min is None else options.d_min,
-    )
 
 
 def read_fbm3w_poses(paths: Sequence[Path], options: Fbm3wOptions) -> PoseStream:

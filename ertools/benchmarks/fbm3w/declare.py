@@ -20,15 +20,8 @@ from ertools.benchmarks.base import (
     resolve_values,
     tf_value,
 )
-from ertools.benchmarks.fbm3w.benchmark import (
-    RUN_MODES,
-    Fbm3wLogs,
-    Fbm3wOptions,
-    load,
-    locate_runs,
-    options_2015,
-    score_found,
-)
+from ertools.benchmarks.fbm3w.benchmark import Fbm3wLogs, load, locate_runs, score_found
+from ertools.benchmarks.fbm3w.config import RUN_MODES, Fbm3wOptions, options_2015
 from ertools.benchmarks.fbm3w.result import Fbm3wResult
 from ertools.benchmarks.fbm3w.runs import RunWindow, parse_run_spec, parse_runs_file
 from ertools.configs._yaml import load_yaml

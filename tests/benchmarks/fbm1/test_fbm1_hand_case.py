@@ -15,7 +15,8 @@ from pathlib import Path
 import pytest
 from fbm1_testkit import ANSWER_S, EXEC_S, RunSpec, bodies, state_streams, write_bag, write_items
 
-from ertools.benchmarks.fbm1.benchmark import Fbm1Options, score_fbm1
+from ertools.benchmarks.fbm1.benchmark import score_fbm1
+from ertools.benchmarks.fbm1.config import Fbm1Options
 from ertools.benchmarks.fbm1.gt import GtOptions
 from ertools.benchmarks.fbm1.result import Fbm1Result
 from ertools.benchmarks.fbm1.runs import find_runs

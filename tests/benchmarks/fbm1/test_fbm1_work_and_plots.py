@@ -64,7 +64,7 @@ def test_fbm1_figures_draw_the_answers() -> None:
     )
     origin, board = bodies(WORK_RUNS)
     items = parse_items(parse_yaml(ITEMS_YAML), "items.yaml")
-    from ertools.benchmarks.fbm1.benchmark import Fbm1Options
+    from ertools.benchmarks.fbm1.config import Fbm1Options
 
     result = score_fbm1(origin, board, found, items, Fbm1Options(benchmark="fbm1w"))
     specs = {s.name: s for s in figure_specs(result)}

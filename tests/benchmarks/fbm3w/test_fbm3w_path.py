@@ -10,7 +10,8 @@ from fbm3w_synth import one_run, place
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ertools.benchmarks.fbm3w.benchmark import Fbm3wOptions, score_runs
+from ertools.benchmarks.fbm3w.benchmark import score_runs
+from ertools.benchmarks.fbm3w.config import Fbm3wOptions
 from ertools.benchmarks.fbm3w.path import run_frame, score_path, subsample_d_min
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.configs.shapes import builtin_shapes, parse_shape

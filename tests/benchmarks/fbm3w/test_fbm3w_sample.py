@@ -5,7 +5,8 @@ from __future__ import annotations
 import pytest
 from fbm3w_kit import Sample
 
-from ertools.benchmarks.fbm3w.benchmark import Fbm3wOptions, score_fbm3w
+from ertools.benchmarks.fbm3w.benchmark import score_fbm3w
+from ertools.benchmarks.fbm3w.config import Fbm3wOptions
 from ertools.configs.fbm3w import Fbm3wConfig
 
 

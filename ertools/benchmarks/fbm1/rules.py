@@ -1,0 +1,79 @@
+"""Where FBM1@Home and FBM1@Work scoring differs from the 2015 node, each difference a
+:class:`~ertools.fidelity.Rule` (the catalogue of :mod:`ertools.fidelity`: what the rulebook
+says, what the node did, what ertools does and why, the option restoring 2015).
+"""
+
+from __future__ import annotations
+
+from ertools.fidelity import Rule
+
+NODE_SOURCE = "scripts/fbm1h, scripts/fbm1w (2015)"
+
+RULE_GT_MOMENT = Rule(
+    key="fbm1.ground-truth",
+    benchmark="fbm1",
+    title="ground-truth moment",
+    rulebook="BMmanager combines the table, board and item transforms (seed 7.1); no moment",
+    node_2015=(
+        f"{NODE_SOURCE}: one tf lookup, `lookupTransform('/origin', '/item', "
+        "rospy.Time(0))`, at the stamp of the item transform broadcast once when the result had "
+        "arrived (the 2016-17 @Home node: when the placement was confirmed, `--gt placed`)"
+    ),
+    ertools=(
+        "mean over the stationary window before the goal, spread reported: one sample carries "
+        "the mocap noise, and the board may be touched while the robot looks"
+    ),
+    option="--gt result",
+)
+
+RULE_TRANS_CLIP = Rule(
+    key="fbm1.translation-clip",
+    benchmark="fbm1",
+    title="translation term clip",
+    rulebook="pose score 1 - t/2 - r/2 with both terms in [0, 1] (score listing, seed 7.1)",
+    node_2015=(
+        f"{NODE_SOURCE}: `if pose_err_trans > max_pose_error : pose_err_trans = 1` with "
+        "max_pose_error = sqrt(2) m: errors of 1..1.41 m stay unclipped (score down to -0.21)"
+    ),
+    ertools="t = min(error, 1 m), so a pose score stays in [0, 1]",
+    option="--clip-above-diagonal",
+)
+
+RULE_THETA_WRAP = Rule(
+    key="fbm1.theta-wrap",
+    benchmark="fbm1",
+    title="theta error wrap",
+    rulebook="the error of the 2D pose; theta in [-180, 180] deg",
+    node_2015=(
+        f"{NODE_SOURCE}: `if w_err > 180: w_err = w_err - 360` and `if w_err < -180: w_err = "
+        "w_err + 360`: one step, answers beyond +-540 deg keep r = 1"
+    ),
+    ertools="wrapped fully to [-180, 180)",
+    option="--single-wrap",
+)
+
+RULE_NAMES = Rule(
+    key="fbm1.names",
+    benchmark="fbm1",
+    title="class and instance comparison",
+    rulebook="object class and instance names [string] (seed 7.1)",
+    node_2015=(
+        f"{NODE_SOURCE}: `result['item_class'] == item['class']`, exact: the 2015 fbm1w.yaml "
+        'class `"Bearing Boxes "` (trailing blank) matched no answer'
+    ),
+    ertools="compared without surrounding blanks",
+    option="--exact-names",
+)
+
+RULE_ABORTED = Rule(
+    key="fbm1.aborted-runs",
+    benchmark="fbm1",
+    title="run stopped before its goal",
+    rulebook="repeated until time runs out or 10 objects have been processed (seed 7.1)",
+    node_2015=(
+        f"{NODE_SOURCE}: `runs = runs + 1` before the manual operation, then `break` when the "
+        "benchmark stopped: the run counts in every divisor with no positive and pose score 0"
+    ),
+    ertools="totals over the runs whose goal was sent (a run never asked is not a failed one)",
+    option="--count-aborted",
+)

@@ -1,0 +1,65 @@
+"""How an FBM2@Home score is computed (the options, as data) and its defaults.
+
+:func:`ertools.benchmarks.fbm2h.declare.make_options` builds :class:`Fbm2hOptions` from the
+declared inputs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ertools.benchmarks.fbm2h.segments import StopParams
+from ertools.configs.transform import (
+    MarkerTransform,
+)
+
+NAMESPACE = "fbm2h"  # of the state topics
+DEFAULT_TOPIC = "/fbm2h/robot_at_home/pose"
+DEFAULT_MAX_GAP_S = 0.1
+
+
+@dataclass(frozen=True)
+class Fbm2hOptions:
+    """Everything ``ertools score fbm2h`` can be told.
+
+    Attributes:
+        goal: Listing 10 goal list file; None = the goal payload in the state topics.
+        transform: Listing 11 file; None with ``team``+``transforms_dir`` = DIR/transform-TEAM.yaml;
+            None otherwise = identity (said in the warnings).
+        team: picks the transform with ``transforms_dir``; alone it changes nothing here (the
+            CLI keeps it as the result's team, see :mod:`ertools.benchmarks.common.teams`).
+        topic / tf_frame: where the marker set's poses are (PoseStamped/Pose2D topic, or a /tf
+            child frame of ``world``).
+        time_source: ``header`` (mocap stamp) or ``record`` (bag time).
+        reached: ``states``, ``timing``, ``auto`` or None (states when present).
+        timing: the timing file for ``reached == "timing"``.
+        max_gap_s: a reached moment needs a GT sample this close.
+        hits: the referee's count of hits.
+        orientation_2015: compute orientation errors as 2015 did (unwrapped).
+        unscored_2015: accuracies as 2015 computed them when segments are not scored: the
+            sums over the scored segments divided by N (the waypoints), the segment the RefBox
+            timed out counted in execution_time (``--unscored-segments 2015``).
+        namespace: the benchmark namespace of the state topics.
+        stops: thresholds for ``auto``.
+        marker_transform: a transform already in hand (``ertools audit``: the one the live
+            score says the node used); None = from ``transform``/``team``, else identity.
+    """
+
+    goal: Path | None = None
+    transform: Path | None = None
+    team: str | None = None
+    transforms_dir: Path | None = None
+    topic: str | None = None
+    tf_frame: str | None = None
+    tf_parent: str = "world"
+    time_source: str = "header"
+    reached: str | None = None
+    timing: Path | None = None
+    max_gap_s: float = DEFAULT_MAX_GAP_S
+    hits: int | None = None
+    orientation_2015: bool = False
+    unscored_2015: bool = False
+    namespace: str = NAMESPACE
+    stops: StopParams = field(default_factory=StopParams)
+    marker_transform: MarkerTransform | None = None

@@ -1,0 +1,74 @@
+"""Where FBM2@Home scoring differs from the 2015 node, each difference a
+:class:`~ertools.fidelity.Rule` (the catalogue of :mod:`ertools.fidelity`: what the rulebook
+says, what the node did, what ertools does and why, the option restoring 2015).
+"""
+
+from __future__ import annotations
+
+from ertools.fidelity import Rule
+
+NODE_SOURCE = "rockin_scoring/scripts/fbm2h (2015)"
+
+# The catalogue rows (ertools.fidelity) of every way FBM2@Home differs from the 2015 node.
+RULE_ORIENTATION_WRAP = Rule(
+    key="fbm2h.orientation-wrap",
+    benchmark="fbm2h",
+    title="orientation error across +-pi",
+    rulebook="orientation error of the robot pose at each waypoint (RoCKIn@Home rulebook 5.2.7)",
+    node_2015=(
+        f"{NODE_SOURCE}: `sin(fabs(rp.theta - tp.theta))` and `cos(...)` of the unwrapped yaw "
+        "difference: a robot at -3.07 rad for theta = pi scored -0.073 rad"
+    ),
+    ertools="the yaw difference wrapped to [0, pi] before sin/cos (the angle between headings)",
+    option="--orientation-2015",
+)
+
+RULE_POSE_MOMENT = Rule(
+    key="fbm2h.pose-moment",
+    benchmark="fbm2h",
+    title="robot pose moment",
+    rulebook="the robot pose when it reaches the waypoint (seed 7.2.1)",
+    node_2015=(
+        f"{NODE_SOURCE}: tf `world -> actual_robot` at the ROS time `now` the node took just after "
+        "`WaitResult()` returned, a few ms after the result"
+    ),
+    ertools=(
+        "the marker pose interpolated (linear + SLERP, as tf) at the logged reached moment; no "
+        "option: the moment the node handled the result is not in the log"
+    ),
+    option="",
+)
+
+RULE_UNSCORED = Rule(
+    key="fbm2h.unscored-segments",
+    benchmark="fbm2h",
+    title="segments not scored",
+    rulebook="accuracy over the waypoints reached; a waypoint not reached in time scores no "
+    "points on that path (seed 7.2, RoCKIn@Home rulebook 5.2.7)",
+    node_2015=(
+        f"{NODE_SOURCE}: `if benchmark.Timeout(): execution_time += segment_time; continue`, then "
+        "`position_accuracy = sum_d / N`, N = the number of waypoints: a timed-out or "
+        "unreached segment adds 0 to the sums but counts in N"
+    ),
+    ertools=(
+        "null accuracies and exit 1 when a segment is not scored (a sum over fewer segments "
+        "divided by N rewards reaching fewer waypoints), with a warning naming them"
+    ),
+    option="--unscored-segments 2015",
+)
+
+RULE_SCORE_FORMAT = Rule(
+    key="fbm2h.score-format",
+    benchmark="fbm2h",
+    title="score layout",
+    rulebook="Listing 13: segments_details under details, poses per segment",
+    node_2015=(
+        f"{NODE_SOURCE}: `yaml.dump` of segments_details at the top level, poses as dumps of "
+        "Pose2D objects, times from the BmBox machine's time.time()"
+    ),
+    ertools=(
+        "Listing 13 nesting, poses as {x, y, theta}, times from the log's clock; no option: "
+        "the numbers are the same, only the layout differs"
+    ),
+    option="",
+)
