@@ -2,6 +2,7 @@
 mode), so helpers shared by several test folders live in one module, ``tests/fakes.py``."""
 
 import os
+from pathlib import Path
 
 import pytest
 
@@ -39,3 +40,14 @@ def pytest_make_collect_report(collector: pytest.Collector) -> object:
         return
     report.outcome = "failed"
     report.longrepr = f"skipped in CI, where the machine must provide it: {reason}"
+
+
+@pytest.fixture(scope="session")
+def sample_competition(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The sample competition (``python -m ertools.samples --competition``, default seed),
+    generated once for the whole session (10 s): tests read it and write nothing into it."""
+    from ertools.samples.competition import DEFAULT_SEED, generate_competition
+
+    root = tmp_path_factory.mktemp("competition") / "day"
+    generate_competition(root, seed=DEFAULT_SEED)
+    return root

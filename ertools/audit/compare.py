@@ -195,16 +195,18 @@ def compare_scores(
     # A referee's input the score only echoes (FBM2H's hits): not given to the rescoring, it
     # is not recomputed, and its live value is no difference in the data.
     echoed = (
-        {i.name for i in registry.get(result.name).inputs}
+        {i.name: i.option for i in registry.get(result.name).inputs}
         if result.name in registry.names()
-        else set()
+        else {}
     )
     for key in keys:
         has_live, has_rec = key in live_flat, key in rec_flat
         lv: Any = live_flat.get(key)
         rv: Any = rec_flat.get(key)
-        if key in echoed and rv is None:
-            has_rec = False
+        if key in echoed and rv is None and has_live:
+            why = f"a referee's input, not given to the rescoring ({echoed[key]})"
+            lines.append(ScoreLine(key, lv, rv, None, "only live", why))
+            continue
         if not has_live or not has_rec:
             if live is None:
                 continue  # nothing to compare with: listing every key says nothing

@@ -16,7 +16,6 @@ from timeline.summaries import Summary, Topic
 
 from ertools.io.formats import Unreadable
 from ertools.rescore.discover import Discovery, discover
-from ertools.samples.competition import generate_competition
 from ertools.samples.competition_schedule import NO_ROBOT_LOG, TRUNCATED
 from ertools.timeline.build import build_timeline
 
@@ -28,11 +27,10 @@ T0 = 1_448_013_600 * S  # 2015-11-20 10:00:00 UTC
 
 
 @pytest.fixture(scope="module")
-def day(tmp_path_factory: pytest.TempPathFactory) -> tuple[Discovery, dict[str, Any]]:
+def day(sample_competition: Path) -> tuple[Discovery, dict[str, Any]]:
     from ertools.timeline.scan import scan
 
-    root = tmp_path_factory.mktemp("competition") / "day"
-    generate_competition(root)
+    root = sample_competition
     answers = json.loads((root / "answers.json").read_text())
     found = discover(scan([root]))
 

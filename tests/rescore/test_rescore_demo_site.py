@@ -32,10 +32,12 @@ pytestmark = [
 
 
 @pytest.fixture(scope="module")
-def demo_site(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any], Path]:
+def demo_site(
+    sample_competition: Path, tmp_path_factory: pytest.TempPathFactory
+) -> tuple[Path, dict[str, Any], Path]:
     root = tmp_path_factory.mktemp("demo")
-    day = root / "competition"
-    make_competition(day)
+    day = sample_competition  # what make_competition writes (tests/conftest.py)
+    make_competition(day)  # there already: not generated again
     step = competition_step(day, root / "rescore")
     err = io.StringIO()
     with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):

@@ -15,7 +15,6 @@ from typing import Any
 import pytest
 
 from ertools.cli.main import main
-from ertools.samples.competition import generate_competition
 
 SEED = 2015_11_20
 # robotto lost its USB key after its second FBM3W: nothing in the logs names the team of that
@@ -25,12 +24,11 @@ OPTION = {"items": "--items", "goal": "--goal", "transform": "--transform", "con
 
 
 @pytest.fixture(scope="module")
-def day(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any], dict[str, Any]]:
-    root = tmp_path_factory.mktemp("sample") / "day"
-    generate_competition(root, seed=SEED)
+def day(sample_competition: Path) -> tuple[Path, dict[str, Any], dict[str, Any]]:
+    root = sample_competition  # generated once per session (tests/conftest.py), seed SEED
     answers: dict[str, Any] = json.loads((root / "answers.json").read_text())
     manifest = root / answers["manifest"]  # the organiser's, written with the logs
-    out = root.parent / "results"
+    out = root.parent / "results"  # beside the day's folder, nothing written into it
     err = io.StringIO()
     with contextlib.redirect_stderr(err):
         code = main(

@@ -22,7 +22,6 @@ from typing import Any
 
 import pytest
 
-from ertools.samples.competition import generate_competition
 from ertools.samples.competition_schedule import MISSING_TRANSFORM, SCHEDULE, TRUNCATED
 
 SEED = 2015_11_20
@@ -35,10 +34,8 @@ SCORED = [s.id for s in SCHEDULE if s.id not in UNSCOREABLE]
 
 
 @pytest.fixture(scope="module")
-def competition(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    root = tmp_path_factory.mktemp("competition") / "day"
-    generate_competition(root, seed=SEED)
-    return root
+def competition(sample_competition: Path) -> Path:
+    return sample_competition  # generated once per session (tests/conftest.py), seed SEED
 
 
 @pytest.fixture(scope="module")
