@@ -21,7 +21,6 @@ import numpy as np
 
 from ertools.errors import UsageError
 from ertools.progress import clear_current
-from ertools.yamlout import dump
 
 if TYPE_CHECKING:  # annotations only: the registry (and `ertools score --help`) stays light
     from ertools.fidelity import Deviation
@@ -166,6 +165,8 @@ def notice(message: str) -> None:
 def dump_yaml(data: Any) -> str:
     """YAML as the 2015 nodes dumped it (block style, keys in insertion order), floats
     rounded to 9 decimal places (:mod:`ertools.yamlout`)."""
+    # lazy: PyYAML (~25 ms) only when YAML is written (JSON and text outputs do without it)
+    from ertools.yamlout import dump
 
     return dump(data)
 

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 from ertools.benchmarks.fbm1.acquire import AcquireOptions, acquire_items_bag
 from ertools.benchmarks.fbm1.config import BENCHMARKS
-from ertools.cli.common import all_failed, note, write_text
+from ertools.cli.common import all_failed
 from ertools.cli.options import (
     add_output,
     add_pose_source,
@@ -26,6 +26,7 @@ from ertools.cli.options import (
     pose_spec,
     positive,
 )
+from ertools.cli.output import note, write_text
 from ertools.configs.items import items_to_yaml
 from ertools.errors import UsageError
 

@@ -14,7 +14,6 @@ from pathlib import Path
 
 from ertools.benchmarks.common.sources import read_source, topic
 from ertools.benchmarks.fbm2h.transform import acquire_transform, check_team_name
-from ertools.cli.common import note, write_text
 from ertools.cli.options import (
     add_out_dir,
     add_pose_source,
@@ -23,6 +22,7 @@ from ertools.cli.options import (
     pose_spec,
     positive,
 )
+from ertools.cli.output import note, write_text
 from ertools.configs.transform import team_transform_path, transform_yaml
 from ertools.errors import ConfigError
 from ertools.io import summary

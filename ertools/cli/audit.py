@@ -18,13 +18,11 @@ from ertools.benchmarks import registry
 from ertools.cli.common import (
     add_output_options,
     emit_result,
-    note,
     write_foxglove_option,
     write_plots_option,
-    write_text,
 )
 from ertools.cli.options import non_negative_int, positive
-from ertools.report.folder import write_report
+from ertools.cli.output import note, write_text
 from ertools.timeutil import s_to_ns
 
 EPILOG = """examples:
@@ -120,6 +118,9 @@ def run(args: argparse.Namespace) -> int:
         for deviation in audit.deviations:
             note(f"differs from 2015: {deviation}")
         if args.report is not None:
+            # lazy: the report's pages and Jinja2 (~30 ms) only when --report asks for them
+            from ertools.report.folder import write_report
+
             index = write_report(
                 audit, args.report, inputs=bags, argv=getattr(args, "command_line", sys.argv)
             )

@@ -10,8 +10,8 @@ from __future__ import annotations
 import argparse
 
 from ertools.benchmarks.base import dump_yaml
-from ertools.cli.common import dump_json, write_text
 from ertools.cli.options import add_output, port, positive, seconds
+from ertools.cli.output import dump_json, write_text
 from ertools.live.clock import query_sntp
 
 EPILOG = """examples:

@@ -1,22 +1,23 @@
-"""Options and output handling shared by the commands."""
+"""What the commands that print a benchmark result share: their output options, and the
+result written as YAML/JSON with its warnings, plots, report and Foxglove file.
+
+The plain output helpers (``note``, ``write_text``, ``dump_json``) are in
+:mod:`ertools.cli.output`, light enough for every command."""
 
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks import document
-from ertools.benchmarks.base import BenchmarkResult, jsonable
+from ertools.benchmarks.base import BenchmarkResult
 from ertools.benchmarks.common.teams import with_team
 from ertools.cli.options import add_output, add_plots, add_report
-from ertools.progress import clear_current
+from ertools.cli.output import dump_json, note, write_text
 from ertools.report.figures import figure_specs, save_figures, save_one_file
-from ertools.report.folder import write_report
-from ertools.report.foxglove import write_foxglove
 
 
 def add_output_options(
@@ -58,32 +59,9 @@ def add_output_options(
         )
 
 
-def write_text(text: str, output: Path | None) -> None:
-    """Text to ``output`` (a file) or stdout (below any progress bar: stdout and stderr may
-    be the same terminal)."""
-    if output is None:
-        clear_current()
-        sys.stdout.write(text if text.endswith("\n") else text + "\n")
-    else:
-        output.parent.mkdir(parents=True, exist_ok=True)
-        output.write_text(text if text.endswith("\n") else text + "\n", encoding="utf-8")
-        note(f"wrote {output}")
-
-
-def note(message: str) -> None:
-    """A human note on stderr (stdout stays parseable), below any progress bar."""
-
-    clear_current()
-    print(f"ertools: {message}", file=sys.stderr)
-
-
 # One definition (ertools.benchmarks.document), shared with rescore; the score commands
 # import it from here.
 all_failed = document.all_failed
-
-
-def dump_json(data: Any) -> str:
-    return json.dumps(jsonable(data), indent=2, allow_nan=False)
 
 
 def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[Path]) -> int:
@@ -108,6 +86,9 @@ def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[
     write_plots_option(result, args)
     report_dir: Path | None = getattr(args, "report", None)
     if report_dir is not None:
+        # lazy: the report's pages, audit and Jinja2 (~30 ms) only when --report asks for them
+        from ertools.report.folder import write_report
+
         index = write_report(
             result, report_dir, inputs=inputs, argv=getattr(args, "command_line", sys.argv)
         )
@@ -132,6 +113,8 @@ def write_foxglove_option(result: Any, args: argparse.Namespace, inputs: list[Pa
     path: Path | None = getattr(args, "foxglove", None)
     if path is None:
         return
+    # lazy: Foxglove's protobuf classes (~30 ms) only when --foxglove asks for them
+    from ertools.report.foxglove import write_foxglove
 
     written = write_foxglove(result, path, inputs=inputs)
     note(f"wrote {written.path} ({written.messages} messages on {len(written.counts)} topics)")

@@ -16,7 +16,6 @@ import argparse
 from pathlib import Path
 
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
-from ertools.cli.common import note, write_text
 from ertools.cli.options import (
     add_pose_source,
     add_time_source,
@@ -26,6 +25,7 @@ from ertools.cli.options import (
     seconds_or_auto,
     time_source,
 )
+from ertools.cli.output import note, write_text
 from ertools.errors import UsageError
 from ertools.export.formats import FORMATS, format_times
 from ertools.export.pairs import (

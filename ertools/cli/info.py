@@ -14,8 +14,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import dump_yaml
-from ertools.cli.common import dump_json, note, write_text
 from ertools.cli.options import add_output
+from ertools.cli.output import dump_json, note, write_text
 from ertools.errors import BagError
 from ertools.io import info as bag_info
 from ertools.io.formats import expand

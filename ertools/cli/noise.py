@@ -16,7 +16,7 @@ from ertools.benchmarks.base import dump_yaml
 from ertools.benchmarks.common.sources import read_source, tf, topic
 from ertools.benchmarks.fbm3w.config import DEFAULT_FRAME, DEFAULT_TOPIC, FALLBACK_TOPIC
 from ertools.benchmarks.noise.benchmark import noise_from_stream
-from ertools.cli.common import dump_json, note, write_plots, write_text
+from ertools.cli.common import write_plots
 from ertools.cli.options import (
     add_output,
     add_plots,
@@ -25,6 +25,7 @@ from ertools.cli.options import (
     pose_spec,
     positive,
 )
+from ertools.cli.output import dump_json, note, write_text
 from ertools.report.plots_noise import figure_specs
 
 if TYPE_CHECKING:

@@ -26,7 +26,6 @@ from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ertools.benchmarks.common.sources import PoseSpec
 from ertools.benchmarks.common.spec import (
     DEFAULT_PARENT,
     DEFAULT_TIME_SOURCE,
@@ -327,6 +326,9 @@ def pose_spec(
 
     tp = prefix if time_prefix is None else time_prefix
     given = getattr(args, _dest(tp, "time_source"), None)
+    # lazy: the bag readers (numpy, the io layer) only at run time: see the top
+    from ertools.benchmarks.common.sources import PoseSpec
+
     return PoseSpec(
         topic=getattr(args, _dest(prefix, "topic"), None),
         tf=getattr(args, _dest(prefix, "tf"), None),

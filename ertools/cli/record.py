@@ -17,8 +17,8 @@ import signal
 import threading
 from pathlib import Path
 
-from ertools.cli.common import note
 from ertools.cli.options import add_out_dir, port, positive
+from ertools.cli.output import note
 from ertools.configs.mocap import load_mocap_config, normalize_namespace, parse_mocap_config
 from ertools.errors import UsageError
 from ertools.live.natnet import NatNetVersion

@@ -10,8 +10,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ertools.cli.common import note
 from ertools.cli.options import add_report
+from ertools.cli.output import note
 from ertools.report.combine import combine
 
 EPILOG = """examples:

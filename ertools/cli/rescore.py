@@ -15,7 +15,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ertools.cli.common import note
+from ertools.cli.output import note
 from ertools.errors import UsageError
 from ertools.rescore.draft import draft_text
 from ertools.rescore.found import find, merge, write_timeline

@@ -14,10 +14,11 @@ from typing import Any
 
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Input
-from ertools.cli.common import add_output_options, all_failed, emit_result, note
+from ertools.cli.common import add_output_options, all_failed, emit_result
 from ertools.cli.groups import add_group_arguments, members_epilog, run_group
 from ertools.cli.main import Command
 from ertools.cli.options import deprecation_note
+from ertools.cli.output import note
 from ertools.errors import UsageError
 
 GROUP_PROG = "ertools score"

@@ -16,8 +16,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from ertools.benchmarks.base import dump_yaml
-from ertools.cli.common import dump_json, note, write_text
 from ertools.cli.options import add_output, plot_file, seconds
+from ertools.cli.output import dump_json, note, write_text
 from ertools.report.plots_timeline import save_timeline_plot
 from ertools.timeline.model import KIND_LABELS, TimelineConfig
 from ertools.timeline.scan import scan

@@ -14,8 +14,6 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
-import yaml
-
 from ertools.errors import BagError
 
 ROS1_MAGIC = b"#ROSBAG V2.0\n"
@@ -108,6 +106,8 @@ def bag_paths(paths: str | Path | list[str | Path] | tuple[str | Path, ...]) -> 
 def _rosbag2_storage(path: Path) -> str:
     meta = path / "metadata.yaml"
     if meta.is_file():
+        import yaml  # lazy: PyYAML (~25 ms) only for a rosbag2 folder's metadata.yaml
+
         try:
             data = yaml.safe_load(meta.read_text(encoding="utf-8"))
             storage = str(data["rosbag2_bagfile_information"]["storage_identifier"])

@@ -48,8 +48,8 @@ def test_library_warnings_read_like_the_cli_notes(capsys: pytest.CaptureFixture[
     # Logged warnings and cli.common.note warnings share one wording: "ertools: warning: ...".
     import logging
 
-    from ertools.cli.common import note
     from ertools.cli.main import _configure_logging
+    from ertools.cli.output import note
 
     root = logging.getLogger("ertools")
     saved = (root.handlers[:], root.level, root.propagate)

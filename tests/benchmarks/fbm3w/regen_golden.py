@@ -15,7 +15,7 @@ def main() -> int:
     sys.path.insert(0, str(HERE))
     from golden_case import golden_result
 
-    from ertools.cli.common import dump_json
+    from ertools.cli.output import dump_json
 
     result = golden_result()
     (HERE / "golden" / "score.yaml").write_text(result.to_yaml(), encoding="utf-8")

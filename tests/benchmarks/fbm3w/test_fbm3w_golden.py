@@ -11,7 +11,7 @@ import pytest
 import yaml
 from golden_case import golden_result
 
-from ertools.cli.common import dump_json
+from ertools.cli.output import dump_json
 
 GOLDEN = Path(__file__).resolve().parent / "golden"
 NUMBER = re.compile(r"-?\d+\.\d+(e-?\d+)?")

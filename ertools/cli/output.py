@@ -1,0 +1,35 @@
+"""How every command writes: results on stdout (or ``--out``), notes on stderr, below any
+progress bar. Light on purpose: every command imports it."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from ertools.benchmarks.base import jsonable
+from ertools.progress import clear_current
+
+
+def write_text(text: str, output: Path | None) -> None:
+    """Text to ``output`` (a file) or stdout (below any progress bar: stdout and stderr may
+    be the same terminal)."""
+    if output is None:
+        clear_current()
+        sys.stdout.write(text if text.endswith("\n") else text + "\n")
+    else:
+        output.parent.mkdir(parents=True, exist_ok=True)
+        output.write_text(text if text.endswith("\n") else text + "\n", encoding="utf-8")
+        note(f"wrote {output}")
+
+
+def note(message: str) -> None:
+    """A human note on stderr (stdout stays parseable), below any progress bar."""
+
+    clear_current()
+    print(f"ertools: {message}", file=sys.stderr)
+
+
+def dump_json(data: Any) -> str:
+    return json.dumps(jsonable(data), indent=2, allow_nan=False)
