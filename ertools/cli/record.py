@@ -181,7 +181,9 @@ def run(args: argparse.Namespace) -> int:
             bodies=bodies,
             n_frames=int(120 * (duration or 10.0)),
             rate_hz=120.0,
-            malformed_at=(1240,),
+            # 2.25 s in: after the first 2 s health line, before frame 1300 (docs/live.md shows
+            # that order; at 1240, exactly 2 s in, the two raced)
+            malformed_at=(1270,),
         )
         sim_thread = motive.start()
         note("record: simulated Motive streaming at 120 Hz (body 0 untracked frames 1300-1399)")
