@@ -15,7 +15,7 @@ from pathlib import Path
 
 from ertools.benchmarks import registry
 from ertools.cli.main import main as ertools_main
-from ertools.samples.competition import DEFAULT_SEED, MANIFEST, generate_competition
+from ertools.samples.competition import DEFAULT_SEED, MANIFEST, write_competition
 
 SAMPLES = Path(__file__).resolve().parent.parent / "sample_bags"
 
@@ -101,7 +101,7 @@ def make_competition(day: Path) -> None:
     print(
         f"== the sample competition: python -m ertools.samples --competition {day}", file=sys.stderr
     )
-    generate_competition(day, seed=DEFAULT_SEED)
+    write_competition(day, seed=DEFAULT_SEED)
 
 
 def run(out: Path, samples: Path = SAMPLES) -> int:

@@ -46,7 +46,6 @@ Exit status 1 when an item could not be acquired (it is written unchanged and na
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-
     parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="log file(s)")
     parser.add_argument(
         "--items", type=Path, required=True, metavar="FILE", help="vanilla item list"
@@ -81,7 +80,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _windows(text: str | None) -> list[tuple[float, float]] | None:
-
     if text is None:
         return None
     out = []
@@ -107,7 +105,6 @@ def _io(spec: PoseSpec, namespace: str, body: str) -> PoseSource | None:
 
 
 def run(args: argparse.Namespace) -> int:
-
     origin = pose_spec(args, "origin-", time_prefix="")
     board = pose_spec(args, "ref-board-", time_prefix="")
     options = AcquireOptions(

@@ -41,12 +41,10 @@ DEFAULT_TOPIC = "/fbm2h/robot_at_home/pose"
 
 
 def _number(text: str) -> float:
-
     return finite(text)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-
     parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="log file(s)")
     parser.add_argument("--team", required=True, metavar="NAME", help="team name (file name)")
     parser.add_argument(
@@ -72,7 +70,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-
     team = check_team_name(args.team)
     out = team_transform_path(args.out_dir, team)
     if out.exists() and not args.force:

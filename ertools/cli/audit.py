@@ -42,7 +42,6 @@ BENCHMARKS = registry.names()
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-
     parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="benchmark log(s)")
     parser.add_argument(
         "--benchmark", choices=BENCHMARKS, help="namespace of the state topics (default: inferred)"
@@ -87,7 +86,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-
     bags: list[Path] = list(args.bags)
     inputs = ScoreInputs(
         goal=args.goal,

@@ -23,7 +23,6 @@ EPILOG = """examples:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-
     parser.add_argument(
         "--server", required=True, help="NTP server host (the 2015 one: 192.168.1.1)"
     )
@@ -42,7 +41,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-
     check = query_sntp(args.server, args.port, timeout_s=args.timeout)
     ok = check.within(args.tolerance)
     if args.format == "text":

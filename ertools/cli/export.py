@@ -54,7 +54,6 @@ exit status: 0 written, 1 unusable data, 2 usage error."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-
     parser.add_argument(
         "bags",
         type=Path,
@@ -123,7 +122,6 @@ PAIR_ONLY = {
 
 
 def run(args: argparse.Namespace) -> int:
-
     if args.out_dir is None:
         given = [f"--{n.replace('_', '-')}" for n, d in PAIR_ONLY.items() if getattr(args, n) != d]
         if given:
@@ -143,7 +141,6 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run_one(args: argparse.Namespace) -> int:
-
     if args.topic is None and args.tf is None:
         raise UsageError("give --topic TOPIC or --tf PARENT:CHILD (or --out-dir for the pair)")
     if args.times is not None and args.format != "kitti":
@@ -166,7 +163,6 @@ def _run_one(args: argparse.Namespace) -> int:
 
 
 def _run_pair(args: argparse.Namespace) -> int:
-
     auto = args.offset == "auto"
     if args.apply_offset and not auto:
         raise UsageError("--apply-offset needs --offset auto")

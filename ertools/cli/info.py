@@ -44,7 +44,6 @@ Exit status 1 when any bag is unreadable, truncated or (with --check) corrupt.
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-
     parser.add_argument(
         "paths", type=Path, nargs="+", metavar="BAG", help="bags, rosbag2 folders or folders"
     )
@@ -137,7 +136,6 @@ def _one_line(text: str) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
-
     infos: list[BagInfo] = []
     problems: list[dict[str, str]] = []
     paths: list[Path] = []

@@ -164,7 +164,6 @@ def _configure_logging(verbose: int) -> None:
     class _BelowTheBar(logging.StreamHandler):  # type: ignore[type-arg]
         # a message logged while a progress bar is drawn starts on a line of its own
         def emit(self, record: logging.LogRecord) -> None:
-
             clear_current()
             super().emit(record)
 

@@ -29,7 +29,6 @@ EPILOG = """examples:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-
     parser.add_argument(
         "directory", type=Path, metavar="DIR", help="the recorder's --out-dir folder"
     )
@@ -70,7 +69,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-
     if not args.directory.is_dir():
         raise UsageError(f"{args.directory} is not a folder")
     options = MonitorOptions(

@@ -46,7 +46,6 @@ recording as stationary, as the 2015 tool did. JSON keys: samples, lost, epsilon
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-
     parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="log file(s)")
     add_pose_source(
         parser,
@@ -76,7 +75,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def _poses(args: argparse.Namespace) -> PoseStream:
-
     return read_source(
         args.bags,
         pose_spec(args),
@@ -87,7 +85,6 @@ def _poses(args: argparse.Namespace) -> PoseStream:
 
 
 def run(args: argparse.Namespace) -> int:
-
     poses = _poses(args)
     result = noise_from_stream(poses, stationary=args.stationary == "auto", bin=args.bin, c=args.c)
     if args.format == "json":

@@ -48,7 +48,6 @@ rigid_bodies:
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-
     parser.add_argument("--config", type=Path, help="mocap YAML (seed Listing 2: rigid_bodies)")
     add_out_dir(parser, "write the MCAP files into DIR", old=("--out",), required=True)
     parser.add_argument("--name", help="file name part (default <namespace>_mocap or mocap)")
@@ -113,7 +112,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-
     if args.config is None and not args.simulate:
         raise UsageError("--config is required (a mocap YAML as seed Listing 2)")
     config = (

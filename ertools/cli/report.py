@@ -34,7 +34,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-
     index = combine(list(args.results), args.report, title=args.title)
     note(f"combined {len(args.results)} result(s) into {index}")
     print(index)

@@ -86,7 +86,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-
     if args.init is not None:
         return _init(args)
     if args.config is None:
@@ -156,7 +155,6 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _init(args: argparse.Namespace) -> int:
-
     if not args.paths:
         raise UsageError("--init FILE drafts the manifest from logs: give the PATHs to scan")
     if args.config is not None or args.out is not None:

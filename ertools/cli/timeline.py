@@ -45,7 +45,6 @@ TIMELINE_PLOT_SUFFIXES = (".png", ".svg", ".html", ".htm")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-
     parser.add_argument("paths", type=Path, nargs="+", metavar="PATH", help="bags or folders")
     add_output(parser, ("text", "json", "yaml", "csv"), aliases={"table": "text"})
     parser.add_argument(
@@ -212,7 +211,6 @@ def to_table(timeline: Timeline, *, color: bool = False) -> str:
 
 
 def _pairing_line(p: Any, paint: _Paint, *, full_path: bool = False) -> str:
-
     name = str(p.path) if full_path else Path(p.path).name
     other = ""
     if p.other_benchmark:

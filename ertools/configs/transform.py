@@ -178,7 +178,6 @@ def team_transform_path(directory: str | Path, team: str) -> Path:
 
 
 def _flow(values: tuple[float, ...]) -> str:
-
     return "[" + ", ".join(repr(yaml_float(float(v))) for v in values) + "]"
 
 

@@ -223,7 +223,6 @@ def read_poses(
 def _tf_edges(
     plist: list[Path], start_ns: int | None, end_ns: int | None
 ) -> dict[tuple[str, str], Edge]:
-
     per_edge: dict[tuple[str, str], list[PoseStream]] = {}
     static_edges: set[tuple[str, str]] = set()
     for p in plist:

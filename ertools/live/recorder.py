@@ -360,7 +360,6 @@ class Recorder:
         return check.to_metadata()
 
     def _open_file(self, index: int) -> None:
-
         opts = self.options
         path = opts.out_dir / log_file_name(opts.name, self._start_s, index)
         self._file = LogFile(path, self._serializer, compression=opts.compression, fsync=opts.fsync)

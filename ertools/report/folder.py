@@ -85,7 +85,6 @@ def _write_report(
     audit: Any,
     team: str | None,
 ) -> Path:
-
     score: BenchmarkResult | None
     if isinstance(result, Audit):
         audit, score = result, result.recomputed

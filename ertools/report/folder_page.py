@@ -114,7 +114,6 @@ def _deviations(score: BenchmarkResult | None, audit: Any) -> list[str]:
 
 
 def _audit_context(audit: Any) -> dict[str, Any]:
-
     facts = [
         ("benchmark", audit.benchmark or "(unknown)"),
         ("first state message", iso_utc(audit.start_ns) if audit.timeline else None),

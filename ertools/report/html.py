@@ -37,7 +37,6 @@ def fmt(value: Any) -> str:
 
 
 def _utc(seconds: float) -> str:
-
     return iso_utc(s_to_ns(seconds)).replace("+00:00", "Z")
 
 

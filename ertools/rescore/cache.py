@@ -29,7 +29,6 @@ CACHE_VERSION = 1
 
 
 def _sha256_file(path: Path) -> str:
-
     return sha256_file(path)
 
 

@@ -20,7 +20,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ertools.errors import ErtoolsError
-from ertools.samples.competition import DEFAULT_SEED, generate_competition
+from ertools.samples.competition import DEFAULT_SEED, write_competition
 from ertools.samples.scenario import (
     DEFAULT_SEEDS,
     SCENARIOS,
@@ -106,15 +106,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _competition(outdir: Path, seed: int | None) -> int:
-
-    partial = outdir.with_name(f".{outdir.name}.partial")
-    if partial.exists():
-        shutil.rmtree(partial)
-    paths = generate_competition(partial, seed=DEFAULT_SEED if seed is None else seed)
-    if outdir.exists():
-        shutil.rmtree(outdir)
-    partial.rename(outdir)
-    total = sum((outdir / p.relative_to(partial)).stat().st_size for p in paths)
+    paths = write_competition(outdir, seed=DEFAULT_SEED if seed is None else seed)
+    total = sum(p.stat().st_size for p in paths)
     print(f"competition\t{total:>10,d}\t{outdir}\t({len(paths)} files)")
     return 0
 

@@ -105,7 +105,6 @@ def _gt_windows() -> list[GtWindow]:
 
 
 def _robot_name(slot_or_bench: str, start_ns: int, team: str) -> str:
-
     stamp = dt.datetime.fromtimestamp(start_ns // NS, tz=dt.UTC)
     return f"robots/{team}/{slot_or_bench.upper()}_{stamp:%Y%m%d%H%M}_{team}.bag"
 
@@ -349,3 +348,17 @@ def _execution_answer(
         "live_score": live,
         "parameters": sim.parameters,
     }
+
+
+def write_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path]:
+    """:func:`generate_competition` into ``outdir`` as a whole or not at all: written into a
+    hidden sibling first, then renamed, so that an interrupted run never leaves a folder that
+    looks complete. Returns every path written, under ``outdir``."""
+    partial = outdir.with_name(f".{outdir.name}.partial")
+    if partial.exists():
+        shutil.rmtree(partial)
+    paths = generate_competition(partial, seed=seed)
+    if outdir.exists():
+        shutil.rmtree(outdir)
+    partial.rename(outdir)
+    return [outdir / p.relative_to(partial) for p in paths]

@@ -29,13 +29,15 @@ def test_runs():
 """
 
 
-def _run(tmp_path: Path, ci: bool) -> str:
+def _pytest(tmp_path: Path, ci: bool, files: dict[str, str]) -> subprocess.CompletedProcess[str]:
+    """pytest on ``files`` (name -> source) beside the suite's own conftest, with or without CI."""
     (tmp_path / "conftest.py").write_text(CONFTEST.read_text(encoding="utf-8"))
-    (tmp_path / "test_cases.py").write_text(CASES)
+    for name, source in files.items():
+        (tmp_path / name).write_text(source)
     env = {k: v for k, v in os.environ.items() if k != "CI"}
     if ci:
         env["CI"] = "true"
-    proc = subprocess.run(
+    return subprocess.run(
         [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(tmp_path)],
         cwd=tmp_path,
         env=env,
@@ -44,7 +46,6 @@ def _run(tmp_path: Path, ci: bool) -> str:
         timeout=120,
         check=False,
     )
-    return proc.stdout.strip().splitlines()[-1]
 
 
 @pytest.mark.parametrize(
@@ -55,35 +56,26 @@ def _run(tmp_path: Path, ci: bool) -> str:
     ],
 )
 def test_skips_fail_only_in_ci(tmp_path: Path, ci: bool, summary: str) -> None:
-    assert _run(tmp_path, ci).startswith(summary)
+    proc = _pytest(tmp_path, ci, {"test_cases.py": CASES})
+    assert proc.stdout.strip().splitlines()[-1].startswith(summary)
+
+
+EXTRA = """import pytest
+pytest.importorskip('no_such_extra_module', reason='needs the extra')
+def test_uses_it():
+    pass
+"""
 
 
 def test_a_module_skipped_at_collection_fails_in_ci(tmp_path: Path) -> None:
     """``pytest.importorskip`` of an extra the install step forgot (the dask extra once):
     a skip of the whole module at collection, which the per-test rule does not see."""
-    (tmp_path / "conftest.py").write_text(CONFTEST.read_text(encoding="utf-8"))
-    (tmp_path / "test_extra.py").write_text(
-        "import pytest\n"
-        "pytest.importorskip('no_such_extra_module', reason='needs the extra')\n"
-        "def test_uses_it():\n    pass\n"
-    )
-    (tmp_path / "test_other.py").write_text("def test_runs():\n    assert True\n")
-    outcome = {}
-    for ci in (True, False):
-        env = {k: v for k, v in os.environ.items() if k != "CI"}
-        if ci:
-            env["CI"] = "true"
-        proc = subprocess.run(
-            [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(tmp_path)],
-            cwd=tmp_path,
-            env=env,
-            capture_output=True,
-            text=True,
-            timeout=120,
-            check=False,
-        )
-        outcome[ci] = (proc.returncode, proc.stdout)
-    assert outcome[True][0] != 0
-    assert "skipped in CI, where the machine must provide it" in outcome[True][1]
-    assert outcome[False][0] == 0
-    assert "1 passed, 1 skipped" in outcome[False][1]
+    files = {"test_extra.py": EXTRA, "test_other.py": "def test_runs():\n    assert True\n"}
+    (tmp_path / "ci").mkdir()
+    (tmp_path / "local").mkdir()
+    in_ci = _pytest(tmp_path / "ci", True, files)
+    local = _pytest(tmp_path / "local", False, files)
+    assert in_ci.returncode != 0
+    assert "skipped in CI, where the machine must provide it" in in_ci.stdout
+    assert local.returncode == 0
+    assert "1 passed, 1 skipped" in local.stdout

@@ -12,6 +12,7 @@ import json
 from html.parser import HTMLParser
 from pathlib import Path
 from typing import Any
+from urllib.parse import unquote, urlsplit
 
 EVIL = "<script>alert('team')</script>"
 S = 1_000_000_000
@@ -280,3 +281,15 @@ class Page(HTMLParser):
             self._rule += data
         if self._section is not None:
             self.sections[self._section] += data
+
+
+def assert_links_resolve(page: Page, index: Path) -> None:
+    """Every link and frame of the page is relative and resolves offline: to a file beside
+    ``index`` or below it, or to an anchor of the page itself."""
+    for link in page.links:
+        parts = urlsplit(link)
+        assert not parts.scheme, link
+        if parts.path:
+            assert (index.parent / unquote(parts.path)).is_file(), link
+        if parts.fragment:
+            assert parts.fragment in page.ids, link

@@ -12,12 +12,11 @@ import subprocess
 import sys
 from pathlib import Path
 from typing import Any
-from urllib.parse import unquote, urlsplit
 
 import numpy as np
 import pytest
 from fakes import BROWSER, CHROMIUM_FLAGS
-from site_results import EVIL, Page, expected_board, results, write_folder
+from site_results import EVIL, Page, assert_links_resolve, expected_board, results, write_folder
 
 from ertools.report.timeline_page import write_timeline_page
 from ertools.report.timeline_style import KIND_COLORS
@@ -87,13 +86,7 @@ def test_dom_has_leaderboards_problems_and_timeline(
         assert p["message"] in page.sections["problems"]
     assert page.frames == ["timeline.html"]
     assert page.executions.count("failed") == page.executions.count("unscoreable") == 1
-    for link in page.links:
-        parts = urlsplit(link)
-        assert not parts.scheme, link
-        if parts.path:
-            assert (index.parent / unquote(parts.path)).is_file(), link
-        if parts.fragment:
-            assert parts.fragment in page.ids, link
+    assert_links_resolve(page, index)
 
 
 def test_timeline_frame_draws_its_chart(site: tuple[dict[str, Any], Path], tmp_path: Path) -> None:

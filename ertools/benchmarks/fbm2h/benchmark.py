@@ -351,7 +351,6 @@ def invalid_warning(count: int, source: str) -> str:
 
 
 def _load_transform(options: Fbm2hOptions) -> MarkerTransform:
-
     if options.marker_transform is not None:
         if options.transform is not None or options.transforms_dir is not None:
             raise ConfigError("a transform in hand excludes --transform and --transforms")

@@ -57,7 +57,6 @@ class TrajectoryConfig:
     before_gt: BeforeGt = "uncovered"
 
     def __post_init__(self) -> None:
-
         if self.association not in ASSOCIATIONS:
             raise ConfigError(
                 f"association {self.association!r} unknown; choose from {', '.join(ASSOCIATIONS)}"

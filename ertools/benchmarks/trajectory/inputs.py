@@ -25,7 +25,6 @@ if TYPE_CHECKING:
 
 
 def _pose_topics(s: BagSummary) -> list[str]:
-
     return [
         t.name for t in s.topics if t.msgtype in POSE_TYPES and t.name not in ("/tf", "/tf_static")
     ]

@@ -429,7 +429,6 @@ class McapIndex:
 
     @staticmethod
     def _spans(buf: U8, off: I64, where: str) -> tuple[I64, I64]:
-
         if len(off) and (int(off.min()) < 0 or int(off.max()) + 9 + MESSAGE_FIXED > len(buf)):
             raise BagError(f"message index points outside its chunk {where}")
         if np.any(buf[off] != OP_MESSAGE):

@@ -229,7 +229,6 @@ class _Chunk:
 
 
 def _ns(t: int) -> str:
-
     return f"{t // 1_000_000_000}.{t % 1_000_000_000:09d} ({iso_utc(t)})"
 
 

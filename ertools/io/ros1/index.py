@@ -512,7 +512,6 @@ class Ros1Bag(BagFile):
             return
         _touched, _chunk_of, rank_of, _t, _off = self.select(conns, start_ns, end_ns)
         found = ros1_runs(self, conns, start_ns, end_ns, current())
-        assert found is not None
         out: list[tuple[int, int, bytes]] = []
         for pos, buf, start, length, t_rec in found.runs:
             data = buf.tobytes()

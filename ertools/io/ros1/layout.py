@@ -54,7 +54,6 @@ OP_AT = (0, 13, 17, 30)  # where the op field can sit in a standard message-reco
 
 
 def op_word(buf: U8, pos: I64) -> npt.NDArray[np.uint64]:
-
     return read_at(buf, pos, np.dtype("<u8"))
 
 
