@@ -129,18 +129,18 @@ def run(args: argparse.Namespace) -> int:
     name = args.name or (f"{ns.strip('/').replace('/', '_')}_mocap" if ns else "mocap")
     group = None if args.unicast else (args.group or config.group)
     interface = args.interface
-    port = args.port if args.port is not None else config.data_port
+    data_port = args.port if args.port is not None else config.data_port
     duration = args.duration
     if args.simulate:
         group, interface = None, "127.0.0.1"
-        port = args.port if args.port is not None else 0
+        data_port = args.port if args.port is not None else 0
         duration = duration if duration is not None else 10.0
     options = RecordOptions(
         out_dir=args.out_dir,
         name=name,
         namespace=ns,
         group=group,
-        port=port,
+        port=data_port,
         interface=interface,
         split_s=args.split,
         duration_s=duration,
