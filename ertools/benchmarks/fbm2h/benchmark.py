@@ -21,7 +21,7 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -30,17 +30,21 @@ import numpy.typing as npt
 
 from ertools.benchmarks.common.hygiene import drop_invalid, frame_change_warning, frozen_around
 from ertools.benchmarks.common.sources import PoseSpec, read_source, topic
+from ertools.benchmarks.common.sources import tf as tf_source
 from ertools.benchmarks.fbm2h import segments as seg
 from ertools.benchmarks.fbm2h.config import (
     DEFAULT_MAX_GAP_S,
     DEFAULT_TOPIC,
+    TF_2015,
     Fbm2hOptions,
 )
 from ertools.benchmarks.fbm2h.result import Fbm2hResult, SegmentResult
 from ertools.benchmarks.fbm2h.rules import (
     RULE_ORIENTATION_WRAP,
     RULE_POSE_MOMENT,
+    RULE_POSE_SOURCE,
     RULE_SCORE_FORMAT,
+    RULE_SEGMENT_CLOCK,
     RULE_UNSCORED,
 )
 from ertools.benchmarks.fbm2h.score import robot_poses_at, segment_errors
@@ -129,15 +133,21 @@ def compute(
         tgt = (float(target[i, 0]), float(target[i, 1]), float(target[i, 2]))
         if i >= k:
             reason = unreached[i - k] if i - k < len(unreached) else f"segment {i}: not reached"
-            timed_out = "timeout" in reason.lower()
+            timed_out = early is not None and early.is_timeout
             if not unscored_2015:
                 failures.append(reason)
                 segments.append(SegmentResult(i, tgt, "unreached", timeout=timed_out))
                 continue
             all_warnings.append(f"{reason}: counted in N with no error, as 2015 did")
-            if early is not None and early.segment == i and early.is_timeout:
+            if (
+                early is not None
+                and early.segment == i
+                and early.is_timeout
+                and early.start_ns is not None
+                and early.end_ns is not None
+            ):
                 # 2015 added the time of the segment the RefBox timed out (``if
-                # benchmark.Timeout(): execution_time += segment_time``); a halt added nothing.
+                # benchmark.Timeout(): execution_time += segment_time``); a stop added nothing.
                 segments.append(
                     SegmentResult(
                         i, tgt, "unreached", early.start_ns, early.end_ns, timeout=timed_out
@@ -217,6 +227,15 @@ def compute(
             "segment times from the log's clock (2015: the BmBox machine's time.time())"
         ),
     ]
+    if moments.method == "states" and moments.clock == "client" and k:
+        deviations.insert(
+            0,
+            RULE_SEGMENT_CLOCK.deviation(
+                "segments timed from the BmBox EXECUTING_GOAL to the Client's COMPLETED_GOAL, "
+                "the pose taken then; the 2015 node read its clock when the BmBox itself "
+                "moved on (its next state message)"
+            ),
+        )
     if not unscored_2015 and not scored:
         unscored = sum(s.status != "ok" for s in segments)
         deviations.insert(
@@ -436,9 +455,12 @@ def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
     plist = tuple(Path(p) for p in paths)
     transform = _load_transform(options)
     goal = load_goal(options.goal) if options.goal is not None else None
-    marker = read_source(
-        list(plist), _pose_spec(options), (topic(DEFAULT_TOPIC),), what="marker set poses"
-    )
+    # The 2015 node looked the marker set up in tf; the topic carries the same poses stamped
+    # a few microseconds earlier, and is what most tools show: the default reads it.
+    defaults = (topic(DEFAULT_TOPIC),)
+    if options.pose_2015:
+        defaults = (tf_source(TF_2015[1], TF_2015[0]), *defaults)
+    marker = read_source(list(plist), _pose_spec(options), defaults, what="marker set poses")
     if len(marker) == 0:
         raise SegmentationError(f"{marker.source or plist[0]}: the marker set pose stream is empty")
     total = len(marker)
@@ -490,7 +512,9 @@ def locate_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
     if reached == "states":
         states = logs.states
         assert states is not None and states.bmbox is not None
-        moments = seg.from_states(states.bmbox, states.client, states.refbox)
+        moments = seg.from_states(
+            states.bmbox, states.client, states.refbox, clock=options.segment_clock
+        )
         if goal is None:
             if moments.goal_payload is None:
                 raise ConfigError(
@@ -502,6 +526,13 @@ def locate_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
             if warning:
                 warnings.append(warning)
         unreached = seg.unreached_reasons(moments, len(goal), states.refbox)
+        warnings.extend(moments.warnings)
+        if moments.early_end is not None and moments.early_end.kind == "cut" and unreached:
+            warnings.append(
+                f"{states.bmbox.topic}: the log ends inside the benchmark (segment "
+                f"{moments.early_end.segment} of {len(goal)}): taken as the benchmark stopped "
+                "there, as the 2015 node would have scored a stop"
+            )
     elif reached == "timing":
         if options.timing is None:
             raise ConfigError("--reached timing needs the timing FILE")
@@ -558,7 +589,7 @@ def score_found(logs: Fbm2hLogs, runs: Fbm2hRuns, options: Fbm2hOptions) -> Fbm2
             ("unscored_segments", "2015" if options.unscored_2015 else "null"),
         ),
     )
-    return compute(
+    result = compute(
         runs.goal,
         logs.transform,
         logs.marker,
@@ -572,6 +603,26 @@ def score_found(logs: Fbm2hLogs, runs: Fbm2hRuns, options: Fbm2hOptions) -> Fbm2
         provenance=provenance,
         origin_ns=logs.bag_start_ns,
     )
+    if _is_tf_2015(logs.marker):
+        return result
+    if options.pose_2015:
+        warning = (
+            f"--2015: the 2015 node read the marker set from /tf {TF_2015[0]} -> {TF_2015[1]}, "
+            f"not in this log; scored from {logs.marker.source or 'the pose stream'}"
+        )
+        return replace(result, warnings=(*result.warnings, warning))
+    deviation = RULE_POSE_SOURCE.deviation(
+        f"marker set poses from {logs.marker.source or 'the pose topic'}; the 2015 node looked "
+        f"them up in /tf ({TF_2015[0]} -> {TF_2015[1]}), the same poses stamped a few "
+        "microseconds later"
+    )
+    return replace(result, deviations=(*result.deviations, deviation))
+
+
+def _is_tf_2015(marker: PoseStream) -> bool:
+    """Whether the marker poses come from the 2015 node's source: /tf world -> robot_at_home."""
+    from_tf = marker.source.rsplit(":", 1)[-1] in ("/tf", "/tf_static")
+    return from_tf and (marker.frame_id, marker.child_frame_id) == TF_2015
 
 
 def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:

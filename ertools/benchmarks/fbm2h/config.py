@@ -16,6 +16,8 @@ from ertools.configs.transform import (
 
 NAMESPACE = "fbm2h"  # of the state topics
 DEFAULT_TOPIC = "/fbm2h/robot_at_home/pose"
+# The 2015 node looked the marker set up in tf (scripts/fbm2h): world -> robot_at_home.
+TF_2015 = ("world", "robot_at_home")
 DEFAULT_MAX_GAP_S = 0.1
 
 
@@ -40,6 +42,11 @@ class Fbm2hOptions:
         unscored_2015: accuracies as 2015 computed them when segments are not scored: the
             sums over the scored segments divided by N (the waypoints), the segment the RefBox
             timed out counted in execution_time (``--unscored-segments 2015``).
+        segment_clock: with ``reached`` states, ``client`` (a segment ends at the Client's
+            COMPLETED_GOAL) or ``bmbox`` (the 2015 node's clock: BmBox messages at both ends,
+            ``--segment-clock bmbox``); see :func:`ertools.benchmarks.fbm2h.segments.from_states`.
+        pose_2015: with no ``topic``/``tf_frame``, read the marker set from /tf
+            ``world -> robot_at_home`` first, the 2015 node's source (``--2015``).
         namespace: the benchmark namespace of the state topics.
         stops: thresholds for ``auto``.
         marker_transform: a transform already in hand (``ertools audit``: the one the live
@@ -60,6 +67,8 @@ class Fbm2hOptions:
     hits: int | None = None
     orientation_2015: bool = False
     unscored_2015: bool = False
+    segment_clock: str = "client"
+    pose_2015: bool = False
     namespace: str = NAMESPACE
     stops: StopParams = field(default_factory=StopParams)
     marker_transform: MarkerTransform | None = None

@@ -104,9 +104,21 @@ INPUTS = (
         group=LEGACY,
     ),
     Input(
+        "segment_clock",
+        "choice",
+        "segment times with --reached states: client (default: from the BmBox EXECUTING_GOAL to "
+        "the Client's COMPLETED_GOAL, the robot's own report) or bmbox (2015: the node's "
+        "clock, BmBox state messages at both ends; the pose is taken at the end)",
+        default="client",
+        choices=("client", "bmbox"),
+        group=LEGACY,
+    ),
+    Input(
         "all_2015",
         "flag",
-        "every 2015 behaviour above (--orientation-2015 --unscored-segments 2015)",
+        "every 2015 behaviour above (--orientation-2015 --unscored-segments 2015 "
+        "--segment-clock bmbox) and the node's pose source, /tf world -> robot_at_home, "
+        "unless --topic or --tf is given",
         flag="--2015",
         group=LEGACY,
     ),
@@ -183,6 +195,8 @@ def make_options(given: Mapping[str, Any]) -> Fbm2hOptions:
         hits=None if v["hits"] is None else int(v["hits"]),
         orientation_2015=v["orientation_2015"] or v["all_2015"],
         unscored_2015=v["unscored_segments"] == "2015" or v["all_2015"],
+        segment_clock="bmbox" if v["all_2015"] else v["segment_clock"],
+        pose_2015=bool(v["all_2015"]),
         namespace=v["namespace"],
         stops=StopParams(
             speed=v["stop_speed"],
@@ -282,8 +296,11 @@ BmBox has sent the goal and ends at the Client's COMPLETED_GOAL; timing FILE: a 
 timing file (p0 starts, p(k+1) closes segment k, seconds from the bag's first message); auto:
 stops detected in the ground truth, assigned to the waypoints in order.
 Orientation errors are wrapped to [0, pi]; --orientation-2015 reproduces the 2015 numbers.
-Accuracies are null (exit 1) when a segment is not scored; --unscored-segments 2015 divides
-the sum over the scored segments by N as 2015 did. --2015: every 2015 behaviour at once."""
+Accuracies are null (exit 1) when a segment is not scored (RefBox timeout or stop, or a log
+that ends inside the benchmark, taken as stopped there); --unscored-segments 2015 divides the
+sum over the scored segments by N as 2015 did. --segment-clock bmbox times segments between
+the BmBox's own transitions as the 2015 node did. --2015: every 2015 behaviour at once, with
+the node's pose source (/tf world -> robot_at_home)."""
 
 BENCHMARK: Benchmark[Fbm2hOptions, Fbm2hLogs, Fbm2hRuns, Fbm2hResult] = Benchmark(
     name=NAME,

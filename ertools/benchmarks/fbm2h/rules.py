@@ -23,6 +23,38 @@ RULE_ORIENTATION_WRAP = Rule(
     option="--orientation-2015",
 )
 
+RULE_SEGMENT_CLOCK = Rule(
+    key="fbm2h.segment-clock",
+    benchmark="fbm2h",
+    title="segment times and the reached moment",
+    rulebook="the time the robot takes from one waypoint to the next; the robot pose when it "
+    "reaches the waypoint (seed 7.2.1, Listing 13 segment_time)",
+    node_2015=(
+        f"{NODE_SOURCE}: `start_segment_time = time.time()` after `SendGoal()` returned and "
+        "`end_segment_time = time.time()` after `WaitResult()` returned, the BmBox's own "
+        "transitions (out of TRANSMITTING_GOAL; out of WAITING_RESULT), the pose looked up then"
+    ),
+    ertools=(
+        "from the BmBox EXECUTING_GOAL to the Client's COMPLETED_GOAL, the robot's own report "
+        "of arrival, the pose taken at it: the BmBox moves on only once it has received that "
+        "report, up to one 10 Hz publishing period later in the log"
+    ),
+    option="--segment-clock bmbox",
+)
+
+RULE_POSE_SOURCE = Rule(
+    key="fbm2h.pose-source",
+    benchmark="fbm2h",
+    title="marker set pose source",
+    rulebook="the robot's marker set tracked by the mocap (seed 7.2.1)",
+    node_2015=f"{NODE_SOURCE}: `lookupTransform('/world', '/robot_at_home', ...)` from /tf",
+    ertools=(
+        "the pose topic /fbm2h/robot_at_home/pose (the same mocap poses, stamped a few "
+        "microseconds before their /tf copies), /tf when asked"
+    ),
+    option="--tf world:robot_at_home",
+)
+
 RULE_POSE_MOMENT = Rule(
     key="fbm2h.pose-moment",
     benchmark="fbm2h",
@@ -33,8 +65,9 @@ RULE_POSE_MOMENT = Rule(
         "`WaitResult()` returned, a few ms after the result"
     ),
     ertools=(
-        "the marker pose interpolated (linear + SLERP, as tf) at the logged reached moment; no "
-        "option: the moment the node handled the result is not in the log"
+        "the marker pose interpolated (linear + SLERP, as tf) at the logged reached moment "
+        "(with --segment-clock bmbox the BmBox message after WAITING_RESULT, the closest the "
+        "log gets to `now`); no option: the moment the node handled the result is not in the log"
     ),
     option="",
 )
@@ -46,13 +79,18 @@ RULE_UNSCORED = Rule(
     rulebook="accuracy over the waypoints reached; a waypoint not reached in time scores no "
     "points on that path (seed 7.2, RoCKIn@Home rulebook 5.2.7)",
     node_2015=(
-        f"{NODE_SOURCE}: `if benchmark.Timeout(): execution_time += segment_time; continue`, then "
-        "`position_accuracy = sum_d / N`, N = the number of waypoints: a timed-out or "
-        "unreached segment adds 0 to the sums but counts in N"
+        f"{NODE_SOURCE}: after `WaitResult()`, `if benchmark.Timeout(): execution_time = "
+        "execution_time + segment_time; continue` and `if not benchmark.Running(): continue` "
+        "(BmBox.py: `Timeout()` is the RefBox payload == 'reason: timeout', `Running()` "
+        "payload != 'reason: stop'); the loop `while benchmark.Running() and not "
+        "benchmark.Timeout()` then ends; `position_accuracy = sum_d / N`, N = the number of "
+        "waypoints: a timed-out, stopped or unreached segment adds 0 to the sums but counts in N"
     ),
     ertools=(
-        "null accuracies and exit 1 when a segment is not scored (a sum over fewer segments "
-        "divided by N rewards reaching fewer waypoints), with a warning naming them"
+        "the segments not scored listed with null errors and named in a warning, accuracies "
+        "null and exit 1 (a sum over fewer segments divided by N rewards reaching fewer "
+        "waypoints); execution_time and the scored segments still given; a log that ends "
+        "inside the benchmark is the benchmark stopped there"
     ),
     option="--unscored-segments 2015",
 )

@@ -26,25 +26,47 @@ from ertools.streams import StateStream
 from ertools.timeutil import ns_to_s
 
 
+# The exact payloads the 2015 BmBox compared the RefBox's with (BmBox.py ``Timeout()``,
+# ``Running()`` and its RefBox callback): any other text changed nothing in the node.
+PAYLOAD_TIMEOUT_2015 = "reason: timeout"
+PAYLOAD_STOP_2015 = "reason: stop"
+
+CLOCKS = ("client", "bmbox")
+
+
 @dataclass(frozen=True)
 class EarlyEnd:
-    """A segment the RefBox ended: started at ``start_ns``, ended by END at ``end_ns``.
+    """Why the benchmark stopped before segment ``segment`` was completed.
 
     Attributes:
-        segment: the segment's index.
-        start_ns: when its goal had been sent (the BmBox in EXECUTING_GOAL).
-        end_ns: the RefBox END message.
-        payload: END's payload (``timeout``, ``halt``...).
+        segment: the first segment not completed.
+        start_ns: when it started (None when its goal was never sent).
+        end_ns: when it ended: the RefBox END (``client`` clock) or the BmBox leaving
+            WAITING_RESULT (``bmbox`` clock); None when the log ends first.
+        kind: ``timeout`` or ``stop`` (the RefBox ended it), ``ended`` (a RefBox END whose
+            payload says neither, or a score sent early) or ``cut`` (the log ends inside the
+            benchmark: taken as the benchmark stopped there, as a stop is).
+        payload: the RefBox payload then ("" when none).
     """
 
     segment: int
-    start_ns: int
-    end_ns: int
-    payload: str
+    start_ns: int | None
+    end_ns: int | None
+    kind: str
+    payload: str = ""
 
     @property
     def is_timeout(self) -> bool:
-        return "timeout" in self.payload.lower()
+        return self.kind == "timeout"
+
+    @property
+    def reason(self) -> str:
+        """What ended the benchmark, for the messages."""
+        if self.kind == "cut":
+            return "the log ends inside the benchmark: taken as the benchmark stopped there"
+        if self.payload.strip():
+            return f"RefBox END ({self.payload.strip()})"
+        return "the benchmark ended without a RefBox reason"
 
 
 @dataclass(frozen=True, eq=False)
@@ -60,8 +82,10 @@ class ReachedMoments:
         unreached: reasons for the segments after the K-th that were never completed (the
             RefBox ended the benchmark early); empty when all were reached.
         notes: what was detected, for the referee.
-        early_end: the segment that was started and never completed because the RefBox ended
-            the benchmark (states only), None otherwise.
+        early_end: states only: why segment K (the first not completed) was not, when the
+            benchmark stopped before its goals ran out (None for timing and auto).
+        clock: states only: ``client`` or ``bmbox`` (see :func:`from_states`).
+        warnings: states only: RefBox payloads the 2015 node would have read otherwise.
     """
 
     method: str
@@ -72,6 +96,8 @@ class ReachedMoments:
     unreached: tuple[str, ...] = ()
     notes: tuple[str, ...] = field(default_factory=tuple)
     early_end: EarlyEnd | None = None
+    clock: str = "client"
+    warnings: tuple[str, ...] = ()
 
     def __len__(self) -> int:
         return int(self.end_ns.shape[0])
@@ -86,77 +112,124 @@ def _first_at_or_after(t: I64, mask: npt.NDArray[np.bool_], t0: int, t1: int | N
     return int(idx[0]) if idx.size else None
 
 
+def _word_kind(payload: str) -> str:
+    """The default's reading of a RefBox END payload: any mention of a timeout, a stop or halt."""
+    text = payload.lower()
+    if "timeout" in text:
+        return "timeout"
+    if any(word in text for word in ("halt", "stop", "abort")):
+        return "stop"
+    return "ended"
+
+
+def kind_2015(payload: str) -> str:
+    """What the 2015 BmBox made of the RefBox payload: ``timeout`` when ``Timeout()``, ``stop``
+    when ``not Running()``, else ``""`` (both compare the whole payload, BmBox.py)."""
+    if payload == PAYLOAD_TIMEOUT_2015:
+        return "timeout"
+    if payload == PAYLOAD_STOP_2015:
+        return "stop"
+    return ""
+
+
+def _payload_at(stream: StateStream | None, t_ns: int) -> str:
+    """The payload of the last message of ``stream`` recorded at or before ``t_ns``: what the
+    2015 BmBox held in ``_refbox_payload`` / ``_client_payload`` then."""
+    if stream is None or len(stream) == 0:
+        return ""
+    i = int(np.searchsorted(stream.t_ns, t_ns, side="right")) - 1
+    return stream.payload[i] if i >= 0 else ""
+
+
+_WAITING = (BmBoxState.EXECUTING_GOAL, BmBoxState.WAITING_RESULT)
+
+
+def _bmbox_window(bm: StateStream, t_goal: int, t_next: int | None) -> tuple[int | None, int | None]:
+    """(start, end) message indices of a segment on the node's own clock.
+
+    ``start``: the first BmBox message no longer TRANSMITTING_GOAL (``SendGoal()`` had
+    returned: 2015 read ``time.time()`` then); ``end``: the first after it that is neither
+    EXECUTING_GOAL nor WAITING_RESULT (``WaitResult()`` had returned), or ``start`` itself when
+    the BmBox was already out of them (``WaitResult()`` then returns at once). None: the log
+    ends (or the next goal comes) first.
+    """
+    i_start = _first_at_or_after(bm.t_ns, bm.state != BmBoxState.TRANSMITTING_GOAL, t_goal, t_next)
+    if i_start is None:
+        return None, None
+    if int(bm.state[i_start]) not in _WAITING:
+        return i_start, i_start
+    waiting = np.isin(bm.state, np.asarray(_WAITING, dtype=bm.state.dtype))
+    i_end = _first_at_or_after(bm.t_ns, ~waiting, int(bm.t_ns[i_start]), t_next)
+    return i_start, i_end
+
+
 def from_states(
     bmbox: StateStream,
     client: StateStream | None,
     refbox: StateStream | None = None,
+    *,
+    clock: str = "client",
 ) -> ReachedMoments:
-    """Segments from the state topics (BmBox required, Client preferred for the end moment)."""
+    """Segments from the state topics (BmBox required, Client preferred for the end moment).
 
+    ``clock`` ``client`` (the default): a segment runs from the BmBox EXECUTING_GOAL (else its
+    first message past TRANSMITTING_GOAL) to the Client's COMPLETED_GOAL, the moment the robot
+    said it had arrived; with no Client topic, to the BmBox leaving WAITING_RESULT. A RefBox
+    END before that ends the benchmark there. ``bmbox`` (the 2015 node): from the first BmBox
+    message past TRANSMITTING_GOAL to the first past WAITING_RESULT, the node's own transitions,
+    and the segment counts as completed unless the RefBox payload then was the node's exact
+    ``reason: timeout`` or ``reason: stop``.
+
+    A log that ends inside the benchmark (a segment started and never ended, or fewer goals
+    than waypoints and no score sent) is the benchmark stopped there: ``early_end`` of kind
+    ``cut``.
+
+    Raises:
+        SegmentationError: no BmBox message, a segment the Client never completed that the
+            BmBox left for the next goal anyway (an inconsistent log), or an unknown ``clock``.
+    """
+    if clock not in CLOCKS:
+        raise SegmentationError(f"segment clock must be client or bmbox, not {clock!r}")
     bm = bmbox.changes()
-    goals = np.flatnonzero(bm.state == BmBoxState.TRANSMITTING_GOAL)
-    if goals.size == 0:
+    if len(bm) == 0:
         raise SegmentationError(
-            f"{bm.topic}: the BmBox never entered TRANSMITTING_GOAL, no segment to score; "
+            f"{bm.topic}: no BmBox state message, no segment to score; "
             "use --reached timing FILE or --reached auto",
             path=bm.source or None,
         )
+    goals = np.flatnonzero(bm.state == BmBoxState.TRANSMITTING_GOAL)
     cl = client.changes() if client is not None and len(client) else None
+    rb = refbox.changes() if refbox is not None and len(refbox) else None
+    warnings = _payload_warnings(rb, clock)
     starts: list[int] = []
     ends: list[int] = []
     payloads: list[str] = []
     notes: list[str] = []
     early: EarlyEnd | None = None
-    goal_payload = bm.payload[int(goals[0])] or None
+    goal_payload = bm.payload[int(goals[0])] or None if goals.size else None
     t_goals = bm.t_ns[goals]
     for k, g in enumerate(goals):
         t_goal = int(bm.t_ns[g])
         t_next = int(t_goals[k + 1]) if k + 1 < len(goals) else None
-        i_exec = _first_at_or_after(bm.t_ns, bm.state == BmBoxState.EXECUTING_GOAL, t_goal, t_next)
-        # 2015 read time.time() when SendGoal() returned, i.e. once the BmBox was executing.
-        t_start = int(bm.t_ns[i_exec]) if i_exec is not None else t_goal
-        t_end: int | None = None
-        payload = ""
-        if cl is not None:
-            i_done = _first_at_or_after(
-                cl.t_ns, cl.state == ClientState.COMPLETED_GOAL, t_start, t_next
-            )
-            if i_done is not None:
-                t_end = int(cl.t_ns[i_done])
-                payload = cl.payload[i_done]
-        if t_end is None:
-            # No Client topic: the BmBox leaving WAITING_RESULT for READY is WaitResult returning.
-            i_wait = _first_at_or_after(
-                bm.t_ns, bm.state == BmBoxState.WAITING_RESULT, t_start, t_next
-            )
-            i_ready = (
-                _first_at_or_after(
-                    bm.t_ns, bm.state == BmBoxState.READY, int(bm.t_ns[i_wait]), t_next
-                )
-                if i_wait is not None
-                else None
-            )
-            if i_ready is not None:
-                t_end = int(bm.t_ns[i_ready])
-                if cl is None:
-                    notes.append(f"segment {k}: end from BmBox READY (no Client topic)")
-        if t_end is None:
-            end = _early_end(refbox, t_start)
-            reason = None if end is None else f"RefBox END ({end[1]})"
-            if end is not None:
-                early = EarlyEnd(k, t_start, end[0], end[1])
-            if reason is None:
-                raise SegmentationError(
-                    f"{bm.topic}: segment {k} (goal sent at "
-                    f"{ns_to_s(t_goal - int(bm.t_ns[0])):.3f} s) was never completed and the "
-                    "RefBox did not end the benchmark; the log may be truncated",
-                    path=bm.source or None,
-                )
-            notes.append(f"segment {k}: not completed ({reason})")
+        if clock == "bmbox":
+            found = _segment_bmbox(bm, cl, rb, k, t_goal, t_next)
+        else:
+            found = _segment_client(bm, cl, rb, k, t_goal, t_next)
+        if isinstance(found, EarlyEnd):
+            early = found
+            notes.append(f"segment {k}: not completed ({found.reason})")
             break
+        t_start, t_end, payload, note = found
+        if note:
+            notes.append(note)
         starts.append(t_start)
         ends.append(t_end)
         payloads.append(payload)
+    else:
+        early = _after_last_goal(bm, rb, len(goals), clock)
+        if early is not None:
+            after = f"after segment {len(goals) - 1}" if len(goals) else "at all"
+            notes.append(f"no goal sent {after} ({early.reason})")
     return ReachedMoments(
         "states",
         np.asarray(starts, dtype=np.int64),
@@ -165,44 +238,156 @@ def from_states(
         goal_payload=goal_payload,
         notes=tuple(notes),
         early_end=early,
+        clock=clock,
+        warnings=warnings,
     )
 
 
-def _early_end(refbox: StateStream | None, after_ns: int) -> tuple[int, str] | None:
-    """(time, payload) of the RefBox END that ended the benchmark early, if any."""
+def _payload_warnings(rb: StateStream | None, clock: str) -> tuple[str, ...]:
+    """A warning per RefBox END payload the 2015 BmBox did not know (it compared the whole
+    payload with ``reason: timeout`` and ``reason: stop``; any other text changed nothing)."""
+    if rb is None:
+        return ()
+    ends = {rb.payload[i] for i in np.flatnonzero(rb.state == RefBoxState.END)}
+    out = []
+    for payload in sorted(p for p in ends if p.strip() and not kind_2015(p)):
+        reading = (
+            "ignored, as the 2015 node did"
+            if clock == "bmbox"
+            else f"read as {_word_kind(payload)} (a stop, timeout or halt word in it, or none)"
+        )
+        out.append(
+            f"RefBox END payload {payload!r} is none the 2015 BmBox compared "
+            f"({PAYLOAD_TIMEOUT_2015!r}, {PAYLOAD_STOP_2015!r}): {reading}"
+        )
+    return tuple(out)
 
-    if refbox is None or len(refbox) == 0:
-        return None
-    rb = refbox.changes()
-    i = _first_at_or_after(rb.t_ns, rb.state == RefBoxState.END, after_ns, None)
-    if i is None:
-        return None
-    payload = rb.payload[i].strip()
-    # A normal END (after the score) has no payload; timeout/halt end the benchmark early.
-    if not any(word in payload.lower() for word in ("timeout", "halt", "stop", "abort")):
-        return None
-    return int(rb.t_ns[i]), payload
+
+_Found = tuple[int, int, str, str] | EarlyEnd  # (start, end, result payload, note) or why not
 
 
-def _early_end_reason(refbox: StateStream | None, after_ns: int) -> str | None:
-    """``RefBox END (timeout)`` and the like, when the RefBox ended the benchmark early."""
-    end = _early_end(refbox, after_ns)
-    return None if end is None else f"RefBox END ({end[1]})"
+def _segment_bmbox(
+    bm: StateStream,
+    cl: StateStream | None,
+    rb: StateStream | None,
+    k: int,
+    t_goal: int,
+    t_next: int | None,
+) -> _Found:
+    i_start, i_end = _bmbox_window(bm, t_goal, t_next)
+    if i_start is None:
+        return EarlyEnd(k, None, None, "cut", _payload_at(rb, int(bm.t_ns[-1])))
+    t_start = int(bm.t_ns[i_start])
+    if i_end is None:
+        return EarlyEnd(k, t_start, None, "cut", _payload_at(rb, int(bm.t_ns[-1])))
+    t_end = int(bm.t_ns[i_end])
+    refbox_payload = _payload_at(rb, t_end)
+    kind = kind_2015(refbox_payload)
+    if kind:
+        return EarlyEnd(k, t_start, t_end, kind, refbox_payload)
+    if int(bm.state[i_end]) != BmBoxState.READY:
+        # Not a result (the BmBox went to END or sent its score): the node stopped here.
+        return EarlyEnd(k, t_start, t_end, "ended", refbox_payload)
+    return t_start, t_end, _payload_at(cl, t_end), ""
+
+
+def _segment_client(
+    bm: StateStream,
+    cl: StateStream | None,
+    rb: StateStream | None,
+    k: int,
+    t_goal: int,
+    t_next: int | None,
+) -> _Found:
+    i_exec = _first_at_or_after(bm.t_ns, bm.state == BmBoxState.EXECUTING_GOAL, t_goal, t_next)
+    i_start, i_bm_end = _bmbox_window(bm, t_goal, t_next)
+    if i_exec is None:
+        i_exec = i_start
+    if i_exec is None:
+        # Never executed: a RefBox END after the goal ended it, else the log ends first.
+        i_rb0 = (
+            None
+            if rb is None
+            else _first_at_or_after(rb.t_ns, rb.state == RefBoxState.END, t_goal, t_next)
+        )
+        if rb is not None and i_rb0 is not None:
+            payload = rb.payload[i_rb0].strip()
+            return EarlyEnd(k, None, int(rb.t_ns[i_rb0]), _word_kind(payload), payload)
+        return EarlyEnd(k, None, None, "cut")
+    t_start = int(bm.t_ns[i_exec])
+    # A RefBox END ends the segment, whatever comes after it (the robot arriving late).
+    i_rb = (
+        None
+        if rb is None
+        else _first_at_or_after(rb.t_ns, rb.state == RefBoxState.END, t_start, t_next)
+    )
+    t_rb = None if i_rb is None or rb is None else int(rb.t_ns[i_rb])
+    if cl is not None:
+        i_done = _first_at_or_after(cl.t_ns, cl.state == ClientState.COMPLETED_GOAL, t_start, t_rb)
+        if i_done is not None and (t_next is None or int(cl.t_ns[i_done]) < t_next):
+            return t_start, int(cl.t_ns[i_done]), cl.payload[i_done], ""
+    elif i_bm_end is not None and int(bm.state[i_bm_end]) == BmBoxState.READY:
+        t_end = int(bm.t_ns[i_bm_end])
+        if t_rb is None or t_end < t_rb:
+            return t_start, t_end, "", f"segment {k}: end from BmBox READY (no Client topic)"
+    if t_rb is not None and rb is not None:
+        payload = rb.payload[i_rb or 0].strip()
+        return EarlyEnd(k, t_start, t_rb, _word_kind(payload), payload)
+    if t_next is not None:
+        raise SegmentationError(
+            f"{bm.topic}: segment {k} was never completed, the RefBox did not end it, and the "
+            "BmBox sent the next goal anyway; the log is inconsistent (messages missing?)",
+            path=bm.source or None,
+        )
+    return EarlyEnd(k, t_start, None, "cut")
+
+
+def _after_last_goal(
+    bm: StateStream, rb: StateStream | None, k: int, clock: str
+) -> EarlyEnd | None:
+    """Why no goal followed the last completed segment ``k - 1`` (None: a normal end, i.e.
+    the BmBox sent its score with no RefBox reason; the waypoint count then decides)."""
+    t_last = int(bm.t_ns[-1])
+    i_rb = (
+        None
+        if rb is None
+        else _first_at_or_after(rb.t_ns, rb.state == RefBoxState.END, int(bm.t_ns[0]), None)
+    )
+    score = np.flatnonzero(bm.state == BmBoxState.TRANSMITTING_SCORE)
+    t_score = int(bm.t_ns[score[0]]) if score.size else None
+    if rb is not None and i_rb is not None:
+        payload = rb.payload[i_rb]
+        kind = kind_2015(payload) if clock == "bmbox" else _word_kind(payload)
+        if kind in ("timeout", "stop") and (t_score is None or int(rb.t_ns[i_rb]) <= t_score):
+            return EarlyEnd(k, None, int(rb.t_ns[i_rb]), kind, payload.strip())
+    if t_score is None:
+        return EarlyEnd(k, None, None, "cut", _payload_at(rb, t_last))
+    return None
 
 
 def unreached_reasons(
-    moments: ReachedMoments, n_waypoints: int, refbox: StateStream | None
+    moments: ReachedMoments, n_waypoints: int, refbox: StateStream | None = None
 ) -> tuple[str, ...]:
-    """Why the segments after the last completed one have no reached moment."""
-    if len(moments) >= n_waypoints:
+    """Why the segments after the last completed one have no reached moment.
+
+    Empty when every waypoint was reached, or when nothing says why (not from the states, or
+    the BmBox sent its score early with no RefBox reason): the count mismatch is then an error
+    (see :func:`ertools.benchmarks.fbm2h.benchmark.compute`). ``refbox`` is not needed any
+    more (the reason is found with the moments) and kept for callers.
+    """
+    del refbox
+    k = len(moments)
+    early = moments.early_end
+    if k >= n_waypoints or early is None:
         return ()
-    after = int(moments.end_ns[-1]) if len(moments) else 0
-    reason = _early_end_reason(refbox, after)
-    if reason is None:
-        return ()  # not an early end: the count mismatch is an error (see compute)
-    return tuple(
-        f"segment {k}: waypoint never reached ({reason})" for k in range(len(moments), n_waypoints)
-    )
+    out = [f"segment {k}: not completed ({early.reason})" if early.start_ns is not None else ""]
+    if not out[0]:
+        out = []
+    first = k + len(out)
+    out += [
+        f"segment {i}: waypoint never reached ({early.reason})" for i in range(first, n_waypoints)
+    ]
+    return tuple(out)
 
 
 def from_timing(t_ns: I64, labels: tuple[str, ...]) -> ReachedMoments:

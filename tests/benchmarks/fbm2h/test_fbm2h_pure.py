@@ -196,6 +196,15 @@ def test_states_segments_and_refbox_timeout() -> None:
     assert [s.status for s in result.segments] == ["ok", "unreached", "unreached"]
     assert result.timeout_segments == 2 and len(result.failures) == 2
     assert result.execution_time == pytest.approx(2.7, abs=1e-9)
-    # Without a timeout END the missing segment is an inconsistency, not a timeout.
+    # An END with no reason still ends the benchmark there, but not as a timeout.
     rb_normal = _states(Machine.REFBOX, [(8.9, RefBoxState.END, "")])
-    assert unreached_reasons(moments, 3, rb_normal) == ()
+    plain = from_states(bm, cl, rb_normal)
+    reasons = unreached_reasons(plain, 3)
+    assert reasons == (
+        "segment 1: not completed (the benchmark ended without a RefBox reason)",
+        "segment 2: waypoint never reached (the benchmark ended without a RefBox reason)",
+    )
+    result = compute(
+        goal, identity_transform(), marker, plain, max_gap_s=20.0, unreached=reasons
+    )
+    assert result.timeout_segments == 0 and len(result.failures) == 2
