@@ -142,12 +142,12 @@ def compute(
             if (
                 early is not None
                 and early.segment == i
-                and early.is_timeout
                 and early.start_ns is not None
                 and early.end_ns is not None
             ):
-                # 2015 added the time of the segment the RefBox timed out (``if
-                # benchmark.Timeout(): execution_time += segment_time``); a stop added nothing.
+                # The node recorded this segment's times; it added them to execution_time only
+                # on a timeout (``if benchmark.Timeout(): execution_time += segment_time``),
+                # not on a stop (see execution_time below).
                 segments.append(
                     SegmentResult(
                         i, tgt, "unreached", early.start_ns, early.end_ns, timeout=timed_out
@@ -196,7 +196,9 @@ def compute(
         sum(
             s.end_ns - s.start_ns
             for s in segments
-            if s.start_ns is not None and s.end_ns is not None
+            if s.start_ns is not None
+            and s.end_ns is not None
+            and (s.status != "unreached" or s.timeout)
         )
     )
     position, orientation = _accuracies(
@@ -457,7 +459,7 @@ def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
     goal = load_goal(options.goal) if options.goal is not None else None
     # The 2015 node looked the marker set up in tf; the topic carries the same poses stamped
     # a few microseconds earlier, and is what most tools show: the default reads it.
-    defaults = (topic(DEFAULT_TOPIC),)
+    defaults: tuple[PoseSpec, ...] = (topic(DEFAULT_TOPIC),)
     if options.pose_2015:
         defaults = (tf_source(TF_2015[1], TF_2015[0]), *defaults)
     marker = read_source(list(plist), _pose_spec(options), defaults, what="marker set poses")

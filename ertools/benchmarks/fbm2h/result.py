@@ -128,9 +128,13 @@ class Fbm2hResult:
 
     @property
     def nothing_scored(self) -> bool:
-        """Not one segment scored: the CLI prints only the failures
-        (``ertools.cli.common.all_failed``)."""
-        return not any(s.status == "ok" for s in self.segments)
+        """Not one segment scored and the data is at fault (ground truth lost): the CLI prints
+        only the failures (``ertools.benchmarks.document``). A benchmark the RefBox ended, or a
+        log ended, before any waypoint was reached is still printed: its segments null, its
+        execution_time, and the warning saying what 2015 gave (``--unscored-segments 2015``)."""
+        if any(s.status == "ok" for s in self.segments):
+            return False
+        return any(s.status == "no_gt" for s in self.segments)
 
     def _segment_listing(self, seg: SegmentResult) -> dict[str, Any]:
         # Keys and order of Listing 13 (the 2015 node wrote "dinstance_error" so, typo included).

@@ -25,7 +25,6 @@ from ertools.states import BmBoxState, ClientState, RefBoxState
 from ertools.streams import StateStream
 from ertools.timeutil import ns_to_s
 
-
 # The exact payloads the 2015 BmBox compared the RefBox's with (BmBox.py ``Timeout()``,
 # ``Running()`` and its RefBox callback): any other text changed nothing in the node.
 PAYLOAD_TIMEOUT_2015 = "reason: timeout"
@@ -144,7 +143,9 @@ def _payload_at(stream: StateStream | None, t_ns: int) -> str:
 _WAITING = (BmBoxState.EXECUTING_GOAL, BmBoxState.WAITING_RESULT)
 
 
-def _bmbox_window(bm: StateStream, t_goal: int, t_next: int | None) -> tuple[int | None, int | None]:
+def _bmbox_window(
+    bm: StateStream, t_goal: int, t_next: int | None
+) -> tuple[int | None, int | None]:
     """(start, end) message indices of a segment on the node's own clock.
 
     ``start``: the first BmBox message no longer TRANSMITTING_GOAL (``SendGoal()`` had
@@ -315,11 +316,12 @@ def _segment_client(
             return EarlyEnd(k, None, int(rb.t_ns[i_rb0]), _word_kind(payload), payload)
         return EarlyEnd(k, None, None, "cut")
     t_start = int(bm.t_ns[i_exec])
-    # A RefBox END ends the segment, whatever comes after it (the robot arriving late).
+    # A RefBox END once the goal is sent ends the segment, whatever comes after it (the robot
+    # arriving late).
     i_rb = (
         None
         if rb is None
-        else _first_at_or_after(rb.t_ns, rb.state == RefBoxState.END, t_start, t_next)
+        else _first_at_or_after(rb.t_ns, rb.state == RefBoxState.END, t_goal, t_next)
     )
     t_rb = None if i_rb is None or rb is None else int(rb.t_ns[i_rb])
     if cl is not None:
@@ -332,7 +334,8 @@ def _segment_client(
             return t_start, t_end, "", f"segment {k}: end from BmBox READY (no Client topic)"
     if t_rb is not None and rb is not None:
         payload = rb.payload[i_rb or 0].strip()
-        return EarlyEnd(k, t_start, t_rb, _word_kind(payload), payload)
+        # An END while the goal was still being sent leaves the segment no time of its own.
+        return EarlyEnd(k, min(t_start, t_rb), t_rb, _word_kind(payload), payload)
     if t_next is not None:
         raise SegmentationError(
             f"{bm.topic}: segment {k} was never completed, the RefBox did not end it, and the "

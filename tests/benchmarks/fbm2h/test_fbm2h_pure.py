@@ -204,7 +204,5 @@ def test_states_segments_and_refbox_timeout() -> None:
         "segment 1: not completed (the benchmark ended without a RefBox reason)",
         "segment 2: waypoint never reached (the benchmark ended without a RefBox reason)",
     )
-    result = compute(
-        goal, identity_transform(), marker, plain, max_gap_s=20.0, unreached=reasons
-    )
+    result = compute(goal, identity_transform(), marker, plain, max_gap_s=20.0, unreached=reasons)
     assert result.timeout_segments == 0 and len(result.failures) == 2
