@@ -13,7 +13,7 @@ import numpy.typing as npt
 
 from ertools.arrays import F64, I64, U8
 from ertools.benchmarks.common.hygiene import same_rows
-from ertools.benchmarks.trajectory.config import BeforeGt, Gaps, Ties
+from ertools.benchmarks.trajectory.config import BeforeGt, Gaps, GtOrder, Ties
 from ertools.errors import ScoringError
 from ertools.geometry import (
     Association,
@@ -76,6 +76,7 @@ def associate(
     ties: Ties = "at",
     gaps: Gaps = "skip",
     before_gt: BeforeGt = "uncovered",
+    gt_order: GtOrder = "time",
 ) -> Matched:
     """Pair every robot pose with the GT pose at its time.
 
@@ -90,9 +91,15 @@ def associate(
     The surrounding GT poses are the last at or before and the first at or after the robot
     time (one sample on an exact tie); with ``ties`` ``before`` (hold only) they are the 2015
     pair on ties too, and ``hold`` takes the first of the pair: the pose before the tie.
+
+    ``gt_order`` ``chain`` (hold with ties before only): ``gt`` is in the order 2015 read it
+    (its files chained by start time, not sorted), and the pair is the one its forward scan
+    stopped at (:func:`chain_pairs`).
     """
     if len(gt) == 0:
         raise ScoringError("the GT stream is empty")
+    if gt_order == "chain":
+        return _associate_chain(robot, gt, max_gap_ns, gaps=gaps, before_gt=before_gt)
     n_gt = len(gt)
     q = robot.t_ns
     interp = interpolate_poses(gt, q, method)
@@ -119,6 +126,97 @@ def associate(
             # Held at the first GT pose: the pair around it is (GT[0], GT[1]), as in 2015.
             gap_ns = np.where(early, int(gt.t_ns[1] - gt.t_ns[0]), gap_ns)
         gt_xyz_at, gt_quat_at = interp.xyz, interp.quat_xyzw
+    ties_n = int(np.count_nonzero(interp.inside & (interp.lo == interp.hi)))
+    return _matched(
+        robot,
+        gt,
+        gt_xyz_at,
+        gt_quat_at,
+        inside,
+        gap_ns,
+        has_pair,
+        fi,
+        si,
+        early,
+        ties_n,
+        max_gap_ns,
+        gaps,
+    )
+
+
+def chain_pairs(gt_t_ns: I64, q: I64) -> I64:
+    """The second index ``j`` of the pair (``j - 1``, ``j``) 2015's scan stopped at for each
+    robot time of ``q`` (increasing), over GT stamps in the order read (not sorted).
+
+    rockin_trajectory_benchmark.py (``seek_mocap_pose_at``) starts at the pair (GT[0], GT[1])
+    and moves one pose forward while the second's stamp is before the robot time, never back:
+    for increasing robot times it stops at the first ``j >= 1`` with ``t[j] >= q``, whatever
+    came before, so ``j`` is where the running maximum of ``t[1:]`` first reaches ``q``.
+    ``len(gt_t_ns)`` means the poses ran out (2015: ``EndOfBag``).
+    """
+    reach = np.maximum.accumulate(gt_t_ns[1:])
+    return np.searchsorted(reach, q, side="left").astype(np.int64) + 1
+
+
+def _associate_chain(
+    robot: PoseStream, gt: PoseStream, max_gap_ns: int, *, gaps: Gaps, before_gt: BeforeGt
+) -> Matched:
+    """:func:`associate` over GT poses in 2015's reading order (hold, the pose before a tie)."""
+    n_gt = len(gt)
+    q = robot.t_ns
+    second = chain_pairs(gt.t_ns, q) if n_gt > 1 else np.full(len(q), n_gt, dtype=np.int64)
+    has_pair = second < n_gt
+    si = np.clip(second, 0, n_gt - 1)
+    fi = np.clip(second - 1, 0, n_gt - 1)
+    # Before the first pose read: 2015 printed its "should never happen" error and went on.
+    early = has_pair & (second == 1) & (q < gt.t_ns[0])
+    inside = has_pair & (~early if before_gt == "uncovered" else True)
+    # An out-of-order pair spans a negative time: 2015 warned it out of order, not as a gap.
+    # Its gap test is ``t2.to_sec() - t1.to_sec() > 0.1`` in float seconds, where a pair 0.1 s
+    # apart can be 0.10000000000000003 s: the test is kept as written.
+    span_s = _to_sec(gt.t_ns.take(si)) - _to_sec(gt.t_ns.take(fi))
+    gap = has_pair & (span_s > max_gap_ns / 1e9)
+    gap_ns = np.where(gap | ~has_pair, np.iinfo(np.int64).max, 0)
+    ties_n = int(np.count_nonzero(has_pair & (gt.t_ns.take(si) == q)))
+    return _matched(
+        robot,
+        gt,
+        _rows(gt.xyz, fi),
+        _rows(gt.quat_xyzw, fi),
+        inside,
+        gap_ns,
+        has_pair,
+        fi,
+        si,
+        early,
+        ties_n,
+        max_gap_ns,
+        gaps,
+    )
+
+
+def _to_sec(t_ns: I64) -> F64:
+    """rospy's ``Time.to_sec()``: float(secs) + float(nsecs) / 1e9."""
+    return np.asarray((t_ns // 1_000_000_000).astype(np.float64) + (t_ns % 1_000_000_000) / 1e9)
+
+
+def _matched(
+    robot: PoseStream,
+    gt: PoseStream,
+    gt_xyz_at: F64,
+    gt_quat_at: F64,
+    inside: npt.NDArray[np.bool_],
+    gap_ns: I64,
+    has_pair: npt.NDArray[np.bool_],
+    fi: npt.NDArray[np.intp],
+    si: npt.NDArray[np.intp],
+    early: npt.NDArray[np.bool_],
+    ties_n: int,
+    max_gap_ns: int,
+    gaps: Gaps,
+) -> Matched:
+    """Statuses and errors from the GT pose chosen for each robot pose."""
+    q = robot.t_ns
     status = np.full(len(q), COMPARED, dtype=np.uint8)
     status[~inside] = UNCOVERED
     across = inside & (gap_ns > max_gap_ns)
@@ -135,7 +233,6 @@ def associate(
     pos_err = np.where(ok, row_norm(robot.xyz - gt_xyz_at), np.nan)
     yaw_err = np.abs(wrap_angle(np.where(ok, robot_yaw - gt_yaw, np.nan)))
     raw = np.where(ok, yaw_tf(robot.quat_xyzw) - yaw_tf(gt_quat_at), np.nan)
-    ties_n = int(np.count_nonzero(interp.inside & (interp.lo == interp.hi)))
     return Matched(
         q, status, gt_xyz, gt_yaw, pos_err, yaw_err, raw, ties_n, across, int(early.sum())
     )

@@ -20,9 +20,11 @@ ASSOCIATIONS: tuple[Association, ...] = ("linear", "nearest", "hold")
 Ties = Literal["at", "before"]
 Gaps = Literal["skip", "compare"]
 BeforeGt = Literal["uncovered", "first"]
+GtOrder = Literal["time", "chain"]
 TIES: tuple[Ties, ...] = ("at", "before")
 GAPS: tuple[Gaps, ...] = ("skip", "compare")
 BEFORE_GT: tuple[BeforeGt, ...] = ("uncovered", "first")
+GT_ORDERS: tuple[GtOrder, ...] = ("time", "chain")
 
 
 @dataclass(frozen=True)
@@ -43,6 +45,9 @@ class TrajectoryConfig:
             given by the association, counted and warned about (``compare``, 2015).
         before_gt: robot poses before the first GT pose are uncovered (``uncovered``) or
             compared with the first GT pose (``first``, 2015).
+        gt_order: the GT poses of all files merged in time order (``time``), or the files
+            chained by start time, each in record order, and scanned forward as 2015 did
+            (``chain``; with ``hold`` and ``ties`` ``before`` only: 2015's scan).
     """
 
     association: Association = "linear"
@@ -55,6 +60,7 @@ class TrajectoryConfig:
     ties: Ties = "at"
     gaps: Gaps = "skip"
     before_gt: BeforeGt = "uncovered"
+    gt_order: GtOrder = "time"
 
     def __post_init__(self) -> None:
         if self.association not in ASSOCIATIONS:
@@ -65,6 +71,7 @@ class TrajectoryConfig:
             ("ties", self.ties, TIES),
             ("gaps", self.gaps, GAPS),
             ("before-gt", self.before_gt, BEFORE_GT),
+            ("gt-order", self.gt_order, GT_ORDERS),
         ):
             if value not in allowed:
                 raise ConfigError(f"--{name} {value!r} unknown; choose from {', '.join(allowed)}")
@@ -72,6 +79,12 @@ class TrajectoryConfig:
             # Only the held pose depends on the tie rule: linear and nearest give the sample at
             # the robot time whichever pair brackets it.
             raise ConfigError(f"--ties before needs --association hold (not {self.association})")
+        if self.gt_order == "chain" and (self.association, self.ties) != ("hold", "before"):
+            # The chained poses are out of time order where files overlap: only 2015's forward
+            # scan (hold, the pose before a tie) says which pose a robot time is paired with.
+            raise ConfigError(
+                "--gt-order chain needs --association hold --ties before (2015's scan)"
+            )
         if self.max_gap_ns <= 0:
             raise ConfigError(f"--max-gap must be positive, not {self.max_gap_ns / NS_PER_S} s")
         if self.offset_range_ns <= 0:
@@ -91,5 +104,11 @@ class TrajectoryConfig:
 # What ``--2015`` selects: each is one option on its own (docs/trajectory.md, the RULE_*
 # constants below). Read-only: the CLI and of_2015 copy it.
 SETTINGS_2015: Mapping[str, str] = MappingProxyType(
-    {"association": "hold", "ties": "before", "gaps": "compare", "before_gt": "first"}
+    {
+        "association": "hold",
+        "ties": "before",
+        "gaps": "compare",
+        "before_gt": "first",
+        "gt_order": "chain",
+    }
 )

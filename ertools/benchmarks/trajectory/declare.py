@@ -22,6 +22,7 @@ from ertools.benchmarks.trajectory.config import (
     ASSOCIATIONS,
     BEFORE_GT,
     GAPS,
+    GT_ORDERS,
     SETTINGS_2015,
     TIES,
     TrajectoryConfig,
@@ -80,10 +81,20 @@ INPUTS = (
         group=LEGACY,
     ),
     Input(
+        "gt_order",
+        "choice",
+        "GT files overlapping in time: their poses merged in time order (time, default) or "
+        "the files chained by start time and scanned forward (chain, 2015; needs "
+        "--association hold --ties before)",
+        choices=GT_ORDERS,
+        group=LEGACY,
+    ),
+    Input(
         "as_2015",
         "flag",
         "compute what the 2015 script did: --association hold --ties before --gaps compare "
-        "--before-gt first (2015's orientation error is orientation_error_2015)",
+        "--before-gt first --gt-order chain (2015's orientation error is "
+        "orientation_error_2015)",
         flag="--2015",
         group=LEGACY,
     ),
@@ -164,7 +175,7 @@ def make_options(given: Mapping[str, Any]) -> TrajectoryOptions:
     auto = offset is None
     if v["apply_offset"] and not auto:
         raise UsageError("--apply-offset needs --offset auto")
-    chosen = {k: v[k] for k in ("association", "ties", "gaps", "before_gt")}
+    chosen = {k: v[k] for k in ("association", "ties", "gaps", "before_gt", "gt_order")}
     settings = {k: value for k, value in chosen.items() if value is not None}
     if v["as_2015"]:
         clash = [

@@ -159,6 +159,37 @@ def read_gt(files: Sequence[str], topic: str, start_ns: int, end_ns: int) -> Pos
     return read_poses(files, topic, start_ns=start_ns, end_ns=end_ns)
 
 
+def read_gt_chain(files: Sequence[str], topic: str) -> PoseStream:
+    """GT poses as the 2015 script read them: whole files, chained in the order given (by
+    start time), each in record order; header stamps, not sorted (``--gt-order chain``)."""
+
+    streams = []
+    for path in files:
+        with open_bag(path) as bag:
+            conns = bag.topic_conns(topic)
+            if not conns:
+                continue
+            batch = load_pose_batch(bag, conns, None, None)
+        # rosbag's read_messages yields a file's messages by record time.
+        order = np.argsort(batch.t_record, kind="stable")
+        streams.append(
+            PoseStream(
+                batch.t_header[order],
+                batch.xyz[order],
+                batch.quat_xyzw[order],
+                source=f"{path}:{topic}",
+            )
+        )
+    if not streams:
+        raise TopicError(f"GT topic {topic} is in none of {', '.join(files)}")
+    return PoseStream(
+        np.concatenate([s.t_ns for s in streams]),
+        np.concatenate([s.xyz for s in streams]),
+        np.concatenate([s.quat_xyzw for s in streams]),
+        source=", ".join(s.source for s in streams),
+    )
+
+
 def same_bag(robot_bag: str | Path, gt_paths: Sequence[str | Path]) -> bool:
     """Whether the GT is read from the robot log itself: no GT path, or only the robot log."""
     robot_real = Path(robot_bag).resolve()

@@ -94,14 +94,18 @@ RULE_GT_OVERLAP = Rule(
     title="GT files overlapping in time",
     rulebook=_SEED,
     node_2015=(
-        "chained the GT files sorted by start time and scanned them in that order, warning "
-        "'poses out of order: result may be invalid' (rockin_trajectory_benchmark.py)"
+        "chained the GT files sorted by start time (`sorted(mocap_bags_list, key=... "
+        "['start'])`, `itertools.chain`) and scanned the chain forward, never back, warning "
+        "'poses out of order: result may be invalid' (rockin_trajectory_benchmark.py, "
+        "DualIterator and seek_mocap_pose_at): a robot pose is paired with the first pose "
+        "of the chain at or after its time and the one read before it, out of order or not"
     ),
     ertools=(
-        "poses merged in time order, a message recorded twice used once; no option: 2015's "
-        "result there depends on where its scan stood, a defect rather than a rule"
+        "poses merged in time order, a message recorded twice used once: the GT pose at the "
+        "robot's time whatever file holds it (2015's pair there can be a pose of the other file "
+        "from before a pose it already passed)"
     ),
-    option="",
+    option="--gt-order chain",
 )
 RULE_INVALID_POSES = Rule(
     key="trajectory.invalid-poses",

@@ -11,6 +11,7 @@ size <= pi moves a mean or an atan2 of the sums by < 1e-13.
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from pathlib import Path
@@ -294,8 +295,11 @@ def hand(tmp_path: Path) -> list[str]:
 @pytest.mark.parametrize(
     ("options", "held_x", "counts"),
     [
-        # 2015: -50 -> GT0, tie 100 -> GT0, 250 -> GT2, 500 -> GT3 across the hole, 900 -> GT4
-        (["--2015"], [0.0, 0.0, 0.2, 0.3, 0.8], {"gaps_compared": 1, "before_gt": 1}),
+        # 2015: -50 -> GT0, tie 100 -> GT0, 250 -> GT2, 500 -> GT3 across the hole, 900 -> GT4;
+        # its gap test in float seconds (to_sec) at this epoch: 900 ms - 800 ms is
+        # 0.10000014305114746 s > 0.1, so the pair (GT4, GT5) counts as a gap too (0 - 100 ms
+        # and 200 - 300 ms give 0.09999990463256836 s)
+        (["--2015"], [0.0, 0.0, 0.2, 0.3, 0.8], {"gaps_compared": 2, "before_gt": 1}),
         # hold: the tie takes the sample at t, the hole is skipped, -50 uncovered
         (["--association", "hold", "--allow-partial"], [0.1, 0.2, 0.9], {"gaps": 1}),
         (
@@ -355,6 +359,8 @@ def test_uncovered_start_error_points_at_before_gt(
         (["--2015", "--association", "linear"], "--2015 sets --association hold"),
         (["--2015", "--gaps", "skip"], "cannot take --gaps skip"),
         (["--ties", "before"], "--ties before needs --association hold"),
+        (["--gt-order", "chain"], "--gt-order chain needs --association hold --ties before"),
+        (["--2015", "--gt-order", "time"], "cannot take --gt-order time"),
     ],
 )
 def test_conflicting_options_are_usage_errors(
@@ -396,12 +402,115 @@ def test_overlapping_gt_files_are_a_deviation(
     a = write_gt(tmp_path / "gt_a.bag", t[:60], xyz[:60], GT_TOPIC)
     b = write_gt(tmp_path / "gt_b.bag", t[40:], xyz[40:], GT_TOPIC)  # 20 messages twice
     robot = write_robot(tmp_path / "robot.bag", t[5:95:10] + 5 * MS, np.zeros((9, 3)), ROBOT_TOPIC)
-    ours = _cli_json([str(robot), str(a), str(b), "--2015"], capsys)
+    others_2015 = ["--association", "hold", "--ties", "before", "--gaps", "compare"]
+    ours = _cli_json([str(robot), str(a), str(b), *others_2015], capsys)
     assert ours["tracking_lost"] == 0  # the duplicates are used once
     assert any(
-        d.startswith("1 pair(s) of GT files overlap") and d.endswith("[trajectory.gt-overlap]")
+        d.startswith("1 pair(s) of GT files overlap")
+        and d.endswith("--gt-order chain restores 2015 [trajectory.gt-overlap]")
         for d in ours["deviations"]
     )
+    # --2015 chains them (the robot poses all lie after the overlap or before it: same pairs).
+    chained = _cli_json([str(robot), str(a), str(b), "--2015"], capsys)
+    assert not any("[trajectory.gt-overlap]" in d for d in chained["deviations"])
+    assert chained["position_error"] == pytest.approx(ours["position_error"], abs=1e-12)
+    node = score_2015(_poses(robot, ROBOT_TOPIC), [_poses(a, GT_TOPIC), _poses(b, GT_TOPIC)])
+    assert_same(chained, node)
+
+
+# --- GT files overlapping in time: 2015 chained them and scanned forward ------------------------
+# The peer suite of rockin_offline_trajectory_benchmark, case 6 (tests/test_bags_6.yaml, "the
+# two mocap bags overlap"): each message (bag, stamp s, x) written with its record time = its
+# stamp (tests/test_bags.py), z = 1, roll = pitch = yaw = 0, frame world.
+PEER_6 = (
+    ("rockin_mocap_bag_1", 0.05, 1.0, 0.0),
+    ("robot_bag", 0.1, 0.0, 0.0),
+    ("rockin_mocap_bag_1", 0.15, 1.1, 0.0),
+    ("robot_bag", 0.2, 0.1, 0.0),
+    ("rockin_mocap_bag_1", 0.35, 1.3, 0.0),
+    ("robot_bag", 0.3, 0.2, 0.0),
+    ("rockin_mocap_bag_2", 0.25, 1.2, 0.0),
+    ("robot_bag", 0.4, 0.3, 0.0),
+    ("rockin_mocap_bag_2", 0.45, 1.4, 0.0),
+    ("robot_bag", 0.5, 0.4, 0.0),
+    ("rockin_mocap_bag_2", 0.55, 1.2, 1.2),
+)
+PEER_ROBOT_TOPIC = "/rockin/team/marker_pose"
+PEER_GT_TOPIC = "/airlab/robot/pose"
+
+
+def _peer_bags(folder: Path, messages: tuple[tuple[str, float, float, float], ...]) -> Path:
+    """The bags of a peer-suite case, as its tests/test_bags.py wrote them."""
+    from ertools.samples.writer import BagWriter
+
+    gt_dir = folder / "mocap"
+    gt_dir.mkdir()
+    for name in dict.fromkeys(m[0] for m in messages):
+        rows = [m for m in messages if m[0] == name]
+        t = np.array([round(s * 1e9) for _, s, _, _ in rows], dtype=np.int64)
+        xyz = np.array([[x, y, 1.0] for _, _, x, y in rows])
+        quat = np.tile([0.0, 0.0, 0.0, 1.0], (len(rows), 1))
+        robot = name == "robot_bag"
+        path = (folder if robot else gt_dir) / f"{name}.bag"
+        with BagWriter(path, "ros1") as bag:
+            topic = PEER_ROBOT_TOPIC if robot else PEER_GT_TOPIC
+            bag.write_pose_stamped(topic, t, t, "world", xyz, quat)
+    return gt_dir
+
+
+def test_peer_case_6_overlapping_gt_files(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    gt_dir = _peer_bags(tmp_path, PEER_6)
+    robot = tmp_path / "robot_bag.bag"
+    # By hand, 2015's scan over the chain 0.05, 0.15, 0.35 | 0.25, 0.45, 0.55 (bag 1 starts
+    # first): robot 0.1 -> x 1.0, 0.2 -> 1.1, 0.3 -> 1.1 (0.35 >= 0.3), 0.4 -> past 0.35 and
+    # 0.25 to 0.45: x 1.2, 0.5 -> 1.4. Distances 1.0, 1.0, 0.9, 0.9, 1.0: 4.8 / 5 = 0.96.
+    ours = _cli_json([str(robot), str(gt_dir), "--2015"], capsys)
+    assert ours["position_error"] == pytest.approx(0.96, abs=1e-12)
+    assert ours["compared"] == 5 and ours["orientation_error_2015"] == 0.0
+    files = [
+        _poses(gt_dir / "rockin_mocap_bag_1.bag", PEER_GT_TOPIC),
+        _poses(gt_dir / "rockin_mocap_bag_2.bag", PEER_GT_TOPIC),
+    ]
+    assert_same(ours, score_2015(_poses(robot, PEER_ROBOT_TOPIC), files))
+    assert any("go back in time at 1 place(s)" in w for w in ours["warnings"])
+    # Time order: 1.0, 1.1, 1.2, 1.3, 1.4 held for 0.0 ... 0.4: 1.0 each, said.
+    time_order = ["--association", "hold", "--ties", "before", "--gaps", "compare"]
+    ours = _cli_json([str(robot), str(gt_dir), *time_order, "--before-gt", "first"], capsys)
+    assert ours["position_error"] == pytest.approx(1.0, abs=1e-12)
+    assert any("[trajectory.gt-overlap]" in d for d in ours["deviations"])
+
+
+def _split(gt: list[Pose], how: str) -> list[list[Pose]]:
+    """GT files as loggers would have left them, in start order."""
+    n = len(gt)
+    if how == "overlap":  # two loggers recording the same topic for a while: messages twice
+        return [gt[: n * 6 // 10], gt[n * 4 // 10 :]]
+    if how == "interleaved":  # two loggers taking turns: a file of even, one of odd frames
+        return [gt[0:n:2], gt[1:n:2]]
+    return [gt[: n // 3], gt[n // 4 : n * 2 // 3], gt[n // 2 :]]  # three, chained overlaps
+
+
+@pytest.mark.parametrize("how", ["overlap", "interleaved", "three"])
+@pytest.mark.parametrize("seed", range(3))
+def test_chained_gt_files_equal_the_2015_scan(seed: int, how: str) -> None:
+    robot, gt = _random_case(seed)
+    files = _split(gt, how)
+    chain = [p for f in files for p in f]
+    node = score_2015(robot, files)
+    ours = _run(robot, chain).to_dict()
+    assert_same(ours, node)
+    # Not vacuous: the chain goes back in time.
+    assert any(b[0] < a[0] for a, b in itertools.pairwise(chain))
+    timed = score_2015(robot, [gt])
+    if how == "interleaved":
+        # Files holding different samples of the same time: 2015's pairs are not the GT's.
+        assert abs(timed.position_error - node.position_error) > 1e-6
+    else:
+        # A file re-recording messages the other holds: the forward scan, past the jump
+        # back, stops where the time-ordered one does.
+        assert node.position_error == pytest.approx(timed.position_error, rel=1e-12)
 
 
 def test_yaw_tf_equals_tf_s_arithmetic() -> None:
