@@ -25,6 +25,7 @@ items:
 # Inputs whose value needs another to be valid (given together with them).
 TOGETHER: dict[tuple[str, str], dict[str, Any]] = {
     ("trajectory", "ties"): {"association": "hold"},
+    ("trajectory", "gt_order"): {"association": "hold", "ties": "before"},
     ("trajectory", "apply_offset"): {"offset": "auto"},
     ("fbm2h", "transforms"): {"team": "homer"},
 }
