@@ -57,7 +57,7 @@ from ertools.configs.transform import (
     load_transform,
     team_transform_path,
 )
-from ertools.errors import ConfigError, ScoringError, SegmentationError
+from ertools.errors import ConfigError, ScoringError, SegmentationError, TopicError
 from ertools.fidelity import Deviation
 from ertools.geometry import compose, yaw_from_quat
 from ertools.io import read_benchmark_states, summary
@@ -459,10 +459,20 @@ def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
     goal = load_goal(options.goal) if options.goal is not None else None
     # The 2015 node looked the marker set up in tf; the topic carries the same poses stamped
     # a few microseconds earlier, and is what most tools show: the default reads it.
+    spec = _pose_spec(options)
     defaults: tuple[PoseSpec, ...] = (topic(DEFAULT_TOPIC),)
-    if options.pose_2015:
-        defaults = (tf_source(TF_2015[1], TF_2015[0]), *defaults)
-    marker = read_source(list(plist), _pose_spec(options), defaults, what="marker set poses")
+    try:
+        marker = read_source(
+            list(plist),
+            spec,
+            (tf_source(TF_2015[1], TF_2015[0]), *defaults) if options.pose_2015 else defaults,
+            what="marker set poses",
+        )
+    except TopicError:
+        if not options.pose_2015 or spec.given:
+            raise
+        # /tf without the marker set: the topic, said in the result (score_found).
+        marker = read_source(list(plist), spec, defaults, what="marker set poses")
     if len(marker) == 0:
         raise SegmentationError(f"{marker.source or plist[0]}: the marker set pose stream is empty")
     total = len(marker)

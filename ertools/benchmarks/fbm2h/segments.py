@@ -2,9 +2,13 @@
 
 Three sources, one result (:class:`ReachedMoments`):
 
-- ``states``: the BmBox/Client state topics, as the 2015 node ran. The node took
-  ``start_segment_time`` right after ``SendGoal()`` returned (the BmBox in EXECUTING_GOAL) and
-  ``end_segment_time`` when ``WaitResult()`` returned (the Client's COMPLETED_GOAL).
+- ``states``: the BmBox/Client/RefBox state topics. The 2015 node took
+  ``start_segment_time`` right after ``SendGoal()`` returned (its BmBox out of
+  TRANSMITTING_GOAL) and ``end_segment_time`` when ``WaitResult()`` returned (out of
+  WAITING_RESULT, once the Client's COMPLETED_GOAL, or the RefBox's ``reason: timeout`` /
+  ``reason: stop``, had arrived): the ``bmbox`` clock times segments between those BmBox
+  messages, the default ``client`` clock ends them at the Client's report itself. A log that
+  ends inside the benchmark is the benchmark stopped there.
 - ``timing``: a reached-waypoint timing file (``p0`` starts the run, ``p(k+1)`` closes
   segment ``k``).
 - ``auto``: stops detected in the ground truth (speed and yaw rate under thresholds for a

@@ -399,3 +399,26 @@ def test_sample_2015_is_the_node_on_its_own_clock(
     assert code == 0 and out["execution_time"] == pytest.approx(41.2, abs=1e-9)
     assert "--segment-clock bmbox restores 2015 [fbm2h.segment-clock]" in err
     assert "--tf world:robot_at_home restores 2015 [fbm2h.pose-source]" in err
+
+
+def test_2015_without_the_node_s_tf_frame_scores_the_topic_and_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A log whose /tf lacks world -> robot_at_home: --2015 reads the pose topic, warned."""
+    t = T0 + np.arange(0, 6 * S, S // HZ, dtype=np.int64)
+    xyz = np.column_stack([np.linspace(0.0, 0.5, len(t)), np.zeros(len(t)), np.full(len(t), 0.85)])
+    quat = np.tile([0.0, 0.0, 0.0, 1.0], (len(t), 1))
+    bag = tmp_path / "log.bag"
+    with BagWriter(bag) as w:
+        w.write_pose_stamped("/fbm2h/robot_at_home/pose", t, t, "world", xyz, quat)
+        w.write_tf(t[:5], t[:5], "world", "map", xyz[:5], quat[:5])
+    goal = tmp_path / "goal.yaml"
+    goal.write_text("goal:\n  waypoints:\n  - [0.1, 0.0, 0.0]\n  - [0.4, 0.0, 0.0]\n")
+    timing = tmp_path / "timing.yaml"
+    timing.write_text("reached_waypoint_timing:\n- p0: 0.5\n- p1: 1.5\n- p2: 5.0\n")
+    args = [str(bag), "--goal", str(goal), "--reached", "timing", str(timing), "--2015"]
+    code, out, err = _score(args, capsys)
+    assert code == 0, err
+    assert "--2015: the 2015 node read the marker set from /tf world -> robot_at_home" in err
+    # x at 1.5 s and 5.0 s of the 6 s ramp to 0.5 m: 0.125 and 0.41667 m; errors 0.025, 0.0167.
+    assert out["position_accuracy"] == pytest.approx((0.025 + 0.5 * 5 / 6 - 0.4) / 2, abs=1e-6)
