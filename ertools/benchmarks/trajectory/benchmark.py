@@ -41,7 +41,7 @@ from ertools.benchmarks.trajectory.scoring import score_streams
 from ertools.errors import ClockError, ScoringError
 from ertools.io import summary
 from ertools.streams import PoseStream
-from ertools.timeutil import NS_PER_S
+from ertools.timeutil import NS_PER_S, iso_utc
 
 if TYPE_CHECKING:
     from ertools.io import BagSummary
@@ -116,6 +116,8 @@ def load(paths: Sequence[str | Path], options: TrajectoryOptions) -> TrajectoryL
             robot_path, gt_paths, lo - margin, hi + margin, options.gt_topic
         )
     if cfg.gt_order == "chain":
+        chosen, dropped = _files_2015(chosen, rs, cfg.offset_ns)
+        warnings.extend(dropped)
         # 2015 read every message of every file chosen, in the files' start order.
         gt = read_gt_chain([s.path for s in chosen], gtopic)
     else:
@@ -123,6 +125,33 @@ def load(paths: Sequence[str | Path], options: TrajectoryOptions) -> TrajectoryL
     return TrajectoryLogs(
         robot_path, topic, robot, tuple(chosen), gtopic, gt, tuple(warnings), tuple(broken)
     )
+
+
+def _files_2015(
+    chosen: Sequence[BagSummary], robot: BagSummary, offset_ns: int
+) -> tuple[list[BagSummary], list[str]]:
+    """The GT files 2015 chained: those whose span overlaps the robot bag's own (``rosbag
+    info`` start <= robot end and end >= robot start, no margin), in start order.
+
+    Only the chain depends on it: a file ending just before the robot log puts its last pose
+    before the first robot pose's pair. Raises ClockError when none is left (2015: exit 4).
+    """
+    lo, hi = robot.start_ns + offset_ns, robot.end_ns + offset_ns
+    inside = [s.start_ns <= hi and s.end_ns >= lo for s in chosen]
+    kept = [s for s, ok in zip(chosen, inside, strict=True) if ok]
+    dropped = [
+        f"GT file {s.path} does not overlap the robot log's span: not chained (--gt-order "
+        "chain chains the files 2015 chose, those overlapping the robot bag)"
+        for s, ok in zip(chosen, inside, strict=True)
+        if not ok
+    ]
+    if not kept:
+        raise ClockError(
+            f"no GT file overlaps the robot log {robot.path} itself ({iso_utc(lo)} to "
+            f"{iso_utc(hi)}): 2015 stopped there ('NO suitable rockin_mocap bags'); "
+            "--gt-order time searches around it"
+        )
+    return kept, dropped
 
 
 def locate_runs(logs: TrajectoryLogs, options: TrajectoryOptions) -> None:

@@ -159,6 +159,7 @@ def score_streams(
             f"{iso_utc(timed.end_ns)}); robot poses span {iso_utc(int(shifted.t_ns[0]))} to "
             f"{iso_utc(int(shifted.t_ns[-1]))} (offset {ns_to_s(offset_ns):+.3f} s)"
         )
+    failures: list[str] = []
     if n_out:
         text = ", ".join(
             f"{iso_utc(a)} to {iso_utc(b)} ({ns_to_s(b - a):.1f} s)" for a, b in spans[:3]
@@ -173,11 +174,21 @@ def score_streams(
                 if early
                 else ""
             )
-            raise ClockError(f"{where}: {msg}; give the missing GT files or --allow-partial{hint}")
-        notes.append(f"partial: {msg}; only the covered part is scored")
+            if early < n_out:
+                # Poses after the GT: 2015 stopped with no score (exit 6); so does this.
+                raise ClockError(
+                    f"{where}: {msg}; give the missing GT files or --allow-partial{hint}"
+                )
+            # Only before the GT, where 2015 still gave a score: the covered part is scored
+            # and printed, the uncovered start a failure (exit 1).
+            failures.append(
+                f"{where}: {msg}; the covered part is scored; give the missing GT files or "
+                f"--allow-partial{hint}"
+            )
+        else:
+            notes.append(f"partial: {msg}; only the covered part is scored")
 
     m = metrics(matched)
-    failures: list[str] = []
     if m is None:
         failures.append(
             f"no robot pose could be compared ({matched.count(GAP)} in GT gaps, "

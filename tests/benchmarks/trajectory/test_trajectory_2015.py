@@ -344,13 +344,25 @@ def test_each_default_names_its_option(hand: list[str], capsys: pytest.CaptureFi
     assert ours["deviations"] == []  # zero yaws: nothing crosses +-pi either
 
 
-def test_uncovered_start_error_points_at_before_gt(
+def test_uncovered_start_is_a_failure_with_the_covered_part_scored(
     hand: list[str], capsys: pytest.CaptureFixture[str]
 ) -> None:
-    assert main(["score", "trajectory", *hand, "--association", "hold"]) == 1
+    """2015 scored this log (the pose before the GT compared with the first GT pose): the
+    default prints the covered part's numbers, exit 1, the failure pointing at the options."""
+    assert main(["score", "trajectory", *hand, "--association", "hold", "--format", "json"]) == 1
+    cap = capsys.readouterr()
+    errors = [ln for ln in cap.err.splitlines() if ln.startswith("ertools: error: ")]
+    assert len(errors) == 1
+    assert "1 lie before the first GT pose" in errors[0] and "--before-gt first" in errors[0]
+    out = json.loads(cap.out)
+    # hold: tie 100 -> 0.1 (the sample at t), 250 -> 0.2, 900 -> 0.9; 500 in the hole skipped.
+    assert out["compared"] == 3 and out["uncovered"] == 1
+    assert out["position_error"] == pytest.approx((0.1 + 0.2 + 0.9) / 3, abs=1e-12)
+    # After the last GT pose 2015 gave no score (exit 6): still an error alone.
+    late = [hand[0], hand[1], "--association", "hold", "--offset", "0.2"]
+    assert main(["score", "trajectory", *late]) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("ertools: error: ")
-    assert "1 lie before the first GT pose" in err[0] and "--before-gt first" in err[0]
 
 
 @pytest.mark.parametrize(
