@@ -67,8 +67,9 @@ RULE_BEFORE_GT = Rule(
         "happen' (rockin_trajectory_benchmark.py, seek_mocap_pose_at)"
     ),
     ertools=(
-        "uncovered: an error naming the span (GT files missing or clocks apart), or not "
-        "scored with --allow-partial"
+        "uncovered, not scored: the covered part is scored and the uncovered span is a "
+        "failure naming it (GT files missing or clocks apart; exit 1), or only said with "
+        "--allow-partial"
     ),
     option="--before-gt first",
 )
