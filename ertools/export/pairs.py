@@ -31,7 +31,7 @@ from ertools.benchmarks.common.sources import read_source
 from ertools.benchmarks.trajectory.association import COMPARED
 from ertools.benchmarks.trajectory.benchmark import score
 from ertools.benchmarks.trajectory.inputs import read_gt
-from ertools.errors import ScoringError, UsageError
+from ertools.errors import ClockError, ScoringError, UsageError
 from ertools.export.formats import SUFFIXES, ExportFormat, format_poses, format_times
 from ertools.geometry import interpolate_poses
 from ertools.streams import PoseStream
@@ -99,6 +99,7 @@ def trajectory_pair(
 
     Raises:
         ScoringError: ``matched`` and no pose could be compared; the errors of ``score``.
+        ClockError: robot poses outside the GT without ``allow_partial``.
     """
 
     result = score(
@@ -109,6 +110,10 @@ def trajectory_pair(
         gt_topic=gt_topic,
         robot_time=robot_time,
     )
+    if result.uncovered and not config.allow_partial:
+        # The score prints the covered part when the uncovered poses precede the GT (a
+        # failure); files written for another tool would carry no such mark: refused.
+        raise ClockError("; ".join(result.failures))
     m = result.matched
     robot = result.robot
     shifted = PoseStream(
