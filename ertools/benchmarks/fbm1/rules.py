@@ -77,3 +77,21 @@ RULE_ABORTED = Rule(
     ertools="totals over the runs whose goal was sent (a run never asked is not a failed one)",
     option="--count-aborted",
 )
+
+RULE_POSE_SOURCE = Rule(
+    key="fbm1.pose-source",
+    benchmark="fbm1",
+    title="table and board pose source",
+    rulebook="the table (origin) and reference board marker sets from the mocap (seed 7.1)",
+    node_2015=(
+        f'{NODE_SOURCE}: `listener.lookupTransform("/origin", "/item", rospy.Time(0))` '
+        "(fbm1h at 117a5d0, line 125): the /tf frames origin and ref_board, never the pose "
+        "topics"
+    ),
+    ertools=(
+        "the pose topics /<ns>/origin/pose and /<ns>/ref_board/pose (the same mocap samples, "
+        "header-stamped), else the /tf frames; the one-lookup ground truths (--gt result, "
+        "placed, goal, and so --rules 2015) take /tf first"
+    ),
+    option="--origin-tf world:origin --ref-board-tf world:ref_board",
+)
