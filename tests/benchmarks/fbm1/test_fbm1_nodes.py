@@ -303,6 +303,7 @@ def test_rules_2015_chooses_the_nodes_pose_source(capsys: pytest.CaptureFixture[
     (bag,) = SAMPLE.glob("*.bag")
     items = SAMPLE / "fbm1h.yaml"
     tf_flags = ["--origin-tf", "world:origin", "--ref-board-tf", "world:ref_board"]
+    topic_flags = ["--ref-board-topic", "/fbm1h/ref_board/pose"]
     chosen, err = ertools_score(bag, items, "fbm1h", ["--rules", "2015"], capsys)
     given, _ = ertools_score(bag, items, "fbm1h", ["--rules", "2015", *tf_flags], capsys)
     assert chosen == given
@@ -310,8 +311,7 @@ def test_rules_2015_chooses_the_nodes_pose_source(capsys: pytest.CaptureFixture[
         bag,
         items,
         "fbm1h",
-        ["--rules", "2015", "--origin-topic", "/fbm1h/origin/pose"]
-        + ["--ref-board-topic", "/fbm1h/ref_board/pose"],
+        ["--rules", "2015", "--origin-topic", "/fbm1h/origin/pose", *topic_flags],
         capsys,
     )
     assert 1e-9 < abs(topics["pose_score"] - chosen["pose_score"]) < 1e-6
