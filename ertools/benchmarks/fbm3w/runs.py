@@ -35,7 +35,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64
-from ertools.benchmarks.common.ending import RefBoxEnd, cut_warning, refbox_ends
+from ertools.benchmarks.common.ending import RefBoxEnd, cut_warning, log_cut, refbox_ends
 from ertools.benchmarks.common.motion import moving_mean
 from ertools.benchmarks.common.phases import (
     DEFAULT_MIN_STILL_S,
@@ -212,6 +212,10 @@ def find_states(states: BenchmarkStates) -> list[RunWindow]:
             close(t, "interrupted", "the benchmark ended before the path")
     if cur is not None:
         close(int(bm.t_ns[-1]), "cut", "the BmBox log ends during the run")
+    elif runs and (cut := log_cut(bm, states.refbox)) is not None:
+        # Between runs: nothing is lost, but the log is not the whole benchmark.
+        said = cut_warning(cut, bm, t0, "the benchmark", "no run was open")
+        runs[-1] = replace(runs[-1], warnings=(*runs[-1].warnings, said))
     if not runs:
         raise SegmentationError(
             f"{bm.topic}: no run found (no EXECUTING_GOAL or manual operation in "
