@@ -74,7 +74,10 @@ RULE_ABORTED = Rule(
         f"{NODE_SOURCE}: `runs = runs + 1` before the manual operation, then `break` when the "
         "benchmark stopped: the run counts in every divisor with no positive and pose score 0"
     ),
-    ertools="totals over the runs whose goal was sent (a run never asked is not a failed one)",
+    ertools=(
+        "totals over the runs whose goal was sent (a run never asked is not a failed one); a "
+        "log that ends before a run's goal is that run stopped there"
+    ),
     option="--count-aborted",
 )
 
