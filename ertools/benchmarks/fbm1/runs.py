@@ -271,13 +271,20 @@ def _stopped_at_cut(
 
 
 def _refbox_item(changes: StateStream | None, lo: int | None, hi: int) -> ItemRef | None:
-    """The last non-empty RefBox EXECUTING_MANUAL_OPERATION payload in (lo, hi]."""
+    """The last non-empty RefBox payload of EXECUTING_MANUAL_OPERATION or EXECUTING_GOAL in
+    (lo, hi].
+
+    scripts/fbm1w (2015) took the item from what ``ManualOperation()`` returned: the RefBox
+    payload in force when the BmBox left WAITING_MANUAL_OPERATION, i.e. that of the RefBox's
+    EXECUTING_GOAL confirming the placement; a RefBox that named the item only while it
+    executed the manual operation is read there.
+    """
     if changes is None:
         return None
     window = changes.window(None if lo is None else lo + 1, hi)
     found: ItemRef | None = None
     for s, p in zip(window.state.tolist(), window.payload, strict=True):
-        if s == RefBoxState.EXECUTING_MANUAL_OPERATION:
+        if s in (RefBoxState.EXECUTING_MANUAL_OPERATION, RefBoxState.EXECUTING_GOAL):
             found = parse_item_ref(p, "refbox payload") or found
     return found
 

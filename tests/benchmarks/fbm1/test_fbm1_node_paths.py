@@ -1,16 +1,18 @@
 """``--rules 2015`` on every path of the 2015 FBM1 node, against its loop run as written.
 
-:func:`fbm1h_2015` is ``main()`` of ``scripts/fbm1h`` (rockin-robot-challenge/
-benchmark_and_scoring_fbm at 117a5d0) statement by statement, over the 2015 BmBox replayed
-from the log (``tests/bmbox2015.py``): ``WaitClient()`` (line 47); ``while Running() and runs
-< BENCHMARK_RUNS`` (50); ``runs = runs + 1`` (51); ``ManualOperation`` (59) and the two ``if
-not Running(): break`` (61, 65); ``SendGoal`` (82), ``start_time`` (83), ``WaitResult`` (86),
+:func:`fbm1_2015` is ``main()`` of ``scripts/fbm1h`` (rockin-robot-challenge/
+benchmark_and_scoring_fbm at 117a5d0) statement by statement, over the 2015 BmBox replayed from
+the log (``tests/bmbox2015.py``): ``WaitClient()`` (line 47); ``while Running() and runs <
+BENCHMARK_RUNS`` (50); ``runs = runs + 1`` (51); ``ManualOperation`` (59) and the two ``if not
+Running(): break`` (61, 65); ``SendGoal`` (82), ``start_time`` (83), ``WaitResult`` (86),
 ``end_time`` (87); ``if Timeout(): execution_time += ...; continue`` (89-92); ``if not
-Running(): continue`` (94-96); the answer, the class and instance ``==`` (106-113), the
+Running(): continue`` (94-96); the answer, the class and instance ``==`` (107-113), the
 lookup of /item in /origin at the node's ``now`` (117-125; the stamp of its item broadcast on
 /tf), the one-step theta wrap (132-133), the translation term set to 1 only above sqrt(2) m
 (147), the rotation clip, ``pose_score_sum`` (153), the time (158); every total over ``runs``
-(164-166).
+(164-166). ``scripts/fbm1w`` (svenschneider's copy at 6fa9eb7) differs in two statements:
+``while benchmark.Running():`` with no run cap, and the item is the one the RefBox payload
+returned by ``ManualOperation()`` names.
 
 The logs are generated with the samples' writer, one per path: a normal benchmark of 10
 runs, a timeout (the 10th run: the node's loop ends by its count), a RefBox stop while the
@@ -66,8 +68,9 @@ ITEMS = [
 # ----------------------------------------------------------------------------- the node
 
 
-def fbm1h_2015(log: Log) -> dict[str, Any]:
-    """``main()`` of scripts/fbm1h at 117a5d0 over the replayed BmBox (see the docstring)."""
+def fbm1_2015(log: Log, ns: str = "fbm1h") -> dict[str, Any]:
+    """``main()`` of scripts/fbm1h at 117a5d0 (or scripts/fbm1w, ``ns="fbm1w"``) over the
+    replayed BmBox (see the module docstring)."""
     benchmark = BmBoxReplay(log.states["bmbox"], log.states["refbox"], log.states["client"])
     items = {i["id"]: i for i in ITEMS}
     runs = 0
@@ -78,13 +81,18 @@ def fbm1h_2015(log: Log) -> dict[str, Any]:
     max_pose_error = math.sqrt(math.pow(1, 2) + math.pow(1, 2))
     per_run: dict[int, dict[str, Any]] = {}
     benchmark.WaitClient()
-    while benchmark.Running() and (runs < BENCHMARK_RUNS):
+    while benchmark.Running() and (ns == "fbm1w" or runs < BENCHMARK_RUNS):
         runs = runs + 1
         per_run[runs] = {"status": "aborted"}
         goals_before = benchmark.goals
-        benchmark.ManualOperation()
-        # random.choice(items) is in the log: the payload the node wrote with its choice
-        item = items[int(benchmark.manual_message.split()[2])]
+        item_instance = benchmark.ManualOperation()
+        if ns == "fbm1w":
+            if not benchmark.Running():
+                break
+            item = [x for x in ITEMS if x["instance"] == item_instance][0]  # noqa: RUF015 (as written)
+        else:
+            # random.choice(items) is in the log: the payload the node wrote with its choice
+            item = items[int(benchmark.manual_message.split()[2])]
         if not benchmark.Running():
             break
         if not benchmark.Running():
@@ -194,9 +202,12 @@ def _board(k: int) -> tuple[float, float, float]:
     return 0.3 + 0.02 * k, 0.2 + 0.01 * (k % 3), -2.9 + 0.6 * k
 
 
-def write_case(path: Path, case: Case) -> Path:
+def write_case(path: Path, case: Case, ns: str = NS, named_while: str = "both") -> Path:
     """The log of ``case``: state topics, 60 Hz mocap of table and board (pose topics and /tf,
-    as the 2015 mocap node), the node's item broadcasts on /tf."""
+    as the 2015 mocap node), the node's item broadcasts on /tf. At @Work (``ns="fbm1w"``) the
+    RefBox names the item (its payload while it executes the manual operation and the goal),
+    the BmBox's manual operation has none; ``named_while="goal"``: only in the EXECUTING_GOAL
+    that confirms the placement (what ``ManualOperation()`` returned to the 2015 node)."""
     tr = [
         Transition(T0 + S // 2, Machine.BMBOX, BmBoxState.START),
         Transition(T0 + S // 2, Machine.REFBOX, RefBoxState.START),
@@ -226,9 +237,20 @@ def write_case(path: Path, case: Case) -> Path:
         rel[on, 0] += 0.002 * (secs[on] - 3 - RUN_S * k)
         item = ITEMS[(3 * k + 1) % BENCHMARK_RUNS]
         payload = f"Place item {item['id']} ({item['instance']}) on the table"
+        named = item["instance"] if ns == "fbm1w" else ""
         tr += [
-            Transition(at(k, WMO), Machine.BMBOX, BmBoxState.WAITING_MANUAL_OPERATION, payload),
-            Transition(at(k, 0.05), Machine.REFBOX, RefBoxState.EXECUTING_MANUAL_OPERATION),
+            Transition(
+                at(k, WMO),
+                Machine.BMBOX,
+                BmBoxState.WAITING_MANUAL_OPERATION,
+                "" if ns == "fbm1w" else payload,
+            ),
+            Transition(
+                at(k, 0.05),
+                Machine.REFBOX,
+                RefBoxState.EXECUTING_MANUAL_OPERATION,
+                "" if named_while == "goal" else named,
+            ),
         ]
         if outcome == "stop-manual":
             tr += [
@@ -237,7 +259,7 @@ def write_case(path: Path, case: Case) -> Path:
             ]
             break
         tr += [
-            Transition(at(k, PLACED), Machine.REFBOX, RefBoxState.EXECUTING_GOAL),
+            Transition(at(k, PLACED), Machine.REFBOX, RefBoxState.EXECUTING_GOAL, named),
             Transition(at(k, CMO), Machine.BMBOX, BmBoxState.COMPLETED_MANUAL_OPERATION),
             Transition(at(k, TG), Machine.BMBOX, BmBoxState.TRANSMITTING_GOAL),
             Transition(at(k, CLIENT_EG), Machine.CLIENT, ClientState.EXECUTING_GOAL),
@@ -289,8 +311,8 @@ def write_case(path: Path, case: Case) -> Path:
             ("ref_board", xyz_w, q_w),
         ):
             pub = simulate_mocap(t[keep], xyz[keep], q[keep], rng=rng, noise=MocapNoise())
-            publish_mocap(bag, NS, body, pub)
-        publish_states(bag, NS, sorted(tr, key=lambda x: x.t_ns), end_ns=cut_ns)
+            publish_mocap(bag, ns, body, pub)
+        publish_states(bag, ns, sorted(tr, key=lambda x: x.t_ns), end_ns=cut_ns)
         for t_cast, item in casts:
             if cut_ns is None or t_cast <= cut_ns:
                 bag.write_tf(
@@ -300,7 +322,7 @@ def write_case(path: Path, case: Case) -> Path:
                     "item",
                     np.array([item["trans"]], dtype=float),
                     np.array([item["rot"]], dtype=float),
-                    callerid=f"/{NS}/benchmark",
+                    callerid=f"/{ns}/benchmark",
                 )
     return path
 
@@ -338,10 +360,22 @@ CASES: dict[str, Case] = {
         for phase in ("WMO", "CMO", "TG", "EG", "WR", "READY")
     },
 }
+# scripts/fbm1w has no run cap (``while benchmark.Running():``): its benchmark ends when the
+# RefBox stops it, the last run counted while waiting for its manual operation. A RefBox timeout
+# or an END it did not know leaves it waiting for the next manual operation forever (the RefBox
+# stops publishing at END): no 2015 score to compare with, so no such case here.
+CASES_1W = {
+    name: Case((*FULL, "stop-manual"), end_payload="reason: stop") if name == "normal" else case
+    for name, case in CASES.items()
+    if not name.startswith(("timeout", "unknown"))
+}
+PATHS = [("fbm1h", n) for n in CASES] + [("fbm1w", n) for n in CASES_1W]
 
 
-def _score(bag: Path, items: Path, args: list[str], capsys: Any) -> tuple[dict[str, Any], str]:
-    code = main(["score", NS, str(bag), "--items", str(items), "--format", "json", *args])
+def _score(
+    bag: Path, items: Path, args: list[str], capsys: Any, ns: str = NS
+) -> tuple[dict[str, Any], str]:
+    code = main(["score", ns, str(bag), "--items", str(items), "--format", "json", *args])
     out, err = capsys.readouterr()
     assert code == 0, err
     data: dict[str, Any] = json.loads(out)
@@ -352,16 +386,16 @@ def _close(got: float, want: float) -> bool:
     return got == pytest.approx(want, rel=REL, abs=1e-15)
 
 
-@pytest.mark.parametrize("name", list(CASES))
+@pytest.mark.parametrize(("ns", "name"), PATHS)
 def test_rules_2015_is_the_node_on_every_path(
-    name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    ns: str, name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    case = CASES[name]
-    bag = write_case(tmp_path / f"{name}.bag", case)
+    case = (CASES_1W if ns == "fbm1w" else CASES)[name]
+    bag = write_case(tmp_path / f"{name}.bag", case, ns)
     items = tmp_path / "items.yaml"
     items.write_text(yaml.safe_dump({"items": ITEMS}), encoding="utf-8")
-    node = fbm1h_2015(read_log(bag, NS))
-    data, err = _score(bag, items, ["--rules", "2015"], capsys)
+    node = fbm1_2015(read_log(bag, ns), ns)
+    data, err = _score(bag, items, ["--rules", "2015"], capsys, ns)
     for key, want in node["score"].items():
         assert _close(data[key], want), (key, data[key], want)
     assert len(data["runs"]) == len(node["runs"]), "every run the node counted, no other"
@@ -391,7 +425,7 @@ def test_rules_2015_is_the_node_on_every_path(
         assert "'reason: finished'" in err
 
     # The default scores every log the node scored, and says where it differs.
-    default, err = _score(bag, items, [], capsys)
+    default, err = _score(bag, items, [], capsys, ns)
     for key in ("class_accuracy", "instance_accuracy", "pose_score", "execution_time"):
         assert isinstance(default[key], float), key
     assert "differs from 2015" in err
@@ -405,9 +439,10 @@ def test_the_paths_give_the_numbers_issue_23_names(
     items = tmp_path / "items.yaml"
     items.write_text(yaml.safe_dump({"items": ITEMS}), encoding="utf-8")
     got = {}
+    ns = NS
     for name in ("stop-during-goal", "cut-in-WR", "cut-in-WMO"):
         bag = write_case(tmp_path / f"{name}.bag", CASES[name])
-        node = fbm1h_2015(read_log(bag, NS))
+        node = fbm1_2015(read_log(bag, ns), ns)
         assert len(node["runs"]) == 6, name
         got[name] = node["score"]
         data, _ = _score(bag, items, ["--rules", "2015"], capsys)
@@ -420,3 +455,18 @@ def test_the_paths_give_the_numbers_issue_23_names(
         assert score["instance_accuracy"] == pytest.approx(3 / 6, rel=REL)
         # the pose score too, over 6 (the mocap noise differs between the logs: 1e-5)
         assert score["pose_score"] == pytest.approx(got["stop-during-goal"]["pose_score"], abs=1e-4)
+
+
+def test_fbm1w_item_is_what_manual_operation_returned(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """scripts/fbm1w took the item from ``ManualOperation()``'s return: the RefBox payload when
+    the BmBox left the manual operation. A RefBox that names it only then is read there."""
+    items = tmp_path / "items.yaml"
+    items.write_text(yaml.safe_dump({"items": ITEMS}), encoding="utf-8")
+    bag = write_case(tmp_path / "w.bag", CASES_1W["normal"], "fbm1w", named_while="goal")
+    node = fbm1_2015(read_log(bag, "fbm1w"), "fbm1w")
+    data, _ = _score(bag, items, ["--rules", "2015"], capsys, "fbm1w")
+    assert [r["status"] for r in data["runs"].values()] == ["scored"] * 10 + ["aborted"]
+    for key, want in node["score"].items():
+        assert _close(data[key], want), key
