@@ -7,6 +7,7 @@ only what all benchmarks and the audit share.
 from __future__ import annotations
 
 import enum
+from dataclasses import dataclass
 
 
 class Machine(enum.Enum):
@@ -125,3 +126,75 @@ def state_name(machine: Machine, code: int) -> str:
 def state_topic(namespace: str, machine: Machine) -> str:
     """The canonical topic of a machine in a benchmark namespace, e.g. ``/fbm3w/bmbox_state``."""
     return f"/{namespace.strip('/')}/{STATE_TOPIC_SUFFIXES[machine][0]}"
+
+
+# --- RefBox END payloads ----------------------------------------------------------------------
+#
+# The 2015 BmBox (rockin_scoring/BmBox.py) reads one thing from the RefBox besides its state:
+# the payload, compared as a whole string. ``Timeout()`` is ``payload == "reason: timeout"``,
+# ``Running()`` is ``payload != "reason: stop"``, and its RefBox callback leaves
+# WAITING_RESULT / EXECUTING_GOAL on END only with one of those two strings (any END payload
+# ends a WAITING_MANUAL_OPERATION). The seed (6.2.3) documents the bare words ``timeout`` and
+# ``halt``. The Python machines themselves never publish END (their 10 Hz loop stops at END),
+# and a ``None`` payload goes out as "" (genpy fills unset strings). docs/fidelity.md lists
+# the forms with their sources.
+
+
+class EndReason(enum.Enum):
+    """What a RefBox END payload means to the 2015 BmBox."""
+
+    TIMEOUT = "timeout"  # Timeout() is true: the run's time counts, the run is over
+    STOP = "stop"  # Running() is false: the benchmark is over
+    UNKNOWN = "unknown"  # neither: the 2015 BmBox went on as if nothing was said
+
+
+@dataclass(frozen=True)
+class EndPayloadForm:
+    """One RefBox END payload the 2015 code or the seed names, and where."""
+
+    text: str
+    reason: EndReason
+    source: str
+
+
+END_PAYLOAD_FORMS: tuple[EndPayloadForm, ...] = (
+    EndPayloadForm(
+        "reason: timeout",
+        EndReason.TIMEOUT,
+        "rockin_scoring/BmBox.py: _refbox_state_cb, WaitResult, Timeout() compare it exactly",
+    ),
+    EndPayloadForm(
+        "reason: stop",
+        EndReason.STOP,
+        "rockin_scoring/BmBox.py: _refbox_state_cb, WaitResult, Running() compare it exactly",
+    ),
+    EndPayloadForm("timeout", EndReason.TIMEOUT, "seed 6.2.3: the RefBox's timeout payload"),
+    EndPayloadForm("halt", EndReason.STOP, "seed 6.2.3: the RefBox's emergency-halt payload"),
+)
+
+_END_FORMS = {f.text: f for f in END_PAYLOAD_FORMS}
+
+
+def end_reason(payload: str) -> EndReason:
+    """The meaning of a RefBox END payload: a known form exactly, else ``UNKNOWN``.
+
+    Exact, as the 2015 BmBox compared (``"Reason: Stop"`` or ``"reason: stop "`` meant
+    nothing to it). An ``UNKNOWN`` payload is neither a timeout nor a stop: callers warn with
+    :func:`unknown_end_warning` rather than guess from its words.
+    """
+    form = _END_FORMS.get(payload)
+    return EndReason.UNKNOWN if form is None else form.reason
+
+
+def known_end_payloads() -> str:
+    """The known END payload forms, quoted, for messages."""
+    return ", ".join(repr(f.text) for f in END_PAYLOAD_FORMS)
+
+
+def unknown_end_warning(payload: str, where: str) -> str:
+    """The one-line warning for a RefBox END payload that is no known form."""
+    return (
+        f"{where}: RefBox END with payload {payload!r}, which is none of the forms the 2015 "
+        f"BmBox or the seed know ({known_end_payloads()}); read as the 2015 BmBox did: neither "
+        "a timeout nor a stop (the BmBox states show what followed)"
+    )

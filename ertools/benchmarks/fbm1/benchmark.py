@@ -48,6 +48,7 @@ from ertools.benchmarks.fbm1.rules import (
     RULE_ABORTED,
     RULE_GT_MOMENT,
     RULE_NAMES,
+    RULE_POSE_SOURCE,
     RULE_THETA_WRAP,
     RULE_TRANS_CLIP,
 )
@@ -73,6 +74,10 @@ if TYPE_CHECKING:
     from ertools.io import PoseSource
 
 log = logging.getLogger("ertools.benchmarks.fbm1.benchmark")
+
+# Ground-truth methods that are one tf lookup, as the nodes made it: their poses come from /tf
+# first (the nodes never read the pose topics).
+TF_LOOKUPS = ("result", "placed", "goal")
 
 
 def _resolve_item(run: Fbm1Run, items: ItemList) -> tuple[Item, list[str]]:
@@ -253,9 +258,19 @@ def score_run(
     )
 
 
-def _deviations(runs: Sequence[Fbm1RunResult], options: Fbm1Options) -> list[Deviation]:
+def _deviations(
+    runs: Sequence[Fbm1RunResult], options: Fbm1Options, bodies: Sequence[PoseStream] = ()
+) -> list[Deviation]:
     """Where this result deliberately differs from the 2015 node, each with its rule."""
     out: list[Deviation] = []
+    topics = [b.source.rsplit(":", 1)[-1] for b in bodies if not b.source.endswith(":/tf")]
+    if topics:
+        out.append(
+            RULE_POSE_SOURCE.deviation(
+                f"poses from {', '.join(topics)}; 2015 looked the origin and ref_board frames "
+                "up in /tf"
+            )
+        )
     rules, gt = options.rules, options.gt
     scored = [r for r in runs if r.errors is not None]
     if gt.method != "result":
@@ -380,7 +395,7 @@ def score_fbm1(
         logged_score=_parse_logged(found.logged_score),
         t0_ns=t0_ns,
         warnings=tuple(warnings),
-        deviations=tuple(_deviations(runs, opts)),
+        deviations=tuple(_deviations(runs, opts, (origin, board))),
         failures=tuple(failures),
         provenance=provenance or Provenance(),
         reference=opts.reference,
@@ -426,9 +441,14 @@ def read_body(
     default_topic: str,
     frame: str,
     window: tuple[int | None, int | None] = (None, None),
+    tf_first: bool = False,
 ) -> PoseStream:
     """A body's poses: the given source, else the 2015 topic, else its /tf frame (the one
-    chooser, :func:`ertools.benchmarks.common.sources.read_source`)."""
+    chooser, :func:`ertools.benchmarks.common.sources.read_source`).
+
+    ``tf_first``: the /tf frame first, then the topic: what the nodes looked up (``--gt
+    result|placed|goal``, and so ``--rules 2015|2016``); the chooser warns when it falls back.
+    """
 
     start, end = window
     if source is not None:
@@ -438,7 +458,7 @@ def read_body(
     return read_source(
         paths,
         PoseSpec(),
-        (topic(default_topic), tf(frame)),
+        (tf(frame), topic(default_topic)) if tf_first else (topic(default_topic), tf(frame)),
         what=f"{frame} poses",
         start_ns=start,
         end_ns=end,
@@ -515,6 +535,7 @@ def locate_runs(logs: Fbm1Logs, options: Fbm1Options) -> Fbm1Runs:
         states.client,
         benchmark=ns,
         items_order=list(options.items_order) if options.items_order is not None else None,
+        t0_ns=logs.t0_ns,
     )
     if states.client is None and logs.results is None:
         # Scoring every run as unanswered would be a silent wrong score.
@@ -528,8 +549,9 @@ def locate_runs(logs: Fbm1Logs, options: Fbm1Options) -> Fbm1Runs:
     lo = min(r.start_ns for r in found.runs) - pad
     hi = max(r.end_ns for r in found.runs) + pad
     src = options.sources
-    origin = read_body(plist, src.origin, f"/{ns}/origin/pose", "origin", (lo, hi))
-    board = read_body(plist, src.board, f"/{ns}/ref_board/pose", "ref_board", (lo, hi))
+    tf_first = options.gt.method in TF_LOOKUPS
+    origin = read_body(plist, src.origin, f"/{ns}/origin/pose", "origin", (lo, hi), tf_first)
+    board = read_body(plist, src.board, f"/{ns}/ref_board/pose", "ref_board", (lo, hi), tf_first)
 
     for body, source in ((origin, src.origin), (board, src.board)):
         if source is None or source.time_source == "header":

@@ -22,9 +22,10 @@ class Fbm1RunResult:
 
     Attributes:
         index: 1-based run number.
-        status: ``scored``, ``no_answer`` (timeout/stop: counted with score 0), ``aborted``
-            (the goal was never sent: not counted), ``unfinished`` (the log ends during the
-            run: not counted) or ``failed`` (cannot be scored: see error).
+        status: ``scored``, ``no_answer`` (timeout/stop, or the log ends after the goal:
+            counted with score 0), ``aborted`` (the goal was never sent: not counted),
+            ``unfinished`` (the BmBox states leave a run open although the log goes on past it:
+            not counted) or ``failed`` (cannot be scored: see error).
         item: the presented item, None when unknown.
         item_text: the text that named it (payload or ``--items-order``).
         answer: the robot's answer, None without one.

@@ -74,6 +74,27 @@ RULE_ABORTED = Rule(
         f"{NODE_SOURCE}: `runs = runs + 1` before the manual operation, then `break` when the "
         "benchmark stopped: the run counts in every divisor with no positive and pose score 0"
     ),
-    ertools="totals over the runs whose goal was sent (a run never asked is not a failed one)",
+    ertools=(
+        "totals over the runs whose goal was sent (a run never asked is not a failed one); a "
+        "log that ends before a run's goal is that run stopped there"
+    ),
     option="--count-aborted",
+)
+
+RULE_POSE_SOURCE = Rule(
+    key="fbm1.pose-source",
+    benchmark="fbm1",
+    title="table and board pose source",
+    rulebook="the table (origin) and reference board marker sets from the mocap (seed 7.1)",
+    node_2015=(
+        f'{NODE_SOURCE}: `listener.lookupTransform("/origin", "/item", rospy.Time(0))` '
+        "(fbm1h at 117a5d0, line 125): the /tf frames origin and ref_board, never the pose "
+        "topics"
+    ),
+    ertools=(
+        "the pose topics /<ns>/origin/pose and /<ns>/ref_board/pose (the same mocap samples, "
+        "header-stamped), else the /tf frames; the one-lookup ground truths (--gt result, "
+        "placed, goal, and so --rules 2015) take /tf first"
+    ),
+    option="--origin-tf world:origin --ref-board-tf world:ref_board",
 )

@@ -6,8 +6,11 @@ EXECUTING_GOAL -> WAITING_RESULT -> READY``. The node measured its execution tim
 moment ``SendGoal`` returned (BmBox in ``EXECUTING_GOAL``) to the moment ``WaitResult``
 returned (BmBox leaving ``WAITING_RESULT``); the answer is the Client's ``COMPLETED_GOAL``
 payload. At @Work the Referee Box chose the item: its ``EXECUTING_MANUAL_OPERATION`` payload
-names it. A RefBox ``END`` with a ``timeout`` payload ends a run without answer; ``stop`` or
-``halt`` ends the benchmark.
+names it. A RefBox ``END`` whose payload the 2015 BmBox knew (:func:`ertools.states.end_reason`:
+``reason: timeout`` / ``timeout`` ends a run without answer, ``reason: stop`` / ``halt`` ends
+the benchmark) before the robot answered ends the run; another END payload is warned about and
+read as the BmBox read it (neither). A log that ends inside a run is that run stopped there
+(:mod:`ertools.benchmarks.common.ending`), said in a warning.
 
 The states were re-published at 10 Hz, so a state shorter than 100 ms may be missing from the
 log: each moment is the first message of the first state at or past it.
@@ -19,7 +22,14 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
-from ertools.states import BmBoxState, ClientState, RefBoxState
+from ertools.benchmarks.common.ending import cut_warning, log_cut, refbox_ends
+from ertools.states import (
+    BmBoxState,
+    ClientState,
+    EndReason,
+    RefBoxState,
+    unknown_end_warning,
+)
 from ertools.streams import StateStream
 
 _GOAL_STATES = (BmBoxState.TRANSMITTING_GOAL, BmBoxState.EXECUTING_GOAL, BmBoxState.WAITING_RESULT)
@@ -101,13 +111,7 @@ def parse_item_ref(text: str, source: str) -> ItemRef | None:
     return ItemRef(None, stripped, stripped, source)
 
 
-def _end_reason(payload: str) -> str | None:
-    low = payload.lower()
-    if "timeout" in low:
-        return "timeout"
-    if "stop" in low or "halt" in low:
-        return "stop"
-    return None
+_ENDED_BY = {EndReason.TIMEOUT: "timeout", EndReason.STOP: "stop"}
 
 
 def _bmbox_runs(bmbox: StateStream) -> tuple[list[Fbm1Run], str | None]:
@@ -172,6 +176,7 @@ def find_runs(
     *,
     benchmark: str = "fbm1h",
     items_order: Sequence[str] | None = None,
+    t0_ns: int | None = None,
 ) -> RunsFound:
     """The runs of one FBM1 execution.
 
@@ -181,6 +186,8 @@ def find_runs(
         client: the Client state topic (answers); None when absent (then ``--results``).
         benchmark: ``fbm1h`` (item from the BmBox payload first) or ``fbm1w`` (RefBox first).
         items_order: item ids or instance names per run, overriding the payloads.
+        t0_ns: the log's first message (times in warnings count from it; default: the first
+            BmBox message).
     """
     warnings: list[str] = []
     runs, logged_score = _bmbox_runs(bmbox)
@@ -210,14 +217,14 @@ def find_runs(
                 if hits:
                     answer_payload = done.payload[hits[0]]
                     answer_ns = int(done.t_ns[hits[0]])
-            if ref_changes is not None:
-                ended = ref_changes.window(run.goal_ns, nxt)
-                for s, p, t in zip(
-                    ended.state.tolist(), ended.payload, ended.t_ns.tolist(), strict=True
-                ):
-                    if s == RefBoxState.END and (answer_ns is None or t < answer_ns):
-                        ended_by = _end_reason(p) or "stop"
-                        break
+            for end in refbox_ends(refbox, run.goal_ns, nxt):
+                if answer_ns is not None and end.t_ns >= answer_ns:
+                    break
+                if end.reason is EndReason.UNKNOWN:
+                    warnings.append(unknown_end_warning(end.payload, f"run {run.index}"))
+                    continue
+                ended_by = _ENDED_BY[end.reason]
+                break
             if ended_by is not None and answer_ns is not None:
                 # The RefBox ended the run before the robot answered: 2015 ignored the answer.
                 answer_payload = answer_ns = None
@@ -230,19 +237,54 @@ def find_runs(
                 ended_by=ended_by,
             )
         )
+    cut = log_cut(bmbox, refbox)
+    if cut is not None:
+        t0 = int(bmbox.t_ns[0]) if t0_ns is None else t0_ns
+        out = _stopped_at_cut(out, cut, bmbox, t0, warnings)
     if items_order is not None:
         out = _apply_order(out, items_order, warnings)
     return RunsFound(tuple(out), tuple(warnings), logged_score)
 
 
+def _stopped_at_cut(
+    runs: list[Fbm1Run], cut_ns: int, bmbox: StateStream, t0_ns: int, warnings: list[str]
+) -> list[Fbm1Run]:
+    """The log ends inside the benchmark: the run in progress is stopped there (2015 on a
+    stop: counted in ``runs``, no answer, no time), and the output says so."""
+    last = runs[-1] if runs else None
+    if last is None or last.result_ns is not None or last.ended_by is not None:
+        warnings.append(cut_warning(cut_ns, bmbox, t0_ns, "the benchmark", "no run was open"))
+        return runs
+    k = last.index
+    if last.goal_ns is None:
+        what = f"run {k} is stopped before its goal (aborted)"
+    elif last.answer_payload is None:
+        what = f"run {k} is stopped without answer (counted, score 0, no time)"
+    else:
+        # The answer came before the log ended: the node had it (the BmBox's READY is what
+        # the log lacks), so the run is scored; its time is unknown.
+        what = f"run {k} was answered before the log ended and is scored"
+    warnings.append(cut_warning(cut_ns, bmbox, t0_ns, f"run {k}", what))
+    if last.goal_ns is None or last.answer_payload is not None:
+        return runs
+    return [*runs[:-1], replace(last, ended_by="stop")]
+
+
 def _refbox_item(changes: StateStream | None, lo: int | None, hi: int) -> ItemRef | None:
-    """The last non-empty RefBox EXECUTING_MANUAL_OPERATION payload in (lo, hi]."""
+    """The last non-empty RefBox payload of EXECUTING_MANUAL_OPERATION or EXECUTING_GOAL in
+    (lo, hi].
+
+    scripts/fbm1w (2015) took the item from what ``ManualOperation()`` returned: the RefBox
+    payload in force when the BmBox left WAITING_MANUAL_OPERATION, i.e. that of the RefBox's
+    EXECUTING_GOAL confirming the placement; a RefBox that named the item only while it
+    executed the manual operation is read there.
+    """
     if changes is None:
         return None
     window = changes.window(None if lo is None else lo + 1, hi)
     found: ItemRef | None = None
     for s, p in zip(window.state.tolist(), window.payload, strict=True):
-        if s == RefBoxState.EXECUTING_MANUAL_OPERATION:
+        if s in (RefBoxState.EXECUTING_MANUAL_OPERATION, RefBoxState.EXECUTING_GOAL):
             found = parse_item_ref(p, "refbox payload") or found
     return found
 

@@ -226,6 +226,8 @@ def score_runs(
     cfg = config if options.d_min is None else config.with_d_min(options.d_min)
     start_ns = poses.start_ns if bag_start_ns is None else bag_start_ns
     runs_in, warnings = with_specs(list(windows), cfg)
+    for w in runs_in:
+        warnings.extend(w.warnings)
     specs = cfg.runs_specifications
     if runs_in and runs_in[0].mode == "auto" and len(runs_in) < len(specs):
         last = runs_in[-1]
@@ -370,8 +372,6 @@ def _score_one(
     partial = window.status == "timeout" and options.timeout_runs == "2015"
     if window.status in ("interrupted", "timeout", "stopped") and not partial:
         return result(None, target_length=target_length)  # reported, not scored
-    if window.status == "incomplete":
-        return result("the log ends during the run; no complete path to score")
     if window.start_ns is None or window.end_ns is None or window.ref_ns is None:
         return result("no reference time or path window was found for this run")
     lo = int(np.searchsorted(poses.t_ns, window.start_ns, side="left"))

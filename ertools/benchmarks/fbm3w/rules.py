@@ -33,12 +33,15 @@ RULE_STOPPED_RUNS = Rule(
     key="fbm3w.stopped-runs",
     benchmark="fbm3w",
     title="stopped runs' time",
-    rulebook="the RefBox ends a benchmark with END and payload halt/stop (seed 6.2.3)",
+    rulebook="the RefBox ends a benchmark with END and payload halt (seed 6.2.3)",
     node_2015=(
         f"{NODE_SOURCE}: `if not benchmark.Running(): continue` comes before the time is added: a "
-        "stopped run was aborted, no score and no time"
+        "run stopped by `reason: stop` (BmBox.py `Running()`) was aborted, no score and no time"
     ),
-    ertools="no score, its time counted in execution_time (the robot did spend it)",
+    ertools=(
+        "no score, its time counted in execution_time (the robot did spend it); a log that "
+        "ends inside a run is that run stopped there"
+    ),
     option="--stopped-runs 2015",
 )
 

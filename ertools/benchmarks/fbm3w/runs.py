@@ -6,9 +6,12 @@ time window of the path. The scorer does the rest, identically for the three mod
 ``states`` (seed 7.3.3, the 2015 node): per run the BmBox goes
 ``WAITING_MANUAL_OPERATION -> COMPLETED_MANUAL_OPERATION`` (reference = pose at completion)
 ``-> TRANSMITTING_GOAL`` (payload: the spec) ``-> EXECUTING_GOAL`` (path starts)
-``-> WAITING_RESULT -> READY`` (path ends when WAITING_RESULT is left). A RefBox ``END`` with
-payload ``timeout``/``halt``/``stop`` during a run ends it early: that run is reported with
-that status and not scored, as the 2015 node skipped it.
+``-> WAITING_RESULT -> READY`` (path ends when WAITING_RESULT is left). A RefBox ``END`` during
+a run ends it early when its payload is one the 2015 BmBox knew (``reason: timeout`` /
+``reason: stop``, or the seed's ``timeout`` / ``halt``: :func:`ertools.states.end_reason`):
+that run is reported as ``timeout`` or ``stopped``. Another END payload is warned about and read
+as the 2015 BmBox read it (neither). A log that ends inside a run is that run stopped there
+(:mod:`ertools.benchmarks.common.ending`), said in a warning.
 
 ``windows``: ``SPEC:REF_T:START_T:END_T`` or a YAML list; times are seconds from the bag's
 first message, or epoch seconds when larger than 1e9.
@@ -32,6 +35,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64
+from ertools.benchmarks.common.ending import RefBoxEnd, cut_warning, log_cut, refbox_ends
 from ertools.benchmarks.common.motion import moving_mean
 from ertools.benchmarks.common.phases import (
     DEFAULT_MIN_STILL_S,
@@ -45,12 +49,15 @@ from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.configs.shapes import Shape
 from ertools.errors import ConfigError, SegmentationError
 from ertools.io.model import BenchmarkStates
-from ertools.states import BmBoxState, RefBoxState
-from ertools.streams import PoseStream, StateStream
+from ertools.states import BmBoxState, EndReason, unknown_end_warning
+from ertools.streams import PoseStream
 from ertools.timeutil import ns_to_s, resolve_time
 
-# RefBox END payloads that end a benchmark early, and the run status reported for them.
-EARLY_END = {"timeout": "timeout", "halt": "stopped", "stop": "stopped", "stopped": "stopped"}
+# What a RefBox END payload does to the run it ends (ertools.states.end_reason).
+EARLY_END = {EndReason.TIMEOUT: "timeout", EndReason.STOP: "stopped"}
+# A RefBox END this long after the BmBox left WAITING_RESULT still ended that run: the BmBox
+# left because of it, and the recorder may write the two machines' messages out of order.
+END_SLACK_NS = 1_000_000_000
 # Still time kept at each side of an auto-detected path: the edge of a move is where the
 # smoothed position left the still one by 4 noise sigmas (>= 0.5 mm), which a robot
 # accelerating over half a second reaches about 0.4 s after it set off.
@@ -78,10 +85,12 @@ class RunWindow:
         spec: the shape named for the run by the logs or the user (None: take the config's).
         ref_ns: time of the reference position (None: unknown).
         start_ns, end_ns: the path window (None for a run interrupted before its path).
-        status: ``completed``, ``timeout``, ``stopped``, ``interrupted`` (benchmark ended
-            before the path) or ``incomplete`` (log ends during the run).
+        status: ``completed``, ``timeout``, ``stopped`` (by the RefBox, or the log ends
+            during the path: stopped there) or ``interrupted`` (benchmark ended before the path).
         mode: ``states``, ``windows`` or ``auto``.
         note: how the times were found, for the referee.
+        warnings: what the state log said about this run that the referee must know (an END
+            payload no 2015 code knew, the log ending inside the run).
     """
 
     index: int
@@ -92,6 +101,7 @@ class RunWindow:
     status: str = "completed"
     mode: str = "states"
     note: str = ""
+    warnings: tuple[str, ...] = ()
 
     @property
     def execution_time_s(self) -> float | None:
@@ -101,19 +111,6 @@ class RunWindow:
 
 
 # --- states -------------------------------------------------------------------------------
-
-
-def _early_end(refbox: StateStream | None) -> tuple[int, str] | None:
-    """(time, status) of the first RefBox END with a timeout/stop payload, if any."""
-    if refbox is None or len(refbox) == 0:
-        return None
-    ch = refbox.changes()
-    for t, s, p in zip(ch.t_ns.tolist(), ch.state.tolist(), ch.payload, strict=True):
-        if s == RefBoxState.END:
-            word = p.strip().lower().split(maxsplit=1)[0] if p.strip() else ""
-            if word in EARLY_END:
-                return int(t), EARLY_END[word]
-    return None
 
 
 def find_states(states: BenchmarkStates) -> list[RunWindow]:
@@ -128,7 +125,8 @@ def find_states(states: BenchmarkStates) -> list[RunWindow]:
             "no /fbm3w/bmbox_state messages: use --runs windows (--run SPEC:REF:START:END) "
             "or --runs auto"
         )
-    early = _early_end(states.refbox)
+    ends = refbox_ends(states.refbox)
+    t0 = int(bm.t_ns[0])
     ch = bm.changes()
     times = ch.t_ns.tolist()
     codes = ch.state.tolist()
@@ -141,18 +139,44 @@ def find_states(states: BenchmarkStates) -> list[RunWindow]:
         if cur is None:
             return
         start = cur["start"]
+        said: list[str] = []
+        index = len(runs)
         if start is None:
-            status, end_ns = ("incomplete" if status == "incomplete" else "interrupted"), None
-        elif early is not None and end_ns is not None and start <= early[0] <= end_ns + 1e9:
-            # a RefBox END(timeout/stop) while the path was collected ended the run; the 2015
-            # node then skipped its accuracy (``if benchmark.Timeout(): ... continue``)
-            status = early[1]
-            note = f"{note}; RefBox END ({early[1]})"
+            if status == "cut" and end_ns is not None:
+                said.append(cut_warning(end_ns, bm, t0, f"run {index}", "its path had not started"))
+            status, end_ns = "interrupted", None
+        elif end_ns is not None:
+            # The BmBox's Timeout()/Running() read the last RefBox payload when WaitResult
+            # returned: the last END of the run decides; an unknown payload is neither.
+            during = refbox_ends_in(start, end_ns + END_SLACK_NS)
+            for e in during:
+                if e.reason is EndReason.UNKNOWN:
+                    said.append(unknown_end_warning(e.payload, f"run {index}"))
+            known = [e for e in during if e.reason is not EndReason.UNKNOWN]
+            if known:
+                status = EARLY_END[known[-1].reason]
+                note = f"{note}; RefBox END {known[-1].payload!r}"
+            elif status == "cut":
+                status = "stopped"
+                said.append(
+                    cut_warning(
+                        end_ns,
+                        bm,
+                        t0,
+                        f"run {index}",
+                        f"run {index} is not scored, and its time counts as a stopped run's",
+                    )
+                )
         ref = cur["ref"] if cur["ref"] is not None else last_ref
         if cur["ref"] is None and ref is not None:
             note += "; reference taken at the previous manual operation"
-        runs.append(RunWindow(len(runs), cur["spec"], ref, start, end_ns, status, "states", note))
+        runs.append(
+            RunWindow(index, cur["spec"], ref, start, end_ns, status, "states", note, tuple(said))
+        )
         cur = None
+
+    def refbox_ends_in(lo: int, hi: int) -> list[RefBoxEnd]:
+        return [e for e in ends if lo <= e.t_ns <= hi]
 
     def new_run() -> dict[str, Any]:
         return {"ref": None, "start": None, "spec": None}
@@ -187,7 +211,11 @@ def find_states(states: BenchmarkStates) -> list[RunWindow]:
         elif code in (BmBoxState.END, BmBoxState.TRANSMITTING_SCORE):
             close(t, "interrupted", "the benchmark ended before the path")
     if cur is not None:
-        close(int(bm.t_ns[-1]), "incomplete", "the BmBox log ends during the run")
+        close(int(bm.t_ns[-1]), "cut", "the BmBox log ends during the run")
+    elif runs and (cut := log_cut(bm, states.refbox)) is not None:
+        # Between runs: nothing is lost, but the log is not the whole benchmark.
+        said = cut_warning(cut, bm, t0, "the benchmark", "no run was open")
+        runs[-1] = replace(runs[-1], warnings=(*runs[-1].warnings, said))
     if not runs:
         raise SegmentationError(
             f"{bm.topic}: no run found (no EXECUTING_GOAL or manual operation in "

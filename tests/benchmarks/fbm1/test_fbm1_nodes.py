@@ -52,7 +52,9 @@ class Log:
     item_stamps: list[int]  # the node's broadcasts of ref_board -> item on /tf
 
 
-def read_log(bag: Path, ns: str) -> Log:
+def read_log(bag: Path, ns: str, bodies: str = "tf") -> Log:
+    """The log as the nodes saw it (``bodies="tf"``), or with the bodies from the pose topics
+    ertools' default reads (``"topic"``)."""
     from rosbags.highlevel import AnyReader
 
     states: dict[str, list[tuple[int, int, str]]] = {"bmbox": [], "refbox": [], "client": []}
@@ -63,23 +65,34 @@ def read_log(bag: Path, ns: str) -> Log:
             for c, t, raw in reader.messages(connections=conns):
                 m = reader.deserialize(raw, c.msgtype)
                 rows_of.append((t, int(m.state), str(m.payload)))
-        for body in ("origin", "ref_board"):
-            conns = [c for c in reader.connections if c.topic == f"/{ns}/{body}/pose"]
-            rows = []
-            for c, _t, raw in reader.messages(connections=conns):
-                m = reader.deserialize(raw, c.msgtype)
-                p, o = m.pose.position, m.pose.orientation
-                stamp = m.header.stamp.sec * 1_000_000_000 + m.header.stamp.nanosec
-                rows.append((stamp, p.x, p.y, p.z, o.x, o.y, o.z, o.w))
-            rows.sort(key=lambda r: r[0])
-            a = np.array(rows, dtype=np.float64)
-            poses[body] = (np.array([r[0] for r in rows], dtype=np.int64), a[:, 1:4], a[:, 4:8])
         t0 = reader.start_time
         stamps = []
+        # The nodes looked /origin and /ref_board up in /tf (``lookupTransform``), never the
+        # pose topics: the mocap's world -> origin and world -> ref_board transforms.
+        rows_of: dict[str, list[tuple[float, ...]]] = {"origin": [], "ref_board": []}
         for c, _t, raw in reader.messages([c for c in reader.connections if c.topic == "/tf"]):
             for tr in reader.deserialize(raw, c.msgtype).transforms:
-                if tr.child_frame_id.lstrip("/") == "item":
-                    stamps.append(tr.header.stamp.sec * 1_000_000_000 + tr.header.stamp.nanosec)
+                child = tr.child_frame_id.lstrip("/")
+                stamp = tr.header.stamp.sec * 1_000_000_000 + tr.header.stamp.nanosec
+                if child == "item":
+                    stamps.append(stamp)
+                elif child in rows_of and tr.header.frame_id.lstrip("/") == "world":
+                    p, o = tr.transform.translation, tr.transform.rotation
+                    rows_of[child].append((stamp, p.x, p.y, p.z, o.x, o.y, o.z, o.w))
+        if bodies == "topic":
+            rows_of = {"origin": [], "ref_board": []}
+            for body, rows in rows_of.items():
+                conns = [c for c in reader.connections if c.topic == f"/{ns}/{body}/pose"]
+                for c, _t, raw in reader.messages(connections=conns):
+                    m = reader.deserialize(raw, c.msgtype)
+                    p, o = m.pose.position, m.pose.orientation
+                    stamp = m.header.stamp.sec * 1_000_000_000 + m.header.stamp.nanosec
+                    rows.append((stamp, p.x, p.y, p.z, o.x, o.y, o.z, o.w))
+        for body, rows in rows_of.items():
+            rows.sort(key=lambda r: r[0])
+            a = np.array(rows, dtype=np.float64)
+            ts = np.array([r[0] for r in rows], dtype=np.int64)
+            poses[body] = (ts, a[:, 1:4], a[:, 4:8])
     return Log(states, poses, t0, sorted(stamps))
 
 
@@ -283,6 +296,33 @@ def test_sample_rules_2015_is_the_2015_node(capsys: pytest.CaptureFixture[str]) 
     assert ref["runs"][8]["pose_score"] < 0.45
 
 
+def test_rules_2015_chooses_the_nodes_pose_source(capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 23 item 1: the nodes looked /origin and /ref_board up in /tf; in the sample the
+    pose topics are stamped microseconds before /tf (pose_score 6e-8 apart), so --rules 2015
+    must choose /tf itself; the default reads the topics and says so."""
+    (bag,) = SAMPLE.glob("*.bag")
+    items = SAMPLE / "fbm1h.yaml"
+    tf_flags = ["--origin-tf", "world:origin", "--ref-board-tf", "world:ref_board"]
+    topic_flags = ["--ref-board-topic", "/fbm1h/ref_board/pose"]
+    chosen, err = ertools_score(bag, items, "fbm1h", ["--rules", "2015"], capsys)
+    given, _ = ertools_score(bag, items, "fbm1h", ["--rules", "2015", *tf_flags], capsys)
+    assert chosen == given
+    topics, _ = ertools_score(
+        bag,
+        items,
+        "fbm1h",
+        ["--rules", "2015", "--origin-topic", "/fbm1h/origin/pose", *topic_flags],
+        capsys,
+    )
+    assert 1e-9 < abs(topics["pose_score"] - chosen["pose_score"]) < 1e-6
+    assert "[fbm1.pose-source]" not in err
+    _, err = ertools_score(bag, items, "fbm1h", [], capsys)
+    assert "poses from /fbm1h/origin/pose, /fbm1h/ref_board/pose" in err
+    assert "[fbm1.pose-source]" in err
+    _, err = ertools_score(bag, items, "fbm1h", tf_flags, capsys)
+    assert "[fbm1.pose-source]" not in err
+
+
 def test_sample_rules_2016_is_the_later_node(capsys: pytest.CaptureFixture[str]) -> None:
     (bag,) = SAMPLE.glob("*.bag")
     items = yaml.safe_load((SAMPLE / "fbm1h.yaml").read_text())["items"]
@@ -323,7 +363,7 @@ def test_default_ground_truth_is_the_mean_of_the_reported_window(
     """
     (bag,) = SAMPLE.glob("*.bag")
     items = {i["id"]: i for i in yaml.safe_load((SAMPLE / "fbm1h.yaml").read_text())["items"]}
-    log = read_log(bag, "fbm1h")
+    log = read_log(bag, "fbm1h", bodies="topic")
     data, _ = ertools_score(bag, SAMPLE / "fbm1h.yaml", "fbm1h", [], capsys)
     tb, xb, qb = log.poses["ref_board"]
     scores = []

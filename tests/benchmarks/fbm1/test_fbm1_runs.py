@@ -129,7 +129,10 @@ def test_items_order_overrides_and_warns_on_count() -> None:
     assert found.warnings and "3 item(s)" in found.warnings[0]
 
 
-def test_log_cut_during_a_run_is_not_counted() -> None:
+def test_log_cut_during_a_run_is_the_run_stopped_there() -> None:
+    """Issue 23: a log that ends inside the benchmark is the benchmark stopped there, what the
+    2015 node did on a RefBox stop (fbm1h at 117a5d0 lines 94-96: ``if not Running():
+    continue``, the run already counted in ``runs``): no answer, score 0, no time."""
     from fbm1_testkit import ITEMS_YAML, bodies
 
     from ertools.benchmarks.fbm1.benchmark import score_fbm1
@@ -148,6 +151,9 @@ def test_log_cut_during_a_run_is_not_counted() -> None:
     found = find_runs(bm, s[Machine.REFBOX].window(None, ns(15.0)), cl)
     origin, board = bodies(runs)
     result = score_fbm1(origin, board, found, parse_items(parse_yaml(ITEMS_YAML)))
-    assert [r.status for r in result.runs] == ["unfinished"]
-    assert result.totals.pose_score is None and not result.failures
-    assert "log ends before the run did" in result.warnings[0]
+    assert [(r.status, r.ended_by) for r in result.runs] == [("no_answer", "stop")]
+    assert result.runs[0].execution_time_ns == 0
+    assert (result.totals.pose_score, result.totals.class_accuracy) == (0.0, 0.0)
+    assert not result.failures
+    said = [w for w in result.warnings if "stopped there" in w]
+    assert len(said) == 1 and "inside run 1 (BmBox in WAITING_RESULT)" in said[0]

@@ -57,6 +57,38 @@ SHAPES = {"line": line_path, "spline": sine}
 Transitions = list[tuple[int, int, str]]
 
 
+def distance_error(
+    t: list[int],
+    xy: list[tuple[float, float]],
+    ref_t: int,
+    start_t: int,
+    end_t: int,
+    spec: str,
+) -> float:
+    """Eq. (1) of one run: the reference is the latest pose at ``ref_t``; the path the poses
+    received in [start_t, end_t] kept by ``mocap_callback`` (D_MIN from the last kept one);
+    the run frame at the first kept pose with x along reference -> start; the shape at l/L."""
+    ref = [p for tt, p in zip(t, xy, strict=True) if tt <= ref_t][-1]
+    path = [p for tt, p in zip(t, xy, strict=True) if start_t <= tt <= end_t]
+    kept = [path[0]]
+    for p in path[1:]:  # mocap_callback
+        if math.sqrt((p[0] - kept[-1][0]) ** 2 + (p[1] - kept[-1][1]) ** 2) >= D_MIN:
+            kept.append(p)
+    ox, oy = kept[0]
+    yaw = math.atan2(oy - ref[1], ox - ref[0])
+    c, s = math.cos(yaw), math.sin(yaw)
+    frame = [(c * (x - ox) + s * (y - oy), -s * (x - ox) + c * (y - oy)) for x, y in kept]
+    lengths = [0.0]
+    for a, b in itertools.pairwise(frame):
+        lengths.append(lengths[-1] + math.sqrt((b[0] - a[0]) ** 2 + (b[1] - a[1]) ** 2))
+    shape = SHAPES[spec]
+    err = 0.0
+    for p, li in zip(frame, lengths, strict=True):
+        tx, ty = shape(li / lengths[-1])
+        err += math.sqrt((p[0] - tx) ** 2 + (p[1] - ty) ** 2)
+    return err / len(kept)
+
+
 def node_2015(
     t: list[int],
     xy: list[tuple[float, float]],
@@ -91,26 +123,8 @@ def node_2015(
         if ended and end_word in ("stop", "halt", "stopped"):
             break  # ``if not benchmark.Running(): continue``, then the loop ends
         total += (run["end"] - run["start"]) / 1e9
-        ref = [p for tt, p in zip(t, xy, strict=True) if tt <= run["ref"]][-1]
-        path = [p for tt, p in zip(t, xy, strict=True) if run["start"] <= tt <= run["end"]]
-        kept = [path[0]]
-        for p in path[1:]:  # mocap_callback
-            if math.sqrt((p[0] - kept[-1][0]) ** 2 + (p[1] - kept[-1][1]) ** 2) >= D_MIN:
-                kept.append(p)
-        ox, oy = kept[0]
-        yaw = math.atan2(oy - ref[1], ox - ref[0])
-        c, s = math.cos(yaw), math.sin(yaw)
-        frame = [(c * (x - ox) + s * (y - oy), -s * (x - ox) + c * (y - oy)) for x, y in kept]
-        lengths = [0.0]
-        for a, b in itertools.pairwise(frame):
-            lengths.append(lengths[-1] + math.sqrt((b[0] - a[0]) ** 2 + (b[1] - a[1]) ** 2))
-        shape = SHAPES[specs[k]]
-        err = 0.0
-        for p, li in zip(frame, lengths, strict=True):
-            tx, ty = shape(li / lengths[-1])
-            err += math.sqrt((p[0] - tx) ** 2 + (p[1] - ty) ** 2)
         details[k] = {
-            "distance_error": err / len(kept),
+            "distance_error": distance_error(t, xy, run["ref"], run["start"], run["end"], specs[k]),
             "execution_time": (run["end"] - run["start"]) / 1e9,
         }
         if ended:

@@ -67,21 +67,48 @@ def test_refbox_timeout_marks_the_run() -> None:
 def test_stop_interrupt_and_log_end() -> None:
     # run 0 stopped by the RefBox during its path; BmBox goes straight to END
     items = [(0.0, B.READY, ""), *run_items(1.0, "line")[:-1], (6.0, B.END, "")]
-    refbox = stream(Machine.REFBOX, [(0.0, R.READY, ""), (5.9, R.END, "stop")])
-    assert (
-        find_states(BenchmarkStates(stream(Machine.BMBOX, items), refbox, None))[0].status
-        == "stopped"
-    )
+    refbox = stream(Machine.REFBOX, [(0.0, R.READY, ""), (5.9, R.END, "reason: stop")])
+    run = find_states(BenchmarkStates(stream(Machine.BMBOX, items), refbox, None))[0]
+    assert (run.status, run.warnings) == ("stopped", ())
+    assert "RefBox END 'reason: stop'" in run.note
     # benchmark ends during the manual operation: reported, no path window
     items = [(0.0, B.READY, ""), *run_items(1.0, "line")[:2], (2.5, B.END, "")]
     run = find_states(BenchmarkStates(stream(Machine.BMBOX, items), None, None))[0]
     assert (run.status, run.start_ns, run.end_ns) == ("interrupted", None, None)
-    # the log stops while the path is collected
+    # the log stops while the path is collected: the benchmark stopped there, said so
     items = [(0.0, B.READY, ""), *run_items(1.0, "line")[:-1]]
-    assert (
-        find_states(BenchmarkStates(stream(Machine.BMBOX, items), None, None))[0].status
-        == "incomplete"
-    )
+    bm = stream(Machine.BMBOX, items)
+    run = find_states(BenchmarkStates(bm, None, None))[0]
+    assert (run.status, run.end_ns) == ("stopped", int(bm.t_ns[-1]))
+    (said,) = run.warnings
+    assert "inside run 0 (BmBox in WAITING_RESULT)" in said and "stopped there" in said
+    # ... and while the manual operation is waited for: no path, said too
+    items = [(0.0, B.READY, ""), *run_items(1.0, "line")[:1]]
+    run = find_states(BenchmarkStates(stream(Machine.BMBOX, items), None, None))[0]
+    assert (run.status, run.start_ns) == ("interrupted", None)
+    assert "its path had not started" in run.warnings[0]
+
+
+def test_end_payloads_as_the_2015_bmbox_compared_them() -> None:
+    """BmBox.py compares the whole payload: "reason: stop" stops, "reason: timeout" times
+    out, the seed's "halt"/"timeout" mean the same; any other END payload meant neither to it
+    (Running() stayed true): the run is what the BmBox did, and a warning names the payload."""
+    items = [(0.0, B.READY, ""), *run_items(1.0, "line")[:-1], (8.0, B.READY, ""), (8.3, B.END, "")]
+    bm = stream(Machine.BMBOX, items)
+    for payload, status in [
+        ("reason: timeout", "timeout"),
+        ("timeout", "timeout"),
+        ("reason: stop", "stopped"),
+        ("halt", "stopped"),
+        ("Reason: Stop", "completed"),
+        ("stopped by the referee", "completed"),
+    ]:
+        rb = stream(Machine.REFBOX, [(0.0, R.READY, ""), (7.95, R.END, payload)])
+        run = find_states(BenchmarkStates(bm, rb, None))[0]
+        assert run.status == status, payload
+        assert bool(run.warnings) is (status == "completed"), payload
+        if run.warnings:
+            assert repr(payload) in run.warnings[0] and "'reason: stop'" in run.warnings[0]
 
 
 def test_reference_carried_over_when_no_manual_operation() -> None:
