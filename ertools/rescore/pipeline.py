@@ -44,6 +44,9 @@ CSV_COLUMNS = (
     "rank_value",
     "report",
 )
+# What an execution no log and no manifest entry names a team for is, on the page and in
+# results.json: scored, left out of the leaderboards until named.
+TEAM_UNKNOWN = "team unknown (name it in the manifest)"
 _UNSAFE = re.compile(r"[^A-Za-z0-9_.-]+")
 
 
@@ -90,7 +93,7 @@ def listed_executions(manifest: Manifest) -> list[Scoring]:
             bags=e.bags,
             start_ns=e.start_ns,
             end_ns=e.end_ns,
-            team_source="manifest",
+            team_source="manifest" if e.team is not None else None,
             values=e.values,
         )
         for e in manifest.executions
@@ -364,7 +367,12 @@ def document(
                 "reason": o.reason,
                 "score": o.score,
                 "rank_value": o.rank_value,
-                "warnings": [*o.warnings, *e.notes, *skipped.get(job.id, [])],
+                "warnings": [
+                    *([TEAM_UNKNOWN] if e.team is None and p.of is None else []),
+                    *o.warnings,
+                    *e.notes,
+                    *skipped.get(job.id, []),
+                ],
                 "deviations": list(o.deviations),
                 "live_score": o.live_score,
                 "live_differences": list(o.live_differences),
@@ -418,8 +426,14 @@ def leaderboards(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
         ranking = registry.get(name).ranking
         sign = 1.0 if ranking.lower_is_better else -1.0
         best: dict[str, Mapping[str, Any]] = {}
+        unranked: list[dict[str, Any]] = []
         for row in rows:
             if row["benchmark"] != name or row["status"] != "scored" or row["rank_value"] is None:
+                continue
+            if row["team"] is None:  # scored, but ranked only once the manifest names it
+                unranked.append(
+                    {"execution": row["id"], "value": row["rank_value"], "note": TEAM_UNKNOWN}
+                )
                 continue
             team = str(row["team"])
             if team not in best or sign * row["rank_value"] < sign * best[team]["rank_value"]:
@@ -444,6 +458,7 @@ def leaderboards(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
                 "rule": ranking.text,
                 "lower_is_better": ranking.lower_is_better,
                 "rows": board_rows,
+                "unranked": unranked,
             }
         )
     return boards
