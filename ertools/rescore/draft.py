@@ -26,7 +26,7 @@ from ertools.benchmarks.base import Input
 from ertools.rescore.discover import Execution
 from ertools.rescore.found import Found, robot_benchmarks
 from ertools.rescore.ledger import Claim, place_files, root_of
-from ertools.rescore.pipeline import TEAM_UNKNOWN
+from ertools.rescore.site_text import TEAM_UNKNOWN
 from ertools.timeutil import NS_PER_S
 
 CONFIG_SUFFIXES = (".yaml", ".yml")

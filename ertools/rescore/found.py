@@ -89,7 +89,8 @@ def payload_teams(timeline: Timeline) -> dict[str, str]:
 
 def find(paths: Sequence[Path], *, progress: Reporter | None = None) -> Found:
     """Scan ``paths`` and turn every execution found into its scorings."""
-    timeline = scan(paths, progress=progress)
+    # absolute, so that every path of the results can be shown relative to the folder
+    timeline = scan([Path(p).resolve() for p in paths], progress=progress)
     discovery = discover(timeline, payload_teams(timeline))
     known = set(registry.names())
     robots = robot_benchmarks()

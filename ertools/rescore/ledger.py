@@ -69,7 +69,12 @@ def relative(path: str, root: str) -> str:
     return path
 
 
+_LOG_SUFFIXES = (".bag", ".bag.active", ".mcap", ".db3")
+
+
 def _unused_reason(path: str) -> str:
+    if path.endswith(_LOG_SUFFIXES):
+        return "a log no execution uses (see the problems of the logs around it)"
     if path.endswith(TIMING_SUFFIX):
         return (
             "a reached-waypoint timing file no execution uses (its log is scored from its state "
@@ -136,13 +141,28 @@ def claims_of(doc: Mapping[str, Any]) -> list[Claim]:
 
 
 def account(
-    doc: Mapping[str, Any], files: Sequence[str], folders: Sequence[str]
+    doc: Mapping[str, Any],
+    files: Sequence[str],
+    folders: Sequence[str],
+    robot_logs: Mapping[str, str] | None = None,
 ) -> dict[str, Any]:
     """``doc`` with ``root`` (the scanned folders' common folder), ``files`` (every file under
     them, each in one place, relative to ``root``) and every unused file added to
-    ``problems`` (kind ``unused``)."""
+    ``problems`` (kind ``unused``).
+
+    ``robot_logs``: robot log -> the benchmark log of its execution, for the robot logs that
+    have no row of their own (no topic to compare: a warning of their execution says so).
+    """
     root = root_of(folders)
-    entries = place_files(files, claims_of(doc), root)
+    ids = {
+        str(row["bags"][0]): str(row["id"])
+        for row in doc.get("executions") or []
+        if row.get("of") is None and row.get("bags")
+    }
+    extra = [
+        Claim(robot, "robot-log", ids.get(log)) for robot, log in (robot_logs or {}).items()
+    ]
+    entries = place_files(files, [*claims_of(doc), *extra], root)
     unused = [
         {"kind": UNUSED, "path": os.path.join(root, e.path), "message": e.reason}
         for e in entries

@@ -30,6 +30,7 @@ from ertools.rescore.jobs import Job, Outcome
 from ertools.rescore.manifest import Manifest
 from ertools.rescore.parallel import run_jobs
 from ertools.rescore.site import write_site
+from ertools.rescore.site_text import TEAM_UNKNOWN
 from ertools.timeutil import NS_PER_S, iso_utc
 
 SCHEMA_VERSION = 1
@@ -44,9 +45,6 @@ CSV_COLUMNS = (
     "rank_value",
     "report",
 )
-# What an execution no log and no manifest entry names a team for is, on the page and in
-# results.json: scored, left out of the leaderboards until named.
-TEAM_UNKNOWN = "team unknown (name it in the manifest)"
 _UNSAFE = re.compile(r"[^A-Za-z0-9_.-]+")
 
 
