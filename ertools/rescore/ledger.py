@@ -98,9 +98,9 @@ def place_files(files: Iterable[str], claims: Sequence[Claim], root: str) -> lis
         folder = path
         while claim is None and os.path.dirname(folder) not in ("", folder):
             folder = os.path.dirname(folder)  # a file of a rosbag2 folder: the folder's place
+            if folder == root or not folder.startswith(root):
+                break  # the scanned folder's own problems are not its files'
             claim = best.get(folder)
-            if folder == root:
-                break
         if claim is None:
             claim = Claim(path, "problem", kind=UNUSED, reason=_unused_reason(path))
         entries.append(

@@ -308,8 +308,8 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
                 "end": _when(ex.get("end")),
                 "status": status,
                 "level": STATUS_LEVEL.get(status, "bad"),
-                "reason": text.manifest_terms(
-                    paths.text(ex.get("reason") or ""), str(ex.get("benchmark"))
+                "reason": text.prose_units(
+                    text.manifest_terms(paths.text(ex.get("reason") or ""), str(ex.get("benchmark")))
                 ),
                 "value": text.with_unit(key, rank_value) if key else text.shown(None, rank_value),
                 "warnings": own_warnings.get(str(ex.get("id")), []),
@@ -331,7 +331,7 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
         {
             "kind": p.get("kind"),
             "path": paths.path(p.get("path")) if p.get("path") else None,
-            "message": paths.text(p.get("message")),
+            "message": text.prose_units(paths.text(p.get("message"))),
         }
         for p in results.get("problems") or []
         if isinstance(p, dict)
@@ -378,7 +378,7 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
         "figure_kind": figure_kind,
         "sessions": timeline.get("sessions") if isinstance(timeline, dict) else None,
         "problems": h.table(problems, columns=["kind", "path", "message"]) if problems else None,
-        "deviations": [str(d) for d in results.get("deviations_in_force") or []],
+        "deviations": [text.prose_units(str(d)) for d in results.get("deviations_in_force") or []],
         "executions": rows,
         "counts": counts,
         "unnamed": unnamed,

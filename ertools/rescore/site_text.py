@@ -55,8 +55,8 @@ def shown(key: str | None, value: Any) -> str:
             return "yes" if value else "no"
         return str(value)
     spec = units.quantity_of(key) if key else None
-    if spec is None:
-        return str(int(x)) if isinstance(value, int) else f"{x:.6g}"
+    if spec is None:  # counts, ratios, scores: 6 significant digits, at most 6 decimals
+        return str(int(x)) if isinstance(value, int) else f"{round(x, 6):.6g}"
     return f"{x * units.factor(*spec):.{DECIMALS[spec[0]]}f}"
 
 
@@ -77,6 +77,20 @@ def rule_text(text: str) -> str:
     for word, unit in _UNIT_WORDS.items():
         text = re.sub(rf"\b{word}\b", unit, text)
     return text
+
+
+_PROSE = re.compile(r"(?<![\w.])(-?\d+(?:\.\d+)?(?:e-?\d+)?) (m|rad)\b(?!/)")
+
+
+def prose_units(text: str) -> str:
+    """Lengths and angles inside a sentence (a deviation, a warning) in the page's units:
+    ``clipped at 1 m`` -> ``clipped at 1000.00 mm``, ``0.0900 rad`` -> ``5.16 deg``."""
+
+    def convert(match: re.Match[str]) -> str:
+        key = "distance_error" if match.group(2) == "m" else "orientation_error"
+        return with_unit(key, float(match.group(1)))
+
+    return _PROSE.sub(convert, text)
 
 
 class Paths:
@@ -199,7 +213,7 @@ def group_warnings(
         for warning in row.get("warnings") or []:
             if warning in skipped:
                 continue
-            text = manifest_terms(paths.text(warning), bench)
+            text = prose_units(manifest_terms(paths.text(warning), bench))
             # the same advice about each execution's own log is one warning of the benchmark
             key = _LOG_FILE.sub("its log", _ROBOT_LOG.sub("its robot log", text))
             by_benchmark.setdefault(bench, {}).setdefault(key, []).append((ident, text))
@@ -225,6 +239,7 @@ __all__ = [
     "group_warnings",
     "manifest_terms",
     "number",
+    "prose_units",
     "rule_text",
     "shown",
     "unit_of",
