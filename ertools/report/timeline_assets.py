@@ -310,6 +310,7 @@ SCRIPT = r"""
   }
   function applyHash(now) {
     var h = decodeURIComponent(window.location.hash.slice(1));
+    if (h === "day") { fitDay(now); return; }
     var m = /^session=(\d+)$/.exec(h);
     if (m && zoomSession(+m[1], now)) { return; }
     m = /^bag=(\d+)$/.exec(h);
