@@ -178,7 +178,7 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
         bags = [_rel(Path(p).resolve(), base) for p in (e.bmbox_log, *e.gt_files)]
         lines += [
             f"  # {e.benchmark} at {_utc(e.start_ns)}: nothing in the logs names its team: it is",
-            f"  # scored and shown as \"{TEAM_UNKNOWN}\", out of the leaderboards.",
+            f'  # scored and shown as "{TEAM_UNKNOWN}", out of the leaderboards.',
             "  # TODO: uncomment and name it:",
             f"  # - benchmark: {e.benchmark}",
             "  #   team: TODO",
@@ -187,7 +187,9 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
     lines += ["", "# The executions found (benchmark log, team and where its name came from):"]
     for e in executions:
         team = f"{e.team} (from {e.team_source})" if e.team else "no team"
-        lines.append(f"#   {_utc(e.start_ns)}  {e.benchmark:<6} {team:<28} {_rel_text(e.bmbox_log, base)}")
+        lines.append(
+            f"#   {_utc(e.start_ns)}  {e.benchmark:<6} {team:<28} {_rel_text(e.bmbox_log, base)}"
+        )
         for problem in e.problems:
             lines.append(f"#       {_rel_text(problem, base)}")
     lines += _file_lines(found, executions, claims, base)
@@ -204,11 +206,7 @@ def _beside(files: Sequence[Path], log: Path, declared: Input) -> list[Path]:
     """The YAML files in ``log``'s folder whose name has ``declared``'s name as a word
     (``fbm2h_test_optitrackless_goal.yaml`` for ``goal``)."""
     word = declared.name.lower()
-    return [
-        f
-        for f in files
-        if f.parent == log.parent and word in re.split(r"[_\-.]", _stem(f))
-    ]
+    return [f for f in files if f.parent == log.parent and word in re.split(r"[_\-.]", _stem(f))]
 
 
 def _listed_entry(
@@ -270,7 +268,10 @@ def _file_lines(
             )
     root = root_of(found.folders)
     entries = place_files(found.files, claims, root)
-    lines = ["", f"# Every file under {_rel(Path(root), base) if root else 'PATH'}, in one place each:"]
+    lines = [
+        "",
+        f"# Every file under {_rel(Path(root), base) if root else 'PATH'}, in one place each:",
+    ]
     for entry in entries:
         where = f"{entry.place}" + (f" of {entry.execution}" if entry.execution else "")
         if entry.kind:

@@ -88,13 +88,13 @@ def place_files(files: Iterable[str], claims: Sequence[Claim], root: str) -> lis
     claim on the rosbag2 folder holding it, or ``problem``/``unused``."""
     rank = {place: i for i, place in enumerate(PLACES)}
     best: dict[str, Claim] = {}
-    for claim in claims:
-        held = best.get(claim.path)
-        if held is None or rank[claim.place] < rank[held.place]:
-            best[claim.path] = claim
+    for given in claims:
+        held = best.get(given.path)
+        if held is None or rank[given.place] < rank[held.place]:
+            best[given.path] = given
     entries = []
     for path in sorted(set(files)):
-        claim = best.get(path)
+        claim: Claim | None = best.get(path)
         folder = path
         while claim is None and os.path.dirname(folder) not in ("", folder):
             folder = os.path.dirname(folder)  # a file of a rosbag2 folder: the folder's place
@@ -159,9 +159,7 @@ def account(
         for row in doc.get("executions") or []
         if row.get("of") is None and row.get("bags")
     }
-    extra = [
-        Claim(robot, "robot-log", ids.get(log)) for robot, log in (robot_logs or {}).items()
-    ]
+    extra = [Claim(robot, "robot-log", ids.get(log)) for robot, log in (robot_logs or {}).items()]
     entries = place_files(files, [*claims_of(doc), *extra], root)
     unused = [
         {"kind": UNUSED, "path": os.path.join(root, e.path), "message": e.reason}

@@ -309,7 +309,9 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
                 "status": status,
                 "level": STATUS_LEVEL.get(status, "bad"),
                 "reason": text.prose_units(
-                    text.manifest_terms(paths.text(ex.get("reason") or ""), str(ex.get("benchmark")))
+                    text.manifest_terms(
+                        paths.text(ex.get("reason") or ""), str(ex.get("benchmark"))
+                    )
                 ),
                 "value": text.with_unit(key, rank_value) if key else text.shown(None, rank_value),
                 "warnings": own_warnings.get(str(ex.get("id")), []),

@@ -299,7 +299,7 @@ def test_figure_problem_list_fits_the_picture() -> None:
     (listing,) = problems.texts
     assert listing.get_text().count("\n") >= 4  # the folder's problem bags, wrapped
     box = listing.get_window_extent(canvas.get_renderer())
-    assert 0 <= box.x0 and box.x1 <= fig.bbox.x1, (box, fig.bbox)
+    assert box.x0 >= 0 and box.x1 <= fig.bbox.x1, (box, fig.bbox)
     # and the panels' lane labels push the axes far right of where the list starts
     assert problems.get_window_extent(canvas.get_renderer()).x0 > box.x0 + 50
 

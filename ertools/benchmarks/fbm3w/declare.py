@@ -258,6 +258,7 @@ stationary at the start, the path, stationary at the end), detected times in the
 Warnings (d_min below the noise measured on the bag's stationary phases, shapes not
 parametrised by arc length) and deviations from 2015 go to stderr."""
 
+
 def gt_only(bags: Sequence[Path]) -> dict[str, Any]:
     """A GT-only FBM3@Work log (mocap alone, no state topics: the 2015 test logs) is scored
     with runs found from motion alone (``runs: auto``); its row says why when none is found
