@@ -160,6 +160,9 @@ def account(
         if row.get("of") is None and row.get("bags")
     }
     extra = [Claim(robot, "robot-log", ids.get(log)) for robot, log in (robot_logs or {}).items()]
+    manifest = (doc.get("manifest") or {}).get("path")
+    if manifest:  # kept with the logs: an input of every execution
+        extra.append(Claim(str(manifest), "input", kind="manifest", reason="the manifest"))
     entries = place_files(files, [*claims_of(doc), *extra], root)
     unused = [
         {"kind": UNUSED, "path": os.path.join(root, e.path), "message": e.reason}

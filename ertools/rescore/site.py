@@ -154,7 +154,7 @@ class LiveRow:
 _LIVE_ORDER = {"differs": 0, "not-recomputed": 1, "same": 2}
 
 
-def _live_rows(executions: Sequence[dict[str, Any]]) -> list[LiveRow]:
+def _live_rows(executions: Sequence[dict[str, Any]], paths: text.Paths) -> list[LiveRow]:
     """Every live field beside the recomputed one, the differing ones first."""
     rows: list[LiveRow] = []
     for ex in executions:
@@ -183,7 +183,13 @@ def _live_rows(executions: Sequence[dict[str, Any]]) -> list[LiveRow]:
                     live=text.with_unit(key, value),
                     recomputed=text.with_unit(key, score.get(key)),
                     difference=d.difference if d is not None else "",
-                    why=d.why if d is not None else "",
+                    why=(
+                        text.prose_units(
+                            text.manifest_terms(paths.text(d.why), str(ex.get("benchmark")))
+                        )
+                        if d is not None
+                        else ""
+                    ),
                     rules=d.rules if d is not None else (),
                     status=status,
                 )
@@ -291,7 +297,7 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
             )
         )
 
-    live_rows = _live_rows(executions)
+    live_rows = _live_rows(executions, paths)
     rows = []
     for ex in executions:
         status = str(ex.get("status"))
@@ -341,7 +347,12 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
     provenance = [
         ("ertools version", results.get("ertools_version", "")),
         ("generated", results.get("generated", "")),
-        ("folder", "the folder scanned: paths on this page are relative to it" if root else ""),
+        (
+            "folder",
+            f"{os.path.basename(root)}/ (the folder scanned: paths on this page are relative to it)"
+            if root
+            else "",
+        ),
         ("command", paths.text(" ".join(str(t) for t in results.get("command") or []))),
         ("manifest", paths.path(manifest_path)),
         ("manifest SHA-256", manifest.get("sha256", "")),
