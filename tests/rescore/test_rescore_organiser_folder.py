@@ -115,6 +115,27 @@ def test_every_file_has_one_place_in_the_draft(folder: dict[str, Any]) -> None:
     assert places[s + "stationary/log_fbm3w_noise_2015-11-20-09-00-00_0.bag"] == ["problem"]
     assert places[s + "timeline/bags/usb_stick/FBM2H_201511201500_homer.bag"] == ["problem"]
     assert places[s + "fbm3w/fbm3w.yaml"] == ["input"]
+    text = folder["draft"].read_text()
+    # the GT logger's recordings that overlap no benchmark log, each with its reason
+    noise = s + "stationary/log_fbm3w_noise_2015-11-20-09-00-00_0.bag"
+    assert f"#   {noise}: problem (gt-only: a noise recording" in text
+    tail = s + "timeline/bags/gtlogger/log_fbm2h_mocap_2015-11-20-14-59-59_2.bag"
+    assert places[tail] == ["problem"]  # the rest of a recording that covers a benchmark log
+    work = s + "timeline/bags/gtlogger_work/log_fbm3w_mocap_2015-11-20-15-00-39_0.bag"
+    assert f"#   {work}: execution of fbm3w-unknown-20151120T150040" in text
+
+
+def test_gt_only_fbm3w_recording_is_scored_with_runs_auto(folder: dict[str, Any]) -> None:
+    """An FBM3@Work GT recording alone is proposed with runs: auto; the sample's (6 s of a
+    robot that never stands still) finds no run: unscoreable, saying why."""
+    manifest = load_manifest(folder["draft"])
+    work = folder["root"] / "sample_bags/timeline/bags/gtlogger_work"
+    bag = work / "log_fbm3w_mocap_2015-11-20-15-00-39_0.bag"
+    (listed,) = [e for e in manifest.executions if e.bags == (bag,)]
+    assert (listed.benchmark, listed.team, dict(listed.values)) == ("fbm3w", None, {"runs": "auto"})
+    (row,) = [r for r in folder["doc"]["executions"] if r["bags"] == [str(bag)]]
+    assert row["status"] == "unscoreable"
+    assert "still phase" in row["reason"] and "never stood still" in row["reason"]
 
 
 def test_every_file_has_one_place_in_the_results(folder: dict[str, Any]) -> None:
