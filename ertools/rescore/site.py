@@ -391,7 +391,10 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
         "figure_kind": figure_kind,
         "sessions": timeline.get("sessions") if isinstance(timeline, dict) else None,
         "problems": h.table(problems, columns=["kind", "path", "message"]) if problems else None,
-        "deviations": [text.prose_units(str(d)) for d in results.get("deviations_in_force") or []],
+        "deviations": [
+            text.prose_units(text.deviation_terms(str(d)))
+            for d in results.get("deviations_in_force") or []
+        ],
         "executions": rows,
         "counts": counts,
         "unnamed": unnamed,

@@ -142,6 +142,19 @@ def manifest_terms(text: str, benchmark: str) -> str:
     return _FLAG.sub(lambda m: options.get(m.group(0), m.group(0)), text)
 
 
+def deviation_terms(text: str) -> str:
+    """A deviation's options as manifest keys: its rule key (``[fbm3w.timeout-runs]``) names
+    the benchmark (``fbm1.`` the FBM1 benchmarks: the first declaring the option)."""
+    keys = _RULE_KEY.findall(text)
+    prefix = keys[-1].split(".", 1)[0] if keys else ""
+    for name in registry.names():
+        if name.startswith(prefix) and prefix:
+            translated = manifest_terms(text, name)
+            if translated != text:
+                return translated
+    return text
+
+
 @dataclass(frozen=True)
 class Difference:
     """One ``live_differences`` line as shown: numbers in display units, and why."""
@@ -235,6 +248,7 @@ __all__ = [
     "Difference",
     "Grouped",
     "Paths",
+    "deviation_terms",
     "difference",
     "group_warnings",
     "manifest_terms",

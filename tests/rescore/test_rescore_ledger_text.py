@@ -10,6 +10,7 @@ from ertools.benchmarks import registry
 from ertools.rescore.ledger import Claim, account, place_files
 from ertools.rescore.site_text import (
     Paths,
+    deviation_terms,
     difference,
     group_warnings,
     manifest_terms,
@@ -140,6 +141,10 @@ def test_paths_relative_and_options_as_manifest_keys() -> None:
     # a robot log's warning in an FBM1H row names the comparison's benchmark
     assert manifest_terms("not compared by trajectory (give --gt-topic)", "fbm1h") == (
         "not compared by trajectory (give benchmarks.trajectory.inputs.gt_topic)"
+    )
+    # a deviation's option, by the benchmark its rule key names (fbm1: the FBM1 benchmarks)
+    assert deviation_terms("--count-aborted restores 2015 [fbm1.aborted-runs]") == (
+        "benchmarks.fbm1h.inputs.count_aborted restores 2015 [fbm1.aborted-runs]"
     )
     assert manifest_terms("give --transform FILE", "fbm2h") == (
         "give benchmarks.fbm2h.teams.TEAM.transform FILE"
