@@ -16,7 +16,14 @@ state payloads), never a file.
 - Its **team**, by :func:`ertools.benchmarks.common.teams.resolve_team`: a team the state
   payloads name (``payload_teams``, read by
   :func:`ertools.benchmarks.common.teams.read_payload_team`), else the robot log's rockin_logger
-  name (``FBM2H_<date>_<team>.bag``), else none (a problem: the manifest must name it).
+  name (``FBM2H_<date>_<team>.bag``), else none (a ``no-team`` problem; the execution is
+  scored all the same, and ranked once the manifest names it).
+- A **GT-only recording** (the GT logger's split files in one folder, none of which overlaps
+  a benchmark log: the 2015 test logs) is an execution with ``gt_only`` set, its first file as
+  ``bmbox_log``; the IO edge asks its benchmark whether and how it is scored alone
+  (:attr:`~ertools.benchmarks.base.Benchmark.gt_only`). A recording naming no benchmark, a
+  noise recording, and the uncovered split files of a recording that covers a benchmark log
+  are ``gt-only`` problems.
 
 Problems (:class:`Problem`, one per file and kind): files nobody could read, truncated or
 unindexed files, copies, clock offsets, gaps between GT split files (from the timeline's

@@ -7,7 +7,9 @@ under PATH has the name the input suggests (``transform-homer.yaml`` for homer's
 fbm3w's first file input), marked ``guessed``; what is still missing is a commented ``TODO``
 line, so the draft validates as it is (those executions are then unscoreable, saying why) and
 the organiser fills in blanks rather than starting from nothing. Inputs come from the registry's
-declarations only.
+declarations only. GT-only recordings are listed under ``executions:`` with the values scoring
+them (and an input file found beside them); the draft ends with every file under PATH and its
+place (:mod:`ertools.rescore.ledger`).
 """
 
 from __future__ import annotations

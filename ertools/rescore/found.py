@@ -6,6 +6,9 @@ Every execution is scored from its benchmark log and the GT files covering it
 (``ertools score NAME BMBOX_LOG GT...``). Its robot's own log, when there is one, is compared
 with the same GT files by every registered benchmark whose bags are a robot log then GT paths
 (:attr:`Benchmark.bags_metavar` ``("ROBOT_BAG", ...)``): the declaration says which, not a name.
+A GT-only recording is scored with the values its benchmark's ``gt_only`` proposes (FBM2H: the
+timing file beside it), or is a ``gt-only`` problem saying why not. Every file under the
+folders is listed too, for the ledger (:mod:`ertools.rescore.ledger`).
 """
 
 from __future__ import annotations
