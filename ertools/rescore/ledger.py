@@ -109,6 +109,17 @@ def place_files(files: Iterable[str], claims: Sequence[Claim], root: str) -> lis
     return entries
 
 
+def _record_paths(value: Any) -> list[str]:
+    """The files of ``inputs`` records, also those inside a value (``reached: [timing,
+    {path, sha256}]``)."""
+    if isinstance(value, dict):
+        own = [str(value["path"])] if value.get("path") else []
+        return own + [p for v in value.values() for p in _record_paths(v)]
+    if isinstance(value, list):
+        return [p for v in value for p in _record_paths(v)]
+    return []
+
+
 def claims_of(doc: Mapping[str, Any]) -> list[Claim]:
     """The places ``results.json``'s rows and problems give files."""
     claims: list[Claim] = []
@@ -124,9 +135,7 @@ def claims_of(doc: Mapping[str, Any]) -> list[Claim]:
             claims.append(Claim(bags[0], "robot-log", str(row["of"])))
             owner = str(row["of"])
         claims += [Claim(b, "gt", owner) for b in bags[1:]]
-        for record in row.get("inputs") or []:
-            if isinstance(record, dict) and record.get("path"):
-                claims.append(Claim(str(record["path"]), "input", owner))
+        claims += [Claim(path, "input", owner) for path in _record_paths(row.get("inputs"))]
     for problem in doc.get("problems") or []:
         if problem.get("path"):
             claims.append(

@@ -69,12 +69,17 @@ def test_account_adds_files_and_unused_problems() -> None:
                 "id": "fbm2h-homer-1",
                 "of": None,
                 "bags": [f"{ROOT}/bm/a.bag", f"{ROOT}/gt/g.bag"],
-                "inputs": [{"name": "goal", "path": f"{ROOT}/goal.yaml", "sha256": "x"}],
+                "inputs": [
+                    {"name": "goal", "path": f"{ROOT}/goal.yaml", "sha256": "x"},
+                    {"name": "reached", "value": ["timing", {"path": f"{ROOT}/t.yaml"}]},
+                ],
             },
         ],
         "problems": [],
     }
-    files = [f"{ROOT}/{p}" for p in ("bm/a.bag", "gt/g.bag", "goal.yaml", "competition.yaml")]
+    files = [
+        f"{ROOT}/{p}" for p in ("bm/a.bag", "gt/g.bag", "goal.yaml", "t.yaml", "competition.yaml")
+    ]
     files += [f"{ROOT}/robots/FBM2H_1_homer.bag", f"{ROOT}/notes.txt"]
     out = account(doc, files, [ROOT], {f"{ROOT}/robots/FBM2H_1_homer.bag": f"{ROOT}/bm/a.bag"})
     places = {e["path"]: (e["place"], e["execution"]) for e in out["files"]}
@@ -82,6 +87,7 @@ def test_account_adds_files_and_unused_problems() -> None:
         "bm/a.bag": ("execution", "fbm2h-homer-1"),
         "gt/g.bag": ("gt", "fbm2h-homer-1"),
         "goal.yaml": ("input", "fbm2h-homer-1"),
+        "t.yaml": ("input", "fbm2h-homer-1"),  # inside a value: the timing file of reached
         "competition.yaml": ("input", None),
         "robots/FBM2H_1_homer.bag": ("robot-log", "fbm2h-homer-1"),
         "notes.txt": ("problem", None),

@@ -179,8 +179,17 @@ def test_real_fbm2h_log_is_proposed_with_its_timing_file(folder: dict[str, Any])
 def test_real_fbm2h_scores_without_a_transform(folder: dict[str, Any]) -> None:
     _need_real(folder)
     doc = folder["doc"]
+    places = {e["path"]: (e["place"], e["execution"]) for e in doc["files"]}
+    # one execution holds the log, its timing file and its goal list
+    (ident,) = {places[f"real/{name}"][1] for name in (REAL_BAG, REAL_TIMING, REAL_GOAL)}
+    assert [places[f"real/{n}"][0] for n in (REAL_BAG, REAL_TIMING, REAL_GOAL)] == [
+        "execution",
+        "input",
+        "input",
+    ]
     bag = str(folder["root"] / "real" / REAL_BAG)
     (row,) = [r for r in doc["executions"] if r["bags"] == [bag]]
+    assert row["id"] == ident
     assert row["status"] == "scored", row["reason"]
     assert abs(row["score"]["position_accuracy"] - REAL_POSITION_ACCURACY) <= 5e-7
     assert row["rank_value"] == row["score"]["position_accuracy"]
