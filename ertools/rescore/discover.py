@@ -68,6 +68,8 @@ _BENCHMARK_LOG_RE = re.compile(
     r"^log_(?P<ns>[ft]bm\d[hw])(?:_mocap)?_(?P<date>\d{4}-\d{2}-\d{2}-\d{2}-\d{2}-\d{2})_\d+$",
     re.IGNORECASE,
 )
+# Words of a GT recording's name that say the marker set lay still (a noise measurement).
+_STILL_WORDS = frozenset({"noise", "static", "stationary", "still"})
 # What the timeline's per-file problem lines say, by kind (ertools.timeline.build writes them).
 _FILE_PROBLEMS: tuple[tuple[str, ProblemKind], ...] = (
     ("truncated", "truncated"),
@@ -333,13 +335,13 @@ def _gt_only(
                     "log overlaps: not an execution",
                 )
             )
-        elif "noise" in bag_stem(first.path).lower().split("_"):
+        elif _STILL_WORDS & set(bag_stem(first.path).lower().split("_")):
             problems.append(
                 Problem(
                     first.path,
                     "gt-only",
-                    "a noise recording (its name says so): `ertools noise` measures it; not a "
-                    "benchmark execution",
+                    "a noise recording of a marker set lying still (its name says so): "
+                    "`ertools noise` measures it; not a benchmark execution",
                 )
             )
         else:
