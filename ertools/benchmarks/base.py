@@ -56,6 +56,10 @@ class Input:
         flag: the option's spelling when it is not derived from ``name``.
         with_file: for a ``choice``: the choices followed by a FILE on the command line
             (``--reached timing FILE``); the value is then ``(choice, path)``, else ``(choice,)``.
+        needed_unless: for a ``per_team`` input without a default: the (input, choices) that
+            make it unnecessary (a manifest requires it of every team otherwise). FBM2H's
+            transform is not needed with ``reached`` ``timing`` or ``auto``: a log the GT logger
+            wrote alone is scored as ``ertools score`` scores it without ``--transform``.
     """
 
     name: str
@@ -73,6 +77,18 @@ class Input:
     metavar: str = ""
     flag: str = ""
     with_file: tuple[str, ...] = ()
+    needed_unless: tuple[tuple[str, tuple[str, ...]], ...] = ()
+
+    def needed(self, values: Mapping[str, Any]) -> bool:
+        """Whether a manifest must give this per-team input, given the other ``values``."""
+        if not self.per_team or self.default is not None:
+            return False
+        for name, choices in self.needed_unless:
+            value = values.get(name)
+            word = value[0] if isinstance(value, tuple | list) and value else value
+            if word in choices:
+                return False
+        return True
 
     @property
     def option(self) -> str:
@@ -233,6 +249,10 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
             audit's comparison shows the first that matches a differing key).
         sample: the sample logs' folder (``sample_bags/``) -> the arguments scoring this
             benchmark on them (``make demo``); None, or a None result: no sample.
+        gt_only: a recording of the GT logger alone (its benchmark's topics, no state topics;
+            its files, the first holding the name) -> the input values that score it as an
+            execution (FBM2H: the timing file beside it; FBM3W: ``runs: auto``), or one line
+            saying why it cannot be one. None: such recordings are never executions.
     """
 
     name: str
@@ -259,6 +279,7 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
     explanations: tuple[Explanation, ...] = ()
     sample: Callable[[Path], Sequence[str] | None] | None = None
     bags_help: str = "log file(s)"
+    gt_only: Callable[[Sequence[Path]], Mapping[str, Any] | str] | None = None
 
     def score(self, bags: Sequence[Path], options: OptionsT) -> ResultT:
         """The whole shape: load -> find runs -> score."""

@@ -19,6 +19,7 @@ from ertools.cli.output import note
 from ertools.errors import UsageError
 from ertools.rescore.draft import draft_text
 from ertools.rescore.found import find, merge, write_timeline
+from ertools.rescore.ledger import account
 from ertools.rescore.manifest import ManifestError, load_manifest
 from ertools.rescore.parallel import default_jobs
 from ertools.rescore.pipeline import listed_executions, rescore, write_results
@@ -110,6 +111,7 @@ def run(args: argparse.Namespace) -> int:
     scorings = listed_executions(manifest)
     problems: list[dict[str, object]] = []
     timeline = None
+    found = None
     if args.paths:
         found = find(args.paths, progress=args.progress)
         scorings = merge(found.scorings, scorings)
@@ -140,6 +142,9 @@ def run(args: argparse.Namespace) -> int:
         progress=args.progress,
         on_outcome=tell,
     )
+    if found is not None:  # every file under PATH in one place (docs/rescore.md, "files")
+        robots = {str(s.bags[0]): s.of for s in found.scorings if s.of is not None}
+        doc = account(doc, found.files, found.folders, robots)
     written = write_results(doc, args.out)
     rows = doc["executions"]
     counts = {s: sum(r["status"] == s for r in rows) for s in ("scored", "unscoreable", "failed")}
@@ -169,8 +174,16 @@ def _init(args: argparse.Namespace) -> int:
     args.init.parent.mkdir(parents=True, exist_ok=True)
     args.init.write_text(text, encoding="utf-8")
     todo = sum("TODO" in line for line in text.splitlines())
+    problems = sum(1 for p in found.problems if p.get("kind") != "no-team")
     note(
-        f"wrote {args.init}: {len(found.discovery.executions)} execution(s), {todo} TODO line(s) "
-        "to fill in"
+        f"wrote {args.init}: {len(found.executions)} execution(s), {todo} TODO line(s) "
+        f"to fill in; {len(found.files)} file(s), each placed at the end of the draft"
+        + (f" ({problems} with a problem)" if problems else "")
     )
+    if not found.executions:
+        note(
+            f"warning: no benchmark execution found under {', '.join(map(str, args.paths))}: "
+            f"why each file is not one is listed at the end of {args.init}"
+        )
+        return 1
     return 0

@@ -256,15 +256,20 @@ def timeline_figure(timeline: Timeline) -> Any:
         ax = fig.add_subplot(grid[len(sessions), 0])
         ax.set_axis_off()
         ax.set_label("problems")
+        # lazy: matplotlib only when a figure is drawn
+        from matplotlib.transforms import blended_transform_factory
+
+        # From the figure's left edge, not the axes': the panels' lane labels widen the left
+        # margin every row of the grid shares, which pushed the list off the right edge.
         ax.text(
-            0.0,
+            0.01,
             1.0,
             ("Problems\n" if numbers else "") + "\n".join(lines),
             va="top",
             ha="left",
             fontsize=8,
             family="monospace",
-            transform=ax.transAxes,
+            transform=blended_transform_factory(fig.transFigure, ax.transAxes),
         )
     readable = [b for b in timeline.bags if b.readable]
     kinds = sorted({b.kind for b in readable})

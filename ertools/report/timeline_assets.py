@@ -62,6 +62,7 @@ table { border-collapse: collapse; font-size: 13px; margin: 4px 0; }
 th, td { border: 1px solid #d9dee5; padding: 3px 8px; text-align: left; vertical-align: top; }
 th { background: #f6f8fa; }
 td { word-break: break-word; }
+.ts { white-space: nowrap; }
 #bags td:first-child { min-width: 18em; }
 tr.problem td:first-child { border-left: 4px solid #000; }
 ul.pl { margin: 0; padding-left: 16px; }
@@ -309,6 +310,7 @@ SCRIPT = r"""
   }
   function applyHash(now) {
     var h = decodeURIComponent(window.location.hash.slice(1));
+    if (h === "day") { fitDay(now); return; }
     var m = /^session=(\d+)$/.exec(h);
     if (m && zoomSession(+m[1], now)) { return; }
     m = /^bag=(\d+)$/.exec(h);
@@ -318,7 +320,16 @@ SCRIPT = r"""
       select(+m[1]);
       return;
     }
-    fitDay(now);
+    opening(now);
+  }
+  // Without a hash, the page opens on the sessions: the whole span when they fill a good part
+  // of it, else the session with the most bags (a span of days is mostly gaps, and its
+  // sessions would be slivers with overlapping labels); "fit day" shows the whole span.
+  function opening(now) {
+    var covered = sessions.reduce(function (a, s) { return a + (s.e - s.s); }, 0);
+    if (!sessions.length || covered >= 0.2 * (dayE - dayS)) { fitDay(now); return; }
+    var best = sessions.slice().sort(function (a, b) { return (b.n - a.n) || (a.s - b.s); })[0];
+    zoomSession(best.index, now);
   }
   function resize() {
     W = Math.max(200, (box.clientWidth || 1000) - LW - RIGHT);

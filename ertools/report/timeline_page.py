@@ -205,6 +205,7 @@ def page_data(timeline: Timeline) -> dict[str, Any]:
                 "s": rel(s.start_ns),
                 "e": rel(s.end_ns),
                 "label": session_label(s),
+                "n": len(s.paths),
             }
             for s in timeline.sessions
         ],
@@ -252,6 +253,11 @@ def _table(head: Sequence[str], rows: Sequence[Sequence[str]], attrs: Sequence[s
     return "".join(out)
 
 
+def _ts(ns: int | None) -> str:
+    """A timestamp cell's text, kept on one line (a break inside a time misreads)."""
+    return f'<span class="ts">{_esc(_when(ns))}</span>'
+
+
 def _problems_cell(problems: Sequence[str]) -> str:
     if not problems:
         return ""
@@ -292,8 +298,8 @@ def timeline_page(timeline: Timeline, *, title: str = "ertools timeline") -> str
         session_rows.append(
             [
                 f'<a href="#session={s.index}" data-session="{s.index}">{s.index}</a>',
-                _esc(_when(s.start_ns)),
-                _esc(_when(s.end_ns)),
+                _ts(s.start_ns),
+                _ts(s.end_ns),
                 f"{s.duration_ns / NS_PER_S:.3f}",
                 str(len(s.paths)),
                 _problems_cell(pairs),
@@ -305,8 +311,8 @@ def timeline_page(timeline: Timeline, *, title: str = "ertools timeline") -> str
             _esc(KIND_LABELS[b.kind]) + (" (copy)" if b.copy_of else ""),
             _esc(lane_name(b)),
             "" if b.session is None else str(b.session),
-            _esc(_when(b.start_ns)),
-            _esc(_when(b.end_ns)),
+            _ts(b.start_ns),
+            _ts(b.end_ns),
             "" if b.duration_ns is None else f"{b.duration_ns / NS_PER_S:.3f}",
             _problems_cell(b.problems),
         ]

@@ -16,7 +16,14 @@ state payloads), never a file.
 - Its **team**, by :func:`ertools.benchmarks.common.teams.resolve_team`: a team the state
   payloads name (``payload_teams``, read by
   :func:`ertools.benchmarks.common.teams.read_payload_team`), else the robot log's rockin_logger
-  name (``FBM2H_<date>_<team>.bag``), else none (a problem: the manifest must name it).
+  name (``FBM2H_<date>_<team>.bag``), else none (a ``no-team`` problem; the execution is
+  scored all the same, and ranked once the manifest names it).
+- A **GT-only recording** (the GT logger's split files in one folder, none of which overlaps
+  a benchmark log: the 2015 test logs) is an execution with ``gt_only`` set, its first file as
+  ``bmbox_log``; the IO edge asks its benchmark whether and how it is scored alone
+  (:attr:`~ertools.benchmarks.base.Benchmark.gt_only`). A recording naming no benchmark, a
+  noise recording, and the uncovered split files of a recording that covers a benchmark log
+  are ``gt-only`` problems.
 
 Problems (:class:`Problem`, one per file and kind): files nobody could read, truncated or
 unindexed files, copies, clock offsets, gaps between GT split files (from the timeline's
@@ -34,7 +41,7 @@ from dataclasses import dataclass
 from typing import Literal
 
 from ertools.benchmarks.common.teams import TeamSource, resolve_team
-from ertools.timeline.build import bag_stem
+from ertools.timeline.build import bag_stem, split_name
 from ertools.timeline.model import BagEntry, Pairing, Timeline
 from ertools.timeutil import NS_PER_S
 
@@ -53,6 +60,7 @@ ProblemKind = Literal[
     "partial-gt",
     "ambiguous",
     "file",
+    "gt-only",
 ]
 
 # The 2015 benchmark manager named its logs log_<namespace>[_mocap]_<YYYY-mm-dd-HH-MM-SS>_<n>.
@@ -60,6 +68,8 @@ _BENCHMARK_LOG_RE = re.compile(
     r"^log_(?P<ns>[ft]bm\d[hw])(?:_mocap)?_(?P<date>\d{4}-\d{2}-\d{2}-\d{2}-\d{2}-\d{2})_\d+$",
     re.IGNORECASE,
 )
+# Words of a GT recording's name that say the marker set lay still (a noise measurement).
+_STILL_WORDS = frozenset({"noise", "static", "stationary", "still"})
 # What the timeline's per-file problem lines say, by kind (ertools.timeline.build writes them).
 _FILE_PROBLEMS: tuple[tuple[str, ProblemKind], ...] = (
     ("truncated", "truncated"),
@@ -98,6 +108,9 @@ class Execution:
         team: the team, or None when nothing names it.
         team_source: where the team came from (``payload``, ``log name``), or None.
         problems: one line per problem of this execution or of one of its files.
+        gt_only: a recording of the GT logger alone (no benchmark log): ``bmbox_log`` is its
+            first file, ``gt_files`` the others; the benchmark's
+            :attr:`~ertools.benchmarks.base.Benchmark.gt_only` says how it is scored, if at all.
     """
 
     benchmark: str
@@ -110,6 +123,7 @@ class Execution:
     team: str | None
     team_source: TeamSource | None
     problems: tuple[str, ...]
+    gt_only: bool = False
 
     @property
     def id(self) -> str:
@@ -175,6 +189,14 @@ def discover(timeline: Timeline, payload_teams: Mapping[str, str] | None = None)
 
     # Each (log, namespace) is an execution; a log naming no benchmark is a problem.
     slots: list[tuple[BagEntry, str]] = []
+    # A GT recording no benchmark log covers: the 2015 GT logger's log of a run scored
+    # without state topics (the test logs), an execution when its benchmark can score it so.
+    lone, lone_problems = _gt_only(originals, timeline.pairings)
+    problems += lone_problems
+    rest: dict[str, tuple[str, ...]] = {}
+    for files in lone:
+        slots += [(files[0], ns) for ns in files[0].benchmarks]
+        rest[files[0].path] = tuple(f.path for f in files[1:])
     for log in bench_logs:
         if not log.benchmarks:
             problems.append(
@@ -234,13 +256,14 @@ def discover(timeline: Timeline, payload_teams: Mapping[str, str] | None = None)
             inputs=[paired.path] if paired is not None else [],
             payload_team=payload_teams.get(log.path),
         )
-        if team is None:
+        if team is None:  # scored all the same; its row says the team is unknown
             text = "no team: no state payload or robot log names one (give it in the manifest)"
-            notes.append(text)
             problems.append(Problem(log.path, "no-team", text))
         pairing = pairings.get(log.path)
         gt = pairing.gt if pairing is not None else ()
-        if not gt:
+        if log.path in rest:  # a GT-only recording: its own files are its GT
+            gt, pairing = rest[log.path], None
+        elif not gt:
             text = "no GT file of its benchmark overlaps it"
             notes.append(text)
             problems.append(Problem(log.path, "no-gt", text))
@@ -256,17 +279,79 @@ def discover(timeline: Timeline, payload_teams: Mapping[str, str] | None = None)
                 benchmark=ns.lower(),
                 namespace=ns,
                 start_ns=log.start_ns,
-                end_ns=log.end_ns,
+                end_ns=max([log.end_ns, *(by_path[g].end_ns or 0 for g in rest.get(log.path, ()))]),
                 bmbox_log=log.path,
                 gt_files=tuple(gt),
                 robot_log=paired.path if paired is not None else None,
                 team=team.name if team is not None else None,
                 team_source=team.source if team is not None else None,
                 problems=tuple(dict.fromkeys(notes)),
+                gt_only=log.path in rest,
             )
         )
     executions.sort(key=lambda e: (e.start_ns, e.benchmark, e.bmbox_log))
     return Discovery(tuple(executions), tuple(dict.fromkeys(problems)))
+
+
+def _gt_only(
+    originals: list[BagEntry], pairings: tuple[Pairing, ...]
+) -> tuple[list[list[BagEntry]], list[Problem]]:
+    """The GT recordings no benchmark log covers, each as its files in split order (one
+    recording: the split files of one logger in one folder), and the problems of those that
+    cannot be an execution (no benchmark named; a noise recording)."""
+    covered = {g for p in pairings if p.kind == "benchmark" for g in p.gt}
+    groups: dict[tuple[str, str], list[tuple[int, BagEntry]]] = {}
+    for entry in originals:
+        if entry.kind != "gt":
+            continue
+        split = split_name(entry.path)
+        folder = entry.path.rsplit("/", 1)[0] if "/" in entry.path else ""
+        key = (folder, split[0]) if split is not None else (entry.path, "")
+        groups.setdefault(key, []).append((split[1] if split is not None else 0, entry))
+    recordings: list[list[BagEntry]] = []
+    problems: list[Problem] = []
+    for members in groups.values():
+        files = [e for _, e in sorted(members, key=lambda m: (m[0], m[1].path))]
+        used = [f for f in files if f.path in covered]
+        if used:  # a recording that covers benchmark logs: the rest of it covers none
+            problems += [
+                Problem(
+                    f.path,
+                    "gt-only",
+                    f"split file of the GT recording {bag_stem(used[0].path)} that overlaps "
+                    "no benchmark log: not used",
+                )
+                for f in files
+                if f.path not in covered
+            ]
+            continue
+        first = files[0]
+        if not first.benchmarks:
+            problems.append(
+                Problem(
+                    first.path,
+                    "gt-only",
+                    "GT logger file naming no benchmark (no /fbm.../ topics) that no benchmark "
+                    "log overlaps: not an execution",
+                )
+            )
+        elif _STILL_WORDS & set(bag_stem(first.path).lower().split("_")):
+            problems.append(
+                Problem(
+                    first.path,
+                    "gt-only",
+                    "a noise recording of a marker set lying still (its name says so): "
+                    "`ertools noise` measures it; not a benchmark execution",
+                )
+            )
+        else:
+            recordings.append(files)
+            continue
+        problems += [
+            Problem(f.path, "gt-only", f"split file of {first.path}: not an execution")
+            for f in files[1:]
+        ]
+    return recordings, problems
 
 
 def _lost_benchmark_log(entry: BagEntry) -> Problem | None:

@@ -7,7 +7,9 @@ under PATH has the name the input suggests (``transform-homer.yaml`` for homer's
 fbm3w's first file input), marked ``guessed``; what is still missing is a commented ``TODO``
 line, so the draft validates as it is (those executions are then unscoreable, saying why) and
 the organiser fills in blanks rather than starting from nothing. Inputs come from the registry's
-declarations only.
+declarations only. GT-only recordings are listed under ``executions:`` with the values scoring
+them (and an input file found beside them); the draft ends with every file under PATH and its
+place (:mod:`ertools.rescore.ledger`).
 """
 
 from __future__ import annotations
@@ -16,13 +18,17 @@ import json
 import os
 import re
 import textwrap
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from datetime import UTC, datetime
 from pathlib import Path
+from typing import Any
 
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Input
+from ertools.rescore.discover import Execution
 from ertools.rescore.found import Found, robot_benchmarks
+from ertools.rescore.ledger import Claim, place_files, root_of
+from ertools.rescore.site_text import TEAM_UNKNOWN
 from ertools.timeutil import NS_PER_S
 
 CONFIG_SUFFIXES = (".yaml", ".yml")
@@ -82,7 +88,8 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
     """The draft manifest for the executions ``found`` under ``paths``, written at ``target``."""
     base = target.resolve().parent
     files = config_files(paths)
-    executions = found.discovery.executions
+    executions = found.executions
+    claims: list[Claim] = []  # every file's place, for the list at the end
     known = set(registry.names())
     lines = [
         f"# Drafted by `{' '.join(command)}`",
@@ -119,6 +126,7 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
                     f" (also: {', '.join(_rel(h, base) for h in hits[1:])})" if hits[1:] else ""
                 )
                 lines.append(f"      {declared.name}: {_yaml(_rel(hits[0], base))}  # {note}")
+                claims.append(Claim(str(hits[0]), "input", f"benchmarks.{name}.inputs"))
             else:
                 lines.append(f"      # {declared.name}:   # {declared.help}")
         others = [
@@ -139,6 +147,7 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
                             f"        {declared.name}: {_yaml(_rel(hits[0], base))}  "
                             "# guessed from its name: check"
                         )
+                        claims.append(Claim(str(hits[0]), "input", f"benchmarks.{name}.teams"))
                     else:
                         entries.append(
                             f"        # {declared.name}:   # TODO: no {declared.name}-{team}.yaml "
@@ -160,12 +169,18 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
             "the options; a GT topic when the GT files hold several)"
         )
         lines += [f"      # {part}" for part in textwrap.wrap(text, 88)]
-    unnamed = [e for e in executions if e.team is None and e.benchmark in known]
-    lines.append("executions:" + ("" if unnamed else " []"))
+    # GT-only recordings (scored with their own values: a timing file...) are listed, so the
+    # organiser sees how each is scored; others with no team get a commented entry to name them.
+    listed = [e for e in executions if e.bmbox_log in found.values]
+    unnamed = [e for e in executions if e.team is None and e.bmbox_log not in found.values]
+    lines.append("executions:" + ("" if unnamed or listed else " []"))
+    for e in listed:
+        lines += _listed_entry(e, found.values[e.bmbox_log], files, base, claims)
     for e in unnamed:
         bags = [_rel(Path(p).resolve(), base) for p in (e.bmbox_log, *e.gt_files)]
         lines += [
-            f"  # {e.benchmark} at {_utc(e.start_ns)}: nothing in the logs names its team.",
+            f"  # {e.benchmark} at {_utc(e.start_ns)}: nothing in the logs names its team: it is",
+            f'  # scored and shown as "{TEAM_UNKNOWN}", out of the leaderboards.',
             "  # TODO: uncomment and name it:",
             f"  # - benchmark: {e.benchmark}",
             "  #   team: TODO",
@@ -174,7 +189,94 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
     lines += ["", "# The executions found (benchmark log, team and where its name came from):"]
     for e in executions:
         team = f"{e.team} (from {e.team_source})" if e.team else "no team"
-        lines.append(f"#   {_utc(e.start_ns)}  {e.benchmark:<6} {team:<28} {e.bmbox_log}")
+        lines.append(
+            f"#   {_utc(e.start_ns)}  {e.benchmark:<6} {team:<28} {_rel_text(e.bmbox_log, base)}"
+        )
         for problem in e.problems:
-            lines.append(f"#       {problem}")
+            lines.append(f"#       {_rel_text(problem, base)}")
+    lines += _file_lines(found, executions, claims, base)
     return "\n".join(lines) + "\n"
+
+
+def _rel_text(text: str, base: Path) -> str:
+    """``text`` with the absolute paths under ``base`` relative to it (the draft's folder)."""
+    prefix = str(base).rstrip("/") + "/"
+    return text.replace(prefix, "")
+
+
+def _beside(files: Sequence[Path], log: Path, declared: Input) -> list[Path]:
+    """The YAML files in ``log``'s folder whose name has ``declared``'s name as a word
+    (``fbm2h_test_optitrackless_goal.yaml`` for ``goal``)."""
+    word = declared.name.lower()
+    return [f for f in files if f.parent == log.parent and word in re.split(r"[_\-.]", _stem(f))]
+
+
+def _listed_entry(
+    e: Execution,
+    values: Mapping[str, Any],
+    files: Sequence[Path],
+    base: Path,
+    claims: list[Claim],
+) -> list[str]:
+    """An ``executions:`` entry for a GT-only recording, with the values scoring it."""
+    bench = registry.get(e.benchmark)
+    log = Path(e.bmbox_log).resolve()
+    bags = [_rel(Path(p).resolve(), base) for p in (e.bmbox_log, *e.gt_files)]
+    out = [
+        f"  # {bench.title} at {_utc(e.start_ns)}: the GT logger's log alone (no state topics)",
+        f"  - benchmark: {e.benchmark}",
+        f"    team: {_yaml(e.team) if e.team else 'null  # TODO: ' + TEAM_UNKNOWN}",
+        f"    bags: {json.dumps(bags)}",
+        "    inputs:",
+    ]
+    for key, value in values.items():
+        if isinstance(value, tuple):
+            words = [_rel(v, base) if isinstance(v, Path) else str(v) for v in value]
+            out.append(f"      {key}: {json.dumps(words)}  # found beside the log")
+            claims += [Claim(str(v), "input", e.id) for v in value if isinstance(v, Path)]
+        else:
+            out.append(f"      {key}: {_yaml(str(value))}  # the GT alone: runs found from motion")
+    for declared in bench.inputs:
+        if declared.kind != "path" or declared.per_team or declared.name in values:
+            continue
+        hits = _beside(files, log, declared)
+        if hits:
+            out.append(
+                f"      {declared.name}: {_yaml(_rel(hits[0], base))}  "
+                "# beside the log, guessed from its name: check"
+            )
+            claims.append(Claim(str(hits[0]), "input", e.id))
+    return out
+
+
+def _file_lines(
+    found: Found, executions: Sequence[Execution], claims: list[Claim], base: Path
+) -> list[str]:
+    """Every file under the folders and its place (each once), as comment lines."""
+    for e in executions:
+        claims.append(Claim(str(Path(e.bmbox_log).resolve()), "execution", e.id))
+        claims += [Claim(str(Path(g).resolve()), "gt", e.id) for g in e.gt_files]
+        if e.robot_log is not None:
+            claims.append(Claim(str(Path(e.robot_log).resolve()), "robot-log", e.id))
+    for problem in found.problems:
+        if problem.get("path"):
+            claims.append(
+                Claim(
+                    str(Path(str(problem["path"])).resolve()),
+                    "problem",
+                    kind=str(problem["kind"]),
+                    reason=str(problem["message"]),
+                )
+            )
+    root = root_of(found.folders)
+    entries = place_files(found.files, claims, root)
+    lines = [
+        "",
+        f"# Every file under {_rel(Path(root), base) if root else 'PATH'}, in one place each:",
+    ]
+    for entry in entries:
+        where = f"{entry.place}" + (f" of {entry.execution}" if entry.execution else "")
+        if entry.kind:
+            where += f" ({entry.kind}: {_rel_text(entry.reason or '', base)})"
+        lines.append(f"#   {entry.path}: {where}")
+    return lines

@@ -6,12 +6,15 @@ Every execution is scored from its benchmark log and the GT files covering it
 (``ertools score NAME BMBOX_LOG GT...``). Its robot's own log, when there is one, is compared
 with the same GT files by every registered benchmark whose bags are a robot log then GT paths
 (:attr:`Benchmark.bags_metavar` ``("ROBOT_BAG", ...)``): the declaration says which, not a name.
+A GT-only recording is scored with the values its benchmark's ``gt_only`` proposes (FBM2H: the
+timing file beside it), or is a ``gt-only`` problem saying why not. Every file under the
+folders is listed too, for the ledger (:mod:`ertools.rescore.ledger`).
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -19,7 +22,7 @@ from ertools.benchmarks import registry
 from ertools.benchmarks.common.teams import read_payload_team
 from ertools.progress import Reporter
 from ertools.report.timeline_page import write_timeline_page
-from ertools.rescore.discover import Discovery, discover
+from ertools.rescore.discover import Discovery, Execution, discover
 from ertools.rescore.pipeline import Scoring
 from ertools.timeline.model import Timeline
 from ertools.timeline.scan import scan
@@ -30,12 +33,37 @@ TIMELINE_PAGE = "timeline.html"
 
 @dataclass(frozen=True)
 class Found:
-    """The logs' scorings, problems (results.json's ``problems``) and timeline."""
+    """The logs' scorings, problems (results.json's ``problems``) and timeline.
+
+    ``executions`` are discovery's executions that are scored (a GT-only recording its
+    benchmark cannot score alone is a problem instead), ``values`` their own input values by
+    benchmark log (a GT-only FBM2H log's timing file...), ``files`` every file under the
+    folders scanned (absolute) and ``folders`` those folders (a file given: its folder).
+    """
 
     scorings: tuple[Scoring, ...]
     problems: tuple[dict[str, Any], ...]
     timeline: Timeline
     discovery: Discovery
+    executions: tuple[Execution, ...] = ()
+    values: Mapping[str, Mapping[str, Any]] = field(default_factory=dict)
+    files: tuple[str, ...] = ()
+    folders: tuple[str, ...] = ()
+
+
+def list_files(paths: Sequence[Path]) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """Every file under ``paths`` (absolute, sorted) and the folders scanned."""
+    files: set[str] = set()
+    folders: list[str] = []
+    for path in paths:
+        path = path.resolve()
+        if path.is_dir():
+            folders.append(str(path))
+            files |= {str(p) for p in path.rglob("*") if p.is_file()}
+        elif path.is_file():
+            folders.append(str(path.parent))
+            files.add(str(path))
+    return tuple(sorted(files)), tuple(dict.fromkeys(folders))
 
 
 def robot_benchmarks() -> tuple[str, ...]:
@@ -64,12 +92,15 @@ def payload_teams(timeline: Timeline) -> dict[str, str]:
 
 def find(paths: Sequence[Path], *, progress: Reporter | None = None) -> Found:
     """Scan ``paths`` and turn every execution found into its scorings."""
-    timeline = scan(paths, progress=progress)
+    # absolute, so that every path of the results can be shown relative to the folder
+    timeline = scan([Path(p).resolve() for p in paths], progress=progress)
     discovery = discover(timeline, payload_teams(timeline))
     known = set(registry.names())
     robots = robot_benchmarks()
     problems = [{"kind": p.kind, "path": p.path, "message": p.message} for p in discovery.problems]
     scorings: list[Scoring] = []
+    kept: list[Execution] = []
+    own: dict[str, Mapping[str, Any]] = {}
     pairings = {p.path: p for p in timeline.pairings}
     for e in discovery.executions:
         if e.benchmark not in known:
@@ -81,22 +112,31 @@ def find(paths: Sequence[Path], *, progress: Reporter | None = None) -> Found:
                 }
             )
             continue
-        blockers: tuple[str, ...] = ()
-        if e.team is None:
-            blockers = (
-                f"no team: nothing in the logs names it; list it in the manifest "
-                f"(executions: benchmark {e.benchmark}, bags [{e.bmbox_log}, ...], team)",
-            )
         gt = tuple(Path(g).resolve() for g in e.gt_files)
+        bags = (Path(e.bmbox_log).resolve(), *gt)
+        values: Mapping[str, Any] = {}
+        if e.gt_only:
+            proposed = _gt_only_values(e.benchmark, bags)
+            if isinstance(proposed, str):
+                problems += [
+                    {"kind": "gt-only", "path": str(b), "message": proposed} for b in bags[:1]
+                ] + [
+                    {"kind": "gt-only", "path": str(b), "message": f"split file of {bags[0]}"}
+                    for b in bags[1:]
+                ]
+                continue
+            values = proposed
+            own[e.bmbox_log] = values
+        kept.append(e)
         scorings.append(
             Scoring(
                 benchmark=e.benchmark,
                 team=e.team,
-                bags=(Path(e.bmbox_log).resolve(), *gt),
+                bags=bags,
                 start_ns=e.start_ns,
                 end_ns=e.end_ns,
                 team_source=e.team_source,
-                blockers=blockers,
+                values=values,
                 notes=e.problems,
             )
         )
@@ -116,11 +156,24 @@ def find(paths: Sequence[Path], *, progress: Reporter | None = None) -> Found:
                     start_ns=e.start_ns,
                     end_ns=e.end_ns,
                     team_source=e.team_source,
-                    blockers=blockers,
                     of=str(Path(e.bmbox_log).resolve()),
                 )
             )
-    return Found(tuple(scorings), tuple(problems), timeline, discovery)
+    files, folders = list_files(paths)
+    return Found(
+        tuple(scorings), tuple(problems), timeline, discovery, tuple(kept), own, files, folders
+    )
+
+
+def _gt_only_values(benchmark: str, bags: Sequence[Path]) -> Mapping[str, Any] | str:
+    """The values scoring a GT-only recording of ``benchmark``, or why it is no execution."""
+    bench = registry.get(benchmark)
+    if bench.gt_only is None:
+        return (
+            f"the GT logger's {bench.title} log alone (no state topics): {bench.name} is "
+            "scored from its benchmark log, which is not here"
+        )
+    return bench.gt_only(bags)
 
 
 def write_timeline(found: Found, out: Path, title: str) -> dict[str, Any]:

@@ -185,8 +185,10 @@ def _score(job: Job) -> Outcome:
     if audit is not None:
         live_score = jsonable(audit.live_score)
         if audit.comparison is not None:
+            # with what explains it (a rule of the benchmark, a deviation's key), for the page
             differences = tuple(
                 f"{line.key}: live {line.live} vs recomputed {line.recomputed}"
+                + (f"; why: {one_line(line.explanation)}" if line.explanation else "")
                 for line in audit.comparison.differences
             )
     report = None

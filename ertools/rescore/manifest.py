@@ -65,7 +65,7 @@ class ListedExecution:
 
     index: int
     benchmark: str
-    team: str
+    team: str | None  # None: nobody named it yet (scored, left out of the leaderboards)
     bags: tuple[Path, ...]
     start_ns: int | None
     end_ns: int | None
@@ -111,7 +111,14 @@ class Manifest:
             f"{benchmark}: no {declared.name} for team {team or '(unknown)'} in the manifest "
             f"(benchmarks.{benchmark}.teams.{team or 'TEAM'}.{declared.name})"
             for declared in self.declared.get(benchmark, ())
-            if declared.per_team and declared.default is None and values.get(declared.name) is None
+            # the rule of `ertools score`: only what this execution's scoring path uses (FBM2H's
+            # transform, unless its reached moments come from a timing file or stop detection)
+            # no team, no team's values: scored as `ertools score` without them (the numbers
+            # first), and ranked only once the manifest names the team (then with them)
+            if team is not None
+            and declared.needed(values)
+            and declared.name != TEAM_INPUT  # the execution's team, when there is one
+            and values.get(declared.name) is None
         ]
         return values, missing
 
@@ -334,7 +341,7 @@ class _Checker:
             return None
         self.unknown(mapping, EXECUTION_KEYS, where)
         ok = True
-        for key in ("benchmark", "team", "bags"):
+        for key in ("benchmark", "bags"):  # no team (or a blank one): scored, not ranked
             if key not in mapping:
                 self.problem(where, f"missing key {key!r}")
                 ok = False
@@ -361,7 +368,7 @@ class _Checker:
         return ListedExecution(
             index=index,
             benchmark=bm.name,
-            team=str(team),
+            team=None if team is None or not str(team).strip() else str(team),
             bags=tuple(bags),
             start_ns=start,
             end_ns=end,

@@ -30,6 +30,7 @@ from ertools.rescore.jobs import Job, Outcome
 from ertools.rescore.manifest import Manifest
 from ertools.rescore.parallel import run_jobs
 from ertools.rescore.site import write_site
+from ertools.rescore.site_text import TEAM_UNKNOWN
 from ertools.timeutil import NS_PER_S, iso_utc
 
 SCHEMA_VERSION = 1
@@ -90,7 +91,7 @@ def listed_executions(manifest: Manifest) -> list[Scoring]:
             bags=e.bags,
             start_ns=e.start_ns,
             end_ns=e.end_ns,
-            team_source="manifest",
+            team_source="manifest" if e.team is not None else None,
             values=e.values,
         )
         for e in manifest.executions
@@ -364,7 +365,12 @@ def document(
                 "reason": o.reason,
                 "score": o.score,
                 "rank_value": o.rank_value,
-                "warnings": [*o.warnings, *e.notes, *skipped.get(job.id, [])],
+                "warnings": [
+                    *([TEAM_UNKNOWN] if e.team is None and p.of is None else []),
+                    *o.warnings,
+                    *e.notes,
+                    *skipped.get(job.id, []),
+                ],
                 "deviations": list(o.deviations),
                 "live_score": o.live_score,
                 "live_differences": list(o.live_differences),
@@ -418,8 +424,14 @@ def leaderboards(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
         ranking = registry.get(name).ranking
         sign = 1.0 if ranking.lower_is_better else -1.0
         best: dict[str, Mapping[str, Any]] = {}
+        unranked: list[dict[str, Any]] = []
         for row in rows:
             if row["benchmark"] != name or row["status"] != "scored" or row["rank_value"] is None:
+                continue
+            if row["team"] is None:  # scored, but ranked only once the manifest names it
+                unranked.append(
+                    {"execution": row["id"], "value": row["rank_value"], "note": TEAM_UNKNOWN}
+                )
                 continue
             team = str(row["team"])
             if team not in best or sign * row["rank_value"] < sign * best[team]["rank_value"]:
@@ -444,6 +456,7 @@ def leaderboards(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
                 "rule": ranking.text,
                 "lower_is_better": ranking.lower_is_better,
                 "rows": board_rows,
+                "unranked": unranked,
             }
         )
     return boards

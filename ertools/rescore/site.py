@@ -19,6 +19,7 @@ Pure: :func:`site_context` turns the document into what the template shows;
 from __future__ import annotations
 
 import math
+import os
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -28,6 +29,8 @@ from typing import Any
 from ertools.errors import ConfigError
 from ertools.report import html as h
 from ertools.report import units
+from ertools.rescore import site_text as text
+from ertools.rescore.site_text import TEAM_UNKNOWN
 
 SCHEMA_VERSION = 1
 TEMPLATE = "rescore_index.html.j2"
@@ -64,6 +67,8 @@ class Board:
     direction: str
     column: str  # the value's header with its unit
     rows: tuple[Standing, ...]
+    unranked: tuple[Standing, ...] = ()  # scored, no team named: out of the ranking
+    warnings: tuple[text.Grouped, ...] = ()  # said once for the benchmark
 
 
 def _anchor(prefix: str, name: str) -> str:
@@ -113,18 +118,6 @@ def _value_key(score: dict[str, Any] | None, value: float | None) -> str | None:
     return next((k for k, v in score.items() if _number(v) == value), None)
 
 
-def _shown(key: str | None, value: Any) -> str:
-    return h.fmt(units.display(key, value) if key else value)
-
-
-def _with_unit(score: Any, value: float | None) -> str:
-    """``12.3 mm``: a ranked value in its display unit (the executions' table mixes them)."""
-    key = _value_key(score, value)
-    spec = units.quantity_of(key) if key else None
-    text = _shown(key, value)
-    return f"{text} {units.unit(spec[0])}" if spec and value is not None else text
-
-
 def _when(iso: Any) -> str:
     """``2015-11-20 09:00:00.000`` of an ISO UTC time (the header says UTC)."""
     text = str(iso or "")
@@ -140,6 +133,74 @@ def _scalars(score: Any) -> dict[str, Any]:
     if not isinstance(score, dict):
         return {}
     return {k: v for k, v in score.items() if v is None or isinstance(v, bool | int | float | str)}
+
+
+@dataclass(frozen=True)
+class LiveRow:
+    """One field of a live 2015 score beside the recomputed one (``status``: ``differs``,
+    ``not-recomputed`` or ``same``: the row's CSS class)."""
+
+    execution: str
+    team: str
+    field: str
+    live: str
+    recomputed: str
+    difference: str
+    why: str
+    rules: tuple[str, ...]
+    status: str
+
+
+_LIVE_ORDER = {"differs": 0, "not-recomputed": 1, "same": 2}
+
+
+def _live_rows(executions: Sequence[dict[str, Any]], paths: text.Paths) -> list[LiveRow]:
+    """Every live field beside the recomputed one, the differing ones first."""
+    rows: list[LiveRow] = []
+    for ex in executions:
+        live = _scalars(ex.get("live_score"))
+        if not live:
+            continue
+        score = _scalars(ex.get("score"))
+        why = {
+            d.key: d
+            for d in (text.difference(str(line)) for line in ex.get("live_differences") or [])
+        }
+        for key, value in live.items():
+            d = why.get(key)
+            status = (
+                "differs"
+                if d is not None
+                else "not-recomputed"
+                if score.get(key) is None and value is not None
+                else "same"
+            )
+            rows.append(
+                LiveRow(
+                    execution=str(ex.get("id")),
+                    team=_team(ex),
+                    field=key,
+                    live=text.with_unit(key, value),
+                    recomputed=text.with_unit(key, score.get(key)),
+                    difference=d.difference if d is not None else "",
+                    why=(
+                        text.prose_units(
+                            text.manifest_terms(paths.text(d.why), str(ex.get("benchmark")))
+                        )
+                        if d is not None
+                        else ""
+                    ),
+                    rules=d.rules if d is not None else (),
+                    status=status,
+                )
+            )
+    rows.sort(key=lambda r: _LIVE_ORDER[r.status])  # stable: time order within each
+    return rows
+
+
+def _team(ex: dict[str, Any] | None) -> str:
+    team = ex.get("team") if ex else None
+    return str(team) if team else TEAM_UNKNOWN
 
 
 def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict[str, Any]:
@@ -162,11 +223,19 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
         e for e in results.get("executions") or [] if isinstance(e, dict)
     ]
     by_id = {str(e.get("id")): e for e in executions}
+    manifest = results.get("manifest") or {}
+    manifest_path = str(manifest.get("path") or "")
+    # Paths relative to the organiser's folder (results.json's ``root``; without one, the
+    # manifest's folder), also those of files kept beside it.
+    root = str(results.get("root") or (os.path.dirname(manifest_path) if manifest_path else ""))
+    folders = {os.path.dirname(str(b)) for e in executions for b in e.get("bags") or []}
+    paths = text.Paths(root, [os.path.dirname(manifest_path), *sorted(folders)])
 
-    def report_link(ex: dict[str, Any] | None, text: str) -> Link:
+    def report_link(ex: dict[str, Any] | None, label: str) -> Link:
         target = ex.get("report") if ex else None
-        return Link(text, str(target) if target and exists(str(target)) else None)
+        return Link(label, str(target) if target and exists(str(target)) else None)
 
+    grouped, own_warnings = text.group_warnings(executions, paths, skip=(TEAM_UNKNOWN,))
     boards = []
     for lb in results.get("leaderboards") or []:
         lower = bool(lb.get("lower_is_better", True))
@@ -185,84 +254,80 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
             standings.append(
                 Standing(
                     rank=rank,
-                    team=str(row.get("team") or "(unknown)"),
-                    value=_shown(key, value),
-                    live=_shown(key, live.get(key)) if key in live else h.fmt(None),
+                    team=str(row.get("team") or TEAM_UNKNOWN),
+                    value=text.shown(key, value),
+                    live=text.shown(key, live.get(key)) if key in live else text.shown(None, None),
                     differs=differs,
+                    execution=report_link(ex, str(row.get("execution"))),
+                )
+            )
+        unranked = []
+        for row in lb.get("unranked") or []:
+            ex = by_id.get(str(row.get("execution")))
+            value = _number(row.get("value"))
+            key = _value_key(ex.get("score") if ex else None, value)
+            keys.add(key)
+            unranked.append(
+                Standing(
+                    rank=None,
+                    team=str(row.get("note") or TEAM_UNKNOWN),
+                    value=text.shown(key, value),
+                    live=text.shown(None, None),
+                    differs=False,
                     execution=report_link(ex, str(row.get("execution"))),
                 )
             )
         # One header for the column: the ranked key's name and unit when every row agrees.
         (only,) = keys if len(keys) == 1 else (None,)
         column = f"{units.header(only)}" if only else "value"
+        name = str(lb.get("benchmark"))
         boards.append(
             Board(
-                anchor=_anchor("lb", str(lb.get("benchmark"))),
-                title=str(lb.get("title") or lb.get("benchmark")),
-                rule=str(lb.get("rule") or ""),
+                anchor=_anchor("lb", name),
+                title=str(lb.get("title") or name),
+                rule=text.rule_text(str(lb.get("rule") or "")),
                 # Said once: the registry's rule texts may already end with the direction.
                 direction=""
                 if "better" in str(lb.get("rule") or "")
                 else ("lower is better" if lower else "higher is better"),
                 column=column,
                 rows=tuple(standings),
+                unranked=tuple(unranked),
+                warnings=tuple(g for g in grouped if g.benchmark == name),
             )
         )
 
-    live_rows: list[dict[str, Any]] = []
-    for ex in executions:
-        live = _scalars(ex.get("live_score"))
-        if not live:
-            continue
-        score = _scalars(ex.get("score"))
-        flagged = _differing_fields(ex.get("live_differences") or [])
-        for key, value in live.items():
-            live_rows.append(
-                {
-                    "execution": ex.get("id"),
-                    "team": ex.get("team"),
-                    "field": key,
-                    "live 2015": _shown(key, value),
-                    "recomputed": _shown(key, score.get(key)),
-                    "unit": units.unit(q[0]) if (q := units.quantity_of(key)) else "",
-                    "differs": (
-                        "DIFFERS"
-                        if key in flagged
-                        else "not recomputed"
-                        if score.get(key) is None and value is not None
-                        else "same"
-                    ),
-                }
-            )
-    live_table = h.table(live_rows, row_class="differs") if live_rows else None
-    # Per execution (collapsed on the page: nested fields make dozens of lines per execution).
-    differences = [
-        (str(ex.get("id")), [str(line) for line in ex.get("live_differences") or []])
-        for ex in executions
-        if ex.get("live_differences")
-    ]
-
+    live_rows = _live_rows(executions, paths)
     rows = []
     for ex in executions:
         status = str(ex.get("status"))
+        score = ex.get("score")
+        rank_value = _number(ex.get("rank_value"))
+        key = _value_key(score if isinstance(score, dict) else None, rank_value)
         rows.append(
             {
                 "id": str(ex.get("id")),
                 "benchmark": str(ex.get("title") or ex.get("benchmark")),
-                "team": str(ex.get("team") or "(unknown)"),
+                "team": _team(ex),
+                "named": bool(ex.get("team")),
                 "start": _when(ex.get("start")),
                 "end": _when(ex.get("end")),
                 "status": status,
                 "level": STATUS_LEVEL.get(status, "bad"),
-                "reason": str(ex.get("reason") or ""),
-                "value": _with_unit(ex.get("score"), _number(ex.get("rank_value"))),
-                "warnings": list(ex.get("warnings") or []),
+                "reason": text.prose_units(
+                    text.manifest_terms(
+                        paths.text(ex.get("reason") or ""), str(ex.get("benchmark"))
+                    )
+                ),
+                "value": text.with_unit(key, rank_value) if key else text.shown(None, rank_value),
+                "warnings": own_warnings.get(str(ex.get("id")), []),
                 "cached": bool(ex.get("cached")),
-                "seconds": h.fmt(_number(ex.get("seconds"))),
+                "seconds": text.shown("seconds", _number(ex.get("seconds"))),
                 "report": report_link(ex, str(ex.get("report") or "")),
             }
         )
     counts = {s: sum(r["status"] == s for r in rows) for s in ("scored", "unscoreable", "failed")}
+    unnamed = sum(not r["named"] for r in rows)
 
     timeline = results.get("timeline") or {}
     figure = str(timeline.get("figure") or "") if isinstance(timeline, dict) else ""
@@ -271,24 +336,37 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
         figure_kind = "image" if Path(figure).suffix.lower() in _IMAGE_SUFFIXES else "frame"
 
     problems = [
-        {"kind": p.get("kind"), "path": p.get("path"), "message": p.get("message")}
+        {
+            "kind": p.get("kind"),
+            "path": paths.path(p.get("path")) if p.get("path") else None,
+            "message": text.prose_units(paths.text(p.get("message"))),
+        }
         for p in results.get("problems") or []
         if isinstance(p, dict)
     ]
-    manifest = results.get("manifest") or {}
     provenance = [
         ("ertools version", results.get("ertools_version", "")),
         ("generated", results.get("generated", "")),
-        ("command", " ".join(str(t) for t in results.get("command") or [])),
-        ("manifest", manifest.get("path", "")),
+        (
+            "folder",
+            f"{os.path.basename(root)}/ (the folder scanned: paths on this page are relative to it)"
+            if root
+            else "",
+        ),
+        ("command", paths.text(" ".join(str(t) for t in results.get("command") or []))),
+        ("manifest", paths.path(manifest_path)),
         ("manifest SHA-256", manifest.get("sha256", "")),
         ("options", ", ".join(f"{k} {v}" for k, v in (results.get("options") or {}).items())),
     ]
     inputs = [
-        {"path": i.get("path"), "size": i.get("size"), "sha256": i.get("sha256")}
+        {"path": paths.path(i.get("path")), "size": i.get("size"), "sha256": i.get("sha256")}
         for i in results.get("inputs") or []
         if isinstance(i, dict)
     ]
+    places: dict[str, int] = {}
+    for entry in results.get("files") or []:
+        if isinstance(entry, dict):
+            places[str(entry.get("place"))] = places.get(str(entry.get("place")), 0) + 1
     nav = [(b.anchor, b.title) for b in boards] + [
         ("live", "Live 2015"),
         ("timeline", "Timeline"),
@@ -307,15 +385,23 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
         ),
         "nav": nav,
         "boards": boards,
-        "live_table": live_table,
-        "differences": differences,
+        "live_rows": live_rows,
+        "live_differing": sum(r.status == "differs" for r in live_rows),
         "figure": figure,
         "figure_kind": figure_kind,
         "sessions": timeline.get("sessions") if isinstance(timeline, dict) else None,
         "problems": h.table(problems, columns=["kind", "path", "message"]) if problems else None,
-        "deviations": [str(d) for d in results.get("deviations_in_force") or []],
+        "deviations": [
+            text.prose_units(text.deviation_terms(str(d)))
+            for d in results.get("deviations_in_force") or []
+        ],
         "executions": rows,
         "counts": counts,
+        "unnamed": unnamed,
+        "team_unknown": TEAM_UNKNOWN,
+        "units": {q: units.unit(q) for q in ("length", "angle", "time")},
+        "decimals": text.DECIMALS,
+        "files": places,
         "provenance": provenance,
         "inputs": h.table(inputs, columns=["path", "size", "sha256"]) if inputs else None,
         "downloads": downloads,

@@ -72,7 +72,9 @@ def test_every_execution_found_with_its_files(day: tuple[Discovery, dict[str, An
             assert got.id == want["id"]
         else:
             assert got.team is None and got.team_source is None
-            assert any("no team" in p for p in got.problems)
+            # a problem of the day; not a note of its row, which says "team unknown"
+            assert (got.bmbox_log, "no-team") in {(p.path, p.kind) for p in found.problems}
+            assert not any("no team" in p for p in got.problems)
 
 
 def test_planted_problems_are_found(day: tuple[Discovery, dict[str, Any]]) -> None:
@@ -219,3 +221,38 @@ def test_copies_and_lost_benchmark_logs() -> None:
     assert by_kind["duplicate"].path == copy.path
     lost = [p for p in found.problems if "execution is missing" in p.message]
     assert len(lost) == 1 and "fbm3w execution started 2015-11-20 11:37:15" in lost[0].message
+
+
+def test_gt_recordings_alone_are_candidate_executions() -> None:
+    """The GT recordings no benchmark log overlaps: one candidate per recording (its split
+    files in order); the uncovered tail of a recording that covers a benchmark log, a
+    recording naming no benchmark and a still marker set's recording are problems."""
+    from ertools.rescore.discover import _gt_only
+    from ertools.timeline.model import BagEntry, Pairing
+
+    def gt(path: str, start: int, benchmarks: tuple[str, ...] = ("fbm3w",)) -> BagEntry:
+        return BagEntry(path, "ros1", start, start + 10, "gt", "gt", benchmarks=benchmarks)
+
+    entries = [
+        gt("work/log_fbm3w_mocap_2015-11-20-10-00-00_1.bag", 10),  # listed out of order
+        gt("work/log_fbm3w_mocap_2015-11-20-10-00-00_0.bag", 0),
+        gt("home/log_fbm2h_mocap_2015-11-20-11-00-00_0.bag", 100, ("fbm2h",)),
+        gt("home/log_fbm2h_mocap_2015-11-20-11-00-00_1.bag", 110, ("fbm2h",)),
+        gt("odd/log_mocap_2015-11-20-12-00-00_0.bag", 200, ()),
+        gt("still/log_fbm3w_static_2015-11-20-13-00-00_0.bag", 300),
+    ]
+    covering = Pairing("bm/log_fbm2h_0.bag", "benchmark", (entries[2].path,), 100.0, ())
+    recordings, problems = _gt_only(entries, (covering,))
+    assert [[f.path for f in r] for r in recordings] == [
+        [
+            "work/log_fbm3w_mocap_2015-11-20-10-00-00_0.bag",
+            "work/log_fbm3w_mocap_2015-11-20-10-00-00_1.bag",
+        ]
+    ]
+    assert {(p.path, p.kind) for p in problems} == {
+        ("home/log_fbm2h_mocap_2015-11-20-11-00-00_1.bag", "gt-only"),
+        ("odd/log_mocap_2015-11-20-12-00-00_0.bag", "gt-only"),
+        ("still/log_fbm3w_static_2015-11-20-13-00-00_0.bag", "gt-only"),
+    }
+    (still,) = [p for p in problems if p.path.startswith("still/")]
+    assert "noise recording" in still.message

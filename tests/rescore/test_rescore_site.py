@@ -51,13 +51,13 @@ def test_leaderboards_ranked_by_each_rule(tmp_path: Path) -> None:
     assert "the best run's distance error (lower is better)" in page.rules["lb-fbm3w"]
     assert "class accuracy (higher is better)" in page.rules["lb-fbm1h"]
     assert page.rules["lb-fbm2h"].count("better") == 1  # not said twice
-    # Values in the display unit of the ranked key: 0.0081 m is 8.1 mm; the live 2015 value
-    # (0.0095 m) beside it, and that row flagged.
+    # Values in the display unit of the ranked key at the page's resolution (0.01 mm): 0.0081 m
+    # is 8.10 mm; the live 2015 value (0.0095 m) beside it, and that row flagged.
     smart = page.boards["lb-fbm3w"][0]
-    assert smart[2] == f"{0.0081 * 1000:.6g}" == "8.1"
-    assert smart[3].startswith("9.5") and "differs" in smart[3]
+    assert smart[2] == f"{0.0081 * 1000:.2f}" == "8.10"
+    assert smart[3].startswith("9.50") and "differs" in smart[3]
     # b-it-bots: the live best_distance_error equals the recomputed one (its best_run does not)
-    assert page.boards["lb-fbm3w"][1][3] == "12.3"
+    assert page.boards["lb-fbm3w"][1][3] == "12.30"
     assert page.differs_rows == 1
 
 
@@ -73,11 +73,14 @@ def test_problems_deviations_timeline_and_executions(tmp_path: Path) -> None:
         assert d in page.sections["deviations"]
     assert page.frames == ["timeline.html"]
     assert "6 session(s)" in page.sections["timeline"]
-    # Live 2015 vs recomputed: both differing fields listed.
-    assert "best_distance_error: live 0.0095 vs recomputed 0.0081" in page.sections["live"]
-    assert "best_run: live 1 vs recomputed 2" in page.sections["live"]
-    assert "fbm3w-smartbots-20151120T091000: 2 field(s) differ" in page.sections["live"]
-    assert "fbm3w-b-it-bots-20151120T090000: 1 field(s) differ" in page.sections["live"]
+    # Live 2015 vs recomputed: the three differing fields first, each with its difference
+    # (recomputed - live: 8.1 - 9.5 = -1.40 mm; best_run 2 - 1 = +1 and 2 - 3 = -1).
+    live = page.sections["live"]
+    assert "show only the 3 differing row(s)" in live
+    assert "best_distance_error\n9.50 mm8.10 mm\n-1.40 mm" in live
+    assert "best_run\n12\n+1" in live and "best_run\n32\n-1" in live
+    first_same = live.index("\nsame\n")  # the first row that agrees
+    assert live.index("-1.40 mm") < first_same and live.index("\n-1\n") < first_same
     # One row per execution with its status; the failed and unscoreable ones say why.
     assert page.executions == [e["status"] for e in doc["executions"]]
     assert page.executions.count("failed") == page.executions.count("unscoreable") == 1

@@ -132,7 +132,7 @@ def day(tmp_path_factory: pytest.TempPathFactory) -> tuple[Timeline, Path]:
 @needs_browser
 def test_page_loads_offline_and_draws_every_bag(day: tuple[Timeline, Path], tmp_path: Path) -> None:
     tl, page = day
-    dom, stderr = dump(tmp_path, page.as_uri())
+    dom, stderr = dump(tmp_path, page.as_uri() + "#day")
     no_script_errors(stderr)
     assert dom.svg.get("data-ready") == "1", "the chart script did not finish"
     readable = [b for b in tl.bags if b.readable]
@@ -157,6 +157,24 @@ def test_page_loads_offline_and_draws_every_bag(day: tuple[Timeline, Path], tmp_
     # each session band's tooltip is its label, computed from the day's layout
     bands = [t for t in dom.titles if t.startswith("session ")]
     assert bands == [label for label, _ in expected_day()]
+
+
+@needs_browser
+def test_page_opens_on_the_sessions(day: tuple[Timeline, Path], tmp_path: Path) -> None:
+    """Without a fragment the page opens on the sessions, not on a day in which they are
+    slivers: the day's six sessions fill little of its six hours, so it opens on the one with
+    the most bags (ties: the first)."""
+    tl, page = day
+    dom, stderr = dump(tmp_path, page.as_uri())
+    no_script_errors(stderr)
+    day_s = (tl.sessions[-1].end_ns - tl.sessions[0].start_ns) / S
+    assert sum(s.duration_ns for s in tl.sessions) / S < 0.2 * day_s
+    most = max(len(s.paths) for s in tl.sessions)
+    busiest = next(s for s in tl.sessions if len(s.paths) == most)
+    s0, s1 = busiest.start_ns / S, busiest.end_ns / S
+    start, end = float(dom.svg["data-view-start"]), float(dom.svg["data-view-end"])
+    assert start <= s0 and end >= s1
+    assert end - start <= (s1 - s0) * 1.2 + 1.0  # the session and its margin (8 %, >= 0.5 s)
 
 
 @needs_browser
@@ -300,7 +318,12 @@ def test_real_and_simulated_logs_in_one_page(tmp_path: Path) -> None:
     sample = Path(__file__).resolve().parents[2] / "sample_bags" / "timeline" / "bags"
     tl = scan([REAL, sample])
     page = write_timeline_page(tl, tmp_path / "mixed.html")
+    # opened as it is: on the session with the most bags (session 2), not on a month
     dom, stderr = dump(tmp_path, page.as_uri())
+    no_script_errors(stderr)
+    start, end = float(dom.svg["data-view-start"]), float(dom.svg["data-view-end"])
+    assert 1448031590.0 <= start <= 1448031600.0 and 1448031634.0 <= end <= 1448031640.0
+    dom, stderr = dump(tmp_path, page.as_uri() + "#day")  # "fit day"
     no_script_errors(stderr)
     # the real GT bag (one session of its own, 2015-10-23) and the sample's 8 readable bags
     # in its 2 sessions (answers file)

@@ -285,6 +285,40 @@ def test_figure_colours_match_the_legend_and_problems_are_numbered() -> None:
     assert f"4. {UNREADABLE.path} (unreadable): truncated {EVIL}" in listing
 
 
+def test_table_times_stay_on_one_line() -> None:
+    """Every time in the sessions and bags tables is one unbreakable span: a table cell that
+    wraps inside ``2015-11-20 09:00:00.000`` misreads."""
+    import re
+
+    tl = day_timeline()
+    text = timeline_page(tl)
+    assert ".ts { white-space: nowrap; }" in text
+    stamp = r"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d\.\d{3}"
+    assert not re.findall(rf"<td>{stamp}</td>", text)
+    spans = re.findall(rf'<td><span class="ts">{stamp}</span></td>', text)
+    readable = [b for b in tl.bags if b.readable]
+    assert len(spans) == 2 * (len(tl.sessions) + len(readable))  # start and end of each
+
+
+def test_figure_problem_list_fits_the_picture() -> None:
+    """The numbered problems are listed within the picture, however wide the panels' lane
+    labels make its left margin (the whole sample folder: a rosbag2 lane label of 42
+    characters)."""
+    tl = scan([Path(__file__).resolve().parents[2] / "sample_bags"], check_clocks=False)
+    fig = timeline_figure(tl)
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    canvas = FigureCanvasAgg(fig)
+    canvas.draw()
+    problems = next(ax for ax in fig.axes if ax.get_label() == "problems")
+    (listing,) = problems.texts
+    assert listing.get_text().count("\n") >= 4  # the folder's problem bags, wrapped
+    box = listing.get_window_extent(canvas.get_renderer())
+    assert box.x0 >= 0 and box.x1 <= fig.bbox.x1, (box, fig.bbox)
+    # and the panels' lane labels push the axes far right of where the list starts
+    assert problems.get_window_extent(canvas.get_renderer()).x0 > box.x0 + 50
+
+
 # --- the command line ------------------------------------------------------------------------
 
 

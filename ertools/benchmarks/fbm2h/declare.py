@@ -6,7 +6,7 @@ score stages.
 from __future__ import annotations
 
 import logging
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -38,6 +38,9 @@ INPUTS = (
         "marker-to-robot transform (Listing 11)",
         metavar="FILE",
         per_team=True,  # each team's robot carries its own marker set
+        # A log the GT logger wrote alone (a test run, reached moments from a timing file or
+        # stop detection) is scored as `ertools score` scores it: the identity, with a warning.
+        needed_unless=(("reached", ("timing", "auto")),),
     ),
     Input("transforms", "path", "folder of transform-<team>.yaml files", metavar="DIR"),
     Input(
@@ -238,6 +241,25 @@ def notes(result: Fbm2hResult) -> list[str]:
     return out
 
 
+TIMING_SUFFIX = "_reached_waypoint_timing.yaml"
+
+
+def gt_only(bags: Sequence[Path]) -> dict[str, Any] | str:
+    """A GT-only FBM2@Home log (no state topics) is an execution when the 2015 reached-waypoint
+    timing file lies beside it (``<log stem>_reached_waypoint_timing.yaml``, as the 2015 test
+    logs ship): ``reached: [timing, FILE]``."""
+    first = bags[0]
+    stem = first.name.removesuffix(".active").removesuffix(".bag")
+    timing = first.with_name(stem + TIMING_SUFFIX)
+    if timing.is_file():
+        return {"reached": ("timing", timing)}
+    return (
+        "the GT logger's FBM2@Home log alone: no state topics and no "
+        f"{timing.name} beside it, so nothing says when each waypoint was reached (list it "
+        "under executions: with reached: auto or [timing, FILE] to score it)"
+    )
+
+
 def sample(samples: Path) -> list[str] | None:
     """The FBM2@Home sample log with its goal list and transform (``make demo``)."""
     folder = samples / NAME
@@ -332,4 +354,5 @@ error, the segment time; then position_accuracy, orientation_accuracy and execut
     sample=sample,
     from_live=from_live,
     explanations=EXPLANATIONS,
+    gt_only=gt_only,
 )
