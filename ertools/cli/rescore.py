@@ -15,11 +15,12 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ertools.atomic import folder_lock
 from ertools.cli.output import note
 from ertools.errors import UsageError
 from ertools.rescore.draft import draft_text
 from ertools.rescore.found import find, merge, write_timeline
-from ertools.rescore.manifest import ManifestError, load_manifest
+from ertools.rescore.manifest import Manifest, ManifestError, load_manifest
 from ertools.rescore.parallel import default_jobs
 from ertools.rescore.pipeline import listed_executions, rescore, write_results
 
@@ -107,6 +108,19 @@ def run(args: argparse.Namespace) -> int:
     if args.check:
         note(f"{args.config}: no problems ({len(manifest.executions)} listed executions)")
         return 0
+
+    def waiting(holder: str) -> None:
+        note(
+            f"{args.out} is being written by another ertools rescore (process {holder}); "
+            "waiting for it to end (Ctrl-C to stop, or give another --out)"
+        )
+
+    # two runs into one folder would mix their reports and caches: one at a time
+    with folder_lock(args.out, on_wait=waiting):
+        return _rescore(args, manifest)
+
+
+def _rescore(args: argparse.Namespace, manifest: Manifest) -> int:
     scorings = listed_executions(manifest)
     problems: list[dict[str, object]] = []
     timeline = None

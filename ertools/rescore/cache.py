@@ -16,12 +16,11 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from ertools import __version__
+from ertools import __version__, atomic
 from ertools.report.records import sha256_file
 from ertools.rescore.jobs import Job, Outcome
 
@@ -77,9 +76,7 @@ class FileHashes:
         if self.store is None or not self.changed:
             return
         self.store.parent.mkdir(parents=True, exist_ok=True)
-        tmp = self.store.with_suffix(".tmp")
-        tmp.write_text(json.dumps(self.known, sort_keys=True), encoding="utf-8")
-        os.replace(tmp, self.store)
+        atomic.write_text(self.store, json.dumps(self.known, sort_keys=True))
 
 
 def value_record(value: Any, hashes: FileHashes) -> Any:
@@ -145,9 +142,7 @@ class Cache:
         if path is None or outcome.status == "failed":
             return
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(".tmp")
-        tmp.write_text(json.dumps(outcome.to_dict(), allow_nan=False), encoding="utf-8")
-        os.replace(tmp, path)
+        atomic.write_text(path, json.dumps(outcome.to_dict(), allow_nan=False))
 
 
 def records(values: Mapping[str, Any], hashes: FileHashes) -> list[dict[str, Any]]:

@@ -11,11 +11,15 @@ breaks its whole pool and every job still in it. Results come back in completion
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import multiprocessing
 import multiprocessing.connection
 import os
 import pickle
+import signal
 import sys
+import threading
+import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -42,8 +46,39 @@ def run_jobs(jobs: Sequence[Job], *, workers: int, scheduler: str | None, on_don
         run_local(jobs, workers=workers, on_done=on_done)
 
 
-def _worker(conn: multiprocessing.connection.Connection) -> None:
+# prctl(2): PR_SET_PDEATHSIG, the signal the kernel sends a process when its parent ends
+_PR_SET_PDEATHSIG = 1
+
+
+def end_with_parent(parent: int) -> None:
+    """End this process when its parent ``parent`` ends, however that ends (``kill -9``
+    included): a worker left behind holds its memory and its job for ever, blocked on a pipe
+    whose other end its siblings keep open (inherited by fork).
+
+    Linux: the kernel sends SIGKILL (``PR_SET_PDEATHSIG``). Elsewhere a thread watches the
+    parent's pid. Either way, a parent that died before this was set up is caught at once.
+    """
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            if libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0:
+                if os.getppid() != parent:  # it died between the fork and the prctl
+                    os._exit(1)
+                return
+        except (OSError, AttributeError):  # no prctl in this libc: watch instead
+            pass
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(1.0)
+    os._exit(1)
+
+
+def _worker(conn: multiprocessing.connection.Connection, parent: int) -> None:
     """A local worker: score the jobs it is sent until it is sent None."""
+    end_with_parent(parent)
     while True:
         try:
             job = conn.recv()
@@ -63,11 +98,13 @@ def run_job_forked(job: Job) -> Outcome:
     if not hasattr(os, "fork"):
         return run_job(job)
     read_fd, write_fd = os.pipe()
+    parent = os.getpid()
     pid = os.fork()
     if pid == 0:  # the child: score, send the outcome, leave without running any cleanup
         os.close(read_fd)
         code = 0
         try:
+            end_with_parent(parent)
             data = pickle.dumps(run_job(job))
             with os.fdopen(write_fd, "wb") as out:
                 out.write(data)
@@ -98,7 +135,7 @@ def _context() -> Any:
 class _Worker:
     def __init__(self, ctx: Any) -> None:
         self.conn, child = ctx.Pipe()
-        self.process = ctx.Process(target=_worker, args=(child,), daemon=True)
+        self.process = ctx.Process(target=_worker, args=(child, os.getpid()), daemon=True)
         self.process.start()
         child.close()
         self.job: Job | None = None

@@ -11,7 +11,6 @@ from __future__ import annotations
 import csv
 import io
 import json
-import os
 import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -19,9 +18,10 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from ertools import __version__
+from ertools import __version__, atomic
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Benchmark
+from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ErtoolsError
 from ertools.io import summary
 from ertools.progress import Reporter
@@ -456,7 +456,9 @@ def csv_text(doc: Mapping[str, Any]) -> str:
     )
     writer.writeheader()
     for row in doc["executions"]:
-        writer.writerow({k: "" if row.get(k) is None else row[k] for k in CSV_COLUMNS})
+        writer.writerow(
+            {k: "" if row.get(k) is None else spreadsheet_safe(row[k]) for k in CSV_COLUMNS}
+        )
     return buffer.getvalue()
 
 
@@ -468,11 +470,7 @@ def write_results(doc: Mapping[str, Any], out: Path) -> list[Path]:
         ("results.json", json.dumps(doc, indent=2, allow_nan=False) + "\n"),
         ("results.csv", csv_text(doc)),
     ):
-        path = out / name
-        tmp = path.with_suffix(".tmp")
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, path)
-        written.append(path)
+        written.append(atomic.write_text(out / name, text))
     # the results page, rebuilt from the document alone (ertools.rescore.site)
     written.append(write_site(dict(doc), out))
     return written

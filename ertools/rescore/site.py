@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ertools import atomic
 from ertools.errors import ConfigError
 from ertools.report import html as h
 from ertools.report import units
@@ -338,7 +339,7 @@ def write_site(results: dict[str, Any], out: Path) -> Path:
     index = out / "index.html"
     try:
         out.mkdir(parents=True, exist_ok=True)
-        index.write_text(h.render(TEMPLATE, **context), encoding="utf-8")
+        atomic.write_text(index, h.render(TEMPLATE, **context))
     except OSError as err:
         raise ConfigError(
             f"cannot write the results site ({err.strerror or err})", path=out
