@@ -11,6 +11,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import logging
 import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -31,6 +32,8 @@ from ertools.rescore.manifest import Manifest
 from ertools.rescore.parallel import run_jobs
 from ertools.rescore.site import write_site
 from ertools.timeutil import NS_PER_S, iso_utc
+
+log = logging.getLogger(__name__)
 
 SCHEMA_VERSION = 1
 CSV_COLUMNS = (
@@ -253,6 +256,18 @@ def rescore(
         else:
             to_run.append(p.job)
     hashes.save()
+    if cache.invalid:
+        path, why = cache.invalid[0]
+        more = f" and {len(cache.invalid) - 1} more" if len(cache.invalid) > 1 else ""
+        log.warning(
+            "%d cache entr%s not used, scored again (%s: %s%s); the cache is not signed: "
+            "docs/rescore.md",
+            len(cache.invalid),
+            "y" if len(cache.invalid) == 1 else "ies",
+            path.name,
+            why,
+            more,
+        )
 
     total = len(planned)
     state = {"done": len(outcomes), "bad": sum(o.status != "scored" for o in outcomes.values())}

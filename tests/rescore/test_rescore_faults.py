@@ -9,6 +9,7 @@ that file appears; a write is killed from inside, by the hook it goes through.
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import json
 import os
@@ -19,6 +20,7 @@ import textwrap
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
 from rescore_competition import LOGS, expected_value, make_competition, use_toy_registry
@@ -235,3 +237,127 @@ def test_csv_cells_that_look_like_formulas_are_text(tmp_path: Path) -> None:
 )
 def test_spreadsheet_safe(cell: object, expected: object) -> None:
     assert spreadsheet_safe(cell) == expected
+
+
+# ------------------------------------------------------------------------------------------
+# The cache trusts nothing it finds
+
+
+def entries(out: Path) -> list[Path]:
+    return sorted((out / "cache" / "outcomes").glob("*.json"))
+
+
+def entry_of(out: Path, ident: str) -> Path:
+    for path in entries(out):
+        if json.loads(path.read_text())["outcome"]["report"].endswith(f"/{ident}/index.html"):
+            return path
+    raise AssertionError(ident)
+
+
+FIRST = "toy-alpha-20151120T091000"
+
+
+def edit(field: str, value: Any, *, keep_checksum: bool = False) -> Callable[[Path], None]:
+    def damage(out: Path) -> None:
+        path = entry_of(out, FIRST)
+        entry = json.loads(path.read_text())
+        entry["outcome"][field] = value
+        if keep_checksum:  # a forger who recomputes the checksum (it is not signed)
+            material = {k: v for k, v in entry.items() if k != "checksum"}
+            entry["checksum"] = hashlib.sha256(
+                json.dumps(material, sort_keys=True).encode()
+            ).hexdigest()
+        path.write_text(json.dumps(entry))
+
+    return damage
+
+
+@pytest.mark.parametrize(
+    ("damage", "why"),
+    [
+        (edit("rank_value", 1e-9), "checksum mismatch"),  # a hand edit
+        (edit("status", "bogus", keep_checksum=True), "invalid status"),
+        (edit("report", 123, keep_checksum=True), "invalid report"),
+        (edit("rank_value", "abc", keep_checksum=True), "invalid rank_value"),
+        (edit("warnings", [1, 2], keep_checksum=True), "invalid warnings"),
+        (lambda out: entry_of(out, FIRST).write_text("{not json"), "not JSON"),
+        (lambda out: entry_of(out, FIRST).write_text('{"rank_value": NaN}'), "cache version"),
+        (
+            lambda out: (out / "executions" / FIRST / "score.json").write_text('{"x"'),
+            "report file score.json has changed",
+        ),
+        (
+            lambda out: (out / "executions" / FIRST / "score.yaml").unlink(),
+            "report file score.yaml is missing",
+        ),
+    ],
+)
+def test_a_cache_entry_that_is_not_right_is_scored_again(
+    damage: Callable[[Path], None], why: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    comp = make_competition(tmp_path / "comp")
+    out = tmp_path / "out"
+    argv = ["rescore", "--config", str(comp.manifest), "--out", str(out), "--jobs", "1"]
+    assert main(argv) == 0
+    report = out / "executions" / FIRST
+    files = {p.relative_to(report): p.read_bytes() for p in report.rglob("*") if p.is_file()}
+    capsys.readouterr()
+    damage(out)
+    assert main(argv) == 0
+    err = capsys.readouterr().err
+    rows = {r["id"]: r for r in json.loads((out / "results.json").read_text())["executions"]}
+    # by hand: the values of the toy competition, whatever the damage
+    assert {i: r["rank_value"] for i, r in rows.items()} == {i: expected_value(i) for i in LOGS}
+    assert [i for i, r in rows.items() if not r["cached"]] == [FIRST]
+    warnings = [line for line in err.splitlines() if "cache entr" in line]
+    assert len(warnings) == 1 and "1 cache entry not used, scored again" in warnings[0]
+    assert why in warnings[0], warnings[0]
+    assert "this is a bug" not in err
+    # the report folder written again: the same files (result.json has its own time stamp)
+    again = {p.relative_to(report) for p in report.rglob("*") if p.is_file()}
+    assert again == set(files)
+    assert (report / "score.json").read_bytes() == files[Path("score.json")]
+    # and the third run takes everything from the cache again
+    assert main(argv) == 0
+    doc = json.loads((out / "results.json").read_text())
+    assert all(r["cached"] for r in doc["executions"])
+    assert "cache entr" not in capsys.readouterr().err
+
+
+def test_a_damaged_hash_memo_costs_the_hashing_only(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    comp = make_competition(tmp_path / "comp")
+    out = tmp_path / "out"
+    argv = ["rescore", "--config", str(comp.manifest), "--out", str(out), "--jobs", "1"]
+    assert main(argv) == 0
+    memo = out / "cache" / "hashes.json"
+    rows = json.loads(memo.read_text())
+    first = next(iter(rows))
+    rows[first] = "bogus"
+    rows["/elsewhere"] = [1, 2]
+    memo.write_text(json.dumps(rows))
+    assert main(argv) == 0
+    doc = json.loads((out / "results.json").read_text())
+    assert all(r["cached"] for r in doc["executions"])  # the file hashed again: same key
+    assert "this is a bug" not in capsys.readouterr().err
+
+
+def test_a_machine_error_is_not_cached(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A report folder that cannot be written makes its execution unscoreable this time, and
+    is not remembered: once the folder can be written, it is scored."""
+    comp = make_competition(tmp_path / "comp")
+    out = tmp_path / "out"
+    argv = ["rescore", "--config", str(comp.manifest), "--out", str(out), "--jobs", "1"]
+    (out / "executions").mkdir(parents=True)
+    (out / "executions" / FIRST).write_text("a file where the report folder goes")
+    assert main(argv) == 1
+    rows = {r["id"]: r for r in json.loads((out / "results.json").read_text())["executions"]}
+    assert rows[FIRST]["status"] == "unscoreable"
+    assert "cannot write the report folder" in rows[FIRST]["reason"]
+    (out / "executions" / FIRST).unlink()
+    assert main(argv) == 0
+    rows = {r["id"]: r for r in json.loads((out / "results.json").read_text())["executions"]}
+    assert rows[FIRST]["status"] == "scored" and not rows[FIRST]["cached"]
+    assert rows[FIRST]["rank_value"] == expected_value(FIRST)
+    assert capsys.readouterr().err.count("0 unscoreable") == 1
