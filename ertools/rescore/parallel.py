@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import logging
 import multiprocessing
 import multiprocessing.connection
 import os
@@ -20,13 +21,14 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
 from ertools.errors import ConfigError
 from ertools.rescore.jobs import Job, Outcome, run_job
 
 OnDone = Callable[[Outcome], None]
+log = logging.getLogger(__name__)
 
 
 def default_jobs() -> int:
@@ -219,6 +221,52 @@ def run_dask(jobs: Sequence[Job], address: str, *, workers: int, on_done: OnDone
             "--scheduler needs Dask distributed: pip install 'ertools[dask]'"
         ) from None
     distributed: Any = _distributed  # untyped calls: its API is checked by the Dask test
+    with _dask_logs_as_one_line(address):
+        _run_dask(distributed, jobs, address, workers=workers, on_done=on_done)
+
+
+class _Held(logging.Handler):
+    def __init__(self) -> None:
+        super().__init__(logging.ERROR)
+        self.records: list[logging.LogRecord] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.records.append(record)
+
+
+@contextlib.contextmanager
+def _dask_logs_as_one_line(address: str) -> Iterator[None]:
+    """``distributed`` logs a lost scheduler as several ERROR records with tracebacks, on
+    stderr by its own handlers: held here, and said in one line (each execution's row already
+    says what became of it)."""
+    # distributed gives several of its loggers a handler of their own (distributed.client...)
+    names = ["distributed", "tornado"] + [
+        name
+        for name in logging.root.manager.loggerDict
+        if name.startswith(("distributed.", "tornado."))
+    ]
+    loggers = [logging.getLogger(name) for name in names]
+    saved = [(lg.handlers[:], lg.propagate) for lg in loggers]
+    held = _Held()
+    for lg in loggers:
+        lg.handlers[:] = [held]
+        lg.propagate = False
+    try:
+        yield
+    finally:
+        for lg, (handlers, propagate) in zip(loggers, saved, strict=True):
+            lg.handlers[:] = handlers
+            lg.propagate = propagate
+        messages = [m for r in held.records if (m := r.getMessage().strip())]
+        if held.records:
+            first = " ".join((messages[0] if messages else "an error").split())
+            more = f" ({len(held.records) - 1} more not shown)" if len(held.records) > 1 else ""
+            log.warning("Dask (%s): %s%s", address, first, more)
+
+
+def _run_dask(
+    distributed: Any, jobs: Sequence[Job], address: str, *, workers: int, on_done: OnDone
+) -> None:
     cluster = None
     try:
         if address == "local":

@@ -26,16 +26,36 @@ def test_the_scheduler_lost_is_one_line(tmp_path: Path) -> None:
         pytest.skip(f"no dask command beside {sys.executable}")
     port = free_port()
     address = f"tcp://127.0.0.1:{port}"
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(HERE), os.environ.get("PYTHONPATH", "")])}
+    env = {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(HERE), os.environ.get("PYTHONPATH", "")]),
+    }
     logs = (tmp_path / "dask.log").open("w")
     scheduler = subprocess.Popen(
         [str(DASK), "scheduler", "--host", "127.0.0.1", "--port", str(port), "--no-dashboard"],
-        env=env, stdout=logs, stderr=subprocess.STDOUT,
+        env=env,
+        stdout=logs,
+        stderr=subprocess.STDOUT,
     )
     worker = subprocess.Popen(
-        [str(DASK), "worker", address, "--nthreads", "1", "--host", "127.0.0.1", "--no-nanny",
-         "--memory-limit", "0", "--local-directory", str(tmp_path / "dask"), "--no-dashboard"],
-        env=env, stdout=logs, stderr=subprocess.STDOUT,
+        [
+            str(DASK),
+            "worker",
+            address,
+            "--nthreads",
+            "1",
+            "--host",
+            "127.0.0.1",
+            "--no-nanny",
+            "--memory-limit",
+            "0",
+            "--local-directory",
+            str(tmp_path / "dask"),
+            "--no-dashboard",
+        ],
+        env=env,
+        stdout=logs,
+        stderr=subprocess.STDOUT,
     )
     comp = make_competition(tmp_path / "comp", extra=dict(list(HOLD.items())[:1]))
     ident = next(iter(HOLD))
@@ -47,17 +67,24 @@ def test_the_scheduler_lost_is_one_line(tmp_path: Path) -> None:
             client.wait_for_workers(1, timeout=30)
         proc = subprocess.Popen(
             [*TOY_RESCORE, str(comp.manifest), "--out", str(out), "--scheduler", address],
-            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
         )
         wait_for(lambda: pid_file.is_file() and pid_file.read_text().endswith("\n"), "held")
         scheduler.send_signal(signal.SIGKILL)
         scheduler.wait()
         _, err = proc.communicate(timeout=120)
-        print(err)
-        assert proc.returncode == 1
-        assert "Traceback" not in err
+        assert proc.returncode == 1, err
+        assert "Traceback" not in err and " - ERROR - " not in err, err
+        dask_lines = [line for line in err.splitlines() if "Dask (" in line]
+        assert len(dask_lines) == 1 and address in dask_lines[0], err
         rows = {r["id"]: r for r in json.loads((out / "results.json").read_text())["executions"]}
         assert rows[ident]["status"] == "failed"
+        assert "scheduler" in rows[ident]["reason"]
+        # the others were scored before the scheduler went, and their values are right
+        assert [r["status"] for i, r in rows.items() if i != ident] == ["scored"] * 3
     finally:
         for p in (proc, scheduler, worker):
             if p is not None:
