@@ -10,6 +10,7 @@ still-recording ``.bag.active`` from a closed bag.
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -155,10 +156,14 @@ def detect_format(path: str | Path) -> str:
         return "ros1-active" if p.name.endswith(".active") else "ros1"
     if head.startswith(b"#ROSBAG V"):
         version = head[len("#ROSBAG V") :].split(b"\n")[0].decode("ascii", "replace")
-        raise BagError(f"ROS1 bag version {version} is not supported (only 2.0)", path=p)
+        if re.fullmatch(r"[0-9]\.[0-9]", version):  # else it is no version: not quoted
+            raise BagError(f"ROS1 bag version {version} is not supported (only 2.0)", path=p)
     if head[: len(MCAP_MAGIC)] == MCAP_MAGIC:
         return "mcap"
+    # What the file holds is not said: it may be anything (a path to /etc/passwd), and this
+    # line reaches results.json and the published pages.
     raise BagError(
-        f"not a ROS1 bag, rosbag2 bag or MCAP file (unknown magic bytes {head[:8]!r})",
+        "not a ROS1 bag, rosbag2 bag or MCAP file: it does not begin with '#ROSBAG V2.0' "
+        "(ROS1) or MCAP's magic bytes",
         path=p,
     )

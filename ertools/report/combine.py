@@ -247,7 +247,9 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
                 target = r.index or r.source
                 rel = os.path.relpath(target.resolve(), outdir.resolve())
                 label = f" ({r.options or 'defaults'})" if x.others else ""
-                links.append((Path(rel).as_posix(), f"{x.team or '(unknown)'}{label}: {rel}"))
+                href = h.relative_href(Path(rel).as_posix())
+                if href is not None:  # another drive (Windows): no link, the text says where
+                    links.append((href, f"{x.team or '(unknown)'}{label}: {rel}"))
         teams = len({x.team for x in group})
         benchmarks.append(
             {

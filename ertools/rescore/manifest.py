@@ -38,7 +38,8 @@ from typing import Any
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Benchmark, Input
 from ertools.configs._yaml import MAX_SECONDS, number, parse_yaml, show
-from ertools.errors import ConfigError
+from ertools.errors import BagError, ConfigError
+from ertools.io.formats import detect_format
 from ertools.timeutil import s_to_ns
 
 VERSION = 1
@@ -340,9 +341,35 @@ class _Checker:
 
     def path(self, text: str, where: str) -> Path | Any:
         path = Path(text).expanduser()
+        if not path.is_absolute() and ".." in path.parts:
+            # a relative path is read from the manifest's folder: one climbing out of it
+            # (`../../../../etc/passwd`) is refused; a file elsewhere is named absolutely
+            resolved = Path(os.path.normpath(self.base / path))
+            if not resolved.is_relative_to(self.base):
+                self.problem(
+                    where,
+                    f"{text} leads out of the manifest's folder ({self.base}); give a path "
+                    "inside it, or an absolute path",
+                )
+                return _BAD
         path = Path(os.path.normpath(path if path.is_absolute() else self.base / path))
         if not path.exists():
             self.problem(where, f"file not found: {path}")
+            return _BAD
+        return path
+
+    def bag(self, text: Any, where: str, bm: Benchmark[Any, Any, Any, Any] | None) -> Any:
+        """A listed log: a path, and, for a benchmark reading bags, a bag (checked by its
+        first bytes; what they hold is never quoted)."""
+        if not isinstance(text, str) or not text:
+            return _BAD
+        path = self.path(text, where)
+        if path is _BAD or bm is None or not bm.logs_are_bags:
+            return path
+        try:
+            detect_format(path)
+        except BagError as err:
+            self.problem(where, err.message)
             return _BAD
         return path
 
@@ -365,9 +392,7 @@ class _Checker:
             ok = False
         bags_raw = mapping.get("bags", [])
         bags_list = bags_raw if isinstance(bags_raw, list) else [bags_raw]
-        bags = [
-            self.path(b, f"{where}.bags") if isinstance(b, str) and b else _BAD for b in bags_list
-        ]
+        bags = [self.bag(b, f"{where}.bags", bm) for b in bags_list]
         if "bags" in mapping and (not bags_list or any(b is _BAD for b in bags)):
             if not bags_list or not all(isinstance(b, str) and b for b in bags_list):
                 self.problem(f"{where}.bags", "expected a list of one or more bag paths")

@@ -166,7 +166,8 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
 
     def report_link(ex: dict[str, Any] | None, text: str) -> Link:
         target = ex.get("report") if ex else None
-        return Link(text, str(target) if target and exists(str(target)) else None)
+        ok = target and exists(str(target))
+        return Link(text, h.relative_href(str(target)) if ok else None)
 
     boards = []
     for lb in results.get("leaderboards") or []:
@@ -310,7 +311,7 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
         "boards": boards,
         "live_table": live_table,
         "differences": differences,
-        "figure": figure,
+        "figure": h.relative_href(figure),
         "figure_kind": figure_kind,
         "sessions": timeline.get("sessions") if isinstance(timeline, dict) else None,
         "problems": h.table(problems, columns=["kind", "path", "message"]) if problems else None,

@@ -111,6 +111,7 @@ TOY = Benchmark(
     description="mean of the numbers times scale plus the team's offset",
     epilog="",
     bags_help="text files of numbers",
+    logs_are_bags=False,
     inputs=(
         Input("transform", "path", "the team's offset file", per_team=True),
         Input("scale", "float", "a factor", default=1.0, positive=True),
