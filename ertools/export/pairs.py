@@ -18,6 +18,7 @@ The formatting is in :mod:`ertools.export.formats` (pure); this module reads and
 
 from __future__ import annotations
 
+import logging
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -35,6 +36,8 @@ from ertools.errors import ScoringError, UsageError
 from ertools.export.formats import SUFFIXES, ExportFormat, format_poses, format_times
 from ertools.geometry import interpolate_poses
 from ertools.streams import PoseStream
+
+log = logging.getLogger(__name__)
 
 if TYPE_CHECKING:
     from ertools.benchmarks.common.sources import PoseSpec
@@ -57,9 +60,17 @@ def export_source(
     fmt: ExportFormat,
 ) -> tuple[PoseStream, str]:
     """Read one pose source (the one chooser, :func:`ertools.benchmarks.common.sources.
-    read_source`: an empty source is refused) and format it: (the stream, the text)."""
+    read_source`: an empty source is refused) and format it: (the stream, the text).
 
-    stream = read_source(paths, spec, what="poses to export")
+    A message recorded twice (the same bag given twice, two loggers' overlapping files: the
+    same stamp and pose) is written once, as ``score`` uses it once."""
+
+    stream, twice = drop_duplicates(read_source(paths, spec, what="poses to export"))
+    if twice:
+        log.warning(
+            "%d pose(s) recorded twice (the same stamp and pose in overlapping files) written once",
+            twice,
+        )
     return stream, format_poses(stream, fmt)
 
 
