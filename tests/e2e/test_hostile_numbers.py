@@ -170,3 +170,29 @@ def test_a_manifest_number_fails_check_not_the_rescore(
     assert code == 1, err
     assert "this is a bug" not in err and HUGE not in err
     assert any(str(manifest) in line and message in line for line in err.splitlines()), err
+
+
+@pytest.mark.parametrize(
+    ("x", "code", "said"),
+    [
+        ("1.0e+308", 1, "goal.waypoints[0][0]: 1e+308 is out of range"),
+        # by hand: 5000 - 2.33 (the GT's largest x) and 31.6 - 2.33
+        ("5000.0", 1, "goal.waypoints[0] (5000, 0.4) lies 4997.7 m outside"),
+        ("31.6", 0, "goal.waypoints[0] (31.6, 0.4) lies 29.3 m outside the area the GT covers"),
+        ("1.6", 0, None),  # the sample's own goal: nothing said
+    ],
+)
+def test_a_goal_far_outside_the_arena(
+    x: str, code: int, said: str | None, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The GT of the sample covers x -1.02..2.33 m, y -0.53..2.59 m (its marker path): a
+    waypoint 29 m beyond is warned, one 5 km beyond refused (issue 25, item 9)."""
+    path = tmp_path / "goal.yaml"
+    path.write_text(first(FBM2H_GOAL.read_text(), "[1.6, 0.4", f"[{x}, 0.4"))
+    assert main([*FBM2H_SCORE, "--goal", str(path), "--transform", str(FBM2H_TRANSFORM)]) == code
+    err = capsys.readouterr().err
+    assert "this is a bug" not in err
+    if said is None:
+        assert "outside the area" not in err
+    else:
+        assert said in err
