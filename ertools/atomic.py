@@ -61,7 +61,13 @@ def replacing(path: Path) -> Iterator[Path]:
 
 
 def write_bytes(path: Path, data: bytes) -> Path:
-    """``data`` into ``path``, whole or not at all."""
+    """``data`` into ``path``, whole or not at all (a pipe or a device, ``-o /dev/stdout``,
+    is written as it is: it cannot be replaced)."""
+    path = Path(path)
+    if path.exists() and not path.is_file():
+        with open(path, "wb") as fh:
+            fh.write(data)
+        return path
     with replacing(path) as tmp:
         tmp.write_bytes(data)
     return path

@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ertools import atomic
 from ertools.atomic import folder_lock
 from ertools.cli.output import note
 from ertools.errors import UsageError
@@ -181,7 +182,7 @@ def _init(args: argparse.Namespace) -> int:
     found = find(args.paths, progress=args.progress)
     text = draft_text(found, args.paths, args.init, args.command_line)
     args.init.parent.mkdir(parents=True, exist_ok=True)
-    args.init.write_text(text, encoding="utf-8")
+    atomic.write_text(args.init, text)
     todo = sum("TODO" in line for line in text.splitlines())
     note(
         f"wrote {args.init}: {len(found.discovery.executions)} execution(s), {todo} TODO line(s) "
