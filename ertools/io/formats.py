@@ -104,6 +104,20 @@ def bag_paths(paths: str | Path | list[str | Path] | tuple[str | Path, ...]) -> 
     return out
 
 
+def metadata_problem(err: Exception) -> str:
+    """What is wrong with a ``metadata.yaml``, on one line and without its text: PyYAML's own
+    message quotes the offending line, and the file may be anything (a symlink to a secret)."""
+    mark = getattr(err, "problem_mark", None)
+    if mark is not None:
+        problem = getattr(err, "problem", None) or "malformed YAML"
+        return f"{problem} at line {mark.line + 1}, column {mark.column + 1}"
+    if isinstance(err, UnicodeDecodeError):
+        return f"not UTF-8 text (byte {err.start})"
+    if isinstance(err, KeyError | TypeError):
+        return "no rosbag2_bagfile_information.storage_identifier"
+    return type(err).__name__
+
+
 def _rosbag2_storage(path: Path) -> str:
     meta = path / "metadata.yaml"
     if meta.is_file():
@@ -113,8 +127,7 @@ def _rosbag2_storage(path: Path) -> str:
             data = yaml.safe_load(meta.read_text(encoding="utf-8"))
             storage = str(data["rosbag2_bagfile_information"]["storage_identifier"])
         except (yaml.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
-            # The YAML parser's message spans several lines (mark, caret): one line here.
-            why = " ".join(str(err).split())
+            why = metadata_problem(err)
             raise BagError(
                 f"unreadable rosbag2 metadata.yaml ({why}); re-create it with `ros2 bag reindex`",
                 path=path,

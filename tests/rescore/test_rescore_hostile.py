@@ -169,3 +169,16 @@ def test_the_results_page_links_only_relative_paths(tmp_path: Path) -> None:
     links = assert_relative_links(page)
     assert "javascript%3Aalert%281%29/index.html" in links
     assert not any("passwd" in link for link in links)
+
+
+def test_a_rosbag2_metadata_that_is_no_yaml_is_not_quoted(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """PyYAML's own message quotes the offending line: ertools says where, not what."""
+    folder = tmp_path / "bag2"
+    folder.mkdir()
+    (folder / "metadata.yaml").write_text("key: [unclosed\n\tSECRET-4711: x\n")
+    assert main(["info", str(folder)]) == 1
+    err = capsys.readouterr().err
+    assert "SECRET" not in err
+    assert "metadata.yaml" in err and "at line" in err
