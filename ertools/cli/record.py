@@ -124,7 +124,10 @@ def run(args: argparse.Namespace) -> int:
     if args.recover is not None:
         return _recover(args.recover)
     if args.out_dir is None:
-        raise UsageError("--out-dir DIR is needed: where the MCAP files go")
+        raise UsageError(
+            "the following arguments are required: --out-dir DIR (where the MCAP files go; "
+            "`ertools record --help` shows how)"
+        )
     if args.config is None and not args.simulate:
         raise UsageError("--config is required (a mocap YAML as seed Listing 2)")
     config = (

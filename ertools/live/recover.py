@@ -83,10 +83,9 @@ def recover(path: Path) -> Recovered:
 def _rewrite(source: Path, target: Path, complete_bytes: int, size: int) -> int:
     """Every complete record of ``source`` into the finished MCAP file ``target``; the
     number of messages."""
-    # lazy: the mcap library only when an MCAP file is written
-    from mcap import records as r
-    from mcap.stream_reader import StreamReader
-    from mcap.writer import CompressionType, Writer
+    from mcap import records as r  # lazy: the mcap library only when a file is recovered
+    from mcap.stream_reader import StreamReader  # lazy: as above
+    from mcap.writer import CompressionType, Writer  # lazy: as above
 
     count = 0
     with open(source, "rb") as fin, open(target, "wb") as fout:

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 from rescore_competition import make_competition
-from test_rescore_dask import DASK, HERE, free_port
+from test_rescore_dask import DASK, HERE, free_port, worker_command
 from test_rescore_faults import HOLD, TOY_RESCORE, wait_for
 
 distributed = pytest.importorskip(
@@ -38,21 +38,7 @@ def test_the_scheduler_lost_is_one_line(tmp_path: Path) -> None:
         stderr=subprocess.STDOUT,
     )
     worker = subprocess.Popen(
-        [
-            str(DASK),
-            "worker",
-            address,
-            "--nthreads",
-            "1",
-            "--host",
-            "127.0.0.1",
-            "--no-nanny",
-            "--memory-limit",
-            "0",
-            "--local-directory",
-            str(tmp_path / "dask"),
-            "--no-dashboard",
-        ],
+        worker_command(address, tmp_path),
         env=env,
         stdout=logs,
         stderr=subprocess.STDOUT,
