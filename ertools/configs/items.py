@@ -140,7 +140,7 @@ def _parse_spread(value: Any, what: str, source: str) -> ItemSpread | None:
             float(window[0]),
             float(window[1]),
         )
-    except (KeyError, TypeError, ValueError, IndexError) as err:
+    except (KeyError, TypeError, ValueError, IndexError, OverflowError) as err:
         raise ConfigError(f"{what}: malformed spread ({err})", path=source) from None
 
 
