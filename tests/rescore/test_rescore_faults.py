@@ -65,34 +65,63 @@ HOLD = {
 }
 
 
+def descendants(pid: int) -> list[int]:
+    """Every process below ``pid`` (children, their children...), from /proc."""
+    children: dict[int, list[int]] = {}
+    for status in Path("/proc").glob("[0-9]*/status"):
+        try:
+            ppid = int(status.read_text().split("\nPPid:\t", 1)[1].split("\n", 1)[0])
+        except (OSError, IndexError, ValueError):
+            continue
+        children.setdefault(ppid, []).append(int(status.parent.name))
+    out, stack = [], [pid]
+    while stack:
+        for child in children.get(stack.pop(), []):
+            out.append(child)
+            stack.append(child)
+    return out
+
+
+def _dask_or_skip() -> None:
+    pytest.importorskip("distributed", reason="needs the dask extra: pip install -e '.[dask]'")
+
+
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
-def test_workers_end_when_the_command_is_killed(tmp_path: Path) -> None:
-    """kill -9 of `rescore --jobs 2` while both workers score: both workers end too."""
+@pytest.mark.parametrize("parallel", [["--jobs", "2"], ["--jobs", "2", "--scheduler", "local"]])
+def test_workers_end_when_the_command_is_killed(parallel: list[str], tmp_path: Path) -> None:
+    """kill -9 of `rescore --jobs 2` (local workers, or a Dask LocalCluster) while both
+    executions are being scored: every process it started ends too."""
+    if "--scheduler" in parallel:
+        _dask_or_skip()
     comp = make_competition(tmp_path / "comp", extra=HOLD)
     pid_files = [comp.log(ident).with_name(comp.log(ident).name + ".pid") for ident in HOLD]
     proc = subprocess.Popen(
-        [*TOY_RESCORE, str(comp.manifest), "--out", str(tmp_path / "out"), "--jobs", "2"],
+        [*TOY_RESCORE, str(comp.manifest), "--out", str(tmp_path / "out"), *parallel],
+        env={
+            **os.environ,
+            "PYTHONPATH": os.pathsep.join([str(HERE), os.environ.get("PYTHONPATH", "")]),
+        },
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     )
-    workers: list[int] = []
+    tree: list[int] = []
     try:
         wait_for(
             lambda: all(p.is_file() and p.read_text().endswith("\n") for p in pid_files),
-            "both workers holding a job",
+            "both executions being scored",
         )
-        workers = [int(p.read_text()) for p in pid_files]
-        assert len(set(workers)) == 2 and proc.pid not in workers
-        assert all(alive(w) for w in workers)
+        scorers = [int(p.read_text()) for p in pid_files]
+        tree = descendants(proc.pid)
+        assert len(set(scorers)) == 2 and set(scorers) <= set(tree)
         proc.send_signal(signal.SIGKILL)
         proc.wait()
-        wait_for(lambda: not any(alive(w) for w in workers), "workers ending with their parent")
+        wait_for(lambda: not any(alive(p) for p in tree), "every process ending with rescore")
     finally:
         proc.kill()
         proc.wait()
-        for w in workers:  # only if the test failed: leave nothing behind
-            if alive(w):
-                os.kill(w, signal.SIGKILL)
+        for p in tree:  # only if the test failed: leave nothing behind
+            if alive(p):
+                os.kill(p, signal.SIGKILL)
 
 
 def test_a_second_rescore_into_the_same_folder_waits_for_the_first(tmp_path: Path) -> None:
