@@ -99,10 +99,17 @@ def show(value: Any) -> str:
 
 
 def _walk(data: Any, where: str) -> Iterator[tuple[str, Any]]:
-    # iterative: the depth is limited by the loader, but data may come from elsewhere
+    # iterative: the depth is limited by the loader, but data may come from elsewhere; each
+    # container once: YAML aliases share one object (a "billion laughs" file is 10 lists
+    # referring 9 times each to the previous one: a billion paths, ten objects)
     stack = [(where, data)]
+    seen: set[int] = set()
     while stack:
         key, value = stack.pop()
+        if isinstance(value, dict | list | tuple):
+            if id(value) in seen:
+                continue
+            seen.add(id(value))
         if isinstance(value, dict):
             stack.extend((f"{key}.{k}" if key else str(k), v) for k, v in value.items())
         elif isinstance(value, list | tuple):

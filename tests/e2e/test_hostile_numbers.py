@@ -196,3 +196,19 @@ def test_a_goal_far_outside_the_arena(
         assert "outside the area" not in err
     else:
         assert said in err
+
+
+def test_a_billion_laughs_file_is_read_in_its_own_size(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Ten lists, each nine aliases of the previous one: a billion paths to walk when every
+    number is checked, ten objects when each is checked once (the test would time out)."""
+    lines = ["a: &a [1, 1, 1, 1, 1, 1, 1, 1, .nan]"]
+    for prev, name in zip("abcdefghi", "bcdefghij", strict=True):
+        lines.append(f"{name}: &{name} [{', '.join([f'*{prev}'] * 9)}]")
+    path = tmp_path / "goal.yaml"
+    path.write_text("\n".join(lines) + "\n")
+    code = main([*FBM2H_SCORE, "--goal", str(path)])
+    err = capsys.readouterr().err
+    assert code == 1 and "this is a bug" not in err
+    assert ": nan is not a finite number" in err  # found through whichever alias came first
