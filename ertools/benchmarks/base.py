@@ -220,6 +220,9 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
         description: the ``ertools score NAME --help`` text.
         epilog: examples and notes after the options in ``--help``.
         bags_help: what the positional ``BAG...`` arguments are (default: log files).
+        logs_are_bags: its logs are ROS1 bags, rosbag2 bags or MCAP files, which the
+            manifest's ``--check`` verifies of every listed one; False for a benchmark that
+            reads other files.
         inputs: every value it takes besides its bags (see :class:`Input`).
         make_options: the values by :attr:`Input.name` (missing ones at their defaults) ->
             validated options; raises :class:`~ertools.errors.UsageError` (exit 2) or
@@ -280,6 +283,7 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
     sample: Callable[[Path], Sequence[str] | None] | None = None
     bags_help: str = "log file(s)"
     gt_only: Callable[[Sequence[Path]], Mapping[str, Any] | str] | None = None
+    logs_are_bags: bool = True
 
     def score(self, bags: Sequence[Path], options: OptionsT) -> ResultT:
         """The whole shape: load -> find runs -> score."""

@@ -158,11 +158,17 @@ def run(args: argparse.Namespace) -> int:
             continue
         infos.append(info)
         fatal = info.fatal_problem
+        # an MCAP cut short (its recorder killed): one command makes it whole
+        fix = (
+            f"; if its recorder was killed, `ertools record --recover {path}` makes it whole"
+            if path.suffix == ".mcap" and not info.summary.indexed
+            else ""
+        )
         if fatal is not None:
-            problems.append({"path": str(path), "problem": _one_line(fatal)})
+            problems.append({"path": str(path), "problem": _one_line(fatal) + fix})
         elif not info.summary.indexed and info.summary.problems:
             # a complete file read record by record (an MCAP without summary) is no warning
-            note(f"warning: {path}: not indexed (still recording?); counts come from a scan")
+            note(f"warning: {path}: not indexed (still recording?){fix}; counts come from a scan")
         # each disagreement --check found is a line of its own
         problems.extend({"path": str(path), "problem": _one_line(p)} for p in info.check_problems)
     if args.format == "text":

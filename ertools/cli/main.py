@@ -258,6 +258,7 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
         print("ertools: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:
+        _silence_stdout()
         return 0
     except OSError as err:  # mostly an output path that cannot be written (-o, --plot...)
         if args.debug:
@@ -297,6 +298,27 @@ def _progress_bar(args: argparse.Namespace) -> Bar | None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Console entry point."""
+    try:
+        code = _main(argv)
+        sys.stdout.flush()  # here, not at exit, where a closed pipe is a traceback
+    except BrokenPipeError:
+        # `ertools --help | head -1`: the reader has all it wants; say nothing more, and
+        # point stdout at nothing so that Python's own flush at exit does not complain
+        _silence_stdout()
+        return 0
+    return code
+
+
+def _silence_stdout() -> None:
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):  # stdout replaced in-process (tests)
+        pass
+
+
+def _main(argv: Sequence[str] | None) -> int:
     args = list(sys.argv[1:] if argv is None else argv)
     if not args or args[0] in ("-h", "--help"):
         print(_top_level_help())

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from ertools import atomic
 from ertools.benchmarks.base import jsonable
 from ertools.progress import clear_current
 
@@ -20,7 +21,7 @@ def write_text(text: str, output: Path | None) -> None:
         sys.stdout.write(text if text.endswith("\n") else text + "\n")
     else:
         output.parent.mkdir(parents=True, exist_ok=True)
-        output.write_text(text if text.endswith("\n") else text + "\n", encoding="utf-8")
+        atomic.write_text(output, text if text.endswith("\n") else text + "\n")
         note(f"wrote {output}")
 
 

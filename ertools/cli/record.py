@@ -23,6 +23,7 @@ from ertools.configs.mocap import load_mocap_config, normalize_namespace, parse_
 from ertools.errors import UsageError
 from ertools.live.natnet import NatNetVersion
 from ertools.live.recorder import Recorder, RecordOptions
+from ertools.live.recover import recover
 from ertools.live.simulate import SimulatedBody, SimulatedMotive
 
 EPILOG = """examples:
@@ -49,7 +50,15 @@ rigid_bodies:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--config", type=Path, help="mocap YAML (seed Listing 2: rigid_bodies)")
-    add_out_dir(parser, "write the MCAP files into DIR", old=("--out",), required=True)
+    add_out_dir(parser, "write the MCAP files into DIR (needed to record)", old=("--out",))
+    parser.add_argument(
+        "--recover",
+        type=Path,
+        metavar="FILE",
+        help="make FILE, a recording cut short (kill -9, power lost), whole: every complete "
+        "message kept, summary and index written (the cut bytes kept as FILE.cut); "
+        "nothing is recorded",
+    )
     parser.add_argument("--name", help="file name part (default <namespace>_mocap or mocap)")
     parser.add_argument(
         "--namespace", default="", help="prefix of the config's relative topics, e.g. /fbm2h"
@@ -112,6 +121,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.recover is not None:
+        return _recover(args.recover)
+    if args.out_dir is None:
+        raise UsageError(
+            "the following arguments are required: --out-dir DIR (where the MCAP files go; "
+            "`ertools record --help` shows how)"
+        )
     if args.config is None and not args.simulate:
         raise UsageError("--config is required (a mocap YAML as seed Listing 2)")
     config = (
@@ -208,4 +224,17 @@ def run(args: argparse.Namespace) -> int:
             f"untracked: {summary.untracked.get(b.body_id, 0)}}}"
         )
     print("\n".join(lines))
+    return 0
+
+
+def _recover(path: Path) -> int:
+    done = recover(path)
+    if done.kept is None:
+        note(f"{path}: already whole (it ends with its footer); nothing done")
+        return 0
+    lost = done.size_bytes - done.complete_bytes
+    note(
+        f"{path}: whole again: {done.messages} messages kept, summary and index written; "
+        f"{lost} bytes after the last complete record dropped; the cut file kept as {done.kept}"
+    )
     return 0

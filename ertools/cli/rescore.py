@@ -15,12 +15,14 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ertools import atomic
+from ertools.atomic import folder_lock
 from ertools.cli.output import note
 from ertools.errors import UsageError
 from ertools.rescore.draft import draft_text
 from ertools.rescore.found import find, merge, write_timeline
 from ertools.rescore.ledger import account
-from ertools.rescore.manifest import ManifestError, load_manifest
+from ertools.rescore.manifest import Manifest, ManifestError, load_manifest
 from ertools.rescore.parallel import default_jobs
 from ertools.rescore.pipeline import listed_executions, rescore, write_results
 
@@ -108,6 +110,19 @@ def run(args: argparse.Namespace) -> int:
     if args.check:
         note(f"{args.config}: no problems ({len(manifest.executions)} listed executions)")
         return 0
+
+    def waiting(holder: str) -> None:
+        note(
+            f"{args.out} is being written by another ertools rescore (process {holder}); "
+            "waiting for it to end (Ctrl-C to stop, or give another --out)"
+        )
+
+    # two runs into one folder would mix their reports and caches: one at a time
+    with folder_lock(args.out, on_wait=waiting):
+        return _rescore(args, manifest)
+
+
+def _rescore(args: argparse.Namespace, manifest: Manifest) -> int:
     scorings = listed_executions(manifest)
     problems: list[dict[str, object]] = []
     timeline = None
@@ -172,7 +187,7 @@ def _init(args: argparse.Namespace) -> int:
     found = find(args.paths, progress=args.progress)
     text = draft_text(found, args.paths, args.init, args.command_line)
     args.init.parent.mkdir(parents=True, exist_ok=True)
-    args.init.write_text(text, encoding="utf-8")
+    atomic.write_text(args.init, text)
     todo = sum("TODO" in line for line in text.splitlines())
     problems = sum(1 for p in found.problems if p.get("kind") != "no-team")
     note(

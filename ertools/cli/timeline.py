@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from ertools.benchmarks.base import dump_yaml
 from ertools.cli.options import add_output, plot_file, seconds
 from ertools.cli.output import dump_json, note, write_text
+from ertools.csvsafe import spreadsheet_safe
 from ertools.report.plots_timeline import save_timeline_plot
 from ertools.timeline.model import KIND_LABELS, TimelineConfig
 from ertools.timeline.scan import scan
@@ -137,7 +138,7 @@ def to_csv(timeline: Timeline) -> str:
     writer = csv.DictWriter(out, fieldnames=fields, lineterminator="\n")
     writer.writeheader()
     for r in rows:
-        writer.writerow({k: "" if v is None else v for k, v in r.items()})
+        writer.writerow({k: "" if v is None else spreadsheet_safe(v) for k, v in r.items()})
     return out.getvalue()
 
 

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ertools.configs._yaml import load_yaml
+from ertools.configs._yaml import load_yaml, show
 from ertools.configs.shapes import Shape, builtin_shapes, parse_shape
 from ertools.errors import ConfigError
 
@@ -77,7 +77,9 @@ class Fbm3wConfig:
 def check_d_min(value: Any, where: str) -> float:
     """``value`` as a finite, non-negative float, or a ConfigError naming ``where``."""
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ConfigError(f"{where}: d_min must be a number of metres, got {value!r}")
+        raise ConfigError(f"{where}: d_min must be a number of metres, got {show(value)}")
+    if isinstance(value, int) and abs(value) > 1:  # a 400-digit integer overflows float()
+        raise ConfigError(f"{where}: d_min {show(value)} m is larger than 5 cm")
     d_min = float(value)
     if not math.isfinite(d_min) or d_min < 0.0:
         raise ConfigError(f"{where}: d_min must be finite and >= 0 metres, got {value!r}")

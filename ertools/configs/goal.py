@@ -7,7 +7,6 @@ payload has no ``goal:`` key). :func:`parse_goal` accepts both.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -15,7 +14,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.configs._yaml import load_yaml, parse_yaml
+from ertools.configs._yaml import load_yaml, number, parse_yaml
 from ertools.errors import ConfigError
 
 Pose2 = tuple[float, float, float]
@@ -48,12 +47,7 @@ class GoalList:
 
 
 def _number(value: Any, what: str, source: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ConfigError(f"{what}: expected a number, got {value!r}", path=source)
-    f = float(value)
-    if not math.isfinite(f):
-        raise ConfigError(f"{what}: not a finite number ({value!r})", path=source)
-    return f
+    return number(value, what, source)
 
 
 def _pose(value: Any, what: str, source: str) -> Pose2:

@@ -19,7 +19,7 @@ from typing import Any
 
 import yaml
 
-from ertools.configs._yaml import load_yaml
+from ertools.configs._yaml import load_yaml, number
 from ertools.errors import ConfigError
 from ertools.yamlout import Dumper, dump
 
@@ -115,9 +115,7 @@ def _numbers(value: Any, n: int, what: str, source: str) -> tuple[float, ...]:
         raise ConfigError(f"{what}: expected a list of {n} numbers, got {value!r}", path=source)
     out = []
     for v in value:
-        if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-            raise ConfigError(f"{what}: {v!r} is not a finite number", path=source)
-        out.append(float(v))
+        out.append(number(v, what, source))
     return tuple(out)
 
 
@@ -142,7 +140,7 @@ def _parse_spread(value: Any, what: str, source: str) -> ItemSpread | None:
             float(window[0]),
             float(window[1]),
         )
-    except (KeyError, TypeError, ValueError, IndexError) as err:
+    except (KeyError, TypeError, ValueError, IndexError, OverflowError) as err:
         raise ConfigError(f"{what}: malformed spread ({err})", path=source) from None
 
 

@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from ertools.arrays import F64
+from ertools.configs._yaml import MAX_NUMBER, show
 from ertools.errors import ConfigError
 
 Curve = Callable[[F64], F64]
@@ -208,6 +209,8 @@ def _compile(node: ast.AST) -> Node:
         value = node.value
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise _RejectedError(f"constant {value!r}")
+        if abs(value) > MAX_NUMBER:  # a 400-digit literal would overflow float()
+            raise _RejectedError(f"constant {show(value)}: too large")
         number = float(value)
         return lambda ll: number
     if isinstance(node, ast.Name):

@@ -13,7 +13,6 @@ as everywhere in ertools). ``p(k+1)`` closes segment ``k`` and opens segment ``k
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -21,7 +20,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.configs._yaml import load_yaml
+from ertools.configs._yaml import MAX_SECONDS, load_yaml, number
 from ertools.errors import ConfigError
 from ertools.timeutil import resolve_time
 
@@ -86,8 +85,8 @@ def parse_timing(data: Any, source: str = "<timing>") -> ReachedTiming:
             )
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise ConfigError(f"{KEY}[{i}] {label}: {value!r} is not a number", path=source)
-        if not math.isfinite(float(value)):
-            raise ConfigError(f"{KEY}[{i}] {label}: {value!r} is not finite", path=source)
+        # seconds from the bag's start, or epoch seconds: either way their ns fit int64
+        number(value, f"{KEY}[{i}] {label}", source, low=-MAX_SECONDS, high=MAX_SECONDS, unit="s")
         if seconds and float(value) <= seconds[-1]:
             raise ConfigError(
                 f"{KEY}[{i}] {label}: {value} s does not come after {labels[-1]} "

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.configs._yaml import load_yaml
+from ertools.configs._yaml import load_yaml, number
 from ertools.errors import ConfigError
 from ertools.geometry import invert
 from ertools.yamlout import yaml_float
@@ -96,9 +96,7 @@ def _numbers(value: Any, n: int, what: str, source: str) -> list[float]:
         raise ConfigError(f"{what}: expected a list of {n} numbers, got {value!r}", path=source)
     out = []
     for v in value:
-        if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(float(v)):
-            raise ConfigError(f"{what}: {v!r} is not a finite number", path=source)
-        out.append(float(v))
+        out.append(number(v, what, source))
     return out
 
 

@@ -18,6 +18,7 @@ The formatting is in :mod:`ertools.export.formats` (pure); this module reads and
 
 from __future__ import annotations
 
+import logging
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -26,6 +27,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ertools import atomic
 from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid
 from ertools.benchmarks.common.sources import read_source
 from ertools.benchmarks.trajectory.association import COMPARED
@@ -35,6 +37,8 @@ from ertools.errors import ClockError, ScoringError, UsageError
 from ertools.export.formats import SUFFIXES, ExportFormat, format_poses, format_times
 from ertools.geometry import interpolate_poses
 from ertools.streams import PoseStream
+
+log = logging.getLogger(__name__)
 
 if TYPE_CHECKING:
     from ertools.benchmarks.common.sources import PoseSpec
@@ -57,9 +61,17 @@ def export_source(
     fmt: ExportFormat,
 ) -> tuple[PoseStream, str]:
     """Read one pose source (the one chooser, :func:`ertools.benchmarks.common.sources.
-    read_source`: an empty source is refused) and format it: (the stream, the text)."""
+    read_source`: an empty source is refused) and format it: (the stream, the text).
 
-    stream = read_source(paths, spec, what="poses to export")
+    A message recorded twice (the same bag given twice, two loggers' overlapping files: the
+    same stamp and pose) is written once, as ``score`` uses it once."""
+
+    stream, twice = drop_duplicates(read_source(paths, spec, what="poses to export"))
+    if twice:
+        log.warning(
+            "%d pose(s) recorded twice (the same stamp and pose in overlapping files) written once",
+            twice,
+        )
     return stream, format_poses(stream, fmt)
 
 
@@ -188,7 +200,7 @@ def write_pair(pair: PairExport, out_dir: str | Path, fmt: ExportFormat) -> list
         texts["gt_times"] = format_times(pair.gt, t0)
     Path(out_dir).mkdir(parents=True, exist_ok=True)
     for key, text in texts.items():
-        paths[key].write_text(text, encoding="utf-8", newline="\n")
+        atomic.write_text(paths[key], text)
     return [paths[k] for k in texts]
 
 

@@ -10,6 +10,7 @@ still-recording ``.bag.active`` from a closed bag.
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -103,6 +104,20 @@ def bag_paths(paths: str | Path | list[str | Path] | tuple[str | Path, ...]) -> 
     return out
 
 
+def metadata_problem(err: Exception) -> str:
+    """What is wrong with a ``metadata.yaml``, on one line and without its text: PyYAML's own
+    message quotes the offending line, and the file may be anything (a symlink to a secret)."""
+    mark = getattr(err, "problem_mark", None)
+    if mark is not None:
+        problem = getattr(err, "problem", None) or "malformed YAML"
+        return f"{problem} at line {mark.line + 1}, column {mark.column + 1}"
+    if isinstance(err, UnicodeDecodeError):
+        return f"not UTF-8 text (byte {err.start})"
+    if isinstance(err, KeyError | TypeError):
+        return "no rosbag2_bagfile_information.storage_identifier"
+    return type(err).__name__
+
+
 def _rosbag2_storage(path: Path) -> str:
     meta = path / "metadata.yaml"
     if meta.is_file():
@@ -112,8 +127,7 @@ def _rosbag2_storage(path: Path) -> str:
             data = yaml.safe_load(meta.read_text(encoding="utf-8"))
             storage = str(data["rosbag2_bagfile_information"]["storage_identifier"])
         except (yaml.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
-            # The YAML parser's message spans several lines (mark, caret): one line here.
-            why = " ".join(str(err).split())
+            why = metadata_problem(err)
             raise BagError(
                 f"unreadable rosbag2 metadata.yaml ({why}); re-create it with `ros2 bag reindex`",
                 path=path,
@@ -155,10 +169,14 @@ def detect_format(path: str | Path) -> str:
         return "ros1-active" if p.name.endswith(".active") else "ros1"
     if head.startswith(b"#ROSBAG V"):
         version = head[len("#ROSBAG V") :].split(b"\n")[0].decode("ascii", "replace")
-        raise BagError(f"ROS1 bag version {version} is not supported (only 2.0)", path=p)
+        if re.fullmatch(r"[0-9]\.[0-9]", version):  # else it is no version: not quoted
+            raise BagError(f"ROS1 bag version {version} is not supported (only 2.0)", path=p)
     if head[: len(MCAP_MAGIC)] == MCAP_MAGIC:
         return "mcap"
+    # What the file holds is not said: it may be anything (a path to /etc/passwd), and this
+    # line reaches results.json and the published pages.
     raise BagError(
-        f"not a ROS1 bag, rosbag2 bag or MCAP file (unknown magic bytes {head[:8]!r})",
+        "not a ROS1 bag, rosbag2 bag or MCAP file: it does not begin with '#ROSBAG V2.0' "
+        "(ROS1) or MCAP's magic bytes",
         path=p,
     )

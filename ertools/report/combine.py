@@ -16,15 +16,17 @@ rockin_logger names give.
 from __future__ import annotations
 
 import csv
+import io
 import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ertools import __version__
+from ertools import __version__, atomic
 from ertools.benchmarks import registry
 from ertools.benchmarks.common.teams import team_from_log_name
+from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ConfigError
 from ertools.report import html as h
 from ertools.report import units
@@ -245,7 +247,9 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
                 target = r.index or r.source
                 rel = os.path.relpath(target.resolve(), outdir.resolve())
                 label = f" ({r.options or 'defaults'})" if x.others else ""
-                links.append((Path(rel).as_posix(), f"{x.team or '(unknown)'}{label}: {rel}"))
+                href = h.relative_href(Path(rel).as_posix())
+                if href is not None:  # another drive (Windows): no link, the text says where
+                    links.append((href, f"{x.team or '(unknown)'}{label}: {rel}"))
         teams = len({x.team for x in group})
         benchmarks.append(
             {
@@ -255,12 +259,13 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
                 "links": links,
             }
         )
-    (outdir / "results.json").write_text(json.dumps(flat, indent=2) + "\n", encoding="utf-8")
+    atomic.write_text(outdir / "results.json", json.dumps(flat, indent=2) + "\n")
     columns = list(dict.fromkeys(k for row in flat for k in row))
-    with (outdir / "results.csv").open("w", newline="", encoding="utf-8") as fh:
-        writer = csv.DictWriter(fh, fieldnames=columns)
-        writer.writeheader()
-        writer.writerows(flat)
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=columns)
+    writer.writeheader()
+    writer.writerows([{k: spreadsheet_safe(v) for k, v in row.items()} for row in flat])
+    atomic.write_text(outdir / "results.csv", buffer.getvalue())
     of_runs = f" of {len(runs)} execution(s)" if len(runs) != len(entries) else ""
     subtitle = f"{len(entries)} result(s){of_runs}, combined by ertools {__version__}"
     index = outdir / "index.html"
@@ -273,7 +278,7 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
         benchmarks=benchmarks,
         teams=_by_team(runs, outdir),
     )
-    index.write_text(page, encoding="utf-8")
+    atomic.write_text(index, page)
     return index
 
 

@@ -12,6 +12,7 @@ from importlib import import_module
 from pathlib import Path
 from typing import Any
 
+from ertools import atomic
 from ertools.benchmarks import registry
 
 # Results that are not a registered benchmark's -> ``module:function`` giving their figures
@@ -54,7 +55,8 @@ def save_figures(specs: Sequence[FigureSpec], outdir: Path, fmt: str = "png") ->
         if spec.title:
             ax.set_title(spec.title)
         path = outdir / f"{spec.name}.{fmt}"
-        fig.savefig(path, dpi=110)
+        with atomic.replacing(path) as tmp:
+            fig.savefig(tmp, dpi=110, format=fmt)
         written.append(path)
     return written
 
@@ -76,5 +78,6 @@ def save_one_file(specs: Sequence[Any], path: Path) -> Path:
         axes[0].text(0.5, 0.5, "no figure for this result", ha="center", va="center")
         axes[0].set_axis_off()
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
+    with atomic.replacing(path) as tmp:
+        fig.savefig(tmp, dpi=110)
     return path

@@ -19,18 +19,20 @@ is one) becomes the score of the folder, and ``audit.yaml``/``audit.json`` are a
 from __future__ import annotations
 
 import csv
+import io
 import json
 import logging
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from ertools import __version__
+from ertools import __version__, atomic
 from ertools.audit.analyse import audit_states
 from ertools.audit.model import Audit
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import BenchmarkResult, Rows, jsonable
 from ertools.benchmarks.common.teams import team_from_log_name, team_from_transform_name
+from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ConfigError, ErtoolsError
 from ertools.io import read_benchmark_states
 from ertools.report import folder_page, plots_audit
@@ -149,7 +151,7 @@ def _write_report(
 
 
 def _write(path: Path, text: str) -> None:
-    path.write_text(text if text.endswith("\n") else text + "\n", encoding="utf-8")
+    atomic.write_text(path, text if text.endswith("\n") else text + "\n")
 
 
 def _audit_inputs(name: str, inputs: list[Path]) -> Any:
@@ -282,7 +284,7 @@ def _csv_cell(value: Any) -> Any:
     value = jsonable(value)
     if isinstance(value, dict | list):
         return json.dumps(value)
-    return "" if value is None else value
+    return "" if value is None else spreadsheet_safe(value)
 
 
 def _write_tables(outdir: Path, tables: dict[str, Rows], *, prefix: str) -> list[str]:
@@ -290,11 +292,12 @@ def _write_tables(outdir: Path, tables: dict[str, Rows], *, prefix: str) -> list
     for name, rows in tables.items():
         safe = csv_stem(f"{prefix}{name}")
         columns = list(dict.fromkeys(k for row in rows for k in row))
-        with (outdir / f"{safe}.csv").open("w", newline="", encoding="utf-8") as fh:
-            writer = csv.writer(fh)
-            writer.writerow(columns)
-            for row in rows:
-                writer.writerow([_csv_cell(row.get(c)) for c in columns])
+        buffer = io.StringIO(newline="")
+        writer = csv.writer(buffer)
+        writer.writerow(columns)
+        for row in rows:
+            writer.writerow([_csv_cell(row.get(c)) for c in columns])
+        atomic.write_text(outdir / f"{safe}.csv", buffer.getvalue())
         names.append(f"{safe}.csv")
     return names
 

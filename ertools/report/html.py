@@ -14,13 +14,27 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache
+from pathlib import PurePosixPath
 from typing import TYPE_CHECKING, Any
+from urllib.parse import quote
 
 from ertools.report import units
 from ertools.timeutil import iso_utc, s_to_ns
 
 if TYPE_CHECKING:
     import jinja2
+
+
+def relative_href(path: str | None) -> str | None:
+    """``path`` as a link that can only be a relative file path, or None (nothing, or an
+    absolute path). Every segment is percent-encoded: a folder named ``javascript:alert(1)``
+    would otherwise be read by the browser as a URL scheme, not a folder."""
+    if not path:
+        return None
+    pure = PurePosixPath(path.replace("\\", "/"))
+    if pure.is_absolute() or (pure.parts[:1] and ":" in pure.parts[0] and len(pure.parts[0]) == 2):
+        return None  # /etc/x, C:/x: not relative to the page
+    return "/".join(quote(part, safe="") for part in pure.parts)
 
 
 def fmt(value: Any) -> str:

@@ -3,8 +3,16 @@
 An execution's key is the SHA-256 of everything its score depends on: the ertools version,
 the benchmark and its registry entry, the team, the SHA-256 of every bag and input file and
 every other input value. Fix one team's transform and only that team's executions get a new
-key. Entries are the outcomes as JSON (``DIR/cache/outcomes/<key>.json``); an entry whose
-report folder has gone is recomputed.
+key. Entries are the outcomes as JSON (``DIR/cache/outcomes/<key>.json``) with the SHA-256 of
+every file of the execution's report folder and a checksum of the whole.
+
+Nothing found in the cache is trusted: an entry that does not match its schema (a status not
+known, a rank value that is not a finite number, a report that is not a path...) or its
+checksum (edited by hand), or whose report folder lacks a file or holds a changed one (a PNG
+truncated by a kill), is a miss: the execution is scored again and the run says so once. Only
+verdicts about the data are kept: an outcome caused by the machine (a report folder that could
+not be written, a disk full) is computed again next time. The checksum catches accidents and
+hand edits, not forgery: the cache is not signed (docs/rescore.md).
 
 Hashing terabytes of mocap at every run would cost more than scoring, so file hashes are
 remembered by (path, size, modification time, inode) in ``DIR/cache/hashes.json``, the way
@@ -16,16 +24,17 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
+import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from ertools import __version__
+from ertools import __version__, atomic
 from ertools.report.records import sha256_file
 from ertools.rescore.jobs import Job, Outcome
 
-CACHE_VERSION = 1
+CACHE_VERSION = 2
+STATUSES = ("scored", "unscoreable")
 
 
 def _sha256_file(path: Path) -> str:
@@ -42,10 +51,10 @@ class FileHashes:
         if store is not None and store.is_file():
             try:
                 loaded = json.loads(store.read_text(encoding="utf-8"))
-                if isinstance(loaded, dict):
-                    self.known = loaded
             except (OSError, ValueError):  # a damaged memo only costs the hashing again
-                self.known = {}
+                loaded = {}
+            if isinstance(loaded, dict):  # rows of another shape are hashed again
+                self.known = {k: v for k, v in loaded.items() if _hash_row(v)}
 
     @staticmethod
     def _stamp(path: Path) -> list[int]:
@@ -77,9 +86,19 @@ class FileHashes:
         if self.store is None or not self.changed:
             return
         self.store.parent.mkdir(parents=True, exist_ok=True)
-        tmp = self.store.with_suffix(".tmp")
-        tmp.write_text(json.dumps(self.known, sort_keys=True), encoding="utf-8")
-        os.replace(tmp, self.store)
+        atomic.write_text(self.store, json.dumps(self.known, sort_keys=True))
+
+
+def _hash_row(row: Any) -> bool:
+    """A ``hashes.json`` row: [size, mtime_ns, inode, sha256 hex]."""
+    return (
+        isinstance(row, list)
+        and len(row) == 4
+        and all(isinstance(v, int) and not isinstance(v, bool) for v in row[:3])
+        and isinstance(row[3], str)
+        and len(row[3]) == 64
+        and all(c in "0123456789abcdef" for c in row[3])
+    )
 
 
 def value_record(value: Any, hashes: FileHashes) -> Any:
@@ -117,10 +136,15 @@ def _hash_only(record: Any) -> Any:
 
 
 class Cache:
-    """Outcomes by key in ``root`` (None: no cache, every job recomputed)."""
+    """Outcomes by key in ``root`` (None: no cache, every job recomputed).
+
+    ``invalid`` lists the entries found and refused (schema, checksum, report folder), each
+    with why: the caller says so once.
+    """
 
     def __init__(self, root: Path | None) -> None:
         self.root = root
+        self.invalid: list[tuple[Path, str]] = []
 
     def _path(self, key: str) -> Path | None:
         return None if self.root is None else self.root / "outcomes" / f"{key}.json"
@@ -131,23 +155,97 @@ class Cache:
             return None
         try:
             data = json.loads(path.read_text(encoding="utf-8"))
-            outcome = Outcome.from_dict({**data, "id": job.id})
-        except (OSError, ValueError, KeyError, TypeError):
+        except (OSError, ValueError):
+            self.invalid.append((path, "not JSON"))
             return None
-        if outcome.report is not None and not Path(outcome.report).is_file():
-            return None  # its report folder was removed: score again to write it
+        why = _invalid_entry(data)
+        if why is not None:
+            self.invalid.append((path, why))
+            return None
+        outcome = Outcome.from_dict({**data["outcome"], "id": job.id})
+        if outcome.report is not None:
+            why = _changed_report(Path(outcome.report), data["report_files"])
+            if why is not None:  # removed, or damaged (a kill while it was written)
+                self.invalid.append((path, why))
+                return None
         return outcome
 
     def put(self, key: str, outcome: Outcome) -> None:
-        """Keep a scored or unscoreable outcome; a failure (a bug, a dead worker) may not
-        happen again, so it is computed again next time."""
+        """Keep a scored or unscoreable outcome; a failure (a bug, a dead worker) or a
+        problem of the machine (a folder not writable) may not happen again, so it is computed
+        again next time."""
         path = self._path(key)
-        if path is None or outcome.status == "failed":
+        if path is None or outcome.status not in STATUSES or outcome.machine:
             return
+        record = outcome.to_dict()
+        files = {}
+        if outcome.report is not None:
+            folder = Path(outcome.report).parent
+            files = {
+                p.relative_to(folder).as_posix(): _sha256_file(p)
+                for p in sorted(folder.rglob("*"))
+                if p.is_file()
+            }
+        entry = {"cache": CACHE_VERSION, "outcome": record, "report_files": files}
+        entry["checksum"] = _checksum(entry)
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_suffix(".tmp")
-        tmp.write_text(json.dumps(outcome.to_dict(), allow_nan=False), encoding="utf-8")
-        os.replace(tmp, path)
+        atomic.write_text(path, json.dumps(entry, allow_nan=False))
+
+
+def _checksum(entry: Mapping[str, Any]) -> str:
+    material = {k: v for k, v in entry.items() if k != "checksum"}
+    return hashlib.sha256(json.dumps(material, sort_keys=True).encode("utf-8")).hexdigest()
+
+
+def _strings(value: Any) -> bool:
+    return isinstance(value, list) and all(isinstance(v, str) for v in value)
+
+
+def _optional(value: Any, kind: type | tuple[type, ...]) -> bool:
+    return value is None or isinstance(value, kind)
+
+
+def _invalid_entry(data: Any) -> str | None:
+    """Why a cache entry cannot be used (None: it can)."""
+    if not isinstance(data, dict) or data.get("cache") != CACHE_VERSION:
+        return "not an entry of this cache version"
+    if data.get("checksum") != _checksum(data):
+        return "checksum mismatch (edited or damaged)"
+    outcome, files = data.get("outcome"), data.get("report_files")
+    if not isinstance(outcome, dict) or not isinstance(files, dict):
+        return "no outcome or report file list"
+    rank, seconds = outcome.get("rank_value"), outcome.get("seconds", 0.0)
+    checks = {
+        "status": outcome.get("status") in STATUSES,
+        "reason": _optional(outcome.get("reason"), str),
+        "score": _optional(outcome.get("score"), dict),
+        "rank_value": rank is None
+        or (isinstance(rank, int | float) and not isinstance(rank, bool) and math.isfinite(rank)),
+        "warnings": _strings(outcome.get("warnings", [])),
+        "deviations": _strings(outcome.get("deviations", [])),
+        "live_differences": _strings(outcome.get("live_differences", [])),
+        "report": _optional(outcome.get("report"), str),
+        "seconds": isinstance(seconds, int | float) and math.isfinite(seconds) and seconds >= 0,
+        "error": _optional(outcome.get("error"), str),
+        "machine": outcome.get("machine", False) is False,
+        "report_files": all(isinstance(k, str) and isinstance(v, str) for k, v in files.items()),
+    }
+    bad = [name for name, ok in checks.items() if not ok]
+    return f"invalid {', '.join(bad)}" if bad else None
+
+
+def _changed_report(index: Path, files: Mapping[str, str]) -> str | None:
+    """Why the report folder of ``index`` is not the one cached (None: it is, file by file)."""
+    folder = index.parent
+    if not index.is_file() or index.relative_to(folder).as_posix() not in files:
+        return "its report folder is gone"
+    for rel, digest in files.items():
+        path = folder / rel
+        if ".." in Path(rel).parts or not path.is_file():
+            return f"report file {rel} is missing"
+        if _sha256_file(path) != digest:
+            return f"report file {rel} has changed"
+    return None
 
 
 def records(values: Mapping[str, Any], hashes: FileHashes) -> list[dict[str, Any]]:

@@ -72,7 +72,9 @@ def guess(
 
 
 def _rel(path: Path, base: Path) -> str:
-    return os.path.relpath(path, base)
+    # a manifest's relative paths stay inside its folder (manifest.py refuses `../`)
+    rel = os.path.relpath(path, base)
+    return str(path.resolve()) if rel.split(os.sep)[0] == ".." else rel
 
 
 def _yaml(value: str) -> str:

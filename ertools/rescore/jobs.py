@@ -73,6 +73,8 @@ class Outcome:
     report: str | None = None
     seconds: float = 0.0
     error: str | None = None  # the error's class (``TopicError``) when not scored
+    # not the data's fault but the machine's (a folder not writable, a disk full): not cached
+    machine: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -88,6 +90,7 @@ class Outcome:
             "report": self.report,
             "seconds": self.seconds,
             "error": self.error,
+            "machine": self.machine,
         }
 
     @classmethod
@@ -105,6 +108,7 @@ class Outcome:
             report=data.get("report"),
             seconds=float(data.get("seconds", 0.0)),
             error=data.get("error"),
+            machine=bool(data.get("machine", False)),
         )
 
 
@@ -136,7 +140,11 @@ def run_job(job: Job) -> Outcome:
             outcome = _score(job)
     except ErtoolsError as err:
         outcome = Outcome(
-            job.id, "unscoreable", reason=one_line(str(err)), error=type(err).__name__
+            job.id,
+            "unscoreable",
+            reason=one_line(str(err)),
+            error=type(err).__name__,
+            machine=_of_the_machine(err),
         )
     except Exception as err:  # a bug in a scorer: this execution's row only
         where = traceback.extract_tb(err.__traceback__)[-1] if err.__traceback__ else None
@@ -155,6 +163,17 @@ def run_job(job: Job) -> Outcome:
     return Outcome(
         **{**outcome.__dict__, "seconds": seconds, "warnings": (*logged, *outcome.warnings)}
     )
+
+
+def _of_the_machine(err: BaseException) -> bool:
+    """An error caused by the machine, not the data: an OSError anywhere in its chain (a
+    report folder not writable, a disk full, a log unreadable for its permissions)."""
+    seen: BaseException | None = err
+    while seen is not None:
+        if isinstance(seen, OSError):
+            return True
+        seen = seen.__cause__ or seen.__context__
+    return False
 
 
 class _Capture(logging.Handler):

@@ -37,8 +37,9 @@ from typing import Any
 
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Benchmark, Input
-from ertools.configs._yaml import parse_yaml
-from ertools.errors import ConfigError
+from ertools.configs._yaml import MAX_SECONDS, number, parse_yaml, show
+from ertools.errors import BagError, ConfigError
+from ertools.io.formats import detect_format
 from ertools.timeutil import s_to_ns
 
 VERSION = 1
@@ -188,7 +189,9 @@ class _Checker:
         self.unknown(top, TOP_KEYS, "")
         version = top.get("version", VERSION)
         if version != VERSION:
-            self.problem("version", f"{version!r}: this ertools reads manifest version {VERSION}")
+            self.problem(
+                "version", f"{show(version)}: this ertools reads manifest version {VERSION}"
+            )
         title = top.get("title", "")
         if not isinstance(title, str):
             self.problem("title", f"expected text, got {_kind_name(title)}")
@@ -285,14 +288,16 @@ class _Checker:
             return self.path(value, where)
         if kind == "float":
             if isinstance(value, bool) or not isinstance(value, int | float):
-                self.problem(where, f"expected a number, got {_kind_name(value)} {value!r}")
+                self.problem(where, f"expected a number, got {_kind_name(value)} {show(value)}")
                 return _BAD
-            return float(value)
+            return self.number(declared, value, where)
         if kind == "int":
             if isinstance(value, bool) or not isinstance(value, int):
-                self.problem(where, f"expected a whole number, got {_kind_name(value)} {value!r}")
+                self.problem(
+                    where, f"expected a whole number, got {_kind_name(value)} {show(value)}"
+                )
                 return _BAD
-            return value
+            return _BAD if self.number(declared, value, where) is _BAD else value
         if kind == "flag":
             if not isinstance(value, bool):
                 self.problem(where, f"expected true or false, got {value!r}")
@@ -305,6 +310,21 @@ class _Checker:
             self.problem(where, f"{value!r} is not one of {', '.join(declared.choices)}")
             return _BAD
         return str(value)
+
+    def number(self, declared: Input, value: float, where: str) -> float | Any:
+        """A finite number within the declared input's minimum (a NaN ``d_min`` would pass
+        here and abort every execution scored with it)."""
+        try:
+            f = number(value, where, "")
+        except ConfigError as err:
+            self.problem(where, err.message.split(": ", 1)[1])
+            return _BAD
+        low = declared.minimum if declared.minimum is not None else 0.0
+        if (declared.positive and f <= low) or (declared.minimum is not None and f < low):
+            sign = ">" if declared.positive else ">="
+            self.problem(where, f"{show(value)} must be {sign} {low:g} {declared.unit}".rstrip())
+            return _BAD
+        return f
 
     def choice_with_file(self, declared: Input, value: Any, where: str) -> Any:
         """``states`` or ``[timing, FILE]``: a choice, with a file for those that take one."""
@@ -328,9 +348,35 @@ class _Checker:
 
     def path(self, text: str, where: str) -> Path | Any:
         path = Path(text).expanduser()
+        if not path.is_absolute() and ".." in path.parts:
+            # a relative path is read from the manifest's folder: one climbing out of it
+            # (`../../../../etc/passwd`) is refused; a file elsewhere is named absolutely
+            resolved = Path(os.path.normpath(self.base / path))
+            if not resolved.is_relative_to(self.base):
+                self.problem(
+                    where,
+                    f"{text} leads out of the manifest's folder ({self.base}); give a path "
+                    "inside it, or an absolute path",
+                )
+                return _BAD
         path = Path(os.path.normpath(path if path.is_absolute() else self.base / path))
         if not path.exists():
             self.problem(where, f"file not found: {path}")
+            return _BAD
+        return path
+
+    def bag(self, text: Any, where: str, bm: Benchmark[Any, Any, Any, Any] | None) -> Any:
+        """A listed log: a path, and, for a benchmark reading bags, a bag (checked by its
+        first bytes; what they hold is never quoted)."""
+        if not isinstance(text, str) or not text:
+            return _BAD
+        path = self.path(text, where)
+        if path is _BAD or bm is None or not bm.logs_are_bags:
+            return path
+        try:
+            detect_format(path)
+        except BagError as err:
+            self.problem(where, err.message)
             return _BAD
         return path
 
@@ -353,9 +399,7 @@ class _Checker:
             ok = False
         bags_raw = mapping.get("bags", [])
         bags_list = bags_raw if isinstance(bags_raw, list) else [bags_raw]
-        bags = [
-            self.path(b, f"{where}.bags") if isinstance(b, str) and b else _BAD for b in bags_list
-        ]
+        bags = [self.bag(b, f"{where}.bags", bm) for b in bags_list]
         if "bags" in mapping and (not bags_list or any(b is _BAD for b in bags)):
             if not bags_list or not all(isinstance(b, str) and b for b in bags_list):
                 self.problem(f"{where}.bags", "expected a list of one or more bag paths")
@@ -389,9 +433,14 @@ class _Checker:
             aware = value if value.tzinfo is not None else value.replace(tzinfo=UTC)
             return s_to_ns(aware.timestamp())
         if isinstance(value, date | bool) or not isinstance(value, int | float):
-            self.problem(where, f"expected a time (ISO 8601 or epoch seconds), got {value!r}")
+            self.problem(where, f"expected a time (ISO 8601 or epoch seconds), got {show(value)}")
             return _BAD
-        return s_to_ns(float(value))
+        try:
+            seconds = number(value, where, "", low=0.0, high=MAX_SECONDS, unit="s")
+        except ConfigError as err:
+            self.problem(where, f"{err.message.split(': ', 1)[1]}; give ISO 8601 or epoch seconds")
+            return _BAD
+        return s_to_ns(seconds)
 
 
 class _Bad:

@@ -11,18 +11,24 @@ breaks its whole pool and every job still in it. Results come back in completion
 from __future__ import annotations
 
 import contextlib
+import ctypes
+import logging
 import multiprocessing
 import multiprocessing.connection
 import os
 import pickle
+import signal
 import sys
-from collections.abc import Callable, Sequence
+import threading
+import time
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any
 
 from ertools.errors import ConfigError
 from ertools.rescore.jobs import Job, Outcome, run_job
 
 OnDone = Callable[[Outcome], None]
+log = logging.getLogger(__name__)
 
 
 def default_jobs() -> int:
@@ -42,8 +48,39 @@ def run_jobs(jobs: Sequence[Job], *, workers: int, scheduler: str | None, on_don
         run_local(jobs, workers=workers, on_done=on_done)
 
 
-def _worker(conn: multiprocessing.connection.Connection) -> None:
+# prctl(2): PR_SET_PDEATHSIG, the signal the kernel sends a process when its parent ends
+_PR_SET_PDEATHSIG = 1
+
+
+def end_with_parent(parent: int) -> None:
+    """End this process when its parent ``parent`` ends, however that ends (``kill -9``
+    included): a worker left behind holds its memory and its job for ever, blocked on a pipe
+    whose other end its siblings keep open (inherited by fork).
+
+    Linux: the kernel sends SIGKILL (``PR_SET_PDEATHSIG``). Elsewhere a thread watches the
+    parent's pid. Either way, a parent that died before this was set up is caught at once.
+    """
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            if libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0:
+                if os.getppid() != parent:  # it died between the fork and the prctl
+                    os._exit(1)
+                return
+        except (OSError, AttributeError):  # no prctl in this libc: watch instead
+            pass
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(1.0)
+    os._exit(1)
+
+
+def _worker(conn: multiprocessing.connection.Connection, parent: int) -> None:
     """A local worker: score the jobs it is sent until it is sent None."""
+    end_with_parent(parent)
     while True:
         try:
             job = conn.recv()
@@ -63,11 +100,13 @@ def run_job_forked(job: Job) -> Outcome:
     if not hasattr(os, "fork"):
         return run_job(job)
     read_fd, write_fd = os.pipe()
+    parent = os.getpid()
     pid = os.fork()
     if pid == 0:  # the child: score, send the outcome, leave without running any cleanup
         os.close(read_fd)
         code = 0
         try:
+            end_with_parent(parent)
             data = pickle.dumps(run_job(job))
             with os.fdopen(write_fd, "wb") as out:
                 out.write(data)
@@ -98,7 +137,7 @@ def _context() -> Any:
 class _Worker:
     def __init__(self, ctx: Any) -> None:
         self.conn, child = ctx.Pipe()
-        self.process = ctx.Process(target=_worker, args=(child,), daemon=True)
+        self.process = ctx.Process(target=_worker, args=(child, os.getpid()), daemon=True)
         self.process.start()
         child.close()
         self.job: Job | None = None
@@ -182,6 +221,52 @@ def run_dask(jobs: Sequence[Job], address: str, *, workers: int, on_done: OnDone
             "--scheduler needs Dask distributed: pip install 'ertools[dask]'"
         ) from None
     distributed: Any = _distributed  # untyped calls: its API is checked by the Dask test
+    with _dask_logs_as_one_line(address):
+        _run_dask(distributed, jobs, address, workers=workers, on_done=on_done)
+
+
+class _Held(logging.Handler):
+    def __init__(self) -> None:
+        super().__init__(logging.ERROR)
+        self.records: list[logging.LogRecord] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.records.append(record)
+
+
+@contextlib.contextmanager
+def _dask_logs_as_one_line(address: str) -> Iterator[None]:
+    """``distributed`` logs a lost scheduler as several ERROR records with tracebacks, on
+    stderr by its own handlers: held here, and said in one line (each execution's row already
+    says what became of it)."""
+    # distributed gives several of its loggers a handler of their own (distributed.client...)
+    names = ["distributed", "tornado"] + [
+        name
+        for name in logging.root.manager.loggerDict
+        if name.startswith(("distributed.", "tornado."))
+    ]
+    loggers = [logging.getLogger(name) for name in names]
+    saved = [(lg.handlers[:], lg.propagate) for lg in loggers]
+    held = _Held()
+    for lg in loggers:
+        lg.handlers[:] = [held]
+        lg.propagate = False
+    try:
+        yield
+    finally:
+        for lg, (handlers, propagate) in zip(loggers, saved, strict=True):
+            lg.handlers[:] = handlers
+            lg.propagate = propagate
+        messages = [m for r in held.records if (m := r.getMessage().strip())]
+        if held.records:
+            first = " ".join((messages[0] if messages else "an error").split())
+            more = f" ({len(held.records) - 1} more not shown)" if len(held.records) > 1 else ""
+            log.warning("Dask (%s): %s%s", address, first, more)
+
+
+def _run_dask(
+    distributed: Any, jobs: Sequence[Job], address: str, *, workers: int, on_done: OnDone
+) -> None:
     cluster = None
     try:
         if address == "local":

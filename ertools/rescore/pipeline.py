@@ -11,7 +11,7 @@ from __future__ import annotations
 import csv
 import io
 import json
-import os
+import logging
 import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -19,9 +19,10 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from ertools import __version__
+from ertools import __version__, atomic
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Benchmark
+from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ErtoolsError
 from ertools.io import summary
 from ertools.progress import Reporter
@@ -32,6 +33,8 @@ from ertools.rescore.parallel import run_jobs
 from ertools.rescore.site import write_site
 from ertools.rescore.site_text import TEAM_UNKNOWN
 from ertools.timeutil import NS_PER_S, iso_utc
+
+log = logging.getLogger(__name__)
 
 SCHEMA_VERSION = 1
 CSV_COLUMNS = (
@@ -254,6 +257,18 @@ def rescore(
         else:
             to_run.append(p.job)
     hashes.save()
+    if cache.invalid:
+        path, why = cache.invalid[0]
+        more = f" and {len(cache.invalid) - 1} more" if len(cache.invalid) > 1 else ""
+        log.warning(
+            "%d cache entr%s not used, scored again (%s: %s%s); the cache is not signed: "
+            "docs/rescore.md",
+            len(cache.invalid),
+            "y" if len(cache.invalid) == 1 else "ies",
+            path.name,
+            why,
+            more,
+        )
 
     total = len(planned)
     state = {"done": len(outcomes), "bad": sum(o.status != "scored" for o in outcomes.values())}
@@ -469,7 +484,9 @@ def csv_text(doc: Mapping[str, Any]) -> str:
     )
     writer.writeheader()
     for row in doc["executions"]:
-        writer.writerow({k: "" if row.get(k) is None else row[k] for k in CSV_COLUMNS})
+        writer.writerow(
+            {k: "" if row.get(k) is None else spreadsheet_safe(row[k]) for k in CSV_COLUMNS}
+        )
     return buffer.getvalue()
 
 
@@ -481,11 +498,7 @@ def write_results(doc: Mapping[str, Any], out: Path) -> list[Path]:
         ("results.json", json.dumps(doc, indent=2, allow_nan=False) + "\n"),
         ("results.csv", csv_text(doc)),
     ):
-        path = out / name
-        tmp = path.with_suffix(".tmp")
-        tmp.write_text(text, encoding="utf-8")
-        os.replace(tmp, path)
-        written.append(path)
+        written.append(atomic.write_text(out / name, text))
     # the results page, rebuilt from the document alone (ertools.rescore.site)
     written.append(write_site(dict(doc), out))
     return written

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ertools import atomic
 from ertools.errors import ConfigError
 from ertools.report import html as h
 from ertools.report import units
@@ -233,7 +234,8 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
 
     def report_link(ex: dict[str, Any] | None, label: str) -> Link:
         target = ex.get("report") if ex else None
-        return Link(label, str(target) if target and exists(str(target)) else None)
+        ok = target and exists(str(target))
+        return Link(label, h.relative_href(str(target)) if ok else None)
 
     grouped, own_warnings = text.group_warnings(executions, paths, skip=(TEAM_UNKNOWN,))
     boards = []
@@ -387,7 +389,7 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
         "boards": boards,
         "live_rows": live_rows,
         "live_differing": sum(r.status == "differs" for r in live_rows),
-        "figure": figure,
+        "figure": h.relative_href(figure),
         "figure_kind": figure_kind,
         "sessions": timeline.get("sessions") if isinstance(timeline, dict) else None,
         "problems": h.table(problems, columns=["kind", "path", "message"]) if problems else None,
@@ -424,7 +426,7 @@ def write_site(results: dict[str, Any], out: Path) -> Path:
     index = out / "index.html"
     try:
         out.mkdir(parents=True, exist_ok=True)
-        index.write_text(h.render(TEMPLATE, **context), encoding="utf-8")
+        atomic.write_text(index, h.render(TEMPLATE, **context))
     except OSError as err:
         raise ConfigError(
             f"cannot write the results site ({err.strerror or err})", path=out

@@ -134,7 +134,8 @@ def test_same_inputs_are_one_execution(tmp_path: Path) -> None:
     tripod = rows[1]
     # The named result is shown; the other is listed by its options (--format is output only).
     assert float(tripod["best_distance_error"]) == 0.0125
-    assert tripod["options"] == "--team tripod"
+    # an option list begins like a formula: a spreadsheet shows the apostrophed text as is
+    assert tripod["options"] == "'--team tripod"
     assert tripod["other results"] == f"(defaults): best_distance_error {0.0123 * 1000:.6g} mm"
     assert rows[0]["other results"] == ""
     page = (out / "index.html").read_text(encoding="utf-8")
@@ -176,6 +177,6 @@ def test_the_fbm2h_sample_scored_twice_is_one_row(
     tol = truth["tolerance"]["distance_error"]["abs"]
     expected = truth["expected"]["position_accuracy"]
     assert float(row["position_accuracy"]) == pytest.approx(expected, abs=tol)
-    assert row["options"] == f"--team simbot --transforms {folder}"
+    assert row["options"] == f"'--team simbot --transforms {folder}"  # text, not a formula
     assert row["other results"].startswith("(defaults): position_accuracy ")
     assert "(unknown)" not in (out / "index.html").read_text(encoding="utf-8")

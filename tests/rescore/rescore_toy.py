@@ -6,12 +6,14 @@ A toy "log" is a text file of numbers, one per line. The score of an execution i
 offset read from the team's per-team input (a YAML file ``{offset: X}``, like a marker-set
 transform). Words in a log make the scorer misbehave on purpose: ``bad`` (an unscoreable log:
 ScoringError), ``boom`` (a bug: RuntimeError), ``die`` (the worker process dies); ``sleep``
-waits a second.
+waits a second; ``hold`` writes the scoring process's pid beside the log (``LOG.pid``) and
+waits for ever: a kill point the fault tests choose by waiting for that file.
 """
 
 from __future__ import annotations
 
 import os
+import threading
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -76,6 +78,9 @@ def load(bags: Sequence[Path], options: ToyOptions) -> list[float]:
                 raise RuntimeError("the toy scorer has a bug")
             if line == "die":
                 os._exit(7)
+            if line == "hold":
+                Path(f"{bag}.pid").write_text(f"{os.getpid()}\n")
+                threading.Event().wait()
             if line == "sleep":  # long enough for a progress bar to show
                 time.sleep(1.0)
                 continue
@@ -106,6 +111,7 @@ TOY = Benchmark(
     description="mean of the numbers times scale plus the team's offset",
     epilog="",
     bags_help="text files of numbers",
+    logs_are_bags=False,
     inputs=(
         Input("transform", "path", "the team's offset file", per_team=True),
         Input("scale", "float", "a factor", default=1.0, positive=True),

@@ -36,6 +36,25 @@ def free_port() -> int:
         return port
 
 
+def worker_command(address: str, tmp_path: Path) -> list[str]:
+    """A `dask worker` of one thread, no nanny, on 127.0.0.1."""
+    return [
+        str(DASK),
+        "worker",
+        address,
+        "--nthreads",
+        "1",
+        "--host",
+        "127.0.0.1",
+        "--no-nanny",
+        "--memory-limit",
+        "0",
+        "--local-directory",
+        str(tmp_path / "dask"),
+        "--no-dashboard",
+    ]
+
+
 @pytest.fixture
 def cluster(tmp_path: Path) -> Iterator[str]:
     if not DASK.exists():
@@ -61,21 +80,7 @@ def cluster(tmp_path: Path) -> Iterator[str]:
         for _ in range(2):
             procs.append(
                 subprocess.Popen(
-                    [
-                        str(DASK),
-                        "worker",
-                        address,
-                        "--nthreads",
-                        "1",
-                        "--host",
-                        "127.0.0.1",
-                        "--no-nanny",
-                        "--memory-limit",
-                        "0",
-                        "--local-directory",
-                        str(tmp_path / "dask"),
-                        *common,
-                    ],
+                    worker_command(address, tmp_path),
                     env=env,
                     stdout=logs,
                     stderr=subprocess.STDOUT,

@@ -98,7 +98,7 @@ def test_every_link_resolves(tmp_path: Path) -> None:
     page = Page(index.read_text(encoding="utf-8"))
     reports = [e["report"] for e in doc["executions"] if e["report"]]
     # every report folder linked (from its leaderboard row and its execution row)
-    assert set(reports) <= set(page.links)
+    assert set(reports) <= {unquote(link) for link in page.links}  # links percent-encoded
     assert {"results.json", "results.csv", "timeline.html"} <= set(page.links)
     for link in page.links:
         parts = urlsplit(link)

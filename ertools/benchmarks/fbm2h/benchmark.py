@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
+from ertools.benchmarks.common.arena import check_in_arena
 from ertools.benchmarks.common.hygiene import drop_invalid, frame_change_warning, frozen_around
 from ertools.benchmarks.common.sources import PoseSpec, read_source, topic
 from ertools.benchmarks.common.sources import tf as tf_source
@@ -118,6 +119,9 @@ def compute(
     t_mr = transform.arrays()
     poses = robot_poses_at(marker, t_mr, moments.end_ns, s_to_ns(max_gap_s))
     target = goal.as_array()
+    far = check_in_arena(target[:, :2], marker.xyz, what="goal.waypoints", source=goal.source)
+    if far:
+        all_warnings.append(far)
     errs = segment_errors(poses.xyyaw[:k], target[:k], orientation_2015=orientation_2015)
     all_warnings.extend(_frozen_warnings(marker, moments, poses.ok[:k], max_gap_s, origin_ns))
     frames = frame_change_warning(marker, origin_ns)

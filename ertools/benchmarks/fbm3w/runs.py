@@ -45,6 +45,7 @@ from ertools.benchmarks.common.phases import (
     protocol_track,
 )
 from ertools.benchmarks.fbm3w.path import subsample_d_min
+from ertools.configs._yaml import MAX_SECONDS, show
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.configs.shapes import Shape
 from ertools.errors import ConfigError, SegmentationError
@@ -230,10 +231,12 @@ def find_states(states: BenchmarkStates) -> list[RunWindow]:
 def _seconds(text: Any, where: str) -> float:
     try:
         value = float(text)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{where}: {text!r} is not a time in seconds") from None
+    except (TypeError, ValueError, OverflowError):  # a 400-digit integer overflows float()
+        raise ConfigError(f"{where}: {show(text)} is not a time in seconds") from None
     if not math.isfinite(value):
-        raise ConfigError(f"{where}: {text!r} is not a finite time")
+        raise ConfigError(f"{where}: {show(text)} is not a finite time")
+    if abs(value) > MAX_SECONDS:  # its nanoseconds would not fit int64
+        raise ConfigError(f"{where}: {show(text)} s is out of range (at most {MAX_SECONDS:g} s)")
     return value
 
 
@@ -241,8 +244,10 @@ def parse_run_spec(text: str, index: int) -> tuple[str, float, float, float]:
     """``SPEC:REF_T:START_T:END_T`` -> (spec, ref, start, end) seconds, unresolved."""
     parts = text.split(":")
     if len(parts) != 4 or not parts[0].strip():
-        raise ConfigError(f"--run {text!r}: expected SPEC:REF_T:START_T:END_T, e.g. line:2:5.5:31")
-    where = f"--run {text!r}"
+        raise ConfigError(
+            f"--run {show(text)}: expected SPEC:REF_T:START_T:END_T, e.g. line:2:5.5:31"
+        )
+    where = f"--run {show(text)}"
     return (
         parts[0].strip(),
         _seconds(parts[1], where),

@@ -12,6 +12,7 @@ import yaml
 
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
+from ertools.io.formats import metadata_problem
 from ertools.io.model import Conn
 
 ROWS_PER_BATCH = 100_000
@@ -24,8 +25,10 @@ def read_metadata(path: Path) -> dict[str, Any]:
     try:
         data = yaml.safe_load(meta.read_text(encoding="utf-8"))
         info = data["rosbag2_bagfile_information"]
-    except (OSError, yaml.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
-        raise BagError(f"unreadable metadata.yaml ({err})", path=path) from err
+    except OSError as err:
+        raise BagError(f"unreadable metadata.yaml ({err.strerror or err})", path=path) from err
+    except (yaml.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
+        raise BagError(f"unreadable metadata.yaml ({metadata_problem(err)})", path=path) from err
     if not isinstance(info, dict):
         raise BagError("metadata.yaml has no rosbag2_bagfile_information", path=path)
     return info

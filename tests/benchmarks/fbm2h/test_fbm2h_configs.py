@@ -102,7 +102,7 @@ def test_timing_resolves_relative_and_epoch_seconds() -> None:
         ({"reached_waypoint_timing": [{"p0": 0.0, "p1": 1.0}, {"p2": 2.0}]}, "one 'pK"),
         ({"reached_waypoint_timing": [{"p0": 0.0}, {"p1": "soon"}]}, "not a number"),
         ({"reached_waypoint_timing": [{"p0": 1.0}, {"p1": 1.0}]}, "must increase"),
-        ({"reached_waypoint_timing": [{"p0": 0.0}, {"p1": math.inf}]}, "not finite"),
+        ({"reached_waypoint_timing": [{"p0": 0.0}, {"p1": math.inf}]}, "not a finite number"),
     ],
 )
 def test_bad_timing(data: object, needle: str) -> None:

@@ -1,0 +1,108 @@
+"""Files written whole or not at all, and folders written by one process at a time.
+
+A laptop closed, a process killed or a disk filled while a page or ``results.json`` is written
+must leave the previous file, never a half-written one: every output goes to a temporary of a
+unique name in the same folder (the rename must not cross file systems), is flushed to disk and
+then renamed over the target, which POSIX makes atomic. Two processes writing the same file
+each have their own temporary; the last rename wins with a whole file.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+import tempfile
+from collections.abc import Callable, Iterator
+from functools import cache
+from pathlib import Path
+
+if sys.platform != "win32":
+    import fcntl
+
+
+@cache
+def _umask() -> int:
+    # the mode a plain open() would give: mkstemp makes 0600 files, fine for secrets, not pages
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _fsync_folder(folder: Path) -> None:
+    # the rename itself is durable only once the folder is (POSIX); not possible everywhere
+    with contextlib.suppress(OSError, AttributeError):
+        fd = os.open(folder, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
+@contextlib.contextmanager
+def replacing(path: Path) -> Iterator[Path]:
+    """A temporary path beside ``path`` (same suffix, for writers that read it) to write in;
+    renamed over ``path`` once the block ends without an error, removed otherwise."""
+    path = Path(path)
+    fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
+    os.close(fd)
+    tmp = Path(name)
+    try:
+        yield tmp
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        os.chmod(tmp, 0o666 & ~_umask())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+        raise
+    _fsync_folder(path.parent)
+
+
+def write_bytes(path: Path, data: bytes) -> Path:
+    """``data`` into ``path``, whole or not at all (a pipe or a device, ``-o /dev/stdout``,
+    is written as it is: it cannot be replaced)."""
+    path = Path(path)
+    if path.exists() and not path.is_file():
+        with open(path, "wb") as fh:
+            fh.write(data)
+        return path
+    with replacing(path) as tmp:
+        tmp.write_bytes(data)
+    return path
+
+
+def write_text(path: Path, text: str) -> Path:
+    """``text`` (UTF-8) into ``path``, whole or not at all."""
+    return write_bytes(path, text.encode("utf-8"))
+
+
+@contextlib.contextmanager
+def folder_lock(folder: Path, *, on_wait: Callable[[str], None] | None = None) -> Iterator[None]:
+    """Hold ``folder/.ertools.lock`` (an advisory ``flock``) for the block.
+
+    When another process holds it, ``on_wait`` is told who (the holder's pid, as it wrote it)
+    and the call waits for it to end. The lock goes with its
+    holder's process, however that ends: a killed run leaves no stale lock. Where there is no
+    ``flock`` (Windows) the block runs unlocked.
+    """
+    if sys.platform == "win32":  # pragma: no cover - not on the platforms tested
+        yield
+        return
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / ".ertools.lock"
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666 & ~_umask())
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.pread(fd, 64, 0).decode("ascii", "replace").strip() or "unknown"
+            if on_wait is not None:
+                on_wait(holder)
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"{os.getpid()}\n".encode("ascii"), 0)
+        yield
+    finally:
+        os.close(fd)  # releases the lock

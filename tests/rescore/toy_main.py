@@ -1,0 +1,17 @@
+"""``python tests/rescore/toy_main.py rescore ...``: the ertools command line with the toy
+benchmark as the only one registered, for the tests that run rescore as a process of its own
+(to kill it, or to run two at once)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+from ertools.benchmarks import registry
+from ertools.cli.main import main
+
+if __name__ == "__main__":
+    registry.REGISTRY = {"toy": "rescore_toy:TOY"}
+    raise SystemExit(main(sys.argv[1:]))
