@@ -394,7 +394,7 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
         "sessions": timeline.get("sessions") if isinstance(timeline, dict) else None,
         "problems": h.table(problems, columns=["kind", "path", "message"]) if problems else None,
         "deviations": [
-            text.prose_units(text.deviation_terms(str(d)))
+            text.prose_units(text.deviation_terms(paths.text(str(d))))
             for d in results.get("deviations_in_force") or []
         ],
         "executions": rows,
