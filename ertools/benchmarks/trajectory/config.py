@@ -4,6 +4,7 @@ selects (:data:`SETTINGS_2015`).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -43,6 +44,9 @@ class TrajectoryConfig:
             given by the association, counted and warned about (``compare``, 2015).
         before_gt: robot poses before the first GT pose are uncovered (``uncovered``) or
             compared with the first GT pose (``first``, 2015).
+        t_max_diff: with ``nearest``, pair as evo does (``--t-max-diff``): the nearest stamp
+            within this many seconds, float seconds as evo compares them (its ``max_diff``);
+            ``max_gap_ns`` and the tracking-lost rule then do not apply. None: ertools' rule.
     """
 
     association: Association = "linear"
@@ -55,6 +59,7 @@ class TrajectoryConfig:
     ties: Ties = "at"
     gaps: Gaps = "skip"
     before_gt: BeforeGt = "uncovered"
+    t_max_diff: float | None = None
 
     def __post_init__(self) -> None:
         if self.association not in ASSOCIATIONS:
@@ -72,6 +77,20 @@ class TrajectoryConfig:
             # Only the held pose depends on the tie rule: linear and nearest give the sample at
             # the robot time whichever pair brackets it.
             raise ConfigError(f"--ties before needs --association hold (not {self.association})")
+        if self.t_max_diff is not None:
+            if self.association != "nearest":
+                raise ConfigError(
+                    f"--t-max-diff needs --association nearest (not {self.association}): "
+                    "it is evo's nearest-stamp pairing"
+                )
+            if not (math.isfinite(self.t_max_diff) and self.t_max_diff >= 0):
+                raise ConfigError(
+                    f"--t-max-diff must be a finite number of seconds >= 0, not {self.t_max_diff}"
+                )
+            if self.gaps != "skip" or self.before_gt != "uncovered":
+                raise ConfigError(
+                    "--t-max-diff pairs as evo does: --gaps and --before-gt do not apply"
+                )
         if self.max_gap_ns <= 0:
             raise ConfigError(f"--max-gap must be positive, not {self.max_gap_ns / NS_PER_S} s")
         if self.offset_range_ns <= 0:

@@ -28,6 +28,7 @@ from ertools.benchmarks.trajectory.config import (
 )
 from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.errors import ConfigError, UsageError
+from ertools.io.text import INPUT_FORMATS
 from ertools.timeutil import s_to_ns
 
 # Offsets beyond this (about 146 years) are not clock offsets; int64 nanoseconds hold them.
@@ -97,6 +98,15 @@ INPUTS = (
         positive=True,
     ),
     Input(
+        "t_max_diff",
+        "float",
+        "with --association nearest: pair as evo does (`evo_ape ... --t_max_diff S`, evo's "
+        "default 0.01): each pose of the shorter trajectory with the nearest stamp of the "
+        "other within S seconds; --max-gap and the tracking-lost rule then do not apply",
+        unit="s",
+        minimum=0.0,
+    ),
+    Input(
         "offset",
         "str",
         "shift the robot stamps by S seconds, or estimate the shift (auto)",
@@ -124,10 +134,25 @@ INPUTS = (
     Input(
         "robot_time_source",
         "choice",
-        "robot pose time: message stamp (default) or the robot bag's record time",
+        "robot pose time: message stamp (default) or the robot bag's record time (the GT "
+        "keeps --time-source)",
         old_flags=("--robot-time",),
-        default="header",
         choices=("header", "record"),
+    ),
+    Input(
+        "time_source",
+        "choice",
+        "the time robot and GT poses are selected and paired by: header stamps (default; "
+        "simulation time in a sim bag, as evo uses) or record times",
+        choices=("header", "record"),
+    ),
+    Input(
+        "input_format",
+        "choice",
+        "read every input as this (default: detected by content): a TUM, KITTI (paired row "
+        "by row, as evo_ape kitti), EuRoC ground-truth or ertools CSV text trajectory, or a "
+        "bag",
+        choices=INPUT_FORMATS,
     ),
 )
 
@@ -186,10 +211,25 @@ def make_options(given: Mapping[str, Any]) -> TrajectoryOptions:
             apply_offset=v["apply_offset"],
             offset_range_ns=s_to_ns(v["offset_range"]),
             allow_partial=v["allow_partial"],
+            t_max_diff=v["t_max_diff"],
         )
     except ConfigError as err:
         raise UsageError(err.message) from None
-    return TrajectoryOptions(config, v["robot_topic"], v["gt_topic"], v["robot_time_source"])
+    both = v["time_source"]
+    robot_time = v["robot_time_source"]
+    if both is not None and robot_time is not None and both != robot_time:
+        raise UsageError(
+            f"--time-source {both} sets the robot's time too: it cannot take "
+            f"--robot-time-source {robot_time}"
+        )
+    return TrajectoryOptions(
+        config,
+        v["robot_topic"],
+        v["gt_topic"],
+        robot_time or both or "header",
+        both or "header",
+        v["input_format"],
+    )
 
 
 def files(bags: Sequence[Path], options: TrajectoryOptions, result: TrajectoryResult) -> list[Path]:
@@ -215,6 +255,9 @@ EPILOG = """examples:
   ertools score trajectory robot.bag gt/ --association hold --gaps compare
   ertools score trajectory robot.bag gt/ --offset auto --apply-offset --format json
   ertools score trajectory robot.bag gt/log_0.bag gt/log_1.bag --offset -0.35 --plot figs/
+  ertools score trajectory ROS_example.bag --robot-topic ORB-SLAM --gt-topic groundtruth \
+      --association nearest --t-max-diff 0.01
+      # the pairs and numbers of: evo_ape bag ROS_example.bag groundtruth ORB-SLAM
   ertools score trajectory both.bag --robot-topic /rockin/homer/marker_pose \\
       --gt-topic /fbm2h/robot_at_home/pose     # one bag holding both topics (evo's bag mode)
 

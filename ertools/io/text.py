@@ -1,0 +1,296 @@
+"""Text trajectories as pose sources: TUM, KITTI, EuRoC ground-truth CSV and ertools' own CSV
+export, detected by content (:func:`sniff`) and read into a :class:`PoseStream`
+(:func:`read_text_poses`).
+
+The layouts are evo's (``evo_ape tum|kitti|euroc``):
+
+- ``tum``: ``t x y z qx qy qz qw``, space separated, ``#`` comments.
+- ``kitti``: 12 numbers a row, the 3x4 ``[R|t]`` row-major, no time: rows are paired by index.
+  The stream's stamps are the row numbers in seconds (0, 1, 2, ...).
+- ``euroc``: ``#timestamp [ns], p_RS_R_x, p_RS_R_y, p_RS_R_z, q_RS_w, q_RS_x, q_RS_y, q_RS_z,
+  ...`` (comma separated, at least 8 columns, the quaternion scalar first).
+- ``csv``: ertools' export (``t_ns,t_s,x,y,z,qx,qy,qz,qw,frame_id``), read back exactly.
+
+Times are kept exactly: a decimal stamp becomes int64 nanoseconds by integer arithmetic
+(rounded half to even past the 9th decimal), and the floats evo parses from the same text
+are kept beside them (:attr:`PoseStream.t_s`) so that evo's association can be reproduced.
+A bad value is one line naming its row (the file's line number) and column.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from decimal import ROUND_HALF_EVEN, Decimal, InvalidOperation
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+import numpy.typing as npt
+
+from ertools.arrays import F64, I64
+from ertools.errors import BagError
+from ertools.streams import PoseStream
+
+TextFormat = Literal["tum", "kitti", "euroc", "csv"]
+TEXT_FORMATS: tuple[TextFormat, ...] = ("tum", "kitti", "euroc", "csv")
+# ``--input-format``: a text layout, or ``bag`` (ROS1, rosbag2, MCAP) to skip the sniffing.
+INPUT_FORMATS: tuple[str, ...] = (*TEXT_FORMATS, "bag")
+CSV_HEADER = "t_ns,t_s,x,y,z,qx,qy,qz,qw,frame_id"
+# How many bytes the sniffer reads: a few comment lines and the first data row.
+_SNIFF_BYTES = 8192
+_NS = 1_000_000_000
+_COLUMNS: dict[TextFormat, tuple[str, ...]] = {
+    "tum": ("t", "x", "y", "z", "qx", "qy", "qz", "qw"),
+    "kitti": ("r11", "r12", "r13", "tx", "r21", "r22", "r23", "ty", "r31", "r32", "r33", "tz"),
+    "euroc": ("timestamp", "p_x", "p_y", "p_z", "q_w", "q_x", "q_y", "q_z"),
+    "csv": ("t_ns", "t_s", "x", "y", "z", "qx", "qy", "qz", "qw", "frame_id"),
+}
+
+
+@dataclass(frozen=True)
+class _Rows:
+    """The data rows of a text file: their cells and their 1-based line numbers."""
+
+    cells: npt.NDArray[np.str_]
+    lines: npt.NDArray[np.intp]
+
+
+def _bag_magic(head: bytes) -> bool:
+    return head.startswith((b"#ROSBAG V", b"\x89MCAP"))
+
+
+def sniff(path: str | Path) -> TextFormat | None:
+    """The text layout of ``path`` from its first data row, None for a bag (or a folder).
+
+    Raises:
+        BagError: a text file that is none of the layouts (it says what its first row holds).
+    """
+    p = Path(path)
+    if not p.is_file():
+        return None
+    try:
+        with p.open("rb") as f:
+            head = f.read(_SNIFF_BYTES)
+    except OSError:
+        return None  # the bag reader says why
+    if not head or _bag_magic(head) or b"\x00" in head:
+        return None
+    try:
+        text = head.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return None
+    lines = text.splitlines()
+    if len(head) == _SNIFF_BYTES and len(lines) > 1:
+        lines = lines[:-1]  # the last one may be cut
+    first_comment = next((ln.strip() for ln in lines if ln.strip().startswith("#")), "")
+    data = next((ln.strip() for ln in lines if ln.strip() and not ln.strip().startswith("#")), "")
+    if data.startswith(CSV_HEADER) or first_comment.startswith(CSV_HEADER):
+        return "csv"
+    if first_comment.lower().startswith("#timestamp") and "," in first_comment:
+        return "euroc"
+    if not data:
+        raise BagError("a text file with no data row: not a bag, TUM, KITTI or EuRoC file", path=p)
+    if "," in data:
+        if len(data.split(",")) >= 8:
+            return "euroc"
+    else:
+        n = len(data.split())
+        if n == 8:
+            return "tum"
+        if n == 12:
+            return "kitti"
+    raise BagError(
+        f"not a bag, and its first data row ({_short(data)}) is no TUM (8 numbers), KITTI "
+        "(12) or EuRoC (8+ comma-separated) row; give --input-format to say which",
+        path=p,
+    )
+
+
+def _short(text: str, n: int = 60) -> str:
+    return repr(text if len(text) <= n else text[:n] + "...")
+
+
+def _rows(path: Path, fmt: TextFormat) -> _Rows:
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError as err:
+        raise BagError(f"not a {fmt.upper()} text file (not UTF-8 text)", path=path) from err
+    except OSError as err:
+        raise BagError(f"cannot read: {err.strerror}", path=path) from err
+    lines = text.splitlines()
+    stripped = [ln.strip() for ln in lines]
+    header = fmt == "csv"
+    keep = [
+        i
+        for i, ln in enumerate(stripped)
+        if ln and not ln.startswith("#") and not (header and ln.startswith("t_ns,"))
+    ]
+    sep = None if fmt in ("tum", "kitti") else ","
+    want = len(_COLUMNS[fmt])
+    split = [stripped[i].split(sep) for i in keep]
+    counts = np.fromiter(map(len, split), dtype=np.intp, count=len(split))
+    bad = counts < want if fmt == "euroc" else counts != want
+    if fmt == "csv":
+        # frame_id may hold a quoted comma: only fewer cells than columns is an error.
+        bad = counts < want
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise BagError(
+            f"row {keep[k] + 1}: {counts[k]} values, a {fmt.upper()} row has "
+            f"{want}{' or more' if fmt == 'euroc' else ''}",
+            path=path,
+        )
+    if not split:
+        raise BagError(f"no data rows in this {fmt.upper()} file", path=path)
+    width = want if fmt != "csv" else want - 1
+    cells = np.array([row[:width] for row in split], dtype=np.str_).reshape(len(split), width)
+    return _Rows(cells, np.asarray(keep, dtype=np.intp) + 1)
+
+
+def _floats(rows: _Rows, cols: list[int], fmt: TextFormat, path: Path) -> F64:
+    block = rows.cells[:, cols]
+    try:
+        out: F64 = block.astype(np.float64)
+    except ValueError:
+        out = _first_bad(rows, cols, fmt, path)
+    if not np.isfinite(out).all():
+        r, c = np.argwhere(~np.isfinite(out))[0]
+        _bad_value(rows, int(r), cols[int(c)], fmt, path, "not a finite number")
+    return out
+
+
+def _first_bad(rows: _Rows, cols: list[int], fmt: TextFormat, path: Path) -> F64:
+    """Only on the error path: find the first cell that is no number, row by row."""
+    for r in range(len(rows.cells)):
+        for c in cols:
+            try:
+                float(rows.cells[r, c])
+            except ValueError:
+                _bad_value(rows, r, c, fmt, path, "not a number")
+    raise AssertionError("unreachable: numpy refused a block whose cells all parse")
+
+
+def _bad_value(rows: _Rows, r: int, c: int, fmt: TextFormat, path: Path, why: str) -> None:
+    name = _COLUMNS[fmt][c]
+    raise BagError(
+        f"row {int(rows.lines[r])}, column {c + 1} ({name}): {_short(str(rows.cells[r, c]), 30)} "
+        f"is {why}",
+        path=path,
+    )
+
+
+def _decimal_ns(rows: _Rows, col: int, fmt: TextFormat, path: Path) -> I64:
+    """Decimal seconds text -> int64 ns, exactly (integer arithmetic, half to even past ns)."""
+    text = rows.cells[:, col]
+    neg = np.char.startswith(text, "-")
+    body = np.where(neg, np.char.lstrip(text, "-"), text)
+    whole, dot, frac = (np.char.partition(body, ".")[:, i] for i in range(3))
+    plain = (
+        np.char.isdigit(whole)
+        & ((dot == "") | (np.char.isdigit(frac) | (frac == "")))
+        & (np.char.str_len(frac) <= 9)
+        & (np.char.str_len(whole) <= 10)
+    )
+    out = np.zeros(len(text), dtype=np.int64)
+    if plain.any():
+        w = whole[plain].astype(np.int64)
+        f = np.char.ljust(frac[plain], 9, "0")
+        f = np.where(f == "", "0", f).astype(np.int64)
+        out[plain] = np.where(neg[plain], -(w * _NS + f), w * _NS + f)
+    for r in np.flatnonzero(~plain).tolist():  # exponents, long fractions: rare
+        try:
+            d = Decimal(str(text[r]))
+            if not d.is_finite():
+                raise InvalidOperation
+            ns = int((d * _NS).quantize(Decimal(1), rounding=ROUND_HALF_EVEN))
+        except (InvalidOperation, ValueError):
+            _bad_value(rows, r, col, fmt, path, "not a time in seconds")
+        if abs(ns) >= 2**63:
+            _bad_value(rows, r, col, fmt, path, "out of the int64 nanosecond range")
+        out[r] = ns
+    return out
+
+
+def _int_ns(rows: _Rows, col: int, fmt: TextFormat, path: Path) -> I64:
+    text = rows.cells[:, col]
+    ok = np.char.isdigit(np.char.lstrip(text, "-")) & (np.char.str_len(text) <= 19)
+    if not ok.all():
+        r = int(np.flatnonzero(~ok)[0])
+        _bad_value(rows, r, col, fmt, path, "not an integer time in nanoseconds")
+    out: I64 = text.astype(np.int64)
+    return out
+
+
+def _quat_from_matrices(rot: npt.NDArray[np.float64]) -> F64:
+    # lazy: scipy only where its rotations are needed (~0.3 s to import)
+    from scipy.spatial.transform import Rotation
+
+    q: F64 = Rotation.from_matrix(rot).as_quat()
+    return q
+
+
+def read_text_poses(path: str | Path, fmt: TextFormat | None = None) -> PoseStream:
+    """The poses of a text trajectory (``fmt`` None: :func:`sniff` it).
+
+    Raises:
+        BagError: not a text trajectory, or a bad value (its row and column named).
+    """
+    p = Path(path)
+    if not p.exists():
+        raise BagError("no such file or directory", path=p)
+    kind = fmt if fmt is not None else sniff(p)
+    if kind is None:
+        raise BagError("not a text trajectory (TUM, KITTI, EuRoC or ertools CSV)", path=p)
+    rows = _rows(p, kind)
+    source = str(p)
+    if kind == "tum":
+        t_ns = _decimal_ns(rows, 0, kind, p)
+        nums = _floats(rows, list(range(8)), kind, p)
+        return PoseStream(t_ns, nums[:, 1:4], nums[:, 4:8], source=source, t_s=nums[:, 0])
+    if kind == "euroc":
+        t_ns = _int_ns(rows, 0, kind, p)
+        nums = _floats(rows, list(range(8)), kind, p)
+        # evo: the stamp parsed as a float, then divided by 1e9 (float64 both times).
+        t_s = nums[:, 0] / 1e9
+        quat = nums[:, [5, 6, 7, 4]]  # EuRoC writes w first
+        return PoseStream(t_ns, nums[:, 1:4], quat, source=source, t_s=t_s)
+    if kind == "kitti":
+        nums = _floats(rows, list(range(12)), kind, p)
+        m = nums.reshape(-1, 3, 4)
+        n = len(m)
+        t_ns = np.arange(n, dtype=np.int64) * _NS
+        return PoseStream(
+            t_ns,
+            np.ascontiguousarray(m[:, :, 3]),
+            _quat_from_matrices(m[:, :, :3]),
+            source=source,
+            t_s=np.arange(n, dtype=np.float64),
+        )
+    t_ns = _int_ns(rows, 0, kind, p)
+    nums = _floats(rows, list(range(2, 9)), kind, p)
+    frame = _csv_frame(p)
+    return PoseStream(t_ns, nums[:, 0:3], nums[:, 3:7], frame_id=frame, source=source)
+
+
+def _csv_frame(path: Path) -> str:
+    """The frame_id of ertools' CSV (one value repeated): read with the csv module, which
+    undoes the RFC 4180 quoting the writer applied."""
+    import csv  # lazy: only for ertools' CSV export read back
+
+    with path.open(encoding="utf-8", newline="") as f:
+        reader = csv.reader(f)
+        next(reader, None)
+        row = next(reader, None)
+    return row[9] if row is not None and len(row) > 9 else ""
+
+
+def is_text_trajectory(path: str | Path, forced: str | None = None) -> TextFormat | None:
+    """The text layout to read ``path`` with: ``forced`` (``--input-format``; ``bag`` gives
+    None), else :func:`sniff`'s answer."""
+    if forced == "bag":
+        return None
+    if forced is not None:
+        if forced not in TEXT_FORMATS:
+            raise ValueError(f"unknown input format {forced!r}")
+        return forced  # type: ignore[return-value]
+    return sniff(path)
