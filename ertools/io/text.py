@@ -289,8 +289,9 @@ def is_text_trajectory(path: str | Path, forced: str | None = None) -> TextForma
     None), else :func:`sniff`'s answer."""
     if forced == "bag":
         return None
+    for kind in TEXT_FORMATS:
+        if forced == kind:
+            return kind
     if forced is not None:
-        if forced not in TEXT_FORMATS:
-            raise ValueError(f"unknown input format {forced!r}")
-        return forced  # type: ignore[return-value]
+        raise ValueError(f"unknown input format {forced!r}")
     return sniff(path)

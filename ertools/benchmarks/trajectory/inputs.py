@@ -174,9 +174,7 @@ def read_gt(
     """
 
     if prefilter:
-        return read_poses(
-            files, topic, time_source=time_source, start_ns=start_ns, end_ns=end_ns
-        )
+        return read_poses(files, topic, time_source=time_source, start_ns=start_ns, end_ns=end_ns)
     return read_poses(files, topic, time_source=time_source).window(start_ns, end_ns)
 
 
