@@ -127,7 +127,10 @@ class McapIndex:
         if bag.format == "mcap":
             return McapIndex([bag.path])
         if bag.format == "rosbag2-mcap":
-            return McapIndex(sorted(bag.path.glob("*.mcap")))
+            # lazy: PyYAML only for rosbag2 folders
+            from ertools.io.rosbag2.metadata import readable_files
+
+            return McapIndex([f for f in readable_files(bag.path) if f.suffix == ".mcap"])
         return None
 
     def plan(self, conns: Sequence[Conn], lo: int | None, hi: int | None) -> McapPlan:
