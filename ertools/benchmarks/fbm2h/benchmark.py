@@ -553,7 +553,7 @@ def score_found(logs: Fbm2hLogs, runs: Fbm2hRuns, options: Fbm2hOptions) -> Fbm2
             ("reached", runs.moments.method),
             ("pose_source", logs.marker.source),
             ("max_gap_s", str(options.max_gap_s)),
-            ("transform", logs.transform.source),
+            ("transform", logs.transform.described),
             ("orientation_2015", str(options.orientation_2015)),
             ("unscored_segments", "2015" if options.unscored_2015 else "null"),
         ),

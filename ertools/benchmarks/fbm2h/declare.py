@@ -199,7 +199,7 @@ def notes(result: Fbm2hResult) -> list[str]:
     if logging.getLogger("ertools").isEnabledFor(logging.INFO):  # -v
         out += list(result.notes)
     out.append(
-        f"reached moments: {result.reached_method}; transform: {result.transform.source}; "
+        f"reached moments: {result.reached_method}; transform: {result.transform.described}; "
         "times from the log's first message"
     )
     n = len(result.segments)
