@@ -554,6 +554,7 @@ def score_found(logs: Fbm2hLogs, runs: Fbm2hRuns, options: Fbm2hOptions) -> Fbm2
             ("pose_source", logs.marker.source),
             ("max_gap_s", str(options.max_gap_s)),
             ("transform", logs.transform.described),
+            ("goal_layout", logs.goal.layout if logs.goal is not None else "log payload"),
             ("orientation_2015", str(options.orientation_2015)),
             ("unscored_segments", "2015" if options.unscored_2015 else "null"),
         ),
