@@ -1,4 +1,4 @@
-"""`score trajectory --association nearest --t-max-diff S` gives evo_ape's pairs and numbers (issue 26).
+"""`score trajectory --association nearest --t-max-diff S` gives evo_ape's pairs and numbers.
 
 evo (MichaelGrupp/evo, a test dependency) is run as its command line, `evo_ape ... --save_results
 res.zip`, under a scratch HOME (it writes ~/.evo/settings.json) with MPLBACKEND=Agg; its stats
