@@ -43,8 +43,19 @@ def _compress(src: Path, dst: Path, storage: str) -> None:
     if not exe.exists():
         pytest.skip("n/a: rosbags-convert not installed (rosbags is a dependency)")
     subprocess.run(
-        [str(exe), "--src", str(src), "--dst", str(dst), "--dst-storage", storage]
-        + ["--compress", "zstd", "--compress-mode", "file"],
+        [
+            str(exe),
+            "--src",
+            str(src),
+            "--dst",
+            str(dst),
+            "--dst-storage",
+            storage,
+            "--compress",
+            "zstd",
+            "--compress-mode",
+            "file",
+        ],
         check=True,
         capture_output=True,
         timeout=120,
