@@ -97,8 +97,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     pair.add_argument(
         "--association",
         choices=("linear", "nearest", "hold"),
-        default="linear",
-        help="GT pose at a robot time with --matched (default linear)",
+        default=None,
+        help="GT pose at a robot time with --matched (default linear; nearest with --t-max-diff)",
     )
     pair.add_argument(
         "--max-gap", type=positive, default=0.1, metavar="S", help="as in `score trajectory`"
@@ -108,8 +108,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         type=non_negative,
         default=None,
         metavar="S",
-        help="with --association nearest: evo's pairs (`evo_ape ... --t_max_diff S`), as in "
-        "`score trajectory`",
+        help="evo's pairs (`evo_ape ... --t_max_diff S`; implies --association nearest), as "
+        "in `score trajectory`",
     )
     pair.add_argument(
         "--offset",
@@ -128,7 +128,7 @@ PAIR_ONLY = {
     "matched": False,
     "robot_topic": None,
     "gt_topic": None,
-    "association": "linear",
+    "association": None,
     "max_gap": 0.1,
     "t_max_diff": None,
     "offset": 0.0,
@@ -210,8 +210,9 @@ def _run_pair(args: argparse.Namespace) -> int:
     if args.format == "kitti" and not args.matched:
         raise UsageError(KITTI_NEEDS_MATCHED)
     refuse_inputs(list(pair_paths(args.out_dir, args.format).values()), list(args.bags))
+    association = args.association or ("nearest" if args.t_max_diff is not None else "linear")
     config = TrajectoryConfig(
-        association=args.association,
+        association=association,
         max_gap_ns=s_to_ns(args.max_gap),
         offset_ns=0 if auto else s_to_ns(float(args.offset)),
         auto_offset=auto,

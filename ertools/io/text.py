@@ -19,6 +19,7 @@ A bad value is one line naming its row (the file's line number) and column.
 
 from __future__ import annotations
 
+import csv
 from dataclasses import dataclass
 from decimal import ROUND_HALF_EVEN, Decimal, InvalidOperation
 from pathlib import Path
@@ -275,8 +276,6 @@ def read_text_poses(path: str | Path, fmt: TextFormat | None = None) -> PoseStre
 def _csv_frame(path: Path) -> str:
     """The frame_id of ertools' CSV (one value repeated): read with the csv module, which
     undoes the RFC 4180 quoting the writer applied."""
-    import csv  # lazy: only for ertools' CSV export read back
-
     with path.open(encoding="utf-8", newline="") as f:
         reader = csv.reader(f)
         next(reader, None)

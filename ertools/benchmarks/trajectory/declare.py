@@ -100,9 +100,9 @@ INPUTS = (
     Input(
         "t_max_diff",
         "float",
-        "with --association nearest: pair as evo does (`evo_ape ... --t_max_diff S`, evo's "
-        "default 0.01): each pose of the shorter trajectory with the nearest stamp of the "
-        "other within S seconds; --max-gap and the tracking-lost rule then do not apply",
+        "pair as evo does (`evo_ape ... --t_max_diff S`, evo's default 0.01; implies "
+        "--association nearest): each pose of the shorter trajectory with the nearest stamp "
+        "of the other within S seconds; --max-gap and the tracking-lost rule do not apply",
         unit="s",
         minimum=0.0,
     ),
@@ -200,6 +200,8 @@ def make_options(given: Mapping[str, Any]) -> TrajectoryOptions:
         if clash:
             raise UsageError(f"--2015 sets {_2015_options()}; it cannot take {', '.join(clash)}")
         settings = dict(SETTINGS_2015)
+    if v["t_max_diff"] is not None and "association" not in settings:
+        settings["association"] = "nearest"  # evo's pairing is a nearest-stamp one
     if settings.get("ties") == "before" and settings.get("association") != "hold":
         raise UsageError("--ties before needs --association hold")
     try:

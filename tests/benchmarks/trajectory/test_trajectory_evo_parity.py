@@ -230,8 +230,12 @@ def test_t_max_diff_needs_nearest(tmp_path: Path, capsys: pytest.CaptureFixture[
     bag = tmp_path / "sim"
     write_sim_bag(bag)
     argv = ["score", "trajectory", str(bag), "--robot-topic", "/amcl_pose", "--gt-topic", "/odom"]
-    assert main([*argv, "--t-max-diff", "0.01"]) == 2
+    assert main([*argv, "--association", "linear", "--t-max-diff", "0.01"]) == 2
     assert "needs --association nearest" in capsys.readouterr().err
+    # Alone it implies nearest: the same pairs as with it spelt out.
+    alone = ertools_json(capsys, *argv[2:], "--t-max-diff", "0.01")
+    spelt = ertools_json(capsys, *argv[2:], *EVO_LINE)
+    assert alone["association"] == "nearest" and alone["compared"] == spelt["compared"]
 
 
 def test_export_matched_gives_evo_pairs(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
