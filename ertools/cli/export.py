@@ -27,6 +27,7 @@ from ertools.cli.options import (
 )
 from ertools.cli.output import note, write_text
 from ertools.errors import UsageError
+from ertools.geometry import Association
 from ertools.export.formats import FORMATS, format_poses, format_times
 from ertools.export.pairs import (
     KITTI_NEEDS_MATCHED,
@@ -210,7 +211,9 @@ def _run_pair(args: argparse.Namespace) -> int:
     if args.format == "kitti" and not args.matched:
         raise UsageError(KITTI_NEEDS_MATCHED)
     refuse_inputs(list(pair_paths(args.out_dir, args.format).values()), list(args.bags))
-    association = args.association or ("nearest" if args.t_max_diff is not None else "linear")
+    association: Association = args.association or (
+        "nearest" if args.t_max_diff is not None else "linear"
+    )
     config = TrajectoryConfig(
         association=association,
         max_gap_ns=s_to_ns(args.max_gap),
