@@ -27,7 +27,6 @@ from ertools.cli.options import (
 )
 from ertools.cli.output import note, write_text
 from ertools.errors import UsageError
-from ertools.geometry import Association
 from ertools.export.formats import FORMATS, format_poses, format_times
 from ertools.export.pairs import (
     KITTI_NEEDS_MATCHED,
@@ -37,6 +36,7 @@ from ertools.export.pairs import (
     trajectory_pair,
     write_pair,
 )
+from ertools.geometry import Association
 from ertools.io.text import INPUT_FORMATS, TextFormat, is_text_trajectory, read_text_poses
 from ertools.timeutil import iso_utc, ns_to_s, s_to_ns
 
