@@ -122,6 +122,8 @@ def load(paths: Sequence[str | Path], options: TrajectoryOptions) -> TrajectoryL
     rs = summary(robot_path)
     topic = pick_robot_topic(rs, options.robot_topic)
     robot, clock_gap = read_robot_clocks(robot_path, topic, options.robot_time)
+    # The robot's header stamps on the GT clock vs its record times.
+    clock_gap += cfg.offset_ns if options.robot_time == "header" else 0
     if len(robot) == 0:
         raise ScoringError(f"{robot_path}: robot topic {topic} has no messages")
     # The robot's span on the GT clock, widened by the clock audit's search range.
@@ -145,31 +147,56 @@ def load(paths: Sequence[str | Path], options: TrajectoryOptions) -> TrajectoryL
             "(--time-source header|record)"
         )
     evo = cfg.t_max_diff is not None
+    window: tuple[int | None, int | None] = (lo - margin, hi + margin)
+    gt: PoseStream | None = None
     if same_bag(robot_path, gt_paths):
         # evo's `bag` mode: one bag holds both the robot's topic and the GT topic.
         chosen = [rs]
         gtopic = pick_gt_in_robot_bag(rs, options.gt_topic, topic, gt_paths)
         broken: list[str] = []
-        window: tuple[int | None, int | None] = (lo - margin, hi + margin)
         if evo:
             window = (None, None)  # evo reads the whole GT topic: its count picks the side
     else:
-        # The GT files' spans are record times: the robot's span in record time finds them.
-        shift = clock_gap if apart and options.robot_time == "header" else 0
-        chosen, gtopic, found_warnings, broken = find_gt_files(
-            robot_path, gt_paths, lo - margin - shift, hi + margin - shift, options.gt_topic
-        )
+        if apart and options.robot_time == "header":
+            # Simulation time: the GT files' spans are record times, so the robot's span in
+            # record time finds them; their poses are then read by header stamps.
+            try:
+                found = find_gt_files(
+                    robot_path,
+                    gt_paths,
+                    lo - margin - clock_gap,
+                    hi + margin - clock_gap,
+                    options.gt_topic,
+                )
+                gt = _read_gt_of(found[0], found[1], window, options.gt_time, prefilter=False)
+            except ClockError:
+                gt = None
+            if gt is not None and len(gt) < 2:
+                # Not a simulation clock shared with the GT: only the robot's stamps are off.
+                # The usual selection says so (no GT file overlaps; --offset).
+                gt = None
+        if gt is None:
+            found = find_gt_files(robot_path, gt_paths, lo - margin, hi + margin, options.gt_topic)
+        chosen, gtopic, found_warnings, broken = found
         warnings += found_warnings
-        window = (lo - margin, hi + margin)
-    gt = read_gt(
-        [s.path for s in chosen],
-        gtopic,
-        *window,
-        time_source=options.gt_time,
-        prefilter=not (apart and options.gt_time == "header"),
-    )
+    if gt is None:
+        prefilter = not (apart and options.gt_time == "header")
+        gt = _read_gt_of(chosen, gtopic, window, options.gt_time, prefilter=prefilter)
     return TrajectoryLogs(
         robot_path, topic, robot, tuple(chosen), gtopic, gt, tuple(warnings), tuple(broken)
+    )
+
+
+def _read_gt_of(
+    chosen: Sequence[BagSummary],
+    topic: str,
+    window: tuple[int | None, int | None],
+    time_source: str,
+    *,
+    prefilter: bool,
+) -> PoseStream:
+    return read_gt(
+        [s.path for s in chosen], topic, *window, time_source=time_source, prefilter=prefilter
     )
 
 
