@@ -112,6 +112,7 @@ def test_same_export_and_timeline(
     pair: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     plain, packed = pair
+    before = {f.name: f.read_bytes() for f in packed.iterdir()}
     outs = []
     for bag in (plain, packed):
         out = tmp_path / f"{bag.name}.csv"
@@ -122,3 +123,5 @@ def test_same_export_and_timeline(
         assert main(["timeline", str(bag), "--format", "json"]) == 0
     capsys.readouterr()
     assert outs[0] == outs[1] and outs[0].count("\n") == 201
+    # Decompressed into a temporary folder: the bag's own files untouched, none added.
+    assert {f.name: f.read_bytes() for f in packed.iterdir()} == before

@@ -88,6 +88,34 @@ def readable_files(path: Path, info: dict[str, Any] | None = None) -> list[Path]
     return [_decompressed(f) for f in files]
 
 
+def readable_dir(path: Path) -> Path:
+    """The rosbag2 directory as a reader that opens a whole directory (rosbags) should see it:
+    ``path`` itself, or for a bag compressed file by file a directory of this process's
+    temporary folder holding links to :func:`readable_files`' copies and the metadata without
+    the file compression. The decompression is that of :func:`readable_files`, done once."""
+    info = read_metadata(path)
+    if file_compression(info) is None:
+        return path
+    files = readable_files(path, info)
+    key = (f"dir:{path.resolve()}", len(files), 0)
+    done = _DECOMPRESSED.get(key)
+    if done is not None and done.exists():
+        return done
+    out = _scratch() / f"bag{len(_DECOMPRESSED)}"
+    out.mkdir(parents=True, exist_ok=True)
+    for f in files:
+        (out / f.name).symlink_to(f)
+    plain = dict(info, compression_format="", compression_mode="")
+    plain["relative_file_paths"] = [f.name for f in files]
+    listed = info.get("files")
+    if isinstance(listed, list) and len(listed) == len(files):
+        plain["files"] = [dict(e, path=f.name) for e, f in zip(listed, files, strict=True)]
+    text = yaml.safe_dump({"rosbag2_bagfile_information": plain}, sort_keys=False)
+    (out / "metadata.yaml").write_text(text, encoding="utf-8")
+    _DECOMPRESSED[key] = out
+    return out
+
+
 def _decompressed(file: Path) -> Path:
     try:
         st = file.stat()
