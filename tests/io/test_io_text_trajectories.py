@@ -177,3 +177,11 @@ def test_export_converts_text(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     a, b = read_text_poses(src), read_text_poses(out)
     assert a.t_ns.tolist() == b.t_ns.tolist()
     assert np.array_equal(a.xyz, b.xyz) and np.array_equal(a.quat_xyzw, b.quat_xyzw)
+
+
+def test_text_has_no_record_time(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    robot, gt = tmp_path / "robot.tum", tmp_path / "gt.tum"
+    robot.write_text("1.0 1 2 3 0 0 0 1\n2.0 1 2 3 0 0 0 1\n")
+    gt.write_text("0.5 1 2 3 0 0 0 1\n2.5 1 2 4 0 0 0 1\n")
+    assert main(["score", "trajectory", str(robot), str(gt), "--time-source", "record"]) == 2
+    assert "TUM text trajectory: it has only its stamps" in capsys.readouterr().err

@@ -217,6 +217,15 @@ def load_text(
             f"a text trajectory holds one trajectory: give the robot's file and one GT file "
             f"(got {len(paths)} path(s))"
         )
+    for time, kind, what in (
+        (options.robot_time, kinds[0], "robot"),
+        (options.gt_time, kinds[1], "GT"),
+    ):
+        if time == "record" and kind is not None:
+            raise UsageError(
+                f"record times asked for the {what}, but its file is a {kind.upper()} text "
+                "trajectory: it has only its stamps (drop --time-source record)"
+            )
     if "kitti" in kinds and kinds[0] != kinds[1]:
         raise UsageError(
             "KITTI files have no time stamps: robot and GT must both be KITTI, paired row by "
