@@ -23,7 +23,7 @@ import csv
 from dataclasses import dataclass
 from decimal import ROUND_HALF_EVEN, Decimal, InvalidOperation
 from pathlib import Path
-from typing import Literal
+from typing import Literal, NoReturn
 
 import numpy as np
 import numpy.typing as npt
@@ -50,10 +50,17 @@ _COLUMNS: dict[TextFormat, tuple[str, ...]] = {
 
 @dataclass(frozen=True)
 class _Rows:
-    """The data rows of a text file: their cells and their 1-based line numbers."""
+    """The data rows of a text file (stripped) and their 1-based line numbers."""
 
-    cells: npt.NDArray[np.str_]
-    lines: npt.NDArray[np.intp]
+    text: list[str]
+    lines: list[int]
+    fmt: TextFormat
+
+    def cells(self, r: int) -> list[str]:
+        """Row ``r`` split into its cells (errors only: the reads below never split rows)."""
+        if self.fmt in ("tum", "kitti"):
+            return self.text[r].split()
+        return self.text[r].split(",", len(_COLUMNS[self.fmt]) - 1)
 
 
 def _bag_magic(head: bytes) -> bool:
@@ -118,108 +125,162 @@ def _rows(path: Path, fmt: TextFormat) -> _Rows:
         raise BagError(f"not a {fmt.upper()} text file (not UTF-8 text)", path=path) from err
     except OSError as err:
         raise BagError(f"cannot read: {err.strerror}", path=path) from err
-    lines = text.splitlines()
-    stripped = [ln.strip() for ln in lines]
+    stripped = [ln.strip() for ln in text.splitlines()]
     header = fmt == "csv"
     keep = [
         i
         for i, ln in enumerate(stripped)
         if ln and not ln.startswith("#") and not (header and ln.startswith("t_ns,"))
     ]
-    sep = None if fmt in ("tum", "kitti") else ","
+    rows = [stripped[i] for i in keep]
     want = len(_COLUMNS[fmt])
-    split = [stripped[i].split(sep) for i in keep]
-    counts = np.fromiter(map(len, split), dtype=np.intp, count=len(split))
-    bad = counts < want if fmt == "euroc" else counts != want
-    if fmt == "csv":
-        # frame_id may hold a quoted comma: only fewer cells than columns is an error.
+    if fmt in ("tum", "kitti"):
+        # One space between values (as every writer does): count the spaces, else split.
+        if "  " in text or "\t" in text:
+            counts = np.fromiter((len(r.split()) for r in rows), dtype=np.intp, count=len(rows))
+        else:
+            counts = np.fromiter((r.count(" ") + 1 for r in rows), dtype=np.intp, count=len(rows))
+        bad = counts != want
+    else:
+        counts = np.fromiter((r.count(",") + 1 for r in rows), dtype=np.intp, count=len(rows))
+        # EuRoC rows have 8 or more columns; ertools' frame_id may hold a quoted comma.
         bad = counts < want
     if bad.any():
         k = int(np.flatnonzero(bad)[0])
         raise BagError(
             f"row {keep[k] + 1}: {counts[k]} values, a {fmt.upper()} row has "
-            f"{want}{' or more' if fmt == 'euroc' else ''}",
+            f"{want}{' or more' if fmt in ('euroc', 'csv') else ''}",
             path=path,
         )
-    if not split:
+    if not rows:
         raise BagError(f"no data rows in this {fmt.upper()} file", path=path)
-    width = want if fmt != "csv" else want - 1
-    cells = np.array([row[:width] for row in split], dtype=np.str_).reshape(len(split), width)
-    return _Rows(cells, np.asarray(keep, dtype=np.intp) + 1)
+    return _Rows(rows, [i + 1 for i in keep], fmt)
 
 
-def _floats(rows: _Rows, cols: list[int], fmt: TextFormat, path: Path) -> F64:
-    block = rows.cells[:, cols]
+def _parse(text: str) -> F64 | None:
+    """Whitespace-separated numbers by NumPy's C parser (correctly rounded, as float()),
+    None when a token is no number."""
     try:
-        out: F64 = block.astype(np.float64)
+        out: F64 = np.fromstring(text, dtype=np.float64, sep=" ")
     except ValueError:
-        out = _first_bad(rows, cols, fmt, path)
-    if not np.isfinite(out).all():
-        r, c = np.argwhere(~np.isfinite(out))[0]
-        _bad_value(rows, int(r), cols[int(c)], fmt, path, "not a finite number")
+        return None
     return out
 
 
-def _first_bad(rows: _Rows, cols: list[int], fmt: TextFormat, path: Path) -> F64:
+def _floats(rows: _Rows, cols: list[int], path: Path) -> F64:
+    """The numbers of columns ``cols`` (all of a row's first columns up to max(cols))."""
+    fmt, n = rows.fmt, len(rows.text)
+    width = max(cols) + 1
+    if fmt in ("tum", "kitti"):
+        parsed = _parse("\n".join(rows.text))
+        block = None if parsed is None else parsed.reshape(n, -1)[:, :width]
+    else:
+        # Only the first ``width`` cells: EuRoC's extra columns, ertools' frame_id.
+        cut = [r.split(",", width)[:width] for r in rows.text]
+        parsed = _parse("\n".join(" ".join(c) for c in cut))
+        block = None if parsed is None or parsed.size != n * width else parsed.reshape(n, width)
+    if block is None:
+        _first_bad(rows, cols, path)
+        raise AssertionError("unreachable: NumPy refused rows whose cells all parse")
+    out: F64 = np.ascontiguousarray(block[:, cols])
+    if not np.isfinite(out).all():
+        r, c = np.argwhere(~np.isfinite(out))[0]
+        _bad_value(rows, int(r), cols[int(c)], path, "not a finite number")
+    return out
+
+
+def _first_bad(rows: _Rows, cols: list[int], path: Path) -> None:
     """Only on the error path: find the first cell that is no number, row by row."""
-    for r in range(len(rows.cells)):
+    for r in range(len(rows.text)):
+        cells = rows.cells(r)
         for c in cols:
             try:
-                float(rows.cells[r, c])
+                float(cells[c])
             except ValueError:
-                _bad_value(rows, r, c, fmt, path, "not a number")
-    raise AssertionError("unreachable: numpy refused a block whose cells all parse")
+                _bad_value(rows, r, c, path, "not a number")
 
 
-def _bad_value(rows: _Rows, r: int, c: int, fmt: TextFormat, path: Path, why: str) -> None:
-    name = _COLUMNS[fmt][c]
+def _bad_value(rows: _Rows, r: int, c: int, path: Path, why: str) -> NoReturn:
+    name = _COLUMNS[rows.fmt][c]
+    cell = rows.cells(r)[c]
     raise BagError(
-        f"row {int(rows.lines[r])}, column {c + 1} ({name}): {_short(str(rows.cells[r, c]), 30)} "
-        f"is {why}",
-        path=path,
+        f"row {rows.lines[r]}, column {c + 1} ({name}): {_short(cell, 30)} is {why}", path=path
     )
 
 
-def _decimal_ns(rows: _Rows, col: int, fmt: TextFormat, path: Path) -> I64:
-    """Decimal seconds text -> int64 ns, exactly (integer arithmetic, half to even past ns)."""
-    text = rows.cells[:, col]
-    neg = np.char.startswith(text, "-")
-    body = np.where(neg, np.char.lstrip(text, "-"), text)
-    whole, dot, frac = (np.char.partition(body, ".")[:, i] for i in range(3))
-    plain = (
-        np.char.isdigit(whole)
-        & ((dot == "") | (np.char.isdigit(frac) | (frac == "")))
-        & (np.char.str_len(frac) <= 9)
-        & (np.char.str_len(whole) <= 10)
-    )
-    out = np.zeros(len(text), dtype=np.int64)
-    if plain.any():
-        w = whole[plain].astype(np.int64)
-        f = np.char.ljust(frac[plain], 9, "0")
-        f = np.where(f == "", "0", f).astype(np.int64)
-        out[plain] = np.where(neg[plain], -(w * _NS + f), w * _NS + f)
+def _first_cells(rows: _Rows) -> list[str]:
+    if rows.fmt in ("tum", "kitti"):
+        return [r.split(None, 1)[0] for r in rows.text]
+    return [r.partition(",")[0] for r in rows.text]
+
+
+def _plain_decimal_ns(tokens: list[str]) -> tuple[I64, npt.NDArray[np.bool_]]:
+    """Plain decimal seconds (``-?d{1,10}(.d{0,9})?``) -> int64 ns by digit arithmetic on the
+    bytes, one character column at a time (vectorised over the tokens); the mask says which
+    tokens were plain (the others are left 0 for the caller)."""
+    n = len(tokens)
+    raw = np.array(tokens, dtype="S")
+    width = raw.dtype.itemsize
+    if n == 0 or width > 21:
+        return np.zeros(n, dtype=np.int64), np.zeros(n, dtype=bool)
+    m = raw.view(np.uint8).reshape(n, width)
+    neg = m[:, 0] == ord("-")
+    dots = np.count_nonzero(m == ord("."), axis=1)
+    at = np.where(dots > 0, np.argmax(m == ord("."), axis=1), width - np.count_nonzero(m == 0, 1))
+    length = width - np.count_nonzero(m == 0, axis=1)
+    whole = at - neg
+    ok = (dots <= 1) & (whole >= 1) & (whole <= 10) & (length - at - 1 <= 9)
+    ns = np.zeros(n, dtype=np.int64)
+    ended = np.zeros(n, dtype=bool)
+    for j in range(width):
+        c = m[:, j]
+        is_pad = c == 0
+        ok &= ~(ended & ~is_pad)  # a NUL only as the padding at the end
+        ended |= is_pad
+        digit = (c >= ord("0")) & (c <= ord("9"))
+        sign = (j == 0) & neg
+        ok &= digit | is_pad | (c == ord(".")) | sign
+        # The power of ten of this digit in nanoseconds: 8 + (dot - j) before the dot,
+        # 9 - (j - dot) after it.
+        exp = np.where(j < at, 8 + at - j, 9 - (j - at))
+        use = digit & ok & (exp >= 0)
+        if use.any():
+            ns += np.where(use, (c.astype(np.int64) - ord("0")) * 10 ** np.clip(exp, 0, 18), 0)
+    # 10 whole digits can pass int64 ns (after 2262): only up to 9 223 372 035 s.
+    top = ok & (whole == 10)
+    if top.any():
+        idx = np.flatnonzero(top)
+        big = np.array([tokens[i].lstrip("-")[:10] > "9223372035" for i in idx.tolist()])
+        ok[idx[big]] = False
+    return np.where(ok, np.where(neg, -ns, ns), 0).astype(np.int64), ok
+
+
+def _decimal_ns(rows: _Rows, path: Path) -> I64:
+    """The first column, decimal seconds, as int64 ns exactly (integer arithmetic; half to
+    even past the 9th decimal, exponents via Decimal)."""
+    tokens = _first_cells(rows)
+    out, plain = _plain_decimal_ns(tokens)
     for r in np.flatnonzero(~plain).tolist():  # exponents, long fractions: rare
+        token = tokens[r]
         try:
-            d = Decimal(str(text[r]))
+            d = Decimal(token)
             if not d.is_finite():
                 raise InvalidOperation
             ns = int((d * _NS).quantize(Decimal(1), rounding=ROUND_HALF_EVEN))
         except (InvalidOperation, ValueError):
-            _bad_value(rows, r, col, fmt, path, "not a time in seconds")
+            _bad_value(rows, r, 0, path, "not a time in seconds")
         if abs(ns) >= 2**63:
-            _bad_value(rows, r, col, fmt, path, "out of the int64 nanosecond range")
+            _bad_value(rows, r, 0, path, "out of the int64 nanosecond range")
         out[r] = ns
     return out
 
 
-def _int_ns(rows: _Rows, col: int, fmt: TextFormat, path: Path) -> I64:
-    text = rows.cells[:, col]
-    ok = np.char.isdigit(np.char.lstrip(text, "-")) & (np.char.str_len(text) <= 19)
-    if not ok.all():
-        r = int(np.flatnonzero(~ok)[0])
-        _bad_value(rows, r, col, fmt, path, "not an integer time in nanoseconds")
-    out: I64 = text.astype(np.int64)
-    return out
+def _int_ns(rows: _Rows, path: Path) -> I64:
+    tokens = _first_cells(rows)
+    for r, token in enumerate(tokens):
+        if not (token.lstrip("-").isdigit() and len(token) <= 19):
+            _bad_value(rows, r, 0, path, "not an integer time in nanoseconds")
+    return np.asarray(list(map(int, tokens)), dtype=np.int64)
 
 
 def _quat_from_matrices(rot: npt.NDArray[np.float64]) -> F64:
@@ -245,18 +306,18 @@ def read_text_poses(path: str | Path, fmt: TextFormat | None = None) -> PoseStre
     rows = _rows(p, kind)
     source = str(p)
     if kind == "tum":
-        t_ns = _decimal_ns(rows, 0, kind, p)
-        nums = _floats(rows, list(range(8)), kind, p)
+        t_ns = _decimal_ns(rows, p)
+        nums = _floats(rows, list(range(8)), p)
         return PoseStream(t_ns, nums[:, 1:4], nums[:, 4:8], source=source, t_s=nums[:, 0])
     if kind == "euroc":
-        t_ns = _int_ns(rows, 0, kind, p)
-        nums = _floats(rows, list(range(8)), kind, p)
+        t_ns = _int_ns(rows, p)
+        nums = _floats(rows, list(range(8)), p)
         # evo: the stamp parsed as a float, then divided by 1e9 (float64 both times).
         t_s = nums[:, 0] / 1e9
         quat = nums[:, [5, 6, 7, 4]]  # EuRoC writes w first
         return PoseStream(t_ns, nums[:, 1:4], quat, source=source, t_s=t_s)
     if kind == "kitti":
-        nums = _floats(rows, list(range(12)), kind, p)
+        nums = _floats(rows, list(range(12)), p)
         m = nums.reshape(-1, 3, 4)
         n = len(m)
         t_ns = np.arange(n, dtype=np.int64) * _NS
@@ -267,8 +328,8 @@ def read_text_poses(path: str | Path, fmt: TextFormat | None = None) -> PoseStre
             source=source,
             t_s=np.arange(n, dtype=np.float64),
         )
-    t_ns = _int_ns(rows, 0, kind, p)
-    nums = _floats(rows, list(range(2, 9)), kind, p)
+    t_ns = _int_ns(rows, p)
+    nums = _floats(rows, list(range(2, 9)), p)
     frame = _csv_frame(p)
     return PoseStream(t_ns, nums[:, 0:3], nums[:, 3:7], frame_id=frame, source=source)
 

@@ -185,3 +185,22 @@ def test_text_has_no_record_time(tmp_path: Path, capsys: pytest.CaptureFixture[s
     gt.write_text("0.5 1 2 3 0 0 0 1\n2.5 1 2 4 0 0 0 1\n")
     assert main(["score", "trajectory", str(robot), str(gt), "--time-source", "record"]) == 2
     assert "TUM text trajectory: it has only its stamps" in capsys.readouterr().err
+
+
+def test_decimal_stamps_exact_on_random_text() -> None:
+    """The vectorised decimal -> ns path against Python's Decimal, on random stamps with 0 to 9
+    decimals, negative ones, and the forms it hands to Decimal (exponent, >9 decimals)."""
+    from ertools.io.text import _plain_decimal_ns
+
+    rng = np.random.default_rng(26)
+    tokens = []
+    for k in rng.integers(0, 10, 20_000).tolist():
+        whole = int(rng.integers(0, 2_000_000_000))
+        sign = "-" if rng.random() < 0.1 else ""
+        frac = f".{int(rng.integers(0, 10**k)):0{k}d}" if k else ""
+        tokens.append(f"{sign}{whole}{frac}")
+    ns, plain = _plain_decimal_ns(tokens)
+    assert plain.all()
+    assert ns.tolist() == [int(Decimal(t) * 10**9) for t in tokens]
+    odd = ["1e9", ".5", "1.0000000001", "1.2.3", "-", "9223372036.5"]
+    assert not _plain_decimal_ns(odd)[1].any()
