@@ -175,9 +175,16 @@ def _floats(rows: _Rows, cols: list[int], path: Path) -> F64:
         parsed = _parse("\n".join(rows.text))
         block = None if parsed is None else parsed.reshape(n, -1)[:, :width]
     else:
-        # Only the first ``width`` cells: EuRoC's extra columns, ertools' frame_id.
-        cut = [r.split(",", width)[:width] for r in rows.text]
-        parsed = _parse("\n".join(" ".join(c) for c in cut))
+        # Only the first ``width`` cells: EuRoC's extra columns, ertools' frame_id (one
+        # value repeated on every row: cut as a common suffix, without splitting rows).
+        first = rows.text[0]
+        tail = first[len(",".join(first.split(",", width)[:width])) :]
+        if all(r.endswith(tail) for r in rows.text):
+            body = [r[: len(r) - len(tail)] for r in rows.text] if tail else rows.text
+            parsed = _parse("\n".join(body).replace(",", " "))
+        else:
+            cut = [r.split(",", width)[:width] for r in rows.text]
+            parsed = _parse("\n".join(" ".join(c) for c in cut))
         block = None if parsed is None or parsed.size != n * width else parsed.reshape(n, width)
     if block is None:
         _first_bad(rows, cols, path)
@@ -277,10 +284,12 @@ def _decimal_ns(rows: _Rows, path: Path) -> I64:
 
 def _int_ns(rows: _Rows, path: Path) -> I64:
     tokens = _first_cells(rows)
-    for r, token in enumerate(tokens):
-        if not (token.lstrip("-").isdigit() and len(token) <= 19):
-            _bad_value(rows, r, 0, path, "not an integer time in nanoseconds")
-    return np.asarray(list(map(int, tokens)), dtype=np.int64)
+    ok = np.fromiter(
+        (t.lstrip("-").isdigit() and len(t) <= 19 for t in tokens), dtype=bool, count=len(tokens)
+    )
+    if not ok.all():
+        _bad_value(rows, int(np.flatnonzero(~ok)[0]), 0, path, "not an integer time in ns")
+    return np.fromiter(map(int, tokens), dtype=np.int64, count=len(tokens))
 
 
 def _quat_from_matrices(rot: npt.NDArray[np.float64]) -> F64:
