@@ -158,7 +158,14 @@ def detect_format(path: str | Path) -> str:
         raise BagError(f"ROS1 bag version {version} is not supported (only 2.0)", path=p)
     if head[: len(MCAP_MAGIC)] == MCAP_MAGIC:
         return "mcap"
+    text = all(32 <= b < 127 or b in (9, 10, 13) for b in head)
     raise BagError(
-        f"not a ROS1 bag, rosbag2 bag or MCAP file (unknown magic bytes {head[:8]!r})",
+        f"not a ROS1 bag, rosbag2 bag or MCAP file (unknown magic bytes {head[:8]!r})"
+        + (
+            "; a text file: TUM, KITTI and EuRoC trajectories are read by `score trajectory` "
+            "and `export`"
+            if text
+            else ""
+        ),
         path=p,
     )
