@@ -257,14 +257,16 @@ EPILOG = """examples:
   ertools score trajectory robot.bag gt/ --association hold --gaps compare
   ertools score trajectory robot.bag gt/ --offset auto --apply-offset --format json
   ertools score trajectory robot.bag gt/log_0.bag gt/log_1.bag --offset -0.35 --plot figs/
-  ertools score trajectory ROS_example.bag --robot-topic ORB-SLAM --gt-topic groundtruth \
+  ertools score trajectory ROS_example.bag --robot-topic ORB-SLAM --gt-topic groundtruth \\
       --association nearest --t-max-diff 0.01
       # the pairs and numbers of: evo_ape bag ROS_example.bag groundtruth ORB-SLAM
+  ertools score trajectory est.txt gt.txt --t-max-diff 0.01   # = evo_ape tum gt.txt est.txt
+  ertools score trajectory est_kitti.txt gt_kitti.txt     # = evo_ape kitti (row by row)
   ertools score trajectory both.bag --robot-topic /rockin/homer/marker_pose \\
       --gt-topic /fbm2h/robot_at_home/pose     # one bag holding both topics (evo's bag mode)
 
 ROBOT_BAG is the robot's log; GT_PATH: GT bags or folders of them (none: the GT topic is in
-ROBOT_BAG itself). offset: seconds added to the robot's stamps to put them on the GT clock
+ROBOT_BAG itself). Either may be a TUM, KITTI, EuRoC or ertools CSV text trajectory. offset: seconds added to the robot's stamps to put them on the GT clock
 (negative when the robot's clock runs ahead). exit status: 0 scored, 1 unusable data, 2 usage
 error.
 """
