@@ -266,8 +266,9 @@ EPILOG = """examples:
       --gt-topic /fbm2h/robot_at_home/pose     # one bag holding both topics (evo's bag mode)
 
 ROBOT_BAG is the robot's log; GT_PATH: GT bags or folders of them (none: the GT topic is in
-ROBOT_BAG itself). Either may be a TUM, KITTI, EuRoC or ertools CSV text trajectory. offset: seconds added to the robot's stamps to put them on the GT clock
-(negative when the robot's clock runs ahead). exit status: 0 scored, 1 unusable data, 2 usage
+ROBOT_BAG itself). Either may be a TUM, KITTI, EuRoC or ertools CSV text trajectory.
+offset: seconds added to the robot's stamps to put them on the GT clock (negative when the
+robot's clock runs ahead). exit status: 0 scored, 1 unusable data, 2 usage
 error.
 """
 
