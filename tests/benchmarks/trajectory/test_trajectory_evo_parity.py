@@ -84,12 +84,19 @@ def assert_same(ours: dict[str, Any], n: int, stats: dict[str, float]) -> None:
 EVO_LINE = ("--association", "nearest", "--t-max-diff", "0.01")
 
 
-def test_ros1_bag_as_evo_ape_bag(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+@pytest.mark.parametrize(
+    ("gt", "robot"),
+    [("groundtruth", "ORB-SLAM"), ("ORB-SLAM", "groundtruth"), ("groundtruth", "S-PTAM")],
+    ids=["robot-shorter", "gt-shorter", "s-ptam"],
+)
+def test_ros1_bag_as_evo_ape_bag(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], gt: str, robot: str
+) -> None:
+    """evo starts from the trajectory with fewer poses: the robot's (ORB-SLAM, 8362 poses
+    against 12765), or the GT's when the roles are swapped."""
     bag = _evo_data("ROS_example.bag")
-    n, stats = evo_ape(tmp_path, "bag", str(bag), "groundtruth", "ORB-SLAM")
-    ours = ertools_json(
-        capsys, str(bag), "--robot-topic", "ORB-SLAM", "--gt-topic", "groundtruth", *EVO_LINE
-    )
+    n, stats = evo_ape(tmp_path, "bag", str(bag), gt, robot)
+    ours = ertools_json(capsys, str(bag), "--robot-topic", robot, "--gt-topic", gt, *EVO_LINE)
     assert_same(ours, n, stats)
     # Every robot pose is either in one of evo's pairs or said to be left out.
     assert ours["compared"] + ours["unpaired"] + ours["uncovered"] == ours["robot_poses"]
