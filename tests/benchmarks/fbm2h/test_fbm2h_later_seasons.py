@@ -114,3 +114,24 @@ def test_erl_rsbb_goal_config(
     got, err = _score(capsys, fbm2h_sample, Path(t), "--goal", str(path))
     _same_score(want, got)
     assert "erl-rsbb" in json.dumps(got) + err
+
+
+def test_erl_rsbb_items_list_reads_as_a_vanilla_list(tmp_path: Path) -> None:
+    """The RSBB's objects_informations/items_list.yaml (id, class, instance, description):
+    the items named, no poses yet (what `ertools acquire items` fills in)."""
+    from ertools.configs.items import load_items
+    from ertools.errors import ConfigError
+
+    path = tmp_path / "items_list.yaml"
+    path.write_text(
+        '\nitems:\n- class: a\n  id: 1\n  instance: a1\n  description: "Grey mug"\n  \n'
+        '- class: b\n  id: 5\n  instance: b1\n  description: "Knife"\n'
+    )
+    items = load_items(path, require_transforms=False)
+    assert [(i.id, i.item_class, i.instance) for i in items.items] == [
+        (1, "a", "a1"),
+        (5, "b", "b1"),
+    ]
+    assert items.is_vanilla
+    with pytest.raises(ConfigError, match="acquire items"):
+        load_items(path)
