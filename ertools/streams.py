@@ -61,6 +61,9 @@ class PoseStream:
         source: where it came from, e.g. ``file.bag:/fbm3w/robot_at_work/pose``.
         frame_changes: where the messages' frame names changed (``frame_id`` and
             ``child_frame_id`` above are the first ones); empty for a consistent topic.
+        t_s: (N,) float64 seconds as a text trajectory wrote them (TUM, EuRoC), None for a
+            bag (ROS's ``sec + nanosec * 1e-9`` of ``t_ns``): evo compares these floats, so
+            ``--t-max-diff`` does too (:func:`float_seconds`).
     """
 
     t_ns: I64
@@ -70,6 +73,7 @@ class PoseStream:
     child_frame_id: str = ""
     source: str = ""
     frame_changes: tuple[FrameChange, ...] = ()
+    t_s: F64 | None = None
 
     def __post_init__(self) -> None:
         n = self.t_ns.shape[0]
@@ -78,6 +82,8 @@ class PoseStream:
                 f"PoseStream shapes disagree: t_ns {self.t_ns.shape}, xyz {self.xyz.shape}, "
                 f"quat_xyzw {self.quat_xyzw.shape}"
             )
+        if self.t_s is not None and self.t_s.shape != (n,):
+            raise ValueError(f"PoseStream t_s has shape {self.t_s.shape}, not ({n},)")
 
     def __len__(self) -> int:
         return int(self.t_ns.shape[0])
@@ -109,6 +115,7 @@ class PoseStream:
             # Absolute times: still true of the subset (a change outside it is still a change
             # of the topic the subset came from).
             self.frame_changes,
+            None if self.t_s is None else self.t_s[index],
         )
 
     def window(self, start_ns: int | None, end_ns: int | None) -> PoseStream:
@@ -136,6 +143,21 @@ class PoseStream:
             child_frame_id,
             source,
         )
+
+
+def float_seconds(stream: PoseStream) -> F64:
+    """The stamps as float64 seconds, computed as evo computes them from the same source.
+
+    A text trajectory keeps the floats its text parses to (evo reads the same text); a bag's
+    stamps are ``sec + nanosec * 1e-9`` (evo's reading of a ROS header), which can differ by a
+    unit in the last place from ``t_ns / 1e9``: at an exact tie or an exact ``max_diff`` that
+    unit decides the pair.
+    """
+    if stream.t_s is not None:
+        return stream.t_s
+    sec, nsec = np.divmod(stream.t_ns, 1_000_000_000)
+    out: F64 = sec.astype(np.float64) + nsec.astype(np.float64) * 1e-9
+    return out
 
 
 @dataclass(frozen=True, eq=False)

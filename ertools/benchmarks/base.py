@@ -223,6 +223,8 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
         logs_are_bags: its logs are ROS1 bags, rosbag2 bags or MCAP files, which the
             manifest's ``--check`` verifies of every listed one; False for a benchmark that
             reads other files.
+        logs_may_be_text: it also reads text trajectories (TUM, KITTI, EuRoC, ertools CSV),
+            which ``--check`` accepts beside bags.
         inputs: every value it takes besides its bags (see :class:`Input`).
         make_options: the values by :attr:`Input.name` (missing ones at their defaults) ->
             validated options; raises :class:`~ertools.errors.UsageError` (exit 2) or
@@ -284,6 +286,7 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
     bags_help: str = "log file(s)"
     gt_only: Callable[[Sequence[Path]], Mapping[str, Any] | str] | None = None
     logs_are_bags: bool = True
+    logs_may_be_text: bool = False
 
     def score(self, bags: Sequence[Path], options: OptionsT) -> ResultT:
         """The whole shape: load -> find runs -> score."""

@@ -20,14 +20,14 @@ from ertools.cli.options import (
     add_pose_source,
     add_time_source,
     deprecated,
+    non_negative,
     pose_spec,
     positive,
     seconds_or_auto,
-    time_source,
 )
 from ertools.cli.output import note, write_text
 from ertools.errors import UsageError
-from ertools.export.formats import FORMATS, format_times
+from ertools.export.formats import FORMATS, format_poses, format_times
 from ertools.export.pairs import (
     KITTI_NEEDS_MATCHED,
     export_source,
@@ -36,6 +36,8 @@ from ertools.export.pairs import (
     trajectory_pair,
     write_pair,
 )
+from ertools.geometry import Association
+from ertools.io.text import INPUT_FORMATS, TextFormat, is_text_trajectory, read_text_poses
 from ertools.timeutil import iso_utc, ns_to_s, s_to_ns
 
 EPILOG = """examples:
@@ -64,6 +66,13 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     # A file format (what the file holds), not the printing format of the other commands.
     parser.add_argument("--format", choices=FORMATS, default="tum", help="file format (tum)")
+    parser.add_argument(
+        "--input-format",
+        choices=INPUT_FORMATS,
+        default=None,
+        help="read the inputs as this (default: detected by content): a TUM, KITTI, EuRoC or "
+        "ertools CSV text trajectory, or a bag",
+    )
     one = parser.add_argument_group("one pose source")
     add_pose_source(one, what="the poses")
     add_time_source(one)
@@ -89,11 +98,19 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     pair.add_argument(
         "--association",
         choices=("linear", "nearest", "hold"),
-        default="linear",
-        help="GT pose at a robot time with --matched (default linear)",
+        default=None,
+        help="GT pose at a robot time with --matched (default linear; nearest with --t-max-diff)",
     )
     pair.add_argument(
         "--max-gap", type=positive, default=0.1, metavar="S", help="as in `score trajectory`"
+    )
+    pair.add_argument(
+        "--t-max-diff",
+        type=non_negative,
+        default=None,
+        metavar="S",
+        help="evo's pairs (`evo_ape ... --t_max_diff S`; implies --association nearest), as "
+        "in `score trajectory`",
     )
     pair.add_argument(
         "--offset",
@@ -112,8 +129,9 @@ PAIR_ONLY = {
     "matched": False,
     "robot_topic": None,
     "gt_topic": None,
-    "association": "linear",
+    "association": None,
     "max_gap": 0.1,
+    "t_max_diff": None,
     "offset": 0.0,
     "apply_offset": False,
     "allow_partial": False,
@@ -141,6 +159,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run_one(args: argparse.Namespace) -> int:
+    kinds = [is_text_trajectory(p, args.input_format) for p in args.bags]
+    if any(kinds):
+        return _run_text(args, kinds)
     if args.topic is None and args.tf is None:
         raise UsageError("give --topic TOPIC or --tf PARENT:CHILD (or --out-dir for the pair)")
     if args.times is not None and args.format != "kitti":
@@ -162,6 +183,27 @@ def _run_one(args: argparse.Namespace) -> int:
     return 0
 
 
+def _run_text(args: argparse.Namespace, kinds: list[TextFormat | None]) -> int:
+    """One text trajectory (TUM, KITTI, EuRoC, ertools CSV) converted to --format."""
+    if len(args.bags) != 1 or kinds[0] is None:
+        raise UsageError("a text trajectory is exported on its own: give one file")
+    if args.topic is not None or args.tf is not None or args.time_source is not None:
+        raise UsageError(
+            f"{args.bags[0]} is a {kinds[0].upper()} text trajectory: --topic, --tf and "
+            "--time-source are for bags"
+        )
+    if args.times is not None and args.format != "kitti":
+        raise UsageError(f"--times is for --format kitti ({args.format} files hold the times)")
+    outputs = [p for p in (args.out, args.times) if p is not None]
+    refuse_inputs(outputs, list(args.bags))
+    stream = read_text_poses(args.bags[0], kinds[0])
+    write_text(format_poses(stream, args.format), args.out)
+    if args.times is not None:
+        write_text(format_times(stream), args.times)
+    note(f"{len(stream)} poses from {stream.source} ({kinds[0].upper()})")
+    return 0
+
+
 def _run_pair(args: argparse.Namespace) -> int:
     auto = args.offset == "auto"
     if args.apply_offset and not auto:
@@ -169,22 +211,35 @@ def _run_pair(args: argparse.Namespace) -> int:
     if args.format == "kitti" and not args.matched:
         raise UsageError(KITTI_NEEDS_MATCHED)
     refuse_inputs(list(pair_paths(args.out_dir, args.format).values()), list(args.bags))
+    association: Association = args.association or (
+        "nearest" if args.t_max_diff is not None else "linear"
+    )
     config = TrajectoryConfig(
-        association=args.association,
+        association=association,
         max_gap_ns=s_to_ns(args.max_gap),
         offset_ns=0 if auto else s_to_ns(float(args.offset)),
         auto_offset=auto,
         apply_offset=bool(args.apply_offset),
         allow_partial=bool(args.allow_partial),
+        t_max_diff=args.t_max_diff,
     )
     robot_bag, *gt_paths = args.bags
+    both = args.time_source
+    robot_time = getattr(args, "robot_time_source", None)
+    if both is not None and robot_time is not None and both != robot_time:
+        raise UsageError(
+            f"--time-source {both} sets the robot's time too: it cannot take "
+            f"--robot-time-source {robot_time}"
+        )
     pair = trajectory_pair(
         robot_bag,
         gt_paths,
         config,
         robot_topic=args.robot_topic,
         gt_topic=args.gt_topic,
-        robot_time=time_source(args, "robot-"),
+        robot_time=robot_time or both or "header",
+        gt_time=both or "header",
+        input_format=args.input_format,
         matched=bool(args.matched),
     )
     written = write_pair(pair, args.out_dir, args.format)

@@ -2,7 +2,9 @@
 
 The same YAML is both the config file (``goal:`` at the top) and the payload of the BmBox's
 first TRANSMITTING_GOAL message (the 2015 node dumped the ``goal`` parameter itself, so the
-payload has no ``goal:`` key). :func:`parse_goal` accepts both.
+payload has no ``goal:`` key). :func:`parse_goal` accepts both, and the ERL 2016-19 RSBB's
+benchmark config (``benchmark_configs/HNF.yaml``: ``starting_pose``, ``waypoints`` and
+``goal_timeout`` at the top level, no ``goal:``); :attr:`GoalList.layout` says which was read.
 """
 
 from __future__ import annotations
@@ -30,6 +32,8 @@ class GoalList:
         penalty_time: seconds, passed to the RefBox only (None when absent).
         timeout_time: seconds, passed to the RefBox only (None when absent).
         source: the file or payload it came from.
+        layout: ``listing-10`` (the seed's, or its payload) or ``erl-rsbb`` (a later
+            season's HNF config; its ``goal_timeout`` is the per-waypoint timeout).
     """
 
     waypoints: tuple[Pose2, ...]
@@ -37,6 +41,7 @@ class GoalList:
     penalty_time: float | None = None
     timeout_time: float | None = None
     source: str = ""
+    layout: str = "listing-10"
 
     def __len__(self) -> int:
         return len(self.waypoints)
@@ -72,6 +77,10 @@ def parse_goal(data: Any, source: str = "<goal>") -> GoalList:
     """Validate a parsed goal list (with or without the top-level ``goal:`` key)."""
     if isinstance(data, dict) and "goal" in data:
         data = data["goal"]
+    layout = "listing-10"
+    if isinstance(data, dict) and "goal_timeout" in data and "timeout_time" not in data:
+        layout = "erl-rsbb"
+        data = {**data, "timeout_time": data["goal_timeout"]}
     if not isinstance(data, dict):
         raise ConfigError(
             "goal list: expected a mapping with 'waypoints' (Listing 10)", path=source
@@ -95,6 +104,7 @@ def parse_goal(data: Any, source: str = "<goal>") -> GoalList:
         penalty_time=_optional_number(data, "penalty_time", source),
         timeout_time=_optional_number(data, "timeout_time", source),
         source=source,
+        layout=layout,
     )
 
 

@@ -6,6 +6,19 @@ acquirer wrote it as tf's ``lookupTransform("/robot_markerset", "/world")`` with
 standing on the world origin, which is that same transform. ``robot_to_marker_transform`` is
 its inverse; the 2015 files also carry extra keys (``mocap``, ``robot_pose``,
 ``marker_to_robot_transform_2D``) that the benchmark never read and that are ignored here.
+
+Three layouts are read (:data:`LAYOUTS`), and the transform says which one it came from:
+
+- ``listing-11``: the seed's Listing 11 (``robot_info``, ``marker_to_robot_transform``, ...).
+- ``erl-rsbb``: the ERL 2016-19 RSBB acquirer's ``yaml.dump`` of tf's lookups:
+  ``team_name``, ``markerset_to_robot_transform: !!python/tuple [[x, y, z], [qx, qy, qz, qw]]``
+  (the same lookup as 2015's, ``/robot_markerset`` -> origin, so the same transform) and
+  ``robot_to_markerset_transform``, its inverse.
+- ``pose-dump``: a rosparam dump of a ``geometry_msgs/Pose`` under ``pose:`` (``position``
+  x/y/z, ``orientation`` x/y/z/w), as some 2015 teams' files were: the marker-to-robot pose.
+
+The ``!!python/tuple`` tag is read by a safe loader that builds a plain list: no Python
+object is ever constructed from a file.
 """
 
 from __future__ import annotations
@@ -18,6 +31,7 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+import yaml
 
 from ertools.configs._yaml import load_yaml, number
 from ertools.errors import ConfigError
@@ -33,6 +47,7 @@ QUAT_NORM_TOLERANCE = 1e-3
 INVERSE_TOLERANCE_M = 1e-3
 INVERSE_TOLERANCE_RAD = 1e-3
 
+LAYOUTS = ("listing-11", "erl-rsbb", "pose-dump", "identity")
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
 
@@ -47,6 +62,7 @@ class MarkerTransform:
         translation: (x, y, z) metres, robot origin in the marker frame.
         quat_xyzw: orientation of the robot in the marker frame (unit, scalar last).
         source: the file, or ``<identity>`` when none was given.
+        layout: which of :data:`LAYOUTS` the file was written in.
     """
 
     robot_info: str
@@ -54,6 +70,14 @@ class MarkerTransform:
     translation: Vec3
     quat_xyzw: Quat
     source: str = ""
+    layout: str = "listing-11"
+
+    @property
+    def described(self) -> str:
+        """The source and, for a file not in the seed's Listing 11, its layout."""
+        if self.layout in ("listing-11", "identity"):
+            return self.source
+        return f"{self.source} ({self.layout} layout)"
 
     @property
     def is_identity(self) -> bool:
@@ -88,7 +112,9 @@ def _quat(a: Any) -> Quat:
 
 def identity_transform() -> MarkerTransform:
     """Listing 12: the marker set sits on the odometric centre."""
-    return MarkerTransform("identity", "0", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0), "<identity>")
+    return MarkerTransform(
+        "identity", "0", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0), "<identity>", "identity"
+    )
 
 
 def _numbers(value: Any, n: int, what: str, source: str) -> list[float]:
@@ -123,16 +149,55 @@ def _pair(data: dict[str, Any], key: str, source: str) -> tuple[Vec3, Quat]:
     return _vec3(t), _quat(q / norm)
 
 
+def _from_pose_dump(pose: Any, source: str) -> dict[str, Any]:
+    """A rosparam ``pose:`` dump as the Listing 11 mapping it stands for."""
+    if not isinstance(pose, dict):
+        raise ConfigError("pose: expected position and orientation mappings", path=source)
+    pos, ori = pose.get("position"), pose.get("orientation")
+    if not isinstance(pos, dict) or not isinstance(ori, dict):
+        raise ConfigError(
+            "pose: expected 'position' (x, y, z) and 'orientation' (x, y, z, w)", path=source
+        )
+    missing = [f"position.{k}" for k in "xyz" if k not in pos]
+    missing += [f"orientation.{k}" for k in "xyzw" if k not in ori]
+    if missing:
+        raise ConfigError(f"pose: missing {', '.join(missing)}", path=source)
+    return {
+        "marker_to_robot_transform": [[pos[k] for k in "xyz"], [ori[k] for k in "xyzw"]],
+    }
+
+
+def _layout(data: dict[str, Any], source: str) -> tuple[str, dict[str, Any]]:
+    """(layout, the mapping in Listing 11 keys) of a parsed transform file."""
+    if "marker_to_robot_transform" in data:
+        return "listing-11", data
+    if "markerset_to_robot_transform" in data:
+        out: dict[str, Any] = {
+            "robot_info": data.get("team_name", data.get("robot_info", "")),
+            "transform_timestamp": data.get("transform_timestamp", ""),
+            "marker_to_robot_transform": data["markerset_to_robot_transform"],
+        }
+        if "robot_to_markerset_transform" in data:
+            out["robot_to_marker_transform"] = data["robot_to_markerset_transform"]
+        return "erl-rsbb", out
+    if "pose" in data:
+        out = _from_pose_dump(data["pose"], source)
+        out["robot_info"] = data.get("robot_info", data.get("team_name", ""))
+        out["transform_timestamp"] = data.get("transform_timestamp", "")
+        return "pose-dump", out
+    raise ConfigError(
+        "transform file: no marker_to_robot_transform (Listing 11), "
+        "markerset_to_robot_transform (ERL RSBB) or pose (rosparam dump); keys found: "
+        f"{', '.join(map(str, data)) or 'none'}",
+        path=source,
+    )
+
+
 def parse_transform(data: Any, source: str = "<transform>") -> MarkerTransform:
-    """Validate a parsed Listing 11/12 mapping."""
+    """Validate a parsed transform mapping: Listing 11/12, ERL RSBB or a ``pose:`` dump."""
     if not isinstance(data, dict):
         raise ConfigError("transform file: expected a mapping (Listing 11)", path=source)
-    if "marker_to_robot_transform" not in data and "pose" in data:
-        raise ConfigError(
-            "transform file: this is a 'pose:' dump, not the Listing 11 format "
-            "(marker_to_robot_transform); re-acquire with `ertools acquire transform`",
-            path=source,
-        )
+    layout, data = _layout(data, source)
     t, q = _pair(data, "marker_to_robot_transform", source)
     result = MarkerTransform(
         robot_info=str(data.get("robot_info", "")),
@@ -140,14 +205,55 @@ def parse_transform(data: Any, source: str = "<transform>") -> MarkerTransform:
         translation=t,
         quat_xyzw=q,
         source=source,
+        layout=layout,
     )
     if "robot_to_marker_transform" in data:
         t_inv, q_inv = _pair(data, "robot_to_marker_transform", source)
         _check_inverse(result, t_inv, q_inv, source)
-    for key in ("robot_info", "transform_timestamp"):
-        if key not in data:
-            log.warning("%s: transform file has no %r (Listing 11)", source, key)
+    if layout == "listing-11":
+        for key in ("robot_info", "transform_timestamp"):
+            if key not in data:
+                log.warning("%s: transform file has no %r (Listing 11)", source, key)
+    else:
+        log.info("%s: transform read in the %s layout", source, layout)
     return result
+
+
+class _TupleSafeLoader(yaml.SafeLoader):
+    """``yaml.SafeLoader`` that also reads ``!!python/tuple`` (PyYAML's dump of a tuple, as
+    the ERL RSBB acquirer wrote tf's lookups) as a plain list. Every other Python tag is
+    still refused: nothing is constructed but lists, mappings, strings and numbers."""
+
+
+def _tuple_as_list(loader: yaml.SafeLoader, node: yaml.Node) -> list[Any]:
+    if not isinstance(node, yaml.SequenceNode):
+        raise yaml.constructor.ConstructorError(
+            None, None, "!!python/tuple must tag a sequence", node.start_mark
+        )
+    return list(loader.construct_sequence(node, deep=True))
+
+
+_TupleSafeLoader.add_constructor("tag:yaml.org,2002:python/tuple", _tuple_as_list)
+
+
+def _load_transform_yaml(path: str | Path) -> Any:
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ConfigError("transform file not found", path=p) from None
+    except (OSError, UnicodeDecodeError) as err:
+        raise ConfigError(f"cannot read transform file: {err}", path=p) from err
+    if "!!python/tuple" not in text:
+        return load_yaml(p, "transform")  # the common loader, for the common files
+    try:
+        # A SafeLoader subclass: safe_load with one more tag, built as a list.
+        return yaml.load(text, Loader=_TupleSafeLoader)
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+        problem = getattr(err, "problem", None) or str(err).splitlines()[0]
+        raise ConfigError(f"malformed transform{where}: {problem}", path=p) from err
 
 
 def _check_inverse(tr: MarkerTransform, t_inv: Vec3, q_inv: Quat, source: str) -> None:
@@ -166,8 +272,8 @@ def _check_inverse(tr: MarkerTransform, t_inv: Vec3, q_inv: Quat, source: str) -
 
 
 def load_transform(path: str | Path) -> MarkerTransform:
-    """Read and validate a ``transform-<team>.yaml`` file."""
-    return parse_transform(load_yaml(path, "transform"), source=str(path))
+    """Read and validate a ``transform-<team>.yaml`` file (any of :data:`LAYOUTS`)."""
+    return parse_transform(_load_transform_yaml(path), source=str(path))
 
 
 def team_transform_path(directory: str | Path, team: str) -> Path:

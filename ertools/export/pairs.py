@@ -36,6 +36,7 @@ from ertools.benchmarks.trajectory.inputs import read_gt
 from ertools.errors import ClockError, ScoringError, UsageError
 from ertools.export.formats import SUFFIXES, ExportFormat, format_poses, format_times
 from ertools.geometry import interpolate_poses
+from ertools.io.text import is_text_trajectory, read_text_poses
 from ertools.streams import PoseStream
 
 log = logging.getLogger(__name__)
@@ -100,6 +101,8 @@ def trajectory_pair(
     robot_topic: str | None = None,
     gt_topic: str | None = None,
     robot_time: str = "header",
+    gt_time: str = "header",
+    input_format: str | None = None,
     matched: bool = False,
 ) -> PairExport:
     """The robot and GT streams ``score trajectory`` compares with these settings.
@@ -121,6 +124,8 @@ def trajectory_pair(
         robot_topic=robot_topic,
         gt_topic=gt_topic,
         robot_time=robot_time,
+        gt_time=gt_time,
+        input_format=input_format,
     )
     if result.uncovered and not config.allow_partial:
         # The score prints the covered part when the uncovered poses precede the GT (a
@@ -144,12 +149,31 @@ def trajectory_pair(
                 f"to export ({'; '.join(result.failures)})"
             )
         shifted = shifted.take(ok)
+        if m.gt_quat_xyzw is not None:
+            # evo's pairs (--t-max-diff): the GT pose of each pair as scored, at the robot's
+            # stamp, so that evo pairs the two files one to one.
+            gt_pairs = PoseStream(
+                shifted.t_ns, m.gt_xyz[ok], m.gt_quat_xyzw[ok], source=result.gt_topic
+            )
+            return PairExport(robot=shifted, gt=gt_pairs, matched=True, result=result)
         # Every compared pose has GT samples around it within max_gap: this window holds them.
         margin = config.max_gap_ns + RAW_GT_MARGIN_NS
         lo, hi = shifted.start_ns - margin, shifted.end_ns + margin
     else:
         lo, hi = int(m.t_ns.min()) - RAW_GT_MARGIN_NS, int(m.t_ns.max()) + RAW_GT_MARGIN_NS
-    gt = read_gt(list(result.gt_files), result.gt_topic, lo, hi)
+    gt_kind = (
+        is_text_trajectory(result.gt_files[0], input_format) if len(result.gt_files) == 1 else None
+    )
+    if gt_kind is not None:
+        whole = read_text_poses(result.gt_files[0], gt_kind)
+        gt = whole.take(np.argsort(whole.t_ns, kind="stable")).window(lo, hi)
+    else:
+        files = list(result.gt_files)
+        gt = read_gt(files, result.gt_topic, lo, hi, time_source=gt_time)
+        if len(gt) < 2:
+            # Header stamps on another clock than the record times (simulation time): the
+            # record-time prefilter finds nothing; the score read them without it.
+            gt = read_gt(files, result.gt_topic, lo, hi, time_source=gt_time, prefilter=False)
     gt, _ = drop_duplicates(gt)
     gt, _ = drop_invalid(gt)
     if matched:

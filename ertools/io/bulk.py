@@ -130,6 +130,17 @@ class _Assembler:
         return batch
 
 
+def mcap_index(bag: BagFile) -> McapIndex | None:
+    """The MCAP index of a standalone MCAP file or of a rosbag2-mcap directory's storage
+    files (decompressed when the bag is compressed file by file), None for other formats."""
+    if bag.format == "rosbag2-mcap":
+        # lazy: PyYAML only for rosbag2 folders
+        from ertools.io.rosbag2.metadata import readable_files
+
+        return McapIndex([f for f in readable_files(bag.path) if f.suffix == ".mcap"])
+    return McapIndex.of(bag)
+
+
 def _label(bag: BagFile, conns: Sequence[Conn]) -> str:
     topic = conns[0].topic if conns else "?"
     return f"reading {topic} from {bag.path.name}"
@@ -142,7 +153,7 @@ def _mcap_runs(
     hi: int | None,
     progress: Reporter | None = None,
 ) -> Located | None:
-    index = McapIndex.of(bag)
+    index = mcap_index(bag)
     if index is None:
         return None
     plan = index.plan(conns, lo, hi)
@@ -247,7 +258,7 @@ def load_all_chunks(bag: BagFile, progress: Reporter | None = None) -> int:
         ):
             total += int(sizes.sum())
         return total
-    index = McapIndex.of(bag)
+    index = mcap_index(bag)
     if index is None:
         raise BagError(f"no chunks to load in a {bag.format} file", path=bag.path)
     jobs = index.all_chunks()

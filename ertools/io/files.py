@@ -78,7 +78,11 @@ class RosbagsFile(BagFile):
                 # lazy: rosbags only on the per-message path (~0.1 s to import)
                 from rosbags.rosbag2 import Reader as Reader2
 
-                self._reader = Reader2(path)
+                # lazy: PyYAML only for rosbag2 folders
+                from ertools.io.rosbag2.metadata import readable_dir
+
+                # A bag compressed file by file: the copies every other reader reads.
+                self._reader = Reader2(readable_dir(path))
             self._reader.open()
         except Exception as err:
             # rosbags raises assorted errors (ReaderError, struct.error, AssertionError...) on

@@ -174,9 +174,17 @@ def detect_format(path: str | Path) -> str:
     if head[: len(MCAP_MAGIC)] == MCAP_MAGIC:
         return "mcap"
     # What the file holds is not said: it may be anything (a path to /etc/passwd), and this
-    # line reaches results.json and the published pages.
+    # line reaches results.json and the published pages. Whether it is text is said: a text
+    # trajectory given where a bag is expected.
+    text = all(32 <= b < 127 or b in (9, 10, 13) for b in head)
     raise BagError(
         "not a ROS1 bag, rosbag2 bag or MCAP file: it does not begin with '#ROSBAG V2.0' "
-        "(ROS1) or MCAP's magic bytes",
+        "(ROS1) or MCAP's magic bytes"
+        + (
+            "; a text file: TUM, KITTI and EuRoC trajectories are read by `score trajectory` "
+            "and `export`"
+            if text
+            else ""
+        ),
         path=p,
     )

@@ -152,13 +152,16 @@ def verify(path: Path, progress: Reporter | None = None) -> list[str]:
         finally:
             bag.close()
     elif fmt in ("mcap", "rosbag2-mcap"):
-        for file in [path] if fmt == "mcap" else sorted(path.glob("*.mcap")):
+        # lazy: PyYAML only for rosbag2 folders
+        from ertools.io.rosbag2.metadata import readable_files
+
+        for file in [path] if fmt == "mcap" else readable_files(path):
             verify_mcap(file, progress)
     else:
         # lazy: sqlite3 and PyYAML only for rosbag2 folders
-        from ertools.io.rosbag2.metadata import query, read_metadata, storage_files
+        from ertools.io.rosbag2.metadata import query, readable_files
 
-        for db in storage_files(path, read_metadata(path)):
+        for db in readable_files(path):
             result = query(db, "PRAGMA quick_check")[0][0]
             if result != "ok":
                 raise BagError(f"sqlite3 storage fails its integrity check ({result})", path=db)

@@ -415,7 +415,7 @@ def _mcap(path: Path, exact: bool, times: Times | None = None) -> BagSummary:
 
 def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagSummary:
     # lazy: sqlite3 and PyYAML only for rosbag2 folders
-    from ertools.io.rosbag2.metadata import read_metadata, storage_files
+    from ertools.io.rosbag2.metadata import read_metadata, readable_files, storage_files
 
     info = read_metadata(path)
     problems = []
@@ -423,6 +423,8 @@ def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> B
     missing = [f.name for f in files if not f.exists()]
     if missing:
         problems.append(f"storage file(s) listed in metadata.yaml missing: {', '.join(missing)}")
+    else:
+        files = readable_files(path, info)
     topics: dict[str, tuple[str, int, int | None, int | None, int]] = {}
     inner: set[str] = set()
     used: set[str] = set()
@@ -534,13 +536,13 @@ def record_times(path: str | Path) -> dict[str, I64]:
     elif fmt in ("mcap", "rosbag2-mcap"):
         # the same choice as the summary: message indexes where they cover every message,
         # else the records themselves
-        for file in [p] if fmt == "mcap" else sorted(p.glob("*.mcap")):
+        for file in [p] if fmt == "mcap" else _mcap_files(p):
             _mcap_file(file, True, parts)
     else:
         # lazy: sqlite3 and PyYAML only for rosbag2 folders
-        from ertools.io.rosbag2.metadata import query, read_metadata, storage_files
+        from ertools.io.rosbag2.metadata import query, readable_files
 
-        for db in storage_files(p, read_metadata(p)):
+        for db in readable_files(p):
             rows = query(
                 db,
                 "SELECT topics.name, timestamp FROM messages "
@@ -552,3 +554,12 @@ def record_times(path: str | Path) -> dict[str, I64]:
             for name, ts in by.items():
                 parts[name].append(np.array(ts, dtype=np.int64))
     return {k: np.sort(np.concatenate(v)) for k, v in parts.items()}
+
+
+def _mcap_files(path: Path) -> list[Path]:
+    """The MCAP storage files of a rosbag2 directory, readable (decompressed when the bag is
+    compressed file by file)."""
+    # lazy: PyYAML only for rosbag2 folders
+    from ertools.io.rosbag2.metadata import readable_files
+
+    return [f for f in readable_files(path) if f.suffix == ".mcap"]

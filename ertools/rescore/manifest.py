@@ -40,6 +40,7 @@ from ertools.benchmarks.base import Benchmark, Input
 from ertools.configs._yaml import MAX_SECONDS, number, parse_yaml, show
 from ertools.errors import BagError, ConfigError
 from ertools.io.formats import detect_format
+from ertools.io.text import sniff
 from ertools.timeutil import s_to_ns
 
 VERSION = 1
@@ -376,6 +377,8 @@ class _Checker:
         try:
             detect_format(path)
         except BagError as err:
+            if bm.logs_may_be_text and sniff(path) is not None:
+                return path  # a TUM, KITTI, EuRoC or ertools CSV trajectory
             self.problem(where, err.message)
             return _BAD
         return path

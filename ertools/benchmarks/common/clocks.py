@@ -403,6 +403,9 @@ def estimate_offset(
         )
     mean_err = float(np.mean(row_norm(r)))
     sigma = _bootstrap_sigma(t_used, r, v, seed)
+    if not np.isfinite(sigma):
+        # Too few blocks for the bootstrap (a short log, or stamps 1 s apart as KITTI's rows).
+        return none("too few poses for the offset's uncertainty", used)
     return OffsetEstimate(
         offset_ns, round(sigma * NS_PER_S), search_range_ns, used, mean_err, zero, "; ".join(notes)
     )
@@ -445,4 +448,6 @@ def _bootstrap_sigma(t_ns: I64, r: F64, v: F64, seed: int) -> float:
     draws = rng.integers(0, nb, size=(BOOTSTRAP_DRAWS, nb))
     num, den = a[draws].sum(axis=1), b[draws].sum(axis=1)
     ok = den > 0
+    if not ok.any():
+        return float("nan")  # no draw with any speed: the caller reports no estimate
     return float(np.std(num[ok] / den[ok]))

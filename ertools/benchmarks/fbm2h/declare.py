@@ -216,8 +216,13 @@ def notes(result: Fbm2hResult) -> list[str]:
     if logging.getLogger("ertools").isEnabledFor(logging.INFO):  # -v
         out += list(result.notes)
     out.append(
-        f"reached moments: {result.reached_method}; transform: {result.transform.source}; "
-        "times from the log's first message"
+        f"reached moments: {result.reached_method}; transform: {result.transform.described}; "
+        + (
+            f"goal: {result.goal.source} ({result.goal.layout} layout); "
+            if result.goal.layout != "listing-10"
+            else ""
+        )
+        + "times from the log's first message"
     )
     n = len(result.segments)
     scored = sum(s.status == "ok" for s in result.segments)

@@ -1,5 +1,6 @@
 """Each robot pose paired with the GT (hold | nearest | linear), with its status: compared, in a GT
-gap, while mocap tracking was lost (repeated GT poses), or outside the GT.
+gap, while mocap tracking was lost (repeated GT poses), or outside the GT. Or evo's pairing
+(:func:`associate_evo`, ``--t-max-diff``): nearest stamps within a limit, nothing else.
 
 Also :func:`yaw_tf`, the yaw as the 2015 script computed it (tf.transformations' arithmetic).
 """
@@ -25,8 +26,8 @@ from ertools.geometry import (
 from ertools.streams import PoseStream
 
 # Per-pose status codes of the association.
-COMPARED, GAP, TRACKING_LOST, UNCOVERED = 0, 1, 2, 3
-STATUS_NAMES = ("compared", "gap", "tracking_lost", "uncovered")
+COMPARED, GAP, TRACKING_LOST, UNCOVERED, UNPAIRED = 0, 1, 2, 3, 4
+STATUS_NAMES = ("compared", "gap", "tracking_lost", "uncovered", "unpaired")
 
 
 @dataclass(frozen=True, eq=False)
@@ -45,6 +46,11 @@ class Matched:
         across_gap: (N,) the robot pose lies in a GT gap longer than the max gap (compared
             or not, as the ``gaps`` setting says).
         before_gt: robot poses before the first GT pose.
+        gt_quat_xyzw: (N, 4) the GT orientation of each compared row (NaN otherwise), kept
+            by :func:`associate_evo`, whose pairs cannot be recomputed from the robot times
+            alone (None for the other associations).
+        robot_rows: with :func:`associate_evo`, the robot pose of each row (a robot pose
+            that evo pairs with two GT poses is two rows); None: row i is robot pose i.
     """
 
     t_ns: I64
@@ -57,6 +63,8 @@ class Matched:
     exact_ties: int
     across_gap: npt.NDArray[np.bool_]
     before_gt: int
+    gt_quat_xyzw: F64 | None = None
+    robot_rows: npt.NDArray[np.intp] | None = None
 
     def count(self, status: int) -> int:
         return int(np.count_nonzero(self.status == status))
@@ -235,6 +243,101 @@ def _matched(
     raw = np.where(ok, yaw_tf(robot.quat_xyzw) - yaw_tf(gt_quat_at), np.nan)
     return Matched(
         q, status, gt_xyz, gt_yaw, pos_err, yaw_err, raw, ties_n, across, int(early.sum())
+    )
+
+
+def evo_matches(
+    short_s: F64, long_s: F64, max_diff_s: float
+) -> tuple[npt.NDArray[np.intp], npt.NDArray[np.intp]]:
+    """evo's ``matching_time_indices`` for sorted ``long_s``, vectorised: for each stamp of
+    ``short_s`` the nearest stamp of ``long_s`` (the later one only when strictly nearer),
+    kept when at most ``max_diff_s`` away. Returns (indices into short, indices into long).
+
+    The same float64 operations in the same order as evo, so a tie or a difference of
+    exactly ``max_diff_s`` falls the same way. A long stamp can be the match of several
+    short stamps, as in evo.
+    """
+    n_long = len(long_s)
+    if n_long == 0 or len(short_s) == 0:
+        empty = np.empty(0, dtype=np.intp)
+        return empty, empty
+    considered = ~((short_s < long_s[0] - max_diff_s) | (short_s > long_s[-1] + max_diff_s))
+    idx = np.minimum(np.searchsorted(long_s, short_s, side="right"), n_long - 1)
+    diff_ub = long_s[idx] - short_s
+    prev = long_s[np.maximum(idx - 1, 0)]
+    diff_lb = np.where(idx > 0, short_s - prev, np.inf)
+    take_ub = (diff_ub <= max_diff_s) & (diff_ub < diff_lb)
+    take_lb = ~take_ub & (diff_lb <= max_diff_s) & (diff_lb <= diff_ub)
+    ok = considered & (take_ub | take_lb)
+    best = np.where(take_ub, idx, idx - 1)
+    return np.flatnonzero(ok), best[ok].astype(np.intp)
+
+
+def associate_evo(
+    robot: PoseStream,
+    gt: PoseStream,
+    robot_s: F64,
+    gt_s: F64,
+    max_diff_s: float,
+    offset_s: float,
+    offset_ns: int,
+) -> Matched:
+    """evo's ``associate_trajectories(gt, robot, max_diff, offset_2=offset)`` (what
+    ``evo_ape`` runs with ``--t_max_diff`` and ``--t_offset``): the trajectory with fewer poses
+    (the robot's on a tie) looks up the nearest stamp of the other, the offset added to the
+    robot's stamps (or subtracted from the GT's, whichever is looked up, as evo does).
+
+    Rows are robot poses, in time order; a robot pose is one row per pair it is in (evo
+    counts a robot pose the nearest of two GT poses twice), or one UNPAIRED row (no GT pose
+    within the limit, or, when the GT looks up, no GT pose chose it). Robot poses more than
+    the limit outside the GT's span are UNCOVERED. No gap or tracking-lost rule: evo has none.
+    """
+    if len(gt) == 0:
+        raise ScoringError("the GT stream is empty")
+    n_robot = len(robot)
+    if n_robot > len(gt):  # evo: second_longer, the GT looks up the robot
+        gi, ri = evo_matches(gt_s, robot_s + offset_s, max_diff_s)
+    else:
+        ri, gi = evo_matches(robot_s, gt_s + -offset_s, max_diff_s)
+    order = np.lexsort((gi, ri))
+    ri, gi = ri[order], gi[order]
+    per_robot = np.bincount(ri, minlength=n_robot)
+    rows = np.repeat(np.arange(n_robot, dtype=np.intp), np.maximum(per_robot, 1))
+    paired = np.repeat(per_robot > 0, np.maximum(per_robot, 1))
+    gt_row = np.full(len(rows), -1, dtype=np.intp)
+    gt_row[paired] = gi  # rows and pairs are both sorted by robot pose, then GT pose
+    t_ns = robot.t_ns.take(rows) + offset_ns
+    lo, hi = float(gt_s[0]), float(gt_s[-1])
+    shifted_s = robot_s.take(rows) + offset_s
+    outside = (shifted_s < lo - max_diff_s) | (shifted_s > hi + max_diff_s)
+    status = np.full(len(rows), UNPAIRED, dtype=np.uint8)
+    status[outside] = UNCOVERED
+    status[paired] = COMPARED
+    ok = paired
+    g = np.maximum(gt_row, 0)
+    nan3, nan4 = np.full((len(rows), 3), np.nan), np.full((len(rows), 4), np.nan)
+    gt_xyz = np.where(ok[:, None], _rows(gt.xyz, g), nan3)
+    gt_quat = np.where(ok[:, None], _rows(gt.quat_xyzw, g), nan4)
+    r_xyz, r_quat = _rows(robot.xyz, rows), _rows(robot.quat_xyzw, rows)
+    gt_yaw = np.where(ok, yaw_from_quat(np.where(ok[:, None], gt_quat, 0.0)), np.nan)
+    pos_err = np.where(ok, row_norm(r_xyz - np.where(ok[:, None], gt_xyz, 0.0)), np.nan)
+    yaw_err = np.abs(wrap_angle(np.where(ok, yaw_from_quat(r_quat) - gt_yaw, np.nan)))
+    safe_q = np.where(ok[:, None], gt_quat, r_quat)
+    raw = np.where(ok, yaw_tf(r_quat) - yaw_tf(safe_q), np.nan)
+    early = int(np.count_nonzero(outside & (shifted_s < lo)))
+    return Matched(
+        t_ns,
+        status,
+        gt_xyz,
+        gt_yaw,
+        pos_err,
+        yaw_err,
+        raw,
+        0,
+        np.zeros(len(rows), dtype=bool),
+        early,
+        gt_quat_xyzw=gt_quat,
+        robot_rows=rows,
     )
 
 

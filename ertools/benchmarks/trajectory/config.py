@@ -4,6 +4,7 @@ selects (:data:`SETTINGS_2015`).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -48,6 +49,9 @@ class TrajectoryConfig:
         gt_order: the GT poses of all files merged in time order (``time``), or the files
             chained by start time, each in record order, and scanned forward as 2015 did
             (``chain``; with ``hold`` and ``ties`` ``before`` only: 2015's scan).
+        t_max_diff: with ``nearest``, pair as evo does (``--t-max-diff``): the nearest stamp
+            within this many seconds, float seconds as evo compares them (its ``max_diff``);
+            ``max_gap_ns`` and the tracking-lost rule then do not apply. None: ertools' rule.
     """
 
     association: Association = "linear"
@@ -61,6 +65,7 @@ class TrajectoryConfig:
     gaps: Gaps = "skip"
     before_gt: BeforeGt = "uncovered"
     gt_order: GtOrder = "time"
+    t_max_diff: float | None = None
 
     def __post_init__(self) -> None:
         if self.association not in ASSOCIATIONS:
@@ -85,6 +90,20 @@ class TrajectoryConfig:
             raise ConfigError(
                 "--gt-order chain needs --association hold --ties before (2015's scan)"
             )
+        if self.t_max_diff is not None:
+            if self.association != "nearest":
+                raise ConfigError(
+                    f"--t-max-diff needs --association nearest (not {self.association}): "
+                    "it is evo's nearest-stamp pairing"
+                )
+            if not (math.isfinite(self.t_max_diff) and self.t_max_diff >= 0):
+                raise ConfigError(
+                    f"--t-max-diff must be a finite number of seconds >= 0, not {self.t_max_diff}"
+                )
+            if self.gaps != "skip" or self.before_gt != "uncovered":
+                raise ConfigError(
+                    "--t-max-diff pairs as evo does: --gaps and --before-gt do not apply"
+                )
         if self.max_gap_ns <= 0:
             raise ConfigError(f"--max-gap must be positive, not {self.max_gap_ns / NS_PER_S} s")
         if self.offset_range_ns <= 0:

@@ -29,6 +29,7 @@ from ertools.benchmarks.trajectory.config import (
 )
 from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.errors import ConfigError, UsageError
+from ertools.io.text import INPUT_FORMATS
 from ertools.timeutil import s_to_ns
 
 # Offsets beyond this (about 146 years) are not clock offsets; int64 nanoseconds hold them.
@@ -108,6 +109,15 @@ INPUTS = (
         positive=True,
     ),
     Input(
+        "t_max_diff",
+        "float",
+        "pair as evo does (`evo_ape ... --t_max_diff S`, evo's default 0.01; implies "
+        "--association nearest): each pose of the shorter trajectory with the nearest stamp "
+        "of the other within S seconds; --max-gap and the tracking-lost rule do not apply",
+        unit="s",
+        minimum=0.0,
+    ),
+    Input(
         "offset",
         "str",
         "shift the robot stamps by S seconds, or estimate the shift (auto)",
@@ -135,10 +145,25 @@ INPUTS = (
     Input(
         "robot_time_source",
         "choice",
-        "robot pose time: message stamp (default) or the robot bag's record time",
+        "robot pose time: message stamp (default) or the robot bag's record time (the GT "
+        "keeps --time-source)",
         old_flags=("--robot-time",),
-        default="header",
         choices=("header", "record"),
+    ),
+    Input(
+        "time_source",
+        "choice",
+        "the time robot and GT poses are selected and paired by: header stamps (default; "
+        "simulation time in a sim bag, as evo uses) or record times",
+        choices=("header", "record"),
+    ),
+    Input(
+        "input_format",
+        "choice",
+        "read every input as this (default: detected by content): a TUM, KITTI (paired row "
+        "by row, as evo_ape kitti), EuRoC ground-truth or ertools CSV text trajectory, or a "
+        "bag",
+        choices=INPUT_FORMATS,
     ),
 )
 
@@ -186,6 +211,8 @@ def make_options(given: Mapping[str, Any]) -> TrajectoryOptions:
         if clash:
             raise UsageError(f"--2015 sets {_2015_options()}; it cannot take {', '.join(clash)}")
         settings = dict(SETTINGS_2015)
+    if v["t_max_diff"] is not None and "association" not in settings:
+        settings["association"] = "nearest"  # evo's pairing is a nearest-stamp one
     if settings.get("ties") == "before" and settings.get("association") != "hold":
         raise UsageError("--ties before needs --association hold")
     try:
@@ -197,10 +224,25 @@ def make_options(given: Mapping[str, Any]) -> TrajectoryOptions:
             apply_offset=v["apply_offset"],
             offset_range_ns=s_to_ns(v["offset_range"]),
             allow_partial=v["allow_partial"],
+            t_max_diff=v["t_max_diff"],
         )
     except ConfigError as err:
         raise UsageError(err.message) from None
-    return TrajectoryOptions(config, v["robot_topic"], v["gt_topic"], v["robot_time_source"])
+    both = v["time_source"]
+    robot_time = v["robot_time_source"]
+    if both is not None and robot_time is not None and both != robot_time:
+        raise UsageError(
+            f"--time-source {both} sets the robot's time too: it cannot take "
+            f"--robot-time-source {robot_time}"
+        )
+    return TrajectoryOptions(
+        config,
+        v["robot_topic"],
+        v["gt_topic"],
+        robot_time or both or "header",
+        both or "header",
+        v["input_format"],
+    )
 
 
 def files(bags: Sequence[Path], options: TrajectoryOptions, result: TrajectoryResult) -> list[Path]:
@@ -226,12 +268,18 @@ EPILOG = """examples:
   ertools score trajectory robot.bag gt/ --association hold --gaps compare
   ertools score trajectory robot.bag gt/ --offset auto --apply-offset --format json
   ertools score trajectory robot.bag gt/log_0.bag gt/log_1.bag --offset -0.35 --plot figs/
+  ertools score trajectory ROS_example.bag --robot-topic ORB-SLAM --gt-topic groundtruth \\
+      --association nearest --t-max-diff 0.01
+      # the pairs and numbers of: evo_ape bag ROS_example.bag groundtruth ORB-SLAM
+  ertools score trajectory est.txt gt.txt --t-max-diff 0.01   # = evo_ape tum gt.txt est.txt
+  ertools score trajectory est_kitti.txt gt_kitti.txt     # = evo_ape kitti (row by row)
   ertools score trajectory both.bag --robot-topic /rockin/homer/marker_pose \\
       --gt-topic /fbm2h/robot_at_home/pose     # one bag holding both topics (evo's bag mode)
 
 ROBOT_BAG is the robot's log; GT_PATH: GT bags or folders of them (none: the GT topic is in
-ROBOT_BAG itself). offset: seconds added to the robot's stamps to put them on the GT clock
-(negative when the robot's clock runs ahead). exit status: 0 scored, 1 unusable data, 2 usage
+ROBOT_BAG itself). Either may be a TUM, KITTI, EuRoC or ertools CSV text trajectory.
+offset: seconds added to the robot's stamps to put them on the GT clock (negative when the
+robot's clock runs ahead). exit status: 0 scored, 1 unusable data, 2 usage
 error.
 """
 
@@ -250,6 +298,7 @@ robot's stamps and the GT clock and says when it matters.""",
     epilog=EPILOG,
     bags_help="the robot's log, then GT bags or folders of them (none: the GT topic is in "
     "ROBOT_BAG itself)",
+    logs_may_be_text=True,
     inputs=INPUTS,
     make_options=make_options,
     load=load,

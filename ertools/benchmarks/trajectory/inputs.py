@@ -53,6 +53,13 @@ def pick_robot_topic(s: BagSummary, topic: str | None) -> str:
 
 def read_robot(path: str, topic: str, time_source: str) -> PoseStream:
     """The robot's poses in recording order (not sorted: non-increasing stamps are errors)."""
+    return read_robot_clocks(path, topic, time_source)[0]
+
+
+def read_robot_clocks(path: str, topic: str, time_source: str) -> tuple[PoseStream, int]:
+    """:func:`read_robot`, and the median of (header stamp - record time) of its messages:
+    far from 0 in a bag recorded in simulation time (header stamps on the simulator's clock,
+    record times on the wall clock)."""
 
     with open_bag(path) as bag:
         conns = bag.topic_conns(topic)
@@ -87,7 +94,8 @@ def read_robot(path: str, topic: str, time_source: str) -> PoseStream:
             path=path,
         )
     t = batch.t_header if time_source == "header" else batch.t_record
-    return PoseStream(t, batch.xyz, batch.quat_xyzw, source=f"{path}:{topic}")
+    gap = int(np.median(batch.t_header - batch.t_record)) if len(batch) else 0
+    return PoseStream(t, batch.xyz, batch.quat_xyzw, source=f"{path}:{topic}"), gap
 
 
 def select_gt(
@@ -148,15 +156,26 @@ def select_gt(
     return with_topic, gt_topic, warnings
 
 
-def read_gt(files: Sequence[str], topic: str, start_ns: int, end_ns: int) -> PoseStream:
-    """GT poses with header stamps in [start_ns, end_ns], in one read of all the files.
+def read_gt(
+    files: Sequence[str],
+    topic: str,
+    start_ns: int | None,
+    end_ns: int | None,
+    time_source: str = "header",
+    prefilter: bool = True,
+) -> PoseStream:
+    """GT poses with stamps (``time_source``) in [start_ns, end_ns], in one read of all the
+    files. ``prefilter`` False: the window is not also applied to the record times while
+    reading (header stamps on another clock than the record times: simulation time).
 
     The reader streams a ROS1 bag's chunks into preallocated arrays: one read of an hour of
     120 Hz GT peaks at ~85 MiB (measured, docs/performance.md), so the 10-minute windows this
     once took (each re-reading 60 s of extra chunks at both ends) only cost time.
     """
 
-    return read_poses(files, topic, start_ns=start_ns, end_ns=end_ns)
+    if prefilter:
+        return read_poses(files, topic, time_source=time_source, start_ns=start_ns, end_ns=end_ns)
+    return read_poses(files, topic, time_source=time_source).window(start_ns, end_ns)
 
 
 def read_gt_chain(files: Sequence[str], topic: str) -> PoseStream:

@@ -17,6 +17,7 @@ from ertools.benchmarks.trajectory.association import (
     STATUS_NAMES,
     TRACKING_LOST,
     UNCOVERED,
+    UNPAIRED,
     Matched,
 )
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
@@ -82,6 +83,11 @@ class TrajectoryResult:
     def uncovered(self) -> int:
         return self.matched.count(UNCOVERED)
 
+    @property
+    def unpaired(self) -> int:
+        """Robot poses evo's association (``--t-max-diff``) left without a GT pose."""
+        return self.matched.count(UNPAIRED)
+
     def to_dict(self) -> dict[str, Any]:
         """Scores, counts and the clock audit (the keys scripts depend on come first)."""
         m = self.metrics
@@ -110,6 +116,8 @@ class TrajectoryResult:
             "partial": self.uncovered > 0,
             "uncovered_spans": [[ns_to_s(s), ns_to_s(e)] for s, e in self.uncovered_spans],
             "max_gap": ns_to_s(self.config.max_gap_ns),
+            "t_max_diff": self.config.t_max_diff,
+            "unpaired": self.unpaired,
             "robot_file": self.robot_file,
             "robot_topic": self.robot_topic,
             "gt_topic": self.gt_topic,

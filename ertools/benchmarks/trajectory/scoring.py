@@ -18,8 +18,10 @@ from ertools.benchmarks.trajectory.association import (
     GAP,
     TRACKING_LOST,
     UNCOVERED,
+    UNPAIRED,
     Matched,
     associate,
+    associate_evo,
 )
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.benchmarks.trajectory.metrics import Metrics, metrics
@@ -34,7 +36,7 @@ from ertools.benchmarks.trajectory.rules import (
 )
 from ertools.errors import ClockError, ScoringError
 from ertools.fidelity import Deviation
-from ertools.streams import PoseStream, Provenance
+from ertools.streams import PoseStream, Provenance, float_seconds
 from ertools.timeutil import iso_utc, ns_to_s
 
 
@@ -83,8 +85,10 @@ def score_streams(
     check_increasing(robot, where)
     notes = list(warnings)
     notes.extend(w for w in (frame_change_warning(gt), frame_change_warning(robot)) if w)
+    evo = config.t_max_diff is not None
     invalid: list[Deviation] = []
-    if config.gt_order == "time":
+    if config.gt_order == "time" and not evo:
+        # evo keeps every pose it read: a sample recorded twice is two poses to it.
         gt, dropped = drop_duplicates(gt)
         if dropped:
             notes.append(
@@ -140,16 +144,34 @@ def score_streams(
         robot.child_frame_id,
         robot.source,
     )
-    matched = associate(
-        shifted,
-        gt,
-        config.association,
-        config.max_gap_ns,
-        ties=config.ties,
-        gaps=config.gaps,
-        before_gt=config.before_gt,
-        gt_order=config.gt_order,
-    )
+    if config.t_max_diff is not None:
+        matched = associate_evo(
+            robot,
+            gt,
+            float_seconds(robot),
+            float_seconds(gt),
+            config.t_max_diff,
+            ns_to_s(offset_ns),
+            offset_ns,
+        )
+        if matched.robot_rows is not None and len(matched.robot_rows) != len(robot):
+            # A robot pose in two of evo's pairs is two rows; the result's robot stream too.
+            robot = robot.take(matched.robot_rows)
+            notes.append(
+                f"{len(matched.robot_rows) - len(shifted)} robot pose(s) are the nearest of two "
+                "GT poses and are counted once per pair, as evo counts them"
+            )
+    else:
+        matched = associate(
+            shifted,
+            gt,
+            config.association,
+            config.max_gap_ns,
+            ties=config.ties,
+            gaps=config.gaps,
+            before_gt=config.before_gt,
+            gt_order=config.gt_order,
+        )
     outside = matched.status == UNCOVERED
     spans = _spans(matched.t_ns, outside)
     n_out = int(outside.sum())
@@ -166,7 +188,7 @@ def score_streams(
         )
         more = f" and {len(spans) - 3} more" if len(spans) > 3 else ""
         msg = f"{n_out} of {len(matched.t_ns)} robot poses lie outside the GT: {text}{more}"
-        if not config.allow_partial:
+        if not (config.allow_partial or evo):
             early = int(np.count_nonzero(outside & (matched.t_ns < timed.t_ns[0])))
             hint = (
                 f" ({early} lie before the first GT pose: 2015 compared them with it, "
@@ -186,13 +208,26 @@ def score_streams(
                 f"--allow-partial{hint}"
             )
         else:
-            notes.append(f"partial: {msg}; only the covered part is scored")
+            notes.append(
+                f"partial: {msg}; only the covered part is scored"
+                + (" (--t-max-diff: as evo, no error)" if evo and not config.allow_partial else "")
+            )
 
     m = metrics(matched)
-    if m is None:
+    if m is None and evo:
+        failures.append(
+            f"no robot pose has a GT pose within --t-max-diff {config.t_max_diff:g} s "
+            f"(evo: 'found no matching timestamps'); check the time source and --offset"
+        )
+    elif m is None:
         failures.append(
             f"no robot pose could be compared ({matched.count(GAP)} in GT gaps, "
             f"{matched.count(TRACKING_LOST)} while tracking was lost)"
+        )
+    if matched.count(UNPAIRED):
+        notes.append(
+            f"{matched.count(UNPAIRED)} robot pose(s) have no GT pose paired within "
+            f"--t-max-diff {config.t_max_diff:g} s (evo's association) and are not compared"
         )
     if matched.count(GAP):
         notes.append(
@@ -244,6 +279,7 @@ def score_streams(
                 ("before_gt", config.before_gt),
                 ("gt_order", config.gt_order),
                 ("max_gap", f"{ns_to_s(config.max_gap_ns):g}"),
+                ("t_max_diff", "" if config.t_max_diff is None else f"{config.t_max_diff!r}"),
                 ("offset", f"{ns_to_s(offset_ns):g}"),
             ),
         ),

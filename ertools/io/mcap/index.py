@@ -123,11 +123,11 @@ class McapIndex:
 
     @staticmethod
     def of(bag: BagFile) -> McapIndex | None:
-        """The index of an MCAP file or a rosbag2-mcap directory, None for other formats."""
+        """The index of a standalone MCAP file, None for other formats (a rosbag2-mcap
+        directory's files come from :func:`ertools.io.bulk.mcap_index`, which knows how
+        the directory stores them)."""
         if bag.format == "mcap":
             return McapIndex([bag.path])
-        if bag.format == "rosbag2-mcap":
-            return McapIndex(sorted(bag.path.glob("*.mcap")))
         return None
 
     def plan(self, conns: Sequence[Conn], lo: int | None, hi: int | None) -> McapPlan:

@@ -27,6 +27,7 @@ TOGETHER: dict[tuple[str, str], dict[str, Any]] = {
     ("trajectory", "ties"): {"association": "hold"},
     ("trajectory", "gt_order"): {"association": "hold", "ties": "before"},
     ("trajectory", "apply_offset"): {"offset": "auto"},
+    ("trajectory", "t_max_diff"): {"association": "nearest"},
     ("fbm2h", "transforms"): {"team": "homer"},
 }
 # A value for the inputs whose kind alone does not say what a valid one is.
