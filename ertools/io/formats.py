@@ -181,8 +181,8 @@ def detect_format(path: str | Path) -> str:
         "not a ROS1 bag, rosbag2 bag or MCAP file: it does not begin with '#ROSBAG V2.0' "
         "(ROS1) or MCAP's magic bytes"
         + (
-            "; a text file: TUM, KITTI and EuRoC trajectories are read by `score trajectory` "
-            "and `export`"
+            "; a text file (if it is a TUM, KITTI or EuRoC trajectory, `score trajectory` "
+            "and `export` read it)"
             if text
             else ""
         ),

@@ -107,15 +107,12 @@ def sniff(path: str | Path) -> TextFormat | None:
             return "tum"
         if n == 12:
             return "kitti"
+    fields = len(data.split(",")) if "," in data else len(data.split())
     raise BagError(
-        f"not a bag, and its first data row ({_short(data)}) is no TUM (8 numbers), KITTI "
+        f"not a bag, and its first data row ({fields} field(s)) is no TUM (8 numbers), KITTI "
         "(12) or EuRoC (8+ comma-separated) row; give --input-format to say which",
         path=p,
     )
-
-
-def _short(text: str, n: int = 60) -> str:
-    return repr(text if len(text) <= n else text[:n] + "...")
 
 
 def _rows(path: Path, fmt: TextFormat) -> _Rows:
@@ -208,11 +205,10 @@ def _first_bad(rows: _Rows, cols: list[int], path: Path) -> None:
 
 
 def _bad_value(rows: _Rows, r: int, c: int, path: Path, why: str) -> NoReturn:
+    # The cell is not quoted: a message may reach published pages, and the file may be
+    # anything (docs/qa.md, "bytes of arbitrary files").
     name = _COLUMNS[rows.fmt][c]
-    cell = rows.cells(r)[c]
-    raise BagError(
-        f"row {rows.lines[r]}, column {c + 1} ({name}): {_short(cell, 30)} is {why}", path=path
-    )
+    raise BagError(f"row {rows.lines[r]}, column {c + 1} ({name}) is {why}", path=path)
 
 
 def _first_cells(rows: _Rows) -> list[str]:

@@ -127,9 +127,9 @@ def test_tum_stamps_in_exponent_notation(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("text", "needle"),
     [
-        ("# c\n1.0 1 2 3 0 0 0 1\n2.0 1 2 x 0 0 0 1\n", "row 3, column 4 (z): 'x' is not a number"),
+        ("# c\n1.0 1 2 3 0 0 0 1\n2.0 1 2 x 0 0 0 1\n", "row 3, column 4 (z) is not a number"),
         ("1.0 1 2 3 0 0 0 1\n2.0 1 2 3 0 0 0\n", "row 2: 7 values, a TUM row has 8"),
-        ("1.0 1 2 3 0 0 0 1\n2.0 1 2 nan 0 0 0 1\n", "row 2, column 4 (z): 'nan' is not a finite"),
+        ("1.0 1 2 3 0 0 0 1\n2.0 1 2 nan 0 0 0 1\n", "row 2, column 4 (z) is not a finite"),
         ("1.0 1 2 3 0 0 0 1\n2.0.1 1 2 3 0 0 0 1\n", "row 2, column 1 (t)"),
     ],
     ids=["word", "short-row", "nan", "bad-time"],

@@ -92,7 +92,8 @@ def test_info_says_which_format_was_expected(
     err = capsys.readouterr().err
     assert err.strip() == (
         f"ertools: error: {path}: not a ROS1 bag, rosbag2 bag or MCAP file: it does not "
-        "begin with '#ROSBAG V2.0' (ROS1) or MCAP's magic bytes"
+        "begin with '#ROSBAG V2.0' (ROS1) or MCAP's magic bytes; a text file (if it is a "
+        "TUM, KITTI or EuRoC trajectory, `score trajectory` and `export` read it)"
     )
 
 
@@ -182,3 +183,26 @@ def test_a_rosbag2_metadata_that_is_no_yaml_is_not_quoted(
     err = capsys.readouterr().err
     assert "SECRET" not in err
     assert "metadata.yaml" in err and "at line" in err
+
+
+def test_check_accepts_text_trajectories_only_where_a_benchmark_reads_them(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    folder = tmp_path / "comp"
+    folder.mkdir()
+    # Two TUM trajectories (t x y z qx qy qz qw), the format `score trajectory` reads.
+    rows = "".join(f"{1.0 + i / 10:.1f} {i / 100:.2f} 0 0 0 0 0 1\n" for i in range(5))
+    (folder / "robot.txt").write_text(rows)
+    (folder / "gt.txt").write_text(rows)
+    config = folder / "competition.yaml"
+    config.write_text(
+        "version: 1\nexecutions:\n"
+        "  - {benchmark: trajectory, team: robotto, bags: [robot.txt, gt.txt]}\n"
+    )
+    assert main(["rescore", "--config", str(config), "--check"]) == 0, capsys.readouterr().err
+    # FBM3W reads bags only: the same text file is refused, by the format expected.
+    config.write_text(
+        "version: 1\nexecutions:\n  - {benchmark: fbm3w, team: robotto, bags: [robot.txt]}\n"
+    )
+    assert main(["rescore", "--config", str(config), "--check"]) == 1
+    assert "not a ROS1 bag, rosbag2 bag or MCAP file" in capsys.readouterr().err
