@@ -23,6 +23,8 @@ from ertools.errors import UsageError
 from ertools.progress import clear_current
 
 if TYPE_CHECKING:  # annotations only: the registry (and `ertools score --help`) stays light
+    import pandas as pd
+
     from ertools.fidelity import Deviation
     from ertools.streams import Provenance
 
@@ -150,6 +152,10 @@ class BenchmarkResult(Protocol):
 
     def tables(self) -> dict[str, Rows]:
         """CSV-ready tables by name (``runs``, ``segments``, ``items``, ``samples``...)."""
+        ...
+
+    def to_frames(self) -> dict[str, pd.DataFrame]:
+        """The :meth:`tables` as pandas DataFrames (epoch times as a UTC index)."""
         ...
 
 
