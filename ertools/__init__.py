@@ -21,10 +21,20 @@ __version__ = "0.1.0"
 # `ertools.audit`, `.timeline`, `.export` and `.rescore` are also packages: a package imported
 # sets its name on this module, so those four packages are themselves callable (their
 # __init__ makes them so) and each call runs the function of ertools.api.
-API = ("audit", "export", "figures", "info", "open_bag", "read_poses", "rescore", "score", "timeline")
+__all__ = [
+    "__version__",
+    "audit",
+    "export",
+    "figures",
+    "info",
+    "open_bag",
+    "read_poses",
+    "rescore",
+    "score",
+    "timeline",
+]
+API = tuple(__all__[1:])
 _PACKAGES = ("audit", "export", "rescore", "timeline")
-
-__all__ = ["__version__", *API]
 
 if TYPE_CHECKING:
     from ertools.api import (

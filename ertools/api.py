@@ -274,7 +274,9 @@ def audit(
     """
     plist = _paths(bags)
     namespace = benchmark or infer_benchmark(plist)
-    declared = {i.name: i for i in registry.get(namespace).inputs} if namespace in registry.names() else {}
+    declared = (
+        {i.name: i for i in registry.get(namespace).inputs} if namespace in registry.names() else {}
+    )
     # an input the benchmark does not declare is passed as given: the audit notes it unused
     given = {
         k: _value(declared[k], v) if k in declared else v
@@ -363,7 +365,7 @@ def export(
     if format not in FORMATS:
         raise UsageError(f"format {format!r}: one of {', '.join(FORMATS)}")
     stream = read_poses(bags, topic=topic, tf=tf)
-    text = format_poses(stream, format)  # type: ignore[arg-type]
+    text = format_poses(stream, format)
     if out is not None:
         target = Path(out)
         if any(target.exists() and target.samefile(p) for p in _paths(bags)):

@@ -1,7 +1,8 @@
 """Results as pandas DataFrames, for notebooks and users' own analysis.
 
 Every result's ``to_frames()`` (a benchmark result, an audit) is :func:`tables_to_frames` of
-its ``tables()``: each table a DataFrame. Columns that hold times become UTC datetimes: epoch-second columns (``time``,
+its ``tables()``: each table a DataFrame. Columns that hold times become UTC datetimes:
+epoch-second columns (``time``,
 ``start_time``, ``*_time`` with values after 2001) are converted, and when a table has one,
 it becomes the DatetimeIndex named ``time``. Columns of seconds *from the start* (``start``,
 ``duration``, ``segment_time``...) stay floats: they are durations, not instants.

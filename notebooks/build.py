@@ -355,7 +355,8 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
             "check = pd.DataFrame(as_2015.comparison.rows())\n"
             "check = check[check.status != 'only recomputed']\n"
             "numbers = check.difference.notna()\n"
-            "same = numbers & (check.difference.abs() <= tol) | ~numbers & (check.status == 'same')\n"
+            "within = check.difference.abs() <= tol\n"
+            "same = numbers & within | ~numbers & (check.status == 'same')\n"
             "print(f'{same.sum()} same, {(~same).sum()} differ (tolerance {tol})')\n"
             "check[~same]",
         ),
@@ -399,7 +400,8 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
             "code",
             "rows = []\n"
             "for association in ('hold', 'nearest', 'linear'):\n"
-            "    d = ertools.score('trajectory', bags, association=association, **kwargs).to_dict()\n"
+            "    r = ertools.score('trajectory', bags, association=association, **kwargs)\n"
+            "    d = r.to_dict()\n"
             "    rows.append({k: d[k] for k in ('association', 'position_error', "
             "'orientation_error', 'rmse', 'compared', 'gaps', 'tracking_lost')})\n"
             "pd.DataFrame(rows).set_index('association')",

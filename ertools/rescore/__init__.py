@@ -15,4 +15,3 @@ Called, this package is the public API's ``ertools.rescore(...)`` (:func:`ertool
 from ertools._callable import make_callable
 
 make_callable(__name__)
-

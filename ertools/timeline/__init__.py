@@ -6,4 +6,3 @@ Called, this package is the public API's ``ertools.timeline(...)`` (:func:`ertoo
 from ertools._callable import make_callable
 
 make_callable(__name__)
-

@@ -130,7 +130,7 @@ def test_score_errors_name_the_inputs() -> None:
         ertools.score("fbm2h", FBM2H_BAG, speed=1)
     with pytest.raises(UsageError, match="unknown benchmark 'fbm4'"):
         ertools.score("fbm4", FBM2H_BAG)
-    with pytest.raises(BagError, match="nope.bag"):
+    with pytest.raises(BagError, match=r"nope\.bag"):
         ertools.score("fbm3w", "nope.bag")
 
 
