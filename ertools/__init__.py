@@ -16,6 +16,8 @@ from __future__ import annotations
 from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
+from ertools._callable import submodules
+
 __version__ = "0.1.0"
 
 # `ertools.audit`, `.timeline`, `.export` and `.rescore` are also packages: a package imported
@@ -55,7 +57,11 @@ def __getattr__(name: str) -> Any:
         return import_module(f"ertools.{name}")
     if name in API:
         return getattr(import_module("ertools.api"), name)
-    raise AttributeError(f"module 'ertools' has no attribute {name!r}")
+    # a private module reached as an attribute (`ertools.yamlout.dump`), imported on first use
+    return _submodule(name)
+
+
+_submodule = submodules(__name__)
 
 
 def __dir__() -> list[str]:

@@ -1,4 +1,5 @@
-"""A package that is also a function of the public API (``ertools.audit(...)``).
+"""Lazy parts of a package: a package that is also a function of the public API
+(``ertools.audit(...)``), and submodules imported on first use (:func:`submodules`).
 
 ``ertools.audit`` is both the package ``ertools/audit/`` and the API function
 ``ertools.api.audit``: Python sets a package imported on its parent module, so the package
@@ -9,6 +10,7 @@ sits above every package).
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable
 from importlib import import_module
 from types import ModuleType
 from typing import Any
@@ -25,3 +27,19 @@ class CallablePackage(ModuleType):
 def make_callable(name: str) -> None:
     """Make the package ``name`` (its ``__name__``) callable; its doc says what the call does."""
     sys.modules[name].__class__ = CallablePackage
+
+
+def submodules(package: str) -> Callable[[str], ModuleType]:
+    """A package's module ``__getattr__`` that imports a submodule on first use: code that
+    needs a heavy part only now and then (``ertools.report.folder`` for ``--report``) imports
+    the light package at its top and reaches the part as an attribute when it runs."""
+
+    def attribute(name: str) -> ModuleType:
+        try:
+            return import_module(f"{package}.{name}")
+        except ModuleNotFoundError as err:
+            if err.name != f"{package}.{name}":
+                raise
+            raise AttributeError(f"module {package!r} has no attribute {name!r}") from None
+
+    return attribute

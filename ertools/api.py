@@ -23,8 +23,9 @@ from ertools.audit.model import Audit
 from ertools.audit.rescore import ScoreInputs, audit_bag, infer_benchmark
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Input
-from ertools.benchmarks.common.sources import PoseSpec, read_source
-from ertools.benchmarks.common.spec import TimeSource, parse_tf
+from ertools.benchmarks.common.sources import read_source
+from ertools.benchmarks.common.spec import PoseSpec, TimeSource, parse_tf
+from ertools.benchmarks.common.which import refuse_other_benchmark
 from ertools.errors import UsageError
 from ertools.export.formats import FORMATS, format_poses
 from ertools.io import files, summary
@@ -237,6 +238,7 @@ def score(name: str, bags: PathLike | Sequence[PathLike], **inputs: Any) -> Benc
     bag_list = _paths(bags)
     if not bag_list:
         raise UsageError(f"give at least one bag (the log file) to score {name}")
+    refuse_other_benchmark(name, bag_list, values)
     options = bench.make_options(values)
     result: BenchmarkResult = bench.score(bag_list, options)
     return result

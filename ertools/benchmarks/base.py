@@ -19,12 +19,14 @@ from typing import TYPE_CHECKING, Any, Generic, Literal, Protocol, TypeVar, runt
 
 import numpy as np
 
+import ertools
 from ertools.errors import UsageError
 from ertools.progress import clear_current
 
 if TYPE_CHECKING:  # annotations only: the registry (and `ertools score --help`) stays light
     import pandas as pd
 
+    import ertools.yamlout  # reached as an attribute of the package, imported on first use
     from ertools.fidelity import Deviation
     from ertools.streams import Provenance
 
@@ -171,10 +173,9 @@ def notice(message: str) -> None:
 def dump_yaml(data: Any) -> str:
     """YAML as the 2015 nodes dumped it (block style, keys in insertion order), floats
     rounded to 9 decimal places (:mod:`ertools.yamlout`)."""
-    # lazy: PyYAML (~25 ms) only when YAML is written (JSON and text outputs do without it)
-    from ertools.yamlout import dump
-
-    return dump(data)
+    # PyYAML (~25 ms) imported now, when YAML is written (JSON and text outputs do without it)
+    text: str = ertools.yamlout.dump(data)
+    return text
 
 
 def jsonable(value: Any) -> Any:
@@ -239,6 +240,10 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
             audit's comparison shows the first that matches a differing key).
         sample: the sample logs' folder (``sample_bags/``) -> the arguments scoring this
             benchmark on them (``make demo``); None, or a None result: no sample.
+        namespace: the first part of its logs' topics (``/fbm2h/...``; default: ``name``),
+            by which a log given to the wrong benchmark is recognised; empty: none.
+        source_inputs: the inputs naming the logs' topics or frames: given, the user has
+            chosen them and the log is taken as it is.
     """
 
     name: str
@@ -265,6 +270,13 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
     explanations: tuple[Explanation, ...] = ()
     sample: Callable[[Path], Sequence[str] | None] | None = None
     bags_help: str = "log file(s)"
+    namespace: str | None = None
+    source_inputs: tuple[str, ...] = ("topic", "tf", "namespace")
+
+    @property
+    def log_namespace(self) -> str:
+        """The first part of its logs' topics (:attr:`namespace`, default the name)."""
+        return self.name if self.namespace is None else self.namespace
 
     def score(self, bags: Sequence[Path], options: OptionsT) -> ResultT:
         """The whole shape: load -> find runs -> score."""

@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from conftest import DT, Scene
 from io_bagmaker import write
+from io_scene import DT, Scene
 
 from ertools.cli.main import main
 

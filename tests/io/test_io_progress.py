@@ -10,8 +10,8 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import Scene
 from io_bagmaker import bag_name, write
+from io_scene import Scene
 from test_io_fastpath import fast_batch
 
 from ertools.cli.main import main

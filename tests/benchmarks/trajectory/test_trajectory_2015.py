@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 import pytest
 from node_2015 import EndOfBagError, Pose, score_2015, tf_yaw
+from stderr_text import error_messages
 from trajectory_helpers import read_back, write_gt, write_robot
 
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
@@ -344,8 +345,8 @@ def test_uncovered_start_error_points_at_before_gt(
     hand: list[str], capsys: pytest.CaptureFixture[str]
 ) -> None:
     assert main(["score", "trajectory", *hand, "--association", "hold"]) == 1
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("ertools: error: ")
+    err = error_messages(capsys.readouterr().err)
+    assert len(err) == 1
     assert "1 lie before the first GT pose" in err[0] and "--before-gt first" in err[0]
 
 
