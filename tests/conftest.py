@@ -61,14 +61,18 @@ TIMING = (
 
 def _slow() -> tuple[str, ...]:
     """The node ids (or prefixes) of tests/slow.txt: tests that take a second or more."""
-    lines = (TESTS / "slow.txt").read_text(encoding="utf-8").splitlines()
+    listed = TESTS / "slow.txt"
+    lines = listed.read_text(encoding="utf-8").splitlines() if listed.is_file() else []
     return tuple(ln.split("#")[0].strip() for ln in lines if ln.split("#")[0].strip())
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     slow = _slow()
     for item in items:
-        rel = Path(str(item.path)).resolve().relative_to(TESTS).as_posix()
+        path = Path(str(item.path)).resolve()
+        if not path.is_relative_to(TESTS):
+            continue
+        rel = path.relative_to(TESTS).as_posix()
         node = rel + item.nodeid[item.nodeid.index("::") :] if "::" in item.nodeid else rel
         if node.startswith(TIMING):
             item.add_marker(pytest.mark.xdist_group("timing"))

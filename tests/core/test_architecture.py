@@ -163,7 +163,8 @@ def test_no_cycle_even_through_annotations(tmp_path: Path) -> None:
     runs = copy / "io" / "ros1" / "runs.py"
     runs.write_text(
         runs.read_text(encoding="utf-8").replace(
-            "if TYPE_CHECKING:\n", "if TYPE_CHECKING:\n    from ertools.io.ros1.index import Ros1Bag\n"
+            "if TYPE_CHECKING:\n",
+            "if TYPE_CHECKING:\n    from ertools.io.ros1.index import Ros1Bag\n",
         ),
         encoding="utf-8",
     )
