@@ -56,6 +56,8 @@ TIMING = (
     "timeline/test_timeline_pictures.py::test_page_of_1000_bags_is_built_quickly",
     "samples/test_samples_writer.py::test_bulk_write_speed",
     "live/",
+    # a recording and its monitor side by side, on a deadline
+    "e2e/test_docs_commands.py::test_docs_commands_run_as_printed[live.md]",
 )
 
 

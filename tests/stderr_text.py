@@ -4,24 +4,23 @@ continues on indented lines (``ertools.cli.main.error_text``); here it is one li
 from __future__ import annotations
 
 
-def error_messages(err: str) -> list[str]:
-    """Each ``ertools: error:`` message of ``err`` on one line: a detail line indented by two
-    spaces is the next clause (joined with "; "), one indented by four the same clause
-    wrapped (joined with a blank)."""
+def joined_lines(err: str) -> list[str]:
+    """The lines of ``err``, each error message on one: after an ``ertools: error:`` line, a
+    line indented by two spaces is the next clause (joined with "; "), one indented by four
+    the same clause wrapped (joined with a blank)."""
     out: list[str] = []
+    in_error = False
     for line in err.splitlines():
-        if line.startswith("ertools: error:"):
-            out.append(line)
-        elif out and line.startswith("    "):
+        if in_error and line.startswith("    "):
             out[-1] += " " + line.strip()
-        elif out and line.startswith("  "):
+        elif in_error and line.startswith("  "):
             out[-1] += "; " + line.strip()
+        else:
+            out.append(line)
+            in_error = line.lstrip("\x1b[K").startswith("ertools: error:")
     return out
 
 
-def one_error(err: str) -> str:
-    """The one error message of ``err`` (asserts there is exactly one, and nothing else but
-    ``ertools:`` lines around it)."""
-    messages = error_messages(err)
-    assert len(messages) == 1, err
-    return messages[0]
+def error_messages(err: str) -> list[str]:
+    """Each ``ertools: error:`` message of ``err``, on one line."""
+    return [line for line in joined_lines(err) if line.startswith("ertools: error:")]
