@@ -43,8 +43,8 @@ pytest: $(DEVSTAMP)
 
 test: lint typecheck pytest
 
-# The edit-test loop (< 1 min): lint and the tests that take under a second (the slow ones are
-# listed in tests/slow.txt and marked `slow` by tests/conftest.py).
+# The edit-test loop: lint and the tests that take under a second (the slow ones are listed in
+# tests/slow.txt and marked `slow` by tests/conftest.py).
 check: $(DEVSTAMP)
 	$(BIN)/ruff check ertools tests bench fuzz
 	$(BIN)/ruff format --check ertools tests bench fuzz

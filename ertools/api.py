@@ -26,7 +26,7 @@ from ertools.benchmarks.base import Input
 from ertools.benchmarks.common.sources import read_source
 from ertools.benchmarks.common.spec import PoseSpec, TimeSource, parse_tf
 from ertools.benchmarks.common.which import refuse_other_benchmark
-from ertools.errors import UsageError
+from ertools.errors import ConfigError, UsageError
 from ertools.export.formats import FORMATS, format_poses
 from ertools.io import files, summary
 from ertools.report.figures import figure_specs
@@ -403,7 +403,7 @@ def rescore(
         and ``score``.
 
     Raises:
-        ConfigError: a manifest with problems (every problem, one per line).
+        ConfigError: a manifest with problems (every problem named, nothing scored).
 
     Example:
         >>> import ertools, pathlib, tempfile
@@ -429,7 +429,8 @@ def rescore(
     try:
         manifest = load_manifest(Path(config))
     except ManifestError as err:
-        raise UsageError("\n".join([str(config), *err.problems])) from None
+        listed = "; ".join(err.problems)
+        raise ConfigError(f"{len(err.problems)} problem(s): {listed}", path=config) from None
     scorings = listed_executions(manifest)
     problems: list[dict[str, object]] = []
     found_timeline = None

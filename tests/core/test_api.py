@@ -18,7 +18,7 @@ import ertools
 from ertools import api
 from ertools.benchmarks.document import score_json
 from ertools.cli.main import main
-from ertools.errors import BagError, TopicError, UsageError
+from ertools.errors import BagError, ConfigError, TopicError, UsageError
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"
@@ -163,3 +163,12 @@ def test_audit_and_timeline() -> None:
     # the ROS1 log and its MCAP copy: one recording in two files
     assert len(t.bags) == 2
     assert [len(f.axes) > 0 for f in ertools.figures(audited)][:1] == [True]
+
+
+def test_rescore_names_every_manifest_problem(tmp_path: Path) -> None:
+    manifest = tmp_path / "competition.yaml"
+    manifest.write_text("benchmarks:\n  fbm9: {}\n  fbm8: {}\n", encoding="utf-8")
+    with pytest.raises(ConfigError, match="2 problem") as raised:
+        ertools.rescore([], config=manifest, out=tmp_path / "out")
+    assert "'fbm9'" in str(raised.value) and "'fbm8'" in str(raised.value)
+    assert not (tmp_path / "out").exists()  # nothing scored, nothing written
