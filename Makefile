@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 DEVSTAMP := $(VENV)/.installed-dev
 DEMO_OUT ?= demo_output
 
-.PHONY: demo test lint typecheck pytest bench fuzz samples notebooks clean
+.PHONY: demo test check lint typecheck pytest bench fuzz samples notebooks clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -35,20 +35,37 @@ lint: $(DEVSTAMP)
 typecheck: $(DEVSTAMP)
 	$(BIN)/mypy ertools
 
+# The suite on every core (pytest-xdist): tests that share a resource or measure time carry an
+# xdist_group mark and run on one worker (tests/conftest.py); the 15 slowest are listed.
+PYTEST_JOBS ?= auto
 pytest: $(DEVSTAMP)
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n $(PYTEST_JOBS) --dist loadgroup --durations=15
 
 test: lint typecheck pytest
+
+# The edit-test loop: lint and the tests that take under a second (the slow ones are listed in
+# tests/slow.txt and marked `slow` by tests/conftest.py).
+check: $(DEVSTAMP)
+	$(BIN)/ruff check ertools tests bench fuzz
+	$(BIN)/ruff format --check ertools tests bench fuzz
+	$(BIN)/lint-imports --no-cache
+	$(BIN)/python -m pytest -q -n $(PYTEST_JOBS) --dist loadgroup -m "not slow"
 
 bench: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e '.[dask]'  # the season's LocalCluster run
 	$(BIN)/python -m compileall -q ertools
 	$(BIN)/python bench/run.py
 
-# JupyterLab in the project's venv, then the notebooks open in it.
+# JupyterLab in the project's venv, then the notebooks open in it. As root (a container),
+# Jupyter refuses to start without --allow-root: given then, with the reason said.
 notebooks: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e '.[notebooks]'
-	$(BIN)/jupyter lab notebooks/
+	@if [ "$$(id -u)" = 0 ]; then \
+		echo "make notebooks: running as root (a container?): jupyter lab --allow-root"; \
+		$(BIN)/jupyter lab --allow-root notebooks/; \
+	else \
+		$(BIN)/jupyter lab notebooks/; \
+	fi
 
 # Mutation fuzzing of the ROS1 and MCAP readers against rosbags / mcap (docs/qa.md).
 # `make fuzz N=500 SEED=7 JOBS=1`; one case in full: `$(BIN)/python fuzz/run.py --seed S --case K`.

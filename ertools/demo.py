@@ -22,11 +22,12 @@ SAMPLES = Path(__file__).resolve().parent.parent / "sample_bags"
 
 @dataclass(frozen=True)
 class Step:
-    """One command of the demo and the file its stdout goes to."""
+    """One command of the demo and the file its stdout goes to (None: it prints nothing on
+    stdout, its outputs are files of its own)."""
 
     title: str
     argv: list[str]
-    stdout_file: str
+    stdout_file: str | None
     # rescore exits 1 when some executions could not be scored: the sample day has such
     # problems on purpose (a truncated log, a missing transform), listed on its page
     expected_exit: int = 0
@@ -88,7 +89,7 @@ def competition_step(day: Path, out: Path) -> Step:
     return Step(
         "rescore of the sample competition (a day at one venue, problems planted)",
         ["rescore", str(day), "--config", str(day / MANIFEST), "--out", str(out), "--jobs", "2"],
-        "rescore.txt",
+        None,  # its results are the folder: results.json, results.csv, index.html
         expected_exit=1,
     )
 
@@ -112,18 +113,24 @@ def run(out: Path, samples: Path = SAMPLES) -> int:
     site = out / "rescore"
     for step in [*steps(samples, out), competition_step(out / "competition", site)]:
         print(f"== {step.title}: ertools {' '.join(step.argv)}", file=sys.stderr)
-        target = out / step.stdout_file
-        with target.open("w", encoding="utf-8") as fh, redirect_stdout(fh):
+        if step.stdout_file is None:
+            target: Path | None = Path(step.argv[step.argv.index("--out") + 1]) / "index.html"
             code = ertools_main(step.argv)
+        else:
+            target = out / step.stdout_file
+            with target.open("w", encoding="utf-8") as fh, redirect_stdout(fh):
+                code = ertools_main(step.argv)
+            if target.stat().st_size == 0:  # nothing printed (its errors are above): no file
+                target.unlink()
+                target = None
+        shown = "nothing on stdout" if target is None else f"-> {target}"
         if code != step.expected_exit:
             failed += 1
             print(f"   exit status {code} (see above)", file=sys.stderr)
         elif code:
-            print(
-                f"   -> {target} (exit {code}, as planted: see the problems above)", file=sys.stderr
-            )
+            print(f"   {shown} (exit {code}, as planted: see the problems above)", file=sys.stderr)
         else:
-            print(f"   -> {target}", file=sys.stderr)
+            print(f"   {shown}", file=sys.stderr)
     index = [p for p in sorted(out.glob("*/index.html")) if p.parent != site]
     print("\nReports written:", file=sys.stderr)
     for p in index:

@@ -3,7 +3,8 @@
     python notebooks/build.py          # rewrites notebooks/*.ipynb (no outputs)
     python notebooks/build.py --check  # exit 1 if a committed notebook differs from this file
 
-The notebooks call the ertools library only; every number they show comes from it. Every input
+The notebooks call ertools' public API only (``import ertools``, docs/api.md: a test refuses
+any other import from ertools); every number they show comes from it. Every input
 is in one cell tagged ``parameters`` (papermill's convention: ``papermill -p NAME VALUE``
 overrides it in a cell tagged ``injected-parameters`` inserted after it); its defaults are the
 sample logs of ``make samples`` (``sample_bags/``, relative to ``notebooks/``). ``answers`` is
@@ -23,11 +24,14 @@ HERE = Path(__file__).resolve().parent
 SAMPLES = "../sample_bags"
 
 SETUP = """\
+%matplotlib inline
 from pathlib import Path
 
 import matplotlib.pyplot as plt
 import pandas as pd
 import yaml
+
+import ertools
 
 pd.set_option("display.width", 160)
 pd.set_option("display.max_columns", 30)"""
@@ -58,32 +62,23 @@ assert not missing, f"missing: {missing} (the sample logs: run `make samples`)"
 # The benchmark state topics of the log (none in a ground-truth-only log such as the real 2015
 # FBM2@Home test run): the audit, the timeline and the live score need them.
 TOPICS = """\
-from ertools.io import summary, topics
-from ertools.states import STATE_TOPIC_SUFFIXES
-
-suffixes = {s for group in STATE_TOPIC_SUFFIXES.values() for s in group}
-state_topics = [t for t in topics(paths) if t.rsplit("/", 1)[-1] in suffixes]
+# the 2015 state machines' topics: /<benchmark>/bmbox_state, refbox_state, client_state
+STATE_SUFFIXES = ("bmbox_state", "bbbox_state", "refbox_state", "client_state")
+summaries = [ertools.info(p) for p in paths]
+names = sorted({t.name for s in summaries for t in s.topics})
+state_topics = [t for t in names if t.rsplit("/", 1)[-1] in STATE_SUFFIXES]
 print("benchmark state topics:", ", ".join(state_topics) or "none")
-s = summary(paths[0])
-pd.DataFrame([(t.name, t.msgtype, t.count) for t in s.topics],
+pd.DataFrame([(t.name, t.msgtype, t.count) for t in summaries[0].topics],
              columns=["topic", "type", "messages"])"""
 
 FIGURES = """\
-from ertools.report.figures import figure_specs
-
-for spec in figure_specs(result):
-    fig, ax = plt.subplots(figsize=spec.size, layout="constrained")
-    spec.draw(ax)
-    ax.set_title(spec.title)
-plt.show()"""
+for fig in ertools.figures(result):
+    display(fig)"""
 
 TIMELINE = """\
-from ertools.report.plots_audit import draw_timeline
-
 if audit is not None:
-    fig, ax = plt.subplots(figsize=(12, 4), layout="constrained")
-    draw_timeline(ax, audit)
-    plt.show()"""
+    for fig in ertools.figures(audit):  # the state machines' timeline
+        display(fig)"""
 
 COMPARISON = """\
 if audit is None:
@@ -141,18 +136,16 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ("md", "## What happened: the state machines' timeline"),
         (
             "code",
-            "from ertools.audit.rescore import ScoreInputs, audit_bag\n\n"
-            "audit, notes = audit_bag(paths, inputs=ScoreInputs(config=config_path))\n"
-            "print(*notes, sep='\\n')\n"
+            "audit = ertools.audit(paths, config=config_path)\n"
+            "print(*audit.warnings, sep='\\n')\n"
             "print(audit.to_text()[:2500])",
         ),
         ("code", TIMELINE),
         ("md", "## The recomputed score, run by run"),
         (
             "code",
-            "from ertools.report.frames import result_to_dataframes\n\n"
             "result = audit.recomputed\n"
-            "frames = result_to_dataframes(result)\n"
+            "frames = result.to_frames()\n"
             "print(result.to_yaml()[:400])\n"
             'frames["runs"]',
         ),
@@ -171,12 +164,9 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ),
         (
             "code",
-            "from ertools.benchmarks.fbm3w.benchmark import Fbm3wOptions, score_fbm3w\n"
-            "from ertools.configs.fbm3w import load_fbm3w_config\n\n"
-            "course = load_fbm3w_config(config_path)\n"
             "rows = []\n"
             "for d_min in d_mins:\n"
-            "    r = score_fbm3w(paths, course, Fbm3wOptions(d_min=d_min)).to_dict()\n"
+            "    r = ertools.score('fbm3w', paths, config=config_path, d_min=d_min).to_dict()\n"
             "    row = {'d_min': d_min, 'best_distance_error': r['best_distance_error']}\n"
             "    row.update({f'run {k}': v.get('distance_error') "
             "for k, v in r['runs_details'].items()})\n"
@@ -239,12 +229,10 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ("md", "## What happened: the state machines' timeline"),
         (
             "code",
-            "from ertools.audit.rescore import ScoreInputs, audit_bag\n\n"
             "audit = None\n"
             "if state_topics:\n"
-            "    inputs = ScoreInputs(goal=goal_path, transform=transform_path)\n"
-            "    audit, notes = audit_bag(paths, inputs=inputs)\n"
-            "    print(*notes, sep='\\n')\n"
+            "    audit = ertools.audit(paths, goal=goal_path, transform=transform_path)\n"
+            "    print(*audit.warnings, sep='\\n')\n"
             "    print(audit.to_text()[:2000])\n"
             "else:\n"
             "    print('no benchmark state topics: no timeline and no live score in this log')",
@@ -253,17 +241,17 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ("md", "## The recomputed segments"),
         (
             "code",
-            "from ertools.benchmarks.fbm2h.benchmark import Fbm2hOptions, score_fbm2h\n"
-            "from ertools.report.frames import result_to_dataframes\n\n"
-            "options = Fbm2hOptions(goal=goal_path, transform=transform_path, reached=reached,\n"
-            "                       timing=timing_path)\n"
-            "result = score_fbm2h(paths, options)\n"
+            "def reached_at(source, timing_file):\n"
+            "    # `--reached timing FILE`: the mode and its file; the others: the mode alone\n"
+            "    return (source, timing_file) if source == 'timing' else source\n\n"
+            "result = ertools.score('fbm2h', paths, goal=goal_path, transform=transform_path,\n"
+            "                       reached=reached_at(reached, timing_path))\n"
             "score = result.to_dict()\n"
             "print(f'reached moments: {reached}')\n"
             "for key in ('position_accuracy', 'orientation_accuracy', 'execution_time'):\n"
             "    print(f'{key}: {score[key]!r}')\n"
             "print(*result.warnings, *result.deviations, sep='\\n')\n"
-            'result_to_dataframes(result)["segments"]',
+            'result.to_frames()["segments"]',
         ),
         ("code", FIGURES),
         ("md", "## Live score vs recomputed score"),
@@ -284,10 +272,9 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
             "rows = []\n"
             "for source, timing_file in sources:\n"
             "    for wrap_2015 in (False, True):\n"
-            "        choice = Fbm2hOptions(goal=goal_path, transform=transform_path,\n"
-            "                              reached=source, timing=timing_file,\n"
-            "                              orientation_2015=wrap_2015)\n"
-            "        r = score_fbm2h(paths, choice).to_dict()\n"
+            "        r = ertools.score('fbm2h', paths, goal=goal_path, transform=transform_path,\n"
+            "                          reached=reached_at(source, timing_file),\n"
+            "                          orientation_2015=wrap_2015).to_dict()\n"
             "        rows.append({'reached': source, 'orientation_2015': wrap_2015,\n"
             "                     'position_accuracy': r['position_accuracy'],\n"
             "                     'orientation_accuracy': r['orientation_accuracy'],\n"
@@ -334,10 +321,8 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ),
         (
             "code",
-            "from ertools.audit.rescore import ScoreInputs, audit_bag\n\n"
-            "inputs = ScoreInputs(items=items_path, results=results_path)\n"
-            "audit, notes = audit_bag(paths, inputs=inputs)\n"
-            "print(*notes, sep='\\n')\n"
+            "audit = ertools.audit(paths, items=items_path, results=results_path)\n"
+            "print(*audit.warnings, sep='\\n')\n"
             "pd.DataFrame(audit.tables()['runs'])"
             "[['run', 'start', 'duration', 'outcome', 'manual_operation', 'result']]",
         ),
@@ -345,9 +330,8 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ("md", "## The recomputed runs"),
         (
             "code",
-            "from ertools.report.frames import result_to_dataframes\n\n"
             "result = audit.recomputed\n"
-            "frames = result_to_dataframes(result)\n"
+            "frames = result.to_frames()\n"
             "print(list(frames))\n"
             "frames[next(iter(frames))]",
         ),
@@ -357,23 +341,24 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         (
             "md",
             "## The 2015 rules reproduce the live score\n\n"
-            "`Fbm1Options.as_2015` applies every quirk of the 2015 node; compared with the live "
-            "score, nothing should differ.",
+            "`rules='2015'` (`--rules 2015`) applies every quirk of the 2015 node; compared with "
+            "the live score, nothing should differ.",
         ),
         (
             "code",
-            "from ertools.audit.compare import DEFAULT_ABS_TOL, compare_scores\n"
-            "from ertools.benchmarks.fbm1.benchmark import Fbm1Options, score_fbm1_bag\n\n"
-            "as_2015 = score_fbm1_bag(paths, items_path, options=Fbm1Options.as_2015('fbm1h'),\n"
-            "                         results_path=results_path)\n"
+            "as_2015 = ertools.audit(paths, items=items_path, results=results_path, rules='2015')\n"
             "# Mocap noise moves a recomputed pose score by ~1e-5: a sample's answers state the\n"
             "# tolerance for it.\n"
             "tol = abs_tol\n"
             "if tol is None:\n"
-            "    tol = ANSWERS['tolerance']['pose_score']['abs'] if ANSWERS else DEFAULT_ABS_TOL\n"
-            "check = compare_scores(audit.live_score, as_2015, abs_tol=tol)\n"
-            "print(f'{check.same} same, {len(check.differences)} differ (tolerance {tol})')\n"
-            "pd.DataFrame(check.rows()).query(\"status != 'only recomputed'\")",
+            "    tol = ANSWERS['tolerance']['pose_score']['abs'] if ANSWERS else 1e-6\n"
+            "check = pd.DataFrame(as_2015.comparison.rows())\n"
+            "check = check[check.status != 'only recomputed']\n"
+            "numbers = check.difference.notna()\n"
+            "within = check.difference.abs() <= tol\n"
+            "same = numbers & within | ~numbers & (check.status == 'same')\n"
+            "print(f'{same.sum()} same, {(~same).sum()} differ (tolerance {tol})')\n"
+            "check[~same]",
         ),
     ],
     "trajectory": [
@@ -401,14 +386,13 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ),
         (
             "code",
-            "from ertools.benchmarks.trajectory.benchmark import score\n"
-            "from ertools.benchmarks.trajectory.config import TrajectoryConfig\n\n"
             "robot_path = Path(robot_bag)\n"
             "gt_paths = [Path(gt)] if isinstance(gt, str) else [Path(g) for g in gt]\n"
             + LOAD_ANSWERS
             + "\n"
+            "bags = [robot_path, *gt_paths]\n"
             "kwargs = dict(robot_topic=robot_topic, gt_topic=gt_topic)\n"
-            "result = score(robot_path, gt_paths, TrajectoryConfig(), **kwargs)\n"
+            "result = ertools.score('trajectory', bags, **kwargs)\n"
             "print(result.to_yaml()[:800])",
         ),
         ("md", "## Association: hold (2015), nearest, linear"),
@@ -416,8 +400,8 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
             "code",
             "rows = []\n"
             "for association in ('hold', 'nearest', 'linear'):\n"
-            "    d = score(robot_path, gt_paths, TrajectoryConfig(association=association), "
-            "**kwargs).to_dict()\n"
+            "    r = ertools.score('trajectory', bags, association=association, **kwargs)\n"
+            "    d = r.to_dict()\n"
             "    rows.append({k: d[k] for k in ('association', 'position_error', "
             "'orientation_error', 'rmse', 'compared', 'gaps', 'tracking_lost')})\n"
             "pd.DataFrame(rows).set_index('association')",
@@ -425,8 +409,8 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ("md", "## The clock audit\n\nThe sample robot's clock was set ahead of the GT logger's."),
         (
             "code",
-            "audited = score(robot_path, gt_paths, "
-            "TrajectoryConfig(auto_offset=True, apply_offset=True), **kwargs)\n"
+            "audited = ertools.score('trajectory', bags, offset='auto', apply_offset=True, "
+            "**kwargs)\n"
             "print('estimated:', audited.to_dict()['clock_audit'])\n"
             "if ANSWERS is not None:\n"
             "    print('generator truth offset [s]:', ANSWERS['truth']['offset_s'])\n"
@@ -436,8 +420,7 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ("md", "## Per-pose errors as a DataFrame (UTC time index)"),
         (
             "code",
-            "from ertools.report.frames import result_to_dataframes\n\n"
-            "samples = result_to_dataframes(audited)['samples']\n"
+            "samples = audited.to_frames()['samples']\n"
             "numeric = samples.select_dtypes('number')\n"
             "numeric.describe().T",
         ),
@@ -464,12 +447,11 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ),
         (
             "code",
-            "from ertools.timeline.scan import scan\n\n"
             "root = Path(folder)\n"
             "assert root.is_dir(), f'{root}: no such folder (the samples: run `make samples`)'\n"
             + LOAD_ANSWERS
             + "\n"
-            "timeline = scan([root])\n"
+            "timeline = ertools.timeline(root)\n"
             "bags = pd.DataFrame(timeline.to_dict()['bags'])\n"
             "bags['path'] = bags['path'].map(lambda p: str(Path(p).relative_to(root)))\n"
             "print(f'{len(bags)} bags, {len(timeline.to_dict()[\"sessions\"])} sessions')\n"
@@ -477,17 +459,11 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ),
         (
             "code",
-            "from ertools.report.plots_timeline import draw_gantt\n\n"
-            "fig, ax = plt.subplots(figsize=(12, 4), layout='constrained')\n"
-            "draw_gantt(ax, timeline)  # the whole folder on one time axis\n"
-            "plt.show()",
-        ),
-        (
-            "code",
-            "from ertools.report.plots_timeline import timeline_figure\n\n"
-            "# one panel per session (its own time axis), problems numbered and listed\n"
+            "# the whole folder on one time axis, then one panel per session (its own time\n"
+            "# axis), problems numbered and listed\n"
             "# (`ertools timeline FOLDER --plot day.html` writes the zoomable page)\n"
-            "timeline_figure(timeline)",
+            "for fig in ertools.figures(timeline):\n"
+            "    display(fig)",
         ),
         ("code", "pd.DataFrame(timeline.to_dict()['problems'])"),
         (
@@ -504,11 +480,10 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ("md", "## Every benchmark log of the folder, audited"),
         (
             "code",
-            "from ertools.audit.rescore import audit_bag\n\n"
             "benchmark_logs = [b for b in timeline.bags if b.kind == 'benchmark' and b.readable]\n"
             "rows = []\n"
             "for b in benchmark_logs:\n"
-            "    audit, _ = audit_bag([Path(b.path)], recompute=False)\n"
+            "    audit = ertools.audit(b.path, recompute=False)\n"
             "    rows.append({'bag': Path(b.path).name, 'benchmark': audit.benchmark,\n"
             "                 'runs': len(audit.runs),\n"
             "                 'illegal transitions': len(audit.illegal_transitions),\n"
@@ -521,12 +496,10 @@ NOTEBOOKS: dict[str, list[tuple[str, str]]] = {
         ),
         (
             "code",
-            "from ertools.report.plots_audit import draw_timeline\n\n"
             "if benchmark_logs:\n"
-            "    audit, _ = audit_bag([Path(benchmark_logs[-1].path)], recompute=False)\n"
-            "    fig, ax = plt.subplots(figsize=(12, 4), layout='constrained')\n"
-            "    draw_timeline(ax, audit)\n"
-            "    plt.show()",
+            "    audit = ertools.audit(benchmark_logs[-1].path, recompute=False)\n"
+            "    for fig in ertools.figures(audit):\n"
+            "        display(fig)",
         ),
     ],
 }

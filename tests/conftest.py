@@ -1,7 +1,10 @@
 """Test-suite root: its presence puts ``tests/`` on ``sys.path`` (pytest's prepend import
 mode), so helpers shared by several test folders live in one module, ``tests/fakes.py``."""
 
+import contextlib
+import fcntl
 import os
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -42,12 +45,71 @@ def pytest_make_collect_report(collector: pytest.Collector) -> object:
     report.longrepr = f"skipped in CI, where the machine must provide it: {reason}"
 
 
+# ---------------------------------------------------------------------------------------------
+# Running in parallel (`make test`: pytest-xdist, --dist loadgroup)
+
+TESTS = Path(__file__).resolve().parent
+# Tests that measure time (a bound on seconds) or hold live sockets and processes: one xdist
+# group, so that they run one after another on one worker, never beside each other's load.
+TIMING = (
+    "core/test_cli_main.py::test_help_is_instant_and_imports_nothing_heavy",
+    "timeline/test_timeline_pictures.py::test_page_of_1000_bags_is_built_quickly",
+    "samples/test_samples_writer.py::test_bulk_write_speed",
+    "live/",
+    # a recording and its monitor side by side, on a deadline
+    "e2e/test_docs_commands.py::test_docs_commands_run_as_printed[live.md]",
+)
+
+
+def _slow() -> tuple[str, ...]:
+    """The node ids (or prefixes) of tests/slow.txt: tests that take a second or more."""
+    listed = TESTS / "slow.txt"
+    lines = listed.read_text(encoding="utf-8").splitlines() if listed.is_file() else []
+    return tuple(ln.split("#")[0].strip() for ln in lines if ln.split("#")[0].strip())
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    slow = _slow()
+    for item in items:
+        path = Path(str(item.path)).resolve()
+        if not path.is_relative_to(TESTS):
+            continue
+        rel = path.relative_to(TESTS).as_posix()
+        node = rel + item.nodeid[item.nodeid.index("::") :] if "::" in item.nodeid else rel
+        if node.startswith(TIMING):
+            item.add_marker(pytest.mark.xdist_group("timing"))
+        if node.startswith(slow):
+            item.add_marker(pytest.mark.slow)
+
+
+@contextlib.contextmanager
+def _exclusive(lock: Path) -> Iterator[None]:
+    """One process at a time (the xdist workers of one session share the data they make)."""
+    with lock.open("a") as fh:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
+
+
+def shared_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A folder every worker of this session sees (the session's own under xdist)."""
+    base = tmp_path_factory.getbasetemp()
+    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+
+
 @pytest.fixture(scope="session")
 def sample_competition(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The sample competition (``python -m ertools.samples --competition``, default seed),
-    generated once for the whole session (10 s): tests read it and write nothing into it."""
-    from ertools.samples.competition import DEFAULT_SEED, generate_competition
+    generated once for the whole session (10 s), by the first worker that needs it:
+    tests read it and write nothing into it."""
+    from ertools.samples.competition import DEFAULT_SEED, write_competition
 
-    root = tmp_path_factory.mktemp("competition") / "day"
-    generate_competition(root, seed=DEFAULT_SEED)
+    shared = shared_dir(tmp_path_factory)
+    root = shared / "competition" / "day"
+    with _exclusive(shared / "competition.lock"):
+        if not root.is_dir():  # written whole or not at all (write_competition)
+            root.parent.mkdir(parents=True, exist_ok=True)
+            write_competition(root, seed=DEFAULT_SEED)
     return root

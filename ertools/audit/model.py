@@ -14,11 +14,14 @@ from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.fidelity import Deviation
+from ertools.frames import tables_to_frames
 from ertools.states import Machine
 from ertools.streams import Provenance
 from ertools.timeutil import iso_utc, ns_to_s
 
 if TYPE_CHECKING:
+    import pandas as pd
+
     from ertools.benchmarks.base import BenchmarkResult
 
 
@@ -295,6 +298,11 @@ class Audit:
             lines.append("warnings:")
             lines += [f"  {w}" for w in self.warnings]
         return "\n".join(lines) + "\n"
+
+    def to_frames(self) -> dict[str, pd.DataFrame]:
+        """Every table of :meth:`tables` as a pandas DataFrame, epoch times as a UTC index
+        (:func:`ertools.frames.tables_to_frames`)."""
+        return tables_to_frames(self.tables())
 
     def tables(self) -> dict[str, Rows]:
         """``timeline``, ``runs``, ``illegal_transitions``, ``silences``, ``early_ends``

@@ -19,10 +19,14 @@ from typing import TYPE_CHECKING, Any, Generic, Literal, Protocol, TypeVar, runt
 
 import numpy as np
 
+import ertools
 from ertools.errors import UsageError
 from ertools.progress import clear_current
 
 if TYPE_CHECKING:  # annotations only: the registry (and `ertools score --help`) stays light
+    import pandas as pd
+
+    import ertools.yamlout  # reached as an attribute of the package, imported on first use
     from ertools.fidelity import Deviation
     from ertools.streams import Provenance
 
@@ -168,6 +172,10 @@ class BenchmarkResult(Protocol):
         """CSV-ready tables by name (``runs``, ``segments``, ``items``, ``samples``...)."""
         ...
 
+    def to_frames(self) -> dict[str, pd.DataFrame]:
+        """The :meth:`tables` as pandas DataFrames (epoch times as a UTC index)."""
+        ...
+
 
 def notice(message: str) -> None:
     """A human note on stderr (``ertools: message``), below any progress bar: what a
@@ -181,10 +189,9 @@ def notice(message: str) -> None:
 def dump_yaml(data: Any) -> str:
     """YAML as the 2015 nodes dumped it (block style, keys in insertion order), floats
     rounded to 9 decimal places (:mod:`ertools.yamlout`)."""
-    # lazy: PyYAML (~25 ms) only when YAML is written (JSON and text outputs do without it)
-    from ertools.yamlout import dump
-
-    return dump(data)
+    # PyYAML (~25 ms) imported now, when YAML is written (JSON and text outputs do without it)
+    text: str = ertools.yamlout.dump(data)
+    return text
 
 
 def jsonable(value: Any) -> Any:
@@ -258,6 +265,10 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
             its files, the first holding the name) -> the input values that score it as an
             execution (FBM2H: the timing file beside it; FBM3W: ``runs: auto``), or one line
             saying why it cannot be one. None: such recordings are never executions.
+        namespace: the first part of its logs' topics (``/fbm2h/...``; default: ``name``),
+            by which a log given to the wrong benchmark is recognised; empty: none.
+        source_inputs: the inputs naming the logs' topics or frames: given, the user has
+            chosen them and the log is taken as it is.
     """
 
     name: str
@@ -287,6 +298,13 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
     gt_only: Callable[[Sequence[Path]], Mapping[str, Any] | str] | None = None
     logs_are_bags: bool = True
     logs_may_be_text: bool = False
+    namespace: str | None = None
+    source_inputs: tuple[str, ...] = ("topic", "tf", "namespace")
+
+    @property
+    def log_namespace(self) -> str:
+        """The first part of its logs' topics (:attr:`namespace`, default the name)."""
+        return self.name if self.namespace is None else self.namespace
 
     def score(self, bags: Sequence[Path], options: OptionsT) -> ResultT:
         """The whole shape: load -> find runs -> score."""

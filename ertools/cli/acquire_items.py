@@ -15,6 +15,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ertools.benchmarks.common.sources import pose_source
 from ertools.benchmarks.fbm1.acquire import AcquireOptions, acquire_items_bag
 from ertools.benchmarks.fbm1.config import BENCHMARKS
 from ertools.cli.common import all_failed
@@ -31,7 +32,7 @@ from ertools.configs.items import items_to_yaml
 from ertools.errors import UsageError
 
 if TYPE_CHECKING:
-    from ertools.benchmarks.common.sources import PoseSpec
+    from ertools.benchmarks.common.spec import PoseSpec
     from ertools.io import PoseSource
 
 EPILOG = """examples:
@@ -101,7 +102,7 @@ def _io(spec: PoseSpec, namespace: str, body: str) -> PoseSource | None:
 
     if not spec.given and spec.time_source_given:
         spec = replace(spec, topic=f"/{namespace}/{body}/pose")
-    return spec.to_io() if spec.given else None
+    return pose_source(spec) if spec.given else None
 
 
 def run(args: argparse.Namespace) -> int:

@@ -12,7 +12,9 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
+from ertools import report
 from ertools.audit.rescore import ScoreInputs, audit_bag
 from ertools.benchmarks import registry
 from ertools.cli.common import (
@@ -24,6 +26,9 @@ from ertools.cli.common import (
 from ertools.cli.options import non_negative_int, positive
 from ertools.cli.output import note, write_text
 from ertools.timeutil import s_to_ns
+
+if TYPE_CHECKING:  # reached as an attribute of the package, imported on first use
+    pass
 
 EPILOG = """examples:
   ertools audit fbm2h.bag                       # YAML on stdout (--format text: a summary)
@@ -116,10 +121,8 @@ def run(args: argparse.Namespace) -> int:
         for deviation in audit.deviations:
             note(f"differs from 2015: {deviation}")
         if args.report is not None:
-            # lazy: the report's pages and Jinja2 (~30 ms) only when --report asks for them
-            from ertools.report.folder import write_report
-
-            index = write_report(
+            # the report's pages and Jinja2 (~30 ms): imported now, for --report
+            index = report.folder.write_report(
                 audit, args.report, inputs=bags, argv=getattr(args, "command_line", sys.argv)
             )
             note(f"wrote report {index}")

@@ -10,14 +10,18 @@ import argparse
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from ertools import report
 from ertools.benchmarks import document
 from ertools.benchmarks.base import BenchmarkResult
 from ertools.benchmarks.common.teams import with_team
 from ertools.cli.options import add_output, add_plots, add_report
 from ertools.cli.output import dump_json, note, write_text
 from ertools.report.figures import figure_specs, save_figures, save_one_file
+
+if TYPE_CHECKING:  # reached as attributes of the package, imported on first use
+    pass
 
 
 def add_output_options(
@@ -86,10 +90,8 @@ def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[
     write_plots_option(result, args)
     report_dir: Path | None = getattr(args, "report", None)
     if report_dir is not None:
-        # lazy: the report's pages, audit and Jinja2 (~30 ms) only when --report asks for them
-        from ertools.report.folder import write_report
-
-        index = write_report(
+        # the report's pages, audit and Jinja2 (~30 ms): imported now, for --report
+        index = report.folder.write_report(
             result, report_dir, inputs=inputs, argv=getattr(args, "command_line", sys.argv)
         )
         note(f"wrote report {index}")
@@ -113,10 +115,8 @@ def write_foxglove_option(result: Any, args: argparse.Namespace, inputs: list[Pa
     path: Path | None = getattr(args, "foxglove", None)
     if path is None:
         return
-    # lazy: Foxglove's protobuf classes (~30 ms) only when --foxglove asks for them
-    from ertools.report.foxglove import write_foxglove
-
-    written = write_foxglove(result, path, inputs=inputs)
+    # Foxglove's protobuf classes (~30 ms): imported now, for --foxglove
+    written = report.foxglove.write_foxglove(result, path, inputs=inputs)
     note(f"wrote {written.path} ({written.messages} messages on {len(written.counts)} topics)")
 
 

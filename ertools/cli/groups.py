@@ -9,8 +9,15 @@ from ertools.cli.main import Command, run_command
 
 
 def add_group_arguments(parser: argparse.ArgumentParser, members: dict[str, Command]) -> None:
-    """The group's parser takes the member name and leaves the rest to the member's parser."""
+    """The group's parser takes the member name and leaves the rest to the member's parser.
+
+    Its usage line names everything a member needs (``ertools score NAME BAG... [OPTIONS]``):
+    the group alone prints it above its one error line."""
     parser.epilog = members_epilog(members)
+    names = "{" + ",".join(members) + "}"
+    parser.usage = f"%(prog)s [-h] [-v] [-q] {names} BAG... [OPTIONS]"
+    # the error of a group given no member: what to give, not argparse's hidden ARGS
+    parser.group_required = f"NAME ({', '.join(members)}), then its BAG... and options"  # type: ignore[attr-defined]
     parser.add_argument(
         "member", choices=list(members), metavar="NAME", help="one of the members below"
     )

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import dump_yaml
+from ertools.cli.main import error_text
 from ertools.cli.options import add_output
 from ertools.cli.output import dump_json, note, write_text
 from ertools.errors import BagError
@@ -180,5 +181,5 @@ def run(args: argparse.Namespace) -> int:
     if text:
         write_text(text, args.out)
     for p in problems:
-        print(f"ertools: error: {p['path']}: {p['problem']}", file=sys.stderr)
+        print(error_text(f"{p['path']}: {p['problem']}"), file=sys.stderr)
     return 1 if problems else 0

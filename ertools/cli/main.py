@@ -8,6 +8,7 @@ import math
 import os
 import re
 import sys
+import textwrap
 from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib import import_module
@@ -92,7 +93,7 @@ COMMANDS: dict[str, Command] = {
 def _top_level_help() -> str:
     width = max(len(name) for name in COMMANDS)
     lines = [
-        "usage: ertools [-h] [--version] COMMAND [ARGS...]",
+        "usage: ertools [-h] [-V] COMMAND [ARGS...]",
         "",
         "Re-score ERL / RoCKIn benchmarks from their logs, with no ROS installed.",
         "",
@@ -103,7 +104,8 @@ def _top_level_help() -> str:
         lines.append(f"  {'':<{width}}    e.g. {cmd.example}")
     lines += [
         "",
-        "`ertools COMMAND --help` shows a command's options with examples.",
+        "`ertools COMMAND --help` shows a command's options with examples;",
+        "`ertools -V` (--version) its version.",
         "Exit status: 0 success, 1 unusable data or config, 2 usage error.",
     ]
     return "\n".join(lines)
@@ -117,7 +119,15 @@ class _Parser(argparse.ArgumentParser):
         one = re.fullmatch(r"one of the arguments (\S+) is required", message)
         if one is not None:
             message = f"the following arguments are required: {one.group(1)}"
-        self.exit(2, f"ertools: error: {self.prog}: {message} (`{self.prog} --help` shows how)\n")
+        group_required: str | None = getattr(self, "group_required", None)
+        usage = ""
+        if group_required and message.startswith("the following arguments are required"):
+            # a group given nothing (`ertools score`): the usage line, then what it needs
+            message = f"the following arguments are required: {group_required}"
+            usage = self.format_usage()
+        self.exit(
+            2, f"{usage}{error_text(f'{self.prog}: {message} (`{self.prog} --help` shows how)')}\n"
+        )
 
 
 def build_parser(prog: str, module_name: str) -> tuple[argparse.ArgumentParser, object]:
@@ -230,6 +240,44 @@ def _one_line(message: str) -> str:
     return " ".join(message.split())
 
 
+# The longest error line: what is wrong and where fits on it; the detail (frames found, the
+# topics there, what to try) goes to further lines, indented, at the message's "; ".
+MAX_ERROR_LINE = 200
+
+
+def _clauses(text: str) -> list[str]:
+    """``text`` split at each "; " outside brackets."""
+    parts, depth, start = [], 0, 0
+    for i, char in enumerate(text):
+        depth += (char in "([{") - (char in ")]}")
+        if depth == 0 and text.startswith("; ", i):
+            parts.append(text[start:i])
+            start = i + 2
+    return [*parts, text[start:]]
+
+
+def error_text(message: str) -> str:
+    """``ertools: error: MESSAGE`` as printed: one line when it fits in
+    :data:`MAX_ERROR_LINE` characters, else each further clause (after "; ") on a line of its
+    own indented by two spaces, and a clause still too long wrapped at words onto lines
+    indented by four."""
+    first = f"ertools: error: {_one_line(message)}"
+    if len(first) <= MAX_ERROR_LINE:
+        return first
+    clauses = _clauses(first)
+    lines = [clauses[0], *(f"  {c}" for c in clauses[1:])]
+    out: list[str] = []
+    for line in lines:
+        out += textwrap.wrap(
+            line,
+            MAX_ERROR_LINE,
+            subsequent_indent="    ",  # deeper than a clause: the same clause goes on
+            break_long_words=False,
+            break_on_hyphens=False,
+        ) or [line]
+    return "\n".join(out)
+
+
 def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
     """Parse ``argv`` for one command module and run it, mapping errors to exit codes."""
 
@@ -252,7 +300,7 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
             if bar is not None:
                 bar.close()
     except ErtoolsError as err:
-        print(f"ertools: error: {_one_line(str(err))}", file=sys.stderr)
+        print(error_text(str(err)), file=sys.stderr)
         return err.exit_code
     except KeyboardInterrupt:
         print("ertools: interrupted", file=sys.stderr)
@@ -323,7 +371,7 @@ def _main(argv: Sequence[str] | None) -> int:
     if not args or args[0] in ("-h", "--help"):
         print(_top_level_help())
         return 0 if args else 2
-    if args[0] == "--version":
+    if args[0] in ("-V", "--version"):
         print(f"ertools {__version__}")
         return 0
     name = args[0]

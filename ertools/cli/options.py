@@ -24,22 +24,19 @@ import math
 import sys
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ertools.benchmarks.common.spec import (
     DEFAULT_PARENT,
     DEFAULT_TIME_SOURCE,
     TIME_SOURCES,
+    PoseSpec,
     parse_tf,
 )
 from ertools.progress import clear_current
 
-if TYPE_CHECKING:
-    from ertools.benchmarks.common.sources import PoseSpec
-
-# ``ertools.benchmarks.common.sources`` reads bags (numpy, rosbags): only :func:`pose_spec`
-# (run time, when poses are read anyway) imports it; the builders use the light
-# ``common.spec``, so that every parser, ``--help`` included, builds without the readers.
+# The builders use the light ``common.spec`` (no numpy, no bag reader), so that every parser,
+# ``--help`` included, builds without the readers.
 
 FORMATS = ("text", "json", "yaml", "csv")
 # Suffixes ``--plot FILE`` can write with matplotlib (html is the timeline's own page).
@@ -326,9 +323,6 @@ def pose_spec(
 
     tp = prefix if time_prefix is None else time_prefix
     given = getattr(args, _dest(tp, "time_source"), None)
-    # lazy: the bag readers (numpy, the io layer) only at run time: see the top
-    from ertools.benchmarks.common.sources import PoseSpec
-
     return PoseSpec(
         topic=getattr(args, _dest(prefix, "topic"), None),
         tf=getattr(args, _dest(prefix, "tf"), None),

@@ -10,6 +10,7 @@ from typing import Any
 
 from ertools import atomic
 from ertools.benchmarks.base import jsonable
+from ertools.cli.main import error_text
 from ertools.progress import clear_current
 
 
@@ -26,10 +27,14 @@ def write_text(text: str, output: Path | None) -> None:
 
 
 def note(message: str) -> None:
-    """A human note on stderr (stdout stays parseable), below any progress bar."""
+    """A human note on stderr (stdout stays parseable), below any progress bar; an
+    ``error: ...`` note as every error is printed (:func:`ertools.cli.main.error_text`)."""
 
     clear_current()
-    print(f"ertools: {message}", file=sys.stderr)
+    if message.startswith("error: "):
+        print(error_text(message.removeprefix("error: ")), file=sys.stderr)
+    else:
+        print(f"ertools: {message}", file=sys.stderr)
 
 
 def dump_json(data: Any) -> str:

@@ -16,15 +16,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ertools import atomic
-from ertools.atomic import folder_lock
 from ertools.cli.output import note
 from ertools.errors import UsageError
 from ertools.rescore.draft import draft_text
-from ertools.rescore.found import find, merge, write_timeline
-from ertools.rescore.ledger import account
-from ertools.rescore.manifest import Manifest, ManifestError, load_manifest
+from ertools.rescore.found import find
+from ertools.rescore.manifest import ManifestError, load_manifest
 from ertools.rescore.parallel import default_jobs
-from ertools.rescore.pipeline import listed_executions, rescore, write_results
+from ertools.rescore.run import rescore_competition
 
 if TYPE_CHECKING:
     from ertools.rescore.jobs import Outcome
@@ -117,58 +115,31 @@ def run(args: argparse.Namespace) -> int:
             "waiting for it to end (Ctrl-C to stop, or give another --out)"
         )
 
-    # two runs into one folder would mix their reports and caches: one at a time
-    with folder_lock(args.out, on_wait=waiting):
-        return _rescore(args, manifest)
-
-
-def _rescore(args: argparse.Namespace, manifest: Manifest) -> int:
-    scorings = listed_executions(manifest)
-    problems: list[dict[str, object]] = []
-    timeline = None
-    found = None
-    if args.paths:
-        found = find(args.paths, progress=args.progress)
-        scorings = merge(found.scorings, scorings)
-        problems = list(found.problems)
-        args.out.mkdir(parents=True, exist_ok=True)
-        timeline = write_timeline(found, args.out, manifest.title)
-    if not scorings:
-        where = ", ".join(map(str, args.paths)) or "no logs were given"
-        note(f"error: no benchmark execution found ({where}) and none listed in {args.config}")
-        return 1
-    workers = args.jobs if args.jobs is not None else default_jobs()
-
     def tell(outcome: Outcome) -> None:
         if outcome.status != "scored" and outcome.error != "TopicError":
             note(f"error: {outcome.id}: {outcome.status}: {outcome.reason}")
 
-    doc = rescore(
-        scorings,
+    done = rescore_competition(
+        args.paths,
         manifest,
         args.out,
-        workers=workers,
+        workers=args.jobs if args.jobs is not None else default_jobs(),
         scheduler=args.scheduler,
         use_cache=not args.no_cache,
         reports=not args.no_reports,
         command=args.command_line,
-        problems=problems,
-        timeline=timeline,
         progress=args.progress,
         on_outcome=tell,
+        on_wait=waiting,
     )
-    if found is not None:  # every file under PATH in one place (docs/rescore.md, "files")
-        robots = {str(s.bags[0]): s.of for s in found.scorings if s.of is not None}
-        doc = account(doc, found.files, found.folders, robots)
-    written = write_results(doc, args.out)
-    rows = doc["executions"]
+    rows = done.doc["executions"]
     counts = {s: sum(r["status"] == s for r in rows) for s in ("scored", "unscoreable", "failed")}
     from_cache = sum(bool(r["cached"]) for r in rows)
     note(
         f"{len(rows)} executions: {counts['scored']} scored, {counts['unscoreable']} unscoreable, "
         f"{counts['failed']} failed ({from_cache} from the cache)"
     )
-    for path in written:
+    for path in done.written:
         note(f"wrote {path}")
     sys.stdout.flush()
     return 0 if counts["scored"] == len(rows) else 1

@@ -1,9 +1,11 @@
 """Recompute a benchmark score from its logs.
 
-Each benchmark has its own options: `ertools score NAME --help`. They are generated from the
-benchmark's declared inputs (:mod:`ertools.benchmarks.registry`), so every benchmark of the
-registry is a member here, with no code of its own in the CLI.
+NAME is the benchmark; each has its own inputs and options: `ertools score NAME --help`.
+The score goes to stdout (YAML, or --format json), notes and warnings to stderr.
 """
+
+# The members and their options are generated from each benchmark's declared inputs (the
+# registry, ertools.benchmarks.registry): a benchmark has no code of its own in the CLI.
 
 from __future__ import annotations
 
@@ -14,6 +16,7 @@ from typing import Any
 
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Input
+from ertools.benchmarks.common.which import refuse_other_benchmark
 from ertools.cli.common import add_output_options, all_failed, emit_result
 from ertools.cli.groups import add_group_arguments, members_epilog, run_group
 from ertools.cli.main import Command
@@ -212,6 +215,7 @@ def run(args: argparse.Namespace) -> int:
     given = args.bags if isinstance(args.bags, list) else [args.bags, *args.more_bags]
     bags = _bags(bench, values, given)
     args.bags = bags
+    refuse_other_benchmark(name, bags, values)
     options = bench.make_options(values)
     result = bench.score(bags, options)
     if not all_failed(result):  # nothing scored: only the errors (emit_result)

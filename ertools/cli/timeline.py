@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from ertools.benchmarks.base import dump_yaml
+from ertools.cli.main import error_text
 from ertools.cli.options import add_output, plot_file, seconds
 from ertools.cli.output import dump_json, note, write_text
 from ertools.csvsafe import spreadsheet_safe
@@ -109,7 +110,7 @@ def run(args: argparse.Namespace) -> int:
         reasons = [" ".join(f"{p.path}: {p.problem}".split()) for p in timeline.problems]
         why = "; ".join(reasons[:3]) + (f"; {len(reasons) - 3} more" if len(reasons) > 3 else "")
         print(
-            f"ertools: error: no readable bag in {where}" + (f" ({why})" if why else ""),
+            error_text(f"no readable bag in {where}" + (f"; {why}" if why else "")),
             file=sys.stderr,
         )
         return 1

@@ -34,6 +34,7 @@ from ertools.io.pipeline import (
     prefetched,
 )
 from ertools.io.ros1.runs import chunk_group, ros1_runs
+from ertools.io.rosbag2.metadata import sqlite_rows
 from ertools.progress import current
 
 if TYPE_CHECKING:
@@ -178,9 +179,6 @@ def _mcap_runs(
 def _sqlite_runs(
     bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None
 ) -> Located | None:
-    # lazy: sqlite3 only for rosbag2 sqlite3 folders
-    from ertools.io.rosbag2.metadata import sqlite_rows
-
     batches = sqlite_rows(bag.path, conns, lo, hi)
     if batches is None:
         return None

@@ -21,7 +21,9 @@ from ertools.errors import BagError
 from ertools.io.formats import detect_format
 from ertools.io.mcap.index import verify_mcap
 from ertools.io.model import BagSummary
+from ertools.io.ros1.check import check_ros1
 from ertools.io.ros1.index import Ros1Bag
+from ertools.io.rosbag2.metadata import query, readable_files
 from ertools.io.summary import INDEX_SELF_CHECK, summary_and_times
 from ertools.timeutil import iso_utc, ns_to_s
 
@@ -141,9 +143,6 @@ def verify(path: Path, progress: Reporter | None = None) -> list[str]:
 
     fmt = detect_format(path)
     if fmt == "ros1":
-        # lazy: the record-by-record check only for --check
-        from ertools.io.ros1.check import check_ros1
-
         return check_ros1(path, progress)
     if fmt == "ros1-active":
         bag = Ros1Bag(path)
@@ -152,15 +151,9 @@ def verify(path: Path, progress: Reporter | None = None) -> list[str]:
         finally:
             bag.close()
     elif fmt in ("mcap", "rosbag2-mcap"):
-        # lazy: PyYAML only for rosbag2 folders
-        from ertools.io.rosbag2.metadata import readable_files
-
         for file in [path] if fmt == "mcap" else readable_files(path):
             verify_mcap(file, progress)
     else:
-        # lazy: sqlite3 and PyYAML only for rosbag2 folders
-        from ertools.io.rosbag2.metadata import query, readable_files
-
         for db in readable_files(path):
             result = query(db, "PRAGMA quick_check")[0][0]
             if result != "ok":

@@ -17,6 +17,7 @@ import numpy.typing as npt
 
 from ertools.errors import BagError, TopicError
 from ertools.io.bagfile import BagFile
+from ertools.io.bulk import locate, try_fast_batch
 from ertools.io.decode.fast import LayoutMismatchError, decode_states, is_state_definition
 from ertools.io.decode.posebatch import PoseBatch, batch_from_messages, concat_batches
 from ertools.io.decode.tf import Edge, chain_pose, frame_key
@@ -87,10 +88,6 @@ def load_pose_batch(
 
     Tries the bulk decoder first; falls back to rosbags per message (logged at INFO).
     """
-
-    # lazy: the bulk decoders (worker threads, MCAP index, sqlite; ~30 ms) only when
-    # messages are read: `ertools info` reads indexes only
-    from ertools.io.bulk import try_fast_batch
 
     fast = try_fast_batch(bag, conns, start_ns, end_ns)
     if fast is not None:
@@ -355,10 +352,6 @@ def _bulk_states(
     ):
         return None
     try:
-        # lazy: the bulk decoders (worker threads, MCAP index, sqlite; ~30 ms) only when
-        # messages are read: `ertools info` reads indexes only
-        from ertools.io.bulk import locate
-
         found = locate(bag, conns, None, None)
         if found is None:
             return None

@@ -36,6 +36,7 @@ from ertools.io.mcap.summary import mcap_errors
 from ertools.io.model import BagSummary, TopicSummary, short_msgtype
 from ertools.io.ros1.index import Ros1Bag
 from ertools.io.ros1.layout import read_layout
+from ertools.io.rosbag2.metadata import query, read_metadata, readable_files, storage_files
 
 log = logging.getLogger("ertools.io.summary")
 
@@ -414,9 +415,6 @@ def _mcap(path: Path, exact: bool, times: Times | None = None) -> BagSummary:
 
 
 def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagSummary:
-    # lazy: sqlite3 and PyYAML only for rosbag2 folders
-    from ertools.io.rosbag2.metadata import read_metadata, readable_files, storage_files
-
     info = read_metadata(path)
     problems = []
     files = storage_files(path, info)
@@ -464,9 +462,6 @@ def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> B
 
 
 def _sqlite_spans(files: list[Path]) -> dict[str, tuple[int, int]]:
-    # lazy: sqlite3 and PyYAML only for rosbag2 folders
-    from ertools.io.rosbag2.metadata import query
-
     out: dict[str, tuple[int, int]] = {}
     for db in files:
         rows = query(
@@ -539,9 +534,6 @@ def record_times(path: str | Path) -> dict[str, I64]:
         for file in [p] if fmt == "mcap" else _mcap_files(p):
             _mcap_file(file, True, parts)
     else:
-        # lazy: sqlite3 and PyYAML only for rosbag2 folders
-        from ertools.io.rosbag2.metadata import query, readable_files
-
         for db in readable_files(p):
             rows = query(
                 db,
@@ -559,7 +551,4 @@ def record_times(path: str | Path) -> dict[str, I64]:
 def _mcap_files(path: Path) -> list[Path]:
     """The MCAP storage files of a rosbag2 directory, readable (decompressed when the bag is
     compressed file by file)."""
-    # lazy: PyYAML only for rosbag2 folders
-    from ertools.io.rosbag2.metadata import readable_files
-
     return [f for f in readable_files(path) if f.suffix == ".mcap"]

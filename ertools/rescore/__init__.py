@@ -8,4 +8,10 @@ when the cache (:mod:`~ertools.rescore.cache`) already holds them, and gathered 
 ``results.json``/``results.csv`` (:mod:`~ertools.rescore.pipeline`), from which
 :mod:`~ertools.rescore.site` renders the results page. The document's contract is
 docs/rescore.md.
+
+Called, this package is the public API's ``ertools.rescore(...)`` (:func:`ertools.api.rescore`).
 """
+
+from ertools._callable import make_callable
+
+make_callable(__name__)

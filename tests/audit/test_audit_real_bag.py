@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 import pytest
+from stderr_text import error_messages
 
 REAL = Path(__file__).resolve().parents[2] / ".." / "shared" / "real_bags"
 BAG = REAL / "log_fbm2h_mocap_2015-10-23-16-15-40_0.bag"
@@ -27,7 +28,7 @@ def test_audit_says_there_is_nothing_to_audit(
     from ertools.cli.main import main
 
     assert main(["audit", str(bag)]) == 1
-    err = capsys.readouterr().err.strip().splitlines()
+    err = error_messages(capsys.readouterr().err)
     assert len(err) == 1 and "no benchmark state topics" in err[0] and bag.name in err[0]
 
 

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 from audit_streams import T0_NS, heartbeat
+from stderr_text import error_messages
 from test_audit import BMBOX, CLIENT, REFBOX
 
 from ertools.cli.main import main
@@ -139,7 +140,7 @@ def test_bag_without_states_is_one_line_error(
     with BagWriter(path, "ros1") as bag:
         bag.write_string("/rosout_text", T0_NS, "hello")
     code = main(["audit", str(path)])
-    err = capsys.readouterr().err.strip().splitlines()
+    err = error_messages(capsys.readouterr().err)
     assert code == 1
     assert len(err) == 1 and "no benchmark state topics" in err[0]
 

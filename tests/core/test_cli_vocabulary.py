@@ -11,10 +11,12 @@ from pathlib import Path
 
 import pytest
 import yaml
+from stderr_text import error_messages
 
 from ertools.benchmarks.common.sources import (
     PoseSpec,
     choose_source,
+    pose_source,
     read_source,
     tf,
     time_source_fallback,
@@ -258,7 +260,8 @@ def test_every_usage_error_exits_2_with_one_line(
     assert out == ""
     # one error line (an old spelling before it adds its deprecation note, nothing else)
     lines = [line for line in err.splitlines() if not line.startswith("ertools: note: ")]
-    assert len(lines) == 1 and lines[0].startswith("ertools: error: "), err
+    assert len(error_messages(err)) == 1 and lines[0].startswith("ertools: error: "), err
+    assert all(line.startswith("  ") for line in lines[1:]), err  # its detail, if any
     assert list(tmp_path.iterdir()) == []
 
 
@@ -362,7 +365,7 @@ def test_spec_and_tf_text_checks() -> None:
             parse_tf(bad)
     with pytest.raises(UsageError):
         PoseSpec(topic="/a", tf=("w", "b"))
-    io_source = PoseSpec(tf=("map", "base")).to_io()
+    io_source = pose_source(PoseSpec(tf=("map", "base")))
     assert (io_source.topic, io_source.parent, io_source.frame) == (None, "map", "base")
 
 

@@ -14,6 +14,7 @@ Cases run in-process through ``ertools.cli.main.main`` with ``capsys``.
 from __future__ import annotations
 
 import hashlib
+import itertools
 import json
 import random
 import re
@@ -25,7 +26,7 @@ from typing import Any
 
 import pytest
 
-from ertools.cli.main import COMMANDS, main
+from ertools.cli.main import COMMANDS, MAX_ERROR_LINE, main
 
 REPO = Path(__file__).resolve().parents[2]
 SAMPLES = REPO / "sample_bags"
@@ -306,16 +307,28 @@ def _run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> Outcome:
 
 
 def _check_error(result: Outcome, code: int, *names: str) -> str:
-    """Exit ``code``, one ``ertools: error:`` line naming one of ``names``, no traceback."""
+    """Exit ``code``, one ``ertools: error:`` message naming one of ``names``, no traceback;
+    its first line at most MAX_ERROR_LINE characters, its detail on indented further lines.
+    Returns the message joined on one line."""
     assert "Traceback" not in result.err + result.out
-    lines = [ln for ln in result.err.splitlines() if ln.startswith("ertools: error:")]
-    assert len(lines) == 1, result.err
-    # Every stderr line is an ertools line: a message wrapped over several lines is not one.
-    assert all(ln.startswith("ertools: ") for ln in result.err.splitlines()), result.err
+    err = result.err.splitlines()
+    starts = [i for i, ln in enumerate(err) if ln.startswith("ertools: error:")]
+    assert len(starts) == 1, result.err
+    # Every stderr line is an ertools line or the indented detail of the error above it: a
+    # third-party message wrapped over several lines is not.
+    first = starts[0]
+    detail = list(itertools.takewhile(lambda ln: ln.startswith("  "), err[first + 1 :]))
+    rest = err[:first] + err[first + 1 + len(detail) :]
+    # (a command group given nothing shows its usage line above the error)
+    assert all(ln.startswith(("ertools: ", "usage: ertools ")) for ln in rest), result.err
+    assert all(len(ln) <= MAX_ERROR_LINE for ln in [err[first], *detail]), result.err
+    message = err[first]
+    for line in detail:  # a clause ("  ", after "; ") or the same clause wrapped ("    ")
+        message += (" " if line.startswith("    ") else "; ") + line.strip()
     assert result.code == code, result.err
-    assert "unexpected" not in lines[0], lines[0]  # the CLI's wording for a bug
-    assert any(n in lines[0] for n in names), (names, lines[0])
-    return lines[0]
+    assert "unexpected" not in message, message  # the CLI's wording for a bug
+    assert any(n in message for n in names), (names, message)
+    return message
 
 
 # ---------------------------------------------------------------------------------------------
@@ -715,10 +728,19 @@ TOPIC_CASES: dict[str, Callable[[Inputs], list[str]]] = {
 @pytest.mark.parametrize("case", list(TOPIC_CASES))
 def test_wrong_topic(case: str, inputs: Inputs, capsys: pytest.CaptureFixture[str]) -> None:
     result = _run(TOPIC_CASES[case](inputs), capsys)
+    if case in WRONG_BENCHMARK:
+        # A log of another benchmark is named for what it is: a usage error (exit 2).
+        line = _check_error(result, 2, "this looks like an")
+        assert line.endswith(f"ertools score {WRONG_BENCHMARK[case]}"), line
+        return
     # Named: the topic or frame asked for, or (for a log of the wrong kind) the log itself.
     _check_error(
         result, 1, "/no/such/topic", "no_such_frame", "fbm3w_mocap", "fbm2h_mocap", "/fbm1h"
     )
+
+
+# the TOPIC_CASES that give a benchmark another one's log, and the benchmark it is
+WRONG_BENCHMARK = {"fbm2h-on-fbm3w-log": "fbm3w", "fbm1h-on-fbm2h-log": "fbm2h"}
 
 
 def test_wrong_topic_audit(inputs: Inputs, capsys: pytest.CaptureFixture[str]) -> None:

@@ -5,8 +5,10 @@ from __future__ import annotations
 import shlex
 from pathlib import Path
 
+import pytest
 from test_readme import ROOT, console_blocks
 
+from ertools import demo
 from ertools.demo import steps
 
 # Where the output goes is the demo's business, not a scoring option.
@@ -37,3 +39,34 @@ def test_demo_steps_use_the_options_the_readme_shows(tmp_path: Path) -> None:
     assert {("score", "fbm3w"), ("score", "fbm2h"), ("score", "trajectory"), ("audit",)} <= shared
     for key in sorted(shared):
         assert demo[key] == readme[key], f"ertools {' '.join(key)}: demo and README differ"
+
+
+def test_the_demo_lists_no_empty_output(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every `-> FILE` the demo prints is a file with content: a command printing nothing on
+    stdout (rescore writes its own folder; a failed step) leaves no 0-byte file behind."""
+    printed_by = {"timeline", "info", "noise"}  # the others print nothing in this fake
+
+    def fake_main(argv: list[str]) -> int:
+        if argv[0] in printed_by:
+            print("some output")
+        if argv[0] == "rescore":
+            out = Path(argv[argv.index("--out") + 1])
+            out.mkdir(parents=True)
+            (out / "index.html").write_text("<html></html>")
+            return 1  # the planted problems
+        return 0
+
+    monkeypatch.setattr(demo, "ertools_main", fake_main)
+    monkeypatch.setattr(demo, "make_competition", lambda day: None)
+    assert demo.run(tmp_path) == 0
+    err = capsys.readouterr().err
+    listed = [Path(line.split("-> ", 1)[1].split(" (exit")[0]) for line in err.splitlines()
+              if "   -> " in line]  # fmt: skip
+    assert len(listed) == len(printed_by) + 1  # and the rescore site
+    assert "nothing on stdout" in err
+    files = [p for p in listed if p.is_file()]
+    assert files and all(p.stat().st_size > 0 for p in files)
+    assert (tmp_path / "rescore" / "index.html") in files
+    assert not [p for p in tmp_path.rglob("*") if p.is_file() and p.stat().st_size == 0]

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+from stderr_text import joined_lines
 
 ROOT = Path(__file__).resolve().parents[2]
 SHARED = ROOT.parent / "shared"
@@ -142,7 +143,10 @@ def test_docs_commands_run_as_printed(name: str, tmp_path: Path) -> None:
             current = int(line.split()[1])
             outputs[current] = []
         elif current >= 0:
-            outputs[current].append(line.strip())
+            outputs[current].append(line)
+    # An error message longer than a line continues on indented lines: the docs show it whole,
+    # on one line (stderr_text.joined_lines).
+    outputs = {n: [x.strip() for x in joined_lines("\n".join(o))] for n, o in outputs.items()}
     ran = max(outputs, default=-1)
     if proc.returncode != 0:
         failed = commands[ran] if ran >= 0 else None

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from stderr_text import joined_lines
 
 from ertools.cli.main import main
 
@@ -26,7 +27,7 @@ FBM1H = SAMPLES / "fbm1h"
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, list[str]]:
     code = main(list(argv))
     out, err = capsys.readouterr()
-    return code, out, [x for x in err.splitlines() if x.strip()]
+    return code, out, [x for x in joined_lines(err) if x.strip()]
 
 
 def only_errors(out: str, err: list[str], *needles: str) -> None:

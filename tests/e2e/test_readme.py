@@ -68,6 +68,17 @@ def test_readme_tour_runs_as_printed(tmp_path: Path) -> None:
         check=False,
     )
     assert proc.returncode == 0, proc.stderr[-2000:]
+    # Run in a checkout, the tour leaves nothing `git status` would show: every file it
+    # writes is under a folder .gitignore ignores (out/).
+    written = sorted(p.name for p in work.iterdir() if p.name not in ("sample_bags", ".venv"))
+    assert written, "the tour writes its outputs somewhere"
+    for name in written:
+        ignored = subprocess.run(
+            ["git", "check-ignore", "--no-index", "-q", name + "/"],
+            cwd=ROOT,
+            check=False,
+        )
+        assert ignored.returncode == 0, f"the tour wrote {name} into the checkout, not ignored"
     out = [line.strip() for line in proc.stdout.splitlines()]
     position = 0
     for expected in (line for _, shown in blocks for line in shown):

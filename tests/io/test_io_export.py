@@ -16,9 +16,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import Scene
 from hypothesis import given
 from hypothesis import strategies as st
+from io_scene import Scene
 
 from ertools.cli.main import main
 from ertools.errors import BagError

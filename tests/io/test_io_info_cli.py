@@ -8,8 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from conftest import DT, Scene
 from io_bagmaker import write
+from io_scene import DT, Scene
+from stderr_text import joined_lines
 
 from ertools.cli.main import main
 
@@ -74,7 +75,7 @@ def test_info_table_and_yaml(
 
 
 def one_error_line(err: str, *needles: str) -> None:
-    lines = [x for x in err.splitlines() if x.strip()]
+    lines = [x for x in joined_lines(err) if x.strip()]
     assert len(lines) == 1, err
     assert lines[0].startswith("ertools: error: ")
     for needle in needles:
@@ -172,7 +173,7 @@ def test_corrupted_record_in_uncompressed_chunk(
     assert code == 1
     # One line per disagreement: the odd record, and the index entry and chunk-info count
     # that still call it a message.
-    lines = err.splitlines()
+    lines = joined_lines(err)
     assert len(lines) == 3, err
     assert all(x.startswith(f"ertools: error: {bad}: chunk at byte ") for x in lines)
     assert "record of op 9 inside the chunk at offset" in lines[0]
@@ -215,7 +216,7 @@ def test_malformed_rosbag2_metadata_is_one_line(
     (bag / "metadata.yaml").write_text("rosbag2_bagfile_information: [unclosed\n  x: {\n")
     code, out, err = run(capsys, str(bag), "--format", "yaml")
     assert code == 1
-    lines = err.strip().splitlines()
+    lines = joined_lines(err.strip())
     assert len(lines) == 1 and lines[0].startswith("ertools: error:"), err
     assert "broken_rosbag2" in lines[0] and "metadata.yaml" in lines[0]
     (problem,) = yaml.safe_load(out)["problems"]

@@ -12,8 +12,8 @@ import json
 from pathlib import Path
 
 import pytest
-from conftest import T0
 from io_bagmaker import FORMATS, Spec, bag_name, write
+from io_scene import T0
 
 from ertools.cli.main import main
 

@@ -15,8 +15,8 @@ from typing import Any
 
 import numpy as np
 import pytest
-from conftest import Scene
 from io_bagmaker import write
+from io_scene import Scene
 
 import ertools.io as eio
 from ertools.cli.main import main

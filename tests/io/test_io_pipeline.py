@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import Scene
 from io_bagmaker import bag_name, write
+from io_scene import Scene
 from test_io_fastpath import POSE_TOPICS, assert_same, fast_batch, reference_batch
 
 import ertools.io as eio

@@ -10,8 +10,9 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import Scene
 from io_bagmaker import bag_name, write
+from io_scene import Scene
+from stderr_text import error_messages
 from test_io_fastpath import fast_batch
 
 from ertools.cli.main import main
@@ -374,7 +375,7 @@ def test_cli_error_after_a_read_starts_on_a_wiped_line(
     bar, error = err.rsplit("\r", 1)
     assert f"\rertools: reading /odom from {ros1_bag.name} [{'#' * 24}]" in bar
     assert error.startswith("\x1b[Kertools: error: GT topic /no is not in the robot log")
-    assert error.count("\n") == 1 and error.endswith("\n")
+    assert len(error_messages(error.removeprefix("\x1b[K"))) == 1 and error.endswith("\n")
 
 
 @pytest.mark.parametrize("where", ["group", "member"])

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 import pytest
 from io_bagmaker import Spec, write
+from stderr_text import error_messages
 
 import ertools.io as eio
 from ertools.cli.main import main
@@ -75,7 +76,7 @@ def two_topic_bag(path: Path, fmt: str = "ros1") -> Path:
 def cli(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, Any, list[str]]:
     code = main(["info", "--format", "json", *args])
     out = capsys.readouterr()
-    errors = [line for line in out.err.splitlines() if line.startswith("ertools: error:")]
+    errors = error_messages(out.err)
     return code, json.loads(out.out), errors
 
 

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import DT, T0, Scene, make_scene
 from io_bagmaker import Spec, bag_name, write
+from io_scene import DT, T0, Scene, make_scene
 
 import ertools.io as eio
 from ertools.errors import BagError, TopicError

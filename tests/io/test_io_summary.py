@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import Scene
 from io_bagmaker import write
+from io_scene import Scene
 
 import ertools.io as eio
 from ertools.errors import BagError

@@ -8,10 +8,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import DT, T0, Scene
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from io_bagmaker import Spec, write
+from io_scene import DT, T0, Scene
 
 import ertools.io as eio
 from ertools.errors import TopicError

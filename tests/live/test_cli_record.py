@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 import yaml
+from stderr_text import error_messages
 
 from ertools.cli.main import main
 from ertools.live.tail import is_finished, read_complete
@@ -42,8 +43,8 @@ def test_usage_and_config_errors(tmp_path: Path, capsys: pytest.CaptureFixture[s
     bad = tmp_path / "bad.yaml"
     bad.write_text("rigid_bodies:\n'3':\n  pose: robot_at_home/pose\n")
     assert main(["record", "--config", str(bad), "--out-dir", str(tmp_path)]) == 1
-    err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0 and "indent them under rigid_bodies" in err
+    err = error_messages(capsys.readouterr().err)
+    assert len(err) == 1 and "indent them under rigid_bodies" in err[0]
     good = Path(__file__).resolve().parents[2] / "configs" / "mocap_home.yaml"
     code = main(
         ["record", "--config", str(good), "--out-dir", str(tmp_path), "--natnet-version", "x"]

@@ -225,3 +225,48 @@ def test_timeline_notebook_on_the_real_logs(tmp_path: Path) -> None:
     assert float(row[4]) == pytest.approx(57.6, abs=0.05)
     assert "nothing to audit" in text
     assert "no answers file" in text
+
+
+def _private_uses(source: str) -> list[str]:
+    """What a notebook's code takes from ertools beyond the public API (docs/api.md): any
+    ``from ertools... import`` or ``import ertools.x``, and ``ertools.NAME`` for a NAME that
+    is not a public one."""
+    import ertools
+
+    public = {*ertools.API, "__version__"}
+    # IPython's magics (`%matplotlib inline`) are not Python
+    code = "\n".join("" if line.lstrip().startswith("%") else line for line in source.split("\n"))
+    found = []
+    for node in ast.walk(ast.parse(code)):
+        if isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] == "ertools":
+            found.append(f"from {node.module} import ...")
+        elif isinstance(node, ast.Import):
+            found += [a.name for a in node.names if a.name.startswith("ertools.")]
+        elif (
+            isinstance(node, ast.Attribute)
+            and isinstance(node.value, ast.Name)
+            and node.value.id == "ertools"
+            and node.attr not in public
+        ):
+            found.append(f"ertools.{node.attr}")
+    return found
+
+
+@pytest.mark.parametrize("name", _names())
+def test_notebook_uses_only_the_public_api(name: str) -> None:
+    import nbformat
+
+    nb = nbformat.read(NOTEBOOKS / f"{name}.ipynb", as_version=4)
+    code = "\n".join(c.source for c in nb.cells if c.cell_type == "code")
+    assert "import ertools" in code
+    assert _private_uses(code) == [], f"{name}.ipynb: use ertools' public API (docs/api.md)"
+
+
+def test_the_public_api_rule_sees_private_imports() -> None:
+    assert _private_uses("import ertools\nertools.score('x', [])\n%matplotlib inline\n") == []
+    assert _private_uses(
+        "from ertools.report.frames import result_to_dataframes\n"
+        "import ertools.audit.rescore\n"
+        "import ertools\n"
+        "ertools.benchmarks.registry.get('fbm2h')\n"
+    ) == ["from ertools.report.frames import ...", "ertools.audit.rescore", "ertools.benchmarks"]

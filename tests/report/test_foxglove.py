@@ -23,6 +23,7 @@ import numpy as np
 import pytest
 import yaml
 from foxglove_readback import ReadBack, read_back, stamp_ns
+from stderr_text import error_messages
 
 from ertools.cli.main import main
 
@@ -368,7 +369,7 @@ def test_audit_of_fbm2h(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> N
 def _one_error(argv: list[str], code: int, capsys: pytest.CaptureFixture[str]) -> str:
     assert main(argv) == code
     err = capsys.readouterr().err
-    lines = [ln for ln in err.splitlines() if ln.startswith("ertools: error:")]
+    lines = error_messages(err)
     assert len(lines) == 1 and "Traceback" not in err, err
     return lines[0]
 

@@ -6,11 +6,11 @@ import pandas as pd
 import pytest
 from report_fakes import fbm3w_like
 
-from ertools.report.frames import result_to_dataframes, rows_to_dataframe
+from ertools.frames import rows_to_dataframe, tables_to_frames
 
 
 def test_epoch_column_becomes_utc_index() -> None:
-    frames = result_to_dataframes(fbm3w_like())
+    frames = tables_to_frames(fbm3w_like().tables())
     runs = frames["runs"]
     assert isinstance(runs.index, pd.DatetimeIndex)
     assert str(runs.index.tz) == "UTC" and runs.index.name == "time"
@@ -38,7 +38,7 @@ def test_audit_tables_as_frames() -> None:
     from ertools.audit.analyse import audit_states
     from ertools.states import Machine
 
-    frames = result_to_dataframes(audit_states(heartbeat(Machine.BMBOX, BMBOX, 20.0)))
+    frames = audit_states(heartbeat(Machine.BMBOX, BMBOX, 20.0)).to_frames()
     tl = frames["timeline"]
     assert tl.index[0] == pd.Timestamp(T0_NS, unit="ns", tz="UTC")
     assert len(tl) == len(BMBOX)

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 from rescore_competition import make_competition, use_toy_registry
+from stderr_text import joined_lines
 
 from ertools.cli.main import main
 from ertools.errors import ConfigError
@@ -94,7 +95,7 @@ def test_every_problem_at_once(tmp_path: Path, capsys: pytest.CaptureFixture[str
     # the command: one line each, nothing scored, exit 1
     code = main(["rescore", "--config", str(comp.manifest), "--out", str(tmp_path / "out")])
     assert code == 1
-    lines = capsys.readouterr().err.splitlines()
+    lines = joined_lines(capsys.readouterr().err)
     assert sorted(lines[:-1]) == sorted(f"ertools: error: {comp.manifest}: {p}" for p in expected)
     assert lines[-1] == f"ertools: error: 14 problem(s) in {comp.manifest}; nothing was scored"
     assert not (tmp_path / "out").exists()

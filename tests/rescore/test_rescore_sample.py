@@ -23,11 +23,17 @@ OPTION = {"items": "--items", "goal": "--goal", "transform": "--transform", "con
 
 
 @pytest.fixture(scope="module")
-def day(sample_competition: Path) -> tuple[Path, dict[str, Any], dict[str, Any]]:
+def results(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """This worker's results folder: the day is shared by the session's workers, read only."""
+    return tmp_path_factory.mktemp("results")
+
+
+@pytest.fixture(scope="module")
+def day(sample_competition: Path, results: Path) -> tuple[Path, dict[str, Any], dict[str, Any]]:
     root = sample_competition  # generated once per session (tests/conftest.py), seed SEED
     answers: dict[str, Any] = json.loads((root / "answers.json").read_text())
     manifest = root / answers["manifest"]  # the organiser's, written with the logs
-    out = root.parent / "results"  # beside the day's folder, nothing written into it
+    out = results
     err = io.StringIO()
     with contextlib.redirect_stderr(err):
         code = main(
@@ -107,7 +113,7 @@ def test_unscoreable_executions_say_why(day: tuple[Path, dict[str, Any], dict[st
 
 
 def test_problems_planted_in_the_day_are_listed(
-    day: tuple[Path, dict[str, Any], dict[str, Any]],
+    day: tuple[Path, dict[str, Any], dict[str, Any]], results: Path
 ) -> None:
     root, answers, doc = day
     listed = {(p["kind"], p["path"]) for p in doc["problems"]}
@@ -118,7 +124,7 @@ def test_problems_planted_in_the_day_are_listed(
     missing = [p for p in doc["problems"] if p["kind"] == "missing-input"]
     assert [p["message"].split(":")[0] for p in missing] == ["fbm2h-skuba-20151120T111450"]
     assert doc["timeline"] == {"figure": "timeline.html", "sessions": doc["timeline"]["sessions"]}
-    assert (root.parent / "results" / "timeline.html").is_file()
+    assert (results / "timeline.html").is_file()
 
 
 def test_leaderboards_follow_each_benchmarks_rule(

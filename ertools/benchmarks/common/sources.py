@@ -19,16 +19,16 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 
 from ertools.benchmarks.common.spec import (
     DEFAULT_PARENT,
     DEFAULT_TIME_SOURCE,
-    TIME_SOURCES,
     TimeSource,
 )
-from ertools.errors import TopicError, UsageError
+from ertools.benchmarks.common.spec import PoseSpec as PoseSpec  # noqa: PLC0414 (re-exported)
+from ertools.errors import TopicError
 from ertools.io import PoseSource, read_pose_source, topics
 from ertools.io.model import POSE_TYPES, TF_TYPES
 from ertools.streams import PoseStream
@@ -39,60 +39,11 @@ log = logging.getLogger(__name__)
 HEADERLESS_TYPES = ("geometry_msgs/Pose2D",)
 
 
-@dataclass(frozen=True)
-class PoseSpec:
-    """A pose source as the command line gives it.
-
-    Attributes:
-        topic: a pose topic (PoseStamped, Pose2D, TransformStamped, PoseWithCovarianceStamped,
-            Odometry), or None.
-        tf: ``(parent, child)`` frames read from ``/tf`` and ``/tf_static``, or None. At most
-            one of ``topic`` and ``tf`` is set; neither means "the command's default".
-        time_source: ``header`` (message stamp) or ``record`` (the bag's record time); tf
-            poses always carry their transforms' stamps.
-        time_source_given: the user chose ``time_source`` (a fallback then says so louder).
-    """
-
-    topic: str | None = None
-    tf: tuple[str, str] | None = None
-    time_source: TimeSource = DEFAULT_TIME_SOURCE
-    time_source_given: bool = False
-
-    def __post_init__(self) -> None:
-        if self.topic is not None and self.tf is not None:
-            raise UsageError(f"give --topic {self.topic} or --tf {self.tf_text}, not both")
-        if self.time_source not in TIME_SOURCES:
-            raise UsageError(f"--time-source {self.time_source}: choose header or record")
-
-    @property
-    def given(self) -> bool:
-        """True when the command line named a topic or a tf pair."""
-        return self.topic is not None or self.tf is not None
-
-    @property
-    def tf_text(self) -> str:
-        return f"{self.tf[0]}:{self.tf[1]}" if self.tf is not None else ""
-
-    @property
-    def name(self) -> str:
-        """The source in messages: the topic, or ``tf PARENT:CHILD``."""
-        if self.topic is not None:
-            return self.topic
-        return f"tf {self.tf_text}" if self.tf is not None else "the default source"
-
-    def describe(self) -> str:
-        """How the user would spell it: ``--topic /x`` or ``--tf world:robot``."""
-        if self.topic is not None:
-            return f"--topic {self.topic}"
-        if self.tf is not None:
-            return f"--tf {self.tf_text}"
-        return "the default source"
-
-    def to_io(self) -> PoseSource:
-        """The reader's :class:`~ertools.io.PoseSource` (a topic, else the tf pair)."""
-        if self.tf is not None:
-            return PoseSource(topic=None, frame=self.tf[1], parent=self.tf[0])
-        return PoseSource(topic=self.topic, time_source=self.time_source)
+def pose_source(spec: PoseSpec) -> PoseSource:
+    """The reader's :class:`~ertools.io.PoseSource` of a spec (a topic, else the tf pair)."""
+    if spec.tf is not None:
+        return PoseSource(topic=None, frame=spec.tf[1], parent=spec.tf[0])
+    return PoseSource(topic=spec.topic, time_source=spec.time_source)
 
 
 def topic(name: str, time_source: TimeSource = DEFAULT_TIME_SOURCE) -> PoseSpec:
@@ -218,7 +169,7 @@ def read_source(
     present = topics(list(paths))
     chosen, fallback = _choose(paths, spec, defaults, what, only_topic, present, flags)
     try:
-        poses = read_pose_source(list(paths), chosen.to_io(), start_ns=start_ns, end_ns=end_ns)
+        poses = read_pose_source(list(paths), pose_source(chosen), start_ns=start_ns, end_ns=end_ns)
     except TopicError as err:
         if fallback is None:
             raise

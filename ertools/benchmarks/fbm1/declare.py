@@ -366,6 +366,7 @@ def _declare(
     return Benchmark(
         name=name,
         title=title,
+        source_inputs=("origin_topic", "origin_tf", "ref_board_topic", "ref_board_tf"),
         summary=summary,
         example=f"ertools score {name} run.bag --items configs/{name}.yaml",
         description=DESCRIPTION,

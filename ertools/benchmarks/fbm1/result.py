@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.benchmarks.fbm1.answers import Answer
@@ -12,8 +12,12 @@ from ertools.benchmarks.fbm1.gt import GroundTruth
 from ertools.benchmarks.fbm1.score import PoseErrors, Totals
 from ertools.configs.items import Item
 from ertools.fidelity import Deviation
+from ertools.frames import tables_to_frames
 from ertools.streams import Provenance
 from ertools.timeutil import NS_PER_S, ns_to_s
+
+if TYPE_CHECKING:
+    import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 
 @dataclass(frozen=True)
@@ -231,6 +235,11 @@ class Fbm1Result:
     def to_yaml(self) -> str:
         """The 2015 score (first four keys, as its node sent them) then the details."""
         return dump_yaml(self.to_dict())
+
+    def to_frames(self) -> dict[str, pd.DataFrame]:
+        """Every table of :meth:`tables` as a pandas DataFrame, epoch times as a UTC index
+        (:func:`ertools.frames.tables_to_frames`)."""
+        return tables_to_frames(self.tables())
 
     def tables(self) -> dict[str, Rows]:
         return {"runs": [r.row(self.t0_ns) for r in self.runs]}

@@ -491,15 +491,7 @@ def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
     if options.reached in (None, "states"):
         states = read_benchmark_states(list(plist), options.namespace)
         if states.bmbox is None:
-            if options.reached == "states":
-                raise SegmentationError(
-                    f"{plist[0]}: no /{options.namespace}/bmbox_state topic; "
-                    "use --reached timing FILE or --reached auto"
-                )
-            raise SegmentationError(
-                f"{plist[0]}: no benchmark state topics to find the reached moments; "
-                "use --reached timing FILE (a reached-waypoint timing file) or --reached auto"
-            )
+            raise SegmentationError(_stateless(Path(plist[0]), options))
     return Fbm2hLogs(
         paths=plist,
         transform=transform,
@@ -509,6 +501,36 @@ def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
         bag_end_ns=max(i.end_ns for i in infos),
         warnings=(invalid_warning(invalid, marker.source),) if invalid else (),
         states=states,
+    )
+
+
+# Where the 2015 loggers left a GT-only log's other inputs: the timing file beside the log,
+# a goal list in its folder (../shared/real_bags: fbm2h_test_optitrackless_goal.yaml).
+TIMING_SUFFIX = "_reached_waypoint_timing.yaml"
+GOAL_PATTERN = "*goal*.yaml"
+
+
+def _stateless(bag: Path, options: Fbm2hOptions) -> str:
+    """What a log without state topics needs, all in one message: the reached moments (a
+    timing file, or stops) and, unless given, the goal list; the files found beside the log
+    are named (only their names are looked at here)."""
+    why = (
+        f"no /{options.namespace}/bmbox_state topic"
+        if options.reached == "states"
+        else "no benchmark state topics (a ground-truth-only log)"
+    )
+    timing = bag.with_name(bag.name.removesuffix(".bag") + TIMING_SUFFIX)
+    goals = sorted(bag.parent.glob(GOAL_PATTERN)) if options.goal is None else []
+    needed = "the reached moments" + (" and the waypoints" if options.goal is None else "")
+    found = timing.is_file()
+    give = [f"--reached timing {timing}" if found else "--reached timing FILE"]
+    if options.goal is None:
+        found = found and len(goals) == 1
+        give.append(f"--goal {goals[0]}" if len(goals) == 1 else "--goal FILE (Listing 10)")
+    where = " (found beside the log)" if found else ""
+    return (
+        f"{bag}: {why}: give {needed}; {' '.join(give)}{where}; "
+        "or --reached auto (stops found in the ground truth)"
     )
 
 

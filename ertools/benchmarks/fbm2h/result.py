@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -14,8 +14,12 @@ from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
 from ertools.fidelity import Deviation
+from ertools.frames import tables_to_frames
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
+
+if TYPE_CHECKING:
+    import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 Pose2 = tuple[float, float, float]
 
@@ -178,6 +182,11 @@ class Fbm2hResult:
         """Same structure as the YAML, segment indices as string keys."""
         data: dict[str, Any] = jsonable(self._listing(string_keys=True))
         return data
+
+    def to_frames(self) -> dict[str, pd.DataFrame]:
+        """Every table of :meth:`tables` as a pandas DataFrame, epoch times as a UTC index
+        (:func:`ertools.frames.tables_to_frames`)."""
+        return tables_to_frames(self.tables())
 
     def tables(self) -> dict[str, Rows]:
         """``segments`` (one row per waypoint) and ``summary``."""

@@ -244,7 +244,7 @@ EXPLANATIONS = (
 EPILOG = """examples:
   ertools score fbm3w log_fbm3w_mocap.bag
   ertools score fbm3w run.bag --config configs/fbm3w.yaml --format json
-  ertools score fbm3w run.bag --d-min 0.0005 --plot plots/
+  ertools score fbm3w run.bag --d-min 0.0005 --plots plots/
   ertools score fbm3w run.bag --d-min-sweep 0.0001:0.001:10
   ertools score fbm3w mocap_only.bag --runs auto
   ertools score fbm3w mocap_only.bag --run line:2.0:3.1:7.1 --run spline:9.3:10.5:16

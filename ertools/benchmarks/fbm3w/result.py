@@ -4,15 +4,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.benchmarks.fbm3w.path import PathScore
 from ertools.benchmarks.fbm3w.runs import RunWindow
 from ertools.benchmarks.noise.benchmark import NoiseResult
 from ertools.fidelity import Deviation
+from ertools.frames import tables_to_frames
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
+
+if TYPE_CHECKING:
+    import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 # Listing 16 keys of one run, in the listing's order; ertools' extra keys follow them.
 RUN_KEYS = ("spec", "distance_error", "execution_time")
@@ -183,6 +187,11 @@ class Fbm3wResult:
     def to_yaml(self) -> str:
         """Listing 16: best_distance_error, best_run, execution_time, runs_details {i: ...}."""
         return dump_yaml(_plain(self._score()))
+
+    def to_frames(self) -> dict[str, pd.DataFrame]:
+        """Every table of :meth:`tables` as a pandas DataFrame, epoch times as a UTC index
+        (:func:`ertools.frames.tables_to_frames`)."""
+        return tables_to_frames(self.tables())
 
     def tables(self) -> dict[str, Rows]:
         runs: Rows = []

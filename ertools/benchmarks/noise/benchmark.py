@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -30,7 +30,11 @@ from ertools.benchmarks.common.phases import (
 )
 from ertools.errors import ScoringError
 from ertools.fidelity import Deviation
+from ertools.frames import tables_to_frames
 from ertools.streams import PoseStream, Provenance
+
+if TYPE_CHECKING:
+    import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 DEFAULT_BIN = 0.00015  # the 2015 tool's D_INTERVAL
 DEFAULT_C = 3.0
@@ -97,6 +101,11 @@ class NoiseResult:
 
     def to_yaml(self) -> str:
         return dump_yaml(jsonable(self.to_dict()))
+
+    def to_frames(self) -> dict[str, pd.DataFrame]:
+        """Every table of :meth:`tables` as a pandas DataFrame, epoch times as a UTC index
+        (:func:`ertools.frames.tables_to_frames`)."""
+        return tables_to_frames(self.tables())
 
     def tables(self) -> dict[str, Rows]:
         edges, counts, overflow = self.histogram()

@@ -267,7 +267,7 @@ EPILOG = """examples:
   ertools score trajectory robot.bag gt/ --2015        # what the 2015 script computed
   ertools score trajectory robot.bag gt/ --association hold --gaps compare
   ertools score trajectory robot.bag gt/ --offset auto --apply-offset --format json
-  ertools score trajectory robot.bag gt/log_0.bag gt/log_1.bag --offset -0.35 --plot figs/
+  ertools score trajectory robot.bag gt/log_0.bag gt/log_1.bag --offset -0.35 --plots figs/
   ertools score trajectory ROS_example.bag --robot-topic ORB-SLAM --gt-topic groundtruth \\
       --association nearest --t-max-diff 0.01
       # the pairs and numbers of: evo_ape bag ROS_example.bag groundtruth ORB-SLAM
@@ -286,6 +286,9 @@ error.
 BENCHMARK: Benchmark[TrajectoryOptions, TrajectoryLogs, None, TrajectoryResult] = Benchmark(
     name="trajectory",
     title="Offline trajectory benchmark",
+    # the robot's own log: /rockin/<team>/marker_pose
+    namespace="rockin",
+    source_inputs=("robot_topic", "gt_topic"),
     summary="robot log vs mocap ground truth, with clock audit",
     example="ertools score trajectory robot.bag gt/ --robot-topic /rockin/homer/marker_pose",
     description="""Compare a robot's own pose log with the mocap ground truth (2015 offline
@@ -293,7 +296,7 @@ trajectory benchmark).
 
 The GT files are picked from GT_PATH (bags or folders) by time overlap with the robot log and
 read as one stream; without GT_PATH the GT topic is read from the robot log itself (evo's
-``bag`` mode). Every run also audits the clocks: it estimates the offset between the
+`bag` mode). Every run also audits the clocks: it estimates the offset between the
 robot's stamps and the GT clock and says when it matters.""",
     epilog=EPILOG,
     bags_help="the robot's log, then GT bags or folders of them (none: the GT topic is in "

@@ -5,7 +5,7 @@ JSON/YAML/text and the CSV tables.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -23,8 +23,12 @@ from ertools.benchmarks.trajectory.association import (
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.benchmarks.trajectory.metrics import Metrics
 from ertools.fidelity import Deviation
+from ertools.frames import tables_to_frames
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import NS_PER_S, ns_to_s
+
+if TYPE_CHECKING:
+    import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 
 @dataclass(frozen=True, eq=False)
@@ -142,6 +146,11 @@ class TrajectoryResult:
     def to_yaml(self) -> str:
         """The same as :meth:`to_dict` as YAML (the 2015 script printed two text lines)."""
         return dump_yaml(self.to_dict())
+
+    def to_frames(self) -> dict[str, pd.DataFrame]:
+        """Every table of :meth:`tables` as a pandas DataFrame, epoch times as a UTC index
+        (:func:`ertools.frames.tables_to_frames`)."""
+        return tables_to_frames(self.tables())
 
     def tables(self) -> dict[str, Rows]:
         """``samples`` (one row per robot pose: the error series) and ``summary``."""

@@ -25,6 +25,7 @@ from ertools.errors import BagError
 from ertools.io.bagfile import BagFile, RawRecord
 from ertools.io.decode.fast import LayoutMismatchError, gather, read_at
 from ertools.io.model import Conn
+from ertools.io.ros1.check import rebuild_layout
 from ertools.io.ros1.layout import (
     INDEX_DTYPE,
     MSG_HEADER_LEN,
@@ -336,9 +337,6 @@ class Ros1Bag(BagFile):
             why,
         )
         self._unmap()
-        # lazy: the record-by-record rebuild only for a bag whose index was found wrong
-        from ertools.io.ros1.check import rebuild_layout
-
         layout = rebuild_layout(self.file, self.path, self.layout.size, _first_record(self), why)
         damage = [p for p in layout.problems if p != why]
         if damage:

@@ -2,7 +2,8 @@
 group of chunks at a time: whole chunks read (and decompressed) on worker threads, or, where
 the wanted records are sparse, only the pages that hold them.
 
-The ROS1 part of :func:`ertools.io.bulk.locate`; :meth:`Ros1Bag.raw` reads through it too.
+The ROS1 part of :func:`ertools.io.bulk.locate`; ``Ros1Bag.raw`` (:mod:`ertools.io.ros1.index`)
+reads through it too.
 """
 
 from __future__ import annotations
@@ -10,11 +11,14 @@ from __future__ import annotations
 import itertools
 import mmap
 from collections.abc import Iterator, Sequence
-from typing import TYPE_CHECKING, Any
+from io import BufferedReader
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
+import numpy.typing as npt
 
-from ertools.arrays import I64
+from ertools.arrays import I64, U8
 from ertools.errors import BagError
 from ertools.io import pipeline
 from ertools.io.model import Conn
@@ -30,16 +34,33 @@ from ertools.io.pipeline import (
     read_at,
     scratch_view,
 )
-from ertools.io.ros1.layout import Ros1Chunk, decompress
+from ertools.io.ros1.layout import Ros1Chunk, Ros1Layout, decompress
 
 if TYPE_CHECKING:
-    # the bag calls this module: its class is an annotation here, never imported
-    from ertools.io.ros1.index import Ros1Bag
     from ertools.progress import Reporter
 
 
+class IndexedBag(Protocol):
+    """What this module reads of an open ROS1 bag (:class:`ertools.io.ros1.index.Ros1Bag`,
+    which calls it: a protocol rather than that class keeps the two modules acyclic)."""
+
+    path: Path
+    layout: Ros1Layout
+
+    @property
+    def file(self) -> BufferedReader: ...
+
+    def select(
+        self, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
+    ) -> tuple[list[int], I64, npt.NDArray[np.integer[Any]], I64, I64]: ...
+
+    def checked_spans(
+        self, buf: U8, offsets: I64, t_ns: I64, conn: I64, where: str
+    ) -> tuple[I64, I64]: ...
+
+
 def ros1_runs(
-    bag: Ros1Bag,
+    bag: IndexedBag,
     conns: Sequence[Conn],
     lo: int | None,
     hi: int | None,
@@ -116,7 +137,7 @@ def ros1_runs(
 SPARSE_GAP = 12 * 1024
 
 
-def sparse_chunks(bag: Ros1Bag, touched: list[int], groups: dict[int, I64]) -> dict[int, int]:
+def sparse_chunks(bag: IndexedBag, touched: list[int], groups: dict[int, I64]) -> dict[int, int]:
     """Uncompressed chunks whose wanted records are sparse -> bytes of the pages they touch."""
     out = {}
     page = mmap.PAGESIZE
@@ -128,7 +149,7 @@ def sparse_chunks(bag: Ros1Bag, touched: list[int], groups: dict[int, I64]) -> d
     return out
 
 
-def mapped_group(bag: Ros1Bag, chunks: list[Ros1Chunk], scratch: list[Any]) -> Group:
+def mapped_group(bag: IndexedBag, chunks: list[Ros1Chunk], scratch: list[Any]) -> Group:
     """Chunks read in place through a read-only map of the stretch they span: the pages
     holding wanted records are read (with the kernel's usual read-ahead), the rest never.
 
@@ -147,7 +168,7 @@ def mapped_group(bag: Ros1Bag, chunks: list[Ros1Chunk], scratch: list[Any]) -> G
     return np.frombuffer(mm, dtype=np.uint8), base, sizes
 
 
-def chunk_group(bag: Ros1Bag, chunks: list[Ros1Chunk], scratch: list[Any]) -> Group:
+def chunk_group(bag: IndexedBag, chunks: list[Ros1Chunk], scratch: list[Any]) -> Group:
     """(bytes, where each chunk's data starts in them, each chunk's size) of ROS1 chunks,
     loaded into ``scratch`` (runs on a loading thread: positional reads only).
 

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 from fbm1_testkit import ITEMS_YAML, RunSpec, bodies, state_streams, write_bag, write_items
+from stderr_text import error_messages
 
 from ertools.benchmarks.fbm1.benchmark import score_fbm1
 from ertools.benchmarks.fbm1.runs import find_runs
@@ -150,8 +151,10 @@ def test_cli_body_missing_from_the_bag(
     bag = write_bag(tmp_path / "missing.bag", [GOOD], omit=[body])
     code, out, err = _cli(tmp_path, capsys, bag)
     assert code == 1 and out == ""
-    lines = err.strip().splitlines()
-    assert len(lines) == 1
+    lines = error_messages(err)
+    assert len(lines) == 1 and all(
+        ln.startswith(("ertools: error:", "  ")) for ln in err.splitlines()
+    )
     assert f"/fbm1h/{body}/pose" in lines[0] and f"tf world:{body}" in lines[0]
 
 

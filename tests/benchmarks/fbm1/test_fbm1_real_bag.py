@@ -20,5 +20,8 @@ def test_fbm2h_log_is_not_an_fbm1_log(tmp_path: Path, capsys: pytest.CaptureFixt
     items = write_items(tmp_path / "items.yaml")
     code = main(["score", "fbm1h", str(BAG), "--items", str(items)])
     out, err = capsys.readouterr()
-    assert code == 1 and out == ""
-    assert err.count("\n") == 1 and "no /fbm1h/bmbox_state messages" in err
+    assert code == 2 and out == ""
+    assert err == (
+        f"ertools: error: {BAG}: this looks like an FBM2@Home log (topics /fbm2h/...): "
+        "ertools score fbm2h\n"
+    )

@@ -7,6 +7,7 @@ from typing import Any
 
 import pytest
 import yaml
+from stderr_text import error_messages
 
 from ertools.cli.main import main
 
@@ -30,7 +31,7 @@ def _sample_seconds(sample: Any) -> list[float]:
 
 
 def _one_error_line(err: str, *needles: str) -> None:
-    lines = [ln for ln in err.splitlines() if ln.startswith("ertools: error:")]
+    lines = error_messages(err)
     assert len(lines) == 1, err
     assert "Traceback" not in err
     for needle in needles:

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
+from stderr_text import error_messages
 
 from ertools.cli.main import main
 
@@ -161,7 +162,10 @@ def test_real_bag_without_states_needs_reached(
     code = main(["score", "fbm2h", str(BAG), "--goal", str(GOAL)])
     err = capsys.readouterr().err
     assert code == 1
-    assert err.count("\n") == 1 and "--reached timing FILE" in err
+    # one message: what is missing, and the files beside the log that hold it
+    (message,) = error_messages(err)
+    assert "no benchmark state topics" in message and "give the reached moments;" in message
+    assert f"--reached timing {TIMING}" in message and "--reached auto" in message
 
 
 def test_real_bag_auto_stops(real: dict[str, Any], capsys: pytest.CaptureFixture[str]) -> None:

@@ -26,6 +26,7 @@ from protocol_logs import (
     write_bag,
     write_config,
 )
+from stderr_text import error_messages
 
 from ertools.cli.main import main
 
@@ -235,7 +236,7 @@ def test_a_log_without_an_end_phase_says_what_it_found(
     config = write_config(["line"], tmp_path / "fbm3w.yaml")
     code, _, err = _cli(capsys, bag, "--config", config, "--runs", "auto")
     assert code == 1
-    lines = [ln for ln in err.splitlines() if ln.startswith("ertools: error:")]
+    lines = error_messages(err)
     assert len(lines) == 1 and "Traceback" not in err
     line = lines[0]
     assert "found 2 still phase(s)" in line
@@ -260,7 +261,7 @@ def test_no_move_matches_the_shape(tmp_path: Path, capsys: pytest.CaptureFixture
     config = write_config(["semi_ellipse"], tmp_path / "fbm3w.yaml")
     code, _, err = _cli(capsys, bag, "--config", config, "--runs", "auto")
     assert code == 1
-    line = next(ln for ln in err.splitlines() if ln.startswith("ertools: error:"))
+    line = error_messages(err)[0]
     assert "matches run 0's shape 'semi_ellipse'" in line
     assert "still phases 0.00-" in line
     pa, pb = log.truth.path[0]

@@ -10,6 +10,7 @@ import pytest
 import yaml
 from fbm3w_kit import Sample
 from fbm3w_synth import one_run
+from stderr_text import error_messages
 
 from ertools.cli.main import main
 from ertools.configs.shapes import builtin_shapes
@@ -21,7 +22,7 @@ def score(*args: str) -> int:
 
 
 def one_line_error(err: str) -> str:
-    lines = [ln for ln in err.splitlines() if ln.startswith("ertools: error:")]
+    lines = error_messages(err)
     assert len(lines) >= 1, err
     assert "Traceback" not in err
     return lines[0]

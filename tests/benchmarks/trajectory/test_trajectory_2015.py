@@ -20,6 +20,7 @@ from typing import Any
 import numpy as np
 import pytest
 from node_2015 import EndOfBagError, Pose, score_2015, tf_yaw
+from stderr_text import error_messages
 from trajectory_helpers import read_back, write_gt, write_robot
 
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
@@ -351,7 +352,7 @@ def test_uncovered_start_is_a_failure_with_the_covered_part_scored(
     default prints the covered part's numbers, exit 1, the failure pointing at the options."""
     assert main(["score", "trajectory", *hand, "--association", "hold", "--format", "json"]) == 1
     cap = capsys.readouterr()
-    errors = [ln for ln in cap.err.splitlines() if ln.startswith("ertools: error: ")]
+    errors = error_messages(cap.err)
     assert len(errors) == 1
     assert "1 lie before the first GT pose" in errors[0] and "--before-gt first" in errors[0]
     out = json.loads(cap.out)
@@ -361,8 +362,9 @@ def test_uncovered_start_is_a_failure_with_the_covered_part_scored(
     # After the last GT pose 2015 gave no score (exit 6): still an error alone.
     late = [hand[0], hand[1], "--association", "hold", "--offset", "0.2"]
     assert main(["score", "trajectory", *late]) == 1
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith("ertools: error: ")
+    err = capsys.readouterr().err
+    assert len(error_messages(err)) == 1
+    assert all(ln.startswith(("ertools: error: ", "  ")) for ln in err.strip().splitlines())
 
 
 @pytest.mark.parametrize(

@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from stderr_text import error_messages
 from trajectory_helpers import write_gt, write_robot
 
 from ertools.cli.main import main
@@ -19,7 +20,7 @@ def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> str:
     """Run, expect exit 1 and exactly one error line (no traceback); return the line."""
     assert main(["score", "trajectory", *args]) == 1
     err = capsys.readouterr().err
-    lines = [ln for ln in err.splitlines() if ln.startswith("ertools: error:")]
+    lines = error_messages(err)
     assert len(lines) == 1, err
     assert "Traceback" not in err and "unexpected" not in err
     return lines[0]

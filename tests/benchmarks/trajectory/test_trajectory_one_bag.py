@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from stderr_text import error_messages
 from test_trajectory_sample import check
 from trajectory_helpers import read_back
 
@@ -104,7 +105,7 @@ def test_cli_one_bag(
 def _one_error(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
     assert main(["score", "trajectory", *argv]) == 1
     err = capsys.readouterr().err
-    lines = [ln for ln in err.splitlines() if ln.startswith("ertools: error:")]
+    lines = error_messages(err)
     assert len(lines) == 1 and "Traceback" not in err, err
     return lines[0]
 

@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from stderr_text import error_messages
 from trajectory_helpers import read_back, yaw
 
 from ertools.benchmarks.trajectory.benchmark import score
@@ -108,7 +109,7 @@ def test_apply_offset_needs_auto(robot_cli: list[str], capsys: pytest.CaptureFix
 
 
 def _one_error_line(err: str) -> str:
-    lines = [ln for ln in err.splitlines() if ln.startswith("ertools: error:")]
+    lines = error_messages(err)
     assert len(lines) == 1, err
     assert "Traceback" not in err
     return lines[0]

@@ -1,7 +1,8 @@
 """Results as pandas DataFrames, for notebooks and users' own analysis.
 
-``result_to_dataframes(result)`` turns every table of a result (``result.tables()``) into a
-DataFrame. Columns that hold times become UTC datetimes: epoch-second columns (``time``,
+Every result's ``to_frames()`` (a benchmark result, an audit) is :func:`tables_to_frames` of
+its ``tables()``: each table a DataFrame. Columns that hold times become UTC datetimes:
+epoch-second columns (``time``,
 ``start_time``, ``*_time`` with values after 2001) are converted, and when a table has one,
 it becomes the DatetimeIndex named ``time``. Columns of seconds *from the start* (``start``,
 ``duration``, ``segment_time``...) stay floats: they are durations, not instants.
@@ -55,15 +56,12 @@ def rows_to_dataframe(rows: list[dict[str, Any]]) -> pd.DataFrame:
     return df
 
 
-def result_to_dataframes(result: Any) -> dict[str, pd.DataFrame]:
-    """Every table of a result (any BenchmarkResult, or an Audit) as a DataFrame.
-
-    Args:
-        result: an object with ``tables() -> dict[str, list[dict]]``.
+def tables_to_frames(tables: dict[str, list[dict[str, Any]]]) -> dict[str, pd.DataFrame]:
+    """Every table of a result's ``tables()`` as a DataFrame.
 
     Returns:
         Table name -> DataFrame; times as a UTC DatetimeIndex named ``time`` where a column
         of epoch times exists (``time``, ``start_time``...), other time columns converted in
         place.
     """
-    return {name: rows_to_dataframe(rows) for name, rows in result.tables().items()}
+    return {name: rows_to_dataframe(rows) for name, rows in tables.items()}

@@ -1,0 +1,64 @@
+"""Which benchmark a log is: ``ertools score fbm3w`` given an FBM2@Home log says so and names
+the command, rather than failing later on a pose topic it cannot find.
+
+A benchmark's logs have their topics under its namespace (``/fbm2h/...``, the robot's own log
+``/rockin/...``: :attr:`~ertools.benchmarks.base.Benchmark.log_namespace`). A log with none
+under the benchmark asked for, and some under another registered one, is that one's log.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from ertools.benchmarks import registry
+from ertools.errors import ErtoolsError, UsageError
+from ertools.io import topics
+
+
+def _namespaces(names: Sequence[str]) -> dict[str, int]:
+    """Topic count by first part (``/fbm2h/robot_at_home/pose`` -> ``fbm2h``)."""
+    counts: dict[str, int] = {}
+    for topic in names:
+        first = topic.strip("/").split("/")[0]
+        if first and "/" in topic.strip("/"):
+            counts[first] = counts.get(first, 0) + 1
+    return counts
+
+
+def other_benchmark(name: str, bag: Path, values: Mapping[str, Any]) -> str | None:
+    """The message when ``bag`` is plainly another benchmark's log, else None.
+
+    None too when the user named the log's topics or frames (the benchmark's
+    :attr:`~ertools.benchmarks.base.Benchmark.source_inputs`: they know the log), or when
+    the log cannot be read (the scorer then says why, as it would have).
+    """
+    bench = registry.get(name)
+    if any(values.get(i) not in (None, False, ()) for i in bench.source_inputs):
+        return None
+    try:
+        spaces = _namespaces(list(topics([bag])))
+    except ErtoolsError:
+        return None
+    if not bench.log_namespace or bench.log_namespace in spaces:
+        return None
+    candidates = []
+    for other in registry.names():
+        ns = registry.get(other).log_namespace
+        if other != name and ns in spaces:
+            candidates.append((-spaces[ns], other, ns))
+    if not candidates:
+        return None
+    _, other, ns = min(candidates)
+    title = registry.get(other).title
+    return f"this looks like an {title} log (topics /{ns}/...): ertools score {other}"
+
+
+def refuse_other_benchmark(name: str, bags: Sequence[Path], values: Mapping[str, Any]) -> None:
+    """A :class:`UsageError` when the first bag is plainly another benchmark's log."""
+    if not bags:
+        return
+    message = other_benchmark(name, bags[0], values)
+    if message is not None:
+        raise UsageError(message, path=bags[0])

@@ -1,0 +1,92 @@
+"""One rescoring of a competition, start to finish: the function behind ``ertools rescore``
+and ``ertools.rescore()``, so the command and the library write the same results.
+
+Under the results folder's lock: the logs under the paths found and merged with the manifest's
+executions, the timeline written, every execution scored (in parallel, cached), every file
+under the paths placed once (the ledger), ``results.json``, ``results.csv`` and the results
+page written.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from ertools.atomic import folder_lock
+from ertools.errors import ConfigError
+from ertools.rescore.found import find, merge, write_timeline
+from ertools.rescore.ledger import account
+from ertools.rescore.manifest import Manifest
+from ertools.rescore.pipeline import listed_executions, rescore, write_results
+
+if TYPE_CHECKING:
+    from ertools.progress import Reporter
+    from ertools.rescore.jobs import Outcome
+
+
+@dataclass(frozen=True)
+class Rescored:
+    """The results document (``results.json``) and the files written."""
+
+    doc: dict[str, Any]
+    written: tuple[Path, ...]
+
+
+def rescore_competition(
+    paths: Sequence[Path],
+    manifest: Manifest,
+    out: Path,
+    *,
+    workers: int,
+    scheduler: str | None = None,
+    use_cache: bool = True,
+    reports: bool = True,
+    command: Sequence[str] = (),
+    progress: Reporter | None = None,
+    on_outcome: Callable[[Outcome], None] | None = None,
+    on_wait: Callable[[str], None] | None = None,
+) -> Rescored:
+    """Rescore the executions under ``paths`` and those ``manifest`` lists into ``out``.
+
+    Raises:
+        ConfigError: no execution found under ``paths`` and none listed (nothing written but
+            the timeline).
+    """
+    # two runs into one folder would mix their reports and caches: one at a time
+    with folder_lock(out, on_wait=on_wait):
+        scorings = listed_executions(manifest)
+        problems: list[dict[str, object]] = []
+        timeline = None
+        found = None
+        if paths:
+            found = find(paths, progress=progress)
+            scorings = merge(found.scorings, scorings)
+            problems = list(found.problems)
+            out.mkdir(parents=True, exist_ok=True)
+            timeline = write_timeline(found, out, manifest.title)
+        if not scorings:
+            where = ", ".join(map(str, paths)) or "no logs were given"
+            raise ConfigError(
+                f"no benchmark execution found ({where}) and none listed in the manifest",
+                path=manifest.path,
+            )
+        doc = rescore(
+            scorings,
+            manifest,
+            out,
+            workers=workers,
+            scheduler=scheduler,
+            use_cache=use_cache,
+            reports=reports,
+            command=list(command),
+            problems=problems,
+            timeline=timeline,
+            progress=progress,
+            on_outcome=on_outcome,
+        )
+        if found is not None:  # every file under PATH in one place (docs/rescore.md, "files")
+            robots = {str(s.bags[0]): s.of for s in found.scorings if s.of is not None}
+            doc = account(doc, found.files, found.folders, robots)
+        return Rescored(doc, tuple(write_results(doc, out)))

@@ -1,0 +1,50 @@
+"""How the suite runs: `make test` on every core with the 15 slowest listed, `make check` the
+fast part; tests/slow.txt and the timing group name tests that exist."""
+
+from __future__ import annotations
+
+import importlib.util
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+TESTS = ROOT / "tests"
+
+
+def _root_conftest() -> object:
+    # by path: every test folder's conftest is a module named `conftest`
+    spec = importlib.util.spec_from_file_location("root_conftest", TESTS / "conftest.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _recipe(target: str) -> str:
+    text = (ROOT / "Makefile").read_text(encoding="utf-8")
+    match = re.search(rf"^{target}:.*\n((?:\t.*\n)+)", text, flags=re.MULTILINE)
+    assert match, f"the Makefile has no {target} target"
+    return match.group(1)
+
+
+def test_make_test_runs_in_parallel_and_lists_the_slowest() -> None:
+    pytest_line = _recipe("pytest")
+    for part in ("-n $(PYTEST_JOBS)", "--dist loadgroup", "--durations=15"):
+        assert part in pytest_line
+    assert re.search(r"^test: lint typecheck pytest$", (ROOT / "Makefile").read_text(), re.M)
+
+
+def test_make_check_is_lint_and_the_fast_tests() -> None:
+    recipe = _recipe("check")
+    assert "ruff check" in recipe and "lint-imports" in recipe
+    assert '-m "not slow"' in recipe
+
+
+def test_listed_tests_exist() -> None:
+    conftest = _root_conftest()
+    for entry in (*conftest._slow(), *conftest.TIMING):  # type: ignore[attr-defined]
+        path = entry.split("::")[0]
+        assert (TESTS / path).exists(), f"tests/slow.txt or TIMING names {entry}: no such file"
+        if "::" in entry:
+            name = entry.split("::")[1].split("[")[0]
+            assert f"def {name}(" in (TESTS / path).read_text(encoding="utf-8"), entry
