@@ -34,7 +34,7 @@ from ertools.io.pipeline import (
     prefetched,
 )
 from ertools.io.ros1.runs import chunk_group, ros1_runs
-from ertools.io.rosbag2.metadata import sqlite_rows
+from ertools.io.rosbag2.metadata import readable_files, sqlite_rows
 from ertools.progress import current
 
 if TYPE_CHECKING:
@@ -135,9 +135,6 @@ def mcap_index(bag: BagFile) -> McapIndex | None:
     """The MCAP index of a standalone MCAP file or of a rosbag2-mcap directory's storage
     files (decompressed when the bag is compressed file by file), None for other formats."""
     if bag.format == "rosbag2-mcap":
-        # lazy: PyYAML only for rosbag2 folders
-        from ertools.io.rosbag2.metadata import readable_files
-
         return McapIndex([f for f in readable_files(bag.path) if f.suffix == ".mcap"])
     return McapIndex.of(bag)
 

@@ -25,6 +25,7 @@ from ertools.io.mcap.scan import SCAN, mcap_layout, scan_mcap
 from ertools.io.mcap.summary import mcap_errors
 from ertools.io.model import Conn, short_msgtype
 from ertools.io.ros1.index import Ros1Bag
+from ertools.io.rosbag2.metadata import readable_dir
 
 log = logging.getLogger("ertools.io.files")
 
@@ -77,9 +78,6 @@ class RosbagsFile(BagFile):
             else:
                 # lazy: rosbags only on the per-message path (~0.1 s to import)
                 from rosbags.rosbag2 import Reader as Reader2
-
-                # lazy: PyYAML only for rosbag2 folders
-                from ertools.io.rosbag2.metadata import readable_dir
 
                 # A bag compressed file by file: the copies every other reader reads.
                 self._reader = Reader2(readable_dir(path))

@@ -10,6 +10,7 @@ import re
 from pathlib import Path
 
 import pytest
+from stderr_text import joined_lines
 
 from ertools.cli.main import main
 
@@ -89,7 +90,7 @@ def test_info_says_which_format_was_expected(
     path = tmp_path / "x.bag"
     path.write_text(SECRET)
     assert main(["info", str(path)]) == 1
-    err = capsys.readouterr().err
+    err = " ".join(joined_lines(capsys.readouterr().err))
     assert err.strip() == (
         f"ertools: error: {path}: not a ROS1 bag, rosbag2 bag or MCAP file: it does not "
         "begin with '#ROSBAG V2.0' (ROS1) or MCAP's magic bytes; a text file (if it is a "
