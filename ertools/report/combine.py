@@ -344,8 +344,8 @@ def _by_team(runs: list[Execution], outdir: Path) -> list[h.Table]:
 
 
 def _score_text(key: str, value: Any) -> str:
-    """``best_distance_error 0.639 mm``: a headline value as text, in its display unit."""
+    """``best_distance_error 0.64 mm``: a headline value as text, in its display unit."""
     spec = units.quantity_of(key)
     if spec is None or not units.is_number(value):
         return f"{key} {h.fmt(value)}"
-    return f"{key} {h.fmt(units.display(key, value))} {units.unit(spec[0])}"
+    return f"{key} {h.fmt(units.display(key, value), spec[0])} {units.unit(spec[0])}"

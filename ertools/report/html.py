@@ -37,8 +37,10 @@ def relative_href(path: str | None) -> str | None:
     return "/".join(quote(part, safe="") for part in pure.parts)
 
 
-def fmt(value: Any) -> str:
-    """A cell's text: floats with 6 significant digits, NaN/None as an em dash."""
+def fmt(value: Any, quantity: str | None = None) -> str:
+    """A cell's text: a float of a ``quantity`` (already in its display unit) at the decimals
+    its data resolves (:func:`ertools.report.units.fixed`), other floats with 6 significant
+    digits, NaN/None as an em dash."""
     if value is None:
         return "\u2014"
     if isinstance(value, bool):
@@ -46,6 +48,8 @@ def fmt(value: Any) -> str:
     if isinstance(value, float):
         if math.isnan(value):
             return "\u2014"
+        if quantity is not None:
+            return units.fixed(value, quantity)
         return f"{value:.6g}"
     return str(value)
 
@@ -110,33 +114,46 @@ def table(
     headers = tuple(
         f"{c} (UTC)" if c in epoch else units.header(c) if c in numeric else c for c in columns
     )
+    quantities = {c: _quantity(c) for c in numeric}
     out: list[Row] = []
     for row in shown:
         cells = []
         for col in columns:
             value = units.display(col, row.get(col))
-            text = _utc(value) if col in epoch and units.is_number(value) else fmt(value)
-            css = ["num"] if units.is_number(value) else []
-            if col == "status":
-                css.append("status")
-            if "\n" in text:
-                cells.append(Cell(text, " ".join(css), pre=True))
-            elif len(text) > long_text:
-                cells.append(Cell(text, "long"))
+            if col in epoch and units.is_number(value):
+                text = _utc(value)
             else:
-                cells.append(Cell(text, " ".join(css)))
+                text = fmt(value, quantities.get(col))
+            cells.append(_cell(text, units.is_number(value), long_text, status=col == "status"))
         out.append(Row(tuple(cells), fmt(row.get(row_class, "")) if row_class else None))
     more = len(rows) - max_rows if max_rows is not None and len(rows) > max_rows else 0
     return Table(headers, tuple(out), caption, more)
 
 
+def _quantity(name: str) -> str | None:
+    spec = units.quantity_of(name)
+    return spec[0] if spec else None
+
+
+def _cell(text: str, number: bool, long_text: int, *, status: bool = False) -> Cell:
+    css = " ".join([*(["num"] if number else []), *(["status"] if status else [])])
+    if "\n" in text:
+        return Cell(text, css, pre=True)
+    if len(text) > long_text:
+        return Cell(text, "long")
+    return Cell(text, css)
+
+
 def key_values(pairs: Sequence[tuple[str, Any]], *, caption: str | None = None) -> Table:
-    """A two-column (metric, value) table; each metric's name carries its unit."""
+    """A two-column (metric, value) table; each metric's name carries its unit and its value
+    the decimals of its quantity."""
     rows = []
     for key, value in pairs:
-        name = units.header(key) if units.is_number(value) else key
-        rows.append({"metric": name, "value": units.display(key, value)})
-    return table(rows, columns=["metric", "value"], caption=caption)
+        number = units.is_number(value)
+        name = units.header(key) if number else key
+        text = fmt(units.display(key, value), _quantity(key) if number else None)
+        rows.append(Row((_cell(name, False, 80), _cell(text, number, 80))))
+    return Table(("metric", "value"), tuple(rows), caption)
 
 
 @dataclass(frozen=True)

@@ -32,6 +32,11 @@ QUANTITIES: dict[str, Quantity] = {
     "time": Quantity("s", {"s": 1.0, "ms": 1e-3, "ns": 1e-9}),
 }
 
+# Decimals shown per quantity, in its display unit (mm, deg, s): what the data resolves. Mocap
+# positions are good to ~0.1 mm (0.1-0.3 mm marker noise), so 0.01 mm keeps one guard digit;
+# orientations to ~0.05 deg; the loggers stamp to the millisecond.
+DECIMALS = {"length": 2, "angle": 2, "time": 3}
+
 # Column or score key -> (quantity, the unit the value is stored in). Keys of every
 # benchmark's tables() and headline; a unit suffix in the name (``_m``, ``_rad``) is dropped
 # from the header, which states the display unit instead.
@@ -110,6 +115,16 @@ def is_epoch(name: str, values: list[Any]) -> bool:
 def factor(quantity: str, stored: str) -> float:
     """What a value stored in ``stored`` units is multiplied by to show it."""
     return QUANTITIES[quantity].factors[stored]
+
+
+def fixed(value: float, quantity: str) -> str:
+    """``value`` (in the display unit of ``quantity``) at :data:`DECIMALS`; a value smaller
+    than the last decimal but not zero (a clock offset's uncertainty of 0.2 ms) keeps two
+    significant digits rather than reading as 0."""
+    text = f"{value:.{DECIMALS[quantity]}f}"
+    if value != 0 and float(text) == 0:
+        return f"{value:.2g}"
+    return text
 
 
 def unit(quantity: str) -> str:

@@ -23,10 +23,8 @@ from ertools.report import units
 # What an execution no log and no manifest entry names a team for is called, on the page and
 # in results.json: scored, left out of the leaderboards until named.
 TEAM_UNKNOWN = "team unknown (name it in the manifest)"
-# Decimals shown per quantity, in its display unit (mm, deg, s): what the data resolves. Mocap
-# positions are good to ~0.1 mm (0.1-0.3 mm marker noise), so 0.01 mm keeps one guard digit;
-# orientations to ~0.05 deg; the loggers stamp to the millisecond.
-DECIMALS = {"length": 2, "angle": 2, "time": 3}
+# Decimals per quantity: one table for the site and the reports (ertools.report.units).
+DECIMALS = units.DECIMALS
 # The rule texts of the registry name the stored unit; the page states the display unit.
 _UNIT_WORDS = {"metres": "mm", "meters": "mm", "radians": "degrees", "seconds": "s"}
 _FLAG = re.compile(r"(?<![\w-])--[a-z0-9][a-z0-9-]*")

@@ -98,8 +98,8 @@ def test_dom_has_tables_and_images(report: Path, tmp_path: Path) -> None:
     assert EVIL in dom.cells  # ...shown as text in the runs table
     assert dom.tables >= 5  # score, runs, comparison, audit tables, timeline
     # The page shows lengths in mm: 0.0123 m (fbm3w_like) is 12.3 mm, with its unit.
-    assert "best_distance_error (mm)" in dom.cells and f"{0.0123 * 1000:.6g}" == "12.3"
-    assert "12.3" in dom.cells
+    # To 0.01 mm, the resolution mocap data has (docs/reports.md).
+    assert "best_distance_error (mm)" in dom.cells and "12.30" in dom.cells
     assert dom.imgs, "no figure in the page"
     for src in dom.imgs:
         if src.startswith("data:"):

@@ -47,9 +47,9 @@ def test_combined_page(
     page = (out / "index.html").read_text(encoding="utf-8")
     assert page.count("<table>") == 2 + 3  # one table per benchmark, one per team
     # tripod, lengths in mm on the page (0.0123 m), times in s; results.csv keeps metres.
-    assert f"{0.0123 * 1000:.6g}" == "12.3"
-    assert "best_distance_error 12.3 mm, best_run 1, execution_time 41.5 s" in page
-    assert "<th>best_distance_error (mm)</th>" in page and '<td class="num">8.7</td>' in page
+    # to the data's resolution: 0.01 mm, 1 ms
+    assert "best_distance_error 12.30 mm, best_run 1, execution_time 41.500 s" in page
+    assert "<th>best_distance_error (mm)</th>" in page and '<td class="num">8.70</td>' in page
     assert "b&lt;it&gt;bots" in page and "<it>" not in page
     assert "Lisbon &lt;2015&gt;" in page
     assert 'href="../results/fbm3w-0.0123/index.html"' in page
@@ -136,7 +136,7 @@ def test_same_inputs_are_one_execution(tmp_path: Path) -> None:
     assert float(tripod["best_distance_error"]) == 0.0125
     # an option list begins like a formula: a spreadsheet shows the apostrophed text as is
     assert tripod["options"] == "'--team tripod"
-    assert tripod["other results"] == f"(defaults): best_distance_error {0.0123 * 1000:.6g} mm"
+    assert tripod["other results"] == "(defaults): best_distance_error 12.30 mm"
     assert rows[0]["other results"] == ""
     page = (out / "index.html").read_text(encoding="utf-8")
     assert "(unknown)" not in page
