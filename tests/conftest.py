@@ -68,6 +68,15 @@ def _slow() -> tuple[str, ...]:
     return tuple(ln.split("#")[0].strip() for ln in lines if ln.split("#")[0].strip())
 
 
+def _shares_a_module_fixture(item: pytest.Item) -> bool:
+    info = getattr(item, "_fixtureinfo", None)
+    if info is None:
+        return False
+    return any(
+        d.scope in ("module", "class") for defs in info.name2fixturedefs.values() for d in defs
+    )
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     slow = _slow()
     for item in items:
@@ -78,6 +87,10 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         node = rel + item.nodeid[item.nodeid.index("::") :] if "::" in item.nodeid else rel
         if node.startswith(TIMING):
             item.add_marker(pytest.mark.xdist_group("timing"))
+        elif _shares_a_module_fixture(item):
+            # Its module's tests on one worker: the fixture (a rescored folder, a report) is
+            # made once, not once on each worker that draws one of them.
+            item.add_marker(pytest.mark.xdist_group(rel))
         if node.startswith(slow):
             item.add_marker(pytest.mark.slow)
 
