@@ -2,7 +2,8 @@
 
 `BagWriter` is the only place the simulator touches a file. Scenario modules hand it whole
 arrays (one call per topic and per stretch of time); it serialises fixed-layout messages
-(PoseStamped, Pose2D, one-transform TFMessage) in bulk with NumPy, buffers everything, and on
+(PoseStamped, Pose2D, one-transform TFMessage) in bulk with NumPy
+(:mod:`ertools.samples.packing`), buffers everything, and on
 close writes all messages **sorted by record time** (stable, so equal times keep call order),
 as ``rosbag record`` did. Nothing in it reads a clock or a random source: the same calls give
 the same bytes.
@@ -46,105 +47,26 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import F64, I64, U8
+from ertools.arrays import I64, U8
 from ertools.errors import UsageError
-from ertools.states import MSG_DEFINITIONS, MSG_TYPES, Machine
+from ertools.samples.packing import (
+    Field,
+    as_bytes,
+    broadcast_rows,
+    pack_messages,
+    rosbags_name,
+    split_time,
+    typestore,
+)
+from ertools.states import MSG_TYPES, Machine
 
 BagFormat = Literal["ros1", "rosbag2-mcap", "rosbag2-sqlite3", "mcap"]
 FORMATS: tuple[BagFormat, ...] = ("ros1", "rosbag2-mcap", "rosbag2-sqlite3", "mcap")
 
 
-# tf2_msgs/TFMessage is not in rosbags' Noetic store; its definition is one line.
-_TF_MESSAGE = "geometry_msgs/TransformStamped[] transforms\n"
-
 # rosgraph_msgs/Log levels (ROS1) and their rcl_interfaces/Log equivalents (ROS 2).
 LOG_LEVELS_ROS1 = {"DEBUG": 1, "INFO": 2, "WARN": 4, "ERROR": 8, "FATAL": 16}
 _LOG_LEVELS_ROS2 = {"DEBUG": 10, "INFO": 20, "WARN": 30, "ERROR": 40, "FATAL": 50}
-
-NS_PER_S = 1_000_000_000
-
-
-def _typestore(ros2: bool) -> Any:
-    """A rosbags typestore with every type the simulator writes (cached per process)."""
-    key = "ros2" if ros2 else "ros1"
-    cached = _STORES.get(key)
-    if cached is not None:
-        return cached
-    # lazy: rosbags only on the per-message path (~0.1 s to import)
-    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
-
-    store = get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
-    types: dict[str, Any] = {}
-    if not ros2:
-        types.update(get_types_from_msg(_TF_MESSAGE, "tf2_msgs/msg/TFMessage"))
-    for machine, text in MSG_DEFINITIONS.items():
-        types.update(get_types_from_msg(text, _msgtype(MSG_TYPES[machine])))
-    store.register(types)
-    _STORES[key] = store
-    return store
-
-
-_STORES: dict[str, Any] = {}
-
-
-def _msgtype(name: str) -> str:
-    """``pkg/Type`` -> ``pkg/msg/Type`` (rosbags' normalised spelling)."""
-    pkg, _, base = name.rpartition("/")
-    return name if pkg.endswith("/msg") else f"{pkg}/msg/{base}"
-
-
-def split_time(t_ns: npt.ArrayLike) -> tuple[I64, I64]:
-    """int64 ns -> (sec, nsec) arrays as ROS stores them."""
-    t = np.asarray(t_ns, dtype=np.int64)
-    return t // NS_PER_S, t % NS_PER_S
-
-
-# --------------------------------------------------------------------------- bulk packing
-
-_Field = tuple[str, Any]  # ("u4"|"i4"|"f8", array (N,) or (N,k)) or ("str", str)
-
-
-def pack_messages(n: int, fields: Sequence[_Field], *, cdr: bool) -> U8:
-    """Serialise ``n`` messages of a fixed layout into an (n, size) byte array in one go.
-
-    ROS1 is packed little-endian with no padding and strings as ``uint32 len + bytes``. CDR
-    (ROS 2) starts with the 4-byte little-endian encapsulation header, aligns every primitive
-    to its size relative to the end of that header, and NUL-terminates strings (the length
-    counts the NUL). Tests check the output byte for byte against rosbags' serialisers.
-    """
-    base = 4 if cdr else 0
-    offsets: list[int] = []
-    pos = base
-    for kind, value in fields:
-        width = 8 if kind == "f8" else 4
-        if cdr:
-            pos += -(pos - base) % width
-        offsets.append(pos)
-        if kind == "str":
-            pos += 4 + len(value.encode()) + (1 if cdr else 0)
-        else:
-            cols = 1 if np.ndim(value) <= 1 else int(np.shape(value)[-1])
-            pos += width * cols
-    buf = np.zeros((n, pos), dtype=np.uint8)
-    if cdr:
-        buf[:, :4] = np.frombuffer(b"\x00\x01\x00\x00", dtype=np.uint8)
-    for (kind, value), off in zip(fields, offsets, strict=True):
-        if kind == "str":
-            raw = value.encode() + (b"\x00" if cdr else b"")
-            head = np.frombuffer(np.uint32(len(raw)).tobytes() + raw, dtype=np.uint8)
-            buf[:, off : off + head.size] = head
-            continue
-        dtype = {"u4": "<u4", "i4": "<i4", "f8": "<f8"}[kind]
-        arr = np.ascontiguousarray(
-            np.broadcast_to(np.asarray(value, dtype=dtype), _shape(n, value))
-        )
-        raw_cols = arr.reshape(n, -1).view(np.uint8)
-        buf[:, off : off + raw_cols.shape[1]] = raw_cols
-    return buf
-
-
-def _shape(n: int, value: Any) -> tuple[int, ...]:
-    return (n,) if np.ndim(value) <= 1 else (n, int(np.shape(value)[-1]))
 
 
 # --------------------------------------------------------------------------- the writer
@@ -201,7 +123,7 @@ class BagWriter:
         self.compression = compression
         self.chunk_size = chunk_size
         self.ros2 = fmt != "ros1"
-        self.typestore = _typestore(self.ros2)
+        self.typestore = typestore(self.ros2)
         self._conns: list[tuple[str, str, str | None, bool]] = []
         self._conn_index: dict[tuple[str, str, str | None], int] = {}
         self._batches: list[_Batch] = []
@@ -226,13 +148,13 @@ class BagWriter:
 
     def msgclass(self, msgtype: str) -> Any:
         """The rosbags dataclass of a type in this store (``pkg/Type`` or ``pkg/msg/Type``)."""
-        return self.typestore.types[_msgtype(msgtype)]
+        return self.typestore.types[rosbags_name(msgtype)]
 
     def connection(
         self, topic: str, msgtype: str, *, callerid: str | None = None, latching: bool = False
     ) -> Connection:
         """Declare (or look up) a connection; ROS 2 formats ignore ``callerid``."""
-        mt = _msgtype(msgtype)
+        mt = rosbags_name(msgtype)
         if mt not in self.typestore.types:
             raise UsageError(f"message type {msgtype} is not in the {self.fmt} type store")
         key = (topic, mt, None if self.ros2 else callerid)
@@ -275,7 +197,7 @@ class BagWriter:
         self._seq[conn.index] = start + n
         return np.arange(start, start + n, dtype=np.int64)
 
-    def _header(self, conn: Connection | None, t_header_ns: I64, frame_id: str) -> list[_Field]:
+    def _header(self, conn: Connection | None, t_header_ns: I64, frame_id: str) -> list[Field]:
         sec, nsec = split_time(t_header_ns)
         n = t_header_ns.size
         if self.ros2:
@@ -297,7 +219,7 @@ class BagWriter:
         callerid: str | None = None,
     ) -> Connection:
         """geometry_msgs/PoseStamped, one per row (scalars broadcast); Header.seq counts up."""
-        t_rec, t_hdr, xyz_a, quat_a = _rows(t_record_ns, t_header_ns, xyz, quat_xyzw)
+        t_rec, t_hdr, xyz_a, quat_a = broadcast_rows(t_record_ns, t_header_ns, xyz, quat_xyzw)
         conn = self.connection(topic, "geometry_msgs/PoseStamped", callerid=callerid)
         fields = [*self._header(conn, t_hdr, frame_id), ("f8", np.hstack([xyz_a, quat_a]))]
         self.write_raw(conn, t_rec, pack_messages(t_rec.size, fields, cdr=self.ros2))
@@ -339,9 +261,9 @@ class BagWriter:
 
         Header.seq is 0 as in the 2015 bags (tf broadcasters did not count).
         """
-        t_rec, t_hdr, xyz_a, quat_a = _rows(t_record_ns, t_header_ns, xyz, quat_xyzw)
+        t_rec, t_hdr, xyz_a, quat_a = broadcast_rows(t_record_ns, t_header_ns, xyz, quat_xyzw)
         conn = self.connection(topic, "tf2_msgs/TFMessage", callerid=callerid)
-        fields: list[_Field] = [
+        fields: list[Field] = [
             ("u4", np.ones(t_rec.size, np.int64)),
             *self._header(None, t_hdr, parent),
             ("str", child),
@@ -563,7 +485,7 @@ class BagWriter:
                 )
             write = writer.write
             for i in order.tolist():
-                write(handles[int(conns[i])], int(times[i]), _as_bytes(rows[i]))
+                write(handles[int(conns[i])], int(times[i]), as_bytes(rows[i]))
 
     def _write_rosbag2(
         self, order: npt.NDArray[np.intp], times: I64, conns: npt.NDArray[np.int64], rows: list[Any]
@@ -586,7 +508,7 @@ class BagWriter:
                 handles[ci] = writer.add_connection(topic, mt, typestore=self.typestore)
             write = writer.write
             for i in order.tolist():
-                write(handles[int(conns[i])], int(times[i]), _as_bytes(rows[i]))
+                write(handles[int(conns[i])], int(times[i]), as_bytes(rows[i]))
 
     def _write_mcap(
         self, order: npt.NDArray[np.intp], times: I64, conns: npt.NDArray[np.int64], rows: list[Any]
@@ -624,26 +546,8 @@ class BagWriter:
                 writer.add_message(
                     channel_id=channels[ci],
                     log_time=t,
-                    data=_as_bytes(rows[i]),
+                    data=as_bytes(rows[i]),
                     publish_time=t,
                     sequence=s,
                 )
             writer.finish()  # type: ignore[no-untyped-call]
-
-
-def _as_bytes(row: Any) -> bytes:
-    return row if isinstance(row, bytes) else bytes(row.tobytes())
-
-
-def _rows(
-    t_record_ns: npt.ArrayLike, t_header_ns: npt.ArrayLike, xyz: npt.ArrayLike, quat: npt.ArrayLike
-) -> tuple[I64, I64, F64, F64]:
-    """Broadcast scalar/array inputs to (N,), (N,), (N,3), (N,4)."""
-    t_rec = np.atleast_1d(np.asarray(t_record_ns, dtype=np.int64))
-    t_hdr = np.atleast_1d(np.asarray(t_header_ns, dtype=np.int64))
-    n = max(t_rec.size, t_hdr.size)
-    t_rec = np.broadcast_to(t_rec, (n,)).copy()
-    t_hdr = np.broadcast_to(t_hdr, (n,)).copy()
-    xyz_a = np.broadcast_to(np.asarray(xyz, dtype=np.float64), (n, 3))
-    quat_a = np.broadcast_to(np.asarray(quat, dtype=np.float64), (n, 4))
-    return t_rec, t_hdr, xyz_a, quat_a

@@ -170,3 +170,36 @@ def test_no_cycle_even_through_annotations(tmp_path: Path) -> None:
     )
     planted = lint()
     assert planted.returncode != 0 and "ertools.io.ros1" in planted.stdout
+
+
+# One concept per module (/work/shared/STYLE.md): a module past this many lines holds more than
+# one and is split into modules of its package (issue 27).
+MAX_MODULE_LINES = 600
+
+
+def _long_modules(package: Path, limit: int) -> list[str]:
+    """``path: N lines`` of every module of ``package`` longer than ``limit`` lines."""
+    out = []
+    for path in sorted(package.rglob("*.py")):
+        count = len(path.read_text(encoding="utf-8").splitlines())
+        if count > limit:
+            out.append(f"{path.relative_to(package.parent)}: {count} lines")
+    return out
+
+
+def test_no_module_over_the_line_limit() -> None:
+    too_long = _long_modules(PACKAGE, MAX_MODULE_LINES)
+    assert not too_long, (
+        f"split these into cohesive modules of at most {MAX_MODULE_LINES} lines:\n"
+        + "\n".join(too_long)
+    )
+
+
+def test_the_line_limit_sees_a_long_module(tmp_path: Path) -> None:
+    package = tmp_path / "pkg"
+    (package / "sub").mkdir(parents=True)
+    (package / "short.py").write_text("x = 1\n" * MAX_MODULE_LINES, encoding="utf-8")
+    (package / "sub" / "long.py").write_text("x = 1\n" * (MAX_MODULE_LINES + 1), encoding="utf-8")
+    assert _long_modules(package, MAX_MODULE_LINES) == [
+        f"pkg/sub/long.py: {MAX_MODULE_LINES + 1} lines"
+    ]

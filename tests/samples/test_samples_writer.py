@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from ertools.errors import UsageError
-from ertools.samples.writer import FORMATS, BagWriter, pack_messages
+from ertools.samples.packing import pack_messages
+from ertools.samples.writer import FORMATS, BagWriter
 from ertools.states import MSG_TYPES, BmBoxState, ClientState, Machine
 
 T0 = 1_448_013_600_123_456_789

@@ -20,8 +20,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ertools.benchmarks.common import motion
-from ertools.benchmarks.fbm1.benchmark import read_body
 from ertools.benchmarks.fbm1.gt import board_in_table, coverage_problem
+from ertools.benchmarks.fbm1.logs import read_body
 from ertools.configs.items import Item, ItemList, ItemSpread, load_items
 from ertools.errors import ConfigError, SegmentationError
 from ertools.fidelity import Deviation, Rule

@@ -21,9 +21,10 @@ from ertools.benchmarks.base import (
     resolve_values,
     tf_value,
 )
-from ertools.benchmarks.fbm1.benchmark import Fbm1Logs, Fbm1Runs, load, locate_runs, score_found
+from ertools.benchmarks.fbm1.benchmark import score_found
 from ertools.benchmarks.fbm1.config import RULE_SETS, BodySources, Fbm1Options
 from ertools.benchmarks.fbm1.gt import GtOptions
+from ertools.benchmarks.fbm1.logs import Fbm1Logs, Fbm1Runs, load, locate_runs
 from ertools.benchmarks.fbm1.result import Fbm1Result
 from ertools.errors import ConfigError, UsageError
 from ertools.io import PoseSource

@@ -19,8 +19,9 @@ from ertools.benchmarks.base import (
     resolve_values,
     tf_value,
 )
-from ertools.benchmarks.fbm2h.benchmark import Fbm2hLogs, Fbm2hRuns, load, locate_runs, score_found
+from ertools.benchmarks.fbm2h.benchmark import score_found
 from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, Fbm2hOptions
+from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, load, locate_runs
 from ertools.benchmarks.fbm2h.result import Fbm2hResult
 from ertools.benchmarks.fbm2h.segments import StopParams
 from ertools.configs.transform import LIVE_TRANSFORM_KEY, live_transform

@@ -24,6 +24,7 @@ from ertools.benchmarks.common.hygiene import (
     identical_poses,
 )
 from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
+from ertools.benchmarks.fbm3w.auto_runs import find_auto
 from ertools.benchmarks.fbm3w.config import (
     DEFAULT_FRAME,
     DEFAULT_TOPIC,
@@ -45,7 +46,6 @@ from ertools.benchmarks.fbm3w.rules import (
 )
 from ertools.benchmarks.fbm3w.runs import (
     RunWindow,
-    find_auto,
     find_states,
     find_windows,
     with_specs,
