@@ -17,10 +17,14 @@ import os
 import pickle
 import sys
 from collections.abc import Callable, Sequence
+from importlib import import_module
 from typing import Any
 
+from ertools.benchmarks import registry
 from ertools.errors import ConfigError
-from ertools.rescore.jobs import Job, Outcome, run_job
+from ertools.report import html
+from ertools.report.figures import preload
+from ertools.rescore.jobs import Job, Outcome, load_benchmark, run_job
 
 OnDone = Callable[[Outcome], None]
 
@@ -54,6 +58,27 @@ def _worker(conn: multiprocessing.connection.Connection) -> None:
         conn.send(run_job(job))
 
 
+_warmed: set[str] = set()
+
+
+def _warm(job: Job) -> None:
+    """Import, in the process that forks, what scoring ``job`` and drawing its report load on
+    first use (its benchmark's modules, matplotlib and its font), once per process: a child
+    forked per job inherits them. Without it every Dask task paid those imports again (issue
+    29: Dask cost +72 % over local workers, which keep them between jobs)."""
+    if job.target in _warmed:
+        return
+    _warmed.add(job.target)
+    with contextlib.suppress(Exception):  # only a head start: the child imports what failed
+        load_benchmark(job.target)
+        if job.report_dir is not None:
+            figures = registry.get(job.benchmark).figures
+            if figures:
+                import_module(figures.partition(":")[0])
+            preload()
+            html.environment().get_template("report.html.j2")  # compiled once, not per job
+
+
 def run_job_forked(job: Job) -> Outcome:
     """:func:`run_job` in a child forked for this job only: a scorer that crashes or is killed
     (for memory) costs this job's row, never the Dask worker running it nor the other tasks that
@@ -62,6 +87,7 @@ def run_job_forked(job: Job) -> Outcome:
     ``multiprocessing`` forbids to have children. Where there is no fork, in this process."""
     if not hasattr(os, "fork"):
         return run_job(job)
+    _warm(job)
     read_fd, write_fd = os.pipe()
     pid = os.fork()
     if pid == 0:  # the child: score, send the outcome, leave without running any cleanup
