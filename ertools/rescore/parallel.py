@@ -16,6 +16,7 @@ import multiprocessing.connection
 import os
 import pickle
 import sys
+import threading
 from collections.abc import Callable, Sequence
 from importlib import import_module
 from typing import Any
@@ -80,39 +81,86 @@ def _warm(job: Job) -> None:
 
 
 def run_job_forked(job: Job) -> Outcome:
-    """:func:`run_job` in a child forked for this job only: a scorer that crashes or is killed
-    (for memory) costs this job's row, never the Dask worker running it nor the other tasks that
-    worker holds (the scheduler would count those as suspects of its death). ``os.fork``, not
-    ``multiprocessing``: a Dask worker under a nanny is a daemonic process, which
-    ``multiprocessing`` forbids to have children. Where there is no fork, in this process."""
+    """:func:`run_job` in a child process forked from this one: a scorer that crashes or is
+    killed (for memory) costs this job's row, never the Dask worker running it nor the other
+    tasks that worker holds (the scheduler would count those as suspects of its death).
+    ``os.fork``, not ``multiprocessing``: a Dask worker under a nanny is a daemonic process,
+    which ``multiprocessing`` forbids to have children. Where there is no fork, in this process.
+
+    The child stays for the next job of the same thread (as a local worker does), so that what
+    a job loads on first use (matplotlib, fonts, compiled templates, the figures' canvases)
+    is loaded once per worker, not once per job: forking a child per job cost the Dask path
+    ~0.8 s of CPU per execution more than local workers (issue 29). A child that died is
+    replaced by the next job."""
     if not hasattr(os, "fork"):
         return run_job(job)
-    _warm(job)
-    read_fd, write_fd = os.pipe()
-    pid = os.fork()
-    if pid == 0:  # the child: score, send the outcome, leave without running any cleanup
-        os.close(read_fd)
-        code = 0
-        try:
-            data = pickle.dumps(run_job(job))
-            with os.fdopen(write_fd, "wb") as out:
-                out.write(data)
-        except BaseException:
-            code = 1
-        os._exit(code)
-    os.close(write_fd)
-    with os.fdopen(read_fd, "rb") as fh:
-        data = fh.read()
-    _, status = os.waitpid(pid, 0)
-    if data:
-        outcome: Outcome = pickle.loads(data)  # from our own child: trusted
+    child: _Child | None = getattr(_children, "child", None)
+    if child is None or child.owner != os.getpid():  # none yet, or one of a parent's
+        _warm(job)
+        child = _children.child = _Child()
+    outcome = child.run(job)
+    if outcome is not None:
         return outcome
-    code = os.waitstatus_to_exitcode(status)
+    code = child.close()
+    _children.child = None
     return Outcome(
         job.id,
         "failed",
         reason=f"the process scoring it died (exit code {code}); the other executions were scored",
     )
+
+
+_children = threading.local()  # one child per thread of a Dask worker that runs tasks
+
+
+class _Child:
+    """A process forked from this one that scores the jobs it is sent, one at a time, until
+    its input closes (this process ended: it leaves with it) or it dies."""
+
+    def __init__(self) -> None:
+        self.owner = os.getpid()
+        job_read, job_write = os.pipe()
+        out_read, out_write = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # the child: leaves without running any of the parent's cleanup
+            os.close(job_write)
+            os.close(out_read)
+            code = 0
+            try:
+                with os.fdopen(job_read, "rb") as jobs, os.fdopen(out_write, "wb") as out:
+                    while True:
+                        try:
+                            job = pickle.load(jobs)  # from our own parent: trusted
+                        except EOFError:
+                            break
+                        pickle.dump(run_job(job), out)
+                        out.flush()
+            except BaseException:
+                code = 1
+            os._exit(code)
+        os.close(job_read)
+        os.close(out_write)
+        self.pid = pid
+        self._jobs = os.fdopen(job_write, "wb")
+        self._out = os.fdopen(out_read, "rb")
+
+    def run(self, job: Job) -> Outcome | None:
+        """The child's outcome of ``job``; None when it died before sending one."""
+        try:
+            pickle.dump(job, self._jobs)
+            self._jobs.flush()
+            outcome: Outcome = pickle.load(self._out)  # from our own child: trusted
+        except (EOFError, OSError, pickle.UnpicklingError):
+            return None
+        return outcome
+
+    def close(self) -> int:
+        """Close the child's input and wait for it; its exit code."""
+        for fh in (self._jobs, self._out):
+            with contextlib.suppress(OSError):
+                fh.close()
+        _, status = os.waitpid(self.pid, 0)
+        return os.waitstatus_to_exitcode(status)
 
 
 def _context() -> Any:
