@@ -10,6 +10,7 @@ breaks its whole pool and every job still in it. Results come back in completion
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import multiprocessing
 import multiprocessing.connection
@@ -98,6 +99,8 @@ def run_job_forked(job: Job) -> Outcome:
     if child is None or child.owner != os.getpid():  # none yet, or one of a parent's
         _warm(job)
         child = _children.child = _Child()
+        # reaped when the worker exits: no orphan, and its CPU time counts as the worker's
+        atexit.register(child.close)
     outcome = child.run(job)
     if outcome is not None:
         return outcome
@@ -155,11 +158,14 @@ class _Child:
         return outcome
 
     def close(self) -> int:
-        """Close the child's input and wait for it; its exit code."""
+        """Close the child's input and wait for it; its exit code (0 when already waited)."""
         for fh in (self._jobs, self._out):
             with contextlib.suppress(OSError):
                 fh.close()
-        _, status = os.waitpid(self.pid, 0)
+        try:
+            _, status = os.waitpid(self.pid, 0)
+        except ChildProcessError:
+            return 0
         return os.waitstatus_to_exitcode(status)
 
 
