@@ -265,12 +265,18 @@ def run_dask(jobs: Sequence[Job], address: str, *, workers: int, on_done: OnDone
     cluster = None
     try:
         if address == "local":
-            cluster = distributed.LocalCluster(
-                n_workers=max(workers, 1),
-                threads_per_worker=1,
-                processes=True,
-                dashboard_address=None,
-            )
+            import dask.config  # lazy: the optional Dask extra (ertools[dask]), as distributed
+
+            # Without the workers' statistical profiler (a thread sampling every 10 ms, ~5 %
+            # of a core per worker: measured in docs/performance.md); the nannies hand this
+            # configuration to the worker processes they start.
+            with dask.config.set({"distributed.worker.profile.enabled": False}):
+                cluster = distributed.LocalCluster(
+                    n_workers=max(workers, 1),
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=None,
+                )
             client = distributed.Client(cluster)
         else:
             client = distributed.Client(address, timeout="10s")
