@@ -268,9 +268,17 @@ def run_dask(jobs: Sequence[Job], address: str, *, workers: int, on_done: OnDone
             import dask.config  # lazy: the optional Dask extra (ertools[dask]), as distributed
 
             # Without the workers' statistical profiler (a thread sampling every 10 ms, ~5 %
-            # of a core per worker: measured in docs/performance.md); the nannies hand this
+            # of a core per worker: measured in docs/performance.md), and without the
+            # MALLOC_TRIM_THRESHOLD_=65536 the nannies put in their workers' environment: glibc
+            # then hands every freed array back to the kernel, and the next execution faults
+            # its pages in again (a local worker keeps them). The nannies hand this
             # configuration to the worker processes they start.
-            with dask.config.set({"distributed.worker.profile.enabled": False}):
+            with dask.config.set(
+                {
+                    "distributed.worker.profile.enabled": False,
+                    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+                }
+            ):
                 cluster = distributed.LocalCluster(
                     n_workers=max(workers, 1),
                     threads_per_worker=1,
