@@ -99,23 +99,30 @@ def draw_timeline(ax: Any, audit: Any) -> None:
     lane = {m: i for i, m in enumerate(_LANES)}
     # Legend: one entry per colour, naming every state drawn in it (with its machine when
     # the name is not the BmBox's).
-    seen: dict[str, tuple[Any, list[str]]] = {}
+    # One collection per lane and colour (a broken_barh call costs the same for one bar as
+    # for hundreds): the bars of a lane never overlap, so the picture is the same.
+    groups: dict[tuple[int, str], list[tuple[float, float]]] = {}
+    names: dict[str, list[str]] = {}
     for e in audit.timeline:
-        y = lane[e.machine]
         colour = state_colour(e.machine, e.state_name)
+        groups.setdefault((lane[e.machine], colour), []).append(
+            (ns_to_s(e.start_ns - t0), max(ns_to_s(e.duration_ns), 0.05))
+        )
+        name = e.state_name
+        if name not in STATE_COLOURS[Machine.BMBOX]:
+            name = f"{name} ({e.machine.value})"
+        if name not in names.setdefault(colour, []):
+            names[colour].append(name)
+    handles: dict[str, Any] = {}
+    for (y, colour), spans in groups.items():
         bar = ax.broken_barh(
-            [(ns_to_s(e.start_ns - t0), max(ns_to_s(e.duration_ns), 0.05))],
+            spans,
             (y - 0.35, 0.7),
             facecolors=colour,
             edgecolors="white" if colour != UNKNOWN_COLOUR else "#444444",
             linewidth=0.4,
         )
-        entry = seen.setdefault(colour, (bar, []))
-        name = e.state_name
-        if name not in STATE_COLOURS[Machine.BMBOX]:
-            name = f"{name} ({e.machine.value})"
-        if name not in entry[1]:
-            entry[1].append(name)
+        handles.setdefault(colour, bar)
     for r in audit.runs:
         ax.axvspan(ns_to_s(r.start_ns - t0), ns_to_s(r.end_ns - t0), color="#000000", alpha=0.04)
         ax.text(
@@ -142,8 +149,8 @@ def draw_timeline(ax: Any, audit: Any) -> None:
     ax.set_ylim(-0.9, len(_LANES) - 0.2)
     ax.set_xlabel(units.label("time from the first state message", "time"))
     ax.legend(
-        [bar for bar, _ in seen.values()],
-        [" / ".join(names) for _, names in seen.values()],
+        [handles[colour] for colour in names],
+        [" / ".join(found) for found in names.values()],
         fontsize=7,
         ncols=3,
         loc="upper center",

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 
 from ertools.report import units
-from ertools.report.figures import FigureSpec
+from ertools.report.figures import FigureSpec, size_of, thin_path
 
 ARROW = 0.25  # metres: length of the heading arrows on the path figure
 
@@ -30,7 +30,7 @@ def _arrows(ax: Any, xyt: np.ndarray, color: str, label: str, marker: str) -> No
 
 def draw_path(result: Any, ax: Any) -> None:
     """Path on the testbed frame, waypoints with target headings, reached poses."""
-    path = result.path_xyyaw
+    path = thin_path(result.path_xyyaw, size_of(ax))
     if len(path):
         ax.plot(path[:, 0], path[:, 1], color="0.55", lw=1.0, label="robot path (GT)")
     targets = np.array([s.target for s in result.segments], dtype=float)

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from ertools.report import units
-from ertools.report.figures import FigureSpec
+from ertools.report.figures import FigureSpec, size_of, thin_path
 
 MM = units.factor("length", "m")
 
@@ -17,10 +17,10 @@ def draw_run(run: Any, ax: Any) -> None:
     """Target and measured path in the run frame (mm); kept samples coloured by their error."""
     score = run.score
     if run.target_dense is not None:
-        t = np.asarray(run.target_dense) * MM
+        t = thin_path(np.asarray(run.target_dense) * MM, size_of(ax))
         ax.plot(t[:, 0], t[:, 1], color="black", lw=1.2, label=f"target ({run.spec})")
     if run.frame_xy is not None:
-        m = np.asarray(run.frame_xy) * MM
+        m = thin_path(np.asarray(run.frame_xy) * MM, size_of(ax))
         ax.plot(m[:, 0], m[:, 1], color="0.65", lw=0.6, label="measured (every sample)")
     if score is not None:
         k = score.kept_frame * MM
@@ -37,9 +37,12 @@ def draw_run(run: Any, ax: Any) -> None:
         # a few error vectors: each kept point is compared with the target at its l/L
         step = max(1, len(k) // 25)
         tg = score.target * MM
-        for i in range(step, len(k), step):
-            ax.plot([k[i, 0], tg[i, 0]], [k[i, 1], tg[i, 1]], color="tab:red", lw=0.6)
-        ax.plot([], [], color="tab:red", lw=0.6, label="compared with target(l/L)")
+        i = np.arange(step, len(k), step)
+        # one line broken by NaN rows: one artist for every vector
+        vectors = np.full((len(i), 3, 2), np.nan)
+        vectors[:, 0], vectors[:, 1] = k[i, :2], tg[i, :2]
+        flat = vectors.reshape(-1, 2)
+        ax.plot(flat[:, 0], flat[:, 1], color="tab:red", lw=0.6, label="compared with target(l/L)")
         ax.scatter([0.0], [0.0], marker="s", color="tab:green", s=30, zorder=4, label="start")
         if run.reference_xy is not None:
             ref = score.frame.to_frame(np.asarray([run.reference_xy])) * MM

@@ -11,7 +11,7 @@ import numpy as np
 
 from ertools.benchmarks.trajectory.association import GAP, TRACKING_LOST, UNCOVERED
 from ertools.report import units
-from ertools.report.figures import FigureSpec
+from ertools.report.figures import FigureSpec, size_of, thin_path, thin_series
 
 if TYPE_CHECKING:
     from ertools.benchmarks.trajectory.result import TrajectoryResult
@@ -25,7 +25,8 @@ def draw_error_over_time(ax: Any, result: TrajectoryResult) -> None:
         return
     t = (m.t_ns - m.t_ns[0]) / 1e9
     mm = units.factor("length", "m")
-    ax.plot(t, m.position_error * mm, lw=0.8, color="C0", label="position error")
+    shown = thin_series(t, m.position_error, size_of(ax)[0])
+    ax.plot(t[shown], m.position_error[shown] * mm, lw=0.8, color="C0", label="position error")
     for code, color, label in (
         (GAP, "C1", "GT gap"),
         (TRACKING_LOST, "C3", "tracking lost"),
@@ -50,9 +51,9 @@ def draw_error_over_time(ax: Any, result: TrajectoryResult) -> None:
 
 def draw_paths(ax: Any, result: TrajectoryResult) -> None:
     """The robot's estimate and the GT, seen from above (drawn in metres, read in mm)."""
-    gt = result.gt_path
-    ax.plot(gt.xyz[:, 0], gt.xyz[:, 1], lw=1.0, color="0.4", label="ground truth")
-    r = result.robot.xyz
+    gt = thin_path(result.gt_path.xyz, size_of(ax))
+    ax.plot(gt[:, 0], gt[:, 1], lw=1.0, color="0.4", label="ground truth")
+    r = thin_path(result.robot.xyz, size_of(ax))
     ax.plot(r[:, 0], r[:, 1], ".", ms=2.5, color="C0", label="robot estimate")
     units.set_axis(ax, "x", "x", "length", "m")
     units.set_axis(ax, "y", "y", "length", "m")
@@ -67,7 +68,8 @@ def draw_yaw_error(ax: Any, result: TrajectoryResult) -> None:
     if len(m.t_ns) == 0:
         return
     t = (m.t_ns - m.t_ns[0]) / 1e9
-    ax.plot(t, m.yaw_error * units.factor("angle", "rad"), lw=0.8, color="C4")
+    shown = thin_series(t, m.yaw_error, size_of(ax)[0])
+    ax.plot(t[shown], m.yaw_error[shown] * units.factor("angle", "rad"), lw=0.8, color="C4")
     ax.set_xlabel(units.label("time since the first robot pose", "time"))
     ax.set_ylabel(units.label("|yaw error|", "angle"))
     ax.grid(True, alpha=0.3)

@@ -10,6 +10,7 @@ breaks its whole pool and every job still in it. Results come back in completion
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import ctypes
 import logging
@@ -22,10 +23,14 @@ import sys
 import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
+from importlib import import_module
 from typing import Any
 
+from ertools.benchmarks import registry
 from ertools.errors import ConfigError
-from ertools.rescore.jobs import Job, Outcome, run_job
+from ertools.report import html
+from ertools.report.figures import preload
+from ertools.rescore.jobs import Job, Outcome, load_benchmark, run_job
 
 OnDone = Callable[[Outcome], None]
 log = logging.getLogger(__name__)
@@ -91,41 +96,114 @@ def _worker(conn: multiprocessing.connection.Connection, parent: int) -> None:
         conn.send(run_job(job))
 
 
+_warmed: set[str] = set()
+
+
+def _warm(job: Job) -> None:
+    """Import, in the process that forks, what scoring ``job`` and drawing its report load on
+    first use (its benchmark's modules, matplotlib and its font), once per process: a child
+    forked per job inherits them. Without it every Dask task paid those imports again (issue
+    29: Dask cost +72 % over local workers, which keep them between jobs)."""
+    if job.target in _warmed:
+        return
+    _warmed.add(job.target)
+    with contextlib.suppress(Exception):  # only a head start: the child imports what failed
+        load_benchmark(job.target)
+        if job.report_dir is not None:
+            figures = registry.get(job.benchmark).figures
+            if figures:
+                import_module(figures.partition(":")[0])
+            preload()
+            html.environment().get_template("report.html.j2")  # compiled once, not per job
+
+
 def run_job_forked(job: Job) -> Outcome:
-    """:func:`run_job` in a child forked for this job only: a scorer that crashes or is killed
-    (for memory) costs this job's row, never the Dask worker running it nor the other tasks that
-    worker holds (the scheduler would count those as suspects of its death). ``os.fork``, not
-    ``multiprocessing``: a Dask worker under a nanny is a daemonic process, which
-    ``multiprocessing`` forbids to have children. Where there is no fork, in this process."""
+    """:func:`run_job` in a child process forked from this one: a scorer that crashes or is
+    killed (for memory) costs this job's row, never the Dask worker running it nor the other
+    tasks that worker holds (the scheduler would count those as suspects of its death).
+    ``os.fork``, not ``multiprocessing``: a Dask worker under a nanny is a daemonic process,
+    which ``multiprocessing`` forbids to have children. Where there is no fork, in this process.
+
+    The child stays for the next job of the same thread (as a local worker does), so that what
+    a job loads on first use (matplotlib, fonts, compiled templates, the figures' canvases)
+    is loaded once per worker, not once per job: forking a child per job cost the Dask path
+    ~0.8 s of CPU per execution more than local workers (issue 29). A child that died is
+    replaced by the next job."""
     if not hasattr(os, "fork"):
         return run_job(job)
-    read_fd, write_fd = os.pipe()
-    parent = os.getpid()
-    pid = os.fork()
-    if pid == 0:  # the child: score, send the outcome, leave without running any cleanup
-        os.close(read_fd)
-        code = 0
-        try:
-            end_with_parent(parent)
-            data = pickle.dumps(run_job(job))
-            with os.fdopen(write_fd, "wb") as out:
-                out.write(data)
-        except BaseException:
-            code = 1
-        os._exit(code)
-    os.close(write_fd)
-    with os.fdopen(read_fd, "rb") as fh:
-        data = fh.read()
-    _, status = os.waitpid(pid, 0)
-    if data:
-        outcome: Outcome = pickle.loads(data)  # from our own child: trusted
+    child: _Child | None = getattr(_children, "child", None)
+    if child is None or child.owner != os.getpid():  # none yet, or one of a parent's
+        _warm(job)
+        child = _children.child = _Child()
+        # reaped when the worker exits: no orphan, and its CPU time counts as the worker's
+        atexit.register(child.close)
+    outcome = child.run(job)
+    if outcome is not None:
         return outcome
-    code = os.waitstatus_to_exitcode(status)
+    code = child.close()
+    _children.child = None
     return Outcome(
         job.id,
         "failed",
         reason=f"the process scoring it died (exit code {code}); the other executions were scored",
     )
+
+
+_children = threading.local()  # one child per thread of a Dask worker that runs tasks
+
+
+class _Child:
+    """A process forked from this one that scores the jobs it is sent, one at a time, until
+    its input closes (this process ended: it leaves with it) or it dies."""
+
+    def __init__(self) -> None:
+        self.owner = os.getpid()
+        job_read, job_write = os.pipe()
+        out_read, out_write = os.pipe()
+        pid = os.fork()
+        if pid == 0:  # the child: leaves without running any of the parent's cleanup
+            os.close(job_write)
+            os.close(out_read)
+            code = 0
+            try:
+                end_with_parent(self.owner)  # a worker killed mid-job takes its child along
+                with os.fdopen(job_read, "rb") as jobs, os.fdopen(out_write, "wb") as out:
+                    while True:
+                        try:
+                            job = pickle.load(jobs)  # from our own parent: trusted
+                        except EOFError:
+                            break
+                        pickle.dump(run_job(job), out)
+                        out.flush()
+            except BaseException:
+                code = 1
+            os._exit(code)
+        os.close(job_read)
+        os.close(out_write)
+        self.pid = pid
+        self._jobs = os.fdopen(job_write, "wb")
+        self._out = os.fdopen(out_read, "rb")
+
+    def run(self, job: Job) -> Outcome | None:
+        """The child's outcome of ``job``; None when it died before sending one."""
+        try:
+            pickle.dump(job, self._jobs)
+            self._jobs.flush()
+            outcome: Outcome = pickle.load(self._out)  # from our own child: trusted
+        except (EOFError, OSError, pickle.UnpicklingError):
+            return None
+        return outcome
+
+    def close(self) -> int:
+        """Close the child's input and wait for it; its exit code (0 when already waited)."""
+        for fh in (self._jobs, self._out):
+            with contextlib.suppress(OSError):
+                fh.close()
+        try:
+            _, status = os.waitpid(self.pid, 0)
+        except ChildProcessError:
+            return 0
+        return os.waitstatus_to_exitcode(status)
 
 
 def _context() -> Any:
@@ -270,12 +348,26 @@ def _run_dask(
     cluster = None
     try:
         if address == "local":
-            cluster = distributed.LocalCluster(
-                n_workers=max(workers, 1),
-                threads_per_worker=1,
-                processes=True,
-                dashboard_address=None,
-            )
+            import dask.config  # lazy: the optional Dask extra (ertools[dask]), as distributed
+
+            # Without the workers' statistical profiler (a thread sampling every 10 ms, ~5 %
+            # of a core per worker: measured in docs/performance.md), and without the
+            # MALLOC_TRIM_THRESHOLD_=65536 the nannies put in their workers' environment: glibc
+            # then hands every freed array back to the kernel, and the next execution faults
+            # its pages in again (a local worker keeps them). The nannies hand this
+            # configuration to the worker processes they start.
+            with dask.config.set(
+                {
+                    "distributed.worker.profile.enabled": False,
+                    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+                }
+            ):
+                cluster = distributed.LocalCluster(
+                    n_workers=max(workers, 1),
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=None,
+                )
             client = distributed.Client(cluster)
         else:
             client = distributed.Client(address, timeout="10s")

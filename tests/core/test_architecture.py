@@ -31,6 +31,7 @@ LAZY_ALLOWED = {
     "lz4",
     "jinja2",
     "distributed",
+    "dask",
     "google",
     "yaml",
 }

@@ -86,7 +86,7 @@ def test_timeline_bars_are_drawn_in_their_state_colour() -> None:
     from matplotlib.figure import Figure
 
     from ertools.audit.analyse import audit_states
-    from ertools.report.plots_audit import draw_timeline
+    from ertools.report.plots_audit import _LANES, draw_timeline
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "audit"))
     from audit_streams import heartbeat
@@ -100,11 +100,22 @@ def test_timeline_bars_are_drawn_in_their_state_colour() -> None:
     )
     ax = Figure().add_subplot()
     draw_timeline(ax, audit)
-    bars = ax.collections[: len(audit.timeline)]
+    # Every bar drawn (the timeline groups them into one collection per lane and colour): its
+    # left edge, its bottom and its colour.
+    drawn_bars = [
+        (float(path.vertices[:, 0].min()), float(path.vertices[:, 1].min()), face)
+        for collection in ax.collections
+        for face in [tuple(collection.get_facecolor()[0])]
+        for path in collection.get_paths()
+    ]
     assert len(audit.timeline) >= 10
-    for bar, e in zip(bars, audit.timeline, strict=True):
+    for e in audit.timeline:
         expected = to_rgba(STATE_COLOURS[e.machine][e.state_name])
-        assert tuple(bar.get_facecolor()[0]) == pytest.approx(expected), e
+        start_s = (e.start_ns - audit.start_ns) / 1e9
+        bottom = _LANES.index(e.machine) - 0.35  # the lanes' order, each bar 0.7 high
+        faces = [f for x, y, f in drawn_bars if abs(x - start_s) < 1e-9 and abs(y - bottom) < 1e-9]
+        assert len(faces) == 1, e
+        assert faces[0] == pytest.approx(expected), e
     # The legend: one entry per colour drawn, each naming its state(s).
     labels = [t.get_text() for t in ax.get_legend().get_texts()]
     drawn = {(e.machine, e.state_name) for e in audit.timeline}
