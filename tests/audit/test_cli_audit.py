@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 from audit_streams import T0_NS, heartbeat
-from stderr_text import error_messages
+from stderr_text import error_messages, joined_lines
 from test_audit import BMBOX, CLIENT, REFBOX
 
 from ertools.cli.main import main
@@ -105,7 +105,7 @@ def test_bad_explicit_input_is_an_error(
     code = main(["audit", str(SAMPLE_FBM2H), "--format", "yaml", option, value])
     err = capsys.readouterr().err
     assert code == 1
-    lines = err.strip().splitlines()
+    lines = joined_lines(err.strip())
     assert len(lines) == 1 and lines[0].startswith("ertools: error:") and named in lines[0], err
     assert "score not recomputed" not in err
 

@@ -10,6 +10,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+from stderr_text import error_messages
 
 from ertools.cli.main import main
 
@@ -83,7 +84,7 @@ def test_a_hostile_number_is_one_line_naming_file_and_key(
     path.write_text(plant(original.read_text(), HOSTILE[value]))
     code = main(command(path))
     err = capsys.readouterr().err
-    lines = [line for line in err.splitlines() if line.startswith("ertools: error:")]
+    lines = error_messages(err)
     assert code == 1, err
     assert len(lines) == 1, err
     assert "this is a bug" not in err and "Traceback" not in err

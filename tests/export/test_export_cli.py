@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from stderr_text import error_messages
 
 from ertools.cli.main import main
 
@@ -25,7 +26,7 @@ def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str]:
 
 
 def one_error(err: str) -> str:
-    lines = [x for x in err.splitlines() if x.startswith("ertools: error:")]
+    lines = error_messages(err)
     assert len(lines) == 1, err
     assert "Traceback" not in err
     return lines[0]

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from stderr_text import error_messages
 
 from ertools.cli.main import main
 from ertools.errors import BagError
@@ -147,7 +148,7 @@ def test_bad_value_names_row_and_column(
     gt.write_text("0.5 1 2 3 0 0 0 1\n2.5 1 2 3 0 0 0 1\n")
     assert main(["score", "trajectory", str(path), str(gt)]) == 1
     err_text = capsys.readouterr().err
-    lines = [ln for ln in err_text.splitlines() if ln.startswith("ertools: error:")]
+    lines = error_messages(err_text)
     assert len(lines) == 1 and needle in lines[0] and "Traceback" not in err_text
 
 
