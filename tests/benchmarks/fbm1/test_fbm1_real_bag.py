@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 from fbm1_testkit import write_items
+from stderr_text import joined_lines
 
 from ertools.cli.main import main
 
@@ -21,7 +22,7 @@ def test_fbm2h_log_is_not_an_fbm1_log(tmp_path: Path, capsys: pytest.CaptureFixt
     code = main(["score", "fbm1h", str(BAG), "--items", str(items)])
     out, err = capsys.readouterr()
     assert code == 2 and out == ""
-    assert err == (
+    assert joined_lines(err) == [  # one message, wrapped where a long path makes it long
         f"ertools: error: {BAG}: this looks like an FBM2@Home log (topics /fbm2h/...): "
-        "ertools score fbm2h\n"
-    )
+        "ertools score fbm2h"
+    ]
