@@ -1,0 +1,272 @@
+"""Confidence intervals of scores: the part every benchmark shares (issue 28).
+
+A score is a function of measured poses. Each *source* of uncertainty (mocap noise, the
+association of robot and GT times, the marker-set transform, FBM3's ``d_min``) is a way the
+measurements could have come out differently around the truth. Each benchmark writes one
+vectorised function that re-scores its runs ``draws`` times with the sources it is given
+perturbed (a parametric bootstrap); this module turns those draws into intervals.
+
+The interval is the *basic* (reverse-percentile) bootstrap interval,
+``[2 s - q(1 - a/2), 2 s - q(a/2)]``: noise does not only spread a score, it biases it (a
+robot exactly on its path still scores the noise's mean distance), and the basic interval
+removes the bias the draws show instead of centring on the biased number. The score itself is
+never changed: the interval is reported beside it.
+
+Each source's *share* is the variance of the draws with only that source perturbed, over the
+sum of those variances: the part of the interval that source explains (shares of sources
+that interact need not add up to the interval's width exactly, which is why they are
+normalised and called shares).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from statistics import NormalDist
+from typing import Any
+
+import numpy as np
+
+from ertools.arrays import F64
+from ertools.benchmarks.base import Input
+from ertools.errors import UsageError
+
+DEFAULT_CONFIDENCE = 0.95
+DEFAULT_DRAWS = 400
+DEFAULT_SEED = 0
+
+# The names of the sources, as they appear in outputs (``uncertainty.sources[].name``).
+MOCAP_NOISE = "mocap_noise"
+TIME_ASSOCIATION = "time_association"
+TRANSFORM = "transform"
+D_MIN = "d_min"
+
+#: The options every ``score`` command takes for its intervals (declared once, listed by each
+#: benchmark's declaration).
+INTERVAL_INPUTS = (
+    Input(
+        "confidence",
+        "float",
+        "confidence level of the score intervals (default 0.95)",
+        default=DEFAULT_CONFIDENCE,
+        minimum=0.0,
+        positive=True,
+        metavar="LEVEL",
+        group="intervals",
+    ),
+    Input(
+        "draws",
+        "int",
+        f"Monte Carlo draws per interval source (default {DEFAULT_DRAWS}; 0: no intervals)",
+        default=DEFAULT_DRAWS,
+        minimum=0,
+        metavar="N",
+        group="intervals",
+    ),
+    Input(
+        "seed",
+        "int",
+        f"seed of the Monte Carlo draws (default {DEFAULT_SEED}): same seed, same intervals",
+        default=DEFAULT_SEED,
+        minimum=0,
+        metavar="N",
+        group="intervals",
+    ),
+)
+
+
+def check_confidence(confidence: float) -> float:
+    """``confidence`` if it is a level strictly between 0 and 1, else a usage error."""
+    if not (math.isfinite(confidence) and 0.0 < confidence < 1.0):
+        raise UsageError(f"--confidence {confidence}: give a level between 0 and 1, e.g. 0.95")
+    return confidence
+
+
+def z_value(confidence: float) -> float:
+    """The two-sided normal quantile of ``confidence`` (1.959964 for 0.95)."""
+    return NormalDist().inv_cdf(0.5 + check_confidence(confidence) / 2.0)
+
+
+def sigma_from_epsilon(epsilon: float) -> float:
+    """Per-axis mocap noise sigma from ``ertools noise``'s epsilon.
+
+    epsilon is the mean (x, y) distance between consecutive measurements of a still marker set.
+    With independent normal noise of sigma per axis, the difference of two measurements is
+    normal with sigma * sqrt(2) per axis, its length Rayleigh-distributed with mean
+    sigma * sqrt(2) * sqrt(pi / 2) = sigma * sqrt(pi).
+    """
+    return epsilon / math.sqrt(math.pi)
+
+
+@dataclass(frozen=True)
+class Source:
+    """One source of uncertainty and the value used for it.
+
+    Attributes:
+        name: one of the names above (``mocap_noise``...).
+        value: its size: a standard deviation, or a half-width for a uniform source.
+        unit: SI unit of ``value`` (``m``, ``rad``, ``s``).
+        measured: True when ``value`` was measured from the data, False for a stated default.
+        note: how it was obtained, in words (``3 stationary phases, 1,204 pairs``).
+    """
+
+    name: str
+    value: float
+    unit: str
+    measured: bool
+    note: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "name": self.name,
+            "value": self.value,
+            "unit": self.unit,
+            "measured": self.measured,
+            "note": self.note,
+        }
+
+
+@dataclass(frozen=True)
+class Interval:
+    """A confidence interval of one score, and each source's share of it."""
+
+    low: float
+    high: float
+    shares: tuple[tuple[str, float], ...] = ()
+
+    def as_list(self) -> list[float]:
+        return [self.low, self.high]
+
+    def contains(self, value: float) -> bool:
+        return self.low <= value <= self.high
+
+    def share_dict(self) -> dict[str, float]:
+        return dict(self.shares)
+
+
+@dataclass(frozen=True)
+class Uncertainty:
+    """The ``uncertainty`` block of a result: how its intervals were obtained.
+
+    ``shares`` maps a score's key (dotted for nested ones: ``runs_details.2.distance_error``)
+    to each source's share of that score's interval.
+    """
+
+    confidence: float
+    method: str
+    draws: int
+    seed: int
+    sources: tuple[Source, ...]
+    shares: Mapping[str, Mapping[str, float]]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "confidence": self.confidence,
+            "method": self.method,
+            "draws": self.draws,
+            "seed": self.seed,
+            "sources": [s.to_dict() for s in self.sources],
+            "shares": {k: dict(v) for k, v in self.shares.items()},
+        }
+
+
+def basic_intervals(estimate: F64, draws: F64, confidence: float) -> tuple[F64, F64]:
+    """The basic bootstrap interval of each score.
+
+    Args:
+        estimate: (S,) the scores from the data.
+        draws: (D, S) the scores re-computed from perturbed data; NaN where a draw could not
+            be scored (left out).
+        confidence: the level.
+
+    Returns:
+        (low, high), each (S,); NaN where a score has fewer than two finite draws.
+    """
+    est = np.asarray(estimate, dtype=np.float64)
+    d = np.asarray(draws, dtype=np.float64)
+    a = (1.0 - check_confidence(confidence)) / 2.0
+    low = np.full(est.shape, np.nan)
+    high = np.full(est.shape, np.nan)
+    ok = np.sum(np.isfinite(d), axis=0) >= 2
+    if ok.any():
+        q = np.nanquantile(d[:, ok], [a, 1.0 - a], axis=0)
+        low[ok] = 2.0 * est[ok] - q[1]
+        high[ok] = 2.0 * est[ok] - q[0]
+    return low, high
+
+
+# perturbed(rng, sources, n) -> (n, S) scores re-computed with only ``sources`` perturbed
+Perturbed = Callable[[np.random.Generator, frozenset[str], int], F64]
+
+
+def monte_carlo(
+    estimate: Sequence[float] | F64,
+    perturbed: Perturbed,
+    sources: Sequence[str],
+    *,
+    draws: int = DEFAULT_DRAWS,
+    seed: int = DEFAULT_SEED,
+    confidence: float = DEFAULT_CONFIDENCE,
+    nonnegative: bool = True,
+) -> list[Interval | None]:
+    """Intervals of ``S`` scores from draws with every source perturbed at once, and each
+    source's share from draws with it alone.
+
+    Reproducible: the draws of each pass come from ``numpy.random.default_rng([seed, k])``,
+    ``k`` = 0 for all sources together and 1.. for each source alone, whatever the order of
+    the scores. ``nonnegative`` clips the low end at 0 for scores that cannot be negative
+    (a distance): the truth is in the clipped interval whenever it was in the unclipped one.
+
+    Returns one Interval per score, None where the score is not finite or the draws do not
+    give one.
+    """
+    est = np.asarray(estimate, dtype=np.float64)
+    if draws <= 0 or not sources or est.size == 0:
+        return [None] * int(est.size)
+    check_confidence(confidence)
+    names = tuple(sources)
+    together = np.asarray(perturbed(np.random.default_rng([seed, 0]), frozenset(names), draws))
+    low, high = basic_intervals(est, together.reshape(draws, est.size), confidence)
+    variances: list[F64] = []
+    if len(names) > 1:
+        for k, name in enumerate(names, start=1):
+            rng = np.random.default_rng([seed, k])
+            alone = np.asarray(perturbed(rng, frozenset((name,)), draws)).reshape(draws, est.size)
+            finite = np.sum(np.isfinite(alone), axis=0) >= 2
+            var = np.zeros(est.size)
+            if finite.any():
+                var[finite] = np.nanvar(alone[:, finite], axis=0)
+            variances.append(var)
+    out: list[Interval | None] = []
+    for i in range(est.size):
+        if not (math.isfinite(est[i]) and math.isfinite(low[i]) and math.isfinite(high[i])):
+            out.append(None)
+            continue
+        lo = max(0.0, float(low[i])) if nonnegative else float(low[i])
+        out.append(Interval(lo, max(lo, float(high[i])), _shares(names, variances, i)))
+    return out
+
+
+def _shares(names: tuple[str, ...], variances: list[F64], i: int) -> tuple[tuple[str, float], ...]:
+    if len(names) == 1:
+        return ((names[0], 1.0),)
+    v = [float(var[i]) for var in variances]
+    total = sum(v)
+    if total <= 0.0:
+        return tuple((n, 0.0) for n in names)
+    return tuple((n, x / total) for n, x in zip(names, v, strict=True))
+
+
+def interval_keys(
+    data: Mapping[str, Any], intervals: Mapping[str, Interval | None]
+) -> dict[str, Any]:
+    """``data`` with ``K_interval: [low, high]`` inserted right after each key ``K`` that has
+    an interval (None: ``K_interval: null``), the other keys in their order."""
+    out: dict[str, Any] = {}
+    for key, value in data.items():
+        out[key] = value
+        if key in intervals:
+            iv = intervals[key]
+            out[f"{key}_interval"] = None if iv is None else iv.as_list()
+    return out
