@@ -113,7 +113,8 @@ def log_cut(
     last_t = int(bmbox.t_ns[-1])
     if int(bmbox.state[-1]) in _FINISHED:
         return None
-    if any(e.reason is EndReason.STOP for e in refbox_ends(refbox, None, last_t, exact_2015=exact_2015)):
+    ends = refbox_ends(refbox, None, last_t, exact_2015=exact_2015)
+    if any(e.reason is EndReason.STOP for e in ends):
         return None
     return last_t
 

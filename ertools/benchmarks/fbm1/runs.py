@@ -10,8 +10,9 @@ names it. A RefBox ``END`` that is a timeout or a stop (:func:`ertools.states.en
 ``reason: timeout`` ends a run without answer, ``reason: stop`` ends the benchmark, the 2015
 BmBox's strings; by default the seed's ``timeout`` / ``halt`` too, not under
 ``--exact-end-payloads``) before the robot answered ends the run; another END payload is warned
-about once, with its file and time, and read as the BmBox read it (neither). A log that ends inside a run is that run stopped there
-(:mod:`ertools.benchmarks.common.ending`), said in a warning.
+about once, with its file and time, and read as the BmBox read it (neither). A log that ends
+inside a run is that run stopped there (:mod:`ertools.benchmarks.common.ending`), said in a
+warning.
 
 The states were re-published at 10 Hz, so a state shorter than 100 ms may be missing from the
 log: each moment is the first message of the first state at or past it.

@@ -123,8 +123,8 @@ INPUTS = (
         "all_2015",
         "flag",
         "every 2015 behaviour above (--orientation-2015 --unscored-segments 2015 "
-        "--segment-clock bmbox --exact-end-payloads) and the node's pose source, /tf world -> robot_at_home, "
-        "unless --topic or --tf is given",
+        "--segment-clock bmbox --exact-end-payloads) and the node's pose source, "
+        "/tf world -> robot_at_home, unless --topic or --tf is given",
         flag="--2015",
         group=LEGACY,
     ),

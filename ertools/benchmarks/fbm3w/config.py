@@ -81,7 +81,8 @@ def options_2015(options: Fbm3wOptions) -> Fbm3wOptions:
     """``options`` with every FBM3W 2015 behaviour on (``--2015``).
 
     Timed-out runs scored and eligible, stopped runs' time left out, RefBox END payloads read
-    as the BmBox compared them, the shapes at their own parameter, and the script's hard-coded D_MIN unless ``--d-min`` says otherwise.
+    as the BmBox compared them, the shapes at their own parameter, and the script's hard-coded
+    D_MIN unless ``--d-min`` says otherwise.
 
     Raises:
         ConfigError: ``--arc-length`` asked for as well (it is not 2015).
