@@ -99,8 +99,11 @@ class Log:
     client: StateStream
 
 
-def _log(payload: str, ns: str = "fbm1h") -> Log:
+def _log(payload: str, ns: str = "fbm1h", *, answered: bool = False) -> Log:
+    """``answered``: the robot reports at 5.5 s and the BmBox leaves WAITING_RESULT at 5.6 s,
+    as the 2015 BmBox did after an END payload it did not compare equal (it waited on)."""
     B, R, C = BmBoxState, RefBoxState, ClientState
+    back = 5.6 if answered else 5.05
     bmbox = _stream(
         Machine.BMBOX,
         [
@@ -110,7 +113,7 @@ def _log(payload: str, ns: str = "fbm1h") -> Log:
             (3.0, B.TRANSMITTING_GOAL, "line"),
             (3.2, B.EXECUTING_GOAL, ""),
             (3.3, B.WAITING_RESULT, ""),
-            (5.05, B.READY, ""),
+            (back, B.READY, ""),
             (6.0, B.TRANSMITTING_SCORE, "{}"),
             (6.5, B.END, ""),
         ],
@@ -126,9 +129,15 @@ def _log(payload: str, ns: str = "fbm1h") -> Log:
         ],
         f"/{ns}/refbox_state",
     )
+    answer = "{item_class: a, item_instance: a1, x: 0.1, y: 0.2, theta: 0.0}"
     client = _stream(
         Machine.CLIENT,
-        [(0.0, C.READY, ""), (0.5, C.WAITING_GOAL, ""), (3.1, C.EXECUTING_GOAL, "")],
+        [
+            (0.0, C.READY, ""),
+            (0.5, C.WAITING_GOAL, ""),
+            (3.1, C.EXECUTING_GOAL, ""),
+            *([(5.5, C.COMPLETED_GOAL, answer)] if answered else []),
+        ],
         f"/{ns}/client_state",
     )
     return Log(bmbox, refbox, client)
@@ -226,6 +235,31 @@ def test_the_audit_reads_the_table(payload: str) -> None:
     named = {T: "timeout", P: "halt"}  # the audit's words for the two early ends
     assert [e.reason for e in audit.early_ends] == ([named[want]] if want in named else [])
     _check_warned(audit.warnings, payload, want)
+
+
+@pytest.mark.parametrize(("payload", "mode"), CASES, ids=IDS)
+def test_neither_means_the_run_goes_on_in_every_consumer(payload: str, mode: str) -> None:
+    """The robot answers after the END: a timeout or a stop ended the run first (its answer is
+    ignored); any other END changed nothing, in FBM1, FBM2H, FBM3W and the audit alike."""
+    exact = MODES[mode]
+    want = _expected(payload, mode)
+    early = want in (T, P)
+    log = _log(payload, answered=True)
+    (run,) = find_runs(log.bmbox, log.refbox, log.client, t0_ns=T0, exact_2015=exact).runs
+    assert (run.answer_payload is None) is early and (run.ended_by is not None) is early
+    log = _log(payload, "fbm2h", answered=True)
+    for clock in ("client", "bmbox"):
+        moments = from_states(
+            log.bmbox, log.client, log.refbox, clock=clock, exact_2015=exact, t0_ns=T0
+        )
+        assert (len(moments), moments.early_end is not None) == (int(not early), early), clock
+    log = _log(payload, "fbm3w", answered=True)
+    (window,) = find_states(BenchmarkStates(log.bmbox, log.refbox, log.client), exact_2015=exact)
+    assert (window.status == "completed") is not early
+    if mode == "default":
+        audit = audit_states(log.bmbox, log.refbox, log.client)
+        (audited,) = audit.runs
+        assert (audited.outcome == "completed") is not early
 
 
 # --- the shared pieces ----------------------------------------------------------------------

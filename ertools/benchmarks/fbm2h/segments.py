@@ -303,13 +303,17 @@ def _segment_client(
             return EarlyEnd(k, None, int(rb.t_ns[i_rb0]), kind, payload)
         return EarlyEnd(k, None, None, "cut")
     t_start = int(bm.t_ns[i_exec])
-    # A RefBox END once the goal is sent ends the segment, whatever comes after it (the robot
-    # arriving late).
-    i_rb = (
-        None
-        if rb is None
-        else _first_at_or_after(rb.t_ns, rb.state == RefBoxState.END, t_goal, t_next)
-    )
+    # A RefBox timeout or stop once the goal is sent ends the segment, whatever comes after it
+    # (the robot arriving late). Another END is neither (as to the 2015 BmBox): the segment
+    # waits on for the robot's report, and ends there only if none comes.
+    i_rb = i_any = None
+    if rb is not None:
+        is_end = rb.state == RefBoxState.END
+        early = np.fromiter(
+            (bool(end_kind(p, exact_2015=exact_2015)) for p in rb.payload), bool, len(rb)
+        )
+        i_rb = _first_at_or_after(rb.t_ns, is_end & early, t_goal, t_next)
+        i_any = _first_at_or_after(rb.t_ns, is_end, t_goal, t_next)
     t_rb = None if i_rb is None or rb is None else int(rb.t_ns[i_rb])
     if cl is not None:
         i_done = _first_at_or_after(cl.t_ns, cl.state == ClientState.COMPLETED_GOAL, t_start, t_rb)
@@ -319,11 +323,12 @@ def _segment_client(
         t_end = int(bm.t_ns[i_bm_end])
         if t_rb is None or t_end < t_rb:
             return t_start, t_end, "", f"segment {k}: end from BmBox READY (no Client topic)"
-    if t_rb is not None and rb is not None:
-        payload = rb.payload[i_rb or 0]
+    i_end = i_rb if i_rb is not None else i_any
+    if rb is not None and i_end is not None:
+        payload, t_end = rb.payload[i_end], int(rb.t_ns[i_end])
         kind = end_kind(payload, exact_2015=exact_2015) or "ended"
         # An END while the goal was still being sent leaves the segment no time of its own.
-        return EarlyEnd(k, min(t_start, t_rb), t_rb, kind, payload)
+        return EarlyEnd(k, min(t_start, t_end), t_end, kind, payload)
     if t_next is not None:
         raise SegmentationError(
             f"{bm.topic}: segment {k} was never completed, the RefBox did not end it, and the "
