@@ -23,6 +23,7 @@ RULE_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm2h.rules",
     "ertools.benchmarks.fbm3w.rules",
     "ertools.benchmarks.trajectory.rules",
+    "ertools.benchmarks.common.ending",
 )
 
 

@@ -130,71 +130,125 @@ def state_topic(namespace: str, machine: Machine) -> str:
 
 # --- RefBox END payloads ----------------------------------------------------------------------
 #
-# The 2015 BmBox (rockin_scoring/BmBox.py) reads one thing from the RefBox besides its state:
-# the payload, compared as a whole string. ``Timeout()`` is ``payload == "reason: timeout"``,
-# ``Running()`` is ``payload != "reason: stop"``, and its RefBox callback leaves
-# WAITING_RESULT / EXECUTING_GOAL on END only with one of those two strings (any END payload
-# ends a WAITING_MANUAL_OPERATION). The seed (6.2.3) documents the bare words ``timeout`` and
-# ``halt``. The Python machines themselves never publish END (their 10 Hz loop stops at END),
-# and a ``None`` payload goes out as "" (genpy fills unset strings). docs/fidelity.md lists
-# the forms with their sources.
+# The 2015 BmBox (rockin_scoring/BmBox.py, svenschneider/benchmark_and_scoring_fbm at 90d5c4d)
+# reads one thing from the RefBox besides its state: the payload, compared as a whole string.
+# ``Timeout()`` is ``payload == "reason: timeout"`` (l. 117), ``Running()`` is
+# ``payload != "reason: stop"`` (l. 126), and its RefBox callback leaves WAITING_RESULT /
+# EXECUTING_GOAL on END only with one of those two strings (l. 49, 53; any END payload ends a
+# WAITING_MANUAL_OPERATION, l. 43). The 2015 @Home RefBox (rockin-robot-challenge/at_home_rsbb,
+# src/core_zone_exec.h, ``phase_post_2``) sent exactly those two strings. The seed (6.2.3)
+# documents the bare words ``timeout`` and ``halt`` instead: they meant nothing to the 2015
+# BmBox, so they are read only by ertools' default (a documented reading of the manual, said in
+# the output), never under ``--2015``. An empty payload is no reason: the RefBox ended the
+# benchmark itself (seed 6.2.3: a payload only when the referee box issued the END). The Python
+# machines never publish END at all (their 10 Hz loop stops there). docs/fidelity.md lists the
+# forms with their sources.
 
 
 class EndReason(enum.Enum):
-    """What a RefBox END payload means to the 2015 BmBox."""
+    """What a RefBox END payload means."""
 
     TIMEOUT = "timeout"  # Timeout() is true: the run's time counts, the run is over
     STOP = "stop"  # Running() is false: the benchmark is over
-    UNKNOWN = "unknown"  # neither: the 2015 BmBox went on as if nothing was said
+    NONE = "none"  # no reason given: the benchmark's own end, neither a timeout nor a stop
+    UNKNOWN = "unknown"  # no known form: neither, as the 2015 BmBox went on; warned about
+
+    @property
+    def ends_early(self) -> bool:
+        """A timeout or a stop: the RefBox cut the run (or the benchmark) short."""
+        return self in (EndReason.TIMEOUT, EndReason.STOP)
 
 
 @dataclass(frozen=True)
 class EndPayloadForm:
-    """One RefBox END payload the 2015 code or the seed names, and where."""
+    """One RefBox END payload the 2015 code or the seed names, and where.
+
+    Attributes:
+        text: the whole payload, compared exactly.
+        reason: what it means.
+        source: where the form comes from.
+        read_2015: whether the 2015 BmBox knew it (else it is read only by ertools' default).
+    """
 
     text: str
     reason: EndReason
     source: str
+    read_2015: bool
 
 
 END_PAYLOAD_FORMS: tuple[EndPayloadForm, ...] = (
     EndPayloadForm(
         "reason: timeout",
         EndReason.TIMEOUT,
-        "rockin_scoring/BmBox.py: _refbox_state_cb, WaitResult, Timeout() compare it exactly",
+        "BmBox.py (90d5c4d) l. 49, 97, 117 compare it exactly; the 2015 @Home RefBox "
+        "(at_home_rsbb core_zone_exec.h, phase_post_2) sent it on a goal's timeout",
+        True,
     ),
     EndPayloadForm(
         "reason: stop",
         EndReason.STOP,
-        "rockin_scoring/BmBox.py: _refbox_state_cb, WaitResult, Running() compare it exactly",
+        "BmBox.py (90d5c4d) l. 53, 100, 126 compare it exactly; the 2015 @Home RefBox "
+        "(at_home_rsbb core_zone_exec.h, phase_post_2) sent it on the benchmark's end or stop",
+        True,
     ),
-    EndPayloadForm("timeout", EndReason.TIMEOUT, "seed 6.2.3: the RefBox's timeout payload"),
-    EndPayloadForm("halt", EndReason.STOP, "seed 6.2.3: the RefBox's emergency-halt payload"),
+    EndPayloadForm(
+        "timeout",
+        EndReason.TIMEOUT,
+        "seed 6.2.3 (the RefBox's timeout payload); unknown to the 2015 BmBox",
+        False,
+    ),
+    EndPayloadForm(
+        "halt",
+        EndReason.STOP,
+        "seed 6.2.3 (the referee's emergency halt); unknown to the 2015 BmBox",
+        False,
+    ),
+    EndPayloadForm(
+        "",
+        EndReason.NONE,
+        "seed 6.2.3 (a payload only when the RefBox issued the END); to the 2015 BmBox "
+        "neither a timeout nor a stop",
+        True,
+    ),
 )
 
 _END_FORMS = {f.text: f for f in END_PAYLOAD_FORMS}
 
 
-def end_reason(payload: str) -> EndReason:
-    """The meaning of a RefBox END payload: a known form exactly, else ``UNKNOWN``.
+def end_reason(payload: str, *, exact_2015: bool = False) -> EndReason:
+    """The meaning of a RefBox END payload: a known form, compared whole, else ``UNKNOWN``.
 
     Exact, as the 2015 BmBox compared (``"Reason: Stop"`` or ``"reason: stop "`` meant
-    nothing to it). An ``UNKNOWN`` payload is neither a timeout nor a stop: callers warn with
-    :func:`unknown_end_warning` rather than guess from its words.
+    nothing to it); never guessed from the words in it. ``exact_2015``: only the forms the
+    2015 BmBox knew (``--2015``), so the seed's bare ``timeout`` / ``halt`` are ``UNKNOWN``
+    as they were to it. An ``UNKNOWN`` payload is neither a timeout nor a stop: callers warn
+    with :func:`unknown_end_warning`.
     """
     form = _END_FORMS.get(payload)
-    return EndReason.UNKNOWN if form is None else form.reason
+    if form is None or (exact_2015 and not form.read_2015):
+        return EndReason.UNKNOWN
+    return form.reason
 
 
-def known_end_payloads() -> str:
-    """The known END payload forms, quoted, for messages."""
-    return ", ".join(repr(f.text) for f in END_PAYLOAD_FORMS)
+def seed_word(payload: str) -> bool:
+    """Whether ``payload`` is one of the seed's words the 2015 BmBox did not know."""
+    form = _END_FORMS.get(payload)
+    return form is not None and not form.read_2015
 
 
-def unknown_end_warning(payload: str, where: str) -> str:
-    """The one-line warning for a RefBox END payload that is no known form."""
+def known_end_payloads(*, exact_2015: bool = False) -> str:
+    """The known non-empty END payload forms of a reading, quoted, for messages."""
+    return ", ".join(
+        repr(f.text) for f in END_PAYLOAD_FORMS if f.text and (f.read_2015 or not exact_2015)
+    )
+
+
+def unknown_end_warning(payload: str, where: str, *, exact_2015: bool = False) -> str:
+    """The one-line warning for a RefBox END payload that is no known form of the reading."""
+    known = known_end_payloads(exact_2015=exact_2015)
+    whose = "the 2015 BmBox knows (--2015)" if exact_2015 else "the 2015 BmBox or the seed know"
     return (
-        f"{where}: RefBox END with payload {payload!r}, which is none of the forms the 2015 "
-        f"BmBox or the seed know ({known_end_payloads()}); read as the 2015 BmBox did: neither "
-        "a timeout nor a stop (the BmBox states show what followed)"
+        f"{where}: RefBox END with payload {payload!r}, which is none of the forms {whose} "
+        f"({known}); read as the 2015 BmBox did: neither a timeout nor a stop (the BmBox states "
+        "show what followed)"
     )

@@ -14,8 +14,9 @@ the BmBox published (10 Hz, plus each change), so here:
   the closest the log gets to it;
 - ``Timeout()`` / ``Running()`` compare the payload of the last RefBox message at that moment
   (the callback stored every message's payload, lines 34-35), with the strings of lines 117 and
-  126, exactly. The seed's forms (6.2.3: ``timeout``, ``halt``) are what the RefBox the seed
-  describes sent for the same two events: they are fed to the BmBox as its two strings;
+  126, exactly, as written: the seed's bare ``timeout`` / ``halt`` (6.2.3) are neither string,
+  so to this BmBox they are no timeout and no stop (the 2015 @Home RefBox sent the two strings
+  themselves: rockin-robot-challenge/at_home_rsbb, src/core_zone_exec.h, ``phase_post_2``);
 - a log that ends while the node waits is the benchmark stopped there (issue 23's rule): a
   RefBox ``reason: stop`` at the last BmBox message, to which the BmBox answers as lines 53-54
   do (back to READY; from TRANSMITTING_GOAL, where the FSM would refuse READY and the real node
@@ -34,11 +35,9 @@ START, WAITING_CLIENT, READY, WAITING_MANUAL_OPERATION = 0, 1, 2, 3
 COMPLETED_MANUAL_OPERATION, TRANSMITTING_GOAL, EXECUTING_GOAL = 4, 5, 6
 WAITING_RESULT, TRANSMITTING_SCORE, END = 7, 8, 9
 
-# The two strings BmBox.py compares (lines 49, 53, 97, 100, 117, 126) and the seed's words for
-# the same two RefBox events.
+# The two strings BmBox.py compares (lines 49, 53, 97, 100, 117, 126), whole.
 TIMEOUT_PAYLOAD = "reason: timeout"
 STOP_PAYLOAD = "reason: stop"
-SEED_FORMS = {"timeout": TIMEOUT_PAYLOAD, "halt": STOP_PAYLOAD}
 
 Msg = tuple[int, int, str]  # record time ns, state code, payload
 
@@ -90,8 +89,7 @@ class BmBoxReplay:
         if self.cut_at is not None:
             return STOP_PAYLOAD
         last = self._last(self.refbox)
-        payload = "" if last is None else last[2]
-        return SEED_FORMS.get(payload, payload)
+        return "" if last is None else last[2]
 
     def client_payload(self) -> str:
         last = self._last(self.client)

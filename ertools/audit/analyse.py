@@ -14,7 +14,10 @@ The audit finds:
 - the runs (a run starts when the BmBox leaves READY for a manual operation or a goal and ends
   when it returns to READY, sends the score or ends) with their manual operation, goal,
   the Client's result and how they ended;
-- benchmarks ended early by the RefBox (END with payload ``timeout`` or ``halt``);
+- benchmarks ended early by the RefBox: an END whose payload is a timeout or a stop, read by
+  :func:`ertools.states.end_reason` as the scorers' default reads it (the 2015 BmBox's
+  ``reason: timeout`` / ``reason: stop`` and the seed's ``timeout`` / ``halt``, each compared
+  whole); any other payload is warned about with its place and is neither;
 - the score sent live (the payload of TRANSMITTING_SCORE), parsed without executing anything.
 """
 
@@ -35,10 +38,12 @@ from ertools.audit.model import (
     Silence,
     TimelineEntry,
 )
+from ertools.benchmarks.common.ending import end_payload_warnings, refbox_ends
 from ertools.states import (
     BMBOX_TRANSITIONS,
     BmBoxState,
     ClientState,
+    EndReason,
     Machine,
     RefBoxState,
     state_name,
@@ -119,7 +124,8 @@ def audit_states(
     )
     silences = tuple(sorted(silences, key=lambda s: s.start_ns))
     runs = _runs(bm, changes.get(Machine.REFBOX), changes.get(Machine.CLIENT))
-    early = _early_ends(changes.get(Machine.REFBOX), bm, runs)
+    early, unknown = _early_ends(changes.get(Machine.REFBOX), bm, runs, start_ns)
+    warnings.extend(unknown)
     runs = _mark_early_ends(runs, early)
     live_text, live, live_warning = _live_score(bm)
     if live_warning:
@@ -329,13 +335,8 @@ def _runs(
     return tuple(runs)
 
 
-def _reason(payload: str) -> str:
-    text = payload.strip().lower()
-    if "timeout" in text:
-        return "timeout"
-    if "halt" in text or "stop" in text:
-        return "halt"
-    return payload.strip()
+# The audit's names of the two early ends (seed 6.2.3 calls a referee's stop a halt).
+_AUDIT_REASONS = {EndReason.TIMEOUT: "timeout", EndReason.STOP: "halt"}
 
 
 def _bm_state_at(bm: StateStream | None, t_ns: int) -> str:
@@ -346,27 +347,28 @@ def _bm_state_at(bm: StateStream | None, t_ns: int) -> str:
 
 
 def _early_ends(
-    refbox: StateStream | None, bm: StateStream | None, runs: tuple[AuditRun, ...]
-) -> tuple[EarlyEnd, ...]:
+    refbox: StateStream | None, bm: StateStream | None, runs: tuple[AuditRun, ...], t0_ns: int
+) -> tuple[tuple[EarlyEnd, ...], list[str]]:
+    """The first RefBox END that is a timeout or a stop, and a warning per unknown END payload.
+
+    END is final: later ends (a payload changed while in END) are not new ends.
+    """
     if refbox is None:
-        return ()
-    out: list[EarlyEnd] = []
-    for i in range(len(refbox)):
-        if int(refbox.state[i]) != RefBoxState.END or not refbox.payload[i].strip():
+        return (), []
+    unknown = end_payload_warnings(refbox, t0_ns)
+    for end in refbox_ends(refbox):
+        if not end.reason.ends_early:
             continue
-        t = int(refbox.t_ns[i])
-        run = next((r.index for r in runs if r.start_ns <= t <= r.end_ns), None)
-        out.append(
-            EarlyEnd(
-                t_ns=t,
-                reason=_reason(refbox.payload[i]),
-                payload=refbox.payload[i],
-                run=run,
-                bmbox_state=_bm_state_at(bm, t),
-            )
+        run = next((r.index for r in runs if r.start_ns <= end.t_ns <= r.end_ns), None)
+        early = EarlyEnd(
+            t_ns=end.t_ns,
+            reason=_AUDIT_REASONS[end.reason],
+            payload=end.payload,
+            run=run,
+            bmbox_state=_bm_state_at(bm, end.t_ns),
         )
-        break  # END is final: later heartbeats with another payload are not new ends
-    return tuple(out)
+        return (early,), unknown
+    return (), unknown
 
 
 def _mark_early_ends(

@@ -73,7 +73,7 @@ class EarlyEnd:
     """The RefBox ended the benchmark (seed 6.4: payload ``timeout`` or ``halt``)."""
 
     t_ns: int
-    reason: str  # "timeout", "halt" or the payload as sent
+    reason: str  # "timeout" or "halt" (ertools.states.end_reason: a timeout or a stop)
     payload: str
     run: int | None  # the run it interrupted, None between runs
     bmbox_state: str  # the BmBox state at that moment

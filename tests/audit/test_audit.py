@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 from audit_streams import BEAT_NS, T0_NS, heartbeat
 
@@ -254,14 +256,23 @@ def test_topic_that_stops_before_the_log_ends() -> None:
 def test_halt_between_runs() -> None:
     # The referee halts the benchmark at 2.5 s, after READY and before any run started.
     bm = heartbeat(Machine.BMBOX, [*BMBOX[:3], (2.6, B.END, "")], 3.0)
-    rb = heartbeat(Machine.REFBOX, [(0.0, R.START, ""), (2.5, R.END, "emergency halt")], 3.0)
+    rb = heartbeat(Machine.REFBOX, [(0.0, R.START, ""), (2.5, R.END, "halt")], 3.0)
     audit = audit_states(bm, rb, None)
     (end,) = audit.early_ends
-    assert (end.reason, end.payload, end.run, end.bmbox_state) == (
-        "halt",
-        "emergency halt",
-        None,
-        "READY",
-    )
+    assert (end.reason, end.payload, end.run, end.bmbox_state) == ("halt", "halt", None, "READY")
     assert audit.runs == ()
     assert not any("without sending a score" in w for w in audit.warnings)  # it was halted
+
+
+def test_an_unknown_end_payload_is_warned_about_and_is_no_halt() -> None:
+    # "emergency halt" is neither the seed's "halt" nor the 2015 "reason: stop": no guessing
+    # from its words; one warning naming the file and the time, and no early end.
+    bm = heartbeat(Machine.BMBOX, [*BMBOX[:3], (2.6, B.END, "")], 3.0)
+    rb = heartbeat(Machine.REFBOX, [(0.0, R.START, ""), (2.5, R.END, "emergency halt")], 3.0)
+    rb = replace(rb, source="run7.bag", topic="/fbm2h/refbox_state")
+    audit = audit_states(bm, rb, None)
+    assert audit.early_ends == ()
+    said = [w for w in audit.warnings if "emergency halt" in w]
+    assert len(said) == 1
+    assert said[0].startswith("run7.bag: /fbm2h/refbox_state at t=2.500 s: RefBox END")
+    assert "neither a timeout nor a stop" in said[0]

@@ -372,7 +372,7 @@ def score_fbm1(
         logged_score=_parse_logged(found.logged_score),
         t0_ns=t0_ns,
         warnings=tuple(warnings),
-        deviations=tuple(_deviations(runs, opts, (origin, board))),
+        deviations=(*_deviations(runs, opts, (origin, board)), *found.deviations),
         failures=tuple(failures),
         provenance=provenance or Provenance(),
         reference=opts.reference,

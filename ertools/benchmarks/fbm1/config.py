@@ -62,6 +62,8 @@ class Fbm1Options:
         results: answers kept outside the log (replaces the Client payloads it covers).
         items_order: item ids or instances per run (overrides the payloads).
         sources: origin/board pose sources (the 2015 topics, else their /tf frames).
+        exact_end_payloads: RefBox END payloads read as the 2015 BmBox did (only
+            ``reason: timeout`` / ``reason: stop``; :func:`ertools.states.end_reason`).
     """
 
     benchmark: str = "fbm1h"
@@ -72,6 +74,7 @@ class Fbm1Options:
     results: Path | None = None
     items_order: tuple[str, ...] | None = None
     sources: BodySources = BodySources()
+    exact_end_payloads: bool = False
 
     @staticmethod
     def for_rules(benchmark: str, rules: str, gt: GtOptions | None = None) -> Fbm1Options:
@@ -88,7 +91,12 @@ class Fbm1Options:
         if rules == "ertools":
             return Fbm1Options(benchmark, base, ScoreRules())
         if rules == "2015":
-            return Fbm1Options(benchmark, replace(base, method="result"), ScoreRules.node_2015())
+            return Fbm1Options(
+                benchmark,
+                replace(base, method="result"),
+                ScoreRules.node_2015(),
+                exact_end_payloads=True,
+            )
         if rules == "2016" and benchmark == "fbm1h":
             return Fbm1Options(benchmark, replace(base, method="placed"), ScoreRules.node_2016())
         if rules == "2016":
@@ -111,6 +119,7 @@ class Fbm1Options:
                 ref = Fbm1Options.for_rules(self.benchmark, name, self.gt)
             except ConfigError:
                 continue
-            if ref.rules == self.rules and ref.gt.method == self.gt.method:
+            same = ref.rules == self.rules and ref.gt.method == self.gt.method
+            if same and ref.exact_end_payloads == self.exact_end_payloads:
                 return text
         return "ertools with some node behaviours (see the rules)"

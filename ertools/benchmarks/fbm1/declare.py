@@ -21,6 +21,7 @@ from ertools.benchmarks.base import (
     resolve_values,
     tf_value,
 )
+from ertools.benchmarks.common.ending import EXACT_HELP
 from ertools.benchmarks.fbm1.benchmark import score_found
 from ertools.benchmarks.fbm1.config import RULE_SETS, BodySources, Fbm1Options
 from ertools.benchmarks.fbm1.gt import GtOptions
@@ -150,6 +151,7 @@ def inputs(name: str) -> tuple[Input, ...]:
             old_flags=("--legacy-names",),
             group=NODES,
         ),
+        Input("exact_end_payloads", "flag", EXACT_HELP, group=NODES),
         Input(
             "count_aborted",
             "flag",
@@ -261,6 +263,7 @@ def options_maker(name: str) -> Callable[[Mapping[str, Any]], Fbm1Options]:
             results=v["results"],
             items_order=order,
             sources=_sources(name, v),
+            exact_end_payloads=base.exact_end_payloads or v["exact_end_payloads"],
         )
 
     return make_options

@@ -132,6 +132,7 @@ def locate_runs(logs: Fbm1Logs, options: Fbm1Options) -> Fbm1Runs:
         benchmark=ns,
         items_order=list(options.items_order) if options.items_order is not None else None,
         t0_ns=logs.t0_ns,
+        exact_2015=options.exact_end_payloads,
     )
     if states.client is None and logs.results is None:
         # Scoring every run as unanswered would be a silent wrong score.

@@ -6,11 +6,13 @@ EXECUTING_GOAL -> WAITING_RESULT -> READY``. The node measured its execution tim
 moment ``SendGoal`` returned (BmBox in ``EXECUTING_GOAL``) to the moment ``WaitResult``
 returned (BmBox leaving ``WAITING_RESULT``); the answer is the Client's ``COMPLETED_GOAL``
 payload. At @Work the Referee Box chose the item: its ``EXECUTING_MANUAL_OPERATION`` payload
-names it. A RefBox ``END`` whose payload the 2015 BmBox knew (:func:`ertools.states.end_reason`:
-``reason: timeout`` / ``timeout`` ends a run without answer, ``reason: stop`` / ``halt`` ends
-the benchmark) before the robot answered ends the run; another END payload is warned about and
-read as the BmBox read it (neither). A log that ends inside a run is that run stopped there
-(:mod:`ertools.benchmarks.common.ending`), said in a warning.
+names it. A RefBox ``END`` that is a timeout or a stop (:func:`ertools.states.end_reason`:
+``reason: timeout`` ends a run without answer, ``reason: stop`` ends the benchmark, the 2015
+BmBox's strings; by default the seed's ``timeout`` / ``halt`` too, not under
+``--exact-end-payloads``) before the robot answered ends the run; another END payload is warned
+about once, with its file and time, and read as the BmBox read it (neither). A log that ends
+inside a run is that run stopped there (:mod:`ertools.benchmarks.common.ending`), said in a
+warning.
 
 The states were re-published at 10 Hz, so a state shorter than 100 ms may be missing from the
 log: each moment is the first message of the first state at or past it.
@@ -22,14 +24,15 @@ import re
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
-from ertools.benchmarks.common.ending import cut_warning, log_cut, refbox_ends
-from ertools.states import (
-    BmBoxState,
-    ClientState,
-    EndReason,
-    RefBoxState,
-    unknown_end_warning,
+from ertools.benchmarks.common.ending import (
+    cut_warning,
+    end_payload_deviation,
+    end_payload_warnings,
+    log_cut,
+    refbox_ends,
 )
+from ertools.fidelity import Deviation
+from ertools.states import BmBoxState, ClientState, EndReason, RefBoxState
 from ertools.streams import StateStream
 
 _GOAL_STATES = (BmBoxState.TRANSMITTING_GOAL, BmBoxState.EXECUTING_GOAL, BmBoxState.WAITING_RESULT)
@@ -93,6 +96,7 @@ class RunsFound:
     runs: tuple[Fbm1Run, ...]
     warnings: tuple[str, ...] = ()
     logged_score: str | None = None  # the BmBox TRANSMITTING_SCORE payload
+    deviations: tuple[Deviation, ...] = ()  # where the state log was read unlike 2015
 
 
 def parse_item_ref(text: str, source: str) -> ItemRef | None:
@@ -177,6 +181,7 @@ def find_runs(
     benchmark: str = "fbm1h",
     items_order: Sequence[str] | None = None,
     t0_ns: int | None = None,
+    exact_2015: bool = False,
 ) -> RunsFound:
     """The runs of one FBM1 execution.
 
@@ -188,8 +193,10 @@ def find_runs(
         items_order: item ids or instance names per run, overriding the payloads.
         t0_ns: the log's first message (times in warnings count from it; default: the first
             BmBox message).
+        exact_2015: RefBox END payloads read as the 2015 BmBox did (``--exact-end-payloads``).
     """
-    warnings: list[str] = []
+    t0 = int(bmbox.t_ns[0]) if t0_ns is None else t0_ns
+    warnings = end_payload_warnings(refbox, t0, exact_2015=exact_2015)
     runs, logged_score = _bmbox_runs(bmbox)
     ref_changes = refbox.changes() if refbox is not None else None
     cli_changes = client.changes() if client is not None else None
@@ -217,14 +224,12 @@ def find_runs(
                 if hits:
                     answer_payload = done.payload[hits[0]]
                     answer_ns = int(done.t_ns[hits[0]])
-            for end in refbox_ends(refbox, run.goal_ns, nxt):
+            for end in refbox_ends(refbox, run.goal_ns, nxt, exact_2015=exact_2015):
                 if answer_ns is not None and end.t_ns >= answer_ns:
                     break
-                if end.reason is EndReason.UNKNOWN:
-                    warnings.append(unknown_end_warning(end.payload, f"run {run.index}"))
-                    continue
-                ended_by = _ENDED_BY[end.reason]
-                break
+                if end.reason.ends_early:  # any other END (warned above) is neither
+                    ended_by = _ENDED_BY[end.reason]
+                    break
             if ended_by is not None and answer_ns is not None:
                 # The RefBox ended the run before the robot answered: 2015 ignored the answer.
                 answer_payload = answer_ns = None
@@ -237,13 +242,13 @@ def find_runs(
                 ended_by=ended_by,
             )
         )
-    cut = log_cut(bmbox, refbox)
+    cut = log_cut(bmbox, refbox, exact_2015=exact_2015)
     if cut is not None:
-        t0 = int(bmbox.t_ns[0]) if t0_ns is None else t0_ns
         out = _stopped_at_cut(out, cut, bmbox, t0, warnings)
     if items_order is not None:
         out = _apply_order(out, items_order, warnings)
-    return RunsFound(tuple(out), tuple(warnings), logged_score)
+    said = end_payload_deviation(refbox, t0, exact_2015=exact_2015)
+    return RunsFound(tuple(out), tuple(warnings), logged_score, () if said is None else (said,))
 
 
 def _stopped_at_cut(

@@ -281,7 +281,7 @@ def compute(
         notes=moments.notes,
         origin_ns=origin_ns,
         warnings=tuple(all_warnings),
-        deviations=tuple(deviations),
+        deviations=(*deviations, *moments.deviations),
         failures=tuple(failures),
         provenance=provenance or Provenance(),
     )

@@ -47,6 +47,8 @@ class Fbm2hOptions:
             ``--segment-clock bmbox``); see :func:`ertools.benchmarks.fbm2h.segments.from_states`.
         pose_2015: with no ``topic``/``tf_frame``, read the marker set from /tf
             ``world -> robot_at_home`` first, the 2015 node's source (``--2015``).
+        exact_end_payloads: RefBox END payloads read as the 2015 BmBox did (only
+            ``reason: timeout`` / ``reason: stop``; :func:`ertools.states.end_reason`).
         namespace: the benchmark namespace of the state topics.
         stops: thresholds for ``auto``.
         marker_transform: a transform already in hand (``ertools audit``: the one the live
@@ -69,6 +71,7 @@ class Fbm2hOptions:
     unscored_2015: bool = False
     segment_clock: str = "client"
     pose_2015: bool = False
+    exact_end_payloads: bool = False
     namespace: str = NAMESPACE
     stops: StopParams = field(default_factory=StopParams)
     marker_transform: MarkerTransform | None = None

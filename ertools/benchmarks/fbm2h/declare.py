@@ -19,6 +19,7 @@ from ertools.benchmarks.base import (
     resolve_values,
     tf_value,
 )
+from ertools.benchmarks.common.ending import EXACT_HELP
 from ertools.benchmarks.fbm2h.benchmark import score_found
 from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, Fbm2hOptions
 from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, load, locate_runs
@@ -117,12 +118,13 @@ INPUTS = (
         choices=("client", "bmbox"),
         group=LEGACY,
     ),
+    Input("exact_end_payloads", "flag", EXACT_HELP, group=LEGACY),
     Input(
         "all_2015",
         "flag",
         "every 2015 behaviour above (--orientation-2015 --unscored-segments 2015 "
-        "--segment-clock bmbox) and the node's pose source, /tf world -> robot_at_home, "
-        "unless --topic or --tf is given",
+        "--segment-clock bmbox --exact-end-payloads) and the node's pose source, "
+        "/tf world -> robot_at_home, unless --topic or --tf is given",
         flag="--2015",
         group=LEGACY,
     ),
@@ -201,6 +203,7 @@ def make_options(given: Mapping[str, Any]) -> Fbm2hOptions:
         unscored_2015=v["unscored_segments"] == "2015" or v["all_2015"],
         segment_clock="bmbox" if v["all_2015"] else v["segment_clock"],
         pose_2015=bool(v["all_2015"]),
+        exact_end_payloads=bool(v["exact_end_payloads"] or v["all_2015"]),
         namespace=v["namespace"],
         stops=StopParams(
             speed=v["stop_speed"],

@@ -216,7 +216,12 @@ def locate_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
         states = logs.states
         assert states is not None and states.bmbox is not None
         moments = seg.from_states(
-            states.bmbox, states.client, states.refbox, clock=options.segment_clock
+            states.bmbox,
+            states.client,
+            states.refbox,
+            clock=options.segment_clock,
+            exact_2015=options.exact_end_payloads,
+            t0_ns=logs.bag_start_ns,
         )
         if goal is None:
             if moments.goal_payload is None:

@@ -8,7 +8,10 @@ Three sources, one result (:class:`ReachedMoments`):
   WAITING_RESULT, once the Client's COMPLETED_GOAL, or the RefBox's ``reason: timeout`` /
   ``reason: stop``, had arrived): the ``bmbox`` clock times segments between those BmBox
   messages, the default ``client`` clock ends them at the Client's report itself. A log that
-  ends inside the benchmark is the benchmark stopped there.
+  ends inside the benchmark is the benchmark stopped there. RefBox END payloads are read by
+  :func:`ertools.states.end_reason` (by default the seed's ``timeout`` / ``halt`` too, under
+  ``--exact-end-payloads`` only the 2015 BmBox's strings); any other is warned about once, with
+  its file and time, and is neither a timeout nor a stop.
 - ``timing``: a reached-waypoint timing file (``p0`` starts the run, ``p(k+1)`` closes
   segment ``k``).
 - ``auto``: stops detected in the ground truth (speed and yaw rate under thresholds for a
@@ -24,17 +27,17 @@ import numpy.typing as npt
 
 from ertools.arrays import F64, I64
 from ertools.benchmarks.common import motion
+from ertools.benchmarks.common.ending import end_payload_deviation, end_payload_warnings
 from ertools.errors import SegmentationError
-from ertools.states import BmBoxState, ClientState, RefBoxState
+from ertools.fidelity import Deviation
+from ertools.states import BmBoxState, ClientState, EndReason, RefBoxState, end_reason
 from ertools.streams import StateStream
 from ertools.timeutil import ns_to_s
 
-# The exact payloads the 2015 BmBox compared the RefBox's with (BmBox.py ``Timeout()``,
-# ``Running()`` and its RefBox callback): any other text changed nothing in the node.
-PAYLOAD_TIMEOUT_2015 = "reason: timeout"
-PAYLOAD_STOP_2015 = "reason: stop"
-
 CLOCKS = ("client", "bmbox")
+
+# An :class:`EarlyEnd` kind per RefBox END reading (a NONE or UNKNOWN payload: ``ended``).
+_KINDS = {EndReason.TIMEOUT: "timeout", EndReason.STOP: "stop"}
 
 
 @dataclass(frozen=True)
@@ -88,7 +91,8 @@ class ReachedMoments:
         early_end: states only: why segment K (the first not completed) was not, when the
             benchmark stopped before its goals ran out (None for timing and auto).
         clock: states only: ``client`` or ``bmbox`` (see :func:`from_states`).
-        warnings: states only: RefBox payloads the 2015 node would have read otherwise.
+        warnings: states only: RefBox END payloads of no known form (file and time).
+        deviations: states only: seed END payloads the default read unlike the 2015 BmBox.
     """
 
     method: str
@@ -101,6 +105,7 @@ class ReachedMoments:
     early_end: EarlyEnd | None = None
     clock: str = "client"
     warnings: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
 
     def __len__(self) -> int:
         return int(self.end_ns.shape[0])
@@ -115,24 +120,12 @@ def _first_at_or_after(t: I64, mask: npt.NDArray[np.bool_], t0: int, t1: int | N
     return int(idx[0]) if idx.size else None
 
 
-def _word_kind(payload: str) -> str:
-    """The default's reading of a RefBox END payload: any mention of a timeout, a stop or halt."""
-    text = payload.lower()
-    if "timeout" in text:
-        return "timeout"
-    if any(word in text for word in ("halt", "stop", "abort")):
-        return "stop"
-    return "ended"
-
-
-def kind_2015(payload: str) -> str:
-    """What the 2015 BmBox made of the RefBox payload: ``timeout`` when ``Timeout()``, ``stop``
-    when ``not Running()``, else ``""`` (both compare the whole payload, BmBox.py)."""
-    if payload == PAYLOAD_TIMEOUT_2015:
-        return "timeout"
-    if payload == PAYLOAD_STOP_2015:
-        return "stop"
-    return ""
+def end_kind(payload: str, *, exact_2015: bool = False) -> str:
+    """``timeout`` or ``stop`` when a RefBox payload says so (:func:`ertools.states.end_reason`,
+    compared whole, never by its words), else ``""``. The 2015 BmBox's ``Timeout()`` and
+    ``Running()`` compared the last RefBox payload whatever its state, and so does the
+    ``bmbox`` clock."""
+    return _KINDS.get(end_reason(payload, exact_2015=exact_2015), "")
 
 
 def _payload_at(stream: StateStream | None, t_ns: int) -> str:
@@ -174,6 +167,8 @@ def from_states(
     refbox: StateStream | None = None,
     *,
     clock: str = "client",
+    exact_2015: bool = False,
+    t0_ns: int | None = None,
 ) -> ReachedMoments:
     """Segments from the state topics (BmBox required, Client preferred for the end moment).
 
@@ -183,7 +178,9 @@ def from_states(
     END before that ends the benchmark there. ``bmbox`` (the 2015 node): from the first BmBox
     message past TRANSMITTING_GOAL to the first past WAITING_RESULT, the node's own transitions,
     and the segment counts as completed unless the RefBox payload then was the node's exact
-    ``reason: timeout`` or ``reason: stop``.
+    ``reason: timeout`` or ``reason: stop`` (by default the seed's ``timeout`` / ``halt`` too;
+    ``exact_2015``: the 2015 strings alone, :func:`ertools.states.end_reason`). ``t0_ns``: the
+    log's first message, from which the warnings count time (default: the first BmBox message).
 
     A log that ends inside the benchmark (a segment started and never ended, or fewer goals
     than waypoints and no score sent) is the benchmark stopped there: ``early_end`` of kind
@@ -205,7 +202,9 @@ def from_states(
     goals = np.flatnonzero(bm.state == BmBoxState.TRANSMITTING_GOAL)
     cl = client.changes() if client is not None and len(client) else None
     rb = refbox.changes() if refbox is not None and len(refbox) else None
-    warnings = _payload_warnings(rb, clock)
+    t0 = int(bmbox.t_ns[0]) if t0_ns is None else t0_ns
+    warnings = tuple(end_payload_warnings(refbox, t0, exact_2015=exact_2015))
+    said = end_payload_deviation(refbox, t0, exact_2015=exact_2015)
     starts: list[int] = []
     ends: list[int] = []
     payloads: list[str] = []
@@ -217,9 +216,9 @@ def from_states(
         t_goal = int(bm.t_ns[g])
         t_next = int(t_goals[k + 1]) if k + 1 < len(goals) else None
         if clock == "bmbox":
-            found = _segment_bmbox(bm, cl, rb, k, t_goal, t_next)
+            found = _segment_bmbox(bm, cl, rb, k, t_goal, t_next, exact_2015)
         else:
-            found = _segment_client(bm, cl, rb, k, t_goal, t_next)
+            found = _segment_client(bm, cl, rb, k, t_goal, t_next, exact_2015)
         if isinstance(found, EarlyEnd):
             early = found
             notes.append(f"segment {k}: not completed ({found.reason})")
@@ -231,7 +230,7 @@ def from_states(
         ends.append(t_end)
         payloads.append(payload)
     else:
-        early = _after_last_goal(bm, rb, len(goals), clock)
+        early = _after_last_goal(bm, rb, len(goals), exact_2015)
         if early is not None:
             after = f"after segment {len(goals) - 1}" if len(goals) else "at all"
             notes.append(f"no goal sent {after} ({early.reason})")
@@ -245,27 +244,8 @@ def from_states(
         early_end=early,
         clock=clock,
         warnings=warnings,
+        deviations=() if said is None else (said,),
     )
-
-
-def _payload_warnings(rb: StateStream | None, clock: str) -> tuple[str, ...]:
-    """A warning per RefBox END payload the 2015 BmBox did not know (it compared the whole
-    payload with ``reason: timeout`` and ``reason: stop``; any other text changed nothing)."""
-    if rb is None:
-        return ()
-    ends = {rb.payload[i] for i in np.flatnonzero(rb.state == RefBoxState.END)}
-    out = []
-    for payload in sorted(p for p in ends if p.strip() and not kind_2015(p)):
-        reading = (
-            "ignored, as the 2015 node did"
-            if clock == "bmbox"
-            else f"read as {_word_kind(payload)} (a stop, timeout or halt word in it, or none)"
-        )
-        out.append(
-            f"RefBox END payload {payload!r} is none the 2015 BmBox compared "
-            f"({PAYLOAD_TIMEOUT_2015!r}, {PAYLOAD_STOP_2015!r}): {reading}"
-        )
-    return tuple(out)
 
 
 _Found = tuple[int, int, str, str] | EarlyEnd  # (start, end, result payload, note) or why not
@@ -278,6 +258,7 @@ def _segment_bmbox(
     k: int,
     t_goal: int,
     t_next: int | None,
+    exact_2015: bool,
 ) -> _Found:
     i_start, i_end = _bmbox_window(bm, t_goal, t_next)
     if i_start is None:
@@ -287,7 +268,7 @@ def _segment_bmbox(
         return EarlyEnd(k, t_start, None, "cut", _payload_at(rb, int(bm.t_ns[-1])))
     t_end = int(bm.t_ns[i_end])
     refbox_payload = _payload_at(rb, t_end)
-    kind = kind_2015(refbox_payload)
+    kind = end_kind(refbox_payload, exact_2015=exact_2015)
     if kind:
         return EarlyEnd(k, t_start, t_end, kind, refbox_payload)
     if int(bm.state[i_end]) != BmBoxState.READY:
@@ -303,6 +284,7 @@ def _segment_client(
     k: int,
     t_goal: int,
     t_next: int | None,
+    exact_2015: bool,
 ) -> _Found:
     i_exec = _first_at_or_after(bm.t_ns, bm.state == BmBoxState.EXECUTING_GOAL, t_goal, t_next)
     i_start, i_bm_end = _bmbox_window(bm, t_goal, t_next)
@@ -316,17 +298,22 @@ def _segment_client(
             else _first_at_or_after(rb.t_ns, rb.state == RefBoxState.END, t_goal, t_next)
         )
         if rb is not None and i_rb0 is not None:
-            payload = rb.payload[i_rb0].strip()
-            return EarlyEnd(k, None, int(rb.t_ns[i_rb0]), _word_kind(payload), payload)
+            payload = rb.payload[i_rb0]
+            kind = end_kind(payload, exact_2015=exact_2015) or "ended"
+            return EarlyEnd(k, None, int(rb.t_ns[i_rb0]), kind, payload)
         return EarlyEnd(k, None, None, "cut")
     t_start = int(bm.t_ns[i_exec])
-    # A RefBox END once the goal is sent ends the segment, whatever comes after it (the robot
-    # arriving late).
-    i_rb = (
-        None
-        if rb is None
-        else _first_at_or_after(rb.t_ns, rb.state == RefBoxState.END, t_goal, t_next)
-    )
+    # A RefBox timeout or stop once the goal is sent ends the segment, whatever comes after it
+    # (the robot arriving late). Another END is neither (as to the 2015 BmBox): the segment
+    # waits on for the robot's report, and ends there only if none comes.
+    i_rb = i_any = None
+    if rb is not None:
+        is_end = rb.state == RefBoxState.END
+        early = np.fromiter(
+            (bool(end_kind(p, exact_2015=exact_2015)) for p in rb.payload), bool, len(rb)
+        )
+        i_rb = _first_at_or_after(rb.t_ns, is_end & early, t_goal, t_next)
+        i_any = _first_at_or_after(rb.t_ns, is_end, t_goal, t_next)
     t_rb = None if i_rb is None or rb is None else int(rb.t_ns[i_rb])
     if cl is not None:
         i_done = _first_at_or_after(cl.t_ns, cl.state == ClientState.COMPLETED_GOAL, t_start, t_rb)
@@ -336,10 +323,12 @@ def _segment_client(
         t_end = int(bm.t_ns[i_bm_end])
         if t_rb is None or t_end < t_rb:
             return t_start, t_end, "", f"segment {k}: end from BmBox READY (no Client topic)"
-    if t_rb is not None and rb is not None:
-        payload = rb.payload[i_rb or 0].strip()
+    i_end = i_rb if i_rb is not None else i_any
+    if rb is not None and i_end is not None:
+        payload, t_end = rb.payload[i_end], int(rb.t_ns[i_end])
+        kind = end_kind(payload, exact_2015=exact_2015) or "ended"
         # An END while the goal was still being sent leaves the segment no time of its own.
-        return EarlyEnd(k, min(t_start, t_rb), t_rb, _word_kind(payload), payload)
+        return EarlyEnd(k, min(t_start, t_end), t_end, kind, payload)
     if t_next is not None:
         raise SegmentationError(
             f"{bm.topic}: segment {k} was never completed, the RefBox did not end it, and the "
@@ -350,7 +339,7 @@ def _segment_client(
 
 
 def _after_last_goal(
-    bm: StateStream, rb: StateStream | None, k: int, clock: str
+    bm: StateStream, rb: StateStream | None, k: int, exact_2015: bool
 ) -> EarlyEnd | None:
     """Why no goal followed the last completed segment ``k - 1`` (None: a normal end, i.e.
     the BmBox sent its score with no RefBox reason; the waypoint count then decides)."""
@@ -364,9 +353,9 @@ def _after_last_goal(
     t_score = int(bm.t_ns[score[0]]) if score.size else None
     if rb is not None and i_rb is not None:
         payload = rb.payload[i_rb]
-        kind = kind_2015(payload) if clock == "bmbox" else _word_kind(payload)
-        if kind in ("timeout", "stop") and (t_score is None or int(rb.t_ns[i_rb]) <= t_score):
-            return EarlyEnd(k, None, int(rb.t_ns[i_rb]), kind, payload.strip())
+        kind = end_kind(payload, exact_2015=exact_2015)
+        if kind and (t_score is None or int(rb.t_ns[i_rb]) <= t_score):
+            return EarlyEnd(k, None, int(rb.t_ns[i_rb]), kind, payload)
     if t_score is None:
         return EarlyEnd(k, None, None, "cut", _payload_at(rb, t_last))
     return None

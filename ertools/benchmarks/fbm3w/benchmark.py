@@ -18,6 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64
+from ertools.benchmarks.common.ending import end_payload_deviation
 from ertools.benchmarks.common.hygiene import (
     frame_change_warning,
     frozen_around,
@@ -159,7 +160,7 @@ def locate_runs(logs: Fbm3wLogs, options: Fbm3wOptions) -> list[RunWindow]:
         windows = find_windows(options.windows, logs.bag_start_ns, logs.bag_end_ns)
     elif mode == "states":
         assert logs.states is not None
-        windows = find_states(logs.states)
+        windows = find_states(logs.states, exact_2015=options.exact_end_payloads)
     else:
         windows = find_auto(logs.poses, options.config or Fbm3wConfig(), **_still(options))
     # State messages and --run windows are timed by record time: header-stamped poses from a
@@ -176,7 +177,7 @@ def score_found(
     logs: Fbm3wLogs, windows: Sequence[RunWindow], options: Fbm3wOptions
 ) -> Fbm3wResult:
     """Score the runs found (:func:`score_runs` on the logs' poses)."""
-    return score_runs(
+    result = score_runs(
         logs.poses,
         windows,
         options.config or Fbm3wConfig(),
@@ -185,6 +186,12 @@ def score_found(
         inputs=tuple(str(p) for p in logs.paths),
         progress=current(),
     )
+    if logs.mode != "states" or logs.states is None or logs.states.bmbox is None:
+        return result
+    # Only the state finder reads the RefBox, and it counts time from the first BmBox message.
+    t0 = int(logs.states.bmbox.t_ns[0])
+    said = end_payload_deviation(logs.states.refbox, t0, exact_2015=options.exact_end_payloads)
+    return result if said is None else replace(result, deviations=(*result.deviations, said))
 
 
 def score_fbm3w(

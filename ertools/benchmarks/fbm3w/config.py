@@ -46,6 +46,8 @@ class Fbm3wOptions:
             run, as the 2015 node did).
         stopped_runs: ``counted`` (default: a run the RefBox stopped counts in
             execution_time) or ``2015`` (its time left out, as the 2015 node did).
+        exact_end_payloads: RefBox END payloads read as the 2015 BmBox did (only
+            ``reason: timeout`` / ``reason: stop``; :func:`ertools.states.end_reason`).
         config: runs_specifications, d_min and shapes (None: the 2015 values,
             ``configs/fbm3w.yaml``); ``d_min`` above overrides its d_min.
 
@@ -67,6 +69,7 @@ class Fbm3wOptions:
     arc_length: bool = False
     timeout_runs: str = "unscored"
     stopped_runs: str = "counted"
+    exact_end_payloads: bool = False
     config: Fbm3wConfig | None = None
 
 
@@ -77,8 +80,9 @@ STOPPED_RUNS = ("counted", "2015")
 def options_2015(options: Fbm3wOptions) -> Fbm3wOptions:
     """``options`` with every FBM3W 2015 behaviour on (``--2015``).
 
-    Timed-out runs scored and eligible, stopped runs' time left out, the shapes at their own
-    parameter, and the script's hard-coded D_MIN unless ``--d-min`` says otherwise.
+    Timed-out runs scored and eligible, stopped runs' time left out, RefBox END payloads read
+    as the BmBox compared them, the shapes at their own parameter, and the script's hard-coded
+    D_MIN unless ``--d-min`` says otherwise.
 
     Raises:
         ConfigError: ``--arc-length`` asked for as well (it is not 2015).
@@ -89,5 +93,6 @@ def options_2015(options: Fbm3wOptions) -> Fbm3wOptions:
         options,
         timeout_runs="2015",
         stopped_runs="2015",
+        exact_end_payloads=True,
         d_min=DEFAULT_D_MIN if options.d_min is None else options.d_min,
     )

@@ -20,6 +20,7 @@ from ertools.benchmarks.base import (
     resolve_values,
     tf_value,
 )
+from ertools.benchmarks.common.ending import EXACT_HELP
 from ertools.benchmarks.fbm3w.benchmark import Fbm3wLogs, load, locate_runs, score_found
 from ertools.benchmarks.fbm3w.config import RUN_MODES, Fbm3wOptions, options_2015
 from ertools.benchmarks.fbm3w.result import Fbm3wResult
@@ -98,10 +99,12 @@ INPUTS = (
         choices=("counted", "2015"),
         group=LEGACY,
     ),
+    Input("exact_end_payloads", "flag", EXACT_HELP, group=LEGACY),
     Input(
         "all_2015",
         "flag",
-        "every 2015 behaviour: --timeout-runs 2015 --stopped-runs 2015, d_min 0.00033 "
+        "every 2015 behaviour: --timeout-runs 2015 --stopped-runs 2015 "
+        "--exact-end-payloads, d_min 0.00033 "
         "unless --d-min is given, no --arc-length",
         flag="--2015",
         group=LEGACY,
@@ -197,6 +200,7 @@ def make_options(given: Mapping[str, Any]) -> Fbm3wOptions:
         arc_length=v["arc_length"],
         timeout_runs=v["timeout_runs"],
         stopped_runs=v["stopped_runs"],
+        exact_end_payloads=v["exact_end_payloads"],
         config=load_fbm3w_config(v["config"]),
     )
     return options_2015(options) if v["all_2015"] else options

@@ -7,10 +7,11 @@ time window of the path. The scorer does the rest, identically for the three mod
 ``WAITING_MANUAL_OPERATION -> COMPLETED_MANUAL_OPERATION`` (reference = pose at completion)
 ``-> TRANSMITTING_GOAL`` (payload: the spec) ``-> EXECUTING_GOAL`` (path starts)
 ``-> WAITING_RESULT -> READY`` (path ends when WAITING_RESULT is left). A RefBox ``END`` during
-a run ends it early when its payload is one the 2015 BmBox knew (``reason: timeout`` /
-``reason: stop``, or the seed's ``timeout`` / ``halt``: :func:`ertools.states.end_reason`):
-that run is reported as ``timeout`` or ``stopped``. Another END payload is warned about and read
-as the 2015 BmBox read it (neither). A log that ends inside a run is that run stopped there
+a run ends it early when its payload is a timeout or a stop (``reason: timeout`` /
+``reason: stop``, the 2015 BmBox's strings; by default the seed's ``timeout`` / ``halt`` too, not
+under ``--exact-end-payloads``: :func:`ertools.states.end_reason`): that run is reported as
+``timeout`` or ``stopped``. Another END payload is warned about once, with its file and time,
+and read as the 2015 BmBox read it (neither). A log that ends inside a run is that run stopped there
 (:mod:`ertools.benchmarks.common.ending`), said in a warning.
 
 ``windows``: ``SPEC:REF_T:START_T:END_T`` or a YAML list; times are seconds from the bag's
@@ -26,12 +27,18 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
-from ertools.benchmarks.common.ending import RefBoxEnd, cut_warning, log_cut, refbox_ends
+from ertools.benchmarks.common.ending import (
+    RefBoxEnd,
+    cut_warning,
+    end_payload_warnings,
+    log_cut,
+    refbox_ends,
+)
 from ertools.configs._yaml import MAX_SECONDS, show
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.errors import ConfigError, SegmentationError
 from ertools.io.model import BenchmarkStates
-from ertools.states import BmBoxState, EndReason, unknown_end_warning
+from ertools.states import BmBoxState, EndReason
 from ertools.timeutil import ns_to_s, resolve_time
 
 # What a RefBox END payload does to the run it ends (ertools.states.end_reason).
@@ -78,8 +85,10 @@ class RunWindow:
 # --- states -------------------------------------------------------------------------------
 
 
-def find_states(states: BenchmarkStates) -> list[RunWindow]:
+def find_states(states: BenchmarkStates, *, exact_2015: bool = False) -> list[RunWindow]:
     """Runs from the BmBox transitions (see the module docstring).
+
+    ``exact_2015``: RefBox END payloads read as the 2015 BmBox did (``--exact-end-payloads``).
 
     Raises:
         SegmentationError: no BmBox state topic, or no run in it.
@@ -90,7 +99,7 @@ def find_states(states: BenchmarkStates) -> list[RunWindow]:
             "no /fbm3w/bmbox_state messages: use --runs windows (--run SPEC:REF:START:END) "
             "or --runs auto"
         )
-    ends = refbox_ends(states.refbox)
+    ends = refbox_ends(states.refbox, exact_2015=exact_2015)
     t0 = int(bm.t_ns[0])
     ch = bm.changes()
     times = ch.t_ns.tolist()
@@ -114,10 +123,7 @@ def find_states(states: BenchmarkStates) -> list[RunWindow]:
             # The BmBox's Timeout()/Running() read the last RefBox payload when WaitResult
             # returned: the last END of the run decides; an unknown payload is neither.
             during = refbox_ends_in(start, end_ns + END_SLACK_NS)
-            for e in during:
-                if e.reason is EndReason.UNKNOWN:
-                    said.append(unknown_end_warning(e.payload, f"run {index}"))
-            known = [e for e in during if e.reason is not EndReason.UNKNOWN]
+            known = [e for e in during if e.reason.ends_early]
             if known:
                 status = EARLY_END[known[-1].reason]
                 note = f"{note}; RefBox END {known[-1].payload!r}"
@@ -177,7 +183,7 @@ def find_states(states: BenchmarkStates) -> list[RunWindow]:
             close(t, "interrupted", "the benchmark ended before the path")
     if cur is not None:
         close(int(bm.t_ns[-1]), "cut", "the BmBox log ends during the run")
-    elif runs and (cut := log_cut(bm, states.refbox)) is not None:
+    elif runs and (cut := log_cut(bm, states.refbox, exact_2015=exact_2015)) is not None:
         # Between runs: nothing is lost, but the log is not the whole benchmark.
         said = cut_warning(cut, bm, t0, "the benchmark", "no run was open")
         runs[-1] = replace(runs[-1], warnings=(*runs[-1].warnings, said))
@@ -186,6 +192,9 @@ def find_states(states: BenchmarkStates) -> list[RunWindow]:
             f"{bm.topic}: no run found (no EXECUTING_GOAL or manual operation in "
             f"{len(ch)} transitions); use --runs windows or --runs auto"
         )
+    unknown = end_payload_warnings(states.refbox, t0, exact_2015=exact_2015)
+    if unknown:
+        runs[0] = replace(runs[0], warnings=(*unknown, *runs[0].warnings))
     return runs
 
 

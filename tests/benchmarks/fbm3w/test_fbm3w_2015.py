@@ -97,10 +97,12 @@ def node_2015(
     specs: list[str],
 ) -> dict[str, Any]:
     """What the 2015 node would have computed from these messages (plain Python)."""
-    end_t, end_word = None, ""
+    # BmBox.py compares the RefBox payload whole: Timeout() is == "reason: timeout" (l. 117),
+    # Running() is != "reason: stop" (l. 126); any other END payload changed nothing.
+    end_t, end_payload = None, ""
     for tt, state, payload in refbox:
-        if state == R.END and payload.strip():
-            end_t, end_word = tt, payload.strip().split()[0].lower()
+        if state == R.END and payload in ("reason: timeout", "reason: stop"):
+            end_t, end_payload = tt, payload
             break
     runs: list[dict[str, Any]] = []
     ref_t = start_t = None
@@ -120,7 +122,7 @@ def node_2015(
     total = 0.0
     for k, run in enumerate(runs):
         ended = end_t is not None and run["start"] <= end_t <= run["end"] + S
-        if ended and end_word in ("stop", "halt", "stopped"):
+        if ended and end_payload == "reason: stop":
             break  # ``if not benchmark.Running(): continue``, then the loop ends
         total += (run["end"] - run["start"]) / 1e9
         details[k] = {
@@ -169,22 +171,37 @@ def test_sample_bag_2015_equals_the_node(
         transitions(states.refbox),
         ["line", "spline", "line", "spline", "line"],
     )
-    # The sample's run 4 timed out mid-path: the node scored and timed it.
+    # The sample's RefBox ends run 4 mid-path with the seed's bare "timeout": to the 2015
+    # BmBox no timeout, so the node scored and timed run 4 as it scores any run.
     assert 4 in node["runs"]
     assert main(["score", "fbm3w", str(bag), "--2015", "--format", "json"]) == 0
     captured = capsys.readouterr()
     out = json.loads(captured.out)
     _check(out, node)
-    assert out["runs_details"]["4"]["status"] == "timeout_scored"
-    assert "--timeout-runs 2015" in captured.err
-    # --timeout-runs 2015 alone gives the same numbers here (d_min already 0.00033, no stop).
+    assert out["runs_details"]["4"]["status"] == "scored"
+    assert "RefBox END with payload 'timeout', which is none of the forms" in captured.err
+    # --timeout-runs 2015 alone reads the seed's word as the timeout it names (said), and
+    # scores the timed-out run as 2015 did: the same numbers here (d_min already 0.00033).
     assert main(["score", "fbm3w", str(bag), "--timeout-runs", "2015", "--format", "json"]) == 0
-    _check(json.loads(capsys.readouterr().out), node)
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    _check(out, node)
+    assert out["runs_details"]["4"]["status"] == "timeout_scored"
+    assert "as a timeout" in captured.err and "[all.end-payloads]" in captured.err
     # Default: the timed-out run has no distance_error, and the output says why.
     assert main(["score", "fbm3w", str(bag), "--format", "json"]) == 0
     captured = capsys.readouterr()
     assert json.loads(captured.out)["runs_details"]["4"]["distance_error"] is None
     assert "differs from 2015: a run the RefBox timed out" in captured.err
+    # --exact-end-payloads alone: the END is no timeout, run 4 is an ordinary completed run.
+    assert main(["score", "fbm3w", str(bag), "--exact-end-payloads", "--format", "json"]) == 0
+    captured = capsys.readouterr()
+    out = json.loads(captured.out)
+    assert out["runs_details"]["4"]["status"] == "scored"
+    assert out["runs_details"]["4"]["distance_error"] == pytest.approx(
+        node["runs"][4]["distance_error"], abs=TOL
+    )
+    assert "[all.end-payloads]" not in captured.err
 
 
 # --- simulated edge cases --------------------------------------------------------------------
@@ -270,7 +287,7 @@ def _scenario(
 
 
 def _ertools(poses: PoseStream, states: BenchmarkStates, options: Fbm3wOptions) -> dict[str, Any]:
-    windows = find_states(states)
+    windows = find_states(states, exact_2015=options.exact_end_payloads)
     data: dict[str, Any] = score_runs(poses, windows, Fbm3wConfig(), options=options).to_dict()
     return data
 
@@ -296,7 +313,7 @@ def test_run_timing_out_midway_is_scored_and_can_be_best(yaw: float) -> None:
         # off, still the best run for 2015.
         {"spec": "spline", "track": {"reach": 0.6, "offset": 0.0003, **common}, "end_at": 19.0},
     ]
-    poses, states, bm, rb = _scenario(runs, (19.0, "timeout"), seed=3)
+    poses, states, bm, rb = _scenario(runs, (19.0, "reason: timeout"), seed=3)
     node = _node(poses, bm, rb, ["line", "spline"])
     assert node["best_run"] == 1 and set(node["runs"]) == {0, 1}
     assert 0.02 < node["runs"][1]["distance_error"] < 0.08 < node["runs"][0]["distance_error"]
@@ -316,7 +333,7 @@ def test_stopped_run_is_neither_scored_nor_timed() -> None:
         {"spec": "line", "track": {"reach": 1.0, "offset": 0.001, **common}},
         {"spec": "spline", "track": {"reach": 0.5, "offset": 0.0002, **common}, "end_at": 20.0},
     ]
-    poses, states, bm, rb = _scenario(runs, (20.0, "stop"), seed=4)
+    poses, states, bm, rb = _scenario(runs, (20.0, "reason: stop"), seed=4)
     node = _node(poses, bm, rb, ["line", "spline"])
     assert set(node["runs"]) == {0}
     out = _ertools(poses, states, options_2015(Fbm3wOptions()))
@@ -387,7 +404,7 @@ def test_stopped_run_from_a_bag_with_the_cli(
         {"spec": "line", "track": {"reach": 1.0, "offset": 0.002, **common}},
         {"spec": "spline", "track": {"reach": 0.4, "offset": 0.0, **common}, "end_at": 19.5},
     ]
-    poses, states, bm, rb = _scenario(runs, (19.5, "stop"), seed=13)
+    poses, states, bm, rb = _scenario(runs, (19.5, "reason: stop"), seed=13)
     assert states.bmbox is not None and states.refbox is not None
     bag = tmp_path / "stopped.bag"
     epoch = 1_448_020_800 * S  # the log's clock: the scenario's seconds from this epoch
