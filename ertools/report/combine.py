@@ -240,10 +240,11 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
             if board.key is not None:
                 row["rank"] = standing.marker if standing else "\u2014"
             row["team"] = x.team or "(unknown)"
-            row.update({k: e.headline.get(k) for k in keys})
-            if board.key is not None:
-                row[board.interval_header] = _interval_text(board.key, record["interval"])
-                row[_P_HEADER] = _p_text(record)
+            for k in keys:
+                row[k] = e.headline.get(k)
+                if k == board.key and board.has_intervals:  # its interval right beside it
+                    row[board.interval_header] = _interval_text(board.key, record["interval"])
+                    row[_P_HEADER] = _p_text(record)
             row["warnings"] = e.warnings
             row["failures"] = e.failures
             row["audit findings"] = e.findings
@@ -320,6 +321,10 @@ class Board:
     confidence: float
     standings: tuple[ranks.Standing, ...]  # ``ident``: the execution's index in the group
     reasons: dict[int, str]  # index -> why that execution is not ranked
+
+    @property
+    def has_intervals(self) -> bool:
+        return any(s.interval is not None for s in self.standings)
 
     @property
     def interval_header(self) -> str:
@@ -425,14 +430,14 @@ def _p_text(record: dict[str, Any]) -> str:
     if p is None:
         note = record["rank_note"]
         return f"\u2014 ({note})" if note else "\u2014"
-    return f"{p * 100:.1f} %"
+    return ranks.percent(p)
 
 
 def _board_context(board: Board) -> dict[str, Any]:
     """The explanation, the one-line summary and the plot of a ranked benchmark."""
     if board.key is None:
         return {"explanation": "", "summary": "", "plot": ""}
-    if all(s.interval is None for s in board.standings):
+    if not board.has_intervals:
         return {
             "explanation": f"Ranked by {board.rule}. {ranks.NONE_EXPLAINED}",
             "summary": "",

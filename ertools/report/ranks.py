@@ -34,6 +34,7 @@ from typing import Any
 
 DEFAULT_CONFIDENCE = 0.95
 NO_INTERVAL = "no interval in this result"
+NEXT_NO_INTERVAL = "the next has no interval"
 NOT_SCOREABLE = "unscoreable"
 NONE_EXPLAINED = (
     "No result here has a confidence interval (written by an ertools without intervals, or "
@@ -158,11 +159,29 @@ def stability(
                     p_swap_next=probabilities[i],
                     group=ranks[members[0]],
                     tied_with=tuple(ordered[j].name for j in members if j != i),
-                    note=NO_INTERVAL if c.interval is None else "",
+                    note=_note(ordered, i),
                     ident=c.ident,
                 )
             )
     return out
+
+
+def _note(ordered: Sequence[Contender], i: int) -> str:
+    if ordered[i].interval is None:
+        return NO_INTERVAL
+    if i + 1 < len(ordered) and ordered[i + 1].interval is None:
+        return NEXT_NO_INTERVAL
+    return ""
+
+
+def percent(p: float) -> str:
+    """``24.4 %``; ``< 0.1 %`` and ``> 99.9 %`` at the ends (a rounded 0.0 % reads as
+    impossible)."""
+    if p < 0.0005:
+        return "< 0.1 %"
+    if p > 0.9995:
+        return "> 99.9 %"
+    return f"{p * 100:.1f} %"
 
 
 def _finite(value: Any) -> float | None:
