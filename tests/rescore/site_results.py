@@ -217,6 +217,8 @@ class Page(HTMLParser):
     def __init__(self, text: str) -> None:
         super().__init__()
         self.boards: dict[str, list[list[str]]] = {}
+        # a standing's rank by the values (data-rank; the cell shows "=2" in a tie group)
+        self.ranks: dict[str, list[int | None]] = {}
         self.rules: dict[str, str] = {}
         self.links: list[str] = []
         self.ids: set[str] = set()
@@ -251,15 +253,21 @@ class Page(HTMLParser):
             if "leaderboard" in cls:
                 self._board = self._section
                 self.boards[self._board] = []
+                self.ranks[self._board] = []
         elif tag == "tr" and "standing" in cls and self._board:
             self._row = []
             self.differs_rows += "differs" in cls
+            self.ranks[self._board].append(int(a["data-rank"]) if a.get("data-rank") else None)
         elif tag == "tr" and "execution" in cls:
             self.executions.append(a.get("data-status", ""))
         elif tag == "td" and self._row is not None:
             self._cell = ""
         elif tag == "p" and "rule" in cls:
             self._rule = ""
+
+    def board(self, anchor: str) -> list[tuple[int | None, str]]:
+        """(rank by the values, team) of a leaderboard's standings, in page order."""
+        return [(r, row[1]) for r, row in zip(self.ranks[anchor], self.boards[anchor], strict=True)]
 
     def handle_endtag(self, tag: str) -> None:
         if tag == "td" and self._cell is not None and self._row is not None:

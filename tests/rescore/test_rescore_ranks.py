@@ -1,0 +1,131 @@
+"""Rank stability on the results of ``ertools rescore``: the leaderboards of results.json and
+results.csv carry each team's interval, P(swap) with the next and its tie group, and the page
+shows them with the plot.
+
+The executions are hand-built (tests/rescore/site_results.py) with intervals written into
+their scores as the scorers write them (``best_distance_error_interval`` and an
+``uncertainty`` block, docs/uncertainty.md); the leaderboards are made by the pipeline's own
+function, then the page from the document. The expected probabilities are computed here from
+the normal CDF. (End to end, with intervals the scorers compute, is left to the sample
+competition's test once the scorers write them.)
+"""
+
+from __future__ import annotations
+
+import csv
+import html
+import io
+import json
+import math
+import re
+from pathlib import Path
+from typing import Any
+
+import pytest
+from site_results import EVIL, Page, fbm2h, fbm3w, results, write_folder
+
+from ertools.rescore.pipeline import csv_text, leaderboards
+from ertools.rescore.site import write_site
+
+Z95 = 1.959963984540054
+
+
+def phi(x: float) -> float:
+    return 0.5 * (1.0 + math.erf(x / math.sqrt(2.0)))
+
+
+def with_interval(ex: dict[str, Any], low: float, high: float) -> dict[str, Any]:
+    ex["score"]["best_distance_error_interval"] = [low, high]
+    ex["score"]["uncertainty"] = {"confidence": 0.95, "method": "monte_carlo", "draws": 500}
+    return ex
+
+
+def document() -> dict[str, Any]:
+    doc = results()
+    exs = [
+        with_interval(fbm3w("smartbots", 0, 0.0081), 0.0079, 0.0083),
+        with_interval(fbm3w("homer", 10, 0.0083), 0.0080, 0.0087),
+        with_interval(fbm3w("b-it-bots", 20, 0.0100), 0.0098, 0.0102),
+        fbm3w(EVIL, 30, 0.0200),  # scored before intervals existed
+        # a team's second execution: only its best is ranked
+        with_interval(fbm3w("homer", 40, 0.0150), 0.0140, 0.0160),
+        fbm2h("homer", 120, 0.097),
+        fbm2h("smartbots", 130, 0.063),
+    ]
+    doc["executions"] = exs
+    doc["leaderboards"] = leaderboards(exs)
+    return doc
+
+
+# smartbots-homer: 0.2 mm apart; facing sides 0.2 mm (smartbots above) and 0.3 mm (homer below)
+P_SMART = phi(-0.2 / math.hypot(0.2 / Z95, 0.3 / Z95))
+# homer-b-it-bots: 1.7 mm apart; facing sides 0.4 mm and 0.2 mm
+P_HOMER = phi(-1.7 / math.hypot(0.4 / Z95, 0.2 / Z95))
+
+
+def test_results_json_and_csv() -> None:
+    assert P_SMART == pytest.approx(0.1385, abs=5e-4)  # Phi(-1.087)
+    doc = document()
+    (board,) = [b for b in doc["leaderboards"] if b["benchmark"] == "fbm3w"]
+    assert board["confidence"] == 0.95
+    rows = {r["team"]: r for r in board["rows"]}
+    assert [r["team"] for r in board["rows"]] == ["smartbots", "homer", "b-it-bots", EVIL]
+    assert rows["smartbots"]["p_swap_next"] == pytest.approx(P_SMART, rel=1e-9)
+    assert rows["homer"]["p_swap_next"] == pytest.approx(P_HOMER, abs=1e-12)  # both ~5e-14
+    assert rows["homer"]["interval"] == [0.0080, 0.0087]  # its best execution's
+    assert rows["homer"]["execution"] == "fbm3w-homer-20151120T091000"
+    assert [(r["rank"], r["rank_group"]) for r in board["rows"]] == [(1, 1), (2, 1), (3, 3), (4, 4)]
+    assert rows["smartbots"]["tied_with"] == ["homer"] and rows["b-it-bots"]["tied_with"] == []
+    assert rows[EVIL]["interval"] is None and rows[EVIL]["rank_note"] == "no interval in this result"
+    assert rows["b-it-bots"]["rank_note"] == "the next has no interval"
+    json.dumps(doc, allow_nan=False)  # the document stays strict JSON
+    table = {r["id"]: r for r in csv.DictReader(io.StringIO(csv_text(doc)))}
+    smart = table["fbm3w-smartbots-20151120T090000"]
+    assert (smart["rank"], smart["rank_group"], smart["tied_with"]) == ("1", "1", "homer")
+    assert (float(smart["interval_low"]), float(smart["interval_high"])) == (0.0079, 0.0083)
+    assert float(smart["p_swap_next"]) == pytest.approx(P_SMART, rel=1e-9)
+    # homer's second execution is not on the leaderboard: no place of its own
+    assert table["fbm3w-homer-20151120T094000"]["rank"] == ""
+    # fbm2h: no intervals, ranked by the values alone
+    (fbm2h_board,) = [b for b in doc["leaderboards"] if b["benchmark"] == "fbm2h"]
+    assert [r["p_swap_next"] for r in fbm2h_board["rows"]] == [None, None]
+
+
+def test_page_shows_intervals_ties_and_plot(tmp_path: Path) -> None:
+    doc = document()
+    write_folder(tmp_path, doc)
+    loaded = json.loads((tmp_path / "results.json").read_text(encoding="utf-8"))
+    index = write_site(loaded, tmp_path)
+    text = index.read_text(encoding="utf-8")
+    page = Page(text)
+    board = page.boards["lb-fbm3w"]
+    assert [r[:2] for r in board] == [
+        ["=1", "smartbots"],
+        ["=1", "homer"],
+        ["3", "b-it-bots"],
+        ["4", EVIL],
+    ]
+    assert page.board("lb-fbm3w") == [(1, "smartbots"), (2, "homer"), (3, "b-it-bots"), (4, EVIL)]
+    # value, interval (mm, 0.01 mm), P(swap) with the next
+    assert board[0][2:5] == ["8.10", "7.90 to 8.30", f"{P_SMART * 100:.1f} %"]
+    assert board[0][4] == "13.8 %"
+    assert board[1][3:5] == ["8.00 to 8.70", "< 0.1 %"]
+    assert board[2][4] == "\u2014 (the next has no interval)"
+    assert board[3][3:5] == ["\u2014", "\u2014 (no interval in this result)"]
+    start = text.index('id="lb-fbm3w"')
+    section = text[start : text.index("</section>", start)]
+    classes = re.findall(r'<tr class="standing([^"]*)"', section)
+    assert classes == [" tied first", " tied last", "", ""]
+    assert "95 % interval (mm)" in section and "does not support the order" in section
+    assert "1 of 3 adjacent order(s) supported by the data" in section
+    assert "tied: smartbots, homer (=1)" in section
+    svg = section[section.index("<svg") : section.index("</svg>")]
+    assert svg.count('class="interval"') == 3 and svg.count("no-interval") == 1
+    assert svg.count('class="tie"') == 1
+    assert EVIL not in svg and html.escape(EVIL, quote=False)[:20] in svg  # a name stays text
+    assert page.scripts == 0
+    # fbm2h has no interval: no such columns, no plot, and the page says why
+    start = text.index('id="lb-fbm2h"')
+    fbm2h = text[start : text.index("</section>", start)]
+    assert "interval (mm)" not in fbm2h and "<svg" not in fbm2h
+    assert "No result here has a confidence interval" in fbm2h
