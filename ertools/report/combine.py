@@ -18,6 +18,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -349,7 +350,7 @@ def _board(bench: str, group: list[Execution]) -> Board:
         if unscoreable is not None:
             reasons[i] = f"unscoreable: {unscoreable}"
             continue
-        if isinstance(value, bool) or not isinstance(value, int | float) or value != value:
+        if isinstance(value, bool) or not isinstance(value, int | float) or math.isnan(value):
             reasons[i] = f"no {key} in this result"
             continue
         contenders.append(
@@ -369,9 +370,7 @@ def _board(bench: str, group: list[Execution]) -> Board:
     standings = ranks.stability(
         _distinct(contenders), lower_is_better=ranking.lower_is_better, confidence=confidence
     )
-    return Board(
-        key, ranking.lower_is_better, ranking.text, confidence, tuple(standings), reasons
-    )
+    return Board(key, ranking.lower_is_better, ranking.text, confidence, tuple(standings), reasons)
 
 
 def _distinct(contenders: list[ranks.Contender]) -> list[ranks.Contender]:

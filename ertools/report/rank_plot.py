@@ -44,9 +44,7 @@ def _ticks(low: float, high: float, count: int = 5) -> list[float]:
 
 def _text(x: float, y: float, text: str, *, anchor: str = "start", css: str = "") -> str:
     style = f' class="{css}"' if css else ""
-    return (
-        f'<text x="{x:.1f}" y="{y:.1f}" text-anchor="{anchor}"{style}>{escape(text)}</text>'
-    )
+    return f'<text x="{x:.1f}" y="{y:.1f}" text-anchor="{anchor}"{style}>{escape(text)}</text>'
 
 
 def interval_plot(
@@ -88,8 +86,7 @@ def interval_plot(
         f'<svg xmlns="http://www.w3.org/2000/svg" class="rank-plot" width="{WIDTH}" '
         f'height="{height}" viewBox="0 0 {WIDTH} {height}" role="img" '
         f'font-family="sans-serif" font-size="12">',
-        f"<title>{escape(f'{label}: score (dot) and its {pct} interval (bar) per team')}"
-        "</title>",
+        f"<title>{escape(f'{label}: score (dot) and its {pct} interval (bar) per team')}</title>",
     ]
     # Tie groups first, behind the rows.
     i = 0
@@ -117,16 +114,14 @@ def interval_plot(
             f'<line x1="{tx:.1f}" y1="{TOP - 4}" x2="{tx:.1f}" y2="{axis_y}" stroke="#ddd"/>'
         )
         parts.append(_text(tx, axis_y + 14, f"{tick:g}", anchor="middle"))
-    parts.append(
-        f'<line x1="{left}" y1="{axis_y}" x2="{right}" y2="{axis_y}" stroke="#666"/>'
-    )
+    parts.append(f'<line x1="{left}" y1="{axis_y}" x2="{right}" y2="{axis_y}" stroke="#666"/>')
     parts.append(_text((left + right) / 2, axis_y + 32, label, anchor="middle"))
     parts.append(_text(left, TOP - 10, f"dot: score; bar: {pct} interval", css="legend"))
     for k, s in enumerate(rows):
         cy = y(k)
         marker = s.marker
         name = s.name if len(s.name) <= NAME else s.name[: NAME - 1] + "\u2026"
-        parts.append(f"<g class=\"row\"><title>{escape(s.name)}</title>")
+        parts.append(f'<g class="row"><title>{escape(s.name)}</title>')
         parts.append(_text(LABEL - 8, cy + 4, f"{marker}  {name}", anchor="end", css="team"))
         shown = f"{s.score * factor:.{decimals}f}"
         if s.interval is not None:
@@ -140,8 +135,7 @@ def interval_plot(
                 f'stroke="{BAR}" stroke-width="2"/></g>'
             )
             parts.append(
-                f'<circle class="score" cx="{x(s.score):.1f}" cy="{cy:.1f}" r="4.5" '
-                f'fill="{DOT}"/>'
+                f'<circle class="score" cx="{x(s.score):.1f}" cy="{cy:.1f}" r="4.5" fill="{DOT}"/>'
             )
             lo, hi = (f"{v * factor:.{decimals}f}" for v in s.interval)
             parts.append(_text(right + 8, cy + 4, f"{shown} [{lo}, {hi}]", css="value"))

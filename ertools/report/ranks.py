@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from itertools import pairwise
 from statistics import NormalDist
 from typing import Any
 
@@ -87,9 +88,7 @@ def z_value(confidence: float) -> float:
     return NormalDist().inv_cdf((1.0 + confidence) / 2.0)
 
 
-def p_swap(
-    better: Contender, worse: Contender, *, lower_is_better: bool
-) -> float | None:
+def p_swap(better: Contender, worse: Contender, *, lower_is_better: bool) -> float | None:
     """The probability that ``worse`` (ranked below ``better`` by the values) truly scores
     better than ``better``, by the model of the module's docstring; None without intervals."""
     if better.interval is None or worse.interval is None:
@@ -135,7 +134,7 @@ def stability(
         ranks.append(ranks[-1] if same else i + 1)
     probabilities: list[float | None] = []
     joined: list[bool] = []  # joined[i]: row i and row i + 1 are one group
-    for a, b in zip(ordered, ordered[1:], strict=False):
+    for a, b in pairwise(ordered):
         p = p_swap(a, b, lower_is_better=lower_is_better)
         probabilities.append(p)
         joined.append(a.score == b.score or (p is not None and p > alpha_half))
@@ -255,9 +254,11 @@ def explanation(confidence: float, lower_is_better: bool) -> str:
 def summary(standings: Sequence[Standing]) -> str:
     """``1 of 3 adjacent orders supported by the data; tied: b, c (=2)``: one line for a
     leaderboard (a pair not assessed, for want of an interval, is not counted as supported)."""
-    pairs = list(zip(standings, standings[1:], strict=False))
+    pairs = list(pairwise(standings))
     joined = [a.group == b.group for a, b in pairs]
-    unassessed = sum(a.p_swap_next is None and not j for (a, _), j in zip(pairs, joined, strict=True))
+    unassessed = sum(
+        a.p_swap_next is None and not j for (a, _), j in zip(pairs, joined, strict=True)
+    )
     supported = len(pairs) - sum(joined) - unassessed
     parts = [f"{supported} of {len(pairs)} adjacent order(s) supported by the data"]
     if unassessed:

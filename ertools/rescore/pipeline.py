@@ -461,14 +461,14 @@ def leaderboards(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
             if team not in best or sign * row["rank_value"] < sign * best[team]["rank_value"]:
                 best[team] = row
         ordered = sorted(best.items(), key=lambda tr: (sign * tr[1]["rank_value"], tr[0]))
-        confidence = ranks.board_confidence(ranks.confidence_of(r["score"]) for _, r in ordered)
+        confidence = ranks.board_confidence(ranks.confidence_of(r.get("score")) for _, r in ordered)
         standings = ranks.stability(
             [
                 ranks.Contender(
                     team,
                     float(row["rank_value"]),
                     _interval(row, ranking.text),
-                    ranks.confidence_of(row["score"]) or ranks.DEFAULT_CONFIDENCE,
+                    ranks.confidence_of(row.get("score")) or ranks.DEFAULT_CONFIDENCE,
                     str(row["id"]),
                 )
                 for team, row in ordered

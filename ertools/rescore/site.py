@@ -162,9 +162,7 @@ def _stability(
         )
     stated = _number(said)
     level = (
-        stated
-        if stated is not None and 0.0 < stated < 1.0
-        else ranks.board_confidence(confidences)
+        stated if stated is not None and 0.0 < stated < 1.0 else ranks.board_confidence(confidences)
     )
     standings = ranks.stability(contenders, lower_is_better=lower, confidence=level)
     return {int(s.ident): s for s in standings}, level
