@@ -445,7 +445,7 @@ def _board_context(board: Board) -> dict[str, Any]:
     spec = units.quantity_of(board.key)
     return {
         "explanation": f"Ranked by {board.rule}. "
-        + ranks.explanation(board.confidence, board.lower_is_better),
+        + ranks.explanation(board.confidence, board.lower_is_better, board.key),
         "summary": ranks.summary(board.standings),
         "plot": interval_plot(
             board.standings,

@@ -236,8 +236,15 @@ def unscoreable_reason(score: Mapping[str, Any] | None) -> str | None:
     return str(score.get("unscoreable_reason") or "the data cannot support a score")
 
 
-def explanation(confidence: float, lower_is_better: bool) -> str:
-    """The words above a leaderboard with rank stability."""
+BEST_OF_RUNS = (
+    " The score is the best of the execution's runs: its interval is the result's interval of "
+    "that best-of-runs value (another run close behind the best widens it), not of one run."
+)
+
+
+def explanation(confidence: float, lower_is_better: bool, key: str | None = None) -> str:
+    """The words above a leaderboard with rank stability (``key``: the ranked score key; a
+    best-of-runs key, ``best_...``, says what its interval covers)."""
     pct = f"{confidence * 100:g} %"
     direction = "lower" if lower_is_better else "higher"
     return (
@@ -248,7 +255,7 @@ def explanation(confidence: float, lower_is_better: bool) -> str:
         f"chance exceeds {(1 - confidence) / 2 * 100:g} % (the {pct} interval of the "
         f"difference contains 0), the data does not support the order: those teams are "
         f"tied, shown '=' with the rank of the group's first team and bracketed in the plot."
-    )
+    ) + (BEST_OF_RUNS if key and key.startswith("best_") else "")
 
 
 def summary(standings: Sequence[Standing]) -> str:

@@ -385,7 +385,7 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
                 unranked=tuple(unranked),
                 warnings=tuple(g for g in grouped if g.benchmark == name),
                 explanation=(
-                    ranks.explanation(confidence, lower)
+                    ranks.explanation(confidence, lower, only)
                     if with_intervals
                     else ranks.NONE_EXPLAINED
                     if shown

@@ -121,6 +121,7 @@ def test_page_shows_intervals_ties_and_plot(tmp_path: Path) -> None:
     assert "95 % interval (mm)" in section and "does not support the order" in section
     assert "1 of 3 adjacent order(s) supported by the data" in section
     assert "tied: smartbots, homer (=1)" in section
+    assert "best of the execution&#39;s runs" in section  # what FBM3W's interval covers
     svg = section[section.index("<svg") : section.index("</svg>")]
     assert svg.count('class="interval"') == 3 and svg.count("no-interval") == 1
     assert svg.count('class="tie"') == 1
