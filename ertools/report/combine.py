@@ -237,6 +237,7 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
             e = x.main
             standing = placed.get(i)
             record = _stability_record(board, standing, board.reasons.get(i))
+            reason = board.reasons.get(i)
             row: dict[str, Any] = {}
             if board.key is not None:
                 row["rank"] = standing.marker if standing else "\u2014"
@@ -245,7 +246,13 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
                 row[k] = e.headline.get(k)
                 if k == board.key and board.has_intervals:  # its interval right beside it
                     row[board.interval_header] = _interval_text(board.key, record["interval"])
-                    row[_P_HEADER] = _p_text(record)
+                    row[_P_HEADER] = (
+                        ranks.p_text(standing)
+                        if standing
+                        else f"\u2014 ({reason})"
+                        if reason
+                        else "\u2014"
+                    )
             row["warnings"] = e.warnings
             row["failures"] = e.failures
             row["audit findings"] = e.findings
@@ -339,8 +346,7 @@ def _board(bench: str, group: list[Execution]) -> Board:
     if bench not in registry.names():
         return Board(None, True, "", ranks.DEFAULT_CONFIDENCE, (), {})
     ranking = registry.get(bench).ranking
-    # The rule's text starts with the ranked key (``best_distance_error (metres, ...)``).
-    key = ranking.text.split(" ", 1)[0]
+    key = ranks.rule_key(ranking.text)
     contenders = []
     reasons: dict[int, str] = {}
     for i, x in enumerate(group):
@@ -421,15 +427,6 @@ def _interval_text(key: str, interval: list[float] | None) -> str:
     spec = units.quantity_of(key)
     low, high = (h.fmt(float(units.display(key, v)), spec[0] if spec else None) for v in interval)
     return f"{low} to {high}"
-
-
-def _p_text(record: dict[str, Any]) -> str:
-    """``3.1 %``, ``tied with b (3.1 %)``; or why there is none."""
-    p = record["p_swap_next"]
-    if p is None:
-        note = record["rank_note"]
-        return f"\u2014 ({note})" if note else "\u2014"
-    return ranks.percent(p)
 
 
 def _board_context(board: Board) -> dict[str, Any]:

@@ -219,14 +219,27 @@ def board_confidence(confidences: Iterable[float | None]) -> float:
     return max(said) if said else DEFAULT_CONFIDENCE
 
 
+def rule_key(rule: str) -> str:
+    """The score key a registry rule's text names first: every ``Ranking.text`` starts with
+    it (``best_distance_error (metres, the best run's ...): lower is better``)."""
+    return rule.split(" ", 1)[0] if rule else ""
+
+
 def ranked_key(score: Mapping[str, Any] | None, value: float | None, rule: str = "") -> str | None:
     """The top-level key of ``score`` holding the ranked ``value``: the one the rule's text
-    names first (``best_distance_error (metres, ...)``) when several keys hold that value."""
+    names (:func:`rule_key`) when several keys hold that value."""
     if not isinstance(score, Mapping) or value is None:
         return None
     keys = [k for k, v in score.items() if _finite(v) == value]
-    named = rule.split(" ", 1)[0] if rule else ""
+    named = rule_key(rule)
     return named if named in keys else (keys[0] if keys else None)
+
+
+def p_text(standing: Standing) -> str:
+    """A row's ``P(swap with next)`` as shown: ``13.8 %``, or why there is none."""
+    if standing.p_swap_next is None:
+        return f"\u2014 ({standing.note})" if standing.note else "\u2014"
+    return percent(standing.p_swap_next)
 
 
 def unscoreable_reason(score: Mapping[str, Any] | None) -> str | None:

@@ -175,11 +175,7 @@ def _interval_text(key: str | None, interval: tuple[float, float] | None) -> str
 
 
 def _p_text(place: ranks.Standing | None) -> str:
-    if place is None:
-        return text.shown(None, None)
-    if place.p_swap_next is None:
-        return f"\u2014 ({place.note})" if place.note else "\u2014"
-    return ranks.percent(place.p_swap_next)
+    return ranks.p_text(place) if place is not None else text.shown(None, None)
 
 
 def _tie_class(

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import random
+import re
 
 import pytest
 
@@ -180,3 +181,33 @@ def test_reading_results() -> None:
     assert ranked_key({"a": 0.8, "b": 0.8}, 0.8) == "a"
     assert unscoreable_reason({"status": "unscoreable", "unscoreable_reason": "no GT"}) == "no GT"
     assert unscoreable_reason({"status": "scored"}) is None
+
+
+def test_plot_places_dots_and_bars_by_the_numbers() -> None:
+    """The SVG from the numbers: scores 0, 5, 10 with intervals; the axis spans [0, 10]
+    padded by 6 % each side (-0.6 .. 10.6) over the plot's x range (LABEL .. WIDTH - RIGHT),
+    so x(v) = LABEL + (v + 0.6) / 11.2 * (WIDTH - RIGHT - LABEL)."""
+    from ertools.report.rank_plot import LABEL, RIGHT, WIDTH, interval_plot
+
+    board = stability(
+        [
+            Contender("a", 0.0, (0.0, 1.0)),
+            Contender("b<&>", 5.0, (4.0, 6.0)),
+            Contender("c", 10.0, (9.5, 10.0)),
+        ],
+        lower_is_better=True,
+    )
+    svg = interval_plot(board, factor=1000.0, unit="mm", decimals=1, axis="error")
+    span = WIDTH - RIGHT - LABEL
+
+    def x(v: float) -> str:
+        return f"{LABEL + (v + 0.6) / 11.2 * span:.1f}"
+
+    dots = re.findall(r'<circle class="score" cx="([0-9.]+)"', svg)
+    assert dots == [x(0.0), x(5.0), x(10.0)]
+    # b's bar from 4 to 6 (values shown in mm: factor 1000)
+    assert f'x1="{x(4.0)}"' in svg and f'x2="{x(6.0)}"' in svg
+    assert "5000.0 [4000.0, 6000.0]" in svg and "error (mm)" in svg
+    assert "b&lt;&amp;&gt;" in svg and "b<&>" not in svg  # a team name is text
+    # a-b: 5 apart, sides 1 and 1 (95 %): P = Phi(-5 / (sqrt(2) / 1.96)), far below 2.5 %
+    assert 'class="tie"' not in svg
