@@ -452,6 +452,18 @@ def leaderboards(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
         for row in rows:
             if row["benchmark"] != name or row["status"] != "scored" or row["rank_value"] is None:
                 continue
+            # A score that says its data cannot support it (validity, docs/uncertainty.md) is
+            # never ranked, whatever number it carries.
+            unscoreable = ranks.unscoreable_reason(row.get("score"))
+            if unscoreable is not None:
+                unranked.append(
+                    {
+                        "execution": row["id"],
+                        "value": row["rank_value"],
+                        "note": f"{row['team'] or TEAM_UNKNOWN}: unscoreable ({unscoreable})",
+                    }
+                )
+                continue
             if row["team"] is None:  # scored, but ranked only once the manifest names it
                 unranked.append(
                     {"execution": row["id"], "value": row["rank_value"], "note": TEAM_UNKNOWN}

@@ -51,7 +51,10 @@ def document() -> dict[str, Any]:
         with_interval(fbm3w("homer", 40, 0.0150), 0.0140, 0.0160),
         fbm2h("homer", 120, 0.097),
         fbm2h("smartbots", 130, 0.063),
+        # a score whose data cannot support it: never ranked, even with a number
+        fbm2h("robotnik", 140, 0.010),
     ]
+    exs[-1]["score"].update(status="unscoreable", unscoreable_reason="no GT at waypoint 2")
     doc["executions"] = exs
     doc["leaderboards"] = leaderboards(exs)
     return doc
@@ -91,6 +94,14 @@ def test_results_json_and_csv() -> None:
     # fbm2h: no intervals, ranked by the values alone
     (fbm2h_board,) = [b for b in doc["leaderboards"] if b["benchmark"] == "fbm2h"]
     assert [r["p_swap_next"] for r in fbm2h_board["rows"]] == [None, None]
+    assert [r["team"] for r in fbm2h_board["rows"]] == ["smartbots", "homer"]
+    assert fbm2h_board["unranked"] == [
+        {
+            "execution": "fbm2h-robotnik-20151120T112000",
+            "value": 0.010,
+            "note": "robotnik: unscoreable (no GT at waypoint 2)",
+        }
+    ]
 
 
 def test_page_shows_intervals_ties_and_plot(tmp_path: Path) -> None:
@@ -132,3 +143,4 @@ def test_page_shows_intervals_ties_and_plot(tmp_path: Path) -> None:
     fbm2h = text[start : text.index("</section>", start)]
     assert "interval (mm)" not in fbm2h and "<svg" not in fbm2h
     assert "No result here has a confidence interval" in fbm2h
+    assert "robotnik: unscoreable (no GT at waypoint 2)" in fbm2h  # out of the ranking
