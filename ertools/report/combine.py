@@ -232,6 +232,7 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
         keys = list(dict.fromkeys(k for x in group for k in x.main.headline if k != "benchmark"))
         merged = any(x.others for x in group)
         rows = []
+        ties: list[str] = []  # the rows' CSS: a tie group's bracket
         links = []
         for i, x in zip(order, group, strict=True):
             e = x.main
@@ -261,6 +262,7 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
                 row["options"] = e.options or "(defaults)"
                 row["other results"] = "; ".join(_variant_text(o, e) for o in x.others)
             rows.append(row)
+            ties.append(_tie_class(board.standings, standing))
             data = {k: v for k, v in row.items() if k not in (board.interval_header, _P_HEADER)}
             data.pop("rank", None)
             flat.append(
@@ -285,7 +287,11 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
             {
                 "anchor": f"b-{bench}",
                 "title": f"{bench} ({len(group)} result(s), {teams} team(s))",
-                "table": h.table(rows),
+                "table": h.table(
+                    [{**row, "_tie": tie} for row, tie in zip(rows, ties, strict=True)],
+                    columns=[c for c in dict.fromkeys(k for r in rows for k in r)],
+                    row_class="_tie",
+                ),
                 "links": links,
                 **_board_context(board),
             }
@@ -427,6 +433,17 @@ def _interval_text(key: str, interval: list[float] | None) -> str:
     spec = units.quantity_of(key)
     low, high = (h.fmt(float(units.display(key, v)), spec[0] if spec else None) for v in interval)
     return f"{low} to {high}"
+
+
+def _tie_class(standings: tuple[ranks.Standing, ...], standing: ranks.Standing | None) -> str:
+    """``tied first``/``tied``/``tied last``: the row's place in a bracket of tied teams."""
+    if standing is None or not standing.tied:
+        return ""
+    members = [s for s in standings if s.group == standing.group]
+    ends = (["first"] if members[0] is standing else []) + (
+        ["last"] if members[-1] is standing else []
+    )
+    return " ".join(["tied", *ends])
 
 
 def _board_context(board: Board) -> dict[str, Any]:

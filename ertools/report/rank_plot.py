@@ -42,8 +42,10 @@ def _ticks(low: float, high: float, count: int = 5) -> list[float]:
     return out
 
 
-def _text(x: float, y: float, text: str, *, anchor: str = "start", css: str = "") -> str:
-    style = f' class="{css}"' if css else ""
+def _text(
+    x: float, y: float, text: str, *, anchor: str = "start", css: str = "", fill: str = ""
+) -> str:
+    style = (f' class="{css}"' if css else "") + (f' fill="{fill}"' if fill else "")
     return f'<text x="{x:.1f}" y="{y:.1f}" text-anchor="{anchor}"{style}>{escape(text)}</text>'
 
 
@@ -104,7 +106,15 @@ def interval_plot(
                 f'<path class="bracket" d="M14 {top + 3} h-6 V{bottom - 3} h6" fill="none" '
                 f'stroke="{TIE_LINE}" stroke-width="2"/>'
             )
-            parts.append(_text(18, (top + bottom) / 2 + 4, f"={rows[i].group}", css="tie-mark"))
+            parts.append(
+                _text(
+                    18,
+                    (top + bottom) / 2 + 4,
+                    f"={rows[i].group}",
+                    css="tie-mark",
+                    fill=TIE_LINE,
+                )
+            )
         i = j + 1
     # Axis: grid lines and ticks.
     axis_y = TOP + ROW * max(n, 1)

@@ -139,6 +139,8 @@ def test_page_shows_intervals_ties_and_plot(competition: tuple[Path, dict[str, A
         for c in re.findall(r"<td[^>]*>.*?</td>", section.split("<tbody>")[1].split("</tbody>")[0])
     ]
     assert cells[:2] == ["=1", "alpha"]
+    # the tie bracketed in the table: alpha opens it, bravo closes it
+    assert re.findall(r'<tr class="([^"]*)"', section)[:3] == ["tied first", "tied last", ""]
     assert "0.40 to 0.60" in cells and f"{expected['alpha'] * 100:.1f} %" in cells
     assert f"{expected['alpha'] * 100:.1f} %" == "24.4 %"
     assert "\u2014 (no interval in this result)" in cells  # delta
