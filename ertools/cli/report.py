@@ -1,8 +1,11 @@
 """Combine several results (a competition's runs) into one HTML page.
 
 RESULTS are report folders written with `--report DIR`, their result.json, or score.json
-files. The page has one table per benchmark, one row per result (team, headline numbers,
-warnings, failures, audit findings) and links to each report.
+files. The page has one table per benchmark, one row per result in rank order (rank, team,
+headline numbers, warnings, failures, audit findings) and links to each report. Where the
+results carry confidence intervals, each rank says whether the data supports it: the interval,
+the probability of swapping with the next team, ties marked =N, and a plot of the intervals
+(docs/uncertainty.md, "Rank stability").
 """
 
 from __future__ import annotations
