@@ -66,6 +66,9 @@ def interval_plot(
     rows = list(standings)
     n = len(rows)
     height = TOP + ROW * max(n, 1) + BOTTOM
+    rows = [s for s in rows if math.isfinite(s.score)]  # an infinite score has no place
+    n = len(rows)
+    height = TOP + ROW * max(n, 1) + BOTTOM
     values = [v * factor for s in rows for v in (s.score, *(s.interval or ()))]
     low, high = (min(values), max(values)) if values else (0.0, 1.0)
     if high - low <= 0.0:

@@ -95,6 +95,8 @@ def p_swap(better: Contender, worse: Contender, *, lower_is_better: bool) -> flo
         return None
     sign = 1.0 if lower_is_better else -1.0
     gap = sign * (worse.score - better.score)  # >= 0 when the two are in rank order
+    if not math.isfinite(gap):
+        return None  # an infinite score (a hand-edited document): nothing to weigh
     # The sides that face each other: above the better score and below the worse one when
     # lower is better, the other way round when higher is.
     if lower_is_better:

@@ -9,6 +9,7 @@ import re
 
 import pytest
 
+from ertools.report.rank_plot import LABEL, RIGHT, WIDTH, interval_plot
 from ertools.report.ranks import (
     NEXT_NO_INTERVAL,
     NO_INTERVAL,
@@ -187,8 +188,6 @@ def test_plot_places_dots_and_bars_by_the_numbers() -> None:
     """The SVG from the numbers: scores 0, 5, 10 with intervals; the axis spans [0, 10]
     padded by 6 % each side (-0.6 .. 10.6) over the plot's x range (LABEL .. WIDTH - RIGHT),
     so x(v) = LABEL + (v + 0.6) / 11.2 * (WIDTH - RIGHT - LABEL)."""
-    from ertools.report.rank_plot import LABEL, RIGHT, WIDTH, interval_plot
-
     board = stability(
         [
             Contender("a", 0.0, (0.0, 1.0)),
@@ -211,3 +210,12 @@ def test_plot_places_dots_and_bars_by_the_numbers() -> None:
     assert "b&lt;&amp;&gt;" in svg and "b<&>" not in svg  # a team name is text
     # a-b: 5 apart, sides 1 and 1 (95 %): P = Phi(-5 / (sqrt(2) / 1.96)), far below 2.5 %
     assert 'class="tie"' not in svg
+
+
+def test_infinite_scores_are_not_weighed() -> None:
+    board = stability(
+        [Contender("a", 1.0, (0.5, 1.5)), Contender("b", float("inf"), (0.0, 2.0))],
+        lower_is_better=True,
+    )
+    assert board[0].p_swap_next is None and not board[0].tied
+    assert interval_plot(board).count('class="score"') == 1
