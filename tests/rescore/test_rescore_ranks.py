@@ -19,12 +19,11 @@ import json
 import math
 import re
 from pathlib import Path
-from typing import Any
 
 import pytest
-from site_results import EVIL, Page, fbm2h, fbm3w, results, write_folder
+from site_results import EVIL, Page, ranked_document, write_folder
 
-from ertools.rescore.pipeline import csv_text, leaderboards
+from ertools.rescore.pipeline import csv_text
 from ertools.rescore.site import write_site
 
 Z95 = 1.959963984540054
@@ -32,32 +31,6 @@ Z95 = 1.959963984540054
 
 def phi(x: float) -> float:
     return 0.5 * (1.0 + math.erf(x / math.sqrt(2.0)))
-
-
-def with_interval(ex: dict[str, Any], low: float, high: float) -> dict[str, Any]:
-    ex["score"]["best_distance_error_interval"] = [low, high]
-    ex["score"]["uncertainty"] = {"confidence": 0.95, "method": "monte_carlo", "draws": 500}
-    return ex
-
-
-def document() -> dict[str, Any]:
-    doc = results()
-    exs = [
-        with_interval(fbm3w("smartbots", 0, 0.0081), 0.0079, 0.0083),
-        with_interval(fbm3w("homer", 10, 0.0083), 0.0080, 0.0087),
-        with_interval(fbm3w("b-it-bots", 20, 0.0100), 0.0098, 0.0102),
-        fbm3w(EVIL, 30, 0.0200),  # scored before intervals existed
-        # a team's second execution: only its best is ranked
-        with_interval(fbm3w("homer", 40, 0.0150), 0.0140, 0.0160),
-        fbm2h("homer", 120, 0.097),
-        fbm2h("smartbots", 130, 0.063),
-        # a score whose data cannot support it: never ranked, even with a number
-        fbm2h("robotnik", 140, 0.010),
-    ]
-    exs[-1]["score"].update(status="unscoreable", unscoreable_reason="no GT at waypoint 2")
-    doc["executions"] = exs
-    doc["leaderboards"] = leaderboards(exs)
-    return doc
 
 
 # smartbots-homer: 0.2 mm apart; facing sides 0.2 mm (smartbots above) and 0.3 mm (homer below)
@@ -68,7 +41,7 @@ P_HOMER = phi(-1.7 / math.hypot(0.4 / Z95, 0.2 / Z95))
 
 def test_results_json_and_csv() -> None:
     assert abs(P_SMART - 0.1385) < 5e-4  # Phi(-1.087), from tables
-    doc = document()
+    doc = ranked_document()
     (board,) = [b for b in doc["leaderboards"] if b["benchmark"] == "fbm3w"]
     assert board["confidence"] == 0.95
     rows = {r["team"]: r for r in board["rows"]}
@@ -105,7 +78,7 @@ def test_results_json_and_csv() -> None:
 
 
 def test_page_shows_intervals_ties_and_plot(tmp_path: Path) -> None:
-    doc = document()
+    doc = ranked_document()
     write_folder(tmp_path, doc)
     loaded = json.loads((tmp_path / "results.json").read_text(encoding="utf-8"))
     index = write_site(loaded, tmp_path)

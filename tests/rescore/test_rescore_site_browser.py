@@ -16,7 +16,15 @@ from typing import Any
 import numpy as np
 import pytest
 from fakes import BROWSER, CHROMIUM_FLAGS
-from site_results import EVIL, Page, assert_links_resolve, expected_board, results, write_folder
+from site_results import (
+    EVIL,
+    Page,
+    assert_links_resolve,
+    expected_board,
+    ranked_document,
+    results,
+    write_folder,
+)
 
 from ertools.report.timeline_page import write_timeline_page
 from ertools.report.timeline_style import KIND_COLORS
@@ -114,10 +122,8 @@ def test_timeline_frame_draws_its_chart(site: tuple[dict[str, Any], Path], tmp_p
 def test_rank_stability_plot_is_drawn(tmp_path: Path) -> None:
     """With intervals: the browser builds the inline SVG plot (a dot per team, the tie band)
     and the tied rows; nothing is refused by the page's content policy."""
-    from test_rescore_ranks import document
-
     out = tmp_path / "site"
-    doc = document()
+    doc = ranked_document()
     write_folder(out, doc)
     index = write_site(doc, out)
     dom = chromium(tmp_path, index.as_uri(), "--dump-dom").stdout
