@@ -198,8 +198,17 @@ def load_entry(path: Path) -> Entry:
     )
 
 
-def combine(paths: list[Path], outdir: Path, *, title: str = "Competition results") -> Path:
+def combine(
+    paths: list[Path],
+    outdir: Path,
+    *,
+    title: str = "Competition results",
+    confidence: float | None = None,
+) -> Path:
     """Write the combined page of ``paths`` into ``outdir``; returns its ``index.html``.
+
+    ``confidence``: the level at which ties are judged (default: the results' own, else
+    0.95; :mod:`ertools.report.ranks`).
 
     Raises:
         ConfigError: a path that is not a result, or no path at all.
@@ -222,7 +231,7 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
         by_team = sorted(
             by_benchmark[bench], key=lambda x: (x.team, x.main.inputs, str(x.main.source))
         )
-        board = _board(bench, by_team)
+        board = _board(bench, by_team, confidence)
         # Ranked executions in rank order, then the others by team.
         placed = {int(s.ident): s for s in board.standings}
         order = [int(s.ident) for s in board.standings]
@@ -347,8 +356,9 @@ class Board:
         return f"{self.confidence * 100:g} % interval{unit}"
 
 
-def _board(bench: str, group: list[Execution]) -> Board:
-    """The executions of ``bench`` ranked by the registry's rule for it."""
+def _board(bench: str, group: list[Execution], chosen: float | None = None) -> Board:
+    """The executions of ``bench`` ranked by the registry's rule for it, ties judged at the
+    ``chosen`` confidence (default: the results' own)."""
     if bench not in registry.names():
         return Board(None, True, "", ranks.DEFAULT_CONFIDENCE, (), {})
     ranking = registry.get(bench).ranking
@@ -376,7 +386,7 @@ def _board(bench: str, group: list[Execution]) -> Board:
         )
     if not contenders:
         return Board(None, ranking.lower_is_better, ranking.text, ranks.DEFAULT_CONFIDENCE, (), {})
-    confidence = ranks.board_confidence(
+    confidence = chosen or ranks.board_confidence(
         ranks.confidence_of(x.main.score) for x in group if x.main.score
     )
     standings = ranks.stability(

@@ -159,3 +159,33 @@ def test_page_shows_intervals_ties_and_plot(competition: tuple[Path, dict[str, A
     fbm2h = page[page.index('id="b-fbm2h"') : page.index('id="b-fbm3w"')]
     assert "No result here has a confidence interval" in fbm2h and "<svg" not in fbm2h
     assert "interval (mm)" not in fbm2h and "P(swap" not in fbm2h  # no empty columns
+
+
+def test_another_confidence_judges_the_ties(tmp_path: Path) -> None:
+    """--confidence 0.5: a tie when P(swap) > 25 %; alpha-bravo (24.4 %) is then an order the
+    data supports. The intervals are still read at their own 95 %."""
+    res = tmp_path / "results"
+    folders = [
+        write_result(res / "a", "fbm3w", "alpha", fbm3w(0.00050, (0.00040, 0.00060))),
+        write_result(res / "b", "fbm3w", "bravo", fbm3w(0.00055, (0.00045, 0.00065))),
+    ]
+    out = tmp_path / "out"
+    assert main(["report", *map(str, folders), "--report", str(out), "--confidence", "0.5"]) == 0
+    rows = json.loads((out / "results.json").read_text(encoding="utf-8"))
+    assert [(r["rank_group"], r["tied_with"], r["confidence"]) for r in rows] == [
+        (1, [], 0.5),
+        (2, [], 0.5),
+    ]
+    assert rows[0]["p_swap_next"] == pytest.approx(phi(-0.05 / math.hypot(0.1 / Z95, 0.1 / Z95)))
+
+
+@pytest.mark.parametrize("value", ["1", "0", "95", "nan"])
+def test_confidence_out_of_range_is_a_usage_error(
+    tmp_path: Path, value: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    folder = write_result(tmp_path / "a", "fbm3w", "alpha", fbm3w(0.0005))
+    argv = ["report", str(folder), "--report", str(tmp_path / "o"), "--confidence", value]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "--confidence" in err and "Traceback" not in err
+    assert not (tmp_path / "o").exists()
