@@ -8,7 +8,8 @@ key ``K`` in a result, at the result's ``uncertainty.confidence``). The model, s
   is that side's half of the interval: ``sigma = (high - score) / z`` above the score and
   ``(score - low) / z`` below, ``z`` the two-sided normal quantile of the interval's
   confidence (1.96 at 95 %). A symmetric interval is one normal; a skewed Monte Carlo
-  interval keeps its skew where it matters, on the side facing the neighbour;
+  interval keeps its skew where it matters, on the side facing the neighbour (a side the
+  interval does not reach, an interval wholly above its score, is no spread);
 - the scores of two teams are independent (different executions, different mocap frames);
   an uncertainty source both share (the ``d_min`` of FBM3) moves both the same way and makes
   their difference *more* certain than this, so the model errs towards calling a tie;
