@@ -117,3 +117,18 @@ def test_page_shows_intervals_ties_and_plot(tmp_path: Path) -> None:
     assert "interval (mm)" not in fbm2h and "<svg" not in fbm2h
     assert "No result here has a confidence interval" in fbm2h
     assert "robotnik: unscoreable (no GT at waypoint 2)" in fbm2h  # out of the ranking
+
+
+def test_an_older_document_takes_the_intervals_from_the_scores(tmp_path: Path) -> None:
+    """A results.json written before leaderboards carried rank stability (rows: rank, team,
+    value, execution only): the page reads each interval from its execution's score and
+    gives the same table."""
+    doc = ranked_document()
+    keep = ("rank", "team", "value", "execution")
+    for board in doc["leaderboards"]:
+        board.pop("confidence")
+        board["rows"] = [{k: r[k] for k in keep} for r in board["rows"]]
+    fresh = Page(write_site(ranked_document(), tmp_path / "fresh").read_text(encoding="utf-8"))
+    old = Page(write_site(doc, tmp_path / "old").read_text(encoding="utf-8"))
+    assert old.boards["lb-fbm3w"][0][:5] == ["=1", "smartbots", "8.10", "7.90 to 8.30", "13.8 %"]
+    assert old.boards == fresh.boards
