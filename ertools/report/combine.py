@@ -18,8 +18,9 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -29,8 +30,9 @@ from ertools.benchmarks.common.teams import team_from_log_name
 from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ConfigError
 from ertools.report import html as h
-from ertools.report import units
+from ertools.report import ranks, units
 from ertools.report.folder import headline
+from ertools.report.rank_plot import interval_plot
 
 # Command-line options that choose where or how output is written, not what is scored.
 _OUTPUT_OPTIONS = frozenset(
@@ -76,6 +78,7 @@ class Entry:
     sha256: tuple[str, ...] = ()  # of the inputs, sorted: same tuple = same execution
     options: str = ""  # the scoring options of its command line ("" = the defaults)
     generated: str = ""
+    score: dict[str, Any] = field(default_factory=dict)  # the whole score (for its intervals)
 
 
 @dataclass(frozen=True)
@@ -170,6 +173,7 @@ def load_entry(path: Path) -> Entry:
             options=_options(argv, records),
             generated=str(meta.get("generated") or ""),
             headline=dict(meta.get("headline") or {}),
+            score=dict(meta["score"]) if isinstance(meta.get("score"), dict) else {},
             inputs=inputs,
             warnings=len(meta.get("warnings") or []),
             failures=len(meta.get("failures") or []),
@@ -184,6 +188,7 @@ def load_entry(path: Path) -> Entry:
         benchmark=_guess_benchmark(score),
         team="",
         headline=headline(score),
+        score=score,
         inputs=(),
         warnings=0,
         failures=0,
@@ -193,8 +198,17 @@ def load_entry(path: Path) -> Entry:
     )
 
 
-def combine(paths: list[Path], outdir: Path, *, title: str = "Competition results") -> Path:
+def combine(
+    paths: list[Path],
+    outdir: Path,
+    *,
+    title: str = "Competition results",
+    confidence: float | None = None,
+) -> Path:
     """Write the combined page of ``paths`` into ``outdir``; returns its ``index.html``.
+
+    ``confidence``: the level at which ties are judged (default: the results' own, else
+    0.95; :mod:`ertools.report.ranks`).
 
     Raises:
         ConfigError: a path that is not a result, or no path at all.
@@ -214,18 +228,41 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
     benchmarks: list[dict[str, Any]] = []
     flat: list[dict[str, Any]] = []
     for bench in sorted(by_benchmark):
-        group = sorted(
+        by_team = sorted(
             by_benchmark[bench], key=lambda x: (x.team, x.main.inputs, str(x.main.source))
         )
+        board = _board(bench, by_team, confidence)
+        # Ranked executions in rank order, then the others by team.
+        placed = {int(s.ident): s for s in board.standings}
+        order = [int(s.ident) for s in board.standings]
+        order += [i for i in range(len(by_team)) if i not in placed]
+        group = [by_team[i] for i in order]
         # The benchmark is the table's title, not a column.
         keys = list(dict.fromkeys(k for x in group for k in x.main.headline if k != "benchmark"))
         merged = any(x.others for x in group)
         rows = []
+        ties: list[str] = []  # the rows' CSS: a tie group's bracket
         links = []
-        for x in group:
+        for i, x in zip(order, group, strict=True):
             e = x.main
-            row: dict[str, Any] = {"team": x.team or "(unknown)"}
-            row.update({k: e.headline.get(k) for k in keys})
+            standing = placed.get(i)
+            record = _stability_record(board, standing, board.reasons.get(i))
+            reason = board.reasons.get(i)
+            row: dict[str, Any] = {}
+            if board.key is not None:
+                row["rank"] = standing.marker if standing else "\u2014"
+            row["team"] = x.team or "(unknown)"
+            for k in keys:
+                row[k] = e.headline.get(k)
+                if k == board.key and board.has_intervals:  # its interval right beside it
+                    row[board.interval_header] = _interval_text(board.key, record["interval"])
+                    row[_P_HEADER] = (
+                        ranks.p_text(standing)
+                        if standing
+                        else f"\u2014 ({reason})"
+                        if reason
+                        else "\u2014"
+                    )
             row["warnings"] = e.warnings
             row["failures"] = e.failures
             row["audit findings"] = e.findings
@@ -234,10 +271,14 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
                 row["options"] = e.options or "(defaults)"
                 row["other results"] = "; ".join(_variant_text(o, e) for o in x.others)
             rows.append(row)
+            ties.append(_tie_class(board.standings, standing))
+            data = {k: v for k, v in row.items() if k not in (board.interval_header, _P_HEADER)}
+            data.pop("rank", None)
             flat.append(
                 {
                     "benchmark": bench,
-                    **row,
+                    **data,
+                    **(record if board.key is not None else {}),
                     "team_source": x.team_source,
                     "source": str(e.source),
                     "other sources": " ".join(str(o.source) for o in x.others),
@@ -255,16 +296,22 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
             {
                 "anchor": f"b-{bench}",
                 "title": f"{bench} ({len(group)} result(s), {teams} team(s))",
-                "table": h.table(rows),
+                "table": h.table(
+                    [{**row, "_tie": tie} for row, tie in zip(rows, ties, strict=True)],
+                    columns=[c for c in dict.fromkeys(k for r in rows for k in r)],
+                    row_class="_tie",
+                ),
                 "links": links,
+                **_board_context(board),
             }
         )
     atomic.write_text(outdir / "results.json", json.dumps(flat, indent=2) + "\n")
-    columns = list(dict.fromkeys(k for row in flat for k in row))
+    table = [_csv_row(row) for row in flat]
+    columns = list(dict.fromkeys(k for row in table for k in row))
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=columns)
     writer.writeheader()
-    writer.writerows([{k: spreadsheet_safe(v) for k, v in row.items()} for row in flat])
+    writer.writerows([{k: spreadsheet_safe(v) for k, v in row.items()} for row in table])
     atomic.write_text(outdir / "results.csv", buffer.getvalue())
     of_runs = f" of {len(runs)} execution(s)" if len(runs) != len(entries) else ""
     subtitle = f"{len(entries)} result(s){of_runs}, combined by ertools {__version__}"
@@ -280,6 +327,170 @@ def combine(paths: list[Path], outdir: Path, *, title: str = "Competition result
     )
     atomic.write_text(index, page)
     return index
+
+
+_P_HEADER = "P(swap with next)"
+
+
+@dataclass(frozen=True)
+class Board:
+    """A benchmark's executions ranked by its rule, with their rank stability
+    (:mod:`ertools.report.ranks`); ``key`` None when the benchmark has no ranking rule or
+    no execution has the ranked value."""
+
+    key: str | None
+    lower_is_better: bool
+    rule: str
+    confidence: float
+    standings: tuple[ranks.Standing, ...]  # ``ident``: the execution's index in the group
+    reasons: dict[int, str]  # index -> why that execution is not ranked
+
+    @property
+    def has_intervals(self) -> bool:
+        return any(s.interval is not None for s in self.standings)
+
+    @property
+    def interval_header(self) -> str:
+        spec = units.quantity_of(self.key) if self.key else None
+        unit = f" ({units.unit(spec[0])})" if spec else ""
+        return f"{self.confidence * 100:g} % interval{unit}"
+
+
+def _board(bench: str, group: list[Execution], chosen: float | None = None) -> Board:
+    """The executions of ``bench`` ranked by the registry's rule for it, ties judged at the
+    ``chosen`` confidence (default: the results' own)."""
+    if bench not in registry.names():
+        return Board(None, True, "", ranks.DEFAULT_CONFIDENCE, (), {})
+    ranking = registry.get(bench).ranking
+    key = ranks.rule_key(ranking.text)
+    contenders = []
+    reasons: dict[int, str] = {}
+    for i, x in enumerate(group):
+        score = x.main.score or x.main.headline
+        unscoreable = ranks.unscoreable_reason(score)
+        value = score.get(key)
+        if unscoreable is not None:
+            reasons[i] = f"unscoreable: {unscoreable}"
+            continue
+        if isinstance(value, bool) or not isinstance(value, int | float) or math.isnan(value):
+            reasons[i] = f"no {key} in this result"
+            continue
+        contenders.append(
+            ranks.Contender(
+                name=x.team or "(unknown)",
+                score=float(value),
+                interval=ranks.interval_of(score, key),
+                confidence=ranks.confidence_of(score) or ranks.DEFAULT_CONFIDENCE,
+                ident=str(i),
+            )
+        )
+    if not contenders:
+        return Board(None, ranking.lower_is_better, ranking.text, ranks.DEFAULT_CONFIDENCE, (), {})
+    confidence = chosen or ranks.board_confidence(
+        ranks.confidence_of(x.main.score) for x in group if x.main.score
+    )
+    standings = ranks.stability(
+        _distinct(contenders), lower_is_better=ranking.lower_is_better, confidence=confidence
+    )
+    return Board(key, ranking.lower_is_better, ranking.text, confidence, tuple(standings), reasons)
+
+
+def _distinct(contenders: list[ranks.Contender]) -> list[ranks.Contender]:
+    """Team names made distinct where a team has several executions: ``homer (2)``."""
+    seen: dict[str, int] = {}
+    for c in contenders:
+        seen[c.name] = seen.get(c.name, 0) + 1
+    count: dict[str, int] = {}
+    out = []
+    for c in contenders:
+        if seen[c.name] > 1:
+            count[c.name] = count.get(c.name, 0) + 1
+            c = ranks.Contender(
+                f"{c.name} ({count[c.name]})", c.score, c.interval, c.confidence, c.ident
+            )
+        out.append(c)
+    return out
+
+
+def _stability_record(
+    board: Board, standing: ranks.Standing | None, reason: str | None
+) -> dict[str, Any]:
+    """What results.json says of an execution's place: in the stored units."""
+    if standing is None:
+        return {
+            "rank": None,
+            "rank_group": None,
+            "tied_with": [],
+            "interval": None,
+            "p_swap_next": None,
+            "confidence": board.confidence,
+            "rank_note": reason or "",
+        }
+    return {
+        "rank": standing.rank,
+        "rank_group": standing.group,
+        "tied_with": list(standing.tied_with),
+        "interval": list(standing.interval) if standing.interval else None,
+        "p_swap_next": standing.p_swap_next,
+        "confidence": board.confidence,
+        "rank_note": standing.note,
+    }
+
+
+def _interval_text(key: str, interval: list[float] | None) -> str:
+    if interval is None:
+        return "\u2014"
+    spec = units.quantity_of(key)
+    low, high = (h.fmt(float(units.display(key, v)), spec[0] if spec else None) for v in interval)
+    return f"{low} to {high}"
+
+
+def _tie_class(standings: tuple[ranks.Standing, ...], standing: ranks.Standing | None) -> str:
+    """``tied first``/``tied``/``tied last``: the row's place in a bracket of tied teams."""
+    if standing is None or not standing.tied:
+        return ""
+    members = [s for s in standings if s.group == standing.group]
+    ends = (["first"] if members[0] is standing else []) + (
+        ["last"] if members[-1] is standing else []
+    )
+    return " ".join(["tied", *ends])
+
+
+def _board_context(board: Board) -> dict[str, Any]:
+    """The explanation, the one-line summary and the plot of a ranked benchmark."""
+    if board.key is None:
+        return {"explanation": "", "summary": "", "plot": ""}
+    if not board.has_intervals:
+        return {
+            "explanation": f"Ranked by {board.rule}. {ranks.NONE_EXPLAINED}",
+            "summary": "",
+            "plot": "",
+        }
+    spec = units.quantity_of(board.key)
+    return {
+        "explanation": f"Ranked by {board.rule}. "
+        + ranks.explanation(board.confidence, board.lower_is_better, board.key),
+        "summary": ranks.summary(board.standings),
+        "plot": interval_plot(
+            board.standings,
+            factor=units.factor(*spec) if spec else 1.0,
+            unit=units.unit(spec[0]) if spec else "",
+            decimals=units.DECIMALS[spec[0]] if spec else 3,
+            axis=board.key,
+            confidence=board.confidence,
+        ),
+    }
+
+
+def _csv_row(row: dict[str, Any]) -> dict[str, Any]:
+    """A results.json row as a CSV row: the interval as two columns, lists joined."""
+    out = dict(row)
+    if "interval" in out:
+        interval = out.pop("interval")
+        out["interval_low"], out["interval_high"] = interval if interval else (None, None)
+    if "tied_with" in out:
+        out["tied_with"] = "; ".join(out["tied_with"])
+    return out
 
 
 def executions(entries: list[Entry]) -> list[Execution]:

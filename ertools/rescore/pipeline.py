@@ -26,6 +26,7 @@ from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ErtoolsError
 from ertools.io import summary
 from ertools.progress import Reporter
+from ertools.report import ranks
 from ertools.rescore.cache import Cache, FileHashes, job_key, records
 from ertools.rescore.jobs import Job, Outcome
 from ertools.rescore.manifest import Manifest
@@ -46,6 +47,14 @@ CSV_COLUMNS = (
     "status",
     "reason",
     "rank_value",
+    # the team's place on its benchmark's leaderboard, when this is its ranked execution
+    # (docs/uncertainty.md, "Rank stability"): empty otherwise
+    "rank",
+    "rank_group",
+    "interval_low",
+    "interval_high",
+    "p_swap_next",
+    "tied_with",
     "report",
 )
 _UNSAFE = re.compile(r"[^A-Za-z0-9_.-]+")
@@ -443,6 +452,18 @@ def leaderboards(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
         for row in rows:
             if row["benchmark"] != name or row["status"] != "scored" or row["rank_value"] is None:
                 continue
+            # A score that says its data cannot support it (validity, docs/uncertainty.md) is
+            # never ranked, whatever number it carries.
+            unscoreable = ranks.unscoreable_reason(row.get("score"))
+            if unscoreable is not None:
+                unranked.append(
+                    {
+                        "execution": row["id"],
+                        "value": row["rank_value"],
+                        "note": f"{row['team'] or TEAM_UNKNOWN}: unscoreable ({unscoreable})",
+                    }
+                )
+                continue
             if row["team"] is None:  # scored, but ranked only once the manifest names it
                 unranked.append(
                     {"execution": row["id"], "value": row["rank_value"], "note": TEAM_UNKNOWN}
@@ -452,17 +473,35 @@ def leaderboards(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
             if team not in best or sign * row["rank_value"] < sign * best[team]["rank_value"]:
                 best[team] = row
         ordered = sorted(best.items(), key=lambda tr: (sign * tr[1]["rank_value"], tr[0]))
-        board_rows: list[dict[str, Any]] = []
-        for i, (team, row) in enumerate(ordered):
-            same = board_rows and board_rows[-1]["value"] == row["rank_value"]
-            board_rows.append(
-                {
-                    "rank": board_rows[-1]["rank"] if same else i + 1,
-                    "team": team,
-                    "value": row["rank_value"],
-                    "execution": row["id"],
-                }
-            )
+        confidence = ranks.board_confidence(ranks.confidence_of(r.get("score")) for _, r in ordered)
+        standings = ranks.stability(
+            [
+                ranks.Contender(
+                    team,
+                    float(row["rank_value"]),
+                    _interval(row, ranking.text),
+                    ranks.confidence_of(row.get("score")) or ranks.DEFAULT_CONFIDENCE,
+                    str(row["id"]),
+                )
+                for team, row in ordered
+            ],
+            lower_is_better=ranking.lower_is_better,
+            confidence=confidence,
+        )
+        board_rows: list[dict[str, Any]] = [
+            {
+                "rank": s.rank,
+                "team": s.name,
+                "value": s.score,
+                "execution": s.ident,
+                "interval": list(s.interval) if s.interval else None,
+                "p_swap_next": s.p_swap_next,
+                "rank_group": s.group,
+                "tied_with": list(s.tied_with),
+                "rank_note": s.note,
+            }
+            for s in standings
+        ]
         title = next(str(r["title"]) for r in rows if r["benchmark"] == name)
         boards.append(
             {
@@ -470,11 +509,36 @@ def leaderboards(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
                 "title": title,
                 "rule": ranking.text,
                 "lower_is_better": ranking.lower_is_better,
+                "confidence": confidence,
                 "rows": board_rows,
                 "unranked": unranked,
             }
         )
     return boards
+
+
+def _interval(row: Mapping[str, Any], rule: str) -> tuple[float, float] | None:
+    """The confidence interval of an execution's ranked value, from its score."""
+    score = row.get("score")
+    key = ranks.ranked_key(score, row.get("rank_value"), rule)
+    return ranks.interval_of(score, key)
+
+
+def _placings(doc: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
+    """Execution id -> its leaderboard row's rank stability, as results.csv columns."""
+    out: dict[str, dict[str, Any]] = {}
+    for board in doc.get("leaderboards") or []:
+        for row in board.get("rows") or []:
+            interval = row.get("interval") or (None, None)
+            out[str(row.get("execution"))] = {
+                "rank": row.get("rank"),
+                "rank_group": row.get("rank_group"),
+                "interval_low": interval[0],
+                "interval_high": interval[1],
+                "p_swap_next": row.get("p_swap_next"),
+                "tied_with": "; ".join(row.get("tied_with") or []),
+            }
+    return out
 
 
 def csv_text(doc: Mapping[str, Any]) -> str:
@@ -483,7 +547,9 @@ def csv_text(doc: Mapping[str, Any]) -> str:
         buffer, fieldnames=CSV_COLUMNS, extrasaction="ignore", lineterminator="\n"
     )
     writer.writeheader()
+    placings = _placings(doc)
     for row in doc["executions"]:
+        row = {**row, **placings.get(str(row["id"]), {})}
         writer.writerow(
             {k: "" if row.get(k) is None else spreadsheet_safe(row[k]) for k in CSV_COLUMNS}
         )

@@ -29,7 +29,8 @@ from typing import Any
 from ertools import atomic
 from ertools.errors import ConfigError
 from ertools.report import html as h
-from ertools.report import units
+from ertools.report import ranks, units
+from ertools.report.rank_plot import interval_plot
 from ertools.rescore import site_text as text
 from ertools.rescore.site_text import TEAM_UNKNOWN
 
@@ -58,6 +59,10 @@ class Standing:
     live: str  # the live 2015 value of the same key, or an em dash
     differs: bool  # the live 2015 score differs from the recomputed one
     execution: Link
+    marker: str = ""  # ``=2`` in a group of teams the data cannot order, else the rank
+    interval: str = "\u2014"  # the value's confidence interval, in the column's unit
+    p_swap: str = "\u2014"  # P(swap with the team below), or why there is none
+    tie: str = ""  # CSS: ``tied``, ``tied first``, ``tied last`` (the bracket's ends)
 
 
 @dataclass(frozen=True)
@@ -70,6 +75,10 @@ class Board:
     rows: tuple[Standing, ...]
     unranked: tuple[Standing, ...] = ()  # scored, no team named: out of the ranking
     warnings: tuple[text.Grouped, ...] = ()  # said once for the benchmark
+    explanation: str = ""  # rank stability in words, above the table
+    summary: str = ""  # ``1 of 3 adjacent order(s) supported by the data; tied: ...``
+    plot: str = ""  # SVG text (ertools.report.rank_plot; every text in it escaped there)
+    interval_column: str = ""  # ``95 % interval (mm)``; "" when no row has an interval
 
 
 def _anchor(prefix: str, name: str) -> str:
@@ -112,11 +121,75 @@ def ranked(
     return out
 
 
-def _value_key(score: dict[str, Any] | None, value: float | None) -> str | None:
-    """The score's top-level key whose value the leaderboard ranks by (for its unit)."""
-    if not isinstance(score, dict) or value is None:
-        return None
-    return next((k for k, v in score.items() if _number(v) == value), None)
+def _value_key(score: dict[str, Any] | None, value: float | None, rule: str = "") -> str | None:
+    """The score's top-level key whose value the leaderboard ranks by (for its unit): the one
+    the rule names when several keys hold the value."""
+    return ranks.ranked_key(score, value, rule)
+
+
+def _stability(
+    placed: Sequence[tuple[int | None, dict[str, Any]]],
+    by_id: dict[str, dict[str, Any]],
+    rule: str,
+    lower: bool,
+    said: Any,
+) -> tuple[dict[int, ranks.Standing], float]:
+    """Rank stability of the ranked rows (by their index in ``placed``): each row's interval
+    as the document gives it, else as its execution's score does (a document written before
+    leaderboards carried them), at the leaderboard's confidence (the document's, else its
+    results' own); and that confidence."""
+    contenders = []
+    confidences = []
+    for i, (rank, row) in enumerate(placed):
+        value = _number(row.get("value"))
+        if rank is None or value is None:
+            continue
+        ex = by_id.get(str(row.get("execution")))
+        score = ex.get("score") if ex else None
+        interval = ranks.interval_of({"v_interval": row.get("interval")}, "v")
+        if interval is None:
+            interval = ranks.interval_of(score, ranks.ranked_key(score, value, rule))
+        confidence = ranks.confidence_of(score)
+        confidences.append(confidence)
+        contenders.append(
+            ranks.Contender(
+                str(row.get("team") or TEAM_UNKNOWN),
+                value,
+                interval,
+                confidence or ranks.DEFAULT_CONFIDENCE,
+                str(i),
+            )
+        )
+    stated = _number(said)
+    level = (
+        stated if stated is not None and 0.0 < stated < 1.0 else ranks.board_confidence(confidences)
+    )
+    standings = ranks.stability(contenders, lower_is_better=lower, confidence=level)
+    return {int(s.ident): s for s in standings}, level
+
+
+def _interval_text(key: str | None, interval: tuple[float, float] | None) -> str:
+    if interval is None:
+        return text.shown(None, None)
+    return f"{text.shown(key, interval[0])} to {text.shown(key, interval[1])}"
+
+
+def _p_text(place: ranks.Standing | None) -> str:
+    return ranks.p_text(place) if place is not None else text.shown(None, None)
+
+
+def _tie_class(
+    placed: Sequence[tuple[int | None, dict[str, Any]]], board: dict[int, ranks.Standing], i: int
+) -> str:
+    """``tied first``/``tied``/``tied last``: the row's place in a bracket of tied teams."""
+    place = board.get(i)
+    if place is None or not place.tied:
+        return ""
+    above = board.get(i - 1)
+    below = board.get(i + 1)
+    first = above is None or above.group != place.group
+    last = below is None or below.group != place.group
+    return " ".join(["tied", *(["first"] if first else []), *(["last"] if last else [])])
 
 
 def _when(iso: Any) -> str:
@@ -241,18 +314,22 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
     boards = []
     for lb in results.get("leaderboards") or []:
         lower = bool(lb.get("lower_is_better", True))
+        rule = str(lb.get("rule") or "")
+        placed = ranked(lb.get("rows") or [], lower)
+        board, confidence = _stability(placed, by_id, rule, lower, lb.get("confidence"))
         standings = []
         keys = set()
-        for rank, row in ranked(lb.get("rows") or [], lower):
+        for i, (rank, row) in enumerate(placed):
             ex = by_id.get(str(row.get("execution")))
             value = _number(row.get("value"))
-            key = _value_key(ex.get("score") if ex else None, value)
+            key = _value_key(ex.get("score") if ex else None, value, rule)
             keys.add(key)
             live = _scalars(ex.get("live_score") if ex else None)
             # Flagged when the ranked value itself differs from the live one (a difference in
             # another field, e.g. a rounded execution_time, is in the live section).
             lines = (ex.get("live_differences") or []) if ex else []
             differs = key in _differing_fields(lines) if key else bool(lines)
+            place = board.get(i)
             standings.append(
                 Standing(
                     rank=rank,
@@ -261,13 +338,17 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
                     live=text.shown(key, live.get(key)) if key in live else text.shown(None, None),
                     differs=differs,
                     execution=report_link(ex, str(row.get("execution"))),
+                    marker=place.marker if place else "",
+                    interval=_interval_text(key, place.interval if place else None),
+                    p_swap=_p_text(place),
+                    tie=_tie_class(placed, board, i),
                 )
             )
         unranked = []
         for row in lb.get("unranked") or []:
             ex = by_id.get(str(row.get("execution")))
             value = _number(row.get("value"))
-            key = _value_key(ex.get("score") if ex else None, value)
+            key = _value_key(ex.get("score") if ex else None, value, str(lb.get("rule") or ""))
             keys.add(key)
             unranked.append(
                 Standing(
@@ -283,6 +364,9 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
         (only,) = keys if len(keys) == 1 else (None,)
         column = f"{units.header(only)}" if only else "value"
         name = str(lb.get("benchmark"))
+        shown = [board[i] for i in sorted(board)]
+        with_intervals = any(p.interval is not None for p in shown)
+        spec = units.quantity_of(only) if only else None
         boards.append(
             Board(
                 anchor=_anchor("lb", name),
@@ -296,6 +380,30 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
                 rows=tuple(standings),
                 unranked=tuple(unranked),
                 warnings=tuple(g for g in grouped if g.benchmark == name),
+                explanation=(
+                    ranks.explanation(confidence, lower, only)
+                    if with_intervals
+                    else ranks.NONE_EXPLAINED
+                    if shown
+                    else ""
+                ),
+                summary=ranks.summary(shown) if with_intervals else "",
+                plot=interval_plot(
+                    shown,
+                    factor=units.factor(*spec) if spec else 1.0,
+                    unit=units.unit(spec[0]) if spec else "",
+                    decimals=text.DECIMALS[spec[0]] if spec else 3,
+                    axis=only or "value",
+                    confidence=confidence,
+                )
+                if with_intervals
+                else "",
+                interval_column=(
+                    f"{confidence * 100:g} % interval"
+                    + (f" ({units.unit(spec[0])})" if spec else "")
+                    if with_intervals
+                    else ""
+                ),
             )
         )
 

@@ -127,17 +127,18 @@ def test_same_inputs_are_one_execution(tmp_path: Path) -> None:
     out = tmp_path / "out"
     assert main(["report", *folders, "--report", str(out)]) == 0
     rows = _csv(out)
+    # In rank order (lower best_distance_error first): tripod 0.0125 m, robox 0.02 m.
     assert [(r["team"], r["team_source"]) for r in rows] == [
-        ("robox", "log name"),
         ("tripod", "explicit"),
+        ("robox", "log name"),
     ]
-    tripod = rows[1]
+    tripod = rows[0]
     # The named result is shown; the other is listed by its options (--format is output only).
     assert float(tripod["best_distance_error"]) == 0.0125
     # an option list begins like a formula: a spreadsheet shows the apostrophed text as is
     assert tripod["options"] == "'--team tripod"
     assert tripod["other results"] == "(defaults): best_distance_error 12.30 mm"
-    assert rows[0]["other results"] == ""
+    assert rows[1]["other results"] == ""
     page = (out / "index.html").read_text(encoding="utf-8")
     assert "(unknown)" not in page
     assert "3 result(s) of 2 execution(s)" in page

@@ -14,6 +14,8 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import unquote, urlsplit
 
+from ertools.rescore import pipeline
+
 EVIL = "<script>alert('team')</script>"
 S = 1_000_000_000
 T0 = 1_448_010_000 * S  # 2015-11-20 09:00:00 UTC
@@ -184,6 +186,34 @@ def results() -> dict[str, Any]:
     }
 
 
+def with_interval(ex: dict[str, Any], low: float, high: float) -> dict[str, Any]:
+    ex["score"]["best_distance_error_interval"] = [low, high]
+    ex["score"]["uncertainty"] = {"confidence": 0.95, "method": "monte_carlo", "draws": 500}
+    return ex
+
+
+def ranked_document() -> dict[str, Any]:
+    """Executions with intervals in their scores (as the scorers write them), the
+    leaderboards made by the pipeline's own function (tests/rescore/test_rescore_ranks.py)."""
+    doc = results()
+    exs = [
+        with_interval(fbm3w("smartbots", 0, 0.0081), 0.0079, 0.0083),
+        with_interval(fbm3w("homer", 10, 0.0083), 0.0080, 0.0087),
+        with_interval(fbm3w("b-it-bots", 20, 0.0100), 0.0098, 0.0102),
+        fbm3w(EVIL, 30, 0.0200),  # scored before intervals existed
+        # a team's second execution: only its best is ranked
+        with_interval(fbm3w("homer", 40, 0.0150), 0.0140, 0.0160),
+        fbm2h("homer", 120, 0.097),
+        fbm2h("smartbots", 130, 0.063),
+        # a score whose data cannot support it: never ranked, even with a number
+        fbm2h("robotnik", 140, 0.010),
+    ]
+    exs[-1]["score"].update(status="unscoreable", unscoreable_reason="no GT at waypoint 2")
+    doc["executions"] = exs
+    doc["leaderboards"] = pipeline.leaderboards(exs)
+    return doc
+
+
 def expected_board(doc: dict[str, Any], bench: str) -> list[tuple[int | None, str]]:
     """(rank, team) in order: rank = 1 + the number of strictly better values (competition
     ranking: a tie shares the rank and the next rank is skipped), ties by team name; rows
@@ -217,6 +247,8 @@ class Page(HTMLParser):
     def __init__(self, text: str) -> None:
         super().__init__()
         self.boards: dict[str, list[list[str]]] = {}
+        # a standing's rank by the values (data-rank; the cell shows "=2" in a tie group)
+        self.ranks: dict[str, list[int | None]] = {}
         self.rules: dict[str, str] = {}
         self.links: list[str] = []
         self.ids: set[str] = set()
@@ -251,15 +283,21 @@ class Page(HTMLParser):
             if "leaderboard" in cls:
                 self._board = self._section
                 self.boards[self._board] = []
+                self.ranks[self._board] = []
         elif tag == "tr" and "standing" in cls and self._board:
             self._row = []
             self.differs_rows += "differs" in cls
+            self.ranks[self._board].append(int(a["data-rank"]) if a.get("data-rank") else None)
         elif tag == "tr" and "execution" in cls:
             self.executions.append(a.get("data-status", ""))
         elif tag == "td" and self._row is not None:
             self._cell = ""
         elif tag == "p" and "rule" in cls:
             self._rule = ""
+
+    def board(self, anchor: str) -> list[tuple[int | None, str]]:
+        """(rank by the values, team) of a leaderboard's standings, in page order."""
+        return [(r, row[1]) for r, row in zip(self.ranks[anchor], self.boards[anchor], strict=True)]
 
     def handle_endtag(self, tag: str) -> None:
         if tag == "td" and self._cell is not None and self._row is not None:

@@ -16,7 +16,15 @@ from typing import Any
 import numpy as np
 import pytest
 from fakes import BROWSER, CHROMIUM_FLAGS
-from site_results import EVIL, Page, assert_links_resolve, expected_board, results, write_folder
+from site_results import (
+    EVIL,
+    Page,
+    assert_links_resolve,
+    expected_board,
+    ranked_document,
+    results,
+    write_folder,
+)
 
 from ertools.report.timeline_page import write_timeline_page
 from ertools.report.timeline_style import KIND_COLORS
@@ -76,10 +84,10 @@ def test_dom_has_leaderboards_problems_and_timeline(
     doc, index = site
     page = Page(chromium(tmp_path, index.as_uri(), "--dump-dom").stdout)
     for bench in ("fbm3w", "fbm1h", "fbm2h"):
-        shown = [
-            (int(r[0]) if r[0] != "\u2014" else None, r[1]) for r in page.boards[f"lb-{bench}"]
-        ]
+        shown = page.board(f"lb-{bench}")
         assert shown == expected_board(doc, bench), bench
+    # the two equal values are one tie group: "=2" on both rows
+    assert [r[0] for r in page.boards["lb-fbm3w"]] == ["1", "=2", "=2", "4"]
     assert page.scripts == 0  # the hostile team name stayed text...
     assert EVIL in page.sections["lb-fbm3w"]  # ...shown as such
     for p in doc["problems"]:
@@ -109,3 +117,17 @@ def test_timeline_frame_draws_its_chart(site: tuple[dict[str, Any], Path], tmp_p
     # legend's swatch (one line of ~10 px, which is static HTML).
     gt = rows_of(KIND_COLORS["gt"])
     assert gt.size and gt.max() - gt.min() > 40
+
+
+def test_rank_stability_plot_is_drawn(tmp_path: Path) -> None:
+    """With intervals: the browser builds the inline SVG plot (a dot per team, the tie band)
+    and the tied rows; nothing is refused by the page's content policy."""
+    out = tmp_path / "site"
+    doc = ranked_document()
+    write_folder(out, doc)
+    index = write_site(doc, out)
+    dom = chromium(tmp_path, index.as_uri(), "--dump-dom").stdout
+    page = Page(dom)
+    assert [r[0] for r in page.boards["lb-fbm3w"]] == ["=1", "=1", "3", "4"]
+    svg = dom[dom.index("<svg") : dom.index("</svg>")]
+    assert svg.count("<circle") == 4 and svg.count('class="tie"') == 1
