@@ -151,7 +151,12 @@ def _layer(ax: Any, layer: Layer, chart: Chart) -> Any:
                 label=label,
             )
         case RefLine():
-            style = {"color": layer.colour, "lw": layer.width, "ls": _LS[layer.dash], "label": label}
+            style = {
+                "color": layer.colour,
+                "lw": layer.width,
+                "ls": _LS[layer.dash],
+                "label": label,
+            }
             if layer.axis == "x":
                 if layer.lo is None or layer.hi is None:
                     ax.axvline(layer.value, **style)

@@ -65,9 +65,7 @@ def figure_specs(result: Any) -> list[FigureSpec]:
     return specs
 
 
-def save_figures(
-    specs: Sequence[FigureSpec], outdir: Path, fmt: str | None = "png"
-) -> list[Path]:
+def save_figures(specs: Sequence[FigureSpec], outdir: Path, fmt: str | None = "png") -> list[Path]:
     """Draw every spec into its own file in ``outdir``; returns the paths written.
 
     ``fmt=None``: SVG for a chart (no matplotlib), PNG for a figure drawn on an Axes: what

@@ -11,7 +11,18 @@ from typing import Any
 import numpy as np
 
 from ertools.report import units
-from ertools.report.chart import COLOURS, Arrows, Axis, Bars, Chart, Layer, Line, RefLine, Scatter, Text
+from ertools.report.chart import (
+    COLOURS,
+    Arrows,
+    Axis,
+    Bars,
+    Chart,
+    Layer,
+    Line,
+    RefLine,
+    Scatter,
+    Text,
+)
 from ertools.report.figures import FigureSpec, chart_spec, thin_path
 
 ARROW = 0.25  # metres: length of the heading arrows on the path figure
@@ -36,7 +47,9 @@ def path_chart(result: Any, size: tuple[float, float] = PATH_SIZE) -> Chart:
     layers: list[Layer] = []
     path = thin_path(np.asarray(result.path_xyyaw, dtype=float).reshape(-1, 3), size)
     if len(path):
-        layers.append(Line(path[:, 0] * MM, path[:, 1] * MM, "#8c8c8c", 1.0, label="robot path (GT)"))
+        layers.append(
+            Line(path[:, 0] * MM, path[:, 1] * MM, "#8c8c8c", 1.0, label="robot path (GT)")
+        )
     targets = np.array([s.target for s in result.segments], dtype=float).reshape(-1, 3)
     layers += _poses(targets, COLOURS["blue"], "waypoint (target heading)", "o")
     reached = np.array(
@@ -84,9 +97,7 @@ def errors_chart(result: Any) -> Chart:
         Bars(idx + 0.2, ori * DEG, 0.4, (orange,), "orientation error", side="right"),
     ]
     if result.position_accuracy is not None:
-        layers.append(
-            RefLine(result.position_accuracy * MM, "y", blue, label="position accuracy")
-        )
+        layers.append(RefLine(result.position_accuracy * MM, "y", blue, label="position accuracy"))
     if result.orientation_accuracy is not None:
         layers.append(
             RefLine(

@@ -6,6 +6,7 @@ Each figure is a :class:`~ertools.report.chart.Chart` in millimetres, built for 
 
 from __future__ import annotations
 
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -76,7 +77,9 @@ def run_chart(run: Any, size: tuple[float, float] = RUN_SIZE) -> Chart:
         if run.reference_xy is not None:
             ref = score.frame.to_frame(np.asarray([run.reference_xy])) * MM
             layers.append(
-                Scatter(ref[:, 0], ref[:, 1], COLOURS["red"], marker="^", size=4.5, label="reference")
+                Scatter(
+                    ref[:, 0], ref[:, 1], COLOURS["red"], marker="^", size=4.5, label="reference"
+                )
             )
     return Chart(
         tuple(layers),
@@ -154,7 +157,7 @@ def figure_specs(result: Any) -> list[FigureSpec]:
         chart_spec(
             f"fbm3w_run{r.index}",
             f"FBM3@Work run {r.index} ({r.spec}): distance_error {r.distance_error * MM:.3f} mm",
-            lambda size, r=r: run_chart(r, size),
+            partial(run_chart, r),
             RUN_SIZE,
         )
         for r in result.runs

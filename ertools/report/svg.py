@@ -58,13 +58,13 @@ def nice_ticks(lo: float, hi: float, target: int) -> tuple[FloatArray, int]:
     their labels need."""
     span = hi - lo
     if not (math.isfinite(span) and span > 0):
-        return np.asarray([lo]), 0
+        return np.asarray([lo], dtype=np.float64), 0
     raw = span / max(target, 1)
     power = 10.0 ** math.floor(math.log10(raw))
     step = next((m * power for m in (1.0, 2.0, 2.5, 5.0, 10.0) if m * power >= raw), 10 * power)
     first = math.ceil(lo / step - 1e-9)
     last = math.floor(hi / step + 1e-9)
-    ticks = np.arange(first, last + 1) * step
+    ticks = np.arange(first, last + 1, dtype=np.float64) * step
     decimals = max(0, -math.floor(math.log10(step) + 1e-9))
     if round(step / 10.0 ** math.floor(math.log10(step) + 1e-9), 6) == 2.5:
         decimals += 1
@@ -104,10 +104,14 @@ def _extent(layers: tuple[Layer, ...], axis: str, side: str) -> list[FloatArray]
             case Line() | Scatter():
                 out.append(floats(layer.x if axis == "x" else layer.y))
             case Arrows():
-                out += [floats(layer.x0), floats(layer.x1)] if axis == "x" else [
-                    floats(layer.y0),
-                    floats(layer.y1),
-                ]
+                out += (
+                    [floats(layer.x0), floats(layer.x1)]
+                    if axis == "x"
+                    else [
+                        floats(layer.y0),
+                        floats(layer.y1),
+                    ]
+                )
             case Span():
                 if layer.axis == axis:
                     out.append(floats([layer.lo, layer.hi]))
@@ -263,8 +267,8 @@ def _layer(layer: Layer, sx: _Scale, sy: _Scale, box: tuple[float, float, float,
             x0, y0 = sx(floats(layer.x0)), sy(floats(layer.y0))
             x1, y1 = sx(floats(layer.x1)), sy(floats(layer.y1))
             out += [
-                _arrow(*map(float, p), layer.colour, layer.width)
-                for p in zip(x0, y0, x1, y1, strict=True)
+                _arrow(float(a), float(b), float(c), float(d), layer.colour, layer.width)
+                for a, b, c, d in zip(x0, y0, x1, y1, strict=True)
             ]
         case Span():
             if layer.axis == "x":
@@ -289,17 +293,17 @@ def _layer(layer: Layer, sx: _Scale, sy: _Scale, box: tuple[float, float, float,
             x, lo, hi = floats(layer.x), floats(layer.lo), floats(layer.hi)
             ok = np.isfinite(x) & np.isfinite(lo) & np.isfinite(hi)
             # one closed polygon per unbroken piece: along hi, back along lo
-            pieces = np.split(np.flatnonzero(ok), np.flatnonzero(np.diff(np.flatnonzero(ok)) > 1) + 1)
+            pieces = np.split(
+                np.flatnonzero(ok), np.flatnonzero(np.diff(np.flatnonzero(ok)) > 1) + 1
+            )
             for piece in pieces:
                 if len(piece) < 2:
                     continue
                 px = sx(np.r_[x[piece], x[piece][::-1]])
                 py = sy(np.r_[hi[piece], lo[piece][::-1]])
                 d, _ = _points(px, py)
-                out.append(
-                    '<path class="band"' + _attr(d=d + "Z", fill=layer.colour,
-                                                 fill_opacity=layer.opacity) + "/>"
-                )  # fmt: skip
+                fill = _attr(d=d + "Z", fill=layer.colour, fill_opacity=layer.opacity)
+                out.append(f'<path class="band"{fill}/>')
         case ErrorBars():
             px, py = sx(floats(layer.x)), sy(floats(layer.y))
             if layer.axis == "y":
@@ -307,41 +311,43 @@ def _layer(layer: Layer, sx: _Scale, sy: _Scale, box: tuple[float, float, float,
             else:
                 plo, phi = sx(floats(layer.lo)), sx(floats(layer.hi))
             c, w = layer.cap, layer.width
-            for x, y, lo_, hi_ in zip(px, py, plo, phi, strict=True):
-                d = []
+            for x, y, lo_, hi_ in zip(
+                px.tolist(), py.tolist(), plo.tolist(), phi.tolist(), strict=True
+            ):
+                segs: list[str] = []
                 for end in (lo_, hi_):
                     if not math.isfinite(end):
                         continue
                     if layer.axis == "y":
                         if math.isfinite(x) and math.isfinite(y):
-                            d.append(f"M{x:.1f},{y:.1f}L{x:.1f},{end:.1f}")
-                        d.append(f"M{x - c:.1f},{end:.1f}L{x + c:.1f},{end:.1f}")
+                            segs.append(f"M{x:.1f},{y:.1f}L{x:.1f},{end:.1f}")
+                        segs.append(f"M{x - c:.1f},{end:.1f}L{x + c:.1f},{end:.1f}")
                     else:
                         if math.isfinite(x) and math.isfinite(y):
-                            d.append(f"M{x:.1f},{y:.1f}L{end:.1f},{y:.1f}")
-                        d.append(f"M{end:.1f},{y - c:.1f}L{end:.1f},{y + c:.1f}")
-                if d and math.isfinite(x if layer.axis == "y" else y):
+                            segs.append(f"M{x:.1f},{y:.1f}L{end:.1f},{y:.1f}")
+                        segs.append(f"M{end:.1f},{y - c:.1f}L{end:.1f},{y + c:.1f}")
+                if segs and math.isfinite(x if layer.axis == "y" else y):
                     out.append(
                         '<path class="errorbar"'
-                        + _attr(d="".join(d), stroke=layer.colour, stroke_width=w)
+                        + _attr(d="".join(segs), stroke=layer.colour, stroke_width=w)
                         + ' fill="none"/>'
                     )
                 if layer.marker is not None and math.isfinite(x) and math.isfinite(y):
                     out.append(_marker(layer.marker, x, y, layer.marker_size, layer.colour))
         case Bars():
-            x, h = floats(layer.x), floats(layer.height)
-            left, right = sx(x - layer.width / 2), sx(x + layer.width / 2)
+            bx_, h = floats(layer.x), floats(layer.height)
+            left, right = sx(bx_ - layer.width / 2), sx(bx_ + layer.width / 2)
             top, base = sy(h), sy.one(0.0)
-            for i in np.flatnonzero(np.isfinite(h) & np.isfinite(x)):
+            for i in np.flatnonzero(np.isfinite(h) & np.isfinite(bx_)):
                 colour = layer.colours[i % len(layer.colours)]
-                y0, y1 = sorted((float(top[i]), base))
+                ya, yb = sorted((float(top[i]), base))
                 out.append(
                     '<rect class="bar"'
                     + _attr(
                         x=f"{left[i]:.1f}",
-                        y=f"{y0:.1f}",
+                        y=f"{ya:.1f}",
                         width=f"{right[i] - left[i]:.1f}",
-                        height=f"{max(y1 - y0, 0.0):.1f}",
+                        height=f"{max(yb - ya, 0.0):.1f}",
                         fill=colour,
                     )
                     + "/>"
@@ -368,18 +374,18 @@ def _layer(layer: Layer, sx: _Scale, sy: _Scale, box: tuple[float, float, float,
                 + ' fill="none"/>'
             )
         case Text():
-            x = sx.one(layer.x) + layer.offset[0]
-            y = sy.one(layer.y) - layer.offset[1]
-            if math.isfinite(x) and math.isfinite(y):
+            tx = sx.one(layer.x) + layer.offset[0]
+            ty = sy.one(layer.y) - layer.offset[1]
+            if math.isfinite(tx) and math.isfinite(ty):
                 lines = layer.text.split("\n")
                 spans = "".join(
-                    f'<tspan x="{x:.1f}" dy="{0 if i == 0 else TICK_PX * 1.15:.1f}">'
+                    f'<tspan x="{tx:.1f}" dy="{0 if i == 0 else TICK_PX * 1.15:.1f}">'
                     f"{escape(t)}</tspan>"
                     for i, t in enumerate(lines)
                 )
-                y -= (len(lines) - 1) * TICK_PX * 1.15
+                ty -= (len(lines) - 1) * TICK_PX * 1.15
                 out.append(
-                    f'<text class="label" x="{x:.1f}" y="{y:.1f}"'
+                    f'<text class="label" x="{tx:.1f}" y="{ty:.1f}"'
                     + _attr(fill=layer.colour, text_anchor=layer.anchor)
                     + f' font-size="{TICK_PX}">{spans}</text>'
                 )
@@ -409,7 +415,7 @@ def _swatch(layer: Layer, x: float, y: float) -> str:
         case ErrorBars():
             s = (
                 f'<path d="M{x + 11:.1f},{y - 6:.1f}L{x + 11:.1f},{y + 6:.1f}'
-                f'M{x + 7:.1f},{y - 6:.1f}L{x + 15:.1f},{y - 6:.1f}'
+                f"M{x + 7:.1f},{y - 6:.1f}L{x + 15:.1f},{y - 6:.1f}"
                 f'M{x + 7:.1f},{y + 6:.1f}L{x + 15:.1f},{y + 6:.1f}"'
                 + _attr(stroke=colour, stroke_width=layer.width)
                 + ' fill="none"/>'
@@ -452,7 +458,9 @@ def stack(panels: list[tuple[Chart, tuple[float, float], str]]) -> str:
     return _document("\n".join(parts), width, y)
 
 
-def _body(chart: Chart, size: tuple[float, float], title: str, uid: str) -> tuple[str, float, float]:
+def _body(
+    chart: Chart, size: tuple[float, float], title: str, uid: str
+) -> tuple[str, float, float]:
     width, height = size[0] * PIXELS_PER_INCH, size[1] * PIXELS_PER_INCH
     layers = chart.layers
     labelled = [layer for layer in layers if getattr(layer, "label", None)]
@@ -500,8 +508,8 @@ def _body(chart: Chart, size: tuple[float, float], title: str, uid: str) -> tupl
         f'<defs><clipPath id="{clip}"><rect x="{left:.1f}" y="{top:.1f}" '
         f'width="{plot_w:.1f}" height="{plot_h:.1f}"/></clipPath></defs>'
     )
-    xt, xd = _ticks(chart.x, xlim, plot_w, 90)
-    yt, yd = _ticks(chart.y, ylim, plot_h, 45)
+    xt, _ = _ticks(chart.x, xlim, plot_w, 90)
+    yt, _ = _ticks(chart.y, ylim, plot_h, 45)
     grid: list[str] = []
     if chart.grid in ("both", "x"):
         grid += [f"M{sx.one(v):.1f},{top:.1f}v{plot_h:.1f}" for v, _ in xt]
