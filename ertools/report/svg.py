@@ -18,7 +18,6 @@ first), which is all the layout needs: labels are never measured to the pixel.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from html import escape
 
 import numpy as np
@@ -39,13 +38,13 @@ from ertools.report.chart import (
     floats,
     viridis,
 )
+from ertools.report.svg_marks import Scale, attr, layer_svg, swatch
 
 PIXELS_PER_INCH = 110  # the reports' PNGs were 110 dpi: the same pixel size for each figure
 FONT = "DejaVu Sans, Verdana, Arial, sans-serif"
 TICK_PX, LABEL_PX, TITLE_PX, LEGEND_PX = 11.0, 12.0, 13.0, 11.0
 CHAR_EM = 0.6
 MARGIN = 0.05  # of the data's span, on each side (matplotlib's default)
-_DASHES = {"solid": "", "dashed": "5,3", "dotted": "1.5,2.5"}
 
 
 def text_width(text: str, px: float) -> float:
@@ -74,24 +73,6 @@ def nice_ticks(lo: float, hi: float, target: int) -> tuple[FloatArray, int]:
 def tick_text(value: float, decimals: int) -> str:
     text = f"{value:.{decimals}f}" if abs(value) < 1e7 else f"{value:.6g}"
     return "0" if text.lstrip("-").strip("0.") == "" else text
-
-
-@dataclass
-class _Scale:
-    """Data -> pixel along one axis (``flip``: y grows upwards)."""
-
-    lo: float
-    hi: float
-    start: float
-    length: float
-    flip: bool = False
-
-    def __call__(self, v: FloatArray) -> FloatArray:
-        f = (np.asarray(v, dtype=float) - self.lo) / (self.hi - self.lo)
-        return self.start + (1.0 - f if self.flip else f) * self.length
-
-    def one(self, v: float) -> float:
-        return float(self(np.asarray([v]))[0])
 
 
 def _extent(layers: tuple[Layer, ...], axis: str, side: str) -> list[FloatArray]:
@@ -165,274 +146,6 @@ def _wrap(text: str, px: float, width: float) -> list[str]:
     return [*lines, line] if line else lines
 
 
-def _attr(**attrs: object) -> str:
-    return "".join(
-        f' {k.rstrip("_").replace("_", "-")}="{escape(str(v))}"'
-        for k, v in attrs.items()
-        if v is not None and v != ""
-    )
-
-
-def _points(px: FloatArray, py: FloatArray) -> tuple[str, int]:
-    """SVG path data of a polyline broken at NaN, and its number of vertices."""
-    ok = np.isfinite(px) & np.isfinite(py)
-    if not ok.any():
-        return "", 0
-    idx = np.flatnonzero(ok)
-    starts = np.ones(len(idx), dtype=bool)
-    starts[1:] = np.diff(idx) > 1
-    parts = []
-    for i, x, y, s in zip(idx, px[idx], py[idx], starts, strict=True):
-        del i
-        parts.append(f"{'M' if s else 'L'}{x:.1f},{y:.1f}")
-    return "".join(parts), len(idx)
-
-
-def _marker(kind: str, x: float, y: float, r: float, colour: str, cls: str = "marker") -> str:
-    if kind == "o":
-        return f'<circle class="{cls}" cx="{x:.1f}" cy="{y:.1f}" r="{r:.1f}" fill="{colour}"/>'
-    if kind == "s":
-        return (
-            f'<rect class="{cls}" x="{x - r:.1f}" y="{y - r:.1f}" width="{2 * r:.1f}" '
-            f'height="{2 * r:.1f}" fill="{colour}"/>'
-        )
-    if kind == "^":
-        return (
-            f'<path class="{cls}" d="M{x:.1f},{y - r * 1.2:.1f}L{x + r:.1f},{y + r * 0.8:.1f}'
-            f'L{x - r:.1f},{y + r * 0.8:.1f}Z" fill="{colour}"/>'
-        )
-    if kind == "x":
-        return (
-            f'<path class="{cls}" d="M{x - r:.1f},{y - r:.1f}L{x + r:.1f},{y + r:.1f}'
-            f'M{x - r:.1f},{y + r:.1f}L{x + r:.1f},{y - r:.1f}" stroke="{colour}" '
-            'stroke-width="1.5" fill="none"/>'
-        )
-    return (  # "|": a tick on the axis
-        f'<path class="{cls}" d="M{x:.1f},{y - r:.1f}L{x:.1f},{y + r:.1f}" stroke="{colour}" '
-        'stroke-width="1.2" fill="none"/>'
-    )
-
-
-def _arrow(x0: float, y0: float, x1: float, y1: float, colour: str, width: float) -> str:
-    dx, dy = x1 - x0, y1 - y0
-    n = math.hypot(dx, dy)
-    if not (math.isfinite(n) and n > 0):
-        return ""
-    ux, uy = dx / n, dy / n
-    head = min(7.0, n * 0.6)
-    bx, by = x1 - ux * head, y1 - uy * head
-    hw = head * 0.45
-    return (
-        f'<path class="arrow" d="M{x0:.1f},{y0:.1f}L{bx:.1f},{by:.1f}" stroke="{colour}" '
-        f'stroke-width="{width}" fill="none"/>'
-        f'<path class="arrow-head" d="M{x1:.1f},{y1:.1f}L{bx - uy * hw:.1f},{by + ux * hw:.1f}'
-        f'L{bx + uy * hw:.1f},{by - ux * hw:.1f}Z" fill="{colour}"/>'
-    )
-
-
-def _layer(layer: Layer, sx: _Scale, sy: _Scale, box: tuple[float, float, float, float],
-           scale: tuple[float, float] | None) -> str:  # fmt: skip
-    """The SVG of one layer inside the axes ``box`` (x, y, width, height)."""
-    bx, by, bw, bh = box
-    out: list[str] = []
-    match layer:
-        case Line():
-            d, n = _points(sx(floats(layer.x)), sy(floats(layer.y)))
-            dash = _DASHES[layer.dash]
-            out.append(
-                f'<path class="line" data-points="{n}"'
-                + _attr(d=d, stroke=layer.colour, stroke_width=layer.width, stroke_dasharray=dash)
-                + ' fill="none" stroke-linejoin="round"/>'
-            )
-            if layer.marker is not None:
-                px, py = sx(floats(layer.x)), sy(floats(layer.y))
-                ok = np.isfinite(px) & np.isfinite(py)
-                out += [
-                    _marker(layer.marker, x, y, layer.marker_size, layer.colour)
-                    for x, y in zip(px[ok], py[ok], strict=True)
-                ]
-        case Scatter():
-            px, py = sx(floats(layer.x)), sy(floats(layer.y))
-            ok = np.isfinite(px) & np.isfinite(py)
-            if layer.values is not None and scale is not None:
-                frac = (floats(layer.values) - scale[0]) / ((scale[1] - scale[0]) or 1.0)
-                colours = viridis(frac)
-            else:
-                colours = [layer.colour] * len(px)
-            out += [
-                _marker(layer.marker, float(px[i]), float(py[i]), layer.size, colours[i])
-                for i in np.flatnonzero(ok)
-            ]
-        case Arrows():
-            x0, y0 = sx(floats(layer.x0)), sy(floats(layer.y0))
-            x1, y1 = sx(floats(layer.x1)), sy(floats(layer.y1))
-            out += [
-                _arrow(float(a), float(b), float(c), float(d), layer.colour, layer.width)
-                for a, b, c, d in zip(x0, y0, x1, y1, strict=True)
-            ]
-        case Span():
-            if layer.axis == "x":
-                a, b = sorted((sx.one(layer.lo), sx.one(layer.hi)))
-                rect = (a, by, b - a, bh)
-            else:
-                a, b = sorted((sy.one(layer.lo), sy.one(layer.hi)))
-                rect = (bx, a, bw, b - a)
-            out.append(
-                '<rect class="span"'
-                + _attr(
-                    x=f"{rect[0]:.1f}",
-                    y=f"{rect[1]:.1f}",
-                    width=f"{max(rect[2], 0.5):.1f}",
-                    height=f"{max(rect[3], 0.5):.1f}",
-                    fill=layer.colour,
-                    fill_opacity=layer.opacity,
-                )
-                + "/>"
-            )
-        case Band():
-            x, lo, hi = floats(layer.x), floats(layer.lo), floats(layer.hi)
-            ok = np.isfinite(x) & np.isfinite(lo) & np.isfinite(hi)
-            # one closed polygon per unbroken piece: along hi, back along lo
-            pieces = np.split(
-                np.flatnonzero(ok), np.flatnonzero(np.diff(np.flatnonzero(ok)) > 1) + 1
-            )
-            for piece in pieces:
-                if len(piece) < 2:
-                    continue
-                px = sx(np.r_[x[piece], x[piece][::-1]])
-                py = sy(np.r_[hi[piece], lo[piece][::-1]])
-                d, _ = _points(px, py)
-                fill = _attr(d=d + "Z", fill=layer.colour, fill_opacity=layer.opacity)
-                out.append(f'<path class="band"{fill}/>')
-        case ErrorBars():
-            px, py = sx(floats(layer.x)), sy(floats(layer.y))
-            if layer.axis == "y":
-                plo, phi = sy(floats(layer.lo)), sy(floats(layer.hi))
-            else:
-                plo, phi = sx(floats(layer.lo)), sx(floats(layer.hi))
-            c, w = layer.cap, layer.width
-            for x, y, lo_, hi_ in zip(
-                px.tolist(), py.tolist(), plo.tolist(), phi.tolist(), strict=True
-            ):
-                segs: list[str] = []
-                for end in (lo_, hi_):
-                    if not math.isfinite(end):
-                        continue
-                    if layer.axis == "y":
-                        if math.isfinite(x) and math.isfinite(y):
-                            segs.append(f"M{x:.1f},{y:.1f}L{x:.1f},{end:.1f}")
-                        segs.append(f"M{x - c:.1f},{end:.1f}L{x + c:.1f},{end:.1f}")
-                    else:
-                        if math.isfinite(x) and math.isfinite(y):
-                            segs.append(f"M{x:.1f},{y:.1f}L{end:.1f},{y:.1f}")
-                        segs.append(f"M{end:.1f},{y - c:.1f}L{end:.1f},{y + c:.1f}")
-                if segs and math.isfinite(x if layer.axis == "y" else y):
-                    out.append(
-                        '<path class="errorbar"'
-                        + _attr(d="".join(segs), stroke=layer.colour, stroke_width=w)
-                        + ' fill="none"/>'
-                    )
-                if layer.marker is not None and math.isfinite(x) and math.isfinite(y):
-                    out.append(_marker(layer.marker, x, y, layer.marker_size, layer.colour))
-        case Bars():
-            bx_, h = floats(layer.x), floats(layer.height)
-            left, right = sx(bx_ - layer.width / 2), sx(bx_ + layer.width / 2)
-            top, base = sy(h), sy.one(0.0)
-            for i in np.flatnonzero(np.isfinite(h) & np.isfinite(bx_)):
-                colour = layer.colours[i % len(layer.colours)]
-                ya, yb = sorted((float(top[i]), base))
-                out.append(
-                    '<rect class="bar"'
-                    + _attr(
-                        x=f"{left[i]:.1f}",
-                        y=f"{ya:.1f}",
-                        width=f"{right[i] - left[i]:.1f}",
-                        height=f"{max(yb - ya, 0.0):.1f}",
-                        fill=colour,
-                    )
-                    + "/>"
-                )
-        case RefLine():
-            if layer.axis == "x":
-                v = sx.one(layer.value)
-                a = by + bh if layer.lo is None else sy.one(layer.lo)
-                b = by if layer.hi is None else sy.one(layer.hi)
-                d = f"M{v:.1f},{a:.1f}L{v:.1f},{b:.1f}"
-            else:
-                v = sy.one(layer.value)
-                a = bx if layer.lo is None else sx.one(layer.lo)
-                b = bx + bw if layer.hi is None else sx.one(layer.hi)
-                d = f"M{a:.1f},{v:.1f}L{b:.1f},{v:.1f}"
-            out.append(
-                '<path class="refline"'
-                + _attr(
-                    d=d,
-                    stroke=layer.colour,
-                    stroke_width=layer.width,
-                    stroke_dasharray=_DASHES[layer.dash],
-                )
-                + ' fill="none"/>'
-            )
-        case Text():
-            tx = sx.one(layer.x) + layer.offset[0]
-            ty = sy.one(layer.y) - layer.offset[1]
-            if math.isfinite(tx) and math.isfinite(ty):
-                lines = layer.text.split("\n")
-                spans = "".join(
-                    f'<tspan x="{tx:.1f}" dy="{0 if i == 0 else TICK_PX * 1.15:.1f}">'
-                    f"{escape(t)}</tspan>"
-                    for i, t in enumerate(lines)
-                )
-                ty -= (len(lines) - 1) * TICK_PX * 1.15
-                out.append(
-                    f'<text class="label" x="{tx:.1f}" y="{ty:.1f}"'
-                    + _attr(fill=layer.colour, text_anchor=layer.anchor)
-                    + f' font-size="{TICK_PX}">{spans}</text>'
-                )
-    label = getattr(layer, "label", None)
-    return f'<g class="series"{_attr(data_label=label)}>{"".join(out)}</g>'
-
-
-def _swatch(layer: Layer, x: float, y: float) -> str:
-    """The legend's sample of ``layer``: 22 px wide, centred on ``y``."""
-    colour = getattr(layer, "colour", None) or layer.colours[0]  # type: ignore[union-attr]
-    match layer:
-        case Line() | RefLine():
-            dash = _DASHES[layer.dash]
-            s = (
-                f'<path d="M{x:.1f},{y:.1f}L{x + 22:.1f},{y:.1f}"'
-                + _attr(stroke=colour, stroke_width=max(layer.width, 1.0), stroke_dasharray=dash)
-                + "/>"
-            )
-            if isinstance(layer, Line) and layer.marker is not None:
-                s += _marker(layer.marker, x + 11, y, layer.marker_size, colour, "swatch")
-            return s
-        case Scatter():
-            c = colour if layer.values is None else viridis(np.asarray([0.6]))[0]
-            return _marker(layer.marker, x + 11, y, max(layer.size, 3.0), c, "swatch")
-        case Arrows():
-            return _arrow(x, y, x + 22, y, colour, layer.width)
-        case ErrorBars():
-            s = (
-                f'<path d="M{x + 11:.1f},{y - 6:.1f}L{x + 11:.1f},{y + 6:.1f}'
-                f"M{x + 7:.1f},{y - 6:.1f}L{x + 15:.1f},{y - 6:.1f}"
-                f'M{x + 7:.1f},{y + 6:.1f}L{x + 15:.1f},{y + 6:.1f}"'
-                + _attr(stroke=colour, stroke_width=layer.width)
-                + ' fill="none"/>'
-            )
-            if layer.marker is not None:
-                s += _marker(layer.marker, x + 11, y, layer.marker_size, colour, "swatch")
-            return s
-        case Text():
-            return ""
-    opacity = getattr(layer, "opacity", 1.0)
-    return (
-        f'<rect x="{x:.1f}" y="{y - 5:.1f}" width="22" height="10"'
-        + _attr(fill=colour, fill_opacity=opacity)
-        + "/>"
-    )
-
-
 def render(chart: Chart, size: tuple[float, float], title: str = "", *, uid: str = "f") -> str:
     """The SVG document of ``chart`` in a ``size``-inch figure (at :data:`PIXELS_PER_INCH`),
     ``title`` above the axes; ``uid`` prefixes the ids inside (clip paths, gradients), for
@@ -498,9 +211,9 @@ def _body(
         if chart.equal_aspect:
             xlim, ylim = _equal(xlim, ylim, plot_w, plot_h)
     box = (left, top, plot_w, plot_h)
-    sx = _Scale(xlim[0], xlim[1], left, plot_w)
-    sy = _Scale(ylim[0], ylim[1], top, plot_h, flip=True)
-    sr = _Scale(rlim[0], rlim[1], top, plot_h, flip=True) if rlim is not None else sy
+    sx = Scale(xlim[0], xlim[1], left, plot_w)
+    sy = Scale(ylim[0], ylim[1], top, plot_h, flip=True)
+    sr = Scale(rlim[0], rlim[1], top, plot_h, flip=True) if rlim is not None else sy
 
     out: list[str] = [f'<rect width="{width:.0f}" height="{height:.0f}" fill="#ffffff"/>']
     clip = f"{uid}-axes"
@@ -522,7 +235,7 @@ def _body(
     out.append(f'<g clip-path="url(#{clip})">')
     for layer in layers:
         ys = sr if getattr(layer, "side", "left") == "right" else sy
-        out.append(_layer(layer, sx, ys, box, scale))
+        out.append(layer_svg(layer, sx, ys, box, scale))
     out.append("</g>")
     out.append(
         f'<rect class="frame" x="{left:.1f}" y="{top:.1f}" width="{plot_w:.1f}" '
@@ -552,14 +265,14 @@ def _body(
         out.append(
             f'<text class="xlabel" x="{left + plot_w / 2:.1f}" '
             f'y="{base + 8 + TICK_PX + LABEL_PX * 1.2:.1f}" text-anchor="middle" '
-            f'font-size="{LABEL_PX}"{_attr(fill=chart.x.colour)}>{escape(chart.x.label)}</text>'
+            f'font-size="{LABEL_PX}"{attr(fill=chart.x.colour)}>{escape(chart.x.label)}</text>'
         )
     if chart.y.label:
         cx, cy = 8 + LABEL_PX, top + plot_h / 2
         out.append(
             f'<text class="ylabel" x="{cx:.1f}" y="{cy:.1f}" text-anchor="middle" '
             f'transform="rotate(-90 {cx:.1f} {cy:.1f})" font-size="{LABEL_PX}"'
-            f"{_attr(fill=chart.y.colour)}>{escape(chart.y.label)}</text>"
+            f"{attr(fill=chart.y.colour)}>{escape(chart.y.label)}</text>"
         )
     if chart.right is not None and rlim is not None:
         rt, _ = _ticks(chart.right, rlim, plot_h, 45)
@@ -574,7 +287,7 @@ def _body(
         out.append(
             f'<text class="rlabel" x="{cx:.1f}" y="{cy:.1f}" text-anchor="middle" '
             f'transform="rotate(90 {cx:.1f} {cy:.1f})" font-size="{LABEL_PX}"'
-            f"{_attr(fill=chart.right.colour)}>{escape(chart.right.label)}</text>"
+            f"{attr(fill=chart.right.colour)}>{escape(chart.right.label)}</text>"
         )
     out.append(f'<path class="ticks" d="{"".join(ticks)}" stroke="#000000" stroke-width="0.8"/>')
     if chart.colour_scale is not None:
@@ -643,7 +356,7 @@ def _legend(rows: list[list[tuple[Layer, float]]], top: float, width: float) -> 
         for layer, w in row:
             label = str(getattr(layer, "label", ""))
             out.append(
-                f'<g class="entry"{_attr(data_label=label)}>{_swatch(layer, x, y)}'
+                f'<g class="entry"{attr(data_label=label)}>{swatch(layer, x, y)}'
                 f'<text x="{x + 28:.1f}" y="{y + LEGEND_PX * 0.35:.1f}" '
                 f'font-size="{LEGEND_PX}">{escape(label)}</text></g>'
             )
@@ -667,7 +380,7 @@ def _colour_bar(chart: Chart, x: float, top: float, h: float, width: float, uid:
         f'<rect x="{x:.1f}" y="{top:.1f}" width="14" height="{h:.1f}" fill="url(#{gid})" '
         'stroke="#000000" stroke-width="0.6"/>',
     ]
-    scale = _Scale(cs.lo, cs.hi if cs.hi > cs.lo else cs.lo + 1.0, top, h, flip=True)
+    scale = Scale(cs.lo, cs.hi if cs.hi > cs.lo else cs.lo + 1.0, top, h, flip=True)
     ticks, decimals = nice_ticks(cs.lo, cs.hi, 5)
     for v in ticks:
         y = scale.one(float(v))
