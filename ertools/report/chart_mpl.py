@@ -54,8 +54,11 @@ def draw(chart: Chart, ax: Any) -> None:
         if right is not None:
             more = right.get_legend_handles_labels()
             handles, labels = handles + more[0], labels + more[1]
-        if handles:
-            ax.legend(handles, labels, loc="best", fontsize="small")
+        # in the chart's order, as the SVG lists them (matplotlib groups them by kind)
+        order = [getattr(layer, "label", None) for layer in chart.layers]
+        pairs = sorted(zip(handles, labels, strict=True), key=lambda p: order.index(p[1]))
+        if pairs:
+            ax.legend(*zip(*pairs, strict=True), loc="best", fontsize="small")
 
 
 def _layer(ax: Any, layer: Layer, chart: Chart) -> Any:

@@ -64,10 +64,9 @@ def nice_ticks(lo: float, hi: float, target: int) -> tuple[FloatArray, int]:
     first = math.ceil(lo / step - 1e-9)
     last = math.floor(hi / step + 1e-9)
     ticks = np.arange(first, last + 1, dtype=np.float64) * step
-    decimals = max(0, -math.floor(math.log10(step) + 1e-9))
-    if round(step / 10.0 ** math.floor(math.log10(step) + 1e-9), 6) == 2.5:
-        decimals += 1
-    return ticks, decimals
+    exponent = math.floor(math.log10(step) + 1e-9)
+    quarter = round(step / 10.0**exponent, 6) == 2.5  # 0.25 needs a decimal more than 0.2
+    return ticks, max(0, -exponent + quarter)
 
 
 def tick_text(value: float, decimals: int) -> str:
@@ -155,6 +154,7 @@ def render(chart: Chart, size: tuple[float, float], title: str = "", *, uid: str
 
 def _document(body: str, width: float, height: float) -> str:
     return (
+        '<?xml version="1.0" encoding="UTF-8"?>\n'
         f'<svg xmlns="http://www.w3.org/2000/svg" width="{width:.0f}" height="{height:.0f}" '
         f'viewBox="0 0 {width:.0f} {height:.0f}" font-family="{FONT}">\n{body}</svg>\n'
     )
