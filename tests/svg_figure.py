@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 NS = {"s": "http://www.w3.org/2000/svg"}
-_PAIR = re.compile(r"([ML])(-?[\d.]+),(-?[\d.]+)")
+PAIR = re.compile(r"([ML])(-?[\d.]+),(-?[\d.]+)")
 
 
 @dataclass
@@ -61,7 +61,7 @@ class Figure:
         ax, bx = self.scale("x")
         ay, by = self.scale("y")
         rows = []
-        for cmd, x, y in _PAIR.findall(path.get("d", "")):
+        for cmd, x, y in PAIR.findall(path.get("d", "")):
             if cmd == "M" and rows:
                 rows.append((np.nan, np.nan))
             rows.append((ax * float(x) + bx, ay * float(y) + by))

@@ -68,11 +68,8 @@ def test_error_bars_span_their_bounds_and_skip_missing_ones() -> None:
     assert len(paths) == 3
     assert len(fig.series("score").findall("s:circle", NS)) == 3  # the values
     for path, lo, hi, x in zip(paths, (4, 5.5, None), (6.5, 8, 9), (1, 2, 3), strict=True):
-        ends = {
-            round(ay * float(p[2]) + by, 1)
-            for p in svg_figure._PAIR.findall(path.get("d", ""))  # noqa: SLF001
-        }
-        xs = [ax * float(p[1]) + bx for p in svg_figure._PAIR.findall(path.get("d", ""))]  # noqa: SLF001
+        ends = {round(ay * float(p[2]) + by, 1) for p in svg_figure.PAIR.findall(path.get("d", ""))}
+        xs = [ax * float(p[1]) + bx for p in svg_figure.PAIR.findall(path.get("d", ""))]
         assert hi in ends and (lo is None or lo in ends)
         assert min(xs) < x < max(xs)  # the caps around the value's x
         if lo is None:  # no bar below the value: nothing drawn under y = 7
@@ -93,7 +90,7 @@ def test_spans_bands_reflines_and_bars() -> None:
     )
     fig = svg_figure.read(svg.render(chart, (6.0, 4.0)))
     ax, bx = fig.scale("x")
-    ay, by = fig.scale("y")
+    ay, _ = fig.scale("y")
     span = fig.series("gap").find("s:rect", NS)
     assert span is not None
     x0 = ax * float(span.get("x", "nan")) + bx
@@ -101,7 +98,7 @@ def test_spans_bands_reflines_and_bars() -> None:
     assert np.allclose([x0, x1], [2.0, 3.0], atol=abs(ax))
     band = fig.series("95 % band").find("s:path", NS)
     assert band is not None and band.get("d", "").endswith("Z")
-    assert len(svg_figure._PAIR.findall(band.get("d", ""))) == 6  # noqa: SLF001
+    assert len(svg_figure.PAIR.findall(band.get("d", ""))) == 6
     rects = fig.series("counts").findall("s:rect", NS)
     assert len(rects) == 1  # the NaN bar is not drawn
     assert abs(ay) * float(rects[0].get("height", "nan")) == pytest.approx(5.0, abs=abs(ay))
