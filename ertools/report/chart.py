@@ -153,6 +153,23 @@ class Bars:
 
 
 @dataclass(frozen=True)
+class Rects:
+    """Rectangles from (x0, y0) to (x1, y1) in data units: the bars of a Gantt chart, a
+    state's span on its lane. ``hatch`` fills them with diagonal lines instead (a silence);
+    ``edge`` outlines each one."""
+
+    x0: FloatArray
+    x1: FloatArray
+    y0: FloatArray
+    y1: FloatArray
+    colour: str = COLOURS["blue"]
+    edge: str | None = None
+    hatch: bool = False
+    label: str | None = None
+    side: Side = "left"
+
+
+@dataclass(frozen=True)
 class RefLine:
     """A line across the axes at ``value``: vertical for ``axis="x"``, horizontal for
     ``"y"``; with ``lo``/``hi`` only from ``lo`` to ``hi`` along the other axis."""
@@ -181,7 +198,7 @@ class Text:
     side: Side = "left"
 
 
-Layer = Line | Scatter | Arrows | Span | Band | ErrorBars | Bars | RefLine | Text
+Layer = Line | Scatter | Arrows | Span | Band | ErrorBars | Bars | Rects | RefLine | Text
 
 
 @dataclass(frozen=True)
@@ -193,6 +210,7 @@ class Axis:
     ticks: tuple[tuple[float, str], ...] | None = None
     colour: str = "#000000"
     include_zero: bool = False  # bars and counts start at zero
+    limits: tuple[float, float] | None = None  # fixed, instead of the data's with margins
 
 
 @dataclass(frozen=True)

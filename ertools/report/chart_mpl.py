@@ -17,6 +17,7 @@ from ertools.report.chart import (
     ErrorBars,
     Layer,
     Line,
+    Rects,
     RefLine,
     Scatter,
     Span,
@@ -41,6 +42,10 @@ def draw(chart: Chart, ax: Any) -> None:
     for axis, spec in ((ax.xaxis, chart.x), (ax.yaxis, chart.y)):
         if spec.ticks is not None:
             axis.set_ticks([v for v, _ in spec.ticks], [t for _, t in spec.ticks])
+    if chart.x.limits is not None:
+        ax.set_xlim(*chart.x.limits)
+    if chart.y.limits is not None:
+        ax.set_ylim(*chart.y.limits)
     if right is not None and chart.right is not None:
         right.set_ylabel(chart.right.label, color=chart.right.colour)
     if chart.equal_aspect:
@@ -151,6 +156,20 @@ def _layer(ax: Any, layer: Layer, chart: Chart) -> Any:
                 np.nan_to_num(floats(layer.height)),
                 width=layer.width,
                 color=[layer.colours[i % len(layer.colours)] for i in range(len(x))],
+                label=label,
+            )
+        case Rects():
+            x0, y0 = floats(layer.x0), floats(layer.y0)
+            ax.bar(
+                x0,
+                floats(layer.y1) - y0,
+                width=floats(layer.x1) - x0,
+                bottom=y0,
+                align="edge",
+                color="none" if layer.hatch else layer.colour,
+                edgecolor=layer.edge or ("#444444" if layer.hatch else "none"),
+                hatch="///" if layer.hatch else None,
+                linewidth=0.4,
                 label=label,
             )
         case RefLine():

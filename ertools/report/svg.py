@@ -31,6 +31,7 @@ from ertools.report.chart import (
     FloatArray,
     Layer,
     Line,
+    Rects,
     RefLine,
     Scatter,
     Span,
@@ -84,6 +85,15 @@ def _extent(layers: tuple[Layer, ...], axis: str, side: str) -> list[FloatArray]
             case Line() | Scatter():
                 out.append(floats(layer.x if axis == "x" else layer.y))
             case Arrows():
+                out += (
+                    [floats(layer.x0), floats(layer.x1)]
+                    if axis == "x"
+                    else [
+                        floats(layer.y0),
+                        floats(layer.y1),
+                    ]
+                )
+            case Rects():
                 out += (
                     [floats(layer.x0), floats(layer.x1)]
                     if axis == "x"
@@ -185,8 +195,10 @@ def _body(
     bottom = 8 + TICK_PX + 6 + (LABEL_PX * 1.4 if chart.x.label else 0) + 4
     bottom += len(legend_rows) * LEGEND_PX * 1.6 + (6 if legend_rows else 0)
 
-    xlim = _limits(_extent(layers, "x", "left"), chart.x.include_zero, MARGIN)
-    ylim = _limits(_extent(layers, "y", "left"), chart.y.include_zero, chart_margin(chart))
+    xlim = chart.x.limits or _limits(_extent(layers, "x", "left"), chart.x.include_zero, MARGIN)
+    ylim = chart.y.limits or _limits(
+        _extent(layers, "y", "left"), chart.y.include_zero, chart_margin(chart)
+    )
     rlim = (
         _limits(_extent(layers, "y", "right"), chart.right.include_zero, chart_margin(chart))
         if chart.right is not None
@@ -219,7 +231,10 @@ def _body(
     clip = f"{uid}-axes"
     out.append(
         f'<defs><clipPath id="{clip}"><rect x="{left:.1f}" y="{top:.1f}" '
-        f'width="{plot_w:.1f}" height="{plot_h:.1f}"/></clipPath></defs>'
+        f'width="{plot_w:.1f}" height="{plot_h:.1f}"/></clipPath>'
+        f'<pattern id="{uid}-hatch" width="6" height="6" patternUnits="userSpaceOnUse" '
+        'patternTransform="rotate(45)"><path d="M0,0v6" stroke="#444444" stroke-width="1"/>'
+        "</pattern></defs>"
     )
     xt, _ = _ticks(chart.x, xlim, plot_w, 90)
     yt, _ = _ticks(chart.y, ylim, plot_h, 45)
@@ -235,7 +250,7 @@ def _body(
     out.append(f'<g clip-path="url(#{clip})">')
     for layer in layers:
         ys = sr if getattr(layer, "side", "left") == "right" else sy
-        out.append(layer_svg(layer, sx, ys, box, scale))
+        out.append(layer_svg(layer, sx, ys, box, scale, uid))
     out.append("</g>")
     out.append(
         f'<rect class="frame" x="{left:.1f}" y="{top:.1f}" width="{plot_w:.1f}" '

@@ -19,6 +19,7 @@ from ertools.report.chart import (
     FloatArray,
     Layer,
     Line,
+    Rects,
     RefLine,
     Scatter,
     Span,
@@ -114,9 +115,16 @@ def arrow(x0: float, y0: float, x1: float, y1: float, colour: str, width: float)
     )
 
 
-def layer_svg(layer: Layer, sx: Scale, sy: Scale, box: tuple[float, float, float, float],
-           scale: tuple[float, float] | None) -> str:  # fmt: skip
-    """The SVG of one layer inside the axes ``box`` (x, y, width, height)."""
+def layer_svg(
+    layer: Layer,
+    sx: Scale,
+    sy: Scale,
+    box: tuple[float, float, float, float],
+    scale: tuple[float, float] | None,
+    uid: str,
+) -> str:
+    """The SVG of one layer inside the axes ``box`` (x, y, width, height); ``scale``: the
+    colour scale's range; ``uid``: the document's id prefix (its hatch pattern)."""
     bx, by, bw, bh = box
     out: list[str] = []
     match layer:
@@ -236,6 +244,24 @@ def layer_svg(layer: Layer, sx: Scale, sy: Scale, box: tuple[float, float, float
                     )
                     + "/>"
                 )
+        case Rects():
+            x0, x1 = sx(floats(layer.x0)), sx(floats(layer.x1))
+            y0, y1 = sy(floats(layer.y0)), sy(floats(layer.y1))
+            left, right = np.minimum(x0, x1), np.maximum(x0, x1)
+            top, bottom = np.minimum(y0, y1), np.maximum(y0, y1)
+            fill = f"url(#{uid}-hatch)" if layer.hatch else layer.colour
+            style = attr(fill=fill, stroke=layer.edge, stroke_width=0.5 if layer.edge else None)
+            out.append(f"<g{style}>")
+            for a, b, c, d in zip(
+                left.tolist(), top.tolist(), right.tolist(), bottom.tolist(), strict=True
+            ):
+                if math.isfinite(a + b + c + d):
+                    w = max(c - a, 0.5)  # a state a few ms long is still seen
+                    out.append(
+                        f'<rect class="rect" x="{a:.1f}" y="{b:.1f}" width="{w:.1f}" '
+                        f'height="{d - b:.1f}"/>'
+                    )
+            out.append("</g>")
         case RefLine():
             if layer.axis == "x":
                 v = sx.one(layer.value)
@@ -309,6 +335,12 @@ def swatch(layer: Layer, x: float, y: float) -> str:
             return s
         case Text():
             return ""
+    if isinstance(layer, Rects) and layer.hatch:
+        return (
+            f'<rect x="{x:.1f}" y="{y - 5:.1f}" width="22" height="10" fill="none"'
+            + attr(stroke=layer.edge or colour, stroke_dasharray="2,2")
+            + "/>"
+        )
     opacity = getattr(layer, "opacity", 1.0)
     return (
         f'<rect x="{x:.1f}" y="{y - 5:.1f}" width="22" height="10"'
