@@ -211,6 +211,7 @@ class Axis:
     colour: str = "#000000"
     include_zero: bool = False  # bars and counts start at zero
     limits: tuple[float, float] | None = None  # fixed, instead of the data's with margins
+    symlog: float | None = None  # linear within +-symlog of 0, logarithmic beyond
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,8 @@ def draw(chart: Chart, ax: Any) -> None:
     for axis, spec in ((ax.xaxis, chart.x), (ax.yaxis, chart.y)):
         if spec.ticks is not None:
             axis.set_ticks([v for v, _ in spec.ticks], [t for _, t in spec.ticks])
+    if chart.y.symlog is not None:
+        ax.set_yscale("symlog", linthresh=chart.y.symlog)
     if chart.x.limits is not None:
         ax.set_xlim(*chart.x.limits)
     if chart.y.limits is not None:

@@ -199,11 +199,11 @@ def _body(
     ylim = chart.y.limits or _limits(
         _extent(layers, "y", "left"), chart.y.include_zero, chart_margin(chart)
     )
-    rlim = (
-        _limits(_extent(layers, "y", "right"), chart.right.include_zero, chart_margin(chart))
-        if chart.right is not None
-        else None
-    )
+    rlim = None
+    if chart.right is not None:
+        rlim = chart.right.limits or _limits(
+            _extent(layers, "y", "right"), chart.right.include_zero, chart_margin(chart)
+        )
     # Horizontal budget: y tick labels and label on the left; right scale or colour bar.
     left = right = 0.0
     for _ in range(2):  # tick labels depend on the limits, the limits (aspect) on the box
@@ -223,9 +223,11 @@ def _body(
         if chart.equal_aspect:
             xlim, ylim = _equal(xlim, ylim, plot_w, plot_h)
     box = (left, top, plot_w, plot_h)
-    sx = Scale(xlim[0], xlim[1], left, plot_w)
-    sy = Scale(ylim[0], ylim[1], top, plot_h, flip=True)
-    sr = Scale(rlim[0], rlim[1], top, plot_h, flip=True) if rlim is not None else sy
+    sx = Scale(xlim[0], xlim[1], left, plot_w, symlog=chart.x.symlog)
+    sy = Scale(ylim[0], ylim[1], top, plot_h, flip=True, symlog=chart.y.symlog)
+    sr = sy
+    if rlim is not None and chart.right is not None:
+        sr = Scale(rlim[0], rlim[1], top, plot_h, flip=True, symlog=chart.right.symlog)
 
     out: list[str] = [f'<rect width="{width:.0f}" height="{height:.0f}" fill="#ffffff"/>']
     clip = f"{uid}-axes"
@@ -330,6 +332,12 @@ def _ticks(
     explicit = getattr(axis, "ticks", None)
     if explicit is not None:
         return [(v, t) for v, t in explicit if lim[0] <= v <= lim[1]], 0
+    threshold = getattr(axis, "symlog", None)
+    if threshold is not None:  # zero and the decades beyond the linear range, both signs
+        decades = threshold * 10.0 ** np.arange(0, 12)
+        values = np.sort(np.r_[-decades, 0.0, decades])
+        values = values[(values >= lim[0]) & (values <= lim[1])]
+        return [(float(v), f"{v:g}") for v in values], 0
     values, decimals = nice_ticks(lim[0], lim[1], max(int(length / spacing), 2))
     return [(float(v), tick_text(float(v), decimals)) for v in values], decimals
 

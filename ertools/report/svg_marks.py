@@ -34,17 +34,28 @@ DASHES = {"solid": "", "dashed": "5,3", "dotted": "1.5,2.5"}
 
 @dataclass
 class Scale:
-    """Data -> pixel along one axis (``flip``: y grows upwards)."""
+    """Data -> pixel along one axis (``flip``: y grows upwards; ``symlog``: linear within
+    +-symlog of zero, logarithmic beyond, as matplotlib's ``symlog`` scale)."""
 
     lo: float
     hi: float
     start: float
     length: float
     flip: bool = False
+    symlog: float | None = None
+
+    def _t(self, v: FloatArray) -> FloatArray:
+        if self.symlog is None:
+            return v
+        out: FloatArray = np.sign(v) * np.log10(1.0 + np.abs(v) / self.symlog)
+        return out
 
     def __call__(self, v: FloatArray) -> FloatArray:
-        f = (np.asarray(v, dtype=float) - self.lo) / (self.hi - self.lo)
-        return self.start + (1.0 - f if self.flip else f) * self.length
+        ends = self._t(np.array([self.lo, self.hi], dtype=np.float64))
+        lo, hi = float(ends[0]), float(ends[1])
+        f = (self._t(np.asarray(v, dtype=np.float64)) - lo) / (hi - lo)
+        out: FloatArray = self.start + (1.0 - f if self.flip else f) * self.length
+        return out
 
     def one(self, v: float) -> float:
         return float(self(np.asarray([v]))[0])
