@@ -130,19 +130,12 @@ def _canvas_figure(size: tuple[float, float]) -> Any:
 
 
 def preload() -> None:
-    """Import what drawing a figure needs and load its font, without writing anything: for a
-    process that forks one child per job (the Dask workers' :func:`ertools.rescore.parallel.
-    run_job_forked`), so that each child inherits them instead of paying ~0.5 s of CPU for
-    matplotlib's imports and font loading again."""
-    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-    from matplotlib.image import imsave  # noqa: F401  # lazy: as above (loads Pillow)
-
-    fig = Figure(figsize=(1.0, 1.0), dpi=DPI)
-    canvas: Any = FigureCanvasAgg(fig)  # matplotlib's draw is untyped
-    fig.add_subplot().set_title("0")
-    canvas.draw()
+    """Import what writing a report's figures needs, without writing anything: for a process
+    that forks one child per job (the Dask workers' :func:`ertools.rescore.parallel.
+    run_job_forked`), so that each child inherits it. The reports' figures are SVG charts
+    (no matplotlib since issue 29); one tiny chart is rendered so that the writer's code
+    paths ran once before the fork."""
+    svg.render(Chart((), note="0"), (1.0, 1.0), "0")
 
 
 def _write_png(fig: Any, path: Path) -> None:
