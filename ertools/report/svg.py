@@ -11,8 +11,9 @@ never hides data). Every element a test or a reader may look for carries a class
 ``bar``, ``refline``, ``arrow`` and ``label`` elements; ``xtick``/``ytick``/``rtick`` texts;
 ``xlabel``/``ylabel``/``rlabel``; ``title``; ``legend``.
 
-Text widths are estimated (0.6 em per character of DejaVu Sans, the font the report names
-first), which is all the layout needs: labels are never measured to the pixel.
+Text widths are estimated (average widths of DejaVu Sans, the font the report names first, for
+capitals, narrow and other characters), which is all the layout needs: labels are never
+measured to the pixel.
 """
 
 from __future__ import annotations
@@ -44,13 +45,18 @@ from ertools.report.svg_marks import Scale, attr, layer_svg, swatch
 PIXELS_PER_INCH = 110  # the reports' PNGs were 110 dpi: the same pixel size for each figure
 FONT = "DejaVu Sans, Verdana, Arial, sans-serif"
 TICK_PX, LABEL_PX, TITLE_PX, LEGEND_PX = 11.0, 12.0, 13.0, 11.0
-CHAR_EM = 0.6
+# Average advance widths of DejaVu Sans in em: capitals and underscores are wider than
+# lower case (a legend of state names is all capitals), spaces and dots narrower.
+_EM_UPPER, _EM_OTHER, _EM_NARROW = 0.72, 0.6, 0.32
+_NARROW = frozenset(" .,:;|!il()[]'")
 MARGIN = 0.05  # of the data's span, on each side (matplotlib's default)
 
 
 def text_width(text: str, px: float) -> float:
     """Estimated width of ``text`` at ``px`` pixels."""
-    return len(text) * px * CHAR_EM
+    upper = sum(c.isupper() or c == "_" for c in text)
+    narrow = sum(c in _NARROW for c in text)
+    return (upper * _EM_UPPER + narrow * _EM_NARROW + (len(text) - upper - narrow) * _EM_OTHER) * px
 
 
 def nice_ticks(lo: float, hi: float, target: int) -> tuple[FloatArray, int]:
