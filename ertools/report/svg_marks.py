@@ -174,12 +174,12 @@ def layer_svg(
                 for a, b, c, d in zip(x0, y0, x1, y1, strict=True)
             ]
         case Span():
-            if layer.axis == "x":
-                a, b = sorted((sx.one(layer.lo), sx.one(layer.hi)))
-                rect = (a, by, b - a, bh)
-            else:
-                a, b = sorted((sy.one(layer.lo), sy.one(layer.hi)))
-                rect = (bx, a, bw, b - a)
+            scale_, (edge, size) = (sx, (bx, bw)) if layer.axis == "x" else (sy, (by, bh))
+            ends = [scale_.one(layer.lo), scale_.one(layer.hi)]
+            if any(math.isnan(e) for e in ends):  # no span; an infinite end: the axes' edge
+                return '<g class="series"></g>'
+            a, b = sorted(min(max(e, edge - 1.0), edge + size + 1.0) for e in ends)
+            rect = (a, by, b - a, bh) if layer.axis == "x" else (bx, a, bw, b - a)
             out.append(
                 '<rect class="span"'
                 + attr(
@@ -278,12 +278,17 @@ def layer_svg(
                 v = sx.one(layer.value)
                 a = by + bh if layer.lo is None else sy.one(layer.lo)
                 b = by if layer.hi is None else sy.one(layer.hi)
-                d = f"M{v:.1f},{a:.1f}L{v:.1f},{b:.1f}"
             else:
                 v = sy.one(layer.value)
                 a = bx if layer.lo is None else sx.one(layer.lo)
                 b = bx + bw if layer.hi is None else sx.one(layer.hi)
-                d = f"M{a:.1f},{v:.1f}L{b:.1f},{v:.1f}"
+            if not all(math.isfinite(n) for n in (v, a, b)):
+                return '<g class="series"></g>'  # a line at no finite value: nothing to draw
+            d = (
+                f"M{v:.1f},{a:.1f}L{v:.1f},{b:.1f}"
+                if layer.axis == "x"
+                else f"M{a:.1f},{v:.1f}L{b:.1f},{v:.1f}"
+            )
             out.append(
                 '<path class="refline"'
                 + attr(

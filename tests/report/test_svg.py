@@ -159,3 +159,50 @@ def test_matplotlib_draws_the_same_layers() -> None:
     chart_mpl.draw(chart, ax)
     assert ax.get_xlabel() == "x (mm)"
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["line", "interval", "gap"]
+
+
+def test_hostile_values_never_reach_the_svg() -> None:
+    """Random charts of every layer with NaN, +-inf, empty arrays and values over twelve
+    decades: well-formed SVG, and no NaN or infinity in any attribute (a browser would drop
+    the element or the whole figure)."""
+    import re
+    import xml.etree.ElementTree as ET
+
+    from ertools.report.chart import Arrows, Rects
+
+    rng = np.random.default_rng(29)
+
+    def arr(n: int) -> np.ndarray:
+        a = rng.normal(size=n) * 10.0 ** rng.integers(-6, 7)
+        u = rng.random(n)
+        a[u < 0.1] = np.nan
+        a[(u >= 0.1) & (u < 0.15)] = np.inf
+        return a
+
+    def one() -> float:
+        return float(arr(1)[0])
+
+    for trial in range(300):
+        n = int(rng.integers(0, 6))
+        layers = [
+            Line(arr(n), arr(n), label="l"),
+            Scatter(arr(n), arr(n), values=arr(n), label="s"),
+            Arrows(arr(n), arr(n), arr(n), arr(n)),
+            Span(one(), one(), "x" if trial % 2 else "y", label="span"),
+            Band(arr(n), arr(n), arr(n), label="band"),
+            ErrorBars(arr(n), arr(n), arr(n), arr(n), label="e"),
+            Bars(arr(n), arr(n), label="bars"),
+            Rects(arr(n), arr(n), arr(n), arr(n), hatch=bool(trial % 2), label="r"),
+            RefLine(one(), "x" if trial % 3 else "y", label="ref"),
+            Text(one(), one(), "t"),
+        ]
+        chart = Chart(
+            tuple(layer for layer in layers if rng.random() < 0.5),
+            y=Axis("y", symlog=10.0 if trial % 7 == 0 else None),
+            right=Axis("r") if trial % 5 == 0 else None,
+            equal_aspect=bool(trial % 2),
+            colour_scale=ColourScale("c", 0.0, 1.0) if trial % 3 == 0 else None,
+        )
+        text = svg.render(chart, (4.0, 3.0), "T")
+        ET.fromstring(text)
+        assert not re.search(r'="[^"]*(nan|inf)[^"]*"', text, re.IGNORECASE), trial
