@@ -203,23 +203,23 @@ def _body(
 
     xlim = chart.x.limits or _limits(_extent(layers, "x", "left"), chart.x.include_zero, MARGIN)
     ylim = chart.y.limits or _limits(
-        _extent(layers, "y", "left"), chart.y.include_zero, chart_margin(chart)
+        _extent(layers, "y", "left"), chart.y.include_zero, _chart_margin(chart)
     )
     rlim = None
     if chart.right is not None:
         rlim = chart.right.limits or _limits(
-            _extent(layers, "y", "right"), chart.right.include_zero, chart_margin(chart)
+            _extent(layers, "y", "right"), chart.right.include_zero, _chart_margin(chart)
         )
     # Horizontal budget: y tick labels and label on the left; right scale or colour bar.
     left = right = 0.0
     for _ in range(2):  # tick labels depend on the limits, the limits (aspect) on the box
         plot_h = height - top - bottom
-        yt, yd = _ticks(chart.y, ylim, plot_h, 45)
-        left = 10 + (LABEL_PX * 1.5 if chart.y.label else 0) + _labels_width(yt, yd, chart.y) + 6
+        yt, _ = _ticks(chart.y, ylim, plot_h, 45)
+        left = 10 + (LABEL_PX * 1.5 if chart.y.label else 0) + _labels_width(yt) + 6
         right = 16.0
         if chart.right is not None and rlim is not None:
-            rt, rd = _ticks(chart.right, rlim, plot_h, 45)
-            right = 10 + LABEL_PX * 1.5 + _labels_width(rt, rd, chart.right) + 6
+            rt, _ = _ticks(chart.right, rlim, plot_h, 45)
+            right = 10 + LABEL_PX * 1.5 + _labels_width(rt) + 6
         if chart.colour_scale is not None:
             cs = chart.colour_scale
             ct, cd = nice_ticks(cs.lo, cs.hi, 5)
@@ -325,7 +325,7 @@ def _body(
     return "\n".join(out) + "\n", width, height
 
 
-def chart_margin(chart: Chart) -> float:
+def _chart_margin(chart: Chart) -> float:
     """The y margin: room above bars for their labels when the chart writes some."""
     labels = any(isinstance(layer, Text) for layer in chart.layers)
     bars = any(isinstance(layer, Bars) for layer in chart.layers)
@@ -348,8 +348,7 @@ def _ticks(
     return [(float(v), tick_text(float(v), decimals)) for v in values], decimals
 
 
-def _labels_width(ticks: list[tuple[float, str]], decimals: int, axis: object) -> float:
-    del decimals, axis
+def _labels_width(ticks: list[tuple[float, str]]) -> float:
     return max((text_width(t, TICK_PX) for _, t in ticks), default=0.0)
 
 
