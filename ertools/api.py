@@ -311,7 +311,8 @@ def timeline(paths: PathLike | Sequence[PathLike], *, check_clocks: bool = True)
 
 
 def figures(result: Any) -> list[Any]:
-    """The figures of a result as matplotlib Figures, those ``--plot`` and the reports draw:
+    """The figures of a result as matplotlib Figures, the charts ``--plot`` and the reports
+    draw (reports write them as SVG without matplotlib; here matplotlib draws the same charts):
     a benchmark's result (its runs, paths, errors); an audit (the state machines' timeline,
     runs shaded, findings marked); a timeline (one panel per session with the problems
     listed, then the whole day on one axis).

@@ -1,7 +1,10 @@
 """Figures as data: a benchmark says what to draw, this module decides where it goes.
 
-Drawing functions take a matplotlib ``Axes``; nothing here selects a backend or uses pyplot,
-so importing ertools never changes matplotlib's global state.
+A figure is either a :class:`~ertools.report.chart.Chart` built from the result (written as
+SVG by :mod:`ertools.report.svg`, without matplotlib: the reports' figures) or, for the
+figures not converted yet, a function drawing on a matplotlib ``Axes``. A chart is drawn by
+matplotlib too when a user asks for a PNG or PDF (``--plot fig.png``). Nothing here selects a
+backend or uses pyplot, so importing ertools never changes matplotlib's global state.
 """
 
 from __future__ import annotations
@@ -17,6 +20,8 @@ import numpy as np
 
 from ertools import atomic
 from ertools.benchmarks import registry
+from ertools.report import chart_mpl, svg
+from ertools.report.chart import Chart
 
 # Results that are not a registered benchmark's -> ``module:function`` giving their figures
 # (a benchmark names its own: :attr:`ertools.benchmarks.base.Benchmark.figures`).
@@ -25,12 +30,28 @@ OTHER_FIGURES: dict[str, str] = {"noise": "ertools.report.plots_noise:figure_spe
 
 @dataclass(frozen=True)
 class FigureSpec:
-    """One figure: a file stem, a title, a size and a function drawing on one Axes."""
+    """One figure: a file stem, a title, a size and a function drawing on one Axes; for a
+    figure built as a :class:`Chart`, ``chart`` builds it for a size in inches (``draw`` then
+    draws that chart: :func:`chart_spec`)."""
 
     name: str
     title: str
     draw: Callable[[Any], None]
     size: tuple[float, float] = (7.0, 5.0)
+    chart: Callable[[tuple[float, float]], Chart] | None = None
+
+
+def chart_spec(
+    name: str,
+    title: str,
+    build: Callable[[tuple[float, float]], Chart],
+    size: tuple[float, float] = (7.0, 5.0),
+) -> FigureSpec:
+    """A figure given as a :class:`Chart` (built for the figure's size in inches, which
+    decides how far its paths are thinned)."""
+    return FigureSpec(
+        name, title, lambda ax: chart_mpl.draw(build(size_of(ax)), ax), size, chart=build
+    )
 
 
 def figure_specs(result: Any) -> list[FigureSpec]:
@@ -44,12 +65,16 @@ def figure_specs(result: Any) -> list[FigureSpec]:
     return specs
 
 
-def save_figures(specs: Sequence[FigureSpec], outdir: Path, fmt: str = "png") -> list[Path]:
-    """Draw every spec into its own file in ``outdir``; returns the paths written."""
+def save_figures(specs: Sequence[FigureSpec], outdir: Path, fmt: str | None = "png") -> list[Path]:
+    """Draw every spec into its own file in ``outdir``; returns the paths written.
+
+    ``fmt=None``: SVG for a chart (no matplotlib), PNG for a figure drawn on an Axes: what
+    report folders write."""
     outdir.mkdir(parents=True, exist_ok=True)
     written: list[Path] = []
     for spec in specs:
-        path = outdir / f"{spec.name}.{fmt}"
+        suffix = fmt or ("svg" if spec.chart is not None else "png")
+        path = outdir / f"{spec.name}.{suffix}"
         with atomic.replacing(path) as tmp:  # a kill leaves the old figure or none, never half
             render(spec, tmp)
         written.append(path)
@@ -62,7 +87,10 @@ def render(spec: FigureSpec, path: Path) -> None:
     "Report figures"): the figure is laid out and drawn once instead of twice, on a figure
     and Agg canvas kept per size and thread, so that the text metrics matplotlib caches per
     renderer (every tick label, legend entry and title) carry over from one figure to the
-    next."""
+    next. A chart asked for as ``.svg`` is written by :mod:`ertools.report.svg` instead."""
+    if spec.chart is not None and path.suffix.lower() == ".svg":
+        path.write_text(svg.render(spec.chart(spec.size), spec.size, spec.title), "utf-8")
+        return
     fig = _canvas_figure(spec.size)
     try:
         ax = fig.add_subplot()
@@ -77,7 +105,7 @@ def render(spec: FigureSpec, path: Path) -> None:
         fig.clear()
 
 
-DPI = 110
+DPI = svg.PIXELS_PER_INCH  # the pixels a figure has: what paths are thinned to
 # zlib level of the PNGs: 6 (matplotlib's) spends ~4x the time of 1 for files ~15 % smaller
 # on these flat-coloured plots (measured in docs/performance.md).
 PNG_COMPRESS_LEVEL = 3
@@ -102,19 +130,12 @@ def _canvas_figure(size: tuple[float, float]) -> Any:
 
 
 def preload() -> None:
-    """Import what drawing a figure needs and load its font, without writing anything: for a
-    process that forks one child per job (the Dask workers' :func:`ertools.rescore.parallel.
-    run_job_forked`), so that each child inherits them instead of paying ~0.5 s of CPU for
-    matplotlib's imports and font loading again."""
-    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-    from matplotlib.image import imsave  # noqa: F401  # lazy: as above (loads Pillow)
-
-    fig = Figure(figsize=(1.0, 1.0), dpi=DPI)
-    canvas: Any = FigureCanvasAgg(fig)  # matplotlib's draw is untyped
-    fig.add_subplot().set_title("0")
-    canvas.draw()
+    """Import what writing a report's figures needs, without writing anything: for a process
+    that forks one child per job (the Dask workers' :func:`ertools.rescore.parallel.
+    run_job_forked`), so that each child inherits it. The reports' figures are SVG charts
+    (no matplotlib since issue 29); one tiny chart is rendered so that the writer's code
+    paths ran once before the fork."""
+    svg.render(Chart((), note="0"), (1.0, 1.0), "0")
 
 
 def _write_png(fig: Any, path: Path) -> None:
@@ -134,7 +155,12 @@ def _write_png(fig: Any, path: Path) -> None:
 
 def save_one_file(specs: Sequence[Any], path: Path) -> Path:
     """Every spec as one panel of one figure, stacked top to bottom, in ``path`` (its suffix
-    picks the format)."""
+    picks the format; an SVG of charts only is written without matplotlib)."""
+    if specs and path.suffix.lower() == ".svg" and all(s.chart is not None for s in specs):
+        panels = [(s.chart(s.size), s.size, s.title) for s in specs]
+        path.parent.mkdir(parents=True, exist_ok=True)
+        atomic.write_text(path, svg.stack(panels))
+        return path
     from matplotlib.figure import Figure  # lazy: matplotlib only when a figure is drawn
 
     width = max((s.size[0] for s in specs), default=6.0)

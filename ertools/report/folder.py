@@ -8,7 +8,7 @@
   no network needed: inline CSS, figures as PNG files beside it;
 - ``score.yaml`` (the seed's listing), ``score.json``;
 - one CSV per table of the result (``runs.csv``, ``segments.csv``...), ``audit_*.csv``;
-- ``figures/*.png``;
+- ``figures/*.svg`` (and ``*.png`` for figures still drawn by matplotlib);
 - ``result.json``: the metadata ``ertools report`` combines (benchmark, team, inputs, the
   headline numbers and the whole score).
 
@@ -320,7 +320,7 @@ def _figures(
     out: list[tuple[Path, str]] = []
     for spec in specs:
         try:
-            out += [(p, spec.title or spec.name) for p in save_figures([spec], figdir)]
+            out += [(p, spec.title or spec.name) for p in save_figures([spec], figdir, None)]
         except Exception as err:  # a plotting bug must not cost the referee the report
             log.warning("figure %s failed: %s", spec.name, err)
             problems.append(f"figure {spec.name} could not be drawn: {err}")

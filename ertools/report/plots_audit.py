@@ -1,6 +1,5 @@
-"""The audit's figure: the three state machines over time, one lane each.
-
-Drawing only (an ``Axes`` in, nothing global); the data comes from
+"""The audit's figure: the three state machines over time, one lane each, as a
+:class:`~ertools.report.chart.Chart` (reports write it as SVG); the data comes from
 :class:`ertools.audit.model.Audit`.
 """
 
@@ -8,8 +7,11 @@ from __future__ import annotations
 
 from typing import Any
 
-from ertools.report import units
-from ertools.report.figures import FigureSpec
+import numpy as np
+
+from ertools.report import chart_mpl, units
+from ertools.report.chart import Axis, Chart, Layer, Rects, RefLine, Scatter, Span, Text
+from ertools.report.figures import FigureSpec, chart_spec
 from ertools.states import Machine
 from ertools.timeutil import ns_to_s
 
@@ -80,80 +82,89 @@ def figure_specs(audit: Any) -> list[FigureSpec]:
     # Spans the page's width (a wide figure): wide enough that its fonts stay small there.
     width = min(18.0, max(13.0, span_s / 20.0))
     return [
-        FigureSpec(
+        chart_spec(
             "audit_timeline",
             "Benchmark state timeline",
-            lambda ax: draw_timeline(ax, audit),
+            lambda size: timeline_chart(audit),
             (width, 5.0),
         )
     ]
 
 
-def draw_timeline(ax: Any, audit: Any) -> None:
-    """Gantt chart of the machines' states; runs shaded, findings marked.
-
-    Red crosses: illegal BmBox transitions; grey hatching: heartbeat silences; a red line:
-    the RefBox ended the benchmark (timeout/halt).
-    """
+def timeline_chart(audit: Any) -> Chart:
+    """Gantt chart of the machines' states, one lane per machine; runs shaded, findings
+    marked: red crosses, illegal BmBox transitions; hatching, heartbeat silences; a red
+    line, the RefBox ended the benchmark (timeout/halt)."""
     t0 = audit.start_ns
     lane = {m: i for i, m in enumerate(_LANES)}
-    # Legend: one entry per colour, naming every state drawn in it (with its machine when
-    # the name is not the BmBox's).
-    # One collection per lane and colour (a broken_barh call costs the same for one bar as
-    # for hundreds): the bars of a lane never overlap, so the picture is the same.
-    groups: dict[tuple[int, str], list[tuple[float, float]]] = {}
+    # One layer per colour, over every lane (the legend names every state drawn in it, with
+    # its machine when the name is not the BmBox's): a few layers, not one per state span.
+    spans: dict[str, list[tuple[float, float, int]]] = {}
     names: dict[str, list[str]] = {}
     for e in audit.timeline:
         colour = state_colour(e.machine, e.state_name)
-        groups.setdefault((lane[e.machine], colour), []).append(
-            (ns_to_s(e.start_ns - t0), max(ns_to_s(e.duration_ns), 0.05))
+        start = ns_to_s(e.start_ns - t0)
+        spans.setdefault(colour, []).append(
+            (start, start + max(ns_to_s(e.duration_ns), 0.05), lane[e.machine])
         )
         name = e.state_name
         if name not in STATE_COLOURS[Machine.BMBOX]:
             name = f"{name} ({e.machine.value})"
         if name not in names.setdefault(colour, []):
             names[colour].append(name)
-    handles: dict[str, Any] = {}
-    for (y, colour), spans in groups.items():
-        bar = ax.broken_barh(
-            spans,
-            (y - 0.35, 0.7),
-            facecolors=colour,
-            edgecolors="white" if colour != UNKNOWN_COLOUR else "#444444",
-            linewidth=0.4,
+    layers: list[Layer] = [
+        Span(ns_to_s(r.start_ns - t0), ns_to_s(r.end_ns - t0), "x", "#000000", 0.04)
+        for r in audit.runs
+    ]
+    for colour, found in names.items():
+        a = np.asarray(spans[colour], dtype=float)
+        layers.append(
+            Rects(
+                a[:, 0],
+                a[:, 1],
+                a[:, 2] - 0.35,
+                a[:, 2] + 0.35,
+                colour,
+                edge="#ffffff" if colour != UNKNOWN_COLOUR else "#444444",
+                label=" / ".join(found),
+            )
         )
-        handles.setdefault(colour, bar)
-    for r in audit.runs:
-        ax.axvspan(ns_to_s(r.start_ns - t0), ns_to_s(r.end_ns - t0), color="#000000", alpha=0.04)
-        ax.text(
-            ns_to_s(r.start_ns - t0),
-            len(_LANES) - 0.45,
-            f"run {r.index}",
-            fontsize=7,
-            color="#333333",
+    layers += [
+        Text(ns_to_s(r.start_ns - t0), len(_LANES) - 0.45, f"run {r.index}", "#333333")
+        for r in audit.runs
+    ]
+    if audit.silences:
+        s = audit.silences
+        starts = np.array([ns_to_s(x.start_ns - t0) for x in s])
+        ends = starts + np.array([ns_to_s(x.duration_ns) for x in s])
+        y = np.array([lane[x.machine] for x in s], dtype=float)
+        layers.append(
+            Rects(starts, ends, y - 0.45, y + 0.45, edge="#444444", hatch=True, label="silence")
         )
-    for s in audit.silences:
-        ax.broken_barh(
-            [(ns_to_s(s.start_ns - t0), ns_to_s(s.duration_ns))],
-            (lane[s.machine] - 0.45, 0.9),
-            facecolors="none",
-            edgecolors="#444444",
-            hatch="///",
+    if audit.illegal_transitions:
+        x = np.array([ns_to_s(t.t_ns - t0) for t in audit.illegal_transitions])
+        layers.append(
+            Scatter(
+                x,
+                np.full(len(x), float(lane[Machine.BMBOX])),
+                "#b42318",
+                marker="x",
+                size=6,
+                label="illegal transition",
+            )
         )
-    for x in audit.illegal_transitions:
-        ax.plot(ns_to_s(x.t_ns - t0), lane[Machine.BMBOX], "x", color="#b42318", ms=10, mew=2)
     for end in audit.early_ends:
-        ax.axvline(ns_to_s(end.t_ns - t0), color="#b42318", lw=1.5)
-        ax.text(ns_to_s(end.t_ns - t0), -0.75, end.reason, color="#b42318", fontsize=8)
-    ax.set_yticks(range(len(_LANES)), [m.value for m in _LANES])
-    ax.set_ylim(-0.9, len(_LANES) - 0.2)
-    ax.set_xlabel(units.label("time from the first state message", "time"))
-    ax.legend(
-        [handles[colour] for colour in names],
-        [" / ".join(found) for found in names.values()],
-        fontsize=7,
-        ncols=3,
-        loc="upper center",
-        bbox_to_anchor=(0.5, -0.18),
-        frameon=False,
+        at = ns_to_s(end.t_ns - t0)
+        layers.append(RefLine(at, "x", "#b42318", 1.5, "solid"))
+        layers.append(Text(at, -0.75, end.reason, "#b42318"))
+    return Chart(
+        tuple(layers),
+        x=Axis(units.label("time from the first state message", "time")),
+        y=Axis(ticks=tuple((float(i), m.value) for i, m in enumerate(_LANES)), limits=(-0.9, 2.8)),
+        grid="x",
     )
+
+
+def draw_timeline(ax: Any, audit: Any) -> None:
+    """The timeline chart drawn by matplotlib on ``ax`` (notebooks: :func:`ertools.api.figures`)."""
+    chart_mpl.draw(timeline_chart(audit), ax)

@@ -1,6 +1,7 @@
 """FBM1 figures: per-run errors and scores, ground truth vs answered poses on the table.
 
-Each draw function takes a matplotlib ``Axes``; nothing here imports pyplot.
+Each figure is a :class:`~ertools.report.chart.Chart` (lengths in mm, angles in degrees);
+reports write it as SVG (:mod:`ertools.report.svg`).
 """
 
 from __future__ import annotations
@@ -8,15 +9,37 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numpy as np
+
 from ertools.benchmarks import registry
 from ertools.report import units
-from ertools.report.figures import FigureSpec
+from ertools.report.chart import (
+    Arrows,
+    Axis,
+    Bars,
+    Chart,
+    Layer,
+    Line,
+    RefLine,
+    Scatter,
+    Text,
+)
+from ertools.report.figures import FigureSpec, chart_spec
 
 # Colours by answer quality (colour-blind safe pairs).
 _RIGHT = "#1b9e77"
 _WRONG_INSTANCE = "#e6ab02"
 _WRONG_CLASS = "#d95f02"
 _NONE = "#999999"
+_QUALITIES = (
+    (_RIGHT, "class and instance right"),
+    (_WRONG_INSTANCE, "instance wrong"),
+    (_WRONG_CLASS, "class wrong"),
+    (_NONE, "no answer / not scored"),
+)
+MM = units.factor("length", "m")
+ARROW = 0.04  # metres: heading arrows a few cm long on a ~1 m table
+_EMPTY = np.empty(0)
 
 
 def _colour(run: Any) -> str:
@@ -27,145 +50,125 @@ def _colour(run: Any) -> str:
     return _RIGHT if run.instance_ok else _WRONG_INSTANCE
 
 
-def _legend(ax: Any) -> None:
-    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
-    from matplotlib.patches import Patch
+def _quality_key() -> list[Layer]:
+    """Legend entries of the answer qualities (layers that draw nothing)."""
+    return [Bars(_EMPTY, _EMPTY, colours=(c,), label=text) for c, text in _QUALITIES]
 
-    ax.legend(
-        handles=[
-            Patch(color=_RIGHT, label="class and instance right"),
-            Patch(color=_WRONG_INSTANCE, label="instance wrong"),
-            Patch(color=_WRONG_CLASS, label="class wrong"),
-            Patch(color=_NONE, label="no answer / not scored"),
-        ],
-        fontsize="small",
-        loc="best",
+
+def scores_chart(result: Any) -> Chart:
+    """Pose score per run, coloured by the answer's quality; the mean dashed."""
+    runs = result.runs
+    xs = np.array([r.index for r in runs], dtype=float)
+    scores = np.array([r.pose_score if r.pose_score is not None else 0.0 for r in runs])
+    layers: list[Layer] = [Bars(xs, scores, 0.8, tuple(_colour(r) for r in runs))]
+    layers += [
+        Text(float(r.index), 0.02, r.status, offset=(0.0, 3.0), anchor="middle")
+        for r in runs
+        if r.status in ("failed", "aborted")
+    ]
+    if result.totals.pose_score is not None:
+        layers.append(RefLine(result.totals.pose_score, "y", "#000000", label="mean"))
+    layers += _quality_key()
+    low = min(0.0, *scores) - 0.05 if len(scores) else -0.05
+    return Chart(
+        tuple(layers),
+        x=Axis("run", ticks=tuple((float(x), str(int(x))) for x in xs)),
+        y=Axis("pose score (1 - t/2 - r/2)", limits=(low, 1.05)),
+        grid="y",
     )
 
 
-def _draw_scores(result: Any) -> Any:
-    def draw(ax: Any) -> None:
-        runs = result.runs
-        xs = [r.index for r in runs]
-        scores = [r.pose_score if r.pose_score is not None else 0.0 for r in runs]
-        ax.bar(xs, scores, color=[_colour(r) for r in runs])
-        for r in runs:
-            if r.status in ("failed", "aborted"):
-                ax.text(r.index, 0.02, r.status, rotation=90, ha="center", va="bottom")
-        if result.totals.pose_score is not None:
-            ax.axhline(result.totals.pose_score, color="k", lw=1, ls="--", label="mean")
-        ax.set_xlabel("run")
-        ax.set_ylabel("pose score (1 - t/2 - r/2)")
-        ax.set_xticks(xs)
-        ax.set_ylim(min(0.0, *scores) - 0.05, 1.05)
-        _legend(ax)
-
-    return draw
-
-
-def _draw_errors(result: Any) -> Any:
-    def draw(ax: Any) -> None:
-        runs = [r for r in result.runs if r.errors is not None]
-        xs = [r.index for r in runs]
-        trans_mm = [r.errors.trans_error_m * units.factor("length", "m") for r in runs]
-        theta = [abs(r.errors.theta_error_deg) for r in runs]
-        width = 0.4
-        ax.bar(
-            [x - width / 2 for x in xs],
-            trans_mm,
-            width,
-            color="#7570b3",
-            label=units.label("|dxy|", "length"),
-        )
-        ax.set_xlabel("run")
-        ax.set_ylabel(units.label("translation error", "length"))
-        ax.set_yscale("symlog", linthresh=10.0)
-        ax.set_xticks([r.index for r in result.runs])
-        twin = ax.twinx()
-        twin.bar(
-            [x + width / 2 for x in xs],
-            theta,
-            width,
-            color="#e7298a",
-            label=units.label("|dtheta|", "angle"),
-        )
-        twin.set_ylabel(units.label("theta error", "angle"))
-        twin.set_ylim(0, max([180.0 * 1.05, *theta]) if any(t > 20 for t in theta) else 20.0)
-        lines = ax.get_legend_handles_labels()
-        more = twin.get_legend_handles_labels()
-        ax.legend(lines[0] + more[0], lines[1] + more[1], fontsize="small", loc="upper left")
-
-    return draw
+def errors_chart(result: Any) -> Chart:
+    """Translation error (left, mm, logarithmic beyond 10 mm) and theta error (right, deg)."""
+    runs = [r for r in result.runs if r.errors is not None]
+    xs = np.array([r.index for r in runs], dtype=float)
+    trans_mm = np.array([r.errors.trans_error_m * MM for r in runs])
+    theta = np.array([abs(r.errors.theta_error_deg) for r in runs])
+    width = 0.4
+    top = max(180.0 * 1.05, *theta) if any(t > 20 for t in theta) else 20.0
+    return Chart(
+        (
+            Bars(xs - width / 2, trans_mm, width, ("#7570b3",), units.label("|dxy|", "length")),
+            Bars(
+                xs + width / 2,
+                theta,
+                width,
+                ("#e7298a",),
+                units.label("|dtheta|", "angle"),
+                side="right",
+            ),
+        ),
+        x=Axis("run", ticks=tuple((float(r.index), str(r.index)) for r in result.runs)),
+        y=Axis(units.label("translation error", "length"), include_zero=True, symlog=10.0),
+        right=Axis(units.label("theta error", "angle"), limits=(0.0, top)),
+        grid="y",
+    )
 
 
-def _draw_table(result: Any) -> Any:
-    def draw(ax: Any) -> None:
-        arrow = 0.04  # metres: heading arrows a few cm long on a ~1 m table
-        for r in result.runs:
-            g = r.gt
-            if g is None:
-                continue
-            ax.plot(*g.board_xy, marker="s", ms=5, color="#bbbbbb", ls="none")
-            ax.annotate(
-                "",
-                xy=(g.x + arrow * math.cos(g.yaw), g.y + arrow * math.sin(g.yaw)),
-                xytext=(g.x, g.y),
-                arrowprops={"arrowstyle": "->", "color": "k", "lw": 1.2},
-            )
-            ax.plot(g.x, g.y, "o", color="k", ms=4)
-            ax.text(g.x, g.y, f" {r.index}", fontsize="small", va="bottom")
-            a = r.answer
-            if a is None:
-                continue
-            th = math.radians(a.theta_deg)
-            colour = _colour(r)
-            ax.plot(a.x, a.y, "x", color=colour, ms=7, mew=2)
-            ax.annotate(
-                "",
-                xy=(a.x + arrow * math.cos(th), a.y + arrow * math.sin(th)),
-                xytext=(a.x, a.y),
-                arrowprops={"arrowstyle": "->", "color": colour, "lw": 1.2},
-            )
-            ax.plot([g.x, a.x], [g.y, a.y], color=colour, lw=0.6, ls=":")
-        ax.plot([0, 0.1], [0, 0], color="r", lw=2)
-        ax.plot([0, 0], [0, 0.1], color="g", lw=2)
-        ax.set_aspect("equal", adjustable="datalim")
-        # Drawn in metres (the results' unit), read in mm like every length of the report.
-        units.set_axis(ax, "x", "x in the table frame", "length", "m")
-        units.set_axis(ax, "y", "y in the table frame", "length", "m")
-        ax.grid(True, lw=0.3)
-        # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
-        from matplotlib.lines import Line2D
+def _arrow(x0: float, y0: float, x1: float, y1: float, colour: str) -> Arrows:
+    return Arrows(np.array([x0]), np.array([y0]), np.array([x1]), np.array([y1]), colour)
 
-        ax.legend(
-            handles=[
-                Line2D([], [], marker="o", color="k", ls="none", label="ground truth"),
-                Line2D([], [], marker="x", color=_RIGHT, ls="none", mew=2, label="answer"),
-                Line2D([], [], marker="s", color="#bbbbbb", ls="none", label="board"),
-            ],
-            fontsize="small",
-            loc="best",
-        )
 
-    return draw
+def _heading(x: float, y: float, yaw: float) -> tuple[float, float]:
+    return (x + ARROW * math.cos(yaw)) * MM, (y + ARROW * math.sin(yaw)) * MM
+
+
+def table_chart(result: Any) -> Chart:
+    """Ground truth (black, with the board's position) and each answer (coloured by its
+    quality, joined to its ground truth) on the table, headings as arrows; the table frame's
+    axes red (x) and green (y)."""
+    layers: list[Layer] = [
+        Line(np.array([0.0, 100.0]), np.zeros(2), "#ff0000", 2.0),
+        Line(np.zeros(2), np.array([0.0, 100.0]), "#008000", 2.0),
+    ]
+    gts = [(r, r.gt) for r in result.runs if r.gt is not None]
+    if gts:
+        board = np.array([g.board_xy for _, g in gts], dtype=float) * MM
+        layers.append(Scatter(board[:, 0], board[:, 1], "#bbbbbb", marker="s", label="board"))
+    for r, g in gts:
+        hx, hy = _heading(g.x, g.y, g.yaw)
+        layers.append(_arrow(g.x * MM, g.y * MM, hx, hy, "#000000"))
+        layers.append(Text(g.x * MM, g.y * MM, str(r.index), offset=(4.0, 4.0)))
+        a = r.answer
+        if a is None:
+            continue
+        colour = _colour(r)
+        hx, hy = _heading(a.x, a.y, math.radians(a.theta_deg))
+        layers += [
+            Line(np.array([g.x, a.x]) * MM, np.array([g.y, a.y]) * MM, colour, 0.6, "dotted"),
+            _arrow(a.x * MM, a.y * MM, hx, hy, colour),
+            Scatter(np.array([a.x * MM]), np.array([a.y * MM]), colour, marker="x", size=4.5),
+        ]
+    if gts:
+        xy = np.array([(g.x, g.y) for _, g in gts]) * MM
+        layers.append(Scatter(xy[:, 0], xy[:, 1], "#000000", size=3.0, label="ground truth"))
+        layers.append(Scatter(_EMPTY, _EMPTY, _RIGHT, marker="x", size=4.5, label="answer"))
+    return Chart(
+        tuple(layers),
+        x=Axis(units.label("x in the table frame", "length")),
+        y=Axis(units.label("y in the table frame", "length")),
+        equal_aspect=True,
+    )
 
 
 def figure_specs(result: Any) -> list[FigureSpec]:
     """The FBM1 figures of a result (``Fbm1Result``)."""
     label = registry.get(result.name).title
     return [
-        FigureSpec(
-            f"{result.name}_pose_scores", f"{label}: pose score per run", _draw_scores(result)
+        chart_spec(
+            f"{result.name}_pose_scores",
+            f"{label}: pose score per run",
+            lambda size: scores_chart(result),
         ),
-        FigureSpec(
+        chart_spec(
             f"{result.name}_errors",
             f"{label}: translation and theta errors",
-            _draw_errors(result),
+            lambda size: errors_chart(result),
         ),
-        FigureSpec(
+        chart_spec(
             f"{result.name}_table",
             f"{label}: ground truth (black) vs answers on the table",
-            _draw_table(result),
-            size=(7.0, 7.0),
+            lambda size: table_chart(result),
+            (7.0, 7.0),
         ),
     ]

@@ -1,4 +1,8 @@
-"""FBM2@Home figures: the robot's path with the waypoints, and the per-waypoint errors."""
+"""FBM2@Home figures: the robot's path with the waypoints, and the per-waypoint errors.
+
+Each figure is a :class:`~ertools.report.chart.Chart` (lengths in mm, angles in degrees),
+built for its size (the path thinned to its pixels); reports write it as SVG.
+"""
 
 from __future__ import annotations
 
@@ -7,97 +11,130 @@ from typing import Any
 import numpy as np
 
 from ertools.report import units
-from ertools.report.figures import FigureSpec, size_of, thin_path
+from ertools.report.chart import (
+    COLOURS,
+    Arrows,
+    Axis,
+    Bars,
+    Chart,
+    Layer,
+    Line,
+    RefLine,
+    Scatter,
+    Text,
+)
+from ertools.report.figures import FigureSpec, chart_spec, thin_path
 
 ARROW = 0.25  # metres: length of the heading arrows on the path figure
+MM = units.factor("length", "m")
+DEG = units.factor("angle", "rad")
+PATH_SIZE = (7.0, 6.0)
 
 
-def _arrows(ax: Any, xyt: np.ndarray, color: str, label: str, marker: str) -> None:
-    ax.scatter(xyt[:, 0], xyt[:, 1], color=color, marker=marker, s=60, zorder=3, label=label)
-    ax.quiver(
-        xyt[:, 0],
-        xyt[:, 1],
-        np.cos(xyt[:, 2]),
-        np.sin(xyt[:, 2]),
-        color=color,
-        angles="xy",
-        scale_units="xy",
-        scale=1.0 / ARROW,
-        width=0.006,
-        zorder=3,
+def _poses(xyt: np.ndarray, colour: str, label: str, marker: Any) -> list[Layer]:
+    """Markers at the poses and an arrow along each heading."""
+    x, y = xyt[:, 0] * MM, xyt[:, 1] * MM
+    return [
+        Scatter(x, y, colour, marker=marker, size=5.0, label=label),
+        Arrows(
+            x, y, x + np.cos(xyt[:, 2]) * ARROW * MM, y + np.sin(xyt[:, 2]) * ARROW * MM, colour
+        ),
+    ]
+
+
+def path_chart(result: Any, size: tuple[float, float] = PATH_SIZE) -> Chart:
+    """Path on the testbed frame, waypoints with target headings, reached poses."""
+    layers: list[Layer] = []
+    path = thin_path(np.asarray(result.path_xyyaw, dtype=float).reshape(-1, 3), size)
+    if len(path):
+        layers.append(
+            Line(path[:, 0] * MM, path[:, 1] * MM, "#8c8c8c", 1.0, label="robot path (GT)")
+        )
+    targets = np.array([s.target for s in result.segments], dtype=float).reshape(-1, 3)
+    layers += _poses(targets, COLOURS["blue"], "waypoint (target heading)", "o")
+    reached = np.array(
+        [s.robot for s in result.segments if s.robot is not None], dtype=float
+    ).reshape(-1, 3)
+    if len(reached):
+        layers += _poses(reached, COLOURS["red"], "robot when reached", "x")
+    layers += [
+        Text(s.target[0] * MM, s.target[1] * MM, str(s.index), COLOURS["blue"], offset=(7.0, 7.0))
+        for s in result.segments
+    ]
+    if result.goal.starting_pose is not None:
+        sx, sy, _ = result.goal.starting_pose
+        layers.append(
+            Scatter(
+                np.array([sx * MM]),
+                np.array([sy * MM]),
+                COLOURS["green"],
+                marker="s",
+                size=4.0,
+                label="starting pose",
+            )
+        )
+    return Chart(
+        tuple(layers),
+        x=Axis(units.label("x in the testbed frame", "length")),
+        y=Axis(units.label("y in the testbed frame", "length")),
+        equal_aspect=True,
     )
 
 
-def draw_path(result: Any, ax: Any) -> None:
-    """Path on the testbed frame, waypoints with target headings, reached poses."""
-    path = thin_path(result.path_xyyaw, size_of(ax))
-    if len(path):
-        ax.plot(path[:, 0], path[:, 1], color="0.55", lw=1.0, label="robot path (GT)")
-    targets = np.array([s.target for s in result.segments], dtype=float)
-    _arrows(ax, targets, "tab:blue", "waypoint (target heading)", "o")
-    reached = np.array([s.robot for s in result.segments if s.robot is not None], dtype=float)
-    if len(reached):
-        _arrows(ax, reached, "tab:red", "robot when reached", "x")
-    for s in result.segments:
-        ax.annotate(
-            str(s.index),
-            s.target[:2],
-            textcoords="offset points",
-            xytext=(6, 6),
-            color="tab:blue",
-        )
-    if result.goal.starting_pose is not None:
-        sx, sy, _ = result.goal.starting_pose
-        ax.scatter([sx], [sy], color="tab:green", marker="s", s=40, label="starting pose")
-    ax.set_aspect("equal", adjustable="datalim")
-    # Drawn in metres (the results' unit), read in mm like every length of the report.
-    units.set_axis(ax, "x", "x in the testbed frame", "length", "m")
-    units.set_axis(ax, "y", "y in the testbed frame", "length", "m")
-    ax.grid(True, alpha=0.3)
-    ax.legend(loc="best", fontsize="small")
-
-
-def draw_errors(result: Any, ax: Any) -> None:
-    """Distance error (bars, left axis) and orientation error (right axis) per waypoint."""
-    idx = np.array([s.index for s in result.segments])
+def errors_chart(result: Any) -> Chart:
+    """Distance error (bars, left axis) and orientation error (right axis) per waypoint;
+    dashed: the accuracies the benchmark counts against."""
+    idx = np.array([s.index for s in result.segments], dtype=float)
     dist = np.array(
         [np.nan if s.distance_error is None else s.distance_error for s in result.segments]
     )
     ori = np.array(
         [np.nan if s.orientation_error is None else s.orientation_error for s in result.segments]
     )
-    mm = units.factor("length", "m")
-    deg = units.factor("angle", "rad")
-    ax.bar(idx - 0.2, dist * mm, width=0.4, color="tab:blue", label="distance error")
-    ax.set_xlabel("waypoint")
-    ax.set_ylabel(units.label("distance error", "length"), color="tab:blue")
-    ax.set_xticks(idx)
-    right = ax.twinx()
-    right.bar(idx + 0.2, ori * deg, width=0.4, color="tab:orange", label="orientation error")
-    right.set_ylabel(units.label("orientation error", "angle"), color="tab:orange")
+    blue, orange = COLOURS["blue"], COLOURS["orange"]
+    layers: list[Layer] = [
+        Bars(idx - 0.2, dist * MM, 0.4, (blue,), "distance error"),
+        Bars(idx + 0.2, ori * DEG, 0.4, (orange,), "orientation error", side="right"),
+    ]
     if result.position_accuracy is not None:
-        ax.axhline(result.position_accuracy * mm, color="tab:blue", ls="--", lw=1)
+        layers.append(RefLine(result.position_accuracy * MM, "y", blue, label="position accuracy"))
     if result.orientation_accuracy is not None:
-        right.axhline(result.orientation_accuracy * deg, color="tab:orange", ls="--", lw=1)
-    for i in idx[np.isnan(dist)]:
-        ax.annotate("no score", (i, 0), ha="center", va="bottom", color="tab:red")
-    ax.grid(True, axis="y", alpha=0.3)
+        layers.append(
+            RefLine(
+                result.orientation_accuracy * DEG,
+                "y",
+                orange,
+                label="orientation accuracy",
+                side="right",
+            )
+        )
+    layers += [
+        Text(float(i), 0.0, "no score", COLOURS["red"], offset=(0.0, 3.0), anchor="middle")
+        for i in idx[np.isnan(dist)]
+    ]
+    return Chart(
+        tuple(layers),
+        x=Axis("waypoint", ticks=tuple((float(i), str(int(i))) for i in idx)),
+        y=Axis(units.label("distance error", "length"), colour=blue, include_zero=True),
+        right=Axis(units.label("orientation error", "angle"), colour=orange, include_zero=True),
+        grid="y",
+    )
 
 
 def figure_specs(result: Any) -> list[FigureSpec]:
     """The path and the errors figures of an ``Fbm2hResult``."""
     mode = "2015 orientation" if result.orientation_2015 else "orientation wrapped to [0, pi]"
     return [
-        FigureSpec(
+        chart_spec(
             "fbm2h_path",
             f"FBM2@Home path and waypoints (reached: {result.reached_method})",
-            lambda ax: draw_path(result, ax),
-            (7.0, 6.0),
+            lambda size: path_chart(result, size),
+            PATH_SIZE,
         ),
-        FigureSpec(
+        chart_spec(
             "fbm2h_errors",
             f"Errors per waypoint (dashed: accuracy; {mode})",
-            lambda ax: draw_errors(result, ax),
+            lambda size: errors_chart(result),
             (7.0, 4.5),
         ),
     ]

@@ -1,148 +1,177 @@
-"""FBM3@Work figures: each run's path in its run frame, the runs' errors, the d_min sweep."""
+"""FBM3@Work figures: each run's path in its run frame, the runs' errors, the d_min sweep.
+
+Each figure is a :class:`~ertools.report.chart.Chart` in millimetres, built for its size
+(paths thinned to its pixels); reports write it as SVG (:mod:`ertools.report.svg`).
+"""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 import numpy as np
 
 from ertools.report import units
-from ertools.report.figures import FigureSpec, size_of, thin_path
+from ertools.report.chart import (
+    COLOURS,
+    CYCLE,
+    Axis,
+    Bars,
+    Chart,
+    ColourScale,
+    Layer,
+    Line,
+    RefLine,
+    Scatter,
+    Text,
+)
+from ertools.report.figures import FigureSpec, chart_spec, thin_path
 
 MM = units.factor("length", "m")
+RUN_SIZE = (8.0, 5.5)
+VECTORS = 25  # about this many "compared with" vectors per run: enough to read, few to clutter
 
 
-def draw_run(run: Any, ax: Any) -> None:
-    """Target and measured path in the run frame (mm); kept samples coloured by their error."""
+def run_chart(run: Any, size: tuple[float, float] = RUN_SIZE) -> Chart:
+    """Target and measured path in the run frame (mm); kept samples coloured by their error,
+    a few of them joined to the target point they are compared with."""
     score = run.score
+    layers: list[Layer] = []
     if run.target_dense is not None:
-        t = thin_path(np.asarray(run.target_dense) * MM, size_of(ax))
-        ax.plot(t[:, 0], t[:, 1], color="black", lw=1.2, label=f"target ({run.spec})")
+        t = thin_path(np.asarray(run.target_dense) * MM, size)
+        layers.append(Line(t[:, 0], t[:, 1], "#000000", 1.2, label=f"target ({run.spec})"))
     if run.frame_xy is not None:
-        m = thin_path(np.asarray(run.frame_xy) * MM, size_of(ax))
-        ax.plot(m[:, 0], m[:, 1], color="0.65", lw=0.6, label="measured (every sample)")
+        m = thin_path(np.asarray(run.frame_xy) * MM, size)
+        layers.append(Line(m[:, 0], m[:, 1], "#a6a6a6", 0.6, label="measured (every sample)"))
+    scale = None
     if score is not None:
-        k = score.kept_frame * MM
-        dots = ax.scatter(
-            k[:, 0],
-            k[:, 1],
-            c=score.errors * MM,
-            cmap="viridis",
-            s=7,
-            zorder=3,
-            label=f"kept samples ({len(k)}, d_min {run.d_min * MM:g} mm)",
+        k = np.asarray(score.kept_frame) * MM
+        errors = np.asarray(score.errors) * MM
+        if len(errors):
+            scale = ColourScale(
+                units.label("error", "length"), float(np.min(errors)), float(np.max(errors))
+            )
+        layers.append(
+            Scatter(
+                k[:, 0],
+                k[:, 1],
+                values=errors,
+                size=2.5,
+                label=f"kept samples ({len(k)}, d_min {run.d_min * MM:g} mm)",
+            )
         )
-        ax.figure.colorbar(dots, ax=ax, label=units.label("error", "length"), shrink=0.8)
-        # a few error vectors: each kept point is compared with the target at its l/L
-        step = max(1, len(k) // 25)
-        tg = score.target * MM
+        # a few error vectors: each kept point is compared with the target at its l/L;
+        # one line broken by NaN rows draws them all
+        step = max(1, len(k) // VECTORS)
+        tg = np.asarray(score.target) * MM
         i = np.arange(step, len(k), step)
-        # one line broken by NaN rows: one artist for every vector
         vectors = np.full((len(i), 3, 2), np.nan)
         vectors[:, 0], vectors[:, 1] = k[i, :2], tg[i, :2]
         flat = vectors.reshape(-1, 2)
-        ax.plot(flat[:, 0], flat[:, 1], color="tab:red", lw=0.6, label="compared with target(l/L)")
-        ax.scatter([0.0], [0.0], marker="s", color="tab:green", s=30, zorder=4, label="start")
+        layers.append(
+            Line(flat[:, 0], flat[:, 1], COLOURS["red"], 0.6, label="compared with target(l/L)")
+        )
+        layers.append(
+            Scatter(np.zeros(1), np.zeros(1), COLOURS["green"], marker="s", size=4, label="start")
+        )
         if run.reference_xy is not None:
             ref = score.frame.to_frame(np.asarray([run.reference_xy])) * MM
-            ax.scatter(
-                ref[:, 0], ref[:, 1], marker="^", color="tab:red", s=30, zorder=4, label="reference"
+            layers.append(
+                Scatter(
+                    ref[:, 0], ref[:, 1], COLOURS["red"], marker="^", size=4.5, label="reference"
+                )
             )
-    ax.set_xlabel(
-        units.label("x in the run frame", "length")
-        + ": origin at the start, x along reference -> start"
+    return Chart(
+        tuple(layers),
+        x=Axis(
+            units.label("x in the run frame", "length")
+            + ": origin at the start, x along reference -> start"
+        ),
+        y=Axis(units.label("y in the run frame", "length")),
+        equal_aspect=True,
+        colour_scale=scale,
+        note=None if layers else "no path for this run",
     )
-    ax.set_ylabel(units.label("y in the run frame", "length"))
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.grid(True, lw=0.3)
-    ax.legend(loc="best", fontsize="small")
 
 
-def draw_runs(result: Any, ax: Any) -> None:
-    """distance_error per run (mm); the best run highlighted, unscored runs labelled."""
+def runs_chart(result: Any) -> Chart:
+    """distance_error per run (mm); the best run highlighted, unscored runs labelled, each
+    shape's floor dotted over its bar."""
     best = result.best_run
-    idx = [r.index for r in result.runs]
-    values = [(r.distance_error or 0.0) * MM for r in result.runs]
-    colors = ["tab:green" if r.index == best else "tab:blue" for r in result.runs]
-    bars = ax.bar(idx, values, color=colors)
-    for bar, r in zip(bars, result.runs, strict=True):
+    idx = np.array([r.index for r in result.runs], dtype=float)
+    values = np.array([(r.distance_error or 0.0) * MM for r in result.runs])
+    colours = tuple(COLOURS["green"] if r.index == best else COLOURS["blue"] for r in result.runs)
+    layers: list[Layer] = [Bars(idx, values, 0.8, colours)]
+    for x, v, r in zip(idx, values, result.runs, strict=True):
         if r.distance_error is None:
-            label = f"{r.spec}\n{r.status}"
+            text = f"{r.spec}\n{r.status}"
         else:
-            label = f"{r.spec}\n{r.distance_error * MM:.2f}"
-        ax.annotate(
-            label,
-            (bar.get_x() + bar.get_width() / 2, bar.get_height()),
-            ha="center",
-            va="bottom",
-            fontsize="small",
-        )
+            text = f"{r.spec}\n{r.distance_error * MM:.2f}"
+        layers.append(Text(float(x), float(v), text, offset=(0.0, 3.0), anchor="middle"))
         floor = getattr(r, "shape_floor", None)
         if floor:
-            ax.hlines(
-                floor * MM,
-                bar.get_x(),
-                bar.get_x() + bar.get_width(),
-                colors="0.3",
-                linestyles=":",
-                lw=1,
+            layers.append(
+                RefLine(floor * MM, "y", "#4d4d4d", 1.0, "dotted", lo=x - 0.4, hi=x + 0.4)
             )
-    ax.set_xticks(idx)
-    ax.set_xlabel("run")
-    ax.set_ylabel(units.label("distance_error", "length"))
-    ax.margins(y=0.2)
-    ax.grid(True, axis="y", lw=0.3)
+    return Chart(
+        tuple(layers),
+        x=Axis("run", ticks=tuple((float(i), str(int(i))) for i in idx)),
+        y=Axis(units.label("distance_error", "length"), include_zero=True),
+        grid="y",
+        legend=False,
+    )
 
 
-def draw_sweep(result: Any, ax: Any) -> None:
+def sweep_chart(result: Any) -> Chart:
     """distance_error of each run over d_min; the d_min used and the one the noise suggests."""
-    d = np.asarray(result.sweep_values) * MM
-    for r in result.runs:
-        ys = [np.nan if e is None else e * MM for _, e in r.sweep]
+    d = np.asarray(result.sweep_values, dtype=float) * MM
+    layers: list[Layer] = []
+    for n, r in enumerate(result.runs):
         if r.sweep:
-            ax.plot(d, ys, marker="o", ms=3, label=f"run {r.index} ({r.spec})")
-    ax.axvline(result.d_min * MM, color="0.3", ls="--", lw=1, label="d_min used")
+            ys = np.array([np.nan if e is None else e * MM for _, e in r.sweep])
+            colour = CYCLE[n % len(CYCLE)]
+            layers.append(Line(d, ys, colour, 1.5, label=f"run {r.index} ({r.spec})", marker="o"))
+    layers.append(RefLine(result.d_min * MM, "x", "#4d4d4d", 1.0, "dashed", "d_min used"))
     noise = result.noise
     if noise is not None and np.isfinite(noise.suggested_d_min):
-        ax.axvline(
-            noise.suggested_d_min * MM,
-            color="tab:red",
-            ls=":",
-            lw=1,
-            label=f"suggested ({noise.c:g} eps)",
+        layers.append(
+            RefLine(
+                noise.suggested_d_min * MM,
+                "x",
+                COLOURS["red"],
+                1.0,
+                "dotted",
+                f"suggested ({noise.c:g} eps)",
+            )
         )
-    ax.set_xlabel(units.label("d_min", "length"))
-    ax.set_ylabel(units.label("distance_error", "length"))
-    ax.grid(True, lw=0.3)
-    ax.legend(loc="best", fontsize="small")
-
-
-def _bind(draw: Callable[[Any, Any], None], item: Any) -> Callable[[Any], None]:
-    return lambda ax: draw(item, ax)
+    return Chart(
+        tuple(layers),
+        x=Axis(units.label("d_min", "length")),
+        y=Axis(units.label("distance_error", "length")),
+    )
 
 
 def figure_specs(result: Any) -> list[FigureSpec]:
     """One figure per scored run, the runs' bar chart, and the sweep when there is one."""
     specs = [
-        FigureSpec(
+        chart_spec(
             f"fbm3w_run{r.index}",
             f"FBM3@Work run {r.index} ({r.spec}): distance_error {r.distance_error * MM:.3f} mm",
-            _bind(draw_run, r),
-            size=(8.0, 5.5),
+            partial(run_chart, r),
+            RUN_SIZE,
         )
         for r in result.runs
         if r.score is not None
     ]
     specs.append(
-        FigureSpec(
-            "fbm3w_runs", "FBM3@Work distance_error per run", lambda ax: draw_runs(result, ax)
+        chart_spec(
+            "fbm3w_runs", "FBM3@Work distance_error per run", lambda size: runs_chart(result)
         )
     )
     if result.sweep_values:
         specs.append(
-            FigureSpec(
-                "fbm3w_d_min_sweep", "distance_error over d_min", lambda ax: draw_sweep(result, ax)
+            chart_spec(
+                "fbm3w_d_min_sweep", "distance_error over d_min", lambda size: sweep_chart(result)
             )
         )
     return specs

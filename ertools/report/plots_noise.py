@@ -1,4 +1,5 @@
-"""Mocap noise figure: the distribution of the distance between consecutive measurements."""
+"""Mocap noise figure: the distribution of the distance between consecutive measurements, as
+a :class:`~ertools.report.chart.Chart` in mm (reports write it as SVG)."""
 
 from __future__ import annotations
 
@@ -7,51 +8,60 @@ from typing import Any
 import numpy as np
 
 from ertools.report import units
-from ertools.report.figures import FigureSpec
+from ertools.report.chart import COLOURS, Axis, Bars, Chart, Layer, RefLine
+from ertools.report.figures import FigureSpec, chart_spec
 
 MM = units.factor("length", "m")
 
 
-def draw_histogram(result: Any, ax: Any) -> None:
+def histogram_chart(result: Any) -> Chart:
     """Histogram in the 2015 tool's bins; epsilon, percentiles and the suggested d_min."""
     d = np.asarray(result.distances) * MM
+    layers: list[Layer] = []
     if d.size:
         top = max(float(np.max(d)), result.suggested_d_min * MM) * 1.05
-        bins = np.arange(0.0, top + result.bin * MM, result.bin * MM)
-        ax.hist(
-            d,
-            bins=bins,
-            color="tab:blue",
-            alpha=0.8,
-            label=f"{d.size} differing pairs ({result.lost} lost)",
+        width = result.bin * MM
+        edges = np.arange(0.0, top + width, width)
+        counts, edges = np.histogram(d, bins=edges)
+        layers.append(
+            Bars(
+                (edges[:-1] + edges[1:]) / 2,
+                counts.astype(float),
+                width,
+                (COLOURS["blue"],),
+                f"{d.size} differing pairs ({result.lost} lost)",
+            )
         )
-        ax.axvline(
-            result.epsilon * MM,
-            color="black",
-            lw=1.2,
-            label=f"epsilon {result.epsilon * MM:.3f} mm",
-        )
-        for key, style in (("95", "--"), ("99", ":")):
+        eps = result.epsilon * MM
+        layers.append(RefLine(eps, "x", "#000000", 1.2, "solid", f"epsilon {eps:.3f} mm"))
+        for key, dash in (("95", "dashed"), ("99", "dotted")):
             v = result.percentiles[key] * MM
-            ax.axvline(v, color="0.4", ls=style, lw=1, label=f"p{key} {v:.3f} mm")
-        ax.axvline(
-            result.suggested_d_min * MM,
-            color="tab:red",
-            lw=1.5,
-            label=f"suggested d_min {result.suggested_d_min * MM:.3f} mm ({result.c:g} eps)",
+            layers.append(RefLine(v, "x", "#666666", 1.0, dash, f"p{key} {v:.3f} mm"))  # type: ignore[arg-type]
+        s = result.suggested_d_min * MM
+        layers.append(
+            RefLine(
+                s,
+                "x",
+                COLOURS["red"],
+                1.5,
+                "solid",
+                f"suggested d_min {s:.3f} mm ({result.c:g} eps)",
+            )
         )
-    ax.set_xlabel(units.label("distance between consecutive measurements", "length"))
-    ax.set_ylabel("pairs")
-    ax.grid(True, lw=0.3)
-    ax.legend(loc="best", fontsize="small")
+    return Chart(
+        tuple(layers),
+        x=Axis(units.label("distance between consecutive measurements", "length")),
+        y=Axis("pairs", include_zero=True),
+        note=None if layers else "no differing pairs",
+    )
 
 
 def figure_specs(result: Any) -> list[FigureSpec]:
     scope = "stationary phases" if result.stationary else "whole recording"
     return [
-        FigureSpec(
+        chart_spec(
             "noise",
             f"Mocap noise ({scope}, {result.samples} samples)",
-            lambda ax: draw_histogram(result, ax),
+            lambda size: histogram_chart(result),
         )
     ]

@@ -1,95 +1,109 @@
 """Figures of a trajectory result: the error over time and the two paths overlaid.
 
-Each drawing function takes a matplotlib ``Axes`` and the result; nothing global is touched.
+Each figure is a :class:`~ertools.report.chart.Chart` (lengths in mm, angles in degrees, time
+in seconds), built for its size (series and paths thinned to its pixels); reports write it as
+SVG (:mod:`ertools.report.svg`).
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ertools.benchmarks.trajectory.association import GAP, TRACKING_LOST, UNCOVERED
 from ertools.report import units
-from ertools.report.figures import FigureSpec, size_of, thin_path, thin_series
+from ertools.report.chart import COLOURS, Axis, Chart, Layer, Line, RefLine, Scatter
+from ertools.report.figures import FigureSpec, chart_spec, thin_path, thin_series
 
 if TYPE_CHECKING:
     from ertools.benchmarks.trajectory.result import TrajectoryResult
 
+MM = units.factor("length", "m")
+DEG = units.factor("angle", "rad")
+TIME_AXIS = units.label("time since the first robot pose", "time")
 
-def draw_error_over_time(ax: Any, result: TrajectoryResult) -> None:
+
+def error_chart(result: TrajectoryResult, size: tuple[float, float]) -> Chart:
     """Position error (mm) per robot pose; gaps and tracking losses marked on the time axis."""
-
     m = result.matched
-    if len(m.t_ns) == 0:
-        return
-    t = (m.t_ns - m.t_ns[0]) / 1e9
-    mm = units.factor("length", "m")
-    shown = thin_series(t, m.position_error, size_of(ax)[0])
-    ax.plot(t[shown], m.position_error[shown] * mm, lw=0.8, color="C0", label="position error")
-    for code, color, label in (
-        (GAP, "C1", "GT gap"),
-        (TRACKING_LOST, "C3", "tracking lost"),
-        (UNCOVERED, "0.5", "no GT"),
-    ):
-        sel = m.status == code
-        if sel.any():
-            ax.plot(t[sel], np.zeros(int(sel.sum())), "|", ms=10, color=color, label=label)
-    if result.metrics is not None:
-        ax.axhline(
-            result.metrics.position_error * mm,
-            color="C2",
-            lw=0.8,
-            ls="--",
-            label=f"mean {result.metrics.position_error * mm:.1f} mm",
-        )
-    ax.set_xlabel(units.label("time since the first robot pose", "time"))
-    ax.set_ylabel(units.label("position error", "length"))
-    ax.legend(loc="upper right", fontsize="small")
-    ax.grid(True, alpha=0.3)
+    layers: list[Layer] = []
+    if len(m.t_ns):
+        t = (m.t_ns - m.t_ns[0]) / 1e9
+        shown = thin_series(t, m.position_error, size[0])
+        err = m.position_error[shown] * MM
+        layers.append(Line(t[shown], err, COLOURS["blue"], 0.8, label="position error"))
+        for code, colour, label in (
+            (GAP, COLOURS["orange"], "GT gap"),
+            (TRACKING_LOST, COLOURS["red"], "tracking lost"),
+            (UNCOVERED, "#808080", "no GT"),
+        ):
+            sel = m.status == code
+            if sel.any():
+                at = t[sel]
+                layers.append(
+                    Scatter(at, np.zeros(len(at)), colour, marker="|", size=6, label=label)
+                )
+        if result.metrics is not None:
+            mean = result.metrics.position_error * MM
+            layers.append(RefLine(mean, "y", COLOURS["green"], 0.8, label=f"mean {mean:.1f} mm"))
+    return Chart(
+        tuple(layers),
+        x=Axis(TIME_AXIS),
+        y=Axis(units.label("position error", "length")),
+        note=None if layers else "no robot pose matched",
+    )
 
 
-def draw_paths(ax: Any, result: TrajectoryResult) -> None:
-    """The robot's estimate and the GT, seen from above (drawn in metres, read in mm)."""
-    gt = thin_path(result.gt_path.xyz, size_of(ax))
-    ax.plot(gt[:, 0], gt[:, 1], lw=1.0, color="0.4", label="ground truth")
-    r = thin_path(result.robot.xyz, size_of(ax))
-    ax.plot(r[:, 0], r[:, 1], ".", ms=2.5, color="C0", label="robot estimate")
-    units.set_axis(ax, "x", "x", "length", "m")
-    units.set_axis(ax, "y", "y", "length", "m")
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.legend(loc="best", fontsize="small")
-    ax.grid(True, alpha=0.3)
+def paths_chart(result: TrajectoryResult, size: tuple[float, float]) -> Chart:
+    """The robot's estimate and the GT, seen from above (mm)."""
+    gt = thin_path(result.gt_path.xyz, size) * MM
+    robot = thin_path(result.robot.xyz, size) * MM
+    return Chart(
+        (
+            Line(gt[:, 0], gt[:, 1], "#666666", 1.0, label="ground truth"),
+            Scatter(robot[:, 0], robot[:, 1], COLOURS["blue"], size=1.3, label="robot estimate"),
+        ),
+        x=Axis(units.label("x", "length")),
+        y=Axis(units.label("y", "length")),
+        equal_aspect=True,
+    )
 
 
-def draw_yaw_error(ax: Any, result: TrajectoryResult) -> None:
+def yaw_chart(result: TrajectoryResult, size: tuple[float, float]) -> Chart:
     """Wrapped yaw error (degrees) per robot pose."""
     m = result.matched
-    if len(m.t_ns) == 0:
-        return
-    t = (m.t_ns - m.t_ns[0]) / 1e9
-    shown = thin_series(t, m.yaw_error, size_of(ax)[0])
-    ax.plot(t[shown], m.yaw_error[shown] * units.factor("angle", "rad"), lw=0.8, color="C4")
-    ax.set_xlabel(units.label("time since the first robot pose", "time"))
-    ax.set_ylabel(units.label("|yaw error|", "angle"))
-    ax.grid(True, alpha=0.3)
+    layers: list[Layer] = []
+    if len(m.t_ns):
+        t = (m.t_ns - m.t_ns[0]) / 1e9
+        shown = thin_series(t, m.yaw_error, size[0])
+        layers.append(Line(t[shown], m.yaw_error[shown] * DEG, COLOURS["purple"], 0.8))
+    return Chart(
+        tuple(layers),
+        x=Axis(TIME_AXIS),
+        y=Axis(units.label("|yaw error|", "angle")),
+        legend=False,
+        note=None if layers else "no robot pose matched",
+    )
 
 
 def figure_specs(result: TrajectoryResult) -> list[FigureSpec]:
     """The figures of ``ertools score trajectory --plot DIR``."""
     off = result.offset_ns / 1e9
     return [
-        FigureSpec(
+        chart_spec(
             "trajectory_error",
             f"Robot vs GT position error ({result.config.association}, offset {off:+.3f} s)",
-            lambda ax: draw_error_over_time(ax, result),
+            lambda size: error_chart(result, size),
             (8.0, 4.0),
         ),
-        FigureSpec("trajectory_paths", "Robot estimate and GT", lambda ax: draw_paths(ax, result)),
-        FigureSpec(
+        chart_spec(
+            "trajectory_paths", "Robot estimate and GT", lambda size: paths_chart(result, size)
+        ),
+        chart_spec(
             "trajectory_yaw_error",
             "Robot vs GT yaw error",
-            lambda ax: draw_yaw_error(ax, result),
+            lambda size: yaw_chart(result, size),
             (8.0, 3.5),
         ),
     ]

@@ -150,26 +150,3 @@ def display(name: str, value: Any) -> Any:
     if spec is None or not is_number(value):
         return value
     return float(value) * factor(*spec)
-
-
-def set_axis(ax: Any, which: str, text: str, quantity: str, stored: str) -> None:
-    """Label an axis with its display unit and show its ticks in that unit.
-
-    The data stays in ``stored`` units (what the results hold: metres, radians); only the
-    tick labels are converted, so a map drawn in metres reads in millimetres.
-
-    Args:
-        ax: a matplotlib Axes.
-        which: ``"x"`` or ``"y"``.
-        text: the label without its unit (``"x in the testbed frame"``).
-        quantity: a key of :data:`QUANTITIES`.
-        stored: the unit the data is drawn in.
-    """
-    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
-    from matplotlib.ticker import FuncFormatter
-
-    k = factor(quantity, stored)
-    axis = ax.xaxis if which == "x" else ax.yaxis
-    axis.set_label_text(label(text, quantity))
-    if k != 1.0:
-        axis.set_major_formatter(FuncFormatter(lambda v, _pos: f"{v * k:.6g}"))

@@ -10,6 +10,7 @@ import logging
 from pathlib import Path
 
 import pytest
+import svg_figure
 import yaml
 from stderr_text import error_messages
 
@@ -292,6 +293,13 @@ def test_plot_suffix_picks_the_format(capsys: pytest.CaptureFixture[str], tmp_pa
         code, _, err = run(capsys, "noise", STATIONARY, "--plot", tmp_path / name)
         assert code == 0, err
         assert (tmp_path / name).is_file() and (tmp_path / name).read_bytes().startswith(magic)
+    # The SVG is ertools' own chart (no matplotlib): the histogram, its axes and its lines.
+    fig = svg_figure.read(tmp_path / "h.svg")
+    assert fig.texts("title")[0].startswith("Mocap noise (")
+    assert fig.texts("xlabel") == ["distance between consecutive measurements (mm)"]
+    labels = fig.labels()
+    assert labels[0].endswith("lost)") and labels[1].startswith("epsilon ")
+    assert fig.series(labels[0]).findall("s:rect", svg_figure.NS)  # the histogram's bars
 
 
 def test_old_plot_folder_still_writes_a_folder_with_a_note(

@@ -8,6 +8,7 @@ from __future__ import annotations
 import base64
 import subprocess
 import sys
+import xml.etree.ElementTree as ET
 from html.parser import HTMLParser
 from pathlib import Path
 
@@ -26,7 +27,7 @@ pytestmark = pytest.mark.browser
 
 FLAGS = list(CHROMIUM_FLAGS)
 # EXECUTING_GOAL in the timeline figure (ertools.report.plots_audit: Okabe-Ito's bluish
-# green, #009E73): its presence in the screenshot proves the PNG beside the page was loaded
+# green, #009E73): its presence in the screenshot proves the SVG beside the page was loaded
 # and painted.
 EXECUTING_GOAL_RGB = (0x00, 0x9E, 0x73)
 
@@ -104,8 +105,12 @@ def test_dom_has_tables_and_images(report: Path, tmp_path: Path) -> None:
     for src in dom.imgs:
         if src.startswith("data:"):
             assert base64.b64decode(src.split(",", 1)[1])[:8] == b"\x89PNG\r\n\x1a\n"
+        elif src.endswith(".svg"):  # the reports' vector figures (issue 29)
+            root = ET.fromstring((report.parent / src).read_text(encoding="utf-8"))
+            assert root.tag == "{http://www.w3.org/2000/svg}svg", src
         else:
             assert (report.parent / src).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", src
+    assert "figures/audit_timeline.svg" in dom.imgs
 
 
 @pytest.mark.skipif(BROWSER is None, reason="chromium not installed (apt-get install chromium)")

@@ -10,6 +10,7 @@ from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
+import svg_figure
 import yaml
 from report_fakes import EVIL, fbm3w_like
 
@@ -139,15 +140,19 @@ def test_audit_report_has_timeline_figure(tmp_path: Path) -> None:
     )
     out = tmp_path / "audit"
     index = write_report(audit, out, inputs=[], argv=[])  # type: ignore[arg-type]
-    png = out / "figures" / "audit_timeline.png"
-    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    figure = svg_figure.read(out / "figures" / "audit_timeline.svg")
+    # The 2 s heartbeat silence, hatched on the BmBox lane, as long as the audit says.
+    (silence,) = figure.series("silence").findall("s:g/s:rect", svg_figure.NS)
+    ax, _ = figure.scale("x")
+    assert ax * float(silence.get("width", "nan")) == pytest.approx(2.0, abs=abs(ax) * 0.2)
+    assert figure.texts("xlabel") == ["time from the first state message (s)"]
     assert not (out / "score.yaml").exists()  # an audit with no re-score has no score
     assert yaml.safe_load((out / "audit.yaml").read_text())["runs"]["1"]["outcome"] == "timeout"
     with (out / "audit_silences.csv").open(newline="") as fh:
         (row,) = list(csv.DictReader(fh))
     assert float(row["duration"]) == pytest.approx(2.0, abs=1e-12)
     page = index.read_text(encoding="utf-8")
-    assert 'src="figures/audit_timeline.png"' in page
+    assert 'src="figures/audit_timeline.svg"' in page
     assert "EXECUTING_GOAL" in page and "TRANSMITTING_GOAL" in page
 
 
@@ -165,7 +170,7 @@ def test_report_of_score_bag_includes_its_audit(tmp_path: Path) -> None:
     write_report(fbm3w_like(), out, inputs=[bag], argv=[])
     meta = json.loads((out / "result.json").read_text())
     assert meta["audit"]["illegal_transitions"] == 1 and meta["audit"]["runs"] == 2
-    assert (out / "figures" / "audit_timeline.png").exists()
+    assert (out / "figures" / "audit_timeline.svg").exists()
 
 
 def test_report_dir_that_is_a_file(tmp_path: Path) -> None:

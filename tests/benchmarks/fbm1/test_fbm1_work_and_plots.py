@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 import pytest
+import svg_figure
 from fbm1_testkit import ITEMS_YAML, RunSpec, bodies, state_streams, write_bag, write_items
 
 from ertools.benchmarks.fbm1.benchmark import score_fbm1
@@ -13,6 +14,7 @@ from ertools.benchmarks.fbm1.runs import find_runs
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import parse_items
+from ertools.report import svg
 from ertools.states import Machine
 
 # Item 3 sits 5 cm along x and y of the board; the board at (0.3, 0.2) unrotated, so the item
@@ -69,15 +71,43 @@ def test_fbm1_figures_draw_the_answers() -> None:
     result = score_fbm1(origin, board, found, items, Fbm1Options(benchmark="fbm1w"))
     specs = {s.name: s for s in figure_specs(result)}
     assert set(specs) == {"fbm1w_pose_scores", "fbm1w_errors", "fbm1w_table"}
-    ax = Figure().add_subplot()
-    specs["fbm1w_table"].draw(ax)
+    # The reports' SVG: the answers (crosses) where the robot said, in mm on the table.
+    table = svg_figure.read(svg.render(specs["fbm1w_table"].chart((7.0, 7.0)), (7.0, 7.0)))
+    assert table.texts("xlabel") == ["x in the table frame (mm)"]
+    ax, bx = table.scale("x")
+    ay, by = table.scale("y")
+    crosses = [
+        e
+        for e in table.root.iter()
+        if e.get("class") == "marker" and e.tag.endswith("path") and "M" in e.get("d", "")
+    ]
     answers = sorted(
-        (float(line.get_xdata()[0]), float(line.get_ydata()[0]))
-        for line in ax.get_lines()
-        if line.get_marker() == "x"
+        (
+            round(ax * float(p[1]) + bx + 4.5 * abs(ax), 0),  # a cross' first stroke starts
+            round(ay * float(p[2]) + by - 4.5 * abs(ay), 0),  # 4.5 px left of and above it
+        )
+        for e in crosses
+        for p in svg_figure.PAIR.findall(e.get("d", ""))[:1]
     )
-    assert answers == [(0.35, 0.25), (0.4, 0.3)]
-    ax = Figure().add_subplot()
-    specs["fbm1w_pose_scores"].draw(ax)
-    heights = [p.get_height() for p in ax.patches]
+    assert answers == [(350.0, 250.0), (400.0, 300.0)]
+    scores = svg_figure.read(svg.render(specs["fbm1w_pose_scores"].chart((7.0, 5.0)), (7.0, 5.0)))
+    ay, _ = scores.scale("y")
+    heights = [
+        abs(ay) * float(r.get("height", "nan"))
+        for r in scores.root.iter()
+        if r.get("class") == "bar"
+    ]
+    assert heights == pytest.approx([1.0, 0.7], abs=abs(ay) * 0.2)
+    legend = [e.get("data-label") for e in scores.root.iter() if e.get("class") == "entry"]
+    assert legend == [
+        "mean",
+        "class and instance right",
+        "instance wrong",
+        "class wrong",
+        "no answer / not scored",
+    ]
+    # matplotlib draws the same chart (PNG on request).
+    ax_ = Figure().add_subplot()
+    specs["fbm1w_pose_scores"].draw(ax_)
+    heights = [p.get_height() for p in ax_.patches]
     assert heights == pytest.approx([1.0, 0.7], abs=1e-9)

@@ -6,6 +6,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import svg_figure
 from matplotlib.figure import Figure
 
 from ertools.benchmarks.fbm2h.benchmark import compute
@@ -33,20 +34,41 @@ def test_path_and_errors_figures(tmp_path: Path) -> None:
     result = _result()
     specs = figure_specs(result)
     assert [s.name for s in specs] == ["fbm2h_path", "fbm2h_errors"]
+    # A report writes both as SVG, without matplotlib.
+    paths = save_figures(specs, tmp_path, None)
+    assert [p.name for p in paths] == ["fbm2h_path.svg", "fbm2h_errors.svg"]
+    path_fig = svg_figure.read(paths[0])
+    # Read in mm like every length of the report.
+    assert path_fig.texts("xlabel") == ["x in the testbed frame (mm)"]
+    assert path_fig.texts("ylabel") == ["y in the testbed frame (mm)"]
+    # The path line is the GT path: x from 0 to 3 m on y = 0, read back through the ticks
+    # (to the 0.1 px the file is written at: ~1 mm here).
+    line, count = path_fig.polyline("robot path (GT)")
+    assert count == len(line) >= 2
+    assert np.allclose(line[0], [0.0, 0.0], atol=2.0)
+    assert np.allclose(line[-1], [3000.0, 0.0], atol=2.0)
+    assert np.allclose(line[:, 1], 0.0, atol=2.0)
+    # Both waypoints are marked and numbered, each with its heading arrow.
+    assert len(path_fig.series("waypoint (target heading)").findall("s:circle", svg_figure.NS)) == 2
+    assert [t for t in path_fig.texts("label")] == ["0", "1"]
+    assert "starting pose" in path_fig.labels()
+
+    errors = svg_figure.read(paths[1])
+    # Distance bars in mm (every length of the report): 0.1 m = 100 mm at waypoint 0 (robot
+    # at (1, 0)), 0 at waypoint 1; orientation errors on their own scale, in degrees.
+    assert errors.texts("ylabel") == ["distance error (mm)"]
+    assert errors.texts("rlabel") == ["orientation error (deg)"]
+    bars = errors.series("distance error").findall("s:rect", svg_figure.NS)
+    ay, _ = errors.scale("y")
+    heights = [abs(ay) * float(b.get("height", "nan")) for b in bars]
+    assert np.allclose(heights, [100.0, 0.0], atol=1.0)
+
+    # matplotlib draws the same charts (PNG on request, notebooks).
     fig = Figure()
     ax = fig.add_subplot()
-    specs[0].draw(ax)
-    # The path line is the GT path: x from 0 to 3 m on y = 0.
-    line = ax.lines[0].get_xydata()
-    assert np.allclose(line[0], [0.0, 0.0])
-    assert np.allclose(line[-1], [3.0, 0.0])
-    fig2 = Figure()
-    ax2 = fig2.add_subplot()
-    specs[1].draw(ax2)
-    # Distance bars in mm (every length of the report): 0.1 m = 100 mm at waypoint 0 (robot
-    # at (1, 0)), 0 at waypoint 1.
-    heights = [p.get_height() for p in ax2.patches]
+    specs[1].draw(ax)
+    heights = [p.get_height() for p in ax.patches]
     assert np.allclose(heights, [0.1 * 1000.0, 0.0])
-    assert ax2.get_ylabel() == "distance error (mm)"
-    paths = save_figures(specs, tmp_path)
-    assert all(p.stat().st_size > 1000 for p in paths)
+    assert ax.get_ylabel() == "distance error (mm)"
+    pngs = save_figures(specs, tmp_path / "png")
+    assert all(p.suffix == ".png" and p.stat().st_size > 1000 for p in pngs)
