@@ -46,6 +46,9 @@ class Fbm3wOptions:
             run, as the 2015 node did).
         stopped_runs: ``counted`` (default: a run the RefBox stopped counts in
             execution_time) or ``2015`` (its time left out, as the 2015 node did).
+        unscoreable_runs: ``null`` (default: a run whose valid ground truth cannot support a
+            score is ``unscoreable`` with no distance_error) or ``2015`` (scored from what it
+            has, as the 2015 node did, with a deviation saying how much of its path was valid).
         config: runs_specifications, d_min and shapes (None: the 2015 values,
             ``configs/fbm3w.yaml``); ``d_min`` above overrides its d_min.
 
@@ -68,6 +71,7 @@ class Fbm3wOptions:
     timeout_runs: str = "unscored"
     stopped_runs: str = "counted"
     config: Fbm3wConfig | None = None
+    unscoreable_runs: str = "null"
 
 
 TIMEOUT_RUNS = ("unscored", "2015")
@@ -89,5 +93,6 @@ def options_2015(options: Fbm3wOptions) -> Fbm3wOptions:
         options,
         timeout_runs="2015",
         stopped_runs="2015",
+        unscoreable_runs="2015",
         d_min=DEFAULT_D_MIN if options.d_min is None else options.d_min,
     )
