@@ -57,6 +57,11 @@ CODE: Mapping[str, int] = {name: code for code, name in enumerate(REASONS)}
 
 Codes = npt.NDArray[np.int8]
 
+# A tracking loss whose two ends are closer than this hid no motion: above the 0.3-1.3 mm
+# frame-to-frame noise of a still marker set on the 2015 logs, below the 6 mm a robot moving
+# at the FBM3 sample's 0.06 m/s covers in the shortest span (0.1 s).
+STILL_M = 0.002
+
 # Consecutive samples further apart than this leave a gap. The same 0.1 s as FBM2H's --max-gap
 # and the clock-offset search (clocks.py): 12 frames at 120 Hz, far above the frame jitter of
 # a recording (a few ms), well below any stretch in which a robot moves a measurable distance
@@ -252,7 +257,8 @@ def summarise(
     # Missing frames: every interval (window edges included) longer than the gap threshold.
     edges = np.concatenate([[start_ns], tw, [end_ns]]).astype(np.int64)
     dt = np.diff(edges)
-    long = dt > gap_ns
+    # an empty window misses every frame it should hold, however short it is
+    long = dt > gap_ns if tw.size else np.ones(1, dtype=bool)
     if period > 0 and long.any():
         # an interval at the window's edge has one received end, an inner one two
         inner = np.ones(dt.size, dtype=np.int64)
@@ -379,6 +385,8 @@ class GapOnPath:
         reason: as :attr:`InvalidSpan.reason`.
         start_xy, end_xy: the plot-frame (x, y) of the valid samples at its ends, None where it
             touches the window's edge (nothing was measured on that side).
+        lost: whether the tracked point may have moved unmeasured in it (:func:`lost_spans`);
+            False for a tracking loss of a point that stood still.
     """
 
     start_s: float
@@ -386,11 +394,16 @@ class GapOnPath:
     reason: str
     start_xy: tuple[float, float] | None
     end_xy: tuple[float, float] | None
+    lost: bool = True
 
 
-def gaps_on_path(validity: Validity, xy: F64 | None, origin_ns: int) -> tuple[GapOnPath, ...]:
+def gaps_on_path(
+    validity: Validity, xy: F64 | None, origin_ns: int, still_m: float = STILL_M
+) -> tuple[GapOnPath, ...]:
     """The spans of ``validity`` with their (x, y) ends in ``xy``, the window's samples in the
-    plot's frame (row 0 = the window's first sample)."""
+    plot's frame (row 0 = the window's first sample; a rotation of the window's world (x, y)
+    keeps the distances that decide ``lost``)."""
+    lost = set(lost_spans(validity, xy, still_m))
 
     def at(i: int) -> tuple[float, float] | None:
         if xy is None or i < 0 or i >= len(xy):
@@ -404,6 +417,7 @@ def gaps_on_path(validity: Validity, xy: F64 | None, origin_ns: int) -> tuple[Ga
             s.reason,
             at(s.before),
             at(s.after),
+            s in lost,
         )
         for s in validity.spans
     )

@@ -25,6 +25,7 @@ from ertools.benchmarks.common.hygiene import (
 )
 from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
 from ertools.benchmarks.common.validity import (
+    STILL_M,
     SampleMask,
     coverage,
     coverage_problem,
@@ -92,7 +93,6 @@ LONG_PATH_RATIO = 1.15
 # ends are within STILL_M of each other hid no motion. Why these values: docs/uncertainty.md.
 MIN_COVERAGE = 0.9
 MAX_INNER_GAP_S = 0.5
-STILL_M = 0.002
 
 
 def read_fbm3w_poses(paths: Sequence[Path], options: Fbm3wOptions) -> PoseStream:
