@@ -167,6 +167,8 @@ class Validity:
             poses that no GT covers).
         spans: the invalid stretches longer than the gap threshold, in time order.
         period_ns: the median frame period used to count missing frames.
+        expected: the fraction's denominator: the window's samples, the frames missing in its
+            gaps and the skipped samples outside it (default: the sum of ``counts``).
     """
 
     window: tuple[int, int]
@@ -174,11 +176,11 @@ class Validity:
     counts: I64
     spans: tuple[InvalidSpan, ...]
     period_ns: int
+    expected: int = -1
 
-    @property
-    def expected(self) -> int:
-        """Samples in the window plus the frames missing in its gaps."""
-        return self.samples + int(self.counts[GAP]) + int(self.counts[OUTSIDE_WINDOW])
+    def __post_init__(self) -> None:
+        if self.expected < 0:
+            object.__setattr__(self, "expected", int(self.counts.sum()))
 
     @property
     def valid_samples(self) -> int:
@@ -219,6 +221,19 @@ class Validity:
             )
         detail = f" ({', '.join(parts)})" if parts else ""
         return f"{label} {self.valid_fraction:.1%} valid{detail}"
+
+
+def from_codes(codes: Codes, t_ns: I64, *, gap_s: float = DEFAULT_GAP_S, nan: int = 0) -> Validity:
+    """The validity of samples whose codes a scorer assigned itself (the trajectory's robot
+    poses, by their association), over their own span; ``nan``: samples dropped before as not
+    finite, counted as such."""
+    counts = np.bincount(codes.astype(np.intp), minlength=len(REASONS)).astype(np.int64)
+    counts[NAN] += nan
+    if not len(t_ns):
+        return Validity((0, 0), 0, counts, (), 0)
+    a, b = int(t_ns[0]), int(t_ns[-1])
+    spans = _spans(t_ns, codes, a, b, round(gap_s * 1e9))
+    return Validity((a, b), len(t_ns) + nan, counts, spans, median_period_ns(t_ns))
 
 
 def median_period_ns(t_ns: I64) -> int:
