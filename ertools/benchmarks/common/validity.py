@@ -236,6 +236,45 @@ def from_codes(codes: Codes, t_ns: I64, *, gap_s: float = DEFAULT_GAP_S, nan: in
     return Validity((a, b), len(t_ns) + nan, counts, spans, median_period_ns(t_ns))
 
 
+def combine(parts: tuple[Validity, ...]) -> Validity:
+    """Several streams' validity over one window as one (FBM1's table and board bodies): the
+    counts and denominators summed, the spans of all in time order (their ``before``/``after``
+    indices stay those of their own stream)."""
+    counts = np.sum([p.counts for p in parts], axis=0).astype(np.int64)
+    return Validity(
+        (min(p.window[0] for p in parts), max(p.window[1] for p in parts)),
+        sum(p.samples for p in parts),
+        counts,
+        tuple(sorted((s for p in parts for s in p.spans), key=lambda s: s.start_ns)),
+        parts[0].period_ns,
+        sum(p.expected for p in parts),
+    )
+
+
+def has_valid(mask: SampleMask, start_ns: int, end_ns: int) -> bool:
+    """Whether a valid sample lies in [start_ns, end_ns]."""
+    lo = int(np.searchsorted(mask.t_ns, start_ns, side="left"))
+    hi = int(np.searchsorted(mask.t_ns, end_ns, side="right"))
+    return bool(np.any(mask.codes[lo:hi] == VALID))
+
+
+def unmeasured(mask: SampleMask, xyz: F64, start_ns: int, end_ns: int, still_m: float) -> bool:
+    """Whether a still body's pose in [start_ns, end_ns] was not measured: no valid sample
+    there, and either none before it or the first valid sample after it more than ``still_m``
+    from the last one before it (the body moved while unseen). A body frozen to the end of
+    the log shows no move: its repeated pose stands."""
+    if has_valid(mask, start_ns, end_ns):
+        return False
+    ok = np.flatnonzero(mask.codes == VALID)
+    k = int(np.searchsorted(mask.t_ns[ok], start_ns))
+    if k == 0:
+        return True
+    if k == len(ok):
+        return False
+    before, after = xyz[ok[k - 1]], xyz[ok[k]]
+    return bool(np.linalg.norm(after - before) > still_m)
+
+
 def median_period_ns(t_ns: I64) -> int:
     """The median positive interval of ``t_ns`` (0 when there is none)."""
     dt = np.diff(t_ns)
