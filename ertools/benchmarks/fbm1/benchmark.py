@@ -285,8 +285,9 @@ def _gt_validity(
 ) -> tuple[Validity, str | None]:
     """Both bodies' validity in the ground truth's window (the samples averaged, or those a
     lookup interpolated between: within --max-gap of its moment), and why it is no
-    measurement: a body without one valid sample there (all repeated poses of a lost marker
-    set, or NaN) that moved more than --still while unseen, or was never seen before
+    measurement: a body without one valid sample within --max-gap of the moment it stands for
+    (the window's end, the goal; or the lookup's moment), all repeated poses of a lost marker
+    set or NaN, that moved more than --still while unseen or was never seen before
     (:func:`~ertools.benchmarks.common.validity.unmeasured`)."""
     max_gap = round(options.gt.max_gap_s * NS_PER_S)
     if masks is None:
@@ -298,20 +299,19 @@ def _gt_validity(
     )
     bodies = ((masks[0], origin, "origin"), (masks[1], board, "ref_board"))
     for mask, stream, name in bodies:
-        if unmeasured(mask, stream.xyz, a, b, options.gt.still_m):
+        # the moment the ground truth stands for: the window's end (the goal) or the lookup
+        if unmeasured(mask, stream.xyz, gt.end_ns - max_gap, gt.end_ns + max_gap, options.gt.still_m):
             lo = int(np.searchsorted(mask.t_ns, a))
             hi = int(np.searchsorted(mask.t_ns, b, side="right"))
             what = ", ".join(
                 f"{int(np.sum(mask.codes[lo:hi] == c))} {REASONS[c]}"
                 for c in np.unique(mask.codes[lo:hi]).tolist()
             )
-            at = f"t={(gt.start_ns - t0_ns) / NS_PER_S:.3f} s"
-            if not lookup:
-                at += f"..{(gt.end_ns - t0_ns) / NS_PER_S:.3f} s"
             return validity, (
                 f"no valid {name} pose within {options.gt.max_gap_s:g} s of the ground truth's "
-                f"{'moment' if lookup else 'window'} {at}: {what or 'no sample'}, and it moved "
-                "while unseen (tracking lost)"
+                f"{'moment' if lookup else 'window end'} t={(gt.end_ns - t0_ns) / NS_PER_S:.3f} "
+                f"s ({what or 'no sample'} in the window), and it moved while unseen (tracking "
+                "lost)"
             )
     return validity, None
 
