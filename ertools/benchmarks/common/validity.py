@@ -258,18 +258,26 @@ def has_valid(mask: SampleMask, start_ns: int, end_ns: int) -> bool:
     return bool(np.any(mask.codes[lo:hi] == VALID))
 
 
-def unmeasured(mask: SampleMask, xyz: F64, start_ns: int, end_ns: int, still_m: float) -> bool:
+def unmeasured(
+    mask: SampleMask,
+    xyz: F64,
+    start_ns: int,
+    end_ns: int,
+    still_m: float,
+    until_ns: int | None = None,
+) -> bool:
     """Whether a still body's pose in [start_ns, end_ns] was not measured: no valid sample
     there, and either none before it or the first valid sample after it more than ``still_m``
     from the last one before it (the body moved while unseen). A body frozen to the end of
-    the log shows no move: its repeated pose stands."""
+    the log, or (``until_ns``) seen again only after the body may have been moved on purpose
+    (the run's end), shows no move: its repeated pose stands."""
     if has_valid(mask, start_ns, end_ns):
         return False
     ok = np.flatnonzero(mask.codes == VALID)
     k = int(np.searchsorted(mask.t_ns[ok], start_ns))
     if k == 0:
         return True
-    if k == len(ok):
+    if k == len(ok) or (until_ns is not None and mask.t_ns[ok[k]] > until_ns):
         return False
     before, after = xyz[ok[k - 1]], xyz[ok[k]]
     return bool(np.linalg.norm(after - before) > still_m)

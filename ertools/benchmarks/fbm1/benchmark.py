@@ -232,7 +232,9 @@ def score_run(
             **base,
         )
     warnings += [f"{where}: {w}" for w in gt_warnings]
-    validity, problem = _gt_validity(origin, board, gt, options, masks, t0_ns)
+    # the board stays while the robot looks: seen again before the result, a move is a move
+    until = run.result_ns if run.result_ns is not None else run.end_ns
+    validity, problem = _gt_validity(origin, board, gt, options, masks, t0_ns, until)
     if problem is not None and not options.rules.score_unscoreable:
         return Fbm1RunResult(
             status="unscoreable",
@@ -282,12 +284,14 @@ def _gt_validity(
     options: Fbm1Options,
     masks: tuple[SampleMask, SampleMask] | None,
     t0_ns: int = 0,
+    until_ns: int | None = None,
 ) -> tuple[Validity, str | None]:
     """Both bodies' validity in the ground truth's window (the samples averaged, or those a
     lookup interpolated between: within --max-gap of its moment), and why it is no
     measurement: a body without one valid sample within --max-gap of the moment it stands for
     (the window's end, the goal; or the lookup's moment), all repeated poses of a lost marker
-    set or NaN, that moved more than --still while unseen or was never seen before
+    set or NaN, that moved more than --still while unseen (seen again before ``until_ns``,
+    the result, after which the board may be taken away) or was never seen before
     (:func:`~ertools.benchmarks.common.validity.unmeasured`)."""
     max_gap = round(options.gt.max_gap_s * NS_PER_S)
     if masks is None:
@@ -300,7 +304,8 @@ def _gt_validity(
     bodies = ((masks[0], origin, "origin"), (masks[1], board, "ref_board"))
     for mask, stream, name in bodies:
         # the moment the ground truth stands for: the window's end (the goal) or the lookup
-        if unmeasured(mask, stream.xyz, gt.end_ns - max_gap, gt.end_ns + max_gap, options.gt.still_m):
+        window = (gt.end_ns - max_gap, gt.end_ns + max_gap)
+        if unmeasured(mask, stream.xyz, *window, options.gt.still_m, until_ns):
             lo = int(np.searchsorted(mask.t_ns, a))
             hi = int(np.searchsorted(mask.t_ns, b, side="right"))
             what = ", ".join(

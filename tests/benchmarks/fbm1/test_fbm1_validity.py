@@ -11,6 +11,7 @@ from fbm1_testkit import ITEMS_YAML, S, T0, RunSpec, bodies, run_start_s, state_
 from ertools.benchmarks.fbm1.benchmark import score_fbm1
 from ertools.benchmarks.fbm1.config import Fbm1Options
 from ertools.benchmarks.fbm1.runs import find_runs
+from ertools.benchmarks.fbm1.score import ScoreRules
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import parse_items
 from ertools.states import Machine
@@ -53,8 +54,9 @@ def _score(board_from_to: tuple[float, float], options: Fbm1Options | None = Non
 
 
 def test_lost_before_the_placement_is_unscoreable() -> None:
-    # frozen from 0.5 s (the board still beside the table) to 9.0 s: placed at 1.0 s unseen
-    _, _, result = _score((0.5, 9.0))
+    # frozen from 0.5 s (the board still beside the table) to 5.0 s, inside the run: placed at
+    # 1.0 s unseen, seen on the table again after the goal (4.0 s)
+    _, _, result = _score((0.5, 5.0))
     (run,) = result.runs
     assert run.status == "unscoreable"
     assert run.pose_score is None and run.errors is None
@@ -66,13 +68,25 @@ def test_lost_before_the_placement_is_unscoreable() -> None:
     assert any("[fbm1.unscoreable]" in d for d in result.deviations)
     d = run.to_dict(T0)
     assert d["status"] == "unscoreable" and d["unscoreable_reason"] == run.unscoreable_reason
-    # as the 2015 node: scored from the pose tf gave it, with a warning
-    _, _, legacy = _score((0.5, 9.0), Fbm1Options.for_rules("fbm1h", "2015"))
+    # as the 2015 node (its rules set --score-unscoreable): scored from the pose it had, with
+    # a warning
+    assert Fbm1Options.for_rules("fbm1h", "2015").rules.score_unscoreable
+    legacy_rules = Fbm1Options(rules=ScoreRules(score_unscoreable=True))
+    _, _, legacy = _score((0.5, 5.0), legacy_rules)
     assert legacy.runs[0].status == "scored"
     assert any(
         "2015 scored this run from a ground truth that was not measured then" in w
         for w in legacy.warnings
     )
+
+
+def test_seen_again_only_after_the_run_is_given_the_benefit() -> None:
+    # frozen beside the table until 9.0 s, after the result (6.0 s): the board may have been
+    # moved on purpose then; nothing while the robot looked shows that it moved
+    _, _, result = _score((0.5, 9.0))
+    assert result.runs[0].status == "scored"
+    assert result.runs[0].validity is not None
+    assert result.runs[0].validity.invalid_samples["tracking_lost"] > 0
 
 
 def test_lost_after_the_placement_is_scored_and_counted() -> None:
