@@ -335,7 +335,9 @@ def summarise(
     )
 
 
-def _spans(t: I64, codes: Codes, start_ns: int, end_ns: int, gap_ns: int) -> tuple[InvalidSpan, ...]:
+def _spans(
+    t: I64, codes: Codes, start_ns: int, end_ns: int, gap_ns: int
+) -> tuple[InvalidSpan, ...]:
     """The stretches between consecutive valid samples (or window edges) longer than gap_ns."""
     ok: IntArr = np.flatnonzero(codes == VALID)
     ends = np.concatenate([[start_ns], t[ok], [end_ns]]).astype(np.int64)
@@ -350,10 +352,9 @@ def _spans(t: I64, codes: Codes, start_ns: int, end_ns: int, gap_ns: int) -> tup
     for k in long.tolist():  # a handful of spans, not a loop over samples
         inside = codes[first[k] : last[k]]
         bad = inside[inside != VALID]
-        if bad.size:
-            reason = REASONS[int(np.bincount(bad.astype(np.intp)).argmax())]
-        else:
-            reason = "gap"
+        # the most frequent invalid reason inside, or a gap where nothing arrived
+        top = int(np.bincount(bad.astype(np.intp)).argmax()) if bad.size else GAP
+        reason = REASONS[top]
         out.append(
             InvalidSpan(
                 int(ends[k]), int(ends[k + 1]), reason, int(bad.size), int(idx[k]), int(idx[k + 1])

@@ -298,9 +298,7 @@ def _gt_validity(
         masks = (_mask(origin), _mask(board))
     lookup = gt.start_ns == gt.end_ns
     a, b = (gt.start_ns - max_gap, gt.end_ns + max_gap) if lookup else (gt.start_ns, gt.end_ns)
-    validity = combine(
-        tuple(summarise(m, a, b, gap_s=options.gt.max_gap_s) for m in masks)
-    )
+    validity = combine(tuple(summarise(m, a, b, gap_s=options.gt.max_gap_s) for m in masks))
     bodies = ((masks[0], origin, "origin"), (masks[1], board, "ref_board"))
     for mask, stream, name in bodies:
         # the moment the ground truth stands for: the window's end (the goal) or the lookup
@@ -438,9 +436,7 @@ def score_fbm1(
     scored = []
     masks = (_mask(origin), _mask(board))
     for run in found.runs:
-        scored.append(
-            score_run(run, items, origin, board, opts, results, t0_ns, item_tf, masks)
-        )
+        scored.append(score_run(run, items, origin, board, opts, results, t0_ns, item_tf, masks))
         if progress is not None:
             progress.advance(1)
     runs = tuple(scored)

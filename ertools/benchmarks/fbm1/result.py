@@ -178,7 +178,9 @@ class Fbm1RunResult:
             "execution_time_s": self.execution_time_s if self.execution_time_s is not None else nan,
             "goal_s": (self.goal_ns - t0_ns) / NS_PER_S if self.goal_ns is not None else nan,
             "error": self.error or "",
-            "valid_fraction": nan if self.validity is None else self.validity.fields()["valid_fraction"],
+            "valid_fraction": nan
+            if self.validity is None
+            else self.validity.fields()["valid_fraction"],
             "invalid_samples": "" if self.validity is None else cell(self.validity.invalid_samples),
             "unscoreable_reason": self.unscoreable_reason or "",
         }
@@ -234,7 +236,8 @@ class Fbm1Result:
                 line += f"; {verdict}: {r.unscoreable_reason}"
             out.append(line)
         if measured and not out:
-            out.append(f"validity: ground truth of runs {measured[0].index}-{measured[-1].index} 100.0% valid")
+            first, last = measured[0].index, measured[-1].index
+            out.append(f"validity: ground truth of runs {first}-{last} 100.0% valid")
         return out
 
     def score(self) -> dict[str, Any]:

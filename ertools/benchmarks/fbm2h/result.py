@@ -177,7 +177,7 @@ class Fbm2hResult:
             (str(s.index) if string_keys else s.index): self._segment_listing(s)
             for s in self.segments
         }
-        out = {
+        out: dict[str, Any] = {
             "position_accuracy": _num(self.position_accuracy),
             "orientation_accuracy": _num(self.orientation_accuracy),
             "execution_time": float(self.execution_time),
@@ -272,7 +272,9 @@ class Fbm2hResult:
                     "valid_fraction": None
                     if s.validity is None
                     else round(s.validity.valid_fraction, 6),
-                    "invalid_samples": "" if s.validity is None else cell(s.validity.invalid_samples),
+                    "invalid_samples": ""
+                    if s.validity is None
+                    else cell(s.validity.invalid_samples),
                     "unscoreable_reason": s.unscoreable_reason,
                 }
             )

@@ -435,7 +435,9 @@ def _score_one(
         return result(err.message, **common)
     if problem is not None and options.unscoreable_runs != "2015":
         # no number, but the path in its frame: the plot shows where the data is missing
-        return result(None, frame_xy=score.frame.to_frame(xy), sample_t_ns=poses.t_ns[lo:hi], **common)
+        return result(
+            None, frame_xy=score.frame.to_frame(xy), sample_t_ns=poses.t_ns[lo:hi], **common
+        )
     if problem is not None:
         warnings.append(
             f"run {window.index}: 2015 scored this run from {common['path_coverage']:.1%} of "

@@ -243,8 +243,7 @@ def score_streams(
         m = None
         invalid.append(
             RULE_UNSCOREABLE.deviation(
-                f"unscoreable, no statistics: {problem}; the 2015 script averaged the pairs "
-                "it had"
+                f"unscoreable, no statistics: {problem}; the 2015 script averaged the pairs it had"
             )
         )
     if m is None and evo:

@@ -6,7 +6,7 @@ repeats counted."""
 from __future__ import annotations
 
 import numpy as np
-from fbm1_testkit import ITEMS_YAML, S, T0, RunSpec, bodies, run_start_s, state_streams
+from fbm1_testkit import ITEMS_YAML, T0, RunSpec, S, bodies, run_start_s, state_streams
 
 from ertools.benchmarks.fbm1.benchmark import score_fbm1
 from ertools.benchmarks.fbm1.config import Fbm1Options
