@@ -4,6 +4,9 @@ cut by hand: the coverage, the spans and the verdict follow from where the frame
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 from fbm3w_synth import FRAME_NS, T0, one_run
@@ -12,6 +15,7 @@ from ertools.benchmarks.fbm3w.benchmark import MAX_INNER_GAP_S, MIN_COVERAGE, sc
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions, options_2015
 from ertools.benchmarks.fbm3w.path import score_path
 from ertools.benchmarks.fbm3w.runs import RunWindow
+from ertools.cli.main import main
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.configs.shapes import builtin_shapes
 from ertools.streams import PoseStream
@@ -152,3 +156,24 @@ def test_a_tracking_loss_while_moving_is_lost_path() -> None:
     assert run.unscoreable_reason is not None
     assert "(tracking_lost," in run.unscoreable_reason
     assert run.details()["invalid_samples"] == {"tracking_lost": 132}
+
+
+SAMPLE = Path(__file__).resolve().parents[3] / "sample_bags" / "fbm3w"
+
+
+def test_the_score_command_prints_validity(capsys: pytest.CaptureFixture[str]) -> None:
+    bag = SAMPLE / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
+    config = SAMPLE / "fbm3w.yaml"
+    args = ["score", "fbm3w", str(bag), "--config", str(config), "--format", "json"]
+    assert main(args) == 0
+    out, err = capsys.readouterr()
+    data = json.loads(out)
+    lines = [line for line in err.splitlines() if line.startswith("ertools: validity: ")]
+    scored = [k for k, r in data["runs_details"].items() if r["status"] == "scored"]
+    assert len(lines) == len(scored)
+    for line, k in zip(lines, scored, strict=True):
+        r = data["runs_details"][k]
+        assert line.startswith(f"ertools: validity: run {k} {r['valid_fraction']:.1%} valid")
+    # the sample's runs are covered: --unscoreable-runs 2015 changes nothing
+    assert main([*args, "--unscoreable-runs", "2015"]) == 0
+    assert json.loads(capsys.readouterr().out) == data

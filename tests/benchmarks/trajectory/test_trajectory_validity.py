@@ -3,11 +3,15 @@ with a hole cut by hand; which robot poses fall in it follows from the stamps al
 
 from __future__ import annotations
 
+import json
+from typing import Any
+
 import numpy as np
 import pytest
 
 from ertools.benchmarks.trajectory.config import SETTINGS_2015, TrajectoryConfig
 from ertools.benchmarks.trajectory.scoring import MIN_VALID_FRACTION, score_streams
+from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
 from ertools.streams import PoseStream
 
@@ -84,3 +88,19 @@ def test_a_long_hole_is_unscoreable_unless_2015() -> None:
     assert held["compared"] == 100
     assert held["invalid_samples"] == {"gap": 60}
     assert held["position_error"] is not None
+
+
+def test_the_score_command_prints_validity(
+    robotlog: dict[str, Any], capsys: pytest.CaptureFixture[str]
+) -> None:
+    args = ["score", "trajectory", str(robotlog["robot"]), str(robotlog["dir"]), "--format", "json"]
+    assert main(args) == 0
+    out, err = capsys.readouterr()
+    data = json.loads(out)
+    (line,) = [x for x in err.splitlines() if x.startswith("ertools: validity: ")]
+    assert line.startswith(f"ertools: validity: trajectory {data['valid_fraction']:.1%} valid")
+    assert data["valid_fraction"] == pytest.approx(data["compared"] / data["robot_poses"], abs=1e-6)
+    # well covered: --unscoreable 2015 changes no number
+    assert main([*args, "--unscoreable", "2015"]) == 0
+    again = json.loads(capsys.readouterr().out)
+    assert again["position_error"] == data["position_error"]
