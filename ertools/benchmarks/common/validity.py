@@ -232,8 +232,10 @@ def from_codes(codes: Codes, t_ns: I64, *, gap_s: float = DEFAULT_GAP_S, nan: in
     if not len(t_ns):
         return Validity((0, 0), 0, counts, (), 0)
     a, b = int(t_ns[0]), int(t_ns[-1])
-    spans = _spans(t_ns, codes, a, b, round(gap_s * 1e9))
-    return Validity((a, b), len(t_ns) + nan, counts, spans, median_period_ns(t_ns))
+    period = median_period_ns(t_ns)
+    # a 10 Hz robot log's own period is the gap threshold: a span needs two periods
+    spans = _spans(t_ns, codes, a, b, max(round(gap_s * 1e9), 2 * period))
+    return Validity((a, b), len(t_ns) + nan, counts, spans, period)
 
 
 def combine(parts: tuple[Validity, ...]) -> Validity:
