@@ -28,6 +28,7 @@ What each reason means in the data (the logs carry no per-frame tracking flag):
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -374,16 +375,28 @@ def lost_spans(validity: Validity, xy: F64 | None, still_m: float) -> tuple[Inva
     window's edge shows no move either (its repeated pose is the last one measured). A gap
     (nothing received) is always lost.
     """
-    out = []
-    for s in validity.spans:
-        if s.reason != "gap" and xy is not None:
-            if s.before >= 0 and s.after >= 0:
-                if float(np.hypot(*(xy[s.after, :2] - xy[s.before, :2]))) <= still_m:
-                    continue
-            elif s.samples:
-                continue
-        out.append(s)
-    return tuple(out)
+
+    def at(i: int) -> tuple[float, float] | None:
+        return None if xy is None or i < 0 else (float(xy[i, 0]), float(xy[i, 1]))
+
+    return tuple(
+        s for s in validity.spans if xy is None or span_lost(s, at(s.before), at(s.after), still_m)
+    )
+
+
+def span_lost(
+    span: InvalidSpan,
+    start_xy: tuple[float, float] | None,
+    end_xy: tuple[float, float] | None,
+    still_m: float = STILL_M,
+) -> bool:
+    """Whether the tracked point may have moved unmeasured in ``span`` (see
+    :func:`lost_spans`), from the (x, y) of its two ends (None at the window's edge)."""
+    if span.reason == "gap":
+        return True
+    if start_xy is not None and end_xy is not None:
+        return math.hypot(end_xy[0] - start_xy[0], end_xy[1] - start_xy[1]) > still_m
+    return span.samples == 0
 
 
 def coverage(validity: Validity, spans: tuple[InvalidSpan, ...] | None = None) -> float:

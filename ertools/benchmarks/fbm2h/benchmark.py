@@ -30,7 +30,14 @@ import numpy.typing as npt
 
 from ertools.benchmarks.common.arena import check_in_arena
 from ertools.benchmarks.common.hygiene import drop_invalid, frame_change_warning, frozen_around
-from ertools.benchmarks.common.validity import sample_codes, summarise, valid_near
+from ertools.benchmarks.common.validity import (
+    GapOnPath,
+    Validity,
+    sample_codes,
+    span_lost,
+    summarise,
+    valid_near,
+)
 from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, TF_2015, Fbm2hOptions
 from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, invalid_warning, load, locate_runs
 from ertools.benchmarks.fbm2h.result import Fbm2hResult, SegmentResult
@@ -155,7 +162,8 @@ def compute(
             "end_ns": end,
             "gt_offset_ns": int(poses.nearest_ns[i]),
             "result_payload": moments.payloads[i],
-            "validity": summarise(mask, start, end, gap_s=max_gap_s),
+            "validity": (validity := summarise(mask, start, end, gap_s=max_gap_s)),
+            "gaps": _gaps(validity, marker, t_mr, max_gap_s, t_rel0),
         }
         if invalid_gt[i]:
             why = (
@@ -342,6 +350,39 @@ def _accuracies(
     if not idx.size:
         return 0.0, 0.0  # 2015: sum_d = 0.0 over N, atan2(0.0, 0.0)
     return float(errs.distance.sum()) / n, errs.orientation_accuracy
+
+
+def _gaps(
+    validity: Validity,
+    marker: PoseStream,
+    t_mr: tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]],
+    max_gap_s: float,
+    origin_ns: int,
+) -> tuple[GapOnPath, ...]:
+    """The segment's invalid spans with the robot's world (x, y) at their ends (None at the
+    segment's edges, where the span counts as lost), for the path plot."""
+    if not validity.spans:
+        return ()
+    ends = np.array([t for s in validity.spans for t in (s.start_ns, s.end_ns)], dtype=np.int64)
+    at = robot_poses_at(marker, t_mr, ends, s_to_ns(max_gap_s))
+    out = []
+    for k, s in enumerate(validity.spans):
+        xy = [
+            None if idx < 0 or not at.ok[j] else (float(at.xyyaw[j, 0]), float(at.xyyaw[j, 1]))
+            for idx, j in ((s.before, 2 * k), (s.after, 2 * k + 1))
+        ]
+        out.append(
+            GapOnPath(
+                (s.start_ns - origin_ns) / 1e9,
+                (s.end_ns - origin_ns) / 1e9,
+                s.reason,
+                xy[0],
+                xy[1],
+                # at a segment's edge nothing shows the robot stood still
+                span_lost(s, xy[0], xy[1]) if None not in xy else True,
+            )
+        )
+    return tuple(out)
 
 
 def _frozen_warnings(

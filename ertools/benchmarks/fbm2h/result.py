@@ -11,7 +11,7 @@ import numpy.typing as npt
 import yaml
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
-from ertools.benchmarks.common.validity import Validity, cell
+from ertools.benchmarks.common.validity import GapOnPath, Validity, cell
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
 from ertools.fidelity import Deviation
@@ -45,6 +45,9 @@ class SegmentResult:
             moment (None when not driven).
         unscoreable_reason: why the reached moment has no valid GT (status ``no_gt``; with
             ``--unscoreable-segments 2015`` the segment is scored and this is kept).
+        gaps: the segment's invalid stretches where the path plot draws them: their times
+            (seconds from the log's first message) and the robot's world (x, y) at their ends,
+            the frame of ``Fbm2hResult.path_xyyaw``.
     """
 
     index: int
@@ -61,6 +64,7 @@ class SegmentResult:
     timeout: bool = False
     validity: Validity | None = field(default=None, compare=False)
     unscoreable_reason: str | None = None
+    gaps: tuple[GapOnPath, ...] = field(default=(), compare=False)
 
     @property
     def segment_time(self) -> float | None:

@@ -165,6 +165,12 @@ def test_frozen_gt_at_a_reached_moment_is_warned() -> None:
     assert repeats == 72  # 0.6 s at 120 Hz
     validity = refused.segments[1].validity
     assert validity is not None and validity.invalid_samples == {"tracking_lost": repeats}
+    # where the path plot draws it: from the last measurement to the reached moment (the
+    # segment's end: no valid sample after it inside the segment)
+    (gap,) = refused.segments[1].gaps
+    assert (gap.reason, gap.end_xy, gap.lost) == ("tracking_lost", None, True)
+    assert gap.start_s == (frozen_from - T0) / 1e9 and gap.end_s == (reached - T0) / 1e9
+    assert gap.start_xy is not None
     assert refused.to_dict()["status"] == "unscoreable"
     assert refused.to_dict()["details"]["segments_details"]["1"]["unscoreable_reason"]
     # as 2015 did, scored from the frozen pose, and warned
