@@ -3,10 +3,12 @@
 Every sample gets one int8 reason code (:data:`REASONS`), computed for a whole stream at once
 (:func:`sample_codes`), then summarised over a scored window (:func:`summarise`): the fraction
 of valid samples, the count of each invalid reason and the invalid spans (where the valid data
-stops and starts again, for the tables and the path plots). The benchmarks turn a summary into
-a verdict with :func:`coverage_problem` / :func:`association_problem`; a run whose valid data
-cannot support a score is ``unscoreable`` with the reason, never scored from what is left
-without saying so (docs/uncertainty.md, "Validity masks and unscoreable runs").
+stops and starts again, for the tables and the path plots). The benchmarks turn it into a
+verdict: :func:`coverage_problem` (FBM3W's path), :func:`valid_near` (FBM2H's reached moments),
+:func:`unmeasured` (FBM1's ground-truth moment), the share of valid pairs (the trajectory); a
+run whose valid data cannot support a score is ``unscoreable`` with the reason, never scored
+from what is left without saying so (docs/uncertainty.md, "Validity masks and unscoreable
+runs").
 
 What each reason means in the data (the logs carry no per-frame tracking flag):
 
@@ -14,7 +16,7 @@ What each reason means in the data (the logs carry no per-frame tracking flag):
   later stamp: Motive re-sending the last pose of a rigid body it lost
   (:func:`ertools.benchmarks.common.hygiene.identical_poses`).
 - ``gap``: frames missing where consecutive samples are more than the gap threshold apart
-  (:data:`DEFAULT_GAP_S`, the FBM2H ``--max-gap`` and clock-offset default); counted as the
+  (:data:`DEFAULT_GAP_S`, the FBM2H ``--gt-tolerance`` and clock-offset default); counted as the
   frames expected at the stream's median frame period.
 - ``outside_window``: the sample lies outside the scored window (not in the fraction's
   denominator).
