@@ -83,6 +83,8 @@ def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[
     fmt = getattr(args, "format", "yaml")
     text = result.to_yaml() if fmt == "yaml" else dump_json(document.score_json(result))
     write_text(text, getattr(args, "out", None))
+    for line in getattr(result, "validity_lines", list)():
+        note(line)
     for warning in result.warnings:
         note(f"warning: {warning}")
     for deviation in result.deviations:

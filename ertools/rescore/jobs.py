@@ -222,9 +222,12 @@ def _score(job: Job) -> Outcome:
         )
         report = str(index)
     rank = benchmark.ranking.key(result)
+    # valid data too thin for a score (issue 28): a verdict on the execution, its report kept
+    unscoreable = getattr(result, "unscoreable_reason", None)
     return Outcome(
         job.id,
-        "scored",
+        "unscoreable" if unscoreable else "scored",
+        reason=one_line(unscoreable) if unscoreable else None,
         score=score_json(result),
         rank_value=None if rank is None else float(rank),
         warnings=warnings,

@@ -42,7 +42,7 @@ UNITLESS = {
     "kept_samples", "tracking_losses", "gt_samples", "states", "class_accuracy",
     "instance_accuracy", "pose_score", "warnings", "failures", "audit findings", "item_id",
     "i", "sample", "l_norm", "count", "pairs", "lost", "transitions", "refbox_timeout",
-    "timeout", "id", "compared", "gaps",
+    "timeout", "id", "compared", "gaps", "valid_fraction", "path_coverage",
 }  # fmt: skip
 
 

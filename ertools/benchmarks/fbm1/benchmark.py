@@ -25,7 +25,18 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ertools.benchmarks.common.hygiene import frame_change_warning
+from ertools.benchmarks.common.validity import (
+    REASONS,
+    SampleMask,
+    Validity,
+    combine,
+    sample_codes,
+    summarise,
+    unmeasured,
+)
 from ertools.benchmarks.fbm1.answers import (
     Answer,
     ResultsFile,
@@ -33,7 +44,12 @@ from ertools.benchmarks.fbm1.answers import (
     parse_answer_payload,
 )
 from ertools.benchmarks.fbm1.config import BENCHMARKS, BodySources, Fbm1Options
-from ertools.benchmarks.fbm1.gt import GroundTruthError, board_motion, measure_ground_truth
+from ertools.benchmarks.fbm1.gt import (
+    GroundTruth,
+    GroundTruthError,
+    board_motion,
+    measure_ground_truth,
+)
 from ertools.benchmarks.fbm1.logs import Fbm1Logs, Fbm1Runs, load, locate_runs
 from ertools.benchmarks.fbm1.result import Fbm1Result, Fbm1RunResult
 from ertools.benchmarks.fbm1.rules import (
@@ -43,6 +59,7 @@ from ertools.benchmarks.fbm1.rules import (
     RULE_POSE_SOURCE,
     RULE_THETA_WRAP,
     RULE_TRANS_CLIP,
+    RULE_UNSCOREABLE,
 )
 from ertools.benchmarks.fbm1.runs import Fbm1Run, RunsFound
 from ertools.benchmarks.fbm1.score import MAX_POSE_ERROR_2015, names_match, pose_errors, totals
@@ -137,8 +154,12 @@ def score_run(
     results: ResultsFile | None = None,
     t0_ns: int = 0,
     item_tf: PoseStream | None = None,
+    masks: tuple[SampleMask, SampleMask] | None = None,
 ) -> Fbm1RunResult:
-    """Score one run; a run that cannot be scored comes back with status ``failed``.
+    """Score one run; a run that cannot be scored comes back with status ``failed``, one
+    whose ground truth is no measurement with status ``unscoreable``.
+
+    ``masks``: the validity codes of ``origin`` and ``board`` (computed here when None).
 
     ``item_tf``: the node's broadcasts of ``ref_board -> item`` on /tf, when logged: their
     stamps are the exact moments of the node's lookups.
@@ -211,6 +232,25 @@ def score_run(
             **base,
         )
     warnings += [f"{where}: {w}" for w in gt_warnings]
+    # the board stays while the robot looks: seen again before the result, a move is a move
+    until = run.result_ns if run.result_ns is not None else run.end_ns
+    validity, problem = _gt_validity(origin, board, gt, options, masks, t0_ns, until)
+    if problem is not None and not options.rules.score_unscoreable:
+        return Fbm1RunResult(
+            status="unscoreable",
+            item=item,
+            answer=answer,
+            gt=gt,
+            warnings=tuple(warnings),
+            validity=validity,
+            unscoreable_reason=problem,
+            **base,
+        )
+    if problem is not None:
+        warnings.append(
+            f"{where}: 2015 scored this run from a ground truth that was not measured then "
+            f"(--score-unscoreable); by default it is unscoreable: {problem}"
+        )
     if run.result_ns is not None:
         max_gap = round(options.gt.max_gap_s * NS_PER_S)
         moved = board_motion(origin, board, gt.board_xy, run.goal_ns, run.result_ns, max_gap)
@@ -226,6 +266,8 @@ def score_run(
         item=item,
         answer=answer,
         gt=gt,
+        validity=validity,
+        unscoreable_reason=problem,
         errors=errors,
         class_ok=names_match(answer.item_class, item.item_class, options.rules),
         instance_ok=names_match(answer.item_instance, item.instance, options.rules),
@@ -233,6 +275,52 @@ def score_run(
         warnings=tuple(warnings),
         **base,
     )
+
+
+def _gt_validity(
+    origin: PoseStream,
+    board: PoseStream,
+    gt: GroundTruth,
+    options: Fbm1Options,
+    masks: tuple[SampleMask, SampleMask] | None,
+    t0_ns: int = 0,
+    until_ns: int | None = None,
+) -> tuple[Validity, str | None]:
+    """Both bodies' validity in the ground truth's window (the samples averaged, or those a
+    lookup interpolated between: within --max-gap of its moment), and why it is no
+    measurement: a body without one valid sample within --max-gap of the moment it stands for
+    (the window's end, the goal; or the lookup's moment), all repeated poses of a lost marker
+    set or NaN, that moved more than --still while unseen (seen again before ``until_ns``,
+    the result, after which the board may be taken away) or was never seen before
+    (:func:`~ertools.benchmarks.common.validity.unmeasured`)."""
+    max_gap = round(options.gt.max_gap_s * NS_PER_S)
+    if masks is None:
+        masks = (_mask(origin), _mask(board))
+    lookup = gt.start_ns == gt.end_ns
+    a, b = (gt.start_ns - max_gap, gt.end_ns + max_gap) if lookup else (gt.start_ns, gt.end_ns)
+    validity = combine(tuple(summarise(m, a, b, gap_s=options.gt.max_gap_s) for m in masks))
+    bodies = ((masks[0], origin, "origin"), (masks[1], board, "ref_board"))
+    for mask, stream, name in bodies:
+        # the moment the ground truth stands for: the window's end (the goal) or the lookup
+        window = (gt.end_ns - max_gap, gt.end_ns + max_gap)
+        if unmeasured(mask, stream.xyz, *window, options.gt.still_m, until_ns):
+            lo = int(np.searchsorted(mask.t_ns, a))
+            hi = int(np.searchsorted(mask.t_ns, b, side="right"))
+            what = ", ".join(
+                f"{int(np.sum(mask.codes[lo:hi] == c))} {REASONS[c]}"
+                for c in np.unique(mask.codes[lo:hi]).tolist()
+            )
+            return validity, (
+                f"no valid {name} pose within {options.gt.max_gap_s:g} s of the ground truth's "
+                f"{'moment' if lookup else 'window end'} t={(gt.end_ns - t0_ns) / NS_PER_S:.3f} "
+                f"s ({what or 'no sample'} in the window), and it moved while unseen (tracking "
+                "lost)"
+            )
+    return validity, None
+
+
+def _mask(stream: PoseStream) -> SampleMask:
+    return sample_codes(stream.t_ns, stream.xyz, stream.quat_xyzw)
 
 
 def _deviations(
@@ -289,6 +377,15 @@ def _deviations(
                 f"theta errors wrapped fully to [-180, 180) deg; 2015 by a single 360 ({affected})"
             )
         )
+    unscoreable = [r for r in runs if r.status == "unscoreable"]
+    if unscoreable:
+        out.append(
+            RULE_UNSCOREABLE.deviation(
+                f"run(s) {', '.join(str(r.index) for r in unscoreable)} unscoreable and left "
+                "out of the totals: no valid mocap sample for their ground truth; the 2015 "
+                "node scored what tf gave it"
+            )
+        )
     if not rules.exact_names:
         out.append(
             RULE_NAMES.deviation(
@@ -337,8 +434,9 @@ def score_fbm1(
     if progress is not None:
         progress.task("scoring runs", len(found.runs), "runs")
     scored = []
+    masks = (_mask(origin), _mask(board))
     for run in found.runs:
-        scored.append(score_run(run, items, origin, board, opts, results, t0_ns, item_tf))
+        scored.append(score_run(run, items, origin, board, opts, results, t0_ns, item_tf, masks))
         if progress is not None:
             progress.advance(1)
     runs = tuple(scored)
@@ -365,6 +463,11 @@ def score_fbm1(
     if results is not None:
         warnings.extend(_unused_results(results, runs))
     failures = [r.error for r in runs if r.error]
+    failures += [
+        f"run {r.index}: unscoreable: {r.unscoreable_reason}"
+        for r in runs
+        if r.status == "unscoreable"
+    ]
     return Fbm1Result(
         name=opts.benchmark,
         runs=runs,

@@ -165,6 +165,13 @@ def inputs(name: str) -> tuple[Input, ...]:
             group=NODES,
         ),
         Input(
+            "score_unscoreable",
+            "flag",
+            "a run whose ground truth has no valid mocap sample (tracking lost) is scored from "
+            "it (both nodes)",
+            group=NODES,
+        ),
+        Input(
             "legacy_totals",
             "flag",
             "deprecated: --count-aborted, and for fbm1h --accuracy-over-10",
@@ -246,6 +253,7 @@ def options_maker(name: str) -> Callable[[Mapping[str, Any]], Fbm1Options]:
             accuracy_over_10=r.accuracy_over_10
             or v["accuracy_over_10"]
             or (old_totals and name == "fbm1h"),
+            score_unscoreable=r.score_unscoreable or v["score_unscoreable"],
         )
         if v["gt"] == "goal":
             notice(

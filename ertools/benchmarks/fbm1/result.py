@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.common.validity import Validity, cell
 from ertools.benchmarks.fbm1.answers import Answer
 from ertools.benchmarks.fbm1.gt import GroundTruth
 from ertools.benchmarks.fbm1.score import PoseErrors, Totals
@@ -29,7 +30,8 @@ class Fbm1RunResult:
         status: ``scored``, ``no_answer`` (timeout/stop, or the log ends after the goal:
             counted with score 0), ``aborted`` (the goal was never sent: not counted),
             ``unfinished`` (the BmBox states leave a run open although the log goes on past it:
-            not counted) or ``failed`` (cannot be scored: see error).
+            not counted), ``unscoreable`` (no valid mocap sample for its ground truth: not
+            counted, see unscoreable_reason) or ``failed`` (cannot be scored: see error).
         item: the presented item, None when unknown.
         item_text: the text that named it (payload or ``--items-order``).
         answer: the robot's answer, None without one.
@@ -44,6 +46,9 @@ class Fbm1RunResult:
         ended_by: ``timeout``/``stop`` when the RefBox ended the run.
         error: why the run failed.
         warnings: things to check in this run.
+        validity: both bodies' samples in the ground truth's window (None when not measured).
+        unscoreable_reason: why the ground truth is no measurement (status ``unscoreable``;
+            scored with ``--score-unscoreable`` / ``--rules 2015``, the reason kept).
     """
 
     index: int
@@ -61,6 +66,8 @@ class Fbm1RunResult:
     ended_by: str | None = None
     error: str | None = None
     warnings: tuple[str, ...] = ()
+    validity: Validity | None = field(default=None, compare=False)
+    unscoreable_reason: str | None = None
 
     @property
     def execution_time_s(self) -> float | None:
@@ -134,6 +141,10 @@ class Fbm1RunResult:
             out["failure"] = self.error
         if self.warnings:
             out["warnings"] = list(self.warnings)
+        if self.validity is not None:
+            out.update(self.validity.fields())
+        if self.unscoreable_reason is not None:
+            out["unscoreable_reason"] = self.unscoreable_reason
         return out
 
     def row(self, t0_ns: int) -> dict[str, Any]:
@@ -167,6 +178,11 @@ class Fbm1RunResult:
             "execution_time_s": self.execution_time_s if self.execution_time_s is not None else nan,
             "goal_s": (self.goal_ns - t0_ns) / NS_PER_S if self.goal_ns is not None else nan,
             "error": self.error or "",
+            "valid_fraction": nan
+            if self.validity is None
+            else self.validity.fields()["valid_fraction"],
+            "invalid_samples": "" if self.validity is None else cell(self.validity.invalid_samples),
+            "unscoreable_reason": self.unscoreable_reason or "",
         }
 
 
@@ -204,6 +220,25 @@ class Fbm1Result:
         """No run counted (scored, or without answer with score 0): no total is a number, so
         the CLI prints only the failures (``ertools.cli.common.all_failed``)."""
         return not any(r.status in ("scored", "no_answer") for r in self.runs)
+
+    def validity_lines(self) -> list[str]:
+        """The stderr lines: one per run whose ground truth's window holds invalid samples or
+        none valid, else one line saying all were valid."""
+        measured = [r for r in self.runs if r.validity is not None]
+        out = []
+        for r in measured:
+            assert r.validity is not None
+            if not r.validity.invalid_samples and r.unscoreable_reason is None:
+                continue
+            line = "validity: " + r.validity.text(f"run {r.index} ground truth", self.t0_ns)
+            if r.unscoreable_reason is not None:
+                verdict = "unscoreable" if r.status == "unscoreable" else "scored as 2015 did"
+                line += f"; {verdict}: {r.unscoreable_reason}"
+            out.append(line)
+        if measured and not out:
+            first, last = measured[0].index, measured[-1].index
+            out.append(f"validity: ground truth of runs {first}-{last} 100.0% valid")
+        return out
 
     def score(self) -> dict[str, Any]:
         """The four keys of the 2015 score payload, in the order ``yaml.dump`` sorted them."""

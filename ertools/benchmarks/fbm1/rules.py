@@ -98,3 +98,20 @@ RULE_POSE_SOURCE = Rule(
     ),
     option="--origin-tf world:origin --ref-board-tf world:ref_board",
 )
+
+RULE_UNSCOREABLE = Rule(
+    key="fbm1.unscoreable",
+    benchmark="fbm1",
+    title="ground truth without a valid mocap sample",
+    rulebook="BMmanager combines the table, board and item transforms (seed 7.1); nothing on "
+    "tracking losses",
+    node_2015=(
+        f"{NODE_SOURCE}: the tf lookup gave the last pose Motive had re-sent, measured or not"
+    ),
+    ertools=(
+        "a run with no valid sample of the table or the board (not a repeated pose of a lost "
+        "marker set, not NaN) within --max-gap of the ground truth's window is unscoreable: "
+        "left out of the totals like a failed run, the reason given (docs/uncertainty.md)"
+    ),
+    option="--score-unscoreable",
+)

@@ -30,6 +30,14 @@ import numpy.typing as npt
 
 from ertools.benchmarks.common.arena import check_in_arena
 from ertools.benchmarks.common.hygiene import drop_invalid, frame_change_warning, frozen_around
+from ertools.benchmarks.common.validity import (
+    GapOnPath,
+    Validity,
+    sample_codes,
+    span_lost,
+    summarise,
+    valid_near,
+)
 from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, TF_2015, Fbm2hOptions
 from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, invalid_warning, load, locate_runs
 from ertools.benchmarks.fbm2h.result import Fbm2hResult, SegmentResult
@@ -72,6 +80,7 @@ def compute(
     hits: int | None = None,
     orientation_2015: bool = False,
     unscored_2015: bool = False,
+    unscoreable_2015: bool = False,
     unreached: Sequence[str] = (),
     warnings: Sequence[str] = (),
     provenance: Provenance | None = None,
@@ -93,18 +102,24 @@ def compute(
     if hits is not None and hits < 0:
         raise ConfigError(f"--hits must be >= 0, got {hits}")
 
+    mask = sample_codes(marker.t_ns, marker.xyz, marker.quat_xyzw)
     marker, invalid = drop_invalid(marker)
     all_warnings = list(warnings)
     if invalid:
         all_warnings.append(invalid_warning(invalid, marker.source))
     t_mr = transform.arrays()
     poses = robot_poses_at(marker, t_mr, moments.end_ns, s_to_ns(max_gap_s))
+    # GT within the tolerance, but only repeated poses of a lost marker set (or clock jumps):
+    # the pose there was not measured then
+    invalid_gt = poses.ok[:k] & ~valid_near(mask, moments.end_ns[:k], s_to_ns(max_gap_s))
     target = goal.as_array()
     far = check_in_arena(target[:, :2], marker.xyz, what="goal.waypoints", source=goal.source)
     if far:
         all_warnings.append(far)
     errs = segment_errors(poses.xyyaw[:k], target[:k], orientation_2015=orientation_2015)
-    all_warnings.extend(_frozen_warnings(marker, moments, poses.ok[:k], max_gap_s, origin_ns))
+    # a moment refused for its invalid GT says so in its failure; scored (2015), it is warned
+    warn_at = poses.ok[:k] & (~invalid_gt | unscoreable_2015)
+    all_warnings.extend(_frozen_warnings(marker, moments, warn_at, max_gap_s, origin_ns))
     frames = frame_change_warning(marker, origin_ns)
     if frames:
         all_warnings.append(frames)
@@ -147,7 +162,26 @@ def compute(
             "end_ns": end,
             "gt_offset_ns": int(poses.nearest_ns[i]),
             "result_payload": moments.payloads[i],
+            "validity": (validity := summarise(mask, start, end, gap_s=max_gap_s)),
+            "gaps": _gaps(validity, marker, t_mr, max_gap_s, t_rel0),
         }
+        if invalid_gt[i]:
+            why = (
+                f"no valid ground truth within --gt-tolerance {max_gap_s} s of the reached "
+                f"moment {ns_to_s(end - t_rel0):.3f} s after {since}: only repeated poses of a "
+                "lost marker set (tracking lost)"
+            )
+            if not unscoreable_2015:
+                failures.append(f"segment {i}: {why} in {marker.source or 'the pose stream'}")
+                segments.append(
+                    SegmentResult(i, tgt, "no_gt", unscoreable_reason=why, **common)  # type: ignore[arg-type]
+                )
+                continue
+            all_warnings.append(
+                f"segment {i}: 2015 scored this segment from a pose that was not measured then "
+                f"(--unscoreable-segments 2015); by default it has no GT: {why}"
+            )
+            common["unscoreable_reason"] = why
         if not poses.ok[i]:
             gap = poses.nearest_ns[i]
             nearest = (
@@ -155,12 +189,15 @@ def compute(
                 if gap == np.iinfo(np.int64).max
                 else (f"nearest GT sample {gap / 1e9:.3g} s away")  # 3 digits, even below 1 ms
             )
-            failures.append(
-                f"segment {i}: no ground truth within --gt-tolerance {max_gap_s} s of the reached "
+            why = (
+                f"no ground truth within --gt-tolerance {max_gap_s} s of the reached "
                 f"moment {ns_to_s(end - t_rel0):.3f} s after {since} "
-                f"({nearest}; tracking lost?) in {marker.source or 'the pose stream'}"
+                f"({nearest}; tracking lost?)"
             )
-            segments.append(SegmentResult(i, tgt, "no_gt", **common))  # type: ignore[arg-type]
+            failures.append(f"segment {i}: {why} in {marker.source or 'the pose stream'}")
+            segments.append(
+                SegmentResult(i, tgt, "no_gt", unscoreable_reason=why, **common)  # type: ignore[arg-type]
+            )
             continue
         xyyaw = poses.xyyaw[i]
         segments.append(
@@ -315,6 +352,39 @@ def _accuracies(
     return float(errs.distance.sum()) / n, errs.orientation_accuracy
 
 
+def _gaps(
+    validity: Validity,
+    marker: PoseStream,
+    t_mr: tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]],
+    max_gap_s: float,
+    origin_ns: int,
+) -> tuple[GapOnPath, ...]:
+    """The segment's invalid spans with the robot's world (x, y) at their ends (None at the
+    segment's edges, where the span counts as lost), for the path plot."""
+    if not validity.spans:
+        return ()
+    ends = np.array([t for s in validity.spans for t in (s.start_ns, s.end_ns)], dtype=np.int64)
+    at = robot_poses_at(marker, t_mr, ends, s_to_ns(max_gap_s))
+    out = []
+    for k, s in enumerate(validity.spans):
+        xy = [
+            None if idx < 0 or not at.ok[j] else (float(at.xyyaw[j, 0]), float(at.xyyaw[j, 1]))
+            for idx, j in ((s.before, 2 * k), (s.after, 2 * k + 1))
+        ]
+        out.append(
+            GapOnPath(
+                (s.start_ns - origin_ns) / 1e9,
+                (s.end_ns - origin_ns) / 1e9,
+                s.reason,
+                xy[0],
+                xy[1],
+                # at a segment's edge nothing shows the robot stood still
+                span_lost(s, xy[0], xy[1]) if None not in xy else True,
+            )
+        )
+    return tuple(out)
+
+
 def _frozen_warnings(
     marker: PoseStream,
     moments: ReachedMoments,
@@ -372,6 +442,7 @@ def score_found(logs: Fbm2hLogs, runs: Fbm2hRuns, options: Fbm2hOptions) -> Fbm2
         hits=options.hits,
         orientation_2015=options.orientation_2015,
         unscored_2015=options.unscored_2015,
+        unscoreable_2015=options.unscoreable_2015,
         unreached=runs.unreached,
         warnings=[*logs.warnings, *runs.warnings],
         provenance=provenance,

@@ -45,6 +45,9 @@ class Fbm2hOptions:
         segment_clock: with ``reached`` states, ``client`` (a segment ends at the Client's
             COMPLETED_GOAL) or ``bmbox`` (the 2015 node's clock: BmBox messages at both ends,
             ``--segment-clock bmbox``); see :func:`ertools.benchmarks.fbm2h.segments.from_states`.
+        unscoreable_2015: a reached moment whose only ground truth within ``max_gap_s`` is
+            invalid (repeated poses of a lost marker set) is scored from it as 2015 did, with a
+            warning (``--unscoreable-segments 2015``); by default the segment has no GT.
         pose_2015: with no ``topic``/``tf_frame``, read the marker set from /tf
             ``world -> robot_at_home`` first, the 2015 node's source (``--2015``).
         exact_end_payloads: RefBox END payloads read as the 2015 BmBox did (only
@@ -73,5 +76,6 @@ class Fbm2hOptions:
     pose_2015: bool = False
     exact_end_payloads: bool = False
     namespace: str = NAMESPACE
+    unscoreable_2015: bool = False
     stops: StopParams = field(default_factory=StopParams)
     marker_transform: MarkerTransform | None = None

@@ -120,11 +120,21 @@ INPUTS = (
     ),
     Input("exact_end_payloads", "flag", EXACT_HELP, group=LEGACY),
     Input(
+        "unscoreable_segments",
+        "choice",
+        "a reached moment whose only ground truth within --gt-tolerance is invalid (repeated "
+        "poses of a lost marker set): no GT, null accuracies (default), or 2015: scored from it, "
+        "with a warning",
+        default="null",
+        choices=("null", "2015"),
+        group=LEGACY,
+    ),
+    Input(
         "all_2015",
         "flag",
         "every 2015 behaviour above (--orientation-2015 --unscored-segments 2015 "
-        "--segment-clock bmbox --exact-end-payloads) and the node's pose source, "
-        "/tf world -> robot_at_home, unless --topic or --tf is given",
+        "--unscoreable-segments 2015 --segment-clock bmbox --exact-end-payloads) and the "
+        "node's pose source, /tf world -> robot_at_home, unless --topic or --tf is given",
         flag="--2015",
         group=LEGACY,
     ),
@@ -205,6 +215,7 @@ def make_options(given: Mapping[str, Any]) -> Fbm2hOptions:
         pose_2015=bool(v["all_2015"]),
         exact_end_payloads=bool(v["exact_end_payloads"] or v["all_2015"]),
         namespace=v["namespace"],
+        unscoreable_2015=v["unscoreable_segments"] == "2015" or v["all_2015"],
         stops=StopParams(
             speed=v["stop_speed"],
             yaw_rate=v["stop_yaw_rate"],

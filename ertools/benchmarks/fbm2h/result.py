@@ -11,6 +11,7 @@ import numpy.typing as npt
 import yaml
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.common.validity import GapOnPath, Validity, cell
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
 from ertools.fidelity import Deviation
@@ -40,6 +41,13 @@ class SegmentResult:
         gt_offset_ns: time from the reached moment to the nearest GT sample.
         result_payload: the Client's COMPLETED_GOAL payload ("" when none).
         timeout: the segment ended by a RefBox timeout.
+        validity: the validity of the GT samples from the segment's start to its reached
+            moment (None when not driven).
+        unscoreable_reason: why the reached moment has no valid GT (status ``no_gt``; with
+            ``--unscoreable-segments 2015`` the segment is scored and this is kept).
+        gaps: the segment's invalid stretches where the path plot draws them: their times
+            (seconds from the log's first message) and the robot's world (x, y) at their ends,
+            the frame of ``Fbm2hResult.path_xyyaw``.
     """
 
     index: int
@@ -54,6 +62,9 @@ class SegmentResult:
     gt_offset_ns: int | None = None
     result_payload: str = ""
     timeout: bool = False
+    validity: Validity | None = field(default=None, compare=False)
+    unscoreable_reason: str | None = None
+    gaps: tuple[GapOnPath, ...] = field(default=(), compare=False)
 
     @property
     def segment_time(self) -> float | None:
@@ -79,6 +90,14 @@ def _payload_value(payload: str) -> Any:
     except yaml.YAMLError:
         return payload
     return value if isinstance(value, dict) else payload
+
+
+def _validity_keys(seg: SegmentResult) -> dict[str, Any]:
+    """The segment's validity keys, after the listing's (none for a segment never driven)."""
+    out: dict[str, Any] = {} if seg.validity is None else seg.validity.fields()
+    if seg.unscoreable_reason is not None:
+        out["unscoreable_reason"] = seg.unscoreable_reason
+    return out
 
 
 def _num(x: float | None) -> float | None:
@@ -154,6 +173,7 @@ class Fbm2hResult:
             "start_segment_time": None if seg.start_ns is None else ns_to_s(seg.start_ns),
             "target_pose": _pose_map(seg.target),
             "timeout": bool(seg.timeout) and not self.unscored_2015,
+            **_validity_keys(seg),
         }
 
     def _listing(self, string_keys: bool) -> dict[str, Any]:
@@ -161,7 +181,7 @@ class Fbm2hResult:
             (str(s.index) if string_keys else s.index): self._segment_listing(s)
             for s in self.segments
         }
-        return {
+        out: dict[str, Any] = {
             "position_accuracy": _num(self.position_accuracy),
             "orientation_accuracy": _num(self.orientation_accuracy),
             "execution_time": float(self.execution_time),
@@ -172,6 +192,43 @@ class Fbm2hResult:
                 "segments_details": details,
             },
         }
+        reason = self.unscoreable_reason
+        if reason is not None:
+            out["status"] = "unscoreable"
+            out["unscoreable_reason"] = reason
+        return out
+
+    @property
+    def unscoreable_reason(self) -> str | None:
+        """Why the accuracies are null when a reached moment had no valid ground truth (the
+        rescore's ``unscoreable`` status), None otherwise."""
+        if self.position_accuracy is not None:
+            return None
+        bad = [s for s in self.segments if s.status == "no_gt" and s.unscoreable_reason]
+        if not bad:
+            return None
+        return "; ".join(f"segment {s.index}: {s.unscoreable_reason}" for s in bad)
+
+    def validity_lines(self) -> list[str]:
+        """The stderr lines: one per driven segment with invalid GT samples or no valid GT at
+        its reached moment, else one line saying every segment's GT was valid."""
+        t0 = self.origin_ns
+        if t0 is None:
+            t0 = next((s.start_ns for s in self.segments if s.start_ns is not None), 0)
+        out = []
+        driven = [s for s in self.segments if s.validity is not None]
+        for s in driven:
+            assert s.validity is not None
+            if not s.validity.invalid_samples and s.unscoreable_reason is None:
+                continue
+            line = "validity: " + s.validity.text(f"segment {s.index}", t0)
+            if s.unscoreable_reason is not None:
+                verdict = "scored as 2015 did" if s.status == "ok" else "no GT"
+                line += f"; {verdict}: {s.unscoreable_reason}"
+            out.append(line)
+        if driven and not out:
+            out.append(f"validity: segments 0-{driven[-1].index} 100.0% valid")
+        return out
 
     def to_yaml(self) -> str:
         """The Listing 13 score."""
@@ -216,6 +273,13 @@ class Fbm2hResult:
                     "orientation_error_rad": _num(s.orientation_error),
                     "dtheta_unwrapped_rad": _num(s.dtheta),
                     "gt_offset_ms": None if s.gt_offset_ns is None else s.gt_offset_ns / 1e6,
+                    "valid_fraction": None
+                    if s.validity is None
+                    else round(s.validity.valid_fraction, 6),
+                    "invalid_samples": ""
+                    if s.validity is None
+                    else cell(s.validity.invalid_samples),
+                    "unscoreable_reason": s.unscoreable_reason,
                 }
             )
         summary: Rows = [

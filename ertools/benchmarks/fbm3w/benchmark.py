@@ -25,6 +25,15 @@ from ertools.benchmarks.common.hygiene import (
     identical_poses,
 )
 from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
+from ertools.benchmarks.common.validity import (
+    STILL_M,
+    SampleMask,
+    coverage,
+    coverage_problem,
+    lost_spans,
+    sample_codes,
+    summarise,
+)
 from ertools.benchmarks.fbm3w.auto_runs import find_auto
 from ertools.benchmarks.fbm3w.config import (
     DEFAULT_FRAME,
@@ -43,6 +52,7 @@ from ertools.benchmarks.fbm3w.rules import (
     RULE_RUN_FINDING,
     RULE_STOPPED_RUNS,
     RULE_TIMEOUT_RUNS,
+    RULE_UNSCOREABLE_RUNS,
     RULE_USER_SHAPES,
 )
 from ertools.benchmarks.fbm3w.runs import (
@@ -78,6 +88,12 @@ FLOOR_SAMPLES = 10_001
 FLOOR_WARN_M = 0.0005
 # A kept path this much longer than the target is suspicious (the sample's runs: 1.00-1.01).
 LONG_PATH_RATIO = 1.15
+# A run is unscoreable when valid data covers less than this fraction of its path window,
+# or a stretch without it longer than MAX_INNER_GAP_S lies between two valid samples (the
+# 2015 formula then follows a straight chord where the robot went). A tracking loss whose two
+# ends are within STILL_M of each other hid no motion. Why these values: docs/uncertainty.md.
+MIN_COVERAGE = 0.9
+MAX_INNER_GAP_S = 0.5
 
 
 def read_fbm3w_poses(paths: Sequence[Path], options: Fbm3wOptions) -> PoseStream:
@@ -247,6 +263,7 @@ def score_runs(
         )
     noise = _noise(poses, options, warnings)
     same = identical_poses(poses)
+    mask = sample_codes(poses.t_ns, poses.xyz, poses.quat_xyzw)
     frames = frame_change_warning(poses, start_ns)
     if frames:
         warnings.append(frames)
@@ -255,7 +272,7 @@ def score_runs(
     if progress is not None:
         progress.task("scoring runs", len(runs_in), "runs")
     for window in runs_in:
-        run = _score_one(poses, same, window, cfg, options, start_ns, warnings)
+        run = _score_one(poses, same, window, cfg, options, start_ns, warnings, mask)
         if progress is not None:
             progress.advance(1)
         results.append(run)
@@ -348,6 +365,7 @@ def _score_one(
     options: Fbm3wOptions,
     bag_start_ns: int,
     warnings: list[str],
+    mask: SampleMask | None = None,
 ) -> RunResult:
     spec = window.spec or ""
 
@@ -390,6 +408,15 @@ def _score_one(
         "tracking_losses": losses,
         "target_length": target_length,
     }
+    problem = None
+    if mask is not None:
+        validity = summarise(mask, window.start_ns, window.end_ns)
+        lost = lost_spans(validity, xy, STILL_M)
+        common["validity"] = validity
+        common["path_coverage"] = coverage(validity, lost)
+        problem = coverage_problem(validity, MIN_COVERAGE, MAX_INNER_GAP_S, lost)
+        if problem is not None:
+            common["unscoreable_reason"] = problem
     rel = (window.start_ns - bag_start_ns) / 1e9, (window.end_ns - bag_start_ns) / 1e9
     if hi - lo < 2:
         return result(
@@ -413,6 +440,16 @@ def _score_one(
         score = score_path(xy, ref_xy, shape, cfg.d_min)
     except ScoringError as err:
         return result(err.message, **common)
+    if problem is not None and options.unscoreable_runs != "2015":
+        # no number, but the path in its frame: the plot shows where the data is missing
+        return result(
+            None, frame_xy=score.frame.to_frame(xy), sample_t_ns=poses.t_ns[lo:hi], **common
+        )
+    if problem is not None:
+        warnings.append(
+            f"run {window.index}: 2015 scored this run from {common['path_coverage']:.1%} of "
+            f"its path (--unscoreable-runs 2015); by default it is unscoreable: {problem}"
+        )
     baseline = float(np.hypot(*(xy[0] - ref_xy)))
     if baseline < SHORT_BASELINE_M:
         warnings.append(
@@ -534,6 +571,15 @@ def _deviations(
                 f"a run the RefBox timed out (run {', '.join(timed_out)}) is listed with its "
                 "time and no distance_error and cannot be the best run; the 2015 node scored it "
                 "on the path it had covered and it could be the best run"
+            )
+        )
+    unscoreable = [r for r in runs if r.status == "unscoreable"]
+    if unscoreable:
+        listed = "; ".join(f"run {r.index}: {r.unscoreable_reason}" for r in unscoreable)
+        out.append(
+            RULE_UNSCOREABLE_RUNS.deviation(
+                f"unscoreable, no distance_error ({listed}); the 2015 node scored such a run "
+                "from the poses it had"
             )
         )
     stopped = [str(r.index) for r in runs if r.window.status == "stopped"]

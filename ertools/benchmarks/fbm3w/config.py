@@ -48,6 +48,9 @@ class Fbm3wOptions:
             execution_time) or ``2015`` (its time left out, as the 2015 node did).
         exact_end_payloads: RefBox END payloads read as the 2015 BmBox did (only
             ``reason: timeout`` / ``reason: stop``; :func:`ertools.states.end_reason`).
+        unscoreable_runs: ``null`` (default: a run whose valid ground truth cannot support a
+            score is ``unscoreable`` with no distance_error) or ``2015`` (scored from what it
+            has, as the 2015 node did, with a deviation saying how much of its path was valid).
         config: runs_specifications, d_min and shapes (None: the 2015 values,
             ``configs/fbm3w.yaml``); ``d_min`` above overrides its d_min.
 
@@ -71,6 +74,7 @@ class Fbm3wOptions:
     stopped_runs: str = "counted"
     exact_end_payloads: bool = False
     config: Fbm3wConfig | None = None
+    unscoreable_runs: str = "null"
 
 
 TIMEOUT_RUNS = ("unscored", "2015")
@@ -94,5 +98,6 @@ def options_2015(options: Fbm3wOptions) -> Fbm3wOptions:
         timeout_runs="2015",
         stopped_runs="2015",
         exact_end_payloads=True,
+        unscoreable_runs="2015",
         d_min=DEFAULT_D_MIN if options.d_min is None else options.d_min,
     )

@@ -101,10 +101,19 @@ INPUTS = (
     ),
     Input("exact_end_payloads", "flag", EXACT_HELP, group=LEGACY),
     Input(
+        "unscoreable_runs",
+        "choice",
+        "a run whose valid ground truth cannot support a score: unscoreable, no "
+        "distance_error (default), or 2015: scored from what it has, with a deviation",
+        default="null",
+        choices=("null", "2015"),
+        group=LEGACY,
+    ),
+    Input(
         "all_2015",
         "flag",
         "every 2015 behaviour: --timeout-runs 2015 --stopped-runs 2015 "
-        "--exact-end-payloads, d_min 0.00033 "
+        "--exact-end-payloads --unscoreable-runs 2015, d_min 0.00033 "
         "unless --d-min is given, no --arc-length",
         flag="--2015",
         group=LEGACY,
@@ -201,6 +210,7 @@ def make_options(given: Mapping[str, Any]) -> Fbm3wOptions:
         timeout_runs=v["timeout_runs"],
         stopped_runs=v["stopped_runs"],
         exact_end_payloads=v["exact_end_payloads"],
+        unscoreable_runs=v["unscoreable_runs"],
         config=load_fbm3w_config(v["config"]),
     )
     return options_2015(options) if v["all_2015"] else options

@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.common.validity import GapOnPath, Validity, cell, gaps_on_path
 from ertools.benchmarks.fbm3w.path import PathScore
 from ertools.benchmarks.fbm3w.runs import RunWindow
 from ertools.benchmarks.noise.benchmark import NoiseResult
@@ -42,6 +43,12 @@ class RunResult:
         shape_floor: distance_error of a noiseless robot exactly on the target.
         target_dense: (M, 2) the target curve, densely sampled (plots).
         sample_t_ns: (N,) times of the samples of ``frame_xy`` (the Foxglove export).
+        validity: the path window's validity mask summary (None when not computed).
+        unscoreable_reason: why the valid data cannot support a score (then ``score`` is None
+            and the status ``unscoreable``; under ``--unscoreable-runs 2015`` the run is scored
+            and this is kept for the warning), None otherwise.
+        path_coverage: the fraction of the path window covered by valid data (a tracking loss
+            that hid no motion counted as covered), None when not computed.
     """
 
     window: RunWindow
@@ -59,15 +66,28 @@ class RunResult:
     shape_floor: float | None = None
     target_dense: Any = None
     sample_t_ns: Any = None
+    validity: Validity | None = None
+    unscoreable_reason: str | None = None
+    path_coverage: float | None = None
 
     @property
     def index(self) -> int:
         return self.window.index
 
     @property
+    def gaps(self) -> tuple[GapOnPath, ...]:
+        """The path window's invalid spans (seconds from the bag start) with their (x, y) ends
+        in the run frame of ``frame_xy``: what the path plot draws as gaps."""
+        if self.validity is None:
+            return ()
+        return gaps_on_path(self.validity, self.frame_xy, self.bag_start_ns)
+
+    @property
     def status(self) -> str:
         if self.error is not None:
             return "failed"
+        if self.score is None and self.unscoreable_reason is not None:
+            return "unscoreable"
         if self.score is not None:
             # --timeout-runs 2015 scores a timed-out run on its partial path: say so.
             return "timeout_scored" if self.window.status == "timeout" else "scored"
@@ -115,6 +135,12 @@ class RunResult:
             o = self.score.frame.origin
             out["starting_position"] = [o[0], o[1]]
             out["frame_yaw"] = self.score.frame.yaw
+        if self.validity is not None:
+            out.update(self.validity.fields())
+        if self.path_coverage is not None:
+            out["path_coverage"] = round(self.path_coverage, 6)
+        if self.unscoreable_reason is not None:
+            out["unscoreable_reason"] = self.unscoreable_reason
         return out
 
 
@@ -154,6 +180,32 @@ class Fbm3wResult:
         best = self.best_run
         run = None if best is None else self._by_index(best)
         return None if run is None else run.distance_error
+
+    def validity_lines(self) -> list[str]:
+        """One stderr line per run with a validity mask: its valid fraction, the invalid samples
+        and the longest gap, and the verdict when unscoreable."""
+        out = []
+        for r in self.runs:
+            if r.validity is None:
+                continue
+            line = "validity: " + r.validity.text(f"run {r.index}", r.bag_start_ns)
+            if r.status == "unscoreable":
+                line += f"; unscoreable: {r.unscoreable_reason}"
+            out.append(line)
+        return out
+
+    @property
+    def unscoreable_reason(self) -> str | None:
+        """Why the execution has no score when no run was scored and some were unscoreable
+        (the rescore's ``unscoreable`` status), None otherwise."""
+        if self.best_run is not None:
+            return None
+        bad = [r for r in self.runs if r.status == "unscoreable"]
+        if not bad:
+            return None
+        return "no run can be scored: " + "; ".join(
+            f"run {r.index}: {r.unscoreable_reason}" for r in bad
+        )
 
     def _by_index(self, index: int) -> RunResult | None:
         return next((r for r in self.runs if r.index == index), None)
@@ -200,6 +252,8 @@ class Fbm3wResult:
             for key in ("reference_position", "starting_position"):
                 if key in row:
                     row[key] = " ".join(f"{v:.6f}" for v in row[key])
+            if "invalid_samples" in row:
+                row["invalid_samples"] = cell(row["invalid_samples"])
             runs.append(row)
         points: Rows = []
         for r in self.runs:
@@ -221,6 +275,21 @@ class Fbm3wResult:
                     }
                 )
         out: dict[str, Rows] = {"runs": runs, "points": points}
+        spans = [
+            {
+                "run": r.index,
+                **s.to_dict(r.bag_start_ns),
+                "start_x": None if g.start_xy is None else g.start_xy[0],
+                "start_y": None if g.start_xy is None else g.start_xy[1],
+                "end_x": None if g.end_xy is None else g.end_xy[0],
+                "end_y": None if g.end_xy is None else g.end_xy[1],
+            }
+            for r in self.runs
+            if r.validity is not None
+            for s, g in zip(r.validity.spans, r.gaps, strict=True)
+        ]
+        if spans:
+            out["invalid_spans"] = spans
         if self.sweep_values:
             out["d_min_sweep"] = [
                 {"d_min": d, **{f"run_{r.index}": e for r, (_, e) in _sweep_cells(self.runs, k)}}

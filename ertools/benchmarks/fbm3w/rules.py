@@ -114,3 +114,21 @@ RULE_ARC_LENGTH = Rule(
     "fractions of the target's arc length instead, on request only",
     option="",
 )
+
+RULE_UNSCOREABLE_RUNS = Rule(
+    key="fbm3w.unscoreable-runs",
+    benchmark="fbm3w",
+    title="runs without enough valid ground truth",
+    rulebook="the end effector's path as the mocap measured it (seed 7.3.3); the seed says "
+    "nothing of tracking losses or gaps",
+    node_2015=(
+        f"{NODE_SOURCE}: every pose it received, repeated poses of a lost marker set and gaps "
+        "included, made the path; a run was scored from whatever it had"
+    ),
+    ertools=(
+        "a run whose path window is less than 90% covered by valid data, or has more than 0.5 s "
+        "without it between two valid samples, is unscoreable: no distance_error, the reason "
+        "given (docs/uncertainty.md)"
+    ),
+    option="--unscoreable-runs 2015",
+)

@@ -20,10 +20,12 @@ ASSOCIATIONS: tuple[Association, ...] = ("linear", "nearest", "hold")
 
 Ties = Literal["at", "before"]
 Gaps = Literal["skip", "compare"]
+Unscoreable = Literal["null", "2015"]
 BeforeGt = Literal["uncovered", "first"]
 GtOrder = Literal["time", "chain"]
 TIES: tuple[Ties, ...] = ("at", "before")
 GAPS: tuple[Gaps, ...] = ("skip", "compare")
+UNSCOREABLE: tuple[Unscoreable, ...] = ("null", "2015")
 BEFORE_GT: tuple[BeforeGt, ...] = ("uncovered", "first")
 GT_ORDERS: tuple[GtOrder, ...] = ("time", "chain")
 
@@ -52,6 +54,9 @@ class TrajectoryConfig:
         t_max_diff: with ``nearest``, pair as evo does (``--t-max-diff``): the nearest stamp
             within this many seconds, float seconds as evo compares them (its ``max_diff``);
             ``max_gap_ns`` and the tracking-lost rule then do not apply. None: ertools' rule.
+        unscoreable: a comparison with too few valid pairs is ``unscoreable``, its statistics
+            null (``null``), or scored from them with a warning (``2015``); see
+            :mod:`ertools.benchmarks.trajectory.scoring`.
     """
 
     association: Association = "linear"
@@ -66,6 +71,7 @@ class TrajectoryConfig:
     before_gt: BeforeGt = "uncovered"
     gt_order: GtOrder = "time"
     t_max_diff: float | None = None
+    unscoreable: Unscoreable = "null"
 
     def __post_init__(self) -> None:
         if self.association not in ASSOCIATIONS:
@@ -77,6 +83,7 @@ class TrajectoryConfig:
             ("gaps", self.gaps, GAPS),
             ("before-gt", self.before_gt, BEFORE_GT),
             ("gt-order", self.gt_order, GT_ORDERS),
+            ("unscoreable", self.unscoreable, UNSCOREABLE),
         ):
             if value not in allowed:
                 raise ConfigError(f"--{name} {value!r} unknown; choose from {', '.join(allowed)}")
@@ -129,5 +136,6 @@ SETTINGS_2015: Mapping[str, str] = MappingProxyType(
         "gaps": "compare",
         "before_gt": "first",
         "gt_order": "chain",
+        "unscoreable": "2015",
     }
 )

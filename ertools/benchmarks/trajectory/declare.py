@@ -25,6 +25,7 @@ from ertools.benchmarks.trajectory.config import (
     GT_ORDERS,
     SETTINGS_2015,
     TIES,
+    UNSCOREABLE,
     TrajectoryConfig,
 )
 from ertools.benchmarks.trajectory.result import TrajectoryResult
@@ -91,10 +92,18 @@ INPUTS = (
         group=LEGACY,
     ),
     Input(
+        "unscoreable",
+        "choice",
+        "a comparison with too few valid pairs (docs/uncertainty.md): unscoreable, null "
+        "statistics (null, default) or scored from them with a warning (2015)",
+        choices=UNSCOREABLE,
+        group=LEGACY,
+    ),
+    Input(
         "as_2015",
         "flag",
         "compute what the 2015 script did: --association hold --ties before --gaps compare "
-        "--before-gt first --gt-order chain (2015's orientation error is "
+        "--before-gt first --gt-order chain --unscoreable 2015 (2015's orientation error is "
         "orientation_error_2015)",
         flag="--2015",
         group=LEGACY,
@@ -200,7 +209,9 @@ def make_options(given: Mapping[str, Any]) -> TrajectoryOptions:
     auto = offset is None
     if v["apply_offset"] and not auto:
         raise UsageError("--apply-offset needs --offset auto")
-    chosen = {k: v[k] for k in ("association", "ties", "gaps", "before_gt", "gt_order")}
+    chosen = {
+        k: v[k] for k in ("association", "ties", "gaps", "before_gt", "gt_order", "unscoreable")
+    }
     settings = {k: value for k, value in chosen.items() if value is not None}
     if v["as_2015"]:
         clash = [

@@ -11,6 +11,7 @@ import numpy as np
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.benchmarks.common.clocks import OffsetEstimate
+from ertools.benchmarks.common.validity import Validity, cell
 from ertools.benchmarks.trajectory.association import (
     COMPARED,
     GAP,
@@ -65,11 +66,29 @@ class TrajectoryResult:
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
     name: str = "trajectory"
+    validity: Validity | None = None
+    unscoreable_reason: str | None = None
 
     @property
     def nothing_scored(self) -> bool:
-        """No robot pose compared, so no metric: the CLI prints only the failure."""
-        return self.metrics is None
+        """No robot pose compared, so no metric: the CLI prints only the failure. An
+        unscoreable comparison is a verdict, printed with its null statistics."""
+        return self.metrics is None and not self.unscoreable
+
+    @property
+    def unscoreable(self) -> bool:
+        """Too few valid pairs for statistics (their values null)."""
+        return self.metrics is None and self.unscoreable_reason is not None
+
+    def validity_lines(self) -> list[str]:
+        """The stderr line: the robot poses' valid fraction and reasons, and the verdict."""
+        if self.validity is None:
+            return []
+        t0 = int(self.matched.t_ns[0]) if len(self.matched.t_ns) else 0
+        line = "validity: " + self.validity.text("trajectory", t0)
+        if self.unscoreable:
+            line += f"; unscoreable: {self.unscoreable_reason}"
+        return [line]
 
     @property
     def compared(self) -> int:
@@ -140,6 +159,12 @@ class TrajectoryResult:
             "warnings": list(self.warnings),
             "deviations": list(self.deviations),
         }
+        if self.validity is not None:
+            data.update(self.validity.fields())
+        if self.unscoreable:
+            data["status"] = "unscoreable"
+        if self.unscoreable_reason is not None:
+            data["unscoreable_reason"] = self.unscoreable_reason
         out: dict[str, Any] = jsonable(data)
         return out
 
@@ -208,6 +233,12 @@ class TrajectoryResult:
         }
         summary["estimated_offset"] = d["clock_audit"]["estimated_offset"]
         summary["offset_uncertainty"] = d["clock_audit"]["uncertainty"]
+        if "valid_fraction" in d:
+            summary["valid_fraction"] = d["valid_fraction"]
+            summary["invalid_samples"] = cell(d["invalid_samples"])
+        if "unscoreable_reason" in d:
+            summary["status"] = d.get("status", "scored")
+            summary["unscoreable_reason"] = d["unscoreable_reason"]
         return {"samples": rows, "summary": [summary]}
 
 

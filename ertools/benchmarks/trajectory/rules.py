@@ -138,3 +138,17 @@ RULE_ROBOT_STAMPS = Rule(
     ),
     option="",
 )
+
+RULE_UNSCOREABLE = Rule(
+    key="trajectory.unscoreable",
+    benchmark="trajectory",
+    title="too few valid pairs",
+    rulebook=_SEED,
+    node_2015="rockin_trajectory_benchmark.py: averaged whatever pairs it had, one or a thousand",
+    ertools=(
+        "fewer than half of the robot poses inside the GT with a valid GT pose (the others in "
+        "GT gaps, while tracking was lost, NaN) is unscoreable: null statistics, the reason "
+        "given (docs/uncertainty.md); evo's pairing (--t-max-diff) is left as evo has it"
+    ),
+    option="--unscoreable 2015",
+)

@@ -13,6 +13,18 @@ import numpy.typing as npt
 from ertools.arrays import I64
 from ertools.benchmarks.common.clocks import OffsetEstimate, estimate_offset
 from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid, frame_change_warning
+from ertools.benchmarks.common.validity import (
+    GAP as V_GAP,
+)
+from ertools.benchmarks.common.validity import (
+    OUTSIDE_WINDOW,
+    VALID,
+    Validity,
+    from_codes,
+)
+from ertools.benchmarks.common.validity import (
+    TRACKING_LOST as V_TRACKING_LOST,
+)
 from ertools.benchmarks.trajectory.association import (
     COMPARED,
     GAP,
@@ -32,6 +44,7 @@ from ertools.benchmarks.trajectory.rules import (
     RULE_GAPS,
     RULE_INVALID_POSES,
     RULE_TIES,
+    RULE_UNSCOREABLE,
     RULE_YAW_WRAP,
 )
 from ertools.errors import ClockError, ScoringError
@@ -214,12 +227,31 @@ def score_streams(
             )
 
     m = metrics(matched)
+    validity = from_codes(
+        validity_codes(matched, int(timed.t_ns[0])),
+        matched.t_ns,
+        gap_s=ns_to_s(config.max_gap_ns),
+        nan=bad_robot,
+    )
+    problem = None if evo or m is None else too_few(validity)
+    if problem is not None and config.unscoreable == "2015":
+        notes.append(
+            f"2015 scored this comparison from {validity.valid_samples} valid pair(s) "
+            f"(--unscoreable 2015); by default it is unscoreable: {problem}"
+        )
+    elif problem is not None:
+        m = None
+        invalid.append(
+            RULE_UNSCOREABLE.deviation(
+                f"unscoreable, no statistics: {problem}; the 2015 script averaged the pairs it had"
+            )
+        )
     if m is None and evo:
         failures.append(
             f"no robot pose has a GT pose within --t-max-diff {config.t_max_diff:g} s "
             f"(evo: 'found no matching timestamps'); check the time source and --offset"
         )
-    elif m is None:
+    elif m is None and problem is None:
         failures.append(
             f"no robot pose could be compared ({matched.count(GAP)} in GT gaps, "
             f"{matched.count(TRACKING_LOST)} while tracking was lost)"
@@ -268,6 +300,8 @@ def score_streams(
         warnings=tuple(notes),
         deviations=(*_deviations(config, matched, m), *invalid),
         failures=tuple(failures),
+        validity=validity,
+        unscoreable_reason=problem,
         provenance=Provenance(
             inputs=(robot_file, *gt_files),
             parameters=(
@@ -285,6 +319,44 @@ def score_streams(
         ),
     )
     return result
+
+
+# A comparison is unscoreable when fewer than this fraction of the robot poses inside the GT
+# have a valid GT pose: the statistics would then describe a part of the run chosen by the
+# mocap's losses, not the run. A small number of valid pairs alone is no verdict: each pair is
+# a measurement, and few of them widen the confidence interval instead (docs/uncertainty.md).
+MIN_VALID_FRACTION = 0.5
+
+
+def validity_codes(matched: Matched, gt_start_ns: int) -> npt.NDArray[np.int8]:
+    """The validity reason of each robot pose from its association status.
+
+    A pose compared across a GT gap (``--gaps compare``) is a ``gap`` and one compared with the
+    first GT pose before the GT began (``--before-gt first``) is ``outside_window``: 2015 used
+    them, but no GT was measured at their moment.
+    """
+    s = matched.status
+    codes = np.full(s.shape, V_GAP, dtype=np.int8)  # GAP and evo's UNPAIRED
+    codes[s == COMPARED] = VALID
+    codes[s == TRACKING_LOST] = V_TRACKING_LOST
+    codes[(s == UNCOVERED) | ((s == COMPARED) & (matched.t_ns < gt_start_ns))] = OUTSIDE_WINDOW
+    codes[(s == COMPARED) & matched.across_gap] = V_GAP
+    return codes
+
+
+def too_few(validity: Validity) -> str | None:
+    """Why the valid pairs cannot support the statistics, or None."""
+    inside = validity.expected - int(validity.counts[OUTSIDE_WINDOW])
+    valid = validity.valid_samples
+    if valid < MIN_VALID_FRACTION * inside:
+        what = ", ".join(
+            f"{v} {k}" for k, v in validity.invalid_samples.items() if k != "outside_window"
+        )
+        return (
+            f"only {valid} of the {inside} robot poses inside the GT have a valid GT pose "
+            f"({what}); at least {MIN_VALID_FRACTION:.0%} are needed"
+        )
+    return None
 
 
 def _audit_warnings(audit: OffsetEstimate, applied_ns: int) -> list[str]:

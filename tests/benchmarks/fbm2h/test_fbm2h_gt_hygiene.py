@@ -147,7 +147,41 @@ def test_frozen_gt_at_a_reached_moment_is_warned() -> None:
     run = _run(2, "timeout", seed=8)
     # Segment 1 is reached at 10.0 s; the body is lost from 9.4 s to 10.5 s.
     run["marker"] = _freeze(run["marker"], 10.0, 0.6, 0.5)
-    result = _compute(run)
+    # by default no valid GT lies within 0.1 s of the moment: the segment has none (issue 28)
+    refused = _compute(run)
+    assert refused.segments[1].status == "no_gt"
+    assert refused.position_accuracy is None
+    assert not [w for w in refused.warnings if "frozen" in w]
+    assert refused.unscoreable_reason == (
+        "segment 1: no valid ground truth within --gt-tolerance 0.1 s of the reached moment "
+        "10.000 s after the log's first message: only repeated poses of a lost marker set "
+        "(tracking lost)"
+    )
+    # the segment's mask: every repeat from the frozen pose on to the reached moment
+    t = run["marker"].t_ns
+    frozen_from = int(t[np.searchsorted(t, T0 + round(9.4 * S))])
+    reached = refused.segments[1].end_ns
+    repeats = int(np.sum((t > frozen_from) & (t <= reached)))
+    assert repeats == 72  # 0.6 s at 120 Hz
+    validity = refused.segments[1].validity
+    assert validity is not None and validity.invalid_samples == {"tracking_lost": repeats}
+    # where the path plot draws it: from the last measurement to the reached moment (the
+    # segment's end: no valid sample after it inside the segment)
+    (gap,) = refused.segments[1].gaps
+    assert (gap.reason, gap.end_xy, gap.lost) == ("tracking_lost", None, True)
+    assert gap.start_s == (frozen_from - T0) / 1e9 and gap.end_s == (reached - T0) / 1e9
+    assert gap.start_xy is not None
+    assert refused.to_dict()["status"] == "unscoreable"
+    assert refused.to_dict()["details"]["segments_details"]["1"]["unscoreable_reason"]
+    # as 2015 did, scored from the frozen pose, and warned
+    result = _compute(run, unscoreable_2015=True)
+    assert result.segments[1].status == "ok"
+    assert result.segments[1].unscoreable_reason == refused.segments[1].unscoreable_reason
+    assert "status" not in result.to_dict()
+    assert any(
+        w.startswith("segment 1: 2015 scored this segment from a pose that was not measured")
+        for w in result.warnings
+    )
     lines = [w for w in result.warnings if "frozen" in w]
     assert len(lines) == 1
     line = lines[0]

@@ -190,5 +190,8 @@ def test_yaml_output_has_listing_13_keys(
         "start_segment_time",
         "target_pose",
         "timeout",
+        # ertools' validity keys after the listing's (issue 28)
+        "valid_fraction",
+        "invalid_samples",
     ]
     assert data["hits"] is None
