@@ -16,7 +16,7 @@ from ertools.benchmarks.fbm3w.benchmark import score_runs
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.configs.shapes import builtin_shapes
 from ertools.report import plots_fbm3w
-from ertools.report.figures import render
+from ertools.report.figures import render, wrap_title
 
 STILL = 30
 PATH = 3000
@@ -99,3 +99,12 @@ def test_matplotlib_draws_the_gaps_too(tmp_path: Path) -> None:
     for cut in ((1000, 1030), (1000, 1072)):
         path = _figure(_result(cut), tmp_path, "png")
         assert imread(path).shape[0] > 100
+
+
+def test_png_titles_wrap_to_the_figure() -> None:
+    # matplotlib does not wrap a title; an unscoreable reason is wider than the figure
+    result = _result((1000, 1072))
+    (spec,) = [s for s in plots_fbm3w.figure_specs(result) if s.name == "fbm3w_run0"]
+    lines = wrap_title(spec.title, spec.size[0]).splitlines()
+    assert len(lines) > 1 and all(len(line) <= 80 for line in lines)
+    assert " ".join(lines) == spec.title
