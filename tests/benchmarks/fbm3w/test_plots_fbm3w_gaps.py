@@ -17,6 +17,7 @@ from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.configs.shapes import builtin_shapes
 from ertools.report import plots_fbm3w
 from ertools.report.figures import render, wrap_title
+from ertools.report.folder import write_report
 
 STILL = 30
 PATH = 3000
@@ -108,3 +109,12 @@ def test_png_titles_wrap_to_the_figure() -> None:
     lines = wrap_title(spec.title, spec.size[0]).splitlines()
     assert len(lines) > 1 and all(len(line) <= 80 for line in lines)
     assert " ".join(lines) == spec.title
+
+
+def test_the_report_folder_shows_the_unscoreable_runs_path(tmp_path: Path) -> None:
+    result = _result((1000, 1072))
+    index = write_report(result, tmp_path / "r", inputs=[], argv=["score", "fbm3w"])  # type: ignore[arg-type]
+    figure = tmp_path / "r" / "figures" / "fbm3w_run0.svg"
+    assert "figures/fbm3w_run0.svg" in index.read_text(encoding="utf-8")
+    title = " ".join(svg_figure.read(figure).texts("title"))
+    assert "unscoreable: " in title and "GT gap" in svg_figure.read(figure).labels()
