@@ -9,6 +9,7 @@ backend or uses pyplot, so importing ertools never changes matplotlib's global s
 
 from __future__ import annotations
 
+import textwrap
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -96,7 +97,7 @@ def render(spec: FigureSpec, path: Path) -> None:
         ax = fig.add_subplot()
         spec.draw(ax)
         if spec.title:
-            ax.set_title(spec.title)
+            ax.set_title(wrap_title(spec.title, spec.size[0]))
         if path.suffix.lower() == ".png":
             _write_png(fig, path)
         else:  # vector formats lay out for their own renderer: matplotlib's own path
@@ -153,6 +154,13 @@ def _write_png(fig: Any, path: Path) -> None:
     )
 
 
+def wrap_title(title: str, width_in: float) -> str:
+    """``title`` broken into lines that fit a ``width_in``-inch figure, as the SVG writer
+    breaks its titles (an unscoreable run's reason is longer than a figure is wide): about 10
+    characters per inch at matplotlib's title size and :data:`DPI`."""
+    return textwrap.fill(title, max(20, int(width_in * 10))) if title else title
+
+
 def save_one_file(specs: Sequence[Any], path: Path) -> Path:
     """Every spec as one panel of one figure, stacked top to bottom, in ``path`` (its suffix
     picks the format; an SVG of charts only is written without matplotlib)."""
@@ -170,7 +178,7 @@ def save_one_file(specs: Sequence[Any], path: Path) -> Path:
     for spec, ax in zip(specs, axes, strict=False):
         spec.draw(ax)
         if spec.title:
-            ax.set_title(spec.title)
+            ax.set_title(wrap_title(spec.title, width))
     if not specs:
         axes[0].text(0.5, 0.5, "no figure for this result", ha="center", va="center")
         axes[0].set_axis_off()

@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ertools.report import units
+from ertools.report import gaps, units
 from ertools.report.chart import (
     COLOURS,
     Arrows,
@@ -43,7 +43,8 @@ def _poses(xyt: np.ndarray, colour: str, label: str, marker: Any) -> list[Layer]
 
 
 def path_chart(result: Any, size: tuple[float, float] = PATH_SIZE) -> Chart:
-    """Path on the testbed frame, waypoints with target headings, reached poses."""
+    """Path on the testbed frame, waypoints with target headings, reached poses, the GT's
+    gaps on the path (:mod:`ertools.report.gaps`)."""
     layers: list[Layer] = []
     path = thin_path(np.asarray(result.path_xyyaw, dtype=float).reshape(-1, 3), size)
     if len(path):
@@ -73,6 +74,7 @@ def path_chart(result: Any, size: tuple[float, float] = PATH_SIZE) -> Chart:
                 label="starting pose",
             )
         )
+    layers += gaps.path_layers((g for s in result.segments for g in s.gaps), MM)
     return Chart(
         tuple(layers),
         x=Axis(units.label("x in the testbed frame", "length")),
@@ -121,13 +123,33 @@ def errors_chart(result: Any) -> Chart:
     )
 
 
+def path_title(result: Any) -> str:
+    """The path figure's title: the reached method, the GT's valid fraction over the driven
+    segments and each segment's where below 100%, the unscoreable verdict."""
+    title = f"FBM2@Home path and waypoints (reached: {result.reached_method})"
+    pooled = gaps.pooled_fraction(s.validity for s in result.segments)
+    if pooled is not None:
+        title += f"; GT {pooled:.1%} valid"
+        partial = [
+            f"{s.index}: {s.validity.valid_fraction:.1%}"
+            for s in result.segments
+            if s.validity is not None and s.validity.valid_fraction < 1.0
+        ]
+        if partial:
+            title += f" (waypoint {', '.join(partial)})"
+    reason = result.unscoreable_reason
+    if reason is not None:
+        title += f"; unscoreable: {reason}"
+    return title
+
+
 def figure_specs(result: Any) -> list[FigureSpec]:
     """The path and the errors figures of an ``Fbm2hResult``."""
     mode = "2015 orientation" if result.orientation_2015 else "orientation wrapped to [0, pi]"
     return [
         chart_spec(
             "fbm2h_path",
-            f"FBM2@Home path and waypoints (reached: {result.reached_method})",
+            path_title(result),
             lambda size: path_chart(result, size),
             PATH_SIZE,
         ),

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from ertools.report import units
+from ertools.report import gaps, units
 from ertools.report.chart import (
     COLOURS,
     CYCLE,
@@ -34,7 +34,8 @@ VECTORS = 25  # about this many "compared with" vectors per run: enough to read,
 
 def run_chart(run: Any, size: tuple[float, float] = RUN_SIZE) -> Chart:
     """Target and measured path in the run frame (mm); kept samples coloured by their error,
-    a few of them joined to the target point they are compared with."""
+    a few of them joined to the target point they are compared with; the GT's gaps on the
+    path (:mod:`ertools.report.gaps`)."""
     score = run.score
     layers: list[Layer] = []
     if run.target_dense is not None:
@@ -81,6 +82,7 @@ def run_chart(run: Any, size: tuple[float, float] = RUN_SIZE) -> Chart:
                     ref[:, 0], ref[:, 1], COLOURS["red"], marker="^", size=4.5, label="reference"
                 )
             )
+    layers += gaps.path_layers(run.gaps, MM)
     return Chart(
         tuple(layers),
         x=Axis(
@@ -96,7 +98,7 @@ def run_chart(run: Any, size: tuple[float, float] = RUN_SIZE) -> Chart:
 
 def runs_chart(result: Any) -> Chart:
     """distance_error per run (mm); the best run highlighted, unscored runs labelled, each
-    shape's floor dotted over its bar."""
+    run's GT valid fraction under its value, each shape's floor dotted over its bar."""
     best = result.best_run
     idx = np.array([r.index for r in result.runs], dtype=float)
     values = np.array([(r.distance_error or 0.0) * MM for r in result.runs])
@@ -107,6 +109,8 @@ def runs_chart(result: Any) -> Chart:
             text = f"{r.spec}\n{r.status}"
         else:
             text = f"{r.spec}\n{r.distance_error * MM:.2f}"
+        if r.validity is not None:
+            text += f"\n{r.validity.valid_fraction:.1%} valid"
         layers.append(Text(float(x), float(v), text, offset=(0.0, 3.0), anchor="middle"))
         floor = getattr(r, "shape_floor", None)
         if floor:
@@ -151,17 +155,25 @@ def sweep_chart(result: Any) -> Chart:
     )
 
 
+def run_title(run: Any) -> str:
+    """``FBM3@Work run 1 (line): distance_error 4.210 mm; GT 97.3% valid`` or, for a run the
+    valid data cannot score, ``...: unscoreable: <reason>``."""
+    head = f"FBM3@Work run {run.index} ({run.spec})"
+    valid = gaps.valid_text(run.validity)
+    if run.score is None:
+        return f"{head}: unscoreable: {run.unscoreable_reason}" + (f"; {valid}" if valid else "")
+    return f"{head}: distance_error {run.distance_error * MM:.3f} mm" + (
+        f"; {valid}" if valid else ""
+    )
+
+
 def figure_specs(result: Any) -> list[FigureSpec]:
-    """One figure per scored run, the runs' bar chart, and the sweep when there is one."""
+    """One figure per scored or unscoreable run (its path and gaps), the runs' bar chart, and
+    the sweep when there is one."""
     specs = [
-        chart_spec(
-            f"fbm3w_run{r.index}",
-            f"FBM3@Work run {r.index} ({r.spec}): distance_error {r.distance_error * MM:.3f} mm",
-            partial(run_chart, r),
-            RUN_SIZE,
-        )
+        chart_spec(f"fbm3w_run{r.index}", run_title(r), partial(run_chart, r), RUN_SIZE)
         for r in result.runs
-        if r.score is not None
+        if r.score is not None or (r.status == "unscoreable" and r.frame_xy is not None)
     ]
     specs.append(
         chart_spec(

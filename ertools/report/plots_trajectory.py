@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ertools.benchmarks.trajectory.association import GAP, TRACKING_LOST, UNCOVERED
-from ertools.report import units
+from ertools.report import gaps, units
 from ertools.report.chart import COLOURS, Axis, Chart, Layer, Line, RefLine, Scatter
 from ertools.report.figures import FigureSpec, chart_spec, thin_path, thin_series
 
@@ -25,13 +25,16 @@ TIME_AXIS = units.label("time since the first robot pose", "time")
 
 
 def error_chart(result: TrajectoryResult, size: tuple[float, float]) -> Chart:
-    """Position error (mm) per robot pose; gaps and tracking losses marked on the time axis."""
+    """Position error (mm) per robot pose; gaps and tracking losses marked on the time axis,
+    the robot poses' invalid spans (result.validity) shaded behind."""
     m = result.matched
     layers: list[Layer] = []
     if len(m.t_ns):
         t = (m.t_ns - m.t_ns[0]) / 1e9
         shown = thin_series(t, m.position_error, size[0])
         err = m.position_error[shown] * MM
+        if result.validity is not None:
+            layers += gaps.time_spans(result.validity.spans, int(m.t_ns[0]))
         layers.append(Line(t[shown], err, COLOURS["blue"], 0.8, label="position error"))
         for code, colour, label in (
             (GAP, COLOURS["orange"], "GT gap"),
@@ -77,6 +80,8 @@ def yaw_chart(result: TrajectoryResult, size: tuple[float, float]) -> Chart:
     if len(m.t_ns):
         t = (m.t_ns - m.t_ns[0]) / 1e9
         shown = thin_series(t, m.yaw_error, size[0])
+        if result.validity is not None:
+            layers += gaps.time_spans(result.validity.spans, int(m.t_ns[0]))
         layers.append(Line(t[shown], m.yaw_error[shown] * DEG, COLOURS["purple"], 0.8))
     return Chart(
         tuple(layers),
@@ -87,13 +92,24 @@ def yaw_chart(result: TrajectoryResult, size: tuple[float, float]) -> Chart:
     )
 
 
+def validity_note(result: TrajectoryResult) -> str:
+    """``; 97.3% of robot poses valid`` and the unscoreable verdict, for the error title."""
+    if result.validity is None:
+        return ""
+    note = f"; {result.validity.valid_fraction:.1%} of robot poses valid"
+    if result.unscoreable:
+        note += f"; unscoreable: {result.unscoreable_reason}"
+    return note
+
+
 def figure_specs(result: TrajectoryResult) -> list[FigureSpec]:
     """The figures of ``ertools score trajectory --plot DIR``."""
     off = result.offset_ns / 1e9
     return [
         chart_spec(
             "trajectory_error",
-            f"Robot vs GT position error ({result.config.association}, offset {off:+.3f} s)",
+            f"Robot vs GT position error ({result.config.association}, offset {off:+.3f} s)"
+            + validity_note(result),
             lambda size: error_chart(result, size),
             (8.0, 4.0),
         ),

@@ -70,11 +70,18 @@ def test_fbm3w_path_figures_hold_each_runs_measured_path(fbm3w: tuple[object, Pa
         fig = svg_figure.read(index.parent / "figures" / f"fbm3w_run{run.index}.svg")
         assert fig.texts("xlabel")[0].startswith("x in the run frame (mm)")
         assert fig.texts("ylabel") == ["y in the run frame (mm)"]
-        assert fig.texts("title") == [
+        assert " ".join(fig.texts("title")) == (
             f"FBM3@Work run {run.index} ({run.spec}): distance_error "
-            f"{run.distance_error * 1000:.3f} mm"
-        ]
+            f"{run.distance_error * 1000:.3f} mm; GT {run.validity.valid_fraction:.1%} valid"
+        )
         legend = [e.get("data-label") for e in fig.root.iter() if e.get("class") == "entry"]
+        # then one entry per kind of GT gap the run has (issue 28), in this order
+        kinds = {
+            ("gap", True): "GT gap",
+            ("tracking_lost", True): "tracking lost",
+            ("tracking_lost", False): "tracking lost, robot still",
+        }
+        has = {kinds.get((g.reason, g.lost), "invalid GT") for g in run.gaps}
         assert legend == [
             f"target ({run.spec})",
             "measured (every sample)",
@@ -82,6 +89,7 @@ def test_fbm3w_path_figures_hold_each_runs_measured_path(fbm3w: tuple[object, Pa
             "compared with target(l/L)",
             "start",
             "reference",
+            *(k for k in [*kinds.values(), "invalid GT"] if k in has),
         ]
         # One polyline of the measured path: fewer vertices than samples (thinned to the
         # figure), more than a handful, none of them off the measured samples.

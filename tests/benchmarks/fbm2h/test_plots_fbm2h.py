@@ -72,3 +72,32 @@ def test_path_and_errors_figures(tmp_path: Path) -> None:
     assert ax.get_ylabel() == "distance error (mm)"
     pngs = save_figures(specs, tmp_path / "png")
     assert all(p.suffix == ".png" and p.stat().st_size > 1000 for p in pngs)
+
+
+def test_path_figure_draws_the_gt_gaps(tmp_path: Path) -> None:
+    # GT at 10 Hz on y = 0.2 x^2 (x = 1 m/s * t), identity transform (the robot is the marker
+    # set); the frames at 1.3, 1.4 and 1.5 s removed: a 0.4 s gap inside segment 1 (1 s ... 2 s)
+    t = np.arange(0, 3 * S + 1, S // 10, dtype=np.int64)
+    t = t[(t < 1.25 * S) | (t > 1.55 * S)]
+    x = t / S
+    xyz = np.column_stack([x, 0.2 * x**2, np.zeros_like(x)])
+    quat = np.tile([0.0, 0.0, 0.0, 1.0], (t.size, 1))
+    marker = PoseStream(t, xyz, quat, "world", "robot_at_home", "test")
+    goal = GoalList(((1.0, 0.2, 0.0), (2.0, 0.8, 0.0)), (0.0, 0.0, 0.0), source="g")
+    moments = ReachedMoments("timing", np.array([0, S]), np.array([S, 2 * S]), ("", ""))
+    result = compute(goal, identity_transform(), marker, moments)
+    (spec, _) = figure_specs(result)
+    (path,) = save_figures([spec], tmp_path, None)
+    fig = svg_figure.read(path)
+    xy, n = fig.polyline("GT gap")
+    # from the last sample before the hole (1.2 s) to the first after it (1.6 s), in mm; the
+    # figure is written to 0.1 px, a pixel is ~5 mm here
+    tol = max(abs(fig.scale("x")[0]), abs(fig.scale("y")[0]))
+    assert n == 2
+    assert np.allclose(xy, [[1200.0, 0.2 * 1.2**2 * 1000], [1600.0, 0.2 * 1.6**2 * 1000]], atol=tol)
+    # segment 1's window (1 s ... 2 s) holds 8 of its 11 frames; segment 0's 11 all arrived
+    title = " ".join(fig.texts("title"))
+    assert title.endswith(f"GT {19 / 22:.1%} valid (waypoint 1: {8 / 11:.1%})")
+    # matplotlib draws it too (a --plot .png)
+    (png,) = save_figures([spec], tmp_path / "png")
+    assert png.stat().st_size > 1000

@@ -4,15 +4,19 @@ with a hole cut by hand; which robot poses fall in it follows from the stamps al
 from __future__ import annotations
 
 import json
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+import svg_figure
 
 from ertools.benchmarks.trajectory.config import SETTINGS_2015, TrajectoryConfig
 from ertools.benchmarks.trajectory.scoring import MIN_VALID_FRACTION, score_streams
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
+from ertools.report.figures import render
+from ertools.report.plots_trajectory import figure_specs
 from ertools.streams import PoseStream
 
 T0 = 1_448_013_600 * 1_000_000_000
@@ -104,3 +108,22 @@ def test_the_score_command_prints_validity(
     assert main([*args, "--unscoreable", "2015"]) == 0
     again = json.loads(capsys.readouterr().out)
     assert again["position_error"] == data["position_error"]
+
+
+def test_the_error_figures_shade_the_hole(tmp_path: Path) -> None:
+    robot, gt = _streams((1.05, 3.05))
+    result = score_streams(robot, gt, TrajectoryConfig())
+    specs = {s.name: s for s in figure_specs(result)}
+    assert specs["trajectory_error"].title.endswith("; 80.0% of robot poses valid")
+    for name in ("trajectory_error", "trajectory_yaw_error"):
+        render(specs[name], tmp_path / f"{name}.svg")
+        fig = svg_figure.read(tmp_path / f"{name}.svg")
+        (rect,) = fig.series("GT gap span").findall("s:rect", svg_figure.NS)
+        a, b = fig.scale("x")
+        lo = a * float(rect.get("x", "nan")) + b
+        hi = a * (float(rect.get("x", "nan")) + float(rect.get("width", "nan"))) + b
+        # from the last robot pose with GT before the hole (1.0 s after the first robot pose)
+        # to the first after it (3.1 s), to the 0.1 px the file is written at
+        assert (lo, hi) == pytest.approx((1.0, 3.1), abs=abs(a))
+        render(specs[name], tmp_path / f"{name}.png")  # matplotlib draws it too
+        assert (tmp_path / f"{name}.png").stat().st_size > 1000
