@@ -8,6 +8,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from ertools.benchmarks.common.uncertainty import (
+    DEFAULT_CONFIDENCE,
+    DEFAULT_DRAWS,
+    DEFAULT_SEED,
+)
 from ertools.benchmarks.noise.benchmark import (
     DEFAULT_C,
 )
@@ -48,6 +53,8 @@ class Fbm3wOptions:
             execution_time) or ``2015`` (its time left out, as the 2015 node did).
         config: runs_specifications, d_min and shapes (None: the 2015 values,
             ``configs/fbm3w.yaml``); ``d_min`` above overrides its d_min.
+        confidence, draws, seed: the score intervals (level, Monte Carlo draws, 0 for none;
+            seed of the draws), :mod:`ertools.benchmarks.fbm3w.intervals`.
 
     The values are validated once, where they come in
     (:func:`ertools.benchmarks.fbm3w.declare.make_options`).
@@ -68,6 +75,9 @@ class Fbm3wOptions:
     timeout_runs: str = "unscored"
     stopped_runs: str = "counted"
     config: Fbm3wConfig | None = None
+    confidence: float = DEFAULT_CONFIDENCE
+    draws: int = DEFAULT_DRAWS
+    seed: int = DEFAULT_SEED
 
 
 TIMEOUT_RUNS = ("unscored", "2015")

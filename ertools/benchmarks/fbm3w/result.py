@@ -7,6 +7,13 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.common.uncertainty import (
+    Interval,
+    Uncertainty,
+    interval_line,
+    split_interval,
+    uncertainty_rows,
+)
 from ertools.benchmarks.fbm3w.path import PathScore
 from ertools.benchmarks.fbm3w.runs import RunWindow
 from ertools.benchmarks.noise.benchmark import NoiseResult
@@ -42,6 +49,8 @@ class RunResult:
         shape_floor: distance_error of a noiseless robot exactly on the target.
         target_dense: (M, 2) the target curve, densely sampled (plots).
         sample_t_ns: (N,) times of the samples of ``frame_xy`` (the Foxglove export).
+        interval: the confidence interval of ``distance_error`` (None: not scored, or
+            ``--draws 0``).
     """
 
     window: RunWindow
@@ -59,6 +68,7 @@ class RunResult:
     shape_floor: float | None = None
     target_dense: Any = None
     sample_t_ns: Any = None
+    interval: Interval | None = None
 
     @property
     def index(self) -> int:
@@ -90,8 +100,10 @@ class RunResult:
             "spec": self.spec,
             "distance_error": self.distance_error,
             "execution_time": self.execution_time,
-            "status": self.status,
         }
+        if self.interval is not None:
+            out["distance_error_interval"] = self.interval.as_list()
+        out["status"] = self.status
         if self.error is not None:
             out["error"] = self.error
         out["d_min"] = self.d_min
@@ -132,6 +144,8 @@ class Fbm3wResult:
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
     count_stopped: bool = True
+    best_interval: Interval | None = None
+    uncertainty: Uncertainty | None = None
 
     @property
     def nothing_scored(self) -> bool:
@@ -172,12 +186,35 @@ class Fbm3wResult:
         )
 
     def _score(self) -> dict[str, Any]:
-        return {
+        out: dict[str, Any] = {
             "best_distance_error": self.best_distance_error,
             "best_run": self.best_run,
             "execution_time": self.execution_time,
             "runs_details": {r.index: r.details() for r in self.runs},
         }
+        # Listing 16's keys first, in its order; the intervals are extra keys after them.
+        if self.uncertainty is not None:
+            best = self.best_interval
+            out["best_distance_error_interval"] = None if best is None else best.as_list()
+            out["uncertainty"] = self.uncertainty.to_dict()
+        return out
+
+    def interval_lines(self) -> list[str]:
+        """One line per score with its interval and the method (for stderr)."""
+        u = self.uncertainty
+        if u is None:
+            return []
+        scores: list[tuple[str, float | None, Interval | None]] = [
+            ("best_distance_error", self.best_distance_error, self.best_interval)
+        ]
+        scores += [
+            (f"run {r.index} distance_error", r.distance_error, r.interval) for r in self.runs
+        ]
+        return [
+            interval_line(name, value, iv, u, scale=1000.0, unit="mm")
+            for name, value, iv in scores
+            if value is not None
+        ]
 
     def to_dict(self) -> dict[str, Any]:
         """Listing 16 nesting with string run keys (JSON)."""
@@ -197,6 +234,7 @@ class Fbm3wResult:
         runs: Rows = []
         for r in self.runs:
             row = {"run": r.index, **r.details()}
+            split_interval(row, "distance_error")
             for key in ("reference_position", "starting_position"):
                 if key in row:
                     row[key] = " ".join(f"{v:.6f}" for v in row[key])
@@ -228,6 +266,8 @@ class Fbm3wResult:
             ]
         if self.noise is not None:
             out["noise"] = self.noise.tables()["summary"]
+        if self.uncertainty is not None:
+            out["uncertainty"] = uncertainty_rows(self.uncertainty)
         return out
 
     def sweep_text(self) -> str:
