@@ -56,7 +56,12 @@ class Coverage:
 
 
 # how each benchmark's widths are shown (its scores' unit)
-UNITS = {"fbm1": (1.0, ""), "fbm2h": (1000.0, "mm"), "fbm3w": (1000.0, "mm"), "trajectory": (1.0, "")}
+UNITS = {
+    "fbm1": (1.0, ""),
+    "fbm2h": (1000.0, "mm"),
+    "fbm3w": (1000.0, "mm"),
+    "trajectory": (1.0, ""),
+}
 
 
 def coverage(rows: list[Row]) -> tuple[int, int, float]:
@@ -94,8 +99,7 @@ def run_benchmark(name: str, trials: int, draws: int, first_seed: int = 0) -> Co
 
 def table(results: list[Coverage], draws: int) -> str:
     lines = [
-        f"| benchmark | trials | scores | coverage of the 95% intervals | mean width | "
-        f"time |",
+        "| benchmark | trials | scores | coverage of the 95% intervals | mean width | time |",
         "|---|---:|---:|---:|---:|---:|",
     ]
     for r in results:

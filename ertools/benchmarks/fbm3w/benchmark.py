@@ -23,8 +23,8 @@ from ertools.benchmarks.common.hygiene import (
     frozen_around,
     identical_poses,
 )
-from ertools.benchmarks.common.uncertainty import Interval, Uncertainty
 from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
+from ertools.benchmarks.common.uncertainty import Interval, Uncertainty
 from ertools.benchmarks.fbm3w.auto_runs import find_auto
 from ertools.benchmarks.fbm3w.config import (
     DEFAULT_FRAME,

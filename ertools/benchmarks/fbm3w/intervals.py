@@ -17,9 +17,11 @@ Sources (:mod:`ertools.benchmarks.common.uncertainty`):
 
 The draws perturb a smoothed path, not the measured one: a quadratic Savitzky-Golay fit over
 9 samples (exact for any motion of constant acceleration over 75 ms at 120 Hz) keeps the
-path and removes most of the noise (its residual variance is 59/231 of sigma^2), and the draws
-add the rest (sigma^2 (1 - 59/231)). Adding sigma to the already noisy positions would double
-the noise variance, and Eq. (1) is far from linear in it: d_min subsampling keeps a still
+path and removes most of the noise (the residual's variance is 59/231 of sigma^2 and, what
+Eq. (1) responds to, its consecutive differences almost vanish), and each draw adds noise of
+the full sigma to it: a draw is then a log of the smoothed path measured again. Adding sigma
+to the already noisy positions would double the noise variance, and Eq. (1) is far from
+linear in it: d_min subsampling keeps a still
 marker set's jitter only when a step passes d_min, a tail probability that grows ~200 times
 from sigma to sigma sqrt(2) at the 2015 values; the basic interval then over-corrects the
 bias (the calibration found every miss above the interval). Each draw's shift from the
@@ -62,7 +64,6 @@ BATCH_ELEMENTS = 2_000_000
 METHOD = "Monte Carlo (parametric bootstrap around the smoothed path, basic interval)"
 # Quadratic Savitzky-Golay weights over 9 samples, and the variance of noise left after it.
 SMOOTH = np.array([-21.0, 14.0, 39.0, 54.0, 59.0, 54.0, 39.0, 14.0, -21.0]) / 231.0
-RESIDUAL = 59.0 / 231.0
 HALF = len(SMOOTH) // 2
 
 
@@ -74,7 +75,9 @@ def smooth(xy: F64) -> F64:
     if n < len(SMOOTH):
         return np.repeat(p.mean(axis=0, keepdims=True), n, axis=0)
     out = np.column_stack([np.convolve(p[:, k], SMOOTH[::-1], mode="valid") for k in (0, 1)])
-    return np.concatenate([np.repeat(out[:1], HALF, axis=0), out, np.repeat(out[-1:], HALF, axis=0)])
+    head = np.repeat(out[:1], HALF, axis=0)
+    tail = np.repeat(out[-1:], HALF, axis=0)
+    return np.concatenate([head, out, tail])
 
 
 @dataclass(frozen=True, eq=False)
@@ -258,31 +261,29 @@ def run_intervals(
     est.append(min(est))
 
     # the smoothed paths' own scores: each draw's shift from them is added to the score
+    chosen: list[RunSamples] = [r for i in scored if (r := runs[i]) is not None]
     centers = np.asarray(
         [
             perturbed_errors(
-                runs[i], np.zeros(1), np.full(1, model.d_min), np.random.default_rng(0), False
+                run, np.zeros(1), np.full(1, model.d_min), np.random.default_rng(0), False
             )[0]
-            for i in scored
+            for run in chosen
         ]
     )
     shift = np.asarray(est[:-1]) - centers
     shift_best = est[-1] - float(np.min(centers))
-    scale = 1.0
 
     def perturbed(rng: np.random.Generator, sources: frozenset[str], n: int) -> F64:
         z_sigma = rng.standard_normal(n)
         z_dmin = rng.standard_normal(n)
-        sigmas = np.full(n, model.sigma * scale)
+        sigmas = np.full(n, model.sigma)
         if MOCAP_NOISE in sources:
             sigmas = sigmas * np.maximum(0.0, 1.0 + model.sigma_rel * z_sigma)
         d_mins = np.full(n, model.d_min)
         if D_MIN in sources:
             d_mins = model.d_min * np.maximum(0.0, 1.0 + model.d_min_rel * z_dmin)
         out = np.empty((n, len(scored) + 1))
-        for col, i in enumerate(scored):
-            run = runs[i]
-            assert run is not None
+        for col, run in enumerate(chosen):
             batch = max(1, BATCH_ELEMENTS // max(len(run.xy), 1))
             for lo in range(0, n, batch):
                 hi = min(n, lo + batch)
@@ -304,8 +305,13 @@ def run_intervals(
 
 
 def uncertainty_block(
-    model: NoiseModel, per_run: Sequence[tuple[int, Interval | None]], best: Interval | None,
-    *, draws: int, seed: int, confidence: float,
+    model: NoiseModel,
+    per_run: Sequence[tuple[int, Interval | None]],
+    best: Interval | None,
+    *,
+    draws: int,
+    seed: int,
+    confidence: float,
 ) -> Uncertainty:
     """The result's ``uncertainty`` block (sources, method, shares by dotted key)."""
     shares: dict[str, dict[str, float]] = {}
