@@ -9,6 +9,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ertools.benchmarks.common.uncertainty import (
+    DEFAULT_CONFIDENCE,
+    DEFAULT_DRAWS,
+    DEFAULT_SEED,
+)
 from ertools.benchmarks.fbm2h.segments import StopParams
 from ertools.configs.transform import (
     MarkerTransform,
@@ -49,6 +54,8 @@ class Fbm2hOptions:
             ``world -> robot_at_home`` first, the 2015 node's source (``--2015``).
         namespace: the benchmark namespace of the state topics.
         stops: thresholds for ``auto``.
+        confidence, draws, seed: the score intervals (level, Monte Carlo draws, 0 for none;
+            seed), :mod:`ertools.benchmarks.fbm2h.intervals`.
         marker_transform: a transform already in hand (``ertools audit``: the one the live
             score says the node used); None = from ``transform``/``team``, else identity.
     """
@@ -72,3 +79,6 @@ class Fbm2hOptions:
     namespace: str = NAMESPACE
     stops: StopParams = field(default_factory=StopParams)
     marker_transform: MarkerTransform | None = None
+    confidence: float = DEFAULT_CONFIDENCE
+    draws: int = DEFAULT_DRAWS
+    seed: int = DEFAULT_SEED
