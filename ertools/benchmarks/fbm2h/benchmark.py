@@ -48,7 +48,7 @@ from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
 from ertools.errors import ConfigError, SegmentationError
 from ertools.fidelity import Deviation
-from ertools.geometry import compose, wrap_angle, yaw_from_quat
+from ertools.geometry import compose, rotate, wrap_angle, yaw_from_quat
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import ns_to_s, s_to_ns
 
@@ -417,8 +417,9 @@ def with_intervals(
     identity = (np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
     at_marker = robot_poses_at(marker, identity, q, gap)
     robot = np.array([s.robot for s in ok], dtype=np.float64)
-    lever = robot[:, :2] - at_marker.xyyaw[:, :2]
     t = marker.t_ns
+    nearest = np.clip(np.searchsorted(t, q), 0, len(t) - 1)
+    lever = rotate(marker.quat_xyzw[nearest], np.broadcast_to(t_mr[0], (len(q), 3)).copy())
     lo = np.clip(np.searchsorted(t, q, side="right") - 1, 0, len(t) - 1)
     hi = np.clip(lo + 1, 0, len(t) - 1)
     span = (t[hi] - t[lo]).astype(np.float64)
@@ -441,6 +442,7 @@ def with_intervals(
         robot=robot,
         target=np.array([s.target for s in ok], dtype=np.float64),
         lever=np.nan_to_num(lever),
+        heading=np.nan_to_num(at_marker.xyyaw[:, 2]),
         averaging=averaging,
         velocity=velocity,
     )

@@ -6,12 +6,15 @@ The robot pose at a reached moment is the marker pose there (interpolated betwee
 GT samples around it) composed with the marker-to-robot transform. Sources
 (:mod:`ertools.benchmarks.common.uncertainty`):
 
-- ``mocap_noise``: the marker's position (normal, sigma per axis) and yaw (sigma_yaw) at the
+- ``mocap_noise``: the marker's position (normal, sigma per axis) and orientation (a small
+  rotation: sigma_tilt about the two horizontal axes, sigma_yaw about the vertical) at the
   moment; sigma = epsilon / sqrt(pi) from the log's own stationary phases (as ``ertools
-  noise --stationary auto``), sigma_yaw = 1.4826 MAD / sqrt(2) of the yaw differences of
-  consecutive still samples (a robust spread: a turn starting inside a phase does not count).
-  Interpolating between two samples with weights w, 1 - w averages their noise: sigma times
-  sqrt(w^2 + (1 - w)^2). The marker's yaw noise also swings the marker-to-robot lever arm.
+  noise --stationary auto``), the rotation sigmas = 1.4826 MAD / sqrt(2) of the relative
+  rotations of consecutive still samples, per axis of the marker frame (a robust spread: a
+  turn starting inside a phase does not count). The rotation swings the marker-to-robot lever
+  arm: a marker set 0.85 m above the robot turns 0.5 mrad of tilt noise into 0.4 mm at the
+  robot, twice the position noise itself. Interpolating between two samples with weights w,
+  1 - w averages their noise: sigma times sqrt(w^2 + (1 - w)^2).
   Without a still phase: the 2015 FBM2 log's values (``transform.py``: ~0.8 mm per still
   step, 13 mrad RMS), stated as defaults.
 - ``time_association``: where the pose was taken is as uncertain as the moment is on the GT
@@ -21,8 +24,8 @@ GT samples around it) composed with the marker-to-robot transform. Sources
   the state messages and the GT (both are stamped by the logging machine): no further offset.
 - ``transform``: the marker-to-robot transform's error, common to every segment. A transform
   file does not carry how it was acquired: the 2015 node read a single tf sample with the
-  robot on the origin, so its error is one mocap measurement's (sigma per axis, sigma_yaw),
-  stated as a default.
+  robot on the origin, so its error is one mocap measurement's (sigma per axis, the rotation
+  sigmas, turning the lever arm as above), stated as a default.
 
 Scores near zero are biased by noise (a distance cannot be negative); the basic interval
 removes the bias the draws show.
@@ -50,7 +53,7 @@ from ertools.benchmarks.common.uncertainty import (
 )
 from ertools.benchmarks.noise.benchmark import noise_from_stream
 from ertools.errors import ScoringError
-from ertools.geometry import wrap_angle, yaw_from_quat
+from ertools.geometry import quat_conjugate, quat_multiply, wrap_angle
 from ertools.streams import PoseStream
 
 METHOD = "Monte Carlo (parametric bootstrap, basic interval)"
@@ -59,7 +62,7 @@ METHOD = "Monte Carlo (parametric bootstrap, basic interval)"
 DEFAULT_EPSILON_M = 0.0008
 DEFAULT_SIGMA_YAW = 0.013
 MAD_TO_SIGMA = 1.4826
-MIN_YAW_PAIRS = 10
+MIN_PAIRS = 10
 
 
 @dataclass(frozen=True, eq=False)
@@ -69,7 +72,8 @@ class Moments:
     Attributes:
         robot: (K, 3) robot x, y, yaw as scored.
         target: (K, 3) the waypoints.
-        lever: (K, 2) the marker-to-robot offset in the world plane at the moment.
+        lever: (K, 3) the marker-to-robot offset in the world at the moment.
+        heading: (K,) the marker's yaw at the moment (turns a transform error into the world).
         averaging: (K,) sqrt(w^2 + (1 - w)^2) of the interpolation (1: one sample).
         velocity: (K, 3) robot vx, vy, yaw rate at the moment (per second).
     """
@@ -77,6 +81,7 @@ class Moments:
     robot: F64
     target: F64
     lever: F64
+    heading: F64
     averaging: F64
     velocity: F64
 
@@ -86,10 +91,9 @@ class Model:
     """The sources' sizes."""
 
     sigma: float
+    sigma_tilt: float
     sigma_yaw: float
     half_period_s: float
-    transform_sigma: float
-    transform_sigma_yaw: float
     sources: tuple[Source, ...]
 
 
@@ -112,16 +116,22 @@ def measure_model(marker: PoseStream) -> Model:
             f"sigma = epsilon / sqrt(pi), epsilon {noise.epsilon * 1000:.4g} mm from "
             f"{noise.distances.size} pairs over {noise.duration_s:.1f} s of stationary phases"
         )
-        yaw = _yaw_sigma(marker)
-        if yaw is not None:
-            sigma_yaw = yaw
-            note += f"; yaw sigma {yaw * 1000:.3g} mrad (1.4826 MAD / sqrt 2 of still yaw steps)"
+        rot = _rotation_sigmas(marker)
+        if rot is not None:
+            sigma_tilt, sigma_yaw = rot
+            note += (
+                f"; rotation sigma {sigma_tilt * 1000:.3g} mrad (tilt), {sigma_yaw * 1000:.3g} "
+                "mrad (yaw): 1.4826 MAD / sqrt 2 of the still samples' relative rotations"
+            )
         else:
-            note += f"; yaw sigma default {DEFAULT_SIGMA_YAW * 1000:g} mrad (too few still pairs)"
+            note += (
+                f"; rotation sigma default {DEFAULT_SIGMA_YAW * 1000:g} mrad per axis (too few "
+                "still pairs)"
+            )
     else:
         note = (
-            "default: no stationary phase in the GT; epsilon 0.8 mm and yaw sigma 13 mrad, "
-            "the 2015 FBM2 log's still marker set"
+            "default: no stationary phase in the GT; epsilon 0.8 mm and 13 mrad per rotation "
+            "axis, the 2015 FBM2 log's still marker set"
         )
     dt = np.diff(marker.t_ns)
     dt = dt[dt > 0]
@@ -141,25 +151,29 @@ def measure_model(marker: PoseStream) -> Model:
         "m",
         False,
         f"default: the transform file carries no acquisition spread; as the 2015 node read a "
-        f"single tf sample, one mocap measurement's error (sigma per axis, yaw "
-        f"{sigma_yaw * 1000:.3g} mrad), common to every segment",
+        f"single tf sample, one mocap measurement's error (sigma per axis, rotation "
+        f"{sigma_tilt * 1000:.3g}/{sigma_yaw * 1000:.3g} mrad tilt/yaw), common to every segment",
     )
-    return Model(sigma, sigma_yaw, half, sigma, sigma_yaw, (mocap, timing, transform))
+    return Model(sigma, sigma_tilt, sigma_yaw, half, (mocap, timing, transform))
 
 
-def _yaw_sigma(marker: PoseStream) -> float | None:
-    xy = marker.xyz[:, :2]
-    phases = stationary_phases(marker.t_ns, xy)
+def _rotation_sigmas(marker: PoseStream) -> tuple[float, float] | None:
+    """(tilt, yaw) rotation noise sigmas from consecutive still samples, None if too few."""
+    phases = stationary_phases(marker.t_ns, marker.xyz[:, :2])
     pairs = phase_pairs(phases, len(marker))
     if not pairs.any():
         return None
-    yaw = yaw_from_quat(marker.quat_xyzw)
-    d = wrap_angle(np.diff(yaw))[pairs]
-    d = d[np.isfinite(d) & (d != 0.0)]  # a repeated pose is a lost frame, not noise
-    if d.size < MIN_YAW_PAIRS:
+    q = marker.quat_xyzw
+    rel = quat_multiply(quat_conjugate(q[:-1]), q[1:])[pairs]
+    rel = rel * np.where(rel[:, 3:] < 0, -1.0, 1.0)  # the short way round
+    rotvec = 2.0 * rel[:, :3]  # small angles: the vector part is half the rotation vector
+    moved = np.isfinite(rotvec).all(axis=1) & np.any(rotvec != 0.0, axis=1)
+    rotvec = rotvec[moved]  # a repeated pose is a lost frame, not noise
+    if len(rotvec) < MIN_PAIRS:
         return None
-    mad = float(np.median(np.abs(d - np.median(d))))
-    return MAD_TO_SIGMA * mad / math.sqrt(2.0)
+    mad = np.median(np.abs(rotvec - np.median(rotvec, axis=0)), axis=0)
+    sig = MAD_TO_SIGMA * mad / math.sqrt(2.0)
+    return float(math.sqrt((sig[0] ** 2 + sig[1] ** 2) / 2.0)), float(sig[2])
 
 
 def perturbed_scores(
@@ -179,33 +193,38 @@ def perturbed_scores(
     y = np.broadcast_to(m.robot[:, 1], (n, k)).copy()
     yaw = np.broadcast_to(m.robot[:, 2], (n, k)).copy()
 
-    def swing(angle: F64, lever: F64) -> tuple[F64, F64]:
-        """The change of a lever (K, 2) turned by ``angle`` (n, K)."""
-        c, s = np.cos(angle) - 1.0, np.sin(angle)
-        return c * lever[:, 0] - s * lever[:, 1], s * lever[:, 0] + c * lever[:, 1]
+    lx, ly, lz = m.lever[:, 0], m.lever[:, 1], m.lever[:, 2]
+
+    def swing(rx: F64, ry: F64, rz: F64) -> tuple[F64, F64]:
+        """The planar change of the lever turned by the small rotation (rx, ry, rz)."""
+        return ry * lz - rz * ly, rz * lx - rx * lz
 
     if MOCAP_NOISE in sources:
         a = m.averaging
         x += rng.standard_normal((n, k)) * model.sigma * a
         y += rng.standard_normal((n, k)) * model.sigma * a
-        dyaw = rng.standard_normal((n, k)) * model.sigma_yaw * a
-        dx, dy = swing(dyaw, m.lever)
-        x, y, yaw = x + dx, y + dy, yaw + dyaw
+        rx = rng.standard_normal((n, k)) * model.sigma_tilt * a
+        ry = rng.standard_normal((n, k)) * model.sigma_tilt * a
+        rz = rng.standard_normal((n, k)) * model.sigma_yaw * a
+        dx, dy = swing(rx, ry, rz)
+        x, y, yaw = x + dx, y + dy, yaw + rz
     if TIME_ASSOCIATION in sources and model.half_period_s > 0:
         dt = rng.uniform(-model.half_period_s, model.half_period_s, size=(n, k))
         x += dt * m.velocity[:, 0]
         y += dt * m.velocity[:, 1]
         yaw += dt * m.velocity[:, 2]
     if TRANSFORM in sources:
-        # one transform error for every segment of a draw: lever offset in the marker frame
-        # (turned into the world with each segment's heading) and a yaw offset
-        t_lever = rng.standard_normal((n, 2)) * model.transform_sigma
-        t_yaw = rng.standard_normal((n, 1)) * model.transform_sigma_yaw
-        heading = m.robot[:, 2][None, :]
-        c, s = np.cos(heading), np.sin(heading)
-        x += c * t_lever[:, :1] - s * t_lever[:, 1:]
-        y += s * t_lever[:, :1] + c * t_lever[:, 1:]
-        dx, dy = swing(np.broadcast_to(t_yaw, (n, k)), m.lever)
+        # one transform error for every segment of a draw, in the marker frame (turned into
+        # the world with each segment's heading): an offset and a small rotation of the lever
+        e = rng.standard_normal((n, 2)) * model.sigma
+        tilt = rng.standard_normal((n, 2)) * model.sigma_tilt
+        t_yaw = rng.standard_normal((n, 1)) * model.sigma_yaw
+        c, s = np.cos(m.heading)[None, :], np.sin(m.heading)[None, :]
+        x += c * e[:, :1] - s * e[:, 1:]
+        y += s * e[:, :1] + c * e[:, 1:]
+        rx = c * tilt[:, :1] - s * tilt[:, 1:]
+        ry = s * tilt[:, :1] + c * tilt[:, 1:]
+        dx, dy = swing(rx, ry, np.broadcast_to(t_yaw, (n, k)))
         x, y, yaw = x + dx, y + dy, yaw + t_yaw
     distance = np.hypot(x - m.target[:, 0], y - m.target[:, 1])
     dtheta = yaw - m.target[:, 2]
