@@ -174,7 +174,10 @@ def perturbed_errors(
     n = len(run.xy)
     measured = int(run.source.max()) + 1 if n else 0
     if noisy:
-        eps = rng.standard_normal((d, measured, 2))[:, run.source, :] * sigmas[:, None, None]
+        eps = rng.standard_normal((d, measured, 2))
+        if measured != n:  # repeated poses carry the noise of the measurement they repeat
+            eps = eps[:, run.source, :]
+        eps *= sigmas[:, None, None]
         ref_eps = rng.standard_normal((d, 2)) * sigmas[:, None]
     else:
         eps = np.zeros((d, n, 2))
@@ -211,32 +214,35 @@ def _subsample(x: F64, y: F64, d_mins: F64) -> np.ndarray:
 
 
 def _eq1(x: F64, y: F64, kept: np.ndarray, rx: F64, ry: F64, shape: Shape) -> F64:
-    """Eq. (1) of every draw from its kept flags (as :func:`~.path.score_path`)."""
-    d, n = x.shape
-    cols = np.arange(n)
-    last = np.maximum.accumulate(np.where(kept, cols, 0), axis=1)
-    prev = last[:, :-1]  # the last kept sample before each sample j >= 1
-    step = np.hypot(
-        x[:, 1:] - np.take_along_axis(x, prev, axis=1),
-        y[:, 1:] - np.take_along_axis(y, prev, axis=1),
-    )
-    step = np.where(kept[:, 1:], step, 0.0)
-    cum = np.concatenate([np.zeros((d, 1)), np.cumsum(step, axis=1)], axis=1)
-    total = cum[:, -1]
-    count = kept.sum(axis=1)
-    x0, y0 = x[:, :1], y[:, :1]
-    yaw = np.arctan2(y0[:, 0] - ry, x0[:, 0] - rx)
-    c, s = np.cos(yaw)[:, None], np.sin(yaw)[:, None]
-    fx = c * (x - x0) + s * (y - y0)
-    fy = -s * (x - x0) + c * (y - y0)
+    """Eq. (1) of every draw from its kept flags (as :func:`~.path.score_path`), on the kept
+    points only: in row-major order each draw's kept points follow one another, its first
+    one (the start, always kept) first."""
+    d = x.shape[0]
+    rows, cols = np.nonzero(kept)
+    xk, yk = x[rows, cols], y[rows, cols]
+    first = cols == 0
+    step = np.empty(rows.size)
+    step[0] = 0.0
+    step[1:] = np.hypot(np.diff(xk), np.diff(yk))
+    step[first] = 0.0
+    run = np.cumsum(step)  # sequential within each draw, as the 2015 loop
+    starts = np.flatnonzero(first)
+    cum = run - np.repeat(run[starts], np.diff(np.append(starts, rows.size)))
+    count = np.bincount(rows, minlength=d)
+    last = np.cumsum(count) - 1
+    total = np.zeros(d)
+    total[count > 0] = cum[last[count > 0]]
+    x0, y0 = x[:, 0], y[:, 0]
+    yaw = np.arctan2(y0 - ry, x0 - rx)
+    c, s = np.cos(yaw)[rows], np.sin(yaw)[rows]
+    dx, dy = xk - x0[rows], yk - y0[rows]
     with np.errstate(invalid="ignore", divide="ignore"):
-        l_norm = np.where(kept, cum / total[:, None], 0.0)
-    target = shape(np.clip(l_norm, 0.0, 1.0).ravel()).reshape(d, n, 2)
-    err = np.hypot(fx - target[:, :, 0], fy - target[:, :, 1])
-    err[:, 0] = 0.0  # 2015 started its sum at the second kept point
-    err = np.where(kept, err, 0.0)
-    out = err.sum(axis=1) / np.maximum(count, 1)
-    bad = (count < 2) | ~(total > 0) | ((x0[:, 0] == rx) & (y0[:, 0] == ry))
+        l_norm = np.clip(np.nan_to_num(cum / total[rows]), 0.0, 1.0)
+    target = shape(l_norm)
+    err = np.hypot(c * dx + s * dy - target[:, 0], -s * dx + c * dy - target[:, 1])
+    err[first] = 0.0  # 2015 started its sum at the second kept point
+    out = np.bincount(rows, weights=err, minlength=d) / np.maximum(count, 1)
+    bad = (count < 2) | ~(total > 0) | ((x0 == rx) & (y0 == ry))
     return np.where(bad, np.nan, out)
 
 
