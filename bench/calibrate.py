@@ -58,7 +58,7 @@ class Coverage:
 # how each benchmark's widths are shown (its scores' unit)
 UNITS = {
     "fbm1": (1.0, ""),
-    "fbm2h": (1000.0, "mm"),
+    "fbm2h": (1000.0, "mm or mrad"),
     "fbm3w": (1000.0, "mm"),
     "trajectory": (1.0, ""),
 }
