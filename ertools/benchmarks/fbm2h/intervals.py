@@ -99,12 +99,9 @@ class Model:
 
 def measure_model(marker: PoseStream) -> Model:
     """The sources' sizes from the marker stream (still phases, frame period)."""
-    sigma, sigma_yaw, measured, note = (
-        DEFAULT_EPSILON_M / math.sqrt(math.pi),
-        DEFAULT_SIGMA_YAW,
-        False,
-        "",
-    )
+    sigma = DEFAULT_EPSILON_M / math.sqrt(math.pi)
+    sigma_tilt = sigma_yaw = DEFAULT_SIGMA_YAW
+    measured = False
     try:
         noise = noise_from_stream(marker, stationary=True)
     except ScoringError:

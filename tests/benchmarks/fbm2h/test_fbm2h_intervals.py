@@ -114,3 +114,17 @@ def test_interval_width_and_shares() -> None:
     half = (found.distance[0].high - found.distance[0].low) / 2
     assert half == pytest.approx(1.959964 * 2e-4, rel=0.03)
     assert found.uncertainty.shares["position_accuracy"] == {MOCAP_NOISE: 1.0}
+
+
+def test_a_robot_never_still_gets_the_stated_defaults() -> None:
+    from ertools.benchmarks.fbm2h.intervals import DEFAULT_EPSILON_M, measure_model
+    from ertools.streams import PoseStream
+
+    t = np.arange(500, dtype=np.int64) * 8_333_333  # 120 Hz, moving 0.6 m/s throughout
+    xyz = np.column_stack([np.linspace(0.0, 5.0, 500), np.zeros(500), np.zeros(500)])
+    model = measure_model(PoseStream(t, xyz, np.tile([0.0, 0.0, 0.0, 1.0], (500, 1))))
+    assert model.sigma == pytest.approx(DEFAULT_EPSILON_M / math.sqrt(math.pi))
+    mocap, timing, transform = model.sources
+    assert not mocap.measured and "default" in mocap.note
+    assert timing.measured and timing.value == pytest.approx(8_333_333 / 2e9)
+    assert not transform.measured
