@@ -60,8 +60,9 @@ bench: $(STAMP)
 # per benchmark (bench/calibration/), the table written into docs/uncertainty.md.
 # `make calibrate TRIALS=200`; one benchmark: `$(BIN)/python bench/calibrate.py --only fbm3w`.
 TRIALS ?= 1000
+CAL_JOBS ?= 2
 calibrate: $(STAMP)
-	$(BIN)/python bench/calibrate.py --trials $(TRIALS)
+	$(BIN)/python bench/calibrate.py --trials $(TRIALS) --jobs $(CAL_JOBS)
 
 # JupyterLab in the project's venv, then the notebooks open in it. As root (a container),
 # Jupyter refuses to start without --allow-root: given then, with the reason said.

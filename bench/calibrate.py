@@ -6,7 +6,7 @@ its docstring), each scored with intervals exactly as ``ertools score`` does; co
 the interval covers the true noiseless score and writes the table (a row per benchmark:
 trials, scores, coverage %, mean width) into docs/uncertainty.md between its markers.
 
-    .venv/bin/python bench/calibrate.py [--trials 1000] [--draws 400] [--only fbm3w]
+    .venv/bin/python bench/calibrate.py [--trials 1000] [--draws 400] [--only fbm3w] [--jobs 2]
         [--docs docs/uncertainty.md | --no-docs]
 
 Nothing here is a test: `make test` runs the small versions (tests/calibration/).
@@ -19,6 +19,7 @@ import importlib
 import math
 import sys
 import time
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -70,20 +71,39 @@ def coverage(rows: list[Row]) -> tuple[int, int, float]:
     return len(rows), covered, sum(hi - lo for _, _, lo, hi in rows)
 
 
-def run_benchmark(name: str, trials: int, draws: int, first_seed: int = 0) -> Coverage | None:
-    """``trials`` trials of one benchmark (seeds first_seed..), None if its module is absent."""
+def _chunk(name: str, seeds: range, draws: int) -> tuple[int, int, float]:
+    """(scores, covered, summed width) of one benchmark's trials over ``seeds``."""
+    module = importlib.import_module(MODULES[name])
+    scores = covered = 0
+    width = 0.0
+    for seed in seeds:
+        n, c, w = coverage(module.trial(seed, draws))
+        scores, covered, width = scores + n, covered + c, width + w
+    return scores, covered, width
+
+
+def run_benchmark(
+    name: str, trials: int, draws: int, first_seed: int = 0, jobs: int = 1
+) -> Coverage | None:
+    """``trials`` trials of one benchmark (seeds first_seed..), on ``jobs`` processes; None if
+    its module is absent."""
     try:
-        module = importlib.import_module(MODULES[name])
+        importlib.import_module(MODULES[name])
     except ModuleNotFoundError as err:
         if err.name != MODULES[name]:
             raise
         return None
     t0 = time.perf_counter()
-    scores = covered = 0
-    width = 0.0
-    for seed in range(first_seed, first_seed + trials):
-        n, c, w = coverage(module.trial(seed, draws))
-        scores, covered, width = scores + n, covered + c, width + w
+    seeds = range(first_seed, first_seed + trials)
+    chunks = [seeds[k::jobs] for k in range(jobs)]
+    if jobs > 1:
+        with ProcessPoolExecutor(jobs) as pool:
+            parts = list(pool.map(_chunk, [name] * jobs, chunks, [draws] * jobs))
+    else:
+        parts = [_chunk(name, seeds, draws)]
+    scores = sum(p[0] for p in parts)
+    covered = sum(p[1] for p in parts)
+    width = sum(p[2] for p in parts)
     scale, unit = UNITS.get(name, (1.0, ""))
     return Coverage(
         name,
@@ -135,12 +155,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--trials", type=int, default=1000)
     ap.add_argument("--draws", type=int, default=400)
     ap.add_argument("--only", action="append", choices=sorted(MODULES))
+    ap.add_argument("--jobs", type=int, default=1, help="processes (seeds split among them)")
     ap.add_argument("--docs", type=Path, default=REPO / "docs" / "uncertainty.md")
     ap.add_argument("--no-docs", action="store_true")
     args = ap.parse_args(argv)
     results = []
     for name in args.only or list(MODULES):
-        r = run_benchmark(name, args.trials, args.draws)
+        r = run_benchmark(name, args.trials, args.draws, jobs=max(1, args.jobs))
         if r is None:
             print(f"{name}: bench/calibration/{name}.py not written yet, skipped")
             continue
