@@ -128,3 +128,35 @@ def test_a_robot_never_still_gets_the_stated_defaults() -> None:
     assert not mocap.measured and "default" in mocap.note
     assert timing.measured and timing.value == pytest.approx(8_333_333 / 2e9)
     assert not transform.measured
+
+
+def test_draws_0_leaves_the_result_as_it_was() -> None:
+    import yaml
+
+    from ertools.benchmarks.fbm2h.benchmark import compute, with_intervals
+    from ertools.benchmarks.fbm2h.config import Fbm2hOptions
+    from ertools.benchmarks.fbm2h.segments import ReachedMoments
+    from ertools.configs.goal import parse_goal
+    from ertools.configs.transform import parse_transform
+    from ertools.samples import fbm2h as sim
+    from ertools.streams import PoseStream
+
+    run = sim.simulate(0)
+    pub = run.bodies[sim.BODY]
+    marker = PoseStream(pub.t_header_ns, pub.xyz, pub.quat_xyzw)
+    goal = parse_goal(yaml.safe_load(run.configs["fbm2h_goal.yaml"]))
+    transform = parse_transform(yaml.safe_load(run.configs[f"transform-{sim.TEAM}.yaml"]))
+    segs = run.truth["segments"]
+    moments = ReachedMoments(
+        "states",
+        np.array([s["start_ns"] for s in segs]),
+        np.array([s["end_ns"] for s in segs]),
+        tuple("" for _ in segs),
+    )
+    plain = compute(goal, transform, marker, moments)
+    assert with_intervals(plain, marker, transform, moments, Fbm2hOptions(draws=0)) is plain
+    full = with_intervals(plain, marker, transform, moments, Fbm2hOptions(draws=50))
+    assert full.intervals is not None
+    listing = list(plain.to_dict())
+    assert list(full.to_dict())[: len(listing)] == listing
+    assert full.position_accuracy == plain.position_accuracy  # the score itself unchanged
