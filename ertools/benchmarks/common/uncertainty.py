@@ -313,8 +313,8 @@ def split_interval(row: dict[str, Any], key: str) -> None:
 
 
 def uncertainty_rows(uncertainty: Uncertainty) -> list[dict[str, Any]]:
-    """The ``uncertainty`` block as table rows: one per score and source (its share), with
-    the source's size and whether it was measured."""
+    """The ``uncertainty`` block as table rows: one per score and source (its share, a
+    fraction), with the source's size (text with its unit) and whether it was measured."""
     sources = {s.name: s for s in uncertainty.sources}
     rows: list[dict[str, Any]] = []
     for score, shares in uncertainty.shares.items():
@@ -325,8 +325,8 @@ def uncertainty_rows(uncertainty: Uncertainty) -> list[dict[str, Any]]:
                     "score": score,
                     "source": name,
                     "share": share,
-                    "value": None if s is None else s.value,
-                    "unit": None if s is None else s.unit,
+                    # one text cell: the sources' sizes are in different units
+                    "size": None if s is None else f"{s.value:.6g} {s.unit}",
                     "measured": None if s is None else s.measured,
                     "confidence": uncertainty.confidence,
                     "draws": uncertainty.draws,

@@ -175,7 +175,7 @@ def perturbed_errors(
     measured = int(run.source.max()) + 1 if n else 0
     if noisy:
         eps = rng.standard_normal((d, measured, 2))
-        if measured != n:  # repeated poses carry the noise of the measurement they repeat
+        if np.any(run.source != np.arange(n)):  # a repeated pose repeats its noise
             eps = eps[:, run.source, :]
         eps *= sigmas[:, None, None]
         ref_eps = rng.standard_normal((d, 2)) * sigmas[:, None]
