@@ -106,3 +106,21 @@ def test_intervals_are_seeded_and_cover_the_best_run() -> None:
     assert (best.low, best.high) == pytest.approx((per_run[0].low, per_run[0].high))
     assert per_run[0].low <= est <= per_run[0].high
     assert run_intervals([run], [est], model, draws=0, seed=0, confidence=0.95) == ([None], None)
+
+
+def test_a_repeated_pose_repeats_its_noise_in_every_draw() -> None:
+    # samples 5-7 repeat sample 4 (tracking lost): in each draw they stay equal to it
+    xy, ref = _line_run(np.random.default_rng(7), 5e-5)
+    source = np.arange(len(xy))
+    source[5:8] = 4
+    xy[5:8] = xy[4]
+    run = RunSamples(xy, source, ref, builtin_shapes()["line"])
+    sigmas = np.full(2, 1e-4)
+    got = perturbed_errors(run, sigmas, np.full(2, 0.00033), np.random.default_rng(3), True)
+    again = np.random.default_rng(3)
+    eps = again.standard_normal((2, len(xy), 2))[:, source, :] * 1e-4
+    ref_eps = again.standard_normal((2, 2)) * 1e-4
+    for k in range(2):
+        assert np.all(eps[k, 5:8] == eps[k, 4])
+        want = eq1(ref + ref_eps[k], xy + eps[k], "line", 0.00033)[0]
+        assert got[k] == pytest.approx(want, rel=1e-12)
