@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 DEVSTAMP := $(VENV)/.installed-dev
 DEMO_OUT ?= demo_output
 
-.PHONY: demo test check lint typecheck pytest bench fuzz samples notebooks clean
+.PHONY: demo test check lint typecheck pytest bench calibrate fuzz samples notebooks clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -55,6 +55,14 @@ bench: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e '.[dask]'  # the season's LocalCluster run
 	$(BIN)/python -m compileall -q ertools
 	$(BIN)/python bench/run.py
+
+# Do the 95% score intervals cover the truth 95% of the time? 1,000 seeded simulated executions
+# per benchmark (bench/calibration/), the table written into docs/uncertainty.md.
+# `make calibrate TRIALS=200`; one benchmark: `$(BIN)/python bench/calibrate.py --only fbm3w`.
+TRIALS ?= 1000
+CAL_JOBS ?= 2
+calibrate: $(STAMP)
+	$(BIN)/python bench/calibrate.py --trials $(TRIALS) --jobs $(CAL_JOBS)
 
 # JupyterLab in the project's venv, then the notebooks open in it. As root (a container),
 # Jupyter refuses to start without --allow-root: given then, with the reason said.

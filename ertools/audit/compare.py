@@ -143,6 +143,12 @@ def _identity_caveat(live: Any, result: BenchmarkResult) -> str:
     return "" if used is not None and used.is_identity else IDENTITY_CAVEAT
 
 
+def _interval_key(key: str) -> bool:
+    """A flattened key of an interval (``..._interval.0``) or of the ``uncertainty`` block."""
+    parts = key.split(".")
+    return parts[0] == "uncertainty" or any(p.endswith("_interval") for p in parts)
+
+
 def compare_scores(
     live: Any,
     result: BenchmarkResult,
@@ -182,7 +188,9 @@ def compare_scores(
         live_flat = {"(live score)": live}
     else:
         live_flat = flatten(_align_indices(_renest(live, recomputed, notes), recomputed, notes))
-    rec_flat = flatten(recomputed)
+    # The intervals and their uncertainty block (issue 28) qualify the recomputed score; the
+    # live node never sent any: not compared, not listed as "only recomputed".
+    rec_flat = {k: v for k, v in flatten(recomputed).items() if not _interval_key(k)}
     flat_2015 = flatten(jsonable(as_2015.to_dict())) if as_2015 is not None else {}
     if live_flat and not set(live_flat) & set(rec_flat):
         notes.append(

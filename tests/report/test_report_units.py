@@ -43,6 +43,7 @@ UNITLESS = {
     "instance_accuracy", "pose_score", "warnings", "failures", "audit findings", "item_id",
     "i", "sample", "l_norm", "count", "pairs", "lost", "transitions", "refbox_timeout",
     "timeout", "id", "compared", "gaps", "valid_fraction", "path_coverage",
+    "share", "confidence", "draws", "seed",  # the uncertainty table: fractions and counts
 }  # fmt: skip
 
 

@@ -270,3 +270,67 @@ def interval_keys(
             iv = intervals[key]
             out[f"{key}_interval"] = None if iv is None else iv.as_list()
     return out
+
+
+def interval_line(
+    name: str,
+    value: float,
+    interval: Interval | None,
+    uncertainty: Uncertainty,
+    *,
+    scale: float = 1.0,
+    unit: str = "",
+) -> str:
+    """One stderr line: the score, its interval and how it was obtained, e.g.
+    ``best_distance_error 0.639 mm, 95% interval [0.41, 0.88] mm (Monte Carlo 400 draws,
+    seed 0; mocap_noise 71%, d_min 29%)``; ``scale`` converts SI values to ``unit``."""
+    u = f" {unit}" if unit else ""
+    how = f"Monte Carlo {uncertainty.draws} draws, seed {uncertainty.seed}"
+    level = f"{uncertainty.confidence * 100:g}%"
+    if interval is None:
+        return f"{name} {value * scale:.4g}{u}, no {level} interval ({how}: too few draws scored)"
+    shares = ", ".join(f"{n} {f:.0%}" for n, f in interval.shares)
+    return (
+        f"{name} {value * scale:.4g}{u}, {level} interval "
+        f"[{interval.low * scale:.4g}, {interval.high * scale:.4g}]{u} ({how}; {shares})"
+    )
+
+
+def split_interval(row: dict[str, Any], key: str) -> None:
+    """A table row's ``K_interval: [low, high]`` as ``K_low`` and ``K_high`` columns (CSV),
+    in its place."""
+    name = f"{key}_interval"
+    if name not in row:
+        return
+    pairs = list(row.items())
+    row.clear()
+    for k, v in pairs:
+        if k == name:
+            row[f"{key}_low"] = None if v is None else v[0]
+            row[f"{key}_high"] = None if v is None else v[1]
+        else:
+            row[k] = v
+
+
+def uncertainty_rows(uncertainty: Uncertainty) -> list[dict[str, Any]]:
+    """The ``uncertainty`` block as table rows: one per score and source (its share, a
+    fraction), with the source's size (text with its unit) and whether it was measured."""
+    sources = {s.name: s for s in uncertainty.sources}
+    rows: list[dict[str, Any]] = []
+    for score, shares in uncertainty.shares.items():
+        for name, share in shares.items():
+            s = sources.get(name)
+            rows.append(
+                {
+                    "score": score,
+                    "source": name,
+                    "share": share,
+                    # one text cell: the sources' sizes are in different units
+                    "size": None if s is None else f"{s.value:.6g} {s.unit}",
+                    "measured": None if s is None else s.measured,
+                    "confidence": uncertainty.confidence,
+                    "draws": uncertainty.draws,
+                    "seed": uncertainty.seed,
+                }
+            )
+    return rows

@@ -9,6 +9,11 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ertools.benchmarks.common.uncertainty import (
+    DEFAULT_CONFIDENCE,
+    DEFAULT_DRAWS,
+    DEFAULT_SEED,
+)
 from ertools.benchmarks.fbm2h.segments import StopParams
 from ertools.configs.transform import (
     MarkerTransform,
@@ -54,6 +59,8 @@ class Fbm2hOptions:
             ``reason: timeout`` / ``reason: stop``; :func:`ertools.states.end_reason`).
         namespace: the benchmark namespace of the state topics.
         stops: thresholds for ``auto``.
+        confidence, draws, seed: the score intervals (level, Monte Carlo draws, 0 for none;
+            seed), :mod:`ertools.benchmarks.fbm2h.intervals`.
         marker_transform: a transform already in hand (``ertools audit``: the one the live
             score says the node used); None = from ``transform``/``team``, else identity.
     """
@@ -79,3 +86,6 @@ class Fbm2hOptions:
     unscoreable_2015: bool = False
     stops: StopParams = field(default_factory=StopParams)
     marker_transform: MarkerTransform | None = None
+    confidence: float = DEFAULT_CONFIDENCE
+    draws: int = DEFAULT_DRAWS
+    seed: int = DEFAULT_SEED

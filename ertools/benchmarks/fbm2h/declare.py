@@ -20,6 +20,7 @@ from ertools.benchmarks.base import (
     tf_value,
 )
 from ertools.benchmarks.common.ending import EXACT_HELP
+from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS, check_confidence
 from ertools.benchmarks.fbm2h.benchmark import score_found
 from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, Fbm2hOptions
 from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, load, locate_runs
@@ -178,6 +179,7 @@ INPUTS = (
         positive=True,
         group=AUTO,
     ),
+    *INTERVAL_INPUTS,
 )
 
 
@@ -222,12 +224,16 @@ def make_options(given: Mapping[str, Any]) -> Fbm2hOptions:
             min_duration_s=v["stop_min"],
             radius=v["stop_radius"],
         ),
+        confidence=check_confidence(v["confidence"]),
+        draws=v["draws"],
+        seed=v["seed"],
     )
 
 
 def notes(result: Fbm2hResult) -> list[str]:
-    """How the reached moments were found (with ``-v``) and the per-segment table."""
-    out = []
+    """The score intervals, how the reached moments were found (with ``-v``) and the
+    per-segment table."""
+    out = result.interval_lines()
     if logging.getLogger("ertools").isEnabledFor(logging.INFO):  # -v
         out += list(result.notes)
     out.append(

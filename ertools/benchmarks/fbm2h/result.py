@@ -12,6 +12,8 @@ import yaml
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.benchmarks.common.validity import GapOnPath, Validity, cell
+from ertools.benchmarks.common.uncertainty import Interval, interval_line, uncertainty_rows
+from ertools.benchmarks.fbm2h.intervals import Fbm2hIntervals
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
 from ertools.fidelity import Deviation
@@ -98,6 +100,8 @@ def _validity_keys(seg: SegmentResult) -> dict[str, Any]:
     if seg.unscoreable_reason is not None:
         out["unscoreable_reason"] = seg.unscoreable_reason
     return out
+def _as_list(iv: Interval | None) -> list[float] | None:
+    return None if iv is None else iv.as_list()
 
 
 def _num(x: float | None) -> float | None:
@@ -126,6 +130,7 @@ class Fbm2hResult:
         notes: how the reached moments were found.
         origin_ns: the log's first message; table times count from it (from the first
             segment start when None).
+        intervals: the confidence intervals of the scores (None with ``--draws 0``).
     """
 
     segments: tuple[SegmentResult, ...]
@@ -148,6 +153,7 @@ class Fbm2hResult:
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
     name: str = "fbm2h"
+    intervals: Fbm2hIntervals | None = None
 
     @property
     def nothing_scored(self) -> bool:
@@ -160,7 +166,17 @@ class Fbm2hResult:
         return any(s.status == "no_gt" for s in self.segments)
 
     def _segment_listing(self, seg: SegmentResult) -> dict[str, Any]:
-        # Keys and order of Listing 13 (the 2015 node wrote "dinstance_error" so, typo included).
+        # Keys and order of Listing 13 (the 2015 node wrote "dinstance_error" so, typo included),
+        # then the intervals of its two errors (issue 28) as extra keys.
+        out = self._segment_listing_2015(seg)
+        iv = self.intervals
+        if iv is not None and seg.index in iv.distance:
+            out["dinstance_error_interval"] = _as_list(iv.distance[seg.index])
+            out["orientation_error_interval"] = _as_list(iv.angle.get(seg.index))
+        out.update(_validity_keys(seg))
+        return out
+
+    def _segment_listing_2015(self, seg: SegmentResult) -> dict[str, Any]:
         return {
             "dinstance_error": _num(seg.distance_error),
             "end_segment_time": None if seg.end_ns is None else ns_to_s(seg.end_ns),
@@ -173,7 +189,6 @@ class Fbm2hResult:
             "start_segment_time": None if seg.start_ns is None else ns_to_s(seg.start_ns),
             "target_pose": _pose_map(seg.target),
             "timeout": bool(seg.timeout) and not self.unscored_2015,
-            **_validity_keys(seg),
         }
 
     def _listing(self, string_keys: bool) -> dict[str, Any]:
@@ -192,6 +207,10 @@ class Fbm2hResult:
                 "segments_details": details,
             },
         }
+        if self.intervals is not None:
+            out["position_accuracy_interval"] = _as_list(self.intervals.position)
+            out["orientation_accuracy_interval"] = _as_list(self.intervals.orientation)
+            out["uncertainty"] = self.intervals.uncertainty.to_dict()
         reason = self.unscoreable_reason
         if reason is not None:
             out["status"] = "unscoreable"
@@ -229,6 +248,61 @@ class Fbm2hResult:
         if driven and not out:
             out.append(f"validity: segments 0-{driven[-1].index} 100.0% valid")
         return out
+
+    def interval_lines(self) -> list[str]:
+        """One line per score with its interval and the method (for stderr)."""
+        iv = self.intervals
+        if iv is None:
+            return []
+        u = iv.uncertainty
+        lines = []
+        if self.position_accuracy is not None:
+            lines.append(
+                interval_line(
+                    "position_accuracy",
+                    self.position_accuracy,
+                    iv.position,
+                    u,
+                    scale=1000.0,
+                    unit="mm",
+                )
+            )
+        if self.orientation_accuracy is not None:
+            lines.append(
+                interval_line(
+                    "orientation_accuracy",
+                    self.orientation_accuracy,
+                    iv.orientation,
+                    u,
+                    scale=1000.0,
+                    unit="mrad",
+                )
+            )
+        for s in self.segments:
+            if s.distance_error is None or s.index not in iv.distance:
+                continue
+            lines.append(
+                interval_line(
+                    f"segment {s.index} distance_error",
+                    s.distance_error,
+                    iv.distance[s.index],
+                    u,
+                    scale=1000.0,
+                    unit="mm",
+                )
+            )
+            if s.orientation_error is not None:
+                lines.append(
+                    interval_line(
+                        f"segment {s.index} orientation_error",
+                        s.orientation_error,
+                        iv.angle.get(s.index),
+                        u,
+                        scale=1000.0,
+                        unit="mrad",
+                    )
+                )
+        return lines
 
     def to_yaml(self) -> str:
         """The Listing 13 score."""
@@ -270,7 +344,9 @@ class Fbm2hResult:
                     "robot_y": None if s.robot is None else s.robot[1],
                     "robot_theta": None if s.robot is None else s.robot[2],
                     "distance_error_m": _num(s.distance_error),
+                    **self._interval_columns("distance_error_m", s.index, "distance"),
                     "orientation_error_rad": _num(s.orientation_error),
+                    **self._interval_columns("orientation_error_rad", s.index, "angle"),
                     "dtheta_unwrapped_rad": _num(s.dtheta),
                     "gt_offset_ms": None if s.gt_offset_ns is None else s.gt_offset_ns / 1e6,
                     "valid_fraction": None
@@ -285,7 +361,9 @@ class Fbm2hResult:
         summary: Rows = [
             {
                 "position_accuracy_m": _num(self.position_accuracy),
+                **self._interval_columns("position_accuracy_m", None, "position"),
                 "orientation_accuracy_rad": _num(self.orientation_accuracy),
+                **self._interval_columns("orientation_accuracy_rad", None, "orientation"),
                 "execution_time_s": self.execution_time,
                 "hits": self.hits,
                 "timeout_segments": self.timeout_segments,
@@ -294,4 +372,24 @@ class Fbm2hResult:
                 "orientation_mode": "2015" if self.orientation_2015 else "wrapped",
             }
         ]
-        return {"segments": rows, "summary": summary}
+        out: dict[str, Rows] = {"segments": rows, "summary": summary}
+        if self.intervals is not None:
+            out["uncertainty"] = uncertainty_rows(self.intervals.uncertainty)
+        return out
+
+    def _interval_columns(self, column: str, index: int | None, which: str) -> dict[str, Any]:
+        """``column_low``/``column_high`` of one interval (none with ``--draws 0``)."""
+        iv = self.intervals
+        if iv is None:
+            return {}
+        found: Interval | None
+        if which == "distance" and index is not None:
+            found = iv.distance.get(index)
+        elif which == "angle" and index is not None:
+            found = iv.angle.get(index)
+        else:
+            found = iv.position if which == "position" else iv.orientation
+        return {
+            f"{column}_low": None if found is None else found.low,
+            f"{column}_high": None if found is None else found.high,
+        }

@@ -8,6 +8,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+from ertools.benchmarks.common.uncertainty import (
+    DEFAULT_CONFIDENCE,
+    DEFAULT_DRAWS,
+    DEFAULT_SEED,
+)
 from ertools.benchmarks.noise.benchmark import (
     DEFAULT_C,
 )
@@ -53,6 +58,8 @@ class Fbm3wOptions:
             has, as the 2015 node did, with a deviation saying how much of its path was valid).
         config: runs_specifications, d_min and shapes (None: the 2015 values,
             ``configs/fbm3w.yaml``); ``d_min`` above overrides its d_min.
+        confidence, draws, seed: the score intervals (level, Monte Carlo draws, 0 for none;
+            seed of the draws), :mod:`ertools.benchmarks.fbm3w.intervals`.
 
     The values are validated once, where they come in
     (:func:`ertools.benchmarks.fbm3w.declare.make_options`).
@@ -75,6 +82,9 @@ class Fbm3wOptions:
     exact_end_payloads: bool = False
     config: Fbm3wConfig | None = None
     unscoreable_runs: str = "null"
+    confidence: float = DEFAULT_CONFIDENCE
+    draws: int = DEFAULT_DRAWS
+    seed: int = DEFAULT_SEED
 
 
 TIMEOUT_RUNS = ("unscored", "2015")

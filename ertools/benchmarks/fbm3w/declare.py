@@ -21,6 +21,7 @@ from ertools.benchmarks.base import (
     tf_value,
 )
 from ertools.benchmarks.common.ending import EXACT_HELP
+from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS, check_confidence
 from ertools.benchmarks.fbm3w.benchmark import Fbm3wLogs, load, locate_runs, score_found
 from ertools.benchmarks.fbm3w.config import RUN_MODES, Fbm3wOptions, options_2015
 from ertools.benchmarks.fbm3w.result import Fbm3wResult
@@ -132,6 +133,7 @@ INPUTS = (
         unit="s",
         positive=True,
     ),
+    *INTERVAL_INPUTS,
 )
 
 
@@ -212,13 +214,16 @@ def make_options(given: Mapping[str, Any]) -> Fbm3wOptions:
         exact_end_payloads=v["exact_end_payloads"],
         unscoreable_runs=v["unscoreable_runs"],
         config=load_fbm3w_config(v["config"]),
+        confidence=check_confidence(v["confidence"]),
+        draws=v["draws"],
+        seed=v["seed"],
     )
     return options_2015(options) if v["all_2015"] else options
 
 
 def notes(result: Fbm3wResult) -> list[str]:
-    """The runs found from motion and the d_min sweep, for stderr."""
-    out = []
+    """The score intervals, the runs found from motion and the d_min sweep, for stderr."""
+    out = result.interval_lines()
     for r in result.runs:
         if r.window.mode == "auto":
             d = r.details()

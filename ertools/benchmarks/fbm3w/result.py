@@ -8,6 +8,13 @@ from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.benchmarks.common.validity import GapOnPath, Validity, cell, gaps_on_path
+from ertools.benchmarks.common.uncertainty import (
+    Interval,
+    Uncertainty,
+    interval_line,
+    split_interval,
+    uncertainty_rows,
+)
 from ertools.benchmarks.fbm3w.path import PathScore
 from ertools.benchmarks.fbm3w.runs import RunWindow
 from ertools.benchmarks.noise.benchmark import NoiseResult
@@ -49,6 +56,8 @@ class RunResult:
             and this is kept for the warning), None otherwise.
         path_coverage: the fraction of the path window covered by valid data (a tracking loss
             that hid no motion counted as covered), None when not computed.
+        interval: the confidence interval of ``distance_error`` (None: not scored, or
+            ``--draws 0``).
     """
 
     window: RunWindow
@@ -69,6 +78,7 @@ class RunResult:
     validity: Validity | None = None
     unscoreable_reason: str | None = None
     path_coverage: float | None = None
+    interval: Interval | None = None
 
     @property
     def index(self) -> int:
@@ -110,8 +120,10 @@ class RunResult:
             "spec": self.spec,
             "distance_error": self.distance_error,
             "execution_time": self.execution_time,
-            "status": self.status,
         }
+        if self.interval is not None:
+            out["distance_error_interval"] = self.interval.as_list()
+        out["status"] = self.status
         if self.error is not None:
             out["error"] = self.error
         out["d_min"] = self.d_min
@@ -158,6 +170,8 @@ class Fbm3wResult:
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
     count_stopped: bool = True
+    best_interval: Interval | None = None
+    uncertainty: Uncertainty | None = None
 
     @property
     def nothing_scored(self) -> bool:
@@ -224,12 +238,35 @@ class Fbm3wResult:
         )
 
     def _score(self) -> dict[str, Any]:
-        return {
+        out: dict[str, Any] = {
             "best_distance_error": self.best_distance_error,
             "best_run": self.best_run,
             "execution_time": self.execution_time,
             "runs_details": {r.index: r.details() for r in self.runs},
         }
+        # Listing 16's keys first, in its order; the intervals are extra keys after them.
+        if self.uncertainty is not None:
+            best = self.best_interval
+            out["best_distance_error_interval"] = None if best is None else best.as_list()
+            out["uncertainty"] = self.uncertainty.to_dict()
+        return out
+
+    def interval_lines(self) -> list[str]:
+        """One line per score with its interval and the method (for stderr)."""
+        u = self.uncertainty
+        if u is None:
+            return []
+        scores: list[tuple[str, float | None, Interval | None]] = [
+            ("best_distance_error", self.best_distance_error, self.best_interval)
+        ]
+        scores += [
+            (f"run {r.index} distance_error", r.distance_error, r.interval) for r in self.runs
+        ]
+        return [
+            interval_line(name, value, iv, u, scale=1000.0, unit="mm")
+            for name, value, iv in scores
+            if value is not None
+        ]
 
     def to_dict(self) -> dict[str, Any]:
         """Listing 16 nesting with string run keys (JSON)."""
@@ -249,6 +286,7 @@ class Fbm3wResult:
         runs: Rows = []
         for r in self.runs:
             row = {"run": r.index, **r.details()}
+            split_interval(row, "distance_error")
             for key in ("reference_position", "starting_position"):
                 if key in row:
                     row[key] = " ".join(f"{v:.6f}" for v in row[key])
@@ -297,6 +335,8 @@ class Fbm3wResult:
             ]
         if self.noise is not None:
             out["noise"] = self.noise.tables()["summary"]
+        if self.uncertainty is not None:
+            out["uncertainty"] = uncertainty_rows(self.uncertainty)
         return out
 
     def sweep_text(self) -> str:

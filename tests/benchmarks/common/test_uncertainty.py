@@ -108,3 +108,39 @@ def test_interval_keys_follow_their_score() -> None:
     out = interval_keys(data, {"b": Interval(1.5, 2.5), "c": None})
     assert list(out) == ["a", "b", "b_interval", "c", "c_interval"]
     assert out["b_interval"] == [1.5, 2.5] and out["c_interval"] is None
+
+
+def test_interval_line_states_value_interval_method_and_shares() -> None:
+    from ertools.benchmarks.common.uncertainty import Source, Uncertainty, interval_line
+
+    u = Uncertainty(0.95, "Monte Carlo", 400, 0, (Source("mocap_noise", 1e-4, "m", True),), {})
+    iv = Interval(0.00041, 0.00088, (("mocap_noise", 0.71), ("d_min", 0.29)))
+    line = interval_line("best_distance_error", 0.000639, iv, u, scale=1000.0, unit="mm")
+    assert line == (
+        "best_distance_error 0.639 mm, 95% interval [0.41, 0.88] mm "
+        "(Monte Carlo 400 draws, seed 0; mocap_noise 71%, d_min 29%)"
+    )
+    assert "no 95% interval" in interval_line("x", 1.0, None, u)
+
+
+def test_split_interval_and_uncertainty_rows() -> None:
+    from ertools.benchmarks.common.uncertainty import (
+        Source,
+        Uncertainty,
+        split_interval,
+        uncertainty_rows,
+    )
+
+    row = {"run": 0, "distance_error": 1.0, "distance_error_interval": [0.5, 1.5], "status": "ok"}
+    split_interval(row, "distance_error")
+    assert list(row) == [
+        "run",
+        "distance_error",
+        "distance_error_low",
+        "distance_error_high",
+        "status",
+    ]
+    assert (row["distance_error_low"], row["distance_error_high"]) == (0.5, 1.5)
+    u = Uncertainty(0.9, "m", 10, 1, (Source("a", 2.0, "m", False, "default"),), {"k": {"a": 1.0}})
+    (only,) = uncertainty_rows(u)
+    assert only["score"] == "k" and only["share"] == 1.0 and only["measured"] is False

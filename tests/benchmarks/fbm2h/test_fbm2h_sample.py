@@ -176,6 +176,10 @@ def test_yaml_output_has_listing_13_keys(
         "hits",
         "timeout_segments",
         "details",
+        # issue 28: the intervals and how they were obtained, after Listing 13's keys
+        "position_accuracy_interval",
+        "orientation_accuracy_interval",
+        "uncertainty",
     ]
     assert list(data["details"]) == ["marker-robot transform", "segments_details"]
     assert list(data["details"]["segments_details"]) == [0, 1, 2, 3, 4]
@@ -190,7 +194,9 @@ def test_yaml_output_has_listing_13_keys(
         "start_segment_time",
         "target_pose",
         "timeout",
-        # ertools' validity keys after the listing's (issue 28)
+        # ertools' interval and validity keys after the listing's (issue 28)
+        "dinstance_error_interval",
+        "orientation_error_interval",
         "valid_fraction",
         "invalid_samples",
     ]

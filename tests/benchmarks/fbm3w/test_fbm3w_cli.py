@@ -31,7 +31,17 @@ def one_line_error(err: str) -> str:
 def test_default_yaml_and_json(fbm3w_sample: Sample, capsys: pytest.CaptureFixture[str]) -> None:
     assert score(fbm3w_sample.bag, "--config", fbm3w_sample.config) == 0
     out = yaml.safe_load(capsys.readouterr().out)
-    assert list(out) == ["best_distance_error", "best_run", "execution_time", "runs_details"]
+    # Listing 16's keys in its order, then the interval and how it was obtained (issue 28)
+    listing = ["best_distance_error", "best_run", "execution_time", "runs_details"]
+    assert list(out) == [*listing, "best_distance_error_interval", "uncertainty"]
+    assert list(out["runs_details"][0])[:4] == [
+        "spec",
+        "distance_error",
+        "execution_time",
+        "distance_error_interval",
+    ]
+    assert score(fbm3w_sample.bag, "--config", fbm3w_sample.config, "--draws", "0") == 0
+    assert list(yaml.safe_load(capsys.readouterr().out)) == listing
     assert out["best_run"] == fbm3w_sample.answers["expected"]["best_run"]
     assert score(fbm3w_sample.bag, "--format", "json") == 0
     data = json.loads(capsys.readouterr().out)

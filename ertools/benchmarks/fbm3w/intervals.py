@@ -1,0 +1,329 @@
+"""Confidence intervals of FBM3@Work's distance errors (issue 28): the runs re-scored with
+perturbed poses and ``d_min``, all Monte Carlo draws at once. No IO here.
+
+Sources (:mod:`ertools.benchmarks.common.uncertainty`):
+
+- ``mocap_noise``: every measured position (and the reference position) moved by normal
+  noise of sigma per axis, sigma = epsilon / sqrt(pi) from the bag's own stationary phases
+  (``noise_from_stream(..., stationary=True)``, as ``ertools noise --stationary auto``).
+  sigma is itself an estimate: each draw takes its own sigma around it, with the relative
+  standard error of a mean of M Rayleigh distances (0.523 / sqrt(M/2); consecutive pairs
+  share a sample, hence M/2). A repeated (frozen) pose repeats its noise too: the mocap sent
+  one measurement several times. Without a still phase: epsilon = d_min / 3 (the seed's
+  D_MIN = c * epsilon with c = 3), stated as a default.
+- ``d_min``: the seed sets d_min = c * epsilon (7.3.2); a d_min chosen from a noise estimate
+  is as uncertain as that estimate, so each draw scales d_min by the same relative standard
+  error as sigma's (10% when there is no estimate, stated as a default).
+
+The draws perturb a smoothed path, not the measured one: a quadratic Savitzky-Golay fit over
+9 samples (exact for any motion of constant acceleration over 75 ms at 120 Hz) keeps the
+path and removes most of the noise (the residual's variance is 59/231 of sigma^2 and, what
+Eq. (1) responds to, its consecutive differences almost vanish), and each draw adds noise of
+the full sigma to it: a draw is then a log of the smoothed path measured again. Adding sigma
+to the already noisy positions would double the noise variance, and Eq. (1) is far from
+linear in it: d_min subsampling keeps a still
+marker set's jitter only when a step passes d_min, a tail probability that grows ~200 times
+from sigma to sigma sqrt(2) at the 2015 values; the basic interval then over-corrects the
+bias (the calibration found every miss above the interval). Each draw's shift from the
+smoothed path's own score, added to the score, gives the basic interval.
+
+Each draw re-runs the whole Eq. (1) on the perturbed positions: the d_min subsampling (a
+sequential rule: one pass over the samples, vectorised over the draws), the run frame from
+the perturbed reference and start, l/L and the mean distance. ``best_distance_error`` is the
+minimum over the runs of each draw.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ertools.arrays import F64, IntArr
+from ertools.benchmarks.common.uncertainty import (
+    D_MIN,
+    MOCAP_NOISE,
+    Interval,
+    Source,
+    Uncertainty,
+    monte_carlo,
+    sigma_from_epsilon,
+)
+from ertools.benchmarks.noise.benchmark import NoiseResult
+from ertools.configs.shapes import Shape
+
+# The coefficient of variation of a Rayleigh distance, sqrt(4/pi - 1): the spread of one
+# consecutive-pair distance around epsilon.
+RAYLEIGH_CV = math.sqrt(4.0 / math.pi - 1.0)
+DEFAULT_C = 3.0  # the seed's D_MIN = c * epsilon (7.3.2), for the default noise
+DEFAULT_D_MIN_REL = 0.10
+# Draws x samples of one batch: bounds the memory of a long run (~8 bytes x a few arrays).
+BATCH_ELEMENTS = 2_000_000
+METHOD = "Monte Carlo (parametric bootstrap around the smoothed path, basic interval)"
+# Quadratic Savitzky-Golay weights over 9 samples, and the variance of noise left after it.
+SMOOTH = np.array([-21.0, 14.0, 39.0, 54.0, 59.0, 54.0, 39.0, 14.0, -21.0]) / 231.0
+HALF = len(SMOOTH) // 2
+
+
+def smooth(xy: F64) -> F64:
+    """(N, 2) positions with most of the noise removed (a quadratic fit over 9 samples);
+    the first and last 4 take the nearest full window's value; fewer than 9: the mean."""
+    p = np.asarray(xy, dtype=np.float64)
+    n = len(p)
+    if n < len(SMOOTH):
+        return np.repeat(p.mean(axis=0, keepdims=True), n, axis=0)
+    out = np.column_stack([np.convolve(p[:, k], SMOOTH[::-1], mode="valid") for k in (0, 1)])
+    head = np.repeat(out[:1], HALF, axis=0)
+    tail = np.repeat(out[-1:], HALF, axis=0)
+    return np.concatenate([head, out, tail])
+
+
+@dataclass(frozen=True, eq=False)
+class RunSamples:
+    """What one scored run's Eq. (1) depends on.
+
+    Attributes:
+        xy: (N, 2) the measured positions of the path window (world).
+        source: (N,) index of the measurement each sample carries (a repeated pose carries
+            the one it repeats).
+        reference_xy: (2,) the measured reference position.
+        shape: the target.
+        center_xy, center_reference_xy: the smoothed path and reference the draws perturb
+            (None: the measured ones).
+    """
+
+    xy: F64
+    source: IntArr
+    reference_xy: F64
+    shape: Shape
+    center_xy: F64 | None = None
+    center_reference_xy: F64 | None = None
+
+
+@dataclass(frozen=True)
+class NoiseModel:
+    """The sources' sizes: sigma per axis (m), its relative standard error, d_min (m) and
+    d_min's relative standard deviation."""
+
+    sigma: float
+    sigma_rel: float
+    d_min: float
+    d_min_rel: float
+    sources: tuple[Source, ...]
+
+
+def measurement_source(repeats: F64 | np.ndarray) -> IntArr:
+    """(N,) index of the measurement each sample carries, from the (N-1,) repeat flags
+    (True where a pose repeats the previous one)."""
+    rep = np.asarray(repeats, dtype=bool)
+    n = rep.size + 1
+    idx = np.arange(n)
+    new = np.ones(n, dtype=bool)
+    new[1:] = ~rep
+    return np.asarray(np.maximum.accumulate(np.where(new, idx, 0)), dtype=np.intp)
+
+
+def noise_model(noise: NoiseResult | None, d_min: float) -> NoiseModel:
+    """The sources' sizes from the bag's noise estimate, or the stated defaults."""
+    pairs = 0 if noise is None else int(noise.distances.size)
+    if noise is not None and pairs >= 2 and math.isfinite(noise.epsilon) and noise.epsilon > 0:
+        sigma = sigma_from_epsilon(noise.epsilon)
+        rel = RAYLEIGH_CV / math.sqrt(pairs / 2.0)
+        note = (
+            f"sigma = epsilon / sqrt(pi), epsilon {noise.epsilon * 1000:.4g} mm from "
+            f"{pairs} pairs over {noise.duration_s:.1f} s of stationary phases (relative "
+            f"standard error {rel:.1%}, drawn per draw)"
+        )
+        mocap = Source(MOCAP_NOISE, sigma, "m", True, note)
+        dmin = Source(
+            D_MIN,
+            d_min * rel,
+            "m",
+            True,
+            f"d_min = c * epsilon is as uncertain as epsilon: d_min x (1 + {rel:.2%} z)",
+        )
+        return NoiseModel(sigma, rel, d_min, rel, (mocap, dmin))
+    epsilon = d_min / DEFAULT_C
+    sigma = sigma_from_epsilon(epsilon)
+    mocap = Source(
+        MOCAP_NOISE,
+        sigma,
+        "m",
+        False,
+        "default: no stationary phase in the poses; epsilon = d_min / 3 (the seed's "
+        "D_MIN = c * epsilon, c = 3), sigma = epsilon / sqrt(pi)",
+    )
+    dmin = Source(
+        D_MIN,
+        d_min * DEFAULT_D_MIN_REL,
+        "m",
+        False,
+        f"default: d_min x (1 + {DEFAULT_D_MIN_REL:.0%} z), no noise estimate to size it",
+    )
+    return NoiseModel(sigma, 0.0, d_min, DEFAULT_D_MIN_REL, (mocap, dmin))
+
+
+def perturbed_errors(
+    run: RunSamples, sigmas: F64, d_mins: F64, rng: np.random.Generator, noisy: bool
+) -> F64:
+    """(D,) distance errors of one run with its positions perturbed by ``sigmas`` (D,) (when
+    ``noisy``) and subsampled with ``d_mins`` (D,); NaN where a draw cannot be scored."""
+    d = sigmas.size
+    n = len(run.xy)
+    measured = int(run.source.max()) + 1 if n else 0
+    if noisy:
+        eps = rng.standard_normal((d, measured, 2))
+        if np.any(run.source != np.arange(n)):  # a repeated pose repeats its noise
+            eps = eps[:, run.source, :]
+        eps *= sigmas[:, None, None]
+        ref_eps = rng.standard_normal((d, 2)) * sigmas[:, None]
+    else:
+        eps = np.zeros((d, n, 2))
+        ref_eps = np.zeros((d, 2))
+    xy = run.xy if run.center_xy is None else run.center_xy
+    ref = run.reference_xy if run.center_reference_xy is None else run.center_reference_xy
+    x = xy[None, :, 0] + eps[:, :, 0]
+    y = xy[None, :, 1] + eps[:, :, 1]
+    rx = ref[0] + ref_eps[:, 0]
+    ry = ref[1] + ref_eps[:, 1]
+    kept = _subsample(x, y, d_mins)
+    return _eq1(x, y, kept, rx, ry, run.shape)
+
+
+def _subsample(x: F64, y: F64, d_mins: F64) -> np.ndarray:
+    """(D, N) kept flags of the 2015 d_min rule in every draw: one pass over the samples,
+    each step vectorised over the draws (the rule is sequential within a draw)."""
+    xt = np.ascontiguousarray(x.T)
+    yt = np.ascontiguousarray(y.T)
+    n = xt.shape[0]
+    kept = np.zeros((n, x.shape[0]), dtype=bool)
+    kept[0] = True
+    lx = xt[0].copy()
+    ly = yt[0].copy()
+    d2 = d_mins * d_mins
+    for j in range(1, n):
+        dx = xt[j] - lx
+        dy = yt[j] - ly
+        k = dx * dx + dy * dy >= d2
+        kept[j] = k
+        np.copyto(lx, xt[j], where=k)
+        np.copyto(ly, yt[j], where=k)
+    return kept.T
+
+
+def _eq1(x: F64, y: F64, kept: np.ndarray, rx: F64, ry: F64, shape: Shape) -> F64:
+    """Eq. (1) of every draw from its kept flags (as :func:`~.path.score_path`), on the kept
+    points only: in row-major order each draw's kept points follow one another, its first
+    one (the start, always kept) first."""
+    d = x.shape[0]
+    rows, cols = np.nonzero(kept)
+    xk, yk = x[rows, cols], y[rows, cols]
+    first = cols == 0
+    step = np.empty(rows.size)
+    step[0] = 0.0
+    step[1:] = np.hypot(np.diff(xk), np.diff(yk))
+    step[first] = 0.0
+    run = np.cumsum(step)  # sequential within each draw, as the 2015 loop
+    starts = np.flatnonzero(first)
+    cum = run - np.repeat(run[starts], np.diff(np.append(starts, rows.size)))
+    count = np.bincount(rows, minlength=d)
+    last = np.cumsum(count) - 1
+    total = np.zeros(d)
+    total[count > 0] = cum[last[count > 0]]
+    x0, y0 = x[:, 0], y[:, 0]
+    yaw = np.arctan2(y0 - ry, x0 - rx)
+    c, s = np.cos(yaw)[rows], np.sin(yaw)[rows]
+    dx, dy = xk - x0[rows], yk - y0[rows]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        l_norm = np.clip(np.nan_to_num(cum / total[rows]), 0.0, 1.0)
+    target = shape(l_norm)
+    err = np.hypot(c * dx + s * dy - target[:, 0], -s * dx + c * dy - target[:, 1])
+    err[first] = 0.0  # 2015 started its sum at the second kept point
+    out = np.bincount(rows, weights=err, minlength=d) / np.maximum(count, 1)
+    bad = (count < 2) | ~(total > 0) | ((x0 == rx) & (y0 == ry))
+    return np.where(bad, np.nan, out)
+
+
+def run_intervals(
+    runs: Sequence[RunSamples | None],
+    estimates: Sequence[float | None],
+    model: NoiseModel,
+    *,
+    draws: int,
+    seed: int,
+    confidence: float,
+) -> tuple[list[Interval | None], Interval | None]:
+    """The interval of each run's distance error (None for runs not scored) and of the best
+    (smallest) one.
+
+    ``runs[i]`` is None for a run without a score; ``estimates`` are the scores themselves.
+    """
+    scored = [i for i, r in enumerate(runs) if r is not None and estimates[i] is not None]
+    if draws <= 0 or not scored:
+        return [None] * len(runs), None
+    est = [float(estimates[i]) for i in scored]  # type: ignore[arg-type]
+    est.append(min(est))
+
+    # the smoothed paths' own scores: each draw's shift from them is added to the score
+    chosen: list[RunSamples] = [r for i in scored if (r := runs[i]) is not None]
+    centers = np.asarray(
+        [
+            perturbed_errors(
+                run, np.zeros(1), np.full(1, model.d_min), np.random.default_rng(0), False
+            )[0]
+            for run in chosen
+        ]
+    )
+    shift = np.asarray(est[:-1]) - centers
+    shift_best = est[-1] - float(np.min(centers))
+
+    def perturbed(rng: np.random.Generator, sources: frozenset[str], n: int) -> F64:
+        z_sigma = rng.standard_normal(n)
+        z_dmin = rng.standard_normal(n)
+        sigmas = np.full(n, model.sigma)
+        if MOCAP_NOISE in sources:
+            sigmas = sigmas * np.maximum(0.0, 1.0 + model.sigma_rel * z_sigma)
+        d_mins = np.full(n, model.d_min)
+        if D_MIN in sources:
+            d_mins = model.d_min * np.maximum(0.0, 1.0 + model.d_min_rel * z_dmin)
+        out = np.empty((n, len(scored) + 1))
+        for col, run in enumerate(chosen):
+            batch = max(1, BATCH_ELEMENTS // max(len(run.xy), 1))
+            for lo in range(0, n, batch):
+                hi = min(n, lo + batch)
+                out[lo:hi, col] = perturbed_errors(
+                    run, sigmas[lo:hi], d_mins[lo:hi], rng, MOCAP_NOISE in sources
+                )
+        # the best run of each draw; NaN when one of its runs could not be scored
+        best = np.min(out[:, :-1], axis=1) + shift_best
+        out[:, :-1] += shift
+        out[:, -1] = best
+        return out
+
+    names = tuple(s.name for s in model.sources)
+    ivs = monte_carlo(est, perturbed, names, draws=draws, seed=seed, confidence=confidence)
+    per_run: list[Interval | None] = [None] * len(runs)
+    for col, i in enumerate(scored):
+        per_run[i] = ivs[col]
+    return per_run, ivs[-1]
+
+
+def uncertainty_block(
+    model: NoiseModel,
+    per_run: Sequence[tuple[int, Interval | None]],
+    best: Interval | None,
+    *,
+    draws: int,
+    seed: int,
+    confidence: float,
+) -> Uncertainty:
+    """The result's ``uncertainty`` block (sources, method, shares by dotted key)."""
+    shares: dict[str, dict[str, float]] = {}
+    if best is not None:
+        shares["best_distance_error"] = best.share_dict()
+    for index, iv in per_run:
+        if iv is not None:
+            shares[f"runs_details.{index}.distance_error"] = iv.share_dict()
+    return Uncertainty(confidence, METHOD, draws, seed, model.sources, shares)

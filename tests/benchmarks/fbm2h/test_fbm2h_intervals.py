@@ -1,0 +1,162 @@
+"""FBM2@Home's perturbed scorer (issue 28): the spread of each source against the one
+computed by hand for a robot far from its waypoint (where the distance is linear in the
+noise)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from ertools.benchmarks.common.uncertainty import (
+    MOCAP_NOISE,
+    TIME_ASSOCIATION,
+    TRANSFORM,
+    Source,
+)
+from ertools.benchmarks.fbm2h.intervals import Model, Moments, intervals, perturbed_scores
+
+N = 20_000  # draws: the sd of a sample sd is 1/sqrt(2N) = 0.5% of it
+
+
+def _moments(lever: tuple[float, float, float], averaging: float = 1.0) -> Moments:
+    # the robot 1 m from its waypoint along x, heading 0.2 rad off the waypoint's theta
+    return Moments(
+        robot=np.array([[1.0, 0.0, 0.2]]),
+        target=np.array([[0.0, 0.0, 0.0]]),
+        lever=np.array([lever]),
+        heading=np.array([0.0]),
+        averaging=np.array([averaging]),
+        velocity=np.array([[0.5, 0.0, 0.0]]),
+    )
+
+
+def _model(sigma: float, tilt: float, yaw: float, half: float) -> Model:
+    return Model(sigma, tilt, yaw, half, ())
+
+
+def _sd(m: Moments, model: Model, source: str) -> tuple[float, float]:
+    d = perturbed_scores(
+        m,
+        model,
+        np.random.default_rng(1),
+        frozenset({source}),
+        N,
+        orientation_2015=False,
+        divide_by=1,
+    )
+    return float(np.std(d[:, 2])), float(np.std(d[:, 3]))
+
+
+def test_position_noise_is_averaged_by_interpolation() -> None:
+    # radial component of isotropic noise: sigma; interpolated at w = 0.5: sigma / sqrt(2)
+    sd, _ = _sd(_moments((0.0, 0.0, 0.0), math.sqrt(0.5)), _model(2e-4, 0, 0, 0), MOCAP_NOISE)
+    assert sd == pytest.approx(2e-4 / math.sqrt(2), rel=0.03)
+
+
+def test_tilt_noise_swings_a_vertical_lever() -> None:
+    # the robot 0.85 m below the marker: a tilt of r rad about y moves it r * 0.85 along x
+    sd, angle_sd = _sd(_moments((0.0, 0.0, -0.85)), _model(0.0, 5e-4, 1e-3, 0), MOCAP_NOISE)
+    assert sd == pytest.approx(0.85 * 5e-4, rel=0.03)
+    assert angle_sd == pytest.approx(1e-3, rel=0.03)
+
+
+def test_time_association_is_velocity_times_half_a_frame() -> None:
+    # 0.5 m/s along the error direction, uniform +-4.17 ms: sd = 0.5 * 4.17e-3 / sqrt(3)
+    sd, _ = _sd(_moments((0.0, 0.0, 0.0)), _model(0, 0, 0, 1 / 240), TIME_ASSOCIATION)
+    assert sd == pytest.approx(0.5 / 240 / math.sqrt(3), rel=0.03)
+
+
+def test_transform_error_is_common_to_every_segment() -> None:
+    # two segments with the same geometry: the transform's offset moves both alike, so the
+    # mean distance spreads as one segment does (independent noise would give 1/sqrt(2))
+    one = _moments((0.0, 0.0, 0.0))
+    two = Moments(*(np.repeat(getattr(one, f), 2, axis=0) for f in Moments.__dataclass_fields__))
+    d = perturbed_scores(
+        two,
+        _model(2e-4, 0, 0, 0),
+        np.random.default_rng(2),
+        frozenset({TRANSFORM}),
+        N,
+        orientation_2015=False,
+        divide_by=2,
+    )
+    assert np.std(d[:, 0]) == pytest.approx(2e-4, rel=0.03)
+    e = perturbed_scores(
+        two,
+        _model(2e-4, 0, 0, 0),
+        np.random.default_rng(2),
+        frozenset({MOCAP_NOISE}),
+        N,
+        orientation_2015=False,
+        divide_by=2,
+    )
+    assert np.std(e[:, 0]) == pytest.approx(2e-4 / math.sqrt(2), rel=0.03)
+
+
+def test_interval_width_and_shares() -> None:
+    # distance 1 m, noise sigma per axis: the 95% interval is +-1.96 sigma around it
+    m = _moments((0.0, 0.0, 0.0))
+    model = Model(2e-4, 0, 1e-3, 0, (Source(MOCAP_NOISE, 2e-4, "m", True),))
+    found = intervals(
+        m,
+        [0],
+        [1.0, 0.2, 1.0, 0.2],
+        model,
+        orientation_2015=False,
+        divide_by=1,
+        draws=N,
+        seed=0,
+        confidence=0.95,
+    )
+    assert found.distance[0] is not None
+    half = (found.distance[0].high - found.distance[0].low) / 2
+    assert half == pytest.approx(1.959964 * 2e-4, rel=0.03)
+    assert found.uncertainty.shares["position_accuracy"] == {MOCAP_NOISE: 1.0}
+
+
+def test_a_robot_never_still_gets_the_stated_defaults() -> None:
+    from ertools.benchmarks.fbm2h.intervals import DEFAULT_EPSILON_M, measure_model
+    from ertools.streams import PoseStream
+
+    t = np.arange(500, dtype=np.int64) * 8_333_333  # 120 Hz, moving 0.6 m/s throughout
+    xyz = np.column_stack([np.linspace(0.0, 5.0, 500), np.zeros(500), np.zeros(500)])
+    model = measure_model(PoseStream(t, xyz, np.tile([0.0, 0.0, 0.0, 1.0], (500, 1))))
+    assert model.sigma == pytest.approx(DEFAULT_EPSILON_M / math.sqrt(math.pi))
+    mocap, timing, transform = model.sources
+    assert not mocap.measured and "default" in mocap.note
+    assert timing.measured and timing.value == pytest.approx(8_333_333 / 2e9)
+    assert not transform.measured
+
+
+def test_draws_0_leaves_the_result_as_it_was() -> None:
+    import yaml
+
+    from ertools.benchmarks.fbm2h.benchmark import compute, with_intervals
+    from ertools.benchmarks.fbm2h.config import Fbm2hOptions
+    from ertools.benchmarks.fbm2h.segments import ReachedMoments
+    from ertools.configs.goal import parse_goal
+    from ertools.configs.transform import parse_transform
+    from ertools.samples import fbm2h as sim
+    from ertools.streams import PoseStream
+
+    run = sim.simulate(0)
+    pub = run.bodies[sim.BODY]
+    marker = PoseStream(pub.t_header_ns, pub.xyz, pub.quat_xyzw)
+    goal = parse_goal(yaml.safe_load(run.configs["fbm2h_goal.yaml"]))
+    transform = parse_transform(yaml.safe_load(run.configs[f"transform-{sim.TEAM}.yaml"]))
+    segs = run.truth["segments"]
+    moments = ReachedMoments(
+        "states",
+        np.array([s["start_ns"] for s in segs]),
+        np.array([s["end_ns"] for s in segs]),
+        tuple("" for _ in segs),
+    )
+    plain = compute(goal, transform, marker, moments)
+    assert with_intervals(plain, marker, transform, moments, Fbm2hOptions(draws=0)) is plain
+    full = with_intervals(plain, marker, transform, moments, Fbm2hOptions(draws=50))
+    assert full.intervals is not None
+    listing = list(plain.to_dict())
+    assert list(full.to_dict())[: len(listing)] == listing
+    assert full.position_accuracy == plain.position_accuracy  # the score itself unchanged
