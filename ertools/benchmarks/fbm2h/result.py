@@ -11,8 +11,8 @@ import numpy.typing as npt
 import yaml
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
-from ertools.benchmarks.common.validity import GapOnPath, Validity, cell
 from ertools.benchmarks.common.uncertainty import Interval, interval_line, uncertainty_rows
+from ertools.benchmarks.common.validity import GapOnPath, Validity, cell
 from ertools.benchmarks.fbm2h.intervals import Fbm2hIntervals
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
@@ -100,6 +100,8 @@ def _validity_keys(seg: SegmentResult) -> dict[str, Any]:
     if seg.unscoreable_reason is not None:
         out["unscoreable_reason"] = seg.unscoreable_reason
     return out
+
+
 def _as_list(iv: Interval | None) -> list[float] | None:
     return None if iv is None else iv.as_list()
 

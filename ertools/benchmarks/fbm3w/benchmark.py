@@ -25,6 +25,7 @@ from ertools.benchmarks.common.hygiene import (
     identical_poses,
 )
 from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
+from ertools.benchmarks.common.uncertainty import Interval, Uncertainty
 from ertools.benchmarks.common.validity import (
     STILL_M,
     SampleMask,
@@ -34,7 +35,6 @@ from ertools.benchmarks.common.validity import (
     sample_codes,
     summarise,
 )
-from ertools.benchmarks.common.uncertainty import Interval, Uncertainty
 from ertools.benchmarks.fbm3w.auto_runs import find_auto
 from ertools.benchmarks.fbm3w.config import (
     DEFAULT_FRAME,

@@ -7,7 +7,6 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
-from ertools.benchmarks.common.validity import GapOnPath, Validity, cell, gaps_on_path
 from ertools.benchmarks.common.uncertainty import (
     Interval,
     Uncertainty,
@@ -15,6 +14,7 @@ from ertools.benchmarks.common.uncertainty import (
     split_interval,
     uncertainty_rows,
 )
+from ertools.benchmarks.common.validity import GapOnPath, Validity, cell, gaps_on_path
 from ertools.benchmarks.fbm3w.path import PathScore
 from ertools.benchmarks.fbm3w.runs import RunWindow
 from ertools.benchmarks.noise.benchmark import NoiseResult
