@@ -34,6 +34,7 @@ from ertools.benchmarks.fbm1.answers import (
 )
 from ertools.benchmarks.fbm1.config import BENCHMARKS, BodySources, Fbm1Options
 from ertools.benchmarks.fbm1.gt import GroundTruthError, board_motion, measure_ground_truth
+from ertools.benchmarks.fbm1.intervals import fbm1_intervals
 from ertools.benchmarks.fbm1.logs import Fbm1Logs, Fbm1Runs, load, locate_runs
 from ertools.benchmarks.fbm1.result import Fbm1Result, Fbm1RunResult
 from ertools.benchmarks.fbm1.rules import (
@@ -365,6 +366,17 @@ def score_fbm1(
     if results is not None:
         warnings.extend(_unused_results(results, runs))
     failures = [r.error for r in runs if r.error]
+    iv = fbm1_intervals(
+        runs,
+        found.runs,
+        origin,
+        board,
+        gt_options=opts.gt,
+        rules=opts.rules,
+        pose_runs=tot.pose_runs,
+        pose_total=tot.pose_score,
+        settings=opts.intervals,
+    )
     return Fbm1Result(
         name=opts.benchmark,
         runs=runs,
@@ -376,6 +388,8 @@ def score_fbm1(
         failures=tuple(failures),
         provenance=provenance or Provenance(),
         reference=opts.reference,
+        intervals=iv.intervals,
+        uncertainty=iv.uncertainty,
     )
 
 

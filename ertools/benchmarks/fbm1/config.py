@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from ertools.benchmarks.common.interval_output import IntervalSettings
 from ertools.benchmarks.fbm1.gt import (
     GtOptions,
 )
@@ -62,6 +63,7 @@ class Fbm1Options:
         results: answers kept outside the log (replaces the Client payloads it covers).
         items_order: item ids or instances per run (overrides the payloads).
         sources: origin/board pose sources (the 2015 topics, else their /tf frames).
+        intervals: confidence level, Monte Carlo draws and seed of the score intervals.
     """
 
     benchmark: str = "fbm1h"
@@ -72,6 +74,7 @@ class Fbm1Options:
     results: Path | None = None
     items_order: tuple[str, ...] | None = None
     sources: BodySources = BodySources()
+    intervals: IntervalSettings = IntervalSettings()
 
     @staticmethod
     def for_rules(benchmark: str, rules: str, gt: GtOptions | None = None) -> Fbm1Options:
