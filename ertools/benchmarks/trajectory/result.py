@@ -4,12 +4,15 @@ JSON/YAML/text and the CSV tables.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.common.interval_output import low_high
+from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, interval_keys
 from ertools.benchmarks.common.clocks import OffsetEstimate
 from ertools.benchmarks.trajectory.association import (
     COMPARED,
@@ -30,6 +33,16 @@ from ertools.timeutil import NS_PER_S, ns_to_s
 if TYPE_CHECKING:
     import pandas as pd  # annotations only: pandas is imported by to_frames()
 
+# The summary table's statistics that get ``_low``/``_high`` columns.
+INTERVAL_COLUMNS = (
+    "position_error",
+    "orientation_error",
+    "rmse",
+    "median",
+    "max",
+    "orientation_error_2015",
+)
+
 
 @dataclass(frozen=True, eq=False)
 class TrajectoryResult:
@@ -46,6 +59,10 @@ class TrajectoryResult:
         gt_path: the GT positions, decimated to at most a few thousand points, for figures.
         audit: the clock-offset estimate.
         uncovered_spans: robot-time spans outside the GT, (start_ns, end_ns) on the GT clock.
+        intervals: the confidence interval of each statistic by key (``rmse``,
+            ``percentiles.p95``...; :mod:`ertools.benchmarks.trajectory.intervals`); empty
+            with ``--draws 0``.
+        uncertainty: how the intervals were obtained (None without intervals).
     """
 
     robot_file: str
@@ -65,6 +82,8 @@ class TrajectoryResult:
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
     name: str = "trajectory"
+    intervals: Mapping[str, Interval | None] = field(default_factory=dict)
+    uncertainty: Uncertainty | None = None
 
     @property
     def nothing_scored(self) -> bool:
@@ -140,6 +159,13 @@ class TrajectoryResult:
             "warnings": list(self.warnings),
             "deviations": list(self.deviations),
         }
+        if self.intervals:
+            data = interval_keys(data, self.intervals)
+            if isinstance(data["percentiles"], dict):
+                pct = {k.split(".", 1)[1]: v for k, v in self.intervals.items() if "." in k}
+                data["percentiles"] = interval_keys(data["percentiles"], pct)
+        if self.uncertainty is not None:
+            data["uncertainty"] = self.uncertainty.to_dict()
         out: dict[str, Any] = jsonable(data)
         return out
 
@@ -208,6 +234,9 @@ class TrajectoryResult:
         }
         summary["estimated_offset"] = d["clock_audit"]["estimated_offset"]
         summary["offset_uncertainty"] = d["clock_audit"]["uncertainty"]
+        if self.intervals:
+            for key in INTERVAL_COLUMNS:
+                summary.update(low_high(key, self.intervals.get(key)))
         return {"samples": rows, "summary": [summary]}
 
 

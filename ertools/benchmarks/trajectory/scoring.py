@@ -12,6 +12,7 @@ import numpy.typing as npt
 
 from ertools.arrays import I64
 from ertools.benchmarks.common.clocks import OffsetEstimate, estimate_offset
+from ertools.benchmarks.common.interval_output import IntervalSettings
 from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid, frame_change_warning
 from ertools.benchmarks.trajectory.association import (
     COMPARED,
@@ -24,6 +25,7 @@ from ertools.benchmarks.trajectory.association import (
     associate_evo,
 )
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.intervals import NO_INTERVALS, trajectory_intervals
 from ertools.benchmarks.trajectory.metrics import Metrics, metrics
 from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.benchmarks.trajectory.rules import (
@@ -70,8 +72,12 @@ def score_streams(
     gt_topic: str = "",
     gt_files: Sequence[str] = (),
     warnings: Sequence[str] = (),
+    intervals: IntervalSettings = IntervalSettings(),
 ) -> TrajectoryResult:
     """Compare a robot stream (stamps on the robot clock, recording order) with GT.
+
+    ``intervals``: level, draws and seed of the statistics' confidence intervals
+    (:mod:`ertools.benchmarks.trajectory.intervals`; draws 0: none).
 
     Raises:
         ScoringError: robot stamps not strictly increasing, or empty streams.
@@ -252,6 +258,18 @@ def score_streams(
             "(repeated GT poses) and are not compared"
         )
     notes.extend(_audit_warnings(audit, offset_ns))
+    iv = NO_INTERVALS
+    if m is not None:
+        iv = trajectory_intervals(
+            robot,
+            timed,
+            matched,
+            audit,
+            _estimates(m),
+            association=config.association,
+            offset_ns=offset_ns,
+            settings=intervals,
+        )
     result = TrajectoryResult(
         robot_file=robot_file,
         robot_topic=robot_topic,
@@ -268,6 +286,8 @@ def score_streams(
         warnings=tuple(notes),
         deviations=(*_deviations(config, matched, m), *invalid),
         failures=tuple(failures),
+        intervals=iv.intervals,
+        uncertainty=iv.uncertainty,
         provenance=Provenance(
             inputs=(robot_file, *gt_files),
             parameters=(
@@ -285,6 +305,20 @@ def score_streams(
         ),
     )
     return result
+
+
+def _estimates(m: Metrics) -> dict[str, float]:
+    """The statistics by interval key (:data:`~ertools.benchmarks.trajectory.intervals.KEYS`)."""
+    out = {
+        "position_error": m.position_error,
+        "orientation_error": m.orientation_error,
+        "rmse": m.rmse,
+        "median": m.median,
+        "max": m.max,
+        "orientation_error_2015": m.orientation_error_2015,
+    }
+    out.update({f"percentiles.p{p:g}": v for p, v in m.percentiles})
+    return out
 
 
 def _audit_warnings(audit: OffsetEstimate, applied_ns: int) -> list[str]:
