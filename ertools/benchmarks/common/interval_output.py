@@ -113,3 +113,51 @@ def lines(
     out = [score_line(k, v, iv, uncertainty, scale=s, unit=u, digits=d) for k, v, iv, s, u, d in rows]
     out.append(sources_line(uncertainty))
     return [line for line in out if line]
+
+
+def _at(data: Mapping[str, Any], dotted: str) -> Any:
+    node: Any = data
+    for part in dotted.split("."):
+        if not isinstance(node, Mapping) or part not in node:
+            return None
+        node = node[part]
+    return node
+
+
+def interval_tables(
+    data: Mapping[str, Any],
+    intervals: Mapping[str, Interval | None],
+    uncertainty: Uncertainty | None,
+) -> dict[str, list[dict[str, Any]]]:
+    """The ``intervals`` table (one row per score: value, low, high, each source's share)
+    and the ``interval_sources`` table, for the CSV files and the HTML report; ``data`` is
+    the result's ``to_dict()`` (a dotted key is a path in it)."""
+    if uncertainty is None or not intervals:
+        return {}
+    names = [s.name for s in uncertainty.sources]
+    rows = []
+    for key, iv in intervals.items():
+        row: dict[str, Any] = {
+            "score": key,
+            "value": _at(data, key),
+            "low": math.nan if iv is None else iv.low,
+            "high": math.nan if iv is None else iv.high,
+            "confidence": uncertainty.confidence,
+        }
+        shares = {} if iv is None else iv.share_dict()
+        row.update({f"share_{n}": shares.get(n, math.nan) for n in names})
+        rows.append(row)
+    sources = [
+        {
+            "source": s.name,
+            "value": s.value,
+            "unit": s.unit,
+            "measured": s.measured,
+            "method": uncertainty.method,
+            "draws": uncertainty.draws,
+            "seed": uncertainty.seed,
+            "note": s.note,
+        }
+        for s in uncertainty.sources
+    ]
+    return {"intervals": rows, "interval_sources": sources}

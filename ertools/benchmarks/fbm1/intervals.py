@@ -271,7 +271,8 @@ def fbm1_intervals(
         else:
             item_sigma[k] = np.median([noises[i].sample_sigma for i in runs_k], axis=0)
     has_transform = bool(item_sigma.any())
-    transform_sigma = float(np.median(item_sigma[item_sigma[:, 0] > 0, 0])) if has_transform else 0.0
+    used = item_sigma[item_sigma.any(axis=1)]
+    transform_sigma = float(np.median(used[:, 0])) if has_transform else None
     # The board's yaw in the table frame turns an item's error (board frame) into the table's.
     board_yaw = np.array(
         [
@@ -336,8 +337,8 @@ def fbm1_intervals(
         ("pose_score", ""),
     ]
     out: dict[str, Interval | None] = {}
-    for b, (section, key) in enumerate(paths):
-        for i, r in enumerate(scored):
+    for i, r in enumerate(scored):
+        for b, (section, key) in enumerate(paths):
             name = f"runs.{r.index}.{section}" + (f".{key}" if key else "")
             iv = got[b * n_runs + i]
             if iv is not None and (section, key) == ("error", "translation"):
@@ -352,7 +353,7 @@ def _uncertainty(
     intervals: Mapping[str, Interval | None],
     noises: Sequence[RunNoise],
     settings: IntervalSettings,
-    transform_sigma: float,
+    transform_sigma: float | None,
     spread_given: int,
     lookup: bool,
 ) -> Uncertainty:
@@ -372,7 +373,7 @@ def _uncertainty(
         "sigma widened by Student t / normal for its own uncertainty"
     )
     sources = [Source(MOCAP_NOISE, xy_sigma, "m", bool(measured), note)]
-    if transform_sigma > 0.0:
+    if transform_sigma is not None:
         sources.append(
             Source(
                 TRANSFORM,

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
-from ertools.benchmarks.common.interval_output import as_list, low_high
+from ertools.benchmarks.common.interval_output import as_list, interval_tables, low_high
 from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, interval_keys
 from ertools.benchmarks.fbm1.answers import Answer
 from ertools.benchmarks.fbm1.gt import GroundTruth
@@ -267,7 +267,7 @@ class Fbm1Result:
                 for column, key in CSV_INTERVALS:
                     row.update(low_high(column, self.intervals.get(f"runs.{r.index}.{key}")))
             rows.append(row)
-        return {"runs": rows}
+        return {"runs": rows, **interval_tables(self.to_dict(), self.intervals, self.uncertainty)}
 
 
 # CSV column prefix -> dotted key under ``runs.<index>.`` of the run's interval.

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
-from ertools.benchmarks.common.interval_output import low_high
+from ertools.benchmarks.common.interval_output import interval_tables, low_high
 from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, interval_keys
 from ertools.benchmarks.common.clocks import OffsetEstimate
 from ertools.benchmarks.trajectory.association import (
@@ -237,7 +237,8 @@ class TrajectoryResult:
         if self.intervals:
             for key in INTERVAL_COLUMNS:
                 summary.update(low_high(key, self.intervals.get(key)))
-        return {"samples": rows, "summary": [summary]}
+        extra = interval_tables(d, self.intervals, self.uncertainty)
+        return {"samples": rows, "summary": [summary], **extra}
 
 
 def _f(x: float) -> float | None:
