@@ -110,7 +110,9 @@ def lines(
     uncertainty: Uncertainty | None,
 ) -> list[str]:
     """The stderr lines of the main scores, then the sources line."""
-    out = [score_line(k, v, iv, uncertainty, scale=s, unit=u, digits=d) for k, v, iv, s, u, d in rows]
+    out = [
+        score_line(k, v, iv, uncertainty, scale=s, unit=u, digits=d) for k, v, iv, s, u, d in rows
+    ]
     out.append(sources_line(uncertainty))
     return [line for line in out if line]
 

@@ -74,7 +74,7 @@ class Fbm1Options:
     results: Path | None = None
     items_order: tuple[str, ...] | None = None
     sources: BodySources = BodySources()
-    intervals: IntervalSettings = IntervalSettings()
+    intervals: IntervalSettings = field(default_factory=IntervalSettings)
 
     @staticmethod
     def for_rules(benchmark: str, rules: str, gt: GtOptions | None = None) -> Fbm1Options:

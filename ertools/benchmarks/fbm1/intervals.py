@@ -14,8 +14,9 @@ Two sources, both measured from the data where the data has them:
   samples has sigma / sqrt(n_eff). Mocap samples are not always independent (a tracker's
   filter smooths them, and one body is interpolated at the other's stamps, which mixes
   neighbouring samples): the lag-1 autocorrelation rho is measured, pooled over every run's
-  window and axis, and n_eff = n (1 - rho) / (1 + rho), the AR(1) effective sample size. A sigma estimated from n samples is itself uncertain: the draws use it scaled by
-  the Student t quantile over the normal one (n_eff - 1 degrees of freedom), so a short window
+  window and axis, and n_eff = n (1 - rho) / (1 + rho), the AR(1) effective sample size.
+  A sigma estimated from n samples is itself uncertain: the draws use it scaled by the
+  Student t quantile over the normal one (n_eff - 1 degrees of freedom), so a short window
   gets the wider interval it deserves. A lookup uses one sample: sigma itself.
 - ``transform``: T_board_item from the item list. A list written by ``ertools acquire items``
   carries each item's spread (RMS over its window) and sample count: per axis spread / sqrt(3)

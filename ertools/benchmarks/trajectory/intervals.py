@@ -18,15 +18,23 @@ side of each compared pair perturbed by two sources, vectorised over (draws, pos
   as the draws do, so the score at a drawn offset is itself a draw of the true score (with
   ``--offset auto`` the applied offset minimises the error: every other offset, the true one
   included, scores higher). Its draws are mirrored about the score before the engine's
-  reflection, and added to the measurement-like draws (their interaction neglected). With ``hold`` (2015) the GT pose compared was
-  measured up to one GT frame period before the robot's moment, with ``nearest`` up to half
-  a period either side: an extra lag drawn uniformly over the pose's own frame period (the
-  basic interval then removes the lag's bias). ``linear`` interpolates: no frame-period term.
+  reflection, and added to the measurement-like draws (their interaction neglected). The GT
+  is interpolated anew at the shifted times (a shift that moves a pose next to a tracking
+  loss changes the score as the score's own association would). With ``hold`` (2015) the
+  GT pose compared was measured up to one GT frame period before the robot's moment, with
+  ``nearest`` up to half a period either side: an extra lag drawn uniformly over the pose's
+  own frame period (the basic interval then removes the lag's bias). ``linear``
+  interpolates: no frame-period term.
 
 The interval is the engine's basic bootstrap: noise makes a distance longer on average (the
 RMSE of a perfect robot is sqrt(3) sigma, not 0) and the reflection removes the bias the draws
-show. The draws work in float32 and in chunks of draws, so an hour's log stays within a few
-hundred megabytes and well under a second.
+show. The draws work in float32 and in chunks of draws. A comparison of more than
+:data:`MAX_POSES` poses (an hour at 10 Hz is 36,000) draws on that many poses spread evenly
+over it: the offset's effect is the same on them as on all, the per-pose noise's spread in
+the mean-like statistics (mean, RMSE, orientation errors) is scaled by sqrt(thinned / all)
+(it averages over all the poses), and in the median, percentiles and max it is left as the
+thinned poses give it (wider: a conservative interval). An hour's log costs a fraction of a
+second.
 """
 
 from __future__ import annotations
@@ -34,8 +42,10 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from ertools.arrays import F64, IntArr
 from ertools.benchmarks.common.clocks import OffsetEstimate
@@ -56,12 +66,19 @@ from ertools.errors import ErtoolsError
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
 
+Floats = npt.NDArray[np.floating[Any]]  # float32 in the draws, float64 elsewhere
+
 # A 2015 mocap marker set when nothing in the log measures it: 0.3 mm per axis, 0.05 deg.
 DEFAULT_SIGMA_M = 3e-4
 DEFAULT_SIGMA_RAD = math.radians(0.05)
 MIN_PAIRS = 50  # stationary pairs (or second differences) needed to measure sigma
 VELOCITY_HALF_SPAN = 5  # GT samples either side of a pose for its velocity (~40 ms at 120 Hz)
 CHUNK_ELEMENTS = 4_000_000  # draws x poses per chunk (float32: ~50 MB of positions)
+# Longer comparisons draw on this many evenly spread poses (module doc): an hour at 10 Hz
+# stays well under a second.
+MAX_POSES = 1500
+OFFSET_GRID = 81  # shifts the statistics are computed at, between the extreme draws
+SIGMA_BLOCKS, SIGMA_BLOCK = 20, 2000  # GT samples the noise is measured on, at most
 
 #: The scores with an interval, in the order of the result's keys (``percentiles.pNN`` nested).
 KEYS = (
@@ -73,6 +90,8 @@ KEYS = (
     *(f"percentiles.p{p:g}" for p in PERCENTILES),
     "orientation_error_2015",
 )
+# Statistics that average over the poses (their noise part shrinks as 1 / sqrt(poses)).
+MEAN_LIKE = [0, 1, 2, len(KEYS) - 1]
 
 
 @dataclass(frozen=True)
@@ -109,8 +128,20 @@ def _second_differences(gt: PoseStream) -> tuple[F64, F64]:
     return d2.reshape(-1), y2
 
 
+def _blocks(gt: PoseStream) -> PoseStream:
+    """At most SIGMA_BLOCKS runs of SIGMA_BLOCK consecutive samples spread over ``gt``: an
+    hour of 120 Hz GT measures its noise as well as from 40,000 samples, 10 times faster."""
+    n = len(gt)
+    if n <= SIGMA_BLOCKS * SIGMA_BLOCK:
+        return gt
+    starts = np.linspace(0, n - SIGMA_BLOCK, SIGMA_BLOCKS).astype(np.intp)
+    index = (starts[:, None] + np.arange(SIGMA_BLOCK)[None, :]).reshape(-1)
+    return gt.take(np.unique(index))
+
+
 def mocap_sigma(gt: PoseStream) -> MocapSigma:
     """The GT's measurement noise, measured from the GT stream (module doc)."""
+    gt = _blocks(gt)
     d2, y2 = _second_differences(gt)
     yaw_sigma = _mad_sigma(y2) if y2.size >= MIN_PAIRS else DEFAULT_SIGMA_RAD
     yaw_note = "yaw from its second differences" if y2.size >= MIN_PAIRS else "yaw default"
@@ -140,12 +171,13 @@ def mocap_sigma(gt: PoseStream) -> MocapSigma:
         DEFAULT_SIGMA_M,
         yaw_sigma,
         False,
-        f"too few GT samples to measure: default {DEFAULT_SIGMA_M * 1000:g} mm per axis; {yaw_note}",
+        f"too few GT samples to measure: default {DEFAULT_SIGMA_M * 1000:g} mm per axis; "
+        + yaw_note,
     )
 
 
 def offset_spread(
-    r_xyz: F64, g_xyz: F64, vel: F64, audit: OffsetEstimate, offset_ns: int
+    r_xyz: Floats, g_xyz: Floats, vel: Floats, audit: OffsetEstimate, offset_ns: int
 ) -> tuple[float, float]:
     """(sd, centre) in seconds of the true clock offset around the one applied.
 
@@ -207,19 +239,19 @@ def trajectory_intervals(
         return NO_INTERVALS
     q = matched.t_ns[ok]
     r_xyz = robot.xyz[ok].astype(np.float32)
-    r_yaw = robot.yaw[ok]
+    r_yaw = robot.yaw[ok].astype(np.float32)
     g_xyz = matched.gt_xyz[ok].astype(np.float32)
-    g_yaw = matched.gt_yaw[ok]
+    g_yaw = matched.gt_yaw[ok].astype(np.float32)
     t = gt.t_ns
     k, k1 = _bracket(t, q)
-    period = (t[k1] - t[k]).astype(np.float64) / NS_PER_S
+    period = ((t[k1] - t[k]) / NS_PER_S).astype(np.float32)
     a = np.clip((q - t[k]) / np.maximum(t[k1] - t[k], 1), 0.0, 1.0)
     # GT velocity and yaw rate around each pose, over ~VELOCITY_HALF_SPAN samples either side
     lo = np.clip(k - VELOCITY_HALF_SPAN, 0, len(t) - 1)
     hi = np.clip(k1 + VELOCITY_HALF_SPAN, 0, len(t) - 1)
     span = np.maximum((t[hi] - t[lo]).astype(np.float64) / NS_PER_S, 1e-9)
     vel = ((gt.xyz[hi] - gt.xyz[lo]) / span[:, None]).astype(np.float32)
-    yaw_rate = np.angle(np.exp(1j * (gt.yaw[hi] - gt.yaw[lo]))) / span
+    yaw_rate = (np.angle(np.exp(1j * (gt.yaw[hi] - gt.yaw[lo]))) / span).astype(np.float32)
     sig = mocap_sigma(gt)
     if association == "linear":
         weight = np.sqrt((1.0 - a) ** 2 + a**2).astype(np.float32)
@@ -232,32 +264,65 @@ def trajectory_intervals(
         lag_lo, lag_hi = -0.5, 0.5
     off_sigma, off_centre = offset_spread(r_xyz, g_xyz, vel, audit, offset_ns)
     frame_term = lag_hi > lag_lo
-    n = len(q)
-
-    def stats(d: F64, dyaw: F64, raw: F64) -> F64:
-        """(draws, S) statistics of (draws, n) errors, as metrics() computes them."""
-        pct = np.percentile(d, PERCENTILES, axis=1).T
-        return np.column_stack(
-            [
-                d.mean(axis=1, dtype=np.float64),
-                np.arctan2(np.sin(dyaw).sum(axis=1), np.cos(dyaw).sum(axis=1)),
-                np.sqrt(np.mean(np.square(d, dtype=np.float64), axis=1)),
-                np.median(d, axis=1),
-                d.max(axis=1),
-                pct,
-                np.arctan2(np.sin(raw).sum(axis=1), np.cos(raw).sum(axis=1)),
-            ]
+    raw0 = matched.yaw_diff_raw[ok].astype(np.float32)
+    n_all = len(q)
+    # An hour's log: the draws run on evenly thinned poses (module doc)
+    if n_all > MAX_POSES:
+        keep = np.unique(np.linspace(0, n_all - 1, MAX_POSES).round().astype(np.intp))
+        r_xyz, r_yaw, g_xyz, g_yaw = r_xyz[keep], r_yaw[keep], g_xyz[keep], g_yaw[keep]
+        vel, yaw_rate, weight, period, raw0 = (
+            vel[keep],
+            yaw_rate[keep],
+            weight[keep],
+            period[keep],
+            raw0[keep],
         )
+    else:
+        keep = np.arange(n_all)
+    q_used = q[keep]
+    n = len(r_yaw)
+    thin = math.sqrt(n / n_all)
+    gt_yaw_all = np.unwrap(gt.yaw)
 
-    raw0 = matched.yaw_diff_raw[ok]
+    def gt_at(times: IntArr) -> tuple[F64, F64]:
+        """The GT pose at shifted robot times, as the association takes it (interpolated
+        anew: a shift that moves a pose next to a tracking loss or across a sample is
+        the score's own, not a linearisation's)."""
+        lo_i, hi_i = _bracket(t, times)
+        span_ns = np.maximum(t[hi_i] - t[lo_i], 1)
+        w = np.clip((times - t[lo_i]) / span_ns, 0.0, 1.0)
+        if association == "hold":
+            w = np.zeros_like(w)
+        elif association != "linear":
+            w = np.round(w)
+        wp = w[..., None]
+        xyz = (1.0 - wp) * gt.xyz[lo_i] + wp * gt.xyz[hi_i]
+        yaw = (1.0 - w) * gt_yaw_all[lo_i] + w * gt_yaw_all[hi_i]
+        return xyz.astype(np.float32), yaw.astype(np.float32)
 
     est = np.array([estimates[key] for key in KEYS])
 
     def errors(gp: F64, gy: F64) -> F64:
-        d = np.sqrt(np.sum(np.square(gp - r_xyz), axis=2))
-        dyaw = np.abs(np.angle(np.exp(1j * (r_yaw - gy))))
-        raw = np.abs(raw0 + (g_yaw - gy))
-        return stats(d, dyaw, raw)
+        """(draws, S) statistics of perturbed GT poses, as metrics() computes them."""
+        d = np.sqrt(np.sum(np.square(gp - r_xyz), axis=-1))
+        pi = np.float32(math.pi)
+        dyaw = np.abs(np.remainder(r_yaw - gy + pi, 2 * pi) - pi)
+        raw = np.abs(raw0 + (np.remainder(g_yaw - gy + pi, 2 * pi) - pi))
+        pct = np.percentile(d, PERCENTILES, axis=-1).T  # PERCENTILES[0] is the median
+        return np.column_stack(
+            [
+                d.mean(axis=-1, dtype=np.float64),
+                np.arctan2(np.sin(dyaw).sum(axis=-1), np.cos(dyaw).sum(axis=-1)),
+                np.sqrt(np.mean(np.square(d, dtype=np.float64), axis=-1)),
+                pct[:, 0],
+                d.max(axis=-1),
+                pct,
+                np.arctan2(np.sin(raw).sum(axis=-1), np.cos(raw).sum(axis=-1)),
+            ]
+        )
+
+    base = errors(g_xyz[None], g_yaw[None])[0]
+    base_off = errors(*gt_at(q_used[None, :]))[0]
 
     def perturbed(rng: np.random.Generator, sources: frozenset[str], draws: int) -> F64:
         """Draws whose basic (reflected) interval is the interval wanted (module doc):
@@ -265,10 +330,11 @@ def trajectory_intervals(
         chunk = max(1, CHUNK_ELEMENTS // max(n, 1))
         noise = MOCAP_NOISE in sources
         timing = TIME_ASSOCIATION in sources
-        out = []
+        measured = np.zeros((draws, est.size))
+        offset = np.zeros((draws, est.size))
         for start in range(0, draws, chunk):
             m = min(chunk, draws - start)
-            x = np.broadcast_to(est, (m, est.size)).copy()
+            rows = slice(start, start + m)
             if noise or (timing and frame_term):
                 gp = np.broadcast_to(g_xyz, (m, n, 3)).copy()
                 gy = np.broadcast_to(g_yaw, (m, n)).copy()
@@ -276,23 +342,36 @@ def trajectory_intervals(
                     gp += rng.standard_normal((m, n, 3), dtype=np.float32) * (
                         np.float32(sig.position) * weight[None, :, None]
                     )
-                    gy += rng.standard_normal((m, n)) * (sig.yaw * weight)
+                    gy += rng.standard_normal((m, n), dtype=np.float32) * (
+                        np.float32(sig.yaw) * weight
+                    )
                 if timing and frame_term:
-                    lag = (rng.uniform(lag_lo, lag_hi, (m, n)) * period).astype(np.float32)
+                    lag = rng.uniform(lag_lo, lag_hi, (m, n)).astype(np.float32) * period
                     gp += lag[..., None] * vel
                     gy += lag * yaw_rate
-                x = errors(gp, gy)
+                measured[rows] = errors(gp, gy) - base
             if timing and off_sigma > 0.0:
-                shift = (rng.standard_normal((m, 1)) * off_sigma + off_centre).astype(np.float32)
-                gp = g_xyz[None, :, :] + shift[..., None] * vel
-                gy = g_yaw[None, :] + shift * yaw_rate
-                # mirrored: the offset is not a measurement of the truth plus an error
-                # that the draws add again, but the truth's offset is spread around the
-                # applied one as the draws are: the reflection of the basic interval
-                # must not apply to it
-                x = x + est - errors(gp, gy)
-            out.append(x)
-        return np.concatenate(out, axis=0)
+                shift = rng.standard_normal(m) * off_sigma + off_centre
+                # one shift for every pose: the statistics are a function of it alone,
+                # computed on a grid of shifts and interpolated (a tracking loss's kink
+                # included: the grid is much finer than the draws' spread)
+                grid = np.linspace(shift.min(), shift.max(), min(m, OFFSET_GRID))
+                gp, gy = gt_at(
+                    q_used[None, :] + np.round(grid[:, None] * NS_PER_S).astype(np.int64)
+                )
+                on_grid = errors(gp, gy) - base_off
+                offset[rows] = np.column_stack(
+                    [np.interp(shift, grid, on_grid[:, j]) for j in range(est.size)]
+                )
+        if thin < 1.0:
+            # per-pose noise averages over all the poses of a mean-like statistic, not only
+            # over the thinned ones: its spread (not its bias) scales with sqrt(n / N)
+            bias = measured[:, MEAN_LIKE].mean(axis=0)
+            measured[:, MEAN_LIKE] = bias + (measured[:, MEAN_LIKE] - bias) * thin
+        # mirrored: the offset is not a measurement of the truth plus an error that the
+        # draws add again; the truth's offset is spread around the applied one as the draws
+        # are, so the reflection of the basic interval must not apply to it
+        return np.asarray(est + measured - offset, dtype=np.float64)
 
     sources = [MOCAP_NOISE]
     if off_sigma > 0.0 or frame_term:

@@ -11,9 +11,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.common.clocks import OffsetEstimate
 from ertools.benchmarks.common.interval_output import interval_tables, low_high
 from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, interval_keys
-from ertools.benchmarks.common.clocks import OffsetEstimate
 from ertools.benchmarks.trajectory.association import (
     COMPARED,
     GAP,

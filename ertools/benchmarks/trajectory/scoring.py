@@ -12,8 +12,8 @@ import numpy.typing as npt
 
 from ertools.arrays import I64
 from ertools.benchmarks.common.clocks import OffsetEstimate, estimate_offset
-from ertools.benchmarks.common.interval_output import IntervalSettings
 from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid, frame_change_warning
+from ertools.benchmarks.common.interval_output import IntervalSettings
 from ertools.benchmarks.trajectory.association import (
     COMPARED,
     GAP,
@@ -40,6 +40,8 @@ from ertools.errors import ClockError, ScoringError
 from ertools.fidelity import Deviation
 from ertools.streams import PoseStream, Provenance, float_seconds
 from ertools.timeutil import iso_utc, ns_to_s
+
+DEFAULT_INTERVALS = IntervalSettings()
 
 
 def check_increasing(robot: PoseStream, where: str) -> None:
@@ -72,7 +74,7 @@ def score_streams(
     gt_topic: str = "",
     gt_files: Sequence[str] = (),
     warnings: Sequence[str] = (),
-    intervals: IntervalSettings = IntervalSettings(),
+    intervals: IntervalSettings = DEFAULT_INTERVALS,
 ) -> TrajectoryResult:
     """Compare a robot stream (stamps on the robot clock, recording order) with GT.
 
