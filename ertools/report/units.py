@@ -96,7 +96,14 @@ def quantity_of(name: str) -> tuple[str, str] | None:
     for pattern, spec in _PATTERNS:
         if pattern.fullmatch(key):
             return spec
+    # a score's interval (``distance_error_interval``, CSV ``distance_error_m_low``): its unit
+    bound = _BOUND.fullmatch(name)
+    if bound is not None:
+        return quantity_of(bound.group(1))
     return None
+
+
+_BOUND = re.compile(r"(.+)_(interval|low|high)")
 
 
 def is_number(value: Any) -> bool:

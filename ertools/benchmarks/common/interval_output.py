@@ -117,43 +117,27 @@ def lines(
     return [line for line in out if line]
 
 
-def _at(data: Mapping[str, Any], dotted: str) -> Any:
-    node: Any = data
-    for part in dotted.split("."):
-        if not isinstance(node, Mapping) or part not in node:
-            return None
-        node = node[part]
-    return node
-
-
 def interval_tables(
-    data: Mapping[str, Any],
-    intervals: Mapping[str, Interval | None],
-    uncertainty: Uncertainty | None,
+    intervals: Mapping[str, Interval | None], uncertainty: Uncertainty | None
 ) -> dict[str, list[dict[str, Any]]]:
-    """The ``intervals`` table (one row per score: value, low, high, each source's share)
-    and the ``interval_sources`` table, for the CSV files and the HTML report; ``data`` is
-    the result's ``to_dict()`` (a dotted key is a path in it)."""
+    """The ``interval_shares`` table (one row per score: each source's share of its interval;
+    the intervals themselves are the ``_low``/``_high`` columns beside their scores) and the
+    ``interval_sources`` table (each source's size, measured or default, and how), for the
+    CSV files and the HTML report."""
     if uncertainty is None or not intervals:
         return {}
     names = [s.name for s in uncertainty.sources]
     rows = []
     for key, iv in intervals.items():
-        row: dict[str, Any] = {
-            "score": key,
-            "value": _at(data, key),
-            "low": math.nan if iv is None else iv.low,
-            "high": math.nan if iv is None else iv.high,
-            "confidence": uncertainty.confidence,
-        }
         shares = {} if iv is None else iv.share_dict()
+        row: dict[str, Any] = {"score": key, "confidence": uncertainty.confidence}
         row.update({f"share_{n}": shares.get(n, math.nan) for n in names})
         rows.append(row)
     sources = [
         {
             "source": s.name,
-            "value": s.value,
-            "unit": s.unit,
+            # mixed units (m, s, rad): the size is written with its own
+            "size": f"{s.value:.6g} {s.unit}",
             "measured": s.measured,
             "method": uncertainty.method,
             "draws": uncertainty.draws,
@@ -162,4 +146,4 @@ def interval_tables(
         }
         for s in uncertainty.sources
     ]
-    return {"intervals": rows, "interval_sources": sources}
+    return {"interval_shares": rows, "interval_sources": sources}

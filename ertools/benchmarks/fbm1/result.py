@@ -267,7 +267,7 @@ class Fbm1Result:
                 for column, key in CSV_INTERVALS:
                     row.update(low_high(column, self.intervals.get(f"runs.{r.index}.{key}")))
             rows.append(row)
-        return {"runs": rows, **interval_tables(self.to_dict(), self.intervals, self.uncertainty)}
+        return {"runs": rows, **interval_tables(self.intervals, self.uncertainty)}
 
 
 # CSV column prefix -> dotted key under ``runs.<index>.`` of the run's interval.

@@ -50,6 +50,8 @@ import numpy.typing as npt
 from ertools.arrays import F64, IntArr
 from ertools.benchmarks.common.clocks import OffsetEstimate
 from ertools.benchmarks.common.interval_output import METHOD, IntervalSettings, shares_of
+
+METHOD_TRAJECTORY = f"{METHOD} (the clock offset's draws mirrored: a percentile interval)"
 from ertools.benchmarks.common.uncertainty import (
     MOCAP_NOISE,
     TIME_ASSOCIATION,
@@ -408,7 +410,7 @@ def trajectory_intervals(
         pass
     unc = Uncertainty(
         confidence=settings.confidence,
-        method=METHOD,
+        method=METHOD_TRAJECTORY,
         draws=settings.draws,
         seed=settings.seed,
         sources=tuple(src),

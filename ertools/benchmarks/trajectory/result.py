@@ -237,7 +237,7 @@ class TrajectoryResult:
         if self.intervals:
             for key in INTERVAL_COLUMNS:
                 summary.update(low_high(key, self.intervals.get(key)))
-        extra = interval_tables(d, self.intervals, self.uncertainty)
+        extra = interval_tables(self.intervals, self.uncertainty)
         return {"samples": rows, "summary": [summary], **extra}
 
 
