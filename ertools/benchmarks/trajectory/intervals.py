@@ -50,8 +50,6 @@ import numpy.typing as npt
 from ertools.arrays import F64, IntArr
 from ertools.benchmarks.common.clocks import OffsetEstimate
 from ertools.benchmarks.common.interval_output import METHOD, IntervalSettings, shares_of
-
-METHOD_TRAJECTORY = f"{METHOD} (the clock offset's draws mirrored: a percentile interval)"
 from ertools.benchmarks.common.uncertainty import (
     MOCAP_NOISE,
     TIME_ASSOCIATION,
@@ -68,6 +66,7 @@ from ertools.errors import ErtoolsError
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
 
+METHOD_TRAJECTORY = f"{METHOD} (the clock offset's draws mirrored: a percentile interval)"
 Floats = npt.NDArray[np.floating[Any]]  # float32 in the draws, float64 elsewhere
 
 # A 2015 mocap marker set when nothing in the log measures it: 0.3 mm per axis, 0.05 deg.

@@ -15,7 +15,7 @@ from ertools.benchmarks.fbm1.intervals import pooled_rho, run_noise
 def test_sigma_of_the_mean_of_independent_samples() -> None:
     rng = np.random.default_rng(4)
     n, sigma = 400, 3e-4
-    xy = rng.normal(0.0, sigma, (n, 2)) + [0.3, 0.2]
+    xy = rng.normal(0.0, sigma, (n, 2)) + np.array([0.3, 0.2])
     yaw = 0.5 + rng.normal(0.0, 1e-3, n)
     got = run_noise(xy, yaw, lookup=False, confidence=0.95, gt_yaw=0.5, rho=0.0)
     widen = student_t.ppf(0.975, n - 1) / 1.959964
