@@ -228,12 +228,13 @@ def trajectory_intervals(
     *,
     association: str,
     offset_ns: int,
+    max_gap_ns: int,
     settings: IntervalSettings,
 ) -> TrajectoryIntervals:
     """The intervals of the statistics ``estimates`` (by :data:`KEYS`) of a comparison.
 
     ``robot``: the robot stream whose row i is matched row i; ``gt``: the GT in time order;
-    ``offset_ns``: the offset the score applied.
+    ``offset_ns``: the offset the score applied; ``max_gap_ns``: the GT gap the score skips.
     """
     ok = matched.status == COMPARED
     if not settings.enabled or not ok.any() or len(gt) < 2:
@@ -246,6 +247,9 @@ def trajectory_intervals(
     t = gt.t_ns
     k, k1 = _bracket(t, q)
     period = ((t[k1] - t[k]) / NS_PER_S).astype(np.float32)
+    # A pose compared across a GT gap (--gaps compare, 2015) is held up to the gap's length:
+    # that is the log's gap (a validity matter, reported), not the frame period's lag
+    period = np.minimum(period, np.float32(1.5) * np.median(period))
     a = np.clip((q - t[k]) / np.maximum(t[k1] - t[k], 1), 0.0, 1.0)
     # GT velocity and yaw rate around each pose, over ~VELOCITY_HALF_SPAN samples either side
     lo = np.clip(k - VELOCITY_HALF_SPAN, 0, len(t) - 1)
@@ -284,6 +288,8 @@ def trajectory_intervals(
     n = len(r_yaw)
     thin = math.sqrt(n / n_all)
     gt_yaw_all = np.unwrap(gt.yaw)
+    repeated = np.zeros(len(t), dtype=bool)  # the pair (k-1, k) has one position: lost
+    repeated[1:] = np.all(gt.xyz[1:] == gt.xyz[:-1], axis=1)
 
     def gt_at(times: IntArr) -> tuple[F64, F64]:
         """The GT pose at shifted robot times, as the association takes it (interpolated
@@ -299,6 +305,15 @@ def trajectory_intervals(
         wp = w[..., None]
         xyz = (1.0 - wp) * gt.xyz[lo_i] + wp * gt.xyz[hi_i]
         yaw = (1.0 - w) * gt_yaw_all[lo_i] + w * gt_yaw_all[hi_i]
+        # shifted into a GT gap, or where tracking was lost (a repeated pose), the score
+        # would not compare the pose: it keeps its GT pose,
+        # moved by the GT velocity (the linearisation) rather than held across the gap
+        gap = (span_ns > max_gap_ns) | repeated[hi_i]
+        if gap.any():
+            dt = ((times - q_used) / NS_PER_S).astype(np.float32)
+            lin = g_xyz + dt[..., None] * vel
+            xyz = np.where(gap[..., None], lin, xyz)
+            yaw = np.where(gap, g_yaw + dt * yaw_rate, yaw)
         return xyz.astype(np.float32), yaw.astype(np.float32)
 
     est = np.array([estimates[key] for key in KEYS])

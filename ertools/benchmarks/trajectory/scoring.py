@@ -270,6 +270,7 @@ def score_streams(
             _estimates(m),
             association=config.association,
             offset_ns=offset_ns,
+            max_gap_ns=config.max_gap_ns,
             settings=intervals,
         )
     result = TrajectoryResult(
