@@ -47,6 +47,8 @@ def _value(name: str, declared: Input, tmp_path: Path) -> Any:
     """A valid value other than the default."""
     if (name, declared.name) in VALUES:
         return VALUES[name, declared.name]
+    if declared.name == "confidence":
+        return 0.9  # a level: three times the default 0.95 is none (issue 28's --confidence)
     if declared.kind == "flag":
         return True
     if declared.kind == "choice":
