@@ -9,8 +9,9 @@ audit estimates the offset and the score uses it) by the pure scorer :func:`~ert
 benchmarks.trajectory.scoring.score_streams`, intervals included.
 
 The true noiseless score is the score of the same log without the mocap's measurement noise
-(each message's pose minus the noise the simulator added; a repeat repeats its truth) on the
-true clock offset, computed by the simulator's own per-pose loop
+(each message's pose minus the noise the simulator added, a repeat repeating its truth,
+stamped at its frame's true time rather than with the node's receive delay) on the true
+clock offset, computed by the simulator's own per-pose loop
 (:func:`ertools.samples.robotlog.expected_scores`): what the referee would get from a
 noiseless mocap and synchronised clocks. Not the robot's error against the continuous truth:
 what the log itself lacks (a pose compared across a tracking loss with a stale sample, the
@@ -43,6 +44,7 @@ def simulate(seed: int) -> tuple[Any, Any, Any]:
     rng = np.random.default_rng(seed)
     starts = (rl.START_NS, rl.START_NS + round((rl.FILE_S[0] + rl.SPLIT_GAP_S) * rl.NS))
     t_parts, xyz_parts, quat_parts, clean_parts, clean_quat = [], [], [], [], []
+    frame_parts = []
     for k, (t_start, duration) in enumerate(zip(starts, rl.FILE_S, strict=True)):
         losses = [x for x in rl.LOSSES_S if (x[0] < rl.FILE_S[0]) == (k == 0)]
         t = frame_times(t_start, duration)
@@ -58,7 +60,9 @@ def simulate(seed: int) -> tuple[Any, Any, Any]:
         t_parts.append(pub.t_header_ns)
         xyz_parts.append(pub.xyz)
         quat_parts.append(pub.quat_xyzw)
-        # the same messages without the measurement noise (a repeat repeats its truth)
+        # the same messages without the measurement noise (a repeat repeats its truth),
+        # stamped at their frames' true times (no stamping delay)
+        frame_parts.append(pub.t_frame_ns)
         clean_parts.append(pub.xyz - pub.noise_xyz)
         clean_quat.append(pub.truth_quat_xyzw)
     gt = PoseStream(
@@ -72,7 +76,7 @@ def simulate(seed: int) -> tuple[Any, Any, Any]:
     tau, est_xyz, est_yaw, _true_xyz, _true_yaw = robot_estimate(rng)
     stamps = tau + round(rl.ROBOT_CLOCK_AHEAD_S * rl.NS)
     robot = PoseStream(stamps, est_xyz, quat_from_yaw(est_yaw), "world", "robot", "robot")
-    clean = (np.concatenate(t_parts), np.concatenate(clean_parts), np.concatenate(clean_quat))
+    clean = (np.concatenate(frame_parts), np.concatenate(clean_parts), np.concatenate(clean_quat))
     return robot, gt, (stamps, est_xyz, est_yaw, clean)
 
 
