@@ -50,6 +50,7 @@ from ertools.benchmarks.fbm1.gt import (
     board_motion,
     measure_ground_truth,
 )
+from ertools.benchmarks.fbm1.intervals import fbm1_intervals
 from ertools.benchmarks.fbm1.logs import Fbm1Logs, Fbm1Runs, load, locate_runs
 from ertools.benchmarks.fbm1.result import Fbm1Result, Fbm1RunResult
 from ertools.benchmarks.fbm1.rules import (
@@ -468,6 +469,17 @@ def score_fbm1(
         for r in runs
         if r.status == "unscoreable"
     ]
+    iv = fbm1_intervals(
+        runs,
+        found.runs,
+        origin,
+        board,
+        gt_options=opts.gt,
+        rules=opts.rules,
+        pose_runs=tot.pose_runs,
+        pose_total=tot.pose_score,
+        settings=opts.intervals,
+    )
     return Fbm1Result(
         name=opts.benchmark,
         runs=runs,
@@ -479,6 +491,8 @@ def score_fbm1(
         failures=tuple(failures),
         provenance=provenance or Provenance(),
         reference=opts.reference,
+        intervals=iv.intervals,
+        uncertainty=iv.uncertainty,
     )
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from ertools.benchmarks.common.interval_output import IntervalSettings
 from ertools.benchmarks.fbm1.gt import (
     GtOptions,
 )
@@ -64,6 +65,7 @@ class Fbm1Options:
         sources: origin/board pose sources (the 2015 topics, else their /tf frames).
         exact_end_payloads: RefBox END payloads read as the 2015 BmBox did (only
             ``reason: timeout`` / ``reason: stop``; :func:`ertools.states.end_reason`).
+        intervals: confidence level, Monte Carlo draws and seed of the score intervals.
     """
 
     benchmark: str = "fbm1h"
@@ -75,6 +77,7 @@ class Fbm1Options:
     items_order: tuple[str, ...] | None = None
     sources: BodySources = BodySources()
     exact_end_payloads: bool = False
+    intervals: IntervalSettings = field(default_factory=IntervalSettings)
 
     @staticmethod
     def for_rules(benchmark: str, rules: str, gt: GtOptions | None = None) -> Fbm1Options:

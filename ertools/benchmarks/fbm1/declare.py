@@ -22,6 +22,9 @@ from ertools.benchmarks.base import (
     tf_value,
 )
 from ertools.benchmarks.common.ending import EXACT_HELP
+from ertools.benchmarks.common.interval_output import IntervalSettings
+from ertools.benchmarks.common.interval_output import lines as interval_lines
+from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS
 from ertools.benchmarks.fbm1.benchmark import score_found
 from ertools.benchmarks.fbm1.config import RULE_SETS, BodySources, Fbm1Options
 from ertools.benchmarks.fbm1.gt import GtOptions
@@ -177,6 +180,7 @@ def inputs(name: str) -> tuple[Input, ...]:
             "deprecated: --count-aborted, and for fbm1h --accuracy-over-10",
             group=NODES,
         ),
+        *INTERVAL_INPUTS,
     )
 
 
@@ -272,6 +276,7 @@ def options_maker(name: str) -> Callable[[Mapping[str, Any]], Fbm1Options]:
             items_order=order,
             sources=_sources(name, v),
             exact_end_payloads=base.exact_end_payloads or v["exact_end_payloads"],
+            intervals=IntervalSettings.from_values(v),
         )
 
     return make_options
@@ -312,6 +317,15 @@ def notes(result: Fbm1Result) -> list[str]:
     if result.logged_score:
         logged = ", ".join(f"{k} {v}" for k, v in result.logged_score.items())
         out.append(f"the 2015 node sent: {logged}")
+    out += interval_lines(
+        [("pose_score", t.pose_score, result.intervals.get("pose_score"), 1.0, "", 4)],
+        result.uncertainty,
+    )
+    if result.uncertainty is not None:
+        out.append(
+            "interval: class_accuracy, instance_accuracy and execution_time are counts and "
+            "state times: no mocap noise enters them (no interval)"
+        )
     return out
 
 

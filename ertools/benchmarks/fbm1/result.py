@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.common.interval_output import as_list, interval_tables, low_high
+from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, interval_keys
 from ertools.benchmarks.common.validity import Validity, cell
 from ertools.benchmarks.fbm1.answers import Answer
 from ertools.benchmarks.fbm1.gt import GroundTruth
@@ -202,6 +205,10 @@ class Fbm1Result:
         provenance: inputs and parameters.
         reference: which reference the rules reproduce (ertools, the 2015 node, the 2016-17
             node).
+        intervals: the confidence interval of each ground-truth-derived number, by dotted key
+            (``pose_score``, ``runs.3.error.translation``...; :mod:`ertools.benchmarks.fbm1.
+            intervals`); empty with ``--draws 0``.
+        uncertainty: how the intervals were obtained (None without intervals).
     """
 
     name: str
@@ -214,6 +221,8 @@ class Fbm1Result:
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
     reference: str = "ertools default"
+    intervals: Mapping[str, Interval | None] = field(default_factory=dict)
+    uncertainty: Uncertainty | None = None
 
     @property
     def nothing_scored(self) -> bool:
@@ -251,19 +260,28 @@ class Fbm1Result:
         }
 
     def to_dict(self) -> dict[str, Any]:
-        out: dict[str, Any] = {**self.score(), "benchmark": self.name}
+        out: dict[str, Any] = {**self.score()}
+        if self.intervals:
+            # after the four keys of the 2015 listing, which keep their order
+            out["pose_score_interval"] = as_list(self.intervals.get("pose_score"))
+        out["benchmark"] = self.name
         out["reference"] = self.reference
         out["counted_runs"] = {
             "accuracy": self.totals.accuracy_runs,
             "pose": self.totals.pose_runs,
         }
-        out["runs"] = {str(r.index): r.to_dict(self.t0_ns) for r in self.runs}
+        out["runs"] = {
+            str(r.index): _with_intervals(r.to_dict(self.t0_ns), r.index, self.intervals)
+            for r in self.runs
+        }
         if self.logged_score is not None:
             out["logged_2015_score"] = self.logged_score
         for key in ("warnings", "deviations", "failures"):
             values = getattr(self, key)
             if values:
                 out[key] = list(values)
+        if self.uncertainty is not None:
+            out["uncertainty"] = self.uncertainty.to_dict()
         result: dict[str, Any] = jsonable(out)
         return result
 
@@ -277,4 +295,37 @@ class Fbm1Result:
         return tables_to_frames(self.tables())
 
     def tables(self) -> dict[str, Rows]:
-        return {"runs": [r.row(self.t0_ns) for r in self.runs]}
+        rows = []
+        for r in self.runs:
+            row = r.row(self.t0_ns)
+            if self.intervals:
+                for column, key in CSV_INTERVALS:
+                    row.update(low_high(column, self.intervals.get(f"runs.{r.index}.{key}")))
+            rows.append(row)
+        return {"runs": rows, **interval_tables(self.intervals, self.uncertainty)}
+
+
+# CSV column prefix -> dotted key under ``runs.<index>.`` of the run's interval.
+CSV_INTERVALS = (
+    ("gt_x", "ground_truth.x"),
+    ("gt_y", "ground_truth.y"),
+    ("gt_theta_deg", "ground_truth.theta"),
+    ("trans_error_m", "error.translation"),
+    ("theta_error_deg", "error.theta"),
+    ("pose_score", "pose_score"),
+)
+
+
+def _with_intervals(
+    entry: dict[str, Any], index: int, intervals: Mapping[str, Interval | None]
+) -> dict[str, Any]:
+    """A run's YAML entry with ``K_interval`` beside each key that has an interval."""
+    prefix = f"runs.{index}."
+    mine = {k[len(prefix) :]: v for k, v in intervals.items() if k.startswith(prefix)}
+    if not mine:
+        return entry
+    for section in ("ground_truth", "error"):
+        sub = {k.split(".", 1)[1]: v for k, v in mine.items() if k.startswith(section + ".")}
+        if sub and isinstance(entry.get(section), dict):
+            entry[section] = interval_keys(entry[section], sub)
+    return interval_keys(entry, {k: v for k, v in mine.items() if "." not in k})

@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ertools.benchmarks.common.interval_output import IntervalSettings
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.benchmarks.trajectory.inputs import (
     find_gt_files,
@@ -65,6 +66,7 @@ class TrajectoryOptions:
         gt_time: the same for the GT (``--time-source`` sets both).
         input_format: ``tum``, ``kitti``, ``euroc``, ``csv`` or ``bag`` for every input
             (``--input-format``); None: detected by content (:func:`ertools.io.text.sniff`).
+        intervals: level, draws and seed of the statistics' confidence intervals.
     """
 
     config: TrajectoryConfig = field(default_factory=TrajectoryConfig)
@@ -73,6 +75,7 @@ class TrajectoryOptions:
     robot_time: str = "header"
     gt_time: str = "header"
     input_format: str | None = None
+    intervals: IntervalSettings = field(default_factory=IntervalSettings)
 
 
 @dataclass(frozen=True, eq=False)
@@ -340,6 +343,7 @@ def score_found(logs: TrajectoryLogs, runs: None, options: TrajectoryOptions) ->
             gt_topic=logs.gt_topic,
             gt_files=files,
             warnings=warnings,
+            intervals=options.intervals,
         )
     except ClockError as err:
         if not logs.broken:

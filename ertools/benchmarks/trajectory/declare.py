@@ -11,6 +11,9 @@ from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks.base import Benchmark, Input, Ranking, resolve_values
+from ertools.benchmarks.common.interval_output import IntervalSettings
+from ertools.benchmarks.common.interval_output import lines as interval_lines
+from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS
 from ertools.benchmarks.trajectory.benchmark import (
     TrajectoryLogs,
     TrajectoryOptions,
@@ -174,6 +177,7 @@ INPUTS = (
         "bag",
         choices=INPUT_FORMATS,
     ),
+    *INTERVAL_INPUTS,
 )
 
 
@@ -253,6 +257,7 @@ def make_options(given: Mapping[str, Any]) -> TrajectoryOptions:
         robot_time or both or "header",
         both or "header",
         v["input_format"],
+        IntervalSettings.from_values(v),
     )
 
 
@@ -270,6 +275,21 @@ def sample(samples: Path) -> list[str] | None:
     if not robots:
         return None
     return [str(robots[0]), str(folder), "--offset", "auto", "--apply-offset"]
+
+
+def notes(result: TrajectoryResult) -> list[str]:
+    """One stderr line per main statistic with its interval and the sources' shares."""
+    m = result.metrics
+    if m is None or result.uncertainty is None:
+        return []
+    iv = result.intervals
+    rows = [
+        ("position_error", m.position_error, iv.get("position_error"), 1000.0, "mm", 2),
+        ("rmse", m.rmse, iv.get("rmse"), 1000.0, "mm", 2),
+        ("max", m.max, iv.get("max"), 1000.0, "mm", 2),
+        ("orientation_error", m.orientation_error, iv.get("orientation_error"), 1.0, "rad", 4),
+    ]
+    return interval_lines(rows, result.uncertainty)
 
 
 EPILOG = """examples:
@@ -330,4 +350,5 @@ robot's stamps and the GT clock and says when it matters.""",
     score_keys=frozenset({"position_error", "association"}),
     values_2015={"as_2015": True},
     sample=sample,
+    notes=notes,
 )

@@ -4,6 +4,7 @@ JSON/YAML/text and the CSV tables.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -11,6 +12,8 @@ import numpy as np
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.benchmarks.common.clocks import OffsetEstimate
+from ertools.benchmarks.common.interval_output import interval_tables, low_high
+from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, interval_keys
 from ertools.benchmarks.common.validity import Validity, cell
 from ertools.benchmarks.trajectory.association import (
     COMPARED,
@@ -31,6 +34,16 @@ from ertools.timeutil import NS_PER_S, ns_to_s
 if TYPE_CHECKING:
     import pandas as pd  # annotations only: pandas is imported by to_frames()
 
+# The summary table's statistics that get ``_low``/``_high`` columns.
+INTERVAL_COLUMNS = (
+    "position_error",
+    "orientation_error",
+    "rmse",
+    "median",
+    "max",
+    "orientation_error_2015",
+)
+
 
 @dataclass(frozen=True, eq=False)
 class TrajectoryResult:
@@ -47,6 +60,10 @@ class TrajectoryResult:
         gt_path: the GT positions, decimated to at most a few thousand points, for figures.
         audit: the clock-offset estimate.
         uncovered_spans: robot-time spans outside the GT, (start_ns, end_ns) on the GT clock.
+        intervals: the confidence interval of each statistic by key (``rmse``,
+            ``percentiles.p95``...; :mod:`ertools.benchmarks.trajectory.intervals`); empty
+            with ``--draws 0``.
+        uncertainty: how the intervals were obtained (None without intervals).
     """
 
     robot_file: str
@@ -68,6 +85,8 @@ class TrajectoryResult:
     name: str = "trajectory"
     validity: Validity | None = None
     unscoreable_reason: str | None = None
+    intervals: Mapping[str, Interval | None] = field(default_factory=dict)
+    uncertainty: Uncertainty | None = None
 
     @property
     def nothing_scored(self) -> bool:
@@ -165,6 +184,13 @@ class TrajectoryResult:
             data["status"] = "unscoreable"
         if self.unscoreable_reason is not None:
             data["unscoreable_reason"] = self.unscoreable_reason
+        if self.intervals:
+            data = interval_keys(data, self.intervals)
+            if isinstance(data["percentiles"], dict):
+                pct = {k.split(".", 1)[1]: v for k, v in self.intervals.items() if "." in k}
+                data["percentiles"] = interval_keys(data["percentiles"], pct)
+        if self.uncertainty is not None:
+            data["uncertainty"] = self.uncertainty.to_dict()
         out: dict[str, Any] = jsonable(data)
         return out
 
@@ -239,7 +265,11 @@ class TrajectoryResult:
         if "unscoreable_reason" in d:
             summary["status"] = d.get("status", "scored")
             summary["unscoreable_reason"] = d["unscoreable_reason"]
-        return {"samples": rows, "summary": [summary]}
+        if self.intervals:
+            for key in INTERVAL_COLUMNS:
+                summary.update(low_high(key, self.intervals.get(key)))
+        extra = interval_tables(self.intervals, self.uncertainty)
+        return {"samples": rows, "summary": [summary], **extra}
 
 
 def _f(x: float) -> float | None:

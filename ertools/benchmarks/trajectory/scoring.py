@@ -13,6 +13,7 @@ import numpy.typing as npt
 from ertools.arrays import I64
 from ertools.benchmarks.common.clocks import OffsetEstimate, estimate_offset
 from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid, frame_change_warning
+from ertools.benchmarks.common.interval_output import IntervalSettings
 from ertools.benchmarks.common.validity import (
     GAP as V_GAP,
 )
@@ -36,6 +37,7 @@ from ertools.benchmarks.trajectory.association import (
     associate_evo,
 )
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.intervals import NO_INTERVALS, trajectory_intervals
 from ertools.benchmarks.trajectory.metrics import Metrics, metrics
 from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.benchmarks.trajectory.rules import (
@@ -51,6 +53,8 @@ from ertools.errors import ClockError, ScoringError
 from ertools.fidelity import Deviation
 from ertools.streams import PoseStream, Provenance, float_seconds
 from ertools.timeutil import iso_utc, ns_to_s
+
+DEFAULT_INTERVALS = IntervalSettings()
 
 
 def check_increasing(robot: PoseStream, where: str) -> None:
@@ -83,8 +87,12 @@ def score_streams(
     gt_topic: str = "",
     gt_files: Sequence[str] = (),
     warnings: Sequence[str] = (),
+    intervals: IntervalSettings = DEFAULT_INTERVALS,
 ) -> TrajectoryResult:
     """Compare a robot stream (stamps on the robot clock, recording order) with GT.
+
+    ``intervals``: level, draws and seed of the statistics' confidence intervals
+    (:mod:`ertools.benchmarks.trajectory.intervals`; draws 0: none).
 
     Raises:
         ScoringError: robot stamps not strictly increasing, or empty streams.
@@ -284,6 +292,19 @@ def score_streams(
             "(repeated GT poses) and are not compared"
         )
     notes.extend(_audit_warnings(audit, offset_ns))
+    iv = NO_INTERVALS
+    if m is not None:
+        iv = trajectory_intervals(
+            robot,
+            timed,
+            matched,
+            audit,
+            _estimates(m),
+            association=config.association,
+            offset_ns=offset_ns,
+            max_gap_ns=config.max_gap_ns,
+            settings=intervals,
+        )
     result = TrajectoryResult(
         robot_file=robot_file,
         robot_topic=robot_topic,
@@ -302,6 +323,8 @@ def score_streams(
         failures=tuple(failures),
         validity=validity,
         unscoreable_reason=problem,
+        intervals=iv.intervals,
+        uncertainty=iv.uncertainty,
         provenance=Provenance(
             inputs=(robot_file, *gt_files),
             parameters=(
@@ -357,6 +380,20 @@ def too_few(validity: Validity) -> str | None:
             f"({what}); at least {MIN_VALID_FRACTION:.0%} are needed"
         )
     return None
+
+
+def _estimates(m: Metrics) -> dict[str, float]:
+    """The statistics by interval key (:data:`~ertools.benchmarks.trajectory.intervals.KEYS`)."""
+    out = {
+        "position_error": m.position_error,
+        "orientation_error": m.orientation_error,
+        "rmse": m.rmse,
+        "median": m.median,
+        "max": m.max,
+        "orientation_error_2015": m.orientation_error_2015,
+    }
+    out.update({f"percentiles.p{p:g}": v for p, v in m.percentiles})
+    return out
 
 
 def _audit_warnings(audit: OffsetEstimate, applied_ns: int) -> list[str]:

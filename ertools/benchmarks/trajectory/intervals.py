@@ -1,0 +1,433 @@
+"""Confidence intervals of the trajectory statistics (issue 28).
+
+Every statistic of :mod:`ertools.benchmarks.trajectory.metrics` (the mean 3D distance, RMSE,
+median, max and percentiles, the orientation errors) is re-computed ``draws`` times with the GT
+side of each compared pair perturbed by two sources, vectorised over (draws, poses):
+
+- ``mocap_noise``: each GT pose used carries the mocap's measurement noise, sigma per axis
+  measured from the GT stream itself: from its stationary phases as ``ertools noise
+  --stationary auto`` finds them (epsilon -> sigma), else from the second differences of the
+  moving stream (at 120 Hz the motion's own second difference is hundredths of a millimetre;
+  the noise's is sqrt(6) sigma: a robust MAD of them gives sigma), else a stated default. The
+  yaw's sigma likewise from the yaw's second differences. An interpolated GT pose mixes two
+  samples: its noise is sigma sqrt((1-a)^2 + a^2).
+- ``time_association``: the robot-to-GT clock offset is known to the clock audit's standard
+  deviation (its block bootstrap): one offset error per draw, common to every pose, moves
+  each GT pose by the GT velocity times it. The offset is not a measurement of the truth
+  plus an error that a draw adds a second time: the true offset lies around the applied one
+  as the draws do, so the score at a drawn offset is itself a draw of the true score (with
+  ``--offset auto`` the applied offset minimises the error: every other offset, the true one
+  included, scores higher). Its draws are mirrored about the score before the engine's
+  reflection, and added to the measurement-like draws (their interaction neglected). The GT
+  is interpolated anew at the shifted times (a shift that moves a pose next to a tracking
+  loss changes the score as the score's own association would). With ``hold`` (2015) the
+  GT pose compared was measured up to one GT frame period before the robot's moment, with
+  ``nearest`` up to half a period either side: an extra lag drawn uniformly over the pose's
+  own frame period (the basic interval then removes the lag's bias). ``linear``
+  interpolates: no frame-period term.
+
+The interval is the engine's basic bootstrap: noise makes a distance longer on average (the
+RMSE of a perfect robot is sqrt(3) sigma, not 0) and the reflection removes the bias the draws
+show. The draws work in float32 and in chunks of draws. A comparison of more than
+:data:`MAX_POSES` poses (an hour at 10 Hz is 36,000) draws on that many poses spread evenly
+over it: the offset's effect is the same on them as on all, the per-pose noise's spread in
+the mean-like statistics (mean, RMSE, orientation errors) is scaled by sqrt(thinned / all)
+(it averages over all the poses), and in the median, percentiles and max it is left as the
+thinned poses give it (wider: a conservative interval). An hour's log costs a fraction of a
+second.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ertools.arrays import F64, IntArr
+from ertools.benchmarks.common.clocks import OffsetEstimate
+from ertools.benchmarks.common.interval_output import METHOD, IntervalSettings, shares_of
+from ertools.benchmarks.common.uncertainty import (
+    MOCAP_NOISE,
+    TIME_ASSOCIATION,
+    Interval,
+    Source,
+    Uncertainty,
+    monte_carlo,
+    sigma_from_epsilon,
+)
+from ertools.benchmarks.noise.benchmark import noise_from_stream
+from ertools.benchmarks.trajectory.association import COMPARED, Matched
+from ertools.benchmarks.trajectory.metrics import PERCENTILES
+from ertools.errors import ErtoolsError
+from ertools.streams import PoseStream
+from ertools.timeutil import NS_PER_S
+
+METHOD_TRAJECTORY = f"{METHOD} (the clock offset's draws mirrored: a percentile interval)"
+Floats = npt.NDArray[np.floating[Any]]  # float32 in the draws, float64 elsewhere
+
+# A 2015 mocap marker set when nothing in the log measures it: 0.3 mm per axis, 0.05 deg.
+DEFAULT_SIGMA_M = 3e-4
+DEFAULT_SIGMA_RAD = math.radians(0.05)
+MIN_PAIRS = 50  # stationary pairs (or second differences) needed to measure sigma
+VELOCITY_HALF_SPAN = 5  # GT samples either side of a pose for its velocity (~40 ms at 120 Hz)
+CHUNK_ELEMENTS = 4_000_000  # draws x poses per chunk (float32: ~50 MB of positions)
+# Longer comparisons draw on this many evenly spread poses (module doc): an hour at 10 Hz
+# stays well under a second.
+MAX_POSES = 1500
+OFFSET_GRID = 81  # shifts the statistics are computed at, between the extreme draws
+SIGMA_BLOCKS, SIGMA_BLOCK = 20, 2000  # GT samples the noise is measured on, at most
+
+#: The scores with an interval, in the order of the result's keys (``percentiles.pNN`` nested).
+KEYS = (
+    "position_error",
+    "orientation_error",
+    "rmse",
+    "median",
+    "max",
+    *(f"percentiles.p{p:g}" for p in PERCENTILES),
+    "orientation_error_2015",
+)
+# Statistics that average over the poses (their noise part shrinks as 1 / sqrt(poses)).
+MEAN_LIKE = [0, 1, 2, len(KEYS) - 1]
+
+
+@dataclass(frozen=True)
+class MocapSigma:
+    """The GT's noise: per-axis position sigma (m), yaw sigma (rad), and how it was found."""
+
+    position: float
+    yaw: float
+    measured: bool
+    note: str
+
+
+def _mad_sigma(d2: F64) -> float:
+    """sigma of the noise from second differences (each sqrt(6) sigma): 1.4826 MAD."""
+    med = np.median(d2)
+    return float(1.4826 * np.median(np.abs(d2 - med)) / math.sqrt(6.0))
+
+
+def _second_differences(gt: PoseStream) -> tuple[F64, F64]:
+    """Second differences of x, y, z (pooled) and of the yaw, over runs of three fresh
+    samples (a repeated pose, tracking lost, is no measurement)."""
+    xyz = gt.xyz
+    if len(gt) < 3:
+        return np.zeros(0), np.zeros(0)
+    fresh = np.ones(len(gt), dtype=bool)
+    fresh[1:] = np.any(xyz[1:] != xyz[:-1], axis=1)
+    dt = np.diff(gt.t_ns)
+    ok = fresh[2:] & fresh[1:-1] & fresh[:-2]
+    # equal spacing (within 25%): a gap is not a second difference of the motion
+    ok &= np.abs(dt[1:] - dt[:-1]) <= 0.25 * np.maximum(dt[1:], 1)
+    d2 = (xyz[2:] - 2.0 * xyz[1:-1] + xyz[:-2])[ok]
+    yaw = np.unwrap(gt.yaw)
+    y2 = (yaw[2:] - 2.0 * yaw[1:-1] + yaw[:-2])[ok]
+    return d2.reshape(-1), y2
+
+
+def _blocks(gt: PoseStream) -> PoseStream:
+    """At most SIGMA_BLOCKS runs of SIGMA_BLOCK consecutive samples spread over ``gt``: an
+    hour of 120 Hz GT measures its noise as well as from 40,000 samples, 10 times faster."""
+    n = len(gt)
+    if n <= SIGMA_BLOCKS * SIGMA_BLOCK:
+        return gt
+    starts = np.linspace(0, n - SIGMA_BLOCK, SIGMA_BLOCKS).astype(np.intp)
+    index = (starts[:, None] + np.arange(SIGMA_BLOCK)[None, :]).reshape(-1)
+    return gt.take(np.unique(index))
+
+
+def mocap_sigma(gt: PoseStream) -> MocapSigma:
+    """The GT's measurement noise, measured from the GT stream (module doc)."""
+    gt = _blocks(gt)
+    d2, y2 = _second_differences(gt)
+    yaw_sigma = _mad_sigma(y2) if y2.size >= MIN_PAIRS else DEFAULT_SIGMA_RAD
+    yaw_note = "yaw from its second differences" if y2.size >= MIN_PAIRS else "yaw default"
+    try:
+        still = noise_from_stream(gt, stationary=True)
+        pairs = int(still.pairs)
+        epsilon = float(still.epsilon)
+    except ErtoolsError:
+        pairs, epsilon = 0, math.nan
+    if pairs >= MIN_PAIRS and math.isfinite(epsilon) and epsilon > 0.0:
+        return MocapSigma(
+            sigma_from_epsilon(epsilon),
+            yaw_sigma,
+            True,
+            f"stationary phases of the GT: epsilon {epsilon * 1000:.3f} mm over {pairs} pairs "
+            f"(sigma = epsilon / sqrt(pi)); {yaw_note}",
+        )
+    if d2.size >= 3 * MIN_PAIRS:
+        return MocapSigma(
+            _mad_sigma(d2),
+            yaw_sigma,
+            True,
+            f"no stationary phase: second differences of the moving GT ({d2.size // 3} "
+            f"triples, 1.4826 MAD / sqrt(6)); {yaw_note}",
+        )
+    return MocapSigma(
+        DEFAULT_SIGMA_M,
+        yaw_sigma,
+        False,
+        f"too few GT samples to measure: default {DEFAULT_SIGMA_M * 1000:g} mm per axis; "
+        + yaw_note,
+    )
+
+
+def offset_spread(
+    r_xyz: Floats, g_xyz: Floats, vel: Floats, audit: OffsetEstimate, offset_ns: int
+) -> tuple[float, float]:
+    """(sd, centre) in seconds of the true clock offset around the one applied.
+
+    The sd is the sandwich standard error of the least-squares offset, the poses taken as
+    independent: sqrt(sum psi_i^2) / sum |v_i|^2 with psi_i = v_i . (robot_i - gt_i). On the
+    simulator (``bench/calibration/trajectory.py``, the robot's error a bias, a 13 s drift
+    and white noise, drawn anew per trial) the offset's actual error is 1.14 of it, while the
+    clock audit's block bootstrap (reported in ``clock_audit``) is 4.5 times the actual
+    error: resampling blocks of a smooth error breaks the cancellation of its projection on
+    a turning path's velocity, which makes it a safe warning threshold but no interval. The
+    centre is the audit's estimate minus the offset applied (0 with ``--offset auto
+    --apply-offset``): a given offset the data disagrees with moves the interval, not the
+    score.
+    """
+    sv = float(np.sum(np.square(vel, dtype=np.float64)))
+    if len(vel) < 3 or sv <= 0.0 or audit.offset_ns is None:
+        return 0.0, 0.0
+    psi = np.sum((r_xyz - g_xyz).astype(np.float64) * vel, axis=1)
+    psi -= psi.mean()
+    return math.sqrt(float(np.dot(psi, psi))) / sv, (audit.offset_ns - offset_ns) / NS_PER_S
+
+
+def _bracket(t: IntArr, q: IntArr) -> tuple[IntArr, IntArr]:
+    """The GT samples k <= q < k+1 (clipped to the stream)."""
+    n = len(t)
+    k = np.clip(np.searchsorted(t, q, side="right") - 1, 0, max(n - 2, 0))
+    return k, np.minimum(k + 1, n - 1)
+
+
+@dataclass(frozen=True)
+class TrajectoryIntervals:
+    """The intervals of one trajectory result, by score key, and how they were obtained."""
+
+    intervals: Mapping[str, Interval | None]
+    uncertainty: Uncertainty | None
+
+
+NO_INTERVALS = TrajectoryIntervals({}, None)
+
+
+def trajectory_intervals(
+    robot: PoseStream,
+    gt: PoseStream,
+    matched: Matched,
+    audit: OffsetEstimate,
+    estimates: Mapping[str, float],
+    *,
+    association: str,
+    offset_ns: int,
+    max_gap_ns: int,
+    settings: IntervalSettings,
+) -> TrajectoryIntervals:
+    """The intervals of the statistics ``estimates`` (by :data:`KEYS`) of a comparison.
+
+    ``robot``: the robot stream whose row i is matched row i; ``gt``: the GT in time order;
+    ``offset_ns``: the offset the score applied; ``max_gap_ns``: the GT gap the score skips.
+    """
+    ok = matched.status == COMPARED
+    if not settings.enabled or not ok.any() or len(gt) < 2:
+        return NO_INTERVALS
+    q = matched.t_ns[ok]
+    r_xyz = robot.xyz[ok].astype(np.float32)
+    r_yaw = robot.yaw[ok].astype(np.float32)
+    g_xyz = matched.gt_xyz[ok].astype(np.float32)
+    g_yaw = matched.gt_yaw[ok].astype(np.float32)
+    t = gt.t_ns
+    k, k1 = _bracket(t, q)
+    period = ((t[k1] - t[k]) / NS_PER_S).astype(np.float32)
+    # A pose compared across a GT gap (--gaps compare, 2015) is held up to the gap's length:
+    # that is the log's gap (a validity matter, reported), not the frame period's lag
+    period = np.minimum(period, np.float32(1.5) * np.median(period))
+    a = np.clip((q - t[k]) / np.maximum(t[k1] - t[k], 1), 0.0, 1.0)
+    # GT velocity and yaw rate around each pose, over ~VELOCITY_HALF_SPAN samples either side
+    lo = np.clip(k - VELOCITY_HALF_SPAN, 0, len(t) - 1)
+    hi = np.clip(k1 + VELOCITY_HALF_SPAN, 0, len(t) - 1)
+    span = np.maximum((t[hi] - t[lo]).astype(np.float64) / NS_PER_S, 1e-9)
+    vel = ((gt.xyz[hi] - gt.xyz[lo]) / span[:, None]).astype(np.float32)
+    yaw_rate = (np.angle(np.exp(1j * (gt.yaw[hi] - gt.yaw[lo]))) / span).astype(np.float32)
+    sig = mocap_sigma(gt)
+    if association == "linear":
+        weight = np.sqrt((1.0 - a) ** 2 + a**2).astype(np.float32)
+        lag_lo, lag_hi = 0.0, 0.0
+    elif association == "hold":
+        weight = np.ones(len(q), np.float32)
+        lag_lo, lag_hi = -1.0, 0.0
+    else:
+        weight = np.ones(len(q), np.float32)
+        lag_lo, lag_hi = -0.5, 0.5
+    off_sigma, off_centre = offset_spread(r_xyz, g_xyz, vel, audit, offset_ns)
+    frame_term = lag_hi > lag_lo
+    raw0 = matched.yaw_diff_raw[ok].astype(np.float32)
+    n_all = len(q)
+    # An hour's log: the draws run on evenly thinned poses (module doc)
+    if n_all > MAX_POSES:
+        keep = np.unique(np.linspace(0, n_all - 1, MAX_POSES).round().astype(np.intp))
+        r_xyz, r_yaw, g_xyz, g_yaw = r_xyz[keep], r_yaw[keep], g_xyz[keep], g_yaw[keep]
+        vel, yaw_rate, weight, period, raw0 = (
+            vel[keep],
+            yaw_rate[keep],
+            weight[keep],
+            period[keep],
+            raw0[keep],
+        )
+    else:
+        keep = np.arange(n_all)
+    q_used = q[keep]
+    n = len(r_yaw)
+    thin = math.sqrt(n / n_all)
+    gt_yaw_all = np.unwrap(gt.yaw)
+    repeated = np.zeros(len(t), dtype=bool)  # the pair (k-1, k) has one position: lost
+    repeated[1:] = np.all(gt.xyz[1:] == gt.xyz[:-1], axis=1)
+
+    def gt_at(times: IntArr) -> tuple[F64, F64]:
+        """The GT pose at shifted robot times, as the association takes it (interpolated
+        anew: a shift that moves a pose next to a tracking loss or across a sample is
+        the score's own, not a linearisation's)."""
+        lo_i, hi_i = _bracket(t, times)
+        span_ns = np.maximum(t[hi_i] - t[lo_i], 1)
+        w = np.clip((times - t[lo_i]) / span_ns, 0.0, 1.0)
+        if association == "hold":
+            w = np.zeros_like(w)
+        elif association != "linear":
+            w = np.round(w)
+        wp = w[..., None]
+        xyz = (1.0 - wp) * gt.xyz[lo_i] + wp * gt.xyz[hi_i]
+        yaw = (1.0 - w) * gt_yaw_all[lo_i] + w * gt_yaw_all[hi_i]
+        # shifted into a GT gap, or where tracking was lost (a repeated pose), the score
+        # would not compare the pose: it keeps its GT pose,
+        # moved by the GT velocity (the linearisation) rather than held across the gap
+        gap = (span_ns > max_gap_ns) | repeated[hi_i]
+        if gap.any():
+            dt = ((times - q_used) / NS_PER_S).astype(np.float32)
+            lin = g_xyz + dt[..., None] * vel
+            xyz = np.where(gap[..., None], lin, xyz)
+            yaw = np.where(gap, g_yaw + dt * yaw_rate, yaw)
+        return xyz.astype(np.float32), yaw.astype(np.float32)
+
+    est = np.array([estimates[key] for key in KEYS])
+
+    def errors(gp: F64, gy: F64) -> F64:
+        """(draws, S) statistics of perturbed GT poses, as metrics() computes them."""
+        d = np.sqrt(np.sum(np.square(gp - r_xyz), axis=-1))
+        pi = np.float32(math.pi)
+        dyaw = np.abs(np.remainder(r_yaw - gy + pi, 2 * pi) - pi)
+        raw = np.abs(raw0 + (np.remainder(g_yaw - gy + pi, 2 * pi) - pi))
+        pct = np.percentile(d, PERCENTILES, axis=-1).T  # PERCENTILES[0] is the median
+        return np.column_stack(
+            [
+                d.mean(axis=-1, dtype=np.float64),
+                np.arctan2(np.sin(dyaw).sum(axis=-1), np.cos(dyaw).sum(axis=-1)),
+                np.sqrt(np.mean(np.square(d, dtype=np.float64), axis=-1)),
+                pct[:, 0],
+                d.max(axis=-1),
+                pct,
+                np.arctan2(np.sin(raw).sum(axis=-1), np.cos(raw).sum(axis=-1)),
+            ]
+        )
+
+    base = errors(g_xyz[None], g_yaw[None])[0]
+    base_off = errors(*gt_at(q_used[None, :]))[0]
+
+    def perturbed(rng: np.random.Generator, sources: frozenset[str], draws: int) -> F64:
+        """Draws whose basic (reflected) interval is the interval wanted (module doc):
+        measurement-like perturbations as re-computed scores, the offset's mirrored."""
+        chunk = max(1, CHUNK_ELEMENTS // max(n, 1))
+        noise = MOCAP_NOISE in sources
+        timing = TIME_ASSOCIATION in sources
+        measured = np.zeros((draws, est.size))
+        offset = np.zeros((draws, est.size))
+        for start in range(0, draws, chunk):
+            m = min(chunk, draws - start)
+            rows = slice(start, start + m)
+            if noise or (timing and frame_term):
+                gp = np.broadcast_to(g_xyz, (m, n, 3)).copy()
+                gy = np.broadcast_to(g_yaw, (m, n)).copy()
+                if noise:
+                    gp += rng.standard_normal((m, n, 3), dtype=np.float32) * (
+                        np.float32(sig.position) * weight[None, :, None]
+                    )
+                    gy += rng.standard_normal((m, n), dtype=np.float32) * (
+                        np.float32(sig.yaw) * weight
+                    )
+                if timing and frame_term:
+                    lag = rng.uniform(lag_lo, lag_hi, (m, n)).astype(np.float32) * period
+                    gp += lag[..., None] * vel
+                    gy += lag * yaw_rate
+                measured[rows] = errors(gp, gy) - base
+            if timing and off_sigma > 0.0:
+                shift = rng.standard_normal(m) * off_sigma + off_centre
+                # one shift for every pose: the statistics are a function of it alone,
+                # computed on a grid of shifts and interpolated (a tracking loss's kink
+                # included: the grid is much finer than the draws' spread)
+                grid = np.linspace(shift.min(), shift.max(), min(m, OFFSET_GRID))
+                gp, gy = gt_at(
+                    q_used[None, :] + np.round(grid[:, None] * NS_PER_S).astype(np.int64)
+                )
+                on_grid = errors(gp, gy) - base_off
+                offset[rows] = np.column_stack(
+                    [np.interp(shift, grid, on_grid[:, j]) for j in range(est.size)]
+                )
+        if thin < 1.0:
+            # per-pose noise averages over all the poses of a mean-like statistic, not only
+            # over the thinned ones: its spread (not its bias) scales with sqrt(n / N)
+            bias = measured[:, MEAN_LIKE].mean(axis=0)
+            measured[:, MEAN_LIKE] = bias + (measured[:, MEAN_LIKE] - bias) * thin
+        # mirrored: the offset is not a measurement of the truth plus an error that the
+        # draws add again; the truth's offset is spread around the applied one as the draws
+        # are, so the reflection of the basic interval must not apply to it
+        return np.asarray(est + measured - offset, dtype=np.float64)
+
+    sources = [MOCAP_NOISE]
+    if off_sigma > 0.0 or frame_term:
+        sources.append(TIME_ASSOCIATION)
+    got = monte_carlo(
+        est,
+        perturbed,
+        sources,
+        draws=settings.draws,
+        seed=settings.seed,
+        confidence=settings.confidence,
+        nonnegative=True,
+    )
+    intervals = dict(zip(KEYS, got, strict=True))
+    src = [Source(MOCAP_NOISE, sig.position, "m", sig.measured, sig.note)]
+    if TIME_ASSOCIATION in sources:
+        parts = []
+        if off_sigma > 0.0:
+            parts.append(
+                f"clock offset sd {off_sigma * 1000:.3f} ms (sandwich standard error of the "
+                f"least-squares offset), centred {off_centre * 1000:+.3f} ms from the applied "
+                "one (the clock audit's estimate); mirrored: drawn as the truth's offset"
+            )
+        else:
+            parts.append(f"no offset estimate (clock audit: {audit.note or 'none'})")
+        if frame_term:
+            med = float(np.median(period)) * 1000
+            parts.append(
+                f"{association}: GT frame period {med:.2f} ms (lag uniform over "
+                f"[{lag_lo:g}, {lag_hi:g}] periods)"
+            )
+        src.append(Source(TIME_ASSOCIATION, off_sigma, "s", off_sigma > 0.0, "; ".join(parts)))
+    elif audit.uncertainty_s is None:
+        pass
+    unc = Uncertainty(
+        confidence=settings.confidence,
+        method=METHOD_TRAJECTORY,
+        draws=settings.draws,
+        seed=settings.seed,
+        sources=tuple(src),
+        shares=shares_of(intervals),
+    )
+    return TrajectoryIntervals(intervals, unc)
