@@ -4,6 +4,7 @@ mode), so helpers shared by several test folders live in one module, ``tests/fak
 import contextlib
 import dataclasses
 import fcntl
+import io
 import os
 from collections.abc import Generator, Iterator
 from pathlib import Path
@@ -129,8 +130,12 @@ def _mark(items: list[pytest.Item]) -> None:
             continue
         rel = path.relative_to(TESTS).as_posix()
         node = rel + item.nodeid[item.nodeid.index("::") :] if "::" in item.nodeid else rel
+        closure = getattr(getattr(item, "_fixtureinfo", None), "names_closure", ())
         if node.startswith(TIMING):
             item.add_marker(pytest.mark.xdist_group("timing"))
+        elif "rescored_competition" in closure:
+            # the modules reading it on one worker: the other would wait for it, idle
+            item.add_marker(pytest.mark.xdist_group("rescored_competition"))
         elif _shares_a_module_fixture(item):
             # Its module's tests on one worker: the fixture (a rescored folder, a report) is
             # made once, not once on each worker that draws one of them.
@@ -170,3 +175,25 @@ def sample_competition(tmp_path_factory: pytest.TempPathFactory) -> Path:
             root.parent.mkdir(parents=True, exist_ok=True)
             write_competition(root, seed=DEFAULT_SEED)
     return root
+
+
+@pytest.fixture(scope="session")
+def rescored_competition(
+    sample_competition: Path, tmp_path_factory: pytest.TempPathFactory
+) -> Path:
+    """The sample competition rescored as ``make demo`` does (its step: reports, 2 jobs), once
+    for the session, by the first worker that needs it: the results folder (results.json,
+    index.html, a report per execution). Tests read it and write nothing into it."""
+    from ertools.cli.main import main
+    from ertools.demo import competition_step
+
+    shared = shared_dir(tmp_path_factory)
+    out = shared / "rescored" / "rescore"
+    with _exclusive(shared / "rescored.lock"):
+        if not (out / "results.json").is_file() or not (out / "index.html").is_file():
+            step = competition_step(sample_competition, out)
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+                code = main([*step.argv, "--quiet"])
+            assert code == step.expected_exit == 1, err.getvalue()[-2000:]
+    return out
