@@ -37,9 +37,13 @@ typecheck: $(DEVSTAMP)
 
 # The suite on every core (pytest-xdist): tests that share a resource or measure time carry an
 # xdist_group mark and run on one worker (tests/conftest.py); the 15 slowest are listed.
+# pytest keeps its rewritten test modules as bytecode (tests/**/__pycache__, ignored by git):
+# where PYTHONDONTWRITEBYTECODE is set it would rewrite all of them in every worker of every
+# run (6 s of CPU each here).
 PYTEST_JOBS ?= auto
+PYTEST := PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest
 pytest: $(DEVSTAMP)
-	$(BIN)/python -m pytest -q -n $(PYTEST_JOBS) --dist loadgroup --durations=15
+	$(PYTEST) -q -n $(PYTEST_JOBS) --dist loadgroup --durations=15
 
 test: lint typecheck pytest
 
@@ -49,7 +53,7 @@ check: $(DEVSTAMP)
 	$(BIN)/ruff check ertools tests bench fuzz
 	$(BIN)/ruff format --check ertools tests bench fuzz
 	$(BIN)/lint-imports --no-cache
-	$(BIN)/python -m pytest -q -n $(PYTEST_JOBS) --dist loadgroup -m "not slow"
+	$(PYTEST) -q -n $(PYTEST_JOBS) --dist loadgroup -m "not slow"
 
 bench: $(STAMP)
 	$(BIN)/python -m pip install --quiet -e '.[dask]'  # the season's LocalCluster run

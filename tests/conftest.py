@@ -2,9 +2,11 @@
 mode), so helpers shared by several test folders live in one module, ``tests/fakes.py``."""
 
 import contextlib
+import dataclasses
 import fcntl
+import io
 import os
-from collections.abc import Iterator
+from collections.abc import Generator, Iterator
 from pathlib import Path
 
 import pytest
@@ -77,7 +79,50 @@ def _shares_a_module_fixture(item: pytest.Item) -> bool:
     )
 
 
-def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+@pytest.hookimpl(wrapper=True)
+def pytest_collection_modifyitems(
+    config: pytest.Config, items: list[pytest.Item]
+) -> Generator[None, None, None]:
+    """Marks the groups and the slow tests before xdist (and every other plugin) reads the
+    marks; after them, makes sure each grouped test's node id carries its group."""
+    _mark(items)
+    yield
+    if getattr(config.option, "loadgroup", False):  # an xdist worker under --dist loadgroup
+        for item in items:
+            _suffix_group(item)
+
+
+def _suffix_group(item: pytest.Item) -> None:
+    """``nodeid@group``, the one thing xdist's loadgroup scheduler reads a test's group from.
+
+    xdist (3.8) writes the suffix into ``item._nodeid``, which pytest 9.2's structured node
+    ids no longer read (pytest-xdist#1386): the groups were silently ignored, every worker
+    set up every module fixture it drew a test of (the rescored competition twice), and the
+    timing tests ran beside each other. Where xdist's own suffix took, nothing is done."""
+    names = sorted(
+        {
+            str(m.args[0] if m.args else m.kwargs.get("name", "default"))
+            for m in item.iter_markers("xdist_group")
+        }
+    )
+    if not names:
+        return
+    suffix = "@" + "_".join(names)
+    if item.nodeid.endswith(suffix):
+        return
+    wanted = item.nodeid + suffix
+    node_id = getattr(item, "_id", None)
+    if node_id is not None and hasattr(node_id, "_str_cache"):  # pytest >= 9.2
+        # the same path, names and parameters; only the string form carries the group
+        node_id = dataclasses.replace(node_id)
+        object.__setattr__(node_id, "_str_cache", wanted)
+        item._id = node_id
+    else:
+        item._nodeid = wanted  # type: ignore[attr-defined]
+    assert item.nodeid == wanted, f"cannot put {item.nodeid} in its xdist group"
+
+
+def _mark(items: list[pytest.Item]) -> None:
     slow = _slow()
     for item in items:
         path = Path(str(item.path)).resolve()
@@ -85,8 +130,12 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             continue
         rel = path.relative_to(TESTS).as_posix()
         node = rel + item.nodeid[item.nodeid.index("::") :] if "::" in item.nodeid else rel
+        closure = getattr(getattr(item, "_fixtureinfo", None), "names_closure", ())
         if node.startswith(TIMING):
             item.add_marker(pytest.mark.xdist_group("timing"))
+        elif "rescored_competition" in closure:
+            # the modules reading it on one worker: the other would wait for it, idle
+            item.add_marker(pytest.mark.xdist_group("rescored_competition"))
         elif _shares_a_module_fixture(item):
             # Its module's tests on one worker: the fixture (a rescored folder, a report) is
             # made once, not once on each worker that draws one of them.
@@ -126,3 +175,25 @@ def sample_competition(tmp_path_factory: pytest.TempPathFactory) -> Path:
             root.parent.mkdir(parents=True, exist_ok=True)
             write_competition(root, seed=DEFAULT_SEED)
     return root
+
+
+@pytest.fixture(scope="session")
+def rescored_competition(
+    sample_competition: Path, tmp_path_factory: pytest.TempPathFactory
+) -> Path:
+    """The sample competition rescored as ``make demo`` does (its step: reports, 2 jobs), once
+    for the session, by the first worker that needs it: the results folder (results.json,
+    index.html, a report per execution). Tests read it and write nothing into it."""
+    from ertools.cli.main import main
+    from ertools.demo import competition_step
+
+    shared = shared_dir(tmp_path_factory)
+    out = shared / "rescored" / "rescore"
+    with _exclusive(shared / "rescored.lock"):
+        if not (out / "results.json").is_file() or not (out / "index.html").is_file():
+            step = competition_step(sample_competition, out)
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+                code = main([*step.argv, "--quiet"])
+            assert code == step.expected_exit == 1, err.getvalue()[-2000:]
+    return out

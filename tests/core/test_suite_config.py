@@ -7,6 +7,8 @@ import importlib.util
 import re
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[2]
 TESTS = ROOT / "tests"
 
@@ -48,3 +50,20 @@ def test_listed_tests_exist() -> None:
         if "::" in entry:
             name = entry.split("::")[1].split("[")[0]
             assert f"def {name}(" in (TESTS / path).read_text(encoding="utf-8"), entry
+
+
+@pytest.fixture(scope="module")
+def made_once() -> int:
+    return 1
+
+
+def test_a_test_sharing_a_module_fixture_carries_its_group(
+    request: pytest.FixtureRequest, made_once: int
+) -> None:
+    """Under ``--dist loadgroup`` a test's group is the ``@group`` suffix of its node id: the
+    one thing xdist's scheduler reads. Without it (pytest 9.2 with xdist 3.8, whose own suffix
+    no longer takes: tests/conftest.py) the groups were silently ignored."""
+    if not getattr(request.config.option, "loadgroup", False):
+        pytest.skip("n/a: not run by an xdist worker under --dist loadgroup")
+    assert made_once == 1
+    assert request.node.nodeid.endswith("@core/test_suite_config.py"), request.node.nodeid

@@ -9,6 +9,10 @@ in that order; ``...`` on its own line elides output, and a shown line ending in
 any line that starts with the text before it (for digits that differ between machines, times,
 ports). Commands that are only illustrations (placeholders, servers) live in ``text`` blocks,
 which this test does not run.
+
+The shell is a real bash; its ``ertools`` commands run in the test's own process
+(tests/shell_bridge.py), since what a page shows is their output, not their start-up. The pages
+of REAL_PROCESSES run every command as a process.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+from shell_bridge import run_bash
 from stderr_text import joined_lines
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -29,6 +34,10 @@ SHARED = ROOT.parent / "shared"
 DOCS = ROOT / "docs"
 FENCE = re.compile(r"^```(\w*)\n(.*?)^```", re.MULTILINE | re.DOTALL)
 MARK = "@@docs-command"
+# Pages whose commands run as processes of their own: a recording and its monitor side by side
+# (the bridge runs one command at a time). Every other page's `ertools` commands run in the
+# test's process, through the same bash (tests/shell_bridge.py).
+REAL_PROCESSES = {"live.md"}
 
 
 @dataclass(frozen=True)
@@ -126,19 +135,23 @@ def test_docs_commands_run_as_printed(name: str, tmp_path: Path) -> None:
     env["PATH"] = "/usr/local/bin:/usr/bin:/bin"
     # Unbuffered, so that stdout and stderr interleave as they do in a terminal.
     env["PYTHONUNBUFFERED"] = "1"
-    proc = subprocess.run(
-        ["bash", "-c", "\n".join(lines)],
-        cwd=work,
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-        timeout=300,
-        check=False,
-    )
+    if name in REAL_PROCESSES:
+        proc = subprocess.run(
+            ["bash", "-c", "\n".join(lines)],
+            cwd=work,
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            timeout=300,
+            check=False,
+        )
+        returncode, printed = proc.returncode, proc.stdout
+    else:  # the same shell, its `ertools` commands run in this process (tests/shell_bridge.py)
+        returncode, printed, _ = run_bash("\n".join(lines), cwd=work, env=env, timeout=300)
     outputs: dict[int, list[str]] = {}
     current = -1
-    for line in proc.stdout.splitlines():
+    for line in printed.splitlines():
         if line.startswith(MARK + " "):
             current = int(line.split()[1])
             outputs[current] = []
@@ -148,11 +161,11 @@ def test_docs_commands_run_as_printed(name: str, tmp_path: Path) -> None:
     # on one line (stderr_text.joined_lines).
     outputs = {n: [x.strip() for x in joined_lines("\n".join(o))] for n, o in outputs.items()}
     ran = max(outputs, default=-1)
-    if proc.returncode != 0:
+    if returncode != 0:
         failed = commands[ran] if ran >= 0 else None
         where = f"line {failed.line}: $ {failed.text}" if failed else "activation"
         tail = "\n".join(outputs.get(ran, [])[-20:])
-        pytest.fail(f"{name} {where}\nexited {proc.returncode}:\n{tail}")
+        pytest.fail(f"{name} {where}\nexited {returncode}:\n{tail}")
     assert ran == len(commands) - 1
     for number, command in enumerate(commands):
         out = outputs[number]

@@ -6,7 +6,8 @@ vocabulary: only the spelling of options may change, never the output) and compa
 and the data files of its report folder with the recording: the same text, numbers to within
 float rounding (``tests/floats.py``: NumPy's results differ in the last ulp between CPUs), after
 normalisations: the temporary folder becomes ``<OUT>``, the repository ``<ROOT>`` and a
-report's ``generated`` time ``<TIME>`` and its recorded command line ``<ARGV>``. Record
+report's ``generated`` time ``<TIME>`` and its recorded command line ``<ARGV>``. The commands
+run in the test's process (tests/inprocess.py), in the temporary folder. Record
 again, only when an output is meant to change, with
 ``ERTOOLS_RECORD_GOLDEN=1 pytest tests/e2e/test_outputs_unchanged.py`` and say why in the
 commit.
@@ -16,13 +17,12 @@ from __future__ import annotations
 
 import os
 import re
-import subprocess
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 from floats import text_difference
+from inprocess import run
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"
@@ -96,7 +96,6 @@ CASES = (
 )
 
 
-ENTRY = "import sys; from ertools.cli.main import main; sys.exit(main())"
 # The command line a report records is spelled as the case spells it; the rest must not move.
 ARGV = re.compile(r'"argv": \[[^\]]*\]')
 # The one field that changes from run to run: when a report was written.
@@ -112,21 +111,9 @@ def _normalise(text: str, out: Path) -> str:
 def _run(case: Case, out: Path) -> dict[str, str]:
     """The case's outputs by name: ``stdout`` and ``<folder>/<relative path>`` data files."""
     argv = [a.format(samples=SAMPLES, real=REAL, out=out) for a in case.argv]
-    proc = subprocess.run(
-        [
-            sys.executable,
-            "-c",
-            "import sys; from ertools.cli.main import main; sys.exit(main())",
-            *argv,
-        ],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        check=False,
-        cwd=out,
-    )
-    assert proc.returncode in (0, 1), proc.stderr[-2000:]
-    outputs = {"stdout": _normalise(proc.stdout, out), "exit": str(proc.returncode)}
+    ran = run(argv, cwd=out)  # in this process (tests/inprocess.py): the outputs are the point
+    assert ran.code in (0, 1), ran.stderr[-2000:]
+    outputs = {"stdout": _normalise(ran.stdout, out), "exit": str(ran.code)}
     if case.folder is not None:
         folder = out / case.folder
         for path in sorted(folder.rglob("*")):

@@ -1,4 +1,5 @@
-"""The README's console blocks, pasted as printed into one shell after the set-up commands.
+"""The README's console blocks, pasted as printed into one shell after the set-up commands
+(a real bash, whose ``ertools`` commands run in the test's process: tests/shell_bridge.py).
 
 Every ``$ `` line (with its ``\\`` continuations) runs in one bash session, in order, from a
 folder laid out as a clone is (``sample_bags/``, ``.venv``, ``../shared``) so that nothing is
@@ -14,6 +15,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from shell_bridge import run_bash
 
 ROOT = Path(__file__).resolve().parents[2]
 SHARED = ROOT.parent / "shared"
@@ -58,16 +60,10 @@ def test_readme_tour_runs_as_printed(tmp_path: Path) -> None:
     env = {k: v for k, v in os.environ.items() if k not in ("VIRTUAL_ENV", "PYTHONPATH")}
     # The shell of a fresh terminal: ertools is on PATH only through the tour's activation.
     env["PATH"] = "/usr/local/bin:/usr/bin:/bin"
-    proc = subprocess.run(
-        ["bash", "-c", script],
-        cwd=work,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=600,
-        check=False,
-    )
-    assert proc.returncode == 0, proc.stderr[-2000:]
+    # a real bash; its `ertools` commands run in this process (tests/shell_bridge.py): the
+    # tour is about what they print
+    code, stdout, stderr = run_bash(script, cwd=work, env=env, timeout=600, merge=False)
+    assert code == 0, stderr[-2000:]
     # Run in a checkout, the tour leaves nothing `git status` would show: every file it
     # writes is under a folder .gitignore ignores (out/).
     written = sorted(p.name for p in work.iterdir() if p.name not in ("sample_bags", ".venv"))
@@ -79,7 +75,7 @@ def test_readme_tour_runs_as_printed(tmp_path: Path) -> None:
             check=False,
         )
         assert ignored.returncode == 0, f"the tour wrote {name} into the checkout, not ignored"
-    out = [line.strip() for line in proc.stdout.splitlines()]
+    out = [line.strip() for line in stdout.splitlines()]
     position = 0
     for expected in (line for _, shown in blocks for line in shown):
         assert expected in out[position:], f"the README shows {expected!r}; the tour printed other"

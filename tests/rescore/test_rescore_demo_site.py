@@ -9,8 +9,6 @@ competition's answers in test_rescore_sample.py.
 
 from __future__ import annotations
 
-import contextlib
-import io
 import json
 from pathlib import Path
 from typing import Any
@@ -21,8 +19,7 @@ from site_results import Page, assert_links_resolve, expected_board
 from test_rescore_site_browser import chromium
 
 from ertools.benchmarks import registry
-from ertools.cli.main import main
-from ertools.demo import competition_step, make_competition
+from ertools.demo import make_competition
 
 pytestmark = [
     pytest.mark.browser,
@@ -32,18 +29,13 @@ pytestmark = [
 
 @pytest.fixture(scope="module")
 def demo_site(
-    sample_competition: Path, tmp_path_factory: pytest.TempPathFactory
+    sample_competition: Path, rescored_competition: Path
 ) -> tuple[Path, dict[str, Any], Path]:
-    root = tmp_path_factory.mktemp("demo")
+    # the demo's rescore step, run once for the session (tests/conftest.py)
     day = sample_competition  # what make_competition writes (tests/conftest.py)
     make_competition(day)  # there already: not generated again
-    step = competition_step(day, root / "rescore")
-    err = io.StringIO()
-    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
-        code = main([*step.argv, "--quiet"])
-    assert code == step.expected_exit == 1, err.getvalue()[-2000:]
     answers = json.loads((day / "answers.json").read_text(encoding="utf-8"))
-    return root / "rescore" / "index.html", answers, day
+    return rescored_competition / "index.html", answers, day
 
 
 def test_the_demo_site_opens_with_its_boards_problems_and_timeline(

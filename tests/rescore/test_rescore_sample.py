@@ -23,35 +23,17 @@ OPTION = {"items": "--items", "goal": "--goal", "transform": "--transform", "con
 
 
 @pytest.fixture(scope="module")
-def results(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """This worker's results folder: the day is shared by the session's workers, read only."""
-    return tmp_path_factory.mktemp("results")
+def results(rescored_competition: Path) -> Path:
+    """The day rescored once for the session, as `make demo` does (tests/conftest.py: the
+    organiser's manifest, 2 jobs, reports): read only."""
+    return rescored_competition
 
 
 @pytest.fixture(scope="module")
 def day(sample_competition: Path, results: Path) -> tuple[Path, dict[str, Any], dict[str, Any]]:
     root = sample_competition  # generated once per session (tests/conftest.py), seed SEED
     answers: dict[str, Any] = json.loads((root / "answers.json").read_text())
-    manifest = root / answers["manifest"]  # the organiser's, written with the logs
-    out = results
-    err = io.StringIO()
-    with contextlib.redirect_stderr(err):
-        code = main(
-            [
-                "rescore",
-                str(root),
-                "--config",
-                str(manifest),
-                "--out",
-                str(out),
-                "--jobs",
-                "2",
-                "--no-reports",
-                "--quiet",
-            ]
-        )
-    assert code == 1, err.getvalue()  # two executions cannot be scored
-    doc: dict[str, Any] = json.loads((out / "results.json").read_text())
+    doc: dict[str, Any] = json.loads((results / "results.json").read_text())
     return root, answers, doc
 
 

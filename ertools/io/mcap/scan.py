@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from ertools import caches
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
 from ertools.io.decode.fast import read_at
@@ -366,6 +367,7 @@ def scan_mcap(
 
 
 _SCANS: dict[tuple[int, int, int, int], McapRecords] = {}
+caches.register(_SCANS.clear)
 
 
 def _scan(buf: U8, path: Path, keep: frozenset[int], check_crc: bool) -> McapRecords:
@@ -443,6 +445,7 @@ class McapLayout:
 
 
 _LAYOUTS: dict[tuple[int, int, int, int], McapLayout] = {}
+caches.register(_LAYOUTS.clear)
 
 
 def mcap_layout(path: Path) -> McapLayout:
