@@ -25,17 +25,9 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from ertools.benchmarks.common.hygiene import frame_change_warning
 from ertools.benchmarks.common.validity import (
-    REASONS,
     SampleMask,
-    Validity,
-    combine,
-    sample_codes,
-    summarise,
-    unmeasured,
 )
 from ertools.benchmarks.fbm1.answers import (
     Answer,
@@ -45,7 +37,6 @@ from ertools.benchmarks.fbm1.answers import (
 )
 from ertools.benchmarks.fbm1.config import BENCHMARKS, BodySources, Fbm1Options
 from ertools.benchmarks.fbm1.gt import (
-    GroundTruth,
     GroundTruthError,
     board_motion,
     measure_ground_truth,
@@ -64,6 +55,7 @@ from ertools.benchmarks.fbm1.rules import (
 )
 from ertools.benchmarks.fbm1.runs import Fbm1Run, RunsFound
 from ertools.benchmarks.fbm1.score import MAX_POSE_ERROR_2015, names_match, pose_errors, totals
+from ertools.benchmarks.fbm1.validity import body_mask, gt_validity
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import Item, ItemList
 from ertools.errors import ConfigError, ScoringError, SegmentationError
@@ -235,7 +227,7 @@ def score_run(
     warnings += [f"{where}: {w}" for w in gt_warnings]
     # the board stays while the robot looks: seen again before the result, a move is a move
     until = run.result_ns if run.result_ns is not None else run.end_ns
-    validity, problem = _gt_validity(origin, board, gt, options, masks, t0_ns, until)
+    validity, problem = gt_validity(origin, board, gt, options, masks, t0_ns, until)
     if problem is not None and not options.rules.score_unscoreable:
         return Fbm1RunResult(
             status="unscoreable",
@@ -276,52 +268,6 @@ def score_run(
         warnings=tuple(warnings),
         **base,
     )
-
-
-def _gt_validity(
-    origin: PoseStream,
-    board: PoseStream,
-    gt: GroundTruth,
-    options: Fbm1Options,
-    masks: tuple[SampleMask, SampleMask] | None,
-    t0_ns: int = 0,
-    until_ns: int | None = None,
-) -> tuple[Validity, str | None]:
-    """Both bodies' validity in the ground truth's window (the samples averaged, or those a
-    lookup interpolated between: within --max-gap of its moment), and why it is no
-    measurement: a body without one valid sample within --max-gap of the moment it stands for
-    (the window's end, the goal; or the lookup's moment), all repeated poses of a lost marker
-    set or NaN, that moved more than --still while unseen (seen again before ``until_ns``,
-    the result, after which the board may be taken away) or was never seen before
-    (:func:`~ertools.benchmarks.common.validity.unmeasured`)."""
-    max_gap = round(options.gt.max_gap_s * NS_PER_S)
-    if masks is None:
-        masks = (_mask(origin), _mask(board))
-    lookup = gt.start_ns == gt.end_ns
-    a, b = (gt.start_ns - max_gap, gt.end_ns + max_gap) if lookup else (gt.start_ns, gt.end_ns)
-    validity = combine(tuple(summarise(m, a, b, gap_s=options.gt.max_gap_s) for m in masks))
-    bodies = ((masks[0], origin, "origin"), (masks[1], board, "ref_board"))
-    for mask, stream, name in bodies:
-        # the moment the ground truth stands for: the window's end (the goal) or the lookup
-        window = (gt.end_ns - max_gap, gt.end_ns + max_gap)
-        if unmeasured(mask, stream.xyz, *window, options.gt.still_m, until_ns):
-            lo = int(np.searchsorted(mask.t_ns, a))
-            hi = int(np.searchsorted(mask.t_ns, b, side="right"))
-            what = ", ".join(
-                f"{int(np.sum(mask.codes[lo:hi] == c))} {REASONS[c]}"
-                for c in np.unique(mask.codes[lo:hi]).tolist()
-            )
-            return validity, (
-                f"no valid {name} pose within {options.gt.max_gap_s:g} s of the ground truth's "
-                f"{'moment' if lookup else 'window end'} t={(gt.end_ns - t0_ns) / NS_PER_S:.3f} "
-                f"s ({what or 'no sample'} in the window), and it moved while unseen (tracking "
-                "lost)"
-            )
-    return validity, None
-
-
-def _mask(stream: PoseStream) -> SampleMask:
-    return sample_codes(stream.t_ns, stream.xyz, stream.quat_xyzw)
 
 
 def _deviations(
@@ -435,7 +381,7 @@ def score_fbm1(
     if progress is not None:
         progress.task("scoring runs", len(found.runs), "runs")
     scored = []
-    masks = (_mask(origin), _mask(board))
+    masks = (body_mask(origin), body_mask(board))
     for run in found.runs:
         scored.append(score_run(run, items, origin, board, opts, results, t0_ns, item_tf, masks))
         if progress is not None:

@@ -25,7 +25,6 @@ from ertools.benchmarks.common.hygiene import (
     identical_poses,
 )
 from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
-from ertools.benchmarks.common.uncertainty import Interval, Uncertainty
 from ertools.benchmarks.common.validity import (
     STILL_M,
     SampleMask,
@@ -43,14 +42,7 @@ from ertools.benchmarks.fbm3w.config import (
     NAMESPACE,
     Fbm3wOptions,
 )
-from ertools.benchmarks.fbm3w.intervals import (
-    RunSamples,
-    measurement_source,
-    noise_model,
-    run_intervals,
-    smooth,
-    uncertainty_block,
-)
+from ertools.benchmarks.fbm3w.intervals import with_intervals
 from ertools.benchmarks.fbm3w.path import score_path
 from ertools.benchmarks.fbm3w.result import Fbm3wResult, RunResult
 from ertools.benchmarks.fbm3w.rules import (
@@ -298,7 +290,7 @@ def score_runs(
         )
     warnings.extend(_frozen_warnings(poses, runs_in, start_ns))
     mode = runs_in[0].mode if runs_in else (options.runs or "states")
-    results, best_interval, uncertainty = _intervals(poses, same, results, cfg, options, noise)
+    results, best_interval, uncertainty = with_intervals(poses, same, results, cfg, options, noise)
     return Fbm3wResult(
         runs=tuple(results),
         best_interval=best_interval,
@@ -322,63 +314,6 @@ def score_runs(
         ),
         count_stopped=options.stopped_runs != "2015",
     )
-
-
-def _intervals(
-    poses: PoseStream,
-    same: npt.NDArray[np.bool_],
-    results: list[RunResult],
-    cfg: Fbm3wConfig,
-    options: Fbm3wOptions,
-    noise: NoiseResult | None,
-) -> tuple[list[RunResult], Interval | None, Uncertainty | None]:
-    """Each scored run's distance_error interval and the best run's
-    (:mod:`ertools.benchmarks.fbm3w.intervals`); the runs unchanged when ``draws`` is 0."""
-    if options.draws <= 0:
-        return results, None, None
-    samples: list[RunSamples | None] = []
-    for run in results:
-        w = run.window
-        if run.score is None or w.start_ns is None or w.end_ns is None or w.ref_ns is None:
-            samples.append(None)
-            continue
-        lo = int(np.searchsorted(poses.t_ns, w.start_ns, side="left"))
-        hi = int(np.searchsorted(poses.t_ns, w.end_ns, side="right"))
-        ref_i = int(np.searchsorted(poses.t_ns, w.ref_ns, side="right")) - 1
-        shape = cfg.shape(run.spec)
-        if options.arc_length:
-            shape = shape.by_arc_length()
-        around = poses.xyz[max(0, ref_i - 4) : ref_i + 5, :2]
-        centre = smooth(around)[min(ref_i, 4)]
-        samples.append(
-            RunSamples(
-                xy=poses.xyz[lo:hi, :2],
-                source=measurement_source(same[lo : hi - 1]),
-                reference_xy=poses.xyz[ref_i, :2],
-                shape=shape,
-                center_xy=smooth(poses.xyz[lo:hi, :2]),
-                center_reference_xy=centre,
-            )
-        )
-    model = noise_model(noise, cfg.d_min)
-    per_run, best = run_intervals(
-        samples,
-        [r.distance_error for r in results],
-        model,
-        draws=options.draws,
-        seed=options.seed,
-        confidence=options.confidence,
-    )
-    block = uncertainty_block(
-        model,
-        [(r.index, iv) for r, iv in zip(results, per_run, strict=True)],
-        best,
-        draws=options.draws,
-        seed=options.seed,
-        confidence=options.confidence,
-    )
-    out = [replace(r, interval=iv) for r, iv in zip(results, per_run, strict=True)]
-    return out, best, block
 
 
 def _frozen_warnings(poses: PoseStream, runs: Sequence[RunWindow], origin_ns: int) -> list[str]:

@@ -37,9 +37,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
+import numpy.typing as npt
 
 from ertools.arrays import F64, IntArr
 from ertools.benchmarks.common.uncertainty import (
@@ -51,8 +52,12 @@ from ertools.benchmarks.common.uncertainty import (
     monte_carlo,
     sigma_from_epsilon,
 )
+from ertools.benchmarks.fbm3w.config import Fbm3wOptions
+from ertools.benchmarks.fbm3w.result import RunResult
 from ertools.benchmarks.noise.benchmark import NoiseResult
+from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.configs.shapes import Shape
+from ertools.streams import PoseStream
 
 # The coefficient of variation of a Rayleigh distance, sqrt(4/pi - 1): the spread of one
 # consecutive-pair distance around epsilon.
@@ -327,3 +332,60 @@ def uncertainty_block(
         if iv is not None:
             shares[f"runs_details.{index}.distance_error"] = iv.share_dict()
     return Uncertainty(confidence, METHOD, draws, seed, model.sources, shares)
+
+
+def with_intervals(
+    poses: PoseStream,
+    same: npt.NDArray[np.bool_],
+    results: list[RunResult],
+    cfg: Fbm3wConfig,
+    options: Fbm3wOptions,
+    noise: NoiseResult | None,
+) -> tuple[list[RunResult], Interval | None, Uncertainty | None]:
+    """Each scored run's distance_error interval and the best run's, from the poses of its
+    window; the runs unchanged when ``draws`` is 0."""
+    if options.draws <= 0:
+        return results, None, None
+    samples: list[RunSamples | None] = []
+    for run in results:
+        w = run.window
+        if run.score is None or w.start_ns is None or w.end_ns is None or w.ref_ns is None:
+            samples.append(None)
+            continue
+        lo = int(np.searchsorted(poses.t_ns, w.start_ns, side="left"))
+        hi = int(np.searchsorted(poses.t_ns, w.end_ns, side="right"))
+        ref_i = int(np.searchsorted(poses.t_ns, w.ref_ns, side="right")) - 1
+        shape = cfg.shape(run.spec)
+        if options.arc_length:
+            shape = shape.by_arc_length()
+        around = poses.xyz[max(0, ref_i - 4) : ref_i + 5, :2]
+        centre = smooth(around)[min(ref_i, 4)]
+        samples.append(
+            RunSamples(
+                xy=poses.xyz[lo:hi, :2],
+                source=measurement_source(same[lo : hi - 1]),
+                reference_xy=poses.xyz[ref_i, :2],
+                shape=shape,
+                center_xy=smooth(poses.xyz[lo:hi, :2]),
+                center_reference_xy=centre,
+            )
+        )
+    model = noise_model(noise, cfg.d_min)
+    per_run, best = run_intervals(
+        samples,
+        [r.distance_error for r in results],
+        model,
+        draws=options.draws,
+        seed=options.seed,
+        confidence=options.confidence,
+    )
+    block = uncertainty_block(
+        model,
+        [(r.index, iv) for r, iv in zip(results, per_run, strict=True)],
+        best,
+        draws=options.draws,
+        seed=options.seed,
+        confidence=options.confidence,
+    )
+    out = [replace(r, interval=iv) for r, iv in zip(results, per_run, strict=True)]
+    return out, best, block
