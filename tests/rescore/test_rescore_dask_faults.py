@@ -59,6 +59,10 @@ def test_the_scheduler_lost_is_one_line(tmp_path: Path) -> None:
             text=True,
         )
         wait_for(lambda: pid_file.is_file() and pid_file.read_text().endswith("\n"), "held")
+        # the three scored before the held one are gathered (and cached) before the scheduler
+        # goes: a result still on its way to the client when the scheduler dies is lost with it
+        outcomes = out / "cache" / "outcomes"
+        wait_for(lambda: len(list(outcomes.glob("*.json"))) >= 3, "the others gathered")
         scheduler.send_signal(signal.SIGKILL)
         scheduler.wait()
         _, err = proc.communicate(timeout=120)
