@@ -27,6 +27,18 @@ METHOD = "Monte Carlo over the sources, basic (bias-correcting) bootstrap interv
 
 
 @dataclass(frozen=True)
+class ResultIntervals:
+    """The intervals of one result, by score key (dotted for nested ones), and how they were
+    obtained (None without intervals)."""
+
+    intervals: Mapping[str, Interval | None]
+    uncertainty: Uncertainty | None
+
+
+NO_INTERVALS = ResultIntervals({}, None)
+
+
+@dataclass(frozen=True)
 class IntervalSettings:
     """``--confidence``, ``--draws`` and ``--seed`` as one value (draws 0: no intervals)."""
 

@@ -38,7 +38,13 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ertools.arrays import F64
-from ertools.benchmarks.common.interval_output import METHOD, IntervalSettings, shares_of
+from ertools.benchmarks.common.interval_output import (
+    METHOD,
+    NO_INTERVALS,
+    IntervalSettings,
+    ResultIntervals,
+    shares_of,
+)
 from ertools.benchmarks.common.uncertainty import (
     MOCAP_NOISE,
     TRANSFORM,
@@ -182,17 +188,6 @@ def _is_identity(item: Item) -> bool:
     return (item.trans, item.rot) in ((IDENTITY_TRANS, IDENTITY_ROT), (None, None))
 
 
-@dataclass(frozen=True)
-class Fbm1Intervals:
-    """The intervals of one FBM1 result, by score key, and how they were obtained."""
-
-    intervals: Mapping[str, Interval | None]
-    uncertainty: Uncertainty | None
-
-
-NO_INTERVALS = Fbm1Intervals({}, None)
-
-
 def fbm1_intervals(
     runs: Sequence[Fbm1RunResult],
     found: Sequence[Fbm1Run],
@@ -204,7 +199,7 @@ def fbm1_intervals(
     pose_runs: int,
     pose_total: float | None,
     settings: IntervalSettings,
-) -> Fbm1Intervals:
+) -> ResultIntervals:
     """The intervals of every ground-truth-derived number of the result (module doc)."""
     scored = [r for r in runs if r.errors is not None and r.gt is not None and r.answer]
     if not settings.enabled or not scored:
@@ -347,7 +342,7 @@ def fbm1_intervals(
             out[name] = iv
     out["pose_score"] = got[-1]
     unc = _uncertainty(out, noises, settings, transform_sigma, spread_given, lookup)
-    return Fbm1Intervals(out, unc)
+    return ResultIntervals(out, unc)
 
 
 def _uncertainty(

@@ -49,11 +49,16 @@ import numpy.typing as npt
 
 from ertools.arrays import F64, IntArr
 from ertools.benchmarks.common.clocks import OffsetEstimate
-from ertools.benchmarks.common.interval_output import METHOD, IntervalSettings, shares_of
+from ertools.benchmarks.common.interval_output import (
+    METHOD,
+    NO_INTERVALS,
+    IntervalSettings,
+    ResultIntervals,
+    shares_of,
+)
 from ertools.benchmarks.common.uncertainty import (
     MOCAP_NOISE,
     TIME_ASSOCIATION,
-    Interval,
     Source,
     Uncertainty,
     monte_carlo,
@@ -208,17 +213,6 @@ def _bracket(t: IntArr, q: IntArr) -> tuple[IntArr, IntArr]:
     return k, np.minimum(k + 1, n - 1)
 
 
-@dataclass(frozen=True)
-class TrajectoryIntervals:
-    """The intervals of one trajectory result, by score key, and how they were obtained."""
-
-    intervals: Mapping[str, Interval | None]
-    uncertainty: Uncertainty | None
-
-
-NO_INTERVALS = TrajectoryIntervals({}, None)
-
-
 def trajectory_intervals(
     robot: PoseStream,
     gt: PoseStream,
@@ -230,7 +224,7 @@ def trajectory_intervals(
     offset_ns: int,
     max_gap_ns: int,
     settings: IntervalSettings,
-) -> TrajectoryIntervals:
+) -> ResultIntervals:
     """The intervals of the statistics ``estimates`` (by :data:`KEYS`) of a comparison.
 
     ``robot``: the robot stream whose row i is matched row i; ``gt``: the GT in time order;
@@ -430,4 +424,4 @@ def trajectory_intervals(
         sources=tuple(src),
         shares=shares_of(intervals),
     )
-    return TrajectoryIntervals(intervals, unc)
+    return ResultIntervals(intervals, unc)

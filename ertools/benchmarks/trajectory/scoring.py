@@ -13,7 +13,7 @@ import numpy.typing as npt
 from ertools.arrays import I64
 from ertools.benchmarks.common.clocks import OffsetEstimate, estimate_offset
 from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid, frame_change_warning
-from ertools.benchmarks.common.interval_output import IntervalSettings
+from ertools.benchmarks.common.interval_output import NO_INTERVALS, IntervalSettings
 from ertools.benchmarks.common.validity import (
     GAP as V_GAP,
 )
@@ -37,7 +37,7 @@ from ertools.benchmarks.trajectory.association import (
     associate_evo,
 )
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
-from ertools.benchmarks.trajectory.intervals import NO_INTERVALS, trajectory_intervals
+from ertools.benchmarks.trajectory.intervals import trajectory_intervals
 from ertools.benchmarks.trajectory.metrics import Metrics, metrics
 from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.benchmarks.trajectory.rules import (
