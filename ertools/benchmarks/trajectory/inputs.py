@@ -219,7 +219,7 @@ def pick_gt_in_robot_bag(
     s: BagSummary, gt_topic: str | None, robot_topic: str, gt_paths: Sequence[str | Path]
 ) -> str:
     """The GT topic in a robot log that holds both (evo's ``bag`` mode), or a one-line error."""
-    how = "the robot log itself" if gt_paths else "no GT_PATH given"
+    how = "the robot log itself" + ("" if gt_paths else ", no GT_PATH given")
     others = [n for n in _pose_topics(s) if n != robot_topic]
     if gt_topic is not None:
         if gt_topic == robot_topic:

@@ -116,6 +116,8 @@ def test_one_bag_without_the_gt_topic(
     robot = str(bags["robot"])
     line = _one_error([robot], capsys)
     assert robot in line and "no GT_PATH given" in line and "GT_PATH" in line
+    # it reads as a sentence: where the GT was looked for, and why there
+    assert "the GT is read from the robot log itself, no GT_PATH given, but" in line
     line = _one_error([robot, "--gt-topic", GT_TOPIC], capsys)
     assert f"GT topic {GT_TOPIC} is not in the robot log {robot}" in line
     line = _one_error([robot, robot, "--gt-topic", GT_TOPIC], capsys)
