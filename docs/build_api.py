@@ -48,6 +48,8 @@ def _markdown(doc: str) -> str:
     """A Google-style docstring as Markdown: sections in bold, their entries as a list,
     reST literals as code."""
     out: list[str] = []
+    # a Sphinx role (:class:`~ertools.errors.ErtoolsError`) reads as its name in Markdown
+    doc = re.sub(r":[a-z]+:`~?([^`]+)`", r"``\1``", doc)
     for line in doc.replace("``", "`").splitlines():
         stripped = line.strip()
         if stripped in ("Args:", "Returns:", "Raises:"):
@@ -96,6 +98,7 @@ def _inputs() -> str:
 
 def api_markdown() -> str:
     intro = inspect.getdoc(api) or ""
+    intro = re.sub(r":[a-z]+:`~?([^`]+)`", r"``\1``", intro)
     sections = [HEADER + intro.strip().replace("``", "`") + "\n"]
     sections += [_section(name) for name in api.ORDER]
     sections.append(_inputs())

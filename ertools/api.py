@@ -6,9 +6,10 @@ convention (docs/ARCHITECTURE.md, "The public API"): it may change in any releas
 examples below run as doctests in ``make test`` from the repository root, on ``sample_bags/``;
 ``docs/api.md`` is generated from these docstrings (``python docs/build_api.py``).
 
-Each function raises the same :class:`~ertools.errors.ErtoolsError` as the command it mirrors,
+Each function raises the same ``ertools.errors.ErtoolsError`` as the command it mirrors,
 with the same message (``ertools.errors.UsageError`` for a wrong value, ``BagError`` for an
 unreadable file...), and prints nothing: warnings and notes are in the results it returns.
+``ertools.errors`` (``ErtoolsError`` and its subclasses) is part of the API, to catch them by.
 """
 
 from __future__ import annotations
@@ -257,7 +258,7 @@ def audit(
         bags: the log.
         benchmark: the namespace of the state topics; found in the log when None.
         recompute: False: the timeline and checks only.
-        inputs: the scoring inputs, as for :func:`score` (``goal=``, ``items=``...).
+        inputs: the scoring inputs, as for ``ertools.score`` (``goal=``, ``items=``...).
 
     Returns:
         The frozen audit: ``to_text()``, ``to_dict()``, ``to_frames()``, ``recomputed``

@@ -52,6 +52,8 @@ class Input:
         minimum: smallest allowed value (inclusive unless ``positive``); a value outside is a
             usage error (exit 2).
         positive: the value must be > 0 (> ``minimum`` when both are given).
+        maximum: largest allowed value (inclusive); above it a usage error (exit 2) that names
+            it, so that a typo (``--draws 1000000000``) is refused rather than run for hours.
         repeat: the option may be given several times (a tuple of values).
         old_flags: former spellings, accepted for one release with a deprecation line.
         group: the help section (``2015 behaviour`` for the options that restore 2015).
@@ -74,6 +76,7 @@ class Input:
     choices: tuple[str, ...] = ()
     minimum: float | None = None
     positive: bool = False
+    maximum: float | None = None
     repeat: bool = False
     old_flags: tuple[str, ...] = ()
     group: str = ""
@@ -352,7 +355,8 @@ def _one_value(declared: Input, value: Any) -> Any:
         if isinstance(value, bool):
             raise ValueError
         number = int(value) if kind == "int" else float(value)
-        if kind == "int" and float(value) != number:
+        # an int is whole however large (float() would round 10**23 and call it fractional)
+        if kind == "int" and not isinstance(value, int) and float(value) != number:
             raise ValueError
     except (TypeError, ValueError):
         what = "a whole number" if kind == "int" else "a number"
@@ -365,6 +369,9 @@ def _one_value(declared: Input, value: Any) -> Any:
         raise UsageError(f"{option} must be {bound}, got {value}")
     if declared.minimum is not None and number < declared.minimum:
         raise UsageError(f"{option} must be >= {declared.minimum:g}{unit}, got {value}")
+    if declared.maximum is not None and number > declared.maximum:
+        top = f"{declared.maximum:g}" if kind == "float" else str(int(declared.maximum))
+        raise UsageError(f"{option} {value}: at most {top}{unit}")
     return number
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 import doctest
 import importlib.util
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -52,6 +53,8 @@ def test_docs_api_md_is_generated_from_the_docstrings() -> None:
     page = (ROOT / "docs" / "api.md").read_text(encoding="utf-8")
     for name in api.ORDER:
         assert f"## `ertools.{name}`" in page
+    # Markdown for users: no Sphinx role (:class:`...`) left as text
+    assert not re.findall(r":[a-z]+:`", page)
 
 
 def test_import_ertools_is_light_and_names_resolve_on_use() -> None:

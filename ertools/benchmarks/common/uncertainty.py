@@ -35,6 +35,12 @@ from ertools.errors import UsageError
 DEFAULT_CONFIDENCE = 0.95
 DEFAULT_DRAWS = 400
 DEFAULT_SEED = 0
+# The most draws an interval takes: 100,000 already take minutes on a sample log (the FBM3W
+# sample: 10 s at 4,000 draws, 90 s at 40,000), and a typo of 10**9 would run for days and
+# hold gigabytes of draws, so more is refused with this number.
+MAX_DRAWS = 100_000
+# numpy seeds any non-negative integer; results and reports carry the seed as an int64
+MAX_SEED = 2**63 - 1
 
 # The names of the sources, as they appear in outputs (``uncertainty.sources[].name``).
 MOCAP_NOISE = "mocap_noise"
@@ -58,9 +64,11 @@ INTERVAL_INPUTS = (
     Input(
         "draws",
         "int",
-        f"Monte Carlo draws per interval source (default {DEFAULT_DRAWS}; 0: no intervals)",
+        f"Monte Carlo draws per interval source (default {DEFAULT_DRAWS}, at most {MAX_DRAWS}; "
+        "0: no intervals)",
         default=DEFAULT_DRAWS,
         minimum=0,
+        maximum=MAX_DRAWS,
         metavar="N",
         group="intervals",
     ),
@@ -70,6 +78,7 @@ INTERVAL_INPUTS = (
         f"seed of the Monte Carlo draws (default {DEFAULT_SEED}): same seed, same intervals",
         default=DEFAULT_SEED,
         minimum=0,
+        maximum=MAX_SEED,
         metavar="N",
         group="intervals",
     ),

@@ -1,0 +1,96 @@
+"""The interval options given nonsense (issue 28): ``--confidence``, ``--draws`` and ``--seed``
+outside what they can mean are one ``ertools: error:`` line and exit 2 on every ``score``
+command; a huge ``--draws`` is refused above its documented cap rather
+than run for days with gigabytes of draws."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import pytest
+from stderr_text import error_messages
+
+from ertools.benchmarks import registry
+from ertools.benchmarks.common.uncertainty import MAX_DRAWS, MAX_SEED
+from ertools.cli.main import MAX_ERROR_LINE, main
+
+ROOT = Path(__file__).resolve().parents[3]
+sys.path.insert(0, str(ROOT / "tests" / "io"))
+from io_bagmaker import Spec, write  # noqa: E402
+
+SAMPLES = ROOT / "sample_bags"
+FBM1 = [SAMPLES / "fbm1h" / "log_fbm1h_2015-11-20-12-00-00_0.bag", "--items"]
+LOGS = {
+    "fbm1h": [*FBM1, SAMPLES / "fbm1h" / "fbm1h.yaml"],
+    "fbm1w": ["FBM1W_LOG", "--items", ROOT / "configs" / "fbm1w.yaml"],
+    "fbm2h": [SAMPLES / "fbm2h" / "log_fbm2h_mocap_2015-11-20-12-00-00_0.bag"],
+    "fbm3w": [SAMPLES / "fbm3w" / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"],
+    "trajectory": [SAMPLES / "robotlog" / "FBM2H_201511201200_homer.bag", SAMPLES / "robotlog"],
+}
+# option, value -> what the one line must say
+NONSENSE = [
+    ("--confidence", "0", "--confidence must be positive"),
+    ("--confidence", "-0.5", "--confidence must be positive"),
+    ("--confidence", "1", "--confidence 1.0: give a level between 0 and 1"),
+    ("--confidence", "1.5", "--confidence 1.5: give a level between 0 and 1"),
+    ("--confidence", "95", "--confidence 95.0: give a level between 0 and 1"),
+    ("--confidence", "nan", "--confidence nan: give a finite number"),
+    ("--draws", "-1", "--draws must be >= 0, got -1"),
+    ("--draws", "1e3", "argument --draws: invalid int value: '1e3'"),
+    ("--draws", str(10**9), f"--draws {10**9}: at most {MAX_DRAWS}"),
+    ("--draws", str(MAX_DRAWS + 1), f"--draws {MAX_DRAWS + 1}: at most {MAX_DRAWS}"),
+    ("--seed", "abc", "argument --seed: invalid int value: 'abc'"),
+    ("--seed", "-1", "--seed must be >= 0, got -1"),
+    # a whole number however long: refused for its size, not called fractional
+    ("--seed", "9" * 23, f"--seed {'9' * 23}: at most {MAX_SEED}"),
+]
+
+
+def _fbm1w_log(tmp_path: Path) -> Path:
+    """A small log with FBM1@Work's topics (the samples have none)."""
+    spec = Spec()
+    pose = spec.conn("/fbm1w/origin/pose", "geometry_msgs/PoseStamped")
+    state = spec.conn("/fbm1w/bmbox_state", "rockin_scoring/BmBoxState")
+    for i in range(5):
+        t = 1_448_020_800_000_000_000 + i * 100_000_000
+        spec.add(pose, t, stamp=t, frame="world", xyz=(0.0, 0.0, 0.0), q=(0.0, 0.0, 0.0, 1.0))
+        spec.add(state, t, state=0, payload="")
+    return write(tmp_path / "log_fbm1w.bag", "ros1", spec)
+
+
+@pytest.mark.parametrize(("option", "value", "says"), NONSENSE, ids=lambda v: str(v)[:12])
+@pytest.mark.parametrize("name", registry.names())
+def test_nonsense_is_one_line_and_exit_2(
+    name: str,
+    option: str,
+    value: str,
+    says: str,
+    capsys: pytest.CaptureFixture[str],
+    tmp_path: Path,
+) -> None:
+    args = [_fbm1w_log(tmp_path) if a == "FBM1W_LOG" else a for a in LOGS[name]]
+    assert main(["score", name, *map(str, args), option, value]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    (line,) = error_messages(err)
+    assert line.startswith("ertools: error: ") and says in line, line
+    assert max(map(len, err.splitlines())) <= MAX_ERROR_LINE
+
+
+def test_the_cap_is_in_the_help(capsys: pytest.CaptureFixture[str]) -> None:
+    for name in registry.names():
+        assert main(["score", name, "--help"]) == 0
+        assert f"at most {MAX_DRAWS}" in " ".join(capsys.readouterr().out.split())
+
+
+def test_the_largest_seed_is_taken() -> None:
+    """The cap is the int64 a result carries: the largest seed scores (and the Python API
+    refuses the next one as the CLI does)."""
+    import ertools
+    from ertools.errors import UsageError
+
+    result = ertools.score("fbm3w", LOGS["fbm3w"], seed=MAX_SEED, draws=20)
+    assert result.to_dict()["uncertainty"]["seed"] == MAX_SEED
+    with pytest.raises(UsageError, match=f"at most {MAX_DRAWS}"):
+        ertools.score("fbm3w", LOGS["fbm3w"], draws=MAX_DRAWS + 1)
