@@ -97,7 +97,8 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
         f"# Drafted by `{' '.join(command)}`",
         f"# from {len(executions)} benchmark execution(s) found in the logs. Fill in the TODO",
         "# lines, check the guessed files, then:",
-        f"#   ertools rescore {' '.join(str(p) for p in paths)} --config {target.name} --out "
+        # the draft's path as given, as the PATHs are: the line runs where `--init` ran
+        f"#   ertools rescore {' '.join(str(p) for p in paths)} --config {target} --out "
         "results/",
         "# Format: docs/rescore.md. Relative paths are from this file's folder.",
         "version: 1",

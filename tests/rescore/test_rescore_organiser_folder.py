@@ -116,6 +116,8 @@ def test_every_file_has_one_place_in_the_draft(folder: dict[str, Any]) -> None:
     assert places[s + "timeline/bags/usb_stick/FBM2H_201511201500_homer.bag"] == ["problem"]
     assert places[s + "fbm3w/fbm3w.yaml"] == ["input"]
     text = folder["draft"].read_text()
+    # the command it says to run next, runnable where --init ran (the draft's path as given)
+    assert f"--config {folder['draft']} --out results/" in text
     # the GT logger's recordings that overlap no benchmark log, each with its reason
     noise = s + "stationary/log_fbm3w_noise_2015-11-20-09-00-00_0.bag"
     assert f"#   {noise}: problem (gt-only: a noise recording" in text
