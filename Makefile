@@ -8,6 +8,10 @@ DEMO_OUT ?= demo_output
 
 .PHONY: demo test check lint typecheck pytest bench calibrate fuzz samples notebooks clean
 
+# pip -qq: errors only. pip 25+ passes on setuptools' notice about every editable install
+# (a "BuildBackendWarning: Editable installation" box), which a first `make demo` need not show.
+PIP := $(BIN)/python -m pip install -qq
+
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
@@ -15,12 +19,12 @@ $(BIN)/python:
 # Byte-compiled on install, as a wheel install would be: where PYTHONDONTWRITEBYTECODE is set,
 # every command would otherwise compile the package again at start-up.
 $(STAMP): pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e .
+	$(PIP) -e .
 	$(BIN)/python -m compileall -q ertools
 	touch $@
 
 $(DEVSTAMP): pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e '.[dev,dask]'
+	$(PIP) -e '.[dev,dask]'
 	$(BIN)/python -m compileall -q ertools
 	touch $@ $(STAMP)
 
@@ -56,7 +60,7 @@ check: $(DEVSTAMP)
 	$(PYTEST) -q -n $(PYTEST_JOBS) --dist loadgroup -m "not slow"
 
 bench: $(STAMP)
-	$(BIN)/python -m pip install --quiet -e '.[dask]'  # the season's LocalCluster run
+	$(PIP) -e '.[dask]'  # the season's LocalCluster run
 	$(BIN)/python -m compileall -q ertools
 	$(BIN)/python bench/run.py
 
@@ -71,7 +75,7 @@ calibrate: $(STAMP)
 # JupyterLab in the project's venv, then the notebooks open in it. As root (a container),
 # Jupyter refuses to start without --allow-root: given then, with the reason said.
 notebooks: $(STAMP)
-	$(BIN)/python -m pip install --quiet -e '.[notebooks]'
+	$(PIP) -e '.[notebooks]'
 	@if [ "$$(id -u)" = 0 ]; then \
 		echo "make notebooks: running as root (a container?): jupyter lab --allow-root"; \
 		$(BIN)/jupyter lab --allow-root notebooks/; \

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 import zipfile
@@ -60,3 +61,21 @@ def test_wheel_installs_on_a_fresh_python_and_answers_version(tmp_path: Path) ->
     version = _run(bin_dir / "ertools", "--version", cwd=tmp_path)
     expected = _run(sys.executable, "-m", "ertools.cli.main", "--version", cwd=ROOT)
     assert version.strip() == expected.strip() != ""
+
+
+def test_the_makefiles_editable_install_shows_no_packaging_warning(tmp_path: Path) -> None:
+    """`make demo`'s first lines: the editable install as the Makefile runs it (its pip flags)
+    into a fresh Python prints no warning box (setuptools' notice on every editable install,
+    which pip 25+ passes on; a deprecated pyproject form)."""
+    makefile = (ROOT / "Makefile").read_text(encoding="utf-8")
+    (flags,) = re.findall(r"^PIP := \$\(BIN\)/python -m pip install (.*)$", makefile, re.M)
+    assert "$(PIP) -e .\n" in makefile
+    _run(sys.executable, "-m", "venv", "--without-pip", tmp_path / "fresh", cwd=tmp_path)
+    proc = subprocess.run(
+        [sys.executable, "-m", "pip", "--python", str(tmp_path / "fresh" / "bin" / "python"),
+         "install", *flags.split(), "--no-deps", "-e", str(ROOT)],
+        cwd=tmp_path, capture_output=True, text=True, timeout=300, check=False,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    shown = (proc.stdout + proc.stderr).lower()
+    assert "warning" not in shown and "deprecat" not in shown, shown[-2000:]
