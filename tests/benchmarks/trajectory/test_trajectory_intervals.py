@@ -3,13 +3,16 @@ moving and on a still body, and the offset's spread."""
 
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from ertools.benchmarks.common.clocks import OffsetEstimate
 from ertools.benchmarks.trajectory.intervals import mocap_sigma, offset_spread
+from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
 from ertools.streams import PoseStream
 
@@ -56,3 +59,36 @@ def test_offset_spread_is_the_least_squares_standard_error() -> None:
     # sigma_r sqrt(sum |v|^2) / sum |v|^2 = 0.01 / sqrt(sum |v|^2)
     assert sd == pytest.approx(0.01 / math.sqrt(float(np.sum(vel**2))), rel=0.1)
     assert centre == pytest.approx(0.001)
+
+
+SAMPLE = Path(__file__).resolve().parents[3] / "sample_bags" / "robotlog"
+SAMPLE_ROBOT = SAMPLE / "FBM2H_201511201200_homer.bag"
+TOP_LEVEL = ("position_error", "orientation_error", "rmse", "median", "max")
+
+
+def _scored(capsys: pytest.CaptureFixture[str], *extra: str) -> tuple[dict, list[str]]:
+    argv = ["score", "trajectory", str(SAMPLE_ROBOT), str(SAMPLE), "--format", "json", *extra]
+    assert main(argv) == 0
+    captured = capsys.readouterr()
+    return json.loads(captured.out), captured.err.splitlines()
+
+
+def test_a_score_outside_its_interval_says_why(capsys: pytest.CaptureFixture[str]) -> None:
+    """The sample robot's clock runs 0.349 s ahead: scored at offset 0, its mean error is
+    147 mm, while the intervals are of the score at the offset the data supports (17 mm).
+    A referee is told so, not left with `146.58 mm [17.53, 18.33]`."""
+    out, err = _scored(capsys)
+    outside = [
+        k for k in TOP_LEVEL if not out[f"{k}_interval"][0] <= out[k] <= out[f"{k}_interval"][1]
+    ]
+    assert outside  # the case exists: the clock offset not applied moves every interval
+    shift_ms = out["clock_audit"]["estimated_offset"] * 1000
+    assert shift_ms == pytest.approx(-349.0, abs=1.0)  # sample_bags/README.md: 0.35 s ahead
+    (note,) = [w for w in out["warnings"] if "outside" in w]
+    assert set(outside) <= set(note.split(" outside ")[0].split(", "))
+    assert f"({shift_ms:+.1f} ms from the one applied)" in note
+    assert f"ertools: warning: {note}" in err
+    # scored at that offset, every score lies inside its interval and nothing is said
+    out, err = _scored(capsys, "--offset", "auto", "--apply-offset")
+    assert all(out[f"{k}_interval"][0] <= out[k] <= out[f"{k}_interval"][1] for k in TOP_LEVEL)
+    assert not [w for w in out["warnings"] if "outside" in w]
