@@ -150,6 +150,8 @@ def test_a_shape_constant_too_large_for_a_float() -> None:
         ("benchmarks:\n  fbm3w:\n    inputs: {d_min: .inf}\n", "benchmarks.fbm3w.inputs.d_min: "),
         (f"benchmarks:\n  fbm3w:\n    inputs: {{d_min: {HUGE}}}\n", "d_min: 11111111111"),
         ("benchmarks:\n  fbm3w:\n    inputs: {d_min: -0.5}\n", "d_min: -0.5 must be >= 0 m"),
+        # the intervals' cap (--draws at most 100000): days of draws refused before scoring
+        ("benchmarks:\n  fbm3w:\n    inputs: {draws: 1000000000}\n", "draws: 1000000000: at most"),
         ("executions:\n- {benchmark: fbm3w, team: a, bags: [BAG], start: 1.0e+300}\n", "start"),
         ("executions:\n- {benchmark: fbm3w, team: a, bags: [BAG], start: .nan}\n", "start"),
         (f"executions:\n- {{benchmark: fbm3w, team: a, bags: [BAG], end: {HUGE}}}\n", "end"),
