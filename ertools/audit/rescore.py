@@ -13,6 +13,7 @@ from ertools.audit.analyse import DEFAULT_MAX_SILENCE_NS, audit_states
 from ertools.audit.compare import attach
 from ertools.audit.model import Audit
 from ertools.benchmarks import registry
+from ertools.benchmarks.common.which import log_benchmark
 from ertools.errors import BagError, ErtoolsError, ScoringError, UsageError
 from ertools.io import read_benchmark_states, topics
 from ertools.states import STATE_TOPIC_SUFFIXES
@@ -151,9 +152,13 @@ def infer_benchmark(paths: Sequence[Path]) -> str:
         }
     )
     if not found:
+        # a GT-only or robot log: the score command that takes it says which inputs it needs
+        name = log_benchmark(Path(paths[0]))
+        title = f"an {registry.get(name).title} log" if name else "a log"
+        hint = f"ertools score {name}" if name else "ertools score NAME ... --reached timing"
         raise BagError(
             "no benchmark state topics (/<benchmark>/bmbox_state, refbox_state, client_state): "
-            "nothing to audit; score such logs with `ertools score NAME ... --reached timing`",
+            f"nothing to audit; {title} without them scores with `{hint}`",
             path=paths[0],
         )
     if len(found) > 1:

@@ -30,6 +30,7 @@ def test_audit_says_there_is_nothing_to_audit(
     assert main(["audit", str(bag)]) == 1
     err = error_messages(capsys.readouterr().err)
     assert len(err) == 1 and "no benchmark state topics" in err[0] and bag.name in err[0]
+    assert "an FBM2@Home log without them scores with `ertools score fbm2h`" in err[0]
 
 
 def test_report_of_the_real_bag_hashes_it_and_has_no_audit(bag: Path, tmp_path: Path) -> None:

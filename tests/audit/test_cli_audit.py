@@ -143,6 +143,28 @@ def test_bag_without_states_is_one_line_error(
     err = error_messages(capsys.readouterr().err)
     assert code == 1
     assert len(err) == 1 and "no benchmark state topics" in err[0]
+    # no benchmark's topics either: the generic hint
+    assert "`ertools score NAME ... --reached timing`" in err[0]
+
+
+SAMPLES = Path(__file__).resolve().parents[2] / "sample_bags"
+
+
+@pytest.mark.parametrize(
+    ("log", "command"),
+    [
+        ("robotlog/FBM2H_201511201200_homer.bag", "ertools score trajectory"),
+        ("stationary/log_fbm3w_noise_2015-11-20-09-00-00_0.bag", "ertools score fbm3w"),
+    ],
+)
+def test_a_log_without_states_names_the_score_command_for_it(
+    log: str, command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A robot's own log is no GT-only log: `--reached timing` would not help it."""
+    assert main(["audit", str(SAMPLES / log)]) == 1
+    (err,) = error_messages(capsys.readouterr().err)
+    assert "nothing to audit" in err and f"scores with `{command}`" in err
+    assert "--reached" not in err
 
 
 def test_missing_bag(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

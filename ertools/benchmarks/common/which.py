@@ -55,6 +55,21 @@ def other_benchmark(name: str, bag: Path, values: Mapping[str, Any]) -> str | No
     return f"this looks like an {title} log (topics /{ns}/...): ertools score {other}"
 
 
+def log_benchmark(bag: Path) -> str | None:
+    """The registered benchmark whose namespace holds most of ``bag``'s topics (None when no
+    namespace is a benchmark's, or the log cannot be read)."""
+    try:
+        spaces = _namespaces(list(topics([bag])))
+    except ErtoolsError:
+        return None
+    found = [
+        (-spaces[ns], name)
+        for name in registry.names()
+        if (ns := registry.get(name).log_namespace) in spaces
+    ]
+    return min(found)[1] if found else None
+
+
 def refuse_other_benchmark(name: str, bags: Sequence[Path], values: Mapping[str, Any]) -> None:
     """A :class:`UsageError` when the first bag is plainly another benchmark's log."""
     if not bags:
