@@ -90,7 +90,15 @@ def inputs(name: str) -> tuple[Input, ...]:
             choices=GT_CHOICES,
             group=GT,
         ),
-        Input("max_window", "float", "default 5", default=5.0, unit="s", positive=True, group=GT),
+        Input(
+            "max_window",
+            "float",
+            "the ground-truth window reaches back at most this far before the goal (default 5 s)",
+            default=5.0,
+            unit="s",
+            positive=True,
+            group=GT,
+        ),
         Input(
             "still",
             "float",

@@ -143,7 +143,7 @@ INPUTS = (
     Input(
         "stop_speed",
         "float",
-        "(default 0.05 m/s)",
+        "a stop: the marker set slower than this (default 0.05 m/s)",
         default=0.05,
         unit="m/s",
         positive=True,
@@ -153,7 +153,7 @@ INPUTS = (
     Input(
         "stop_yaw_rate",
         "float",
-        "(default 0.1 rad/s)",
+        "a stop: turning slower than this (default 0.1 rad/s)",
         default=0.1,
         unit="rad/s",
         positive=True,
@@ -163,7 +163,7 @@ INPUTS = (
     Input(
         "stop_min",
         "float",
-        "(default 0.5 s)",
+        "a stop: both for at least this long (default 0.5 s)",
         old_flags=("--stop-min-duration",),
         default=0.5,
         unit="s",
