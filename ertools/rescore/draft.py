@@ -98,8 +98,7 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
         f"# from {len(executions)} benchmark execution(s) found in the logs. Fill in the TODO",
         "# lines, check the guessed files, then:",
         # the draft's path as given, as the PATHs are: the line runs where `--init` ran
-        f"#   ertools rescore {' '.join(str(p) for p in paths)} --config {target} --out "
-        "results/",
+        f"#   ertools rescore {' '.join(str(p) for p in paths)} --config {target} --out results/",
         "# Format: docs/rescore.md. Relative paths are from this file's folder.",
         "version: 1",
         'title: ""  # TODO: the competition, as the results page shows it',
