@@ -54,6 +54,7 @@ class Input:
         positive: the value must be > 0 (> ``minimum`` when both are given).
         maximum: largest allowed value (inclusive); above it a usage error (exit 2) that names
             it, so that a typo (``--draws 1000000000``) is refused rather than run for hours.
+        below: the value must be < this (a confidence level, below 1).
         repeat: the option may be given several times (a tuple of values).
         old_flags: former spellings, accepted for one release with a deprecation line.
         group: the help section (``2015 behaviour`` for the options that restore 2015).
@@ -77,6 +78,7 @@ class Input:
     minimum: float | None = None
     positive: bool = False
     maximum: float | None = None
+    below: float | None = None
     repeat: bool = False
     old_flags: tuple[str, ...] = ()
     group: str = ""
@@ -369,6 +371,8 @@ def _one_value(declared: Input, value: Any) -> Any:
         raise UsageError(f"{option} must be {bound}, got {value}")
     if declared.minimum is not None and number < declared.minimum:
         raise UsageError(f"{option} must be >= {declared.minimum:g}{unit}, got {value}")
+    if declared.below is not None and number >= declared.below:
+        raise UsageError(f"{option} must be < {declared.below:g}{unit}, got {value}")
     if declared.maximum is not None and number > declared.maximum:
         top = f"{declared.maximum:g}" if kind == "float" else str(int(declared.maximum))
         raise UsageError(f"{option} {value}: at most {top}{unit}")

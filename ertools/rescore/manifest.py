@@ -325,6 +325,11 @@ class _Checker:
             sign = ">" if declared.positive else ">="
             self.problem(where, f"{show(value)} must be {sign} {low:g} {declared.unit}".rstrip())
             return _BAD
+        if declared.below is not None and f >= declared.below:
+            self.problem(
+                where, f"{show(value)} must be < {declared.below:g} {declared.unit}".rstrip()
+            )
+            return _BAD
         if declared.maximum is not None and f > declared.maximum:
             self.problem(
                 where, f"{show(value)}: at most {declared.maximum:g} {declared.unit}".rstrip()

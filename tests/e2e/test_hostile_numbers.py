@@ -152,6 +152,8 @@ def test_a_shape_constant_too_large_for_a_float() -> None:
         ("benchmarks:\n  fbm3w:\n    inputs: {d_min: -0.5}\n", "d_min: -0.5 must be >= 0 m"),
         # the intervals' cap (--draws at most 100000): days of draws refused before scoring
         ("benchmarks:\n  fbm3w:\n    inputs: {draws: 1000000000}\n", "draws: 1000000000: at most"),
+        # a level of 1.5 passed --check, then made every execution unscoreable
+        ("benchmarks:\n  fbm3w:\n    inputs: {confidence: 1.5}\n", "confidence: 1.5 must be < 1"),
         ("executions:\n- {benchmark: fbm3w, team: a, bags: [BAG], start: 1.0e+300}\n", "start"),
         ("executions:\n- {benchmark: fbm3w, team: a, bags: [BAG], start: .nan}\n", "start"),
         (f"executions:\n- {{benchmark: fbm3w, team: a, bags: [BAG], end: {HUGE}}}\n", "end"),

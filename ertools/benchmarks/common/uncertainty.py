@@ -58,6 +58,7 @@ INTERVAL_INPUTS = (
         default=DEFAULT_CONFIDENCE,
         minimum=0.0,
         positive=True,
+        below=1.0,
         metavar="LEVEL",
         group="intervals",
     ),

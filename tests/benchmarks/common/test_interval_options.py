@@ -32,9 +32,9 @@ LOGS = {
 NONSENSE = [
     ("--confidence", "0", "--confidence must be positive"),
     ("--confidence", "-0.5", "--confidence must be positive"),
-    ("--confidence", "1", "--confidence 1.0: give a level between 0 and 1"),
-    ("--confidence", "1.5", "--confidence 1.5: give a level between 0 and 1"),
-    ("--confidence", "95", "--confidence 95.0: give a level between 0 and 1"),
+    ("--confidence", "1", "--confidence must be < 1, got 1.0"),
+    ("--confidence", "1.5", "--confidence must be < 1, got 1.5"),
+    ("--confidence", "95", "--confidence must be < 1, got 95.0"),
     ("--confidence", "nan", "--confidence nan: give a finite number"),
     ("--draws", "-1", "--draws must be >= 0, got -1"),
     ("--draws", "1e3", "argument --draws: invalid int value: '1e3'"),
