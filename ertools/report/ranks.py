@@ -264,8 +264,9 @@ def explanation(confidence: float, lower_is_better: bool, key: str | None = None
     pct = f"{confidence * 100:g} %"
     direction = "lower" if lower_is_better else "higher"
     return (
-        f"Each score comes with its {pct} interval: the range the score would take with "
-        f"another draw of the motion-capture noise and the other measured uncertainties. "
+        f"Each score comes with its {pct} interval: where the score free of measurement "
+        f"error lies, at that confidence, given the motion-capture noise and the other "
+        f"uncertainties measured from the log. "
         f"'P(swap)' is the chance that the team below truly scored better ({direction} is "
         f"better), reading each interval as a normal spread around the score. Where that "
         f"chance exceeds {(1 - confidence) / 2 * 100:g} % (the {pct} interval of the "
