@@ -125,6 +125,15 @@ def _choose(
         only = PoseSpec(topic=found_topics[0], time_source=spec.time_source)
         return only, f"{what}: using the only pose topic {found_topics[0]}"
     tried = ", ".join(d.name for d in defaults)
+    if not found_topics and not any(t in present for t in ("/tf", "/tf_static")):
+        # a benchmarking box's state log: the 2015 mocap logger wrote the poses to its own
+        # files, which are further BAGs (as `rescore` gives them), not a topic of this one
+        raise TopicError(
+            f"no {what}" + (f": {tried} absent" if tried else "") + "; the log holds no poses "
+            "at all (a state log?): give the mocap logger's files too, as further BAGs "
+            "(`ertools timeline FOLDER` pairs them)",
+            path=paths[0],
+        )
     raise TopicError(
         f"no {what}"
         + (f": {tried} absent" if tried else "")

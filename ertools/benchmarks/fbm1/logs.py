@@ -141,6 +141,13 @@ def locate_runs(logs: Fbm1Logs, options: Fbm1Options) -> Fbm1Runs:
             "give them with --results FILE",
             path=plist[0],
         )
+    if not found.runs:
+        # nothing to score; a bare min() below would fail as a bug
+        raise SegmentationError(
+            f"/{ns}/bmbox_state: no run found (the benchmarking box sent no goal in "
+            f"{len(states.bmbox.t_ns)} state messages)",
+            path=plist[0],
+        )
     # Read the bodies only around the runs (windowed reads touch only those chunks).
     pad = round((options.gt.max_window_s + options.gt.max_gap_s + 2.0) * NS_PER_S)
     lo = min(r.start_ns for r in found.runs) - pad
