@@ -16,6 +16,8 @@ from ertools.benchmarks import registry
 from ertools.errors import ErtoolsError, UsageError
 from ertools.io import topics
 
+GT_USE = "ertools score trajectory ROBOT_LOG MOCAP..."
+
 
 def _namespaces(names: Sequence[str]) -> dict[str, int]:
     """Topic count by first part (``/fbm2h/robot_at_home/pose`` -> ``fbm2h``)."""
@@ -50,6 +52,17 @@ def other_benchmark(name: str, bag: Path, values: Mapping[str, Any]) -> str | No
             candidates.append((-spaces[ns], other, ns))
     if not candidates:
         return None
+    if len(candidates) > 1:
+        # a mocap logger recording every arena (the 2015 GT logger's own files): no one
+        # benchmark's log, but the poses that go with one
+        listed = ", ".join(f"/{ns}/..." for _, _, ns in sorted(candidates, key=lambda c: c[2]))
+        what = f"this log holds the poses of several benchmarks ({listed}), as a mocap logger's"
+        if name == "trajectory":
+            return f"{what} file does; give it as the GT after the robot's own log: " + GT_USE
+        return (
+            f"{what} file does; give it after the benchmark's own log (ertools score {name} "
+            f"LOG MOCAP...), or as the GT of {GT_USE}"
+        )
     _, other, ns = min(candidates)
     title = registry.get(other).title
     return f"this looks like an {title} log (topics /{ns}/...): ertools score {other}"

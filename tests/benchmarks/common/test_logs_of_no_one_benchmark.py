@@ -1,6 +1,6 @@
-"""A benchmarking box's state log given alone (the 2015 layout: states in one file, the mocap
-logger's poses in its own): the error says to give the mocap files too, not to pick a pose
-topic among none."""
+"""Logs that are not one benchmark's own: a benchmarking box's state log given alone (the 2015
+layout: states in one file, the mocap logger's poses in its own) asks for the mocap files, not
+for a pose topic among none; a mocap logger's file of every arena is named so."""
 
 from __future__ import annotations
 
@@ -52,3 +52,38 @@ def test_fbm1_states_without_a_run_say_so(
         f"ertools: error: {bag}: /fbm1h/bmbox_state: no run found (the benchmarking box sent "
         "no goal in 5 state messages)"
     )
+
+
+def _mocap_log(tmp_path: Path) -> Path:
+    """A mocap logger's file recording every arena (the sample competition's gtlogger)."""
+    spec = Spec()
+    poses = [
+        spec.conn(f"/{ns}/{body}/pose", "geometry_msgs/PoseStamped")
+        for ns, body in (("fbm1h", "origin"), ("fbm2h", "robot_at_home"), ("fbm3w", "robot"))
+    ]
+    for i in range(5):
+        t = 1_448_020_800_000_000_000 + i * 100_000_000
+        for c in poses:
+            spec.add(c, t, stamp=t, frame="world", xyz=(i, 0.0, 0.0), q=(0.0, 0.0, 0.0, 1.0))
+    return write(tmp_path / "log_mocap_2015-11-20-08-59-58_0.bag", "ros1", spec)
+
+
+@pytest.mark.parametrize(
+    ("name", "advice"),
+    [
+        ("fbm1w", "give it after the benchmark's own log (ertools score fbm1w LOG MOCAP...), "),
+        ("trajectory", "give it as the GT after the robot's own log: ertools score trajectory "),
+    ],
+)
+def test_a_mocap_log_of_several_benchmarks_is_named_so(
+    name: str, advice: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Not 'this looks like an FBM1@Home log' because /fbm1h/ has a topic more than the rest."""
+    bag = _mocap_log(tmp_path)
+    assert main(["score", name, str(bag)]) == 2
+    (message,) = joined_lines(capsys.readouterr().err)
+    assert message.startswith(
+        f"ertools: error: {bag}: this log holds the poses of several benchmarks (/fbm1h/..., "
+        "/fbm2h/..., /fbm3w/...), as a mocap logger's file does"
+    )
+    assert advice in message and "ROBOT_LOG MOCAP..." in message
