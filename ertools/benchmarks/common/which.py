@@ -69,8 +69,8 @@ def other_benchmark(name: str, bag: Path, values: Mapping[str, Any]) -> str | No
 
 
 def log_benchmark(bag: Path) -> str | None:
-    """The registered benchmark whose namespace holds most of ``bag``'s topics (None when no
-    namespace is a benchmark's, or the log cannot be read)."""
+    """The registered benchmark whose namespace holds ``bag``'s topics (None when none does,
+    when several do, as in a mocap logger's file of every arena, or the log cannot be read)."""
     try:
         spaces = _namespaces(list(topics([bag])))
     except ErtoolsError:
@@ -80,7 +80,7 @@ def log_benchmark(bag: Path) -> str | None:
         for name in registry.names()
         if (ns := registry.get(name).log_namespace) in spaces
     ]
-    return min(found)[1] if found else None
+    return found[0][1] if len(found) == 1 else None
 
 
 def refuse_other_benchmark(name: str, bags: Sequence[Path], values: Mapping[str, Any]) -> None:
