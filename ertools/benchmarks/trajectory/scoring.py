@@ -11,9 +11,11 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import I64
+from ertools.benchmarks import registry
 from ertools.benchmarks.common.clocks import OffsetEstimate, estimate_offset
 from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid, frame_change_warning
 from ertools.benchmarks.common.interval_output import NO_INTERVALS, IntervalSettings
+from ertools.benchmarks.common.teams import parse_robot_log_name
 from ertools.benchmarks.common.uncertainty import Interval
 from ertools.benchmarks.common.validity import (
     GAP as V_GAP,
@@ -105,7 +107,7 @@ def score_streams(
     if len(gt) < 2:
         raise ScoringError(f"GT {gt_topic}: {len(gt)} pose(s) in the robot log's span")
     check_increasing(robot, where)
-    notes = list(warnings)
+    notes = [*warnings, *_other_benchmark_gt(robot_file, gt_topic)]
     notes.extend(w for w in (frame_change_warning(gt), frame_change_warning(robot)) if w)
     evo = config.t_max_diff is not None
     invalid: list[Deviation] = []
@@ -416,6 +418,20 @@ def _audit_warnings(audit: OffsetEstimate, applied_ns: int) -> list[str]:
     if audit.note:
         out.append(f"clock audit: {audit.note}")
     return out
+
+
+def _other_benchmark_gt(robot_file: str, gt_topic: str) -> list[str]:
+    """A warning when the robot log's rockin_logger name names one benchmark and the GT topic
+    lies under another's namespace (a folder of the other arena's mocap files given as
+    GT_PATH: their times overlap at a venue recording both arenas at once)."""
+    named = parse_robot_log_name(robot_file) if robot_file else None
+    ns = gt_topic.strip("/").split("/")[0]
+    if named is None or ns == named.benchmark or ns not in registry.names():
+        return []
+    return [
+        f"the robot log's name says {named.benchmark}, but the GT {gt_topic} is the "
+        f"{registry.get(ns).title} arena's: check GT_PATH (or --gt-topic)"
+    ]
 
 
 def _outside_note(

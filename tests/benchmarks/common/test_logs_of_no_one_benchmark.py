@@ -87,3 +87,23 @@ def test_a_mocap_log_of_several_benchmarks_is_named_so(
         "/fbm2h/..., /fbm3w/...), as a mocap logger's file does"
     )
     assert advice in message and "ROBOT_LOG MOCAP..." in message
+
+
+SAMPLES = ROOT / "sample_bags"
+ROBOT = SAMPLES / "robotlog" / "FBM2H_201511201200_homer.bag"
+
+
+@pytest.mark.parametrize(("gt", "warned"), [("fbm3w", True), ("robotlog", False)])
+def test_trajectory_gt_of_the_other_arena_is_said(
+    gt: str, warned: bool, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An FBM2@Home robot log against a folder of FBM3@Work mocap files (both arenas record at
+    once at a venue, so their times overlap): scored as asked, with a warning naming both."""
+    assert main(["score", "trajectory", str(ROBOT), str(SAMPLES / gt), "--draws", "0"]) == 0
+    err = capsys.readouterr().err
+    said = (
+        "ertools: warning: the robot log's name says fbm2h, but the GT /fbm3w/robot_at_work/pose "
+        "is the FBM3@Work arena's: check GT_PATH (or --gt-topic)"
+    )
+    assert (said in err) == warned, err
+    assert ("the robot log's name says" in err) == warned
