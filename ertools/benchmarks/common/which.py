@@ -16,7 +16,7 @@ from ertools.benchmarks import registry
 from ertools.errors import ErtoolsError, UsageError
 from ertools.io import topics
 
-GT_USE = "ertools score trajectory ROBOT_LOG MOCAP..."
+GT_USE = "ertools score trajectory ROBOT_BAG MOCAP..."
 
 
 def _namespaces(names: Sequence[str]) -> dict[str, int]:
@@ -57,8 +57,10 @@ def other_benchmark(name: str, bag: Path, values: Mapping[str, Any]) -> str | No
         # benchmark's log, but the poses that go with one
         listed = ", ".join(f"/{ns}/..." for _, _, ns in sorted(candidates, key=lambda c: c[2]))
         what = f"this log holds the poses of several benchmarks ({listed}), as a mocap logger's"
-        if name == "trajectory":
-            return f"{what} file does; give it as the GT after the robot's own log: " + GT_USE
+        if not isinstance(bench.bags_metavar, str):
+            # a command of a robot log and its GT (ROBOT_BAG GT_PATH): the file is a GT_PATH
+            robot, gt = bench.bags_metavar
+            return f"{what} file does; give it as {gt} after the {robot}: {GT_USE}"
         return (
             f"{what} file does; give it after the benchmark's own log (ertools score {name} "
             f"LOG MOCAP...), or as the GT of {GT_USE}"

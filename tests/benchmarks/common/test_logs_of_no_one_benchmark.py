@@ -72,7 +72,7 @@ def _mocap_log(tmp_path: Path) -> Path:
     ("name", "advice"),
     [
         ("fbm1w", "give it after the benchmark's own log (ertools score fbm1w LOG MOCAP...), "),
-        ("trajectory", "give it as the GT after the robot's own log: ertools score trajectory "),
+        ("trajectory", "give it as GT_PATH after the ROBOT_BAG: ertools score trajectory "),
     ],
 )
 def test_a_mocap_log_of_several_benchmarks_is_named_so(
@@ -86,7 +86,7 @@ def test_a_mocap_log_of_several_benchmarks_is_named_so(
         f"ertools: error: {bag}: this log holds the poses of several benchmarks (/fbm1h/..., "
         "/fbm2h/..., /fbm3w/...), as a mocap logger's file does"
     )
-    assert advice in message and "ROBOT_LOG MOCAP..." in message
+    assert advice in message and "ROBOT_BAG MOCAP..." in message
 
 
 SAMPLES = ROOT / "sample_bags"
