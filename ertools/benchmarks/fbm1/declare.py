@@ -15,6 +15,7 @@ from typing import Any
 from ertools.benchmarks.base import (
     Benchmark,
     Explanation,
+    FormerName,
     Input,
     Ranking,
     notice,
@@ -25,6 +26,7 @@ from ertools.benchmarks.common.ending import EXACT_HELP
 from ertools.benchmarks.common.interval_output import IntervalSettings
 from ertools.benchmarks.common.interval_output import lines as interval_lines
 from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS
+from ertools.benchmarks.common.validity import SCORE_AS_2015, unscoreable_input
 from ertools.benchmarks.fbm1.benchmark import score_found
 from ertools.benchmarks.fbm1.config import RULE_SETS, BodySources, Fbm1Options
 from ertools.benchmarks.fbm1.gt import GtOptions
@@ -167,13 +169,8 @@ def inputs(name: str) -> tuple[Input, ...]:
             "class and instance accuracies divided by 10 whatever the runs (2016-17 @Home)",
             group=NODES,
         ),
-        Input(
-            "score_unscoreable",
-            "flag",
-            "a run whose ground truth has no valid mocap sample (tracking lost) is scored from "
-            "it (both nodes)",
-            group=NODES,
-        ),
+        # both nodes scored a run whose ground truth had no valid mocap sample (tracking lost)
+        unscoreable_input(NODES, FormerName("score_unscoreable", SCORE_AS_2015)),
         Input(
             "legacy_totals",
             "flag",
@@ -257,7 +254,7 @@ def options_maker(name: str) -> Callable[[Mapping[str, Any]], Fbm1Options]:
             accuracy_over_10=r.accuracy_over_10
             or v["accuracy_over_10"]
             or (old_totals and name == "fbm1h"),
-            score_unscoreable=r.score_unscoreable or v["score_unscoreable"],
+            score_unscoreable=r.score_unscoreable or v["unscoreable"] == SCORE_AS_2015,
         )
         if v["gt"] == "goal":
             notice(

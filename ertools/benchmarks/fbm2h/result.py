@@ -46,7 +46,7 @@ class SegmentResult:
         validity: the validity of the GT samples from the segment's start to its reached
             moment (None when not driven).
         unscoreable_reason: why the reached moment has no valid GT (status ``no_gt``; with
-            ``--unscoreable-segments 2015`` the segment is scored and this is kept).
+            ``--unscoreable 2015`` the segment is scored and this is kept).
         gaps: the segment's invalid stretches where the path plot draws them: their times
             (seconds from the log's first message) and the robot's world (x, y) at their ends,
             the frame of ``Fbm2hResult.path_xyyaw``.

@@ -52,7 +52,7 @@ class RunResult:
         sample_t_ns: (N,) times of the samples of ``frame_xy`` (the Foxglove export).
         validity: the path window's validity mask summary (None when not computed).
         unscoreable_reason: why the valid data cannot support a score (then ``score`` is None
-            and the status ``unscoreable``; under ``--unscoreable-runs 2015`` the run is scored
+            and the status ``unscoreable``; under ``--unscoreable 2015`` the run is scored
             and this is kept for the warning), None otherwise.
         path_coverage: the fraction of the path window covered by valid data (a tracking loss
             that hid no motion counted as covered), None when not computed.

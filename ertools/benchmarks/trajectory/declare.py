@@ -14,6 +14,7 @@ from ertools.benchmarks.base import Benchmark, Input, Ranking, resolve_values
 from ertools.benchmarks.common.interval_output import IntervalSettings
 from ertools.benchmarks.common.interval_output import lines as interval_lines
 from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS
+from ertools.benchmarks.common.validity import unscoreable_input
 from ertools.benchmarks.trajectory.benchmark import (
     TrajectoryLogs,
     TrajectoryOptions,
@@ -28,7 +29,6 @@ from ertools.benchmarks.trajectory.config import (
     GT_ORDERS,
     SETTINGS_2015,
     TIES,
-    UNSCOREABLE,
     TrajectoryConfig,
 )
 from ertools.benchmarks.trajectory.result import TrajectoryResult
@@ -94,14 +94,8 @@ INPUTS = (
         choices=GT_ORDERS,
         group=LEGACY,
     ),
-    Input(
-        "unscoreable",
-        "choice",
-        "a comparison with too few valid pairs (docs/uncertainty.md): unscoreable, null "
-        "statistics (null, default) or scored from them with a warning (2015)",
-        choices=UNSCOREABLE,
-        group=LEGACY,
-    ),
+    # too few valid pairs make the comparison unscoreable (docs/uncertainty.md)
+    unscoreable_input(LEGACY),
     Input(
         "as_2015",
         "flag",
