@@ -23,8 +23,11 @@ from ertools.benchmarks.base import (
     tf_value,
 )
 from ertools.benchmarks.common.ending import EXACT_HELP
-from ertools.benchmarks.common.interval_output import IntervalSettings
-from ertools.benchmarks.common.interval_output import lines as interval_lines
+from ertools.benchmarks.common.interval_output import (
+    IntervalSettings,
+    ScoreRow,
+    interval_lines,
+)
 from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS
 from ertools.benchmarks.common.validity import SCORE_AS_2015, unscoreable_input
 from ertools.benchmarks.fbm1.benchmark import score_found
@@ -315,7 +318,7 @@ def notes(result: Fbm1Result) -> list[str]:
         logged = ", ".join(f"{k} {v}" for k, v in result.logged_score.items())
         out.append(f"the 2015 node sent: {logged}")
     out += interval_lines(
-        [("pose_score", t.pose_score, result.intervals.get("pose_score"), 1.0, "", 4)],
+        [ScoreRow("pose_score", t.pose_score, result.intervals.get("pose_score"))],
         result.uncertainty,
     )
     if result.uncertainty is not None:
