@@ -528,7 +528,7 @@ def with_intervals(
         m,
         indices,
         estimates,
-        measure_model(marker),
+        measure_model(marker, transform.spread),
         orientation_2015=result.orientation_2015,
         divide_by=len(result.segments) if result.unscored_2015 else len(ok),
         draws=options.draws,
