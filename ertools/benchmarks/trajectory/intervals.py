@@ -11,8 +11,9 @@ side of each compared pair perturbed by two sources, vectorised over (draws, pos
   the noise's is sqrt(6) sigma: a robust MAD of them gives sigma), else a stated default. The
   yaw's sigma likewise from the yaw's second differences. An interpolated GT pose mixes two
   samples: its noise is sigma sqrt((1-a)^2 + a^2).
-- ``time_association``: the robot-to-GT clock offset is known to the clock audit's standard
-  deviation (its block bootstrap): one offset error per draw, common to every pose, moves
+- ``time_association``: the robot-to-GT clock offset is known to the standard error of the
+  least-squares offset, the robot's correlated error slid along the path by every lag
+  (:func:`offset_spread`): one offset error per draw, common to every pose, moves
   each GT pose by the GT velocity times it. The offset is not a measurement of the truth
   plus an error that a draw adds a second time: the true offset lies around the applied one
   as the draws do, so the score at a drawn offset is itself a draw of the true score (with
@@ -187,23 +188,40 @@ def offset_spread(
 ) -> tuple[float, float]:
     """(sd, centre) in seconds of the true clock offset around the one applied.
 
-    The sd is the sandwich standard error of the least-squares offset, the poses taken as
-    independent: sqrt(sum psi_i^2) / sum |v_i|^2 with psi_i = v_i . (robot_i - gt_i). On the
-    simulator (``bench/calibration/trajectory.py``, the robot's error a bias, a 13 s drift
-    and white noise, drawn anew per trial) the offset's actual error is 1.14 of it, while the
-    clock audit's block bootstrap (reported in ``clock_audit``) is 4.5 times the actual
-    error: resampling blocks of a smooth error breaks the cancellation of its projection on
-    a turning path's velocity, which makes it a safe warning threshold but no interval. The
-    centre is the audit's estimate minus the offset applied (0 with ``--offset auto
-    --apply-offset``): a given offset the data disagrees with moves the interval, not the
-    score.
+    The least-squares offset is off by ``sum_i v_i . e_i / sum_i |v_i|^2`` (v the GT
+    velocity at robot pose i, e the robot's error there). The poses' errors are not
+    independent (a robot's estimate drifts over seconds), and how much a drift moves that sum
+    depends on how it lines up with the path's velocity, which turns over a lap. The sd takes
+    that from the log itself: the error series slid along the path by every lag h is as
+    likely an alignment as the one logged (a stationary error, independent of where the path
+    turns), so the variance of the sum is that of the cross-correlation over the lags,
+    ``sum_h c(h)^2 / n`` with ``c(h) = sum_i v_i . e_(i+h)`` (e centred; all lags, no
+    window: a window keeps the lags over which a lap's drift projection adds up and drops
+    those over which it cancels, which is why a Newey-West sum overshoots 1.25 to 4 times).
+    For independent errors it is the sandwich standard error. On the simulator
+    (``bench/calibration/trajectory.py``: a bias, a 13 s drift and white noise, drawn anew per
+    trial) the offset's actual error is 1.11 times it, as it is of the variance the
+    simulator's own error model gives (the rest: the GT's stamping delay); the independent
+    poses' sandwich error was 1.57 times too small. The clock audit's block bootstrap
+    (``clock_audit``) stays the audit's warning threshold. The centre is the audit's estimate
+    minus the offset applied (0 with ``--offset auto --apply-offset``): a given offset the
+    data disagrees with moves the interval, not the score.
     """
     sv = float(np.sum(np.square(vel, dtype=np.float64)))
-    if len(vel) < 3 or sv <= 0.0 or audit.offset_ns is None:
+    n = len(vel)
+    if n < 3 or sv <= 0.0 or audit.offset_ns is None:
         return 0.0, 0.0
-    psi = np.sum((r_xyz - g_xyz).astype(np.float64) * vel, axis=1)
-    psi -= psi.mean()
-    return math.sqrt(float(np.dot(psi, psi))) / sv, (audit.offset_ns - offset_ns) / NS_PER_S
+    e = (r_xyz - g_xyz).astype(np.float64)
+    e -= e.mean(axis=0)
+    v = vel.astype(np.float64)
+    # c(h) for every lag at once: zero-padded to a length >= 2n - 1, so the FFT's circular
+    # correlation is the linear one; sum_h c(h)^2 = sum_f |C(f)|^2 / m (Parseval)
+    m = 1 << (2 * n - 1).bit_length()
+    cross = np.sum(np.conj(np.fft.rfft(v, m, axis=0)) * np.fft.rfft(e, m, axis=0), axis=1)
+    power = np.abs(cross) ** 2
+    # rfft keeps f = 0..m/2: every other frequency stands for its conjugate twin too
+    total = float(power[0] + power[-1] + 2.0 * np.sum(power[1:-1])) / m
+    return math.sqrt(total / n) / sv, (audit.offset_ns - offset_ns) / NS_PER_S
 
 
 def _bracket(t: IntArr, q: IntArr) -> tuple[IntArr, IntArr]:
@@ -401,8 +419,9 @@ def trajectory_intervals(
         parts = []
         if off_sigma > 0.0:
             parts.append(
-                f"clock offset sd {off_sigma * 1000:.3f} ms (sandwich standard error of the "
-                f"least-squares offset), centred {off_centre * 1000:+.3f} ms from the applied "
+                f"clock offset sd {off_sigma * 1000:.3f} ms (standard error of the "
+                "least-squares offset, the robot's error slid along the path by every lag), "
+                f"centred {off_centre * 1000:+.3f} ms from the applied "
                 "one (the clock audit's estimate); mirrored: drawn as the truth's offset"
             )
         else:
