@@ -9,7 +9,14 @@ import numpy as np
 import pytest
 
 from ertools.benchmarks.common.clocks import OffsetEstimate
-from ertools.benchmarks.trajectory.intervals import mocap_sigma, offset_spread
+from ertools.benchmarks.trajectory.association import associate
+from ertools.benchmarks.trajectory.intervals import (
+    KEYS,
+    Rescoring,
+    mocap_sigma,
+    offset_effects,
+    offset_spread,
+)
 from ertools.geometry import quat_from_yaw
 from ertools.streams import PoseStream
 
@@ -97,3 +104,48 @@ def test_offset_spread_follows_an_error_drifting_along_a_turning_path(
     assert 0.75 * exact <= got.mean() <= 1.5 * exact
     if lap_s == 12.0:
         assert exact > 20 * sigma * math.sqrt(sv) / sv  # what the independent poses' sd misses
+
+
+def test_offset_draws_rescore_poses_entering_and_leaving_a_tracking_loss() -> None:
+    """GT along x at 1 m/s, 120 Hz, for 10 s; tracking lost over frames 600 to 647 (each
+    repeats frame 599's position). The robot at 10 Hz from 1 s, 1 cm to the side of the truth,
+    except one pose P 2 ms before frame 647 (inside the loss: not compared at the applied
+    offset). Shifted +4 ms, P enters the comparison between the last repeat (stale, at
+    599/120 m) and frame 648, as the score at that offset compares it; shifted -4 ms, the
+    pose at frame 648's time falls into that stale pair instead. The means and maxima below
+    are the straight line's distances by hand."""
+    k = np.arange(1200)
+    t = T0 + np.round(k * 1e9 / 120).astype(np.int64)
+    x = k / 120.0
+    x[600:648] = x[599]
+    gt = PoseStream(t, np.column_stack([x, 0 * x, 0 * x]), quat_from_yaw(0 * x), "world", "b", "gt")
+    times = T0 + np.arange(10, 91) * 100_000_000
+    p_ns = int(t[647]) - 2_000_000
+    times[43] = p_ns  # the pose at 5.3 s (inside the loss) moved to P
+    rx = (times - T0) / 1e9
+    robot = PoseStream(
+        times, np.column_stack([rx, 0 * rx + 0.01, 0 * rx]), quat_from_yaw(0 * rx), "w", "r", "r"
+    )
+
+    def rescore(rows: np.ndarray, shift_ns: int):  # type: ignore[no-untyped-def]
+        part = robot.take(rows)
+        moved = PoseStream(part.t_ns + shift_ns, part.xyz, part.quat_xyzw, "w", "r", "r")
+        return associate(moved, gt, "linear", 100_000_000)
+
+    got = offset_effects(Rescoring(times, rescore), t, np.array([0.0, 0.004, -0.004]))
+    mean, top = KEYS.index("position_error"), KEYS.index("max")
+    assert got[0] == pytest.approx(np.zeros(len(KEYS)))
+    # at the applied offset: 77 poses compared (5.0 to 5.2 s and P in the loss), each 1 cm off
+    d_shift = math.hypot(0.01, 0.004)  # every ordinary pose, 4 ms along the line
+    period = 1 / 120
+    stale, fresh = 599 / 120, 648 / 120
+    # +4 ms: P (at frame 647 - 2 ms) compared 2 ms into the pair (stale, frame 648)
+    gx = stale + (0.002 / period) * (fresh - stale)
+    d_p = math.hypot(0.01, (p_ns - T0) / 1e9 - gx)
+    assert got[1, top] == pytest.approx(d_p - 0.01, rel=1e-6)
+    assert got[1, mean] == pytest.approx((77 * d_shift + d_p) / 78 - 0.01, rel=1e-6)
+    # -4 ms: the pose at 5.4 s (frame 648) compared 4 ms before it, in the stale pair
+    gx = stale + ((period - 0.004) / period) * (fresh - stale)
+    d_q = math.hypot(0.01, 5.4 - gx)
+    assert got[2, top] == pytest.approx(d_q - 0.01, rel=1e-6)
+    assert got[2, mean] == pytest.approx((76 * d_shift + d_q) / 77 - 0.01, rel=1e-6)
