@@ -23,7 +23,7 @@ from typing import TYPE_CHECKING, Any, cast
 from ertools.audit.model import Audit
 from ertools.audit.rescore import ScoreInputs, audit_bag, infer_benchmark
 from ertools.benchmarks import registry
-from ertools.benchmarks.base import Input
+from ertools.benchmarks.base import Input, rename_former
 from ertools.benchmarks.common.sources import read_source
 from ertools.benchmarks.common.spec import PoseSpec, TimeSource, parse_tf
 from ertools.benchmarks.common.which import refuse_other_benchmark
@@ -189,6 +189,7 @@ def _value(declared: Input, value: Any) -> Any:
 def _values(name: str, inputs: Mapping[str, Any]) -> dict[str, Any]:
     bench = registry.get(name)
     declared = {i.name: i for i in bench.inputs}
+    inputs = rename_former(bench.inputs, inputs)
     unknown = sorted(set(inputs) - set(declared))
     if unknown:
         raise UsageError(
@@ -275,9 +276,9 @@ def audit(
     """
     plist = _paths(bags)
     namespace = benchmark or infer_benchmark(plist)
-    declared = (
-        {i.name: i for i in registry.get(namespace).inputs} if namespace in registry.names() else {}
-    )
+    known = registry.get(namespace).inputs if namespace in registry.names() else ()
+    declared = {i.name: i for i in known}
+    inputs = rename_former(known, inputs)
     # an input the benchmark does not declare is passed as given: the audit notes it unused
     given = {
         k: _value(declared[k], v) if k in declared else v

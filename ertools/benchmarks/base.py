@@ -36,6 +36,32 @@ InputKind = Literal["path", "paths", "float", "int", "str", "choice", "flag"]
 
 
 @dataclass(frozen=True)
+class FormerName:
+    """A former name of an input, still accepted with a one-line deprecation note naming the
+    new spelling: the option ``--`` + name (``-`` for ``_``), the manifest key and the keyword
+    argument of :func:`ertools.score`.
+
+    Attributes:
+        name: the former name (``unscoreable_runs``).
+        value: what a former *switch* (an option taking no value, ``--score-unscoreable``)
+            stood for (``"2015"``); None: the former name took the input's own values.
+    """
+
+    name: str
+    value: str | None = None
+
+    @property
+    def option(self) -> str:
+        return "--" + self.name.replace("_", "-")
+
+    def new_value(self, value: Any) -> Any:
+        """The input's value for ``value`` given under this name (None: not given)."""
+        if self.value is None:
+            return value
+        return self.value if value is True else None
+
+
+@dataclass(frozen=True)
 class Input:
     """One value a benchmark takes besides its bags, declared once: it is the command-line option
     of ``ertools score NAME``, the key of the competition manifest and a row of the report's
@@ -57,6 +83,9 @@ class Input:
         below: the value must be < this (a confidence level, below 1).
         repeat: the option may be given several times (a tuple of values).
         old_flags: former spellings, accepted for one release with a deprecation line.
+        former: former names (:class:`FormerName`): unlike ``old_flags`` (command line only),
+            also former manifest keys and keyword arguments, and possibly a switch standing
+            for one value (``--score-unscoreable`` = ``--unscoreable 2015``).
         group: the help section (``2015 behaviour`` for the options that restore 2015).
         per_team: in a manifest, the value may differ per team (a marker-set transform).
         metavar: the placeholder in ``--help`` (default from ``unit`` or the kind).
@@ -87,6 +116,7 @@ class Input:
     flag: str = ""
     with_file: tuple[str, ...] = ()
     needed_unless: tuple[tuple[str, tuple[str, ...]], ...] = ()
+    former: tuple[FormerName, ...] = ()
 
     def needed(self, values: Mapping[str, Any]) -> bool:
         """Whether a manifest must give this per-team input, given the other ``values``."""
@@ -440,4 +470,33 @@ def resolve_values(inputs: Sequence[Input], given: Mapping[str, Any]) -> dict[st
             out[name] = tuple(_one_value(declared, v) for v in values)
         else:
             out[name] = _one_value(declared, value)
+    return out
+
+
+def rename_former(
+    inputs: Sequence[Input], given: Mapping[str, Any], *, where: str = ""
+) -> dict[str, Any]:
+    """``given`` (values by name) with each :attr:`Input.former` name's value moved to its
+    input's name, each said once on stderr naming the new spelling: as a keyword argument
+    (``unscoreable_runs='2015' is deprecated, use unscoreable='2015'``), or as a manifest
+    key under ``where`` (``benchmarks.fbm3w.inputs.unscoreable_runs is deprecated, use
+    benchmarks.fbm3w.inputs.unscoreable: 2015``). The current name wins when both are given.
+    """
+
+    formers = {f.name: (i, f) for i in inputs for f in i.former}
+    out = {k: v for k, v in given.items() if k not in formers}
+    for key, value in given.items():
+        if key not in formers or value is None or value is False:
+            continue
+        declared, former = formers[key]
+        new = former.new_value(value)
+        if where:
+            old_text = f"{where}.{key}"
+            new_text = f"{where}.{declared.name}: {new}"
+        else:
+            old_text = f"{key}={value!r}"
+            new_text = f"{declared.name}={new!r}"
+        notice(f"note: {old_text} is deprecated, use {new_text}")
+        if out.get(declared.name) is None and new is not None:
+            out[declared.name] = new
     return out

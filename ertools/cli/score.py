@@ -97,8 +97,9 @@ def _metavar(declared: Input) -> str | None:
 
 def _help(declared: Input) -> str:
     text = declared.help
-    if declared.old_flags:
-        text += f" (formerly {', '.join(declared.old_flags)})"
+    formerly = [*declared.old_flags, *(f.option for f in declared.former)]
+    if formerly:
+        text += f" (formerly {', '.join(formerly)})"
     return text.replace("%", "%%")
 
 
@@ -131,6 +132,13 @@ def _add_input(target: Any, declared: Input) -> None:
     for old in declared.old_flags:
         old_kw = {**kw, "dest": _old_dest(old), "help": argparse.SUPPRESS}
         target.add_argument(old, **old_kw)
+    for former in declared.former:
+        if former.value is None:
+            former_kw = {**kw, "dest": former.name, "help": argparse.SUPPRESS}
+        else:  # a former switch, standing for one value
+            former_kw = {"dest": former.name, "action": "store_true", "default": None}
+            former_kw["help"] = argparse.SUPPRESS
+        target.add_argument(former.option, **former_kw)
 
 
 def add_benchmark_arguments(parser: argparse.ArgumentParser, name: str) -> None:
@@ -179,6 +187,15 @@ def _values(bench: registry.AnyBenchmark, args: argparse.Namespace) -> dict[str,
             deprecation_note(old, declared.option + frame)
             if not value:
                 value = old_value
+        for former in declared.former:
+            old_value = getattr(args, former.name)
+            if old_value is None or old_value is False:
+                continue
+            new_value = former.new_value(old_value)
+            given = "" if former.value is not None else f" {old_value}"
+            deprecation_note(former.option + given, f"{declared.option} {new_value}")
+            if not value:
+                value = new_value
         if declared.kind == "flag" and not value:
             value = None  # not given: make_options applies the default
         values[declared.name] = value

@@ -52,6 +52,38 @@ Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
 
 
+#: The key ``ertools acquire transform`` writes after the Listing 11 keys: how much the
+#: averaged marker poses spread (the 2015 node read the listing's keys by name, and ignores it).
+SPREAD_KEY = "acquisition_spread"
+
+
+@dataclass(frozen=True)
+class TransformSpread:
+    """The spread of the marker poses an acquisition averaged (one standard deviation each).
+
+    Attributes:
+        position_std: (x, y, z) metres, along the axes of the mean marker frame (the frame of
+            ``marker_to_robot_transform``'s translation).
+        rotation_std: (x, y, z) radians, the rotation vector of each pose from the mean, about
+            the same axes (x, y: tilt; z: yaw).
+        samples: the number of poses averaged.
+        effective_samples: as many independent poses as the averaged ones are worth (fewer
+            when consecutive poses are correlated: ``samples (1 - rho) / (1 + rho)``, rho their
+            lag-1 autocorrelation); the transform's error is the spread over its square root.
+    """
+
+    position_std: Vec3
+    rotation_std: Vec3
+    samples: int
+    effective_samples: int
+
+    def standard_errors(self) -> tuple[Vec3, Vec3]:
+        """(position, rotation) standard errors of the averaged transform, per axis."""
+        root = math.sqrt(max(1, self.effective_samples))
+        p, r = self.position_std, self.rotation_std
+        return (p[0] / root, p[1] / root, p[2] / root), (r[0] / root, r[1] / root, r[2] / root)
+
+
 @dataclass(frozen=True)
 class MarkerTransform:
     """T_marker_robot and where it came from.
@@ -63,6 +95,8 @@ class MarkerTransform:
         quat_xyzw: orientation of the robot in the marker frame (unit, scalar last).
         source: the file, or ``<identity>`` when none was given.
         layout: which of :data:`LAYOUTS` the file was written in.
+        spread: the acquisition's spread (:data:`SPREAD_KEY`), None for a file without it
+            (older acquisitions, hand-written and 2015 files).
     """
 
     robot_info: str
@@ -71,6 +105,7 @@ class MarkerTransform:
     quat_xyzw: Quat
     source: str = ""
     layout: str = "listing-11"
+    spread: TransformSpread | None = None
 
     @property
     def described(self) -> str:
@@ -193,6 +228,35 @@ def _layout(data: dict[str, Any], source: str) -> tuple[str, dict[str, Any]]:
     )
 
 
+def _parse_spread(value: Any, source: str) -> TransformSpread | None:
+    """The :data:`SPREAD_KEY` mapping; a malformed one is an error (never silently a default)."""
+    if value is None:
+        return None
+    what = SPREAD_KEY
+    if not isinstance(value, dict):
+        raise ConfigError(
+            f"{what}: expected a mapping (position_std, rotation_std, samples)", path=source
+        )
+    missing = [k for k in ("position_std", "rotation_std", "samples") if k not in value]
+    if missing:
+        raise ConfigError(f"{what}: missing {', '.join(missing)}", path=source)
+    pos = _numbers(value["position_std"], 3, f"{what}.position_std", source)
+    rot = _numbers(value["rotation_std"], 3, f"{what}.rotation_std", source)
+    counts = []
+    for key in ("samples", "effective_samples"):
+        v = value.get(key, value["samples"])
+        if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+            raise ConfigError(f"{what}.{key}: expected a whole number >= 1, got {v!r}", path=source)
+        counts.append(v)
+    if any(x < 0 for x in (*pos, *rot)):
+        raise ConfigError(f"{what}: a standard deviation cannot be negative", path=source)
+    if counts[1] > counts[0]:
+        raise ConfigError(
+            f"{what}: effective_samples {counts[1]} exceeds samples {counts[0]}", path=source
+        )
+    return TransformSpread(_vec3(pos), _vec3(rot), counts[0], counts[1])
+
+
 def parse_transform(data: Any, source: str = "<transform>") -> MarkerTransform:
     """Validate a parsed transform mapping: Listing 11/12, ERL RSBB or a ``pose:`` dump."""
     if not isinstance(data, dict):
@@ -206,6 +270,7 @@ def parse_transform(data: Any, source: str = "<transform>") -> MarkerTransform:
         quat_xyzw=q,
         source=source,
         layout=layout,
+        spread=_parse_spread(data.get(SPREAD_KEY), source),
     )
     if "robot_to_marker_transform" in data:
         t_inv, q_inv = _pair(data, "robot_to_marker_transform", source)
@@ -286,9 +351,11 @@ def _flow(values: tuple[float, ...]) -> str:
 
 
 def transform_yaml(tr: MarkerTransform) -> str:
-    """Listing 11 text: team, timestamp, both directions, with the listing's comments."""
+    """Listing 11 text: team, timestamp, both directions, with the listing's comments; then,
+    for an acquisition that measured it, its spread (:data:`SPREAD_KEY`, an extra key after
+    the listing's)."""
     t_inv, q_inv = tr.inverse()
-    return (
+    text = (
         f"robot_info: {tr.robot_info}      # team name or other team identifier\n"
         f"transform_timestamp: {tr.timestamp} # acquisition timestamp\n"
         "marker_to_robot_transform:\n"
@@ -298,6 +365,16 @@ def transform_yaml(tr: MarkerTransform) -> str:
         f"- {_flow(t_inv)}          # translation from robot to markerset\n"
         f"- {_flow(q_inv)} # orientation of markerset wrt robot\n"
     )
+    s = tr.spread
+    if s is not None:
+        text += (
+            f"{SPREAD_KEY}:            # ertools: the averaged marker poses' spread (1 std)\n"
+            f"  position_std: {_flow(s.position_std)}  # m, marker frame x y z\n"
+            f"  rotation_std: {_flow(s.rotation_std)}  # rad, about marker x y z\n"
+            f"  samples: {s.samples}  # poses averaged\n"
+            f"  effective_samples: {s.effective_samples}  # independent poses they are worth\n"
+        )
+    return text
 
 
 # The live FBM2H score records the transform its node used (seed Listing 13: details.marker-robot

@@ -36,7 +36,7 @@ from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks import registry
-from ertools.benchmarks.base import Benchmark, Input
+from ertools.benchmarks.base import Benchmark, Input, rename_former
 from ertools.configs._yaml import MAX_SECONDS, number, parse_yaml, show
 from ertools.errors import BagError, ConfigError
 from ertools.io.formats import detect_format
@@ -244,7 +244,7 @@ class _Checker:
         self, bm: Benchmark[Any, Any, Any, Any], body: Any, where: str, *, team: bool
     ) -> dict[str, Any]:
         """Declared inputs only, each converted to its kind; a team may set per-team ones."""
-        mapping = self.mapping(body, where) or {}
+        mapping = rename_former(bm.inputs, self.mapping(body, where) or {}, where=where)
         declared = {i.name: i for i in bm.inputs}
         allowed = [i.name for i in bm.inputs if i.per_team] if team else list(declared)
         out: dict[str, Any] = {}

@@ -135,7 +135,8 @@ def manifest_terms(text: str, benchmark: str) -> str:
             continue
         for declared in registry.get(name).inputs:
             where = "teams.TEAM" if declared.per_team else "inputs"
-            for flag in (declared.option, *declared.old_flags):
+            formers = [f.option for f in declared.former]
+            for flag in (declared.option, *declared.old_flags, *formers):
                 options[flag] = f"benchmarks.{name}.{where}.{declared.name}"
     return _FLAG.sub(lambda m: options.get(m.group(0), m.group(0)), text)
 

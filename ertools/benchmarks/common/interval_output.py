@@ -1,9 +1,10 @@
 """How a benchmark takes the interval options and prints its intervals (issue 28).
 
 The engine (:mod:`ertools.benchmarks.common.uncertainty`) computes intervals; this module holds
-what the FBM1 and trajectory benchmarks share around it: the three options as one frozen value
-(:class:`IntervalSettings`), the stderr line of a score with its interval, the method and the
-sources' shares (:func:`score_line`), and small helpers for the result's outputs.
+what every benchmark shares around it: the three options as one frozen value
+(:class:`IntervalSettings`), the one stderr line of a score with its interval, the method and
+the sources' shares (:func:`interval_line`, :func:`interval_lines`), and small helpers for the
+result's outputs.
 """
 
 from __future__ import annotations
@@ -80,36 +81,59 @@ def low_high(prefix: str, iv: Interval | None) -> dict[str, float]:
     return {f"{prefix}_low": iv.low, f"{prefix}_high": iv.high}
 
 
-def score_line(
-    key: str,
-    value: float | None,
-    iv: Interval | None,
-    uncertainty: Uncertainty | None,
-    *,
-    scale: float = 1.0,
-    unit: str = "",
-    digits: int = 4,
-    top: int = 2,
-) -> str | None:
-    """One stderr line: ``interval: pose_score 0.9312 [0.9301, 0.9322] (95%, Monte Carlo
-    ..., 400 draws, seed 0; mocap_noise 71%, transform 29%)``; None without an interval."""
-    if value is None or iv is None or uncertainty is None:
-        return None
-    u = f" {unit}" if unit else ""
-    ranked = sorted(iv.shares, key=lambda s: -s[1])[:top]
-    shares = ", ".join(f"{name} {share * 100:.0f}%" for name, share in ranked)
+#: Every interval is drawn by :func:`~ertools.benchmarks.common.uncertainty.monte_carlo`: the
+#: stderr line names the method by this; the ``uncertainty`` block states it in full (the kind
+#: of interval, what is mirrored).
+METHOD_NAME = "Monte Carlo"
+#: The CLI wraps its error lines at 200 characters; an interval line stays within them.
+MAX_LINE = 200
+
+
+@dataclass(frozen=True)
+class ScoreRow:
+    """One score to print with its interval: ``value`` and the interval in SI units, shown
+    times ``scale`` in ``unit`` (``1000.0``, ``mm``)."""
+
+    name: str
+    value: float | None
+    interval: Interval | None
+    scale: float = 1.0
+    unit: str = ""
+
+
+def _num(x: float) -> str:
+    return f"{x:.4g}"
+
+
+def interval_line(row: ScoreRow, uncertainty: Uncertainty, *, top: int = 3) -> str:
+    """The one stderr line of a score with its interval, in every benchmark:
+    ``interval: best_distance_error 0.639 mm [0.41, 0.88] mm at 95% (Monte Carlo, 400 draws,
+    seed 0; mocap_noise 71%, d_min 29%)``: the score, its interval at the level, the method
+    and the ``top`` sources by share (fewer when the line would pass :data:`MAX_LINE`).
+    Without an interval (too few draws scored): ``interval: NAME VALUE: no 95% interval
+    (...)``."""
+    if row.value is None:
+        raise ValueError(f"{row.name}: no score, no interval line")
+    u = f" {row.unit}" if row.unit else ""
+    head = f"interval: {row.name} {_num(row.value * row.scale)}{u}"
     level = f"{uncertainty.confidence * 100:g}%"
-    return (
-        f"interval: {key} {value * scale:.{digits}f}{u} "
-        f"[{iv.low * scale:.{digits}f}, {iv.high * scale:.{digits}f}]{u} ({level}, "
-        f"{uncertainty.method}, {uncertainty.draws} draws, seed {uncertainty.seed}; {shares})"
-    )
+    how = f"{METHOD_NAME}, {uncertainty.draws} draws, seed {uncertainty.seed}"
+    iv = row.interval
+    if iv is None:
+        return f"{head}: no {level} interval ({how}: too few draws scored)"
+    span = f"[{_num(iv.low * row.scale)}, {_num(iv.high * row.scale)}]{u}"
+    ranked = sorted(iv.shares, key=lambda s: -s[1])
+    for n in range(min(top, len(ranked)), 0, -1):
+        shares = ", ".join(f"{name} {share * 100:.0f}%" for name, share in ranked[:n])
+        line = f"{head} {span} at {level} ({how}; {shares})"
+        if len(line) <= MAX_LINE:
+            return line
+    return f"{head} {span} at {level} ({how})"
 
 
-def sources_line(uncertainty: Uncertainty | None) -> str | None:
-    """The sources of the intervals in one stderr line (measured or a stated default)."""
-    if uncertainty is None:
-        return None
+def sources_line(uncertainty: Uncertainty) -> str:
+    """The sources of the intervals in one stderr line: each one's size, measured from the
+    data or a stated default."""
     parts = [
         f"{s.name} {s.value:.3g} {s.unit} ({'measured' if s.measured else 'default'})"
         for s in uncertainty.sources
@@ -117,16 +141,14 @@ def sources_line(uncertainty: Uncertainty | None) -> str | None:
     return "interval sources: " + "; ".join(parts)
 
 
-def lines(
-    rows: Sequence[tuple[str, float | None, Interval | None, float, str, int]],
-    uncertainty: Uncertainty | None,
-) -> list[str]:
-    """The stderr lines of the main scores, then the sources line."""
-    out = [
-        score_line(k, v, iv, uncertainty, scale=s, unit=u, digits=d) for k, v, iv, s, u, d in rows
-    ]
-    out.append(sources_line(uncertainty))
-    return [line for line in out if line]
+def interval_lines(rows: Sequence[ScoreRow], uncertainty: Uncertainty | None) -> list[str]:
+    """The stderr lines of a result's intervals, the same in every benchmark: one
+    :func:`interval_line` per score that has a value, then the :func:`sources_line`; none
+    without intervals (``--draws 0``)."""
+    if uncertainty is None:
+        return []
+    out = [interval_line(r, uncertainty) for r in rows if r.value is not None]
+    return [*out, sources_line(uncertainty)]
 
 
 def interval_tables(

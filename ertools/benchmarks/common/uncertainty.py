@@ -282,30 +282,6 @@ def interval_keys(
     return out
 
 
-def interval_line(
-    name: str,
-    value: float,
-    interval: Interval | None,
-    uncertainty: Uncertainty,
-    *,
-    scale: float = 1.0,
-    unit: str = "",
-) -> str:
-    """One stderr line: the score, its interval and how it was obtained, e.g.
-    ``best_distance_error 0.639 mm, 95% interval [0.41, 0.88] mm (Monte Carlo 400 draws,
-    seed 0; mocap_noise 71%, d_min 29%)``; ``scale`` converts SI values to ``unit``."""
-    u = f" {unit}" if unit else ""
-    how = f"Monte Carlo {uncertainty.draws} draws, seed {uncertainty.seed}"
-    level = f"{uncertainty.confidence * 100:g}%"
-    if interval is None:
-        return f"{name} {value * scale:.4g}{u}, no {level} interval ({how}: too few draws scored)"
-    shares = ", ".join(f"{n} {f:.0%}" for n, f in interval.shares)
-    return (
-        f"{name} {value * scale:.4g}{u}, {level} interval "
-        f"[{interval.low * scale:.4g}, {interval.high * scale:.4g}]{u} ({how}; {shares})"
-    )
-
-
 def split_interval(row: dict[str, Any], key: str) -> None:
     """A table row's ``K_interval: [low, high]`` as ``K_low`` and ``K_high`` columns (CSV),
     in its place."""

@@ -242,7 +242,7 @@ def score_run(
     if problem is not None:
         warnings.append(
             f"{where}: 2015 scored this run from a ground truth that was not measured then "
-            f"(--score-unscoreable); by default it is unscoreable: {problem}"
+            f"(--unscoreable 2015); by default it is unscoreable: {problem}"
         )
     if run.result_ns is not None:
         max_gap = round(options.gt.max_gap_s * NS_PER_S)

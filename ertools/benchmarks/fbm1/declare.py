@@ -15,6 +15,7 @@ from typing import Any
 from ertools.benchmarks.base import (
     Benchmark,
     Explanation,
+    FormerName,
     Input,
     Ranking,
     notice,
@@ -22,9 +23,13 @@ from ertools.benchmarks.base import (
     tf_value,
 )
 from ertools.benchmarks.common.ending import EXACT_HELP
-from ertools.benchmarks.common.interval_output import IntervalSettings
-from ertools.benchmarks.common.interval_output import lines as interval_lines
+from ertools.benchmarks.common.interval_output import (
+    IntervalSettings,
+    ScoreRow,
+    interval_lines,
+)
 from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS
+from ertools.benchmarks.common.validity import SCORE_AS_2015, unscoreable_input
 from ertools.benchmarks.fbm1.benchmark import score_found
 from ertools.benchmarks.fbm1.config import RULE_SETS, BodySources, Fbm1Options
 from ertools.benchmarks.fbm1.gt import GtOptions
@@ -175,13 +180,8 @@ def inputs(name: str) -> tuple[Input, ...]:
             "class and instance accuracies divided by 10 whatever the runs (2016-17 @Home)",
             group=NODES,
         ),
-        Input(
-            "score_unscoreable",
-            "flag",
-            "a run whose ground truth has no valid mocap sample (tracking lost) is scored from "
-            "it (both nodes)",
-            group=NODES,
-        ),
+        # both nodes scored a run whose ground truth had no valid mocap sample (tracking lost)
+        unscoreable_input(NODES, FormerName("score_unscoreable", SCORE_AS_2015)),
         Input(
             "legacy_totals",
             "flag",
@@ -265,7 +265,7 @@ def options_maker(name: str) -> Callable[[Mapping[str, Any]], Fbm1Options]:
             accuracy_over_10=r.accuracy_over_10
             or v["accuracy_over_10"]
             or (old_totals and name == "fbm1h"),
-            score_unscoreable=r.score_unscoreable or v["score_unscoreable"],
+            score_unscoreable=r.score_unscoreable or v["unscoreable"] == SCORE_AS_2015,
         )
         if v["gt"] == "goal":
             notice(
@@ -326,7 +326,7 @@ def notes(result: Fbm1Result) -> list[str]:
         logged = ", ".join(f"{k} {v}" for k, v in result.logged_score.items())
         out.append(f"the 2015 node sent: {logged}")
     out += interval_lines(
-        [("pose_score", t.pose_score, result.intervals.get("pose_score"), 1.0, "", 4)],
+        [ScoreRow("pose_score", t.pose_score, result.intervals.get("pose_score"))],
         result.uncertainty,
     )
     if result.uncertainty is not None:

@@ -51,7 +51,7 @@ class Fbm1RunResult:
         warnings: things to check in this run.
         validity: both bodies' samples in the ground truth's window (None when not measured).
         unscoreable_reason: why the ground truth is no measurement (status ``unscoreable``;
-            scored with ``--score-unscoreable`` / ``--rules 2015``, the reason kept).
+            scored with ``--unscoreable 2015`` / ``--rules 2015``, the reason kept).
     """
 
     index: int

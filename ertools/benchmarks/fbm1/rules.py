@@ -113,5 +113,5 @@ RULE_UNSCOREABLE = Rule(
         "marker set, not NaN) within --max-gap of the ground truth's window is unscoreable: "
         "left out of the totals like a failed run, the reason given (docs/uncertainty.md)"
     ),
-    option="--score-unscoreable",
+    option="--unscoreable 2015",
 )

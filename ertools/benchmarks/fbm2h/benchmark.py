@@ -180,7 +180,7 @@ def compute(
                 continue
             all_warnings.append(
                 f"segment {i}: 2015 scored this segment from a pose that was not measured then "
-                f"(--unscoreable-segments 2015); by default it has no GT: {why}"
+                f"(--unscoreable 2015); by default it has no GT: {why}"
             )
             common["unscoreable_reason"] = why
         if not poses.ok[i]:
@@ -528,7 +528,7 @@ def with_intervals(
         m,
         indices,
         estimates,
-        measure_model(marker),
+        measure_model(marker, transform.spread),
         orientation_2015=result.orientation_2015,
         divide_by=len(result.segments) if result.unscored_2015 else len(ok),
         draws=options.draws,

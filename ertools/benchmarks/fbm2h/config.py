@@ -52,7 +52,7 @@ class Fbm2hOptions:
             ``--segment-clock bmbox``); see :func:`ertools.benchmarks.fbm2h.segments.from_states`.
         unscoreable_2015: a reached moment whose only ground truth within ``max_gap_s`` is
             invalid (repeated poses of a lost marker set) is scored from it as 2015 did, with a
-            warning (``--unscoreable-segments 2015``); by default the segment has no GT.
+            warning (``--unscoreable 2015``); by default the segment has no GT.
         pose_2015: with no ``topic``/``tf_frame``, read the marker set from /tf
             ``world -> robot_at_home`` first, the 2015 node's source (``--2015``).
         exact_end_payloads: RefBox END payloads read as the 2015 BmBox did (only

@@ -14,6 +14,7 @@ from typing import Any
 from ertools.benchmarks.base import (
     Benchmark,
     Explanation,
+    FormerName,
     Input,
     Ranking,
     resolve_values,
@@ -21,6 +22,7 @@ from ertools.benchmarks.base import (
 )
 from ertools.benchmarks.common.ending import EXACT_HELP
 from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS, check_confidence
+from ertools.benchmarks.common.validity import SCORE_AS_2015, unscoreable_input
 from ertools.benchmarks.fbm2h.benchmark import score_found
 from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, Fbm2hOptions
 from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, load, locate_runs
@@ -120,21 +122,14 @@ INPUTS = (
         group=LEGACY,
     ),
     Input("exact_end_payloads", "flag", EXACT_HELP, group=LEGACY),
-    Input(
-        "unscoreable_segments",
-        "choice",
-        "a reached moment whose only ground truth within --gt-tolerance is invalid (repeated "
-        "poses of a lost marker set): no GT, null accuracies (default), or 2015: scored from it, "
-        "with a warning",
-        default="null",
-        choices=("null", "2015"),
-        group=LEGACY,
-    ),
+    # a segment is unscoreable when the only ground truth within --gt-tolerance of its
+    # reached moment is invalid (repeated poses of a lost marker set)
+    unscoreable_input(LEGACY, FormerName("unscoreable_segments")),
     Input(
         "all_2015",
         "flag",
         "every 2015 behaviour above (--orientation-2015 --unscored-segments 2015 "
-        "--unscoreable-segments 2015 --segment-clock bmbox --exact-end-payloads) and the "
+        "--unscoreable 2015 --segment-clock bmbox --exact-end-payloads) and the "
         "node's pose source, /tf world -> robot_at_home, unless --topic or --tf is given",
         flag="--2015",
         group=LEGACY,
@@ -217,7 +212,7 @@ def make_options(given: Mapping[str, Any]) -> Fbm2hOptions:
         pose_2015=bool(v["all_2015"]),
         exact_end_payloads=bool(v["exact_end_payloads"] or v["all_2015"]),
         namespace=v["namespace"],
-        unscoreable_2015=v["unscoreable_segments"] == "2015" or v["all_2015"],
+        unscoreable_2015=v["unscoreable"] == SCORE_AS_2015 or v["all_2015"],
         stops=StopParams(
             speed=v["stop_speed"],
             yaw_rate=v["stop_yaw_rate"],

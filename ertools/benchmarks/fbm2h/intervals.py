@@ -22,9 +22,13 @@ GT samples around it) composed with the marker-to-robot transform. Sources
   a period (uniform, the median frame period measured from the GT); the robot's velocity there
   (from the GT around the moment) turns that into a pose error. No clock audit exists between
   the state messages and the GT (both are stamped by the logging machine): no further offset.
-- ``transform``: the marker-to-robot transform's error, common to every segment. A transform
-  file does not carry how it was acquired: the 2015 node read a single tf sample with the
-  robot on the origin, so its error is one mocap measurement's (sigma per axis, the rotation
+- ``transform``: the marker-to-robot transform's error, common to every segment. A file
+  written by ``ertools acquire transform`` carries the spread of the poses it averaged
+  (``acquisition_spread``: per axis of the marker frame, and the number of independent poses
+  they are worth): the error is that spread over the square root of the count, per axis
+  (offset x, y; tilt x, y; yaw), measured. A file without it (older acquisitions,
+  hand-written, the 2015 files) is taken as the 2015 node acquired it, a single tf sample with
+  the robot on the origin: one mocap measurement's error (sigma per axis, the rotation
   sigmas, turning the lever arm as above), stated as a default.
 
 Scores near zero are biased by noise (a distance cannot be negative); the basic interval
@@ -52,6 +56,7 @@ from ertools.benchmarks.common.uncertainty import (
     sigma_from_epsilon,
 )
 from ertools.benchmarks.noise.benchmark import noise_from_stream
+from ertools.configs.transform import TransformSpread
 from ertools.errors import ScoringError
 from ertools.geometry import quat_conjugate, quat_multiply, wrap_angle
 from ertools.streams import PoseStream
@@ -88,17 +93,29 @@ class Moments:
 
 @dataclass(frozen=True)
 class Model:
-    """The sources' sizes."""
+    """The sources' sizes. ``transform_sd``: the transform's standard errors (offset x, y;
+    tilt x, y; yaw) in the marker frame; None: one mocap measurement's (``sigma``,
+    ``sigma_tilt``, ``sigma_yaw``)."""
 
     sigma: float
     sigma_tilt: float
     sigma_yaw: float
     half_period_s: float
     sources: tuple[Source, ...]
+    transform_sd: tuple[float, float, float, float, float] | None = None
+
+    def transform_errors(self) -> tuple[F64, F64, float]:
+        """(offset (2,), tilt (2,), yaw) standard deviations of the transform's error."""
+        if self.transform_sd is None:
+            pair = np.array([self.sigma, self.sigma])
+            return pair, np.array([self.sigma_tilt, self.sigma_tilt]), self.sigma_yaw
+        x, y, tx, ty, yaw = self.transform_sd
+        return np.array([x, y]), np.array([tx, ty]), yaw
 
 
-def measure_model(marker: PoseStream) -> Model:
-    """The sources' sizes from the marker stream (still phases, frame period)."""
+def measure_model(marker: PoseStream, spread: TransformSpread | None = None) -> Model:
+    """The sources' sizes from the marker stream (still phases, frame period) and the
+    transform file's acquisition ``spread`` (None: the stated default)."""
     sigma = DEFAULT_EPSILON_M / math.sqrt(math.pi)
     sigma_tilt = sigma_yaw = DEFAULT_SIGMA_YAW
     measured = False
@@ -142,16 +159,33 @@ def measure_model(marker: PoseStream) -> Model:
         f"uniform within half the median GT frame period ({half * 2e3:.3g} ms), times the "
         "robot's velocity at the moment; no clock offset between states and GT (same machine)",
     )
+    if spread is None:
+        transform = Source(
+            TRANSFORM,
+            sigma,
+            "m",
+            False,
+            f"default: the transform file carries no acquisition spread; as the 2015 node read "
+            f"a single tf sample, one mocap measurement's error (sigma per axis, rotation "
+            f"{sigma_tilt * 1000:.3g}/{sigma_yaw * 1000:.3g} mrad tilt/yaw), common to every "
+            "segment",
+        )
+        return Model(sigma, sigma_tilt, sigma_yaw, half, (mocap, timing, transform))
+    (px, py, _), (rx, ry, rz) = spread.standard_errors()
+    mm = ", ".join(f"{v * 1000:.3g}" for v in spread.position_std)
+    mrad = ", ".join(f"{v * 1000:.3g}" for v in spread.rotation_std)
     transform = Source(
         TRANSFORM,
-        sigma,
+        math.hypot(px, py) / math.sqrt(2.0),
         "m",
-        False,
-        f"default: the transform file carries no acquisition spread; as the 2015 node read a "
-        f"single tf sample, one mocap measurement's error (sigma per axis, rotation "
-        f"{sigma_tilt * 1000:.3g}/{sigma_yaw * 1000:.3g} mrad tilt/yaw), common to every segment",
+        True,
+        f"the acquisition's spread: position {mm} mm, rotation {mrad} mrad (marker x, y, z) over "
+        f"{spread.samples} poses worth {spread.effective_samples} independent ones; the "
+        "error is spread / sqrt(that), per axis, common to every segment",
     )
-    return Model(sigma, sigma_tilt, sigma_yaw, half, (mocap, timing, transform))
+    return Model(
+        sigma, sigma_tilt, sigma_yaw, half, (mocap, timing, transform), (px, py, rx, ry, rz)
+    )
 
 
 def _rotation_sigmas(marker: PoseStream) -> tuple[float, float] | None:
@@ -213,9 +247,10 @@ def perturbed_scores(
     if TRANSFORM in sources:
         # one transform error for every segment of a draw, in the marker frame (turned into
         # the world with each segment's heading): an offset and a small rotation of the lever
-        e = rng.standard_normal((n, 2)) * model.sigma
-        tilt = rng.standard_normal((n, 2)) * model.sigma_tilt
-        t_yaw = rng.standard_normal((n, 1)) * model.sigma_yaw
+        sd_offset, sd_tilt, sd_yaw = model.transform_errors()
+        e = rng.standard_normal((n, 2)) * sd_offset
+        tilt = rng.standard_normal((n, 2)) * sd_tilt
+        t_yaw = rng.standard_normal((n, 1)) * sd_yaw
         c, s = np.cos(m.heading)[None, :], np.sin(m.heading)[None, :]
         x += c * e[:, :1] - s * e[:, 1:]
         y += s * e[:, :1] + c * e[:, 1:]

@@ -11,7 +11,8 @@ import numpy.typing as npt
 import yaml
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
-from ertools.benchmarks.common.uncertainty import Interval, interval_line, uncertainty_rows
+from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
+from ertools.benchmarks.common.uncertainty import Interval, uncertainty_rows
 from ertools.benchmarks.common.validity import GapOnPath, Validity, cell
 from ertools.benchmarks.fbm2h.intervals import Fbm2hIntervals
 from ertools.configs.goal import GoalList
@@ -46,7 +47,7 @@ class SegmentResult:
         validity: the validity of the GT samples from the segment's start to its reached
             moment (None when not driven).
         unscoreable_reason: why the reached moment has no valid GT (status ``no_gt``; with
-            ``--unscoreable-segments 2015`` the segment is scored and this is kept).
+            ``--unscoreable 2015`` the segment is scored and this is kept).
         gaps: the segment's invalid stretches where the path plot draws them: their times
             (seconds from the log's first message) and the robot's world (x, y) at their ends,
             the frame of ``Fbm2hResult.path_xyyaw``.
@@ -252,59 +253,31 @@ class Fbm2hResult:
         return out
 
     def interval_lines(self) -> list[str]:
-        """One line per score with its interval and the method (for stderr)."""
+        """The stderr lines of the intervals (:func:`interval_lines`): the accuracies, then
+        each segment's errors, then the sources."""
         iv = self.intervals
         if iv is None:
             return []
-        u = iv.uncertainty
-        lines = []
-        if self.position_accuracy is not None:
-            lines.append(
-                interval_line(
-                    "position_accuracy",
-                    self.position_accuracy,
-                    iv.position,
-                    u,
-                    scale=1000.0,
-                    unit="mm",
-                )
-            )
-        if self.orientation_accuracy is not None:
-            lines.append(
-                interval_line(
-                    "orientation_accuracy",
-                    self.orientation_accuracy,
-                    iv.orientation,
-                    u,
-                    scale=1000.0,
-                    unit="mrad",
-                )
-            )
+        rows = [
+            ScoreRow("position_accuracy", self.position_accuracy, iv.position, 1000.0, "mm"),
+            ScoreRow(
+                "orientation_accuracy", self.orientation_accuracy, iv.orientation, 1000.0, "mrad"
+            ),
+        ]
         for s in self.segments:
             if s.distance_error is None or s.index not in iv.distance:
                 continue
-            lines.append(
-                interval_line(
-                    f"segment {s.index} distance_error",
-                    s.distance_error,
-                    iv.distance[s.index],
-                    u,
-                    scale=1000.0,
-                    unit="mm",
+            name = f"segment {s.index}"
+            rows.append(
+                ScoreRow(
+                    f"{name} distance_error", s.distance_error, iv.distance[s.index], 1000.0, "mm"
                 )
             )
-            if s.orientation_error is not None:
-                lines.append(
-                    interval_line(
-                        f"segment {s.index} orientation_error",
-                        s.orientation_error,
-                        iv.angle.get(s.index),
-                        u,
-                        scale=1000.0,
-                        unit="mrad",
-                    )
-                )
-        return lines
+            angle = iv.angle.get(s.index)
+            rows.append(
+                ScoreRow(f"{name} orientation_error", s.orientation_error, angle, 1000.0, "mrad")
+            )
+        return interval_lines(rows, iv.uncertainty)
 
     def to_yaml(self) -> str:
         """The Listing 13 score."""

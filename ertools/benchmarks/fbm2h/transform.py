@@ -6,22 +6,33 @@ it as ``marker_to_robot_transform`` (and ``/world -> /robot_markerset`` as
 ``robot_to_marker_transform``). With the robot frame equal to the world frame, T_marker_world
 is T_marker_robot. ertools does the same from a log, but averages the marker pose over a
 stationary window instead of taking one sample, and reports the spread so a referee sees
-whether the robot stood still.
+whether the robot stood still; the file carries it (``acquisition_spread``, after the listing's
+keys), and FBM2H's intervals take the transform's error from it.
 """
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 from datetime import UTC, datetime
 
 import numpy as np
 
+from ertools.arrays import F64
 from ertools.benchmarks.common.hygiene import drop_invalid
 from ertools.benchmarks.fbm2h.segments import StopParams, detect_stops
-from ertools.configs.transform import MarkerTransform
+from ertools.configs.transform import MarkerTransform, TransformSpread
 from ertools.errors import ConfigError, SegmentationError
-from ertools.geometry import MeanPose, invert, mean_pose, yaw_from_quat
+from ertools.geometry import (
+    MeanPose,
+    invert,
+    mean_pose,
+    quat_conjugate,
+    quat_multiply,
+    rotate,
+    yaw_from_quat,
+)
 from ertools.streams import Interval, PoseStream
 from ertools.timeutil import ns_to_s
 
@@ -78,6 +89,44 @@ def _longest_stop(marker: PoseStream, params: StopParams, max_gap_ns: int) -> In
     return Interval(int(marker.t_ns[s]), int(marker.t_ns[e]))
 
 
+def pose_spread(xyz: F64, quat_xyzw: F64, mean: MeanPose) -> TransformSpread:
+    """How much the averaged marker poses spread around their ``mean``, per axis of the mean
+    marker frame (the frame of the transform's translation): position and rotation-vector
+    standard deviations (ddof 1), and the effective number of independent poses.
+
+    The effective count is the AR(1) one, ``n (1 - rho) / (1 + rho)``: rho is the lag-1
+    autocorrelation of the six deviation series pooled (their mean), clipped at 0 (white noise
+    keeps all n). A marker set swaying slowly on a standing robot makes consecutive poses
+    alike, and the mean of n of them is then worth fewer than n.
+    """
+    n = len(xyz)
+    q_inv = np.broadcast_to(quat_conjugate(mean.quat_xyzw[None, :]), (n, 4))
+    dp = rotate(q_inv, xyz - mean.xyz)
+    rel = quat_multiply(q_inv, quat_xyzw)
+    rel = rel * np.where(rel[:, 3:] < 0, -1.0, 1.0)  # the short way round
+    vec = np.linalg.norm(rel[:, :3], axis=1)
+    angle = 2.0 * np.arctan2(vec, rel[:, 3])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        scale = np.where(vec > 0, angle / vec, 2.0)
+    dr = rel[:, :3] * scale[:, None]
+    dev = np.concatenate([dp, dr], axis=1)
+    ddof = 1 if n > 1 else 0
+    std = dev.std(axis=0, ddof=ddof)
+    centred = dev - dev.mean(axis=0)
+    power = np.sum(centred**2, axis=0)
+    lagged = np.sum(centred[1:] * centred[:-1], axis=0)
+    live = power > 0
+    rho = float(np.mean(lagged[live] / power[live])) if live.any() and n > 2 else 0.0
+    rho = min(max(rho, 0.0), 1.0)
+    effective = int(max(1, min(n, math.floor(n * (1.0 - rho) / (1.0 + rho)))))
+    return TransformSpread(
+        (float(std[0]), float(std[1]), float(std[2])),
+        (float(std[3]), float(std[4]), float(std[5])),
+        n,
+        effective,
+    )
+
+
 def acquire_transform(
     marker: PoseStream,
     team: str,
@@ -131,6 +180,7 @@ def acquire_transform(
         translation=(float(t_mr[0]), float(t_mr[1]), float(t_mr[2])),
         quat_xyzw=(float(q_mr[0]), float(q_mr[1]), float(q_mr[2]), float(q_mr[3])),
         source=marker.source,
+        spread=pose_spread(part.xyz, part.quat_xyzw, mean),
     )
     warnings = []
     if invalid:

@@ -452,7 +452,7 @@ def _score_one(
     if problem is not None:
         warnings.append(
             f"run {window.index}: 2015 scored this run from {common['path_coverage']:.1%} of "
-            f"its path (--unscoreable-runs 2015); by default it is unscoreable: {problem}"
+            f"its path (--unscoreable 2015); by default it is unscoreable: {problem}"
         )
     baseline = float(np.hypot(*(xy[0] - ref_xy)))
     if baseline < SHORT_BASELINE_M:

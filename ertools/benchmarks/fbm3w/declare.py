@@ -15,6 +15,7 @@ from typing import Any
 from ertools.benchmarks.base import (
     Benchmark,
     Explanation,
+    FormerName,
     Input,
     Ranking,
     resolve_values,
@@ -22,6 +23,7 @@ from ertools.benchmarks.base import (
 )
 from ertools.benchmarks.common.ending import EXACT_HELP
 from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS, check_confidence
+from ertools.benchmarks.common.validity import UNSCOREABLE_CHOICES, unscoreable_input
 from ertools.benchmarks.fbm3w.benchmark import Fbm3wLogs, load, locate_runs, score_found
 from ertools.benchmarks.fbm3w.config import RUN_MODES, Fbm3wOptions, options_2015
 from ertools.benchmarks.fbm3w.result import Fbm3wResult
@@ -101,20 +103,12 @@ INPUTS = (
         group=LEGACY,
     ),
     Input("exact_end_payloads", "flag", EXACT_HELP, group=LEGACY),
-    Input(
-        "unscoreable_runs",
-        "choice",
-        "a run whose valid ground truth cannot support a score: unscoreable, no "
-        "distance_error (default), or 2015: scored from what it has, with a deviation",
-        default="null",
-        choices=("null", "2015"),
-        group=LEGACY,
-    ),
+    unscoreable_input(LEGACY, FormerName("unscoreable_runs")),
     Input(
         "all_2015",
         "flag",
         "every 2015 behaviour: --timeout-runs 2015 --stopped-runs 2015 "
-        "--exact-end-payloads --unscoreable-runs 2015, d_min 0.00033 "
+        "--exact-end-payloads --unscoreable 2015, d_min 0.00033 "
         "unless --d-min is given, no --arc-length",
         flag="--2015",
         group=LEGACY,
@@ -212,7 +206,7 @@ def make_options(given: Mapping[str, Any]) -> Fbm3wOptions:
         timeout_runs=v["timeout_runs"],
         stopped_runs=v["stopped_runs"],
         exact_end_payloads=v["exact_end_payloads"],
-        unscoreable_runs=v["unscoreable_runs"],
+        unscoreable_runs=v["unscoreable"] or UNSCOREABLE_CHOICES[0],
         config=load_fbm3w_config(v["config"]),
         confidence=check_confidence(v["confidence"]),
         draws=v["draws"],

@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
 from ertools.benchmarks.common.uncertainty import (
     Interval,
     Uncertainty,
-    interval_line,
     split_interval,
     uncertainty_rows,
 )
@@ -52,7 +52,7 @@ class RunResult:
         sample_t_ns: (N,) times of the samples of ``frame_xy`` (the Foxglove export).
         validity: the path window's validity mask summary (None when not computed).
         unscoreable_reason: why the valid data cannot support a score (then ``score`` is None
-            and the status ``unscoreable``; under ``--unscoreable-runs 2015`` the run is scored
+            and the status ``unscoreable``; under ``--unscoreable 2015`` the run is scored
             and this is kept for the warning), None otherwise.
         path_coverage: the fraction of the path window covered by valid data (a tracking loss
             that hid no motion counted as covered), None when not computed.
@@ -252,21 +252,14 @@ class Fbm3wResult:
         return out
 
     def interval_lines(self) -> list[str]:
-        """One line per score with its interval and the method (for stderr)."""
-        u = self.uncertainty
-        if u is None:
-            return []
-        scores: list[tuple[str, float | None, Interval | None]] = [
-            ("best_distance_error", self.best_distance_error, self.best_interval)
+        """The stderr lines of the intervals (:func:`interval_lines`): the best run's, each
+        run's, then the sources."""
+        rows = [ScoreRow("best_distance_error", self.best_distance_error, self.best_interval)]
+        rows += [
+            ScoreRow(f"run {r.index} distance_error", r.distance_error, r.interval)
+            for r in self.runs
         ]
-        scores += [
-            (f"run {r.index} distance_error", r.distance_error, r.interval) for r in self.runs
-        ]
-        return [
-            interval_line(name, value, iv, u, scale=1000.0, unit="mm")
-            for name, value, iv in scores
-            if value is not None
-        ]
+        return interval_lines([replace(r, scale=1000.0, unit="mm") for r in rows], self.uncertainty)
 
     def to_dict(self) -> dict[str, Any]:
         """Listing 16 nesting with string run keys (JSON)."""

@@ -130,5 +130,5 @@ RULE_UNSCOREABLE_RUNS = Rule(
         "without it between two valid samples, is unscoreable: no distance_error, the reason "
         "given (docs/uncertainty.md)"
     ),
-    option="--unscoreable-runs 2015",
+    option="--unscoreable 2015",
 )

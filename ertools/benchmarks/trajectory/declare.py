@@ -11,9 +11,13 @@ from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks.base import Benchmark, Input, Ranking, resolve_values
-from ertools.benchmarks.common.interval_output import IntervalSettings
-from ertools.benchmarks.common.interval_output import lines as interval_lines
+from ertools.benchmarks.common.interval_output import (
+    IntervalSettings,
+    ScoreRow,
+    interval_lines,
+)
 from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS
+from ertools.benchmarks.common.validity import unscoreable_input
 from ertools.benchmarks.trajectory.benchmark import (
     TrajectoryLogs,
     TrajectoryOptions,
@@ -28,7 +32,6 @@ from ertools.benchmarks.trajectory.config import (
     GT_ORDERS,
     SETTINGS_2015,
     TIES,
-    UNSCOREABLE,
     TrajectoryConfig,
 )
 from ertools.benchmarks.trajectory.result import TrajectoryResult
@@ -94,14 +97,8 @@ INPUTS = (
         choices=GT_ORDERS,
         group=LEGACY,
     ),
-    Input(
-        "unscoreable",
-        "choice",
-        "a comparison with too few valid pairs (docs/uncertainty.md): unscoreable, null "
-        "statistics (null, default) or scored from them with a warning (2015)",
-        choices=UNSCOREABLE,
-        group=LEGACY,
-    ),
+    # too few valid pairs make the comparison unscoreable (docs/uncertainty.md)
+    unscoreable_input(LEGACY),
     Input(
         "as_2015",
         "flag",
@@ -284,10 +281,10 @@ def notes(result: TrajectoryResult) -> list[str]:
         return []
     iv = result.intervals
     rows = [
-        ("position_error", m.position_error, iv.get("position_error"), 1000.0, "mm", 2),
-        ("rmse", m.rmse, iv.get("rmse"), 1000.0, "mm", 2),
-        ("max", m.max, iv.get("max"), 1000.0, "mm", 2),
-        ("orientation_error", m.orientation_error, iv.get("orientation_error"), 1.0, "rad", 4),
+        ScoreRow("position_error", m.position_error, iv.get("position_error"), 1000.0, "mm"),
+        ScoreRow("rmse", m.rmse, iv.get("rmse"), 1000.0, "mm"),
+        ScoreRow("max", m.max, iv.get("max"), 1000.0, "mm"),
+        ScoreRow("orientation_error", m.orientation_error, iv.get("orientation_error"), 1.0, "rad"),
     ]
     return interval_lines(rows, result.uncertainty)
 

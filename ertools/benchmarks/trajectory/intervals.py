@@ -11,16 +11,21 @@ side of each compared pair perturbed by two sources, vectorised over (draws, pos
   the noise's is sqrt(6) sigma: a robust MAD of them gives sigma), else a stated default. The
   yaw's sigma likewise from the yaw's second differences. An interpolated GT pose mixes two
   samples: its noise is sigma sqrt((1-a)^2 + a^2).
-- ``time_association``: the robot-to-GT clock offset is known to the clock audit's standard
-  deviation (its block bootstrap): one offset error per draw, common to every pose, moves
+- ``time_association``: the robot-to-GT clock offset is known to the standard error of the
+  least-squares offset, the robot's correlated error slid along the path by every lag
+  (:func:`offset_spread`): one offset error per draw, common to every pose, moves
   each GT pose by the GT velocity times it. The offset is not a measurement of the truth
   plus an error that a draw adds a second time: the true offset lies around the applied one
   as the draws do, so the score at a drawn offset is itself a draw of the true score (with
   ``--offset auto`` the applied offset minimises the error: every other offset, the true one
   included, scores higher). Its draws are mirrored about the score before the engine's
-  reflection, and added to the measurement-like draws (their interaction neglected). The GT
-  is interpolated anew at the shifted times (a shift that moves a pose next to a tracking
-  loss changes the score as the score's own association would). With ``hold`` (2015) the
+  reflection, and added to the measurement-like draws (their interaction neglected). At
+  each shift the comparison is re-scored by the score's own association and metrics
+  (:class:`Rescoring`, :func:`offset_effects`): a pose the shift moves into a tracking loss
+  or a GT gap leaves the comparison, one it moves out of them enters it, and one moved next
+  to a loss's stale sample is compared with it, all as the score at that offset would (no
+  linearisation: a GT velocity measured across a loss's repeated samples is not the
+  body's). With ``hold`` (2015) the
   GT pose compared was measured up to one GT frame period before the robot's moment, with
   ``nearest`` up to half a period either side: an extra lag drawn uniformly over the pose's
   own frame period (the basic interval then removes the lag's bias). ``linear``
@@ -33,14 +38,14 @@ show. The draws work in float32 and in chunks of draws. A comparison of more tha
 over it: the offset's effect is the same on them as on all, the per-pose noise's spread in
 the mean-like statistics (mean, RMSE, orientation errors) is scaled by sqrt(thinned / all)
 (it averages over all the poses), and in the median, percentiles and max it is left as the
-thinned poses give it (wider: a conservative interval). An hour's log costs a fraction of a
-second.
+thinned poses give it (wider: a conservative interval); the offset's grid re-scores at most
+as many robot poses, evenly spread. An hour's log costs a fraction of a second.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -66,7 +71,7 @@ from ertools.benchmarks.common.uncertainty import (
 )
 from ertools.benchmarks.noise.benchmark import noise_from_stream
 from ertools.benchmarks.trajectory.association import COMPARED, Matched
-from ertools.benchmarks.trajectory.metrics import PERCENTILES
+from ertools.benchmarks.trajectory.metrics import PERCENTILES, Metrics, metrics
 from ertools.errors import ErtoolsError
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
@@ -83,7 +88,8 @@ CHUNK_ELEMENTS = 4_000_000  # draws x poses per chunk (float32: ~50 MB of positi
 # Longer comparisons draw on this many evenly spread poses (module doc): an hour at 10 Hz
 # stays well under a second.
 MAX_POSES = 1500
-OFFSET_GRID = 81  # shifts the statistics are computed at, between the extreme draws
+OFFSET_GRID = 81  # shifts the statistics are re-scored at, over OFFSET_SPAN sd either side
+OFFSET_SPAN = 4.0  # a draw beyond (1 in 16,000) takes the grid's end value
 SIGMA_BLOCKS, SIGMA_BLOCK = 20, 2000  # GT samples the noise is measured on, at most
 
 #: The scores with an interval, in the order of the result's keys (``percentiles.pNN`` nested).
@@ -98,6 +104,38 @@ KEYS = (
 )
 # Statistics that average over the poses (their noise part shrinks as 1 / sqrt(poses)).
 MEAN_LIKE = [0, 1, 2, len(KEYS) - 1]
+
+
+@dataclass(frozen=True)
+class Rescoring:
+    """How the score associated the robot poses, for the offset's draws to re-score with.
+
+    Attributes:
+        t_ns: the robot poses as logged, stamped on the GT clock at the applied offset.
+        associate: (rows of those poses, extra shift in ns) -> the score's own association
+            of those poses at the applied offset plus the shift.
+    """
+
+    t_ns: IntArr
+    associate: Callable[[npt.NDArray[np.intp], int], Matched]
+
+
+def _statistics(m: Metrics | None) -> F64 | None:
+    """The statistics of :data:`KEYS` in order (None: no pose compared)."""
+    if m is None:
+        return None
+    pct = [v for _, v in m.percentiles]
+    return np.array(
+        [
+            m.position_error,
+            m.orientation_error,
+            m.rmse,
+            m.median,
+            m.max,
+            *pct,
+            m.orientation_error_2015,
+        ]
+    )
 
 
 @dataclass(frozen=True)
@@ -187,23 +225,40 @@ def offset_spread(
 ) -> tuple[float, float]:
     """(sd, centre) in seconds of the true clock offset around the one applied.
 
-    The sd is the sandwich standard error of the least-squares offset, the poses taken as
-    independent: sqrt(sum psi_i^2) / sum |v_i|^2 with psi_i = v_i . (robot_i - gt_i). On the
-    simulator (``bench/calibration/trajectory.py``, the robot's error a bias, a 13 s drift
-    and white noise, drawn anew per trial) the offset's actual error is 1.14 of it, while the
-    clock audit's block bootstrap (reported in ``clock_audit``) is 4.5 times the actual
-    error: resampling blocks of a smooth error breaks the cancellation of its projection on
-    a turning path's velocity, which makes it a safe warning threshold but no interval. The
-    centre is the audit's estimate minus the offset applied (0 with ``--offset auto
-    --apply-offset``): a given offset the data disagrees with moves the interval, not the
-    score.
+    The least-squares offset is off by ``sum_i v_i . e_i / sum_i |v_i|^2`` (v the GT
+    velocity at robot pose i, e the robot's error there). The poses' errors are not
+    independent (a robot's estimate drifts over seconds), and how much a drift moves that sum
+    depends on how it lines up with the path's velocity, which turns over a lap. The sd takes
+    that from the log itself: the error series slid along the path by every lag h is as
+    likely an alignment as the one logged (a stationary error, independent of where the path
+    turns), so the variance of the sum is that of the cross-correlation over the lags,
+    ``sum_h c(h)^2 / n`` with ``c(h) = sum_i v_i . e_(i+h)`` (e centred; all lags, no
+    window: a window keeps the lags over which a lap's drift projection adds up and drops
+    those over which it cancels, which is why a Newey-West sum overshoots 1.25 to 4 times).
+    For independent errors it is the sandwich standard error. On the simulator
+    (``bench/calibration/trajectory.py``: a bias, a 13 s drift and white noise, drawn anew per
+    trial) the offset's actual error is 1.11 times it, as it is of the variance the
+    simulator's own error model gives (the rest: the GT's stamping delay); the independent
+    poses' sandwich error was 1.57 times too small. The clock audit's block bootstrap
+    (``clock_audit``) stays the audit's warning threshold. The centre is the audit's estimate
+    minus the offset applied (0 with ``--offset auto --apply-offset``): a given offset the
+    data disagrees with moves the interval, not the score.
     """
     sv = float(np.sum(np.square(vel, dtype=np.float64)))
-    if len(vel) < 3 or sv <= 0.0 or audit.offset_ns is None:
+    n = len(vel)
+    if n < 3 or sv <= 0.0 or audit.offset_ns is None:
         return 0.0, 0.0
-    psi = np.sum((r_xyz - g_xyz).astype(np.float64) * vel, axis=1)
-    psi -= psi.mean()
-    return math.sqrt(float(np.dot(psi, psi))) / sv, (audit.offset_ns - offset_ns) / NS_PER_S
+    e = (r_xyz - g_xyz).astype(np.float64)
+    e -= e.mean(axis=0)
+    v = vel.astype(np.float64)
+    # c(h) for every lag at once: zero-padded to a length >= 2n - 1, so the FFT's circular
+    # correlation is the linear one; sum_h c(h)^2 = sum_f |C(f)|^2 / m (Parseval)
+    m = 1 << (2 * n - 1).bit_length()
+    cross = np.sum(np.conj(np.fft.rfft(v, m, axis=0)) * np.fft.rfft(e, m, axis=0), axis=1)
+    power = np.abs(cross) ** 2
+    # rfft keeps f = 0..m/2: every other frequency stands for its conjugate twin too
+    total = float(power[0] + power[-1] + 2.0 * np.sum(power[1:-1])) / m
+    return math.sqrt(total / n) / sv, (audit.offset_ns - offset_ns) / NS_PER_S
 
 
 def _bracket(t: IntArr, q: IntArr) -> tuple[IntArr, IntArr]:
@@ -211,6 +266,34 @@ def _bracket(t: IntArr, q: IntArr) -> tuple[IntArr, IntArr]:
     n = len(t)
     k = np.clip(np.searchsorted(t, q, side="right") - 1, 0, max(n - 2, 0))
     return k, np.minimum(k + 1, n - 1)
+
+
+def _rescored_rows(t_robot: IntArr, t_gt: IntArr, reach_s: float) -> npt.NDArray[np.intp]:
+    """The robot poses the offset's grid re-scores: those the GT covers at some shift of the
+    grid, at most :data:`MAX_POSES` of them evenly spread (an hour's log: module doc)."""
+    reach = round(reach_s * NS_PER_S) + 1
+    rows = np.flatnonzero((t_robot >= t_gt[0] - reach) & (t_robot <= t_gt[-1] + reach))
+    if len(rows) > MAX_POSES:
+        rows = rows[np.unique(np.linspace(0, len(rows) - 1, MAX_POSES).round().astype(np.intp))]
+    return rows
+
+
+def offset_effects(rescoring: Rescoring, t_gt: IntArr, shifts_s: F64) -> F64:
+    """(shifts, KEYS) change of each statistic when the offset applied moves by each shift
+    (seconds), the comparison re-scored by the score's own association and metrics: a pose
+    a shift moves into a tracking loss or a GT gap leaves the comparison, one it moves out
+    of them enters it, next to a stale sample as the score at that offset would compare it
+    (0 where no pose would be compared: no score there)."""
+    poses = _rescored_rows(rescoring.t_ns, t_gt, float(np.max(np.abs(shifts_s))))
+    ref = _statistics(metrics(rescoring.associate(poses, 0)))
+    out = np.zeros((len(shifts_s), len(KEYS)))
+    if ref is None:
+        return out
+    for i, shift in enumerate(shifts_s):
+        got = _statistics(metrics(rescoring.associate(poses, round(float(shift) * NS_PER_S))))
+        if got is not None:
+            out[i] = got - ref
+    return out
 
 
 def trajectory_intervals(
@@ -222,13 +305,14 @@ def trajectory_intervals(
     *,
     association: str,
     offset_ns: int,
-    max_gap_ns: int,
     settings: IntervalSettings,
+    rescoring: Rescoring,
 ) -> ResultIntervals:
     """The intervals of the statistics ``estimates`` (by :data:`KEYS`) of a comparison.
 
     ``robot``: the robot stream whose row i is matched row i; ``gt``: the GT in time order;
-    ``offset_ns``: the offset the score applied; ``max_gap_ns``: the GT gap the score skips.
+    ``offset_ns``: the offset the score applied; ``rescoring``: the score's association, which
+    the offset's draws re-score with.
     """
     ok = matched.status == COMPARED
     if not settings.enabled or not ok.any() or len(gt) < 2:
@@ -278,38 +362,8 @@ def trajectory_intervals(
         )
     else:
         keep = np.arange(n_all)
-    q_used = q[keep]
     n = len(r_yaw)
     thin = math.sqrt(n / n_all)
-    gt_yaw_all = np.unwrap(gt.yaw)
-    repeated = np.zeros(len(t), dtype=bool)  # the pair (k-1, k) has one position: lost
-    repeated[1:] = np.all(gt.xyz[1:] == gt.xyz[:-1], axis=1)
-
-    def gt_at(times: IntArr) -> tuple[F64, F64]:
-        """The GT pose at shifted robot times, as the association takes it (interpolated
-        anew: a shift that moves a pose next to a tracking loss or across a sample is
-        the score's own, not a linearisation's)."""
-        lo_i, hi_i = _bracket(t, times)
-        span_ns = np.maximum(t[hi_i] - t[lo_i], 1)
-        w = np.clip((times - t[lo_i]) / span_ns, 0.0, 1.0)
-        if association == "hold":
-            w = np.zeros_like(w)
-        elif association != "linear":
-            w = np.round(w)
-        wp = w[..., None]
-        xyz = (1.0 - wp) * gt.xyz[lo_i] + wp * gt.xyz[hi_i]
-        yaw = (1.0 - w) * gt_yaw_all[lo_i] + w * gt_yaw_all[hi_i]
-        # shifted into a GT gap, or where tracking was lost (a repeated pose), the score
-        # would not compare the pose: it keeps its GT pose,
-        # moved by the GT velocity (the linearisation) rather than held across the gap
-        gap = (span_ns > max_gap_ns) | repeated[hi_i]
-        if gap.any():
-            dt = ((times - q_used) / NS_PER_S).astype(np.float32)
-            lin = g_xyz + dt[..., None] * vel
-            xyz = np.where(gap[..., None], lin, xyz)
-            yaw = np.where(gap, g_yaw + dt * yaw_rate, yaw)
-        return xyz.astype(np.float32), yaw.astype(np.float32)
-
     est = np.array([estimates[key] for key in KEYS])
 
     def errors(gp: F64, gy: F64) -> F64:
@@ -332,7 +386,14 @@ def trajectory_intervals(
         )
 
     base = errors(g_xyz[None], g_yaw[None])[0]
-    base_off = errors(*gt_at(q_used[None, :]))[0]
+    # The offset's effect: the comparison re-scored by the score's own association and
+    # metrics at shifts of the offset (every robot pose inside the GT, compared or not: a
+    # shift moves a pose into a tracking loss or out of one, across a GT sample or next
+    # to a stale one, as the score at that offset would), on a grid the draws interpolate
+    grid = np.linspace(-OFFSET_SPAN, OFFSET_SPAN, OFFSET_GRID) * off_sigma + off_centre
+    on_grid = np.zeros((OFFSET_GRID, est.size))
+    if off_sigma > 0.0:
+        on_grid = offset_effects(rescoring, t, grid)
 
     def perturbed(rng: np.random.Generator, sources: frozenset[str], draws: int) -> F64:
         """Draws whose basic (reflected) interval is the interval wanted (module doc):
@@ -363,13 +424,8 @@ def trajectory_intervals(
             if timing and off_sigma > 0.0:
                 shift = rng.standard_normal(m) * off_sigma + off_centre
                 # one shift for every pose: the statistics are a function of it alone,
-                # computed on a grid of shifts and interpolated (a tracking loss's kink
-                # included: the grid is much finer than the draws' spread)
-                grid = np.linspace(shift.min(), shift.max(), min(m, OFFSET_GRID))
-                gp, gy = gt_at(
-                    q_used[None, :] + np.round(grid[:, None] * NS_PER_S).astype(np.int64)
-                )
-                on_grid = errors(gp, gy) - base_off
+                # re-scored on the grid and interpolated (the grid's step, a tenth of the
+                # sd, is much finer than the draws' spread)
                 offset[rows] = np.column_stack(
                     [np.interp(shift, grid, on_grid[:, j]) for j in range(est.size)]
                 )
@@ -401,8 +457,9 @@ def trajectory_intervals(
         parts = []
         if off_sigma > 0.0:
             parts.append(
-                f"clock offset sd {off_sigma * 1000:.3f} ms (sandwich standard error of the "
-                f"least-squares offset), centred {off_centre * 1000:+.3f} ms from the applied "
+                f"clock offset sd {off_sigma * 1000:.3f} ms (standard error of the "
+                "least-squares offset, the robot's error slid along the path by every lag), "
+                f"centred {off_centre * 1000:+.3f} ms from the applied "
                 "one (the clock audit's estimate); mirrored: drawn as the truth's offset"
             )
         else:

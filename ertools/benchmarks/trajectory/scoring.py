@@ -40,7 +40,7 @@ from ertools.benchmarks.trajectory.association import (
     associate_evo,
 )
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
-from ertools.benchmarks.trajectory.intervals import trajectory_intervals
+from ertools.benchmarks.trajectory.intervals import Rescoring, trajectory_intervals
 from ertools.benchmarks.trajectory.metrics import Metrics, metrics
 from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.benchmarks.trajectory.rules import (
@@ -168,6 +168,41 @@ def score_streams(
         robot.child_frame_id,
         robot.source,
     )
+    logged = robot  # the robot poses as logged (evo's association may repeat some)
+
+    def rescore(rows: npt.NDArray[np.intp], shift_ns: int) -> Matched:
+        """The score's own association of the robot poses ``rows`` at the applied offset
+        plus ``shift_ns`` (the intervals' offset draws re-score with it)."""
+        part = logged.take(rows)
+        at = offset_ns + shift_ns
+        if config.t_max_diff is not None:
+            return associate_evo(
+                part,
+                gt,
+                float_seconds(part),
+                float_seconds(gt),
+                config.t_max_diff,
+                ns_to_s(at),
+                at,
+            )
+        return associate(
+            PoseStream(
+                part.t_ns + at,
+                part.xyz,
+                part.quat_xyzw,
+                part.frame_id,
+                part.child_frame_id,
+                part.source,
+            ),
+            gt,
+            config.association,
+            config.max_gap_ns,
+            ties=config.ties,
+            gaps=config.gaps,
+            before_gt=config.before_gt,
+            gt_order=config.gt_order,
+        )
+
     if config.t_max_diff is not None:
         matched = associate_evo(
             robot,
@@ -305,8 +340,8 @@ def score_streams(
             _estimates(m),
             association=config.association,
             offset_ns=offset_ns,
-            max_gap_ns=config.max_gap_ns,
             settings=intervals,
+            rescoring=Rescoring(logged.t_ns + offset_ns, rescore),
         )
         notes.extend(_outside_note(_estimates(m), iv.intervals, audit, offset_ns))
     result = TrajectoryResult(

@@ -111,16 +111,41 @@ def test_interval_keys_follow_their_score() -> None:
 
 
 def test_interval_line_states_value_interval_method_and_shares() -> None:
-    from ertools.benchmarks.common.uncertainty import Source, Uncertainty, interval_line
-
-    u = Uncertainty(0.95, "Monte Carlo", 400, 0, (Source("mocap_noise", 1e-4, "m", True),), {})
-    iv = Interval(0.00041, 0.00088, (("mocap_noise", 0.71), ("d_min", 0.29)))
-    line = interval_line("best_distance_error", 0.000639, iv, u, scale=1000.0, unit="mm")
-    assert line == (
-        "best_distance_error 0.639 mm, 95% interval [0.41, 0.88] mm "
-        "(Monte Carlo 400 draws, seed 0; mocap_noise 71%, d_min 29%)"
+    from ertools.benchmarks.common.interval_output import (
+        MAX_LINE,
+        ScoreRow,
+        interval_line,
+        interval_lines,
     )
-    assert "no 95% interval" in interval_line("x", 1.0, None, u)
+    from ertools.benchmarks.common.uncertainty import Source, Uncertainty
+
+    sources = (Source("mocap_noise", 1e-4, "m", True), Source("d_min", 3.3e-4, "m", False))
+    u = Uncertainty(0.95, "Monte Carlo (details)", 400, 0, sources, {})
+    iv = Interval(0.00041, 0.00088, (("d_min", 0.29), ("mocap_noise", 0.71)))
+    row = ScoreRow("best_distance_error", 0.000639, iv, 1000.0, "mm")
+    # the score, its interval at the level, the method, the sources by share (largest first)
+    assert interval_line(row, u) == (
+        "interval: best_distance_error 0.639 mm [0.41, 0.88] mm at 95% "
+        "(Monte Carlo, 400 draws, seed 0; mocap_noise 71%, d_min 29%)"
+    )
+    assert interval_line(ScoreRow("x", 1.0, None), u) == (
+        "interval: x 1: no 95% interval (Monte Carlo, 400 draws, seed 0: too few draws scored)"
+    )
+    # a score without a value has no line; the sources close the list
+    lines = interval_lines([row, ScoreRow("run 1 distance_error", None, None)], u)
+    assert lines == [
+        interval_line(row, u),
+        "interval sources: mocap_noise 0.0001 m (measured); d_min 0.00033 m (default)",
+    ]
+    assert interval_lines([row], None) == []
+    # the line stays within the CLI's 200 characters: the smallest shares go first
+    many = tuple((f"source_with_a_long_name_{k}", 0.2 - 0.01 * k) for k in range(5))
+    long_row = ScoreRow("segment 12345 orientation_error", 1.0, Interval(0.5, 1.5, many))
+    long_u = Uncertainty(0.95, "Monte Carlo", 400, 2**62, sources, {})
+    line = interval_line(long_row, long_u)
+    assert len(line) <= MAX_LINE
+    assert "source_with_a_long_name_0 20%" in line
+    assert "source_with_a_long_name_2" not in line
 
 
 def test_split_interval_and_uncertainty_rows() -> None:

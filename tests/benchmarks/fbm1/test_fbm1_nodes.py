@@ -343,7 +343,8 @@ def test_sample_rules_2016_is_the_later_node(capsys: pytest.CaptureFixture[str])
         "--single-wrap",
         "--exact-names",
         "--count-aborted",
-        "--score-unscoreable",
+        "--unscoreable",
+        "2015",
         "--accuracy-over-10",
     ]
     data2, _ = ertools_score(bag, SAMPLE / "fbm1h.yaml", "fbm1h", single, capsys)
@@ -615,11 +616,12 @@ def test_old_spellings_still_work_and_say_what_they_mean(
     items_path = tmp_path / "items.yaml"
     items_path.write_text(ITEMS, encoding="utf-8")
     old_flags = ["--legacy-clip", "--legacy-wrap", "--legacy-names", "--legacy-totals"]
-    # --score-unscoreable came later (issue 28): no old spelling
     given = ["--gt", "placed", *old_flags, "--score-unscoreable"]
     old, err = ertools_score(bag, items_path, "fbm1h", given, capsys)
     for flag in old_flags:
         assert f"ertools: note: {flag} is deprecated, use --" in err
+    # issue 28's switch, now the option every benchmark spells alike
+    assert "ertools: note: --score-unscoreable is deprecated, use --unscoreable 2015\n" in err
     new, _ = ertools_score(bag, items_path, "fbm1h", ["--rules", "2016"], capsys)
     assert old == new
 

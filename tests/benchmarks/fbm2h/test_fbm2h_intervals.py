@@ -5,10 +5,13 @@ noise)."""
 from __future__ import annotations
 
 import math
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 
+import ertools
 from ertools.benchmarks.common.uncertainty import (
     MOCAP_NOISE,
     TIME_ASSOCIATION,
@@ -16,6 +19,7 @@ from ertools.benchmarks.common.uncertainty import (
     Source,
 )
 from ertools.benchmarks.fbm2h.intervals import Model, Moments, intervals, perturbed_scores
+from ertools.configs.transform import SPREAD_KEY
 
 N = 20_000  # draws: the sd of a sample sd is 1/sqrt(2N) = 0.5% of it
 
@@ -160,3 +164,49 @@ def test_draws_0_leaves_the_result_as_it_was() -> None:
     listing = list(plain.to_dict())
     assert list(full.to_dict())[: len(listing)] == listing
     assert full.position_accuracy == plain.position_accuracy  # the score itself unchanged
+
+
+SAMPLE = Path(__file__).resolve().parents[3] / "sample_bags" / "fbm2h"
+
+
+def _score_with_spread(tmp_path: Path, spread: tuple[float, float, int] | None) -> dict[str, Any]:
+    """The sample scored with its transform file, carrying ``(position std, rotation std,
+    samples)`` as ``ertools acquire transform`` writes it (None: the file as it is)."""
+    text = (SAMPLE / "transform-simbot.yaml").read_text()
+    if spread is not None:
+        p, r, n = spread
+        text += (
+            f"{SPREAD_KEY}:\n  position_std: [{p}, {p}, {p}]\n  rotation_std: [{r}, {r}, {r}]\n"
+            f"  samples: {n}\n  effective_samples: {n}\n"
+        )
+    transform = tmp_path / "transform-simbot.yaml"
+    transform.write_text(text)
+    result = ertools.score(
+        "fbm2h",
+        SAMPLE / "log_fbm2h_mocap_2015-11-20-12-00-00_0.bag",
+        goal=SAMPLE / "fbm2h_goal.yaml",
+        transform=transform,
+        draws=200,
+    )
+    data: dict[str, Any] = result.to_dict()
+    return data
+
+
+def test_the_transform_source_is_the_acquisitions_spread(tmp_path: Path) -> None:
+    """A transform file with the acquisition's spread makes the transform source measured:
+    its size the spread over sqrt(samples), its share of the intervals growing with it; a
+    file without it keeps the stated default."""
+    default = _score_with_spread(tmp_path, None)
+    (t_default,) = [s for s in default["uncertainty"]["sources"] if s["name"] == TRANSFORM]
+    assert not t_default["measured"] and t_default["note"].startswith("default: ")
+    shares = []
+    for p_std in (2e-4, 1e-3, 5e-3):
+        data = _score_with_spread(tmp_path, (p_std, 2.5 * p_std, 100))
+        (t,) = [s for s in data["uncertainty"]["sources"] if s["name"] == TRANSFORM]
+        assert t["measured"] is True
+        assert t["value"] == pytest.approx(p_std / 10.0, rel=1e-12)  # spread / sqrt(100)
+        assert "100 poses" in t["note"]
+        # the scores do not move, only their intervals
+        assert data["position_accuracy"] == default["position_accuracy"]
+        shares.append(data["uncertainty"]["shares"]["position_accuracy"][TRANSFORM])
+    assert shares[0] < shares[1] < shares[2]

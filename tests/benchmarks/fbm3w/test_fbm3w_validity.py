@@ -6,13 +6,16 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 from fbm3w_synth import FRAME_NS, T0, one_run
 
+from ertools.benchmarks.base import rename_former
 from ertools.benchmarks.fbm3w.benchmark import MAX_INNER_GAP_S, MIN_COVERAGE, score_runs
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions, options_2015
+from ertools.benchmarks.fbm3w.declare import BENCHMARK
 from ertools.benchmarks.fbm3w.path import score_path
 from ertools.benchmarks.fbm3w.runs import RunWindow
 from ertools.cli.main import main
@@ -125,6 +128,27 @@ def test_2015_scores_it_with_a_warning() -> None:
     assert not any("unscoreable-runs" in d for d in result.deviations)
 
 
+def test_both_spellings_score_it_alike(capsys: pytest.CaptureFixture[str]) -> None:
+    """``--unscoreable 2015`` and the former ``--unscoreable-runs 2015`` give the options that
+    score the gapped run from its path (the default leaves it unscoreable)."""
+    stream, window = _run()
+    cut = _cut(stream, [(1000, 1072)])
+
+    def run(**given: str) -> Any:
+        options = BENCHMARK.make_options(rename_former(BENCHMARK.inputs, given))
+        return score_runs(cut, [window], Fbm3wConfig(), options=options, bag_start_ns=0).runs[0]
+
+    assert run().status == "unscoreable"
+    new = run(unscoreable="2015")
+    assert capsys.readouterr().err == ""
+    old = run(unscoreable_runs="2015")
+    assert capsys.readouterr().err == (
+        "ertools: note: unscoreable_runs='2015' is deprecated, use unscoreable='2015'\n"
+    )
+    assert new.status == old.status == "scored"
+    assert new.distance_error == old.distance_error == _expected_score(cut, window)
+
+
 def test_coverage_below_the_fraction_is_unscoreable() -> None:
     stream, window = _run()
     # 8 gaps of 0.45 s (54 frames, 55 periods each), each under MAX_INNER_GAP_S: 440 of
@@ -175,5 +199,5 @@ def test_the_score_command_prints_validity(capsys: pytest.CaptureFixture[str]) -
         r = data["runs_details"][k]
         assert line.startswith(f"ertools: validity: run {k} {r['valid_fraction']:.1%} valid")
     # the sample's runs are covered: --unscoreable-runs 2015 changes nothing
-    assert main([*args, "--unscoreable-runs", "2015"]) == 0
+    assert main([*args, "--unscoreable", "2015"]) == 0
     assert json.loads(capsys.readouterr().out) == data
