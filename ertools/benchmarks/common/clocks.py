@@ -34,6 +34,9 @@ from ertools.geometry import bracket, row_dot, row_norm
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
 
+# A clock residual worth a warning must also matter for a score: 10 ms is 5 mm at a typical
+# 0.5 m/s
+MATTERS_NS = 10_000_000
 COARSE_STEP_NS = 20_000_000  # 20 ms: at 1 m/s a 2 cm change of the cost, well resolved
 FINE_STEP_NS = 1_000_000
 GRID_NS = COARSE_STEP_NS // 2
@@ -78,6 +81,15 @@ class OffsetEstimate:
     @property
     def uncertainty_s(self) -> float | None:
         return None if self.uncertainty_ns is None else self.uncertainty_ns / NS_PER_S
+
+    def disagrees_with(self, applied_ns: int) -> bool:
+        """Whether the stamps fit the GT at an offset other than ``applied_ns`` both
+        significantly (3 sigma) and by enough to matter for a score (10 ms: 5 mm at a typical
+        0.5 m/s): the clock audit's warning."""
+        if self.offset_ns is None:
+            return False
+        sigma = self.uncertainty_ns or 0
+        return abs(self.offset_ns - applied_ns) > max(3 * sigma, MATTERS_NS)
 
 
 @dataclass(frozen=True, eq=False)

@@ -249,8 +249,16 @@ def offset_spread(
     if n < 3 or sv <= 0.0 or audit.offset_ns is None:
         return 0.0, 0.0
     e = (r_xyz - g_xyz).astype(np.float64)
-    e -= e.mean(axis=0)
     v = vel.astype(np.float64)
+    centre = (audit.offset_ns - offset_ns) / NS_PER_S
+    if audit.disagrees_with(offset_ns):
+        # scored at an offset the data disagrees with (``--offset 0`` on a robot 0.35 s
+        # ahead), the errors hold v times that disagreement: the spread is the errors' at
+        # the offset the interval is centred on (left in, it made the sd 0.2 s there). Not
+        # done otherwise: removing an offset estimated from these same errors would take
+        # out the drift's projection whose variance this measures.
+        e -= v * centre
+    e -= e.mean(axis=0)
     # c(h) for every lag at once: zero-padded to a length >= 2n - 1, so the FFT's circular
     # correlation is the linear one; sum_h c(h)^2 = sum_f |C(f)|^2 / m (Parseval)
     m = 1 << (2 * n - 1).bit_length()
@@ -258,7 +266,7 @@ def offset_spread(
     power = np.abs(cross) ** 2
     # rfft keeps f = 0..m/2: every other frequency stands for its conjugate twin too
     total = float(power[0] + power[-1] + 2.0 * np.sum(power[1:-1])) / m
-    return math.sqrt(total / n) / sv, (audit.offset_ns - offset_ns) / NS_PER_S
+    return math.sqrt(total / n) / sv, centre
 
 
 def _bracket(t: IntArr, q: IntArr) -> tuple[IntArr, IntArr]:

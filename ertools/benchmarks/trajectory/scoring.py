@@ -439,11 +439,8 @@ def _audit_warnings(audit: OffsetEstimate, applied_ns: int) -> list[str]:
     if audit.offset_ns is None:
         return [f"clock audit: no offset estimate ({audit.note})"]
     out = []
-    residual = audit.offset_ns - applied_ns
     sigma = audit.uncertainty_ns or 0
-    # Worth a warning when the residual is both significant (3 sigma) and large enough to
-    # matter for the score (10 ms: 5 mm at a typical 0.5 m/s).
-    if abs(residual) > max(3 * sigma, 10_000_000):
+    if audit.disagrees_with(applied_ns):
         out.append(
             f"clock audit: the robot stamps fit the GT best shifted by "
             f"{ns_to_s(audit.offset_ns):+.3f} +- {ns_to_s(sigma):.3f} s, but the score uses "

@@ -68,6 +68,20 @@ def test_offset_spread_is_the_least_squares_standard_error() -> None:
     assert centre == pytest.approx(0.001)
 
 
+def test_offset_spread_at_an_offset_the_data_disagrees_with() -> None:
+    """Scored 0.35 s off the offset the data fits (the audit: -0.35 s +- 9 ms), each error
+    holds v times -0.35 s: the spread is that of the errors at the fitted offset, the
+    independent residuals' 0.01 / sqrt(sum |v|^2), not the misalignment's (~0.35 s)."""
+    rng = np.random.default_rng(6)
+    n = 500
+    vel = rng.normal(0.0, 0.4, (n, 3))
+    resid = rng.normal(0.0, 0.01, (n, 3))
+    audit = OffsetEstimate(-350_000_000, 9_000_000, 5 * 10**9, n, 0.01, 0.02)
+    sd, centre = offset_spread(resid + vel * -0.35, np.zeros((n, 3)), vel, audit, 0)
+    assert centre == pytest.approx(-0.35)
+    assert sd == pytest.approx(0.01 / math.sqrt(float(np.sum(vel**2))), rel=0.1)
+
+
 SAMPLE = Path(__file__).resolve().parents[3] / "sample_bags" / "robotlog"
 SAMPLE_ROBOT = SAMPLE / "FBM2H_201511201200_homer.bag"
 TOP_LEVEL = ("position_error", "orientation_error", "rmse", "median", "max")
