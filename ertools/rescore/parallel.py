@@ -22,7 +22,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from importlib import import_module
 from typing import Any
 
@@ -31,6 +31,7 @@ from ertools.errors import ConfigError
 from ertools.report import html
 from ertools.report.figures import preload
 from ertools.rescore.jobs import Job, Outcome, load_benchmark, run_job
+from ertools.rescore.schedule import Schedule
 
 OnDone = Callable[[Outcome], None]
 log = logging.getLogger(__name__)
@@ -40,17 +41,26 @@ def default_jobs() -> int:
     return os.cpu_count() or 1
 
 
-def run_jobs(jobs: Sequence[Job], *, workers: int, scheduler: str | None, on_done: OnDone) -> None:
-    """Score every job (by ``workers`` local processes, or the Dask ``scheduler``)."""
+def run_jobs(
+    jobs: Sequence[Job],
+    *,
+    workers: int,
+    scheduler: str | None,
+    on_done: OnDone,
+    known: Iterable[tuple[str, float]] = (),
+) -> None:
+    """Score every job (by ``workers`` local processes, or the Dask ``scheduler``); with
+    several workers, the longest expected first (:mod:`ertools.rescore.schedule`; ``known``:
+    (benchmark, seconds) of executions already timed)."""
     if not jobs:
         return
     if scheduler is not None:
-        run_dask(jobs, scheduler, workers=workers, on_done=on_done)
+        run_dask(jobs, scheduler, workers=workers, on_done=on_done, known=known)
     elif workers <= 1:
         for job in jobs:  # in this process: the simplest path, and the reference for the others
             on_done(run_job(job))
     else:
-        run_local(jobs, workers=workers, on_done=on_done)
+        run_local(jobs, workers=workers, on_done=on_done, known=known)
 
 
 # prctl(2): PR_SET_PDEATHSIG, the signal the kernel sends a process when its parent ends
@@ -221,10 +231,17 @@ class _Worker:
         self.job: Job | None = None
 
 
-def run_local(jobs: Sequence[Job], *, workers: int, on_done: OnDone) -> None:
-    """Score ``jobs`` with ``workers`` local processes; a worker that dies costs its job."""
+def run_local(
+    jobs: Sequence[Job],
+    *,
+    workers: int,
+    on_done: OnDone,
+    known: Iterable[tuple[str, float]] = (),
+) -> None:
+    """Score ``jobs`` with ``workers`` local processes, the longest expected first; a worker
+    that dies costs its job."""
     ctx = _context()
-    pending = list(reversed(jobs))
+    pending = Schedule(jobs, known)
     pool = [_Worker(ctx) for _ in range(min(workers, len(jobs)))]
     try:
         for worker in pool:
@@ -244,13 +261,15 @@ def run_local(jobs: Sequence[Job], *, workers: int, on_done: OnDone) -> None:
                         outcome = _died(worker)
                         pool[i] = worker = _replace(worker, ctx)
                     worker.job = None
+                    pending.done(outcome)
+                    _assign(worker, pending)  # the next job first: the worker waits for none
                     on_done(outcome)
-                    _assign(worker, pending)
                 elif worker.process.sentinel in ready:
                     outcome = _died(worker)
                     pool[i] = worker = _replace(worker, ctx)
-                    on_done(outcome)
+                    pending.done(outcome)
                     _assign(worker, pending)
+                    on_done(outcome)
     finally:
         for worker in pool:
             with contextlib.suppress(OSError, ValueError):  # a worker already gone
@@ -262,10 +281,11 @@ def run_local(jobs: Sequence[Job], *, workers: int, on_done: OnDone) -> None:
                 worker.process.join()
 
 
-def _assign(worker: _Worker, pending: list[Job]) -> None:
-    if pending:
-        worker.job = pending.pop()
-        worker.conn.send(worker.job)
+def _assign(worker: _Worker, pending: Schedule) -> None:
+    job = pending.next()
+    if job is not None:
+        worker.job = job
+        worker.conn.send(job)
 
 
 def _died(worker: _Worker) -> Outcome:
@@ -284,7 +304,14 @@ def _replace(worker: _Worker, ctx: Any) -> _Worker:
     return _Worker(ctx)
 
 
-def run_dask(jobs: Sequence[Job], address: str, *, workers: int, on_done: OnDone) -> None:
+def run_dask(
+    jobs: Sequence[Job],
+    address: str,
+    *,
+    workers: int,
+    on_done: OnDone,
+    known: Iterable[tuple[str, float]] = (),
+) -> None:
     """Score ``jobs`` on a Dask cluster (``local``: a LocalCluster of ``workers`` processes).
 
     Only the jobs (paths and values) go through the scheduler; workers read the logs from the
@@ -300,7 +327,7 @@ def run_dask(jobs: Sequence[Job], address: str, *, workers: int, on_done: OnDone
         ) from None
     distributed: Any = _distributed  # untyped calls: its API is checked by the Dask test
     with _dask_logs_as_one_line(address):
-        _run_dask(distributed, jobs, address, workers=workers, on_done=on_done)
+        _run_dask(distributed, jobs, address, workers=workers, on_done=on_done, known=known)
 
 
 class _Held(logging.Handler):
@@ -343,7 +370,13 @@ def _dask_logs_as_one_line(address: str) -> Iterator[None]:
 
 
 def _run_dask(
-    distributed: Any, jobs: Sequence[Job], address: str, *, workers: int, on_done: OnDone
+    distributed: Any,
+    jobs: Sequence[Job],
+    address: str,
+    *,
+    workers: int,
+    on_done: OnDone,
+    known: Iterable[tuple[str, float]] = (),
 ) -> None:
     cluster = None
     try:
@@ -374,14 +407,25 @@ def _run_dask(
     except (OSError, TimeoutError) as err:
         raise ConfigError(f"--scheduler {address}: cannot connect ({err})") from err
     try:
-        futures = {
-            client.submit(
-                run_job_forked, job, key=f"rescore-{job.id}-{os.getpid()}", pure=False
-            ): job
-            for job in jobs
-        }
-        for future in distributed.as_completed(futures):
-            job = futures[future]
+        # Handed out as on local workers, the longest expected first: a few tasks per worker
+        # thread in flight (none waits for the scheduler), the next chosen as each ends.
+        pending = Schedule(jobs, known)
+        slots = sum(client.nthreads().values()) or max(workers, 1)
+        futures: dict[Any, Job] = {}
+        running = distributed.as_completed()
+
+        def submit() -> None:
+            job = pending.next()
+            if job is not None:
+                key = f"rescore-{job.id}-{os.getpid()}"
+                future = client.submit(run_job_forked, job, key=key, pure=False)
+                futures[future] = job
+                running.add(future)
+
+        for _ in range(2 * slots):
+            submit()
+        for future in running:
+            job = futures.pop(future)
             try:
                 outcome = future.result()
             except distributed.KilledWorker:
@@ -393,6 +437,8 @@ def _run_dask(
             except Exception as err:  # lost connection, a worker without ertools...
                 text = " ".join(f"{type(err).__name__}: {err}".split())
                 outcome = Outcome(job.id, "failed", reason=f"Dask: {text}")
+            pending.done(outcome)
+            submit()
             on_done(outcome)
             future.release()
     finally:

@@ -302,7 +302,9 @@ def rescore(
             on_outcome(outcome)
         tell()
 
-    run_jobs(to_run, workers=workers, scheduler=scheduler, on_done=done)
+    # what the cache hits took tells the schedule which benchmarks cost most
+    known = [(p.job.benchmark, outcomes[p.job.id].seconds) for p in planned if p.job.id in cached]
+    run_jobs(to_run, workers=workers, scheduler=scheduler, on_done=done, known=known)
     return document(
         planned,
         outcomes,

@@ -19,6 +19,7 @@ from ertools.errors import ConfigError
 from ertools.rescore.found import find, merge, write_timeline
 from ertools.rescore.ledger import account
 from ertools.rescore.manifest import Manifest
+from ertools.rescore.memo import FileMemo
 from ertools.rescore.pipeline import listed_executions, rescore, write_results
 
 if TYPE_CHECKING:
@@ -61,7 +62,10 @@ def rescore_competition(
         timeline = None
         found = None
         if paths:
-            found = find(paths, progress=progress)
+            # what each log says, remembered between runs (a warm rerun reads no log)
+            memo = FileMemo(out / "cache" / "files.json", load=use_cache)
+            found = find(paths, progress=progress, memo=memo)
+            memo.save()
             scorings = merge(found.scorings, scorings)
             problems = list(found.problems)
             out.mkdir(parents=True, exist_ok=True)
