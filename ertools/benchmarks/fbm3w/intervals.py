@@ -204,10 +204,23 @@ def perturbed_runs(
         for lo in range(0, d, batch)
     ]
     for group in _groups(pieces, [len(r.xy) for r in runs], budget):
-        drawn = [_positions(runs[col], sigmas[lo:hi], rng, noisy) for col, lo, hi in group]
-        kept = _subsample([(x, y) for x, y, _, _ in drawn], [d_mins[lo:hi] for _, lo, hi in group])
-        for (col, lo, hi), (x, y, rx, ry), k in zip(group, drawn, kept, strict=True):
-            out[lo:hi, col] = _eq1(x, y, k, rx, ry, runs[col].shape)
+        # every piece's draws side by side, samples down the rows (shorter runs padded with
+        # NaN, never kept): the positions are drawn straight into these two arrays
+        lengths = [len(runs[col].xy) for col, _, _ in group]
+        edges = np.cumsum([0, *(hi - lo for _, lo, hi in group)])
+        xt = np.full((max(lengths), int(edges[-1])), np.nan)
+        yt = np.full_like(xt, np.nan)
+        views = [
+            (xt[:m, a:b].T, yt[:m, a:b].T, slice(a, b), m)
+            for a, b, m in zip(edges[:-1], edges[1:], lengths, strict=True)
+        ]
+        refs = [
+            _positions(runs[col], sigmas[lo:hi], rng, noisy, x, y)
+            for (col, lo, hi), (x, y, _, _) in zip(group, views, strict=True)
+        ]
+        kept = _subsample(xt, yt, np.concatenate([d_mins[lo:hi] for _, lo, hi in group]))
+        for (col, lo, hi), (x, y, cols, m), (rx, ry) in zip(group, views, refs, strict=True):
+            out[lo:hi, col] = _eq1(x, y, kept[:m, cols].T, rx, ry, runs[col].shape)
     return out
 
 
@@ -231,43 +244,36 @@ def _groups(
 
 
 def _positions(
-    run: RunSamples, sigmas: F64, rng: np.random.Generator, noisy: bool
-) -> tuple[F64, F64, F64, F64]:
-    """(D, N) perturbed x and y of one run's samples and (D,) of its reference; the noise
-    of the samples drawn first (D, measurements, 2), then the reference's (D, 2)."""
+    run: RunSamples, sigmas: F64, rng: np.random.Generator, noisy: bool, x: F64, y: F64
+) -> tuple[F64, F64]:
+    """One run's perturbed sample positions written into ``x`` and ``y`` (D, N), and the
+    (D,) x and y of its reference; the noise of the samples drawn first (D, measurements,
+    2), then the reference's (D, 2)."""
     d = sigmas.size
     n = len(run.xy)
     xy = run.xy if run.center_xy is None else run.center_xy
     ref = run.reference_xy if run.center_reference_xy is None else run.center_reference_xy
     if not noisy:
-        x = np.repeat(xy[None, :, 0], d, axis=0)
-        y = np.repeat(xy[None, :, 1], d, axis=0)
-        return x, y, np.full(d, ref[0] + 0.0), np.full(d, ref[1] + 0.0)
+        np.add(xy[None, :, 0], 0.0, out=x)
+        np.add(xy[None, :, 1], 0.0, out=y)
+        return np.full(d, ref[0] + 0.0), np.full(d, ref[1] + 0.0)
     measured = int(run.source.max()) + 1 if n else 0
     eps = rng.standard_normal((d, measured, 2))
     if np.any(run.source != np.arange(n)):  # a repeated pose repeats its noise
         eps = eps[:, run.source, :]
     eps *= sigmas[:, None, None]
     ref_eps = rng.standard_normal((d, 2)) * sigmas[:, None]
-    x = xy[None, :, 0] + eps[:, :, 0]
-    y = xy[None, :, 1] + eps[:, :, 1]
-    return x, y, ref[0] + ref_eps[:, 0], ref[1] + ref_eps[:, 1]
+    np.add(xy[None, :, 0], eps[:, :, 0], out=x)
+    np.add(xy[None, :, 1], eps[:, :, 1], out=y)
+    return ref[0] + ref_eps[:, 0], ref[1] + ref_eps[:, 1]
 
 
-def _subsample(paths: Sequence[tuple[F64, F64]], d_mins: Sequence[F64]) -> list[Bool]:
-    """(D_i, N_i) kept flags of the 2015 d_min rule for every draw of every path: one pass
-    over the samples, each step vectorised over all the paths' draws side by side (the
-    rule is sequential within a draw). Shorter paths are padded with NaN, never kept."""
-    widths = [x.shape[0] for x, _ in paths]
-    lengths = [x.shape[1] for x, _ in paths]
-    n, w = max(lengths), sum(widths)
-    xt = np.full((n, w), np.nan)
-    yt = np.full((n, w), np.nan)
-    cols = np.cumsum([0, *widths])
-    for (x, y), lo, hi, m in zip(paths, cols[:-1], cols[1:], lengths, strict=True):
-        xt[:m, lo:hi] = x.T
-        yt[:m, lo:hi] = y.T
-    d2 = np.concatenate(d_mins) ** 2
+def _subsample(xt: F64, yt: F64, d_mins: F64) -> Bool:
+    """(N, W) kept flags of the 2015 d_min rule for the W draws side by side in the columns
+    of ``xt``, ``yt`` (N, W), each with its d_min: one pass over the samples, each step
+    vectorised over every draw (the rule is sequential within a draw). NaN is never kept."""
+    n, w = xt.shape
+    d2 = d_mins * d_mins
     kept = np.zeros((n, w), dtype=bool)
     kept[0] = True
     lx = xt[0].copy()
@@ -284,7 +290,7 @@ def _subsample(paths: Sequence[tuple[F64, F64]], d_mins: Sequence[F64]) -> list[
         k = np.greater_equal(dx, d2, out=kept[j])
         np.copyto(lx, xt[j], where=k)
         np.copyto(ly, yt[j], where=k)
-    return [kept[:m, lo:hi].T for lo, hi, m in zip(cols[:-1], cols[1:], lengths, strict=True)]
+    return kept
 
 
 def _eq1(x: F64, y: F64, kept: Bool, rx: F64, ry: F64, shape: Shape) -> F64:
@@ -293,10 +299,10 @@ def _eq1(x: F64, y: F64, kept: Bool, rx: F64, ry: F64, shape: Shape) -> F64:
     one (the start, always kept) first. Temporaries are reused (``out=``): on this scale
     (10^5 kept points per run) fresh arrays cost more in page faults than in arithmetic."""
     d = x.shape[0]
-    count = np.count_nonzero(kept, axis=1)
-    flat = np.flatnonzero(kept)
-    xk, yk = x.ravel()[flat], y.ravel()[flat]
-    m = flat.size
+    rows, cols = np.nonzero(kept)  # draw by draw (row-major), whatever the layout in memory
+    count = np.bincount(rows, minlength=d)
+    xk, yk = x[rows, cols], y[rows, cols]
+    m = rows.size
     starts = np.cumsum(count) - count  # each draw's first kept point (column 0)
     a, b = np.empty(m), np.empty(m)
     run = np.empty(m)
@@ -328,7 +334,6 @@ def _eq1(x: F64, y: F64, kept: Bool, rx: F64, ry: F64, shape: Shape) -> F64:
     b -= target[:, 1]
     err = np.hypot(a, b, out=a)
     err[starts] = 0.0  # 2015 started its sum at the second kept point
-    rows = np.repeat(np.arange(d), count)
     out = np.bincount(rows, weights=err, minlength=d) / np.maximum(count, 1)
     bad = (count < 2) | ~(total > 0) | ((x0 == rx) & (y0 == ry))
     return np.where(bad, np.nan, out)
