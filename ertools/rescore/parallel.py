@@ -48,14 +48,17 @@ def run_jobs(
     scheduler: str | None,
     on_done: OnDone,
     known: Iterable[tuple[str, float]] = (),
+    dask: DaskClient | None = None,
 ) -> None:
     """Score every job (by ``workers`` local processes, or the Dask ``scheduler``); with
     several workers, the longest expected first (:mod:`ertools.rescore.schedule`; ``known``:
-    (benchmark, seconds) of executions already timed)."""
+    (benchmark, seconds) of executions already timed). ``dask``: the scheduler's client,
+    already being started (:func:`early_dask`); closed in the background once the jobs are
+    done."""
     if not jobs:
         return
     if scheduler is not None:
-        run_dask(jobs, scheduler, workers=workers, on_done=on_done, known=known)
+        run_dask(jobs, scheduler, workers=workers, on_done=on_done, known=known, dask=dask)
     elif workers <= 1:
         for job in jobs:  # in this process: the simplest path, and the reference for the others
             on_done(run_job(job))
@@ -311,23 +314,110 @@ def run_dask(
     workers: int,
     on_done: OnDone,
     known: Iterable[tuple[str, float]] = (),
+    dask: DaskClient | None = None,
 ) -> None:
     """Score ``jobs`` on a Dask cluster (``local``: a LocalCluster of ``workers`` processes).
 
     Only the jobs (paths and values) go through the scheduler; workers read the logs from the
     shared file system. A job whose worker died as often as the scheduler allows
     (``distributed.scheduler.allowed-failures``) comes back as ``KilledWorker``: one row.
+    ``dask``: a client started earlier (:func:`early_dask`): it is closed in the background
+    (its owner waits for it), else the client is started here and closed before returning.
     """
+    owned = dask is None
+    handle = dask if dask is not None else DaskClient(address, workers)
     try:
-        # optional extra `ertools[dask]`: imported only when a scheduler is asked for
-        import distributed as _distributed  # lazy: the optional Dask extra (ertools[dask])
-    except ImportError:
-        raise ConfigError(
-            "--scheduler needs Dask distributed: pip install 'ertools[dask]'"
-        ) from None
-    distributed: Any = _distributed  # untyped calls: its API is checked by the Dask test
-    with _dask_logs_as_one_line(address):
-        _run_dask(distributed, jobs, address, workers=workers, on_done=on_done, known=known)
+        distributed, client = handle.get()
+        _run_dask(distributed, client, jobs, workers=workers, on_done=on_done, known=known)
+    finally:
+        handle.close(wait=owned)
+
+
+class DaskClient:
+    """A Dask client being connected (a LocalCluster being started: its scheduler, nannies
+    and worker processes) in a thread of its own, so that a run can start it before scanning
+    the logs, and close it while it writes the results: Dask's fixed costs (~3.4 s of CPU,
+    mostly in the processes it starts, and seconds of waiting for them; docs/rescore.md)
+    overlap the main process's own work instead of adding to it.
+
+    ``distributed``'s log records are held from the start to the close and said in one line
+    (:func:`_dask_logs_as_one_line`).
+    """
+
+    def __init__(self, address: str, workers: int) -> None:
+        self.address = address
+        self._stack = contextlib.ExitStack()
+        self._got: tuple[Any, Any] | None = None
+        self._cluster: Any = None
+        self._error: BaseException | None = None
+        self._closing: threading.Thread | None = None
+        self._thread = threading.Thread(target=self._start, args=(workers,), daemon=True)
+        self._thread.start()
+
+    def _start(self, workers: int) -> None:
+        try:
+            try:
+                # optional extra `ertools[dask]`: imported only when a scheduler is asked for
+                import distributed as _distributed  # lazy: the optional Dask extra
+            except ImportError:
+                raise ConfigError(
+                    "--scheduler needs Dask distributed: pip install 'ertools[dask]'"
+                ) from None
+            distributed: Any = _distributed  # untyped calls: its API is checked by the Dask test
+            self._stack.enter_context(_dask_logs_as_one_line(self.address))
+            client, self._cluster = _connect(distributed, self.address, workers)
+            self._got = (distributed, client)
+        except BaseException as err:  # said by get(), in the thread that needs the client
+            self._error = err
+
+    def get(self) -> tuple[Any, Any]:
+        """(the ``distributed`` module, the client), once started.
+
+        Raises:
+            ConfigError: Dask not installed, the scheduler not reachable.
+        """
+        self._thread.join()
+        if self._error is not None:
+            raise self._error
+        assert self._got is not None
+        return self._got
+
+    def close(self, *, wait: bool = True) -> None:
+        """Close the client (and the LocalCluster); ``wait`` False: in the background, see
+        :meth:`join`."""
+        if self._closing is None:
+            self._closing = threading.Thread(target=self._close, daemon=True)
+            self._closing.start()
+        if wait:
+            self.join()
+
+    def join(self) -> None:
+        """Wait for the start, and the close when one was asked (with :meth:`close`)."""
+        self._thread.join()
+        if self._closing is not None:
+            self._closing.join()
+
+    def _close(self) -> None:
+        self._thread.join()
+        try:
+            if self._got is not None:
+                with contextlib.suppress(Exception):  # a scheduler already gone
+                    self._got[1].close()
+            if self._cluster is not None:
+                with contextlib.suppress(Exception):
+                    self._cluster.close()
+        finally:
+            self._stack.close()
+            sys.stderr.flush()
+
+
+def early_dask(scheduler: str | None, workers: int, cold: bool) -> DaskClient | None:
+    """A Dask client started now, for a run that will need it: with a scheduler, on a
+    ``cold`` run (nothing in the cache: every execution is to be scored). A rerun may find
+    everything in the cache and need no cluster: its client is started only if needed."""
+    if scheduler is None or not cold:
+        return None
+    return DaskClient(scheduler, workers)
 
 
 class _Held(logging.Handler):
@@ -369,15 +459,8 @@ def _dask_logs_as_one_line(address: str) -> Iterator[None]:
             log.warning("Dask (%s): %s%s", address, first, more)
 
 
-def _run_dask(
-    distributed: Any,
-    jobs: Sequence[Job],
-    address: str,
-    *,
-    workers: int,
-    on_done: OnDone,
-    known: Iterable[tuple[str, float]] = (),
-) -> None:
+def _connect(distributed: Any, address: str, workers: int) -> tuple[Any, Any]:
+    """(the client, the LocalCluster or None) for ``address``."""
     cluster = None
     try:
         if address == "local":
@@ -387,12 +470,18 @@ def _run_dask(
             # of a core per worker: measured in docs/performance.md), and without the
             # MALLOC_TRIM_THRESHOLD_=65536 the nannies put in their workers' environment: glibc
             # then hands every freed array back to the kernel, and the next execution faults
-            # its pages in again (a local worker keeps them). The nannies hand this
-            # configuration to the worker processes they start.
+            # its pages in again (a local worker keeps them). The event loops' tick monitor
+            # (every 20 ms), the system monitor (500 ms) and the memory monitor (100 ms) of
+            # the scheduler, nannies and workers cost 7 % of a core while the cluster waits
+            # (1.08 s of CPU in 15 s); at 1 s, 5 s and 1 s, 1.5 % (0.23 s). The nannies hand
+            # this configuration to the worker processes they start.
             with dask.config.set(
                 {
                     "distributed.worker.profile.enabled": False,
                     "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+                    "distributed.admin.tick.interval": "1s",
+                    "distributed.admin.system-monitor.interval": "5s",
+                    "distributed.worker.memory.monitor-interval": "1s",
                 }
             ):
                 cluster = distributed.LocalCluster(
@@ -401,48 +490,55 @@ def _run_dask(
                     processes=True,
                     dashboard_address=None,
                 )
-            client = distributed.Client(cluster)
-        else:
-            client = distributed.Client(address, timeout="10s")
+            return distributed.Client(cluster), cluster
+        return distributed.Client(address, timeout="10s"), None
     except (OSError, TimeoutError) as err:
-        raise ConfigError(f"--scheduler {address}: cannot connect ({err})") from err
-    try:
-        # Handed out as on local workers, the longest expected first: a few tasks per worker
-        # thread in flight (none waits for the scheduler), the next chosen as each ends.
-        pending = Schedule(jobs, known)
-        slots = sum(client.nthreads().values()) or max(workers, 1)
-        futures: dict[Any, Job] = {}
-        running = distributed.as_completed()
-
-        def submit() -> None:
-            job = pending.next()
-            if job is not None:
-                key = f"rescore-{job.id}-{os.getpid()}"
-                future = client.submit(run_job_forked, job, key=key, pure=False)
-                futures[future] = job
-                running.add(future)
-
-        for _ in range(2 * slots):
-            submit()
-        for future in running:
-            job = futures.pop(future)
-            try:
-                outcome = future.result()
-            except distributed.KilledWorker:
-                outcome = Outcome(
-                    job.id,
-                    "failed",
-                    reason="the Dask worker scoring it died; the others were scored",
-                )
-            except Exception as err:  # lost connection, a worker without ertools...
-                text = " ".join(f"{type(err).__name__}: {err}".split())
-                outcome = Outcome(job.id, "failed", reason=f"Dask: {text}")
-            pending.done(outcome)
-            submit()
-            on_done(outcome)
-            future.release()
-    finally:
-        client.close()
         if cluster is not None:
-            cluster.close()
-        sys.stderr.flush()
+            with contextlib.suppress(Exception):
+                cluster.close()
+        raise ConfigError(f"--scheduler {address}: cannot connect ({err})") from err
+
+
+def _run_dask(
+    distributed: Any,
+    client: Any,
+    jobs: Sequence[Job],
+    *,
+    workers: int,
+    on_done: OnDone,
+    known: Iterable[tuple[str, float]] = (),
+) -> None:
+    # Handed out as on local workers, the longest expected first: a few tasks per worker
+    # thread in flight (none waits for the scheduler), the next chosen as each ends.
+    pending = Schedule(jobs, known)
+    slots = sum(client.nthreads().values()) or max(workers, 1)
+    futures: dict[Any, Job] = {}
+    running = distributed.as_completed()
+
+    def submit() -> None:
+        job = pending.next()
+        if job is not None:
+            key = f"rescore-{job.id}-{os.getpid()}"
+            future = client.submit(run_job_forked, job, key=key, pure=False)
+            futures[future] = job
+            running.add(future)
+
+    for _ in range(2 * slots):
+        submit()
+    for future in running:
+        job = futures.pop(future)
+        try:
+            outcome = future.result()
+        except distributed.KilledWorker:
+            outcome = Outcome(
+                job.id,
+                "failed",
+                reason="the Dask worker scoring it died; the others were scored",
+            )
+        except Exception as err:  # lost connection, a worker without ertools...
+            text = " ".join(f"{type(err).__name__}: {err}".split())
+            outcome = Outcome(job.id, "failed", reason=f"Dask: {text}")
+        pending.done(outcome)
+        submit()
+        on_done(outcome)
+        future.release()
