@@ -420,6 +420,8 @@ def main() -> int:
             f"by the CPU time ({rate:,.0f} executions/hour)"
         )
     labels = {g: [label for label, _ in docs] for g, docs in results.items()}
+    if results["season"] and results["day 1"]:
+        labels["day 1 in the season"] = [results["day 1"][0][0], results["season"][0][0]]
     args.json.parent.mkdir(parents=True, exist_ok=True)
     args.json.write_text(
         json.dumps(
@@ -432,7 +434,7 @@ def main() -> int:
                 "rounds": {k: [asdict(v) for v in vs] for k, vs in rounds.items()},
                 "checks": checks,
                 "identical": {
-                    group: {"identical": ok, "differences": diffs, "runs": labels[group]}
+                    group: {"identical": ok, "differences": diffs, "runs": labels.get(group, [])}
                     for group, (ok, diffs) in identical.items()
                 },
                 "extrapolation": {
