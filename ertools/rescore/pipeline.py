@@ -244,7 +244,7 @@ def rescore(
     out.mkdir(parents=True, exist_ok=True)
     cache_dir = out / "cache"
     hashes = FileHashes(cache_dir / "hashes.json")
-    cache = Cache(cache_dir)
+    cache = Cache(cache_dir, hashes)
     planned = plan(executions, manifest, out, reports=reports)
     outcomes: dict[str, Outcome] = {}
     cached: set[str] = set()
