@@ -14,7 +14,12 @@ time. A poller reads the peak RSS (``VmHWM``) of the command and of every proces
 
 Targets (on a 2-core machine): --jobs 2 at least 1.7x faster than --jobs 1; Dask within 15 % of
 --jobs 2; a warm rerun under 2 s; every process under 200 MiB; time linear in the executions
-(per-execution time of one day within 15 % of the whole season's).
+(per-execution time of one day within 15 % of the whole season's); identical results in every
+configuration (bench/season_compare.py: every run's results.json against the first's, scores,
+intervals, verdicts and leaderboards, timings and paths left out).
+
+The machine may be shared: beside each wall time the CPU time (user + system, every process)
+and the load average before the run are printed; CPU time does not depend on the neighbours.
 """
 
 from __future__ import annotations
@@ -38,6 +43,7 @@ REPO = HERE.parent
 sys.path.insert(0, str(HERE))
 
 from season import DAYS, SLOTS_PER_DAY, generate_season  # noqa: E402
+from season_compare import comparable, compare  # noqa: E402
 
 from ertools.benchmarks import registry  # noqa: E402
 
@@ -57,6 +63,7 @@ class Run:
     cpu_s: float  # user + system time of the command and every process it waited for
     scored: int = 0
     cached: int = 0
+    load: float = 0.0  # the 1-minute load average just before the run
     note: str = ""
     peaks: dict[str, float] = field(default_factory=dict)
 
@@ -194,10 +201,16 @@ def timed(name: str, argv: list[str], executions: int) -> Run:
     return run
 
 
-def _counts(out: Path, run: Run) -> Run:
+def _doc(out: Path) -> dict[str, Any] | None:
     try:
-        doc = json.loads((out / "results.json").read_text(encoding="utf-8"))
+        doc: dict[str, Any] = json.loads((out / "results.json").read_text(encoding="utf-8"))
     except (OSError, json.JSONDecodeError):
+        return None
+    return doc
+
+
+def _counts(doc: dict[str, Any] | None, run: Run) -> Run:
+    if doc is None:
         return run
     rows = doc.get("executions") or []
     run.scored = sum(r.get("status") == "scored" for r in rows)
@@ -251,7 +264,7 @@ def main() -> int:
     print(f"machine: {os.cpu_count()} cores, load average {load} at start")
     print(
         f"  {'ertools rescore ...':<44} {'execs':>5} {'wall s':>8} {'s/exec':>7} "
-        f"{'CPU s':>7} {'main MiB':>8} {'other MiB':>9} {'procs':>5}  scored/cached"
+        f"{'CPU s':>7} {'load':>5} {'main MiB':>8} {'other MiB':>9} {'procs':>5}  scored/cached"
     )
 
     runs: dict[str, Run] = {}
@@ -260,10 +273,24 @@ def main() -> int:
     # (and the configs), not the season's, or it scores the whole season
     day_paths = [str(root / "day1"), str(root / "configs")]
 
+    # the results of every run, by what they must equal: the season's (every configuration,
+    # every round, the warm rerun) and day 1's (with and without reports)
+    results: dict[str, list[tuple[str, dict[str, Any]]]] = {"season": [], "day 1": []}
+    day_ids: set[str] = set()
+
     def go(key: str, label: str, config: Path, out: Path, count: int, *extra: str) -> Run:
         paths = day_paths if config == one_day else [str(root)]
         argv = [ERTOOLS, "rescore", *paths, "--config", str(config), "--out", str(out), *extra]
-        run = _counts(out, timed(label, argv, count))
+        load_before = os.getloadavg()[0]
+        run = timed(label, argv, count)
+        run.load = load_before
+        doc = _doc(out)
+        run = _counts(doc, run)
+        if doc is not None:
+            group = "day 1" if config == one_day else "season"
+            results[group].append((f"{label} (round {len(rounds.get(key, [])) + 1})", doc))
+            if group == "day 1":
+                day_ids.update(str(r["id"]) for r in doc.get("executions") or [])
         # The least disturbed of the rounds counts (this machine is shared: other processes
         # only ever add time); every round is in the JSON.
         rounds.setdefault(key, []).append(run)
@@ -271,7 +298,7 @@ def main() -> int:
             runs[key] = run
         print(
             f"  {label:<44} {count:>5} {run.wall_s:8.2f} {run.per_execution_s:7.3f} "
-            f"{run.cpu_s:7.1f} {run.peak_main_mib:8.1f} {run.peak_other_mib:9.1f} "
+            f"{run.cpu_s:7.1f} {run.load:5.1f} {run.peak_main_mib:8.1f} {run.peak_other_mib:9.1f} "
             f"{run.processes:>5}  "
             f"{run.scored}/{run.cached}{'' if run.exit in (0, 1) else '  FAILED: ' + run.note}",
             flush=True,
@@ -351,6 +378,19 @@ def main() -> int:
     )
     everything = all(r.scored == r.executions for r in every)
     check("scored", "every execution scored in every run", f"{j2.scored}/{n}", everything)
+    identical, compared = _identical(results, day_ids)
+    same = all(ok for ok, _ in identical.values())
+    check(
+        "identical",
+        "identical results in every configuration",
+        f"{'yes' if same else 'NO'} ({compared} runs)",
+        same,
+    )
+    for group, (_, diffs) in identical.items():
+        for label, lines in diffs.items():
+            print(f"    {group}: {label} differs from the first run:")
+            for line in lines:
+                print(f"      {line}")
 
     # A 16-worker cluster by the same measure (Amdahl): the serial part (manifest, hashes,
     # cache check, writing results and the site: what a warm run does) plus the executions
@@ -379,6 +419,9 @@ def main() -> int:
             f"  {w:>2} worker(s), {n} executions: {a:8.1f} s by the wall time here, {b:8.1f} s "
             f"by the CPU time ({rate:,.0f} executions/hour)"
         )
+    labels = {g: [label for label, _ in docs] for g, docs in results.items()}
+    if results["season"] and results["day 1"]:
+        labels["day 1 in the season"] = [results["day 1"][0][0], results["season"][0][0]]
     args.json.parent.mkdir(parents=True, exist_ok=True)
     args.json.write_text(
         json.dumps(
@@ -390,6 +433,10 @@ def main() -> int:
                 "runs": {k: asdict(v) for k, v in runs.items()},
                 "rounds": {k: [asdict(v) for v in vs] for k, vs in rounds.items()},
                 "checks": checks,
+                "identical": {
+                    group: {"identical": ok, "differences": diffs, "runs": labels.get(group, [])}
+                    for group, (ok, diffs) in identical.items()
+                },
                 "extrapolation": {
                     "serial_s": serial,
                     "wall_per_execution_s": wall_per_exec,
@@ -404,6 +451,23 @@ def main() -> int:
     )
     print(f"\nwrote {args.json}")
     return 0 if all(checks.values()) else 1
+
+
+def _identical(
+    results: dict[str, list[tuple[str, dict[str, Any]]]], day_ids: set[str]
+) -> tuple[dict[str, tuple[bool, dict[str, list[str]]]], int]:
+    """Each group's runs compared with its first; day 1's executions also compared between
+    the day's first run and the season's first run (the same executions, scored alone)."""
+    out = {
+        group: compare([(label, comparable(doc)) for label, doc in docs])
+        for group, docs in results.items()
+    }
+    if results["season"] and results["day 1"]:
+        pair = [results["day 1"][0], results["season"][0]]
+        out["day 1 in the season"] = compare(
+            [(label, comparable(doc, day_ids)) for label, doc in pair]
+        )
+    return out, sum(len(docs) for docs in results.values())
 
 
 if __name__ == "__main__":

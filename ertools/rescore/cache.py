@@ -17,7 +17,9 @@ hand edits, not forgery: the cache is not signed (docs/rescore.md).
 Hashing terabytes of mocap at every run would cost more than scoring, so file hashes are
 remembered by (path, size, modification time, inode) in ``DIR/cache/hashes.json``, the way
 ``git`` trusts its index: a file rewritten in place with the same size and time is not seen
-(docs/rescore.md says so).
+(docs/rescore.md says so). The report files' hashes are remembered the same way: a warm rerun
+checks each report folder file by file from its stamps, reading only the files that changed
+(ertools writes every file by renaming a new one over it: a new inode, never the same stamp).
 """
 
 from __future__ import annotations
@@ -68,8 +70,9 @@ class FileHashes:
         st = path.stat()
         return [st.st_size, st.st_mtime_ns, st.st_ino]
 
-    def sha256(self, path: Path) -> str:
-        key = str(path.resolve())
+    def sha256(self, path: Path, key: str | None = None) -> str:
+        """The file's SHA-256, remembered by ``key`` (its resolved path unless given)."""
+        key = key if key is not None else str(path.resolve())
         stamp = self._stamp(path)
         known = self.known.get(key)
         if known is not None and known[:3] == stamp:
@@ -139,11 +142,14 @@ class Cache:
     """Outcomes by key in ``root`` (None: no cache, every job recomputed).
 
     ``invalid`` lists the entries found and refused (schema, checksum, report folder), each
-    with why: the caller says so once.
+    with why: the caller says so once. ``hashes``: where the report files' SHA-256 are
+    remembered by stamp, as the inputs' are (a warm rerun of a season then reads none of its
+    ~2,000 report files; None: each is read and hashed at every check).
     """
 
-    def __init__(self, root: Path | None) -> None:
+    def __init__(self, root: Path | None, hashes: FileHashes | None = None) -> None:
         self.root = root
+        self.hashes = hashes
         self.invalid: list[tuple[Path, str]] = []
 
     def _path(self, key: str) -> Path | None:
@@ -164,7 +170,7 @@ class Cache:
             return None
         outcome = Outcome.from_dict({**data["outcome"], "id": job.id})
         if outcome.report is not None:
-            why = _changed_report(Path(outcome.report), data["report_files"])
+            why = _changed_report(Path(outcome.report), data["report_files"], self.hashes)
             if why is not None:  # removed, or damaged (a kill while it was written)
                 self.invalid.append((path, why))
                 return None
@@ -181,10 +187,12 @@ class Cache:
         files = {}
         if outcome.report is not None:
             folder = Path(outcome.report).parent
+            base = str(folder.resolve())
             files = {
-                p.relative_to(folder).as_posix(): _sha256_file(p)
+                rel: _report_sha256(p, base, rel, self.hashes)
                 for p in sorted(folder.rglob("*"))
                 if p.is_file()
+                for rel in [p.relative_to(folder).as_posix()]
             }
         entry = {"cache": CACHE_VERSION, "outcome": record, "report_files": files}
         entry["checksum"] = _checksum(entry)
@@ -234,16 +242,25 @@ def _invalid_entry(data: Any) -> str | None:
     return f"invalid {', '.join(bad)}" if bad else None
 
 
-def _changed_report(index: Path, files: Mapping[str, str]) -> str | None:
-    """Why the report folder of ``index`` is not the one cached (None: it is, file by file)."""
+def _report_sha256(path: Path, base: str, rel: str, hashes: FileHashes | None) -> str:
+    # the folder resolved once, not each of its files (a resolve is a stat per path part)
+    return _sha256_file(path) if hashes is None else hashes.sha256(path, f"{base}/{rel}")
+
+
+def _changed_report(
+    index: Path, files: Mapping[str, str], hashes: FileHashes | None = None
+) -> str | None:
+    """Why the report folder of ``index`` is not the one cached (None: it is, file by file;
+    with ``hashes``, a file whose stamp is the one remembered is not read again)."""
     folder = index.parent
     if not index.is_file() or index.relative_to(folder).as_posix() not in files:
         return "its report folder is gone"
+    base = str(folder.resolve())
     for rel, digest in files.items():
         path = folder / rel
         if ".." in Path(rel).parts or not path.is_file():
             return f"report file {rel} is missing"
-        if _sha256_file(path) != digest:
+        if _report_sha256(path, base, rel, hashes) != digest:
             return f"report file {rel} has changed"
     return None
 

@@ -15,17 +15,32 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks import registry
 from ertools.benchmarks.common.teams import read_payload_team
+from ertools.io.clock import clock_check
 from ertools.progress import Reporter
 from ertools.report.timeline_page import write_timeline_page
 from ertools.rescore.discover import Discovery, Execution, discover
+from ertools.rescore.memo import (
+    CLOCK,
+    TEAM,
+    FileMemo,
+    clock_from_json,
+    clock_json_valid,
+    clock_to_json,
+    team_json_valid,
+)
 from ertools.rescore.pipeline import Scoring
 from ertools.timeline.model import Timeline
 from ertools.timeline.scan import scan
+
+if TYPE_CHECKING:
+    from ertools.io import BagSummary
+    from ertools.io.model import ClockCheck
 
 ROBOT_BAG = "ROBOT_BAG"
 TIMELINE_PAGE = "timeline.html"
@@ -76,25 +91,40 @@ def robot_benchmarks() -> tuple[str, ...]:
     return tuple(out)
 
 
-def payload_teams(timeline: Timeline) -> dict[str, str]:
-    """Benchmark log -> the team its state payloads name (where one does)."""
+def payload_teams(timeline: Timeline, memo: FileMemo | None = None) -> dict[str, str]:
+    """Benchmark log -> the team its state payloads name (where one does); remembered in
+    ``memo`` by the log's stamp."""
+    memo = memo or FileMemo(None)
     teams: dict[str, str] = {}
     for entry in timeline.bags:
         if entry.kind != "benchmark" or not entry.readable or entry.copy_of is not None:
             continue
         for namespace in entry.benchmarks:
-            team = read_payload_team([entry.path], namespace.lower())
+            ns = namespace.lower()
+            team = memo.get(
+                entry.path, TEAM + ns, partial(read_payload_team, [entry.path], ns), team_json_valid
+            )
             if team:
                 teams[entry.path] = team
                 break
     return teams
 
 
-def find(paths: Sequence[Path], *, progress: Reporter | None = None) -> Found:
-    """Scan ``paths`` and turn every execution found into its scorings."""
+def find(
+    paths: Sequence[Path], *, progress: Reporter | None = None, memo: FileMemo | None = None
+) -> Found:
+    """Scan ``paths`` and turn every execution found into its scorings; what each log says
+    (its clock check, its payloads' team) is taken from ``memo`` while the log is unchanged
+    (:mod:`ertools.rescore.memo`)."""
+    memo = memo or FileMemo(None)
+
+    def clock(s: BagSummary) -> ClockCheck | None:
+        value = memo.get(s.path, CLOCK, lambda: clock_to_json(clock_check(s)), clock_json_valid)
+        return clock_from_json(str(s.path), value)
+
     # absolute, so that every path of the results can be shown relative to the folder
-    timeline = scan([Path(p).resolve() for p in paths], progress=progress)
-    discovery = discover(timeline, payload_teams(timeline))
+    timeline = scan([Path(p).resolve() for p in paths], progress=progress, clock=clock)
+    discovery = discover(timeline, payload_teams(timeline, memo))
     known = set(registry.names())
     robots = robot_benchmarks()
     problems = [{"kind": p.kind, "path": p.path, "message": p.message} for p in discovery.problems]

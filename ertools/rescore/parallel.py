@@ -22,7 +22,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from importlib import import_module
 from typing import Any
 
@@ -31,6 +31,7 @@ from ertools.errors import ConfigError
 from ertools.report import html
 from ertools.report.figures import preload
 from ertools.rescore.jobs import Job, Outcome, load_benchmark, run_job
+from ertools.rescore.schedule import Schedule
 
 OnDone = Callable[[Outcome], None]
 log = logging.getLogger(__name__)
@@ -40,17 +41,29 @@ def default_jobs() -> int:
     return os.cpu_count() or 1
 
 
-def run_jobs(jobs: Sequence[Job], *, workers: int, scheduler: str | None, on_done: OnDone) -> None:
-    """Score every job (by ``workers`` local processes, or the Dask ``scheduler``)."""
+def run_jobs(
+    jobs: Sequence[Job],
+    *,
+    workers: int,
+    scheduler: str | None,
+    on_done: OnDone,
+    known: Iterable[tuple[str, float]] = (),
+    dask: DaskClient | None = None,
+) -> None:
+    """Score every job (by ``workers`` local processes, or the Dask ``scheduler``); with
+    several workers, the longest expected first (:mod:`ertools.rescore.schedule`; ``known``:
+    (benchmark, seconds) of executions already timed). ``dask``: the scheduler's client,
+    already being started (:func:`early_dask`); closed in the background once the jobs are
+    done."""
     if not jobs:
         return
     if scheduler is not None:
-        run_dask(jobs, scheduler, workers=workers, on_done=on_done)
+        run_dask(jobs, scheduler, workers=workers, on_done=on_done, known=known, dask=dask)
     elif workers <= 1:
         for job in jobs:  # in this process: the simplest path, and the reference for the others
             on_done(run_job(job))
     else:
-        run_local(jobs, workers=workers, on_done=on_done)
+        run_local(jobs, workers=workers, on_done=on_done, known=known)
 
 
 # prctl(2): PR_SET_PDEATHSIG, the signal the kernel sends a process when its parent ends
@@ -135,6 +148,7 @@ def run_job_forked(job: Job) -> Outcome:
     if child is None or child.owner != os.getpid():  # none yet, or one of a parent's
         _warm(job)
         child = _children.child = _Child()
+        _forked.append(child)
         # reaped when the worker exits: no orphan, and its CPU time counts as the worker's
         atexit.register(child.close)
     outcome = child.run(job)
@@ -150,6 +164,16 @@ def run_job_forked(job: Job) -> Outcome:
 
 
 _children = threading.local()  # one child per thread of a Dask worker that runs tasks
+_forked: list[_Child] = []  # every child of this process, to close with an in-process cluster
+
+
+def close_children() -> None:
+    """Close the scoring children this process forked (its LocalCluster's worker threads
+    are gone: a library caller's process does not keep them until it exits)."""
+    mine = [c for c in _forked if c.owner == os.getpid()]
+    _forked[:] = [c for c in _forked if c.owner != os.getpid()]
+    for child in mine:
+        child.close()
 
 
 class _Child:
@@ -221,10 +245,17 @@ class _Worker:
         self.job: Job | None = None
 
 
-def run_local(jobs: Sequence[Job], *, workers: int, on_done: OnDone) -> None:
-    """Score ``jobs`` with ``workers`` local processes; a worker that dies costs its job."""
+def run_local(
+    jobs: Sequence[Job],
+    *,
+    workers: int,
+    on_done: OnDone,
+    known: Iterable[tuple[str, float]] = (),
+) -> None:
+    """Score ``jobs`` with ``workers`` local processes, the longest expected first; a worker
+    that dies costs its job."""
     ctx = _context()
-    pending = list(reversed(jobs))
+    pending = Schedule(jobs, known)
     pool = [_Worker(ctx) for _ in range(min(workers, len(jobs)))]
     try:
         for worker in pool:
@@ -244,13 +275,15 @@ def run_local(jobs: Sequence[Job], *, workers: int, on_done: OnDone) -> None:
                         outcome = _died(worker)
                         pool[i] = worker = _replace(worker, ctx)
                     worker.job = None
+                    pending.done(outcome)
+                    _assign(worker, pending)  # the next job first: the worker waits for none
                     on_done(outcome)
-                    _assign(worker, pending)
                 elif worker.process.sentinel in ready:
                     outcome = _died(worker)
                     pool[i] = worker = _replace(worker, ctx)
-                    on_done(outcome)
+                    pending.done(outcome)
                     _assign(worker, pending)
+                    on_done(outcome)
     finally:
         for worker in pool:
             with contextlib.suppress(OSError, ValueError):  # a worker already gone
@@ -262,10 +295,11 @@ def run_local(jobs: Sequence[Job], *, workers: int, on_done: OnDone) -> None:
                 worker.process.join()
 
 
-def _assign(worker: _Worker, pending: list[Job]) -> None:
-    if pending:
-        worker.job = pending.pop()
-        worker.conn.send(worker.job)
+def _assign(worker: _Worker, pending: Schedule) -> None:
+    job = pending.next()
+    if job is not None:
+        worker.job = job
+        worker.conn.send(job)
 
 
 def _died(worker: _Worker) -> Outcome:
@@ -284,23 +318,118 @@ def _replace(worker: _Worker, ctx: Any) -> _Worker:
     return _Worker(ctx)
 
 
-def run_dask(jobs: Sequence[Job], address: str, *, workers: int, on_done: OnDone) -> None:
+def run_dask(
+    jobs: Sequence[Job],
+    address: str,
+    *,
+    workers: int,
+    on_done: OnDone,
+    known: Iterable[tuple[str, float]] = (),
+    dask: DaskClient | None = None,
+) -> None:
     """Score ``jobs`` on a Dask cluster (``local``: a LocalCluster of ``workers`` processes).
 
     Only the jobs (paths and values) go through the scheduler; workers read the logs from the
     shared file system. A job whose worker died as often as the scheduler allows
     (``distributed.scheduler.allowed-failures``) comes back as ``KilledWorker``: one row.
+    ``dask``: a client started earlier (:func:`early_dask`): it is closed in the background
+    (its owner waits for it), else the client is started here and closed before returning.
     """
+    owned = dask is None
+    handle = dask if dask is not None else DaskClient(address, workers)
     try:
-        # optional extra `ertools[dask]`: imported only when a scheduler is asked for
-        import distributed as _distributed  # lazy: the optional Dask extra (ertools[dask])
-    except ImportError:
-        raise ConfigError(
-            "--scheduler needs Dask distributed: pip install 'ertools[dask]'"
-        ) from None
-    distributed: Any = _distributed  # untyped calls: its API is checked by the Dask test
-    with _dask_logs_as_one_line(address):
-        _run_dask(distributed, jobs, address, workers=workers, on_done=on_done)
+        distributed, client = handle.get()
+        _run_dask(distributed, client, jobs, workers=workers, on_done=on_done, known=known)
+    finally:
+        handle.close(wait=owned)
+
+
+class DaskClient:
+    """A Dask client being connected (a LocalCluster being started: its scheduler, nannies
+    and worker processes) in a thread of its own, so that a run can start it before scanning
+    the logs, and close it while it writes the results: Dask's fixed costs (~3.4 s of CPU,
+    mostly in the processes it starts, and seconds of waiting for them; docs/rescore.md)
+    overlap the main process's own work instead of adding to it.
+
+    ``distributed``'s log records are held from the start to the close and said in one line
+    (:func:`_dask_logs_as_one_line`).
+    """
+
+    def __init__(self, address: str, workers: int) -> None:
+        self.address = address
+        self._stack = contextlib.ExitStack()
+        self._got: tuple[Any, Any] | None = None
+        self._cluster: Any = None
+        self._error: BaseException | None = None
+        self._closing: threading.Thread | None = None
+        self._thread = threading.Thread(target=self._start, args=(workers,), daemon=True)
+        self._thread.start()
+
+    def _start(self, workers: int) -> None:
+        try:
+            try:
+                # optional extra `ertools[dask]`: imported only when a scheduler is asked for
+                import distributed as _distributed  # lazy: the optional Dask extra
+            except ImportError:
+                raise ConfigError(
+                    "--scheduler needs Dask distributed: pip install 'ertools[dask]'"
+                ) from None
+            distributed: Any = _distributed  # untyped calls: its API is checked by the Dask test
+            self._stack.enter_context(_dask_logs_as_one_line(self.address))
+            client, self._cluster = _connect(distributed, self.address, workers)
+            self._got = (distributed, client)
+        except BaseException as err:  # said by get(), in the thread that needs the client
+            self._error = err
+
+    def get(self) -> tuple[Any, Any]:
+        """(the ``distributed`` module, the client), once started.
+
+        Raises:
+            ConfigError: Dask not installed, the scheduler not reachable.
+        """
+        self._thread.join()
+        if self._error is not None:
+            raise self._error
+        assert self._got is not None
+        return self._got
+
+    def close(self, *, wait: bool = True) -> None:
+        """Close the client (and the LocalCluster); ``wait`` False: in the background, see
+        :meth:`join`."""
+        if self._closing is None:
+            self._closing = threading.Thread(target=self._close, daemon=True)
+            self._closing.start()
+        if wait:
+            self.join()
+
+    def join(self) -> None:
+        """Wait for the start, and the close when one was asked (with :meth:`close`)."""
+        self._thread.join()
+        if self._closing is not None:
+            self._closing.join()
+
+    def _close(self) -> None:
+        self._thread.join()
+        try:
+            if self._got is not None:
+                with contextlib.suppress(Exception):  # a scheduler already gone
+                    self._got[1].close()
+            if self._cluster is not None:
+                with contextlib.suppress(Exception):
+                    self._cluster.close()
+                close_children()
+        finally:
+            self._stack.close()
+            sys.stderr.flush()
+
+
+def early_dask(scheduler: str | None, workers: int, cold: bool) -> DaskClient | None:
+    """A Dask client started now, for a run that will need it: with a scheduler, on a
+    ``cold`` run (nothing in the cache: every execution is to be scored). A rerun may find
+    everything in the cache and need no cluster: its client is started only if needed."""
+    if scheduler is None or not cold:
+        return None
+    return DaskClient(scheduler, workers)
 
 
 class _Held(logging.Handler):
@@ -342,61 +471,90 @@ def _dask_logs_as_one_line(address: str) -> Iterator[None]:
             log.warning("Dask (%s): %s%s", address, first, more)
 
 
-def _run_dask(
-    distributed: Any, jobs: Sequence[Job], address: str, *, workers: int, on_done: OnDone
-) -> None:
+def _connect(distributed: Any, address: str, workers: int) -> tuple[Any, Any]:
+    """(the client, the LocalCluster or None) for ``address``."""
     cluster = None
     try:
         if address == "local":
             import dask.config  # lazy: the optional Dask extra (ertools[dask]), as distributed
 
+            # The workers are threads of this process (processes=False): each scores its jobs
+            # in a process forked from this one (run_job_forked), as on any Dask worker, so
+            # the executions still run side by side and a crash costs one row; what goes is
+            # spawning a nanny and a worker process per worker, each importing distributed
+            # and ertools (~2.3 s of CPU for two, plus each worker's first imports: the
+            # LocalCluster was 6 % slower than --jobs 2 on a day, +21 % with them).
             # Without the workers' statistical profiler (a thread sampling every 10 ms, ~5 %
             # of a core per worker: measured in docs/performance.md), and without the
-            # MALLOC_TRIM_THRESHOLD_=65536 the nannies put in their workers' environment: glibc
-            # then hands every freed array back to the kernel, and the next execution faults
-            # its pages in again (a local worker keeps them). The nannies hand this
-            # configuration to the worker processes they start.
+            # MALLOC_TRIM_THRESHOLD_=65536 nannies put in their workers' environment (glibc
+            # then hands every freed array back to the kernel: for a cluster started with
+            # processes). The event loops' tick monitor (every 20 ms), the system monitor
+            # (500 ms) and the memory monitor (100 ms) cost 7 % of a core while a cluster
+            # waits (1.08 s of CPU in 15 s); at 1 s, 5 s and 1 s, 1.5 % (0.23 s).
             with dask.config.set(
                 {
                     "distributed.worker.profile.enabled": False,
                     "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
+                    "distributed.admin.tick.interval": "1s",
+                    "distributed.admin.system-monitor.interval": "5s",
+                    "distributed.worker.memory.monitor-interval": "1s",
                 }
             ):
                 cluster = distributed.LocalCluster(
                     n_workers=max(workers, 1),
                     threads_per_worker=1,
-                    processes=True,
+                    processes=False,
                     dashboard_address=None,
                 )
-            client = distributed.Client(cluster)
-        else:
-            client = distributed.Client(address, timeout="10s")
+            return distributed.Client(cluster), cluster
+        return distributed.Client(address, timeout="10s"), None
     except (OSError, TimeoutError) as err:
-        raise ConfigError(f"--scheduler {address}: cannot connect ({err})") from err
-    try:
-        futures = {
-            client.submit(
-                run_job_forked, job, key=f"rescore-{job.id}-{os.getpid()}", pure=False
-            ): job
-            for job in jobs
-        }
-        for future in distributed.as_completed(futures):
-            job = futures[future]
-            try:
-                outcome = future.result()
-            except distributed.KilledWorker:
-                outcome = Outcome(
-                    job.id,
-                    "failed",
-                    reason="the Dask worker scoring it died; the others were scored",
-                )
-            except Exception as err:  # lost connection, a worker without ertools...
-                text = " ".join(f"{type(err).__name__}: {err}".split())
-                outcome = Outcome(job.id, "failed", reason=f"Dask: {text}")
-            on_done(outcome)
-            future.release()
-    finally:
-        client.close()
         if cluster is not None:
-            cluster.close()
-        sys.stderr.flush()
+            with contextlib.suppress(Exception):
+                cluster.close()
+        raise ConfigError(f"--scheduler {address}: cannot connect ({err})") from err
+
+
+def _run_dask(
+    distributed: Any,
+    client: Any,
+    jobs: Sequence[Job],
+    *,
+    workers: int,
+    on_done: OnDone,
+    known: Iterable[tuple[str, float]] = (),
+) -> None:
+    # Handed out as on local workers, the longest expected first: a few tasks per worker
+    # thread in flight (none waits for the scheduler), the next chosen as each ends.
+    pending = Schedule(jobs, known)
+    slots = sum(client.nthreads().values()) or max(workers, 1)
+    futures: dict[Any, Job] = {}
+    running = distributed.as_completed()
+
+    def submit() -> None:
+        job = pending.next()
+        if job is not None:
+            key = f"rescore-{job.id}-{os.getpid()}"
+            future = client.submit(run_job_forked, job, key=key, pure=False)
+            futures[future] = job
+            running.add(future)
+
+    for _ in range(2 * slots):
+        submit()
+    for future in running:
+        job = futures.pop(future)
+        try:
+            outcome = future.result()
+        except distributed.KilledWorker:
+            outcome = Outcome(
+                job.id,
+                "failed",
+                reason="the Dask worker scoring it died; the others were scored",
+            )
+        except Exception as err:  # lost connection, a worker without ertools...
+            text = " ".join(f"{type(err).__name__}: {err}".split())
+            outcome = Outcome(job.id, "failed", reason=f"Dask: {text}")
+        pending.done(outcome)
+        submit()
+        on_done(outcome)
+        future.release()

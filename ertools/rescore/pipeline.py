@@ -30,7 +30,7 @@ from ertools.report import ranks
 from ertools.rescore.cache import Cache, FileHashes, job_key, records
 from ertools.rescore.jobs import Job, Outcome
 from ertools.rescore.manifest import Manifest
-from ertools.rescore.parallel import run_jobs
+from ertools.rescore.parallel import DaskClient, run_jobs
 from ertools.rescore.site import write_site
 from ertools.rescore.site_text import TEAM_UNKNOWN
 from ertools.timeutil import NS_PER_S, iso_utc
@@ -221,6 +221,7 @@ def rescore(
     timeline: Mapping[str, Any] | None = None,
     progress: Reporter | None = None,
     on_outcome: Callable[[Outcome], None] | None = None,
+    dask: DaskClient | None = None,
 ) -> dict[str, Any]:
     """Score every execution (cache first) and return the ``results.json`` document.
 
@@ -238,11 +239,12 @@ def rescore(
         timeline: the ``timeline`` entry of the document (figure, sessions).
         progress: told of every execution done.
         on_outcome: called with each outcome as it arrives (the CLI's stderr lines).
+        dask: the ``scheduler``'s client, started earlier (the caller closes it).
     """
     out.mkdir(parents=True, exist_ok=True)
     cache_dir = out / "cache"
     hashes = FileHashes(cache_dir / "hashes.json")
-    cache = Cache(cache_dir)
+    cache = Cache(cache_dir, hashes)
     planned = plan(executions, manifest, out, reports=reports)
     outcomes: dict[str, Outcome] = {}
     cached: set[str] = set()
@@ -302,7 +304,9 @@ def rescore(
             on_outcome(outcome)
         tell()
 
-    run_jobs(to_run, workers=workers, scheduler=scheduler, on_done=done)
+    # what the cache hits took tells the schedule which benchmarks cost most
+    known = [(p.job.benchmark, outcomes[p.job.id].seconds) for p in planned if p.job.id in cached]
+    run_jobs(to_run, workers=workers, scheduler=scheduler, on_done=done, known=known, dask=dask)
     return document(
         planned,
         outcomes,

@@ -19,11 +19,14 @@ from ertools.errors import ConfigError
 from ertools.rescore.found import find, merge, write_timeline
 from ertools.rescore.ledger import account
 from ertools.rescore.manifest import Manifest
+from ertools.rescore.memo import FileMemo
+from ertools.rescore.parallel import early_dask
 from ertools.rescore.pipeline import listed_executions, rescore, write_results
 
 if TYPE_CHECKING:
     from ertools.progress import Reporter
     from ertools.rescore.jobs import Outcome
+    from ertools.rescore.parallel import DaskClient
 
 
 @dataclass(frozen=True)
@@ -56,37 +59,78 @@ def rescore_competition(
     """
     # two runs into one folder would mix their reports and caches: one at a time
     with folder_lock(out, on_wait=on_wait):
-        scorings = listed_executions(manifest)
-        problems: list[dict[str, object]] = []
-        timeline = None
-        found = None
-        if paths:
-            found = find(paths, progress=progress)
-            scorings = merge(found.scorings, scorings)
-            problems = list(found.problems)
-            out.mkdir(parents=True, exist_ok=True)
-            timeline = write_timeline(found, out, manifest.title)
-        if not scorings:
-            where = ", ".join(map(str, paths)) or "no logs were given"
-            raise ConfigError(
-                f"no benchmark execution found ({where}) and none listed in the manifest",
-                path=manifest.path,
+        # A first run into this folder scores everything: a Dask cluster is started now, while
+        # the logs are scanned, not after (a rerun starts one only if the cache lacks a score)
+        cold = not use_cache or not any((out / "cache" / "outcomes").glob("*.json"))
+        dask = early_dask(scheduler, workers, cold)
+        try:
+            return _rescore(
+                paths,
+                manifest,
+                out,
+                workers=workers,
+                scheduler=scheduler,
+                use_cache=use_cache,
+                reports=reports,
+                command=command,
+                progress=progress,
+                on_outcome=on_outcome,
+                dask=dask,
             )
-        doc = rescore(
-            scorings,
-            manifest,
-            out,
-            workers=workers,
-            scheduler=scheduler,
-            use_cache=use_cache,
-            reports=reports,
-            command=list(command),
-            problems=problems,
-            timeline=timeline,
-            progress=progress,
-            on_outcome=on_outcome,
+        finally:
+            if dask is not None:
+                dask.close()  # closing since the last job ended, while the results were written
+
+
+def _rescore(
+    paths: Sequence[Path],
+    manifest: Manifest,
+    out: Path,
+    *,
+    workers: int,
+    scheduler: str | None,
+    use_cache: bool,
+    reports: bool,
+    command: Sequence[str],
+    progress: Reporter | None,
+    on_outcome: Callable[[Outcome], None] | None,
+    dask: DaskClient | None,
+) -> Rescored:
+    scorings = listed_executions(manifest)
+    problems: list[dict[str, object]] = []
+    timeline = None
+    found = None
+    if paths:
+        # what each log says, remembered between runs (a warm rerun reads no log)
+        memo = FileMemo(out / "cache" / "files.json", load=use_cache)
+        found = find(paths, progress=progress, memo=memo)
+        memo.save()
+        scorings = merge(found.scorings, scorings)
+        problems = list(found.problems)
+        out.mkdir(parents=True, exist_ok=True)
+        timeline = write_timeline(found, out, manifest.title)
+    if not scorings:
+        where = ", ".join(map(str, paths)) or "no logs were given"
+        raise ConfigError(
+            f"no benchmark execution found ({where}) and none listed in the manifest",
+            path=manifest.path,
         )
-        if found is not None:  # every file under PATH in one place (docs/rescore.md, "files")
-            robots = {str(s.bags[0]): s.of for s in found.scorings if s.of is not None}
-            doc = account(doc, found.files, found.folders, robots)
-        return Rescored(doc, tuple(write_results(doc, out)))
+    doc = rescore(
+        scorings,
+        manifest,
+        out,
+        workers=workers,
+        scheduler=scheduler,
+        use_cache=use_cache,
+        reports=reports,
+        command=list(command),
+        problems=problems,
+        timeline=timeline,
+        progress=progress,
+        on_outcome=on_outcome,
+        dask=dask,
+    )
+    if found is not None:  # every file under PATH in one place (docs/rescore.md, "files")
+        robots = {str(s.bags[0]): s.of for s in found.scorings if s.of is not None}
+        doc = account(doc, found.files, found.folders, robots)
+    return Rescored(doc, tuple(write_results(doc, out)))

@@ -525,10 +525,12 @@ def write_site(results: dict[str, Any], out: Path) -> Path:
         ConfigError: not a results document, or ``out`` cannot be written.
     """
 
+    base = out.resolve()  # once: a resolve is a stat per part of the path
+
     def exists(rel: str) -> bool:
         # Only files inside ``out``: a link the page shows must open from the folder alone.
-        target = (out / rel).resolve()
-        return target.is_file() and target.is_relative_to(out.resolve())
+        target = (base / rel).resolve()
+        return target.is_file() and target.is_relative_to(base)
 
     context = site_context(results, exists)
     index = out / "index.html"

@@ -33,6 +33,7 @@ def check_recordings(
     summaries: Sequence[BagSummary],
     tolerance_ns: int,
     on_progress: Callable[[int], None] | None = None,
+    check: Callable[[BagSummary], ClockCheck | None] | None = None,
 ) -> list[ClockCheck]:
     """Clock checks, one per recording unless it finds a problem.
 
@@ -41,6 +42,7 @@ def check_recordings(
     ``tolerance_ns`` the other files of that recording are checked too, so every flagged
     file was measured. Files that are not split files are each checked.
     """
+    check = check or clock_check
     groups: dict[str, list[tuple[int, BagSummary]]] = {}
     for s in summaries:
         split = split_name(s.path)
@@ -50,7 +52,7 @@ def check_recordings(
     done = 0
     for members in groups.values():
         members.sort(key=lambda m: m[0])
-        first = clock_check(members[0][1])
+        first = check(members[0][1])
         done += 1
         if on_progress is not None:
             on_progress(done)
@@ -59,7 +61,7 @@ def check_recordings(
         checks.append(first)
         if abs(first.offset_ns) > tolerance_ns:
             for _, s in members[1:]:
-                c = clock_check(s)
+                c = check(s)
                 if c is not None:
                     checks.append(c)
     return checks
@@ -102,6 +104,7 @@ def scan(
     *,
     check_clocks: bool = True,
     progress: Reporter | None = None,
+    clock: Callable[[BagSummary], ClockCheck | None] | None = None,
 ) -> Timeline:
     """Find, summarise and clock-check the bags under ``paths`` and build their timeline.
 
@@ -110,15 +113,20 @@ def scan(
         config: thresholds.
         check_clocks: compare header stamps with record times (reads a second per bag).
         progress: gets the bags summarised, then the recordings clock-checked.
+        clock: the clock check of one bag (a rescore passes one that remembers its checks).
     """
 
     found = find_bags(Path(p) for p in paths)
     with reporting(None):  # counted by bag and recording: the reads inside do not report
-        return _scan(found, config, check_clocks, progress)
+        return _scan(found, config, check_clocks, progress, clock)
 
 
 def _scan(
-    found: Found, config: TimelineConfig | None, check_clocks: bool, progress: Reporter | None
+    found: Found,
+    config: TimelineConfig | None,
+    check_clocks: bool,
+    progress: Reporter | None,
+    clock: Callable[[BagSummary], ClockCheck | None] | None = None,
 ) -> Timeline:
     tick: Callable[[int], None] | None = None
     if progress is not None:
@@ -132,5 +140,5 @@ def _scan(
             recordings = {(split_name(s.path) or (s.path, 0))[0] for s in summaries}
             progress.task("checking clocks", len(recordings), "recordings")
             tick = _ticker(progress)
-        checks = check_recordings(summaries, tolerance, tick)
+        checks = check_recordings(summaries, tolerance, tick, clock)
     return build_timeline(summaries, [*found.problems, *unreadable], checks, config)

@@ -390,3 +390,39 @@ def test_a_machine_error_is_not_cached(tmp_path: Path, capsys: pytest.CaptureFix
     assert rows[FIRST]["status"] == "scored" and not rows[FIRST]["cached"]
     assert rows[FIRST]["rank_value"] == expected_value(FIRST)
     assert capsys.readouterr().err.count("0 unscoreable") == 1
+
+
+def test_report_files_are_read_again_only_when_their_stamp_changed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A warm rerun checks the report folders from the stamps remembered in hashes.json (no
+    file read); a file rewritten with the same size (a new inode and time, as any write
+    gives) is read, found changed, and its execution scored again."""
+    from ertools.rescore import cache
+
+    comp = make_competition(tmp_path / "comp")
+    out = tmp_path / "out"
+    argv = ["rescore", "--config", str(comp.manifest), "--out", str(out), "--jobs", "1"]
+    assert main(argv) == 0
+    read: list[str] = []
+    real = cache._sha256_file
+
+    def counted(path: Path) -> str:
+        read.append(path.name)
+        return real(path)
+
+    monkeypatch.setattr(cache, "_sha256_file", counted)
+    assert main(argv) == 0
+    assert read == []  # every report file known by its stamp
+    score = out / "executions" / FIRST / "score.json"
+    text = score.read_bytes()
+    flipped = text.replace(b"4.25", b"9.25", 1)  # same size, other content
+    assert flipped != text and len(flipped) == len(text)
+    score.unlink()  # a new file, as an editor or a copy writes it
+    score.write_bytes(flipped)
+    capsys.readouterr()
+    assert main(argv) == 0
+    assert "report file score.json has changed" in capsys.readouterr().err
+    rows = {r["id"]: r for r in json.loads((out / "results.json").read_text())["executions"]}
+    assert [i for i, r in rows.items() if not r["cached"]] == [FIRST]
+    assert score.read_bytes() == text  # written again by the scorer

@@ -28,8 +28,9 @@ bias (the calibration found every miss above the interval). Each draw's shift fr
 smoothed path's own score, added to the score, gives the basic interval.
 
 Each draw re-runs the whole Eq. (1) on the perturbed positions: the d_min subsampling (a
-sequential rule: one pass over the samples, vectorised over the draws), the run frame from
-the perturbed reference and start, l/L and the mean distance. ``best_distance_error`` is the
+sequential rule: one pass over the samples, each step vectorised over the draws of all the
+runs side by side), the run frame from the perturbed reference and start, l/L and the mean
+distance. ``best_distance_error`` is the
 minimum over the runs of each draw.
 """
 
@@ -42,7 +43,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import F64, IntArr
+from ertools.arrays import F64, Bool, IntArr
 from ertools.benchmarks.common.uncertainty import (
     D_MIN,
     MOCAP_NOISE,
@@ -66,6 +67,10 @@ DEFAULT_C = 3.0  # the seed's D_MIN = c * epsilon (7.3.2), for the default noise
 DEFAULT_D_MIN_REL = 0.10
 # Draws x samples of one batch: bounds the memory of a long run (~8 bytes x a few arrays).
 BATCH_ELEMENTS = 2_000_000
+# Draws x samples of the runs whose d_min rule runs in one pass (padded to the longest): a
+# competition's four runs of ~600 samples x 400 draws in two passes, ~8 MB a pass, so that a
+# score's peak memory stays within 4 MB of the run-by-run pass it replaced.
+GROUP_ELEMENTS = 600_000
 METHOD = "Monte Carlo (parametric bootstrap around the smoothed path, basic interval)"
 # Quadratic Savitzky-Golay weights over 9 samples, and the variance of noise left after it.
 SMOOTH = np.array([-21.0, 14.0, 39.0, 54.0, 59.0, 54.0, 39.0, 14.0, -21.0]) / 231.0
@@ -175,77 +180,164 @@ def perturbed_errors(
 ) -> F64:
     """(D,) distance errors of one run with its positions perturbed by ``sigmas`` (D,) (when
     ``noisy``) and subsampled with ``d_mins`` (D,); NaN where a draw cannot be scored."""
+    return perturbed_runs([run], sigmas, d_mins, rng, noisy)[:, 0]
+
+
+def perturbed_runs(
+    runs: Sequence[RunSamples],
+    sigmas: F64,
+    d_mins: F64,
+    rng: np.random.Generator,
+    noisy: bool,
+    *,
+    budget: int = BATCH_ELEMENTS,
+) -> F64:
+    """(D, R) distance errors of every run in every draw: column ``r`` is
+    :func:`perturbed_errors` of ``runs[r]``, with the noise drawn from ``rng`` in the same
+    order (run by run, each run's draws in batches of at most ``budget`` samples).
+
+    The d_min rule is one pass over the samples for as many runs (all their draws side by
+    side) as fit in :data:`GROUP_ELEMENTS` (or ``budget``, if smaller) padded samples.
+    """
+    d = sigmas.size
+    out = np.empty((d, len(runs)))
+    pieces = [
+        (col, lo, min(d, lo + batch))
+        for col, run in enumerate(runs)
+        for batch in [max(1, budget // max(len(run.xy), 1))]
+        for lo in range(0, d, batch)
+    ]
+    for group in _groups(pieces, [len(r.xy) for r in runs], min(budget, GROUP_ELEMENTS)):
+        # every piece's draws side by side, samples down the rows (shorter runs padded with
+        # NaN, never kept): the positions are drawn straight into these two arrays
+        lengths = [len(runs[col].xy) for col, _, _ in group]
+        edges = np.cumsum([0, *(hi - lo for _, lo, hi in group)])
+        xt = np.full((max(lengths), int(edges[-1])), np.nan)
+        yt = np.full_like(xt, np.nan)
+        views = [
+            (xt[:m, a:b].T, yt[:m, a:b].T, slice(a, b), m)
+            for a, b, m in zip(edges[:-1], edges[1:], lengths, strict=True)
+        ]
+        refs = [
+            _positions(runs[col], sigmas[lo:hi], rng, noisy, x, y)
+            for (col, lo, hi), (x, y, _, _) in zip(group, views, strict=True)
+        ]
+        kept = _subsample(xt, yt, np.concatenate([d_mins[lo:hi] for _, lo, hi in group]))
+        for (col, lo, hi), (x, y, cols, m), (rx, ry) in zip(group, views, refs, strict=True):
+            out[lo:hi, col] = _eq1(x, y, kept[:m, cols].T, rx, ry, runs[col].shape)
+    return out
+
+
+def _groups(
+    pieces: list[tuple[int, int, int]], lengths: list[int], budget: int
+) -> list[list[tuple[int, int, int]]]:
+    """Consecutive (run, lo, hi) pieces grouped while the group's draws x its longest run
+    stay within ``budget`` (a piece alone may exceed it only with a single draw)."""
+    groups: list[list[tuple[int, int, int]]] = []
+    width = longest = 0
+    for piece in pieces:
+        col, lo, hi = piece
+        w, n = width + hi - lo, max(longest, lengths[col])
+        if groups and w * n <= budget:
+            groups[-1].append(piece)
+            width, longest = w, n
+        else:
+            groups.append([piece])
+            width, longest = hi - lo, lengths[col]
+    return groups
+
+
+def _positions(
+    run: RunSamples, sigmas: F64, rng: np.random.Generator, noisy: bool, x: F64, y: F64
+) -> tuple[F64, F64]:
+    """One run's perturbed sample positions written into ``x`` and ``y`` (D, N), and the
+    (D,) x and y of its reference; the noise of the samples drawn first (D, measurements,
+    2), then the reference's (D, 2)."""
     d = sigmas.size
     n = len(run.xy)
-    measured = int(run.source.max()) + 1 if n else 0
-    if noisy:
-        eps = rng.standard_normal((d, measured, 2))
-        if np.any(run.source != np.arange(n)):  # a repeated pose repeats its noise
-            eps = eps[:, run.source, :]
-        eps *= sigmas[:, None, None]
-        ref_eps = rng.standard_normal((d, 2)) * sigmas[:, None]
-    else:
-        eps = np.zeros((d, n, 2))
-        ref_eps = np.zeros((d, 2))
     xy = run.xy if run.center_xy is None else run.center_xy
     ref = run.reference_xy if run.center_reference_xy is None else run.center_reference_xy
-    x = xy[None, :, 0] + eps[:, :, 0]
-    y = xy[None, :, 1] + eps[:, :, 1]
-    rx = ref[0] + ref_eps[:, 0]
-    ry = ref[1] + ref_eps[:, 1]
-    kept = _subsample(x, y, d_mins)
-    return _eq1(x, y, kept, rx, ry, run.shape)
+    if not noisy:
+        np.add(xy[None, :, 0], 0.0, out=x)
+        np.add(xy[None, :, 1], 0.0, out=y)
+        return np.full(d, ref[0] + 0.0), np.full(d, ref[1] + 0.0)
+    measured = int(run.source.max()) + 1 if n else 0
+    eps = rng.standard_normal((d, measured, 2))
+    if np.any(run.source != np.arange(n)):  # a repeated pose repeats its noise
+        eps = eps[:, run.source, :]
+    eps *= sigmas[:, None, None]
+    ref_eps = rng.standard_normal((d, 2)) * sigmas[:, None]
+    np.add(xy[None, :, 0], eps[:, :, 0], out=x)
+    np.add(xy[None, :, 1], eps[:, :, 1], out=y)
+    return ref[0] + ref_eps[:, 0], ref[1] + ref_eps[:, 1]
 
 
-def _subsample(x: F64, y: F64, d_mins: F64) -> np.ndarray:
-    """(D, N) kept flags of the 2015 d_min rule in every draw: one pass over the samples,
-    each step vectorised over the draws (the rule is sequential within a draw)."""
-    xt = np.ascontiguousarray(x.T)
-    yt = np.ascontiguousarray(y.T)
-    n = xt.shape[0]
-    kept = np.zeros((n, x.shape[0]), dtype=bool)
+def _subsample(xt: F64, yt: F64, d_mins: F64) -> Bool:
+    """(N, W) kept flags of the 2015 d_min rule for the W draws side by side in the columns
+    of ``xt``, ``yt`` (N, W), each with its d_min: one pass over the samples, each step
+    vectorised over every draw (the rule is sequential within a draw). NaN is never kept."""
+    n, w = xt.shape
+    d2 = d_mins * d_mins
+    kept = np.zeros((n, w), dtype=bool)
     kept[0] = True
     lx = xt[0].copy()
     ly = yt[0].copy()
-    d2 = d_mins * d_mins
+    dx = np.empty(w)
+    dy = np.empty(w)
     for j in range(1, n):
-        dx = xt[j] - lx
-        dy = yt[j] - ly
-        k = dx * dx + dy * dy >= d2
-        kept[j] = k
+        # dx*dx + dy*dy >= d_min^2 against the last kept point, in place (no temporaries)
+        np.subtract(xt[j], lx, out=dx)
+        np.subtract(yt[j], ly, out=dy)
+        np.multiply(dx, dx, out=dx)
+        np.multiply(dy, dy, out=dy)
+        np.add(dx, dy, out=dx)
+        k = np.greater_equal(dx, d2, out=kept[j])
         np.copyto(lx, xt[j], where=k)
         np.copyto(ly, yt[j], where=k)
-    return kept.T
+    return kept
 
 
-def _eq1(x: F64, y: F64, kept: np.ndarray, rx: F64, ry: F64, shape: Shape) -> F64:
+def _eq1(x: F64, y: F64, kept: Bool, rx: F64, ry: F64, shape: Shape) -> F64:
     """Eq. (1) of every draw from its kept flags (as :func:`~.path.score_path`), on the kept
     points only: in row-major order each draw's kept points follow one another, its first
-    one (the start, always kept) first."""
+    one (the start, always kept) first. Temporaries are reused (``out=``): on this scale
+    (10^5 kept points per run) fresh arrays cost more in page faults than in arithmetic."""
     d = x.shape[0]
-    rows, cols = np.nonzero(kept)
-    xk, yk = x[rows, cols], y[rows, cols]
-    first = cols == 0
-    step = np.empty(rows.size)
-    step[0] = 0.0
-    step[1:] = np.hypot(np.diff(xk), np.diff(yk))
-    step[first] = 0.0
-    run = np.cumsum(step)  # sequential within each draw, as the 2015 loop
-    starts = np.flatnonzero(first)
-    cum = run - np.repeat(run[starts], np.diff(np.append(starts, rows.size)))
+    rows, cols = np.nonzero(kept)  # draw by draw (row-major), whatever the layout in memory
     count = np.bincount(rows, minlength=d)
-    last = np.cumsum(count) - 1
+    xk, yk = x[rows, cols], y[rows, cols]
+    m = rows.size
+    starts = np.cumsum(count) - count  # each draw's first kept point (column 0)
+    a, b = np.empty(m), np.empty(m)
+    run = np.empty(m)
+    run[0] = 0.0
+    np.subtract(xk[1:], xk[:-1], out=a[1:])
+    np.subtract(yk[1:], yk[:-1], out=b[1:])
+    np.hypot(a[1:], b[1:], out=run[1:])
+    run[starts] = 0.0
+    np.cumsum(run, out=run)  # sequential within each draw, as the 2015 loop
+    cum = np.subtract(run, np.repeat(run[starts], count), out=run)
+    last = starts + count - 1
     total = np.zeros(d)
     total[count > 0] = cum[last[count > 0]]
     x0, y0 = x[:, 0], y[:, 0]
     yaw = np.arctan2(y0 - ry, x0 - rx)
-    c, s = np.cos(yaw)[rows], np.sin(yaw)[rows]
-    dx, dy = xk - x0[rows], yk - y0[rows]
+    dx = np.subtract(xk, np.repeat(x0, count), out=xk)
+    dy = np.subtract(yk, np.repeat(y0, count), out=yk)
     with np.errstate(invalid="ignore", divide="ignore"):
-        l_norm = np.clip(np.nan_to_num(cum / total[rows]), 0.0, 1.0)
+        l_norm = np.divide(cum, np.repeat(total, count), out=cum)
+    np.clip(np.nan_to_num(l_norm, copy=False), 0.0, 1.0, out=l_norm)
     target = shape(l_norm)
-    err = np.hypot(c * dx + s * dy - target[:, 0], -s * dx + c * dy - target[:, 1])
-    err[first] = 0.0  # 2015 started its sum at the second kept point
+    c, s = np.repeat(np.cos(yaw), count), np.repeat(np.sin(yaw), count)
+    # the run frame: (c dx + s dy, -s dx + c dy), each minus the target
+    np.multiply(c, dx, out=a)
+    a += np.multiply(s, dy, out=b)
+    a -= target[:, 0]
+    np.multiply(c, dy, out=b)
+    b -= np.multiply(s, dx, out=c)
+    b -= target[:, 1]
+    err = np.hypot(a, b, out=a)
+    err[starts] = 0.0  # 2015 started its sum at the second kept point
     out = np.bincount(rows, weights=err, minlength=d) / np.maximum(count, 1)
     bad = (count < 2) | ~(total > 0) | ((x0 == rx) & (y0 == ry))
     return np.where(bad, np.nan, out)
@@ -273,14 +365,9 @@ def run_intervals(
 
     # the smoothed paths' own scores: each draw's shift from them is added to the score
     chosen: list[RunSamples] = [r for i in scored if (r := runs[i]) is not None]
-    centers = np.asarray(
-        [
-            perturbed_errors(
-                run, np.zeros(1), np.full(1, model.d_min), np.random.default_rng(0), False
-            )[0]
-            for run in chosen
-        ]
-    )
+    centers = perturbed_runs(
+        chosen, np.zeros(1), np.full(1, model.d_min), np.random.default_rng(0), False
+    )[0]
     shift = np.asarray(est[:-1]) - centers
     shift_best = est[-1] - float(np.min(centers))
 
@@ -294,13 +381,7 @@ def run_intervals(
         if D_MIN in sources:
             d_mins = model.d_min * np.maximum(0.0, 1.0 + model.d_min_rel * z_dmin)
         out = np.empty((n, len(scored) + 1))
-        for col, run in enumerate(chosen):
-            batch = max(1, BATCH_ELEMENTS // max(len(run.xy), 1))
-            for lo in range(0, n, batch):
-                hi = min(n, lo + batch)
-                out[lo:hi, col] = perturbed_errors(
-                    run, sigmas[lo:hi], d_mins[lo:hi], rng, MOCAP_NOISE in sources
-                )
+        out[:, :-1] = perturbed_runs(chosen, sigmas, d_mins, rng, MOCAP_NOISE in sources)
         # the best run of each draw; NaN when one of its runs could not be scored
         best = np.min(out[:, :-1], axis=1) + shift_best
         out[:, :-1] += shift

@@ -15,6 +15,7 @@ from ertools.benchmarks.fbm3w.intervals import (
     measurement_source,
     noise_model,
     perturbed_errors,
+    perturbed_runs,
     run_intervals,
     smooth,
 )
@@ -124,3 +125,42 @@ def test_a_repeated_pose_repeats_its_noise_in_every_draw() -> None:
         assert np.all(eps[k, 5:8] == eps[k, 4])
         want = eq1(ref + ref_eps[k], xy + eps[k], "line", 0.00033)[0]
         assert got[k] == pytest.approx(want, rel=1e-12)
+
+
+@pytest.mark.parametrize("budget", [2_000_000, 900, 1])
+def test_runs_scored_in_one_pass_equal_each_run_alone_and_the_seed_loop(budget: int) -> None:
+    # Three runs of different lengths (one with repeated poses), their draws side by side in
+    # one d_min pass (or split in groups and batches by a small budget): each column equals
+    # the seed's plain loop on positions drawn from the generator in the documented order:
+    # run by run, in batches of budget // samples draws, the samples' noise then the
+    # reference's.
+    line = builtin_shapes()["line"]
+    runs = []
+    for k, n in enumerate((400, 150, 260)):
+        xy, ref = _line_run(np.random.default_rng(20 + k), 5e-5)
+        idx = np.linspace(0, len(xy) - 1, n).astype(int)
+        source = np.arange(n)
+        if k == 1:
+            source[40:44] = 39
+        runs.append(RunSamples(xy[idx][source], source, ref, line))
+    sigmas = np.array([1e-4, 5e-5, 2e-4, 1.5e-4])
+    d_mins = np.array([0.00033, 0.0005, 0.0002, 0.00033])
+    got = perturbed_runs(runs, sigmas, d_mins, np.random.default_rng(11), True, budget=budget)
+    assert got.shape == (4, 3)
+    again = np.random.default_rng(11)
+    for col, run in enumerate(runs):
+        measured = int(run.source.max()) + 1
+        batch = max(1, budget // len(run.xy))
+        eps, ref_eps = np.empty((4, len(run.xy), 2)), np.empty((4, 2))
+        for lo in range(0, 4, batch):
+            hi = min(4, lo + batch)
+            z = again.standard_normal((hi - lo, measured, 2))[:, run.source, :]
+            eps[lo:hi] = z * sigmas[lo:hi, None, None]
+            ref_eps[lo:hi] = again.standard_normal((hi - lo, 2)) * sigmas[lo:hi, None]
+        for k in range(4):
+            want = eq1(run.reference_xy + ref_eps[k], run.xy + eps[k], "line", float(d_mins[k]))
+            assert got[k, col] == pytest.approx(want[0], rel=1e-12)
+    if budget >= 2_000_000:  # unbatched: equal to each run alone, bit for bit
+        rng = np.random.default_rng(11)
+        alone = [perturbed_errors(r, sigmas, d_mins, rng, True) for r in runs]
+        assert np.array_equal(got, np.column_stack(alone))
