@@ -386,8 +386,12 @@ def test_a_scan_is_made_once_per_file_version(
     # the recorder wrote on: another version of the file
     st = path.stat()
     os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000))
-    assert layout.read_layout(path) is not first
-    assert len(scans) == 2
+    second = layout.read_layout(path)
+    assert second is not first and len(scans) == 2
+    # only the latest version of a path is kept
+    st = path.stat()
+    latest = (str(path), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+    assert [k for k in layout._SCANNED if k[0] == str(path)] == [latest]
     caches.clear()
     layout.read_layout(path)
     assert len(scans) == 3

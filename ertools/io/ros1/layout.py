@@ -161,7 +161,11 @@ def read_layout(path: Path) -> Ros1Layout:
         if found is None:
             found = _read_layout(f, path, st.st_size)
             if not found.indexed:
-                if len(_SCANNED) >= 8:  # a few hour-long files' chunk lists at most
+                # one version per path (a recording's file grows: only its latest scan is
+                # worth keeping) and a few files at most (an hour's entries are ~20 MB)
+                for old in [k for k in _SCANNED if k[0] == key[0]]:
+                    del _SCANNED[old]
+                if len(_SCANNED) >= 4:
                     _SCANNED.clear()
                 _SCANNED[key] = found
     return found
