@@ -1,9 +1,10 @@
-"""Mutation fuzzing of the ROS1 and MCAP readers (``fuzz/``): a 500-case sample of `make fuzz`.
+"""Mutation fuzzing of the ROS1 and MCAP readers (``fuzz/``): a 116-case sample of `make fuzz`.
 
 The full run (10,000 cases) is `make fuzz`; see docs/qa.md. Here: the seed files read the same
 through ertools and the official readers, mutations are reproducible and reach every field
-category, the judge flags wrong answers, and 500 mutants give no traceback, no hang, no CLI
-misbehaviour and no disagreement that the concurrent reader work (issue 17) does not cover.
+category, the judge flags wrong answers, and a sample of the mutants gives no traceback, no hang,
+no CLI misbehaviour and no disagreement that the concurrent reader work (issue 17) does not
+cover.
 """
 
 from __future__ import annotations
@@ -113,18 +114,25 @@ def test_the_judge_flags_wrong_answers() -> None:
     )
 
 
-def test_500_mutants() -> None:
+# Cases 0-99 of seed 1 (each of the ten seed files ten times) and the CLI cases among 100-499
+# (one in 25 also runs `ertools info` and `ertools noise`): 116 cases, all 20 CLI cases of the
+# 500 this test ran before (21 s of CPU; now 7). `make fuzz` runs cases 0-9,999 of the same seed.
+SAMPLE = [*range(100), *range(100, 500, 25)]
+
+
+def test_a_sample_of_mutants() -> None:
     """No traceback, no hang, CLI lines right, no disagreement."""
-    results = run_cases(seed=1, indices=list(range(500)), jobs=2, timeout=20.0)
+    results = run_cases(seed=1, indices=SAMPLE, jobs=2, timeout=20.0)
     verdicts = Counter(r["verdict"] for r in results)
-    assert len(results) == 500
+    n = len(SAMPLE)
+    assert len(results) == n
     assert verdicts["traceback"] == 0, [r for r in results if r["verdict"] == "traceback"][:3]
     assert verdicts["hang"] == 0
     # the sample really reads files: at least a third agree with the official reader
     # the mutants are not all refused (a mutator that only wrecked files would prove
     # nothing): 31 % agree since summaries `info` refuses count as refusals (was 40 %)
-    assert verdicts["agree"] + verdicts["salvaged"] >= 500 // 4
-    assert verdicts["refused"] >= 50
+    assert verdicts["agree"] + verdicts["salvaged"] >= n // 4
+    assert verdicts["refused"] >= n // 10
     cli = [r for r in results if r["index"] % 25 == 0]
     assert len(cli) == 20 and all(r["cli"] == "" for r in cli)
     seeds = Counter(r["seed_file"] for r in results)

@@ -351,3 +351,50 @@ def test_a_header_claiming_an_empty_index_over_chunks_is_not_an_empty_bag(tmp_pa
     s = eio.summary(path)
     assert (s.message_count, s.indexed) == (N + N // 3, False)
     assert s.problems
+
+
+def test_a_scan_is_made_once_per_file_version(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An unindexed bag (a recording's ``.active`` file) is scanned record by record; one
+    command opens it several times (summary, states, poses): the scan is kept by the file's
+    identity, made again when the file changes and after ``ertools.caches.clear()``."""
+    import os
+
+    from ertools import caches
+    from ertools.io.ros1 import layout
+
+    raw = bytearray(two_topic_bag(tmp_path / "b.bag").read_bytes())
+    _pos, _op, fields, _dpos, _dlen = records(bytes(raw))[0]
+    struct.pack_into("<Q", raw, fields["index_pos"][0], 0)  # "recording not closed"
+    path = tmp_path / "b.bag.active"
+    path.write_bytes(bytes(raw))
+    scans: list[Path] = []
+    real = layout.scan_layout
+
+    def counted(f: Any, p: Path, size: int, pos: int, why: str) -> layout.Ros1Layout:
+        scans.append(p)
+        return real(f, p, size, pos, why)
+
+    monkeypatch.setattr(layout, "scan_layout", counted)
+    caches.clear()
+    first = layout.read_layout(path)
+    assert not first.indexed and sum(c.counts.get(0, 0) for c in first.chunks) == N
+    assert layout.read_layout(path) is first
+    assert eio.summary(path).message_count == N + N // 3
+    assert len(scans) == 1
+    # the recorder wrote on: another version of the file
+    st = path.stat()
+    os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000))
+    second = layout.read_layout(path)
+    assert second is not first and len(scans) == 2
+    # only the latest version of a path is kept
+    st = path.stat()
+    latest = (str(path), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+    assert [k for k in layout._SCANNED if k[0] == str(path)] == [latest]
+    caches.clear()
+    layout.read_layout(path)
+    assert len(scans) == 3
+    # an indexed bag is read from its index, never kept
+    sound = two_topic_bag(tmp_path / "sound.bag")
+    assert layout.read_layout(sound).indexed and len(scans) == 3

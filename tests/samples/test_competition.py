@@ -148,7 +148,8 @@ def _score(root: Path, e: dict[str, Any]) -> tuple[int, dict[str, Any]]:
         args += [opt[key], str(root / rel)]
     out, err = io.StringIO(), io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        code = main([*args, "--format", "json"])
+        # the answers hold scores, not intervals: no Monte Carlo draws
+        code = main([*args, "--format", "json", "--draws", "0"])
     return code, json.loads(out.getvalue()) if out.getvalue() else {}
 
 
@@ -231,7 +232,7 @@ def test_each_fbm2h_robot_log_scores_as_its_answers(
     args = ["score", "trajectory", str(competition / r["path"])]
     args += [str(competition / g) for g in r["gt_files"]]
     args += ["--robot-topic", traj["robot_topic"], "--gt-topic", traj["gt_topic"]]
-    args += ["--offset", repr(traj["offset_s"]), "--format", "json"]
+    args += ["--offset", repr(traj["offset_s"]), "--format", "json", "--draws", "0"]
     out = io.StringIO()
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
         assert main(args) == 0

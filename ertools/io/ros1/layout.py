@@ -11,6 +11,7 @@ from __future__ import annotations
 import bz2
 import functools
 import logging
+import os
 import struct
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
@@ -21,6 +22,7 @@ from typing import BinaryIO
 import numpy as np
 import numpy.typing as npt
 
+from ertools import caches
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
 from ertools.io.decode.fast import read_at
@@ -138,65 +140,90 @@ def index_header(header: bytes) -> tuple[int, int, int, int] | None:
         return None
 
 
+# Layouts rebuilt by a scan, by the file's identity: the scan walks every record (seconds for
+# an hour-long ``.active`` file) and one command opens a file several times (its summary, its
+# states, its poses). A file that grew or changed has another key.
+_SCANNED: dict[tuple[str, int, int, int, int], Ros1Layout] = {}
+caches.register(_SCANNED.clear)
+
+
 def read_layout(path: Path) -> Ros1Layout:
-    """The index of the bag at ``path``; scans when the index is missing or damaged.
+    """The index of the bag at ``path``; scans when the index is missing or damaged (a scan
+    is kept per file version, :mod:`ertools.caches`).
 
     Raises:
         BagError: not even the bag header is readable.
     """
-    size = path.stat().st_size
     with path.open("rb") as f:
-        try:
-            head, _ = read_record(f, MAGIC_LEN, size)
-            if head.op != OP_BAG_HEADER:
-                raise RecordError("first record is not the bag header", MAGIC_LEN)
-            index_pos = u64(head.fields, "index_pos")
-            conn_count = u32(head.fields, "conn_count")
-            chunk_count = u32(head.fields, "chunk_count")
-        except (RecordError, KeyError, struct_error) as err:
-            raise BagError(f"unreadable ROS1 bag header ({err}); not a bag?", path=path) from err
-        if index_pos == 0:
-            return scan_layout(f, path, size, head.end, "not indexed (recording not closed)")
-        if head.end == index_pos == size and conn_count == 0 and chunk_count == 0:
-            # What a recorder leaves when nothing arrived: the header, then an empty index
-            # (nothing between them; records there would mean a damaged header: scanned).
-            return Ros1Layout(path, size, True, [], [])
-        if index_pos >= size:
-            return scan_layout(
-                f,
-                path,
-                size,
-                head.end,
-                f"truncated: the index at byte {index_pos} lies past the end ({size} bytes)",
-            )
-        try:
-            conns: list[Conn] = []
-            pos = index_pos
-            for _ in range(conn_count):
-                rec, data = read_record(f, pos, size, with_data=True)
-                if rec.op != OP_CONNECTION:
-                    raise RecordError("expected a connection record", pos)
-                cid, topic, fields = connection_fields(rec, data)
-                if any(c.id == cid for c in conns):
-                    # a damaged id: one connection's messages would be read as another's
-                    raise RecordError(f"two connection records with id {cid}", pos)
-                conns.append(conn_record(cid, topic, fields))
-                pos = rec.end
-            if chunk_count == 0 and conn_count and index_pos > head.end:
-                # records between the header and the index, but no chunk to find them by
-                raise RecordError("the bag header counts no chunks before its index", MAGIC_LEN)
-            chunks = []
-            for _ in range(chunk_count):
-                rec, data = read_record(f, pos, size, with_data=True)
-                if rec.op != OP_CHUNK_INFO:
-                    raise RecordError("expected a chunk-info record", pos)
-                cpos, start, end, counts = chunk_info(rec, data)
-                if cpos >= size:
-                    raise RecordError(f"chunk position {cpos} past the end of the file", pos)
-                chunks.append(Ros1Chunk(cpos, start, end, counts))
-                pos = rec.end
-        except (RecordError, KeyError, struct_error, IndexError) as err:
-            return scan_layout(f, path, size, head.end, f"damaged index ({err})")
+        st = os.fstat(f.fileno())
+        key = (str(path), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+        found = _SCANNED.get(key)
+        if found is None:
+            found = _read_layout(f, path, st.st_size)
+            if not found.indexed:
+                # one version per path (a recording's file grows: only its latest scan is
+                # worth keeping) and a few files at most (an hour's entries are ~20 MB)
+                for old in [k for k in _SCANNED if k[0] == key[0]]:
+                    del _SCANNED[old]
+                if len(_SCANNED) >= 4:
+                    _SCANNED.clear()
+                _SCANNED[key] = found
+    return found
+
+
+def _read_layout(f: BinaryIO, path: Path, size: int) -> Ros1Layout:
+    """:func:`read_layout` of the open file ``f`` (``size`` bytes)."""
+    try:
+        head, _ = read_record(f, MAGIC_LEN, size)
+        if head.op != OP_BAG_HEADER:
+            raise RecordError("first record is not the bag header", MAGIC_LEN)
+        index_pos = u64(head.fields, "index_pos")
+        conn_count = u32(head.fields, "conn_count")
+        chunk_count = u32(head.fields, "chunk_count")
+    except (RecordError, KeyError, struct_error) as err:
+        raise BagError(f"unreadable ROS1 bag header ({err}); not a bag?", path=path) from err
+    if index_pos == 0:
+        return scan_layout(f, path, size, head.end, "not indexed (recording not closed)")
+    if head.end == index_pos == size and conn_count == 0 and chunk_count == 0:
+        # What a recorder leaves when nothing arrived: the header, then an empty index
+        # (nothing between them; records there would mean a damaged header: scanned).
+        return Ros1Layout(path, size, True, [], [])
+    if index_pos >= size:
+        return scan_layout(
+            f,
+            path,
+            size,
+            head.end,
+            f"truncated: the index at byte {index_pos} lies past the end ({size} bytes)",
+        )
+    try:
+        conns: list[Conn] = []
+        pos = index_pos
+        for _ in range(conn_count):
+            rec, data = read_record(f, pos, size, with_data=True)
+            if rec.op != OP_CONNECTION:
+                raise RecordError("expected a connection record", pos)
+            cid, topic, fields = connection_fields(rec, data)
+            if any(c.id == cid for c in conns):
+                # a damaged id: one connection's messages would be read as another's
+                raise RecordError(f"two connection records with id {cid}", pos)
+            conns.append(conn_record(cid, topic, fields))
+            pos = rec.end
+        if chunk_count == 0 and conn_count and index_pos > head.end:
+            # records between the header and the index, but no chunk to find them by
+            raise RecordError("the bag header counts no chunks before its index", MAGIC_LEN)
+        chunks = []
+        for _ in range(chunk_count):
+            rec, data = read_record(f, pos, size, with_data=True)
+            if rec.op != OP_CHUNK_INFO:
+                raise RecordError("expected a chunk-info record", pos)
+            cpos, start, end, counts = chunk_info(rec, data)
+            if cpos >= size:
+                raise RecordError(f"chunk position {cpos} past the end of the file", pos)
+            chunks.append(Ros1Chunk(cpos, start, end, counts))
+            pos = rec.end
+    except (RecordError, KeyError, struct_error, IndexError) as err:
+        return scan_layout(f, path, size, head.end, f"damaged index ({err})")
     return Ros1Layout(path, size, True, conns, chunks)
 
 

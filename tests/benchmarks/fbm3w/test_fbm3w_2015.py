@@ -41,6 +41,8 @@ from ertools.streams import PoseStream
 S = 1_000_000_000
 D_MIN = 0.00033  # seed 7.3.4: hard-coded in the 2015 script
 TOL = 1e-12  # float rounding of the same formulas summed in another order
+# the 2015 node's numbers are the subject here, not the intervals: no Monte Carlo draws
+NO_DRAWS = ("score", "fbm3w", "--draws", "0")
 
 
 # Seed Listing 15 (the Lisbon 2015 shapes), l in [0, 1].
@@ -174,7 +176,7 @@ def test_sample_bag_2015_equals_the_node(
     # The sample's RefBox ends run 4 mid-path with the seed's bare "timeout": to the 2015
     # BmBox no timeout, so the node scored and timed run 4 as it scores any run.
     assert 4 in node["runs"]
-    assert main(["score", "fbm3w", str(bag), "--2015", "--format", "json"]) == 0
+    assert main([*NO_DRAWS, str(bag), "--2015", "--format", "json"]) == 0
     captured = capsys.readouterr()
     out = json.loads(captured.out)
     _check(out, node)
@@ -182,19 +184,19 @@ def test_sample_bag_2015_equals_the_node(
     assert "RefBox END with payload 'timeout', which is none of the forms" in captured.err
     # --timeout-runs 2015 alone reads the seed's word as the timeout it names (said), and
     # scores the timed-out run as 2015 did: the same numbers here (d_min already 0.00033).
-    assert main(["score", "fbm3w", str(bag), "--timeout-runs", "2015", "--format", "json"]) == 0
+    assert main([*NO_DRAWS, str(bag), "--timeout-runs", "2015", "--format", "json"]) == 0
     captured = capsys.readouterr()
     out = json.loads(captured.out)
     _check(out, node)
     assert out["runs_details"]["4"]["status"] == "timeout_scored"
     assert "as a timeout" in captured.err and "[all.end-payloads]" in captured.err
     # Default: the timed-out run has no distance_error, and the output says why.
-    assert main(["score", "fbm3w", str(bag), "--format", "json"]) == 0
+    assert main([*NO_DRAWS, str(bag), "--format", "json"]) == 0
     captured = capsys.readouterr()
     assert json.loads(captured.out)["runs_details"]["4"]["distance_error"] is None
     assert "differs from 2015: a run the RefBox timed out" in captured.err
     # --exact-end-payloads alone: the END is no timeout, run 4 is an ordinary completed run.
-    assert main(["score", "fbm3w", str(bag), "--exact-end-payloads", "--format", "json"]) == 0
+    assert main([*NO_DRAWS, str(bag), "--exact-end-payloads", "--format", "json"]) == 0
     captured = capsys.readouterr()
     out = json.loads(captured.out)
     assert out["runs_details"]["4"]["status"] == "scored"
@@ -383,7 +385,7 @@ def test_2015_uses_the_script_d_min_over_the_config(
 ) -> None:
     config = tmp_path / "fbm3w.yaml"
     config.write_text("runs_specifications: [line, spline, line, spline, line]\nd_min: 0.001\n")
-    argv = ["score", "fbm3w", str(fbm3w_sample.bag), "--config", str(config), "--format", "json"]
+    argv = [*NO_DRAWS, str(fbm3w_sample.bag), "--config", str(config), "--format", "json"]
     assert main(argv) == 0
     assert json.loads(capsys.readouterr().out)["runs_details"]["0"]["d_min"] == 0.001
     assert main([*argv, "--2015"]) == 0
@@ -421,7 +423,7 @@ def test_stopped_run_from_a_bag_with_the_cli(
                 s.machine, f"/fbm3w/{topic}", s.t_ns + epoch, list(s.state), list(s.payload)
             )
     node = _node(poses, bm, rb, ["line", "spline"])
-    argv = ["score", "fbm3w", str(bag), "--format", "json"]
+    argv = [*NO_DRAWS, str(bag), "--format", "json"]
     assert main([*argv, "--stopped-runs", "2015"]) == 0
     captured = capsys.readouterr()
     _check(json.loads(captured.out), node)

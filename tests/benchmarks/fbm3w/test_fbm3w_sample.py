@@ -9,6 +9,9 @@ from ertools.benchmarks.fbm3w.benchmark import score_fbm3w
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
 from ertools.configs.fbm3w import Fbm3wConfig
 
+# the answers hold scores, not intervals: no Monte Carlo draws (draws=0 in every Fbm3wOptions)
+NO_DRAWS = Fbm3wOptions(draws=0)
+
 
 def _tol(sample: Sample, key: str) -> float:
     return float(sample.answers["tolerance"][key]["abs"])
@@ -18,7 +21,7 @@ def _tol(sample: Sample, key: str) -> float:
 def test_each_run_matches_the_answers(fbm3w_sample: Sample, mode: str) -> None:
     windows = fbm3w_sample.windows() if mode == "windows" else ()
     result = score_fbm3w(
-        [fbm3w_sample.bag], Fbm3wConfig(), Fbm3wOptions(runs=mode, windows=windows)
+        [fbm3w_sample.bag], Fbm3wConfig(), Fbm3wOptions(draws=0, runs=mode, windows=windows)
     )
     # the answers file justifies it: single noisy reference/start samples fix the run frame
     tol = _tol(fbm3w_sample, "distance_error")
@@ -34,7 +37,7 @@ def test_each_run_matches_the_answers(fbm3w_sample: Sample, mode: str) -> None:
 
 def test_states_mode_equals_the_live_node(fbm3w_sample: Sample) -> None:
     """The scenario recomputes what the 2015 node saw (the published Pose2D messages)."""
-    result = score_fbm3w([fbm3w_sample.bag], Fbm3wConfig())
+    result = score_fbm3w([fbm3w_sample.bag], Fbm3wConfig(), NO_DRAWS)
     live = fbm3w_sample.answers["expected"]["published"]
     tol = _tol(fbm3w_sample, "published")
     for run in result.runs[:4]:
@@ -48,7 +51,7 @@ def test_states_mode_equals_the_live_node(fbm3w_sample: Sample) -> None:
 
 
 def test_states_mode_times_and_timeout(fbm3w_sample: Sample) -> None:
-    result = score_fbm3w([fbm3w_sample.bag], Fbm3wConfig())
+    result = score_fbm3w([fbm3w_sample.bag], Fbm3wConfig(), NO_DRAWS)
     assert len(result.runs) == 5
     assert all(r.window.mode == "states" for r in result.runs)
     tol = _tol(fbm3w_sample, "execution_time")
@@ -73,8 +76,8 @@ def test_states_mode_times_and_timeout(fbm3w_sample: Sample) -> None:
 
 
 def test_rosbag2_mcap_copy_scores_the_same(fbm3w_sample: Sample) -> None:
-    ros1 = score_fbm3w([fbm3w_sample.bag], Fbm3wConfig())
-    mcap = score_fbm3w([fbm3w_sample.mcap], Fbm3wConfig())
+    ros1 = score_fbm3w([fbm3w_sample.bag], Fbm3wConfig(), NO_DRAWS)
+    mcap = score_fbm3w([fbm3w_sample.mcap], Fbm3wConfig(), NO_DRAWS)
     # same messages in another container: identical numbers
     assert mcap.to_dict() == ros1.to_dict()
 
@@ -83,7 +86,7 @@ def test_rosbag2_mcap_copy_scores_the_same(fbm3w_sample: Sample) -> None:
 def test_noiseless_recording_gives_the_answers_exactly(fbm3w_noiseless: Sample, mode: str) -> None:
     windows = fbm3w_noiseless.windows() if mode == "windows" else ()
     result = score_fbm3w(
-        [fbm3w_noiseless.bag], Fbm3wConfig(), Fbm3wOptions(runs=mode, windows=windows)
+        [fbm3w_noiseless.bag], Fbm3wConfig(), Fbm3wOptions(draws=0, runs=mode, windows=windows)
     )
     tol = _tol(fbm3w_noiseless, "distance_error_noiseless")
     for run in result.runs[:4]:
@@ -98,7 +101,7 @@ def test_noiseless_recording_gives_the_answers_exactly(fbm3w_noiseless: Sample, 
 
 
 def test_auto_mode_reports_detected_times(fbm3w_sample: Sample) -> None:
-    result = score_fbm3w([fbm3w_sample.bag], Fbm3wConfig(), Fbm3wOptions(runs="auto"))
+    result = score_fbm3w([fbm3w_sample.bag], Fbm3wConfig(), Fbm3wOptions(draws=0, runs="auto"))
     truth = fbm3w_sample.answers["truth"]["runs"]
     start_ns = fbm3w_sample.answers["truth"]["bag_start_ns"]
     for run in result.runs:
@@ -121,7 +124,7 @@ def test_auto_mode_reports_detected_times(fbm3w_sample: Sample) -> None:
         for r in result.runs
     )
     again = score_fbm3w(
-        [fbm3w_sample.bag], Fbm3wConfig(), Fbm3wOptions(runs="windows", windows=given)
+        [fbm3w_sample.bag], Fbm3wConfig(), Fbm3wOptions(draws=0, runs="windows", windows=given)
     )
     assert [r.distance_error for r in again.runs] == [r.distance_error for r in result.runs]
     assert all(r.distance_error is not None for r in again.runs)
@@ -131,7 +134,7 @@ def test_d_min_below_noise_is_warned(fbm3w_sample: Sample) -> None:
     result = score_fbm3w(
         [fbm3w_sample.bag],
         Fbm3wConfig(),
-        Fbm3wOptions(d_min=0.0002, sweep=(0.0002, 0.0005)),
+        Fbm3wOptions(draws=0, d_min=0.0002, sweep=(0.0002, 0.0005)),
     )
     eps = fbm3w_sample.answers["expected"]["noise"]["epsilon"]
     warning = next(w for w in result.warnings if "below the mocap noise" in w)
