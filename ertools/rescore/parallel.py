@@ -148,7 +148,6 @@ def run_job_forked(job: Job) -> Outcome:
     if child is None or child.owner != os.getpid():  # none yet, or one of a parent's
         _warm(job)
         child = _children.child = _Child()
-        _forked.append(child)
         # reaped when the worker exits: no orphan, and its CPU time counts as the worker's
         atexit.register(child.close)
     outcome = child.run(job)
@@ -164,16 +163,6 @@ def run_job_forked(job: Job) -> Outcome:
 
 
 _children = threading.local()  # one child per thread of a Dask worker that runs tasks
-_forked: list[_Child] = []  # every child of this process, to close with an in-process cluster
-
-
-def close_children() -> None:
-    """Close the scoring children this process forked (its LocalCluster's worker threads
-    are gone: a library caller's process does not keep them until it exits)."""
-    mine = [c for c in _forked if c.owner == os.getpid()]
-    _forked[:] = [c for c in _forked if c.owner != os.getpid()]
-    for child in mine:
-        child.close()
 
 
 class _Child:
@@ -417,7 +406,6 @@ class DaskClient:
             if self._cluster is not None:
                 with contextlib.suppress(Exception):
                     self._cluster.close()
-                close_children()
         finally:
             self._stack.close()
             sys.stderr.flush()
@@ -478,19 +466,15 @@ def _connect(distributed: Any, address: str, workers: int) -> tuple[Any, Any]:
         if address == "local":
             import dask.config  # lazy: the optional Dask extra (ertools[dask]), as distributed
 
-            # The workers are threads of this process (processes=False): each scores its jobs
-            # in a process forked from this one (run_job_forked), as on any Dask worker, so
-            # the executions still run side by side and a crash costs one row; what goes is
-            # spawning a nanny and a worker process per worker, each importing distributed
-            # and ertools (~2.3 s of CPU for two, plus each worker's first imports: the
-            # LocalCluster was 6 % slower than --jobs 2 on a day, +21 % with them).
             # Without the workers' statistical profiler (a thread sampling every 10 ms, ~5 %
             # of a core per worker: measured in docs/performance.md), and without the
-            # MALLOC_TRIM_THRESHOLD_=65536 nannies put in their workers' environment (glibc
-            # then hands every freed array back to the kernel: for a cluster started with
-            # processes). The event loops' tick monitor (every 20 ms), the system monitor
-            # (500 ms) and the memory monitor (100 ms) cost 7 % of a core while a cluster
-            # waits (1.08 s of CPU in 15 s); at 1 s, 5 s and 1 s, 1.5 % (0.23 s).
+            # MALLOC_TRIM_THRESHOLD_=65536 the nannies put in their workers' environment: glibc
+            # then hands every freed array back to the kernel, and the next execution faults
+            # its pages in again (a local worker keeps them). The event loops' tick monitor
+            # (every 20 ms), the system monitor (500 ms) and the memory monitor (100 ms) of
+            # the scheduler, nannies and workers cost 7 % of a core while the cluster waits
+            # (1.08 s of CPU in 15 s); at 1 s, 5 s and 1 s, 1.5 % (0.23 s). The nannies hand
+            # this configuration to the worker processes they start.
             with dask.config.set(
                 {
                     "distributed.worker.profile.enabled": False,
@@ -503,7 +487,7 @@ def _connect(distributed: Any, address: str, workers: int) -> tuple[Any, Any]:
                 cluster = distributed.LocalCluster(
                     n_workers=max(workers, 1),
                     threads_per_worker=1,
-                    processes=False,
+                    processes=True,
                     dashboard_address=None,
                 )
             return distributed.Client(cluster), cluster
