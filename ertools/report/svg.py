@@ -90,23 +90,11 @@ def _extent(layers: tuple[Layer, ...], axis: str, side: str) -> list[FloatArray]
         match layer:
             case Line() | Scatter():
                 out.append(floats(layer.x if axis == "x" else layer.y))
-            case Arrows():
+            case Arrows() | Rects():
                 out += (
                     [floats(layer.x0), floats(layer.x1)]
                     if axis == "x"
-                    else [
-                        floats(layer.y0),
-                        floats(layer.y1),
-                    ]
-                )
-            case Rects():
-                out += (
-                    [floats(layer.x0), floats(layer.x1)]
-                    if axis == "x"
-                    else [
-                        floats(layer.y0),
-                        floats(layer.y1),
-                    ]
+                    else [floats(layer.y0), floats(layer.y1)]
                 )
             case Span():
                 if layer.axis == axis:

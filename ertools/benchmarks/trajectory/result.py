@@ -25,6 +25,7 @@ from ertools.benchmarks.trajectory.association import (
     Matched,
 )
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.intervals import KEYS
 from ertools.benchmarks.trajectory.metrics import Metrics
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames
@@ -34,15 +35,9 @@ from ertools.timeutil import NS_PER_S, ns_to_s
 if TYPE_CHECKING:
     import pandas as pd  # annotations only: pandas is imported by to_frames()
 
-# The summary table's statistics that get ``_low``/``_high`` columns.
-INTERVAL_COLUMNS = (
-    "position_error",
-    "orientation_error",
-    "rmse",
-    "median",
-    "max",
-    "orientation_error_2015",
-)
+# The summary table's statistics that get ``_low``/``_high`` columns (the percentiles have
+# their own table).
+INTERVAL_COLUMNS = tuple(k for k in KEYS if not k.startswith("percentiles."))
 
 
 @dataclass(frozen=True, eq=False)

@@ -160,21 +160,12 @@ def score_streams(
         if audit.offset_ns is None:
             raise ClockError(f"{where}: cannot apply the estimated clock offset: {audit.note}")
         offset_ns = audit.offset_ns
-    shifted = PoseStream(
-        robot.t_ns + offset_ns,
-        robot.xyz,
-        robot.quat_xyzw,
-        robot.frame_id,
-        robot.child_frame_id,
-        robot.source,
-    )
     logged = robot  # the robot poses as logged (evo's association may repeat some)
 
-    def rescore(rows: npt.NDArray[np.intp], shift_ns: int) -> Matched:
-        """The score's own association of the robot poses ``rows`` at the applied offset
-        plus ``shift_ns`` (the intervals' offset draws re-score with it)."""
-        part = logged.take(rows)
-        at = offset_ns + shift_ns
+    def match(part: PoseStream, at: int) -> Matched:
+        """The score's association of the robot poses ``part`` at the clock offset ``at``
+        (the score's own, at the offset applied; the intervals' offset draws re-score with it
+        at shifted offsets)."""
         if config.t_max_diff is not None:
             return associate_evo(
                 part,
@@ -203,33 +194,16 @@ def score_streams(
             gt_order=config.gt_order,
         )
 
-    if config.t_max_diff is not None:
-        matched = associate_evo(
-            robot,
-            gt,
-            float_seconds(robot),
-            float_seconds(gt),
-            config.t_max_diff,
-            ns_to_s(offset_ns),
-            offset_ns,
-        )
-        if matched.robot_rows is not None and len(matched.robot_rows) != len(robot):
-            # A robot pose in two of evo's pairs is two rows; the result's robot stream too.
-            robot = robot.take(matched.robot_rows)
-            notes.append(
-                f"{len(matched.robot_rows) - len(shifted)} robot pose(s) are the nearest of two "
-                "GT poses and are counted once per pair, as evo counts them"
-            )
-    else:
-        matched = associate(
-            shifted,
-            gt,
-            config.association,
-            config.max_gap_ns,
-            ties=config.ties,
-            gaps=config.gaps,
-            before_gt=config.before_gt,
-            gt_order=config.gt_order,
+    def rescore(rows: npt.NDArray[np.intp], shift_ns: int) -> Matched:
+        return match(logged.take(rows), offset_ns + shift_ns)
+
+    matched = match(robot, offset_ns)
+    if matched.robot_rows is not None and len(matched.robot_rows) != len(robot):
+        # A robot pose in two of evo's pairs is two rows; the result's robot stream too.
+        robot = robot.take(matched.robot_rows)
+        notes.append(
+            f"{len(matched.robot_rows) - len(logged)} robot pose(s) are the nearest of two "
+            "GT poses and are counted once per pair, as evo counts them"
         )
     outside = matched.status == UNCOVERED
     spans = _spans(matched.t_ns, outside)
@@ -237,8 +211,9 @@ def score_streams(
     if n_out == len(matched.t_ns):
         raise ClockError(
             f"{where}: no robot pose lies within the GT ({iso_utc(timed.start_ns)} to "
-            f"{iso_utc(timed.end_ns)}); robot poses span {iso_utc(int(shifted.t_ns[0]))} to "
-            f"{iso_utc(int(shifted.t_ns[-1]))} (offset {ns_to_s(offset_ns):+.3f} s)"
+            f"{iso_utc(timed.end_ns)}); robot poses span "
+            f"{iso_utc(int(logged.t_ns[0]) + offset_ns)} to "
+            f"{iso_utc(int(logged.t_ns[-1]) + offset_ns)} (offset {ns_to_s(offset_ns):+.3f} s)"
         )
     failures: list[str] = []
     if n_out:
