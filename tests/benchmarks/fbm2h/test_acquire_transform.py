@@ -16,6 +16,7 @@ from scipy.stats import chi2
 
 from ertools.cli.main import main
 from ertools.configs.transform import SPREAD_KEY, load_transform, transform_yaml
+from ertools.errors import ConfigError
 from ertools.samples.mocap import MocapNoise, frame_times, publish_mocap, simulate_mocap
 from ertools.samples.writer import BagWriter
 
@@ -145,8 +146,6 @@ def test_the_file_carries_the_measured_spread(
 
 
 def test_a_file_without_spread_and_a_malformed_one(tmp_path: Path) -> None:
-    from ertools.errors import ConfigError
-
     body = (
         "robot_info: t\ntransform_timestamp: 0\n"
         "marker_to_robot_transform:\n- [0.1, 0.0, -0.8]\n- [0.0, 0.0, 0.0, 1.0]\n"
