@@ -10,27 +10,18 @@ breaks its whole pool and every job still in it. Results come back in completion
 
 from __future__ import annotations
 
-import atexit
 import contextlib
-import ctypes
 import logging
-import multiprocessing
 import multiprocessing.connection
 import os
-import pickle
-import signal
 import sys
 import threading
-import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from importlib import import_module
 from typing import Any
 
-from ertools.benchmarks import registry
 from ertools.errors import ConfigError
-from ertools.report import html
-from ertools.report.figures import preload
-from ertools.rescore.jobs import Job, Outcome, load_benchmark, run_job
+from ertools.rescore.children import Child, close_server, forks_ready, run_job_forked, server
+from ertools.rescore.jobs import Job, Outcome, run_job
 from ertools.rescore.schedule import Schedule
 
 OnDone = Callable[[Outcome], None]
@@ -66,174 +57,6 @@ def run_jobs(
         run_local(jobs, workers=workers, on_done=on_done, known=known)
 
 
-# prctl(2): PR_SET_PDEATHSIG, the signal the kernel sends a process when its parent ends
-_PR_SET_PDEATHSIG = 1
-
-
-def end_with_parent(parent: int) -> None:
-    """End this process when its parent ``parent`` ends, however that ends (``kill -9``
-    included): a worker left behind holds its memory and its job for ever, blocked on a pipe
-    whose other end its siblings keep open (inherited by fork).
-
-    Linux: the kernel sends SIGKILL (``PR_SET_PDEATHSIG``). Elsewhere a thread watches the
-    parent's pid. Either way, a parent that died before this was set up is caught at once.
-    """
-    if sys.platform.startswith("linux"):
-        try:
-            libc = ctypes.CDLL(None, use_errno=True)
-            if libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0) == 0:
-                if os.getppid() != parent:  # it died between the fork and the prctl
-                    os._exit(1)
-                return
-        except (OSError, AttributeError):  # no prctl in this libc: watch instead
-            pass
-    threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
-
-
-def _watch_parent(parent: int) -> None:
-    while os.getppid() == parent:
-        time.sleep(1.0)
-    os._exit(1)
-
-
-def _worker(conn: multiprocessing.connection.Connection, parent: int) -> None:
-    """A local worker: score the jobs it is sent until it is sent None."""
-    end_with_parent(parent)
-    while True:
-        try:
-            job = conn.recv()
-        except EOFError:
-            return
-        if job is None:
-            return
-        conn.send(run_job(job))
-
-
-_warmed: set[str] = set()
-
-
-def _warm(job: Job) -> None:
-    """Import, in the process that forks, what scoring ``job`` and drawing its report load on
-    first use (its benchmark's modules, matplotlib and its font), once per process: a child
-    forked per job inherits them. Without it every Dask task paid those imports again (issue
-    29: Dask cost +72 % over local workers, which keep them between jobs)."""
-    if job.target in _warmed:
-        return
-    _warmed.add(job.target)
-    with contextlib.suppress(Exception):  # only a head start: the child imports what failed
-        load_benchmark(job.target)
-        if job.report_dir is not None:
-            figures = registry.get(job.benchmark).figures
-            if figures:
-                import_module(figures.partition(":")[0])
-            preload()
-            html.environment().get_template("report.html.j2")  # compiled once, not per job
-
-
-def run_job_forked(job: Job) -> Outcome:
-    """:func:`run_job` in a child process forked from this one: a scorer that crashes or is
-    killed (for memory) costs this job's row, never the Dask worker running it nor the other
-    tasks that worker holds (the scheduler would count those as suspects of its death).
-    ``os.fork``, not ``multiprocessing``: a Dask worker under a nanny is a daemonic process,
-    which ``multiprocessing`` forbids to have children. Where there is no fork, in this process.
-
-    The child stays for the next job of the same thread (as a local worker does), so that what
-    a job loads on first use (matplotlib, fonts, compiled templates, the figures' canvases)
-    is loaded once per worker, not once per job: forking a child per job cost the Dask path
-    ~0.8 s of CPU per execution more than local workers (issue 29). A child that died is
-    replaced by the next job."""
-    if not hasattr(os, "fork"):
-        return run_job(job)
-    child: _Child | None = getattr(_children, "child", None)
-    if child is None or child.owner != os.getpid():  # none yet, or one of a parent's
-        _warm(job)
-        child = _children.child = _Child()
-        # reaped when the worker exits: no orphan, and its CPU time counts as the worker's
-        atexit.register(child.close)
-    outcome = child.run(job)
-    if outcome is not None:
-        return outcome
-    code = child.close()
-    _children.child = None
-    return Outcome(
-        job.id,
-        "failed",
-        reason=f"the process scoring it died (exit code {code}); the other executions were scored",
-    )
-
-
-_children = threading.local()  # one child per thread of a Dask worker that runs tasks
-
-
-class _Child:
-    """A process forked from this one that scores the jobs it is sent, one at a time, until
-    its input closes (this process ended: it leaves with it) or it dies."""
-
-    def __init__(self) -> None:
-        self.owner = os.getpid()
-        job_read, job_write = os.pipe()
-        out_read, out_write = os.pipe()
-        pid = os.fork()
-        if pid == 0:  # the child: leaves without running any of the parent's cleanup
-            os.close(job_write)
-            os.close(out_read)
-            code = 0
-            try:
-                end_with_parent(self.owner)  # a worker killed mid-job takes its child along
-                with os.fdopen(job_read, "rb") as jobs, os.fdopen(out_write, "wb") as out:
-                    while True:
-                        try:
-                            job = pickle.load(jobs)  # from our own parent: trusted
-                        except EOFError:
-                            break
-                        pickle.dump(run_job(job), out)
-                        out.flush()
-            except BaseException:
-                code = 1
-            os._exit(code)
-        os.close(job_read)
-        os.close(out_write)
-        self.pid = pid
-        self._jobs = os.fdopen(job_write, "wb")
-        self._out = os.fdopen(out_read, "rb")
-
-    def run(self, job: Job) -> Outcome | None:
-        """The child's outcome of ``job``; None when it died before sending one."""
-        try:
-            pickle.dump(job, self._jobs)
-            self._jobs.flush()
-            outcome: Outcome = pickle.load(self._out)  # from our own child: trusted
-        except (EOFError, OSError, pickle.UnpicklingError):
-            return None
-        return outcome
-
-    def close(self) -> int:
-        """Close the child's input and wait for it; its exit code (0 when already waited)."""
-        for fh in (self._jobs, self._out):
-            with contextlib.suppress(OSError):
-                fh.close()
-        try:
-            _, status = os.waitpid(self.pid, 0)
-        except ChildProcessError:
-            return 0
-        return os.waitstatus_to_exitcode(status)
-
-
-def _context() -> Any:
-    # fork: a worker starts in milliseconds with ertools already imported; elsewhere spawn
-    methods = multiprocessing.get_all_start_methods()
-    return multiprocessing.get_context("fork" if "fork" in methods else "spawn")
-
-
-class _Worker:
-    def __init__(self, ctx: Any) -> None:
-        self.conn, child = ctx.Pipe()
-        self.process = ctx.Process(target=_worker, args=(child, os.getpid()), daemon=True)
-        self.process.start()
-        child.close()
-        self.job: Job | None = None
-
-
 def run_local(
     jobs: Sequence[Job],
     *,
@@ -241,70 +64,54 @@ def run_local(
     on_done: OnDone,
     known: Iterable[tuple[str, float]] = (),
 ) -> None:
-    """Score ``jobs`` with ``workers`` local processes, the longest expected first; a worker
-    that dies costs its job."""
-    ctx = _context()
+    """Score ``jobs`` with ``workers`` local processes (children of the fork server), the
+    longest expected first; a worker that dies costs its job, and a new one takes the rest.
+    Where there is no fork, one by one in this process."""
+    if not hasattr(os, "fork"):
+        for job in jobs:
+            on_done(run_job(job))
+        return
     pending = Schedule(jobs, known)
-    pool = [_Worker(ctx) for _ in range(min(workers, len(jobs)))]
-    try:
-        for worker in pool:
-            _assign(worker, pending)
-        while any(w.job is not None for w in pool):
-            busy = [w for w in pool if w.job is not None]
-            ready = multiprocessing.connection.wait(
-                [w.conn for w in busy] + [w.process.sentinel for w in busy]
-            )
-            for i, worker in enumerate(pool):
-                if worker.job is None:
-                    continue
-                if worker.conn in ready:
-                    try:
-                        outcome: Outcome = worker.conn.recv()
-                    except (EOFError, OSError):
-                        outcome = _died(worker)
-                        pool[i] = worker = _replace(worker, ctx)
-                    worker.job = None
-                    pending.done(outcome)
-                    _assign(worker, pending)  # the next job first: the worker waits for none
-                    on_done(outcome)
-                elif worker.process.sentinel in ready:
-                    outcome = _died(worker)
-                    pool[i] = worker = _replace(worker, ctx)
-                    pending.done(outcome)
-                    _assign(worker, pending)
-                    on_done(outcome)
-    finally:
-        for worker in pool:
-            with contextlib.suppress(OSError, ValueError):  # a worker already gone
-                worker.conn.send(None)
-        for worker in pool:
-            worker.process.join(timeout=5)
-            if worker.process.is_alive():
-                worker.process.kill()
-                worker.process.join()
+    with forks_ready():
+        busy: dict[int, tuple[Child, Job]] = {}  # by the descriptor its outcome comes on
+        for _ in range(min(workers, len(jobs))):
+            _hand(busy, None, pending.next())
+        while busy:
+            for fd in multiprocessing.connection.wait(list(busy)):
+                assert isinstance(fd, int)
+                child, job = busy.pop(fd)
+                outcome = child.receive()
+                alive = outcome is not None
+                if outcome is None:
+                    outcome = _died(child, job)
+                pending.done(outcome)
+                # the next job first: the worker waits for none
+                _hand(busy, child if alive else None, pending.next())
+                on_done(outcome)
 
 
-def _assign(worker: _Worker, pending: Schedule) -> None:
-    job = pending.next()
-    if job is not None:
-        worker.job = job
-        worker.conn.send(job)
+def _hand(busy: dict[int, tuple[Child, Job]], child: Child | None, job: Job | None) -> None:
+    """Give ``job`` to ``child`` (idle), or to a new worker when ``child`` is None or has died
+    since; with no job left, ``child`` ends."""
+    if job is None:
+        if child is not None:
+            child.close()
+        return
+    if child is None or not child.send(job):
+        if child is not None:
+            child.close()  # died since its outcome: of no job
+        child = server().child(job)
+        child.send(job)  # one that died at once says so when read
+    busy[child.fileno()] = (child, job)
 
 
-def _died(worker: _Worker) -> Outcome:
-    worker.process.join(timeout=5)
-    code = worker.process.exitcode
-    assert worker.job is not None
+def _died(child: Child, job: Job) -> Outcome:
+    code = child.close()
     return Outcome(
-        worker.job.id,
+        job.id,
         "failed",
         reason=f"the worker scoring it died (exit code {code}); the other executions were scored",
     )
-
-
-def _replace(worker: _Worker, ctx: Any) -> _Worker:
-    worker.conn.close()
-    return _Worker(ctx)
 
 
 def run_dask(
@@ -406,6 +213,7 @@ class DaskClient:
             if self._cluster is not None:
                 with contextlib.suppress(Exception):
                     self._cluster.close()
+                close_server()  # its workers were threads here: their scoring children too
         finally:
             self._stack.close()
             sys.stderr.flush()
@@ -487,7 +295,7 @@ def _connect(distributed: Any, address: str, workers: int) -> tuple[Any, Any]:
                 cluster = distributed.LocalCluster(
                     n_workers=max(workers, 1),
                     threads_per_worker=1,
-                    processes=True,
+                    processes=False,
                     dashboard_address=None,
                 )
             return distributed.Client(cluster), cluster

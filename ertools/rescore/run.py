@@ -10,12 +10,14 @@ page written.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ertools.atomic import folder_lock
 from ertools.errors import ConfigError
+from ertools.rescore.children import forks_ready
 from ertools.rescore.found import find, merge, write_timeline
 from ertools.rescore.ledger import account
 from ertools.rescore.manifest import Manifest
@@ -58,7 +60,7 @@ def rescore_competition(
             the timeline).
     """
     # two runs into one folder would mix their reports and caches: one at a time
-    with folder_lock(out, on_wait=on_wait):
+    with folder_lock(out, on_wait=on_wait), _scoring_processes(scheduler, workers):
         # A first run into this folder scores everything: a Dask cluster is started now, while
         # the logs are scanned, not after (a rerun starts one only if the cache lacks a score)
         cold = not use_cache or not any((out / "cache" / "outcomes").glob("*.json"))
@@ -80,6 +82,14 @@ def rescore_competition(
         finally:
             if dask is not None:
                 dask.close()  # closing since the last job ended, while the results were written
+
+
+def _scoring_processes(scheduler: str | None, workers: int) -> AbstractContextManager[None]:
+    """The scoring processes' fork server (:mod:`ertools.rescore.children`), forked now, while
+    this process has one thread: a LocalCluster's workers are threads of this process."""
+    if scheduler == "local" or (scheduler is None and workers > 1):
+        return forks_ready()
+    return nullcontext()
 
 
 def _rescore(

@@ -7,7 +7,8 @@ offset read from the team's per-team input (a YAML file ``{offset: X}``, like a 
 transform). Words in a log make the scorer misbehave on purpose: ``bad`` (an unscoreable log:
 ScoringError), ``boom`` (a bug: RuntimeError), ``die`` (the worker process dies); ``sleep``
 waits a second; ``hold`` writes the scoring process's pid beside the log (``LOG.pid``) and
-waits for ever: a kill point the fault tests choose by waiting for that file.
+waits for ever: a kill point the fault tests choose by waiting for that file; ``locked`` takes
+:data:`LOCK` (a scorer forked while another thread of its parent held it would wait for ever).
 """
 
 from __future__ import annotations
@@ -26,6 +27,8 @@ from ertools.benchmarks.base import Benchmark, Input, Ranking, Rows
 from ertools.errors import ConfigError, ScoringError, UsageError
 from ertools.fidelity import Deviation
 from ertools.streams import Provenance
+
+LOCK = threading.Lock()
 
 
 @dataclass(frozen=True)
@@ -81,6 +84,9 @@ def load(bags: Sequence[Path], options: ToyOptions) -> list[float]:
             if line == "hold":
                 Path(f"{bag}.pid").write_text(f"{os.getpid()}\n")
                 threading.Event().wait()
+            if line == "locked":
+                with LOCK:
+                    continue
             if line == "sleep":  # long enough for a progress bar to show
                 time.sleep(1.0)
                 continue
