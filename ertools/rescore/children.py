@@ -291,7 +291,6 @@ def server() -> ForkServer:
     with _server_lock:
         if os.getpid() not in _servers:
             _servers[os.getpid()] = ForkServer()
-            atexit.register(close_server)  # no orphan; the children's CPU counts as ours
         return _servers[os.getpid()]
 
 
@@ -304,6 +303,9 @@ def close_server() -> None:
             child.close()
         if (ours := _servers.pop(os.getpid(), None)) is not None:
             ours.close()
+
+
+atexit.register(close_server)  # no orphan; the children's CPU time counts as this process's
 
 
 @contextlib.contextmanager
@@ -347,5 +349,7 @@ def run_job_forked(job: Job) -> Outcome:
 
 if __name__ == "__main__":  # a fork server as a fresh interpreter: ForkServer, with threads
     _fd, _owner = (int(arg) for arg in sys.argv[1:3])
+    # Also ends when the owner's thread that started it ends (PR_SET_PDEATHSIG): a Dask
+    # worker's task threads live as long as the worker
     end_with_parent(_owner)
     _serve(socket.socket(fileno=_fd))

@@ -1,5 +1,6 @@
 """Scoring jobs in parallel: local worker processes (``--jobs N``) or a Dask cluster
-(``--scheduler ADDRESS|local``).
+(``--scheduler ADDRESS|local``); the scoring processes are children of the fork server
+(:mod:`ertools.rescore.children`).
 
 Each local worker is a process of its own holding one job at a time, so that when one dies
 (killed for memory, a crash in a native library) the job it held is known: that job's row
@@ -123,7 +124,8 @@ def run_dask(
     known: Iterable[tuple[str, float]] = (),
     dask: DaskClient | None = None,
 ) -> None:
-    """Score ``jobs`` on a Dask cluster (``local``: a LocalCluster of ``workers`` processes).
+    """Score ``jobs`` on a Dask cluster (``local``: a LocalCluster of ``workers`` threads,
+    each scoring in a child of the fork server, :mod:`ertools.rescore.children`).
 
     Only the jobs (paths and values) go through the scheduler; workers read the logs from the
     shared file system. A job whose worker died as often as the scheduler allows
@@ -141,11 +143,11 @@ def run_dask(
 
 
 class DaskClient:
-    """A Dask client being connected (a LocalCluster being started: its scheduler, nannies
-    and worker processes) in a thread of its own, so that a run can start it before scanning
-    the logs, and close it while it writes the results: Dask's fixed costs (~3.4 s of CPU,
-    mostly in the processes it starts, and seconds of waiting for them; docs/rescore.md)
-    overlap the main process's own work instead of adding to it.
+    """A Dask client being connected (a LocalCluster being started: its scheduler and worker
+    threads) in a thread of its own, so that a run can start it before scanning the logs, and
+    close it while it writes the results: Dask's fixed costs (~1 s of CPU, importing
+    ``distributed`` and starting the cluster; docs/rescore.md) overlap the main process's own
+    work instead of adding to it.
 
     ``distributed``'s log records are held from the start to the close and said in one line
     (:func:`_dask_logs_as_one_line`).
@@ -274,19 +276,17 @@ def _connect(distributed: Any, address: str, workers: int) -> tuple[Any, Any]:
         if address == "local":
             import dask.config  # lazy: the optional Dask extra (ertools[dask]), as distributed
 
-            # Without the workers' statistical profiler (a thread sampling every 10 ms, ~5 %
-            # of a core per worker: measured in docs/performance.md), and without the
-            # MALLOC_TRIM_THRESHOLD_=65536 the nannies put in their workers' environment: glibc
-            # then hands every freed array back to the kernel, and the next execution faults
-            # its pages in again (a local worker keeps them). The event loops' tick monitor
-            # (every 20 ms), the system monitor (500 ms) and the memory monitor (100 ms) of
-            # the scheduler, nannies and workers cost 7 % of a core while the cluster waits
-            # (1.08 s of CPU in 15 s); at 1 s, 5 s and 1 s, 1.5 % (0.23 s). The nannies hand
-            # this configuration to the worker processes they start.
+            # The workers are threads of this process (processes=False), each scoring in a
+            # child of the fork server as a --jobs worker does: no nanny and worker process
+            # spawned per worker, each importing distributed and ertools (~3.4 s of CPU for
+            # two, which put a 15-20 s day up to +20 % over --jobs 2). Without the workers'
+            # statistical profiler (a thread sampling every 10 ms, ~5 % of a core per worker:
+            # measured in docs/performance.md). The event loops' tick monitor (every 20 ms),
+            # the system monitor (500 ms) and the memory monitor (100 ms) cost 7 % of a core
+            # while the cluster waits (1.08 s of CPU in 15 s); at 1 s, 5 s and 1 s, 1.5 %.
             with dask.config.set(
                 {
                     "distributed.worker.profile.enabled": False,
-                    "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None,
                     "distributed.admin.tick.interval": "1s",
                     "distributed.admin.system-monitor.interval": "5s",
                     "distributed.worker.memory.monitor-interval": "1s",
