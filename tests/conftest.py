@@ -11,6 +11,10 @@ from pathlib import Path
 
 import pytest
 
+from ertools.cli.main import main
+from ertools.demo import competition_step
+from ertools.samples.competition import DEFAULT_SEED, write_competition
+
 # A skip says "this machine cannot run it". CI's machine can run everything (it has ../shared
 # beside the clone and .ci/run installs Chromium), so in CI a skip means a missing install step
 # that would otherwise look like success. Skips that are not about the machine (a case covered
@@ -166,7 +170,6 @@ def sample_competition(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The sample competition (``python -m ertools.samples --competition``, default seed),
     generated once for the whole session (10 s), by the first worker that needs it:
     tests read it and write nothing into it."""
-    from ertools.samples.competition import DEFAULT_SEED, write_competition
 
     shared = shared_dir(tmp_path_factory)
     root = shared / "competition" / "day"
@@ -184,8 +187,6 @@ def rescored_competition(
     """The sample competition rescored as ``make demo`` does (its step: reports, 2 jobs), once
     for the session, by the first worker that needs it: the results folder (results.json,
     index.html, a report per execution). Tests read it and write nothing into it."""
-    from ertools.cli.main import main
-    from ertools.demo import competition_step
 
     shared = shared_dir(tmp_path_factory)
     out = shared / "rescored" / "rescore"

@@ -7,6 +7,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from ertools.samples.__main__ import generate
+
 REPO = Path(__file__).resolve().parents[2]
 
 
@@ -15,7 +17,6 @@ def sample_dir(name: str, tmp_factory: pytest.TempPathFactory) -> Path:
     shipped = REPO / "sample_bags" / name
     if shipped.is_dir() and any(shipped.glob("*.answers.yaml")):
         return shipped
-    from ertools.samples.__main__ import generate
 
     out = tmp_factory.mktemp(f"samples_{name}")
     generate(out, [name])

@@ -7,7 +7,11 @@ import json
 from pathlib import Path
 
 import pytest
+from fakes import FakeResult
 from stderr_text import error_messages
+
+from ertools.cli.main import main
+from ertools.report.folder import write_report
 
 REAL = Path(__file__).resolve().parents[2] / ".." / "shared" / "real_bags"
 BAG = REAL / "log_fbm2h_mocap_2015-10-23-16-15-40_0.bag"
@@ -25,8 +29,6 @@ def bag() -> Path:
 def test_audit_says_there_is_nothing_to_audit(
     bag: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from ertools.cli.main import main
-
     assert main(["audit", str(bag)]) == 1
     err = error_messages(capsys.readouterr().err)
     assert len(err) == 1 and "no benchmark state topics" in err[0] and bag.name in err[0]
@@ -34,10 +36,6 @@ def test_audit_says_there_is_nothing_to_audit(
 
 
 def test_report_of_the_real_bag_hashes_it_and_has_no_audit(bag: Path, tmp_path: Path) -> None:
-    from fakes import FakeResult
-
-    from ertools.report.folder import write_report
-
     digest = hashlib.sha256()
     with bag.open("rb") as fh:  # read-only, as every input
         for block in iter(lambda: fh.read(1 << 16), b""):

@@ -16,6 +16,7 @@ from audit_samples import answers, sample_dir
 from ertools.audit.compare import IDENTITY_CAVEAT, POSE_KEYS, attach
 from ertools.audit.rescore import ScoreInputs, audit_bag, rescore
 from ertools.cli.main import main
+from ertools.report.folder import write_report
 
 
 @pytest.fixture(scope="module")
@@ -87,8 +88,6 @@ def test_identity_caveat_when_the_payload_lacks_the_transform(fbm2h: Path) -> No
 
 
 def test_identity_caveat_titles_the_report(fbm2h: Path, tmp_path: Path) -> None:
-    from ertools.report.folder import write_report
-
     (bag,) = fbm2h.glob("*.bag")
     audit, _ = audit_bag([bag], recompute=False)
     live = copy.deepcopy(audit.live_score)

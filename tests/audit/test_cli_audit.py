@@ -11,13 +11,12 @@ from stderr_text import error_messages, joined_lines
 from test_audit import BMBOX, CLIENT, REFBOX
 
 from ertools.cli.main import main
+from ertools.samples.writer import BagWriter
 from ertools.states import Machine
 from ertools.streams import StateStream
 
 
 def _write_bag(path: Path, streams: list[StateStream]) -> Path:
-    from ertools.samples.writer import BagWriter
-
     with BagWriter(path, "ros1") as bag:
         for s in streams:
             bag.write_state(s.machine, s.topic, s.t_ns, [int(x) for x in s.state], list(s.payload))
@@ -136,8 +135,6 @@ def test_input_of_another_benchmark_keeps_the_warning(
 def test_bag_without_states_is_one_line_error(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from ertools.samples.writer import BagWriter
-
     path = tmp_path / "poses.bag"
     with BagWriter(path, "ros1") as bag:
         bag.write_string("/rosout_text", T0_NS, "hello")

@@ -12,12 +12,12 @@ from audit_samples import answers, sample_dir
 from ertools.audit.analyse import audit_states
 from ertools.audit.compare import attach, flatten
 from ertools.audit.model import Audit
-from ertools.audit.rescore import ScoreInputs, rescore
+from ertools.audit.rescore import ScoreInputs, audit_bag, rescore
+from ertools.cli.main import main
+from ertools.io import read_benchmark_states
 
 
 def _audit(folder: Path, ns: str) -> Audit:
-    from ertools.io import read_benchmark_states
-
     (bag,) = folder.glob("*.bag")
     st = read_benchmark_states([bag], ns)
     return audit_states(st.bmbox, st.refbox, st.client, benchmark=ns)
@@ -98,8 +98,6 @@ def test_fbm1h_live_is_the_2015_totals(fbm1h: Path) -> None:
     assert by_key["pose_score"].status == "differs"
     assert "runs" in by_key["pose_score"].explanation
     # The 2015 rules reproduce the live pose score (within 0.1 %): a deliberate deviation.
-    from ertools.audit.rescore import audit_bag
-
     audited, _ = audit_bag([bag], inputs=ScoreInputs(items=fbm1h / "fbm1h.yaml"))
     assert audited.comparison is not None
     (line,) = audited.comparison.differences
@@ -124,8 +122,6 @@ def test_fbm2h_goal_and_results_in_the_runs(fbm2h: Path) -> None:
 
 
 def test_fbm3w_other_d_min_is_explained_by_the_2015_rules(fbm3w: Path) -> None:
-    from ertools.audit.rescore import audit_bag
-
     (bag,) = fbm3w.glob("*.bag")
     audit, _ = audit_bag([bag], inputs=ScoreInputs(d_min=0.0005))
     assert audit.comparison is not None
@@ -141,8 +137,6 @@ def test_fbm2h_live_score_beside_the_recomputed_one(
 ) -> None:
     """The sample's BmBox sends the score the 2015 node would have (answers:
     expected.published); the audit shows it beside ertools' score, differences explained."""
-    from ertools.audit.rescore import audit_bag
-    from ertools.cli.main import main
 
     ans = answers(fbm2h)
     exp, tols = ans["expected"], ans["tolerance"]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 import sys
 from pathlib import Path
 
@@ -12,7 +13,6 @@ if str(BENCH) not in sys.path:
 
 def coverage(module_name: str, trials: int, draws: int) -> tuple[int, int, list[str]]:
     """(scores, covered, the misses described) over seeds 0..trials-1."""
-    import importlib
 
     module = importlib.import_module(f"calibration.{module_name}")
     scores = covered = 0

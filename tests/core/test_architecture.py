@@ -1,4 +1,5 @@
-"""The architecture as written in docs/ARCHITECTURE.md: imports at the top, layers kept.
+"""The architecture as written in docs/ARCHITECTURE.md: imports at the top (the tests' too),
+layers kept.
 
 ``make lint`` runs the import-linter contracts of ``pyproject.toml``; these tests show that
 they can fail (an upward import planted in a copy of the package is refused) and keep the one
@@ -12,6 +13,7 @@ import ast
 import shutil
 import subprocess
 import sys
+from collections.abc import Iterable, Set
 from pathlib import Path
 
 import pytest
@@ -70,16 +72,60 @@ def _function_imports(path: Path) -> list[tuple[int, str, str]]:
 LAZY_ERTOOLS: frozenset[str] = frozenset()
 
 
-def test_function_level_imports_are_heavy_third_party_with_a_reason() -> None:
+def _misplaced(paths: Iterable[Path], allowed: Set[str]) -> list[str]:
+    """``path:line: module: what to do`` of every import inside a function of ``paths`` that
+    is not a package of ``allowed`` imported with a ``# lazy:`` reason (on its line or the two
+    above). Code in strings (a script for a subprocess, a module written to a folder) is text,
+    not an import of the file."""
     bad = []
-    for path in sorted(PACKAGE.rglob("*.py")):
+    for path in paths:
+        shown = path.relative_to(ROOT) if path.is_relative_to(ROOT) else path
         for line, module, context in _function_imports(path):
-            where = f"{path.relative_to(ROOT)}:{line}: {module}"
-            if module.split(".")[0] not in LAZY_ALLOWED and module not in LAZY_ERTOOLS:
+            where = f"{shown}:{line}: {module}"
+            if module.split(".")[0] not in allowed and module not in LAZY_ERTOOLS:
                 bad.append(f"{where}: import it at the top of the module")
             elif "# lazy:" not in context:
                 bad.append(f"{where}: say why it is imported here (# lazy: ...)")
+    return bad
+
+
+def test_function_level_imports_are_heavy_third_party_with_a_reason() -> None:
+    bad = _misplaced(sorted(PACKAGE.rglob("*.py")), LAZY_ALLOWED)
     assert not bad, "\n".join(bad)
+
+
+# The tests keep the package's rule. Beyond its lazy packages, the dev extra's slow ones that
+# only a few tests need: evo (each such test skips without it, pytest.importorskip) and
+# papermill (the notebook runs).
+TESTS = ROOT / "tests"
+LAZY_IN_TESTS = LAZY_ALLOWED | {"evo", "papermill"}
+
+
+def test_tests_import_at_the_top_too() -> None:
+    bad = _misplaced(sorted(TESTS.rglob("*.py")), LAZY_IN_TESTS)
+    assert not bad, "\n".join(bad)
+
+
+def test_the_tests_rule_refuses_what_it_should(tmp_path: Path) -> None:
+    module = tmp_path / "test_m.py"
+    module.write_text(
+        "import subprocess\n\n"
+        "def test_a():\n    from ertools.errors import UsageError\n    return UsageError\n\n"
+        "def test_b():\n    import json\n    return json\n\n"
+        "def test_c():\n    # lazy: slow\n    from evo.core import sync\n    return sync\n\n"
+        "def test_d():\n    from evo.core import sync\n    return sync\n\n"
+        "def test_e():\n    import shutil  # lazy: not a heavy package, refused anyway\n\n"
+        "def test_f():\n"
+        "    code = 'from ertools.io import read_poses\\nimport json'\n"
+        "    subprocess.run(['python', '-c', code])\n",
+        encoding="utf-8",
+    )
+    assert _misplaced([module], LAZY_IN_TESTS) == [
+        f"{module}:4: ertools.errors: import it at the top of the module",
+        f"{module}:8: json: import it at the top of the module",
+        f"{module}:17: evo.core: say why it is imported here (# lazy: ...)",
+        f"{module}:21: shutil: import it at the top of the module",
+    ]
 
 
 def test_the_rule_sees_a_function_level_import(tmp_path: Path) -> None:

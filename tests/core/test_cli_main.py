@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import logging
 import subprocess
 import sys
 import time
 
 import pytest
 
-from ertools.cli.main import COMMANDS, main
+from ertools.cli.main import COMMANDS, _configure_logging, main
+from ertools.cli.output import note
 
 
 def test_help_lists_every_command_with_an_example(capsys: pytest.CaptureFixture[str]) -> None:
@@ -46,11 +48,6 @@ def test_help_is_instant_and_imports_nothing_heavy() -> None:
 
 def test_library_warnings_read_like_the_cli_notes(capsys: pytest.CaptureFixture[str]) -> None:
     # Logged warnings and cli.common.note warnings share one wording: "ertools: warning: ...".
-    import logging
-
-    from ertools.cli.main import _configure_logging
-    from ertools.cli.output import note
-
     root = logging.getLogger("ertools")
     saved = (root.handlers[:], root.level, root.propagate)
     try:

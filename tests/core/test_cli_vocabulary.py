@@ -25,6 +25,7 @@ from ertools.benchmarks.common.sources import (
 )
 from ertools.benchmarks.common.spec import parse_tf
 from ertools.cli.main import build_parser, main
+from ertools.cli.options import pose_spec, time_source
 from ertools.errors import TopicError, UsageError
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -119,7 +120,6 @@ def test_each_command_accepts_the_common_spellings(
 
 def test_time_source_has_one_default_everywhere() -> None:
     """Not given, it is None in the namespace and ``header`` in every pose spec."""
-    from ertools.cli.options import pose_spec, time_source
 
     for command, argv in (
         ("noise", ("b.bag",)),

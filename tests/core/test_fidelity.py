@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 import pickle
 import re
 from pathlib import Path
@@ -9,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from ertools.benchmarks.base import dump_yaml, jsonable
+from ertools.cli.main import main
 from ertools.fidelity import (
     BEGIN,
     END,
@@ -103,8 +105,6 @@ def test_every_rule_option_is_exercised_by_a_test() -> None:
 
 
 def test_rule_modules_exist_and_declare_rules_at_module_level() -> None:
-    import importlib
-
     for name in RULE_MODULES:
         importlib.import_module(name)
 
@@ -145,7 +145,6 @@ PRINTED = re.compile(r"^ertools: differs from 2015: .*\[(?P<key>[a-z0-9]+\.[a-z0
 def test_every_printed_deviation_has_a_rule(case: str, capsys: pytest.CaptureFixture[str]) -> None:
     """What the commands print on the samples under the default and the 2015 options: each
     ``differs from 2015`` line names a rule of the catalogue (and so a row of the docs)."""
-    from ertools.cli.main import main
 
     assert main(RUNS[case]) == 0
     err = capsys.readouterr().err

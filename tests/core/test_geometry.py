@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import math
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
+from scipy.spatial.transform import Rotation, Slerp
 
 from ertools.geometry import (
     angle_error,
@@ -21,6 +24,7 @@ from ertools.geometry import (
     quat_from_yaw,
     row_dot,
     row_norm,
+    slerp,
     transform_points,
     wrap_angle,
     yaw_from_quat,
@@ -205,8 +209,6 @@ def test_compose_accepts_read_only_inputs() -> None:
 def test_numpy_compose_matches_scipy(
     t1: np.ndarray, q1: np.ndarray, t2: np.ndarray, q2: np.ndarray
 ) -> None:
-    from scipy.spatial.transform import Rotation
-
     t, q = compose(t1, q1, t2, q2)
     r1, r2 = Rotation.from_quat(q1), Rotation.from_quat(q2)
     np.testing.assert_allclose(t, t1 + r1.apply(t2), atol=1e-9)
@@ -217,19 +219,12 @@ def test_numpy_compose_matches_scipy(
 @settings(max_examples=80, deadline=None)
 @given(quat, quat, st.floats(0.0, 1.0))
 def test_slerp_matches_scipy(q0: np.ndarray, q1: np.ndarray, alpha: float) -> None:
-    from scipy.spatial.transform import Rotation, Slerp
-
-    from ertools.geometry import slerp
-
     expected = Slerp([0.0, 1.0], Rotation.from_quat(np.stack([q0, q1])))([alpha]).as_quat()[0]
     got = slerp(q0[None], q1[None], np.array([alpha]))[0]
     assert min(np.abs(got - expected).max(), np.abs(got + expected).max()) < 1e-7
 
 
 def test_geometry_import_does_not_load_scipy() -> None:
-    import subprocess
-    import sys
-
     code = "import sys, ertools.geometry; print('scipy.spatial' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"

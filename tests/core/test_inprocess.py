@@ -16,6 +16,8 @@ from inprocess import run
 from shell_bridge import parse_request, run_bash
 
 from ertools import caches
+from ertools.cli import info
+from ertools.io.mcap import scan, summary
 
 ROOT = Path(__file__).resolve().parents[2]
 BAG = "sample_bags/fbm3w/log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
@@ -48,8 +50,6 @@ def test_a_relative_path_is_read_from_the_folder_given(tmp_path: Path) -> None:
 
 @pytest.mark.skipif(MCAP is None, reason="n/a: the samples hold no MCAP file")
 def test_file_memories_are_emptied_before_and_after() -> None:
-    from ertools.io.mcap import scan, summary
-
     assert MCAP is not None
     assert run(["info", str(MCAP)]).code == 0
     assert not summary._SUMMARIES and not scan._SCANS and not scan._LAYOUTS
@@ -58,7 +58,6 @@ def test_file_memories_are_emptied_before_and_after() -> None:
 
 def test_a_warning_is_printed_each_time_as_by_a_new_process() -> None:
     """Python's "once per place" memory is per process: the second run prints it again."""
-    from ertools.cli import info
 
     def warn_then_fail(args: object) -> int:
         warnings.warn("careful", UserWarning, stacklevel=1)

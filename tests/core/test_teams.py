@@ -20,8 +20,11 @@ from ertools.benchmarks.common.teams import (
     with_team,
 )
 from ertools.cli.main import main
+from ertools.samples.__main__ import generate
+from ertools.samples.writer import BagWriter
 from ertools.states import Machine
 from ertools.streams import Provenance
+from ertools.timeline.build import benchmark_names
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -31,7 +34,6 @@ def _sample_dir(name: str, tmp_factory: pytest.TempPathFactory) -> Path:
     shipped = REPO / "sample_bags" / name
     if shipped.is_dir() and any(shipped.glob("*.answers.yaml")):
         return shipped
-    from ertools.samples.__main__ import generate
 
     out = tmp_factory.mktemp(f"samples_{name}")
     generate(out, [name])
@@ -73,8 +75,6 @@ def test_names_the_logger_did_not_give(name: str) -> None:
 
 
 def test_timeline_uses_the_same_helper() -> None:
-    from ertools.timeline.build import benchmark_names
-
     assert benchmark_names([], "FBMH2_201511201200_homer.bag") == ("fbm2h",)
     assert benchmark_names([], "robot.bag") == ()
 
@@ -119,8 +119,6 @@ class _Result:
 
 
 def test_payload_team_read_from_a_bag(tmp_path: Path) -> None:
-    from ertools.samples.writer import BagWriter
-
     bag = tmp_path / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
     t = 1_447_999_200_000_000_000 + 100_000_000 * __import__("numpy").arange(5)
     with BagWriter(bag, "ros1") as w:

@@ -21,10 +21,15 @@ import re
 import shutil
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from importlib import import_module
 from pathlib import Path
 from typing import Any
 
 import pytest
+import yaml
+from rosbags.highlevel import AnyReader
+from rosbags.rosbag1 import Writer
+from rosbags.typesys import Stores, get_typestore
 
 from ertools.cli.main import COMMANDS, MAX_ERROR_LINE, main
 
@@ -95,8 +100,6 @@ class Inputs:
 
 def _pose_bag(path: Path, topic: str, t0_ns: int, n: int, rate_hz: float, nan: Any) -> Path:
     """A ROS1 bag of PoseStamped on ``topic``; ``nan(i)`` says which samples are NaN."""
-    from rosbags.rosbag1 import Writer
-    from rosbags.typesys import Stores, get_typestore
 
     ts = get_typestore(Stores.ROS1_NOETIC)
     T = ts.types
@@ -125,8 +128,6 @@ def _shifted_copy(
 ) -> Path:
     """``src`` with the header stamps (of ``topics``, else all) and, with ``record_too``, the
     record times moved by ``shift_ns``."""
-    from rosbags.highlevel import AnyReader
-    from rosbags.rosbag1 import Writer
 
     with AnyReader([src]) as reader, Writer(dst) as w:
         ts = reader.typestore  # the bag's own definitions (the 2015 state messages too)
@@ -577,7 +578,6 @@ def test_short_items_order_keeps_the_payloads_of_later_runs(
 ) -> None:
     """`--items-order 10` fixes run 1 only (the sample shows item 10 first): the totals are
     the answers file's, not nine 'no item named' failures."""
-    import yaml
 
     answers = yaml.safe_load(next((SAMPLES / "fbm1h").glob("*.answers.yaml")).read_text())
     first = answers["expected"]["runs"][0]
@@ -761,8 +761,6 @@ def _late_timing(i: Inputs) -> Path:
 
 
 def _far_windows(i: Inputs) -> str:
-    import yaml
-
     n = len(yaml.safe_load(i.items.read_text())["items"])
     return ",".join(f"{5000 + 10 * k}:{5005 + 10 * k}" for k in range(n))
 
@@ -1021,8 +1019,6 @@ def test_mocap_clock_off_the_logger_clock(
     assert f"{shift_s:+.3f} s" in line and "--time-source record" in line
     if which == "fbm2h":
         # ... and the way out scores as the answers file says (its 2 mm tolerance).
-        import yaml
-
         answers = yaml.safe_load(next((SAMPLES / "fbm2h").glob("*.answers.yaml")).read_text())
         again = _run(
             ["score", which, str(bag), *extra, "--time-source", "record", "--format", "json"],
@@ -1053,7 +1049,6 @@ def test_small_clock_offset_is_never_silent(
     inputs: Inputs, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """The sample robot clock runs 0.35 s ahead (answers file): scored, but said loudly."""
-    import yaml
 
     answers = yaml.safe_load(next((SAMPLES / "robotlog").glob("*.answers.yaml")).read_text())
     true_offset = answers["truth"]["offset_s"]  # seconds added to the robot stamps
@@ -1243,8 +1238,6 @@ def test_non_finite_number_option(
 
 
 def _every_command() -> Iterator[list[str]]:
-    from importlib import import_module
-
     for name, cmd in COMMANDS.items():
         yield [name]
         members = getattr(import_module(cmd.module), "MEMBERS", None)

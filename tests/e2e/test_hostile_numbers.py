@@ -13,6 +13,9 @@ import pytest
 from stderr_text import error_messages
 
 from ertools.cli.main import main
+from ertools.configs._yaml import MAX_DEPTH, parse_yaml
+from ertools.configs.shapes import compile_expression
+from ertools.errors import ConfigError
 
 ROOT = Path(__file__).resolve().parents[2]
 FBM2H = ROOT / "sample_bags" / "fbm2h"
@@ -106,8 +109,6 @@ def test_deep_nesting_is_refused_with_a_message(
 
 
 def test_sixty_four_levels_are_still_read(tmp_path: Path) -> None:
-    from ertools.configs._yaml import MAX_DEPTH, parse_yaml
-
     data = parse_yaml("[" * (MAX_DEPTH - 1) + "1" + "]" * (MAX_DEPTH - 1))
     for _ in range(MAX_DEPTH - 1):
         data = data[0]
@@ -136,8 +137,6 @@ def test_a_run_given_on_the_command_line(spec: str, capsys: pytest.CaptureFixtur
 
 def test_a_shape_constant_too_large_for_a_float() -> None:
     """A 300-digit constant fits the expression's 400 characters but not a float."""
-    from ertools.configs.shapes import compile_expression
-    from ertools.errors import ConfigError
 
     with pytest.raises(ConfigError, match=r"shapes.odd.x: .*constant 1111.*too large"):
         compile_expression("1" * 300 + " * l", where="shapes.odd.x")

@@ -6,9 +6,12 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+from ertools.benchmarks.common.hygiene import drop_duplicates
 from ertools.cli.main import main
+from ertools.streams import PoseStream
 
 ROOT = Path(__file__).resolve().parents[2]
 BAG = ROOT / "sample_bags" / "fbm3w" / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
@@ -34,10 +37,6 @@ def test_a_bag_given_with_its_copy_writes_each_pose_once(
 def test_a_real_repeat_with_a_fresh_stamp_is_kept(tmp_path: Path) -> None:
     """Only identical stamp and pose go: the hygiene rule `score` uses (a repeated pose with a
     new stamp is Motive's tracking-loss repeat, not a copy)."""
-    import numpy as np
-
-    from ertools.benchmarks.common.hygiene import drop_duplicates
-    from ertools.streams import PoseStream
 
     t = np.array([0, 10, 10, 20], dtype=np.int64)
     xyz = np.array([[0, 0, 0], [1, 0, 0], [1, 0, 0], [1, 0, 0]], dtype=np.float64)

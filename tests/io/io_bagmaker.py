@@ -11,6 +11,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+from mcap.writer import CompressionType
+from mcap.writer import Writer as McapWriter
+from rosbags.rosbag1 import Writer
+from rosbags.rosbag2 import StoragePlugin
+from rosbags.rosbag2 import Writer as Writer2
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
 from ertools.states import MSG_DEFINITIONS, MSG_TYPES
 
 FORMATS = (
@@ -27,8 +35,6 @@ TF_MSG = "geometry_msgs/TransformStamped[] transforms\n"
 
 
 def typestore(ros1: bool) -> Any:
-    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
-
     ts = get_typestore(Stores.ROS1_NOETIC if ros1 else Stores.ROS2_HUMBLE)
     extra: dict[str, Any] = {}
     for machine, name in MSG_TYPES.items():
@@ -101,8 +107,6 @@ def build(ts: Any, ros1: bool, msgtype: str, v: dict[str, Any], seq: int) -> Any
     if msgtype in ("tf2_msgs/TFMessage", "tf/tfMessage"):
         return T[long](transforms=[_tfs(ts, ros1, x, seq) for x in v["transforms"]])
     if msgtype == "geometry_msgs/PoseWithCovarianceStamped":
-        import numpy as np
-
         # A covariance unlike any pose value: a decoder reading the wrong 56 bytes shows.
         cov = np.linspace(-1e3, 1e3, 36) + seq
         return T[long](
@@ -112,8 +116,6 @@ def build(ts: Any, ros1: bool, msgtype: str, v: dict[str, Any], seq: int) -> Any
             ),
         )
     if msgtype == "nav_msgs/Odometry":
-        import numpy as np
-
         cov = np.arange(36, dtype=np.float64)
         return T[long](
             header=_header(ts, ros1, v["stamp"], v["frame"], seq),
@@ -146,8 +148,6 @@ def write(
     ros1 = fmt.startswith("ros1") or fmt == "mcap-ros1"
     ts = typestore(ros1)
     if fmt.startswith("ros1"):
-        from rosbags.rosbag1 import Writer
-
         w = Writer(path)
         if fmt != "ros1":
             w.set_compression(Writer.CompressionFormat[fmt.split("-")[1].upper()])
@@ -163,9 +163,6 @@ def write(
                 w.write(conns[ci], t_ns, ts.serialize_ros1(msg, conns[ci].msgtype))
         return path
     if fmt.startswith("rosbag2"):
-        from rosbags.rosbag2 import StoragePlugin
-        from rosbags.rosbag2 import Writer as Writer2
-
         plugin = StoragePlugin.SQLITE3 if fmt.endswith("sqlite3") else StoragePlugin.MCAP
         with Writer2(path, version=9, storage_plugin=plugin) as w2:
             conns2 = {}
@@ -182,8 +179,6 @@ def write(
                 msg = build(ts, False, spec.conns[ci][1], v, seq)
                 w2.write(conns2[ci], t_ns, ts.serialize_cdr(msg, conns2[ci].msgtype))
         return path
-    from mcap.writer import CompressionType
-    from mcap.writer import Writer as McapWriter
 
     with path.open("wb") as f:
         options = {"compression": CompressionType.LZ4, **mcap_options}

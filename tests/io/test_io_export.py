@@ -19,6 +19,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from io_scene import Scene
+from rosbags.highlevel import AnyReader
 
 from ertools.cli.main import main
 from ertools.errors import BagError
@@ -125,7 +126,6 @@ def test_tf_source_is_the_pose_of_the_child(
 
 def _rosbags_poses(path: Path, topic: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Header stamps, positions and quaternions of a PoseStamped topic, read by rosbags."""
-    from rosbags.highlevel import AnyReader
 
     t, xyz, q = [], [], []
     with AnyReader([path]) as reader:

@@ -6,11 +6,18 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from rosbags.highlevel import AnyReader
+from rosbags.rosbag1 import Writer
 
+import ertools.io as eio
+from ertools.io import summary
 from ertools.io.bulk import try_fast_batch
 from ertools.io.decode.posebatch import PoseBatch
+from ertools.io.decode.typestore import Deserializer
 from ertools.io.files import RosbagsFile, open_bag
-from ertools.io.reader import slow_pose_batch
+from ertools.io.formats import detect_format, find_bags
+from ertools.io.model import POSE_TYPES
+from ertools.io.reader import _bulk_states, slow_pose_batch
 
 POSE_TOPICS = (
     "/fbm3w/robot_at_work/pose",
@@ -27,7 +34,6 @@ def reference_batch(
     """rosbags' own reader and deserializer (rosbag1/rosbag2 Reader), or for files rosbags
     does not open (standalone MCAP, unindexed .bag.active) their per-message raw records
     deserialized by rosbags."""
-    from ertools.io.formats import detect_format
 
     fmt = detect_format(path)
     bag = RosbagsFile(path, fmt) if fmt not in ("mcap", "ros1-active") else open_bag(path)
@@ -64,16 +70,11 @@ REAL_BAG = REPO / ".." / "shared" / "real_bags" / "log_fbm2h_mocap_2015-10-23-16
 
 
 def _sample_bags() -> list[Path]:
-    from ertools.io.formats import find_bags
-
     folder = REPO / "sample_bags"
     return list(find_bags([folder]).bags) if folder.is_dir() else []
 
 
 def test_fast_equals_rosbags_on_sample_bags() -> None:
-    from ertools.io import summary
-    from ertools.io.model import POSE_TYPES
-
     bags = _sample_bags()
     if not bags:
         pytest.skip("sample_bags/ is empty (run `make samples`)")
@@ -99,9 +100,6 @@ def test_real_bag_end_to_end() -> None:
     """Topics, counts, start/end and first pose, checked against rosbags' AnyReader directly."""
     if not REAL_BAG.exists():
         pytest.skip("../shared/real_bags not present")
-    from rosbags.highlevel import AnyReader
-
-    import ertools.io as eio
 
     with AnyReader([REAL_BAG]) as reader:
         start, end = reader.start_time, reader.end_time - 1  # rosbags' end is exclusive
@@ -140,8 +138,6 @@ STATE_TOPICS = ("/fbm3w/bmbox_state", "/fbm3w/refbox_state")
 
 def reference_states(path: Path, topic: str) -> tuple[list[int], list[int], list[str]]:
     """States deserialized one by one by rosbags' own readers."""
-    from ertools.io.decode.typestore import Deserializer
-    from ertools.io.formats import detect_format
 
     fmt = detect_format(path)
     bag = RosbagsFile(path, fmt) if fmt not in ("mcap", "ros1-active") else open_bag(path)
@@ -154,8 +150,6 @@ def reference_states(path: Path, topic: str) -> tuple[list[int], list[int], list
 
 @pytest.mark.parametrize("topic", STATE_TOPICS)
 def test_bulk_states_equal_rosbags(scene_bag: tuple[str, Path], topic: str) -> None:
-    from ertools.io.reader import _bulk_states
-
     _fmt, path = scene_bag
     with open_bag(path) as bag:
         bulk = _bulk_states(bag, bag.topic_conns(topic))
@@ -165,9 +159,6 @@ def test_bulk_states_equal_rosbags(scene_bag: tuple[str, Path], topic: str) -> N
 
 
 def test_bulk_states_on_sample_and_real_bags() -> None:
-    from ertools.io import summary
-    from ertools.io.reader import _bulk_states
-
     bags = _sample_bags()
     if not bags:
         pytest.skip("sample_bags/ is empty (run `make samples`)")
@@ -186,9 +177,6 @@ def test_bulk_states_on_sample_and_real_bags() -> None:
 
 def test_other_state_layout_falls_back(tmp_path: Path) -> None:
     """A state type with an extra field is still read, through rosbags."""
-    from rosbags.rosbag1 import Writer
-
-    import ertools.io as eio
 
     path = tmp_path / "odd.bag"
     definition = "uint8 state\nstring payload\nuint32 extra\n"

@@ -17,6 +17,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from fuzz.judge import ertools_answer
+
 REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
@@ -31,8 +33,6 @@ from fuzz.seeds import N_POSES, POSE_TOPIC, SEEDS, T0_NS, seed_bytes, suffix  # 
 def test_seed_files_read_the_same(
     tmp_path: Path, name: str, caplog: pytest.LogCaptureFixture
 ) -> None:
-    from fuzz.judge import ertools_answer
-
     path = tmp_path / f"seed{suffix(name)}"
     path.write_bytes(seed_bytes(name))
     off = official_answer(path)

@@ -11,8 +11,11 @@ import yaml
 from io_bagmaker import write
 from io_scene import DT, Scene
 from stderr_text import joined_lines
+from test_io_summary import make_active
 
 from ertools.cli.main import main
+from ertools.errors import BagError
+from ertools.io import read_poses
 
 POSE = "/fbm3w/robot_at_work/pose"
 
@@ -138,9 +141,6 @@ def test_corrupted_chunk(capsys: pytest.CaptureFixture[str], scene: Scene, tmp_p
     assert code == 1
     one_error_line(err, "corrupt.bag", "chunk")
     # Reading the damaged chunk's poses fails the same way (never a silently short stream).
-    from ertools.errors import BagError
-    from ertools.io import read_poses
-
     with pytest.raises(BagError, match="corrupt"):
         read_poses(bad, POSE)
 
@@ -185,8 +185,6 @@ def test_corrupted_record_in_uncompressed_chunk(
 def test_active_bag_warns_and_exits_0(
     capsys: pytest.CaptureFixture[str], scene: Scene, tmp_path: Path
 ) -> None:
-    from test_io_summary import make_active
-
     good = write(tmp_path / "g.bag", "ros1", scene.spec, chunk_bytes=2000)
     active = make_active(good, tmp_path / "rec.bag.active")
     code, out, err = run(capsys, str(active))

@@ -17,9 +17,11 @@ import numpy as np
 import pytest
 from io_bagmaker import write
 from io_scene import Scene
+from mcap.writer import CompressionType, IndexType, Writer
 
 import ertools.io as eio
 from ertools.cli.main import main
+from ertools.io.mcap import scan as mcap_scan
 from ertools.io.summary import record_times
 
 POSE = "/fbm3w/robot_at_work/pose"
@@ -28,8 +30,6 @@ INDEXED, SCAN = "summary+message-indexes", "scan"
 
 
 def _options() -> dict[str, tuple[dict[str, Any], str, str]]:
-    from mcap.writer import CompressionType, IndexType
-
     return {
         # id: (Writer options, index info reports, why the indexes do not answer)
         "default": ({}, INDEXED, ""),
@@ -167,8 +167,6 @@ def test_attachments_and_metadata_keep_the_indexes(
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    from mcap.writer import Writer
-
     finish = Writer.finish
 
     def finish_with_extras(self: Any) -> None:
@@ -229,7 +227,6 @@ def test_scan_finds_every_record(
     scene: Scene,
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    from ertools.io.mcap import scan as mcap_scan
 
     # small windows (a few records) and early bulk reads: record chains cut at window edges
     monkeypatch.setattr(mcap_scan, "WINDOW", window)

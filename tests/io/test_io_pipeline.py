@@ -8,21 +8,25 @@ bit with rosbags.
 
 from __future__ import annotations
 
+import mmap
 import os
 import shutil
+import struct
 import threading
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
-from io_bagmaker import bag_name, write
+from io_bagmaker import Spec, bag_name, write
 from io_scene import Scene
+from mcap.reader import make_reader
 from test_io_fastpath import POSE_TOPICS, assert_same, fast_batch, reference_batch
 
 import ertools.io as eio
 from ertools.errors import BagError, ErtoolsError
 from ertools.io import bulk, pipeline
+from ertools.io.files import open_bag
 from ertools.io.mcap.index import _in_order
 from ertools.io.ros1 import runs as ros1_runs
 
@@ -147,15 +151,12 @@ def test_load_all_chunks_counts_every_uncompressed_byte(
     fmt, path = scene_bag
     if fmt.startswith("rosbag2-sqlite") or fmt == "rosbag2-mcap":
         pytest.skip("n/a: chunk floor measured on single-file ROS1 and MCAP")
-    from ertools.io.files import open_bag
 
     with open_bag(path) as bag:
         total = bulk.load_all_chunks(bag)
     if fmt.startswith("ros1"):
         expected = _ros1_sizes(path)
     else:
-        from mcap.reader import make_reader
-
         with path.open("rb") as f:
             summary = make_reader(f).get_summary()
         assert summary is not None
@@ -165,7 +166,6 @@ def test_load_all_chunks_counts_every_uncompressed_byte(
 
 def _ros1_sizes(path: Path) -> int:
     """Sum of the ``size`` field of every chunk record, walked record by record."""
-    import struct
 
     data = path.read_bytes()
     pos, total = 13, 0
@@ -200,8 +200,6 @@ def test_default_groups_equal_small_groups(scene_bag: tuple[str, Path]) -> None:
 
 
 def _pose_between_blobs(tmp_path: Path, blob_bytes: int) -> Path:
-    from io_bagmaker import Spec
-
     s = Spec()
     pose = s.conn("/robot/pose", "geometry_msgs/PoseStamped")
     blob = s.conn("/robot/camera", "std_msgs/String")
@@ -237,8 +235,6 @@ def test_pose_topic_between_big_messages_is_read_in_place(
 
 
 def test_a_reused_slot_releases_its_map(tmp_path: Path) -> None:
-    import mmap
-
     path = tmp_path / "f.bin"
     path.write_bytes(b"\0" * 100_000)
     with path.open("rb") as f:

@@ -8,12 +8,21 @@ values unlike any pose, so a decoder reading the wrong 56 bytes cannot pass.
 
 from __future__ import annotations
 
+import json
 import struct
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from mcap.reader import make_reader
+from rosbags.highlevel import AnyReader
+
+from ertools.benchmarks.trajectory.inputs import read_robot
+from ertools.cli.main import main
+from ertools.errors import TopicError
+from ertools.io.info import describe
+from ertools.io.model import short_msgtype
 
 sys.path.insert(0, str(Path(__file__).parent))
 
@@ -163,9 +172,6 @@ def test_pwcs_layout_by_hand(cdr: bool) -> None:
 
 @pytest.mark.parametrize("topic", sorted(TOPICS))
 def test_trajectory_robot_topic_accepts_every_type(typed_bag: Path, topic: str) -> None:
-    from ertools.benchmarks.trajectory.inputs import read_robot
-    from ertools.errors import TopicError
-
     _, t_rec, t_hdr, xyz, _quat = truth()
     rec = read_robot(str(typed_bag), topic, "record")
     np.testing.assert_array_equal(rec.t_ns, t_rec)
@@ -180,10 +186,6 @@ def test_trajectory_robot_topic_accepts_every_type(typed_bag: Path, topic: str) 
 def test_noise_topic_option_takes_a_covariance_pose(
     typed_bag: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    import json
-
-    from ertools.cli.main import main
-
     code = main(["noise", str(typed_bag), "--topic", "/amcl_pose", "--format", "json"])
     out = json.loads(capsys.readouterr().out)
     assert code == 0
@@ -196,12 +198,9 @@ def test_noise_topic_option_takes_a_covariance_pose(
 def official_summary(path: Path) -> tuple[dict[str, tuple[str, int, int, int]], int, int]:
     """topic -> (type, count, first, last) and the bag's (start, end) by the official reader
     of the format: rosbags for ROS1 and rosbag2, the mcap library for bare MCAP files."""
-    from ertools.io.model import short_msgtype
 
     topics: dict[str, tuple[str, int, int, int]] = {}
     if path.suffix == ".mcap":
-        from mcap.reader import make_reader
-
         with path.open("rb") as f:
             reader = make_reader(f)
             summary = reader.get_summary()
@@ -216,7 +215,6 @@ def official_summary(path: Path) -> tuple[dict[str, tuple[str, int, int, int]], 
                 assert stats.channel_message_counts.get(cid, 0) == len(ts)
                 topics[channel.topic] = (short_msgtype(schema.name), len(ts), min(ts), max(ts))
             return topics, stats.message_start_time, stats.message_end_time
-    from rosbags.highlevel import AnyReader
 
     with AnyReader([path]) as reader:
         seen: dict[str, list[int]] = {}
@@ -229,8 +227,6 @@ def official_summary(path: Path) -> tuple[dict[str, tuple[str, int, int, int]], 
 
 
 def test_summary_matches_the_official_reader(typed_bag: Path) -> None:
-    from ertools.io.info import describe
-
     path = typed_bag
     topics, start, end = official_summary(path)
     exact = describe(path).summary
@@ -245,9 +241,6 @@ def test_summary_matches_the_official_reader(typed_bag: Path) -> None:
 
 
 def test_trajectory_robot_topic_of_several_tf_bodies_is_refused(tmp_path: Path) -> None:
-    from ertools.benchmarks.trajectory.inputs import read_robot
-    from ertools.errors import TopicError
-
     s = Spec()
     c = s.conn("/tf", "tf2_msgs/TFMessage")
     for i in range(3):

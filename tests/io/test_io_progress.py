@@ -4,24 +4,32 @@ through the ``mcap`` library's summary)."""
 
 from __future__ import annotations
 
+import fcntl
 import io
+import os
+import pty
 import re
 import struct
+import subprocess
 import sys
+import termios
+import time
 from pathlib import Path
 
 import pytest
 from io_bagmaker import bag_name, write
 from io_scene import Scene
+from mcap.reader import make_reader
 from stderr_text import error_messages
 from test_io_fastpath import fast_batch
 
+import ertools.progress
 from ertools.cli.main import main
 from ertools.io import bulk, pipeline
 from ertools.io.files import open_bag
 from ertools.io.info import describe
 from ertools.io.ros1.check import check_ros1
-from ertools.progress import reporting
+from ertools.progress import Bar, reporting
 
 TOPIC = "/fbm3w/robot_at_work/pose"
 
@@ -89,8 +97,6 @@ def _ros1_chunk_bytes(path: Path, topic: str | None) -> list[int]:
 
 
 def _mcap_chunk_bytes(path: Path, topic: str | None) -> list[int]:
-    from mcap.reader import make_reader
-
     out = []
     for file in [path] if path.is_file() else sorted(path.glob("*.mcap")):
         with file.open("rb") as f:
@@ -213,8 +219,6 @@ class Tty(io.StringIO):
 
 @pytest.fixture
 def no_delay(monkeypatch: pytest.MonkeyPatch) -> None:
-    import ertools.progress
-
     monkeypatch.setattr(ertools.progress, "DELAY_S", 0.0)
 
 
@@ -258,11 +262,6 @@ def test_cli_bar_on_a_terminal_unless_quiet(
 def _on_a_pty(argv: list[str], columns: int | None) -> tuple[int, bytes, str]:
     """(exit status, stdout, what the terminal got on stderr) of ``ertools ARGV`` run with
     stderr on a new pseudo-terminal (``columns`` wide, or of no size: the fallback 200)."""
-    import fcntl
-    import os
-    import pty
-    import subprocess
-    import termios
 
     code = (
         "import sys, ertools.progress as p; p.DELAY_S = 0.0\n"
@@ -314,9 +313,6 @@ def test_cli_bar_through_a_real_pty(ros1_bag: Path) -> None:
 
 def test_bar_appears_for_a_slow_read_only(scene: Scene, tmp_path: Path, small_groups: None) -> None:
     """Real clock, real delay: a read slowed to ~1 s shows the bar, a quick one shows none."""
-    import time
-
-    from ertools.progress import Bar
 
     path = write(bag_name(tmp_path, "ros1"), "ros1", scene.spec, chunk_bytes=2000)
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import logging
+import os
 import struct
 from pathlib import Path
 from typing import Any
@@ -16,11 +17,17 @@ from typing import Any
 import numpy as np
 import pytest
 from io_bagmaker import Spec, write
+from rosbags.rosbag1 import Reader, Writer
+from rosbags.typesys import Stores, get_typestore
 from stderr_text import error_messages
+from test_io_fastpath import REAL_BAG, _sample_bags
 
 import ertools.io as eio
+from ertools import caches
 from ertools.cli.main import main
-from ertools.io.ros1.check import check_ros1
+from ertools.io.ros1 import layout
+from ertools.io.ros1.check import check_ros1, rebuild_layout
+from ertools.io.ros1.layout import scan_layout
 
 T0 = 1_445_609_740_000_000_000
 DT = 10_000_000
@@ -87,9 +94,6 @@ def cli(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, Any, 
 def test_empty_bag_is_a_valid_bag(
     tmp_path: Path, with_connection: bool, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from rosbags.rosbag1 import Reader, Writer
-    from rosbags.typesys import Stores, get_typestore
-
     path = tmp_path / "empty.bag"
     with Writer(path) as w:
         if with_connection:
@@ -121,7 +125,6 @@ def test_sound_bags_check_clean(tmp_path: Path, fmt: str) -> None:
 
 
 def test_sample_and_real_bags_check_clean() -> None:
-    from test_io_fastpath import REAL_BAG, _sample_bags
 
     # (the samples include deliberately truncated bags: those already fail the summary)
     bags = [p for p in _sample_bags() if p.suffix == ".bag" and not eio.summary(p).problems]
@@ -238,7 +241,6 @@ def truth_record_times() -> np.ndarray:
 def test_fast_path_distrusts_an_index_that_contradicts_itself(
     tmp_path: Path, how: str, caplog: pytest.LogCaptureFixture
 ) -> None:
-
     path, _what = damaged(tmp_path, how)
     with caplog.at_level(logging.WARNING, logger="ertools"):
         rec = eio.read_poses(path, "/pose", time_source="record")
@@ -270,7 +272,6 @@ def test_a_wider_chunk_span_contradicts_no_read(
 ) -> None:
     """A chunk info moved weeks outwards: every index time still lies inside it, so the read
     (planned from the index data's own times) is right and says nothing; --check finds it."""
-    from rosbags.rosbag1 import Reader
 
     path, _what = damaged(tmp_path, how)
     with caplog.at_level(logging.WARNING, logger="ertools"):
@@ -296,9 +297,6 @@ def test_fast_path_on_a_sound_bag_warns_nothing(
 
 @pytest.mark.parametrize("fmt", ["ros1", "ros1-lz4"])
 def test_rebuilt_layout_equals_the_record_by_record_scan(tmp_path: Path, fmt: str) -> None:
-    from ertools.io.ros1.check import rebuild_layout
-    from ertools.io.ros1.layout import scan_layout
-
     path = two_topic_bag(tmp_path / "b.bag", fmt)
     size = path.stat().st_size
     first = records(path.read_bytes())[0]
@@ -359,10 +357,6 @@ def test_a_scan_is_made_once_per_file_version(
     """An unindexed bag (a recording's ``.active`` file) is scanned record by record; one
     command opens it several times (summary, states, poses): the scan is kept by the file's
     identity, made again when the file changes and after ``ertools.caches.clear()``."""
-    import os
-
-    from ertools import caches
-    from ertools.io.ros1 import layout
 
     raw = bytearray(two_topic_bag(tmp_path / "b.bag").read_bytes())
     _pos, _op, fields, _dpos, _dlen = records(bytes(raw))[0]

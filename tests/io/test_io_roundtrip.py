@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from io_bagmaker import Spec, bag_name, write
 from io_scene import DT, T0, Scene, make_scene
+from rosbags.rosbag1 import Writer
 
 import ertools.io as eio
 from ertools.errors import BagError, TopicError
@@ -161,8 +162,6 @@ def test_missing_and_broken_files(tmp_path: Path, scene: Scene) -> None:
 
 
 def test_no_stored_definition(tmp_path: Path) -> None:
-    from rosbags.rosbag1 import Writer
-
     path = tmp_path / "nodef.bag"
     with Writer(path) as w:
         c = w.add_connection(

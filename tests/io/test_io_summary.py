@@ -13,6 +13,7 @@ from io_scene import Scene
 
 import ertools.io as eio
 from ertools.errors import BagError
+from ertools.io.ros1.layout import read_layout
 from ertools.io.summary import record_times
 
 POSE = "/fbm3w/robot_at_work/pose"
@@ -133,7 +134,6 @@ def test_active_bag_with_open_chunk(tmp_path: Path, scene: Scene) -> None:
     """The chunk a recorder is filling has a placeholder size of 0 and its records follow it
     outside any chunk: they are read too."""
     good = write(tmp_path / "g.bag", "ros1", scene.spec, chunk_bytes=2000)
-    from ertools.io.ros1.layout import read_layout
 
     data = bytearray(make_active(good, tmp_path / "tmp.bag.active").read_bytes())
     last = read_layout(good).chunks[-1].pos

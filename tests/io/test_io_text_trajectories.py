@@ -19,7 +19,7 @@ from stderr_text import error_messages
 from ertools.cli.main import main
 from ertools.errors import BagError
 from ertools.export.formats import format_csv, format_tum
-from ertools.io.text import read_text_poses, sniff
+from ertools.io.text import _plain_decimal_ns, read_text_poses, sniff
 from ertools.streams import PoseStream
 
 REPO = Path(__file__).resolve().parents[2]
@@ -57,6 +57,7 @@ def test_sniffed_by_content(name: str, kind: str | None) -> None:
 
 def test_tum_as_evo_reads_it() -> None:
     pytest.importorskip("evo", reason="evo is in the dev extra")
+    # lazy: evo is the dev extra's (importorskip above) and takes ~1 s to import
     from evo.tools import file_interface
 
     path = _evo_data("freiburg1_xyz-groundtruth.txt")
@@ -72,6 +73,7 @@ def test_tum_as_evo_reads_it() -> None:
 
 def test_euroc_as_evo_reads_it() -> None:
     pytest.importorskip("evo", reason="evo is in the dev extra")
+    # lazy: evo is the dev extra's (importorskip above) and takes ~1 s to import
     from evo.tools import file_interface
 
     path = _evo_data("V102_groundtruth.csv")
@@ -86,6 +88,7 @@ def test_euroc_as_evo_reads_it() -> None:
 
 def test_kitti_as_evo_reads_it() -> None:
     pytest.importorskip("evo", reason="evo is in the dev extra")
+    # lazy: evo is the dev extra's (importorskip above) and takes ~1 s to import
     from evo.tools import file_interface
 
     path = _evo_data("KITTI_00_ORB.txt")
@@ -191,7 +194,6 @@ def test_text_has_no_record_time(tmp_path: Path, capsys: pytest.CaptureFixture[s
 def test_decimal_stamps_exact_on_random_text() -> None:
     """The vectorised decimal -> ns path against Python's Decimal, on random stamps with 0 to 9
     decimals, negative ones, and the forms it hands to Decimal (exponent, >9 decimals)."""
-    from ertools.io.text import _plain_decimal_ns
 
     rng = np.random.default_rng(26)
     tokens = []

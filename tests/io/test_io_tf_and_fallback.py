@@ -12,9 +12,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from io_bagmaker import Spec, write
 from io_scene import DT, T0, Scene
+from rosbags.rosbag1 import Writer
 
 import ertools.io as eio
 from ertools.errors import TopicError
+from ertools.geometry import compose
 from ertools.io.decode.tf import Edge, chain_pose
 from ertools.io.files import open_bag
 from ertools.io.ros1.index import Ros1Bag
@@ -90,7 +92,6 @@ def test_chain_recomposes(
     pa: tuple[float, ...], pb: tuple[float, ...], qa: tuple[float, ...], qb: tuple[float, ...]
 ) -> None:
     """T_world_a * T_a_b (from the chain a <- world -> b) gives back T_world_b."""
-    from ertools.geometry import compose
 
     qa_n = np.array(qa) / np.linalg.norm(qa)
     qb_n = np.array(qb) / np.linalg.norm(qb)
@@ -129,7 +130,6 @@ def test_window_reads_only_overlapping_chunks(tmp_path: Path, scene: Scene) -> N
 
 def test_non_standard_layout_falls_back(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
     """A Pose2D under the standard name but with an extra field: decoded by rosbags."""
-    from rosbags.rosbag1 import Writer
 
     path = tmp_path / "odd.bag"
     with Writer(path) as w:

@@ -10,6 +10,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from rosbags.rosbag2 import Reader, StoragePlugin, Writer
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 import ertools.io as eio
 from ertools.io.model import long_msgtype, short_msgtype
@@ -21,8 +23,6 @@ DEFINITION = "int64 a\nint64 b\n"
 
 def write_event_bag(path: Path, plugin: str) -> Path:
     """A rosbag2 bag with a service-event topic of 3 messages (a, b) = (i, 10 i)."""
-    from rosbags.rosbag2 import StoragePlugin, Writer
-    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
     ts = get_typestore(Stores.EMPTY)
     # Same fields under a message name: the serialized bytes are those of the event.
@@ -38,8 +38,6 @@ def write_event_bag(path: Path, plugin: str) -> Path:
 
 @pytest.mark.parametrize("plugin", ["SQLITE3", "MCAP"])
 def test_service_event_types_keep_srv(tmp_path: Path, plugin: str) -> None:
-    from rosbags.rosbag2 import Reader
-
     bag = write_event_bag(tmp_path / f"events_{plugin.lower()}", plugin)
     with Reader(bag) as reader:
         official = {c.topic: c.msgtype for c in reader.connections}

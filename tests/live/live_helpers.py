@@ -16,6 +16,9 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
+from mcap.reader import NonSeekingReader
+from rosbags.typesys import Stores, get_typestore
+
 NTP_DELTA = 2_208_988_800
 
 
@@ -84,8 +87,6 @@ def read_mcap(path: Path) -> tuple[list[tuple[str, int, Any]], bool]:
     the end cleanly. Uses mcap's non-seeking reader, which reads a file cut short up to the
     record the cut falls in (then raises; the messages before are kept).
     """
-    from mcap.reader import NonSeekingReader
-    from rosbags.typesys import Stores, get_typestore
 
     store = get_typestore(Stores.ROS2_HUMBLE)
     out: list[tuple[str, int, Any]] = []

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import platform
+import socket
 import sys
 import threading
 import time
@@ -11,11 +12,12 @@ from pathlib import Path
 
 import pytest
 from live_helpers import fake_sntp_server, read_mcap
+from mcap.reader import make_reader
 
 from ertools.configs.mocap import parse_mocap_config
-from ertools.live.natnet import FrameExtras, NatNetVersion, RigidBody
+from ertools.live.natnet import FrameExtras, NatNetVersion, RigidBody, encode_frame
 from ertools.live.recorder import Recorder, RecordOptions, RecordSummary
-from ertools.live.simulate import SimulatedBody, SimulatedMotive
+from ertools.live.simulate import SimulatedBody, SimulatedMotive, make_frame
 from ertools.live.tail import is_finished, read_complete
 
 CONFIG = parse_mocap_config(
@@ -170,7 +172,6 @@ def test_split_every_second_with_clock_metadata(tmp_path: Path) -> None:
     assert [n.rsplit("_", 1)[1] for n in names] == ["0.mcap", "1.mcap", "2.mcap"]
     sent = expected_poses(motive, 3)
     got = []
-    from mcap.reader import make_reader
 
     for path in summary.files:
         assert is_finished(path)
@@ -277,11 +278,6 @@ def test_stamps_are_kernel_arrival_times(tmp_path: Path) -> None:
 
 
 def test_source_filter_ignores_a_second_motive(tmp_path: Path) -> None:
-    import socket
-
-    from ertools.live.natnet import encode_frame
-    from ertools.live.simulate import make_frame
-
     options = RecordOptions(
         out_dir=tmp_path, name="src", group=None, port=0, interface="127.0.0.1",
         source="127.0.0.1", duration_s=0.6, namespace="/fbm2h",

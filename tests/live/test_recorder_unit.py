@@ -9,7 +9,8 @@ from live_helpers import read_mcap
 
 from ertools.configs.mocap import parse_mocap_config
 from ertools.live.natnet import FrameOfData, NatNetVersion, RigidBody, encode_frame
-from ertools.live.recorder import Recorder, RecordOptions
+from ertools.live.recorder import Recorder, RecordOptions, record
+from ertools.live.tail import is_finished, read_complete
 
 CONFIG = parse_mocap_config("rigid_bodies: {'3': {pose: robot/pose}}")
 V = NatNetVersion(3, 1)
@@ -57,8 +58,6 @@ def test_counters_follow_the_frame_numbers(tmp_path: Path) -> None:
 
 def test_record_function_without_data(tmp_path: Path) -> None:
     """The library call: no sender, a short duration: one closed, empty-but-valid file."""
-    from ertools.live.recorder import record
-    from ertools.live.tail import is_finished, read_complete
 
     options = RecordOptions(
         out_dir=tmp_path / "new", group=None, port=0, interface="127.0.0.1", duration_s=0.35,

@@ -11,15 +11,19 @@ from __future__ import annotations
 import json
 import shutil
 import signal
+import struct
 import subprocess
 import sys
 import textwrap
 from pathlib import Path
 
 import pytest
+from mcap.exceptions import McapError
+from mcap.reader import make_reader
 
 from ertools.cli.main import main
 from ertools.live.recover import RECOVERY_METADATA
+from ertools.live.rosmsg import Ros2Serializer
 from ertools.live.tail import is_finished
 
 TOPICS = ("/fbm2h/robot_at_home/pose2d", "/fbm2h/origin/pose2d")
@@ -66,8 +70,6 @@ def killed(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def mcap_default_read(path: Path) -> list[tuple[str, int, bytes]]:
-    from mcap.reader import make_reader
-
     with open(path, "rb") as f:
         return [
             (channel.topic, msg.log_time, msg.data)
@@ -76,8 +78,6 @@ def mcap_default_read(path: Path) -> list[tuple[str, int, bytes]]:
 
 
 def expected(n: int) -> list[tuple[str, int, bytes]]:
-    from ertools.live.rosmsg import Ros2Serializer
-
     serializer = Ros2Serializer()
     out = []
     for i in range(n):
@@ -100,8 +100,6 @@ def test_a_killed_recording_made_whole(
     shutil.copyfile(killed, path)
     cut = path.read_bytes()
     # before: mcap's default reader refuses it, ertools info says how to recover it
-    from mcap.exceptions import McapError
-
     with pytest.raises((McapError, Exception)):
         mcap_default_read(path)
     _, _, err = info_messages(path, capsys)
@@ -117,7 +115,6 @@ def test_a_killed_recording_made_whole(
     assert code == 0 and count == n and "not indexed" not in err
     # the cut bytes kept as they were; the recovery says what it did
     assert (tmp_path / (path.name + ".cut")).read_bytes() == cut
-    from mcap.reader import make_reader
 
     with open(path, "rb") as f:
         metadata = {m.name: m.metadata for m in make_reader(f).iter_metadata()}
@@ -131,7 +128,6 @@ def test_a_killed_recording_made_whole(
 
 def chunk_ends(path: Path) -> list[int]:
     """The byte offsets where each chunk record of ``path`` ends (read by hand: op, length)."""
-    import struct
 
     data = path.read_bytes()
     ends, pos = [], 8  # after the magic

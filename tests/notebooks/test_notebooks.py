@@ -11,12 +11,18 @@ running.
 from __future__ import annotations
 
 import ast
+import importlib.util
 import json
 import re
 from pathlib import Path
 from typing import Any
 
+import nbformat
 import pytest
+
+import ertools
+from ertools.cli.main import main
+from ertools.samples.__main__ import generate
 
 REPO = Path(__file__).resolve().parents[2]
 NOTEBOOKS = REPO / "notebooks"
@@ -48,7 +54,6 @@ def samples(tmp_path_factory: pytest.TempPathFactory) -> Path:
     shipped = REPO / "sample_bags"
     if all(any((shipped / s).glob("*.answers.yaml")) for s in SCENARIOS):
         return shipped
-    from ertools.samples.__main__ import generate
 
     out = tmp_path_factory.mktemp("samples")
     generate(out, list(SCENARIOS))
@@ -63,7 +68,6 @@ def _parameters_cell(nb: Any) -> Any:
 
 def _defaults(name: str) -> dict[str, Any]:
     """The parameters cell's assignments, as papermill reads them (literals only)."""
-    import nbformat
 
     nb = nbformat.read(NOTEBOOKS / f"{name}.ipynb", as_version=4)
     tree = ast.parse(_parameters_cell(nb).source)
@@ -78,7 +82,7 @@ def _defaults(name: str) -> dict[str, Any]:
 
 def _run(name: str, parameters: dict[str, Any], out: Path) -> Any:
     """Execute notebooks/NAME.ipynb with papermill; the executed notebook."""
-    import nbformat
+    # lazy: papermill (dev extra) takes 0.7 s to import; only the notebook runs need it
     import papermill
     from papermill.exceptions import PapermillExecutionError
 
@@ -124,8 +128,6 @@ def _printed(nb: Any, key: str) -> float:
 
 
 def test_every_notebook_is_built_by_build_py() -> None:
-    import importlib.util
-
     spec = importlib.util.spec_from_file_location("nb_build", NOTEBOOKS / "build.py")
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
@@ -136,8 +138,6 @@ def test_every_notebook_is_built_by_build_py() -> None:
 
 @pytest.mark.parametrize("name", _names())
 def test_every_input_is_a_parameter(name: str) -> None:
-    import nbformat
-
     nb = nbformat.read(NOTEBOOKS / f"{name}.ipynb", as_version=4)
     assert all(not c.get("outputs") for c in nb.cells if c.cell_type == "code"), (
         "commit notebooks without outputs"
@@ -172,7 +172,6 @@ def test_notebook_runs_on_the_samples(name: str, samples: Path, tmp_path: Path) 
 def test_fbm2h_notebook_on_the_real_log(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """The score the notebook prints is `ertools score fbm2h` of the same inputs."""
     _real()
-    from ertools.cli.main import main
 
     assert (
         main(
@@ -235,7 +234,6 @@ def _private_uses(source: str) -> list[str]:
     """What a notebook's code takes from ertools beyond the public API (docs/api.md): any
     ``from ertools... import`` or ``import ertools.x``, and ``ertools.NAME`` for a NAME that
     is not a public one."""
-    import ertools
 
     # the exceptions the API raises are public too (docs/ARCHITECTURE.md, "The public API")
     public = {*ertools.API, "__version__", "errors"}
@@ -265,8 +263,6 @@ def _private_uses(source: str) -> list[str]:
 
 @pytest.mark.parametrize("name", _names())
 def test_notebook_uses_only_the_public_api(name: str) -> None:
-    import nbformat
-
     nb = nbformat.read(NOTEBOOKS / f"{name}.ipynb", as_version=4)
     code = "\n".join(c.source for c in nb.cells if c.cell_type == "code")
     assert "import ertools" in code

@@ -12,6 +12,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
+from mcap.reader import make_reader
+
 
 @dataclass
 class Topic:
@@ -32,9 +35,6 @@ class ReadBack:
 
 
 def read_back(path: Path) -> ReadBack:
-    from google.protobuf import descriptor_pb2, descriptor_pool, message_factory
-    from mcap.reader import make_reader
-
     classes: dict[int, Any] = {}
     topics: dict[str, Topic] = {}
     file_times: list[int] = []

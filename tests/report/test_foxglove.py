@@ -23,9 +23,15 @@ import numpy as np
 import pytest
 import yaml
 from foxglove_readback import ReadBack, read_back, stamp_ns
+from rosbags.highlevel import AnyReader
 from stderr_text import error_messages
 
+from ertools.benchmarks.fbm2h.benchmark import score_fbm2h
+from ertools.benchmarks.fbm2h.config import Fbm2hOptions
+from ertools.benchmarks.trajectory.benchmark import score as score_trajectory
+from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.cli.main import main
+from ertools.report.foxglove import write_foxglove
 
 SAMPLES = Path(__file__).resolve().parents[2] / "sample_bags"
 FBM3W = SAMPLES / "fbm3w" / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
@@ -149,9 +155,6 @@ def test_fbm3w(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def test_fbm2h(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from ertools.benchmarks.fbm2h.benchmark import score_fbm2h
-    from ertools.benchmarks.fbm2h.config import Fbm2hOptions
-
     out = tmp_path / "fbm2h.mcap"
     score = run_json(["score", "fbm2h", str(FBM2H), *FBM2H_ARGS, "--foxglove", str(out)], capsys)
     fg = read_back(out)
@@ -253,8 +256,6 @@ def test_fbm1h(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def _stamps(path: Path, topic: str) -> list[int]:
-    from rosbags.highlevel import AnyReader
-
     out = []
     with AnyReader([path]) as reader:
         conns = [c for c in reader.connections if c.topic == topic]
@@ -265,9 +266,6 @@ def _stamps(path: Path, topic: str) -> list[int]:
 
 
 def test_trajectory(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    from ertools.benchmarks.trajectory.benchmark import score as score_trajectory
-    from ertools.benchmarks.trajectory.config import TrajectoryConfig
-
     out = tmp_path / "trajectory.mcap"
     argv = ["score", "trajectory", str(ROBOT), str(ROBOT.parent), "--offset", "auto"]
     score = run_json([*argv, "--apply-offset", "--foxglove", str(out)], capsys)
@@ -318,9 +316,6 @@ def test_trajectory(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def test_trajectory_streams_over_the_limit_are_decimated(tmp_path: Path) -> None:
-    from ertools.benchmarks.trajectory.benchmark import score as score_trajectory
-    from ertools.report.foxglove import write_foxglove
-
     result = score_trajectory(ROBOT, [ROBOT.parent])
     n, compared = len(result.matched.t_ns), result.compared
     written = write_foxglove(result, tmp_path / "t.mcap", limit=100)

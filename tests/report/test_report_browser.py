@@ -6,6 +6,8 @@ Skipped, saying why, where Chromium is not installed (Debian: ``apt-get install 
 from __future__ import annotations
 
 import base64
+import re
+import shutil
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -14,9 +16,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from matplotlib.image import imread
 from report_fakes import EVIL, fbm3w_like
 
+from ertools.audit.analyse import audit_states
+from ertools.audit.compare import attach
 from ertools.report.folder import write_report
+from ertools.states import Machine
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "audit"))
 from audit_streams import heartbeat
@@ -74,10 +80,6 @@ def _chromium(tmp_path: Path, url: str, *extra: str) -> subprocess.CompletedProc
 
 @pytest.fixture(scope="module")
 def report(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    from ertools.audit.analyse import audit_states
-    from ertools.audit.compare import attach
-    from ertools.states import Machine
-
     tmp = tmp_path_factory.mktemp("browser")
     audit = audit_states(
         heartbeat(Machine.BMBOX, BMBOX, 20.0, drop=(5.0, 7.0)),
@@ -115,8 +117,6 @@ def test_dom_has_tables_and_images(report: Path, tmp_path: Path) -> None:
 
 @pytest.mark.skipif(BROWSER is None, reason="chromium not installed (apt-get install chromium)")
 def test_screenshot_shows_the_page_and_its_figure(report: Path, tmp_path: Path) -> None:
-    from matplotlib.image import imread
-
     shot = tmp_path / "shot.png"
     proc = _chromium(tmp_path, report.as_uri(), f"--screenshot={shot}", "--window-size=1280,2400")
     assert proc.returncode == 0 and shot.exists(), proc.stderr[-2000:]
@@ -155,11 +155,8 @@ class _Body(HTMLParser):
 
 @pytest.mark.skipif(BROWSER is None, reason="chromium not installed (apt-get install chromium)")
 def test_report_uses_the_window_width(report: Path, tmp_path: Path) -> None:
-    import re
-    import shutil as sh
-
     copy = tmp_path / "copy"
-    sh.copytree(report.parent, copy)
+    shutil.copytree(report.parent, copy)
     page = (copy / "index.html").read_text(encoding="utf-8")
     page, n = re.subn(r'<meta http-equiv="Content-Security-Policy"[^>]*>', "", page)
     assert n == 1

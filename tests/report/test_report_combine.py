@@ -7,10 +7,14 @@ import json
 from pathlib import Path
 
 import pytest
+import yaml
 from report_fakes import FakeResult, fbm3w_like
 
 from ertools.cli.main import main
+from ertools.report.combine import load_entry
 from ertools.report.folder import write_report
+from ertools.samples.fbm2h import generate
+from ertools.streams import Provenance
 
 
 @pytest.fixture
@@ -56,8 +60,6 @@ def test_combined_page(
 
 
 def test_lone_score_json_is_recognised(tmp_path: Path) -> None:
-    from ertools.report.combine import load_entry
-
     path = tmp_path / "score.json"
     path.write_text(json.dumps({"best_distance_error": 0.01, "runs_details": {}}))
     entry = load_entry(path)
@@ -90,8 +92,6 @@ def _csv(out: Path) -> list[dict[str, str]]:
 
 
 def test_same_inputs_are_one_execution(tmp_path: Path) -> None:
-    from ertools.streams import Provenance
-
     log = tmp_path / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
     log.write_bytes(b"one recording")
     same = tmp_path / "copy" / log.name  # the same bytes elsewhere: the same execution
@@ -149,12 +149,9 @@ def test_the_fbm2h_sample_scored_twice_is_one_row(
 ) -> None:
     """Issue 19: the FBM2H log scored with the identity transform and with --team simbot
     --transforms was listed twice, once as "(unknown)"; it is one execution of simbot."""
-    import yaml
 
     folder = Path(__file__).resolve().parents[2] / "sample_bags" / "fbm2h"
     if not folder.is_dir():
-        from ertools.samples.fbm2h import generate
-
         generate(tmp_path / "fbm2h", seed=2016)
         folder = tmp_path / "fbm2h"
     (bag,) = folder.glob("log_fbm2h_*.bag")

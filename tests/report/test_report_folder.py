@@ -13,9 +13,13 @@ import pytest
 import svg_figure
 import yaml
 from report_fakes import EVIL, fbm3w_like
+from test_cli_audit import _write_bag
 
+from ertools.audit.analyse import audit_states
+from ertools.errors import ConfigError
 from ertools.report.folder import write_report
 from ertools.report.records import sha256_file
+from ertools.states import Machine
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "audit"))
 from audit_streams import heartbeat
@@ -129,9 +133,6 @@ def test_sha256_of_a_rosbag2_directory(tmp_path: Path) -> None:
 
 
 def test_audit_report_has_timeline_figure(tmp_path: Path) -> None:
-    from ertools.audit.analyse import audit_states
-    from ertools.states import Machine
-
     audit = audit_states(
         heartbeat(Machine.BMBOX, BMBOX, 20.0, drop=(5.0, 7.0)),
         heartbeat(Machine.REFBOX, REFBOX, 20.0),
@@ -158,9 +159,6 @@ def test_audit_report_has_timeline_figure(tmp_path: Path) -> None:
 
 def test_report_of_score_bag_includes_its_audit(tmp_path: Path) -> None:
     """A score report whose bag has the state topics audits them by itself."""
-    from test_cli_audit import _write_bag
-
-    from ertools.states import Machine
 
     bag = _write_bag(
         tmp_path / "fbm3w.bag",
@@ -174,8 +172,6 @@ def test_report_of_score_bag_includes_its_audit(tmp_path: Path) -> None:
 
 
 def test_report_dir_that_is_a_file(tmp_path: Path) -> None:
-    from ertools.errors import ConfigError
-
     target = tmp_path / "taken"
     target.write_text("not a folder")
     with pytest.raises(ConfigError, match="cannot write the report folder"):

@@ -2,11 +2,20 @@
 
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 import pandas as pd
 import pytest
 from report_fakes import fbm3w_like
 
+from ertools.audit.analyse import audit_states
 from ertools.frames import rows_to_dataframe, tables_to_frames
+from ertools.states import Machine
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "audit"))
+from audit_streams import T0_NS, heartbeat
+from test_audit import BMBOX
 
 
 def test_epoch_column_becomes_utc_index() -> None:
@@ -28,16 +37,6 @@ def test_relative_seconds_stay_numbers() -> None:
 
 
 def test_audit_tables_as_frames() -> None:
-    import sys
-    from pathlib import Path
-
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "audit"))
-    from audit_streams import T0_NS, heartbeat
-    from test_audit import BMBOX
-
-    from ertools.audit.analyse import audit_states
-    from ertools.states import Machine
-
     frames = audit_states(heartbeat(Machine.BMBOX, BMBOX, 20.0)).to_frames()
     tl = frames["timeline"]
     assert tl.index[0] == pd.Timestamp(T0_NS, unit="ns", tz="UTC")

@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 import svg_figure
 from fakes import BROWSER, CHROMIUM_FLAGS
+from matplotlib.image import imread
 
 from ertools import api
 from ertools.report.folder import write_report
@@ -206,7 +207,6 @@ def test_browser_loads_every_svg_figure(
 def test_browser_paints_the_path_figure(fbm3w: tuple[object, Path], tmp_path: Path) -> None:
     """The run figure as Chromium paints it: the black target line, the viridis markers of
     the kept samples at both ends of the scale, the green start."""
-    from matplotlib.image import imread
 
     _, index = fbm3w
     shot = tmp_path / "shot.png"

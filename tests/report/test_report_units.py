@@ -12,14 +12,17 @@ import csv
 import json
 import math
 import re
+from datetime import UTC, datetime
 from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
 import yaml
+from report_fakes import fbm3w_like
 from yaml_rounding import YAML_ROUNDING
 
 from ertools.cli.main import main
+from ertools.report.folder import write_report
 
 ROOT = Path(__file__).resolve().parents[2]
 S = ROOT / "sample_bags"
@@ -244,12 +247,6 @@ def test_layout_is_fluid(reports: dict[str, Path], name: str) -> None:
 
 
 def test_instants_read_as_utc(tmp_path: Path) -> None:
-    from datetime import UTC, datetime
-
-    from report_fakes import fbm3w_like
-
-    from ertools.report.folder import write_report
-
     index = write_report(fbm3w_like(), tmp_path / "r", inputs=[], argv=[])
     page = _page(index.parent)
     runs = _table(page, "run", "start_time (UTC)")

@@ -3,6 +3,9 @@ through the scale its own tick labels state (tests/svg_figure.py), never through
 
 from __future__ import annotations
 
+import re
+import xml.etree.ElementTree as ET
+
 import numpy as np
 import pytest
 import svg_figure
@@ -10,6 +13,7 @@ from matplotlib.figure import Figure
 
 from ertools.report import chart_mpl, svg
 from ertools.report.chart import (
+    Arrows,
     Axis,
     Band,
     Bars,
@@ -17,6 +21,7 @@ from ertools.report.chart import (
     ColourScale,
     ErrorBars,
     Line,
+    Rects,
     RefLine,
     Scatter,
     Span,
@@ -165,10 +170,6 @@ def test_hostile_values_never_reach_the_svg() -> None:
     """Random charts of every layer with NaN, +-inf, empty arrays and values over twelve
     decades: well-formed SVG, and no NaN or infinity in any attribute (a browser would drop
     the element or the whole figure)."""
-    import re
-    import xml.etree.ElementTree as ET
-
-    from ertools.report.chart import Arrows, Rects
 
     rng = np.random.default_rng(29)
 

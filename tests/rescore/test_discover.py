@@ -7,6 +7,7 @@ benchmark log, span, GT hour files, robot log and team, and the problems planted
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 from typing import Any
@@ -15,9 +16,11 @@ import pytest
 from timeline.summaries import Summary, Topic
 
 from ertools.io.formats import Unreadable
-from ertools.rescore.discover import Discovery, discover
+from ertools.rescore.discover import Discovery, _gt_only, discover
 from ertools.samples.competition_schedule import NO_ROBOT_LOG, TRUNCATED
 from ertools.timeline.build import build_timeline
+from ertools.timeline.model import BagEntry, Pairing
+from ertools.timeline.scan import scan
 
 S = 1_000_000_000
 T0 = 1_448_013_600 * S  # 2015-11-20 10:00:00 UTC
@@ -28,8 +31,6 @@ T0 = 1_448_013_600 * S  # 2015-11-20 10:00:00 UTC
 
 @pytest.fixture(scope="module")
 def day(sample_competition: Path) -> tuple[Discovery, dict[str, Any]]:
-    from ertools.timeline.scan import scan
-
     root = sample_competition
     answers = json.loads((root / "answers.json").read_text())
     found = discover(scan([root]))
@@ -38,8 +39,6 @@ def day(sample_competition: Path) -> tuple[Discovery, dict[str, Any]]:
         return str(Path(p).relative_to(root))
 
     # paths relative to the folder, as answers.json gives them
-    import dataclasses
-
     executions = tuple(
         dataclasses.replace(
             e,
@@ -227,8 +226,6 @@ def test_gt_recordings_alone_are_candidate_executions() -> None:
     """The GT recordings no benchmark log overlaps: one candidate per recording (its split
     files in order); the uncovered tail of a recording that covers a benchmark log, a
     recording naming no benchmark and a still marker set's recording are problems."""
-    from ertools.rescore.discover import _gt_only
-    from ertools.timeline.model import BagEntry, Pairing
 
     def gt(path: str, start: int, benchmarks: tuple[str, ...] = ("fbm3w",)) -> BagEntry:
         return BagEntry(path, "ros1", start, start + 10, "gt", "gt", benchmarks=benchmarks)

@@ -4,9 +4,11 @@ leaderboards, failure isolation, cache, exit codes."""
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
 import json
 import re
+import shutil
 import sys
 from pathlib import Path
 from typing import Any
@@ -24,6 +26,7 @@ from rescore_competition import (
 from ertools.benchmarks import registry
 from ertools.benchmarks.document import score_json
 from ertools.cli.main import main
+from ertools.rescore import cache
 
 
 @pytest.fixture(autouse=True)
@@ -66,7 +69,6 @@ def test_scores_every_execution_through_the_registry(
         assert row["start"] == start.replace("Z", ".000000+00:00")
         assert row["bags"] == [str(comp.log(ident))]
         transform = comp.transform(team)
-        import hashlib
 
         assert {
             "name": "transform",
@@ -170,7 +172,6 @@ def test_cache_key_has_the_ertools_version(tmp_path: Path, monkeypatch: pytest.M
     out = tmp_path / "out"
     args = ("--config", str(comp.manifest), "--out", str(out), "--jobs", "1", "--no-reports")
     rescore(*args)
-    from ertools.rescore import cache
 
     monkeypatch.setattr(cache, "__version__", "9.9.9")
     rescore(*args)
@@ -182,7 +183,6 @@ def test_removed_report_folder_is_written_again(tmp_path: Path) -> None:
     out = tmp_path / "out"
     args = ("--config", str(comp.manifest), "--out", str(out), "--jobs", "1")
     rescore(*args)
-    import shutil
 
     shutil.rmtree(out / "executions" / "toy-beta-20151120T093000")
     rescore(*args)
@@ -217,8 +217,6 @@ def test_usage_errors_exit_2(
 def test_scheduler_without_dask_installed_is_one_line(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    import sys
-
     comp = make_competition(tmp_path / "comp")
     monkeypatch.setitem(sys.modules, "distributed", None)  # import distributed -> ImportError
     code = rescore(

@@ -28,6 +28,7 @@ from rescore_competition import LOGS, expected_value, make_competition, use_toy_
 from ertools import atomic
 from ertools.cli.main import main
 from ertools.csvsafe import spreadsheet_safe
+from ertools.rescore import cache
 
 HERE = Path(__file__).parent
 TOY_MAIN = HERE / "toy_main.py"
@@ -398,7 +399,6 @@ def test_report_files_are_read_again_only_when_their_stamp_changed(
     """A warm rerun checks the report folders from the stamps remembered in hashes.json (no
     file read); a file rewritten with the same size (a new inode and time, as any write
     gives) is read, found changed, and its execution scored again."""
-    from ertools.rescore import cache
 
     comp = make_competition(tmp_path / "comp")
     out = tmp_path / "out"

@@ -8,11 +8,13 @@ from __future__ import annotations
 import json
 import re
 from pathlib import Path
+from urllib.parse import unquote
 
 import pytest
 from stderr_text import joined_lines
 
 from ertools.cli.main import main
+from ertools.rescore.site import write_site
 
 ROOT = Path(__file__).resolve().parents[2]
 FBM3W_BAG = ROOT / "sample_bags" / "fbm3w" / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
@@ -131,15 +133,11 @@ def test_report_links_a_folder_named_like_a_url_as_a_relative_path(
     expected = "javascript%3Aalert%28document.domain%29/index.html"
     assert expected in links
     # the encoded link still opens the report: the browser decodes it to the folder's name
-    from urllib.parse import unquote
-
     assert (out / unquote(expected)).resolve() == (folder / "index.html").resolve()
     capsys.readouterr()
 
 
 def test_the_results_page_links_only_relative_paths(tmp_path: Path) -> None:
-    from ertools.rescore.site import write_site
-
     out = tmp_path / "out"
     evil = out / "javascript:alert(1)"
     evil.mkdir(parents=True)

@@ -8,6 +8,7 @@ import pytest
 from rescore_competition import make_competition, use_toy_registry
 from stderr_text import joined_lines
 
+from ertools.benchmarks import registry
 from ertools.cli.main import main
 from ertools.errors import ConfigError
 from ertools.rescore.manifest import ManifestError, load_manifest
@@ -133,7 +134,6 @@ def test_missing_manifest_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixt
 
 def test_a_choice_that_takes_a_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """FBM2H's `--reached timing FILE`: `[timing, FILE]` in a manifest, the file checked."""
-    from ertools.benchmarks import registry
 
     monkeypatch.setattr(
         registry, "REGISTRY", {"fbm2h": "ertools.benchmarks.fbm2h.declare:BENCHMARK"}

@@ -18,6 +18,7 @@
 from __future__ import annotations
 
 import contextlib
+import html as htmllib
 import io
 import json
 import os
@@ -302,7 +303,6 @@ def _measure(index: Path, tmp_path: Path) -> dict[str, Any]:
     assert proc.returncode == 0, proc.stderr[-2000:]
     match = re.search(r'<pre id="probe">(.*?)</pre>', proc.stdout, re.S)
     assert match, proc.stdout[-2000:]
-    import html as htmllib
 
     data: dict[str, Any] = json.loads(htmllib.unescape(match.group(1)))
     return data

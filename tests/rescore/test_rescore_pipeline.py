@@ -8,8 +8,9 @@ from pathlib import Path
 import pytest
 from rescore_competition import LOGS, expected_value, make_competition, use_toy_registry
 
+from ertools.benchmarks import registry
 from ertools.rescore.manifest import load_manifest
-from ertools.rescore.pipeline import Scoring, leaderboards, listed_executions, rescore
+from ertools.rescore.pipeline import Scoring, leaderboards, listed_executions, rescore, score_argv
 
 
 @pytest.fixture(autouse=True)
@@ -113,8 +114,6 @@ def test_leaderboard_ties_share_a_rank() -> None:
 def test_score_argv_is_the_score_command(tmp_path: Path) -> None:
     """The command line a report shows: the score command's own options, from the declarations
     (the team through FBM2H's own --team; a choice with its file as one option)."""
-    from ertools.benchmarks import registry
-    from ertools.rescore.pipeline import score_argv
 
     bench = registry.get("toy")
     argv = score_argv(bench, [Path("a.txt")], {"scale": 2.0, "transform": Path("t.yaml")}, "x")

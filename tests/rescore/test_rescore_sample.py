@@ -14,6 +14,7 @@ from typing import Any
 import pytest
 
 from ertools.cli.main import main
+from ertools.rescore.manifest import load_manifest
 
 SEED = 2015_11_20
 # robotto lost its USB key after its second FBM3W: nothing in the logs names the team of that
@@ -132,8 +133,6 @@ def test_leaderboards_follow_each_benchmarks_rule(
 def test_init_drafts_the_manifest_from_the_logs(
     day: tuple[Path, dict[str, Any], dict[str, Any]], tmp_path: Path
 ) -> None:
-    from ertools.rescore.manifest import load_manifest
-
     root, answers, _ = day
     draft = tmp_path / "competition.yaml"
     err = io.StringIO()

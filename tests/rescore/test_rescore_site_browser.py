@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 import pytest
 from fakes import BROWSER, CHROMIUM_FLAGS
+from matplotlib.image import imread
 from site_results import (
     EVIL,
     Page,
@@ -98,8 +99,6 @@ def test_dom_has_leaderboards_problems_and_timeline(
 
 
 def test_timeline_frame_draws_its_chart(site: tuple[dict[str, Any], Path], tmp_path: Path) -> None:
-    from matplotlib.image import imread
-
     _, index = site
     shot = tmp_path / "shot.png"
     chromium(tmp_path, index.as_uri(), f"--screenshot={shot}", "--virtual-time-budget=5000")

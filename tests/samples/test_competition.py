@@ -22,6 +22,9 @@ from typing import Any
 
 import pytest
 
+from ertools.benchmarks.common.teams import parse_robot_log_name
+from ertools.cli.main import main
+from ertools.samples.__main__ import main as samples_main
 from ertools.samples.competition_schedule import MISSING_TRANSFORM, SCHEDULE, TRUNCATED
 
 SEED = 2015_11_20
@@ -73,10 +76,8 @@ def test_two_generations_are_byte_identical(competition: Path, tmp_path: Path) -
 def test_command_line_refuses_mixed_modes(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from ertools.samples.__main__ import main
-
     with pytest.raises(SystemExit) as exc:
-        main([str(tmp_path / "x"), "--competition", str(tmp_path / "y")])
+        samples_main([str(tmp_path / "x"), "--competition", str(tmp_path / "y")])
     assert exc.value.code == 2
     assert "--competition" in capsys.readouterr().err
 
@@ -139,8 +140,6 @@ def _get(d: Any, field: str) -> Any:
 
 
 def _score(root: Path, e: dict[str, Any]) -> tuple[int, dict[str, Any]]:
-    from ertools.cli.main import main
-
     opt = {"items": "--items", "goal": "--goal", "transform": "--transform", "config": "--config"}
     args = ["score", e["benchmark"], str(root / e["bmbox_log"])]
     args += [str(root / g) for g in e["gt_files"]]
@@ -195,8 +194,6 @@ def test_unscoreable_executions(competition: Path, answers: dict[str, Any]) -> N
 
 
 def test_robot_logs_and_problems(competition: Path, answers: dict[str, Any]) -> None:
-    from ertools.benchmarks.common.teams import parse_robot_log_name
-
     for r in answers["robot_logs"]:
         parsed = parse_robot_log_name(r["path"])
         assert parsed is not None and parsed.team == r["team"]
@@ -225,8 +222,6 @@ def test_each_fbm2h_robot_log_scores_as_its_answers(
     # The robots' marker pose estimates against the GT hour files (ertools score trajectory,
     # the robot's clock offset applied): the answers are the robotlog scenario's plain loop
     # over the same arrays, so counts are exact and errors agree to float rounding.
-    from ertools.cli.main import main
-
     (r,) = [x for x in answers["robot_logs"] if x["execution"] == slot]
     traj = r["trajectory"]
     args = ["score", "trajectory", str(competition / r["path"])]

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from rosbags.highlevel import AnyReader
 
 from ertools.geometry import quat_from_yaw, yaw_from_quat
 from ertools.samples.mocap import (
@@ -97,8 +98,6 @@ def test_random_losses_are_seeded_and_inside() -> None:
 
 
 def test_published_topics(tmp_path: Path) -> None:
-    from rosbags.highlevel import AnyReader
-
     t, xyz, quat = _circle(5.0)
     pub = simulate_mocap(t, xyz, quat, rng=np.random.default_rng(2))
     path = tmp_path / "m.bag"

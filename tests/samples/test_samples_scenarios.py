@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 import yaml
 from floats import FLOAT_ATOL, FLOAT_RTOL, same_text
+from rosbags.highlevel import AnyReader
 
 from ertools.samples.__main__ import main
 from ertools.samples.scenario import (
@@ -38,8 +39,6 @@ def _files(root: Path) -> dict[str, bytes]:
 
 
 def test_stationary_answers_match_the_bag(tmp_path: Path) -> None:
-    from rosbags.highlevel import AnyReader
-
     paths = load_scenario("stationary")(tmp_path, seed=11)
     bag = next(p for p in paths if p.suffix == ".bag")
     answers = yaml.safe_load(answers_path(bag).read_text())
@@ -161,7 +160,6 @@ def _close(a: Any, b: Any, where: str) -> list[str]:
 def _bag_differences(committed: Path, fresh: Path) -> list[str]:
     """Messages of two bags that differ beyond float rounding: same connections, counts,
     record times and bytes, except float fields within FLOAT_RTOL (decoded by rosbags)."""
-    from rosbags.highlevel import AnyReader
 
     with AnyReader([committed]) as ra, AnyReader([fresh]) as rb:
         conns_a = [(c.topic, c.msgtype, c.msgcount) for c in ra.connections]

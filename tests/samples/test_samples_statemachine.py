@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from rosbags.highlevel import AnyReader
 
 from ertools.samples.statemachine import Transition, machine_messages, publish_states
 from ertools.samples.writer import BagWriter
@@ -68,8 +69,6 @@ def test_invalid_bmbox_transition_is_refused_unless_asked() -> None:
 
 
 def test_published_state_topics_read_back(tmp_path: Path) -> None:
-    from rosbags.highlevel import AnyReader
-
     trs = [
         *BM,
         Transition(T0 + 50_000_000, Machine.REFBOX, RefBoxState.START),

@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 import hashlib
+import time
 from pathlib import Path
 
 import numpy as np
 import pytest
+from mcap.reader import make_reader
+from rosbags.highlevel import AnyReader
+from rosbags.rosbag1 import Reader
 
 from ertools.errors import UsageError
 from ertools.samples.packing import pack_messages
@@ -107,8 +111,6 @@ def _write_everything(path: Path, fmt: str) -> dict[str, object]:
 
 @pytest.mark.parametrize("fmt", FORMATS)
 def test_round_trip_every_format(tmp_path: Path, fmt: str) -> None:
-    from rosbags.highlevel import AnyReader
-
     path = _path(tmp_path, fmt)
     truth = _write_everything(path, fmt)
     counts: dict[str, int] = {}
@@ -190,8 +192,6 @@ def _ros_md5(definition: str) -> str:
 
 
 def test_ros1_stores_custom_definitions_and_caller_ids(tmp_path: Path) -> None:
-    from rosbags.rosbag1 import Reader
-
     path = tmp_path / "x.bag"
     _write_everything(path, "ros1")
     with Reader(path) as reader:
@@ -208,8 +208,6 @@ def test_ros1_stores_custom_definitions_and_caller_ids(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("fmt", ["mcap", "rosbag2-mcap"])
 def test_ros2_formats_store_custom_definitions(tmp_path: Path, fmt: str) -> None:
-    from mcap.reader import make_reader
-
     path = _path(tmp_path, fmt)
     _write_everything(path, fmt)
     file = path if fmt == "mcap" else next(path.glob("*.mcap"))
@@ -242,8 +240,6 @@ def test_writer_refuses_existing_path_and_bad_options(tmp_path: Path) -> None:
 
 @pytest.mark.parametrize("compression", ["bz2", "lz4"])
 def test_ros1_compressed_chunks(tmp_path: Path, compression: str) -> None:
-    from rosbags.rosbag1 import Reader
-
     path = tmp_path / "c.bag"
     with BagWriter(path, "ros1", compression=compression) as bag:
         bag.write_pose2d("/p", T0 + np.arange(1000), np.arange(1000.0), 0.0, 0.0)
@@ -260,8 +256,6 @@ def test_ros1_compressed_chunks(tmp_path: Path, compression: str) -> None:
     ("fmt", "compression"), [("rosbag2-mcap", "zstd"), ("mcap", "zstd"), ("mcap", "lz4")]
 )
 def test_ros2_compressed_round_trip(tmp_path: Path, fmt: str, compression: str) -> None:
-    from rosbags.highlevel import AnyReader
-
     path = _path(tmp_path, fmt)
     with BagWriter(path, fmt, compression=compression) as bag:  # type: ignore[arg-type]
         bag.write_pose2d("/p", T0 + np.arange(2000), np.arange(2000.0), 1.0, 2.0)
@@ -271,8 +265,6 @@ def test_ros2_compressed_round_trip(tmp_path: Path, fmt: str, compression: str) 
 
 
 def test_bulk_write_speed(tmp_path: Path) -> None:
-    import time
-
     n = 100_000
     t = T0 + np.arange(n, dtype=np.int64) * 8_333_333
     xyz = np.zeros((n, 3))
@@ -288,8 +280,6 @@ def test_bulk_write_speed(tmp_path: Path) -> None:
 
 
 def test_write_many_keeps_call_order_for_equal_times(tmp_path: Path) -> None:
-    from rosbags.highlevel import AnyReader
-
     path = tmp_path / "m.bag"
     with BagWriter(path) as bag:
         conn = bag.connection("/s", "std_msgs/String")

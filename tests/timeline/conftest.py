@@ -7,11 +7,12 @@ from typing import Any
 import pytest
 import yaml
 
+from ertools.samples.timeline_folder import generate
+
 
 @pytest.fixture(scope="session")
 def folder(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     """``root`` (the bags folder) and ``answers`` of the ``timeline`` scenario."""
-    from ertools.samples.timeline_folder import generate
 
     out = tmp_path_factory.mktemp("timeline")
     root, answers = generate(out, seed=0)

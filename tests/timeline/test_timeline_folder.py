@@ -5,16 +5,22 @@ from __future__ import annotations
 import csv
 import io
 import json
+import random
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 from summaries import BAG_KEYS
 
+import ertools.timeline.scan as ts
 from ertools.cli.main import main
+from ertools.geometry import quat_from_yaw
 from ertools.io.formats import find_bags
+from ertools.io.model import ClockCheck
 from ertools.progress import reporting
+from ertools.samples.writer import BagWriter
 from ertools.timeline.scan import scan
 
 
@@ -174,8 +180,6 @@ def test_find_bags_walks_and_takes_rosbag2_folders(tmp_path: Path) -> None:
 def test_bad_files_are_listed_and_the_rest_still_read(
     folder: dict[str, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    import random
-
     (tmp_path / "empty.bag").write_bytes(b"")
     (tmp_path / "random.bag").write_bytes(random.Random(0).randbytes(3000))
     good = next(folder["root"].glob("gtlogger/*_0.bag"))
@@ -218,8 +222,6 @@ def test_real_2015_bag() -> None:
 
 
 def test_clock_checked_once_per_recording_unless_off(monkeypatch: pytest.MonkeyPatch) -> None:
-    import ertools.timeline.scan as ts
-    from ertools.io.model import ClockCheck
 
     @dataclass(frozen=True)
     class S:
@@ -247,11 +249,6 @@ def test_clock_checked_once_per_recording_unless_off(monkeypatch: pytest.MonkeyP
 
 @pytest.mark.parametrize("fmt", ["mcap", "rosbag2-mcap", "rosbag2-sqlite3"])
 def test_other_formats_are_found_and_classified(fmt: str, tmp_path: Path) -> None:
-    import numpy as np
-
-    from ertools.geometry import quat_from_yaw
-    from ertools.samples.writer import BagWriter
-
     t0 = 1_448_013_600 * 1_000_000_000
     t = t0 + np.arange(240, dtype=np.int64) * 8_333_333
     name = "gt.mcap" if fmt == "mcap" else "gt_ros2"

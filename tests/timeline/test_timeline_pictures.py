@@ -8,12 +8,17 @@ sample folder's answers file, not from the code under test.
 from __future__ import annotations
 
 import json
+import re
+import time
 from datetime import UTC, datetime
 from html.parser import HTMLParser
 from pathlib import Path
 from typing import Any
 
+import matplotlib.dates as mdates
 import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import to_hex
 from timeline_day import DAY0, EVIL, EVIL_IMG, SESSIONS, UNREADABLE, S, day_timeline, many_bags
 
 from ertools.cli.main import main
@@ -194,8 +199,6 @@ def test_page_of_the_real_bag() -> None:
 
 
 def test_page_of_1000_bags_is_built_quickly() -> None:
-    import time
-
     tl = many_bags(1000)
     t = time.perf_counter()
     page = Page(timeline_page(tl))
@@ -217,8 +220,6 @@ def session_axes(fig: Any) -> dict[int, Any]:
 
 
 def test_figure_has_one_panel_per_session_spanning_it() -> None:
-    import matplotlib.dates as mdates
-
     tl = day_timeline()
     fig = timeline_figure(tl)
     panels = session_axes(fig)
@@ -239,8 +240,6 @@ def test_figure_has_one_panel_per_session_spanning_it() -> None:
 
 
 def test_figure_colours_match_the_legend_and_problems_are_numbered() -> None:
-    from matplotlib.colors import to_hex
-
     tl = day_timeline()
     fig = timeline_figure(tl)
     (legend,) = fig.legends
@@ -288,7 +287,6 @@ def test_figure_colours_match_the_legend_and_problems_are_numbered() -> None:
 def test_table_times_stay_on_one_line() -> None:
     """Every time in the sessions and bags tables is one unbreakable span: a table cell that
     wraps inside ``2015-11-20 09:00:00.000`` misreads."""
-    import re
 
     tl = day_timeline()
     text = timeline_page(tl)
@@ -306,7 +304,6 @@ def test_figure_problem_list_fits_the_picture() -> None:
     characters)."""
     tl = scan([Path(__file__).resolve().parents[2] / "sample_bags"], check_clocks=False)
     fig = timeline_figure(tl)
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     canvas = FigureCanvasAgg(fig)
     canvas.draw()

@@ -11,9 +11,11 @@ from pathlib import Path
 import pytest
 from stderr_text import error_messages
 
+import ertools
 from ertools.benchmarks import registry
 from ertools.benchmarks.common.uncertainty import MAX_DRAWS, MAX_SEED
 from ertools.cli.main import MAX_ERROR_LINE, main
+from ertools.errors import UsageError
 
 ROOT = Path(__file__).resolve().parents[3]
 sys.path.insert(0, str(ROOT / "tests" / "io"))
@@ -87,8 +89,6 @@ def test_the_cap_is_in_the_help(capsys: pytest.CaptureFixture[str]) -> None:
 def test_the_largest_seed_is_taken() -> None:
     """The cap is the int64 a result carries: the largest seed scores (and the Python API
     refuses the next one as the CLI does)."""
-    import ertools
-    from ertools.errors import UsageError
 
     result = ertools.score("fbm3w", LOGS["fbm3w"], seed=MAX_SEED, draws=20)
     assert result.to_dict()["uncertainty"]["seed"] == MAX_SEED

@@ -8,12 +8,22 @@ import math
 import numpy as np
 import pytest
 
+from ertools.benchmarks.common.interval_output import (
+    MAX_LINE,
+    ScoreRow,
+    interval_line,
+    interval_lines,
+)
 from ertools.benchmarks.common.uncertainty import (
     Interval,
+    Source,
+    Uncertainty,
     basic_intervals,
     interval_keys,
     monte_carlo,
     sigma_from_epsilon,
+    split_interval,
+    uncertainty_rows,
     z_value,
 )
 from ertools.errors import UsageError
@@ -111,14 +121,6 @@ def test_interval_keys_follow_their_score() -> None:
 
 
 def test_interval_line_states_value_interval_method_and_shares() -> None:
-    from ertools.benchmarks.common.interval_output import (
-        MAX_LINE,
-        ScoreRow,
-        interval_line,
-        interval_lines,
-    )
-    from ertools.benchmarks.common.uncertainty import Source, Uncertainty
-
     sources = (Source("mocap_noise", 1e-4, "m", True), Source("d_min", 3.3e-4, "m", False))
     u = Uncertainty(0.95, "Monte Carlo (details)", 400, 0, sources, {})
     iv = Interval(0.00041, 0.00088, (("d_min", 0.29), ("mocap_noise", 0.71)))
@@ -149,13 +151,6 @@ def test_interval_line_states_value_interval_method_and_shares() -> None:
 
 
 def test_split_interval_and_uncertainty_rows() -> None:
-    from ertools.benchmarks.common.uncertainty import (
-        Source,
-        Uncertainty,
-        split_interval,
-        uncertainty_rows,
-    )
-
     row = {"run": 0, "distance_error": 1.0, "distance_error_interval": [0.5, 1.5], "status": "ok"}
     split_interval(row, "distance_error")
     assert list(row) == [

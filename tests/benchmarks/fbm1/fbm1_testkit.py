@@ -16,6 +16,9 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from ertools.samples.mocap import MocapNoise, publish_mocap, simulate_mocap
+from ertools.samples.statemachine import Transition, publish_states
+from ertools.samples.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 from ertools.streams import PoseStream, StateStream
 
@@ -176,9 +179,6 @@ def write_bag(
     drop: (body, from_s, to_s) windows with no mocap message of that body (tracking lost).
     omit: bodies not recorded at all. no_client: no /<ns>/client_state topic.
     """
-    from ertools.samples.mocap import MocapNoise, publish_mocap, simulate_mocap
-    from ertools.samples.statemachine import Transition, publish_states
-    from ertools.samples.writer import BagWriter
 
     origin, board = bodies(runs, table)
     tr = [

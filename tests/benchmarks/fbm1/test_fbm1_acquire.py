@@ -17,6 +17,8 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from ertools.cli.main import main
 from ertools.configs.items import load_items
+from ertools.samples.mocap import MocapNoise, frame_times, publish_mocap, simulate_mocap
+from ertools.samples.writer import BagWriter
 
 S = 1_000_000_000
 T0 = 1_448_030_000 * S
@@ -45,9 +47,6 @@ def _origin_board(k: int) -> tuple[np.ndarray, Rotation]:
 
 
 def _write_log(path: Path, vanilla: Path) -> None:
-    from ertools.samples.mocap import MocapNoise, frame_times, publish_mocap, simulate_mocap
-    from ertools.samples.writer import BagWriter
-
     t = frame_times(T0, 16.0)
     secs = (t - T0) / S
     key_t = np.array([k[0] for k in KEYS])

@@ -10,6 +10,7 @@ import pytest
 from fbm1_testkit import ITEMS_YAML, RunSpec, bodies, state_streams, write_bag, write_items
 from stderr_text import error_messages
 
+from ertools.benchmarks.fbm1.answers import parse_answer_payload
 from ertools.benchmarks.fbm1.benchmark import score_fbm1
 from ertools.benchmarks.fbm1.runs import find_runs
 from ertools.cli.main import main
@@ -200,8 +201,6 @@ def test_bad_item_list_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture
 
 
 def test_numbers_yaml_reads_as_text_are_accepted() -> None:
-    from ertools.benchmarks.fbm1.answers import parse_answer_payload
-
     a = parse_answer_payload(
         "{item_class: a, item_instance: a1, x: 4e-1, y: '0.2', theta: 1e1}", "run 1"
     )

@@ -9,12 +9,27 @@ at (-0.1 + 0.2 sin 45, 0.5 + 0.2 cos 45) = (0.041421, 0.641421), yaw 45 deg.
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
-from fbm1_testkit import ANSWER_S, EXEC_S, RunSpec, bodies, state_streams, write_bag, write_items
+import yaml
+from fbm1_testkit import (
+    ANSWER_S,
+    EXEC_S,
+    ITEMS_YAML,
+    RunSpec,
+    bodies,
+    state_streams,
+    write_bag,
+    write_items,
+)
+from scipy.spatial.transform import Rotation
+from yaml_rounding import assert_yaml_of
 
+from ertools.benchmarks.base import BenchmarkResult
 from ertools.benchmarks.fbm1.benchmark import score_fbm1
 from ertools.benchmarks.fbm1.config import Fbm1Options
 from ertools.benchmarks.fbm1.gt import GtOptions
@@ -25,6 +40,7 @@ from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import ItemList, parse_items
 from ertools.states import Machine
+from ertools.streams import PoseStream
 
 RUNS = [
     RunSpec(
@@ -55,8 +71,6 @@ TOL = 1e-9
 
 
 def _items() -> ItemList:
-    from fbm1_testkit import ITEMS_YAML
-
     return parse_items(parse_yaml(ITEMS_YAML), "items.yaml")
 
 
@@ -110,7 +124,6 @@ def test_hand_case_through_a_bag_and_the_cli(
     code = main(["score", "fbm1h", str(bag), "--items", str(items), "--format", "json"])
     out, err = capsys.readouterr()
     assert code == 0, err
-    import json
 
     data = json.loads(out)
     assert data["benchmark"] == "fbm1h"
@@ -130,10 +143,6 @@ def test_hand_case_through_a_bag_and_the_cli(
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_moving_the_whole_world_changes_nothing(seed: int) -> None:
     """A rigid motion of the mocap world (both bodies) leaves every table-frame number as is."""
-    import numpy as np
-    from scipy.spatial.transform import Rotation
-
-    from ertools.streams import PoseStream
 
     rng = np.random.default_rng(seed)
     rot = Rotation.from_rotvec(rng.normal(0, 1.0, 3))
@@ -157,11 +166,6 @@ def test_moving_the_whole_world_changes_nothing(seed: int) -> None:
 
 
 def test_result_protocol_and_formats() -> None:
-    import yaml
-    from yaml_rounding import assert_yaml_of
-
-    from ertools.benchmarks.base import BenchmarkResult
-
     result = _score()
     assert isinstance(result, BenchmarkResult)
     data = yaml.safe_load(result.to_yaml())

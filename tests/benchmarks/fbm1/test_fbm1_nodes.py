@@ -33,9 +33,14 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
+from rosbags.highlevel import AnyReader
+from scipy.spatial.transform import Rotation
 
 from ertools.cli.main import main
-from ertools.states import BmBoxState, ClientState, RefBoxState
+from ertools.samples.mocap import MocapNoise, publish_mocap, simulate_mocap
+from ertools.samples.statemachine import Transition, publish_states
+from ertools.samples.writer import BagWriter
+from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
 TOL = 1e-12
 SAMPLE = Path(__file__).resolve().parents[3] / "sample_bags" / "fbm1h"
@@ -55,7 +60,6 @@ class Log:
 def read_log(bag: Path, ns: str, bodies: str = "tf") -> Log:
     """The log as the nodes saw it (``bodies="tf"``), or with the bodies from the pose topics
     ertools' default reads (``"topic"``)."""
-    from rosbags.highlevel import AnyReader
 
     states: dict[str, list[tuple[int, int, str]]] = {"bmbox": [], "refbox": [], "client": []}
     poses = {}
@@ -426,12 +430,6 @@ def _edge_bag(
     after the BmBox left WAITING_RESULT) or the 2016-17 node (``2016``: 7 ms after the
     placement was confirmed) made them.
     """
-    from scipy.spatial.transform import Rotation
-
-    from ertools.samples.mocap import MocapNoise, publish_mocap, simulate_mocap
-    from ertools.samples.statemachine import Transition, publish_states
-    from ertools.samples.writer import BagWriter
-    from ertools.states import Machine
 
     items = yaml.safe_load(ITEMS)["items"]
     t0 = 1_448_020_000 * S

@@ -4,9 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from fbm1_testkit import RunSpec, ns, state_streams
+from fbm1_testkit import ITEMS_YAML, RunSpec, bodies, ns, state_streams
 
+from ertools.benchmarks.fbm1.benchmark import score_fbm1
 from ertools.benchmarks.fbm1.runs import find_runs, parse_item_ref
+from ertools.configs._yaml import parse_yaml
+from ertools.configs.items import parse_items
 from ertools.states import BmBoxState as B
 from ertools.states import ClientState as C
 from ertools.states import Machine
@@ -133,11 +136,6 @@ def test_log_cut_during_a_run_is_the_run_stopped_there() -> None:
     """Issue 23: a log that ends inside the benchmark is the benchmark stopped there, what the
     2015 node did on a RefBox stop (fbm1h at 117a5d0 lines 94-96: ``if not Running():
     continue``, the run already counted in ``runs``): no answer, score 0, no time."""
-    from fbm1_testkit import ITEMS_YAML, bodies
-
-    from ertools.benchmarks.fbm1.benchmark import score_fbm1
-    from ertools.configs._yaml import parse_yaml
-    from ertools.configs.items import parse_items
 
     runs = [
         RunSpec(

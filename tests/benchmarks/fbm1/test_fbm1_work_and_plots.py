@@ -8,13 +8,16 @@ from pathlib import Path
 import pytest
 import svg_figure
 from fbm1_testkit import ITEMS_YAML, RunSpec, bodies, state_streams, write_bag, write_items
+from matplotlib.figure import Figure
 
 from ertools.benchmarks.fbm1.benchmark import score_fbm1
+from ertools.benchmarks.fbm1.config import Fbm1Options
 from ertools.benchmarks.fbm1.runs import find_runs
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import parse_items
 from ertools.report import svg
+from ertools.report.figures import figure_specs
 from ertools.states import Machine
 
 # Item 3 sits 5 cm along x and y of the board; the board at (0.3, 0.2) unrotated, so the item
@@ -56,17 +59,12 @@ def test_fbm1w_items_order(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -
 
 
 def test_fbm1_figures_draw_the_answers() -> None:
-    from matplotlib.figure import Figure
-
-    from ertools.report.figures import figure_specs
-
     streams = state_streams(WORK_RUNS)
     found = find_runs(
         streams[Machine.BMBOX], streams[Machine.REFBOX], streams[Machine.CLIENT], benchmark="fbm1w"
     )
     origin, board = bodies(WORK_RUNS)
     items = parse_items(parse_yaml(ITEMS_YAML), "items.yaml")
-    from ertools.benchmarks.fbm1.config import Fbm1Options
 
     result = score_fbm1(origin, board, found, items, Fbm1Options(benchmark="fbm1w"))
     specs = {s.name: s for s in figure_specs(result)}

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -11,7 +12,12 @@ from scipy.spatial.transform import Rotation
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.goal import goal_from_payload, parse_goal
 from ertools.configs.timing import parse_timing
-from ertools.configs.transform import MarkerTransform, parse_transform, transform_yaml
+from ertools.configs.transform import (
+    MarkerTransform,
+    load_transform,
+    parse_transform,
+    transform_yaml,
+)
 from ertools.errors import ConfigError
 
 S = 1_000_000_000
@@ -73,10 +79,6 @@ def test_transform_yaml_round_trip() -> None:
 
 
 def test_identity_listing_12_file() -> None:
-    from pathlib import Path
-
-    from ertools.configs.transform import load_transform
-
     path = Path(__file__).resolve().parents[3] / "configs" / "transform-identity.yaml"
     tr = load_transform(path)
     assert tr.is_identity and tr.robot_info == "identity" and tr.timestamp == "0"

@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+import yaml
 
 import ertools
 from ertools.benchmarks.common.uncertainty import (
@@ -18,8 +19,21 @@ from ertools.benchmarks.common.uncertainty import (
     TRANSFORM,
     Source,
 )
-from ertools.benchmarks.fbm2h.intervals import Model, Moments, intervals, perturbed_scores
-from ertools.configs.transform import SPREAD_KEY
+from ertools.benchmarks.fbm2h.benchmark import compute, with_intervals
+from ertools.benchmarks.fbm2h.config import Fbm2hOptions
+from ertools.benchmarks.fbm2h.intervals import (
+    DEFAULT_EPSILON_M,
+    Model,
+    Moments,
+    intervals,
+    measure_model,
+    perturbed_scores,
+)
+from ertools.benchmarks.fbm2h.segments import ReachedMoments
+from ertools.configs.goal import parse_goal
+from ertools.configs.transform import SPREAD_KEY, parse_transform
+from ertools.samples import fbm2h as sim
+from ertools.streams import PoseStream
 
 N = 20_000  # draws: the sd of a sample sd is 1/sqrt(2N) = 0.5% of it
 
@@ -121,9 +135,6 @@ def test_interval_width_and_shares() -> None:
 
 
 def test_a_robot_never_still_gets_the_stated_defaults() -> None:
-    from ertools.benchmarks.fbm2h.intervals import DEFAULT_EPSILON_M, measure_model
-    from ertools.streams import PoseStream
-
     t = np.arange(500, dtype=np.int64) * 8_333_333  # 120 Hz, moving 0.6 m/s throughout
     xyz = np.column_stack([np.linspace(0.0, 5.0, 500), np.zeros(500), np.zeros(500)])
     model = measure_model(PoseStream(t, xyz, np.tile([0.0, 0.0, 0.0, 1.0], (500, 1))))
@@ -135,16 +146,6 @@ def test_a_robot_never_still_gets_the_stated_defaults() -> None:
 
 
 def test_draws_0_leaves_the_result_as_it_was() -> None:
-    import yaml
-
-    from ertools.benchmarks.fbm2h.benchmark import compute, with_intervals
-    from ertools.benchmarks.fbm2h.config import Fbm2hOptions
-    from ertools.benchmarks.fbm2h.segments import ReachedMoments
-    from ertools.configs.goal import parse_goal
-    from ertools.configs.transform import parse_transform
-    from ertools.samples import fbm2h as sim
-    from ertools.streams import PoseStream
-
     run = sim.simulate(0)
     pub = run.bodies[sim.BODY]
     marker = PoseStream(pub.t_header_ns, pub.xyz, pub.quat_xyzw)

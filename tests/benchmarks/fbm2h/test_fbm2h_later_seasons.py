@@ -17,6 +17,8 @@ import pytest
 import yaml
 
 from ertools.cli.main import main
+from ertools.configs.items import load_items
+from ertools.errors import ConfigError
 
 
 def _score(capsys: pytest.CaptureFixture[str], sample: Any, transform: Path, *extra: str) -> Any:
@@ -119,8 +121,6 @@ def test_erl_rsbb_goal_config(
 def test_erl_rsbb_items_list_reads_as_a_vanilla_list(tmp_path: Path) -> None:
     """The RSBB's objects_informations/items_list.yaml (id, class, instance, description):
     the items named, no poses yet (what `ertools acquire items` fills in)."""
-    from ertools.configs.items import load_items
-    from ertools.errors import ConfigError
 
     path = tmp_path / "items_list.yaml"
     path.write_text(

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
+from rosbags.highlevel import AnyReader
 from stderr_text import error_messages
 
 from ertools.cli.main import main
@@ -32,7 +33,6 @@ pytestmark = pytest.mark.real
 def real() -> dict[str, Any]:
     if not BAG.exists():
         pytest.skip("../shared/real_bags not present")
-    from rosbags.highlevel import AnyReader
 
     rows = []
     with AnyReader([BAG]) as reader:

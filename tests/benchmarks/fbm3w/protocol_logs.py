@@ -27,6 +27,8 @@ import numpy.typing as npt
 import yaml
 from scipy.interpolate import CubicSpline
 
+from ertools.samples.writer import BagWriter
+
 F64 = npt.NDArray[np.float64]
 I64 = npt.NDArray[np.int64]
 RATE_HZ = 120.0
@@ -229,7 +231,6 @@ def _path(
 
 def write_bag(log: Log, path: Path, *, clean: bool = False) -> Path:
     """The log (or its noiseless twin) as a ROS1 bag of geometry_msgs/Pose2D, 2015 topic."""
-    from ertools.samples.writer import BagWriter
 
     xy = log.clean if clean else log.xy
     with BagWriter(path, "ros1") as bag:

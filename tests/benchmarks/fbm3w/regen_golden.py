@@ -5,18 +5,17 @@ Run it only after a deliberate change of the output layout, and review the diff.
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
+
+# golden_case sits beside this script: run as a script, its folder is sys.path[0]
+from golden_case import golden_result
+
+from ertools.cli.output import dump_json
 
 HERE = Path(__file__).resolve().parent
 
 
 def main() -> int:
-    sys.path.insert(0, str(HERE))
-    from golden_case import golden_result
-
-    from ertools.cli.output import dump_json
-
     result = golden_result()
     (HERE / "golden" / "score.yaml").write_text(result.to_yaml(), encoding="utf-8")
     (HERE / "golden" / "score.json").write_text(

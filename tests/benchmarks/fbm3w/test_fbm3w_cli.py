@@ -10,6 +10,7 @@ import pytest
 import yaml
 from fbm3w_kit import Sample
 from fbm3w_synth import one_run
+from protocol_logs import generate, write_bag, write_config
 from stderr_text import error_messages
 
 from ertools.cli.main import main
@@ -268,7 +269,6 @@ def test_window_outside_the_log_is_an_error(
     window: str, where: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """Issue 15 (4): a window cut by the log's end was scored from what was left."""
-    from protocol_logs import generate, write_bag, write_config
 
     log = generate(np.random.default_rng(4), ["line"], sigma=0.5e-3, approach=0.05)
     bag = write_bag(log, tmp_path / "run.bag")

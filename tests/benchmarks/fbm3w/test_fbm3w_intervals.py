@@ -19,6 +19,7 @@ from ertools.benchmarks.fbm3w.intervals import (
     run_intervals,
     smooth,
 )
+from ertools.benchmarks.noise.benchmark import noise_statistics
 from ertools.configs.shapes import builtin_shapes
 from ertools.samples.fbm3w import eq1, target
 
@@ -75,8 +76,6 @@ def test_smoothing_keeps_a_quadratic_path_and_removes_noise() -> None:
 
 
 def test_sources_measured_from_the_noise_estimate_or_defaults() -> None:
-    from ertools.benchmarks.noise.benchmark import noise_statistics
-
     rng = np.random.default_rng(2)
     xy = rng.normal(0.0, 1e-4, (5001, 2))
     t = np.arange(5001, dtype=np.int64) * 8_333_333

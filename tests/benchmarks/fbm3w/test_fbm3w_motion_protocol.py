@@ -6,7 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ertools.benchmarks.common.phases import noise_sigma, protocol_track, window_speed
+from ertools.benchmarks.common.phases import (
+    noise_sigma,
+    protocol_track,
+    stationary_phases,
+    window_speed,
+)
 
 FRAME_NS = 8_333_333  # 120 Hz
 
@@ -94,6 +99,5 @@ def test_high_noise_does_not_chop_a_still_phase() -> None:
     assert track.half_s == pytest.approx(0.4, abs=0.05)
     assert track.onset_ns[0] / 1e9 == pytest.approx(onset, abs=0.5)
     assert track.arrival_ns[0] / 1e9 == pytest.approx(stop, abs=0.5)
-    from ertools.benchmarks.common.phases import stationary_phases
 
     assert len(stationary_phases(t, noisy)) > 2  # the old detector: chopped

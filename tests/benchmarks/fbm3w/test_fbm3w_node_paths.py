@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 import pytest
 from bmbox2015 import BmBoxReplay
+from rosbags.highlevel import AnyReader
 from test_fbm3w_2015 import SHAPES, _track, distance_error
 
 from ertools.cli.main import main
@@ -215,8 +216,6 @@ def write_case(path: Path, case: Case) -> tuple[list[int], list[tuple[float, flo
 
 
 def _states(bag: Path) -> dict[str, list[tuple[int, int, str]]]:
-    from rosbags.highlevel import AnyReader
-
     out: dict[str, list[tuple[int, int, str]]] = {"bmbox": [], "refbox": []}
     with AnyReader([bag]) as reader:
         for machine, rows in out.items():

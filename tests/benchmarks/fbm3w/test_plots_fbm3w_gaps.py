@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 import svg_figure
 from fbm3w_synth import one_run
+from matplotlib.image import imread
 
 from ertools.benchmarks.fbm3w.benchmark import score_runs
 from ertools.configs.fbm3w import Fbm3wConfig
@@ -94,9 +95,6 @@ def test_an_unscoreable_run_has_its_figure_and_verdict(tmp_path: Path) -> None:
 
 
 def test_matplotlib_draws_the_gaps_too(tmp_path: Path) -> None:
-    pytest.importorskip("matplotlib")
-    from matplotlib.image import imread  # lazy: matplotlib is optional
-
     for cut in ((1000, 1030), (1000, 1072)):
         path = _figure(_result(cut), tmp_path, "png")
         assert imread(path).shape[0] > 100

@@ -11,10 +11,12 @@ import numpy as np
 import pytest
 import yaml
 
-from ertools.benchmarks.noise.benchmark import noise_statistics
+from ertools.benchmarks.noise.benchmark import noise_from_stream, noise_statistics
 from ertools.cli.main import main
+from ertools.errors import ScoringError
 from ertools.samples import fbm3w
 from ertools.samples.stationary import generate
+from ertools.streams import PoseStream
 
 
 @pytest.fixture(scope="module")
@@ -121,10 +123,6 @@ def test_bad_inputs(
 
 
 def test_all_nan_stream_is_named() -> None:
-    from ertools.benchmarks.noise.benchmark import noise_from_stream
-    from ertools.errors import ScoringError
-    from ertools.streams import PoseStream
-
     n = 5
     nan = np.full((n, 3), np.nan)
     quat = np.tile([0.0, 0.0, 0.0, 1.0], (n, 1))

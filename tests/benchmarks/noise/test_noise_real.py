@@ -8,6 +8,7 @@ import math
 from pathlib import Path
 
 import pytest
+from rosbags.highlevel import AnyReader
 
 from ertools.cli.main import main
 
@@ -17,8 +18,6 @@ TOPIC = "/fbm2h/robot_at_home/pose2d"
 
 
 def _pose2d_by_rosbags() -> list[tuple[float, float, float]]:
-    from rosbags.highlevel import AnyReader
-
     with AnyReader([BAG]) as reader:
         conns = [c for c in reader.connections if c.topic == TOPIC]
         return [

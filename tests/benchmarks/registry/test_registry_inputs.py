@@ -7,6 +7,7 @@ that changes nothing would be an option that silently does nothing).
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any
 
@@ -15,7 +16,7 @@ import pytest
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Input, resolve_values
 from ertools.cli import score as score_cli
-from ertools.cli.main import build_parser
+from ertools.cli.main import build_parser, main
 from ertools.errors import UsageError
 
 ITEMS = """\
@@ -159,8 +160,6 @@ def test_make_options_refuses_bad_values(
 
 
 def _escape(text: str) -> str:
-    import re
-
     return re.escape(text)
 
 
@@ -168,7 +167,6 @@ def test_d_min_negative_is_a_usage_error_on_the_command_line(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
     """Issue 16: `--d-min -0.001` exits 2 (it used to be a config error, exit 1)."""
-    from ertools.cli.main import main
 
     assert main(["score", "fbm3w", "nonexistent.bag", "--d-min", "-0.001"]) == 2
     err = capsys.readouterr().err.strip().splitlines()

@@ -7,11 +7,12 @@ from typing import Any
 import pytest
 import yaml
 
+from ertools.samples.robotlog import generate
+
 
 @pytest.fixture(scope="session")
 def robotlog(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
     """Paths of the generated robot log and GT files, and the generator's answers."""
-    from ertools.samples.robotlog import generate
 
     out = tmp_path_factory.mktemp("robotlog")
     paths = generate(out, seed=7)

@@ -20,13 +20,16 @@ from typing import Any
 import numpy as np
 import pytest
 from node_2015 import EndOfBagError, Pose, score_2015, tf_yaw
+from rosbags.highlevel import AnyReader
 from stderr_text import error_messages
 from trajectory_helpers import read_back, write_gt, write_robot
 
+from ertools.benchmarks.trajectory.association import yaw_tf
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.benchmarks.trajectory.scoring import score_streams
 from ertools.cli.main import main
 from ertools.errors import ClockError
+from ertools.samples.writer import BagWriter
 from ertools.streams import PoseStream
 
 TOL = 1e-12
@@ -46,7 +49,6 @@ def _poses(path: Path, topic: str, shift_ns: int = 0) -> list[Pose]:
 
 def _gt_files_by_start() -> list[list[Pose]]:
     """The GT split files as the 2015 script opened them: sorted by the bag's start time."""
-    from rosbags.highlevel import AnyReader
 
     files = sorted(SAMPLE.glob("log_*.bag"))
     starts = {}
@@ -455,7 +457,6 @@ PEER_GT_TOPIC = "/airlab/robot/pose"
 
 def _peer_bags(folder: Path, messages: tuple[tuple[str, float, float, float], ...]) -> Path:
     """The bags of a peer-suite case, as its tests/test_bags.py wrote them."""
-    from ertools.samples.writer import BagWriter
 
     gt_dir = folder / "mocap"
     gt_dir.mkdir()
@@ -528,8 +529,6 @@ def test_chained_gt_files_equal_the_2015_scan(seed: int, how: str) -> None:
 
 
 def test_yaw_tf_equals_tf_s_arithmetic() -> None:
-    from ertools.benchmarks.trajectory.association import yaw_tf
-
     rng = np.random.default_rng(3)
     q = rng.normal(size=(2000, 4)) * rng.uniform(0.5, 2.0, (2000, 1))  # any norm, any pitch
     special = np.array(

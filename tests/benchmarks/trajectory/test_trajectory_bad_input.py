@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 from typing import Any
 
@@ -89,8 +90,6 @@ def test_random_bytes_as_gt(
 def test_broken_bag_in_a_gt_folder_is_skipped_with_a_warning(
     robotlog: dict[str, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    import shutil
-
     folder = tmp_path / "gt"
     folder.mkdir()
     for p in robotlog["gt"]:

@@ -26,8 +26,10 @@ from typing import Any
 import numpy as np
 import pytest
 
+from ertools.benchmarks.trajectory.association import evo_matches
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
+from ertools.samples.writer import BagWriter
 
 REPO = Path(__file__).resolve().parents[3]
 EVO_DATA = REPO.parent / "shared" / "evo_testdata"
@@ -135,7 +137,6 @@ def write_sim_bag(
     """A navigation bag recorded from a simulator: header stamps on the simulation clock
     (from 928 s), record times on the wall clock (2023), the robot (~7 Hz, jittered stamps)
     noisy around the GT (/odom, 30 Hz)."""
-    from ertools.samples.writer import BagWriter
 
     rng = np.random.default_rng(26)
     wall0, sim0 = 1_700_000_000 * NS, 928 * NS
@@ -266,9 +267,8 @@ def test_evo_matches_is_evos_rule() -> None:
     its corner cases: exact ties between two neighbours, differences of exactly max_diff,
     stamps beyond both ends, one long stamp nearest to several short ones."""
     pytest.importorskip("evo", reason="evo is in the dev extra: `make test` installs it")
+    # lazy: evo is the dev extra's (importorskip above) and takes ~1 s to import
     from evo.core.sync import matching_time_indices
-
-    from ertools.benchmarks.trajectory.association import evo_matches
 
     rng = np.random.default_rng(5)
     for trial in range(30):

@@ -14,10 +14,12 @@ from typing import Any
 
 import numpy as np
 import pytest
+from rosbags.rosbag1 import Reader
 from stderr_text import error_messages
 from test_trajectory_sample import check
 from trajectory_helpers import read_back
 
+from ertools.benchmarks.trajectory.association import COMPARED
 from ertools.benchmarks.trajectory.benchmark import score
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.cli.main import main
@@ -158,11 +160,9 @@ def test_one_bag_agrees_with_evo_bag_mode(bags: dict[str, Path]) -> None:
     if bags["both"].suffix != ".bag":
         pytest.skip("n/a: evo reads ROS1 bags and rosbag2 folders, not plain MCAP files")
     pytest.importorskip("evo", reason="evo is in the dev extra: `make test` installs it")
+    # lazy: evo is the dev extra's (importorskip above) and takes ~1 s to import
     from evo.core import metrics, sync
     from evo.tools import file_interface
-    from rosbags.rosbag1 import Reader
-
-    from ertools.benchmarks.trajectory.association import COMPARED
 
     with Reader(bags["both"]) as reader:
         ref = file_interface.read_bag_trajectory(reader, GT_TOPIC)

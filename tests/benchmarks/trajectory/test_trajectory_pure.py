@@ -7,7 +7,14 @@ import math
 import numpy as np
 import pytest
 
-from ertools.benchmarks.common.clocks import estimate_offset
+from ertools.benchmarks.common import clocks as clock_offset
+from ertools.benchmarks.common.clocks import (
+    GRID_NS,
+    MIN_POSES,
+    _around_window,
+    _coarse_scan,
+    estimate_offset,
+)
 from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid
 from ertools.benchmarks.trajectory.association import (
     COMPARED,
@@ -218,7 +225,6 @@ def test_coarse_scan_equals_a_direct_nearest_grid_computation() -> None:
     definition written out per offset: mean distance to the GT interpolated at the nearest
     10 ms grid point, over the grid points not strictly inside a GT gap > max_gap (the first
     grid point judged by the first GT interval), offsets reaching past the GT included."""
-    from ertools.benchmarks.common.clocks import GRID_NS, MIN_POSES, _coarse_scan
 
     robot, gt = _moving(250 * MS, seed=5)
     # Gaps: at the start (first interval), in the middle, and one just above max_gap.
@@ -265,7 +271,6 @@ def test_fine_scan_window_search_equals_binary_searches() -> None:
     """The fine scan counts GT samples inside each pose's window instead of searching: the
     same indices as two binary searches, with exact hits, doubled stamps and windows running
     past both ends of the GT; a window too dense to pay falls back (None)."""
-    from ertools.benchmarks.common.clocks import _around_window
 
     t = np.array([0, 8, 17, 25, 25, 33, 42, 50, 58], dtype=np.int64) * MS
     robot_t = np.array([-30, 0, 12, 25, 41, 57, 70], dtype=np.int64) * MS
@@ -283,7 +288,6 @@ def test_coarse_grid_in_chunks_equals_one_interpolation(monkeypatch: pytest.Monk
     """Grid chunks of 97 points (boundaries everywhere, exact hits included) against one
     np.interp over the whole GT: the same float32 values; NaN in the padding and strictly
     inside the gap."""
-    from ertools.benchmarks.common import clocks as clock_offset
 
     _, gt = _moving(0, seed=6)
     keep = np.ones(len(gt), dtype=bool)

@@ -9,12 +9,15 @@ from typing import Any
 
 import numpy as np
 import pytest
+import yaml
 from stderr_text import error_messages
-from trajectory_helpers import read_back, yaw
+from trajectory_helpers import read_back, write_gt, yaw
 
+import ertools.benchmarks.trajectory.inputs as tr
 from ertools.benchmarks.trajectory.benchmark import score
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.cli.main import main
+from ertools.io import read_poses
 from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC, expected_scores, truth_at
 
 KEYS = ("compared", "gaps", "tracking_lost", "uncovered")
@@ -89,8 +92,6 @@ def test_cli_json_has_the_documented_keys(
 def test_cli_yaml_and_plots(
     robot_cli: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    import yaml
-
     assert main([*robot_cli, "--offset", "-0.35", "--plot", str(tmp_path / "figs")]) == 0
     cap = capsys.readouterr()
     data = yaml.safe_load(cap.out)
@@ -143,7 +144,6 @@ def test_overlapping_gt_files(
     robotlog: dict[str, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A copy of file 1 and an extra logger bridging the split gap, both overlapping."""
-    from trajectory_helpers import write_gt
 
     gt0, gt1 = robotlog["gt"]
     copy = tmp_path / "copy" / gt1.name
@@ -226,9 +226,6 @@ def test_gt_read_is_one_read_equal_to_the_whole_cut(
     monkeypatch: pytest.MonkeyPatch,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    import ertools.benchmarks.trajectory.inputs as tr
-    from ertools.io import read_poses
-
     gt0, gt1 = robotlog["gt"]
     copy = tmp_path / gt1.name
     shutil.copyfile(gt1, copy)

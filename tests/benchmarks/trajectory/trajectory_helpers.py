@@ -6,6 +6,10 @@ import math
 from pathlib import Path
 
 import numpy as np
+from rosbags.highlevel import AnyReader
+
+from ertools.geometry import quat_from_yaw
+from ertools.samples.writer import BagWriter
 
 
 def read_back(path: Path, topic: str) -> tuple[list[int], list[list[float]], list[list[float]]]:
@@ -13,7 +17,6 @@ def read_back(path: Path, topic: str) -> tuple[list[int], list[list[float]], lis
 
     Independent of ertools.io: the tests compare the scorer with values computed from this.
     """
-    from rosbags.highlevel import AnyReader
 
     t: list[int] = []
     xyz: list[list[float]] = []
@@ -36,8 +39,6 @@ def yaw(q: list[float]) -> float:
 
 def write_robot(path: Path, stamps: np.ndarray, xyz: np.ndarray, topic: str) -> Path:
     """A robot log with the given header stamps (record times increase regardless)."""
-    from ertools.geometry import quat_from_yaw
-    from ertools.samples.writer import BagWriter
 
     rec = np.arange(len(stamps), dtype=np.int64) * 100_000_000 + int(stamps[0])
     with BagWriter(path, "ros1") as bag:
@@ -49,8 +50,6 @@ def write_robot(path: Path, stamps: np.ndarray, xyz: np.ndarray, topic: str) -> 
 
 def write_gt(path: Path, t: np.ndarray, xyz: np.ndarray, topic: str) -> Path:
     """A GT file with the given header stamps (recorded 0.3 ms later)."""
-    from ertools.geometry import quat_from_yaw
-    from ertools.samples.writer import BagWriter
 
     with BagWriter(path, "ros1") as bag:
         bag.write_pose_stamped(topic, t + 300_000, t, "world", xyz, quat_from_yaw(np.zeros(len(t))))
