@@ -13,8 +13,9 @@ time. A poller reads the peak RSS (``VmHWM``) of the command and of every proces
     .venv/bin/python bench/rescore_season.py [--days 3] [--per-day 36] [--rounds 2] [--json F]
 
 Targets (on a 2-core machine): --jobs 2 at least 1.7x faster than --jobs 1; Dask within 15 % of
---jobs 2; a warm rerun under 2 s; every process under 200 MiB; time linear in the executions
-(per-execution time of one day within 15 % of the whole season's); identical results in every
+--jobs 2; with reports at most 2x the --no-reports time per execution; a warm rerun under
+2 s; every process under 200 MiB; time linear in the executions (per-execution time of one
+day within 15 % of the whole season's); identical results in every
 configuration (bench/season_compare.py: every run's results.json against the first's, scores,
 intervals, verdicts and leaderboards, timings and paths left out).
 
@@ -344,7 +345,7 @@ def main() -> int:
         "--no-reports",
     )
 
-    print("\ntargets (issue 18 item 6):")
+    print("\ntargets (issues 18 item 6 and 29):")
     checks: dict[str, bool] = {}
 
     def check(key: str, text: str, value: str, ok: bool) -> None:
@@ -354,6 +355,14 @@ def main() -> int:
     j1, j2 = runs["jobs1"], runs["jobs2"]
     speedup = j1.wall_s / j2.wall_s
     check("speedup", "--jobs 2 vs --jobs 1 (>= 1.7x)", f"{speedup:.2f}x", speedup >= 1.7)
+    # per execution: the season's --jobs 1 against day 1's without reports (issue 29 item 1)
+    reports = j1.per_execution_s / runs["day1_noreports"].per_execution_s
+    check(
+        "reports",
+        "with reports vs --no-reports, --jobs 1 (<= 2x)",
+        f"{reports:.2f}x",
+        reports <= 2.0,
+    )
     if "dask" in runs:
         slower = runs["dask"].wall_s / j2.wall_s - 1
         check(
