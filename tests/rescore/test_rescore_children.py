@@ -1,12 +1,12 @@
 """The scoring processes' fork server (ertools/rescore/children.py): a scorer never inherits a
-lock held by another thread of the process that asked for it, the command's server is a fork
-(it starts warm), and a scorer that dies costs its job only."""
+lock held by another thread of the process that asked for it. (The command's server is a fork
+of it, its scorers the server's children, and all end with it: test_rescore_faults.py; a
+scorer that dies costs its job only: test_rescore_cli.py, test_rescore_dask.py.)"""
 
 from __future__ import annotations
 
 import json
 import os
-import signal
 import subprocess
 import sys
 import textwrap
@@ -14,7 +14,6 @@ from pathlib import Path
 
 import pytest
 from rescore_competition import LOGS, expected_value, make_competition
-from test_rescore_faults import HOLD, TOY_RESCORE, alive, descendants, wait_for
 
 HERE = Path(__file__).parent
 LOCKED = {"toy-alpha-20151120T114000": ("alpha", "2015-11-20T11:40:00Z", "1\nlocked\n5\n")}
@@ -90,53 +89,3 @@ def test_a_lock_held_by_another_thread_is_not_inherited(
         assert rows[ident]["rank_value"] == expected_value(ident)
     # the toy's value: the numbers' mean x the scale (2) + alpha's offset (0.25)
     assert rows["toy-alpha-20151120T114000"]["rank_value"] == pytest.approx(3 * 2 + 0.25)
-
-
-@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="n/a: reads /proc")
-@pytest.mark.parametrize("parallel", [["--jobs", "2"], ["--jobs", "2", "--scheduler", "local"]])
-def test_the_command_forks_its_server_and_its_scorers(parallel: list[str], tmp_path: Path) -> None:
-    """The command has one thread when its server starts: the server is a fork of it (warm,
-    in milliseconds), not a fresh interpreter; the two scorers are the server's children, and
-    the three end when the command is killed."""
-    if "--scheduler" in parallel:
-        pytest.importorskip("distributed", reason="needs the dask extra: pip install -e '.[dask]'")
-    comp = make_competition(tmp_path / "comp", extra=HOLD)
-    pid_files = [comp.log(ident).with_name(comp.log(ident).name + ".pid") for ident in HOLD]
-    proc = subprocess.Popen(
-        [*TOY_RESCORE, str(comp.manifest), "--out", str(tmp_path / "out"), *parallel],
-        env=_env(),
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-    )
-    tree: list[int] = []
-    try:
-        wait_for(
-            lambda: all(p.is_file() and p.read_text().endswith("\n") for p in pid_files),
-            "both executions being scored",
-        )
-        scorers = {int(p.read_text()) for p in pid_files}
-        tree = descendants(proc.pid)
-        parents = {pid: _ppid(pid) for pid in tree}
-        servers = [pid for pid in tree if parents[pid] == proc.pid]
-        assert len(servers) == 1, f"one server below the command: {tree}"
-        assert {parents[pid] for pid in scorers} == set(servers)
-        assert "ertools.rescore.children" not in _cmdline(servers[0])
-        assert _cmdline(servers[0]) == _cmdline(proc.pid)  # a fork: the command's own line
-        proc.send_signal(signal.SIGKILL)
-        proc.wait()
-        wait_for(lambda: not any(alive(p) for p in tree), "the server and scorers ending")
-    finally:
-        proc.kill()
-        proc.wait()
-        for pid in tree:  # only if the test failed: leave nothing behind
-            if alive(pid):
-                os.kill(pid, signal.SIGKILL)
-
-
-def _ppid(pid: int) -> int:
-    status = Path(f"/proc/{pid}/status").read_text()
-    return int(status.split("\nPPid:\t", 1)[1].split("\n", 1)[0])
-
-
-def _cmdline(pid: int) -> str:
-    return Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode()

@@ -66,6 +66,15 @@ HOLD = {
 }
 
 
+def ppid(pid: int) -> int:
+    status = Path(f"/proc/{pid}/status").read_text()
+    return int(status.split("\nPPid:\t", 1)[1].split("\n", 1)[0])
+
+
+def cmdline(pid: int) -> str:
+    return Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode()
+
+
 def descendants(pid: int) -> list[int]:
     """Every process below ``pid`` (children, their children...), from /proc."""
     children: dict[int, list[int]] = {}
@@ -91,7 +100,9 @@ def _dask_or_skip() -> None:
 @pytest.mark.parametrize("parallel", [["--jobs", "2"], ["--jobs", "2", "--scheduler", "local"]])
 def test_workers_end_when_the_command_is_killed(parallel: list[str], tmp_path: Path) -> None:
     """kill -9 of `rescore --jobs 2` (local workers, or a Dask LocalCluster) while both
-    executions are being scored: every process it started ends too."""
+    executions are being scored: every process it started ends too. What it started: one fork
+    server, a fork of the command (it had one thread then: ertools/rescore/children.py), and
+    the two scorers, the server's children."""
     if "--scheduler" in parallel:
         _dask_or_skip()
     comp = make_competition(tmp_path / "comp", extra=HOLD)
@@ -114,6 +125,10 @@ def test_workers_end_when_the_command_is_killed(parallel: list[str], tmp_path: P
         scorers = [int(p.read_text()) for p in pid_files]
         tree = descendants(proc.pid)
         assert len(set(scorers)) == 2 and set(scorers) <= set(tree)
+        servers = [pid for pid in tree if ppid(pid) == proc.pid]
+        assert len(servers) == 1, f"one server below the command: {tree}"
+        assert {ppid(pid) for pid in scorers} == set(servers)
+        assert cmdline(servers[0]) == cmdline(proc.pid)  # a fork, not a fresh interpreter
         proc.send_signal(signal.SIGKILL)
         proc.wait()
         wait_for(lambda: not any(alive(p) for p in tree), "every process ending with rescore")
