@@ -170,10 +170,13 @@ class ForkServer:
                 os._exit(code)  # none of the parent's cleanup
             self._pid = pid
         else:
+            # with this process's import path: a notebook's sys.path.insert included
+            path = os.pathsep.join(p for p in sys.path if p)
             self._popen = subprocess.Popen(
                 [sys.executable, "-m", __name__, str(theirs.fileno()), str(self.owner)],
                 pass_fds=[theirs.fileno()],
                 stdin=subprocess.DEVNULL,
+                env={**os.environ, "PYTHONPATH": path},
             )
             self._pid = self._popen.pid
         theirs.close()

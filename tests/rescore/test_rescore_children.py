@@ -22,13 +22,6 @@ LOCKED = {"toy-alpha-20151120T114000": ("alpha", "2015-11-20T11:40:00Z", "1\nloc
 HANG_S = 120
 
 
-def _env() -> dict[str, str]:
-    return {
-        **os.environ,
-        "PYTHONPATH": os.pathsep.join([str(HERE), os.environ.get("PYTHONPATH", "")]),
-    }
-
-
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="n/a: no fork on this platform")
 @pytest.mark.parametrize("parallel", [["--jobs", "2"], ["--jobs", "2", "--scheduler", "local"]])
 def test_a_lock_held_by_another_thread_is_not_inherited(
@@ -36,7 +29,8 @@ def test_a_lock_held_by_another_thread_is_not_inherited(
 ) -> None:
     """A library caller with threads of its own (a notebook's) runs rescore while one of them
     holds a lock the scorer takes: a scorer forked from that process would wait for it for
-    ever. Every execution is scored, the locked one included."""
+    ever. Every execution is scored, the locked one included, by scorers that import the toy
+    from the folder the caller put on its sys.path (a fresh interpreter is given it)."""
     if "--scheduler" in parallel:
         pytest.importorskip("distributed", reason="needs the dask extra: pip install -e '.[dask]'")
     comp = make_competition(tmp_path / "comp", extra=LOCKED)
@@ -45,6 +39,7 @@ def test_a_lock_held_by_another_thread_is_not_inherited(
         textwrap.dedent(
             """
             import sys, threading
+            sys.path.insert(0, sys.argv.pop(1))  # as a notebook adds a folder of its own
             import rescore_toy
             from ertools.benchmarks import registry
             from ertools.cli.main import main
@@ -68,6 +63,7 @@ def test_a_lock_held_by_another_thread_is_not_inherited(
         [
             sys.executable,
             str(caller),
+            str(HERE),
             "rescore",
             "-q",
             "--no-reports",
@@ -77,7 +73,7 @@ def test_a_lock_held_by_another_thread_is_not_inherited(
             str(out),
             *parallel,
         ],
-        env=_env(),
+        env={k: v for k, v in os.environ.items() if k != "PYTHONPATH"},
         check=False,
         capture_output=True,
         text=True,
