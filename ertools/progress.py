@@ -63,6 +63,19 @@ def _amount(n: float, unit: str) -> str:
 
 # The bar appears only for work lasting longer than this: a command done sooner prints nothing.
 DELAY_S = 0.75
+# Counted work says how long is left once it has gone on this long (a pace from one or two
+# items says little)
+ETA_AFTER_S = 5.0
+
+
+def _duration(seconds: float) -> str:
+    """``40 s``, ``3 min``, ``1 h 05 min``: as precise as an estimate deserves."""
+    if seconds < 60:
+        return f"{max(round(seconds), 1)} s"
+    minutes = round(seconds / 60)
+    if minutes < 60:
+        return f"{minutes} min"
+    return f"{minutes // 60} h {minutes % 60:02d} min"
 
 
 class Bar:
@@ -98,17 +111,25 @@ class Bar:
         self.total = 0
         self.done = 0
         self.task_start = self.start
+        self.paced_from: tuple[float, int] | None = None  # (time, count) the pace runs from
         self.drawn_at = -1.0e18
         self.shown = False
         self.closed = False
 
     def task(self, label: str, total: int, unit: str) -> None:
+        """A new stretch of work; counted work announced again unfinished, with the same total
+        (a new label: ``rescoring (2 not scored)``), is the same stretch: its pace goes on."""
+        again = unit == self.unit != "B" and max(total, 0) == self.total > self.done
         self.label, self.total, self.unit, self.done = label, max(total, 0), unit, 0
-        self.task_start = self.clock()
+        if not again:
+            self.task_start = self.clock()
+            self.paced_from = None
         self._maybe_draw(force=True)
 
     def advance(self, n: int) -> None:
         self.done += n
+        if self.paced_from is None:  # the first count: what was done before (cached) is not pace
+            self.paced_from = (self.clock(), self.done)
         # counts of runs or bags are few and each slow: every one is shown
         self._maybe_draw(force=self.done >= self.total or self.unit != "B")
 
@@ -137,6 +158,12 @@ class Bar:
         rate = ""
         if self.unit == "B" and elapsed > 0.2:
             rate = f"  {_amount(self.done / elapsed, 'B')}/s"
+        elif self.paced_from is not None and self.done < self.total:
+            # counted work (executions of a season, runs): what is left at the pace so far
+            since, before = self.paced_from
+            if self.done > before and now - since > ETA_AFTER_S:
+                left = (now - since) / (self.done - before) * (self.total - self.done)
+                rate = f"  ~{_duration(left)} left"
         head = f"ertools: {self.label}"
         for width, tail in ((self.WIDTH, rate), (self.WIDTH, ""), (self.NARROW, "")):
             filled = min(width, width * self.done // max(self.total, 1))

@@ -47,6 +47,54 @@ def test_bar_line_shows_fraction_amounts_and_rate() -> None:
     assert out.getvalue().endswith("\r\x1b[K")
 
 
+def test_counted_work_says_how_long_is_left_at_its_pace() -> None:
+    """A season's executions: after 5 s, the time left at the pace so far (90 executions in
+    56 s: 200 more take 124 s), rounded as an estimate deserves; none once done."""
+    clock, out = Clock(), Tty()
+    bar = Bar(out, delay_s=0.0, clock=clock, columns=120)
+    bar.task("scoring", 300, "executions")
+    clock.t = 4.0
+    bar.advance(10)
+    assert out.getvalue().endswith("] 10/300 executions\x1b[K")  # too early to say
+    clock.t = 60.0
+    bar.advance(90)
+    assert out.getvalue().endswith("] 100/300 executions  ~2 min left\x1b[K")
+    clock.t = 120.0
+    bar.advance(190)  # 280 in 116 s: 10 more take 4.1 s
+    assert out.getvalue().endswith("] 290/300 executions  ~4 s left\x1b[K")
+    bar.advance(10)
+    assert out.getvalue().endswith("] 300/300 executions\x1b[K")
+    bar.task("scoring", 3000, "executions")
+    bar.advance(0)
+    clock.t += 600.0
+    bar.advance(600)  # 2,400 more at one a second
+    assert out.getvalue().endswith("  ~40 min left\x1b[K")
+    bar.task("scoring", 7600, "executions")
+    bar.advance(0)
+    clock.t += 600.0
+    bar.advance(600)  # 7,000 more at one a second
+    assert out.getvalue().endswith("  ~1 h 57 min left\x1b[K")
+
+
+def test_the_pace_leaves_out_what_was_done_before_and_survives_a_new_label() -> None:
+    """A rerun finds 200 of 300 executions in the cache at once: the pace is that of the
+    executions scored since (10 in 10 s: 90 more take 90 s), also once the label changes."""
+    clock, out = Clock(), Tty()
+    bar = Bar(out, delay_s=0.0, clock=clock, columns=120)
+    bar.task("rescoring", 300, "executions")
+    bar.advance(200)
+    clock.t = 10.0
+    bar.task("rescoring (1 not scored)", 300, "executions")  # as rescore says it
+    bar.advance(210)
+    assert out.getvalue().endswith(
+        "(1 not scored) [################--------] 210/300 executions  ~2 min left\x1b[K"
+    )
+    bar.task("reading x.bag", 300, "B")  # bytes of the same size: a new task
+    clock.t = 11.0
+    bar.advance(150)
+    assert out.getvalue().endswith("] 150 B/300 B  150 B/s\x1b[K")
+
+
 def test_bar_silent_before_its_delay_and_off_a_terminal() -> None:
     clock = Clock()
     quick = Tty()
