@@ -7,6 +7,7 @@ import logging
 import math
 import os
 import re
+import select
 import sys
 import textwrap
 from collections.abc import Sequence
@@ -305,7 +306,16 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
     except KeyboardInterrupt:
         print("ertools: interrupted", file=sys.stderr)
         return 130
-    except BrokenPipeError:
+    except BrokenPipeError as err:
+        if not _stdout_closed():  # a pipe of ertools' own, not the reader of stdout: a bug
+            if args.debug:
+                raise
+            print(
+                f"ertools: error: unexpected BrokenPipeError: {_one_line(str(err))} "
+                "(this is a bug in ertools; re-run with --debug for the traceback)",
+                file=sys.stderr,
+            )
+            return 1
         _silence_stdout()
         return 0
     except OSError as err:  # mostly an output path that cannot be written (-o, --plot...)
@@ -355,6 +365,18 @@ def main(argv: Sequence[str] | None = None) -> int:
         _silence_stdout()
         return 0
     return code
+
+
+def _stdout_closed() -> bool:
+    """Whether stdout's reader has gone (``ertools ... | head -1``): its pipe then polls as an
+    error. Where that cannot be asked, assumed."""
+    try:
+        poll = select.poll()
+        poll.register(sys.stdout.fileno(), select.POLLOUT)
+        events = poll.poll(0)
+    except (AttributeError, OSError, ValueError):  # no poll, stdout replaced in-process
+        return True
+    return any(mask & (select.POLLERR | select.POLLHUP) for _, mask in events)
 
 
 def _silence_stdout() -> None:

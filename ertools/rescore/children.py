@@ -44,6 +44,15 @@ _LENGTH = struct.Struct("!I")  # a request's length, before its pickle
 _NUMBER = struct.Struct("!q")  # a reply: a child's pid, or its exit code
 
 
+class ForkServerError(RuntimeError):
+    """The fork server ended (killed by hand or for memory): not a ``BrokenPipeError``, which
+    the command line reads as its own output closed."""
+
+
+class ForkFailedError(ForkServerError):
+    """The fork server runs, but could not fork a scorer (out of processes or memory)."""
+
+
 def end_with_parent(parent: int) -> None:
     """End this process when its parent ``parent`` ends, however that ends (``kill -9``
     included): a worker left behind holds its memory and its job for ever, blocked on a pipe
@@ -133,9 +142,10 @@ class Child:
         """The channel's descriptor: readable when an outcome arrived, or the child died."""
         return self._channel.fileno()
 
-    def close(self) -> int:
+    def close(self) -> int | None:
         """Close the child's input (an idle child leaves at once; one still scoring is killed:
-        the run was interrupted) and wait for it; its exit code (0 when the server is gone)."""
+        the run was interrupted) and wait for it; its exit code (None when the server ended
+        first: it took its children along)."""
         if self._closed:
             return 0
         self._closed = True
@@ -186,25 +196,38 @@ class ForkServer:
         """A new scoring child, forked once the server has loaded what ``job`` needs.
 
         Raises:
-            OSError: the server is gone.
+            ForkServerError: the server ended, or could not fork.
         """
         with self._lock:
             _send(self._control, ("child", job))
             pid, fds = _reply(self._control, fds=1)
+        if pid < 0:  # it could not fork (out of processes or memory)
+            raise ForkFailedError(
+                f"the fork server could not start a scoring process: {os.strerror(-pid)}"
+            )
         child = Child(self, pid, socket.socket(fileno=fds[0]))
         with _server_lock:
             _children.append(child)  # closed with the server, whoever forgets it
         return child
 
-    def wait(self, pid: int) -> int:
-        """The exit code of the server's child ``pid``, once it ended (0: server gone)."""
+    def wait(self, pid: int) -> int | None:
+        """The exit code of the server's child ``pid``, once it ended (None: server gone)."""
         with self._lock:
             try:
                 _send(self._control, ("wait", pid))
                 code, _ = _reply(self._control, fds=0)
-            except OSError:
-                return 0
+            except ForkServerError:
+                return None
         return code
+
+    def alive(self) -> bool:
+        """Whether the server still runs (killed by hand, or for memory, it is not)."""
+        if self._popen is not None:
+            return self._popen.poll() is None
+        try:
+            return os.waitpid(self._pid, os.WNOHANG) == (0, 0)
+        except ChildProcessError:
+            return False
 
     def close(self) -> None:
         """End the server (its children end with it) and reap it."""
@@ -219,16 +242,23 @@ class ForkServer:
 
 def _send(control: socket.socket, request: tuple[str, object]) -> None:
     data = pickle.dumps(request)
-    control.sendall(_LENGTH.pack(len(data)) + data)
+    try:
+        control.sendall(_LENGTH.pack(len(data)) + data)
+    except OSError as err:
+        raise ForkServerError(f"the fork server ended ({err})") from err
 
 
 def _reply(control: socket.socket, *, fds: int) -> tuple[int, list[int]]:
-    data, got, _, _ = socket.recv_fds(control, _NUMBER.size, fds)
-    while data and len(data) < _NUMBER.size:  # a stream: the rest may come apart
-        data += control.recv(_NUMBER.size - len(data))
-    if len(data) < _NUMBER.size or len(got) < fds:
-        raise OSError("the fork server ended")
-    return _NUMBER.unpack(data)[0], list(got)
+    try:
+        data, got, _, _ = socket.recv_fds(control, _NUMBER.size, fds)
+        while data and len(data) < _NUMBER.size:  # a stream: the rest may come apart
+            data += control.recv(_NUMBER.size - len(data))
+    except OSError as err:
+        raise ForkServerError(f"the fork server ended ({err})") from err
+    number: int = _NUMBER.unpack(data)[0] if len(data) == _NUMBER.size else 0
+    if len(data) < _NUMBER.size or (number >= 0 and len(got) < fds):
+        raise ForkServerError("the fork server ended")
+    return number, list(got)
 
 
 def _read(stream: BinaryIO, size: int) -> bytes | None:
@@ -249,7 +279,13 @@ def _serve(control: socket.socket) -> None:
         if kind == "child":
             warm(arg)
             mine, theirs = socket.socketpair()
-            pid = os.fork()
+            try:
+                pid = os.fork()
+            except OSError as err:  # said to the asker, who fails that job: the server goes on
+                mine.close()
+                theirs.close()
+                control.sendall(_NUMBER.pack(-(err.errno or 1)))
+                continue
             if pid == 0:
                 requests.close()
                 control.close()
@@ -292,7 +328,10 @@ _children: list[Child] = []  # every child of this process: closed with the serv
 def server() -> ForkServer:
     """This process's fork server, started now if it has none."""
     with _server_lock:
-        if os.getpid() not in _servers:
+        current = _servers.get(os.getpid())
+        if current is None or not current.alive():  # none yet, or it was killed: a new one
+            if current is not None:
+                current.close()
             _servers[os.getpid()] = ForkServer()
         return _servers[os.getpid()]
 
@@ -324,6 +363,25 @@ def forks_ready() -> Iterator[None]:
             close_server()
 
 
+def new_child(job: Job) -> Child:
+    """A new scoring child of this process's server, for ``job``; a server found dead is
+    replaced once.
+
+    Raises:
+        ForkServerError: the new server ended too (ForkFailedError: a server could not fork).
+    """
+    try:
+        return server().child(job)
+    except ForkFailedError:
+        raise
+    except ForkServerError:  # it ended: its scorers went with it
+        with _server_lock:
+            dead = _servers.pop(os.getpid(), None)
+        if dead is not None:
+            dead.close()
+        return server().child(job)
+
+
 def run_job_forked(job: Job) -> Outcome:
     """:func:`run_job` in a child of this process's fork server: a scorer that crashes or is
     killed (for memory) costs this job's row, never the Dask worker running it nor the other
@@ -337,17 +395,22 @@ def run_job_forked(job: Job) -> Outcome:
         return run_job(job)
     child: Child | None = getattr(_local, "child", None)
     if child is None or child.owner != os.getpid():  # none yet, or one of a parent's
-        child = _local.child = server().child(job)
+        child = _local.child = new_child(job)
     outcome = child.run(job)
     if outcome is not None:
         return outcome
     _local.child = None
-    code = child.close()
     return Outcome(
         job.id,
         "failed",
-        reason=f"the process scoring it died (exit code {code}); the other executions were scored",
+        reason=f"the process scoring it died ({ended(child)}); the other executions were scored",
     )
+
+
+def ended(child: Child) -> str:
+    """How a dead ``child`` ended, for its job's row: ``exit code -9``, or its server ended."""
+    code = child.close()
+    return "its fork server ended" if code is None else f"exit code {code}"
 
 
 if __name__ == "__main__":  # a fork server as a fresh interpreter: ForkServer, with threads

@@ -21,7 +21,15 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 from typing import Any
 
 from ertools.errors import ConfigError
-from ertools.rescore.children import Child, close_server, forks_ready, run_job_forked, server
+from ertools.rescore.children import (
+    Child,
+    ForkServerError,
+    close_server,
+    ended,
+    forks_ready,
+    new_child,
+    run_job_forked,
+)
 from ertools.rescore.jobs import Job, Outcome, run_job
 from ertools.rescore.schedule import Schedule
 
@@ -76,7 +84,7 @@ def run_local(
     with forks_ready():
         busy: dict[int, tuple[Child, Job]] = {}  # by the descriptor its outcome comes on
         for _ in range(min(workers, len(jobs))):
-            _hand(busy, None, pending.next())
+            _hand(busy, None, pending, on_done)
         while busy:
             for fd in multiprocessing.connection.wait(list(busy)):
                 assert isinstance(fd, int)
@@ -87,31 +95,42 @@ def run_local(
                     outcome = _died(child, job)
                 pending.done(outcome)
                 # the next job first: the worker waits for none
-                _hand(busy, child if alive else None, pending.next())
+                _hand(busy, child if alive else None, pending, on_done)
                 on_done(outcome)
 
 
-def _hand(busy: dict[int, tuple[Child, Job]], child: Child | None, job: Job | None) -> None:
-    """Give ``job`` to ``child`` (idle), or to a new worker when ``child`` is None or has died
-    since; with no job left, ``child`` ends."""
-    if job is None:
-        if child is not None:
-            child.close()
-        return
-    if child is None or not child.send(job):
+def _hand(
+    busy: dict[int, tuple[Child, Job]], child: Child | None, pending: Schedule, on_done: OnDone
+) -> None:
+    """Give the next job to ``child`` (idle), or to a new worker when ``child`` is None or has
+    died since; with no job left, ``child`` ends. A job no process can be started for costs
+    its own row (the fork server could not fork: out of processes or memory)."""
+    while (job := pending.next()) is not None:
+        if child is not None and child.send(job):
+            busy[child.fileno()] = (child, job)
+            return
         if child is not None:
             child.close()  # died since its outcome: of no job
-        child = server().child(job)
+        try:
+            child = new_child(job)
+        except ForkServerError as err:
+            child = None
+            outcome = Outcome(job.id, "failed", reason=f"no process could score it: {err}")
+            pending.done(outcome)
+            on_done(outcome)
+            continue
         child.send(job)  # one that died at once says so when read
-    busy[child.fileno()] = (child, job)
+        busy[child.fileno()] = (child, job)
+        return
+    if child is not None:
+        child.close()
 
 
 def _died(child: Child, job: Job) -> Outcome:
-    code = child.close()
     return Outcome(
         job.id,
         "failed",
-        reason=f"the worker scoring it died (exit code {code}); the other executions were scored",
+        reason=f"the worker scoring it died ({ended(child)}); the other executions were scored",
     )
 
 

@@ -28,3 +28,26 @@ def test_a_closed_stdout_is_not_an_error(argv: list[str]) -> None:
         os.close(write_end)
     assert proc.stderr == ""
     assert proc.returncode in (0, 2)  # bare `ertools` is a usage error (2) that shows the help
+
+
+def test_a_broken_pipe_of_its_own_is_an_error_not_a_silent_success() -> None:
+    """A BrokenPipeError from a pipe or socket of ertools' own (a scoring process's, gone),
+    while stdout's reader is still there: one error line and exit 1, never the silent 0 of a
+    reader that stopped early (the results would be missing without a word)."""
+    script = (
+        "import ertools.cli.info as info\n"
+        "def run(args):\n"
+        "    raise BrokenPipeError(32, 'Broken pipe')\n"
+        "info.run = run\n"
+        "from ertools.cli.main import main\n"
+        "raise SystemExit(main(['info', 'x.bag']))\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, check=False
+    )
+    assert proc.returncode == 1
+    assert proc.stderr == (
+        "ertools: error: unexpected BrokenPipeError: [Errno 32] Broken pipe (this is a bug in "
+        "ertools; re-run with --debug for the traceback)\n"
+    )
+    assert proc.stdout == ""

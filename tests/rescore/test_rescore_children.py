@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import os
+import signal
 import subprocess
 import sys
 import textwrap
@@ -14,6 +15,7 @@ from pathlib import Path
 
 import pytest
 from rescore_competition import LOGS, expected_value, make_competition
+from test_rescore_faults import DEADLINE_S, HOLD, TOY_RESCORE, ppid, wait_for
 
 HERE = Path(__file__).parent
 LOCKED = {"toy-alpha-20151120T114000": ("alpha", "2015-11-20T11:40:00Z", "1\nlocked\n5\n")}
@@ -85,3 +87,113 @@ def test_a_lock_held_by_another_thread_is_not_inherited(
         assert rows[ident]["rank_value"] == expected_value(ident)
     # the toy's value: the numbers' mean x the scale (2) + alpha's offset (0.25)
     assert rows["toy-alpha-20151120T114000"]["rank_value"] == pytest.approx(3 * 2 + 0.25)
+
+
+AFTER = {  # scored after the held ones: in time order, as the toy's executions are handed out
+    "toy-alpha-20151120T120000": ("alpha", "2015-11-20T12:00:00Z", "2\n4\n"),
+    "toy-beta-20151120T123000": ("beta", "2015-11-20T12:30:00Z", "3\n"),
+}
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="n/a: reads /proc")
+def test_a_killed_server_costs_the_jobs_its_scorers_held(tmp_path: Path) -> None:
+    """The fork server killed (by hand, or for memory) while its two scorers hold a job each:
+    those two rows say so, and the executions after them are scored by a new server."""
+    comp = make_competition(tmp_path / "comp", extra={**HOLD, **AFTER})
+    pid_files = [comp.log(ident).with_name(comp.log(ident).name + ".pid") for ident in HOLD]
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [*TOY_RESCORE, str(comp.manifest), "--out", str(out), "--jobs", "2"],
+        env={
+            **os.environ,
+            "PYTHONPATH": os.pathsep.join([str(HERE), os.environ.get("PYTHONPATH", "")]),
+        },
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        wait_for(
+            lambda: all(p.is_file() and p.read_text().endswith("\n") for p in pid_files),
+            "both held executions being scored",
+        )
+        scorers = {int(p.read_text()) for p in pid_files}
+        (server,) = {ppid(pid) for pid in scorers}
+        os.kill(server, signal.SIGKILL)
+        _, err = proc.communicate(timeout=DEADLINE_S)
+    finally:
+        proc.kill()
+        proc.wait()
+    assert proc.returncode == 1, err
+    rows = {r["id"]: r for r in json.loads((out / "results.json").read_text())["executions"]}
+    for ident in HOLD:
+        assert rows[ident]["status"] == "failed"
+        assert "the worker scoring it died (its fork server ended)" in rows[ident]["reason"]
+    for ident in LOGS:
+        assert rows[ident]["rank_value"] == expected_value(ident)
+    # the numbers' mean x the scale (2) + the team's offset (alpha 0.25, beta 10)
+    assert rows["toy-alpha-20151120T120000"]["rank_value"] == pytest.approx(3 * 2 + 0.25)
+    assert rows["toy-beta-20151120T123000"]["rank_value"] == pytest.approx(3 * 2 + 10.0)
+    assert "Traceback" not in err
+
+
+@pytest.mark.skipif(not hasattr(os, "fork"), reason="n/a: no fork on this platform")
+def test_a_server_that_cannot_fork_costs_each_job_its_row(tmp_path: Path) -> None:
+    """The server runs but the system refuses it a process (EAGAIN: out of processes): each
+    execution's row says so, in one line; the command ends with the others' outcome (1), not
+    a traceback, and not the silent 0 a broken pipe would give."""
+    comp = make_competition(tmp_path / "comp")
+    caller = tmp_path / "caller.py"
+    caller.write_text(
+        textwrap.dedent(
+            """
+            import errno, os, sys
+            sys.path.insert(0, sys.argv.pop(1))
+            from ertools.benchmarks import registry
+            from ertools.cli.main import main
+
+            registry.REGISTRY = {"toy": "rescore_toy:TOY"}
+            command, fork = os.getpid(), os.fork
+
+            def refused():  # in the server only: the command forks the server itself
+                if os.getpid() != command:
+                    raise OSError(errno.EAGAIN, os.strerror(errno.EAGAIN))
+                return fork()
+
+            os.fork = refused
+            raise SystemExit(main(sys.argv[1:]))
+            """
+        )
+    )
+    out = tmp_path / "out"
+    done = subprocess.run(
+        [
+            sys.executable,
+            str(caller),
+            str(HERE),
+            "rescore",
+            "-q",
+            "--no-reports",
+            "--config",
+            str(comp.manifest),
+            "--out",
+            str(out),
+            "--jobs",
+            "2",
+        ],
+        env={k: v for k, v in os.environ.items() if k != "PYTHONPATH"},
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=HANG_S,
+    )
+    assert done.returncode == 1, done.stderr
+    rows = json.loads((out / "results.json").read_text())["executions"]
+    assert {r["id"] for r in rows} == set(LOGS)
+    for row in rows:
+        assert row["status"] == "failed"
+        assert row["reason"] == (
+            "no process could score it: the fork server could not start a scoring process: "
+            "Resource temporarily unavailable"
+        )
+    assert "Traceback" not in done.stderr
