@@ -316,6 +316,10 @@ def _connect(distributed: Any, address: str, workers: int) -> tuple[Any, Any]:
                     threads_per_worker=1,
                     processes=False,
                     dashboard_address=None,
+                    # its scheduler's HTTP routes (health, metrics) on a free port of this
+                    # machine only: at the default 8787 a second run, or anything else there,
+                    # drew "Port 8787 is already in use" on the referee's terminal
+                    scheduler_kwargs={"dashboard": False, "dashboard_address": "127.0.0.1:0"},
                 )
             return distributed.Client(cluster), cluster
         return distributed.Client(address, timeout="10s"), None

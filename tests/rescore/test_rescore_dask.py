@@ -3,6 +3,7 @@ processes on 127.0.0.1, started here and torn down; the results equal `--jobs 1`
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shutil
@@ -140,8 +141,18 @@ def test_dask_cluster_gives_the_results_of_one_process(
     )
 
 
-def test_local_cluster(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """--scheduler local starts a LocalCluster of --jobs workers."""
+def test_local_cluster(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    recwarn: pytest.WarningsRecorder,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """--scheduler local starts a LocalCluster of --jobs workers; with Dask's default port
+    (8787) taken, nothing is said of it (its HTTP routes take a free port)."""
+    taken = socket.socket()
+    with contextlib.suppress(OSError):  # already taken by something else: as good
+        taken.bind(("", 8787))
+        taken.listen()
     use_toy_registry(monkeypatch)
     monkeypatch.syspath_prepend(str(HERE))
     monkeypatch.setenv("PYTHONPATH", str(HERE))
@@ -167,3 +178,6 @@ def test_local_cluster(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     assert {r["id"]: r["rank_value"] for r in doc["executions"]} == {
         i: expected_value(i) for i in LOGS
     }
+    taken.close()
+    assert not [w for w in recwarn if "already in use" in str(w.message)]
+    assert "already in use" not in capsys.readouterr().err
