@@ -80,7 +80,21 @@ def _watch_parent(parent: int) -> None:
     os._exit(1)
 
 
+# What scoring imports only where it is used (each a `# lazy:` import, so that the command line
+# starts fast): imported by the server as it starts, or each scorer imports them on its first
+# job (~600 modules, 1.3 s of CPU per scorer, measured on a day of the season: --jobs 2 paid
+# them twice where --jobs 1 paid them once). tests/rescore/test_rescore_children.py checks
+# that every lazy scipy import of ertools is here.
+SCORING_IMPORTS = ("scipy.spatial.transform", "scipy.interpolate", "scipy.stats")
+
 _warmed: set[str] = set()
+
+
+def preload_scoring() -> None:
+    """Import :data:`SCORING_IMPORTS` (in the server: while its owner scans the logs)."""
+    with contextlib.suppress(Exception):  # only a head start: a scorer imports what failed
+        for name in SCORING_IMPORTS:
+            import_module(name)
 
 
 def warm(job: Job) -> None:
@@ -91,6 +105,8 @@ def warm(job: Job) -> None:
     if job.target in _warmed:
         return
     _warmed.add(job.target)
+    if job.target.startswith("ertools."):  # one of ertools' own benchmarks
+        preload_scoring()
     with contextlib.suppress(Exception):  # only a head start: the child imports what failed
         load_benchmark(job.target)
         if job.report_dir is not None:
@@ -162,7 +178,7 @@ class ForkServer:
     """The fork server of this process (see the module's text); :meth:`child` is safe from
     any thread."""
 
-    def __init__(self) -> None:
+    def __init__(self, *, preload: bool = False) -> None:
         self.owner = os.getpid()
         self._lock = threading.Lock()
         ours, theirs = socket.socketpair()
@@ -174,7 +190,7 @@ class ForkServer:
                 code = 0
                 try:
                     end_with_parent(self.owner)
-                    _serve(theirs)
+                    _serve(theirs, preload=preload)
                 except BaseException:
                     code = 1
                 os._exit(code)  # none of the parent's cleanup
@@ -183,7 +199,8 @@ class ForkServer:
             # with this process's import path: a notebook's sys.path.insert included
             path = os.pathsep.join(p for p in sys.path if p)
             self._popen = subprocess.Popen(
-                [sys.executable, "-m", __name__, str(theirs.fileno()), str(self.owner)],
+                [sys.executable, "-m", __name__, str(theirs.fileno()), str(self.owner)]
+                + (["preload"] if preload else []),
                 pass_fds=[theirs.fileno()],
                 stdin=subprocess.DEVNULL,
                 env={**os.environ, "PYTHONPATH": path},
@@ -230,9 +247,12 @@ class ForkServer:
             return False
 
     def close(self) -> None:
-        """End the server (its children end with it) and reap it."""
+        """End the server (its children end with it) and reap it: killed, not waited for
+        through what it may still be importing (a rerun that scored nothing)."""
         with contextlib.suppress(OSError):
             self._control.close()
+        with contextlib.suppress(ProcessLookupError):
+            os.kill(self._pid, signal.SIGKILL)
         if self._popen is not None:
             self._popen.wait()
             return
@@ -266,10 +286,13 @@ def _read(stream: BinaryIO, size: int) -> bytes | None:
     return data if data is not None and len(data) == size else None
 
 
-def _serve(control: socket.socket) -> None:
+def _serve(control: socket.socket, *, preload: bool) -> None:
     """The server's loop: a child per ``child`` request, an exit code per ``wait``; ends when
-    its owner closes the control socket (or dies)."""
+    its owner closes the control socket (or dies). ``preload``: :func:`preload_scoring` first
+    (while the owner scans the logs)."""
     me = os.getpid()
+    if preload:
+        preload_scoring()
     requests = control.makefile("rb")
     while (head := _read(requests, _LENGTH.size)) is not None:
         body = _read(requests, _LENGTH.unpack(head)[0])
@@ -325,14 +348,15 @@ _local = threading.local()  # a thread's child, kept for its next job (a Dask wo
 _children: list[Child] = []  # every child of this process: closed with the server
 
 
-def server() -> ForkServer:
-    """This process's fork server, started now if it has none."""
+def server(*, preload: bool = False) -> ForkServer:
+    """This process's fork server, started now if it has none (``preload``: see
+    :func:`forks_ready`)."""
     with _server_lock:
         current = _servers.get(os.getpid())
         if current is None or not current.alive():  # none yet, or it was killed: a new one
             if current is not None:
                 current.close()
-            _servers[os.getpid()] = ForkServer()
+            _servers[os.getpid()] = ForkServer(preload=preload)
         return _servers[os.getpid()]
 
 
@@ -351,11 +375,12 @@ atexit.register(close_server)  # no orphan; the children's CPU time counts as th
 
 
 @contextlib.contextmanager
-def forks_ready() -> Iterator[None]:
+def forks_ready(*, preload: bool = False) -> Iterator[None]:
     """This process's fork server, started now if it has none (in a command: before any
-    thread), and then closed with its children at the end."""
+    thread), and then closed with its children at the end. ``preload``: the server imports
+    what ertools' benchmarks import lazily as it starts (:data:`SCORING_IMPORTS`)."""
     started = os.getpid() not in _servers
-    server()
+    server(preload=preload)
     try:
         yield
     finally:
@@ -415,7 +440,8 @@ def ended(child: Child) -> str:
 
 if __name__ == "__main__":  # a fork server as a fresh interpreter: ForkServer, with threads
     _fd, _owner = (int(arg) for arg in sys.argv[1:3])
+    _preload = sys.argv[3:] == ["preload"]
     # Also ends when the owner's thread that started it ends (PR_SET_PDEATHSIG): a Dask
     # worker's task threads live as long as the worker
     end_with_parent(_owner)
-    _serve(socket.socket(fileno=_fd))
+    _serve(socket.socket(fileno=_fd), preload=_preload)

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ertools.atomic import folder_lock
+from ertools.benchmarks import registry
 from ertools.errors import ConfigError
 from ertools.rescore.children import forks_ready
 from ertools.rescore.found import find, merge, write_timeline
@@ -88,7 +89,10 @@ def _scoring_processes(scheduler: str | None, workers: int) -> AbstractContextMa
     """The scoring processes' fork server (:mod:`ertools.rescore.children`), forked now, while
     this process has one thread: a LocalCluster's workers are threads of this process."""
     if scheduler == "local" or (scheduler is None and workers > 1):
-        return forks_ready()
+        # what ertools' benchmarks import lazily, imported by the server while the logs are
+        # scanned (not for a registry of other benchmarks only: a test's)
+        ours = any(target.startswith("ertools.") for target in registry.REGISTRY.values())
+        return forks_ready(preload=ours)
     return nullcontext()
 
 

@@ -5,6 +5,7 @@ scorer that dies costs its job only: test_rescore_cli.py, test_rescore_dask.py.)
 
 from __future__ import annotations
 
+import ast
 import json
 import os
 import signal
@@ -17,7 +18,10 @@ import pytest
 from rescore_competition import LOGS, expected_value, make_competition
 from test_rescore_faults import DEADLINE_S, HOLD, TOY_RESCORE, ppid, wait_for
 
+from ertools.rescore.children import SCORING_IMPORTS
+
 HERE = Path(__file__).parent
+ROOT = HERE.parents[1]
 LOCKED = {"toy-alpha-20151120T114000": ("alpha", "2015-11-20T11:40:00Z", "1\nlocked\n5\n")}
 # scored by a scorer that waited on an inherited lock, the run would never end: far longer
 # than the run takes on a loaded 2-core machine (a few seconds)
@@ -197,3 +201,29 @@ def test_a_server_that_cannot_fork_costs_each_job_its_row(tmp_path: Path) -> Non
             "Resource temporarily unavailable"
         )
     assert "Traceback" not in done.stderr
+
+
+def test_the_server_preloads_every_lazy_scipy_import_of_ertools() -> None:
+    """Each function-level ``scipy`` import of ertools (lazy, to keep the command line's start
+    fast) is among what the fork server imports as it starts: one missing is imported again by
+    every scorer on its first job (scipy.stats alone: ~1 s of CPU each)."""
+    lazy: dict[str, str] = {}
+    for path in sorted((ROOT / "ertools").rglob("*.py")):
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for func in ast.walk(tree):
+            if not isinstance(func, ast.FunctionDef | ast.AsyncFunctionDef):
+                continue
+            for node in ast.walk(func):
+                names = (
+                    [node.module or ""]
+                    if isinstance(node, ast.ImportFrom)
+                    else [a.name for a in node.names]
+                    if isinstance(node, ast.Import)
+                    else []
+                )
+                for name in names:
+                    if name.split(".")[0] == "scipy":
+                        lazy[name] = f"{path.relative_to(ROOT)}:{node.lineno}"
+    assert lazy, "no lazy scipy import found: the scan is broken"
+    missing = {name: where for name, where in lazy.items() if name not in SCORING_IMPORTS}
+    assert not missing, f"add to children.SCORING_IMPORTS: {missing}"
