@@ -9,6 +9,7 @@ page written.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
@@ -61,10 +62,12 @@ def rescore_competition(
             the timeline).
     """
     # two runs into one folder would mix their reports and caches: one at a time
-    with folder_lock(out, on_wait=on_wait), _scoring_processes(scheduler, workers):
+    with contextlib.ExitStack() as stack:
+        stack.enter_context(folder_lock(out, on_wait=on_wait))
         # A first run into this folder scores everything: a Dask cluster is started now, while
         # the logs are scanned, not after (a rerun starts one only if the cache lacks a score)
         cold = not use_cache or not any((out / "cache" / "outcomes").glob("*.json"))
+        stack.enter_context(_scoring_processes(scheduler, workers, cold=cold))
         dask = early_dask(scheduler, workers, cold)
         try:
             return _rescore(
@@ -85,14 +88,16 @@ def rescore_competition(
                 dask.close()  # closing since the last job ended, while the results were written
 
 
-def _scoring_processes(scheduler: str | None, workers: int) -> AbstractContextManager[None]:
+def _scoring_processes(
+    scheduler: str | None, workers: int, *, cold: bool
+) -> AbstractContextManager[None]:
     """The scoring processes' fork server (:mod:`ertools.rescore.children`), forked now, while
     this process has one thread: a LocalCluster's workers are threads of this process."""
     if scheduler == "local" or (scheduler is None and workers > 1):
-        # what ertools' benchmarks import lazily, imported by the server while the logs are
-        # scanned (not for a registry of other benchmarks only: a test's)
+        # On a first run, what ertools' benchmarks import lazily, imported by the server while
+        # the logs are scanned (a rerun may score nothing; a test's registry holds none)
         ours = any(target.startswith("ertools.") for target in registry.REGISTRY.values())
-        return forks_ready(preload=ours)
+        return forks_ready(preload=cold and ours)
     return nullcontext()
 
 
