@@ -183,6 +183,7 @@ class ForkServer:
         self._lock = threading.Lock()
         ours, theirs = socket.socketpair()
         self._popen: subprocess.Popen[bytes] | None = None
+        self._reaped = False  # its pid may belong to another process since
         if threading.active_count() == 1:  # no other thread: nothing locked to inherit
             pid = os.fork()
             if pid == 0:
@@ -241,23 +242,27 @@ class ForkServer:
         """Whether the server still runs (killed by hand, or for memory, it is not)."""
         if self._popen is not None:
             return self._popen.poll() is None
-        try:
-            return os.waitpid(self._pid, os.WNOHANG) == (0, 0)
-        except ChildProcessError:
-            return False
+        if not self._reaped:
+            try:
+                self._reaped = os.waitpid(self._pid, os.WNOHANG) != (0, 0)
+            except ChildProcessError:
+                self._reaped = True
+        return not self._reaped
 
     def close(self) -> None:
         """End the server (its children end with it) and reap it: killed, not waited for
         through what it may still be importing (a rerun that scored nothing)."""
         with contextlib.suppress(OSError):
             self._control.close()
-        with contextlib.suppress(ProcessLookupError):
-            os.kill(self._pid, signal.SIGKILL)
         if self._popen is not None:
+            self._popen.kill()  # nothing once reaped
             self._popen.wait()
-            return
-        with contextlib.suppress(ChildProcessError):
-            os.waitpid(self._pid, 0)
+        elif not self._reaped:
+            self._reaped = True
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(self._pid, signal.SIGKILL)
+            with contextlib.suppress(ChildProcessError):
+                os.waitpid(self._pid, 0)
 
 
 def _send(control: socket.socket, request: tuple[str, object]) -> None:

@@ -28,6 +28,36 @@ LOCKED = {"toy-alpha-20151120T114000": ("alpha", "2015-11-20T11:40:00Z", "1\nloc
 HANG_S = 120
 
 
+def rescore_from(
+    caller: str, tmp_path: Path, manifest: Path, out: Path, *options: str
+) -> subprocess.CompletedProcess[str]:
+    """``rescore`` run by the script ``caller`` (its text; it adds its first argument, the toy's
+    folder, to its sys.path and calls the command line with the rest), as a library caller's
+    process would: its environment holds no PYTHONPATH."""
+    script = tmp_path / "caller.py"
+    script.write_text(textwrap.dedent(caller))
+    return subprocess.run(
+        [
+            sys.executable,
+            str(script),
+            str(HERE),
+            "rescore",
+            "-q",
+            "--no-reports",
+            "--config",
+            str(manifest),
+            "--out",
+            str(out),
+            *options,
+        ],
+        env={k: v for k, v in os.environ.items() if k != "PYTHONPATH"},
+        check=False,
+        capture_output=True,
+        text=True,
+        timeout=HANG_S,
+    )
+
+
 @pytest.mark.skipif(not hasattr(os, "fork"), reason="n/a: no fork on this platform")
 @pytest.mark.parametrize("parallel", [["--jobs", "2"], ["--jobs", "2", "--scheduler", "local"]])
 def test_a_lock_held_by_another_thread_is_not_inherited(
@@ -40,10 +70,8 @@ def test_a_lock_held_by_another_thread_is_not_inherited(
     if "--scheduler" in parallel:
         pytest.importorskip("distributed", reason="needs the dask extra: pip install -e '.[dask]'")
     comp = make_competition(tmp_path / "comp", extra=LOCKED)
-    caller = tmp_path / "caller.py"
-    caller.write_text(
-        textwrap.dedent(
-            """
+    out = tmp_path / "out"
+    caller = """
             import sys, threading
             sys.path.insert(0, sys.argv.pop(1))  # as a notebook adds a folder of its own
             import rescore_toy
@@ -62,29 +90,7 @@ def test_a_lock_held_by_another_thread_is_not_inherited(
             held.wait()
             raise SystemExit(main(sys.argv[1:]))
             """
-        )
-    )
-    out = tmp_path / "out"
-    done = subprocess.run(
-        [
-            sys.executable,
-            str(caller),
-            str(HERE),
-            "rescore",
-            "-q",
-            "--no-reports",
-            "--config",
-            str(comp.manifest),
-            "--out",
-            str(out),
-            *parallel,
-        ],
-        env={k: v for k, v in os.environ.items() if k != "PYTHONPATH"},
-        check=False,
-        capture_output=True,
-        text=True,
-        timeout=HANG_S,
-    )
+    done = rescore_from(caller, tmp_path, comp.manifest, out, *parallel)
     assert done.returncode == 0, done.stderr
     rows = {r["id"]: r for r in json.loads((out / "results.json").read_text())["executions"]}
     for ident in LOGS:
@@ -147,10 +153,8 @@ def test_a_server_that_cannot_fork_costs_each_job_its_row(tmp_path: Path) -> Non
     execution's row says so, in one line; the command ends with the others' outcome (1), not
     a traceback, and not the silent 0 a broken pipe would give."""
     comp = make_competition(tmp_path / "comp")
-    caller = tmp_path / "caller.py"
-    caller.write_text(
-        textwrap.dedent(
-            """
+    out = tmp_path / "out"
+    caller = """
             import errno, os, sys
             sys.path.insert(0, sys.argv.pop(1))
             from ertools.benchmarks import registry
@@ -167,30 +171,7 @@ def test_a_server_that_cannot_fork_costs_each_job_its_row(tmp_path: Path) -> Non
             os.fork = refused
             raise SystemExit(main(sys.argv[1:]))
             """
-        )
-    )
-    out = tmp_path / "out"
-    done = subprocess.run(
-        [
-            sys.executable,
-            str(caller),
-            str(HERE),
-            "rescore",
-            "-q",
-            "--no-reports",
-            "--config",
-            str(comp.manifest),
-            "--out",
-            str(out),
-            "--jobs",
-            "2",
-        ],
-        env={k: v for k, v in os.environ.items() if k != "PYTHONPATH"},
-        check=False,
-        capture_output=True,
-        text=True,
-        timeout=HANG_S,
-    )
+    done = rescore_from(caller, tmp_path, comp.manifest, out, "--jobs", "2")
     assert done.returncode == 1, done.stderr
     rows = json.loads((out / "results.json").read_text())["executions"]
     assert {r["id"] for r in rows} == set(LOGS)
