@@ -308,14 +308,7 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
         return 130
     except BrokenPipeError as err:
         if not _stdout_closed():  # a pipe of ertools' own, not the reader of stdout: a bug
-            if args.debug:
-                raise
-            print(
-                f"ertools: error: unexpected BrokenPipeError: {_one_line(str(err))} "
-                "(this is a bug in ertools; re-run with --debug for the traceback)",
-                file=sys.stderr,
-            )
-            return 1
+            return _unexpected(err, args)
         _silence_stdout()
         return 0
     except OSError as err:  # mostly an output path that cannot be written (-o, --plot...)
@@ -328,18 +321,24 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
         )
         return 1
     except Exception as err:  # a bug: still one line unless --debug
-        # A group member's own --debug re-raises through the group's run_command, whose
-        # parser left --debug in the member's arguments: the mark keeps the traceback.
-        if args.debug or getattr(err, "ertools_debug", False):
-            err.ertools_debug = True  # type: ignore[attr-defined]
-            raise
-        print(
-            f"ertools: error: unexpected {type(err).__name__}: {_one_line(str(err))} "
-            "(this is a bug in ertools; re-run with --debug for the traceback)",
-            file=sys.stderr,
-        )
-        return 1
+        return _unexpected(err, args)
     return code
+
+
+def _unexpected(err: Exception, args: argparse.Namespace) -> int:
+    """A bug: one line and exit 1; with --debug, ``err`` raised again (its traceback).
+
+    A group member's own --debug re-raises through the group's run_command, whose parser left
+    --debug in the member's arguments: the mark keeps the traceback."""
+    if args.debug or getattr(err, "ertools_debug", False):
+        err.ertools_debug = True  # type: ignore[attr-defined]
+        raise err
+    print(
+        f"ertools: error: unexpected {type(err).__name__}: {_one_line(str(err))} "
+        "(this is a bug in ertools; re-run with --debug for the traceback)",
+        file=sys.stderr,
+    )
+    return 1
 
 
 def _progress_bar(args: argparse.Namespace) -> Bar | None:

@@ -132,8 +132,8 @@ def _canvas_figure(size: tuple[float, float]) -> Any:
 
 def preload() -> None:
     """Import what writing a report's figures needs, without writing anything: for a process
-    that forks one child per job (the Dask workers' :func:`ertools.rescore.parallel.
-    run_job_forked`), so that each child inherits it. The reports' figures are SVG charts
+    that forks the scoring processes (the fork server, :mod:`ertools.rescore.children`), so
+    that each of them inherits it. The reports' figures are SVG charts
     (no matplotlib since issue 29); one tiny chart is rendered so that the writer's code
     paths ran once before the fork."""
     svg.render(Chart((), note="0"), (1.0, 1.0), "0")

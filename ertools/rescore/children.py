@@ -7,8 +7,8 @@ minutes (issue 29). The fork server has one thread when it forks. It is forked f
 ``rescore`` before any thread starts (:func:`forks_ready`); in a process that already has
 threads (a Dask worker, a notebook) it is a fresh interpreter instead
 (``python -m ertools.rescore.children``). It keeps what a job loads on first use imported
-(the benchmark's modules, matplotlib and its font, the report template), so each child
-starts warm in milliseconds.
+(the benchmark's modules, what they import lazily, the SVG figure writer, the report
+template), so each child starts warm in milliseconds.
 
 A child scores the jobs it is sent, one at a time, over a socket of its own, until that
 socket closes; one that dies costs its job only. Every process here ends with its parent,
@@ -45,8 +45,8 @@ _NUMBER = struct.Struct("!q")  # a reply: a child's pid, or its exit code
 
 
 class ForkServerError(RuntimeError):
-    """The fork server ended (killed by hand or for memory): not a ``BrokenPipeError``, which
-    the command line reads as its own output closed."""
+    """The fork server ended (killed by hand or for memory), or could not fork: not a
+    ``BrokenPipeError``, which the command line reads as its own output closed."""
 
 
 class ForkFailedError(ForkServerError):
@@ -97,15 +97,21 @@ def preload_scoring() -> None:
             import_module(name)
 
 
+def ertools_own(target: str) -> bool:
+    """Whether the registry entry ``target`` is one of ertools' benchmarks (whose lazy imports
+    :data:`SCORING_IMPORTS` lists), not another's (a test's toy)."""
+    return target.startswith("ertools.")
+
+
 def warm(job: Job) -> None:
     """Import what scoring ``job`` and drawing its report load on first use (its benchmark's
-    modules, matplotlib and its font, the compiled template), once per process: the children
+    modules, the SVG figure writer, the compiled template), once per process: the children
     forked after it inherit them (issue 29: re-importing them per task cost the Dask path
     +72 % over local workers)."""
     if job.target in _warmed:
         return
     _warmed.add(job.target)
-    if job.target.startswith("ertools."):  # one of ertools' own benchmarks
+    if ertools_own(job.target):
         preload_scoring()
     with contextlib.suppress(Exception):  # only a head start: the child imports what failed
         load_benchmark(job.target)
@@ -430,17 +436,19 @@ def run_job_forked(job: Job) -> Outcome:
     if outcome is not None:
         return outcome
     _local.child = None
+    return died(child, job, "process")
+
+
+def died(child: Child, job: Job, scorer: str) -> Outcome:
+    """The row of ``job``, whose ``child`` died scoring it: how it ended (``exit code -9``, or
+    its server ended), ``scorer`` naming the child as the user knows it (a worker, a process)."""
+    code = child.close()
+    how = "its fork server ended" if code is None else f"exit code {code}"
     return Outcome(
         job.id,
         "failed",
-        reason=f"the process scoring it died ({ended(child)}); the other executions were scored",
+        reason=f"the {scorer} scoring it died ({how}); the other executions were scored",
     )
-
-
-def ended(child: Child) -> str:
-    """How a dead ``child`` ended, for its job's row: ``exit code -9``, or its server ended."""
-    code = child.close()
-    return "its fork server ended" if code is None else f"exit code {code}"
 
 
 if __name__ == "__main__":  # a fork server as a fresh interpreter: ForkServer, with threads

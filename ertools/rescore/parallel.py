@@ -25,7 +25,7 @@ from ertools.rescore.children import (
     Child,
     ForkServerError,
     close_server,
-    ended,
+    died,
     forks_ready,
     new_child,
     run_job_forked,
@@ -92,7 +92,7 @@ def run_local(
                 outcome = child.receive()
                 alive = outcome is not None
                 if outcome is None:
-                    outcome = _died(child, job)
+                    outcome = died(child, job, "worker")
                 pending.done(outcome)
                 # the next job first: the worker waits for none
                 _hand(busy, child if alive else None, pending, on_done)
@@ -124,14 +124,6 @@ def _hand(
         return
     if child is not None:
         child.close()
-
-
-def _died(child: Child, job: Job) -> Outcome:
-    return Outcome(
-        job.id,
-        "failed",
-        reason=f"the worker scoring it died ({ended(child)}); the other executions were scored",
-    )
 
 
 def run_dask(

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any
 from ertools.atomic import folder_lock
 from ertools.benchmarks import registry
 from ertools.errors import ConfigError
-from ertools.rescore.children import forks_ready
+from ertools.rescore.children import ertools_own, forks_ready
 from ertools.rescore.found import find, merge, write_timeline
 from ertools.rescore.ledger import account
 from ertools.rescore.manifest import Manifest
@@ -96,7 +96,7 @@ def _scoring_processes(
     if scheduler == "local" or (scheduler is None and workers > 1):
         # On a first run, what ertools' benchmarks import lazily, imported by the server while
         # the logs are scanned (a rerun may score nothing; a test's registry holds none)
-        ours = any(target.startswith("ertools.") for target in registry.REGISTRY.values())
+        ours = any(ertools_own(target) for target in registry.REGISTRY.values())
         return forks_ready(preload=cold and ours)
     return nullcontext()
 
