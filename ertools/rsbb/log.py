@@ -186,7 +186,15 @@ def read_referee_items(
     if not lasts:
         return None
     last_ns = max(lasts)
-    msgs = read_messages(plist, CORE_TO_GUI_TOPIC, start_ns=last_ns - GUI_WINDOW_NS)
+    # A file's index may give a topic's end as its chunk's: widen the window until it holds
+    # the topic's last messages (each window is read only once the narrower one came back empty).
+    window = GUI_WINDOW_NS
+    while True:
+        start = last_ns - window
+        msgs = read_messages(plist, CORE_TO_GUI_TOPIC, start_ns=start)
+        if msgs or window > last_ns:
+            break
+        window *= 10
     for m in reversed(msgs):
         for zone in m.msg.zones:
             if zone.code != code or zone.team != team or (run is not None and zone.run != run):
