@@ -28,11 +28,12 @@ def body(
     name: str,
     pose: Callable[[int], tuple[Vec, Quat]],
     start: int = T0,
-    end: int = T0 + 1000 * S,
+    end: int = T0 + 100 * S,
     gaps: tuple[tuple[int, int], ...] = (),
     parent: str = "testbed_origin",
 ) -> None:
-    """Samples of ``name`` every 10 ms from ``start`` to ``end`` (none inside the ``gaps``)."""
+    """Samples of ``name`` every 10 ms from ``start`` to ``end`` (none inside the ``gaps``);
+    the default span, 100 s, holds the hand-built runs."""
     t = start
     while t <= end:
         if not any(a <= t < b for a, b in gaps):

@@ -75,12 +75,14 @@ def execute(w: World, version: str = "2bb8a41") -> None:
     while w.is_benchmark_running() and (i < N):
         if not objects:
             raise IndexError("Cannot choose from an empty sequence")
-        wanted = w.tl.files["objects_order"].pop(0)
+        order: list[int] = w.tl.files["objects_order"]
+        wanted = order.pop(0) if order else objects[0]["id"]  # unlogged: ends before the goal
         obj = next(o for o in objects if o["id"] == wanted)
         objects.remove(obj)
         w.score["goal_%i" % i] = {}
         g.object_grasped = False
-        target_x, target_y = w.tl.files["targets"].pop(0)
+        targets: list[tuple[float, float]] = w.tl.files["targets"]
+        target_x, target_y = targets.pop(0) if targets else (min_x, min_y)
         assert min_x <= target_x <= max_x and min_y <= target_y <= max_y
         mo1 = ManualOperationObject(
             "Place the %s on the table, with MoCap markers attached." % obj["description"]

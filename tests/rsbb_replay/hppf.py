@@ -19,7 +19,10 @@ VERSIONS = ("2bb8a41",)
 def _draw(w: World, people: list[str]) -> str:
     if not people:
         raise IndexError("Cannot choose from an empty sequence")
-    wanted = w.tl.files["people_order"].pop(0)
+    order: list[str] = w.tl.files["people_order"]
+    if not order:
+        return people[0]  # a draw the log does not show: the iteration ends before its request
+    wanted = order.pop(0)
     assert wanted in people, f"{wanted} is not among the people left ({people})"
     return wanted
 

@@ -28,7 +28,9 @@ def test_python2_str_of_floats() -> None:
     assert py2_str(60.0) == "60.0"
     assert py2_str(66.67) == "66.67"
     assert py2_str(100.0) == "100.0"
-    assert py2_str(0.1 + 0.2) == "0.3"  # 12 significant digits, where repr gives 0.30000000000000004
+    assert (
+        py2_str(0.1 + 0.2) == "0.3"
+    )  # 12 significant digits, where repr gives 0.30000000000000004
     assert py2_str(1e16) == "1e+16"
     assert py2_str(1.0 / 3) == "0.333333333333"
 

@@ -165,7 +165,10 @@ class Buffer:
     def add(
         self, parent: str, child: str, stamp: int, arrival: int, value: tuple[Vec, Quat]
     ) -> None:
-        link = self.links.setdefault(frame(child), Link(frame(parent)))
+        name = frame(child)
+        link = self.links.get(name)
+        if link is None:
+            link = self.links[name] = Link(frame(parent))
         if link.parent != frame(parent):
             # tf2 re-parents a frame to its latest parent; the scripts never do this.
             raise ValueError(f"frame {child} under two parents")
