@@ -7,7 +7,7 @@ from math import atan2, cos, pi, sin
 import pytest
 
 from rsbb_replay import hnf
-from rsbb_replay.hand import MS, S, T0, body, steps, still
+from rsbb_replay.hand import MS, T0, S, body, steps, still
 from rsbb_replay.py2 import dump_none, dump_pose2d
 from rsbb_replay.world import TGoal, Timeline, TManual, World, run_script
 

@@ -11,7 +11,7 @@ from math import pi
 import pytest
 
 from rsbb_replay import hopf
-from rsbb_replay.hand import MS, S, T0, body, still
+from rsbb_replay.hand import MS, T0, S, body, still
 from rsbb_replay.world import TGoal, Timeline, TManual, World, run_script
 
 ITEMS = [
