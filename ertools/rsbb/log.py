@@ -87,7 +87,8 @@ class RefBoxStream:
         """The first message and every message where a state or a payload changed (the 10 Hz
         re-publications of an unchanged state dropped)."""
         n = len(self)
-        keep = np.ones(n, dtype=bool)
+        keep = np.zeros(n, dtype=bool)
+        keep[:1] = True
         if n > 1:
             for codes in (self.benchmark, self.goal, self.manual):
                 keep[1:] |= codes[1:] != codes[:-1]
