@@ -7,7 +7,7 @@ from datetime import datetime
 from pathlib import Path
 
 import pytest
-from rsbb_scenarios import at, hnf_scenario
+from rsbb_replay.scenarios import at, hnf_scenario
 
 from ertools.errors import UsageError
 from ertools.rsbb.layout import FileKind, classify, pair_runs, scan

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from rsbb_scenarios import MS, at, hnf_scenario
+from rsbb_replay.scenarios import MS, at, hnf_scenario
 
 from ertools.errors import TopicError
 from ertools.io import read_messages, topics
