@@ -81,6 +81,7 @@ def test_pairing_by_code_team_run_and_time() -> None:
     )
 
 
+@pytest.mark.slow  # writes two run bags (~2 s)
 def test_scan_a_written_season(tmp_path: Path) -> None:
     write_rsbb_run(tmp_path, hnf_scenario())
     write_rsbb_run(tmp_path, replace(hnf_scenario(), team="teamB", t_connect_ns=at(0.7)))

@@ -23,6 +23,8 @@ from ertools.rsbb_states import BENCHMARKS, BMBOX_STATE_TOPIC, REFBOX_STATE_TOPI
 from ertools.samples.rsbb import live_score_text, result_object, write_rsbb_run
 from ertools.samples.writer import BagWriter
 
+pytestmark = pytest.mark.slow  # each writes and reads a run bag (~0.5-1 s)
+
 
 def test_goals_manual_operations_and_the_end(tmp_path: Path) -> None:
     paths = write_rsbb_run(tmp_path, hnf_scenario())

@@ -20,6 +20,8 @@ from rsbb_replay.py2 import dump_pose2d
 from rsbb_replay.scenarios import at, hnf_scenario, still_body
 from rsbb_replay.world import World, run_script
 
+pytestmark = pytest.mark.slow  # writes and reads a run bag (~0.6 s)
+
 WAYPOINTS = [[1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]
 PARAMS = {"starting_pose": [0.0, 0.0, 0.0], "waypoints": WAYPOINTS, "goal_timeout": 120.0}
 

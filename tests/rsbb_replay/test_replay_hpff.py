@@ -17,6 +17,8 @@ from rsbb_replay.hand import MS, T0, S, body, still
 from rsbb_replay.tf2 import Quat, Vec
 from rsbb_replay.world import TGoal, Timeline, World, run_script
 
+pytestmark = pytest.mark.slow  # runs of several hundred samples: seconds each
+
 REQUEST = T0 + 2 * S
 START = T0 + 3 * S
 FIRST_SAMPLE = START + 8 * S
@@ -38,7 +40,8 @@ def _timeline(
 ) -> Timeline:
     tl = Timeline(t_ready_ns=T0 + S, params={**PARAMS, "goal_timeout": goal_timeout})
     tl.files["transform"] = [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]]
-    span = T0 + round(goal_timeout) * S + 20 * S
+    t_end = end if end is not None else REQUEST + round(goal_timeout * S)
+    span = t_end + 20 * S
     body(tl.tf, "robot_markerset", robot, end=span)
     body(tl.tf, "actor_markerset", actor, end=span)
     stamps = [T0 + S + 10 * MS]  # the check before the goal
@@ -46,7 +49,6 @@ def _timeline(
         s = FIRST_SAMPLE + k * HALF
         stamps += [s + 200 * MS + 1000] if k in fails else [s, s + 30 * MS]
     tl.lookups = {"robot": stamps}
-    t_end = end if end is not None else REQUEST + round(goal_timeout * S)
     tl.goals = [TGoal(START, t_end, "timeout" if end is None else "result", "{}")]
     return tl
 
@@ -112,13 +114,26 @@ def test_a_result_long_before_the_timeout_fails_the_run() -> None:
 
 
 def test_the_duration_bounds_are_inclusive() -> None:
-    # a result 285.0 s after the start passes (not below 300 - 15); the loop notices it at the
-    # next sample: the last sample starts at 284.5 s after... choose the result at a sample end
-    t_end = START + 285 * S  # = FIRST_SAMPLE + 554 * 0.5 s: a sample boundary
-    tl = _timeline(300.0, 560, set(), still((0.0, 0.0, 0.0)), still((2.0, 0.0, 1.7)), end=t_end)
-    score = run_script(World(tl), hpff.execute).score
-    assert score["Benchmark reliability"] == "100.0%"
-    assert "Result" not in score
+    # goal_timeout 25 s: the run passes with 10 s <= duration <= 40 s. A result 10.0 s after
+    # the start (at a sample's end: 8 s of sleep + 4 samples) passes, 9.5 s fails.
+    for seconds, passes in ((10.0, True), (9.5, False)):
+        t_end = START + round(seconds * S)
+        tl = _timeline(25.0, 10, set(), still((0.0, 0.0, 0.0)), still((2.0, 0.0, 1.7)), end=t_end)
+        score = run_script(World(tl), hpff.execute).score
+        assert ("Result" not in score) is passes, seconds
+        if passes:
+            assert score["Benchmark reliability"] == "100.0%"
+
+
+def test_no_sample_and_a_passing_duration_divides_by_zero() -> None:
+    # goal_timeout 20 s (pass from 5 s): a result 5 s after the start, inside the 8 s sleep;
+    # the loop never samples, duration 8 s passes, 0 / 0.0 kills the script: nothing saved.
+    tl = _timeline(
+        20.0, 0, set(), still((0.0, 0.0, 0.0)), still((2.0, 0.0, 1.7)), end=START + 5 * S
+    )
+    result = run_script(World(tl), hpff.execute)
+    assert result.crashed is not None and result.crashed.startswith("ZeroDivisionError")
+    assert result.score == {}
 
 
 def test_a_stop_while_following_leaves_an_empty_score() -> None:
