@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 
 from ertools.samples.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
-from ertools.samples.rsbb import (
+from ertools.samples.rsbb_scenario import (
     Body,
     Broadcast,
     Goal,

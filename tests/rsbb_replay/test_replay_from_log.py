@@ -13,7 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from ertools.samples.rsbb import Broadcast, Goal, Save, write_rsbb_run
+from ertools.samples.rsbb import write_rsbb_run
+from ertools.samples.rsbb_scenario import Broadcast, Goal, Save
 from rsbb_replay import hnf
 from rsbb_replay.fromlog import timeline_from_bag
 from rsbb_replay.py2 import dump_pose2d
