@@ -14,8 +14,8 @@ from pathlib import Path
 import pytest
 
 from ertools.samples.rsbb import write_rsbb_run
-from ertools.samples.rsbb_scenario import Broadcast, Goal, Save
-from rsbb_replay import hnf
+from ertools.samples.rsbb_scenario import Broadcast, Goal, ManualOperation, Save
+from rsbb_replay import hgmf, hnf, hopf, hppf
 from rsbb_replay.fromlog import timeline_from_bag
 from rsbb_replay.py2 import dump_pose2d
 from rsbb_replay.scenarios import at, hnf_scenario, still_body
@@ -72,3 +72,143 @@ def test_hnf_replayed_from_its_bag(tmp_path: Path) -> None:
     assert score["execution_time[s]"] == 15.0
     assert score["position_accuracy[m]"] == pytest.approx(1.0, abs=1e-12)
     assert score["orientation_accuracy[rad]"] == pytest.approx(0.0, abs=1e-12)
+
+
+def _one_goal_run(code: str, bodies: tuple, manual: tuple, broadcasts: tuple, goal: Goal) -> object:  # type: ignore[type-arg]
+    """A run of ``code`` with one goal and its manual operations, stopped at 15 s while the
+    next goal's first manual operation waits."""
+    return replace(
+        hnf_scenario(),
+        code=code,
+        t_end_ns=at(15.0),
+        end="stop",
+        t_disconnect_ns=at(16.0),
+        manual_operations=manual,
+        goals=(goal,),
+        broadcasts=broadcasts,
+        saves=(Save(at(15.0), {}),),
+        params={},
+        bodies=bodies,
+    )
+
+
+IDENTITY = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
+
+
+def test_hopf_replayed_from_its_bag(tmp_path: Path) -> None:
+    # the item 0.1 m ahead of the positioner at (0.5, 0.6): (0.6, 0.6); answered (0.6, 0.7)
+    item = {
+        "id": 1,
+        "class": "a",
+        "instance": "i1",
+        "description": "thing 1",
+        "trans": [0.1, 0.0, 0.0],
+        "rot": [0.0, 0.0, 0.0, 1.0],
+    }
+    place = "Place the positioner and the thing 1 (id: 1, instance: i1) on the table"
+    sc = _one_goal_run(
+        "HOPF",
+        (
+            still_body("table_origin", (0.0, 0.0, 0.0), 20.0),
+            still_body("positioner_origin", (0.5, 0.6, 0.0), 20.0),
+        ),
+        (
+            ManualOperation(at(2.5), at(3.0), place),
+            ManualOperation(at(4.0), at(5.0), "Remove the positioner"),
+            ManualOperation(
+                at(11.0),
+                None,
+                place.replace("thing 1 (id: 1, instance: i1)", "thing 2 (id: 2, instance: i2)"),
+            ),
+        ),
+        (
+            Broadcast(
+                at(3.01), "/item", "/positioner_origin", (0.1, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0)
+            ),
+        ),
+        Goal(
+            at(5.5),
+            at(6.0),
+            at(10.0),
+            "{}\n",
+            "result",
+            "{x: 0.6, y: 0.7, theta: 0.0, class: a, instance: i1}",
+        ),
+    )
+    paths = write_rsbb_run(tmp_path, sc)  # type: ignore[arg-type]
+    params = {"table_size": {"x": 1.0, "y": 1.5}, "goal_timeout": 120}
+    item2 = {**item, "id": 2, "instance": "i2", "description": "thing 2"}
+    tl = timeline_from_bag(paths.bag, params, {"items": [item, item2]})
+    assert tl.files["items_order"] == [1, 2]
+    result = run_script(World(tl), hopf.execute)
+    assert result.crashed is None
+    g1 = result.score["goal_1"]
+    assert g1["item_acquired"]["pose"] == pytest.approx([0.6, 0.6, 0.0], abs=1e-12)
+    assert g1["partial_score"]["pose_score"] == pytest.approx(1 - 0.1 / 2, abs=1e-12)
+    assert result.score["class_accuracy"] == 1.0 and result.score["execution_time"] == 4.0
+    assert result.score["goal_2"] == {}
+
+
+def test_hppf_replayed_from_its_bag(tmp_path: Path) -> None:
+    enter = (
+        "Joe should enter the target area wearing a cap with MoCap markers, and place "
+        "him/herself in an arbitrary position."
+    )
+    sc = _one_goal_run(
+        "HPPF",
+        (still_body("actor_markerset", (1.0, 2.0, 1.7), 20.0),),
+        (
+            ManualOperation(at(2.5), at(3.0), enter),
+            ManualOperation(at(11.0), None, enter.replace("Joe", "Ann")),
+        ),
+        (
+            Broadcast(at(3.01), "/person", "/actor_markerset", *IDENTITY),
+            Broadcast(at(10.01), "/person", "/actor_markerset", *IDENTITY),
+        ),
+        Goal(
+            at(5.5),
+            at(6.0),
+            at(10.0),
+            "{}\n",
+            "result",
+            "{x: 1.3, y: 2.4, theta: 0, person_name: JOE}",
+        ),
+    )
+    paths = write_rsbb_run(tmp_path, sc)  # type: ignore[arg-type]
+    tl = timeline_from_bag(paths.bag, {"people": ["Joe", "Ann"], "goal_timeout": 120.0}, {})
+    assert tl.files["people_order"] == ["Joe", "Ann"]
+    result = run_script(World(tl), hppf.execute)
+    assert result.score["goal_0"]["position_error"] == pytest.approx(0.5, abs=1e-12)
+    assert result.score["% Recognized persons"] == "50.0%"
+    assert result.score["goal_1"] == {}
+
+
+def test_hgmf_replayed_from_its_bag(tmp_path: Path) -> None:
+    place = "Place the Brick on the table, with MoCap markers attached."
+    sc = _one_goal_run(
+        "HGMF",
+        (
+            still_body("table_origin", (0.0, 0.0, 0.0), 20.0),
+            still_body("actor_markerset", (0.7, 0.9, 0.0), 20.0),
+        ),
+        (
+            ManualOperation(at(2.5), at(3.0), place),
+            ManualOperation(at(11.0), None, place.replace("Brick", "Cube")),
+        ),
+        (
+            Broadcast(at(3.01), "/object", "/actor_markerset", *IDENTITY),
+            Broadcast(at(10.01), "/object", "/actor_markerset", *IDENTITY),
+        ),
+        Goal(at(5.5), at(6.0), at(10.0), "[0.8, 0.9, 1]\n", "result", "{}"),
+    )
+    paths = write_rsbb_run(tmp_path, sc)  # type: ignore[arg-type]
+    objects = [{"id": 1, "description": "Brick"}, {"id": 2, "description": "Cube"}]
+    params = {"objects": objects, "table_size": {"x": 1.0, "y": 1.5}, "goal_timeout": 120.0}
+    tl = timeline_from_bag(paths.bag, params, {})
+    assert tl.files["objects_order"] == [1] and tl.files["targets"] == [(0.8, 0.9)]
+    result = run_script(World(tl), hgmf.execute)
+    assert result.crashed is None
+    g0 = result.score["goal_0"]
+    assert g0["Object grasped"] is False
+    assert g0["Distance error"] == pytest.approx(0.1, abs=1e-12)
+    assert result.score["Objects grasped"] == "0 out of 2"
