@@ -1,9 +1,10 @@
-"""The replays driven by a run bag (``fromlog``): a simulated HNF run whose every moment is known.
+"""The replays driven by a run bag (``fromlog``): simulated runs whose every moment is known.
 
 The robot's marker set stands at (1.5, 0, 0.3) (noiseless mocap); the team transform is the
 identity; goal 1 (waypoint (1, 0, 0)) runs from 4 s to its result at 10 s, goal 2 ((2, 0, 0))
 from 12 s to its timeout at 21 s; the script looks the robot up 10 ms after each. By hand:
-both segments 0.5 m off, one waypoint reached: position_accuracy = (0.5 + 0.5) / 1.
+both segments 0.5 m off, one waypoint reached: position_accuracy = (0.5 + 0.5) / 1. The other
+benchmarks: one goal each, numbers in their tests.
 """
 
 from __future__ import annotations
@@ -15,10 +16,10 @@ import pytest
 
 from ertools.samples.rsbb import write_rsbb_run
 from ertools.samples.rsbb_scenario import Broadcast, Goal, ManualOperation, Save
-from rsbb_replay import hgmf, hnf, hopf, hppf
+from rsbb_replay import hgmf, hnf, hopf, hpff, hppf
 from rsbb_replay.fromlog import timeline_from_bag
 from rsbb_replay.py2 import dump_pose2d
-from rsbb_replay.scenarios import at, hnf_scenario, still_body
+from rsbb_replay.scenarios import MS, at, hnf_scenario, still_body
 from rsbb_replay.world import World, run_script
 
 pytestmark = pytest.mark.slow  # writes and reads a run bag (~0.6 s)
@@ -212,3 +213,50 @@ def test_hgmf_replayed_from_its_bag(tmp_path: Path) -> None:
     assert g0["Object grasped"] is False
     assert g0["Distance error"] == pytest.approx(0.1, abs=1e-12)
     assert result.score["Objects grasped"] == "0 out of 2"
+
+
+def test_hpff_replayed_from_its_bag(tmp_path: Path) -> None:
+    # goal_timeout 25 s from the request at 3 s: samples from 3.5 + 8 = 11.5 s every 0.5 s until
+    # the timeout at 28 s (33 samples), each a relative and an absolute broadcast; the robot 2 m
+    # behind the cap: no deviation, nothing covered (0.0: pairs of equal poses were added).
+    samples = [at(11.5) + k * 500 * MS for k in range(33)]
+    broadcasts = [Broadcast(at(2.01), "/robot", "/robot_markerset", *IDENTITY)]
+    for s in samples:
+        broadcasts += [
+            Broadcast(s, "/robot", "/robot_markerset", *IDENTITY),
+            Broadcast(s + 30 * MS, "/robot", "/robot_markerset", *IDENTITY),
+        ]
+    sc = replace(
+        hnf_scenario(),
+        code="HPFF",
+        t_end_ns=at(28.1),
+        end="stop",
+        t_disconnect_ns=at(29.0),
+        manual_operations=(),
+        goals=(Goal(at(3.0), at(3.5), at(28.0), "{}\n", "timeout"),),
+        broadcasts=tuple(broadcasts),
+        saves=(Save(at(28.05), {}),),
+        params={},
+        bodies=(
+            still_body("robot_markerset", (0.0, 0.0, 0.0), 35.0),
+            still_body("actor_markerset", (2.0, 0.0, 1.7), 35.0),
+        ),
+    )
+    paths = write_rsbb_run(tmp_path, sc)
+    params = {
+        "min_following_distance": 0.15,
+        "max_following_distance": 3.5,
+        "desired_following_distance": 2.0,
+        "goal_timeout": 25.0,
+    }
+    transform = [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]]
+    tl = timeline_from_bag(paths.bag, params, {"transform": transform})
+    assert len(tl.lookups["robot"]) == 67
+    result = run_script(World(tl), hpff.execute)
+    assert result.crashed is None
+    assert result.score == {
+        "Average deviation from desired distance": pytest.approx(0.0, abs=1e-12),
+        "Distance covered while following": 0.0,
+        "Benchmark reliability": "100.0%",
+    }
+    assert type(result.score["Distance covered while following"]) is float
