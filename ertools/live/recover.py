@@ -48,7 +48,7 @@ def recover(path: Path) -> Recovered:
             recover), or ``path.cut`` exists already (a recovery done before).
     """
     if not path.is_file():
-        raise BagError("no such file", path=path)
+        raise BagError("no such file", path=path, transient=True)
     size = path.stat().st_size
     if is_finished(path):
         return Recovered(path, None, 0, size, size)

@@ -24,7 +24,7 @@ from ertools.audit.compare import attach
 from ertools.benchmarks.base import Benchmark, jsonable
 from ertools.benchmarks.common.teams import with_team
 from ertools.benchmarks.document import all_failed, score_json
-from ertools.errors import ErtoolsError
+from ertools.errors import ErtoolsError, transient_error, watching
 from ertools.progress import reporting
 from ertools.report.folder import _audit_inputs, write_report
 
@@ -133,10 +133,11 @@ def run_job(job: Job) -> Outcome:
     # stderr interleaved from several workers
     logger.handlers[:] = [captured]
     logger.propagate = False
+    met: list[BaseException] = []
     try:
         # a worker forked from the command holds its progress bar: the bar is the parent's, and
         # counts executions; the reads inside one report nothing
-        with reporting(None):
+        with reporting(None), watching() as met:
             outcome = _score(job)
     except ErtoolsError as err:
         outcome = Outcome(
@@ -144,7 +145,7 @@ def run_job(job: Job) -> Outcome:
             "unscoreable",
             reason=one_line(str(err)),
             error=type(err).__name__,
-            machine=_of_the_machine(err),
+            machine=transient_error(err),
         )
     except Exception as err:  # a bug in a scorer: this execution's row only
         where = traceback.extract_tb(err.__traceback__)[-1] if err.__traceback__ else None
@@ -160,20 +161,28 @@ def run_job(job: Job) -> Outcome:
         logger.propagate = propagate
     seconds = round(time.perf_counter() - start, 3)
     logged = tuple(dict.fromkeys(captured.lines))
+    extra: tuple[str, ...] = ()
+    if met and not outcome.machine:
+        # met and handled by the scorer (a GT file skipped for a moment): what it computed may
+        # not be what the same bytes give next time
+        extra = (transient_note(met[0]),)
     return Outcome(
-        **{**outcome.__dict__, "seconds": seconds, "warnings": (*logged, *outcome.warnings)}
+        **{
+            **outcome.__dict__,
+            "seconds": seconds,
+            "warnings": (*logged, *outcome.warnings, *extra),
+            "machine": outcome.machine or bool(met),
+        }
     )
 
 
-def _of_the_machine(err: BaseException) -> bool:
-    """An error caused by the machine, not the data: an OSError anywhere in its chain (a
-    report folder not writable, a disk full, a log unreadable for its permissions)."""
-    seen: BaseException | None = err
-    while seen is not None:
-        if isinstance(seen, OSError):
-            return True
-        seen = seen.__cause__ or seen.__context__
-    return False
+def transient_note(err: BaseException) -> str:
+    """The warning of an execution scored while a problem of the machine or the moment was met
+    (:func:`ertools.errors.transient_error`): not cached, scored again by the next run."""
+    return (
+        f"a problem of the machine or the moment was met while it was scored "
+        f"({one_line(str(err))}): not kept in the cache, a rerun scores it again"
+    )
 
 
 class _Capture(logging.Handler):
