@@ -261,6 +261,8 @@ def rescore(
     keyed: dict[str, Fingerprints] = {}
     inputs: dict[str, list[dict[str, Any]]] = {}
     to_run: list[Job] = []
+    scorer: dict[str, str] = {}  # a key -> the id of the job that scores it
+    sharing: dict[str, list[str]] = {}  # that id -> the ids of the same key, given its outcome
     for p in planned:
         if p.missing:
             outcomes[p.job.id] = Outcome(p.job.id, "unscoreable", reason="; ".join(p.missing))
@@ -281,7 +283,10 @@ def rescore(
         if hit is not None:
             outcomes[p.job.id] = hit
             cached.add(p.job.id)
+        elif keys[p.job.id] in scorer:  # the same bytes, team and inputs: scored once
+            sharing.setdefault(scorer[keys[p.job.id]], []).append(p.job.id)
         else:
+            scorer[keys[p.job.id]] = p.job.id
             to_run.append(p.job)
     hashes.save()
     if cache.invalid:
@@ -311,18 +316,23 @@ def rescore(
             on_outcome(outcome)
     tell()
 
-    def done(outcome: Outcome) -> None:
-        changed = changed_files(keyed[outcome.id], hashes)
-        # scored from bytes that are not those keyed and recorded: no score (a row that says
-        # why it has none, of the moment, says it better: a file it could not find)
-        if changed and (outcome.status == "scored" or not outcome.machine):
-            outcome = input_changed(outcome, changed)
-        outcomes[outcome.id] = outcome
-        cache.put(keys[outcome.id], outcome)
-        state["done"] += 1
-        state["bad"] += outcome.status != "scored"
-        if on_outcome is not None:
-            on_outcome(outcome)
+    def done(scored: Outcome) -> None:
+        copies = [
+            replace(scored, id=other, warnings=(*scored.warnings, same_as(scored.id)))
+            for other in sharing.get(scored.id, [])
+        ]
+        for outcome in (scored, *copies):
+            changed = changed_files(keyed[outcome.id], hashes)
+            # scored from bytes that are not those keyed and recorded: no score (a row that
+            # says why it has none, of the moment, says it better: a file it could not find)
+            if changed and (outcome.status == "scored" or not outcome.machine):
+                outcome = input_changed(outcome, changed)
+            outcomes[outcome.id] = outcome
+            cache.put(keys[outcome.id], outcome)
+            state["done"] += 1
+            state["bad"] += outcome.status != "scored"
+            if on_outcome is not None:
+                on_outcome(outcome)
         tell()
 
     # what the cache hits took tells the schedule which benchmarks cost most
@@ -341,6 +351,14 @@ def rescore(
         timeline=timeline,
         inputs=inputs,
         keyed=keyed,
+    )
+
+
+def same_as(ident: str) -> str:
+    """The warning of an execution whose bytes, team and inputs are another's (its cache key):
+    a log copied under two names, listed twice."""
+    return (
+        f"the same logs (byte for byte), team, time and inputs as {ident}: scored once, as {ident}"
     )
 
 

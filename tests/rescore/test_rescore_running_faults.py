@@ -261,3 +261,123 @@ def test_a_log_replaced_while_it_is_read_is_no_score(
     row = {r["id"]: r for r in doc["executions"]}[ident]
     assert row["status"] == "scored" and not row["cached"]
     assert row["score"]["toy"]["value"] == pytest.approx(100 * SCALE + OFFSETS["beta"])
+
+
+# --- finding 9: one execution listed many times ---------------------------------------------
+
+ALIASED = """\
+version: 1
+benchmarks:
+  toy:
+    inputs: {{scale: 2.0}}
+    teams:
+      alpha: {{transform: configs/transform-alpha.yaml}}
+executions:
+  - &one {{benchmark: toy, team: alpha, bags: [logs/a.txt], start: 2015-11-20T09:00:00Z}}
+{copies}  - {{benchmark: toy, team: alpha, bags: [logs/b.txt], start: 2015-11-20T10:00:00Z}}
+  - {{benchmark: toy, team: alpha, bags: [logs/../logs/a.txt], start: 2015-11-20T09:00:00Z}}
+"""
+
+
+def aliased_day(root: Path, copies: int) -> Path:
+    """One execution listed ``copies`` more times as YAML aliases, once more as a copy (its
+    path spelt another way), and a different one."""
+    (root / "logs").mkdir(parents=True)
+    (root / "configs").mkdir()
+    (root / "configs" / "transform-alpha.yaml").write_text("offset: 0.25\n")
+    (root / "logs" / "a.txt").write_text("1\n2\n")
+    (root / "logs" / "b.txt").write_text("4\n")
+    manifest = root / "competition.yaml"
+    manifest.write_text(ALIASED.format(copies="  - *one\n" * copies))
+    return manifest
+
+
+def test_check_names_an_execution_listed_twice(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    use_toy_registry(monkeypatch)
+    manifest = aliased_day(tmp_path, copies=3)
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        code = main(["rescore", "--check", "--config", str(manifest)])
+    lines = err.getvalue().splitlines()
+    assert code == 0
+    # the three aliases (executions[1..3]) and the copy (executions[5]); not the other one
+    assert lines[0] == (
+        f"ertools: warning: {manifest}: executions[1], executions[2], executions[3], "
+        "executions[5]: the same execution as executions[0] (listed 4 more times: same "
+        "benchmark, team, logs, time and inputs); scored once"
+    )
+    assert "2 listed executions" in lines[-1] and len(lines) == 2
+
+
+def test_an_execution_listed_many_times_is_scored_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """1,000 aliases of one execution: one job, one row, and a problem naming the copies."""
+    use_toy_registry(monkeypatch)
+    manifest = aliased_day(tmp_path, copies=1000)
+    scored: list[str] = []
+    real = pipeline.run_jobs
+
+    def counting(jobs: Any, **kwargs: Any) -> None:
+        scored.extend(job.id for job in jobs)
+        real(jobs, **kwargs)
+
+    monkeypatch.setattr(pipeline, "run_jobs", counting)
+    code, doc, err = rescore(manifest, tmp_path / "out", "--no-reports")
+    assert code == 0
+    assert len(scored) == 2 == len(doc["executions"])
+    values = sorted(r["score"]["toy"]["value"] for r in doc["executions"])
+    assert values == pytest.approx([1.5 * SCALE + 0.25, 4 * SCALE + 0.25])
+    dupes = [p for p in doc["problems"] if p["kind"] == "duplicate-execution"]
+    assert len(dupes) == 1 and "1001 more times" in dupes[0]["message"]
+    assert "the same execution as executions[0]" in err
+
+
+def test_the_same_bytes_listed_twice_are_scored_once(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Two listed executions whose logs are byte-identical copies (same team, inputs, time):
+    one cache key, scored once; both rows scored, the second saying whose score it shares."""
+    use_toy_registry(monkeypatch)
+    manifest = aliased_day(tmp_path, copies=0)
+    shutil.copyfile(tmp_path / "logs" / "a.txt", tmp_path / "logs" / "copy.txt")
+    text = manifest.read_text().replace("logs/../logs/a.txt", "logs/copy.txt")
+    manifest.write_text(text)
+    scored: list[str] = []
+    real = pipeline.run_jobs
+
+    def counting(jobs: Any, **kwargs: Any) -> None:
+        scored.extend(job.id for job in jobs)
+        real(jobs, **kwargs)
+
+    monkeypatch.setattr(pipeline, "run_jobs", counting)
+    code, doc, _ = rescore(manifest, tmp_path / "out", "--no-reports")
+    assert code == 0 and len(scored) == 2 and len(doc["executions"]) == 3
+    rows = [r for r in doc["executions"] if r["bags"][0].endswith(("a.txt", "copy.txt"))]
+    assert [r["status"] for r in rows] == ["scored", "scored"]
+    assert rows[0]["score"] == rows[1]["score"]
+    assert any(f"scored once, as {rows[0]['id']}" in w for w in rows[1]["warnings"])
+
+
+def test_check_names_one_log_listed_for_two_teams(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    use_toy_registry(monkeypatch)
+    manifest = aliased_day(tmp_path, copies=0)
+    (tmp_path / "configs" / "transform-beta.yaml").write_text("offset: 1\n")
+    text = manifest.read_text().replace(
+        "      alpha: {transform: configs/transform-alpha.yaml}\n",
+        "      alpha: {transform: configs/transform-alpha.yaml}\n"
+        "      beta: {transform: configs/transform-beta.yaml}\n",
+    )
+    text += "  - {benchmark: toy, team: beta, bags: [logs/a.txt], start: 2015-11-20T09:00:00Z}\n"
+    manifest.write_text(text)
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        assert main(["rescore", "--check", "--config", str(manifest)]) == 0
+    assert (
+        "executions[3]: the logs and time of executions[0] for another team (beta, there "
+        "alpha): both are scored; remove the wrong one"
+    ) in err.getvalue()
