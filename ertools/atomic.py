@@ -106,3 +106,16 @@ def folder_lock(folder: Path, *, on_wait: Callable[[str], None] | None = None) -
         yield
     finally:
         os.close(fd)  # releases the lock
+
+
+def hold(fd: int) -> bool:
+    """Take the advisory lock (``flock``) of the open file ``fd`` for as long as it stays open,
+    without waiting: False when another open of it holds it (a recording being written). Where
+    there is no ``flock`` (Windows), True."""
+    if sys.platform == "win32":  # pragma: no cover - not on the platforms tested
+        return True
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return False
+    return True
