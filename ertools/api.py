@@ -20,6 +20,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
+from ertools import atomic
 from ertools.audit.model import Audit
 from ertools.audit.rescore import ScoreInputs, audit_bag, infer_benchmark
 from ertools.benchmarks import registry
@@ -373,7 +374,7 @@ def export(
         target = Path(out)
         if any(target.exists() and target.samefile(p) for p in _paths(bags)):
             raise UsageError(f"out={target}: that is an input; ertools never overwrites its inputs")
-        target.write_text(text, encoding="utf-8")
+        atomic.write_text(target, text)
     return text
 
 

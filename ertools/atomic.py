@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import shutil
 import sys
 import tempfile
 from collections.abc import Callable, Iterator
@@ -19,6 +20,9 @@ from pathlib import Path
 
 if sys.platform != "win32":
     import fcntl
+
+
+_FOLDER_TRIES = 10  # replace_folder: runs racing for one folder, at most
 
 
 @cache
@@ -76,6 +80,30 @@ def write_bytes(path: Path, data: bytes) -> Path:
 def write_text(path: Path, text: str) -> Path:
     """``text`` (UTF-8) into ``path``, whole or not at all."""
     return write_bytes(path, text.encode("utf-8"))
+
+
+def replace_folder(new: Path, path: Path) -> None:
+    """The folder ``new`` (built whole beside ``path``, by ``tempfile.mkdtemp``) put at
+    ``path``: what was there is renamed away first, under a unique name, and removed after.
+    Two runs doing it at once each end with a whole folder there (the last one's)."""
+    for _ in range(_FOLDER_TRIES):
+        old: Path | None = None
+        if path.is_symlink():
+            path.unlink()
+        elif path.exists():
+            old = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.", suffix=".old"))
+            # over an empty folder (POSIX allows it); gone already: another run moved it
+            with contextlib.suppress(FileNotFoundError):
+                os.replace(path, old)
+        try:
+            os.replace(new, path)
+        except OSError:  # another run put its folder there meanwhile: move it away too
+            continue
+        finally:
+            if old is not None:
+                shutil.rmtree(old, ignore_errors=True)
+        return
+    raise FileExistsError(f"{path}: replaced by other runs {_FOLDER_TRIES} times; not written")
 
 
 @contextlib.contextmanager

@@ -7,12 +7,14 @@ Runs the same CLI a referee would type, so the demo shows (and checks) the real 
 
 from __future__ import annotations
 
+import io
 import sys
 from collections.abc import Iterator
 from contextlib import redirect_stdout
 from dataclasses import dataclass
 from pathlib import Path
 
+from ertools import atomic
 from ertools.benchmarks import registry
 from ertools.cli.main import main as ertools_main
 from ertools.samples.competition import DEFAULT_SEED, MANIFEST, write_competition
@@ -118,10 +120,13 @@ def run(out: Path, samples: Path = SAMPLES) -> int:
             code = ertools_main(step.argv)
         else:
             target = out / step.stdout_file
-            with target.open("w", encoding="utf-8") as fh, redirect_stdout(fh):
+            printed = io.StringIO()
+            with redirect_stdout(printed):
                 code = ertools_main(step.argv)
-            if target.stat().st_size == 0:  # nothing printed (its errors are above): no file
-                target.unlink()
+            if printed.getvalue():  # nothing printed (its errors are above): no file
+                atomic.write_text(target, printed.getvalue())
+            else:
+                target.unlink(missing_ok=True)
                 target = None
         shown = "nothing on stdout" if target is None else f"-> {target}"
         if code != step.expected_exit:

@@ -16,6 +16,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
+from ertools import atomic
+
 # Modules that declare Rule constants; the catalogue is what these hold, in this order.
 RULE_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm1.rules",
@@ -145,7 +147,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"## {path}\n\n{table}")
         return 0
     for path, table in targets.items():
-        path.write_text(replace_table(path.read_text(encoding="utf-8"), table), encoding="utf-8")
+        atomic.write_text(path, replace_table(path.read_text(encoding="utf-8"), table))
         print(f"wrote the rule table of {path}")
     return 0
 
