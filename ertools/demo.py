@@ -7,8 +7,16 @@ Runs the same CLI a referee would type, so the demo shows (and checks) the real 
 
 from __future__ import annotations
 
-import io
 import sys
+
+if __name__ == "__main__":
+    # `python -m ertools.demo`: the module run under its own name, its imports included, inside
+    # ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
+    from ertools import launch
+
+    sys.exit(launch.run("ertools.demo:main", "python -m ertools.demo"))
+
+import io
 from collections.abc import Iterator
 from contextlib import redirect_stdout
 from dataclasses import dataclass
@@ -153,7 +161,3 @@ def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else argv
     out = Path(args[0]) if args else Path("demo_output")
     return 1 if run(out) else 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

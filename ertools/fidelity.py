@@ -10,8 +10,17 @@ that is added, removed or reworded changes the docs in the same commit.
 
 from __future__ import annotations
 
-import importlib
 import sys
+
+if __name__ == "__main__":
+    # `python -m ertools.fidelity`: the module run under its own name, its imports included, inside
+    # ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
+    # (the benchmark modules' Rule class is that module's, not __main__'s)
+    from ertools import launch
+
+    sys.exit(launch.run("ertools.fidelity:main", "python -m ertools.fidelity"))
+
+import importlib
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -150,11 +159,3 @@ def main(argv: list[str] | None = None) -> int:
         atomic.write_text(path, replace_table(path.read_text(encoding="utf-8"), table))
         print(f"wrote the rule table of {path}")
     return 0
-
-
-if __name__ == "__main__":
-    # Run as ``-m`` this file is ``__main__``, whose Rule class is not the one the benchmark
-    # modules import: the catalogue must come from the imported module.
-    from ertools.fidelity import main as _main
-
-    raise SystemExit(_main())

@@ -6,16 +6,25 @@ instead (:mod:`ertools.samples.competition`): one day of logs at one venue and i
 
 Every registered scenario (:data:`ertools.samples.scenario.SCENARIOS`) is generated into
 ``OUTDIR/<name>/``, which is replaced as a whole (built in a folder of a unique name,
-``OUTDIR/.<name>.XXXXXXXX.partial``, first, so a failure leaves the old folder in place). Without ``--seed`` each scenario uses its fixed
+``OUTDIR/.<name>.XXXXXXXX.partial``, first, so a failure leaves the old folder in place).
+Without ``--seed`` each scenario uses its fixed
 default seed, so the output is byte-identical from run to run. A scenario whose module does
 not exist is an error naming it, before anything is written.
 """
 
 from __future__ import annotations
 
+import sys
+
+if __name__ == "__main__":
+    # `python -m ertools.samples`: the module run under its own name, its imports included,
+    # inside ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
+    from ertools import launch
+
+    sys.exit(launch.run("ertools.samples.__main__:program", "python -m ertools.samples"))
+
 import argparse
 import shutil
-import sys
 import tempfile
 from collections.abc import Sequence
 from pathlib import Path
@@ -116,6 +125,7 @@ def _competition(outdir: Path, seed: int | None) -> int:
     return 0
 
 
-if __name__ == "__main__":
+def program() -> int:
+    """``python -m ertools.samples``: :func:`main` on ``sys.argv``."""
     rerun_pinned(sys.argv[1:])  # bit-identical samples on AVX-512 CPUs too (samples.simd)
-    sys.exit(main())
+    return main()
