@@ -146,7 +146,7 @@ class Child:
         try:
             pickle.dump(job, self._jobs)
             self._jobs.flush()
-        except OSError:
+        except (OSError, ValueError):  # ValueError: closed meanwhile, as in receive
             return False
         self._busy = True
         return True

@@ -89,7 +89,6 @@ CASES = [
 ]
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize(("kind", "target", "args", "program", "module"), CASES)
 def test_a_ctrl_c_while_a_module_loads_is_one_line(
     kind: str, target: str, args: list[str], program: str, module: str, tmp_path: Path
@@ -114,7 +113,6 @@ def loaded(pid: int, library: str) -> bool:
         return False
 
 
-@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 @pytest.mark.parametrize(
     ("library", "after_s"),

@@ -96,7 +96,6 @@ def around_scoring(monkeypatch: pytest.MonkeyPatch, before: Any, after: Any) -> 
 # --- finding 1: a file missing for a moment -------------------------------------------------
 
 
-@pytest.mark.slow
 def test_a_log_missing_for_a_moment_is_not_cached(
     fbm3w_day: tuple[Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -220,7 +219,6 @@ def test_watching_sees_errors_handled_inside() -> None:
 # --- finding 2: a file replaced while it is scored ------------------------------------------
 
 
-@pytest.mark.slow
 def test_a_log_replaced_after_it_was_scored_keeps_the_scored_hash(
     fbm3w_day: tuple[Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
