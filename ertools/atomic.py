@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import shutil
 import sys
 import tempfile
 from collections.abc import Callable, Iterator
@@ -19,6 +20,9 @@ from pathlib import Path
 
 if sys.platform != "win32":
     import fcntl
+
+
+_FOLDER_TRIES = 10  # replace_folder: runs racing for one folder, at most
 
 
 @cache
@@ -78,6 +82,30 @@ def write_text(path: Path, text: str) -> Path:
     return write_bytes(path, text.encode("utf-8"))
 
 
+def replace_folder(new: Path, path: Path) -> None:
+    """The folder ``new`` (built whole beside ``path``, by ``tempfile.mkdtemp``) put at
+    ``path``: what was there is renamed away first, under a unique name, and removed after.
+    Two runs doing it at once each end with a whole folder there (the last one's)."""
+    for _ in range(_FOLDER_TRIES):
+        old: Path | None = None
+        if path.is_symlink():
+            path.unlink()
+        elif path.exists():
+            old = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.", suffix=".old"))
+            # over an empty folder (POSIX allows it); gone already: another run moved it
+            with contextlib.suppress(FileNotFoundError):
+                os.replace(path, old)
+        try:
+            os.replace(new, path)
+        except OSError:  # another run put its folder there meanwhile: move it away too
+            continue
+        finally:
+            if old is not None:
+                shutil.rmtree(old, ignore_errors=True)
+        return
+    raise FileExistsError(f"{path}: replaced by other runs {_FOLDER_TRIES} times; not written")
+
+
 @contextlib.contextmanager
 def folder_lock(folder: Path, *, on_wait: Callable[[str], None] | None = None) -> Iterator[None]:
     """Hold ``folder/.ertools.lock`` (an advisory ``flock``) for the block.
@@ -106,3 +134,16 @@ def folder_lock(folder: Path, *, on_wait: Callable[[str], None] | None = None) -
         yield
     finally:
         os.close(fd)  # releases the lock
+
+
+def hold(fd: int) -> bool:
+    """Take the advisory lock (``flock``) of the open file ``fd`` for as long as it stays open,
+    without waiting: False when another open of it holds it (a recording being written). Where
+    there is no ``flock`` (Windows), True."""
+    if sys.platform == "win32":  # pragma: no cover - not on the platforms tested
+        return True
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return False
+    return True

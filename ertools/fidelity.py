@@ -10,11 +10,22 @@ that is added, removed or reworded changes the docs in the same commit.
 
 from __future__ import annotations
 
-import importlib
 import sys
+
+if __name__ == "__main__":
+    # `python -m ertools.fidelity`: the module run under its own name, its imports included, inside
+    # ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
+    # (the benchmark modules' Rule class is that module's, not __main__'s)
+    from ertools import launch
+
+    sys.exit(launch.run("ertools.fidelity:main", "python -m ertools.fidelity"))
+
+import importlib
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
+
+from ertools import atomic
 
 # Modules that declare Rule constants; the catalogue is what these hold, in this order.
 RULE_MODULES: tuple[str, ...] = (
@@ -145,14 +156,6 @@ def main(argv: list[str] | None = None) -> int:
             print(f"## {path}\n\n{table}")
         return 0
     for path, table in targets.items():
-        path.write_text(replace_table(path.read_text(encoding="utf-8"), table), encoding="utf-8")
+        atomic.write_text(path, replace_table(path.read_text(encoding="utf-8"), table))
         print(f"wrote the rule table of {path}")
     return 0
-
-
-if __name__ == "__main__":
-    # Run as ``-m`` this file is ``__main__``, whose Rule class is not the one the benchmark
-    # modules import: the catalogue must come from the imported module.
-    from ertools.fidelity import main as _main
-
-    raise SystemExit(_main())

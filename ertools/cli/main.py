@@ -9,6 +9,14 @@ import os
 import re
 import select
 import sys
+
+if __name__ == "__main__":
+    # `python -m ertools.cli.main`: the module run under its own name, its imports included, inside
+    # ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
+    from ertools import launch
+
+    sys.exit(launch.run("ertools.cli.main:main", "ertools"))
+
 import textwrap
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -403,7 +411,3 @@ def _main(argv: Sequence[str] | None) -> int:
         )
         return 2
     return run_command(f"ertools {name}", COMMANDS[name].module, args[1:])
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

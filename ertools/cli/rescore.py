@@ -106,6 +106,8 @@ def run(args: argparse.Namespace) -> int:
         note(f"error: {len(err.problems)} problem(s) in {args.config}; nothing was scored")
         return 1
     if args.check:
+        for line in manifest.duplicates:
+            note(f"warning: {args.config}: {line}")
         note(f"{args.config}: no problems ({len(manifest.executions)} listed executions)")
         return 0
 

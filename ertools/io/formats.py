@@ -151,7 +151,7 @@ def detect_format(path: str | Path) -> str:
     """
     p = Path(path)
     if not p.exists():
-        raise BagError("no such file or directory", path=p)
+        raise BagError("no such file or directory", path=p, transient=True)
     if p.is_dir():
         return _rosbag2_storage(p)
     try:

@@ -304,7 +304,7 @@ def read_text_poses(path: str | Path, fmt: TextFormat | None = None) -> PoseStre
     """
     p = Path(path)
     if not p.exists():
-        raise BagError("no such file or directory", path=p)
+        raise BagError("no such file or directory", path=p, transient=True)
     kind = fmt if fmt is not None else sniff(p)
     if kind is None:
         raise BagError("not a text trajectory (TUM, KITTI, EuRoC or ertools CSV)", path=p)

@@ -138,7 +138,7 @@ def load_entry(path: Path) -> Entry:
     """A result from a report folder, a ``result.json`` or a ``score.json``."""
 
     if not path.exists():
-        raise ConfigError("no such file or folder", path=path)
+        raise ConfigError("no such file or folder", path=path, transient=True)
     folder = path if path.is_dir() else path.parent
     meta_path = folder / "result.json"
     if path.is_dir() and not meta_path.exists():

@@ -10,6 +10,7 @@ page written.
 from __future__ import annotations
 
 import contextlib
+import logging
 from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
@@ -26,6 +27,8 @@ from ertools.rescore.manifest import Manifest
 from ertools.rescore.memo import FileMemo
 from ertools.rescore.parallel import early_dask
 from ertools.rescore.pipeline import listed_executions, rescore, write_results
+
+log = logging.getLogger(__name__)
 
 if TYPE_CHECKING:
     from ertools.progress import Reporter
@@ -117,6 +120,11 @@ def _rescore(
 ) -> Rescored:
     scorings = listed_executions(manifest)
     problems: list[dict[str, object]] = []
+    for line in manifest.duplicates:  # each scored once (load_manifest): said once too
+        log.warning("%s: %s", manifest.path, line)
+        problems.append(
+            {"kind": "duplicate-execution", "path": str(manifest.path), "message": line}
+        )
     timeline = None
     found = None
     if paths:
@@ -125,7 +133,7 @@ def _rescore(
         found = find(paths, progress=progress, memo=memo)
         memo.save()
         scorings = merge(found.scorings, scorings)
-        problems = list(found.problems)
+        problems += found.problems
         out.mkdir(parents=True, exist_ok=True)
         timeline = write_timeline(found, out, manifest.title)
     if not scorings:

@@ -278,7 +278,7 @@ def find_gt_files(
     for problem in found.problems:
         if not Path(problem.path).exists():
             # A mistyped GT path must not pass unnoticed behind the other GT files.
-            raise BagError(f"GT path: {problem.problem}", path=problem.path)
+            raise BagError(f"GT path: {problem.problem}", path=problem.path, transient=True)
         skipped.append(f"GT path {problem.path}: {problem.problem}")
     gt_summaries = []
     broken: list[str] = []
