@@ -422,10 +422,13 @@ def _score_one(
         if problem is not None:
             common["unscoreable_reason"] = problem
     rel = (window.start_ns - bag_start_ns) / 1e9, (window.end_ns - bag_start_ns) / 1e9
-    if hi - lo < 2:
+    as_2015 = options.unscoreable_runs == "2015"
+    if hi - lo < (1 if as_2015 else 2):
+        crashed = " (the 2015 node failed here, robot_path[0] of an empty path, and sent no score)"
         return result(
             f"{hi - lo} pose sample(s) in the path window {rel[0]:.3f}-{rel[1]:.3f} s; "
-            "at least 2 are needed (tracking lost, or wrong window?)",
+            "at least 2 are needed (tracking lost, or wrong window?)"
+            + (crashed if as_2015 else ""),
             **common,
         )
     ref_i = int(np.searchsorted(poses.t_ns, window.ref_ns, side="right")) - 1
@@ -441,7 +444,7 @@ def _score_one(
     ref_xy = poses.xyz[ref_i, :2].copy()
     common["reference_xy"] = (float(ref_xy[0]), float(ref_xy[1]))
     try:
-        score = score_path(xy, ref_xy, shape, cfg.d_min)
+        score = score_path(xy, ref_xy, shape, cfg.d_min, as_2015=as_2015)
     except ScoringError as err:
         return result(err.message, **common)
     if problem is not None and options.unscoreable_runs != "2015":
@@ -453,6 +456,12 @@ def _score_one(
         warnings.append(
             f"run {window.index}: 2015 scored this run from {common['path_coverage']:.1%} of "
             f"its path (--unscoreable 2015); by default it is unscoreable: {problem}"
+        )
+    if len(score.kept) == 1:
+        warnings.append(
+            f"run {window.index}: no pose of its path moved d_min from the first: 2015 scored "
+            "it error_sum / N = 0.0 over its one kept pose (--unscoreable 2015); by default it "
+            "has no distance_error"
         )
     baseline = float(np.hypot(*(xy[0] - ref_xy)))
     if baseline < SHORT_BASELINE_M:
