@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from ertools.fidelity import Rule
 
-NODE_SOURCE = "rockin_scoring/scripts/fbm2h (2015)"
+NODE_SOURCE = "scripts/fbm2h (50b173b, RoCKIn 2015; unchanged in 2016-17)"
 
 # The catalogue rows (ertools.fidelity) of every way FBM2@Home differs from the 2015 node.
 RULE_ORIENTATION_WRAP = Rule(
@@ -79,18 +79,21 @@ RULE_UNSCORED = Rule(
     rulebook="accuracy over the waypoints reached; a waypoint not reached in time scores no "
     "points on that path (seed 7.2, RoCKIn@Home rulebook 5.2.7)",
     node_2015=(
-        f"{NODE_SOURCE}: after `WaitResult()`, `if benchmark.Timeout(): execution_time = "
-        "execution_time + segment_time; continue` and `if not benchmark.Running(): continue` "
-        "(BmBox.py: `Timeout()` is the RefBox payload == 'reason: timeout', `Running()` "
-        "payload != 'reason: stop'); the loop `while benchmark.Running() and not "
-        "benchmark.Timeout()` then ends; `position_accuracy = sum_d / N`, N = the number of "
-        "waypoints: a timed-out, stopped or unreached segment adds 0 to the sums but counts in N"
+        f"{NODE_SOURCE}: every segment whose `WaitResult()` returned is scored there, whatever "
+        "ended it: the stop check is commented out (l. 175-179) and `if benchmark.Timeout(): "
+        "timeouts = timeouts + 1` (l. 168-173) only counts a RefBox timeout in "
+        "timeout_segments; `while benchmark.Running() and not benchmark.Timeout()` (l. 97) "
+        "then ends the loop; `position_accuracy = sum_d / N` (l. 225), N = the number of "
+        "waypoints: a segment never sent adds 0 to the sums but counts in N (since 97be032; "
+        "before it a timed-out segment added its time and no error, a stopped one nothing)"
     ),
     ertools=(
-        "the segments not scored listed with null errors and named in a warning, accuracies "
-        "null and exit 1 (a sum over fewer segments divided by N rewards reaching fewer "
-        "waypoints); execution_time and the scored segments still given; a log that ends "
-        "inside the benchmark is the benchmark stopped there"
+        "the segment a RefBox timeout or stop (or the log's end) cut short and the segments "
+        "never reached listed with null errors and named in a warning, accuracies null and "
+        "exit 1 (a robot stopped on its way was not at the waypoint, and a sum over fewer "
+        "segments divided by N rewards reaching fewer waypoints); execution_time and the "
+        "scored segments still given; a log that ends inside the benchmark is the benchmark "
+        "stopped there"
     ),
     option="--unscored-segments 2015",
 )
