@@ -49,7 +49,7 @@ RULE_END_PAYLOADS = Rule(
     rulebook="END with payload `timeout` or `halt` (seed 6.2.3); an empty payload: the RefBox "
     "did not issue the END",
     node_2015=(
-        "rockin_scoring/BmBox.py (90d5c4d) l. 49, 53, 117, 126: only the whole strings "
+        "rockin_scoring/BmBox.py (7628309) l. 49, 53, 117, 126: only the whole strings "
         "`reason: timeout` (Timeout()) and `reason: stop` (not Running()), which the 2015 "
         "@Home RefBox sent (at_home_rsbb core_zone_exec.h phase_post_2); `timeout` or `halt` "
         "meant neither"

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from ertools.fidelity import Rule
 
-NODE_SOURCE = "scripts/fbm1h, scripts/fbm1w (2015)"
+NODE_SOURCE = "scripts/fbm1h (e373be0), scripts/fbm1w (7628309): RoCKIn 2015"
 
 RULE_GT_MOMENT = Rule(
     key="fbm1.ground-truth",
@@ -17,7 +17,8 @@ RULE_GT_MOMENT = Rule(
     node_2015=(
         f"{NODE_SOURCE}: one tf lookup, `lookupTransform('/origin', '/item', "
         "rospy.Time(0))`, at the stamp of the item transform broadcast once when the result had "
-        "arrived (the 2016-17 @Home node: when the placement was confirmed, `--gt placed`)"
+        "arrived (the 2016 and 2017 @Home nodes, 40ba68b and 89dfa75: when the placement was "
+        "confirmed, `--gt placed`)"
     ),
     ertools=(
         "mean over the stationary window before the goal, spread reported: one sample carries "
@@ -33,7 +34,8 @@ RULE_TRANS_CLIP = Rule(
     rulebook="pose score 1 - t/2 - r/2 with both terms in [0, 1] (score listing, seed 7.1)",
     node_2015=(
         f"{NODE_SOURCE}: `if pose_err_trans > max_pose_error : pose_err_trans = 1` with "
-        "max_pose_error = sqrt(2) m: errors of 1..1.41 m stay unclipped (score down to -0.21)"
+        "max_pose_error = sqrt(2) m: errors of 1..1.41 m stay unclipped (score down to -0.21); "
+        "so the 2016 node (40ba68b); the 2017 node (89dfa75) clipped at 1 m as ertools does"
     ),
     ertools="t = min(error, 1 m), so a pose score stays in [0, 1]",
     option="--clip-above-diagonal",
@@ -88,7 +90,7 @@ RULE_POSE_SOURCE = Rule(
     rulebook="the table (origin) and reference board marker sets from the mocap (seed 7.1)",
     node_2015=(
         f'{NODE_SOURCE}: `listener.lookupTransform("/origin", "/item", rospy.Time(0))` '
-        "(fbm1h at 117a5d0, line 125): the /tf frames origin and ref_board, never the pose "
+        "(fbm1h at e373be0, line 125): the /tf frames origin and ref_board, never the pose "
         "topics"
     ),
     ertools=(

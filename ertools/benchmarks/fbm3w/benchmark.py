@@ -17,7 +17,6 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import F64
 from ertools.benchmarks.common.ending import end_payload_deviation
 from ertools.benchmarks.common.hygiene import (
     frame_change_warning,
@@ -43,7 +42,7 @@ from ertools.benchmarks.fbm3w.config import (
     Fbm3wOptions,
 )
 from ertools.benchmarks.fbm3w.intervals import with_intervals
-from ertools.benchmarks.fbm3w.path import score_path
+from ertools.benchmarks.fbm3w.path import score_path, shape_floor, try_score
 from ertools.benchmarks.fbm3w.result import Fbm3wResult, RunResult
 from ertools.benchmarks.fbm3w.rules import (
     RULE_ARC_LENGTH,
@@ -67,8 +66,7 @@ from ertools.benchmarks.noise.benchmark import (
     noise_from_stream,
 )
 from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
-from ertools.configs.shapes import Shape
-from ertools.errors import ConfigError, ErtoolsError, ScoringError
+from ertools.errors import ConfigError, ScoringError
 from ertools.fidelity import Deviation
 from ertools.io import read_benchmark_states, summary, topics
 from ertools.io.clock import check_header_clock
@@ -84,8 +82,7 @@ STALE_REFERENCE_S = 0.5
 # Below this reference-start distance the run frame's direction is uncertain (1 mm of noise
 # turns a 1 cm baseline by ~0.1 rad).
 SHORT_BASELINE_M = 0.01
-# Samples of the noiseless robot used for shape_floor, and the floor worth a warning.
-FLOOR_SAMPLES = 10_001
+# The shape floor worth a warning.
 FLOOR_WARN_M = 0.0005
 # A kept path this much longer than the target is suspicious (the sample's runs: 1.00-1.01).
 LONG_PATH_RATIO = 1.15
@@ -482,7 +479,7 @@ def _score_one(
             f"({score.path_length:.4f} vs {target_length:.4f} m): jitter passing d_min or a "
             "detour inflates L and shifts l/L; see --d-min-sweep"
         )
-    swept = tuple((d, _try_score(xy, ref_xy, shape, d)) for d in options.sweep)
+    swept = tuple((d, try_score(xy, ref_xy, shape, d)) for d in options.sweep)
     floor = shape_floor(shape, cfg.d_min)
     if floor > FLOOR_WARN_M and not any(spec in w and "floor" in w for w in warnings):
         warnings.append(
@@ -500,27 +497,6 @@ def _score_one(
         target_dense=shape.dense(501),
         **common,
     )
-
-
-def shape_floor(shape: Shape, d_min: float) -> float:
-    """distance_error of a noiseless robot exactly on ``shape`` (1e4 samples), metres.
-
-    0 up to the d_min quantisation for shapes parametrised by arc length; 8.4 mm for the 2015
-    ``sine``, whose parameter is proportional to x, not to the length travelled.
-    """
-    pts = shape(np.linspace(0.0, 1.0, FLOOR_SAMPLES))
-    reference = np.array([-0.05, 0.0])  # run frame = world frame
-    try:
-        return score_path(pts, reference, shape, d_min).distance_error
-    except ErtoolsError:
-        return math.nan
-
-
-def _try_score(xy: F64, ref_xy: F64, shape: Shape, d_min: float) -> float | None:
-    try:
-        return score_path(xy, ref_xy, shape, d_min).distance_error
-    except ErtoolsError:
-        return None
 
 
 def _deviations(

@@ -21,13 +21,15 @@ import numpy as np
 
 from ertools.arrays import F64, IntArr
 from ertools.configs.shapes import Shape
-from ertools.errors import ScoringError
+from ertools.errors import ErtoolsError, ScoringError
 
 # Samples probed one by one after each kept point before switching to a vectorised search:
 # while the end effector moves, the next kept sample is usually within a few samples (cheap
 # scalar test); while it stands still with noise below d_min the gap is long (vector search).
 _SCALAR_PROBE = 8
 _FIRST_WINDOW = 64
+# Samples of the noiseless robot used for shape_floor.
+FLOOR_SAMPLES = 10_001
 
 
 def subsample_d_min(xy: F64, d_min: float) -> IntArr:
@@ -201,3 +203,25 @@ def score_path(
         total,
         raw_length,
     )
+
+
+def shape_floor(shape: Shape, d_min: float) -> float:
+    """distance_error of a noiseless robot exactly on ``shape`` (1e4 samples), metres.
+
+    0 up to the d_min quantisation for shapes parametrised by arc length; 8.4 mm for the 2015
+    ``sine``, whose parameter is proportional to x, not to the length travelled.
+    """
+    pts = shape(np.linspace(0.0, 1.0, FLOOR_SAMPLES))
+    reference = np.array([-0.05, 0.0])  # run frame = world frame
+    try:
+        return score_path(pts, reference, shape, d_min).distance_error
+    except ErtoolsError:
+        return math.nan
+
+
+def try_score(xy: F64, ref_xy: F64, shape: Shape, d_min: float) -> float | None:
+    """``distance_error`` of the run at ``d_min``, or None where it cannot be scored."""
+    try:
+        return score_path(xy, ref_xy, shape, d_min).distance_error
+    except ErtoolsError:
+        return None
