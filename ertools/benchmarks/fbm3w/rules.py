@@ -18,7 +18,7 @@ RULE_TIMEOUT_RUNS = Rule(
     rulebook="the RefBox ends a benchmark with END and payload timeout (seed 6.2.3); seed 7.3 "
     "does not say how such a run is scored",
     node_2015=(
-        f"{NODE_SOURCE}: `if benchmark.Timeout(): print \"TIMEOUT\"` only (l. 234-237, the time "
+        f'{NODE_SOURCE}: `if benchmark.Timeout(): print "TIMEOUT"` only (l. 234-237, the time '
         "and `continue` commented out by 7942ea2): a timed-out run is timed, scored on the path "
         "it covered, eligible as best run, and the loop goes on with the next run (before "
         "7942ea2: its time added, no score, the same run number again)"
