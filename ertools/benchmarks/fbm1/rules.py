@@ -5,7 +5,7 @@ says, what the node did, what ertools does and why, the option restoring 2015).
 
 from __future__ import annotations
 
-from ertools.fidelity import Rule
+from ertools.fidelity import NodeVersion, Rule
 
 NODE_SOURCE = "scripts/fbm1h (e373be0), scripts/fbm1w (7628309): RoCKIn 2015"
 
@@ -116,4 +116,64 @@ RULE_UNSCOREABLE = Rule(
         "left out of the totals like a failed run, the reason given (docs/uncertainty.md)"
     ),
     option="--unscoreable 2015",
+)
+
+# The versions of the FBM1 nodes (rows of the version table, ertools.fidelity.NodeVersion).
+_H = "scripts/fbm1h"
+VERSIONS = (
+    NodeVersion(
+        _H,
+        "5fdbdc2",
+        "2015-04-03",
+        'RoCKIn Camp 2015 ("release used at rockin camp 2015")',
+        "the 2015 scoring: totals over runs played + aborted, one tf lookup when the result "
+        "arrived, translation set to 1 only above sqrt(2) m, one-step theta wrap, exact names",
+        "`--rules 2015` (the same arithmetic; its BmBox waited on a RefBox END during a manual "
+        "operation)",
+    ),
+    NodeVersion(_H, "8eb3450", "2015-06-23", "development", "none (imports)", "`--rules 2015`"),
+    NodeVersion(_H, "117a5d0", "2015-10-26", "development", "none (a log level)", "`--rules 2015`"),
+    NodeVersion(
+        _H,
+        "e373be0",
+        "2015-10-30",
+        "RoCKIn 2015 Lisbon",
+        "none (waits for ENTER at the end)",
+        "`--rules 2015` (`--2015`)",
+    ),
+    NodeVersion(
+        _H,
+        "40ba68b",
+        "2017-01-26",
+        "Lisbon 2016 second local competition",
+        "the ground truth looked up when the placement was confirmed, before the goal (then "
+        "ENTER once the positioner is removed); class and instance accuracies over "
+        "BENCHMARK_RUNS = 10",
+        "`--rules 2016` (`--2016`)",
+    ),
+    NodeVersion(
+        _H,
+        "27d9a23",
+        "2017-05-04",
+        "the Peccioli competition, May 2017 (its commit)",
+        "none (a partial score published for display)",
+        "`--rules 2016` (the same arithmetic)",
+    ),
+    NodeVersion(
+        _H,
+        "89dfa75",
+        "2017-11-10",
+        "Lisbon 2017 major tournament",
+        "the translation term clipped at 1 m (`if pose_err_trans > 1.0`), not above sqrt(2) m",
+        "`--rules 2017` (`--2017`)",
+    ),
+    NodeVersion(
+        "scripts/fbm1w",
+        "7628309",
+        "2015-07-06",
+        "RoCKIn 2015 Lisbon (its only version)",
+        "FBM1@Home's arithmetic without a run cap (`while benchmark.Running()`), the item the "
+        "RefBox names (ManualOperation()'s payload)",
+        "`--rules 2015` (`--2015`)",
+    ),
 )

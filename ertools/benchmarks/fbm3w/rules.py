@@ -6,7 +6,7 @@ says, what the node did, what ertools does and why, the option restoring 2015).
 from __future__ import annotations
 
 from ertools.benchmarks.fbm3w.config import DEFAULT_FRAME, DEFAULT_TOPIC, FALLBACK_TOPIC
-from ertools.fidelity import Rule
+from ertools.fidelity import NodeVersion, Rule
 
 NODE_SOURCE = "scripts/fbm3w (50b173b, RoCKIn 2015)"
 
@@ -142,4 +142,150 @@ RULE_UNSCOREABLE_RUNS = Rule(
         "reference, is a failure"
     ),
     option="--unscoreable 2015",
+)
+
+# The versions of scripts/fbm3w (rows of the version table, ertools.fidelity.NodeVersion).
+_F = "scripts/fbm3w"
+_DEV = "not restorable: a development version, run in no competition"
+_DRAFT = "not restorable: no score computed"
+_PRE = (
+    "in part: its shapes as user shapes in the config (docs/fbm3w.md) and `--timeout-runs "
+    "unscored` (time, no score); not restorable: a timed-out run was repeated under its run "
+    "number and spec, which the next manual operation in the log does not show"
+)
+VERSIONS = (
+    NodeVersion(_F, "ef3ed26", "2015-10-30", "development", "FBM1@Work's node copied", _DRAFT),
+    NodeVersion(
+        _F,
+        "1101e55",
+        "2015-11-03",
+        "development",
+        "runs from runs_specifications, D_MIN 0.002; no score yet",
+        _DRAFT,
+    ),
+    NodeVersion(_F, "e2b7475", "2015-11-04", "development", "no score yet", _DRAFT),
+    NodeVersion(_F, "0f20ffd", "2015-11-05", "development", "none (notes)", _DRAFT),
+    NodeVersion(
+        _F,
+        "f127618",
+        "2015-11-05",
+        "development",
+        "the path collected from pose2d (D_MIN 0.002) while the goal ran; a RefBox timeout: "
+        "its time; no score yet",
+        _DRAFT,
+    ),
+    NodeVersion(_F, "65dfee4", "2015-11-05", "development", "none (the file's mode)", _DRAFT),
+    NodeVersion(
+        _F,
+        "71d270d",
+        "2015-11-06",
+        "development",
+        "an error printed, not scored (in the world frame, the target at the length itself)",
+        _DRAFT,
+    ),
+    NodeVersion(
+        _F,
+        "5568eef",
+        "2015-11-06",
+        "development",
+        "D_MIN 0.01, one manual operation for all runs; still printed only",
+        _DRAFT,
+    ),
+    NodeVersion(
+        _F,
+        "3e6dd79",
+        "2015-11-08",
+        "development",
+        "the first score (best_distance_error): Eq. (1) in the run frame at l/L, D_MIN 0.005, "
+        "line (0.30 l, 0.10 l), spline a semi-ellipse (0.050, 0.048); a RefBox timeout: its "
+        "time, no score, the run repeated",
+        _DEV,
+    ),
+    NodeVersion(
+        _F, "f8b4b26", "2015-11-09", "development", "none (not running, its commit says)", _DEV
+    ),
+    NodeVersion(
+        _F,
+        "d76de82",
+        "2015-11-09",
+        "development",
+        "the run frame's x axis atan2(start - reference)",
+        _DEV,
+    ),
+    NodeVersion(
+        _F,
+        "d161ac8",
+        "2015-11-09",
+        "development",
+        "D_MIN 0.00033; a manual operation per run; the start measured in the first run only",
+        _DEV,
+    ),
+    NodeVersion(
+        _F,
+        "f82940c",
+        "2015-11-09",
+        "development",
+        "the reference measured after each manual operation",
+        _DEV,
+    ),
+    NodeVersion(
+        _F,
+        "f012c65",
+        "2015-11-09",
+        "development",
+        "the start measured 2 s after the goal was sent",
+        _DEV,
+    ),
+    NodeVersion(
+        _F,
+        "2320dc4",
+        "2015-11-10",
+        "development",
+        "the start is the first pose of the path",
+        _DEV,
+    ),
+    NodeVersion(
+        _F, "9417897", "2015-11-10", "development", "an ENTER awaited before each path", _DEV
+    ),
+    NodeVersion(
+        _F,
+        "f7ff352",
+        "2015-11-10",
+        "development",
+        "no ENTER; the paths published for display",
+        _DEV,
+    ),
+    NodeVersion(
+        _F,
+        "e9620e6",
+        "2015-11-10",
+        "RoCKIn 2015 Lisbon, before its days 2 and 3 (the next commit says)",
+        "none (comments)",
+        _PRE,
+    ),
+    NodeVersion(
+        _F,
+        "6615fb0",
+        "2015-11-22",
+        "RoCKIn 2015 Lisbon, competition days 2 and 3 (its commit)",
+        "the spline a semi-ellipse of 0.11 x 0.11 (a sine defined, unused)",
+        _PRE,
+    ),
+    NodeVersion(
+        _F,
+        "7942ea2",
+        "2015-11-30",
+        'RoCKIn 2015 Lisbon ("changes during rockin 2015")',
+        "line (0.15 l, 0.045 l) and spline the sine (Listing 15); a timed-out run timed, "
+        "scored, eligible as best, the loop going on",
+        "`--2015` (50b173b differs only where a tf lookup failed)",
+    ),
+    NodeVersion(
+        _F,
+        "50b173b",
+        "2015-11-30",
+        "RoCKIn 2015 Lisbon (its final state; unchanged to 89dfa75)",
+        "a failed tf lookup (no mocap) retried, no longer ending the node",
+        "`--2015`",
+    ),
 )
