@@ -261,8 +261,9 @@ def compute(
         )
     deviations: list[Deviation] = [
         RULE_POSE_MOMENT.deviation(
-            "robot pose interpolated (linear + SLERP) at the logged reached moment; 2015's tf "
-            "lookup interpolated at the ROS time its node handled the result, a few ms later"
+            "robot pose interpolated (linear + SLERP) at the logged reached moment; the 2015 "
+            "node's tf lookup interpolated at its own `now`, taken once WaitResult() had "
+            "returned, a few milliseconds later"
         ),
         RULE_SCORE_FORMAT.deviation(
             "segments_details nested under details as in Listing 13 (the 2015 node wrote it at "

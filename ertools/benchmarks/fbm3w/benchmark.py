@@ -510,7 +510,8 @@ def _deviations(
     if mode == "states":
         out.append(
             RULE_LIVE_CLOCK.deviation(
-                "reference = last logged pose at or before COMPLETED_MANUAL_OPERATION and "
+                "reference = last logged pose at or before the BmBox left "
+                "WAITING_MANUAL_OPERATION and "
                 "execution_time from the BmBox state messages' record times; 2015 read the live "
                 "tf and its own wall clock at the same transitions"
             )

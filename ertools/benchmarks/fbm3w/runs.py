@@ -4,7 +4,8 @@ Every finder returns :class:`RunWindow` s: when the reference position is taken,
 time window of the path. The scorer does the rest, identically for the three modes.
 
 ``states`` (seed 7.3.3, the 2015 node): per run the BmBox goes
-``WAITING_MANUAL_OPERATION -> COMPLETED_MANUAL_OPERATION`` (reference = pose at completion)
+``WAITING_MANUAL_OPERATION -> COMPLETED_MANUAL_OPERATION`` (reference = the pose when it left
+WAITING_MANUAL_OPERATION, READY on a RefBox END too: the node's ``ManualOperation()`` returned)
 ``-> TRANSMITTING_GOAL`` (payload: the spec) ``-> EXECUTING_GOAL`` (path starts)
 ``-> WAITING_RESULT -> READY`` (path ends when WAITING_RESULT is left). A RefBox ``END`` during
 a run ends it early when its payload is a timeout or a stop (``reason: timeout`` /
