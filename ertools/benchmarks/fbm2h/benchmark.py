@@ -261,9 +261,8 @@ def compute(
         )
     deviations: list[Deviation] = [
         RULE_POSE_MOMENT.deviation(
-            "robot pose interpolated (linear + SLERP) at the logged reached moment; the 2015 "
-            "node's tf lookup interpolated at its own `now`, taken once WaitResult() had "
-            "returned, a few milliseconds later"
+            "robot pose interpolated (linear + SLERP) at the logged reached moment; 2015's tf "
+            "lookup interpolated at the ROS time its node handled the result, a few ms later"
         ),
         RULE_SCORE_FORMAT.deviation(
             "segments_details nested under details as in Listing 13 (the 2015 node wrote it at "
@@ -460,7 +459,8 @@ def score_found(logs: Fbm2hLogs, runs: Fbm2hRuns, options: Fbm2hOptions) -> Fbm2
             ("goal_layout", logs.goal.layout if logs.goal is not None else "log payload"),
             ("orientation_2015", str(options.orientation_2015)),
             ("unscored_segments", "2015" if options.unscored_2015 else "null"),
-            ("rules", options.rules),
+            # the node reproduced, when one is (the notes name its commit)
+            *((("rules", options.rules),) if options.rules != "ertools" else ()),
         ),
     )
     result = compute(

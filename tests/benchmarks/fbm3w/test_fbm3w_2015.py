@@ -9,8 +9,8 @@ to the pose2d topic from ``SendGoal`` (BmBox EXECUTING_GOAL) until ``WaitResult`
 one; the run frame has its origin at the first kept pose and its x axis along reference ->
 start; Eq. (1) averages the distances to the shape at l_i / L over the N kept poses. ``if
 benchmark.Timeout()`` only prints, before ``if not benchmark.Running(): continue``: a run the
-RefBox timed out is scored on what it covered and timed, a stopped run neither. Nothing here calls ertools' scoring code; ertools
-only reads the bag (the reader is tested elsewhere).
+RefBox timed out is scored on what it covered and timed, a stopped run neither. Nothing here
+calls ertools' scoring code; ertools only reads the bag (the reader is tested elsewhere).
 """
 
 from __future__ import annotations

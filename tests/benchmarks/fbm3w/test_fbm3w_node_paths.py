@@ -304,3 +304,13 @@ def test_issue_23_stopped_and_cut_runs_add_no_time_in_2015(
     for data in got.values():
         assert _close(data["execution_time"], 12.0)
         assert set(data["runs_details"]) == {"0", "1", "2"}
+
+
+def test_rules_2015_is_2015(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--rules 2015`` is ``--2015``, the spelling FBM1 and FBM2@Home share."""
+    bag, node = _node("timeout-then-waits", tmp_path)
+    flag, _ = _score(bag, ["--2015"], capsys)
+    rules, _ = _score(bag, ["--rules", "2015"], capsys)
+    assert rules == flag and _close(rules["execution_time"], node["execution_time"])
+    assert main(["score", "fbm3w", str(bag), "--rules", "2015", "--arc-length"]) == 2
+    assert "contradict" in capsys.readouterr().err
