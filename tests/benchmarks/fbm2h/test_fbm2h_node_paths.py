@@ -65,7 +65,7 @@ class Case:
     """One path: what happens in segment ``at``, and the 2015 numbers to expect by hand."""
 
     name: str
-    event: str  # normal, timeout, stop, timeout_sending, stop_sending, bare_timeout, cut_*
+    event: str  # normal, timeout, stop, timeout_sending, stop_sending, bare_timeout, unknown, cut_*
     at: int = 2  # the segment it happens in
 
 
@@ -77,9 +77,11 @@ CASES = (
     Case("timeout while the goal is sent", "timeout_sending"),
     Case("stop while the goal is sent", "stop_sending"),
     Case("bare 'timeout' payload", "bare_timeout"),
+    Case("an END payload no code knew", "unknown"),
     Case("cut before the first goal", "cut_before"),
     Case("cut while the goal is sent", "cut_sending"),
     Case("cut while driving", "cut_driving"),
+    Case("cut before WAITING_RESULT", "cut_executing"),
     Case("cut between segments", "cut_between"),
 )
 
@@ -134,6 +136,9 @@ def _transitions(case: Case) -> tuple[list[Transition], int | None]:
         ]
         if here and case.event == "cut_driving":
             return tr, at(g + 3.0)
+        if here and case.event == "cut_executing":
+            # The log ends at the BmBox's EXECUTING_GOAL, before its WAITING_RESULT.
+            return [x for x in tr if x.t_ns < at(g + 0.21)], at(g + 0.205)
         if here and case.event in ("timeout", "stop"):
             tr += [
                 Transition(at(g + 3.0), Machine.REFBOX, R.END, f"reason: {case.event}"),
@@ -142,14 +147,15 @@ def _transitions(case: Case) -> tuple[list[Transition], int | None]:
             ]
             t_score = g + 3.2
             break
-        if here and case.event == "bare_timeout":
-            tr.append(Transition(at(g + 3.0), Machine.REFBOX, R.END, "timeout"))
+        if here and case.event in ("bare_timeout", "unknown"):
+            text = "timeout" if case.event == "bare_timeout" else "reason: finished"
+            tr.append(Transition(at(g + 3.0), Machine.REFBOX, R.END, text))
         tr += [
             Transition(at(g + 5.0), Machine.CLIENT, C.COMPLETED_GOAL, f"waypoint: {k}\n"),
             Transition(at(g + 5.06), Machine.BMBOX, B.READY),
             Transition(at(g + 5.2), Machine.CLIENT, C.WAITING_GOAL),
         ]
-        ended = case.event in ("timeout_sending", "bare_timeout") and k >= case.at
+        ended = case.event in ("timeout_sending", "bare_timeout", "unknown") and k >= case.at
         if not ended:
             tr.append(Transition(at(g + 5.08), Machine.REFBOX, R.READY))
         if here and case.event == "timeout_sending":
@@ -316,9 +322,11 @@ BY_HAND = {
     "timeout_sending": ([0, 1, 2], 2, False),
     "stop_sending": ([0, 1], None, True),
     "bare_timeout": ([0, 1, 2, 3], None, False),
+    "unknown": ([0, 1, 2, 3], None, False),
     "cut_before": ([], None, True),
     "cut_sending": ([0, 1], None, True),
     "cut_driving": ([0, 1, 2], None, True),
+    "cut_executing": ([0, 1, 2], None, True),
     "cut_between": ([0, 1], None, True),
 }
 
@@ -351,8 +359,9 @@ def test_rules_equal_the_node(
     assert_same(out, node)
     if len(node.details) < len(WAYPOINTS):
         assert "counted in N with no error, as 2015 did" in err
-    if case.event == "bare_timeout":
-        said = "RefBox END with payload 'timeout', which is none of the forms the 2015 BmBox knows"
+    if case.event in ("bare_timeout", "unknown"):
+        text = "timeout" if case.event == "bare_timeout" else "reason: finished"
+        said = f"RefBox END with payload '{text}', which is none of the forms the 2015 BmBox knows"
         assert said in err and "neither a timeout nor a stop" in err
     assert ("the log ends inside the benchmark" in err) is node.cut
 
@@ -366,9 +375,11 @@ BY_DEFAULT = {
     "timeout_sending": [0, 1],
     "stop_sending": [0, 1],
     "bare_timeout": [0, 1],  # the seed's 'timeout' read as the timeout it names, said
+    "unknown": [0, 1, 2, 3],  # no known form: neither, warned
     "cut_before": [],
     "cut_sending": [0, 1],
     "cut_driving": [0, 1],
+    "cut_executing": [0, 1],
     "cut_between": [0, 1],
 }
 
