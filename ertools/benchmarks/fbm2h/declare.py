@@ -353,10 +353,12 @@ timing file (p0 starts, p(k+1) closes segment k, seconds from the bag's first me
 stops detected in the ground truth, assigned to the waypoints in order.
 Orientation errors are wrapped to [0, pi]; --orientation-2015 reproduces the 2015 numbers.
 Accuracies are null (exit 1) when a segment is not scored (RefBox timeout or stop, or a log
-that ends inside the benchmark, taken as stopped there); --unscored-segments 2015 divides the
-sum over the scored segments by N as 2015 did. --segment-clock bmbox times segments between
-the BmBox's own transitions as the 2015 node did. --2015: every 2015 behaviour at once, with
-the node's pose source (/tf world -> robot_at_home)."""
+that ends inside the benchmark, taken as stopped there); --unscored-segments 2015 scores the
+segment cut short where the node's wait returned and divides the sums by N as 2015 did.
+--segment-clock bmbox times segments between the BmBox's own transitions as the node did.
+--2015 (= --rules 2015: scripts/fbm2h at 50b173b, RoCKIn 2015; --rules 2016 and 2017 name the
+same file at 40ba68b and 89dfa75): every 2015 behaviour at once, with the node's pose source
+(/tf world -> robot_at_home)."""
 
 BENCHMARK: Benchmark[Fbm2hOptions, Fbm2hLogs, Fbm2hRuns, Fbm2hResult] = Benchmark(
     name=NAME,
