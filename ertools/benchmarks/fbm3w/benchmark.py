@@ -17,7 +17,6 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import F64
 from ertools.benchmarks.common.ending import end_payload_deviation
 from ertools.benchmarks.common.hygiene import (
     frame_change_warning,
@@ -43,7 +42,7 @@ from ertools.benchmarks.fbm3w.config import (
     Fbm3wOptions,
 )
 from ertools.benchmarks.fbm3w.intervals import with_intervals
-from ertools.benchmarks.fbm3w.path import score_path
+from ertools.benchmarks.fbm3w.path import score_path, shape_floor, try_score
 from ertools.benchmarks.fbm3w.result import Fbm3wResult, RunResult
 from ertools.benchmarks.fbm3w.rules import (
     RULE_ARC_LENGTH,
@@ -67,8 +66,7 @@ from ertools.benchmarks.noise.benchmark import (
     noise_from_stream,
 )
 from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
-from ertools.configs.shapes import Shape
-from ertools.errors import ConfigError, ErtoolsError, ScoringError
+from ertools.errors import ConfigError, ScoringError
 from ertools.fidelity import Deviation
 from ertools.io import read_benchmark_states, summary, topics
 from ertools.io.clock import check_header_clock
@@ -84,8 +82,7 @@ STALE_REFERENCE_S = 0.5
 # Below this reference-start distance the run frame's direction is uncertain (1 mm of noise
 # turns a 1 cm baseline by ~0.1 rad).
 SHORT_BASELINE_M = 0.01
-# Samples of the noiseless robot used for shape_floor, and the floor worth a warning.
-FLOOR_SAMPLES = 10_001
+# The shape floor worth a warning.
 FLOOR_WARN_M = 0.0005
 # A kept path this much longer than the target is suspicious (the sample's runs: 1.00-1.01).
 LONG_PATH_RATIO = 1.15
@@ -422,10 +419,13 @@ def _score_one(
         if problem is not None:
             common["unscoreable_reason"] = problem
     rel = (window.start_ns - bag_start_ns) / 1e9, (window.end_ns - bag_start_ns) / 1e9
-    if hi - lo < 2:
+    as_2015 = options.unscoreable_runs == "2015"
+    if hi - lo < (1 if as_2015 else 2):
+        crashed = " (the 2015 node failed here, robot_path[0] of an empty path, and sent no score)"
         return result(
             f"{hi - lo} pose sample(s) in the path window {rel[0]:.3f}-{rel[1]:.3f} s; "
-            "at least 2 are needed (tracking lost, or wrong window?)",
+            "at least 2 are needed (tracking lost, or wrong window?)"
+            + (crashed if as_2015 else ""),
             **common,
         )
     ref_i = int(np.searchsorted(poses.t_ns, window.ref_ns, side="right")) - 1
@@ -441,7 +441,7 @@ def _score_one(
     ref_xy = poses.xyz[ref_i, :2].copy()
     common["reference_xy"] = (float(ref_xy[0]), float(ref_xy[1]))
     try:
-        score = score_path(xy, ref_xy, shape, cfg.d_min)
+        score = score_path(xy, ref_xy, shape, cfg.d_min, as_2015=as_2015)
     except ScoringError as err:
         return result(err.message, **common)
     if problem is not None and options.unscoreable_runs != "2015":
@@ -453,6 +453,12 @@ def _score_one(
         warnings.append(
             f"run {window.index}: 2015 scored this run from {common['path_coverage']:.1%} of "
             f"its path (--unscoreable 2015); by default it is unscoreable: {problem}"
+        )
+    if len(score.kept) == 1:
+        warnings.append(
+            f"run {window.index}: no pose of its path moved d_min from the first: 2015 scored "
+            "it error_sum / N = 0.0 over its one kept pose (--unscoreable 2015); by default it "
+            "has no distance_error"
         )
     baseline = float(np.hypot(*(xy[0] - ref_xy)))
     if baseline < SHORT_BASELINE_M:
@@ -473,7 +479,7 @@ def _score_one(
             f"({score.path_length:.4f} vs {target_length:.4f} m): jitter passing d_min or a "
             "detour inflates L and shifts l/L; see --d-min-sweep"
         )
-    swept = tuple((d, _try_score(xy, ref_xy, shape, d)) for d in options.sweep)
+    swept = tuple((d, try_score(xy, ref_xy, shape, d)) for d in options.sweep)
     floor = shape_floor(shape, cfg.d_min)
     if floor > FLOOR_WARN_M and not any(spec in w and "floor" in w for w in warnings):
         warnings.append(
@@ -493,27 +499,6 @@ def _score_one(
     )
 
 
-def shape_floor(shape: Shape, d_min: float) -> float:
-    """distance_error of a noiseless robot exactly on ``shape`` (1e4 samples), metres.
-
-    0 up to the d_min quantisation for shapes parametrised by arc length; 8.4 mm for the 2015
-    ``sine``, whose parameter is proportional to x, not to the length travelled.
-    """
-    pts = shape(np.linspace(0.0, 1.0, FLOOR_SAMPLES))
-    reference = np.array([-0.05, 0.0])  # run frame = world frame
-    try:
-        return score_path(pts, reference, shape, d_min).distance_error
-    except ErtoolsError:
-        return math.nan
-
-
-def _try_score(xy: F64, ref_xy: F64, shape: Shape, d_min: float) -> float | None:
-    try:
-        return score_path(xy, ref_xy, shape, d_min).distance_error
-    except ErtoolsError:
-        return None
-
-
 def _deviations(
     cfg: Fbm3wConfig,
     runs: Sequence[RunResult],
@@ -525,7 +510,8 @@ def _deviations(
     if mode == "states":
         out.append(
             RULE_LIVE_CLOCK.deviation(
-                "reference = last logged pose at or before COMPLETED_MANUAL_OPERATION and "
+                "reference = last logged pose at or before the BmBox left "
+                "WAITING_MANUAL_OPERATION and "
                 "execution_time from the BmBox state messages' record times; 2015 read the live "
                 "tf and its own wall clock at the same transitions"
             )
