@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.configs._yaml import load_yaml, number, parse_yaml
+from ertools.configs._yaml import load_yaml, number, parse_payload
 from ertools.errors import ConfigError
 
 Pose2 = tuple[float, float, float]
@@ -115,4 +115,4 @@ def load_goal(path: str | Path) -> GoalList:
 
 def goal_from_payload(payload: str, source: str) -> GoalList:
     """The goal list carried by the first TRANSMITTING_GOAL payload."""
-    return parse_goal(parse_yaml(payload, source=source, what="goal payload"), source=source)
+    return parse_goal(parse_payload(payload, source=source, what="goal payload"), source=source)

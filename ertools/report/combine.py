@@ -20,6 +20,7 @@ import io
 import json
 import math
 import os
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -113,9 +114,53 @@ def _options(argv: list[str], inputs: list[dict[str, Any]]) -> str:
     return " ".join(kept)
 
 
+class _DuplicateKeyError(ValueError):
+    pass
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    out = dict(pairs)
+    if len(out) != len(pairs):
+        raise _DuplicateKeyError
+    return out
+
+
+# a JSON text's tokens: strings (escapes kept), punctuation, anything else up to a delimiter
+_TOKEN = re.compile(r'"(?:[^"\\]|\\.)*"|[{}\[\]:,]|[^\s{}\[\]:,"]+')
+
+
+def _first_duplicate(text: str) -> str:
+    """``duplicate key 'k' at line L (first at line F)`` of a JSON text holding one (found by
+    a scan of its tokens: the json module's hook says that a key repeats, not where)."""
+    stack: list[dict[str, int] | None] = []  # per open object: key -> line; None: a list
+    tokens = list(_TOKEN.finditer(text))
+    for k, m in enumerate(tokens):
+        token = m.group()
+        if token in "{[":
+            stack.append({} if token == "{" else None)
+        elif token in "}]":
+            stack.pop()
+        elif (
+            token.startswith('"')
+            and stack
+            and (keys := stack[-1]) is not None
+            and k + 1 < len(tokens)
+            and tokens[k + 1].group() == ":"
+        ):
+            key, line = json.loads(token), text.count("\n", 0, m.start()) + 1
+            if key in keys:
+                return f"duplicate key {key!r} at line {line} (first at line {keys[key]})"
+            keys[key] = line
+    return "a key given twice"
+
+
 def _load_json(path: Path) -> Any:
+    """A result's JSON; a key given twice is refused (the json module keeps the last)."""
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
+        text = path.read_text(encoding="utf-8")
+        return json.loads(text, object_pairs_hook=_unique_keys)
+    except _DuplicateKeyError:
+        raise ConfigError(f"cannot read a result: {_first_duplicate(text)}", path=path) from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
         raise ConfigError(f"cannot read a result: {err}", path=path) from err
 
@@ -253,7 +298,7 @@ def combine(
                 row["rank"] = standing.marker if standing else "\u2014"
             row["team"] = x.team or "(unknown)"
             for k in keys:
-                row[k] = e.headline.get(k)
+                row[k] = _finite(e.headline.get(k))
                 if k == board.key and board.has_intervals:  # its interval right beside it
                     row[board.interval_header] = _interval_text(board.key, record["interval"])
                     row[_P_HEADER] = (
@@ -305,7 +350,8 @@ def combine(
                 **_board_context(board),
             }
         )
-    atomic.write_text(outdir / "results.json", json.dumps(flat, indent=2) + "\n")
+    text = json.dumps(_finite(flat), indent=2, allow_nan=False)
+    atomic.write_text(outdir / "results.json", text + "\n")
     table = [_csv_row(row) for row in flat]
     columns = list(dict.fromkeys(k for row in table for k in row))
     buffer = io.StringIO()
@@ -330,6 +376,18 @@ def combine(
 
 
 _P_HEADER = "P(swap with next)"
+
+
+def _finite(value: Any) -> Any:
+    """``value`` with every float that is not finite (a result's Infinity, NaN) as None:
+    results.json stays JSON, and the tables show no such number."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    return value
 
 
 @dataclass(frozen=True)
@@ -372,8 +430,11 @@ def _board(bench: str, group: list[Execution], chosen: float | None = None) -> B
         if unscoreable is not None:
             reasons[i] = f"unscoreable: {unscoreable}"
             continue
-        if isinstance(value, bool) or not isinstance(value, int | float) or math.isnan(value):
+        if isinstance(value, bool) or not isinstance(value, int | float):
             reasons[i] = f"no {key} in this result"
+            continue
+        if not math.isfinite(value):  # json reads Infinity and NaN: never a place on a board
+            reasons[i] = f"{key} is {value} in this result: not a finite number"
             continue
         contenders.append(
             ranks.Contender(

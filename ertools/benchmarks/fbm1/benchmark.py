@@ -56,7 +56,7 @@ from ertools.benchmarks.fbm1.rules import (
 from ertools.benchmarks.fbm1.runs import Fbm1Run, RunsFound
 from ertools.benchmarks.fbm1.score import MAX_POSE_ERROR_2015, names_match, pose_errors, totals
 from ertools.benchmarks.fbm1.validity import body_mask, gt_validity
-from ertools.configs._yaml import parse_yaml
+from ertools.configs._yaml import parse_payload
 from ertools.configs.items import Item, ItemList
 from ertools.errors import ConfigError, ScoringError, SegmentationError
 from ertools.fidelity import Deviation
@@ -468,7 +468,7 @@ def _parse_logged(payload: str | None) -> dict[str, Any] | None:
         return None
 
     try:
-        data = parse_yaml(payload, "BmBox TRANSMITTING_SCORE payload")
+        data = parse_payload(payload, "BmBox TRANSMITTING_SCORE payload")
     except ConfigError:
         log.warning("the logged 2015 score payload is not YAML: %.60r", payload)
         return None
