@@ -134,6 +134,26 @@ def check_numbers(data: Any, source: str) -> Any:
     return data
 
 
+# An angle in radians beyond a full turn either way is no heading but a number in degrees (a
+# goal's theta of 180 scored an orientation error of 1.744 rad instead of 0.070); the slack
+# admits 2*pi written with fewer digits than the float's.
+FULL_TURN = 2.0 * math.pi + 1e-6
+
+
+def check_radians(
+    value: float, key: str, source: str, *, limit: float = FULL_TURN, bound: str = "2 pi"
+) -> float:
+    """``value`` when it is an angle of at most ``limit`` radians (``bound`` in words) either
+    way, else a ConfigError naming the key and what the value would be in degrees."""
+    if abs(value) <= limit:
+        return value
+    raise ConfigError(
+        f"{key}: {value:g} is more than {bound} either way: angles are in radians here "
+        f"({value:g} degrees would be {math.radians(value):.4f} rad)",
+        path=source,
+    )
+
+
 def number(
     value: Any,
     key: str,

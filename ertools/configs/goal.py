@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.configs._yaml import load_yaml, number, parse_payload
+from ertools.configs._yaml import check_radians, load_yaml, number, parse_payload
 from ertools.errors import ConfigError
 
 Pose2 = tuple[float, float, float]
@@ -65,7 +65,7 @@ def _pose(value: Any, what: str, source: str) -> Pose2:
     if not isinstance(value, list | tuple) or len(value) != 3:
         raise ConfigError(f"{what}: expected [x, y, theta], got {value!r}", path=source)
     x, y, theta = (_number(v, what, source) for v in value)
-    return (x, y, theta)
+    return (x, y, check_radians(theta, f"{what} theta", source))
 
 
 def _optional_number(data: dict[str, Any], key: str, source: str) -> float | None:

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.configs._yaml import load_yaml, number
+from ertools.configs._yaml import check_radians, load_yaml, number
 from ertools.errors import ConfigError
 from ertools.geometry import invert
 from ertools.yamlout import yaml_float
@@ -249,6 +249,9 @@ def _parse_spread(value: Any, source: str) -> TransformSpread | None:
         counts.append(v)
     if any(x < 0 for x in (*pos, *rot)):
         raise ConfigError(f"{what}: a standard deviation cannot be negative", path=source)
+    for axis, r in zip("xyz", rot, strict=True):
+        # a rotation vector is at most pi long: a larger spread is a number in degrees
+        check_radians(r, f"{what}.rotation_std {axis}", source, limit=math.pi, bound="pi")
     if counts[1] > counts[0]:
         raise ConfigError(
             f"{what}: effective_samples {counts[1]} exceeds samples {counts[0]}", path=source

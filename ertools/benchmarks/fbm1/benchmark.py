@@ -25,7 +25,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.common.hygiene import frame_change_warning
+from ertools.benchmarks.common.hygiene import frame_change_warning, impossible_warning
 from ertools.benchmarks.common.validity import (
     SampleMask,
 )
@@ -399,6 +399,7 @@ def score_fbm1(
     warnings = list(found.warnings)
     # A GT body whose frame_id changes mid-log mixes frames (ertools.streams).
     warnings += [w for w in (frame_change_warning(b, t0_ns or None) for b in (origin, board)) if w]
+    warnings += [w for w in (impossible_warning(b, t0_ns or None) for b in (origin, board)) if w]
     if items.is_vanilla:
         warnings.append(
             f"{items.source or 'the item list'} has identity transforms only (a vanilla list): "

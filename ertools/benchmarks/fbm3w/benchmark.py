@@ -23,9 +23,12 @@ from ertools.benchmarks.common.hygiene import (
     frame_change_warning,
     frozen_around,
     identical_poses,
+    impossible_warning,
 )
 from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
 from ertools.benchmarks.common.validity import (
+    FAR,
+    JUMP,
     STILL_M,
     SampleMask,
     coverage,
@@ -262,18 +265,23 @@ def score_runs(
             f"shape {specs[len(runs_in)]!r} between still phases; the log ends there or the "
             "rest need --runs windows"
         )
-    noise = _noise(poses, options, warnings)
-    same = identical_poses(poses)
     mask = sample_codes(poses.t_ns, poses.xyz, poses.quat_xyzw)
-    frames = frame_change_warning(poses, start_ns)
-    if frames:
-        warnings.append(frames)
+    # a physically impossible pose (far, jump) is no measurement: every number is computed
+    # without it, and the validity counts it (docs/uncertainty.md, "Impossible samples")
+    usable = ~np.isin(mask.codes, (FAR, JUMP))
+    full = poses
+    poses = poses if usable.all() else poses.take(usable)
+    noise = _noise(poses, options, warnings)
+    same = identical_poses(full)
+    warnings.extend(
+        w for w in (frame_change_warning(full, start_ns), impossible_warning(full, start_ns)) if w
+    )
     results: list[RunResult] = []
     failures: list[str] = []
     if progress is not None:
         progress.task("scoring runs", len(runs_in), "runs")
     for window in runs_in:
-        run = _score_one(poses, same, window, cfg, options, start_ns, warnings, mask)
+        run = _score_one(full, same, window, cfg, options, start_ns, warnings, mask, usable)
         if progress is not None:
             progress.advance(1)
         results.append(run)
@@ -290,7 +298,9 @@ def score_runs(
         )
     warnings.extend(_frozen_warnings(poses, runs_in, start_ns))
     mode = runs_in[0].mode if runs_in else (options.runs or "states")
-    results, best_interval, uncertainty = with_intervals(poses, same, results, cfg, options, noise)
+    results, best_interval, uncertainty = with_intervals(
+        poses, identical_poses(poses), results, cfg, options, noise
+    )
     return Fbm3wResult(
         runs=tuple(results),
         best_interval=best_interval,
@@ -370,6 +380,7 @@ def _score_one(
     bag_start_ns: int,
     warnings: list[str],
     mask: SampleMask | None = None,
+    usable: npt.NDArray[np.bool_] | None = None,
 ) -> RunResult:
     spec = window.spec or ""
 
@@ -405,7 +416,9 @@ def _score_one(
         return result("no reference time or path window was found for this run")
     lo = int(np.searchsorted(poses.t_ns, window.start_ns, side="left"))
     hi = int(np.searchsorted(poses.t_ns, window.end_ns, side="right"))
-    xy = poses.xyz[lo:hi, :2]
+    window_xy = poses.xyz[lo:hi, :2]
+    keep = np.ones(hi - lo, dtype=bool) if usable is None else usable[lo:hi]
+    xy = window_xy[keep]  # the samples scored: without the impossible ones
     losses = int(np.sum(same[lo : max(lo, hi - 1)])) if hi - lo > 1 else 0
     common: dict[str, Any] = {
         "samples": hi - lo,
@@ -415,20 +428,23 @@ def _score_one(
     problem = None
     if mask is not None:
         validity = summarise(mask, window.start_ns, window.end_ns)
-        lost = lost_spans(validity, xy, STILL_M)
+        lost = lost_spans(validity, window_xy, STILL_M)
         common["validity"] = validity
         common["path_coverage"] = coverage(validity, lost)
         problem = coverage_problem(validity, MIN_COVERAGE, MAX_INNER_GAP_S, lost)
         if problem is not None:
             common["unscoreable_reason"] = problem
     rel = (window.start_ns - bag_start_ns) / 1e9, (window.end_ns - bag_start_ns) / 1e9
-    if hi - lo < 2:
+    if len(xy) < 2:
         return result(
-            f"{hi - lo} pose sample(s) in the path window {rel[0]:.3f}-{rel[1]:.3f} s; "
+            f"{len(xy)} pose sample(s) in the path window {rel[0]:.3f}-{rel[1]:.3f} s; "
             "at least 2 are needed (tracking lost, or wrong window?)",
             **common,
         )
     ref_i = int(np.searchsorted(poses.t_ns, window.ref_ns, side="right")) - 1
+    if usable is not None and ref_i >= 0 and not usable[ref_i]:
+        before = np.flatnonzero(usable[: ref_i + 1])
+        ref_i = int(before[-1]) if before.size else -1
     ref_rel = (window.ref_ns - bag_start_ns) / 1e9
     if ref_i < 0:
         return result(f"no pose at or before the reference time {ref_rel:.3f} s", **common)
@@ -447,7 +463,7 @@ def _score_one(
     if problem is not None and options.unscoreable_runs != "2015":
         # no number, but the path in its frame: the plot shows where the data is missing
         return result(
-            None, frame_xy=score.frame.to_frame(xy), sample_t_ns=poses.t_ns[lo:hi], **common
+            None, frame_xy=score.frame.to_frame(xy), sample_t_ns=poses.t_ns[lo:hi][keep], **common
         )
     if problem is not None:
         warnings.append(
@@ -486,7 +502,7 @@ def _score_one(
         score=score,
         sweep=swept,
         frame_xy=score.frame.to_frame(xy),
-        sample_t_ns=poses.t_ns[lo:hi],
+        sample_t_ns=poses.t_ns[lo:hi][keep],
         shape_floor=floor,
         target_dense=shape.dense(501),
         **common,
