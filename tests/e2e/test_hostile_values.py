@@ -173,6 +173,19 @@ def test_trajectory_keeps_a_robot_estimate_that_jumps(
     assert "1 robot pose(s) with NaN, zero-norm or impossible poses ignored" in huge.err
 
 
+@pytest.mark.parametrize("kind", ["huge", "spike"])
+def test_noise_leaves_an_impossible_pose_out(
+    kind: str, bags: dict[str, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Before: 1e300 m overflowed (RuntimeWarning) into the noise statistics."""
+    tail = ["--topic", FBM3W_TOPIC, "--format", "json"]
+    got = strict(["noise", str(bags[f"fbm3w-{kind}"]), *tail], capsys)
+    ref = strict(["noise", str(bags["fbm3w-dropped"]), *tail], capsys)
+    assert got.code == ref.code == 0, got.err
+    assert got.json()["epsilon"] == ref.json()["epsilon"]
+    assert "left out as invalid" in got.err
+
+
 # --- finding 4: angles in degrees where radians are meant -----------------------------------
 
 
