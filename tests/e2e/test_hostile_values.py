@@ -234,3 +234,78 @@ def test_a_transform_spread_in_degrees_is_refused(
     assert (
         str(transform) in line and "acquisition_spread.rotation_std z: 12 is more than pi" in line
     )
+
+
+# --- finding 6: a score of too few samples ----------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def short_robot_logs(tmp_path_factory: pytest.TempPathFactory) -> dict[int, Path]:
+    """The robot log cut to its poses 100 to 100 + n (10 Hz, all inside the GT)."""
+    root = tmp_path_factory.mktemp("short_robot")
+    return {
+        n: edited_copy(
+            ROBOT,
+            root / f"robot{n}.bag",
+            ROBOT_TOPIC,
+            lambda k, p, n=n: p if 100 <= k < 100 + n else None,
+        )
+        for n in (1, 19, 20)
+    }
+
+
+def test_a_trajectory_of_one_pose_has_no_interval(
+    short_robot_logs: dict[int, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Before: exit 0 with a tight interval of the mocap noise alone ([132.7, 133.5] mm),
+    valid_fraction 1.0 and no warning."""
+    got = strict(
+        ["score", "trajectory", str(short_robot_logs[1]), *map(str, GT), "--format", "json"], capsys
+    )
+    assert got.code == 0, got.err
+    score = got.json()
+    assert score["compared"] == 1
+    assert score["position_error_interval"] is None and score["rmse_interval"] is None
+    assert score["percentiles"]["p90_interval"] is None
+    reason = score["uncertainty"]["withheld"]["position_error"]
+    assert reason.startswith("only 1 compared pose(s): an interval needs at least 20")
+    assert "the comparison rests on 1 compared pose(s) only (fewer than 30)" in got.err
+    assert "no 95% interval (only 1 compared pose(s)" in got.err
+
+
+def test_twenty_compared_poses_have_an_interval(
+    short_robot_logs: dict[int, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The clock audit estimates the offset from 20 poses (clocks.MIN_POSES): from there on
+    the interval holds the time association too; one pose fewer, none."""
+    tail = [*map(str, GT), "--format", "json"]
+    few = strict(["score", "trajectory", str(short_robot_logs[19]), *tail], capsys).json()
+    enough = strict(["score", "trajectory", str(short_robot_logs[20]), *tail], capsys).json()
+    assert few["compared"] == 19 and few["position_error_interval"] is None
+    assert enough["compared"] == 20 and enough["position_error_interval"] is not None
+    assert "time_association" in enough["uncertainty"]["shares"]["position_error"]
+    assert "withheld" not in enough["uncertainty"]
+
+
+def test_fbm3w_runs_of_few_kept_points_have_no_interval(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """d_min 5 cm keeps 4 to 6 points of each 16-32 cm path: no interval, said per run, and
+    none for the best score (run 2's)."""
+    got = strict(["score", "fbm3w", str(FBM3W), "--d-min", "0.05", "--format", "json"], capsys)
+    assert got.code == 0, got.err
+    score = got.json()
+    assert score["best_distance_error_interval"] is None
+    withheld = score["uncertainty"]["withheld"]
+    for k in ("0", "1", "2", "3"):
+        run = score["runs_details"][k]
+        assert run["kept_samples"] < 10 and run.get("distance_error_interval") is None
+        assert withheld[f"runs_details.{k}.distance_error"].startswith(
+            f"only {run['kept_samples']} kept path point(s)"
+        )
+        assert f"run {k} rests on {run['kept_samples']} kept path point(s) only" in got.err
+    assert withheld["best_distance_error"] == withheld["runs_details.2.distance_error"]
+    # the sample's own d_min keeps 249-427 points: every run has its interval
+    plain = strict(["score", "fbm3w", str(FBM3W), "--format", "json"], capsys).json()
+    assert plain["best_distance_error_interval"] is not None
+    assert "withheld" not in plain["uncertainty"]

@@ -26,6 +26,7 @@ from ertools.benchmarks.common.hygiene import (
     impossible_warning,
 )
 from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
+from ertools.benchmarks.common.uncertainty import few_warning
 from ertools.benchmarks.common.validity import (
     FAR,
     JUMP,
@@ -470,6 +471,9 @@ def _score_one(
             f"run {window.index}: 2015 scored this run from {common['path_coverage']:.1%} of "
             f"its path (--unscoreable 2015); by default it is unscoreable: {problem}"
         )
+    few = few_warning(len(score.kept), "kept path point(s)", f"run {window.index}")
+    if few is not None:
+        warnings.append(few)
     baseline = float(np.hypot(*(xy[0] - ref_xy)))
     if baseline < SHORT_BASELINE_M:
         warnings.append(

@@ -21,7 +21,7 @@ from ertools.benchmarks.common.hygiene import (
 )
 from ertools.benchmarks.common.interval_output import NO_INTERVALS, IntervalSettings
 from ertools.benchmarks.common.teams import parse_robot_log_name
-from ertools.benchmarks.common.uncertainty import Interval
+from ertools.benchmarks.common.uncertainty import Interval, few_warning
 from ertools.benchmarks.common.validity import (
     GAP as V_GAP,
 )
@@ -314,6 +314,9 @@ def score_streams(
             "(repeated GT poses) and are not compared"
         )
     notes.extend(_audit_warnings(audit, offset_ns))
+    few = few_warning(matched.count(COMPARED), "compared pose(s)", "the comparison")
+    if few is not None and m is not None:
+        notes.append(few)
     iv = NO_INTERVALS
     if m is not None:
         iv = trajectory_intervals(
