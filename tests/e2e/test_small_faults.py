@@ -5,6 +5,9 @@ from __future__ import annotations
 
 import csv
 import json
+import subprocess
+import sys
+import tempfile
 from pathlib import Path
 from typing import Any
 
@@ -60,3 +63,49 @@ def test_report_ranks_no_result_whose_score_is_not_a_number(
     with (out / "results.csv").open() as f:
         table = {r["team"]: r for r in csv.DictReader(f)}
     assert table["bravo"]["rank"] == "" and table["bravo"]["best_distance_error"] == ""
+
+
+# --- output paths: a full disk, a read-only folder ----------------------------------------------
+
+INFO = ["info", str(FBM3W_BAG), "--format", "json"]
+
+
+def test_a_full_device_is_named(capsys: pytest.CaptureFixture[str]) -> None:
+    """Before: `ertools: error: No space left on device: cannot read or write there`."""
+    assert main([*INFO, "-o", "/dev/full"]) == 1
+    err = capsys.readouterr().err
+    assert err == "ertools: error: /dev/full: No space left on device: cannot read or write there\n"
+
+
+def test_a_full_disk_names_the_output_and_leaves_no_temporary(tmp_path: Path) -> None:
+    """A file size limit (RLIMIT_FSIZE, as a full disk: the write fails, naming no file) on a
+    process writing its output through a temporary: the error names the output."""
+    out = tmp_path / "out" / "info.json"
+    out.parent.mkdir()
+    code = (
+        "import resource, signal, sys\n"
+        "signal.signal(signal.SIGXFSZ, signal.SIG_IGN)\n"
+        "resource.setrlimit(resource.RLIMIT_FSIZE, (200, 200))\n"
+        "from ertools.cli.main import main\n"
+        f"sys.exit(main({[*INFO, '-o', str(out)]!r}))\n"
+    )
+    ran = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
+    assert ran.returncode == 1, ran.stderr
+    assert ran.stderr == f"ertools: error: {out}: File too large: cannot read or write there\n"
+    assert list(out.parent.iterdir()) == []  # no output, no temporary
+
+
+def test_a_read_only_folder_names_the_output(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The tests run as root, whom no mode stops: the refusal is made as the OS makes it to
+    anyone else (mkstemp's PermissionError names the temporary it could not create)."""
+    out = tmp_path / "score.json"
+
+    def refuse(dir: str, prefix: str, suffix: str) -> tuple[int, str]:
+        raise PermissionError(13, "Permission denied", f"{dir}/{prefix}abc123{suffix}")
+
+    monkeypatch.setattr(tempfile, "mkstemp", refuse)
+    assert main([*INFO, "-o", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert err == f"ertools: error: {out}: Permission denied: cannot read or write there\n"
