@@ -289,6 +289,7 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
         return stop.code if isinstance(stop.code, int) else 2
     # The command as run, for report provenance (sys.argv is wrong when called in-process).
     args.command_line = [*prog.split(), *argv]
+    args.argv = list(argv)  # a group hands its member the words after the member's name
     _configure_logging(args.verbose)
     bar = _progress_bar(args)
     try:

@@ -5,12 +5,14 @@ from __future__ import annotations
 
 import csv
 import json
+import shutil
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
 from typing import Any
 
+import inprocess
 import pytest
 
 from ertools.cli.main import main
@@ -109,3 +111,27 @@ def test_a_read_only_folder_names_the_output(
     assert main([*INFO, "-o", str(out)]) == 1
     err = capsys.readouterr().err
     assert err == f"ertools: error: {out}: Permission denied: cannot read or write there\n"
+
+
+# --- `--` before a bag whose name starts with a dash ---------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["score", "fbm3w", "--", "-h.bag"],
+        ["score", "-v", "fbm3w", "--", "-h.bag"],
+        ["score", "--", "fbm3w", "-h.bag"],
+        ["score", "fbm3w", "--draws", "0", "--", "-h.bag"],
+    ],
+)
+def test_a_bag_named_like_an_option_after_a_double_dash(
+    argv: list[str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Before: `score fbm3w -- -h.bag` printed "argument -h/--help: ignored explicit argument
+    '.bag'", exit 2 (the group's parser dropped the `--` before handing the rest on)."""
+    shutil.copy(FBM3W_BAG, tmp_path / "-h.bag")
+    monkeypatch.chdir(tmp_path)
+    ran = inprocess.run(argv)
+    assert ran.code == 0, ran.stderr
+    assert "best_distance_error" in ran.stdout
