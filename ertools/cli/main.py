@@ -167,6 +167,10 @@ def _configure_logging(verbose: int) -> None:
     class _LowerLevel(logging.Formatter):
         # "ertools: warning: ..." like the CLI's own notes (cli/common.note), not "WARNING";
         # the record itself is left as is (other handlers may see it).
+        def formatMessage(self, record: logging.LogRecord) -> str:  # noqa: N802 (logging's)
+            record.message = printable(record.message)  # one line, whatever a path holds
+            return super().formatMessage(record)
+
         def format(self, record: logging.LogRecord) -> str:
             text = super().format(record)
             head = f"ertools: {record.levelname}:"
@@ -236,6 +240,22 @@ def _check_numbers(args: argparse.Namespace) -> None:
                 )
 
 
+# Control characters as escapes: a file name holding a newline (or an escape sequence) must
+# not start a line of its own in a command's output, nor drive the terminal.
+_CONTROL = {c: f"\\x{c:02x}" for c in (*range(0x20), 0x7F, *range(0x80, 0xA0))} | {
+    0x09: "\\t",
+    0x0A: "\\n",
+    0x0D: "\\r",
+    0x2028: "\\u2028",
+    0x2029: "\\u2029",
+}
+
+
+def printable(text: str) -> str:
+    """``text`` with its control characters escaped as Python writes them (``\\n``)."""
+    return text.translate(_CONTROL)
+
+
 def _one_line(message: str) -> str:
     """The message on one line: wrapped third-party texts (a YAML parser's) span several."""
     return " ".join(message.split())
@@ -262,7 +282,7 @@ def error_text(message: str) -> str:
     :data:`MAX_ERROR_LINE` characters, else each further clause (after "; ") on a line of its
     own indented by two spaces, and a clause still too long wrapped at words onto lines
     indented by four."""
-    first = f"ertools: error: {_one_line(message)}"
+    first = f"ertools: error: {printable(_one_line(message))}"
     if len(first) <= MAX_ERROR_LINE:
         return first
     clauses = _clauses(first)

@@ -20,12 +20,11 @@ import io
 import json
 import math
 import os
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ertools import __version__, atomic
+from ertools import __version__, atomic, jsonin
 from ertools.benchmarks import registry
 from ertools.benchmarks.common.teams import team_from_log_name
 from ertools.csvsafe import spreadsheet_safe
@@ -114,54 +113,11 @@ def _options(argv: list[str], inputs: list[dict[str, Any]]) -> str:
     return " ".join(kept)
 
 
-class _DuplicateKeyError(ValueError):
-    pass
-
-
-def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
-    out = dict(pairs)
-    if len(out) != len(pairs):
-        raise _DuplicateKeyError
-    return out
-
-
-# a JSON text's tokens: strings (escapes kept), punctuation, anything else up to a delimiter
-_TOKEN = re.compile(r'"(?:[^"\\]|\\.)*"|[{}\[\]:,]|[^\s{}\[\]:,"]+')
-
-
-def _first_duplicate(text: str) -> str:
-    """``duplicate key 'k' at line L (first at line F)`` of a JSON text holding one (found by
-    a scan of its tokens: the json module's hook says that a key repeats, not where)."""
-    stack: list[dict[str, int] | None] = []  # per open object: key -> line; None: a list
-    tokens = list(_TOKEN.finditer(text))
-    for k, m in enumerate(tokens):
-        token = m.group()
-        if token in "{[":
-            stack.append({} if token == "{" else None)
-        elif token in "}]":
-            stack.pop()
-        elif (
-            token.startswith('"')
-            and stack
-            and (keys := stack[-1]) is not None
-            and k + 1 < len(tokens)
-            and tokens[k + 1].group() == ":"
-        ):
-            key, line = json.loads(token), text.count("\n", 0, m.start()) + 1
-            if key in keys:
-                return f"duplicate key {key!r} at line {line} (first at line {keys[key]})"
-            keys[key] = line
-    return "a key given twice"
-
-
 def _load_json(path: Path) -> Any:
     """A result's JSON; a key given twice is refused (the json module keeps the last)."""
     try:
-        text = path.read_text(encoding="utf-8")
-        return json.loads(text, object_pairs_hook=_unique_keys)
-    except _DuplicateKeyError:
-        raise ConfigError(f"cannot read a result: {_first_duplicate(text)}", path=path) from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        return jsonin.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as err:
         raise ConfigError(f"cannot read a result: {err}", path=path) from err
 
 

@@ -135,3 +135,40 @@ def test_a_bag_named_like_an_option_after_a_double_dash(
     ran = inprocess.run(argv)
     assert ran.code == 0, ran.stderr
     assert "best_distance_error" in ran.stdout
+
+
+# --- a file name holding a newline or an escape sequence -----------------------------------------
+
+FORGED = "evil\nertools: error: forged.bag"
+
+
+def test_a_file_name_cannot_forge_lines_of_the_timeline(tmp_path: Path) -> None:
+    """Before: the path's newline started a line `ertools: error: forged.bag` of its own in
+    the table (and of the pairing below it)."""
+    folder = tmp_path / "logs"
+    folder.mkdir()
+    shutil.copy(FBM3W_BAG, folder / FORGED)
+    shutil.copy(FBM3W_BAG, folder / "\x1b[2Jclear.bag")
+    (folder / "broken\nertools: error: forged too.bag").write_bytes(b"#ROSBAG V2.0\n")
+    ran = inprocess.run(["timeline", str(folder)])
+    assert ran.code == 0, ran.stderr
+    for stream in (ran.stdout, ran.stderr):
+        assert "\x1b" not in stream
+        assert not any(line.startswith("ertools: error: forged") for line in stream.splitlines())
+    assert all(line.startswith("ertools: ") for line in ran.stderr.splitlines()), ran.stderr
+    assert "evil\\nertools: error: forged.bag" in ran.stdout
+    assert "\\x1b[2Jclear.bag" in ran.stdout
+    assert "broken\\nertools: error: forged too.bag" in ran.stderr  # its problem, on one line
+
+
+def test_a_file_name_cannot_forge_lines_of_info_or_score(tmp_path: Path) -> None:
+    bag = tmp_path / FORGED
+    shutil.copy(FBM3W_BAG, bag)
+    info = inprocess.run(["info", str(bag)])
+    assert info.code == 0 and "evil\\nertools: error: forged.bag" in info.stdout
+    score = inprocess.run(
+        ["score", "fbm3w", str(bag), "--draws", "0", "-o", str(tmp_path / "s.yaml")]
+    )
+    assert score.code == 0, score.stderr
+    assert all(line.startswith("ertools: ") for line in score.stderr.splitlines()), score.stderr
+    assert not any(line.startswith("ertools: error: forged") for line in score.stderr.splitlines())

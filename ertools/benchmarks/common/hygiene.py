@@ -9,6 +9,7 @@ measurements never repeat a float64 coordinate, so an equal row is a re-sent pos
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -378,6 +379,29 @@ def frozen_around(
                 a, b = int(starts[r]), int(ends[r])
                 out[k] = FrozenSpan(int(t[a]), int(t[b]), b - a + 1)
                 break
+    return out
+
+
+def frozen_warnings(
+    poses: PoseStream, moments: Sequence[tuple[str, str, int]], origin_ns: int
+) -> list[str]:
+    """A warning per moment ``(who, what, t_ns)`` (``("run 2", "start", t)``) whose pose is a
+    frozen (repeated) pose (:func:`frozen_around`): the last pose before a tracking loss, not
+    where the body was then."""
+    if not moments:
+        return []
+    out = []
+    for (who, what, t), span in zip(
+        moments, frozen_around(poses, [m[2] for m in moments]), strict=True
+    ):
+        if span is None:
+            continue
+        out.append(
+            f"{who}: the pose at its {what} time {(t - origin_ns) / 1e9:.3f} s is frozen: "
+            f"{span.samples} identical poses over {span.duration_s:.3f} s "
+            f"({(span.start_ns - origin_ns) / 1e9:.3f}-{(span.end_ns - origin_ns) / 1e9:.3f} s "
+            "from the log's first message; tracking lost, or a noiseless recording)"
+        )
     return out
 
 

@@ -160,6 +160,22 @@ def sample_codes(t_ns: I64, xyz: F64, quat_xyzw: F64 | None = None) -> SampleMas
     return SampleMask(t_ns, codes)
 
 
+def measured(mask: SampleMask) -> Bool:
+    """Which samples of ``mask``'s stream are measurements at all: not ``far`` or a ``jump``
+    (physically impossible: every number is computed without them, the validity counts
+    them; docs/uncertainty.md, "Impossible samples")."""
+    ok: Bool = ~np.isin(mask.codes, (FAR, JUMP))
+    return ok
+
+
+def last_measured(ok: Bool, i: int) -> int:
+    """The last index at or before ``i`` where ``ok`` holds, -1 when none does."""
+    if i < 0 or ok[i]:
+        return i
+    before = np.flatnonzero(ok[: i + 1])
+    return int(before[-1]) if before.size else -1
+
+
 @dataclass(frozen=True)
 class InvalidSpan:
     """A stretch of the window without valid data longer than the gap threshold.

@@ -21,20 +21,20 @@ from ertools.arrays import F64
 from ertools.benchmarks.common.ending import end_payload_deviation
 from ertools.benchmarks.common.hygiene import (
     frame_change_warning,
-    frozen_around,
+    frozen_warnings,
     identical_poses,
     impossible_warning,
 )
 from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
 from ertools.benchmarks.common.uncertainty import few_warning
 from ertools.benchmarks.common.validity import (
-    FAR,
-    JUMP,
     STILL_M,
     SampleMask,
     coverage,
     coverage_problem,
+    last_measured,
     lost_spans,
+    measured,
     sample_codes,
     summarise,
 )
@@ -267,16 +267,11 @@ def score_runs(
             "rest need --runs windows"
         )
     mask = sample_codes(poses.t_ns, poses.xyz, poses.quat_xyzw)
-    # a physically impossible pose (far, jump) is no measurement: every number is computed
-    # without it, and the validity counts it (docs/uncertainty.md, "Impossible samples")
-    usable = ~np.isin(mask.codes, (FAR, JUMP))
-    full = poses
+    full, usable = poses, measured(mask)  # scored without the impossible poses
     poses = poses if usable.all() else poses.take(usable)
-    noise = _noise(poses, options, warnings)
-    same = identical_poses(full)
-    warnings.extend(
-        w for w in (frame_change_warning(full, start_ns), impossible_warning(full, start_ns)) if w
-    )
+    noise, same = _noise(poses, options, warnings), identical_poses(full)
+    said = (frame_change_warning(full, start_ns), impossible_warning(full, start_ns))
+    warnings.extend(w for w in said if w)
     results: list[RunResult] = []
     failures: list[str] = []
     if progress is not None:
@@ -297,7 +292,11 @@ def score_runs(
             f"suggested d_min {noise.suggested_d_min:.5f} m ({noise.c:g} * epsilon); see "
             "--d-min-sweep"
         )
-    warnings.extend(_frozen_warnings(poses, runs_in, start_ns))
+    # the reference and starting positions set the run frame: a frozen pose there is the last
+    # one before a tracking loss, not where the marker set was
+    moments = (("reference", "ref_ns"), ("start", "start_ns"), ("end", "end_ns"))
+    at = [(f"run {w.index}", what, getattr(w, k)) for w in runs_in for what, k in moments]
+    warnings.extend(frozen_warnings(poses, [m for m in at if m[2] is not None], start_ns))
     mode = runs_in[0].mode if runs_in else (options.runs or "states")
     results, best_interval, uncertainty = with_intervals(
         poses, identical_poses(poses), results, cfg, options, noise
@@ -325,34 +324,6 @@ def score_runs(
         ),
         count_stopped=options.stopped_runs != "2015",
     )
-
-
-def _frozen_warnings(poses: PoseStream, runs: Sequence[RunWindow], origin_ns: int) -> list[str]:
-    """A warning per run whose reference, start or end pose is a frozen (repeated) pose.
-
-    The reference and starting positions set the run frame: a pose repeated for longer than
-    :data:`~ertools.benchmarks.common.hygiene.FROZEN_MIN_S` there is the last pose before a
-    tracking loss, not where the marker set was.
-    """
-    moments: list[tuple[int, str, int]] = []
-    for w in runs:
-        for what, t in (("reference", w.ref_ns), ("start", w.start_ns), ("end", w.end_ns)):
-            if t is not None:
-                moments.append((w.index, what, t))
-    if not moments:
-        return []
-    spans = frozen_around(poses, [m[2] for m in moments])
-    out = []
-    for (index, what, t), span in zip(moments, spans, strict=True):
-        if span is None:
-            continue
-        out.append(
-            f"run {index}: the pose at its {what} time {(t - origin_ns) / 1e9:.3f} s is frozen: "
-            f"{span.samples} identical poses over {span.duration_s:.3f} s "
-            f"({(span.start_ns - origin_ns) / 1e9:.3f}-{(span.end_ns - origin_ns) / 1e9:.3f} s "
-            "from the log's first message; tracking lost, or a noiseless recording)"
-        )
-    return out
 
 
 def _noise(poses: PoseStream, options: Fbm3wOptions, warnings: list[str]) -> NoiseResult | None:
@@ -443,9 +414,7 @@ def _score_one(
             **common,
         )
     ref_i = int(np.searchsorted(poses.t_ns, window.ref_ns, side="right")) - 1
-    if usable is not None and ref_i >= 0 and not usable[ref_i]:
-        before = np.flatnonzero(usable[: ref_i + 1])
-        ref_i = int(before[-1]) if before.size else -1
+    ref_i = ref_i if usable is None else last_measured(usable, ref_i)
     ref_rel = (window.ref_ns - bag_start_ns) / 1e9
     if ref_i < 0:
         return result(f"no pose at or before the reference time {ref_rel:.3f} s", **common)
@@ -472,8 +441,7 @@ def _score_one(
             f"its path (--unscoreable 2015); by default it is unscoreable: {problem}"
         )
     few = few_warning(len(score.kept), "kept path point(s)", f"run {window.index}")
-    if few is not None:
-        warnings.append(few)
+    warnings.extend([few] if few else [])
     baseline = float(np.hypot(*(xy[0] - ref_xy)))
     if baseline < SHORT_BASELINE_M:
         warnings.append(
