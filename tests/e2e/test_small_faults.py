@@ -14,6 +14,7 @@ from typing import Any
 
 import inprocess
 import pytest
+from stderr_text import error_messages
 
 from ertools.cli.main import main
 
@@ -172,3 +173,40 @@ def test_a_file_name_cannot_forge_lines_of_info_or_score(tmp_path: Path) -> None
     assert score.code == 0, score.stderr
     assert all(line.startswith("ertools: ") for line in score.stderr.splitlines()), score.stderr
     assert not any(line.startswith("ertools: error: forged") for line in score.stderr.splitlines())
+
+
+# --- rescore: its own results folder inside the scanned one; a topic missing -------------------
+
+
+def test_a_results_folder_inside_the_logs_is_not_listed_as_unused(tmp_path: Path) -> None:
+    """Before: the second run listed the first run's results, pages and cache (30 files) as
+    `unused` problems of the logs' folder."""
+    logs = tmp_path / "logs"
+    logs.mkdir()
+    shutil.copy(FBM3W_BAG, logs / FBM3W_BAG.name)
+    manifest = tmp_path / "competition.yaml"
+    manifest.write_text("version: 1\n")
+    argv = ["rescore", str(logs), "--config", str(manifest), "--out", str(logs / "results")]
+    for _ in range(2):
+        ran = inprocess.run([*argv, "--jobs", "1"])
+        assert ran.code == 0, ran.stderr
+    doc = json.loads((logs / "results" / "results.json").read_text())
+    assert [f["path"] for f in doc["files"]] == [FBM3W_BAG.name]
+    assert not [p for p in doc["problems"] if p["kind"] == "unused"]
+
+
+def test_an_execution_unscoreable_for_a_missing_topic_is_said_on_stderr(tmp_path: Path) -> None:
+    """Before: its row said `unscoreable` in results.json, and stderr nothing but the count."""
+    manifest = tmp_path / "competition.yaml"
+    manifest.write_text(
+        "version: 1\nbenchmarks:\n  fbm3w:\n    inputs: {topic: /no/such/topic}\n"
+        f"executions:\n- {{benchmark: fbm3w, team: a, bags: [{FBM3W_BAG}]}}\n"
+    )
+    ran = inprocess.run(
+        ["rescore", "--config", str(manifest), "--out", str(tmp_path / "out"), "--jobs", "1"]
+    )
+    assert ran.code == 1
+    lines = error_messages(ran.stderr)
+    assert len(lines) == 1, ran.stderr
+    assert lines[0].startswith("ertools: error: fbm3w-a-20151120T120000: unscoreable: ")
+    assert "/no/such/topic: no such topic" in lines[0]
