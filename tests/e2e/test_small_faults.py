@@ -210,3 +210,30 @@ def test_an_execution_unscoreable_for_a_missing_topic_is_said_on_stderr(tmp_path
     assert len(lines) == 1, ran.stderr
     assert lines[0].startswith("ertools: error: fbm3w-a-20151120T120000: unscoreable: ")
     assert "/no/such/topic: no such topic" in lines[0]
+
+
+# --- a report folder reused for another benchmark --------------------------------------------
+
+FBM2H_BAG = SAMPLES / "fbm2h" / "log_fbm2h_mocap_2015-11-20-12-00-00_0.bag"
+
+
+def test_a_reused_report_folder_keeps_nothing_of_the_previous_report(tmp_path: Path) -> None:
+    """Before: runs.csv, points.csv, noise.csv and the fbm3w figures stayed beside the fbm2h
+    report written into the same folder. Only files the previous report listed go: the
+    user's own stay, and a listed path leading out of the folder is never touched."""
+    report = tmp_path / "report"
+    first = inprocess.run(["score", "fbm3w", str(FBM3W_BAG), "--report", str(report)])
+    assert first.code == 0, first.stderr
+    (report / "notes.txt").write_text("the referee's own notes\n")
+    outside = tmp_path / "outside.txt"
+    outside.write_text("not the report's\n")
+    meta = json.loads((report / "result.json").read_text())
+    meta["files"].append("../outside.txt")
+    (report / "result.json").write_text(json.dumps(meta))
+    second = inprocess.run(["score", "fbm2h", str(FBM2H_BAG), "--report", str(report)])
+    assert second.code == 0, second.stderr
+    names = {p.relative_to(report).as_posix() for p in report.rglob("*") if p.is_file()}
+    listed = set(json.loads((report / "result.json").read_text())["files"])
+    assert names == listed | {"notes.txt", "result.json"}
+    assert not any("fbm3w" in n for n in names) and "runs.csv" not in names
+    assert outside.exists()
