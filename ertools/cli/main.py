@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import errno
 import logging
 import math
 import os
@@ -335,7 +336,7 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
     except OSError as err:  # mostly an output path that cannot be written (-o, --plot...)
         if args.debug:
             raise
-        where = f"{err.filename}: " if err.filename else ""
+        where = f"{err.filename}: " if err.filename else _writing(err, args)
         print(
             _one_line(f"ertools: error: {where}{err.strerror or err}: cannot read or write there"),
             file=sys.stderr,
@@ -344,6 +345,20 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
     except Exception as err:  # a bug: still one line unless --debug
         return _unexpected(err, args)
     return code
+
+
+# A full disk or quota, a file too large: a write's errors, which name no file.
+_WRITE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG})
+
+
+def _writing(err: OSError, args: argparse.Namespace) -> str:
+    """``writing OUT: `` for a write error naming no file (a writer not through
+    :mod:`ertools.atomic`, which names its own): the outputs the command was given, else
+    stdout; "" for any other error."""
+    if err.errno not in _WRITE_ERRNOS:
+        return ""
+    outs = [str(v) for name in OUTPUT_OPTIONS if isinstance(v := getattr(args, name, None), Path)]
+    return f"writing {', '.join(outs) or 'stdout'}: "
 
 
 def _unexpected(err: Exception, args: argparse.Namespace) -> int:

@@ -123,6 +123,7 @@ def _write_report(
     figures, figure_problems = _figures(score, audit, outdir / "figures")
 
     generated = datetime.now(UTC).isoformat(timespec="seconds")
+    files = [*written, "index.html", *(f"figures/{p.name}" for p, _ in figures)]
     meta = {
         "benchmark": benchmark,
         "team": team,
@@ -137,7 +138,7 @@ def _write_report(
         "warnings": list(_warnings(score, audit)),
         "failures": list(score.failures if score is not None else ()),
         "audit": _audit_summary(audit),
-        "files": [*written, "index.html", *(f"figures/{p.name}" for p, _ in figures)],
+        "files": files,
     }
     _write(outdir / "result.json", json.dumps(jsonable(meta), indent=2))
     page = folder_page.page(
@@ -145,7 +146,7 @@ def _write_report(
     )
     index = outdir / "index.html"
     _write(index, page)
-    _remove_stale(outdir, before - set(meta["files"]))
+    _remove_stale(outdir, before - set(files))
     return index
 
 

@@ -80,6 +80,23 @@ def test_a_full_device_is_named(capsys: pytest.CaptureFixture[str]) -> None:
     assert err == "ertools: error: /dev/full: No space left on device: cannot read or write there\n"
 
 
+def test_a_full_stdout_is_named() -> None:
+    """Writes that go through no temporary (stdout here) name what was being written."""
+    code = f"import sys\nfrom ertools.cli.main import main\nsys.exit(main({INFO!r}))\n"
+    with open("/dev/full", "w") as full:
+        ran = subprocess.run(
+            [sys.executable, "-c", code],
+            stdout=full,
+            stderr=subprocess.PIPE,
+            text=True,
+            check=False,
+        )
+    assert ran.returncode == 1
+    assert ran.stderr == (
+        "ertools: error: writing stdout: No space left on device: cannot read or write there\n"
+    )
+
+
 def test_a_full_disk_names_the_output_and_leaves_no_temporary(tmp_path: Path) -> None:
     """A file size limit (RLIMIT_FSIZE, as a full disk: the write fails, naming no file) on a
     process writing its output through a temporary: the error names the output."""
