@@ -43,12 +43,28 @@ def _fsync_folder(folder: Path) -> None:
             os.close(fd)
 
 
+def _named(err: OSError, path: Path) -> OSError:
+    """``err`` naming ``path`` where it names no file (a full disk: ``write`` says none) or
+    the temporary (a read-only folder: ``mkstemp`` names it): the user asked for ``path``."""
+    name = None if err.filename is None else Path(os.fsdecode(err.filename)).name
+    if name is not None and not name.startswith(f".{path.name}."):
+        return err  # another file, named already
+    try:
+        return type(err)(err.errno, err.strerror or str(err), str(path))
+    except TypeError:  # a subclass with its own arguments
+        return OSError(err.errno, err.strerror or str(err), str(path))
+
+
 @contextlib.contextmanager
 def replacing(path: Path) -> Iterator[Path]:
     """A temporary path beside ``path`` (same suffix, for writers that read it) to write in;
-    renamed over ``path`` once the block ends without an error, removed otherwise."""
+    renamed over ``path`` once the block ends without an error, removed otherwise. An error
+    of the temporary's is raised naming ``path``."""
     path = Path(path)
-    fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
+    try:
+        fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
+    except OSError as err:
+        raise _named(err, path) from err
     os.close(fd)
     tmp = Path(name)
     try:
@@ -57,9 +73,11 @@ def replacing(path: Path) -> Iterator[Path]:
             os.fsync(fh.fileno())
         os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as err:
         with contextlib.suppress(OSError):
             tmp.unlink()
+        if isinstance(err, OSError):
+            raise _named(err, path) from err
         raise
     _fsync_folder(path.parent)
 
@@ -69,8 +87,11 @@ def write_bytes(path: Path, data: bytes) -> Path:
     is written as it is: it cannot be replaced)."""
     path = Path(path)
     if path.exists() and not path.is_file():
-        with open(path, "wb") as fh:
-            fh.write(data)
+        try:
+            with open(path, "wb") as fh:
+                fh.write(data)
+        except OSError as err:  # a full device: the write names no file
+            raise _named(err, path) from err
         return path
     with replacing(path) as tmp:
         tmp.write_bytes(data)

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import dump_yaml
-from ertools.cli.main import error_text
+from ertools.cli.main import error_text, printable
 from ertools.cli.options import add_output
 from ertools.cli.output import dump_json, note, write_text
 from ertools.errors import BagError
@@ -79,7 +79,7 @@ def table(info: BagInfo) -> str:
 
     s = info.summary
     lines = [
-        f"path:        {s.path}",
+        f"path:        {printable(str(s.path))}",
         f"format:      {s.format} (version {s.version or 'unknown'})"
         + ("" if s.indexed else "  NOT INDEXED: scanned"),
     ]

@@ -118,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
         )
 
     def tell(outcome: Outcome) -> None:
-        if outcome.status != "scored" and outcome.error != "TopicError":
+        if outcome.status != "scored":
             note(f"error: {outcome.id}: {outcome.status}: {outcome.reason}")
 
     done = rescore_competition(

@@ -15,6 +15,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
+from ertools import yamlin
 from ertools.errors import BagError
 
 ROS1_MAGIC = b"#ROSBAG V2.0\n"
@@ -108,6 +109,8 @@ def metadata_problem(err: Exception) -> str:
     """What is wrong with a ``metadata.yaml``, on one line and without its text: PyYAML's own
     message quotes the offending line, and the file may be anything (a symlink to a secret)."""
     mark = getattr(err, "problem_mark", None)
+    if isinstance(err, yamlin.DuplicateKeyError) and mark is not None:
+        return f"a key given twice, at line {mark.line + 1}"  # its name is the file's text
     if mark is not None:
         problem = getattr(err, "problem", None) or "malformed YAML"
         return f"{problem} at line {mark.line + 1}, column {mark.column + 1}"
@@ -121,12 +124,10 @@ def metadata_problem(err: Exception) -> str:
 def _rosbag2_storage(path: Path) -> str:
     meta = path / "metadata.yaml"
     if meta.is_file():
-        import yaml  # lazy: PyYAML (~25 ms) only for a rosbag2 folder's metadata.yaml
-
         try:
-            data = yaml.safe_load(meta.read_text(encoding="utf-8"))
+            data = yamlin.load(meta.read_text(encoding="utf-8"))
             storage = str(data["rosbag2_bagfile_information"]["storage_identifier"])
-        except (yaml.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
+        except (yamlin.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
             why = metadata_problem(err)
             raise BagError(
                 f"unreadable rosbag2 metadata.yaml ({why}); re-create it with `ros2 bag reindex`",

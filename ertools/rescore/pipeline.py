@@ -246,7 +246,8 @@ def rescore(
         problems: problems found before scoring (the logs' discovery, the timeline).
         timeline: the ``timeline`` entry of the document (figure, sessions).
         progress: told of every execution done.
-        on_outcome: called with each outcome as it arrives (the CLI's stderr lines).
+        on_outcome: called with each outcome as it arrives (the CLI's stderr lines), but a
+            robot log's with no topic to compare (no row: its execution's warning says so).
         dask: the ``scheduler``'s client, started earlier (the caller closes it).
     """
     out.mkdir(parents=True, exist_ok=True)
@@ -311,9 +312,16 @@ def rescore(
             progress.task(label, total, "executions")
             progress.advance(state["done"])
 
-    for outcome in outcomes.values():
-        if on_outcome is not None:
+    # a robot log with no topic to compare is no row (its execution's warning says so): not
+    # told; every other execution not scored is, a missing topic's too
+    robot_jobs = {p.job.id for p in planned if p.of is not None}
+
+    def told(outcome: Outcome) -> None:
+        if on_outcome is not None and not (outcome.id in robot_jobs and _no_topics(outcome)):
             on_outcome(outcome)
+
+    for outcome in outcomes.values():
+        told(outcome)
     tell()
 
     def done(scored: Outcome) -> None:
@@ -331,8 +339,7 @@ def rescore(
             cache.put(keys[outcome.id], outcome)
             state["done"] += 1
             state["bad"] += outcome.status != "scored"
-            if on_outcome is not None:
-                on_outcome(outcome)
+            told(outcome)
         tell()
 
     # what the cache hits took tells the schedule which benchmarks cost most

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import os
 from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
@@ -159,5 +160,9 @@ def _rescore(
     )
     if found is not None:  # every file under PATH in one place (docs/rescore.md, "files")
         robots = {str(s.bags[0]): s.of for s in found.scorings if s.of is not None}
-        doc = account(doc, found.files, found.folders, robots)
+        # the results folder inside a scanned one holds no input: its files are none of its
+        # logs' (they were listed as unused on the next run)
+        mine = str(out.resolve()) + os.sep
+        files = [f for f in found.files if not f.startswith(mine)]
+        doc = account(doc, files, found.folders, robots)
     return Rescored(doc, tuple(write_results(doc, out)))

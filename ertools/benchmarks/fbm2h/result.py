@@ -10,6 +10,7 @@ import numpy as np
 import numpy.typing as npt
 import yaml
 
+from ertools import yamlin
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
 from ertools.benchmarks.common.uncertainty import Interval, uncertainty_rows
@@ -89,7 +90,7 @@ def _payload_value(payload: str) -> Any:
         return {}
 
     try:
-        value = yaml.safe_load(text)
+        value = yamlin.load(text, duplicates=[])  # shown as the 2015 node read it
     except yaml.YAMLError:
         return payload
     return value if isinstance(value, dict) else payload

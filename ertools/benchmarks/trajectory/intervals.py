@@ -53,21 +53,24 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, IntArr
-from ertools.benchmarks.common.clocks import OffsetEstimate
+from ertools.benchmarks.common.clocks import MIN_POSES, OffsetEstimate
 from ertools.benchmarks.common.interval_output import (
     METHOD,
     NO_INTERVALS,
     IntervalSettings,
     ResultIntervals,
     shares_of,
+    withheld,
 )
 from ertools.benchmarks.common.uncertainty import (
+    MIN_INTERVAL_SAMPLES,
     MOCAP_NOISE,
     TIME_ASSOCIATION,
     Source,
     Uncertainty,
     monte_carlo,
     sigma_from_epsilon,
+    too_few,
 )
 from ertools.benchmarks.noise.benchmark import noise_from_stream
 from ertools.benchmarks.trajectory.association import COMPARED, Matched
@@ -325,6 +328,16 @@ def trajectory_intervals(
     ok = matched.status == COMPARED
     if not settings.enabled or not ok.any() or len(gt) < 2:
         return NO_INTERVALS
+    few = too_few(
+        int(ok.sum()),
+        "compared pose(s)",
+        max(MIN_INTERVAL_SAMPLES, MIN_POSES),
+        f"the clock offset's spread (the time association, most often the largest source) "
+        f"being measured from {MIN_POSES} or more",
+    )
+    if few is not None:
+        # a null interval with the reason, not one of the mocap noise alone
+        return withheld(KEYS, few, settings, METHOD_TRAJECTORY)
     q = matched.t_ns[ok]
     r_xyz = robot.xyz[ok].astype(np.float32)
     r_yaw = robot.yaw[ok].astype(np.float32)

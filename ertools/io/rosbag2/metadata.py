@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from ertools import yamlin
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
 from ertools.io.formats import metadata_problem
@@ -28,11 +29,11 @@ def read_metadata(path: Path) -> dict[str, Any]:
 
     meta = path / "metadata.yaml"
     try:
-        data = yaml.safe_load(meta.read_text(encoding="utf-8"))
+        data = yamlin.load(meta.read_text(encoding="utf-8"))
         info = data["rosbag2_bagfile_information"]
     except OSError as err:
         raise BagError(f"unreadable metadata.yaml ({err.strerror or err})", path=path) from err
-    except (yaml.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
+    except (yamlin.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
         raise BagError(f"unreadable metadata.yaml ({metadata_problem(err)})", path=path) from err
     if not isinstance(info, dict):
         raise BagError("metadata.yaml has no rosbag2_bagfile_information", path=path)
