@@ -14,6 +14,9 @@ import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ertools.errors import BagError
+from ertools.io.inflate import inflate
+
 MAGIC = b"\x89MCAP0\r\n"
 _RECORD_HEAD = struct.Struct("<BQ")
 OP_FOOTER = 0x02
@@ -51,18 +54,10 @@ _CHUNK_HEAD = struct.Struct("<QQQI")  # start time, end time, uncompressed size,
 _MESSAGE_HEAD = struct.Struct("<HIQQ")  # channel id, sequence, log time, publish time
 
 
-def _decompress(compression: str, data: bytes, size: int) -> bytes:
-    if compression == "zstd":
-        import zstandard  # lazy: a decompressor only for compressed chunks
-
-        return bytes(zstandard.ZstdDecompressor().decompress(data, max_output_size=size))
-    if compression == "lz4":
-        import lz4.frame  # lazy: a decompressor only for compressed chunks
-
-        return bytes(lz4.frame.decompress(data))
-    if compression == "":
-        return data
-    raise ValueError(f"unsupported chunk compression {compression!r}")
+def _decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
+    # the one bounded decompressor of every reader (the budget of docs/io.md)
+    out: bytes = inflate(compression, data, size, where, "MCAP chunk")
+    return out
 
 
 @dataclass
@@ -133,7 +128,7 @@ class McapTail:
                     self._channel(data, body)
                 elif opcode == OP_MESSAGE:
                     self._message(data, body, end, cutoff, keep_data, out)
-            except (struct.error, ValueError, UnicodeDecodeError) as err:
+            except (struct.error, ValueError, UnicodeDecodeError, BagError) as err:
                 self.corrupt = f"unreadable record at offset {self.offset + body - 9}: {err}"
                 pos = body - _RECORD_HEAD.size
                 break
@@ -171,7 +166,8 @@ class McapTail:
         p += 4 + n
         (length,) = _U64.unpack_from(data, p)
         p += 8
-        records = _decompress(compression, data[p : p + length], size)
+        where = f"at offset {self.offset + pos}"
+        records = _decompress(compression, data[p : p + length], size, where)
         skip_messages = cutoff is not None and end_time < cutoff
         q = 0
         while q + _RECORD_HEAD.size <= len(records):

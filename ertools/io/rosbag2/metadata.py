@@ -17,7 +17,9 @@ import yaml
 
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
-from ertools.io.formats import metadata_problem
+from ertools.inputs import check_regular, open_regular, why_not
+from ertools.io.formats import load_metadata, metadata_problem
+from ertools.io.inflate import inflate_file
 from ertools.io.model import Conn
 
 ROWS_PER_BATCH = 100_000
@@ -26,12 +28,11 @@ ROWS_PER_BATCH = 100_000
 def read_metadata(path: Path) -> dict[str, Any]:
     """``rosbag2_bagfile_information`` of a rosbag2 directory."""
 
-    meta = path / "metadata.yaml"
     try:
-        data = yaml.safe_load(meta.read_text(encoding="utf-8"))
+        data = load_metadata(path)
         info = data["rosbag2_bagfile_information"]
     except OSError as err:
-        raise BagError(f"unreadable metadata.yaml ({err.strerror or err})", path=path) from err
+        raise BagError(f"unreadable metadata.yaml ({why_not(err)})", path=path) from err
     except (yaml.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
         raise BagError(f"unreadable metadata.yaml ({metadata_problem(err)})", path=path) from err
     if not isinstance(info, dict):
@@ -128,23 +129,29 @@ def _decompressed(file: Path) -> Path:
     done = _DECOMPRESSED.get(key)
     if done is not None and done.exists():
         return done
-    import zstandard  # lazy: a decompressor only for file-compressed rosbag2 storage
-
     name = file.name[: -len(".zstd")] if file.name.endswith(".zstd") else file.name
     out = _scratch() / str(len(_DECOMPRESSED)) / name
     out.parent.mkdir(parents=True, exist_ok=True)
     try:
-        with file.open("rb") as src, out.open("wb") as dst:
-            zstandard.ZstdDecompressor().copy_stream(src, dst)
-    except (OSError, zstandard.ZstdError) as err:
+        with open_regular(file) as src, out.open("wb") as dst:
+            inflate_file("zstd", src, dst, st.st_size, "")
+    except OSError as err:
         out.unlink(missing_ok=True)
-        raise BagError(f"damaged zstd-compressed storage file ({err})", path=file) from err
+        raise BagError(f"cannot read storage file: {why_not(err)}", path=file) from err
+    except BagError as err:
+        out.unlink(missing_ok=True)
+        raise BagError(err.message, path=file) from err
     _DECOMPRESSED[key] = out
     return out
 
 
 def _connect(db: Path) -> sqlite3.Connection:
-    # Read-only: an input file is never modified (not even a journal is created).
+    # Read-only: an input file is never modified (not even a journal is created). sqlite
+    # opens the path itself: a named pipe there would block it, so the type is checked first.
+    try:
+        check_regular(db)
+    except OSError as err:
+        raise sqlite3.OperationalError(f"unable to open database file: {why_not(err)}") from err
     return sqlite3.connect(f"{db.resolve().as_uri()}?mode=ro", uri=True)
 
 
