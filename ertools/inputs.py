@@ -16,7 +16,7 @@ from __future__ import annotations
 import errno
 import os
 import stat
-from typing import BinaryIO
+from io import BufferedReader
 
 StrPath = str | os.PathLike[str]
 
@@ -24,7 +24,7 @@ StrPath = str | os.PathLike[str]
 MAX_SHOWN = 120
 
 _KINDS = (
-    (stat.S_ISFIFO, "a named pipe (FIFO)"),
+    (stat.S_ISFIFO, "a FIFO"),
     (stat.S_ISSOCK, "a socket"),
     (stat.S_ISCHR, "a character device"),
     (stat.S_ISBLK, "a block device"),
@@ -41,7 +41,7 @@ class NotRegularFileError(OSError):
 
 
 def kind_of(mode: int) -> str:
-    """What a file of ``mode`` is, in words ("a named pipe (FIFO)"); "" for a regular file."""
+    """What a file of ``mode`` is, in words ("a FIFO"); "" for a regular file."""
     if stat.S_ISREG(mode):
         return ""
     return next((name for test, name in _KINDS if test(mode)), "a special file")
@@ -70,7 +70,7 @@ _FLAGS = (
 )
 
 
-def open_regular(path: StrPath) -> BinaryIO:
+def open_regular(path: StrPath) -> BufferedReader:
     """``path`` opened for reading in binary, when it is a regular file.
 
     Checked before the open (opening a device can do things) and on the open file (a pipe

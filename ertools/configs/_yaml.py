@@ -18,6 +18,7 @@ from typing import Any
 import yaml
 
 from ertools.errors import ConfigError
+from ertools.inputs import read_regular_text, why_not
 
 MAX_DEPTH = 64
 # int64 nanoseconds hold ~9.2e18; a float beyond this cannot be a time, a length or a count
@@ -58,10 +59,12 @@ def load_yaml(path: str | Path, what: str = "config") -> Any:
 
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
+        text = read_regular_text(p)  # a named pipe would block open() for ever
     except FileNotFoundError:
         raise ConfigError(f"{what} file not found", path=p) from None
-    except (OSError, UnicodeDecodeError) as err:
+    except OSError as err:
+        raise ConfigError(f"cannot read {what} file: {why_not(err)}", path=p) from err
+    except UnicodeDecodeError as err:
         raise ConfigError(f"cannot read {what} file: {err}", path=p) from err
     return check_numbers(parse_yaml(text, source=str(p), what=what), str(p))
 

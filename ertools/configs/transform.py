@@ -36,6 +36,7 @@ import yaml
 from ertools.configs._yaml import load_yaml, number
 from ertools.errors import ConfigError
 from ertools.geometry import invert
+from ertools.inputs import read_regular_text
 from ertools.yamlout import yaml_float
 
 log = logging.getLogger("ertools.configs.transform")
@@ -304,7 +305,7 @@ _TupleSafeLoader.add_constructor("tag:yaml.org,2002:python/tuple", _tuple_as_lis
 def _load_transform_yaml(path: str | Path) -> Any:
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
+        text = read_regular_text(p)  # a named pipe would block open() for ever
     except FileNotFoundError:
         raise ConfigError("transform file not found", path=p) from None
     except (OSError, UnicodeDecodeError) as err:

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from ertools.errors import BagError
+from ertools.inputs import open_regular
 from ertools.io.bagfile import BagFile, RawRecord
 from ertools.io.formats import detect_format
 from ertools.io.mcap.scan import SCAN, mcap_layout, scan_mcap
@@ -147,7 +148,7 @@ class McapFile(BagFile):
         self.format = "mcap"
         self.unfinished = False
         self.scanned = False
-        self._f = path.open("rb")
+        self._f = open_regular(path)
         unreadable: tuple[type[BaseException], ...] = (BagError, *mcap_errors())
         try:
             layout = mcap_layout(path)

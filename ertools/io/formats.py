@@ -162,6 +162,37 @@ def _walk(root: Path, bags: list[Path], problems: list[Unreadable]) -> None:
         todo.extend(reversed(subfolders))
 
 
+def regular_files(paths: Iterable[Path]) -> tuple[list[Path], list[Unreadable]]:
+    """Every regular file under ``paths`` (a file given is itself), and one problem per path
+    or folder that cannot be listed or looked at. Symbolic links to folders are followed once
+    (a link back up the tree is not walked again)."""
+    files: list[Path] = []
+    problems: list[Unreadable] = []
+    seen: set[tuple[int, int]] = set()
+    todo = list(paths)[::-1]
+    while todo:
+        here = todo.pop()
+        try:
+            st = os.stat(here)
+        except OSError as err:
+            problems.append(_unreadable(here, err, "skipped: "))
+            continue
+        if stat.S_ISREG(st.st_mode):
+            files.append(here)
+            continue
+        if not stat.S_ISDIR(st.st_mode) or (st.st_dev, st.st_ino) in seen:
+            continue
+        seen.add((st.st_dev, st.st_ino))
+        try:
+            with os.scandir(here) as it:
+                names = sorted(e.name for e in it)
+        except OSError as err:
+            problems.append(_unreadable(here, err, "folder skipped: "))
+            continue
+        todo.extend(here / name for name in reversed(names))
+    return files, problems
+
+
 def expand(paths: Iterable[Path]) -> list[Path]:
     """Files and rosbag2 folders as given; other folders replaced by the bags inside.
 

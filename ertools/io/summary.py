@@ -28,6 +28,7 @@ import numpy as np
 
 from ertools.arrays import I64
 from ertools.errors import BagError
+from ertools.inputs import open_regular
 from ertools.io.decode.fast import LayoutMismatchError, gather
 from ertools.io.formats import detect_format
 from ertools.io.mcap.index import McapIndex
@@ -273,7 +274,7 @@ def _mcap_indexed(
     counts: dict[int, int] = {} if read_indexes else dict(stats.channel_message_counts)
     # channel -> (chunk, message index offset) of every chunk holding it
     located: dict[int, list[tuple[Any, int]]] = {}
-    with path.open("rb") as f:
+    with open_regular(path) as f:
         for chunk in summary.chunk_indexes:
             compressions.add(chunk.compression or "none")
             for cid, offset in chunk.message_index_offsets.items():
@@ -340,7 +341,7 @@ def _check_ends(
     """
 
     chunks: dict[int, np.ndarray] = {}
-    with path.open("rb") as f:
+    with open_regular(path) as f:
         for cid, where in located.items():
             lo, hi = spans[cid]
             for chunk, offset in where:
@@ -400,7 +401,7 @@ def _mcap_version(path: Path) -> str:
     from mcap.reader import make_reader  # lazy: the mcap library only when an MCAP file is read
 
     try:
-        with path.open("rb") as f:
+        with open_regular(path) as f:
             header = make_reader(f).get_header()
     except mcap_errors():
         return ""

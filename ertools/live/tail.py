@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ertools.errors import BagError
+from ertools.inputs import open_regular
 from ertools.io.inflate import inflate
 
 MAGIC = b"\x89MCAP0\r\n"
@@ -30,7 +31,7 @@ MAX_RECORD = 1 << 31
 def is_finished(path: Path) -> bool:
     """True when the file ends with MCAP's closing magic (closed cleanly)."""
     try:
-        with open(path, "rb") as f:
+        with open_regular(path) as f:
             f.seek(0, 2)
             if f.tell() < 2 * len(MAGIC):
                 return False
@@ -87,7 +88,7 @@ class McapTail:
         if self.finished or self.corrupt:
             return out
         try:
-            with open(self.path, "rb") as f:
+            with open_regular(self.path) as f:
                 f.seek(self.offset)
                 data = f.read()
         except OSError:

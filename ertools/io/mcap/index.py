@@ -21,6 +21,7 @@ import numpy as np
 
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
+from ertools.inputs import open_regular
 from ertools.io import pipeline
 from ertools.io.bagfile import BagFile
 from ertools.io.decode.fast import LayoutMismatchError, gather
@@ -127,7 +128,7 @@ class McapIndex:
             if layout.index == SCAN:
                 raise LayoutMismatchError(f"MCAP file {path.name}: {layout.why}")
             summary: Any = layout.summary
-            with path.open("rb") as f:
+            with open_regular(path) as f:
                 channels = {cid for cid, ch in layout.channels.items() if ch.topic in topics}
                 chunks = summary.chunk_indexes
                 chunks_per_file.append(chunks)
@@ -195,7 +196,7 @@ class McapIndex:
         """(file, chunk index record) of every chunk, in file order."""
         out: list[tuple[Path, Any]] = []
         for path in self.files:
-            with path.open("rb") as f:
+            with open_regular(path) as f:
                 summary = read_summary(f, path)
             if summary is not None:
                 out.extend((path, c) for c in summary.chunk_indexes)
@@ -273,7 +274,7 @@ class McapIndex:
         view = scratch_view(scratch, int(sizes.sum()))
         for (path, chunk), b, n in zip(chunks, base.tolist(), sizes.tolist(), strict=True):
             where = f"in {path} at byte {chunk.chunk_start_offset}"
-            with path.open("rb") as f:
+            with open_regular(path) as f:
                 compression, at, nbytes, usize, crc = McapIndex._chunk_head(f.fileno(), path, chunk)
                 if compression or nbytes != n or usize != n:
                     raise BagError(f"chunk record disagrees with the summary's index {where}")
@@ -367,7 +368,7 @@ class McapIndex:
     def _chunk_raw(path: Path, chunk: Any) -> tuple[str, bytes, int, int]:
         """(compression, compressed records, uncompressed size, CRC) of a chunk record."""
         where = f"in {path} at byte {chunk.chunk_start_offset}"
-        with path.open("rb") as f:
+        with open_regular(path) as f:
             compression, at, nbytes, usize, crc = McapIndex._chunk_head(f.fileno(), path, chunk)
             data = pread(f.fileno(), nbytes, at)
         if len(data) != nbytes:
@@ -469,7 +470,7 @@ def verify_mcap(path: Path, progress: Reporter | None = None) -> None:
         if found.problem:
             raise BagError(found.problem, path=path)
         return
-    with path.open("rb") as f:
+    with open_regular(path) as f:
         summary: Any = layout.summary
         if progress is not None:
             total = sum(int(c.compressed_size) for c in summary.chunk_indexes)

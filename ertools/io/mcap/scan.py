@@ -26,6 +26,7 @@ import numpy as np
 from ertools import caches
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
+from ertools.inputs import open_regular
 from ertools.io import budget
 from ertools.io.decode.fast import read_at
 from ertools.io.inflate import Allowance
@@ -334,7 +335,7 @@ def scan_mcap(
     Raises:
         BagError: not an MCAP file (no magic), or a corrupt compressed chunk.
     """
-    with path.open("rb") as f:
+    with open_regular(path) as f:
         st = os.fstat(f.fileno())
         key = (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
         if not keep and check_crc and key in _SCANS:
@@ -479,7 +480,7 @@ def _scan_layout(summary: Any, why: str) -> McapLayout:
 
 
 def _layout(path: Path) -> McapLayout:
-    with path.open("rb") as f:
+    with open_regular(path) as f:
         size = os.fstat(f.fileno()).st_size
         if size < 2 * len(MAGIC) + FOOTER_SIZE or os.pread(f.fileno(), 8, size - 8) != MAGIC:
             # no footer to find a summary with: a recording not finished, or a copy cut short

@@ -28,6 +28,7 @@ import numpy.typing as npt
 
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
+from ertools.inputs import open_regular
 from ertools.io import budget
 from ertools.io.decode.fast import gather
 from ertools.io.inflate import Allowance
@@ -284,7 +285,7 @@ def check_ros1(path: Path, progress: Reporter | None = None) -> list[str]:
         BagError: the bag header itself is unreadable (not a bag).
     """
     size = path.stat().st_size
-    with path.open("rb") as f:
+    with open_regular(path) as f:
         return _check(f, path, size, progress)
 
 

@@ -22,6 +22,7 @@ import numpy.typing as npt
 
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
+from ertools.inputs import open_regular
 from ertools.io import budget
 from ertools.io.bagfile import BagFile, RawRecord
 from ertools.io.decode.fast import LayoutMismatchError, gather, read_at
@@ -122,7 +123,7 @@ class Ros1Bag(BagFile):
             log.warning("%s: %s; reading what the scan found", path, "; ".join(problems))
         self.connections = tuple(self.layout.conns)
         self._inflation = Allowance(self.layout.size, str(path))
-        self._f: BufferedReader | None = path.open("rb")
+        self._f: BufferedReader | None = open_regular(path)
         self._mm: mmap.mmap | None = None
 
     def _unmap(self) -> None:

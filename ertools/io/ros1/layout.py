@@ -24,6 +24,7 @@ import numpy.typing as npt
 from ertools import caches
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
+from ertools.inputs import open_regular
 from ertools.io.decode.fast import read_at
 from ertools.io.inflate import Allowance, inflate
 from ertools.io.model import Conn, short_msgtype
@@ -156,7 +157,7 @@ def read_layout(path: Path) -> Ros1Layout:
     Raises:
         BagError: not even the bag header is readable.
     """
-    with path.open("rb") as f:
+    with open_regular(path) as f:
         st = os.fstat(f.fileno())
         key = (str(path), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
         found = _SCANNED.get(key)
