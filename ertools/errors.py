@@ -10,6 +10,19 @@ from __future__ import annotations
 
 from pathlib import Path
 
+# The longest path a message shows whole: a folder deeper than the system's path limit (4096
+# bytes on Linux) would make a line thousands of characters long.
+MAX_SHOWN = 120
+
+
+def shown(path: str | Path) -> str:
+    """``path`` for a message: whole up to :data:`MAX_SHOWN` characters, else its start and
+    end around "...", with its length said."""
+    text = str(path)
+    if len(text) <= MAX_SHOWN:
+        return text
+    return f"{text[:40]}...{text[-60:]} ({len(text)} characters)"
+
 
 class ErtoolsError(Exception):
     """Root of every error ertools raises on purpose."""
@@ -19,7 +32,7 @@ class ErtoolsError(Exception):
     def __init__(self, message: str, *, path: str | Path | None = None) -> None:
         self.path = str(path) if path is not None else None
         self.message = message
-        super().__init__(f"{self.path}: {message}" if self.path else message)
+        super().__init__(f"{shown(self.path)}: {message}" if self.path else message)
 
 
 class BagError(ErtoolsError):

@@ -7,8 +7,7 @@ file (opened without blocking, so a pipe swapped in between cannot hang it). The
 ``OSError`` (:class:`NotRegularFileError`): callers turn it into their one-line error as they do a
 missing or unreadable file.
 
-:func:`shown` shortens a path for a message: a folder deeper than the system's path limit
-(4096 bytes on Linux) would otherwise make a message line thousands of characters long.
+(Paths in messages are shortened by :func:`ertools.errors.shown`.)
 """
 
 from __future__ import annotations
@@ -19,9 +18,6 @@ import stat
 from io import BufferedReader
 
 StrPath = str | os.PathLike[str]
-
-# The longest path a message shows whole; longer ones keep their start and their end.
-MAX_SHOWN = 120
 
 _KINDS = (
     (stat.S_ISFIFO, "a FIFO"),
@@ -112,15 +108,6 @@ def read_regular_text(path: StrPath, encoding: str = "utf-8") -> str:
     """
     text = read_regular(path).decode(encoding)
     return text.replace("\r\n", "\n").replace("\r", "\n")
-
-
-def shown(path: StrPath | str) -> str:
-    """``path`` for a message: whole up to :data:`MAX_SHOWN` characters, else its start and
-    end around "...", with its length said."""
-    text = os.fspath(path)
-    if len(text) <= MAX_SHOWN:
-        return text
-    return f"{text[:40]}...{text[-60:]} ({len(text)} characters)"
 
 
 def why_not(err: OSError) -> str:

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ertools.errors import BagError
-from ertools.inputs import kind_of, open_regular, read_regular, shown, why_not
+from ertools.errors import BagError, shown
+from ertools.inputs import kind_of, open_regular, read_regular, why_not
 from ertools.io import budget
 
 ROS1_MAGIC = b"#ROSBAG V2.0\n"
