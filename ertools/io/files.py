@@ -19,9 +19,10 @@ from typing import Any
 import numpy as np
 
 from ertools.errors import BagError
-from ertools.inputs import open_regular
 from ertools.io.bagfile import BagFile, RawRecord
+from ertools.io.decode.fast import LayoutMismatchError
 from ertools.io.formats import detect_format
+from ertools.io.mcap.index import McapIndex
 from ertools.io.mcap.scan import SCAN, mcap_layout, scan_mcap
 from ertools.io.mcap.summary import mcap_errors
 from ertools.io.model import Conn, short_msgtype
@@ -32,8 +33,6 @@ log = logging.getLogger("ertools.io.files")
 
 # (reference positions, bytes, data starts, data lengths, log times, channel ids)
 ScannedRun = tuple[Any, Any, Any, Any, Any, Any]
-
-INT64_MAX = (1 << 63) - 1
 
 
 def _conn_from_rosbags(c: Any) -> Conn:
@@ -142,19 +141,15 @@ class McapFile(BagFile):
     """
 
     def __init__(self, path: Path) -> None:
-        from mcap.reader import make_reader  # lazy: the mcap library only when an MCAP file is read
-
         self.path = path
         self.format = "mcap"
         self.unfinished = False
         self.scanned = False
-        self._f = open_regular(path)
-        unreadable: tuple[type[BaseException], ...] = (BagError, *mcap_errors())
         try:
             layout = mcap_layout(path)
-            self._reader = make_reader(self._f)
-        except unreadable as err:
-            self._f.close()
+        except BagError:
+            raise
+        except mcap_errors() as err:
             raise BagError(f"unreadable MCAP file ({err})", path=path) from err
         if layout.index == SCAN:
             self.connections = self._scan(layout.why)
@@ -168,17 +163,12 @@ class McapFile(BagFile):
         """Read every complete record (the summary's indexes do not answer for them all)."""
         self.scanned = True
         log.info("%s: %s; reading the file record by record", self.path, why)
-        try:
-            found = scan_mcap(self.path)
-        except BagError:
-            self._f.close()
-            raise
+        found = scan_mcap(self.path)
         conns = {
             cid: _conn_from_channel(ch, found.schemas.get(ch.schema_id))
             for cid, ch in found.channels.items()
         }
         if not conns and not found.complete:
-            self._f.close()
             raise BagError(
                 f"unreadable MCAP file: no complete channel record ({found.problem})",
                 path=self.path,
@@ -252,26 +242,19 @@ class McapFile(BagFile):
                 a = int(start[i])
                 yield by_id[int(cid[i])], int(t[i]), buf[a : a + int(length[i])].tobytes()
             return
-        topics = sorted({c.topic for c in conns})
         try:
-            for _schema, channel, message in self._reader.iter_messages(
-                topics=topics,
-                starting_at=start_ns,
-                ending_at=end_ns,
-                log_time_order=True,
-            ):
-                conn = by_id.get(channel.id)
-                if conn is not None:
-                    if message.log_time > INT64_MAX:
-                        raise ValueError(f"message log time {message.log_time} out of range")
-                    yield conn, int(message.log_time), bytes(message.data)
-        except mcap_errors() as err:
-            raise BagError(
-                f"damaged MCAP data ({type(err).__name__}: {err})", path=self.path
-            ) from err
-
-    def close(self) -> None:
-        self._f.close()
+            found = McapIndex([self.path]).messages(conns, start_ns, end_ns)
+        except LayoutMismatchError as err:
+            # indexes that do not answer for every message (padded message indexes): the
+            # messages are read record by record, as a file without indexes is
+            log.info("%s: %s; reading the file record by record", self.path, err)
+            self.scanned = True
+            yield from self.raw(conns, start_ns, end_ns)
+            return
+        for _file, cid, t, data in found:
+            conn = by_id.get(cid)
+            if conn is not None:
+                yield conn, t, data
 
 
 def open_bag(path: str | Path) -> BagFile:

@@ -79,7 +79,7 @@ def inflate_into(
     check_declared(size, where, what)
     if compression == "zstd":
         got, more = _guarded(compression, where, what, lambda: _zstd(data, out))
-        _verdict(got, more, size, where, what)
+        _verdict(compression, got, more, size, where, what)
         return
     got = 0
     for piece in _checked(compression, data, size, where, what):
@@ -106,10 +106,10 @@ def _checked(compression: str, data: Any, size: int, where: str, what: str) -> I
         if piece is None:
             break
         if got + len(piece) > size:
-            _verdict(got, True, size, where, what)
+            _verdict(compression, got, True, size, where, what)
         got += len(piece)
         yield piece
-    _verdict(got, False, size, where, what)
+    _verdict(compression, got, False, size, where, what)
 
 
 def _guarded(compression: str, where: str, what: str, step: Callable[[], T]) -> T:
@@ -122,15 +122,15 @@ def _guarded(compression: str, where: str, what: str, step: Callable[[], T]) -> 
         raise BagError(f"corrupt {compression} {what} {where} ({err})") from err
 
 
-def _verdict(got: int, more: bool, size: int, where: str, what: str) -> None:
+def _verdict(compression: str, got: int, more: bool, size: int, where: str, what: str) -> None:
     if more:
         raise BagError(
-            f"damaged {what} {where}: it inflates to more than the {size} bytes its header "
+            f"damaged {compression} {what} {where}: it inflates to more than the {size} bytes its header "
             "declares (decompression stopped there)"
         )
     if got != size:
         raise BagError(
-            f"damaged {what} {where}: it inflates to {got} bytes, not the {size} its header "
+            f"damaged {compression} {what} {where}: it inflates to {got} bytes, not the {size} its header "
             "declares"
         )
 

@@ -173,3 +173,171 @@ def bz2_bomb(extra_bytes: int, step: int = 8 << 20) -> Callable[[bytes], bytes]:
         return bz2.compress(inner) + bz2_zeros(step) * (extra_bytes // step)
 
     return compress
+
+
+# --- MCAP (https://mcap.dev/spec): records are op (u8), length (u64), body --------------------
+
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+
+def _mrec(op: int, body: bytes) -> bytes:
+    return bytes([op]) + u64(len(body)) + body
+
+
+def _mstr(text: str | bytes) -> bytes:
+    raw = text.encode() if isinstance(text, str) else text
+    return u32(len(raw)) + raw
+
+
+def mcap_message(channel: int, t_ns: int, data: bytes, seq: int = 0) -> bytes:
+    return _mrec(0x05, struct.pack("<HIQQ", channel, seq, t_ns, t_ns) + data)
+
+
+@dataclass
+class McapChannel:
+    cid: int
+    topic: str
+    schema_name: str = "std_msgs/msg/String"
+    schema: str = "string data\n"
+
+
+@dataclass
+class McapChunk:
+    """Messages (channel, t_ns, data) of one chunk, stored as ``compression`` says; ``size``
+    overrides the declared uncompressed size; ``zeros`` (channel, t_ns, n) adds one last
+    message of n zero bytes, built as zstd frames of zeros (cheap however large)."""
+
+    messages: list[tuple[int, int, bytes]]
+    compression: str = ""
+    size: int | None = None
+    zeros: tuple[int, int, int] | None = None
+
+
+def zstd_of(data: bytes) -> bytes:
+    return zstandard.ZstdCompressor().compress(data)
+
+
+def mcap_file(path: Path, channels: Sequence[McapChannel], chunks: Sequence[McapChunk]) -> Path:
+    """An indexed MCAP file: header, schemas and channels, chunks each followed by their
+    message indexes, data end, then a summary (schemas, channels, chunk indexes, statistics)
+    and the footer. Chunk CRCs are 0 (not computed), which the specification allows."""
+    import lz4.frame
+
+    out = MCAP_MAGIC + _mrec(0x01, _mstr("ros2") + _mstr("ertools-tests"))
+    defs = b""
+    for ch in channels:
+        defs += _mrec(
+            0x03,
+            struct.pack("<H", ch.cid) + _mstr(ch.schema_name) + _mstr("ros2msg") + _mstr(ch.schema),
+        )
+        defs += _mrec(
+            0x04,
+            struct.pack("<HH", ch.cid, ch.cid) + _mstr(ch.topic) + _mstr("cdr") + u32(0),
+        )
+    out += defs
+    indexes = b""
+    counts: dict[int, int] = {}
+    times: list[int] = []
+    for chunk in chunks:
+        records = b""
+        entries: dict[int, list[tuple[int, int]]] = {}
+        for cid, t, data in chunk.messages:
+            entries.setdefault(cid, []).append((t, len(records)))
+            records += mcap_message(cid, t, data)
+            counts[cid] = counts.get(cid, 0) + 1
+            times.append(t)
+        true_size = len(records)
+        ts = [m[1] for m in chunk.messages]
+        if chunk.zeros is not None:
+            assert chunk.compression == "zstd"
+            cid, t, n = chunk.zeros
+            entries.setdefault(cid, []).append((t, len(records)))
+            counts[cid] = counts.get(cid, 0) + 1
+            times.append(t)
+            ts.append(t)
+            records += _mrec(0x05, b"")[:1] + u64(22 + n) + struct.pack("<HIQQ", cid, 0, t, t)
+            true_size = len(records) + n
+        size = true_size if chunk.size is None else chunk.size
+        if chunk.zeros is not None:
+            stored = zstd_frame(records, chunk.zeros[2])
+        elif chunk.compression == "zstd":
+            stored = zstd_of(records)
+        elif chunk.compression == "lz4":
+            stored = lz4.frame.compress(records)
+        else:
+            stored = records
+        ts = ts or [0]
+        start = len(out)
+        out += _mrec(
+            0x06,
+            struct.pack("<QQQI", min(ts), max(ts), size, 0)
+            + _mstr(chunk.compression)
+            + u64(len(stored))
+            + stored,
+        )
+        chunk_len = len(out) - start
+        offsets = {}
+        mi_start = len(out)
+        for cid, items in entries.items():
+            offsets[cid] = len(out)
+            pairs = b"".join(struct.pack("<QQ", t, off) for t, off in items)
+            out += _mrec(0x07, struct.pack("<H", cid) + u32(len(pairs)) + pairs)
+        offset_map = b"".join(struct.pack("<HQ", c, o) for c, o in offsets.items())
+        indexes += _mrec(
+            0x08,
+            struct.pack("<QQQQ", min(ts), max(ts), start, chunk_len)
+            + u32(len(offset_map))
+            + offset_map
+            + u64(len(out) - mi_start)
+            + _mstr(chunk.compression)
+            + struct.pack("<QQ", len(stored), size),
+        )
+    out += _mrec(0x0F, u32(0))
+    summary_start = len(out)
+    count_map = b"".join(struct.pack("<HQ", c, n) for c, n in counts.items())
+    stats = _mrec(
+        0x0B,
+        struct.pack(
+            "<QHIIIIQQ",
+            sum(counts.values()),
+            len(channels),
+            len(channels),
+            0,
+            0,
+            len(chunks),
+            min(times or [0]),
+            max(times or [0]),
+        )
+        + u32(len(count_map))
+        + count_map,
+    )
+    out += defs + indexes + stats
+    out += _mrec(0x02, struct.pack("<QQI", summary_start, 0, 0))
+    path.write_bytes(out + MCAP_MAGIC)
+    return path
+
+
+ZSTD_BLOCK = 128 << 10  # the largest block a zstd frame may hold
+
+
+def zstd_frame(head: bytes, zeros: int) -> bytes:
+    """One zstd frame holding ``head`` then ``zeros`` zero bytes, its header stating the
+    whole size, written block by block (RFC 8878): ``head`` in raw blocks, the zeros in RLE
+    blocks of 128 KiB, 4 bytes each, so a gigabyte costs 32 KiB."""
+
+    def block(kind: int, size: int, content: bytes, last: bool) -> bytes:
+        return (int(last) | kind << 1 | size << 3).to_bytes(3, "little") + content
+
+    blocks = []
+    for at in range(0, len(head), ZSTD_BLOCK):
+        part = head[at : at + ZSTD_BLOCK]
+        blocks.append((0, len(part), part))
+    for at in range(0, zeros, ZSTD_BLOCK):
+        blocks.append((1, min(ZSTD_BLOCK, zeros - at), b"\0"))
+    body = b"".join(
+        block(kind, size, content, i == len(blocks) - 1)
+        for i, (kind, size, content) in enumerate(blocks)
+    )
+    # magic; descriptor: an 8-byte content size, no single segment, no checksum; a window of
+    # 2^(10+7) = 128 KiB
+    return b"\x28\xb5\x2f\xfd" + bytes([0xC0, 7 << 3]) + u64(len(head) + zeros) + body

@@ -247,6 +247,33 @@ class McapIndex:
         weights = [sum(int(chunk_of(key)[1].compressed_size) for key, _ in part) for part in todo]
         return len(todo), load, weights
 
+    def messages(
+        self, conns: Sequence[Conn], lo: int | None, hi: int | None
+    ) -> list[tuple[int, int, int, bytes]]:
+        """(file index, channel id, log time, data) of every message on the topics of
+        ``conns`` in [lo, hi], in the reference order: the per-message path, through the same
+        bounded chunk loads as the fast path (the ``mcap`` library's own decompression trusts
+        a zstd frame's stated size, however large).
+
+        Raises:
+            BagError: damaged index or chunk, or a chunk over the budget.
+            LayoutMismatchError: as :meth:`plan`.
+        """
+        plan = self.plan(conns, lo, hi)
+        count, load, _weights = self.run_loader(plan)
+        n = len(plan.t_record)
+        data: list[bytes] = [b""] * n
+        channel = np.zeros(n, dtype=np.int64)
+        scratch: list[Any] = []
+        for k in range(count):
+            rows, buf, start, length = load(k, scratch)
+            # a record's channel id follows its op code and length
+            channel[rows] = read_fields(buf, start - MESSAGE_FIXED, np.dtype("<u2"))
+            for row, a, m in zip(rows.tolist(), start.tolist(), length.tolist(), strict=True):
+                data[row] = bytes(buf[a : a + m])
+        files, times, channels = plan.file.tolist(), plan.t_record.tolist(), channel.tolist()
+        return list(zip(files, channels, times, data, strict=True))
+
     @staticmethod
     def _group_bytes(chunks: list[tuple[Path, Any]], scratch: list[Any]) -> Group:
         """The records of several chunks end to end in ``scratch``: uncompressed chunks are

@@ -242,6 +242,8 @@ def chunk_head(fields: dict[str, bytes]) -> tuple[str, int]:
 def decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
     """Uncompressed chunk bytes, never more than the ``size`` the chunk record declares
     (:func:`ertools.io.inflate.inflate`: within the budget, or a BagError)."""
+    if compression not in ("none", "bz2", "lz4"):  # what the ROS1 format defines
+        raise BagError(f"unsupported chunk compression {compression!r} {where}")
     if compression != "none" and size < 0:
         raise BagError(f"damaged {compression} chunk {where}: its record states no size")
     out: bytes = inflate(compression, data, size, where)
