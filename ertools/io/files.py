@@ -11,6 +11,8 @@ the ``mcap`` library's (log time, chunk, position) order for MCAP).
 
 from __future__ import annotations
 
+import dataclasses
+import heapq
 import logging
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -22,12 +24,18 @@ from ertools.errors import BagError
 from ertools.io.bagfile import BagFile, RawRecord
 from ertools.io.decode.fast import LayoutMismatchError
 from ertools.io.formats import detect_format
+from ertools.io.inflate import inflate_message
 from ertools.io.mcap.index import McapIndex
 from ertools.io.mcap.scan import SCAN, mcap_layout, scan_mcap
 from ertools.io.mcap.summary import mcap_errors
 from ertools.io.model import Conn, short_msgtype
 from ertools.io.ros1.index import Ros1Bag
-from ertools.io.rosbag2.metadata import readable_dir
+from ertools.io.rosbag2.metadata import (
+    message_compression,
+    read_metadata,
+    readable_dir,
+    readable_files,
+)
 
 log = logging.getLogger("ertools.io.files")
 
@@ -64,12 +72,20 @@ def _conn_from_rosbags(c: Any) -> Conn:
 
 
 class RosbagsFile(BagFile):
-    """ROS1 and rosbag2 through rosbags' readers (builds rosbags' per-message index)."""
+    """ROS1 and rosbag2 through rosbags' readers (builds rosbags' per-message index).
+
+    Messages of a rosbag2 bag compressed one by one reach this class compressed (rosbags
+    reads a copy of the metadata without the compression: :func:`readable_dir`) and are
+    decompressed here, within the budget (rosbags' own decompression trusts the size a zstd
+    frame states, however large)."""
 
     def __init__(self, path: Path, fmt: str) -> None:
         self.path = path
         self.format = fmt
+        self._inflate: str | None = None
         try:
+            if fmt != "ros1":
+                self._inflate = message_compression(read_metadata(path))
             if fmt == "ros1":
                 # lazy: rosbags only on the per-message path (~0.1 s to import)
                 from rosbags.rosbag1 import Reader as Reader1
@@ -101,7 +117,12 @@ class RosbagsFile(BagFile):
         stop = None if end_ns is None else end_ns + 1
         try:
             for c, t, data in self._reader.messages(connections=rb, start=start_ns, stop=stop):
+                if self._inflate is not None:
+                    where = f"of {c.topic} at {t} ns"
+                    data = inflate_message(self._inflate, bytes(data), where)
                 yield by_id[int(c.id)], int(t), bytes(data)
+        except BagError as err:
+            raise BagError(err.message, path=self.path) from err
         except Exception as err:
             raise BagError(
                 f"damaged message data ({type(err).__name__}: {err})", path=self.path
@@ -257,6 +278,49 @@ class McapFile(BagFile):
                 yield conn, t, data
 
 
+class Rosbag2McapFile(BagFile):
+    """A rosbag2 bag with MCAP storage, read as standalone MCAP files are (:class:`McapFile`:
+    through their indexes, every chunk within the budget; rosbags' MCAP reader inflates a
+    chunk to whatever size its zstd frame states). One connection per topic, as rosbag2
+    records them; messages of several files merged by record time, file order on ties."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.format = "rosbag2-mcap"
+        info = read_metadata(path)
+        self._inflate = message_compression(info)
+        self._files = [McapFile(f) for f in readable_files(path, info) if f.suffix == ".mcap"]
+        by_topic: dict[str, Conn] = {}
+        for f in self._files:
+            for c in f.connections:
+                by_topic.setdefault(c.topic, c)
+        self.connections = tuple(
+            dataclasses.replace(c, id=i) for i, c in enumerate(by_topic.values(), start=1)
+        )
+
+    def raw(
+        self, conns: Sequence[Conn], start_ns: int | None = None, end_ns: int | None = None
+    ) -> Iterator[RawRecord]:
+        wanted = {c.topic: c for c in conns}
+        if not wanted:
+            return
+        parts = []
+        for f in self._files:
+            mine = [c for c in f.connections if c.topic in wanted]
+            if mine:
+                parts.append(
+                    [(wanted[c.topic], t, data) for c, t, data in f.raw(mine, start_ns, end_ns)]
+                )
+        for conn, t, data in heapq.merge(*parts, key=lambda r: r[1]):
+            if self._inflate is not None:
+                where = f"of {conn.topic} at {t} ns"
+                try:
+                    data = inflate_message(self._inflate, data, where)
+                except BagError as err:
+                    raise BagError(err.message, path=self.path) from err
+            yield conn, t, data
+
+
 def open_bag(path: str | Path) -> BagFile:
     """Open one bag of any format for per-message reading.
 
@@ -271,4 +335,6 @@ def open_bag(path: str | Path) -> BagFile:
         fmt = "ros1"
     if fmt == "ros1":
         return Ros1Bag(p)
+    if fmt == "rosbag2-mcap":
+        return Rosbag2McapFile(p)
     return RosbagsFile(p, fmt)

@@ -67,6 +67,26 @@ def inflate(compression: str, data: Any, size: int, where: str, what: str = "chu
     return b"".join(pieces)
 
 
+def inflate_message(compression: str, data: bytes, where: str) -> Any:
+    """One message of a rosbag2 bag compressed message by message: a zstd frame, whose header
+    states its size (rosbag2 writes it; a frame without one is refused, as rosbags does).
+
+    Raises:
+        BagError: as :func:`inflate`.
+    """
+    if compression != "zstd":
+        raise BagError(f"unsupported message compression {compression!r} {where}")
+    import zstandard  # lazy: a decompressor only for compressed messages
+
+    try:
+        size = zstandard.frame_content_size(data)
+    except zstandard.ZstdError as err:
+        raise BagError(f"corrupt zstd message {where} ({err})") from err
+    if size < 0:
+        raise BagError(f"damaged zstd message {where}: its frame states no size")
+    return inflate(compression, data, size, where, "message")
+
+
 def inflate_into(
     compression: str, data: Any, out: memoryview, where: str, what: str = "chunk"
 ) -> None:
@@ -125,13 +145,13 @@ def _guarded(compression: str, where: str, what: str, step: Callable[[], T]) -> 
 def _verdict(compression: str, got: int, more: bool, size: int, where: str, what: str) -> None:
     if more:
         raise BagError(
-            f"damaged {compression} {what} {where}: it inflates to more than the {size} bytes its header "
-            "declares (decompression stopped there)"
+            f"damaged {compression} {what} {where}: it inflates to more than the {size} bytes "
+            "its header declares (decompression stopped there)"
         )
     if got != size:
         raise BagError(
-            f"damaged {compression} {what} {where}: it inflates to {got} bytes, not the {size} its header "
-            "declares"
+            f"damaged {compression} {what} {where}: it inflates to {got} bytes, not the {size} "
+            "its header declares"
         )
 
 

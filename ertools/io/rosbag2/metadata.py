@@ -68,6 +68,14 @@ def file_compression(info: dict[str, Any]) -> str | None:
     return fmt if mode == "file" and fmt else None
 
 
+def message_compression(info: dict[str, Any]) -> str | None:
+    """The compression of each message (``compression_mode: message``), None when messages
+    are stored as they are (or the files are compressed whole)."""
+    mode = str(info.get("compression_mode") or "").lower()
+    fmt = str(info.get("compression_format") or "").lower()
+    return fmt if mode == "message" and fmt else None
+
+
 def readable_files(path: Path, info: dict[str, Any] | None = None) -> list[Path]:
     """The storage files of a rosbag2 directory as files a reader can open: those listed, or
     for a bag compressed file by file, their decompressed copies in a temporary folder of
@@ -94,11 +102,13 @@ def readable_files(path: Path, info: dict[str, Any] | None = None) -> list[Path]
 
 def readable_dir(path: Path) -> Path:
     """The rosbag2 directory as a reader that opens a whole directory (rosbags) should see it:
-    ``path`` itself, or for a bag compressed file by file a directory of this process's
-    temporary folder holding links to :func:`readable_files`' copies and the metadata without
-    the file compression. The decompression is that of :func:`readable_files`, done once."""
+    ``path`` itself, or for a compressed bag a directory of this process's temporary folder
+    holding links to :func:`readable_files` (the copies of files compressed whole) and the
+    metadata without the compression: the caller decompresses messages compressed one by one
+    (:func:`message_compression`) itself, within the budget. A file's decompression is that
+    of :func:`readable_files`, done once."""
     info = read_metadata(path)
-    if file_compression(info) is None:
+    if file_compression(info) is None and message_compression(info) is None:
         return path
     files = readable_files(path, info)
     key = (f"dir:{path.resolve()}", len(files), 0)
@@ -108,7 +118,7 @@ def readable_dir(path: Path) -> Path:
     out = _scratch() / f"bag{len(_DECOMPRESSED)}"
     out.mkdir(parents=True, exist_ok=True)
     for f in files:
-        (out / f.name).symlink_to(f)
+        (out / f.name).symlink_to(f.resolve())
     plain = dict(info, compression_format="", compression_mode="")
     plain["relative_file_paths"] = [f.name for f in files]
     listed = info.get("files")
