@@ -240,25 +240,31 @@ class Allowance:
     """The uncompressed bytes the chunks of one file have declared so far, refused once past
     :func:`~ertools.io.budget.allowance` of the file's size (each chunk counted once)."""
 
-    def __init__(self, file_size: int, where: str) -> None:
+    def __init__(self, file_size: int, path: str) -> None:
         self.limit = budget.allowance(file_size)
         self.file_size = file_size
-        self.where = where
+        self.path = path or None
         self.declared = 0
 
-    def add(self, size: int) -> None:
-        """Count one more chunk of ``size`` declared bytes.
+    def add(self, size: int, where: str, what: str = "chunk") -> None:
+        """Count one more chunk (at ``where``) of ``size`` declared bytes.
 
         Raises:
-            BagError: the file's chunks now declare more than the file's allowance.
+            BagError: the chunk is over :data:`~ertools.io.budget.MAX_CHUNK_BYTES`, or the
+                file's chunks now declare more than the file's allowance (naming the file).
         """
+        try:
+            check_declared(size, where, what)
+        except BagError as err:
+            raise BagError(err.message, path=self.path) from err
         self.declared += max(size, 0)
         if self.declared > self.limit:
             raise BagError(
                 budget.over_budget(
-                    f"the chunks of {self.where} ({self.file_size} bytes)",
-                    f"more than {self.declared} bytes uncompressed",
+                    f"the chunks of this {self.file_size}-byte file, up to the {what} {where}",
+                    f"{self.declared} bytes uncompressed",
                     self.limit,
                     "MAX_INFLATE_PER_BYTE x the file's size + MAX_CHUNK_BYTES",
-                )
+                ),
+                path=self.path,
             )

@@ -167,6 +167,9 @@ def _ros1(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagS
 MAX_INDEX_PROBLEMS = 5
 # Ends each such line: ``info --check`` replaces them by its record-level lines.
 INDEX_SELF_CHECK = "(damaged index; info --check reads the records)"
+# Ends a line on a chunk that does not decompress (damaged, or over the budget): info --check
+# says the same of every chunk.
+CHUNK_SELF_CHECK = "(info --check reads every chunk)"
 
 
 def _ros1_check_ends(bag: Any, chunks: list[Any], spans: dict[int, list[int]]) -> list[str]:
@@ -186,11 +189,20 @@ def _ros1_check_ends(bag: Any, chunks: list[Any], spans: dict[int, list[int]]) -
             continue
         where = f"in {bag.path} at byte {chunk.pos}"
         try:
-            buf = np.frombuffer(bag.chunk_bytes(chunk), dtype=np.uint8)
+            data = bag.chunk_bytes(chunk)
+        except BagError as err:  # damaged data or over the budget, not a damaged index
+            return [f"{err.message} {CHUNK_SELF_CHECK}"]
+        try:
+            buf = np.frombuffer(data, dtype=np.uint8)
             entries = bag.chunk_entries(chunk)
-            for cid in bounding:
-                t, off = entries.get(cid, (np.empty(0, np.int64), np.empty(0, np.int64)))
-                bag.checked_spans(buf, off, t, np.full(len(t), cid, dtype=np.int64), where)
+            found = [(cid, *entries[cid]) for cid in bounding if cid in entries]
+            if found:
+                # one check of every bounding connection's entries: a call per connection
+                # cost 0.26 ms each (40,000 connections: 10 s)
+                t = np.concatenate([f[1] for f in found])
+                off = np.concatenate([f[2] for f in found])
+                conn = np.repeat([f[0] for f in found], [len(f[1]) for f in found])
+                bag.checked_spans(buf, off, t, conn.astype(np.int64), where)
         except BagError as err:
             return [f"chunk at byte {chunk.pos}: {err.message} {INDEX_SELF_CHECK}"]
     return []

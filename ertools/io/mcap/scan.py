@@ -306,7 +306,7 @@ def _chunk(buf: Any, at: int, end: int, sink: _Sink) -> None:
         raise _CutError
     where = f"in {sink.path} at byte {at}"
     if compression:
-        sink.allowance.add(usize)
+        sink.allowance.add(usize, f"at byte {at}", "MCAP chunk")
     stored = buf[at : at + nbytes]
     # an uncompressed chunk is read in place (no copy); the decompressors take any buffer
     inner = stored if compression == "" else decompress(compression, stored, usize, where)

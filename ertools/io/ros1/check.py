@@ -323,7 +323,7 @@ def _check(f: BinaryIO, path: Path, size: int, progress: Reporter | None) -> lis
             if rec.op == OP_CHUNK:
                 compression, usize = chunk_head(rec.fields)
                 if compression != "none":
-                    allowance.add(usize)
+                    allowance.add(usize, f"at byte {pos}")
                 chunks.append(_Chunk(pos, compression, usize, rec.data_pos, rec.data_len))
             elif rec.op == OP_INDEX:
                 cid, count = records.u32(rec.fields, "conn"), records.u32(rec.fields, "count")
@@ -493,7 +493,7 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
             if rec.op == OP_CHUNK:
                 compression, usize = chunk_head(rec.fields)
                 if compression != "none":
-                    allowance.add(usize)
+                    allowance.add(usize, f"at byte {pos}")
                 found.append((pos, compression, usize, rec.data_pos, rec.data_len, []))
             elif rec.op == OP_INDEX and found:
                 found[-1][5].append(entries_from_index(data[: 12 * (len(data) // 12)]))

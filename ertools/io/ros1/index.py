@@ -171,7 +171,7 @@ class Ros1Bag(BagFile):
             )
         if chunk.compression != "none":
             # each chunk's header is read once: what the chunks read so far may inflate to
-            self._inflation.add(chunk.size)
+            self._inflation.add(chunk.size, f"at byte {chunk.pos}")
         return rec
 
     def compressions(self) -> list[str]:
@@ -251,9 +251,9 @@ class Ros1Bag(BagFile):
         if len(data) != chunk.data_len:
             raise BagError(f"chunk at byte {chunk.pos} cut off by end of file", path=self.path)
         try:
-            return decompress(chunk.compression, data, chunk.size, self._where(chunk))
+            return decompress(chunk.compression, data, chunk.size, f"at byte {chunk.pos}")
         except BagError as err:
-            raise BagError(err.message, path=None) from err
+            raise BagError(err.message, path=self.path) from err
 
     def select(
         self, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None

@@ -162,7 +162,12 @@ def read_layout(path: Path) -> Ros1Layout:
         key = (str(path), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
         found = _SCANNED.get(key)
         if found is None:
-            found = _read_layout(f, path, st.st_size)
+            try:
+                found = _read_layout(f, path, st.st_size)
+            except BagError as err:
+                if err.path is not None:
+                    raise
+                raise BagError(err.message, path=path) from err
             if not found.indexed:
                 # one version per path (a recording's file grows: only its latest scan is
                 # worth keeping) and a few files at most (an hour's entries are ~20 MB)
@@ -341,7 +346,7 @@ def scan_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ros1L
             flush()
             compression, usize = chunk_head(rec.fields)
             if compression != "none":
-                allowance.add(usize)
+                allowance.add(usize, f"at byte {pos}")
             try:
                 buf = decompress(compression, data, usize, f"at byte {pos}")
                 per: dict[int, tuple[list[int], list[int]]] = {}
