@@ -414,6 +414,17 @@ def _check(f: BinaryIO, path: Path, size: int, progress: Reporter | None) -> lis
     return rep.result()
 
 
+def _by_conn(conn: I64) -> dict[int, I64]:
+    """conn -> the positions of its records, in record order: one sort for all connections
+    (a mask per connection was quadratic in a chunk of many connections)."""
+    order = np.argsort(conn, kind="stable")
+    cids, first, count = np.unique(conn[order], return_index=True, return_counts=True)
+    return {
+        int(c): order[a : a + n]
+        for c, a, n in zip(cids.tolist(), first.tolist(), count.tolist(), strict=True)
+    }
+
+
 def _compare_chunk(
     rep: _Report,
     where: str,
@@ -421,7 +432,8 @@ def _compare_chunk(
     recs: ChunkRecords,
     info: tuple[int, int, int, dict[int, int]] | None,
 ) -> None:
-    present = np.unique(recs.msg_conn)
+    of_conn = _by_conn(recs.msg_conn)
+    present = np.fromiter(of_conn, dtype=np.int64, count=len(of_conn))
     if len(recs.msg_time) and info is not None:
         ipos, start, end, counts = info
         lo, hi = int(recs.msg_time.min()), int(recs.msg_time.max())
@@ -431,7 +443,7 @@ def _compare_chunk(
                 f"its messages span {_ns(lo)} to {_ns(hi)}"
             )
         for cid in sorted(set(counts) | {int(c) for c in present}):
-            held = int(np.count_nonzero(recs.msg_conn == cid))
+            held = len(of_conn.get(cid, ()))
             if counts.get(cid, 0) != held:
                 rep.add(
                     f"{where}: connection {cid}: chunk info counts {counts.get(cid, 0)} "
@@ -440,7 +452,7 @@ def _compare_chunk(
     elif info is None:
         rep.add(f"{where}: no chunk-info record")
     for cid in sorted(set(chunk.index) | {int(c) for c in present}):
-        mine = recs.msg_conn == cid
+        mine = of_conn.get(cid, np.empty(0, np.int64))
         off, t_rec = recs.msg_off[mine], recs.msg_time[mine]
         t_idx, o_idx = chunk.index.get(cid, (np.empty(0, np.int64), np.empty(0, np.int64)))
         tag = f"{where}: connection {cid}"
@@ -538,8 +550,8 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
         if not len(recs.msg_off):
             continue
         entries = {
-            int(cid): (recs.msg_time[recs.msg_conn == cid], recs.msg_off[recs.msg_conn == cid])
-            for cid in np.unique(recs.msg_conn)
+            cid: (recs.msg_time[at], recs.msg_off[at])
+            for cid, at in _by_conn(recs.msg_conn).items()
         }
         chunks.append(
             Ros1Chunk(
