@@ -451,3 +451,40 @@ def test_the_cli_says_a_bomb_in_one_line(
         err = capsys.readouterr().err
         (line,) = [ln for ln in err.splitlines() if ln.startswith("ertools: error:")]
         assert "bomb." in line and "Traceback" not in err
+
+
+# --- nesting of stored message definitions --------------------------------------------------
+
+SEP = "=" * 80 + "\n"
+
+
+def _nested_type_bag(path: Path, levels: int) -> Path:
+    """A topic whose type holds a type that holds a type... ``levels`` types in all, the last
+    one an int32."""
+    parts = [f"pkg/A{i + 1} a\n" for i in range(levels - 1)] + ["int32 x\n"]
+    definition = parts[0] + "".join(f"{SEP}MSG: pkg/A{i}\n{parts[i]}" for i in range(1, levels))
+    conn = Ros1Conn(0, "/deep", msgtype="pkg/A0", definition=definition, md5="0" * 32)
+    return ros1_bag(path, [conn], [Ros1Chunk([(0, T0, u32(5))])])
+
+
+def test_message_type_nesting_just_under_and_just_over(tmp_path: Path) -> None:
+    """rosbags builds its deserializers recursively, a level per nested type: 3,000 levels
+    was a RecursionError (a traceback in the API, "unexpected" in the CLI)."""
+    under = _nested_type_bag(tmp_path / "under.bag", budget.MAX_NESTING)
+    (msg,) = eio.read_messages(under, "/deep")
+    inner = msg.msg
+    for _ in range(budget.MAX_NESTING - 1):
+        inner = inner.a
+    assert inner.x == 5
+    over = _nested_type_bag(tmp_path / "over.bag", budget.MAX_NESTING + 1)
+    _refusal(lambda: eio.read_messages(over, "/deep"), "over.bag", "pkg/msg/A0", "MAX_NESTING")
+    far = _nested_type_bag(tmp_path / "far.bag", 3000)
+    _refusal(lambda: eio.read_messages(far, "/deep"), "far.bag", "nested deeper")
+
+
+def test_a_recursive_message_type_is_refused(tmp_path: Path) -> None:
+    conn = Ros1Conn(
+        0, "/loop", msgtype="pkg/Loop", definition="pkg/Loop[] children\nint32 x\n", md5="0" * 32
+    )
+    bag = ros1_bag(tmp_path / "loop.bag", [conn], [Ros1Chunk([(0, T0, u32(0) + u32(5))])])
+    _refusal(lambda: eio.read_messages(bag, "/loop"), "loop.bag", "its own type pkg/msg/Loop")
