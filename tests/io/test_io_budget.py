@@ -488,3 +488,63 @@ def test_a_recursive_message_type_is_refused(tmp_path: Path) -> None:
     )
     bag = ros1_bag(tmp_path / "loop.bag", [conn], [Ros1Chunk([(0, T0, u32(0) + u32(5))])])
     _refusal(lambda: eio.read_messages(bag, "/loop"), "loop.bag", "its own type pkg/msg/Loop")
+
+
+# --- rosbag2 compressed message by message ----------------------------------------------------
+
+
+def test_a_rosbag2_message_whose_frame_says_300_mib_is_refused_unread(
+    tmp_path: Path, scene: Scene
+) -> None:
+    """A bag written by rosbags with ``compression_mode: message``; one state message's blob
+    replaced by a zstd frame of 300 MiB of zeros (1.9 KiB, its header saying so): rosbags'
+    ``zstd.decompress`` inflated it whole. Over MAX_CHUNK_BYTES now, refused from the frame's
+    header; the bag's other reads are unaffected."""
+    import sqlite3
+
+    from hostile_files import zstd_frame
+    from io_bagmaker import build, typestore
+    from rosbags.rosbag2 import Writer as Writer2
+    from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
+
+    path = tmp_path / "r2"
+    ts = typestore(False)
+    writer = Writer2(path, version=9)
+    writer.set_compression(CompressionMode.MESSAGE, CompressionFormat.ZSTD)
+    with writer:
+        conns: dict[str, Any] = {}
+        for seq, (ci, t, v) in enumerate(scene.spec.msgs):
+            topic, msgtype, _caller = scene.spec.conns[ci]
+            if topic not in conns:
+                conns[topic] = writer.add_connection(
+                    topic, msgtype.replace("/", "/msg/"), typestore=ts
+                )
+            conn = conns[topic]
+            writer.write(conn, t, ts.serialize_cdr(build(ts, False, msgtype, v, seq), conn.msgtype))
+    states = eio.read_states(path, "/fbm3w/bmbox_state")
+    assert len(states.t_ns) == sum(
+        1 for ci, _t, _v in scene.spec.msgs if scene.spec.conns[ci][0] == "/fbm3w/bmbox_state"
+    )
+    poses = eio.read_poses(path, "/fbm3w/robot_at_work/pose")
+    (db,) = path.glob("*.db3")
+    with sqlite3.connect(db) as con:
+        (topic_id,) = con.execute(
+            "SELECT id FROM topics WHERE name = '/fbm3w/bmbox_state'"
+        ).fetchone()
+        con.execute(
+            "UPDATE messages SET data = ? WHERE id = (SELECT min(id) FROM messages WHERE "
+            "topic_id = ?)",
+            (zstd_frame(b"", 300 * MiB), topic_id),
+        )
+    with peak_memory() as peak:
+        _refusal(
+            lambda: eio.read_states(path, "/fbm3w/bmbox_state"),
+            "r2",
+            "/fbm3w/bmbox_state",
+            f"{300 * MiB} bytes uncompressed",
+            "MAX_CHUNK_BYTES",
+        )
+    # rosbags' reader and its generated deserializers take ~16 MiB of their own here; the
+    # message would have been 300
+    assert peak[0] < 64 * MiB
+    assert len(eio.read_poses(path, "/fbm3w/robot_at_work/pose")) == len(poses)
