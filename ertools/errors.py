@@ -11,13 +11,14 @@ from __future__ import annotations
 from pathlib import Path
 
 # The longest path a message shows whole: a folder deeper than the system's path limit (4096
-# bytes on Linux) would make a line thousands of characters long.
-MAX_SHOWN = 120
+# bytes on Linux) would make a line thousands of characters long. A path has no spaces to
+# wrap at: this one leaves room in the 200 characters of an error's first line.
+MAX_SHOWN = 160
 
 
 def shown(path: str | Path) -> str:
     """``path`` for a message: whole up to :data:`MAX_SHOWN` characters, else its start and
-    end around "...", with its length said."""
+    end around "..." with its length said (about 120 characters)."""
     text = str(path)
     if len(text) <= MAX_SHOWN:
         return text

@@ -11,6 +11,7 @@ the ``mcap`` library's (log time, chunk, position) order for MCAP).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import heapq
 import logging
@@ -289,10 +290,14 @@ class Rosbag2McapFile(BagFile):
         self.format = "rosbag2-mcap"
         info = read_metadata(path)
         self._inflate = message_compression(info)
-        self._files = [McapFile(f) for f in readable_files(path, info) if f.suffix == ".mcap"]
+        self._files: list[McapFile] = []
+        for storage in readable_files(path, info):
+            if storage.suffix == ".mcap":
+                with self._naming(storage):
+                    self._files.append(McapFile(storage))
         by_topic: dict[str, Conn] = {}
-        for f in self._files:
-            for c in f.connections:
+        for opened in self._files:
+            for c in opened.connections:
                 by_topic.setdefault(c.topic, c)
         self.connections = tuple(
             dataclasses.replace(c, id=i) for i, c in enumerate(by_topic.values(), start=1)
@@ -308,9 +313,9 @@ class Rosbag2McapFile(BagFile):
         for f in self._files:
             mine = [c for c in f.connections if c.topic in wanted]
             if mine:
-                parts.append(
-                    [(wanted[c.topic], t, data) for c, t, data in f.raw(mine, start_ns, end_ns)]
-                )
+                with self._naming(f.path):
+                    got = [(wanted[c.topic], t, d) for c, t, d in f.raw(mine, start_ns, end_ns)]
+                parts.append(got)
         for conn, t, data in heapq.merge(*parts, key=lambda r: r[1]):
             if self._inflate is not None:
                 where = f"of {conn.topic} at {t} ns"
@@ -319,6 +324,14 @@ class Rosbag2McapFile(BagFile):
                 except BagError as err:
                     raise BagError(err.message, path=self.path) from err
             yield conn, t, data
+
+    @contextlib.contextmanager
+    def _naming(self, file: Path) -> Iterator[None]:
+        """An error of one storage file said as the bag's, naming the file."""
+        try:
+            yield
+        except BagError as err:
+            raise BagError(f"storage file {file.name}: {err.message}", path=self.path) from err
 
 
 def open_bag(path: str | Path) -> BagFile:

@@ -10,6 +10,7 @@ too many (a bz2 stream a few hundred bytes long may hold gigabytes of zeros).
 
 from __future__ import annotations
 
+import bz2
 from collections.abc import Callable, Iterator
 from typing import Any, BinaryIO, Protocol, TypeVar
 
@@ -110,8 +111,6 @@ def inflate_into(
 def _checked(compression: str, data: Any, size: int, where: str, what: str) -> Iterator[bytes]:
     """The pieces of a bz2 or lz4 stream, exactly ``size`` bytes in all (or a BagError)."""
     if compression == "bz2":
-        import bz2  # lazy: a decompressor only for compressed chunks
-
         make: Any = bz2.BZ2Decompressor
     elif compression == "lz4":
         import lz4.frame  # lazy: a decompressor only for compressed chunks

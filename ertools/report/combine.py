@@ -29,6 +29,7 @@ from ertools.benchmarks import registry
 from ertools.benchmarks.common.teams import team_from_log_name
 from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ConfigError
+from ertools.inputs import read_regular_text, why_not
 from ertools.report import html as h
 from ertools.report import ranks, units
 from ertools.report.folder import headline
@@ -115,8 +116,10 @@ def _options(argv: list[str], inputs: list[dict[str, Any]]) -> str:
 
 def _load_json(path: Path) -> Any:
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        return json.loads(read_regular_text(path))  # a named pipe would block for ever
+    except OSError as err:
+        raise ConfigError(f"cannot read a result: {why_not(err)}", path=path) from err
+    except (UnicodeDecodeError, json.JSONDecodeError) as err:
         raise ConfigError(f"cannot read a result: {err}", path=path) from err
 
 

@@ -459,7 +459,8 @@ def test_bad_bag(
 
 
 @pytest.mark.parametrize(
-    "bad", ["missing", "empty", "random", "truncated-json", "wrong-shape-json", "plain-folder"]
+    "bad",
+    ["missing", "empty", "random", "truncated-json", "wrong-shape-json", "plain-folder", "fifo"],
 )
 def test_report_bad_result(
     bad: str, inputs: Inputs, tmp_path: Path, capsys: pytest.CaptureFixture[str]
@@ -472,6 +473,7 @@ def test_report_bad_result(
         "truncated-json": tmp_path / "truncated.json",
         "wrong-shape-json": tmp_path / "list.json",
         "plain-folder": tmp_path / "not_a_report",
+        "fifo": tmp_path / "fifo.json",
     }[bad]
     if bad == "truncated-json":
         path.write_text('{"name": "fbm2h", "position_accuracy": 0.1')
@@ -479,6 +481,10 @@ def test_report_bad_result(
         path.write_text("[1, 2]")
     elif bad == "plain-folder":
         path.mkdir()
+    elif bad == "fifo":
+        if not hasattr(os, "mkfifo"):
+            pytest.skip("n/a: no FIFOs on this system")
+        os.mkfifo(path)
     result = _run(["report", str(path), "--report", str(tmp_path / "page")], capsys)
     _check_error(result, 1, path.name)
     assert not (tmp_path / "page" / "index.html").exists()

@@ -18,6 +18,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import lz4.frame
 import zstandard
 
 STRING_DEF = "string data\n"
@@ -221,8 +222,6 @@ def mcap_file(path: Path, channels: Sequence[McapChannel], chunks: Sequence[Mcap
     """An indexed MCAP file: header, schemas and channels, chunks each followed by their
     message indexes, data end, then a summary (schemas, channels, chunk indexes, statistics)
     and the footer. Chunk CRCs are 0 (not computed), which the specification allows."""
-    import lz4.frame
-
     out = MCAP_MAGIC + _mrec(0x01, _mstr("ros2") + _mstr("ertools-tests"))
     defs = b""
     for ch in channels:
