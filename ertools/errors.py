@@ -21,6 +21,19 @@ from pathlib import Path
 
 # The transient errors made while a :func:`watching` block runs (None: none is watched)
 _WATCHED: ContextVar[list[BaseException] | None] = ContextVar("ertools_transient", default=None)
+# The longest path a message shows whole: a folder deeper than the system's path limit (4096
+# bytes on Linux) would make a line thousands of characters long. A path has no spaces to
+# wrap at: this one leaves room in the 200 characters of an error's first line.
+MAX_SHOWN = 160
+
+
+def shown(path: str | Path) -> str:
+    """``path`` for a message: whole up to :data:`MAX_SHOWN` characters, else its start and
+    end around "..." with its length said (about 120 characters)."""
+    text = str(path)
+    if len(text) <= MAX_SHOWN:
+        return text
+    return f"{text[:40]}...{text[-60:]} ({len(text)} characters)"
 
 
 class ErtoolsError(Exception):
@@ -43,7 +56,7 @@ class ErtoolsError(Exception):
         self.transient = transient if transient is not None else transient_error(handled)
         if self.transient:
             _note(self)
-        super().__init__(f"{self.path}: {message}" if self.path else message)
+        super().__init__(f"{shown(self.path)}: {message}" if self.path else message)
 
 
 class BagError(ErtoolsError):

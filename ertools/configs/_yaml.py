@@ -20,6 +20,7 @@ import yaml
 
 from ertools import yamlin
 from ertools.errors import ConfigError
+from ertools.inputs import read_regular_text, why_not
 from ertools.yamlin import Tags
 
 log = logging.getLogger("ertools.configs")
@@ -35,10 +36,12 @@ def load_yaml(path: str | Path, what: str = "config", tags: Tags = "safe") -> An
 
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
+        text = read_regular_text(p)  # a named pipe would block open() for ever
     except FileNotFoundError:
         raise ConfigError(f"{what} file not found", path=p) from None
-    except (OSError, UnicodeDecodeError) as err:
+    except OSError as err:
+        raise ConfigError(f"cannot read {what} file: {why_not(err)}", path=p) from err
+    except UnicodeDecodeError as err:
         raise ConfigError(f"cannot read {what} file: {err}", path=p) from err
     return check_numbers(parse_yaml(text, source=str(p), what=what, tags=tags), str(p))
 

@@ -29,6 +29,7 @@ from ertools.benchmarks import registry
 from ertools.benchmarks.common.teams import team_from_log_name
 from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ConfigError
+from ertools.inputs import read_regular_text, why_not
 from ertools.report import html as h
 from ertools.report import ranks, units
 from ertools.report.folder import headline
@@ -116,8 +117,10 @@ def _options(argv: list[str], inputs: list[dict[str, Any]]) -> str:
 def _load_json(path: Path) -> Any:
     """A result's JSON; a key given twice is refused (the json module keeps the last)."""
     try:
-        return jsonin.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError) as err:
+        return jsonin.loads(read_regular_text(path))  # a named pipe would block for ever
+    except OSError as err:
+        raise ConfigError(f"cannot read a result: {why_not(err)}", path=path) from err
+    except (UnicodeDecodeError, ValueError) as err:
         raise ConfigError(f"cannot read a result: {err}", path=path) from err
 
 

@@ -39,6 +39,7 @@ from ertools.benchmarks import registry
 from ertools.benchmarks.base import Benchmark, Input, rename_former
 from ertools.configs._yaml import MAX_SECONDS, number, parse_yaml, show
 from ertools.errors import BagError, ConfigError
+from ertools.inputs import read_regular
 from ertools.io.formats import detect_format
 from ertools.io.text import sniff
 from ertools.timeutil import s_to_ns
@@ -130,7 +131,7 @@ class Manifest:
 def load_manifest(path: Path) -> Manifest:
     """Read, safe-load and validate a manifest; :class:`ManifestError` lists every problem."""
     try:
-        raw = path.read_bytes()
+        raw = read_regular(path)  # a named pipe would block open() for ever
     except FileNotFoundError:
         raise ConfigError("manifest not found", path=path) from None
     except OSError as err:
