@@ -11,12 +11,13 @@ import os
 import subprocess
 import sys
 
-from ertools.samples.simd import ENV
+from ertools.samples.simd import BLAS_ENV, ENV
 
 
 def unpinned_env() -> dict[str, str]:
-    """``os.environ`` without ``NPY_DISABLE_CPU_FEATURES``: as users run a command."""
-    return {k: v for k, v in os.environ.items() if k != ENV}
+    """``os.environ`` without ``NPY_DISABLE_CPU_FEATURES`` and ``OPENBLAS_CORETYPE``: as
+    users run a command."""
+    return {k: v for k, v in os.environ.items() if k not in (ENV, BLAS_ENV)}
 
 
 def baseline_env() -> dict[str, str]:

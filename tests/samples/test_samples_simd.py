@@ -20,7 +20,14 @@ from pathlib import Path
 from simd_paths import baseline_env, unpinned_env
 
 from ertools.samples.scenario import SCENARIOS
-from ertools.samples.simd import ENV, all_targets, dispatch, pinned_targets
+from ertools.samples.simd import (
+    BLAS_ENV,
+    ENV,
+    all_targets,
+    dispatch,
+    pinned_env,
+    pinned_targets,
+)
 
 
 def _generate(out: Path, env: dict[str, str]) -> dict[str, bytes]:
@@ -55,6 +62,29 @@ def test_the_targets_switched_off() -> None:
     # make test's second pass: every one the CPU has (not AVX512_SPR: this CPU lacks it)
     assert all_targets(dispatched, have) == ["X86_V3", "X86_V4", "AVX512_ICL"]
     assert all_targets(["ASIMDHP", "SVE"], {"ASIMDHP": True}) == ["ASIMDHP"]
+
+
+def test_the_command_pins_numpy_and_openblas_once() -> None:
+    dispatched = ["X86_V3", "X86_V4", "AVX512_ICL"]
+    avx512 = {"AVX2": True, "FMA3": True, "X86_V3": True, "X86_V4": True, "AVX512_ICL": True}
+    env = pinned_env({"HOME": "/h"}, dispatched, avx512)
+    assert env == {"HOME": "/h", ENV: "X86_V4 AVX512_ICL", BLAS_ENV: "Haswell"}
+    # the re-run: NumPy then reports the targets off, the features as they are
+    rerun = {**avx512, "X86_V4": False, "AVX512_ICL": False}
+    assert pinned_env(env, dispatched, rerun) is None
+    # an AVX2 CPU: OpenBLAS's kernels only (those it would pick anyway, by name)
+    avx2 = {"AVX2": True, "FMA3": True, "X86_V3": True}
+    assert pinned_env({}, dispatched, avx2) == {BLAS_ENV: "Haswell"}
+    # an older x86-64 CPU, or not x86-64: nothing it can run to pin
+    assert pinned_env({}, dispatched, {"AVX": True}) is None
+    assert pinned_env({}, ["ASIMDHP", "SVE"], {"ASIMDHP": True, "SVE": True}) is None
+    # what the user set is left as it is
+    mine = {ENV: "", BLAS_ENV: "Nehalem"}
+    assert pinned_env(mine, dispatched, avx512) is None
+    assert pinned_env({BLAS_ENV: "Nehalem"}, dispatched, avx512) == {
+        BLAS_ENV: "Nehalem",
+        ENV: "X86_V4 AVX512_ICL",
+    }
 
 
 def test_the_printed_targets_leave_numpy_its_baseline() -> None:
