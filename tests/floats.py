@@ -4,18 +4,19 @@ between CPUs (docs/qa.md, "Results on every CPU").
 NumPy picks its transcendental functions (sin, cos, arctan2, exp...) by instruction set (its
 AVX-512, AVX2 or baseline code, or the C library's) and OpenBLAS its kernels by CPU: the
 results agree to an ulp or two, not bit for bit. Basic arithmetic, sums and sorts give the
-same bits on every path. Measured on the golden outputs (an AVX-512 CPU as users run it,
-against NumPy's AVX-512 targets off, OpenBLAS's Haswell kernels, and every SIMD target off
-with OpenBLAS's oldest kernels): scores and intervals moved by 2.6e-14 relative at most, a
-difference of two nearly equal angles by 4.4e-16 absolute, an interval's variance shares by
-9.7e-13 relative. The tolerances, per quantity:
+same bits on every path. Measured on the golden outputs and the sample competition's
+rescore (an AVX-512 CPU as users run it, against NumPy's AVX-512 targets off, OpenBLAS's
+Haswell kernels, and every SIMD target off with OpenBLAS's oldest kernels): scores and
+intervals moved by 4.9e-14 relative at most, a difference of two nearly equal angles by
+4.4e-16 absolute, an interval's variance shares by 1.0e-12 relative. The tolerances, per
+quantity:
 
 - :data:`EXACT`: integers, and numbers of a million and more (epoch times, nanosecond
   counts: they come from integers, and 1e-12 of an epoch time is a millisecond);
 - :data:`VALUE`: every other number (scores, intervals, poses, times from the start);
 - :data:`SHARE`: a source's share of an interval, a ratio of the variances of Monte Carlo
   draws; each draw is a score re-computed (s, moving by its last bits) and the variance of
-  draws spread by sigma around it moves by those bits times s / sigma (up to ~1e4 here);
+  draws spread by sigma around it moves by those bits times s / sigma;
 - a number that was rounded on output (YAML's 9 decimals, ``ertools.yamlout``) may in
   addition move by one unit in its last digit (:data:`YAML_UNIT`): a value within its
   quantity's tolerance of a rounding boundary rounds either way. Numbers written with fewer
@@ -52,11 +53,11 @@ class Tolerance:
         return abs(a - b) <= self.rel * max(abs(a), abs(b)) + self.abs + rounded
 
 
-# Scores and intervals: 40 times the worst measured (2.6e-14). Absolute 1e-12 (a picometre,
+# Scores and intervals: 20 times the worst measured (4.9e-14). Absolute 1e-12 (a picometre,
 # a picoradian): a difference of two positions within 100 m or two angles within 360
 # degrees carries their last bits (ulp 1.4e-14 and 5.7e-14), whatever its own size.
 VALUE = Tolerance(rel=1e-12, abs=1e-12)
-# Variance shares: 1000 times the worst measured (9.7e-13); module doc.
+# Variance shares: 1000 times the worst measured (1.0e-12); module doc.
 SHARE = Tolerance(rel=1e-9, abs=1e-12)
 EXACT = Tolerance(rel=0.0, abs=0.0)
 EXACT_FROM = 1e6

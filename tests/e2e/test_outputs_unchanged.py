@@ -11,8 +11,8 @@ the last digit), after normalisations: the temporary folder becomes ``<OUT>``, t
 ``<ARGV>``. The commands run in the test's process (tests/inprocess.py), in the temporary
 folder. Record again, only when an output is meant to change, with
 ``ERTOOLS_RECORD_GOLDEN=1 pytest tests/e2e/test_outputs_unchanged.py`` and say why in the
-commit (``make golden`` records with NumPy's AVX-512 targets off, as an AVX2 CPU computes, so
-that a re-recording on an AVX-512 CPU shows only what changed).
+commit; on an AVX-512 CPU prefix ``NPY_DISABLE_CPU_FEATURES="X86_V4 AVX512_ICL"`` (the AVX2
+path the recording was made on) so that the diff shows only what changed (docs/qa.md).
 """
 
 from __future__ import annotations
