@@ -20,11 +20,30 @@ from types import FrameType
 
 INTERRUPTED = 130  # 128 + SIGINT
 
+# Set by the first Ctrl-C: an extension module interrupted while it loads (NumPy's C core) may
+# turn the KeyboardInterrupt into an ImportError of its own, with its advice on reinstalling.
+_received = threading.Event()
+
 
 def _first_interrupt(signum: int, frame: FrameType | None) -> None:
     # the next one is the operating system's: the process ends there and then
     signal.signal(signal.SIGINT, signal.SIG_DFL)
+    _received.set()
     raise KeyboardInterrupt
+
+
+def _caused_by_interrupt(err: BaseException) -> bool:
+    """Whether ``err`` came of a Ctrl-C: one was received, or one is in its chain."""
+    if _received.is_set():
+        return True
+    seen: set[int] = set()
+    cause: BaseException | None = err
+    while cause is not None and id(cause) not in seen:
+        if isinstance(cause, KeyboardInterrupt):
+            return True
+        seen.add(id(cause))
+        cause = cause.__cause__ or cause.__context__
+    return False
 
 
 def interrupted(program: str) -> int:
@@ -50,6 +69,10 @@ def run(target: str, program: str) -> int:
         code = getattr(import_module(module), name)()
     except KeyboardInterrupt:
         return interrupted(program)
+    except Exception as err:  # an ImportError of NumPy's, say, made of the interrupt
+        if _caused_by_interrupt(err):
+            return interrupted(program)
+        raise
     if threading.current_thread() is threading.main_thread():
         # done: a Ctrl-C while Python exits (its atexit work) ends it at once, no traceback
         signal.signal(signal.SIGINT, signal.SIG_DFL)

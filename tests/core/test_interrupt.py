@@ -18,9 +18,12 @@ import subprocess
 import sys
 import textwrap
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+
+from ertools import launch
 
 ROOT = Path(__file__).resolve().parents[2]
 BAG = ROOT / "sample_bags" / "fbm3w" / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
@@ -146,3 +149,39 @@ def test_a_real_ctrl_c_in_the_first_moments(library: str, after_s: float) -> Non
     assert "Traceback" not in err
     if proc.returncode != 0:
         assert (proc.returncode, err.splitlines()[-1]) == (130, "ertools: interrupted")
+
+
+@pytest.fixture(autouse=False)
+def sigint_kept() -> Iterator[None]:
+    """``launch.run`` sets the SIGINT handler of the process it runs in: pytest's is put back."""
+    handler = signal.getsignal(signal.SIGINT)
+    yield
+    signal.signal(signal.SIGINT, handler)
+
+
+@pytest.mark.usefixtures("sigint_kept")
+def test_an_import_error_made_of_an_interrupt_is_one_line(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """NumPy's C core, interrupted while it loads, raises an ImportError of its own (with its
+    advice on reinstalling) whose context is the KeyboardInterrupt: still one line and 130."""
+    (tmp_path / "numpyish.py").write_text(
+        "try:\n"
+        "    raise KeyboardInterrupt\n"
+        "except KeyboardInterrupt as exc:\n"
+        "    raise ImportError('IMPORTANT: PLEASE READ THIS FOR ADVICE') from exc\n",
+        encoding="utf-8",
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert launch.run("numpyish:main", "ertools") == launch.INTERRUPTED
+    assert capsys.readouterr().err == "ertools: interrupted\n"
+
+
+@pytest.mark.usefixtures("sigint_kept")
+def test_an_import_error_of_its_own_is_not_an_interrupt(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    (tmp_path / "broken.py").write_text("raise ImportError('no such thing')\n", encoding="utf-8")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    with pytest.raises(ImportError, match="no such thing"):
+        launch.run("broken:main", "ertools")
