@@ -1,0 +1,70 @@
+"""A benchmark is one package (issue 37): no module named after a benchmark, and none
+importing a benchmark package, outside ``benchmarks/<name>/``; the registry and the CLI's
+command modules (which import what their command runs) aside."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from archscan import ROOT, outside_benchmark_modules, plant, ratchet
+
+ALLOWED = frozenset(
+    {
+        "ertools/configs/fbm3w.py: named after a benchmark",
+        "ertools/configs/goal.py: named after a benchmark",
+        "ertools/configs/shapes.py: named after a benchmark",
+        "ertools/configs/timing.py: named after a benchmark",
+        "ertools/export/pairs.py: imports ertools.benchmarks.trajectory",
+        "ertools/report/foxglove/fbm1.py: imports ertools.benchmarks.fbm1",
+        "ertools/report/foxglove/fbm1.py: named after a benchmark",
+        "ertools/report/foxglove/fbm2h.py: imports ertools.benchmarks.fbm2h",
+        "ertools/report/foxglove/fbm2h.py: named after a benchmark",
+        "ertools/report/foxglove/fbm3w.py: imports ertools.benchmarks.fbm3w",
+        "ertools/report/foxglove/fbm3w.py: named after a benchmark",
+        "ertools/report/foxglove/trajectory.py: imports ertools.benchmarks.trajectory",
+        "ertools/report/foxglove/trajectory.py: named after a benchmark",
+        "ertools/report/plots_fbm1.py: named after a benchmark",
+        "ertools/report/plots_fbm2h.py: named after a benchmark",
+        "ertools/report/plots_fbm3w.py: named after a benchmark",
+        "ertools/report/plots_noise.py: named after a benchmark",
+        "ertools/report/plots_trajectory.py: imports ertools.benchmarks.trajectory",
+        "ertools/report/plots_trajectory.py: named after a benchmark",
+        "ertools/samples/fbm1.py: named after a benchmark",
+        "ertools/samples/fbm2h.py: named after a benchmark",
+        "ertools/samples/fbm3w.py: named after a benchmark",
+        "ertools/samples/robotlog.py: imports ertools.benchmarks.fbm2h",
+        "ertools/samples/robotlog.py: named after a benchmark",
+        "ertools/samples/scenario.py: imports ertools.benchmarks.fbm1",
+        "ertools/samples/scenario.py: imports ertools.benchmarks.fbm2h",
+        "ertools/samples/scenario.py: imports ertools.benchmarks.fbm3w",
+        "ertools/samples/stationary.py: imports ertools.benchmarks.fbm3w",
+        "ertools/samples/stationary.py: named after a benchmark",
+        "ertools/samples/timeline_folder.py: imports ertools.benchmarks.fbm2h",
+    }
+)
+
+
+def test_no_new_benchmark_module_outside_its_package() -> None:
+    ratchet(outside_benchmark_modules(ROOT), ALLOWED, "benchmark modules outside their package")
+
+
+def test_a_module_outside_its_package_is_found(tmp_path: Path) -> None:
+    root = plant(
+        tmp_path,
+        {
+            "ertools/benchmarks/registry.py": "import ertools.benchmarks.fbm9.declare\n",
+            "ertools/benchmarks/common/gaps.py": "",
+            "ertools/benchmarks/fbm9/declare.py": "from ertools.benchmarks.common import gaps\n",
+            "ertools/benchmarks/fbm9/plots.py": "from ertools.benchmarks.fbm9 import declare\n",
+            "ertools/report/plots_fbm9.py": "",
+            "ertools/report/shared.py": "from ertools.benchmarks.fbm9.result import R\n",
+            "ertools/report/common.py": "from ertools.benchmarks.common import gaps\n",
+            "ertools/samples/robotlog.py": "",
+            "ertools/cli/score.py": "from ertools.benchmarks.fbm9 import declare\n",
+        },
+    )
+    assert outside_benchmark_modules(root) == {
+        "ertools/report/plots_fbm9.py: named after a benchmark",
+        "ertools/report/shared.py: imports ertools.benchmarks.fbm9",
+        "ertools/samples/robotlog.py: named after a benchmark",
+    }
