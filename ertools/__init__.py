@@ -17,8 +17,7 @@ from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
 from ertools._callable import submodules
-
-__version__ = "0.1.0"
+from ertools._version import __version__
 
 # `ertools.audit`, `.timeline`, `.export` and `.rescore` are also packages: a package imported
 # sets its name on this module, so those four packages are themselves callable (their

@@ -74,6 +74,7 @@ PROGRAMS = [
         ],
     ),
     ("module", "ertools.cli.main", ["info", str(BAG)], "ertools", ["ertools.cli.info", "numpy"]),
+    ("module", "ertools", ["info", str(BAG)], "ertools", ["ertools.cli.main", "numpy"]),
     ("module", "ertools.samples", ["--help"], "python -m ertools.samples", ["numpy", "yaml"]),
     (
         "module",
