@@ -23,7 +23,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
-from ertools import atomic
+from ertools.atomic import write_text
 from ertools.audit.model import Audit
 from ertools.audit.rescore import ScoreInputs, audit_bag, infer_benchmark
 from ertools.benchmarks import registry
@@ -351,7 +351,7 @@ def export(
         target = Path(out)
         if any(target.exists() and target.samefile(p) for p in paths_list(bags)):
             raise UsageError(f"out={target}: that is an input; ertools never overwrites its inputs")
-        atomic.write_text(target, text)
+        write_text(target, text)
     return text
 
 

@@ -12,9 +12,9 @@ import sys
 if __name__ == "__main__":
     # `python -m ertools.demo`: the module run under its own name, its imports included, inside
     # ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
-    from ertools import launch
+    from ertools.launch import run as launch
 
-    sys.exit(launch.run("ertools.demo:main", "python -m ertools.demo"))
+    sys.exit(launch("ertools.demo:main", "python -m ertools.demo"))
 
 import io
 from collections.abc import Iterator
@@ -22,7 +22,7 @@ from contextlib import redirect_stdout
 from dataclasses import dataclass
 from pathlib import Path
 
-from ertools import atomic
+from ertools.atomic import write_text
 from ertools.benchmarks import registry
 from ertools.cli.main import main as ertools_main
 from ertools.samples.competition import DEFAULT_SEED, MANIFEST, write_competition
@@ -132,7 +132,7 @@ def run(out: Path, samples: Path = SAMPLES) -> int:
             with redirect_stdout(printed):
                 code = ertools_main(step.argv)
             if printed.getvalue():  # nothing printed (its errors are above): no file
-                atomic.write_text(target, printed.getvalue())
+                write_text(target, printed.getvalue())
             else:
                 target.unlink(missing_ok=True)
                 target = None

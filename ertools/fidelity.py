@@ -18,16 +18,16 @@ if __name__ == "__main__":
     # `python -m ertools.fidelity`: the module run under its own name, its imports included, inside
     # ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
     # (the benchmark modules' Rule class is that module's, not __main__'s)
-    from ertools import launch
+    from ertools.launch import run as launch
 
-    sys.exit(launch.run("ertools.fidelity:main", "python -m ertools.fidelity"))
+    sys.exit(launch("ertools.fidelity:main", "python -m ertools.fidelity"))
 
 import importlib
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
-from ertools import atomic
+from ertools.atomic import write_text
 
 # Modules that declare Rule constants; the catalogue is what these hold, in this order.
 RULE_MODULES: tuple[str, ...] = (
@@ -218,6 +218,6 @@ def main(argv: list[str] | None = None) -> int:
     text = path.read_text(encoding="utf-8")
     for table, begin, end in tables:
         text = replace_table(text, table, begin, end)
-    atomic.write_text(path, text)
+    write_text(path, text)
     print(f"wrote the version and rule tables of {path}")
     return 0

@@ -30,7 +30,6 @@ from typing import Any
 import numpy as np
 import yaml
 
-from ertools import yamlin
 from ertools.audit.model import (
     Audit,
     AuditRun,
@@ -51,6 +50,7 @@ from ertools.states import (
 )
 from ertools.streams import Provenance, StateStream
 from ertools.timeutil import NS_PER_S, ns_to_s
+from ertools.yamlin import load as load_yaml
 
 log = logging.getLogger("ertools.audit.analyse")
 
@@ -403,4 +403,4 @@ def parse_payload(text: str) -> Any:
     """A YAML payload from a bag, read safely; python tags as the 2015 nodes wrote them
     (``yaml.dump`` of a ``Pose2D``) are read as the plain data under them, and of a key given
     twice the last value counts, as the 2015 nodes read it (the scorers warn of it)."""
-    return yamlin.load(text, tags="plain", duplicates=[])
+    return load_yaml(text, tags="plain", duplicates=[])

@@ -19,14 +19,12 @@ from typing import TYPE_CHECKING, Any, Generic, Literal, Protocol, TypeVar, runt
 
 import numpy as np
 
-import ertools
 from ertools.errors import UsageError
 from ertools.progress import clear_current
 
 if TYPE_CHECKING:  # annotations only: the registry (and `ertools score --help`) stays light
     import pandas as pd
 
-    import ertools.yamlout  # reached as an attribute of the package, imported on first use
     from ertools.fidelity import Deviation
     from ertools.streams import Provenance
 
@@ -224,8 +222,9 @@ def notice(message: str) -> None:
 def dump_yaml(data: Any) -> str:
     """YAML as the 2015 nodes dumped it (block style, keys in insertion order), floats
     rounded to 9 decimal places (:mod:`ertools.yamlout`)."""
-    # PyYAML (~25 ms) imported now, when YAML is written (JSON and text outputs do without it)
-    text: str = ertools.yamlout.dump(data)
+    from ertools.yamlout import dump  # lazy: PyYAML, 12-15 ms; JSON and text do without
+
+    text: str = dump(data)
     return text
 
 

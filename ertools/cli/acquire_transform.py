@@ -12,7 +12,7 @@ import argparse
 import math
 from pathlib import Path
 
-from ertools import atomic
+from ertools.atomic import write_text as write_file
 from ertools.benchmarks.common.sources import read_source, topic
 from ertools.benchmarks.fbm2h.transform import acquire_transform, check_team_name
 from ertools.cli.options import (
@@ -87,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
     text = transform_yaml(acq.transform)
     out.parent.mkdir(parents=True, exist_ok=True)
     write_text(text, None)
-    atomic.write_text(out, text)
+    write_file(out, text)
     how = "detected" if acq.detected else "given"
     note(
         f"window ({how}): {(acq.window.start_ns - bag_start) / 1e9:.3f} s to "

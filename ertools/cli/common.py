@@ -12,7 +12,6 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ertools import report
 from ertools.benchmarks import document
 from ertools.benchmarks.base import BenchmarkResult
 from ertools.benchmarks.common.teams import with_team
@@ -92,8 +91,9 @@ def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[
     write_plots_option(result, args)
     report_dir: Path | None = getattr(args, "report", None)
     if report_dir is not None:
-        # the report's pages, audit and Jinja2 (~30 ms): imported now, for --report
-        index = report.folder.write_report(
+        from ertools.report.folder import write_report  # lazy: pages, Jinja2: 35-70 ms
+
+        index = write_report(
             result, report_dir, inputs=inputs, argv=getattr(args, "command_line", sys.argv)
         )
         note(f"wrote report {index}")
@@ -117,8 +117,9 @@ def write_foxglove_option(result: Any, args: argparse.Namespace, inputs: list[Pa
     path: Path | None = getattr(args, "foxglove", None)
     if path is None:
         return
-    # Foxglove's protobuf classes (~30 ms): imported now, for --foxglove
-    written = report.foxglove.write_foxglove(result, path, inputs=inputs)
+    from ertools.report.foxglove import write_foxglove  # lazy: protobuf, 20-75 ms
+
+    written = write_foxglove(result, path, inputs=inputs)
     note(f"wrote {written.path} ({written.messages} messages on {len(written.counts)} topics)")
 
 

@@ -14,9 +14,9 @@ import sys
 if __name__ == "__main__":
     # `python -m ertools.cli.main`: the module run under its own name, its imports included, inside
     # ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
-    from ertools import launch
+    from ertools.launch import run as launch
 
-    sys.exit(launch.run("ertools.cli.main:main", "ertools"))
+    sys.exit(launch("ertools.cli.main:main", "ertools"))
 
 import textwrap
 from collections.abc import Sequence
@@ -25,7 +25,7 @@ from importlib import import_module
 from pathlib import Path
 from typing import NoReturn
 
-from ertools import __version__
+from ertools._version import __version__
 from ertools.benchmarks.registry import names
 from ertools.errors import ErtoolsError, UsageError
 from ertools.progress import Bar, clear_current, reporting

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ertools import atomic
+from ertools.atomic import write_text as write_file
 from ertools.benchmarks.base import jsonable
 from ertools.cli.main import error_text, printable
 from ertools.progress import clear_current
@@ -22,7 +22,7 @@ def write_text(text: str, output: Path | None) -> None:
         sys.stdout.write(text if text.endswith("\n") else text + "\n")
     else:
         output.parent.mkdir(parents=True, exist_ok=True)
-        atomic.write_text(output, text if text.endswith("\n") else text + "\n")
+        write_file(output, text if text.endswith("\n") else text + "\n")
         note(f"wrote {output}")
 
 

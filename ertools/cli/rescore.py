@@ -15,7 +15,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ertools import atomic
+from ertools.atomic import write_text
 from ertools.cli.output import note
 from ertools.errors import UsageError
 from ertools.rescore.draft import draft_text
@@ -160,7 +160,7 @@ def _init(args: argparse.Namespace) -> int:
     found = find(args.paths, progress=args.progress)
     text = draft_text(found, args.paths, args.init, args.command_line)
     args.init.parent.mkdir(parents=True, exist_ok=True)
-    atomic.write_text(args.init, text)
+    write_text(args.init, text)
     todo = sum("TODO" in line for line in text.splitlines())
     problems = sum(1 for p in found.problems if p.get("kind") != "no-team")
     note(

@@ -19,8 +19,8 @@ from typing import Literal
 import numpy as np
 import numpy.typing as npt
 
-from ertools import atomic
 from ertools.arrays import F64, I64
+from ertools.atomic import write_text
 from ertools.errors import BagError
 from ertools.streams import PoseStream
 
@@ -152,5 +152,5 @@ def write_poses(stream: PoseStream, path: str | Path, fmt: ExportFormat) -> Path
     out = Path(path)
     text = format_poses(stream, fmt)
     out.parent.mkdir(parents=True, exist_ok=True)
-    atomic.write_text(out, text)
+    write_text(out, text)
     return out

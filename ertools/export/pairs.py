@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ertools import atomic
+from ertools.atomic import write_text
 from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid
 from ertools.benchmarks.common.sources import read_source
 from ertools.benchmarks.trajectory.association import COMPARED
@@ -224,7 +224,7 @@ def write_pair(pair: PairExport, out_dir: str | Path, fmt: ExportFormat) -> list
         texts["gt_times"] = format_times(pair.gt, t0)
     Path(out_dir).mkdir(parents=True, exist_ok=True)
     for key, text in texts.items():
-        atomic.write_text(paths[key], text)
+        write_text(paths[key], text)
     return [paths[k] for k in texts]
 
 

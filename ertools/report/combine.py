@@ -24,12 +24,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ertools import __version__, atomic, jsonin
+from ertools._version import __version__
+from ertools.atomic import write_text
 from ertools.benchmarks import registry
 from ertools.benchmarks.common.teams import team_from_log_name
 from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ConfigError
 from ertools.inputs import read_regular_text, why_not
+from ertools.jsonin import loads as loads_json
 from ertools.report import html as h
 from ertools.report import ranks, units
 from ertools.report.folder import headline
@@ -117,7 +119,7 @@ def _options(argv: list[str], inputs: list[dict[str, Any]]) -> str:
 def _load_json(path: Path) -> Any:
     """A result's JSON; a key given twice is refused (the json module keeps the last)."""
     try:
-        return jsonin.loads(read_regular_text(path))  # a named pipe would block for ever
+        return loads_json(read_regular_text(path))  # a named pipe would block for ever
     except OSError as err:
         raise ConfigError(f"cannot read a result: {why_not(err)}", path=path) from err
     except (UnicodeDecodeError, ValueError) as err:
@@ -310,14 +312,14 @@ def combine(
             }
         )
     text = json.dumps(_finite(flat), indent=2, allow_nan=False)
-    atomic.write_text(outdir / "results.json", text + "\n")
+    write_text(outdir / "results.json", text + "\n")
     table = [_csv_row(row) for row in flat]
     columns = list(dict.fromkeys(k for row in table for k in row))
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=columns)
     writer.writeheader()
     writer.writerows([{k: spreadsheet_safe(v) for k, v in row.items()} for row in table])
-    atomic.write_text(outdir / "results.csv", buffer.getvalue())
+    write_text(outdir / "results.csv", buffer.getvalue())
     of_runs = f" of {len(runs)} execution(s)" if len(runs) != len(entries) else ""
     subtitle = f"{len(entries)} result(s){of_runs}, combined by ertools {__version__}"
     index = outdir / "index.html"
@@ -330,7 +332,7 @@ def combine(
         benchmarks=benchmarks,
         teams=_by_team(runs, outdir),
     )
-    atomic.write_text(index, page)
+    write_text(index, page)
     return index
 
 

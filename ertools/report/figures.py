@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ertools import atomic
+from ertools.atomic import replacing, write_text
 from ertools.benchmarks import registry
 from ertools.report import chart_mpl, svg
 from ertools.report.chart import Chart
@@ -76,7 +76,7 @@ def save_figures(specs: Sequence[FigureSpec], outdir: Path, fmt: str | None = "p
     for spec in specs:
         suffix = fmt or ("svg" if spec.chart is not None else "png")
         path = outdir / f"{spec.name}.{suffix}"
-        with atomic.replacing(path) as tmp:  # a kill leaves the old figure or none, never half
+        with replacing(path) as tmp:  # a kill leaves the old figure or none, never half
             render(spec, tmp)
         written.append(path)
     return written
@@ -167,7 +167,7 @@ def save_one_file(specs: Sequence[Any], path: Path) -> Path:
     if specs and path.suffix.lower() == ".svg" and all(s.chart is not None for s in specs):
         panels = [(s.chart(s.size), s.size, s.title) for s in specs]
         path.parent.mkdir(parents=True, exist_ok=True)
-        atomic.write_text(path, svg.stack(panels))
+        write_text(path, svg.stack(panels))
         return path
     from matplotlib.figure import Figure  # lazy: matplotlib only when a figure is drawn
 
@@ -183,7 +183,7 @@ def save_one_file(specs: Sequence[Any], path: Path) -> Path:
         axes[0].text(0.5, 0.5, "no figure for this result", ha="center", va="center")
         axes[0].set_axis_off()
     path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic.replacing(path) as tmp:
+    with replacing(path) as tmp:
         fig.savefig(tmp, dpi=110)
     return path
 

@@ -27,7 +27,8 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from ertools import __version__, atomic
+from ertools._version import __version__
+from ertools.atomic import write_text
 from ertools.audit.analyse import audit_states
 from ertools.audit.model import Audit
 from ertools.benchmarks import registry
@@ -177,7 +178,7 @@ def _remove_stale(outdir: Path, names: set[str]) -> None:
 
 
 def _write(path: Path, text: str) -> None:
-    atomic.write_text(path, text if text.endswith("\n") else text + "\n")
+    write_text(path, text if text.endswith("\n") else text + "\n")
 
 
 def _audit_inputs(name: str, inputs: list[Path]) -> Any:
@@ -323,7 +324,7 @@ def _write_tables(outdir: Path, tables: dict[str, Rows], *, prefix: str) -> list
         writer.writerow(columns)
         for row in rows:
             writer.writerow([_csv_cell(row.get(c)) for c in columns])
-        atomic.write_text(outdir / f"{safe}.csv", buffer.getvalue())
+        write_text(outdir / f"{safe}.csv", buffer.getvalue())
         names.append(f"{safe}.csv")
     return names
 

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ertools import atomic
+from ertools.atomic import replacing
 from ertools.errors import UsageError
 from ertools.report.timeline_page import (
     display_names,
@@ -354,6 +354,6 @@ def save_timeline_plot(timeline: Timeline, path: Path) -> Path:
         return write_timeline_page(timeline, path)
     fig = timeline_figure(timeline)
     path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic.replacing(path) as tmp:
+    with replacing(path) as tmp:
         fig.savefig(tmp, dpi=110)
     return path

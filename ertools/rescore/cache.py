@@ -31,7 +31,8 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from ertools import __version__, atomic
+from ertools._version import __version__
+from ertools.atomic import write_text
 from ertools.report.records import sha256_file
 from ertools.rescore.jobs import Job, Outcome
 
@@ -99,7 +100,7 @@ class FileHashes:
         if self.store is None or not self.changed:
             return
         self.store.parent.mkdir(parents=True, exist_ok=True)
-        atomic.write_text(self.store, json.dumps(self.known, sort_keys=True))
+        write_text(self.store, json.dumps(self.known, sort_keys=True))
 
 
 def job_files(job: Job) -> list[Path]:
@@ -273,7 +274,7 @@ class Cache:
         entry = {"cache": CACHE_VERSION, "outcome": record, "report_files": files}
         entry["checksum"] = _checksum(entry)
         path.parent.mkdir(parents=True, exist_ok=True)
-        atomic.write_text(path, json.dumps(entry, allow_nan=False))
+        write_text(path, json.dumps(entry, allow_nan=False))
 
 
 def _checksum(entry: Mapping[str, Any]) -> str:

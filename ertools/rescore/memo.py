@@ -19,7 +19,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ertools import __version__, atomic
+from ertools._version import __version__
+from ertools.atomic import write_text
 from ertools.errors import watching
 from ertools.io.model import ClockCheck
 
@@ -110,7 +111,7 @@ class FileMemo:
             return
         self.store.parent.mkdir(parents=True, exist_ok=True)
         doc = {"memo": MEMO_VERSION, "ertools": __version__, "files": self.rows}
-        atomic.write_text(self.store, json.dumps(doc, sort_keys=True))
+        write_text(self.store, json.dumps(doc, sort_keys=True))
         self.changed = False
 
 

@@ -19,7 +19,8 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from ertools import __version__, atomic
+from ertools._version import __version__
+from ertools.atomic import write_text
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Benchmark
 from ertools.csvsafe import spreadsheet_safe
@@ -566,7 +567,7 @@ def write_results(doc: Mapping[str, Any], out: Path) -> list[Path]:
         ("results.json", json.dumps(doc, indent=2, allow_nan=False) + "\n"),
         ("results.csv", csv_text(doc)),
     ):
-        written.append(atomic.write_text(out / name, text))
+        written.append(write_text(out / name, text))
     # the results page, rebuilt from the document alone (ertools.rescore.site)
     written.append(write_site(dict(doc), out))
     return written

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ertools import atomic
+from ertools.atomic import write_text
 from ertools.errors import ConfigError
 from ertools.report import html as h
 from ertools.report import ranks, units
@@ -536,7 +536,7 @@ def write_site(results: dict[str, Any], out: Path) -> Path:
     index = out / "index.html"
     try:
         out.mkdir(parents=True, exist_ok=True)
-        atomic.write_text(index, h.render(TEMPLATE, **context))
+        write_text(index, h.render(TEMPLATE, **context))
     except OSError as err:
         raise ConfigError(
             f"cannot write the results site ({err.strerror or err})", path=out

@@ -50,7 +50,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from ertools import atomic
+from ertools.atomic import replace_folder
 from ertools.errors import UsageError
 from ertools.samples import fbm1, fbm2h
 from ertools.samples.competition_files import (
@@ -366,5 +366,5 @@ def write_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path]:
     except BaseException:
         shutil.rmtree(partial, ignore_errors=True)
         raise
-    atomic.replace_folder(partial, outdir)
+    replace_folder(partial, outdir)
     return [outdir / p.relative_to(partial) for p in paths]

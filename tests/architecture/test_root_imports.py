@@ -5,51 +5,17 @@ closes a cycle through the API's ``TYPE_CHECKING`` import. Import what is meant 
 
 from __future__ import annotations
 
+import shutil
+import subprocess
+import sys
 from pathlib import Path
 
+import pytest
 from archscan import ROOT, plant, ratchet, root_imports
 
-ALLOWED = frozenset(
-    {
-        "ertools/api.py",
-        "ertools/audit/analyse.py",
-        "ertools/benchmarks/base.py",
-        "ertools/benchmarks/common/teams.py",
-        "ertools/benchmarks/fbm2h/result.py",
-        "ertools/cli/acquire_transform.py",
-        "ertools/cli/audit.py",
-        "ertools/cli/common.py",
-        "ertools/cli/main.py",
-        "ertools/cli/output.py",
-        "ertools/cli/rescore.py",
-        "ertools/configs/_yaml.py",
-        "ertools/demo.py",
-        "ertools/export/formats.py",
-        "ertools/export/pairs.py",
-        "ertools/fidelity.py",
-        "ertools/io/formats.py",
-        "ertools/io/mcap/scan.py",
-        "ertools/io/mcap/summary.py",
-        "ertools/io/ros1/layout.py",
-        "ertools/io/rosbag2/metadata.py",
-        "ertools/live/logfile.py",
-        "ertools/live/recorder.py",
-        "ertools/live/recover.py",
-        "ertools/report/combine.py",
-        "ertools/report/figures.py",
-        "ertools/report/folder.py",
-        "ertools/report/foxglove/__init__.py",
-        "ertools/report/foxglove/mcapout.py",
-        "ertools/report/plots_timeline.py",
-        "ertools/report/timeline_page.py",
-        "ertools/rescore/cache.py",
-        "ertools/rescore/memo.py",
-        "ertools/rescore/pipeline.py",
-        "ertools/rescore/site.py",
-        "ertools/samples/__main__.py",
-        "ertools/samples/competition.py",
-    }
-)
+LINT_IMPORTS = Path(sys.executable).with_name("lint-imports")
+
+ALLOWED: frozenset[str] = frozenset()
 
 
 def test_no_new_root_import() -> None:
@@ -69,3 +35,25 @@ def test_every_spelling_of_a_root_import_is_found(tmp_path: Path) -> None:
         },
     )
     assert root_imports(root) == {"ertools/a.py", "ertools/b.py", "ertools/c.py"}
+
+
+@pytest.mark.skipif(not LINT_IMPORTS.exists(), reason="lint-imports not installed (dev extra)")
+def test_the_root_contract_refuses_a_version_import(tmp_path: Path) -> None:
+    """pyproject.toml's ``root`` contract (``make lint``) sees ``from ertools import
+    __version__``, the spelling that the AST test shares with it."""
+    copy = tmp_path / "ertools"
+    shutil.copytree(ROOT / "ertools", copy, ignore=shutil.ignore_patterns("__pycache__"))
+    model = copy / "io" / "model.py"
+    text = model.read_text(encoding="utf-8")
+    model.write_text(text + "\nfrom ertools import __version__\n", encoding="utf-8")
+    refused = subprocess.run(
+        [str(LINT_IMPORTS), "--no-cache", "--contract", "root", str(ROOT / "pyproject.toml")],
+        cwd=tmp_path,
+        env={"PYTHONPATH": str(tmp_path), "PATH": "/usr/bin:/bin"},
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+    )
+    assert refused.returncode != 0, refused.stdout
+    assert "ertools.io.model -> ertools " in refused.stdout + " ", refused.stdout

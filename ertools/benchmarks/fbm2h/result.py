@@ -10,7 +10,6 @@ import numpy as np
 import numpy.typing as npt
 import yaml
 
-from ertools import yamlin
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
 from ertools.benchmarks.common.uncertainty import Interval, uncertainty_rows
@@ -22,6 +21,7 @@ from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
+from ertools.yamlin import load as load_yaml
 
 if TYPE_CHECKING:
     import pandas as pd  # annotations only: pandas is imported by to_frames()
@@ -90,7 +90,7 @@ def _payload_value(payload: str) -> Any:
         return {}
 
     try:
-        value = yamlin.load(text, duplicates=[])  # shown as the 2015 node read it
+        value = load_yaml(text, duplicates=[])  # shown as the 2015 node read it
     except yaml.YAMLError:
         return payload
     return value if isinstance(value, dict) else payload

@@ -23,8 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from ertools import caches
 from ertools.arrays import I64, U8
+from ertools.caches import register
 from ertools.errors import BagError
 from ertools.inputs import open_regular
 from ertools.io import budget
@@ -373,7 +373,7 @@ def scan_mcap(
 
 
 _SCANS: dict[tuple[int, int, int, int], McapRecords] = {}
-caches.register(_SCANS.clear)
+register(_SCANS.clear)
 
 
 def _scan(buf: U8, path: Path, keep: frozenset[int], check_crc: bool) -> McapRecords:
@@ -451,7 +451,7 @@ class McapLayout:
 
 
 _LAYOUTS: dict[tuple[int, int, int, int], McapLayout] = {}
-caches.register(_LAYOUTS.clear)
+register(_LAYOUTS.clear)
 
 
 def mcap_layout(path: Path) -> McapLayout:

@@ -12,7 +12,7 @@ import struct
 from pathlib import Path
 from typing import Any, BinaryIO
 
-from ertools import caches
+from ertools.caches import register
 from ertools.errors import BagError
 from ertools.io.inflate import inflate
 from ertools.io.mcap.crc import crc32
@@ -42,7 +42,7 @@ def mcap_errors() -> tuple[type[BaseException], ...]:
 
 # Summaries parsed, by file identity: opening a file and planning a read need the same one.
 _SUMMARIES: dict[tuple[int, int, int, int], Any] = {}
-caches.register(_SUMMARIES.clear)
+register(_SUMMARIES.clear)
 
 
 def read_summary(f: BinaryIO, path: Path) -> Any:

@@ -18,7 +18,7 @@ from importlib import import_module
 from pathlib import Path
 from typing import Any
 
-from ertools import __version__
+from ertools._version import __version__
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import jsonable
 from ertools.errors import UsageError

@@ -6,7 +6,8 @@ import os
 from collections.abc import Sequence
 from pathlib import Path
 
-from ertools import __version__, atomic
+from ertools._version import __version__
+from ertools.atomic import replacing
 from ertools.errors import UsageError
 from ertools.report.foxglove.messages import Collected
 
@@ -38,7 +39,7 @@ def write_mcap(out: Collected, path: Path) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     # a temporary of a unique name (ertools.atomic): a name chosen in advance follows a symlink
     # planted there, and two exports at once would write into the same file
-    with atomic.replacing(path) as tmp, tmp.open("r+b") as f:
+    with replacing(path) as tmp, tmp.open("r+b") as f:
         w = Writer(f)
         w.start(profile="", library=f"ertools {__version__}")
         schema_ids: dict[str, int] = {}
