@@ -35,7 +35,6 @@ __all__ = [
     "timeline",
 ]
 API = tuple(__all__[1:])
-_PACKAGES = ("audit", "export", "rescore", "timeline")
 
 if TYPE_CHECKING:
     from ertools.api import (
@@ -52,8 +51,6 @@ if TYPE_CHECKING:
 
 
 def __getattr__(name: str) -> Any:
-    if name in _PACKAGES:
-        return import_module(f"ertools.{name}")
     if name in API:
         return getattr(import_module("ertools.api"), name)
     # a private module reached as an attribute (`ertools.yamlout.dump`), imported on first use

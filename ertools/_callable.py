@@ -1,7 +1,7 @@
 """Lazy parts of a package: a package that is also a function of the public API
 (``ertools.audit(...)``), and submodules imported on first use (:func:`submodules`).
 
-``ertools.audit`` is both the package ``ertools/audit/`` and the API function
+``ertools.audit`` is both the package ``ertools/auditing/`` and the API function
 ``ertools.api.audit``: Python sets a package imported on its parent module, so the package
 itself is made callable and a call runs the API function (imported then, by name: the API
 sits above every package).

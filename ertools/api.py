@@ -24,24 +24,24 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
 from ertools.atomic import write_text
-from ertools.audit.model import Audit
-from ertools.audit.rescore import ScoreInputs, audit_bag, infer_benchmark
+from ertools.auditing.model import Audit
+from ertools.auditing.recompute import ScoreInputs, audit_bag, infer_benchmark
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import rename_former
 from ertools.benchmarks.common.sources import read_source
 from ertools.benchmarks.common.spec import PoseSpec, TimeSource, parse_tf
 from ertools.benchmarks.common.which import refuse_other_benchmark
+from ertools.competition.manifest import ManifestError, load_manifest
+from ertools.competition.run import rescore_competition
 from ertools.errors import ConfigError, UsageError
-from ertools.export.formats import FORMATS, format_poses
+from ertools.exporting.formats import FORMATS, format_poses
 from ertools.io import files, summary
 from ertools.parameters import checked, paths_list, value_of
 from ertools.report.figures import figure_specs
 from ertools.report.plots_audit import draw_timeline
 from ertools.report.plots_timeline import draw_gantt, timeline_figure
-from ertools.rescore.manifest import ManifestError, load_manifest
-from ertools.rescore.run import rescore_competition
-from ertools.timeline.model import Timeline
-from ertools.timeline.scan import scan
+from ertools.timelines.model import Timeline
+from ertools.timelines.scan import scan
 
 if TYPE_CHECKING:
     from ertools.benchmarks.base import BenchmarkResult

@@ -17,12 +17,12 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any, TypeVar, cast
 
-from ertools.audit.model import Audit
+from ertools.auditing.model import Audit
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Input
 from ertools.errors import UsageError
-from ertools.export.formats import FORMATS
-from ertools.timeline.model import Timeline
+from ertools.exporting.formats import FORMATS
+from ertools.timelines.model import Timeline
 
 # The largest magnitude a number input may have (the CLI's rule, ertools.cli.main).
 _MAX_NUMBER = 4.6e9

@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ertools.audit.rescore import ScoreInputs, audit_bag
+from ertools.auditing.recompute import ScoreInputs, audit_bag
 from ertools.benchmarks import registry
 from ertools.cli.common import (
     add_output_options,

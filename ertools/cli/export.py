@@ -27,8 +27,8 @@ from ertools.cli.options import (
 )
 from ertools.cli.output import note, write_text
 from ertools.errors import UsageError
-from ertools.export.formats import FORMATS, format_poses, format_times
-from ertools.export.pairs import (
+from ertools.exporting.formats import FORMATS, format_poses, format_times
+from ertools.exporting.pairs import (
     KITTI_NEEDS_MATCHED,
     export_source,
     pair_paths,

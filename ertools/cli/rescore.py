@@ -17,15 +17,15 @@ from typing import TYPE_CHECKING
 
 from ertools.atomic import write_text
 from ertools.cli.output import note
+from ertools.competition.draft import draft_text
+from ertools.competition.found import find
+from ertools.competition.manifest import ManifestError, load_manifest
+from ertools.competition.parallel import default_jobs
+from ertools.competition.run import rescore_competition
 from ertools.errors import UsageError
-from ertools.rescore.draft import draft_text
-from ertools.rescore.found import find
-from ertools.rescore.manifest import ManifestError, load_manifest
-from ertools.rescore.parallel import default_jobs
-from ertools.rescore.run import rescore_competition
 
 if TYPE_CHECKING:
-    from ertools.rescore.jobs import Outcome
+    from ertools.competition.jobs import Outcome
 
 EPILOG = """examples:
   ertools rescore --config competition.yaml --out results/

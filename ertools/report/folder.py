@@ -12,7 +12,7 @@
 - ``result.json``: the metadata ``ertools report`` combines (benchmark, team, inputs, the
   headline numbers and the whole score).
 
-An :class:`~ertools.audit.model.Audit` is accepted as well: its recomputed score (when there
+An :class:`~ertools.auditing.model.Audit` is accepted as well: its recomputed score (when there
 is one) becomes the score of the folder, and ``audit.yaml``/``audit.json`` are added.
 """
 
@@ -29,8 +29,8 @@ from typing import Any
 
 from ertools._version import __version__
 from ertools.atomic import write_text
-from ertools.audit.analyse import audit_states
-from ertools.audit.model import Audit
+from ertools.auditing.analyse import audit_states
+from ertools.auditing.model import Audit
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import BenchmarkResult, Rows, jsonable
 from ertools.benchmarks.common.teams import team_from_log_name, team_from_transform_name
@@ -61,7 +61,7 @@ def write_report(
     """Write the report folder of ``result`` into ``outdir``; returns the ``index.html`` path.
 
     Args:
-        result: any benchmark result, or an :class:`ertools.audit.model.Audit`.
+        result: any benchmark result, or an :class:`ertools.auditing.model.Audit`.
         outdir: the folder (created; files of the same names are overwritten).
         inputs: the bags the result was computed from (hashed, not modified).
         argv: the command line (shown; file arguments that are not inputs are the configs).

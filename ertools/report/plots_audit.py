@@ -1,6 +1,6 @@
 """The audit's figure: the three state machines over time, one lane each, as a
 :class:`~ertools.report.chart.Chart` (reports write it as SVG); the data comes from
-:class:`ertools.audit.model.Audit`.
+:class:`ertools.auditing.model.Audit`.
 """
 
 from __future__ import annotations

@@ -38,7 +38,7 @@ from ertools.report.timeline_style import (
     UNCOVERED_COLOR,
     lane_name,
 )
-from ertools.timeline.model import BagEntry, Session, Timeline
+from ertools.timelines.model import BagEntry, Session, Timeline
 
 PLOT_SUFFIXES = (".png", ".svg", ".html", ".htm")
 # Panels beyond this many would make a figure metres tall; the page shows every session.

@@ -35,7 +35,7 @@ from ertools.report.timeline_style import (
     UNCOVERED_COLOR,
     lane_name,
 )
-from ertools.timeline.model import BagEntry, Session, Timeline
+from ertools.timelines.model import BagEntry, Session, Timeline
 from ertools.timeutil import NS_PER_S, iso_utc
 
 # Bags of one logger that overlap (a copy, a restarted logger) are stacked in rows of the

@@ -14,7 +14,7 @@ Layout (times in seconds after :data:`T0`, the record times of each bag's first/
     old/log_fbm2h_mocap_<date>_0.bag               a GT bag truncated at 55 % of its bytes
 
 Every bag holds only topics whose record times the scenario sets, so each bag's span is known
-exactly. Answers (``expected``), computed here without ``ertools.timeline.build``:
+exactly. Answers (``expected``), computed here without ``ertools.timelines.build``:
 
 - ``bags``: per file (path relative to the folder): start, end (epoch s), kind;
 - ``overlaps``: per readable file, the files whose closed spans intersect its own (a plain

@@ -14,7 +14,7 @@ ALLOWED = frozenset(
         "ertools/configs/goal.py: named after a benchmark",
         "ertools/configs/shapes.py: named after a benchmark",
         "ertools/configs/timing.py: named after a benchmark",
-        "ertools/export/pairs.py: imports ertools.benchmarks.trajectory",
+        "ertools/exporting/pairs.py: imports ertools.benchmarks.trajectory",
         "ertools/report/foxglove/fbm1.py: imports ertools.benchmarks.fbm1",
         "ertools/report/foxglove/fbm1.py: named after a benchmark",
         "ertools/report/foxglove/fbm2h.py: imports ertools.benchmarks.fbm2h",

@@ -20,8 +20,8 @@ ALLOWED = frozenset(
         "ertools/report/__init__.py: module __getattr__ assigned",
         "ertools/report/figures.py: import_module outside the registry",
         "ertools/report/foxglove/__init__.py: import_module outside the registry",
-        "ertools/rescore/children.py: import_module outside the registry",
-        "ertools/rescore/jobs.py: import_module outside the registry",
+        "ertools/competition/children.py: import_module outside the registry",
+        "ertools/competition/jobs.py: import_module outside the registry",
         "ertools/samples/scenario.py: import_module outside the registry",
     }
 )

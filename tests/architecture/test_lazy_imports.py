@@ -16,7 +16,7 @@ ALLOWED = frozenset(
         "ertools/benchmarks/fbm1/intervals.py: scipy.stats",
         "ertools/configs/shapes.py: scipy.interpolate",
         "ertools/configs/transform.py: scipy.spatial.transform",
-        "ertools/export/formats.py: scipy.spatial.transform",
+        "ertools/exporting/formats.py: scipy.spatial.transform",
         "ertools/geometry.py: scipy.spatial.transform",
         "ertools/io/decode/typestore.py: rosbags.serde",
         "ertools/io/decode/typestore.py: rosbags.typesys",

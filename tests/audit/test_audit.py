@@ -7,7 +7,7 @@ from dataclasses import replace
 import pytest
 from audit_streams import BEAT_NS, T0_NS, heartbeat
 
-from ertools.audit.analyse import audit_states, parse_payload
+from ertools.auditing.analyse import audit_states, parse_payload
 from ertools.states import BmBoxState as B
 from ertools.states import ClientState as C
 from ertools.states import Machine

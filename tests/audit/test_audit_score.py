@@ -8,8 +8,8 @@ import pytest
 from audit_streams import heartbeat
 from fakes import FakeResult
 
-from ertools.audit.analyse import audit_states
-from ertools.audit.compare import attach, compare_scores, flatten
+from ertools.auditing.analyse import audit_states
+from ertools.auditing.compare import attach, compare_scores, flatten
 from ertools.states import BmBoxState as B
 from ertools.states import Machine
 from ertools.streams import Provenance

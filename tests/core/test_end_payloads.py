@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from ertools.audit.analyse import audit_states
+from ertools.auditing.analyse import audit_states
 from ertools.benchmarks.common.ending import (
     RULE_END_PAYLOADS,
     cut_warning,

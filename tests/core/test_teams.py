@@ -24,7 +24,7 @@ from ertools.samples.__main__ import generate
 from ertools.samples.writer import BagWriter
 from ertools.states import Machine
 from ertools.streams import Provenance
-from ertools.timeline.build import benchmark_names
+from ertools.timelines.build import benchmark_names
 
 REPO = Path(__file__).resolve().parents[2]
 

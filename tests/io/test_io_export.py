@@ -1,4 +1,4 @@
-"""`ertools export` / ertools.export.formats: files read back with NumPy give the written
+"""`ertools export` / ertools.exporting.formats: files read back with NumPy give the written
 poses back.
 
 The expected values are the generator's (conftest.make_scene: stamps, positions, quaternions
@@ -23,7 +23,7 @@ from rosbags.highlevel import AnyReader
 
 from ertools.cli.main import main
 from ertools.errors import BagError
-from ertools.export.formats import (
+from ertools.exporting.formats import (
     format_csv,
     format_tum,
     rotation_matrices,

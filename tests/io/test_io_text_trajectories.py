@@ -18,7 +18,7 @@ from stderr_text import error_messages
 
 from ertools.cli.main import main
 from ertools.errors import BagError
-from ertools.export.formats import format_csv, format_tum
+from ertools.exporting.formats import format_csv, format_tum
 from ertools.io.text import _plain_decimal_ns, read_text_poses, sniff
 from ertools.streams import PoseStream
 

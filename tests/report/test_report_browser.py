@@ -19,8 +19,8 @@ import pytest
 from matplotlib.image import imread
 from report_fakes import EVIL, fbm3w_like
 
-from ertools.audit.analyse import audit_states
-from ertools.audit.compare import attach
+from ertools.auditing.analyse import audit_states
+from ertools.auditing.compare import attach
 from ertools.report.folder import write_report
 from ertools.states import Machine
 

@@ -12,7 +12,7 @@ import pytest
 import svg_figure
 from matplotlib.figure import Figure
 
-from ertools.audit.analyse import audit_states
+from ertools.auditing.analyse import audit_states
 from ertools.report import svg
 from ertools.report.plots_audit import (
     OKABE_ITO,

@@ -15,7 +15,7 @@ import yaml
 from report_fakes import EVIL, fbm3w_like
 from test_cli_audit import _write_bag
 
-from ertools.audit.analyse import audit_states
+from ertools.auditing.analyse import audit_states
 from ertools.errors import ConfigError
 from ertools.report.folder import write_report
 from ertools.report.records import sha256_file

@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 from report_fakes import fbm3w_like
 
-from ertools.audit.analyse import audit_states
+from ertools.auditing.analyse import audit_states
 from ertools.frames import rows_to_dataframe, tables_to_frames
 from ertools.states import Machine
 

@@ -1,5 +1,5 @@
 """A toy benchmark registered only by the rescore tests: `ertools rescore` must score it with no
-change to ertools/rescore (adding a benchmark adds it to rescore).
+change to ertools/competition (adding a benchmark adds it to rescore).
 
 A toy "log" is a text file of numbers, one per line. The score of an execution is
 ``mean(numbers) * scale + offset`` (``mode: max``: the largest number instead of the mean), the

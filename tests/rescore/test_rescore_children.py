@@ -1,4 +1,4 @@
-"""The scoring processes' fork server (ertools/rescore/children.py): a scorer never inherits a
+"""The scoring processes' fork server (ertools/competition/children.py): a scorer never inherits a
 lock held by another thread of the process that asked for it. (The command's server is a fork
 of it, its scorers the server's children, and all end with it: test_rescore_faults.py; a
 scorer that dies costs its job only: test_rescore_cli.py, test_rescore_dask.py.)"""
@@ -18,7 +18,7 @@ import pytest
 from rescore_competition import LOGS, expected_value, make_competition
 from test_rescore_faults import DEADLINE_S, HOLD, TOY_RESCORE, ppid, wait_for
 
-from ertools.rescore.children import SCORING_IMPORTS
+from ertools.competition.children import SCORING_IMPORTS
 
 HERE = Path(__file__).parent
 ROOT = HERE.parents[1]

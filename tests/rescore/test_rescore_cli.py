@@ -26,7 +26,7 @@ from rescore_competition import (
 from ertools.benchmarks import registry
 from ertools.benchmarks.document import score_json
 from ertools.cli.main import main
-from ertools.rescore import cache
+from ertools.competition import cache
 
 
 @pytest.fixture(autouse=True)

@@ -27,8 +27,8 @@ from rescore_competition import LOGS, expected_value, make_competition, use_toy_
 
 from ertools import atomic
 from ertools.cli.main import main
+from ertools.competition import cache
 from ertools.csvsafe import spreadsheet_safe
-from ertools.rescore import cache
 
 HERE = Path(__file__).parent
 TOY_MAIN = HERE / "toy_main.py"
@@ -101,7 +101,7 @@ def _dask_or_skip() -> None:
 def test_workers_end_when_the_command_is_killed(parallel: list[str], tmp_path: Path) -> None:
     """kill -9 of `rescore --jobs 2` (local workers, or a Dask LocalCluster) while both
     executions are being scored: every process it started ends too. What it started: one fork
-    server, a fork of the command (it had one thread then: ertools/rescore/children.py), and
+    server, a fork of the command (it had one thread then: ertools/competition/children.py), and
     the two scorers, the server's children."""
     if "--scheduler" in parallel:
         _dask_or_skip()

@@ -10,8 +10,8 @@ from stderr_text import joined_lines
 
 from ertools.benchmarks import registry
 from ertools.cli.main import main
+from ertools.competition.manifest import ManifestError, load_manifest
 from ertools.errors import ConfigError
-from ertools.rescore.manifest import ManifestError, load_manifest
 
 
 @pytest.fixture(autouse=True)

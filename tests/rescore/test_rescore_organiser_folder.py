@@ -32,7 +32,7 @@ import pytest
 from fakes import BROWSER, CHROMIUM_FLAGS
 
 from ertools.cli.main import main
-from ertools.rescore.manifest import load_manifest
+from ertools.competition.manifest import load_manifest
 
 REPO = Path(__file__).resolve().parents[2]
 SAMPLES = REPO / "sample_bags"

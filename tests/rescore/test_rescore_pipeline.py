@@ -9,8 +9,14 @@ import pytest
 from rescore_competition import LOGS, expected_value, make_competition, use_toy_registry
 
 from ertools.benchmarks import registry
-from ertools.rescore.manifest import load_manifest
-from ertools.rescore.pipeline import Scoring, leaderboards, listed_executions, rescore, score_argv
+from ertools.competition.manifest import load_manifest
+from ertools.competition.pipeline import (
+    Scoring,
+    leaderboards,
+    listed_executions,
+    rescore,
+    score_argv,
+)
 
 
 @pytest.fixture(autouse=True)

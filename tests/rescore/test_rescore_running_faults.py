@@ -23,11 +23,11 @@ import yaml
 from rescore_competition import OFFSETS, SCALE, make_competition, use_toy_registry
 
 from ertools.cli.main import main
+from ertools.competition import pipeline
+from ertools.competition.jobs import Job, run_job
+from ertools.competition.memo import FileMemo
 from ertools.errors import BagError, ConfigError, transient_error, watching
 from ertools.io.formats import detect_format
-from ertools.rescore import pipeline
-from ertools.rescore.jobs import Job, run_job
-from ertools.rescore.memo import FileMemo
 
 SAMPLES = Path(__file__).resolve().parents[2] / "sample_bags" / "fbm3w"
 FBM3W_BAG = SAMPLES / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"

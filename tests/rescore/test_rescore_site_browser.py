@@ -27,9 +27,9 @@ from site_results import (
     write_folder,
 )
 
+from ertools.competition.site import write_site
 from ertools.report.timeline_page import write_timeline_page
 from ertools.report.timeline_style import KIND_COLORS
-from ertools.rescore.site import write_site
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "timeline"))
 from timeline_day import day_timeline

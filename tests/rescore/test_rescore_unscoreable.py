@@ -9,7 +9,7 @@ from pathlib import Path
 
 from rescore_toy import TOY, ToyOptions, ToyResult
 
-from ertools.rescore.jobs import Job, run_job
+from ertools.competition.jobs import Job, run_job
 
 REASON = "valid data covers only 61.0% of the window (12 tracking_lost); at least 90% is needed"
 

@@ -19,8 +19,8 @@ from test_timeline_pictures import expected_day
 from timeline_day import EVIL, EVIL_IMG, S, day_timeline
 
 from ertools.report.timeline_page import write_timeline_page
-from ertools.timeline.model import Timeline
-from ertools.timeline.scan import scan
+from ertools.timelines.model import Timeline
+from ertools.timelines.scan import scan
 
 pytestmark = pytest.mark.browser
 

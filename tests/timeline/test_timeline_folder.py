@@ -14,14 +14,14 @@ import numpy as np
 import pytest
 from summaries import BAG_KEYS
 
-import ertools.timeline.scan as ts
+import ertools.timelines.scan as ts
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
 from ertools.io.formats import find_bags
 from ertools.io.model import ClockCheck
 from ertools.progress import reporting
 from ertools.samples.writer import BagWriter
-from ertools.timeline.scan import scan
+from ertools.timelines.scan import scan
 
 
 def rel(root: Path, path: str) -> str:

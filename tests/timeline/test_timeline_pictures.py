@@ -24,8 +24,8 @@ from timeline_day import DAY0, EVIL, EVIL_IMG, SESSIONS, UNREADABLE, S, day_time
 from ertools.cli.main import main
 from ertools.report.plots_timeline import timeline_figure
 from ertools.report.timeline_page import timeline_page
-from ertools.timeline.model import Timeline
-from ertools.timeline.scan import scan
+from ertools.timelines.model import Timeline
+from ertools.timelines.scan import scan
 
 REAL = Path(__file__).resolve().parents[2] / ".." / "shared" / "real_bags"
 REAL_BAG = REAL / "log_fbm2h_mocap_2015-10-23-16-15-40_0.bag"

@@ -12,8 +12,8 @@ from __future__ import annotations
 from summaries import Summary, Topic
 
 from ertools.io.formats import Unreadable
-from ertools.timeline.build import build_timeline
-from ertools.timeline.model import Timeline
+from ertools.timelines.build import build_timeline
+from ertools.timelines.model import Timeline
 
 S = 1_000_000_000
 DAY0 = 1_448_010_000 * S  # 2015-11-20 09:00:00 UTC

@@ -29,7 +29,7 @@ from ertools.report.foxglove.messages import Collected
 # adding its content to a Collected. Dotted names, not classes: nothing is imported until a
 # file is written.
 CONTENT: dict[str, str] = {
-    "ertools.audit.model.Audit": "ertools.report.foxglove.audit:content",
+    "ertools.auditing.model.Audit": "ertools.report.foxglove.audit:content",
 }
 
 # Pose and error streams longer than this keep every k-th message, k = ceil(n / limit): an

@@ -12,7 +12,7 @@ Topics:
 
 from __future__ import annotations
 
-from ertools.audit.model import Audit
+from ertools.auditing.model import Audit
 from ertools.report.foxglove import content_function
 from ertools.report.foxglove.messages import (
     INFO,

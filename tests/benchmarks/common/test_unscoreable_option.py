@@ -18,7 +18,7 @@ from ertools.benchmarks import registry
 from ertools.benchmarks.common.validity import UNSCOREABLE
 from ertools.cli import score as score_cli
 from ertools.cli.main import build_parser
-from ertools.rescore.manifest import load_manifest
+from ertools.competition.manifest import load_manifest
 
 # what each benchmark needs besides the option (make_options reads no file)
 REQUIRED = {"fbm1h": ["--items", "items.yaml"], "fbm1w": ["--items", "items.yaml"]}

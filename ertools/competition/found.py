@@ -1,5 +1,5 @@
 """What the logs hold: the timeline of the given folders, the executions
-:mod:`ertools.rescore.discover` finds in it, and each one as a :class:`Scoring` (the IO edge
+:mod:`ertools.competition.discover` finds in it, and each one as a :class:`Scoring` (the IO edge
 of discovery: it reads the state payloads for team names and writes the timeline page).
 
 Every execution is scored from its benchmark log and the GT files covering it
@@ -8,7 +8,7 @@ with the same GT files by every registered benchmark whose bags are a robot log 
 (:attr:`Benchmark.bags_metavar` ``("ROBOT_BAG", ...)``): the declaration says which, not a name.
 A GT-only recording is scored with the values its benchmark's ``gt_only`` proposes (FBM2H: the
 timing file beside it), or is a ``gt-only`` problem saying why not. Every file under the
-folders is listed too, for the ledger (:mod:`ertools.rescore.ledger`).
+folders is listed too, for the ledger (:mod:`ertools.competition.ledger`).
 """
 
 from __future__ import annotations
@@ -21,12 +21,8 @@ from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks import registry
 from ertools.benchmarks.common.teams import read_payload_team
-from ertools.io.clock import clock_check
-from ertools.io.formats import regular_files
-from ertools.progress import Reporter
-from ertools.report.timeline_page import write_timeline_page
-from ertools.rescore.discover import Discovery, Execution, discover
-from ertools.rescore.memo import (
+from ertools.competition.discover import Discovery, Execution, discover
+from ertools.competition.memo import (
     CLOCK,
     TEAM,
     FileMemo,
@@ -35,9 +31,13 @@ from ertools.rescore.memo import (
     clock_to_json,
     team_json_valid,
 )
-from ertools.rescore.pipeline import Scoring
-from ertools.timeline.model import Timeline
-from ertools.timeline.scan import scan
+from ertools.competition.pipeline import Scoring
+from ertools.io.clock import clock_check
+from ertools.io.formats import regular_files
+from ertools.progress import Reporter
+from ertools.report.timeline_page import write_timeline_page
+from ertools.timelines.model import Timeline
+from ertools.timelines.scan import scan
 
 if TYPE_CHECKING:
     from ertools.io import BagSummary
@@ -119,7 +119,7 @@ def find(
 ) -> Found:
     """Scan ``paths`` and turn every execution found into its scorings; what each log says
     (its clock check, its payloads' team) is taken from ``memo`` while the log is unchanged
-    (:mod:`ertools.rescore.memo`)."""
+    (:mod:`ertools.competition.memo`)."""
     memo = memo or FileMemo(None)
 
     def clock(s: BagSummary) -> ClockCheck | None:

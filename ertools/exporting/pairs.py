@@ -13,7 +13,7 @@ Two library functions, one per mode of the command:
   evo's nearest-time association pairs them one to one and its APE (translation part, no
   alignment) is ertools' position error.
 
-The formatting is in :mod:`ertools.export.formats` (pure); this module reads and selects.
+The formatting is in :mod:`ertools.exporting.formats` (pure); this module reads and selects.
 """
 
 from __future__ import annotations
@@ -34,7 +34,7 @@ from ertools.benchmarks.trajectory.association import COMPARED
 from ertools.benchmarks.trajectory.benchmark import score
 from ertools.benchmarks.trajectory.inputs import read_gt
 from ertools.errors import ClockError, ScoringError, UsageError
-from ertools.export.formats import SUFFIXES, ExportFormat, format_poses, format_times
+from ertools.exporting.formats import SUFFIXES, ExportFormat, format_poses, format_times
 from ertools.geometry import interpolate_poses
 from ertools.io.text import is_text_trajectory, read_text_poses
 from ertools.streams import PoseStream

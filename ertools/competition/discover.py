@@ -1,7 +1,7 @@
 """Every benchmark execution in a timeline, with its team, GT files and robot log.
 
-Pure: it reads the :class:`~ertools.timeline.model.Timeline` that
-:func:`ertools.timeline.scan.scan` built (and, optionally, the teams the IO edge read from the
+Pure: it reads the :class:`~ertools.timelines.model.Timeline` that
+:func:`ertools.timelines.scan.scan` built (and, optionally, the teams the IO edge read from the
 state payloads), never a file.
 
 - An **execution** is a benchmark log (a bag with state topics, ``kind == "benchmark"``) and
@@ -41,8 +41,8 @@ from dataclasses import dataclass
 from typing import Literal
 
 from ertools.benchmarks.common.teams import TeamSource, resolve_team
-from ertools.timeline.build import bag_stem, split_name
-from ertools.timeline.model import BagEntry, Pairing, Timeline
+from ertools.timelines.build import bag_stem, split_name
+from ertools.timelines.model import BagEntry, Pairing, Timeline
 from ertools.timeutil import NS_PER_S
 
 # Spelled as the ``problems[].kind`` of results.json (the rescore contract).
@@ -70,7 +70,7 @@ _BENCHMARK_LOG_RE = re.compile(
 )
 # Words of a GT recording's name that say the marker set lay still (a noise measurement).
 _STILL_WORDS = frozenset({"noise", "static", "stationary", "still"})
-# What the timeline's per-file problem lines say, by kind (ertools.timeline.build writes them).
+# What the timeline's per-file problem lines say, by kind (ertools.timelines.build writes them).
 _FILE_PROBLEMS: tuple[tuple[str, ProblemKind], ...] = (
     ("truncated", "truncated"),
     ("same recording as", "duplicate"),
@@ -168,8 +168,8 @@ def discover(timeline: Timeline, payload_teams: Mapping[str, str] | None = None)
     """The benchmark executions of ``timeline`` and what is wrong (see the module docstring).
 
     Args:
-        timeline: from :func:`ertools.timeline.scan.scan` (or
-            :func:`ertools.timeline.build.build_timeline`).
+        timeline: from :func:`ertools.timelines.scan.scan` (or
+            :func:`ertools.timelines.build.build_timeline`).
         payload_teams: benchmark log path -> the team its state payloads name, for the logs
             where the IO edge found one (:func:`ertools.benchmarks.common.teams.read_payload_team`).
     """

@@ -2,7 +2,8 @@
 
 Pure: takes :class:`~ertools.streams.StateStream` objects (one per machine, ``None`` where a
 topic is absent) and returns a frozen :class:`Audit`. Reading the bag is the CLI's job
-(``ertools.io.read_benchmark_states``); recomputing the score is :mod:`ertools.audit.rescore`'s.
+(``ertools.io.read_benchmark_states``); recomputing the score is
+:mod:`ertools.auditing.recompute`'s.
 
 The audit finds:
 
@@ -30,7 +31,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from ertools.audit.model import (
+from ertools.auditing.model import (
     Audit,
     AuditRun,
     EarlyEnd,
@@ -52,7 +53,7 @@ from ertools.streams import Provenance, StateStream
 from ertools.timeutil import NS_PER_S, ns_to_s
 from ertools.yamlin import load as load_yaml
 
-log = logging.getLogger("ertools.audit.analyse")
+log = logging.getLogger("ertools.auditing.analyse")
 
 DEFAULT_MAX_SILENCE_NS = NS_PER_S  # the machines published at 10 Hz: 1 s is 10 lost beats
 

@@ -33,8 +33,8 @@ from typing import Any
 
 from ertools._version import __version__
 from ertools.atomic import write_text
+from ertools.competition.jobs import Job, Outcome
 from ertools.report.records import sha256_file
-from ertools.rescore.jobs import Job, Outcome
 
 CACHE_VERSION = 2
 STATUSES = ("scored", "unscoreable")

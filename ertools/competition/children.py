@@ -6,7 +6,7 @@ while the main thread wrote its progress line, and the scorer hung on the inheri
 minutes (issue 29). The fork server has one thread when it forks. It is forked from
 ``rescore`` before any thread starts (:func:`forks_ready`); in a process that already has
 threads (a Dask worker, a notebook) it is a fresh interpreter instead
-(``python -m ertools.rescore.children``). It keeps what a job loads on first use imported
+(``python -m ertools.competition.children``). It keeps what a job loads on first use imported
 (the benchmark's modules, what they import lazily, the SVG figure writer, the report
 template), so each child starts warm in milliseconds.
 
@@ -34,9 +34,9 @@ from importlib import import_module
 from typing import BinaryIO
 
 from ertools.benchmarks import registry
+from ertools.competition.jobs import Job, Outcome, load_benchmark, run_job
 from ertools.report import html
 from ertools.report.figures import preload
-from ertools.rescore.jobs import Job, Outcome, load_benchmark, run_job
 
 # prctl(2): PR_SET_PDEATHSIG, the signal the kernel sends a process when its parent ends
 _PR_SET_PDEATHSIG = 1

@@ -27,12 +27,12 @@ from pathlib import Path
 from typing import Any
 
 from ertools.atomic import write_text
+from ertools.competition import site_text as text
+from ertools.competition.site_text import TEAM_UNKNOWN
 from ertools.errors import ConfigError
 from ertools.report import html as h
 from ertools.report import ranks, units
 from ertools.report.rank_plot import interval_plot
-from ertools.rescore import site_text as text
-from ertools.rescore.site_text import TEAM_UNKNOWN
 
 SCHEMA_VERSION = 1
 TEMPLATE = "rescore_index.html.j2"

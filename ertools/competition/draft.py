@@ -9,7 +9,7 @@ line, so the draft validates as it is (those executions are then unscoreable, sa
 the organiser fills in blanks rather than starting from nothing. Inputs come from the registry's
 declarations only. GT-only recordings are listed under ``executions:`` with the values scoring
 them (and an input file found beside them); the draft ends with every file under PATH and its
-place (:mod:`ertools.rescore.ledger`).
+place (:mod:`ertools.competition.ledger`).
 """
 
 from __future__ import annotations
@@ -25,11 +25,11 @@ from typing import Any
 
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Input
+from ertools.competition.discover import Execution
+from ertools.competition.found import Found, robot_benchmarks
+from ertools.competition.ledger import Claim, place_files, root_of
+from ertools.competition.site_text import TEAM_UNKNOWN
 from ertools.io.formats import regular_files
-from ertools.rescore.discover import Execution
-from ertools.rescore.found import Found, robot_benchmarks
-from ertools.rescore.ledger import Claim, place_files, root_of
-from ertools.rescore.site_text import TEAM_UNKNOWN
 from ertools.timeutil import NS_PER_S
 
 CONFIG_SUFFIXES = (".yaml", ".yml")

@@ -2,7 +2,7 @@
 
 :func:`rescore` is the one library function behind ``ertools rescore``: it plans one job per
 execution (values from the manifest, through the registry only), takes what the cache holds,
-scores the rest (:mod:`ertools.rescore.parallel`), and returns the ``results.json`` document
+scores the rest (:mod:`ertools.competition.parallel`), and returns the ``results.json`` document
 (schema in docs/rescore.md) that :func:`write_results` writes with ``results.csv``.
 """
 
@@ -23,12 +23,8 @@ from ertools._version import __version__
 from ertools.atomic import write_text
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Benchmark
-from ertools.csvsafe import spreadsheet_safe
-from ertools.errors import ErtoolsError
-from ertools.io import summary
-from ertools.progress import Reporter
-from ertools.rescore.boards import leaderboards
-from ertools.rescore.cache import (
+from ertools.competition.boards import leaderboards
+from ertools.competition.cache import (
     Cache,
     FileHashes,
     Fingerprints,
@@ -37,11 +33,15 @@ from ertools.rescore.cache import (
     job_key,
     records,
 )
-from ertools.rescore.jobs import Job, Outcome
-from ertools.rescore.manifest import Manifest
-from ertools.rescore.parallel import DaskClient, run_jobs
-from ertools.rescore.site import write_site
-from ertools.rescore.site_text import TEAM_UNKNOWN
+from ertools.competition.jobs import Job, Outcome
+from ertools.competition.manifest import Manifest
+from ertools.competition.parallel import DaskClient, run_jobs
+from ertools.competition.site import write_site
+from ertools.competition.site_text import TEAM_UNKNOWN
+from ertools.csvsafe import spreadsheet_safe
+from ertools.errors import ErtoolsError
+from ertools.io import summary
+from ertools.progress import Reporter
 from ertools.timeutil import NS_PER_S, iso_utc
 
 log = logging.getLogger(__name__)
@@ -517,7 +517,7 @@ def document(
 
 
 def _size(state: tuple[Any, ...]) -> int:
-    """The size in a :func:`~ertools.rescore.cache.file_state` (a folder's: its files')."""
+    """The size in a :func:`~ertools.competition.cache.file_state` (a folder's: its files')."""
     if state and isinstance(state[0], tuple):
         return sum(int(f[1]) for f in state)
     return int(state[0]) if state else 0
@@ -568,6 +568,6 @@ def write_results(doc: Mapping[str, Any], out: Path) -> list[Path]:
         ("results.csv", csv_text(doc)),
     ):
         written.append(write_text(out / name, text))
-    # the results page, rebuilt from the document alone (ertools.rescore.site)
+    # the results page, rebuilt from the document alone (ertools.competition.site)
     written.append(write_site(dict(doc), out))
     return written

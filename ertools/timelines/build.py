@@ -15,7 +15,7 @@ its copies are listed under it and left out of overlaps, sessions and pairings, 
 1,000 copies gives one recording with 999 copies, not a million overlaps.
 
 Pure: it takes bag summaries (``ertools.io.BagSummary`` or anything with the same attributes),
-never opens a file. :mod:`ertools.timeline.scan` is the IO edge that produces its inputs.
+never opens a file. :mod:`ertools.timelines.scan` is the IO edge that produces its inputs.
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ from pathlib import Path
 from ertools.benchmarks.common.teams import parse_robot_log_name
 from ertools.io.formats import Unreadable
 from ertools.io.model import ClockCheck
-from ertools.timeline.model import (
+from ertools.timelines.model import (
     BagEntry,
     Kind,
     Pairing,
@@ -245,7 +245,7 @@ def build_timeline(
     Args:
         summaries: one per readable bag (a bag with no messages counts as unreadable).
         unreadable: paths that could not be summarised and why.
-        clock_checks: measured record-minus-header offsets (see :mod:`ertools.timeline.scan`).
+        clock_checks: measured record-minus-header offsets (see :mod:`ertools.timelines.scan`).
         config: thresholds.
     """
     cfg = config or TimelineConfig()

@@ -3,7 +3,7 @@
 Everything read here goes through :mod:`ertools.io`: summaries come from each file's index
 (never its message data), and the clock check decodes only the first second of one pose topic
 per bag with a windowed read. :func:`scan` returns the pure
-:class:`~ertools.timeline.model.Timeline`.
+:class:`~ertools.timelines.model.Timeline`.
 """
 
 from __future__ import annotations
@@ -19,14 +19,14 @@ from ertools.io.clock import clock_check
 from ertools.io.formats import Found, Unreadable, find_bags
 from ertools.io.model import ClockCheck
 from ertools.progress import reporting
-from ertools.timeline.build import build_timeline, split_name
-from ertools.timeline.model import Timeline, TimelineConfig
+from ertools.timelines.build import build_timeline, split_name
+from ertools.timelines.model import Timeline, TimelineConfig
 
 if TYPE_CHECKING:
     from ertools.io import BagSummary
     from ertools.progress import Reporter
 
-log = logging.getLogger("ertools.timeline.scan")
+log = logging.getLogger("ertools.timelines.scan")
 
 
 def check_recordings(

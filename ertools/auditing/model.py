@@ -1,8 +1,8 @@
 """The frozen data of an audit: what happened in a benchmark execution, and how its live score
 compares with the recomputed one.
 
-:mod:`ertools.audit.analyse` builds an :class:`Audit` from the state topics,
-:mod:`ertools.audit.compare` builds a :class:`ScoreComparison`, :mod:`ertools.audit.rescore`
+:mod:`ertools.auditing.analyse` builds an :class:`Audit` from the state topics,
+:mod:`ertools.auditing.compare` builds a :class:`ScoreComparison`, :mod:`ertools.auditing.recompute`
 recomputes the score. This module holds the types they share and their output (JSON, YAML, CSV
 tables, text), so that none of them needs another to describe its result.
 """
@@ -112,7 +112,7 @@ class Audit:
         runs: the runs/segments the BmBox went through.
         live_score: the score sent live, parsed (None when not sent or unparsable).
         live_score_text: the raw TRANSMITTING_SCORE payload.
-        recomputed: the score recomputed from the same bag (see ``ertools.audit.rescore``).
+        recomputed: the score recomputed from the same bag (see ``ertools.auditing.recompute``).
         comparison: live vs recomputed, key by key.
     """
 

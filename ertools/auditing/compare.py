@@ -9,7 +9,7 @@ from the 2015 node (``result.deviations``), and patterns recognised in the numbe
 (the orientation wrap, segments numbered from 1).
 
 Pure: no file is read here. :func:`attach` puts a comparison into an
-:class:`~ertools.audit.model.Audit`.
+:class:`~ertools.auditing.model.Audit`.
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ import re
 from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
-from ertools.audit.explain import explain, is_number
-from ertools.audit.model import Audit, ScoreComparison, ScoreLine
+from ertools.auditing.explain import explain, is_number
+from ertools.auditing.model import Audit, ScoreComparison, ScoreLine
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import jsonable
 from ertools.configs.transform import LIVE_TRANSFORM_KEY, MarkerTransform, live_transform

@@ -8,9 +8,9 @@ timing file), else a ``problem`` with its kind and reason (an unreadable bag, a 
 recording that is no execution, or a file that is not a log and that no input names:
 ``unused``). A file inside a rosbag2 folder belongs to that folder's bag.
 
-Pure: the files are listed by the IO edge (:func:`ertools.rescore.found.list_files`); the
+Pure: the files are listed by the IO edge (:func:`ertools.competition.found.list_files`); the
 claims come from ``results.json``'s rows and problems (:func:`account`) or from the draft
-(:mod:`ertools.rescore.draft`).
+(:mod:`ertools.competition.draft`).
 """
 
 from __future__ import annotations

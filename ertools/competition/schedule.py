@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 
-from ertools.rescore.jobs import Job, Outcome
+from ertools.competition.jobs import Job, Outcome
 
 
 class Schedule:

@@ -9,9 +9,9 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ertools.audit.analyse import DEFAULT_MAX_SILENCE_NS, audit_states
-from ertools.audit.compare import attach
-from ertools.audit.model import Audit
+from ertools.auditing.analyse import DEFAULT_MAX_SILENCE_NS, audit_states
+from ertools.auditing.compare import attach
+from ertools.auditing.model import Audit
 from ertools.benchmarks import registry
 from ertools.benchmarks.common.which import log_benchmark
 from ertools.errors import BagError, ErtoolsError, ScoringError, UsageError

@@ -20,21 +20,21 @@ from typing import TYPE_CHECKING, Any
 
 from ertools.atomic import folder_lock
 from ertools.benchmarks import registry
+from ertools.competition.children import ertools_own, forks_ready
+from ertools.competition.found import find, merge, write_timeline
+from ertools.competition.ledger import account
+from ertools.competition.manifest import Manifest
+from ertools.competition.memo import FileMemo
+from ertools.competition.parallel import early_dask
+from ertools.competition.pipeline import listed_executions, rescore, write_results
 from ertools.errors import ConfigError
-from ertools.rescore.children import ertools_own, forks_ready
-from ertools.rescore.found import find, merge, write_timeline
-from ertools.rescore.ledger import account
-from ertools.rescore.manifest import Manifest
-from ertools.rescore.memo import FileMemo
-from ertools.rescore.parallel import early_dask
-from ertools.rescore.pipeline import listed_executions, rescore, write_results
 
 log = logging.getLogger(__name__)
 
 if TYPE_CHECKING:
+    from ertools.competition.jobs import Outcome
+    from ertools.competition.parallel import DaskClient
     from ertools.progress import Reporter
-    from ertools.rescore.jobs import Outcome
-    from ertools.rescore.parallel import DaskClient
 
 
 @dataclass(frozen=True)
@@ -95,7 +95,7 @@ def rescore_competition(
 def _scoring_processes(
     scheduler: str | None, workers: int, *, cold: bool
 ) -> AbstractContextManager[None]:
-    """The scoring processes' fork server (:mod:`ertools.rescore.children`), forked now, while
+    """The scoring processes' fork server (:mod:`ertools.competition.children`), forked now, while
     this process has one thread: a LocalCluster's workers are threads of this process."""
     if scheduler == "local" or (scheduler is None and workers > 1):
         # On a first run, what ertools' benchmarks import lazily, imported by the server while

@@ -7,8 +7,8 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from ertools.benchmarks import registry
+from ertools.competition.site_text import TEAM_UNKNOWN
 from ertools.report import ranks
-from ertools.rescore.site_text import TEAM_UNKNOWN
 
 
 def leaderboards(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:

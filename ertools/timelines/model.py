@@ -1,7 +1,7 @@
 """The data of a timeline (:class:`Timeline`: bags, sessions, pairings, problems) and the
 thresholds it is built with (:class:`TimelineConfig`), with its JSON layout and CSV rows.
 
-:mod:`ertools.timeline.build` builds it from bag summaries; :mod:`ertools.timeline.scan` reads
+:mod:`ertools.timelines.build` builds it from bag summaries; :mod:`ertools.timelines.scan` reads
 the summaries; the report draws it.
 """
 

@@ -1,6 +1,6 @@
 """Scoring jobs in parallel: local worker processes (``--jobs N``) or a Dask cluster
 (``--scheduler ADDRESS|local``); the scoring processes are children of the fork server
-(:mod:`ertools.rescore.children`).
+(:mod:`ertools.competition.children`).
 
 Each local worker is a process of its own holding one job at a time, so that when one dies
 (killed for memory, a crash in a native library) the job it held is known: that job's row
@@ -20,8 +20,7 @@ import threading
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from typing import Any
 
-from ertools.errors import ConfigError
-from ertools.rescore.children import (
+from ertools.competition.children import (
     Child,
     ForkServerError,
     close_idle_server,
@@ -30,8 +29,9 @@ from ertools.rescore.children import (
     new_child,
     run_job_forked,
 )
-from ertools.rescore.jobs import Job, Outcome, run_job
-from ertools.rescore.schedule import Schedule
+from ertools.competition.jobs import Job, Outcome, run_job
+from ertools.competition.schedule import Schedule
+from ertools.errors import ConfigError
 
 OnDone = Callable[[Outcome], None]
 log = logging.getLogger(__name__)
@@ -51,7 +51,7 @@ def run_jobs(
     dask: DaskClient | None = None,
 ) -> None:
     """Score every job (by ``workers`` local processes, or the Dask ``scheduler``); with
-    several workers, the longest expected first (:mod:`ertools.rescore.schedule`; ``known``:
+    several workers, the longest expected first (:mod:`ertools.competition.schedule`; ``known``:
     (benchmark, seconds) of executions already timed). ``dask``: the scheduler's client,
     already being started (:func:`early_dask`); closed in the background once the jobs are
     done."""
@@ -136,7 +136,7 @@ def run_dask(
     dask: DaskClient | None = None,
 ) -> None:
     """Score ``jobs`` on a Dask cluster (``local``: a LocalCluster of ``workers`` threads,
-    each scoring in a child of the fork server, :mod:`ertools.rescore.children`).
+    each scoring in a child of the fork server, :mod:`ertools.competition.children`).
 
     Only the jobs (paths and values) go through the scheduler; workers read the logs from the
     shared file system. A job whose worker died as often as the scheduler allows
