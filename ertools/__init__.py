@@ -13,15 +13,11 @@ Everything else is private by convention and may change in any release
 
 from __future__ import annotations
 
-from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
-from ertools._callable import submodules
 from ertools._version import __version__
 
-# `ertools.audit`, `.timeline`, `.export` and `.rescore` are also packages: a package imported
-# sets its name on this module, so those four packages are themselves callable (their
-# __init__ makes them so) and each call runs the function of ertools.api.
+# The public names, once, in the order docs/api.md shows them.
 __all__ = [
     "__version__",
     "audit",
@@ -36,7 +32,7 @@ __all__ = [
 ]
 API = tuple(__all__[1:])
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # the same names for type checkers (tests/api: equal to API)
     from ertools.api import (
         audit,
         export,
@@ -51,14 +47,13 @@ if TYPE_CHECKING:
 
 
 def __getattr__(name: str) -> Any:
-    if name in API:
-        return getattr(import_module("ertools.api"), name)
-    # a private module reached as an attribute (`ertools.yamlout.dump`), imported on first use
-    return _submodule(name)
+    """A public function of ertools.api (PEP 562); any other name is an AttributeError."""
+    if name not in API:
+        raise AttributeError(f"module 'ertools' has no attribute {name!r}")
+    from ertools import api  # lazy: NumPy, the readers, the report: 300-700 ms
 
-
-_submodule = submodules(__name__)
+    return getattr(api, name)
 
 
 def __dir__() -> list[str]:
-    return sorted({*globals(), *API})
+    return sorted({"API", *__all__, *(name for name in globals() if name.startswith("__"))})

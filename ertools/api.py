@@ -51,30 +51,6 @@ if TYPE_CHECKING:
 
 PathLike = str | Path
 
-# The public names, in the order docs/api.md lists them.
-__all__ = [
-    "audit",
-    "export",
-    "figures",
-    "info",
-    "open_bag",
-    "read_poses",
-    "rescore",
-    "score",
-    "timeline",
-]
-ORDER = (
-    "info",
-    "open_bag",
-    "read_poses",
-    "score",
-    "audit",
-    "timeline",
-    "figures",
-    "export",
-    "rescore",
-)
-
 
 @checked
 def info(path: PathLike) -> BagSummary:

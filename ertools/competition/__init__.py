@@ -4,15 +4,9 @@ The competition manifest (:mod:`~ertools.competition.manifest`) names every benc
 and each team's; executions (listed in the manifest, or found in the logs by
 :mod:`ertools.competition.discover`) become independent jobs
 (:mod:`~ertools.competition.jobs`), scored through the benchmark registry only, in parallel
-(:mod:`~ertools.competition.parallel`), skipped
-when the cache (:mod:`~ertools.competition.cache`) already holds them, and gathered into
+(:mod:`~ertools.competition.parallel`), skipped when the cache
+(:mod:`~ertools.competition.cache`) already holds them, and gathered into
 ``results.json``/``results.csv`` (:mod:`~ertools.competition.pipeline`), from which
 :mod:`~ertools.competition.site` renders the results page. The document's contract is
-docs/rescore.md.
-
-Called, this package is the public API's ``ertools.rescore(...)`` (:func:`ertools.api.rescore`).
+docs/rescore.md. The public API's function is ``ertools.rescore``.
 """
-
-from ertools._callable import make_callable
-
-make_callable(__name__)

@@ -16,6 +16,7 @@ from typing import Any
 
 import pytest
 
+import ertools
 from ertools import api
 from ertools.benchmarks import registry
 from ertools.errors import UsageError
@@ -83,7 +84,7 @@ def _call(function: Callable[..., Any], name: str, value: Any) -> None:
 def _parameters() -> list[tuple[str, str]]:
     return [
         (function, parameter.name)
-        for function in api.ORDER
+        for function in ertools.API
         for parameter in inspect.signature(getattr(api, function)).parameters.values()
         if parameter.kind is not parameter.VAR_KEYWORD
     ]
