@@ -19,6 +19,7 @@ import sys
 import textwrap
 import time
 from collections.abc import Iterator
+from importlib import import_module
 from pathlib import Path
 
 import pytest
@@ -174,7 +175,7 @@ def test_an_import_error_made_of_an_interrupt_is_one_line(
         encoding="utf-8",
     )
     monkeypatch.syspath_prepend(str(tmp_path))
-    assert launch.run("numpyish:main", "ertools") == launch.INTERRUPTED
+    assert launch.run(lambda: import_module("numpyish"), "ertools") == launch.INTERRUPTED
     assert capsys.readouterr().err == "ertools: interrupted\n"
 
 
@@ -185,4 +186,4 @@ def test_an_import_error_of_its_own_is_not_an_interrupt(
     (tmp_path / "broken.py").write_text("raise ImportError('no such thing')\n", encoding="utf-8")
     monkeypatch.syspath_prepend(str(tmp_path))
     with pytest.raises(ImportError, match="no such thing"):
-        launch.run("broken:main", "ertools")
+        launch.run(lambda: import_module("broken"), "ertools")
