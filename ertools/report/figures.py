@@ -1,6 +1,6 @@
 """Figures as data: a benchmark says what to draw, this module decides where it goes.
 
-A figure is either a :class:`~ertools.report.chart.Chart` built from the result (written as
+A figure is either a :class:`~ertools.views.chart.Chart` built from the result (written as
 SVG by :mod:`ertools.report.svg`, without matplotlib: the reports' figures) or, for the
 figures not converted yet, a function drawing on a matplotlib ``Axes``. A chart is drawn by
 matplotlib too when a user asks for a PNG or PDF (``--plot fig.png``). Nothing here selects a
@@ -22,7 +22,7 @@ import numpy as np
 from ertools.atomic import replacing, write_text
 from ertools.benchmarks import registry
 from ertools.report import chart_mpl, svg
-from ertools.report.chart import Chart
+from ertools.views.chart import Chart
 
 # Results that are not a registered benchmark's -> ``module:function`` giving their figures
 # (a benchmark names its own: :attr:`ertools.benchmarks.base.Benchmark.figures`).

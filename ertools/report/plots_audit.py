@@ -1,5 +1,5 @@
 """The audit's figure: the three state machines over time, one lane each, as a
-:class:`~ertools.report.chart.Chart` (reports write it as SVG); the data comes from
+:class:`~ertools.views.chart.Chart` (reports write it as SVG); the data comes from
 :class:`ertools.auditing.model.Audit`.
 """
 
@@ -9,11 +9,12 @@ from typing import Any
 
 import numpy as np
 
-from ertools.report import chart_mpl, units
-from ertools.report.chart import Axis, Chart, Layer, Rects, RefLine, Scatter, Span, Text
+from ertools.report import chart_mpl
 from ertools.report.figures import FigureSpec, chart_spec
 from ertools.states import Machine
 from ertools.timeutil import ns_to_s
+from ertools.views import units
+from ertools.views.chart import Axis, Chart, Layer, Rects, RefLine, Scatter, Span, Text
 
 _LANES = (Machine.CLIENT, Machine.REFBOX, Machine.BMBOX)  # bottom to top
 # Okabe & Ito's colour-blind-safe palette (2008), plus two greys that differ in lightness.

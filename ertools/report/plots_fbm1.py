@@ -1,6 +1,6 @@
 """FBM1 figures: per-run errors and scores, ground truth vs answered poses on the table.
 
-Each figure is a :class:`~ertools.report.chart.Chart` (lengths in mm, angles in degrees);
+Each figure is a :class:`~ertools.views.chart.Chart` (lengths in mm, angles in degrees);
 reports write it as SVG (:mod:`ertools.report.svg`).
 """
 
@@ -12,8 +12,9 @@ from typing import Any
 import numpy as np
 
 from ertools.benchmarks import registry
-from ertools.report import units
-from ertools.report.chart import (
+from ertools.report.figures import FigureSpec, chart_spec
+from ertools.views import units
+from ertools.views.chart import (
     Arrows,
     Axis,
     Bars,
@@ -24,7 +25,6 @@ from ertools.report.chart import (
     Scatter,
     Text,
 )
-from ertools.report.figures import FigureSpec, chart_spec
 
 # Colours by answer quality (colour-blind safe pairs).
 _RIGHT = "#1b9e77"

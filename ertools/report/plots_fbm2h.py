@@ -1,6 +1,6 @@
 """FBM2@Home figures: the robot's path with the waypoints, and the per-waypoint errors.
 
-Each figure is a :class:`~ertools.report.chart.Chart` (lengths in mm, angles in degrees),
+Each figure is a :class:`~ertools.views.chart.Chart` (lengths in mm, angles in degrees),
 built for its size (the path thinned to its pixels); reports write it as SVG.
 """
 
@@ -10,8 +10,10 @@ from typing import Any
 
 import numpy as np
 
-from ertools.report import gaps, units
-from ertools.report.chart import (
+from ertools.report import gaps
+from ertools.report.figures import FigureSpec, chart_spec, thin_path
+from ertools.views import units
+from ertools.views.chart import (
     COLOURS,
     Arrows,
     Axis,
@@ -23,7 +25,6 @@ from ertools.report.chart import (
     Scatter,
     Text,
 )
-from ertools.report.figures import FigureSpec, chart_spec, thin_path
 
 ARROW = 0.25  # metres: length of the heading arrows on the path figure
 MM = units.factor("length", "m")

@@ -1,6 +1,6 @@
 """FBM3@Work figures: each run's path in its run frame, the runs' errors, the d_min sweep.
 
-Each figure is a :class:`~ertools.report.chart.Chart` in millimetres, built for its size
+Each figure is a :class:`~ertools.views.chart.Chart` in millimetres, built for its size
 (paths thinned to its pixels); reports write it as SVG (:mod:`ertools.report.svg`).
 """
 
@@ -11,8 +11,10 @@ from typing import Any
 
 import numpy as np
 
-from ertools.report import gaps, units
-from ertools.report.chart import (
+from ertools.report import gaps
+from ertools.report.figures import FigureSpec, chart_spec, thin_path
+from ertools.views import units
+from ertools.views.chart import (
     COLOURS,
     CYCLE,
     Axis,
@@ -25,7 +27,6 @@ from ertools.report.chart import (
     Scatter,
     Text,
 )
-from ertools.report.figures import FigureSpec, chart_spec, thin_path
 
 MM = units.factor("length", "m")
 RUN_SIZE = (8.0, 5.5)

@@ -1,5 +1,5 @@
 """Mocap noise figure: the distribution of the distance between consecutive measurements, as
-a :class:`~ertools.report.chart.Chart` in mm (reports write it as SVG)."""
+a :class:`~ertools.views.chart.Chart` in mm (reports write it as SVG)."""
 
 from __future__ import annotations
 
@@ -7,9 +7,9 @@ from typing import Any
 
 import numpy as np
 
-from ertools.report import units
-from ertools.report.chart import COLOURS, Axis, Bars, Chart, Layer, RefLine
 from ertools.report.figures import FigureSpec, chart_spec
+from ertools.views import units
+from ertools.views.chart import COLOURS, Axis, Bars, Chart, Layer, RefLine
 
 MM = units.factor("length", "m")
 

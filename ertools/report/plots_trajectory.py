@@ -1,6 +1,6 @@
 """Figures of a trajectory result: the error over time and the two paths overlaid.
 
-Each figure is a :class:`~ertools.report.chart.Chart` (lengths in mm, angles in degrees, time
+Each figure is a :class:`~ertools.views.chart.Chart` (lengths in mm, angles in degrees, time
 in seconds), built for its size (series and paths thinned to its pixels); reports write it as
 SVG (:mod:`ertools.report.svg`).
 """
@@ -12,9 +12,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ertools.benchmarks.trajectory.association import GAP, TRACKING_LOST, UNCOVERED
-from ertools.report import gaps, units
-from ertools.report.chart import COLOURS, Axis, Chart, Layer, Line, RefLine, Scatter
+from ertools.report import gaps
 from ertools.report.figures import FigureSpec, chart_spec, thin_path, thin_series
+from ertools.views import units
+from ertools.views.chart import COLOURS, Axis, Chart, Layer, Line, RefLine, Scatter
 
 if TYPE_CHECKING:
     from ertools.benchmarks.trajectory.result import TrajectoryResult

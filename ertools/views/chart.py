@@ -4,7 +4,7 @@ reports' vector figures, written straight from the arrays) or by matplotlib
 
 A plot module builds a :class:`Chart` from a result and the figure's size in inches (the size
 decides how far paths are thinned: :func:`ertools.report.figures.thin_path`); it never draws.
-Values are in the unit shown (mm, deg, s: :mod:`ertools.report.units`), so both renderers
+Values are in the unit shown (mm, deg, s: :mod:`ertools.views.units`), so both renderers
 print the ticks as they are. Colours are CSS colours; :data:`COLOURS` names the report's
 palette (matplotlib's ``tab:`` colours, so PNG and SVG figures read the same).
 """
