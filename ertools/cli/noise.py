@@ -26,7 +26,7 @@ from ertools.cli.options import (
     positive,
 )
 from ertools.cli.output import dump_json, note, write_text
-from ertools.report.plots_noise import figure_specs
+from ertools.report.figures import figure_specs
 
 if TYPE_CHECKING:
     from ertools.streams import PoseStream

@@ -12,7 +12,6 @@ from typing import Any
 import numpy as np
 
 from ertools.benchmarks import registry
-from ertools.report.figures import FigureSpec, chart_spec
 from ertools.views import units
 from ertools.views.chart import (
     Arrows,
@@ -25,6 +24,7 @@ from ertools.views.chart import (
     Scatter,
     Text,
 )
+from ertools.views.spec import ChartSpec
 
 # Colours by answer quality (colour-blind safe pairs).
 _RIGHT = "#1b9e77"
@@ -151,21 +151,21 @@ def table_chart(result: Any) -> Chart:
     )
 
 
-def figure_specs(result: Any) -> list[FigureSpec]:
+def figure_specs(result: Any) -> list[ChartSpec]:
     """The FBM1 figures of a result (``Fbm1Result``)."""
     label = registry.get(result.name).title
     return [
-        chart_spec(
+        ChartSpec(
             f"{result.name}_pose_scores",
             f"{label}: pose score per run",
             lambda size: scores_chart(result),
         ),
-        chart_spec(
+        ChartSpec(
             f"{result.name}_errors",
             f"{label}: translation and theta errors",
             lambda size: errors_chart(result),
         ),
-        chart_spec(
+        ChartSpec(
             f"{result.name}_table",
             f"{label}: ground truth (black) vs answers on the table",
             lambda size: table_chart(result),

@@ -11,7 +11,6 @@ from typing import Any
 import numpy as np
 
 from ertools.report import gaps
-from ertools.report.figures import FigureSpec, chart_spec, thin_path
 from ertools.views import units
 from ertools.views.chart import (
     COLOURS,
@@ -25,6 +24,8 @@ from ertools.views.chart import (
     Scatter,
     Text,
 )
+from ertools.views.spec import ChartSpec
+from ertools.views.thinning import thin_path
 
 ARROW = 0.25  # metres: length of the heading arrows on the path figure
 MM = units.factor("length", "m")
@@ -144,17 +145,17 @@ def path_title(result: Any) -> str:
     return title
 
 
-def figure_specs(result: Any) -> list[FigureSpec]:
+def figure_specs(result: Any) -> list[ChartSpec]:
     """The path and the errors figures of an ``Fbm2hResult``."""
     mode = "2015 orientation" if result.orientation_2015 else "orientation wrapped to [0, pi]"
     return [
-        chart_spec(
+        ChartSpec(
             "fbm2h_path",
             path_title(result),
             lambda size: path_chart(result, size),
             PATH_SIZE,
         ),
-        chart_spec(
+        ChartSpec(
             "fbm2h_errors",
             f"Errors per waypoint (dashed: accuracy; {mode})",
             lambda size: errors_chart(result),

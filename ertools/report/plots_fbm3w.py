@@ -12,7 +12,6 @@ from typing import Any
 import numpy as np
 
 from ertools.report import gaps
-from ertools.report.figures import FigureSpec, chart_spec, thin_path
 from ertools.views import units
 from ertools.views.chart import (
     COLOURS,
@@ -27,6 +26,8 @@ from ertools.views.chart import (
     Scatter,
     Text,
 )
+from ertools.views.spec import ChartSpec
+from ertools.views.thinning import thin_path
 
 MM = units.factor("length", "m")
 RUN_SIZE = (8.0, 5.5)
@@ -168,22 +169,20 @@ def run_title(run: Any) -> str:
     )
 
 
-def figure_specs(result: Any) -> list[FigureSpec]:
+def figure_specs(result: Any) -> list[ChartSpec]:
     """One figure per scored or unscoreable run (its path and gaps), the runs' bar chart, and
     the sweep when there is one."""
     specs = [
-        chart_spec(f"fbm3w_run{r.index}", run_title(r), partial(run_chart, r), RUN_SIZE)
+        ChartSpec(f"fbm3w_run{r.index}", run_title(r), partial(run_chart, r), RUN_SIZE)
         for r in result.runs
         if r.score is not None or (r.status == "unscoreable" and r.frame_xy is not None)
     ]
     specs.append(
-        chart_spec(
-            "fbm3w_runs", "FBM3@Work distance_error per run", lambda size: runs_chart(result)
-        )
+        ChartSpec("fbm3w_runs", "FBM3@Work distance_error per run", lambda size: runs_chart(result))
     )
     if result.sweep_values:
         specs.append(
-            chart_spec(
+            ChartSpec(
                 "fbm3w_d_min_sweep", "distance_error over d_min", lambda size: sweep_chart(result)
             )
         )

@@ -25,6 +25,7 @@ import numpy as np
 
 from ertools.report.svg_marks import Scale, attr, layer_svg, swatch
 from ertools.views.chart import (
+    PIXELS_PER_INCH,
     Arrows,
     Band,
     Bars,
@@ -42,7 +43,6 @@ from ertools.views.chart import (
     viridis,
 )
 
-PIXELS_PER_INCH = 110  # the reports' PNGs were 110 dpi: the same pixel size for each figure
 FONT = "DejaVu Sans, Verdana, Arial, sans-serif"
 TICK_PX, LABEL_PX, TITLE_PX, LEGEND_PX = 11.0, 12.0, 13.0, 11.0
 # Average advance widths of DejaVu Sans in em: capitals and underscores are wider than
