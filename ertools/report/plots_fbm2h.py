@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from ertools.report import gaps
+from ertools.benchmarks.common import gaps
 from ertools.views import units
 from ertools.views.chart import (
     COLOURS,
@@ -46,7 +46,7 @@ def _poses(xyt: np.ndarray, colour: str, label: str, marker: Any) -> list[Layer]
 
 def path_chart(result: Any, size: tuple[float, float] = PATH_SIZE) -> Chart:
     """Path on the testbed frame, waypoints with target headings, reached poses, the GT's
-    gaps on the path (:mod:`ertools.report.gaps`)."""
+    gaps on the path (:mod:`ertools.benchmarks.common.gaps`)."""
     layers: list[Layer] = []
     path = thin_path(np.asarray(result.path_xyyaw, dtype=float).reshape(-1, 3), size)
     if len(path):

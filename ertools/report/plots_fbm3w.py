@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from ertools.report import gaps
+from ertools.benchmarks.common import gaps
 from ertools.views import units
 from ertools.views.chart import (
     COLOURS,
@@ -37,7 +37,7 @@ VECTORS = 25  # about this many "compared with" vectors per run: enough to read,
 def run_chart(run: Any, size: tuple[float, float] = RUN_SIZE) -> Chart:
     """Target and measured path in the run frame (mm); kept samples coloured by their error,
     a few of them joined to the target point they are compared with; the GT's gaps on the
-    path (:mod:`ertools.report.gaps`)."""
+    path (:mod:`ertools.benchmarks.common.gaps`)."""
     score = run.score
     layers: list[Layer] = []
     if run.target_dense is not None:

@@ -11,8 +11,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ertools.benchmarks.common import gaps
 from ertools.benchmarks.trajectory.association import GAP, TRACKING_LOST, UNCOVERED
-from ertools.report import gaps
 from ertools.views import units
 from ertools.views.chart import COLOURS, Axis, Chart, Layer, Line, RefLine, Scatter
 from ertools.views.spec import ChartSpec
