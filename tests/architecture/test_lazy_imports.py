@@ -35,12 +35,12 @@ ALLOWED = frozenset(
         "ertools/report/plots_timeline.py: matplotlib.figure",
         "ertools/report/plots_timeline.py: matplotlib.patches",
         "ertools/report/plots_timeline.py: matplotlib.transforms",
-        "ertools/samples/packing.py: rosbags.typesys",
-        "ertools/samples/rsbb.py: rosbags.typesys",
-        "ertools/samples/writer.py: mcap.writer",
-        "ertools/samples/writer.py: rosbags.rosbag1",
-        "ertools/samples/writer.py: rosbags.rosbag2",
-        "ertools/samples/writer.py: rosbags.rosbag2.enums",
+        "ertools/simulator/packing.py: rosbags.typesys",
+        "ertools/simulator/rsbb.py: rosbags.typesys",
+        "ertools/simulator/writer.py: mcap.writer",
+        "ertools/simulator/writer.py: rosbags.rosbag1",
+        "ertools/simulator/writer.py: rosbags.rosbag2",
+        "ertools/simulator/writer.py: rosbags.rosbag2.enums",
     }
 )
 
