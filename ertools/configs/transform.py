@@ -35,7 +35,7 @@ import numpy.typing as npt
 from ertools.configs._yaml import check_radians, load_yaml, number
 from ertools.errors import ConfigError
 from ertools.geometry import invert
-from ertools.yamlout import yaml_float
+from ertools.serialize import yaml_float
 
 log = logging.getLogger("ertools.configs.transform")
 

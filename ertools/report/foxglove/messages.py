@@ -30,7 +30,7 @@ from foxglove_schemas_protobuf.TextPrimitive_pb2 import TextPrimitive
 from google.protobuf.message import Message
 
 from ertools.arrays import F64, I64
-from ertools.benchmarks.base import jsonable
+from ertools.serialize import jsonable
 
 WORLD = "world"  # the mocap frame every pose of a 2015 benchmark is in
 

@@ -34,8 +34,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.base import Benchmark, Input, Ranking, dump_yaml, resolve_values
-from ertools.io import PoseSource, read_pose_source
+from ertools.benchmarks.base import Benchmark, Input, Ranking, resolve_values
+from ertools.io.model import PoseSource
+from ertools.io.reader import read_pose_source
+from ertools.serialize import dump_yaml
 from ertools.streams import Provenance
 
 INPUTS = (
