@@ -25,7 +25,7 @@ from ertools.cli.options import (
     positive,
 )
 from ertools.cli.output import dump_json, note, write_text
-from ertools.report.plots_noise import figure_specs
+from ertools.report.figures import figure_specs
 from ertools.serialize import dump_yaml
 
 if TYPE_CHECKING:

@@ -11,7 +11,7 @@ from stderr_text import error_messages, joined_lines
 from test_audit import BMBOX, CLIENT, REFBOX
 
 from ertools.cli.main import main
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 from ertools.states import Machine
 from ertools.streams import StateStream
 

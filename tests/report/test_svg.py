@@ -12,7 +12,7 @@ import svg_figure
 from matplotlib.figure import Figure
 
 from ertools.report import chart_mpl, svg
-from ertools.report.chart import (
+from ertools.views.chart import (
     Arrows,
     Axis,
     Band,

@@ -34,9 +34,9 @@ from scipy.spatial.transform import Rotation
 from test_fbm1_nodes import read_log, tf_lookup
 
 from ertools.cli.main import main
-from ertools.samples.mocap import MocapNoise, publish_mocap, simulate_mocap
-from ertools.samples.statemachine import Transition, publish_states
-from ertools.samples.writer import BagWriter
+from ertools.simulator.mocap import MocapNoise, publish_mocap, simulate_mocap
+from ertools.simulator.statemachine import Transition, publish_states
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
 S = 1_000_000_000

@@ -15,7 +15,7 @@ from stderr_text import error_messages
 
 from ertools.cli.main import main
 from ertools.configs.shapes import builtin_shapes
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 
 
 def score(*args: str, draws: bool = False) -> int:

@@ -32,8 +32,8 @@ from rosbags.highlevel import AnyReader
 from test_fbm3w_2015 import _track
 
 from ertools.cli.main import main
-from ertools.samples.statemachine import Transition, publish_states
-from ertools.samples.writer import BagWriter
+from ertools.simulator.statemachine import Transition, publish_states
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
 S = 1_000_000_000

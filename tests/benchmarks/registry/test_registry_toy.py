@@ -17,8 +17,8 @@ import pytest
 
 from ertools.benchmarks import registry
 from ertools.cli.main import main
-from ertools.samples.statemachine import Transition, publish_states
-from ertools.samples.writer import BagWriter
+from ertools.simulator.statemachine import Transition, publish_states
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, Machine
 
 T0 = 1_448_013_600 * 1_000_000_000

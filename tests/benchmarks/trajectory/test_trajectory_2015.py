@@ -29,7 +29,7 @@ from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.benchmarks.trajectory.scoring import score_streams
 from ertools.cli.main import main
 from ertools.errors import ClockError
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 from ertools.streams import PoseStream
 
 TOL = 1e-12

@@ -25,7 +25,7 @@ from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
 from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 
 FORMATS = {"ros1": "bag", "mcap": "mcap"}
 

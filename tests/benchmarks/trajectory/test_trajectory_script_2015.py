@@ -24,7 +24,7 @@ from script2015 import Bag, PoseStamped, Run, Time, run_2015
 from stderr_text import error_messages
 
 from ertools.cli.main import main
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 
 S = 1_000_000_000
 MS = 1_000_000

@@ -3,7 +3,7 @@
 `BagWriter` is the only place the simulator touches a file. Scenario modules hand it whole
 arrays (one call per topic and per stretch of time); it serialises fixed-layout messages
 (PoseStamped, Pose2D, one-transform TFMessage) in bulk with NumPy
-(:mod:`ertools.samples.packing`), buffers everything, and on
+(:mod:`ertools.simulator.packing`), buffers everything, and on
 close writes all messages **sorted by record time** (stable, so equal times keep call order),
 as ``rosbag record`` did. Nothing in it reads a clock or a random source: the same calls give
 the same bytes.
@@ -49,7 +49,7 @@ import numpy.typing as npt
 
 from ertools.arrays import I64, U8
 from ertools.errors import UsageError
-from ertools.samples.packing import (
+from ertools.simulator.packing import (
     Field,
     as_bytes,
     broadcast_rows,

@@ -1,4 +1,4 @@
-"""Bulk serialisation for :class:`ertools.samples.writer.BagWriter`: fixed-layout messages packed
+"""Bulk serialisation for :class:`ertools.simulator.writer.BagWriter`: fixed-layout messages packed
 with NumPy (ROS1 and CDR), the rosbags typestore of every type the simulator writes, and the
 array helpers the writer's calls share. No file, clock or random source is touched here.
 """
