@@ -12,7 +12,6 @@ from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks.base import (
-    Benchmark,
     Explanation,
     FormerName,
     Input,
@@ -28,6 +27,7 @@ from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, NODES, RULE_SETS,
 from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, load, locate_runs
 from ertools.benchmarks.fbm2h.result import Fbm2hResult
 from ertools.benchmarks.fbm2h.segments import StopParams
+from ertools.benchmarks.legacy import LegacyBenchmark
 from ertools.configs.transform import LIVE_TRANSFORM_KEY, live_transform
 from ertools.errors import UsageError
 
@@ -360,7 +360,7 @@ segment cut short where the node's wait returned and divides the sums by N as 20
 same file at 40ba68b and 89dfa75): every 2015 behaviour at once, with the node's pose source
 (/tf world -> robot_at_home)."""
 
-BENCHMARK: Benchmark[Fbm2hOptions, Fbm2hLogs, Fbm2hRuns, Fbm2hResult] = Benchmark(
+BENCHMARK: LegacyBenchmark[Fbm2hOptions, Fbm2hLogs, Fbm2hRuns, Fbm2hResult] = LegacyBenchmark(
     name=NAME,
     title="FBM2@Home",
     summary="FBM2@Home navigation: waypoint errors",
