@@ -13,7 +13,6 @@ Topics:
 from __future__ import annotations
 
 from ertools.auditing.model import Audit
-from ertools.report.foxglove import content_function
 from ertools.report.foxglove.messages import (
     INFO,
     WARNING,
@@ -22,6 +21,7 @@ from ertools.report.foxglove.messages import (
     log,
     result_notes,
 )
+from ertools.report.foxglove.write import content_function
 
 RUN_SCHEMA = JsonSchema(
     "ertools.AuditRun",
