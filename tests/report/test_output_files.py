@@ -80,6 +80,7 @@ ALLOWED = {
     # a generated folder is built whole in a tempfile.mkdtemp folder, then put in place by
     # atomic.replace_folder; its bags by their writers, with O_EXCL
     ("samples/", ""): "inside a tempfile.mkdtemp folder",
+    ("simulator/", ""): "inside a tempfile.mkdtemp folder",
     ("api.py", ">>> _ = manifest.write_text("): "a docstring's example",
 }
 WRITE = re.compile(
