@@ -30,7 +30,7 @@ ALLOWED = frozenset(
         "ertools/report/figures.py: matplotlib.backends.backend_agg",
         "ertools/report/figures.py: matplotlib.figure",
         "ertools/report/figures.py: matplotlib.image",
-        "ertools/report/foxglove/messages.py: google.protobuf.descriptor_pb2",
+        "ertools/views/foxglove.py: google.protobuf.descriptor_pb2",
         "ertools/report/plots_timeline.py: matplotlib.dates x3",
         "ertools/report/plots_timeline.py: matplotlib.figure",
         "ertools/report/plots_timeline.py: matplotlib.patches",

@@ -12,7 +12,7 @@ from pathlib import Path
 from mcap.reader import make_reader
 
 from ertools.report.foxglove.mcapout import write_mcap
-from ertools.report.foxglove.messages import Channel, Collected
+from ertools.views.foxglove import Channel, Collected
 
 PACKAGE = Path(__file__).resolve().parents[2] / "ertools"
 TOPIC = "/ertools/note"

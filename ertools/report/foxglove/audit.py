@@ -13,7 +13,8 @@ Topics:
 from __future__ import annotations
 
 from ertools.auditing.model import Audit
-from ertools.report.foxglove.messages import (
+from ertools.report.foxglove.write import content_function
+from ertools.views.foxglove import (
     INFO,
     WARNING,
     Collected,
@@ -21,7 +22,6 @@ from ertools.report.foxglove.messages import (
     log,
     result_notes,
 )
-from ertools.report.foxglove.write import content_function
 
 RUN_SCHEMA = JsonSchema(
     "ertools.AuditRun",

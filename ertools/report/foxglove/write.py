@@ -22,8 +22,8 @@ from ertools._version import __version__
 from ertools.benchmarks import registry
 from ertools.errors import UsageError
 from ertools.report.foxglove.mcapout import refuse_inputs, write_mcap
-from ertools.report.foxglove.messages import Collected
 from ertools.serialize import jsonable
+from ertools.views.foxglove import Collected
 
 # ``module.Class`` of a result that is no registered benchmark's -> ``module:function``
 # adding its content to a Collected. Dotted names, not classes: nothing is imported until a
@@ -65,7 +65,8 @@ def content_function(result: Any) -> Callable[..., None] | None:
 
 
 def collect(result: Any, *, limit: int = STREAM_LIMIT) -> Any:
-    """The result's Foxglove messages (a :class:`messages.Collected`), not yet written."""
+    """The result's Foxglove messages, not yet written (an
+    :class:`ertools.views.foxglove.Collected`)."""
 
     fn = content_function(result)
     if fn is None:
