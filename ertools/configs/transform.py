@@ -287,8 +287,7 @@ def parse_transform(data: Any, source: str = "<transform>") -> MarkerTransform:
 
 
 def _check_inverse(tr: MarkerTransform, t_inv: Vec3, q_inv: Quat, source: str) -> None:
-    # lazy: scipy only where its rotations/statistics are needed (~0.3 s to import)
-    from scipy.spatial.transform import Rotation
+    from scipy.spatial.transform import Rotation  # lazy: scipy, 300 ms
 
     t_exp, q_exp = tr.inverse()
     dt = float(np.linalg.norm(np.subtract(t_exp, t_inv)))

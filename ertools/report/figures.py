@@ -116,9 +116,8 @@ _local = threading.local()
 def _canvas_figure(size: tuple[float, float]) -> Any:
     """This thread's figure of ``size`` inches, cleared, with its Agg canvas (created on first
     use; never pyplot, so no global state and no GUI backend)."""
-    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
+    from matplotlib.backends.backend_agg import FigureCanvasAgg  # lazy: matplotlib, 300 ms
+    from matplotlib.figure import Figure  # lazy: matplotlib, 300 ms
 
     figures: dict[tuple[float, float], Any] = getattr(_local, "figures", None) or {}
     _local.figures = figures
@@ -140,8 +139,7 @@ def preload() -> None:
 
 
 def _write_png(fig: Any, path: Path) -> None:
-    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
-    from matplotlib.image import imsave
+    from matplotlib.image import imsave  # lazy: matplotlib, 300 ms
 
     canvas = fig.canvas
     canvas.draw()  # runs the constrained layout, then renders: one pass
@@ -169,7 +167,7 @@ def save_one_file(specs: Sequence[Any], path: Path) -> Path:
         path.parent.mkdir(parents=True, exist_ok=True)
         write_text(path, svg.stack(panels))
         return path
-    from matplotlib.figure import Figure  # lazy: matplotlib only when a figure is drawn
+    from matplotlib.figure import Figure  # lazy: matplotlib, 300 ms
 
     width = max((s.size[0] for s in specs), default=6.0)
     height = sum(s.size[1] for s in specs) or 4.0

@@ -167,8 +167,7 @@ def _sample(changes: Sequence[tuple[int, Any]], ticks: np.ndarray) -> list[Any]:
 
 def _register_types(bag: BagWriter) -> None:
     """Add the RSBB message types to the writer's type store (once per store)."""
-    # lazy: rosbags only on the per-message path (~0.1 s to import)
-    from rosbags.typesys import get_types_from_msg
+    from rosbags.typesys import get_types_from_msg  # lazy: rosbags, 100 ms
 
     missing = {
         n: d for n, d in MSG_DEFINITIONS.items() if rosbags_name(n) not in bag.typestore.types

@@ -102,8 +102,7 @@ def descriptor_set(desc: Any) -> bytes:
     """
     name = desc.full_name
     if name not in _DESCRIPTOR_SETS:
-        # lazy: protobuf only for --foxglove
-        from google.protobuf.descriptor_pb2 import FileDescriptorSet
+        from google.protobuf.descriptor_pb2 import FileDescriptorSet  # lazy: protobuf, 50 ms
 
         fds = FileDescriptorSet()
         seen: set[str] = set()
