@@ -41,7 +41,7 @@ from ertools.samples.competition_files import (
 
 # The one helper the sample competition keeps private: its FBM1 answer errors per team.
 from ertools.samples.competition_schedule import _fbm1_errors
-from ertools.samples.scenario import EPOCH_2015, log_name
+from ertools.simulator.answers import EPOCH_2015, log_name
 from ertools.simulator.simulated import SimulatedRun
 
 NS = 1_000_000_000

@@ -117,7 +117,7 @@ def write_foxglove_option(result: Any, args: argparse.Namespace, inputs: list[Pa
     path: Path | None = getattr(args, "foxglove", None)
     if path is None:
         return
-    from ertools.report.foxglove import write_foxglove  # lazy: protobuf, 20-75 ms
+    from ertools.report.foxglove.write import write_foxglove  # lazy: protobuf, 20-75 ms
 
     written = write_foxglove(result, path, inputs=inputs)
     note(f"wrote {written.path} ({written.messages} messages on {len(written.counts)} topics)")

@@ -34,7 +34,7 @@ class SimulatedRun:
         bodies: body name -> what the mocap node published for it.
         configs: config file name -> text (goal, items, shapes, transform files).
         parameters, truth, expected, tolerance: the answers-file sections
-            (:func:`~ertools.samples.scenario.write_answers`).
+            (:func:`~ertools.simulator.answers.write_answers`).
     """
 
     benchmark: str

@@ -31,7 +31,7 @@ from ertools.benchmarks.fbm2h.config import Fbm2hOptions
 from ertools.benchmarks.trajectory.benchmark import score as score_trajectory
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.cli.main import main
-from ertools.report.foxglove import write_foxglove
+from ertools.report.foxglove.write import write_foxglove
 
 SAMPLES = Path(__file__).resolve().parents[2] / "sample_bags"
 FBM3W = SAMPLES / "fbm3w" / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"

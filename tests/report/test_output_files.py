@@ -12,7 +12,7 @@ from pathlib import Path
 from mcap.reader import make_reader
 
 from ertools.report.foxglove.mcapout import write_mcap
-from ertools.report.foxglove.messages import Channel, Collected
+from ertools.views.foxglove import Channel, Collected
 
 PACKAGE = Path(__file__).resolve().parents[2] / "ertools"
 TOPIC = "/ertools/note"
@@ -80,6 +80,7 @@ ALLOWED = {
     # a generated folder is built whole in a tempfile.mkdtemp folder, then put in place by
     # atomic.replace_folder; its bags by their writers, with O_EXCL
     ("samples/", ""): "inside a tempfile.mkdtemp folder",
+    ("simulator/", ""): "inside a tempfile.mkdtemp folder",
     ("api.py", ">>> _ = manifest.write_text("): "a docstring's example",
 }
 WRITE = re.compile(

@@ -15,7 +15,7 @@ from __future__ import annotations
 from ertools.auditing.model import Audit
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Reported
-from ertools.report.foxglove.messages import (
+from ertools.views.foxglove import (
     INFO,
     WARNING,
     Collected,
