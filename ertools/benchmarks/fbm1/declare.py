@@ -21,14 +21,17 @@ from ertools.benchmarks.base import (
     resolve_values,
     tf_value,
 )
-from ertools.benchmarks.common.ending import EXACT_HELP
+from ertools.benchmarks.common.inputs import (
+    EXACT_HELP,
+    INTERVAL_INPUTS,
+    SCORE_AS_2015,
+    unscoreable_input,
+)
 from ertools.benchmarks.common.interval_output import (
     IntervalSettings,
     ScoreRow,
     interval_lines,
 )
-from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS
-from ertools.benchmarks.common.validity import SCORE_AS_2015, unscoreable_input
 from ertools.benchmarks.fbm1.benchmark import score_found
 from ertools.benchmarks.fbm1.config import RULE_SETS, BodySources, Fbm1Options
 from ertools.benchmarks.fbm1.gt import GtOptions

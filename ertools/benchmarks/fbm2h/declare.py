@@ -19,9 +19,13 @@ from ertools.benchmarks.base import (
     resolve_values,
     tf_value,
 )
-from ertools.benchmarks.common.ending import EXACT_HELP
-from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS, check_confidence
-from ertools.benchmarks.common.validity import SCORE_AS_2015, unscoreable_input
+from ertools.benchmarks.common.inputs import (
+    EXACT_HELP,
+    INTERVAL_INPUTS,
+    SCORE_AS_2015,
+    check_confidence,
+    unscoreable_input,
+)
 from ertools.benchmarks.fbm2h.benchmark import score_found
 from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, NODES, RULE_SETS, Fbm2hOptions
 from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, load, locate_runs

@@ -8,11 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from ertools.benchmarks.common.uncertainty import (
-    DEFAULT_CONFIDENCE,
-    DEFAULT_DRAWS,
-    DEFAULT_SEED,
-)
+from ertools.benchmarks.common.inputs import DEFAULT_CONFIDENCE, DEFAULT_DRAWS, DEFAULT_SEED
 from ertools.benchmarks.noise.benchmark import (
     DEFAULT_C,
 )

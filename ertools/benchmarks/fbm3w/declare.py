@@ -20,9 +20,13 @@ from ertools.benchmarks.base import (
     resolve_values,
     tf_value,
 )
-from ertools.benchmarks.common.ending import EXACT_HELP
-from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS, check_confidence
-from ertools.benchmarks.common.validity import UNSCOREABLE_CHOICES, unscoreable_input
+from ertools.benchmarks.common.inputs import (
+    EXACT_HELP,
+    INTERVAL_INPUTS,
+    UNSCOREABLE_CHOICES,
+    check_confidence,
+    unscoreable_input,
+)
 from ertools.benchmarks.fbm3w.benchmark import Fbm3wLogs, load, locate_runs, score_found
 from ertools.benchmarks.fbm3w.config import RUN_MODES, Fbm3wOptions, options_2015
 from ertools.benchmarks.fbm3w.result import Fbm3wResult

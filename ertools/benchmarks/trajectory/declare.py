@@ -11,13 +11,12 @@ from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks.base import Input, Ranking, resolve_values
+from ertools.benchmarks.common.inputs import INTERVAL_INPUTS, unscoreable_input
 from ertools.benchmarks.common.interval_output import (
     IntervalSettings,
     ScoreRow,
     interval_lines,
 )
-from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS
-from ertools.benchmarks.common.validity import unscoreable_input
 from ertools.benchmarks.legacy import LegacyBenchmark
 from ertools.benchmarks.trajectory.benchmark import (
     TrajectoryLogs,
