@@ -234,7 +234,7 @@ def _configure_logging(verbose: int) -> None:
     level = logging.WARNING if verbose == 0 else logging.INFO if verbose == 1 else logging.DEBUG
 
     class _LowerLevel(logging.Formatter):
-        # "ertools: warning: ..." like the CLI's own notes (cli/common.note), not "WARNING";
+        # "ertools: warning: ..." like the CLI's own notes (cli/output.note), not "WARNING";
         # the record itself is left as is (other handlers may see it).
         def formatMessage(self, record: logging.LogRecord) -> str:  # noqa: N802 (logging's)
             record.message = printable(record.message)  # one line, whatever a path holds

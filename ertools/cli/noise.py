@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 from ertools.benchmarks.common.epsilon import noise_from_stream
 from ertools.benchmarks.common.sources import read_source, tf, topic
 from ertools.benchmarks.fbm3w.config import DEFAULT_FRAME, DEFAULT_TOPIC, FALLBACK_TOPIC
-from ertools.cli.common import write_plots
+from ertools.cli.emit import write_plots
 from ertools.cli.options import (
     add_output,
     add_plots,

@@ -17,12 +17,11 @@ from typing import Any
 
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import AnyBenchmark, Described, Input, Reported
-from ertools.benchmarks.scoring import score_execution
 from ertools.cli.command import Command, Delegate
-from ertools.cli.common import add_output_options, all_failed, emit_result
 from ertools.cli.groups import add_group_arguments, run_group
 from ertools.cli.options import deprecation_note
 from ertools.cli.output import note
+from ertools.cli.result_options import add_output_options
 from ertools.errors import UsageError
 
 GROUP_PROG = "ertools score"
@@ -219,6 +218,10 @@ def run(args: argparse.Namespace) -> int | Delegate:
     given = args.bags if isinstance(args.bags, list) else [args.bags, *args.more_bags]
     bags = _bags(bench, values, given)
     args.bags = bags
+    from ertools.benchmarks.document import all_failed  # lazy: NumPy, the scorer, 250 ms
+    from ertools.benchmarks.scoring import score_execution  # lazy: 250 ms
+    from ertools.cli.emit import emit_result  # lazy: the report, 300 ms
+
     scored = score_execution(bench, bags, values)  # what ertools.score calls
     result = scored.result
     inputs = list(bags)
