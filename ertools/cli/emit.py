@@ -16,7 +16,6 @@ from ertools.benchmarks.base import BenchmarkResult
 from ertools.benchmarks.common.teams import with_team
 from ertools.benchmarks.document import all_failed
 from ertools.cli.output import dump_json, note, write_text
-from ertools.report.figures import figure_specs, save_figures, save_one_file
 
 
 def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[Path]) -> int:
@@ -61,6 +60,8 @@ def write_plots_option(result: Any, args: argparse.Namespace) -> None:
     if getattr(args, "plot", None) is None and getattr(args, "plots", None) is None:
         return
     scored = getattr(result, "recomputed", None)
+    from ertools.report.figures import figure_specs  # lazy: the charts, 40 ms; --plot only
+
     write_plots(figure_specs(scored if scored is not None else result), args)
 
 
@@ -77,6 +78,8 @@ def write_foxglove_option(result: Any, args: argparse.Namespace, inputs: list[Pa
 
 def write_plots(specs: Sequence[Any], args: argparse.Namespace) -> list[Path]:
     """Write ``--plot FILE`` and ``--plots DIR`` of ``specs`` (:class:`FigureSpec`), when asked."""
+    from ertools.report.figures import save_figures, save_one_file  # lazy: 40 ms
+
     written: list[Path] = []
     one: Path | None = getattr(args, "plot", None)
     if one is not None:
