@@ -51,8 +51,9 @@ import numpy as np
 import yaml
 
 from ertools.atomic import replace_folder
+from ertools.benchmarks.fbm1 import sample as fbm1
 from ertools.errors import UsageError
-from ertools.samples import fbm1, fbm2h
+from ertools.samples import fbm2h
 from ertools.samples.competition_files import (
     GtWindow,
     organiser_manifest,

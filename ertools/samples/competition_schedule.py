@@ -12,7 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from ertools.samples import fbm1, fbm2h, fbm3w
+from ertools.benchmarks.fbm1 import sample as fbm1
+from ertools.samples import fbm2h, fbm3w
 from ertools.simulator.answers import EPOCH_2015
 from ertools.simulator.simulated import SimulatedRun
 
