@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from ertools.benchmarks.common.interval_output import IntervalSettings
+from ertools.benchmarks.common.inputs import IntervalSettings
 from ertools.benchmarks.fbm1.gt import (
     GtOptions,
 )

@@ -25,13 +25,10 @@ from ertools.benchmarks.common.inputs import (
     EXACT_HELP,
     INTERVAL_INPUTS,
     SCORE_AS_2015,
+    IntervalSettings,
     unscoreable_input,
 )
-from ertools.benchmarks.common.interval_output import (
-    IntervalSettings,
-    ScoreRow,
-    interval_lines,
-)
+from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
 from ertools.benchmarks.fbm1.benchmark import score_found
 from ertools.benchmarks.fbm1.config import RULE_SETS, BodySources, Fbm1Options
 from ertools.benchmarks.fbm1.gt import GtOptions

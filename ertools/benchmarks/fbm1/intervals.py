@@ -38,10 +38,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ertools.arrays import F64
+from ertools.benchmarks.common.inputs import IntervalSettings
 from ertools.benchmarks.common.interval_output import (
     METHOD,
     NO_INTERVALS,
-    IntervalSettings,
     ResultIntervals,
     shares_of,
 )
