@@ -38,7 +38,7 @@ from ertools.errors import UsageError
 
 SCENARIOS: dict[str, str] = {
     FBM3W: "ertools.samples.fbm3w:generate",
-    FBM2H: "ertools.samples.fbm2h:generate",
+    FBM2H: "ertools.benchmarks.fbm2h.sample:generate",
     FBM1[0]: "ertools.benchmarks.fbm1.sample:generate",
     "robotlog": "ertools.samples.robotlog:generate",
     "stationary": "ertools.samples.stationary:generate",
