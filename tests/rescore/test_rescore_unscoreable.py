@@ -4,10 +4,10 @@ of the tool."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
-from rescore_toy import TOY, ToyOptions, ToyResult
+from rescore_toy import Toy, ToyOptions, ToyResult
 
 from ertools.competition.jobs import Job, run_job
 
@@ -26,7 +26,16 @@ def _score_thin(loaded: list[float], runs: list[float], options: ToyOptions) -> 
     return ThinResult("thin", mean, len(runs), 0.0, unscoreable_reason=reason)
 
 
-THIN = replace(TOY, name="thin", score_runs=_score_thin)
+class Thin(Toy):
+    """The toy whose scorer says when its data is too thin."""
+
+    name = "thin"
+
+    def score_runs(self, loaded: list[float], runs: list[float], options: ToyOptions) -> ThinResult:
+        return _score_thin(loaded, runs, options)
+
+
+THIN = Thin()
 
 
 def _job(tmp_path: Path, numbers: str) -> Job:

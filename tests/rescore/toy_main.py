@@ -13,5 +13,5 @@ from ertools.benchmarks import registry
 from ertools.cli.main import main
 
 if __name__ == "__main__":
-    registry.REGISTRY = {"toy": "rescore_toy:TOY"}
+    registry.ENTRIES = (registry.Entry("toy", "rescore_toy:TOY", "a toy benchmark"),)
     raise SystemExit(main(sys.argv[1:]))

@@ -14,14 +14,13 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from ertools.benchmarks.common.uncertainty import (
+from ertools.benchmarks.common.inputs import (
     DEFAULT_CONFIDENCE,
     DEFAULT_DRAWS,
     DEFAULT_SEED,
-    Interval,
-    Uncertainty,
     check_confidence,
 )
+from ertools.benchmarks.common.uncertainty import Interval, Uncertainty
 
 #: The method named in the ``uncertainty`` block and on stderr.
 METHOD = "Monte Carlo over the sources, basic (bias-correcting) bootstrap interval"

@@ -228,7 +228,7 @@ class Fbm1Result:
     @property
     def nothing_scored(self) -> bool:
         """No run counted (scored, or without answer with score 0): no total is a number, so
-        the CLI prints only the failures (``ertools.cli.common.all_failed``)."""
+        the CLI prints only the failures (``ertools.benchmarks.document.all_failed``)."""
         return not any(r.status in ("scored", "no_answer") for r in self.runs)
 
     def validity_lines(self) -> list[str]:

@@ -3,9 +3,9 @@
 Each result type has a small content function turning it into
 Foxglove messages: paths as ``foxglove.PoseInFrame`` / ``foxglove.PosesInFrame``, targets,
 pairs and errors as ``foxglove.SceneUpdate``, states and notes as ``foxglove.Log``, and the
-numbers Foxglove plots on JSON topics. A benchmark names its own
-(:attr:`ertools.benchmarks.base.Benchmark.foxglove`); :data:`CONTENT` maps the class of the
-other results (the audit's) to theirs, so no shared code switches over benchmark names.
+numbers Foxglove plots on JSON topics. A benchmark gives its own
+(:meth:`ertools.benchmarks.base.Reported.foxglove`); an audit's is
+:mod:`ertools.report.foxglove.audit`, so no shared code switches over benchmark names.
 docs/foxglove.md lists every topic.
 """
 
@@ -14,23 +14,17 @@ from __future__ import annotations
 import json
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from importlib import import_module
 from pathlib import Path
 from typing import Any
 
 from ertools._version import __version__
+from ertools.auditing.model import Audit
 from ertools.benchmarks import registry
+from ertools.benchmarks.base import Reported
 from ertools.errors import UsageError
 from ertools.report.foxglove.mcapout import refuse_inputs, write_mcap
 from ertools.serialize import jsonable
 from ertools.views.foxglove import Collected
-
-# ``module.Class`` of a result that is no registered benchmark's -> ``module:function``
-# adding its content to a Collected. Dotted names, not classes: nothing is imported until a
-# file is written.
-CONTENT: dict[str, str] = {
-    "ertools.auditing.model.Audit": "ertools.report.foxglove.audit:content",
-}
 
 # Pose and error streams longer than this keep every k-th message, k = ceil(n / limit): an
 # hour of 100 Hz robot poses is 360 000 messages, more than a viewer needs.
@@ -50,18 +44,15 @@ class Written:
 
 
 def content_function(result: Any) -> Callable[..., None] | None:
-    """The content function the result's benchmark declares (or registered for its class),
-    None when there is none."""
-    cls = type(result)
-    target = CONTENT.get(f"{cls.__module__}.{cls.__qualname__}")
+    """The content function of the result's benchmark (of the audit, for an audit), None when
+    there is none."""
+    if isinstance(result, Audit):
+        from ertools.report.foxglove.audit import content  # lazy: the audit's messages, 10 ms
+
+        return content
     name = str(getattr(result, "name", ""))
-    if target is None and name in registry.names():
-        target = registry.get(name).foxglove
-    if not target:
-        return None
-    module, _, name = target.partition(":")
-    fn: Callable[..., None] = getattr(import_module(module), name)
-    return fn
+    bench = registry.get(name) if name in registry.names() else None
+    return bench.foxglove if isinstance(bench, Reported) else None
 
 
 def collect(result: Any, *, limit: int = STREAM_LIMIT) -> Any:
