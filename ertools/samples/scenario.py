@@ -41,7 +41,7 @@ SCENARIOS: dict[str, str] = {
     FBM2H: "ertools.benchmarks.fbm2h.sample:generate",
     FBM1[0]: "ertools.benchmarks.fbm1.sample:generate",
     "robotlog": "ertools.samples.robotlog:generate",
-    "stationary": "ertools.samples.stationary:generate",
+    "stationary": "ertools.benchmarks.noise.sample:generate",
     "timeline": "ertools.samples.timeline_folder:generate",
 }
 

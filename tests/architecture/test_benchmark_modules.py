@@ -13,12 +13,14 @@ ALLOWED = frozenset(
         "ertools/configs/fbm3w.py: named after a benchmark",
         "ertools/configs/shapes.py: named after a benchmark",
         "ertools/exporting/pairs.py: imports ertools.benchmarks.trajectory",
+        # the noise figures, named until noise is a registered benchmark (it was an import of
+        # report.plots_noise, which drew noise results: the same edge, now visible)
+        "ertools/report/figures.py: imports ertools.benchmarks.noise",
         "ertools/report/foxglove/fbm3w.py: imports ertools.benchmarks.fbm3w",
         "ertools/report/foxglove/fbm3w.py: named after a benchmark",
         "ertools/report/foxglove/trajectory.py: imports ertools.benchmarks.trajectory",
         "ertools/report/foxglove/trajectory.py: named after a benchmark",
         "ertools/report/plots_fbm3w.py: named after a benchmark",
-        "ertools/report/plots_noise.py: named after a benchmark",
         "ertools/report/plots_trajectory.py: imports ertools.benchmarks.trajectory",
         "ertools/report/plots_trajectory.py: named after a benchmark",
         "ertools/samples/fbm3w.py: named after a benchmark",
@@ -27,8 +29,6 @@ ALLOWED = frozenset(
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm1",
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm2h",
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm3w",
-        "ertools/samples/stationary.py: imports ertools.benchmarks.fbm3w",
-        "ertools/samples/stationary.py: named after a benchmark",
         "ertools/samples/timeline_folder.py: imports ertools.benchmarks.fbm2h",
     }
 )
