@@ -63,9 +63,9 @@ def _acquired(items: list[dict[str, Any]], rng: np.random.Generator) -> Any:
 
 def score(seed: int, draws: int) -> tuple[Any, Any]:
     """(the simulated execution, its score with intervals)."""
-    from ertools.benchmarks.common.interval_output import IntervalSettings
-    from ertools.benchmarks.fbm1.benchmark import score_fbm1
+    from ertools.benchmarks.common.inputs import IntervalSettings
     from ertools.benchmarks.fbm1.config import Fbm1Options
+    from ertools.benchmarks.fbm1.pipeline import score_fbm1
     from ertools.benchmarks.fbm1.runs import find_runs
     from ertools.benchmarks.fbm1.sample import item_list, simulate
     from ertools.simulator.statemachine import state_messages

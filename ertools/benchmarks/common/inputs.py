@@ -8,7 +8,9 @@ builds a benchmark's parser from these declarations without loading the scorers.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from typing import Any
 
 from ertools.benchmarks.base import FormerName, Input
 from ertools.errors import UsageError
@@ -66,6 +68,32 @@ def check_confidence(confidence: float) -> float:
     if not (math.isfinite(confidence) and 0.0 < confidence < 1.0):
         raise UsageError(f"--confidence {confidence}: give a level between 0 and 1, e.g. 0.95")
     return confidence
+
+
+@dataclass(frozen=True)
+class IntervalSettings:
+    """``--confidence``, ``--draws`` and ``--seed`` as one value (draws 0: no intervals)."""
+
+    draws: int = DEFAULT_DRAWS
+    seed: int = DEFAULT_SEED
+    confidence: float = DEFAULT_CONFIDENCE
+
+    @property
+    def enabled(self) -> bool:
+        return self.draws > 0
+
+    @staticmethod
+    def from_values(values: Mapping[str, Any]) -> IntervalSettings:
+        """From resolved input values (:data:`INTERVAL_INPUTS`); a level outside (0, 1) is a
+        usage error."""
+        confidence = values.get("confidence")
+        draws = values.get("draws")
+        seed = values.get("seed")
+        return IntervalSettings(
+            DEFAULT_DRAWS if draws is None else int(draws),
+            DEFAULT_SEED if seed is None else int(seed),
+            check_confidence(DEFAULT_CONFIDENCE if confidence is None else float(confidence)),
+        )
 
 
 #: ``unscoreable``'s values: ``null`` (default: the verdict ``unscoreable``, no score, the

@@ -25,17 +25,14 @@ from ertools.benchmarks.common.inputs import (
     EXACT_HELP,
     INTERVAL_INPUTS,
     SCORE_AS_2015,
+    IntervalSettings,
     unscoreable_input,
 )
-from ertools.benchmarks.common.interval_output import (
-    IntervalSettings,
-    ScoreRow,
-    interval_lines,
-)
-from ertools.benchmarks.fbm1.benchmark import score_found
+from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
 from ertools.benchmarks.fbm1.config import RULE_SETS, BodySources, Fbm1Options
 from ertools.benchmarks.fbm1.gt import GtOptions
 from ertools.benchmarks.fbm1.logs import Fbm1Logs, Fbm1Runs, load, locate_runs
+from ertools.benchmarks.fbm1.pipeline import score_found
 from ertools.benchmarks.fbm1.result import Fbm1Result
 from ertools.benchmarks.legacy import LegacyBenchmark
 from ertools.errors import ConfigError, UsageError

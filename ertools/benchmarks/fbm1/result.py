@@ -12,8 +12,8 @@ from ertools.benchmarks.common.interval_output import as_list, interval_tables, 
 from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, interval_keys
 from ertools.benchmarks.common.validity import Validity, cell
 from ertools.benchmarks.fbm1.answers import Answer
+from ertools.benchmarks.fbm1.formula import PoseErrors, Totals
 from ertools.benchmarks.fbm1.gt import GroundTruth
-from ertools.benchmarks.fbm1.score import PoseErrors, Totals
 from ertools.configs.items import Item
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames

@@ -11,12 +11,8 @@ from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks.base import Input, Ranking, resolve_values
-from ertools.benchmarks.common.inputs import INTERVAL_INPUTS, unscoreable_input
-from ertools.benchmarks.common.interval_output import (
-    IntervalSettings,
-    ScoreRow,
-    interval_lines,
-)
+from ertools.benchmarks.common.inputs import INTERVAL_INPUTS, IntervalSettings, unscoreable_input
+from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
 from ertools.benchmarks.legacy import LegacyBenchmark
 from ertools.benchmarks.trajectory.benchmark import (
     TrajectoryLogs,

@@ -55,10 +55,10 @@ import numpy.typing as npt
 from ertools.arrays import F64, IntArr
 from ertools.benchmarks.common.clocks import MIN_POSES, OffsetEstimate
 from ertools.benchmarks.common.epsilon import noise_from_stream
+from ertools.benchmarks.common.inputs import IntervalSettings
 from ertools.benchmarks.common.interval_output import (
     METHOD,
     NO_INTERVALS,
-    IntervalSettings,
     ResultIntervals,
     shares_of,
     withheld,

@@ -11,7 +11,7 @@ from fbm1_testkit import ITEMS_YAML, RunSpec, bodies, state_streams, write_bag, 
 from stderr_text import error_messages
 
 from ertools.benchmarks.fbm1.answers import parse_answer_payload
-from ertools.benchmarks.fbm1.benchmark import score_fbm1
+from ertools.benchmarks.fbm1.pipeline import score_fbm1
 from ertools.benchmarks.fbm1.runs import find_runs
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
