@@ -40,7 +40,7 @@ SCENARIOS: dict[str, str] = {
     FBM3W: "ertools.samples.fbm3w:generate",
     FBM2H: "ertools.benchmarks.fbm2h.sample:generate",
     FBM1[0]: "ertools.benchmarks.fbm1.sample:generate",
-    "robotlog": "ertools.samples.robotlog:generate",
+    "robotlog": "ertools.benchmarks.trajectory.sample:generate",
     "stationary": "ertools.benchmarks.noise.sample:generate",
     "timeline": "ertools.samples.timeline_folder:generate",
 }
