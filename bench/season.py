@@ -31,7 +31,8 @@ from typing import Any
 import numpy as np
 
 from ertools.benchmarks.fbm1 import sample as fbm1
-from ertools.samples import fbm2h, fbm3w
+from ertools.benchmarks.fbm2h import sample as fbm2h
+from ertools.samples import fbm3w
 from ertools.samples.competition_files import (
     GtWindow,
     robot_poses,

@@ -16,6 +16,7 @@ import argparse
 from pathlib import Path
 
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.pairs import trajectory_pair
 from ertools.cli.options import (
     add_pose_source,
     add_time_source,
@@ -28,12 +29,11 @@ from ertools.cli.options import (
 from ertools.cli.output import note, write_text
 from ertools.errors import UsageError
 from ertools.exporting.formats import FORMATS, format_poses, format_times
-from ertools.exporting.pairs import (
+from ertools.exporting.write import (
     KITTI_NEEDS_MATCHED,
     export_source,
     pair_paths,
     refuse_inputs,
-    trajectory_pair,
     write_pair,
 )
 from ertools.geometry import Association

@@ -59,7 +59,7 @@ def figure_specs(result: Any) -> list[FigureSpec]:
     if isinstance(bench, Reported):
         specs = bench.figures(result)
     elif name == "noise":  # not a registered benchmark (yet): `ertools noise`'s result
-        from ertools.report.plots_noise import figure_specs as noise_figures  # lazy: 300 ms
+        from ertools.benchmarks.noise.plots import figure_specs as noise_figures  # lazy: 300 ms
 
         specs = noise_figures(result)
     return [drawable(spec) for spec in specs]

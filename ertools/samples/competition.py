@@ -52,8 +52,8 @@ import yaml
 
 from ertools.atomic import replace_folder
 from ertools.benchmarks.fbm1 import sample as fbm1
+from ertools.benchmarks.fbm2h import sample as fbm2h
 from ertools.errors import UsageError
-from ertools.samples import fbm2h
 from ertools.samples.competition_files import (
     GtWindow,
     organiser_manifest,

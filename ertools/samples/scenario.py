@@ -38,10 +38,10 @@ from ertools.errors import UsageError
 
 SCENARIOS: dict[str, str] = {
     FBM3W: "ertools.samples.fbm3w:generate",
-    FBM2H: "ertools.samples.fbm2h:generate",
+    FBM2H: "ertools.benchmarks.fbm2h.sample:generate",
     FBM1[0]: "ertools.benchmarks.fbm1.sample:generate",
-    "robotlog": "ertools.samples.robotlog:generate",
-    "stationary": "ertools.samples.stationary:generate",
+    "robotlog": "ertools.benchmarks.trajectory.sample:generate",
+    "stationary": "ertools.benchmarks.noise.sample:generate",
     "timeline": "ertools.samples.timeline_folder:generate",
 }
 

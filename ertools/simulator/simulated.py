@@ -1,12 +1,11 @@
 """One simulated benchmark execution, before it is written to any file.
 
-The scenario modules (:mod:`ertools.benchmarks.fbm1.sample`, :mod:`~ertools.samples.fbm2h`,
-:mod:`~ertools.samples.fbm3w`) split into ``simulate(...) -> SimulatedRun`` (pure: the
-transitions, what the mocap node published, the configs' texts and the answers) and
-``generate(outdir, seed=...)``, which writes one log per execution as ``sample_bags/`` has it.
-The sample competition (:mod:`ertools.samples.competition`) writes the same simulated
-executions differently: states into the benchmark manager's logs, mocap into the GT logger's
-hourly files.
+The scenario modules of the 2015 benchmarks (``ertools.benchmarks.<fbm1|fbm2h|fbm3w>.sample``)
+split into ``simulate(...) -> SimulatedRun`` (pure: the transitions, what the mocap node
+published, the configs' texts and the answers) and ``generate(outdir, seed=...)``, which writes
+one log per execution as ``sample_bags/`` has it. The sample competition
+(:mod:`ertools.samples.competition`) writes the same simulated executions differently: states
+into the benchmark manager's logs, mocap into the GT logger's hourly files.
 """
 
 from __future__ import annotations

@@ -11,30 +11,17 @@ from archscan import ROOT, outside_benchmark_modules, plant, ratchet
 ALLOWED = frozenset(
     {
         "ertools/configs/fbm3w.py: named after a benchmark",
-        "ertools/configs/goal.py: named after a benchmark",
         "ertools/configs/shapes.py: named after a benchmark",
-        "ertools/configs/timing.py: named after a benchmark",
-        "ertools/exporting/pairs.py: imports ertools.benchmarks.trajectory",
-        "ertools/report/foxglove/fbm2h.py: imports ertools.benchmarks.fbm2h",
-        "ertools/report/foxglove/fbm2h.py: named after a benchmark",
+        # the noise figures, named until noise is a registered benchmark (it was an import of
+        # report.plots_noise, which drew noise results: the same edge, now visible)
+        "ertools/report/figures.py: imports ertools.benchmarks.noise",
         "ertools/report/foxglove/fbm3w.py: imports ertools.benchmarks.fbm3w",
         "ertools/report/foxglove/fbm3w.py: named after a benchmark",
-        "ertools/report/foxglove/trajectory.py: imports ertools.benchmarks.trajectory",
-        "ertools/report/foxglove/trajectory.py: named after a benchmark",
-        "ertools/report/plots_fbm2h.py: named after a benchmark",
         "ertools/report/plots_fbm3w.py: named after a benchmark",
-        "ertools/report/plots_noise.py: named after a benchmark",
-        "ertools/report/plots_trajectory.py: imports ertools.benchmarks.trajectory",
-        "ertools/report/plots_trajectory.py: named after a benchmark",
-        "ertools/samples/fbm2h.py: named after a benchmark",
         "ertools/samples/fbm3w.py: named after a benchmark",
-        "ertools/samples/robotlog.py: imports ertools.benchmarks.fbm2h",
-        "ertools/samples/robotlog.py: named after a benchmark",
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm1",
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm2h",
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm3w",
-        "ertools/samples/stationary.py: imports ertools.benchmarks.fbm3w",
-        "ertools/samples/stationary.py: named after a benchmark",
         "ertools/samples/timeline_folder.py: imports ertools.benchmarks.fbm2h",
     }
 )
@@ -55,7 +42,6 @@ def test_a_module_outside_its_package_is_found(tmp_path: Path) -> None:
             "ertools/report/plots_fbm9.py": "",
             "ertools/report/shared.py": "from ertools.benchmarks.fbm9.result import R\n",
             "ertools/report/common.py": "from ertools.benchmarks.common import gaps\n",
-            "ertools/samples/robotlog.py": "",
             "ertools/cli/score.py": "from ertools.benchmarks.fbm9 import declare\n",
             "ertools/samples/competition.py": "from ertools.benchmarks.fbm9 import sample\n",
             "ertools/samples/competition_x.py": "import ertools.benchmarks.fbm9.sample\n",
@@ -66,7 +52,6 @@ def test_a_module_outside_its_package_is_found(tmp_path: Path) -> None:
     assert outside_benchmark_modules(root) == {
         "ertools/report/plots_fbm9.py: named after a benchmark",
         "ertools/report/shared.py: imports ertools.benchmarks.fbm9",
-        "ertools/samples/robotlog.py: named after a benchmark",
         "ertools/samples/schedule.py: imports ertools.benchmarks.fbm9",
         "ertools/samples/competition_y.py: imports ertools.benchmarks.fbm9",
     }

@@ -17,9 +17,9 @@ from pathlib import Path
 import pytest
 from stderr_text import error_messages
 
+from ertools.benchmarks.fbm2h.goal import goal_from_payload
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_payload, parse_yaml
-from ertools.configs.goal import goal_from_payload
 from ertools.configs.mocap import load_mocap_config
 from ertools.errors import ConfigError
 

@@ -10,10 +10,10 @@ import pytest
 import yaml
 from report_fakes import FakeResult, fbm3w_like
 
+from ertools.benchmarks.fbm2h.sample import generate
 from ertools.cli.main import main
 from ertools.report.combine import load_entry
 from ertools.report.folder import write_report
-from ertools.samples.fbm2h import generate
 from ertools.streams import Provenance
 
 

@@ -98,7 +98,7 @@ def test_missing_scenario_module_is_an_error_naming_it(
     monkeypatch.setitem(SCENARIOS, "ghost", "ertools.samples.no_such_module:generate")
     with pytest.raises(ScenarioMissingError, match="no_such_module"):
         load_scenario("ghost")
-    monkeypatch.setitem(SCENARIOS, "ghost", "ertools.samples.stationary:nope")
+    monkeypatch.setitem(SCENARIOS, "ghost", "ertools.benchmarks.noise.sample:nope")
     assert main([str(tmp_path), "--only", "stationary"]) == 0
     # argparse choices were built from SCENARIOS at call time, so "ghost" is accepted.
     assert main([str(tmp_path / "x"), "--only", "ghost", "stationary"]) == 1

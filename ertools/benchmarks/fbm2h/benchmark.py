@@ -39,6 +39,7 @@ from ertools.benchmarks.common.validity import (
     valid_near,
 )
 from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, TF_2015, Fbm2hOptions
+from ertools.benchmarks.fbm2h.goal import GoalList
 from ertools.benchmarks.fbm2h.intervals import Moments, intervals, measure_model
 from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, invalid_warning, load, locate_runs
 from ertools.benchmarks.fbm2h.result import Fbm2hResult, SegmentResult
@@ -52,7 +53,6 @@ from ertools.benchmarks.fbm2h.rules import (
 )
 from ertools.benchmarks.fbm2h.score import robot_poses_at, segment_errors
 from ertools.benchmarks.fbm2h.segments import ReachedMoments
-from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
 from ertools.errors import ConfigError, SegmentationError
 from ertools.fidelity import Deviation

@@ -14,8 +14,8 @@ from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
 from ertools.benchmarks.common.uncertainty import Interval, uncertainty_rows
 from ertools.benchmarks.common.validity import GapOnPath, Validity, cell
+from ertools.benchmarks.fbm2h.goal import GoalList
 from ertools.benchmarks.fbm2h.intervals import Fbm2hIntervals
-from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames

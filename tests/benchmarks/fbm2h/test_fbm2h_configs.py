@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from ertools.benchmarks.fbm2h.goal import goal_from_payload, parse_goal
+from ertools.benchmarks.fbm2h.timing import parse_timing
 from ertools.configs._yaml import parse_yaml
-from ertools.configs.goal import goal_from_payload, parse_goal
-from ertools.configs.timing import parse_timing
 from ertools.configs.transform import (
     MarkerTransform,
     load_transform,

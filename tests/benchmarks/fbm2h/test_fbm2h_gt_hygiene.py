@@ -13,9 +13,9 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from ertools.benchmarks.fbm2h.benchmark import compute
+from ertools.benchmarks.fbm2h.goal import GoalList
 from ertools.benchmarks.fbm2h.segments import from_states, unreached_reasons
 from ertools.cli.main import main
-from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
 from ertools.io.reader import read_poses
 from ertools.simulator.writer import BagWriter

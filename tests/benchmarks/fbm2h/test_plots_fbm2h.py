@@ -10,8 +10,8 @@ import svg_figure
 from matplotlib.figure import Figure
 
 from ertools.benchmarks.fbm2h.benchmark import compute
+from ertools.benchmarks.fbm2h.goal import GoalList
 from ertools.benchmarks.fbm2h.segments import ReachedMoments
-from ertools.configs.goal import GoalList
 from ertools.configs.transform import identity_transform
 from ertools.report.figures import figure_specs, save_figures
 from ertools.streams import PoseStream

@@ -27,6 +27,10 @@ EXCEPTIONS: dict[str, str] = {
     "ertools/samples/": "the sample generator simulates the 2015 logs of named benchmarks (a "
     "competition's schedule, scenario folders named after them): names there are data, not "
     "a dispatch over benchmarks",
+    "ertools/benchmarks/noise/sample.py": "the simulated 2015 noise recording is on FBM3@Work's "
+    "topics (/fbm3w/...): a namespace in a log's topic names is data",
+    "ertools/benchmarks/trajectory/sample.py": "the simulated 2015 GT logger recorded FBM2@Home's "
+    "marker set (/fbm2h/...): a namespace in a log's topic names is data",
 }
 
 

@@ -11,8 +11,8 @@ import pytest
 from stderr_text import error_messages
 from trajectory_helpers import write_gt, write_robot
 
+from ertools.benchmarks.trajectory.sample import GT_TOPIC, ROBOT_TOPIC
 from ertools.cli.main import main
-from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC
 
 T0 = 1_448_013_600 * 1_000_000_000
 

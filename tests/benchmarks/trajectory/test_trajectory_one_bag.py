@@ -22,9 +22,9 @@ from trajectory_helpers import read_back
 from ertools.benchmarks.trajectory.association import COMPARED
 from ertools.benchmarks.trajectory.benchmark import score
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.sample import GT_TOPIC, ROBOT_TOPIC
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
-from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC
 from ertools.simulator.writer import BagWriter
 
 FORMATS = {"ros1": "bag", "mcap": "mcap"}

@@ -16,9 +16,9 @@ from trajectory_helpers import read_back, write_gt, yaw
 import ertools.benchmarks.trajectory.inputs as tr
 from ertools.benchmarks.trajectory.benchmark import score
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.sample import GT_TOPIC, ROBOT_TOPIC, expected_scores, truth_at
 from ertools.cli.main import main
 from ertools.io.reader import read_poses
-from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC, expected_scores, truth_at
 
 KEYS = ("compared", "gaps", "tracking_lost", "uncovered")
 ERRORS = ("position_error", "orientation_error", "rmse", "median", "max")
