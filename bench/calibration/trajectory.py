@@ -6,7 +6,7 @@ and white noise) at 10 Hz on a clock running 0.35 s ahead of the GT's; the mocap
 pose at 120 Hz in two files with a gap and two tracking losses. Everything is drawn from the seed.
 The log is scored as the sample is (``--offset auto --apply-offset``: the clock audit estimates the
 offset and the score uses it) by the pure scorer :func:`~ertools.
-benchmarks.trajectory.scoring.score_streams`, intervals included.
+benchmarks.trajectory.comparison.score_streams`, intervals included.
 
 The true noiseless score is the score of the same log without the mocap's measurement noise
 (each message's pose minus the noise the simulator added, a repeat repeating its truth,
@@ -136,8 +136,8 @@ def true_scores(truth: Any) -> dict[str, float]:
 def score(seed: int, draws: int) -> tuple[Any, dict[str, float]]:
     """(the result with intervals, the true noiseless scores)."""
     from ertools.benchmarks.common.inputs import IntervalSettings
+    from ertools.benchmarks.trajectory.comparison import score_streams
     from ertools.benchmarks.trajectory.config import TrajectoryConfig
-    from ertools.benchmarks.trajectory.scoring import score_streams
 
     robot, gt, truth = simulate(seed)
     config = TrajectoryConfig(auto_offset=True, apply_offset=True)

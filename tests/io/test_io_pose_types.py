@@ -18,7 +18,7 @@ import pytest
 from mcap.reader import make_reader
 from rosbags.highlevel import AnyReader
 
-from ertools.benchmarks.trajectory.inputs import read_robot
+from ertools.benchmarks.trajectory.logs import read_robot
 from ertools.cli.main import main
 from ertools.errors import TopicError
 from ertools.io.info import describe

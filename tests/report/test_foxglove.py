@@ -28,8 +28,8 @@ from stderr_text import error_messages
 
 from ertools.benchmarks.fbm2h.benchmark import score_fbm2h
 from ertools.benchmarks.fbm2h.config import Fbm2hOptions
-from ertools.benchmarks.trajectory.benchmark import score as score_trajectory
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.pipeline import score as score_trajectory
 from ertools.cli.main import main
 from ertools.report.foxglove.write import write_foxglove
 

@@ -56,7 +56,7 @@ class TrajectoryConfig:
             ``max_gap_ns`` and the tracking-lost rule then do not apply. None: ertools' rule.
         unscoreable: a comparison with too few valid pairs is ``unscoreable``, its statistics
             null (``null``), or scored from them with a warning (``2015``); see
-            :mod:`ertools.benchmarks.trajectory.scoring`.
+            :mod:`ertools.benchmarks.trajectory.comparison`.
     """
 
     association: Association = "linear"

@@ -14,13 +14,6 @@ from ertools.benchmarks.base import Input, Ranking, resolve_values
 from ertools.benchmarks.common.inputs import INTERVAL_INPUTS, IntervalSettings, unscoreable_input
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
 from ertools.benchmarks.legacy import LegacyBenchmark
-from ertools.benchmarks.trajectory.benchmark import (
-    TrajectoryLogs,
-    TrajectoryOptions,
-    load,
-    locate_runs,
-    score_found,
-)
 from ertools.benchmarks.trajectory.config import (
     ASSOCIATIONS,
     BEFORE_GT,
@@ -29,6 +22,13 @@ from ertools.benchmarks.trajectory.config import (
     SETTINGS_2015,
     TIES,
     TrajectoryConfig,
+)
+from ertools.benchmarks.trajectory.pipeline import (
+    TrajectoryLogs,
+    TrajectoryOptions,
+    load,
+    locate_runs,
+    score_found,
 )
 from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.errors import ConfigError, UsageError

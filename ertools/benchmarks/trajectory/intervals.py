@@ -1,6 +1,6 @@
 """Confidence intervals of the trajectory statistics (issue 28).
 
-Every statistic of :mod:`ertools.benchmarks.trajectory.metrics` (the mean 3D distance, RMSE,
+Every statistic of :mod:`ertools.benchmarks.trajectory.formula` (the mean 3D distance, RMSE,
 median, max and percentiles, the orientation errors) is re-computed ``draws`` times with the GT
 side of each compared pair perturbed by two sources, vectorised over (draws, poses):
 
@@ -74,7 +74,7 @@ from ertools.benchmarks.common.uncertainty import (
     too_few,
 )
 from ertools.benchmarks.trajectory.association import COMPARED, Matched
-from ertools.benchmarks.trajectory.metrics import PERCENTILES, Metrics, metrics
+from ertools.benchmarks.trajectory.formula import PERCENTILES, Metrics, metrics
 from ertools.errors import ErtoolsError
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S

@@ -20,8 +20,8 @@ import numpy as np
 
 from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid
 from ertools.benchmarks.trajectory.association import COMPARED
-from ertools.benchmarks.trajectory.benchmark import score
-from ertools.benchmarks.trajectory.inputs import read_gt
+from ertools.benchmarks.trajectory.logs import read_gt
+from ertools.benchmarks.trajectory.pipeline import score
 from ertools.errors import ClockError, ScoringError
 from ertools.geometry import interpolate_poses
 from ertools.io.text import is_text_trajectory, read_text_poses
@@ -67,7 +67,7 @@ def trajectory_pair(
 ) -> PairExport:
     """The robot and GT streams ``score trajectory`` compares with these settings.
 
-    The scoring itself runs (:func:`ertools.benchmarks.trajectory.benchmark.score`), so the files,
+    The scoring itself runs (:func:`ertools.benchmarks.trajectory.pipeline.score`), so the files,
     topics, offset and association are exactly the ones of the score; the GT is then read
     again (the result keeps only a decimated copy) around the robot poses and cleaned the
     same way (samples recorded twice, NaN or zero quaternions dropped).

@@ -25,8 +25,8 @@ from ertools.benchmarks.trajectory.association import (
     Matched,
 )
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.formula import Metrics
 from ertools.benchmarks.trajectory.intervals import KEYS
-from ertools.benchmarks.trajectory.metrics import Metrics
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames
 from ertools.serialize import dump_yaml, jsonable

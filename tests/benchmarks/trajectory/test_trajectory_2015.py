@@ -25,8 +25,8 @@ from stderr_text import error_messages
 from trajectory_helpers import read_back, write_gt, write_robot
 
 from ertools.benchmarks.trajectory.association import yaw_tf
+from ertools.benchmarks.trajectory.comparison import score_streams
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
-from ertools.benchmarks.trajectory.scoring import score_streams
 from ertools.cli.main import main
 from ertools.errors import ClockError
 from ertools.simulator.writer import BagWriter

@@ -20,8 +20,8 @@ from test_trajectory_sample import check
 from trajectory_helpers import read_back
 
 from ertools.benchmarks.trajectory.association import COMPARED
-from ertools.benchmarks.trajectory.benchmark import score
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.pipeline import score
 from ertools.benchmarks.trajectory.sample import GT_TOPIC, ROBOT_TOPIC
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw

@@ -23,9 +23,9 @@ from ertools.benchmarks.trajectory.association import (
     UNCOVERED,
     associate,
 )
+from ertools.benchmarks.trajectory.comparison import check_increasing, score_streams
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
-from ertools.benchmarks.trajectory.metrics import metrics
-from ertools.benchmarks.trajectory.scoring import check_increasing, score_streams
+from ertools.benchmarks.trajectory.formula import metrics
 from ertools.errors import ClockError, ConfigError, ScoringError
 from ertools.geometry import quat_from_yaw
 from ertools.streams import PoseStream

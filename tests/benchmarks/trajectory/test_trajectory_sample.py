@@ -13,9 +13,9 @@ import yaml
 from stderr_text import error_messages
 from trajectory_helpers import read_back, write_gt, yaw
 
-import ertools.benchmarks.trajectory.inputs as tr
-from ertools.benchmarks.trajectory.benchmark import score
+import ertools.benchmarks.trajectory.logs as tr
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.pipeline import score
 from ertools.benchmarks.trajectory.sample import GT_TOPIC, ROBOT_TOPIC, expected_scores, truth_at
 from ertools.cli.main import main
 from ertools.io.reader import read_poses

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 import svg_figure
 
+from ertools.benchmarks.trajectory.comparison import MIN_VALID_FRACTION, score_streams
 from ertools.benchmarks.trajectory.config import SETTINGS_2015, TrajectoryConfig
-from ertools.benchmarks.trajectory.scoring import MIN_VALID_FRACTION, score_streams
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
 from ertools.report.figures import figure_specs, render

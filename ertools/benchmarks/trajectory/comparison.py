@@ -46,8 +46,8 @@ from ertools.benchmarks.trajectory.association import (
     associate_evo,
 )
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.formula import Metrics, metrics
 from ertools.benchmarks.trajectory.intervals import Rescoring, trajectory_intervals
-from ertools.benchmarks.trajectory.metrics import Metrics, metrics
 from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.benchmarks.trajectory.rules import (
     RULE_ASSOCIATION,

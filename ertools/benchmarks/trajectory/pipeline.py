@@ -13,7 +13,7 @@ Shape: load (robot stream, GT files selected by time overlap, read as one stream
 ``metrics`` -> frozen :class:`~ertools.benchmarks.trajectory.result.TrajectoryResult`
 (``result``). The settings are in ``config``, the 2015 rules in ``rules``. The clock audit
 (:mod:`ertools.benchmarks.common.clocks`) runs every time.
-:func:`~ertools.benchmarks.trajectory.scoring.score_streams` is pure; :func:`score` is the IO
+:func:`~ertools.benchmarks.trajectory.comparison.score_streams` is pure; :func:`score` is the IO
 edge.
 """
 
@@ -28,8 +28,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ertools.benchmarks.common.inputs import IntervalSettings
+from ertools.benchmarks.trajectory.comparison import score_streams
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
-from ertools.benchmarks.trajectory.inputs import (
+from ertools.benchmarks.trajectory.logs import (
     find_gt_files,
     pick_gt_in_robot_bag,
     pick_robot_topic,
@@ -41,7 +42,6 @@ from ertools.benchmarks.trajectory.inputs import (
 )
 from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.benchmarks.trajectory.rules import RULE_GT_OVERLAP
-from ertools.benchmarks.trajectory.scoring import score_streams
 from ertools.errors import ClockError, ScoringError, UsageError
 from ertools.io.summary import summary
 from ertools.io.text import is_text_trajectory, read_text_poses
