@@ -20,16 +20,15 @@ edge.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from itertools import pairwise
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ertools.benchmarks.common.inputs import IntervalSettings
 from ertools.benchmarks.trajectory.comparison import score_streams
-from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.config import TrajectoryConfig, TrajectoryOptions
 from ertools.benchmarks.trajectory.logs import (
     find_gt_files,
     pick_gt_in_robot_bag,
@@ -50,32 +49,6 @@ from ertools.timeutil import NS_PER_S, iso_utc, ns_to_s
 
 if TYPE_CHECKING:
     from ertools.io.model import BagSummary
-
-
-@dataclass(frozen=True)
-class TrajectoryOptions:
-    """Everything ``ertools score trajectory`` can be told: how to compare (``config``) and
-    where the poses are.
-
-    Attributes:
-        config: association, gaps, offset, coverage (:class:`TrajectoryConfig`).
-        robot_topic: the robot's pose of its marker set (None: the one
-            ``/rockin/*/marker_pose``).
-        gt_topic: the mocap pose of that marker set (None: the one PoseStamped topic).
-        robot_time: ``header`` (message stamps) or ``record`` (the robot bag's record time).
-        gt_time: the same for the GT (``--time-source`` sets both).
-        input_format: ``tum``, ``kitti``, ``euroc``, ``csv`` or ``bag`` for every input
-            (``--input-format``); None: detected by content (:func:`ertools.io.text.sniff`).
-        intervals: level, draws and seed of the statistics' confidence intervals.
-    """
-
-    config: TrajectoryConfig = field(default_factory=TrajectoryConfig)
-    robot_topic: str | None = None
-    gt_topic: str | None = None
-    robot_time: str = "header"
-    gt_time: str = "header"
-    input_format: str | None = None
-    intervals: IntervalSettings = field(default_factory=IntervalSettings)
 
 
 @dataclass(frozen=True, eq=False)
@@ -313,12 +286,12 @@ def load_text(
     )
 
 
-def locate_runs(logs: TrajectoryLogs, options: TrajectoryOptions) -> None:
+def find_runs(logs: TrajectoryLogs, options: TrajectoryOptions) -> None:
     """Nothing to find: the whole robot log is the one run compared."""
     return None
 
 
-def score_found(logs: TrajectoryLogs, runs: None, options: TrajectoryOptions) -> TrajectoryResult:
+def score_runs(logs: TrajectoryLogs, runs: None, options: TrajectoryOptions) -> TrajectoryResult:
     """Compare the robot stream with the GT stream (:func:`score_streams`).
 
     Raises:
@@ -379,10 +352,10 @@ def score(
     input_format: str | None = None,
 ) -> TrajectoryResult:
     """Score a robot log against the GT files (or folders of them) that cover it: load ->
-    compare (see :func:`load`, :func:`score_found`)."""
+    compare (see :func:`load`, :func:`score_runs`)."""
     options = TrajectoryOptions(
         config or TrajectoryConfig(), robot_topic, gt_topic, robot_time, gt_time, input_format
     )
     logs = load([robot_bag, *gt_paths], options)
-    locate_runs(logs, options)  # one run: the whole robot log
-    return score_found(logs, None, options)
+    find_runs(logs, options)  # one run: the whole robot log
+    return score_runs(logs, None, options)
