@@ -9,7 +9,7 @@ import yaml
 
 from ertools.benchmarks.fbm1.pipeline import score_fbm1_bag
 from ertools.benchmarks.fbm3w.benchmark import score_fbm3w
-from ertools.configs.fbm3w import Fbm3wConfig
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.progress import reporting
 
 S = Path(__file__).resolve().parents[2] / "sample_bags"

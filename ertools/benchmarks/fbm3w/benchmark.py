@@ -69,7 +69,7 @@ from ertools.benchmarks.fbm3w.runs import (
     find_windows,
     with_specs,
 )
-from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
+from ertools.benchmarks.fbm3w.settings import DEFAULT_D_MIN, Fbm3wConfig
 from ertools.errors import ConfigError, ScoringError
 from ertools.fidelity import Deviation
 from ertools.io.clock import check_header_clock
