@@ -8,8 +8,7 @@ from __future__ import annotations
 import numpy as np
 from fbm1_testkit import ITEMS_YAML, T0, RunSpec, S, bodies, run_start_s, state_streams
 
-from ertools.benchmarks.fbm1.config import Fbm1Options
-from ertools.benchmarks.fbm1.formula import ScoreRules
+from ertools.benchmarks.fbm1.config import Fbm1Options, ScoreRules
 from ertools.benchmarks.fbm1.pipeline import score_fbm1
 from ertools.benchmarks.fbm1.runs import find_runs
 from ertools.configs._yaml import parse_yaml
