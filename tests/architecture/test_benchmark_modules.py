@@ -16,7 +16,6 @@ ALLOWED = frozenset(
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm1",
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm2h",
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm3w",
-        "ertools/samples/timeline_folder.py: imports ertools.benchmarks.fbm2h",
     }
 )
 
