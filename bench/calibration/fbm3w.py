@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 from ertools.benchmarks.fbm3w import sample as sim_fbm3w
-from ertools.benchmarks.fbm3w.benchmark import score_runs
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
+from ertools.benchmarks.fbm3w.pipeline import score_runs
 from ertools.benchmarks.fbm3w.runs import RunWindow
 from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.streams import PoseStream

@@ -8,7 +8,7 @@ from pathlib import Path
 import yaml
 
 from ertools.benchmarks import registry
-from ertools.benchmarks.fbm3w.benchmark import score_fbm3w
+from ertools.benchmarks.fbm3w.pipeline import score_fbm3w
 from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.benchmarks.scoring import score_execution
 from ertools.progress import reporting

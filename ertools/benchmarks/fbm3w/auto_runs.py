@@ -26,7 +26,7 @@ from ertools.benchmarks.common.phases import (
     Track,
     protocol_track,
 )
-from ertools.benchmarks.fbm3w.path import subsample_d_min
+from ertools.benchmarks.fbm3w.formula import subsample_d_min
 from ertools.benchmarks.fbm3w.runs import RunWindow
 from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.benchmarks.fbm3w.shapes import Shape

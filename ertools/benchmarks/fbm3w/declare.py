@@ -27,8 +27,8 @@ from ertools.benchmarks.common.inputs import (
     check_confidence,
     unscoreable_input,
 )
-from ertools.benchmarks.fbm3w.benchmark import Fbm3wLogs, load, locate_runs, score_found
 from ertools.benchmarks.fbm3w.config import RUN_MODES, Fbm3wOptions, options_2015
+from ertools.benchmarks.fbm3w.pipeline import Fbm3wLogs, load, locate_runs, score_found
 from ertools.benchmarks.fbm3w.result import Fbm3wResult
 from ertools.benchmarks.fbm3w.runs import RunWindow, parse_run_spec, parse_runs_file
 from ertools.benchmarks.fbm3w.settings import check_d_min, load_fbm3w_config

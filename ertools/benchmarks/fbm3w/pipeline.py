@@ -2,7 +2,7 @@
 
 :func:`score_fbm3w` reads bags through :mod:`ertools.io` and calls :func:`score_runs`, which
 is pure (pose stream + run windows + config -> :class:`Fbm3wResult`). The scoring itself is in
-:mod:`ertools.benchmarks.fbm3w.path`, run finding in :mod:`ertools.benchmarks.fbm3w.runs`.
+:mod:`ertools.benchmarks.fbm3w.formula`, run finding in :mod:`ertools.benchmarks.fbm3w.runs`.
 """
 
 from __future__ import annotations
@@ -49,8 +49,8 @@ from ertools.benchmarks.fbm3w.config import (
     NAMESPACE,
     Fbm3wOptions,
 )
+from ertools.benchmarks.fbm3w.formula import score_path, shape_floor, try_score
 from ertools.benchmarks.fbm3w.intervals import with_intervals
-from ertools.benchmarks.fbm3w.path import score_path, shape_floor, try_score
 from ertools.benchmarks.fbm3w.result import Fbm3wResult, RunResult
 from ertools.benchmarks.fbm3w.rules import (
     RULE_ARC_LENGTH,
@@ -79,7 +79,7 @@ from ertools.io.summary import summary
 from ertools.progress import Reporter, current
 from ertools.streams import PoseStream, Provenance
 
-log = logging.getLogger("ertools.benchmarks.fbm3w.benchmark")
+log = logging.getLogger("ertools.benchmarks.fbm3w.pipeline")
 
 # The reference pose is the last sample at or before the reference time; older than this, the
 # marker set was probably not tracked at that moment.
