@@ -28,7 +28,8 @@ from ertools.benchmarks.common.inputs import (
     unscoreable_input,
 )
 from ertools.benchmarks.fbm3w.config import RUN_MODES, Fbm3wOptions, options_2015
-from ertools.benchmarks.fbm3w.pipeline import Fbm3wLogs, load, locate_runs, score_found
+from ertools.benchmarks.fbm3w.logs import Fbm3wLogs
+from ertools.benchmarks.fbm3w.pipeline import load, locate_runs, score_found
 from ertools.benchmarks.fbm3w.result import Fbm3wResult
 from ertools.benchmarks.fbm3w.runs import RunWindow, parse_run_spec, parse_runs_file
 from ertools.benchmarks.fbm3w.settings import check_d_min, load_fbm3w_config
