@@ -32,7 +32,7 @@ import numpy as np
 
 from ertools.benchmarks.fbm1 import sample as fbm1
 from ertools.benchmarks.fbm2h import sample as fbm2h
-from ertools.samples import fbm3w
+from ertools.benchmarks.fbm3w import sample as fbm3w
 from ertools.samples.competition_files import (
     GtWindow,
     robot_poses,

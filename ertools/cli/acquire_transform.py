@@ -14,7 +14,7 @@ from pathlib import Path
 
 from ertools.atomic import write_text as write_file
 from ertools.benchmarks.common.sources import read_source, topic
-from ertools.benchmarks.fbm2h.transform import acquire_transform, check_team_name
+from ertools.benchmarks.fbm2h.acquire import acquire_transform, check_team_name
 from ertools.cli.options import (
     add_out_dir,
     add_pose_source,

@@ -14,7 +14,7 @@ from typing import Any
 
 from ertools.benchmarks.fbm1 import sample as fbm1
 from ertools.benchmarks.fbm2h import sample as fbm2h
-from ertools.samples import fbm3w
+from ertools.benchmarks.fbm3w import sample as fbm3w
 from ertools.simulator.answers import EPOCH_2015
 from ertools.simulator.simulated import SimulatedRun
 

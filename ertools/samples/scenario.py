@@ -37,7 +37,7 @@ from ertools.benchmarks.fbm3w.config import NAMESPACE as FBM3W
 from ertools.errors import UsageError
 
 SCENARIOS: dict[str, str] = {
-    FBM3W: "ertools.samples.fbm3w:generate",
+    FBM3W: "ertools.benchmarks.fbm3w.sample:generate",
     FBM2H: "ertools.benchmarks.fbm2h.sample:generate",
     FBM1[0]: "ertools.benchmarks.fbm1.sample:generate",
     "robotlog": "ertools.benchmarks.trajectory.sample:generate",

@@ -37,7 +37,6 @@ from pathlib import Path
 import numpy as np
 
 from ertools.arrays import I64
-from ertools.benchmarks.fbm2h.config import NAMESPACE as FBM2H
 from ertools.geometry import quat_from_yaw
 from ertools.simulator.answers import EPOCH_2015, log_name, tol, write_answers
 from ertools.simulator.mocap import FRAME_NS
@@ -46,6 +45,7 @@ from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
 NS = 1_000_000_000
 T0 = EPOCH_2015 + 5 * 3600 * NS  # 15:00 UTC
+FBM2H = "fbm2h"  # the namespace of the FBM2@Home logs this folder holds: data
 GT_TOPIC = "/fbm2h/robot_at_home/pose"
 WORK_TOPIC = "/fbm3w/robot_at_work/pose"
 ROBOT_TOPIC = "/rockin/homer/marker_pose"

@@ -10,19 +10,12 @@ from archscan import ROOT, outside_benchmark_modules, plant, ratchet
 
 ALLOWED = frozenset(
     {
-        "ertools/configs/fbm3w.py: named after a benchmark",
-        "ertools/configs/shapes.py: named after a benchmark",
         # the noise figures, named until noise is a registered benchmark (it was an import of
         # report.plots_noise, which drew noise results: the same edge, now visible)
         "ertools/report/figures.py: imports ertools.benchmarks.noise",
-        "ertools/report/foxglove/fbm3w.py: imports ertools.benchmarks.fbm3w",
-        "ertools/report/foxglove/fbm3w.py: named after a benchmark",
-        "ertools/report/plots_fbm3w.py: named after a benchmark",
-        "ertools/samples/fbm3w.py: named after a benchmark",
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm1",
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm2h",
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm3w",
-        "ertools/samples/timeline_folder.py: imports ertools.benchmarks.fbm2h",
     }
 )
 

@@ -8,9 +8,9 @@ from pathlib import Path
 import yaml
 
 from ertools.benchmarks import registry
-from ertools.benchmarks.fbm3w.benchmark import score_fbm3w
+from ertools.benchmarks.fbm3w.pipeline import score_fbm3w
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.benchmarks.scoring import score_execution
-from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.progress import reporting
 
 S = Path(__file__).resolve().parents[2] / "sample_bags"

@@ -32,7 +32,7 @@ from ertools.benchmarks.common.ending import (
     refbox_ends,
 )
 from ertools.benchmarks.fbm1.runs import find_runs
-from ertools.benchmarks.fbm2h.segments import from_states
+from ertools.benchmarks.fbm2h.runs import from_states
 from ertools.benchmarks.fbm3w.runs import find_states
 from ertools.io.model import BenchmarkStates
 from ertools.states import (

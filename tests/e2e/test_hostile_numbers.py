@@ -12,9 +12,9 @@ from pathlib import Path
 import pytest
 from stderr_text import error_messages
 
+from ertools.benchmarks.fbm3w.shapes import compile_expression
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
-from ertools.configs.shapes import compile_expression
 from ertools.errors import ConfigError
 from ertools.yamlin import MAX_DEPTH
 

@@ -26,8 +26,8 @@ from foxglove_readback import ReadBack, read_back, stamp_ns
 from rosbags.highlevel import AnyReader
 from stderr_text import error_messages
 
-from ertools.benchmarks.fbm2h.benchmark import score_fbm2h
 from ertools.benchmarks.fbm2h.config import Fbm2hOptions
+from ertools.benchmarks.fbm2h.pipeline import score_fbm2h
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.benchmarks.trajectory.pipeline import score as score_trajectory
 from ertools.cli.main import main

@@ -10,7 +10,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ertools.benchmarks.common.inputs import DEFAULT_CONFIDENCE, DEFAULT_DRAWS, DEFAULT_SEED
-from ertools.benchmarks.fbm2h.segments import StopParams
+from ertools.benchmarks.fbm2h.runs import StopParams
 from ertools.configs.transform import (
     MarkerTransform,
 )
@@ -56,7 +56,7 @@ class Fbm2hOptions:
             timed out counted in execution_time (``--unscored-segments 2015``).
         segment_clock: with ``reached`` states, ``client`` (a segment ends at the Client's
             COMPLETED_GOAL) or ``bmbox`` (the 2015 node's clock: BmBox messages at both ends,
-            ``--segment-clock bmbox``); see :func:`ertools.benchmarks.fbm2h.segments.from_states`.
+            ``--segment-clock bmbox``); see :func:`ertools.benchmarks.fbm2h.runs.from_states`.
         unscoreable_2015: a reached moment whose only ground truth within ``max_gap_s`` is
             invalid (repeated poses of a lost marker set) is scored from it as 2015 did, with a
             warning (``--unscoreable 2015``); by default the segment has no GT.

@@ -26,11 +26,11 @@ from ertools.benchmarks.common.inputs import (
     check_confidence,
     unscoreable_input,
 )
-from ertools.benchmarks.fbm2h.benchmark import score_found
 from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, NODES, RULE_SETS, Fbm2hOptions
 from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, load, locate_runs
+from ertools.benchmarks.fbm2h.pipeline import score_found
 from ertools.benchmarks.fbm2h.result import Fbm2hResult
-from ertools.benchmarks.fbm2h.segments import StopParams
+from ertools.benchmarks.fbm2h.runs import StopParams
 from ertools.benchmarks.legacy import LegacyBenchmark
 from ertools.configs.transform import LIVE_TRANSFORM_KEY, live_transform
 from ertools.errors import UsageError

@@ -62,7 +62,7 @@ from ertools.geometry import quat_conjugate, quat_multiply, wrap_angle
 from ertools.streams import PoseStream
 
 METHOD = "Monte Carlo (parametric bootstrap, basic interval)"
-# The 2015 FBM2 log's still marker set (ertools/benchmarks/fbm2h/transform.py): ~0.8 mm per
+# The 2015 FBM2 log's still marker set (ertools/benchmarks/fbm2h/acquire.py): ~0.8 mm per
 # consecutive still pair (epsilon) and ~13 mrad RMS yaw.
 DEFAULT_EPSILON_M = 0.0008
 DEFAULT_SIGMA_YAW = 0.013

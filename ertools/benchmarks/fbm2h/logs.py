@@ -12,10 +12,10 @@ import numpy as np
 from ertools.benchmarks.common.hygiene import drop_invalid, impossible_warning
 from ertools.benchmarks.common.sources import PoseSpec, read_source, topic
 from ertools.benchmarks.common.sources import tf as tf_source
-from ertools.benchmarks.fbm2h import segments as seg
+from ertools.benchmarks.fbm2h import runs as seg
 from ertools.benchmarks.fbm2h.config import DEFAULT_TOPIC, TF_2015, Fbm2hOptions
 from ertools.benchmarks.fbm2h.goal import GoalList, goal_from_payload, load_goal
-from ertools.benchmarks.fbm2h.segments import ReachedMoments
+from ertools.benchmarks.fbm2h.runs import ReachedMoments
 from ertools.benchmarks.fbm2h.timing import load_timing
 from ertools.configs.transform import (
     MarkerTransform,

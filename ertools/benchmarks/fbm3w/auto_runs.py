@@ -26,10 +26,10 @@ from ertools.benchmarks.common.phases import (
     Track,
     protocol_track,
 )
-from ertools.benchmarks.fbm3w.path import subsample_d_min
+from ertools.benchmarks.fbm3w.formula import subsample_d_min
 from ertools.benchmarks.fbm3w.runs import RunWindow
-from ertools.configs.fbm3w import Fbm3wConfig
-from ertools.configs.shapes import Shape
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
+from ertools.benchmarks.fbm3w.shapes import Shape
 from ertools.errors import ConfigError, SegmentationError
 from ertools.streams import PoseStream
 

@@ -12,7 +12,7 @@ from ertools.benchmarks.common.epsilon import (
     DEFAULT_C,
 )
 from ertools.benchmarks.common.inputs import DEFAULT_CONFIDENCE, DEFAULT_DRAWS, DEFAULT_SEED
-from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
+from ertools.benchmarks.fbm3w.settings import DEFAULT_D_MIN, Fbm3wConfig
 from ertools.errors import ConfigError
 
 NAMESPACE = "fbm3w"

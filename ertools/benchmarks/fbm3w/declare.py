@@ -27,13 +27,14 @@ from ertools.benchmarks.common.inputs import (
     check_confidence,
     unscoreable_input,
 )
-from ertools.benchmarks.fbm3w.benchmark import Fbm3wLogs, load, locate_runs, score_found
 from ertools.benchmarks.fbm3w.config import RUN_MODES, Fbm3wOptions, options_2015
+from ertools.benchmarks.fbm3w.logs import Fbm3wLogs
+from ertools.benchmarks.fbm3w.pipeline import load, locate_runs, score_found
 from ertools.benchmarks.fbm3w.result import Fbm3wResult
 from ertools.benchmarks.fbm3w.runs import RunWindow, parse_run_spec, parse_runs_file
+from ertools.benchmarks.fbm3w.settings import check_d_min, load_fbm3w_config
 from ertools.benchmarks.legacy import LegacyBenchmark
 from ertools.configs._yaml import load_yaml
-from ertools.configs.fbm3w import check_d_min, load_fbm3w_config
 from ertools.errors import ConfigError, UsageError
 
 LEGACY = "2015 behaviour (each difference can be undone)"
@@ -311,8 +312,8 @@ best_run, best_distance_error and execution_time (sum of the run times).""",
             "lower is better",
         ),
         notes=notes,
-        figures="ertools.report.plots_fbm3w:figure_specs",
-        foxglove="ertools.report.foxglove.fbm3w:content",
+        figures="ertools.benchmarks.fbm3w.plots:figure_specs",
+        foxglove="ertools.benchmarks.fbm3w.foxglove:content",
         score_keys=frozenset({"best_distance_error", "runs_details"}),
         state_topics=True,
         # The 2015 node's hard-coded d_min too, whatever d_min the audit was given.

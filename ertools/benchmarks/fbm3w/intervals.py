@@ -57,8 +57,8 @@ from ertools.benchmarks.common.uncertainty import (
 )
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
 from ertools.benchmarks.fbm3w.result import RunResult
-from ertools.configs.fbm3w import Fbm3wConfig
-from ertools.configs.shapes import Shape
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
+from ertools.benchmarks.fbm3w.shapes import Shape
 from ertools.streams import PoseStream
 
 # The coefficient of variation of a Rayleigh distance, sqrt(4/pi - 1): the spread of one

@@ -16,7 +16,7 @@ from ertools.benchmarks.common.uncertainty import (
     uncertainty_rows,
 )
 from ertools.benchmarks.common.validity import GapOnPath, Validity, cell, gaps_on_path
-from ertools.benchmarks.fbm3w.path import PathScore
+from ertools.benchmarks.fbm3w.formula import PathScore
 from ertools.benchmarks.fbm3w.runs import RunWindow
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames

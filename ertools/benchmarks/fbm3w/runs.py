@@ -37,8 +37,8 @@ from ertools.benchmarks.common.ending import (
     log_cut,
     refbox_ends,
 )
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.configs._yaml import show
-from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.errors import ConfigError, SegmentationError
 from ertools.io.model import BenchmarkStates
 from ertools.states import BmBoxState, EndReason, end_reason

@@ -12,9 +12,9 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from ertools.benchmarks.fbm2h.benchmark import compute
 from ertools.benchmarks.fbm2h.goal import GoalList
-from ertools.benchmarks.fbm2h.segments import from_states, unreached_reasons
+from ertools.benchmarks.fbm2h.pipeline import compute
+from ertools.benchmarks.fbm2h.runs import from_states, unreached_reasons
 from ertools.cli.main import main
 from ertools.configs.transform import MarkerTransform
 from ertools.io.reader import read_poses

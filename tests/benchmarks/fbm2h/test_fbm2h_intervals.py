@@ -20,7 +20,6 @@ from ertools.benchmarks.common.uncertainty import (
     Source,
 )
 from ertools.benchmarks.fbm2h import sample as sim
-from ertools.benchmarks.fbm2h.benchmark import compute, with_intervals
 from ertools.benchmarks.fbm2h.config import Fbm2hOptions
 from ertools.benchmarks.fbm2h.goal import parse_goal
 from ertools.benchmarks.fbm2h.intervals import (
@@ -31,7 +30,8 @@ from ertools.benchmarks.fbm2h.intervals import (
     measure_model,
     perturbed_scores,
 )
-from ertools.benchmarks.fbm2h.segments import ReachedMoments
+from ertools.benchmarks.fbm2h.pipeline import compute, with_intervals
+from ertools.benchmarks.fbm2h.runs import ReachedMoments
 from ertools.configs.transform import SPREAD_KEY, parse_transform
 from ertools.streams import PoseStream
 

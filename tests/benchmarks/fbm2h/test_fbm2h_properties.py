@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from ertools.benchmarks.fbm2h.score import robot_poses_at, segment_errors
+from ertools.benchmarks.fbm2h.formula import robot_poses_at, segment_errors
 from ertools.streams import PoseStream
 
 angles = st.floats(-math.pi, math.pi, allow_nan=False)

@@ -9,9 +9,9 @@ import numpy as np
 import svg_figure
 from matplotlib.figure import Figure
 
-from ertools.benchmarks.fbm2h.benchmark import compute
 from ertools.benchmarks.fbm2h.goal import GoalList
-from ertools.benchmarks.fbm2h.segments import ReachedMoments
+from ertools.benchmarks.fbm2h.pipeline import compute
+from ertools.benchmarks.fbm2h.runs import ReachedMoments
 from ertools.configs.transform import identity_transform
 from ertools.report.figures import figure_specs, save_figures
 from ertools.streams import PoseStream

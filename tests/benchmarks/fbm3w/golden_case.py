@@ -5,12 +5,12 @@ from __future__ import annotations
 import numpy as np
 from fbm3w_synth import T0, one_run
 
-from ertools.benchmarks.fbm3w.benchmark import score_runs
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
+from ertools.benchmarks.fbm3w.pipeline import score_runs
 from ertools.benchmarks.fbm3w.result import Fbm3wResult
 from ertools.benchmarks.fbm3w.runs import RunWindow
-from ertools.configs.fbm3w import Fbm3wConfig
-from ertools.configs.shapes import builtin_shapes
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
+from ertools.benchmarks.fbm3w.shapes import builtin_shapes
 from ertools.streams import concatenate_poses
 
 S = 1_000_000_000

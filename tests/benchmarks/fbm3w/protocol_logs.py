@@ -1,6 +1,6 @@
 """FBM3@Work mocap logs written from the protocol (seed 7.3.3), not from the detector.
 
-Independent of ertools' simulator (``ertools.samples.fbm3w``) and of ``--runs auto``: the
+Independent of ertools' simulator (``ertools.benchmarks.fbm3w.sample``) and of ``--runs auto``: the
 shapes are written out again from the manual (Listing 15) and ``configs/fbm3w.yaml``, the
 motion from what the manual says a run is, and the detector's constants are not used.
 

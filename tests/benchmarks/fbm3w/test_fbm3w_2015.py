@@ -26,11 +26,11 @@ from fbm3w_kit import Sample
 from fbm3w_synth import place
 from test_fbm3w_runs import stream
 
-from ertools.benchmarks.fbm3w.benchmark import score_runs
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions, options_2015
+from ertools.benchmarks.fbm3w.pipeline import score_runs
 from ertools.benchmarks.fbm3w.runs import find_states
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.cli.main import main
-from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.geometry import quat_from_yaw
 from ertools.io.model import BenchmarkStates
 from ertools.io.reader import read_benchmark_states, read_poses

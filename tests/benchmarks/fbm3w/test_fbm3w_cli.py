@@ -13,8 +13,8 @@ from fbm3w_synth import one_run
 from protocol_logs import generate, write_bag, write_config
 from stderr_text import error_messages
 
+from ertools.benchmarks.fbm3w.shapes import builtin_shapes
 from ertools.cli.main import main
-from ertools.configs.shapes import builtin_shapes
 from ertools.simulator.writer import BagWriter
 
 

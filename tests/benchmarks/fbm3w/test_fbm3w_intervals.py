@@ -20,8 +20,8 @@ from ertools.benchmarks.fbm3w.intervals import (
     run_intervals,
     smooth,
 )
-from ertools.configs.shapes import builtin_shapes
-from ertools.samples.fbm3w import eq1, target
+from ertools.benchmarks.fbm3w.sample import eq1, target
+from ertools.benchmarks.fbm3w.shapes import builtin_shapes
 
 
 def _line_run(rng: np.random.Generator, sigma: float) -> tuple[np.ndarray, np.ndarray]:

@@ -10,11 +10,11 @@ from fbm3w_synth import one_run, place
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ertools.benchmarks.fbm3w.benchmark import score_runs
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
-from ertools.benchmarks.fbm3w.path import run_frame, score_path, subsample_d_min
-from ertools.configs.fbm3w import Fbm3wConfig
-from ertools.configs.shapes import builtin_shapes, parse_shape
+from ertools.benchmarks.fbm3w.formula import run_frame, score_path, subsample_d_min
+from ertools.benchmarks.fbm3w.pipeline import score_runs
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
+from ertools.benchmarks.fbm3w.shapes import builtin_shapes, parse_shape
 from ertools.errors import ScoringError
 
 # the path arithmetic is the subject, not the intervals: no Monte Carlo draws

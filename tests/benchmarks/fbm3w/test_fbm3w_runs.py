@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from ertools.benchmarks.fbm3w.runs import find_states, find_windows, with_specs
-from ertools.configs.fbm3w import Fbm3wConfig
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.errors import SegmentationError
 from ertools.io.model import BenchmarkStates
 from ertools.states import BmBoxState as B

@@ -5,9 +5,9 @@ from __future__ import annotations
 import pytest
 from fbm3w_kit import Sample
 
-from ertools.benchmarks.fbm3w.benchmark import score_fbm3w
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
-from ertools.configs.fbm3w import Fbm3wConfig
+from ertools.benchmarks.fbm3w.pipeline import score_fbm3w
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 
 # the answers hold scores, not intervals: no Monte Carlo draws (draws=0 in every Fbm3wOptions)
 NO_DRAWS = Fbm3wOptions(draws=0)

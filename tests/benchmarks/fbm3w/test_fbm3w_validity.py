@@ -13,14 +13,14 @@ import pytest
 from fbm3w_synth import FRAME_NS, T0, one_run
 
 from ertools.benchmarks.base import rename_former
-from ertools.benchmarks.fbm3w.benchmark import MAX_INNER_GAP_S, MIN_COVERAGE, score_runs
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions, options_2015
 from ertools.benchmarks.fbm3w.declare import BENCHMARK
-from ertools.benchmarks.fbm3w.path import score_path
+from ertools.benchmarks.fbm3w.formula import score_path
+from ertools.benchmarks.fbm3w.pipeline import MAX_INNER_GAP_S, MIN_COVERAGE, score_runs
 from ertools.benchmarks.fbm3w.runs import RunWindow
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
+from ertools.benchmarks.fbm3w.shapes import builtin_shapes
 from ertools.cli.main import main
-from ertools.configs.fbm3w import Fbm3wConfig
-from ertools.configs.shapes import builtin_shapes
 from ertools.streams import PoseStream
 
 STILL = 30

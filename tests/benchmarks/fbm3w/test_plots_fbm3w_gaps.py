@@ -13,9 +13,9 @@ import svg_figure
 from fbm3w_synth import one_run
 from matplotlib.image import imread
 
-from ertools.benchmarks.fbm3w.benchmark import score_runs
-from ertools.configs.fbm3w import Fbm3wConfig
-from ertools.configs.shapes import builtin_shapes
+from ertools.benchmarks.fbm3w.pipeline import score_runs
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
+from ertools.benchmarks.fbm3w.shapes import builtin_shapes
 from ertools.report.figures import figure_specs, render, wrap_title
 from ertools.report.folder import write_report
 

@@ -12,10 +12,10 @@ import pytest
 import yaml
 
 from ertools.benchmarks.common.epsilon import noise_from_stream, noise_statistics
+from ertools.benchmarks.fbm3w import sample as fbm3w
 from ertools.benchmarks.noise.sample import generate
 from ertools.cli.main import main
 from ertools.errors import ScoringError
-from ertools.samples import fbm3w
 from ertools.streams import PoseStream
 
 

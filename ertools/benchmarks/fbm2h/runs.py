@@ -372,7 +372,7 @@ def unreached_reasons(
 
     Empty when every waypoint was reached, or when nothing says why (not from the states, or
     the BmBox sent its score early with no RefBox reason): the count mismatch is then an error
-    (see :func:`ertools.benchmarks.fbm2h.benchmark.compute`). ``refbox`` is not needed any
+    (see :func:`ertools.benchmarks.fbm2h.pipeline.compute`). ``refbox`` is not needed any
     more (the reason is found with the moments) and kept for callers.
     """
     del refbox

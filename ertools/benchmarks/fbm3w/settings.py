@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ertools.benchmarks.fbm3w.shapes import Shape, builtin_shapes, parse_shape
 from ertools.configs._yaml import load_yaml, show
-from ertools.configs.shapes import Shape, builtin_shapes, parse_shape
 from ertools.errors import ConfigError
 
 # The 2015 script's threshold (rockin_scoring/scripts/fbm3w, Lisbon 2015: "reasonable with a

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ertools.arrays import F64, IntArr
-from ertools.configs.shapes import Shape
+from ertools.benchmarks.fbm3w.shapes import Shape
 from ertools.errors import ErtoolsError, ScoringError
 
 # Samples probed one by one after each kept point before switching to a vectorised search:

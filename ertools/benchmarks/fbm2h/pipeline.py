@@ -39,6 +39,7 @@ from ertools.benchmarks.common.validity import (
     valid_near,
 )
 from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, TF_2015, Fbm2hOptions
+from ertools.benchmarks.fbm2h.formula import robot_poses_at, segment_errors
 from ertools.benchmarks.fbm2h.goal import GoalList
 from ertools.benchmarks.fbm2h.intervals import Moments, intervals, measure_model
 from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, invalid_warning, load, locate_runs
@@ -51,8 +52,7 @@ from ertools.benchmarks.fbm2h.rules import (
     RULE_SEGMENT_CLOCK,
     RULE_UNSCORED,
 )
-from ertools.benchmarks.fbm2h.score import robot_poses_at, segment_errors
-from ertools.benchmarks.fbm2h.segments import ReachedMoments
+from ertools.benchmarks.fbm2h.runs import ReachedMoments
 from ertools.configs.transform import MarkerTransform
 from ertools.errors import ConfigError, SegmentationError
 from ertools.fidelity import Deviation
@@ -60,7 +60,7 @@ from ertools.geometry import compose, rotate, wrap_angle, yaw_from_quat
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import ns_to_s, s_to_ns
 
-log = logging.getLogger("ertools.benchmarks.fbm2h.benchmark")
+log = logging.getLogger("ertools.benchmarks.fbm2h.pipeline")
 
 # Figures need the path, not every 120 Hz sample.
 PATH_POINTS = 3000

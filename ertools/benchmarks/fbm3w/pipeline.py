@@ -2,7 +2,7 @@
 
 :func:`score_fbm3w` reads bags through :mod:`ertools.io` and calls :func:`score_runs`, which
 is pure (pose stream + run windows + config -> :class:`Fbm3wResult`). The scoring itself is in
-:mod:`ertools.benchmarks.fbm3w.path`, run finding in :mod:`ertools.benchmarks.fbm3w.runs`.
+:mod:`ertools.benchmarks.fbm3w.formula`, run finding in :mod:`ertools.benchmarks.fbm3w.runs`.
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -28,7 +28,6 @@ from ertools.benchmarks.common.hygiene import (
     identical_poses,
     impossible_warning,
 )
-from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
 from ertools.benchmarks.common.uncertainty import few_warning
 from ertools.benchmarks.common.validity import (
     STILL_M,
@@ -43,14 +42,13 @@ from ertools.benchmarks.common.validity import (
 )
 from ertools.benchmarks.fbm3w.auto_runs import find_auto
 from ertools.benchmarks.fbm3w.config import (
-    DEFAULT_FRAME,
     DEFAULT_TOPIC,
-    FALLBACK_TOPIC,
     NAMESPACE,
     Fbm3wOptions,
 )
+from ertools.benchmarks.fbm3w.formula import score_path, shape_floor, try_score
 from ertools.benchmarks.fbm3w.intervals import with_intervals
-from ertools.benchmarks.fbm3w.path import score_path, shape_floor, try_score
+from ertools.benchmarks.fbm3w.logs import Fbm3wLogs, read_fbm3w_poses
 from ertools.benchmarks.fbm3w.result import Fbm3wResult, RunResult
 from ertools.benchmarks.fbm3w.rules import (
     RULE_ARC_LENGTH,
@@ -69,17 +67,16 @@ from ertools.benchmarks.fbm3w.runs import (
     find_windows,
     with_specs,
 )
-from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
+from ertools.benchmarks.fbm3w.settings import DEFAULT_D_MIN, Fbm3wConfig
 from ertools.errors import ConfigError, ScoringError
 from ertools.fidelity import Deviation
 from ertools.io.clock import check_header_clock
-from ertools.io.model import BenchmarkStates
 from ertools.io.reader import read_benchmark_states, topics
 from ertools.io.summary import summary
 from ertools.progress import Reporter, current
 from ertools.streams import PoseStream, Provenance
 
-log = logging.getLogger("ertools.benchmarks.fbm3w.benchmark")
+log = logging.getLogger("ertools.benchmarks.fbm3w.pipeline")
 
 # The reference pose is the last sample at or before the reference time; older than this, the
 # marker set was probably not tracked at that moment.
@@ -97,38 +94,6 @@ LONG_PATH_RATIO = 1.15
 # ends are within STILL_M of each other hid no motion. Why these values: docs/uncertainty.md.
 MIN_COVERAGE = 0.9
 MAX_INNER_GAP_S = 0.5
-
-
-def read_fbm3w_poses(paths: Sequence[Path], options: Fbm3wOptions) -> PoseStream:
-    """The end-effector poses: ``--topic``/``--frame``, else pose2d, pose, tf ``robot_at_work``.
-
-    Raises:
-        TopicError: none of them is in the bags (the message lists the pose topics there are).
-    """
-    # the one pose-source chooser (benchmarks/common/sources.py): the given source, else the
-    # first of pose2d, pose, the tf frame present, with a warning when not the first
-    spec = PoseSpec(
-        topic=options.topic,
-        tf=None
-        if options.topic is not None or options.frame is None
-        else (options.tf_parent, options.frame),
-        time_source="record" if options.time_source == "record" else "header",
-    )
-    defaults = (topic(DEFAULT_TOPIC), topic(FALLBACK_TOPIC), tf(DEFAULT_FRAME))
-    return read_source(paths, spec, defaults, what="end-effector poses")
-
-
-@dataclass(frozen=True, eq=False)
-class Fbm3wLogs:
-    """What :func:`load` read: the bags, their end-effector poses, span and topics, the run
-    mode and, for ``states``, the benchmark state streams."""
-
-    paths: tuple[Path, ...]
-    poses: PoseStream
-    bag_start_ns: int
-    bag_end_ns: int
-    mode: str
-    states: BenchmarkStates | None = None
 
 
 def load(paths: Sequence[Path], options: Fbm3wOptions) -> Fbm3wLogs:
