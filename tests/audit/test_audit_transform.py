@@ -18,6 +18,8 @@ from ertools.auditing.recompute import ScoreInputs, audit_bag, rescore
 from ertools.cli.main import main
 from ertools.report.folder import write_report
 
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def fbm2h(tmp_path_factory: pytest.TempPathFactory) -> Path:

@@ -50,6 +50,7 @@ def test_audit_json_from_bag(bag: Path, capsys: pytest.CaptureFixture[str]) -> N
     assert [r["outcome"] for r in data["runs"].values()] == ["completed", "timeout"]
 
 
+@pytest.mark.slow
 def test_audit_text_report_and_strict(
     bag: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

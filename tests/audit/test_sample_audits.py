@@ -16,6 +16,8 @@ from ertools.auditing.recompute import ScoreInputs, audit_bag, rescore
 from ertools.cli.main import main
 from ertools.io import read_benchmark_states
 
+pytestmark = pytest.mark.slow
+
 
 def _audit(folder: Path, ns: str) -> Audit:
     (bag,) = folder.glob("*.bag")

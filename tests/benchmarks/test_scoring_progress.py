@@ -5,12 +5,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 import yaml
 
 from ertools.benchmarks.fbm1.benchmark import score_fbm1_bag
 from ertools.benchmarks.fbm3w.benchmark import score_fbm3w
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.progress import reporting
+
+pytestmark = pytest.mark.slow
 
 S = Path(__file__).resolve().parents[2] / "sample_bags"
 

@@ -16,6 +16,7 @@ from scipy.stats import binom
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
 
+import pytest
 from calibration import fbm1
 
 TRIALS = 12
@@ -23,6 +24,7 @@ DRAWS = 200
 KEYS = ("ground_truth.x", "ground_truth.y", "ground_truth.theta")
 
 
+@pytest.mark.slow
 def test_95_percent_intervals_cover_the_truth_95_percent_of_the_time() -> None:
     covered = total = 0
     for seed in range(TRIALS):

@@ -3,7 +3,10 @@ small number of simulated executions (``make calibrate`` runs 1,000)."""
 
 from __future__ import annotations
 
+import pytest
 from trials import coverage
+
+pytestmark = pytest.mark.slow
 
 TRIALS = 40
 DRAWS = 200

@@ -16,7 +16,10 @@ from scipy.stats import binom
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
 
+import pytest
 from calibration import trajectory
+
+pytestmark = pytest.mark.slow
 
 TRIALS = 40
 DRAWS = 100

@@ -36,6 +36,7 @@ def _build_api() -> object:
     return module
 
 
+@pytest.mark.slow
 def test_every_example_runs(monkeypatch: pytest.MonkeyPatch) -> None:
     """The docstrings' examples, as doctests from the repository root (they read sample_bags/)."""
     monkeypatch.chdir(ROOT)
@@ -56,6 +57,7 @@ def test_docs_api_md_is_generated_from_the_docstrings() -> None:
     assert not re.findall(r":[a-z]+:`", page)
 
 
+@pytest.mark.slow
 def test_import_ertools_is_light_and_names_resolve_on_use() -> None:
     code = (
         "import sys, ertools\n"
@@ -136,6 +138,7 @@ def test_score_errors_name_the_inputs() -> None:
         ertools.score("fbm3w", "nope.bag")
 
 
+@pytest.mark.slow
 def test_read_poses_topic_and_tf() -> None:
     poses = ertools.read_poses(FBM3W_BAG, topic="/fbm3w/robot_at_work/pose")
     with ertools.open_bag(FBM3W_BAG) as bag:
@@ -147,6 +150,7 @@ def test_read_poses_topic_and_tf() -> None:
         ertools.read_poses(FBM3W_BAG, tf="world:nothing_here")
 
 
+@pytest.mark.slow
 def test_export_writes_what_the_command_writes(tmp_path: Path) -> None:
     out = tmp_path / "api.tum"
     text = ertools.export(FBM3W_BAG, topic="/fbm3w/robot_at_work/pose", out=out)
@@ -157,6 +161,7 @@ def test_export_writes_what_the_command_writes(tmp_path: Path) -> None:
         ertools.export(FBM3W_BAG, topic="/fbm3w/robot_at_work/pose", out=FBM3W_BAG)
 
 
+@pytest.mark.slow
 def test_audit_and_timeline() -> None:
     audited = ertools.audit(FBM2H_BAG, goal=FBM2H / "fbm2h_goal.yaml", speed=3)
     assert audited.benchmark == "fbm2h" and audited.recomputed is not None

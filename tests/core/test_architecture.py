@@ -89,6 +89,7 @@ def _misplaced(paths: Iterable[Path], allowed: Set[str]) -> list[str]:
     return bad
 
 
+@pytest.mark.slow
 def test_function_level_imports_are_heavy_third_party_with_a_reason() -> None:
     bad = _misplaced(sorted(PACKAGE.rglob("*.py")), LAZY_ALLOWED | LAZY_ERTOOLS)
     assert not bad, "\n".join(bad)
@@ -156,6 +157,7 @@ def _lint_imports(package_parent: Path) -> subprocess.CompletedProcess[str]:
     )
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not LINT_IMPORTS.exists(), reason="lint-imports not installed (dev extra)")
 def test_the_contract_holds_and_refuses_an_upward_import(tmp_path: Path) -> None:
     copy = tmp_path / "ertools"
@@ -185,6 +187,7 @@ ancestors = ["ertools"]
 """
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not LINT_IMPORTS.exists(), reason="lint-imports not installed (dev extra)")
 def test_no_cycle_even_through_annotations(tmp_path: Path) -> None:
     """Imports under TYPE_CHECKING (annotations only) count for the contracts: a cycle

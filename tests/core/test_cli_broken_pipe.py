@@ -10,6 +10,7 @@ import sys
 import pytest
 
 
+@pytest.mark.slow_cases("argv3")
 @pytest.mark.parametrize("argv", [[], ["--help"], ["--version"], ["info", "--help"]])
 def test_a_closed_stdout_is_not_an_error(argv: list[str]) -> None:
     # the pipe's reading end is closed before ertools starts: its first write finds the

@@ -31,6 +31,7 @@ def test_unknown_command(capsys: pytest.CaptureFixture[str]) -> None:
     assert err.count("\n") == 1 and "unknown command 'frobnicate'" in err
 
 
+@pytest.mark.xdist_group("timing")
 def test_help_is_instant_and_imports_nothing_heavy() -> None:
     code = (
         "import sys, time; t=time.perf_counter(); from ertools.cli.main import main; "

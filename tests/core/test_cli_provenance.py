@@ -9,6 +9,8 @@ import pytest
 
 from ertools.cli.main import main
 
+pytestmark = pytest.mark.slow
+
 SAMPLE = Path(__file__).resolve().parents[2] / "sample_bags" / "fbm3w"
 
 

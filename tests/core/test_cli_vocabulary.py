@@ -269,6 +269,7 @@ def test_every_usage_error_exits_2_with_one_line(
 # ---------------------------------------------------------------- --plot FILE and --plots DIR
 
 
+@pytest.mark.slow
 def test_plot_file_is_a_file_and_plots_dir_a_folder(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
@@ -288,6 +289,7 @@ def test_plot_file_is_a_file_and_plots_dir_a_folder(
     assert yaml.safe_load(out)["best_distance_error"] > 0
 
 
+@pytest.mark.slow
 def test_plot_suffix_picks_the_format(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     for name, magic in (("h.svg", b"<?xml"), ("h.pdf", b"%PDF")):
         code, _, err = run(capsys, "noise", STATIONARY, "--plot", tmp_path / name)
@@ -302,6 +304,7 @@ def test_plot_suffix_picks_the_format(capsys: pytest.CaptureFixture[str], tmp_pa
     assert fig.series(labels[0]).findall("s:rect", svg_figure.NS)  # the histogram's bars
 
 
+@pytest.mark.slow
 def test_old_plot_folder_still_writes_a_folder_with_a_note(
     capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:

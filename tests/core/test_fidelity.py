@@ -207,6 +207,7 @@ RUNS = {
 PRINTED = re.compile(r"^ertools: differs from 2015: .*\[(?P<key>[a-z0-9]+\.[a-z0-9-]+)\]$")
 
 
+@pytest.mark.slow_cases("audit", "fbm3w-2015", "fbm3w-auto-arc", "fbm3w-d-min", "fbm3w")
 @pytest.mark.parametrize("case", list(RUNS))
 def test_every_printed_deviation_has_a_rule(case: str, capsys: pytest.CaptureFixture[str]) -> None:
     """What the commands print on the samples under the default and the 2015 options: each

@@ -99,6 +99,7 @@ def test_invert_by_hand() -> None:
     assert float(yaw_from_quat(q)) == pytest.approx(-math.pi / 2)
 
 
+@pytest.mark.slow
 @settings(max_examples=60, deadline=None)
 @given(vec3, quat)
 def test_compose_with_inverse_is_identity(t: np.ndarray, q: np.ndarray) -> None:
@@ -109,6 +110,7 @@ def test_compose_with_inverse_is_identity(t: np.ndarray, q: np.ndarray) -> None:
     assert abs(abs(q0[3]) - 1.0) < 1e-9
 
 
+@pytest.mark.slow
 @settings(max_examples=60, deadline=None)
 @given(vec3, quat, vec3, quat, vec3, quat)
 def test_compose_is_associative(
@@ -122,6 +124,7 @@ def test_compose_is_associative(
     assert min(np.abs(qa - qb).max(), np.abs(qa + qb).max()) < 1e-9
 
 
+@pytest.mark.slow
 @settings(max_examples=60, deadline=None)
 @given(vec3, quat, vec3)
 def test_transform_points_matches_compose(t: np.ndarray, q: np.ndarray, p: np.ndarray) -> None:
@@ -130,6 +133,7 @@ def test_transform_points_matches_compose(t: np.ndarray, q: np.ndarray, p: np.nd
     np.testing.assert_allclose(transform_points(t, q, p), tp, atol=1e-9)
 
 
+@pytest.mark.slow
 @settings(max_examples=100, deadline=None)
 @given(st.floats(-50, 50, allow_nan=False), st.floats(-50, 50, allow_nan=False))
 def test_angle_error_in_range_and_symmetric(a: float, b: float) -> None:
@@ -204,6 +208,7 @@ def test_compose_accepts_read_only_inputs() -> None:
     np.testing.assert_allclose(ti, np.tile([0.0, 1.0, 0.0], (3, 1)), atol=1e-12)
 
 
+@pytest.mark.slow
 @settings(max_examples=80, deadline=None)
 @given(vec3, quat, vec3, quat)
 def test_numpy_compose_matches_scipy(
@@ -216,6 +221,7 @@ def test_numpy_compose_matches_scipy(
     assert min(np.abs(q - expected).max(), np.abs(q + expected).max()) < 1e-9
 
 
+@pytest.mark.slow
 @settings(max_examples=80, deadline=None)
 @given(quat, quat, st.floats(0.0, 1.0))
 def test_slerp_matches_scipy(q0: np.ndarray, q1: np.ndarray, alpha: float) -> None:
@@ -224,6 +230,7 @@ def test_slerp_matches_scipy(q0: np.ndarray, q1: np.ndarray, alpha: float) -> No
     assert min(np.abs(got - expected).max(), np.abs(got + expected).max()) < 1e-7
 
 
+@pytest.mark.slow
 def test_geometry_import_does_not_load_scipy() -> None:
     code = "import sys, ertools.geometry; print('scipy.spatial' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)

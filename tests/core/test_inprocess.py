@@ -103,6 +103,7 @@ wc -l < info.txt
 """
 
 
+@pytest.mark.slow
 def test_the_bridge_prints_what_the_processes_print(tmp_path: Path) -> None:
     """The same script through bash with ``ertools`` as the console script and through the
     bridge: the same output, byte for byte, and the same files."""

@@ -25,6 +25,8 @@ import pytest
 
 from ertools import launch
 
+pytestmark = pytest.mark.slow
+
 ROOT = Path(__file__).resolve().parents[2]
 BAG = ROOT / "sample_bags" / "fbm3w" / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
 CONFIG = ROOT / "sample_bags" / "fbm3w" / "fbm3w.yaml"

@@ -1,25 +1,18 @@
 """How the suite runs: `make test` on every core with the 15 slowest listed, `make check` the
-fast part; tests/slow.txt and the timing group name tests that exist."""
+fast part (the tests not marked `slow`), the groups that xdist reads."""
 
 from __future__ import annotations
 
-import importlib.util
+import os
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 TESTS = ROOT / "tests"
-
-
-def _root_conftest() -> object:
-    # by path: every test folder's conftest is a module named `conftest`
-    spec = importlib.util.spec_from_file_location("root_conftest", TESTS / "conftest.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def _recipe(target: str) -> str:
@@ -70,14 +63,55 @@ def test_make_check_is_lint_and_the_fast_tests() -> None:
     assert '-m "not slow"' in recipe
 
 
-def test_listed_tests_exist() -> None:
-    conftest = _root_conftest()
-    for entry in (*conftest._slow(), *conftest.TIMING):  # type: ignore[attr-defined]
-        path = entry.split("::")[0]
-        assert (TESTS / path).exists(), f"tests/slow.txt or TIMING names {entry}: no such file"
-        if "::" in entry:
-            name = entry.split("::")[1].split("[")[0]
-            assert f"def {name}(" in (TESTS / path).read_text(encoding="utf-8"), entry
+PLANTED = """
+import pytest
+
+@pytest.mark.slow_cases("b")
+@pytest.mark.parametrize("x", ["a", "b", "c"])
+def test_cases(x):
+    pass
+"""
+
+
+def _collect(tmp_path: Path, module: str, *args: str) -> subprocess.CompletedProcess[str]:
+    """pytest with the suite's conftest as its only plug-in, on one planted module."""
+    ini = "[pytest]\naddopts = --strict-markers\nmarkers =\n    slow\n    slow_cases\n"
+    (tmp_path / "pytest.ini").write_text(ini, encoding="utf-8")
+    (tmp_path / "test_planted.py").write_text(module, encoding="utf-8")
+    argv = ["-p", "tests.conftest", "-p", "no:cacheprovider", "--collect-only", "-q", *args]
+    return subprocess.run(
+        [sys.executable, "-m", "pytest", *argv],
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=120,
+    )
+
+
+@pytest.mark.slow
+def test_slow_cases_marks_the_named_cases_and_refuses_a_name_of_none(tmp_path: Path) -> None:
+    """`make check` leaves out what `slow_cases` names, and only that; a name that is no case
+    (a typo, a renamed parameter) stops the run rather than putting the case back unnoticed."""
+    slow = _collect(tmp_path, PLANTED, "-m", "slow")
+    assert slow.returncode == 0, slow.stdout + slow.stderr
+    listed, _, summary = slow.stdout.partition("\n\n")
+    assert listed.split() == ["test_planted.py::test_cases[b]"]
+    assert summary.startswith("1/3 tests collected (2 deselected)"), summary
+    typo = _collect(tmp_path, PLANTED.replace('slow_cases("b")', 'slow_cases("b", "d")'))
+    assert typo.returncode != 0
+    assert "slow_cases names no case of its test: test_planted.py::test_cases[d]" in typo.stderr
+    # one case asked for by its id: the others were not collected, so nothing to check
+    one = _collect(
+        tmp_path, PLANTED.replace('"b"', '"b", "d"', 1), "test_planted.py::test_cases[a]"
+    )
+    assert one.returncode == 0, one.stdout + one.stderr
+
+
+def test_no_list_of_slow_tests_beside_the_marks() -> None:
+    """Slow tests are marked on the test (issue 37): a list would drift from the tests."""
+    assert not (TESTS / "slow.txt").exists()
 
 
 @pytest.fixture(scope="module")

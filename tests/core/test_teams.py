@@ -162,6 +162,7 @@ def _argv(case: Case, folder: Path, bag: Path) -> list[str]:
     return ["score", case.command, str(bag), *extra]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", CASES, ids=[c.command for c in CASES])
 def test_scoring_commands_store_the_team(
     case: Case,
@@ -189,6 +190,7 @@ def test_scoring_commands_store_the_team(
     capsys.readouterr()
 
 
+@pytest.mark.slow
 def test_fbm2h_team_alone_keeps_the_identity_transform(
     tmp_path: Path, tmp_path_factory: pytest.TempPathFactory, capsys: pytest.CaptureFixture[str]
 ) -> None:

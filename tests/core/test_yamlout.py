@@ -32,6 +32,7 @@ def test_binary_noise_is_gone_and_epoch_times_keep_every_bit() -> None:
     assert math.isnan(special[0]) and special[1:] == [math.inf, -math.inf, 3, True, None]
 
 
+@pytest.mark.slow
 @given(st.floats(min_value=-1e6, max_value=1e6, allow_nan=False))
 def test_written_value_within_half_a_nano(x: float) -> None:
     back = yaml.safe_load(dump_yaml({"x": x}))["x"]

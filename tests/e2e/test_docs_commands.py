@@ -116,7 +116,14 @@ def test_shell_commands_in_docs_are_console_or_text_blocks() -> None:
                 pytest.fail(f"{page.name}: a ```{fence.group(1)} block holds $ commands")
 
 
-@pytest.mark.parametrize("name", pages())
+def _cases() -> list[object]:
+    # live.md records and monitors side by side on a deadline: in the timing group (conftest)
+    timing = pytest.mark.xdist_group("timing")
+    return [pytest.param(n, marks=timing) if n == "live.md" else n for n in pages()]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", _cases())
 def test_docs_commands_run_as_printed(name: str, tmp_path: Path) -> None:
     if not SHARED.is_dir():
         pytest.skip("../shared not present: the docs' commands read its real bags")

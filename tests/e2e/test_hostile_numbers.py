@@ -97,6 +97,7 @@ def test_a_hostile_number_is_one_line_naming_file_and_key(
     assert re.search(r"too large|not a finite|out of range|larger than", lines[0]), lines[0]
 
 
+@pytest.mark.slow
 def test_deep_nesting_is_refused_with_a_message(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

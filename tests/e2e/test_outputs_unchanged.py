@@ -26,6 +26,8 @@ import pytest
 from floats import output_difference
 from inprocess import run
 
+pytestmark = pytest.mark.slow
+
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"
 REAL = ROOT.parent / "shared" / "real_bags"

@@ -46,6 +46,7 @@ def test_console_blocks_parse_commands_continuations_and_output() -> None:
     assert console_blocks(text) == [(["a \\\n   --b", "c"], ["out: 1"])]
 
 
+@pytest.mark.slow
 def test_readme_tour_runs_as_printed(tmp_path: Path) -> None:
     if not SHARED.is_dir():
         pytest.skip("../shared not present: the tour scores its real bag")

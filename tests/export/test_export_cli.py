@@ -112,6 +112,7 @@ def test_pair_errors_are_the_scores(tmp_path: Path, capsys: pytest.CaptureFixtur
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_pair_kitti_matched_rows_and_times(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -37,6 +37,8 @@ from evo.tools import file_interface
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "io"))
 from io_bagmaker import Spec, write
 
+pytestmark = pytest.mark.slow
+
 REPO = Path(__file__).resolve().parents[2]
 ROBOTLOG = REPO / "sample_bags/robotlog"
 ROBOT_BAG = ROBOTLOG / "FBM2H_201511201200_homer.bag"

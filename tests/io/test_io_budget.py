@@ -110,6 +110,7 @@ def _ros1_bomb(path: Path, extra: int, compression: str = "bz2") -> Path:
     return ros1_bag(path, [conn], [chunk])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("compression", ["bz2", "lz4"])
 def test_a_ros1_chunk_that_inflates_past_its_declared_size_is_refused_there(
     tmp_path: Path, compression: str
@@ -136,6 +137,7 @@ def test_a_ros1_chunk_that_inflates_past_its_declared_size_is_refused_there(
         assert peak[0] < 16 * MiB, f"peak {peak[0] / MiB:.0f} MiB"
 
 
+@pytest.mark.slow
 def test_info_on_a_bz2_bomb_is_one_line_and_small_in_a_fresh_process(tmp_path: Path) -> None:
     """The whole command in its own process: its peak resident memory stays near the
     interpreter's (about 40 MB here), not the gigabyte the bomb holds. VmHWM, not ru_maxrss:
@@ -299,6 +301,7 @@ def test_the_record_header_budget_just_under_and_just_over(
 # --- MCAP: a valid 16 MB chunk reads, a 2 GiB one is refused without inflating it ------------
 
 
+@pytest.mark.slow
 def test_a_valid_mcap_with_a_16_mb_chunk_reads(tmp_path: Path, scene: Scene) -> None:
     """Finding 13: one message of 16 MB (a 4000 x 4000 occupancy grid's data, zeros: zstd
     stores it in a few hundred bytes, 30,000 times smaller) was "damaged chunk record".
@@ -385,6 +388,7 @@ def test_an_mcap_chunk_whose_frame_says_more_than_its_record_stops_there(
 # --- rosbag2: metadata.yaml and storage files compressed whole ---------------------------------
 
 
+@pytest.mark.slow
 def test_metadata_size_and_nesting_just_under_and_just_over(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, scene: Scene
 ) -> None:
@@ -411,6 +415,7 @@ def test_metadata_size_and_nesting_just_under_and_just_over(
     _refusal(lambda: eio.summary(good), "r2", "nested deeper")
 
 
+@pytest.mark.slow
 def test_a_file_compressed_storage_copy_within_the_budget(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, scene: Scene
 ) -> None:

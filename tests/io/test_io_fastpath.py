@@ -98,6 +98,7 @@ def fast_batch(path: Path, topic: str, lo: int | None = None, hi: int | None = N
     return batch
 
 
+@pytest.mark.slow_cases("rosbag2-mcap-/odom", "rosbag2-mcap-/tf", "rosbag2-sqlite3-/odom")
 @pytest.mark.parametrize("topic", POSE_TOPICS)
 def test_fast_equals_rosbags(scene_bag: tuple[str, Path], topic: str) -> None:
     _fmt, path = scene_bag
@@ -113,6 +114,7 @@ def _sample_bags() -> list[Path]:
     return list(find_bags([folder]).bags) if folder.is_dir() else []
 
 
+@pytest.mark.slow
 def test_fast_equals_rosbags_on_sample_bags() -> None:
     bags = _sample_bags()
     if not bags:
@@ -126,6 +128,7 @@ def test_fast_equals_rosbags_on_sample_bags() -> None:
     assert checked > 0
 
 
+@pytest.mark.slow
 @pytest.mark.real
 def test_fast_equals_rosbags_on_real_bag() -> None:
     if not REAL_BAG.exists():
@@ -134,6 +137,7 @@ def test_fast_equals_rosbags_on_real_bag() -> None:
         assert_same(fast_batch(REAL_BAG, topic), reference_batch(REAL_BAG, topic))
 
 
+@pytest.mark.slow
 @pytest.mark.real
 def test_real_bag_end_to_end() -> None:
     """Topics, counts, start/end and first pose, checked against rosbags' AnyReader directly."""
@@ -195,6 +199,7 @@ def test_bulk_states_equal_rosbags(scene_bag: tuple[str, Path], topic: str) -> N
     assert bulk[0].tolist() == t and bulk[1].tolist() == state and bulk[2] == payload
 
 
+@pytest.mark.slow
 def test_bulk_states_on_sample_and_real_bags() -> None:
     bags = _sample_bags()
     if not bags:

@@ -29,6 +29,7 @@ from fuzz.run import SEED_NAMES, run_cases  # noqa: E402
 from fuzz.seeds import N_POSES, POSE_TOPIC, SEEDS, T0_NS, seed_bytes, suffix  # noqa: E402
 
 
+@pytest.mark.slow_cases("ros1")
 @pytest.mark.parametrize("name", list(SEEDS))
 def test_seed_files_read_the_same(
     tmp_path: Path, name: str, caplog: pytest.LogCaptureFixture
@@ -120,6 +121,7 @@ def test_the_judge_flags_wrong_answers() -> None:
 SAMPLE = [*range(100), *range(100, 500, 25)]
 
 
+@pytest.mark.slow
 def test_a_sample_of_mutants() -> None:
     """No traceback, no hang, CLI lines right, no disagreement."""
     results = run_cases(seed=1, indices=SAMPLE, jobs=2, timeout=20.0)
@@ -147,6 +149,7 @@ def test_a_sample_of_mutants() -> None:
     )
 
 
+@pytest.mark.slow
 def test_a_stalled_case_is_a_hang_and_the_next_case_runs(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("ERTOOLS_FUZZ_STALL", "1")
     results = run_cases(seed=1, indices=[0, 1, 2], jobs=1, timeout=3.0)

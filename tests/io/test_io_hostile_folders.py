@@ -91,6 +91,7 @@ def test_a_folder_really_unreadable(tmp_path: Path) -> None:
     assert [p.problem for p in found.problems] == ["folder skipped: permission denied"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("argv", "code", "kind"),
     [
@@ -159,6 +160,7 @@ def test_a_folder_deeper_than_the_path_limit_is_one_short_problem(tmp_path: Path
     assert len(f"{problem.path}: {problem.problem}") < 200
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("argv", "code", "kind"),
     [

@@ -52,6 +52,7 @@ def test_info_json_every_format(
     }.get(fmt, fmt)
 
 
+@pytest.mark.slow
 def test_info_table_and_yaml(
     capsys: pytest.CaptureFixture[str], scene: Scene, tmp_path: Path
 ) -> None:
@@ -110,6 +111,7 @@ def test_empty_random_missing_and_empty_dir(
     one_error_line(err, "nobags", "holds no bags")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["ros1", "ros1-bz2", "mcap-cdr"])
 def test_truncated_anywhere(
     capsys: pytest.CaptureFixture[str], scene: Scene, tmp_path: Path, fmt: str
@@ -127,6 +129,7 @@ def test_truncated_anywhere(
         one_error_line(err, bad.name)
 
 
+@pytest.mark.slow
 def test_corrupted_chunk(capsys: pytest.CaptureFixture[str], scene: Scene, tmp_path: Path) -> None:
     good = write(tmp_path / "good.bag", "ros1-lz4", scene.spec, chunk_bytes=2000)
     data = bytearray(good.read_bytes())
@@ -159,6 +162,7 @@ def test_good_and_bad_together(
     one_error_line(err, "bad.bag")
 
 
+@pytest.mark.slow
 def test_corrupted_record_in_uncompressed_chunk(
     capsys: pytest.CaptureFixture[str], scene: Scene, tmp_path: Path
 ) -> None:

@@ -123,6 +123,9 @@ def check_reads(path: Path, scene: Scene) -> None:
     np.testing.assert_array_equal(record_times(path)[POSE], scene.t_rec)
 
 
+@pytest.mark.slow_cases(
+    "channels-only-in-chunks", "no-chunk-indexes", "no-message-indexes", "schemas-only-in-chunks"
+)
 @pytest.mark.parametrize("layout", LAYOUTS)
 def test_layout_read_exactly(
     layout: str,
@@ -147,6 +150,7 @@ def test_layout_read_exactly(
     assert bag["messages"] == len(scene.spec.msgs)
 
 
+@pytest.mark.slow
 def test_no_summary_section(
     tmp_path: Path, scene: Scene, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -253,6 +257,7 @@ def test_scan_finds_every_record(
     assert len(kept) == int((found.channel_id == 1).sum())
 
 
+@pytest.mark.slow
 def test_verbose_says_why_a_file_is_read_record_by_record(
     tmp_path: Path, scene: Scene, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -265,6 +270,7 @@ def test_verbose_says_why_a_file_is_read_record_by_record(
     assert "record by record" not in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_rosbag2_mcap_storage_without_summary(tmp_path: Path, scene: Scene) -> None:
     folder = write(tmp_path / "r2", "rosbag2-mcap", scene.spec)
     (storage,) = folder.glob("*.mcap")

@@ -46,6 +46,7 @@ def test_many_groups_on_worker_threads_equal_rosbags(
     assert_same(fast_batch(path, topic), reference_batch(path, topic))
 
 
+@pytest.mark.slow_cases("rosbag2-mcap", "rosbag2-sqlite3")
 def test_many_groups_with_a_window_equal_rosbags(
     scene_bag: tuple[str, Path], small_groups: None
 ) -> None:
@@ -96,6 +97,7 @@ def test_worker_error_reaches_the_caller_as_itself(monkeypatch: pytest.MonkeyPat
     assert not [t for t in threading.enumerate() if t.name.startswith("ThreadPoolExecutor")]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["ros1", "ros1-lz4", "ros1-bz2", "mcap-cdr"])
 def test_damaged_chunk_read_on_a_worker_is_one_ertools_error(
     tmp_path: Path, scene: Scene, fmt: str, small_groups: None

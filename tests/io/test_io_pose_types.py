@@ -34,6 +34,8 @@ from ertools.io.decode.fast import decode
 from ertools.io.decode.uniform import decode_uniform, layout_of
 from ertools.io.model import POSE_TYPES, PoseSource
 
+pytestmark = pytest.mark.slow
+
 T0 = 1_700_000_000_000_000_000
 N = 40
 # topic -> (type, child frame written, frame written)

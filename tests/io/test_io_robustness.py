@@ -15,6 +15,8 @@ import ertools.io as eio
 from ertools.errors import ErtoolsError
 from ertools.io.info import describe
 
+pytestmark = pytest.mark.slow
+
 
 @pytest.mark.parametrize("fmt", ["ros1", "ros1-lz4", "mcap-cdr", "rosbag2-sqlite3"])
 def test_cut_or_flipped_bytes_give_ertools_errors(

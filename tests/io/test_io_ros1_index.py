@@ -124,6 +124,7 @@ def test_sound_bags_check_clean(tmp_path: Path, fmt: str) -> None:
     assert check_ros1(two_topic_bag(tmp_path / "b.bag", fmt)) == []
 
 
+@pytest.mark.slow
 def test_sample_and_real_bags_check_clean() -> None:
 
     # (the samples include deliberately truncated bags: those already fail the summary)

@@ -68,6 +68,7 @@ def test_tf_direct_and_chain(scene: Scene, scene_bag: tuple[str, Path]) -> None:
     )
 
 
+@pytest.mark.slow_cases("rosbag2-mcap")
 def test_states_decode_from_stored_definitions(scene: Scene, scene_bag: tuple[str, Path]) -> None:
     _, path = scene_bag
     states = eio.read_benchmark_states(path, "fbm3w")
@@ -81,6 +82,7 @@ def test_states_decode_from_stored_definitions(scene: Scene, scene_bag: tuple[st
     np.testing.assert_array_equal(states.refbox.t_ns, scene.t_rec[idx] + 1)
 
 
+@pytest.mark.slow_cases("rosbag2-mcap", "rosbag2-sqlite3")
 def test_window_and_messages(scene: Scene, scene_bag: tuple[str, Path]) -> None:
     _, path = scene_bag
     lo, hi = int(scene.t_rec[10]), int(scene.t_rec[20])
@@ -114,6 +116,7 @@ def test_unknown_topic_lists_pose_topics(scene_bag: tuple[str, Path]) -> None:
         eio.read_poses(path, "/chatter")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["ros1", "mcap-cdr", "rosbag2-sqlite3"])
 def test_split_files_merge_in_time_order(
     tmp_path: Path, fmt: str, caplog: pytest.LogCaptureFixture

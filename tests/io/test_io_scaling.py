@@ -32,6 +32,8 @@ import ertools.io as eio
 from ertools import caches
 from ertools.io.info import describe
 
+pytestmark = pytest.mark.slow
+
 T0 = 1_448_020_800 * 10**9
 SMALL, LARGE = 400, 1600
 MAX_RATIO = 6.0

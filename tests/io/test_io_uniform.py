@@ -131,6 +131,7 @@ def test_topic_with_a_different_frame_midway_matches_rosbags(fmt: str, tmp_path:
     assert list(fast.frame_names()[[0, 25, 50]]) == ["world", "earth", "map"]
 
 
+@pytest.mark.slow_cases("ros1-bz2", "ros1-lz4", "ros1", "rosbag2-mcap", "rosbag2-sqlite3")
 def test_uniform_decoder_is_used_on_standard_topics(
     scene_bag: tuple[str, Path], monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -11,7 +11,10 @@ from stderr_text import error_messages
 from ertools.cli.main import main
 from ertools.live.tail import is_finished, read_complete
 
+pytestmark = pytest.mark.xdist_group("timing")
 
+
+@pytest.mark.slow
 def test_simulate_demo_records_and_summarises(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -13,6 +13,8 @@ from ertools.cli.main import main
 from ertools.errors import ClockError
 from ertools.live.clock import ns_to_ntp, ntp_to_ns, query_sntp
 
+pytestmark = pytest.mark.xdist_group("timing")
+
 
 @pytest.mark.parametrize("offset", [2.5, -0.25, 0.0])
 def test_offset_is_measured_within_half_the_delay(offset: float) -> None:
@@ -61,6 +63,7 @@ def test_cli_within_and_outside_tolerance(capsys: pytest.CaptureFixture[str]) ->
         assert abs(offset - 0.2) <= delay / 2 + 2e-6
 
 
+@pytest.mark.slow
 def test_cli_unreachable_is_one_line(capsys: pytest.CaptureFixture[str]) -> None:
     port = free_udp_port()  # nobody listens there
     code = main(["clock", "--server", "127.0.0.1", "--port", str(port), "--timeout", "0.3"])

@@ -17,6 +17,8 @@ from ertools.errors import BagError
 from ertools.live.simulate import SimulatedBody, SimulatedMotive
 from ertools.live.tail import is_finished, read_complete
 
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("timing")]
+
 REPO = Path(__file__).resolve().parents[2]
 
 

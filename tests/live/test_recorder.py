@@ -20,6 +20,8 @@ from ertools.live.recorder import Recorder, RecordOptions, RecordSummary
 from ertools.live.simulate import SimulatedBody, SimulatedMotive, make_frame
 from ertools.live.tail import is_finished, read_complete
 
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("timing")]
+
 CONFIG = parse_mocap_config(
     """
 rigid_bodies:

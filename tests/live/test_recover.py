@@ -26,6 +26,8 @@ from ertools.live.recover import RECOVERY_METADATA
 from ertools.live.rosmsg import Ros2Serializer
 from ertools.live.tail import is_finished
 
+pytestmark = pytest.mark.xdist_group("timing")
+
 TOPICS = ("/fbm2h/robot_at_home/pose2d", "/fbm2h/origin/pose2d")
 PER_FLUSH = 50  # messages between two flushes (a flush closes a chunk)
 FLUSHES = 4  # flushes before the kill
@@ -93,6 +95,7 @@ def info_messages(path: Path, capsys: pytest.CaptureFixture[str]) -> tuple[int, 
     return code, int(bag["messages"]), err
 
 
+@pytest.mark.slow
 def test_a_killed_recording_made_whole(
     killed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -141,6 +144,7 @@ def chunk_ends(path: Path) -> list[int]:
     return ends
 
 
+@pytest.mark.slow_cases("mid-chunk")
 @pytest.mark.parametrize("where", ["mid-chunk", "after-chunk", "one-byte-into-next"])
 def test_a_cut_inside_a_record_keeps_the_complete_chunks(
     where: str, killed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]

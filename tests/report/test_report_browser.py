@@ -29,7 +29,7 @@ from audit_streams import heartbeat
 from fakes import BROWSER, CHROMIUM_FLAGS
 from test_audit import BMBOX, CLIENT, REFBOX
 
-pytestmark = pytest.mark.browser
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 FLAGS = list(CHROMIUM_FLAGS)
 # EXECUTING_GOAL in the timeline figure (ertools.report.plots_audit: Okabe-Ito's bluish

@@ -94,6 +94,7 @@ def test_a_phase_keeps_its_colour_across_lanes() -> None:
     assert bm["TRANSMITTING_SCORE"] == ref["RECEIVED_SCORE"]
 
 
+@pytest.mark.slow
 def test_timeline_bars_are_drawn_in_their_state_colour() -> None:
     audit = audit_states(
         heartbeat(Machine.BMBOX, BMBOX, 20.0),

@@ -144,6 +144,7 @@ def test_same_inputs_are_one_execution(tmp_path: Path) -> None:
     assert "3 result(s) of 2 execution(s)" in page
 
 
+@pytest.mark.slow
 def test_the_fbm2h_sample_scored_twice_is_one_row(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -132,6 +132,7 @@ def test_sha256_of_a_rosbag2_directory(tmp_path: Path) -> None:
     assert sha256_file(d) == hashlib.sha256(lines.encode()).hexdigest()
 
 
+@pytest.mark.slow
 def test_audit_report_has_timeline_figure(tmp_path: Path) -> None:
     audit = audit_states(
         heartbeat(Machine.BMBOX, BMBOX, 20.0, drop=(5.0, 7.0)),
@@ -157,6 +158,7 @@ def test_audit_report_has_timeline_figure(tmp_path: Path) -> None:
     assert "EXECUTING_GOAL" in page and "TRANSMITTING_GOAL" in page
 
 
+@pytest.mark.slow
 def test_report_of_score_bag_includes_its_audit(tmp_path: Path) -> None:
     """A score report whose bag has the state topics audits them by itself."""
 

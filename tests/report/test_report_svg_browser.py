@@ -24,6 +24,8 @@ from matplotlib.image import imread
 from ertools import api
 from ertools.report.folder import write_report
 
+pytestmark = pytest.mark.slow
+
 REPO = Path(__file__).resolve().parents[2]
 FBM3W = sorted((REPO / "sample_bags" / "fbm3w").glob("*.bag"))
 FBM2H = REPO / "sample_bags" / "fbm2h"

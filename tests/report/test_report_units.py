@@ -24,6 +24,8 @@ from yaml_rounding import YAML_ROUNDING
 from ertools.cli.main import main
 from ertools.report.folder import write_report
 
+pytestmark = pytest.mark.slow
+
 ROOT = Path(__file__).resolve().parents[2]
 S = ROOT / "sample_bags"
 COMMANDS = {

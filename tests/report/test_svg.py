@@ -166,6 +166,7 @@ def test_matplotlib_draws_the_same_layers() -> None:
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["line", "interval", "gap"]
 
 
+@pytest.mark.slow
 def test_hostile_values_never_reach_the_svg() -> None:
     """Random charts of every layer with NaN, +-inf, empty arrays and values over twelve
     decades: well-formed SVG, and no NaN or infinity in any attribute (a browser would drop

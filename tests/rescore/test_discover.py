@@ -22,6 +22,8 @@ from ertools.timelines.build import build_timeline
 from ertools.timelines.model import BagEntry, Pairing
 from ertools.timelines.scan import scan
 
+pytestmark = pytest.mark.slow
+
 S = 1_000_000_000
 T0 = 1_448_013_600 * S  # 2015-11-20 10:00:00 UTC
 

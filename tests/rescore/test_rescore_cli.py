@@ -114,6 +114,7 @@ def test_score_is_the_score_commands_json(tmp_path: Path) -> None:
         assert row["report"] is None
 
 
+@pytest.mark.slow
 def test_a_failure_costs_one_row(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     comp = make_competition(
         tmp_path / "comp",
@@ -234,6 +235,7 @@ class _Terminal(io.StringIO):
         return True
 
 
+@pytest.mark.slow
 def test_progress_bar_on_a_terminal(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     comp = make_competition(
         tmp_path / "comp",

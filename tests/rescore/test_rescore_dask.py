@@ -19,6 +19,8 @@ from rescore_competition import LOGS, expected_value, make_competition, use_toy_
 
 from ertools.cli.main import main
 
+pytestmark = pytest.mark.slow
+
 distributed = pytest.importorskip(
     "distributed", reason="needs the dask extra: pip install -e '.[dask]'"
 )

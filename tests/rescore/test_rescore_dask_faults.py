@@ -16,6 +16,8 @@ from rescore_competition import make_competition
 from test_rescore_dask import DASK, HERE, free_port, worker_command
 from test_rescore_faults import HOLD, TOY_RESCORE, wait_for
 
+pytestmark = pytest.mark.slow
+
 distributed = pytest.importorskip(
     "distributed", reason="needs the dask extra: pip install -e '.[dask]'"
 )

@@ -23,6 +23,7 @@ from ertools.demo import make_competition
 
 pytestmark = [
     pytest.mark.browser,
+    pytest.mark.slow,
     pytest.mark.skipif(BROWSER is None, reason="chromium not installed (apt-get install chromium)"),
 ]
 

@@ -34,6 +34,8 @@ from fakes import BROWSER, CHROMIUM_FLAGS
 from ertools.cli.main import main
 from ertools.competition.manifest import load_manifest
 
+pytestmark = pytest.mark.slow
+
 REPO = Path(__file__).resolve().parents[2]
 SAMPLES = REPO / "sample_bags"
 REAL = REPO / ".." / "shared" / "real_bags"

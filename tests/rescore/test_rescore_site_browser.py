@@ -36,6 +36,7 @@ from timeline_day import day_timeline
 
 pytestmark = [
     pytest.mark.browser,
+    pytest.mark.slow,
     pytest.mark.skipif(BROWSER is None, reason="chromium not installed (apt-get install chromium)"),
 ]
 

@@ -20,6 +20,8 @@ from pathlib import Path
 import pytest
 from rescore_competition import LOGS, OFFSETS, SCALE, expected_value, make_competition
 
+pytestmark = pytest.mark.slow
+
 HERE = Path(__file__).parent
 ROUNDS = 3
 # three rounds of a few seconds each; a hang would otherwise block the suite

@@ -27,6 +27,8 @@ from ertools.cli.main import main
 from ertools.samples.__main__ import main as samples_main
 from ertools.samples.competition_schedule import MISSING_TRANSFORM, SCHEDULE, TRUNCATED
 
+pytestmark = pytest.mark.slow
+
 SEED = 2015_11_20
 UNSCOREABLE = sorted(
     s.id

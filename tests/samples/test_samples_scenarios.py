@@ -38,6 +38,7 @@ def _files(root: Path) -> dict[str, bytes]:
     }
 
 
+@pytest.mark.slow
 def test_stationary_answers_match_the_bag(tmp_path: Path) -> None:
     paths = load_scenario("stationary")(tmp_path, seed=11)
     bag = next(p for p in paths if p.suffix == ".bag")
@@ -79,6 +80,7 @@ def test_stationary_answers_match_the_bag(tmp_path: Path) -> None:
     assert bag.stat().st_size < 2_600_000
 
 
+@pytest.mark.slow
 def test_stationary_is_byte_identical_on_rerun(tmp_path: Path) -> None:
     assert main([str(tmp_path / "a"), "--only", "stationary"]) == 0
     assert main([str(tmp_path / "b"), "--only", "stationary"]) == 0
@@ -89,6 +91,7 @@ def test_stationary_is_byte_identical_on_rerun(tmp_path: Path) -> None:
     assert _files(tmp_path / "c") != a
 
 
+@pytest.mark.slow
 def test_rerun_replaces_a_scenario_folder(tmp_path: Path) -> None:
     assert main([str(tmp_path), "--only", "stationary"]) == 0
     (tmp_path / "stationary" / "stale.txt").write_text("old")
@@ -97,6 +100,7 @@ def test_rerun_replaces_a_scenario_folder(tmp_path: Path) -> None:
     assert not list(tmp_path.glob(".*partial"))
 
 
+@pytest.mark.slow
 def test_missing_scenario_module_is_an_error_naming_it(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -193,6 +197,7 @@ def _differences(
     return found
 
 
+@pytest.mark.slow
 def test_sample_bags_folder_regenerates_but_for_float_rounding(tmp_path: Path) -> None:
     missing = []
     for name in SCENARIOS:

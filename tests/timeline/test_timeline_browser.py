@@ -22,7 +22,7 @@ from ertools.report.timeline_page import write_timeline_page
 from ertools.timelines.model import Timeline
 from ertools.timelines.scan import scan
 
-pytestmark = pytest.mark.browser
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 FLAGS = [
     *CHROMIUM_FLAGS,

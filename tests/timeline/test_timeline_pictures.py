@@ -198,6 +198,8 @@ def test_page_of_the_real_bag() -> None:
     check_page(page, tl, [label], [REAL_BAG.name])
 
 
+@pytest.mark.slow
+@pytest.mark.xdist_group("timing")
 def test_page_of_1000_bags_is_built_quickly() -> None:
     tl = many_bags(1000)
     t = time.perf_counter()
@@ -219,6 +221,7 @@ def session_axes(fig: Any) -> dict[int, Any]:
     }
 
 
+@pytest.mark.slow
 def test_figure_has_one_panel_per_session_spanning_it() -> None:
     tl = day_timeline()
     fig = timeline_figure(tl)
@@ -239,6 +242,7 @@ def test_figure_has_one_panel_per_session_spanning_it() -> None:
     assert bar.get_width() / (hi - lo) == pytest.approx(8.0 / 8.8, abs=1e-6)
 
 
+@pytest.mark.slow
 def test_figure_colours_match_the_legend_and_problems_are_numbered() -> None:
     tl = day_timeline()
     fig = timeline_figure(tl)
@@ -298,6 +302,7 @@ def test_table_times_stay_on_one_line() -> None:
     assert len(spans) == 2 * (len(tl.sessions) + len(readable))  # start and end of each
 
 
+@pytest.mark.slow
 def test_figure_problem_list_fits_the_picture() -> None:
     """The numbered problems are listed within the picture, however wide the panels' lane
     labels make its left margin (the whole sample folder: a rosbag2 lane label of 42
@@ -319,6 +324,7 @@ def test_figure_problem_list_fits_the_picture() -> None:
 # --- the command line ------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_cli_plot_picks_the_format_by_suffix(folder: dict[str, Any], tmp_path: Path) -> None:
     page, png = tmp_path / "day.html", tmp_path / "day.png"
     argv = ["timeline", str(folder["root"]), "--plot", str(page), "--plot", str(png)]

@@ -86,6 +86,7 @@ def test_the_cap_is_in_the_help(capsys: pytest.CaptureFixture[str]) -> None:
         assert f"at most {MAX_DRAWS}" in " ".join(capsys.readouterr().out.split())
 
 
+@pytest.mark.slow
 def test_the_largest_seed_is_taken() -> None:
     """The cap is the int64 a result carries: the largest seed scores (and the Python API
     refuses the next one as the CLI does)."""

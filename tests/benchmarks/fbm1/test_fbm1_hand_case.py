@@ -116,6 +116,7 @@ def test_accuracy_over_10_divides_accuracy_by_ten_at_home() -> None:
     assert totals.pose_score == pytest.approx((SCORE1 + SCORE2) / 2, abs=TOL)
 
 
+@pytest.mark.slow
 def test_hand_case_through_a_bag_and_the_cli(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -39,6 +39,8 @@ from ertools.samples.statemachine import Transition, publish_states
 from ertools.samples.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
+pytestmark = pytest.mark.slow
+
 S = 1_000_000_000
 MS = 1_000_000
 T0 = 1_448_020_000 * S

@@ -12,6 +12,8 @@ import yaml
 from ertools.cli.main import main
 from ertools.samples.fbm1 import generate
 
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def sample(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:

@@ -32,6 +32,7 @@ WORK_RUNS = [
 ]
 
 
+@pytest.mark.slow
 def test_fbm1w_cli_uses_refbox_items(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     bag = write_bag(tmp_path / "work.bag", WORK_RUNS, namespace="fbm1w")
     items = write_items(tmp_path / "fbm1w.yaml")
@@ -47,6 +48,7 @@ def test_fbm1w_cli_uses_refbox_items(tmp_path: Path, capsys: pytest.CaptureFixtu
     assert "--gt result" in " ".join(data["deviations"])
 
 
+@pytest.mark.slow
 def test_fbm1w_items_order(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     runs = [RunSpec("", r.answer) for r in WORK_RUNS]  # nothing names the items in the log
     bag = write_bag(tmp_path / "work.bag", runs, namespace="fbm1w")

@@ -38,6 +38,7 @@ def _one_error_line(err: str, *needles: str) -> None:
         assert needle in lines[0], lines[0]
 
 
+@pytest.mark.slow_cases("not-increasing")
 @pytest.mark.parametrize(
     ("edit", "needle"),
     [

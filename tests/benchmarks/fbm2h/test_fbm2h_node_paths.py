@@ -41,6 +41,8 @@ from ertools.states import ClientState as C
 from ertools.states import Machine
 from ertools.states import RefBoxState as R
 
+pytestmark = pytest.mark.slow
+
 S = 1_000_000_000
 MS = 1_000_000
 T0 = 1_448_020_800 * S  # 2015-11-20T12:00:00Z

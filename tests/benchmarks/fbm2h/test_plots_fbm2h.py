@@ -6,6 +6,7 @@ import math
 from pathlib import Path
 
 import numpy as np
+import pytest
 import svg_figure
 from matplotlib.figure import Figure
 
@@ -15,6 +16,8 @@ from ertools.configs.goal import GoalList
 from ertools.configs.transform import identity_transform
 from ertools.report.figures import figure_specs, save_figures
 from ertools.streams import PoseStream
+
+pytestmark = pytest.mark.slow
 
 S = 1_000_000_000
 

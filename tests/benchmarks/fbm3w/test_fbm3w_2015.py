@@ -156,6 +156,7 @@ def _check(out: dict[str, Any], node: dict[str, Any]) -> None:
         assert got["execution_time"] == pytest.approx(d["execution_time"], abs=TOL)
 
 
+@pytest.mark.slow
 def test_sample_bag_2015_equals_the_node(
     fbm3w_sample: Sample, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -305,6 +306,7 @@ def _node(poses: PoseStream, bm: Transitions, rb: Transitions, specs: list[str])
 SEAM = (math.pi - 0.01, -math.pi + 0.01)
 
 
+@pytest.mark.slow_cases("-3.1315926535897933")
 @pytest.mark.parametrize("yaw", SEAM)
 def test_run_timing_out_midway_is_scored_and_can_be_best(yaw: float) -> None:
     common = {"path_s": 3.0, "origin": (1.2, 0.7), "yaw": yaw}
@@ -330,6 +332,7 @@ def test_run_timing_out_midway_is_scored_and_can_be_best(yaw: float) -> None:
     assert default["execution_time"] == pytest.approx(node["execution_time"], abs=TOL)
 
 
+@pytest.mark.slow
 def test_stopped_run_is_neither_scored_nor_timed() -> None:
     common = {"path_s": 4.0, "origin": (-0.4, 1.1), "yaw": 2.0}
     runs = [
@@ -352,6 +355,7 @@ def test_stopped_run_is_neither_scored_nor_timed() -> None:
     assert default["execution_time"] == pytest.approx(node["execution_time"] + stopped_s, abs=TOL)
 
 
+@pytest.mark.slow
 def test_2015_and_arc_length_contradict(
     fbm3w_sample: Sample, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -381,6 +385,7 @@ def test_frozen_reference_pose_is_warned() -> None:
     assert not [w for w in plain.warnings if "frozen" in w]
 
 
+@pytest.mark.slow
 def test_2015_uses_the_script_d_min_over_the_config(
     fbm3w_sample: Sample, tmp_path: Any, capsys: pytest.CaptureFixture[str]
 ) -> None:

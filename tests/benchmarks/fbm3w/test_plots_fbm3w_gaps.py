@@ -56,6 +56,7 @@ def _tolerance(fig: svg_figure.Figure) -> float:
     return max(abs(fig.scale("x")[0]), abs(fig.scale("y")[0]))
 
 
+@pytest.mark.slow
 def test_a_gap_is_drawn_between_the_samples_around_the_hole(tmp_path: Path) -> None:
     # 30 frames cut: 0.258 s, under the 0.5 s a path may cross, so the run is scored
     result = _result((1000, 1030))
@@ -94,6 +95,7 @@ def test_an_unscoreable_run_has_its_figure_and_verdict(tmp_path: Path) -> None:
     assert any(t.endswith("% valid") for t in runs.texts("label"))
 
 
+@pytest.mark.slow
 def test_matplotlib_draws_the_gaps_too(tmp_path: Path) -> None:
     for cut in ((1000, 1030), (1000, 1072)):
         path = _figure(_result(cut), tmp_path, "png")

@@ -18,6 +18,8 @@ from ertools.samples import fbm3w
 from ertools.samples.stationary import generate
 from ertools.streams import PoseStream
 
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def stationary(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:

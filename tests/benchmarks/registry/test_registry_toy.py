@@ -170,6 +170,7 @@ def test_score_takes_the_declared_inputs(toy: Path, capsys: pytest.CaptureFixtur
     ]
 
 
+@pytest.mark.slow
 def test_report_folder_and_combined_page(
     toy: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -27,6 +27,8 @@ from ertools.geometry import quat_from_yaw
 from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC
 from ertools.samples.writer import BagWriter
 
+pytestmark = pytest.mark.slow
+
 FORMATS = {"ros1": "bag", "mcap": "mcap"}
 
 

@@ -94,6 +94,7 @@ def test_a_long_hole_is_unscoreable_unless_2015() -> None:
     assert held["position_error"] is not None
 
 
+@pytest.mark.slow
 def test_the_score_command_prints_validity(
     robotlog: dict[str, Any], capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -110,6 +111,7 @@ def test_the_score_command_prints_validity(
     assert again["position_error"] == data["position_error"]
 
 
+@pytest.mark.slow
 def test_the_error_figures_shade_the_hole(tmp_path: Path) -> None:
     robot, gt = _streams((1.05, 3.05))
     result = score_streams(robot, gt, TrajectoryConfig())
