@@ -2,7 +2,7 @@
 (``inside_s``: the work itself, after the imports, which are timed apart as ``import_s``).
 
 python bench/extract.py bytes PATH              read the file's bytes
-python bench/extract.py ertools PATH TOPIC      ertools.io.read_poses -> arrays
+python bench/extract.py ertools PATH TOPIC      ertools.io.reader.read_poses -> arrays
 python bench/extract.py rosbags PATH TOPIC      rosbags AnyReader, one message at a time
 python bench/extract.py inflate PATH            read and decompress every chunk, no decoding
 """
@@ -19,7 +19,7 @@ def main() -> None:
     mode, path = sys.argv[1], Path(sys.argv[2])
     t_import = time.perf_counter()
     if mode == "ertools":
-        from ertools.io import read_poses
+        from ertools.io.reader import read_poses
     elif mode == "rosbags":
         import numpy as np
         from rosbags.highlevel import AnyReader

@@ -18,17 +18,17 @@ from typing import TYPE_CHECKING, Any
 from ertools._version import __version__
 
 # The public names, once, in the order docs/api.md shows them.
-__all__ = [
+__all__ = [  # noqa: RUF022 (the docs' order, not alphabetical)
     "__version__",
-    "audit",
-    "export",
-    "figures",
     "info",
     "open_bag",
     "read_poses",
-    "rescore",
     "score",
+    "audit",
     "timeline",
+    "figures",
+    "export",
+    "rescore",
 ]
 API = tuple(__all__[1:])
 

@@ -35,7 +35,8 @@ from ertools.competition.manifest import ManifestError, load_manifest
 from ertools.competition.run import rescore_competition
 from ertools.errors import ConfigError, UsageError
 from ertools.exporting.formats import FORMATS, format_poses
-from ertools.io import files, summary
+from ertools.io import files
+from ertools.io.summary import summary
 from ertools.parameters import checked, paths_list, value_of
 from ertools.report.figures import figure_specs
 from ertools.report.plots_audit import draw_timeline

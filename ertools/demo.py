@@ -14,7 +14,12 @@ if __name__ == "__main__":
     # ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
     from ertools.launch import run as launch
 
-    sys.exit(launch("ertools.demo:main", "python -m ertools.demo"))
+    def _start() -> object:
+        from ertools.demo import main  # lazy: this module under its own name, in the guard
+
+        return main()
+
+    sys.exit(launch(_start, "python -m ertools.demo"))
 
 import io
 from collections.abc import Iterator

@@ -1,5 +1,5 @@
 """Reading ertools' stderr in tests: an error message longer than the CLI's line limit
-continues on indented lines (``ertools.cli.main.error_text``); here it is one line again."""
+continues on indented lines (``ertools.cli.text.error_text``); here it is one line again."""
 
 from __future__ import annotations
 

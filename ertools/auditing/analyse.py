@@ -2,7 +2,7 @@
 
 Pure: takes :class:`~ertools.streams.StateStream` objects (one per machine, ``None`` where a
 topic is absent) and returns a frozen :class:`Audit`. Reading the bag is the CLI's job
-(``ertools.io.read_benchmark_states``); recomputing the score is
+(``ertools.io.reader.read_benchmark_states``); recomputing the score is
 :mod:`ertools.auditing.recompute`'s.
 
 The audit finds:

@@ -15,7 +15,7 @@ from ertools.auditing.model import Audit
 from ertools.benchmarks import registry
 from ertools.benchmarks.common.which import log_benchmark
 from ertools.errors import BagError, ErtoolsError, ScoringError, UsageError
-from ertools.io import read_benchmark_states, topics
+from ertools.io.reader import read_benchmark_states, topics
 from ertools.states import STATE_TOPIC_SUFFIXES
 
 if TYPE_CHECKING:

@@ -33,7 +33,7 @@ from ertools.errors import UsageError
 
 if TYPE_CHECKING:
     from ertools.benchmarks.common.spec import PoseSpec
-    from ertools.io import PoseSource
+    from ertools.io.model import PoseSource
 
 EPILOG = """examples:
   ertools acquire items items.bag --items fbm1h-vanilla.yaml -o fbm1h.yaml

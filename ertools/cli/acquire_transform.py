@@ -26,7 +26,7 @@ from ertools.cli.options import (
 from ertools.cli.output import note, write_text
 from ertools.configs.transform import team_transform_path, transform_yaml
 from ertools.errors import ConfigError
-from ertools.io import summary
+from ertools.io.summary import summary
 from ertools.streams import Interval
 from ertools.timeutil import resolve_time, s_to_ns
 

@@ -14,9 +14,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import dump_yaml
-from ertools.cli.main import error_text, printable
 from ertools.cli.options import add_output
 from ertools.cli.output import dump_json, note, write_text
+from ertools.cli.text import error_text, printable
 from ertools.errors import BagError
 from ertools.io import info as bag_info
 from ertools.io.formats import find_bags

@@ -10,7 +10,7 @@ from typing import Any
 
 from ertools.atomic import write_text as write_file
 from ertools.benchmarks.base import jsonable
-from ertools.cli.main import error_text, printable
+from ertools.cli.text import error_text, printable
 from ertools.progress import clear_current
 
 
@@ -28,7 +28,7 @@ def write_text(text: str, output: Path | None) -> None:
 
 def note(message: str) -> None:
     """A human note on stderr (stdout stays parseable), below any progress bar; an
-    ``error: ...`` note as every error is printed (:func:`ertools.cli.main.error_text`)."""
+    ``error: ...`` note as every error is printed (:func:`ertools.cli.text.error_text`)."""
 
     clear_current()
     if message.startswith("error: "):

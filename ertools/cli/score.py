@@ -17,9 +17,9 @@ from typing import Any
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Input
 from ertools.benchmarks.common.which import refuse_other_benchmark
+from ertools.cli.command import Command, Delegate
 from ertools.cli.common import add_output_options, all_failed, emit_result
 from ertools.cli.groups import add_group_arguments, members_epilog, run_group
-from ertools.cli.main import Command
 from ertools.cli.options import deprecation_note
 from ertools.cli.output import note
 from ertools.errors import UsageError
@@ -30,20 +30,13 @@ _TYPES: dict[str, Any] = {"float": float, "int": int, "path": Path, "paths": Pat
 
 
 def members() -> dict[str, Command]:
-    """Every registered benchmark, as a member of the ``score`` group (this module)."""
+    """Every registered benchmark, as a member of the ``score`` group (this module); it
+    imports every declaration (every group module has this function)."""
     out = {}
     for name in registry.names():
         bench = registry.get(name)
         out[name] = Command(__name__, bench.summary, bench.example)
     return out
-
-
-def __getattr__(name: str) -> Any:
-    """``MEMBERS``, as the other command groups have it, built on first use (it imports
-    every declaration)."""
-    if name == "MEMBERS":
-        return members()
-    raise AttributeError(name)
 
 
 def _unread_members() -> dict[str, Command]:
@@ -223,7 +216,7 @@ def _bags(bench: registry.AnyBenchmark, values: dict[str, Any], bags: Sequence[P
     return out
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace) -> int | Delegate:
     name: str | None = getattr(args, "benchmark", None)
     if name is None:
         return run_group("score", _unread_members(), args)

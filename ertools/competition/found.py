@@ -40,8 +40,7 @@ from ertools.timelines.model import Timeline
 from ertools.timelines.scan import scan
 
 if TYPE_CHECKING:
-    from ertools.io import BagSummary
-    from ertools.io.model import ClockCheck
+    from ertools.io.model import BagSummary, ClockCheck
 
 ROBOT_BAG = "ROBOT_BAG"
 TIMELINE_PAGE = "timeline.html"

@@ -40,7 +40,7 @@ from ertools.competition.site import write_site
 from ertools.competition.site_text import TEAM_UNKNOWN
 from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ErtoolsError
-from ertools.io import summary
+from ertools.io.summary import summary
 from ertools.progress import Reporter
 from ertools.timeutil import NS_PER_S, iso_utc
 

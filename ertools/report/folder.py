@@ -36,7 +36,7 @@ from ertools.benchmarks.base import BenchmarkResult, Rows, jsonable
 from ertools.benchmarks.common.teams import team_from_log_name, team_from_transform_name
 from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ConfigError, ErtoolsError
-from ertools.io import read_benchmark_states
+from ertools.io.reader import read_benchmark_states
 from ertools.report import folder_page, plots_audit
 from ertools.report.figures import FigureSpec, figure_specs, save_figures
 from ertools.report.records import FileRecord, csv_stem, file_record

@@ -21,7 +21,12 @@ if __name__ == "__main__":
     # inside ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
     from ertools.launch import run as launch
 
-    sys.exit(launch("ertools.samples.__main__:program", "python -m ertools.samples"))
+    def _start() -> object:
+        from ertools.samples.__main__ import program  # lazy: own name, in the guard
+
+        return program()
+
+    sys.exit(launch(_start, "python -m ertools.samples"))
 
 import argparse
 import shutil

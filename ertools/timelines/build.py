@@ -14,7 +14,7 @@ name, folder or format (same topics, message counts, first and last message) is 
 its copies are listed under it and left out of overlaps, sessions and pairings, so a folder of
 1,000 copies gives one recording with 999 copies, not a million overlaps.
 
-Pure: it takes bag summaries (``ertools.io.BagSummary`` or anything with the same attributes),
+Pure: it takes bag summaries (``ertools.io.model.BagSummary`` or anything with the same attributes),
 never opens a file. :mod:`ertools.timelines.scan` is the IO edge that produces its inputs.
 """
 

@@ -26,7 +26,7 @@ KIND_LABELS: dict[str, str] = {
 
 
 class TopicLike(Protocol):
-    """What the timeline needs of a topic summary (``ertools.io.TopicSummary``)."""
+    """What the timeline needs of a topic summary (``ertools.io.model.TopicSummary``)."""
 
     @property
     def name(self) -> str: ...
@@ -39,7 +39,7 @@ class TopicLike(Protocol):
 
 
 class SummaryLike(Protocol):
-    """What the timeline needs of a bag summary (``ertools.io.BagSummary``)."""
+    """What the timeline needs of a bag summary (``ertools.io.model.BagSummary``)."""
 
     @property
     def path(self) -> str | Path: ...

@@ -14,16 +14,16 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ertools.errors import ErtoolsError
-from ertools.io import summary
 from ertools.io.clock import clock_check
 from ertools.io.formats import Found, Unreadable, find_bags
 from ertools.io.model import ClockCheck
+from ertools.io.summary import summary
 from ertools.progress import reporting
 from ertools.timelines.build import build_timeline, split_name
 from ertools.timelines.model import Timeline, TimelineConfig
 
 if TYPE_CHECKING:
-    from ertools.io import BagSummary
+    from ertools.io.model import BagSummary
     from ertools.progress import Reporter
 
 log = logging.getLogger("ertools.timelines.scan")

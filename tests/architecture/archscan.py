@@ -253,6 +253,19 @@ def root_imports(root: Path) -> set[str]:
     return out
 
 
+def facade_packages(root: Path) -> set[str]:
+    """Package ``__init__.py`` files (the root's aside) that import anything: a package that
+    re-exports its modules hides which one a user depends on (the contracts see the package)."""
+    out = set()
+    for path in sorted((root / "ertools").rglob("__init__.py")):
+        rel = path.relative_to(root).as_posix()
+        if rel != "ertools/__init__.py" and any(
+            isinstance(node, ast.Import | ast.ImportFrom) for node in ast.walk(_parse(path))
+        ):
+            out.add(rel)
+    return out
+
+
 SHARED_BENCHMARK_FOLDERS = frozenset({"common", "__pycache__"})
 # Names that mean one benchmark besides its package's: the registry's names and the sample
 # folders and configuration files that belong to one.

@@ -14,7 +14,7 @@ from ertools.auditing.compare import attach, flatten
 from ertools.auditing.model import Audit
 from ertools.auditing.recompute import ScoreInputs, audit_bag, rescore
 from ertools.cli.main import main
-from ertools.io import read_benchmark_states
+from ertools.io.reader import read_benchmark_states
 
 pytestmark = pytest.mark.slow
 

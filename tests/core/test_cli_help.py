@@ -12,7 +12,8 @@ import pytest
 from stderr_text import error_messages, joined_lines
 
 from ertools.benchmarks import registry
-from ertools.cli.main import COMMANDS, MAX_ERROR_LINE, error_text, main
+from ertools.cli.main import COMMANDS, main
+from ertools.cli.text import MAX_ERROR_LINE, error_text
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"

@@ -36,7 +36,8 @@ from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Writer
 from rosbags.typesys import Stores, get_typestore
 
-from ertools.cli.main import COMMANDS, MAX_ERROR_LINE, main
+from ertools.cli.main import COMMANDS, main
+from ertools.cli.text import MAX_ERROR_LINE
 
 REPO = Path(__file__).resolve().parents[2]
 SAMPLES = REPO / "sample_bags"
@@ -1331,8 +1332,8 @@ def test_non_finite_number_option(
 def _every_command() -> Iterator[list[str]]:
     for name, cmd in COMMANDS.items():
         yield [name]
-        members = getattr(import_module(cmd.module), "MEMBERS", None)
-        for member in members or ():
+        members = getattr(import_module(cmd.module), "members", None)
+        for member in members() if members is not None else ():
             yield [name, member]
 
 

@@ -13,9 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import ertools.io as eio
 from ertools.errors import BagError
 from ertools.io.info import describe
+from ertools.io.reader import read_poses
 
 REPO = Path(__file__).resolve().parents[2]
 if str(REPO) not in sys.path:
@@ -52,7 +52,7 @@ def damaged(tmp_path: Path, name: str, edits: list[tuple[int, bytes]]) -> Path:
 
 
 def assert_true_poses(path: Path) -> None:
-    rec = eio.read_poses(path, POSE_TOPIC, time_source="record")
+    rec = read_poses(path, POSE_TOPIC, time_source="record")
     np.testing.assert_array_equal(rec.t_ns, TRUE_T)
     np.testing.assert_allclose(rec.xyz[:, 0], TRUE_X, rtol=0, atol=1e-12)
 
@@ -82,7 +82,7 @@ def test_mcap_chunk_op_code_damaged_where_the_summary_indexes_a_chunk(tmp_path: 
     at, _n = site("mcap-lz4-nomsgindex", "chunk.opcode", 1)
     path = damaged(tmp_path, "mcap-lz4-nomsgindex", [(at, b"\xff")])
     with pytest.raises(BagError, match=r"indexes a chunk at byte .* where the records hold no"):
-        eio.read_poses(path, POSE_TOPIC)
+        read_poses(path, POSE_TOPIC)
 
 
 def test_mcap_records_after_a_footer_are_damage(tmp_path: Path) -> None:
@@ -90,7 +90,7 @@ def test_mcap_records_after_a_footer_are_damage(tmp_path: Path) -> None:
     at, _n = site("mcap-lz4-nomsgindex", "chunk.opcode", 4)
     path = damaged(tmp_path, "mcap-lz4-nomsgindex", [(at, b"\x02")])
     with pytest.raises(BagError, match="footer record ends at byte"):
-        eio.read_poses(path, POSE_TOPIC)
+        read_poses(path, POSE_TOPIC)
 
 
 def test_mcap_footer_before_damaged_magic_reads_as_finished(tmp_path: Path) -> None:
@@ -152,14 +152,14 @@ def test_ros1_record_conn_differing_from_its_index_entry_is_refused(tmp_path: Pa
     pose = next(s for s in conns if struct.unpack_from("<I", data, s.offset)[0] == 0)
     path = damaged(tmp_path, "ros1", [(pose.offset, struct.pack("<I", 1))])
     with pytest.raises(BagError, match="differs from its index entry"):
-        eio.read_poses(path, POSE_TOPIC)
+        read_poses(path, POSE_TOPIC)
 
 
 def test_ros1_two_connection_records_with_one_id_are_damage(tmp_path: Path) -> None:
     at, _n = site("ros1", "connection.conn", 1)
     path = damaged(tmp_path, "ros1", [(at, struct.pack("<I", 0))])
     with pytest.raises(BagError):
-        eio.read_poses(path, POSE_TOPIC)
+        read_poses(path, POSE_TOPIC)
 
 
 # --- the judge's evidence and verdict --------------------------------------------------------

@@ -11,8 +11,6 @@ from mcap.reader import make_reader
 from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Writer
 
-import ertools.io as eio
-from ertools.io import summary
 from ertools.io.bagfile import BagFile, RawRecord
 from ertools.io.bulk import try_fast_batch
 from ertools.io.decode.posebatch import PoseBatch
@@ -20,7 +18,9 @@ from ertools.io.decode.typestore import Deserializer
 from ertools.io.files import RosbagsFile, open_bag
 from ertools.io.formats import detect_format, find_bags
 from ertools.io.model import POSE_TYPES, Conn
-from ertools.io.reader import _bulk_states, slow_pose_batch
+from ertools.io.reader import _bulk_states, read_poses, read_states, read_tf, slow_pose_batch
+from ertools.io.reader import topics as bag_topics
+from ertools.io.summary import summary
 
 POSE_TOPICS = (
     "/fbm3w/robot_at_work/pose",
@@ -149,7 +149,7 @@ def test_real_bag_end_to_end() -> None:
         conns = [c for c in reader.connections if c.topic == "/fbm2h/robot_at_home/pose"]
         _, t_first, raw = next(reader.messages(connections=conns))
         first = reader.deserialize(raw, conns[0].msgtype)
-    found = eio.topics(REAL_BAG)
+    found = bag_topics(REAL_BAG)
     assert found == {
         "/fbm2h/map": "nav_msgs/OccupancyGrid",
         "/fbm2h/map_metadata": "nav_msgs/MapMetaData",
@@ -158,21 +158,21 @@ def test_real_bag_end_to_end() -> None:
         "/rosout": "rosgraph_msgs/Log",
         "/tf": "tf2_msgs/TFMessage",
     }
-    s = eio.summary(REAL_BAG)
+    s = summary(REAL_BAG)
     assert (s.start_ns, s.end_ns) == (start, end)
-    pose = eio.read_poses(REAL_BAG, "/fbm2h/robot_at_home/pose")
-    rec = eio.read_poses(REAL_BAG, "/fbm2h/robot_at_home/pose", time_source="record")
+    pose = read_poses(REAL_BAG, "/fbm2h/robot_at_home/pose")
+    rec = read_poses(REAL_BAG, "/fbm2h/robot_at_home/pose", time_source="record")
     assert len(pose) == 6887 and rec.t_ns[0] == t_first
     p, q = first.pose.position, first.pose.orientation
     assert pose.t_ns[0] == first.header.stamp.sec * 10**9 + first.header.stamp.nanosec
     np.testing.assert_array_equal(pose.xyz[0], [p.x, p.y, p.z])
     np.testing.assert_array_equal(pose.quat_xyzw[0], [q.x, q.y, q.z, q.w])
     assert pose.frame_id == first.header.frame_id == "world"
-    assert len(eio.read_poses(REAL_BAG, "/fbm2h/robot_at_home/pose2d")) == 6887
-    tf = eio.read_tf(REAL_BAG, "world", "robot_at_home")
+    assert len(read_poses(REAL_BAG, "/fbm2h/robot_at_home/pose2d")) == 6887
+    tf = read_tf(REAL_BAG, "world", "robot_at_home")
     assert len(tf) == 6887
     np.testing.assert_array_equal(tf.xyz[0], pose.xyz[0])  # the mocap node publishes both
-    static = eio.read_tf(REAL_BAG, "world", "map")
+    static = read_tf(REAL_BAG, "world", "map")
     assert len(static) == 573
 
 
@@ -238,5 +238,5 @@ def test_other_state_layout_falls_back(tmp_path: Path) -> None:
                 + (7).to_bytes(4, "little")
             )
             w.write(c, 10**18 + i, raw)
-    s = eio.read_states(path, "/fbm1h/bmbox_state")
+    s = read_states(path, "/fbm1h/bmbox_state")
     assert s.state.tolist() == [0, 1, 2] and s.payload == ("p0", "p1", "p2")

@@ -12,7 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from ertools.cli.main import MAX_ERROR_LINE, main
+from ertools.cli.main import main
+from ertools.cli.text import MAX_ERROR_LINE
 from ertools.io.formats import find_bags, regular_files
 
 REPO = Path(__file__).resolve().parents[2]

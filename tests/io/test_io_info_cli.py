@@ -15,7 +15,7 @@ from test_io_summary import make_active
 
 from ertools.cli.main import main
 from ertools.errors import BagError
-from ertools.io import read_poses
+from ertools.io.reader import read_poses
 
 POSE = "/fbm3w/robot_at_work/pose"
 

@@ -23,11 +23,11 @@ from io_scene import Scene
 from mcap.reader import make_reader
 from test_io_fastpath import POSE_TOPICS, assert_same, fast_batch, reference_batch
 
-import ertools.io as eio
 from ertools.errors import BagError, ErtoolsError
 from ertools.io import bulk, pipeline
 from ertools.io.files import open_bag
 from ertools.io.mcap.index import _in_order
+from ertools.io.reader import read_poses
 from ertools.io.ros1 import runs as ros1_runs
 
 
@@ -114,7 +114,7 @@ def test_damaged_chunk_read_on_a_worker_is_one_ertools_error(
             data[int(at)] ^= 0x5A
         path.write_bytes(bytes(data))
         try:
-            eio.read_poses(path, "/fbm3w/robot_at_work/pose")
+            read_poses(path, "/fbm3w/robot_at_work/pose")
         except ErtoolsError as err:
             assert str(err)
             raised += 1

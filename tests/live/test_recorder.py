@@ -221,7 +221,7 @@ def test_read_complete_agrees_with_mcap_reader(tmp_path: Path) -> None:
 def test_ertools_io_reads_the_recording(tmp_path: Path) -> None:
     io = pytest.importorskip("ertools.io", reason="ertools.io not built yet")
     if not hasattr(io, "read_poses"):
-        pytest.skip("ertools.io.read_poses not available yet")
+        pytest.skip("ertools.io.reader.read_poses not available yet")
     summary, motive, _ = run_recording(
         tmp_path, {"bodies": (SimulatedBody(3),), "n_frames": 30, "rate_hz": 100.0}
     )

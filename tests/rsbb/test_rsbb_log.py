@@ -10,7 +10,7 @@ import pytest
 from rsbb_replay.scenarios import MS, at, hnf_scenario
 
 from ertools.errors import TopicError
-from ertools.io import read_messages, topics
+from ertools.io.reader import read_messages, topics
 from ertools.rsbb.log import (
     EndKind,
     GoalOutcome,

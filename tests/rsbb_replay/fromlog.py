@@ -18,7 +18,7 @@ from typing import Any
 
 import yaml
 
-from ertools.io import read_messages, topics
+from ertools.io.reader import read_messages, topics
 from rsbb_replay.tf2 import Buffer, frame
 from rsbb_replay.world import TGoal, Timeline, TManual
 

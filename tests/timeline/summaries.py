@@ -1,4 +1,4 @@
-"""Hand-made bag summaries for the pure timeline (what ``ertools.io.BagSummary`` offers)."""
+"""Hand-made bag summaries for the pure timeline (what ``ertools.io.model.BagSummary`` offers)."""
 
 from __future__ import annotations
 

@@ -27,7 +27,7 @@ from typing import Any, Literal
 import yaml
 
 from ertools.errors import ErtoolsError
-from ertools.io import read_benchmark_states
+from ertools.io.reader import read_benchmark_states
 from ertools.yamlin import load as load_yaml
 
 TeamSource = Literal["explicit", "payload", "log name", "transform"]

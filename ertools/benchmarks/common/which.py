@@ -14,7 +14,7 @@ from typing import Any
 
 from ertools.benchmarks import registry
 from ertools.errors import ErtoolsError, UsageError
-from ertools.io import topics
+from ertools.io.reader import topics
 
 GT_USE = "ertools score trajectory ROBOT_BAG MOCAP..."
 

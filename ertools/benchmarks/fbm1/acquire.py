@@ -26,12 +26,12 @@ from ertools.configs.items import Item, ItemList, ItemSpread, load_items
 from ertools.errors import ConfigError, SegmentationError
 from ertools.fidelity import Deviation, Rule
 from ertools.geometry import invert, mean_pose
-from ertools.io import summary
+from ertools.io.summary import summary
 from ertools.streams import Interval, PoseStream, Provenance
 from ertools.timeutil import NS_PER_S, resolve_time
 
 if TYPE_CHECKING:
-    from ertools.io import PoseSource
+    from ertools.io.model import PoseSource
 
 # The look-ahead over which a still board must not move (long against mocap noise, short
 # against a referee's hand).

@@ -18,7 +18,7 @@ from ertools.benchmarks.fbm1.score import (
     ScoreRules,
 )
 from ertools.errors import ConfigError
-from ertools.io import PoseSource
+from ertools.io.model import PoseSource
 
 BENCHMARKS = ("fbm1h", "fbm1w")
 

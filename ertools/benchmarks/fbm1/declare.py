@@ -36,7 +36,7 @@ from ertools.benchmarks.fbm1.gt import GtOptions
 from ertools.benchmarks.fbm1.logs import Fbm1Logs, Fbm1Runs, load, locate_runs
 from ertools.benchmarks.fbm1.result import Fbm1Result
 from ertools.errors import ConfigError, UsageError
-from ertools.io import PoseSource
+from ertools.io.model import PoseSource
 
 GT_CHOICES = ("window", "placed", "goal", "result")
 BODIES = "table and board poses"

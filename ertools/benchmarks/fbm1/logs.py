@@ -16,14 +16,15 @@ from ertools.benchmarks.fbm1.runs import RunsFound, find_runs
 from ertools.configs._yaml import load_yaml
 from ertools.configs.items import ItemList, load_items
 from ertools.errors import ConfigError, SegmentationError, TopicError
-from ertools.io import read_benchmark_states, read_pose_source, read_tf, summary
 from ertools.io.clock import check_header_clock
 from ertools.io.model import BenchmarkStates
+from ertools.io.reader import read_benchmark_states, read_pose_source, read_tf
+from ertools.io.summary import summary
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
 
 if TYPE_CHECKING:
-    from ertools.io import PoseSource
+    from ertools.io.model import PoseSource
 
 
 # Ground-truth methods that are one tf lookup, as the nodes made it: their poses come from /tf

@@ -25,9 +25,10 @@ from ertools.configs.transform import (
 )
 from ertools.errors import ConfigError, ScoringError, SegmentationError, TopicError
 from ertools.geometry import compose, yaw_from_quat
-from ertools.io import read_benchmark_states, summary
 from ertools.io.clock import check_header_clock
 from ertools.io.model import BenchmarkStates
+from ertools.io.reader import read_benchmark_states
+from ertools.io.summary import summary
 from ertools.streams import PoseStream
 from ertools.timeutil import s_to_ns
 

@@ -72,9 +72,10 @@ from ertools.benchmarks.noise.benchmark import (
 from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
 from ertools.errors import ConfigError, ScoringError
 from ertools.fidelity import Deviation
-from ertools.io import read_benchmark_states, summary, topics
 from ertools.io.clock import check_header_clock
 from ertools.io.model import BenchmarkStates
+from ertools.io.reader import read_benchmark_states, topics
+from ertools.io.summary import summary
 from ertools.progress import Reporter, current
 from ertools.streams import PoseStream, Provenance
 

@@ -43,13 +43,13 @@ from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.benchmarks.trajectory.rules import RULE_GT_OVERLAP
 from ertools.benchmarks.trajectory.scoring import score_streams
 from ertools.errors import ClockError, ScoringError, UsageError
-from ertools.io import summary
+from ertools.io.summary import summary
 from ertools.io.text import is_text_trajectory, read_text_poses
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S, iso_utc, ns_to_s
 
 if TYPE_CHECKING:
-    from ertools.io import BagSummary
+    from ertools.io.model import BagSummary
 
 
 @dataclass(frozen=True)

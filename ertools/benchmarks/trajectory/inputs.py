@@ -12,16 +12,16 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ertools.errors import BagError, ClockError, ErtoolsError, TopicError
-from ertools.io import read_poses, summary
 from ertools.io.files import open_bag
 from ertools.io.formats import NO_SUCH, find_bags
 from ertools.io.model import POSE_TYPES, TF_TYPES
-from ertools.io.reader import load_pose_batch
+from ertools.io.reader import load_pose_batch, read_poses
+from ertools.io.summary import summary
 from ertools.streams import PoseStream
 from ertools.timeutil import iso_utc, ns_to_s
 
 if TYPE_CHECKING:
-    from ertools.io import BagSummary
+    from ertools.io.model import BagSummary
 
 
 def _pose_topics(s: BagSummary) -> list[str]:

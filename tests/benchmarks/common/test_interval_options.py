@@ -14,7 +14,8 @@ from stderr_text import error_messages
 import ertools
 from ertools.benchmarks import registry
 from ertools.benchmarks.common.uncertainty import MAX_DRAWS, MAX_SEED
-from ertools.cli.main import MAX_ERROR_LINE, main
+from ertools.cli.main import main
+from ertools.cli.text import MAX_ERROR_LINE
 from ertools.errors import UsageError
 
 ROOT = Path(__file__).resolve().parents[3]

@@ -17,7 +17,7 @@ from ertools.benchmarks.fbm2h.segments import from_states, unreached_reasons
 from ertools.cli.main import main
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
-from ertools.io import read_poses
+from ertools.io.reader import read_poses
 from ertools.samples.writer import BagWriter
 from ertools.states import BmBoxState as B
 from ertools.states import ClientState as C

@@ -32,7 +32,8 @@ from ertools.benchmarks.fbm3w.runs import find_states
 from ertools.cli.main import main
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.geometry import quat_from_yaw
-from ertools.io import BenchmarkStates, read_benchmark_states, read_poses
+from ertools.io.model import BenchmarkStates
+from ertools.io.reader import read_benchmark_states, read_poses
 from ertools.samples.writer import BagWriter
 from ertools.states import BmBoxState as B
 from ertools.states import Machine

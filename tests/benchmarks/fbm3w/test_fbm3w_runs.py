@@ -8,7 +8,7 @@ import pytest
 from ertools.benchmarks.fbm3w.runs import find_states, find_windows, with_specs
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.errors import SegmentationError
-from ertools.io import BenchmarkStates
+from ertools.io.model import BenchmarkStates
 from ertools.states import BmBoxState as B
 from ertools.states import Machine
 from ertools.states import RefBoxState as R

@@ -35,7 +35,8 @@ from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks.base import Benchmark, Input, Ranking, dump_yaml, resolve_values
-from ertools.io import PoseSource, read_pose_source
+from ertools.io.model import PoseSource
+from ertools.io.reader import read_pose_source
 from ertools.streams import Provenance
 
 INPUTS = (

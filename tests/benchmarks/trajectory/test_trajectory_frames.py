@@ -9,7 +9,7 @@ import numpy as np
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.benchmarks.trajectory.scoring import score_streams
 from ertools.geometry import quat_from_yaw
-from ertools.io import read_poses
+from ertools.io.reader import read_poses
 from ertools.samples.writer import BagWriter
 from ertools.streams import PoseStream
 

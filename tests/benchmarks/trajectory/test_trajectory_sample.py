@@ -17,7 +17,7 @@ import ertools.benchmarks.trajectory.inputs as tr
 from ertools.benchmarks.trajectory.benchmark import score
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.cli.main import main
-from ertools.io import read_poses
+from ertools.io.reader import read_poses
 from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC, expected_scores, truth_at
 
 KEYS = ("compared", "gaps", "tracking_lost", "uncovered")
