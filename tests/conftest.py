@@ -1,5 +1,6 @@
-"""Test-suite root: its presence puts ``tests/`` on ``sys.path`` (pytest's prepend import
-mode), so helpers shared by several test folders live in one module, ``tests/fakes.py``."""
+"""Test-suite root: fixtures and hooks for every test. ``tests`` is a package (pytest's
+``pythonpath`` puts the clone's root on ``sys.path``): a test imports what it shares with
+other folders as ``from tests.fakes import ...``."""
 
 import contextlib
 import dataclasses

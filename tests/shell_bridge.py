@@ -26,7 +26,7 @@ import traceback
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 
-from inprocess import run
+from tests.inprocess import run
 
 # A request is the arguments, NUL-separated: the function's process (for its file descriptors),
 # its folder, the number of arguments, then each; it is whole when the function closes the

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from archscan import ROOT, hidden_imports, plant, ratchet
+from tests.architecture.archscan import ROOT, hidden_imports, plant, ratchet
 
 ALLOWED = frozenset(
     {

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from archscan import ROOT, facade_packages, plant, ratchet
+from tests.architecture.archscan import ROOT, facade_packages, plant, ratchet
 
 # report/foxglove/__init__.py holds the Foxglove writer: it moves to report/foxglove/write.py
 # (issue 37, S6). The list only shrinks.

@@ -5,13 +5,13 @@ from __future__ import annotations
 from dataclasses import replace
 
 import pytest
-from audit_streams import BEAT_NS, T0_NS, heartbeat
 
 from ertools.auditing.analyse import audit_states, parse_payload
 from ertools.states import BmBoxState as B
 from ertools.states import ClientState as C
 from ertools.states import Machine
 from ertools.states import RefBoxState as R
+from tests.audit.audit_streams import BEAT_NS, T0_NS, heartbeat
 
 GOAL = "goal:\n  waypoints:\n  - [1.0, 2.0, 0.5]\n"
 

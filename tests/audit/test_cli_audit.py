@@ -6,14 +6,14 @@ import json
 from pathlib import Path
 
 import pytest
-from audit_streams import T0_NS, heartbeat
-from stderr_text import error_messages, joined_lines
-from test_audit import BMBOX, CLIENT, REFBOX
 
 from ertools.cli.main import main
 from ertools.samples.writer import BagWriter
 from ertools.states import Machine
 from ertools.streams import StateStream
+from tests.audit.audit_streams import T0_NS, heartbeat
+from tests.audit.test_audit import BMBOX, CLIENT, REFBOX
+from tests.stderr_text import error_messages, joined_lines
 
 
 def _write_bag(path: Path, streams: list[StateStream]) -> Path:

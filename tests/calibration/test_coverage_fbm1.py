@@ -9,15 +9,9 @@ truth are independent noise components: each (run, component) is one Bernoulli t
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
-from scipy.stats import binom
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
-
 import pytest
 from calibration import fbm1
+from scipy.stats import binom
 
 TRIALS = 12
 DRAWS = 200

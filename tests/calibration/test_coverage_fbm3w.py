@@ -4,7 +4,8 @@ small number of simulated executions (``make calibrate`` runs 1,000)."""
 from __future__ import annotations
 
 import pytest
-from trials import coverage
+
+from tests.calibration.trials import coverage
 
 pytestmark = pytest.mark.slow
 

@@ -9,15 +9,9 @@ compared moment, computed there with plain NumPy).
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
-from scipy.stats import binom
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
-
 import pytest
 from calibration import trajectory
+from scipy.stats import binom
 
 pytestmark = pytest.mark.slow
 

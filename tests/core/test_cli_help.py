@@ -5,20 +5,18 @@ given to the wrong benchmark named for what it is."""
 from __future__ import annotations
 
 import re
-import sys
 from pathlib import Path
 
 import pytest
-from stderr_text import error_messages, joined_lines
 
 from ertools.benchmarks import registry
 from ertools.cli.main import COMMANDS, main
 from ertools.cli.text import MAX_ERROR_LINE, error_text
+from tests.io.io_bagmaker import Spec, write
+from tests.stderr_text import error_messages, joined_lines
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"
-sys.path.insert(0, str(ROOT / "tests" / "io"))
-from io_bagmaker import Spec, write  # noqa: E402
 
 MEMBERS = {"score": registry.names(), "acquire": ("transform", "items")}
 HELPS = [[name] for name in COMMANDS] + [[g, m] for g, ms in MEMBERS.items() for m in ms]

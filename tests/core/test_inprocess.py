@@ -12,12 +12,12 @@ import warnings
 from pathlib import Path
 
 import pytest
-from inprocess import run
-from shell_bridge import parse_request, run_bash
 
 from ertools import caches
 from ertools.cli import info
 from ertools.io.mcap import scan, summary
+from tests.inprocess import run
+from tests.shell_bridge import parse_request, run_bash
 
 ROOT = Path(__file__).resolve().parents[2]
 BAG = "sample_bags/fbm3w/log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"

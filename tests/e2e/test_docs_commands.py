@@ -26,8 +26,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
-from shell_bridge import run_bash
-from stderr_text import joined_lines
+
+from tests.shell_bridge import run_bash
+from tests.stderr_text import joined_lines
 
 ROOT = Path(__file__).resolve().parents[2]
 SHARED = ROOT.parent / "shared"

@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pytest
 import yaml
-from stderr_text import joined_lines
 
 from ertools.cli.main import main
+from tests.stderr_text import joined_lines
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"

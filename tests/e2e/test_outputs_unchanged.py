@@ -23,8 +23,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
-from floats import output_difference
-from inprocess import run
+
+from tests.floats import output_difference
+from tests.inprocess import run
 
 pytestmark = pytest.mark.slow
 

@@ -15,7 +15,8 @@ import sys
 from pathlib import Path
 
 import pytest
-from shell_bridge import run_bash
+
+from tests.shell_bridge import run_bash
 
 ROOT = Path(__file__).resolve().parents[2]
 SHARED = ROOT.parent / "shared"

@@ -8,9 +8,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from stderr_text import error_messages
 
 from ertools.cli.main import main
+from tests.stderr_text import error_messages
 
 REPO = Path(__file__).resolve().parents[2]
 ROBOTLOG = REPO / "sample_bags/robotlog"

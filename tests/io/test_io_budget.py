@@ -25,7 +25,20 @@ import lz4.frame
 import pytest
 import yaml
 import zstandard
-from hostile_files import (
+from mcap.reader import make_reader
+from mcap.writer import CompressionType
+from mcap.writer import Writer as McapWriter
+from rosbags.rosbag2 import Writer as Writer2
+from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
+
+from ertools.cli.main import main
+from ertools.errors import BagError
+from ertools.io import budget
+from ertools.io.files import open_bag
+from ertools.io.info import describe
+from ertools.io.reader import read_messages, read_poses, read_states
+from ertools.io.summary import summary as bag_summary
+from tests.io.hostile_files import (
     McapChannel,
     McapChunk,
     Ros1Chunk,
@@ -40,21 +53,8 @@ from hostile_files import (
     u32,
     zstd_frame,
 )
-from io_bagmaker import build, typestore, write
-from io_scene import Scene
-from mcap.reader import make_reader
-from mcap.writer import CompressionType
-from mcap.writer import Writer as McapWriter
-from rosbags.rosbag2 import Writer as Writer2
-from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
-
-from ertools.cli.main import main
-from ertools.errors import BagError
-from ertools.io import budget
-from ertools.io.files import open_bag
-from ertools.io.info import describe
-from ertools.io.reader import read_messages, read_poses, read_states
-from ertools.io.summary import summary as bag_summary
+from tests.io.io_bagmaker import build, typestore, write
+from tests.io.io_scene import Scene
 
 T0 = 1_448_020_800 * 10**9  # the 2015 sample logs' start
 MiB = 1 << 20

@@ -18,7 +18,6 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from io_scene import Scene
 from rosbags.highlevel import AnyReader
 
 from ertools.cli.main import main
@@ -31,6 +30,7 @@ from ertools.exporting.formats import (
     write_poses,
 )
 from ertools.streams import PoseStream
+from tests.io.io_scene import Scene
 
 POSE = "/fbm3w/robot_at_work/pose"
 REPO = Path(__file__).resolve().parents[2]

@@ -10,23 +10,16 @@ cover.
 from __future__ import annotations
 
 import logging
-import sys
 from collections import Counter
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from fuzz.judge import ertools_answer
-
-REPO = Path(__file__).resolve().parents[2]
-if str(REPO) not in sys.path:
-    sys.path.insert(0, str(REPO))
-
-from fuzz.judge import Outcome, judge_part, official_answer  # noqa: E402
-from fuzz.mutate import CATEGORIES, layout, mutate  # noqa: E402
-from fuzz.run import SEED_NAMES, run_cases  # noqa: E402
-from fuzz.seeds import N_POSES, POSE_TOPIC, SEEDS, T0_NS, seed_bytes, suffix  # noqa: E402
+from fuzz.judge import Outcome, ertools_answer, judge_part, official_answer
+from fuzz.mutate import CATEGORIES, layout, mutate
+from fuzz.run import SEED_NAMES, run_cases
+from fuzz.seeds import N_POSES, POSE_TOPIC, SEEDS, T0_NS, seed_bytes, suffix
 
 
 @pytest.mark.slow_cases("ros1")

@@ -8,14 +8,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from io_bagmaker import write
-from io_scene import DT, Scene
-from stderr_text import joined_lines
-from test_io_summary import make_active
 
 from ertools.cli.main import main
 from ertools.errors import BagError
 from ertools.io.reader import read_poses
+from tests.io.io_bagmaker import write
+from tests.io.io_scene import DT, Scene
+from tests.io.test_io_summary import make_active
+from tests.stderr_text import joined_lines
 
 POSE = "/fbm3w/robot_at_work/pose"
 

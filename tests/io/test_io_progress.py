@@ -17,11 +17,7 @@ import time
 from pathlib import Path
 
 import pytest
-from io_bagmaker import bag_name, write
-from io_scene import Scene
 from mcap.reader import make_reader
-from stderr_text import error_messages
-from test_io_fastpath import fast_batch
 
 import ertools.progress
 from ertools.cli.main import main
@@ -30,6 +26,10 @@ from ertools.io.files import open_bag
 from ertools.io.info import describe
 from ertools.io.ros1.check import check_ros1
 from ertools.progress import Bar, reporting
+from tests.io.io_bagmaker import bag_name, write
+from tests.io.io_scene import Scene
+from tests.io.test_io_fastpath import fast_batch
+from tests.stderr_text import error_messages
 
 TOPIC = "/fbm3w/robot_at_work/pose"
 

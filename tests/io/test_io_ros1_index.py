@@ -16,11 +16,8 @@ from typing import Any
 
 import numpy as np
 import pytest
-from io_bagmaker import Spec, write
 from rosbags.rosbag1 import Reader, Writer
 from rosbags.typesys import Stores, get_typestore
-from stderr_text import error_messages
-from test_io_fastpath import REAL_BAG, _sample_bags
 
 from ertools import caches
 from ertools.cli.main import main
@@ -29,6 +26,9 @@ from ertools.io.ros1 import layout
 from ertools.io.ros1.check import check_ros1, rebuild_layout
 from ertools.io.ros1.layout import scan_layout
 from ertools.io.summary import summary as bag_summary
+from tests.io.io_bagmaker import Spec, write
+from tests.io.test_io_fastpath import REAL_BAG, _sample_bags
+from tests.stderr_text import error_messages
 
 T0 = 1_445_609_740_000_000_000
 DT = 10_000_000

@@ -7,8 +7,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_bagmaker import Spec, bag_name, write
-from io_scene import DT, T0, Scene, make_scene
 from rosbags.rosbag1 import Writer
 
 from ertools.errors import BagError, TopicError
@@ -24,6 +22,8 @@ from ertools.io.reader import (
 from ertools.io.reader import topics as bag_topics
 from ertools.io.summary import summary as bag_summary
 from ertools.states import Machine
+from tests.io.io_bagmaker import Spec, bag_name, write
+from tests.io.io_scene import DT, T0, Scene, make_scene
 
 POSE = "/fbm3w/robot_at_work/pose"
 

@@ -17,7 +17,12 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from hostile_files import (
+
+from ertools import caches
+from ertools.io.info import describe
+from ertools.io.reader import read_messages
+from ertools.io.summary import summary as bag_summary
+from tests.io.hostile_files import (
     McapChannel,
     McapChunk,
     Ros1Chunk,
@@ -27,11 +32,6 @@ from hostile_files import (
     string_payload,
     u32,
 )
-
-from ertools import caches
-from ertools.io.info import describe
-from ertools.io.reader import read_messages
-from ertools.io.summary import summary as bag_summary
 
 pytestmark = pytest.mark.slow
 

@@ -14,13 +14,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from stderr_text import error_messages
 
 from ertools.cli.main import main
 from ertools.errors import BagError
 from ertools.exporting.formats import format_csv, format_tum
 from ertools.io.text import _plain_decimal_ns, read_text_poses, sniff
 from ertools.streams import PoseStream
+from tests.stderr_text import error_messages
 
 REPO = Path(__file__).resolve().parents[2]
 EVO_DATA = REPO.parent / "shared" / "evo_testdata"

@@ -4,20 +4,16 @@ CDR serialization rules, exact values back, and a fallback whenever one message 
 from __future__ import annotations
 
 import struct
-import sys
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))
-
-from io_bagmaker import FORMATS, Spec, bag_name, write
-from test_io_fastpath import assert_same, fast_batch, reference_batch
-
 from ertools.io import bulk
 from ertools.io.decode.uniform import decode_uniform, layout_of
+from tests.io.io_bagmaker import FORMATS, Spec, bag_name, write
+from tests.io.test_io_fastpath import assert_same, fast_batch, reference_batch
 
 POSE = (1.5, -2.25, 0.125, 0.0, 0.0, 0.6, 0.8)
 

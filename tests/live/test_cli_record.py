@@ -6,10 +6,10 @@ from pathlib import Path
 
 import pytest
 import yaml
-from stderr_text import error_messages
 
 from ertools.cli.main import main
 from ertools.live.tail import is_finished, read_complete
+from tests.stderr_text import error_messages
 
 pytestmark = pytest.mark.xdist_group("timing")
 

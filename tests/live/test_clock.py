@@ -7,11 +7,11 @@ import re
 
 import pytest
 import yaml
-from live_helpers import fake_sntp_server, free_udp_port
 
 from ertools.cli.main import main
 from ertools.errors import ClockError
 from ertools.live.clock import ns_to_ntp, ntp_to_ns, query_sntp
+from tests.live.live_helpers import fake_sntp_server, free_udp_port
 
 pytestmark = pytest.mark.xdist_group("timing")
 

@@ -6,12 +6,12 @@ import struct
 from pathlib import Path
 
 import pytest
-from live_helpers import read_mcap
 
 from ertools.configs.mocap import parse_mocap_config
 from ertools.live.natnet import FrameOfData, NatNetVersion, RigidBody, encode_frame
 from ertools.live.recorder import Recorder, RecordOptions, record
 from ertools.live.tail import is_finished, read_complete
+from tests.live.live_helpers import read_mcap
 
 pytestmark = pytest.mark.xdist_group("timing")
 

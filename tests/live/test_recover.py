@@ -9,6 +9,7 @@ resembles) and `ertools info` read every message that was complete, and nothing 
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import signal
 import struct
@@ -40,10 +41,9 @@ def message(i: int) -> tuple[str, int, tuple[float, float, float]]:
 
 WRITER = textwrap.dedent(
     """
-    import os, signal, sys
+    import os, signal
     from pathlib import Path
-    sys.path.insert(0, {tests!r})
-    from test_recover import FLUSHES, PER_FLUSH, message
+    from tests.live.test_recover import FLUSHES, PER_FLUSH, message
     from ertools.live.logfile import LogFile
     from ertools.live.rosmsg import POSE_2D, Ros2Serializer
 
@@ -64,8 +64,9 @@ WRITER = textwrap.dedent(
 def killed(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("killed")
     path = folder / "log_fbm2h_mocap_2015-11-20-12-00-00_0.mcap"
-    script = WRITER.format(tests=str(Path(__file__).parent), path=str(path))
-    proc = subprocess.run([sys.executable, "-c", script], check=False)
+    script = WRITER.format(path=str(path))
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])}  # tests.live
+    proc = subprocess.run([sys.executable, "-c", script], env=env, check=False)
     assert proc.returncode == -signal.SIGKILL
     assert not is_finished(path)
     return path

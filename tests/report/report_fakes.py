@@ -2,9 +2,8 @@
 
 from __future__ import annotations
 
-from fakes import FakeResult
-
 from ertools.streams import Provenance
+from tests.fakes import FakeResult
 
 EVIL = "<script>alert('x')</script>"
 EVIL_IMG = '<img src=x onerror="alert(1)">'

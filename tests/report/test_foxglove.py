@@ -22,9 +22,7 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from foxglove_readback import ReadBack, read_back, stamp_ns
 from rosbags.highlevel import AnyReader
-from stderr_text import error_messages
 
 from ertools.benchmarks.fbm2h.benchmark import score_fbm2h
 from ertools.benchmarks.fbm2h.config import Fbm2hOptions
@@ -32,6 +30,8 @@ from ertools.benchmarks.trajectory.benchmark import score as score_trajectory
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.cli.main import main
 from ertools.report.foxglove import write_foxglove
+from tests.report.foxglove_readback import ReadBack, read_back, stamp_ns
+from tests.stderr_text import error_messages
 
 SAMPLES = Path(__file__).resolve().parents[2] / "sample_bags"
 FBM3W = SAMPLES / "fbm3w" / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"

@@ -8,13 +8,13 @@ from pathlib import Path
 
 import pytest
 import yaml
-from report_fakes import FakeResult, fbm3w_like
 
 from ertools.cli.main import main
 from ertools.report.combine import load_entry
 from ertools.report.folder import write_report
 from ertools.samples.fbm2h import generate
 from ertools.streams import Provenance
+from tests.report.report_fakes import FakeResult, fbm3w_like
 
 
 @pytest.fixture

@@ -5,25 +5,22 @@ from __future__ import annotations
 import csv
 import hashlib
 import json
-import sys
 from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
-import svg_figure
 import yaml
-from report_fakes import EVIL, fbm3w_like
-from test_cli_audit import _write_bag
 
 from ertools.auditing.analyse import audit_states
 from ertools.errors import ConfigError
 from ertools.report.folder import write_report
 from ertools.report.records import sha256_file
 from ertools.states import Machine
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "audit"))
-from audit_streams import heartbeat
-from test_audit import BMBOX, CLIENT, REFBOX
+from tests import svg_figure
+from tests.audit.audit_streams import heartbeat
+from tests.audit.test_audit import BMBOX, CLIENT, REFBOX
+from tests.audit.test_cli_audit import _write_bag
+from tests.report.report_fakes import EVIL, fbm3w_like
 
 BAG_BYTES = b"#ROSBAG V2.0\n" + bytes(range(256)) * 50
 

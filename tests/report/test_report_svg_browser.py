@@ -17,12 +17,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import svg_figure
-from fakes import BROWSER, CHROMIUM_FLAGS
 from matplotlib.image import imread
 
 from ertools import api
 from ertools.report.folder import write_report
+from tests import svg_figure
+from tests.fakes import BROWSER, CHROMIUM_FLAGS
 
 pytestmark = pytest.mark.slow
 

@@ -18,11 +18,11 @@ from pathlib import Path
 
 import pytest
 import yaml
-from report_fakes import fbm3w_like
-from yaml_rounding import YAML_ROUNDING
 
 from ertools.cli.main import main
 from ertools.report.folder import write_report
+from tests.report.report_fakes import fbm3w_like
+from tests.yaml_rounding import YAML_ROUNDING
 
 pytestmark = pytest.mark.slow
 

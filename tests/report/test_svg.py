@@ -8,7 +8,6 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
-import svg_figure
 from matplotlib.figure import Figure
 
 from ertools.report import chart_mpl, svg
@@ -28,6 +27,7 @@ from ertools.report.chart import (
     Text,
     viridis,
 )
+from tests import svg_figure
 
 NS = svg_figure.NS
 

@@ -14,7 +14,12 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from rescore_competition import (
+
+from ertools.benchmarks import registry
+from ertools.benchmarks.document import score_json
+from ertools.cli.main import main
+from ertools.competition import cache
+from tests.rescore.rescore_competition import (
     LOGS,
     OFFSETS,
     expected_value,
@@ -22,11 +27,6 @@ from rescore_competition import (
     use_toy_registry,
     write_offsets,
 )
-
-from ertools.benchmarks import registry
-from ertools.benchmarks.document import score_json
-from ertools.cli.main import main
-from ertools.competition import cache
 
 
 @pytest.fixture(autouse=True)

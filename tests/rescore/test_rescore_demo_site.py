@@ -14,12 +14,12 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from fakes import BROWSER
-from site_results import Page, assert_links_resolve, expected_board
-from test_rescore_site_browser import chromium
 
 from ertools.benchmarks import registry
 from ertools.demo import make_competition
+from tests.fakes import BROWSER
+from tests.rescore.site_results import Page, assert_links_resolve, expected_board
+from tests.rescore.test_rescore_site_browser import chromium
 
 pytestmark = [
     pytest.mark.browser,

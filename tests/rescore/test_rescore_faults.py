@@ -23,12 +23,17 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from rescore_competition import LOGS, expected_value, make_competition, use_toy_registry
 
 from ertools import atomic
 from ertools.cli.main import main
 from ertools.competition import cache
 from ertools.csvsafe import spreadsheet_safe
+from tests.rescore.rescore_competition import (
+    LOGS,
+    expected_value,
+    make_competition,
+    use_toy_registry,
+)
 
 HERE = Path(__file__).parent
 TOY_MAIN = HERE / "toy_main.py"

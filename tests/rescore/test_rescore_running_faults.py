@@ -20,7 +20,6 @@ from typing import Any
 
 import pytest
 import yaml
-from rescore_competition import OFFSETS, SCALE, make_competition, use_toy_registry
 
 from ertools.cli.main import main
 from ertools.competition import pipeline
@@ -28,6 +27,7 @@ from ertools.competition.jobs import Job, run_job
 from ertools.competition.memo import FileMemo
 from ertools.errors import BagError, ConfigError, transient_error, watching
 from ertools.io.formats import detect_format
+from tests.rescore.rescore_competition import OFFSETS, SCALE, make_competition, use_toy_registry
 
 SAMPLES = Path(__file__).resolve().parents[2] / "sample_bags" / "fbm3w"
 FBM3W_BAG = SAMPLES / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
@@ -176,7 +176,7 @@ def test_an_unwritable_report_folder_is_not_cached(tmp_path: Path) -> None:
     job = Job(
         "toy-1",
         "toy",
-        "rescore_toy:TOY",
+        "tests.rescore.rescore_toy:TOY",
         None,
         (str(log),),
         report_dir=str(blocker / "report"),

@@ -13,9 +13,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from rsbb_replay.py2 import euler_yaw
-from rsbb_replay.tf2 import TfError
-from rsbb_replay.world import World
+from tests.rsbb_replay.py2 import euler_yaw
+from tests.rsbb_replay.tf2 import TfError
+from tests.rsbb_replay.world import World
 
 
 @dataclass

@@ -14,7 +14,6 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from floats import FLOAT_ATOL, FLOAT_RTOL, same_text
 from rosbags.highlevel import AnyReader
 
 from ertools.samples.__main__ import main
@@ -25,6 +24,7 @@ from ertools.samples.scenario import (
     load_scenario,
     log_name,
 )
+from tests.floats import FLOAT_ATOL, FLOAT_RTOL, same_text
 
 REPO = Path(__file__).resolve().parents[2]
 SAMPLE_BAGS = REPO / "sample_bags"

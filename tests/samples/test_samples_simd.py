@@ -18,7 +18,6 @@ import sys
 from pathlib import Path
 
 import pytest
-from simd_paths import baseline_env, unpinned_env
 
 from ertools.samples.scenario import SCENARIOS
 from ertools.samples.simd import (
@@ -29,6 +28,7 @@ from ertools.samples.simd import (
     pinned_env,
     pinned_targets,
 )
+from tests.simd_paths import baseline_env, unpinned_env
 
 
 def _generate(out: Path, env: dict[str, str]) -> dict[str, bytes]:

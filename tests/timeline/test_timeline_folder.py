@@ -12,7 +12,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-from summaries import BAG_KEYS
 
 import ertools.timelines.scan as ts
 from ertools.cli.main import main
@@ -22,6 +21,7 @@ from ertools.io.model import ClockCheck
 from ertools.progress import reporting
 from ertools.samples.writer import BagWriter
 from ertools.timelines.scan import scan
+from tests.timeline.summaries import BAG_KEYS
 
 
 def rel(root: Path, path: str) -> str:

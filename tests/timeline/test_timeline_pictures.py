@@ -19,13 +19,22 @@ import matplotlib.dates as mdates
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import to_hex
-from timeline_day import DAY0, EVIL, EVIL_IMG, SESSIONS, UNREADABLE, S, day_timeline, many_bags
 
 from ertools.cli.main import main
 from ertools.report.plots_timeline import timeline_figure
 from ertools.report.timeline_page import timeline_page
 from ertools.timelines.model import Timeline
 from ertools.timelines.scan import scan
+from tests.timeline.timeline_day import (
+    DAY0,
+    EVIL,
+    EVIL_IMG,
+    SESSIONS,
+    UNREADABLE,
+    S,
+    day_timeline,
+    many_bags,
+)
 
 REAL = Path(__file__).resolve().parents[2] / ".." / "shared" / "real_bags"
 REAL_BAG = REAL / "log_fbm2h_mocap_2015-10-23-16-15-40_0.bag"

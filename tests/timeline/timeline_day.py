@@ -9,11 +9,10 @@ below, not from the code: each session's bags are written down as such.
 
 from __future__ import annotations
 
-from summaries import Summary, Topic
-
 from ertools.io.formats import Unreadable
 from ertools.timelines.build import build_timeline
 from ertools.timelines.model import Timeline
+from tests.timeline.summaries import Summary, Topic
 
 S = 1_000_000_000
 DAY0 = 1_448_010_000 * S  # 2015-11-20 09:00:00 UTC

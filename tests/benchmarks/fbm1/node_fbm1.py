@@ -40,7 +40,8 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import yaml
-from bmbox2015 import Blocked, BmBoxReplay, Msg
+
+from tests.bmbox2015 import Blocked, BmBoxReplay, Msg
 
 BENCHMARK_RUNS = 10
 # The versions: (script, commit).

@@ -7,8 +7,6 @@ import math
 from pathlib import Path
 
 import pytest
-from fbm1_testkit import ITEMS_YAML, RunSpec, bodies, state_streams, write_bag, write_items
-from stderr_text import error_messages
 
 from ertools.benchmarks.fbm1.answers import parse_answer_payload
 from ertools.benchmarks.fbm1.benchmark import score_fbm1
@@ -17,6 +15,15 @@ from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import ItemList, parse_items
 from ertools.states import Machine
+from tests.benchmarks.fbm1.fbm1_testkit import (
+    ITEMS_YAML,
+    RunSpec,
+    bodies,
+    state_streams,
+    write_bag,
+    write_items,
+)
+from tests.stderr_text import error_messages
 
 GOOD = RunSpec(
     "Place item 3 (b2) on the table",

@@ -16,18 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from fbm1_testkit import (
-    ANSWER_S,
-    EXEC_S,
-    ITEMS_YAML,
-    RunSpec,
-    bodies,
-    state_streams,
-    write_bag,
-    write_items,
-)
 from scipy.spatial.transform import Rotation
-from yaml_rounding import assert_yaml_of
 
 from ertools.benchmarks.base import BenchmarkResult
 from ertools.benchmarks.fbm1.benchmark import score_fbm1
@@ -41,6 +30,17 @@ from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import ItemList, parse_items
 from ertools.states import Machine
 from ertools.streams import PoseStream
+from tests.benchmarks.fbm1.fbm1_testkit import (
+    ANSWER_S,
+    EXEC_S,
+    ITEMS_YAML,
+    RunSpec,
+    bodies,
+    state_streams,
+    write_bag,
+    write_items,
+)
+from tests.yaml_rounding import assert_yaml_of
 
 RUNS = [
     RunSpec(

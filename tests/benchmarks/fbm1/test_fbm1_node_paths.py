@@ -29,15 +29,15 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from node_fbm1 import VERSIONS, fbm1_node
 from scipy.spatial.transform import Rotation
-from test_fbm1_nodes import read_log, tf_lookup
 
 from ertools.cli.main import main
 from ertools.samples.mocap import MocapNoise, publish_mocap, simulate_mocap
 from ertools.samples.statemachine import Transition, publish_states
 from ertools.samples.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
+from tests.benchmarks.fbm1.node_fbm1 import VERSIONS, fbm1_node
+from tests.benchmarks.fbm1.test_fbm1_nodes import read_log, tf_lookup
 
 pytestmark = pytest.mark.slow
 

@@ -47,8 +47,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from bmbox2015 import Blocked, BmBoxReplay
 from scipy.spatial.transform import Rotation, Slerp
+
+from tests.bmbox2015 import Blocked, BmBoxReplay
 
 
 @dataclass

@@ -7,9 +7,9 @@ from typing import Any
 
 import pytest
 import yaml
-from stderr_text import error_messages
 
 from ertools.cli.main import main
+from tests.stderr_text import error_messages
 
 
 def _run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:

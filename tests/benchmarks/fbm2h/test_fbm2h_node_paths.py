@@ -28,8 +28,6 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from bmbox2015 import BmBoxReplay
-from node_fbm2h import Score2015, TfPoses, fbm2h_node
 from rosbags.highlevel import AnyReader
 from scipy.spatial.transform import Rotation
 
@@ -40,6 +38,8 @@ from ertools.states import BmBoxState as B
 from ertools.states import ClientState as C
 from ertools.states import Machine
 from ertools.states import RefBoxState as R
+from tests.benchmarks.fbm2h.node_fbm2h import Score2015, TfPoses, fbm2h_node
+from tests.bmbox2015 import BmBoxReplay
 
 pytestmark = pytest.mark.slow
 

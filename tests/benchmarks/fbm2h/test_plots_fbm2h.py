@@ -7,7 +7,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import svg_figure
 from matplotlib.figure import Figure
 
 from ertools.benchmarks.fbm2h.benchmark import compute
@@ -16,6 +15,7 @@ from ertools.configs.goal import GoalList
 from ertools.configs.transform import identity_transform
 from ertools.report.figures import figure_specs, save_figures
 from ertools.streams import PoseStream
+from tests import svg_figure
 
 pytestmark = pytest.mark.slow
 

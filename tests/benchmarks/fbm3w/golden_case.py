@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from fbm3w_synth import T0, one_run
 
 from ertools.benchmarks.fbm3w.benchmark import score_runs
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
@@ -12,6 +11,7 @@ from ertools.benchmarks.fbm3w.runs import RunWindow
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.configs.shapes import builtin_shapes
 from ertools.streams import concatenate_poses
+from tests.benchmarks.fbm3w.fbm3w_synth import T0, one_run
 
 S = 1_000_000_000
 

@@ -42,7 +42,7 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from bmbox2015 import Blocked, BmBoxReplay, Msg
+from tests.bmbox2015 import Blocked, BmBoxReplay, Msg
 
 BENCHMARK_RUNS = 5
 D_MIN = 0.00033

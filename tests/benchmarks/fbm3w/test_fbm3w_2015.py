@@ -22,9 +22,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-from fbm3w_kit import Sample
-from fbm3w_synth import place
-from test_fbm3w_runs import stream
 
 from ertools.benchmarks.fbm3w.benchmark import score_runs
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions, options_2015
@@ -39,6 +36,9 @@ from ertools.states import BmBoxState as B
 from ertools.states import Machine
 from ertools.states import RefBoxState as R
 from ertools.streams import PoseStream
+from tests.benchmarks.fbm3w.fbm3w_kit import Sample
+from tests.benchmarks.fbm3w.fbm3w_synth import place
+from tests.benchmarks.fbm3w.test_fbm3w_runs import stream
 
 S = 1_000_000_000
 D_MIN = 0.00033  # seed 7.3.4: hard-coded in the 2015 script

@@ -17,7 +17,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from protocol_logs import (
+
+from ertools.cli.main import main
+from tests.benchmarks.fbm3w.protocol_logs import (
     SHAPES,
     Log,
     by_arc_length,
@@ -26,9 +28,7 @@ from protocol_logs import (
     write_bag,
     write_config,
 )
-from stderr_text import error_messages
-
-from ertools.cli.main import main
+from tests.stderr_text import error_messages
 
 EDGE_TOLERANCE_S = 0.5
 

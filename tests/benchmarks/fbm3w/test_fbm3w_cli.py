@@ -8,14 +8,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from fbm3w_kit import Sample
-from fbm3w_synth import one_run
-from protocol_logs import generate, write_bag, write_config
-from stderr_text import error_messages
 
 from ertools.cli.main import main
 from ertools.configs.shapes import builtin_shapes
 from ertools.samples.writer import BagWriter
+from tests.benchmarks.fbm3w.fbm3w_kit import Sample
+from tests.benchmarks.fbm3w.fbm3w_synth import one_run
+from tests.benchmarks.fbm3w.protocol_logs import generate, write_bag, write_config
+from tests.stderr_text import error_messages
 
 
 def score(*args: str, draws: bool = False) -> int:

@@ -9,10 +9,10 @@ from typing import Any
 
 import pytest
 import yaml
-from floats import YAML_UNIT, tree_difference
-from golden_case import golden_result
 
 from ertools.cli.output import dump_json
+from tests.benchmarks.fbm3w.golden_case import golden_result
+from tests.floats import YAML_UNIT, tree_difference
 
 GOLDEN = Path(__file__).resolve().parent / "golden"
 NUMBER = re.compile(r"-?\d+\.\d+(e-?\d+)?")

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import pytest
-from fbm3w_kit import Sample
 
 from ertools.benchmarks.fbm3w.benchmark import score_fbm3w
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
 from ertools.configs.fbm3w import Fbm3wConfig
+from tests.benchmarks.fbm3w.fbm3w_kit import Sample
 
 # the answers hold scores, not intervals: no Monte Carlo draws (draws=0 in every Fbm3wOptions)
 NO_DRAWS = Fbm3wOptions(draws=0)

@@ -10,7 +10,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-from fbm3w_synth import FRAME_NS, T0, one_run
 
 from ertools.benchmarks.base import rename_former
 from ertools.benchmarks.fbm3w.benchmark import MAX_INNER_GAP_S, MIN_COVERAGE, score_runs
@@ -22,6 +21,7 @@ from ertools.cli.main import main
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.configs.shapes import builtin_shapes
 from ertools.streams import PoseStream
+from tests.benchmarks.fbm3w.fbm3w_synth import FRAME_NS, T0, one_run
 
 STILL = 30
 PATH = 3000  # 25 s at 120 Hz

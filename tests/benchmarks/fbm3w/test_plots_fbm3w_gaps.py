@@ -9,8 +9,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import svg_figure
-from fbm3w_synth import one_run
 from matplotlib.image import imread
 
 from ertools.benchmarks.fbm3w.benchmark import score_runs
@@ -19,6 +17,8 @@ from ertools.configs.shapes import builtin_shapes
 from ertools.report import plots_fbm3w
 from ertools.report.figures import render, wrap_title
 from ertools.report.folder import write_report
+from tests import svg_figure
+from tests.benchmarks.fbm3w.fbm3w_synth import one_run
 
 STILL = 30
 PATH = 3000

@@ -19,10 +19,7 @@ from typing import Any
 
 import numpy as np
 import pytest
-from node_2015 import EndOfBagError, Pose, score_2015, tf_yaw
 from rosbags.highlevel import AnyReader
-from stderr_text import error_messages
-from trajectory_helpers import read_back, write_gt, write_robot
 
 from ertools.benchmarks.trajectory.association import yaw_tf
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
@@ -31,6 +28,9 @@ from ertools.cli.main import main
 from ertools.errors import ClockError
 from ertools.samples.writer import BagWriter
 from ertools.streams import PoseStream
+from tests.benchmarks.trajectory.node_2015 import EndOfBagError, Pose, score_2015, tf_yaw
+from tests.benchmarks.trajectory.trajectory_helpers import read_back, write_gt, write_robot
+from tests.stderr_text import error_messages
 
 TOL = 1e-12
 ROOT = Path(__file__).resolve().parents[3]

@@ -8,11 +8,11 @@ from typing import Any
 
 import numpy as np
 import pytest
-from stderr_text import error_messages
-from trajectory_helpers import write_gt, write_robot
 
 from ertools.cli.main import main
 from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC
+from tests.benchmarks.trajectory.trajectory_helpers import write_gt, write_robot
+from tests.stderr_text import error_messages
 
 T0 = 1_448_013_600 * 1_000_000_000
 

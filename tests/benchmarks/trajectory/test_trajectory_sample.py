@@ -10,8 +10,6 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from stderr_text import error_messages
-from trajectory_helpers import read_back, write_gt, yaw
 
 import ertools.benchmarks.trajectory.inputs as tr
 from ertools.benchmarks.trajectory.benchmark import score
@@ -19,6 +17,8 @@ from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.cli.main import main
 from ertools.io.reader import read_poses
 from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC, expected_scores, truth_at
+from tests.benchmarks.trajectory.trajectory_helpers import read_back, write_gt, yaw
+from tests.stderr_text import error_messages
 
 KEYS = ("compared", "gaps", "tracking_lost", "uncovered")
 ERRORS = ("position_error", "orientation_error", "rmse", "median", "max")

@@ -9,7 +9,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-import svg_figure
 
 from ertools.benchmarks.trajectory.config import SETTINGS_2015, TrajectoryConfig
 from ertools.benchmarks.trajectory.scoring import MIN_VALID_FRACTION, score_streams
@@ -18,6 +17,7 @@ from ertools.geometry import quat_from_yaw
 from ertools.report.figures import render
 from ertools.report.plots_trajectory import figure_specs
 from ertools.streams import PoseStream
+from tests import svg_figure
 
 T0 = 1_448_013_600 * 1_000_000_000
 S = 1_000_000_000
