@@ -42,7 +42,7 @@ from ertools.samples.competition_files import (
 # The one helper the sample competition keeps private: its FBM1 answer errors per team.
 from ertools.samples.competition_schedule import _fbm1_errors
 from ertools.samples.scenario import EPOCH_2015, log_name
-from ertools.samples.simulated import SimulatedRun
+from ertools.simulator.simulated import SimulatedRun
 
 NS = 1_000_000_000
 SEED = 2015_11_18

@@ -279,8 +279,7 @@ def figures(result: Any) -> list[Any]:
         >>> [type(f).__name__ for f in ertools.figures(t)]
         ['Figure', 'Figure']
     """
-    # lazy: matplotlib (~0.3 s) only when a figure is drawn
-    from matplotlib.figure import Figure
+    from matplotlib.figure import Figure  # lazy: matplotlib, 300 ms
 
     if isinstance(result, Timeline):
         day = Figure(figsize=(12, 4), layout="constrained")

@@ -15,7 +15,7 @@ if __name__ == "__main__":
     from ertools.launch import run as launch
 
     def _start() -> object:
-        from ertools.demo import main  # lazy: this module under its own name, in the guard
+        from ertools.demo import main  # lazy: in launch's Ctrl-C guard, 600 ms
 
         return main()
 

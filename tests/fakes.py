@@ -6,7 +6,8 @@ import shutil
 from dataclasses import dataclass, field
 from typing import Any
 
-from ertools.benchmarks.base import Rows, dump_yaml
+from ertools.benchmarks.base import Rows
+from ertools.serialize import dump_yaml
 from ertools.streams import Provenance
 
 

@@ -17,7 +17,7 @@ quantity:
 - :data:`SHARE`: a source's share of an interval, a ratio of the variances of Monte Carlo
   draws; each draw is a score re-computed (s, moving by its last bits) and the variance of
   draws spread by sigma around it moves by those bits times s / sigma;
-- a number that was rounded on output (YAML's 9 decimals, ``ertools.yamlout``) may in
+- a number that was rounded on output (YAML's 9 decimals, ``ertools.serialize``) may in
   addition move by one unit in its last digit (:data:`YAML_UNIT`): a value within its
   quantity's tolerance of a rounding boundary rounds either way. Numbers written with fewer
   digits inside text (a note's ``1.538 ms``) get no such allowance: a value within 1e-12 of
@@ -61,7 +61,7 @@ VALUE = Tolerance(rel=1e-12, abs=1e-12)
 SHARE = Tolerance(rel=1e-9, abs=1e-12)
 EXACT = Tolerance(rel=0.0, abs=0.0)
 EXACT_FROM = 1e6
-YAML_UNIT = 1e-9  # one in the ninth decimal (ertools.yamlout)
+YAML_UNIT = 1e-9  # one in the ninth decimal (ertools.serialize)
 
 # The names the old tests import: a value's tolerance.
 FLOAT_RTOL = VALUE.rel

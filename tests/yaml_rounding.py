@@ -1,6 +1,6 @@
 """Compare a YAML output with the full-precision data it was written from.
 
-``ertools.benchmarks.base.dump_yaml`` rounds floats to 9 decimal places, so a YAML value is at
+``ertools.serialize.dump_yaml`` rounds floats to 9 decimal places, so a YAML value is at
 most half a unit of the 9th decimal (5e-10) from its float64 (plus the float's own rounding of
 that decimal, far below 1e-15 for values under 1e3); JSON keeps every bit.
 """

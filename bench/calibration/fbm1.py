@@ -68,7 +68,7 @@ def score(seed: int, draws: int) -> tuple[Any, Any]:
     from ertools.benchmarks.fbm1.config import Fbm1Options
     from ertools.benchmarks.fbm1.runs import find_runs
     from ertools.samples.fbm1 import item_list, simulate
-    from ertools.samples.statemachine import state_messages
+    from ertools.simulator.statemachine import state_messages
     from ertools.states import Machine
     from ertools.streams import PoseStream, StateStream
 

@@ -38,7 +38,7 @@ def simulate(seed: int) -> tuple[Any, Any, Any]:
     # lazy: the calibration imports fast; the simulator on demand
     from ertools.geometry import quat_from_yaw
     from ertools.samples import robotlog as rl
-    from ertools.samples.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
+    from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
     from ertools.streams import PoseStream
 
     rng = np.random.default_rng(seed)

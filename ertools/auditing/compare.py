@@ -21,8 +21,8 @@ from typing import TYPE_CHECKING, Any
 from ertools.auditing.explain import explain, is_number
 from ertools.auditing.model import Audit, ScoreComparison, ScoreLine
 from ertools.benchmarks import registry
-from ertools.benchmarks.base import jsonable
 from ertools.configs.transform import LIVE_TRANSFORM_KEY, MarkerTransform, live_transform
+from ertools.serialize import jsonable
 
 if TYPE_CHECKING:
     from ertools.benchmarks.base import BenchmarkResult

@@ -17,8 +17,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Generic, Literal, Protocol, TypeVar, runtime_checkable
 
-import numpy as np
-
 from ertools.errors import UsageError
 from ertools.progress import clear_current
 
@@ -217,36 +215,6 @@ def notice(message: str) -> None:
 
     clear_current()
     print(f"ertools: {message}", file=sys.stderr)
-
-
-def dump_yaml(data: Any) -> str:
-    """YAML as the 2015 nodes dumped it (block style, keys in insertion order), floats
-    rounded to 9 decimal places (:mod:`ertools.yamlout`)."""
-    from ertools.yamlout import dump  # lazy: PyYAML, 12-15 ms; JSON and text do without
-
-    text: str = dump(data)
-    return text
-
-
-def jsonable(value: Any) -> Any:
-    """Convert NumPy scalars/arrays and tuples inside ``value`` to plain JSON types."""
-
-    if isinstance(value, dict):
-        return {str(k): jsonable(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return jsonable(value.tolist())
-    if isinstance(value, np.bool_):
-        return bool(value)
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.floating):
-        f = float(value)
-        return None if math.isnan(f) else f
-    if isinstance(value, float) and math.isnan(value):
-        return None
-    return value
 
 
 @dataclass(frozen=True)

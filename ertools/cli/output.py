@@ -9,9 +9,9 @@ from pathlib import Path
 from typing import Any
 
 from ertools.atomic import write_text as write_file
-from ertools.benchmarks.base import jsonable
 from ertools.cli.text import error_text, printable
 from ertools.progress import clear_current
+from ertools.serialize import jsonable
 
 
 def write_text(text: str, output: Path | None) -> None:

@@ -23,12 +23,13 @@ from pathlib import Path
 from typing import Any, Literal
 
 from ertools.auditing.compare import attach
-from ertools.benchmarks.base import Benchmark, jsonable
+from ertools.benchmarks.base import Benchmark
 from ertools.benchmarks.common.teams import with_team
 from ertools.benchmarks.document import all_failed, score_json
 from ertools.errors import ErtoolsError, transient_error, watching
 from ertools.progress import reporting
 from ertools.report.folder import _audit_inputs, write_report
+from ertools.serialize import jsonable
 
 Status = Literal["scored", "unscoreable", "failed"]
 

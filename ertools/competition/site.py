@@ -31,8 +31,9 @@ from ertools.competition import site_text as text
 from ertools.competition.site_text import TEAM_UNKNOWN
 from ertools.errors import ConfigError
 from ertools.report import html as h
-from ertools.report import ranks, units
+from ertools.report import ranks
 from ertools.report.rank_plot import interval_plot
+from ertools.views import units
 
 SCHEMA_VERSION = 1
 TEMPLATE = "rescore_index.html.j2"

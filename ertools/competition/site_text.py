@@ -18,12 +18,12 @@ from dataclasses import dataclass
 from typing import Any
 
 from ertools.benchmarks import registry
-from ertools.report import units
+from ertools.views import units
 
 # What an execution no log and no manifest entry names a team for is called, on the page and
 # in results.json: scored, left out of the leaderboards until named.
 TEAM_UNKNOWN = "team unknown (name it in the manifest)"
-# Decimals per quantity: one table for the site and the reports (ertools.report.units).
+# Decimals per quantity: one table for the site and the reports (ertools.views.units).
 DECIMALS = units.DECIMALS
 # The rule texts of the registry name the stored unit; the page states the display unit.
 _UNIT_WORDS = {"metres": "mm", "meters": "mm", "radians": "degrees", "seconds": "s"}

@@ -298,8 +298,7 @@ def _expression_shape(name: str, spec: Mapping[str, Any], where: str) -> Shape:
 
 
 def _points_shape(name: str, points: Any, where: str) -> Shape:
-    # lazy: scipy only where its rotations/statistics are needed (~0.3 s to import)
-    from scipy.interpolate import CubicSpline
+    from scipy.interpolate import CubicSpline  # lazy: scipy, 300 ms
 
     try:
         pts = np.asarray(points, dtype=np.float64)

@@ -73,8 +73,7 @@ def rotation_matrices(quat_xyzw: F64, where: str = "") -> npt.NDArray[np.float64
     Raises:
         BagError: a zero or non-finite quaternion (it has no rotation matrix).
     """
-    # lazy: scipy only where its rotations/statistics are needed (~0.3 s to import)
-    from scipy.spatial.transform import Rotation
+    from scipy.spatial.transform import Rotation  # lazy: scipy, 300 ms
 
     q = np.asarray(quat_xyzw, dtype=np.float64)
     if len(q) == 0:

@@ -291,8 +291,7 @@ def _int_ns(rows: _Rows, path: Path) -> I64:
 
 
 def _quat_from_matrices(rot: npt.NDArray[np.float64]) -> F64:
-    # lazy: scipy only where its rotations are needed (~0.3 s to import)
-    from scipy.spatial.transform import Rotation
+    from scipy.spatial.transform import Rotation  # lazy: scipy, 300 ms
 
     q: F64 = Rotation.from_matrix(rot).as_quat()
     return q

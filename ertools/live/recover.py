@@ -97,9 +97,9 @@ def _recover(path: Path) -> Recovered:
 def _rewrite(source: Path, target: Path, complete_bytes: int, size: int) -> int:
     """Every complete record of ``source`` into the finished MCAP file ``target``; the
     number of messages."""
-    from mcap import records as r  # lazy: the mcap library only when a file is recovered
-    from mcap.stream_reader import StreamReader  # lazy: as above
-    from mcap.writer import CompressionType, Writer  # lazy: as above
+    from mcap import records as r  # lazy: mcap, 20 ms
+    from mcap.stream_reader import StreamReader  # lazy: mcap, 20 ms
+    from mcap.writer import CompressionType, Writer  # lazy: mcap, 100 ms
 
     count = 0
     with open(source, "rb") as fin, open(target, "wb") as fout:

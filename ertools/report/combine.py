@@ -33,9 +33,10 @@ from ertools.errors import ConfigError
 from ertools.inputs import read_regular_text, why_not
 from ertools.jsonin import loads as loads_json
 from ertools.report import html as h
-from ertools.report import ranks, units
+from ertools.report import ranks
 from ertools.report.folder import headline
 from ertools.report.rank_plot import interval_plot
+from ertools.views import units
 
 # Command-line options that choose where or how output is written, not what is scored.
 _OUTPUT_OPTIONS = frozenset(

@@ -32,14 +32,15 @@ from ertools.atomic import write_text
 from ertools.auditing.analyse import audit_states
 from ertools.auditing.model import Audit
 from ertools.benchmarks import registry
-from ertools.benchmarks.base import BenchmarkResult, Rows, jsonable
+from ertools.benchmarks.base import BenchmarkResult, Rows
 from ertools.benchmarks.common.teams import team_from_log_name, team_from_transform_name
 from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ConfigError, ErtoolsError
 from ertools.io.reader import read_benchmark_states
 from ertools.report import folder_page, plots_audit
-from ertools.report.figures import FigureSpec, figure_specs, save_figures
+from ertools.report.figures import FigureSpec, drawable, figure_specs, save_figures
 from ertools.report.records import FileRecord, csv_stem, file_record
+from ertools.serialize import jsonable
 
 log = logging.getLogger("ertools.report.folder")
 
@@ -343,7 +344,7 @@ def _figures(
             log.warning("no figures for %s: %s", score.name, err)
             problems.append(f"no figures for {score.name}: {type(err).__name__}: {err}")
     if audit is not None:
-        specs += plots_audit.figure_specs(audit)
+        specs += [drawable(spec) for spec in plots_audit.figure_specs(audit)]
     out: list[tuple[Path, str]] = []
     for spec in specs:
         try:

@@ -1,6 +1,6 @@
 """FBM1 figures: per-run errors and scores, ground truth vs answered poses on the table.
 
-Each figure is a :class:`~ertools.report.chart.Chart` (lengths in mm, angles in degrees);
+Each figure is a :class:`~ertools.views.chart.Chart` (lengths in mm, angles in degrees);
 reports write it as SVG (:mod:`ertools.report.svg`).
 """
 
@@ -12,8 +12,8 @@ from typing import Any
 import numpy as np
 
 from ertools.benchmarks import registry
-from ertools.report import units
-from ertools.report.chart import (
+from ertools.views import units
+from ertools.views.chart import (
     Arrows,
     Axis,
     Bars,
@@ -24,7 +24,7 @@ from ertools.report.chart import (
     Scatter,
     Text,
 )
-from ertools.report.figures import FigureSpec, chart_spec
+from ertools.views.spec import ChartSpec
 
 # Colours by answer quality (colour-blind safe pairs).
 _RIGHT = "#1b9e77"
@@ -151,21 +151,21 @@ def table_chart(result: Any) -> Chart:
     )
 
 
-def figure_specs(result: Any) -> list[FigureSpec]:
+def figure_specs(result: Any) -> list[ChartSpec]:
     """The FBM1 figures of a result (``Fbm1Result``)."""
     label = registry.get(result.name).title
     return [
-        chart_spec(
+        ChartSpec(
             f"{result.name}_pose_scores",
             f"{label}: pose score per run",
             lambda size: scores_chart(result),
         ),
-        chart_spec(
+        ChartSpec(
             f"{result.name}_errors",
             f"{label}: translation and theta errors",
             lambda size: errors_chart(result),
         ),
-        chart_spec(
+        ChartSpec(
             f"{result.name}_table",
             f"{label}: ground truth (black) vs answers on the table",
             lambda size: table_chart(result),

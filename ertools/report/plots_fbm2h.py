@@ -1,6 +1,6 @@
 """FBM2@Home figures: the robot's path with the waypoints, and the per-waypoint errors.
 
-Each figure is a :class:`~ertools.report.chart.Chart` (lengths in mm, angles in degrees),
+Each figure is a :class:`~ertools.views.chart.Chart` (lengths in mm, angles in degrees),
 built for its size (the path thinned to its pixels); reports write it as SVG.
 """
 
@@ -10,8 +10,9 @@ from typing import Any
 
 import numpy as np
 
-from ertools.report import gaps, units
-from ertools.report.chart import (
+from ertools.benchmarks.common import gaps
+from ertools.views import units
+from ertools.views.chart import (
     COLOURS,
     Arrows,
     Axis,
@@ -23,7 +24,8 @@ from ertools.report.chart import (
     Scatter,
     Text,
 )
-from ertools.report.figures import FigureSpec, chart_spec, thin_path
+from ertools.views.spec import ChartSpec
+from ertools.views.thinning import thin_path
 
 ARROW = 0.25  # metres: length of the heading arrows on the path figure
 MM = units.factor("length", "m")
@@ -44,7 +46,7 @@ def _poses(xyt: np.ndarray, colour: str, label: str, marker: Any) -> list[Layer]
 
 def path_chart(result: Any, size: tuple[float, float] = PATH_SIZE) -> Chart:
     """Path on the testbed frame, waypoints with target headings, reached poses, the GT's
-    gaps on the path (:mod:`ertools.report.gaps`)."""
+    gaps on the path (:mod:`ertools.benchmarks.common.gaps`)."""
     layers: list[Layer] = []
     path = thin_path(np.asarray(result.path_xyyaw, dtype=float).reshape(-1, 3), size)
     if len(path):
@@ -143,17 +145,17 @@ def path_title(result: Any) -> str:
     return title
 
 
-def figure_specs(result: Any) -> list[FigureSpec]:
+def figure_specs(result: Any) -> list[ChartSpec]:
     """The path and the errors figures of an ``Fbm2hResult``."""
     mode = "2015 orientation" if result.orientation_2015 else "orientation wrapped to [0, pi]"
     return [
-        chart_spec(
+        ChartSpec(
             "fbm2h_path",
             path_title(result),
             lambda size: path_chart(result, size),
             PATH_SIZE,
         ),
-        chart_spec(
+        ChartSpec(
             "fbm2h_errors",
             f"Errors per waypoint (dashed: accuracy; {mode})",
             lambda size: errors_chart(result),

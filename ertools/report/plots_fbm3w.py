@@ -1,6 +1,6 @@
 """FBM3@Work figures: each run's path in its run frame, the runs' errors, the d_min sweep.
 
-Each figure is a :class:`~ertools.report.chart.Chart` in millimetres, built for its size
+Each figure is a :class:`~ertools.views.chart.Chart` in millimetres, built for its size
 (paths thinned to its pixels); reports write it as SVG (:mod:`ertools.report.svg`).
 """
 
@@ -11,8 +11,9 @@ from typing import Any
 
 import numpy as np
 
-from ertools.report import gaps, units
-from ertools.report.chart import (
+from ertools.benchmarks.common import gaps
+from ertools.views import units
+from ertools.views.chart import (
     COLOURS,
     CYCLE,
     Axis,
@@ -25,7 +26,8 @@ from ertools.report.chart import (
     Scatter,
     Text,
 )
-from ertools.report.figures import FigureSpec, chart_spec, thin_path
+from ertools.views.spec import ChartSpec
+from ertools.views.thinning import thin_path
 
 MM = units.factor("length", "m")
 RUN_SIZE = (8.0, 5.5)
@@ -35,7 +37,7 @@ VECTORS = 25  # about this many "compared with" vectors per run: enough to read,
 def run_chart(run: Any, size: tuple[float, float] = RUN_SIZE) -> Chart:
     """Target and measured path in the run frame (mm); kept samples coloured by their error,
     a few of them joined to the target point they are compared with; the GT's gaps on the
-    path (:mod:`ertools.report.gaps`)."""
+    path (:mod:`ertools.benchmarks.common.gaps`)."""
     score = run.score
     layers: list[Layer] = []
     if run.target_dense is not None:
@@ -167,22 +169,20 @@ def run_title(run: Any) -> str:
     )
 
 
-def figure_specs(result: Any) -> list[FigureSpec]:
+def figure_specs(result: Any) -> list[ChartSpec]:
     """One figure per scored or unscoreable run (its path and gaps), the runs' bar chart, and
     the sweep when there is one."""
     specs = [
-        chart_spec(f"fbm3w_run{r.index}", run_title(r), partial(run_chart, r), RUN_SIZE)
+        ChartSpec(f"fbm3w_run{r.index}", run_title(r), partial(run_chart, r), RUN_SIZE)
         for r in result.runs
         if r.score is not None or (r.status == "unscoreable" and r.frame_xy is not None)
     ]
     specs.append(
-        chart_spec(
-            "fbm3w_runs", "FBM3@Work distance_error per run", lambda size: runs_chart(result)
-        )
+        ChartSpec("fbm3w_runs", "FBM3@Work distance_error per run", lambda size: runs_chart(result))
     )
     if result.sweep_values:
         specs.append(
-            chart_spec(
+            ChartSpec(
                 "fbm3w_d_min_sweep", "distance_error over d_min", lambda size: sweep_chart(result)
             )
         )

@@ -1,5 +1,5 @@
 """Mocap noise figure: the distribution of the distance between consecutive measurements, as
-a :class:`~ertools.report.chart.Chart` in mm (reports write it as SVG)."""
+a :class:`~ertools.views.chart.Chart` in mm (reports write it as SVG)."""
 
 from __future__ import annotations
 
@@ -7,9 +7,9 @@ from typing import Any
 
 import numpy as np
 
-from ertools.report import units
-from ertools.report.chart import COLOURS, Axis, Bars, Chart, Layer, RefLine
-from ertools.report.figures import FigureSpec, chart_spec
+from ertools.views import units
+from ertools.views.chart import COLOURS, Axis, Bars, Chart, Layer, RefLine
+from ertools.views.spec import ChartSpec
 
 MM = units.factor("length", "m")
 
@@ -56,10 +56,10 @@ def histogram_chart(result: Any) -> Chart:
     )
 
 
-def figure_specs(result: Any) -> list[FigureSpec]:
+def figure_specs(result: Any) -> list[ChartSpec]:
     scope = "stationary phases" if result.stationary else "whole recording"
     return [
-        chart_spec(
+        ChartSpec(
             "noise",
             f"Mocap noise ({scope}, {result.samples} samples)",
             lambda size: histogram_chart(result),

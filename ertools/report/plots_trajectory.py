@@ -1,6 +1,6 @@
 """Figures of a trajectory result: the error over time and the two paths overlaid.
 
-Each figure is a :class:`~ertools.report.chart.Chart` (lengths in mm, angles in degrees, time
+Each figure is a :class:`~ertools.views.chart.Chart` (lengths in mm, angles in degrees, time
 in seconds), built for its size (series and paths thinned to its pixels); reports write it as
 SVG (:mod:`ertools.report.svg`).
 """
@@ -11,10 +11,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ertools.benchmarks.common import gaps
 from ertools.benchmarks.trajectory.association import GAP, TRACKING_LOST, UNCOVERED
-from ertools.report import gaps, units
-from ertools.report.chart import COLOURS, Axis, Chart, Layer, Line, RefLine, Scatter
-from ertools.report.figures import FigureSpec, chart_spec, thin_path, thin_series
+from ertools.views import units
+from ertools.views.chart import COLOURS, Axis, Chart, Layer, Line, RefLine, Scatter
+from ertools.views.spec import ChartSpec
+from ertools.views.thinning import thin_path, thin_series
 
 if TYPE_CHECKING:
     from ertools.benchmarks.trajectory.result import TrajectoryResult
@@ -102,21 +104,21 @@ def validity_note(result: TrajectoryResult) -> str:
     return note
 
 
-def figure_specs(result: TrajectoryResult) -> list[FigureSpec]:
+def figure_specs(result: TrajectoryResult) -> list[ChartSpec]:
     """The figures of ``ertools score trajectory --plot DIR``."""
     off = result.offset_ns / 1e9
     return [
-        chart_spec(
+        ChartSpec(
             "trajectory_error",
             f"Robot vs GT position error ({result.config.association}, offset {off:+.3f} s)"
             + validity_note(result),
             lambda size: error_chart(result, size),
             (8.0, 4.0),
         ),
-        chart_spec(
+        ChartSpec(
             "trajectory_paths", "Robot estimate and GT", lambda size: paths_chart(result, size)
         ),
-        chart_spec(
+        ChartSpec(
             "trajectory_yaw_error",
             "Robot vs GT yaw error",
             lambda size: yaw_chart(result, size),

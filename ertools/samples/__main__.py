@@ -22,7 +22,7 @@ if __name__ == "__main__":
     from ertools.launch import run as launch
 
     def _start() -> object:
-        from ertools.samples.__main__ import program  # lazy: own name, in the guard
+        from ertools.samples.__main__ import program  # lazy: in the Ctrl-C guard, 600 ms
 
         return program()
 

@@ -72,11 +72,11 @@ from ertools.samples.competition_schedule import (
     simulate_slot,
 )
 from ertools.samples.competition_scores import expected_score, expected_trajectory
-from ertools.samples.mocap import pose_topic
 from ertools.samples.scenario import EPOCH_2015, log_name, to_plain
-from ertools.samples.simulated import SimulatedRun
-from ertools.samples.statemachine import state_messages
 from ertools.samples.timeline_folder import make_active
+from ertools.simulator.mocap import pose_topic
+from ertools.simulator.simulated import SimulatedRun
+from ertools.simulator.statemachine import state_messages
 from ertools.states import BmBoxState, Machine
 
 NS = 1_000_000_000

@@ -14,7 +14,7 @@ from typing import Any
 
 from ertools.samples import fbm1, fbm2h, fbm3w
 from ertools.samples.scenario import EPOCH_2015
-from ertools.samples.simulated import SimulatedRun
+from ertools.simulator.simulated import SimulatedRun
 
 NS = 1_000_000_000
 

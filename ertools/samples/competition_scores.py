@@ -15,9 +15,9 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.geometry import yaw_from_quat
-from ertools.samples.mocap import MocapPublished
 from ertools.samples.robotlog import expected_scores
-from ertools.samples.simulated import SimulatedRun
+from ertools.simulator.mocap import MocapPublished
+from ertools.simulator.simulated import SimulatedRun
 
 Fields = dict[str, Any]
 MAX_GAP_NS = 100_000_000  # the trajectory scorer's default --max-gap

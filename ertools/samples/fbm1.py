@@ -43,7 +43,8 @@ import yaml
 from scipy.spatial.transform import Rotation
 
 from ertools.arrays import F64
-from ertools.samples.mocap import (
+from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
+from ertools.simulator.mocap import (
     MocapNoise,
     frame_times,
     pose_topic,
@@ -51,10 +52,9 @@ from ertools.samples.mocap import (
     publish_mocap,
     simulate_mocap,
 )
-from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
-from ertools.samples.simulated import SimulatedRun
-from ertools.samples.statemachine import Transition, publish_states
-from ertools.samples.writer import BagWriter
+from ertools.simulator.simulated import SimulatedRun
+from ertools.simulator.statemachine import Transition, publish_states
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
 S = 1_000_000_000

@@ -45,7 +45,8 @@ import yaml
 
 from ertools.arrays import F64
 from ertools.geometry import quat_from_yaw
-from ertools.samples.mocap import (
+from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
+from ertools.simulator.mocap import (
     MocapNoise,
     TrackingLoss,
     frame_times,
@@ -53,10 +54,9 @@ from ertools.samples.mocap import (
     publish_mocap,
     simulate_mocap,
 )
-from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
-from ertools.samples.simulated import SimulatedRun
-from ertools.samples.statemachine import Transition, publish_states
-from ertools.samples.writer import BagWriter
+from ertools.simulator.simulated import SimulatedRun
+from ertools.simulator.statemachine import Transition, publish_states
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
 Motion = Callable[[F64], F64]  # time (s from the mocap start) -> (N, 2) world positions

@@ -38,7 +38,8 @@ import numpy as np
 from ertools.arrays import F64, I64
 from ertools.benchmarks.fbm2h.config import NAMESPACE as FBM2H
 from ertools.geometry import quat_from_yaw
-from ertools.samples.mocap import (
+from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
+from ertools.simulator.mocap import (
     MocapNoise,
     MocapPublished,
     TrackingLoss,
@@ -48,8 +49,7 @@ from ertools.samples.mocap import (
     publish_mocap,
     simulate_mocap,
 )
-from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 
 NS = 1_000_000_000
 TEAM = "homer"

@@ -2,7 +2,7 @@
 
 A scenario is a function ``generate(outdir: Path, *, seed: int) -> list[Path]`` in its own
 module. It writes one or more logs into ``outdir`` (which exists and is empty) with
-:class:`ertools.samples.writer.BagWriter`, the answers a correct scorer must find next to each
+:class:`ertools.simulator.writer.BagWriter`, the answers a correct scorer must find next to each
 log, and any config YAML the scorer needs; it returns every path it wrote (files, or rosbag2
 directories). ``python -m ertools.samples OUTDIR`` runs each registered scenario into
 ``OUTDIR/<name>/``.
@@ -18,8 +18,8 @@ Rules for scenario authors:
   publish 120 Hz only for the bodies the benchmark needs.
 - Independent: compute ``expected`` from the noiseless truth with the seed manual's formulas,
   written out in the scenario module; never import ``ertools.benchmarks``.
-- Use :mod:`ertools.samples.mocap` for what the mocap node published,
-  :mod:`ertools.samples.statemachine` for the state topics, :func:`write_answers` here.
+- Use :mod:`ertools.simulator.mocap` for what the mocap node published,
+  :mod:`ertools.simulator.statemachine` for the state topics, :func:`write_answers` here.
 
 Answers file ``<log stem>.answers.yaml`` (``<name>.bag`` -> ``<name>.answers.yaml``; a rosbag2
 directory ``<name>/`` -> ``<name>.answers.yaml`` beside it), top-level keys in this order:

@@ -33,7 +33,8 @@ import numpy as np
 
 from ertools.benchmarks.fbm3w.config import NAMESPACE as FBM3W
 from ertools.geometry import quat_from_yaw
-from ertools.samples.mocap import (
+from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
+from ertools.simulator.mocap import (
     MocapNoise,
     TrackingLoss,
     frame_times,
@@ -44,8 +45,7 @@ from ertools.samples.mocap import (
     simulate_mocap,
     small_rotation,
 )
-from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 
 NAMESPACE = FBM3W
 BODY = "robot_at_work"

@@ -64,7 +64,7 @@ def test_the_typed_import_names_the_same() -> None:
 FRESH = """
 import sys, ertools
 assert "numpy" not in sys.modules and "ertools.api" not in sys.modules, "not light"
-for name in ("yamlout", "auditing", "api", "nope"):
+for name in ("serialize", "auditing", "api", "nope"):
     try:
         getattr(ertools, name)
     except AttributeError as err:
@@ -80,7 +80,7 @@ def test_a_fresh_import_offers_only_the_api() -> None:
         [sys.executable, "-c", FRESH], capture_output=True, text=True, timeout=60, check=True
     ).stdout.splitlines()
     assert out[:3] == [
-        "yamlout AttributeError module 'ertools' has no attribute 'yamlout'",
+        "serialize AttributeError module 'ertools' has no attribute 'serialize'",
         "auditing AttributeError module 'ertools' has no attribute 'auditing'",
         "api AttributeError module 'ertools' has no attribute 'api'",
     ]

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from ertools.cli.main import main
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 from ertools.states import Machine
 from ertools.streams import StateStream
 from tests.audit.audit_streams import T0_NS, heartbeat

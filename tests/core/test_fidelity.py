@@ -9,7 +9,6 @@ from pathlib import Path
 
 import pytest
 
-from ertools.benchmarks.base import dump_yaml, jsonable
 from ertools.benchmarks.fbm1.config import NODE_2015, NODE_2016, NODE_2017
 from ertools.benchmarks.fbm2h.config import NODES as FBM2H_NODES
 from ertools.cli.main import main
@@ -27,6 +26,7 @@ from ertools.fidelity import (
     replace_table,
     version_table,
 )
+from ertools.serialize import dump_yaml, jsonable
 
 ROOT = Path(__file__).resolve().parents[2]
 OPTION = re.compile(r"--[a-z0-9][a-z0-9-]*")

@@ -21,7 +21,7 @@ from ertools.benchmarks.common.teams import (
 )
 from ertools.cli.main import main
 from ertools.samples.__main__ import generate
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 from ertools.states import Machine
 from ertools.streams import Provenance
 from ertools.timelines.build import benchmark_names

@@ -18,7 +18,7 @@ import pytest
 
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 
 pytestmark = pytest.mark.slow
 

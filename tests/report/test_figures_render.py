@@ -9,7 +9,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from ertools.report.figures import DPI, FigureSpec, render, thin_path, thin_series
+from ertools.report.figures import DPI, FigureSpec, render
+from ertools.views.thinning import thin_path, thin_series
 
 matplotlib = pytest.importorskip("matplotlib")
 from matplotlib.figure import Figure  # noqa: E402

@@ -11,7 +11,7 @@ import pytest
 from matplotlib.figure import Figure
 
 from ertools.report import chart_mpl, svg
-from ertools.report.chart import (
+from ertools.views.chart import (
     Arrows,
     Axis,
     Band,

@@ -10,7 +10,7 @@ import pytest
 
 from ertools.errors import UsageError
 from ertools.rsbb.layout import FileKind, classify, pair_runs, scan
-from ertools.samples.rsbb import write_rsbb_run
+from ertools.simulator.rsbb import write_rsbb_run
 from tests.rsbb_replay.scenarios import at, hnf_scenario
 
 

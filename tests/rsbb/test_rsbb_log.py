@@ -19,9 +19,9 @@ from ertools.rsbb.log import (
     read_script_broadcasts,
 )
 from ertools.rsbb_states import BENCHMARKS, BMBOX_STATE_TOPIC, REFBOX_STATE_TOPIC, RefBoxState
-from ertools.samples.rsbb import write_rsbb_run
-from ertools.samples.rsbb_scenario import live_score_text, result_object
-from ertools.samples.writer import BagWriter
+from ertools.simulator.rsbb import write_rsbb_run
+from ertools.simulator.rsbb_scenario import live_score_text, result_object
+from ertools.simulator.writer import BagWriter
 from tests.rsbb_replay.scenarios import MS, at, hnf_scenario
 
 pytestmark = pytest.mark.slow  # each writes and reads a run bag (~0.5-1 s)

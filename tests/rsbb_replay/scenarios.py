@@ -11,8 +11,8 @@ from typing import Any
 
 import numpy as np
 
-from ertools.samples.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
-from ertools.samples.rsbb_scenario import (
+from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
+from ertools.simulator.rsbb_scenario import (
     Body,
     Broadcast,
     Goal,

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from ertools.samples.rsbb import write_rsbb_run
-from ertools.samples.rsbb_scenario import Broadcast, Goal, ManualOperation, Save
+from ertools.simulator.rsbb import write_rsbb_run
+from ertools.simulator.rsbb_scenario import Broadcast, Goal, ManualOperation, Save
 from tests.rsbb_replay import hgmf, hnf, hopf, hpff, hppf
 from tests.rsbb_replay.fromlog import timeline_from_bag
 from tests.rsbb_replay.py2 import dump_pose2d

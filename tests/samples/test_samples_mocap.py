@@ -9,7 +9,7 @@ import pytest
 from rosbags.highlevel import AnyReader
 
 from ertools.geometry import quat_from_yaw, yaw_from_quat
-from ertools.samples.mocap import (
+from ertools.simulator.mocap import (
     MocapNoise,
     TrackingLoss,
     frame_times,
@@ -19,7 +19,7 @@ from ertools.samples.mocap import (
     random_losses,
     simulate_mocap,
 )
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 
 T0 = 1_448_013_600_000_000_000
 

@@ -13,8 +13,8 @@ from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Reader
 
 from ertools.errors import UsageError
-from ertools.samples.packing import pack_messages
-from ertools.samples.writer import FORMATS, BagWriter
+from ertools.simulator.packing import pack_messages
+from ertools.simulator.writer import FORMATS, BagWriter
 from ertools.states import MSG_TYPES, BmBoxState, ClientState, Machine
 
 T0 = 1_448_013_600_123_456_789

@@ -19,7 +19,7 @@ from ertools.geometry import quat_from_yaw
 from ertools.io.formats import find_bags
 from ertools.io.model import ClockCheck
 from ertools.progress import reporting
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 from ertools.timelines.scan import scan
 from tests.timeline.summaries import BAG_KEYS
 

@@ -199,8 +199,7 @@ def stationary_tail(
     The final pose is the mean of the last 0.2 s, so one noisy last sample does not decide.
     A tracking gap longer than ``max_gap_ns`` ends the tail too: nobody saw the board then.
     """
-    # lazy: scipy only where its rotations/statistics are needed (~0.3 s to import)
-    from scipy.spatial.transform import Rotation
+    from scipy.spatial.transform import Rotation  # lazy: scipy, 300 ms
 
     if len(rel) == 0:
         return rel
@@ -228,8 +227,7 @@ def settled(tail: PoseStream) -> PoseStream:
     window, so anyone can average the same samples (a noisy sample later on stays, as any
     mocap sample of a still board).
     """
-    # lazy: scipy only where its rotations/statistics are needed (~0.3 s to import)
-    from scipy.spatial.transform import Rotation
+    from scipy.spatial.transform import Rotation  # lazy: scipy, 300 ms
 
     if len(tail) < 5:
         return tail

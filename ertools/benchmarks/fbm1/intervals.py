@@ -150,8 +150,7 @@ def run_noise(
     xy: F64, yaw: F64, *, lookup: bool, confidence: float, gt_yaw: float, rho: float
 ) -> RunNoise:
     """The noise of a ground truth measured on ``n`` still samples (module doc)."""
-    # lazy: scipy only where its statistics are needed (~0.3 s to import)
-    from scipy.stats import t as student_t
+    from scipy.stats import t as student_t  # lazy: scipy, 300 ms
 
     n = len(yaw)
     if n < 3:

@@ -7,7 +7,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import as_list, interval_tables, low_high
 from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, interval_keys
 from ertools.benchmarks.common.validity import Validity, cell
@@ -17,6 +17,7 @@ from ertools.benchmarks.fbm1.score import PoseErrors, Totals
 from ertools.configs.items import Item
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames
+from ertools.serialize import dump_yaml, jsonable
 from ertools.streams import Provenance
 from ertools.timeutil import NS_PER_S, ns_to_s
 

@@ -10,7 +10,7 @@ import numpy as np
 import numpy.typing as npt
 import yaml
 
-from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
 from ertools.benchmarks.common.uncertainty import Interval, uncertainty_rows
 from ertools.benchmarks.common.validity import GapOnPath, Validity, cell
@@ -19,6 +19,7 @@ from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames
+from ertools.serialize import dump_yaml, jsonable
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
 from ertools.yamlin import load as load_yaml

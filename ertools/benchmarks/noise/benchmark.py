@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ertools.arrays import F64, I64, Bool
-from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.hygiene import (
     identical_poses,
     impossible_samples,
@@ -35,6 +35,7 @@ from ertools.benchmarks.common.phases import (
 from ertools.errors import ScoringError
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames
+from ertools.serialize import dump_yaml, jsonable
 from ertools.streams import PoseStream, Provenance
 
 if TYPE_CHECKING:

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.clocks import OffsetEstimate
 from ertools.benchmarks.common.interval_output import interval_tables, low_high
 from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, interval_keys
@@ -29,6 +29,7 @@ from ertools.benchmarks.trajectory.intervals import KEYS
 from ertools.benchmarks.trajectory.metrics import Metrics
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames
+from ertools.serialize import dump_yaml, jsonable
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import NS_PER_S, ns_to_s
 

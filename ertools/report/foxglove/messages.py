@@ -30,7 +30,7 @@ from foxglove_schemas_protobuf.TextPrimitive_pb2 import TextPrimitive
 from google.protobuf.message import Message
 
 from ertools.arrays import F64, I64
-from ertools.benchmarks.base import jsonable
+from ertools.serialize import jsonable
 
 WORLD = "world"  # the mocap frame every pose of a 2015 benchmark is in
 
@@ -102,8 +102,7 @@ def descriptor_set(desc: Any) -> bytes:
     """
     name = desc.full_name
     if name not in _DESCRIPTOR_SETS:
-        # lazy: protobuf only for --foxglove
-        from google.protobuf.descriptor_pb2 import FileDescriptorSet
+        from google.protobuf.descriptor_pb2 import FileDescriptorSet  # lazy: protobuf, 50 ms
 
         fds = FileDescriptorSet()
         seen: set[str] = set()

@@ -17,8 +17,8 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from ertools.cli.main import main
 from ertools.configs.items import load_items
-from ertools.samples.mocap import MocapNoise, frame_times, publish_mocap, simulate_mocap
-from ertools.samples.writer import BagWriter
+from ertools.simulator.mocap import MocapNoise, frame_times, publish_mocap, simulate_mocap
+from ertools.simulator.writer import BagWriter
 
 S = 1_000_000_000
 T0 = 1_448_030_000 * S

@@ -32,9 +32,9 @@ import yaml
 from scipy.spatial.transform import Rotation
 
 from ertools.cli.main import main
-from ertools.samples.mocap import MocapNoise, publish_mocap, simulate_mocap
-from ertools.samples.statemachine import Transition, publish_states
-from ertools.samples.writer import BagWriter
+from ertools.simulator.mocap import MocapNoise, publish_mocap, simulate_mocap
+from ertools.simulator.statemachine import Transition, publish_states
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 from tests.benchmarks.fbm1.node_fbm1 import VERSIONS, fbm1_node
 from tests.benchmarks.fbm1.test_fbm1_nodes import read_log, tf_lookup

@@ -38,9 +38,9 @@ from rosbags.highlevel import AnyReader
 from scipy.spatial.transform import Rotation
 
 from ertools.cli.main import main
-from ertools.samples.mocap import MocapNoise, publish_mocap, simulate_mocap
-from ertools.samples.statemachine import Transition, publish_states
-from ertools.samples.writer import BagWriter
+from ertools.simulator.mocap import MocapNoise, publish_mocap, simulate_mocap
+from ertools.simulator.statemachine import Transition, publish_states
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
 pytestmark = pytest.mark.slow

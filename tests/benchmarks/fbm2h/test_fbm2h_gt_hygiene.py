@@ -18,7 +18,7 @@ from ertools.cli.main import main
 from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
 from ertools.io.reader import read_poses
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState as B
 from ertools.states import ClientState as C
 from ertools.states import Machine

@@ -27,7 +27,7 @@ import numpy.typing as npt
 import yaml
 from scipy.interpolate import CubicSpline
 
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 
 F64 = npt.NDArray[np.float64]
 I64 = npt.NDArray[np.int64]

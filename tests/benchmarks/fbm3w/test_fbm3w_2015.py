@@ -31,7 +31,7 @@ from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.geometry import quat_from_yaw
 from ertools.io.model import BenchmarkStates
 from ertools.io.reader import read_benchmark_states, read_poses
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState as B
 from ertools.states import Machine
 from ertools.states import RefBoxState as R

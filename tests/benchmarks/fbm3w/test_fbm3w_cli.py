@@ -11,7 +11,7 @@ import yaml
 
 from ertools.cli.main import main
 from ertools.configs.shapes import builtin_shapes
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 from tests.benchmarks.fbm3w.fbm3w_kit import Sample
 from tests.benchmarks.fbm3w.fbm3w_synth import one_run
 from tests.benchmarks.fbm3w.protocol_logs import generate, write_bag, write_config

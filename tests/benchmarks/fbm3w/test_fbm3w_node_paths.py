@@ -30,8 +30,8 @@ import pytest
 from rosbags.highlevel import AnyReader
 
 from ertools.cli.main import main
-from ertools.samples.statemachine import Transition, publish_states
-from ertools.samples.writer import BagWriter
+from ertools.simulator.statemachine import Transition, publish_states
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 from tests.benchmarks.fbm3w.node_fbm3w import SPECS, fbm3w_node
 from tests.benchmarks.fbm3w.test_fbm3w_2015 import _track

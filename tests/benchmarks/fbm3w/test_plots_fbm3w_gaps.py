@@ -14,8 +14,7 @@ from matplotlib.image import imread
 from ertools.benchmarks.fbm3w.benchmark import score_runs
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.configs.shapes import builtin_shapes
-from ertools.report import plots_fbm3w
-from ertools.report.figures import render, wrap_title
+from ertools.report.figures import figure_specs, render, wrap_title
 from ertools.report.folder import write_report
 from tests import svg_figure
 from tests.benchmarks.fbm3w.fbm3w_synth import one_run
@@ -41,7 +40,7 @@ def _line_mm(i: int) -> tuple[float, float]:
 
 
 def _figure_named(result: object, name: str, path: Path) -> Path:
-    (spec,) = [s for s in plots_fbm3w.figure_specs(result) if s.name == name]
+    (spec,) = [s for s in figure_specs(result) if s.name == name]
     render(spec, path)
     return path
 
@@ -105,7 +104,7 @@ def test_matplotlib_draws_the_gaps_too(tmp_path: Path) -> None:
 def test_png_titles_wrap_to_the_figure() -> None:
     # matplotlib does not wrap a title; an unscoreable reason is wider than the figure
     result = _result((1000, 1072))
-    (spec,) = [s for s in plots_fbm3w.figure_specs(result) if s.name == "fbm3w_run0"]
+    (spec,) = [s for s in figure_specs(result) if s.name == "fbm3w_run0"]
     lines = wrap_title(spec.title, spec.size[0]).splitlines()
     assert len(lines) > 1 and all(len(line) <= 80 for line in lines)
     assert " ".join(lines) == spec.title

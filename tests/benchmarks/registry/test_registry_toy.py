@@ -17,8 +17,8 @@ import pytest
 
 from ertools.benchmarks import registry
 from ertools.cli.main import main
-from ertools.samples.statemachine import Transition, publish_states
-from ertools.samples.writer import BagWriter
+from ertools.simulator.statemachine import Transition, publish_states
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, Machine
 
 T0 = 1_448_013_600 * 1_000_000_000
@@ -34,9 +34,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.base import Benchmark, Input, Ranking, dump_yaml, resolve_values
+from ertools.benchmarks.base import Benchmark, Input, Ranking, resolve_values
 from ertools.io.model import PoseSource
 from ertools.io.reader import read_pose_source
+from ertools.serialize import dump_yaml
 from ertools.streams import Provenance
 
 INPUTS = (

@@ -26,7 +26,7 @@ from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.benchmarks.trajectory.scoring import score_streams
 from ertools.cli.main import main
 from ertools.errors import ClockError
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 from ertools.streams import PoseStream
 from tests.benchmarks.trajectory.node_2015 import EndOfBagError, Pose, score_2015, tf_yaw
 from tests.benchmarks.trajectory.trajectory_helpers import read_back, write_gt, write_robot

@@ -29,7 +29,7 @@ import pytest
 from ertools.benchmarks.trajectory.association import evo_matches
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 
 REPO = Path(__file__).resolve().parents[3]
 EVO_DATA = REPO.parent / "shared" / "evo_testdata"

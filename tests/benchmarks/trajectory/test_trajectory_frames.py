@@ -10,7 +10,7 @@ from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.benchmarks.trajectory.scoring import score_streams
 from ertools.geometry import quat_from_yaw
 from ertools.io.reader import read_poses
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 from ertools.streams import PoseStream
 
 S = 1_000_000_000

@@ -22,7 +22,7 @@ from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
 from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 from tests.benchmarks.trajectory.test_trajectory_sample import check
 from tests.benchmarks.trajectory.trajectory_helpers import read_back
 from tests.stderr_text import error_messages

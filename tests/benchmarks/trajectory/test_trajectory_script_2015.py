@@ -22,7 +22,7 @@ import pytest
 from rosbags.highlevel import AnyReader
 
 from ertools.cli.main import main
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 from tests.benchmarks.trajectory.script2015 import Bag, PoseStamped, Run, Time, run_2015
 from tests.stderr_text import error_messages
 

@@ -14,8 +14,7 @@ from ertools.benchmarks.trajectory.config import SETTINGS_2015, TrajectoryConfig
 from ertools.benchmarks.trajectory.scoring import MIN_VALID_FRACTION, score_streams
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
-from ertools.report.figures import render
-from ertools.report.plots_trajectory import figure_specs
+from ertools.report.figures import figure_specs, render
 from ertools.streams import PoseStream
 from tests import svg_figure
 

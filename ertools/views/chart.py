@@ -3,8 +3,8 @@ reports' vector figures, written straight from the arrays) or by matplotlib
 (:mod:`ertools.report.chart_mpl`, for a PNG or PDF a user asks for, and for notebooks).
 
 A plot module builds a :class:`Chart` from a result and the figure's size in inches (the size
-decides how far paths are thinned: :func:`ertools.report.figures.thin_path`); it never draws.
-Values are in the unit shown (mm, deg, s: :mod:`ertools.report.units`), so both renderers
+decides how far paths are thinned: :mod:`ertools.views.thinning`); it never draws.
+Values are in the unit shown (mm, deg, s: :mod:`ertools.views.units`), so both renderers
 print the ticks as they are. Colours are CSS colours; :data:`COLOURS` names the report's
 palette (matplotlib's ``tab:`` colours, so PNG and SVG figures read the same).
 """
@@ -18,6 +18,8 @@ import numpy as np
 import numpy.typing as npt
 
 FloatArray = npt.NDArray[np.float64]
+
+PIXELS_PER_INCH = 110  # the reports' PNGs were 110 dpi: the same pixel size for each figure
 
 COLOURS = {
     "blue": "#1f77b4",

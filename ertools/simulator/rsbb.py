@@ -1,7 +1,7 @@
 """Simulated RSBB runs (ERL @Home 2017-19): the bag and the result file a run left.
 
 Given a timed :class:`RsbbScenario` (the manual operations, goals, stop, the script's tf
-broadcasts and saves, the mocap bodies as :func:`ertools.samples.mocap.simulate_mocap`
+broadcasts and saves, the mocap bodies as :func:`ertools.simulator.mocap.simulate_mocap`
 publishes them), :func:`write_rsbb_run` writes what the RSBB recorded (docs/rsbb.md):
 ``rsbb_logs/<CODE>/<team>/run_<n>_<date>.bag`` with the RefBox state (at each change and at
 10 Hz), the BmBox state (10 Hz only), ``/timeout``, the live score, ``/tf`` (mocap bodies under
@@ -44,9 +44,9 @@ from ertools.rsbb_states import (
     body_pose2d_topic,
     body_pose_topic,
 )
-from ertools.samples.mocap import MocapPublished, simple_map
-from ertools.samples.packing import rosbags_name
-from ertools.samples.rsbb_scenario import (
+from ertools.simulator.mocap import MocapPublished, simple_map
+from ertools.simulator.packing import rosbags_name
+from ertools.simulator.rsbb_scenario import (
     RsbbScenario,
     Save,
     live_score_text,
@@ -54,7 +54,7 @@ from ertools.samples.rsbb_scenario import (
     result_object,
     result_time_text,
 )
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 
 MS = 1_000_000
 BMBOX_CALLER = "/rsbb/rsbb_bmbox"
@@ -167,8 +167,7 @@ def _sample(changes: Sequence[tuple[int, Any]], ticks: np.ndarray) -> list[Any]:
 
 def _register_types(bag: BagWriter) -> None:
     """Add the RSBB message types to the writer's type store (once per store)."""
-    # lazy: rosbags only on the per-message path (~0.1 s to import)
-    from rosbags.typesys import get_types_from_msg
+    from rosbags.typesys import get_types_from_msg  # lazy: rosbags, 100 ms
 
     missing = {
         n: d for n, d in MSG_DEFINITIONS.items() if rosbags_name(n) not in bag.typestore.types

@@ -11,8 +11,8 @@ import yaml
 from hypothesis import given
 from hypothesis import strategies as st
 
-from ertools.benchmarks.base import dump_yaml
 from ertools.cli.main import main
+from ertools.serialize import dump_yaml
 
 ROOT = Path(__file__).resolve().parents[2]
 FBM2H = ROOT / "sample_bags" / "fbm2h"

@@ -1,6 +1,6 @@
 """The timed scenario of a simulated RSBB run and the texts the BmBox wrote for it.
 
-:mod:`ertools.samples.rsbb` writes a scenario's bag and result file; this module holds what a
+:mod:`ertools.simulator.rsbb` writes a scenario's bag and result file; this module holds what a
 scenario is (manual operations, goals, the script's broadcasts and saves, the mocap bodies)
 and the result mapping and live-score texts made from a save (docs/rsbb.md, "Saving and the
 live score").
@@ -24,7 +24,7 @@ from ertools.rsbb_states import (
     RESULT_TIME_FORMAT,
     RefBoxState,
 )
-from ertools.samples.mocap import MocapPublished
+from ertools.simulator.mocap import MocapPublished
 
 MS = 1_000_000
 

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ertools.report.chart import COLOURS, Dash, Layer, Line, Span
+from ertools.views.chart import COLOURS, Dash, Layer, Line, Span
 
 # (legend label, colour, dash) of each kind of gap, in legend order.
 KINDS: dict[str, tuple[str, Dash]] = {

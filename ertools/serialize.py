@@ -1,4 +1,5 @@
-"""How ertools writes YAML: the safe dumper, with floats rounded to 9 decimal places.
+"""Results as plain data and text: :func:`jsonable` (JSON types) and :func:`dump_yaml` (YAML
+through the safe dumper, floats rounded to 9 decimal places).
 
 Every quantity ertools writes is in seconds, metres, radians, degrees or a ratio, so 9
 decimals keep the nanosecond, the nanometre and the nanoradian, far finer than anything
@@ -13,6 +14,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import numpy as np
 import yaml
 
 YAML_DECIMALS = 9
@@ -38,9 +40,9 @@ Dumper.add_representer(float, _represent_float)  # the exact type's entry wins o
 Dumper.add_multi_representer(float, _represent_float)
 
 
-def dump(data: Any, **options: Any) -> str:
-    """YAML text of ``data`` (block style, keys in insertion order unless ``options`` say
-    otherwise) through :class:`Dumper`."""
+def dump_yaml(data: Any, **options: Any) -> str:
+    """YAML as the 2015 nodes dumped it (block style, keys in insertion order unless
+    ``options`` say otherwise) through :class:`Dumper`: floats rounded to 9 decimals."""
     kwargs: dict[str, Any] = {
         "default_flow_style": False,
         "sort_keys": False,
@@ -50,3 +52,25 @@ def dump(data: Any, **options: Any) -> str:
     kwargs.setdefault("Dumper", Dumper)
     text: str = yaml.dump(data, **kwargs)
     return text
+
+
+def jsonable(value: Any) -> Any:
+    """``value`` as plain JSON types: NumPy scalars and arrays as numbers and lists, tuples as
+    lists, mapping keys as text, NaN as None."""
+
+    if isinstance(value, dict):
+        return {str(k): jsonable(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return jsonable(value.tolist())
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating):
+        f = float(value)
+        return None if math.isnan(f) else f
+    if isinstance(value, float) and math.isnan(value):
+        return None
+    return value

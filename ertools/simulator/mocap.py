@@ -43,7 +43,7 @@ import numpy.typing as npt
 
 from ertools.arrays import F64, I64, Bool
 from ertools.geometry import normalize_quat, yaw_from_quat
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 
 MOCAP_RATE_HZ = 120.0
 FRAME_NS = 8_333_333  # 1/120 s, as the 2015 Motive setup streamed

@@ -15,8 +15,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from ertools.samples.mocap import MocapPublished
-from ertools.samples.statemachine import Transition
+from ertools.simulator.mocap import MocapPublished
+from ertools.simulator.statemachine import Transition
 
 
 @dataclass(frozen=True, eq=False)
@@ -29,7 +29,7 @@ class SimulatedRun:
         start_ns: when the benchmark's recorder started (its first message).
         end_ns: when the recorder stopped (nothing of the execution after it).
         transitions: the three state machines' transitions.
-        state_end_ns: ``end_ns`` given to :func:`~ertools.samples.statemachine.publish_states`
+        state_end_ns: ``end_ns`` given to :func:`~ertools.simulator.statemachine.publish_states`
             (None: each machine stops at its END).
         bodies: body name -> what the mocap node published for it.
         configs: config file name -> text (goal, items, shapes, transform files).

@@ -3,7 +3,7 @@
 `BagWriter` is the only place the simulator touches a file. Scenario modules hand it whole
 arrays (one call per topic and per stretch of time); it serialises fixed-layout messages
 (PoseStamped, Pose2D, one-transform TFMessage) in bulk with NumPy
-(:mod:`ertools.samples.packing`), buffers everything, and on
+(:mod:`ertools.simulator.packing`), buffers everything, and on
 close writes all messages **sorted by record time** (stable, so equal times keep call order),
 as ``rosbag record`` did. Nothing in it reads a clock or a random source: the same calls give
 the same bytes.
@@ -49,7 +49,7 @@ import numpy.typing as npt
 
 from ertools.arrays import I64, U8
 from ertools.errors import UsageError
-from ertools.samples.packing import (
+from ertools.simulator.packing import (
     Field,
     as_bytes,
     broadcast_rows,
@@ -464,8 +464,7 @@ class BagWriter:
     def _write_ros1(
         self, order: npt.NDArray[np.intp], times: I64, conns: npt.NDArray[np.int64], rows: list[Any]
     ) -> None:
-        # lazy: rosbags only on the per-message path (~0.1 s to import)
-        from rosbags.rosbag1 import Writer
+        from rosbags.rosbag1 import Writer  # lazy: rosbags, 100 ms
 
         writer = Writer(self.path)
         writer.chunk_threshold = self.chunk_size
@@ -490,11 +489,8 @@ class BagWriter:
     def _write_rosbag2(
         self, order: npt.NDArray[np.intp], times: I64, conns: npt.NDArray[np.int64], rows: list[Any]
     ) -> None:
-        # lazy: rosbags only on the per-message path (~0.1 s to import)
-        from rosbags.rosbag2 import StoragePlugin, Writer
-
-        # lazy: rosbags only on the per-message path (~0.1 s to import)
-        from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
+        from rosbags.rosbag2 import StoragePlugin, Writer  # lazy: rosbags, 100 ms
+        from rosbags.rosbag2.enums import CompressionFormat, CompressionMode  # lazy: 100 ms
 
         plugin = StoragePlugin.MCAP if self.fmt == "rosbag2-mcap" else StoragePlugin.SQLITE3
         writer = Writer(self.path, version=9, storage_plugin=plugin)
@@ -513,8 +509,7 @@ class BagWriter:
     def _write_mcap(
         self, order: npt.NDArray[np.intp], times: I64, conns: npt.NDArray[np.int64], rows: list[Any]
     ) -> None:
-        # lazy: the mcap library only when an MCAP file is read
-        from mcap.writer import CompressionType, Writer
+        from mcap.writer import CompressionType, Writer  # lazy: mcap, 100 ms
 
         ctype = {
             None: CompressionType.NONE,

@@ -1,4 +1,4 @@
-"""Bulk serialisation for :class:`ertools.samples.writer.BagWriter`: fixed-layout messages packed
+"""Bulk serialisation for :class:`ertools.simulator.writer.BagWriter`: fixed-layout messages packed
 with NumPy (ROS1 and CDR), the rosbags typestore of every type the simulator writes, and the
 array helpers the writer's calls share. No file, clock or random source is touched here.
 """
@@ -26,8 +26,7 @@ def typestore(ros2: bool) -> Any:
     cached = _STORES.get(key)
     if cached is not None:
         return cached
-    # lazy: rosbags only on the per-message path (~0.1 s to import)
-    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore  # lazy: rosbags, 100 ms
 
     store = get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
     types: dict[str, Any] = {}

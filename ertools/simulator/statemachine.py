@@ -27,7 +27,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import I64
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 from ertools.states import BMBOX_TRANSITIONS, STATE_ENUMS, BmBoxState, Machine, state_topic
 
 HEARTBEAT_NS = 100_000_000  # 10 Hz
