@@ -1,14 +1,60 @@
-"""Hand-built state streams: 10 Hz heartbeats from a schedule of (time, state, payload)."""
+"""Hand-built state streams: 10 Hz heartbeats from a schedule of (time, state, payload), the
+schedules of an FBM2-like benchmark, and a bag written from them."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
+from ertools.simulator.writer import BagWriter
+from ertools.states import BmBoxState as B
+from ertools.states import ClientState as C
 from ertools.states import Machine
+from ertools.states import RefBoxState as R
 from ertools.streams import StateStream
 
 T0_NS = 1_445_000_000_000_000_000  # an epoch time in October 2015
 BEAT_NS = 100_000_000  # 10 Hz
+
+GOAL = "goal:\n  waypoints:\n  - [1.0, 2.0, 0.5]\n"
+
+# An FBM2-like benchmark of two segments. Segment 1 contains an illegal transition
+# (EXECUTING_GOAL -> TRANSMITTING_GOAL at 12.0 s) and is ended by a RefBox timeout at 19.9 s;
+# the BmBox heartbeat is lost between 5.0 s and 7.0 s.
+BMBOX = [
+    (0.0, B.START, ""),
+    (1.0, B.WAITING_CLIENT, ""),
+    (2.0, B.READY, ""),
+    (3.0, B.TRANSMITTING_GOAL, GOAL),
+    (3.5, B.EXECUTING_GOAL, ""),
+    (4.0, B.WAITING_RESULT, ""),
+    (10.0, B.READY, ""),
+    (11.0, B.TRANSMITTING_GOAL, ""),
+    (11.5, B.EXECUTING_GOAL, ""),
+    (12.0, B.TRANSMITTING_GOAL, ""),
+    (12.5, B.EXECUTING_GOAL, ""),
+    (13.0, B.WAITING_RESULT, ""),
+    (20.0, B.END, ""),
+]
+REFBOX = [
+    (0.0, R.START, ""),
+    (0.5, R.WAITING_CLIENT, ""),
+    (1.5, R.READY, ""),
+    (3.0, R.EXECUTING_GOAL, ""),
+    (19.9, R.END, "timeout"),
+]
+CLIENT = [
+    (0.0, C.START, ""),
+    (0.5, C.CONNECTING, ""),
+    (1.5, C.READY, ""),
+    (2.5, C.WAITING_GOAL, ""),
+    (3.5, C.EXECUTING_GOAL, ""),
+    (9.8, C.COMPLETED_GOAL, "{int: 1}"),
+    (10.2, C.WAITING_GOAL, ""),
+    (11.5, C.EXECUTING_GOAL, ""),
+    (20.0, C.END, ""),
+]
 
 
 def heartbeat(
@@ -39,3 +85,11 @@ def heartbeat(
         topic,
         "hand-built",
     )
+
+
+def write_bag(path: Path, streams: list[StateStream]) -> Path:
+    """A ROS1 bag of the streams' state messages, on their topics."""
+    with BagWriter(path, "ros1") as bag:
+        for s in streams:
+            bag.write_state(s.machine, s.topic, s.t_ns, [int(x) for x in s.state], list(s.payload))
+    return path

@@ -10,22 +10,13 @@ import pytest
 from ertools.cli.main import main
 from ertools.simulator.writer import BagWriter
 from ertools.states import Machine
-from ertools.streams import StateStream
-from tests.audit.audit_streams import T0_NS, heartbeat
-from tests.audit.test_audit import BMBOX, CLIENT, REFBOX
+from tests.audit.audit_streams import BMBOX, CLIENT, REFBOX, T0_NS, heartbeat, write_bag
 from tests.stderr_text import error_messages, joined_lines
-
-
-def _write_bag(path: Path, streams: list[StateStream]) -> Path:
-    with BagWriter(path, "ros1") as bag:
-        for s in streams:
-            bag.write_state(s.machine, s.topic, s.t_ns, [int(x) for x in s.state], list(s.payload))
-    return path
 
 
 @pytest.fixture
 def bag(tmp_path: Path) -> Path:
-    return _write_bag(
+    return write_bag(
         tmp_path / "fbm2h_states.bag",
         [
             heartbeat(Machine.BMBOX, BMBOX, 20.0, drop=(5.0, 7.0), topic="/fbm2h/bmbox_state"),
@@ -175,7 +166,7 @@ def test_missing_bag(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None
 def test_several_benchmarks_need_benchmark_option(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    bag = _write_bag(
+    bag = write_bag(
         tmp_path / "two.bag",
         [
             heartbeat(Machine.BMBOX, BMBOX, 20.0, topic="/fbm2h/bmbox_state"),

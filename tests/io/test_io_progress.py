@@ -26,9 +26,9 @@ from ertools.io.files import open_bag
 from ertools.io.info import describe
 from ertools.io.ros1.check import check_ros1
 from ertools.progress import Bar, reporting
+from tests.helpers.fastpath import fast_batch
 from tests.io.io_bagmaker import bag_name, write
 from tests.io.io_scene import Scene
-from tests.io.test_io_fastpath import fast_batch
 from tests.stderr_text import error_messages
 
 TOPIC = "/fbm3w/robot_at_work/pose"

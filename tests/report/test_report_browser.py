@@ -21,8 +21,7 @@ from ertools.auditing.analyse import audit_states
 from ertools.auditing.compare import attach
 from ertools.report.folder import write_report
 from ertools.states import Machine
-from tests.audit.audit_streams import heartbeat
-from tests.audit.test_audit import BMBOX, CLIENT, REFBOX
+from tests.audit.audit_streams import BMBOX, CLIENT, REFBOX, heartbeat
 from tests.fakes import BROWSER, CHROMIUM_FLAGS
 from tests.report.report_fakes import EVIL, fbm3w_like
 

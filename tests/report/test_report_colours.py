@@ -20,8 +20,7 @@ from ertools.report.plots_audit import (
 )
 from ertools.states import STATE_ENUMS, Machine
 from tests import svg_figure
-from tests.audit.audit_streams import heartbeat
-from tests.audit.test_audit import BMBOX, CLIENT, REFBOX
+from tests.audit.audit_streams import BMBOX, CLIENT, REFBOX, heartbeat
 
 # Machado, Oliveira & Fernandes (2009), "A physiologically-based model for simulation of
 # color vision deficiency", Table 1, severity 1.0: matrices on linear RGB.

@@ -17,9 +17,7 @@ from ertools.report.folder import write_report
 from ertools.report.records import sha256_file
 from ertools.states import Machine
 from tests import svg_figure
-from tests.audit.audit_streams import heartbeat
-from tests.audit.test_audit import BMBOX, CLIENT, REFBOX
-from tests.audit.test_cli_audit import _write_bag
+from tests.audit.audit_streams import BMBOX, CLIENT, REFBOX, heartbeat, write_bag
 from tests.report.report_fakes import EVIL, fbm3w_like
 
 BAG_BYTES = b"#ROSBAG V2.0\n" + bytes(range(256)) * 50
@@ -159,7 +157,7 @@ def test_audit_report_has_timeline_figure(tmp_path: Path) -> None:
 def test_report_of_score_bag_includes_its_audit(tmp_path: Path) -> None:
     """A score report whose bag has the state topics audits them by itself."""
 
-    bag = _write_bag(
+    bag = write_bag(
         tmp_path / "fbm3w.bag",
         [heartbeat(Machine.BMBOX, BMBOX, 20.0, topic="/fbm3w/bmbox_state")],
     )

@@ -8,8 +8,7 @@ import pytest
 from ertools.auditing.analyse import audit_states
 from ertools.frames import rows_to_dataframe, tables_to_frames
 from ertools.states import Machine
-from tests.audit.audit_streams import T0_NS, heartbeat
-from tests.audit.test_audit import BMBOX
+from tests.audit.audit_streams import BMBOX, T0_NS, heartbeat
 from tests.report.report_fakes import fbm3w_like
 
 
