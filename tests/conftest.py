@@ -1,6 +1,6 @@
 """Test-suite root: fixtures and hooks for every test. ``tests`` is a package (pytest's
 ``pythonpath`` puts the clone's root on ``sys.path``): a test imports what it shares with
-other folders as ``from tests.fakes import ...``."""
+other folders as ``from tests.helpers.fakes import ...``."""
 
 import contextlib
 import dataclasses

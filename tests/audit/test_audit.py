@@ -11,7 +11,7 @@ from ertools.states import BmBoxState as B
 from ertools.states import ClientState as C
 from ertools.states import Machine
 from ertools.states import RefBoxState as R
-from tests.audit.audit_streams import BEAT_NS, BMBOX, CLIENT, GOAL, REFBOX, T0_NS, heartbeat
+from tests.helpers.audit_streams import BEAT_NS, BMBOX, CLIENT, GOAL, REFBOX, T0_NS, heartbeat
 
 
 def _ns(seconds: float) -> int:

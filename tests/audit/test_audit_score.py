@@ -11,8 +11,8 @@ from ertools.auditing.compare import attach, compare_scores, flatten
 from ertools.states import BmBoxState as B
 from ertools.states import Machine
 from ertools.streams import Provenance
-from tests.audit.audit_streams import heartbeat
-from tests.fakes import FakeResult
+from tests.helpers.audit_streams import heartbeat
+from tests.helpers.fakes import FakeResult
 
 WRAP_DEV = "orientation errors are wrapped to [0, pi] (2015 used the unwrapped difference)"
 

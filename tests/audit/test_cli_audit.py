@@ -10,8 +10,8 @@ import pytest
 from ertools.cli.main import main
 from ertools.simulator.writer import BagWriter
 from ertools.states import Machine
-from tests.audit.audit_streams import BMBOX, CLIENT, REFBOX, T0_NS, heartbeat, write_bag
-from tests.stderr_text import error_messages, joined_lines
+from tests.helpers.audit_streams import BMBOX, CLIENT, REFBOX, T0_NS, heartbeat, write_bag
+from tests.helpers.stderr_text import error_messages, joined_lines
 
 
 @pytest.fixture

@@ -12,8 +12,8 @@ import pytest
 from ertools.benchmarks import registry
 from ertools.cli.main import COMMANDS, main
 from ertools.cli.text import MAX_ERROR_LINE, error_text
-from tests.io.io_bagmaker import Spec, write
-from tests.stderr_text import error_messages, joined_lines
+from tests.helpers.bagmaker import Spec, write
+from tests.helpers.stderr_text import error_messages, joined_lines
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"

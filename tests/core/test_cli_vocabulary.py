@@ -25,8 +25,8 @@ from ertools.benchmarks.common.spec import parse_tf
 from ertools.cli.main import build_parser, main
 from ertools.cli.options import pose_spec, time_source
 from ertools.errors import TopicError, UsageError
-from tests import svg_figure
-from tests.stderr_text import error_messages
+from tests.helpers import svg_figure
+from tests.helpers.stderr_text import error_messages
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"

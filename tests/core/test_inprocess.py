@@ -1,5 +1,6 @@
-"""The in-process runner (tests/inprocess.py) and the shell bridge (tests/shell_bridge.py): a
-command run in the test's process prints what the process prints, and leaves nothing behind.
+"""The in-process runner (tests/helpers/inprocess.py) and the shell bridge
+(tests/helpers/shell_bridge.py): a command run in the test's process prints what the process
+prints, and leaves nothing behind.
 """
 
 from __future__ import annotations
@@ -16,8 +17,8 @@ import pytest
 from ertools import caches
 from ertools.cli import info
 from ertools.io.mcap import scan, summary
-from tests.inprocess import run
-from tests.shell_bridge import parse_request, run_bash
+from tests.helpers.inprocess import run
+from tests.helpers.shell_bridge import parse_request, run_bash
 
 ROOT = Path(__file__).resolve().parents[2]
 BAG = "sample_bags/fbm3w/log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"

@@ -16,7 +16,7 @@ from ertools.configs._yaml import parse_yaml
 from ertools.configs.shapes import compile_expression
 from ertools.errors import ConfigError
 from ertools.yamlin import MAX_DEPTH
-from tests.stderr_text import error_messages
+from tests.helpers.stderr_text import error_messages
 
 ROOT = Path(__file__).resolve().parents[2]
 FBM2H = ROOT / "sample_bags" / "fbm2h"

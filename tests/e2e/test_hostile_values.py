@@ -20,7 +20,7 @@ import pytest
 from ertools.caches import clear as clear_caches
 from ertools.cli.main import main
 from tests.e2e.edited_bags import edited_copy, poses_between
-from tests.stderr_text import error_messages
+from tests.helpers.stderr_text import error_messages
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"

@@ -21,7 +21,7 @@ from ertools.configs._yaml import parse_payload, parse_yaml
 from ertools.configs.goal import goal_from_payload
 from ertools.configs.mocap import load_mocap_config
 from ertools.errors import ConfigError
-from tests.stderr_text import error_messages
+from tests.helpers.stderr_text import error_messages
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"

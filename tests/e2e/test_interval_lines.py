@@ -13,7 +13,7 @@ from typing import Any
 import pytest
 
 from ertools.cli.main import main
-from tests.stderr_text import joined_lines
+from tests.helpers.stderr_text import joined_lines
 
 SAMPLES = Path(__file__).resolve().parents[2] / "sample_bags"
 FBM2 = SAMPLES / "fbm2h"

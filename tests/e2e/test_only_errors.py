@@ -15,7 +15,7 @@ import pytest
 import yaml
 
 from ertools.cli.main import main
-from tests.stderr_text import joined_lines
+from tests.helpers.stderr_text import joined_lines
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"

@@ -15,8 +15,8 @@ from typing import Any
 import pytest
 
 from ertools.cli.main import main
-from tests import inprocess
-from tests.stderr_text import error_messages
+from tests.helpers import inprocess
+from tests.helpers.stderr_text import error_messages
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from ertools.cli.main import main
-from tests.stderr_text import error_messages
+from tests.helpers.stderr_text import error_messages
 
 REPO = Path(__file__).resolve().parents[2]
 ROBOTLOG = REPO / "sample_bags/robotlog"

@@ -33,7 +33,7 @@ from evo.core import metrics, sync
 from evo.core.sync_method import SyncMethod
 from evo.tools import file_interface
 
-from tests.io.io_bagmaker import Spec, write
+from tests.helpers.bagmaker import Spec, write
 
 pytestmark = pytest.mark.slow
 

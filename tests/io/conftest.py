@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from tests.io.io_bagmaker import FORMATS, bag_name, write
-from tests.io.io_scene import Scene, make_scene
+from tests.helpers.bagmaker import FORMATS, bag_name, write
+from tests.helpers.scene import Scene, make_scene
 
 
 @pytest.fixture(scope="session")

@@ -38,6 +38,8 @@ from ertools.io.files import open_bag
 from ertools.io.info import describe
 from ertools.io.reader import read_messages, read_poses, read_states
 from ertools.io.summary import summary as bag_summary
+from tests.helpers.bagmaker import build, typestore, write
+from tests.helpers.scene import Scene
 from tests.io.hostile_files import (
     McapChannel,
     McapChunk,
@@ -53,8 +55,6 @@ from tests.io.hostile_files import (
     u32,
     zstd_frame,
 )
-from tests.io.io_bagmaker import build, typestore, write
-from tests.io.io_scene import Scene
 
 T0 = 1_448_020_800 * 10**9  # the 2015 sample logs' start
 MiB = 1 << 20

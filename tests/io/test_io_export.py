@@ -30,7 +30,7 @@ from ertools.exporting.formats import (
     write_poses,
 )
 from ertools.streams import PoseStream
-from tests.io.io_scene import Scene
+from tests.helpers.scene import Scene
 
 POSE = "/fbm3w/robot_at_work/pose"
 REPO = Path(__file__).resolve().parents[2]

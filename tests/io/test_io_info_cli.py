@@ -12,10 +12,10 @@ import yaml
 from ertools.cli.main import main
 from ertools.errors import BagError
 from ertools.io.reader import read_poses
-from tests.io.io_bagmaker import write
-from tests.io.io_scene import DT, Scene
+from tests.helpers.bagmaker import write
+from tests.helpers.scene import DT, Scene
+from tests.helpers.stderr_text import joined_lines
 from tests.io.test_io_summary import make_active
-from tests.stderr_text import joined_lines
 
 POSE = "/fbm3w/robot_at_work/pose"
 

@@ -14,8 +14,8 @@ from pathlib import Path
 import pytest
 
 from ertools.cli.main import main
-from tests.io.io_bagmaker import FORMATS, Spec, bag_name, write
-from tests.io.io_scene import T0
+from tests.helpers.bagmaker import FORMATS, Spec, bag_name, write
+from tests.helpers.scene import T0
 
 FRAME = 8_333_333  # 120 Hz
 MS = 1_000_000

@@ -22,8 +22,8 @@ from ertools.io.mcap import scan as mcap_scan
 from ertools.io.reader import read_poses, read_states
 from ertools.io.summary import record_times
 from ertools.io.summary import summary as bag_summary
-from tests.io.io_bagmaker import write
-from tests.io.io_scene import Scene
+from tests.helpers.bagmaker import write
+from tests.helpers.scene import Scene
 
 POSE = "/fbm3w/robot_at_work/pose"
 BMBOX = "/fbm3w/bmbox_state"

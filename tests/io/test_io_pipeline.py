@@ -26,9 +26,9 @@ from ertools.io.files import open_bag
 from ertools.io.mcap.index import _in_order
 from ertools.io.reader import read_poses
 from ertools.io.ros1 import runs as ros1_runs
+from tests.helpers.bagmaker import Spec, bag_name, write
 from tests.helpers.fastpath import POSE_TOPICS, assert_same, fast_batch, reference_batch
-from tests.io.io_bagmaker import Spec, bag_name, write
-from tests.io.io_scene import Scene
+from tests.helpers.scene import Scene
 
 
 @pytest.fixture

@@ -27,8 +27,8 @@ from ertools.io.model import POSE_TYPES, PoseSource, short_msgtype
 from ertools.io.reader import read_pose_source, read_poses
 from ertools.io.reader import topics as bag_topics
 from ertools.io.summary import summary as bag_summary
+from tests.helpers.bagmaker import FORMATS, Spec, bag_name, write
 from tests.helpers.fastpath import assert_same, fast_batch, reference_batch
-from tests.io.io_bagmaker import FORMATS, Spec, bag_name, write
 
 pytestmark = pytest.mark.slow
 

@@ -26,10 +26,10 @@ from ertools.io.files import open_bag
 from ertools.io.info import describe
 from ertools.io.ros1.check import check_ros1
 from ertools.progress import Bar, reporting
+from tests.helpers.bagmaker import bag_name, write
 from tests.helpers.fastpath import fast_batch
-from tests.io.io_bagmaker import bag_name, write
-from tests.io.io_scene import Scene
-from tests.stderr_text import error_messages
+from tests.helpers.scene import Scene
+from tests.helpers.stderr_text import error_messages
 
 TOPIC = "/fbm3w/robot_at_work/pose"
 

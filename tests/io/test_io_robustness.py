@@ -12,8 +12,8 @@ import pytest
 from ertools.errors import ErtoolsError
 from ertools.io.info import describe
 from ertools.io.reader import read_poses, read_states, read_tf
-from tests.io.io_bagmaker import bag_name, write
-from tests.io.io_scene import Scene
+from tests.helpers.bagmaker import bag_name, write
+from tests.helpers.scene import Scene
 
 pytestmark = pytest.mark.slow
 

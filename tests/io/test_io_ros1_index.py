@@ -26,9 +26,9 @@ from ertools.io.ros1 import layout
 from ertools.io.ros1.check import check_ros1, rebuild_layout
 from ertools.io.ros1.layout import scan_layout
 from ertools.io.summary import summary as bag_summary
-from tests.io.io_bagmaker import Spec, write
+from tests.helpers.bagmaker import Spec, write
+from tests.helpers.stderr_text import error_messages
 from tests.io.test_io_fastpath import REAL_BAG, _sample_bags
-from tests.stderr_text import error_messages
 
 T0 = 1_445_609_740_000_000_000
 DT = 10_000_000

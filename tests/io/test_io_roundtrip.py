@@ -22,8 +22,8 @@ from ertools.io.reader import (
 from ertools.io.reader import topics as bag_topics
 from ertools.io.summary import summary as bag_summary
 from ertools.states import Machine
-from tests.io.io_bagmaker import Spec, bag_name, write
-from tests.io.io_scene import DT, T0, Scene, make_scene
+from tests.helpers.bagmaker import Spec, bag_name, write
+from tests.helpers.scene import DT, T0, Scene, make_scene
 
 POSE = "/fbm3w/robot_at_work/pose"
 

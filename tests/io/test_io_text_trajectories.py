@@ -20,7 +20,7 @@ from ertools.errors import BagError
 from ertools.exporting.formats import format_csv, format_tum
 from ertools.io.text import _plain_decimal_ns, read_text_poses, sniff
 from ertools.streams import PoseStream
-from tests.stderr_text import error_messages
+from tests.helpers.stderr_text import error_messages
 
 REPO = Path(__file__).resolve().parents[2]
 EVO_DATA = REPO.parent / "shared" / "evo_testdata"

@@ -19,8 +19,8 @@ from ertools.io.files import open_bag
 from ertools.io.reader import read_poses, read_tf
 from ertools.io.ros1.index import Ros1Bag
 from ertools.streams import PoseStream
-from tests.io.io_bagmaker import Spec, write
-from tests.io.io_scene import DT, T0, Scene
+from tests.helpers.bagmaker import Spec, write
+from tests.helpers.scene import DT, T0, Scene
 
 
 def q_yaw(yaw: float) -> tuple[float, float, float, float]:

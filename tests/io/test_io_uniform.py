@@ -12,8 +12,8 @@ import pytest
 
 from ertools.io import bulk
 from ertools.io.decode.uniform import decode_uniform, layout_of
+from tests.helpers.bagmaker import FORMATS, Spec, bag_name, write
 from tests.helpers.fastpath import assert_same, fast_batch, reference_batch
-from tests.io.io_bagmaker import FORMATS, Spec, bag_name, write
 
 POSE = (1.5, -2.25, 0.125, 0.0, 0.0, 0.6, 0.8)
 

@@ -9,7 +9,7 @@ import yaml
 
 from ertools.cli.main import main
 from ertools.live.tail import is_finished, read_complete
-from tests.stderr_text import error_messages
+from tests.helpers.stderr_text import error_messages
 
 pytestmark = pytest.mark.xdist_group("timing")
 

@@ -30,8 +30,8 @@ from ertools.benchmarks.trajectory.benchmark import score as score_trajectory
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.cli.main import main
 from ertools.report.foxglove import write_foxglove
-from tests.report.foxglove_readback import ReadBack, read_back, stamp_ns
-from tests.stderr_text import error_messages
+from tests.helpers.foxglove_readback import ReadBack, read_back, stamp_ns
+from tests.helpers.stderr_text import error_messages
 
 SAMPLES = Path(__file__).resolve().parents[2] / "sample_bags"
 FBM3W = SAMPLES / "fbm3w" / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"

@@ -21,9 +21,9 @@ from ertools.auditing.analyse import audit_states
 from ertools.auditing.compare import attach
 from ertools.report.folder import write_report
 from ertools.states import Machine
-from tests.audit.audit_streams import BMBOX, CLIENT, REFBOX, heartbeat
-from tests.fakes import BROWSER, CHROMIUM_FLAGS
-from tests.report.report_fakes import EVIL, fbm3w_like
+from tests.helpers.audit_streams import BMBOX, CLIENT, REFBOX, heartbeat
+from tests.helpers.fakes import BROWSER, CHROMIUM_FLAGS
+from tests.helpers.report_fakes import EVIL, fbm3w_like
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 

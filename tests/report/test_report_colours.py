@@ -19,8 +19,8 @@ from ertools.report.plots_audit import (
     timeline_chart,
 )
 from ertools.states import STATE_ENUMS, Machine
-from tests import svg_figure
-from tests.audit.audit_streams import BMBOX, CLIENT, REFBOX, heartbeat
+from tests.helpers import svg_figure
+from tests.helpers.audit_streams import BMBOX, CLIENT, REFBOX, heartbeat
 
 # Machado, Oliveira & Fernandes (2009), "A physiologically-based model for simulation of
 # color vision deficiency", Table 1, severity 1.0: matrices on linear RGB.

@@ -14,7 +14,7 @@ from ertools.report.combine import load_entry
 from ertools.report.folder import write_report
 from ertools.samples.fbm2h import generate
 from ertools.streams import Provenance
-from tests.report.report_fakes import FakeResult, fbm3w_like
+from tests.helpers.report_fakes import FakeResult, fbm3w_like
 
 
 @pytest.fixture

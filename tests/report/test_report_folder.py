@@ -16,9 +16,9 @@ from ertools.errors import ConfigError
 from ertools.report.folder import write_report
 from ertools.report.records import sha256_file
 from ertools.states import Machine
-from tests import svg_figure
-from tests.audit.audit_streams import BMBOX, CLIENT, REFBOX, heartbeat, write_bag
-from tests.report.report_fakes import EVIL, fbm3w_like
+from tests.helpers import svg_figure
+from tests.helpers.audit_streams import BMBOX, CLIENT, REFBOX, heartbeat, write_bag
+from tests.helpers.report_fakes import EVIL, fbm3w_like
 
 BAG_BYTES = b"#ROSBAG V2.0\n" + bytes(range(256)) * 50
 

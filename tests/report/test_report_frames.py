@@ -8,8 +8,8 @@ import pytest
 from ertools.auditing.analyse import audit_states
 from ertools.frames import rows_to_dataframe, tables_to_frames
 from ertools.states import Machine
-from tests.audit.audit_streams import BMBOX, T0_NS, heartbeat
-from tests.report.report_fakes import fbm3w_like
+from tests.helpers.audit_streams import BMBOX, T0_NS, heartbeat
+from tests.helpers.report_fakes import fbm3w_like
 
 
 def test_epoch_column_becomes_utc_index() -> None:

@@ -21,8 +21,8 @@ from matplotlib.image import imread
 
 from ertools import api
 from ertools.report.folder import write_report
-from tests import svg_figure
-from tests.fakes import BROWSER, CHROMIUM_FLAGS
+from tests.helpers import svg_figure
+from tests.helpers.fakes import BROWSER, CHROMIUM_FLAGS
 
 pytestmark = pytest.mark.slow
 

@@ -1,5 +1,6 @@
 """The SVG writer of the reports' figures: charts built by hand, read back from the SVG text
-through the scale its own tick labels state (tests/svg_figure.py), never through the writer."""
+through the scale its own tick labels state (tests/helpers/svg_figure.py), never through the
+writer."""
 
 from __future__ import annotations
 
@@ -27,7 +28,7 @@ from ertools.views.chart import (
     Text,
     viridis,
 )
-from tests import svg_figure
+from tests.helpers import svg_figure
 
 NS = svg_figure.NS
 

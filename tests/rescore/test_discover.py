@@ -20,7 +20,7 @@ from ertools.samples.competition_schedule import NO_ROBOT_LOG, TRUNCATED
 from ertools.timelines.build import build_timeline
 from ertools.timelines.model import BagEntry, Pairing
 from ertools.timelines.scan import scan
-from tests.timeline.summaries import Summary, Topic
+from tests.helpers.summaries import Summary, Topic
 
 pytestmark = pytest.mark.slow
 

@@ -17,7 +17,7 @@ import pytest
 
 from ertools.benchmarks import registry
 from ertools.demo import make_competition
-from tests.fakes import BROWSER
+from tests.helpers.fakes import BROWSER
 from tests.rescore.site_results import Page, assert_links_resolve, expected_board
 from tests.rescore.test_rescore_site_browser import chromium
 

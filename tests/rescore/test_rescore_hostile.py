@@ -14,7 +14,7 @@ import pytest
 
 from ertools.cli.main import main
 from ertools.competition.site import write_site
-from tests.stderr_text import joined_lines
+from tests.helpers.stderr_text import joined_lines
 
 ROOT = Path(__file__).resolve().parents[2]
 FBM3W_BAG = ROOT / "sample_bags" / "fbm3w" / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"

@@ -10,8 +10,8 @@ from ertools.benchmarks import registry
 from ertools.cli.main import main
 from ertools.competition.manifest import ManifestError, load_manifest
 from ertools.errors import ConfigError
+from tests.helpers.stderr_text import joined_lines
 from tests.rescore.rescore_competition import make_competition, use_toy_registry
-from tests.stderr_text import joined_lines
 
 
 @pytest.fixture(autouse=True)

@@ -32,7 +32,7 @@ import pytest
 
 from ertools.cli.main import main
 from ertools.competition.manifest import load_manifest
-from tests.fakes import BROWSER, CHROMIUM_FLAGS
+from tests.helpers.fakes import BROWSER, CHROMIUM_FLAGS
 
 pytestmark = pytest.mark.slow
 

@@ -12,8 +12,8 @@ import pytest
 from ertools.competition.site import ranked, write_site
 from ertools.errors import ConfigError
 from ertools.report.timeline_page import write_timeline_page
+from tests.helpers.timeline_day import day_timeline
 from tests.rescore.site_results import EVIL, Page, expected_board, results, write_folder
-from tests.timeline.timeline_day import day_timeline
 
 
 def build(out: Path) -> tuple[dict[str, Any], Path]:

@@ -19,7 +19,8 @@ from matplotlib.image import imread
 from ertools.competition.site import write_site
 from ertools.report.timeline_page import write_timeline_page
 from ertools.report.timeline_style import KIND_COLORS
-from tests.fakes import BROWSER, CHROMIUM_FLAGS
+from tests.helpers.fakes import BROWSER, CHROMIUM_FLAGS
+from tests.helpers.timeline_day import day_timeline
 from tests.rescore.site_results import (
     EVIL,
     Page,
@@ -29,7 +30,6 @@ from tests.rescore.site_results import (
     results,
     write_folder,
 )
-from tests.timeline.timeline_day import day_timeline
 
 pytestmark = [
     pytest.mark.browser,

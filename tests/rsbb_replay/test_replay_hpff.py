@@ -12,10 +12,10 @@ from collections.abc import Callable
 
 import pytest
 
-from tests.rsbb_replay import hpff
-from tests.rsbb_replay.hand import MS, T0, S, body, still
-from tests.rsbb_replay.tf2 import Quat, Vec
-from tests.rsbb_replay.world import TGoal, Timeline, World, run_script
+from tests.helpers.rsbb_replay import hpff
+from tests.helpers.rsbb_replay.hand import MS, T0, S, body, still
+from tests.helpers.rsbb_replay.tf2 import Quat, Vec
+from tests.helpers.rsbb_replay.world import TGoal, Timeline, World, run_script
 
 pytestmark = pytest.mark.slow  # runs of several hundred samples: seconds each
 

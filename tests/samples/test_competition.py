@@ -25,7 +25,7 @@ from ertools.benchmarks.common.teams import parse_robot_log_name
 from ertools.cli.main import main
 from ertools.samples.__main__ import main as samples_main
 from ertools.samples.competition_schedule import MISSING_TRANSFORM, SCHEDULE, TRUNCATED
-from tests.simd_paths import baseline_env
+from tests.helpers.simd_paths import baseline_env
 
 pytestmark = pytest.mark.slow
 

@@ -24,7 +24,7 @@ from ertools.samples.scenario import (
     load_scenario,
     log_name,
 )
-from tests.floats import FLOAT_ATOL, FLOAT_RTOL, same_text
+from tests.helpers.floats import FLOAT_ATOL, FLOAT_RTOL, same_text
 
 REPO = Path(__file__).resolve().parents[2]
 SAMPLE_BAGS = REPO / "sample_bags"

@@ -28,7 +28,7 @@ from ertools.samples.simd import (
     pinned_env,
     pinned_targets,
 )
-from tests.simd_paths import baseline_env, unpinned_env
+from tests.helpers.simd_paths import baseline_env, unpinned_env
 
 
 def _generate(out: Path, env: dict[str, str]) -> dict[str, bytes]:

@@ -18,9 +18,9 @@ import pytest
 from ertools.report.timeline_page import write_timeline_page
 from ertools.timelines.model import Timeline
 from ertools.timelines.scan import scan
-from tests.fakes import BROWSER, CHROMIUM_FLAGS
+from tests.helpers.fakes import BROWSER, CHROMIUM_FLAGS
+from tests.helpers.timeline_day import EVIL, EVIL_IMG, S, day_timeline
 from tests.timeline.test_timeline_pictures import expected_day
-from tests.timeline.timeline_day import EVIL, EVIL_IMG, S, day_timeline
 
 pytestmark = [pytest.mark.browser, pytest.mark.slow]
 

@@ -21,7 +21,7 @@ from ertools.io.model import ClockCheck
 from ertools.progress import reporting
 from ertools.simulator.writer import BagWriter
 from ertools.timelines.scan import scan
-from tests.timeline.summaries import BAG_KEYS
+from tests.helpers.summaries import BAG_KEYS
 
 
 def rel(root: Path, path: str) -> str:

@@ -25,7 +25,7 @@ from ertools.report.plots_timeline import timeline_figure
 from ertools.report.timeline_page import timeline_page
 from ertools.timelines.model import Timeline
 from ertools.timelines.scan import scan
-from tests.timeline.timeline_day import (
+from tests.helpers.timeline_day import (
     DAY0,
     EVIL,
     EVIL_IMG,

@@ -17,7 +17,7 @@ from ertools.timelines.build import (
     split_name,
 )
 from ertools.timelines.model import TimelineConfig
-from tests.timeline.summaries import BAG_KEYS, Summary, Topic
+from tests.helpers.summaries import BAG_KEYS, Summary, Topic
 
 S = 1_000_000_000
 T0 = 1_448_013_600 * S

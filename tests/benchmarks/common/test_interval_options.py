@@ -15,8 +15,8 @@ from ertools.benchmarks.common.uncertainty import MAX_DRAWS, MAX_SEED
 from ertools.cli.main import main
 from ertools.cli.text import MAX_ERROR_LINE
 from ertools.errors import UsageError
-from tests.io.io_bagmaker import Spec, write
-from tests.stderr_text import error_messages
+from tests.helpers.bagmaker import Spec, write
+from tests.helpers.stderr_text import error_messages
 
 ROOT = Path(__file__).resolve().parents[3]
 

@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 
 from ertools.cli.main import main
-from tests.io.io_bagmaker import Spec, write
-from tests.stderr_text import joined_lines
+from tests.helpers.bagmaker import Spec, write
+from tests.helpers.stderr_text import joined_lines
 
 ROOT = Path(__file__).resolve().parents[3]
 

@@ -23,7 +23,7 @@ from tests.benchmarks.fbm1.fbm1_testkit import (
     write_bag,
     write_items,
 )
-from tests.stderr_text import error_messages
+from tests.helpers.stderr_text import error_messages
 
 GOOD = RunSpec(
     "Place item 3 (b2) on the table",

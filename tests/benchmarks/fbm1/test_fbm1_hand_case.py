@@ -40,7 +40,7 @@ from tests.benchmarks.fbm1.fbm1_testkit import (
     write_bag,
     write_items,
 )
-from tests.yaml_rounding import assert_yaml_of
+from tests.helpers.yaml_rounding import assert_yaml_of
 
 RUNS = [
     RunSpec(

@@ -8,7 +8,7 @@ import pytest
 
 from ertools.cli.main import main
 from tests.benchmarks.fbm1.fbm1_testkit import write_items
-from tests.stderr_text import joined_lines
+from tests.helpers.stderr_text import joined_lines
 
 REAL = Path(__file__).resolve().parents[3] / ".." / "shared" / "real_bags"
 BAG = REAL / "log_fbm2h_mocap_2015-10-23-16-15-40_0.bag"

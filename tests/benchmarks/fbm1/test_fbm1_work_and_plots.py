@@ -17,7 +17,6 @@ from ertools.configs.items import parse_items
 from ertools.report import svg
 from ertools.report.figures import figure_specs
 from ertools.states import Machine
-from tests import svg_figure
 from tests.benchmarks.fbm1.fbm1_testkit import (
     ITEMS_YAML,
     RunSpec,
@@ -26,6 +25,7 @@ from tests.benchmarks.fbm1.fbm1_testkit import (
     write_bag,
     write_items,
 )
+from tests.helpers import svg_figure
 
 # Item 3 sits 5 cm along x and y of the board; the board at (0.3, 0.2) unrotated, so the item
 # is at (0.35, 0.25) yaw 0; item 1 (0.1 m along x) at (0.4, 0.2).

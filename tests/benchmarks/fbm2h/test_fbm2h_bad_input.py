@@ -9,7 +9,7 @@ import pytest
 import yaml
 
 from ertools.cli.main import main
-from tests.stderr_text import error_messages
+from tests.helpers.stderr_text import error_messages
 
 
 def _run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:

@@ -19,7 +19,7 @@ from rosbags.highlevel import AnyReader
 from scipy.spatial.transform import Rotation, Slerp
 
 from ertools.cli.main import main
-from tests.stderr_text import error_messages
+from tests.helpers.stderr_text import error_messages
 
 REAL = Path(__file__).resolve().parents[3] / ".." / "shared" / "real_bags"
 BAG = REAL / "log_fbm2h_mocap_2015-10-23-16-15-40_0.bag"

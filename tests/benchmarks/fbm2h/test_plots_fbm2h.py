@@ -15,7 +15,7 @@ from ertools.configs.goal import GoalList
 from ertools.configs.transform import identity_transform
 from ertools.report.figures import figure_specs, save_figures
 from ertools.streams import PoseStream
-from tests import svg_figure
+from tests.helpers import svg_figure
 
 pytestmark = pytest.mark.slow
 

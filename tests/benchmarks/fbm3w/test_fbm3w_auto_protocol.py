@@ -28,7 +28,7 @@ from tests.benchmarks.fbm3w.protocol_logs import (
     write_bag,
     write_config,
 )
-from tests.stderr_text import error_messages
+from tests.helpers.stderr_text import error_messages
 
 EDGE_TOLERANCE_S = 0.5
 

@@ -15,7 +15,7 @@ from ertools.simulator.writer import BagWriter
 from tests.benchmarks.fbm3w.fbm3w_kit import Sample
 from tests.benchmarks.fbm3w.fbm3w_synth import one_run
 from tests.benchmarks.fbm3w.protocol_logs import generate, write_bag, write_config
-from tests.stderr_text import error_messages
+from tests.helpers.stderr_text import error_messages
 
 
 def score(*args: str, draws: bool = False) -> int:

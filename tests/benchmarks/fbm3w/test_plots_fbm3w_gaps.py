@@ -1,6 +1,6 @@
 """The FBM3@Work run figure draws the ground truth's gaps where they are on the path and says
 the run's valid fraction (issue 28): a noiseless synthetic line run with frames cut by hand, its
-figure read back from the SVG (tests/svg_figure.py) and compared with the generator's points
+figure read back from the SVG (tests/helpers/svg_figure.py) and compared with the generator's points
 either side of the hole."""
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.configs.shapes import builtin_shapes
 from ertools.report.figures import figure_specs, render, wrap_title
 from ertools.report.folder import write_report
-from tests import svg_figure
 from tests.benchmarks.fbm3w.fbm3w_synth import one_run
+from tests.helpers import svg_figure
 
 STILL = 30
 PATH = 3000

@@ -30,7 +30,7 @@ from ertools.simulator.writer import BagWriter
 from ertools.streams import PoseStream
 from tests.benchmarks.trajectory.node_2015 import EndOfBagError, Pose, score_2015, tf_yaw
 from tests.benchmarks.trajectory.trajectory_helpers import read_back, write_gt, write_robot
-from tests.stderr_text import error_messages
+from tests.helpers.stderr_text import error_messages
 
 TOL = 1e-12
 ROOT = Path(__file__).resolve().parents[3]

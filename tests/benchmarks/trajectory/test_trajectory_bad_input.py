@@ -12,7 +12,7 @@ import pytest
 from ertools.cli.main import main
 from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC
 from tests.benchmarks.trajectory.trajectory_helpers import write_gt, write_robot
-from tests.stderr_text import error_messages
+from tests.helpers.stderr_text import error_messages
 
 T0 = 1_448_013_600 * 1_000_000_000
 

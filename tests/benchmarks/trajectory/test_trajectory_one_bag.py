@@ -25,7 +25,7 @@ from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC
 from ertools.simulator.writer import BagWriter
 from tests.benchmarks.trajectory.test_trajectory_sample import check
 from tests.benchmarks.trajectory.trajectory_helpers import read_back
-from tests.stderr_text import error_messages
+from tests.helpers.stderr_text import error_messages
 
 pytestmark = pytest.mark.slow
 

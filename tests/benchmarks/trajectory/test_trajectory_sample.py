@@ -18,7 +18,7 @@ from ertools.cli.main import main
 from ertools.io.reader import read_poses
 from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC, expected_scores, truth_at
 from tests.benchmarks.trajectory.trajectory_helpers import read_back, write_gt, yaw
-from tests.stderr_text import error_messages
+from tests.helpers.stderr_text import error_messages
 
 KEYS = ("compared", "gaps", "tracking_lost", "uncovered")
 ERRORS = ("position_error", "orientation_error", "rmse", "median", "max")

@@ -24,7 +24,7 @@ from rosbags.highlevel import AnyReader
 from ertools.cli.main import main
 from ertools.simulator.writer import BagWriter
 from tests.benchmarks.trajectory.script2015 import Bag, PoseStamped, Run, Time, run_2015
-from tests.stderr_text import error_messages
+from tests.helpers.stderr_text import error_messages
 
 S = 1_000_000_000
 MS = 1_000_000

@@ -16,7 +16,7 @@ from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
 from ertools.report.figures import figure_specs, render
 from ertools.streams import PoseStream
-from tests import svg_figure
+from tests.helpers import svg_figure
 
 T0 = 1_448_013_600 * 1_000_000_000
 S = 1_000_000_000

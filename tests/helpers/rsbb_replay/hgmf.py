@@ -13,10 +13,10 @@ from __future__ import annotations
 from math import sqrt
 from typing import Any
 
-from tests.rsbb_replay.helper import pose2d_from_tf_concatenation
-from tests.rsbb_replay.py2 import to_sec
-from tests.rsbb_replay.tf2 import TfError
-from tests.rsbb_replay.world import GoalObject, ManualOperationObject, World
+from tests.helpers.rsbb_replay.helper import pose2d_from_tf_concatenation
+from tests.helpers.rsbb_replay.py2 import to_sec
+from tests.helpers.rsbb_replay.tf2 import TfError
+from tests.helpers.rsbb_replay.world import GoalObject, ManualOperationObject, World
 
 VERSIONS = ("2bb8a41",)
 

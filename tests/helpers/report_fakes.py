@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from ertools.streams import Provenance
-from tests.fakes import FakeResult
+from tests.helpers.fakes import FakeResult
 
 EVIL = "<script>alert('x')</script>"
 EVIL_IMG = '<img src=x onerror="alert(1)">'

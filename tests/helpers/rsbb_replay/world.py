@@ -19,8 +19,8 @@ from typing import Any
 
 import yaml
 
-from tests.rsbb_replay.py2 import dump_request
-from tests.rsbb_replay.tf2 import Buffer, Quat, TfError, Vec, frame
+from tests.helpers.rsbb_replay.py2 import dump_request
+from tests.helpers.rsbb_replay.tf2 import Buffer, Quat, TfError, Vec, frame
 
 MS = 1_000_000
 NS = 1_000_000_000

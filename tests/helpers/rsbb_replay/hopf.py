@@ -16,9 +16,9 @@ from __future__ import annotations
 from math import pi, pow, sqrt
 from typing import Any
 
-from tests.rsbb_replay.helper import Pose2D, pose2d_from_tf_concatenation
-from tests.rsbb_replay.py2 import to_sec
-from tests.rsbb_replay.world import GoalObject, ManualOperationObject, World
+from tests.helpers.rsbb_replay.helper import Pose2D, pose2d_from_tf_concatenation
+from tests.helpers.rsbb_replay.py2 import to_sec
+from tests.helpers.rsbb_replay.world import GoalObject, ManualOperationObject, World
 
 VERSIONS = ("b5d91f4", "00e3106", "2bb8a41")
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from tests.rsbb_replay.tf2 import Buffer, Quat, Vec
+from tests.helpers.rsbb_replay.tf2 import Buffer, Quat, Vec
 
 S = 1_000_000_000
 MS = 1_000_000

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from tests.io.io_bagmaker import Spec
+from tests.helpers.bagmaker import Spec
 
 T0 = 1_445_609_740_000_000_000  # 2015-10-23, like the real bag
 DT = 8_333_333  # 120 Hz

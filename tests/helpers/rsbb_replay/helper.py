@@ -13,9 +13,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from tests.rsbb_replay.py2 import euler_yaw
-from tests.rsbb_replay.tf2 import TfError
-from tests.rsbb_replay.world import World
+from tests.helpers.rsbb_replay.py2 import euler_yaw
+from tests.helpers.rsbb_replay.tf2 import TfError
+from tests.helpers.rsbb_replay.world import World
 
 
 @dataclass

@@ -19,8 +19,8 @@ from typing import Any
 import yaml
 
 from ertools.io.reader import read_messages, topics
-from tests.rsbb_replay.tf2 import Buffer, frame
-from tests.rsbb_replay.world import TGoal, Timeline, TManual
+from tests.helpers.rsbb_replay.tf2 import Buffer, frame
+from tests.helpers.rsbb_replay.world import TGoal, Timeline, TManual
 
 REFBOX = "/rsbb/bmbox/refbox_state"
 BMBOX = "/rsbb/bmbox/bmbox_state"

@@ -1,4 +1,4 @@
-"""A bash session whose ``ertools`` commands run in this process (tests/inprocess.py).
+"""A bash session whose ``ertools`` commands run in this process (tests/helpers/inprocess.py).
 
 The documentation's commands are pasted into bash as printed: bash does the quoting, globs,
 variables, redirections, pipes and ``|| echo`` exactly as for a reader. Only ``ertools`` is a
@@ -26,7 +26,7 @@ import traceback
 from collections.abc import Iterator, Mapping
 from pathlib import Path
 
-from tests.inprocess import run
+from tests.helpers.inprocess import run
 
 # A request is the arguments, NUL-separated: the function's process (for its file descriptors),
 # its folder, the number of arguments, then each; it is whole when the function closes the

@@ -12,7 +12,7 @@ from __future__ import annotations
 from ertools.io.formats import Unreadable
 from ertools.timelines.build import build_timeline
 from ertools.timelines.model import Timeline
-from tests.timeline.summaries import Summary, Topic
+from tests.helpers.summaries import Summary, Topic
 
 S = 1_000_000_000
 DAY0 = 1_448_010_000 * S  # 2015-11-20 09:00:00 UTC

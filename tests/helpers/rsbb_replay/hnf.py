@@ -15,10 +15,10 @@ from __future__ import annotations
 
 from math import atan2, cos, fabs, sin, sqrt
 
-from tests.rsbb_replay.helper import Pose2D, pose2d_from_tf_concatenation
-from tests.rsbb_replay.py2 import dump_none, dump_pose2d, euler_yaw, to_sec
-from tests.rsbb_replay.tf2 import TfError
-from tests.rsbb_replay.world import GoalObject, ManualOperationObject, World
+from tests.helpers.rsbb_replay.helper import Pose2D, pose2d_from_tf_concatenation
+from tests.helpers.rsbb_replay.py2 import dump_none, dump_pose2d, euler_yaw, to_sec
+from tests.helpers.rsbb_replay.tf2 import TfError
+from tests.helpers.rsbb_replay.world import GoalObject, ManualOperationObject, World
 
 VERSIONS = ("069fd1d", "f594ff1", "00e3106", "2bb8a41")
 
