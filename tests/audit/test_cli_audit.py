@@ -84,7 +84,7 @@ SAMPLE_FBM2H = (
     ("option", "value", "named"),
     [
         # A topic the log does not have (a value no scorer takes, `--hits -5`, is a usage
-        # error of the parser, exit 2: tests/core/test_cli_vocabulary.py).
+        # error of the parser, exit 2: tests/cli/test_cli_vocabulary.py).
         ("--topic", "/no/such/topic", "/no/such/topic"),
     ],
 )

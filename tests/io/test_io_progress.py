@@ -49,7 +49,7 @@ class Recorder:
 
 @pytest.fixture(autouse=True)
 def wide(monkeypatch: pytest.MonkeyPatch) -> None:
-    # lines are cut to the terminal's width (tests/core/test_progress.py): these check labels
+    # lines are cut to the terminal's width (tests/progress/test_progress.py): these check labels
     monkeypatch.setenv("COLUMNS", "200")
 
 

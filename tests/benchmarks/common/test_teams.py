@@ -26,7 +26,7 @@ from ertools.states import Machine
 from ertools.streams import Provenance
 from ertools.timelines.build import benchmark_names
 
-REPO = Path(__file__).resolve().parents[2]
+REPO = Path(__file__).resolve().parents[3]
 
 
 def _sample_dir(name: str, tmp_factory: pytest.TempPathFactory) -> Path:

@@ -128,4 +128,4 @@ def test_a_test_sharing_a_module_fixture_carries_its_group(
     if not getattr(request.config.option, "loadgroup", False):
         pytest.skip("n/a: not run by an xdist worker under --dist loadgroup")
     assert made_once == 1
-    assert request.node.nodeid.endswith("@core/test_suite_config.py"), request.node.nodeid
+    assert request.node.nodeid.endswith("@suite/test_suite_config.py"), request.node.nodeid
