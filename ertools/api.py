@@ -30,7 +30,7 @@ from ertools.benchmarks import registry
 from ertools.benchmarks.base import rename_former
 from ertools.benchmarks.common.sources import read_source
 from ertools.benchmarks.common.spec import PoseSpec, TimeSource, parse_tf
-from ertools.benchmarks.common.which import refuse_other_benchmark
+from ertools.benchmarks.scoring import score_execution
 from ertools.competition.manifest import ManifestError, load_manifest
 from ertools.competition.run import rescore_competition
 from ertools.errors import ConfigError, UsageError
@@ -189,10 +189,7 @@ def score(name: str, bags: PathLike | Sequence[PathLike], **inputs: Any) -> Benc
     bag_list = paths_list(bags)
     if not bag_list:
         raise UsageError(f"give at least one bag (the log file) to score {name}")
-    refuse_other_benchmark(name, bag_list, values)
-    options = bench.make_options(values)
-    result: BenchmarkResult = bench.score(bag_list, options)
-    return result
+    return score_execution(bench, bag_list, values).result
 
 
 @checked

@@ -29,6 +29,7 @@ from pathlib import Path
 
 from ertools.atomic import write_text
 from ertools.benchmarks import registry
+from ertools.benchmarks.base import Audited, Reported, Simulated
 from ertools.cli.main import main as ertools_main
 from ertools.samples.competition import DEFAULT_SEED, MANIFEST, write_competition
 
@@ -65,7 +66,7 @@ def steps(samples: Path, out: Path) -> Iterator[Step]:
     samples_by_name = {}
     for name in registry.names():
         bench = registry.get(name)
-        sample = bench.sample(samples) if bench.sample is not None else None
+        sample = bench.sample_args(samples) if isinstance(bench, Simulated) else None
         if sample is not None:
             samples_by_name[name] = list(sample)
     if not samples_by_name:
@@ -78,7 +79,7 @@ def steps(samples: Path, out: Path) -> Iterator[Step]:
     )
     for name, sample in samples_by_name.items():
         bench = registry.get(name)
-        foxglove = ["--foxglove", str(out / f"{name}.mcap")] if bench.foxglove else []
+        foxglove = ["--foxglove", str(out / f"{name}.mcap")] if isinstance(bench, Reported) else []
         yield Step(
             f"{bench.title} score",
             ["score", name, *sample, "--report", str(out / name), *foxglove],
@@ -91,7 +92,7 @@ def steps(samples: Path, out: Path) -> Iterator[Step]:
     )
     for name, sample in samples_by_name.items():
         bench = registry.get(name)
-        if bench.state_topics:
+        if isinstance(bench, Audited):
             yield Step(
                 f"audit of the {bench.title} benchmark",
                 ["audit", sample[0], "--format", "text", "--report", str(out / f"audit_{name}")],

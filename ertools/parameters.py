@@ -23,9 +23,8 @@ from ertools.benchmarks.base import Input
 from ertools.errors import UsageError
 from ertools.exporting.formats import FORMATS
 from ertools.timelines.model import Timeline
+from ertools.timeutil import MAX_SECONDS
 
-# The largest magnitude a number input may have (the CLI's rule, ertools.cli.main).
-_MAX_NUMBER = 4.6e9
 F = TypeVar("F", bound=Callable[..., Any])
 PathLike = str | Path
 
@@ -176,9 +175,9 @@ def value_of(declared: Input, value: Any) -> Any:
         )
     if declared.repeat:
         return [value]
-    if declared.kind == "float" and not (math.isfinite(value) and abs(value) < _MAX_NUMBER):
+    if declared.kind == "float" and not (math.isfinite(value) and abs(value) < MAX_SECONDS):
         raise UsageError(
-            f"{declared.name}={value}: give a finite number smaller than {_MAX_NUMBER:g} in size"
+            f"{declared.name}={value}: give a finite number smaller than {MAX_SECONDS:g} in size"
         )
     return value
 

@@ -54,14 +54,20 @@ def dump_yaml(data: Any, **options: Any) -> str:
     return text
 
 
-def jsonable(value: Any) -> Any:
+def jsonable(value: Any, *, string_keys: bool = True) -> Any:
     """``value`` as plain JSON types: NumPy scalars and arrays as numbers and lists, tuples as
-    lists, mapping keys as text, NaN as None."""
+    lists, mapping keys as text (integer keys kept when not ``string_keys``: the 2015 YAML's
+    ``0:``), NaN as None."""
 
     if isinstance(value, dict):
-        return {str(k): jsonable(v) for k, v in value.items()}
+        return {
+            k if not string_keys and isinstance(k, int) else str(k): jsonable(
+                v, string_keys=string_keys
+            )
+            for k, v in value.items()
+        }
     if isinstance(value, list | tuple):
-        return [jsonable(v) for v in value]
+        return [jsonable(v, string_keys=string_keys) for v in value]
     if isinstance(value, np.ndarray):
         return jsonable(value.tolist())
     if isinstance(value, np.bool_):

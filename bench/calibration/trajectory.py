@@ -135,7 +135,7 @@ def true_scores(truth: Any) -> dict[str, float]:
 
 def score(seed: int, draws: int) -> tuple[Any, dict[str, float]]:
     """(the result with intervals, the true noiseless scores)."""
-    from ertools.benchmarks.common.interval_output import IntervalSettings
+    from ertools.benchmarks.common.inputs import IntervalSettings
     from ertools.benchmarks.trajectory.config import TrajectoryConfig
     from ertools.benchmarks.trajectory.scoring import score_streams
 

@@ -10,10 +10,10 @@ import re
 from typing import Any
 
 from ertools.benchmarks import registry
-from ertools.benchmarks.base import Explanation
+from ertools.benchmarks.base import Audited, Explanation
 
 # Explanations every benchmark shares; a benchmark declares its own
-# (:attr:`ertools.benchmarks.base.Benchmark.explanations`), tried first.
+# (``explanations`` of :class:`ertools.benchmarks.base.Audited`), tried first.
 _GENERAL: tuple[Explanation, ...] = (
     Explanation(
         r"(time|_time)$",
@@ -47,7 +47,8 @@ def explain(
         pattern = _number_pattern(leaf, float(live), float(recomputed))
         if pattern:
             parts.append(pattern)
-    own = registry.get(benchmark).explanations if benchmark in registry.names() else ()
+    bench = registry.get(benchmark) if benchmark in registry.names() else None
+    own = bench.explanations if isinstance(bench, Audited) else ()
     for rule in (*own, *_GENERAL):
         if re.search(rule.pattern, leaf):
             parts.append(rule.text)

@@ -13,7 +13,9 @@ from ertools.auditing.analyse import DEFAULT_MAX_SILENCE_NS, audit_states
 from ertools.auditing.compare import attach
 from ertools.auditing.model import Audit
 from ertools.benchmarks import registry
+from ertools.benchmarks.base import AnyBenchmark, Audited
 from ertools.benchmarks.common.which import log_benchmark
+from ertools.benchmarks.scoring import score_execution
 from ertools.errors import BagError, ErtoolsError, ScoringError, UsageError
 from ertools.io.reader import read_benchmark_states, topics
 from ertools.states import STATE_TOPIC_SUFFIXES
@@ -69,23 +71,13 @@ def uses(benchmark: str) -> frozenset[str]:
     return frozenset(i.name for i in registry.get(benchmark).inputs)
 
 
-def _scorer(benchmark: str) -> registry.AnyBenchmark:
-    """The registered benchmark an audit can recompute (its states are logged)."""
+def _scorer(benchmark: str) -> AnyBenchmark:
+    """The registered benchmark an audit can recompute (its states are logged: Audited)."""
 
-    if benchmark not in registry.names() or not registry.get(benchmark).state_topics:
+    bench = registry.get(benchmark) if benchmark in registry.names() else None
+    if not isinstance(bench, Audited):
         raise ScoringError(f"no scorer to recompute {benchmark!r} from an audit")
-    return registry.get(benchmark)
-
-
-def _options(
-    bench: registry.AnyBenchmark, values: dict[str, Any], live: Any
-) -> tuple[Any, tuple[str, ...]]:
-    """The benchmark's options from the values, adjusted from the live score
-    (:attr:`~ertools.benchmarks.base.Benchmark.from_live`)."""
-    options = bench.make_options(values)
-    if bench.from_live is None:
-        return options, ()
-    return bench.from_live(options, live)
+    return bench
 
 
 def rescore(
@@ -109,26 +101,26 @@ def rescore(
     ignored = sorted(set(given) - declared)
     notes = tuple(f"--{name.replace('_', '-')} is not used by {benchmark}" for name in ignored)
     values = {k: v for k, v in given.items() if k in declared}
-    options, said = _options(bench, values, live)
     plist = [Path(p) for p in paths]
-    return bench.score(plist, options), notes + said
+    scored = score_execution(bench, plist, values, live=live, check_logs=False)
+    return scored.result, notes + scored.said
 
 
 def rescore_2015(
     benchmark: str, paths: Sequence[Path], inputs: ScoreInputs, live: Any = None
 ) -> BenchmarkResult | None:
     """The score recomputed with every 2015 behaviour the scorer can restore (the benchmark's
-    :attr:`~ertools.benchmarks.base.Benchmark.values_2015`: FBM2H unwrapped orientation and
+    ``values_2015`` (:class:`~ertools.benchmarks.base.Audited`): FBM2H unwrapped orientation and
     unscored segments over N; FBM1 the 2015 node's rules; FBM3W ``--2015``), or None when it
     declares none."""
     bench = _scorer(benchmark)
-    if not bench.values_2015:
+    if not isinstance(bench, Audited) or not bench.values_2015:  # (Audited: _scorer's)
         return None
     declared = uses(benchmark)
     values = {k: v for k, v in inputs.values().items() if k in declared}
-    options, _ = _options(bench, {**values, **bench.values_2015}, live)
-    result: BenchmarkResult = bench.score([Path(p) for p in paths], options)
-    return result
+    plist = [Path(p) for p in paths]
+    values = {**values, **bench.values_2015}
+    return score_execution(bench, plist, values, live=live, check_logs=False).result
 
 
 # --------------------------------------------------------------------------------------------

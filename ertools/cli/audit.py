@@ -16,14 +16,10 @@ from typing import TYPE_CHECKING
 
 from ertools.auditing.recompute import ScoreInputs, audit_bag
 from ertools.benchmarks import registry
-from ertools.cli.common import (
-    add_output_options,
-    emit_result,
-    write_foxglove_option,
-    write_plots_option,
-)
+from ertools.cli.emit import emit_result, write_foxglove_option, write_plots_option
 from ertools.cli.options import non_negative_int, positive
 from ertools.cli.output import note, write_text
+from ertools.cli.result_options import add_output_options
 from ertools.timeutil import s_to_ns
 
 if TYPE_CHECKING:  # reached as an attribute of the package, imported on first use

@@ -25,12 +25,14 @@ def add_group_arguments(parser: argparse.ArgumentParser, members: dict[str, Comm
 
 
 def members_epilog(members: dict[str, Command]) -> str:
-    """The ``--help`` list of a group's members, each with its summary and an example."""
+    """The ``--help`` list of a group's members, each with its summary and an example (when
+    it has one: a benchmark's are in its own ``--help``)."""
     lines = ["members:"]
     width = max(len(n) for n in members)
     for name, cmd in members.items():
         lines.append(f"  {name:<{width}}  {cmd.summary}")
-        lines.append(f"  {'':<{width}}    e.g. {cmd.example}")
+        if cmd.example:
+            lines.append(f"  {'':<{width}}    e.g. {cmd.example}")
     return "\n".join(lines)
 
 

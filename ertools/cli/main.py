@@ -34,6 +34,7 @@ from ertools.cli.command import Command, Delegate
 from ertools.cli.text import error_text, one_line, printable
 from ertools.errors import ErtoolsError, UsageError
 from ertools.progress import Bar, clear_current, reporting
+from ertools.timeutil import MAX_SECONDS
 
 COMMANDS: dict[str, Command] = {
     "info": Command("ertools.cli.info", "describe bags like `rosbag info`", "ertools info run.bag"),
@@ -233,7 +234,7 @@ def _configure_logging(verbose: int) -> None:
     level = logging.WARNING if verbose == 0 else logging.INFO if verbose == 1 else logging.DEBUG
 
     class _LowerLevel(logging.Formatter):
-        # "ertools: warning: ..." like the CLI's own notes (cli/common.note), not "WARNING";
+        # "ertools: warning: ..." like the CLI's own notes (cli/output.note), not "WARNING";
         # the record itself is left as is (other handlers may see it).
         def formatMessage(self, record: logging.LogRecord) -> str:  # noqa: N802 (logging's)
             record.message = printable(record.message)  # one line, whatever a path holds
@@ -291,20 +292,15 @@ def _refuse_overwriting_inputs(args: argparse.Namespace) -> None:
                 )
 
 
-# The largest magnitude a number option may have: seconds up to it (epoch seconds included)
-# still fit int64 nanoseconds with room to spare; no metre, radian or rate option comes near.
-MAX_OPTION_VALUE = 4.6e9
-
-
 def _check_numbers(args: argparse.Namespace) -> None:
     """A UsageError for a NaN, infinite or absurdly large number option (`--max-gap nan`)."""
 
     for name, value in vars(args).items():
         for v in value if isinstance(value, list | tuple) else [value]:
-            if isinstance(v, float) and not (math.isfinite(v) and abs(v) < MAX_OPTION_VALUE):
+            if isinstance(v, float) and not (math.isfinite(v) and abs(v) < MAX_SECONDS):
                 flag = "--" + name.replace("_", "-")
                 raise UsageError(
-                    f"{flag} {v}: give a finite number smaller than {MAX_OPTION_VALUE:g} in size"
+                    f"{flag} {v}: give a finite number smaller than {MAX_SECONDS:g} in size"
                 )
 
 

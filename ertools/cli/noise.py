@@ -12,10 +12,10 @@ import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ertools.benchmarks.common.epsilon import noise_from_stream
 from ertools.benchmarks.common.sources import read_source, tf, topic
 from ertools.benchmarks.fbm3w.config import DEFAULT_FRAME, DEFAULT_TOPIC, FALLBACK_TOPIC
-from ertools.benchmarks.noise.benchmark import noise_from_stream
-from ertools.cli.common import write_plots
+from ertools.cli.emit import write_plots
 from ertools.cli.options import (
     add_output,
     add_plots,

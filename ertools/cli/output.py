@@ -11,7 +11,6 @@ from typing import Any
 from ertools.atomic import write_text as write_file
 from ertools.cli.text import error_text, printable
 from ertools.progress import clear_current
-from ertools.serialize import jsonable
 
 
 def write_text(text: str, output: Path | None) -> None:
@@ -38,4 +37,7 @@ def note(message: str) -> None:
 
 
 def dump_json(data: Any) -> str:
+    """``data`` as indented JSON (NumPy values as plain numbers, NaN as null)."""
+    from ertools.serialize import jsonable  # lazy: NumPy and PyYAML, 120 ms; not for --help
+
     return json.dumps(jsonable(data), indent=2, allow_nan=False)

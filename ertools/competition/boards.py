@@ -7,6 +7,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from ertools.benchmarks import registry
+from ertools.benchmarks.base import Discovered
 from ertools.competition.site_text import TEAM_UNKNOWN
 from ertools.report import ranks
 
@@ -18,7 +19,10 @@ def leaderboards(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
     names = [n for n in registry.names() if any(r["benchmark"] == n for r in rows)]
     names += sorted({str(r["benchmark"]) for r in rows} - set(names))
     for name in names:
-        ranking = registry.get(name).ranking
+        bench = registry.get(name)
+        if not isinstance(bench, Discovered):  # a manifest takes no other
+            continue
+        ranking = bench.ranking
         sign = 1.0 if ranking.lower_is_better else -1.0
         best: dict[str, Mapping[str, Any]] = {}
         unranked: list[dict[str, Any]] = []

@@ -30,11 +30,10 @@ import sys
 import threading
 import time
 from collections.abc import Iterator
-from importlib import import_module
 from typing import BinaryIO
 
 from ertools.benchmarks import registry
-from ertools.competition.jobs import Job, Outcome, load_benchmark, run_job
+from ertools.competition.jobs import Job, Outcome, run_job
 from ertools.report import html
 from ertools.report.figures import preload
 
@@ -93,8 +92,10 @@ _warmed: set[str] = set()
 def preload_scoring() -> None:
     """Import :data:`SCORING_IMPORTS` (in the server: while its owner scans the logs)."""
     with contextlib.suppress(Exception):  # only a head start: a scorer imports what failed
-        for name in SCORING_IMPORTS:
-            import_module(name)
+        # (imported for what they leave in sys.modules: the scorers forked later inherit them)
+        import scipy.interpolate  # lazy: scipy, 300 ms
+        import scipy.spatial.transform  # lazy: scipy, 300 ms
+        import scipy.stats  # noqa: F401  # lazy: scipy, 300 ms
 
 
 def ertools_own(target: str) -> bool:
@@ -114,11 +115,8 @@ def warm(job: Job) -> None:
     if ertools_own(job.target):
         preload_scoring()
     with contextlib.suppress(Exception):  # only a head start: the child imports what failed
-        load_benchmark(job.target)
+        registry.warm(job.target, report=job.report_dir is not None)
         if job.report_dir is not None:
-            figures = registry.get(job.benchmark).figures
-            if figures:
-                import_module(figures.partition(":")[0])
             preload()
             html.environment().get_template("report.html.j2")
 

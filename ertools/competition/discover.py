@@ -21,7 +21,7 @@ state payloads), never a file.
 - A **GT-only recording** (the GT logger's split files in one folder, none of which overlaps
   a benchmark log: the 2015 test logs) is an execution with ``gt_only`` set, its first file as
   ``bmbox_log``; the IO edge asks its benchmark whether and how it is scored alone
-  (:attr:`~ertools.benchmarks.base.Benchmark.gt_only`). A recording naming no benchmark, a
+  (:meth:`~ertools.benchmarks.base.Discovered.gt_only`). A recording naming no benchmark, a
   noise recording, and the uncovered split files of a recording that covers a benchmark log
   are ``gt-only`` problems.
 
@@ -110,7 +110,7 @@ class Execution:
         problems: one line per problem of this execution or of one of its files.
         gt_only: a recording of the GT logger alone (no benchmark log): ``bmbox_log`` is its
             first file, ``gt_files`` the others; the benchmark's
-            :attr:`~ertools.benchmarks.base.Benchmark.gt_only` says how it is scored, if at all.
+            :meth:`~ertools.benchmarks.base.Discovered.gt_only` says how it is scored, if at all.
     """
 
     benchmark: str

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks import registry
+from ertools.benchmarks.base import Described, Discovered
 from ertools.benchmarks.common.teams import read_payload_team
 from ertools.competition.discover import Discovery, Execution, discover
 from ertools.competition.memo import (
@@ -88,7 +89,10 @@ def robot_benchmarks() -> tuple[str, ...]:
     """The registered benchmarks that score a robot's own log against GT files."""
     out = []
     for name in registry.names():
-        metavar = registry.get(name).bags_metavar
+        bench = registry.get(name)
+        if not isinstance(bench, Described | Discovered):
+            continue
+        metavar = bench.bags_metavar if isinstance(bench, Described) else Described.bags_metavar
         if not isinstance(metavar, str) and metavar[0] == ROBOT_BAG:
             out.append(name)
     return tuple(out)
@@ -201,12 +205,13 @@ def find(
 def _gt_only_values(benchmark: str, bags: Sequence[Path]) -> Mapping[str, Any] | str:
     """The values scoring a GT-only recording of ``benchmark``, or why it is no execution."""
     bench = registry.get(benchmark)
-    if bench.gt_only is None:
+    values = bench.gt_only(bags) if isinstance(bench, Discovered) else None
+    if values is None:
         return (
             f"the GT logger's {bench.title} log alone (no state topics): {bench.name} is "
             "scored from its benchmark log, which is not here"
         )
-    return bench.gt_only(bags)
+    return values
 
 
 def write_timeline(found: Found, out: Path, title: str) -> dict[str, Any]:

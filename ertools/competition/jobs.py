@@ -18,14 +18,15 @@ import time
 import traceback
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
-from importlib import import_module
 from pathlib import Path
 from typing import Any, Literal
 
 from ertools.auditing.compare import attach
-from ertools.benchmarks.base import Benchmark
+from ertools.benchmarks import registry
+from ertools.benchmarks.base import Discovered, Reported
 from ertools.benchmarks.common.teams import with_team
 from ertools.benchmarks.document import all_failed, score_json
+from ertools.benchmarks.scoring import score_execution
 from ertools.errors import ErtoolsError, transient_error, watching
 from ertools.progress import reporting
 from ertools.report.folder import _audit_inputs, write_report
@@ -117,13 +118,6 @@ class Outcome:
 
 def one_line(text: str) -> str:
     return " ".join(text.split())
-
-
-def load_benchmark(target: str) -> Benchmark[Any, Any, Any, Any]:
-    """The benchmark a registry entry names (``module:ATTR``)."""
-    module_name, _, attribute = target.partition(":")
-    benchmark: Benchmark[Any, Any, Any, Any] = getattr(import_module(module_name), attribute)
-    return benchmark
 
 
 def run_job(job: Job) -> Outcome:
@@ -240,13 +234,16 @@ _capturing = _Dispatch().capture
 
 
 def _score(job: Job) -> Outcome:
-    benchmark = load_benchmark(job.target)
+    benchmark = registry.load(job.target)
     bags = [Path(p) for p in job.bags]
-    options = benchmark.make_options(dict(job.values))
-    result = benchmark.score(bags, options)
+    # the manifest chose the benchmark of each execution: its logs are not second-guessed
+    scored = score_execution(benchmark, bags, dict(job.values), check_logs=False)
+    result = scored.result
     if all_failed(result):
         return Outcome(job.id, "unscoreable", reason=one_line("; ".join(result.failures)))
-    files = benchmark.input_files(bags, options, result)  # as the score command's report
+    files = list(bags)  # as the score command's report
+    if isinstance(benchmark, Reported):
+        files = benchmark.input_files(bags, scored.options, result)
     result = with_team(result, job.team, files)
     warnings = tuple(str(w) for w in result.warnings)
     warnings += tuple(f"error: {f}" for f in result.failures)  # runs that failed, others scored
@@ -273,7 +270,7 @@ def _score(job: Job) -> Outcome:
             team=job.team,
         )
         report = str(index)
-    rank = benchmark.ranking.key(result)
+    rank = benchmark.ranking.key(result) if isinstance(benchmark, Discovered) else None
     # valid data too thin for a score (issue 28): a verdict on the execution, its report kept
     unscoreable = getattr(result, "unscoreable_reason", None)
     return Outcome(

@@ -36,13 +36,13 @@ from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks import registry
-from ertools.benchmarks.base import Benchmark, Input, rename_former
-from ertools.configs._yaml import MAX_SECONDS, number, parse_yaml, show
+from ertools.benchmarks.base import Benchmark, Discovered, Input, rename_former
+from ertools.configs._yaml import number, parse_yaml, show
 from ertools.errors import BagError, ConfigError
 from ertools.inputs import read_regular
 from ertools.io.formats import detect_format
 from ertools.io.text import sniff
-from ertools.timeutil import s_to_ns
+from ertools.timeutil import MAX_SECONDS, s_to_ns
 
 VERSION = 1
 TOP_KEYS = ("version", "title", "benchmarks", "executions")
@@ -179,13 +179,17 @@ class _Checker:
                 )
 
     def benchmark(self, name: str, where: str) -> Benchmark[Any, Any, Any, Any] | None:
-        if name not in registry.REGISTRY:
+        if name not in registry.names():
             self.problem(
                 where, f"unknown benchmark {name!r} (one of {', '.join(registry.names())})"
             )
             return None
         if name not in self.benchmarks:
-            self.benchmarks[name] = registry.get(name)
+            bench = registry.get(name)
+            if not isinstance(bench, Discovered):
+                self.problem(where, f"{name} is no benchmark of a competition (it has no ranking)")
+                return None
+            self.benchmarks[name] = bench
         return self.benchmarks[name]
 
     def manifest(self, data: Any, path: Path, sha256: str) -> Manifest:
@@ -387,7 +391,7 @@ class _Checker:
         if not isinstance(text, str) or not text:
             return _BAD
         path = self.path(text, where)
-        if path is _BAD or bm is None or not bm.logs_are_bags:
+        if path is _BAD or not isinstance(bm, Discovered) or not bm.logs_are_bags:
             return path
         try:
             detect_format(path)

@@ -202,7 +202,7 @@ def plan(
         job = Job(
             id=ident,
             benchmark=benchmark.name,
-            target=registry.REGISTRY[benchmark.name],
+            target=registry.target(benchmark.name),
             team=execution.team,
             bags=tuple(str(b) for b in execution.bags),
             values=values,

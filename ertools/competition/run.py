@@ -100,7 +100,7 @@ def _scoring_processes(
     if scheduler == "local" or (scheduler is None and workers > 1):
         # On a first run, what ertools' benchmarks import lazily, imported by the server while
         # the logs are scanned (a rerun may score nothing; a test's registry holds none)
-        ours = any(ertools_own(target) for target in registry.REGISTRY.values())
+        ours = any(ertools_own(registry.target(n)) for n in registry.names())
         return forks_ready(preload=cold and ours)
     return nullcontext()
 

@@ -27,8 +27,6 @@ log = logging.getLogger("ertools.configs")
 
 # int64 nanoseconds hold ~9.2e18; a float beyond this cannot be a time, a length or a count
 MAX_NUMBER = 9.2e18
-# seconds: epoch seconds (~1.4e9 in 2015) and bag-relative ones; their nanoseconds fit int64
-MAX_SECONDS = 4.6e9
 
 
 def load_yaml(path: str | Path, what: str = "config", tags: Tags = "safe") -> Any:

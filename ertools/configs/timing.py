@@ -20,9 +20,9 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.configs._yaml import MAX_SECONDS, load_yaml, number
+from ertools.configs._yaml import load_yaml, number
 from ertools.errors import ConfigError
-from ertools.timeutil import resolve_time
+from ertools.timeutil import MAX_SECONDS, resolve_time
 
 KEY = "reached_waypoint_timing"
 

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from ertools.streams import StateStream
+if TYPE_CHECKING:  # annotations only: options hold a PoseSource, and parsers build options
+    from ertools.streams import StateStream
 
 # Bag formats :func:`ertools.io.formats.detect_format` tells apart.
 FORMATS = ("ros1", "ros1-active", "rosbag2-sqlite3", "rosbag2-mcap", "mcap")

@@ -27,6 +27,7 @@ from typing import Any
 from ertools._version import __version__
 from ertools.atomic import write_text
 from ertools.benchmarks import registry
+from ertools.benchmarks.base import Discovered, Reported
 from ertools.benchmarks.common.teams import team_from_log_name
 from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ConfigError
@@ -57,7 +58,7 @@ _OUTPUT_FLAGS = frozenset({"-v", "--verbose", "-q", "--quiet"})
 _SOURCE_RANK = {"explicit": 0, "payload": 1, "log name": 2, "transform": 3}
 
 # Keys that identify a score that is no registered benchmark's (a benchmark declares its own:
-# :attr:`ertools.benchmarks.base.Benchmark.score_keys`) when no result.json says which it is.
+# ``score_keys`` of :class:`ertools.benchmarks.base.Reported`) when no result.json says which it is.
 _OTHER_SIGNATURES: tuple[tuple[str, frozenset[str]], ...] = (
     ("noise", frozenset({"epsilon", "suggested_d_min"})),
 )
@@ -134,7 +135,11 @@ def _guess_benchmark(score: dict[str, Any]) -> str:
     if isinstance(said, str) and said in registry.names():
         return said
     keys = set(score)
-    declared = [(name, registry.get(name).score_keys) for name in registry.names()]
+    declared = [
+        (name, bench.score_keys)
+        for name in registry.names()
+        if isinstance(bench := registry.get(name), Reported)
+    ]
     for name, signature in (*declared, *_OTHER_SIGNATURES):
         if signature and signature <= keys:
             return name
@@ -379,9 +384,10 @@ class Board:
 def _board(bench: str, group: list[Execution], chosen: float | None = None) -> Board:
     """The executions of ``bench`` ranked by the registry's rule for it, ties judged at the
     ``chosen`` confidence (default: the results' own)."""
-    if bench not in registry.names():
+    found = registry.get(bench) if bench in registry.names() else None
+    if not isinstance(found, Discovered):
         return Board(None, True, "", ranks.DEFAULT_CONFIDENCE, (), {})
-    ranking = registry.get(bench).ranking
+    ranking = found.ranking
     key = ranks.rule_key(ranking.text)
     contenders = []
     reasons: dict[int, str] = {}

@@ -13,7 +13,6 @@ import textwrap
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from importlib import import_module
 from pathlib import Path
 from typing import Any
 
@@ -21,13 +20,10 @@ import numpy as np
 
 from ertools.atomic import replacing, write_text
 from ertools.benchmarks import registry
+from ertools.benchmarks.base import Reported
 from ertools.report import chart_mpl, svg
 from ertools.views.chart import PIXELS_PER_INCH, Chart
 from ertools.views.spec import ChartSpec
-
-# Results that are not a registered benchmark's -> ``module:function`` giving their figures
-# (a benchmark names its own: :attr:`ertools.benchmarks.base.Benchmark.figures`).
-OTHER_FIGURES: dict[str, str] = {"noise": "ertools.report.plots_noise:figure_specs"}
 
 
 @dataclass(frozen=True)
@@ -58,11 +54,14 @@ def drawable(spec: ChartSpec) -> FigureSpec:
 def figure_specs(result: Any) -> list[FigureSpec]:
     """The figures of a result, from the charts its benchmark declares."""
     name = str(result.name)
-    target = registry.get(name).figures if name in registry.names() else OTHER_FIGURES.get(name)
-    if not target:
-        return []
-    module_name, _, function = target.partition(":")
-    specs: list[ChartSpec] = getattr(import_module(module_name), function)(result)
+    specs: Sequence[ChartSpec] = []
+    bench = registry.get(name) if name in registry.names() else None
+    if isinstance(bench, Reported):
+        specs = bench.figures(result)
+    elif name == "noise":  # not a registered benchmark (yet): `ertools noise`'s result
+        from ertools.report.plots_noise import figure_specs as noise_figures  # lazy: 300 ms
+
+        specs = noise_figures(result)
     return [drawable(spec) for spec in specs]
 
 

@@ -32,7 +32,7 @@ from ertools.atomic import write_text
 from ertools.auditing.analyse import audit_states
 from ertools.auditing.model import Audit
 from ertools.benchmarks import registry
-from ertools.benchmarks.base import BenchmarkResult, Rows
+from ertools.benchmarks.base import Audited, BenchmarkResult, Rows
 from ertools.benchmarks.common.teams import team_from_log_name, team_from_transform_name
 from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ConfigError, ErtoolsError
@@ -184,7 +184,8 @@ def _write(path: Path, text: str) -> None:
 
 def _audit_inputs(name: str, inputs: list[Path]) -> Any:
     """The audit of the bags' state topics, or None (no namespace, no topics, unreadable)."""
-    if name not in registry.names() or not registry.get(name).state_topics or not inputs:
+    bench = registry.get(name) if name in registry.names() else None
+    if not isinstance(bench, Audited) or not inputs:
         return None
 
     try:

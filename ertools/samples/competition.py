@@ -51,8 +51,9 @@ import numpy as np
 import yaml
 
 from ertools.atomic import replace_folder
+from ertools.benchmarks.fbm1 import sample as fbm1
 from ertools.errors import UsageError
-from ertools.samples import fbm1, fbm2h
+from ertools.samples import fbm2h
 from ertools.samples.competition_files import (
     GtWindow,
     organiser_manifest,
@@ -72,8 +73,8 @@ from ertools.samples.competition_schedule import (
     simulate_slot,
 )
 from ertools.samples.competition_scores import expected_score, expected_trajectory
-from ertools.samples.scenario import EPOCH_2015, log_name, to_plain
 from ertools.samples.timeline_folder import make_active
+from ertools.simulator.answers import EPOCH_2015, log_name, to_plain
 from ertools.simulator.mocap import pose_topic
 from ertools.simulator.simulated import SimulatedRun
 from ertools.simulator.statemachine import state_messages

@@ -45,7 +45,7 @@ import yaml
 from scipy.spatial.transform import Rotation, Slerp
 
 from ertools.arrays import F64
-from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
+from ertools.simulator.answers import EPOCH_2015, log_name, tol, window, write_answers
 from ertools.simulator.mocap import (
     MocapNoise,
     MocapPublished,

@@ -38,7 +38,7 @@ import numpy as np
 from ertools.arrays import F64, I64
 from ertools.benchmarks.fbm2h.config import NAMESPACE as FBM2H
 from ertools.geometry import quat_from_yaw
-from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
+from ertools.simulator.answers import EPOCH_2015, log_name, tol, window, write_answers
 from ertools.simulator.mocap import (
     MocapNoise,
     MocapPublished,

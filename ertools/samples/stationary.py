@@ -33,7 +33,7 @@ import numpy as np
 
 from ertools.benchmarks.fbm3w.config import NAMESPACE as FBM3W
 from ertools.geometry import quat_from_yaw
-from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
+from ertools.simulator.answers import EPOCH_2015, log_name, tol, window, write_answers
 from ertools.simulator.mocap import (
     MocapNoise,
     TrackingLoss,

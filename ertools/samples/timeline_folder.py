@@ -39,7 +39,7 @@ import numpy as np
 from ertools.arrays import I64
 from ertools.benchmarks.fbm2h.config import NAMESPACE as FBM2H
 from ertools.geometry import quat_from_yaw
-from ertools.samples.scenario import EPOCH_2015, log_name, tol, write_answers
+from ertools.simulator.answers import EPOCH_2015, log_name, tol, write_answers
 from ertools.simulator.mocap import FRAME_NS
 from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState

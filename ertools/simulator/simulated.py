@@ -1,6 +1,6 @@
 """One simulated benchmark execution, before it is written to any file.
 
-The scenario modules (:mod:`ertools.samples.fbm1`, :mod:`~ertools.samples.fbm2h`,
+The scenario modules (:mod:`ertools.benchmarks.fbm1.sample`, :mod:`~ertools.samples.fbm2h`,
 :mod:`~ertools.samples.fbm3w`) split into ``simulate(...) -> SimulatedRun`` (pure: the
 transitions, what the mocap node published, the configs' texts and the answers) and
 ``generate(outdir, seed=...)``, which writes one log per execution as ``sample_bags/`` has it.
@@ -34,7 +34,7 @@ class SimulatedRun:
         bodies: body name -> what the mocap node published for it.
         configs: config file name -> text (goal, items, shapes, transform files).
         parameters, truth, expected, tolerance: the answers-file sections
-            (:func:`~ertools.samples.scenario.write_answers`).
+            (:func:`~ertools.simulator.answers.write_answers`).
     """
 
     benchmark: str

@@ -278,7 +278,10 @@ BENCHMARK_WORDS = frozenset(
 def outside_benchmark_modules(root: Path) -> set[str]:
     """``file: why`` of every benchmark module outside ``benchmarks/<name>/``: named after a
     benchmark, or importing a benchmark package's modules, anywhere but that package, the
-    registry and the CLI's command modules (which may import what their command runs)."""
+    registry and the CLI's command modules (which may import what their command runs). The
+    sample competition (``samples/competition*.py``) may import the benchmarks' ``sample``
+    modules: it schedules the simulated executions of named benchmarks (data, not a
+    dispatch)."""
     bench = root / "ertools" / "benchmarks"
     packages = sorted(
         p.name for p in bench.iterdir() if p.is_dir() and p.name not in SHARED_BENCHMARK_FOLDERS
@@ -286,6 +289,7 @@ def outside_benchmark_modules(root: Path) -> set[str]:
     names = set(packages) | BENCHMARK_WORDS
     word = re.compile(r"(^|_)(" + "|".join(sorted(names, key=len, reverse=True)) + r")(_|$)")
     own = re.compile(r"ertools\.benchmarks\.(" + "|".join(packages) + r")\b")
+    competition = re.compile(r"ertools/samples/competition\w*\.py$")
     out = set()
     for path in sorted((root / "ertools").rglob("*.py")):
         rel = path.relative_to(root).as_posix()
@@ -298,14 +302,17 @@ def outside_benchmark_modules(root: Path) -> set[str]:
             out.add(f"{rel}: named after a benchmark")
         for node in ast.walk(_parse(path)):
             if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-                mods = [node.module]
+                mods = [f"{node.module}.{a.name}" for a in node.names]
             elif isinstance(node, ast.Import):
                 mods = [a.name for a in node.names]
             else:
                 continue
             for m in mods:
-                if (found := own.match(m)) is not None:
-                    out.add(f"{rel}: imports ertools.benchmarks.{found.group(1)}")
+                if (found := own.match(m)) is None:
+                    continue
+                if competition.match(rel) and m == f"{found.group(0)}.sample":
+                    continue
+                out.add(f"{rel}: imports ertools.benchmarks.{found.group(1)}")
     return out
 
 

@@ -8,13 +8,13 @@ from pathlib import Path
 
 from tests.architecture.archscan import ROOT, hidden_imports, plant, ratchet
 
+# legacy.py (the old benchmark record's "module:function" texts) goes when the last benchmark
+# is converted to the protocols (S8b); fidelity's rule modules and samples' scenarios become
+# the registry's parts. The list only shrinks.
 ALLOWED = frozenset(
     {
-        "ertools/competition/children.py: import_module outside the registry",
-        "ertools/competition/jobs.py: import_module outside the registry",
+        "ertools/benchmarks/legacy.py: import_module outside the registry",
         "ertools/fidelity.py: import_module outside the registry",
-        "ertools/report/figures.py: import_module outside the registry",
-        "ertools/report/foxglove/__init__.py: import_module outside the registry",
         "ertools/samples/scenario.py: import_module outside the registry",
     }
 )

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from ertools.benchmarks.fbm1.benchmark import score_fbm1_bag
+from ertools.benchmarks.fbm1.pipeline import score_fbm1_bag
 from ertools.benchmarks.fbm3w.benchmark import score_fbm3w
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.progress import reporting

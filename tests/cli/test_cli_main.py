@@ -48,7 +48,7 @@ def test_help_is_instant_and_imports_nothing_heavy() -> None:
 
 
 def test_library_warnings_read_like_the_cli_notes(capsys: pytest.CaptureFixture[str]) -> None:
-    # Logged warnings and cli.common.note warnings share one wording: "ertools: warning: ...".
+    # Logged warnings and cli.output.note warnings share one wording: "ertools: warning: ...".
     root = logging.getLogger("ertools")
     saved = (root.handlers[:], root.level, root.propagate)
     try:

@@ -29,7 +29,7 @@ from ertools.benchmarks.fbm2h.config import Fbm2hOptions
 from ertools.benchmarks.trajectory.benchmark import score as score_trajectory
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.cli.main import main
-from ertools.report.foxglove import write_foxglove
+from ertools.report.foxglove.write import write_foxglove
 from tests.helpers.foxglove_readback import ReadBack, read_back, stamp_ns
 from tests.helpers.stderr_text import error_messages
 

@@ -78,7 +78,7 @@ def test_a_lock_held_by_another_thread_is_not_inherited(
             from ertools.benchmarks import registry
             from ertools.cli.main import main
 
-            registry.REGISTRY = {"toy": "rescore_toy:TOY"}
+            registry.ENTRIES = (registry.Entry("toy", "rescore_toy:TOY", "a toy benchmark"),)
             held = threading.Event()
 
             def hold():
@@ -160,7 +160,7 @@ def test_a_server_that_cannot_fork_costs_each_job_its_row(tmp_path: Path) -> Non
             from ertools.benchmarks import registry
             from ertools.cli.main import main
 
-            registry.REGISTRY = {"toy": "rescore_toy:TOY"}
+            registry.ENTRIES = (registry.Entry("toy", "rescore_toy:TOY", "a toy benchmark"),)
             command, fork = os.getpid(), os.fork
 
             def refused():  # in the server only: the command forks the server itself

@@ -17,6 +17,7 @@ import pytest
 
 from ertools.benchmarks import registry
 from ertools.benchmarks.document import score_json
+from ertools.benchmarks.scoring import score_execution
 from ertools.cli.main import main
 from ertools.competition import cache
 from tests.rescore.rescore_competition import (
@@ -109,8 +110,9 @@ def test_score_is_the_score_commands_json(tmp_path: Path) -> None:
     toy = registry.get("toy")
     for ident, row in by_id(load(out)).items():
         team = LOGS[ident][0]
-        options = toy.make_options({"scale": 2.0, "transform": comp.transform(team)})
-        assert row["score"] == score_json(toy.score([comp.log(ident)], options))
+        values = {"scale": 2.0, "transform": comp.transform(team)}
+        result = score_execution(toy, [comp.log(ident)], values, check_logs=False).result
+        assert row["score"] == score_json(result)
         assert row["report"] is None
 
 

@@ -140,8 +140,7 @@ def test_score_argv_is_the_score_command(tmp_path: Path) -> None:
         "--team",
         "x",
     ]
-    registry.REGISTRY["fbm2h"] = "ertools.benchmarks.fbm2h.declare:BENCHMARK"
-    fbm2h = registry.get("fbm2h")
+    fbm2h = registry.load("ertools.benchmarks.fbm2h.declare:BENCHMARK")
     values = {"reached": ("timing", Path("t.yaml")), "team": "homer", "orientation_2015": True}
     assert score_argv(fbm2h, [Path("r.bag")], values, "homer") == [
         "ertools",

@@ -35,7 +35,7 @@ from pathlib import Path
 sys.path.insert(0, sys.argv[1])
 from ertools.benchmarks import registry
 
-registry.REGISTRY = {"toy": "rescore_toy:TOY"}
+registry.ENTRIES = (registry.Entry("toy", "rescore_toy:TOY", "a toy benchmark"),)
 import logging
 
 import ertools

@@ -4,11 +4,11 @@ of the tool."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 from ertools.competition.jobs import Job, run_job
-from tests.rescore.rescore_toy import TOY, ToyOptions, ToyResult
+from tests.rescore.rescore_toy import Toy, ToyOptions, ToyResult
 
 REASON = "valid data covers only 61.0% of the window (12 tracking_lost); at least 90% is needed"
 
@@ -25,7 +25,16 @@ def _score_thin(loaded: list[float], runs: list[float], options: ToyOptions) -> 
     return ThinResult("thin", mean, len(runs), 0.0, unscoreable_reason=reason)
 
 
-THIN = replace(TOY, name="thin", score_runs=_score_thin)
+class Thin(Toy):
+    """The toy whose scorer says when its data is too thin."""
+
+    name = "thin"
+
+    def score_runs(self, loaded: list[float], runs: list[float], options: ToyOptions) -> ThinResult:
+        return _score_thin(loaded, runs, options)
+
+
+THIN = Thin()
 
 
 def _job(tmp_path: Path, numbers: str) -> Job:

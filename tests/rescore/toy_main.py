@@ -11,5 +11,5 @@ from ertools.cli.main import main
 
 if __name__ == "__main__":
     # run as a script, whose folder (tests/rescore, rescore_toy's) heads sys.path
-    registry.REGISTRY = {"toy": "rescore_toy:TOY"}
+    registry.ENTRIES = (registry.Entry("toy", "rescore_toy:TOY", "a toy benchmark"),)
     raise SystemExit(main(sys.argv[1:]))

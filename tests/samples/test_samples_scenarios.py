@@ -17,13 +17,8 @@ import yaml
 from rosbags.highlevel import AnyReader
 
 from ertools.samples.__main__ import main
-from ertools.samples.scenario import (
-    SCENARIOS,
-    ScenarioMissingError,
-    answers_path,
-    load_scenario,
-    log_name,
-)
+from ertools.samples.scenario import SCENARIOS, ScenarioMissingError, load_scenario
+from ertools.simulator.answers import answers_path, log_name
 from tests.helpers.floats import FLOAT_ATOL, FLOAT_RTOL, same_text
 
 REPO = Path(__file__).resolve().parents[2]

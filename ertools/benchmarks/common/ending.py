@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ertools.benchmarks.common.inputs import EXACT_FLAG
 from ertools.fidelity import Deviation, NodeVersion, Rule
 from ertools.states import (
     BmBoxState,
@@ -34,13 +35,6 @@ from ertools.states import (
 )
 from ertools.streams import StateStream
 from ertools.timeutil import ns_to_s
-
-# The option every FBM benchmark has (``--2015`` / ``--rules 2015`` set it), and its help.
-EXACT_FLAG = "--exact-end-payloads"
-EXACT_HELP = (
-    "RefBox END payloads read as the 2015 BmBox compared them: only 'reason: timeout' and "
-    "'reason: stop' (the manual's bare timeout / halt then mean neither)"
-)
 
 RULE_END_PAYLOADS = Rule(
     key="all.end-payloads",

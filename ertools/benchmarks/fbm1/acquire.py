@@ -103,7 +103,7 @@ class AcquireResult:
     @property
     def nothing_scored(self) -> bool:
         """Not one item acquired (each failed): the CLI prints only the failures, not the
-        vanilla list back (``ertools.cli.common.all_failed``)."""
+        vanilla list back (``ertools.benchmarks.document.all_failed``)."""
         return len(self.failures) >= len(self.items)
 
 

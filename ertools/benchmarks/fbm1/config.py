@@ -10,12 +10,12 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from ertools.benchmarks.common.interval_output import IntervalSettings
+from ertools.benchmarks.common.inputs import IntervalSettings
+from ertools.benchmarks.fbm1.formula import (
+    ScoreRules,
+)
 from ertools.benchmarks.fbm1.gt import (
     GtOptions,
-)
-from ertools.benchmarks.fbm1.score import (
-    ScoreRules,
 )
 from ertools.errors import ConfigError
 from ertools.io.model import PoseSource

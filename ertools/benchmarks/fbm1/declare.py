@@ -13,7 +13,6 @@ from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks.base import (
-    Benchmark,
     Explanation,
     FormerName,
     Input,
@@ -22,19 +21,20 @@ from ertools.benchmarks.base import (
     resolve_values,
     tf_value,
 )
-from ertools.benchmarks.common.ending import EXACT_HELP
-from ertools.benchmarks.common.interval_output import (
+from ertools.benchmarks.common.inputs import (
+    EXACT_HELP,
+    INTERVAL_INPUTS,
+    SCORE_AS_2015,
     IntervalSettings,
-    ScoreRow,
-    interval_lines,
+    unscoreable_input,
 )
-from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS
-from ertools.benchmarks.common.validity import SCORE_AS_2015, unscoreable_input
-from ertools.benchmarks.fbm1.benchmark import score_found
+from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
 from ertools.benchmarks.fbm1.config import RULE_SETS, BodySources, Fbm1Options
 from ertools.benchmarks.fbm1.gt import GtOptions
 from ertools.benchmarks.fbm1.logs import Fbm1Logs, Fbm1Runs, load, locate_runs
+from ertools.benchmarks.fbm1.pipeline import score_found
 from ertools.benchmarks.fbm1.result import Fbm1Result
+from ertools.benchmarks.legacy import LegacyBenchmark
 from ertools.errors import ConfigError, UsageError
 from ertools.io.model import PoseSource
 
@@ -402,8 +402,8 @@ instance_accuracy, pose_score, execution_time."""
 
 def _declare(
     name: str, title: str, summary: str
-) -> Benchmark[Fbm1Options, Fbm1Logs, Fbm1Runs, Fbm1Result]:
-    return Benchmark(
+) -> LegacyBenchmark[Fbm1Options, Fbm1Logs, Fbm1Runs, Fbm1Result]:
+    return LegacyBenchmark(
         name=name,
         title=title,
         source_inputs=("origin_topic", "origin_tf", "ref_board_topic", "ref_board_tf"),
@@ -422,8 +422,8 @@ def _declare(
             text="pose_score (0..1, the mean of the runs' pose scores): higher is better",
         ),
         notes=notes,
-        figures="ertools.report.plots_fbm1:figure_specs",
-        foxglove="ertools.report.foxglove.fbm1:content",
+        figures="ertools.benchmarks.fbm1.plots:figure_specs",
+        foxglove="ertools.benchmarks.fbm1.foxglove:content",
         files=files,
         score_keys=frozenset({"class_accuracy", "instance_accuracy"}),
         state_topics=True,

@@ -12,8 +12,8 @@ from ertools.benchmarks.common.interval_output import as_list, interval_tables, 
 from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, interval_keys
 from ertools.benchmarks.common.validity import Validity, cell
 from ertools.benchmarks.fbm1.answers import Answer
+from ertools.benchmarks.fbm1.formula import PoseErrors, Totals
 from ertools.benchmarks.fbm1.gt import GroundTruth
-from ertools.benchmarks.fbm1.score import PoseErrors, Totals
 from ertools.configs.items import Item
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames
@@ -228,7 +228,7 @@ class Fbm1Result:
     @property
     def nothing_scored(self) -> bool:
         """No run counted (scored, or without answer with score 0): no total is a number, so
-        the CLI prints only the failures (``ertools.cli.common.all_failed``)."""
+        the CLI prints only the failures (``ertools.benchmarks.document.all_failed``)."""
         return not any(r.status in ("scored", "no_answer") for r in self.runs)
 
     def validity_lines(self) -> list[str]:

@@ -9,11 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ertools.benchmarks.common.uncertainty import (
-    DEFAULT_CONFIDENCE,
-    DEFAULT_DRAWS,
-    DEFAULT_SEED,
-)
+from ertools.benchmarks.common.inputs import DEFAULT_CONFIDENCE, DEFAULT_DRAWS, DEFAULT_SEED
 from ertools.benchmarks.fbm2h.segments import StopParams
 from ertools.configs.transform import (
     MarkerTransform,

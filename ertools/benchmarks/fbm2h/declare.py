@@ -12,7 +12,6 @@ from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks.base import (
-    Benchmark,
     Explanation,
     FormerName,
     Input,
@@ -20,14 +19,19 @@ from ertools.benchmarks.base import (
     resolve_values,
     tf_value,
 )
-from ertools.benchmarks.common.ending import EXACT_HELP
-from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS, check_confidence
-from ertools.benchmarks.common.validity import SCORE_AS_2015, unscoreable_input
+from ertools.benchmarks.common.inputs import (
+    EXACT_HELP,
+    INTERVAL_INPUTS,
+    SCORE_AS_2015,
+    check_confidence,
+    unscoreable_input,
+)
 from ertools.benchmarks.fbm2h.benchmark import score_found
 from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, NODES, RULE_SETS, Fbm2hOptions
 from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, load, locate_runs
 from ertools.benchmarks.fbm2h.result import Fbm2hResult
 from ertools.benchmarks.fbm2h.segments import StopParams
+from ertools.benchmarks.legacy import LegacyBenchmark
 from ertools.configs.transform import LIVE_TRANSFORM_KEY, live_transform
 from ertools.errors import UsageError
 
@@ -360,7 +364,7 @@ segment cut short where the node's wait returned and divides the sums by N as 20
 same file at 40ba68b and 89dfa75): every 2015 behaviour at once, with the node's pose source
 (/tf world -> robot_at_home)."""
 
-BENCHMARK: Benchmark[Fbm2hOptions, Fbm2hLogs, Fbm2hRuns, Fbm2hResult] = Benchmark(
+BENCHMARK: LegacyBenchmark[Fbm2hOptions, Fbm2hLogs, Fbm2hRuns, Fbm2hResult] = LegacyBenchmark(
     name=NAME,
     title="FBM2@Home",
     summary="FBM2@Home navigation: waypoint errors",

@@ -44,6 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ertools.arrays import F64
+from ertools.benchmarks.common.epsilon import noise_from_stream
 from ertools.benchmarks.common.phases import phase_pairs, stationary_phases
 from ertools.benchmarks.common.uncertainty import (
     MOCAP_NOISE,
@@ -55,7 +56,6 @@ from ertools.benchmarks.common.uncertainty import (
     monte_carlo,
     sigma_from_epsilon,
 )
-from ertools.benchmarks.noise.benchmark import noise_from_stream
 from ertools.configs.transform import TransformSpread
 from ertools.errors import ScoringError
 from ertools.geometry import quat_conjugate, quat_multiply, wrap_angle

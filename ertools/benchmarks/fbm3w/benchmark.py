@@ -18,6 +18,10 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.benchmarks.common.ending import end_payload_deviation
+from ertools.benchmarks.common.epsilon import (
+    NoiseResult,
+    noise_from_stream,
+)
 from ertools.benchmarks.common.hygiene import (
     frame_change_warning,
     frozen_warnings,
@@ -64,10 +68,6 @@ from ertools.benchmarks.fbm3w.runs import (
     find_states,
     find_windows,
     with_specs,
-)
-from ertools.benchmarks.noise.benchmark import (
-    NoiseResult,
-    noise_from_stream,
 )
 from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
 from ertools.errors import ConfigError, ScoringError

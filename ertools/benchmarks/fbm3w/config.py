@@ -8,14 +8,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from ertools.benchmarks.common.uncertainty import (
-    DEFAULT_CONFIDENCE,
-    DEFAULT_DRAWS,
-    DEFAULT_SEED,
-)
-from ertools.benchmarks.noise.benchmark import (
+from ertools.benchmarks.common.epsilon import (
     DEFAULT_C,
 )
+from ertools.benchmarks.common.inputs import DEFAULT_CONFIDENCE, DEFAULT_DRAWS, DEFAULT_SEED
 from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
 from ertools.errors import ConfigError
 

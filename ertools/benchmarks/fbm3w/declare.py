@@ -13,7 +13,6 @@ from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks.base import (
-    Benchmark,
     Explanation,
     FormerName,
     Input,
@@ -21,13 +20,18 @@ from ertools.benchmarks.base import (
     resolve_values,
     tf_value,
 )
-from ertools.benchmarks.common.ending import EXACT_HELP
-from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS, check_confidence
-from ertools.benchmarks.common.validity import UNSCOREABLE_CHOICES, unscoreable_input
+from ertools.benchmarks.common.inputs import (
+    EXACT_HELP,
+    INTERVAL_INPUTS,
+    UNSCOREABLE_CHOICES,
+    check_confidence,
+    unscoreable_input,
+)
 from ertools.benchmarks.fbm3w.benchmark import Fbm3wLogs, load, locate_runs, score_found
 from ertools.benchmarks.fbm3w.config import RUN_MODES, Fbm3wOptions, options_2015
 from ertools.benchmarks.fbm3w.result import Fbm3wResult
 from ertools.benchmarks.fbm3w.runs import RunWindow, parse_run_spec, parse_runs_file
+from ertools.benchmarks.legacy import LegacyBenchmark
 from ertools.configs._yaml import load_yaml
 from ertools.configs.fbm3w import check_d_min, load_fbm3w_config
 from ertools.errors import ConfigError, UsageError
@@ -281,38 +285,40 @@ def gt_only(bags: Sequence[Path]) -> dict[str, Any]:
     return {"runs": "auto"}
 
 
-BENCHMARK: Benchmark[Fbm3wOptions, Fbm3wLogs, Sequence[RunWindow], Fbm3wResult] = Benchmark(
-    name="fbm3w",
-    title="FBM3@Work",
-    summary="FBM3@Work trajectory following: path error",
-    example="ertools score fbm3w run.bag --config configs/fbm3w.yaml",
-    description="""Recompute an FBM3@Work (trajectory following) score from the logs
+BENCHMARK: LegacyBenchmark[Fbm3wOptions, Fbm3wLogs, Sequence[RunWindow], Fbm3wResult] = (
+    LegacyBenchmark(
+        name="fbm3w",
+        title="FBM3@Work",
+        summary="FBM3@Work trajectory following: path error",
+        example="ertools score fbm3w run.bag --config configs/fbm3w.yaml",
+        description="""Recompute an FBM3@Work (trajectory following) score from the logs
 (seed 7.3, Listing 16).
 
 Per run: the measured end-effector path subsampled with d_min, put in the run frame (origin at
 the starting position, x axis along reference -> start), compared with the target shape at
 each kept point's normalised path length; distance_error = the mean distance (Eq. 1). Then
 best_run, best_distance_error and execution_time (sum of the run times).""",
-    epilog=EPILOG,
-    inputs=INPUTS,
-    make_options=make_options,
-    load=load,
-    find_runs=locate_runs,
-    score_runs=score_found,
-    ranking=Ranking(
-        key=lambda r: r.best_distance_error,
-        lower_is_better=True,
-        text="best_distance_error (metres, the best run's mean distance to the target): "
-        "lower is better",
-    ),
-    notes=notes,
-    figures="ertools.report.plots_fbm3w:figure_specs",
-    foxglove="ertools.report.foxglove.fbm3w:content",
-    score_keys=frozenset({"best_distance_error", "runs_details"}),
-    state_topics=True,
-    # The 2015 node's hard-coded d_min too, whatever d_min the audit was given.
-    values_2015={"all_2015": True, "d_min": None},
-    sample=sample,
-    explanations=EXPLANATIONS,
-    gt_only=gt_only,
+        epilog=EPILOG,
+        inputs=INPUTS,
+        make_options=make_options,
+        load=load,
+        find_runs=locate_runs,
+        score_runs=score_found,
+        ranking=Ranking(
+            key=lambda r: r.best_distance_error,
+            lower_is_better=True,
+            text="best_distance_error (metres, the best run's mean distance to the target): "
+            "lower is better",
+        ),
+        notes=notes,
+        figures="ertools.report.plots_fbm3w:figure_specs",
+        foxglove="ertools.report.foxglove.fbm3w:content",
+        score_keys=frozenset({"best_distance_error", "runs_details"}),
+        state_topics=True,
+        # The 2015 node's hard-coded d_min too, whatever d_min the audit was given.
+        values_2015={"all_2015": True, "d_min": None},
+        sample=sample,
+        explanations=EXPLANATIONS,
+        gt_only=gt_only,
+    )
 )

@@ -44,6 +44,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, Bool, IntArr
+from ertools.benchmarks.common.epsilon import NoiseResult
 from ertools.benchmarks.common.uncertainty import (
     D_MIN,
     MOCAP_NOISE,
@@ -56,7 +57,6 @@ from ertools.benchmarks.common.uncertainty import (
 )
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
 from ertools.benchmarks.fbm3w.result import RunResult
-from ertools.benchmarks.noise.benchmark import NoiseResult
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.configs.shapes import Shape
 from ertools.streams import PoseStream

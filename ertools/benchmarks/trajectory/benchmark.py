@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ertools.benchmarks.common.interval_output import IntervalSettings
+from ertools.benchmarks.common.inputs import IntervalSettings
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.benchmarks.trajectory.inputs import (
     find_gt_files,

@@ -10,14 +10,10 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.base import Benchmark, Input, Ranking, resolve_values
-from ertools.benchmarks.common.interval_output import (
-    IntervalSettings,
-    ScoreRow,
-    interval_lines,
-)
-from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS
-from ertools.benchmarks.common.validity import unscoreable_input
+from ertools.benchmarks.base import Input, Ranking, resolve_values
+from ertools.benchmarks.common.inputs import INTERVAL_INPUTS, IntervalSettings, unscoreable_input
+from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
+from ertools.benchmarks.legacy import LegacyBenchmark
 from ertools.benchmarks.trajectory.benchmark import (
     TrajectoryLogs,
     TrajectoryOptions,
@@ -37,10 +33,8 @@ from ertools.benchmarks.trajectory.config import (
 from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.errors import ConfigError, UsageError
 from ertools.io.text import INPUT_FORMATS
-from ertools.timeutil import s_to_ns
+from ertools.timeutil import MAX_SECONDS, s_to_ns
 
-# Offsets beyond this (about 146 years) are not clock offsets; int64 nanoseconds hold them.
-MAX_OFFSET_S = 4.6e9
 LEGACY = "2015 behaviour (each difference can be undone)"
 
 INPUTS = (
@@ -191,9 +185,9 @@ def _offset(text: str) -> float | None:
         value = float(text)
     except ValueError:
         raise UsageError(f"--offset takes seconds or 'auto', not {text!r}") from None
-    if not (math.isfinite(value) and abs(value) < MAX_OFFSET_S):
+    if not (math.isfinite(value) and abs(value) < MAX_SECONDS):
         raise UsageError(
-            f"--offset {text}: give a finite number smaller than {MAX_OFFSET_S:g} s in size "
+            f"--offset {text}: give a finite number smaller than {MAX_SECONDS:g} s in size "
             "or 'auto'"
         )
     return value
@@ -311,41 +305,43 @@ robot's clock runs ahead). exit status: 0 scored, 1 unusable data, 2 usage
 error.
 """
 
-BENCHMARK: Benchmark[TrajectoryOptions, TrajectoryLogs, None, TrajectoryResult] = Benchmark(
-    name="trajectory",
-    title="Offline trajectory benchmark",
-    # the robot's own log: /rockin/<team>/marker_pose
-    namespace="rockin",
-    source_inputs=("robot_topic", "gt_topic"),
-    summary="robot log vs mocap ground truth, with clock audit",
-    example="ertools score trajectory robot.bag gt/ --robot-topic /rockin/homer/marker_pose",
-    description="""Compare a robot's own pose log with the mocap ground truth (2015 offline
+BENCHMARK: LegacyBenchmark[TrajectoryOptions, TrajectoryLogs, None, TrajectoryResult] = (
+    LegacyBenchmark(
+        name="trajectory",
+        title="Offline trajectory benchmark",
+        # the robot's own log: /rockin/<team>/marker_pose
+        namespace="rockin",
+        source_inputs=("robot_topic", "gt_topic"),
+        summary="robot log vs mocap ground truth, with clock audit",
+        example="ertools score trajectory robot.bag gt/ --robot-topic /rockin/homer/marker_pose",
+        description="""Compare a robot's own pose log with the mocap ground truth (2015 offline
 trajectory benchmark).
 
 The GT files are picked from GT_PATH (bags or folders) by time overlap with the robot log and
 read as one stream; without GT_PATH the GT topic is read from the robot log itself (evo's
 `bag` mode). Every run also audits the clocks: it estimates the offset between the
 robot's stamps and the GT clock and says when it matters.""",
-    epilog=EPILOG,
-    bags_help="the robot's log, then GT bags or folders of them (none: the GT topic is in "
-    "ROBOT_BAG itself)",
-    logs_may_be_text=True,
-    inputs=INPUTS,
-    make_options=make_options,
-    load=load,
-    find_runs=locate_runs,
-    score_runs=score_found,
-    ranking=Ranking(
-        key=lambda r: None if r.metrics is None else r.metrics.position_error,
-        lower_is_better=True,
-        text="position_error (metres, the mean 3D distance to the GT): lower is better",
-    ),
-    figures="ertools.report.plots_trajectory:figure_specs",
-    foxglove="ertools.report.foxglove.trajectory:content",
-    files=files,
-    bags_metavar=("ROBOT_BAG", "GT_PATH"),
-    score_keys=frozenset({"position_error", "association"}),
-    values_2015={"as_2015": True},
-    sample=sample,
-    notes=notes,
+        epilog=EPILOG,
+        bags_help="the robot's log, then GT bags or folders of them (none: the GT topic is in "
+        "ROBOT_BAG itself)",
+        logs_may_be_text=True,
+        inputs=INPUTS,
+        make_options=make_options,
+        load=load,
+        find_runs=locate_runs,
+        score_runs=score_found,
+        ranking=Ranking(
+            key=lambda r: None if r.metrics is None else r.metrics.position_error,
+            lower_is_better=True,
+            text="position_error (metres, the mean 3D distance to the GT): lower is better",
+        ),
+        figures="ertools.report.plots_trajectory:figure_specs",
+        foxglove="ertools.report.foxglove.trajectory:content",
+        files=files,
+        bags_metavar=("ROBOT_BAG", "GT_PATH"),
+        score_keys=frozenset({"position_error", "association"}),
+        values_2015={"as_2015": True},
+        sample=sample,
+        notes=notes,
+    )
 )

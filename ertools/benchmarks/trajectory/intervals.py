@@ -54,10 +54,11 @@ import numpy.typing as npt
 
 from ertools.arrays import F64, IntArr
 from ertools.benchmarks.common.clocks import MIN_POSES, OffsetEstimate
+from ertools.benchmarks.common.epsilon import noise_from_stream
+from ertools.benchmarks.common.inputs import IntervalSettings
 from ertools.benchmarks.common.interval_output import (
     METHOD,
     NO_INTERVALS,
-    IntervalSettings,
     ResultIntervals,
     shares_of,
     withheld,
@@ -72,7 +73,6 @@ from ertools.benchmarks.common.uncertainty import (
     sigma_from_epsilon,
     too_few,
 )
-from ertools.benchmarks.noise.benchmark import noise_from_stream
 from ertools.benchmarks.trajectory.association import COMPARED, Matched
 from ertools.benchmarks.trajectory.metrics import PERCENTILES, Metrics, metrics
 from ertools.errors import ErtoolsError

@@ -19,7 +19,8 @@ from ertools.benchmarks.common.hygiene import (
     frame_change_warning,
     impossible_warning,
 )
-from ertools.benchmarks.common.interval_output import NO_INTERVALS, IntervalSettings
+from ertools.benchmarks.common.inputs import IntervalSettings
+from ertools.benchmarks.common.interval_output import NO_INTERVALS
 from ertools.benchmarks.common.teams import parse_robot_log_name
 from ertools.benchmarks.common.uncertainty import Interval, few_warning
 from ertools.benchmarks.common.validity import (

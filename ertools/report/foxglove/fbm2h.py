@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from ertools.benchmarks.fbm2h.result import Fbm2hResult
-from ertools.report.foxglove.messages import (
+from ertools.views.foxglove import (
     BLUE,
     ERROR,
     GREEN,

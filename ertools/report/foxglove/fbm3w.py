@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from ertools.benchmarks.fbm3w.result import Fbm3wResult, RunResult
-from ertools.report.foxglove.messages import (
+from ertools.views.foxglove import (
     BLUE,
     ERROR,
     GREEN,

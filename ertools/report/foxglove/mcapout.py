@@ -9,7 +9,7 @@ from pathlib import Path
 from ertools._version import __version__
 from ertools.atomic import replacing
 from ertools.errors import UsageError
-from ertools.report.foxglove.messages import Collected
+from ertools.views.foxglove import Collected
 
 
 def refuse_inputs(out: Path, inputs: Sequence[str | Path]) -> None:

@@ -23,7 +23,7 @@ import numpy as np
 
 from ertools.benchmarks.trajectory.association import COMPARED, STATUS_NAMES
 from ertools.benchmarks.trajectory.result import TrajectoryResult
-from ertools.report.foxglove.messages import (
+from ertools.views.foxglove import (
     INFO,
     RED,
     WARNING,

@@ -11,7 +11,7 @@ import pytest
 
 import ertools
 from ertools.benchmarks import registry
-from ertools.benchmarks.common.uncertainty import MAX_DRAWS, MAX_SEED
+from ertools.benchmarks.common.inputs import MAX_DRAWS, MAX_SEED
 from ertools.cli.main import main
 from ertools.cli.text import MAX_ERROR_LINE
 from ertools.errors import UsageError

@@ -15,7 +15,7 @@ import pytest
 
 from ertools.api import _values as api_values
 from ertools.benchmarks import registry
-from ertools.benchmarks.common.validity import UNSCOREABLE
+from ertools.benchmarks.common.inputs import UNSCOREABLE
 from ertools.cli import score as score_cli
 from ertools.cli.main import build_parser
 from ertools.competition.manifest import load_manifest

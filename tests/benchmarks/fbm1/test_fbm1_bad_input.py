@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from ertools.benchmarks.fbm1.answers import parse_answer_payload
-from ertools.benchmarks.fbm1.benchmark import score_fbm1
+from ertools.benchmarks.fbm1.pipeline import score_fbm1
 from ertools.benchmarks.fbm1.runs import find_runs
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml

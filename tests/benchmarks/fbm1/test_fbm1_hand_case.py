@@ -19,12 +19,12 @@ import yaml
 from scipy.spatial.transform import Rotation
 
 from ertools.benchmarks.base import BenchmarkResult
-from ertools.benchmarks.fbm1.benchmark import score_fbm1
 from ertools.benchmarks.fbm1.config import Fbm1Options
+from ertools.benchmarks.fbm1.formula import ScoreRules
 from ertools.benchmarks.fbm1.gt import GtOptions
+from ertools.benchmarks.fbm1.pipeline import score_fbm1
 from ertools.benchmarks.fbm1.result import Fbm1Result
 from ertools.benchmarks.fbm1.runs import find_runs
-from ertools.benchmarks.fbm1.score import ScoreRules
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import ItemList, parse_items

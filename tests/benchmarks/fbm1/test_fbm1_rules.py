@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from ertools.benchmarks.fbm1.score import (
+from ertools.benchmarks.fbm1.formula import (
     ScoreRules,
     names_match,
     pose_errors,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ertools.benchmarks.fbm1.benchmark import score_fbm1
+from ertools.benchmarks.fbm1.pipeline import score_fbm1
 from ertools.benchmarks.fbm1.runs import find_runs, parse_item_ref
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import parse_items

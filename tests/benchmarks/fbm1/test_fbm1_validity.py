@@ -7,10 +7,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ertools.benchmarks.fbm1.benchmark import score_fbm1
 from ertools.benchmarks.fbm1.config import Fbm1Options
+from ertools.benchmarks.fbm1.formula import ScoreRules
+from ertools.benchmarks.fbm1.pipeline import score_fbm1
 from ertools.benchmarks.fbm1.runs import find_runs
-from ertools.benchmarks.fbm1.score import ScoreRules
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import parse_items
 from ertools.states import Machine

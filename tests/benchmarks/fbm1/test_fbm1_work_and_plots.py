@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 from matplotlib.figure import Figure
 
-from ertools.benchmarks.fbm1.benchmark import score_fbm1
 from ertools.benchmarks.fbm1.config import Fbm1Options
+from ertools.benchmarks.fbm1.pipeline import score_fbm1
 from ertools.benchmarks.fbm1.runs import find_runs
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml

@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from ertools.benchmarks.common.epsilon import noise_statistics
 from ertools.benchmarks.common.uncertainty import D_MIN, MOCAP_NOISE
 from ertools.benchmarks.fbm3w.intervals import (
     RAYLEIGH_CV,
@@ -19,7 +20,6 @@ from ertools.benchmarks.fbm3w.intervals import (
     run_intervals,
     smooth,
 )
-from ertools.benchmarks.noise.benchmark import noise_statistics
 from ertools.configs.shapes import builtin_shapes
 from ertools.samples.fbm3w import eq1, target
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import yaml
 
-from ertools.benchmarks.noise.benchmark import noise_from_stream, noise_statistics
+from ertools.benchmarks.common.epsilon import noise_from_stream, noise_statistics
 from ertools.cli.main import main
 from ertools.errors import ScoringError
 from ertools.samples import fbm3w

@@ -43,7 +43,7 @@ import yaml
 from scipy.spatial.transform import Rotation
 
 from ertools.arrays import F64
-from ertools.samples.scenario import EPOCH_2015, log_name, tol, window, write_answers
+from ertools.simulator.answers import EPOCH_2015, log_name, tol, window, write_answers
 from ertools.simulator.mocap import (
     MocapNoise,
     frame_times,

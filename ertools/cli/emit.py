@@ -1,8 +1,7 @@
-"""What the commands that print a benchmark result share: their output options, and the
-result written as YAML/JSON with its warnings, plots, report and Foxglove file.
-
-The plain output helpers (``note``, ``write_text``, ``dump_json``) are in
-:mod:`ertools.cli.output`, light enough for every command."""
+"""A benchmark result written as the commands that score print it: YAML/JSON with its
+warnings, plots, report and Foxglove file. Their options are :mod:`ertools.cli.result_options`
+(light: the parsers need them); the plain output helpers (``note``, ``write_text``,
+``dump_json``) are in :mod:`ertools.cli.output`."""
 
 from __future__ import annotations
 
@@ -10,61 +9,13 @@ import argparse
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ertools.benchmarks import document
 from ertools.benchmarks.base import BenchmarkResult
 from ertools.benchmarks.common.teams import with_team
-from ertools.cli.options import add_output, add_plots, add_report
+from ertools.benchmarks.document import all_failed
 from ertools.cli.output import dump_json, note, write_text
-from ertools.report.figures import figure_specs, save_figures, save_one_file
-
-if TYPE_CHECKING:  # reached as attributes of the package, imported on first use
-    pass
-
-
-def add_output_options(
-    parser: argparse.ArgumentParser,
-    formats: tuple[str, ...] = ("yaml", "json"),
-    *,
-    report: bool = True,
-    plot: bool = True,
-    foxglove: bool = True,
-    team: bool = True,
-) -> None:
-    """``--format``, ``--out/-o``, ``--team``, and where the benchmark has them
-    ``--report``/``--plot``/``--plots``/``--foxglove``: the vocabulary of
-    :mod:`ertools.cli.options` (old spellings ``--output`` and ``--plot DIR`` still work, with
-    a deprecation note)."""
-    add_output(parser, formats)
-    if report:
-        add_report(
-            parser,
-            "write a self-contained report folder (index.html, score.yaml/json, CSV, plots)",
-        )
-    if plot:
-        add_plots(parser, what="the benchmark's figures (one panel each)")
-    if foxglove:
-        parser.add_argument(
-            "--foxglove",
-            type=Path,
-            metavar="FILE.mcap",
-            help="write what was scored (paths, targets, pairs, errors, states) as an MCAP "
-            "file for Foxglove (docs/foxglove.md)",
-        )
-    if team:
-        parser.add_argument(
-            "--team",
-            metavar="NAME",
-            help="the team that ran it, kept in the result and report (default: a name in the "
-            "state payloads, else the rockin_logger log name <BENCHMARK>_<DATE>_<NAME>.bag, "
-            "else the FBM2H transform's team); fbm2h --transforms DIR: DIR/transform-NAME.yaml",
-        )
-
-
-# One definition (ertools.benchmarks.document), shared with rescore; the score commands
-# import it from here.
-all_failed = document.all_failed
 
 
 def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[Path]) -> int:
@@ -109,6 +60,8 @@ def write_plots_option(result: Any, args: argparse.Namespace) -> None:
     if getattr(args, "plot", None) is None and getattr(args, "plots", None) is None:
         return
     scored = getattr(result, "recomputed", None)
+    from ertools.report.figures import figure_specs  # lazy: the charts, 40 ms; --plot only
+
     write_plots(figure_specs(scored if scored is not None else result), args)
 
 
@@ -117,7 +70,7 @@ def write_foxglove_option(result: Any, args: argparse.Namespace, inputs: list[Pa
     path: Path | None = getattr(args, "foxglove", None)
     if path is None:
         return
-    from ertools.report.foxglove import write_foxglove  # lazy: protobuf, 20-75 ms
+    from ertools.report.foxglove.write import write_foxglove  # lazy: protobuf, 20-75 ms
 
     written = write_foxglove(result, path, inputs=inputs)
     note(f"wrote {written.path} ({written.messages} messages on {len(written.counts)} topics)")
@@ -125,6 +78,8 @@ def write_foxglove_option(result: Any, args: argparse.Namespace, inputs: list[Pa
 
 def write_plots(specs: Sequence[Any], args: argparse.Namespace) -> list[Path]:
     """Write ``--plot FILE`` and ``--plots DIR`` of ``specs`` (:class:`FigureSpec`), when asked."""
+    from ertools.report.figures import save_figures, save_one_file  # lazy: 40 ms
+
     written: list[Path] = []
     one: Path | None = getattr(args, "plot", None)
     if one is not None:

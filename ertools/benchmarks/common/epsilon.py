@@ -1,4 +1,5 @@
-"""Mocap noise statistics of a stationary marker set (seed 7.3.13, mocap_noise_statistics).
+"""Epsilon, the mocap noise of a stationary marker set (seed 7.3.13, mocap_noise_statistics):
+what ``ertools noise`` reports, and what every benchmark's intervals measure on its own GT.
 
 As the 2015 tool did: the distance in (x, y) between consecutive measurements, binned in
 0.15 mm quanta; two consecutive identical poses count as one *lost* sample (Motive repeats the

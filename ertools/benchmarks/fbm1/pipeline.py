@@ -36,6 +36,7 @@ from ertools.benchmarks.fbm1.answers import (
     parse_answer_payload,
 )
 from ertools.benchmarks.fbm1.config import BENCHMARKS, BodySources, Fbm1Options
+from ertools.benchmarks.fbm1.formula import MAX_POSE_ERROR_2015, names_match, pose_errors, totals
 from ertools.benchmarks.fbm1.gt import (
     GroundTruthError,
     board_motion,
@@ -54,7 +55,6 @@ from ertools.benchmarks.fbm1.rules import (
     RULE_UNSCOREABLE,
 )
 from ertools.benchmarks.fbm1.runs import Fbm1Run, RunsFound
-from ertools.benchmarks.fbm1.score import MAX_POSE_ERROR_2015, names_match, pose_errors, totals
 from ertools.benchmarks.fbm1.validity import body_mask, gt_validity
 from ertools.configs._yaml import parse_payload
 from ertools.configs.items import Item, ItemList
@@ -64,7 +64,7 @@ from ertools.progress import Reporter, current
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import NS_PER_S
 
-log = logging.getLogger("ertools.benchmarks.fbm1.benchmark")
+log = logging.getLogger("ertools.benchmarks.fbm1.pipeline")
 
 
 def _resolve_item(run: Fbm1Run, items: ItemList) -> tuple[Item, list[str]]:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 
 from ertools.benchmarks.fbm1.result import Fbm1Result, Fbm1RunResult
-from ertools.report.foxglove.messages import (
+from ertools.views.foxglove import (
     BLUE,
     ERROR,
     GREEN,
