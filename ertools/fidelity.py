@@ -37,7 +37,6 @@ from ertools.atomic import write_text
 # Modules that declare Rule constants; the catalogue is what these hold, in this order.
 RULE_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm1.rules",
-    "ertools.benchmarks.fbm1.acquire",
     "ertools.benchmarks.fbm2h.rules",
     "ertools.benchmarks.fbm3w.rules",
     "ertools.benchmarks.trajectory.rules",

@@ -8,8 +8,9 @@ from pathlib import Path
 import pytest
 import yaml
 
-from ertools.benchmarks.fbm1.pipeline import score_fbm1_bag
+from ertools.benchmarks import registry
 from ertools.benchmarks.fbm3w.benchmark import score_fbm3w
+from ertools.benchmarks.scoring import score_execution
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.progress import reporting
 
@@ -57,7 +58,7 @@ def test_fbm1_reports_reads_then_runs() -> None:
     assert runs == 10
     rec = Recorder()
     with reporting(rec):
-        score_fbm1_bag([bag], S / "fbm1h/fbm1h.yaml")
+        score_execution(registry.get("fbm1h"), [bag], {"items": S / "fbm1h/fbm1h.yaml"})
     _check(rec, bag, runs, "/fbm1h/origin/pose")
 
 

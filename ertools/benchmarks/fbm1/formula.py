@@ -28,41 +28,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from ertools.benchmarks.fbm1.config import ScoreRules
 from ertools.timeutil import ns_to_s
 
 # The @Home nodes played at most this many runs; the 2016-17 one divided the accuracies by it.
 BENCHMARK_RUNS_HOME = 10
 # The 2015 "maximum pose error": the diagonal of a 1 m x 1 m table.
 MAX_POSE_ERROR_2015 = math.sqrt(2.0)
-
-
-@dataclass(frozen=True)
-class ScoreRules:
-    """Which node behaviours to reproduce (all False: ertools' rules; see the module doc)."""
-
-    clip_above_diagonal: bool = False
-    single_wrap: bool = False
-    exact_names: bool = False
-    count_aborted: bool = False
-    accuracy_over_10: bool = False
-    # a run whose ground truth has no valid mocap sample is scored from it (the nodes scored
-    # what tf gave them) instead of being unscoreable
-    score_unscoreable: bool = False
-
-    @staticmethod
-    def node_2015() -> ScoreRules:
-        """The 2015 nodes (``fbm1h`` and ``fbm1w``): divisor ``runs`` for every total."""
-        return ScoreRules(True, True, True, True, False, score_unscoreable=True)
-
-    @staticmethod
-    def node_2016() -> ScoreRules:
-        """The 2016 @Home node (40ba68b): as 2015, accuracies divided by 10."""
-        return ScoreRules(True, True, True, True, True, score_unscoreable=True)
-
-    @staticmethod
-    def node_2017() -> ScoreRules:
-        """The 2017 @Home node (89dfa75): as 2016, the translation term clipped at 1 m."""
-        return ScoreRules(False, True, True, True, True, score_unscoreable=True)
 
 
 @dataclass(frozen=True)

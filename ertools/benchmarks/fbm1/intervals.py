@@ -54,13 +54,9 @@ from ertools.benchmarks.common.uncertainty import (
     monte_carlo,
     z_value,
 )
-from ertools.benchmarks.fbm1.formula import MAX_POSE_ERROR_2015, ScoreRules
-from ertools.benchmarks.fbm1.gt import (
-    GroundTruthError,
-    GtOptions,
-    board_in_table,
-    measure_ground_truth,
-)
+from ertools.benchmarks.fbm1.config import GtOptions, ScoreRules
+from ertools.benchmarks.fbm1.formula import MAX_POSE_ERROR_2015
+from ertools.benchmarks.fbm1.gt import GroundTruthError, board_in_table, measure_ground_truth
 from ertools.benchmarks.fbm1.result import Fbm1RunResult
 from ertools.benchmarks.fbm1.runs import Fbm1Run
 from ertools.configs.items import IDENTITY_ROT, IDENTITY_TRANS, Item

@@ -3,13 +3,13 @@
 For each run the referee placed the reference board carrying one item on the FBM1 table; the
 robot answered the item's class, instance and pose (x, y in metres, theta in degrees) in the
 table frame. The ground truth is T_origin_item = T_world_origin^-1 * T_world_board *
-T_board_item (``fbm1_gt``); the 2015 rules are in ``fbm1_score``; runs come from the state
-topics (``fbm1_runs``); answers from the Client payloads or a results file (``fbm1_answers``).
+T_board_item (``gt``); the seed's arithmetic is in ``formula``; runs come from the state
+topics (``runs``); answers from the Client payloads or a results file (``answers``).
 
-``score_fbm1`` is the pure computation on streams; ``score_fbm1_bag`` reads a log through
-:mod:`ertools.io` (``fbm1_logs``: ``load``, ``locate_runs``) and calls it. Both benchmarks
-share everything: ``benchmark`` only decides where the item's name is read first and which
-nodes exist to reproduce.
+The stages are :func:`load`, :func:`find_runs` and :func:`score_runs` (the benchmark's slots);
+:func:`score_fbm1` is the pure computation on streams they end in. Both benchmarks share
+everything: ``benchmark`` only decides where the item's name is read first and which nodes
+exist to reproduce.
 
 Three references (``Fbm1Options.for_rules``): ``ertools`` (the default), ``2015`` (the 2015
 nodes ``scripts/fbm1h`` and ``scripts/fbm1w``) and ``2016`` (the later @Home node, used in
@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Sequence
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -35,7 +34,7 @@ from ertools.benchmarks.fbm1.answers import (
     answer_from_mapping,
     parse_answer_payload,
 )
-from ertools.benchmarks.fbm1.config import BENCHMARKS, BodySources, Fbm1Options
+from ertools.benchmarks.fbm1.config import BENCHMARKS, Fbm1Options
 from ertools.benchmarks.fbm1.formula import MAX_POSE_ERROR_2015, names_match, pose_errors, totals
 from ertools.benchmarks.fbm1.gt import (
     GroundTruthError,
@@ -43,7 +42,7 @@ from ertools.benchmarks.fbm1.gt import (
     measure_ground_truth,
 )
 from ertools.benchmarks.fbm1.intervals import fbm1_intervals
-from ertools.benchmarks.fbm1.logs import Fbm1Logs, Fbm1Runs, load, locate_runs
+from ertools.benchmarks.fbm1.logs import TF_LOOKUPS, Fbm1Logs, Fbm1Runs, read_body, read_logs
 from ertools.benchmarks.fbm1.result import Fbm1Result, Fbm1RunResult
 from ertools.benchmarks.fbm1.rules import (
     RULE_ABORTED,
@@ -55,11 +54,14 @@ from ertools.benchmarks.fbm1.rules import (
     RULE_UNSCOREABLE,
 )
 from ertools.benchmarks.fbm1.runs import Fbm1Run, RunsFound
+from ertools.benchmarks.fbm1.runs import find_runs as runs_in_states
 from ertools.benchmarks.fbm1.validity import body_mask, gt_validity
 from ertools.configs._yaml import parse_payload
 from ertools.configs.items import Item, ItemList
-from ertools.errors import ConfigError, ScoringError, SegmentationError
+from ertools.errors import ConfigError, ScoringError, SegmentationError, TopicError
 from ertools.fidelity import Deviation
+from ertools.io.clock import check_header_clock
+from ertools.io.reader import read_tf
 from ertools.progress import Reporter, current
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import NS_PER_S
@@ -476,7 +478,68 @@ def _parse_logged(payload: str | None) -> dict[str, Any] | None:
     return data if isinstance(data, dict) else None
 
 
-def score_found(logs: Fbm1Logs, runs: Fbm1Runs, options: Fbm1Options) -> Fbm1Result:
+def load(paths: Sequence[Path], options: Fbm1Options) -> Fbm1Logs:
+    """The item list, the answers file and the state topics (:func:`logs.read_logs`)."""
+    return read_logs(paths, options)
+
+
+def find_runs(logs: Fbm1Logs, options: Fbm1Options) -> Fbm1Runs:
+    """The runs from the states, then the table and board poses around them.
+
+    Raises:
+        SegmentationError: no Client states and no results file (the answers are unknown).
+        TopicError: a body's poses are nowhere.
+        ClockError: header-stamped poses on another clock than the state messages.
+    """
+    ns = options.benchmark
+    plist = list(logs.paths)
+    states = logs.states
+    assert states.bmbox is not None
+    found = runs_in_states(
+        states.bmbox,
+        states.refbox,
+        states.client,
+        benchmark=ns,
+        items_order=list(options.items_order) if options.items_order is not None else None,
+        t0_ns=logs.t0_ns,
+        exact_2015=options.exact_end_payloads,
+    )
+    if states.client is None and logs.results is None:
+        # Scoring every run as unanswered would be a silent wrong score.
+        raise SegmentationError(
+            f"no /{ns}/client_state in the log: the robot's answers are unknown; "
+            "give them with --results FILE",
+            path=plist[0],
+        )
+    if not found.runs:
+        # nothing to score; a bare min() below would fail as a bug
+        raise SegmentationError(
+            f"/{ns}/bmbox_state: no run found (the benchmarking box sent no goal in "
+            f"{len(states.bmbox.t_ns)} state messages)",
+            path=plist[0],
+        )
+    # Read the bodies only around the runs (windowed reads touch only those chunks).
+    pad = round((options.gt.max_window_s + options.gt.max_gap_s + 2.0) * NS_PER_S)
+    lo = min(r.start_ns for r in found.runs) - pad
+    hi = max(r.end_ns for r in found.runs) + pad
+    src = options.sources
+    tf_first = options.gt.method in TF_LOOKUPS
+    origin = read_body(plist, src.origin, f"/{ns}/origin/pose", "origin", (lo, hi), tf_first)
+    board = read_body(plist, src.board, f"/{ns}/ref_board/pose", "ref_board", (lo, hi), tf_first)
+
+    for body, source in ((origin, src.origin), (board, src.board)):
+        if source is None or source.time_source == "header":
+            check_header_clock(plist, body, "state messages")
+    item_tf = None
+    if options.gt.method != "window":
+        try:
+            item_tf = read_tf(plist, "ref_board", "item", start_ns=lo, end_ns=hi)
+        except TopicError:
+            item_tf = None  # not logged: the state messages give the moments
+    return Fbm1Runs(found, origin, board, item_tf)
+
+
+def score_runs(logs: Fbm1Logs, runs: Fbm1Runs, options: Fbm1Options) -> Fbm1Result:
     """Score every run found (:func:`score_fbm1`), with the provenance of the inputs."""
     gt = options.gt
     provenance = Provenance(
@@ -508,42 +571,3 @@ def score_found(logs: Fbm1Logs, runs: Fbm1Runs, options: Fbm1Options) -> Fbm1Res
         item_tf=runs.item_tf,
         progress=current(),
     )
-
-
-def score_fbm1_bag(
-    paths: Sequence[str | Path],
-    items_path: str | Path,
-    *,
-    options: Fbm1Options | None = None,
-    results_path: str | Path | None = None,
-    items_order: Sequence[str] | None = None,
-    sources: BodySources | None = None,
-) -> Fbm1Result:
-    """Recompute an FBM1 score from a log (one bag or a split log's files): load -> locate
-    the runs -> score them.
-
-    Args:
-        paths: the log file(s).
-        items_path: the item list (Listing 9).
-        options: benchmark and rules.
-        results_path: answers kept outside the log (replaces the Client payloads it covers).
-        items_order: item ids or instances per run (overrides the payloads).
-        sources: origin/board pose sources; the 2015 topics ``/<ns>/origin/pose`` and
-            ``/<ns>/ref_board/pose`` (falling back to the /tf frames) by default.
-
-    Raises:
-        BagError, TopicError: unreadable log, missing state or body topics.
-        ConfigError: bad item list or results file.
-        SegmentationError: no run in the log.
-    """
-
-    opts = replace(
-        options or Fbm1Options(),
-        items=Path(items_path),
-        results=None if results_path is None else Path(results_path),
-        items_order=None if items_order is None else tuple(items_order),
-        sources=sources or BodySources(),
-    )
-    plist = [Path(p) for p in paths]
-    logs = load(plist, opts)
-    return score_found(logs, locate_runs(logs, opts), opts)

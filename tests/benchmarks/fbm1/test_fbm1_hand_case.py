@@ -19,9 +19,7 @@ import yaml
 from scipy.spatial.transform import Rotation
 
 from ertools.benchmarks.base import BenchmarkResult
-from ertools.benchmarks.fbm1.config import Fbm1Options
-from ertools.benchmarks.fbm1.formula import ScoreRules
-from ertools.benchmarks.fbm1.gt import GtOptions
+from ertools.benchmarks.fbm1.config import Fbm1Options, GtOptions, ScoreRules
 from ertools.benchmarks.fbm1.pipeline import score_fbm1
 from ertools.benchmarks.fbm1.result import Fbm1Result
 from ertools.benchmarks.fbm1.runs import find_runs

@@ -8,8 +8,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from ertools.benchmarks.fbm1.config import ScoreRules
 from ertools.benchmarks.fbm1.formula import (
-    ScoreRules,
     names_match,
     pose_errors,
     rot_term,

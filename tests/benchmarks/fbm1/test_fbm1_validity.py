@@ -7,8 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ertools.benchmarks.fbm1.config import Fbm1Options
-from ertools.benchmarks.fbm1.formula import ScoreRules
+from ertools.benchmarks.fbm1.config import Fbm1Options, ScoreRules
 from ertools.benchmarks.fbm1.pipeline import score_fbm1
 from ertools.benchmarks.fbm1.runs import find_runs
 from ertools.configs._yaml import parse_yaml
