@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from archscan import ROOT, outside_benchmark_modules, plant, ratchet
+from tests.architecture.archscan import ROOT, outside_benchmark_modules, plant, ratchet
 
 ALLOWED = frozenset(
     {

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from archscan import ROOT, cycles, module_graph, plant, ratchet
+from tests.architecture.archscan import ROOT, cycles, module_graph, plant, ratchet
 
 # Today's modules in a cycle (all in one, closed through the root's TYPE_CHECKING import of
 # ertools.api and the modules that import the root): the list only shrinks.

@@ -8,7 +8,7 @@ import importlib
 import re
 from pathlib import Path
 
-from archscan import ROOT, dotted_references, modules, ratchet
+from tests.architecture.archscan import ROOT, dotted_references, modules, ratchet
 
 # Names in the ertools namespace that are data, not Python: the Foxglove schemas
 # (`ertools.Fbm3wRun`: capitalised, as no module is) and the MCAP metadata records of

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from archscan import ROOT, hidden_imports, plant, ratchet
+from tests.architecture.archscan import ROOT, hidden_imports, plant, ratchet
 
 # legacy.py (the old benchmark record's "module:function" texts) goes when the last benchmark
 # is converted to the protocols (S8b); fidelity's rule modules and samples' scenarios become

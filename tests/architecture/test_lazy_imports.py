@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from archscan import ROOT, plant, ratchet, unexplained_lazy_imports
+from tests.architecture.archscan import ROOT, plant, ratchet, unexplained_lazy_imports
 
 ALLOWED: frozenset[str] = frozenset()
 

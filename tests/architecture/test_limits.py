@@ -7,11 +7,11 @@ from __future__ import annotations
 import re
 
 import pytest
-from archscan import ROOT
 
 from ertools.benchmarks.base import Input, resolve_values
 from ertools.errors import UsageError
 from ertools.timeutil import MAX_SECONDS, NS_PER_S
+from tests.architecture.archscan import ROOT
 
 LITERAL = re.compile(r"\b4\.6e9\b|\b4_600_000_000\b|\b4600000000\b")
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from archscan import ROOT, facade_packages, plant, ratchet
+from tests.architecture.archscan import ROOT, facade_packages, plant, ratchet
 
 # The list only shrinks.
 ALLOWED: frozenset[str] = frozenset()

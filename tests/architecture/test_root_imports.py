@@ -11,7 +11,8 @@ import sys
 from pathlib import Path
 
 import pytest
-from archscan import ROOT, plant, ratchet, root_imports
+
+from tests.architecture.archscan import ROOT, plant, ratchet, root_imports
 
 LINT_IMPORTS = Path(sys.executable).with_name("lint-imports")
 

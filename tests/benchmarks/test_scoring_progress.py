@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 import yaml
 
 from ertools.benchmarks import registry
@@ -12,6 +13,8 @@ from ertools.benchmarks.fbm3w.pipeline import score_fbm3w
 from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.benchmarks.scoring import score_execution
 from ertools.progress import reporting
+
+pytestmark = pytest.mark.slow
 
 S = Path(__file__).resolve().parents[2] / "sample_bags"
 

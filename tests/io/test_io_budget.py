@@ -25,7 +25,22 @@ import lz4.frame
 import pytest
 import yaml
 import zstandard
-from hostile_files import (
+from mcap.reader import make_reader
+from mcap.writer import CompressionType
+from mcap.writer import Writer as McapWriter
+from rosbags.rosbag2 import Writer as Writer2
+from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
+
+from ertools.cli.main import main
+from ertools.errors import BagError
+from ertools.io import budget
+from ertools.io.files import open_bag
+from ertools.io.info import describe
+from ertools.io.reader import read_messages, read_poses, read_states
+from ertools.io.summary import summary as bag_summary
+from tests.helpers.bagmaker import build, typestore, write
+from tests.helpers.scene import Scene
+from tests.io.hostile_files import (
     McapChannel,
     McapChunk,
     Ros1Chunk,
@@ -40,21 +55,6 @@ from hostile_files import (
     u32,
     zstd_frame,
 )
-from io_bagmaker import build, typestore, write
-from io_scene import Scene
-from mcap.reader import make_reader
-from mcap.writer import CompressionType
-from mcap.writer import Writer as McapWriter
-from rosbags.rosbag2 import Writer as Writer2
-from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
-
-from ertools.cli.main import main
-from ertools.errors import BagError
-from ertools.io import budget
-from ertools.io.files import open_bag
-from ertools.io.info import describe
-from ertools.io.reader import read_messages, read_poses, read_states
-from ertools.io.summary import summary as bag_summary
 
 T0 = 1_448_020_800 * 10**9  # the 2015 sample logs' start
 MiB = 1 << 20
@@ -111,6 +111,7 @@ def _ros1_bomb(path: Path, extra: int, compression: str = "bz2") -> Path:
     return ros1_bag(path, [conn], [chunk])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("compression", ["bz2", "lz4"])
 def test_a_ros1_chunk_that_inflates_past_its_declared_size_is_refused_there(
     tmp_path: Path, compression: str
@@ -137,6 +138,7 @@ def test_a_ros1_chunk_that_inflates_past_its_declared_size_is_refused_there(
         assert peak[0] < 16 * MiB, f"peak {peak[0] / MiB:.0f} MiB"
 
 
+@pytest.mark.slow
 def test_info_on_a_bz2_bomb_is_one_line_and_small_in_a_fresh_process(tmp_path: Path) -> None:
     """The whole command in its own process: its peak resident memory stays near the
     interpreter's (about 40 MB here), not the gigabyte the bomb holds. VmHWM, not ru_maxrss:
@@ -300,6 +302,7 @@ def test_the_record_header_budget_just_under_and_just_over(
 # --- MCAP: a valid 16 MB chunk reads, a 2 GiB one is refused without inflating it ------------
 
 
+@pytest.mark.slow
 def test_a_valid_mcap_with_a_16_mb_chunk_reads(tmp_path: Path, scene: Scene) -> None:
     """Finding 13: one message of 16 MB (a 4000 x 4000 occupancy grid's data, zeros: zstd
     stores it in a few hundred bytes, 30,000 times smaller) was "damaged chunk record".
@@ -386,6 +389,7 @@ def test_an_mcap_chunk_whose_frame_says_more_than_its_record_stops_there(
 # --- rosbag2: metadata.yaml and storage files compressed whole ---------------------------------
 
 
+@pytest.mark.slow
 def test_metadata_size_and_nesting_just_under_and_just_over(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, scene: Scene
 ) -> None:
@@ -412,6 +416,7 @@ def test_metadata_size_and_nesting_just_under_and_just_over(
     _refusal(lambda: bag_summary(good), "r2", "nested deeper")
 
 
+@pytest.mark.slow
 def test_a_file_compressed_storage_copy_within_the_budget(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, scene: Scene
 ) -> None:

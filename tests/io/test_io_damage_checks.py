@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import logging
 import struct
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -16,20 +15,15 @@ import pytest
 from ertools.errors import BagError
 from ertools.io.info import describe
 from ertools.io.reader import read_poses
-
-REPO = Path(__file__).resolve().parents[2]
-if str(REPO) not in sys.path:
-    sys.path.insert(0, str(REPO))
-
-from fuzz.judge import (  # noqa: E402
+from fuzz.judge import (
     Outcome,
     mcap_crc_evidence,
     misread,
     ros1_index_evidence,
     ros1_record_summary,
 )
-from fuzz.mutate import layout  # noqa: E402
-from fuzz.seeds import N_POSES, POSE_TOPIC, T0_NS, seed_bytes, suffix  # noqa: E402
+from fuzz.mutate import layout
+from fuzz.seeds import N_POSES, POSE_TOPIC, T0_NS, seed_bytes, suffix
 
 DT = 33_333_337  # ns between the seeds' poses (1/30 s, rounded as the formula does)
 TRUE_T = T0_NS + np.arange(N_POSES, dtype=np.int64) * DT

@@ -2,102 +2,30 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import numpy as np
 import pytest
-from mcap.reader import make_reader
 from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Writer
 
-from ertools.io.bagfile import BagFile, RawRecord
-from ertools.io.bulk import try_fast_batch
-from ertools.io.decode.posebatch import PoseBatch
 from ertools.io.decode.typestore import Deserializer
-from ertools.io.files import RosbagsFile, open_bag
-from ertools.io.formats import detect_format, find_bags
-from ertools.io.model import POSE_TYPES, Conn
-from ertools.io.reader import _bulk_states, read_poses, read_states, read_tf, slow_pose_batch
+from ertools.io.files import open_bag
+from ertools.io.formats import find_bags
+from ertools.io.model import POSE_TYPES
+from ertools.io.reader import _bulk_states, read_poses, read_states, read_tf
 from ertools.io.reader import topics as bag_topics
 from ertools.io.summary import summary
-
-POSE_TOPICS = (
-    "/fbm3w/robot_at_work/pose",
-    "/fbm3w/robot_at_work/pose2d",
-    "/tf",
-    "/fbm3w/tfs",
-    "/odom",
+from tests.helpers.fastpath import (
+    POSE_TOPICS,
+    assert_same,
+    fast_batch,
+    reference_bag,
+    reference_batch,
 )
 
 
-class LibraryMcap(BagFile):
-    """A standalone MCAP file whose messages the ``mcap`` library reads (ertools reads them
-    through its own indexes: the reference stays independent of them). A file ertools reads
-    record by record (no usable index) is read so here too."""
-
-    def __init__(self, path: Path) -> None:
-        self.inner = open_bag(path)
-        self.path, self.format = path, "mcap"
-        self.connections = self.inner.connections
-
-    def raw(
-        self, conns: Sequence[Conn], start_ns: int | None = None, end_ns: int | None = None
-    ) -> Iterator[RawRecord]:
-        if getattr(self.inner, "scanned", False):
-            yield from self.inner.raw(conns, start_ns, end_ns)
-            return
-        by_id = {c.id: c for c in conns}
-        with self.path.open("rb") as f:
-            for _schema, channel, message in make_reader(f).iter_messages(
-                topics=sorted({c.topic for c in conns}),
-                starting_at=start_ns,
-                ending_at=end_ns,
-                log_time_order=True,
-            ):
-                if channel.id in by_id:
-                    yield by_id[channel.id], int(message.log_time), bytes(message.data)
-
-    def close(self) -> None:
-        self.inner.close()
-
-
-def _reference_bag(path: Path) -> BagFile:
-    fmt = detect_format(path)
-    if fmt == "mcap":
-        return LibraryMcap(path)
-    return RosbagsFile(path, fmt) if fmt != "ros1-active" else open_bag(path)
-
-
-def reference_batch(
-    path: Path, topic: str, lo: int | None = None, hi: int | None = None
-) -> PoseBatch:
-    """rosbags' own reader and deserializer (rosbag1/rosbag2 Reader), or for files rosbags
-    does not open their per-message raw records deserialized by rosbags: standalone MCAP
-    read by the ``mcap`` library, unindexed .bag.active by ertools' scan."""
-
-    with _reference_bag(path) as bag:
-        return slow_pose_batch(bag, bag.topic_conns(topic), lo, hi)
-
-
-def assert_same(fast: PoseBatch, ref: PoseBatch) -> None:
-    assert len(fast) == len(ref)
-    np.testing.assert_array_equal(fast.t_record, ref.t_record)
-    np.testing.assert_array_equal(fast.t_header, ref.t_header)
-    # Bit for bit: compare the float64 bit patterns, not values within a tolerance.
-    np.testing.assert_array_equal(fast.xyz.view(np.int64), ref.xyz.view(np.int64))
-    np.testing.assert_array_equal(fast.quat_xyzw.view(np.int64), ref.quat_xyzw.view(np.int64))
-    np.testing.assert_array_equal(fast.frame_names(), ref.frame_names())
-    np.testing.assert_array_equal(fast.child_names(), ref.child_names())
-
-
-def fast_batch(path: Path, topic: str, lo: int | None = None, hi: int | None = None) -> PoseBatch:
-    with open_bag(path) as bag:
-        batch = try_fast_batch(bag, bag.topic_conns(topic), lo, hi)
-    assert batch is not None, f"fast path did not apply to {path}:{topic}"
-    return batch
-
-
+@pytest.mark.slow_cases("rosbag2-mcap-/odom", "rosbag2-mcap-/tf", "rosbag2-sqlite3-/odom")
 @pytest.mark.parametrize("topic", POSE_TOPICS)
 def test_fast_equals_rosbags(scene_bag: tuple[str, Path], topic: str) -> None:
     _fmt, path = scene_bag
@@ -113,6 +41,7 @@ def _sample_bags() -> list[Path]:
     return list(find_bags([folder]).bags) if folder.is_dir() else []
 
 
+@pytest.mark.slow
 def test_fast_equals_rosbags_on_sample_bags() -> None:
     bags = _sample_bags()
     if not bags:
@@ -126,6 +55,7 @@ def test_fast_equals_rosbags_on_sample_bags() -> None:
     assert checked > 0
 
 
+@pytest.mark.slow
 @pytest.mark.real
 def test_fast_equals_rosbags_on_real_bag() -> None:
     if not REAL_BAG.exists():
@@ -134,6 +64,7 @@ def test_fast_equals_rosbags_on_real_bag() -> None:
         assert_same(fast_batch(REAL_BAG, topic), reference_batch(REAL_BAG, topic))
 
 
+@pytest.mark.slow
 @pytest.mark.real
 def test_real_bag_end_to_end() -> None:
     """Topics, counts, start/end and first pose, checked against rosbags' AnyReader directly."""
@@ -178,7 +109,7 @@ STATE_TOPICS = ("/fbm3w/bmbox_state", "/fbm3w/refbox_state")
 def reference_states(path: Path, topic: str) -> tuple[list[int], list[int], list[str]]:
     """States deserialized one by one by rosbags' own readers."""
 
-    with _reference_bag(path) as bag:
+    with reference_bag(path) as bag:
         conns = bag.topic_conns(topic)
         deser = Deserializer(conns, path)
         msgs = [(t, deser(raw, c)) for c, t, raw in bag.raw(conns)]
@@ -195,6 +126,7 @@ def test_bulk_states_equal_rosbags(scene_bag: tuple[str, Path], topic: str) -> N
     assert bulk[0].tolist() == t and bulk[1].tolist() == state and bulk[2] == payload
 
 
+@pytest.mark.slow
 def test_bulk_states_on_sample_and_real_bags() -> None:
     bags = _sample_bags()
     if not bags:

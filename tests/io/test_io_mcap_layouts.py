@@ -15,8 +15,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-from io_bagmaker import write
-from io_scene import Scene
 from mcap.writer import CompressionType, IndexType, Writer
 
 from ertools.cli.main import main
@@ -24,6 +22,8 @@ from ertools.io.mcap import scan as mcap_scan
 from ertools.io.reader import read_poses, read_states
 from ertools.io.summary import record_times
 from ertools.io.summary import summary as bag_summary
+from tests.helpers.bagmaker import write
+from tests.helpers.scene import Scene
 
 POSE = "/fbm3w/robot_at_work/pose"
 BMBOX = "/fbm3w/bmbox_state"
@@ -124,6 +124,9 @@ def check_reads(path: Path, scene: Scene) -> None:
     np.testing.assert_array_equal(record_times(path)[POSE], scene.t_rec)
 
 
+@pytest.mark.slow_cases(
+    "channels-only-in-chunks", "no-chunk-indexes", "no-message-indexes", "schemas-only-in-chunks"
+)
 @pytest.mark.parametrize("layout", LAYOUTS)
 def test_layout_read_exactly(
     layout: str,
@@ -148,6 +151,7 @@ def test_layout_read_exactly(
     assert bag["messages"] == len(scene.spec.msgs)
 
 
+@pytest.mark.slow
 def test_no_summary_section(
     tmp_path: Path, scene: Scene, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -254,6 +258,7 @@ def test_scan_finds_every_record(
     assert len(kept) == int((found.channel_id == 1).sum())
 
 
+@pytest.mark.slow
 def test_verbose_says_why_a_file_is_read_record_by_record(
     tmp_path: Path, scene: Scene, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -266,6 +271,7 @@ def test_verbose_says_why_a_file_is_read_record_by_record(
     assert "record by record" not in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_rosbag2_mcap_storage_without_summary(tmp_path: Path, scene: Scene) -> None:
     folder = write(tmp_path / "r2", "rosbag2-mcap", scene.spec)
     (storage,) = folder.glob("*.mcap")

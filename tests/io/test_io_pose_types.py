@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import struct
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -21,20 +20,17 @@ from rosbags.highlevel import AnyReader
 from ertools.benchmarks.trajectory.logs import read_robot
 from ertools.cli.main import main
 from ertools.errors import TopicError
-from ertools.io.info import describe
-from ertools.io.model import short_msgtype
-
-sys.path.insert(0, str(Path(__file__).parent))
-
-from io_bagmaker import FORMATS, Spec, bag_name, write
-from test_io_fastpath import assert_same, fast_batch, reference_batch
-
 from ertools.io.decode.fast import decode
 from ertools.io.decode.uniform import decode_uniform, layout_of
-from ertools.io.model import POSE_TYPES, PoseSource
+from ertools.io.info import describe
+from ertools.io.model import POSE_TYPES, PoseSource, short_msgtype
 from ertools.io.reader import read_pose_source, read_poses
 from ertools.io.reader import topics as bag_topics
 from ertools.io.summary import summary as bag_summary
+from tests.helpers.bagmaker import FORMATS, Spec, bag_name, write
+from tests.helpers.fastpath import assert_same, fast_batch, reference_batch
+
+pytestmark = pytest.mark.slow
 
 T0 = 1_700_000_000_000_000_000
 N = 40

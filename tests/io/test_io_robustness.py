@@ -8,12 +8,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_bagmaker import bag_name, write
-from io_scene import Scene
 
 from ertools.errors import ErtoolsError
 from ertools.io.info import describe
 from ertools.io.reader import read_poses, read_states, read_tf
+from tests.helpers.bagmaker import bag_name, write
+from tests.helpers.scene import Scene
+
+pytestmark = pytest.mark.slow
 
 
 @pytest.mark.parametrize("fmt", ["ros1", "ros1-lz4", "mcap-cdr", "rosbag2-sqlite3"])

@@ -16,11 +16,8 @@ from typing import Any
 
 import numpy as np
 import pytest
-from io_bagmaker import Spec, write
 from rosbags.rosbag1 import Reader, Writer
 from rosbags.typesys import Stores, get_typestore
-from stderr_text import error_messages
-from test_io_fastpath import REAL_BAG, _sample_bags
 
 from ertools import caches
 from ertools.cli.main import main
@@ -29,6 +26,9 @@ from ertools.io.ros1 import layout
 from ertools.io.ros1.check import check_ros1, rebuild_layout
 from ertools.io.ros1.layout import scan_layout
 from ertools.io.summary import summary as bag_summary
+from tests.helpers.bagmaker import Spec, write
+from tests.helpers.stderr_text import error_messages
+from tests.io.test_io_fastpath import REAL_BAG, _sample_bags
 
 T0 = 1_445_609_740_000_000_000
 DT = 10_000_000
@@ -125,6 +125,7 @@ def test_sound_bags_check_clean(tmp_path: Path, fmt: str) -> None:
     assert check_ros1(two_topic_bag(tmp_path / "b.bag", fmt)) == []
 
 
+@pytest.mark.slow
 def test_sample_and_real_bags_check_clean() -> None:
 
     # (the samples include deliberately truncated bags: those already fail the summary)

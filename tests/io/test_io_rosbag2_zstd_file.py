@@ -20,6 +20,8 @@ from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
 from ertools.simulator.writer import BagWriter
 
+pytestmark = pytest.mark.slow
+
 BIN = Path(sys.executable).parent
 NS = 1_000_000_000
 # What differs between a bag and its compressed copy, by construction.

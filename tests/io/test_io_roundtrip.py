@@ -7,8 +7,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_bagmaker import Spec, bag_name, write
-from io_scene import DT, T0, Scene, make_scene
 from rosbags.rosbag1 import Writer
 
 from ertools.errors import BagError, TopicError
@@ -24,6 +22,8 @@ from ertools.io.reader import (
 from ertools.io.reader import topics as bag_topics
 from ertools.io.summary import summary as bag_summary
 from ertools.states import Machine
+from tests.helpers.bagmaker import Spec, bag_name, write
+from tests.helpers.scene import DT, T0, Scene, make_scene
 
 POSE = "/fbm3w/robot_at_work/pose"
 
@@ -78,6 +78,7 @@ def test_tf_direct_and_chain(scene: Scene, scene_bag: tuple[str, Path]) -> None:
     )
 
 
+@pytest.mark.slow_cases("rosbag2-mcap")
 def test_states_decode_from_stored_definitions(scene: Scene, scene_bag: tuple[str, Path]) -> None:
     _, path = scene_bag
     states = read_benchmark_states(path, "fbm3w")
@@ -91,6 +92,7 @@ def test_states_decode_from_stored_definitions(scene: Scene, scene_bag: tuple[st
     np.testing.assert_array_equal(states.refbox.t_ns, scene.t_rec[idx] + 1)
 
 
+@pytest.mark.slow_cases("rosbag2-mcap", "rosbag2-sqlite3")
 def test_window_and_messages(scene: Scene, scene_bag: tuple[str, Path]) -> None:
     _, path = scene_bag
     lo, hi = int(scene.t_rec[10]), int(scene.t_rec[20])
@@ -124,6 +126,7 @@ def test_unknown_topic_lists_pose_topics(scene_bag: tuple[str, Path]) -> None:
         read_poses(path, "/chatter")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["ros1", "mcap-cdr", "rosbag2-sqlite3"])
 def test_split_files_merge_in_time_order(
     tmp_path: Path, fmt: str, caplog: pytest.LogCaptureFixture

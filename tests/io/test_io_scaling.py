@@ -17,7 +17,12 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from hostile_files import (
+
+from ertools import caches
+from ertools.io.info import describe
+from ertools.io.reader import read_messages
+from ertools.io.summary import summary as bag_summary
+from tests.io.hostile_files import (
     McapChannel,
     McapChunk,
     Ros1Chunk,
@@ -28,10 +33,7 @@ from hostile_files import (
     u32,
 )
 
-from ertools import caches
-from ertools.io.info import describe
-from ertools.io.reader import read_messages
-from ertools.io.summary import summary as bag_summary
+pytestmark = pytest.mark.slow
 
 T0 = 1_448_020_800 * 10**9
 SMALL, LARGE = 400, 1600

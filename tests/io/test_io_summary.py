@@ -8,14 +8,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_bagmaker import write
-from io_scene import Scene
 
 from ertools.errors import BagError
 from ertools.io.reader import read_poses
 from ertools.io.ros1.layout import read_layout
 from ertools.io.summary import record_times
 from ertools.io.summary import summary as bag_summary
+from tests.helpers.bagmaker import write
+from tests.helpers.scene import Scene
 
 POSE = "/fbm3w/robot_at_work/pose"
 

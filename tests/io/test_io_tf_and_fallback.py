@@ -10,8 +10,6 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from io_bagmaker import Spec, write
-from io_scene import DT, T0, Scene
 from rosbags.rosbag1 import Writer
 
 from ertools.errors import TopicError
@@ -21,6 +19,8 @@ from ertools.io.files import open_bag
 from ertools.io.reader import read_poses, read_tf
 from ertools.io.ros1.index import Ros1Bag
 from ertools.streams import PoseStream
+from tests.helpers.bagmaker import Spec, write
+from tests.helpers.scene import DT, T0, Scene
 
 
 def q_yaw(yaw: float) -> tuple[float, float, float, float]:

@@ -11,11 +11,13 @@ import time
 from pathlib import Path
 
 import pytest
-from live_helpers import free_udp_port, read_mcap
 
 from ertools.errors import BagError
 from ertools.live.simulate import SimulatedBody, SimulatedMotive
 from ertools.live.tail import is_finished, read_complete
+from tests.live.live_helpers import free_udp_port, read_mcap
+
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("timing")]
 
 REPO = Path(__file__).resolve().parents[2]
 

@@ -11,7 +11,6 @@ import time
 from pathlib import Path
 
 import pytest
-from live_helpers import fake_sntp_server, read_mcap
 from mcap.reader import make_reader
 
 from ertools.configs.mocap import parse_mocap_config
@@ -19,6 +18,9 @@ from ertools.live.natnet import FrameExtras, NatNetVersion, RigidBody, encode_fr
 from ertools.live.recorder import Recorder, RecordOptions, RecordSummary
 from ertools.live.simulate import SimulatedBody, SimulatedMotive, make_frame
 from ertools.live.tail import is_finished, read_complete
+from tests.live.live_helpers import fake_sntp_server, read_mcap
+
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("timing")]
 
 CONFIG = parse_mocap_config(
     """

@@ -21,6 +21,8 @@ from ertools.errors import BagError
 from ertools.live.recover import recover
 from ertools.live.tail import is_finished
 
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("timing")]
+
 RECORDER = textwrap.dedent(
     """
     import sys, time

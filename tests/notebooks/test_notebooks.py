@@ -24,6 +24,8 @@ import ertools
 from ertools.cli.main import main
 from ertools.samples.__main__ import generate
 
+pytestmark = pytest.mark.slow
+
 REPO = Path(__file__).resolve().parents[2]
 NOTEBOOKS = REPO / "notebooks"
 SCENARIOS = ("fbm1h", "fbm2h", "fbm3w", "robotlog", "timeline")

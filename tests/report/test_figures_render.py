@@ -52,6 +52,7 @@ def _pixels(path: Path) -> np.ndarray:
     return np.asarray(imread(path))
 
 
+@pytest.mark.slow
 def test_render_draws_what_savefig_draws(tmp_path: Path) -> None:
     # Two specs of the same size one after the other: the second is drawn on the canvas the
     # first used, and nothing of the first (its colorbar, its twin axes) may remain.
@@ -85,6 +86,7 @@ def _hour(rng: np.random.Generator) -> np.ndarray:
     return xy
 
 
+@pytest.mark.slow
 def test_thin_path_keeps_what_the_figure_shows(tmp_path: Path) -> None:
     xy = _hour(np.random.default_rng(7))
     size = (7.0, 6.0)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import pytest
 from mcap.reader import make_reader
 
 from ertools.report.foxglove.mcapout import write_mcap
@@ -99,6 +100,7 @@ def allowed(rel: str, code: str) -> bool:
     return any(rel.startswith(where) and line in code for where, line in ALLOWED)
 
 
+@pytest.mark.slow
 def test_every_writer_goes_through_a_unique_temporary() -> None:
     """No module of ertools writes a file in place (``open(..., "w")``, ``write_text``,
     ``write_bytes``) or through a name chosen in advance (``.part``), but through

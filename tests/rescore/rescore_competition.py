@@ -40,7 +40,9 @@ class Competition:
 def use_toy_registry(monkeypatch: pytest.MonkeyPatch) -> None:
     """The registry holds the toy benchmark only (tests/rescore/rescore_toy.py)."""
     monkeypatch.setattr(
-        registry, "ENTRIES", (registry.Entry("toy", "rescore_toy:TOY", "a toy benchmark"),)
+        registry,
+        "ENTRIES",
+        (registry.Entry("toy", "tests.rescore.rescore_toy:TOY", "a toy benchmark"),),
     )
 
 

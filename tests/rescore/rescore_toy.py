@@ -129,7 +129,8 @@ def score_runs(loaded: list[float], runs: list[float], options: ToyOptions) -> T
 
 
 class Toy(Benchmark[ToyOptions, list[float], list[float], ToyResult], Described, Discovered):
-    """Registered as ``rescore_toy:TOY`` by the tests."""
+    """Registered as ``tests.rescore.rescore_toy:TOY`` (``rescore_toy:TOY`` by the scripts run
+    from its folder)."""
 
     name = "toy"
     title = "Toy@Test"

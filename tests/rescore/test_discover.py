@@ -13,7 +13,6 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from timeline.summaries import Summary, Topic
 
 from ertools.competition.discover import Discovery, _gt_only, discover
 from ertools.io.formats import Unreadable
@@ -21,6 +20,9 @@ from ertools.samples.competition_schedule import NO_ROBOT_LOG, TRUNCATED
 from ertools.timelines.build import build_timeline
 from ertools.timelines.model import BagEntry, Pairing
 from ertools.timelines.scan import scan
+from tests.helpers.summaries import Summary, Topic
+
+pytestmark = pytest.mark.slow
 
 S = 1_000_000_000
 T0 = 1_448_013_600 * S  # 2015-11-20 10:00:00 UTC

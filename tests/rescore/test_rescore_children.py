@@ -15,10 +15,10 @@ import textwrap
 from pathlib import Path
 
 import pytest
-from rescore_competition import LOGS, expected_value, make_competition
-from test_rescore_faults import DEADLINE_S, HOLD, TOY_RESCORE, ppid, wait_for
 
 from ertools.competition.children import SCORING_IMPORTS
+from tests.rescore.rescore_competition import LOGS, expected_value, make_competition
+from tests.rescore.test_rescore_faults import DEADLINE_S, HOLD, TOY_RESCORE, ppid, wait_for
 
 HERE = Path(__file__).parent
 ROOT = HERE.parents[1]

@@ -5,13 +5,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from rescore_competition import make_competition, use_toy_registry
-from stderr_text import joined_lines
 
 from ertools.benchmarks import registry
 from ertools.cli.main import main
 from ertools.competition.manifest import ManifestError, load_manifest
 from ertools.errors import ConfigError
+from tests.helpers.stderr_text import joined_lines
+from tests.rescore.rescore_competition import make_competition, use_toy_registry
 
 
 @pytest.fixture(autouse=True)

@@ -78,6 +78,7 @@ def _counting(monkeypatch: pytest.MonkeyPatch) -> dict[str, int]:
     return counts
 
 
+@pytest.mark.slow
 def test_a_warm_discovery_reads_no_log_and_finds_the_same(
     sample_competition: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

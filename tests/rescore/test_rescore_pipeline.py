@@ -6,7 +6,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from rescore_competition import LOGS, expected_value, make_competition, use_toy_registry
 
 from ertools.benchmarks import registry
 from ertools.competition.manifest import load_manifest
@@ -16,6 +15,12 @@ from ertools.competition.pipeline import (
     listed_executions,
     rescore,
     score_argv,
+)
+from tests.rescore.rescore_competition import (
+    LOGS,
+    expected_value,
+    make_competition,
+    use_toy_registry,
 )
 
 

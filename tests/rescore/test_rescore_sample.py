@@ -16,6 +16,8 @@ import pytest
 from ertools.cli.main import main
 from ertools.competition.manifest import load_manifest
 
+pytestmark = pytest.mark.slow
+
 SEED = 2015_11_20
 # robotto lost its USB key after its second FBM3W: nothing in the logs names the team of that
 # execution, so the manifest lists it (its benchmark log and GT file).

@@ -18,7 +18,10 @@ import textwrap
 from pathlib import Path
 
 import pytest
-from rescore_competition import LOGS, OFFSETS, SCALE, expected_value, make_competition
+
+from tests.rescore.rescore_competition import LOGS, OFFSETS, SCALE, expected_value, make_competition
+
+pytestmark = pytest.mark.slow
 
 HERE = Path(__file__).parent
 ROUNDS = 3

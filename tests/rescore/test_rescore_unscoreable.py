@@ -7,9 +7,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from rescore_toy import Toy, ToyOptions, ToyResult
-
 from ertools.competition.jobs import Job, run_job
+from tests.rescore.rescore_toy import Toy, ToyOptions, ToyResult
 
 REASON = "valid data covers only 61.0% of the window (12 tracking_lost); at least 90% is needed"
 
@@ -41,7 +40,7 @@ THIN = Thin()
 def _job(tmp_path: Path, numbers: str) -> Job:
     log = tmp_path / "thin.txt"
     log.write_text(numbers, encoding="utf-8")
-    return Job("thin-1", "thin", "test_rescore_unscoreable:THIN", "team", (str(log),))
+    return Job("thin-1", "thin", "tests.rescore.test_rescore_unscoreable:THIN", "team", (str(log),))
 
 
 def test_an_unscoreable_execution_is_a_verdict(tmp_path: Path) -> None:

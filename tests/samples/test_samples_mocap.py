@@ -97,6 +97,7 @@ def test_random_losses_are_seeded_and_inside() -> None:
     assert all(t[120] <= x.t_ns <= t[-121] and 2 <= x.repeat_frames <= 6 for x in a)
 
 
+@pytest.mark.slow
 def test_published_topics(tmp_path: Path) -> None:
     t, xyz, quat = _circle(5.0)
     pub = simulate_mocap(t, xyz, quat, rng=np.random.default_rng(2))

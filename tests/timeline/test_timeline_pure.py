@@ -5,7 +5,6 @@ from __future__ import annotations
 import json
 
 import pytest
-from summaries import BAG_KEYS, Summary, Topic
 
 from ertools.io.formats import Unreadable
 from ertools.io.model import ClockCheck
@@ -18,6 +17,7 @@ from ertools.timelines.build import (
     split_name,
 )
 from ertools.timelines.model import TimelineConfig
+from tests.helpers.summaries import BAG_KEYS, Summary, Topic
 
 S = 1_000_000_000
 T0 = 1_448_013_600 * S

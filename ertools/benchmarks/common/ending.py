@@ -76,7 +76,7 @@ VERSIONS = (
         "any RefBox END moves WAITING_MANUAL_OPERATION to READY (l. 43-44) and "
         "ManualOperation() returns the RefBox payload (FBM1@Work's item): a stop during a "
         "manual operation ends the benchmark",
-        "every `--2015` and `--rules` (tests/bmbox2015.py replays it)",
+        "every `--2015` and `--rules` (tests/helpers/bmbox2015.py replays it)",
     ),
     NodeVersion(
         "src/rockin_scoring/FSM.py",
@@ -85,7 +85,7 @@ VERSIONS = (
         f"{_ALL_THREE} (its only version)",
         "an update its transition table refuses changes nothing (BmBox.py 133-142): a RefBox "
         "stop while a goal is sent leaves the node waiting in SendGoal()",
-        "every `--2015` and `--rules` (tests/bmbox2015.py replays it)",
+        "every `--2015` and `--rules` (tests/helpers/bmbox2015.py replays it)",
     ),
 )
 

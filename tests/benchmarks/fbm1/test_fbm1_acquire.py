@@ -96,6 +96,7 @@ def _check(path: Path) -> None:
         assert 5e-5 < item.spread.position_m < 1e-3
 
 
+@pytest.mark.slow
 def test_acquire_found_phases_round_trip(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

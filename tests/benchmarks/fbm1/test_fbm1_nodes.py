@@ -43,6 +43,8 @@ from ertools.simulator.statemachine import Transition, publish_states
 from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
+pytestmark = pytest.mark.slow
+
 TOL = 1e-12
 SAMPLE = Path(__file__).resolve().parents[3] / "sample_bags" / "fbm1h"
 

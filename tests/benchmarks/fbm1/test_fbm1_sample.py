@@ -12,6 +12,8 @@ import yaml
 from ertools.benchmarks.fbm1.sample import generate
 from ertools.cli.main import main
 
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def sample(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:

@@ -6,7 +6,6 @@ repeats counted."""
 from __future__ import annotations
 
 import numpy as np
-from fbm1_testkit import ITEMS_YAML, T0, RunSpec, S, bodies, run_start_s, state_streams
 
 from ertools.benchmarks.fbm1.config import Fbm1Options, ScoreRules
 from ertools.benchmarks.fbm1.pipeline import score_fbm1
@@ -15,6 +14,15 @@ from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import parse_items
 from ertools.states import Machine
 from ertools.streams import PoseStream
+from tests.benchmarks.fbm1.fbm1_testkit import (
+    ITEMS_YAML,
+    T0,
+    RunSpec,
+    S,
+    bodies,
+    run_start_s,
+    state_streams,
+)
 
 GOOD = RunSpec(
     "Place item 3 (b2) on the table",

@@ -210,6 +210,7 @@ def _frame_change_bag(path: Path) -> None:
         w.write_pose_stamped(topic, t[~first], t[~first], "optitrack", xyz[~first], quat[~first])
 
 
+@pytest.mark.slow
 def test_frame_id_change_is_warned_in_output_and_report(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from fbm3w_synth import T0, one_run
 
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
 from ertools.benchmarks.fbm3w.pipeline import score_runs
@@ -12,6 +11,7 @@ from ertools.benchmarks.fbm3w.runs import RunWindow
 from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.benchmarks.fbm3w.shapes import builtin_shapes
 from ertools.streams import concatenate_poses
+from tests.benchmarks.fbm3w.fbm3w_synth import T0, one_run
 
 S = 1_000_000_000
 

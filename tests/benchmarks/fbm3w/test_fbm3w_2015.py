@@ -22,9 +22,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-from fbm3w_kit import Sample
-from fbm3w_synth import place
-from test_fbm3w_runs import stream
 
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions, options_2015
 from ertools.benchmarks.fbm3w.pipeline import score_runs
@@ -39,6 +36,9 @@ from ertools.states import BmBoxState as B
 from ertools.states import Machine
 from ertools.states import RefBoxState as R
 from ertools.streams import PoseStream
+from tests.benchmarks.fbm3w.fbm3w_kit import Sample
+from tests.benchmarks.fbm3w.fbm3w_synth import place
+from tests.benchmarks.fbm3w.test_fbm3w_runs import stream
 
 S = 1_000_000_000
 D_MIN = 0.00033  # seed 7.3.4: hard-coded in the 2015 script
@@ -157,6 +157,7 @@ def _check(out: dict[str, Any], node: dict[str, Any]) -> None:
         assert got["execution_time"] == pytest.approx(d["execution_time"], abs=TOL)
 
 
+@pytest.mark.slow
 def test_sample_bag_2015_equals_the_node(
     fbm3w_sample: Sample, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -306,6 +307,7 @@ def _node(poses: PoseStream, bm: Transitions, rb: Transitions, specs: list[str])
 SEAM = (math.pi - 0.01, -math.pi + 0.01)
 
 
+@pytest.mark.slow_cases("-3.1315926535897933")
 @pytest.mark.parametrize("yaw", SEAM)
 def test_run_timing_out_midway_is_scored_and_can_be_best(yaw: float) -> None:
     common = {"path_s": 3.0, "origin": (1.2, 0.7), "yaw": yaw}
@@ -331,6 +333,7 @@ def test_run_timing_out_midway_is_scored_and_can_be_best(yaw: float) -> None:
     assert default["execution_time"] == pytest.approx(node["execution_time"], abs=TOL)
 
 
+@pytest.mark.slow
 def test_stopped_run_is_neither_scored_nor_timed() -> None:
     common = {"path_s": 4.0, "origin": (-0.4, 1.1), "yaw": 2.0}
     runs = [
@@ -353,6 +356,7 @@ def test_stopped_run_is_neither_scored_nor_timed() -> None:
     assert default["execution_time"] == pytest.approx(node["execution_time"] + stopped_s, abs=TOL)
 
 
+@pytest.mark.slow
 def test_2015_and_arc_length_contradict(
     fbm3w_sample: Sample, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -382,6 +386,7 @@ def test_frozen_reference_pose_is_warned() -> None:
     assert not [w for w in plain.warnings if "frozen" in w]
 
 
+@pytest.mark.slow
 def test_2015_uses_the_script_d_min_over_the_config(
     fbm3w_sample: Sample, tmp_path: Any, capsys: pytest.CaptureFixture[str]
 ) -> None:

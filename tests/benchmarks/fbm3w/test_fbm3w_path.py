@@ -6,7 +6,6 @@ import math
 
 import numpy as np
 import pytest
-from fbm3w_synth import one_run, place
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -16,6 +15,7 @@ from ertools.benchmarks.fbm3w.pipeline import score_runs
 from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.benchmarks.fbm3w.shapes import builtin_shapes, parse_shape
 from ertools.errors import ScoringError
+from tests.benchmarks.fbm3w.fbm3w_synth import one_run, place
 
 # the path arithmetic is the subject, not the intervals: no Monte Carlo draws
 NO_DRAWS = Fbm3wOptions(draws=0)

@@ -194,6 +194,7 @@ class _FloatConstants(ast.NodeTransformer):
         return ast.copy_location(call, node)
 
 
+@pytest.mark.slow
 @pytest.mark.filterwarnings("ignore::hypothesis.errors.HypothesisWarning")
 @settings(max_examples=150, deadline=None)
 @given(text=_expressions())

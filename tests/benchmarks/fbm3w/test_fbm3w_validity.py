@@ -10,7 +10,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-from fbm3w_synth import FRAME_NS, T0, one_run
 
 from ertools.benchmarks.base import rename_former
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions, options_2015
@@ -22,6 +21,7 @@ from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.benchmarks.fbm3w.shapes import builtin_shapes
 from ertools.cli.main import main
 from ertools.streams import PoseStream
+from tests.benchmarks.fbm3w.fbm3w_synth import FRAME_NS, T0, one_run
 
 STILL = 30
 PATH = 3000  # 25 s at 120 Hz
@@ -48,6 +48,7 @@ def _expected_score(stream: PoseStream, window: RunWindow) -> float:
     return score_path(stream.xyz[sel, :2], ref, shape, Fbm3wConfig().d_min).distance_error
 
 
+@pytest.mark.slow
 def test_a_clean_run_is_fully_covered() -> None:
     stream, window = _run()
     run = score_runs(stream, [window], Fbm3wConfig(), bag_start_ns=0).runs[0]
@@ -109,6 +110,7 @@ def test_a_long_gap_mid_path_is_unscoreable() -> None:
     ]
 
 
+@pytest.mark.slow
 def test_2015_scores_it_with_a_warning() -> None:
     stream, window = _run()
     cut = _cut(stream, [(1000, 1072)])
@@ -149,6 +151,7 @@ def test_both_spellings_score_it_alike(capsys: pytest.CaptureFixture[str]) -> No
     assert new.distance_error == old.distance_error == _expected_score(cut, window)
 
 
+@pytest.mark.slow
 def test_coverage_below_the_fraction_is_unscoreable() -> None:
     stream, window = _run()
     # 8 gaps of 0.45 s (54 frames, 55 periods each), each under MAX_INNER_GAP_S: 440 of
@@ -185,6 +188,7 @@ def test_a_tracking_loss_while_moving_is_lost_path() -> None:
 SAMPLE = Path(__file__).resolve().parents[3] / "sample_bags" / "fbm3w"
 
 
+@pytest.mark.slow
 def test_the_score_command_prints_validity(capsys: pytest.CaptureFixture[str]) -> None:
     bag = SAMPLE / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
     config = SAMPLE / "fbm3w.yaml"

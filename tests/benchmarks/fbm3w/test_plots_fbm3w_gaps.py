@@ -1,6 +1,6 @@
 """The FBM3@Work run figure draws the ground truth's gaps where they are on the path and says
 the run's valid fraction (issue 28): a noiseless synthetic line run with frames cut by hand, its
-figure read back from the SVG (tests/svg_figure.py) and compared with the generator's points
+figure read back from the SVG (tests/helpers/svg_figure.py) and compared with the generator's points
 either side of the hole."""
 
 from __future__ import annotations
@@ -9,8 +9,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import svg_figure
-from fbm3w_synth import one_run
 from matplotlib.image import imread
 
 from ertools.benchmarks.fbm3w.pipeline import score_runs
@@ -18,6 +16,8 @@ from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.benchmarks.fbm3w.shapes import builtin_shapes
 from ertools.report.figures import figure_specs, render, wrap_title
 from ertools.report.folder import write_report
+from tests.benchmarks.fbm3w.fbm3w_synth import one_run
+from tests.helpers import svg_figure
 
 STILL = 30
 PATH = 3000
@@ -55,6 +55,7 @@ def _tolerance(fig: svg_figure.Figure) -> float:
     return max(abs(fig.scale("x")[0]), abs(fig.scale("y")[0]))
 
 
+@pytest.mark.slow
 def test_a_gap_is_drawn_between_the_samples_around_the_hole(tmp_path: Path) -> None:
     # 30 frames cut: 0.258 s, under the 0.5 s a path may cross, so the run is scored
     result = _result((1000, 1030))
@@ -93,6 +94,7 @@ def test_an_unscoreable_run_has_its_figure_and_verdict(tmp_path: Path) -> None:
     assert any(t.endswith("% valid") for t in runs.texts("label"))
 
 
+@pytest.mark.slow
 def test_matplotlib_draws_the_gaps_too(tmp_path: Path) -> None:
     for cut in ((1000, 1030), (1000, 1072)):
         path = _figure(_result(cut), tmp_path, "png")

@@ -18,6 +18,8 @@ from ertools.cli.main import main
 from ertools.errors import ScoringError
 from ertools.streams import PoseStream
 
+pytestmark = pytest.mark.slow
+
 
 @pytest.fixture(scope="module")
 def stationary(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, Any]]:

@@ -10,6 +10,8 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import pytest
+
 from ertools.benchmarks import registry
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -48,6 +50,7 @@ def test_the_names_checked_are_the_registry() -> None:
     assert set(OWN_PACKAGE) == set(registry.names())
 
 
+@pytest.mark.slow
 def test_no_benchmark_name_outside_its_package_and_the_registry() -> None:
     offenders = []
     for path in sorted(PACKAGE.rglob("*.py")):

@@ -169,6 +169,7 @@ def test_score_takes_the_declared_inputs(toy: Path, capsys: pytest.CaptureFixtur
     assert members[-4:] == ["toy", "a", "toy", "benchmark"]  # its registry line, unimported
 
 
+@pytest.mark.slow
 def test_report_folder_and_combined_page(
     toy: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -94,6 +94,7 @@ def _scored(capsys: pytest.CaptureFixture[str], *extra: str) -> tuple[dict, list
     return json.loads(captured.out), captured.err.splitlines()
 
 
+@pytest.mark.slow
 def test_a_score_outside_its_interval_says_why(capsys: pytest.CaptureFixture[str]) -> None:
     """The sample robot's clock runs 0.349 s ahead: scored at offset 0, its mean error is
     147 mm, while the intervals are of the score at the offset the data supports (17 mm).
