@@ -124,7 +124,7 @@ class Paths:
 
 
 def manifest_terms(text: str, benchmark: str) -> str:
-    """``give --robot-topic`` -> ``give benchmarks.trajectory.logs.robot_topic``: the
+    """``give --robot-topic`` -> ``give benchmarks.trajectory.inputs.robot_topic``: the
     options a warning names, as the manifest keys that set them (a rescore has no command
     line per execution)."""
     # the execution's benchmark, and one the text names (``... by trajectory``: its robot log)

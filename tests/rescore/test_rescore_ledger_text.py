@@ -142,11 +142,11 @@ def test_paths_relative_and_options_as_manifest_keys() -> None:
     text = f"{ROOT}/bm/a.bag:/fbm2h/robot_at_home/pose: no messages (see {ROOT}/gt/g.bag)"
     assert paths.text(text) == "bm/a.bag:/fbm2h/robot_at_home/pose: no messages (see gt/g.bag)"
     assert manifest_terms("give --robot-topic (found 0)", "trajectory") == (
-        "give benchmarks.trajectory.logs.robot_topic (found 0)"
+        "give benchmarks.trajectory.inputs.robot_topic (found 0)"
     )
     # a robot log's warning in an FBM1H row names the comparison's benchmark
     assert manifest_terms("not compared by trajectory (give --gt-topic)", "fbm1h") == (
-        "not compared by trajectory (give benchmarks.trajectory.logs.gt_topic)"
+        "not compared by trajectory (give benchmarks.trajectory.inputs.gt_topic)"
     )
     # a deviation's option, by the benchmark its rule key names (fbm1: the FBM1 benchmarks)
     assert deviation_terms("--count-aborted restores 2015 [fbm1.aborted-runs]") == (
@@ -177,7 +177,7 @@ def test_a_warning_shared_by_executions_is_said_once() -> None:
     (g,) = grouped
     assert g.text == (
         "its robot log: not compared with the GT by trajectory "
-        "(its log: give benchmarks.trajectory.logs.robot_topic)"
+        "(its log: give benchmarks.trajectory.inputs.robot_topic)"
     )
     assert g.executions == ("fbm1h-homer-1", "fbm1h-socrob-1", "fbm1h-skuba-1") and g.of == 3
     assert own == {"fbm1h-homer-1": ["only mine"], "fbm1h-socrob-1": [], "fbm1h-skuba-1": []}
