@@ -10,6 +10,11 @@ As the 2015 node did (rockin_scoring/scripts/fbm3w, seed 7.3.1-7.3.3):
    run frame's), ``L`` its total; each kept point i >= 1 is compared with the target at
    ``l_i / L``; the start point counts with error 0;
 4. distance_error = sum of the errors / N, N the number of kept points.
+
+Written once for every caller: :func:`score_path` (one run), the intervals (every Monte Carlo
+draw side by side: :func:`kept_flags`, then :func:`arc_fractions` and :func:`frame_errors` on
+the kept points of all draws laid end to end) and ``--runs auto`` (a candidate move in two
+frames).
 """
 
 from __future__ import annotations
@@ -19,7 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ertools.arrays import F64, IntArr
+from ertools.arrays import F64, Bool, IntArr
 from ertools.benchmarks.fbm3w.shapes import Shape
 from ertools.errors import ErtoolsError, ScoringError
 
@@ -86,6 +91,81 @@ def subsample_d_min(xy: F64, d_min: float) -> IntArr:
         kept.append(nxt)
         last = nxt
     return np.asarray(kept, dtype=np.intp)
+
+
+def kept_flags(x: F64, y: F64, d_mins: F64) -> Bool:
+    """(N, W) flags of the d_min rule for W paths side by side in the columns of ``x``, ``y``
+    (N, W), column w with ``d_mins[w]``; NaN (padding) is never kept.
+
+    The same comparison as :func:`subsample_d_min` (which one column takes): the rule is
+    sequential within a path, so the W paths advance together, one sample per step.
+    """
+    n, w = x.shape
+    if w == 1:
+        flags = np.zeros((n, 1), dtype=bool)
+        flags[subsample_d_min(np.column_stack([x[:, 0], y[:, 0]]), float(d_mins[0])), 0] = True
+        return flags
+    flags = np.zeros((n, w), dtype=bool)
+    flags[0] = True
+    lx = x[0].copy()
+    ly = y[0].copy()
+    dx = np.empty(w)
+    dy = np.empty(w)
+    for j in range(1, n):
+        # sqrt(dx*dx + dy*dy) >= d_min against the last kept point, in place (no temporaries)
+        np.subtract(x[j], lx, out=dx)
+        np.subtract(y[j], ly, out=dy)
+        np.multiply(dx, dx, out=dx)
+        np.multiply(dy, dy, out=dy)
+        np.add(dx, dy, out=dx)
+        np.sqrt(dx, out=dx)
+        k = np.greater_equal(dx, d_mins, out=flags[j])
+        np.copyto(lx, x[j], where=k)
+        np.copyto(ly, y[j], where=k)
+    return flags
+
+
+def arc_fractions(xk: F64, yk: F64, counts: IntArr) -> tuple[F64, F64]:
+    """``l / L`` of every kept point and each path's ``L``, for D kept paths laid end to end
+    in ``xk``, ``yk`` (M,), path i being ``counts[i]`` >= 1 points.
+
+    ``l`` sums the steps in order within a path, as the 2015 loop; a path of zero length has
+    ``l / L`` = 0.
+    """
+    m = xk.size
+    starts = np.cumsum(counts) - counts
+    run = np.empty(m)
+    run[:1] = 0.0
+    np.hypot(np.diff(xk), np.diff(yk), out=run[1:])
+    run[starts] = 0.0
+    np.cumsum(run, out=run)
+    cum = np.subtract(run, np.repeat(run[starts], counts), out=run)
+    total = cum[starts + counts - 1]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        l_norm = np.divide(cum, np.repeat(total, counts), out=cum)
+    np.clip(np.nan_to_num(l_norm, copy=False), 0.0, 1.0, out=l_norm)
+    return l_norm, total
+
+
+def frame_errors(xk: F64, yk: F64, counts: IntArr, target: F64, cos_yaw: F64, sin_yaw: F64) -> F64:
+    """(M,) Eq. (1)'s distance of each kept point (laid out as for :func:`arc_fractions`)
+    from its ``target`` (M, 2), in its path's run frame: origin at the path's first point, x
+    axis at ``yaw`` (D,) in the world. Each first point counts 0 (2015 summed from the second).
+    """
+    starts = np.cumsum(counts) - counts
+    dx = xk - np.repeat(xk[starts], counts)
+    dy = yk - np.repeat(yk[starts], counts)
+    c, s = np.repeat(cos_yaw, counts), np.repeat(sin_yaw, counts)
+    # the run frame: (c dx + s dy, -s dx + c dy), each minus the target
+    a: F64 = np.multiply(c, dx)
+    a += np.multiply(s, dy)
+    a -= target[:, 0]
+    b = np.multiply(c, dy)
+    b -= np.multiply(s, dx, out=c)
+    b -= target[:, 1]
+    np.hypot(a, b, out=a)
+    a[starts] = 0.0
+    return a
 
 
 @dataclass(frozen=True)
@@ -180,17 +260,16 @@ def score_path(
             f"the path has zero length: no sample moved d_min = {d_min * 1000:.3g} mm from the "
             "starting position"
         )
-    steps = np.hypot(*np.diff(path, axis=0).T)
-    cum = np.concatenate([[0.0], np.cumsum(steps)])  # sequential, as the 2015 loop
-    total = float(cum[-1])
+    one = np.array([len(path)])
+    l_norm, totals = arc_fractions(path[:, 0], path[:, 1], one)
+    total = float(totals[0])
     if total <= 0.0 and not (as_2015 and len(path) == 1):
         raise ScoringError("the path has zero length")
     frame = run_frame(reference_xy, path[0], as_2015=as_2015)
-    in_frame = frame.to_frame(path)
-    l_norm = cum / total if total > 0.0 else np.zeros(1)
     target = shape(l_norm)
-    errors = np.hypot(*(in_frame - target).T)
-    errors[0] = 0.0  # 2015 started its sum at the second kept point
+    cos_yaw, sin_yaw = np.array([math.cos(frame.yaw)]), np.array([math.sin(frame.yaw)])
+    errors = frame_errors(path[:, 0], path[:, 1], one, target, cos_yaw, sin_yaw)
+    in_frame = frame.to_frame(path)
     raw_length = float(np.sum(np.hypot(*np.diff(pts, axis=0).T)))
     return PathScore(
         float(np.sum(errors) / len(path)),

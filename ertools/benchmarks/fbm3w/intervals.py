@@ -56,6 +56,7 @@ from ertools.benchmarks.common.uncertainty import (
     too_few,
 )
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
+from ertools.benchmarks.fbm3w.formula import arc_fractions, frame_errors, kept_flags
 from ertools.benchmarks.fbm3w.result import RunResult
 from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.benchmarks.fbm3w.shapes import Shape
@@ -223,7 +224,7 @@ def perturbed_runs(
             _positions(runs[col], sigmas[lo:hi], rng, noisy, x, y)
             for (col, lo, hi), (x, y, _, _) in zip(group, views, strict=True)
         ]
-        kept = _subsample(xt, yt, np.concatenate([d_mins[lo:hi] for _, lo, hi in group]))
+        kept = kept_flags(xt, yt, np.concatenate([d_mins[lo:hi] for _, lo, hi in group]))
         for (col, lo, hi), (x, y, cols, m), (rx, ry) in zip(group, views, refs, strict=True):
             out[lo:hi, col] = _eq1(x, y, kept[:m, cols].T, rx, ry, runs[col].shape)
     return out
@@ -273,72 +274,19 @@ def _positions(
     return ref[0] + ref_eps[:, 0], ref[1] + ref_eps[:, 1]
 
 
-def _subsample(xt: F64, yt: F64, d_mins: F64) -> Bool:
-    """(N, W) kept flags of the 2015 d_min rule for the W draws side by side in the columns
-    of ``xt``, ``yt`` (N, W), each with its d_min: one pass over the samples, each step
-    vectorised over every draw (the rule is sequential within a draw). NaN is never kept."""
-    n, w = xt.shape
-    d2 = d_mins * d_mins
-    kept = np.zeros((n, w), dtype=bool)
-    kept[0] = True
-    lx = xt[0].copy()
-    ly = yt[0].copy()
-    dx = np.empty(w)
-    dy = np.empty(w)
-    for j in range(1, n):
-        # dx*dx + dy*dy >= d_min^2 against the last kept point, in place (no temporaries)
-        np.subtract(xt[j], lx, out=dx)
-        np.subtract(yt[j], ly, out=dy)
-        np.multiply(dx, dx, out=dx)
-        np.multiply(dy, dy, out=dy)
-        np.add(dx, dy, out=dx)
-        k = np.greater_equal(dx, d2, out=kept[j])
-        np.copyto(lx, xt[j], where=k)
-        np.copyto(ly, yt[j], where=k)
-    return kept
-
-
 def _eq1(x: F64, y: F64, kept: Bool, rx: F64, ry: F64, shape: Shape) -> F64:
-    """Eq. (1) of every draw from its kept flags (as :func:`~.path.score_path`), on the kept
-    points only: in row-major order each draw's kept points follow one another, its first
-    one (the start, always kept) first. Temporaries are reused (``out=``): on this scale
-    (10^5 kept points per run) fresh arrays cost more in page faults than in arithmetic."""
+    """(D,) Eq. (1) of every draw (rows of ``x``, ``y``) from its kept flags, as
+    :func:`~ertools.benchmarks.fbm3w.formula.score_path` computes one: the kept points of all
+    draws laid end to end (row-major: each draw's start, always kept, first); NaN where a
+    draw cannot be scored."""
     d = x.shape[0]
     rows, cols = np.nonzero(kept)  # draw by draw (row-major), whatever the layout in memory
     count = np.bincount(rows, minlength=d)
     xk, yk = x[rows, cols], y[rows, cols]
-    m = rows.size
-    starts = np.cumsum(count) - count  # each draw's first kept point (column 0)
-    a, b = np.empty(m), np.empty(m)
-    run = np.empty(m)
-    run[0] = 0.0
-    np.subtract(xk[1:], xk[:-1], out=a[1:])
-    np.subtract(yk[1:], yk[:-1], out=b[1:])
-    np.hypot(a[1:], b[1:], out=run[1:])
-    run[starts] = 0.0
-    np.cumsum(run, out=run)  # sequential within each draw, as the 2015 loop
-    cum = np.subtract(run, np.repeat(run[starts], count), out=run)
-    last = starts + count - 1
-    total = np.zeros(d)
-    total[count > 0] = cum[last[count > 0]]
+    l_norm, total = arc_fractions(xk, yk, count)
     x0, y0 = x[:, 0], y[:, 0]
     yaw = np.arctan2(y0 - ry, x0 - rx)
-    dx = np.subtract(xk, np.repeat(x0, count), out=xk)
-    dy = np.subtract(yk, np.repeat(y0, count), out=yk)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        l_norm = np.divide(cum, np.repeat(total, count), out=cum)
-    np.clip(np.nan_to_num(l_norm, copy=False), 0.0, 1.0, out=l_norm)
-    target = shape(l_norm)
-    c, s = np.repeat(np.cos(yaw), count), np.repeat(np.sin(yaw), count)
-    # the run frame: (c dx + s dy, -s dx + c dy), each minus the target
-    np.multiply(c, dx, out=a)
-    a += np.multiply(s, dy, out=b)
-    a -= target[:, 0]
-    np.multiply(c, dy, out=b)
-    b -= np.multiply(s, dx, out=c)
-    b -= target[:, 1]
-    err = np.hypot(a, b, out=a)
-    err[starts] = 0.0  # 2015 started its sum at the second kept point
+    err = frame_errors(xk, yk, count, shape(l_norm), np.cos(yaw), np.sin(yaw))
     out = np.bincount(rows, weights=err, minlength=d) / np.maximum(count, 1)
     bad = (count < 2) | ~(total > 0) | ((x0 == rx) & (y0 == ry))
     return np.where(bad, np.nan, out)
