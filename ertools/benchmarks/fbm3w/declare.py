@@ -29,7 +29,7 @@ from ertools.benchmarks.common.inputs import (
 )
 from ertools.benchmarks.fbm3w.config import RUN_MODES, Fbm3wOptions, options_2015
 from ertools.benchmarks.fbm3w.logs import Fbm3wLogs
-from ertools.benchmarks.fbm3w.pipeline import load, locate_runs, score_found
+from ertools.benchmarks.fbm3w.pipeline import find_runs, load, score_runs
 from ertools.benchmarks.fbm3w.result import Fbm3wResult
 from ertools.benchmarks.fbm3w.runs import RunWindow, parse_run_spec, parse_runs_file
 from ertools.benchmarks.fbm3w.settings import check_d_min, load_fbm3w_config
@@ -303,8 +303,8 @@ best_run, best_distance_error and execution_time (sum of the run times).""",
         inputs=INPUTS,
         make_options=make_options,
         load=load,
-        find_runs=locate_runs,
-        score_runs=score_found,
+        find_runs=find_runs,
+        score_runs=score_runs,
         ranking=Ranking(
             key=lambda r: r.best_distance_error,
             lower_is_better=True,

@@ -1,6 +1,6 @@
 """FBM3@Work trajectory following (seed 7.3): load -> find runs -> score -> result.
 
-:func:`score_fbm3w` reads bags through :mod:`ertools.io` and calls :func:`score_runs`, which
+:func:`score_fbm3w` reads bags through :mod:`ertools.io` and calls :func:`score_paths`, which
 is pure (pose stream + run windows + config -> :class:`Fbm3wResult`). The scoring itself is in
 :mod:`ertools.benchmarks.fbm3w.formula`, run finding in :mod:`ertools.benchmarks.fbm3w.runs`.
 """
@@ -129,7 +129,7 @@ def load(paths: Sequence[Path], options: Fbm3wOptions) -> Fbm3wLogs:
     )
 
 
-def locate_runs(logs: Fbm3wLogs, options: Fbm3wOptions) -> list[RunWindow]:
+def find_runs(logs: Fbm3wLogs, options: Fbm3wOptions) -> list[RunWindow]:
     """The run windows: from explicit windows, the BmBox states or motion.
 
     Raises:
@@ -157,11 +157,9 @@ def locate_runs(logs: Fbm3wLogs, options: Fbm3wOptions) -> list[RunWindow]:
     return windows
 
 
-def score_found(
-    logs: Fbm3wLogs, windows: Sequence[RunWindow], options: Fbm3wOptions
-) -> Fbm3wResult:
-    """Score the runs found (:func:`score_runs` on the logs' poses)."""
-    result = score_runs(
+def score_runs(logs: Fbm3wLogs, windows: Sequence[RunWindow], options: Fbm3wOptions) -> Fbm3wResult:
+    """Score the runs found (:func:`score_paths` on the logs' poses)."""
+    result = score_paths(
         logs.poses,
         windows,
         options.config or Fbm3wConfig(),
@@ -190,7 +188,7 @@ def score_fbm3w(
     """
     opts = replace(options, config=config)
     logs = load(paths, opts)
-    return score_found(logs, locate_runs(logs, opts), opts)
+    return score_runs(logs, find_runs(logs, opts), opts)
 
 
 def _still(options: Fbm3wOptions) -> dict[str, float]:
@@ -202,7 +200,7 @@ def _still(options: Fbm3wOptions) -> dict[str, float]:
     return out
 
 
-def score_runs(
+def score_paths(
     poses: PoseStream,
     windows: Sequence[RunWindow],
     config: Fbm3wConfig,

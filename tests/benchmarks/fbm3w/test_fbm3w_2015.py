@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions, options_2015
-from ertools.benchmarks.fbm3w.pipeline import score_runs
+from ertools.benchmarks.fbm3w.pipeline import score_paths
 from ertools.benchmarks.fbm3w.runs import find_states
 from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.cli.main import main
@@ -293,7 +293,7 @@ def _scenario(
 
 def _ertools(poses: PoseStream, states: BenchmarkStates, options: Fbm3wOptions) -> dict[str, Any]:
     windows = find_states(states, exact_2015=options.exact_end_payloads)
-    data: dict[str, Any] = score_runs(poses, windows, Fbm3wConfig(), options=options).to_dict()
+    data: dict[str, Any] = score_paths(poses, windows, Fbm3wConfig(), options=options).to_dict()
     return data
 
 
@@ -376,13 +376,13 @@ def test_frozen_reference_pose_is_warned() -> None:
     xyz = poses.xyz.copy()
     xyz[a:b] = xyz[a]
     frozen = PoseStream(poses.t_ns, xyz, poses.quat_xyzw, "world", "robot_at_work", "sim")
-    result = score_runs(frozen, windows, Fbm3wConfig(), bag_start_ns=0)
+    result = score_paths(frozen, windows, Fbm3wConfig(), bag_start_ns=0)
     lines = [w for w in result.warnings if "frozen" in w]
     assert len(lines) == 1
     assert lines[0].startswith("run 0: the pose at its reference time 2.000 s is frozen")
     assert f"{b - a} identical poses" in lines[0] and "(1.500-2.492 s" in lines[0]
     # Unfrozen, nothing is said.
-    plain = score_runs(poses, windows, Fbm3wConfig(), bag_start_ns=0)
+    plain = score_paths(poses, windows, Fbm3wConfig(), bag_start_ns=0)
     assert not [w for w in plain.warnings if "frozen" in w]
 
 

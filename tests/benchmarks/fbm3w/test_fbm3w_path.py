@@ -19,7 +19,7 @@ from ertools.benchmarks.fbm3w.formula import (
     score_path,
     subsample_d_min,
 )
-from ertools.benchmarks.fbm3w.pipeline import score_runs
+from ertools.benchmarks.fbm3w.pipeline import score_paths
 from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.benchmarks.fbm3w.shapes import builtin_shapes, parse_shape
 from ertools.errors import ScoringError
@@ -135,14 +135,14 @@ def test_robot_exactly_on_target_scores_zero(name: str) -> None:
     shape = builtin_shapes()[name]
     path = shape(np.linspace(0.0, 1.0, 3000))
     stream, window = one_run(path, spec=name, yaw=-1.1, origin=(3.0, -4.0))
-    result = score_runs(stream, [window], Fbm3wConfig(), options=NO_DRAWS)
+    result = score_paths(stream, [window], Fbm3wConfig(), options=NO_DRAWS)
     # 0 up to the d_min quantisation: the last kept point may stop up to d_min short of the
     # end, which rescales l/L by < d_min / L and moves the compared target by < d_min
     assert result.runs[0].distance_error is not None
     assert result.runs[0].distance_error < 0.00033
     assert result.failures == ()
     # with d_min = 0 every sample is kept and the quantisation vanishes
-    exact = score_runs(stream, [window], Fbm3wConfig(), options=Fbm3wOptions(d_min=0.0, draws=0))
+    exact = score_paths(stream, [window], Fbm3wConfig(), options=Fbm3wOptions(d_min=0.0, draws=0))
     assert exact.runs[0].distance_error == pytest.approx(0.0, abs=1e-12)
 
 
@@ -150,14 +150,14 @@ def test_sine_scores_its_floor_unless_arc_length() -> None:
     shape = builtin_shapes()["spline"]
     path = shape(np.linspace(0.0, 1.0, 4000))
     stream, window = one_run(path, spec="spline")
-    result = score_runs(stream, [window], Fbm3wConfig(), options=NO_DRAWS)
+    result = score_paths(stream, [window], Fbm3wConfig(), options=NO_DRAWS)
     run = result.runs[0]
     # the 2015 sine is parametrised by x, not by length: a perfect robot scores its floor
     # (computed on 10001 samples; with 4000 the kept points fall elsewhere: ~0.1 mm apart)
     assert run.distance_error == pytest.approx(run.shape_floor, abs=2e-4)
     assert run.distance_error > 0.008
     assert any("not parametrised by arc length" in w for w in result.warnings)
-    fixed = score_runs(
+    fixed = score_paths(
         stream, [window], Fbm3wConfig(), options=Fbm3wOptions(arc_length=True, draws=0)
     )
     # arc-length target vs a path sampled uniformly in the shape's own parameter: 0 up to the
@@ -217,7 +217,7 @@ def test_long_path_is_warned() -> None:
         [np.zeros_like(u), np.sin(40 * np.pi * u)]
     )
     stream, window = one_run(zigzag)
-    result = score_runs(stream, [window], Fbm3wConfig(), options=NO_DRAWS)
+    result = score_paths(stream, [window], Fbm3wConfig(), options=NO_DRAWS)
     run = result.runs[0]
     assert run.score is not None and run.target_length is not None
     ratio = run.score.path_length / run.target_length

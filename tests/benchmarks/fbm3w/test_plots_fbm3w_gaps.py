@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from matplotlib.image import imread
 
-from ertools.benchmarks.fbm3w.pipeline import score_runs
+from ertools.benchmarks.fbm3w.pipeline import score_paths
 from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.benchmarks.fbm3w.shapes import builtin_shapes
 from ertools.report.figures import figure_specs, render, wrap_title
@@ -29,7 +29,7 @@ def _result(cut: tuple[int, int]) -> object:
     stream, window = one_run(builtin_shapes()["line"](L), still=STILL)
     keep = np.ones(len(stream), dtype=bool)
     keep[2 * STILL + cut[0] : 2 * STILL + cut[1]] = False
-    return score_runs(stream.take(keep), [window], Fbm3wConfig(), bag_start_ns=0)
+    return score_paths(stream.take(keep), [window], Fbm3wConfig(), bag_start_ns=0)
 
 
 def _line_mm(i: int) -> tuple[float, float]:
