@@ -78,6 +78,25 @@ def test_score_help_lists_every_benchmark_and_imports_none() -> None:
         assert loaded(modules, package) == [], name
 
 
+# Benchmarks still declared with the old record (benchmarks/legacy.py): their declaration
+# imports their scorers, so their parser loads NumPy. The list only shrinks (plan 37, S8b).
+HEAVY_DECLARES = frozenset({"fbm2h"})
+
+
+def test_a_benchmarks_help_imports_its_declaration_and_no_numpy() -> None:
+    heavy = set()
+    for name, package in packages().items():
+        code, modules = imported("score", name, "--help")
+        assert code == 0, name
+        others = {p for p in packages().values() if p != package}
+        assert {p for p in others if loaded(modules, p)} == set(), name
+        if "numpy" in modules:
+            heavy.add(name)
+    new, fixed = sorted(heavy - HEAVY_DECLARES), sorted(HEAVY_DECLARES - heavy)
+    assert not new, f"these parsers import NumPy: {new}"
+    assert not fixed, f"NumPy-free now: remove them from HEAVY_DECLARES: {fixed}"
+
+
 @pytest.mark.skipif(not ROBOTLOG.is_dir(), reason="no sample logs (make samples)")
 def test_scoring_a_trajectory_imports_nothing_heavy_and_no_other_benchmark() -> None:
     robot = sorted(ROBOTLOG.glob("FBM2H_*.bag"))[0]

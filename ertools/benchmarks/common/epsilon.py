@@ -27,6 +27,7 @@ from ertools.benchmarks.common.hygiene import (
     impossible_samples,
     impossible_warning,
 )
+from ertools.benchmarks.common.inputs import DEFAULT_C
 from ertools.benchmarks.common.phases import (
     DEFAULT_MIN_STILL_S,
     DEFAULT_STILL_SPEED,
@@ -43,7 +44,6 @@ if TYPE_CHECKING:
     import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 DEFAULT_BIN = 0.00015  # the 2015 tool's D_INTERVAL
-DEFAULT_C = 3.0
 PERCENTILES = (50, 95, 99)
 # Rows the 2015 tool printed (0 to 7.5 mm); longer tails are folded into one overflow row.
 HISTOGRAM_ROWS = 50

@@ -24,6 +24,9 @@ DEFAULT_SEED = 0
 MAX_DRAWS = 100_000
 # numpy seeds any non-negative integer; results and reports carry the seed as an int64
 MAX_SEED = 2**63 - 1
+# The seed's D_MIN = c * epsilon (7.3.2): the c of the suggested d_min (``ertools noise``) and
+# of FBM3@Work's default noise when a log has no still phase.
+DEFAULT_C = 3.0
 
 #: The options every ``score`` command takes for its intervals (declared once, listed by each
 #: benchmark's declaration).

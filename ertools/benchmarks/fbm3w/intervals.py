@@ -45,6 +45,7 @@ import numpy.typing as npt
 
 from ertools.arrays import F64, Bool, IntArr
 from ertools.benchmarks.common.epsilon import NoiseResult
+from ertools.benchmarks.common.inputs import DEFAULT_C
 from ertools.benchmarks.common.uncertainty import (
     D_MIN,
     MOCAP_NOISE,
@@ -65,7 +66,6 @@ from ertools.streams import PoseStream
 # The coefficient of variation of a Rayleigh distance, sqrt(4/pi - 1): the spread of one
 # consecutive-pair distance around epsilon.
 RAYLEIGH_CV = math.sqrt(4.0 / math.pi - 1.0)
-DEFAULT_C = 3.0  # the seed's D_MIN = c * epsilon (7.3.2), for the default noise
 DEFAULT_D_MIN_REL = 0.10
 # Draws x samples of one batch: bounds the memory of a long run (~8 bytes x a few arrays).
 BATCH_ELEMENTS = 2_000_000
