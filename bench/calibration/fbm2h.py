@@ -1,7 +1,7 @@
 """FBM2@Home calibration trial: the simulator's five-waypoint execution
 (ertools.benchmarks.fbm2h.sample: 120 Hz mocap, 0.2 mm and 0.5 mrad of noise, one tracking
 loss while driving, a tilted marker set), its noisy marker stream scored as ``ertools score
-fbm2h`` scores it (``compute`` then ``with_intervals``, the pure stages of ``score_found``; the
+fbm2h`` scores it (``compute`` then ``with_intervals``, the pure stages of ``score_runs``; the
 reached moments are the logged ones: EXECUTING_GOAL to the Client's COMPLETED_GOAL), against
 the simulator's noiseless truth (``expected``: the stop poses against the waypoints, with the
 seed's formulas).

@@ -27,8 +27,8 @@ from ertools.benchmarks.common.inputs import (
     unscoreable_input,
 )
 from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, NODES, RULE_SETS, Fbm2hOptions
-from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, load, locate_runs
-from ertools.benchmarks.fbm2h.pipeline import score_found
+from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, find_runs, load
+from ertools.benchmarks.fbm2h.pipeline import score_runs
 from ertools.benchmarks.fbm2h.result import Fbm2hResult
 from ertools.benchmarks.fbm2h.runs import StopParams
 from ertools.benchmarks.legacy import LegacyBenchmark
@@ -378,8 +378,8 @@ error, the segment time; then position_accuracy, orientation_accuracy and execut
     inputs=INPUTS,
     make_options=make_options,
     load=load,
-    find_runs=locate_runs,
-    score_runs=score_found,
+    find_runs=find_runs,
+    score_runs=score_runs,
     ranking=Ranking(
         key=lambda r: r.position_accuracy,
         lower_is_better=True,

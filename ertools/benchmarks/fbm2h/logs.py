@@ -1,5 +1,5 @@
 """FBM2@Home log reading: the configs and the marker set poses (``load``), then the reached
-moments from the states, a timing file or stops in the ground truth (``locate_runs``)."""
+moments from the states, a timing file or stops in the ground truth (``find_runs``)."""
 
 from __future__ import annotations
 
@@ -106,7 +106,7 @@ class Fbm2hLogs:
 
 @dataclass(frozen=True)
 class Fbm2hRuns:
-    """What :func:`locate_runs` found: the reached moments, the goal list they close (given,
+    """What :func:`find_runs` found: the reached moments, the goal list they close (given,
     or the one the BmBox sent), the waypoints not reached and why, and warnings."""
 
     moments: ReachedMoments
@@ -142,7 +142,7 @@ def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
     except TopicError:
         if not options.pose_2015 or spec.given:
             raise
-        # /tf without the marker set: the topic, said in the result (score_found).
+        # /tf without the marker set: the topic, said in the result (score_runs).
         marker = read_source(list(plist), spec, defaults, what="marker set poses")
     if len(marker) == 0:
         raise SegmentationError(f"{marker.source or plist[0]}: the marker set pose stream is empty")
@@ -204,7 +204,7 @@ def _stateless(bag: Path, options: Fbm2hOptions) -> str:
     )
 
 
-def locate_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
+def find_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
     """The reached moments: from the states, a timing file or stops in the ground truth.
 
     Raises:

@@ -42,7 +42,7 @@ from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, TF_2015, Fbm2hOpt
 from ertools.benchmarks.fbm2h.formula import robot_poses_at, segment_errors
 from ertools.benchmarks.fbm2h.goal import GoalList
 from ertools.benchmarks.fbm2h.intervals import Moments, intervals, measure_model
-from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, invalid_warning, load, locate_runs
+from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, find_runs, invalid_warning, load
 from ertools.benchmarks.fbm2h.result import Fbm2hResult, SegmentResult
 from ertools.benchmarks.fbm2h.rules import (
     RULE_ORIENTATION_WRAP,
@@ -446,7 +446,7 @@ def _frozen_warnings(
     return out
 
 
-def score_found(logs: Fbm2hLogs, runs: Fbm2hRuns, options: Fbm2hOptions) -> Fbm2hResult:
+def score_runs(logs: Fbm2hLogs, runs: Fbm2hRuns, options: Fbm2hOptions) -> Fbm2hResult:
     """Score the reached moments (:func:`compute`), with the provenance of the inputs."""
     provenance = Provenance(
         inputs=tuple(str(p) for p in logs.paths)
@@ -576,4 +576,4 @@ def _is_tf_2015(marker: PoseStream) -> bool:
 def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
     """Read the bags and configs, find the reached moments and score them."""
     logs = load(paths, options)
-    return score_found(logs, locate_runs(logs, options), options)
+    return score_runs(logs, find_runs(logs, options), options)
