@@ -21,7 +21,8 @@ import numpy as np
 
 from ertools.arrays import F64
 from ertools.benchmarks.common.hygiene import drop_invalid
-from ertools.benchmarks.fbm2h.runs import StopParams, detect_stops
+from ertools.benchmarks.fbm2h.config import StopParams
+from ertools.benchmarks.fbm2h.runs import detect_stops
 from ertools.configs.transform import MarkerTransform, TransformSpread
 from ertools.errors import ConfigError, SegmentationError
 from ertools.geometry import (

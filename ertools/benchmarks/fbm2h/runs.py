@@ -28,6 +28,7 @@ import numpy.typing as npt
 from ertools.arrays import F64, I64
 from ertools.benchmarks.common import motion
 from ertools.benchmarks.common.ending import end_payload_deviation, end_payload_warnings
+from ertools.benchmarks.fbm2h.config import StopParams
 from ertools.errors import SegmentationError
 from ertools.fidelity import Deviation
 from ertools.states import BmBoxState, ClientState, EndReason, RefBoxState, end_reason
@@ -400,28 +401,6 @@ def from_timing(t_ns: I64, labels: tuple[str, ...]) -> ReachedMoments:
         tuple("" for _ in range(len(t) - 1)),
         notes=tuple(f"{labels[k + 1]} closes segment {k}" for k in range(len(t) - 1)),
     )
-
-
-@dataclass(frozen=True)
-class StopParams:
-    """Thresholds of the ``auto`` stop detector.
-
-    Attributes:
-        speed: m/s; the robot counts as stopped below it (mocap jitter on a still marker set
-            gives ~1 mm over the window, i.e. a few mm/s; the 2015 test robot crept at a few
-            cm/s while "standing" at its waypoints).
-        yaw_rate: rad/s; also required, so a robot turning on the spot is not "stopped".
-        min_duration_s: a stop lasts at least this long (the 2015 robot paused 0.7 to 3 s).
-        window_s: speeds are displacements over this window (per-sample differences of 120 Hz
-            mocap are dominated by jitter).
-        radius: metres; a stop is assigned to a waypoint only if it lies this close to it.
-    """
-
-    speed: float = 0.05
-    yaw_rate: float = 0.1
-    min_duration_s: float = 0.5
-    window_s: float = 0.5
-    radius: float = 0.5
 
 
 def detect_stops(
