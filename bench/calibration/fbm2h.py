@@ -20,7 +20,8 @@ from scipy.spatial.transform import Rotation
 from ertools.benchmarks.fbm2h import sample as sim_fbm2h
 from ertools.benchmarks.fbm2h.config import Fbm2hOptions
 from ertools.benchmarks.fbm2h.goal import parse_goal
-from ertools.benchmarks.fbm2h.pipeline import compute, with_intervals
+from ertools.benchmarks.fbm2h.intervals import with_intervals
+from ertools.benchmarks.fbm2h.pipeline import compute
 from ertools.benchmarks.fbm2h.runs import ReachedMoments
 from ertools.configs.transform import MarkerTransform, parse_transform
 from ertools.streams import PoseStream

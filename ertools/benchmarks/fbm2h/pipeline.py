@@ -41,7 +41,7 @@ from ertools.benchmarks.common.validity import (
 from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, TF_2015, Fbm2hOptions
 from ertools.benchmarks.fbm2h.formula import robot_poses_at, segment_errors
 from ertools.benchmarks.fbm2h.goal import GoalList
-from ertools.benchmarks.fbm2h.intervals import Moments, intervals, measure_model
+from ertools.benchmarks.fbm2h.intervals import with_intervals
 from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, find_runs, invalid_warning, load
 from ertools.benchmarks.fbm2h.result import Fbm2hResult, SegmentResult
 from ertools.benchmarks.fbm2h.rules import (
@@ -56,7 +56,7 @@ from ertools.benchmarks.fbm2h.runs import ReachedMoments
 from ertools.configs.transform import MarkerTransform
 from ertools.errors import ConfigError, SegmentationError
 from ertools.fidelity import Deviation
-from ertools.geometry import compose, rotate, wrap_angle, yaw_from_quat
+from ertools.geometry import compose, yaw_from_quat
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import ns_to_s, s_to_ns
 
@@ -493,78 +493,6 @@ def score_runs(logs: Fbm2hLogs, runs: Fbm2hRuns, options: Fbm2hOptions) -> Fbm2h
         "microseconds later"
     )
     return replace(result, deviations=(*result.deviations, deviation))
-
-
-VELOCITY_FRAMES = 5
-
-
-def with_intervals(
-    result: Fbm2hResult,
-    marker: PoseStream,
-    transform: MarkerTransform,
-    moments: ReachedMoments,
-    options: Fbm2hOptions,
-) -> Fbm2hResult:
-    """``result`` with the intervals of its scores (:mod:`ertools.benchmarks.fbm2h.intervals`);
-    unchanged with ``--draws 0`` or nothing scored."""
-    ok = [s for s in result.segments if s.status == "ok" and s.robot is not None]
-    if options.draws <= 0 or not ok:
-        return result
-    marker, _ = drop_invalid(marker)
-    q = np.array([s.end_ns for s in ok], dtype=np.int64)
-    gap = s_to_ns(options.max_gap_s)
-    t_mr = transform.arrays()
-    identity = (np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
-    at_marker = robot_poses_at(marker, identity, q, gap)
-    robot = np.array([s.robot for s in ok], dtype=np.float64)
-    t = marker.t_ns
-    nearest = np.clip(np.searchsorted(t, q), 0, len(t) - 1)
-    lever = rotate(marker.quat_xyzw[nearest], np.broadcast_to(t_mr[0], (len(q), 3)).copy())
-    lo = np.clip(np.searchsorted(t, q, side="right") - 1, 0, len(t) - 1)
-    hi = np.clip(lo + 1, 0, len(t) - 1)
-    span = (t[hi] - t[lo]).astype(np.float64)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        w = np.where(span > 0, (q - t[lo]) / span, 0.0)
-    interpolated = robot_poses_at(marker, t_mr, q, gap).interpolated
-    averaging = np.where(interpolated, np.sqrt(w**2 + (1.0 - w) ** 2), 1.0)
-    dts = np.diff(t)
-    period = int(np.median(dts[dts > 0])) if np.any(dts > 0) else 0
-    velocity = np.zeros((len(q), 3))
-    if period > 0:
-        # over 5 frames each side: one frame's difference would read the noise as motion
-        base = VELOCITY_FRAMES * period
-        after = robot_poses_at(marker, t_mr, q + base, gap).xyyaw
-        before = robot_poses_at(marker, t_mr, q - base, gap).xyyaw
-        step = after - before
-        step[:, 2] = wrap_angle(step[:, 2])
-        velocity = np.nan_to_num(step / (2 * base / 1e9))
-    m = Moments(
-        robot=robot,
-        target=np.array([s.target for s in ok], dtype=np.float64),
-        lever=np.nan_to_num(lever),
-        heading=np.nan_to_num(at_marker.xyyaw[:, 2]),
-        averaging=averaging,
-        velocity=velocity,
-    )
-    indices = [s.index for s in ok]
-    estimates = [
-        result.position_accuracy,
-        result.orientation_accuracy,
-        *[s.distance_error for s in ok],
-        *[s.orientation_error for s in ok],
-    ]
-    found = intervals(
-        m,
-        indices,
-        estimates,
-        measure_model(marker, transform.spread),
-        orientation_2015=result.orientation_2015,
-        divide_by=len(result.segments) if result.unscored_2015 else len(ok),
-        draws=options.draws,
-        seed=options.seed,
-        confidence=options.confidence,
-    )
-    return replace(result, intervals=found)
 
 
 def _is_tf_2015(marker: PoseStream) -> bool:

@@ -12,10 +12,9 @@ import yaml
 
 from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
-from ertools.benchmarks.common.uncertainty import Interval, uncertainty_rows
+from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, uncertainty_rows
 from ertools.benchmarks.common.validity import GapOnPath, Validity, cell
 from ertools.benchmarks.fbm2h.goal import GoalList
-from ertools.benchmarks.fbm2h.intervals import Fbm2hIntervals
 from ertools.configs.transform import MarkerTransform
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames
@@ -28,6 +27,17 @@ if TYPE_CHECKING:
     import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 Pose2 = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class Fbm2hIntervals:
+    """The intervals of one result: accuracies, then per scored segment index."""
+
+    position: Interval | None
+    orientation: Interval | None
+    distance: dict[int, Interval | None]
+    angle: dict[int, Interval | None]
+    uncertainty: Uncertainty
 
 
 @dataclass(frozen=True)

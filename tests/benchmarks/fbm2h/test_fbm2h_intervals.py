@@ -29,8 +29,9 @@ from ertools.benchmarks.fbm2h.intervals import (
     intervals,
     measure_model,
     perturbed_scores,
+    with_intervals,
 )
-from ertools.benchmarks.fbm2h.pipeline import compute, with_intervals
+from ertools.benchmarks.fbm2h.pipeline import compute
 from ertools.benchmarks.fbm2h.runs import ReachedMoments
 from ertools.configs.transform import SPREAD_KEY, parse_transform
 from ertools.streams import PoseStream
