@@ -15,24 +15,37 @@ from collections.abc import Iterator, Sequence
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
+import numpy.typing as npt
 
-from ertools.arrays import I64
+from ertools.arrays import I64, U8
 from ertools.errors import BagError
 from ertools.io import pipeline
 from ertools.io.bagfile import BagFile
-from ertools.io.decode.fast import FAST_TYPES, Decoded, LayoutMismatchError, decode, to_batch
+from ertools.io.decode.fast import FAST_TYPES, LayoutMismatchError, decode, gather, to_batch
 from ertools.io.decode.posebatch import PoseBatch, concat_batches
-from ertools.io.decode.uniform import Rows, decode_uniform
+from ertools.io.decode.uniform import (
+    Layout,
+    Rows,
+    decoded,
+    empty_rows,
+    layout_of,
+    same_structure,
+    write_rows,
+)
 from ertools.io.mcap.index import McapIndex
 from ertools.io.model import TF_TYPES, Conn
 from ertools.io.pipeline import (
     Group,
     Located,
+    LocatedMany,
+    Request,
     Run,
     ascending,
+    group_positions,
     joined,
     prefetched,
 )
+from ertools.io.ros1.layout import cat_arrays
 from ertools.io.ros1.runs import chunk_group, ros1_runs
 from ertools.io.rosbag2.metadata import readable_files, sqlite_rows
 from ertools.progress import current
@@ -47,88 +60,241 @@ log = logging.getLogger("ertools.io.bulk")
 
 
 class _Assembler:
-    """Collects per-chunk decoded rows into one batch in the reference order.
+    """Collects a read's decoded rows into one batch in the reference order.
 
-    Types with one pose per message are written straight into preallocated arrays at their
-    reference positions (no concatenation, no sort); TF messages, which may hold several
-    transforms, are collected and ordered at the end.
+    With the message count known up front (ROS1, MCAP), rows are written straight into
+    preallocated arrays at their messages' reference positions (no concatenation, no sort).
+    Messages decoded field by field that give other than one row (a TF message with several
+    transforms) are collected apart and merged with the others at the end, as are all rows of
+    a read whose count is unknown (sqlite rows of several storage files, merged by time).
     """
 
     def __init__(self, msgtype: str, count: int | None) -> None:
-        self.multi = msgtype in TF_TYPES or count is None
-        # sqlite rows of several storage files come file by file: merged by time at the end
+        self.tf = msgtype in TF_TYPES
         self.by_time = count is None
-        n = 0 if self.multi or count is None else count
+        n = 0 if count is None else count
         self.t_record = np.empty(n, dtype=np.int64)
         self.t_header = np.empty(n, dtype=np.int64)
         self.xyz = np.empty((n, 3))
         self.quat = np.empty((n, 4))
         self.frame_idx = np.zeros(n, dtype=np.int32)
         self.child_idx = np.zeros(n, dtype=np.int32)
+        # which messages have their row in the arrays (only tracked for TF, which may have
+        # rows elsewhere, in parts)
+        self.filled = np.zeros(n if self.tf else 0, dtype=bool)
         self.frames: dict[str, int] = {"": 0}
         self.parts: list[tuple[I64, PoseBatch]] = []
 
-    def run_slice(self, pos: I64) -> slice | None:
-        """The rows at ``pos`` as a slice when they are consecutive and ascending (one
-        connection read in order): written as a block, or decoded in place."""
-        if self.multi or not len(pos):
-            return None
-        if int(pos[-1]) - int(pos[0]) == len(pos) - 1 and ascending(pos):
+    @property
+    def direct(self) -> bool:
+        """Whether one-row-per-message decoders write into the arrays (count known)."""
+        return not self.by_time
+
+    def code(self, name: str | None) -> int:
+        return self.frames.setdefault(name or "", len(self.frames))
+
+    def at(self, pos: I64) -> slice | I64:
+        """The rows of messages ``pos``: a slice when consecutive and ascending (one
+        connection read in order: written as a block, or decoded in place)."""
+        if len(pos) and int(pos[-1]) - int(pos[0]) == len(pos) - 1 and ascending(pos):
             return slice(int(pos[0]), int(pos[-1]) + 1)
-        return None
+        return pos
 
-    def rows(self, at: slice) -> Rows:
-        """Where a decoder may write the rows ``at`` itself."""
-        return Rows(self.t_header[at], self.xyz[at], self.quat[at])
-
-    def wrote(self, at: slice, t_record: I64, dec: Decoded) -> None:
-        """Rows ``at`` were decoded in place (see :meth:`rows`): their record times and
-        frame names (types without a header are timed by record time, as in ``to_batch``)."""
+    def write(self, pos: I64, t_record: I64, lay: Layout, rows: U8, skip: int) -> None:
+        """Rows in layout ``lay`` (checked) of the messages ``pos`` decoded into place."""
+        if not self.direct:
+            tmp = empty_rows(len(pos))
+            write_rows(rows, skip, lay, tmp)
+            self.parts.append((pos, to_batch(rows, decoded(lay, tmp), t_record)))
+            return
+        at = self.at(pos)
+        if isinstance(at, slice):
+            write_rows(rows, skip, lay, Rows(self.t_header[at], self.xyz[at], self.quat[at]))
+        else:
+            tmp = empty_rows(len(pos))
+            write_rows(rows, skip, lay, tmp)
+            self.t_header[at] = tmp.t_header
+            _scatter(self.xyz, at, tmp.xyz)
+            _scatter(self.quat, at, tmp.quat)
         self.t_record[at] = t_record
-        if not dec.has_header:
-            self.t_header[at] = t_record
-        self.frame_idx[at] = self.frames.setdefault(dec.frame_text or "", len(self.frames))
-        self.child_idx[at] = self.frames.setdefault(dec.child_text or "", len(self.frames))
+        if lay.stamp is None:
+            self.t_header[at] = t_record  # no header: timed by record time, as in to_batch
+        self.frame_idx[at] = self.code(lay.frame)
+        self.child_idx[at] = self.code(lay.child)
+        if self.tf:
+            self.filled[at] = True
 
-    def add(self, pos: I64, batch: PoseBatch) -> None:
-        """Decoded rows and the reference position of the message of each row."""
-        if self.multi:
+    def add(self, pos: I64, batch: PoseBatch, one_each: bool) -> None:
+        """Decoded rows and the reference position of the message of each row (``one_each``:
+        every message has exactly one row)."""
+        if not self.direct or not one_each:
             self.parts.append((pos, batch))
             return
-        remap = np.array(
-            [self.frames.setdefault(f, len(self.frames)) for f in batch.frames], np.int32
-        )
-        run = self.run_slice(pos)
-        # consecutive rows are written as a block (a copy, not a scatter)
-        at: slice | I64 = run if run is not None else pos
+        remap = np.array([self.code(f) for f in batch.frames], np.int32)
+        at = self.at(pos)
         self.t_record[at] = batch.t_record
         self.t_header[at] = batch.t_header
         self.xyz[at] = batch.xyz
         self.quat[at] = batch.quat_xyzw
         self.frame_idx[at] = remap[batch.frame_idx]
         self.child_idx[at] = remap[batch.child_idx]
+        if self.tf:
+            self.filled[at] = True
+
+    def _arrays(self) -> PoseBatch:
+        return PoseBatch(
+            self.t_record,
+            self.t_header,
+            self.xyz,
+            self.quat,
+            self.frame_idx,
+            self.child_idx,
+            tuple(self.frames),
+        )
 
     def result(self) -> PoseBatch:
-        if not self.multi:
-            return PoseBatch(
-                self.t_record,
-                self.t_header,
-                self.xyz,
-                self.quat,
-                self.frame_idx,
-                self.child_idx,
-                tuple(self.frames),
-            )
         if not self.parts:
-            return PoseBatch.empty()
-        batch = concat_batches([p[1] for p in self.parts])
-        pos = np.concatenate([p[0] for p in self.parts])
+            if self.tf and not bool(self.filled.all()):
+                return self._arrays().take(np.flatnonzero(self.filled))
+            return self._arrays()
+        done = np.flatnonzero(self.filled) if self.tf else np.empty(0, np.int64)
+        parts = [*self.parts, (done, self._arrays().take(done))] if len(done) else self.parts
+        batch = concat_batches([p[1] for p in parts])
+        pos = np.concatenate([p[0] for p in parts])
         if len(pos) > 1 and np.any(pos[1:] < pos[:-1]):
             batch = batch.take(np.argsort(pos, kind="stable"))
         t = batch.t_record
         if self.by_time and len(t) > 1 and np.any(t[1:] < t[:-1]):
             batch = batch.take(np.argsort(t, kind="stable"))
         return batch
+
+
+def _scatter(dst: npt.NDArray[np.float64], at: I64, src: npt.NDArray[np.float64]) -> None:
+    """``dst[at] = src`` for (n, k) float64 rows, a row at a time rather than a value."""
+    k = dst.shape[1]
+    block = np.dtype((np.void, 8 * k))
+    if dst.flags.c_contiguous and src.flags.c_contiguous:
+        dst.view(block).reshape(len(dst))[at] = src.view(block).reshape(len(src))
+    else:
+        dst[at] = src
+
+
+class KnownSpans:
+    """Messages whose data spans are known already (sqlite rows, a scan's copied records)."""
+
+    def __init__(self, buf: U8, start: I64, length: I64) -> None:
+        self.buf, self.start, self.length = buf, start, length
+
+    def spans(self) -> tuple[I64, I64]:
+        return self.start, self.length
+
+    def size_hint(self, i: int) -> int | None:
+        return int(self.length[i])
+
+    def rows(self, idx: I64, size: int) -> tuple[U8, int] | None:
+        start = self.start[idx]
+        if not len(idx) or not bool(np.all(self.length[idx] == size)):
+            return None
+        if int(start.min()) < 0 or int(start.max()) + size > len(self.buf):
+            return None
+        return gather(self.buf, start, size), 0
+
+
+# Messages of one run decoded by their own layout in at most this many classes (connection,
+# then data length); past it the run is decoded field by field.
+MAX_CLASSES = 16
+
+
+class _Decoder:
+    """Decodes the runs of one read into its :class:`_Assembler`, class by class.
+
+    A class is the messages of one connection in a run (a topic recorded by one logger has
+    one frame name, so one layout): its records are gathered with one gather each (record
+    head and message data), checked (the record's own head, and the bytes every message of
+    the layout must share) and its stamps and poses copied out as strided columns. A class
+    that does not fit (lengths that vary, other frame names, several transforms per TF
+    message, a record in an unusual layout) goes the general way: checked spans, then one
+    layout per data length, and field by field for what still differs.
+    """
+
+    def __init__(self, msgtype: str, cdr: bool, out: _Assembler) -> None:
+        self.msgtype, self.cdr, self.out = msgtype, cdr, out
+        self.layouts: dict[tuple[int, int], Layout] = {}
+
+    def _layout(self, key: tuple[int, int], rows: U8, skip: int) -> Layout | None:
+        """The layout of the rows' messages (the one of ``key`` seen before, or learnt from
+        the first row), None when some row does not share it."""
+        lay = self.layouts.get(key)
+        if lay is not None and same_structure(rows, skip, lay):
+            return lay
+        lay = layout_of(self.msgtype, self.cdr, rows[0, skip:].tobytes())
+        if lay is None or lay.size != rows.shape[1] - skip or not same_structure(rows, skip, lay):
+            return None
+        self.layouts[key] = lay
+        return lay
+
+    def run(self, run: Run) -> None:
+        conn = run.conn
+        if not len(conn):
+            return
+        if int(conn[0]) == int(conn[-1]) and bool(np.all(conn == conn[0])):
+            classes = [(int(conn[0]), np.arange(len(conn), dtype=np.int64))]
+        else:
+            classes = group_positions(conn)
+        if len(classes) > MAX_CLASSES:
+            self.general(run, np.arange(len(conn), dtype=np.int64))
+            return
+        rest = []
+        for cid, idx in classes:
+            if not self.fast(run, cid, idx):
+                rest.append(idx)
+        if rest:
+            self.general(run, cat_arrays(rest) if len(rest) == 1 else np.sort(np.concatenate(rest)))
+
+    def fast(self, run: Run, cid: int, idx: I64) -> bool:
+        """One class by one gather of its records; False when it does not fit."""
+        lay = self.layouts.get((cid, -1))
+        size = lay.size if lay is not None else run.records.size_hint(int(idx[0]))
+        if size is None:
+            return False
+        got = run.records.rows(idx, size)
+        if got is None:
+            return False
+        rows, skip = got
+        found = self._layout((cid, -1), rows, skip)
+        if found is None:
+            return False
+        self.out.write(run.pos[idx], run.t_record[idx], found, rows, skip)
+        return True
+
+    def general(self, run: Run, idx: I64) -> None:
+        """Messages ``idx`` of a run from their checked spans: one layout per data length
+        where the messages share it, field by field otherwise."""
+        start, length = run.spans()
+        start, length = start[idx], length[idx]
+        lengths = group_positions(length)
+        if len(lengths) <= MAX_CLASSES:
+            rest = []
+            for size, sub in lengths:
+                if size <= 0 or int(start[sub].min()) < 0:
+                    rest.append(sub)
+                    continue
+                rows = gather(run.buf, start[sub], size)
+                lay = self._layout((-1, size), rows, 0)
+                if lay is None:
+                    rest.append(sub)
+                    continue
+                self.out.write(run.pos[idx[sub]], run.t_record[idx[sub]], lay, rows, 0)
+            if not rest:
+                return
+            sub = np.sort(np.concatenate(rest))
+            idx, start, length = idx[sub], start[sub], length[sub]
+        dec = decode(self.msgtype, self.cdr, run.buf, start, length)
+        one_each = len(dec.msg_index) == len(idx) and bool(
+            np.all(dec.msg_index == np.arange(len(idx)))
+        )
+        t_rec = run.t_record[idx]
+        self.out.add(run.pos[idx][dec.msg_index], to_batch(run.buf, dec, t_rec), one_each)
 
 
 def mcap_index(bag: BagFile) -> McapIndex | None:
@@ -139,73 +305,76 @@ def mcap_index(bag: BagFile) -> McapIndex | None:
     return McapIndex.of(bag)
 
 
-def _label(bag: BagFile, conns: Sequence[Conn]) -> str:
-    topic = conns[0].topic if conns else "?"
-    return f"reading {topic} from {bag.path.name}"
-
-
 def _mcap_runs(
-    bag: BagFile,
-    conns: Sequence[Conn],
-    lo: int | None,
-    hi: int | None,
-    progress: Reporter | None = None,
-) -> Located | None:
+    bag: BagFile, requests: Sequence[Request], progress: Reporter | None = None
+) -> LocatedMany | None:
     index = mcap_index(bag)
     if index is None:
         return None
-    plan = index.plan(conns, lo, hi)
-    count, load, weights = index.run_loader(plan)
-    compressed = any(c.compression for chunks in plan.chunks for c in chunks)
-
-    def load_run(k: int, scratch: list[Any]) -> Run:
-        pos, buf, start, length = load(k, scratch)
-        return pos, buf, start, length, plan.t_record[pos]
-
+    plans = index.plan_many(requests)
+    count, load, weights = index.run_loader(plans)
+    compressed = any(c.compression for plan in plans for chunks in plan.chunks for c in chunks)
+    topics = list(dict.fromkeys(c.topic for r in requests for c in r.conns))
     runs = prefetched(
         count,
-        load_run,
+        load,
         parallel=compressed,
         progress=progress,
         weights=weights,
-        label=_label(bag, conns),
+        label=f"reading {', '.join(topics) or '?'} from {bag.path.name}",
     )
-    return Located(len(plan.t_record), runs)
+    return LocatedMany([len(p.t_record) for p in plans], runs)
 
 
-def _sqlite_runs(
-    bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None
-) -> Located | None:
-    batches = sqlite_rows(bag.path, conns, lo, hi)
-    if batches is None:
+def _one_by_one(count: int, located: Iterator[tuple[int, Run]]) -> Iterator[list[Run | None]]:
+    """Runs of several requests read one request after the other, as :class:`LocatedMany`
+    gives them (the other requests None)."""
+    for i, run in located:
+        out: list[Run | None] = [None] * count
+        out[i] = run
+        yield out
+
+
+def _sqlite_runs(bag: BagFile, requests: Sequence[Request]) -> LocatedMany | None:
+    found = [sqlite_rows(bag.path, r.conns, r.lo, r.hi) for r in requests]
+    if any(f is None for f in found):
         return None
 
-    def runs() -> Iterator[Run]:
-        done = 0
-        for buf, start, length, t_rec in batches:
-            yield np.arange(done, done + len(start), dtype=np.int64), buf, start, length, t_rec
-            done += len(start)
+    def runs() -> Iterator[tuple[int, Run]]:
+        for i, (req, batches) in enumerate(zip(requests, found, strict=True)):
+            assert batches is not None
+            cid = req.conns[0].id if req.conns else 0  # rosbag2: one connection per topic
+            done = 0
+            for buf, start, length, t_rec in batches:
+                pos = np.arange(done, done + len(start), dtype=np.int64)
+                conn = np.full(len(start), cid, dtype=np.int64)
+                yield i, Run(pos, buf, t_rec, conn, KnownSpans(buf, start, length))
+                done += len(start)
 
-    return Located(None, runs())
+    return LocatedMany([None] * len(requests), _one_by_one(len(requests), runs()))
 
 
-def _scanned_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None) -> Located:
+def _scanned_runs(bag: BagFile, requests: Sequence[Request]) -> LocatedMany:
     """Messages of an MCAP file its indexes do not cover, read record by record: the runs
     of copied message bytes the scan gives, so the same decoders apply."""
-    runs = list(cast("McapFile", bag).scanned_runs(conns, lo, hi))  # only scanned MCAP files
-    count = sum(len(r[0]) for r in runs)
-    return Located(count, iter([r[:5] for r in runs]))
+    mcap = cast("McapFile", bag)  # only scanned MCAP files
+    every = [list(mcap.scanned_runs(r.conns, r.lo, r.hi)) for r in requests]
+
+    def runs() -> Iterator[tuple[int, Run]]:
+        for i, found in enumerate(every):
+            for pos, buf, start, length, t_rec, cid in found:
+                yield i, Run(pos, buf, t_rec, cid, KnownSpans(buf, start, length))
+
+    counts: list[int | None] = [sum(len(r[0]) for r in found) for found in every]
+    return LocatedMany(counts, _one_by_one(len(requests), runs()))
 
 
-def locate(
-    bag: BagFile,
-    conns: Sequence[Conn],
-    start_ns: int | None,
-    end_ns: int | None,
-    progress: Reporter | None = None,
-) -> Located | None:
-    """The messages of ``conns`` with record time in [start_ns, end_ns], or None when the
-    format has no bulk access (then the caller reads per message).
+def locate_many(
+    bag: BagFile, requests: Sequence[Request], progress: Reporter | None = None
+) -> LocatedMany | None:
+    """The messages of each request (connections, record-time window), located in one pass
+    over the file's index and loaded in one pass over the chunks any of them touches; None
+    when the format has no bulk access (then the caller reads per message).
 
     ROS1 and MCAP reads report the bytes of each group of chunks to ``progress`` (default:
     the reporter made current by :func:`ertools.progress.reporting`, if any).
@@ -216,14 +385,27 @@ def locate(
     if progress is None:
         progress = current()
     if bag.format in ("ros1", "ros1-active"):
-        return ros1_runs(cast("Ros1Bag", bag), conns, start_ns, end_ns, progress)
+        return ros1_runs(cast("Ros1Bag", bag), requests, progress)
     if bag.format == "rosbag2-sqlite3":
-        return _sqlite_runs(bag, conns, start_ns, end_ns)
+        return _sqlite_runs(bag, requests)
     if getattr(bag, "scanned", False):
-        return _scanned_runs(bag, conns, start_ns, end_ns)
+        return _scanned_runs(bag, requests)
     if bag.format in ("mcap", "rosbag2-mcap"):
-        return _mcap_runs(bag, conns, start_ns, end_ns, progress)
+        return _mcap_runs(bag, requests, progress)
     return None
+
+
+def locate(
+    bag: BagFile,
+    conns: Sequence[Conn],
+    start_ns: int | None,
+    end_ns: int | None,
+    progress: Reporter | None = None,
+) -> Located | None:
+    """The messages of ``conns`` with record time in [start_ns, end_ns]: one request of
+    :func:`locate_many`."""
+    found = locate_many(bag, [Request(tuple(conns), start_ns, end_ns)], progress)
+    return None if found is None else found.only(0)
 
 
 def load_all_chunks(bag: BagFile, progress: Reporter | None = None) -> int:
@@ -276,10 +458,8 @@ def load_all_chunks(bag: BagFile, progress: Reporter | None = None) -> int:
     return total
 
 
-def try_fast_batch(
-    bag: BagFile, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
-) -> PoseBatch | None:
-    """Pose rows of ``conns`` decoded in bulk, or None when the fast path does not apply."""
+def _fast_type(bag: BagFile, conns: Sequence[Conn]) -> str | None:
+    """The pose type the bulk decoders read ``conns`` as, None (logged) when they do not."""
     types = {c.msgtype for c in conns}
     encodings = {c.encoding for c in conns}
     if len(types) != 1 or len(encodings) != 1 or next(iter(types)) not in FAST_TYPES:
@@ -289,34 +469,63 @@ def try_fast_batch(
             ", ".join(sorted(types)),
         )
         return None
-    msgtype = next(iter(types))
-    cdr = conns[0].encoding == "cdr"
+    return next(iter(types))
+
+
+def try_fast_batches(bag: BagFile, requests: Sequence[Request]) -> list[PoseBatch | None]:
+    """Pose rows of each request decoded in bulk, from one pass over the file; None for a
+    request the fast path does not apply to (the caller reads it per message)."""
+    out: list[PoseBatch | None] = [None] * len(requests)
+    kinds = [_fast_type(bag, r.conns) for r in requests]
+    mine = [i for i, k in enumerate(kinds) if k is not None]
+    if not mine:
+        return out
     try:
-        found = locate(bag, conns, start_ns, end_ns)
-        if found is not None:
-            # Decoded here, not on the loading threads: its many small NumPy calls hold the
-            # GIL, and two threads decoding were slower than one (measured).
-            out = _Assembler(msgtype, found.count)
-            for pos, buf, start, length, t_rec in found.runs:
-                # The usual case, consecutive rows: decoded straight into the result.
-                at = out.run_slice(pos)
-                into = out.rows(at) if at is not None else None
-                dec = decode_uniform(msgtype, cdr, buf, start, length, into=into)
-                if dec is not None and at is not None:
-                    out.wrote(at, t_rec, dec)
-                    continue
-                if dec is None:
-                    dec = decode(msgtype, cdr, buf, start, length)
-                out.add(pos[dec.msg_index], to_batch(buf, dec, t_rec))
-            return out.result()
+        found = locate_many(bag, [requests[i] for i in mine])
     except LayoutMismatchError as err:
-        log.info(
-            "%s: %s on %s not in the standard layout (%s); decoding per message",
-            bag.path,
-            msgtype,
-            conns[0].topic,
-            err,
-        )
-        return None
-    log.info("%s: no bulk reader for %s files; decoding per message", bag.path, bag.format)
-    return None
+        log.info("%s: not read in bulk (%s); decoding per message", bag.path, err)
+        return out
+    if found is None:
+        log.info("%s: no bulk reader for %s files; decoding per message", bag.path, bag.format)
+        return out
+    assemblers = [
+        _Assembler(cast(str, kinds[i]), n) for i, n in zip(mine, found.counts, strict=True)
+    ]
+    decoders: list[_Decoder | None] = [
+        _Decoder(cast(str, kinds[i]), requests[i].conns[0].encoding == "cdr", a)
+        for i, a in zip(mine, assemblers, strict=True)
+    ]
+    try:
+        # Decoded here, not on the loading threads: its many small NumPy calls hold the GIL,
+        # and two threads decoding were slower than one (measured).
+        for runs in found.runs:
+            for k, run in enumerate(runs):
+                dec = decoders[k]
+                if run is None or dec is None:
+                    continue
+                try:
+                    dec.run(run)
+                except LayoutMismatchError as err:
+                    req = requests[mine[k]]
+                    log.info(
+                        "%s: %s on %s not in the standard layout (%s); decoding per message",
+                        bag.path,
+                        kinds[mine[k]],
+                        req.conns[0].topic,
+                        err,
+                    )
+                    decoders[k] = None
+    except LayoutMismatchError as err:
+        log.info("%s: not read in bulk (%s); decoding per message", bag.path, err)
+        return out
+    for k, i in enumerate(mine):
+        if decoders[k] is not None:
+            out[i] = assemblers[k].result()
+    return out
+
+
+def try_fast_batch(
+    bag: BagFile, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
+) -> PoseBatch | None:
+    """Pose rows of ``conns`` decoded in bulk, or None when the fast path does not apply."""
+    return try_fast_batches(bag, [Request(tuple(conns), start_ns, end_ns)])[0]

@@ -20,11 +20,12 @@ from collections import deque
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 import numpy as np
 
-from ertools.arrays import I64, U8
+from ertools.arrays import I64, U8, Bool
+from ertools.io.model import Conn
 
 if TYPE_CHECKING:
     from ertools.progress import Reporter
@@ -183,9 +184,47 @@ def group_positions(keys: I64) -> list[tuple[int, I64]]:
     return [(int(sorted_keys[a]), order[a:b]) for a, b in zip(starts, ends, strict=True)]
 
 
-# One run of messages: (reference positions, buffer, data starts, data lengths, record times).
-# The buffer is only valid until the next run is asked for (it may be reused).
-Run = tuple[I64, U8, I64, I64, I64]
+class Records(Protocol):
+    """Where the data of a run's messages lies in its buffer, found and checked by the format
+    that located them (ROS1 message records, MCAP message records, or spans known already)."""
+
+    def spans(self) -> tuple[I64, I64]:
+        """(data start, data length) of every message, each record checked (the general
+        path: any record layout the format allows; a damaged record raises BagError)."""
+        ...
+
+    def size_hint(self, i: int) -> int | None:
+        """The data length of message ``i`` as its record's head gives it, unchecked (what
+        :meth:`rows` is then asked for and checks); None when the head is unusual."""
+        ...
+
+    def rows(self, idx: I64, size: int) -> tuple[U8, int] | None:
+        """The messages ``idx`` as rows of one gather: ``(rows, skip)``, each row the record's
+        head (``skip`` bytes) then its ``size`` data bytes, when every one of them is a record
+        in the format's usual layout whose data is ``size`` bytes long and whose head carries
+        the time (and connection) it was located by. None otherwise: the caller then goes
+        through :meth:`spans`, which handles (or refuses) every other case."""
+        ...
+
+
+@dataclass(frozen=True, eq=False)
+class Run:
+    """The messages of one read in one group of chunks, in its reference order.
+
+    ``pos``: each message's reference position in the whole read; ``buf``: the group's bytes
+    (valid only until the next run of the same read is asked for: it may be reused);
+    ``t_record``: record times; ``conn``: each message's connection id; ``records``: how to
+    find each message's data in ``buf``.
+    """
+
+    pos: I64
+    buf: U8
+    t_record: I64
+    conn: I64
+    records: Records
+
+    def spans(self) -> tuple[I64, I64]:
+        return self.records.spans()
 
 
 @dataclass(frozen=True)
@@ -199,3 +238,58 @@ class Located:
 
     count: int | None
     runs: Iterator[Run]
+
+
+@dataclass(frozen=True)
+class Request:
+    """One read of several sharing a pass over a file: some connections, and the record
+    time window [lo, hi] (None: open) of their messages."""
+
+    conns: tuple[Conn, ...]
+    lo: int | None = None
+    hi: int | None = None
+
+
+@dataclass(frozen=True)
+class LocatedMany:
+    """The messages of several requests located in one pass over a file's index.
+
+    ``counts[i]`` is request i's number of messages (None: unknown up front); each item of
+    ``runs`` is one group of chunks loaded once, with one :class:`Run` per request (None for a
+    request with no message in that group).
+    """
+
+    counts: list[int | None]
+    runs: Iterator[list[Run | None]]
+
+    def only(self, i: int) -> Located:
+        """Request ``i`` alone (the others' runs are skipped, their groups still loaded)."""
+
+        def runs() -> Iterator[Run]:
+            for group in self.runs:
+                run = group[i]
+                if run is not None:
+                    yield run
+
+        return Located(self.counts[i], runs())
+
+
+def window(requests: Sequence[Request]) -> tuple[int | None, int | None]:
+    """The record-time window covering every request's."""
+    los = [r.lo for r in requests if r.lo is not None]
+    his = [r.hi for r in requests if r.hi is not None]
+    lo = min(los) if los and len(los) == len(requests) else None
+    hi = max(his) if his and len(his) == len(requests) else None
+    return lo, hi
+
+
+def in_window(t: I64, lo: int | None, hi: int | None) -> Bool | None:
+    """Which of ``t`` lie in [lo, hi]; None when the window is open on both sides."""
+    if lo is None and hi is None:
+        return None
+    keep = np.ones(len(t), dtype=bool)
+    if lo is not None:
+        keep &= t >= lo
+    if hi is not None:
+        keep &= t <= hi
+    return keep

@@ -356,10 +356,11 @@ def _bulk_states(
         if found is None:
             return None
         pos_parts, t_parts, s_parts, payloads = [], [], [], []
-        for pos, buf, start, length, t_rec in found.runs:
-            state, text = decode_states(buf, start, length, conns[0].encoding == "cdr")
-            pos_parts.append(pos)
-            t_parts.append(t_rec)
+        for run in found.runs:
+            start, length = run.spans()
+            state, text = decode_states(run.buf, start, length, conns[0].encoding == "cdr")
+            pos_parts.append(run.pos)
+            t_parts.append(run.t_record)
             s_parts.append(state)
             payloads.extend(text)
     except LayoutMismatchError as err:

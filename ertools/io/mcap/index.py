@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, BinaryIO
 
 import numpy as np
+import numpy.typing as npt
 
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
@@ -29,7 +30,17 @@ from ertools.io.mcap.crc import crc32
 from ertools.io.mcap.scan import SCAN, mcap_layout, scan_mcap
 from ertools.io.mcap.summary import decompress, file_size, read_summary
 from ertools.io.model import Conn
-from ertools.io.pipeline import Group, group_positions, pread, read_at, scratch_view
+from ertools.io.pipeline import (
+    Group,
+    Request,
+    Run,
+    group_positions,
+    in_window,
+    pread,
+    read_at,
+    scratch_view,
+    window,
+)
 
 if TYPE_CHECKING:
     from ertools.progress import Reporter
@@ -113,6 +124,7 @@ class McapPlan:
     key: I64  # file << 32 | chunk index
     file: I64
     chunks: list[list[Any]]
+    channel: I64
 
 
 class McapIndex:
@@ -131,16 +143,21 @@ class McapIndex:
         return None
 
     def plan(self, conns: Sequence[Conn], lo: int | None, hi: int | None) -> McapPlan:
-        """Locate the messages of ``conns`` in [lo, hi] from the message indexes (no chunk data).
+        """Locate the messages of ``conns`` in [lo, hi]: one request of :meth:`plan_many`."""
+        return self.plan_many([Request(tuple(conns), lo, hi)])[0]
+
+    def plan_many(self, requests: Sequence[Request]) -> list[McapPlan]:
+        """Locate the messages of each request (connections, log-time window) from the message
+        indexes, each in its reference order, reading every message index once (no chunk data).
 
         Raises:
             BagError: damaged index.
             LayoutMismatchError: a file's indexes do not answer for every message (no summary,
                 no message indexes, channels only inside chunks...): the caller falls back.
         """
-
-        topics = {c.topic for c in conns}
-        sels: list[tuple[int, int, int, I64, I64]] = []  # file, chunk idx, chunk offset, t, off
+        lo, hi = window(requests)
+        # per request: file, chunk idx, chunk offset, t, off, channel of each run of entries
+        sels: list[list[tuple[int, int, int, I64, I64, int]]] = [[] for _ in requests]
         chunks_per_file: list[list[Any]] = []
         for fi, path in enumerate(self.files):
             layout = mcap_layout(path)
@@ -148,11 +165,17 @@ class McapIndex:
                 raise LayoutMismatchError(f"MCAP file {path.name}: {layout.why}")
             summary: Any = layout.summary
             with path.open("rb") as f:
-                channels = {cid for cid, ch in layout.channels.items() if ch.topic in topics}
+                # channel -> the requests that want it (by topic, as the readers name them)
+                wants: dict[int, list[int]] = {}
+                for ri, req in enumerate(requests):
+                    topics = {c.topic for c in req.conns}
+                    for cid, ch in layout.channels.items():
+                        if ch.topic in topics:
+                            wants.setdefault(cid, []).append(ri)
                 chunks = summary.chunk_indexes
                 chunks_per_file.append(chunks)
                 total_size = file_size(f)
-                planned = dict.fromkeys(channels, 0)  # messages per channel, for the statistics
+                planned = dict.fromkeys(wants, 0)  # messages per channel, for the statistics
                 for ci, chunk in enumerate(chunks):
                     if lo is not None and chunk.message_end_time < lo:
                         continue
@@ -171,7 +194,7 @@ class McapIndex:
                             "names a channel the summary section does not declare",
                             path=path,
                         )
-                    wanted = [c for c in channels if c in chunk.message_index_offsets]
+                    wanted = [c for c in wants if c in chunk.message_index_offsets]
                     if not wanted:
                         if chunk.message_index_length == 0 and chunk.uncompressed_size:
                             raise LayoutMismatchError("MCAP chunk without message indexes")
@@ -179,37 +202,16 @@ class McapIndex:
                     for cid in wanted:
                         offset = chunk.message_index_offsets[cid]
                         t, off = self._message_index(f, path, offset, cid, total_size, padded=False)
-                        if lo is not None or hi is not None:
-                            keep = np.ones(len(t), dtype=bool)
-                            if lo is not None:
-                                keep &= t >= lo
-                            if hi is not None:
-                                keep &= t <= hi
-                            t, off = t[keep], off[keep]
                         planned[cid] = planned.get(cid, 0) + len(t)
-                        if len(t):
-                            sels.append((fi, ci, int(chunk.chunk_start_offset), t, off))
+                        for ri in wants[cid]:
+                            keep = in_window(t, requests[ri].lo, requests[ri].hi)
+                            tk, ok = (t, off) if keep is None else (t[keep], off[keep])
+                            if len(tk):
+                                start = int(chunk.chunk_start_offset)
+                                sels[ri].append((fi, ci, start, tk, ok, cid))
             if lo is None and hi is None:
                 _check_counts(path, summary, planned)
-        if not sels:
-            e = np.empty(0, np.int64)
-            return McapPlan(e, e, e, e, chunks_per_file)
-        t_all = np.concatenate([s[3] for s in sels])
-        off_all = np.concatenate([s[4] for s in sels])
-        # file, chunk and chunk offset of every row: one repeat each, not an array per chunk
-        counts = np.array([len(s[3]) for s in sels], dtype=np.int64)
-        key = np.repeat(np.array([(s[0] << 32) + s[1] for s in sels], dtype=np.int64), counts)
-        file_all = key >> 32
-        # the mcap library's order: log time, then file, chunk position, record position. One
-        # channel logged in time order is in that order already: no sort (times that strictly
-        # increase need no other key).
-        if bool(np.all(t_all[1:] > t_all[:-1])):
-            return McapPlan(t_all, off_all, key, file_all, chunks_per_file)
-        cstart_all = np.repeat(np.array([s[2] for s in sels], dtype=np.int64), counts)
-        if _in_order(t_all, file_all, cstart_all, off_all):
-            return McapPlan(t_all, off_all, key, file_all, chunks_per_file)
-        order = np.lexsort((off_all, cstart_all, file_all, t_all))
-        return McapPlan(t_all[order], off_all[order], key[order], file_all[order], chunks_per_file)
+        return [_ordered(s, chunks_per_file) for s in sels]
 
     def all_chunks(self) -> list[tuple[Path, Any]]:
         """(file, chunk index record) of every chunk, in file order."""
@@ -222,48 +224,55 @@ class McapIndex:
         return out
 
     def run_loader(
-        self, plan: McapPlan
-    ) -> tuple[int, Callable[[int, list[Any]], tuple[I64, U8, I64, I64]], list[int]]:
+        self, plans: Sequence[McapPlan]
+    ) -> tuple[int, Callable[[int, list[Any]], list[Run | None]], list[int]]:
         """(number of groups, load, bytes) where ``load(k, scratch)`` decompresses the k-th
-        group of chunks (up to ``GROUP_BYTES`` uncompressed) into ``scratch`` and gives
-        (reference positions, bytes, data starts, data lengths) of the planned messages in
-        it, and ``bytes[k]`` is what that group reads from the file (its chunks' compressed
-        sizes, for progress). ``load`` may run on a worker thread (it opens the file
-        itself)."""
-        todo: list[list[tuple[int, I64]]] = []
+        group of chunks (up to ``GROUP_BYTES`` uncompressed; the chunks any plan needs) into
+        ``scratch`` and gives each plan's :class:`Run` of its messages in it (None when it
+        has none there), and ``bytes[k]`` is what that group reads from the file (its chunks'
+        compressed sizes, for progress). ``load`` may run on a worker thread (it opens the
+        file itself)."""
+        rows_of: list[dict[int, I64]] = [dict(group_positions(p.key)) for p in plans]
+        keys = sorted({k for rows in rows_of for k in rows})
+        chunks_of = plans[0].chunks if plans else []
+        todo: list[list[int]] = []
         size = 0
-        for key, rows in group_positions(plan.key):
+        for key in keys:
             if not todo or size >= pipeline.GROUP_BYTES:
                 todo.append([])
                 size = 0
-            todo[-1].append((key, rows))
-            size += int(plan.chunks[key >> 32][key & 0xFFFFFFFF].uncompressed_size)
+            todo[-1].append(key)
+            size += int(chunks_of[key >> 32][key & 0xFFFFFFFF].uncompressed_size)
 
         def chunk_of(key: int) -> tuple[Path, Any]:
-            return self.files[key >> 32], plan.chunks[key >> 32][key & 0xFFFFFFFF]
+            return self.files[key >> 32], chunks_of[key >> 32][key & 0xFFFFFFFF]
 
-        def load(k: int, scratch: list[Any]) -> tuple[I64, U8, I64, I64]:
+        def load(k: int, scratch: list[Any]) -> list[Run | None]:
             part = todo[k]
-            buf, base, sizes = self._group_bytes([chunk_of(key) for key, _ in part], scratch)
-            rows = np.concatenate([r for _k, r in part])
-            which = np.concatenate([np.full(len(r), i) for i, (_k, r) in enumerate(part)])
-            path, first = chunk_of(part[0][0])
+            buf, base, sizes = self._group_bytes([chunk_of(key) for key in part], scratch)
+            path, first = chunk_of(part[0])
             where = f"in {path} in chunks from byte {first.chunk_start_offset}"
-            offsets = plan.offset[rows]
-            # a record inside its chunk: no earlier (here), no later (its end, checked below)
-            if len(offsets) and int(offsets.min()) < 0:
-                raise BagError(f"message index points outside its chunk {where}")
-            limit = base[which] + sizes[which]
-            start, length, log_time = _checked_records(buf, offsets + base[which], limit, where)
-            # The record's own log time must be the index's: a damaged index entry would
-            # otherwise give another record's data (or a wrong time) without a word.
-            if np.any(log_time != plan.t_record[rows]):
-                raise BagError(
-                    f"message index disagrees with the message records' log times {where}"
-                )
-            return rows, buf, start, length
+            out: list[Run | None] = []
+            for plan, rows_by_key in zip(plans, rows_of, strict=True):
+                mine = [(i, rows_by_key[key]) for i, key in enumerate(part) if key in rows_by_key]
+                if not mine:
+                    out.append(None)
+                    continue
+                rows = np.concatenate([r for _i, r in mine])
+                which = np.concatenate([np.full(len(r), i) for i, r in mine])
+                offsets = plan.offset[rows]
+                # a record inside its chunk: no earlier (here), no later (its end, checked
+                # with the record)
+                if len(offsets) and int(offsets.min()) < 0:
+                    raise BagError(f"message index points outside its chunk {where}")
+                t = plan.t_record[rows]
+                channel = plan.channel[rows]
+                limit = base[which] + sizes[which]
+                records = McapRecords(buf, offsets + base[which], limit, t, channel, where)
+                out.append(Run(rows, buf, t, channel, records))
+            return out
 
-        weights = [sum(int(chunk_of(key)[1].compressed_size) for key, _ in part) for part in todo]
+        weights = [sum(int(chunk_of(key)[1].compressed_size) for key in part) for part in todo]
         return len(todo), load, weights
 
     @staticmethod
@@ -441,6 +450,32 @@ class McapIndex:
         return start, length
 
 
+def _ordered(sels: list[tuple[int, int, int, I64, I64, int]], chunks: list[list[Any]]) -> McapPlan:
+    """One request's located messages in the mcap library's order: log time, then file,
+    chunk position, record position."""
+    if not sels:
+        e = np.empty(0, np.int64)
+        return McapPlan(e, e, e, e, chunks, e)
+    t_all = np.concatenate([s[3] for s in sels])
+    off_all = np.concatenate([s[4] for s in sels])
+    # file, chunk and chunk offset of every row: one repeat each, not an array per chunk
+    counts = np.array([len(s[3]) for s in sels], dtype=np.int64)
+    key = np.repeat(np.array([(s[0] << 32) + s[1] for s in sels], dtype=np.int64), counts)
+    channel = np.repeat(np.array([s[5] for s in sels], dtype=np.int64), counts)
+    file_all = key >> 32
+    # One channel logged in time order is in that order already: no sort (times that
+    # strictly increase need no other key).
+    if bool(np.all(t_all[1:] > t_all[:-1])):
+        return McapPlan(t_all, off_all, key, file_all, chunks, channel)
+    cstart_all = np.repeat(np.array([s[2] for s in sels], dtype=np.int64), counts)
+    if _in_order(t_all, file_all, cstart_all, off_all):
+        return McapPlan(t_all, off_all, key, file_all, chunks, channel)
+    order = np.lexsort((off_all, cstart_all, file_all, t_all))
+    return McapPlan(
+        t_all[order], off_all[order], key[order], file_all[order], chunks, channel[order]
+    )
+
+
 # A message record's head: op code (1), record length (8), channel id (2), sequence (4), log
 # time (8).
 _HEAD = 1 + 8 + 2 + 4 + 8
@@ -474,6 +509,66 @@ def _checked_records(buf: U8, off: I64, limit: I64, where: str) -> tuple[I64, I6
         raise BagError(f"message record length runs into no record {where}")
     log_time = np.ndarray((n,), "<u8", buffer=head, offset=15, strides=(_HEAD,))
     return start, length, log_time.astype(np.int64)
+
+
+class McapRecords:
+    """The message records of one run: where each starts in the group's bytes, the end of its
+    chunk, and the log time and channel its message index gives (see
+    :class:`ertools.io.pipeline.Records`)."""
+
+    def __init__(
+        self, buf: U8, offsets: I64, limit: I64, t_ns: I64, channel: I64, where: str
+    ) -> None:
+        self.buf, self.offsets, self.limit, self.where = buf, offsets, limit, where
+        self.t_ns, self.channel = t_ns, channel
+        self._spans: tuple[I64, I64] | None = None
+
+    def spans(self) -> tuple[I64, I64]:
+        if self._spans is None:
+            start, length, log_time = _checked_records(
+                self.buf, self.offsets, self.limit, self.where
+            )
+            # The record's own log time must be the index's: a damaged index entry would
+            # otherwise give another record's data (or a wrong time) without a word.
+            if np.any(log_time != self.t_ns):
+                raise BagError(
+                    f"message index disagrees with the message records' log times {self.where}"
+                )
+            self._spans = start, length
+        return self._spans
+
+    def size_hint(self, i: int) -> int | None:
+        at = int(self.offsets[i])
+        if at < 0 or at + 9 > len(self.buf):
+            return None
+        size = int.from_bytes(self.buf[at + 1 : at + 9].tobytes(), "little") - MESSAGE_FIXED
+        return size if 0 <= size <= len(self.buf) else None
+
+    def rows(self, idx: I64, size: int) -> tuple[U8, int] | None:
+        n = len(idx)
+        off = self.offsets[idx]
+        width = _HEAD + 8 + size  # the publish time too
+        if not n or int(off.min()) < 0 or int(off.max()) + width > len(self.buf):
+            return None
+        rows = gather(self.buf, off, width)
+
+        def col(at: int, kind: str) -> npt.NDArray[Any]:
+            return np.ndarray((n,), kind, buffer=rows, offset=at, strides=(width,))
+
+        end = off + width
+        limit = self.limit[idx]
+        ok = col(0, "u1") == OP_MESSAGE
+        ok &= col(1, "<u8") == MESSAGE_FIXED + size
+        ok &= col(9, "<u2") == self.channel[idx]
+        ok &= col(15, "<i8") == self.t_ns[idx]
+        ok &= end <= limit
+        if not bool(ok.all()):
+            return None
+        # as _checked_records: each record ends at its chunk's end or where another begins
+        after = self.buf[np.minimum(end, len(self.buf) - 1)]
+        if not bool(np.all(_RECORD_STARTS[after] | (end == limit))):
+            return None
+        return rows, width - size
 
 
 def verify_mcap(path: Path, progress: Reporter | None = None) -> None:

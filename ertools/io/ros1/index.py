@@ -25,6 +25,7 @@ from ertools.errors import BagError
 from ertools.io.bagfile import BagFile, RawRecord
 from ertools.io.decode.fast import LayoutMismatchError, gather, read_at
 from ertools.io.model import Conn
+from ertools.io.pipeline import Request, in_window, window
 from ertools.io.ros1.check import rebuild_layout
 from ertools.io.ros1.layout import (
     INDEX_DTYPE,
@@ -64,6 +65,9 @@ if TYPE_CHECKING:
     from ertools.progress import Reporter
 
 log = logging.getLogger("ertools.io.ros1.index")
+
+# (chunk indices touched, chunk index, conn rank, record time, record offset per message)
+Selection = tuple[list[int], I64, npt.NDArray[np.integer[Any]], I64, I64]
 
 
 def _first_record(bag: Ros1Bag) -> int:
@@ -237,14 +241,18 @@ class Ros1Bag(BagFile):
         except BagError as err:
             raise BagError(err.message, path=None) from err
 
-    def select(
-        self, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
-    ) -> tuple[list[int], I64, npt.NDArray[np.integer[Any]], I64, I64]:
-        """Messages of ``conns`` in [start_ns, end_ns], in the reference order.
+    def select(self, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None) -> Selection:
+        """Messages of ``conns`` in [start_ns, end_ns], in the reference order: one request
+        of :meth:`select_many`."""
+        return self.select_many([Request(tuple(conns), start_ns, end_ns)])[0]
 
-        Returns (chunk indices touched, chunk index per message, conn rank per message, record
-        time per message, record offset per message); only chunks whose span overlaps the
-        window and that hold one of ``conns`` are read.
+    def select_many(self, requests: Sequence[Request]) -> list[Selection]:
+        """The messages of each request (connections, record-time window), each in its
+        reference order, from one pass over the index: (chunk indices touched, chunk index per
+        message, conn rank per message, record time per message, record offset per message).
+
+        Only chunks whose span overlaps a request's window and that hold one of the requested
+        connections are read.
         """
         if self.layout.indexed:
             # A chunk info naming a connection the bag does not have is damaged: the chunk
@@ -253,9 +261,10 @@ class Ros1Bag(BagFile):
             unknown = sorted({cid for ch in self.layout.chunks for cid in ch.counts} - known)
             if unknown:
                 self._rescan(f"chunk info names connection {unknown[0]}, which the bag lacks")
-        rank = {c.id: i for i, c in enumerate(conns)}
-        raw: dict[int, list[bytes | tuple[I64, I64]]] = {cid: [] for cid in rank}
-        where: dict[int, list[tuple[int, int]]] = {cid: [] for cid in rank}
+        wanted = {c.id for r in requests for c in r.conns}
+        start_ns, end_ns = window(requests)
+        raw: dict[int, list[bytes | tuple[I64, I64]]] = {cid: [] for cid in wanted}
+        where: dict[int, list[tuple[int, int]]] = {cid: [] for cid in wanted}
         for ci, chunk in enumerate(self.layout.chunks):
             if start_ns is not None and chunk.end_ns < start_ns:
                 continue
@@ -263,7 +272,7 @@ class Ros1Bag(BagFile):
                 continue
             if chunk.entries is not None:  # a scanned bag: entries already decoded
                 for cid, (t, off) in chunk.entries.items():
-                    if cid in rank:
+                    if cid in wanted:
                         raw[cid].append((t, off))
                         where[cid].append((ci, len(t)))
                 continue
@@ -272,7 +281,7 @@ class Ros1Bag(BagFile):
             # (a damaged connection id or count there dropped a chunk from its connection's
             # read, or read another connection's entries, without a word).
             counts: dict[int, int] = {}
-            for cid, data in self._index_data(chunk, rank, counts).items():
+            for cid, data in self._index_data(chunk, wanted, counts).items():
                 raw[cid].append(data)
                 where[cid].append((ci, len(data) // INDEX_DTYPE.itemsize))
             if nonzero_counts(counts) != nonzero_counts(chunk.counts):
@@ -280,13 +289,11 @@ class Ros1Bag(BagFile):
                     f"chunk at byte {chunk.pos}: the chunk info and the index data give "
                     "different connections or counts"
                 )
-                return self.select(conns, start_ns, end_ns)
+                return self.select_many(requests)
         self._unmap()  # the index pages touched would otherwise stay in this process's RSS
-        tt: list[I64] = []
-        oo: list[I64] = []
-        ck: list[I64] = []
-        rk: list[npt.NDArray[np.integer[Any]]] = []
-        for cid, r in rank.items():
+        # per connection: (record times, offsets, chunk index) of its entries in the window
+        entries: dict[int, tuple[I64, I64, I64]] = {}
+        for cid in wanted:
             if not raw[cid]:
                 continue
             t, off = joined_entries(raw[cid])
@@ -294,17 +301,27 @@ class Ros1Bag(BagFile):
                 outside = outside_chunk_info(self.layout.chunks, cid, t, where[cid])
                 if outside is not None:
                     self._rescan(outside)
-                    return self.select(conns, start_ns, end_ns)
+                    return self.select_many(requests)
             c = np.repeat(
                 np.array([w[0] for w in where[cid]], dtype=np.int64),
                 np.array([w[1] for w in where[cid]], dtype=np.int64),
             )
-            if start_ns is not None or end_ns is not None:
-                keep = np.ones(len(t), dtype=bool)
-                if start_ns is not None:
-                    keep &= t >= start_ns
-                if end_ns is not None:
-                    keep &= t <= end_ns
+            entries[cid] = (t, off, c)
+        return [self._ordered(r, entries) for r in requests]
+
+    def _ordered(self, request: Request, entries: dict[int, tuple[I64, I64, I64]]) -> Selection:
+        """One request's messages, in rosbags' order, from every wanted connection's entries."""
+        rank = {c.id: i for i, c in enumerate(request.conns)}
+        tt: list[I64] = []
+        oo: list[I64] = []
+        ck: list[I64] = []
+        rk: list[npt.NDArray[np.integer[Any]]] = []
+        for cid, r in rank.items():
+            if cid not in entries:
+                continue
+            t, off, c = entries[cid]
+            keep = in_window(t, request.lo, request.hi)
+            if keep is not None:
                 t, off, c = t[keep], off[keep], c[keep]
             tt.append(t)
             oo.append(off)
@@ -319,12 +336,12 @@ class Ros1Bag(BagFile):
         touched = np.flatnonzero(np.bincount(c_all, minlength=len(self.layout.chunks))).tolist()
         # rosbags: per connection sorted by time (stable over chunk and index order), then a
         # heap merge over connections in the order given (ties: the earlier connection).
-        # Entries are gathered connection by connection, each in chunk and index order, so
-        # ``seq`` keeps that order among equal times of one connection.
-        if len(rank) == 1 and np.all(t_all[1:] >= t_all[:-1]):
-            return touched, c_all, r_all, t_all, o_all  # one connection, already in order
-        seq = np.arange(len(t_all))
-        order = np.lexsort((seq, r_all, t_all))
+        # Entries are gathered connection by connection, each in chunk and index order: a
+        # stable sort by time alone keeps that order among equal times (the connection's
+        # rank, then its chunk and index order), and runs in linear time over sorted runs.
+        if bool(np.all(t_all[1:] >= t_all[:-1])):
+            return touched, c_all, r_all, t_all, o_all  # already in order
+        order = np.argsort(t_all, kind="stable")
         return touched, c_all[order], r_all[order], t_all[order], o_all[order]
 
     def _rescan(self, why: str) -> None:
@@ -508,20 +525,26 @@ class Ros1Bag(BagFile):
         the requested messages' bytes are held until yielded in order)."""
         if not conns:
             return
-        _touched, _chunk_of, rank_of, _t, _off = self.select(conns, start_ns, end_ns)
-        found = ros1_runs(self, conns, start_ns, end_ns, current())
-        out: list[tuple[int, int, bytes]] = []
-        for pos, buf, start, length, t_rec in found.runs:
-            data = buf.tobytes()
+        request = Request(tuple(conns), start_ns, end_ns)
+        by_id = {c.id: c for c in conns}
+        out: list[tuple[int, int, int, bytes]] = []
+        for run in ros1_runs(self, [request], current()).only(0).runs:
+            start, length = run.spans()
+            data = run.buf.tobytes()
             out.extend(
-                (p, t, data[a : a + n])
-                for p, t, a, n in zip(
-                    pos.tolist(), t_rec.tolist(), start.tolist(), length.tolist(), strict=True
+                (p, t, c, data[a : a + n])
+                for p, t, c, a, n in zip(
+                    run.pos.tolist(),
+                    run.t_record.tolist(),
+                    run.conn.tolist(),
+                    start.tolist(),
+                    length.tolist(),
+                    strict=True,
                 )
             )
         out.sort(key=lambda x: x[0])
-        for p, t, data in out:
-            yield conns[int(rank_of[p])], t, data
+        for _p, t, c, data in out:
+            yield by_id[c], t, data
 
     def verify(self, progress: Reporter | None = None) -> None:
         """Decompress every chunk and check that every indexed record is a message record

@@ -21,10 +21,11 @@ import numpy.typing as npt
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
 from ertools.io import pipeline
-from ertools.io.model import Conn
+from ertools.io.decode.fast import gather
 from ertools.io.pipeline import (
     Group,
-    Located,
+    LocatedMany,
+    Request,
     Run,
     group_positions,
     joined,
@@ -34,7 +35,16 @@ from ertools.io.pipeline import (
     read_at,
     scratch_view,
 )
-from ertools.io.ros1.layout import Ros1Chunk, Ros1Layout, decompress
+from ertools.io.ros1.layout import (
+    MSG_HEADER_LEN,
+    OP_AT,
+    OP_MSG_WORD,
+    Ros1Chunk,
+    Ros1Layout,
+    cat_arrays,
+    decompress,
+    value_offsets,
+)
 
 if TYPE_CHECKING:
     from ertools.progress import Reporter
@@ -50,27 +60,115 @@ class IndexedBag(Protocol):
     @property
     def file(self) -> BufferedReader: ...
 
-    def select(
-        self, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
-    ) -> tuple[list[int], I64, npt.NDArray[np.integer[Any]], I64, I64]: ...
+    def select_many(
+        self, requests: Sequence[Request]
+    ) -> list[tuple[list[int], I64, npt.NDArray[np.integer[Any]], I64, I64]]: ...
 
     def checked_spans(
         self, buf: U8, offsets: I64, t_ns: I64, conn: I64, where: str
     ) -> tuple[I64, I64]: ...
 
 
-def ros1_runs(
-    bag: IndexedBag,
-    conns: Sequence[Conn],
-    lo: int | None,
-    hi: int | None,
-    progress: Reporter | None = None,
-) -> Located:
-    touched, chunk_of, rank_of, t_of, off_of = bag.select(conns, lo, hi)
-    conn_of = np.array([c.id for c in conns], dtype=np.int64)[rank_of]
+# A message record's head as rosbag writes it: header length, the 38-byte header (conn, op
+# and time fields), data length.
+HEAD = 4 + MSG_HEADER_LEN + 4
 
-    groups = dict(group_positions(chunk_of))
-    sparse = sparse_chunks(bag, touched, groups)
+
+class Ros1Records:
+    """The message records of one run: where each starts in the group's bytes, the end of
+    its chunk, and the time and connection its index entry gives (see :class:`Records`)."""
+
+    def __init__(
+        self, bag: IndexedBag, buf: U8, offsets: I64, limit: I64, t_ns: I64, conn: I64, where: str
+    ) -> None:
+        self.bag, self.buf, self.where = bag, buf, where
+        self.offsets, self.limit, self.t_ns, self.conn = offsets, limit, t_ns, conn
+        self._spans: tuple[I64, I64] | None = None
+        self._head: tuple[int, int, int] | None = None
+        self._head_known = False
+
+    def spans(self) -> tuple[I64, I64]:
+        if self._spans is None:
+            # each record checked to carry its index entry's time and connection
+            start, length = self.bag.checked_spans(
+                self.buf, self.offsets, self.t_ns, self.conn, self.where
+            )
+            if np.any(start + length > self.limit):
+                raise BagError(f"message record runs past the end of its chunk {self.where}")
+            self._spans = start, length
+        return self._spans
+
+    def _head_fields(self) -> tuple[int, int, int] | None:
+        """(op, conn value, time value) offsets in the first record's header when it is the
+        standard 38-byte one, else None."""
+        if not self._head_known:
+            self._head_known = True
+            first = int(self.offsets[0])
+            if first >= 0 and first + HEAD <= len(self.buf):
+                header = bytes(self.buf[first + 4 : first + 4 + MSG_HEADER_LEN])
+                word = OP_MSG_WORD.to_bytes(8, "little")
+                op_at = next((at for at in OP_AT if header[at : at + 8] == word), None)
+                fields = value_offsets(self.buf, first + 4)
+                if op_at is not None and fields is not None:
+                    self._head = (op_at, *fields)
+        return self._head
+
+    def size_hint(self, i: int) -> int | None:
+        at = int(self.offsets[i])
+        if at < 0 or at + HEAD > len(self.buf):
+            return None
+        if int.from_bytes(self.buf[at : at + 4].tobytes(), "little") != MSG_HEADER_LEN:
+            return None
+        return int.from_bytes(self.buf[at + HEAD - 4 : at + HEAD].tobytes(), "little")
+
+    def rows(self, idx: I64, size: int) -> tuple[U8, int] | None:
+        n = len(idx)
+        off = self.offsets[idx]
+        width = HEAD + size
+        if not n or int(off.min()) < 0 or int(off.max()) + width > len(self.buf):
+            return None
+        head = self._head_fields()
+        if head is None:
+            return None
+        op_at, conn_at, time_at = head
+        rows = gather(self.buf, off, width)
+
+        def col(at: int, kind: str) -> npt.NDArray[Any]:
+            return np.ndarray((n,), kind, buffer=rows, offset=at, strides=(width,))
+
+        ok = col(0, "<u4") == MSG_HEADER_LEN
+        ok &= col(4 + op_at, "<u8") == OP_MSG_WORD
+        ok &= col(HEAD - 4, "<u4") == size
+        ok &= col(4 + conn_at, "<u4") == self.conn[idx]
+        t = np.multiply(col(4 + time_at, "<u4"), 1_000_000_000, dtype=np.int64)
+        t += col(8 + time_at, "<u4")
+        ok &= t == self.t_ns[idx]
+        ok &= off + width <= self.limit[idx]
+        return (rows, HEAD) if bool(ok.all()) else None
+
+
+def _label(requests: Sequence[Request], path: Path) -> str:
+    topics = list(dict.fromkeys(c.topic for r in requests for c in r.conns))
+    return f"reading {', '.join(topics) if topics else '?'} from {path.name}"
+
+
+def ros1_runs(
+    bag: IndexedBag, requests: Sequence[Request], progress: Reporter | None = None
+) -> LocatedMany:
+    """The messages of each request, located in one pass over the index and loaded in one
+    pass over the chunks any of them touches."""
+    sels = bag.select_many(requests)
+    plans: list[tuple[dict[int, I64], I64, I64, I64]] = []
+    per_chunk: dict[int, int] = {}
+    for req, (_touched, chunk_of, rank_of, t_of, off_of) in zip(requests, sels, strict=True):
+        ids = np.array([c.id for c in req.conns], dtype=np.int64)
+        conn_of = ids[rank_of] if len(t_of) else np.empty(0, np.int64)
+        groups = dict(group_positions(chunk_of))
+        for ci, rows in groups.items():
+            per_chunk[ci] = per_chunk.get(ci, 0) + len(rows)
+        plans.append((groups, conn_of, t_of, off_of))
+    touched = sorted(per_chunk)
+    sparse = sparse_chunks(bag, touched, per_chunk)
 
     def batches() -> Iterator[list[int]]:
         # Several chunks are decoded together (fewer NumPy calls per message), up to
@@ -94,38 +192,44 @@ def ros1_runs(
 
     todo = list(batches())
 
-    def load_run(k: int, scratch: list[Any]) -> Run:
+    def load_runs(k: int, scratch: list[Any]) -> list[Run | None]:
         batch = todo[k]
         chunks = [bag.layout.chunks[c] for c in batch]
         if batch[0] in sparse:
             buf, base, sizes = mapped_group(bag, chunks, scratch)
         else:
             buf, base, sizes = chunk_group(bag, chunks, scratch)
-        sel = np.concatenate([groups[c] for c in batch])
-        which = np.concatenate([np.full(len(groups[c]), i) for i, c in enumerate(batch)])
         where = f"in {bag.path} in chunks at bytes {chunks[0].pos}..{chunks[-1].pos}"
-        offsets = off_of[sel]
-        if np.any(offsets + 8 > sizes[which]):
-            raise BagError(f"index points outside its chunk {where}")
-        # each record checked to carry its index entry's time and connection
-        start, length = bag.checked_spans(
-            buf, offsets + base[which], t_of[sel], conn_of[sel], where
-        )
-        if np.any(start + length > base[which] + sizes[which]):
-            raise BagError(f"message record runs past the end of its chunk {where}")
-        return sel, buf, start, length, t_of[sel]
+        out: list[Run | None] = []
+        for groups, conn_of, t_of, off_of in plans:
+            mine = [(i, groups[c]) for i, c in enumerate(batch) if c in groups]
+            if not mine:
+                out.append(None)
+                continue
+            sel = cat_arrays([g for _i, g in mine])
+            which = cat_arrays([np.full(len(g), i, dtype=np.int64) for i, g in mine])
+            offsets = off_of[sel]
+            if np.any(offsets + 8 > sizes[which]):
+                raise BagError(f"index points outside its chunk {where}")
+            t = t_of[sel]
+            conn = conn_of[sel]
+            records = Ros1Records(
+                bag, buf, offsets + base[which], base[which] + sizes[which], t, conn, where
+            )
+            out.append(Run(sel, buf, t, conn, records))
+        return out
 
     compressed = any(bag.layout.chunks[ci].compression != "none" for ci in touched)
     weights = [sum(max(bag.layout.chunks[c].data_len, 0) for c in batch) for batch in todo]
     runs = prefetched(
         len(todo),
-        load_run,
+        load_runs,
         parallel=compressed,
         progress=progress,
         weights=weights,
-        label=f"reading {conns[0].topic if conns else '?'} from {bag.path.name}",
+        label=_label(requests, bag.path),
     )
-    return Located(len(t_of), runs)
+    return LocatedMany([len(s[3]) for s in sels], runs)
 
 
 # Wanted records further apart than this on average are read in place (mapped) rather than
@@ -137,13 +241,14 @@ def ros1_runs(
 SPARSE_GAP = 12 * 1024
 
 
-def sparse_chunks(bag: IndexedBag, touched: list[int], groups: dict[int, I64]) -> dict[int, int]:
-    """Uncompressed chunks whose wanted records are sparse -> bytes of the pages they touch."""
+def sparse_chunks(bag: IndexedBag, touched: list[int], counts: dict[int, int]) -> dict[int, int]:
+    """Uncompressed chunks whose wanted records are sparse -> bytes of the pages they touch
+    (``counts``: wanted records per chunk)."""
     out = {}
     page = mmap.PAGESIZE
     for ci in touched:
         chunk = bag.layout.chunks[ci]
-        count = len(groups[ci])
+        count = counts[ci]
         if chunk.compression == "none" and chunk.data_len >= SPARSE_GAP * count:
             out[ci] = count * 2 * page  # a record touches one or two pages
     return out
