@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import I64, U8
+from ertools.arrays import I64, U8, Bool
 from ertools.errors import BagError
 from ertools.io import pipeline
 from ertools.io.bagfile import BagFile
@@ -69,11 +69,13 @@ class _Assembler:
     a read whose count is unknown (sqlite rows of several storage files, merged by time).
     """
 
-    def __init__(self, msgtype: str, count: int | None) -> None:
+    def __init__(self, msgtype: str, count: int | None, times: I64 | None = None) -> None:
         self.tf = msgtype in TF_TYPES
         self.by_time = count is None
         n = 0 if count is None else count
-        self.t_record = np.empty(n, dtype=np.int64)
+        # the record times in the reference order, when the index gave them: not copied
+        self.times_known = times is not None and len(times) == n
+        self.t_record = times if times is not None and self.times_known else np.empty(n, np.int64)
         self.t_header = np.empty(n, dtype=np.int64)
         self.xyz = np.empty((n, 3))
         self.quat = np.empty((n, 4))
@@ -116,13 +118,19 @@ class _Assembler:
             self.t_header[at] = tmp.t_header
             _scatter(self.xyz, at, tmp.xyz)
             _scatter(self.quat, at, tmp.quat)
-        self.t_record[at] = t_record
+        if not self.times_known:
+            self.t_record[at] = t_record
         if lay.stamp is None:
             self.t_header[at] = t_record  # no header: timed by record time, as in to_batch
         self.frame_idx[at] = self.code(lay.frame)
         self.child_idx[at] = self.code(lay.child)
         if self.tf:
             self.filled[at] = True
+
+    def unfilled(self, pos: I64) -> None:
+        """Messages ``pos`` have no row yet (written over afterwards, or left out)."""
+        if self.tf:
+            self.filled[pos] = False
 
     def add(self, pos: I64, batch: PoseBatch, one_each: bool) -> None:
         """Decoded rows and the reference position of the message of each row (``one_each``:
@@ -132,7 +140,8 @@ class _Assembler:
             return
         remap = np.array([self.code(f) for f in batch.frames], np.int32)
         at = self.at(pos)
-        self.t_record[at] = batch.t_record
+        if not self.times_known:
+            self.t_record[at] = batch.t_record
         self.t_header[at] = batch.t_header
         self.xyz[at] = batch.xyz
         self.quat[at] = batch.quat_xyzw
@@ -191,9 +200,13 @@ class KnownSpans:
     def size_hint(self, i: int) -> int | None:
         return int(self.length[i])
 
-    def rows(self, idx: I64, size: int) -> tuple[U8, int] | None:
-        start = self.start[idx]
-        if not len(idx) or not bool(np.all(self.length[idx] == size)):
+    def rows(
+        self, idx: I64 | None, size: int, conn: int, member: Bool | None = None
+    ) -> tuple[U8, int] | None:
+        start = self.start if idx is None else self.start[idx]
+        length = self.length if idx is None else self.length[idx]
+        same = length == size
+        if not len(start) or not bool(np.all(same if member is None else same | ~member)):
             return None
         if int(start.min()) < 0 or int(start.max()) + size > len(self.buf):
             return None
@@ -217,18 +230,23 @@ class _Decoder:
     layout per data length, and field by field for what still differs.
     """
 
-    def __init__(self, msgtype: str, cdr: bool, out: _Assembler) -> None:
+    def __init__(self, msgtype: str, cdr: bool, ids: Sequence[int], out: _Assembler) -> None:
         self.msgtype, self.cdr, self.out = msgtype, cdr, out
+        self.ids = list(dict.fromkeys(ids))  # the read's connections, each once
         self.layouts: dict[tuple[int, int], Layout] = {}
 
-    def _layout(self, key: tuple[int, int], rows: U8, skip: int) -> Layout | None:
+    def _layout(
+        self, key: tuple[int, int], rows: U8, skip: int, member: Bool | None = None, first: int = 0
+    ) -> Layout | None:
         """The layout of the rows' messages (the one of ``key`` seen before, or learnt from
-        the first row), None when some row does not share it."""
+        row ``first``), None when some row (where ``member``) does not share it."""
         lay = self.layouts.get(key)
-        if lay is not None and same_structure(rows, skip, lay):
+        if lay is not None and same_structure(rows, skip, lay, member):
             return lay
-        lay = layout_of(self.msgtype, self.cdr, rows[0, skip:].tobytes())
-        if lay is None or lay.size != rows.shape[1] - skip or not same_structure(rows, skip, lay):
+        lay = layout_of(self.msgtype, self.cdr, rows[first, skip:].tobytes())
+        if lay is None or lay.size != rows.shape[1] - skip:
+            return None
+        if not same_structure(rows, skip, lay, member):
             return None
         self.layouts[key] = lay
         return lay
@@ -238,33 +256,66 @@ class _Decoder:
         if not len(conn):
             return
         if int(conn[0]) == int(conn[-1]) and bool(np.all(conn == conn[0])):
-            classes = [(int(conn[0]), np.arange(len(conn), dtype=np.int64))]
-        else:
-            classes = group_positions(conn)
-        if len(classes) > MAX_CLASSES:
+            if not self.fast(run, int(conn[0]), None):
+                self.general(run, np.arange(len(conn), dtype=np.int64))
+            return
+        if len(self.ids) > MAX_CLASSES:
             self.general(run, np.arange(len(conn), dtype=np.int64))
             return
+        # one pass per connection of the read (a few), cheaper than sorting by connection
+        masks = [(cid, conn == cid) for cid in self.ids]
+        classes = [(cid, np.flatnonzero(m), m) for cid, m in masks if bool(m.any())]
+        if sum(len(c[1]) for c in classes) != len(conn):
+            self.general(run, np.arange(len(conn), dtype=np.int64))  # ids of other readers
+            return
+        big = max(range(len(classes)), key=lambda k: len(classes[k][1]))
+        if self.out.direct and 2 * len(classes[big][1]) >= len(conn):
+            # The connection of most messages (a mocap body's /tf beside a 10 Hz static
+            # transform) is decoded with the rows of every message, as if all were its own,
+            # so its values go out as one block; the few others are then decoded on their own
+            # and overwrite their rows.
+            cid, idx, member = classes[big]
+            if self.fast(run, cid, None, member, int(idx[0])):
+                self.out.unfilled(run.pos[~member])
+                del classes[big]
         rest = []
-        for cid, idx in classes:
+        for cid, idx, _m in classes:
             if not self.fast(run, cid, idx):
                 rest.append(idx)
         if rest:
             self.general(run, cat_arrays(rest) if len(rest) == 1 else np.sort(np.concatenate(rest)))
 
-    def fast(self, run: Run, cid: int, idx: I64) -> bool:
-        """One class by one gather of its records; False when it does not fit."""
-        lay = self.layouts.get((cid, -1))
-        size = lay.size if lay is not None else run.records.size_hint(int(idx[0]))
-        if size is None:
-            return False
-        got = run.records.rows(idx, size)
+    def fast(
+        self,
+        run: Run,
+        cid: int,
+        idx: I64 | None,
+        member: Bool | None = None,
+        first: int | None = None,
+    ) -> bool:
+        """One class (messages ``idx`` of connection ``cid``; None: the whole run, or those
+        where ``member`` is, the first at ``first``) by one gather of its records; False when
+        it does not fit."""
+        if first is None:
+            first = 0 if idx is None else int(idx[0])
+        known = self.layouts.get((cid, -1))
+        got = None if known is None else run.records.rows(idx, known.size, cid, member)
+        if got is None:
+            # first seen, or its messages changed length (another frame name)
+            size = run.records.size_hint(first)
+            if size is None or (known is not None and size == known.size):
+                return False
+            got = run.records.rows(idx, size, cid, member)
         if got is None:
             return False
         rows, skip = got
-        found = self._layout((cid, -1), rows, skip)
+        row = first if idx is None else 0
+        found = self._layout((cid, -1), rows, skip, member, row)
         if found is None:
             return False
-        self.out.write(run.pos[idx], run.t_record[idx], found, rows, skip)
+        pos = run.pos if idx is None else run.pos[idx]
+        t_rec = run.t_record if idx is None else run.t_record[idx]
+        self.out.write(pos, t_rec, found, rows, skip)
         return True
 
     def general(self, run: Run, idx: I64) -> None:
@@ -323,7 +374,7 @@ def _mcap_runs(
         weights=weights,
         label=f"reading {', '.join(topics) or '?'} from {bag.path.name}",
     )
-    return LocatedMany([len(p.t_record) for p in plans], runs)
+    return LocatedMany([len(p.t_record) for p in plans], runs, [p.t_record for p in plans])
 
 
 def _one_by_one(count: int, located: Iterator[tuple[int, Run]]) -> Iterator[list[Run | None]]:
@@ -488,11 +539,18 @@ def try_fast_batches(bag: BagFile, requests: Sequence[Request]) -> list[PoseBatc
     if found is None:
         log.info("%s: no bulk reader for %s files; decoding per message", bag.path, bag.format)
         return out
+    times = found.times or [None] * len(mine)
     assemblers = [
-        _Assembler(cast(str, kinds[i]), n) for i, n in zip(mine, found.counts, strict=True)
+        _Assembler(cast(str, kinds[i]), n, t)
+        for i, n, t in zip(mine, found.counts, times, strict=True)
     ]
     decoders: list[_Decoder | None] = [
-        _Decoder(cast(str, kinds[i]), requests[i].conns[0].encoding == "cdr", a)
+        _Decoder(
+            cast(str, kinds[i]),
+            requests[i].conns[0].encoding == "cdr",
+            [c.id for c in requests[i].conns],
+            a,
+        )
         for i, a in zip(mine, assemblers, strict=True)
     ]
     try:

@@ -198,12 +198,18 @@ class Records(Protocol):
         :meth:`rows` is then asked for and checks); None when the head is unusual."""
         ...
 
-    def rows(self, idx: I64, size: int) -> tuple[U8, int] | None:
-        """The messages ``idx`` as rows of one gather: ``(rows, skip)``, each row the record's
-        head (``skip`` bytes) then its ``size`` data bytes, when every one of them is a record
-        in the format's usual layout whose data is ``size`` bytes long and whose head carries
-        the time (and connection) it was located by. None otherwise: the caller then goes
-        through :meth:`spans`, which handles (or refuses) every other case."""
+    def rows(
+        self, idx: I64 | None, size: int, conn: int, member: Bool | None = None
+    ) -> tuple[U8, int] | None:
+        """The messages ``idx`` (None: all), all of connection ``conn``, as rows of one
+        gather: ``(rows, skip)``, each row the record's head (``skip`` bytes) then its
+        ``size`` data bytes, when every one of them is a record in the format's usual layout
+        whose data is ``size`` bytes long and whose head carries the time (and connection) it
+        was located by. None otherwise: the caller then goes through :meth:`spans`, which
+        handles (or refuses) every other case.
+
+        With ``member`` (``idx`` None), only the messages where it is True must be so; the
+        others are gathered as far as the width reaches (inside the buffer), unchecked."""
         ...
 
 
@@ -254,13 +260,15 @@ class Request:
 class LocatedMany:
     """The messages of several requests located in one pass over a file's index.
 
-    ``counts[i]`` is request i's number of messages (None: unknown up front); each item of
-    ``runs`` is one group of chunks loaded once, with one :class:`Run` per request (None for a
-    request with no message in that group).
+    ``counts[i]`` is request i's number of messages (None: unknown up front), ``times[i]``
+    their record times in the reference order when the index gives them up front; each item
+    of ``runs`` is one group of chunks loaded once, with one :class:`Run` per request (None
+    for a request with no message in that group).
     """
 
     counts: list[int | None]
     runs: Iterator[list[Run | None]]
+    times: list[I64 | None] | None = None
 
     def only(self, i: int) -> Located:
         """Request ``i`` alone (the others' runs are skipped, their groups still loaded)."""

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import I64, U8
+from ertools.arrays import I64, U8, Bool
 from ertools.geometry import quat_from_yaw
 from ertools.io.decode.fast import Decoded, gather
 
@@ -169,10 +169,10 @@ def _column(rows: U8, offset: int, dtype: str, count: int = 1) -> npt.NDArray[np
     return np.ndarray((n, count), dtype=dtype, buffer=rows, offset=offset, strides=(size, step))
 
 
-def same_structure(rows: U8, skip: int, lay: Layout) -> bool:
-    """Whether every row (a message from byte ``skip`` on) has the bytes of ``lay.ref`` where
-    the layout's fixed ranges are (string lengths and names, CDR header and padding, the TF
-    transform count).
+def same_structure(rows: U8, skip: int, lay: Layout, member: Bool | None = None) -> bool:
+    """Whether every row (a message from byte ``skip`` on; with ``member``, every row where
+    it is True) has the bytes of ``lay.ref`` where the layout's fixed ranges are (string
+    lengths and names, CDR header and padding, the TF transform count).
 
     Compared a word at a time (8 bytes, or 4, 2, 1 for shorter ranges; the last word
     overlaps the one before when the range is not a multiple of it), so the cost is a few
@@ -187,7 +187,10 @@ def same_structure(rows: U8, skip: int, lay: Layout) -> bool:
             starts.append(b - width)  # the last word overlaps the one before
         for at in starts:
             want = int.from_bytes(lay.ref[at : at + width], "little")
-            if not bool(np.all(_column(rows, skip + at, f"<u{width}") == want)):
+            same = _column(rows, skip + at, f"<u{width}") == want
+            if member is not None:
+                same |= ~member
+            if not bool(np.all(same)):
                 return False
     return True
 
@@ -229,7 +232,10 @@ def write_rows(rows: U8, skip: int, lay: Layout, out: Rows) -> None:
         values = _column(rows, skip + lay.values_at, "<f8", lay.values)
         out.xyz[:, :2] = values[:, :2]
         out.xyz[:, 2] = 0.0
-        out.quat[...] = quat_from_yaw(np.array(values[:, 2], dtype=np.float64)).reshape(n, 4)
+        # (rows of other messages, overwritten afterwards, may hold any bits: no warnings)
+        with np.errstate(all="ignore"):
+            yaw = np.array(values[:, 2], dtype=np.float64)
+            out.quat[...] = quat_from_yaw(yaw).reshape(n, 4)
 
 
 def decoded(lay: Layout, out: Rows) -> Decoded:

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any, BinaryIO
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import I64, U8
+from ertools.arrays import I64, U8, Bool
 from ertools.errors import BagError
 from ertools.io import pipeline
 from ertools.io.bagfile import BagFile
@@ -544,29 +544,36 @@ class McapRecords:
         size = int.from_bytes(self.buf[at + 1 : at + 9].tobytes(), "little") - MESSAGE_FIXED
         return size if 0 <= size <= len(self.buf) else None
 
-    def rows(self, idx: I64, size: int) -> tuple[U8, int] | None:
-        n = len(idx)
-        off = self.offsets[idx]
+    def rows(
+        self, idx: I64 | None, size: int, conn: int, member: Bool | None = None
+    ) -> tuple[U8, int] | None:
+        off = self.offsets if idx is None else self.offsets[idx]
+        n = len(off)
         width = _HEAD + 8 + size  # the publish time too
-        if not n or int(off.min()) < 0 or int(off.max()) + width > len(self.buf):
+        # records do not overlap: more rows than the buffer holds is no usual layout
+        if not n or n * width > len(self.buf) or int(off.min()) < 0:
+            return None
+        if int(off.max()) + width > len(self.buf):
+            return None
+        end = off + width
+        limit = self.limit if idx is None else self.limit[idx]
+        inside = end <= limit
+        if not bool(np.all(inside if member is None else inside | ~member)):
             return None
         rows = gather(self.buf, off, width)
 
         def col(at: int, kind: str) -> npt.NDArray[Any]:
             return np.ndarray((n,), kind, buffer=rows, offset=at, strides=(width,))
 
-        end = off + width
-        limit = self.limit[idx]
         ok = col(0, "u1") == OP_MESSAGE
         ok &= col(1, "<u8") == MESSAGE_FIXED + size
-        ok &= col(9, "<u2") == self.channel[idx]
-        ok &= col(15, "<i8") == self.t_ns[idx]
-        ok &= end <= limit
-        if not bool(ok.all()):
-            return None
+        ok &= col(9, "<u2") == conn
+        ok &= col(15, "<i8") == (self.t_ns if idx is None else self.t_ns[idx])
         # as _checked_records: each record ends at its chunk's end or where another begins
-        after = self.buf[np.minimum(end, len(self.buf) - 1)]
-        if not bool(np.all(_RECORD_STARTS[after] | (end == limit))):
+        ok &= _RECORD_STARTS[self.buf[np.minimum(end, len(self.buf) - 1)]] | (end == limit)
+        if member is not None:
+            ok |= ~member
+        if not bool(ok.all()):
             return None
         return rows, width - size
 

@@ -99,6 +99,46 @@ def _standard_spans(buf: U8, offsets: I64) -> tuple[I64, I64] | None:
     return start, length
 
 
+def _run_starts(a: I64) -> I64:
+    """Where each run of equal values of ``a`` starts."""
+    if not len(a):
+        return np.empty(0, np.int64)
+    return np.concatenate([[0], np.flatnonzero(a[1:] != a[:-1]) + 1])
+
+
+def _merged_order(parts: list[I64]) -> I64 | None:
+    """The order of the times ``parts`` (one array per connection, end to end) that a stable
+    sort by time gives: equal times keep their connection's rank, then their own order. None
+    when they are in that order already.
+
+    Connections logged in time order (each part ascending) are merged by binary search, in
+    linear time; otherwise one stable sort.
+    """
+    t_all = cat_arrays(parts)
+    if bool(np.all(t_all[1:] >= t_all[:-1])):
+        return None
+    if not all(bool(np.all(p[1:] >= p[:-1])) for p in parts):
+        return np.argsort(t_all, kind="stable")
+    merged_t = parts[0]
+    order = np.arange(len(merged_t), dtype=np.int64)
+    done = len(merged_t)
+    for part in parts[1:]:
+        # each entry of ``part`` after every earlier entry of equal time
+        at = np.searchsorted(merged_t, part, side="right") + np.arange(len(part))
+        n = len(merged_t) + len(part)
+        theirs = np.zeros(n, dtype=bool)
+        theirs[at] = True
+        new_order = np.empty(n, dtype=np.int64)
+        new_t = np.empty(n, dtype=np.int64)
+        new_order[at] = np.arange(done, done + len(part), dtype=np.int64)
+        new_t[at] = part
+        new_order[~theirs] = order
+        new_t[~theirs] = merged_t
+        order, merged_t = new_order, new_t
+        done += len(part)
+    return order
+
+
 class Ros1Bag(BagFile):
     """A ROS1 bag read through its index (or a scan): raw messages and chunk access."""
 
@@ -332,16 +372,13 @@ class Ros1Bag(BagFile):
             return [], e, e, e, e
         t_all, c_all, o_all = cat_arrays(tt), cat_arrays(ck), cat_arrays(oo)
         r_all = rk[0] if len(rk) == 1 else np.concatenate(rk)
-        # (np.unique would import numpy.ma, 10 ms of a whole command's start)
-        touched = np.flatnonzero(np.bincount(c_all, minlength=len(self.layout.chunks))).tolist()
+        # each connection's chunk indices ascend (its entries are gathered chunk by chunk)
+        touched = sorted({ci for c in ck for ci in c[_run_starts(c)].tolist()})
         # rosbags: per connection sorted by time (stable over chunk and index order), then a
         # heap merge over connections in the order given (ties: the earlier connection).
-        # Entries are gathered connection by connection, each in chunk and index order: a
-        # stable sort by time alone keeps that order among equal times (the connection's
-        # rank, then its chunk and index order), and runs in linear time over sorted runs.
-        if bool(np.all(t_all[1:] >= t_all[:-1])):
+        order = _merged_order(tt)
+        if order is None:
             return touched, c_all, r_all, t_all, o_all  # already in order
-        order = np.argsort(t_all, kind="stable")
         return touched, c_all[order], r_all[order], t_all[order], o_all[order]
 
     def _rescan(self, why: str) -> None:

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import I64, U8
+from ertools.arrays import I64, U8, Bool
 from ertools.errors import BagError
 from ertools.io import pipeline
 from ertools.io.decode.fast import gather
@@ -121,16 +121,26 @@ class Ros1Records:
             return None
         return int.from_bytes(self.buf[at + HEAD - 4 : at + HEAD].tobytes(), "little")
 
-    def rows(self, idx: I64, size: int) -> tuple[U8, int] | None:
-        n = len(idx)
-        off = self.offsets[idx]
+    def rows(
+        self, idx: I64 | None, size: int, conn: int, member: Bool | None = None
+    ) -> tuple[U8, int] | None:
+        off = self.offsets if idx is None else self.offsets[idx]
+        n = len(off)
         width = HEAD + size
-        if not n or int(off.min()) < 0 or int(off.max()) + width > len(self.buf):
+        # records do not overlap: more rows than the buffer holds is no usual layout
+        if not n or n * width > len(self.buf) or int(off.min()) < 0:
+            return None
+        if int(off.max()) + width > len(self.buf):
             return None
         head = self._head_fields()
         if head is None:
             return None
         op_at, conn_at, time_at = head
+        limit = self.limit if idx is None else self.limit[idx]
+        t_ns = self.t_ns if idx is None else self.t_ns[idx]
+        inside = off + width <= limit
+        if not bool(np.all(inside if member is None else inside | ~member)):
+            return None
         rows = gather(self.buf, off, width)
 
         def col(at: int, kind: str) -> npt.NDArray[Any]:
@@ -139,11 +149,12 @@ class Ros1Records:
         ok = col(0, "<u4") == MSG_HEADER_LEN
         ok &= col(4 + op_at, "<u8") == OP_MSG_WORD
         ok &= col(HEAD - 4, "<u4") == size
-        ok &= col(4 + conn_at, "<u4") == self.conn[idx]
+        ok &= col(4 + conn_at, "<u4") == conn
         t = np.multiply(col(4 + time_at, "<u4"), 1_000_000_000, dtype=np.int64)
         t += col(8 + time_at, "<u4")
-        ok &= t == self.t_ns[idx]
-        ok &= off + width <= self.limit[idx]
+        ok &= t == t_ns
+        if member is not None:
+            ok |= ~member
         return (rows, HEAD) if bool(ok.all()) else None
 
 
@@ -152,21 +163,69 @@ def _label(requests: Sequence[Request], path: Path) -> str:
     return f"reading {', '.join(topics) if topics else '?'} from {path.name}"
 
 
+class _Plan:
+    """One request's located messages, cut into the runs of each group of chunks."""
+
+    def __init__(
+        self, request: Request, sel: tuple[list[int], I64, npt.NDArray[np.integer[Any]], I64, I64]
+    ) -> None:
+        _touched, chunk_of, rank_of, self.t_of, self.off_of = sel
+        ids = np.array([c.id for c in request.conns], dtype=np.int64)
+        self.conn_of = ids[rank_of] if len(self.t_of) else np.empty(0, np.int64)
+        self.chunk_of = chunk_of
+        # Messages in chunk order (one connection, or several in time order over
+        # time-ordered chunks: the usual case) are sliced per group, not gathered.
+        self.sorted = bool(np.all(chunk_of[1:] >= chunk_of[:-1]))
+        if self.sorted:
+            cuts = np.flatnonzero(chunk_of[1:] != chunk_of[:-1]) + 1
+            starts = np.concatenate([[0], cuts]).astype(np.int64)
+            ends = np.concatenate([cuts, [len(chunk_of)]]).astype(np.int64)
+            keys = chunk_of[starts].tolist() if len(chunk_of) else []
+            self.ranges = {
+                ci: (a, b) for ci, a, b in zip(keys, starts.tolist(), ends.tolist(), strict=True)
+            }
+            self.counts = {ci: b - a for ci, (a, b) in self.ranges.items()}
+        else:
+            self.groups = dict(group_positions(chunk_of))
+            self.counts = {ci: len(rows) for ci, rows in self.groups.items()}
+
+    def run(
+        self, bag: IndexedBag, batch: list[int], buf: U8, base: I64, sizes: I64, where: str
+    ) -> Run | None:
+        """The run of this request's messages in the group of chunks ``batch`` (loaded into
+        ``buf``, chunk i at ``base[i]``, ``sizes[i]`` bytes long)."""
+        present = [i for i, c in enumerate(batch) if c in self.counts]
+        if not present:
+            return None
+        counts = np.array([self.counts[batch[i]] for i in present], dtype=np.int64)
+        at = np.array(present, dtype=np.int64)
+        sel: I64
+        if self.sorted:
+            a, b = self.ranges[batch[present[0]]][0], self.ranges[batch[present[-1]]][1]
+            sel = np.arange(a, b, dtype=np.int64)
+            offsets, t, conn = self.off_of[a:b], self.t_of[a:b], self.conn_of[a:b]
+        else:
+            sel = cat_arrays([self.groups[batch[i]] for i in present])
+            offsets, t, conn = self.off_of[sel], self.t_of[sel], self.conn_of[sel]
+        size = np.repeat(sizes[at], counts)
+        if np.any(offsets + 8 > size):
+            raise BagError(f"index points outside its chunk {where}")
+        start = np.repeat(base[at], counts)
+        records = Ros1Records(bag, buf, offsets + start, start + size, t, conn, where)
+        return Run(sel, buf, t, conn, records)
+
+
 def ros1_runs(
     bag: IndexedBag, requests: Sequence[Request], progress: Reporter | None = None
 ) -> LocatedMany:
     """The messages of each request, located in one pass over the index and loaded in one
     pass over the chunks any of them touches."""
     sels = bag.select_many(requests)
-    plans: list[tuple[dict[int, I64], I64, I64, I64]] = []
+    plans = [_Plan(req, sel) for req, sel in zip(requests, sels, strict=True)]
     per_chunk: dict[int, int] = {}
-    for req, (_touched, chunk_of, rank_of, t_of, off_of) in zip(requests, sels, strict=True):
-        ids = np.array([c.id for c in req.conns], dtype=np.int64)
-        conn_of = ids[rank_of] if len(t_of) else np.empty(0, np.int64)
-        groups = dict(group_positions(chunk_of))
-        for ci, rows in groups.items():
-            per_chunk[ci] = per_chunk.get(ci, 0) + len(rows)
-        plans.append((groups, conn_of, t_of, off_of))
+    for plan in plans:
+        for ci, n in plan.counts.items():
+            per_chunk[ci] = per_chunk.get(ci, 0) + n
     touched = sorted(per_chunk)
     sparse = sparse_chunks(bag, touched, per_chunk)
 
@@ -200,24 +259,7 @@ def ros1_runs(
         else:
             buf, base, sizes = chunk_group(bag, chunks, scratch)
         where = f"in {bag.path} in chunks at bytes {chunks[0].pos}..{chunks[-1].pos}"
-        out: list[Run | None] = []
-        for groups, conn_of, t_of, off_of in plans:
-            mine = [(i, groups[c]) for i, c in enumerate(batch) if c in groups]
-            if not mine:
-                out.append(None)
-                continue
-            sel = cat_arrays([g for _i, g in mine])
-            which = cat_arrays([np.full(len(g), i, dtype=np.int64) for i, g in mine])
-            offsets = off_of[sel]
-            if np.any(offsets + 8 > sizes[which]):
-                raise BagError(f"index points outside its chunk {where}")
-            t = t_of[sel]
-            conn = conn_of[sel]
-            records = Ros1Records(
-                bag, buf, offsets + base[which], base[which] + sizes[which], t, conn, where
-            )
-            out.append(Run(sel, buf, t, conn, records))
-        return out
+        return [plan.run(bag, batch, buf, base, sizes, where) for plan in plans]
 
     compressed = any(bag.layout.chunks[ci].compression != "none" for ci in touched)
     weights = [sum(max(bag.layout.chunks[c].data_len, 0) for c in batch) for batch in todo]
@@ -229,7 +271,7 @@ def ros1_runs(
         weights=weights,
         label=_label(requests, bag.path),
     )
-    return LocatedMany([len(s[3]) for s in sels], runs)
+    return LocatedMany([len(s[3]) for s in sels], runs, [s[3] for s in sels])
 
 
 # Wanted records further apart than this on average are read in place (mapped) rather than
