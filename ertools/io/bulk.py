@@ -95,21 +95,31 @@ class _Assembler:
     def code(self, name: str | None) -> int:
         return self.frames.setdefault(name or "", len(self.frames))
 
-    def at(self, pos: I64) -> slice | I64:
+    def at(self, pos: I64, consecutive: bool = False) -> slice | I64:
         """The rows of messages ``pos``: a slice when consecutive and ascending (one
         connection read in order: written as a block, or decoded in place)."""
-        if len(pos) and int(pos[-1]) - int(pos[0]) == len(pos) - 1 and ascending(pos):
+        span = len(pos) and int(pos[-1]) - int(pos[0]) == len(pos) - 1
+        if span and (consecutive or ascending(pos)):
             return slice(int(pos[0]), int(pos[-1]) + 1)
         return pos
 
-    def write(self, pos: I64, t_record: I64, lay: Layout, rows: U8, skip: int) -> None:
-        """Rows in layout ``lay`` (checked) of the messages ``pos`` decoded into place."""
+    def write(
+        self,
+        pos: I64,
+        t_record: I64,
+        lay: Layout,
+        rows: U8,
+        skip: int,
+        consecutive: bool = False,
+    ) -> None:
+        """Rows in layout ``lay`` (checked) of the messages ``pos`` (``consecutive``: known to
+        be a range) decoded into place."""
         if not self.direct:
             tmp = empty_rows(len(pos))
             write_rows(rows, skip, lay, tmp)
             self.parts.append((pos, to_batch(rows, decoded(lay, tmp), t_record)))
             return
-        at = self.at(pos)
+        at = self.at(pos, consecutive)
         if isinstance(at, slice):
             write_rows(rows, skip, lay, Rows(self.t_header[at], self.xyz[at], self.quat[at]))
         else:
@@ -315,7 +325,7 @@ class _Decoder:
             return False
         pos = run.pos if idx is None else run.pos[idx]
         t_rec = run.t_record if idx is None else run.t_record[idx]
-        self.out.write(pos, t_rec, found, rows, skip)
+        self.out.write(pos, t_rec, found, rows, skip, idx is None and run.consecutive)
         return True
 
     def general(self, run: Run, idx: I64) -> None:

@@ -220,7 +220,7 @@ class Run:
     ``pos``: each message's reference position in the whole read; ``buf``: the group's bytes
     (valid only until the next run of the same read is asked for: it may be reused);
     ``t_record``: record times; ``conn``: each message's connection id; ``records``: how to
-    find each message's data in ``buf``.
+    find each message's data in ``buf``; ``consecutive``: ``pos`` is known to be a range.
     """
 
     pos: I64
@@ -228,6 +228,7 @@ class Run:
     t_record: I64
     conn: I64
     records: Records
+    consecutive: bool = False
 
     def spans(self) -> tuple[I64, I64]:
         return self.records.spans()

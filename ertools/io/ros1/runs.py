@@ -89,6 +89,8 @@ class Ros1Records:
 
     def spans(self) -> tuple[I64, I64]:
         if self._spans is None:
+            if np.any(self.offsets + 8 > self.limit):
+                raise BagError(f"index points outside its chunk {self.where}")
             # each record checked to carry its index entry's time and connection
             start, length = self.bag.checked_spans(
                 self.buf, self.offsets, self.t_ns, self.conn, self.where
@@ -127,10 +129,12 @@ class Ros1Records:
         off = self.offsets if idx is None else self.offsets[idx]
         n = len(off)
         width = HEAD + size
-        # records do not overlap: more rows than the buffer holds is no usual layout
-        if not n or n * width > len(self.buf) or int(off.min()) < 0:
+        # records do not overlap: more rows than the buffer holds is no usual layout (offsets
+        # are never negative, and a record inside its chunk is inside the buffer; the rows
+        # of other messages than ``member`` only need to be)
+        if not n or n * width > len(self.buf):
             return None
-        if int(off.max()) + width > len(self.buf):
+        if member is not None and int(off.max()) + width > len(self.buf):
             return None
         head = self._head_fields()
         if head is None:
@@ -207,12 +211,10 @@ class _Plan:
         else:
             sel = cat_arrays([self.groups[batch[i]] for i in present])
             offsets, t, conn = self.off_of[sel], self.t_of[sel], self.conn_of[sel]
-        size = np.repeat(sizes[at], counts)
-        if np.any(offsets + 8 > size):
-            raise BagError(f"index points outside its chunk {where}")
         start = np.repeat(base[at], counts)
-        records = Ros1Records(bag, buf, offsets + start, start + size, t, conn, where)
-        return Run(sel, buf, t, conn, records)
+        limit = np.repeat(base[at] + sizes[at], counts)
+        records = Ros1Records(bag, buf, offsets + start, limit, t, conn, where)
+        return Run(sel, buf, t, conn, records, consecutive=self.sorted)
 
 
 def ros1_runs(
