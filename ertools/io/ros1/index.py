@@ -58,16 +58,13 @@ from ertools.io.ros1.records import (
     parse_fields,
     read_record,
 )
-from ertools.io.ros1.runs import ros1_runs
+from ertools.io.ros1.runs import Ints, Selection, ros1_runs
 from ertools.progress import current
 
 if TYPE_CHECKING:
     from ertools.progress import Reporter
 
 log = logging.getLogger("ertools.io.ros1.index")
-
-# (chunk indices touched, chunk index, conn rank, record time, record offset per message)
-Selection = tuple[list[int], I64, npt.NDArray[np.integer[Any]], I64, I64]
 
 
 def _first_record(bag: Ros1Bag) -> int:
@@ -97,6 +94,19 @@ def _standard_spans(buf: U8, offsets: I64) -> tuple[I64, I64] | None:
     if int((start + length).max()) > n:
         return None
     return start, length
+
+
+def _entries(parts: list[bytes | tuple[I64, I64]]) -> tuple[I64, Ints]:
+    """(record times, offsets in their chunks) of one connection's index entries over several
+    chunks. Offsets read from index data stay uint32 as stored (widened per group, where they
+    are added to the chunk's place in the group's bytes)."""
+    if not all(isinstance(p, bytes) for p in parts):
+        return joined_entries(parts)
+    arr = np.frombuffer(b"".join(p for p in parts if isinstance(p, bytes)), dtype=INDEX_DTYPE)
+    # Computed in place: fresh memory is slow to fault in, and an hour's entries are 5 MB.
+    t = np.multiply(arr["sec"], 1_000_000_000, dtype=np.int64)
+    np.add(t, arr["nsec"], out=t)
+    return t, np.ascontiguousarray(arr["off"])
 
 
 def _run_starts(a: I64) -> I64:
@@ -311,10 +321,10 @@ class Ros1Bag(BagFile):
             if end_ns is not None and chunk.start_ns > end_ns:
                 continue
             if chunk.entries is not None:  # a scanned bag: entries already decoded
-                for cid, (t, off) in chunk.entries.items():
+                for cid, entry in chunk.entries.items():
                     if cid in wanted:
-                        raw[cid].append((t, off))
-                        where[cid].append((ci, len(t)))
+                        raw[cid].append(entry)
+                        where[cid].append((ci, len(entry[0])))
                 continue
             # Every chunk's index-data headers are read, the planned chunks' and the others':
             # their connection ids and counts must be the chunk info's, which chose the chunks
@@ -332,11 +342,11 @@ class Ros1Bag(BagFile):
                 return self.select_many(requests)
         self._unmap()  # the index pages touched would otherwise stay in this process's RSS
         # per connection: (record times, offsets, chunk index) of its entries in the window
-        entries: dict[int, tuple[I64, I64, I64]] = {}
+        entries: dict[int, tuple[I64, Ints, I64]] = {}
         for cid in wanted:
             if not raw[cid]:
                 continue
-            t, off = joined_entries(raw[cid])
+            t, off = _entries(raw[cid])
             if self.layout.indexed:
                 outside = outside_chunk_info(self.layout.chunks, cid, t, where[cid])
                 if outside is not None:
@@ -349,11 +359,11 @@ class Ros1Bag(BagFile):
             entries[cid] = (t, off, c)
         return [self._ordered(r, entries) for r in requests]
 
-    def _ordered(self, request: Request, entries: dict[int, tuple[I64, I64, I64]]) -> Selection:
+    def _ordered(self, request: Request, entries: dict[int, tuple[I64, Ints, I64]]) -> Selection:
         """One request's messages, in rosbags' order, from every wanted connection's entries."""
         rank = {c.id: i for i, c in enumerate(request.conns)}
         tt: list[I64] = []
-        oo: list[I64] = []
+        oo: list[Ints] = []
         ck: list[I64] = []
         rk: list[npt.NDArray[np.integer[Any]]] = []
         for cid, r in rank.items():
@@ -370,7 +380,8 @@ class Ros1Bag(BagFile):
         if not tt or not sum(len(t) for t in tt):
             e = np.empty(0, np.int64)
             return [], e, e, e, e
-        t_all, c_all, o_all = cat_arrays(tt), cat_arrays(ck), cat_arrays(oo)
+        t_all, c_all = cat_arrays(tt), cat_arrays(ck)
+        o_all = oo[0] if len(oo) == 1 else np.concatenate(oo)
         r_all = rk[0] if len(rk) == 1 else np.concatenate(rk)
         # each connection's chunk indices ascend (its entries are gathered chunk by chunk)
         touched = sorted({ci for c in ck for ci in c[_run_starts(c)].tolist()})

@@ -50,6 +50,12 @@ if TYPE_CHECKING:
     from ertools.progress import Reporter
 
 
+Ints = npt.NDArray[np.integer[Any]]
+# One request's messages, in its reference order: (chunk indices touched, chunk index, conn
+# rank, record time, record offset in its chunk per message)
+Selection = tuple[list[int], I64, Ints, I64, Ints]
+
+
 class IndexedBag(Protocol):
     """What this module reads of an open ROS1 bag (:class:`ertools.io.ros1.index.Ros1Bag`,
     which calls it: a protocol rather than that class keeps the two modules acyclic)."""
@@ -60,9 +66,7 @@ class IndexedBag(Protocol):
     @property
     def file(self) -> BufferedReader: ...
 
-    def select_many(
-        self, requests: Sequence[Request]
-    ) -> list[tuple[list[int], I64, npt.NDArray[np.integer[Any]], I64, I64]]: ...
+    def select_many(self, requests: Sequence[Request]) -> list[Selection]: ...
 
     def checked_spans(
         self, buf: U8, offsets: I64, t_ns: I64, conn: I64, where: str
@@ -75,17 +79,38 @@ HEAD = 4 + MSG_HEADER_LEN + 4
 
 
 class Ros1Records:
-    """The message records of one run: where each starts in the group's bytes, the end of
-    its chunk, and the time and connection its index entry gives (see :class:`Records`)."""
+    """The message records of one run: where each starts in the group's bytes, the chunk it
+    lies in, and the time and connection its index entry gives (see :class:`Records`).
+
+    ``cuts`` are the run positions where each chunk's messages begin, ``ends`` where each of
+    those chunks ends in the buffer.
+    """
 
     def __init__(
-        self, bag: IndexedBag, buf: U8, offsets: I64, limit: I64, t_ns: I64, conn: I64, where: str
+        self,
+        bag: IndexedBag,
+        buf: U8,
+        offsets: I64,
+        cuts: I64,
+        ends: I64,
+        t_ns: I64,
+        conn: I64,
+        where: str,
     ) -> None:
         self.bag, self.buf, self.where = bag, buf, where
-        self.offsets, self.limit, self.t_ns, self.conn = offsets, limit, t_ns, conn
+        self.offsets, self.cuts, self.ends, self.t_ns, self.conn = offsets, cuts, ends, t_ns, conn
+        self._limit: I64 | None = None
         self._spans: tuple[I64, I64] | None = None
         self._head: tuple[int, int, int] | None = None
         self._head_known = False
+
+    @property
+    def limit(self) -> I64:
+        """Where each message's chunk ends in the buffer."""
+        if self._limit is None:
+            counts = np.diff(np.append(self.cuts, len(self.offsets)))
+            self._limit = np.repeat(self.ends, counts)
+        return self._limit
 
     def spans(self) -> tuple[I64, I64]:
         if self._spans is None:
@@ -123,6 +148,18 @@ class Ros1Records:
             return None
         return int.from_bytes(self.buf[at + HEAD - 4 : at + HEAD].tobytes(), "little")
 
+    def _inside(self, idx: I64 | None, width: int, member: Bool | None) -> bool:
+        """Whether the records ``idx`` (where ``member``), ``width`` bytes each, end inside
+        their chunks."""
+        if idx is None and member is None:
+            # one maximum per chunk, not a limit per message
+            last = np.maximum.reduceat(self.offsets, self.cuts) + width
+            return bool(np.all(last <= self.ends))
+        off = self.offsets if idx is None else self.offsets[idx]
+        limit = self.limit if idx is None else self.limit[idx]
+        inside = off + width <= limit
+        return bool(np.all(inside if member is None else inside | ~member))
+
     def rows(
         self, idx: I64 | None, size: int, conn: int, member: Bool | None = None
     ) -> tuple[U8, int] | None:
@@ -137,14 +174,10 @@ class Ros1Records:
         if member is not None and int(off.max()) + width > len(self.buf):
             return None
         head = self._head_fields()
-        if head is None:
+        if head is None or not self._inside(idx, width, member):
             return None
         op_at, conn_at, time_at = head
-        limit = self.limit if idx is None else self.limit[idx]
         t_ns = self.t_ns if idx is None else self.t_ns[idx]
-        inside = off + width <= limit
-        if not bool(np.all(inside if member is None else inside | ~member)):
-            return None
         rows = gather(self.buf, off, width)
 
         def col(at: int, kind: str) -> npt.NDArray[Any]:
@@ -170,21 +203,22 @@ def _label(requests: Sequence[Request], path: Path) -> str:
 class _Plan:
     """One request's located messages, cut into the runs of each group of chunks."""
 
-    def __init__(
-        self, request: Request, sel: tuple[list[int], I64, npt.NDArray[np.integer[Any]], I64, I64]
-    ) -> None:
-        _touched, chunk_of, rank_of, self.t_of, self.off_of = sel
-        ids = np.array([c.id for c in request.conns], dtype=np.int64)
-        self.conn_of = ids[rank_of] if len(self.t_of) else np.empty(0, np.int64)
+    def __init__(self, request: Request, sel: Selection) -> None:
+        _touched, chunk_of, self.rank_of, self.t_of, self.off_of = sel
+        self.ids = np.array([c.id for c in request.conns], dtype=np.int64)
         self.chunk_of = chunk_of
         # Messages in chunk order (one connection, or several in time order over
         # time-ordered chunks: the usual case) are sliced per group, not gathered.
         self.sorted = bool(np.all(chunk_of[1:] >= chunk_of[:-1]))
+        self.ranges: dict[int, tuple[int, int]] = {}
+        self.counts: dict[int, int] = {}
+        if not len(chunk_of):
+            return
         if self.sorted:
             cuts = np.flatnonzero(chunk_of[1:] != chunk_of[:-1]) + 1
             starts = np.concatenate([[0], cuts]).astype(np.int64)
             ends = np.concatenate([cuts, [len(chunk_of)]]).astype(np.int64)
-            keys = chunk_of[starts].tolist() if len(chunk_of) else []
+            keys = chunk_of[starts].tolist()
             self.ranges = {
                 ci: (a, b) for ci, a, b in zip(keys, starts.tolist(), ends.tolist(), strict=True)
             }
@@ -192,6 +226,12 @@ class _Plan:
         else:
             self.groups = dict(group_positions(chunk_of))
             self.counts = {ci: len(rows) for ci, rows in self.groups.items()}
+
+    def _conn(self, rank: Ints) -> I64:
+        """Connection ids of messages of these ranks (one connection: no per-message array)."""
+        if len(self.ids) == 1:
+            return np.broadcast_to(self.ids[0], rank.shape)
+        return self.ids[rank.astype(np.intp)]
 
     def run(
         self, bag: IndexedBag, batch: list[int], buf: U8, base: I64, sizes: I64, where: str
@@ -201,19 +241,25 @@ class _Plan:
         present = [i for i, c in enumerate(batch) if c in self.counts]
         if not present:
             return None
-        counts = np.array([self.counts[batch[i]] for i in present], dtype=np.int64)
-        at = np.array(present, dtype=np.int64)
+        counts = [self.counts[batch[i]] for i in present]
         sel: I64
         if self.sorted:
             a, b = self.ranges[batch[present[0]]][0], self.ranges[batch[present[-1]]][1]
             sel = np.arange(a, b, dtype=np.int64)
-            offsets, t, conn = self.off_of[a:b], self.t_of[a:b], self.conn_of[a:b]
+            rel, t, rank = self.off_of[a:b], self.t_of[a:b], self.rank_of[a:b]
         else:
             sel = cat_arrays([self.groups[batch[i]] for i in present])
-            offsets, t, conn = self.off_of[sel], self.t_of[sel], self.conn_of[sel]
-        start = np.repeat(base[at], counts)
-        limit = np.repeat(base[at] + sizes[at], counts)
-        records = Ros1Records(bag, buf, offsets + start, limit, t, conn, where)
+            rel, t, rank = self.off_of[sel], self.t_of[sel], self.rank_of[sel]
+        # offsets into the buffer, one chunk's messages at a time (a few chunks per group)
+        offsets = rel.astype(np.int64)
+        cuts = np.zeros(len(present), dtype=np.int64)
+        np.cumsum(counts[:-1], out=cuts[1:])
+        for k, i in enumerate(present):
+            if base[i]:
+                offsets[cuts[k] : cuts[k] + counts[k]] += base[i]
+        ends = base[present] + sizes[present]
+        conn = self._conn(rank)
+        records = Ros1Records(bag, buf, offsets, cuts, ends, t, conn, where)
         return Run(sel, buf, t, conn, records, consecutive=self.sorted)
 
 
