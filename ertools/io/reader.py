@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -17,7 +18,7 @@ import numpy.typing as npt
 
 from ertools.errors import BagError, TopicError
 from ertools.io.bagfile import BagFile
-from ertools.io.bulk import locate, try_fast_batch
+from ertools.io.bulk import locate, try_fast_batches
 from ertools.io.decode.fast import LayoutMismatchError, decode_states, is_state_definition
 from ertools.io.decode.posebatch import PoseBatch, batch_from_messages, concat_batches
 from ertools.io.decode.tf import Edge, chain_pose, frame_key
@@ -33,7 +34,7 @@ from ertools.io.model import (
     PoseSource,
     RawMessage,
 )
-from ertools.io.pipeline import group_positions
+from ertools.io.pipeline import Request, group_positions
 from ertools.states import MSG_TYPES, STATE_TOPIC_SUFFIXES, Machine
 from ertools.streams import MAX_FRAME_CHANGES, FrameChange, PoseStream, StateStream
 
@@ -88,11 +89,17 @@ def load_pose_batch(
 
     Tries the bulk decoder first; falls back to rosbags per message (logged at INFO).
     """
+    return load_pose_batches(bag, [Request(tuple(conns), start_ns, end_ns)])[0]
 
-    fast = try_fast_batch(bag, conns, start_ns, end_ns)
-    if fast is not None:
-        return fast
-    return slow_pose_batch(bag, conns, start_ns, end_ns)
+
+def load_pose_batches(bag: BagFile, requests: Sequence[Request]) -> list[PoseBatch]:
+    """:func:`load_pose_batch` of several requests, read in bulk from one pass over the file
+    (those the bulk decoder cannot read are read per message afterwards)."""
+    fast = try_fast_batches(bag, requests)
+    return [
+        b if b is not None else slow_pose_batch(bag, r.conns, r.lo, r.hi)
+        for b, r in zip(fast, requests, strict=True)
+    ]
 
 
 def slow_pose_batch(
@@ -195,56 +202,134 @@ def read_poses(
         TopicError: topic absent from every file (the message lists the pose topics there are),
             or not a pose type.
     """
-    if time_source not in ("header", "record"):
-        raise ValueError(f"time_source must be 'header' or 'record', not {time_source!r}")
+    return _read_sources(paths, [_TopicRead(topic, time_source)], start_ns, end_ns)[0]
+
+
+@dataclass(frozen=True)
+class _TopicRead:
+    """A pose topic read as a stream (:func:`read_poses`)."""
+
+    topic: str
+    time_source: str
+
+
+@dataclass(frozen=True)
+class _TfRead:
+    """A frame's pose from ``/tf`` and ``/tf_static`` (:func:`read_tf`)."""
+
+    parent: str
+    child: str
+
+
+def _read_sources(
+    paths: PathsLike,
+    reads: Sequence[_TopicRead | _TfRead],
+    start_ns: int | None,
+    end_ns: int | None,
+) -> list[PoseStream]:
+    """Pose topics and tf frames of the same files, each file read once for all of them (one
+    pass over its index and chunks, :func:`load_pose_batches`)."""
+    for r in reads:
+        if isinstance(r, _TopicRead) and r.time_source not in ("header", "record"):
+            raise ValueError(f"time_source must be 'header' or 'record', not {r.time_source!r}")
     plist = _paths(paths)
-    margin = HEADER_WINDOW_MARGIN_NS if time_source == "header" else 0
-    lo = None if start_ns is None else start_ns - margin
-    hi = None if end_ns is None else end_ns + margin
-    streams = []
-    for p in plist:
-        with open_bag(p) as bag:
-            conns = bag.topic_conns(topic)
-            if not conns:
-                continue
-            msgtype = _check_pose_conns(conns, topic, p)
-            batch = load_pose_batch(bag, conns, lo, hi)
-        source = f"{p}:{topic}"
-        stream = sort_poses(_batch_to_stream(batch, msgtype, time_source, source), source)
-        streams.append(stream.window(start_ns, end_ns))
-    if not streams:
-        raise _topic_error(plist, topic)
-    return merge_poses(streams, topic)
-
-
-def _tf_edges(
-    plist: list[Path], start_ns: int | None, end_ns: int | None
-) -> dict[tuple[str, str], Edge]:
+    parts: list[list[PoseStream]] = [[] for _ in reads]
     per_edge: dict[tuple[str, str], list[PoseStream]] = {}
     static_edges: set[tuple[str, str]] = set()
+    tf = any(isinstance(r, _TfRead) for r in reads)
     for p in plist:
         with open_bag(p) as bag:
-            for topic in TF_TOPICS:
-                conns = [c for c in bag.topic_conns(topic) if c.msgtype in TF_TYPES]
+            requests: list[Request] = []
+            topic_plan: list[tuple[int, int, str]] = []  # (read, request, msgtype)
+            for i, r in enumerate(reads):
+                if not isinstance(r, _TopicRead):
+                    continue
+                conns = bag.topic_conns(r.topic)
                 if not conns:
                     continue
-                static = topic == "/tf_static"
-                window = (None, None) if static else (start_ns, end_ns)
-                batch = load_pose_batch(bag, conns, *window)
-                frames = np.asarray([frame_key(f) for f in batch.frames], dtype=np.str_)
-                pairs = batch.frame_idx.astype(np.int64) * len(frames) + batch.child_idx
-                for code, rows in group_positions(pairs):
-                    key = (str(frames[code // len(frames)]), str(frames[code % len(frames)]))
-                    sub = batch.take(rows)
-                    s = PoseStream(sub.t_header, sub.xyz, sub.quat_xyzw, key[0], key[1], str(p))
-                    per_edge.setdefault(key, []).append(sort_poses(s, f"{p}:{topic} {key}"))
-                    if static or (any(c.latching for c in conns) and len(rows) == 1):
-                        static_edges.add(key)
-    edges = {}
-    for key, parts in per_edge.items():
-        merged = merge_poses(parts, f"tf {key[0]} -> {key[1]}")
+                msgtype = _check_pose_conns(conns, r.topic, p)
+                margin = HEADER_WINDOW_MARGIN_NS if r.time_source == "header" else 0
+                lo = None if start_ns is None else start_ns - margin
+                hi = None if end_ns is None else end_ns + margin
+                topic_plan.append((i, _want(requests, conns, lo, hi), msgtype))
+            tf_plan: list[tuple[str, list[Conn], int]] = []
+            if tf:
+                lo = None if start_ns is None else start_ns - HEADER_WINDOW_MARGIN_NS
+                hi = None if end_ns is None else end_ns + HEADER_WINDOW_MARGIN_NS
+                for topic in TF_TOPICS:
+                    tf_conns = [c for c in bag.topic_conns(topic) if c.msgtype in TF_TYPES]
+                    if tf_conns:
+                        window = (None, None) if topic == "/tf_static" else (lo, hi)
+                        tf_plan.append((topic, tf_conns, _want(requests, tf_conns, *window)))
+            batches = load_pose_batches(bag, requests)
+        for i, k, msgtype in topic_plan:
+            r = reads[i]
+            assert isinstance(r, _TopicRead)
+            source = f"{p}:{r.topic}"
+            stream = _batch_to_stream(batches[k], msgtype, r.time_source, source)
+            parts[i].append(sort_poses(stream, source).window(start_ns, end_ns))
+        for topic, tf_conns, k in tf_plan:
+            _add_tf_edges(per_edge, static_edges, p, topic, tf_conns, batches[k])
+    edges: dict[tuple[str, str], Edge] = {}
+    for key, found in per_edge.items():
+        merged = merge_poses(found, f"tf {key[0]} -> {key[1]}")
         edges[key] = Edge(merged, key in static_edges or len(merged) == 1)
-    return edges
+    out = []
+    for r, found in zip(reads, parts, strict=True):
+        if isinstance(r, _TopicRead):
+            if not found:
+                raise _topic_error(plist, r.topic)
+            out.append(merge_poses(found, r.topic))
+        else:
+            out.append(_tf_chain(plist, edges, r.parent, r.child, start_ns, end_ns))
+    return out
+
+
+def _want(requests: list[Request], conns: Sequence[Conn], lo: int | None, hi: int | None) -> int:
+    """The index of the request for ``conns`` in [lo, hi] (added unless there already)."""
+    req = Request(tuple(conns), lo, hi)
+    if req not in requests:
+        requests.append(req)
+    return requests.index(req)
+
+
+def _add_tf_edges(
+    per_edge: dict[tuple[str, str], list[PoseStream]],
+    static_edges: set[tuple[str, str]],
+    path: Path,
+    topic: str,
+    conns: Sequence[Conn],
+    batch: PoseBatch,
+) -> None:
+    """The transforms of one tf topic of one file, split by (parent, child) edge."""
+    static = topic == "/tf_static"
+    frames = np.asarray([frame_key(f) for f in batch.frames], dtype=np.str_)
+    pairs = batch.frame_idx.astype(np.int64) * len(frames) + batch.child_idx
+    for code, rows in group_positions(pairs):
+        key = (str(frames[code // len(frames)]), str(frames[code % len(frames)]))
+        sub = batch.take(rows)
+        s = PoseStream(sub.t_header, sub.xyz, sub.quat_xyzw, key[0], key[1], str(path))
+        per_edge.setdefault(key, []).append(sort_poses(s, f"{path}:{topic} {key}"))
+        if static or (any(c.latching for c in conns) and len(rows) == 1):
+            static_edges.add(key)
+
+
+def _tf_chain(
+    plist: list[Path],
+    edges: dict[tuple[str, str], Edge],
+    parent: str,
+    child: str,
+    start_ns: int | None,
+    end_ns: int | None,
+) -> PoseStream:
+    if not edges:
+        raise _topic_error(plist, "/tf", "tf topic")
+    source = f"{plist[0]}:/tf" if len(plist) == 1 else f"{len(plist)} files:/tf"
+    try:
+        stream = chain_pose(edges, parent, child, source)
+    except TopicError as err:
+        raise TopicError(f"{err.message} (in {source})") from err
+    return stream.window(start_ns, end_ns)
 
 
 def read_tf(
@@ -265,18 +350,7 @@ def read_tf(
     Raises:
         TopicError: no tf topic, an unknown frame, or no chain between the frames.
     """
-    plist = _paths(paths)
-    lo = None if start_ns is None else start_ns - HEADER_WINDOW_MARGIN_NS
-    hi = None if end_ns is None else end_ns + HEADER_WINDOW_MARGIN_NS
-    edges = _tf_edges(plist, lo, hi)
-    if not edges:
-        raise _topic_error(plist, "/tf", "tf topic")
-    source = f"{plist[0]}:/tf" if len(plist) == 1 else f"{len(plist)} files:/tf"
-    try:
-        stream = chain_pose(edges, parent, child, source)
-    except TopicError as err:
-        raise TopicError(f"{err.message} (in {source})") from err
-    return stream.window(start_ns, end_ns)
+    return _read_sources(paths, [_TfRead(parent, child)], start_ns, end_ns)[0]
 
 
 def read_pose_source(
@@ -287,13 +361,32 @@ def read_pose_source(
     end_ns: int | None = None,
 ) -> PoseStream:
     """A pose topic, or a tf frame when ``source.topic`` is None or a tf topic."""
-    if source.topic is not None and source.topic not in TF_TOPICS:
-        return read_poses(
-            paths, source.topic, time_source=source.time_source, start_ns=start_ns, end_ns=end_ns
-        )
-    if not source.frame:
-        raise TopicError("a tf pose source needs a frame (the tf child frame)")
-    return read_tf(paths, source.parent, source.frame, start_ns=start_ns, end_ns=end_ns)
+    return read_pose_sources(paths, [source], start_ns=start_ns, end_ns=end_ns)[0]
+
+
+def read_pose_sources(
+    paths: PathsLike,
+    sources: Sequence[PoseSource],
+    *,
+    start_ns: int | None = None,
+    end_ns: int | None = None,
+) -> list[PoseStream]:
+    """Several pose sources of the same bags (:func:`read_pose_source` each), every file
+    read once for all of them: one pass over its index and one over the chunks any of them
+    touches (the GT hour's PoseStamped, Pose2D and /tf topics cost one read of the file).
+
+    Raises:
+        TopicError: a source not in the bags, as :func:`read_poses` and :func:`read_tf` say.
+    """
+    reads: list[_TopicRead | _TfRead] = []
+    for source in sources:
+        if source.topic is not None and source.topic not in TF_TOPICS:
+            reads.append(_TopicRead(source.topic, source.time_source))
+            continue
+        if not source.frame:
+            raise TopicError("a tf pose source needs a frame (the tf child frame)")
+        reads.append(_TfRead(source.parent, source.frame))
+    return _read_sources(paths, reads, start_ns, end_ns)
 
 
 def read_messages(
