@@ -11,14 +11,14 @@ import logging
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
+from ertools.arrays import I64, U8
 from ertools.errors import BagError, TopicError
 from ertools.io.bagfile import BagFile
-from ertools.io.bulk import locate, try_fast_batches
+from ertools.io.bulk import locate_many, try_fast_batches
 from ertools.io.decode.fast import LayoutMismatchError, decode_states, is_state_definition
 from ertools.io.decode.posebatch import PoseBatch, batch_from_messages, concat_batches
 from ertools.io.decode.tf import Edge, chain_pose, frame_key
@@ -431,43 +431,76 @@ def _machine_of(topic: str, msgtype: str) -> Machine | None:
     return None
 
 
-def _bulk_states(
-    bag: BagFile, conns: list[Conn]
-) -> (
-    tuple[np.ndarray[Any, np.dtype[np.int64]], np.ndarray[Any, np.dtype[np.uint8]], list[str]]
-    | None
-):
+States = tuple[npt.NDArray[np.int64], npt.NDArray[np.uint8], list[str]]
+
+
+def _bulk_states(bag: BagFile, conns: list[Conn]) -> States | None:
     """(record times, states, payloads) decoded in bulk, None when the layout is not the 2015
     one or the format has no bulk access."""
+    return _bulk_states_many(bag, [conns])[0]
 
-    if len({c.encoding for c in conns}) != 1 or not all(
-        is_state_definition(c.msgdef) for c in conns
-    ):
-        return None
+
+def _bulk_states_many(bag: BagFile, topics: Sequence[list[Conn]]) -> list[States | None]:
+    """:func:`_bulk_states` of several topics, from one pass over the file."""
+    out: list[States | None] = [None] * len(topics)
+    mine = [
+        i
+        for i, conns in enumerate(topics)
+        if len({c.encoding for c in conns}) == 1
+        and all(is_state_definition(c.msgdef) for c in conns)
+    ]
+    if not mine:
+        return out
     try:
-        found = locate(bag, conns, None, None)
-        if found is None:
-            return None
-        pos_parts, t_parts, s_parts, payloads = [], [], [], []
-        for run in found.runs:
-            start, length = run.spans()
-            state, text = decode_states(run.buf, start, length, conns[0].encoding == "cdr")
-            pos_parts.append(run.pos)
-            t_parts.append(run.t_record)
-            s_parts.append(state)
-            payloads.extend(text)
+        found = locate_many(bag, [Request(tuple(topics[i])) for i in mine])
     except LayoutMismatchError as err:
-        log.info("%s: %s not in the 2015 state layout (%s)", bag.path, conns[0].topic, err)
-        return None
-    if not pos_parts:
+        log.info("%s: state topics not read in bulk (%s)", bag.path, err)
+        return out
+    if found is None:
+        return out
+    parts: list[list[tuple[I64, I64, U8, list[str]]] | None] = [[] for _ in mine]
+    try:
+        for runs in found.runs:
+            for k, run in enumerate(runs):
+                got = parts[k]
+                if run is None or got is None:
+                    continue
+                conns = topics[mine[k]]
+                try:
+                    start, length = run.spans()
+                    cdr = conns[0].encoding == "cdr"
+                    state, text = decode_states(run.buf, start, length, cdr)
+                except LayoutMismatchError as err:
+                    log.info(
+                        "%s: %s not in the 2015 state layout (%s)", bag.path, conns[0].topic, err
+                    )
+                    parts[k] = None
+                    continue
+                got.append((run.pos, run.t_record, state, text))
+    except LayoutMismatchError as err:
+        log.info("%s: state topics not read in bulk (%s)", bag.path, err)
+        return out
+    for k, i in enumerate(mine):
+        got = parts[k]
+        if got is not None:
+            out[i] = _ordered_states(got)
+    return out
+
+
+def _ordered_states(parts: list[tuple[I64, I64, U8, list[str]]]) -> States:
+    """The runs of one state topic in the reference order, then by record time."""
+    if not parts:
         return np.empty(0, np.int64), np.empty(0, np.uint8), []
-    pos = np.concatenate(pos_parts)
+    pos = np.concatenate([p[0] for p in parts])
+    t_all = np.concatenate([p[1] for p in parts])
+    payloads = [text for p in parts for text in p[3]]
     order = np.argsort(pos, kind="stable")
-    t = np.concatenate(t_parts)[order]
+    t = t_all[order]
     if len(t) > 1 and np.any(t[1:] < t[:-1]):
         order = order[np.argsort(t, kind="stable")]
-        t = np.concatenate(t_parts)[order]
-    return t, np.concatenate(s_parts)[order], [payloads[i] for i in order.tolist()]
+        t = t_all[order]
+    states = np.concatenate([p[2] for p in parts])[order]
+    return t, states, [payloads[i] for i in order.tolist()]
 
 
 def read_states(paths: PathsLike, topic: str) -> StateStream:
@@ -480,50 +513,68 @@ def read_states(paths: PathsLike, topic: str) -> StateStream:
     Raises:
         TopicError: topic absent, or not a state topic (no ``state``/``payload`` fields).
     """
-    plist = _paths(paths)
-    t_parts, s_parts, payloads = [], [], []
-    msgtype = ""
+    return _read_states(_paths(paths), [topic])[0]
+
+
+def _read_states(plist: list[Path], names: Sequence[str]) -> list[StateStream]:
+    """:func:`read_states` of several topics, each file read once for all of them."""
+    t_parts: list[list[npt.NDArray[np.int64]]] = [[] for _ in names]
+    s_parts: list[list[npt.NDArray[np.uint8]]] = [[] for _ in names]
+    payloads: list[list[str]] = [[] for _ in names]
+    msgtypes = [""] * len(names)
     for p in plist:
         with open_bag(p) as bag:
-            conns = bag.topic_conns(topic)
-            if not conns:
-                continue
-            msgtype = msgtype or conns[0].msgtype
-            if _machine_of(topic, conns[0].msgtype) is None:
-                raise TopicError(
-                    f"topic {topic} ({conns[0].msgtype}) is not a benchmark state topic "
-                    "(bmbox_state, refbox_state, client_state)",
-                    path=p,
-                )
-            bulk = _bulk_states(bag, conns)
-            if bulk is None:
-                deser = Deserializer(conns, p)
-                msgs = [(t, deser(raw, c)) for c, t, raw in bag.raw(conns)]
-                if msgs and not (hasattr(msgs[0][1], "state") and hasattr(msgs[0][1], "payload")):
+            present: list[tuple[int, list[Conn]]] = []
+            for i, topic in enumerate(names):
+                conns = bag.topic_conns(topic)
+                if not conns:
+                    continue
+                msgtypes[i] = msgtypes[i] or conns[0].msgtype
+                if _machine_of(topic, conns[0].msgtype) is None:
                     raise TopicError(
-                        f"topic {topic}: type {conns[0].msgtype} has no state/payload fields",
+                        f"topic {topic} ({conns[0].msgtype}) is not a benchmark state topic "
+                        "(bmbox_state, refbox_state, client_state)",
                         path=p,
                     )
-                bulk = (
-                    np.fromiter((t for t, _ in msgs), dtype=np.int64, count=len(msgs)),
-                    np.fromiter((int(m.state) for _, m in msgs), dtype=np.uint8, count=len(msgs)),
-                    [str(m.payload) for _, m in msgs],
-                )
-        t_parts.append(bulk[0])
-        s_parts.append(bulk[1])
-        payloads.extend(bulk[2])
-    if not t_parts:
-        raise _topic_error(plist, topic, "state topic")
-    machine = _machine_of(topic, msgtype)
-    assert machine is not None
-    t = np.concatenate(t_parts)
-    state = np.concatenate(s_parts)
-    if len(t) > 1 and np.any(t[1:] < t[:-1]):
-        log.warning("%s: messages from several files out of time order; sorted", topic)
-        order = np.argsort(t, kind="stable")
-        t, state, payloads = t[order], state[order], [payloads[i] for i in order.tolist()]
-    src = str(plist[0]) if len(plist) == 1 else ";".join(map(str, plist))
-    return StateStream(machine, t, state, tuple(payloads), topic, src)
+                present.append((i, conns))
+            bulks = _bulk_states_many(bag, [conns for _i, conns in present])
+            for (i, conns), bulk in zip(present, bulks, strict=True):
+                if bulk is None:
+                    bulk = _slow_states(bag, conns, names[i], p)
+                t_parts[i].append(bulk[0])
+                s_parts[i].append(bulk[1])
+                payloads[i].extend(bulk[2])
+    out = []
+    for i, topic in enumerate(names):
+        if not t_parts[i]:
+            raise _topic_error(plist, topic, "state topic")
+        machine = _machine_of(topic, msgtypes[i])
+        assert machine is not None
+        t = np.concatenate(t_parts[i])
+        state = np.concatenate(s_parts[i])
+        texts = payloads[i]
+        if len(t) > 1 and np.any(t[1:] < t[:-1]):
+            log.warning("%s: messages from several files out of time order; sorted", topic)
+            order = np.argsort(t, kind="stable")
+            t, state, texts = t[order], state[order], [texts[k] for k in order.tolist()]
+        src = str(plist[0]) if len(plist) == 1 else ";".join(map(str, plist))
+        out.append(StateStream(machine, t, state, tuple(texts), topic, src))
+    return out
+
+
+def _slow_states(bag: BagFile, conns: list[Conn], topic: str, path: Path) -> States:
+    """A state topic of one file deserialized by rosbags, message by message."""
+    deser = Deserializer(conns, path)
+    msgs = [(t, deser(raw, c)) for c, t, raw in bag.raw(conns)]
+    if msgs and not (hasattr(msgs[0][1], "state") and hasattr(msgs[0][1], "payload")):
+        raise TopicError(
+            f"topic {topic}: type {conns[0].msgtype} has no state/payload fields", path=path
+        )
+    return (
+        np.fromiter((t for t, _ in msgs), dtype=np.int64, count=len(msgs)),
+        np.fromiter((int(m.state) for _, m in msgs), dtype=np.uint8, count=len(msgs)),
+        [str(m.payload) for _, m in msgs],
+    )
 
 
 def read_benchmark_states(paths: PathsLike, namespace: str) -> BenchmarkStates:
@@ -535,10 +586,14 @@ def read_benchmark_states(paths: PathsLike, namespace: str) -> BenchmarkStates:
     plist = _paths(paths)
     present = topics(plist)
     ns = "/" + namespace.strip("/")
-    found: dict[Machine, StateStream | None] = {}
+    wanted: dict[Machine, str] = {}
     for machine, suffixes in STATE_TOPIC_SUFFIXES.items():
         topic = next((f"{ns}/{s}" for s in suffixes if f"{ns}/{s}" in present), None)
-        found[machine] = None if topic is None else read_states(plist, topic)
+        if topic is not None:
+            wanted[machine] = topic
+    # the three topics from one pass over each file
+    streams = dict(zip(wanted, _read_states(plist, list(wanted.values())), strict=True))
+    found: dict[Machine, StateStream | None] = {m: streams.get(m) for m in STATE_TOPIC_SUFFIXES}
     if all(v is None for v in found.values()):
         log.info("no state topics of %s in %s", ns, plist[0])
     return BenchmarkStates(found[Machine.BMBOX], found[Machine.REFBOX], found[Machine.CLIENT])
