@@ -34,7 +34,7 @@ from ertools.io.model import (
     PoseSource,
     RawMessage,
 )
-from ertools.io.pipeline import Request, group_positions
+from ertools.io.pipeline import Request
 from ertools.states import MSG_TYPES, STATE_TOPIC_SUFFIXES, Machine
 from ertools.streams import MAX_FRAME_CHANGES, FrameChange, PoseStream, StateStream
 
@@ -303,14 +303,20 @@ def _add_tf_edges(
 ) -> None:
     """The transforms of one tf topic of one file, split by (parent, child) edge."""
     static = topic == "/tf_static"
-    frames = np.asarray([frame_key(f) for f in batch.frames], dtype=np.str_)
+    frames = [frame_key(f) for f in batch.frames]
     pairs = batch.frame_idx.astype(np.int64) * len(frames) + batch.child_idx
-    for code, rows in group_positions(pairs):
-        key = (str(frames[code // len(frames)]), str(frames[code % len(frames)]))
-        sub = batch.take(rows)
-        s = PoseStream(sub.t_header, sub.xyz, sub.quat_xyzw, key[0], key[1], str(path))
+    # a few (parent, child) pairs: one comparison each rather than a sort of every row
+    counts = np.bincount(pairs, minlength=len(frames) ** 2) if len(pairs) else pairs
+    for code in np.flatnonzero(counts).tolist():
+        key = (frames[code // len(frames)], frames[code % len(frames)])
+        rows: slice | npt.NDArray[np.bool_] = (
+            slice(None) if counts[code] == len(pairs) else pairs == code
+        )
+        s = PoseStream(
+            batch.t_header[rows], batch.xyz[rows], batch.quat_xyzw[rows], key[0], key[1], str(path)
+        )
         per_edge.setdefault(key, []).append(sort_poses(s, f"{path}:{topic} {key}"))
-        if static or (any(c.latching for c in conns) and len(rows) == 1):
+        if static or (any(c.latching for c in conns) and int(counts[code]) == 1):
             static_edges.add(key)
 
 
