@@ -65,7 +65,8 @@ def main() -> None:
 
         n = sum(len(s) for s in read_pose_sources(path, sources))
     elif mode == "each":
-        n = sum(len(read_pose_source(path, s)) for s in sources)
+        streams = [read_pose_source(path, s) for s in sources]  # kept, as one read keeps them
+        n = sum(len(s) for s in streams)
     else:
         raise SystemExit(f"unknown mode {mode}")
     done = time.perf_counter()

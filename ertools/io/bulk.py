@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any, cast
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import I64, U8, Bool
+from ertools.arrays import I32, I64, U8, Bool
 from ertools.errors import BagError
 from ertools.io import pipeline
 from ertools.io.bagfile import BagFile
@@ -76,11 +76,18 @@ class _Assembler:
         # the record times in the reference order, when the index gave them: not copied
         self.times_known = times is not None and len(times) == n
         self.t_record = times if times is not None and self.times_known else np.empty(n, np.int64)
-        self.t_header = np.empty(n, dtype=np.int64)
+        # a type without a header is timed by its record times: no array of its own
+        self.headless = msgtype == "geometry_msgs/Pose2D"
+        self.t_header = np.empty(0 if self.headless else n, dtype=np.int64)
         self.xyz = np.empty((n, 3))
         self.quat = np.empty((n, 4))
+        # Frame codes: while every row written has the same (frame, child) pair (a logger's
+        # topic), the arrays are not written (zeroed memory never touched costs no memory)
+        # and the batch gets the pair broadcast; a second pair writes them out.
         self.frame_idx = np.zeros(n, dtype=np.int32)
         self.child_idx = np.zeros(n, dtype=np.int32)
+        self.pair: tuple[int, int] | None = None
+        self.pairs_written = False
         # which messages have their row in the arrays (only tracked for TF, which may have
         # rows elsewhere, in parts)
         self.filled = np.zeros(n if self.tf else 0, dtype=bool)
@@ -120,22 +127,41 @@ class _Assembler:
             self.parts.append((pos, to_batch(rows, decoded(lay, tmp), t_record)))
             return
         at = self.at(pos, consecutive)
-        if isinstance(at, slice):
+        if isinstance(at, slice) and not self.headless:
             write_rows(rows, skip, lay, Rows(self.t_header[at], self.xyz[at], self.quat[at]))
+        elif isinstance(at, slice):
+            stamps = np.empty(len(pos), np.int64)  # (none: zeros written, unused)
+            write_rows(rows, skip, lay, Rows(stamps, self.xyz[at], self.quat[at]))
         else:
             tmp = empty_rows(len(pos))
             write_rows(rows, skip, lay, tmp)
-            self.t_header[at] = tmp.t_header
+            if not self.headless:
+                self.t_header[at] = tmp.t_header
             _scatter(self.xyz, at, tmp.xyz)
             _scatter(self.quat, at, tmp.quat)
         if not self.times_known:
             self.t_record[at] = t_record
-        if lay.stamp is None:
+        if lay.stamp is None and not self.headless:
             self.t_header[at] = t_record  # no header: timed by record time, as in to_batch
-        self.frame_idx[at] = self.code(lay.frame)
-        self.child_idx[at] = self.code(lay.child)
+        self._codes(at, self.code(lay.frame), self.code(lay.child))
         if self.tf:
             self.filled[at] = True
+
+    def _codes(self, at: slice | I64, frame: int | I32, child: int | I32) -> None:
+        """Frame codes of rows ``at`` (see ``pair`` in ``__init__``)."""
+        if not self.pairs_written:
+            pair = (_single(frame), _single(child))
+            if pair[0] is not None and pair[1] is not None:
+                if self.pair is None:
+                    self.pair = (pair[0], pair[1])
+                if self.pair == pair:
+                    return
+            if self.pair is not None:
+                self.frame_idx[...] = self.pair[0]
+                self.child_idx[...] = self.pair[1]
+            self.pairs_written = True
+        self.frame_idx[at] = frame
+        self.child_idx[at] = child
 
     def unfilled(self, pos: I64) -> None:
         """Messages ``pos`` have no row yet (written over afterwards, or left out)."""
@@ -145,6 +171,8 @@ class _Assembler:
     def add(self, pos: I64, batch: PoseBatch, one_each: bool) -> None:
         """Decoded rows and the reference position of the message of each row (``one_each``:
         every message has exactly one row)."""
+        if not len(pos):
+            return
         if not self.direct or not one_each:
             self.parts.append((pos, batch))
             return
@@ -152,22 +180,27 @@ class _Assembler:
         at = self.at(pos)
         if not self.times_known:
             self.t_record[at] = batch.t_record
-        self.t_header[at] = batch.t_header
+        if not self.headless:
+            self.t_header[at] = batch.t_header
         self.xyz[at] = batch.xyz
         self.quat[at] = batch.quat_xyzw
-        self.frame_idx[at] = remap[batch.frame_idx]
-        self.child_idx[at] = remap[batch.child_idx]
+        self._codes(at, remap[batch.frame_idx], remap[batch.child_idx])
         if self.tf:
             self.filled[at] = True
 
     def _arrays(self) -> PoseBatch:
+        frame_idx, child_idx = self.frame_idx, self.child_idx
+        if not self.pairs_written and self.pair is not None:
+            n = len(self.t_record)
+            frame_idx = np.broadcast_to(np.int32(self.pair[0]), (n,))
+            child_idx = np.broadcast_to(np.int32(self.pair[1]), (n,))
         return PoseBatch(
             self.t_record,
-            self.t_header,
+            self.t_record if self.headless else self.t_header,
             self.xyz,
             self.quat,
-            self.frame_idx,
-            self.child_idx,
+            frame_idx,
+            child_idx,
             tuple(self.frames),
         )
 
@@ -186,6 +219,15 @@ class _Assembler:
         if self.by_time and len(t) > 1 and np.any(t[1:] < t[:-1]):
             batch = batch.take(np.argsort(t, kind="stable"))
         return batch
+
+
+def _single(codes: int | I32) -> int | None:
+    """The one value of ``codes`` (every row the same), else None."""
+    if isinstance(codes, int):
+        return codes
+    if len(codes) and bool(np.all(codes == codes[0])):
+        return int(codes[0])
+    return None
 
 
 def _scatter(dst: npt.NDArray[np.float64], at: I64, src: npt.NDArray[np.float64]) -> None:

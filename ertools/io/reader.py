@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import I64, U8
+from ertools.arrays import F64, I64, U8
 from ertools.errors import BagError, TopicError
 from ertools.io.bagfile import BagFile
 from ertools.io.bulk import locate_many, try_fast_batches
@@ -268,8 +268,10 @@ def _read_sources(
             source = f"{p}:{r.topic}"
             stream = _batch_to_stream(batches[k], msgtype, r.time_source, source)
             parts[i].append(sort_poses(stream, source).window(start_ns, end_ns))
+        shared = {k for _i, k, _t in topic_plan}
         for topic, tf_conns, k in tf_plan:
-            _add_tf_edges(per_edge, static_edges, p, topic, tf_conns, batches[k])
+            own = k not in shared  # (a topic read of the same request keeps the batch's rows)
+            _add_tf_edges(per_edge, static_edges, p, topic, tf_conns, batches[k], own)
     edges: dict[tuple[str, str], Edge] = {}
     for key, found in per_edge.items():
         merged = merge_poses(found, f"tf {key[0]} -> {key[1]}")
@@ -300,24 +302,53 @@ def _add_tf_edges(
     topic: str,
     conns: Sequence[Conn],
     batch: PoseBatch,
+    own: bool,
 ) -> None:
-    """The transforms of one tf topic of one file, split by (parent, child) edge."""
+    """The transforms of one tf topic of one file, split by (parent, child) edge (``own``: the
+    batch is this function's to consume)."""
     static = topic == "/tf_static"
     frames = [frame_key(f) for f in batch.frames]
     pairs = batch.frame_idx.astype(np.int64) * len(frames) + batch.child_idx
     # a few (parent, child) pairs: one comparison each rather than a sort of every row
     counts = np.bincount(pairs, minlength=len(frames) ** 2) if len(pairs) else pairs
-    for code in np.flatnonzero(counts).tolist():
+    codes = np.flatnonzero(counts).tolist()
+    biggest = max(codes, key=lambda c: int(counts[c])) if codes else -1
+    found: dict[int, tuple[I64, F64, F64]] = {}
+    for code in codes:
+        if code != biggest or not own:
+            rows = pairs == code
+            found[code] = (batch.t_header[rows], batch.xyz[rows], batch.quat_xyzw[rows])
+    if codes and own:
+        # the edge of most rows (a body beside a static transform): moved up in the batch's
+        # own arrays rather than copied
+        found[biggest] = _compacted(batch, pairs == biggest if len(codes) > 1 else None)
+    for code in codes:
         key = (frames[code // len(frames)], frames[code % len(frames)])
-        rows: slice | npt.NDArray[np.bool_] = (
-            slice(None) if counts[code] == len(pairs) else pairs == code
-        )
-        s = PoseStream(
-            batch.t_header[rows], batch.xyz[rows], batch.quat_xyzw[rows], key[0], key[1], str(path)
-        )
+        t, xyz, quat = found[code]
+        s = PoseStream(t, xyz, quat, key[0], key[1], str(path))
         per_edge.setdefault(key, []).append(sort_poses(s, f"{path}:{topic} {key}"))
         if static or (any(c.latching for c in conns) and int(counts[code]) == 1):
             static_edges.add(key)
+
+
+# Rows moved per step when an edge is compacted in place (a temporary of this many rows).
+_COMPACT_ROWS = 1 << 16
+
+
+def _compacted(batch: PoseBatch, keep: npt.NDArray[np.bool_] | None) -> tuple[I64, F64, F64]:
+    """The stamps and poses of the rows ``keep`` (None: all), moved to the front of the
+    batch's own arrays a block at a time (a row only moves forward, past rows already read)."""
+    arrays = (batch.t_header, batch.xyz, batch.quat_xyzw)
+    if keep is None:
+        return arrays
+    done = 0
+    for start in range(0, len(keep), _COMPACT_ROWS):
+        mine = keep[start : start + _COMPACT_ROWS]
+        n = int(np.count_nonzero(mine))
+        for a in arrays:
+            a[done : done + n] = a[start : start + _COMPACT_ROWS][mine]
+        done += n
+    return batch.t_header[:done], batch.xyz[:done], batch.quat_xyzw[:done]
 
 
 def _tf_chain(

@@ -206,7 +206,6 @@ class _Plan:
     def __init__(self, request: Request, sel: Selection) -> None:
         _touched, chunk_of, self.rank_of, self.t_of, self.off_of = sel
         self.ids = np.array([c.id for c in request.conns], dtype=np.int64)
-        self.chunk_of = chunk_of
         # Messages in chunk order (one connection, or several in time order over
         # time-ordered chunks: the usual case) are sliced per group, not gathered.
         self.sorted = bool(np.all(chunk_of[1:] >= chunk_of[:-1]))
