@@ -169,30 +169,40 @@ def _column(rows: U8, offset: int, dtype: str, count: int = 1) -> npt.NDArray[np
     return np.ndarray((n, count), dtype=dtype, buffer=rows, offset=offset, strides=(size, step))
 
 
+def _words(lay: Layout) -> list[tuple[int, str, int]]:
+    """(offset, dtype, value) of the words that cover the layout's fixed ranges: 8 bytes, or
+    4, 2, 1 for shorter ranges; the last word overlaps the one before when a range is not a
+    multiple of it."""
+    out: list[tuple[int, str, int]] = []
+    for a, b in lay.fixed:
+        width = next(w for w in (8, 4, 2, 1) if w <= b - a)
+        starts = list(range(a, b - width + 1, width))
+        if starts[-1] != b - width:
+            starts.append(b - width)
+        out.extend(
+            (at, f"<u{width}", int.from_bytes(lay.ref[at : at + width], "little")) for at in starts
+        )
+    return out
+
+
 def same_structure(rows: U8, skip: int, lay: Layout, member: Bool | None = None) -> bool:
     """Whether every row (a message from byte ``skip`` on; with ``member``, every row where
     it is True) has the bytes of ``lay.ref`` where the layout's fixed ranges are (string
     lengths and names, CDR header and padding, the TF transform count).
 
-    Compared a word at a time (8 bytes, or 4, 2, 1 for shorter ranges; the last word
-    overlaps the one before when the range is not a multiple of it), so the cost is a few
-    strided reads per row, not one per byte.
+    Compared a word at a time, so the cost is a few strided reads per row, not one per byte.
     """
     if not len(rows):
         return True
-    for a, b in lay.fixed:
-        width = next(w for w in (8, 4, 2, 1) if w <= b - a)
-        starts = list(range(a, b - width + 1, width))
-        if starts[-1] != b - width:
-            starts.append(b - width)  # the last word overlaps the one before
-        for at in starts:
-            want = int.from_bytes(lay.ref[at : at + width], "little")
-            same = _column(rows, skip + at, f"<u{width}") == want
-            if member is not None:
-                same |= ~member
-            if not bool(np.all(same)):
+    bad: Bool | None = None
+    for at, kind, want in _words(lay):
+        differs = _column(rows, skip + at, kind) != want
+        if member is None:
+            if bool(differs.any()):
                 return False
-    return True
+        else:
+            bad = differs if bad is None else np.logical_or(bad, differs, out=bad)
+    return member is None or bad is None or not bool(np.any(bad & member))
 
 
 # Raw bytes are copied into float64 arrays as they are (one copy per row and block, faster

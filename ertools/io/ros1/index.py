@@ -58,7 +58,7 @@ from ertools.io.ros1.records import (
     parse_fields,
     read_record,
 )
-from ertools.io.ros1.runs import Ints, Selection, ros1_runs
+from ertools.io.ros1.runs import Ints, Selection, Words, ros1_runs
 from ertools.progress import current
 
 if TYPE_CHECKING:
@@ -96,17 +96,21 @@ def _standard_spans(buf: U8, offsets: I64) -> tuple[I64, I64] | None:
     return start, length
 
 
-def _entries(parts: list[bytes | tuple[I64, I64]]) -> tuple[I64, Ints]:
-    """(record times, offsets in their chunks) of one connection's index entries over several
-    chunks. Offsets read from index data stay uint32 as stored (widened per group, where they
-    are added to the chunk's place in the group's bytes)."""
+def _entries(parts: list[bytes | tuple[I64, I64]]) -> tuple[I64, Ints, Words | None]:
+    """(record times, offsets in their chunks, time words) of one connection's index entries
+    over several chunks. Offsets read from index data stay uint32 as stored (widened per
+    group, where they are added to the chunk's place in the group's bytes); the time words
+    are each entry's (sec, nsec) as one little-endian uint64, the bytes a message record's
+    time field must hold (None for entries a scan found)."""
     if not all(isinstance(p, bytes) for p in parts):
-        return joined_entries(parts)
+        t, off = joined_entries(parts)
+        return t, off, None
     arr = np.frombuffer(b"".join(p for p in parts if isinstance(p, bytes)), dtype=INDEX_DTYPE)
     # Computed in place: fresh memory is slow to fault in, and an hour's entries are 5 MB.
     t = np.multiply(arr["sec"], 1_000_000_000, dtype=np.int64)
     np.add(t, arr["nsec"], out=t)
-    return t, np.ascontiguousarray(arr["off"])
+    words = np.ndarray((len(arr),), "<u8", buffer=arr, strides=(INDEX_DTYPE.itemsize,))
+    return t, np.ascontiguousarray(arr["off"]), np.ascontiguousarray(words)
 
 
 def _run_starts(a: I64) -> I64:
@@ -291,10 +295,12 @@ class Ros1Bag(BagFile):
         except BagError as err:
             raise BagError(err.message, path=None) from err
 
-    def select(self, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None) -> Selection:
+    def select(
+        self, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
+    ) -> tuple[list[int], I64, Ints, I64, Ints]:
         """Messages of ``conns`` in [start_ns, end_ns], in the reference order: one request
         of :meth:`select_many`."""
-        return self.select_many([Request(tuple(conns), start_ns, end_ns)])[0]
+        return self.select_many([Request(tuple(conns), start_ns, end_ns)])[0][:5]
 
     def select_many(self, requests: Sequence[Request]) -> list[Selection]:
         """The messages of each request (connections, record-time window), each in its
@@ -342,11 +348,11 @@ class Ros1Bag(BagFile):
                 return self.select_many(requests)
         self._unmap()  # the index pages touched would otherwise stay in this process's RSS
         # per connection: (record times, offsets, chunk index) of its entries in the window
-        entries: dict[int, tuple[I64, Ints, I64]] = {}
+        entries: dict[int, tuple[I64, Ints, I64, Words | None]] = {}
         for cid in wanted:
             if not raw[cid]:
                 continue
-            t, off = _entries(raw[cid])
+            t, off, words = _entries(raw[cid])
             if self.layout.indexed:
                 outside = outside_chunk_info(self.layout.chunks, cid, t, where[cid])
                 if outside is not None:
@@ -356,41 +362,50 @@ class Ros1Bag(BagFile):
                 np.array([w[0] for w in where[cid]], dtype=np.int64),
                 np.array([w[1] for w in where[cid]], dtype=np.int64),
             )
-            entries[cid] = (t, off, c)
+            entries[cid] = (t, off, c, words)
         return [self._ordered(r, entries) for r in requests]
 
-    def _ordered(self, request: Request, entries: dict[int, tuple[I64, Ints, I64]]) -> Selection:
+    def _ordered(
+        self, request: Request, entries: dict[int, tuple[I64, Ints, I64, Words | None]]
+    ) -> Selection:
         """One request's messages, in rosbags' order, from every wanted connection's entries."""
         rank = {c.id: i for i, c in enumerate(request.conns)}
         tt: list[I64] = []
         oo: list[Ints] = []
         ck: list[I64] = []
+        ww: list[Words | None] = []
         rk: list[npt.NDArray[np.integer[Any]]] = []
         for cid, r in rank.items():
             if cid not in entries:
                 continue
-            t, off, c = entries[cid]
+            t, off, c, words = entries[cid]
             keep = in_window(t, request.lo, request.hi)
             if keep is not None:
                 t, off, c = t[keep], off[keep], c[keep]
+                words = None if words is None else words[keep]
             tt.append(t)
             oo.append(off)
             ck.append(c)
+            ww.append(words)
             rk.append(np.full(len(t), r, dtype=np.int8 if len(rank) < 128 else np.int64))
         if not tt or not sum(len(t) for t in tt):
             e = np.empty(0, np.int64)
-            return [], e, e, e, e
+            return [], e, e, e, e, None
         t_all, c_all = cat_arrays(tt), cat_arrays(ck)
         o_all = oo[0] if len(oo) == 1 else np.concatenate(oo)
         r_all = rk[0] if len(rk) == 1 else np.concatenate(rk)
+        w_all: Words | None = None
+        if all(w is not None for w in ww):
+            w_all = ww[0] if len(ww) == 1 else np.concatenate([w for w in ww if w is not None])
         # each connection's chunk indices ascend (its entries are gathered chunk by chunk)
         touched = sorted({ci for c in ck for ci in c[_run_starts(c)].tolist()})
         # rosbags: per connection sorted by time (stable over chunk and index order), then a
         # heap merge over connections in the order given (ties: the earlier connection).
         order = _merged_order(tt)
         if order is None:
-            return touched, c_all, r_all, t_all, o_all  # already in order
-        return touched, c_all[order], r_all[order], t_all[order], o_all[order]
+            return touched, c_all, r_all, t_all, o_all, w_all  # already in order
+        w_sorted = None if w_all is None else w_all[order]
+        return touched, c_all[order], r_all[order], t_all[order], o_all[order], w_sorted
 
     def _rescan(self, why: str) -> None:
         """Distrust the index from now on: rebuild the layout from the records themselves."""

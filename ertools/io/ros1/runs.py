@@ -51,9 +51,11 @@ if TYPE_CHECKING:
 
 
 Ints = npt.NDArray[np.integer[Any]]
+Words = npt.NDArray[np.uint64]
 # One request's messages, in its reference order: (chunk indices touched, chunk index, conn
-# rank, record time, record offset in its chunk per message)
-Selection = tuple[list[int], I64, Ints, I64, Ints]
+# rank, record time, record offset in its chunk, and the record time as its record stores it,
+# (sec, nsec) in one uint64, when the index gave it, per message)
+Selection = tuple[list[int], I64, Ints, I64, Ints, Words | None]
 
 
 class IndexedBag(Protocol):
@@ -96,8 +98,9 @@ class Ros1Records:
         t_ns: I64,
         conn: I64,
         where: str,
+        words: Words | None = None,
     ) -> None:
-        self.bag, self.buf, self.where = bag, buf, where
+        self.bag, self.buf, self.where, self.words = bag, buf, where, words
         self.offsets, self.cuts, self.ends, self.t_ns, self.conn = offsets, cuts, ends, t_ns, conn
         self._limit: I64 | None = None
         self._spans: tuple[I64, I64] | None = None
@@ -177,7 +180,6 @@ class Ros1Records:
         if head is None or not self._inside(idx, width, member):
             return None
         op_at, conn_at, time_at = head
-        t_ns = self.t_ns if idx is None else self.t_ns[idx]
         rows = gather(self.buf, off, width)
 
         def col(at: int, kind: str) -> npt.NDArray[Any]:
@@ -187,9 +189,13 @@ class Ros1Records:
         ok &= col(4 + op_at, "<u8") == OP_MSG_WORD
         ok &= col(HEAD - 4, "<u4") == size
         ok &= col(4 + conn_at, "<u4") == conn
-        t = np.multiply(col(4 + time_at, "<u4"), 1_000_000_000, dtype=np.int64)
-        t += col(8 + time_at, "<u4")
-        ok &= t == t_ns
+        if self.words is not None:
+            # the time field's bytes against the index entry's, as stored
+            ok &= col(4 + time_at, "<u8") == (self.words if idx is None else self.words[idx])
+        else:
+            t = np.multiply(col(4 + time_at, "<u4"), 1_000_000_000, dtype=np.int64)
+            t += col(8 + time_at, "<u4")
+            ok &= t == (self.t_ns if idx is None else self.t_ns[idx])
         if member is not None:
             ok |= ~member
         return (rows, HEAD) if bool(ok.all()) else None
@@ -204,7 +210,7 @@ class _Plan:
     """One request's located messages, cut into the runs of each group of chunks."""
 
     def __init__(self, request: Request, sel: Selection) -> None:
-        _touched, chunk_of, self.rank_of, self.t_of, self.off_of = sel
+        _touched, chunk_of, self.rank_of, self.t_of, self.off_of, self.words = sel
         self.ids = np.array([c.id for c in request.conns], dtype=np.int64)
         # Messages in chunk order (one connection, or several in time order over
         # time-ordered chunks: the usual case) are sliced per group, not gathered.
@@ -246,9 +252,11 @@ class _Plan:
             a, b = self.ranges[batch[present[0]]][0], self.ranges[batch[present[-1]]][1]
             sel = np.arange(a, b, dtype=np.int64)
             rel, t, rank = self.off_of[a:b], self.t_of[a:b], self.rank_of[a:b]
+            words = None if self.words is None else self.words[a:b]
         else:
             sel = cat_arrays([self.groups[batch[i]] for i in present])
             rel, t, rank = self.off_of[sel], self.t_of[sel], self.rank_of[sel]
+            words = None if self.words is None else self.words[sel]
         # offsets into the buffer, one chunk's messages at a time (a few chunks per group)
         offsets = rel.astype(np.int64)
         cuts = np.zeros(len(present), dtype=np.int64)
@@ -258,7 +266,7 @@ class _Plan:
                 offsets[cuts[k] : cuts[k] + counts[k]] += base[i]
         ends = base[present] + sizes[present]
         conn = self._conn(rank)
-        records = Ros1Records(bag, buf, offsets, cuts, ends, t, conn, where)
+        records = Ros1Records(bag, buf, offsets, cuts, ends, t, conn, where, words)
         return Run(sel, buf, t, conn, records, consecutive=self.sorted)
 
 
