@@ -148,7 +148,7 @@ def _batch_to_stream(batch: PoseBatch, msgtype: str, time_source: str, source: s
     frame = batch.frames[fi[0]] if len(fi) else ""
     child = batch.frames[ci[0]] if len(ci) else ""
     changes: tuple[FrameChange, ...] = ()
-    if len(fi) and (np.any(fi != fi[0]) or np.any(ci != ci[0])):
+    if len(fi) and (_varies(fi) or _varies(ci)):
         changes = _frame_changes(batch, t)
         used = {batch.frames[i] for i in np.unique(np.concatenate([fi, ci]))}
         log.warning(
@@ -159,6 +159,14 @@ def _batch_to_stream(batch: PoseBatch, msgtype: str, time_source: str, source: s
             child,
         )
     return PoseStream(t, batch.xyz, batch.quat_xyzw, frame, child, source, changes)
+
+
+def _varies(codes: npt.NDArray[np.int32]) -> bool:
+    """Whether the frame codes of a batch differ (a bulk read's codes of one frame pair are
+    one value broadcast: nothing to compare)."""
+    if codes.strides == (0,):
+        return False
+    return bool(np.any(codes != codes[0]))
 
 
 def _frame_changes(batch: PoseBatch, t: npt.NDArray[np.int64]) -> tuple[FrameChange, ...]:
@@ -337,18 +345,18 @@ _COMPACT_ROWS = 1 << 16
 
 def _compacted(batch: PoseBatch, keep: npt.NDArray[np.bool_] | None) -> tuple[I64, F64, F64]:
     """The stamps and poses of the rows ``keep`` (None: all), moved to the front of the
-    batch's own arrays a block at a time (a row only moves forward, past rows already read)."""
+    batch's own arrays a block at a time: the rows of a block are taken (whole rows at a time)
+    before any is written, and each row only moves forward, past rows already read."""
     arrays = (batch.t_header, batch.xyz, batch.quat_xyzw)
     if keep is None:
         return arrays
-    done = 0
-    for start in range(0, len(keep), _COMPACT_ROWS):
-        mine = keep[start : start + _COMPACT_ROWS]
-        n = int(np.count_nonzero(mine))
+    rows = np.flatnonzero(keep)
+    for start in range(0, len(rows), _COMPACT_ROWS):
+        part = rows[start : start + _COMPACT_ROWS]
         for a in arrays:
-            a[done : done + n] = a[start : start + _COMPACT_ROWS][mine]
-        done += n
-    return batch.t_header[:done], batch.xyz[:done], batch.quat_xyzw[:done]
+            a[start : start + len(part)] = np.take(a, part, axis=0)
+    n = len(rows)
+    return batch.t_header[:n], batch.xyz[:n], batch.quat_xyzw[:n]
 
 
 def _tf_chain(

@@ -22,7 +22,6 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import I64, U8, Bool
-from ertools.geometry import quat_from_yaw
 from ertools.io.decode.fast import Decoded, gather
 
 # Odometry after its pose: pose covariance (36), twist (6), twist covariance (36) float64.
@@ -228,7 +227,6 @@ def write_rows(rows: U8, skip: int, lay: Layout, out: Rows) -> None:
     """Stamps and poses of every row (its message from byte ``skip`` on, in layout ``lay``,
     checked with :func:`same_structure`) into ``out``. Types without a header get stamp 0
     (their time is the record time)."""
-    n = len(rows)
     if lay.stamp is not None:
         sec_at, nsec_at, sec_type = lay.stamp
         np.multiply(
@@ -244,8 +242,12 @@ def write_rows(rows: U8, skip: int, lay: Layout, out: Rows) -> None:
         out.xyz[:, 2] = 0.0
         # (rows of other messages, overwritten afterwards, may hold any bits: no warnings)
         with np.errstate(all="ignore"):
-            yaw = np.array(values[:, 2], dtype=np.float64)
-            out.quat[...] = quat_from_yaw(yaw).reshape(n, 4)
+            # quat_from_yaw's own operations on the same contiguous input (the same bits),
+            # written into place rather than stacked
+            half = 0.5 * np.array(values[:, 2], dtype=np.float64)
+            out.quat[:, :2] = 0.0
+            out.quat[:, 2] = np.sin(half)
+            out.quat[:, 3] = np.cos(half)
 
 
 def decoded(lay: Layout, out: Rows) -> Decoded:
