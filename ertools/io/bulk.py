@@ -10,8 +10,10 @@ INFO, visible with ``-v``).
 
 from __future__ import annotations
 
+import contextlib
 import logging
 from collections.abc import Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
@@ -605,29 +607,46 @@ def try_fast_batches(bag: BagFile, requests: Sequence[Request]) -> list[PoseBatc
         )
         for i, a in zip(mine, assemblers, strict=True)
     ]
-    try:
-        # Decoded here, not on the loading threads: its many small NumPy calls hold the GIL,
-        # and two threads decoding were slower than one (measured).
-        for runs in found.runs:
-            for k, run in enumerate(runs):
-                dec = decoders[k]
-                if run is None or dec is None:
+    failed: list[LayoutMismatchError | None] = [None] * len(mine)
+
+    def decode_run(k: int, run: Run) -> None:
+        dec = decoders[k]
+        if dec is None or failed[k] is not None:
+            return
+        try:
+            dec.run(run)
+        except LayoutMismatchError as err:
+            failed[k] = err
+
+    # The requests of a group are decoded side by side, one per thread: NumPy releases the GIL
+    # in its loops, and each request has its own decoder and result (the group's bytes are
+    # only read). A group's runs are all decoded before the next group is asked for (which
+    # may reuse its buffer); errors are raised in request order, as one thread would.
+    threads = min(pipeline.workers(), len(mine))
+    with contextlib.ExitStack() as stack:
+        pool = stack.enter_context(ThreadPoolExecutor(threads)) if threads > 1 else None
+        try:
+            for runs in found.runs:
+                todo = [(k, run) for k, run in enumerate(runs) if run is not None]
+                if pool is None or len(todo) < 2:
+                    for k, run in todo:
+                        decode_run(k, run)
                     continue
-                try:
-                    dec.run(run)
-                except LayoutMismatchError as err:
-                    req = requests[mine[k]]
-                    log.info(
-                        "%s: %s on %s not in the standard layout (%s); decoding per message",
-                        bag.path,
-                        kinds[mine[k]],
-                        req.conns[0].topic,
-                        err,
-                    )
-                    decoders[k] = None
-    except LayoutMismatchError as err:
-        log.info("%s: not read in bulk (%s); decoding per message", bag.path, err)
-        return out
+                for future in [pool.submit(decode_run, k, run) for k, run in todo]:
+                    future.result()
+        except LayoutMismatchError as err:
+            log.info("%s: not read in bulk (%s); decoding per message", bag.path, err)
+            return out
+    for k, why in enumerate(failed):
+        if why is not None:
+            log.info(
+                "%s: %s on %s not in the standard layout (%s); decoding per message",
+                bag.path,
+                kinds[mine[k]],
+                requests[mine[k]].conns[0].topic,
+                why,
+            )
+            decoders[k] = None
     for k, i in enumerate(mine):
         if decoders[k] is not None:
             out[i] = assemblers[k].result()

@@ -311,6 +311,29 @@ def test_damaged_record_fails_alike_alone_and_in_one_read(tmp_path: Path, what: 
     assert "chunk" in str(alone.value)
 
 
+def test_errors_of_requests_decoded_side_by_side_come_in_request_order(tmp_path: Path) -> None:
+    """Two damaged topics in one group of chunks (their requests decoded on two threads): the
+    error raised is the first request's, as one thread decoding them in turn raises it."""
+    path = _plain_bag(tmp_path)
+    data = bytearray(path.read_bytes())
+    fields = list(_record_time_fields(bytes(data)))
+    at_p, at_q = fields[10], fields[21]  # an even (/p) and an odd (/q) record
+    data[at_p : at_p + 4] = struct.pack("<I", 12345)  # /p: time differs from its index entry
+    data[at_q + 8 : at_q + 12] = struct.pack("<I", 1 << 20)  # /q: data runs past its chunk
+    path.write_bytes(bytes(data))
+    errors = {}
+    for topic in ("/p", "/q"):
+        with pytest.raises(BagError) as alone:
+            eio.read_poses(path, topic)
+        errors[topic] = str(alone.value)
+    assert errors["/p"] != errors["/q"]
+    for first, second in (("/p", "/q"), ("/q", "/p")):
+        sources = [PoseSource(topic=first), PoseSource(topic=second)]
+        with pytest.raises(BagError) as together:
+            eio.read_pose_sources(path, sources)
+        assert str(together.value) == errors[first]
+
+
 # --- property tests
 
 
