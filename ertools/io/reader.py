@@ -15,13 +15,11 @@ from pathlib import Path
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import F64, I64, U8
 from ertools.errors import BagError, TopicError
 from ertools.io.bagfile import BagFile
-from ertools.io.bulk import locate_many, try_fast_batches
-from ertools.io.decode.fast import LayoutMismatchError, decode_states, is_state_definition
+from ertools.io.bulk import States, bulk_states_many, try_fast_batches
 from ertools.io.decode.posebatch import PoseBatch, batch_from_messages, concat_batches
-from ertools.io.decode.tf import Edge, chain_pose, frame_key
+from ertools.io.decode.tf import Edge, chain_pose, split_edges
 from ertools.io.decode.typestore import Deserializer
 from ertools.io.files import open_bag
 from ertools.io.formats import bag_paths
@@ -315,48 +313,10 @@ def _add_tf_edges(
     """The transforms of one tf topic of one file, split by (parent, child) edge (``own``: the
     batch is this function's to consume)."""
     static = topic == "/tf_static"
-    frames = [frame_key(f) for f in batch.frames]
-    pairs = batch.frame_idx.astype(np.int64) * len(frames) + batch.child_idx
-    # a few (parent, child) pairs: one comparison each rather than a sort of every row
-    counts = np.bincount(pairs, minlength=len(frames) ** 2) if len(pairs) else pairs
-    codes = np.flatnonzero(counts).tolist()
-    biggest = max(codes, key=lambda c: int(counts[c])) if codes else -1
-    found: dict[int, tuple[I64, F64, F64]] = {}
-    for code in codes:
-        if code != biggest or not own:
-            rows = pairs == code
-            found[code] = (batch.t_header[rows], batch.xyz[rows], batch.quat_xyzw[rows])
-    if codes and own:
-        # the edge of most rows (a body beside a static transform): moved up in the batch's
-        # own arrays rather than copied
-        found[biggest] = _compacted(batch, pairs == biggest if len(codes) > 1 else None)
-    for code in codes:
-        key = (frames[code // len(frames)], frames[code % len(frames)])
-        t, xyz, quat = found[code]
-        s = PoseStream(t, xyz, quat, key[0], key[1], str(path))
+    for key, count, s in split_edges(batch, str(path), own):
         per_edge.setdefault(key, []).append(sort_poses(s, f"{path}:{topic} {key}"))
-        if static or (any(c.latching for c in conns) and int(counts[code]) == 1):
+        if static or (any(c.latching for c in conns) and count == 1):
             static_edges.add(key)
-
-
-# Rows moved per step when an edge is compacted in place (a temporary of this many rows).
-_COMPACT_ROWS = 1 << 16
-
-
-def _compacted(batch: PoseBatch, keep: npt.NDArray[np.bool_] | None) -> tuple[I64, F64, F64]:
-    """The stamps and poses of the rows ``keep`` (None: all), moved to the front of the
-    batch's own arrays a block at a time: the rows of a block are taken (whole rows at a time)
-    before any is written, and each row only moves forward, past rows already read."""
-    arrays = (batch.t_header, batch.xyz, batch.quat_xyzw)
-    if keep is None:
-        return arrays
-    rows = np.flatnonzero(keep)
-    for start in range(0, len(rows), _COMPACT_ROWS):
-        part = rows[start : start + _COMPACT_ROWS]
-        for a in arrays:
-            a[start : start + len(part)] = np.take(a, part, axis=0)
-    n = len(rows)
-    return batch.t_header[:n], batch.xyz[:n], batch.quat_xyzw[:n]
 
 
 def _tf_chain(
@@ -476,78 +436,6 @@ def _machine_of(topic: str, msgtype: str) -> Machine | None:
     return None
 
 
-States = tuple[npt.NDArray[np.int64], npt.NDArray[np.uint8], list[str]]
-
-
-def _bulk_states(bag: BagFile, conns: list[Conn]) -> States | None:
-    """(record times, states, payloads) decoded in bulk, None when the layout is not the 2015
-    one or the format has no bulk access."""
-    return _bulk_states_many(bag, [conns])[0]
-
-
-def _bulk_states_many(bag: BagFile, topics: Sequence[list[Conn]]) -> list[States | None]:
-    """:func:`_bulk_states` of several topics, from one pass over the file."""
-    out: list[States | None] = [None] * len(topics)
-    mine = [
-        i
-        for i, conns in enumerate(topics)
-        if len({c.encoding for c in conns}) == 1
-        and all(is_state_definition(c.msgdef) for c in conns)
-    ]
-    if not mine:
-        return out
-    try:
-        found = locate_many(bag, [Request(tuple(topics[i])) for i in mine])
-    except LayoutMismatchError as err:
-        log.info("%s: state topics not read in bulk (%s)", bag.path, err)
-        return out
-    if found is None:
-        return out
-    parts: list[list[tuple[I64, I64, U8, list[str]]] | None] = [[] for _ in mine]
-    try:
-        for runs in found.runs:
-            for k, run in enumerate(runs):
-                got = parts[k]
-                if run is None or got is None:
-                    continue
-                conns = topics[mine[k]]
-                try:
-                    start, length = run.spans()
-                    cdr = conns[0].encoding == "cdr"
-                    state, text = decode_states(run.buf, start, length, cdr)
-                except LayoutMismatchError as err:
-                    log.info(
-                        "%s: %s not in the 2015 state layout (%s)", bag.path, conns[0].topic, err
-                    )
-                    parts[k] = None
-                    continue
-                got.append((run.pos, run.t_record, state, text))
-    except LayoutMismatchError as err:
-        log.info("%s: state topics not read in bulk (%s)", bag.path, err)
-        return out
-    for k, i in enumerate(mine):
-        got = parts[k]
-        if got is not None:
-            out[i] = _ordered_states(got)
-    return out
-
-
-def _ordered_states(parts: list[tuple[I64, I64, U8, list[str]]]) -> States:
-    """The runs of one state topic in the reference order, then by record time."""
-    if not parts:
-        return np.empty(0, np.int64), np.empty(0, np.uint8), []
-    pos = np.concatenate([p[0] for p in parts])
-    t_all = np.concatenate([p[1] for p in parts])
-    payloads = [text for p in parts for text in p[3]]
-    order = np.argsort(pos, kind="stable")
-    t = t_all[order]
-    if len(t) > 1 and np.any(t[1:] < t[:-1]):
-        order = order[np.argsort(t, kind="stable")]
-        t = t_all[order]
-    states = np.concatenate([p[2] for p in parts])[order]
-    return t, states, [payloads[i] for i in order.tolist()]
-
-
 def read_states(paths: PathsLike, topic: str) -> StateStream:
     """A BmBox/RefBox/Client state topic as (record time, state code, payload), time-ordered.
 
@@ -582,7 +470,7 @@ def _read_states(plist: list[Path], names: Sequence[str]) -> list[StateStream]:
                         path=p,
                     )
                 present.append((i, conns))
-            bulks = _bulk_states_many(bag, [conns for _i, conns in present])
+            bulks = bulk_states_many(bag, [conns for _i, conns in present])
             for (i, conns), bulk in zip(present, bulks, strict=True):
                 if bulk is None:
                     bulk = _slow_states(bag, conns, names[i], p)

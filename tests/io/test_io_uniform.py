@@ -16,7 +16,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from io_bagmaker import FORMATS, Spec, bag_name, write
 from test_io_fastpath import assert_same, fast_batch, reference_batch
 
-from ertools.io import bulk
+from ertools.io import assemble
 from ertools.io.decode.uniform import decode_uniform, layout_of
 
 POSE = (1.5, -2.25, 0.125, 0.0, 0.0, 0.6, 0.8)
@@ -138,7 +138,7 @@ def test_uniform_decoder_is_used_on_standard_topics(
     connection's records gathered once, head and data), so the fast-path tests against
     rosbags exercise it."""
     used: list[str] = []
-    real = bulk._Decoder.fast
+    real = assemble.Decoder.fast
 
     def spy(self: Any, *args: Any, **kwargs: Any) -> Any:
         out = real(self, *args, **kwargs)
@@ -146,7 +146,7 @@ def test_uniform_decoder_is_used_on_standard_topics(
             used.append(self.msgtype)
         return out
 
-    monkeypatch.setattr(bulk._Decoder, "fast", spy)
+    monkeypatch.setattr(assemble.Decoder, "fast", spy)
     _fmt, path = scene_bag
     for topic in (
         "/fbm3w/robot_at_work/pose",

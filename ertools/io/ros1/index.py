@@ -27,6 +27,7 @@ from ertools.io.decode.fast import LayoutMismatchError, gather, read_at
 from ertools.io.model import Conn
 from ertools.io.pipeline import Request, in_window, window
 from ertools.io.ros1.check import rebuild_layout
+from ertools.io.ros1.entries import Ints, Selection, Words, entries_of, merged_order, run_starts
 from ertools.io.ros1.layout import (
     INDEX_DTYPE,
     MSG_HEADER_LEN,
@@ -40,7 +41,6 @@ from ertools.io.ros1.layout import (
     entries_from_index,
     fields_before,
     index_header,
-    joined_entries,
     nonzero_counts,
     op_word,
     outside_chunk_info,
@@ -58,7 +58,7 @@ from ertools.io.ros1.records import (
     parse_fields,
     read_record,
 )
-from ertools.io.ros1.runs import Ints, Selection, Words, ros1_runs
+from ertools.io.ros1.runs import ros1_runs
 from ertools.progress import current
 
 if TYPE_CHECKING:
@@ -94,63 +94,6 @@ def _standard_spans(buf: U8, offsets: I64) -> tuple[I64, I64] | None:
     if int((start + length).max()) > n:
         return None
     return start, length
-
-
-def _entries(parts: list[bytes | tuple[I64, I64]]) -> tuple[I64, Ints, Words | None]:
-    """(record times, offsets in their chunks, time words) of one connection's index entries
-    over several chunks. Offsets read from index data stay uint32 as stored (widened per
-    group, where they are added to the chunk's place in the group's bytes); the time words
-    are each entry's (sec, nsec) as one little-endian uint64, the bytes a message record's
-    time field must hold (None for entries a scan found)."""
-    if not all(isinstance(p, bytes) for p in parts):
-        t, off = joined_entries(parts)
-        return t, off, None
-    arr = np.frombuffer(b"".join(p for p in parts if isinstance(p, bytes)), dtype=INDEX_DTYPE)
-    # Computed in place: fresh memory is slow to fault in, and an hour's entries are 5 MB.
-    t = np.multiply(arr["sec"], 1_000_000_000, dtype=np.int64)
-    np.add(t, arr["nsec"], out=t)
-    words = np.ndarray((len(arr),), "<u8", buffer=arr, strides=(INDEX_DTYPE.itemsize,))
-    return t, np.ascontiguousarray(arr["off"]), np.ascontiguousarray(words)
-
-
-def _run_starts(a: I64) -> I64:
-    """Where each run of equal values of ``a`` starts."""
-    if not len(a):
-        return np.empty(0, np.int64)
-    return np.concatenate([[0], np.flatnonzero(a[1:] != a[:-1]) + 1])
-
-
-def _merged_order(parts: list[I64]) -> I64 | None:
-    """The order of the times ``parts`` (one array per connection, end to end) that a stable
-    sort by time gives: equal times keep their connection's rank, then their own order. None
-    when they are in that order already.
-
-    Connections logged in time order (each part ascending) are merged by binary search, in
-    linear time; otherwise one stable sort.
-    """
-    t_all = cat_arrays(parts)
-    if bool(np.all(t_all[1:] >= t_all[:-1])):
-        return None
-    if not all(bool(np.all(p[1:] >= p[:-1])) for p in parts):
-        return np.argsort(t_all, kind="stable")
-    merged_t = parts[0]
-    order = np.arange(len(merged_t), dtype=np.int64)
-    done = len(merged_t)
-    for part in parts[1:]:
-        # each entry of ``part`` after every earlier entry of equal time
-        at = np.searchsorted(merged_t, part, side="right") + np.arange(len(part))
-        n = len(merged_t) + len(part)
-        theirs = np.zeros(n, dtype=bool)
-        theirs[at] = True
-        new_order = np.empty(n, dtype=np.int64)
-        new_t = np.empty(n, dtype=np.int64)
-        new_order[at] = np.arange(done, done + len(part), dtype=np.int64)
-        new_t[at] = part
-        new_order[~theirs] = order
-        new_t[~theirs] = merged_t
-        order, merged_t = new_order, new_t
-        done += len(part)
-    return order
 
 
 class Ros1Bag(BagFile):
@@ -352,7 +295,7 @@ class Ros1Bag(BagFile):
         for cid in wanted:
             if not raw[cid]:
                 continue
-            t, off, words = _entries(raw[cid])
+            t, off, words = entries_of(raw[cid])
             if self.layout.indexed:
                 outside = outside_chunk_info(self.layout.chunks, cid, t, where[cid])
                 if outside is not None:
@@ -398,10 +341,10 @@ class Ros1Bag(BagFile):
         if all(w is not None for w in ww):
             w_all = ww[0] if len(ww) == 1 else np.concatenate([w for w in ww if w is not None])
         # each connection's chunk indices ascend (its entries are gathered chunk by chunk)
-        touched = sorted({ci for c in ck for ci in c[_run_starts(c)].tolist()})
+        touched = sorted({ci for c in ck for ci in c[run_starts(c)].tolist()})
         # rosbags: per connection sorted by time (stable over chunk and index order), then a
         # heap merge over connections in the order given (ties: the earlier connection).
-        order = _merged_order(tt)
+        order = merged_order(tt)
         if order is None:
             return touched, c_all, r_all, t_all, o_all, w_all  # already in order
         w_sorted = None if w_all is None else w_all[order]

@@ -35,6 +35,7 @@ from ertools.io.pipeline import (
     read_at,
     scratch_view,
 )
+from ertools.io.ros1.entries import Ints, Selection, Words
 from ertools.io.ros1.layout import (
     MSG_HEADER_LEN,
     OP_AT,
@@ -48,14 +49,6 @@ from ertools.io.ros1.layout import (
 
 if TYPE_CHECKING:
     from ertools.progress import Reporter
-
-
-Ints = npt.NDArray[np.integer[Any]]
-Words = npt.NDArray[np.uint64]
-# One request's messages, in its reference order: (chunk indices touched, chunk index, conn
-# rank, record time, record offset in its chunk, and the record time as its record stores it,
-# (sec, nsec) in one uint64, when the index gave it, per message)
-Selection = tuple[list[int], I64, Ints, I64, Ints, Words | None]
 
 
 class IndexedBag(Protocol):
