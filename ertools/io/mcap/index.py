@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, BinaryIO
 
 import numpy as np
+import numpy.typing as npt
 
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
@@ -118,9 +119,21 @@ class McapPlan:
     t_record: I64
     offset: I64
     key: I64  # file << 32 | chunk index
-    file: I64
     chunks: list[list[Any]]
-    channel: I64
+    channel: npt.NDArray[np.uint16]
+
+    def by_key(self) -> dict[int, slice | I64]:
+        """The messages of each chunk (by key): a slice of the plan when its messages are in
+        chunk order (one channel logged in time order), else their positions."""
+        key = self.key
+        if not len(key):
+            return {}
+        if bool(np.all(key[1:] >= key[:-1])):
+            cuts = np.flatnonzero(key[1:] != key[:-1]) + 1
+            starts = [0, *cuts.tolist()]
+            ends = [*cuts.tolist(), len(key)]
+            return {int(key[a]): slice(a, b) for a, b in zip(starts, ends, strict=True)}
+        return dict(group_positions(key))
 
 
 class McapIndex:
@@ -228,7 +241,7 @@ class McapIndex:
         has none there), and ``bytes[k]`` is what that group reads from the file (its chunks'
         compressed sizes, for progress). ``load`` may run on a worker thread (it opens the
         file itself)."""
-        rows_of: list[dict[int, I64]] = [dict(group_positions(p.key)) for p in plans]
+        rows_of = [p.by_key() for p in plans]
         keys = sorted({k for rows in rows_of for k in rows})
         chunks_of = plans[0].chunks if plans else []
         todo: list[list[int]] = []
@@ -254,18 +267,29 @@ class McapIndex:
                 if not mine:
                     out.append(None)
                     continue
-                rows = np.concatenate([r for _i, r in mine])
-                which = np.concatenate([np.full(len(r), i) for i, r in mine])
-                offsets = plan.offset[rows]
+                counts = [_count(r) for _i, r in mine]
+                which = np.repeat(np.array([i for i, _r in mine], dtype=np.int64), counts)
+                sel: slice | I64
+                first, last = mine[0][1], mine[-1][1]
+                if all(isinstance(r, slice) for _i, r in mine):
+                    # one range of the plan (its chunks' slices follow each other)
+                    assert isinstance(first, slice) and isinstance(last, slice)
+                    sel = slice(first.start, last.stop)
+                    rows = np.arange(first.start, last.stop, dtype=np.int64)
+                else:
+                    rows = np.concatenate([_positions(r) for _i, r in mine])
+                    sel = rows
+                offsets = plan.offset[sel]
                 # a record inside its chunk: no earlier (here), no later (its end, checked
                 # with the record)
                 if len(offsets) and int(offsets.min()) < 0:
                     raise BagError(f"message index points outside its chunk {where}")
-                t = plan.t_record[rows]
-                channel = plan.channel[rows]
+                t = plan.t_record[sel]
+                channel = plan.channel[sel].astype(np.int64)
                 limit = base[which] + sizes[which]
                 records = McapRecords(buf, offsets + base[which], limit, t, channel, where)
-                out.append(Run(rows, buf, t, channel, records))
+                consecutive = isinstance(sel, slice)
+                out.append(Run(rows, buf, t, channel, records, consecutive=consecutive))
             return out
 
         weights = [sum(int(chunk_of(key)[1].compressed_size) for key in part) for part in todo]
@@ -446,30 +470,36 @@ class McapIndex:
         return start, length
 
 
+def _count(rows: slice | I64) -> int:
+    return rows.stop - rows.start if isinstance(rows, slice) else len(rows)
+
+
+def _positions(rows: slice | I64) -> I64:
+    return np.arange(rows.start, rows.stop, dtype=np.int64) if isinstance(rows, slice) else rows
+
+
 def _ordered(sels: list[tuple[int, int, int, I64, I64, int]], chunks: list[list[Any]]) -> McapPlan:
     """One request's located messages in the mcap library's order: log time, then file,
     chunk position, record position."""
     if not sels:
         e = np.empty(0, np.int64)
-        return McapPlan(e, e, e, e, chunks, e)
+        return McapPlan(e, e, e, chunks, np.empty(0, np.uint16))
     t_all = np.concatenate([s[3] for s in sels])
     off_all = np.concatenate([s[4] for s in sels])
     # file, chunk and chunk offset of every row: one repeat each, not an array per chunk
     counts = np.array([len(s[3]) for s in sels], dtype=np.int64)
     key = np.repeat(np.array([(s[0] << 32) + s[1] for s in sels], dtype=np.int64), counts)
-    channel = np.repeat(np.array([s[5] for s in sels], dtype=np.int64), counts)
-    file_all = key >> 32
+    channel = np.repeat(np.array([s[5] for s in sels], dtype=np.uint16), counts)
     # One channel logged in time order is in that order already: no sort (times that
     # strictly increase need no other key).
     if bool(np.all(t_all[1:] > t_all[:-1])):
-        return McapPlan(t_all, off_all, key, file_all, chunks, channel)
+        return McapPlan(t_all, off_all, key, chunks, channel)
+    file_all = key >> 32
     cstart_all = np.repeat(np.array([s[2] for s in sels], dtype=np.int64), counts)
     if _in_order(t_all, file_all, cstart_all, off_all):
-        return McapPlan(t_all, off_all, key, file_all, chunks, channel)
+        return McapPlan(t_all, off_all, key, chunks, channel)
     order = np.lexsort((off_all, cstart_all, file_all, t_all))
-    return McapPlan(
-        t_all[order], off_all[order], key[order], file_all[order], chunks, channel[order]
-    )
+    return McapPlan(t_all[order], off_all[order], key[order], chunks, channel[order])
 
 
 def verify_mcap(path: Path, progress: Reporter | None = None) -> None:

@@ -17,7 +17,7 @@ Words = npt.NDArray[np.uint64]
 # One request's messages, in its reference order: (chunk indices touched, chunk index, conn
 # rank, record time, record offset in its chunk, and the record time as its record stores it,
 # (sec, nsec) in one uint64, when the index gave it, per message)
-Selection = tuple[list[int], I64, Ints, I64, Ints, Words | None]
+Selection = tuple[list[int], Ints, Ints, I64, Ints, Words | None]
 
 
 def entries_of(parts: list[bytes | tuple[I64, I64]]) -> tuple[I64, Ints, Words | None]:
@@ -37,7 +37,7 @@ def entries_of(parts: list[bytes | tuple[I64, I64]]) -> tuple[I64, Ints, Words |
     return t, np.ascontiguousarray(arr["off"]), np.ascontiguousarray(words)
 
 
-def run_starts(a: I64) -> I64:
+def run_starts(a: Ints) -> I64:
     """Where each run of equal values of ``a`` starts."""
     if not len(a):
         return np.empty(0, np.int64)

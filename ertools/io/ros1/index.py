@@ -240,7 +240,7 @@ class Ros1Bag(BagFile):
 
     def select(
         self, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
-    ) -> tuple[list[int], I64, Ints, I64, Ints]:
+    ) -> tuple[list[int], Ints, Ints, I64, Ints]:
         """Messages of ``conns`` in [start_ns, end_ns], in the reference order: one request
         of :meth:`select_many`."""
         return self.select_many([Request(tuple(conns), start_ns, end_ns)])[0][:5]
@@ -291,7 +291,7 @@ class Ros1Bag(BagFile):
                 return self.select_many(requests)
         self._unmap()  # the index pages touched would otherwise stay in this process's RSS
         # per connection: (record times, offsets, chunk index) of its entries in the window
-        entries: dict[int, tuple[I64, Ints, I64, Words | None]] = {}
+        entries: dict[int, tuple[I64, Ints, Ints, Words | None]] = {}
         for cid in wanted:
             if not raw[cid]:
                 continue
@@ -302,20 +302,20 @@ class Ros1Bag(BagFile):
                     self._rescan(outside)
                     return self.select_many(requests)
             c = np.repeat(
-                np.array([w[0] for w in where[cid]], dtype=np.int64),
+                np.array([w[0] for w in where[cid]], dtype=np.int32),
                 np.array([w[1] for w in where[cid]], dtype=np.int64),
             )
             entries[cid] = (t, off, c, words)
         return [self._ordered(r, entries) for r in requests]
 
     def _ordered(
-        self, request: Request, entries: dict[int, tuple[I64, Ints, I64, Words | None]]
+        self, request: Request, entries: dict[int, tuple[I64, Ints, Ints, Words | None]]
     ) -> Selection:
         """One request's messages, in rosbags' order, from every wanted connection's entries."""
         rank = {c.id: i for i, c in enumerate(request.conns)}
         tt: list[I64] = []
         oo: list[Ints] = []
-        ck: list[I64] = []
+        ck: list[Ints] = []
         ww: list[Words | None] = []
         rk: list[npt.NDArray[np.integer[Any]]] = []
         for cid, r in rank.items():
@@ -334,7 +334,8 @@ class Ros1Bag(BagFile):
         if not tt or not sum(len(t) for t in tt):
             e = np.empty(0, np.int64)
             return [], e, e, e, e, None
-        t_all, c_all = cat_arrays(tt), cat_arrays(ck)
+        t_all = cat_arrays(tt)
+        c_all = ck[0] if len(ck) == 1 else np.concatenate(ck)
         o_all = oo[0] if len(oo) == 1 else np.concatenate(oo)
         r_all = rk[0] if len(rk) == 1 else np.concatenate(rk)
         w_all: Words | None = None

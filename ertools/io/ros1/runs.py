@@ -222,7 +222,7 @@ class _Plan:
             }
             self.counts = {ci: b - a for ci, (a, b) in self.ranges.items()}
         else:
-            self.groups = dict(group_positions(chunk_of))
+            self.groups = dict(group_positions(chunk_of.astype(np.int64)))
             self.counts = {ci: len(rows) for ci, rows in self.groups.items()}
 
     def _conn(self, rank: Ints) -> I64:
