@@ -6,6 +6,7 @@ offsets, windows that cut chunks, compressed and uncompressed chunks, and random
 
 from __future__ import annotations
 
+import itertools
 import struct
 from collections.abc import Iterator
 from pathlib import Path
@@ -28,7 +29,7 @@ from ertools.io.files import open_bag
 from ertools.io.model import PoseSource
 from ertools.io.pipeline import Request
 from ertools.io.ros1 import runs as ros1_runs
-from ertools.io.ros1.entries import merged_order
+from ertools.io.ros1.entries import merged_columns
 
 STATE_TOPICS = ("/fbm3w/bmbox_state", "/fbm3w/refbox_state")
 
@@ -338,12 +339,18 @@ def test_errors_of_requests_decoded_side_by_side_come_in_request_order(tmp_path:
 
 @settings(max_examples=200, deadline=None)
 @given(st.lists(st.lists(st.integers(0, 30), max_size=12), min_size=1, max_size=4), st.data())
-def test_merged_order_is_a_stable_sort(parts: list[list[int]], data: st.DataObject) -> None:
+def test_merged_columns_are_a_stable_sort(parts: list[list[int]], data: st.DataObject) -> None:
+    """Each connection's entries (times, and their places end to end as a second column)
+    merged as one stable sort by time orders them: ties keep the connection's rank, then
+    their own order; parts not in time order are sorted."""
     arrays = [np.array(sorted(p) if data.draw(st.booleans()) else p, dtype=np.int64) for p in parts]
     t = np.concatenate(arrays)
-    got = merged_order(arrays)
+    cut = np.cumsum([0, *map(len, arrays)]).tolist()
+    places = [np.arange(a, b, dtype=np.int64) for a, b in itertools.pairwise(cut)]
+    merged_t, order = merged_columns(arrays, [arrays, places])
     expected = np.argsort(t, kind="stable")
-    np.testing.assert_array_equal(np.arange(len(t)) if got is None else got, expected)
+    np.testing.assert_array_equal(order, expected)
+    np.testing.assert_array_equal(merged_t, t[expected])
 
 
 # A few bit patterns rosbags must give back as they are: signed zero, the extremes, NaN with a

@@ -10,7 +10,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import I64
-from ertools.io.ros1.layout import INDEX_DTYPE, cat_arrays, joined_entries
+from ertools.io.ros1.layout import INDEX_DTYPE, joined_entries
 
 Ints = npt.NDArray[np.integer[Any]]
 Words = npt.NDArray[np.uint64]
@@ -44,34 +44,33 @@ def run_starts(a: Ints) -> I64:
     return np.concatenate([[0], np.flatnonzero(a[1:] != a[:-1]) + 1])
 
 
-def merged_order(parts: list[I64]) -> I64 | None:
-    """The order of the times ``parts`` (one array per connection, end to end) that a stable
-    sort by time gives: equal times keep their connection's rank, then their own order. None
-    when they are in that order already.
+def merged_columns(times: list[I64], columns: list[list[Any]]) -> list[npt.NDArray[Any]]:
+    """Each column (one array per connection, as ``times``; the first column is ``times``
+    itself) end to end in the order a stable sort by ``times`` gives them: equal times keep
+    their connection's rank, then their own order.
 
-    Connections logged in time order (each part ascending) are merged by binary search, in
-    linear time; otherwise one stable sort.
+    Connections logged in time order (each part ascending) are merged one into the others by
+    binary search, every column placed by one mask and one scatter (no sort, no gather of the
+    whole); otherwise one stable sort of the times orders every column.
     """
-    t_all = cat_arrays(parts)
+    whole = [parts[0] if len(parts) == 1 else np.concatenate(parts) for parts in columns]
+    t_all = whole[0]
     if bool(np.all(t_all[1:] >= t_all[:-1])):
-        return None
-    if not all(bool(np.all(p[1:] >= p[:-1])) for p in parts):
-        return np.argsort(t_all, kind="stable")
-    merged_t = parts[0]
-    order = np.arange(len(merged_t), dtype=np.int64)
-    done = len(merged_t)
-    for part in parts[1:]:
-        # each entry of ``part`` after every earlier entry of equal time
-        at = np.searchsorted(merged_t, part, side="right") + np.arange(len(part))
-        n = len(merged_t) + len(part)
-        theirs = np.zeros(n, dtype=bool)
-        theirs[at] = True
-        new_order = np.empty(n, dtype=np.int64)
-        new_t = np.empty(n, dtype=np.int64)
-        new_order[at] = np.arange(done, done + len(part), dtype=np.int64)
-        new_t[at] = part
-        new_order[~theirs] = order
-        new_t[~theirs] = merged_t
-        order, merged_t = new_order, new_t
-        done += len(part)
-    return order
+        return whole  # already in order (one connection in time order, or none overlapping)
+    if not all(bool(np.all(p[1:] >= p[:-1])) for p in times):
+        order = np.argsort(t_all, kind="stable")
+        return [c[order] for c in whole]
+    merged = [parts[0] for parts in columns]
+    for k in range(1, len(times)):
+        # each entry of part k after every earlier entry of equal time
+        at = np.searchsorted(merged[0], times[k], side="right") + np.arange(len(times[k]))
+        earlier = np.ones(len(merged[0]) + len(times[k]), dtype=bool)
+        earlier[at] = False
+        out = []
+        for column, parts in zip(merged, columns, strict=True):
+            new = np.empty(len(earlier), dtype=column.dtype)
+            new[earlier] = column
+            new[at] = parts[k]
+            out.append(new)
+        merged = out
+    return merged

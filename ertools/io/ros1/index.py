@@ -27,7 +27,14 @@ from ertools.io.decode.fast import LayoutMismatchError, gather, read_at
 from ertools.io.model import Conn
 from ertools.io.pipeline import Request, in_window, window
 from ertools.io.ros1.check import rebuild_layout
-from ertools.io.ros1.entries import Ints, Selection, Words, entries_of, merged_order, run_starts
+from ertools.io.ros1.entries import (
+    Ints,
+    Selection,
+    Words,
+    entries_of,
+    merged_columns,
+    run_starts,
+)
 from ertools.io.ros1.layout import (
     INDEX_DTYPE,
     MSG_HEADER_LEN,
@@ -36,7 +43,6 @@ from ertools.io.ros1.layout import (
     U32,
     Ros1Chunk,
     Ros1Layout,
-    cat_arrays,
     decompress,
     entries_from_index,
     fields_before,
@@ -334,22 +340,14 @@ class Ros1Bag(BagFile):
         if not tt or not sum(len(t) for t in tt):
             e = np.empty(0, np.int64)
             return [], e, e, e, e, None
-        t_all = cat_arrays(tt)
-        c_all = ck[0] if len(ck) == 1 else np.concatenate(ck)
-        o_all = oo[0] if len(oo) == 1 else np.concatenate(oo)
-        r_all = rk[0] if len(rk) == 1 else np.concatenate(rk)
-        w_all: Words | None = None
-        if all(w is not None for w in ww):
-            w_all = ww[0] if len(ww) == 1 else np.concatenate([w for w in ww if w is not None])
         # each connection's chunk indices ascend (its entries are gathered chunk by chunk)
         touched = sorted({ci for c in ck for ci in c[run_starts(c)].tolist()})
         # rosbags: per connection sorted by time (stable over chunk and index order), then a
         # heap merge over connections in the order given (ties: the earlier connection).
-        order = merged_order(tt)
-        if order is None:
-            return touched, c_all, r_all, t_all, o_all, w_all  # already in order
-        w_sorted = None if w_all is None else w_all[order]
-        return touched, c_all[order], r_all[order], t_all[order], o_all[order], w_sorted
+        known = [w for w in ww if w is not None]
+        columns: list[list[Any]] = [tt, ck, rk, oo, *([known] if len(known) == len(ww) else [])]
+        t_all, c_all, r_all, o_all, *w_all = merged_columns(tt, columns)
+        return touched, c_all, r_all, t_all, o_all, (w_all[0] if w_all else None)
 
     def _rescan(self, why: str) -> None:
         """Distrust the index from now on: rebuild the layout from the records themselves."""
