@@ -10,7 +10,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import I64
-from ertools.io.ros1.layout import INDEX_DTYPE, joined_entries
+from ertools.io.ros1.layout import INDEX_DTYPE, cat_arrays, joined_entries
 
 Ints = npt.NDArray[np.integer[Any]]
 Words = npt.NDArray[np.uint64]
@@ -53,13 +53,13 @@ def merged_columns(times: list[I64], columns: list[list[Any]]) -> list[npt.NDArr
     binary search, every column placed by one mask and one scatter (no sort, no gather of the
     whole); otherwise one stable sort of the times orders every column.
     """
-    whole = [parts[0] if len(parts) == 1 else np.concatenate(parts) for parts in columns]
-    t_all = whole[0]
+    t_all = cat_arrays(times)
     if bool(np.all(t_all[1:] >= t_all[:-1])):
-        return whole  # already in order (one connection in time order, or none overlapping)
+        # already in order (one connection in time order, or none overlapping)
+        return [t_all, *(_joined(parts) for parts in columns[1:])]
     if not all(bool(np.all(p[1:] >= p[:-1])) for p in times):
         order = np.argsort(t_all, kind="stable")
-        return [c[order] for c in whole]
+        return [t_all[order], *(_joined(parts)[order] for parts in columns[1:])]
     merged = [parts[0] for parts in columns]
     for k in range(1, len(times)):
         # each entry of part k after every earlier entry of equal time
@@ -74,3 +74,7 @@ def merged_columns(times: list[I64], columns: list[list[Any]]) -> list[npt.NDArr
             out.append(new)
         merged = out
     return merged
+
+
+def _joined(parts: list[Any]) -> npt.NDArray[Any]:
+    return parts[0] if len(parts) == 1 else np.concatenate(parts)
