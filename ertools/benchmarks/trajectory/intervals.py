@@ -33,7 +33,8 @@ side of each compared pair perturbed by two sources, vectorised over (draws, pos
 
 The interval is the engine's basic bootstrap: noise makes a distance longer on average (the
 RMSE of a perfect robot is sqrt(3) sigma, not 0) and the reflection removes the bias the draws
-show. The draws work in float32 and in chunks of draws. A comparison of more than
+show. The draws work in float64 (float32's sin, cos and arctan2 differ between CPUs: see
+:data:`CHUNK_ELEMENTS`) and in chunks of draws. A comparison of more than
 :data:`MAX_POSES` poses (an hour at 10 Hz is 36,000) draws on that many poses spread evenly
 over it: the offset's effect is the same on them as on all, the per-pose noise's spread in
 the mean-like statistics (mean, RMSE, orientation errors) is scaled by sqrt(thinned / all)
@@ -47,27 +48,29 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, IntArr
-from ertools.benchmarks.common.clocks import OffsetEstimate
+from ertools.benchmarks.common.clocks import MIN_POSES, OffsetEstimate
 from ertools.benchmarks.common.interval_output import (
     METHOD,
     NO_INTERVALS,
     IntervalSettings,
     ResultIntervals,
     shares_of,
+    withheld,
 )
 from ertools.benchmarks.common.uncertainty import (
+    MIN_INTERVAL_SAMPLES,
     MOCAP_NOISE,
     TIME_ASSOCIATION,
     Source,
     Uncertainty,
     monte_carlo,
     sigma_from_epsilon,
+    too_few,
 )
 from ertools.benchmarks.noise.benchmark import noise_from_stream
 from ertools.benchmarks.trajectory.association import COMPARED, Matched
@@ -77,14 +80,17 @@ from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
 
 METHOD_TRAJECTORY = f"{METHOD} (the clock offset's draws mirrored: a percentile interval)"
-Floats = npt.NDArray[np.floating[Any]]  # float32 in the draws, float64 elsewhere
 
 # A 2015 mocap marker set when nothing in the log measures it: 0.3 mm per axis, 0.05 deg.
 DEFAULT_SIGMA_M = 3e-4
 DEFAULT_SIGMA_RAD = math.radians(0.05)
 MIN_PAIRS = 50  # stationary pairs (or second differences) needed to measure sigma
 VELOCITY_HALF_SPAN = 5  # GT samples either side of a pose for its velocity (~40 ms at 120 Hz)
-CHUNK_ELEMENTS = 4_000_000  # draws x poses per chunk (float32: ~50 MB of positions)
+# Draws x poses per chunk: ~50 MB of float64 positions. float64, not float32: NumPy's float32
+# sin, cos and arctan2 are its own SIMD code, one per instruction set (AVX-512, AVX2, SSE),
+# which differ by a float32 ulp (6e-8), and a quantile of such draws moved the intervals by
+# 6e-8 between CPUs (issue 36). The float64 ones differ by a float64 ulp at most: 1e-15.
+CHUNK_ELEMENTS = 2_000_000
 # Longer comparisons draw on this many evenly spread poses (module doc): an hour at 10 Hz
 # stays well under a second.
 MAX_POSES = 1500
@@ -221,7 +227,7 @@ def mocap_sigma(gt: PoseStream) -> MocapSigma:
 
 
 def offset_spread(
-    r_xyz: Floats, g_xyz: Floats, vel: Floats, audit: OffsetEstimate, offset_ns: int
+    r_xyz: F64, g_xyz: F64, vel: F64, audit: OffsetEstimate, offset_ns: int
 ) -> tuple[float, float]:
     """(sd, centre) in seconds of the true clock offset around the one applied.
 
@@ -244,7 +250,7 @@ def offset_spread(
     minus the offset applied (0 with ``--offset auto --apply-offset``): a given offset the
     data disagrees with moves the interval, not the score.
     """
-    sv = float(np.sum(np.square(vel, dtype=np.float64)))
+    sv = float(np.sum(np.square(vel)))
     n = len(vel)
     if n < 3 or sv <= 0.0 or audit.offset_ns is None:
         return 0.0, 0.0
@@ -325,37 +331,47 @@ def trajectory_intervals(
     ok = matched.status == COMPARED
     if not settings.enabled or not ok.any() or len(gt) < 2:
         return NO_INTERVALS
+    few = too_few(
+        int(ok.sum()),
+        "compared pose(s)",
+        max(MIN_INTERVAL_SAMPLES, MIN_POSES),
+        f"the clock offset's spread (the time association, most often the largest source) "
+        f"being measured from {MIN_POSES} or more",
+    )
+    if few is not None:
+        # a null interval with the reason, not one of the mocap noise alone
+        return withheld(KEYS, few, settings, METHOD_TRAJECTORY)
     q = matched.t_ns[ok]
-    r_xyz = robot.xyz[ok].astype(np.float32)
-    r_yaw = robot.yaw[ok].astype(np.float32)
-    g_xyz = matched.gt_xyz[ok].astype(np.float32)
-    g_yaw = matched.gt_yaw[ok].astype(np.float32)
+    r_xyz = robot.xyz[ok]
+    r_yaw = robot.yaw[ok]
+    g_xyz = matched.gt_xyz[ok]
+    g_yaw = matched.gt_yaw[ok]
     t = gt.t_ns
     k, k1 = _bracket(t, q)
-    period = ((t[k1] - t[k]) / NS_PER_S).astype(np.float32)
+    period = (t[k1] - t[k]) / NS_PER_S
     # A pose compared across a GT gap (--gaps compare, 2015) is held up to the gap's length:
     # that is the log's gap (a validity matter, reported), not the frame period's lag
-    period = np.minimum(period, np.float32(1.5) * np.median(period))
+    period = np.minimum(period, 1.5 * np.median(period))
     a = np.clip((q - t[k]) / np.maximum(t[k1] - t[k], 1), 0.0, 1.0)
     # GT velocity and yaw rate around each pose, over ~VELOCITY_HALF_SPAN samples either side
     lo = np.clip(k - VELOCITY_HALF_SPAN, 0, len(t) - 1)
     hi = np.clip(k1 + VELOCITY_HALF_SPAN, 0, len(t) - 1)
     span = np.maximum((t[hi] - t[lo]).astype(np.float64) / NS_PER_S, 1e-9)
-    vel = ((gt.xyz[hi] - gt.xyz[lo]) / span[:, None]).astype(np.float32)
-    yaw_rate = (np.angle(np.exp(1j * (gt.yaw[hi] - gt.yaw[lo]))) / span).astype(np.float32)
+    vel = (gt.xyz[hi] - gt.xyz[lo]) / span[:, None]
+    yaw_rate = np.angle(np.exp(1j * (gt.yaw[hi] - gt.yaw[lo]))) / span
     sig = mocap_sigma(gt)
     if association == "linear":
-        weight = np.sqrt((1.0 - a) ** 2 + a**2).astype(np.float32)
+        weight = np.sqrt((1.0 - a) ** 2 + a**2)
         lag_lo, lag_hi = 0.0, 0.0
     elif association == "hold":
-        weight = np.ones(len(q), np.float32)
+        weight = np.ones(len(q))
         lag_lo, lag_hi = -1.0, 0.0
     else:
-        weight = np.ones(len(q), np.float32)
+        weight = np.ones(len(q))
         lag_lo, lag_hi = -0.5, 0.5
     off_sigma, off_centre = offset_spread(r_xyz, g_xyz, vel, audit, offset_ns)
     frame_term = lag_hi > lag_lo
-    raw0 = matched.yaw_diff_raw[ok].astype(np.float32)
+    raw0 = matched.yaw_diff_raw[ok]
     n_all = len(q)
     # An hour's log: the draws run on evenly thinned poses (module doc)
     if n_all > MAX_POSES:
@@ -377,15 +393,15 @@ def trajectory_intervals(
     def errors(gp: F64, gy: F64) -> F64:
         """(draws, S) statistics of perturbed GT poses, as metrics() computes them."""
         d = np.sqrt(np.sum(np.square(gp - r_xyz), axis=-1))
-        pi = np.float32(math.pi)
+        pi = math.pi
         dyaw = np.abs(np.remainder(r_yaw - gy + pi, 2 * pi) - pi)
         raw = np.abs(raw0 + (np.remainder(g_yaw - gy + pi, 2 * pi) - pi))
         pct = np.percentile(d, PERCENTILES, axis=-1).T  # PERCENTILES[0] is the median
         return np.column_stack(
             [
-                d.mean(axis=-1, dtype=np.float64),
+                d.mean(axis=-1),
                 np.arctan2(np.sin(dyaw).sum(axis=-1), np.cos(dyaw).sum(axis=-1)),
-                np.sqrt(np.mean(np.square(d, dtype=np.float64), axis=-1)),
+                np.sqrt(np.mean(np.square(d), axis=-1)),
                 pct[:, 0],
                 d.max(axis=-1),
                 pct,
@@ -418,14 +434,14 @@ def trajectory_intervals(
                 gp = np.broadcast_to(g_xyz, (m, n, 3)).copy()
                 gy = np.broadcast_to(g_yaw, (m, n)).copy()
                 if noise:
+                    # drawn in float32 (the stream the calibration was measured with;
+                    # seven digits of a noise sample are plenty), added in float64
                     gp += rng.standard_normal((m, n, 3), dtype=np.float32) * (
-                        np.float32(sig.position) * weight[None, :, None]
+                        sig.position * weight[None, :, None]
                     )
-                    gy += rng.standard_normal((m, n), dtype=np.float32) * (
-                        np.float32(sig.yaw) * weight
-                    )
+                    gy += rng.standard_normal((m, n), dtype=np.float32) * (sig.yaw * weight)
                 if timing and frame_term:
-                    lag = rng.uniform(lag_lo, lag_hi, (m, n)).astype(np.float32) * period
+                    lag = rng.uniform(lag_lo, lag_hi, (m, n)) * period
                     gp += lag[..., None] * vel
                     gy += lag * yaw_rate
                 measured[rows] = errors(gp, gy) - base
