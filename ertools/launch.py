@@ -12,24 +12,72 @@ removed) ends the process at once, without a word.
 
 from __future__ import annotations
 
+import _thread
+import os
 import signal
 import sys
 import threading
+import time
+from collections.abc import Callable
 from importlib import import_module
 from types import FrameType
+from typing import Any
 
 INTERRUPTED = 130  # 128 + SIGINT
 
 # Set by the first Ctrl-C: an extension module interrupted while it loads (NumPy's C core) may
 # turn the KeyboardInterrupt into an ImportError of its own, with its advice on reinstalling.
 _received = threading.Event()
+# Set when a KeyboardInterrupt was swallowed (raised inside a callback Python cannot raise from)
+# and is being delivered again.
+_again = threading.Event()
 
 
-def _first_interrupt(signum: int, frame: FrameType | None) -> None:
-    # the next one is the operating system's: the process ends there and then
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
+def _on_interrupt(signum: int, frame: FrameType | None) -> None:
+    if _again.is_set():
+        if _delivering.locked():  # still inside the hook below: later
+            _deliver_later()
+            return
+        _again.clear()
+        raise KeyboardInterrupt
+    if _received.is_set():
+        # a second Ctrl-C while the first is answered: the operating system's default, at once
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        os.kill(os.getpid(), signal.SIGINT)
+        return
     _received.set()
     raise KeyboardInterrupt
+
+
+# Held while the hook below runs (always in the main thread, where signal handlers run).
+_delivering = threading.Lock()
+
+
+def _deliver_later() -> None:
+    def deliver() -> None:
+        time.sleep(0.001)  # the main thread leaves the callback meanwhile, most often
+        _thread.interrupt_main(signal.SIGINT)
+
+    # a bare thread: threading.Thread.start() waits for it, and the handler would run there
+    _thread.start_new_thread(deliver, ())
+
+
+def _unraisable(hook: Callable[[Any], object]) -> Callable[[Any], object]:
+    """``sys.unraisablehook`` that delivers again a Ctrl-C that landed where an exception
+    cannot propagate (a weakref callback of the import machinery, a ``__del__``): Python would
+    print "Exception ignored in" with a traceback and carry on as if no key had been pressed.
+    One that lands in a callback again comes back here, until it reaches code that can raise.
+    """
+
+    def deliver_again(unraisable: Any) -> object:
+        if not isinstance(unraisable.exc_value, KeyboardInterrupt):
+            return hook(unraisable)
+        with _delivering:
+            _again.set()
+            _deliver_later()
+        return None
+
+    return deliver_again
 
 
 def _caused_by_interrupt(err: BaseException) -> bool:
@@ -62,9 +110,11 @@ def run(target: str, program: str) -> int:
     """Import ``module:function`` and call it (no arguments; it reads ``sys.argv``); its exit
     status, or :data:`INTERRUPTED` after one line when a Ctrl-C came at any moment, imports
     included."""
+    hook = sys.unraisablehook
     try:
         if threading.current_thread() is threading.main_thread():
-            signal.signal(signal.SIGINT, _first_interrupt)
+            signal.signal(signal.SIGINT, _on_interrupt)
+            sys.unraisablehook = _unraisable(hook)
         module, _, name = target.partition(":")
         code = getattr(import_module(module), name)()
     except KeyboardInterrupt:
@@ -73,6 +123,8 @@ def run(target: str, program: str) -> int:
         if _caused_by_interrupt(err):
             return interrupted(program)
         raise
+    finally:
+        sys.unraisablehook = hook
     if threading.current_thread() is threading.main_thread():
         # done: a Ctrl-C while Python exits (its atexit work) ends it at once, no traceback
         signal.signal(signal.SIGINT, signal.SIG_DFL)

@@ -185,3 +185,47 @@ def test_an_import_error_of_its_own_is_not_an_interrupt(
     monkeypatch.syspath_prepend(str(tmp_path))
     with pytest.raises(ImportError, match="no such thing"):
         launch.run("broken:main", "ertools")
+
+
+SWALLOWED = textwrap.dedent(
+    """
+    import signal, sys, time
+
+    class Dropped:
+        def __del__(self):
+            # the handler runs here, where Python cannot raise: it would print
+            # "Exception ignored in" and carry on
+            signal.raise_signal(signal.SIGINT)
+            time.sleep(0.01)
+
+    def main():
+        Dropped()
+        end = time.monotonic() + 30
+        while time.monotonic() < end:
+            pass
+        print("finished as if no key had been pressed")
+        return 0
+    """
+)
+
+
+def test_a_ctrl_c_inside_a_callback_is_delivered_again(tmp_path: Path) -> None:
+    """A Ctrl-C that lands in a ``__del__`` or a weakref callback of the import machinery (a
+    real one did, in CI) still ends the program with one line and 130: not Python's "Exception
+    ignored" traceback followed by a complete run."""
+    (tmp_path / "swallowing.py").write_text(SWALLOWED)
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import sys; from ertools import launch; "
+            "sys.exit(launch.run('swallowing:main', 'prog'))",
+        ],
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": str(tmp_path)},
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT_S,
+        check=False,
+    )
+    assert (proc.returncode, proc.stdout, proc.stderr) == (130, "", "prog: interrupted\n")
