@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 from io_bagmaker import FORMATS, Spec, bag_name, write
 from io_scene import DT, T0, Scene
 from mcap.writer import CompressionType
-from test_io_fastpath import POSE_TOPICS, assert_same, reference_batch
+from test_io_fastpath import POSE_TOPICS, _reference_bag, assert_same, reference_batch
 
 import ertools.io as eio
 from ertools.errors import BagError, TopicError
@@ -425,3 +425,50 @@ def test_random_layouts_equal_rosbags(
         return
     for topic, batch in zip(present, fast_many(path, present), strict=True):
         assert_same(batch, reference_batch(path, topic))
+
+
+# --- one publisher of a topic of several
+
+
+def _publishers_spec(shared: bool) -> Spec:
+    """/tf of two publishers: a mocap node whose messages carry world->robot and, every third
+    one, world->other too; a second node publishing world->map, and (``shared``) also
+    world->robot now and then, at the record time and stamp of a mocap message (a tie the
+    read must order as one read of both publishers does)."""
+    rng = np.random.default_rng(11)
+    s = Spec()
+    mocap = s.conn("/tf", "tf2_msgs/TFMessage", "/mocap")
+    other = s.conn("/tf", "tf2_msgs/TFMessage", "/other")
+    pose = s.conn("/p", "geometry_msgs/PoseStamped")
+    for i in range(90):
+        t = T0 + i * DT
+        xyz, q = rng.normal(size=3), rng.normal(size=4)
+        robot = dict(stamp=t - 7, frame="world", child="robot", xyz=xyz, q=q)
+        extra = [dict(stamp=t - 5, frame="/world", child="other", xyz=-xyz, q=q)]
+        s.add(mocap, t, transforms=[robot, *(extra if i % 3 == 0 else [])])
+        s.add(pose, t + 1, stamp=t, frame="world", xyz=xyz, q=q)
+        if i % 10 == 0:
+            s.add(
+                other, t + 2, transforms=[dict(stamp=t, frame="world", child="map", xyz=xyz, q=q)]
+            )
+        if shared and i % 7 == 0:
+            tie = dict(stamp=t - 7, frame="world", child="robot", xyz=2 * xyz, q=-q)
+            s.add(other, t, transforms=[tie])
+    return s
+
+
+@pytest.mark.parametrize("fmt", ["ros1", "ros1-lz4", "mcap-cdr", "mcap-ros1"])
+def test_a_request_of_one_publisher_reads_only_its_messages(tmp_path: Path, fmt: str) -> None:
+    """One connection of a topic of several (an MCAP channel too, not the whole topic)."""
+    path = write(bag_name(tmp_path, fmt), fmt, _publishers_spec(True), chunk_bytes=2500)
+    with open_bag(path) as bag, _reference_bag(path) as ref:
+        conns = bag.topic_conns("/tf")
+        assert len(conns) == 2
+        fast = bulk.try_fast_batches(bag, [Request((c,)) for c in conns])
+        for conn, batch in zip(conns, fast, strict=True):
+            assert batch is not None
+            expected = reader.slow_pose_batch(
+                ref, [c for c in ref.connections if c.id == conn.id], None, None
+            )
+            assert 9 <= len(expected) < len(reference_batch(path, "/tf"))
+            assert_same(batch, expected)

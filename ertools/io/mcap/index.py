@@ -120,8 +120,12 @@ class McapPlan:
 class McapIndex:
     """Chunk-level access to one or more MCAP files (a rosbag2 directory may hold several)."""
 
-    def __init__(self, files: list[Path]) -> None:
+    def __init__(self, files: list[Path], by_id: bool = False) -> None:
+        """``by_id``: a request's connections are the file's channels (a standalone MCAP
+        file), so a request wants exactly their ids; otherwise (rosbag2, one connection per
+        topic over several files) it wants every channel on their topics."""
         self.files = files
+        self.by_id = by_id
 
     @staticmethod
     def of(bag: BagFile) -> McapIndex | None:
@@ -129,7 +133,7 @@ class McapIndex:
         directory's files come from :func:`ertools.io.bulk.mcap_index`, which knows how
         the directory stores them)."""
         if bag.format == "mcap":
-            return McapIndex([bag.path])
+            return McapIndex([bag.path], by_id=True)
         return None
 
     def plan(self, conns: Sequence[Conn], lo: int | None, hi: int | None) -> McapPlan:
@@ -155,12 +159,13 @@ class McapIndex:
                 raise LayoutMismatchError(f"MCAP file {path.name}: {layout.why}")
             summary: Any = layout.summary
             with open_regular(path) as f:
-                # channel -> the requests that want it (by topic, as the readers name them)
+                # channel -> the requests that want it
                 wants: dict[int, list[int]] = {}
                 for ri, req in enumerate(requests):
                     topics = {c.topic for c in req.conns}
+                    ids = {c.id for c in req.conns}
                     for cid, ch in layout.channels.items():
-                        if ch.topic in topics:
+                        if (cid in ids) if self.by_id else (ch.topic in topics):
                             wants.setdefault(cid, []).append(ri)
                 chunks = summary.chunk_indexes
                 chunks_per_file.append(chunks)
@@ -279,8 +284,8 @@ class McapIndex:
     def messages(
         self, conns: Sequence[Conn], lo: int | None, hi: int | None
     ) -> list[tuple[int, int, int, bytes]]:
-        """(file index, channel id, log time, data) of every message on the topics of
-        ``conns`` in [lo, hi], in the reference order: the per-message path, through the same
+        """(file index, channel id, log time, data) of every message ``conns`` want (see
+        ``by_id``) in [lo, hi], in the reference order: the per-message path, through the same
         bounded chunk loads as the fast path (the ``mcap`` library's own decompression trusts
         a zstd frame's stated size, however large).
 
