@@ -19,7 +19,7 @@ from ertools.errors import BagError, TopicError
 from ertools.io.bagfile import BagFile
 from ertools.io.bulk import States, bulk_states_many, try_fast_batches
 from ertools.io.decode.posebatch import PoseBatch, batch_from_messages, concat_batches
-from ertools.io.decode.tf import Edge, chain_pose, split_edges
+from ertools.io.decode.tf import Edge, chain_pose, edges_overlap, split_edges
 from ertools.io.decode.typestore import Deserializer
 from ertools.io.files import open_bag
 from ertools.io.formats import bag_paths
@@ -258,7 +258,7 @@ def _read_sources(
                 lo = None if start_ns is None else start_ns - margin
                 hi = None if end_ns is None else end_ns + margin
                 topic_plan.append((i, _want(requests, conns, lo, hi), msgtype))
-            tf_plan: list[tuple[str, list[Conn], int]] = []
+            tf_plan: list[tuple[str, list[Conn], tuple[int | None, int | None], list[int]]] = []
             if tf:
                 lo = None if start_ns is None else start_ns - HEADER_WINDOW_MARGIN_NS
                 hi = None if end_ns is None else end_ns + HEADER_WINDOW_MARGIN_NS
@@ -266,18 +266,32 @@ def _read_sources(
                     tf_conns = [c for c in bag.topic_conns(topic) if c.msgtype in TF_TYPES]
                     if tf_conns:
                         window = (None, None) if topic == "/tf_static" else (lo, hi)
-                        tf_plan.append((topic, tf_conns, _want(requests, tf_conns, *window)))
+                        # One request per publisher: its transforms are one class to the
+                        # decoder and usually one edge, with no merge of the publishers'
+                        # messages to undo when the edges are split.
+                        wants = [_want(requests, [c], *window) for c in tf_conns]
+                        tf_plan.append((topic, tf_conns, window, wants))
             batches = load_pose_batches(bag, requests)
+            shared = {k for _i, k, _t in topic_plan}
+            tf_found = []
+            for topic, tf_conns, window, wants in tf_plan:
+                tf_batches = [batches[k] for k in wants]
+                # (a topic read of the same request keeps the batch's rows)
+                owns = [k not in shared for k in wants]
+                if edges_overlap(tf_batches):
+                    # Publishers sharing an edge: their transforms are needed in the order of
+                    # one read of them all (each format orders ties its own way).
+                    tf_batches, owns = [load_pose_batch(bag, tf_conns, *window)], [True]
+                tf_found.append((topic, tf_conns, tf_batches, owns))
         for i, k, msgtype in topic_plan:
             r = reads[i]
             assert isinstance(r, _TopicRead)
             source = f"{p}:{r.topic}"
             stream = _batch_to_stream(batches[k], msgtype, r.time_source, source)
             parts[i].append(sort_poses(stream, source).window(start_ns, end_ns))
-        shared = {k for _i, k, _t in topic_plan}
-        for topic, tf_conns, k in tf_plan:
-            own = k not in shared  # (a topic read of the same request keeps the batch's rows)
-            _add_tf_edges(per_edge, static_edges, p, topic, tf_conns, batches[k], own)
+        for topic, tf_conns, tf_batches, owns in tf_found:
+            for batch, own in zip(tf_batches, owns, strict=True):
+                _add_tf_edges(per_edge, static_edges, p, topic, tf_conns, batch, own)
     edges: dict[tuple[str, str], Edge] = {}
     for key, found in per_edge.items():
         merged = merge_poses(found, f"tf {key[0]} -> {key[1]}")

@@ -231,7 +231,10 @@ def test_read_pose_sources_equals_one_source_at_a_time(
 
     monkeypatch.setattr(reader, "try_fast_batches", spy)
     together = eio.read_pose_sources(path, sources)
-    assert passes == [4]  # three topics and /tf (for the frame; no /tf_static): one pass
+    with open_bag(path) as bag:
+        publishers = len(bag.topic_conns("/tf"))  # (two, but one in rosbag2)
+    # one pass: three topics and each /tf publisher (for the frame; no /tf_static)
+    assert passes == [3 + publishers]
     for a, b in zip(alone, together, strict=True):
         np.testing.assert_array_equal(a.t_ns, b.t_ns)
         np.testing.assert_array_equal(a.xyz.view(np.int64), b.xyz.view(np.int64))
@@ -427,7 +430,7 @@ def test_random_layouts_equal_rosbags(
         assert_same(batch, reference_batch(path, topic))
 
 
-# --- one publisher of a topic of several
+# --- tf frames read publisher by publisher
 
 
 def _publishers_spec(shared: bool) -> Spec:
@@ -455,6 +458,46 @@ def _publishers_spec(shared: bool) -> Spec:
             tie = dict(stamp=t - 7, frame="world", child="robot", xyz=2 * xyz, q=-q)
             s.add(other, t, transforms=[tie])
     return s
+
+
+def _edge_by_hand(path: Path, parent: str, child: str) -> PoseBatch:
+    """The rows of one edge of rosbags' /tf, in its order, then stably by stamp (what a tf
+    read of one link gives)."""
+    ref = reference_batch(path, "/tf")
+    rows = np.flatnonzero(
+        (np.char.lstrip(ref.frame_names(), "/") == parent) & (ref.child_names() == child)
+    )
+    rows = rows[np.argsort(ref.t_header[rows], kind="stable")]
+    return ref.take(rows)
+
+
+@pytest.mark.parametrize("shared", [False, True], ids=["own_edges", "shared_edge"])
+@pytest.mark.parametrize("fmt", FORMATS)
+def test_tf_frames_of_several_publishers_equal_rosbags(
+    tmp_path: Path, fmt: str, shared: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each /tf publisher is its own request; frames of messages with several transforms are
+    picked out; an edge two publishers share is read again as one request of both."""
+    path = write(bag_name(tmp_path, fmt), fmt, _publishers_spec(shared), chunk_bytes=2500)
+    again: list[int] = []
+    real = reader.load_pose_batch
+
+    def spy(bag: Any, conns: Any, lo: Any, hi: Any) -> Any:
+        again.append(len(conns))
+        return real(bag, conns, lo, hi)
+
+    monkeypatch.setattr(reader, "load_pose_batch", spy)
+    sources = [PoseSource(topic="/p"), *(PoseSource(frame=f) for f in ("robot", "other", "map"))]
+    streams = eio.read_pose_sources(path, sources)
+    with open_bag(path) as bag:
+        publishers = len(bag.topic_conns("/tf"))  # (one in rosbag2: nothing to share)
+    assert again == ([2] if shared and publishers == 2 else [])
+    for child, stream in zip(("robot", "other", "map"), streams[1:], strict=True):
+        ref = _edge_by_hand(path, "world", child)
+        assert len(ref) >= 9 and (stream.frame_id, stream.child_frame_id) == ("world", child)
+        np.testing.assert_array_equal(stream.t_ns, ref.t_header)
+        np.testing.assert_array_equal(stream.xyz.view(np.int64), ref.xyz.view(np.int64))
+        np.testing.assert_array_equal(stream.quat_xyzw.view(np.int64), ref.quat_xyzw.view(np.int64))
 
 
 @pytest.mark.parametrize("fmt", ["ros1", "ros1-lz4", "mcap-cdr", "mcap-ros1"])

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ertools.arrays import F64, I64, Bool
+from ertools.arrays import F64, I32, I64, Bool
 from ertools.errors import TopicError
 from ertools.geometry import compose, interpolate_poses, invert
 from ertools.io.decode.posebatch import PoseBatch
@@ -33,6 +33,34 @@ def frame_key(name: str) -> str:
     return name.lstrip("/")
 
 
+def _one_code(codes: I32) -> bool:
+    """Whether frame codes are one value broadcast (a bulk read of one frame pair)."""
+    return len(codes) > 0 and codes.strides == (0,)
+
+
+def edge_keys(batch: PoseBatch) -> set[tuple[str, str]]:
+    """The (parent, child) edges of a tf batch, frame names as tf2 compares them."""
+    if not len(batch):
+        return set()
+    frames = [frame_key(f) for f in batch.frames]
+    if _one_code(batch.frame_idx) and _one_code(batch.child_idx):
+        return {(frames[int(batch.frame_idx[0])], frames[int(batch.child_idx[0])])}
+    pairs = batch.frame_idx.astype(np.int64) * len(frames) + batch.child_idx
+    codes = np.flatnonzero(np.bincount(pairs, minlength=len(frames) ** 2)).tolist()
+    return {(frames[c // len(frames)], frames[c % len(frames)]) for c in codes}
+
+
+def edges_overlap(batches: list[PoseBatch]) -> bool:
+    """Whether two of the batches (a topic's publishers) hold the same edge."""
+    seen: set[tuple[str, str]] = set()
+    for batch in batches:
+        keys = edge_keys(batch)
+        if keys & seen:
+            return True
+        seen |= keys
+    return False
+
+
 def split_edges(
     batch: PoseBatch, source: str, own: bool
 ) -> list[tuple[tuple[str, str], int, PoseStream]]:
@@ -41,6 +69,13 @@ def split_edges(
     to consume) the edge of most rows (a body beside a static transform) is moved up in the
     batch's own arrays rather than copied."""
     frames = [frame_key(f) for f in batch.frames]
+    if _one_code(batch.frame_idx) and _one_code(batch.child_idx):
+        # one edge (a publisher of one transform): its rows are the batch's, nothing to split
+        key = (frames[int(batch.frame_idx[0])], frames[int(batch.child_idx[0])])
+        t, xyz, quat = batch.t_header, batch.xyz, batch.quat_xyzw
+        if not own:
+            t, xyz, quat = t.copy(), xyz.copy(), quat.copy()
+        return [(key, len(batch), PoseStream(t, xyz, quat, key[0], key[1], source))]
     pairs = batch.frame_idx.astype(np.int64) * len(frames) + batch.child_idx
     # a few (parent, child) pairs: one comparison each rather than a sort of every row
     counts = np.bincount(pairs, minlength=len(frames) ** 2) if len(pairs) else pairs
