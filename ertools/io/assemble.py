@@ -281,7 +281,10 @@ class Decoder:
         conn = run.conn
         if not len(conn):
             return
-        if int(conn[0]) == int(conn[-1]) and bool(np.all(conn == conn[0])):
+        # (one connection's ids come broadcast from one value: nothing to compare)
+        if int(conn[0]) == int(conn[-1]) and (
+            conn.strides == (0,) or bool(np.all(conn == conn[0]))
+        ):
             if not self.fast(run, int(conn[0]), None):
                 self.general(run, np.arange(len(conn), dtype=np.int64))
             return

@@ -229,6 +229,13 @@ class McapIndex:
         file itself)."""
         rows_of = [p.by_key() for p in plans]
         keys = sorted({k for rows in rows_of for k in rows})
+        # a plan of one channel gives its runs that id broadcast (no array per run)
+        single = [
+            int(p.channel[0])
+            if len(p.channel) and bool(np.all(p.channel == p.channel[0]))
+            else None
+            for p in plans
+        ]
         chunks_of = plans[0].chunks if plans else []
         todo: list[list[int]] = []
         size = 0
@@ -248,7 +255,7 @@ class McapIndex:
             path, first = chunk_of(part[0])
             where = f"in {path} in chunks from byte {first.chunk_start_offset}"
             out: list[Run | None] = []
-            for plan, rows_by_key in zip(plans, rows_of, strict=True):
+            for plan, rows_by_key, one in zip(plans, rows_of, single, strict=True):
                 mine = [(i, rows_by_key[key]) for i, key in enumerate(part) if key in rows_by_key]
                 if not mine:
                     out.append(None)
@@ -271,7 +278,11 @@ class McapIndex:
                 if len(offsets) and int(offsets.min()) < 0:
                     raise BagError(f"message index points outside its chunk {where}")
                 t = plan.t_record[sel]
-                channel = plan.channel[sel].astype(np.int64)
+                channel = (
+                    plan.channel[sel].astype(np.int64)
+                    if one is None
+                    else np.broadcast_to(np.int64(one), t.shape)
+                )
                 limit = base[which] + sizes[which]
                 records = McapRecords(buf, offsets + base[which], limit, t, channel, where)
                 consecutive = isinstance(sel, slice)
