@@ -10,10 +10,8 @@ INFO, visible with ``-v``).
 
 from __future__ import annotations
 
-import contextlib
 import logging
 from collections.abc import Iterator, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
@@ -64,7 +62,7 @@ def mcap_index(bag: BagFile) -> McapIndex | None:
 
 
 def _mcap_runs(
-    bag: BagFile, requests: Sequence[Request], progress: Reporter | None = None
+    bag: BagFile, requests: Sequence[Request], progress: Reporter | None = None, hold: int = 0
 ) -> LocatedMany | None:
     index = mcap_index(bag)
     if index is None:
@@ -80,6 +78,7 @@ def _mcap_runs(
         progress=progress,
         weights=weights,
         label=f"reading {', '.join(topics) or '?'} from {bag.path.name}",
+        hold=hold,
     )
     return LocatedMany([len(p.t_record) for p in plans], runs, [p.t_record for p in plans])
 
@@ -128,14 +127,16 @@ def _scanned_runs(bag: BagFile, requests: Sequence[Request]) -> LocatedMany:
 
 
 def locate_many(
-    bag: BagFile, requests: Sequence[Request], progress: Reporter | None = None
+    bag: BagFile, requests: Sequence[Request], progress: Reporter | None = None, hold: int = 0
 ) -> LocatedMany | None:
     """The messages of each request (connections, record-time window), located in one pass
     over the file's index and loaded in one pass over the chunks any of them touches; None
     when the format has no bulk access (then the caller reads per message).
 
     ROS1 and MCAP reads report the bytes of each group of chunks to ``progress`` (default:
-    the reporter made current by :func:`ertools.progress.reporting`, if any).
+    the reporter made current by :func:`ertools.progress.reporting`, if any). A group's runs
+    stay valid until ``hold + 1`` more groups are asked for (see
+    :func:`ertools.io.pipeline.prefetched`).
 
     Raises:
         LayoutMismatchError: the file lacks the index records the bulk path needs.
@@ -143,13 +144,13 @@ def locate_many(
     if progress is None:
         progress = current()
     if bag.format in ("ros1", "ros1-active"):
-        return ros1_runs(cast("Ros1Bag", bag), requests, progress)
+        return ros1_runs(cast("Ros1Bag", bag), requests, progress, hold)
     if bag.format == "rosbag2-sqlite3":
         return _sqlite_runs(bag, requests)
     if getattr(bag, "scanned", False):
         return _scanned_runs(bag, requests)
     if bag.format in ("mcap", "rosbag2-mcap"):
-        return _mcap_runs(bag, requests, progress)
+        return _mcap_runs(bag, requests, progress, hold)
     return None
 
 
@@ -239,7 +240,7 @@ def try_fast_batches(bag: BagFile, requests: Sequence[Request]) -> list[PoseBatc
     if not mine:
         return out
     try:
-        found = locate_many(bag, [requests[i] for i in mine])
+        found = locate_many(bag, [requests[i] for i in mine], hold=pipeline.lanes_for(len(mine)))
     except LayoutMismatchError as err:
         log.info("%s: not read in bulk (%s); decoding per message", bag.path, err)
         return out
@@ -271,25 +272,12 @@ def try_fast_batches(bag: BagFile, requests: Sequence[Request]) -> list[PoseBatc
         except LayoutMismatchError as err:
             failed[k] = err
 
-    # The requests of a group are decoded side by side, one per thread: NumPy releases the GIL
-    # in its loops, and each request has its own decoder and result (the group's bytes are
-    # only read). A group's runs are all decoded before the next group is asked for (which
-    # may reuse its buffer); errors are raised in request order, as one thread would.
-    threads = min(pipeline.workers(), len(mine))
-    with contextlib.ExitStack() as stack:
-        pool = stack.enter_context(ThreadPoolExecutor(threads)) if threads > 1 else None
-        try:
-            for runs in found.runs:
-                todo = [(k, run) for k, run in enumerate(runs) if run is not None]
-                if pool is None or len(todo) < 2:
-                    for k, run in todo:
-                        decode_run(k, run)
-                    continue
-                for future in [pool.submit(decode_run, k, run) for k, run in todo]:
-                    future.result()
-        except LayoutMismatchError as err:
-            log.info("%s: not read in bulk (%s); decoding per message", bag.path, err)
-            return out
+    # the requests side by side, each on a thread of its own (NumPy releases the GIL)
+    try:
+        pipeline.decoded_in_lanes(found.runs, decode_run, len(mine))
+    except LayoutMismatchError as err:
+        log.info("%s: not read in bulk (%s); decoding per message", bag.path, err)
+        return out
     for k, why in enumerate(failed):
         if why is not None:
             log.info(

@@ -3,7 +3,8 @@
 Reading a pose topic is three steps per group of chunks: read the bytes, decompress them, and
 decode the messages. File reads and lz4/zstd/bz2 decompression release the GIL, so worker
 threads load the next groups while the calling thread decodes the current one: on two cores a
-topic costs about the larger of decompressing and decoding, not their sum.
+topic costs about the larger of decompressing and decoding, not their sum. The topics of one
+read are decoded on lanes, a thread each (:func:`decoded_in_lanes`).
 
 Each group is loaded whole into one buffer (its chunks end to end) that is reused once the
 caller has moved on, so memory stays at a few groups whatever the size of the file, and fresh
@@ -16,10 +17,11 @@ import contextlib
 import mmap
 import os
 import threading
-from collections import deque
-from collections.abc import Callable, Iterator, Sequence
+from collections import Counter, deque
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from queue import SimpleQueue
 from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 import numpy as np
@@ -49,14 +51,16 @@ def prefetched(
     progress: Reporter | None = None,
     weights: Sequence[int] = (),
     label: str = "reading",
+    hold: int = 0,
 ) -> Iterator[T]:
     """``load(k, scratch)`` for k in 0..count-1, in order, computed ahead on worker threads.
 
     ``scratch`` is a slot: a list holding the bytearray ``load`` may fill (and grow, see
-    :func:`scratch_view`) and maps it read through (:func:`keep`); a result is valid until the
-    next one is asked for, after which its slot is reused. Without ``parallel`` (reads with
-    nothing to decompress: a second thread only competes with the decoder, measured) the
-    loads run in turn on the calling thread.
+    :func:`scratch_view`) and maps it read through (:func:`keep`); a result is valid until
+    ``hold + 1`` more are asked for (the caller may still be decoding the ``hold`` before the
+    one it holds), after which its slot is reused. Without ``parallel`` (reads with nothing
+    to decompress: a second thread only competes with the decoder, measured) the loads run in
+    turn on the calling thread.
 
     With ``progress``, ``weights[k]`` (the bytes load k reads from the file) is reported as
     each load is handed over, on the calling thread: one call per group of chunks.
@@ -67,16 +71,17 @@ def prefetched(
         report.task(label, sum(weights), "B")
     ahead = min(workers(), count) if parallel else 1
     if ahead <= 1:
-        scratch: list[Any] = []
+        turns: list[list[Any]] = [[] for _ in range(hold + 1)]
         for k in range(count):
-            got = load(k, scratch)
+            got = load(k, turns[k % len(turns)])
             if report is not None:
                 report.advance(weights[k])
             yield got
         return
 
-    # ahead groups in flight plus the one the caller holds: none shares a buffer.
-    slots: list[list[Any]] = [[] for _ in range(ahead + 1)]
+    # ahead groups in flight plus the one the caller holds and the ``hold`` before it: none
+    # shares a buffer.
+    slots: list[list[Any]] = [[] for _ in range(ahead + 1 + hold)]
     with ThreadPoolExecutor(ahead) as pool:
         pending = deque(pool.submit(load, k, slots[k % len(slots)]) for k in range(ahead))
         for k in range(count):
@@ -86,6 +91,91 @@ def prefetched(
             if report is not None:
                 report.advance(weights[k])
             yield got
+
+
+# Groups a lane of :func:`decoded_in_lanes` may lag behind the one being loaded.
+LANE_HOLD = 1
+
+
+def lanes_for(count: int) -> int:
+    """The ``hold`` a read of ``count`` requests passes to its loads: :data:`LANE_HOLD` when
+    :func:`decoded_in_lanes` runs them on lanes, else 0."""
+    return LANE_HOLD if count > 1 and workers() > 1 else 0
+
+
+def decoded_in_lanes(
+    groups: Iterable[Sequence[T | None]], decode: Callable[[int, T], None], count: int
+) -> None:
+    """``decode(i, item)`` for every item of every group, item i (request i's run) of each
+    group on lane i: a thread of its own that takes request i's runs in group order. The
+    requests of a group, and of the group before it, are so decoded side by side with no
+    wait for the slowest at every group: NumPy releases the GIL in its loops, and each
+    request has its own decoder and result. A group is asked for only once the group
+    :data:`LANE_HOLD` + 1 before it is decoded (its buffer is reused then: ``groups`` comes
+    from loads made with ``hold`` = :func:`lanes_for`).
+
+    The error raised is the one a single thread decoding the groups in turn, items in request
+    order, meets first (a load's error comes after the decoding errors of the groups before
+    it); no group after it is asked for.
+    """
+    if lanes_for(count) == 0:
+        for group in groups:
+            for i, item in enumerate(group):
+                if item is not None:
+                    decode(i, item)
+        return
+    cond = threading.Condition()
+    outstanding: Counter[int] = Counter()
+    errors: list[tuple[int, int, Exception]] = []
+    queues: list[SimpleQueue[tuple[int, T] | None]] = [SimpleQueue() for _ in range(count)]
+
+    def lane(i: int) -> None:
+        while (got := queues[i].get()) is not None:
+            k, item = got
+            try:
+                with cond:
+                    after = any(e[0] < k for e in errors)  # one thread had stopped before
+                if not after:
+                    decode(i, item)
+            except Exception as err:  # raised by the caller, in order
+                with cond:
+                    errors.append((k, i, err))
+            finally:
+                with cond:
+                    outstanding[k] -= 1
+                    cond.notify_all()
+
+    threads = [
+        threading.Thread(target=lane, args=(i,), daemon=True, name=f"ertools-lane-{i}")
+        for i in range(count)
+    ]
+    for thread in threads:
+        thread.start()
+    k = 0
+    try:
+        for group in groups:
+            for i, item in enumerate(group):
+                if item is not None:
+                    with cond:
+                        outstanding[k] += 1
+                    queues[i].put((k, item))
+            k += 1
+            reused = k - 1 - LANE_HOLD  # the group whose buffer the next load reuses
+            with cond:
+                while not errors and outstanding[reused]:
+                    cond.wait()
+                if errors:
+                    break
+    except Exception as err:  # a load's: after the lanes' errors of earlier groups
+        with cond:
+            errors.append((k, -1, err))
+    finally:
+        for q in queues:
+            q.put(None)
+        for thread in threads:
+            thread.join()
+    if errors:
+        raise min(errors, key=lambda e: (e[0], e[1]))[2]
 
 
 def scratch_view(scratch: list[Any], size: int) -> memoryview:

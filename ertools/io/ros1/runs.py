@@ -264,10 +264,11 @@ class _Plan:
 
 
 def ros1_runs(
-    bag: IndexedBag, requests: Sequence[Request], progress: Reporter | None = None
+    bag: IndexedBag, requests: Sequence[Request], progress: Reporter | None = None, hold: int = 0
 ) -> LocatedMany:
     """The messages of each request, located in one pass over the index and loaded in one
-    pass over the chunks any of them touches."""
+    pass over the chunks any of them touches (each group's runs valid until ``hold + 1``
+    more are asked for)."""
     sels = bag.select_many(requests)
     plans = [_Plan(req, sel) for req, sel in zip(requests, sels, strict=True)]
     per_chunk: dict[int, int] = {}
@@ -318,6 +319,7 @@ def ros1_runs(
         progress=progress,
         weights=weights,
         label=_label(requests, bag.path),
+        hold=hold,
     )
     return LocatedMany([len(s[3]) for s in sels], runs, [s[3] for s in sels])
 
