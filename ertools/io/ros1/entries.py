@@ -4,6 +4,7 @@ rosbags yields the messages of several connections.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -20,16 +21,20 @@ Words = npt.NDArray[np.uint64]
 Selection = tuple[list[int], Ints, Ints, I64, Ints, Words | None]
 
 
-def entries_of(parts: list[bytes | tuple[I64, I64]]) -> tuple[I64, Ints, Words | None]:
+def entries_of(
+    parts: Sequence[bytes | memoryview | tuple[I64, I64]],
+) -> tuple[I64, Ints, Words | None]:
     """(record times, offsets in their chunks, time words) of one connection's index entries
-    over several chunks. Offsets read from index data stay uint32 as stored (widened per
-    group, where they are added to the chunk's place in the group's bytes); the time words
-    are each entry's (sec, nsec) as one little-endian uint64, the bytes a message record's
-    time field must hold (None for entries a scan found)."""
-    if not all(isinstance(p, bytes) for p in parts):
-        t, off = joined_entries(parts)
+    over several chunks (raw index data, or the entries a scan found). Offsets read from
+    index data stay uint32 as stored (widened per group, where they are added to the chunk's
+    place in the group's bytes); the time words are each entry's (sec, nsec) as one
+    little-endian uint64, the bytes a message record's time field must hold (None for
+    entries a scan found)."""
+    data = [p for p in parts if not isinstance(p, tuple)]
+    if len(data) != len(parts):
+        t, off = joined_entries([bytes(p) if not isinstance(p, tuple) else p for p in parts])
         return t, off, None
-    arr = np.frombuffer(b"".join(p for p in parts if isinstance(p, bytes)), dtype=INDEX_DTYPE)
+    arr = np.frombuffer(b"".join(data), dtype=INDEX_DTYPE)
     # Computed in place: fresh memory is slow to fault in, and an hour's entries are 5 MB.
     t = np.multiply(arr["sec"], 1_000_000_000, dtype=np.int64)
     np.add(t, arr["nsec"], out=t)

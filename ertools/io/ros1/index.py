@@ -12,6 +12,7 @@ import contextlib
 import logging
 import mmap
 from collections.abc import Collection, Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from io import BufferedReader
 from pathlib import Path
 from struct import error as struct_error
@@ -28,7 +29,7 @@ from ertools.io.bagfile import BagFile, RawRecord
 from ertools.io.decode.fast import LayoutMismatchError, gather, read_at
 from ertools.io.inflate import Allowance
 from ertools.io.model import Conn
-from ertools.io.pipeline import Request, in_window, window
+from ertools.io.pipeline import Request, in_window, window, workers
 from ertools.io.ros1.check import rebuild_layout
 from ertools.io.ros1.entries import (
     Ints,
@@ -202,16 +203,19 @@ class Ros1Bag(BagFile):
         chunk: Ros1Chunk,
         wanted: Collection[int] | None,
         counts: dict[int, int] | None = None,
-    ) -> dict[int, bytes]:
+        view: memoryview | None = None,
+    ) -> dict[int, bytes | memoryview]:
         """conn -> raw (sec, nsec, offset) entries of one chunk, for the ``wanted`` connections
         (all when None), from the index-data records that follow the chunk; ``counts`` gets
-        every record's conn -> count (all connections)."""
+        every record's conn -> count (all connections). With ``view`` (of the mapped file),
+        the entries are slices of it, not copies."""
         if chunk.data_pos < 0:
             self.chunk_record(chunk)
         mm = self._mapped()
+        src = mm if view is None else view
         size = min(len(mm), self.layout.size)
         pos = chunk.data_pos + chunk.data_len
-        out: dict[int, bytes] = {}
+        out: dict[int, bytes | memoryview] = {}
         try:
             for _ in range(len(chunk.counts)):
                 if pos + 8 > size:
@@ -234,7 +238,7 @@ class Ros1Bag(BagFile):
                 if counts is not None:
                     counts[cid] = counts.get(cid, 0) + count
                 if wanted is None or cid in wanted:
-                    out[cid] = mm[data_pos : data_pos + dlen]
+                    out[cid] = src[data_pos : data_pos + dlen]
                 pos = data_pos + dlen
         except (RecordError, KeyError, struct_error, IndexError) as err:
             raise BagError(
@@ -286,8 +290,37 @@ class Ros1Bag(BagFile):
                 self._rescan(f"chunk info names connection {unknown[0]}, which the bag lacks")
         wanted = {c.id for r in requests for c in r.conns}
         start_ns, end_ns = window(requests)
-        raw: dict[int, list[bytes | tuple[I64, I64]]] = {cid: [] for cid in wanted}
+        raw: dict[int, list[bytes | memoryview | tuple[I64, I64]]] = {cid: [] for cid in wanted}
         where: dict[int, list[tuple[int, int]]] = {cid: [] for cid in wanted}
+        # the entries are sliced out of the mapped file, and copied once, joined per connection
+        indexed = any(c.entries is None for c in self.layout.chunks)
+        view = memoryview(self._mapped()) if indexed else None
+        try:
+            damage = self._gather_entries(start_ns, end_ns, wanted, raw, where, view)
+            if damage is None:
+                entries, damage = self._entries(raw, where)
+        finally:
+            raw.clear()  # (the slices of the map, before it is closed)
+            if view is not None:
+                view.release()
+            self._unmap()  # the index pages touched would otherwise stay in this process's RSS
+        if damage is not None:
+            self._rescan(damage)
+            return self.select_many(requests)
+        return [self._ordered(r, entries) for r in requests]
+
+    def _gather_entries(
+        self,
+        start_ns: int | None,
+        end_ns: int | None,
+        wanted: set[int],
+        raw: dict[int, list[bytes | memoryview | tuple[I64, I64]]],
+        where: dict[int, list[tuple[int, int]]],
+        view: memoryview | None,
+    ) -> str | None:
+        """Each wanted connection's raw entries into ``raw`` (and (chunk, count) of each into
+        ``where``) from the chunks overlapping [start_ns, end_ns]; why the index is damaged,
+        or None."""
         for ci, chunk in enumerate(self.layout.chunks):
             if start_ns is not None and chunk.end_ns < start_ns:
                 continue
@@ -304,33 +337,50 @@ class Ros1Bag(BagFile):
             # (a damaged connection id or count there dropped a chunk from its connection's
             # read, or read another connection's entries, without a word).
             counts: dict[int, int] = {}
-            for cid, data in self._index_data(chunk, wanted, counts).items():
+            for cid, data in self._index_data(chunk, wanted, counts, view).items():
                 raw[cid].append(data)
                 where[cid].append((ci, len(data) // INDEX_DTYPE.itemsize))
             if nonzero_counts(counts) != nonzero_counts(chunk.counts):
-                self._rescan(
+                return (
                     f"chunk at byte {chunk.pos}: the chunk info and the index data give "
                     "different connections or counts"
                 )
-                return self.select_many(requests)
-        self._unmap()  # the index pages touched would otherwise stay in this process's RSS
-        # per connection: (record times, offsets, chunk index) of its entries in the window
-        entries: dict[int, tuple[I64, Ints, Ints, Words | None]] = {}
-        for cid in wanted:
-            if not raw[cid]:
-                continue
+        return None
+
+    def _entries(
+        self,
+        raw: dict[int, list[bytes | memoryview | tuple[I64, I64]]],
+        where: dict[int, list[tuple[int, int]]],
+    ) -> tuple[dict[int, tuple[I64, Ints, Ints, Words | None]], str | None]:
+        """Per connection: (record times, offsets, chunk index, time words) of its entries,
+        the connections side by side on threads (NumPy releases the GIL); and why the index
+        contradicts its chunk infos, or None."""
+        cids = [cid for cid in sorted(raw) if raw[cid]]
+
+        def one(cid: int) -> tuple[I64, Ints, Ints, Words | None] | str:
             t, off, words = entries_of(raw[cid])
             if self.layout.indexed:
                 outside = outside_chunk_info(self.layout.chunks, cid, t, where[cid])
                 if outside is not None:
-                    self._rescan(outside)
-                    return self.select_many(requests)
+                    return outside
             c = np.repeat(
                 np.array([w[0] for w in where[cid]], dtype=np.int32),
                 np.array([w[1] for w in where[cid]], dtype=np.int64),
             )
-            entries[cid] = (t, off, c, words)
-        return [self._ordered(r, entries) for r in requests]
+            return t, off, c, words
+
+        threads = min(workers(), len(cids))
+        if threads > 1:
+            with ThreadPoolExecutor(threads) as pool:
+                found = list(pool.map(one, cids))
+        else:
+            found = [one(cid) for cid in cids]
+        entries = {}
+        for cid, got in zip(cids, found, strict=True):
+            if isinstance(got, str):
+                return {}, got
+            entries[cid] = got
+        return entries, None
 
     def _ordered(
         self, request: Request, entries: dict[int, tuple[I64, Ints, Ints, Words | None]]
