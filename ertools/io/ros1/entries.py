@@ -1,17 +1,26 @@
-"""A ROS1 bag's index entries as arrays: parsed from its index-data records, and ordered as
-rosbags yields the messages of several connections.
+"""A ROS1 bag's index entries as arrays: parsed from its index-data records (each
+connection's on a thread of its own), and ordered as rosbags yields the messages of several
+connections.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import I64
-from ertools.io.ros1.layout import INDEX_DTYPE, cat_arrays, joined_entries
+from ertools.io.pipeline import Request, in_window, workers
+from ertools.io.ros1.layout import (
+    INDEX_DTYPE,
+    Ros1Layout,
+    cat_arrays,
+    joined_entries,
+    outside_chunk_info,
+)
 
 Ints = npt.NDArray[np.integer[Any]]
 Words = npt.NDArray[np.uint64]
@@ -83,3 +92,77 @@ def merged_columns(times: list[I64], columns: list[list[Any]]) -> list[npt.NDArr
 
 def _joined(parts: list[Any]) -> npt.NDArray[Any]:
     return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
+
+Entries = dict[int, tuple[I64, Ints, Ints, Words | None]]
+
+
+def connection_entries(
+    raw: dict[int, list[bytes | memoryview | tuple[I64, I64]]],
+    where: dict[int, list[tuple[int, int]]],
+    layout: Ros1Layout,
+) -> tuple[Entries, str | None]:
+    """Per connection of ``raw`` (its index data chunk by chunk; ``where``: (chunk, count) of
+    each part): (record times, offsets, chunk index, time words) of its entries, the
+    connections side by side on threads (NumPy and the join release the GIL); and why the
+    index contradicts its chunk infos, or None."""
+    cids = [cid for cid in sorted(raw) if raw[cid]]
+
+    def one(cid: int) -> tuple[I64, Ints, Ints, Words | None] | str:
+        t, off, words = entries_of(raw[cid])
+        if layout.indexed:
+            outside = outside_chunk_info(layout.chunks, cid, t, where[cid])
+            if outside is not None:
+                return outside
+        c = np.repeat(
+            np.array([w[0] for w in where[cid]], dtype=np.int32),
+            np.array([w[1] for w in where[cid]], dtype=np.int64),
+        )
+        return t, off, c, words
+
+    threads = min(workers(), len(cids))
+    if threads > 1:
+        with ThreadPoolExecutor(threads) as pool:
+            found = list(pool.map(one, cids))
+    else:
+        found = [one(cid) for cid in cids]
+    entries: Entries = {}
+    for cid, got in zip(cids, found, strict=True):
+        if isinstance(got, str):
+            return {}, got
+        entries[cid] = got
+    return entries, None
+
+
+def ordered(request: Request, entries: Entries) -> Selection:
+    """One request's messages, in rosbags' order, from every wanted connection's entries."""
+    rank = {c.id: i for i, c in enumerate(request.conns)}
+    tt: list[I64] = []
+    oo: list[Ints] = []
+    ck: list[Ints] = []
+    ww: list[Words | None] = []
+    rk: list[npt.NDArray[np.integer[Any]]] = []
+    for cid, r in rank.items():
+        if cid not in entries:
+            continue
+        t, off, c, words = entries[cid]
+        keep = in_window(t, request.lo, request.hi)
+        if keep is not None:
+            t, off, c = t[keep], off[keep], c[keep]
+            words = None if words is None else words[keep]
+        tt.append(t)
+        oo.append(off)
+        ck.append(c)
+        ww.append(words)
+        rk.append(np.full(len(t), r, dtype=np.int8 if len(rank) < 128 else np.int64))
+    if not tt or not sum(len(t) for t in tt):
+        e = np.empty(0, np.int64)
+        return [], e, e, e, e, None
+    # each connection's chunk indices ascend (its entries are gathered chunk by chunk)
+    touched = sorted({ci for c in ck for ci in c[run_starts(c)].tolist()})
+    # rosbags: per connection sorted by time (stable over chunk and index order), then a
+    # heap merge over connections in the order given (ties: the earlier connection).
+    known = [w for w in ww if w is not None]
+    columns: list[list[Any]] = [tt, ck, rk, oo, *([known] if len(known) == len(ww) else [])]
+    t_all, c_all, r_all, o_all, *w_all = merged_columns(tt, columns)
+    return touched, c_all, r_all, t_all, o_all, (w_all[0] if w_all else None)

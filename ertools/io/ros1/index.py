@@ -12,7 +12,6 @@ import contextlib
 import logging
 import mmap
 from collections.abc import Collection, Iterator, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from io import BufferedReader
 from pathlib import Path
 from struct import error as struct_error
@@ -29,16 +28,9 @@ from ertools.io.bagfile import BagFile, RawRecord
 from ertools.io.decode.fast import LayoutMismatchError, gather, read_at
 from ertools.io.inflate import Allowance
 from ertools.io.model import Conn
-from ertools.io.pipeline import Request, in_window, window, workers
+from ertools.io.pipeline import Request, window
 from ertools.io.ros1.check import rebuild_layout
-from ertools.io.ros1.entries import (
-    Ints,
-    Selection,
-    Words,
-    entries_of,
-    merged_columns,
-    run_starts,
-)
+from ertools.io.ros1.entries import Ints, Selection, connection_entries, ordered
 from ertools.io.ros1.layout import (
     INDEX_DTYPE,
     MSG_HEADER_LEN,
@@ -54,7 +46,6 @@ from ertools.io.ros1.layout import (
     index_header,
     nonzero_counts,
     op_word,
-    outside_chunk_info,
     read_layout,
     value_offsets,
 )
@@ -298,7 +289,7 @@ class Ros1Bag(BagFile):
         try:
             damage = self._gather_entries(start_ns, end_ns, wanted, raw, where, view)
             if damage is None:
-                entries, damage = self._entries(raw, where)
+                entries, damage = connection_entries(raw, where, self.layout)
         finally:
             raw.clear()  # (the slices of the map, before it is closed)
             if view is not None:
@@ -307,7 +298,7 @@ class Ros1Bag(BagFile):
         if damage is not None:
             self._rescan(damage)
             return self.select_many(requests)
-        return [self._ordered(r, entries) for r in requests]
+        return [ordered(r, entries) for r in requests]
 
     def _gather_entries(
         self,
@@ -346,76 +337,6 @@ class Ros1Bag(BagFile):
                     "different connections or counts"
                 )
         return None
-
-    def _entries(
-        self,
-        raw: dict[int, list[bytes | memoryview | tuple[I64, I64]]],
-        where: dict[int, list[tuple[int, int]]],
-    ) -> tuple[dict[int, tuple[I64, Ints, Ints, Words | None]], str | None]:
-        """Per connection: (record times, offsets, chunk index, time words) of its entries,
-        the connections side by side on threads (NumPy releases the GIL); and why the index
-        contradicts its chunk infos, or None."""
-        cids = [cid for cid in sorted(raw) if raw[cid]]
-
-        def one(cid: int) -> tuple[I64, Ints, Ints, Words | None] | str:
-            t, off, words = entries_of(raw[cid])
-            if self.layout.indexed:
-                outside = outside_chunk_info(self.layout.chunks, cid, t, where[cid])
-                if outside is not None:
-                    return outside
-            c = np.repeat(
-                np.array([w[0] for w in where[cid]], dtype=np.int32),
-                np.array([w[1] for w in where[cid]], dtype=np.int64),
-            )
-            return t, off, c, words
-
-        threads = min(workers(), len(cids))
-        if threads > 1:
-            with ThreadPoolExecutor(threads) as pool:
-                found = list(pool.map(one, cids))
-        else:
-            found = [one(cid) for cid in cids]
-        entries = {}
-        for cid, got in zip(cids, found, strict=True):
-            if isinstance(got, str):
-                return {}, got
-            entries[cid] = got
-        return entries, None
-
-    def _ordered(
-        self, request: Request, entries: dict[int, tuple[I64, Ints, Ints, Words | None]]
-    ) -> Selection:
-        """One request's messages, in rosbags' order, from every wanted connection's entries."""
-        rank = {c.id: i for i, c in enumerate(request.conns)}
-        tt: list[I64] = []
-        oo: list[Ints] = []
-        ck: list[Ints] = []
-        ww: list[Words | None] = []
-        rk: list[npt.NDArray[np.integer[Any]]] = []
-        for cid, r in rank.items():
-            if cid not in entries:
-                continue
-            t, off, c, words = entries[cid]
-            keep = in_window(t, request.lo, request.hi)
-            if keep is not None:
-                t, off, c = t[keep], off[keep], c[keep]
-                words = None if words is None else words[keep]
-            tt.append(t)
-            oo.append(off)
-            ck.append(c)
-            ww.append(words)
-            rk.append(np.full(len(t), r, dtype=np.int8 if len(rank) < 128 else np.int64))
-        if not tt or not sum(len(t) for t in tt):
-            e = np.empty(0, np.int64)
-            return [], e, e, e, e, None
-        # each connection's chunk indices ascend (its entries are gathered chunk by chunk)
-        touched = sorted({ci for c in ck for ci in c[run_starts(c)].tolist()})
-        # rosbags: per connection sorted by time (stable over chunk and index order), then a
-        # heap merge over connections in the order given (ties: the earlier connection).
-        known = [w for w in ww if w is not None]
-        columns: list[list[Any]] = [tt, ck, rk, oo, *([known] if len(known) == len(ww) else [])]
-        t_all, c_all, r_all, o_all, *w_all = merged_columns(tt, columns)
-        return touched, c_all, r_all, t_all, o_all, (w_all[0] if w_all else None)
 
     def _rescan(self, why: str) -> None:
         """Distrust the index from now on: rebuild the layout from the records themselves."""
