@@ -19,14 +19,21 @@ from hypothesis import strategies as st
 from io_bagmaker import FORMATS, Spec, bag_name, write
 from io_scene import DT, T0, Scene
 from mcap.writer import CompressionType
-from test_io_fastpath import POSE_TOPICS, _reference_bag, assert_same, reference_batch
+from test_io_fastpath import (
+    POSE_TOPICS,
+    REAL_BAG,
+    _reference_bag,
+    _sample_bags,
+    assert_same,
+    reference_batch,
+)
 
 import ertools.io as eio
 from ertools.errors import BagError, TopicError
-from ertools.io import assemble, bulk, reader
+from ertools.io import assemble, bulk, reader, summary
 from ertools.io.decode.posebatch import PoseBatch
 from ertools.io.files import open_bag
-from ertools.io.model import PoseSource
+from ertools.io.model import POSE_TYPES, PoseSource
 from ertools.io.pipeline import Request
 from ertools.io.ros1 import runs as ros1_runs
 from ertools.io.ros1.entries import merged_columns
@@ -91,6 +98,32 @@ def test_general_and_field_paths_equal_the_one_gather_path(
     slow = fast_many(path, list(POSE_TOPICS))
     for a, b in zip(fast, slow, strict=True):
         assert_same(a, b)
+
+
+def _recorded_bags() -> list[Any]:
+    """The real 2015 bag and every sample bag, each once (as pytest params)."""
+    real = [pytest.param(REAL_BAG, marks=pytest.mark.real, id="real-2015")]
+    return real + [pytest.param(p, id=p.name) for p in _sample_bags()]
+
+
+@pytest.mark.parametrize("path", _recorded_bags())
+def test_one_read_of_a_recorded_bag_equals_rosbags_and_the_general_path(
+    path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Every pose topic of a bag the loggers of 2015 wrote (or the samples made like them),
+    from one read: each as rosbags deserializes it alone, and as the general path decodes it
+    (checked spans, layouts per data length, the field decoder)."""
+    if not path.exists():
+        pytest.skip(f"{path} not present")
+    topics = [t.name for t in summary(path).topics if t.msgtype in POSE_TYPES and t.count]
+    if not topics:
+        pytest.skip(f"{path.name} has no pose topic")
+    fast = fast_many(path, topics)
+    monkeypatch.setattr(assemble.Decoder, "fast", lambda *args, **kwargs: False)
+    general = fast_many(path, topics)
+    for topic, a, b in zip(topics, fast, general, strict=True):
+        assert_same(a, b)
+        assert_same(a, reference_batch(path, topic))
 
 
 def test_windows_cutting_chunks_in_one_read(scene_bag: tuple[str, Path], scene: Scene) -> None:
