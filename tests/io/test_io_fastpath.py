@@ -14,13 +14,13 @@ from rosbags.rosbag1 import Writer
 import ertools.io as eio
 from ertools.io import summary
 from ertools.io.bagfile import BagFile, RawRecord
-from ertools.io.bulk import try_fast_batch
+from ertools.io.bulk import bulk_states, try_fast_batch
 from ertools.io.decode.posebatch import PoseBatch
 from ertools.io.decode.typestore import Deserializer
 from ertools.io.files import RosbagsFile, open_bag
 from ertools.io.formats import detect_format, find_bags
 from ertools.io.model import POSE_TYPES, Conn
-from ertools.io.reader import _bulk_states, slow_pose_batch
+from ertools.io.reader import slow_pose_batch
 
 POSE_TOPICS = (
     "/fbm3w/robot_at_work/pose",
@@ -189,7 +189,7 @@ def reference_states(path: Path, topic: str) -> tuple[list[int], list[int], list
 def test_bulk_states_equal_rosbags(scene_bag: tuple[str, Path], topic: str) -> None:
     _fmt, path = scene_bag
     with open_bag(path) as bag:
-        bulk = _bulk_states(bag, bag.topic_conns(topic))
+        bulk = bulk_states(bag, bag.topic_conns(topic))
     assert bulk is not None, "bulk state decoder did not apply"
     t, state, payload = reference_states(path, topic)
     assert bulk[0].tolist() == t and bulk[1].tolist() == state and bulk[2] == payload
@@ -204,7 +204,7 @@ def test_bulk_states_on_sample_and_real_bags() -> None:
         for topic in summary(path).topics:
             if topic.msgtype.startswith("rockin_scoring/") and topic.count:
                 with open_bag(path) as bag:
-                    bulk = _bulk_states(bag, bag.topic_conns(topic.name))
+                    bulk = bulk_states(bag, bag.topic_conns(topic.name))
                 assert bulk is not None
                 t, state, payload = reference_states(path, topic.name)
                 assert bulk[0].tolist() == t and bulk[1].tolist() == state and bulk[2] == payload

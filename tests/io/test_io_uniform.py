@@ -16,7 +16,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 from io_bagmaker import FORMATS, Spec, bag_name, write
 from test_io_fastpath import assert_same, fast_batch, reference_batch
 
-from ertools.io import bulk
+from ertools.io import assemble
 from ertools.io.decode.uniform import decode_uniform, layout_of
 
 POSE = (1.5, -2.25, 0.125, 0.0, 0.0, 0.6, 0.8)
@@ -134,18 +134,19 @@ def test_topic_with_a_different_frame_midway_matches_rosbags(fmt: str, tmp_path:
 def test_uniform_decoder_is_used_on_standard_topics(
     scene_bag: tuple[str, Path], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """On a logger's bag (one frame per topic) the one-gather decoder does the work, so the
-    fast-path tests against rosbags exercise it."""
+    """On a logger's bag (one frame per topic) the one-gather decoder does the work (each
+    connection's records gathered once, head and data), so the fast-path tests against
+    rosbags exercise it."""
     used: list[str] = []
-    real = bulk.decode_uniform
+    real = assemble.Decoder.fast
 
-    def spy(msgtype: str, *args: Any, **kwargs: Any) -> Any:
-        out = real(msgtype, *args, **kwargs)
-        if out is not None:
-            used.append(msgtype)
+    def spy(self: Any, *args: Any, **kwargs: Any) -> Any:
+        out = real(self, *args, **kwargs)
+        if out:
+            used.append(self.msgtype)
         return out
 
-    monkeypatch.setattr(bulk, "decode_uniform", spy)
+    monkeypatch.setattr(assemble.Decoder, "fast", spy)
     _fmt, path = scene_bag
     for topic in (
         "/fbm3w/robot_at_work/pose",
