@@ -29,12 +29,17 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
 S = REPO / "sample_bags"
 
-# the interval entry point of each benchmark: (module, attribute) wrapped by a CPU clock
+# the interval code of each benchmark: (module, attribute) wrapped by a CPU clock (an
+# attribute a version does not have is skipped: the trajectory's noise is measured inside
+# trajectory_intervals before issue 39, beside it after)
 ENTRY = {
-    "trajectory": ("ertools.benchmarks.trajectory.scoring", "trajectory_intervals"),
-    "fbm3w": ("ertools.benchmarks.fbm3w.benchmark", "with_intervals"),
-    "fbm2h": ("ertools.benchmarks.fbm2h.benchmark", "with_intervals"),
-    "fbm1": ("ertools.benchmarks.fbm1.benchmark", "fbm1_intervals"),
+    "trajectory": (
+        ("ertools.benchmarks.trajectory.scoring", "trajectory_intervals"),
+        ("ertools.benchmarks.trajectory.scoring", "mocap_sigma"),
+    ),
+    "fbm3w": (("ertools.benchmarks.fbm3w.benchmark", "with_intervals"),),
+    "fbm2h": (("ertools.benchmarks.fbm2h.benchmark", "with_intervals"),),
+    "fbm1": (("ertools.benchmarks.fbm1.benchmark", "fbm1_intervals"),),
 }
 
 
@@ -115,18 +120,25 @@ def child(entry: str, argv: list[str]) -> None:
     import importlib  # lazy: the child's imports are part of what it measures
 
     spent = [0.0]
-    module, name = ENTRY[entry]
-    mod = importlib.import_module(module)
-    inner = getattr(mod, name)
+    depth = [0]  # a wrapped function calling another is timed once
 
-    def timed(*args: Any, **kwargs: Any) -> Any:
-        t0 = time.process_time()
-        try:
-            return inner(*args, **kwargs)
-        finally:
-            spent[0] += time.process_time() - t0
+    def timer(inner: Any) -> Any:
+        def timed(*args: Any, **kwargs: Any) -> Any:
+            depth[0] += 1
+            t0 = time.process_time()
+            try:
+                return inner(*args, **kwargs)
+            finally:
+                depth[0] -= 1
+                if depth[0] == 0:
+                    spent[0] += time.process_time() - t0
 
-    setattr(mod, name, timed)
+        return timed
+
+    for module, name in ENTRY[entry]:
+        mod = importlib.import_module(module)
+        if hasattr(mod, name):
+            setattr(mod, name, timer(getattr(mod, name)))
     from ertools.cli.main import main  # lazy: after the wrapper is in place
 
     code = main([*argv, "--format", "json", "--out", "/dev/null"])

@@ -5,7 +5,8 @@ ertools differs from the 2015 script.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import replace
 
 import numpy as np
 import numpy.typing as npt
@@ -14,9 +15,13 @@ from ertools.arrays import I64
 from ertools.benchmarks import registry
 from ertools.benchmarks.common.clocks import OffsetEstimate, estimate_offset
 from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid, frame_change_warning
-from ertools.benchmarks.common.interval_output import NO_INTERVALS, IntervalSettings
+from ertools.benchmarks.common.interval_output import (
+    NO_INTERVALS,
+    IntervalSettings,
+    ResultIntervals,
+    shares_of,
+)
 from ertools.benchmarks.common.teams import parse_robot_log_name
-from ertools.benchmarks.common.uncertainty import Interval
 from ertools.benchmarks.common.validity import (
     GAP as V_GAP,
 )
@@ -40,9 +45,16 @@ from ertools.benchmarks.trajectory.association import (
     associate_evo,
 )
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
-from ertools.benchmarks.trajectory.intervals import Rescoring, trajectory_intervals
+from ertools.benchmarks.trajectory.intervals import (
+    FITTED_KEYS,
+    FITTED_SUFFIX,
+    MocapSigma,
+    Rescoring,
+    mocap_sigma,
+    trajectory_intervals,
+)
 from ertools.benchmarks.trajectory.metrics import Metrics, metrics
-from ertools.benchmarks.trajectory.result import TrajectoryResult
+from ertools.benchmarks.trajectory.result import FittedScore, TrajectoryResult
 from ertools.benchmarks.trajectory.rules import (
     RULE_ASSOCIATION,
     RULE_BEFORE_GT,
@@ -176,6 +188,10 @@ def score_streams(
                 ns_to_s(at),
                 at,
             )
+        return match_rows(part, at)
+
+    def match_rows(part: PoseStream, at: int | I64) -> Matched:
+        """:func:`associate`, row by row: ``at`` one offset, or one per pose."""
         return associate(
             PoseStream(
                 part.t_ns + at,
@@ -194,8 +210,18 @@ def score_streams(
             gt_order=config.gt_order,
         )
 
-    def rescore(rows: npt.NDArray[np.intp], shift_ns: int) -> Matched:
-        return match(logged.take(rows), offset_ns + shift_ns)
+    def rescoring(at: int) -> Rescoring:
+        """How the intervals' offset draws re-score the comparison around the offset ``at``:
+        all shifts in one association, except evo's (not row by row)."""
+
+        def rescore(rows: npt.NDArray[np.intp], shift_ns: int) -> Matched:
+            return match(logged.take(rows), at + shift_ns)
+
+        def rescore_shifted(rows: npt.NDArray[np.intp], shifts_ns: I64) -> Matched:
+            return match_rows(logged.take(rows), at + shifts_ns)
+
+        shifted = None if config.t_max_diff is not None else rescore_shifted
+        return Rescoring(logged.t_ns + at, rescore, shifted)
 
     matched = match(robot, offset_ns)
     if matched.robot_rows is not None and len(matched.robot_rows) != len(robot):
@@ -304,9 +330,10 @@ def score_streams(
             f"{matched.count(TRACKING_LOST)} robot pose(s) fall where mocap tracking was lost "
             "(repeated GT poses) and are not compared"
         )
-    notes.extend(_audit_warnings(audit, offset_ns))
     iv = NO_INTERVALS
+    fitted: FittedScore | None = None
     if m is not None:
+        sigma = mocap_sigma(timed) if intervals.enabled else None
         iv = trajectory_intervals(
             robot,
             timed,
@@ -316,9 +343,29 @@ def score_streams(
             association=config.association,
             offset_ns=offset_ns,
             settings=intervals,
-            rescoring=Rescoring(logged.t_ns + offset_ns, rescore),
+            rescoring=rescoring(offset_ns),
+            sigma=sigma,
         )
-        notes.extend(_outside_note(_estimates(m), iv.intervals, audit, offset_ns))
+        disagree = audit.offset_ns is not None and audit.disagrees_with(offset_ns)
+        if sigma is not None and audit.offset_ns is not None and disagree:
+            fitted = _at_fitted_offset(
+                logged,
+                timed,
+                audit,
+                audit.offset_ns,
+                match,
+                rescoring,
+                config,
+                intervals,
+                sigma,
+            )
+        if fitted is not None and iv.uncertainty is not None:
+            shares = dict(iv.uncertainty.shares)
+            shares.update(
+                {f"{k}{FITTED_SUFFIX}": v for k, v in shares_of(fitted.intervals).items()}
+            )
+            iv = ResultIntervals(iv.intervals, replace(iv.uncertainty, shares=shares))
+    notes.extend(_audit_warnings(audit, offset_ns, fitted))
     result = TrajectoryResult(
         robot_file=robot_file,
         robot_topic=robot_topic,
@@ -339,6 +386,7 @@ def score_streams(
         unscoreable_reason=problem,
         intervals=iv.intervals,
         uncertainty=iv.uncertainty,
+        fitted=fitted,
         provenance=Provenance(
             inputs=(robot_file, *gt_files),
             parameters=(
@@ -410,21 +458,74 @@ def _estimates(m: Metrics) -> dict[str, float]:
     return out
 
 
-def _audit_warnings(audit: OffsetEstimate, applied_ns: int) -> list[str]:
+def _audit_warnings(
+    audit: OffsetEstimate, applied_ns: int, fitted: FittedScore | None = None
+) -> list[str]:
     if audit.offset_ns is None:
         return [f"clock audit: no offset estimate ({audit.note})"]
     out = []
     sigma = audit.uncertainty_ns or 0
     if audit.disagrees_with(applied_ns):
+        there = ""
+        if fitted is not None and fitted.metrics is not None:
+            iv = fitted.intervals.get("position_error")
+            span = "" if iv is None else f" [{iv.low * 1000:.4g}, {iv.high * 1000:.4g}]"
+            there = (
+                f"; scored there, position_error{FITTED_SUFFIX} is "
+                f"{fitted.metrics.position_error * 1000:.4g}{span} mm (the *{FITTED_SUFFIX} "
+                "keys)"
+            )
         out.append(
             f"clock audit: the robot stamps fit the GT best shifted by "
             f"{ns_to_s(audit.offset_ns):+.3f} +- {ns_to_s(sigma):.3f} s, but the score uses "
-            f"{ns_to_s(applied_ns):+.3f} s; check the clocks, or re-run with "
+            f"{ns_to_s(applied_ns):+.3f} s{there}; check the clocks, or re-run with "
             "--offset auto --apply-offset"
         )
     if audit.note:
         out.append(f"clock audit: {audit.note}")
     return out
+
+
+def _at_fitted_offset(
+    logged: PoseStream,
+    timed: PoseStream,
+    audit: OffsetEstimate,
+    fitted_ns: int,
+    match: Callable[[PoseStream, int], Matched],
+    rescoring: Callable[[int], Rescoring],
+    config: TrajectoryConfig,
+    settings: IntervalSettings,
+    sigma: MocapSigma,
+) -> FittedScore | None:
+    """The statistics of :data:`FITTED_KEYS` at the clock offset the audit fits, with their
+    intervals (centred there): what ``--offset auto --apply-offset`` would score. None where
+    no pose would be compared there, or too few for a score."""
+    matched = match(logged, fitted_ns)
+    robot = logged if matched.robot_rows is None else logged.take(matched.robot_rows)
+    m = metrics(matched)
+    if m is None:
+        return None
+    validity = from_codes(
+        validity_codes(matched, int(timed.t_ns[0])),
+        matched.t_ns,
+        gap_s=ns_to_s(config.max_gap_ns),
+    )
+    if config.t_max_diff is None and too_few(validity) is not None:
+        return None
+    iv = trajectory_intervals(
+        robot,
+        timed,
+        matched,
+        audit,
+        _estimates(m),
+        association=config.association,
+        offset_ns=fitted_ns,
+        settings=settings,
+        rescoring=rescoring(fitted_ns),
+        sigma=sigma,
+    )
+    kept = {k: iv.intervals.get(k) for k in FITTED_KEYS}
+    return FittedScore(fitted_ns, m, kept)
 
 
 def _other_benchmark_gt(robot_file: str, gt_topic: str) -> list[str]:
@@ -438,32 +539,6 @@ def _other_benchmark_gt(robot_file: str, gt_topic: str) -> list[str]:
     return [
         f"the robot log's name says {named.benchmark}, but the GT {gt_topic} is the "
         f"{registry.get(ns).title} arena's: check GT_PATH (or --gt-topic)"
-    ]
-
-
-def _outside_note(
-    estimates: Mapping[str, float],
-    intervals: Mapping[str, Interval | None],
-    audit: OffsetEstimate,
-    applied_ns: int,
-) -> list[str]:
-    """Why a score lies outside its own interval, when it does: the intervals are of the
-    score at the offset the data supports, centred there and not on the one applied (a
-    referee reading ``18.06 mm [17.79, 17.95]`` otherwise sees a contradiction)."""
-    if audit.offset_ns is None or audit.offset_ns == applied_ns:
-        return []
-    outside = [
-        k
-        for k, iv in intervals.items()
-        if iv is not None and "." not in k and not iv.contains(estimates[k])
-    ]
-    if not outside:
-        return []
-    shift = (audit.offset_ns - applied_ns) / 1e6
-    return [
-        f"{', '.join(outside)} outside {'its' if len(outside) == 1 else 'their'} interval: "
-        f"the intervals are of the score at the clock offset the data fits best ({shift:+.1f} "
-        "ms from the one applied); --offset auto --apply-offset scores there"
     ]
 
 
