@@ -39,6 +39,8 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from statistics import NormalDist
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -68,10 +70,17 @@ DEFAULT_D_MIN_REL = 0.10
 # Draws x samples of one batch: bounds the memory of a long run (~8 bytes x a few arrays).
 BATCH_ELEMENTS = 2_000_000
 # Draws x samples of the runs whose d_min rule runs in one pass (padded to the longest): a
-# competition's four runs of ~600 samples x 400 draws in two passes, ~8 MB a pass, so that a
-# score's peak memory stays within 4 MB of the run-by-run pass it replaced.
-GROUP_ELEMENTS = 600_000
-METHOD = "Monte Carlo (parametric bootstrap around the smoothed path, basic interval)"
+# competition's four runs of ~600 samples x 400 draws in one pass, float32 positions and
+# steps, ~13 MB.
+GROUP_ELEMENTS = 1_200_000
+METHOD = (
+    "Monte Carlo (parametric bootstrap around the smoothed path, basic interval; the shares: "
+    "d_min's variance alone at 16 stratified d_mins, the mocap noise's the rest)"
+)
+# d_mins at which the smoothed paths are scored for d_min's share (run_intervals)
+D_MIN_NODES = 16
+TABLE = 4097  # targets the draws interpolate (target_table)
+BLOCK = 64  # samples of Eq. (1) computed at a time (_eq1): 64 x 400 draws, 200 kB an array
 # Quadratic Savitzky-Golay weights over 9 samples, and the variance of noise left after it.
 SMOOTH = np.array([-21.0, 14.0, 39.0, 54.0, 59.0, 54.0, 39.0, 14.0, -21.0]) / 231.0
 HALF = len(SMOOTH) // 2
@@ -191,41 +200,109 @@ def perturbed_runs(
     noisy: bool,
     *,
     budget: int = BATCH_ELEMENTS,
+    antithetic: bool = True,
 ) -> F64:
-    """(D, R) distance errors of every run in every draw: column ``r`` is
-    :func:`perturbed_errors` of ``runs[r]``, with the noise drawn from ``rng`` in the same
-    order (run by run, each run's draws in batches of at most ``budget`` samples).
+    """(D, R) distance errors of every run in every draw (column ``r``: ``runs[r]``).
 
-    The d_min rule is one pass over the samples for as many runs (all their draws side by
-    side) as fit in :data:`GROUP_ELEMENTS` (or ``budget``, if smaller) padded samples.
+    The runs' draws go side by side in groups (run by run, each run's draws in batches of
+    at most ``budget`` samples, as many as fit in :data:`GROUP_ELEMENTS` padded samples);
+    the d_min rule is one pass over the samples of a group. The noise of a group is drawn
+    from ``rng`` at once (when ``noisy``, :func:`_noise`), each draw's scaled by its sigma;
+    a repeated pose takes the noise of the sample it repeats. The positions are complex64
+    x + iy (one array and one operation for both coordinates, the distance ``abs``),
+    relative to each run's first (smoothed) sample: float32 parts resolve a run's metres to
+    0.1 um, against noise of 50 um and d_min of 330 um; lengths add up in float64.
     """
     d = sigmas.size
     out = np.empty((d, len(runs)))
+    tables: dict[int, tuple[npt.NDArray[np.complex64], npt.NDArray[np.complex64]]] = {}
     pieces = [
         (col, lo, min(d, lo + batch))
         for col, run in enumerate(runs)
         for batch in [max(1, budget // max(len(run.xy), 1))]
         for lo in range(0, d, batch)
     ]
+    scratch = _Scratch(
+        max((min(len(runs[c].xy), BLOCK) * (hi - lo) for c, lo, hi in pieces), default=0)
+    )
     for group in _groups(pieces, [len(r.xy) for r in runs], min(budget, GROUP_ELEMENTS)):
         # every piece's draws side by side, samples down the rows (shorter runs padded with
-        # NaN, never kept): the positions are drawn straight into these two arrays
+        # NaN, never kept): the positions are drawn straight into this array
         lengths = [len(runs[col].xy) for col, _, _ in group]
         edges = np.cumsum([0, *(hi - lo for _, lo, hi in group)])
-        xt = np.full((max(lengths), int(edges[-1])), np.nan)
-        yt = np.full_like(xt, np.nan)
+        width, longest = int(edges[-1]), max(lengths)
+        scale = np.concatenate([sigmas[lo:hi] for _, lo, hi in group]).astype(np.float32)
+        if noisy:
+            zt, ref_noise = _noise(rng, longest, np.diff(edges), antithetic)
+            zt *= scale
+            ref_noise *= scale
+        else:
+            zt = np.zeros((longest, width), dtype=np.complex64)
+            ref_noise = np.zeros(width, dtype=np.complex64)
         views = [
-            (xt[:m, a:b].T, yt[:m, a:b].T, slice(a, b), m)
+            (zt[:m, a:b], slice(a, b), m)
             for a, b, m in zip(edges[:-1], edges[1:], lengths, strict=True)
         ]
         refs = [
-            _positions(runs[col], sigmas[lo:hi], rng, noisy, x, y)
-            for (col, lo, hi), (x, y, _, _) in zip(group, views, strict=True)
+            _positions(runs[col], z, ref_noise[cols])
+            for (col, _, _), (z, cols, _) in zip(group, views, strict=True)
         ]
-        kept = _subsample(xt, yt, np.concatenate([d_mins[lo:hi] for _, lo, hi in group]))
-        for (col, lo, hi), (x, y, cols, m), (rx, ry) in zip(group, views, refs, strict=True):
-            out[lo:hi, col] = _eq1(x, y, kept[:m, cols].T, rx, ry, runs[col].shape)
+        for _, cols, m in views:
+            zt[m:, cols] = np.nan  # padding: never kept
+        kept, cum = _subsample(zt, np.concatenate([d_mins[lo:hi] for _, lo, hi in group]))
+        for (col, lo, hi), (z, cols, m), ref in zip(group, views, refs, strict=True):
+            table = tables.get(col)
+            if table is None:
+                table = tables[col] = target_table(runs[col].shape)
+            out[lo:hi, col] = _eq1(z, kept[:m, cols], cum[:m, cols], ref, table, scratch)
     return out
+
+
+def _noise(
+    rng: np.random.Generator, rows: int, widths: IntArr, antithetic: bool
+) -> tuple[npt.NDArray[np.complex64], npt.NDArray[np.complex64]]:
+    """(rows, sum of widths) standard normal noise x + iy of the samples and (sum of
+    widths,) of the references, for pieces of draws side by side.
+
+    Drawn in float32 (x and y side by side read as one complex64 number): the samples'
+    (rows, draws, 2), then the references' (draws, 2). ``antithetic``: each piece's
+    second half of draws is the first half's noise negated (its first ceil(w / 2) draws
+    drawn, the rest their negatives in order): every draw is still exactly the model's,
+    the draws cost half the random numbers, and a score that grows with the noise one way
+    and shrinks the other (FBM3's runs: the correlation of f(z) and f(-z) measured -0.55
+    to -0.94 on the sample) has its quantiles no less precise than from independent draws.
+    A score even in the noise would count a pair as one draw.
+    """
+    total = int(np.sum(widths))
+    if not antithetic:
+        drawn = rng.standard_normal((rows, total, 2), dtype=np.float32)
+        refs = rng.standard_normal((total, 2), dtype=np.float32)
+        return drawn.view(np.complex64)[..., 0], refs.view(np.complex64)[:, 0].copy()
+    halves = [(int(w) + 1) // 2 for w in widths]
+    drawn = rng.standard_normal((rows, sum(halves), 2), dtype=np.float32)
+    refs = rng.standard_normal((sum(halves), 2), dtype=np.float32)
+    half = drawn.view(np.complex64)[..., 0]
+    half_ref = refs.view(np.complex64)[:, 0]
+    out = np.empty((rows, total), dtype=np.complex64)
+    out_ref = np.empty(total, dtype=np.complex64)
+    a = g = 0
+    for w, h in zip(widths.tolist(), halves, strict=True):
+        out[:, a : a + h] = half[:, g : g + h]
+        np.negative(half[:, g : g + w - h], out=out[:, a + h : a + w])
+        out_ref[a : a + h] = half_ref[g : g + h]
+        out_ref[a + h : a + w] = -half_ref[g : g + w - h]
+        a, g = a + w, g + h
+    return out, out_ref
+
+
+def target_table(shape: Shape) -> tuple[npt.NDArray[np.complex64], npt.NDArray[np.complex64]]:
+    """The target x + iy at TABLE evenly spaced l in [0, 1] and each row's step to the next
+    (0 after the last), which the draws interpolate linearly (:func:`_eq1`): for the 2015
+    shapes within 2e-8 m of the curve (the sine's y'' = 2.6 m, times (1 / 4096)^2 / 8); a shape
+    given by points is exact but within 1 / 4096 of l around its corners."""
+    xy = shape(np.linspace(0.0, 1.0, TABLE))
+    t = (xy[:, 0] + 1j * xy[:, 1]).astype(np.complex64)
+    return t, np.diff(t, append=t[-1:]).astype(np.complex64)
 
 
 def _groups(
@@ -247,100 +324,121 @@ def _groups(
     return groups
 
 
-def _positions(
-    run: RunSamples, sigmas: F64, rng: np.random.Generator, noisy: bool, x: F64, y: F64
-) -> tuple[F64, F64]:
-    """One run's perturbed sample positions written into ``x`` and ``y`` (D, N), and the
-    (D,) x and y of its reference; the noise of the samples drawn first (D, measurements,
-    2), then the reference's (D, 2)."""
-    d = sigmas.size
-    n = len(run.xy)
+def origin_of(run: RunSamples) -> F64:
+    """The point the draws' positions are relative to: the run's first (smoothed) sample."""
     xy = run.xy if run.center_xy is None else run.center_xy
-    ref = run.reference_xy if run.center_reference_xy is None else run.center_reference_xy
-    if not noisy:
-        np.add(xy[None, :, 0], 0.0, out=x)
-        np.add(xy[None, :, 1], 0.0, out=y)
-        return np.full(d, ref[0] + 0.0), np.full(d, ref[1] + 0.0)
-    measured = int(run.source.max()) + 1 if n else 0
-    eps = rng.standard_normal((d, measured, 2))
-    if np.any(run.source != np.arange(n)):  # a repeated pose repeats its noise
-        eps = eps[:, run.source, :]
-    eps *= sigmas[:, None, None]
-    ref_eps = rng.standard_normal((d, 2)) * sigmas[:, None]
-    np.add(xy[None, :, 0], eps[:, :, 0], out=x)
-    np.add(xy[None, :, 1], eps[:, :, 1], out=y)
-    return ref[0] + ref_eps[:, 0], ref[1] + ref_eps[:, 1]
+    return np.asarray(xy[0], dtype=np.float64)
 
 
-def _subsample(xt: F64, yt: F64, d_mins: F64) -> Bool:
+def _positions(
+    run: RunSamples, z: npt.NDArray[np.complex64], ref_noise: npt.NDArray[np.complex64]
+) -> npt.NDArray[np.complex128]:
+    """One run's sample positions put into ``z`` (N, D), which holds their noise, as x + iy
+    relative to :func:`origin_of` (a repeated pose repeats the noise of the sample it
+    repeats); the (D,) positions of its reference, whose noise is ``ref_noise``."""
+    origin = origin_of(run)
+    xy = (run.xy if run.center_xy is None else run.center_xy) - origin
+    ref = (
+        run.reference_xy if run.center_reference_xy is None else run.center_reference_xy
+    ) - origin
+    if np.any(run.source != np.arange(len(xy))):
+        z[:] = z[run.source]
+    z += (xy[:, 0] + 1j * xy[:, 1]).astype(np.complex64)[:, None]
+    return np.asarray(complex(ref[0], ref[1]) + ref_noise.astype(np.complex128))
+
+
+def _subsample(zt: npt.NDArray[np.complex64], d_mins: F64) -> tuple[Bool, npt.NDArray[np.float32]]:
     """(N, W) kept flags of the 2015 d_min rule for the W draws side by side in the columns
-    of ``xt``, ``yt`` (N, W), each with its d_min: one pass over the samples, each step
-    vectorised over every draw (the rule is sequential within a draw). NaN is never kept."""
-    n, w = xt.shape
-    d2 = d_mins * d_mins
+    of ``zt`` (N, W), each with its d_min, and the (N, W) length of the kept polyline up to
+    each sample (summed in float64 row by row, sequentially as the 2015 loop did; stored in
+    float32, 6e-8 relative): one pass over the samples, each step vectorised over every
+    draw (the rule is sequential within a draw). NaN is never kept."""
+    n, w = zt.shape
+    d_min = d_mins.astype(np.float32)
     kept = np.zeros((n, w), dtype=bool)
     kept[0] = True
-    lx = xt[0].copy()
-    ly = yt[0].copy()
-    dx = np.empty(w)
-    dy = np.empty(w)
+    cum = np.zeros((n, w), dtype=np.float32)
+    length = np.zeros(w)
+    last = zt[0].copy()
+    dz = np.empty(w, dtype=np.complex64)
+    dist = np.empty(w, dtype=np.float32)
     for j in range(1, n):
-        # dx*dx + dy*dy >= d_min^2 against the last kept point, in place (no temporaries)
-        np.subtract(xt[j], lx, out=dx)
-        np.subtract(yt[j], ly, out=dy)
-        np.multiply(dx, dx, out=dx)
-        np.multiply(dy, dy, out=dy)
-        np.add(dx, dy, out=dx)
-        k = np.greater_equal(dx, d2, out=kept[j])
-        np.copyto(lx, xt[j], where=k)
-        np.copyto(ly, yt[j], where=k)
-    return kept
+        # 2015: sqrt(dx**2 + dy**2) >= D_MIN against the last kept point, in place
+        np.subtract(zt[j], last, out=dz)
+        np.abs(dz, out=dist)
+        k = np.greater_equal(dist, d_min, out=kept[j])
+        np.copyto(last, zt[j], where=k)
+        np.multiply(dist, k, out=dist)  # the step to a kept sample adds to the polyline
+        np.add(length, dist, out=length)
+        cum[j] = length
+    return kept, cum
 
 
-def _eq1(x: F64, y: F64, kept: Bool, rx: F64, ry: F64, shape: Shape) -> F64:
-    """Eq. (1) of every draw from its kept flags (as :func:`~.path.score_path`), on the kept
-    points only: in row-major order each draw's kept points follow one another, its first
-    one (the start, always kept) first. Temporaries are reused (``out=``): on this scale
-    (10^5 kept points per run) fresh arrays cost more in page faults than in arithmetic."""
-    d = x.shape[0]
-    rows, cols = np.nonzero(kept)  # draw by draw (row-major), whatever the layout in memory
-    count = np.bincount(rows, minlength=d)
-    xk, yk = x[rows, cols], y[rows, cols]
-    m = rows.size
-    starts = np.cumsum(count) - count  # each draw's first kept point (column 0)
-    a, b = np.empty(m), np.empty(m)
-    run = np.empty(m)
-    run[0] = 0.0
-    np.subtract(xk[1:], xk[:-1], out=a[1:])
-    np.subtract(yk[1:], yk[:-1], out=b[1:])
-    np.hypot(a[1:], b[1:], out=run[1:])
-    run[starts] = 0.0
-    np.cumsum(run, out=run)  # sequential within each draw, as the 2015 loop
-    cum = np.subtract(run, np.repeat(run[starts], count), out=run)
-    last = starts + count - 1
-    total = np.zeros(d)
-    total[count > 0] = cum[last[count > 0]]
-    x0, y0 = x[:, 0], y[:, 0]
-    yaw = np.arctan2(y0 - ry, x0 - rx)
-    dx = np.subtract(xk, np.repeat(x0, count), out=xk)
-    dy = np.subtract(yk, np.repeat(y0, count), out=yk)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        l_norm = np.divide(cum, np.repeat(total, count), out=cum)
-    np.clip(np.nan_to_num(l_norm, copy=False), 0.0, 1.0, out=l_norm)
-    target = shape(l_norm)
-    c, s = np.repeat(np.cos(yaw), count), np.repeat(np.sin(yaw), count)
-    # the run frame: (c dx + s dy, -s dx + c dy), each minus the target
-    np.multiply(c, dx, out=a)
-    a += np.multiply(s, dy, out=b)
-    a -= target[:, 0]
-    np.multiply(c, dy, out=b)
-    b -= np.multiply(s, dx, out=c)
-    b -= target[:, 1]
-    err = np.hypot(a, b, out=a)
-    err[starts] = 0.0  # 2015 started its sum at the second kept point
-    out = np.bincount(rows, weights=err, minlength=d) / np.maximum(count, 1)
-    bad = (count < 2) | ~(total > 0) | ((x0 == rx) & (y0 == ry))
-    return np.where(bad, np.nan, out)
+class _Scratch:
+    """Work arrays of :func:`_eq1`, allocated once for every piece of a call: fresh
+    arrays of megabytes cost more in page faults than the arithmetic on them."""
+
+    def __init__(self, size: int) -> None:
+        self.real = np.empty(size, dtype=np.float32)
+        self.other = np.empty(size, dtype=np.float32)
+        self.index = np.empty(size, dtype=np.intp)
+        self.target = np.empty(size, dtype=np.complex64)
+        self.work = np.empty(size, dtype=np.complex64)
+
+    def shaped(self, m: int, w: int) -> tuple[Any, ...]:
+        n = m * w
+        return tuple(
+            a[:n].reshape(m, w) for a in (self.real, self.other, self.index, self.target, self.work)
+        )
+
+
+def _eq1(
+    z: npt.NDArray[np.complex64],
+    kept: Bool,
+    cum: npt.NDArray[np.float32],
+    ref: npt.NDArray[np.complex128],
+    table: tuple[npt.NDArray[np.complex64], npt.NDArray[np.complex64]],
+    scratch: _Scratch | None = None,
+) -> F64:
+    """Eq. (1) of every draw (column) from its kept flags and polyline lengths (as
+    :func:`~.path.score_path`), the target at l/L interpolated in ``table``
+    (:func:`target_table`); the errors are computed at every sample and summed where kept
+    (whole arrays: faster than gathering the kept points), :data:`BLOCK` samples at a time
+    in ``scratch``'s arrays (kept in the CPU's cache from one operation to the next)."""
+    m, w = z.shape
+    work = scratch if scratch is not None else _Scratch(min(m, BLOCK) * w)
+    total = cum[m - 1]
+    # l / L in table rows: cum <= total, so the row is at most the last (its step is 0)
+    scale = np.zeros_like(total)
+    np.divide(np.float32(TABLE - 1), total, out=scale, where=total > 0)
+    # the run frame: origin at the start, x along reference -> start (turn by -yaw)
+    start = z[0]
+    axis = start.astype(np.complex128) - ref
+    turn = (np.conj(axis) / np.abs(axis)).astype(np.complex64)
+    sums = np.zeros(w)
+    for lo in range(0, m, BLOCK):
+        hi = min(m, lo + BLOCK)
+        at, row, index, target, moved = work.shaped(hi - lo, w)
+        np.multiply(cum[lo:hi], scale, out=at)
+        np.floor(at, out=row)
+        at -= row
+        np.copyto(index, row, casting="unsafe")
+        np.take(table[0], index, out=target)
+        np.take(table[1], index, out=moved)
+        moved *= at
+        target += moved
+        np.subtract(z[lo:hi], start, out=moved)
+        moved *= turn
+        moved -= target
+        err = np.abs(moved, out=row)
+        err *= kept[lo:hi]
+        if lo == 0:
+            err[0] = 0.0  # 2015 started its sum at the second kept point (row 0: the start)
+        sums += err.sum(axis=0, dtype=np.float64)
+    count = np.count_nonzero(kept, axis=0)
+    out = sums / np.maximum(count, 1)
+    bad = (count < 2) | ~(total > 0) | (axis == 0)
+    return np.asarray(np.where(bad, np.nan, out), dtype=np.float64)
 
 
 def run_intervals(
@@ -363,13 +461,17 @@ def run_intervals(
     est = [float(estimates[i]) for i in scored]  # type: ignore[arg-type]
     est.append(min(est))
 
-    # the smoothed paths' own scores: each draw's shift from them is added to the score
     chosen: list[RunSamples] = [r for i in scored if (r := runs[i]) is not None]
-    centers = perturbed_runs(
-        chosen, np.zeros(1), np.full(1, model.d_min), np.random.default_rng(0), False
-    )[0]
-    shift = np.asarray(est[:-1]) - centers
-    shift_best = est[-1] - float(np.min(centers))
+    # Columns that ride along in the draws' d_min pass (sigma 0: the smoothed paths as
+    # they are): the smoothed paths' own scores at d_min, from which each draw's shift is
+    # added to the score, and at D_MIN_NODES equally likely d_mins (the normal's quantiles
+    # at the midpoints of as many equal slices: a stratified draw of d_min's one
+    # dimension) for d_min's share, instead of a pass of draws of its own.
+    nodes = np.array([NormalDist().inv_cdf((k + 0.5) / D_MIN_NODES) for k in range(D_MIN_NODES)])
+    extra_d_mins = np.concatenate(
+        [[model.d_min], model.d_min * np.maximum(0.0, 1.0 + model.d_min_rel * nodes)]
+    )
+    along: dict[str, F64] = {}
 
     def perturbed(rng: np.random.Generator, sources: frozenset[str], n: int) -> F64:
         z_sigma = rng.standard_normal(n)
@@ -380,20 +482,51 @@ def run_intervals(
         d_mins = np.full(n, model.d_min)
         if D_MIN in sources:
             d_mins = model.d_min * np.maximum(0.0, 1.0 + model.d_min_rel * z_dmin)
-        out = np.empty((n, len(scored) + 1))
-        out[:, :-1] = perturbed_runs(chosen, sigmas, d_mins, rng, MOCAP_NOISE in sources)
+        raw = perturbed_runs(
+            chosen,
+            np.concatenate([sigmas, np.zeros(extra_d_mins.size)]),
+            np.concatenate([d_mins, extra_d_mins]),
+            rng,
+            MOCAP_NOISE in sources,
+        )
+        centers = raw[n]
+        shift = np.asarray(est[:-1]) - centers
+        shift_best = est[-1] - float(np.min(centers))
+        out = np.empty((raw.shape[0], len(scored) + 1))
         # the best run of each draw; NaN when one of its runs could not be scored
-        best = np.min(out[:, :-1], axis=1) + shift_best
-        out[:, :-1] += shift
-        out[:, -1] = best
-        return out
+        out[:, -1] = np.min(raw, axis=1) + shift_best
+        out[:, :-1] = raw + shift
+        along["d_min"] = _nanvar(out[n + 1 :])
+        return out[:n]
+
+    def d_min_alone() -> F64:
+        """The scores' variance with d_min alone perturbed (the stratified d_mins of the
+        together pass)."""
+        return along["d_min"]
 
     names = tuple(s.name for s in model.sources)
-    ivs = monte_carlo(est, perturbed, names, draws=draws, seed=seed, confidence=confidence)
+    # the mocap noise's share: what the together pass's variance leaves over d_min's
+    ivs = monte_carlo(
+        est,
+        perturbed,
+        names,
+        draws=draws,
+        seed=seed,
+        confidence=confidence,
+        alone_variance={D_MIN: d_min_alone},
+    )
     per_run: list[Interval | None] = [None] * len(runs)
     for col, i in enumerate(scored):
         per_run[i] = ivs[col]
     return per_run, ivs[-1]
+
+
+def _nanvar(values: F64) -> F64:
+    """(S,) variance of each column's finite values (0 with fewer than two)."""
+    var = np.zeros(values.shape[1])
+    finite = np.sum(np.isfinite(values), axis=0) >= 2
+    var[finite] = np.nanvar(values[:, finite], axis=0)
+    return var
 
 
 def uncertainty_block(
