@@ -361,11 +361,15 @@ def _subsample(zt: npt.NDArray[np.complex64], d_mins: F64) -> tuple[Bool, npt.ND
     length = np.zeros(w)
     last = zt[0].copy()
     dz = np.empty(w, dtype=np.complex64)
+    parts = dz.view(np.float32)  # x, y, x, y...
     dist = np.empty(w, dtype=np.float32)
     for j in range(1, n):
-        # 2015: sqrt(dx**2 + dy**2) >= D_MIN against the last kept point, in place
+        # 2015: sqrt(dx**2 + dy**2) >= D_MIN against the last kept point, in place; in
+        # real arithmetic (IEEE: the same bits on every CPU, unlike NumPy's complex abs)
         np.subtract(zt[j], last, out=dz)
-        np.abs(dz, out=dist)
+        np.multiply(parts, parts, out=parts)
+        np.add(parts[0::2], parts[1::2], out=dist)
+        np.sqrt(dist, out=dist)
         k = np.greater_equal(dist, d_min, out=kept[j])
         np.copyto(last, zt[j], where=k)
         np.multiply(dist, k, out=dist)  # the step to a kept sample adds to the polyline
@@ -379,17 +383,18 @@ class _Scratch:
     arrays of megabytes cost more in page faults than the arithmetic on them."""
 
     def __init__(self, size: int) -> None:
-        self.real = np.empty(size, dtype=np.float32)
-        self.other = np.empty(size, dtype=np.float32)
-        self.index = np.empty(size, dtype=np.intp)
-        self.target = np.empty(size, dtype=np.complex64)
-        self.work = np.empty(size, dtype=np.complex64)
+        self.arrays = (
+            np.empty(size, dtype=np.float32),
+            np.empty(size, dtype=np.float32),
+            np.empty(size, dtype=np.float32),
+            np.empty(size, dtype=np.intp),
+            np.empty(size, dtype=np.complex64),
+            np.empty(size, dtype=np.complex64),
+        )
 
     def shaped(self, m: int, w: int) -> tuple[Any, ...]:
         n = m * w
-        return tuple(
-            a[:n].reshape(m, w) for a in (self.real, self.other, self.index, self.target, self.work)
-        )
+        return tuple(a[:n].reshape(m, w) for a in self.arrays)
 
 
 def _eq1(
@@ -411,26 +416,44 @@ def _eq1(
     # l / L in table rows: cum <= total, so the row is at most the last (its step is 0)
     scale = np.zeros_like(total)
     np.divide(np.float32(TABLE - 1), total, out=scale, where=total > 0)
-    # the run frame: origin at the start, x along reference -> start (turn by -yaw)
+    # the run frame: origin at the start, x along reference -> start: turned by -yaw
     start = z[0]
     axis = start.astype(np.complex128) - ref
-    turn = (np.conj(axis) / np.abs(axis)).astype(np.complex64)
+    norm = np.sqrt(axis.real**2 + axis.imag**2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        c, s = (axis.real / norm).astype(np.float32), (axis.imag / norm).astype(np.float32)
     sums = np.zeros(w)
+    # real arithmetic on the complex arrays' x and y: NumPy's complex multiply and abs
+    # differ in the last bit between CPUs (AVX2 or not), its float add, multiply and sqrt
+    # do not
     for lo in range(0, m, BLOCK):
         hi = min(m, lo + BLOCK)
-        at, row, index, target, moved = work.shaped(hi - lo, w)
+        at, row, err, index, target, moved = work.shaped(hi - lo, w)
         np.multiply(cum[lo:hi], scale, out=at)
         np.floor(at, out=row)
         at -= row
         np.copyto(index, row, casting="unsafe")
         np.take(table[0], index, out=target)
         np.take(table[1], index, out=moved)
-        moved *= at
+        step = moved.view(np.float32).reshape(hi - lo, w, 2)
+        step *= at[..., None]
         target += moved
         np.subtract(z[lo:hi], start, out=moved)
-        moved *= turn
-        moved -= target
-        err = np.abs(moved, out=row)
+        mx, my = moved.real, moved.imag
+        tx, ty = target.real, target.imag
+        # run frame x = c mx + s my - tx, y = c my - s mx - ty, each into its own array
+        np.multiply(mx, c, out=at)
+        np.multiply(my, s, out=row)
+        at += row
+        at -= tx
+        np.multiply(my, c, out=row)
+        np.multiply(mx, s, out=err)
+        row -= err
+        row -= ty
+        np.multiply(at, at, out=at)
+        np.multiply(row, row, out=row)
+        np.add(at, row, out=err)
+        np.sqrt(err, out=err)
         err *= kept[lo:hi]
         if lo == 0:
             err[0] = 0.0  # 2015 started its sum at the second kept point (row 0: the start)
