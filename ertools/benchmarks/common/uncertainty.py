@@ -236,6 +236,9 @@ def monte_carlo(
     ``k`` = 0 for all sources together and 1.. for each source alone, whatever the order of
     the scores. ``nonnegative`` clips the low end at 0 for scores that cannot be negative
     (a distance): the truth is in the clipped interval whenever it was in the unclipped one.
+    Every interval holds its score (a referee reads it as that score's): where the basic
+    interval would lie wholly on one side of it (a bias larger than the spread: a score of
+    noise alone), it is widened to the score, which can only add coverage.
 
     Returns one Interval per score, None where the score is not finite or the draws do not
     give one.
@@ -272,7 +275,11 @@ def monte_carlo(
             out.append(None)
             continue
         lo = max(0.0, float(low[i])) if nonnegative else float(low[i])
-        out.append(Interval(lo, max(lo, float(high[i])), _shares(names, variances, i)))
+        hi = max(lo, float(high[i]))
+        # an interval holds its score: where the draws' bias is larger than their spread
+        # (a score all noise), the reflected interval would pass it; it reaches it instead
+        lo, hi = min(lo, float(est[i])), max(hi, float(est[i]))
+        out.append(Interval(lo, hi, _shares(names, variances, i)))
     return out
 
 
