@@ -6,9 +6,11 @@ this script: it wraps the benchmark's interval entry point with a CPU clock, run
 command in-process (``ertools.cli.main.main``) and prints the interval time and the
 process's CPU time since it started (imports included, as a user's command pays them).
 The table gives the medians, the command with ``--draws 0`` beside, and the intervals'
-share of the default command.
+share of the default command; ``--before`` measures another checkout's code (a worktree of
+the main branch) in the same run, interleaved.
 
     .venv/bin/python bench/intervals_cost.py [--runs N] [--hour DIR] [--only NAME ...]
+        [--before CHECKOUT] [--json FILE]
 
 ``--hour DIR`` holds ``gt_hour.bag`` and ``robot_hour.bag`` (bench/data.py's hour; written
 there when missing). Nothing here is a test: `make test` never runs it.
@@ -18,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
@@ -146,11 +149,17 @@ def child(entry: str, argv: list[str]) -> None:
     print(json.dumps({"exit": code, "interval_s": spent[0], "total_s": total}))
 
 
-def run_child(entry: str, argv: list[str]) -> dict[str, float]:
+def run_child(entry: str, argv: list[str], code: Path | None = None) -> dict[str, float]:
+    """One child run; ``code``: the checkout whose ertools it imports (PYTHONPATH; None:
+    this one's)."""
+    env = dict(os.environ)
+    if code is not None:
+        env["PYTHONPATH"] = str(code)
     done = subprocess.run(
         [sys.executable, str(Path(__file__)), "--child", entry, *argv],
         capture_output=True,
         cwd=REPO,
+        env=env,
         check=False,
     )
     lines = done.stdout.decode().strip().splitlines()
@@ -203,26 +212,42 @@ def main() -> int:
     ap.add_argument("--hour", type=Path, default=REPO / "build" / "bench" / "intervals")
     ap.add_argument("--only", nargs="*", default=None)
     ap.add_argument("--json", type=Path, default=None)
+    ap.add_argument(
+        "--before",
+        type=Path,
+        default=None,
+        help="another checkout (e.g. a worktree of main) measured in the same run",
+    )
     args = ap.parse_args()
     ensure_hour(args.hour)
     fbm1w = ensure_fbm1w(args.hour)
     rows = []
-    print(
-        "| case | default command CPU s | of which intervals s | share | --draws 0 CPU s |\n"
-        "|---|---:|---:|---:|---:|"
-    )
+    versions: list[tuple[str, Path | None]] = [("after", None)]
+    if args.before is not None:
+        versions.insert(0, ("before", args.before.resolve()))
+    head = " | ".join(f"{v}: command CPU s | {v}: intervals s | {v}: share" for v, _ in versions)
+    print(f"| case | {head} | --draws 0 CPU s |")
+    print("|---|" + "---:|" * (3 * len(versions) + 1))
     for name, (entry, argv) in cases(args.hour, fbm1w).items():
         if args.only and name not in args.only:
             continue
-        full, none = [], []
-        for _ in range(args.runs):  # interleaved: the machine's load hits both alike
-            full.append(run_child(entry, argv))
+        got: dict[str, list[dict[str, float]]] = {v: [] for v, _ in versions}
+        none = []
+        for _ in range(args.runs):  # interleaved: the machine's load hits all alike
+            for v, code in versions:
+                got[v].append(run_child(entry, argv, code))
             none.append(run_child(entry, [*argv, "--draws", "0"]))
-        total = statistics.median(r["total_s"] for r in full)
-        iv = statistics.median(r["interval_s"] for r in full)
+        row: dict[str, Any] = {"case": name}
+        cells = []
+        for v, _ in versions:
+            total = statistics.median(r["total_s"] for r in got[v])
+            iv = statistics.median(r["interval_s"] for r in got[v])
+            row[v] = {"total_s": total, "interval_s": iv}
+            cells.append(f"{total:.3f} | {iv:.3f} | {iv / total:.1%}")
         bare = statistics.median(r["total_s"] for r in none)
-        rows.append({"case": name, "total_s": total, "interval_s": iv, "draws0_s": bare})
-        print(f"| {name} | {total:.3f} | {iv:.3f} | {iv / total:.1%} | {bare:.3f} |", flush=True)
+        row["draws0_s"] = bare
+        rows.append(row)
+        print(f"| {name} | {' | '.join(cells)} | {bare:.3f} |", flush=True)
     if args.json:
         args.json.write_text(json.dumps(rows, indent=1))
     return 0
