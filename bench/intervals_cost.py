@@ -174,8 +174,8 @@ def ensure_hour(folder: Path) -> None:
     if (folder / "gt_hour.bag").exists() and (folder / "robot_hour.bag").exists():
         return
     sys.path.insert(0, str(HERE))
-    from bagwrite import write_ros1
-    from data import T0, gt_topics, robot_topics
+    from bagwrite import write_ros1  # lazy: bench/'s writer, only to write the hour once
+    from data import T0, gt_topics, robot_topics  # lazy: as above
 
     folder.mkdir(parents=True, exist_ok=True)
     write_ros1(folder / "gt_hour.bag", gt_topics(T0, 3600, seed=1))
@@ -188,9 +188,9 @@ def ensure_fbm1w(folder: Path) -> Path:
     if path.exists():
         return path
     from ertools.samples import fbm1  # lazy: only to write the log once
-    from ertools.samples.mocap import publish_environment, publish_mocap
-    from ertools.samples.statemachine import publish_states
-    from ertools.samples.writer import BagWriter
+    from ertools.samples.mocap import publish_environment, publish_mocap  # lazy: as above
+    from ertools.samples.statemachine import publish_states  # lazy: as above
+    from ertools.samples.writer import BagWriter  # lazy: as above
 
     sim = fbm1.simulate(0)
     with BagWriter(path, "ros1") as bag:
