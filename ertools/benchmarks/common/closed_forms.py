@@ -14,8 +14,9 @@ Fisher). The derivations and their assumptions are in docs/uncertainty.md ("Clos
 - :func:`angle_moments`: ``|sin x|`` (or 2015's unwrapped ``sign(x) sin x``) and ``cos x``
   of a noisy angle ``x``, the terms of ``atan2(sum sin|x|, sum cos|x|)``.
 - :func:`mean_moments`, :func:`circular_mean_moments`: those summed over the poses.
-- :func:`order_band`: the poses whose noise can move an order statistic (max, percentiles),
-  so that draws perturb only them.
+
+What has no closed form worth its risk (the order statistics) is drawn
+(:mod:`ertools.benchmarks.common.draws`).
 
 Pure NumPy (no SciPy on the trajectory's import path): erf is taken from :mod:`math` for
 the few arguments where it is not 1 to double precision.
@@ -28,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ertools.arrays import F64, IntArr
+from ertools.arrays import F64
 
 SQRT_2_PI = math.sqrt(2.0 / math.pi)
 INV_SQRT_2PI = 1.0 / math.sqrt(2.0 * math.pi)
@@ -252,30 +253,3 @@ def circular_mean_moments(m: AngleMoments) -> SumMoments:
         return SumMoments(math.atan2(a, b), 0.0, 0.0)
     var = b * b * float(np.sum(va)) + a * a * float(np.sum(vb)) - 2 * a * b * float(np.sum(cab))
     return SumMoments(math.atan2(a, b), max(var, 0.0) / r2**2, 0.0)
-
-
-# Noise of more than this many sigma (chi with 3 degrees of freedom: P = 1e-10) is taken as
-# never drawn when choosing the poses that can move an order statistic.
-BAND_SIGMAS = 7.0
-
-
-def order_band(values: F64, bound: F64, ranks: IntArr) -> tuple[IntArr, IntArr]:
-    """The poses whose perturbation can move the order statistics of ``ranks`` (0-based
-    ranks of ``values``' ascending order), and those ranks among them.
-
-    Each value moves by at most its ``bound`` in any draw, so an order statistic moves by at
-    most B = max(bound). A value whose upper bound stays below the lowest rank's statistic
-    minus B is below every wanted statistic in every draw: it only shifts the ranks by one.
-    One whose lower bound stays above the highest rank's statistic plus B never reaches
-    them. Returns (indices of the other values, ``ranks`` minus the count of values always
-    below).
-    """
-    v = np.asarray(values, dtype=np.float64)
-    b = np.asarray(bound, dtype=np.float64)
-    order = np.sort(v)
-    reach = float(np.max(b)) if b.size else 0.0
-    lo = order[int(np.min(ranks))] - reach
-    hi = order[int(np.max(ranks))] + reach
-    below = v + b < lo
-    keep = np.flatnonzero(~below & (v - b <= hi))
-    return keep, np.asarray(ranks, dtype=np.intp) - int(np.count_nonzero(below))

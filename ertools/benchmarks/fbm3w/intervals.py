@@ -46,6 +46,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, Bool, IntArr
+from ertools.benchmarks.common.draws import normal_pairs
 from ertools.benchmarks.common.uncertainty import (
     D_MIN,
     MOCAP_NOISE,
@@ -207,8 +208,9 @@ def perturbed_runs(
     The runs' draws go side by side in groups (run by run, each run's draws in batches of
     at most ``budget`` samples, as many as fit in :data:`GROUP_ELEMENTS` padded samples);
     the d_min rule is one pass over the samples of a group. The noise of a group is drawn
-    from ``rng`` at once (when ``noisy``, :func:`_noise`), each draw's scaled by its sigma;
-    a repeated pose takes the noise of the sample it repeats. The positions are complex64
+    from ``rng`` at once (when ``noisy``: :func:`~ertools.benchmarks.common.draws.
+    normal_pairs`), each draw's scaled by its sigma; a repeated pose takes the noise of the
+    sample it repeats. The positions are complex64
     x + iy (one array and one operation for both coordinates, the distance ``abs``),
     relative to each run's first (smoothed) sample: float32 parts resolve a run's metres to
     0.1 um, against noise of 50 um and d_min of 330 um; lengths add up in float64.
@@ -233,7 +235,7 @@ def perturbed_runs(
         width, longest = int(edges[-1]), max(lengths)
         scale = np.concatenate([sigmas[lo:hi] for _, lo, hi in group]).astype(np.float32)
         if noisy:
-            zt, ref_noise = _noise(rng, longest, np.diff(edges), antithetic)
+            zt, ref_noise = normal_pairs(rng, longest, np.diff(edges), antithetic)
             zt *= scale
             ref_noise *= scale
         else:
@@ -256,43 +258,6 @@ def perturbed_runs(
                 table = tables[col] = target_table(runs[col].shape)
             out[lo:hi, col] = _eq1(z, kept[:m, cols], cum[:m, cols], ref, table, scratch)
     return out
-
-
-def _noise(
-    rng: np.random.Generator, rows: int, widths: IntArr, antithetic: bool
-) -> tuple[npt.NDArray[np.complex64], npt.NDArray[np.complex64]]:
-    """(rows, sum of widths) standard normal noise x + iy of the samples and (sum of
-    widths,) of the references, for pieces of draws side by side.
-
-    Drawn in float32 (x and y side by side read as one complex64 number): the samples'
-    (rows, draws, 2), then the references' (draws, 2). ``antithetic``: each piece's
-    second half of draws is the first half's noise negated (its first ceil(w / 2) draws
-    drawn, the rest their negatives in order): every draw is still exactly the model's,
-    the draws cost half the random numbers, and a score that grows with the noise one way
-    and shrinks the other (FBM3's runs: the correlation of f(z) and f(-z) measured -0.55
-    to -0.94 on the sample) has its quantiles no less precise than from independent draws.
-    A score even in the noise would count a pair as one draw.
-    """
-    total = int(np.sum(widths))
-    if not antithetic:
-        drawn = rng.standard_normal((rows, total, 2), dtype=np.float32)
-        refs = rng.standard_normal((total, 2), dtype=np.float32)
-        return drawn.view(np.complex64)[..., 0], refs.view(np.complex64)[:, 0].copy()
-    halves = [(int(w) + 1) // 2 for w in widths]
-    drawn = rng.standard_normal((rows, sum(halves), 2), dtype=np.float32)
-    refs = rng.standard_normal((sum(halves), 2), dtype=np.float32)
-    half = drawn.view(np.complex64)[..., 0]
-    half_ref = refs.view(np.complex64)[:, 0]
-    out = np.empty((rows, total), dtype=np.complex64)
-    out_ref = np.empty(total, dtype=np.complex64)
-    a = g = 0
-    for w, h in zip(widths.tolist(), halves, strict=True):
-        out[:, a : a + h] = half[:, g : g + h]
-        np.negative(half[:, g : g + w - h], out=out[:, a + h : a + w])
-        out_ref[a : a + h] = half_ref[g : g + h]
-        out_ref[a + h : a + w] = -half_ref[g : g + w - h]
-        a, g = a + w, g + h
-    return out, out_ref
 
 
 def target_table(shape: Shape) -> tuple[npt.NDArray[np.complex64], npt.NDArray[np.complex64]]:

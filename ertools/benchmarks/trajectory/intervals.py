@@ -1,55 +1,27 @@
-"""Confidence intervals of the trajectory statistics (issues 28 and 39).
+"""Confidence intervals of the trajectory statistics (issues 28 and 39; the model and its
+derivations: docs/uncertainty.md, "Trajectory" and "Closed forms").
 
-Every statistic of :mod:`ertools.benchmarks.trajectory.metrics` (the mean 3D distance, RMSE,
-median, max and percentiles, the orientation errors) gets the interval of its value under two
-sources of uncertainty on the GT side of each compared pair:
+Every statistic of :mod:`ertools.benchmarks.trajectory.metrics` gets the interval of its
+value under two sources of uncertainty on the GT side of each compared pair:
 
-- ``mocap_noise``: each GT pose used carries the mocap's measurement noise, sigma per axis
-  measured from the GT stream itself: from its stationary phases as ``ertools noise
-  --stationary auto`` finds them (epsilon -> sigma), else from the second differences of the
-  moving stream (at 120 Hz the motion's own second difference is hundredths of a millimetre;
-  the noise's is sqrt(6) sigma: a robust MAD of them gives sigma), else a stated default. The
-  yaw's sigma likewise from the yaw's second differences. An interpolated GT pose mixes two
-  samples: its noise is sigma sqrt((1-a)^2 + a^2).
-- ``time_association``: the robot-to-GT clock offset is known to the standard error of the
-  least-squares offset, the robot's correlated error slid along the path by every lag
-  (:func:`offset_spread`): one offset error per draw, common to every pose, centred on the
-  offset applied (the interval is the score's, whatever offset it was scored at; where the
-  data fits another offset, the score there is reported beside with its own interval). The
-  offset is not a measurement of the truth plus an error that a draw adds a second time: the
-  true offset lies around the applied one as the draws do, so the score at a drawn offset is
-  itself a draw of the true score (with ``--offset auto`` the applied offset minimises the
-  error: every other offset, the true one included, scores higher). Its draws are mirrored
-  about the score before the engine's reflection, and added to the measurement-like draws
-  (their interaction neglected). At each shift of a grid the comparison is re-scored by the
-  score's own association and metrics (:class:`Rescoring`, :func:`offset_effects`, all
-  shifts in one association where it works row by row): a pose the shift moves into a
-  tracking loss or a GT gap leaves the comparison, one it moves out of them enters it, one
-  moved next to a loss's stale sample is compared with it, as the score at that offset would.
-  With ``hold`` (2015) the GT pose compared was measured up to one GT frame period before
-  the robot's moment, with ``nearest`` up to half a period either side: an extra lag uniform
-  over the pose's own frame period. ``linear`` interpolates: no frame-period term.
+- ``mocap_noise``: sigma per axis (and the yaw's) measured from the GT stream itself
+  (:func:`mocap_sigma`: its stationary phases, else its second differences); an
+  interpolated GT pose mixes two samples: sigma sqrt((1-a)^2 + a^2).
+- ``time_association``: the clock offset, known to the standard error of the least-squares
+  offset (:func:`offset_spread`), one error per draw centred on the offset applied (the
+  interval is the score's; where the data fits another offset, the score there is reported
+  beside with its own). The score at a drawn offset is itself a draw of the true score: its
+  draws are mirrored about the score before the engine's reflection and added to the
+  measurement-like draws. The comparison is re-scored by the score's own association at a
+  grid of shifts (:class:`Rescoring`, :func:`offset_effects`), so that poses entering or
+  leaving a tracking loss or a GT gap are counted as the score at that offset would. With
+  ``hold`` or ``nearest``, also a lag uniform over the pose's own GT frame period.
 
-How each statistic's measurement-like part (noise, frame lag) is obtained (docs/
-uncertainty.md, "Closed forms"):
-
-- the mean distance, the RMSE and the two circular means are sums of independent per-pose
-  terms: their distribution follows from the per-pose moments in closed form (a noncentral
-  chi distribution with 3 degrees of freedom for a noisy distance, its square a noncentral
-  chi-square; the delta method for the circular mean; a uniform lag's mixture by Gauss-
-  Legendre nodes), normal with a Cornish-Fisher skewness correction
-  (:mod:`ertools.benchmarks.common.closed_forms`). One draw of it per Monte Carlo draw keeps
-  the engine's basic interval and shares.
-- the max and the percentiles are drawn, but only on the poses whose noise can move them
-  (:func:`~ertools.benchmarks.common.closed_forms.order_band`: the others stay on their side
-  of the order statistic in every draw), in float32: the errors are differences of at most
-  metres, resolved to a tenth of a micrometre, against noise of tenths of a millimetre. A
-  comparison of more than :data:`MAX_POSES` poses draws its percentiles on that many poses
-  spread evenly over it (wider than all the poses would give: conservative); the max on all
-  of them.
-
-The interval is the engine's basic bootstrap: noise makes a distance longer on average (the
-RMSE of a perfect robot is sqrt(3) sigma, not 0) and the reflection removes the bias.
+The measurement-like part of the mean distance, the RMSE and the two circular means comes
+from their closed-form distribution (:mod:`ertools.benchmarks.common.closed_forms`, one draw
+of it per Monte Carlo draw); the max and the percentiles are drawn on the poses that can
+move them only (:mod:`ertools.benchmarks.common.draws`), the percentiles of a comparison of
+more than :data:`MAX_POSES` poses on that many spread evenly over it (conservative).
 """
 
 from __future__ import annotations
@@ -65,7 +37,6 @@ import numpy.typing as npt
 from ertools.arrays import F64, I64, IntArr
 from ertools.benchmarks.common.clocks import OffsetEstimate
 from ertools.benchmarks.common.closed_forms import (
-    BAND_SIGMAS,
     AngleMoments,
     Raw,
     angle_moments,
@@ -76,7 +47,14 @@ from ertools.benchmarks.common.closed_forms import (
     lag_nodes,
     mean_moments,
     mix_angles,
-    order_band,
+)
+from ertools.benchmarks.common.draws import (
+    BAND_SIGMAS,
+    Distances,
+    OrderStat,
+    draw_order_stats,
+    order_stats,
+    percentile_rows,
 )
 from ertools.benchmarks.common.interval_output import (
     METHOD,
@@ -95,7 +73,7 @@ from ertools.benchmarks.common.uncertainty import (
 )
 from ertools.benchmarks.noise.benchmark import noise_from_stream
 from ertools.benchmarks.trajectory.association import COMPARED, Matched
-from ertools.benchmarks.trajectory.metrics import PERCENTILES, Metrics
+from ertools.benchmarks.trajectory.metrics import PERCENTILES
 from ertools.errors import ErtoolsError
 from ertools.geometry import wrap_angle, yaw_from_quat
 from ertools.streams import PoseStream
@@ -113,7 +91,6 @@ DEFAULT_SIGMA_M = 3e-4
 DEFAULT_SIGMA_RAD = math.radians(0.05)
 MIN_PAIRS = 50  # stationary pairs (or second differences) needed to measure sigma
 VELOCITY_HALF_SPAN = 5  # GT samples either side of a pose for its velocity (~40 ms at 120 Hz)
-CHUNK_ELEMENTS = 4_000_000  # draws x poses per chunk of the order statistics' draws
 # Longer comparisons draw their percentiles on this many evenly spread poses (module doc),
 # and re-score the offset's grid on MAX_GRID_POSES robot poses: the grid's statistics are
 # averages of per-pose changes that 1,000 poses spread over the log measure to a few percent
@@ -165,24 +142,6 @@ class Rescoring:
     t_ns: IntArr
     associate: Callable[[npt.NDArray[np.intp], int], Matched]
     associate_shifted: Callable[[npt.NDArray[np.intp], I64], Matched] | None = None
-
-
-def _statistics(m: Metrics | None) -> F64 | None:
-    """The statistics of :data:`KEYS` in order (None: no pose compared)."""
-    if m is None:
-        return None
-    pct = [v for _, v in m.percentiles]
-    return np.array(
-        [
-            m.position_error,
-            m.orientation_error,
-            m.rmse,
-            m.median,
-            m.max,
-            *pct,
-            m.orientation_error_2015,
-        ]
-    )
 
 
 @dataclass(frozen=True)
@@ -354,17 +313,6 @@ def _rescored_rows(t_robot: IntArr, t_gt: IntArr, reach_s: float) -> npt.NDArray
     return rows
 
 
-def _percentile_rows(values: F64, count: IntArr, percent: float) -> F64:
-    """Each row's percentile (NumPy's linear method) of its first ``count`` values, the
-    rows sorted ascending."""
-    rows = np.arange(len(values))
-    h = np.maximum(count - 1, 0) * (percent / 100.0)
-    lo = np.floor(h).astype(np.intp)
-    hi = np.minimum(lo + 1, np.maximum(count - 1, 0))
-    a, b = values[rows, lo], values[rows, hi]
-    return np.asarray(a + (h - lo) * (b - a), dtype=np.float64)
-
-
 def grid_statistics(m: Matched, shifts: int) -> F64:
     """(shifts, KEYS) statistics of an association of ``shifts`` blocks of rows (each block
     the same poses at one shift), as :func:`~ertools.benchmarks.trajectory.metrics.metrics`
@@ -382,8 +330,8 @@ def grid_statistics(m: Matched, shifts: int) -> F64:
     )
     o2015 = np.arctan2(np.where(ok, np.sin(raw), 0.0).sum(1), np.where(ok, np.cos(raw), 0.0).sum(1))
     ranked = np.sort(np.where(ok, d, np.inf), axis=1)
-    pct = [_percentile_rows(ranked, count, p) for p in PERCENTILES]
-    top = _percentile_rows(ranked, count, 100.0)
+    pct = [percentile_rows(ranked, count, p) for p in PERCENTILES]
+    top = percentile_rows(ranked, count, 100.0)
     out = np.column_stack([mean, orient, rmse, pct[0], top, *pct, o2015])
     out[count == 0] = np.nan
     return np.asarray(out, dtype=np.float64)
@@ -479,91 +427,6 @@ class PoseTerms:
         return out
 
 
-@dataclass(frozen=True)
-class OrderStat:
-    """One order statistic to draw: its columns in KEYS (the median is p50 too), the poses
-    that can move it (indices into the compared poses) and its ranks among them,
-    interpolated by ``fraction``."""
-
-    columns: tuple[int, ...]
-    poses: IntArr
-    low: int
-    high: int
-    fraction: float
-
-
-def order_stats(d: F64, thinned: IntArr, bounds: F64) -> tuple[list[OrderStat], F64]:
-    """The order statistics of :data:`ORDER_STATS` to draw (the max over all poses, the
-    percentiles over the ``thinned`` ones) and their unperturbed values."""
-    out: list[OrderStat] = []
-    base = []
-    percents = sorted({p for _, p in ORDER_STATS})
-    for percent in percents:
-        columns = tuple(c for c, p in ORDER_STATS if p == percent)
-        pool = np.arange(len(d)) if percent == 100.0 else thinned
-        values = d[pool]
-        n = len(values)
-        h = (n - 1) * percent / 100.0
-        lo = math.floor(h)
-        hi = min(lo + 1, n - 1)
-        frac = h - lo
-        ranked = np.sort(values)
-        base.append(ranked[lo] + frac * (ranked[hi] - ranked[lo]))
-        keep, ranks = order_band(values, bounds[pool], np.array([lo, hi]))
-        out.append(OrderStat(columns, pool[keep], int(ranks[0]), int(ranks[1]), frac))
-    return out, np.asarray(base, dtype=np.float64)
-
-
-def draw_order_stats(
-    terms: PoseTerms,
-    stats: list[OrderStat],
-    rng: np.random.Generator,
-    draws: int,
-    noise: bool,
-    lag: bool,
-) -> F64:
-    """(draws, len(stats)) values of the order statistics with the poses that can move them
-    perturbed, in float32 (module doc).
-
-    A pose's perturbed distance is drawn from two numbers, not three: with the noise s z
-    split along the error e (s r, r standard normal) and across it (its squared length
-    s^2 |z_perp|^2, chi-square with 2 degrees of freedom: 2 s^2 E, E standard exponential),
-    |e + s z|^2 = (|e| + s r)^2 + 2 s^2 E, the same distribution. A lag l moves the GT by
-    l v: |e - l v|^2 = |e|^2 - 2 l e.v + l^2 |v|^2.
-    """
-    union = np.unique(np.concatenate([s.poses for s in stats]))
-    cols = [np.searchsorted(union, s.poses) for s in stats]
-    e, v = terms.error[union], terms.velocity[union]
-    # sums of three written out: one order of additions on every CPU
-    d = np.sqrt(e[:, 0] ** 2 + e[:, 1] ** 2 + e[:, 2] ** 2).astype(np.float32)
-    s = terms.sigma[union].astype(np.float32)
-    ev = (e[:, 0] * v[:, 0] + e[:, 1] * v[:, 1] + e[:, 2] * v[:, 2]).astype(np.float32)
-    vv = (v[:, 0] ** 2 + v[:, 1] ** 2 + v[:, 2] ** 2).astype(np.float32)
-    period = terms.period[union].astype(np.float32)
-    out = np.empty((draws, len(stats)))
-    width = max(len(union), 1)
-    chunk = max(1, CHUNK_ELEMENTS // width)
-    for start in range(0, draws, chunk):
-        m = min(chunk, draws - start)
-        dist = np.broadcast_to(d, (m, len(union)))
-        if lag and terms.lag is not None:
-            lo, hi = terms.lag
-            shift = rng.uniform(lo, hi, (m, len(union))).astype(np.float32) * period
-            sq = d * d - 2.0 * shift * ev + shift * shift * vv
-            dist = np.sqrt(np.maximum(sq, 0.0))
-        if noise:
-            along = dist + rng.standard_normal((m, len(union)), dtype=np.float32) * s
-            across = rng.standard_exponential((m, len(union)), dtype=np.float32)
-            across *= 2.0 * s * s
-            dist = np.sqrt(along * along + across)
-        for k, (st, c) in enumerate(zip(stats, cols, strict=True)):
-            # a sort is faster than a partition at these widths (a few hundred poses)
-            part = np.sort(dist[:, c], axis=1)
-            a, b = part[:, st.low].astype(np.float64), part[:, st.high].astype(np.float64)
-            out[start : start + m, k] = a + st.fraction * (b - a)
-    return out
-
-
 def trajectory_intervals(
     robot: PoseStream,
     gt: PoseStream,
@@ -624,6 +487,7 @@ def trajectory_intervals(
         period=period,
         lag=lag,
     )
+    distances = Distances(terms.error, terms.sigma, terms.velocity, terms.period)
     n_all = len(q)
     thinned = np.arange(n_all)
     if n_all > MAX_POSES:
@@ -655,11 +519,14 @@ def trajectory_intervals(
             key = (noise, frame)  # the same closed forms and bands in two passes
             if key not in closed:
                 closed[key] = terms.mean_like(noise, frame)
-                bands[key] = order_stats(d, thinned, terms.bounds(noise, frame))
+                bands[key] = order_stats(d, thinned, terms.bounds(noise, frame), ORDER_STATS)
             for j, (col, value) in enumerate(zip(mean_cols, closed[key], strict=True)):
                 measured[:, col] = value(z[:, j]) - est[col]
             stats, base = bands[key]
-            got = draw_order_stats(terms, stats, rng, draws, noise, frame) - base
+            got = draw_order_stats(
+                stats, distances, rng, draws, noise=noise, lag=lag if frame else None
+            )
+            got -= base
             for k, st in enumerate(stats):
                 for col in st.columns:
                     measured[:, col] = got[:, k]

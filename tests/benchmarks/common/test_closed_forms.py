@@ -20,8 +20,8 @@ from ertools.benchmarks.common.closed_forms import (
     lag_nodes,
     mean_moments,
     mix_angles,
-    order_band,
 )
+from ertools.benchmarks.common.draws import order_band
 
 N = 400_000  # draws of one pose's term
 Z = 5.0  # standard errors allowed
