@@ -337,8 +337,7 @@ def _subsample(zt: npt.NDArray[np.complex64], d_mins: F64) -> tuple[Bool, npt.ND
         np.sqrt(dist, out=dist)
         k = np.greater_equal(dist, d_min, out=kept[j])
         np.copyto(last, zt[j], where=k)
-        np.multiply(dist, k, out=dist)  # the step to a kept sample adds to the polyline
-        np.add(length, dist, out=length)
+        np.add(length, dist, out=length, where=k)  # a kept sample's step adds to the polyline
         cum[j] = length
     return kept, cum
 
