@@ -10,26 +10,31 @@ Each function raises the same ``ertools.errors.ErtoolsError`` as the command it 
 with the same message (``ertools.errors.UsageError`` for a wrong value, ``BagError`` for an
 unreadable file...), and prints nothing: warnings and notes are in the results it returns.
 ``ertools.errors`` (``ErtoolsError`` and its subclasses) is part of the API, to catch them by.
+An argument of the wrong type (a ``bytes`` path, ``config={...}``, ``tf=123``, a dict where
+paths are expected) is a ``UsageError`` naming the parameter, raised before anything is read:
+``ertools.score: bags=b'run.bag' (bytes): give a bag path (str or pathlib.Path) or a list of
+paths``. Paths are ``str`` or ``pathlib.Path``; several paths a list or a tuple of them.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
+from ertools import atomic
 from ertools.audit.model import Audit
 from ertools.audit.rescore import ScoreInputs, audit_bag, infer_benchmark
 from ertools.benchmarks import registry
-from ertools.benchmarks.base import Input, rename_former
+from ertools.benchmarks.base import rename_former
 from ertools.benchmarks.common.sources import read_source
 from ertools.benchmarks.common.spec import PoseSpec, TimeSource, parse_tf
 from ertools.benchmarks.common.which import refuse_other_benchmark
 from ertools.errors import ConfigError, UsageError
 from ertools.export.formats import FORMATS, format_poses
 from ertools.io import files, summary
+from ertools.parameters import checked, paths_list, value_of
 from ertools.report.figures import figure_specs
 from ertools.report.plots_audit import draw_timeline
 from ertools.report.plots_timeline import draw_gantt, timeline_figure
@@ -70,16 +75,8 @@ ORDER = (
     "rescore",
 )
 
-# The largest magnitude a number input may have (the CLI's rule, ertools.cli.main).
-_MAX_NUMBER = 4.6e9
 
-
-def _paths(paths: PathLike | Sequence[PathLike]) -> list[Path]:
-    if isinstance(paths, str | Path):
-        return [Path(paths)]
-    return [Path(p) for p in paths]
-
-
+@checked
 def info(path: PathLike) -> BagSummary:
     """What one bag holds, from its index, as ``ertools info`` shows it: format, times,
     compression and every topic with its type and message count.
@@ -101,6 +98,7 @@ def info(path: PathLike) -> BagSummary:
     return summary(path)
 
 
+@checked
 def open_bag(path: PathLike) -> BagFile:
     """One bag of any format opened for reading messages: its ``connections`` (topic, type)
     and ``raw(conns)`` records (connection, record time in ns, serialized bytes), in record
@@ -121,6 +119,7 @@ def open_bag(path: PathLike) -> BagFile:
     return files.open_bag(path)
 
 
+@checked
 def read_poses(
     paths: PathLike | Sequence[PathLike],
     *,
@@ -154,36 +153,10 @@ def read_poses(
     """
     if (topic is None) == (tf is None):
         raise UsageError("give topic=TOPIC or tf='PARENT:CHILD' (one of them)")
-    pair = parse_tf(tf) if isinstance(tf, str) else tf
+    pair = parse_tf(tf) if isinstance(tf, str) else None if tf is None else (tf[0], tf[1])
     source = cast(TimeSource, time_source)  # PoseSpec refuses any other word
     spec = PoseSpec(topic=topic, tf=pair, time_source=source, time_source_given=True)
-    return read_source(_paths(paths), spec, what="poses")
-
-
-def _value(declared: Input, value: Any) -> Any:
-    """A keyword argument as the command line would have given it (``str`` paths as Paths, a
-    ``with_file`` choice as its words, a flag not set as None)."""
-    if value is None:
-        return None
-    if declared.kind == "flag":
-        return True if value else None
-    if declared.kind == "path":
-        return Path(value)
-    if declared.kind == "paths":
-        return _paths(value)
-    if declared.with_file:
-        return [value] if isinstance(value, str) else [str(v) for v in value]
-    if declared.kind == "choice" and value not in declared.choices:
-        raise UsageError(
-            f"{declared.name}={value!r}: choose from {', '.join(map(repr, declared.choices))}"
-        )
-    if declared.repeat and not isinstance(value, list | tuple):
-        return [value]
-    if isinstance(value, float) and not (math.isfinite(value) and abs(value) < _MAX_NUMBER):
-        raise UsageError(
-            f"{declared.name}={value}: give a finite number smaller than {_MAX_NUMBER:g} in size"
-        )
-    return value
+    return read_source(paths_list(paths), spec, what="poses")
 
 
 def _values(name: str, inputs: Mapping[str, Any]) -> dict[str, Any]:
@@ -195,9 +168,10 @@ def _values(name: str, inputs: Mapping[str, Any]) -> dict[str, Any]:
         raise UsageError(
             f"{name} takes no input {', '.join(unknown)}; its inputs: {', '.join(declared)}"
         )
-    return {n: _value(d, inputs.get(n)) for n, d in declared.items()}
+    return {n: value_of(d, inputs.get(n)) for n, d in declared.items()}
 
 
+@checked
 def score(name: str, bags: PathLike | Sequence[PathLike], **inputs: Any) -> BenchmarkResult:
     """Score one benchmark execution, as ``ertools score NAME BAG... --OPTION VALUE`` does.
 
@@ -235,7 +209,7 @@ def score(name: str, bags: PathLike | Sequence[PathLike], **inputs: Any) -> Benc
     """
     bench = registry.get(name)
     values = _values(name, inputs)
-    bag_list = _paths(bags)
+    bag_list = paths_list(bags)
     if not bag_list:
         raise UsageError(f"give at least one bag (the log file) to score {name}")
     refuse_other_benchmark(name, bag_list, values)
@@ -244,6 +218,7 @@ def score(name: str, bags: PathLike | Sequence[PathLike], **inputs: Any) -> Benc
     return result
 
 
+@checked
 def audit(
     bags: PathLike | Sequence[PathLike],
     *,
@@ -274,14 +249,14 @@ def audit(
         >>> round(a.recomputed.to_dict()["best_distance_error"], 5)
         0.00064
     """
-    plist = _paths(bags)
+    plist = paths_list(bags)
     namespace = benchmark or infer_benchmark(plist)
     known = registry.get(namespace).inputs if namespace in registry.names() else ()
     declared = {i.name: i for i in known}
     inputs = rename_former(known, inputs)
     # an input the benchmark does not declare is passed as given: the audit notes it unused
     given = {
-        k: _value(declared[k], v) if k in declared else v
+        k: value_of(declared[k], v) if k in declared else v
         for k, v in inputs.items()
         if v is not None
     }
@@ -294,6 +269,7 @@ def audit(
     return replace(result, warnings=(*result.warnings, *notes)) if notes else result
 
 
+@checked
 def timeline(paths: PathLike | Sequence[PathLike], *, check_clocks: bool = True) -> Timeline:
     """Order the bags under ``paths`` (files and folders, searched recursively) by time, as
     ``ertools timeline`` does: sessions, overlaps, gaps, clock problems, copies, which GT files
@@ -309,9 +285,10 @@ def timeline(paths: PathLike | Sequence[PathLike], *, check_clocks: bool = True)
         >>> [b.kind for b in t.bags]
         ['benchmark']
     """
-    return scan(_paths(paths), check_clocks=check_clocks)
+    return scan(paths_list(paths), check_clocks=check_clocks)
 
 
+@checked
 def figures(result: Any) -> list[Any]:
     """The figures of a result as matplotlib Figures, the charts ``--plot`` and the reports
     draw (reports write them as SVG without matplotlib; here matplotlib draws the same charts):
@@ -347,6 +324,7 @@ def figures(result: Any) -> list[Any]:
     return out
 
 
+@checked
 def export(
     bags: PathLike | Sequence[PathLike],
     *,
@@ -371,12 +349,13 @@ def export(
     text = format_poses(stream, format)
     if out is not None:
         target = Path(out)
-        if any(target.exists() and target.samefile(p) for p in _paths(bags)):
+        if any(target.exists() and target.samefile(p) for p in paths_list(bags)):
             raise UsageError(f"out={target}: that is an input; ertools never overwrites its inputs")
-        target.write_text(text, encoding="utf-8")
+        atomic.write_text(target, text)
     return text
 
 
+@checked
 def rescore(
     paths: PathLike | Sequence[PathLike],
     *,
@@ -422,7 +401,7 @@ def rescore(
     """
     if jobs < 1:
         raise UsageError(f"jobs={jobs}: give 1 or more worker processes")
-    where = _paths(paths)
+    where = paths_list(paths)
     for path in where:
         if not path.exists():
             raise UsageError(f"{path}: no such file or folder")

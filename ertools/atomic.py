@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import shutil
 import sys
 import tempfile
 from collections.abc import Callable, Iterator
@@ -19,6 +20,9 @@ from pathlib import Path
 
 if sys.platform != "win32":
     import fcntl
+
+
+_FOLDER_TRIES = 10  # replace_folder: runs racing for one folder, at most
 
 
 @cache
@@ -39,12 +43,28 @@ def _fsync_folder(folder: Path) -> None:
             os.close(fd)
 
 
+def _named(err: OSError, path: Path) -> OSError:
+    """``err`` naming ``path`` where it names no file (a full disk: ``write`` says none) or
+    the temporary (a read-only folder: ``mkstemp`` names it): the user asked for ``path``."""
+    name = None if err.filename is None else Path(os.fsdecode(err.filename)).name
+    if name is not None and not name.startswith(f".{path.name}."):
+        return err  # another file, named already
+    try:
+        return type(err)(err.errno, err.strerror or str(err), str(path))
+    except TypeError:  # a subclass with its own arguments
+        return OSError(err.errno, err.strerror or str(err), str(path))
+
+
 @contextlib.contextmanager
 def replacing(path: Path) -> Iterator[Path]:
     """A temporary path beside ``path`` (same suffix, for writers that read it) to write in;
-    renamed over ``path`` once the block ends without an error, removed otherwise."""
+    renamed over ``path`` once the block ends without an error, removed otherwise. An error
+    of the temporary's is raised naming ``path``."""
     path = Path(path)
-    fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
+    try:
+        fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=path.suffix)
+    except OSError as err:
+        raise _named(err, path) from err
     os.close(fd)
     tmp = Path(name)
     try:
@@ -53,9 +73,11 @@ def replacing(path: Path) -> Iterator[Path]:
             os.fsync(fh.fileno())
         os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as err:
         with contextlib.suppress(OSError):
             tmp.unlink()
+        if isinstance(err, OSError):
+            raise _named(err, path) from err
         raise
     _fsync_folder(path.parent)
 
@@ -65,8 +87,11 @@ def write_bytes(path: Path, data: bytes) -> Path:
     is written as it is: it cannot be replaced)."""
     path = Path(path)
     if path.exists() and not path.is_file():
-        with open(path, "wb") as fh:
-            fh.write(data)
+        try:
+            with open(path, "wb") as fh:
+                fh.write(data)
+        except OSError as err:  # a full device: the write names no file
+            raise _named(err, path) from err
         return path
     with replacing(path) as tmp:
         tmp.write_bytes(data)
@@ -76,6 +101,30 @@ def write_bytes(path: Path, data: bytes) -> Path:
 def write_text(path: Path, text: str) -> Path:
     """``text`` (UTF-8) into ``path``, whole or not at all."""
     return write_bytes(path, text.encode("utf-8"))
+
+
+def replace_folder(new: Path, path: Path) -> None:
+    """The folder ``new`` (built whole beside ``path``, by ``tempfile.mkdtemp``) put at
+    ``path``: what was there is renamed away first, under a unique name, and removed after.
+    Two runs doing it at once each end with a whole folder there (the last one's)."""
+    for _ in range(_FOLDER_TRIES):
+        old: Path | None = None
+        if path.is_symlink():
+            path.unlink()
+        elif path.exists():
+            old = Path(tempfile.mkdtemp(dir=path.parent, prefix=f".{path.name}.", suffix=".old"))
+            # over an empty folder (POSIX allows it); gone already: another run moved it
+            with contextlib.suppress(FileNotFoundError):
+                os.replace(path, old)
+        try:
+            os.replace(new, path)
+        except OSError:  # another run put its folder there meanwhile: move it away too
+            continue
+        finally:
+            if old is not None:
+                shutil.rmtree(old, ignore_errors=True)
+        return
+    raise FileExistsError(f"{path}: replaced by other runs {_FOLDER_TRIES} times; not written")
 
 
 @contextlib.contextmanager
@@ -106,3 +155,16 @@ def folder_lock(folder: Path, *, on_wait: Callable[[str], None] | None = None) -
         yield
     finally:
         os.close(fd)  # releases the lock
+
+
+def hold(fd: int) -> bool:
+    """Take the advisory lock (``flock``) of the open file ``fd`` for as long as it stays open,
+    without waiting: False when another open of it holds it (a recording being written). Where
+    there is no ``flock`` (Windows), True."""
+    if sys.platform == "win32":  # pragma: no cover - not on the platforms tested
+        return True
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        return False
+    return True

@@ -8,11 +8,21 @@ Runs the same CLI a referee would type, so the demo shows (and checks) the real 
 from __future__ import annotations
 
 import sys
+
+if __name__ == "__main__":
+    # `python -m ertools.demo`: the module run under its own name, its imports included, inside
+    # ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
+    from ertools import launch
+
+    sys.exit(launch.run("ertools.demo:main", "python -m ertools.demo"))
+
+import io
 from collections.abc import Iterator
 from contextlib import redirect_stdout
 from dataclasses import dataclass
 from pathlib import Path
 
+from ertools import atomic
 from ertools.benchmarks import registry
 from ertools.cli.main import main as ertools_main
 from ertools.samples.competition import DEFAULT_SEED, MANIFEST, write_competition
@@ -118,10 +128,13 @@ def run(out: Path, samples: Path = SAMPLES) -> int:
             code = ertools_main(step.argv)
         else:
             target = out / step.stdout_file
-            with target.open("w", encoding="utf-8") as fh, redirect_stdout(fh):
+            printed = io.StringIO()
+            with redirect_stdout(printed):
                 code = ertools_main(step.argv)
-            if target.stat().st_size == 0:  # nothing printed (its errors are above): no file
-                target.unlink()
+            if printed.getvalue():  # nothing printed (its errors are above): no file
+                atomic.write_text(target, printed.getvalue())
+            else:
+                target.unlink(missing_ok=True)
                 target = None
         shown = "nothing on stdout" if target is None else f"-> {target}"
         if code != step.expected_exit:
@@ -148,7 +161,3 @@ def main(argv: list[str] | None = None) -> int:
     args = sys.argv[1:] if argv is None else argv
     out = Path(args[0]) if args else Path("demo_output")
     return 1 if run(out) else 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

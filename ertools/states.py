@@ -130,8 +130,9 @@ def state_topic(namespace: str, machine: Machine) -> str:
 
 # --- RefBox END payloads ----------------------------------------------------------------------
 #
-# The 2015 BmBox (rockin_scoring/BmBox.py, svenschneider/benchmark_and_scoring_fbm at 90d5c4d)
-# reads one thing from the RefBox besides its state: the payload, compared as a whole string.
+# The 2015 BmBox (src/rockin_scoring/BmBox.py of rockin-robot-challenge/benchmark_and_scoring_fbm
+# at 7628309, unchanged through 89dfa75) reads one thing from the RefBox besides its state:
+# the payload, compared as a whole string.
 # ``Timeout()`` is ``payload == "reason: timeout"`` (l. 117), ``Running()`` is
 # ``payload != "reason: stop"`` (l. 126), and its RefBox callback leaves WAITING_RESULT /
 # EXECUTING_GOAL on END only with one of those two strings (l. 49, 53; any END payload ends a
@@ -180,14 +181,14 @@ END_PAYLOAD_FORMS: tuple[EndPayloadForm, ...] = (
     EndPayloadForm(
         "reason: timeout",
         EndReason.TIMEOUT,
-        "BmBox.py (90d5c4d) l. 49, 97, 117 compare it exactly; the 2015 @Home RefBox "
+        "BmBox.py (7628309) l. 49, 97, 117 compare it exactly; the 2015 @Home RefBox "
         "(at_home_rsbb core_zone_exec.h, phase_post_2) sent it on a goal's timeout",
         True,
     ),
     EndPayloadForm(
         "reason: stop",
         EndReason.STOP,
-        "BmBox.py (90d5c4d) l. 53, 100, 126 compare it exactly; the 2015 @Home RefBox "
+        "BmBox.py (7628309) l. 53, 100, 126 compare it exactly; the 2015 @Home RefBox "
         "(at_home_rsbb core_zone_exec.h, phase_post_2) sent it on the benchmark's end or stop",
         True,
     ),

@@ -6,6 +6,8 @@ import dataclasses
 import fcntl
 import io
 import os
+import subprocess
+import sys
 from collections.abc import Generator, Iterator
 from pathlib import Path
 
@@ -13,7 +15,7 @@ import pytest
 
 from ertools.cli.main import main
 from ertools.demo import competition_step
-from ertools.samples.competition import DEFAULT_SEED, write_competition
+from ertools.samples.competition import DEFAULT_SEED
 
 # A skip says "this machine cannot run it". CI's machine can run everything (it has ../shared
 # beside the clone and .ci/run installs Chromium), so in CI a skip means a missing install step
@@ -169,14 +171,24 @@ def shared_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
 def sample_competition(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """The sample competition (``python -m ertools.samples --competition``, default seed),
     generated once for the whole session (10 s), by the first worker that needs it:
-    tests read it and write nothing into it."""
+    tests read it and write nothing into it. Through the command, as users make it: its
+    bytes are the same on every x86-64 CPU (``ertools.samples.simd``), an in-process
+    ``write_competition`` call's are not (docs/samples.md)."""
 
     shared = shared_dir(tmp_path_factory)
     root = shared / "competition" / "day"
     with _exclusive(shared / "competition.lock"):
         if not root.is_dir():  # written whole or not at all (write_competition)
             root.parent.mkdir(parents=True, exist_ok=True)
-            write_competition(root, seed=DEFAULT_SEED)
+            argv = ["--competition", str(root), "--seed", str(DEFAULT_SEED)]
+            proc = subprocess.run(
+                [sys.executable, "-m", "ertools.samples", *argv],
+                capture_output=True,
+                text=True,
+                check=False,
+                timeout=300,
+            )
+            assert proc.returncode == 0, proc.stderr
     return root
 
 

@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from ertools import yamlin
 from ertools.audit.model import (
     Audit,
     AuditRun,
@@ -398,28 +399,8 @@ def _live_score(bm: StateStream | None) -> tuple[str | None, Any, str]:
         return text, None, f"the live score payload is not YAML ({line}); shown as text"
 
 
-class _TagTolerantLoader(yaml.SafeLoader):
-    """SafeLoader that reads python-specific tags (the 2015 nodes dumped ``Pose2D`` objects
-    with ``yaml.dump``) as the plain mapping/sequence/scalar under the tag: nothing is ever
-    constructed or executed."""
-
-
-def _construct_plain(loader: yaml.SafeLoader, suffix: str, node: yaml.Node) -> Any:
-    if isinstance(node, yaml.MappingNode):
-        return loader.construct_mapping(node, deep=True)
-    if isinstance(node, yaml.SequenceNode):
-        return loader.construct_sequence(node, deep=True)
-    return loader.construct_scalar(node)  # type: ignore[arg-type]
-
-
-_TagTolerantLoader.add_multi_constructor("tag:yaml.org,2002:python/", _construct_plain)
-_TagTolerantLoader.add_multi_constructor("!", _construct_plain)
-
-
 def parse_payload(text: str) -> Any:
-    """A YAML payload from a bag: ``yaml.safe_load``, or, when it carries python tags as the
-    2015 nodes wrote them, the same safe loader reading the tagged nodes as plain data."""
-    try:
-        return yaml.safe_load(text)
-    except yaml.constructor.ConstructorError:
-        return yaml.load(text, Loader=_TagTolerantLoader)  # a SafeLoader subclass
+    """A YAML payload from a bag, read safely; python tags as the 2015 nodes wrote them
+    (``yaml.dump`` of a ``Pose2D``) are read as the plain data under them, and of a key given
+    twice the last value counts, as the 2015 nodes read it (the scorers warn of it)."""
+    return yamlin.load(text, tags="plain", duplicates=[])

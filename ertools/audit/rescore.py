@@ -202,7 +202,7 @@ def audit_bag(
     plist = [Path(p) for p in paths]
     for path in plist:
         if not path.exists():
-            raise BagError("no such file or directory", path=path)
+            raise BagError("no such file or directory", path=path, transient=True)
     ns = benchmark or infer_benchmark(plist)
     states = read_benchmark_states(plist, ns)
     if states.bmbox is None and states.refbox is None and states.client is None:

@@ -34,13 +34,29 @@ def members_epilog(members: dict[str, Command]) -> str:
     return "\n".join(lines)
 
 
+def _member_words(argv: list[str] | None, member: str, rest: list[str]) -> list[str]:
+    """The words after the member's name as given: argparse's REMAINDER drops a ``--`` right
+    after the name (``score fbm3w -- -h.bag`` then read ``-h`` as --help). A ``--`` before the
+    name made every later word a name or a bag: it is passed on too."""
+    if argv is None:
+        return rest
+    for i, word in enumerate(argv):
+        if word == member:
+            before = argv[:i]
+            return (["--"] if "--" in before else []) + argv[i + 1 :]
+        if word == "--" or word.startswith("-"):
+            continue  # the group's own options (-v, -q, --debug) come before the name
+        break
+    return rest
+
+
 def run_group(group: str, members: dict[str, Command], args: argparse.Namespace) -> int:
     """Run the member's own parser on the remaining arguments."""
 
     extra = ["-v"] * args.verbose + (["--debug"] if args.debug else [])
     extra += ["--quiet"] if args.quiet else []
     member: str = args.member
-    rest: list[str] = list(args.rest)
+    rest: list[str] = _member_words(getattr(args, "argv", None), member, list(args.rest))
     if member not in members:  # argparse checked already; keeps mypy honest
         print(f"ertools: error: unknown {group} {member!r}", file=sys.stderr)
         return 2

@@ -14,12 +14,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import dump_yaml
-from ertools.cli.main import error_text
+from ertools.cli.main import error_text, printable
 from ertools.cli.options import add_output
 from ertools.cli.output import dump_json, note, write_text
 from ertools.errors import BagError
 from ertools.io import info as bag_info
-from ertools.io.formats import expand
+from ertools.io.formats import find_bags
 from ertools.io.info import span_s
 from ertools.progress import reporting
 from ertools.timeutil import iso_utc, ns_to_s
@@ -79,7 +79,7 @@ def table(info: BagInfo) -> str:
 
     s = info.summary
     lines = [
-        f"path:        {s.path}",
+        f"path:        {printable(str(s.path))}",
         f"format:      {s.format} (version {s.version or 'unknown'})"
         + ("" if s.indexed else "  NOT INDEXED: scanned"),
     ]
@@ -141,10 +141,11 @@ def run(args: argparse.Namespace) -> int:
     problems: list[dict[str, str]] = []
     paths: list[Path] = []
     for given in args.paths:
-        try:
-            paths.extend(expand([given]))
-        except BagError as err:  # a missing path or an empty folder: the others still run
-            problems.append({"path": str(given), "problem": err.message})
+        # a missing path, an empty folder, a folder that cannot be read, a FIFO: one problem
+        # each, and the other bags still run
+        found = find_bags([given])
+        paths.extend(found.bags)
+        problems.extend({"path": p.path, "problem": p.problem} for p in found.problems)
     progress = getattr(args, "progress", None)  # set by run_command
     if progress is not None and not args.check:  # --check reports the bytes of each file
         progress.task("reading indexes", len(paths), "bags")

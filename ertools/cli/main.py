@@ -3,12 +3,21 @@
 from __future__ import annotations
 
 import argparse
+import errno
 import logging
 import math
 import os
 import re
 import select
 import sys
+
+if __name__ == "__main__":
+    # `python -m ertools.cli.main`: the module run under its own name, its imports included, inside
+    # ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
+    from ertools import launch
+
+    sys.exit(launch.run("ertools.cli.main:main", "ertools"))
+
 import textwrap
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -167,6 +176,10 @@ def _configure_logging(verbose: int) -> None:
     class _LowerLevel(logging.Formatter):
         # "ertools: warning: ..." like the CLI's own notes (cli/common.note), not "WARNING";
         # the record itself is left as is (other handlers may see it).
+        def formatMessage(self, record: logging.LogRecord) -> str:  # noqa: N802 (logging's)
+            record.message = printable(record.message)  # one line, whatever a path holds
+            return super().formatMessage(record)
+
         def format(self, record: logging.LogRecord) -> str:
             text = super().format(record)
             head = f"ertools: {record.levelname}:"
@@ -236,6 +249,22 @@ def _check_numbers(args: argparse.Namespace) -> None:
                 )
 
 
+# Control characters as escapes: a file name holding a newline (or an escape sequence) must
+# not start a line of its own in a command's output, nor drive the terminal.
+_CONTROL = {c: f"\\x{c:02x}" for c in (*range(0x20), 0x7F, *range(0x80, 0xA0))} | {
+    0x09: "\\t",
+    0x0A: "\\n",
+    0x0D: "\\r",
+    0x2028: "\\u2028",
+    0x2029: "\\u2029",
+}
+
+
+def printable(text: str) -> str:
+    """``text`` with its control characters escaped as Python writes them (``\\n``)."""
+    return text.translate(_CONTROL)
+
+
 def _one_line(message: str) -> str:
     """The message on one line: wrapped third-party texts (a YAML parser's) span several."""
     return " ".join(message.split())
@@ -262,7 +291,7 @@ def error_text(message: str) -> str:
     :data:`MAX_ERROR_LINE` characters, else each further clause (after "; ") on a line of its
     own indented by two spaces, and a clause still too long wrapped at words onto lines
     indented by four."""
-    first = f"ertools: error: {_one_line(message)}"
+    first = f"ertools: error: {printable(_one_line(message))}"
     if len(first) <= MAX_ERROR_LINE:
         return first
     clauses = _clauses(first)
@@ -289,6 +318,7 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
         return stop.code if isinstance(stop.code, int) else 2
     # The command as run, for report provenance (sys.argv is wrong when called in-process).
     args.command_line = [*prog.split(), *argv]
+    args.argv = list(argv)  # a group hands its member the words after the member's name
     _configure_logging(args.verbose)
     bar = _progress_bar(args)
     try:
@@ -314,7 +344,7 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
     except OSError as err:  # mostly an output path that cannot be written (-o, --plot...)
         if args.debug:
             raise
-        where = f"{err.filename}: " if err.filename else ""
+        where = f"{err.filename}: " if err.filename else _writing(err, args)
         print(
             _one_line(f"ertools: error: {where}{err.strerror or err}: cannot read or write there"),
             file=sys.stderr,
@@ -323,6 +353,20 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
     except Exception as err:  # a bug: still one line unless --debug
         return _unexpected(err, args)
     return code
+
+
+# A full disk or quota, a file too large: a write's errors, which name no file.
+_WRITE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG})
+
+
+def _writing(err: OSError, args: argparse.Namespace) -> str:
+    """``writing OUT: `` for a write error naming no file (a writer not through
+    :mod:`ertools.atomic`, which names its own): the outputs the command was given, else
+    stdout; "" for any other error."""
+    if err.errno not in _WRITE_ERRNOS:
+        return ""
+    outs = [str(v) for name in OUTPUT_OPTIONS if isinstance(v := getattr(args, name, None), Path)]
+    return f"writing {', '.join(outs) or 'stdout'}: "
 
 
 def _unexpected(err: Exception, args: argparse.Namespace) -> int:
@@ -403,7 +447,3 @@ def _main(argv: Sequence[str] | None) -> int:
         )
         return 2
     return run_command(f"ertools {name}", COMMANDS[name].module, args[1:])
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

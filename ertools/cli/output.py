@@ -10,7 +10,7 @@ from typing import Any
 
 from ertools import atomic
 from ertools.benchmarks.base import jsonable
-from ertools.cli.main import error_text
+from ertools.cli.main import error_text, printable
 from ertools.progress import clear_current
 
 
@@ -34,7 +34,7 @@ def note(message: str) -> None:
     if message.startswith("error: "):
         print(error_text(message.removeprefix("error: ")), file=sys.stderr)
     else:
-        print(f"ertools: {message}", file=sys.stderr)
+        print(f"ertools: {printable(message)}", file=sys.stderr)
 
 
 def dump_json(data: Any) -> str:

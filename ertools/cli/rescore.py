@@ -106,6 +106,8 @@ def run(args: argparse.Namespace) -> int:
         note(f"error: {len(err.problems)} problem(s) in {args.config}; nothing was scored")
         return 1
     if args.check:
+        for line in manifest.duplicates:
+            note(f"warning: {args.config}: {line}")
         note(f"{args.config}: no problems ({len(manifest.executions)} listed executions)")
         return 0
 
@@ -116,7 +118,7 @@ def run(args: argparse.Namespace) -> int:
         )
 
     def tell(outcome: Outcome) -> None:
-        if outcome.status != "scored" and outcome.error != "TopicError":
+        if outcome.status != "scored":
             note(f"error: {outcome.id}: {outcome.status}: {outcome.reason}")
 
     done = rescore_competition(

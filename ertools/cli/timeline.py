@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from ertools.benchmarks.base import dump_yaml
-from ertools.cli.main import error_text
+from ertools.cli.main import error_text, printable
 from ertools.cli.options import add_output, plot_file, seconds
 from ertools.cli.output import dump_json, note, write_text
 from ertools.csvsafe import spreadsheet_safe
@@ -123,7 +123,7 @@ def run(args: argparse.Namespace) -> int:
         if shown == MAX_PROBLEM_NOTES:
             note(f"warning: {len(by_path) - shown} more file(s) with problems: see the output")
             break
-        note(" ".join(f"warning: {path}: {'; '.join(problems)}".split()))  # one line each
+        note(" ".join(f"warning: {printable(path)}: {'; '.join(problems)}".split()))  # one line
     return 0
 
 
@@ -183,16 +183,16 @@ def to_table(timeline: Timeline, *, color: bool = False) -> str:
         ses = "-" if b.session is None else str(b.session)
         row = (
             f"{_when(b.start_ns):<23}  {_when(b.end_ns):<23}  {dur:>9}  "
-            f"{KIND_LABELS[b.kind]:<13}  {ses:>3}  {b.path}"
+            f"{KIND_LABELS[b.kind]:<13}  {ses:>3}  {printable(str(b.path))}"
         )
         style = "error" if not b.readable else ("hi" if b.overlaps else "")
         lines.append(paint(row, style) if style else row)
         if b.overlaps:
-            lines.append(paint(f"{'':>77}overlaps: {', '.join(b.overlaps)}", "dim"))
+            lines.append(paint(f"{'':>77}overlaps: {printable(', '.join(b.overlaps))}", "dim"))
         if b.copies:
             lines.append(paint(f"{'':>77}{len(b.copies)} copy(ies) of this recording", "dim"))
         for p in b.problems:
-            lines.append(paint(f"{'':>77}! {p}", "warn" if b.readable else "error"))
+            lines.append(paint(f"{'':>77}! {printable(p)}", "warn" if b.readable else "error"))
     if timeline.sessions:
         lines += ["", paint("sessions:", "bold")]
     for s in timeline.sessions:
@@ -208,19 +208,19 @@ def to_table(timeline: Timeline, *, color: bool = False) -> str:
     if timeline.problems:
         lines += ["", paint(f"problems ({len(timeline.problems)}):", "bold")]
         for pr in timeline.problems:
-            lines.append(paint(f"  {pr.path}: {pr.problem}", "warn"))
+            lines.append(paint(printable(f"  {pr.path}: {pr.problem}"), "warn"))
     return "\n".join(lines)
 
 
 def _pairing_line(p: Any, paint: _Paint, *, full_path: bool = False) -> str:
-    name = str(p.path) if full_path else Path(p.path).name
+    name = printable(str(p.path) if full_path else Path(p.path).name)
     other = ""
     if p.other_benchmark:
-        names = ", ".join(Path(g).name for g in p.other_benchmark)
+        names = printable(", ".join(Path(g).name for g in p.other_benchmark))
         other = f"; not paired, another benchmark: {names}"
     if not p.gt:
         return paint(f"       {KIND_LABELS[p.kind]} {name}: no GT file covers it{other}", "error")
-    gts = ", ".join(Path(g).name for g in p.gt)
+    gts = printable(", ".join(Path(g).name for g in p.gt))
     by_time = " by time only (no benchmark named)" if p.basis == "time" else ""
     text = (
         f"       {KIND_LABELS[p.kind]} {name}: GT coverage {p.coverage:.1f} % ({gts}){by_time}"

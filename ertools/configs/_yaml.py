@@ -1,8 +1,8 @@
 """Safe YAML loading shared by every config format.
 
 Every config and the manifest go through here, so the limits on what a file may hold are set
-once: nesting no deeper than :data:`MAX_DEPTH` (PyYAML's composer recurses, and a file of
-thousands of ``[`` would end in a RecursionError), and, in files, numbers that are numbers:
+once: those of :mod:`ertools.yamlin` (nesting no deeper than its ``MAX_DEPTH``, aliases
+included; no key given twice), and, in files, numbers that are numbers:
 finite, and no larger in size than :data:`MAX_NUMBER` (no metre, second, radian or count in a
 config comes near; a 400-digit integer or ``1e300`` would overflow the first conversion to
 nanoseconds or to float). Each reader checks its own keys' ranges with :func:`number`.
@@ -10,6 +10,7 @@ nanoseconds or to float). Each reader checks its own keys' ranges with :func:`nu
 
 from __future__ import annotations
 
+import logging
 import math
 from collections.abc import Iterator
 from pathlib import Path
@@ -17,67 +18,75 @@ from typing import Any
 
 import yaml
 
+from ertools import yamlin
 from ertools.errors import ConfigError
+from ertools.inputs import read_regular_text, why_not
+from ertools.yamlin import Tags
 
-MAX_DEPTH = 64
+log = logging.getLogger("ertools.configs")
+
 # int64 nanoseconds hold ~9.2e18; a float beyond this cannot be a time, a length or a count
 MAX_NUMBER = 9.2e18
 # seconds: epoch seconds (~1.4e9 in 2015) and bag-relative ones; their nanoseconds fit int64
 MAX_SECONDS = 4.6e9
 
 
-class _Loader(yaml.SafeLoader):
-    """``yaml.SafeLoader`` that refuses nesting deeper than :data:`MAX_DEPTH`."""
-
-    depth = 0
-
-    def compose_node(self, parent: Any, index: Any) -> Any:
-        self.depth += 1
-        try:
-            if self.depth > MAX_DEPTH:
-                mark = self.peek_event().start_mark  # type: ignore[no-untyped-call]
-                raise yaml.YAMLError(
-                    f"nested more than {MAX_DEPTH} levels deep at line {mark.line + 1}"
-                )
-            return super().compose_node(parent, index)
-        finally:
-            self.depth -= 1
-
-
-def safe_load(text: str) -> Any:
-    """``yaml.safe_load`` with the nesting limit."""
-    loader = _Loader(text)
-    try:
-        return loader.get_single_data()
-    finally:
-        loader.dispose()
-
-
-def load_yaml(path: str | Path, what: str = "config") -> Any:
-    """Parse a YAML file with ``yaml.safe_load``; errors become one-line ``ConfigError``s."""
+def load_yaml(path: str | Path, what: str = "config", tags: Tags = "safe") -> Any:
+    """Parse a YAML file (:func:`parse_yaml`); errors become one-line ``ConfigError``s."""
 
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
+        text = read_regular_text(p)  # a named pipe would block open() for ever
     except FileNotFoundError:
         raise ConfigError(f"{what} file not found", path=p) from None
-    except (OSError, UnicodeDecodeError) as err:
+    except OSError as err:
+        raise ConfigError(f"cannot read {what} file: {why_not(err)}", path=p) from err
+    except UnicodeDecodeError as err:
         raise ConfigError(f"cannot read {what} file: {err}", path=p) from err
-    return check_numbers(parse_yaml(text, source=str(p), what=what), str(p))
+    return check_numbers(parse_yaml(text, source=str(p), what=what, tags=tags), str(p))
 
 
-def parse_yaml(text: str, source: str = "<string>", what: str = "YAML") -> Any:
-    """Parse YAML text (a payload, a config) with ``yaml.safe_load`` (nesting limited)."""
+def parse_yaml(text: str, source: str = "<string>", what: str = "YAML", tags: Tags = "safe") -> Any:
+    """Parse a config's YAML text (:func:`ertools.yamlin.load`: safe tags, nesting limited,
+    duplicate keys refused); errors become one-line ``ConfigError``s naming the line."""
 
     try:
-        return safe_load(text)
-    except RecursionError:  # pragma: no cover - the depth limit comes first
+        return yamlin.load(text, tags=tags)
+    except RecursionError:  # the loader's depth limit comes first; called from deep, say so
         raise ConfigError(f"malformed {what}: nested too deep", path=source) from None
     except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-        problem = getattr(err, "problem", None) or str(err).splitlines()[0]
-        raise ConfigError(f"malformed {what}{where}: {problem}", path=source) from err
+        raise ConfigError(f"malformed {what}{_where(err)}", path=source) from err
+
+
+def parse_payload(text: str, source: str, what: str = "payload", tags: Tags = "safe") -> Any:
+    """Parse a state payload's YAML as the 2015 nodes did (PyYAML: of a key given twice, the
+    last value counts), warning of each duplicate: the bag records what the live system read,
+    and a rescore that refused it would drop a run the live score counted
+    (docs/fidelity.md, "Payloads with a key given twice")."""
+
+    duplicates: list[yamlin.DuplicateKey] = []
+    try:
+        data = yamlin.load(text, tags=tags, duplicates=duplicates)
+    except RecursionError:
+        raise ConfigError(f"malformed {what}: nested too deep", path=source) from None
+    except yaml.YAMLError as err:
+        raise ConfigError(f"malformed {what}{_where(err)}", path=source) from err
+    for d in duplicates:
+        log.warning(
+            "%s: %s of the %s: the last value is used, as the 2015 nodes read it",
+            source,
+            d.text(),
+            what,
+        )
+    return data
+
+
+def _where(err: yaml.YAMLError) -> str:
+    """`` at line L, column C: problem`` of a PyYAML error, on one line."""
+    mark = getattr(err, "problem_mark", None)
+    where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+    problem = getattr(err, "problem", None) or str(err).splitlines()[0]
+    return f"{where}: {problem}"
 
 
 def require(mapping: Any, key: str, source: str, what: str) -> Any:
@@ -126,6 +135,26 @@ def check_numbers(data: Any, source: str) -> Any:
             continue
         number(value, key or "the file", source)
     return data
+
+
+# An angle in radians beyond a full turn either way is no heading but a number in degrees (a
+# goal's theta of 180 scored an orientation error of 1.744 rad instead of 0.070); the slack
+# admits 2*pi written with fewer digits than the float's.
+FULL_TURN = 2.0 * math.pi + 1e-6
+
+
+def check_radians(
+    value: float, key: str, source: str, *, limit: float = FULL_TURN, bound: str = "2 pi"
+) -> float:
+    """``value`` when it is an angle of at most ``limit`` radians (``bound`` in words) either
+    way, else a ConfigError naming the key and what the value would be in degrees."""
+    if abs(value) <= limit:
+        return value
+    raise ConfigError(
+        f"{key}: {value:g} is more than {bound} either way: angles are in radians here "
+        f"({value:g} degrees would be {math.radians(value):.4f} rad)",
+        path=source,
+    )
 
 
 def number(

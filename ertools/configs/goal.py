@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.configs._yaml import load_yaml, number, parse_yaml
+from ertools.configs._yaml import check_radians, load_yaml, number, parse_payload
 from ertools.errors import ConfigError
 
 Pose2 = tuple[float, float, float]
@@ -65,7 +65,7 @@ def _pose(value: Any, what: str, source: str) -> Pose2:
     if not isinstance(value, list | tuple) or len(value) != 3:
         raise ConfigError(f"{what}: expected [x, y, theta], got {value!r}", path=source)
     x, y, theta = (_number(v, what, source) for v in value)
-    return (x, y, theta)
+    return (x, y, check_radians(theta, f"{what} theta", source))
 
 
 def _optional_number(data: dict[str, Any], key: str, source: str) -> float | None:
@@ -115,4 +115,4 @@ def load_goal(path: str | Path) -> GoalList:
 
 def goal_from_payload(payload: str, source: str) -> GoalList:
     """The goal list carried by the first TRANSMITTING_GOAL payload."""
-    return parse_goal(parse_yaml(payload, source=source, what="goal payload"), source=source)
+    return parse_goal(parse_payload(payload, source=source, what="goal payload"), source=source)

@@ -31,9 +31,8 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-import yaml
 
-from ertools.configs._yaml import load_yaml, number
+from ertools.configs._yaml import check_radians, load_yaml, number
 from ertools.errors import ConfigError
 from ertools.geometry import invert
 from ertools.yamlout import yaml_float
@@ -250,6 +249,9 @@ def _parse_spread(value: Any, source: str) -> TransformSpread | None:
         counts.append(v)
     if any(x < 0 for x in (*pos, *rot)):
         raise ConfigError(f"{what}: a standard deviation cannot be negative", path=source)
+    for axis, r in zip("xyz", rot, strict=True):
+        # a rotation vector is at most pi long: a larger spread is a number in degrees
+        check_radians(r, f"{what}.rotation_std {axis}", source, limit=math.pi, bound="pi")
     if counts[1] > counts[0]:
         raise ConfigError(
             f"{what}: effective_samples {counts[1]} exceeds samples {counts[0]}", path=source
@@ -284,43 +286,6 @@ def parse_transform(data: Any, source: str = "<transform>") -> MarkerTransform:
     return result
 
 
-class _TupleSafeLoader(yaml.SafeLoader):
-    """``yaml.SafeLoader`` that also reads ``!!python/tuple`` (PyYAML's dump of a tuple, as
-    the ERL RSBB acquirer wrote tf's lookups) as a plain list. Every other Python tag is
-    still refused: nothing is constructed but lists, mappings, strings and numbers."""
-
-
-def _tuple_as_list(loader: yaml.SafeLoader, node: yaml.Node) -> list[Any]:
-    if not isinstance(node, yaml.SequenceNode):
-        raise yaml.constructor.ConstructorError(
-            None, None, "!!python/tuple must tag a sequence", node.start_mark
-        )
-    return list(loader.construct_sequence(node, deep=True))
-
-
-_TupleSafeLoader.add_constructor("tag:yaml.org,2002:python/tuple", _tuple_as_list)
-
-
-def _load_transform_yaml(path: str | Path) -> Any:
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ConfigError("transform file not found", path=p) from None
-    except (OSError, UnicodeDecodeError) as err:
-        raise ConfigError(f"cannot read transform file: {err}", path=p) from err
-    if "!!python/tuple" not in text:
-        return load_yaml(p, "transform")  # the common loader, for the common files
-    try:
-        # A SafeLoader subclass: safe_load with one more tag, built as a list.
-        return yaml.load(text, Loader=_TupleSafeLoader)
-    except yaml.YAMLError as err:
-        mark = getattr(err, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-        problem = getattr(err, "problem", None) or str(err).splitlines()[0]
-        raise ConfigError(f"malformed transform{where}: {problem}", path=p) from err
-
-
 def _check_inverse(tr: MarkerTransform, t_inv: Vec3, q_inv: Quat, source: str) -> None:
     # lazy: scipy only where its rotations/statistics are needed (~0.3 s to import)
     from scipy.spatial.transform import Rotation
@@ -338,7 +303,9 @@ def _check_inverse(tr: MarkerTransform, t_inv: Vec3, q_inv: Quat, source: str) -
 
 def load_transform(path: str | Path) -> MarkerTransform:
     """Read and validate a ``transform-<team>.yaml`` file (any of :data:`LAYOUTS`)."""
-    return parse_transform(_load_transform_yaml(path), source=str(path))
+    # every file read with the tuple tag (built as a list), so that the common limits apply
+    # whatever the text says (a comment naming the tag once chose another loader)
+    return parse_transform(load_yaml(path, "transform", tags="tuples"), source=str(path))
 
 
 def team_transform_path(directory: str | Path, team: str) -> Path:

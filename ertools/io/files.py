@@ -11,6 +11,9 @@ the ``mcap`` library's (log time, chunk, position) order for MCAP).
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
+import heapq
 import logging
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -20,19 +23,25 @@ import numpy as np
 
 from ertools.errors import BagError
 from ertools.io.bagfile import BagFile, RawRecord
+from ertools.io.decode.fast import LayoutMismatchError
 from ertools.io.formats import detect_format
+from ertools.io.inflate import inflate_message
+from ertools.io.mcap.index import McapIndex
 from ertools.io.mcap.scan import SCAN, mcap_layout, scan_mcap
 from ertools.io.mcap.summary import mcap_errors
 from ertools.io.model import Conn, short_msgtype
 from ertools.io.ros1.index import Ros1Bag
-from ertools.io.rosbag2.metadata import readable_dir
+from ertools.io.rosbag2.metadata import (
+    message_compression,
+    read_metadata,
+    readable_dir,
+    readable_files,
+)
 
 log = logging.getLogger("ertools.io.files")
 
 # (reference positions, bytes, data starts, data lengths, log times, channel ids)
 ScannedRun = tuple[Any, Any, Any, Any, Any, Any]
-
-INT64_MAX = (1 << 63) - 1
 
 
 def _conn_from_rosbags(c: Any) -> Conn:
@@ -64,12 +73,20 @@ def _conn_from_rosbags(c: Any) -> Conn:
 
 
 class RosbagsFile(BagFile):
-    """ROS1 and rosbag2 through rosbags' readers (builds rosbags' per-message index)."""
+    """ROS1 and rosbag2 through rosbags' readers (builds rosbags' per-message index).
+
+    Messages of a rosbag2 bag compressed one by one reach this class compressed (rosbags
+    reads a copy of the metadata without the compression: :func:`readable_dir`) and are
+    decompressed here, within the budget (rosbags' own decompression trusts the size a zstd
+    frame states, however large)."""
 
     def __init__(self, path: Path, fmt: str) -> None:
         self.path = path
         self.format = fmt
+        self._inflate: str | None = None
         try:
+            if fmt != "ros1":
+                self._inflate = message_compression(read_metadata(path))
             if fmt == "ros1":
                 # lazy: rosbags only on the per-message path (~0.1 s to import)
                 from rosbags.rosbag1 import Reader as Reader1
@@ -101,7 +118,12 @@ class RosbagsFile(BagFile):
         stop = None if end_ns is None else end_ns + 1
         try:
             for c, t, data in self._reader.messages(connections=rb, start=start_ns, stop=stop):
+                if self._inflate is not None:
+                    where = f"of {c.topic} at {t} ns"
+                    data = inflate_message(self._inflate, bytes(data), where)
                 yield by_id[int(c.id)], int(t), bytes(data)
+        except BagError as err:
+            raise BagError(err.message, path=self.path) from err
         except Exception as err:
             raise BagError(
                 f"damaged message data ({type(err).__name__}: {err})", path=self.path
@@ -141,19 +163,15 @@ class McapFile(BagFile):
     """
 
     def __init__(self, path: Path) -> None:
-        from mcap.reader import make_reader  # lazy: the mcap library only when an MCAP file is read
-
         self.path = path
         self.format = "mcap"
         self.unfinished = False
         self.scanned = False
-        self._f = path.open("rb")
-        unreadable: tuple[type[BaseException], ...] = (BagError, *mcap_errors())
         try:
             layout = mcap_layout(path)
-            self._reader = make_reader(self._f)
-        except unreadable as err:
-            self._f.close()
+        except BagError:
+            raise
+        except mcap_errors() as err:
             raise BagError(f"unreadable MCAP file ({err})", path=path) from err
         if layout.index == SCAN:
             self.connections = self._scan(layout.why)
@@ -167,17 +185,12 @@ class McapFile(BagFile):
         """Read every complete record (the summary's indexes do not answer for them all)."""
         self.scanned = True
         log.info("%s: %s; reading the file record by record", self.path, why)
-        try:
-            found = scan_mcap(self.path)
-        except BagError:
-            self._f.close()
-            raise
+        found = scan_mcap(self.path)
         conns = {
             cid: _conn_from_channel(ch, found.schemas.get(ch.schema_id))
             for cid, ch in found.channels.items()
         }
         if not conns and not found.complete:
-            self._f.close()
             raise BagError(
                 f"unreadable MCAP file: no complete channel record ({found.problem})",
                 path=self.path,
@@ -251,26 +264,74 @@ class McapFile(BagFile):
                 a = int(start[i])
                 yield by_id[int(cid[i])], int(t[i]), buf[a : a + int(length[i])].tobytes()
             return
-        topics = sorted({c.topic for c in conns})
         try:
-            for _schema, channel, message in self._reader.iter_messages(
-                topics=topics,
-                starting_at=start_ns,
-                ending_at=end_ns,
-                log_time_order=True,
-            ):
-                conn = by_id.get(channel.id)
-                if conn is not None:
-                    if message.log_time > INT64_MAX:
-                        raise ValueError(f"message log time {message.log_time} out of range")
-                    yield conn, int(message.log_time), bytes(message.data)
-        except mcap_errors() as err:
-            raise BagError(
-                f"damaged MCAP data ({type(err).__name__}: {err})", path=self.path
-            ) from err
+            found = McapIndex([self.path]).messages(conns, start_ns, end_ns)
+        except LayoutMismatchError as err:
+            # indexes that do not answer for every message (padded message indexes): the
+            # messages are read record by record, as a file without indexes is
+            log.info("%s: %s; reading the file record by record", self.path, err)
+            self.scanned = True
+            yield from self.raw(conns, start_ns, end_ns)
+            return
+        for _file, cid, t, data in found:
+            conn = by_id.get(cid)
+            if conn is not None:
+                yield conn, t, data
 
-    def close(self) -> None:
-        self._f.close()
+
+class Rosbag2McapFile(BagFile):
+    """A rosbag2 bag with MCAP storage, read as standalone MCAP files are (:class:`McapFile`:
+    through their indexes, every chunk within the budget; rosbags' MCAP reader inflates a
+    chunk to whatever size its zstd frame states). One connection per topic, as rosbag2
+    records them; messages of several files merged by record time, file order on ties."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.format = "rosbag2-mcap"
+        info = read_metadata(path)
+        self._inflate = message_compression(info)
+        self._files: list[McapFile] = []
+        for storage in readable_files(path, info):
+            if storage.suffix == ".mcap":
+                with self._naming(storage):
+                    self._files.append(McapFile(storage))
+        by_topic: dict[str, Conn] = {}
+        for opened in self._files:
+            for c in opened.connections:
+                by_topic.setdefault(c.topic, c)
+        self.connections = tuple(
+            dataclasses.replace(c, id=i) for i, c in enumerate(by_topic.values(), start=1)
+        )
+
+    def raw(
+        self, conns: Sequence[Conn], start_ns: int | None = None, end_ns: int | None = None
+    ) -> Iterator[RawRecord]:
+        wanted = {c.topic: c for c in conns}
+        if not wanted:
+            return
+        parts = []
+        for f in self._files:
+            mine = [c for c in f.connections if c.topic in wanted]
+            if mine:
+                with self._naming(f.path):
+                    got = [(wanted[c.topic], t, d) for c, t, d in f.raw(mine, start_ns, end_ns)]
+                parts.append(got)
+        for conn, t, data in heapq.merge(*parts, key=lambda r: r[1]):
+            if self._inflate is not None:
+                where = f"of {conn.topic} at {t} ns"
+                try:
+                    data = inflate_message(self._inflate, data, where)
+                except BagError as err:
+                    raise BagError(err.message, path=self.path) from err
+            yield conn, t, data
+
+    @contextlib.contextmanager
+    def _naming(self, file: Path) -> Iterator[None]:
+        """An error of one storage file said as the bag's, naming the file."""
+        try:
+            yield
+        except BagError as err:
+            raise BagError(f"storage file {file.name}: {err.message}", path=self.path) from err
 
 
 def open_bag(path: str | Path) -> BagFile:
@@ -287,4 +348,6 @@ def open_bag(path: str | Path) -> BagFile:
         fmt = "ros1"
     if fmt == "ros1":
         return Ros1Bag(p)
+    if fmt == "rosbag2-mcap":
+        return Rosbag2McapFile(p)
     return RosbagsFile(p, fmt)

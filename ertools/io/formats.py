@@ -11,11 +11,16 @@ from __future__ import annotations
 
 import os
 import re
+import stat
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
-from ertools.errors import BagError
+from ertools import yamlin
+from ertools.errors import BagError, shown
+from ertools.inputs import kind_of, open_regular, read_regular, why_not
+from ertools.io import budget
 
 ROS1_MAGIC = b"#ROSBAG V2.0\n"
 MCAP_MAGIC = b"\x89MCAP0\r\n"
@@ -41,8 +46,45 @@ class Found:
 
 
 def is_rosbag2_dir(path: Path) -> bool:
-    """A folder that is one rosbag2 bag: it holds ``metadata.yaml`` or sqlite3 storage files."""
-    return (path / "metadata.yaml").is_file() or any(path.glob("*.db3"))
+    """A folder that is one rosbag2 bag: it holds ``metadata.yaml`` or sqlite3 storage files
+    (False when it cannot be listed)."""
+    try:
+        with os.scandir(path) as it:
+            return _is_rosbag2_listing(list(it))
+    except OSError:
+        return False
+
+
+def _is_rosbag2_listing(entries: list[os.DirEntry[str]]) -> bool:
+    # a metadata.yaml that is no regular file (a pipe) still marks the folder: its reader
+    # then says what is wrong with it
+    for e in entries:
+        if e.name.endswith(".db3") or (e.name == "metadata.yaml" and not _is_dir(e)):
+            return True
+    return False
+
+
+def _is_dir(entry: os.DirEntry[str]) -> bool:
+    try:
+        return entry.is_dir()
+    except OSError:
+        return False
+
+
+def _special(entry: os.DirEntry[str]) -> str:
+    """What a directory entry is when it is neither a regular file nor a folder (symbolic
+    links followed), "" otherwise or when it cannot be looked at (the reader then says)."""
+    try:
+        return kind_of(entry.stat().st_mode)
+    except OSError:
+        return ""
+
+
+NO_SUCH = "no such file or directory"
+
+
+def _unreadable(path: Path | str, err: OSError, what: str = "") -> Unreadable:
+    return Unreadable(shown(path), f"{what}{why_not(err)}")
 
 
 def find_bags(paths: Iterable[Path]) -> Found:
@@ -50,33 +92,106 @@ def find_bags(paths: Iterable[Path]) -> Found:
 
     A file named explicitly is taken whatever its name (the reader then says whether it is a
     bag); directories are walked recursively, and a rosbag2 folder counts as one bag. A path
-    that does not exist, or a folder with no bag, is a problem, not an error: the caller
-    decides.
+    that does not exist, a folder with no bag, a folder that cannot be listed (no permission,
+    a path longer than the system allows) and an entry that is no regular file (a named pipe,
+    a device, a socket) are problems, one each, not errors: the caller decides, and the other
+    paths are still searched.
     """
     bags: list[Path] = []
     problems: list[Unreadable] = []
     for root in paths:
-        if not root.exists():
-            problems.append(Unreadable(str(root), "no such file or directory"))
+        try:
+            mode = os.stat(root).st_mode
+        except FileNotFoundError:
+            problems.append(Unreadable(shown(root), NO_SUCH))
             continue
-        if root.is_file() or is_rosbag2_dir(root):
+        except OSError as err:
+            problems.append(_unreadable(root, err, "cannot look at it: "))
+            continue
+        if stat.S_ISREG(mode):
             bags.append(root)
             continue
-        before = len(bags)
-        for dirpath, dirnames, filenames in os.walk(root):
-            here = Path(dirpath)
-            keep = []
-            for d in sorted(dirnames):
-                if is_rosbag2_dir(here / d):
-                    bags.append(here / d)
-                else:
-                    keep.append(d)
-            dirnames[:] = keep  # do not descend into rosbag2 folders
-            bags.extend(here / f for f in sorted(filenames) if f.endswith(BAG_SUFFIXES))
-        if len(bags) == before:
-            problems.append(Unreadable(str(root), NO_BAGS))
+        if not stat.S_ISDIR(mode):
+            problems.append(Unreadable(shown(root), f"not a regular file ({kind_of(mode)})"))
+            continue
+        before = (len(bags), len(problems))
+        _walk(root, bags, problems)
+        if (len(bags), len(problems)) == before:
+            problems.append(Unreadable(shown(root), NO_BAGS))
     unique = sorted(dict.fromkeys(bags), key=str)
     return Found(tuple(unique), tuple(problems))
+
+
+def _walk(root: Path, bags: list[Path], problems: list[Unreadable]) -> None:
+    """The bags under the folder ``root`` (a rosbag2 folder is one; symbolic links to
+    folders are not followed, but one to a rosbag2 folder is a bag)."""
+    todo = [root]
+    while todo:
+        here = todo.pop()
+        try:
+            with os.scandir(here) as it:
+                entries = sorted(it, key=lambda e: e.name)
+        except OSError as err:
+            problems.append(_unreadable(here, err, "folder skipped: "))
+            continue
+        if _is_rosbag2_listing(entries):
+            bags.append(here)
+            continue
+        subfolders = []
+        for e in entries:
+            path = here / e.name
+            try:
+                folder = e.is_dir()
+                link = e.is_symlink()
+            except OSError as err:
+                problems.append(_unreadable(path, err, "skipped: "))
+                continue
+            if folder:
+                if link:
+                    if is_rosbag2_dir(path):
+                        bags.append(path)
+                else:
+                    subfolders.append(path)
+            elif e.name.endswith(BAG_SUFFIXES):
+                kind = _special(e)
+                if kind:
+                    problems.append(
+                        Unreadable(shown(path), f"not a regular file ({kind}); skipped")
+                    )
+                else:
+                    bags.append(path)
+        todo.extend(reversed(subfolders))
+
+
+def regular_files(paths: Iterable[Path]) -> tuple[list[Path], list[Unreadable]]:
+    """Every regular file under ``paths`` (a file given is itself), and one problem per path
+    or folder that cannot be listed or looked at. Symbolic links to folders are followed once
+    (a link back up the tree is not walked again)."""
+    files: list[Path] = []
+    problems: list[Unreadable] = []
+    seen: set[tuple[int, int]] = set()
+    todo = list(paths)[::-1]
+    while todo:
+        here = todo.pop()
+        try:
+            st = os.stat(here)
+        except OSError as err:
+            problems.append(_unreadable(here, err, "skipped: "))
+            continue
+        if stat.S_ISREG(st.st_mode):
+            files.append(here)
+            continue
+        if not stat.S_ISDIR(st.st_mode) or (st.st_dev, st.st_ino) in seen:
+            continue
+        seen.add((st.st_dev, st.st_ino))
+        try:
+            with os.scandir(here) as it:
+                names = sorted(e.name for e in it)
+        except OSError as err:
+            problems.append(_unreadable(here, err, "folder skipped: "))
+            continue
+        todo.extend(here / name for name in reversed(names))
+    return files, problems
 
 
 def expand(paths: Iterable[Path]) -> list[Path]:
@@ -108,6 +223,8 @@ def metadata_problem(err: Exception) -> str:
     """What is wrong with a ``metadata.yaml``, on one line and without its text: PyYAML's own
     message quotes the offending line, and the file may be anything (a symlink to a secret)."""
     mark = getattr(err, "problem_mark", None)
+    if isinstance(err, yamlin.DuplicateKeyError) and mark is not None:
+        return f"a key given twice, at line {mark.line + 1}"  # its name is the file's text
     if mark is not None:
         problem = getattr(err, "problem", None) or "malformed YAML"
         return f"{problem} at line {mark.line + 1}, column {mark.column + 1}"
@@ -118,15 +235,62 @@ def metadata_problem(err: Exception) -> str:
     return type(err).__name__
 
 
+def load_metadata(path: Path) -> Any:
+    """The parsed ``metadata.yaml`` of the rosbag2 folder ``path``, read as any input is
+    (a regular file, within :data:`~ertools.io.budget.MAX_METADATA_BYTES` and
+    :data:`~ertools.io.budget.MAX_NESTING` levels).
+
+    Raises:
+        OSError: it cannot be read (or is no regular file).
+        BagError: over the budget.
+        yaml.YAMLError, UnicodeDecodeError: it does not parse.
+    """
+    import yaml  # lazy: PyYAML (~25 ms) only for a rosbag2 folder's metadata.yaml
+
+    meta = path / "metadata.yaml"
+    raw = read_regular(meta, budget.MAX_METADATA_BYTES)
+    if len(raw) > budget.MAX_METADATA_BYTES:
+        raise BagError(
+            budget.over_budget(
+                "metadata.yaml",
+                f"more than {budget.MAX_METADATA_BYTES} bytes",
+                budget.MAX_METADATA_BYTES,
+                "MAX_METADATA_BYTES",
+            ),
+            path=path,
+        )
+    text = raw.decode("utf-8")
+    # PyYAML builds nested nodes recursively (a deep file is a RecursionError); its event
+    # parser is not recursive, so the depth is measured first
+    depth = 0
+    for event in yaml.parse(text, Loader=yaml.SafeLoader):
+        if isinstance(event, yaml.CollectionStartEvent):
+            depth += 1
+            if depth > budget.MAX_NESTING:
+                line = event.start_mark.line + 1 if event.start_mark else 0
+                raise BagError(
+                    budget.over_budget(
+                        f"metadata.yaml at line {line}",
+                        "nested deeper",
+                        f"{budget.MAX_NESTING} levels",
+                        "MAX_NESTING",
+                    ),
+                    path=path,
+                )
+        elif isinstance(event, yaml.CollectionEndEvent):
+            depth -= 1
+    return yamlin.load(text)
+
+
 def _rosbag2_storage(path: Path) -> str:
     meta = path / "metadata.yaml"
-    if meta.is_file():
-        import yaml  # lazy: PyYAML (~25 ms) only for a rosbag2 folder's metadata.yaml
-
+    if os.path.exists(meta) and not meta.is_dir():
         try:
-            data = yaml.safe_load(meta.read_text(encoding="utf-8"))
+            data = load_metadata(path)
             storage = str(data["rosbag2_bagfile_information"]["storage_identifier"])
-        except (yaml.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
+        except OSError as err:
+            raise BagError(f"unreadable metadata.yaml ({why_not(err)})", path=path) from err
+        except (yamlin.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
             why = metadata_problem(err)
             raise BagError(
                 f"unreadable rosbag2 metadata.yaml ({why}); re-create it with `ros2 bag reindex`",
@@ -135,7 +299,7 @@ def _rosbag2_storage(path: Path) -> str:
         if storage in ("sqlite3", "mcap"):
             return f"rosbag2-{storage}"
         raise BagError(f"unsupported rosbag2 storage {storage!r}", path=path)
-    if any(path.glob("*.db3")):
+    if is_rosbag2_dir(path):
         return "rosbag2-sqlite3"
     raise BagError(
         "directory is not a rosbag2 bag (no metadata.yaml); give the bag files inside it",
@@ -150,15 +314,19 @@ def detect_format(path: str | Path) -> str:
         BagError: missing path, empty file, or bytes that are no bag.
     """
     p = Path(path)
-    if not p.exists():
-        raise BagError("no such file or directory", path=p)
-    if p.is_dir():
+    try:
+        mode = os.stat(p).st_mode
+    except FileNotFoundError as err:
+        raise BagError(NO_SUCH, path=p) from err
+    except OSError as err:
+        raise BagError(f"cannot open: {why_not(err)}", path=p) from err
+    if stat.S_ISDIR(mode):
         return _rosbag2_storage(p)
     try:
-        with p.open("rb") as f:
+        with open_regular(p) as f:
             head = f.read(len(ROS1_MAGIC))
     except OSError as err:
-        raise BagError(f"cannot open: {err.strerror}", path=p) from err
+        raise BagError(f"cannot open: {why_not(err)}", path=p) from err
     if not head:
         raise BagError("empty file (0 bytes): not a bag", path=p)
     if len(head) < len(ROS1_MAGIC) and (ROS1_MAGIC.startswith(head) or MCAP_MAGIC.startswith(head)):

@@ -24,7 +24,7 @@ from ertools.io.model import BagSummary
 from ertools.io.ros1.check import check_ros1
 from ertools.io.ros1.index import Ros1Bag
 from ertools.io.rosbag2.metadata import query, readable_files
-from ertools.io.summary import INDEX_SELF_CHECK, summary_and_times
+from ertools.io.summary import CHUNK_SELF_CHECK, INDEX_SELF_CHECK, summary_and_times
 from ertools.timeutil import iso_utc, ns_to_s
 
 if TYPE_CHECKING:
@@ -124,7 +124,7 @@ def describe(path: str | Path, *, check: bool = False, progress: Reporter | None
     found = verify(Path(path), progress) if check else []
     if check:
         # the record-level check says each index disagreement exactly: not twice
-        kept = [p for p in s.problems if not p.endswith(INDEX_SELF_CHECK)]
+        kept = [p for p in s.problems if not p.endswith((INDEX_SELF_CHECK, CHUNK_SELF_CHECK))]
         s = replace(s, problems=type(s.problems)(kept))
     return BagInfo(s, rates, check, tuple(found))
 

@@ -28,6 +28,7 @@ import numpy as np
 
 from ertools.arrays import I64
 from ertools.errors import BagError
+from ertools.inputs import open_regular
 from ertools.io.decode.fast import LayoutMismatchError, gather
 from ertools.io.formats import detect_format
 from ertools.io.mcap.index import McapIndex
@@ -166,6 +167,9 @@ def _ros1(path: Path, fmt: str, exact: bool, times: Times | None = None) -> BagS
 MAX_INDEX_PROBLEMS = 5
 # Ends each such line: ``info --check`` replaces them by its record-level lines.
 INDEX_SELF_CHECK = "(damaged index; info --check reads the records)"
+# Ends a line on a chunk that does not decompress (damaged, or over the budget): info --check
+# says the same of every chunk.
+CHUNK_SELF_CHECK = "(info --check reads every chunk)"
 
 
 def _ros1_check_ends(bag: Any, chunks: list[Any], spans: dict[int, list[int]]) -> list[str]:
@@ -185,11 +189,20 @@ def _ros1_check_ends(bag: Any, chunks: list[Any], spans: dict[int, list[int]]) -
             continue
         where = f"in {bag.path} at byte {chunk.pos}"
         try:
-            buf = np.frombuffer(bag.chunk_bytes(chunk), dtype=np.uint8)
+            data = bag.chunk_bytes(chunk)
+        except BagError as err:  # damaged data or over the budget, not a damaged index
+            return [f"{err.message} {CHUNK_SELF_CHECK}"]
+        try:
+            buf = np.frombuffer(data, dtype=np.uint8)
             entries = bag.chunk_entries(chunk)
-            for cid in bounding:
-                t, off = entries.get(cid, (np.empty(0, np.int64), np.empty(0, np.int64)))
-                bag.checked_spans(buf, off, t, np.full(len(t), cid, dtype=np.int64), where)
+            found = [(cid, *entries[cid]) for cid in bounding if cid in entries]
+            if found:
+                # one check of every bounding connection's entries: a call per connection
+                # cost 0.26 ms each (40,000 connections: 10 s)
+                t = np.concatenate([f[1] for f in found])
+                off = np.concatenate([f[2] for f in found])
+                conn = np.repeat([f[0] for f in found], [len(f[1]) for f in found])
+                bag.checked_spans(buf, off, t, conn.astype(np.int64), where)
         except BagError as err:
             return [f"chunk at byte {chunk.pos}: {err.message} {INDEX_SELF_CHECK}"]
     return []
@@ -273,7 +286,7 @@ def _mcap_indexed(
     counts: dict[int, int] = {} if read_indexes else dict(stats.channel_message_counts)
     # channel -> (chunk, message index offset) of every chunk holding it
     located: dict[int, list[tuple[Any, int]]] = {}
-    with path.open("rb") as f:
+    with open_regular(path) as f:
         for chunk in summary.chunk_indexes:
             compressions.add(chunk.compression or "none")
             for cid, offset in chunk.message_index_offsets.items():
@@ -340,7 +353,7 @@ def _check_ends(
     """
 
     chunks: dict[int, np.ndarray] = {}
-    with path.open("rb") as f:
+    with open_regular(path) as f:
         for cid, where in located.items():
             lo, hi = spans[cid]
             for chunk, offset in where:
@@ -400,7 +413,7 @@ def _mcap_version(path: Path) -> str:
     from mcap.reader import make_reader  # lazy: the mcap library only when an MCAP file is read
 
     try:
-        with path.open("rb") as f:
+        with open_regular(path) as f:
             header = make_reader(f).get_header()
     except mcap_errors():
         return ""

@@ -20,6 +20,7 @@ A bad value is one line naming its row (the file's line number) and column.
 from __future__ import annotations
 
 import csv
+import io
 from dataclasses import dataclass
 from decimal import ROUND_HALF_EVEN, Decimal, InvalidOperation
 from pathlib import Path
@@ -30,6 +31,7 @@ import numpy.typing as npt
 
 from ertools.arrays import F64, I64
 from ertools.errors import BagError
+from ertools.inputs import open_regular, read_regular_text, why_not
 from ertools.streams import PoseStream
 
 TextFormat = Literal["tum", "kitti", "euroc", "csv"]
@@ -77,7 +79,7 @@ def sniff(path: str | Path) -> TextFormat | None:
     if not p.is_file():
         return None
     try:
-        with p.open("rb") as f:
+        with open_regular(p) as f:
             head = f.read(_SNIFF_BYTES)
     except OSError:
         return None  # the bag reader says why
@@ -117,11 +119,11 @@ def sniff(path: str | Path) -> TextFormat | None:
 
 def _rows(path: Path, fmt: TextFormat) -> _Rows:
     try:
-        text = path.read_text(encoding="utf-8-sig")
+        text = read_regular_text(path, "utf-8-sig")
     except UnicodeDecodeError as err:
         raise BagError(f"not a {fmt.upper()} text file (not UTF-8 text)", path=path) from err
     except OSError as err:
-        raise BagError(f"cannot read: {err.strerror}", path=path) from err
+        raise BagError(f"cannot read: {why_not(err)}", path=path) from err
     stripped = [ln.strip() for ln in text.splitlines()]
     header = fmt == "csv"
     keep = [
@@ -304,7 +306,7 @@ def read_text_poses(path: str | Path, fmt: TextFormat | None = None) -> PoseStre
     """
     p = Path(path)
     if not p.exists():
-        raise BagError("no such file or directory", path=p)
+        raise BagError("no such file or directory", path=p, transient=True)
     kind = fmt if fmt is not None else sniff(p)
     if kind is None:
         raise BagError("not a text trajectory (TUM, KITTI, EuRoC or ertools CSV)", path=p)
@@ -342,7 +344,7 @@ def read_text_poses(path: str | Path, fmt: TextFormat | None = None) -> PoseStre
 def _csv_frame(path: Path) -> str:
     """The frame_id of ertools' CSV (one value repeated): read with the csv module, which
     undoes the RFC 4180 quoting the writer applied."""
-    with path.open(encoding="utf-8", newline="") as f:
+    with io.TextIOWrapper(open_regular(path), encoding="utf-8", newline="") as f:
         reader = csv.reader(f)
         next(reader, None)
         row = next(reader, None)

@@ -16,7 +16,7 @@ import time
 from pathlib import Path
 from typing import IO, Any
 
-from ertools import __version__
+from ertools import __version__, atomic
 from ertools.errors import BagError
 from ertools.live.rosmsg import MESSAGE_ENCODING, SCHEMA_ENCODING, Ros2Serializer
 
@@ -63,6 +63,9 @@ class LogFile:
             self._stream: IO[bytes] = open(path, "xb")  # noqa: SIM115 - closed in close()
         except OSError as err:
             raise BagError(f"cannot create log file: {err.strerror or err}", path=path) from err
+        # held from the first byte to the last (and released however the recorder ends):
+        # `record --recover` refuses a file locked so (ertools.live.recover)
+        atomic.hold(self._stream.fileno())
         self._writer: Any = Writer(self._stream, chunk_size=chunk_size, compression=kind)
         self._writer.start(profile="ros2", library=f"ertools {__version__} record")
         self._schemas: dict[str, int] = {}

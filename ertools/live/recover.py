@@ -48,7 +48,20 @@ def recover(path: Path) -> Recovered:
             recover), or ``path.cut`` exists already (a recovery done before).
     """
     if not path.is_file():
-        raise BagError("no such file", path=path)
+        raise BagError("no such file", path=path, transient=True)
+    with open(path, "rb") as held:
+        # a recorder holds its file's lock until its last byte: cutting it now would leave
+        # the recorder writing into the part cut off
+        if not atomic.hold(held.fileno()):
+            raise BagError(
+                "is being recorded (a recorder holds its lock); --recover is for a recording "
+                "cut short",
+                path=path,
+            )
+        return _recover(path)
+
+
+def _recover(path: Path) -> Recovered:
     size = path.stat().st_size
     if is_finished(path):
         return Recovered(path, None, 0, size, size)

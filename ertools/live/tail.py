@@ -14,6 +14,10 @@ import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ertools.errors import BagError
+from ertools.inputs import open_regular
+from ertools.io.inflate import inflate
+
 MAGIC = b"\x89MCAP0\r\n"
 _RECORD_HEAD = struct.Struct("<BQ")
 OP_FOOTER = 0x02
@@ -27,7 +31,7 @@ MAX_RECORD = 1 << 31
 def is_finished(path: Path) -> bool:
     """True when the file ends with MCAP's closing magic (closed cleanly)."""
     try:
-        with open(path, "rb") as f:
+        with open_regular(path) as f:
             f.seek(0, 2)
             if f.tell() < 2 * len(MAGIC):
                 return False
@@ -51,18 +55,10 @@ _CHUNK_HEAD = struct.Struct("<QQQI")  # start time, end time, uncompressed size,
 _MESSAGE_HEAD = struct.Struct("<HIQQ")  # channel id, sequence, log time, publish time
 
 
-def _decompress(compression: str, data: bytes, size: int) -> bytes:
-    if compression == "zstd":
-        import zstandard  # lazy: a decompressor only for compressed chunks
-
-        return bytes(zstandard.ZstdDecompressor().decompress(data, max_output_size=size))
-    if compression == "lz4":
-        import lz4.frame  # lazy: a decompressor only for compressed chunks
-
-        return bytes(lz4.frame.decompress(data))
-    if compression == "":
-        return data
-    raise ValueError(f"unsupported chunk compression {compression!r}")
+def _decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
+    # the one bounded decompressor of every reader (the budget of docs/io.md)
+    out: bytes = inflate(compression, data, size, where, "MCAP chunk")
+    return out
 
 
 @dataclass
@@ -92,7 +88,7 @@ class McapTail:
         if self.finished or self.corrupt:
             return out
         try:
-            with open(self.path, "rb") as f:
+            with open_regular(self.path) as f:
                 f.seek(self.offset)
                 data = f.read()
         except OSError:
@@ -133,7 +129,7 @@ class McapTail:
                     self._channel(data, body)
                 elif opcode == OP_MESSAGE:
                     self._message(data, body, end, cutoff, keep_data, out)
-            except (struct.error, ValueError, UnicodeDecodeError) as err:
+            except (struct.error, ValueError, UnicodeDecodeError, BagError) as err:
                 self.corrupt = f"unreadable record at offset {self.offset + body - 9}: {err}"
                 pos = body - _RECORD_HEAD.size
                 break
@@ -171,7 +167,8 @@ class McapTail:
         p += 4 + n
         (length,) = _U64.unpack_from(data, p)
         p += 8
-        records = _decompress(compression, data[p : p + length], size)
+        where = f"at offset {self.offset + pos}"
+        records = _decompress(compression, data[p : p + length], size, where)
         skip_messages = cutoff is not None and end_time < cutoff
         q = 0
         while q + _RECORD_HEAD.size <= len(records):

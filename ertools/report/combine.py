@@ -24,11 +24,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ertools import __version__, atomic
+from ertools import __version__, atomic, jsonin
 from ertools.benchmarks import registry
 from ertools.benchmarks.common.teams import team_from_log_name
 from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ConfigError
+from ertools.inputs import read_regular_text, why_not
 from ertools.report import html as h
 from ertools.report import ranks, units
 from ertools.report.folder import headline
@@ -114,9 +115,12 @@ def _options(argv: list[str], inputs: list[dict[str, Any]]) -> str:
 
 
 def _load_json(path: Path) -> Any:
+    """A result's JSON; a key given twice is refused (the json module keeps the last)."""
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
+        return jsonin.loads(read_regular_text(path))  # a named pipe would block for ever
+    except OSError as err:
+        raise ConfigError(f"cannot read a result: {why_not(err)}", path=path) from err
+    except (UnicodeDecodeError, ValueError) as err:
         raise ConfigError(f"cannot read a result: {err}", path=path) from err
 
 
@@ -138,7 +142,7 @@ def load_entry(path: Path) -> Entry:
     """A result from a report folder, a ``result.json`` or a ``score.json``."""
 
     if not path.exists():
-        raise ConfigError("no such file or folder", path=path)
+        raise ConfigError("no such file or folder", path=path, transient=True)
     folder = path if path.is_dir() else path.parent
     meta_path = folder / "result.json"
     if path.is_dir() and not meta_path.exists():
@@ -253,7 +257,7 @@ def combine(
                 row["rank"] = standing.marker if standing else "\u2014"
             row["team"] = x.team or "(unknown)"
             for k in keys:
-                row[k] = e.headline.get(k)
+                row[k] = _finite(e.headline.get(k))
                 if k == board.key and board.has_intervals:  # its interval right beside it
                     row[board.interval_header] = _interval_text(board.key, record["interval"])
                     row[_P_HEADER] = (
@@ -305,7 +309,8 @@ def combine(
                 **_board_context(board),
             }
         )
-    atomic.write_text(outdir / "results.json", json.dumps(flat, indent=2) + "\n")
+    text = json.dumps(_finite(flat), indent=2, allow_nan=False)
+    atomic.write_text(outdir / "results.json", text + "\n")
     table = [_csv_row(row) for row in flat]
     columns = list(dict.fromkeys(k for row in table for k in row))
     buffer = io.StringIO()
@@ -330,6 +335,18 @@ def combine(
 
 
 _P_HEADER = "P(swap with next)"
+
+
+def _finite(value: Any) -> Any:
+    """``value`` with every float that is not finite (a result's Infinity, NaN) as None:
+    results.json stays JSON, and the tables show no such number."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(v) for v in value]
+    return value
 
 
 @dataclass(frozen=True)
@@ -372,8 +389,11 @@ def _board(bench: str, group: list[Execution], chosen: float | None = None) -> B
         if unscoreable is not None:
             reasons[i] = f"unscoreable: {unscoreable}"
             continue
-        if isinstance(value, bool) or not isinstance(value, int | float) or math.isnan(value):
+        if isinstance(value, bool) or not isinstance(value, int | float):
             reasons[i] = f"no {key} in this result"
+            continue
+        if not math.isfinite(value):  # json reads Infinity and NaN: never a place on a board
+            reasons[i] = f"{key} is {value} in this result: not a finite number"
             continue
         contenders.append(
             ranks.Contender(

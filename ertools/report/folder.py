@@ -18,6 +18,7 @@ is one) becomes the score of the folder, and ``audit.yaml``/``audit.json`` are a
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
@@ -102,6 +103,7 @@ def _write_report(
     if not team:
         team, team_source = _team(argv, inputs, score, audit, configs)
 
+    before = _listed(outdir)
     written: list[str] = []
     if score is not None:
         _write(outdir / "score.yaml", score.to_yaml())
@@ -121,6 +123,7 @@ def _write_report(
     figures, figure_problems = _figures(score, audit, outdir / "figures")
 
     generated = datetime.now(UTC).isoformat(timespec="seconds")
+    files = [*written, "index.html", *(f"figures/{p.name}" for p, _ in figures)]
     meta = {
         "benchmark": benchmark,
         "team": team,
@@ -135,7 +138,7 @@ def _write_report(
         "warnings": list(_warnings(score, audit)),
         "failures": list(score.failures if score is not None else ()),
         "audit": _audit_summary(audit),
-        "files": [*written, "index.html", *(f"figures/{p.name}" for p, _ in figures)],
+        "files": files,
     }
     _write(outdir / "result.json", json.dumps(jsonable(meta), indent=2))
     page = folder_page.page(
@@ -143,7 +146,30 @@ def _write_report(
     )
     index = outdir / "index.html"
     _write(index, page)
+    _remove_stale(outdir, before - set(files))
     return index
+
+
+def _listed(outdir: Path) -> set[str]:
+    """The files a report already in ``outdir`` wrote (its ``result.json`` lists them)."""
+    try:
+        files = json.loads((outdir / "result.json").read_text(encoding="utf-8"))["files"]
+    except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError):
+        return set()  # no report of ertools' here: nothing is ours to remove
+    return {f for f in files if isinstance(f, str)} if isinstance(files, list) else set()
+
+
+def _remove_stale(outdir: Path, names: set[str]) -> None:
+    """Remove the files of the previous report in ``outdir`` that this one did not write (a
+    reused folder kept another benchmark's tables and figures beside the new ones); only
+    files inside the folder, never anything else there."""
+    root = outdir.resolve()
+    for name in sorted(names):
+        path = (outdir / name).resolve()
+        if path.parent == root or root in path.parents:
+            with contextlib.suppress(OSError):
+                if path.is_file():
+                    path.unlink()
 
 
 # --------------------------------------------------------------------------------------------

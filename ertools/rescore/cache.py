@@ -37,6 +37,7 @@ from ertools.rescore.jobs import Job, Outcome
 
 CACHE_VERSION = 2
 STATUSES = ("scored", "unscoreable")
+_READS = 3  # times a file changing while it is hashed is read again
 
 
 def _sha256_file(path: Path) -> str:
@@ -71,15 +72,24 @@ class FileHashes:
         return [st.st_size, st.st_mtime_ns, st.st_ino]
 
     def sha256(self, path: Path, key: str | None = None) -> str:
-        """The file's SHA-256, remembered by ``key`` (its resolved path unless given)."""
+        """The file's SHA-256, remembered by ``key`` (its resolved path unless given).
+
+        A file that changes while it is read (its stamp before and after differ) is read
+        again; one that keeps changing is not remembered: the hash is of bytes that are gone.
+        """
         key = key if key is not None else str(path.resolve())
         stamp = self._stamp(path)
         known = self.known.get(key)
         if known is not None and known[:3] == stamp:
             return str(known[3])
-        digest = _sha256_file(path)
-        self.known[key] = [*stamp, digest]
-        self.changed = True
+        for _ in range(_READS):
+            digest = _sha256_file(path)
+            after = self._stamp(path)
+            if after == stamp:
+                self.known[key] = [*stamp, digest]
+                self.changed = True
+                break
+            stamp = after
         return digest
 
     def size(self, path: Path) -> int:
@@ -90,6 +100,72 @@ class FileHashes:
             return
         self.store.parent.mkdir(parents=True, exist_ok=True)
         atomic.write_text(self.store, json.dumps(self.known, sort_keys=True))
+
+
+def job_files(job: Job) -> list[Path]:
+    """Every file a job reads by name: its bags, then the files among its input values."""
+    files = [Path(b) for b in job.bags]
+    for value in job.values.values():
+        for item in value if isinstance(value, tuple | list) else (value,):
+            if isinstance(item, Path):
+                files.append(item)
+    return list(dict.fromkeys(files))
+
+
+def file_state(path: Path) -> tuple[Any, ...] | None:
+    """What says a file is unchanged (size, times, inode; of each file of a rosbag2 folder),
+    finer than the hash memo's stamp: the change time, which no tool sets back, counts too.
+    None: the file is gone (or cannot be looked at)."""
+    try:
+        if path.is_dir():
+            return tuple(
+                (p.relative_to(path).as_posix(), *_stat_state(p))
+                for p in sorted(path.rglob("*"))
+                if p.is_file()
+            )
+        return _stat_state(path)
+    except OSError:
+        return None
+
+
+def _stat_state(path: Path) -> tuple[int, ...]:
+    st = path.stat()
+    return (st.st_size, st.st_mtime_ns, st.st_ctime_ns, st.st_ino, st.st_dev)
+
+
+Fingerprints = dict[str, tuple[tuple[Any, ...] | None, str]]
+
+
+def fingerprints(job: Job, hashes: FileHashes) -> Fingerprints:
+    """Each of the job's files' state and SHA-256 as it is keyed (taken after :func:`job_key`,
+    whose hashes are remembered: nothing is read again)."""
+    out: Fingerprints = {}
+    for path in job_files(job):
+        state = file_state(path)
+        try:
+            digest = hashes.sha256(path)
+        except OSError:  # gone since it was keyed: said after scoring
+            digest = ""
+        # changed while it was hashed: looked at again after scoring
+        out[str(path)] = (state if file_state(path) == state else None, digest)
+    return out
+
+
+def changed_files(before: Fingerprints, hashes: FileHashes) -> list[str]:
+    """The files of ``before`` whose bytes are not those keyed any more: gone, or of another
+    SHA-256 (a file whose state is unchanged is not read again)."""
+    changed = []
+    for name, (state, digest) in before.items():
+        path = Path(name)
+        now = file_state(path)
+        if state is not None and now == state:
+            continue
+        try:
+            if now is None or hashes.sha256(path) != digest:
+                changed.append(name)
+        except OSError:
+            changed.append(name)
+    return changed
 
 
 def _hash_row(row: Any) -> bool:

@@ -146,7 +146,7 @@ class Child:
         try:
             pickle.dump(job, self._jobs)
             self._jobs.flush()
-        except OSError:
+        except (OSError, ValueError):  # ValueError: closed meanwhile, as in receive
             return False
         self._busy = True
         return True
@@ -155,8 +155,8 @@ class Child:
         """The outcome of the job sent last (waiting for it); None when the child died."""
         try:
             outcome: Outcome = pickle.load(self._out)  # from our own child: trusted
-        except (EOFError, OSError, pickle.UnpicklingError):
-            return None
+        except (EOFError, OSError, ValueError, pickle.UnpicklingError):
+            return None  # ValueError: closed meanwhile (the process's server closed)
         self._busy = False
         return outcome
 
@@ -210,6 +210,9 @@ class ForkServer:
                 + (["preload"] if preload else []),
                 pass_fds=[theirs.fileno()],
                 stdin=subprocess.DEVNULL,
+                # a Ctrl-C at the terminal is its owner's to act on (it closes the server);
+                # in the terminal's process group, the server would print its own traceback
+                start_new_session=True,
                 env={**os.environ, "PYTHONPATH": path},
             )
             self._pid = self._popen.pid
@@ -354,6 +357,9 @@ def _score(channel: socket.socket, server: int) -> int:
 
 
 _servers: dict[int, ForkServer] = {}  # by the pid that started it: a forked copy is not ours
+# the calls inside forks_ready, by pid: two rescorings at once (two threads of a notebook)
+# share the server, and the last to end closes it, never one the other still uses
+_users: dict[int, int] = {}
 _server_lock = threading.Lock()
 _local = threading.local()  # a thread's child, kept for its next job (a Dask worker's thread)
 _children: list[Child] = []  # every child of this process: closed with the server
@@ -372,31 +378,50 @@ def server(*, preload: bool = False) -> ForkServer:
 
 
 def close_server() -> None:
-    """Close this process's scoring children and its fork server, if it has them."""
+    """Close this process's scoring children and its fork server, if it has them (at exit,
+    whoever still uses them: see :func:`close_idle_server`)."""
     with _server_lock:
-        mine = [c for c in _children if c.owner == os.getpid()]
-        _children[:] = [c for c in _children if c.owner != os.getpid()]
-        for child in mine:
-            child.close()
-        if (ours := _servers.pop(os.getpid(), None)) is not None:
-            ours.close()
+        _close_locked()
+
+
+def _close_locked() -> None:
+    mine = [c for c in _children if c.owner == os.getpid()]
+    _children[:] = [c for c in _children if c.owner != os.getpid()]
+    for child in mine:
+        child.close()
+    if (ours := _servers.pop(os.getpid(), None)) is not None:
+        ours.close()
 
 
 atexit.register(close_server)  # no orphan; the children's CPU time counts as this process's
 
 
+def close_idle_server() -> None:
+    """:func:`close_server`, unless a :func:`forks_ready` block of this process still runs
+    (another thread's rescoring): its last block closes it."""
+    with _server_lock:
+        if not _users.get(os.getpid(), 0):
+            _close_locked()
+
+
 @contextlib.contextmanager
 def forks_ready(*, preload: bool = False) -> Iterator[None]:
     """This process's fork server, started now if it has none (in a command: before any
-    thread), and then closed with its children at the end. ``preload``: the server imports
-    what ertools' benchmarks import lazily as it starts (:data:`SCORING_IMPORTS`)."""
-    started = os.getpid() not in _servers
-    server(preload=preload)
+    thread), and then closed with its children when the last block of this process using it
+    ends (blocks of several threads overlap: each its own rescoring). ``preload``: the server
+    imports what ertools' benchmarks import lazily as it starts (:data:`SCORING_IMPORTS`)."""
+    pid = os.getpid()
+    with _server_lock:
+        _users[pid] = _users.get(pid, 0) + 1
     try:
+        server(preload=preload)
         yield
     finally:
-        if started:
-            close_server()
+        with _server_lock:
+            _users[pid] -= 1
+            if not _users[pid]:
+                del _users[pid]
+                _close_locked()
 
 
 def new_child(job: Job) -> Child:
@@ -454,7 +479,8 @@ def died(child: Child, job: Job, scorer: str) -> Outcome:
 if __name__ == "__main__":  # a fork server as a fresh interpreter: ForkServer, with threads
     _fd, _owner = (int(arg) for arg in sys.argv[1:3])
     _preload = sys.argv[3:] == ["preload"]
-    # Also ends when the owner's thread that started it ends (PR_SET_PDEATHSIG): a Dask
-    # worker's task threads live as long as the worker
-    end_with_parent(_owner)
+    # It ends when its owner ends, however: the owner's end of the control socket closes and
+    # the loop reads its end. Not by PR_SET_PDEATHSIG, which fires when the owner's *thread*
+    # that started it ends: a notebook's thread that ran one rescoring, while another thread's
+    # rescoring still uses the server (issue 36).
     _serve(socket.socket(fileno=_fd), preload=_preload)

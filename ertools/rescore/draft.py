@@ -25,6 +25,7 @@ from typing import Any
 
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Input
+from ertools.io.formats import regular_files
 from ertools.rescore.discover import Execution
 from ertools.rescore.found import Found, robot_benchmarks
 from ertools.rescore.ledger import Claim, place_files, root_of
@@ -40,17 +41,9 @@ def _utc(ns: int) -> str:
 
 def config_files(paths: Sequence[Path]) -> list[Path]:
     """The YAML files under ``paths`` (the candidates for file inputs), sorted."""
-    out: set[Path] = set()
-    for path in paths:
-        if path.is_file() and path.suffix.lower() in CONFIG_SUFFIXES:
-            out.add(path.resolve())
-        elif path.is_dir():
-            out |= {
-                p.resolve()
-                for p in path.rglob("*")
-                if p.is_file() and p.suffix.lower() in CONFIG_SUFFIXES
-            }
-    return sorted(out)
+    # a folder that cannot be listed is one of the timeline scan's problems already
+    found, _problems = regular_files(paths)
+    return sorted({p.resolve() for p in found if p.suffix.lower() in CONFIG_SUFFIXES})
 
 
 def _stem(path: Path) -> str:

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 from ertools.benchmarks import registry
 from ertools.benchmarks.common.teams import read_payload_team
 from ertools.io.clock import clock_check
+from ertools.io.formats import regular_files
 from ertools.progress import Reporter
 from ertools.report.timeline_page import write_timeline_page
 from ertools.rescore.discover import Discovery, Execution, discover
@@ -74,10 +75,13 @@ def list_files(paths: Sequence[Path]) -> tuple[tuple[str, ...], tuple[str, ...]]
         path = path.resolve()
         if path.is_dir():
             folders.append(str(path))
-            files |= {str(p) for p in path.rglob("*") if p.is_file()}
         elif path.is_file():
             folders.append(str(path.parent))
-            files.add(str(path))
+        else:
+            continue
+        # a folder that cannot be listed is one of the timeline scan's problems already
+        found, _problems = regular_files([path])
+        files |= {str(p) for p in found}
     return tuple(sorted(files)), tuple(dict.fromkeys(folders))
 
 

@@ -11,10 +11,12 @@ costs one row.
 
 from __future__ import annotations
 
+import contextlib
 import logging
+import threading
 import time
 import traceback
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from importlib import import_module
 from pathlib import Path
@@ -24,7 +26,7 @@ from ertools.audit.compare import attach
 from ertools.benchmarks.base import Benchmark, jsonable
 from ertools.benchmarks.common.teams import with_team
 from ertools.benchmarks.document import all_failed, score_json
-from ertools.errors import ErtoolsError
+from ertools.errors import ErtoolsError, transient_error, watching
 from ertools.progress import reporting
 from ertools.report.folder import _audit_inputs, write_report
 
@@ -126,65 +128,114 @@ def load_benchmark(target: str) -> Benchmark[Any, Any, Any, Any]:
 def run_job(job: Job) -> Outcome:
     """Score one job; every problem becomes the outcome's status and reason, never a raise."""
     start = time.perf_counter()
-    logger = logging.getLogger("ertools")
-    handlers, propagate = logger.handlers[:], logger.propagate
-    captured = _Capture()
     # what the readers log (a file not indexed...) belongs to this execution's row, not to
     # stderr interleaved from several workers
-    logger.handlers[:] = [captured]
-    logger.propagate = False
+    with _capturing() as captured:
+        outcome, met = _outcome(job)
+    seconds = round(time.perf_counter() - start, 3)
+    logged = tuple(dict.fromkeys(captured))
+    extra: tuple[str, ...] = ()
+    if met and not outcome.machine:
+        # met and handled by the scorer (a GT file skipped for a moment): what it computed may
+        # not be what the same bytes give next time
+        extra = (transient_note(met[0]),)
+    return Outcome(
+        **{
+            **outcome.__dict__,
+            "seconds": seconds,
+            "warnings": (*logged, *outcome.warnings, *extra),
+            "machine": outcome.machine or bool(met),
+        }
+    )
+
+
+def _outcome(job: Job) -> tuple[Outcome, list[BaseException]]:
+    """The job's outcome, and the transient errors met while it was scored."""
+    met: list[BaseException] = []
     try:
         # a worker forked from the command holds its progress bar: the bar is the parent's, and
         # counts executions; the reads inside one report nothing
-        with reporting(None):
-            outcome = _score(job)
+        with reporting(None), watching() as met:
+            return _score(job), met
     except ErtoolsError as err:
-        outcome = Outcome(
+        return Outcome(
             job.id,
             "unscoreable",
             reason=one_line(str(err)),
             error=type(err).__name__,
-            machine=_of_the_machine(err),
-        )
+            machine=transient_error(err),
+        ), met
     except Exception as err:  # a bug in a scorer: this execution's row only
         where = traceback.extract_tb(err.__traceback__)[-1] if err.__traceback__ else None
         at = f" at {Path(where.filename).name}:{where.lineno}" if where else ""
-        outcome = Outcome(
+        return Outcome(
             job.id,
             "failed",
             reason=one_line(f"unexpected {type(err).__name__}: {err}{at}"),
             error=type(err).__name__,
-        )
-    finally:
-        logger.handlers[:] = handlers
-        logger.propagate = propagate
-    seconds = round(time.perf_counter() - start, 3)
-    logged = tuple(dict.fromkeys(captured.lines))
-    return Outcome(
-        **{**outcome.__dict__, "seconds": seconds, "warnings": (*logged, *outcome.warnings)}
+        ), met
+
+
+def transient_note(err: BaseException) -> str:
+    """The warning of an execution scored while a problem of the machine or the moment was met
+    (:func:`ertools.errors.transient_error`): not cached, scored again by the next run."""
+    return (
+        f"a problem of the machine or the moment was met while it was scored "
+        f"({one_line(str(err))}): not kept in the cache, a rerun scores it again"
     )
 
 
-def _of_the_machine(err: BaseException) -> bool:
-    """An error caused by the machine, not the data: an OSError anywhere in its chain (a
-    report folder not writable, a disk full, a log unreadable for its permissions)."""
-    seen: BaseException | None = err
-    while seen is not None:
-        if isinstance(seen, OSError):
-            return True
-        seen = seen.__cause__ or seen.__context__
-    return False
-
-
-class _Capture(logging.Handler):
-    """Keeps the warnings logged while one job is scored."""
+class _Dispatch(logging.Handler):
+    """On the ``ertools`` logger while jobs are scored: a record logged by a thread scoring a
+    job goes to that job's lines; any other thread's to the handlers the logger had. Two
+    rescorings of one process score in two threads at once (jobs=1, or two calls of a
+    notebook): each job's warnings are its own row's, and the logger is given back whole."""
 
     def __init__(self) -> None:
-        super().__init__(logging.WARNING)
-        self.lines: list[str] = []
+        super().__init__(logging.NOTSET)
+        self.lines = threading.local()  # .lines: the current thread's job's lines
+        self.guard = threading.Lock()
+        self.users = 0
+        self.saved: tuple[list[logging.Handler], bool] = ([], True)
 
     def emit(self, record: logging.LogRecord) -> None:
-        self.lines.append(one_line(record.getMessage()))
+        lines: list[str] | None = getattr(self.lines, "lines", None)
+        if lines is not None:
+            if record.levelno >= logging.WARNING:
+                lines.append(one_line(record.getMessage()))
+            return
+        handlers, propagate = self.saved
+        for handler in handlers:
+            if record.levelno >= handler.level:
+                handler.handle(record)
+        parent = logging.getLogger("ertools").parent
+        if propagate and parent is not None:
+            parent.callHandlers(record)
+
+    @contextlib.contextmanager
+    def capture(self) -> Iterator[list[str]]:
+        """The warnings this thread logs while the block runs (not shown elsewhere)."""
+        logger = logging.getLogger("ertools")
+        with self.guard:
+            if self.users == 0:
+                self.saved = (logger.handlers[:], logger.propagate)
+                logger.handlers[:] = [self]
+                logger.propagate = False
+            self.users += 1
+        outer = getattr(self.lines, "lines", None)
+        lines: list[str] = []
+        self.lines.lines = lines
+        try:
+            yield lines
+        finally:
+            self.lines.lines = outer
+            with self.guard:
+                self.users -= 1
+                if self.users == 0:
+                    logger.handlers[:], logger.propagate = self.saved
+
+
+_capturing = _Dispatch().capture
 
 
 def _score(job: Job) -> Outcome:

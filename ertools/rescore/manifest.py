@@ -39,6 +39,7 @@ from ertools.benchmarks import registry
 from ertools.benchmarks.base import Benchmark, Input, rename_former
 from ertools.configs._yaml import MAX_SECONDS, number, parse_yaml, show
 from ertools.errors import BagError, ConfigError
+from ertools.inputs import read_regular
 from ertools.io.formats import detect_format
 from ertools.io.text import sniff
 from ertools.timeutil import s_to_ns
@@ -93,6 +94,8 @@ class Manifest:
     benchmarks: Mapping[str, BenchmarkEntry]
     executions: tuple[ListedExecution, ...] = ()
     declared: Mapping[str, tuple[Input, ...]] = field(default_factory=dict)
+    # executions listed more than once (YAML aliases, copies), one line each: scored once
+    duplicates: tuple[str, ...] = ()
 
     def values_for(
         self, benchmark: str, team: str | None, overrides: Mapping[str, Any] | None = None
@@ -128,7 +131,7 @@ class Manifest:
 def load_manifest(path: Path) -> Manifest:
     """Read, safe-load and validate a manifest; :class:`ManifestError` lists every problem."""
     try:
-        raw = path.read_bytes()
+        raw = read_regular(path)  # a named pipe would block open() for ever
     except FileNotFoundError:
         raise ConfigError("manifest not found", path=path) from None
     except OSError as err:
@@ -208,13 +211,15 @@ class _Checker:
             executions = []
         listed = [self.execution(i, item) for i, item in enumerate(executions)]
         declared = {name: bm.inputs for name, bm in self.benchmarks.items()}
+        once, duplicates = _listed_once([e for e in listed if e is not None])
         manifest = Manifest(
             path=path.resolve(),
             sha256=sha256,
             title=title,
             benchmarks=entries,
-            executions=tuple(e for e in listed if e is not None),
+            executions=once,
             declared=declared,
+            duplicates=duplicates,
         )
         for entry in entries.values():
             for team in entry.teams:
@@ -454,6 +459,54 @@ class _Checker:
             self.problem(where, f"{err.message.split(': ', 1)[1]}; give ISO 8601 or epoch seconds")
             return _BAD
         return s_to_ns(seconds)
+
+
+def _identity(execution: ListedExecution) -> tuple[Any, ...]:
+    """What makes two listed executions the same one: everything its score depends on."""
+    values = tuple(sorted((k, repr(v)) for k, v in execution.values.items()))
+    return (
+        execution.benchmark,
+        execution.team,
+        execution.bags,  # normalised, absolute (_Checker.path)
+        execution.start_ns,
+        execution.end_ns,
+        values,
+    )
+
+
+def _listed_once(
+    executions: Sequence[ListedExecution],
+) -> tuple[tuple[ListedExecution, ...], tuple[str, ...]]:
+    """Each execution once (its first listing), and one line per execution listed again: as
+    YAML aliases or copies, 1,000 listings cost 1,000 scorings of the same cache key. The
+    same log and time listed for two teams is named too (both are scored: which is right is
+    the organiser's to say)."""
+    first: dict[tuple[Any, ...], ListedExecution] = {}
+    again: dict[int, list[int]] = {}
+    for execution in executions:
+        seen = first.setdefault(_identity(execution), execution)
+        if seen is not execution:
+            again.setdefault(seen.index, []).append(execution.index)
+    lines = []
+    for index, copies in again.items():
+        shown = ", ".join(f"executions[{i}]" for i in copies[:5])
+        more = f" and {len(copies) - 5} more" if len(copies) > 5 else ""
+        times = "once more" if len(copies) == 1 else f"{len(copies)} more times"
+        lines.append(
+            f"{shown}{more}: the same execution as executions[{index}] (listed {times}: "
+            "same benchmark, team, logs, time and inputs); scored once"
+        )
+    by_log: dict[tuple[Any, ...], ListedExecution] = {}
+    for execution in first.values():
+        where = (execution.benchmark, execution.bags, execution.start_ns, execution.end_ns)
+        other = by_log.setdefault(where, execution)
+        if other is not execution and other.team != execution.team:
+            lines.append(
+                f"executions[{execution.index}]: the logs and time of executions[{other.index}] "
+                f"for another team ({execution.team or 'none'}, there {other.team or 'none'}): "
+                "both are scored; remove the wrong one"
+            )
+    return tuple(first.values()), tuple(lines)
 
 
 class _Bad:

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from ertools import __version__, atomic
+from ertools.errors import watching
 from ertools.io.model import ClockCheck
 
 MEMO_VERSION = 1
@@ -92,8 +93,12 @@ class FileMemo:
             and valid(row[fact])
         ):
             return row[fact]
-        value = compute()
-        if stamp is not None:
+        with watching() as met:
+            value = compute()
+        # a fact learnt while the file was missing for a moment, or unreadable, is the
+        # moment's, not the bytes': computed again next time; and one whose file changed
+        # while it was read belongs to neither stamp
+        if stamp is not None and not met and _stamp(Path(path)) == stamp:
             if row is None or row["stamp"] != stamp:
                 row = self.rows[key] = {"stamp": stamp}
             row[fact] = value

@@ -24,7 +24,7 @@ from ertools.errors import ConfigError
 from ertools.rescore.children import (
     Child,
     ForkServerError,
-    close_server,
+    close_idle_server,
     died,
     forks_ready,
     new_child,
@@ -226,7 +226,9 @@ class DaskClient:
             if self._cluster is not None:
                 with contextlib.suppress(Exception):
                     self._cluster.close()
-                close_server()  # its workers were threads here: their scoring children too
+                # its workers were threads here: their scoring children too (unless another
+                # rescoring of this process uses the server)
+                close_idle_server()
         finally:
             self._stack.close()
             sys.stderr.flush()

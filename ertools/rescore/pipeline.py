@@ -26,8 +26,16 @@ from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ErtoolsError
 from ertools.io import summary
 from ertools.progress import Reporter
-from ertools.report import ranks
-from ertools.rescore.cache import Cache, FileHashes, job_key, records
+from ertools.rescore.boards import leaderboards
+from ertools.rescore.cache import (
+    Cache,
+    FileHashes,
+    Fingerprints,
+    changed_files,
+    fingerprints,
+    job_key,
+    records,
+)
 from ertools.rescore.jobs import Job, Outcome
 from ertools.rescore.manifest import Manifest
 from ertools.rescore.parallel import DaskClient, run_jobs
@@ -238,7 +246,8 @@ def rescore(
         problems: problems found before scoring (the logs' discovery, the timeline).
         timeline: the ``timeline`` entry of the document (figure, sessions).
         progress: told of every execution done.
-        on_outcome: called with each outcome as it arrives (the CLI's stderr lines).
+        on_outcome: called with each outcome as it arrives (the CLI's stderr lines), but a
+            robot log's with no topic to compare (no row: its execution's warning says so).
         dask: the ``scheduler``'s client, started earlier (the caller closes it).
     """
     out.mkdir(parents=True, exist_ok=True)
@@ -249,23 +258,36 @@ def rescore(
     outcomes: dict[str, Outcome] = {}
     cached: set[str] = set()
     keys: dict[str, str] = {}
+    # each job's files as keyed: what its row records, and what is checked once it is scored
+    keyed: dict[str, Fingerprints] = {}
+    inputs: dict[str, list[dict[str, Any]]] = {}
     to_run: list[Job] = []
+    scorer: dict[str, str] = {}  # a key -> the id of the job that scores it
+    sharing: dict[str, list[str]] = {}  # that id -> the ids of the same key, given its outcome
     for p in planned:
         if p.missing:
             outcomes[p.job.id] = Outcome(p.job.id, "unscoreable", reason="; ".join(p.missing))
             continue
         try:
             keys[p.job.id] = job_key(p.job, hashes)
-        except OSError as err:  # a bag gone between discovery and now
+            inputs[p.job.id] = records(p.job.values, hashes)
+        except OSError as err:  # a bag gone between discovery and now: the moment's verdict
             outcomes[p.job.id] = Outcome(
-                p.job.id, "unscoreable", reason=f"cannot read {err.filename}: {err.strerror}"
+                p.job.id,
+                "unscoreable",
+                reason=f"cannot read {err.filename}: {err.strerror}",
+                machine=True,
             )
             continue
+        keyed[p.job.id] = fingerprints(p.job, hashes)
         hit = cache.get(keys[p.job.id], p.job) if use_cache else None
         if hit is not None:
             outcomes[p.job.id] = hit
             cached.add(p.job.id)
+        elif keys[p.job.id] in scorer:  # the same bytes, team and inputs: scored once
+            sharing.setdefault(scorer[keys[p.job.id]], []).append(p.job.id)
         else:
+            scorer[keys[p.job.id]] = p.job.id
             to_run.append(p.job)
     hashes.save()
     if cache.invalid:
@@ -290,18 +312,34 @@ def rescore(
             progress.task(label, total, "executions")
             progress.advance(state["done"])
 
-    for outcome in outcomes.values():
-        if on_outcome is not None:
+    # a robot log with no topic to compare is no row (its execution's warning says so): not
+    # told; every other execution not scored is, a missing topic's too
+    robot_jobs = {p.job.id for p in planned if p.of is not None}
+
+    def told(outcome: Outcome) -> None:
+        if on_outcome is not None and not (outcome.id in robot_jobs and _no_topics(outcome)):
             on_outcome(outcome)
+
+    for outcome in outcomes.values():
+        told(outcome)
     tell()
 
-    def done(outcome: Outcome) -> None:
-        outcomes[outcome.id] = outcome
-        cache.put(keys[outcome.id], outcome)
-        state["done"] += 1
-        state["bad"] += outcome.status != "scored"
-        if on_outcome is not None:
-            on_outcome(outcome)
+    def done(scored: Outcome) -> None:
+        copies = [
+            replace(scored, id=other, warnings=(*scored.warnings, same_as(scored.id)))
+            for other in sharing.get(scored.id, [])
+        ]
+        for outcome in (scored, *copies):
+            changed = changed_files(keyed[outcome.id], hashes)
+            # scored from bytes that are not those keyed and recorded: no score (a row that
+            # says why it has none, of the moment, says it better: a file it could not find)
+            if changed and (outcome.status == "scored" or not outcome.machine):
+                outcome = input_changed(outcome, changed)
+            outcomes[outcome.id] = outcome
+            cache.put(keys[outcome.id], outcome)
+            state["done"] += 1
+            state["bad"] += outcome.status != "scored"
+            told(outcome)
         tell()
 
     # what the cache hits took tells the schedule which benchmarks cost most
@@ -318,6 +356,35 @@ def rescore(
         options={"jobs": workers, "scheduler": scheduler},
         problems=problems,
         timeline=timeline,
+        inputs=inputs,
+        keyed=keyed,
+    )
+
+
+def same_as(ident: str) -> str:
+    """The warning of an execution whose bytes, team and inputs are another's (its cache key):
+    a log copied under two names, listed twice."""
+    return (
+        f"the same logs (byte for byte), team, time and inputs as {ident}: scored once, as {ident}"
+    )
+
+
+def input_changed(outcome: Outcome, changed: Sequence[str]) -> Outcome:
+    """The row of an execution one of whose files changed (or went) while it was scored: its
+    score came from bytes no longer there, or from a mix of old and new; not cached."""
+    more = f" and {len(changed) - 1} more" if len(changed) > 1 else ""
+    return Outcome(
+        outcome.id,
+        "failed",
+        reason=(
+            f"its input changed or went while it was scored ({changed[0]}{more}): no score "
+            "kept; "
+            "run rescore again to score the files as they are now"
+        ),
+        warnings=outcome.warnings,
+        seconds=outcome.seconds,
+        error="InputChanged",
+        machine=True,
     )
 
 
@@ -345,8 +412,19 @@ def document(
     options: Mapping[str, Any],
     problems: Sequence[Mapping[str, Any]],
     timeline: Mapping[str, Any] | None,
+    inputs: Mapping[str, list[dict[str, Any]]] | None = None,
+    keyed: Mapping[str, Fingerprints] | None = None,
 ) -> dict[str, Any]:
-    """The ``results.json`` document (docs/rescore.md)."""
+    """The ``results.json`` document (docs/rescore.md). ``inputs`` (a row's input records) and
+    ``keyed`` (its files' SHA-256), by execution id, as they were when the executions were
+    keyed: the hashes of the bytes scored, not of what lies there now."""
+    inputs = inputs or {}
+    scored = {
+        name: (digest, _size(state))
+        for prints in (keyed or {}).values()
+        for name, (state, digest) in prints.items()
+        if digest and state is not None
+    }
     rows: list[dict[str, Any]] = []
     all_problems = [dict(p) for p in problems]
     files: dict[str, Path] = {}
@@ -365,7 +443,7 @@ def document(
         o = outcomes[job.id]
         if p.of is not None and _no_topics(o):
             continue
-        inputs = records(job.values, hashes)
+        row_inputs = inputs[job.id] if job.id in inputs else records(job.values, hashes)
         for bag in e.bags:
             files[str(bag)] = bag
         for value in job.values.values():
@@ -388,7 +466,7 @@ def document(
                 "start": iso_utc(e.start_ns) if e.start_ns is not None else None,
                 "end": iso_utc(e.end_ns) if e.end_ns is not None else None,
                 "bags": [str(b) for b in e.bags],
-                "inputs": inputs,
+                "inputs": row_inputs,
                 "status": o.status,
                 "reason": o.reason,
                 "score": o.score,
@@ -412,9 +490,8 @@ def document(
     provenance = []
     for name, path in sorted(files.items()):
         try:
-            provenance.append(
-                {"path": name, "sha256": hashes.sha256(path), "size": hashes.size(path)}
-            )
+            digest, size = scored.get(name) or (hashes.sha256(path), hashes.size(path))
+            provenance.append({"path": name, "sha256": digest, "size": size})
         except OSError:
             provenance.append({"path": name, "sha256": None, "size": None})
     hashes.save()
@@ -438,94 +515,15 @@ def document(
     }
 
 
+def _size(state: tuple[Any, ...]) -> int:
+    """The size in a :func:`~ertools.rescore.cache.file_state` (a folder's: its files')."""
+    if state and isinstance(state[0], tuple):
+        return sum(int(f[1]) for f in state)
+    return int(state[0]) if state else 0
+
+
 def _no_topics(outcome: Outcome) -> bool:
     return outcome.status == "unscoreable" and outcome.error == "TopicError"
-
-
-def leaderboards(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
-    """Per benchmark (registry order), each team's best scored execution by the benchmark's
-    own :class:`~ertools.benchmarks.base.Ranking`; equal values share a rank."""
-    boards: list[dict[str, Any]] = []
-    names = [n for n in registry.names() if any(r["benchmark"] == n for r in rows)]
-    names += sorted({str(r["benchmark"]) for r in rows} - set(names))
-    for name in names:
-        ranking = registry.get(name).ranking
-        sign = 1.0 if ranking.lower_is_better else -1.0
-        best: dict[str, Mapping[str, Any]] = {}
-        unranked: list[dict[str, Any]] = []
-        for row in rows:
-            if row["benchmark"] != name or row["status"] != "scored" or row["rank_value"] is None:
-                continue
-            # A score that says its data cannot support it (validity, docs/uncertainty.md) is
-            # never ranked, whatever number it carries.
-            unscoreable = ranks.unscoreable_reason(row.get("score"))
-            if unscoreable is not None:
-                unranked.append(
-                    {
-                        "execution": row["id"],
-                        "value": row["rank_value"],
-                        "note": f"{row['team'] or TEAM_UNKNOWN}: unscoreable ({unscoreable})",
-                    }
-                )
-                continue
-            if row["team"] is None:  # scored, but ranked only once the manifest names it
-                unranked.append(
-                    {"execution": row["id"], "value": row["rank_value"], "note": TEAM_UNKNOWN}
-                )
-                continue
-            team = str(row["team"])
-            if team not in best or sign * row["rank_value"] < sign * best[team]["rank_value"]:
-                best[team] = row
-        ordered = sorted(best.items(), key=lambda tr: (sign * tr[1]["rank_value"], tr[0]))
-        confidence = ranks.board_confidence(ranks.confidence_of(r.get("score")) for _, r in ordered)
-        standings = ranks.stability(
-            [
-                ranks.Contender(
-                    team,
-                    float(row["rank_value"]),
-                    _interval(row, ranking.text),
-                    ranks.confidence_of(row.get("score")) or ranks.DEFAULT_CONFIDENCE,
-                    str(row["id"]),
-                )
-                for team, row in ordered
-            ],
-            lower_is_better=ranking.lower_is_better,
-            confidence=confidence,
-        )
-        board_rows: list[dict[str, Any]] = [
-            {
-                "rank": s.rank,
-                "team": s.name,
-                "value": s.score,
-                "execution": s.ident,
-                "interval": list(s.interval) if s.interval else None,
-                "p_swap_next": s.p_swap_next,
-                "rank_group": s.group,
-                "tied_with": list(s.tied_with),
-                "rank_note": s.note,
-            }
-            for s in standings
-        ]
-        title = next(str(r["title"]) for r in rows if r["benchmark"] == name)
-        boards.append(
-            {
-                "benchmark": name,
-                "title": title,
-                "rule": ranking.text,
-                "lower_is_better": ranking.lower_is_better,
-                "confidence": confidence,
-                "rows": board_rows,
-                "unranked": unranked,
-            }
-        )
-    return boards
-
-
-def _interval(row: Mapping[str, Any], rule: str) -> tuple[float, float] | None:
-    """The confidence interval of an execution's ranked value, from its score."""
-    score = row.get("score")
-    key = ranks.ranked_key(score, row.get("rank_value"), rule)
-    return ranks.interval_of(score, key)
 
 
 def _placings(doc: Mapping[str, Any]) -> dict[str, dict[str, Any]]:

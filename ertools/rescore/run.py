@@ -10,6 +10,8 @@ page written.
 from __future__ import annotations
 
 import contextlib
+import logging
+import os
 from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass
@@ -26,6 +28,8 @@ from ertools.rescore.manifest import Manifest
 from ertools.rescore.memo import FileMemo
 from ertools.rescore.parallel import early_dask
 from ertools.rescore.pipeline import listed_executions, rescore, write_results
+
+log = logging.getLogger(__name__)
 
 if TYPE_CHECKING:
     from ertools.progress import Reporter
@@ -117,6 +121,11 @@ def _rescore(
 ) -> Rescored:
     scorings = listed_executions(manifest)
     problems: list[dict[str, object]] = []
+    for line in manifest.duplicates:  # each scored once (load_manifest): said once too
+        log.warning("%s: %s", manifest.path, line)
+        problems.append(
+            {"kind": "duplicate-execution", "path": str(manifest.path), "message": line}
+        )
     timeline = None
     found = None
     if paths:
@@ -125,7 +134,7 @@ def _rescore(
         found = find(paths, progress=progress, memo=memo)
         memo.save()
         scorings = merge(found.scorings, scorings)
-        problems = list(found.problems)
+        problems += found.problems
         out.mkdir(parents=True, exist_ok=True)
         timeline = write_timeline(found, out, manifest.title)
     if not scorings:
@@ -151,5 +160,9 @@ def _rescore(
     )
     if found is not None:  # every file under PATH in one place (docs/rescore.md, "files")
         robots = {str(s.bags[0]): s.of for s in found.scorings if s.of is not None}
-        doc = account(doc, found.files, found.folders, robots)
+        # the results folder inside a scanned one holds no input: its files are none of its
+        # logs' (they were listed as unused on the next run)
+        mine = str(out.resolve()) + os.sep
+        files = [f for f in found.files if not f.startswith(mine)]
+        doc = account(doc, files, found.folders, robots)
     return Rescored(doc, tuple(write_results(doc, out)))

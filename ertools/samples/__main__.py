@@ -5,20 +5,31 @@ instead (:mod:`ertools.samples.competition`): one day of logs at one venue and i
 ``answers.json``; DIR is replaced as a whole, like a scenario folder.
 
 Every registered scenario (:data:`ertools.samples.scenario.SCENARIOS`) is generated into
-``OUTDIR/<name>/``, which is replaced as a whole (built in ``OUTDIR/.<name>.partial`` first,
-so a failure leaves the old folder in place). Without ``--seed`` each scenario uses its fixed
+``OUTDIR/<name>/``, which is replaced as a whole (built in a folder of a unique name,
+``OUTDIR/.<name>.XXXXXXXX.partial``, first, so a failure leaves the old folder in place).
+Without ``--seed`` each scenario uses its fixed
 default seed, so the output is byte-identical from run to run. A scenario whose module does
 not exist is an error naming it, before anything is written.
 """
 
 from __future__ import annotations
 
+import sys
+
+if __name__ == "__main__":
+    # `python -m ertools.samples`: the module run under its own name, its imports included,
+    # inside ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
+    from ertools import launch
+
+    sys.exit(launch.run("ertools.samples.__main__:program", "python -m ertools.samples"))
+
 import argparse
 import shutil
-import sys
+import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
+from ertools import atomic
 from ertools.errors import ErtoolsError
 from ertools.samples.competition import DEFAULT_SEED, write_competition
 from ertools.samples.scenario import (
@@ -54,14 +65,15 @@ def generate(outdir: Path, names: Sequence[str], seed: int | None = None) -> dic
     outdir.mkdir(parents=True, exist_ok=True)
     for name, gen in generators.items():
         final = outdir / name
-        partial = outdir / f".{name}.partial"
-        if partial.exists():
-            shutil.rmtree(partial)
-        partial.mkdir()
-        paths = gen(partial, seed=DEFAULT_SEEDS[name] if seed is None else seed)
-        if final.exists():
-            shutil.rmtree(final)
-        partial.rename(final)
+        # a folder of a unique name: two runs at once each build their own (the last rename
+        # wins, with a whole folder)
+        partial = Path(tempfile.mkdtemp(dir=outdir, prefix=f".{name}.", suffix=".partial"))
+        try:
+            paths = gen(partial, seed=DEFAULT_SEEDS[name] if seed is None else seed)
+        except BaseException:
+            shutil.rmtree(partial, ignore_errors=True)
+            raise
+        atomic.replace_folder(partial, final)
         written[name] = [final / p.relative_to(partial) for p in paths]
     return written
 
@@ -113,6 +125,7 @@ def _competition(outdir: Path, seed: int | None) -> int:
     return 0
 
 
-if __name__ == "__main__":
+def program() -> int:
+    """``python -m ertools.samples``: :func:`main` on ``sys.argv``."""
     rerun_pinned(sys.argv[1:])  # bit-identical samples on AVX-512 CPUs too (samples.simd)
-    sys.exit(main())
+    return main()

@@ -43,12 +43,14 @@ from __future__ import annotations
 import datetime as dt
 import json
 import shutil
+import tempfile
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import yaml
 
+from ertools import atomic
 from ertools.errors import UsageError
 from ertools.samples import fbm1, fbm2h
 from ertools.samples.competition_files import (
@@ -354,11 +356,15 @@ def write_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path]:
     """:func:`generate_competition` into ``outdir`` as a whole or not at all: written into a
     hidden sibling first, then renamed, so that an interrupted run never leaves a folder that
     looks complete. Returns every path written, under ``outdir``."""
-    partial = outdir.with_name(f".{outdir.name}.partial")
-    if partial.exists():
-        shutil.rmtree(partial)
-    paths = generate_competition(partial, seed=seed)
-    if outdir.exists():
-        shutil.rmtree(outdir)
-    partial.rename(outdir)
+    outdir.parent.mkdir(parents=True, exist_ok=True)
+    # a folder of a unique name: two runs at once each build their own
+    partial = Path(
+        tempfile.mkdtemp(dir=outdir.parent, prefix=f".{outdir.name}.", suffix=".partial")
+    )
+    try:
+        paths = generate_competition(partial, seed=seed)
+    except BaseException:
+        shutil.rmtree(partial, ignore_errors=True)
+        raise
+    atomic.replace_folder(partial, outdir)
     return [outdir / p.relative_to(partial) for p in paths]

@@ -131,7 +131,7 @@ def test_score_refuses_what_the_command_refuses(
 def test_score_errors_name_the_inputs() -> None:
     with pytest.raises(UsageError, match="fbm2h takes no input speed; its inputs: goal"):
         ertools.score("fbm2h", FBM2H_BAG, speed=1)
-    with pytest.raises(UsageError, match="unknown benchmark 'fbm4'"):
+    with pytest.raises(UsageError, match=r"name='fbm4' \(str\): give the name of a benchmark"):
         ertools.score("fbm4", FBM2H_BAG)
     with pytest.raises(BagError, match=r"nope\.bag"):
         ertools.score("fbm3w", "nope.bag")

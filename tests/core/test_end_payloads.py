@@ -2,10 +2,11 @@
 
 The table is derived from the 2015 code and the seed, not from ertools:
 
-- ``rockin_scoring/BmBox.py`` (svenschneider/benchmark_and_scoring_fbm at 90d5c4d) compares
-  the whole payload with ``==`` / ``!=``: ``"reason: timeout"`` (l. 49, 97, 117: ``Timeout()``)
-  and ``"reason: stop"`` (l. 53, 100, 126: ``Running()``). Nothing else was a timeout or a stop
-  to it: under ``--2015`` (``--exact-end-payloads``) only these two strings are.
+- ``rockin_scoring/BmBox.py`` (rockin-robot-challenge/benchmark_and_scoring_fbm at 7628309)
+  compares the whole payload with ``==`` / ``!=``: ``"reason: timeout"`` (l. 49, 97, 117:
+  ``Timeout()``) and ``"reason: stop"`` (l. 53, 100, 126: ``Running()``). Nothing else was a
+  timeout or a stop to it: under ``--2015`` (``--exact-end-payloads``) only these two strings
+  are.
 - The 2015 @Home RefBox (rockin-robot-challenge/at_home_rsbb, src/core_zone_exec.h,
   ``phase_post_2``) sent exactly those two strings.
 - The seed (6.2.3) names ``timeout`` and ``halt`` (the referee's stop); an END without payload is

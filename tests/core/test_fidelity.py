@@ -10,16 +10,22 @@ from pathlib import Path
 import pytest
 
 from ertools.benchmarks.base import dump_yaml, jsonable
+from ertools.benchmarks.fbm1.config import NODE_2015, NODE_2016, NODE_2017
+from ertools.benchmarks.fbm2h.config import NODES as FBM2H_NODES
 from ertools.cli.main import main
 from ertools.fidelity import (
     BEGIN,
     END,
     RULE_MODULES,
+    VERSIONS_BEGIN,
+    VERSIONS_END,
     Deviation,
     Rule,
     all_rules,
+    all_versions,
     markdown_table,
     replace_table,
+    version_table,
 )
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -71,6 +77,66 @@ def test_docs_table_is_the_catalogue() -> None:
         "docs/fidelity.md is out of date with the rules in the code: "
         "run python -m ertools.fidelity --write"
     )
+
+
+def test_docs_version_table_is_the_code() -> None:
+    text = (ROOT / "docs" / "fidelity.md").read_text(encoding="utf-8")
+    section = text[text.index(VERSIONS_BEGIN) + len(VERSIONS_BEGIN) : text.index(VERSIONS_END)]
+    assert section.strip("\n") == version_table(all_versions()).strip("\n"), (
+        "docs/fidelity.md's version table is out of date: run python -m ertools.fidelity --write"
+    )
+    assert text.index(VERSIONS_BEGIN) < text.index(BEGIN), "the version table opens the doc"
+
+
+# What each option reproduces (issue 35, from rockin-robot-challenge/benchmark_and_scoring_fbm
+# read at these commits): (file, commit, competition, the option).
+REPRODUCED = (
+    ("src/rockin_scoring/BmBox.py", "7628309", "RoCKIn 2015 Lisbon", "--2015"),
+    ("scripts/fbm1h", "e373be0", "RoCKIn 2015 Lisbon", "--rules 2015"),
+    ("scripts/fbm1w", "7628309", "RoCKIn 2015 Lisbon", "--rules 2015"),
+    ("scripts/fbm1h", "40ba68b", "Lisbon 2016 second local", "--rules 2016"),
+    ("scripts/fbm1h", "89dfa75", "Lisbon 2017 major tournament", "--rules 2017"),
+    ("scripts/fbm2h", "50b173b", "RoCKIn 2015 Lisbon", "--rules 2015"),
+    ("scripts/fbm2h", "40ba68b", "Lisbon 2016 second local", "--rules 2016"),
+    ("scripts/fbm2h", "89dfa75", "Lisbon 2017 major tournament", "--rules 2017"),
+    ("scripts/fbm3w", "50b173b", "RoCKIn 2015 Lisbon", "--2015"),
+)
+
+
+# What the outputs say each option reproduces (the `reference` of FBM1, FBM2@Home's notes).
+SAID = {
+    ("scripts/fbm1h", "--rules 2015"): NODE_2015,
+    ("scripts/fbm1w", "--rules 2015"): NODE_2015,
+    ("scripts/fbm1h", "--rules 2016"): NODE_2016,
+    ("scripts/fbm1h", "--rules 2017"): NODE_2017,
+    **{("scripts/fbm2h", f"--rules {k}"): v for k, v in FBM2H_NODES.items()},
+}
+
+
+@pytest.mark.parametrize(("file", "commit", "event", "option"), REPRODUCED)
+def test_each_option_names_its_node_version(
+    file: str, commit: str, event: str, option: str
+) -> None:
+    rows = [v for v in all_versions() if (v.file, v.commit) == (file, commit)]
+    assert len(rows) == 1, (file, commit)
+    assert event in rows[0].event and option in rows[0].restores
+    if (file, option) in SAID:
+        assert commit in SAID[file, option], (file, option)
+
+
+def test_version_rows_are_in_order_and_unique() -> None:
+    seen: set[tuple[str, str]] = set()
+    last: dict[str, str] = {}
+    for v in all_versions():
+        assert v.changes and v.restores and v.event, v
+        assert (v.file, v.commit) not in seen, v
+        seen.add((v.file, v.commit))
+        assert v.date >= last.get(v.file, ""), f"{v.file}: {v.commit} out of date order"
+        last[v.file] = v.date
+        competed = any(e in v.event for e in ("RoCKIn", "Lisbon", "Peccioli"))
+        assert competed or v.event.startswith("development"), v
+        # a version no competition ran is restored by nothing, and says why
+        assert competed or v.restores.startswith(("not restorable:", "`--rules")), v
 
 
 def test_readme_summarises_and_links_the_table() -> None:

@@ -33,7 +33,35 @@ def test_make_test_runs_in_parallel_and_lists_the_slowest() -> None:
     pytest_line = _recipe("pytest")
     for part in ("-n $(PYTEST_JOBS)", "--dist loadgroup", "--durations=15"):
         assert part in pytest_line
-    assert re.search(r"^test: lint typecheck pytest$", (ROOT / "Makefile").read_text(), re.M)
+    assert re.search(
+        r"^test: lint typecheck pytest pytest-simd-off$", (ROOT / "Makefile").read_text(), re.M
+    )
+
+
+def _make_variable(name: str) -> list[str]:
+    text = (ROOT / "Makefile").read_text(encoding="utf-8")
+    match = re.search(rf"^{name} := ((?:.*\\\n)*.*)$", text, flags=re.MULTILINE)
+    assert match, f"the Makefile has no {name}"
+    return match.group(1).replace("\\\n", " ").split()
+
+
+def test_the_second_pass_switches_every_simd_target_off_and_names_real_tests() -> None:
+    """``make test`` runs the numeric tests again with NumPy's SIMD targets off (docs/qa.md,
+    "Results on every CPU"): the variable set to what ``ertools.samples.simd`` lists, and
+    every test it names exists."""
+    recipe = _recipe("pytest-simd-off")
+    assert (
+        "python -m ertools.samples.simd" in recipe and "env -u NPY_DISABLE_CPU_FEATURES" in recipe
+    )
+    assert 'NPY_DISABLE_CPU_FEATURES="$$targets"' in recipe and "OPENBLAS_CORETYPE=" in recipe
+    assert "$(SIMD_OFF_TESTS)" in recipe and "--deselect $(SIMD_OFF_SKIP)" in recipe
+    tests = _make_variable("SIMD_OFF_TESTS")
+    assert "tests/e2e/test_outputs_unchanged.py" in tests
+    for entry in (*tests, *_make_variable("SIMD_OFF_SKIP")):
+        path, _, name = entry.partition("::")
+        assert (ROOT / path).is_file(), f"SIMD_OFF_TESTS names {entry}: no such file"
+        if name:
+            assert f"def {name}(" in (ROOT / path).read_text(encoding="utf-8"), entry
 
 
 def test_make_check_is_lint_and_the_fast_tests() -> None:

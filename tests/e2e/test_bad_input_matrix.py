@@ -13,12 +13,17 @@ Cases run in-process through ``ertools.cli.main.main`` with ``capsys``.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import itertools
 import json
+import os
 import random
 import re
 import shutil
+import stat
+import threading
+import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from importlib import import_module
@@ -166,6 +171,10 @@ def inputs(tmp_path_factory: pytest.TempPathFactory) -> Inputs:
 
     (root / "empty.bag").write_bytes(b"")
     (root / "random.bag").write_bytes(random.Random(7).randbytes(6000))
+    if hasattr(os, "mkfifo"):
+        # where a bag or a config should be: an open() of it blocks until a writer comes
+        os.mkfifo(root / "fifo.bag")
+        os.mkfifo(root / "fifo.yaml")
     (root / "bad.yaml").write_text("goal:\n  waypoints: [1, 2\n  x: : :\n")
     (root / "list.yaml").write_text("- 1\n- 2\n")
     (root / "evil.yaml").write_text(
@@ -297,12 +306,50 @@ class Outcome:
     err: str
 
 
+# A command still blocked on a FIFO after this long would block for ever: the watchdog then
+# opens the FIFO for writing and closes it (the reader gets an end of file) and the case fails.
+FIFO_PATIENCE_S = 30.0
+
+
+@contextlib.contextmanager
+def _fifo_watchdog(argv: list[str]) -> Iterator[list[str]]:
+    """Yields the FIFOs of ``argv`` a blocked command was freed from (none when it never
+    blocked on one)."""
+    fifos = [a for a in argv if Path(a).exists() and stat.S_ISFIFO(os.stat(a).st_mode)]
+    freed: list[str] = []
+    done = threading.Event()
+
+    def watch() -> None:
+        if done.wait(FIFO_PATIENCE_S):
+            return
+        while not done.is_set():
+            for fifo in fifos:
+                try:  # succeeds only while a reader is blocked opening it
+                    os.close(os.open(fifo, os.O_WRONLY | os.O_NONBLOCK))
+                    freed.append(fifo)
+                except OSError:
+                    pass
+            time.sleep(0.1)
+
+    watcher = threading.Thread(target=watch, daemon=True)
+    if fifos:
+        watcher.start()
+    try:
+        yield freed
+    finally:
+        done.set()
+        if fifos:
+            watcher.join()
+
+
 def _run(argv: list[str], capsys: pytest.CaptureFixture[str]) -> Outcome:
     capsys.readouterr()
     files = _files(argv)
     before = _snapshot(files)
-    code = main(argv)
+    with _fifo_watchdog(argv) as freed:
+        code = main(argv)
     captured = capsys.readouterr()
+    assert not freed, f"blocked reading the FIFO {freed[0]} (freed after {FIFO_PATIENCE_S} s)"
     assert _snapshot(files) == before, "an input file was modified"
     return Outcome(code, captured.out, captured.err)
 
@@ -344,6 +391,7 @@ BAD_BAGS = [
     "rosbag2-metadata-python-tag",
     "rosbag2-mcap-truncated",
     "mcap-truncated",
+    "fifo",
 ]
 ROSBAG2 = next((SAMPLES / "fbm3w").glob("*_mcap"))
 
@@ -385,6 +433,10 @@ def test_bad_bag(
     elif bad == "mcap-truncated":
         (mcap,) = ROSBAG2.glob("*.mcap")
         bag = inputs.truncated(mcap, 0.4)
+    elif bad == "fifo":
+        bag = inputs.root / "fifo.bag"
+        if not bag.exists():
+            pytest.skip("n/a: no FIFOs on this system")
     else:
         bag = getattr(inputs, bad)
     argv = argv_of(inputs, bag, tmp_path / "out")
@@ -399,13 +451,16 @@ def test_bad_bag(
         assert "truncated" in warnings[0] or "damaged" in warnings[0]
         assert "ertools: error:" not in result.err
         return
-    _check_error(result, 1, bag.name)
+    line = _check_error(result, 1, bag.name)
+    if bad == "fifo":
+        assert "not a regular file (a FIFO)" in line  # said as such, not "no bags there"
     assert not (tmp_path / "out").exists(), "nothing is written when the input is bad"
     assert not (inputs.root / SENTINEL_NAME).exists(), "a YAML python tag was executed"
 
 
 @pytest.mark.parametrize(
-    "bad", ["missing", "empty", "random", "truncated-json", "wrong-shape-json", "plain-folder"]
+    "bad",
+    ["missing", "empty", "random", "truncated-json", "wrong-shape-json", "plain-folder", "fifo"],
 )
 def test_report_bad_result(
     bad: str, inputs: Inputs, tmp_path: Path, capsys: pytest.CaptureFixture[str]
@@ -418,6 +473,7 @@ def test_report_bad_result(
         "truncated-json": tmp_path / "truncated.json",
         "wrong-shape-json": tmp_path / "list.json",
         "plain-folder": tmp_path / "not_a_report",
+        "fifo": tmp_path / "fifo.json",
     }[bad]
     if bad == "truncated-json":
         path.write_text('{"name": "fbm2h", "position_accuracy": 0.1')
@@ -425,6 +481,10 @@ def test_report_bad_result(
         path.write_text("[1, 2]")
     elif bad == "plain-folder":
         path.mkdir()
+    elif bad == "fifo":
+        if not hasattr(os, "mkfifo"):
+            pytest.skip("n/a: no FIFOs on this system")
+        os.mkfifo(path)
     result = _run(["report", str(path), "--report", str(tmp_path / "page")], capsys)
     _check_error(result, 1, path.name)
     assert not (tmp_path / "page" / "index.html").exists()
@@ -525,7 +585,7 @@ AUDIT_CONFIG_OPTIONS: dict[str, ConfArgv] = {
     "audit--items": lambda i, y: ["audit", str(i.fbm1h), "--items", str(y)],
     "audit--config": lambda i, y: ["audit", str(i.fbm3w), "--config", str(y)],
 }
-BAD_CONFIGS = ["malformed", "wrong-shape", "python-tag", "missing"]
+BAD_CONFIGS = ["malformed", "wrong-shape", "python-tag", "missing", "fifo"]
 
 
 def _bad_config(inputs: Inputs, kind: str) -> Path:
@@ -534,6 +594,7 @@ def _bad_config(inputs: Inputs, kind: str) -> Path:
         "wrong-shape": inputs.list_yaml,
         "python-tag": inputs.evil_yaml,
         "missing": inputs.root / "no_such_config.yaml",
+        "fifo": inputs.root / "fifo.yaml",
     }[kind]
 
 
@@ -541,9 +602,13 @@ def _check_config_case(
     argv_of: ConfArgv, kind: str, inputs: Inputs, capsys: pytest.CaptureFixture[str]
 ) -> None:
     config = _bad_config(inputs, kind)
+    if kind == "fifo" and not config.exists():
+        pytest.skip("n/a: no FIFOs on this system")
     result = _run(argv_of(inputs, config), capsys)
     assert not (inputs.root / SENTINEL_NAME).exists(), "a YAML python tag was executed"
     line = _check_error(result, 1, config.name)
+    if kind == "fifo":
+        assert "not a regular file (a FIFO)" in line
     if kind == "python-tag":
         assert "python/object" in line  # says which tag it refused
 

@@ -13,9 +13,10 @@ import pytest
 from stderr_text import error_messages
 
 from ertools.cli.main import main
-from ertools.configs._yaml import MAX_DEPTH, parse_yaml
+from ertools.configs._yaml import parse_yaml
 from ertools.configs.shapes import compile_expression
 from ertools.errors import ConfigError
+from ertools.yamlin import MAX_DEPTH
 
 ROOT = Path(__file__).resolve().parents[2]
 FBM2H = ROOT / "sample_bags" / "fbm2h"
@@ -105,7 +106,9 @@ def test_deep_nesting_is_refused_with_a_message(
     err = capsys.readouterr().err
     assert code == 1
     assert "this is a bug" not in err
-    assert f"{path}: malformed goal list: nested more than 64 levels deep" in err
+    assert (
+        f"{path}: malformed goal list at line 1, column 70: nested more than 64 levels deep" in err
+    )
 
 
 def test_sixty_four_levels_are_still_read(tmp_path: Path) -> None:

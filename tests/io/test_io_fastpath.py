@@ -2,21 +2,24 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import numpy as np
 import pytest
+from mcap.reader import make_reader
 from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Writer
 
 import ertools.io as eio
 from ertools.io import summary
+from ertools.io.bagfile import BagFile, RawRecord
 from ertools.io.bulk import try_fast_batch
 from ertools.io.decode.posebatch import PoseBatch
 from ertools.io.decode.typestore import Deserializer
 from ertools.io.files import RosbagsFile, open_bag
 from ertools.io.formats import detect_format, find_bags
-from ertools.io.model import POSE_TYPES
+from ertools.io.model import POSE_TYPES, Conn
 from ertools.io.reader import _bulk_states, slow_pose_batch
 
 POSE_TOPICS = (
@@ -28,16 +31,52 @@ POSE_TOPICS = (
 )
 
 
+class LibraryMcap(BagFile):
+    """A standalone MCAP file whose messages the ``mcap`` library reads (ertools reads them
+    through its own indexes: the reference stays independent of them). A file ertools reads
+    record by record (no usable index) is read so here too."""
+
+    def __init__(self, path: Path) -> None:
+        self.inner = open_bag(path)
+        self.path, self.format = path, "mcap"
+        self.connections = self.inner.connections
+
+    def raw(
+        self, conns: Sequence[Conn], start_ns: int | None = None, end_ns: int | None = None
+    ) -> Iterator[RawRecord]:
+        if getattr(self.inner, "scanned", False):
+            yield from self.inner.raw(conns, start_ns, end_ns)
+            return
+        by_id = {c.id: c for c in conns}
+        with self.path.open("rb") as f:
+            for _schema, channel, message in make_reader(f).iter_messages(
+                topics=sorted({c.topic for c in conns}),
+                starting_at=start_ns,
+                ending_at=end_ns,
+                log_time_order=True,
+            ):
+                if channel.id in by_id:
+                    yield by_id[channel.id], int(message.log_time), bytes(message.data)
+
+    def close(self) -> None:
+        self.inner.close()
+
+
+def _reference_bag(path: Path) -> BagFile:
+    fmt = detect_format(path)
+    if fmt == "mcap":
+        return LibraryMcap(path)
+    return RosbagsFile(path, fmt) if fmt != "ros1-active" else open_bag(path)
+
+
 def reference_batch(
     path: Path, topic: str, lo: int | None = None, hi: int | None = None
 ) -> PoseBatch:
     """rosbags' own reader and deserializer (rosbag1/rosbag2 Reader), or for files rosbags
-    does not open (standalone MCAP, unindexed .bag.active) their per-message raw records
-    deserialized by rosbags."""
+    does not open their per-message raw records deserialized by rosbags: standalone MCAP
+    read by the ``mcap`` library, unindexed .bag.active by ertools' scan."""
 
-    fmt = detect_format(path)
-    bag = RosbagsFile(path, fmt) if fmt not in ("mcap", "ros1-active") else open_bag(path)
-    with bag:
+    with _reference_bag(path) as bag:
         return slow_pose_batch(bag, bag.topic_conns(topic), lo, hi)
 
 
@@ -139,9 +178,7 @@ STATE_TOPICS = ("/fbm3w/bmbox_state", "/fbm3w/refbox_state")
 def reference_states(path: Path, topic: str) -> tuple[list[int], list[int], list[str]]:
     """States deserialized one by one by rosbags' own readers."""
 
-    fmt = detect_format(path)
-    bag = RosbagsFile(path, fmt) if fmt not in ("mcap", "ros1-active") else open_bag(path)
-    with bag:
+    with _reference_bag(path) as bag:
         conns = bag.topic_conns(topic)
         deser = Deserializer(conns, path)
         msgs = [(t, deser(raw, c)) for c, t, raw in bag.raw(conns)]

@@ -6,13 +6,19 @@ A toy "log" is a text file of numbers, one per line. The score of an execution i
 offset read from the team's per-team input (a YAML file ``{offset: X}``, like a marker-set
 transform). Words in a log make the scorer misbehave on purpose: ``bad`` (an unscoreable log:
 ScoringError), ``boom`` (a bug: RuntimeError), ``die`` (the worker process dies); ``sleep``
-waits a second; ``hold`` writes the scoring process's pid beside the log (``LOG.pid``) and
-waits for ever: a kill point the fault tests choose by waiting for that file; ``locked`` takes
-:data:`LOCK` (a scorer forked while another thread of its parent held it would wait for ever).
+waits a second; ``moment`` looks for a file ``LOG.absent`` and goes on without it (a scorer
+skipping a file it could not find at that moment); ``warn`` logs a warning naming the log;
+``replace`` replaces the log by a file of other numbers while it is scored (the numbers
+already read are scored); ``hold`` writes the scoring process's pid beside the log
+(``LOG.pid``) and waits for ever: a kill point the fault tests choose by waiting for that
+file; ``locked`` takes :data:`LOCK` (a scorer forked while another thread of its parent held
+it would wait for ever).
 """
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import os
 import threading
 import time
@@ -24,8 +30,9 @@ from typing import Any
 import yaml
 
 from ertools.benchmarks.base import Benchmark, Input, Ranking, Rows
-from ertools.errors import ConfigError, ScoringError, UsageError
+from ertools.errors import BagError, ConfigError, ScoringError, UsageError
 from ertools.fidelity import Deviation
+from ertools.io.formats import detect_format
 from ertools.streams import Provenance
 
 LOCK = threading.Lock()
@@ -87,6 +94,18 @@ def load(bags: Sequence[Path], options: ToyOptions) -> list[float]:
             if line == "locked":
                 with LOCK:
                     continue
+            if line == "warn":
+                logging.getLogger("ertools.toy").warning("toy warning from %s", Path(bag).name)
+                continue
+            if line == "moment":
+                with contextlib.suppress(BagError):
+                    detect_format(Path(f"{bag}.absent"))
+                continue
+            if line == "replace":
+                new = Path(f"{bag}.new")
+                new.write_text("100\n")
+                new.replace(bag)
+                continue
             if line == "sleep":  # long enough for a progress bar to show
                 time.sleep(1.0)
                 continue

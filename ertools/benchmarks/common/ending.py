@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ertools.fidelity import Deviation, Rule
+from ertools.fidelity import Deviation, NodeVersion, Rule
 from ertools.states import (
     BmBoxState,
     EndReason,
@@ -49,7 +49,7 @@ RULE_END_PAYLOADS = Rule(
     rulebook="END with payload `timeout` or `halt` (seed 6.2.3); an empty payload: the RefBox "
     "did not issue the END",
     node_2015=(
-        "rockin_scoring/BmBox.py (90d5c4d) l. 49, 53, 117, 126: only the whole strings "
+        "rockin_scoring/BmBox.py (7628309) l. 49, 53, 117, 126: only the whole strings "
         "`reason: timeout` (Timeout()) and `reason: stop` (not Running()), which the 2015 "
         "@Home RefBox sent (at_home_rsbb core_zone_exec.h phase_post_2); `timeout` or `halt` "
         "meant neither"
@@ -60,6 +60,39 @@ RULE_END_PAYLOADS = Rule(
         "with its file and time and read as neither, never guessed from its words"
     ),
     option=EXACT_FLAG,
+)
+
+# The BmBox every node imports (rows of the version table, ertools.fidelity.NodeVersion).
+_ALL_THREE = "RoCKIn 2015 Lisbon; Lisbon 2016 second local; Lisbon 2017 major tournament"
+VERSIONS = (
+    NodeVersion(
+        "src/rockin_scoring/BmBox.py",
+        "3a41cb2",
+        "2015-07-06",
+        "development (moved from src/rockin_benchmarking/, RoCKIn Camp 2015's 5fdbdc2)",
+        "none (the package renamed): a RefBox END during a manual operation left "
+        "ManualOperation() waiting",
+        "not restorable: no competition of this table ran it",
+    ),
+    NodeVersion(
+        "src/rockin_scoring/BmBox.py",
+        "7628309",
+        "2015-07-06",
+        f"{_ALL_THREE} (unchanged through 89dfa75)",
+        "any RefBox END moves WAITING_MANUAL_OPERATION to READY (l. 43-44) and "
+        "ManualOperation() returns the RefBox payload (FBM1@Work's item): a stop during a "
+        "manual operation ends the benchmark",
+        "every `--2015` and `--rules` (tests/bmbox2015.py replays it)",
+    ),
+    NodeVersion(
+        "src/rockin_scoring/FSM.py",
+        "3a41cb2",
+        "2015-07-06",
+        f"{_ALL_THREE} (its only version)",
+        "an update its transition table refuses changes nothing (BmBox.py 133-142): a RefBox "
+        "stop while a goal is sent leaves the node waiting in SendGoal()",
+        "every `--2015` and `--rules` (tests/bmbox2015.py replays it)",
+    ),
 )
 
 # BmBox states of a benchmark that is over: the score is being sent, or the node ended.

@@ -1,6 +1,7 @@
 """Sample hygiene shared by the benchmarks, each test written once: repeated poses (mocap
 tracking lost, samples recorded twice, frozen stretches), poses that cannot be compared (NaN,
-infinite, zero quaternions) and frame names that change mid-log.
+infinite, zero quaternions), poses no body can have taken (kilometres away, or reached faster
+than any robot: :func:`impossible_samples`) and frame names that change mid-log.
 
 Every repeat test is exact float equality of whole rows (:func:`rows_equal`): real mocap
 measurements never repeat a float64 coordinate, so an equal row is a re-sent pose.
@@ -8,6 +9,7 @@ measurements never repeat a float64 coordinate, so an equal row is a re-sent pos
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -108,20 +110,214 @@ def _all_valid(stream: PoseStream) -> bool:
     return True
 
 
-def drop_invalid(stream: PoseStream) -> tuple[PoseStream, int]:
+def drop_invalid(stream: PoseStream, *, jumps: bool = True) -> tuple[PoseStream, int]:
     """The stream without samples whose position or orientation is not usable.
 
     NaN or infinite values, or a zero quaternion (a node publishing "no pose"), cannot be
-    compared; dropping them (and saying how many) beats a NaN score.
+    compared; neither can a pose no body took (:func:`impossible_samples`; ``jumps``: the
+    jump test too, for a measured body, not a robot's own estimate, which may jump when it
+    relocalises). Dropping them (and saying how many) beats a NaN or an absurd score.
     """
-    if _all_valid(stream):
+    impossible = impossible_samples(stream.t_ns, stream.xyz, jumps=jumps)
+    if _all_valid(stream) and not impossible.count:
         return stream, 0
     with np.errstate(over="ignore"):  # an overflowing norm is not finite: dropped below
         norm = row_norm(stream.quat_xyzw)
     ok = np.all(np.isfinite(stream.xyz), axis=1) & np.isfinite(norm) & (norm > 1e-9)
+    ok &= ~(impossible.far | impossible.jump)
     if ok.all():
         return stream, 0
     return stream.take(ok), int((~ok).sum())
+
+
+# Physically impossible samples (docs/uncertainty.md, "Impossible samples"). No frame on Earth
+# puts a point further from its origin than the Earth's circumference (4e7 m); nor can any
+# squared distance of such points overflow a float64.
+MAX_COORD_M = 1e8
+# From the stream's median position: no arena is a kilometre across (a home or work testbed is
+# about 10 m; ertools.benchmarks.common.arena refuses inputs this far from the GT too).
+FAR_M = 1000.0
+# Faster than any robot of the leagues: the RoCKIn/ERL robots drive at 1-1.5 m/s at most and
+# FBM3's end effector follows its paths at a few cm/s; 5 m/s is three times the fastest of
+# them and still five times below a single-frame 1 m spike at 25 Hz. A jump must also exceed
+# JUMP_MIN_M, 100 times the 1 mm noise of a mocap frame, so that stamp jitter between two
+# nearby samples never makes one.
+MAX_SPEED_M_S = 5.0
+JUMP_MIN_M = 0.1
+# A stretch that leaves by a jump and comes back by one within this is a glitch (a marker set
+# mistaken for another for a few frames, a forged pose); longer ones are the data on one side
+# of a step, which side cannot be told: said, not dropped.
+EXCURSION_MAX_S = 0.5
+_MEDIAN_SAMPLES = 10_000  # the centre from at most this many samples (a median is robust)
+
+
+@dataclass(frozen=True)
+class Jump:
+    """A move between two consecutive measured samples faster than any robot.
+
+    Attributes:
+        t_ns: the stamp of the sample it lands on.
+        distance_m: how far it goes.
+        speed_m_s: over the time between the two samples (at least the median frame period).
+    """
+
+    t_ns: int
+    distance_m: float
+    speed_m_s: float
+
+
+@dataclass(frozen=True)
+class Impossible:
+    """The samples of a stream no body can have taken.
+
+    Attributes:
+        far: (N,) positions beyond :data:`MAX_COORD_M`, or :data:`FAR_M` from the stream's
+            median position.
+        jump: (N,) samples of a stretch left and re-entered by jumps (:class:`Jump`) within
+            :data:`EXCURSION_MAX_S`.
+        steps: the jumps that bound no such stretch: the data on one side is wrong, which
+            cannot be told (their samples stay valid; the warning says where).
+    """
+
+    far: Bool
+    jump: Bool
+    steps: tuple[Jump, ...] = ()
+
+    @property
+    def count(self) -> int:
+        return int(np.count_nonzero(self.far | self.jump))
+
+
+def impossible_samples(t_ns: npt.NDArray[np.int64], xyz: F64, *, jumps: bool = True) -> Impossible:
+    """Which samples of a stream are physically impossible (:class:`Impossible`).
+
+    Not-finite samples are neither far nor jumps (they are invalid already); a sample that
+    repeats the previous position (Motive re-sending a lost body's pose) is not a
+    measurement, so a jump is measured from the last real one (no jump when tracking comes
+    back after a loss the body moved through).
+    """
+    n = len(t_ns)
+    far = np.zeros(n, dtype=bool)
+    jump = np.zeros(n, dtype=bool)
+    if not n:
+        return Impossible(far, jump)
+    finite = np.isfinite(xyz).all(axis=1)
+    far[finite] = (np.abs(xyz[finite]) > MAX_COORD_M).any(axis=1)
+    ok = np.flatnonzero(finite & ~far)
+    if ok.size:
+        centre = np.median(xyz[ok[:: max(1, ok.size // _MEDIAN_SAMPLES)]], axis=0)
+        far[ok[row_norm(xyz[ok] - centre) > FAR_M]] = True
+    if not jumps:
+        return Impossible(far, jump)
+    measured = finite & ~far
+    if n > 1:
+        measured[1:] &= ~rows_equal(xyz[1:], xyz[:-1])
+    ok = np.flatnonzero(measured)
+    if ok.size < 2:
+        return Impossible(far, jump)
+    t = t_ns[ok]
+    dt = np.diff(t)
+    positive = dt[dt > 0]
+    period = int(np.median(positive)) if positive.size else 1
+    dist = row_norm(np.diff(xyz[ok], axis=0))
+    speed = dist / (np.maximum(dt, max(period, 1)) / 1e9)
+    big = (dist > JUMP_MIN_M) & (speed > MAX_SPEED_M_S)
+    if not big.any():
+        return Impossible(far, jump)
+    # stretch k of the measured samples lies between jump k-1 and jump k (or the stream's ends)
+    at = np.flatnonzero(big) + 1  # first sample of stretches 1, 2, ...
+    first = np.concatenate([[0], at])
+    last = np.concatenate([at - 1, [ok.size - 1]])
+    kept, steps = _kept_stretches(t, xyz[ok], first, last, period)
+    # every sample from a stretch's first measured one to the next stretch's, repeats included
+    of = np.searchsorted(ok[at], np.arange(n), side="right")
+    jump[:] = ~kept[of] & finite & ~far
+    return Impossible(far, jump, steps)
+
+
+def _kept_stretches(
+    t: npt.NDArray[np.int64],
+    xyz: F64,
+    first: npt.NDArray[np.intp],
+    last: npt.NDArray[np.intp],
+    period: int,
+) -> tuple[Bool, tuple[Jump, ...]]:
+    """Which stretches between jumps are the body's, and the steps among them.
+
+    From the longest stretch (the body's own; when even it lasts no longer than a glitch,
+    nothing is dropped), outwards both ways: the next stretch is kept
+    when the body could have reached it from the last sample kept (a spike's way back lands
+    where the body was); else it is dropped when it lasts at most :data:`EXCURSION_MAX_S`
+    (the glitch), and kept as a step when longer (which side is wrong cannot be told). A
+    handful of stretches, not samples: the loop is short.
+    """
+    count = len(first)
+    lasting = t[last] - t[first]
+    short = lasting <= round(EXCURSION_MAX_S * 1e9)
+    anchor = int(np.argmax(lasting))
+    kept = np.zeros(count, dtype=bool)
+    kept[anchor] = True
+    if short[anchor]:
+        # no stretch outlasts a glitch: which one is the body's cannot be told; all stay
+        short[:] = False
+    steps: list[Jump] = []
+
+    def move(i: int, j: int) -> Jump:
+        d = float(np.linalg.norm(xyz[j] - xyz[i]))
+        return Jump(int(t[max(i, j)]), d, d / (max(abs(int(t[j] - t[i])), period) / 1e9))
+
+    for order in (range(anchor + 1, count), range(anchor - 1, -1, -1)):
+        ref = int(last[anchor] if order.step > 0 else first[anchor])
+        for s in order:
+            near, far_end = (
+                (int(first[s]), int(last[s])) if order.step > 0 else (int(last[s]), int(first[s]))
+            )
+            m = move(ref, near)
+            if m.distance_m > JUMP_MIN_M and m.speed_m_s > MAX_SPEED_M_S:
+                if short[s]:
+                    continue  # an excursion: left out
+                steps.append(m)
+            kept[s] = True
+            ref = far_end
+    return kept, tuple(steps[:3])
+
+
+def impossible_warning(
+    stream: PoseStream, origin_ns: int | None = None, *, jumps: bool = True
+) -> str | None:
+    """One warning line when ``stream`` holds impossible samples (left out of every score:
+    :func:`drop_invalid`, the validity masks) or steps no body can make, else None."""
+    found = impossible_samples(stream.t_ns, stream.xyz, jumps=jumps)
+    if not found.count and not found.steps:
+        return None
+
+    def when(t: int) -> str:
+        return f"{(t - origin_ns) / 1e9:.3f} s" if origin_ns is not None else iso_utc(t)
+
+    parts = []
+    far = int(np.count_nonzero(found.far))
+    if far:
+        i = int(np.flatnonzero(found.far)[0])
+        parts.append(
+            f"{far} pose(s) kilometres from the others (the first at {when(int(stream.t_ns[i]))})"
+        )
+    glitch = int(np.count_nonzero(found.jump))
+    if glitch:
+        i = int(np.flatnonzero(found.jump)[0])
+        parts.append(
+            f"{glitch} pose(s) reached and left faster than {MAX_SPEED_M_S:g} m/s (the first "
+            f"at {when(int(stream.t_ns[i]))})"
+        )
+    left = f"{'; '.join(parts)}: left out as invalid" if parts else ""
+    steps = "; ".join(
+        f"{s.distance_m:.3g} m at {s.speed_m_s:.3g} m/s at {when(s.t_ns)}" for s in found.steps
+    )
+    if steps:
+        steps = (
+            f"{'; and ' if left else ''}jump(s) faster than any robot that do not come back "
+            f"({steps}): the poses on one side are wrong, which cannot be told"
+        )
+    return f"{stream.source or 'the pose stream'}: {left}{steps}"
 
 
 # Identical poses lasting longer than this around a scored moment are reported. Real mocap
@@ -183,6 +379,29 @@ def frozen_around(
                 a, b = int(starts[r]), int(ends[r])
                 out[k] = FrozenSpan(int(t[a]), int(t[b]), b - a + 1)
                 break
+    return out
+
+
+def frozen_warnings(
+    poses: PoseStream, moments: Sequence[tuple[str, str, int]], origin_ns: int
+) -> list[str]:
+    """A warning per moment ``(who, what, t_ns)`` (``("run 2", "start", t)``) whose pose is a
+    frozen (repeated) pose (:func:`frozen_around`): the last pose before a tracking loss, not
+    where the body was then."""
+    if not moments:
+        return []
+    out = []
+    for (who, what, t), span in zip(
+        moments, frozen_around(poses, [m[2] for m in moments]), strict=True
+    ):
+        if span is None:
+            continue
+        out.append(
+            f"{who}: the pose at its {what} time {(t - origin_ns) / 1e9:.3f} s is frozen: "
+            f"{span.samples} identical poses over {span.duration_s:.3f} s "
+            f"({(span.start_ns - origin_ns) / 1e9:.3f}-{(span.end_ns - origin_ns) / 1e9:.3f} s "
+            "from the log's first message; tracking lost, or a noiseless recording)"
+        )
     return out
 
 

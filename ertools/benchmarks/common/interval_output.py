@@ -65,6 +65,24 @@ class IntervalSettings:
         )
 
 
+def withheld(
+    keys: Sequence[str], reason: str, settings: IntervalSettings, method: str = ""
+) -> ResultIntervals:
+    """No interval for any of ``keys`` (each ``null`` in the result), and why."""
+    return ResultIntervals(
+        dict.fromkeys(keys),
+        Uncertainty(
+            settings.confidence,
+            method or METHOD,
+            settings.draws,
+            settings.seed,
+            (),
+            {},
+            dict.fromkeys(keys, reason),
+        ),
+    )
+
+
 def shares_of(intervals: Mapping[str, Interval | None]) -> dict[str, dict[str, float]]:
     """Each interval's source shares by score key (the ``uncertainty.shares`` mapping)."""
     return {k: iv.share_dict() for k, iv in intervals.items() if iv is not None}
@@ -99,6 +117,7 @@ class ScoreRow:
     interval: Interval | None
     scale: float = 1.0
     unit: str = ""
+    key: str = ""  # the score's key in the result (default: ``name``)
 
 
 def _num(x: float) -> str:
@@ -119,6 +138,9 @@ def interval_line(row: ScoreRow, uncertainty: Uncertainty, *, top: int = 3) -> s
     level = f"{uncertainty.confidence * 100:g}%"
     how = f"{METHOD_NAME}, {uncertainty.draws} draws, seed {uncertainty.seed}"
     iv = row.interval
+    withheld = uncertainty.withheld.get(row.key or row.name)
+    if iv is None and withheld:
+        return f"{head}: no {level} interval ({withheld})"
     if iv is None:
         return f"{head}: no {level} interval ({how}: too few draws scored)"
     span = f"[{_num(iv.low * row.scale)}, {_num(iv.high * row.scale)}]{u}"
@@ -148,7 +170,7 @@ def interval_lines(rows: Sequence[ScoreRow], uncertainty: Uncertainty | None) ->
     if uncertainty is None:
         return []
     out = [interval_line(r, uncertainty) for r in rows if r.value is not None]
-    return [*out, sources_line(uncertainty)]
+    return [*out, sources_line(uncertainty)] if uncertainty.sources else out
 
 
 def interval_tables(

@@ -26,6 +26,7 @@ from typing import Any, Literal
 
 import yaml
 
+from ertools import yamlin
 from ertools.errors import ErtoolsError
 from ertools.io import read_benchmark_states
 
@@ -118,7 +119,7 @@ def team_from_payloads(payloads: Iterable[str]) -> str | None:
         if ":" not in text or not any(k in text for k in PAYLOAD_KEYS):
             continue
         try:
-            data = yaml.safe_load(text)
+            data = yamlin.load(text, duplicates=[])  # a name: read as the 2015 nodes did
         except yaml.YAMLError:
             continue
         if not isinstance(data, dict):

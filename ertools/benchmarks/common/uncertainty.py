@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from statistics import NormalDist
 from typing import Any
 
@@ -41,6 +41,17 @@ DEFAULT_SEED = 0
 MAX_DRAWS = 100_000
 # numpy seeds any non-negative integer; results and reports carry the seed as an int64
 MAX_SEED = 2**63 - 1
+
+# How many measured samples a score needs behind it (docs/uncertainty.md, "Too few samples").
+# An interval's width is measured from the samples themselves (the spread of the errors, the
+# clock offset's standard error from their cross-correlation, the noise along a path): a
+# spread estimated from n values is itself uncertain by about sqrt(2 / (n - 1)) of its size,
+# more than half below 10 values, so an interval from fewer would state a precision the data
+# cannot show: none is given (null, with the reason). Below 30 the width is known to within a
+# quarter only, and a statistic of so few samples describes a moment more than a run (the p90
+# of fewer than 10 values is their max): the score is given with a warning.
+MIN_INTERVAL_SAMPLES = 10
+MIN_SCORE_SAMPLES = 30
 
 # The names of the sources, as they appear in outputs (``uncertainty.sources[].name``).
 MOCAP_NOISE = "mocap_noise"
@@ -160,7 +171,8 @@ class Uncertainty:
     """The ``uncertainty`` block of a result: how its intervals were obtained.
 
     ``shares`` maps a score's key (dotted for nested ones: ``runs_details.2.distance_error``)
-    to each source's share of that score's interval.
+    to each source's share of that score's interval; ``withheld`` a score's key to why it has
+    no interval (too few samples behind it: :data:`MIN_INTERVAL_SAMPLES`).
     """
 
     confidence: float
@@ -169,9 +181,10 @@ class Uncertainty:
     seed: int
     sources: tuple[Source, ...]
     shares: Mapping[str, Mapping[str, float]]
+    withheld: Mapping[str, str] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
-        return {
+        out = {
             "confidence": self.confidence,
             "method": self.method,
             "draws": self.draws,
@@ -179,6 +192,31 @@ class Uncertainty:
             "sources": [s.to_dict() for s in self.sources],
             "shares": {k: dict(v) for k, v in self.shares.items()},
         }
+        if self.withheld:
+            out["withheld"] = dict(self.withheld)
+        return out
+
+
+def too_few(
+    count: int, what: str, minimum: int = MIN_INTERVAL_SAMPLES, why: str = ""
+) -> str | None:
+    """Why a score of ``count`` samples (``what``: ``compared pose(s)``) gets no interval, or
+    None when it has at least ``minimum`` (a benchmark whose sources need more says ``why``)."""
+    if count >= minimum:
+        return None
+    return f"only {count} {what}: an interval needs at least {minimum}, " + (
+        why or "its width being measured from them"
+    )
+
+
+def few_warning(count: int, what: str, where: str) -> str | None:
+    """A warning for a score of fewer than :data:`MIN_SCORE_SAMPLES` samples, else None."""
+    if count >= MIN_SCORE_SAMPLES:
+        return None
+    return (
+        f"{where} rests on {count} {what} only (fewer than {MIN_SCORE_SAMPLES}): a statistic "
+        "of so few samples says little of the whole run"
+    )
 
 
 def basic_intervals(estimate: F64, draws: F64, confidence: float) -> tuple[F64, F64]:

@@ -23,6 +23,11 @@ What each reason means in the data (the logs carry no per-frame tracking flag):
 - ``nan``: a position or orientation that is not finite, or a zero quaternion.
 - ``clock_jump``: a different pose at the very stamp of the previous sample: the clock did not
   advance (or stepped back and the stream was sorted), so its time is not the measurement's.
+- ``far``: a position no body in an arena can have: kilometres from the stream's other
+  samples, or beyond any frame on Earth (:func:`~ertools.benchmarks.common.hygiene.
+  impossible_samples`).
+- ``jump``: a pose reached and left again faster than any robot moves (a marker set mistaken
+  for another for a few frames, a forged pose): a glitch, not a measurement.
 - ``occluded``: reserved for a source that flags untracked frames. No log format ertools reads
   carries that flag: ``ertools record`` does not write an untracked frame (a ``gap``), the 2015
   mocap_optitrack re-published the last pose (``tracking_lost``), a NaN pose is ``nan``.
@@ -39,7 +44,7 @@ import numpy.typing as npt
 
 from ertools.arrays import F64, I64, Bool, IntArr
 from ertools.benchmarks.base import FormerName, Input
-from ertools.benchmarks.common.hygiene import rows_equal
+from ertools.benchmarks.common.hygiene import impossible_samples, rows_equal
 
 VALID = 0
 TRACKING_LOST = 1
@@ -48,6 +53,8 @@ OUTSIDE_WINDOW = 3
 NAN = 4
 CLOCK_JUMP = 5
 OCCLUDED = 6
+FAR = 7
+JUMP = 8
 REASONS: tuple[str, ...] = (
     "valid",
     "tracking_lost",
@@ -56,7 +63,11 @@ REASONS: tuple[str, ...] = (
     "nan",
     "clock_jump",
     "occluded",
+    "far",
+    "jump",
 )
+#: the codes of samples whose position cannot be used at all (not merely a repeat)
+UNUSABLE = (NAN, FAR, JUMP)
 CODE: Mapping[str, int] = {name: code for code, name in enumerate(REASONS)}
 
 Codes = npt.NDArray[np.int8]
@@ -122,7 +133,8 @@ class SampleMask:
 def sample_codes(t_ns: I64, xyz: F64, quat_xyzw: F64 | None = None) -> SampleMask:
     """Each sample's reason code, from the stream alone (window and gaps aside).
 
-    Precedence: ``nan`` over ``clock_jump`` over ``tracking_lost``. A sample equal to the
+    Precedence: ``nan`` over ``far`` over ``jump`` over ``clock_jump`` over
+    ``tracking_lost``. A sample equal to the
     previous one at the same stamp is a second recording of it (two loggers on one topic) and
     stays valid: it neither adds nor hides a measurement.
     """
@@ -136,6 +148,9 @@ def sample_codes(t_ns: I64, xyz: F64, quat_xyzw: F64 | None = None) -> SampleMas
         same_t = t_ns[1:] == t_ns[:-1]
         codes[1:][same & ~same_t] = TRACKING_LOST
         codes[1:][same_t & ~same] = CLOCK_JUMP
+    impossible = impossible_samples(t_ns, xyz)
+    codes[impossible.jump] = JUMP
+    codes[impossible.far] = FAR
     bad = ~np.all(np.isfinite(rows), axis=1)
     if quat_xyzw is not None:
         with np.errstate(over="ignore", invalid="ignore"):
@@ -143,6 +158,22 @@ def sample_codes(t_ns: I64, xyz: F64, quat_xyzw: F64 | None = None) -> SampleMas
         bad |= ~(norm > 1e-18)
     codes[bad] = NAN
     return SampleMask(t_ns, codes)
+
+
+def measured(mask: SampleMask) -> Bool:
+    """Which samples of ``mask``'s stream are measurements at all: not ``far`` or a ``jump``
+    (physically impossible: every number is computed without them, the validity counts
+    them; docs/uncertainty.md, "Impossible samples")."""
+    ok: Bool = ~np.isin(mask.codes, (FAR, JUMP))
+    return ok
+
+
+def last_measured(ok: Bool, i: int) -> int:
+    """The last index at or before ``i`` where ``ok`` holds, -1 when none does."""
+    if i < 0 or ok[i]:
+        return i
+    before = np.flatnonzero(ok[: i + 1])
+    return int(before[-1]) if before.size else -1
 
 
 @dataclass(frozen=True)

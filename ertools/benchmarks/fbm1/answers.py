@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from ertools.configs._yaml import parse_yaml
+from ertools.configs._yaml import parse_payload
 from ertools.errors import ConfigError, ScoringError
 
 ANSWER_FIELDS = ("item_class", "item_instance", "x", "y", "theta")
@@ -70,7 +70,7 @@ def answer_from_mapping(data: Any, where: str, source: str) -> Answer:
 def parse_answer_payload(payload: str, where: str) -> Answer:
     """The Client's COMPLETED_GOAL payload (YAML text) as an Answer."""
     try:
-        data = parse_yaml(payload, source="client payload", what="answer YAML")
+        data = parse_payload(payload, source="client payload", what=f"answer YAML of {where}")
     except ConfigError as err:
         raise ScoringError(
             f"{where}: answer payload is not YAML ({err}): {_short(payload)}"

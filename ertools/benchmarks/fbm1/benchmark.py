@@ -25,7 +25,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.common.hygiene import frame_change_warning
+from ertools.benchmarks.common.hygiene import frame_change_warning, impossible_warning
 from ertools.benchmarks.common.validity import (
     SampleMask,
 )
@@ -56,7 +56,7 @@ from ertools.benchmarks.fbm1.rules import (
 from ertools.benchmarks.fbm1.runs import Fbm1Run, RunsFound
 from ertools.benchmarks.fbm1.score import MAX_POSE_ERROR_2015, names_match, pose_errors, totals
 from ertools.benchmarks.fbm1.validity import body_mask, gt_validity
-from ertools.configs._yaml import parse_yaml
+from ertools.configs._yaml import parse_payload
 from ertools.configs.items import Item, ItemList
 from ertools.errors import ConfigError, ScoringError, SegmentationError
 from ertools.fidelity import Deviation
@@ -399,6 +399,7 @@ def score_fbm1(
     warnings = list(found.warnings)
     # A GT body whose frame_id changes mid-log mixes frames (ertools.streams).
     warnings += [w for w in (frame_change_warning(b, t0_ns or None) for b in (origin, board)) if w]
+    warnings += [w for w in (impossible_warning(b, t0_ns or None) for b in (origin, board)) if w]
     if items.is_vanilla:
         warnings.append(
             f"{items.source or 'the item list'} has identity transforms only (a vanilla list): "
@@ -468,7 +469,7 @@ def _parse_logged(payload: str | None) -> dict[str, Any] | None:
         return None
 
     try:
-        data = parse_yaml(payload, "BmBox TRANSMITTING_SCORE payload")
+        data = parse_payload(payload, "BmBox TRANSMITTING_SCORE payload")
     except ConfigError:
         log.warning("the logged 2015 score payload is not YAML: %.60r", payload)
         return None

@@ -23,22 +23,33 @@ from ertools.io import PoseSource
 BENCHMARKS = ("fbm1h", "fbm1w")
 
 
-# The nodes ertools can reproduce: (--rules value, what it is, the file the arithmetic is in).
+# The nodes ertools can reproduce (rockin-robot-challenge/benchmark_and_scoring_fbm, each read
+# at its commit; the version table of docs/fidelity.md).
 NODE_2015 = (
-    "2015 node (rockin-robot-challenge/benchmark_and_scoring_fbm scripts/fbm1h at 117a5d0; "
-    "scripts/fbm1w as in svenschneider/benchmark_and_scoring_fbm): totals over runs played + "
-    "aborted, ground truth looked up when the result arrived"
+    "2015 node (rockin-robot-challenge/benchmark_and_scoring_fbm scripts/fbm1h at e373be0, "
+    "scripts/fbm1w at 7628309: RoCKIn 2015 Lisbon): totals over runs played + aborted, ground "
+    "truth looked up when the result arrived"
 )
 
 
 NODE_2016 = (
-    "2016-17 @Home node (rockin-robot-challenge/benchmark_and_scoring_fbm scripts/fbm1h at "
-    "40ba68b): accuracies over 10, pose score over runs played + aborted, ground truth looked "
-    "up when the placement was confirmed, before the goal"
+    "2016 @Home node (rockin-robot-challenge/benchmark_and_scoring_fbm scripts/fbm1h at "
+    "40ba68b: the Lisbon 2016 second local competition): accuracies over 10, pose score over "
+    "runs played + aborted, ground truth looked up when the placement was confirmed, before "
+    "the goal"
 )
 
 
-RULE_SETS = ("ertools", "2015", "2016")
+NODE_2017 = (
+    "2017 @Home node (rockin-robot-challenge/benchmark_and_scoring_fbm scripts/fbm1h at "
+    "89dfa75: the Lisbon 2017 major tournament): the 2016 node with the translation term "
+    "clipped at 1 m"
+)
+
+
+RULE_SETS = ("ertools", "2015", "2016", "2017")
+# The --rules values each benchmark has (no later FBM1@Work node is known).
+RULES_OF = {"fbm1h": RULE_SETS, "fbm1w": ("ertools", "2015")}
 
 
 @dataclass(frozen=True)
@@ -81,13 +92,14 @@ class Fbm1Options:
 
     @staticmethod
     def for_rules(benchmark: str, rules: str, gt: GtOptions | None = None) -> Fbm1Options:
-        """Every behaviour of one reference: ``ertools``, ``2015`` or ``2016`` (@Home only).
+        """Every behaviour of one reference: ``ertools``, ``2015``, ``2016`` or ``2017`` (the
+        last two @Home only).
 
         ``gt`` gives the tolerances of the window (its method is replaced by the node's).
 
         Raises:
-            ConfigError: an unknown reference, or ``2016`` for @Work (no later @Work node is
-                known).
+            ConfigError: an unknown reference, or ``2016`` / ``2017`` for @Work (no later
+                @Work node is known).
         """
 
         base = gt or GtOptions()
@@ -100,11 +112,16 @@ class Fbm1Options:
                 ScoreRules.node_2015(),
                 exact_end_payloads=True,
             )
-        if rules == "2016" and benchmark == "fbm1h":
-            return Fbm1Options(benchmark, replace(base, method="placed"), ScoreRules.node_2016())
-        if rules == "2016":
+        if rules in ("2016", "2017") and benchmark == "fbm1h":
+            # Both import the 2015 BmBox.py unchanged: its two END strings only.
+            node = ScoreRules.node_2016() if rules == "2016" else ScoreRules.node_2017()
+            return Fbm1Options(
+                benchmark, replace(base, method="placed"), node, exact_end_payloads=True
+            )
+        if rules in ("2016", "2017"):
             raise ConfigError(
-                "no 2016-17 FBM1@Work node is known (only the 2015 scripts/fbm1w); use 2015"
+                f"no {rules} FBM1@Work node is known (scripts/fbm1w has one version, 7628309, "
+                "RoCKIn 2015); use 2015"
             )
         raise ConfigError(f"unknown FBM1 rules {rules!r}; use {', '.join(RULE_SETS)}")
 
@@ -116,7 +133,12 @@ class Fbm1Options:
     @property
     def reference(self) -> str:
         """Which reference these options reproduce: ertools, a node, or a mixture."""
-        refs = (("ertools", "ertools default"), ("2015", NODE_2015), ("2016", NODE_2016))
+        refs = (
+            ("ertools", "ertools default"),
+            ("2015", NODE_2015),
+            ("2016", NODE_2016),
+            ("2017", NODE_2017),
+        )
         for name, text in refs:
             try:
                 ref = Fbm1Options.for_rules(self.benchmark, name, self.gt)

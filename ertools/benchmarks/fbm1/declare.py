@@ -41,7 +41,7 @@ from ertools.io import PoseSource
 GT_CHOICES = ("window", "placed", "goal", "result")
 BODIES = "table and board poses"
 GT = "ground truth"
-NODES = "node rules (each option restores one behaviour of the 2015 / 2016-17 nodes)"
+NODES = "node rules (each option restores one behaviour of the 2015, 2016 or 2017 nodes)"
 
 
 def inputs(name: str) -> tuple[Input, ...]:
@@ -90,8 +90,8 @@ def inputs(name: str) -> tuple[Input, ...]:
             "choice",
             "window: mean over the stationary window before the goal (default); or one tf "
             "lookup interpolated at a moment: result: when the result arrived (2015 nodes), "
-            "placed: when the placement was confirmed (2016-17 @Home node), goal: when the goal "
-            "was sent",
+            "placed: when the placement was confirmed (2016 and 2017 @Home nodes), goal: when "
+            "the goal was sent",
             choices=GT_CHOICES,
             group=GT,
         ),
@@ -134,15 +134,19 @@ def inputs(name: str) -> tuple[Input, ...]:
         Input(
             "rules",
             "choice",
-            "every behaviour of one reference at once: ertools (default), 2015 (the 2015 "
-            "nodes), 2016 (the 2016-17 @Home node); single options below add to it",
+            "every behaviour of one reference at once: ertools (default), 2015 (the RoCKIn 2015 "
+            "nodes: fbm1h e373be0, fbm1w 7628309), 2016 (@Home node 40ba68b, Lisbon 2016), "
+            "2017 (@Home node 89dfa75, Lisbon 2017); single options below add to it",
             choices=RULE_SETS,
             group=NODES,
         ),
         Input("all_2015", "flag", "= --rules 2015", flag="--2015", group=NODES),
-        # No 2016-17 @Work node is known: @Work has no --2016 (--rules 2016 says why).
+        # No later @Work node is known: @Work has no --2016 (--rules 2016 says why).
         *(
-            [Input("all_2016", "flag", "= --rules 2016", flag="--2016", group=NODES)]
+            [
+                Input("all_2016", "flag", "= --rules 2016", flag="--2016", group=NODES),
+                Input("all_2017", "flag", "= --rules 2017", flag="--2017", group=NODES),
+            ]
             if name == "fbm1h"
             else []
         ),
@@ -177,7 +181,7 @@ def inputs(name: str) -> tuple[Input, ...]:
         Input(
             "accuracy_over_10",
             "flag",
-            "class and instance accuracies divided by 10 whatever the runs (2016-17 @Home)",
+            "class and instance accuracies divided by 10 whatever the runs (2016, 2017 @Home)",
             group=NODES,
         ),
         # both nodes scored a run whose ground truth had no valid mocap sample (tracking lost)
@@ -196,8 +200,9 @@ def _rules_name(v: Mapping[str, Any]) -> str:
     chosen = {v["rules"]} - {None}
     chosen |= {"2015"} if v["all_2015"] else set()
     chosen |= {"2016"} if v.get("all_2016") else set()
+    chosen |= {"2017"} if v.get("all_2017") else set()
     if len(chosen) > 1:
-        raise UsageError(f"--rules/--2015/--2016 name {len(chosen)} references; give one")
+        raise UsageError(f"--rules/--2015/--2016/--2017 name {len(chosen)} references; give one")
     return chosen.pop() if chosen else "ertools"
 
 
@@ -239,7 +244,7 @@ def options_maker(name: str) -> Callable[[Mapping[str, Any]], Fbm1Options]:
             now = (
                 "--count-aborted (the 2015 @Work node's divisors)"
                 if name == "fbm1w"
-                else "--count-aborted --accuracy-over-10 (the 2016-17 @Home node's divisors; "
+                else "--count-aborted --accuracy-over-10 (the 2016 and 2017 @Home nodes' divisors; "
                 "the 2015 node's are --count-aborted alone)"
             )
             notice(f"note: --legacy-totals is deprecated, use {now}")
@@ -269,7 +274,7 @@ def options_maker(name: str) -> Callable[[Mapping[str, Any]], Fbm1Options]:
         )
         if v["gt"] == "goal":
             notice(
-                "--gt goal looks the ground truth up when the goal was sent; the 2016-17 node "
+                "--gt goal looks the ground truth up when the goal was sent; the 2016-17 nodes "
                 "did it when the placement was confirmed (--gt placed)"
             )
         order = None
@@ -375,8 +380,9 @@ EPILOG = """examples:
   ertools score {name} run.bag --items configs/{name}.yaml
   ertools score fbm1w run.bag --items configs/fbm1w.yaml --items-order 3,7,1,2
   ertools score fbm1h run.bag --items fbm1h.yaml --results answers.yaml --format json
-  ertools score fbm1h run.bag --items fbm1h.yaml --rules 2015   # the 2015 node's numbers
-  ertools score fbm1h run.bag --items fbm1h.yaml --rules 2016   # the 2016-17 @Home node's
+  ertools score fbm1h run.bag --items fbm1h.yaml --rules 2015   # RoCKIn 2015's node (e373be0)
+  ertools score fbm1h run.bag --items fbm1h.yaml --rules 2016   # Lisbon 2016's (40ba68b)
+  ertools score fbm1h run.bag --items fbm1h.yaml --rules 2017   # Lisbon 2017's (89dfa75)
 
 --results FILE: a YAML list of answers, each {{run: N or item: ID, item_class, item_instance,
 x, y, theta}} (theta in degrees), used instead of the Client payloads it covers.

@@ -26,6 +26,7 @@ from typing import Literal
 import numpy as np
 
 from ertools.benchmarks.common import motion
+from ertools.benchmarks.common.hygiene import drop_invalid
 from ertools.configs.items import Item
 from ertools.geometry import compose, interpolate_poses, invert, mean_pose, yaw_from_quat
 from ertools.streams import PoseStream
@@ -109,8 +110,10 @@ def board_in_table(origin: PoseStream, board: PoseStream, max_gap_ns: int) -> Po
     """T_origin_board at each board sample where the origin is known (interpolated).
 
     Board samples outside the origin's time span, or inside an origin gap longer than
-    ``max_gap_ns``, are dropped.
+    ``max_gap_ns``, are dropped, and so are the samples of either body that are no
+    measurement (NaN, a zero quaternion, physically impossible: the validity counts them).
     """
+    origin, board = drop_invalid(origin)[0], drop_invalid(board)[0]
     if len(origin) == 0 or len(board) == 0:
         return PoseStream.empty("origin", "ref_board")
     at = interpolate_poses(origin, board.t_ns, "linear")
@@ -258,7 +261,10 @@ def lookup_at(
     """
     at = np.array([at_ns], dtype=np.int64)
     poses = []
-    for stream, name in ((origin, "origin"), (board, "ref_board")):
+    for stream, name in (
+        (drop_invalid(origin)[0], "origin"),
+        (drop_invalid(board)[0], "ref_board"),
+    ):
         if len(stream) == 0:
             raise GroundTruthError(f"no {name} pose in the log")
         got = interpolate_poses(stream, at, "linear")

@@ -5,9 +5,9 @@ says, what the node did, what ertools does and why, the option restoring 2015).
 
 from __future__ import annotations
 
-from ertools.fidelity import Rule
+from ertools.fidelity import NodeVersion, Rule
 
-NODE_SOURCE = "scripts/fbm1h, scripts/fbm1w (2015)"
+NODE_SOURCE = "scripts/fbm1h (e373be0), scripts/fbm1w (7628309): RoCKIn 2015"
 
 RULE_GT_MOMENT = Rule(
     key="fbm1.ground-truth",
@@ -17,7 +17,8 @@ RULE_GT_MOMENT = Rule(
     node_2015=(
         f"{NODE_SOURCE}: one tf lookup, `lookupTransform('/origin', '/item', "
         "rospy.Time(0))`, at the stamp of the item transform broadcast once when the result had "
-        "arrived (the 2016-17 @Home node: when the placement was confirmed, `--gt placed`)"
+        "arrived (the 2016 and 2017 @Home nodes, 40ba68b and 89dfa75: when the placement was "
+        "confirmed, `--gt placed`)"
     ),
     ertools=(
         "mean over the stationary window before the goal, spread reported: one sample carries "
@@ -33,7 +34,8 @@ RULE_TRANS_CLIP = Rule(
     rulebook="pose score 1 - t/2 - r/2 with both terms in [0, 1] (score listing, seed 7.1)",
     node_2015=(
         f"{NODE_SOURCE}: `if pose_err_trans > max_pose_error : pose_err_trans = 1` with "
-        "max_pose_error = sqrt(2) m: errors of 1..1.41 m stay unclipped (score down to -0.21)"
+        "max_pose_error = sqrt(2) m: errors of 1..1.41 m stay unclipped (score down to -0.21); "
+        "so the 2016 node (40ba68b); the 2017 node (89dfa75) clipped at 1 m as ertools does"
     ),
     ertools="t = min(error, 1 m), so a pose score stays in [0, 1]",
     option="--clip-above-diagonal",
@@ -88,7 +90,7 @@ RULE_POSE_SOURCE = Rule(
     rulebook="the table (origin) and reference board marker sets from the mocap (seed 7.1)",
     node_2015=(
         f'{NODE_SOURCE}: `listener.lookupTransform("/origin", "/item", rospy.Time(0))` '
-        "(fbm1h at 117a5d0, line 125): the /tf frames origin and ref_board, never the pose "
+        "(fbm1h at e373be0, line 125): the /tf frames origin and ref_board, never the pose "
         "topics"
     ),
     ertools=(
@@ -114,4 +116,64 @@ RULE_UNSCOREABLE = Rule(
         "left out of the totals like a failed run, the reason given (docs/uncertainty.md)"
     ),
     option="--unscoreable 2015",
+)
+
+# The versions of the FBM1 nodes (rows of the version table, ertools.fidelity.NodeVersion).
+_H = "scripts/fbm1h"
+VERSIONS = (
+    NodeVersion(
+        _H,
+        "5fdbdc2",
+        "2015-04-03",
+        'RoCKIn Camp 2015 ("release used at rockin camp 2015")',
+        "the 2015 scoring: totals over runs played + aborted, one tf lookup when the result "
+        "arrived, translation set to 1 only above sqrt(2) m, one-step theta wrap, exact names",
+        "`--rules 2015` (the same arithmetic; its BmBox waited on a RefBox END during a manual "
+        "operation)",
+    ),
+    NodeVersion(_H, "8eb3450", "2015-06-23", "development", "none (imports)", "`--rules 2015`"),
+    NodeVersion(_H, "117a5d0", "2015-10-26", "development", "none (a log level)", "`--rules 2015`"),
+    NodeVersion(
+        _H,
+        "e373be0",
+        "2015-10-30",
+        "RoCKIn 2015 Lisbon",
+        "none (waits for ENTER at the end)",
+        "`--rules 2015` (`--2015`)",
+    ),
+    NodeVersion(
+        _H,
+        "40ba68b",
+        "2017-01-26",
+        "Lisbon 2016 second local competition",
+        "the ground truth looked up when the placement was confirmed, before the goal (then "
+        "ENTER once the positioner is removed); class and instance accuracies over "
+        "BENCHMARK_RUNS = 10",
+        "`--rules 2016` (`--2016`)",
+    ),
+    NodeVersion(
+        _H,
+        "27d9a23",
+        "2017-05-04",
+        "the Peccioli competition, May 2017 (its commit)",
+        "none (a partial score published for display)",
+        "`--rules 2016` (the same arithmetic)",
+    ),
+    NodeVersion(
+        _H,
+        "89dfa75",
+        "2017-11-10",
+        "Lisbon 2017 major tournament",
+        "the translation term clipped at 1 m (`if pose_err_trans > 1.0`), not above sqrt(2) m",
+        "`--rules 2017` (`--2017`)",
+    ),
+    NodeVersion(
+        "scripts/fbm1w",
+        "7628309",
+        "2015-07-06",
+        "RoCKIn 2015 Lisbon (its only version)",
+        "FBM1@Home's arithmetic without a run cap (`while benchmark.Running()`), the item the "
+        "RefBox names (ManualOperation()'s payload)",
+        "`--rules 2015` (`--2015`)",
+    ),
 )

@@ -9,16 +9,18 @@ mean over the runs, execution_time = sum of the runs' goal-to-result times (seco
 The nodes' behaviours, each restored by one :class:`ScoreRules` field (named for what it
 restores; ``Fbm1Options.for_rules`` selects those of one node):
 
-- ``clip_above_diagonal``: both nodes compared t with the table diagonal sqrt(2) m and set only
-  larger errors to 1, leaving errors between 1 and 1.41 m unclipped (a pose score below 0).
+- ``clip_above_diagonal``: the 2015 and 2016 nodes compared t with the table diagonal sqrt(2) m
+  and set only larger errors to 1, leaving errors between 1 and 1.41 m unclipped (a pose score
+  below 0); the 2017 node clipped at 1 m.
 - ``single_wrap``: both nodes wrapped theta errors by a single +-360, so answers beyond +-540 deg
   kept a rotation term of 1 however close they were.
 - ``exact_names``: both nodes compared classes and instances exactly; the 2015 ``fbm1w.yaml``
   has the class ``"Bearing Boxes "`` with a trailing blank that no robot answer matched.
 - ``count_aborted``: both nodes counted a run the benchmark stopped before its goal in their
   divisor (``runs`` was incremented before the manual operation).
-- ``accuracy_over_10``: the 2016-17 @Home node divided the accuracies by ``BENCHMARK_RUNS`` (10)
-  even when fewer runs were played; the 2015 nodes divided them by ``runs``.
+- ``accuracy_over_10``: the 2016 and 2017 @Home nodes divided the accuracies by
+  ``BENCHMARK_RUNS`` (10) even when fewer runs were played; the 2015 nodes divided them by
+  ``runs``.
 """
 
 from __future__ import annotations
@@ -54,8 +56,13 @@ class ScoreRules:
 
     @staticmethod
     def node_2016() -> ScoreRules:
-        """The 2016-17 @Home node: as 2015, accuracies divided by 10."""
+        """The 2016 @Home node (40ba68b): as 2015, accuracies divided by 10."""
         return ScoreRules(True, True, True, True, True, score_unscoreable=True)
+
+    @staticmethod
+    def node_2017() -> ScoreRules:
+        """The 2017 @Home node (89dfa75): as 2016, the translation term clipped at 1 m."""
+        return ScoreRules(False, True, True, True, True, score_unscoreable=True)
 
 
 @dataclass(frozen=True)

@@ -100,6 +100,29 @@ def compute(
             f"{k} reached moments ({moments.method}) for {n} waypoints ({goal.source}); "
             "each waypoint needs exactly one"
         )
+    early = moments.early_end
+    # --unscored-segments 2015: the segment a RefBox END or the log's end cut short is scored
+    # where the node's WaitResult() returned, as every segment was (scripts/fbm2h 50b173b).
+    ended = (
+        k
+        if unscored_2015
+        and k < n
+        and early is not None
+        and early.segment == k
+        and early.start_ns is not None
+        and early.end_ns is not None
+        else None
+    )
+    first_unreached = k
+    if ended is not None:
+        assert early is not None and early.start_ns is not None and early.end_ns is not None
+        moments = replace(
+            moments,
+            start_ns=np.append(moments.start_ns, np.int64(early.start_ns)),
+            end_ns=np.append(moments.end_ns, np.int64(early.end_ns)),
+            payloads=(*moments.payloads, ""),
+        )
+        k += 1
     if hits is not None and hits < 0:
         raise ConfigError(f"--hits must be >= 0, got {hits}")
 
@@ -124,7 +147,6 @@ def compute(
     frames = frame_change_warning(marker, origin_ns)
     if frames:
         all_warnings.append(frames)
-    early = moments.early_end
     failures: list[str] = []
     segments: list[SegmentResult] = []
     # Failure messages count time as the table does: from the log's first message when known.
@@ -133,31 +155,26 @@ def compute(
     for i in range(n):
         tgt = (float(target[i, 0]), float(target[i, 1]), float(target[i, 2]))
         if i >= k:
-            reason = unreached[i - k] if i - k < len(unreached) else f"segment {i}: not reached"
+            j = i - first_unreached
+            reason = unreached[j] if j < len(unreached) else f"segment {i}: not reached"
             timed_out = early is not None and early.is_timeout
             if not unscored_2015:
                 failures.append(reason)
                 segments.append(SegmentResult(i, tgt, "unreached", timeout=timed_out))
                 continue
+            # The node never sent this goal: nothing of it, 0 in the sums, 1 in N.
             all_warnings.append(f"{reason}: counted in N with no error, as 2015 did")
-            if (
-                early is not None
-                and early.segment == i
-                and early.start_ns is not None
-                and early.end_ns is not None
-            ):
-                # The node recorded this segment's times; it added them to execution_time only
-                # on a timeout (``if benchmark.Timeout(): execution_time += segment_time``),
-                # not on a stop (see execution_time below).
-                segments.append(
-                    SegmentResult(
-                        i, tgt, "unreached", early.start_ns, early.end_ns, timeout=timed_out
-                    )
-                )
-            else:
-                segments.append(SegmentResult(i, tgt, "unreached", timeout=timed_out))
+            segments.append(SegmentResult(i, tgt, "unreached"))
             continue
         start, end = int(moments.start_ns[i]), int(moments.end_ns[i])
+        if i == ended:
+            assert early is not None
+            all_warnings.append(
+                f"segment {i}: {early.reason}; scored where the 2015 node's WaitResult() "
+                f"returned, {ns_to_s(end - t_rel0):.3f} s after {since}"
+                + (", and counted in timeout_segments" if early.is_timeout else "")
+                + " (--unscored-segments 2015)"
+            )
         common = {
             "start_ns": start,
             "end_ns": end,
@@ -206,6 +223,7 @@ def compute(
                 i,
                 tgt,
                 "ok",
+                timeout=i == ended and early is not None and early.is_timeout,
                 robot=(float(xyyaw[0]), float(xyyaw[1]), float(xyyaw[2])),
                 distance_error=float(errs.distance[i]),
                 orientation_error=float(errs.orientation[i]),
@@ -267,8 +285,17 @@ def compute(
             0,
             RULE_UNSCORED.deviation(
                 f"position_accuracy and orientation_accuracy are null: {unscored} of {n} "
-                "segments not scored; 2015 divided the sums over the scored segments by N = "
-                f"{n}, counting the others as 0"
+                "segments not scored; 2015 "
+                + (
+                    f"scored segment {early.segment} where its wait returned ({early.reason}), "
+                    if early is not None
+                    and early.start_ns is not None
+                    and early.end_ns is not None
+                    and early.segment < n
+                    else ""
+                )
+                + f"divided the sums over the scored segments by N = {n}, counting the others "
+                "as 0"
             ),
         )
     if orientation_2015:
@@ -432,6 +459,8 @@ def score_found(logs: Fbm2hLogs, runs: Fbm2hRuns, options: Fbm2hOptions) -> Fbm2
             ("goal_layout", logs.goal.layout if logs.goal is not None else "log payload"),
             ("orientation_2015", str(options.orientation_2015)),
             ("unscored_segments", "2015" if options.unscored_2015 else "null"),
+            # the node reproduced, when one is (the notes name its commit)
+            *((("rules", options.rules),) if options.rules != "ertools" else ()),
         ),
     )
     result = compute(

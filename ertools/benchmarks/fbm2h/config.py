@@ -26,6 +26,17 @@ TF_2015 = ("world", "robot_at_home")
 DEFAULT_MAX_GAP_S = 0.1
 
 
+# The nodes ``--rules`` reproduces: rockin-robot-challenge/benchmark_and_scoring_fbm
+# scripts/fbm2h, read at each commit (the version table of docs/fidelity.md). One file (blob
+# 9abe295) served the three competitions: the names say which one a score reproduces.
+NODES = {
+    "2015": "scripts/fbm2h at 50b173b (RoCKIn 2015 Lisbon; 0e7a367's arithmetic)",
+    "2016": "scripts/fbm2h at 40ba68b (the Lisbon 2016 second local competition; = 50b173b)",
+    "2017": "scripts/fbm2h at 89dfa75 (the Lisbon 2017 major tournament; = 50b173b)",
+}
+RULE_SETS = ("ertools", *NODES)
+
+
 @dataclass(frozen=True)
 class Fbm2hOptions:
     """Everything ``ertools score fbm2h`` can be told.
@@ -63,6 +74,8 @@ class Fbm2hOptions:
             seed), :mod:`ertools.benchmarks.fbm2h.intervals`.
         marker_transform: a transform already in hand (``ertools audit``: the one the live
             score says the node used); None = from ``transform``/``team``, else identity.
+        rules: the node every 2015 behaviour reproduces (``2015``, ``2016``, ``2017``: keys
+            of :data:`NODES`), or ``ertools`` (the single options decide).
     """
 
     goal: Path | None = None
@@ -89,3 +102,4 @@ class Fbm2hOptions:
     confidence: float = DEFAULT_CONFIDENCE
     draws: int = DEFAULT_DRAWS
     seed: int = DEFAULT_SEED
+    rules: str = "ertools"

@@ -24,7 +24,7 @@ from ertools.benchmarks.common.ending import EXACT_HELP
 from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS, check_confidence
 from ertools.benchmarks.common.validity import SCORE_AS_2015, unscoreable_input
 from ertools.benchmarks.fbm2h.benchmark import score_found
-from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, Fbm2hOptions
+from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, NODES, RULE_SETS, Fbm2hOptions
 from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, load, locate_runs
 from ertools.benchmarks.fbm2h.result import Fbm2hResult
 from ertools.benchmarks.fbm2h.segments import StopParams
@@ -126,14 +126,18 @@ INPUTS = (
     # reached moment is invalid (repeated poses of a lost marker set)
     unscoreable_input(LEGACY, FormerName("unscoreable_segments")),
     Input(
-        "all_2015",
-        "flag",
-        "every 2015 behaviour above (--orientation-2015 --unscored-segments 2015 "
-        "--unscoreable 2015 --segment-clock bmbox --exact-end-payloads) and the "
-        "node's pose source, /tf world -> robot_at_home, unless --topic or --tf is given",
-        flag="--2015",
+        "rules",
+        "choice",
+        "every behaviour of one node at once (--orientation-2015 --unscored-segments 2015 "
+        "--unscoreable 2015 --segment-clock bmbox --exact-end-payloads, and the node's pose "
+        "source, /tf world -> robot_at_home, unless --topic or --tf is given): 2015 "
+        "(scripts/fbm2h 50b173b, RoCKIn 2015 Lisbon), 2016 (40ba68b, Lisbon 2016), 2017 "
+        "(89dfa75, Lisbon 2017): one file, the same numbers; ertools (default): the options "
+        "above decide",
+        choices=RULE_SETS,
         group=LEGACY,
     ),
+    Input("all_2015", "flag", "= --rules 2015", flag="--2015", group=LEGACY),
     Input("namespace", "str", "benchmark namespace of the state topics", default=NAME),
     Input(
         "stop_speed",
@@ -193,6 +197,11 @@ def make_options(given: Mapping[str, Any]) -> Fbm2hOptions:
     if v["transforms"] is not None and v["team"] is None:
         raise UsageError("--transforms DIR needs --team NAME (DIR/transform-NAME.yaml)")
     reached: tuple[str | None, ...] = v["reached"] or (None,)
+    chosen = {v["rules"]} - {None} | ({"2015"} if v["all_2015"] else set())
+    if len(chosen) > 1:
+        raise UsageError(f"--rules/--2015 name {len(chosen)} nodes; give one")
+    rules = chosen.pop() if chosen else "ertools"
+    node = rules != "ertools"
     return Fbm2hOptions(
         goal=v["goal"],
         transform=v["transform"],
@@ -206,13 +215,14 @@ def make_options(given: Mapping[str, Any]) -> Fbm2hOptions:
         timing=Path(str(reached[1])) if len(reached) > 1 else None,
         max_gap_s=v["gt_tolerance"],
         hits=None if v["hits"] is None else int(v["hits"]),
-        orientation_2015=v["orientation_2015"] or v["all_2015"],
-        unscored_2015=v["unscored_segments"] == "2015" or v["all_2015"],
-        segment_clock="bmbox" if v["all_2015"] else v["segment_clock"],
-        pose_2015=bool(v["all_2015"]),
-        exact_end_payloads=bool(v["exact_end_payloads"] or v["all_2015"]),
+        orientation_2015=v["orientation_2015"] or node,
+        unscored_2015=v["unscored_segments"] == "2015" or node,
+        segment_clock="bmbox" if node else v["segment_clock"],
+        pose_2015=node,
+        exact_end_payloads=bool(v["exact_end_payloads"] or node),
         namespace=v["namespace"],
-        unscoreable_2015=v["unscoreable"] == SCORE_AS_2015 or v["all_2015"],
+        unscoreable_2015=v["unscoreable"] == SCORE_AS_2015 or node,
+        rules=rules,
         stops=StopParams(
             speed=v["stop_speed"],
             yaw_rate=v["stop_yaw_rate"],
@@ -229,6 +239,9 @@ def notes(result: Fbm2hResult) -> list[str]:
     """The score intervals, how the reached moments were found (with ``-v``) and the
     per-segment table."""
     out = result.interval_lines()
+    rules = dict(result.provenance.parameters).get("rules", "ertools")
+    if rules in NODES:
+        out.append(f"reproducing: {NODES[rules]}")
     if logging.getLogger("ertools").isEnabledFor(logging.INFO):  # -v
         out += list(result.notes)
     out.append(
@@ -340,10 +353,12 @@ timing file (p0 starts, p(k+1) closes segment k, seconds from the bag's first me
 stops detected in the ground truth, assigned to the waypoints in order.
 Orientation errors are wrapped to [0, pi]; --orientation-2015 reproduces the 2015 numbers.
 Accuracies are null (exit 1) when a segment is not scored (RefBox timeout or stop, or a log
-that ends inside the benchmark, taken as stopped there); --unscored-segments 2015 divides the
-sum over the scored segments by N as 2015 did. --segment-clock bmbox times segments between
-the BmBox's own transitions as the 2015 node did. --2015: every 2015 behaviour at once, with
-the node's pose source (/tf world -> robot_at_home)."""
+that ends inside the benchmark, taken as stopped there); --unscored-segments 2015 scores the
+segment cut short where the node's wait returned and divides the sums by N as 2015 did.
+--segment-clock bmbox times segments between the BmBox's own transitions as the node did.
+--2015 (= --rules 2015: scripts/fbm2h at 50b173b, RoCKIn 2015; --rules 2016 and 2017 name the
+same file at 40ba68b and 89dfa75): every 2015 behaviour at once, with the node's pose source
+(/tf world -> robot_at_home)."""
 
 BENCHMARK: Benchmark[Fbm2hOptions, Fbm2hLogs, Fbm2hRuns, Fbm2hResult] = Benchmark(
     name=NAME,

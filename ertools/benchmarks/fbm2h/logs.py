@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ertools.benchmarks.common.hygiene import drop_invalid
+from ertools.benchmarks.common.hygiene import drop_invalid, impossible_warning
 from ertools.benchmarks.common.sources import PoseSpec, read_source, topic
 from ertools.benchmarks.common.sources import tf as tf_source
 from ertools.benchmarks.fbm2h import segments as seg
@@ -33,9 +33,10 @@ from ertools.timeutil import s_to_ns
 
 
 def invalid_warning(count: int, source: str) -> str:
-    """The warning for marker poses dropped because they are NaN or zero quaternions."""
+    """The warning for marker poses dropped: NaN, zero quaternions, physically impossible."""
     return (
-        f"{count} marker set pose(s) with NaN or zero-quaternion values ignored "
+        f"{count} marker set pose(s) with NaN, zero-quaternion or physically impossible values "
+        "ignored "
         f"({source or 'the pose stream'}): reached moments near them may have no ground truth"
     )
 
@@ -145,11 +146,12 @@ def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
     if len(marker) == 0:
         raise SegmentationError(f"{marker.source or plist[0]}: the marker set pose stream is empty")
     total = len(marker)
+    impossible = impossible_warning(marker)
     marker, invalid = drop_invalid(marker)
     if len(marker) == 0:
         raise ScoringError(
-            f"{marker.source or plist[0]}: all {total} marker set poses are NaN or have a zero "
-            "quaternion: nothing to score (was the body tracked?)"
+            f"{marker.source or plist[0]}: all {total} marker set poses are NaN, have a zero "
+            "quaternion or are physically impossible: nothing to score (was the body tracked?)"
         )
     infos = [summary(p) for p in plist]
     states = None
@@ -164,7 +166,9 @@ def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
         marker=marker,
         bag_start_ns=min(i.start_ns for i in infos),
         bag_end_ns=max(i.end_ns for i in infos),
-        warnings=(invalid_warning(invalid, marker.source),) if invalid else (),
+        warnings=tuple(
+            w for w in (invalid and invalid_warning(invalid, marker.source), impossible) if w
+        ),
         states=states,
     )
 

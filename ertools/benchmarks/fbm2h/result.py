@@ -10,6 +10,7 @@ import numpy as np
 import numpy.typing as npt
 import yaml
 
+from ertools import yamlin
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
 from ertools.benchmarks.common.uncertainty import Interval, uncertainty_rows
@@ -89,7 +90,7 @@ def _payload_value(payload: str) -> Any:
         return {}
 
     try:
-        value = yaml.safe_load(text)
+        value = yamlin.load(text, duplicates=[])  # shown as the 2015 node read it
     except yaml.YAMLError:
         return payload
     return value if isinstance(value, dict) else payload
@@ -126,9 +127,10 @@ class Fbm2hResult:
         goal: the goal list.
         reached_method: ``states``, ``timing`` or ``auto``.
         orientation_2015: True when errors were computed the 2015 way (unwrapped).
-        unscored_2015: True when unscored segments were counted as 2015 did; the listing then
-            also follows Listing 13's ``timeout_segments: 0`` / ``timeout: false`` (2015 never
-            set them) and flags ``refbox_timeout`` on the segment the RefBox ended only.
+        unscored_2015: True when the segments were counted as 2015 did (the one a RefBox
+            END or the log's end cut short scored, the others 0 in the sums and 1 in N); the
+            listing then writes ``refbox_timeout: false`` as the node always did, ``timeout``
+            on the segment ``Timeout()`` was true after, and their count.
         path_t_ns, path_xyyaw: the robot's path (decimated) for the figures.
         notes: how the reached moments were found.
         origin_ns: the log's first message; table times count from it (from the first
@@ -184,14 +186,15 @@ class Fbm2hResult:
             "dinstance_error": _num(seg.distance_error),
             "end_segment_time": None if seg.end_ns is None else ns_to_s(seg.end_ns),
             "orientation_error": _num(seg.orientation_error),
-            "refbox_timeout": bool(seg.timeout)
-            and (not self.unscored_2015 or seg.start_ns is not None),
+            # 2015 (scripts/fbm2h 50b173b, l. 158-164): `Timeout() and not Running()` never
+            # holds, so the node always wrote False here.
+            "refbox_timeout": bool(seg.timeout) and not self.unscored_2015,
             "result_payload": _payload_value(seg.result_payload),
             "robot_pose": _pose_map(seg.robot),
             "segment_time": seg.segment_time,
             "start_segment_time": None if seg.start_ns is None else ns_to_s(seg.start_ns),
             "target_pose": _pose_map(seg.target),
-            "timeout": bool(seg.timeout) and not self.unscored_2015,
+            "timeout": bool(seg.timeout),
         }
 
     def _listing(self, string_keys: bool) -> dict[str, Any]:
@@ -204,7 +207,7 @@ class Fbm2hResult:
             "orientation_accuracy": _num(self.orientation_accuracy),
             "execution_time": float(self.execution_time),
             "hits": self.hits,
-            "timeout_segments": 0 if self.unscored_2015 else int(self.timeout_segments),
+            "timeout_segments": int(self.timeout_segments),
             "details": {
                 "marker-robot transform": self.transform.as_listing(),
                 "segments_details": details,

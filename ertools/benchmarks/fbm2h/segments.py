@@ -20,7 +20,7 @@ Three sources, one result (:class:`ReachedMoments`):
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import numpy.typing as npt
@@ -48,7 +48,8 @@ class EarlyEnd:
         segment: the first segment not completed.
         start_ns: when it started (None when its goal was never sent).
         end_ns: when it ended: the RefBox END (``client`` clock) or the BmBox leaving
-            WAITING_RESULT (``bmbox`` clock); None when the log ends first.
+            WAITING_RESULT (``bmbox`` clock); for a ``cut`` the log's last BmBox message, the
+            stop the cut stands for (None when the segment had not started).
         kind: ``timeout`` or ``stop`` (the RefBox ended it), ``ended`` (a RefBox END whose
             payload says neither, or a score sent early) or ``cut`` (the log ends inside the
             benchmark: taken as the benchmark stopped there, as a stop is).
@@ -234,6 +235,9 @@ def from_states(
         if early is not None:
             after = f"after segment {len(goals) - 1}" if len(goals) else "at all"
             notes.append(f"no goal sent {after} ({early.reason})")
+    if early is not None and early.kind == "cut" and early.start_ns is not None:
+        # Stopped at the log's last BmBox message: where the 2015 node's wait returned.
+        early = replace(early, end_ns=max(early.start_ns, int(bmbox.t_ns[-1])))
     return ReachedMoments(
         "states",
         np.asarray(starts, dtype=np.int64),

@@ -152,8 +152,8 @@ def acquire_transform(
     marker, invalid = drop_invalid(marker)
     if len(marker) == 0:
         raise SegmentationError(
-            f"{marker.source}: all {total} marker set poses are NaN or have a zero quaternion "
-            "(was the marker set tracked?)"
+            f"{marker.source}: all {total} marker set poses are NaN, have a zero quaternion or "
+            "are physically impossible (was the marker set tracked?)"
         )
     detected = window is None
     win = (
@@ -168,7 +168,11 @@ def acquire_transform(
         raise SegmentationError(
             f"{marker.source}: only {len(part)} marker poses from {where}; need at least "
             f"{MIN_SAMPLES} (is the window inside the log?"
-            + (f" {invalid} NaN or zero-quaternion poses were left out" if invalid else "")
+            + (
+                f" {invalid} NaN, zero-quaternion or impossible poses were left out"
+                if invalid
+                else ""
+            )
             + ")"
         )
     mean = mean_pose(part.xyz, part.quat_xyzw)
@@ -185,7 +189,8 @@ def acquire_transform(
     warnings = []
     if invalid:
         warnings.append(
-            f"{invalid} marker set pose(s) with NaN or zero-quaternion values left out "
+            f"{invalid} marker set pose(s) with NaN, zero-quaternion or physically impossible "
+            "values left out "
             f"({marker.source})"
         )
     if mean.position_std > SPREAD_WARN_M or mean.angle_std > SPREAD_WARN_RAD:

@@ -17,20 +17,23 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import F64
 from ertools.benchmarks.common.ending import end_payload_deviation
 from ertools.benchmarks.common.hygiene import (
     frame_change_warning,
-    frozen_around,
+    frozen_warnings,
     identical_poses,
+    impossible_warning,
 )
 from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
+from ertools.benchmarks.common.uncertainty import few_warning
 from ertools.benchmarks.common.validity import (
     STILL_M,
     SampleMask,
     coverage,
     coverage_problem,
+    last_measured,
     lost_spans,
+    measured,
     sample_codes,
     summarise,
 )
@@ -43,7 +46,7 @@ from ertools.benchmarks.fbm3w.config import (
     Fbm3wOptions,
 )
 from ertools.benchmarks.fbm3w.intervals import with_intervals
-from ertools.benchmarks.fbm3w.path import score_path
+from ertools.benchmarks.fbm3w.path import score_path, shape_floor, try_score
 from ertools.benchmarks.fbm3w.result import Fbm3wResult, RunResult
 from ertools.benchmarks.fbm3w.rules import (
     RULE_ARC_LENGTH,
@@ -67,8 +70,7 @@ from ertools.benchmarks.noise.benchmark import (
     noise_from_stream,
 )
 from ertools.configs.fbm3w import DEFAULT_D_MIN, Fbm3wConfig
-from ertools.configs.shapes import Shape
-from ertools.errors import ConfigError, ErtoolsError, ScoringError
+from ertools.errors import ConfigError, ScoringError
 from ertools.fidelity import Deviation
 from ertools.io import read_benchmark_states, summary, topics
 from ertools.io.clock import check_header_clock
@@ -84,8 +86,7 @@ STALE_REFERENCE_S = 0.5
 # Below this reference-start distance the run frame's direction is uncertain (1 mm of noise
 # turns a 1 cm baseline by ~0.1 rad).
 SHORT_BASELINE_M = 0.01
-# Samples of the noiseless robot used for shape_floor, and the floor worth a warning.
-FLOOR_SAMPLES = 10_001
+# The shape floor worth a warning.
 FLOOR_WARN_M = 0.0005
 # A kept path this much longer than the target is suspicious (the sample's runs: 1.00-1.01).
 LONG_PATH_RATIO = 1.15
@@ -262,18 +263,18 @@ def score_runs(
             f"shape {specs[len(runs_in)]!r} between still phases; the log ends there or the "
             "rest need --runs windows"
         )
-    noise = _noise(poses, options, warnings)
-    same = identical_poses(poses)
     mask = sample_codes(poses.t_ns, poses.xyz, poses.quat_xyzw)
-    frames = frame_change_warning(poses, start_ns)
-    if frames:
-        warnings.append(frames)
+    full, usable = poses, measured(mask)  # scored without the impossible poses
+    poses = poses if usable.all() else poses.take(usable)
+    noise, same = _noise(poses, options, warnings), identical_poses(full)
+    said = (frame_change_warning(full, start_ns), impossible_warning(full, start_ns))
+    warnings.extend(w for w in said if w)
     results: list[RunResult] = []
     failures: list[str] = []
     if progress is not None:
         progress.task("scoring runs", len(runs_in), "runs")
     for window in runs_in:
-        run = _score_one(poses, same, window, cfg, options, start_ns, warnings, mask)
+        run = _score_one(full, same, window, cfg, options, start_ns, warnings, mask, usable)
         if progress is not None:
             progress.advance(1)
         results.append(run)
@@ -288,9 +289,15 @@ def score_runs(
             f"suggested d_min {noise.suggested_d_min:.5f} m ({noise.c:g} * epsilon); see "
             "--d-min-sweep"
         )
-    warnings.extend(_frozen_warnings(poses, runs_in, start_ns))
+    # the reference and starting positions set the run frame: a frozen pose there is the last
+    # one before a tracking loss, not where the marker set was
+    moments = (("reference", "ref_ns"), ("start", "start_ns"), ("end", "end_ns"))
+    at = [(f"run {w.index}", what, getattr(w, k)) for w in runs_in for what, k in moments]
+    warnings.extend(frozen_warnings(poses, [m for m in at if m[2] is not None], start_ns))
     mode = runs_in[0].mode if runs_in else (options.runs or "states")
-    results, best_interval, uncertainty = with_intervals(poses, same, results, cfg, options, noise)
+    results, best_interval, uncertainty = with_intervals(
+        poses, identical_poses(poses), results, cfg, options, noise
+    )
     return Fbm3wResult(
         runs=tuple(results),
         best_interval=best_interval,
@@ -314,34 +321,6 @@ def score_runs(
         ),
         count_stopped=options.stopped_runs != "2015",
     )
-
-
-def _frozen_warnings(poses: PoseStream, runs: Sequence[RunWindow], origin_ns: int) -> list[str]:
-    """A warning per run whose reference, start or end pose is a frozen (repeated) pose.
-
-    The reference and starting positions set the run frame: a pose repeated for longer than
-    :data:`~ertools.benchmarks.common.hygiene.FROZEN_MIN_S` there is the last pose before a
-    tracking loss, not where the marker set was.
-    """
-    moments: list[tuple[int, str, int]] = []
-    for w in runs:
-        for what, t in (("reference", w.ref_ns), ("start", w.start_ns), ("end", w.end_ns)):
-            if t is not None:
-                moments.append((w.index, what, t))
-    if not moments:
-        return []
-    spans = frozen_around(poses, [m[2] for m in moments])
-    out = []
-    for (index, what, t), span in zip(moments, spans, strict=True):
-        if span is None:
-            continue
-        out.append(
-            f"run {index}: the pose at its {what} time {(t - origin_ns) / 1e9:.3f} s is frozen: "
-            f"{span.samples} identical poses over {span.duration_s:.3f} s "
-            f"({(span.start_ns - origin_ns) / 1e9:.3f}-{(span.end_ns - origin_ns) / 1e9:.3f} s "
-            "from the log's first message; tracking lost, or a noiseless recording)"
-        )
-    return out
 
 
 def _noise(poses: PoseStream, options: Fbm3wOptions, warnings: list[str]) -> NoiseResult | None:
@@ -370,6 +349,7 @@ def _score_one(
     bag_start_ns: int,
     warnings: list[str],
     mask: SampleMask | None = None,
+    usable: npt.NDArray[np.bool_] | None = None,
 ) -> RunResult:
     spec = window.spec or ""
 
@@ -405,7 +385,9 @@ def _score_one(
         return result("no reference time or path window was found for this run")
     lo = int(np.searchsorted(poses.t_ns, window.start_ns, side="left"))
     hi = int(np.searchsorted(poses.t_ns, window.end_ns, side="right"))
-    xy = poses.xyz[lo:hi, :2]
+    window_xy = poses.xyz[lo:hi, :2]
+    keep = np.ones(hi - lo, dtype=bool) if usable is None else usable[lo:hi]
+    xy = window_xy[keep]  # the samples scored: without the impossible ones
     losses = int(np.sum(same[lo : max(lo, hi - 1)])) if hi - lo > 1 else 0
     common: dict[str, Any] = {
         "samples": hi - lo,
@@ -415,20 +397,24 @@ def _score_one(
     problem = None
     if mask is not None:
         validity = summarise(mask, window.start_ns, window.end_ns)
-        lost = lost_spans(validity, xy, STILL_M)
+        lost = lost_spans(validity, window_xy, STILL_M)
         common["validity"] = validity
         common["path_coverage"] = coverage(validity, lost)
         problem = coverage_problem(validity, MIN_COVERAGE, MAX_INNER_GAP_S, lost)
         if problem is not None:
             common["unscoreable_reason"] = problem
     rel = (window.start_ns - bag_start_ns) / 1e9, (window.end_ns - bag_start_ns) / 1e9
-    if hi - lo < 2:
+    as_2015 = options.unscoreable_runs == "2015"
+    if len(xy) < (1 if as_2015 else 2):
+        crashed = " (the 2015 node failed here, robot_path[0] of an empty path, and sent no score)"
         return result(
-            f"{hi - lo} pose sample(s) in the path window {rel[0]:.3f}-{rel[1]:.3f} s; "
-            "at least 2 are needed (tracking lost, or wrong window?)",
+            f"{len(xy)} pose sample(s) in the path window {rel[0]:.3f}-{rel[1]:.3f} s; "
+            "at least 2 are needed (tracking lost, or wrong window?)"
+            + (crashed if as_2015 else ""),
             **common,
         )
     ref_i = int(np.searchsorted(poses.t_ns, window.ref_ns, side="right")) - 1
+    ref_i = ref_i if usable is None else last_measured(usable, ref_i)
     ref_rel = (window.ref_ns - bag_start_ns) / 1e9
     if ref_i < 0:
         return result(f"no pose at or before the reference time {ref_rel:.3f} s", **common)
@@ -441,19 +427,28 @@ def _score_one(
     ref_xy = poses.xyz[ref_i, :2].copy()
     common["reference_xy"] = (float(ref_xy[0]), float(ref_xy[1]))
     try:
-        score = score_path(xy, ref_xy, shape, cfg.d_min)
+        score = score_path(xy, ref_xy, shape, cfg.d_min, as_2015=as_2015)
     except ScoringError as err:
         return result(err.message, **common)
     if problem is not None and options.unscoreable_runs != "2015":
         # no number, but the path in its frame: the plot shows where the data is missing
         return result(
-            None, frame_xy=score.frame.to_frame(xy), sample_t_ns=poses.t_ns[lo:hi], **common
+            None, frame_xy=score.frame.to_frame(xy), sample_t_ns=poses.t_ns[lo:hi][keep], **common
         )
     if problem is not None:
         warnings.append(
             f"run {window.index}: 2015 scored this run from {common['path_coverage']:.1%} of "
             f"its path (--unscoreable 2015); by default it is unscoreable: {problem}"
         )
+    if len(score.kept) == 1:
+        warnings.append(
+            f"run {window.index}: no pose of its path moved d_min from the first: 2015 scored "
+            "it error_sum / N = 0.0 over its one kept pose (--unscoreable 2015); by default it "
+            "has no distance_error"
+        )
+    else:
+        few = few_warning(len(score.kept), "kept path point(s)", f"run {window.index}")
+        warnings.extend([few] if few else [])
     baseline = float(np.hypot(*(xy[0] - ref_xy)))
     if baseline < SHORT_BASELINE_M:
         warnings.append(
@@ -473,7 +468,7 @@ def _score_one(
             f"({score.path_length:.4f} vs {target_length:.4f} m): jitter passing d_min or a "
             "detour inflates L and shifts l/L; see --d-min-sweep"
         )
-    swept = tuple((d, _try_score(xy, ref_xy, shape, d)) for d in options.sweep)
+    swept = tuple((d, try_score(xy, ref_xy, shape, d)) for d in options.sweep)
     floor = shape_floor(shape, cfg.d_min)
     if floor > FLOOR_WARN_M and not any(spec in w and "floor" in w for w in warnings):
         warnings.append(
@@ -486,32 +481,11 @@ def _score_one(
         score=score,
         sweep=swept,
         frame_xy=score.frame.to_frame(xy),
-        sample_t_ns=poses.t_ns[lo:hi],
+        sample_t_ns=poses.t_ns[lo:hi][keep],
         shape_floor=floor,
         target_dense=shape.dense(501),
         **common,
     )
-
-
-def shape_floor(shape: Shape, d_min: float) -> float:
-    """distance_error of a noiseless robot exactly on ``shape`` (1e4 samples), metres.
-
-    0 up to the d_min quantisation for shapes parametrised by arc length; 8.4 mm for the 2015
-    ``sine``, whose parameter is proportional to x, not to the length travelled.
-    """
-    pts = shape(np.linspace(0.0, 1.0, FLOOR_SAMPLES))
-    reference = np.array([-0.05, 0.0])  # run frame = world frame
-    try:
-        return score_path(pts, reference, shape, d_min).distance_error
-    except ErtoolsError:
-        return math.nan
-
-
-def _try_score(xy: F64, ref_xy: F64, shape: Shape, d_min: float) -> float | None:
-    try:
-        return score_path(xy, ref_xy, shape, d_min).distance_error
-    except ErtoolsError:
-        return None
 
 
 def _deviations(
@@ -525,7 +499,8 @@ def _deviations(
     if mode == "states":
         out.append(
             RULE_LIVE_CLOCK.deviation(
-                "reference = last logged pose at or before COMPLETED_MANUAL_OPERATION and "
+                "reference = last logged pose at or before the BmBox left "
+                "WAITING_MANUAL_OPERATION and "
                 "execution_time from the BmBox state messages' record times; 2015 read the live "
                 "tf and its own wall clock at the same transitions"
             )

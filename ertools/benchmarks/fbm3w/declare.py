@@ -105,14 +105,15 @@ INPUTS = (
     Input("exact_end_payloads", "flag", EXACT_HELP, group=LEGACY),
     unscoreable_input(LEGACY, FormerName("unscoreable_runs")),
     Input(
-        "all_2015",
-        "flag",
-        "every 2015 behaviour: --timeout-runs 2015 --stopped-runs 2015 "
-        "--exact-end-payloads --unscoreable 2015, d_min 0.00033 "
-        "unless --d-min is given, no --arc-length",
-        flag="--2015",
+        "rules",
+        "choice",
+        "every behaviour of one node at once: 2015 (scripts/fbm3w 50b173b, RoCKIn 2015 "
+        "Lisbon: --timeout-runs 2015 --stopped-runs 2015 --exact-end-payloads --unscoreable "
+        "2015, d_min 0.00033 unless --d-min is given, no --arc-length) or ertools (default)",
+        choices=("ertools", "2015"),
         group=LEGACY,
     ),
+    Input("all_2015", "flag", "= --rules 2015", flag="--2015", group=LEGACY),
     Input(
         "still_speed",
         "float",
@@ -182,7 +183,8 @@ def make_options(given: Mapping[str, Any]) -> Fbm3wOptions:
         raise UsageError(
             f"--run/--runs-file give explicit windows; they contradict --runs {v['runs']}"
         )
-    if v["all_2015"] and v["arc_length"]:
+    node = bool(v["all_2015"]) or v["rules"] == "2015"
+    if node and v["arc_length"]:
         raise UsageError("--2015 and --arc-length contradict each other (2015 had no arc length)")
     if v["topic"] is not None and v["tf"] is not None:
         raise UsageError("give either --topic or --tf, not both")
@@ -212,7 +214,7 @@ def make_options(given: Mapping[str, Any]) -> Fbm3wOptions:
         draws=v["draws"],
         seed=v["seed"],
     )
-    return options_2015(options) if v["all_2015"] else options
+    return options_2015(options) if node else options
 
 
 def notes(result: Fbm3wResult) -> list[str]:
@@ -262,9 +264,9 @@ EPILOG = """examples:
   ertools score fbm3w mocap_only.bag --runs auto
   ertools score fbm3w mocap_only.bag --run line:2.0:3.1:7.1 --run spline:9.3:10.5:16
 
---runs: states (default when /fbm3w/bmbox_state exists): reference = pose at
-COMPLETED_MANUAL_OPERATION, path from EXECUTING_GOAL until WAITING_RESULT is left, as the 2015
-node; windows: --run SPEC:REF_T:START_T:END_T (repeatable) or --runs-file FILE (YAML list of
+--runs: states (default when /fbm3w/bmbox_state exists): reference = the pose when the BmBox
+leaves WAITING_MANUAL_OPERATION, path from EXECUTING_GOAL until WAITING_RESULT is left, as the
+2015 node; windows: --run SPEC:REF_T:START_T:END_T (repeatable) or --runs-file FILE (YAML list of
 {spec, reference, start, end}), times in seconds from the bag's first message or epoch
 seconds; auto: runs found from motion alone (stationary at the reference, short move,
 stationary at the start, the path, stationary at the end), detected times in the output.

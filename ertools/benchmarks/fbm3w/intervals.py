@@ -37,7 +37,7 @@ minimum over the runs of each draw.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from statistics import NormalDist
 from typing import Any
@@ -55,6 +55,7 @@ from ertools.benchmarks.common.uncertainty import (
     Uncertainty,
     monte_carlo,
     sigma_from_epsilon,
+    too_few,
 )
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
 from ertools.benchmarks.fbm3w.result import RunResult
@@ -524,15 +525,17 @@ def uncertainty_block(
     draws: int,
     seed: int,
     confidence: float,
+    withheld: Mapping[str, str] | None = None,
 ) -> Uncertainty:
-    """The result's ``uncertainty`` block (sources, method, shares by dotted key)."""
+    """The result's ``uncertainty`` block (sources, method, shares by dotted key, and why a
+    score has no interval)."""
     shares: dict[str, dict[str, float]] = {}
     if best is not None:
         shares["best_distance_error"] = best.share_dict()
     for index, iv in per_run:
         if iv is not None:
             shares[f"runs_details.{index}.distance_error"] = iv.share_dict()
-    return Uncertainty(confidence, METHOD, draws, seed, model.sources, shares)
+    return Uncertainty(confidence, METHOD, draws, seed, model.sources, shares, withheld or {})
 
 
 def with_intervals(
@@ -580,6 +583,19 @@ def with_intervals(
         seed=options.seed,
         confidence=options.confidence,
     )
+    # a run of too few kept points has no interval (null, with the reason), nor has the best
+    # score when it is that run's (common/uncertainty.py, MIN_INTERVAL_SAMPLES)
+    withheld: dict[str, str] = {}
+    scored = [r for r in results if r.score is not None and r.distance_error is not None]
+    first_best = min(scored, key=lambda r: r.distance_error or 0.0, default=None)
+    for k, r in enumerate(results):
+        few = None if r.score is None else too_few(len(r.score.kept), "kept path point(s)")
+        if few is not None and per_run[k] is not None:
+            per_run[k] = None
+            withheld[f"runs_details.{r.index}.distance_error"] = few
+            if r is first_best:
+                best = None
+                withheld["best_distance_error"] = few
     block = uncertainty_block(
         model,
         [(r.index, iv) for r, iv in zip(results, per_run, strict=True)],
@@ -587,6 +603,7 @@ def with_intervals(
         draws=options.draws,
         seed=options.seed,
         confidence=options.confidence,
+        withheld=withheld,
     )
     out = [replace(r, interval=iv) for r, iv in zip(results, per_run, strict=True)]
     return out, best, block

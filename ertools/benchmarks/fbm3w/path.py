@@ -21,13 +21,15 @@ import numpy as np
 
 from ertools.arrays import F64, IntArr
 from ertools.configs.shapes import Shape
-from ertools.errors import ScoringError
+from ertools.errors import ErtoolsError, ScoringError
 
 # Samples probed one by one after each kept point before switching to a vectorised search:
 # while the end effector moves, the next kept sample is usually within a few samples (cheap
 # scalar test); while it stands still with noise below d_min the gap is long (vector search).
 _SCALAR_PROBE = 8
 _FIRST_WINDOW = 64
+# Samples of the noiseless robot used for shape_floor.
+FLOOR_SAMPLES = 10_001
 
 
 def subsample_d_min(xy: F64, d_min: float) -> IntArr:
@@ -108,17 +110,17 @@ class RunFrame:
         )
 
 
-def run_frame(reference_xy: F64, start_xy: F64) -> RunFrame:
+def run_frame(reference_xy: F64, start_xy: F64, *, as_2015: bool = False) -> RunFrame:
     """The run frame from the reference and starting positions.
 
     Raises:
         ScoringError: the two positions coincide, so the x axis is undefined (2015 silently
-            used the world's x axis).
+            used the world's x axis, ``as_2015``).
     """
     ref = np.asarray(reference_xy, dtype=np.float64)
     start = np.asarray(start_xy, dtype=np.float64)
     dx, dy = float(start[0] - ref[0]), float(start[1] - ref[1])
-    if dx == 0.0 and dy == 0.0:
+    if dx == 0.0 and dy == 0.0 and not as_2015:
         raise ScoringError(
             "the reference and starting positions coincide, so the run frame's x axis is "
             "undefined; check the reference time"
@@ -153,21 +155,27 @@ class PathScore:
     raw_length: float
 
 
-def score_path(xy: F64, reference_xy: F64, shape: Shape, d_min: float) -> PathScore:
+def score_path(
+    xy: F64, reference_xy: F64, shape: Shape, d_min: float, *, as_2015: bool = False
+) -> PathScore:
     """Score the measured positions ``xy`` (N, 2, world) of one run against ``shape``.
 
+    ``as_2015``: what the 2015 node computed where ertools refuses to score: a path of one
+    kept point is ``error_sum / N`` = 0.0 (scripts/fbm3w 50b173b, lines 273-295, run no loop),
+    and a start on the reference gives the world's x axis (``atan2(0, 0)``).
+
     Raises:
-        ScoringError: fewer than 2 samples or kept points, a path of zero length, coincident
-            reference and start, non-finite positions.
+        ScoringError: fewer than 2 samples or kept points (one with ``as_2015``), a path of
+            zero length, coincident reference and start, non-finite positions.
     """
     pts = np.asarray(xy, dtype=np.float64)
-    if len(pts) < 2:
+    if len(pts) < (1 if as_2015 else 2):
         raise ScoringError(f"the run has {len(pts)} pose sample(s); at least 2 are needed")
     if not np.all(np.isfinite(pts)):
         raise ScoringError("the run has non-finite positions (NaN or inf)")
     kept = subsample_d_min(pts, d_min)
     path = pts[kept]
-    if len(path) < 2:
+    if len(path) < 2 and not as_2015:
         raise ScoringError(
             f"the path has zero length: no sample moved d_min = {d_min * 1000:.3g} mm from the "
             "starting position"
@@ -175,11 +183,11 @@ def score_path(xy: F64, reference_xy: F64, shape: Shape, d_min: float) -> PathSc
     steps = np.hypot(*np.diff(path, axis=0).T)
     cum = np.concatenate([[0.0], np.cumsum(steps)])  # sequential, as the 2015 loop
     total = float(cum[-1])
-    if total <= 0.0:
+    if total <= 0.0 and not (as_2015 and len(path) == 1):
         raise ScoringError("the path has zero length")
-    frame = run_frame(reference_xy, path[0])
+    frame = run_frame(reference_xy, path[0], as_2015=as_2015)
     in_frame = frame.to_frame(path)
-    l_norm = cum / total
+    l_norm = cum / total if total > 0.0 else np.zeros(1)
     target = shape(l_norm)
     errors = np.hypot(*(in_frame - target).T)
     errors[0] = 0.0  # 2015 started its sum at the second kept point
@@ -195,3 +203,25 @@ def score_path(xy: F64, reference_xy: F64, shape: Shape, d_min: float) -> PathSc
         total,
         raw_length,
     )
+
+
+def shape_floor(shape: Shape, d_min: float) -> float:
+    """distance_error of a noiseless robot exactly on ``shape`` (1e4 samples), metres.
+
+    0 up to the d_min quantisation for shapes parametrised by arc length; 8.4 mm for the 2015
+    ``sine``, whose parameter is proportional to x, not to the length travelled.
+    """
+    pts = shape(np.linspace(0.0, 1.0, FLOOR_SAMPLES))
+    reference = np.array([-0.05, 0.0])  # run frame = world frame
+    try:
+        return score_path(pts, reference, shape, d_min).distance_error
+    except ErtoolsError:
+        return math.nan
+
+
+def try_score(xy: F64, ref_xy: F64, shape: Shape, d_min: float) -> float | None:
+    """``distance_error`` of the run at ``d_min``, or None where it cannot be scored."""
+    try:
+        return score_path(xy, ref_xy, shape, d_min).distance_error
+    except ErtoolsError:
+        return None

@@ -256,7 +256,12 @@ class Fbm3wResult:
         run's, then the sources."""
         rows = [ScoreRow("best_distance_error", self.best_distance_error, self.best_interval)]
         rows += [
-            ScoreRow(f"run {r.index} distance_error", r.distance_error, r.interval)
+            ScoreRow(
+                f"run {r.index} distance_error",
+                r.distance_error,
+                r.interval,
+                key=f"runs_details.{r.index}.distance_error",
+            )
             for r in self.runs
         ]
         return interval_lines([replace(r, scale=1000.0, unit="mm") for r in rows], self.uncertainty)

@@ -6,9 +6,9 @@ says, what the node did, what ertools does and why, the option restoring 2015).
 from __future__ import annotations
 
 from ertools.benchmarks.fbm3w.config import DEFAULT_FRAME, DEFAULT_TOPIC, FALLBACK_TOPIC
-from ertools.fidelity import Rule
+from ertools.fidelity import NodeVersion, Rule
 
-NODE_SOURCE = "rockin_scoring/scripts/fbm3w (2015)"
+NODE_SOURCE = "scripts/fbm3w (50b173b, RoCKIn 2015)"
 
 # The catalogue rows (ertools.fidelity) of every way FBM3@Work differs from the 2015 node.
 RULE_TIMEOUT_RUNS = Rule(
@@ -18,9 +18,10 @@ RULE_TIMEOUT_RUNS = Rule(
     rulebook="the RefBox ends a benchmark with END and payload timeout (seed 6.2.3); seed 7.3 "
     "does not say how such a run is scored",
     node_2015=(
-        f"{NODE_SOURCE}: `if benchmark.Timeout(): ... execution_time = execution_time + "
-        "(end_time - start_time)` before the `not Running()` check; the final Lisbon node "
-        "scored the run on the path it had covered and it could be the best run (issue 15)"
+        f'{NODE_SOURCE}: `if benchmark.Timeout(): print "TIMEOUT"` only (l. 234-237, the time '
+        "and `continue` commented out by 7942ea2): a timed-out run is timed, scored on the path "
+        "it covered, eligible as best run, and the loop goes on with the next run (before "
+        "7942ea2: its time added, no score, the same run number again)"
     ),
     ertools=(
         "listed with its time and no distance_error, never the best run: a partial path "
@@ -35,8 +36,9 @@ RULE_STOPPED_RUNS = Rule(
     title="stopped runs' time",
     rulebook="the RefBox ends a benchmark with END and payload halt (seed 6.2.3)",
     node_2015=(
-        f"{NODE_SOURCE}: `if not benchmark.Running(): continue` comes before the time is added: a "
-        "run stopped by `reason: stop` (BmBox.py `Running()`) was aborted, no score and no time"
+        f"{NODE_SOURCE}: `if not benchmark.Running(): continue` (l. 239-241) comes before the "
+        "time is added: a run stopped by `reason: stop` (BmBox.py `Running()`) was aborted, no "
+        "score and no time, and the loop ended"
     ),
     ertools=(
         "no score, its time counted in execution_time (the robot did spend it); a log that "
@@ -51,10 +53,14 @@ RULE_LIVE_CLOCK = Rule(
     title="reference pose and run times",
     rulebook="reference acquired when the manual operation completes; execution time of each "
     "run (seed 7.3.3, Listing 16)",
-    node_2015=f"{NODE_SOURCE}: the live tf and the node's own wall clock at the transitions",
+    node_2015=(
+        f"{NODE_SOURCE}: tf's latest pose (`lookupTransform(..., rospy.Time(0))`) once "
+        "`ManualOperation()` returned (l. 206-208), and its own wall clock at the transitions"
+    ),
     ertools=(
-        "the last logged pose at or before COMPLETED_MANUAL_OPERATION and the state messages' "
-        "record times; no option: the live tf and wall clock are not in the log"
+        "the last logged pose at or before the BmBox left WAITING_MANUAL_OPERATION (for "
+        "COMPLETED_MANUAL_OPERATION, or READY on a RefBox END) and the state messages' record "
+        "times; no option: the live tf and wall clock are not in the log"
     ),
     option="",
 )
@@ -87,7 +93,7 @@ RULE_D_MIN = Rule(
     benchmark="fbm3w",
     title="subsampling threshold d_min",
     rulebook="d_min = c * epsilon, c chosen experimentally (seed 7.3.2, 7.3.5)",
-    node_2015=f"{NODE_SOURCE}: `D_MIN` hard-coded (0.00033 m in the seed)",
+    node_2015=f"{NODE_SOURCE}: `D_MIN = 0.00033` hard-coded (l. 20; the seed's value)",
     ertools="the config's d_min (default 0.00033 m), warned when below the bag's own noise",
     option="--d-min 0.00033",
 )
@@ -97,7 +103,10 @@ RULE_USER_SHAPES = Rule(
     benchmark="fbm3w",
     title="target shapes",
     rulebook="mathematically defined curves hard-coded in the script (seed 7.3.7, Listing 15)",
-    node_2015=f"{NODE_SOURCE}: line_path, semi_ellipse, sine (= spline_path) only",
+    node_2015=(
+        f"{NODE_SOURCE}: line_path (0.15 l, 0.045 l) and sine (= spline_path) since 7942ea2 "
+        "(before: the 0.30/0.10 line and the semi-ellipse); semi_ellipse defined, unused"
+    ),
     ertools="the built-in shapes plus user shapes from the config; no option: a user shape is "
     "the user's choice, said in the output",
     option="",
@@ -123,12 +132,160 @@ RULE_UNSCOREABLE_RUNS = Rule(
     "nothing of tracking losses or gaps",
     node_2015=(
         f"{NODE_SOURCE}: every pose it received, repeated poses of a lost marker set and gaps "
-        "included, made the path; a run was scored from whatever it had"
+        "included, made the path; a run was scored from whatever it had: one kept pose gave "
+        "`error_sum / N` = 0.0, a start on the reference the world's x axis"
     ),
     ertools=(
         "a run whose path window is less than 90% covered by valid data, or has more than 0.5 s "
         "without it between two valid samples, is unscoreable: no distance_error, the reason "
-        "given (docs/uncertainty.md)"
+        "given (docs/uncertainty.md); a path that never moved d_min, or starts on the "
+        "reference, is a failure"
     ),
     option="--unscoreable 2015",
+)
+
+# The versions of scripts/fbm3w (rows of the version table, ertools.fidelity.NodeVersion).
+_F = "scripts/fbm3w"
+_DEV = "not restorable: a development version, run in no competition"
+_DRAFT = "not restorable: no score computed"
+_PRE = (
+    "in part: its shapes as user shapes in the config (docs/fbm3w.md) and `--timeout-runs "
+    "unscored` (time, no score); not restorable: a timed-out run was repeated under its run "
+    "number and spec, which the next manual operation in the log does not show"
+)
+VERSIONS = (
+    NodeVersion(_F, "ef3ed26", "2015-10-30", "development", "FBM1@Work's node copied", _DRAFT),
+    NodeVersion(
+        _F,
+        "1101e55",
+        "2015-11-03",
+        "development",
+        "runs from runs_specifications, D_MIN 0.002; no score yet",
+        _DRAFT,
+    ),
+    NodeVersion(_F, "e2b7475", "2015-11-04", "development", "no score yet", _DRAFT),
+    NodeVersion(_F, "0f20ffd", "2015-11-05", "development", "none (notes)", _DRAFT),
+    NodeVersion(
+        _F,
+        "f127618",
+        "2015-11-05",
+        "development",
+        "the path collected from pose2d (D_MIN 0.002) while the goal ran; a RefBox timeout: "
+        "its time; no score yet",
+        _DRAFT,
+    ),
+    NodeVersion(_F, "65dfee4", "2015-11-05", "development", "none (the file's mode)", _DRAFT),
+    NodeVersion(
+        _F,
+        "71d270d",
+        "2015-11-06",
+        "development",
+        "an error printed, not scored (in the world frame, the target at the length itself)",
+        _DRAFT,
+    ),
+    NodeVersion(
+        _F,
+        "5568eef",
+        "2015-11-06",
+        "development",
+        "D_MIN 0.01, one manual operation for all runs; still printed only",
+        _DRAFT,
+    ),
+    NodeVersion(
+        _F,
+        "3e6dd79",
+        "2015-11-08",
+        "development",
+        "the first score (best_distance_error): Eq. (1) in the run frame at l/L, D_MIN 0.005, "
+        "line (0.30 l, 0.10 l), spline a semi-ellipse (0.050, 0.048); a RefBox timeout: its "
+        "time, no score, the run repeated",
+        _DEV,
+    ),
+    NodeVersion(
+        _F, "f8b4b26", "2015-11-09", "development", "none (not running, its commit says)", _DEV
+    ),
+    NodeVersion(
+        _F,
+        "d76de82",
+        "2015-11-09",
+        "development",
+        "the run frame's x axis atan2(start - reference)",
+        _DEV,
+    ),
+    NodeVersion(
+        _F,
+        "d161ac8",
+        "2015-11-09",
+        "development",
+        "D_MIN 0.00033; a manual operation per run; the start measured in the first run only",
+        _DEV,
+    ),
+    NodeVersion(
+        _F,
+        "f82940c",
+        "2015-11-09",
+        "development",
+        "the reference measured after each manual operation",
+        _DEV,
+    ),
+    NodeVersion(
+        _F,
+        "f012c65",
+        "2015-11-09",
+        "development",
+        "the start measured 2 s after the goal was sent",
+        _DEV,
+    ),
+    NodeVersion(
+        _F,
+        "2320dc4",
+        "2015-11-10",
+        "development",
+        "the start is the first pose of the path",
+        _DEV,
+    ),
+    NodeVersion(
+        _F, "9417897", "2015-11-10", "development", "an ENTER awaited before each path", _DEV
+    ),
+    NodeVersion(
+        _F,
+        "f7ff352",
+        "2015-11-10",
+        "development",
+        "no ENTER; the paths published for display",
+        _DEV,
+    ),
+    NodeVersion(
+        _F,
+        "e9620e6",
+        "2015-11-10",
+        "RoCKIn 2015 Lisbon, before its days 2 and 3 (the next commit says)",
+        "none (comments)",
+        _PRE,
+    ),
+    NodeVersion(
+        _F,
+        "6615fb0",
+        "2015-11-22",
+        "RoCKIn 2015 Lisbon, competition days 2 and 3 (its commit)",
+        "the spline a semi-ellipse of 0.11 x 0.11 (a sine defined, unused)",
+        _PRE,
+    ),
+    NodeVersion(
+        _F,
+        "7942ea2",
+        "2015-11-30",
+        'RoCKIn 2015 Lisbon ("changes during rockin 2015")',
+        "line (0.15 l, 0.045 l) and spline the sine (Listing 15); a timed-out run timed, "
+        "scored, eligible as best, the loop going on",
+        "`--2015` (50b173b differs only where a tf lookup failed)",
+    ),
+    NodeVersion(
+        _F,
+        "50b173b",
+        "2015-11-30",
+        "RoCKIn 2015 Lisbon (its final state; unchanged to 89dfa75)",
+        "a failed tf lookup (no mocap) retried, no longer ending the node",
+        "`--2015`",
+    ),
 )

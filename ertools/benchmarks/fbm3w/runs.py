@@ -4,7 +4,8 @@ Every finder returns :class:`RunWindow` s: when the reference position is taken,
 time window of the path. The scorer does the rest, identically for the three modes.
 
 ``states`` (seed 7.3.3, the 2015 node): per run the BmBox goes
-``WAITING_MANUAL_OPERATION -> COMPLETED_MANUAL_OPERATION`` (reference = pose at completion)
+``WAITING_MANUAL_OPERATION -> COMPLETED_MANUAL_OPERATION`` (reference = the pose when it left
+WAITING_MANUAL_OPERATION, READY on a RefBox END too: the node's ``ManualOperation()`` returned)
 ``-> TRANSMITTING_GOAL`` (payload: the spec) ``-> EXECUTING_GOAL`` (path starts)
 ``-> WAITING_RESULT -> READY`` (path ends when WAITING_RESULT is left). A RefBox ``END`` during
 a run ends it early when its payload is a timeout or a stop (``reason: timeout`` /
@@ -27,6 +28,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
+import numpy as np
+
 from ertools.benchmarks.common.ending import (
     RefBoxEnd,
     cut_warning,
@@ -38,7 +41,8 @@ from ertools.configs._yaml import MAX_SECONDS, show
 from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.errors import ConfigError, SegmentationError
 from ertools.io.model import BenchmarkStates
-from ertools.states import BmBoxState, EndReason
+from ertools.states import BmBoxState, EndReason, end_reason
+from ertools.streams import StateStream
 from ertools.timeutil import ns_to_s, resolve_time
 
 # What a RefBox END payload does to the run it ends (ertools.states.end_reason).
@@ -122,8 +126,7 @@ def find_states(states: BenchmarkStates, *, exact_2015: bool = False) -> list[Ru
         elif end_ns is not None:
             # The BmBox's Timeout()/Running() read the last RefBox payload when WaitResult
             # returned: the last END of the run decides; an unknown payload is neither.
-            during = refbox_ends_in(start, end_ns + END_SLACK_NS)
-            known = [e for e in during if e.reason.ends_early]
+            known = _early_ends(start, end_ns)
             if known:
                 status = EARLY_END[known[-1].reason]
                 note = f"{note}; RefBox END {known[-1].payload!r}"
@@ -146,20 +149,33 @@ def find_states(states: BenchmarkStates, *, exact_2015: bool = False) -> list[Ru
         )
         cur = None
 
-    def refbox_ends_in(lo: int, hi: int) -> list[RefBoxEnd]:
-        return [e for e in ends if lo <= e.t_ns <= hi]
+    def _early_ends(start: int, end: int) -> list[RefBoxEnd]:
+        if exact_2015:
+            # As Timeout() and Running() read it when WaitResult returned: the payload of the
+            # last RefBox message then, whatever its state (BmBox.py 34-35, 114-126).
+            payload = _payload_at(states.refbox, end)
+            reason = end_reason(payload, exact_2015=True)
+            return [RefBoxEnd(end, payload, reason)] if reason.ends_early else []
+        return [e for e in ends if start <= e.t_ns <= end + END_SLACK_NS and e.reason.ends_early]
 
     def new_run() -> dict[str, Any]:
         return {"ref": None, "start": None, "spec": None}
 
+    prev = None
     for i, (t, code) in enumerate(zip(times, codes, strict=True)):
         payload = ch.payload[i].strip()
+        if prev == BmBoxState.WAITING_MANUAL_OPERATION and cur is not None:
+            # ManualOperation() returned (to COMPLETED_MANUAL_OPERATION, or READY on a RefBox
+            # END, BmBox.py 40-44) and the node took its reference then (scripts/fbm3w 206-208).
+            cur["ref"] = last_ref = t
+        prev = code
         if code == BmBoxState.WAITING_MANUAL_OPERATION:
             close(t, "interrupted", "BmBox back to a manual operation")
             cur = new_run()
         elif code == BmBoxState.COMPLETED_MANUAL_OPERATION:
             cur = cur or new_run()
-            cur["ref"] = last_ref = t
+            if cur["ref"] is None:
+                cur["ref"] = last_ref = t
         elif code == BmBoxState.TRANSMITTING_GOAL:
             if cur is not None and cur["start"] is not None:
                 close(t, "interrupted", "")
@@ -196,6 +212,14 @@ def find_states(states: BenchmarkStates, *, exact_2015: bool = False) -> list[Ru
     if unknown:
         runs[0] = replace(runs[0], warnings=(*unknown, *runs[0].warnings))
     return runs
+
+
+def _payload_at(stream: StateStream | None, t_ns: int) -> str:
+    """The payload of the last message of ``stream`` recorded at or before ``t_ns``."""
+    if stream is None or len(stream) == 0:
+        return ""
+    i = int(np.searchsorted(stream.t_ns, t_ns, side="right")) - 1
+    return stream.payload[i] if i >= 0 else ""
 
 
 # --- windows ------------------------------------------------------------------------------

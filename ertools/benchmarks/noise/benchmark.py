@@ -21,7 +21,11 @@ import numpy as np
 
 from ertools.arrays import F64, I64, Bool
 from ertools.benchmarks.base import Rows, dump_yaml, jsonable
-from ertools.benchmarks.common.hygiene import identical_poses
+from ertools.benchmarks.common.hygiene import (
+    identical_poses,
+    impossible_samples,
+    impossible_warning,
+)
 from ertools.benchmarks.common.phases import (
     DEFAULT_MIN_STILL_S,
     DEFAULT_STILL_SPEED,
@@ -239,6 +243,11 @@ def noise_from_stream(
         ScoringError: every pose is NaN (named with the stream's source), or as
             :func:`noise_statistics`.
     """
+    impossible = impossible_samples(poses.t_ns, poses.xyz)
+    said = impossible_warning(poses) if impossible.count else None
+    if impossible.count:
+        # no measurement: left out as a frame the mocap never sent (a gap of one frame)
+        poses = poses.take(~(impossible.far | impossible.jump))
     xy = poses.xyz[:, :2]
     if len(poses) and not np.isfinite(xy).all(axis=1).any():
         # Said here, where the file and topic are known: noise_statistics would only find
@@ -269,7 +278,7 @@ def noise_from_stream(
         stationary=stationary,
         phases=spans,
     )
-    warnings: list[str] = []
+    warnings: list[str] = [said] if said else []
     if result.distances.size == 0:
         warnings.append("no two consecutive measurements differ: epsilon is undefined")
     elif not stationary:

@@ -14,7 +14,7 @@ import numpy as np
 from ertools.errors import BagError, ClockError, ErtoolsError, TopicError
 from ertools.io import read_poses, summary
 from ertools.io.files import open_bag
-from ertools.io.formats import find_bags
+from ertools.io.formats import NO_SUCH, find_bags
 from ertools.io.model import POSE_TYPES, TF_TYPES
 from ertools.io.reader import load_pose_batch
 from ertools.streams import PoseStream
@@ -276,9 +276,9 @@ def find_gt_files(
     explicit = {Path(p) for p in gt_paths}
     skipped: list[str] = []
     for problem in found.problems:
-        if not Path(problem.path).exists():
+        if problem.problem == NO_SUCH:
             # A mistyped GT path must not pass unnoticed behind the other GT files.
-            raise BagError(f"GT path: {problem.problem}", path=problem.path)
+            raise BagError(f"GT path: {problem.problem}", path=problem.path, transient=True)
         skipped.append(f"GT path {problem.path}: {problem.problem}")
     gt_summaries = []
     broken: list[str] = []

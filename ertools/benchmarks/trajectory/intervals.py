@@ -21,7 +21,11 @@ The measurement-like part of the mean distance, the RMSE and the two circular me
 from their closed-form distribution (:mod:`ertools.benchmarks.common.closed_forms`, one draw
 of it per Monte Carlo draw); the max and the percentiles are drawn on the poses that can
 move them only (:mod:`ertools.benchmarks.common.draws`), the percentiles of a comparison of
-more than :data:`MAX_POSES` poses on that many spread evenly over it (conservative).
+more than :data:`MAX_POSES` poses on that many spread evenly over it (conservative). The
+closed forms work in float64; the order statistics' draws in float32 with additions, products
+and square roots only, which give the same bits on every CPU (float32's sin, cos and arctan2
+do not: issue 36). A comparison of too few poses to measure the offset's spread gets no
+interval, with the reason (:func:`~ertools.benchmarks.common.uncertainty.too_few`).
 """
 
 from __future__ import annotations
@@ -29,13 +33,12 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, I64, IntArr
-from ertools.benchmarks.common.clocks import OffsetEstimate
+from ertools.benchmarks.common.clocks import MIN_POSES, OffsetEstimate
 from ertools.benchmarks.common.closed_forms import (
     AngleMoments,
     Raw,
@@ -62,14 +65,17 @@ from ertools.benchmarks.common.interval_output import (
     IntervalSettings,
     ResultIntervals,
     shares_of,
+    withheld,
 )
 from ertools.benchmarks.common.uncertainty import (
+    MIN_INTERVAL_SAMPLES,
     MOCAP_NOISE,
     TIME_ASSOCIATION,
     Source,
     Uncertainty,
     monte_carlo,
     sigma_from_epsilon,
+    too_few,
 )
 from ertools.benchmarks.noise.benchmark import noise_from_stream
 from ertools.benchmarks.trajectory.association import COMPARED, Matched
@@ -84,7 +90,6 @@ METHOD_TRAJECTORY = (
     "closed-form distribution, the max and percentiles from draws of the poses that can move "
     "them; the clock offset's draws (centred on the offset applied) mirrored"
 )
-Floats = npt.NDArray[np.floating[Any]]  # float32 in the draws, float64 elsewhere
 
 # A 2015 mocap marker set when nothing in the log measures it: 0.3 mm per axis, 0.05 deg.
 DEFAULT_SIGMA_M = 3e-4
@@ -245,7 +250,7 @@ def _fast_length(n: int) -> int:
 
 
 def offset_spread(
-    r_xyz: Floats, g_xyz: Floats, vel: Floats, audit: OffsetEstimate, offset_ns: int
+    r_xyz: F64, g_xyz: F64, vel: F64, audit: OffsetEstimate, offset_ns: int
 ) -> tuple[float, float]:
     """(sd, disagreement) in seconds: the standard error of the clock offset, and how far
     the clock audit's estimate lies from the offset applied.
@@ -270,12 +275,12 @@ def offset_spread(
     intervals are centred on the offset applied whatever it is (they are the score's), and
     the score at the audit's offset gets its own (``*_at_fitted_offset``).
     """
-    sv = float(np.sum(np.square(vel, dtype=np.float64)))
+    sv = float(np.sum(np.square(vel)))
     n = len(vel)
     if n < 3 or sv <= 0.0 or audit.offset_ns is None:
         return 0.0, 0.0
-    e = (r_xyz - g_xyz).astype(np.float64)
-    v = vel.astype(np.float64)
+    e = r_xyz - g_xyz
+    v = vel
     centre = (audit.offset_ns - offset_ns) / NS_PER_S
     if audit.disagrees_with(offset_ns):
         # scored at an offset the data disagrees with (``--offset 0`` on a robot 0.35 s
@@ -450,6 +455,16 @@ def trajectory_intervals(
     ok = matched.status == COMPARED
     if not settings.enabled or not ok.any() or len(gt) < 2:
         return NO_INTERVALS
+    few = too_few(
+        int(ok.sum()),
+        "compared pose(s)",
+        max(MIN_INTERVAL_SAMPLES, MIN_POSES),
+        f"the clock offset's spread (the time association, most often the largest source) "
+        f"being measured from {MIN_POSES} or more",
+    )
+    if few is not None:
+        # a null interval with the reason, not one of the mocap noise alone
+        return withheld(KEYS, few, settings, METHOD_TRAJECTORY)
     q = matched.t_ns[ok]
     r_xyz = robot.xyz[ok]
     g_xyz = matched.gt_xyz[ok]

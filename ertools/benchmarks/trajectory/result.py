@@ -51,11 +51,13 @@ class FittedScore:
         metrics: the statistics there.
         intervals: the intervals of :data:`~ertools.benchmarks.trajectory.intervals.
             FITTED_KEYS` there, centred on that offset.
+        withheld: why a key of those has no interval (too few poses compared there).
     """
 
     offset_ns: int
     metrics: Metrics
     intervals: Mapping[str, Interval | None]
+    withheld: Mapping[str, str] = field(default_factory=dict)
 
     def values(self) -> dict[str, float]:
         m = self.metrics

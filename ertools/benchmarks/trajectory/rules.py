@@ -111,15 +111,18 @@ RULE_GT_OVERLAP = Rule(
 RULE_INVALID_POSES = Rule(
     key="trajectory.invalid-poses",
     benchmark="trajectory",
-    title="NaN poses and zero quaternions",
+    title="NaN poses, zero quaternions and impossible positions",
     rulebook=_SEED,
     node_2015=(
         "used as they were: a NaN made the score NaN, a zero quaternion gave tf's identity, a "
-        "yaw of 0 (rockin_trajectory_benchmark.py, Error.update)"
+        "yaw of 0, a pose kilometres away its distance (rockin_trajectory_benchmark.py, "
+        "Error.update)"
     ),
     ertools=(
-        "ignored and counted in a warning; no option: a NaN score is no score, and a zero "
-        "quaternion is a node publishing 'no pose'"
+        "ignored and counted in a warning; no option: a NaN score is no score, a zero "
+        "quaternion is a node publishing 'no pose', and a position kilometres from the others "
+        "(or a GT pose reached and left faster than any robot) is no measurement "
+        "(docs/uncertainty.md, 'Impossible samples')"
     ),
     option="",
 )

@@ -14,7 +14,12 @@ import numpy.typing as npt
 from ertools.arrays import I64
 from ertools.benchmarks import registry
 from ertools.benchmarks.common.clocks import OffsetEstimate, estimate_offset
-from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid, frame_change_warning
+from ertools.benchmarks.common.hygiene import (
+    drop_duplicates,
+    drop_invalid,
+    frame_change_warning,
+    impossible_warning,
+)
 from ertools.benchmarks.common.interval_output import (
     NO_INTERVALS,
     IntervalSettings,
@@ -22,6 +27,7 @@ from ertools.benchmarks.common.interval_output import (
     shares_of,
 )
 from ertools.benchmarks.common.teams import parse_robot_log_name
+from ertools.benchmarks.common.uncertainty import few_warning
 from ertools.benchmarks.common.validity import (
     GAP as V_GAP,
 )
@@ -121,6 +127,9 @@ def score_streams(
     check_increasing(robot, where)
     notes = [*warnings, *_other_benchmark_gt(robot_file, gt_topic)]
     notes.extend(w for w in (frame_change_warning(gt), frame_change_warning(robot)) if w)
+    # a robot's estimate may jump (relocalising): only the measured GT's jumps are impossible
+    found = (impossible_warning(gt), impossible_warning(robot, jumps=False))
+    notes.extend(w for w in found if w)
     evo = config.t_max_diff is not None
     invalid: list[Deviation] = []
     if config.gt_order == "time" and not evo:
@@ -131,18 +140,19 @@ def score_streams(
                 f"{dropped} GT sample(s) recorded twice (overlapping GT files) were used once"
             )
     gt, bad_gt = drop_invalid(gt)
-    robot, bad_robot = drop_invalid(robot)
+    robot, bad_robot = drop_invalid(robot, jumps=False)
     if bad_gt:
-        notes.append(f"{bad_gt} GT sample(s) with NaN or zero-norm poses ignored")
+        notes.append(f"{bad_gt} GT sample(s) with NaN, zero-norm or impossible poses ignored")
     if bad_gt or bad_robot:
         invalid.append(
             RULE_INVALID_POSES.deviation(
-                f"{bad_gt} GT and {bad_robot} robot pose(s) with NaN or zero-norm quaternions "
-                "ignored (2015 used them: a NaN score, or a yaw of 0)"
+                f"{bad_gt} GT and {bad_robot} robot pose(s) with NaN, zero-norm quaternions or "
+                "physically impossible positions ignored (2015 used them: a NaN or absurd "
+                "score, or a yaw of 0)"
             )
         )
     if bad_robot:
-        notes.append(f"{bad_robot} robot pose(s) with NaN or zero-norm poses ignored")
+        notes.append(f"{bad_robot} robot pose(s) with NaN, zero-norm or impossible poses ignored")
     if len(robot) == 0:
         raise ScoringError(
             f"{where}: no valid robot poses left to compare (NaN or zero quaternions)"
@@ -364,8 +374,13 @@ def score_streams(
             shares.update(
                 {f"{k}{FITTED_SUFFIX}": v for k, v in shares_of(fitted.intervals).items()}
             )
-            iv = ResultIntervals(iv.intervals, replace(iv.uncertainty, shares=shares))
+            why = dict(iv.uncertainty.withheld)
+            why.update({f"{k}{FITTED_SUFFIX}": v for k, v in fitted.withheld.items()})
+            iv = ResultIntervals(iv.intervals, replace(iv.uncertainty, shares=shares, withheld=why))
     notes.extend(_audit_warnings(audit, offset_ns, fitted))
+    few = few_warning(matched.count(COMPARED), "compared pose(s)", "the comparison")
+    if few is not None and m is not None:
+        notes.append(few)
     result = TrajectoryResult(
         robot_file=robot_file,
         robot_topic=robot_topic,
@@ -525,7 +540,8 @@ def _at_fitted_offset(
         sigma=sigma,
     )
     kept = {k: iv.intervals.get(k) for k in FITTED_KEYS}
-    return FittedScore(fitted_ns, m, kept)
+    why = {} if iv.uncertainty is None else iv.uncertainty.withheld
+    return FittedScore(fitted_ns, m, kept, {k: why[k] for k in FITTED_KEYS if k in why})
 
 
 def _other_benchmark_gt(robot_file: str, gt_topic: str) -> list[str]:

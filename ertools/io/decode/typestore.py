@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from ertools.errors import BagError
+from ertools.io import budget
 from ertools.io.model import Conn, long_msgtype
 
 _IDL_SEP = "=" * 80 + "\n"
@@ -70,6 +71,7 @@ class Deserializer:
                     f"({_first_line(err)})",
                     path=path,
                 ) from err
+        _check_nesting(types, path)
         self.typestore = get_typestore(Stores.EMPTY)
         try:
             self.typestore.register(types)
@@ -98,6 +100,65 @@ class Deserializer:
                 f"stored definition ({type(err).__name__}: {err})",
                 path=self.path,
             ) from err
+
+
+def _check_nesting(types: dict[str, Any], path: Path) -> None:
+    """Refuse stored definitions whose types nest deeper than the budget, or hold themselves:
+    rosbags builds and runs its (de)serializers recursively, one level per nested type."""
+    depth: dict[str, int] = {}
+    for root in types:
+        # iterative depth-first walk: a definition thousands of types deep must not recurse
+        stack: list[tuple[str, list[str]]] = [(root, _nested(types, root))]
+        on_path = {root}
+        while stack:
+            name, todo = stack[-1]
+            if len(stack) > budget.MAX_NESTING:
+                raise BagError(
+                    budget.over_budget(
+                        f"stored definition of {root}",
+                        "types nested deeper",
+                        f"{budget.MAX_NESTING} levels",
+                        "MAX_NESTING",
+                    ),
+                    path=path,
+                )
+            if not todo:
+                stack.pop()
+                on_path.discard(name)
+                depth[name] = 1 + max((depth.get(n, 0) for n in _nested(types, name)), default=0)
+                continue
+            child = todo.pop()
+            if child in on_path:
+                raise BagError(
+                    f"stored definition of {name} holds a field of its own type {child} "
+                    "(a recursive definition: not a ROS message)",
+                    path=path,
+                )
+            if child in depth or child not in types:
+                continue
+            stack.append((child, _nested(types, child)))
+            on_path.add(child)
+        if depth.get(root, 0) > budget.MAX_NESTING:
+            raise BagError(
+                budget.over_budget(
+                    f"stored definition of {root}",
+                    "types nested deeper",
+                    f"{budget.MAX_NESTING} levels",
+                    "MAX_NESTING",
+                ),
+                path=path,
+            )
+
+
+def _nested(types: dict[str, Any], name: str) -> list[str]:
+    """The message types the fields of ``name`` hold (arrays' and sequences' too)."""
+    out = []
+    for _field, (kind, detail) in types[name][1]:
+        while kind in (3, 4):  # ARRAY, SEQUENCE: ((kind, detail), count)
+            (kind, detail), _count = detail
+        if kind == 2:  # NAME
+            out.append(str(detail))
+    return out
 
 
 def _first_line(err: Exception, limit: int = 160) -> str:

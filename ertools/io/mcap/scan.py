@@ -26,7 +26,10 @@ import numpy as np
 from ertools import caches
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
+from ertools.inputs import open_regular
+from ertools.io import budget
 from ertools.io.decode.fast import read_at
+from ertools.io.inflate import Allowance
 from ertools.io.mcap.crc import crc32
 from ertools.io.mcap.summary import decompress, read_summary
 
@@ -104,6 +107,7 @@ class _Sink:
     chunks: int = 0
     chunk_at: list[int] = field(default_factory=list)
     data_end: bool = False
+    allowance: Allowance = field(default_factory=lambda: Allowance(0, ""))
 
     def messages(self, buf: U8, at: I64) -> None:
         """Message records starting at ``at`` (vectorised)."""
@@ -298,9 +302,11 @@ def _chunk(buf: Any, at: int, end: int, sink: _Sink) -> None:
     compression = bytes(buf[at : at + clen]).decode("ascii", "replace")
     (nbytes,) = _U64.unpack_from(buf, at + clen)
     at += clen + 8
-    if at + nbytes > end or usize > 1000 * max(nbytes, 1) + (1 << 20):
+    if at + nbytes > end:
         raise _CutError
     where = f"in {sink.path} at byte {at}"
+    if compression:
+        sink.allowance.add(usize, f"at byte {at}", "MCAP chunk")
     stored = buf[at : at + nbytes]
     # an uncompressed chunk is read in place (no copy); the decompressors take any buffer
     inner = stored if compression == "" else decompress(compression, stored, usize, where)
@@ -329,7 +335,7 @@ def scan_mcap(
     Raises:
         BagError: not an MCAP file (no magic), or a corrupt compressed chunk.
     """
-    with path.open("rb") as f:
+    with open_regular(path) as f:
         st = os.fstat(f.fileno())
         key = (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
         if not keep and check_crc and key in _SCANS:
@@ -374,7 +380,7 @@ def _scan(buf: U8, path: Path, keep: frozenset[int], check_crc: bool) -> McapRec
     size = len(buf)
     if buf[: len(MAGIC)].tobytes() != MAGIC:
         raise BagError("no MCAP magic at the start", path=path)
-    sink = _Sink(keep, check_crc, path)
+    sink = _Sink(keep, check_crc, path, allowance=Allowance(size, str(path)))
     end = size - len(MAGIC) if buf[size - len(MAGIC) :].tobytes() == MAGIC else size
     foot = size - len(MAGIC) - FOOTER_SIZE
     if end == size and foot > len(MAGIC) and buf[foot : foot + 9].tobytes() == _FOOTER_HEAD:
@@ -474,7 +480,7 @@ def _scan_layout(summary: Any, why: str) -> McapLayout:
 
 
 def _layout(path: Path) -> McapLayout:
-    with path.open("rb") as f:
+    with open_regular(path) as f:
         size = os.fstat(f.fileno()).st_size
         if size < 2 * len(MAGIC) + FOOTER_SIZE or os.pread(f.fileno(), 8, size - 8) != MAGIC:
             # no footer to find a summary with: a recording not finished, or a copy cut short
@@ -486,6 +492,7 @@ def _layout(path: Path) -> McapLayout:
         if summary is None:
             return _scan_layout(None, "no summary section")
         chunks = summary.chunk_indexes
+        _check_declared(path, size, chunks)
         if any(not c.message_index_offsets and c.uncompressed_size for c in chunks):
             return _scan_layout(summary, "chunks without message indexes")
         f.seek(size - len(MAGIC) - FOOTER_SIZE)
@@ -516,6 +523,22 @@ def _layout(path: Path) -> McapLayout:
     if {c.schema_id for c in channels.values() if c.schema_id} - set(schemas):
         return _scan_layout(summary, "schemas written only inside chunks")
     return McapLayout(summary, INDEXED, "", channels, schemas)
+
+
+def _check_declared(path: Path, size: int, chunks: list[Any]) -> None:
+    """Refuse a file whose compressed chunks declare more than its size allows
+    (:func:`ertools.io.budget.allowance`): each chunk is checked again when it is read."""
+    declared = sum(int(c.uncompressed_size) for c in chunks if c.compression)
+    if declared > budget.allowance(size):
+        raise BagError(
+            budget.over_budget(
+                f"the chunks of this {size}-byte file",
+                f"{declared} bytes uncompressed",
+                budget.allowance(size),
+                "MAX_INFLATE_PER_BYTE x the file's size + MAX_CHUNK_BYTES",
+            ),
+            path=path,
+        )
 
 
 def _walk_loose(fd: int, pos: int, end: int, sink: _Sink) -> int:

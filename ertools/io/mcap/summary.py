@@ -14,6 +14,7 @@ from typing import Any, BinaryIO
 
 from ertools import caches
 from ertools.errors import BagError
+from ertools.io.inflate import inflate
 from ertools.io.mcap.crc import crc32
 from ertools.io.pipeline import pread
 
@@ -109,23 +110,10 @@ def _check_summary_crc(f: BinaryIO, path: Path) -> None:
         raise BagError("damaged MCAP summary section: it fails its CRC check", path=path)
 
 
-def decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
-    """Uncompressed MCAP chunk records."""
-    try:
-        if compression == "":
-            return data
-        if compression == "zstd":
-            import zstandard  # lazy: a decompressor only for compressed chunks
-
-            return bytes(zstandard.ZstdDecompressor().decompress(data, max_output_size=size))
-        if compression == "lz4":
-            import lz4.frame  # lazy: a decompressor only for compressed chunks
-
-            return bytes(lz4.frame.decompress(data))
-    except Exception as err:
-        # zstandard and lz4 raise their own error classes on corrupt input.
-        raise BagError(f"corrupt {compression} MCAP chunk {where} ({err})") from err
-    raise BagError(f"unsupported MCAP chunk compression {compression!r} {where}")
+def decompress(compression: str, data: Any, size: int, where: str) -> Any:
+    """Uncompressed MCAP chunk records: exactly ``size`` bytes, within the budget
+    (:func:`ertools.io.inflate.inflate`)."""
+    return inflate(compression, data, size, where, "MCAP chunk")
 
 
 def file_size(f: BinaryIO) -> int:

@@ -17,6 +17,7 @@ odd headers) is walked record by record.
 
 from __future__ import annotations
 
+import os
 import struct
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,11 +28,15 @@ import numpy.typing as npt
 
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
+from ertools.inputs import open_regular
+from ertools.io import budget
 from ertools.io.decode.fast import gather
+from ertools.io.inflate import Allowance
 from ertools.io.ros1 import records
 from ertools.io.ros1.layout import (
     Ros1Chunk,
     Ros1Layout,
+    chunk_head,
     conn_record,
     decompress,
     entries_from_index,
@@ -223,9 +228,25 @@ def _conn_text(topic: bytes, fields: dict[str, bytes]) -> tuple[str, str, str]:
 class _Chunk:
     pos: int
     compression: str
-    data: bytes
+    size: int  # declared uncompressed
     data_pos: int
+    data_len: int
     index: dict[int, tuple[I64, I64]] = field(default_factory=dict)  # conn -> (times, offsets)
+
+
+def _chunk_data(f: BinaryIO, path: Path, pos: int, data_pos: int, data_len: int) -> bytes:
+    """A chunk's stored bytes, read when it is checked (one chunk held at a time)."""
+    if data_len > budget.MAX_CHUNK_BYTES:
+        raise BagError(
+            budget.over_budget(
+                f"chunk at byte {pos}",
+                f"{data_len} bytes stored",
+                budget.MAX_CHUNK_BYTES,
+                "MAX_CHUNK_BYTES",
+            ),
+            path=path,
+        )
+    return os.pread(f.fileno(), data_len, data_pos)
 
 
 def _ns(t: int) -> str:
@@ -264,7 +285,7 @@ def check_ros1(path: Path, progress: Reporter | None = None) -> list[str]:
         BagError: the bag header itself is unreadable (not a bag).
     """
     size = path.stat().st_size
-    with path.open("rb") as f:
+    with open_regular(path) as f:
         return _check(f, path, size, progress)
 
 
@@ -287,16 +308,23 @@ def _check(f: BinaryIO, path: Path, size: int, progress: Reporter | None) -> lis
     if progress is not None:
         progress.task(f"reading {path.name}", size, "B")
         progress.advance(pos)
+    allowance = Allowance(size, str(path))
     while pos < size:
         try:
-            rec, data = records.read_record(f, pos, size, with_data=True)
+            rec, data = records.read_record(
+                f, pos, size, with_data=True, lazy_ops=frozenset({OP_CHUNK})
+            )
         except records.RecordError as err:
             rep.add(f"unreadable record at byte {pos} ({err}); nothing after it was checked")
             break
+        except BagError as err:
+            raise BagError(err.message, path=path) from err
         try:
             if rec.op == OP_CHUNK:
-                compression = rec.fields.get("compression", b"none").decode("ascii", "replace")
-                chunks.append(_Chunk(pos, compression, data, rec.data_pos))
+                compression, usize = chunk_head(rec.fields)
+                if compression != "none":
+                    allowance.add(usize, f"at byte {pos}")
+                chunks.append(_Chunk(pos, compression, usize, rec.data_pos, rec.data_len))
             elif rec.op == OP_INDEX:
                 cid, count = records.u32(rec.fields, "conn"), records.u32(rec.fields, "count")
                 if records.u32(rec.fields, "ver") != 1 or len(data) != 12 * count:
@@ -347,14 +375,15 @@ def _check(f: BinaryIO, path: Path, size: int, progress: Reporter | None) -> lis
 
     used: set[int] = set()
     if progress is not None:
-        progress.task(f"checking chunks of {path.name}", sum(len(c.data) for c in chunks), "B")
+        progress.task(f"checking chunks of {path.name}", sum(c.data_len for c in chunks), "B")
     for chunk in chunks:
         if progress is not None:
-            progress.advance(len(chunk.data))
+            progress.advance(chunk.data_len)
         where = f"chunk at byte {chunk.pos}"
+        data = _chunk_data(f, path, chunk.pos, chunk.data_pos, chunk.data_len)
         try:
             buf = np.frombuffer(
-                decompress(chunk.compression, chunk.data, f"at byte {chunk.pos}"), np.uint8
+                decompress(chunk.compression, data, chunk.size, f"at byte {chunk.pos}"), np.uint8
             )
         except BagError as err:
             rep.add(f"{where}: {err.message}")
@@ -385,6 +414,17 @@ def _check(f: BinaryIO, path: Path, size: int, progress: Reporter | None) -> lis
     return rep.result()
 
 
+def _by_conn(conn: I64) -> dict[int, I64]:
+    """conn -> the positions of its records, in record order: one sort for all connections
+    (a mask per connection was quadratic in a chunk of many connections)."""
+    order = np.argsort(conn, kind="stable")
+    cids, first, count = np.unique(conn[order], return_index=True, return_counts=True)
+    return {
+        int(c): order[a : a + n]
+        for c, a, n in zip(cids.tolist(), first.tolist(), count.tolist(), strict=True)
+    }
+
+
 def _compare_chunk(
     rep: _Report,
     where: str,
@@ -392,7 +432,8 @@ def _compare_chunk(
     recs: ChunkRecords,
     info: tuple[int, int, int, dict[int, int]] | None,
 ) -> None:
-    present = np.unique(recs.msg_conn)
+    of_conn = _by_conn(recs.msg_conn)
+    present = np.fromiter(of_conn, dtype=np.int64, count=len(of_conn))
     if len(recs.msg_time) and info is not None:
         ipos, start, end, counts = info
         lo, hi = int(recs.msg_time.min()), int(recs.msg_time.max())
@@ -402,7 +443,7 @@ def _compare_chunk(
                 f"its messages span {_ns(lo)} to {_ns(hi)}"
             )
         for cid in sorted(set(counts) | {int(c) for c in present}):
-            held = int(np.count_nonzero(recs.msg_conn == cid))
+            held = len(of_conn.get(cid, ()))
             if counts.get(cid, 0) != held:
                 rep.add(
                     f"{where}: connection {cid}: chunk info counts {counts.get(cid, 0)} "
@@ -411,7 +452,7 @@ def _compare_chunk(
     elif info is None:
         rep.add(f"{where}: no chunk-info record")
     for cid in sorted(set(chunk.index) | {int(c) for c in present}):
-        mine = recs.msg_conn == cid
+        mine = of_conn.get(cid, np.empty(0, np.int64))
         off, t_rec = recs.msg_off[mine], recs.msg_time[mine]
         t_idx, o_idx = chunk.index.get(cid, (np.empty(0, np.int64), np.empty(0, np.int64)))
         tag = f"{where}: connection {cid}"
@@ -453,14 +494,19 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
     """
     start = pos
     conns: dict[int, Conn] = {}
-    found: list[tuple[int, str, int, int, bytes, list[tuple[I64, I64]]]] = []
+    found: list[tuple[int, str, int, int, int, list[tuple[I64, I64]]]] = []
     problems = [why]
+    allowance = Allowance(size, str(path))
     try:
         while pos < size:
-            rec, data = records.read_record(f, pos, size, with_data=True)
+            rec, data = records.read_record(
+                f, pos, size, with_data=True, lazy_ops=frozenset({OP_CHUNK})
+            )
             if rec.op == OP_CHUNK:
-                compression = rec.fields.get("compression", b"none").decode("ascii", "replace")
-                found.append((pos, compression, rec.data_pos, rec.data_len, data, []))
+                compression, usize = chunk_head(rec.fields)
+                if compression != "none":
+                    allowance.add(usize, f"at byte {pos}")
+                found.append((pos, compression, usize, rec.data_pos, rec.data_len, []))
             elif rec.op == OP_INDEX and found:
                 found[-1][5].append(entries_from_index(data[: 12 * (len(data) // 12)]))
             elif rec.op == OP_CONNECTION:
@@ -472,9 +518,10 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
     except (records.RecordError, KeyError, IndexError, struct.error):
         return scan_layout(f, path, size, start, why)
     chunks = []
-    for cpos, compression, data_pos, data_len, data, hints in found:
+    for cpos, compression, usize, data_pos, data_len, hints in found:
+        data = _chunk_data(f, path, cpos, data_pos, data_len)
         try:
-            buf = np.frombuffer(decompress(compression, data, f"at byte {cpos}"), np.uint8)
+            buf = np.frombuffer(decompress(compression, data, usize, f"at byte {cpos}"), np.uint8)
         except BagError as err:
             problems.append(f"corrupt chunk at byte {cpos} skipped ({err.message})")
             continue
@@ -503,8 +550,8 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
         if not len(recs.msg_off):
             continue
         entries = {
-            int(cid): (recs.msg_time[recs.msg_conn == cid], recs.msg_off[recs.msg_conn == cid])
-            for cid in np.unique(recs.msg_conn)
+            cid: (recs.msg_time[at], recs.msg_off[at])
+            for cid, at in _by_conn(recs.msg_conn).items()
         }
         chunks.append(
             Ros1Chunk(
@@ -516,6 +563,7 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
                 data_pos,
                 data_len,
                 entries,
+                usize,
             )
         )
     return Ros1Layout(

@@ -22,8 +22,11 @@ import numpy.typing as npt
 
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
+from ertools.inputs import open_regular
+from ertools.io import budget
 from ertools.io.bagfile import BagFile, RawRecord
 from ertools.io.decode.fast import LayoutMismatchError, gather, read_at
+from ertools.io.inflate import Allowance
 from ertools.io.model import Conn
 from ertools.io.ros1.check import rebuild_layout
 from ertools.io.ros1.layout import (
@@ -35,6 +38,7 @@ from ertools.io.ros1.layout import (
     Ros1Chunk,
     Ros1Layout,
     cat_arrays,
+    chunk_head,
     decompress,
     entries_from_index,
     fields_before,
@@ -118,7 +122,8 @@ class Ros1Bag(BagFile):
         if problems and strict:
             log.warning("%s: %s; reading what the scan found", path, "; ".join(problems))
         self.connections = tuple(self.layout.conns)
-        self._f: BufferedReader | None = path.open("rb")
+        self._inflation = Allowance(self.layout.size, str(path))
+        self._f: BufferedReader | None = open_regular(path)
         self._mm: mmap.mmap | None = None
 
     def _unmap(self) -> None:
@@ -152,8 +157,21 @@ class Ros1Bag(BagFile):
             raise BagError(f"damaged chunk record ({err})", path=self.path) from err
         if rec.op != OP_CHUNK:
             raise BagError(f"expected a chunk record at byte {chunk.pos}", path=self.path)
-        chunk.compression = rec.fields.get("compression", b"none").decode("ascii", "replace")
+        chunk.compression, chunk.size = chunk_head(rec.fields)
         chunk.data_pos, chunk.data_len = rec.data_pos, rec.data_len
+        if rec.data_len > budget.MAX_CHUNK_BYTES:
+            raise BagError(
+                budget.over_budget(
+                    f"chunk at byte {chunk.pos}",
+                    f"{rec.data_len} bytes stored",
+                    budget.MAX_CHUNK_BYTES,
+                    "MAX_CHUNK_BYTES",
+                ),
+                path=self.path,
+            )
+        if chunk.compression != "none":
+            # each chunk's header is read once: what the chunks read so far may inflate to
+            self._inflation.add(chunk.size, f"at byte {chunk.pos}")
         return rec
 
     def compressions(self) -> list[str]:
@@ -233,9 +251,9 @@ class Ros1Bag(BagFile):
         if len(data) != chunk.data_len:
             raise BagError(f"chunk at byte {chunk.pos} cut off by end of file", path=self.path)
         try:
-            return decompress(chunk.compression, data, self._where(chunk))
+            return decompress(chunk.compression, data, chunk.size, f"at byte {chunk.pos}")
         except BagError as err:
-            raise BagError(err.message, path=None) from err
+            raise BagError(err.message, path=self.path) from err
 
     def select(
         self, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None

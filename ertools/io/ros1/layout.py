@@ -8,7 +8,6 @@ usable index (``.bag.active`` files, truncated copies).
 
 from __future__ import annotations
 
-import bz2
 import functools
 import logging
 import os
@@ -25,7 +24,9 @@ import numpy.typing as npt
 from ertools import caches
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
+from ertools.inputs import open_regular
 from ertools.io.decode.fast import read_at
+from ertools.io.inflate import Allowance, inflate
 from ertools.io.model import Conn, short_msgtype
 from ertools.io.ros1.records import (
     MAGIC_LEN,
@@ -67,7 +68,8 @@ class Ros1Chunk:
     """One chunk: where it is, its time span and per-connection counts.
 
     ``entries`` (conn -> (record times, offsets in the uncompressed chunk)) is filled when the
-    index-data records after the chunk are read (or by a scan).
+    index-data records after the chunk are read (or by a scan); ``compression``, ``data_pos``,
+    ``data_len`` and ``size`` (its declared uncompressed size) when its record header is.
     """
 
     pos: int
@@ -78,6 +80,7 @@ class Ros1Chunk:
     data_pos: int = -1
     data_len: int = -1
     entries: dict[int, tuple[I64, I64]] | None = None
+    size: int = -1
 
 
 @dataclass
@@ -154,12 +157,17 @@ def read_layout(path: Path) -> Ros1Layout:
     Raises:
         BagError: not even the bag header is readable.
     """
-    with path.open("rb") as f:
+    with open_regular(path) as f:
         st = os.fstat(f.fileno())
         key = (str(path), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
         found = _SCANNED.get(key)
         if found is None:
-            found = _read_layout(f, path, st.st_size)
+            try:
+                found = _read_layout(f, path, st.st_size)
+            except BagError as err:
+                if err.path is not None:
+                    raise
+                raise BagError(err.message, path=path) from err
             if not found.indexed:
                 # one version per path (a recording's file grows: only its latest scan is
                 # worth keeping) and a few files at most (an hour's entries are ~20 MB)
@@ -198,15 +206,17 @@ def _read_layout(f: BinaryIO, path: Path, size: int) -> Ros1Layout:
         )
     try:
         conns: list[Conn] = []
+        ids: set[int] = set()
         pos = index_pos
         for _ in range(conn_count):
             rec, data = read_record(f, pos, size, with_data=True)
             if rec.op != OP_CONNECTION:
                 raise RecordError("expected a connection record", pos)
             cid, topic, fields = connection_fields(rec, data)
-            if any(c.id == cid for c in conns):
+            if cid in ids:
                 # a damaged id: one connection's messages would be read as another's
                 raise RecordError(f"two connection records with id {cid}", pos)
+            ids.add(cid)
             conns.append(conn_record(cid, topic, fields))
             pos = rec.end
         if chunk_count == 0 and conn_count and index_pos > head.end:
@@ -227,20 +237,22 @@ def _read_layout(f: BinaryIO, path: Path, size: int) -> Ros1Layout:
     return Ros1Layout(path, size, True, conns, chunks)
 
 
-def decompress(compression: str, data: bytes, where: str) -> bytes:
-    """Uncompressed chunk bytes."""
-    try:
-        if compression == "none":
-            return data
-        if compression == "bz2":
-            return bz2.decompress(data)
-        if compression == "lz4":
-            import lz4.frame  # lazy: a decompressor only for compressed chunks
+def chunk_head(fields: dict[str, bytes]) -> tuple[str, int]:
+    """(compression, declared uncompressed size; -1 when not stated) of a chunk record."""
+    compression = fields.get("compression", b"none").decode("ascii", "replace")
+    size = u32(fields, "size") if len(fields.get("size", b"")) >= 4 else -1
+    return compression, size
 
-            return bytes(lz4.frame.decompress(data))
-    except (OSError, ValueError, RuntimeError, EOFError) as err:
-        raise BagError(f"corrupt {compression} chunk {where} ({err})") from err
-    raise BagError(f"unsupported chunk compression {compression!r} {where}")
+
+def decompress(compression: str, data: bytes, size: int, where: str) -> bytes:
+    """Uncompressed chunk bytes, never more than the ``size`` the chunk record declares
+    (:func:`ertools.io.inflate.inflate`: within the budget, or a BagError)."""
+    if compression not in ("none", "bz2", "lz4"):  # what the ROS1 format defines
+        raise BagError(f"unsupported chunk compression {compression!r} {where}")
+    if compression != "none" and size < 0:
+        raise BagError(f"damaged {compression} chunk {where}: its record states no size")
+    out: bytes = inflate(compression, data, size, where)
+    return out
 
 
 def _walk_chunk(buf: bytes, base: int) -> Iterator[tuple[int, dict[str, bytes], int, int]]:
@@ -298,6 +310,7 @@ def scan_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ros1L
     chunks: list[Ros1Chunk] = []
     loose: dict[int, tuple[list[int], list[int]]] = {}
     loose_start = loose_end = -1
+    allowance = Allowance(size, str(path))
 
     def flush() -> None:
         nonlocal loose, loose_start
@@ -331,9 +344,11 @@ def scan_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ros1L
                 break
         elif rec.op == OP_CHUNK:
             flush()
-            compression = rec.fields.get("compression", b"none").decode("ascii", "replace")
+            compression, usize = chunk_head(rec.fields)
+            if compression != "none":
+                allowance.add(usize, f"at byte {pos}")
             try:
-                buf = decompress(compression, data, f"at byte {pos}")
+                buf = decompress(compression, data, usize, f"at byte {pos}")
                 per: dict[int, tuple[list[int], list[int]]] = {}
                 for off, fields, dpos, dlen in _walk_chunk(buf, rec.data_pos):
                     op = fields["op"][0]
@@ -361,7 +376,9 @@ def scan_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ros1L
                 pos = rec.end
                 continue
             if per:
-                chunks.append(_scanned_chunk(pos, compression, rec.data_pos, rec.data_len, per))
+                found = _scanned_chunk(pos, compression, rec.data_pos, rec.data_len, per)
+                found.size = usize
+                chunks.append(found)
         elif rec.op in (OP_INDEX, OP_CHUNK_INFO):
             flush()
         else:

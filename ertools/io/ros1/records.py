@@ -13,6 +13,9 @@ import struct
 from dataclasses import dataclass
 from typing import BinaryIO
 
+from ertools.errors import BagError
+from ertools.io import budget
+
 OP_MSG = 0x02
 OP_BAG_HEADER = 0x03
 OP_INDEX = 0x04
@@ -21,10 +24,6 @@ OP_CHUNK_INFO = 0x06
 OP_CONNECTION = 0x07
 
 MAGIC_LEN = 13  # b"#ROSBAG V2.0\n"
-
-# A header or data length larger than this is corruption, not a record (the biggest 2015
-# records are map chunks of a few MB).
-MAX_RECORD = 1 << 31
 
 _U32 = struct.Struct("<I")
 _U64 = struct.Struct("<Q")
@@ -97,20 +96,37 @@ class Record:
 
 
 def read_record(
-    f: BinaryIO, pos: int, file_size: int, *, with_data: bool = False
+    f: BinaryIO,
+    pos: int,
+    file_size: int,
+    *,
+    with_data: bool = False,
+    lazy_ops: frozenset[int] = frozenset(),
 ) -> tuple[Record, bytes]:
-    """The record at ``pos`` (data read only when ``with_data``).
+    """The record at ``pos`` (data read only when ``with_data``, and not for records whose op
+    is in ``lazy_ops``: a caller that reads a chunk's data later holds one at a time).
 
     Raises:
         RecordError: the record is cut off by the end of the file or malformed.
+        BagError: its header, or (``with_data``) its data, is over the budget
+            (:mod:`ertools.io.budget`).
     """
     f.seek(pos)
     raw = f.read(4)
     if len(raw) < 4:
         raise RecordError("record header length cut off by end of file", pos)
     (hlen,) = _U32.unpack(raw)
-    if hlen > MAX_RECORD or pos + 8 + hlen > file_size:
+    if pos + 8 + hlen > file_size:
         raise RecordError("record header cut off by end of file or absurd length", pos)
+    if hlen > budget.MAX_RECORD_HEADER_BYTES:
+        raise BagError(
+            budget.over_budget(
+                f"record at byte {pos}",
+                f"a header of {hlen} bytes",
+                budget.MAX_RECORD_HEADER_BYTES,
+                "MAX_RECORD_HEADER_BYTES",
+            )
+        )
     header = f.read(hlen)
     raw = f.read(4)
     if len(header) < hlen or len(raw) < 4:
@@ -124,6 +140,17 @@ def read_record(
         op = op_of(fields)
     except KeyError as err:
         raise RecordError("record header without op field", pos) from err
+    with_data = with_data and op not in lazy_ops
+    if with_data and dlen > budget.MAX_CHUNK_BYTES:
+        # a chunk's stored bytes are read whole (and other records are far smaller)
+        raise BagError(
+            budget.over_budget(
+                f"record at byte {pos}",
+                f"{dlen} bytes of data",
+                budget.MAX_CHUNK_BYTES,
+                "MAX_CHUNK_BYTES",
+            )
+        )
     data = f.read(dlen) if with_data else b""
     return Record(pos, op, fields, data_pos, dlen), data
 

@@ -194,5 +194,5 @@ def chunk_group(bag: IndexedBag, chunks: list[Ros1Chunk], scratch: list[Any]) ->
         data = pread(fd, chunk.data_len, chunk.data_pos)
         if len(data) != chunk.data_len:
             raise BagError(f"chunk at byte {chunk.pos} cut off by end of file", path=bag.path)
-        parts.append(decompress(chunk.compression, data, where))
+        parts.append(decompress(chunk.compression, data, chunk.size, where))
     return joined(parts, scratch)

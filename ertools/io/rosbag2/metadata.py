@@ -15,9 +15,12 @@ from typing import Any
 import numpy as np
 import yaml
 
+from ertools import yamlin
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
-from ertools.io.formats import metadata_problem
+from ertools.inputs import check_regular, open_regular, why_not
+from ertools.io.formats import load_metadata, metadata_problem
+from ertools.io.inflate import inflate_file
 from ertools.io.model import Conn
 
 ROWS_PER_BATCH = 100_000
@@ -26,13 +29,12 @@ ROWS_PER_BATCH = 100_000
 def read_metadata(path: Path) -> dict[str, Any]:
     """``rosbag2_bagfile_information`` of a rosbag2 directory."""
 
-    meta = path / "metadata.yaml"
     try:
-        data = yaml.safe_load(meta.read_text(encoding="utf-8"))
+        data = load_metadata(path)
         info = data["rosbag2_bagfile_information"]
     except OSError as err:
-        raise BagError(f"unreadable metadata.yaml ({err.strerror or err})", path=path) from err
-    except (yaml.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
+        raise BagError(f"unreadable metadata.yaml ({why_not(err)})", path=path) from err
+    except (yamlin.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
         raise BagError(f"unreadable metadata.yaml ({metadata_problem(err)})", path=path) from err
     if not isinstance(info, dict):
         raise BagError("metadata.yaml has no rosbag2_bagfile_information", path=path)
@@ -67,6 +69,14 @@ def file_compression(info: dict[str, Any]) -> str | None:
     return fmt if mode == "file" and fmt else None
 
 
+def message_compression(info: dict[str, Any]) -> str | None:
+    """The compression of each message (``compression_mode: message``), None when messages
+    are stored as they are (or the files are compressed whole)."""
+    mode = str(info.get("compression_mode") or "").lower()
+    fmt = str(info.get("compression_format") or "").lower()
+    return fmt if mode == "message" and fmt else None
+
+
 def readable_files(path: Path, info: dict[str, Any] | None = None) -> list[Path]:
     """The storage files of a rosbag2 directory as files a reader can open: those listed, or
     for a bag compressed file by file, their decompressed copies in a temporary folder of
@@ -93,11 +103,13 @@ def readable_files(path: Path, info: dict[str, Any] | None = None) -> list[Path]
 
 def readable_dir(path: Path) -> Path:
     """The rosbag2 directory as a reader that opens a whole directory (rosbags) should see it:
-    ``path`` itself, or for a bag compressed file by file a directory of this process's
-    temporary folder holding links to :func:`readable_files`' copies and the metadata without
-    the file compression. The decompression is that of :func:`readable_files`, done once."""
+    ``path`` itself, or for a compressed bag a directory of this process's temporary folder
+    holding links to :func:`readable_files` (the copies of files compressed whole) and the
+    metadata without the compression: the caller decompresses messages compressed one by one
+    (:func:`message_compression`) itself, within the budget. A file's decompression is that
+    of :func:`readable_files`, done once."""
     info = read_metadata(path)
-    if file_compression(info) is None:
+    if file_compression(info) is None and message_compression(info) is None:
         return path
     files = readable_files(path, info)
     key = (f"dir:{path.resolve()}", len(files), 0)
@@ -107,7 +119,7 @@ def readable_dir(path: Path) -> Path:
     out = _scratch() / f"bag{len(_DECOMPRESSED)}"
     out.mkdir(parents=True, exist_ok=True)
     for f in files:
-        (out / f.name).symlink_to(f)
+        (out / f.name).symlink_to(f.resolve())
     plain = dict(info, compression_format="", compression_mode="")
     plain["relative_file_paths"] = [f.name for f in files]
     listed = info.get("files")
@@ -128,23 +140,29 @@ def _decompressed(file: Path) -> Path:
     done = _DECOMPRESSED.get(key)
     if done is not None and done.exists():
         return done
-    import zstandard  # lazy: a decompressor only for file-compressed rosbag2 storage
-
     name = file.name[: -len(".zstd")] if file.name.endswith(".zstd") else file.name
     out = _scratch() / str(len(_DECOMPRESSED)) / name
     out.parent.mkdir(parents=True, exist_ok=True)
     try:
-        with file.open("rb") as src, out.open("wb") as dst:
-            zstandard.ZstdDecompressor().copy_stream(src, dst)
-    except (OSError, zstandard.ZstdError) as err:
+        with open_regular(file) as src, out.open("wb") as dst:
+            inflate_file("zstd", src, dst, st.st_size, "")
+    except OSError as err:
         out.unlink(missing_ok=True)
-        raise BagError(f"damaged zstd-compressed storage file ({err})", path=file) from err
+        raise BagError(f"cannot read storage file: {why_not(err)}", path=file) from err
+    except BagError as err:
+        out.unlink(missing_ok=True)
+        raise BagError(err.message, path=file) from err
     _DECOMPRESSED[key] = out
     return out
 
 
 def _connect(db: Path) -> sqlite3.Connection:
-    # Read-only: an input file is never modified (not even a journal is created).
+    # Read-only: an input file is never modified (not even a journal is created). sqlite
+    # opens the path itself: a named pipe there would block it, so the type is checked first.
+    try:
+        check_regular(db)
+    except OSError as err:
+        raise sqlite3.OperationalError(f"unable to open database file: {why_not(err)}") from err
     return sqlite3.connect(f"{db.resolve().as_uri()}?mode=ro", uri=True)
 
 

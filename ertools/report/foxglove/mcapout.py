@@ -6,7 +6,7 @@ import os
 from collections.abc import Sequence
 from pathlib import Path
 
-from ertools import __version__
+from ertools import __version__, atomic
 from ertools.errors import UsageError
 from ertools.report.foxglove.messages import Collected
 
@@ -36,29 +36,26 @@ def write_mcap(out: Collected, path: Path) -> None:
 
     order = sorted(range(len(out.messages)), key=lambda i: out.messages[i][0])
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.part")
-    try:
-        with tmp.open("wb") as f:
-            w = Writer(f)
-            w.start(profile="", library=f"ertools {__version__}")
-            schema_ids: dict[str, int] = {}
-            channel_ids: dict[str, int] = {}
-            for topic, ch in out.channels.items():
-                if ch.schema_name not in schema_ids:
-                    schema_ids[ch.schema_name] = w.register_schema(
-                        ch.schema_name, ch.schema_encoding, ch.schema_data
-                    )
-                channel_ids[topic] = w.register_channel(
-                    topic, ch.message_encoding, schema_ids[ch.schema_name]
+    # a temporary of a unique name (ertools.atomic): a name chosen in advance follows a symlink
+    # planted there, and two exports at once would write into the same file
+    with atomic.replacing(path) as tmp, tmp.open("r+b") as f:
+        w = Writer(f)
+        w.start(profile="", library=f"ertools {__version__}")
+        schema_ids: dict[str, int] = {}
+        channel_ids: dict[str, int] = {}
+        for topic, ch in out.channels.items():
+            if ch.schema_name not in schema_ids:
+                schema_ids[ch.schema_name] = w.register_schema(
+                    ch.schema_name, ch.schema_encoding, ch.schema_data
                 )
-            sequence: dict[str, int] = {}
-            for i in order:
-                t, topic, data = out.messages[i]
-                seq = sequence[topic] = sequence.get(topic, -1) + 1
-                w.add_message(channel_ids[topic], t, data, t, seq)
-            if out.metadata:
-                w.add_metadata("ertools", dict(out.metadata))
-            w.finish()  # type: ignore[no-untyped-call]
-        tmp.replace(path)
-    finally:
-        tmp.unlink(missing_ok=True)
+            channel_ids[topic] = w.register_channel(
+                topic, ch.message_encoding, schema_ids[ch.schema_name]
+            )
+        sequence: dict[str, int] = {}
+        for i in order:
+            t, topic, data = out.messages[i]
+            seq = sequence[topic] = sequence.get(topic, -1) + 1
+            w.add_message(channel_ids[topic], t, data, t, seq)
+        if out.metadata:
+            w.add_metadata("ertools", dict(out.metadata))
+        w.finish()  # type: ignore[no-untyped-call]

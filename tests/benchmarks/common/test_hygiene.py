@@ -7,12 +7,15 @@ import numpy as np
 
 from ertools.benchmarks.common.hygiene import (
     drop_duplicates,
+    drop_invalid,
     drop_repeats,
     identical_poses,
+    impossible_samples,
     repeated_positions,
     rows_equal,
     same_rows,
 )
+from ertools.benchmarks.common.validity import FAR, JUMP, sample_codes
 from ertools.streams import PoseStream
 
 T0 = 1_448_013_600 * 1_000_000_000
@@ -62,3 +65,103 @@ def test_rows_equal_is_np_all_including_nan() -> None:
     i = rng.integers(0, 500, size=300)
     j = rng.integers(0, 500, size=300)
     assert np.array_equal(same_rows(a, i, j), np.all(a[i] == a[j], axis=1))
+
+
+# --- physically impossible samples (issue 36, finding 5) ------------------------------------
+
+
+def _walk(n: int, speed: float, dt: int = DT, seed: int = 3) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` samples of a body driving along x at ``speed`` m/s, with 1 mm of mocap noise."""
+    t = T0 + dt * np.arange(n, dtype=np.int64)
+    rng = np.random.default_rng(seed)
+    x = speed * (t - T0) / 1e9
+    xyz = np.column_stack([x, np.zeros(n), np.zeros(n)]) + rng.normal(0, 0.001, (n, 3))
+    return t, xyz
+
+
+def test_a_fast_robot_is_possible() -> None:
+    """4 m/s (over twice the fastest robot of the leagues), 120 Hz, with noise: nothing."""
+    t, xyz = _walk(1200, 4.0)
+    found = impossible_samples(t, xyz)
+    assert found.count == 0 and found.steps == ()
+
+
+def test_a_one_frame_spike_of_one_metre_is_a_jump() -> None:
+    t, xyz = _walk(1200, 0.5)
+    xyz[600, 1] += 1.0
+    found = impossible_samples(t, xyz)
+    assert np.flatnonzero(found.jump).tolist() == [600] and not found.far.any()
+    assert found.steps == ()
+
+
+def test_an_excursion_and_the_repeats_inside_it_are_left_out() -> None:
+    """Mistaken for another body for 0.3 s (36 frames), Motive re-sending its pose 5 times
+    there: all 36 out; the way back lands where the body had got to, so the rest stays."""
+    t, xyz = _walk(1200, 0.5)
+    xyz[500:536] += np.array([3.0, -2.0, 0.0])
+    xyz[510:515] = xyz[509]
+    found = impossible_samples(t, xyz)
+    assert np.flatnonzero(found.jump).tolist() == list(range(500, 536))
+
+
+def test_a_step_that_stays_is_said_not_dropped() -> None:
+    """Half the log 2 m away from the other half: which half is wrong cannot be told."""
+    t, xyz = _walk(1200, 0.2)
+    xyz[700:] += np.array([0.0, 2.0, 0.0])
+    found = impossible_samples(t, xyz)
+    assert found.count == 0
+    assert len(found.steps) == 1 and found.steps[0].t_ns == int(t[700])
+    # 2 m in one frame: 240 m/s; by hand 2 + 0.2/120 along x (the hypotenuse) ~ 2.0000007
+    assert abs(found.steps[0].distance_m - 2.0) < 0.01
+    assert abs(found.steps[0].speed_m_s - found.steps[0].distance_m * 120) < 1.0
+
+
+def test_tracking_regained_after_a_loss_is_no_jump() -> None:
+    """Motive repeats the last pose while the body is lost (1 s, moving 0.5 m meanwhile); the
+    first new pose is 0.5 m from the repeats one frame later, but 1 s after the last
+    measurement: 0.5 m/s."""
+    t, xyz = _walk(1200, 0.5)
+    xyz[400:520] = xyz[399]
+    assert impossible_samples(t, xyz).count == 0
+
+
+def test_stamp_jitter_is_no_jump() -> None:
+    """Two samples 10 microseconds apart (a logger's burst), 2 mm apart: 200 m/s by their
+    stamps, but below JUMP_MIN_M and measured over at least a frame period."""
+    t, xyz = _walk(1200, 0.2)
+    t[301] = t[300] + 10_000
+    assert impossible_samples(t, xyz).count == 0
+
+
+def test_far_and_beyond_any_frame() -> None:
+    t, xyz = _walk(1200, 0.2)
+    xyz[10] = [1e300, 0.0, 0.0]
+    xyz[20] = [0.0, 5000.0, 0.0]
+    xyz[30] = [np.nan, 0.0, 0.0]  # not finite: invalid already, neither far nor a jump
+    found = impossible_samples(t, xyz)
+    assert np.flatnonzero(found.far).tolist() == [10, 20]
+    assert not found.jump.any()
+
+
+def test_a_frame_far_from_its_origin_is_possible() -> None:
+    """A consistent stream 4e6 m from its origin (a UTM frame): the median is there too."""
+    t, xyz = _walk(1200, 0.5)
+    assert impossible_samples(t, xyz + np.array([4e6, 5e6, 0.0])).count == 0
+
+
+def test_a_robot_estimate_may_jump() -> None:
+    t, xyz = _walk(120, 0.5, dt=100_000_000)  # 10 Hz
+    xyz[60, 0] += 1.0
+    assert impossible_samples(t, xyz, jumps=False).count == 0
+    assert impossible_samples(t, xyz).count == 1
+
+
+def test_drop_invalid_and_the_validity_codes_agree() -> None:
+    t, xyz = _walk(1200, 0.5)
+    xyz[100] = [1e300, 0, 0]
+    xyz[600, 1] += 1.0
+    quat = np.tile([0.0, 0.0, 0.0, 1.0], (1200, 1))
+    kept, dropped = drop_invalid(PoseStream(t, xyz, quat))
+    assert dropped == 2 and len(kept) == 1198
+    codes = sample_codes(t, xyz, quat).codes
+    assert codes[100] == FAR and codes[600] == JUMP and int(np.count_nonzero(codes)) == 2

@@ -61,7 +61,8 @@ def test_sample_codes_by_hand() -> None:
 def test_a_sample_recorded_twice_stays_valid() -> None:
     t = T0 + DT * np.arange(4, dtype=np.int64)
     t[2] = t[1]
-    xyz = np.column_stack([np.arange(4.0), np.zeros(4), np.zeros(4)])
+    # 1 cm a frame (1.2 m/s): a robot's pace (a metre a frame would be impossible: a jump)
+    xyz = np.column_stack([0.01 * np.arange(4.0), np.zeros(4), np.zeros(4)])
     xyz[2] = xyz[1]  # same stamp, same pose: a second logger's copy
     assert sample_codes(t, xyz).codes.tolist() == [VALID] * 4
 
@@ -180,4 +181,6 @@ def test_reason_names_are_the_contract() -> None:
         "nan",
         "clock_jump",
         "occluded",
+        "far",
+        "jump",
     )

@@ -1,27 +1,21 @@
-"""``--rules 2015`` on every path of the 2015 FBM1 node, against its loop run as written.
+"""``--rules 2015/2016/2017`` on every path of the FBM1 nodes, against their loops run as written.
 
-:func:`fbm1_2015` is ``main()`` of ``scripts/fbm1h`` (rockin-robot-challenge/
-benchmark_and_scoring_fbm at 117a5d0) statement by statement, over the 2015 BmBox replayed from
-the log (``tests/bmbox2015.py``): ``WaitClient()`` (line 47); ``while Running() and runs <
-BENCHMARK_RUNS`` (50); ``runs = runs + 1`` (51); ``ManualOperation`` (59) and the two ``if not
-Running(): break`` (61, 65); ``SendGoal`` (82), ``start_time`` (83), ``WaitResult`` (86),
-``end_time`` (87); ``if Timeout(): execution_time += ...; continue`` (89-92); ``if not
-Running(): continue`` (94-96); the answer, the class and instance ``==`` (107-113), the
-lookup of /item in /origin at the node's ``now`` (117-125; the stamp of its item broadcast on
-/tf), the one-step theta wrap (132-133), the translation term set to 1 only above sqrt(2) m
-(147), the rotation clip, ``pose_score_sum`` (153), the time (158); every total over ``runs``
-(164-166). ``scripts/fbm1w`` (svenschneider's copy at 6fa9eb7) differs in two statements:
-``while benchmark.Running():`` with no run cap, and the item is the one the RefBox payload
-returned by ``ManualOperation()`` names.
+The nodes (``node_fbm1.py``, each ported statement by statement from its commit, over the
+BmBox replayed from the log, ``tests/bmbox2015.py``): ``scripts/fbm1h`` at e373be0 (RoCKIn 2015
+Lisbon, ``--rules 2015``), ``scripts/fbm1w`` at 7628309 (RoCKIn 2015 Lisbon, ``--rules 2015``),
+``scripts/fbm1h`` at 40ba68b (the Lisbon 2016 second local competition, ``--rules 2016``) and
+at 89dfa75 (the Lisbon 2017 major tournament, ``--rules 2017``).
 
 The logs are generated with the samples' writer, one per path: a normal benchmark of 10
-runs, a timeout (the 10th run: the node's loop ends by its count), a RefBox stop while the
-robot works and one during the manual operation, the seed's bare ``timeout`` / ``halt`` (no
-string BmBox.py compares: the BmBox waits on for the robot), an END payload no 2015 code knew,
-and the log cut inside every phase of a run. The rule for a cut (issue 23):
-the benchmark stopped there. ertools' ``--rules 2015`` must equal the replay to 1e-12
-(relative), field for field; the default must score every one of these logs (exit 0, numbers,
-the deviations said).
+runs; a RefBox timeout at the 10th run (the loop ends by its count) and at the 7th (the node goes
+on: its next manual operation waits until the log ends); a RefBox stop while the robot works and
+one during the manual operation; the seed's bare ``timeout`` / ``halt`` (no string BmBox.py
+compares: the BmBox waits on for the robot); an END payload no 2015 code knew; the log cut
+inside every phase of a run. The rule for a cut (issue 23): the benchmark stopped there. Each
+node's logs carry its item broadcasts where it made them (2015: after the answer; 2016-17:
+after the placement). ertools' ``--rules`` must equal the replay to 1e-12 (relative), field
+for field; the default must score every one of these logs (exit 0, numbers, the deviations
+said).
 """
 
 from __future__ import annotations
@@ -35,9 +29,9 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from bmbox2015 import BmBoxReplay
+from node_fbm1 import VERSIONS, fbm1_node
 from scipy.spatial.transform import Rotation
-from test_fbm1_nodes import Log, read_log, tf_lookup
+from test_fbm1_nodes import read_log, tf_lookup
 
 from ertools.cli.main import main
 from ertools.samples.mocap import MocapNoise, publish_mocap, simulate_mocap
@@ -64,100 +58,6 @@ ITEMS = [
     }
     for k in range(BENCHMARK_RUNS)
 ]
-
-
-# ----------------------------------------------------------------------------- the node
-
-
-def fbm1_2015(log: Log, ns: str = "fbm1h") -> dict[str, Any]:
-    """``main()`` of scripts/fbm1h at 117a5d0 (or scripts/fbm1w, ``ns="fbm1w"``) over the
-    replayed BmBox (see the module docstring)."""
-    benchmark = BmBoxReplay(log.states["bmbox"], log.states["refbox"], log.states["client"])
-    items = {i["id"]: i for i in ITEMS}
-    runs = 0
-    class_positives = 0.0
-    instance_positives = 0.0
-    pose_score_sum = 0.0
-    execution_time = 0.0
-    max_pose_error = math.sqrt(math.pow(1, 2) + math.pow(1, 2))
-    per_run: dict[int, dict[str, Any]] = {}
-    benchmark.WaitClient()
-    while benchmark.Running() and (ns == "fbm1w" or runs < BENCHMARK_RUNS):
-        runs = runs + 1
-        per_run[runs] = {"status": "aborted"}
-        goals_before = benchmark.goals
-        item_instance = benchmark.ManualOperation()
-        if ns == "fbm1w":
-            if not benchmark.Running():
-                break
-            item = [x for x in ITEMS if x["instance"] == item_instance][0]  # noqa: RUF015 (as written)
-        else:
-            # random.choice(items) is in the log: the payload the node wrote with its choice
-            item = items[int(benchmark.manual_message.split()[2])]
-        if not benchmark.Running():
-            break
-        if not benchmark.Running():
-            break
-        benchmark.SendGoal()
-        runs_goals = benchmark.goals
-        start_time = benchmark.now
-        result_yaml = benchmark.WaitResult()
-        end_time = benchmark.now
-        # The goal is in the log (BmBox TRANSMITTING_GOAL) or the benchmark stopped before it.
-        per_run[runs] = {"status": "no_answer" if runs_goals > goals_before else "aborted"}
-        if benchmark.Timeout():
-            execution_time = execution_time + (end_time - start_time) / 1e9
-            continue
-        if not benchmark.Running():
-            continue
-        assert result_yaml is not None
-        result = yaml.safe_load(result_yaml)
-        c_ok = result["item_class"] == item["class"]
-        i_ok = result["item_instance"] == item["instance"]
-        if c_ok:
-            class_positives = class_positives + 1
-        if i_ok:
-            instance_positives = instance_positives + 1
-        # now = rospy.Time.now(): the stamp of the node's item broadcast that follows
-        now = next(t for t in log.item_stamps if t > start_time)
-        benchmark.sleep(0.5)  # line 119
-        benchmark.sleep(0.5)  # line 121
-        x, y, yaw = tf_lookup(log, item, now)
-        x_err = result["x"] - x
-        y_err = result["y"] - y
-        w_err = result["theta"] - yaw
-        if w_err > 180:
-            w_err = w_err - 360
-        if w_err < -180:
-            w_err = w_err + 360
-        pose_err_trans = math.sqrt(math.pow(x_err, 2) + math.pow(y_err, 2))
-        if pose_err_trans > max_pose_error:
-            pose_err_trans = 1
-        pose_err_rot = abs(w_err) / 180
-        if pose_err_rot > 1:  # noqa: PLR1730 (the node's own statement)
-            pose_err_rot = 1
-        pose_score = 1 - (pose_err_trans / 2) - (pose_err_rot / 2)
-        pose_score_sum = pose_score_sum + pose_score
-        execution_time = execution_time + (end_time - start_time) / 1e9
-        per_run[runs] = {
-            "status": "scored",
-            "gt": (x, y, yaw),
-            "err": (x_err, y_err, w_err),
-            "class_ok": c_ok,
-            "instance_ok": i_ok,
-            "pose_score": pose_score,
-            "execution_time": (end_time - start_time) / 1e9,
-        }
-    return {
-        "score": {
-            "class_accuracy": class_positives / runs,
-            "instance_accuracy": instance_positives / runs,
-            "pose_score": pose_score_sum / runs,
-            "execution_time": execution_time,
-        },
-        "runs": per_run,
-        "cut": benchmark.cut_at is not None,
-    }
 
 
 # ----------------------------------------------------------------------------- the logs
@@ -203,12 +103,19 @@ def _board(k: int) -> tuple[float, float, float]:
     return 0.3 + 0.02 * k, 0.2 + 0.01 * (k % 3), -2.9 + 0.6 * k
 
 
-def write_case(path: Path, case: Case, ns: str = NS, named_while: str = "both") -> Path:
+def write_case(
+    path: Path, case: Case, ns: str = NS, named_while: str = "both", node: str = "2015"
+) -> Path:
     """The log of ``case``: state topics, 60 Hz mocap of table and board (pose topics and /tf,
-    as the 2015 mocap node), the node's item broadcasts on /tf. At @Work (``ns="fbm1w"``) the
-    RefBox names the item (its payload while it executes the manual operation and the goal),
-    the BmBox's manual operation has none; ``named_while="goal"``: only in the EXECUTING_GOAL
-    that confirms the placement (what ``ManualOperation()`` returned to the 2015 node)."""
+    as the 2015 mocap node), the node's item broadcasts on /tf (``node`` 2015: after the answer;
+    2016 or 2017: after the placement). At @Work (``ns="fbm1w"``) the RefBox names the item
+    (its payload while it executes the manual operation and the goal), the BmBox's manual
+    operation has none; ``named_while="goal"``: only in the EXECUTING_GOAL that confirms the
+    placement (what ``ManualOperation()`` returned to the 2015 node)."""
+
+    def at(k: int, s: float) -> int:
+        return T0 + round((3 + RUN_S * k + s) * S)
+
     tr = [
         Transition(T0 + S // 2, Machine.BMBOX, BmBoxState.START),
         Transition(T0 + S // 2, Machine.REFBOX, RefBoxState.START),
@@ -220,6 +127,7 @@ def write_case(path: Path, case: Case, ns: str = NS, named_while: str = "both") 
         Transition(T0 + 2 * S + S // 2, Machine.CLIENT, ClientState.WAITING_GOAL),
     ]
     casts: list[tuple[int, dict[str, Any]]] = []
+    cut_ns = None if case.cut is None else at(case.cut[0], CUT_AT[case.cut[1]])
     rng = np.random.default_rng(len(case.outcomes) * 31 + len(tr))
     table_xyz, r_t = np.array([1.0, 2.0, 0.7]), Rotation.from_euler("z", 0.3)
     n_runs = len(case.outcomes)
@@ -227,9 +135,6 @@ def write_case(path: Path, case: Case, ns: str = NS, named_while: str = "both") 
     t = T0 + np.arange(0, end_s * RATE_HZ) * (S // RATE_HZ)
     secs = (t - T0) / S
     rel = np.tile([-0.5, -0.5, 0.0, 0.0], (t.size, 1))  # the board off the table between runs
-
-    def at(k: int, s: float) -> int:
-        return T0 + round((3 + RUN_S * k + s) * S)
 
     for k, outcome in enumerate(case.outcomes):
         bx, by, byaw = _board(k)
@@ -267,12 +172,28 @@ def write_case(path: Path, case: Case, ns: str = NS, named_while: str = "both") 
             Transition(at(k, EG), Machine.BMBOX, BmBoxState.EXECUTING_GOAL),
             Transition(at(k, WR), Machine.BMBOX, BmBoxState.WAITING_RESULT),
         ]
-        if outcome in ("timeout", "stop"):
+        if node != "2015":
+            casts.append((at(k, CMO) + 7 * MS, item))
+        if outcome in ("timeout", "stop", "timeout-wait"):
             tr += [
                 Transition(at(k, 2.4), Machine.REFBOX, RefBoxState.END, case.end_payload),
                 Transition(at(k, 2.4) + 30 * MS, Machine.CLIENT, ClientState.END),
                 Transition(at(k, 2.4) + 50 * MS, Machine.BMBOX, BmBoxState.READY),
             ]
+            if outcome == "timeout-wait":
+                # The node goes on (Running() is true): its next manual operation waits for a
+                # RefBox that has ended, until the log ends.
+                nxt = ITEMS[(3 * (k + 1) + 1) % BENCHMARK_RUNS]
+                text = f"Place item {nxt['id']} ({nxt['instance']}) on the table"
+                tr.append(
+                    Transition(
+                        at(k + 1, WMO),
+                        Machine.BMBOX,
+                        BmBoxState.WAITING_MANUAL_OPERATION,
+                        "" if ns == "fbm1w" else text,
+                    )
+                )
+                cut_ns = at(k + 1, CUT_AT["WMO"])
             break
         if outcome == "unknown":  # an END the BmBox did not understand: it waits on
             tr.append(Transition(at(k, 2.4), Machine.REFBOX, RefBoxState.END, case.end_payload))
@@ -295,13 +216,14 @@ def write_case(path: Path, case: Case, ns: str = NS, named_while: str = "both") 
             Transition(at(k, DONE), Machine.BMBOX, BmBoxState.READY),
             Transition(at(k, DONE) + 40 * MS, Machine.CLIENT, ClientState.WAITING_GOAL),
         ]
-        casts.append((at(k, DONE) + 7 * MS, item))
+        if node == "2015":
+            casts.append((at(k, DONE) + 7 * MS, item))
     last = max(x.t_ns for x in tr)
-    tr += [
-        Transition(last + S // 2, Machine.BMBOX, BmBoxState.TRANSMITTING_SCORE, "{}"),
-        Transition(last + S, Machine.BMBOX, BmBoxState.END),
-    ]
-    cut_ns = None if case.cut is None else at(case.cut[0], CUT_AT[case.cut[1]])
+    if cut_ns is None:
+        tr += [
+            Transition(last + S // 2, Machine.BMBOX, BmBoxState.TRANSMITTING_SCORE, "{}"),
+            Transition(last + S, Machine.BMBOX, BmBoxState.END),
+        ]
     keep = t <= (cut_ns if cut_ns is not None else t[-1])
     xyz_w = np.array([_world(table_xyz, r_t, x, y) for x, y in rel[:, :2]])
     xyz_w[:, 2] += rel[:, 2]
@@ -352,6 +274,7 @@ CASES: dict[str, Case] = {
     # The seed's bare words (6.2.3) are neither string BmBox.py compares: its BmBox waited on
     # for the robot, as for any END it did not know (lines 49-55).
     "timeout-seed-form": Case(("answer",) * 9 + ("unknown",), end_payload="timeout"),
+    "timeout-then-waits": Case(("answer",) * 6 + ("timeout-wait",), end_payload="reason: timeout"),
     "stop-during-goal": Case(("answer",) * 5 + ("stop",), end_payload="reason: stop"),
     "halt-seed-form": Case(("answer",) * 9 + ("unknown",), end_payload="halt"),
     "stop-during-manual-operation": Case(
@@ -364,17 +287,18 @@ CASES: dict[str, Case] = {
     },
 }
 # scripts/fbm1w has no run cap (``while benchmark.Running():``): its benchmark ends when the
-# RefBox stops it, the last run counted while waiting for its manual operation. A RefBox timeout
-# or an END it did not know leaves it waiting for the next manual operation forever (the RefBox
-# stops publishing at END): no 2015 score to compare with, so no such case here.
+# RefBox stops it, the last run counted while waiting for its manual operation. After a RefBox
+# timeout, or an END it did not know, it waits for the next manual operation until the log
+# ends; the 10th run is not the last for it, so those cases end at the 7th run here.
 CASES_1W = {
     name: Case((*FULL, "stop-manual"), end_payload="reason: stop") if name == "normal" else case
     for name, case in CASES.items()
-    if not name.startswith(("timeout", "unknown", "halt"))
+    if name == "timeout-then-waits" or not name.startswith(("timeout", "unknown", "halt"))
 }
 # Under --rules 2015 these END payloads are none of the two strings: warned about.
 UNKNOWN_2015 = ("unknown-end-payload", "timeout-seed-form", "halt-seed-form")
-PATHS = [("fbm1h", n) for n in CASES] + [("fbm1w", n) for n in CASES_1W]
+# (node version of node_fbm1.VERSIONS, case): every case at every version of each script.
+PATHS = [(v, n) for v in ("2015", "2016", "2017") for n in CASES] + [("2015w", n) for n in CASES_1W]
 
 
 def _score(
@@ -393,16 +317,25 @@ def _close(got: float, want: float) -> bool:
     return got == pytest.approx(want, rel=REL, abs=1e-15)
 
 
-@pytest.mark.parametrize(("ns", "name"), PATHS)
-def test_rules_2015_is_the_node_on_every_path(
-    ns: str, name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+def _run_node(bag: Path, version: str) -> dict[str, Any]:
+    ns = VERSIONS[version][0]
+    log = read_log(bag, ns)
+    return fbm1_node(
+        log.states, ITEMS, log.item_stamps, lambda item, t: tf_lookup(log, item, t), version
+    )
+
+
+@pytest.mark.parametrize(("version", "name"), PATHS)
+def test_rules_are_the_node_on_every_path(
+    version: str, name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
+    ns = VERSIONS[version][0]
     case = (CASES_1W if ns == "fbm1w" else CASES)[name]
-    bag = write_case(tmp_path / f"{name}.bag", case, ns)
+    bag = write_case(tmp_path / f"{name}.bag", case, ns, node=version.rstrip("w"))
     items = tmp_path / "items.yaml"
     items.write_text(yaml.safe_dump({"items": ITEMS}), encoding="utf-8")
-    node = fbm1_2015(read_log(bag, ns), ns)
-    data, err = _score(bag, items, ["--rules", "2015"], capsys, ns)
+    node = _run_node(bag, version)
+    data, err = _score(bag, items, ["--rules", version.rstrip("w")], capsys, ns)
     for key, want in node["score"].items():
         assert _close(data[key], want), (key, data[key], want)
     assert len(data["runs"]) == len(node["runs"]), "every run the node counted, no other"
@@ -446,10 +379,9 @@ def test_the_paths_give_the_numbers_issue_23_names(
     items = tmp_path / "items.yaml"
     items.write_text(yaml.safe_dump({"items": ITEMS}), encoding="utf-8")
     got = {}
-    ns = NS
     for name in ("stop-during-goal", "cut-in-WR", "cut-in-WMO"):
         bag = write_case(tmp_path / f"{name}.bag", CASES[name])
-        node = fbm1_2015(read_log(bag, ns), ns)
+        node = _run_node(bag, "2015")
         assert len(node["runs"]) == 6, name
         got[name] = node["score"]
         data, _ = _score(bag, items, ["--rules", "2015"], capsys)
@@ -472,7 +404,7 @@ def test_fbm1w_item_is_what_manual_operation_returned(
     items = tmp_path / "items.yaml"
     items.write_text(yaml.safe_dump({"items": ITEMS}), encoding="utf-8")
     bag = write_case(tmp_path / "w.bag", CASES_1W["normal"], "fbm1w", named_while="goal")
-    node = fbm1_2015(read_log(bag, "fbm1w"), "fbm1w")
+    node = _run_node(bag, "2015w")
     data, _ = _score(bag, items, ["--rules", "2015"], capsys, "fbm1w")
     assert [r["status"] for r in data["runs"].values()] == ["scored"] * 10 + ["aborted"]
     for key, want in node["score"].items():

@@ -4,7 +4,8 @@ The nodes are re-implemented here from their code, independently of ertools: the
 with rosbags, the node's loop is replayed over the logged state messages, and tf's lookup is
 done by hand (linear position, slerp rotation at the moment, 4x4 matrices, yaw as
 ``euler_from_quaternion``). The two nodes (``scripts/fbm1h`` and ``scripts/fbm1w`` of
-rockin-robot-challenge/benchmark_and_scoring_fbm, 2015 at 117a5d0, 2016-17 at 40ba68b):
+rockin-robot-challenge/benchmark_and_scoring_fbm, 2015 at e373be0 (117a5d0's scoring), 2016 at
+40ba68b; the 2017 node, 89dfa75, is 40ba68b with the translation clipped at 1 m):
 
 - ``runs = runs + 1`` before the manual operation; ``break`` when the benchmark stopped then
   (an aborted run counts in ``runs``); a timed-out run adds its time and ``continue``s; a stopped
@@ -336,8 +337,8 @@ def test_sample_rules_2016_is_the_later_node(capsys: pytest.CaptureFixture[str])
     ref = node(log, items, rules="2016", benchmark="fbm1h")
     data, err = ertools_score(bag, SAMPLE / "fbm1h.yaml", "fbm1h", ["--2016"], capsys)
     assert_same(data, ref)
-    assert data["reference"].startswith("2016-17 @Home node")
-    assert "reproducing: 2016-17 @Home node" in err
+    assert data["reference"].startswith("2016 @Home node")
+    assert "reproducing: 2016 @Home node" in err
     # The two lookup moments see different mocap samples: the test tells them apart.
     ref15 = node(log, items, rules="2015", benchmark="fbm1h")
     assert abs(ref15["runs"][1]["gt"][0] - ref["runs"][1]["gt"][0]) > 1e-6
@@ -352,9 +353,15 @@ def test_sample_rules_2016_is_the_later_node(capsys: pytest.CaptureFixture[str])
         "--unscoreable",
         "2015",
         "--accuracy-over-10",
+        "--exact-end-payloads",
     ]
     data2, _ = ertools_score(bag, SAMPLE / "fbm1h.yaml", "fbm1h", single, capsys)
     assert data2 == data
+    # 2017 (89dfa75): the same but the translation term clipped at 1 m, ertools' own clip.
+    data3, _ = ertools_score(bag, SAMPLE / "fbm1h.yaml", "fbm1h", ["--rules", "2017"], capsys)
+    single.remove("--clip-above-diagonal")
+    data4, _ = ertools_score(bag, SAMPLE / "fbm1h.yaml", "fbm1h", single, capsys)
+    assert data3["reference"].startswith("2017 @Home node") and data4 == data3
 
 
 # ----------------------------------------------------------------------------- FBM1H precision
@@ -616,7 +623,7 @@ def test_old_spellings_still_work_and_say_what_they_mean(
     items_path = tmp_path / "items.yaml"
     items_path.write_text(ITEMS, encoding="utf-8")
     old_flags = ["--legacy-clip", "--legacy-wrap", "--legacy-names", "--legacy-totals"]
-    given = ["--gt", "placed", *old_flags, "--score-unscoreable"]
+    given = ["--gt", "placed", *old_flags, "--score-unscoreable", "--exact-end-payloads"]
     old, err = ertools_score(bag, items_path, "fbm1h", given, capsys)
     for flag in old_flags:
         assert f"ertools: note: {flag} is deprecated, use --" in err
@@ -635,7 +642,7 @@ def test_rules_2016_at_work_is_a_usage_error(
     code = main(["score", "fbm1w", str(bag), "--items", str(items_path), "--rules", "2016"])
     out, err = capsys.readouterr()
     assert code == 2 and out == ""
-    assert err.count("\n") == 1 and "no 2016-17 FBM1@Work node" in err
+    assert err.count("\n") == 1 and "no 2016 FBM1@Work node" in err
 
 
 def test_edge_cases_rules_2016_uses_the_logged_broadcast(

@@ -134,7 +134,7 @@ def test_items_order_overrides_and_warns_on_count() -> None:
 
 def test_log_cut_during_a_run_is_the_run_stopped_there() -> None:
     """Issue 23: a log that ends inside the benchmark is the benchmark stopped there, what the
-    2015 node did on a RefBox stop (fbm1h at 117a5d0 lines 94-96: ``if not Running():
+    2015 node did on a RefBox stop (fbm1h at e373be0 lines 94-96: ``if not Running():
     continue``, the run already counted in ``runs``): no answer, score 0, no time."""
 
     runs = [

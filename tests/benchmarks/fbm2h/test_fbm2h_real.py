@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 import yaml
 from rosbags.highlevel import AnyReader
+from scipy.spatial.transform import Rotation, Slerp
 from stderr_text import error_messages
 
 from ertools.cli.main import main
@@ -218,3 +219,48 @@ def test_real_bag_pose2d_topic(real: dict[str, Any], capsys: pytest.CaptureFixtu
         assert segs[str(k)]["dinstance_error"] == pytest.approx(
             math.hypot(x - target[0], y - target[1]), abs=2e-4
         )
+
+
+def _tf_pose(t_ns: int) -> tuple[float, float, float]:
+    """tf's world -> robot_at_home at ``t_ns`` read by hand from the bag's /tf (rosbags):
+    linear in time between the stamps around it, SLERP of the orientation (scipy)."""
+    rows = []
+    with AnyReader([BAG]) as reader:
+        conns = [c for c in reader.connections if c.topic == "/tf"]
+        for conn, _, raw in reader.messages(connections=conns):
+            for tr in reader.deserialize(raw, conn.msgtype).transforms:
+                if tr.child_frame_id.lstrip("/") != "robot_at_home":
+                    continue
+                st, p, q = tr.header.stamp, tr.transform.translation, tr.transform.rotation
+                rows.append((st.sec * 1_000_000_000 + st.nanosec, p.x, p.y, q.x, q.y, q.z, q.w))
+    rows.sort()
+    t = np.array([r[0] for r in rows], dtype=np.int64)
+    i = int(np.searchsorted(t, t_ns))  # t[i-1] < t_ns <= t[i]
+    a = (t_ns - t[i - 1]) / (t[i] - t[i - 1])
+    x0, y0, *q0 = rows[i - 1][1:]
+    x1, y1, *q1 = rows[i][1:]
+    rot = Slerp([0.0, 1.0], Rotation.from_quat([q0, q1]))([a])[0]
+    return x0 + a * (x1 - x0), y0 + a * (y1 - y0), float(rot.as_euler("xyz")[2])
+
+
+def test_real_bag_2015_takes_the_tf_pose_at_the_reached_moment(
+    real: dict[str, Any], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Issue 35, item 4: under --2015 the pose is tf world -> robot_at_home (the node's source)
+    at the timing file's reached moment, and the output keeps saying that the node's own lookup
+    was at its ``now`` (the ROS time it handled the result), a few milliseconds after it."""
+    argv = ["score", "fbm2h", str(BAG), "--goal", str(GOAL), "--reached", "timing", str(TIMING)]
+    code = main([*argv, "--2015", "--draws", "0", "--format", "json"])
+    out = capsys.readouterr()
+    assert code == 0, out.err
+    segs = json.loads(out.out)["details"]["segments_details"]
+    for k in range(len(real["goal"])):
+        moment = real["start"] + round(real["p"][k + 1] * 1e9)
+        x, y, yaw = _tf_pose(moment)
+        pose = segs[str(k)]["robot_pose"]
+        # The same samples and formulas (linear, SLERP): float rounding only, ~1e-15 m.
+        assert (pose["x"], pose["y"], pose["theta"]) == pytest.approx((x, y, yaw), abs=1e-9)
+    assert "[fbm2h.pose-source]" not in out.err  # /tf is what the node read
+    (line,) = [ln for ln in out.err.splitlines() if "[fbm2h.pose-moment]" in ln]
+    assert "at the logged reached moment" in line and "a few ms later" in line
+    assert "the ROS time its node handled the result" in line

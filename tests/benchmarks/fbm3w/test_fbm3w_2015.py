@@ -1,15 +1,16 @@
 """``--2015`` against the 2015 node's arithmetic, re-implemented here as plain loops.
 
-The re-implementation follows ``rockin_scoring/scripts/fbm3w`` (RoCKIn repository
-``benchmark_and_scoring_fbm``) and seed 7.3: per run the reference is the latest pose when the
-manual operation completed; the node subscribed to the pose2d topic from ``SendGoal`` (BmBox
-EXECUTING_GOAL) until ``WaitResult`` returned (BmBox leaving WAITING_RESULT) and kept a pose
-when it lay at least D_MIN from the last kept one; the run frame has its origin at the first
-kept pose and its x axis along reference -> start; Eq. (1) averages the distances to the shape
-at l_i / L over the N kept poses. ``if benchmark.Timeout(): execution_time += ...`` came before
-``if not benchmark.Running(): continue``: a run the RefBox timed out is scored on what it
-covered and timed, a stopped run neither. Nothing here calls ertools' scoring code; ertools
-only reads the bag (the reader is tested elsewhere).
+The re-implementation follows ``scripts/fbm3w`` of rockin-robot-challenge/
+benchmark_and_scoring_fbm at 50b173b (RoCKIn 2015; its statement-by-statement replay over the
+BmBox is ``node_fbm3w.py``, on every path in ``test_fbm3w_node_paths.py``) and seed 7.3: per
+run the reference is the latest pose when the manual operation completed; the node subscribed
+to the pose2d topic from ``SendGoal`` (BmBox EXECUTING_GOAL) until ``WaitResult`` returned
+(BmBox leaving WAITING_RESULT) and kept a pose when it lay at least D_MIN from the last kept
+one; the run frame has its origin at the first kept pose and its x axis along reference ->
+start; Eq. (1) averages the distances to the shape at l_i / L over the N kept poses. ``if
+benchmark.Timeout()`` only prints, before ``if not benchmark.Running(): continue``: a run the
+RefBox timed out is scored on what it covered and timed, a stopped run neither. Nothing here
+calls ertools' scoring code; ertools only reads the bag (the reader is tested elsewhere).
 """
 
 from __future__ import annotations

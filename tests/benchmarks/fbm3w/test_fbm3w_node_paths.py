@@ -1,30 +1,21 @@
-"""``--2015`` on every path of the 2015 FBM3@Work node, against its loop run as written.
+"""``--2015`` on every path of the RoCKIn 2015 FBM3@Work node, against its loop run as written.
 
-:func:`fbm3w_2015` is ``main()`` of ``scripts/fbm3w`` (rockin-robot-challenge/
-benchmark_and_scoring_fbm at 65dfee4) statement by statement, over the 2015 BmBox replayed
-from the log (``tests/bmbox2015.py``): ``WaitClient()`` (line 94); ``for run in
-runs_specifications`` (97) and ``if not Running(): break`` (99); the manual operation and ``if
-not Running(): break`` (131, 134); the pose2d subscription (141) around ``SendGoal`` (145),
-``start_time`` (146), ``WaitResult`` (149), ``end_time`` (150) and the unsubscription (153);
-``if Timeout(): execution_time += ...; continue`` (156-159); ``if not Running(): continue``
-(161-163); the accuracy, then ``execution_time += ...`` (169).
+The node is ``scripts/fbm3w`` at 50b173b (2015-11-30), ported statement by statement in
+``node_fbm3w.py`` over the BmBox replayed from the log (``tests/bmbox2015.py``). It differs
+from the versions before it on these paths: 7942ea2 (2015-11-30) scores and times a run the
+RefBox timed out and goes on with the next run (before it: time added, no score, ``continue``
+with the same run number); 7942ea2 also replaced the 0.30/0.10 line and the semi-ellipse
+spline by the line and sine of Listing 15 (``node_fbm3w.TARGETS``).
 
-Where 65dfee4 is a draft, the seed's protocol (7.3.3) decides, as the logs follow it: one
-manual operation per run, after which the reference is the latest pose
-(``acquire_robot_position``, ``lookupTransform(..., Time(0))``), and one goal, the path (the
-draft's separate "go to starting position" goal is in no log); the path is what
-``mocap_callback`` kept (D_MIN, line 66) from the poses received while the goal ran
-([EXECUTING_GOAL, leaving WAITING_RESULT]: the robot stands at the start before); the
-accuracy, a ``TODO`` in 65dfee4, is Eq. (1) (seed 7.3.1); a timed-out run is scored on the
-path it covered and can be the best run (the final Lisbon node, issue 15). Best run: the
-smallest distance error, the first on ties.
-
-The logs are generated with the samples' writer, one per path: normal, a RefBox timeout during
-the last run's path, a stop during a path and during a manual operation, an END payload no
-2015 code knew, the seed's bare ``timeout`` / ``halt`` (to the 2015 BmBox no known string:
-it waited on for the robot, as for any unknown END), and the log cut inside every
-phase of a run (the benchmark stopped there: issue 23). ertools' ``--2015`` must equal the
-replay to 1e-12 (relative), field for field; the default must score every one of them.
+The logs are generated with the samples' writer, one per path: normal; a RefBox timeout
+during the last run's path, during an earlier one (the node then waits for the next manual
+operation until the log ends) and during a manual operation (the BmBox back to READY by
+BmBox.py 43-44: the node takes its reference there and runs the goal); a stop during a path
+and during a manual operation; an END payload no 2015 code knew and the seed's bare
+``timeout`` / ``halt`` (to the 2015 BmBox no known string: it waited on for the robot); the
+log cut inside every phase of a run (the benchmark stopped there: issue 23). ertools'
+``--2015`` must equal the replay to 1e-12 (relative), field for field; the default must score
+every one of them and say where it differs.
 """
 
 from __future__ import annotations
@@ -36,9 +27,9 @@ from typing import Any
 
 import numpy as np
 import pytest
-from bmbox2015 import BmBoxReplay
+from node_fbm3w import SPECS, fbm3w_node
 from rosbags.highlevel import AnyReader
-from test_fbm3w_2015 import SHAPES, _track, distance_error
+from test_fbm3w_2015 import _track
 
 from ertools.cli.main import main
 from ertools.samples.statemachine import Transition, publish_states
@@ -49,62 +40,7 @@ S = 1_000_000_000
 MS = 1_000_000
 T0 = 1_448_020_800 * S
 REL = 1e-12
-SPECS = ["line", "spline", "line", "spline", "line"]  # seed Listing 14 (configs/fbm3w.yaml)
 TOPIC = "/fbm3w/robot_at_work/pose2d"
-
-
-# ----------------------------------------------------------------------------- the node
-
-
-def fbm3w_2015(
-    bm: list[tuple[int, int, str]],
-    rb: list[tuple[int, int, str]],
-    t: list[int],
-    xy: list[tuple[float, float]],
-) -> dict[str, Any]:
-    """``main()`` of scripts/fbm3w over the replayed BmBox (see the module docstring)."""
-    benchmark = BmBoxReplay(bm, rb, [])
-    current_run = 0
-    execution_time = 0.0
-    details: dict[int, dict[str, Any]] = {}
-    benchmark.WaitClient()
-    for k, spec in enumerate(SPECS):
-        if not benchmark.Running():
-            break
-        benchmark.ManualOperation()
-        reference_t = benchmark.now  # acquire_robot_position(): the latest pose
-        if not benchmark.Running():
-            break
-        benchmark.SendGoal(spec)
-        start_time = benchmark.now
-        benchmark.WaitResult()
-        end_time = benchmark.now
-        if benchmark.Timeout():
-            execution_time = execution_time + (end_time - start_time) / 1e9
-            details[k] = {
-                "distance_error": distance_error(t, xy, reference_t, start_time, end_time, spec),
-                "execution_time": (end_time - start_time) / 1e9,
-            }
-            continue
-        if not benchmark.Running():
-            continue
-        details[k] = {
-            "distance_error": distance_error(t, xy, reference_t, start_time, end_time, spec),
-            "execution_time": (end_time - start_time) / 1e9,
-        }
-        execution_time = execution_time + (end_time - start_time) / 1e9
-        current_run = current_run + 1
-    best = None
-    for k, d in details.items():
-        if best is None or d["distance_error"] < details[best]["distance_error"]:
-            best = k
-    return {
-        "best_run": best,
-        "best_distance_error": None if best is None else details[best]["distance_error"],
-        "execution_time": execution_time,
-        "runs": details,
-        "cut": benchmark.cut_at is not None,
-    }
 
 
 # ----------------------------------------------------------------------------- the logs
@@ -112,12 +48,15 @@ def fbm3w_2015(
 
 @dataclass(frozen=True)
 class Case:
-    """What ends the benchmark: a RefBox END (payload) in run ``run`` at ``phase``, or the log
-    cut there; None: the five runs end normally."""
+    """What happens in run ``run`` at ``phase``: a RefBox END (payload) or the log cut there;
+    None: the five runs end normally. ``after`` a timeout: ``score`` (the node sends its score:
+    the last run), ``wait`` (the node asks for the next manual operation, which never comes,
+    until the log ends) or ``go on`` (a timeout during the manual operation: the run goes on)."""
 
     run: int | None = None
     phase: str = ""
     end_payload: str | None = None  # None: a cut
+    after: str = "score"
 
 
 # Seconds into a run (each 12 s): the manual operation, its confirmation, the goal, the path
@@ -171,21 +110,35 @@ def write_case(path: Path, case: Case) -> tuple[list[int], list[tuple[float, flo
         ]
         if ends_here and case.end_payload is None:
             cut_ns = at(AT[case.phase])
-        if ends_here and case.end_payload is not None and case.phase == "WMO":
+        payload = case.end_payload
+        if ends_here and payload is not None and case.phase == "WMO":
+            # BmBox.py 43-44: any RefBox END moves it out of WAITING_MANUAL_OPERATION.
             tr += [
-                Transition(at(AT["WMO"]), Machine.REFBOX, RefBoxState.END, case.end_payload),
+                Transition(at(AT["WMO"]), Machine.REFBOX, RefBoxState.END, payload),
                 Transition(at(AT["WMO"] + 0.02), Machine.BMBOX, BmBoxState.READY),
             ]
-            break
+            if case.after != "go on":
+                break
+        else:
+            tr += [
+                Transition(at(CONFIRM), Machine.REFBOX, RefBoxState.EXECUTING_GOAL),
+                Transition(at(CMO), Machine.BMBOX, BmBoxState.COMPLETED_MANUAL_OPERATION),
+            ]
         tr += [
-            Transition(at(CONFIRM), Machine.REFBOX, RefBoxState.EXECUTING_GOAL),
-            Transition(at(CMO), Machine.BMBOX, BmBoxState.COMPLETED_MANUAL_OPERATION),
             Transition(at(TG), Machine.BMBOX, BmBoxState.TRANSMITTING_GOAL, spec),
             Transition(at(CLIENT_EG), Machine.CLIENT, ClientState.EXECUTING_GOAL),
             Transition(at(EG), Machine.BMBOX, BmBoxState.EXECUTING_GOAL),
-            Transition(at(WR), Machine.BMBOX, BmBoxState.WAITING_RESULT),
         ]
-        payload = case.end_payload
+        if ends_here and payload is not None and case.phase == "EG":
+            # The timeout reaches the BmBox before the node's own WAITING_RESULT (BmBox.py
+            # 49-50 from EXECUTING_GOAL): WaitResult() returns at once.
+            tr += [
+                Transition(at(AT["EG"]), Machine.REFBOX, RefBoxState.END, payload),
+                Transition(at(AT["EG"] + 0.01), Machine.CLIENT, ClientState.END),
+                Transition(at(AT["EG"] + 0.02), Machine.BMBOX, BmBoxState.READY),
+            ]
+            break
+        tr.append(Transition(at(WR), Machine.BMBOX, BmBoxState.WAITING_RESULT))
         if ends_here and payload is not None and case.phase == "WR":
             tr.append(Transition(at(AT["WR"]), Machine.REFBOX, RefBoxState.END, payload))
             if payload in ("reason: timeout", "reason: stop"):
@@ -193,6 +146,11 @@ def write_case(path: Path, case: Case) -> tuple[list[int], list[tuple[float, flo
                     Transition(at(AT["WR"] + 0.02), Machine.CLIENT, ClientState.END),
                     Transition(at(AT["WR"] + 0.05), Machine.BMBOX, BmBoxState.READY),
                 ]
+                if case.after == "wait":
+                    # The RefBox published its END once: the next manual operation waits.
+                    wmo = BmBoxState.WAITING_MANUAL_OPERATION
+                    tr.append(Transition(at(12.0), Machine.BMBOX, wmo))
+                    cut_ns = at(12.5)
                 break
             # Not a string the BmBox compared (the seed's bare words neither): it waited on for
             # the robot (BmBox.py lines 49-55).
@@ -202,10 +160,11 @@ def write_case(path: Path, case: Case) -> tuple[list[int], list[tuple[float, flo
             Transition(at(DONE + 0.05), Machine.CLIENT, ClientState.WAITING_GOAL),
         ]
     last = max(x.t_ns for x in tr)
-    tr += [
-        Transition(last + S // 4, Machine.BMBOX, BmBoxState.TRANSMITTING_SCORE, "{}"),
-        Transition(last + S // 2, Machine.BMBOX, BmBoxState.END),
-    ]
+    if cut_ns is None:
+        tr += [
+            Transition(last + S // 4, Machine.BMBOX, BmBoxState.TRANSMITTING_SCORE, "{}"),
+            Transition(last + S // 2, Machine.BMBOX, BmBoxState.END),
+        ]
     t_ns = T0 + np.round(np.concatenate(ts) * S).astype(np.int64)
     xy_all = np.vstack(xys)
     keep = t_ns <= (cut_ns if cut_ns is not None else t_ns[-1])
@@ -229,6 +188,9 @@ def _states(bag: Path) -> dict[str, list[tuple[int, int, str]]]:
 CASES: dict[str, Case] = {
     "normal": Case(),
     "timeout": Case(4, "WR", "reason: timeout"),
+    "timeout-then-waits": Case(2, "WR", "reason: timeout", after="wait"),
+    "timeout-before-waiting-result": Case(4, "EG", "reason: timeout"),
+    "timeout-during-manual-operation": Case(3, "WMO", "reason: timeout", after="go on"),
     "timeout-seed-form": Case(4, "WR", "timeout"),
     "stop-during-path": Case(2, "WR", "reason: stop"),
     "halt-seed-form": Case(2, "WR", "halt"),
@@ -236,6 +198,22 @@ CASES: dict[str, Case] = {
     "unknown-end-payload": Case(4, "WR", "reason: finished"),
     **{f"cut-in-{p}": Case(2, p) for p in ("WMO", "CMO", "TG", "EG", "WR")},
     "cut-in-READY": Case(1, "READY"),
+}
+# What the node does on each path, read from its source by hand: the runs it scores (and
+# times), whether the log's end stopped it.
+BY_HAND = {
+    "normal": ([0, 1, 2, 3, 4], False),
+    "timeout": ([0, 1, 2, 3, 4], False),
+    "timeout-then-waits": ([0, 1, 2], True),
+    "timeout-before-waiting-result": ([0, 1, 2, 3, 4], False),
+    "timeout-during-manual-operation": ([0, 1, 2, 3, 4], False),
+    "timeout-seed-form": ([0, 1, 2, 3, 4], False),
+    "stop-during-path": ([0, 1], False),
+    "halt-seed-form": ([0, 1, 2, 3, 4], False),
+    "stop-during-manual-operation": ([0, 1], False),
+    "unknown-end-payload": ([0, 1, 2, 3, 4], False),
+    **{f"cut-in-{p}": ([0, 1], True) for p in ("WMO", "CMO", "TG", "EG", "WR")},
+    "cut-in-READY": ([0, 1], True),
 }
 
 
@@ -252,25 +230,47 @@ def _close(got: float, want: float) -> bool:
     return got == pytest.approx(want, rel=REL, abs=1e-15)
 
 
+def _node(name: str, tmp_path: Path) -> tuple[Path, dict[str, Any]]:
+    bag = tmp_path / f"{name}.bag"
+    t, xy = write_case(bag, CASES[name])
+    states = _states(bag)
+    return bag, fbm3w_node(states["bmbox"], states["refbox"], t, xy)
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_the_port_follows_the_source(name: str, tmp_path: Path) -> None:
+    """The replay's outcome on each path is the one read from the source by hand."""
+    _, node = _node(name, tmp_path)
+    scored, cut = BY_HAND[name]
+    runs = node["runs_details"]
+    assert [k for k, r in runs.items() if "distance_error" in r] == scored
+    assert [k for k, r in runs.items() if "execution_time" in r] == scored
+    assert node["cut"] is cut
+    if name.startswith("timeout") and name != "timeout-seed-form":
+        run = CASES[name].run
+        assert runs[run]["timeout"] and "distance_error" in runs[run]
+
+
 @pytest.mark.parametrize("name", list(CASES))
 def test_2015_is_the_node_on_every_path(
     name: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    case = CASES[name]
-    bag = tmp_path / f"{name}.bag"
-    t, xy = write_case(bag, case)
-    states = _states(bag)
-    node = fbm3w_2015(states["bmbox"], states["refbox"], t, xy)
+    bag, node = _node(name, tmp_path)
     data, err = _score(bag, ["--2015"], capsys)
     assert data["best_run"] == node["best_run"]
     assert _close(data["best_distance_error"], node["best_distance_error"])
     assert _close(data["execution_time"], node["execution_time"])
     scored = {int(k): r for k, r in data["runs_details"].items() if r["distance_error"] is not None}
-    assert set(scored) == set(node["runs"]), "the runs the node scored, no other"
-    for k, want in node["runs"].items():
-        assert _close(scored[k]["distance_error"], want["distance_error"]), k
-        assert _close(scored[k]["execution_time"], want["execution_time"]), k
+    want = {k: r for k, r in node["runs_details"].items() if "distance_error" in r}
+    assert set(scored) == set(want), "the runs the node scored, no other"
+    for k, r in want.items():
+        assert _close(scored[k]["distance_error"], r["distance_error"]), k
+        assert _close(scored[k]["execution_time"], r["execution_time"]), k
     assert ("stopped there" in err) is node["cut"], err
+    if name == "timeout-before-waiting-result":
+        # One kept pose: scripts/fbm3w divides an empty sum by N = 1; the best run.
+        assert data["runs_details"]["4"]["distance_error"] == 0.0 and data["best_run"] == 4
+        assert "2015 scored it error_sum / N = 0.0 over its one kept pose" in err
     unknown_2015 = ("unknown-end-payload", "timeout-seed-form", "halt-seed-form")
     assert ("none of the forms" in err) is (name in unknown_2015), err
 
@@ -304,4 +304,13 @@ def test_issue_23_stopped_and_cut_runs_add_no_time_in_2015(
     for data in got.values():
         assert _close(data["execution_time"], 12.0)
         assert set(data["runs_details"]) == {"0", "1", "2"}
-    assert SHAPES  # the shapes of Listing 15 the node compares with
+
+
+def test_rules_2015_is_2015(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--rules 2015`` is ``--2015``, the spelling FBM1 and FBM2@Home share."""
+    bag, node = _node("timeout-then-waits", tmp_path)
+    flag, _ = _score(bag, ["--2015"], capsys)
+    rules, _ = _score(bag, ["--rules", "2015"], capsys)
+    assert rules == flag and _close(rules["execution_time"], node["execution_time"])
+    assert main(["score", "fbm3w", str(bag), "--rules", "2015", "--arc-length"]) == 2
+    assert "contradict" in capsys.readouterr().err

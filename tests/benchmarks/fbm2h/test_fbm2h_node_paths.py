@@ -1,15 +1,17 @@
-"""``score fbm2h --2015`` against the 2015 node's loop as written, on every path of its
-state machine; the default mode on the same logs.
+"""``score fbm2h --2015`` (and ``--rules 2016``, ``--rules 2017``) against the node's loop as
+written, on every path of its state machine; the default mode on the same logs.
 
-``node2015_fbm2h`` ports ``scripts/fbm2h`` and ``BmBox.py`` line by line (see its
-docstring) and replays it over the state messages of each generated log, read back with
+``node_fbm2h.py`` ports ``scripts/fbm2h`` at 50b173b statement by statement (the RoCKIn 2015
+node; the same file ran the Lisbon 2016 and 2017 competitions, 40ba68b and 89dfa75) and
+replays it over the BmBox of each generated log (``tests/bmbox2015.py``), read back with
 rosbags (not ertools.io); the robot pose is tf ``world -> robot_at_home`` read the same way
 and interpolated with scipy. Each log is written with the samples' writer: a benchmark of four
 waypoints in which one thing happens: a normal end; the RefBox's ``reason: timeout`` or
-``reason: stop`` while the robot drives; a timeout or stop while the goal is being sent (the
-2015 BmBox does not leave TRANSMITTING_GOAL for them); the seed's bare ``timeout`` payload
-(the 2015 BmBox ignored it); the log cut before the first goal, while a goal is sent, while the
-robot drives and between two segments.
+``reason: stop`` while the robot drives (the node scores that segment where ``WaitResult()``
+returned and counts a timeout in ``timeout_segments``); a timeout or stop while the goal is
+being sent (the BmBox does not leave TRANSMITTING_GOAL for them); the seed's bare ``timeout``
+payload (the BmBox ignored it); the log cut before the first goal, while a goal is sent, while
+the robot drives and between two segments.
 
 Tolerance 1e-12 relative: both sides add the same terms in the same order; ertools sums the
 segment times in int64 ns before converting (the port adds float seconds), ~1e-16 apart.
@@ -26,7 +28,8 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from node2015_fbm2h import Message, Replay, Score2015, TfPoses, node_2015
+from bmbox2015 import BmBoxReplay
+from node_fbm2h import Score2015, TfPoses, fbm2h_node
 from rosbags.highlevel import AnyReader
 from scipy.spatial.transform import Rotation
 
@@ -62,7 +65,7 @@ class Case:
     """One path: what happens in segment ``at``, and the 2015 numbers to expect by hand."""
 
     name: str
-    event: str  # normal, timeout, stop, timeout_sending, stop_sending, bare_timeout, cut_*
+    event: str  # normal, timeout, stop, timeout_sending, stop_sending, bare_timeout, unknown, cut_*
     at: int = 2  # the segment it happens in
 
 
@@ -74,9 +77,11 @@ CASES = (
     Case("timeout while the goal is sent", "timeout_sending"),
     Case("stop while the goal is sent", "stop_sending"),
     Case("bare 'timeout' payload", "bare_timeout"),
+    Case("an END payload no code knew", "unknown"),
     Case("cut before the first goal", "cut_before"),
     Case("cut while the goal is sent", "cut_sending"),
     Case("cut while driving", "cut_driving"),
+    Case("cut before WAITING_RESULT", "cut_executing"),
     Case("cut between segments", "cut_between"),
 )
 
@@ -131,6 +136,9 @@ def _transitions(case: Case) -> tuple[list[Transition], int | None]:
         ]
         if here and case.event == "cut_driving":
             return tr, at(g + 3.0)
+        if here and case.event == "cut_executing":
+            # The log ends at the BmBox's EXECUTING_GOAL, before its WAITING_RESULT.
+            return [x for x in tr if x.t_ns < at(g + 0.21)], at(g + 0.205)
         if here and case.event in ("timeout", "stop"):
             tr += [
                 Transition(at(g + 3.0), Machine.REFBOX, R.END, f"reason: {case.event}"),
@@ -139,14 +147,15 @@ def _transitions(case: Case) -> tuple[list[Transition], int | None]:
             ]
             t_score = g + 3.2
             break
-        if here and case.event == "bare_timeout":
-            tr.append(Transition(at(g + 3.0), Machine.REFBOX, R.END, "timeout"))
+        if here and case.event in ("bare_timeout", "unknown"):
+            text = "timeout" if case.event == "bare_timeout" else "reason: finished"
+            tr.append(Transition(at(g + 3.0), Machine.REFBOX, R.END, text))
         tr += [
             Transition(at(g + 5.0), Machine.CLIENT, C.COMPLETED_GOAL, f"waypoint: {k}\n"),
             Transition(at(g + 5.06), Machine.BMBOX, B.READY),
             Transition(at(g + 5.2), Machine.CLIENT, C.WAITING_GOAL),
         ]
-        ended = case.event in ("timeout_sending", "bare_timeout") and k >= case.at
+        ended = case.event in ("timeout_sending", "bare_timeout", "unknown") and k >= case.at
         if not ended:
             tr.append(Transition(at(g + 5.08), Machine.REFBOX, R.READY))
         if here and case.event == "timeout_sending":
@@ -221,6 +230,18 @@ def _write(case: Case, folder: Path) -> tuple[Path, Path, Path]:
     return bag, goal, transform
 
 
+Message = tuple[int, Machine, int, str]  # (record time ns, machine, state, payload)
+
+
+def replay(msgs: list[Message]) -> BmBoxReplay:
+    """The BmBox of the node over the three machines' logged messages."""
+    by = {
+        m: [(t, st, p) for t, mm, st, p in sorted(msgs, key=lambda x: x[0]) if mm is m]
+        for m in Machine
+    }
+    return BmBoxReplay(by[Machine.BMBOX], by[Machine.REFBOX], by[Machine.CLIENT])
+
+
 def _read_back(bag: Path) -> tuple[list[Message], TfPoses]:
     """State messages and the /tf marker poses, through rosbags (not ertools.io)."""
     machines = {f"/fbm2h/{m.value}_state": m for m in Machine}
@@ -257,32 +278,25 @@ def _close(ours: float | None, theirs: float, what: str) -> None:
     assert ours == pytest.approx(theirs, rel=REL, abs=1e-15), what
 
 
-def assert_same(out: dict[str, Any], node: Score2015, log_ended_at: int | None) -> None:
-    """Every number the 2015 node computed, field for field."""
+def assert_same(out: dict[str, Any], node: Score2015) -> None:
+    """Every number the node computed, field for field."""
     _close(out["position_accuracy"], node.position_accuracy, "position_accuracy")
     _close(out["orientation_accuracy"], node.orientation_accuracy, "orientation_accuracy")
     _close(out["execution_time"], node.execution_time, "execution_time")
-    assert out["timeout_segments"] == node.timeout_segments == 0  # Listing 13: "always 0"
+    assert out["timeout_segments"] == node.timeout_segments
     segs = out["details"]["segments_details"]
     for i, d in node.details.items():
         ours = segs[str(i)]
-        if i == log_ended_at:
-            # The node never got past this wait: nothing it wrote is in the log.
-            assert ours["dinstance_error"] is None and ours["segment_time"] is None
-            continue
         _close(ours["start_segment_time"], d["start_segment_time"] / 1e9, f"{i} start")
         _close(ours["end_segment_time"], d["end_segment_time"] / 1e9, f"{i} end")
         _close(ours["segment_time"], d["segment_time"], f"{i} segment_time")
         assert ours["refbox_timeout"] is d["refbox_timeout"], i
-        if "dinstance_error" in d:
-            _close(ours["dinstance_error"], d["dinstance_error"], f"{i} distance")
-            _close(ours["orientation_error"], d["orientation_error"], f"{i} orientation")
-            rp = ours["robot_pose"]
-            for key, v in zip(("x", "y", "theta"), d["robot_pose"], strict=True):
-                _close(rp[key], v, f"{i} robot {key}")
-            assert ours["result_payload"] == {"waypoint": i}
-        else:
-            assert ours["dinstance_error"] is None
+        assert ours["timeout"] is d["timeout"], i
+        _close(ours["dinstance_error"], d["dinstance_error"], f"{i} distance")
+        _close(ours["orientation_error"], d["orientation_error"], f"{i} orientation")
+        rp = ours["robot_pose"]
+        for key, v in zip(("x", "y", "theta"), d["robot_pose"], strict=True):
+            _close(rp[key], v, f"{i} robot {key}")
     for i in range(len(WAYPOINTS)):
         if i not in node.details:
             assert segs[str(i)]["dinstance_error"] is None and segs[str(i)]["segment_time"] is None
@@ -294,71 +308,89 @@ def logged(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFact
     folder = tmp_path_factory.mktemp(case.event)
     bag, goal, transform = _write(case, folder)
     msgs, tf = _read_back(bag)
-    replay = Replay(msgs)
-    node = node_2015(replay, tf, WAYPOINTS, (M2R_T, M2R_Q))
+    node = fbm2h_node(replay(msgs), tf, WAYPOINTS, (M2R_T, M2R_Q))
     args = [str(bag), "--goal", str(goal), "--transform", str(transform)]
-    return case, node, replay, args
+    return case, node, args
 
 
-# What 2015 scored on each path, by hand from the node's loop: the segments scored, the
-# segment whose time it added without an error (timeout), where its loop stopped.
+# What the node scored on each path, by hand from its loop: the segments scored, the one it
+# counted as timed out, whether the log's end stopped it.
 BY_HAND = {
-    "normal": ([0, 1, 2, 3], None),
-    "timeout": ([0, 1], 2),
-    "stop": ([0, 1], None),
-    "timeout_sending": ([0, 1], 2),
-    "stop_sending": ([0, 1], None),
-    "bare_timeout": ([0, 1, 2, 3], None),
-    "cut_before": ([], None),
-    "cut_sending": ([0, 1], None),
-    "cut_driving": ([0, 1], None),
-    "cut_between": ([0, 1], None),
+    "normal": ([0, 1, 2, 3], None, False),
+    "timeout": ([0, 1, 2], 2, False),
+    "stop": ([0, 1, 2], None, False),
+    "timeout_sending": ([0, 1, 2], 2, False),
+    "stop_sending": ([0, 1], None, True),
+    "bare_timeout": ([0, 1, 2, 3], None, False),
+    "unknown": ([0, 1, 2, 3], None, False),
+    "cut_before": ([], None, True),
+    "cut_sending": ([0, 1], None, True),
+    "cut_driving": ([0, 1, 2], None, True),
+    "cut_executing": ([0, 1, 2], None, True),
+    "cut_between": ([0, 1], None, True),
 }
 
 
-def test_the_port_follows_the_2015_loop(logged: Any) -> None:
-    """The port's outcome on each path is the one read from the 2015 source by hand."""
-    case, node, replay, _ = logged
-    scored, timed_out = BY_HAND[case.event]
+def test_the_port_follows_the_loop(logged: Any) -> None:
+    """The port's outcome on each path is the one read from the source by hand."""
+    case, node, _ = logged
+    scored, timed_out, cut = BY_HAND[case.event]
     if case.event == "stop" and case.at == 0:
-        scored = []
+        scored = [0]
     assert [i for i, d in node.details.items() if "dinstance_error" in d] == scored
-    assert [i for i, d in node.details.items() if d.get("refbox_timeout")] == (
+    assert [i for i, d in node.details.items() if d["timeout"]] == (
         [] if timed_out is None else [timed_out]
     )
-    assert replay.log_ended is case.event.startswith(("cut", "stop_sending"))
-    # sum_d over N = 4 whatever was scored (l. 226).
+    assert not any(d["refbox_timeout"] for d in node.details.values())  # l. 158: dead
+    assert node.timeout_segments == (0 if timed_out is None else 1)
+    assert node.cut is cut
+    # sum_d over N = 4 whatever was scored (l. 225).
     d = [node.details[i]["dinstance_error"] for i in scored]
     assert node.position_accuracy == pytest.approx(sum(d) / 4, rel=1e-15, abs=0)
 
 
-def test_2015_equals_the_node(logged: Any, capsys: pytest.CaptureFixture[str]) -> None:
-    case, node, replay, args = logged
-    code, out, err = _score([*args, "--2015"], capsys)
+@pytest.mark.parametrize("rules", [["--2015"], ["--rules", "2016"], ["--rules", "2017"]])
+def test_rules_equal_the_node(
+    logged: Any, rules: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    case, node, args = logged
+    code, out, err = _score([*args, *rules], capsys)
     assert code == 0, err
-    ended_at = None
-    if replay.log_ended:
-        ended_at = max(node.details) if node.details else None
-    assert_same(out, node, ended_at)
-    if case.event not in {"normal", "bare_timeout"}:
+    assert_same(out, node)
+    if len(node.details) < len(WAYPOINTS):
         assert "counted in N with no error, as 2015 did" in err
-    if case.event == "bare_timeout":
-        said = "RefBox END with payload 'timeout', which is none of the forms the 2015 BmBox knows"
+    if case.event in ("bare_timeout", "unknown"):
+        text = "timeout" if case.event == "bare_timeout" else "reason: finished"
+        said = f"RefBox END with payload '{text}', which is none of the forms the 2015 BmBox knows"
         assert said in err and "neither a timeout nor a stop" in err
-    if replay.log_ended:
-        assert "the log ends inside the benchmark" in err
+    assert ("the log ends inside the benchmark" in err) is node.cut
 
 
-def test_default_scores_what_2015_scored_and_names_the_rest(
+# What the default scores on each path: the segments the Client completed; a segment a RefBox
+# timeout or stop (or the log's end) cut short is not scored (rule fbm2h.unscored-segments).
+BY_DEFAULT = {
+    "normal": [0, 1, 2, 3],
+    "timeout": [0, 1],
+    "stop": [0, 1],
+    "timeout_sending": [0, 1],
+    "stop_sending": [0, 1],
+    "bare_timeout": [0, 1],  # the seed's 'timeout' read as the timeout it names, said
+    "unknown": [0, 1, 2, 3],  # no known form: neither, warned
+    "cut_before": [],
+    "cut_sending": [0, 1],
+    "cut_driving": [0, 1],
+    "cut_executing": [0, 1],
+    "cut_between": [0, 1],
+}
+
+
+def test_default_scores_the_completed_segments_and_names_the_rest(
     logged: Any, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    case, node, _, args = logged
+    case, node, args = logged
     code, out, err = _score(args, capsys)
-    scored = [i for i, d in node.details.items() if "dinstance_error" in d]
+    scored = [] if case.event == "stop" and case.at == 0 else BY_DEFAULT[case.event]
     if case.event == "bare_timeout":
-        # The default reads the seed's bare 'timeout' as the timeout it names (said): the
-        # benchmark ended in segment 2 there, where the 2015 node ignored it.
-        scored = [0, 1]
         assert "as a timeout" in err and "[all.end-payloads]" in err
     segs = out["details"]["segments_details"]
     assert [int(i) for i, s in segs.items() if s["dinstance_error"] is not None] == scored
@@ -369,14 +401,20 @@ def test_default_scores_what_2015_scored_and_names_the_rest(
     # Unscored segments: null, named in the errors and the warning, exit 1 with the numbers.
     assert code == 1
     assert out["position_accuracy"] is None and out["orientation_accuracy"] is None
+    timed = [i for i, s in segs.items() if s["dinstance_error"] is None and s["timeout"]]
     assert out["execution_time"] == pytest.approx(
-        sum(segs[str(i)]["segment_time"] for i in scored), rel=REL
+        sum(segs[str(i)]["segment_time"] for i in scored)
+        + sum(segs[i]["segment_time"] or 0.0 for i in timed),
+        rel=REL,
     )
     assert "--unscored-segments 2015 divides the sum" in err
     missing = [i for i in range(len(WAYPOINTS)) if i not in scored]
     assert f"segment(s) {', '.join(map(str, missing))} of 4 not scored" in err
     for i in missing:
         assert f"segment {i}:" in err
+    # Where the node scored a segment the default leaves null, the output says so.
+    if set(node.details) - set(scored):
+        assert "[fbm2h.unscored-segments]" in err
 
 
 def test_sample_2015_is_the_node_on_its_own_clock(
@@ -388,12 +426,12 @@ def test_sample_2015_is_the_node_on_its_own_clock(
     answers = fbm2h_sample.answers
     waypoints = [tuple(s["target_pose"]) for s in answers["expected"]["segments"]]
     tr = yaml.safe_load(fbm2h_sample.transform.read_text())["marker_to_robot_transform"]
-    node = node_2015(Replay(msgs), tf, waypoints, (tr[0], tr[1]))
+    node = fbm2h_node(replay(msgs), tf, waypoints, (tr[0], tr[1]))
     folder = str(fbm2h_sample.folder)
     args = [str(fbm2h_sample.bag), "--team", "simbot", "--transforms", folder]
     code, out, err = _score([*args, "--2015"], capsys)
     assert code == 0, err
-    assert_same(out, node, None)
+    assert_same(out, node)
     assert node.execution_time == pytest.approx(41.5, abs=1e-9)
     assert node.details[2]["orientation_error"] < 0  # the +-pi seam, unwrapped
     # The default: the Client's reports and the pose topic, said.
