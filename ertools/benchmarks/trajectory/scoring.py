@@ -5,7 +5,7 @@ ertools differs from the 2015 script.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
@@ -13,7 +13,7 @@ import numpy.typing as npt
 
 from ertools.arrays import I64
 from ertools.benchmarks import registry
-from ertools.benchmarks.common.clocks import OffsetEstimate, estimate_offset
+from ertools.benchmarks.common.clocks import estimate_offset
 from ertools.benchmarks.common.hygiene import (
     drop_duplicates,
     drop_invalid,
@@ -29,16 +29,7 @@ from ertools.benchmarks.common.interval_output import (
 from ertools.benchmarks.common.teams import parse_robot_log_name
 from ertools.benchmarks.common.uncertainty import few_warning
 from ertools.benchmarks.common.validity import (
-    GAP as V_GAP,
-)
-from ertools.benchmarks.common.validity import (
-    OUTSIDE_WINDOW,
-    VALID,
-    Validity,
     from_codes,
-)
-from ertools.benchmarks.common.validity import (
-    TRACKING_LOST as V_TRACKING_LOST,
 )
 from ertools.benchmarks.trajectory.association import (
     COMPARED,
@@ -51,10 +42,9 @@ from ertools.benchmarks.trajectory.association import (
     associate_evo,
 )
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.fitted import at_fitted_offset, audit_warnings, estimates
 from ertools.benchmarks.trajectory.intervals import (
-    FITTED_KEYS,
     FITTED_SUFFIX,
-    MocapSigma,
     Rescoring,
     mocap_sigma,
     trajectory_intervals,
@@ -70,6 +60,7 @@ from ertools.benchmarks.trajectory.rules import (
     RULE_UNSCOREABLE,
     RULE_YAW_WRAP,
 )
+from ertools.benchmarks.trajectory.validity import too_few, validity_codes
 from ertools.errors import ClockError, ScoringError
 from ertools.fidelity import Deviation
 from ertools.streams import PoseStream, Provenance, float_seconds
@@ -349,7 +340,7 @@ def score_streams(
             timed,
             matched,
             audit,
-            _estimates(m),
+            estimates(m),
             association=config.association,
             offset_ns=offset_ns,
             settings=intervals,
@@ -358,7 +349,7 @@ def score_streams(
         )
         disagree = audit.offset_ns is not None and audit.disagrees_with(offset_ns)
         if sigma is not None and audit.offset_ns is not None and disagree:
-            fitted = _at_fitted_offset(
+            fitted = at_fitted_offset(
                 logged,
                 timed,
                 audit,
@@ -377,7 +368,7 @@ def score_streams(
             why = dict(iv.uncertainty.withheld)
             why.update({f"{k}{FITTED_SUFFIX}": v for k, v in fitted.withheld.items()})
             iv = ResultIntervals(iv.intervals, replace(iv.uncertainty, shares=shares, withheld=why))
-    notes.extend(_audit_warnings(audit, offset_ns, fitted))
+    notes.extend(audit_warnings(audit, offset_ns, fitted))
     few = few_warning(matched.count(COMPARED), "compared pose(s)", "the comparison")
     if few is not None and m is not None:
         notes.append(few)
@@ -419,129 +410,6 @@ def score_streams(
         ),
     )
     return result
-
-
-# A comparison is unscoreable when fewer than this fraction of the robot poses inside the GT
-# have a valid GT pose: the statistics would then describe a part of the run chosen by the
-# mocap's losses, not the run. A small number of valid pairs alone is no verdict: each pair is
-# a measurement, and few of them widen the confidence interval instead (docs/uncertainty.md).
-MIN_VALID_FRACTION = 0.5
-
-
-def validity_codes(matched: Matched, gt_start_ns: int) -> npt.NDArray[np.int8]:
-    """The validity reason of each robot pose from its association status.
-
-    A pose compared across a GT gap (``--gaps compare``) is a ``gap`` and one compared with the
-    first GT pose before the GT began (``--before-gt first``) is ``outside_window``: 2015 used
-    them, but no GT was measured at their moment.
-    """
-    s = matched.status
-    codes = np.full(s.shape, V_GAP, dtype=np.int8)  # GAP and evo's UNPAIRED
-    codes[s == COMPARED] = VALID
-    codes[s == TRACKING_LOST] = V_TRACKING_LOST
-    codes[(s == UNCOVERED) | ((s == COMPARED) & (matched.t_ns < gt_start_ns))] = OUTSIDE_WINDOW
-    codes[(s == COMPARED) & matched.across_gap] = V_GAP
-    return codes
-
-
-def too_few(validity: Validity) -> str | None:
-    """Why the valid pairs cannot support the statistics, or None."""
-    inside = validity.expected - int(validity.counts[OUTSIDE_WINDOW])
-    valid = validity.valid_samples
-    if valid < MIN_VALID_FRACTION * inside:
-        what = ", ".join(
-            f"{v} {k}" for k, v in validity.invalid_samples.items() if k != "outside_window"
-        )
-        return (
-            f"only {valid} of the {inside} robot poses inside the GT have a valid GT pose "
-            f"({what}); at least {MIN_VALID_FRACTION:.0%} are needed"
-        )
-    return None
-
-
-def _estimates(m: Metrics) -> dict[str, float]:
-    """The statistics by interval key (:data:`~ertools.benchmarks.trajectory.intervals.KEYS`)."""
-    out = {
-        "position_error": m.position_error,
-        "orientation_error": m.orientation_error,
-        "rmse": m.rmse,
-        "median": m.median,
-        "max": m.max,
-        "orientation_error_2015": m.orientation_error_2015,
-    }
-    out.update({f"percentiles.p{p:g}": v for p, v in m.percentiles})
-    return out
-
-
-def _audit_warnings(
-    audit: OffsetEstimate, applied_ns: int, fitted: FittedScore | None = None
-) -> list[str]:
-    if audit.offset_ns is None:
-        return [f"clock audit: no offset estimate ({audit.note})"]
-    out = []
-    sigma = audit.uncertainty_ns or 0
-    if audit.disagrees_with(applied_ns):
-        there = ""
-        if fitted is not None and fitted.metrics is not None:
-            iv = fitted.intervals.get("position_error")
-            span = "" if iv is None else f" [{iv.low * 1000:.4g}, {iv.high * 1000:.4g}]"
-            there = (
-                f"; scored there, position_error{FITTED_SUFFIX} is "
-                f"{fitted.metrics.position_error * 1000:.4g}{span} mm (the *{FITTED_SUFFIX} "
-                "keys)"
-            )
-        out.append(
-            f"clock audit: the robot stamps fit the GT best shifted by "
-            f"{ns_to_s(audit.offset_ns):+.3f} +- {ns_to_s(sigma):.3f} s, but the score uses "
-            f"{ns_to_s(applied_ns):+.3f} s{there}; check the clocks, or re-run with "
-            "--offset auto --apply-offset"
-        )
-    if audit.note:
-        out.append(f"clock audit: {audit.note}")
-    return out
-
-
-def _at_fitted_offset(
-    logged: PoseStream,
-    timed: PoseStream,
-    audit: OffsetEstimate,
-    fitted_ns: int,
-    match: Callable[[PoseStream, int], Matched],
-    rescoring: Callable[[int], Rescoring],
-    config: TrajectoryConfig,
-    settings: IntervalSettings,
-    sigma: MocapSigma,
-) -> FittedScore | None:
-    """The statistics of :data:`FITTED_KEYS` at the clock offset the audit fits, with their
-    intervals (centred there): what ``--offset auto --apply-offset`` would score. None where
-    no pose would be compared there, or too few for a score."""
-    matched = match(logged, fitted_ns)
-    robot = logged if matched.robot_rows is None else logged.take(matched.robot_rows)
-    m = metrics(matched)
-    if m is None:
-        return None
-    validity = from_codes(
-        validity_codes(matched, int(timed.t_ns[0])),
-        matched.t_ns,
-        gap_s=ns_to_s(config.max_gap_ns),
-    )
-    if config.t_max_diff is None and too_few(validity) is not None:
-        return None
-    iv = trajectory_intervals(
-        robot,
-        timed,
-        matched,
-        audit,
-        _estimates(m),
-        association=config.association,
-        offset_ns=fitted_ns,
-        settings=settings,
-        rescoring=rescoring(fitted_ns),
-        sigma=sigma,
-    )
-    kept = {k: iv.intervals.get(k) for k in FITTED_KEYS}
-    why = {} if iv.uncertainty is None else iv.uncertainty.withheld
-    return FittedScore(fitted_ns, m, kept, {k: why[k] for k in FITTED_KEYS if k in why})
 
 
 def _other_benchmark_gt(robot_file: str, gt_topic: str) -> list[str]:

@@ -11,14 +11,12 @@ import pytest
 from ertools.benchmarks.common.uncertainty import D_MIN, MOCAP_NOISE
 from ertools.benchmarks.fbm3w.intervals import (
     RAYLEIGH_CV,
-    RunSamples,
     measurement_source,
     noise_model,
-    perturbed_errors,
-    perturbed_runs,
     run_intervals,
     smooth,
 )
+from ertools.benchmarks.fbm3w.perturbed import RunSamples, perturbed_errors, perturbed_runs
 from ertools.benchmarks.noise.benchmark import noise_statistics
 from ertools.configs.shapes import builtin_shapes
 from ertools.samples.fbm3w import eq1, target
@@ -61,7 +59,7 @@ def _draw_positions(
 def _standard_noise(
     rng: np.random.Generator, rows: int, widths: list[int]
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The documented order of the draws' noise (intervals._noise, antithetic): per piece of
+    """The documented order of the draws' noise (draws.normal_pairs, antithetic): per piece of
     w draws its first ceil(w / 2) drawn, the rest their negatives; the samples' (rows,
     halves, x and y) in float32, then the references' (halves, x and y)."""
     halves = [(w + 1) // 2 for w in widths]
