@@ -34,6 +34,7 @@ from ertools.benchmarks.trajectory.config import (
     TIES,
     TrajectoryConfig,
 )
+from ertools.benchmarks.trajectory.intervals import FITTED_SUFFIX
 from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.errors import ConfigError, UsageError
 from ertools.io.text import INPUT_FORMATS
@@ -286,6 +287,27 @@ def notes(result: TrajectoryResult) -> list[str]:
         ScoreRow("max", m.max, iv.get("max"), 1000.0, "mm"),
         ScoreRow("orientation_error", m.orientation_error, iv.get("orientation_error"), 1.0, "rad"),
     ]
+    fit = result.fitted
+    if fit is not None:
+        # the score at the offset the data fits, beside the clock audit's warning
+        fi = fit.intervals
+        suffix = FITTED_SUFFIX
+        rows += [
+            ScoreRow(
+                f"position_error{suffix}",
+                fit.metrics.position_error,
+                fi.get("position_error"),
+                1000.0,
+                "mm",
+            ),
+            ScoreRow(
+                f"orientation_error{suffix}",
+                fit.metrics.orientation_error,
+                fi.get("orientation_error"),
+                1.0,
+                "rad",
+            ),
+        ]
     return interval_lines(rows, result.uncertainty)
 
 

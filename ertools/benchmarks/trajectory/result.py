@@ -25,7 +25,7 @@ from ertools.benchmarks.trajectory.association import (
     Matched,
 )
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
-from ertools.benchmarks.trajectory.intervals import KEYS
+from ertools.benchmarks.trajectory.intervals import FITTED_KEYS, FITTED_SUFFIX, KEYS
 from ertools.benchmarks.trajectory.metrics import Metrics
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames
@@ -38,6 +38,37 @@ if TYPE_CHECKING:
 # The summary table's statistics that get ``_low``/``_high`` columns (the percentiles have
 # their own table).
 INTERVAL_COLUMNS = tuple(k for k in KEYS if not k.startswith("percentiles."))
+
+
+@dataclass(frozen=True)
+class FittedScore:
+    """The statistics at the clock offset the audit fits, where the score used another one
+    the data disagrees with: what ``--offset auto --apply-offset`` would score, beside the
+    score (``<key>_at_fitted_offset`` and its interval).
+
+    Attributes:
+        offset_ns: the fitted offset.
+        metrics: the statistics there.
+        intervals: the intervals of :data:`~ertools.benchmarks.trajectory.intervals.
+            FITTED_KEYS` there, centred on that offset.
+        withheld: why a key of those has no interval (too few poses compared there).
+    """
+
+    offset_ns: int
+    metrics: Metrics
+    intervals: Mapping[str, Interval | None]
+    withheld: Mapping[str, str] = field(default_factory=dict)
+
+    def values(self) -> dict[str, float]:
+        m = self.metrics
+        every = {
+            "position_error": m.position_error,
+            "orientation_error": m.orientation_error,
+            "rmse": m.rmse,
+            "median": m.median,
+            "max": m.max,
+        }
+        return {k: every[k] for k in FITTED_KEYS}
 
 
 @dataclass(frozen=True, eq=False)
@@ -59,6 +90,8 @@ class TrajectoryResult:
             ``percentiles.p95``...; :mod:`ertools.benchmarks.trajectory.intervals`); empty
             with ``--draws 0``.
         uncertainty: how the intervals were obtained (None without intervals).
+        fitted: the statistics at the offset the clock audit fits, where the score used one
+            the data disagrees with (with intervals only; None otherwise).
     """
 
     robot_file: str
@@ -82,6 +115,7 @@ class TrajectoryResult:
     unscoreable_reason: str | None = None
     intervals: Mapping[str, Interval | None] = field(default_factory=dict)
     uncertainty: Uncertainty | None = None
+    fitted: FittedScore | None = None
 
     @property
     def nothing_scored(self) -> bool:
@@ -181,6 +215,8 @@ class TrajectoryResult:
             data["unscoreable_reason"] = self.unscoreable_reason
         if self.intervals:
             data = interval_keys(data, self.intervals)
+            if self.fitted is not None:
+                data = _with_fitted(data, self.fitted)
             if isinstance(data["percentiles"], dict):
                 pct = {k.split(".", 1)[1]: v for k, v in self.intervals.items() if "." in k}
                 data["percentiles"] = interval_keys(data["percentiles"], pct)
@@ -269,3 +305,18 @@ class TrajectoryResult:
 
 def _f(x: float) -> float | None:
     return None if np.isnan(x) else float(x)
+
+
+def _with_fitted(data: dict[str, Any], fitted: FittedScore) -> dict[str, Any]:
+    """``data`` with ``K_at_fitted_offset`` and its interval after ``K_interval`` for each
+    statistic of the fitted score."""
+    values = fitted.values()
+    out: dict[str, Any] = {}
+    for key, value in data.items():
+        out[key] = value
+        base = key.removesuffix("_interval")
+        if key.endswith("_interval") and base in values:
+            iv = fitted.intervals.get(base)
+            out[f"{base}{FITTED_SUFFIX}"] = values[base]
+            out[f"{base}{FITTED_SUFFIX}_interval"] = None if iv is None else iv.as_list()
+    return out

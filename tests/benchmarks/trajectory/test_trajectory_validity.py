@@ -12,7 +12,8 @@ import pytest
 import svg_figure
 
 from ertools.benchmarks.trajectory.config import SETTINGS_2015, TrajectoryConfig
-from ertools.benchmarks.trajectory.scoring import MIN_VALID_FRACTION, score_streams
+from ertools.benchmarks.trajectory.scoring import score_streams
+from ertools.benchmarks.trajectory.validity import MIN_VALID_FRACTION
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
 from ertools.report.figures import render
