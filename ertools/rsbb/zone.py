@@ -35,12 +35,15 @@ class ZoneSeries:
         executing: (N,) the stop button was enabled (the benchmark executing).
         states: the state texts' first lines (``Benchmark completed by the robot``...).
         items: the items at the last message.
+        team, run: the zone's team and run (the last message's).
     """
 
     t_ns: I64
     executing: np.ndarray
     states: tuple[str, ...]
     items: tuple[Item, ...]
+    team: str = ""
+    run: int = 0
 
     def spans(self) -> list[tuple[int, int]]:
         """The executing spans: from the first executing message to the first that is not
@@ -72,8 +75,11 @@ class ZoneSeries:
         return self.states[int(later[0])] if later.size else ""
 
 
-def read_zone(paths: PathsLike, code: str, team: str, run: int | None = None) -> ZoneSeries:
-    """The zone of ``code`` run by ``team`` (run ``run``) in every ``/core/to_gui`` message.
+def read_zone(
+    paths: PathsLike, code: str, team: str | None = None, run: int | None = None
+) -> ZoneSeries:
+    """The zone of ``code`` run by ``team`` (run ``run``; None: any) in every ``/core/to_gui``
+    message.
 
     Raises:
         TopicError: no ``/core/to_gui`` in the bag, or no message shows that zone.
@@ -90,7 +96,9 @@ def read_zone(paths: PathsLike, code: str, team: str, run: int | None = None) ->
     for m in read_messages(plist, CORE_TO_GUI_TOPIC):
         # One message a tenth of a second, a few zones each: the zone is picked by its fields.
         for zone in m.msg.zones:
-            if zone.code != code or zone.team != team or (run is not None and zone.run != run):
+            if zone.code != code or (team is not None and zone.team != team):
+                continue
+            if run is not None and zone.run != run:
                 continue
             times.append(m.t_ns)
             executing.append(bool(zone.stop_enabled))
@@ -99,7 +107,8 @@ def read_zone(paths: PathsLike, code: str, team: str, run: int | None = None) ->
             break
     if last is None:
         raise TopicError(
-            f"{plist[0]}: no {CORE_TO_GUI_TOPIC} message shows {code} of team {team}"
+            f"{plist[0]}: no {CORE_TO_GUI_TOPIC} message shows {code}"
+            + (f" of team {team}" if team is not None else "")
             + (f" run {run}" if run is not None else "")
         )
     items = tuple(
@@ -110,7 +119,12 @@ def read_zone(paths: PathsLike, code: str, team: str, run: int | None = None) ->
         )
     )
     return ZoneSeries(
-        np.asarray(times, dtype=np.int64), np.asarray(executing), tuple(states), items
+        np.asarray(times, dtype=np.int64),
+        np.asarray(executing),
+        tuple(states),
+        items,
+        str(last.team),
+        int(last.run),
     )
 
 
