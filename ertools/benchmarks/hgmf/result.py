@@ -159,8 +159,13 @@ class HgmfResult:
         return bool(completed) and not any(g.distance_error is not None for g in completed)
 
     def to_dict(self) -> dict[str, Any]:
-        """The score mapping (JSON), the result file's form."""
+        """The score mapping (JSON), the result file's form; with intervals, also
+        ``Avg distance error_interval`` and the ``uncertainty`` block (leaderboards read them)."""
         out: dict[str, Any] = plain(self.score)
+        iv = self.intervals.get(AVERAGE_KEY)
+        if iv is not None and self.uncertainty is not None:
+            out[f"{AVERAGE_KEY}_interval"] = iv.as_list()
+            out["uncertainty"] = self.uncertainty.to_dict()
         return out
 
     def to_yaml(self) -> str:
