@@ -11,6 +11,7 @@ from typing import Any
 
 from ertools.benchmarks.base import Benchmark, Input, Ranking, resolve_values
 from ertools.benchmarks.referee.config import CODES, RefereeOptions, make_options, title
+from ertools.benchmarks.referee.formula import leaderboard_columns
 from ertools.benchmarks.referee.pipeline import RefereeLogs, find_runs, load, score_runs
 from ertools.benchmarks.referee.result import RefereeResult
 
@@ -75,7 +76,12 @@ they add up to, how long the benchmark executed and how it ended; ranked by the 
         load=load,
         find_runs=find_runs,
         score_runs=score_runs,
-        ranking=Ranking(key=lambda r: r.rank_value, lower_is_better=False, text=RULE_TEXT),
+        ranking=Ranking(
+            key=lambda r: r.rank_value,
+            lower_is_better=False,
+            text=RULE_TEXT,
+            columns=leaderboard_columns,
+        ),
         score_keys=frozenset({"erl_rank", "achievements", "penalized_behaviors"}),
         sample=sample,
         bags_help="the run's bag (rsbb_logs/<CODE>/<team>/run_<n>_<date>.bag)",

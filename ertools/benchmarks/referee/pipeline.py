@@ -14,6 +14,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from ertools.benchmarks.base import notice
 from ertools.benchmarks.referee.config import RefereeOptions
 from ertools.benchmarks.referee.result import RefereeResult
 from ertools.errors import ConfigError, TopicError, UsageError
@@ -28,8 +29,9 @@ from ertools.rsbb.referee import (
     tally,
 )
 from ertools.rsbb.results import load_result
+from ertools.rsbb.sidefiles import find_side_files, run_place
 from ertools.rsbb.zone import ZoneSeries, read_zone
-from ertools.rsbb_states import REFBOX_STATE_TOPIC
+from ertools.rsbb_states import BENCHMARKS, REFBOX_STATE_TOPIC
 from ertools.streams import Provenance
 
 _END_TEXT = {
@@ -63,6 +65,17 @@ class RefereeLogs:
     executing_ns: int | None
     end: str
     notes: tuple[str, ...]
+    result: Path | None = None
+
+
+DESCRIPTION = Path("rsbb_etc", "config", "benchmarks_description.yaml")
+
+
+def description_file(bag: Path) -> Path | None:
+    """``rsbb_etc/config/benchmarks_description.yaml`` of the season holding ``bag``."""
+    root = run_place(bag).root
+    path = None if root is None else root / DESCRIPTION
+    return path if path is not None and path.is_file() else None
 
 
 def _where(bag: Path, options: RefereeOptions) -> tuple[str | None, int | None]:
@@ -109,8 +122,14 @@ def load(bags: Sequence[Path], options: RefereeOptions) -> RefereeLogs:
     bag = Path(bags[0])
     team, run = _where(bag, options)
     notes: list[str] = []
-    items = _from_result(options.result, options) if options.result is not None else None
-    source = f"result file {options.result}"
+    result = options.result
+    if result is None and BENCHMARKS[options.code].scripted:
+        side = find_side_files(bag, options.code, want={"result"}, team=team)
+        result = side.result
+        for line in side.found:
+            notice(line)
+    items = _from_result(result, options) if result is not None else None
+    source = f"result file {result}"
     zone: ZoneSeries | None = None
     try:
         zone = read_zone(bag, options.code, team, run)
@@ -139,7 +158,9 @@ def load(bags: Sequence[Path], options: RefereeOptions) -> RefereeLogs:
         executing, end = None, ""
     if executing is None:
         notes.append("the log does not say how long the benchmark executed: ranked last on time")
-    return RefereeLogs(bag, team or "", run, tuple(items), source, executing, end, tuple(notes))
+    return RefereeLogs(
+        bag, team or "", run, tuple(items), source, executing, end, tuple(notes), result
+    )
 
 
 def _values(items: Sequence[Item]) -> list[tuple[str, int]]:
@@ -156,17 +177,22 @@ def score_runs(loaded: RefereeLogs, runs: RefereeLogs, options: RefereeOptions) 
     notes = list(runs.notes)
     items = runs.items
     inputs = [str(runs.bag)]
-    if options.description is not None:
-        descriptions = load_descriptions(options.description)
-        inputs.append(str(options.description))
+    description = options.description
+    if description is None:
+        description = description_file(runs.bag)
+        if description is not None:
+            notice(f"the benchmarks description found in the RSBB layout: {description}")
+    if description is not None:
+        descriptions = load_descriptions(description)
+        inputs.append(str(description))
         spec = descriptions.get(options.code)
         if spec is None:
-            notes.append(f"{options.description} does not describe {options.code}")
+            notes.append(f"{description} does not describe {options.code}")
         else:
             items, differences = match_description(items, spec.items)
             notes += list(differences)
-    if options.result is not None:
-        inputs.append(str(options.result))
+    if runs.result is not None:
+        inputs.append(str(runs.result))
     counted = tally(items)
     if counted.disqualified:
         notes.append("disqualified: " + "; ".join(counted.disqualified))
