@@ -71,6 +71,7 @@ SCENARIOS: dict[str, str] = {
     "stationary": "ertools.samples.stationary:generate",
     "timeline": "ertools.samples.timeline_folder:generate",
     "hgmf": "ertools.samples.hgmf:generate",
+    "season2019": "ertools.samples.season:generate",
 }
 
 
