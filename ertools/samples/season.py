@@ -29,7 +29,8 @@ from typing import Any
 
 import yaml
 
-from ertools.samples.hgmf import T0, GoalPlan, RunPlan, build, expected, write_config
+from ertools.samples.hgmf import T0 as HGMF_T0
+from ertools.samples.hgmf import GoalPlan, RunPlan, build, expected, write_config
 from ertools.samples.rsbb import write_rsbb_run
 from ertools.samples.rsbb_scenario import Goal, RsbbScenario, Save
 from ertools.samples.rsbb_task import COMPLETED, STOPPED, TaskScenario, write_task_run
@@ -37,6 +38,9 @@ from ertools.samples.scenario import tol
 
 S = 1_000_000_000
 MS = 1_000_000
+# Saturday 13 April 2019, 10:00:00 UTC: the day after the HGMF sample's run (no two sample
+# files share a name).
+T0 = HGMF_T0 + 24 * 3600 * S
 TEAMS = ("simbot", "homebot")
 OBJECTS = (
     {"id": 1, "description": "mug"},
