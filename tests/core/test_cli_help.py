@@ -58,7 +58,9 @@ def test_a_group_alone_shows_a_usage_naming_what_it_needs(
 ) -> None:
     assert main(["score"]) == 2
     err = capsys.readouterr().err
-    usage, error = err.splitlines()
+    lines = err.splitlines()
+    # the error continues on further lines once the names fill one
+    usage, error = lines[0], " ".join(ln.strip() for ln in lines[1:])
     assert usage.startswith("usage: ertools score ")
     for needed in (*registry.names(), "BAG..."):
         assert needed in usage
@@ -115,7 +117,10 @@ TITLES = {
     "trajectory": "Offline trajectory benchmark",
 }
 NAMESPACES = {"trajectory": "rockin"}
-PAIRS = [(asked, log) for asked in registry.names() for log in registry.names() if asked != log]
+# The benchmarks whose logs a topic namespace names (2015); an RSBB run is recognised by its
+# folder instead (rsbb_logs/<CODE>/...), tests/benchmarks/hgmf/test_hgmf_bad_input.py.
+NAMED = [n for n in registry.names() if registry.get(n).log_namespace]
+PAIRS = [(asked, log) for asked in NAMED for log in NAMED if asked != log]
 
 
 @pytest.mark.parametrize(("asked", "log"), PAIRS)

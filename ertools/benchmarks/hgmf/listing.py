@@ -64,7 +64,7 @@ def score_listing(
         entry["completed"] = a.times.completed
         if a.times.completed:
             scored = g.distance_error is not None
-            if options.restarted_goals_2019 or scored:
+            if scored or (options.restarted_goals_2019 and a.restarted):
                 counted += 1
                 grasped += int(g.grasped)
             if a.restarted:
@@ -97,4 +97,10 @@ def score_listing(
         score[EXECUTION_TIME] = float(to_sec(elapsed))
     if len(flow.begun) > len(goals):  # the last iteration ended before its goal (a stop)
         score[f"goal_{flow.begun[-1]}"] = {}
+    if not options.exact and counted and any(g.distance_error is not None for g in goals):
+        # ertools' reading: the totals over every goal counted (the script wrote them at each
+        # measured goal only, so a goal counted after the last one left them stale)
+        average = total / counted
+        score[GRASPED] = grasp_text(grasped, objects)
+        score[AVERAGE] = average
     return Listing(score, average, counted, grasped, notes, failures)

@@ -71,10 +71,11 @@ VERSIONS = (
         SCRIPT,
         "2bb8a41",
         "2019-04-08",
-        "ERL Consumer 2019 season",
+        "development (rockin-robot-challenge/rsbb: the code of the ERL 2018-19 season; no "
+        "event evidenced)",
         "a new script: a grasp when the object rises 3 cm over its height before the goal "
         "at a 10 Hz check; the distance of the object to the target in the table's plane, "
         "averaged over the goals completed",
-        "--rules 2019",
+        "`--rules 2019`",
     ),
 )

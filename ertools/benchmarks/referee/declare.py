@@ -40,9 +40,9 @@ RULE_TEXT = (
 )
 
 EPILOG = """examples:
-  ertools score hwv rsbb_logs/HWV/teamA/run_1_2019-04-11-10-00-00.bag
-  ertools score stb rsbb_logs/STB/teamA/run_2_DATE.bag --result RESULT.yaml
-  ertools score hgtkmh RUN.bag --description rsbb_etc/config/benchmarks_description.yaml
+  ertools score {name} rsbb_logs/{code}/teamA/run_1_2019-04-11-10-00-00.bag
+  ertools score {name} RUN.bag --description rsbb_etc/config/benchmarks_description.yaml
+  ertools score {name} RUN.bag --result RESULT.yaml        # a scripted run's referee_score
 
 Nothing is recomputed: the referee scored these benchmarks. The items (achievements,
 penalized and disqualifying behaviors, benchmarks_description.yaml) are read from the result
@@ -70,7 +70,7 @@ def _declare(name: str) -> Benchmark[RefereeOptions, RefereeLogs, RefereeLogs, R
 
 Its items (achievements, penalized behaviors, disqualifying behaviors) with their values, what
 they add up to, how long the benchmark executed and how it ended; ranked by the ERL rule.""",
-        epilog=EPILOG,
+        epilog=EPILOG.format(name=name, code=code),
         inputs=INPUTS,
         make_options=options,
         load=load,

@@ -84,3 +84,32 @@ def test_ertools_reading(capsys: pytest.CaptureFixture[str], answers: dict[str, 
         assert f"restores 2019 [{key}]" in err
     assert "differs from 2019:" in err
     assert "3 of 24 fields differ" in err  # the two totals and goal_2's distance
+
+
+@pytest.mark.parametrize(
+    ("option", "grasped", "average"),
+    [
+        # the restarted goal_2 counts in the divisor and the grasps: 0.03 / 2
+        (["--restarted-goals", "2019"], "2 out of 4", 0.03 / 2),
+        # the timer sees the same 10 cm lifts: the same counts as ertools' reading
+        (["--grasp-sampling", "timer"], "1 out of 4", 0.03),
+        # goal_2's position across its 0.3 s gap is measured: (0.03 + 0.05) / 2
+        (["--gt-gaps", "interpolate"], "2 out of 4", (0.03 + 0.05) / 2),
+    ],
+    ids=["restarted-goals", "grasp-sampling", "gt-gaps"],
+)
+def test_each_option_restores_one_behaviour(
+    capsys: pytest.CaptureFixture[str],
+    answers: dict[str, Any],
+    option: list[str],
+    grasped: str,
+    average: float,
+) -> None:
+    score, err = _score(capsys, *option)
+    d_tol = answers["tolerance"]["distance_error"]["abs"]
+    assert score["Objects grasped"] == grasped
+    assert score["Avg distance error"] == pytest.approx(average, abs=d_tol)
+    key = {"--restarted-goals": "restarted-goals", "--grasp-sampling": "grasp-sampling"}
+    restored = key.get(option[0], "gt-gaps")
+    assert f"[hgmf.{restored}]" not in err  # that rule at the script's, the others not
+    assert err.count("differs from 2019:") == 2
