@@ -508,7 +508,7 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
         if isinstance(entry, dict):
             places[str(entry.get("place"))] = places.get(str(entry.get("place")), 0) + 1
     nav = [(b.anchor, b.title) for b in boards] + [
-        ("live", "Live 2015"),
+        ("live", "Live scores"),
         ("timeline", "Timeline"),
         ("problems", f"Problems ({len(problems)})"),
         ("deviations", "Deviations"),
