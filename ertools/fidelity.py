@@ -37,6 +37,7 @@ RULE_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm3w.rules",
     "ertools.benchmarks.trajectory.rules",
     "ertools.benchmarks.common.ending",
+    "ertools.benchmarks.hnf.rules",
 )
 
 
@@ -149,6 +150,7 @@ VERSION_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm1.rules",
     "ertools.benchmarks.fbm2h.rules",
     "ertools.benchmarks.fbm3w.rules",
+    "ertools.benchmarks.hnf.rules",
 )
 
 
