@@ -26,6 +26,7 @@ REGISTRY: dict[str, str] = {
     "fbm3w": "ertools.benchmarks.fbm3w.declare:BENCHMARK",
     "trajectory": "ertools.benchmarks.trajectory.declare:BENCHMARK",
     "hnf": "ertools.benchmarks.hnf.declare:BENCHMARK",
+    "hpff": "ertools.benchmarks.hpff.declare:BENCHMARK",
 }
 
 
