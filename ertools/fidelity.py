@@ -38,6 +38,7 @@ RULE_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.trajectory.rules",
     "ertools.benchmarks.common.ending",
     "ertools.benchmarks.hnf.rules",
+    "ertools.benchmarks.hpff.rules",
 )
 
 
@@ -151,6 +152,7 @@ VERSION_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm2h.rules",
     "ertools.benchmarks.fbm3w.rules",
     "ertools.benchmarks.hnf.rules",
+    "ertools.benchmarks.hpff.rules",
 )
 
 
