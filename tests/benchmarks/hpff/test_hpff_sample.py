@@ -58,3 +58,29 @@ def test_run_2_stopped() -> None:
     assert score["Result"].startswith("Benchmark failed")
     assert score[DEVIATION] == pytest.approx(answers[DEVIATION], abs=1e-3)
     assert "the run was stopped" in err
+
+
+def test_report_plot_and_foxglove(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    ran = run(
+        [
+            "score",
+            "hpff",
+            str(RUNS[0]),
+            "--draws",
+            "20",
+            "--report",
+            str(out / "report"),
+            "--plot",
+            str(out / "hpff.png"),
+            "--foxglove",
+            str(out / "hpff.mcap"),
+        ]
+    )
+    assert ran.code == 0, ran.stderr
+    assert "interval: Average deviation from desired distance" in ran.stderr
+    report = out / "report"
+    assert (report / "index.html").is_file() and (report / "samples.csv").is_file()
+    assert "Benchmark reliability" in (report / "score.yaml").read_text()
+    assert (out / "hpff.png").stat().st_size > 10_000
+    assert (out / "hpff.mcap").stat().st_size > 1_000
