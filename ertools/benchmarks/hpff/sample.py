@@ -3,8 +3,9 @@
 A person wearing a cap (tilted 0.1 rad forward) walks a circle of 1.5 m radius at 0.2 m/s;
 the robot follows on the same circle, 11 s behind (about 2 m) give or take a slow sway of
 1.5 s. Its marker set sits 0.4 m above its odometric centre, 10 cm ahead, 5 cm left, turned
--0.3 rad (``transform-simbot.yaml``). The mocap adds noise (0.2 mm, 0.5 mrad) and jitter, on ``/tf`` only (the pose topics,
-which neither the script nor ertools reads, are left out to keep the sample small).
+-0.3 rad (``transform-simbot.yaml``). The mocap adds noise (0.2 mm, 0.5 mrad) and jitter,
+on ``/tf`` only (the pose topics, which neither the script nor ertools reads, are left out to
+keep the sample small).
 
 - ``run_1``: the config's goal_timeout is 40 s; the RefBox times the goal out; the cap is lost
   for 2 s at 25 s (the relative lookups fail, the grid samples there are not measured); the
