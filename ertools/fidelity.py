@@ -37,6 +37,8 @@ RULE_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm3w.rules",
     "ertools.benchmarks.trajectory.rules",
     "ertools.benchmarks.common.ending",
+    "ertools.benchmarks.hnf.rules",
+    "ertools.benchmarks.hpff.rules",
     "ertools.benchmarks.hgmf.rules",
 )
 
@@ -150,6 +152,8 @@ VERSION_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm1.rules",
     "ertools.benchmarks.fbm2h.rules",
     "ertools.benchmarks.fbm3w.rules",
+    "ertools.benchmarks.hnf.rules",
+    "ertools.benchmarks.hpff.rules",
     "ertools.benchmarks.hgmf.rules",
 )
 

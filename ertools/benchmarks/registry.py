@@ -26,6 +26,7 @@ REGISTRY: dict[str, str] = {
     "fbm3w": "ertools.benchmarks.fbm3w.declare:BENCHMARK",
     "trajectory": "ertools.benchmarks.trajectory.declare:BENCHMARK",
     "hnf": "ertools.benchmarks.hnf.declare:BENCHMARK",
+    "hpff": "ertools.benchmarks.hpff.declare:BENCHMARK",
     "hgmf": "ertools.benchmarks.hgmf.declare:BENCHMARK",
     "hgtkmh": "ertools.benchmarks.referee.declare:HGTKMH",
     "hwv": "ertools.benchmarks.referee.declare:HWV",

@@ -70,6 +70,8 @@ SCENARIOS: dict[str, str] = {
     "robotlog": "ertools.samples.robotlog:generate",
     "stationary": "ertools.samples.stationary:generate",
     "timeline": "ertools.samples.timeline_folder:generate",
+    "hnf": "ertools.benchmarks.hnf.sample:generate",
+    "hpff": "ertools.benchmarks.hpff.sample:generate",
     "hgmf": "ertools.samples.hgmf:generate",
     "season2019": "ertools.samples.season:generate",
 }

@@ -117,8 +117,8 @@ TITLES = {
     "trajectory": "Offline trajectory benchmark",
 }
 NAMESPACES = {"trajectory": "rockin"}
-# The benchmarks whose logs a topic namespace names (2015); an RSBB run is recognised by its
-# folder instead (rsbb_logs/<CODE>/...), tests/benchmarks/hgmf/test_hgmf_bad_input.py.
+# The benchmarks whose logs their topics name (the RSBB benchmarks share /rsbb/...: their run
+# bags are told apart by their folder, rsbb_logs/<CODE>/, tests/benchmarks/hnf/).
 NAMED = [n for n in registry.names() if registry.get(n).log_namespace]
 PAIRS = [(asked, log) for asked in NAMED for log in NAMED if asked != log]
 

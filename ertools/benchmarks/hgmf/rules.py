@@ -71,8 +71,7 @@ VERSIONS = (
         SCRIPT,
         "2bb8a41",
         "2019-04-08",
-        "development (rockin-robot-challenge/rsbb: the code of the ERL 2018-19 season; no "
-        "event evidenced)",
+        "ERL @Home 2018-19 (its only version)",
         "a new script: a grasp when the object rises 3 cm over its height before the goal "
         "at a 10 Hz check; the distance of the object to the target in the table's plane, "
         "averaged over the goals completed",

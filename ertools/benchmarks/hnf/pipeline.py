@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -280,7 +280,15 @@ def score_runs(logs: HnfLogs, flow: HnfFlow, options: HnfOptions) -> HnfResult:
             "no waypoint was reached with a measured pose: position_accuracy and "
             "orientation_accuracy are null"
         )
-    comparison = compare_scores(score, logs.run.live, logs.result_file)
+    # compared in the script's own format (pose dumps), so that only numbers can differ
+    form = (
+        score
+        if options.score_format_2019
+        else score_listing(
+            segments, flow, replace(options, score_format_2019=True), totals, position, orientation
+        )
+    )
+    comparison = compare_scores(form, logs.run.live, logs.result_file)
     intervals, uncertainty = hnf_intervals(logs, segments, summed, divisor, options)
     provenance = Provenance(
         inputs=(str(logs.bag), logs.config_source, logs.transform_source)
@@ -333,7 +341,7 @@ def _flow_warnings(flow: HnfFlow, segments: list[HnfSegment], options: HnfOption
         )
         out.append(
             f"{what} the run {ns_to_s(flow.stop_ns - flow.t_start_ns):.3f} s after its start"
-            + ("" if flow.totals else " while the robot's pose was being acquired")
+            + ("" if flow.totals else " (the script returned without its totals)")
         )
     for s in segments:
         if s.flow.skipped:

@@ -22,6 +22,7 @@ OWN_PACKAGE = {
     "fbm3w": "fbm3w",
     "trajectory": "trajectory",
     "hnf": "hnf",
+    "hpff": "hpff",
     "hgmf": "hgmf",
     "hgtkmh": "referee",
     "hwv": "referee",
