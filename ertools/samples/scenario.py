@@ -72,7 +72,7 @@ SCENARIOS: dict[str, str] = {
     "timeline": "ertools.samples.timeline_folder:generate",
     "hnf": "ertools.benchmarks.hnf.sample:generate",
     "hpff": "ertools.benchmarks.hpff.sample:generate",
-    "hgmf": "ertools.samples.hgmf:generate",
+    "hgmf": "ertools.benchmarks.hgmf.sample:generate",
     "season2019": "ertools.samples.season:generate",
 }
 

@@ -7,7 +7,7 @@ benchmarks_description.yaml`` (the referee items, in ertools' own words) and
 ``rsbb_bmbox/scripts/benchmark_configs/HGMF.yaml``. Teams ``simbot`` and ``homebot`` each ran:
 
 - HGMF (FBM6, scripted): simbot puts its three objects 2, 4 and 3 cm from their targets;
-  homebot 5 and 7 cm, one goal timed out (:mod:`ertools.samples.hgmf`);
+  homebot 5 and 7 cm, one goal timed out (:mod:`ertools.benchmarks.hgmf.sample`);
 - HGTKMH (task benchmark 1, referee-scored): both 5 achievements and 1 penalty, homebot 5 s
   faster: the time decides;
 - HWV (task benchmark 2): simbot 3 achievements; homebot 4, but it hit a visitor: disqualified;
@@ -29,8 +29,8 @@ from typing import Any
 
 import yaml
 
-from ertools.samples.hgmf import T0 as HGMF_T0
-from ertools.samples.hgmf import GoalPlan, RunPlan, build, expected, write_config
+from ertools.benchmarks.hgmf.sample import T0 as HGMF_T0
+from ertools.benchmarks.hgmf.sample import GoalPlan, RunPlan, build, expected, write_config
 from ertools.samples.rsbb import write_rsbb_run
 from ertools.samples.rsbb_scenario import Goal, RsbbScenario, Save
 from ertools.samples.rsbb_task import COMPLETED, STOPPED, TaskScenario, write_task_run

@@ -18,9 +18,9 @@ from rsbb_replay import hgmf as replay
 from rsbb_replay.fromlog import timeline_from_bag
 from rsbb_replay.world import World, run_script
 
+from ertools.benchmarks.hgmf.sample import OBJECTS, SAMPLE, GoalPlan, RunPlan, build
 from ertools.cli.main import main
 from ertools.rsbb.score import flatten
-from ertools.samples.hgmf import OBJECTS, SAMPLE, GoalPlan, RunPlan, build
 from ertools.samples.rsbb import write_rsbb_run
 
 pytestmark = pytest.mark.slow  # each writes a run bag and scores it (~2 s)

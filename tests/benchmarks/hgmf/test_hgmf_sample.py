@@ -1,6 +1,6 @@
 """``ertools score hgmf`` on the simulated sample run (sample_bags/hgmf/): its answers come
-from the noiseless truth (ertools/samples/hgmf.py), the tolerances are theirs (2 mm of mocap
-noise on a distance, exact times and grasps). Side files found in the RSBB layout; the live
+from the noiseless truth (ertools/benchmarks/hgmf/sample.py), the tolerances are theirs (2 mm
+of mocap noise on a distance, exact times and grasps). Side files found in the RSBB layout; the live
 score and the result file agree with --rules 2019; ertools' reading differs where the sample
 planted it (a restarted goal, a 0.3 s tracking loss under a lookup)."""
 
