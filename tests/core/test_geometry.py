@@ -8,7 +8,7 @@ import sys
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 from scipy.spatial.transform import Rotation, Slerp
@@ -219,6 +219,9 @@ def test_numpy_compose_matches_scipy(
 @settings(max_examples=80, deadline=None)
 @given(quat, quat, st.floats(0.0, 1.0))
 def test_slerp_matches_scipy(q0: np.ndarray, q1: np.ndarray, alpha: float) -> None:
+    # rotations exactly pi apart (orthogonal quaternions) have two shortest arcs, and either
+    # library may take either: no answer to compare (a real pose pair 1/120 s apart never is)
+    assume(abs(float(np.dot(unit(q0), unit(q1)))) > 1e-6)
     expected = Slerp([0.0, 1.0], Rotation.from_quat(np.stack([q0, q1])))([alpha]).as_quat()[0]
     got = slerp(q0[None], q1[None], np.array([alpha]))[0]
     assert min(np.abs(got - expected).max(), np.abs(got + expected).max()) < 1e-7
