@@ -85,6 +85,19 @@ def _items(side: SideFiles, params: Any, options: HopfOptions) -> HopfItems:
     return load_items(side.items)
 
 
+def script_params(side: SideFiles, run: RsbbRun, result_file: RsbbResult | None) -> Any:
+    """The benchmark config the script started with: the file given or found, else the first
+    live score's copy (saved before ``execute()`` began), else the result file's (which holds
+    the config as the script left it: November 2017 removed the items it drew)."""
+    if side.config is not None:
+        return read_side_yaml(side.config, f"{CODE} config")
+    for message in run.live:
+        info = message.result.get("benchmark_info") if message.result is not None else None
+        if isinstance(info, dict) and info.get("params") not in (None, "None"):
+            return info["params"]
+    return None if result_file is None else result_file.params
+
+
 def load(bags: Sequence[Path], options: HopfOptions) -> HopfLogs:
     """The run bag's events and ``/tf``, the items, the config and the result file.
 
@@ -114,13 +127,9 @@ def load(bags: Sequence[Path], options: HopfOptions) -> HopfLogs:
         raise ConfigError(
             f"the result file is a {result_file.code} run's, not HOPF's", path=result_file.path
         )
-    params: Any = None
-    if side.config is not None:
-        params = read_side_yaml(side.config, "HOPF config")
-    elif result_file is not None:
-        params = result_file.params
-    items = _items(side, params, options)
     run = read_rsbb_run(paths)
+    params = script_params(side, run, result_file)
+    items = _items(side, params, options)
     tracks = read_tf_tracks(paths)
     origin = min(summary(p).start_ns for p in paths)
     return HopfLogs(paths, run, tracks, items, params, result_file, side, origin)
