@@ -21,9 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ertools.arrays import F64, I64
-
-NS_PER_S = 1_000_000_000
+from ertools.arrays import F64
 
 
 @dataclass(frozen=True, eq=False)
@@ -93,13 +91,3 @@ def totals(class_ok: np.ndarray, instance_ok: np.ndarray, pose_score: F64, divis
     classes = float(np.count_nonzero(class_ok))
     instances = float(np.count_nonzero(instance_ok))
     return Totals(classes / divisor, instances / divisor, running_sum(pose_score) / divisor)
-
-
-def duration_to_sec(ns: I64 | int) -> F64:
-    """``genpy.Duration.to_sec()`` of int64 nanoseconds: whole seconds and nanoseconds added as
-    floats (``float(secs) + float(nsecs) / 1e9``), which may differ from ``ns / 1e9`` in the
-    last bit."""
-    arr = np.asarray(ns, dtype=np.int64)
-    secs, nsecs = np.divmod(arr, NS_PER_S)
-    out: F64 = secs.astype(np.float64) + nsecs.astype(np.float64) / 1e9
-    return out

@@ -19,10 +19,11 @@ import numpy as np
 import yaml
 
 from ertools.benchmarks.hopf.config import CLIP_TRANSLATION_M, HopfOptions
-from ertools.benchmarks.hopf.formula import PoseTerms, duration_to_sec, pose_terms, totals
+from ertools.benchmarks.hopf.formula import PoseTerms, pose_terms, totals
 from ertools.benchmarks.hopf.items import HopfItem, HopfItems
 from ertools.benchmarks.hopf.runs import Iteration
-from ertools.rsbb.log import GoalOutcome
+from ertools.rsbb.clock import GoalTimes, goal_times
+from ertools.rsbb.py2 import to_sec
 
 Pose2 = tuple[float, float, float]
 N_GOALS = 10  # the script's N (l. 54)
@@ -50,47 +51,13 @@ class Truth:
     reason: str | None = None
 
 
-@dataclass(frozen=True)
-class GoalTimes:
-    """When the script took its start and end times, and what the goal object said."""
-
-    start_ns: int | None
-    end_ns: int | None
-    timeout: bool | None
-    completed: bool
-
-
-def goal_times(it: Iteration, stop_ns: int | None) -> GoalTimes | None:
-    """The script's view of the iteration's goal (BenchmarkObjects.py's ``request_goal`` and
-    ``wait_goal_result``, docs/rsbb.md "A run, event by event"); None: the log ends first."""
-    goal = it.goal
-    if goal is None:
+def script_goal(it: Iteration, stop_ns: int | None) -> GoalTimes | None:
+    """The script's view of the iteration's goal (None: no goal, or the log ends first); its
+    clock when it sent the goal was the removal's completion."""
+    if it.goal is None:
         return None
     clock = it.remove.t_done_ns if it.remove is not None and it.remove.t_done_ns else 0
-
-    def stopped_by(t: int) -> bool:
-        return stop_ns is not None and stop_ns <= t
-
-    ended = goal.outcome in (GoalOutcome.RESULT, GoalOutcome.TIMEOUT) and goal.t_end_ns is not None
-    returns = goal.t_start_ns
-    if returns is None and ended and goal.outcome is GoalOutcome.TIMEOUT:
-        returns = goal.t_end_ns  # timed out while the robot prepared: request_goal ends then
-    if returns is None or stopped_by(returns):
-        if stop_ns is None:
-            return None
-        start = max(clock, stop_ns)
-        return GoalTimes(start, start, None, False)
-    start = max(clock, returns)
-    if goal.t_start_ns is None:  # the timeout during the preparation
-        return GoalTimes(start, start, True, False)
-    if not ended or goal.t_end_ns is None or stopped_by(goal.t_end_ns):
-        if stop_ns is None:
-            return None
-        return GoalTimes(start, max(start, stop_ns), None, False)
-    end = max(start, goal.t_end_ns)
-    if goal.outcome is GoalOutcome.TIMEOUT:
-        return GoalTimes(start, end, True, False)
-    return GoalTimes(start, end, False, True)
+    return goal_times(it.goal, clock, stop_ns)
 
 
 @dataclass(frozen=True)
@@ -188,10 +155,7 @@ class GoalRecord:
 
     @property
     def segment_ns(self) -> int | None:
-        t = self.times
-        if t is None or t.start_ns is None or t.end_ns is None:
-            return None
-        return t.end_ns - t.start_ns
+        return None if self.times is None else self.times.segment_ns
 
 
 @dataclass(frozen=True)
@@ -289,7 +253,7 @@ def _precompute(
     pairs: list[tuple[int, Pose2, Pose2]] = []
     for k, it in enumerate(its):
         item = items.by_id(it.item_id) if it.item_id is not None else None
-        times = goal_times(it, stop_ns)
+        times = script_goal(it, stop_ns)
         truth = truths[k]
         answer: Answer | None = None
         class_ok = instance_ok = None
@@ -434,13 +398,13 @@ def run_script(
             out.append(_with(rec, status))
             break
         times = rec.times
-        seg = (times.end_ns or 0) - (times.start_ns or 0)
+        seg = times.segment_ns
         exec_ns += seg
         if not late:
             data[g] = {}
         data[g]["timeout"] = times.timeout
         data[g]["completed"] = times.completed
-        data[g]["segment_time"] = float(duration_to_sec(seg))
+        data[g]["segment_time"] = to_sec(seg)
         save()
         if times.completed:
             answer = rec.answer
@@ -476,7 +440,7 @@ def run_script(
         data["class_accuracy"] = tot.class_accuracy
         data["instance_accuracy"] = tot.instance_accuracy
         data["pose_score"] = None if unknown_pose else tot.pose_score
-        data["execution_time"] = float(duration_to_sec(exec_ns))
+        data["execution_time"] = to_sec(exec_ns)
         divisor = i
         save()
         if times.timeout is None:  # the stop came during the goal: the loop ends
@@ -526,7 +490,7 @@ def run_ertools(
             exec_ns += seg
             entry["timeout"] = rec.times.timeout
             entry["completed"] = rec.times.completed
-            entry["segment_time"] = float(duration_to_sec(seg))
+            entry["segment_time"] = to_sec(seg)
         a = rec.answer
         if status == "scored" and a is not None:
             assert rec.item is not None and rec.truth is not None and rec.truth.pose is not None
@@ -570,7 +534,7 @@ def run_ertools(
     data["class_accuracy"] = tot.class_accuracy
     data["instance_accuracy"] = tot.instance_accuracy
     data["pose_score"] = tot.pose_score
-    data["execution_time"] = float(duration_to_sec(exec_ns))
+    data["execution_time"] = to_sec(exec_ns)
     return Scored(data, tuple(out), None, tuple(notes), divisor)
 
 
