@@ -53,8 +53,6 @@ class Rule:
         ertools: what ertools does by default, and why.
         option: the command-line option that restores 2015; empty where none can (then
             ``ertools`` says why).
-        season: the code the rule differs from: ``2015`` (the 2015 nodes), or a later
-            season whose scripts ``node_2015`` then describes (``2019``: the RSBB scripts).
     """
 
     key: str
@@ -64,7 +62,6 @@ class Rule:
     node_2015: str
     ertools: str
     option: str
-    season: str = "2015"
 
     def deviation(self, detail: str) -> Deviation:
         """The line to print for one result: ``detail`` says what differs in this result."""
@@ -107,7 +104,7 @@ class Deviation(str):
     def __new__(cls, rule: Rule, detail: str) -> Deviation:
         text = detail
         if rule.option and rule.option not in detail:
-            text += f"; {rule.option} restores {rule.season}"
+            text += f"; {rule.option} restores 2015"
         self = super().__new__(cls, f"{text} [{rule.key}]")
         self.rule = rule
         self.detail = detail
@@ -115,15 +112,6 @@ class Deviation(str):
 
     def __reduce__(self) -> tuple[type[Deviation], tuple[Rule, str]]:
         return (Deviation, (self.rule, self.detail))
-
-
-
-def deviation_line(deviation: str) -> str:
-    """The line printed for a deviation: ``differs from <season>: <text>`` (2015 for a plain
-    text, as a result read back from JSON holds)."""
-    rule = getattr(deviation, "rule", None)
-    season = rule.season if isinstance(rule, Rule) else "2015"
-    return f"differs from {season}: {deviation}"
 
 
 def all_rules() -> tuple[Rule, ...]:
