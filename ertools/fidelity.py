@@ -37,6 +37,8 @@ RULE_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm3w.rules",
     "ertools.benchmarks.trajectory.rules",
     "ertools.benchmarks.common.ending",
+    "ertools.benchmarks.hopf.rules",
+    "ertools.benchmarks.hppf.rules",
 )
 
 
@@ -149,6 +151,8 @@ VERSION_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm1.rules",
     "ertools.benchmarks.fbm2h.rules",
     "ertools.benchmarks.fbm3w.rules",
+    "ertools.benchmarks.hopf.rules",
+    "ertools.benchmarks.hppf.rules",
 )
 
 

@@ -338,7 +338,7 @@ def score_runs(logs: HopfLogs, runs: HopfRuns, options: HopfOptions) -> HopfResu
     ]
     comparison = None
     if logs.run.live or logs.result_file is not None:
-        comparison = compare_scores(scored.score, logs.run.live, logs.result_file)
+        comparison = compare_scores(script_fields(scored.score), logs.run.live, logs.result_file)
     notes = list(validity)
     if options.script is not None:
         notes.append(f"reproducing: {SCRIPT_TEXT[options.rules]}")
@@ -372,6 +372,20 @@ def score_runs(logs: HopfLogs, runs: HopfRuns, options: HopfOptions) -> HopfResu
             ),
         ),
     )
+
+
+#: The keys ertools' reading adds to a goal (the script never wrote them).
+EXTRA_GOAL_KEYS = ("status", "answer_problem", "unscoreable_reason")
+
+
+def script_fields(score: dict[str, Any]) -> dict[str, Any]:
+    """The score without the keys ertools adds, for the comparison with the script's."""
+    return {
+        k: {kk: vv for kk, vv in v.items() if kk not in EXTRA_GOAL_KEYS}
+        if isinstance(v, dict)
+        else v
+        for k, v in score.items()
+    }
 
 
 def scored_goals(result: HopfResult) -> tuple[GoalRecord, ...]:

@@ -23,6 +23,7 @@ RULE_TRANSLATION_CLIP = Rule(
     ),
     ertools="t = min(distance, 1 m), so a pose score stays in [0, 1] (as fbm1.translation-clip)",
     option="--clip-translation none",
+    season="2019",
 )
 
 RULE_THETA_WRAP = Rule(
@@ -36,6 +37,7 @@ RULE_THETA_WRAP = Rule(
     ),
     ertools="the error wrapped fully to [-pi, pi)",
     option="--single-wrap",
+    season="2019",
 )
 
 RULE_NAMES = Rule(
@@ -46,6 +48,7 @@ RULE_NAMES = Rule(
     node_2015=f"{SCRIPT} l. 256, 261: `==` on the strings, surrounding blanks count",
     ertools="compared without surrounding blanks (as fbm1.names)",
     option="--exact-names",
+    season="2019",
 )
 
 RULE_STOPPED_GOAL = Rule(
@@ -63,6 +66,7 @@ RULE_STOPPED_GOAL = Rule(
         "interrupted is listed and not counted"
     ),
     option="--stopped-goals 2019",
+    season="2019",
 )
 
 RULE_ANSWER_FIELDS = Rule(
@@ -80,6 +84,7 @@ RULE_ANSWER_FIELDS = Rule(
         "class or instance incorrect), the field named; the run goes on"
     ),
     option="--rules 2019",
+    season="2019",
 )
 
 RULE_GT_GAPS = Rule(
@@ -96,6 +101,7 @@ RULE_GT_GAPS = Rule(
         "unscoreable, left out of the totals, the reason given"
     ),
     option="--gt-gaps interpolate",
+    season="2019",
 )
 
 # The versions of the script (rows of the version table, ertools.fidelity.NodeVersion).

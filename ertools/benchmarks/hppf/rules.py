@@ -28,6 +28,7 @@ RULE_ANSWER_FIELDS = Rule(
         "the run goes on"
     ),
     option="--rules 2019",
+    season="2019",
 )
 
 RULE_NAMES = Rule(
@@ -38,6 +39,7 @@ RULE_NAMES = Rule(
     node_2015=f"{SCRIPT} l. 190: `lower()` on both names, surrounding blanks count",
     ertools="lower-cased and compared without surrounding blanks",
     option="--exact-names",
+    season="2019",
 )
 
 RULE_GT_GAPS = Rule(
@@ -55,6 +57,7 @@ RULE_GT_GAPS = Rule(
         "name still counts"
     ),
     option="--gt-gaps interpolate",
+    season="2019",
 )
 
 VERSIONS = (
