@@ -105,7 +105,7 @@ def read_answer(text: str) -> Answer:
         return Answer(text, data, None, None, None, None, f"the result is {what}", True)
     missing = [k for k in ("x", "y", "theta", "class", "instance") if k not in data]
     item_class, instance = data.get("class"), data.get("instance")
-    raw = tuple(data.get(k) for k in ("x", "y", "theta"))
+    raw: tuple[Any, Any, Any] = (data.get("x"), data.get("y"), data.get("theta"))
     unreadable = [
         k for k, v in zip(("x", "y", "theta"), raw, strict=True) if k in data and not _is_number(v)
     ]
@@ -114,13 +114,13 @@ def read_answer(text: str) -> Answer:
         problems.append("no " + ", ".join(missing))
     if unreadable:
         problems.append(", ".join(f"{k} {data[k]!r} is no number" for k in unreadable))
-    if missing or unreadable:
-        pose_ok = not any(k in ("x", "y", "theta") for k in missing + unreadable)
-        values = (raw[0], raw[1], raw[2]) if pose_ok else None
-        pose = (float(raw[0]), float(raw[1]), float(raw[2])) if pose_ok else None
-        return Answer(text, data, pose, values, item_class, instance, "; ".join(problems), True)
-    pose = (float(raw[0]), float(raw[1]), float(raw[2]))
-    return Answer(text, data, pose, (raw[0], raw[1], raw[2]), item_class, instance, None, False)
+    pose_ok = not any(k in ("x", "y", "theta") for k in missing + unreadable)
+    pose = (float(raw[0]), float(raw[1]), float(raw[2])) if pose_ok else None
+    fatal = bool(missing or unreadable)
+    if pose is not None and not all(math.isfinite(v) for v in pose):
+        problems.append("a pose value is not finite")  # the script went on with it
+    problem = "; ".join(problems) or None
+    return Answer(text, data, pose, raw if pose_ok else None, item_class, instance, problem, fatal)
 
 
 @dataclass(frozen=True)
@@ -494,7 +494,9 @@ def run_ertools(
         a = rec.answer
         if status == "scored" and a is not None:
             assert rec.item is not None and rec.truth is not None and rec.truth.pose is not None
-            if rec.terms is None:  # no usable pose in the answer: the worst pose score
+            item = rec.item
+            usable = a.pose is not None and all(math.isfinite(v) for v in a.pose)
+            if rec.terms is None or not usable:  # no usable pose: the worst pose score
                 rec = GoalRecord(
                     rec.index,
                     rec.item,
@@ -506,7 +508,7 @@ def run_ertools(
                     rec.class_ok,
                     rec.instance_ok,
                 )
-            entry.update(goal_entry(rec, rec.item, truth_names=False))
+            entry.update(goal_entry(rec, item, truth_names=False))
             if a.problem is not None:
                 entry["answer_problem"] = a.problem
                 notes.append(f"goal {it.index}: {a.problem}: that part scored as wrong")
@@ -539,10 +541,10 @@ def run_ertools(
 
 
 def _worst_terms(options: HopfOptions) -> tuple[float, float, float, float, float, float]:
-    """The terms of an answer without a pose: t and r at their clips (pose score 0 with the
-    1 m clip)."""
+    """The terms of an answer without a usable pose: scored as wrong, pose score 0 (t at its
+    clip, r = 1; no t without the clip)."""
     t = CLIP_TRANSLATION_M if options.clip_translation else math.nan
-    return (math.nan, math.nan, math.nan, t, 1.0, 1 - t / 2 - 0.5)
+    return (math.nan, math.nan, math.nan, t, 1.0, 0.0)
 
 
 def _as_2019(recs: Sequence[GoalRecord]) -> tuple[list[GoalRecord], int]:

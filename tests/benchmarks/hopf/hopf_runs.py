@@ -27,6 +27,9 @@ from typing import Any
 
 import numpy as np
 import yaml
+from rsbb_replay import hopf as replay_hopf
+from rsbb_replay.fromlog import timeline_from_bag
+from rsbb_replay.world import ReplayResult, World, run_script
 from scipy.spatial.transform import Rotation
 
 from ertools.samples.mocap import MocapNoise, frame_times, simulate_mocap
@@ -39,9 +42,6 @@ from ertools.samples.rsbb_scenario import (
     RsbbScenario,
     Save,
 )
-from rsbb_replay import hopf as replay_hopf
-from rsbb_replay.fromlog import timeline_from_bag
-from rsbb_replay.world import ReplayResult, World, run_script
 
 S = 1_000_000_000
 MS = 1_000_000
