@@ -13,12 +13,15 @@ What happens (goals numbered from 1, as the script's ``i``):
   script's three 1 s attempts fail, it asks the referee to move the positioner (``The
   position of the positioner could not be acquired!...``), the lookup after that succeeds;
 - goal 4: right class, wrong instance; goal 5: times out (the config's ``goal_timeout`` is
-  5 s here, to keep the log short);
+  3 s here, to keep the log short);
 - goal 6: theta 3.0 rad off; goal 7: 1.08 m off and the wrong class (the 2019 script's pose
   score goes below 0.5 - 0.54; ertools clips the translation at 1 m);
 - goal 9: the class answered with a trailing blank (``"a "``): wrong for the script, right for
   ertools (names compared without blanks);
 - goal 10: the referee stops the benchmark while the robot works on it.
+
+To keep the bag small (~0.4 MB) the table is published only while the positioner stands on it
+(the RSBB's mocap streamed it throughout): the lookups and the noise estimate need no more.
 
 The run is written in the RSBB layout: ``rsbb_logs/HOPF/simbot/run_1_<date>.bag``,
 ``results/HOPF/simbot/result_run_1_<date>.yaml``, ``rsbb_etc/objects_informations/
@@ -60,7 +63,7 @@ S = 1_000_000_000
 MS = 1_000_000
 T0 = 1_555_000_000 * S  # 2019-04-11 16:26:40 UTC
 TEAM = "simbot"
-GOAL_TIMEOUT_S = 5
+GOAL_TIMEOUT_S = 3
 PARAMS = {"table_size": {"x": 1.0, "y": 1.5}, "goal_timeout": GOAL_TIMEOUT_S}
 TABLE = (1.0, 2.0, 0.75, 0.4)  # x, y, z, yaw in the testbed frame
 ITEM_OFFSET = (-0.14, 0.0, 0.0, -math.pi / 4)  # the item on the positioner: x, y, z, yaw
@@ -82,7 +85,7 @@ PLAN: tuple[tuple[tuple[float, float, float], tuple[float, float, float], str], 
 PLACE_AGAIN = (0.55, 0.95, 1.1)
 ORDER = (3, 7, 1, 10, 5, 2, 11, 6, 4, 9)  # the items drawn (ids)
 DROPOUT_S = 3.5  # goal 3: the positioner hidden this long after it was placed
-ANSWER_S = (1.2, 0.9, 1.5, 1.1, 0.0, 1.3, 0.8, 1.0, 1.4, 0.0)  # the robot's time per goal
+ANSWER_S = (0.9, 0.7, 1.1, 0.8, 0.0, 1.0, 0.6, 0.7, 1.2, 0.0)  # the robot's time per goal
 STOP_AFTER_S = 0.7  # goal 10: the referee's stop, after the robot started
 
 
@@ -315,7 +318,8 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
             break
         spans_end = end
         t = spans_end + 50 * MS
-    table_body = _body("table_origin", [(t_start, stop_ns + 2 * S, TABLE)], rng)
+    table_spans = [(a, b, (TABLE[0], TABLE[1], TABLE[2], TABLE[3])) for a, b, _ in spans]
+    table_body = _body("table_origin", table_spans, rng)
     positioner = _body("positioner_origin", spans, rng)
     saves.append(Save(stop_ns + 5 * MS, _copy(score)))
     sc = RsbbScenario(
@@ -335,7 +339,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         params=PARAMS,
         bodies=(table_body, positioner),
     )
-    paths = write_rsbb_run(outdir, sc, compression="lz4")
+    paths = write_rsbb_run(outdir, sc, compression="bz2")
     items_path = outdir / "rsbb_etc" / "objects_informations" / "items_with_pose.yaml"
     config_path = outdir / "rsbb_bmbox" / "scripts" / "benchmark_configs" / "HOPF.yaml"
     for path, data in ((items_path, {"items": list(items.values())}), (config_path, PARAMS)):
