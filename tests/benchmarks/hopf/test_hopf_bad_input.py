@@ -68,11 +68,13 @@ def test_items_that_lack_the_item_shown(
         ("items: []", "non-empty list"),
         ("[1, 2", "malformed"),
         (
-            "items: [{id: 1, class: a, instance: a1, description: d, trans: [0, 0], rot: [0, 0, 0, 1]}]",
+            "items: [{id: 1, class: a, instance: a1, description: d, trans: [0, 0], "
+            "rot: [0, 0, 0, 1]}]",
             "3 finite numbers",
         ),
         (
-            "items: [{id: 1, class: a, instance: a1, description: d, trans: [0, 0, 0], rot: [0, 0, 0, 0]}]",
+            "items: [{id: 1, class: a, instance: a1, description: d, trans: [0, 0, 0], "
+            "rot: [0, 0, 0, 0]}]",
             "zero quaternion",
         ),
     ],

@@ -22,12 +22,12 @@ from typing import Any
 
 import pytest
 import yaml
+from rsbb_replay.scenarios import at, hnf_scenario, still_body
 
 from ertools.benchmarks import registry
 from ertools.samples.mocap import TrackingLoss
 from ertools.samples.rsbb import write_rsbb_run
 from ertools.samples.rsbb_scenario import Broadcast, Goal, ManualOperation, Save
-from rsbb_replay.scenarios import MS, at, hnf_scenario, still_body
 
 pytestmark = pytest.mark.slow  # writes and reads a run bag
 

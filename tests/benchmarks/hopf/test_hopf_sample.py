@@ -9,12 +9,12 @@ from typing import Any
 
 import pytest
 import yaml
-from test_hopf_replay_parity import same
-
-from ertools.cli.main import main
 from rsbb_replay import hopf as replay_hopf
 from rsbb_replay.fromlog import timeline_from_bag
 from rsbb_replay.world import World, run_script
+from test_hopf_replay_parity import same
+
+from ertools.cli.main import main
 
 SAMPLE = Path(__file__).parents[3] / "sample_bags" / "hopf"
 BAG = next(SAMPLE.glob("rsbb_logs/HOPF/*/run_*.bag"))
