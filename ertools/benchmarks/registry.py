@@ -26,6 +26,7 @@ REGISTRY: dict[str, str] = {
     "fbm3w": "ertools.benchmarks.fbm3w.declare:BENCHMARK",
     "trajectory": "ertools.benchmarks.trajectory.declare:BENCHMARK",
     "hopf": "ertools.benchmarks.hopf.declare:BENCHMARK",
+    "hppf": "ertools.benchmarks.hppf.declare:BENCHMARK",
 }
 
 

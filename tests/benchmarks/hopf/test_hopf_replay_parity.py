@@ -9,19 +9,17 @@ Strings, booleans and nulls exactly; the keys exactly.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 from hopf_runs import STOPS, build, replay, write
+from rsbb_fields import same
 
 from ertools.benchmarks import registry
 
 pytestmark = pytest.mark.slow  # writes and reads run bags (~1 s each)
-
-TOL = 1e-12
 
 PLANS = {
     "normal": ["right", "wrong", "int", "right", "blank"],
@@ -45,29 +43,6 @@ PLANS = {
 PLANS.update({stop: ["right", "timeout", stop] for stop in STOPS})
 PLANS["global_timeout"] = ["wrong", "global_timeout"]
 PLANS["stop_first"] = ["stop_mo1"]
-
-
-def same(a: Any, b: Any, where: str = "score") -> None:
-    """Field for field: mappings with the same keys, numbers within TOL, the rest equal."""
-    if isinstance(a, dict) or isinstance(b, dict):
-        assert isinstance(a, dict) and isinstance(b, dict), f"{where}: {a!r} vs {b!r}"
-        assert sorted(a) == sorted(b), f"{where}: keys {sorted(a)} vs {sorted(b)}"
-        for k in a:
-            same(a[k], b[k], f"{where}.{k}")
-        return
-    if isinstance(a, list) or isinstance(b, list):
-        assert isinstance(a, list) and isinstance(b, list) and len(a) == len(b), where
-        for k, (x, y) in enumerate(zip(a, b, strict=True)):
-            same(x, y, f"{where}[{k}]")
-        return
-    if isinstance(a, float) or isinstance(b, float):
-        assert type(a) in (int, float) and type(b) in (int, float), f"{where}: {a!r} vs {b!r}"
-        if math.isnan(a) or math.isnan(b):
-            assert math.isnan(a) and math.isnan(b), where
-        else:
-            assert abs(a - b) <= TOL, f"{where}: {a!r} vs {b!r}"
-        return
-    assert type(a) is type(b) and a == b, f"{where}: {a!r} vs {b!r}"
 
 
 def _score(bag: Path, items: Path, config: Path, rules: str) -> Any:

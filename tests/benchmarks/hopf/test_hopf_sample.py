@@ -9,10 +9,10 @@ from typing import Any
 
 import pytest
 import yaml
+from rsbb_fields import same
 from rsbb_replay import hopf as replay_hopf
 from rsbb_replay.fromlog import timeline_from_bag
 from rsbb_replay.world import World, run_script
-from test_hopf_replay_parity import same
 
 from ertools.cli.main import main
 
