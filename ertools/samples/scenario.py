@@ -71,6 +71,7 @@ SCENARIOS: dict[str, str] = {
     "stationary": "ertools.samples.stationary:generate",
     "timeline": "ertools.samples.timeline_folder:generate",
     "hopf": "ertools.samples.hopf:generate",
+    "hppf": "ertools.samples.hppf:generate",
 }
 
 

@@ -3,8 +3,9 @@
 The ground truth is one tf lookup: the table and the positioner, one interpolated sample each.
 Their mocap noise is measured around the lookups (the bodies stand still while the robot
 looks): per body, the scatter of successive samples' x, y and yaw within
-:data:`WINDOW_NS` of each lookup, sigma = std(difference) / sqrt(2) (differences cancel a slow
-drift). A draw moves both bodies by that noise and re-computes the item's pose in the table
+:data:`WINDOW_NS` of each lookup (pairs less than :data:`PAIR_NS` apart), sigma = 1.4826
+MAD(difference) / sqrt(2) (a difference cancels a slow drift; the median absolute deviation
+ignores the jump when the positioner is moved). A draw moves both bodies by that noise and re-computes the item's pose in the table
 frame to first order (the positioner's and the table's positions, and their yaws turning the
 item's offset and the item's position about the table's origin), then every pose score and
 the total, with :func:`ertools.benchmarks.hopf.formula.pose_terms` vectorised over the draws.
@@ -34,6 +35,7 @@ from ertools.rsbb.tf import TfTrack, euler_yaw
 
 #: The samples around each lookup the noise is measured on.
 WINDOW_NS = 1_000_000_000
+PAIR_NS = 50_000_000
 #: Where too few samples are around the lookups: one sample of a still marker set (0.3 mm per
 #: axis, 0.05 deg), as ertools states for the 2015 mocap (fbm1's default).
 DEFAULT_SIGMA_M = 3e-4
@@ -50,10 +52,10 @@ def _scatter(track: TfTrack | None, moments: list[int]) -> tuple[F64, F64]:
         hi = np.searchsorted(track.t_ns, t + WINDOW_NS, side="right")
         if hi - lo < 2:
             continue
-        xy = track.xyz[lo:hi, :2]
+        close = np.diff(track.t_ns[lo:hi]) < PAIR_NS
         yaw = np.unwrap(euler_yaw(track.quat_xyzw[lo:hi]))
-        dxy.append(np.diff(xy, axis=0))
-        dyaw.append(np.diff(yaw))
+        dxy.append(np.diff(track.xyz[lo:hi, :2], axis=0)[close])
+        dyaw.append(np.diff(yaw)[close])
     if not dxy:
         return np.empty((0, 2)), np.empty(0)
     return np.concatenate(dxy), np.concatenate(dyaw)
@@ -78,13 +80,21 @@ def _sigma(bodies: tuple[TfTrack | None, ...], moments: list[int]) -> tuple[floa
             DEFAULT_SIGMA_RAD,
             Source(MOCAP_NOISE, DEFAULT_SIGMA_M, "m", False, note),
         )
-    s_m = float(np.std(dxy) / math.sqrt(2.0))
-    s_rad = float(np.std(dyaw) / math.sqrt(2.0))
+    s_m = robust_sigma(dxy.ravel())
+    s_rad = robust_sigma(dyaw)
     note = (
         f"table and positioner, {dyaw.size} successive samples within "
         f"{WINDOW_NS / 1e9:g} s of the lookups; yaw sigma {s_rad:.3g} rad"
     )
     return s_m, s_rad, Source(MOCAP_NOISE, s_m, "m", True, note)
+
+
+def robust_sigma(differences: F64) -> float:
+    """The noise of samples whose successive ``differences`` are given: 1.4826 times their
+    median absolute deviation (a normal's sigma), over sqrt(2) (a difference of two)."""
+    d = np.asarray(differences, np.float64)
+    mad = float(np.median(np.abs(d - np.median(d))))
+    return 1.4826 * mad / math.sqrt(2.0)
 
 
 def hopf_intervals(

@@ -2,8 +2,10 @@
 
 The ground truth is one tf lookup of the cap's marker set after each answer. Its mocap noise
 is measured around those lookups (the person stands still while the robot looks): the scatter
-of successive samples' x and y within :data:`WINDOW_NS` of each lookup, sigma =
-std(difference) / sqrt(2). A draw moves each ground truth by that noise and re-computes the
+of successive samples' x and y within :data:`WINDOW_NS` of each lookup (pairs less than
+:data:`PAIR_NS` apart), sigma = 1.4826 MAD(difference) / sqrt(2): a difference cancels a slow
+drift, the median absolute deviation ignores the jump when a person leaves and the next
+enters. A draw moves each ground truth by that noise and re-computes the
 position errors (:func:`ertools.benchmarks.hppf.formula.position_errors`, vectorised over the
 draws) and the Distance error. The names and the execution time carry no measurement noise.
 """
@@ -30,6 +32,7 @@ from ertools.benchmarks.hppf.result import DISTANCE_KEY, HppfIntervals
 from ertools.rsbb.tf import TfTrack
 
 WINDOW_NS = 1_000_000_000
+PAIR_NS = 50_000_000
 #: Where too few samples are around the lookups: a still marker set's noise (0.3 mm per axis).
 DEFAULT_SIGMA_M = 3e-4
 
@@ -41,14 +44,23 @@ def _sigma(actor: TfTrack | None, moments: list[int]) -> tuple[float, Source]:
             lo = np.searchsorted(actor.t_ns, t - WINDOW_NS, side="left")
             hi = np.searchsorted(actor.t_ns, t + WINDOW_NS, side="right")
             if hi - lo >= 2:
-                diffs.append(np.diff(actor.xyz[lo:hi, :2], axis=0))
-    d = np.concatenate(diffs) if diffs else np.empty((0, 2))
-    if d.shape[0] < MIN_INTERVAL_SAMPLES:
-        note = f"only {d.shape[0]} successive samples around the lookups: a stated noise"
+                close = np.diff(actor.t_ns[lo:hi]) < PAIR_NS
+                diffs.append(np.diff(actor.xyz[lo:hi, :2], axis=0)[close])
+    d = np.concatenate(diffs).ravel() if diffs else np.empty(0)
+    if d.size < MIN_INTERVAL_SAMPLES:
+        note = f"only {d.size} successive samples around the lookups: a stated noise"
         return DEFAULT_SIGMA_M, Source(MOCAP_NOISE, DEFAULT_SIGMA_M, "m", False, note)
-    sigma = float(np.std(d) / math.sqrt(2.0))
-    note = f"the cap, {d.shape[0]} successive samples within {WINDOW_NS / 1e9:g} s of the lookups"
+    sigma = robust_sigma(d)
+    note = f"the cap, {d.size // 2} successive samples within {WINDOW_NS / 1e9:g} s of the lookups"
     return sigma, Source(MOCAP_NOISE, sigma, "m", True, note)
+
+
+def robust_sigma(differences: F64) -> float:
+    """The per-axis noise of samples whose successive ``differences`` are given: 1.4826 times
+    their median absolute deviation (a normal's sigma), over sqrt(2) (a difference of two)."""
+    d = np.asarray(differences, np.float64)
+    mad = float(np.median(np.abs(d - np.median(d))))
+    return 1.4826 * mad / math.sqrt(2.0)
 
 
 def hppf_intervals(
