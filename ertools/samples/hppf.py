@@ -165,7 +165,8 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
             truth_rows.append({**row, "segment_time": _to_sec(stop_ns - start)})
             break
         end = start + round(ANSWER_S * S)
-        answer = {"x": where[0] + err[0], "y": where[1] + err[1], "theta": 0.5, "person_name": name}
+        said = (where[0] + err[0], where[1] + err[1])
+        answer = {"x": said[0], "y": said[1], "theta": 0.5, "person_name": name}
         goals.append(Goal(request, start, end, "{}\n", "result", _flow(answer)))
         if what == "restart":  # the cap lost after the answer: the lookups fail, goal again
             spans.append((seen_from, check + 200 * MS, where))
@@ -190,7 +191,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
             "recognized": ok_2019,
             "position_error": error,
             "ground-truth person position": _text(where),
-            "robot-estimated person position": _text((answer["x"], answer["y"])),
+            "robot-estimated person position": _text(said),
         }
         score["Recognized persons"] = recognized["2019"]
         score["% Recognized persons"] = f"{round(recognized['2019'] / len(PEOPLE) * 100, 2)}%"
