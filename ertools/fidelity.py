@@ -37,6 +37,7 @@ RULE_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm3w.rules",
     "ertools.benchmarks.trajectory.rules",
     "ertools.benchmarks.common.ending",
+    "ertools.benchmarks.hnf.rules",
     "ertools.benchmarks.hopf.rules",
     "ertools.benchmarks.hppf.rules",
 )
@@ -151,6 +152,7 @@ VERSION_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm1.rules",
     "ertools.benchmarks.fbm2h.rules",
     "ertools.benchmarks.fbm3w.rules",
+    "ertools.benchmarks.hnf.rules",
     "ertools.benchmarks.hopf.rules",
     "ertools.benchmarks.hppf.rules",
 )

@@ -25,6 +25,8 @@ REGISTRY: dict[str, str] = {
     "fbm2h": "ertools.benchmarks.fbm2h.declare:BENCHMARK",
     "fbm3w": "ertools.benchmarks.fbm3w.declare:BENCHMARK",
     "trajectory": "ertools.benchmarks.trajectory.declare:BENCHMARK",
+    "hnf": "ertools.benchmarks.hnf.declare:BENCHMARK",
+    "hpff": "ertools.benchmarks.hpff.declare:BENCHMARK",
     "hopf": "ertools.benchmarks.hopf.declare:BENCHMARK",
     "hppf": "ertools.benchmarks.hppf.declare:BENCHMARK",
 }

@@ -13,6 +13,7 @@ its last save in both, a run whose recorder stopped early has an older live scor
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -59,9 +60,26 @@ def _is_number(v: Any) -> bool:
     return isinstance(v, int | float) and not isinstance(v, bool)
 
 
+_FLOAT_IN_TEXT = re.compile(r"-?\d+\.\d+(?:[eE][-+]?\d+)?")
+
+
+def _same_text(a: str, b: str, abs_tol: float) -> bool:
+    """Texts that agree word for word, the decimal numbers in them (HNF's pose dumps hold each
+    float's ``repr``) within ``abs_tol``."""
+    if a == b:
+        return True
+    if _FLOAT_IN_TEXT.sub("#", a) != _FLOAT_IN_TEXT.sub("#", b):
+        return False
+    na = [float(x) for x in _FLOAT_IN_TEXT.findall(a)]
+    nb = [float(x) for x in _FLOAT_IN_TEXT.findall(b)]
+    return all(abs(x - y) <= abs_tol for x, y in zip(na, nb, strict=True))
+
+
 def same_value(a: Any, b: Any, abs_tol: float = SCORE_ABS_TOL) -> bool:
     """Whether two score leaves agree: numbers within ``abs_tol`` (NaN equals NaN), lists
-    element by element, anything else exactly (type included: ``True`` is not ``1``)."""
+    element by element, texts word for word with their decimal numbers within ``abs_tol``
+    (``"60.0%"`` is not ``"60.1%"``; a pose dump's last digit may differ), anything else
+    exactly (type included: ``True`` is not ``1``)."""
     if _is_number(a) and _is_number(b):
         fa, fb = float(a), float(b)
         if math.isnan(fa) or math.isnan(fb):
@@ -71,6 +89,8 @@ def same_value(a: Any, b: Any, abs_tol: float = SCORE_ABS_TOL) -> bool:
         return len(a) == len(b) and all(
             same_value(x, y, abs_tol) for x, y in zip(a, b, strict=True)
         )
+    if isinstance(a, str) and isinstance(b, str):
+        return _same_text(a, b, abs_tol)
     return type(a) is type(b) and bool(a == b)
 
 

@@ -70,6 +70,7 @@ SCENARIOS: dict[str, str] = {
     "robotlog": "ertools.samples.robotlog:generate",
     "stationary": "ertools.samples.stationary:generate",
     "timeline": "ertools.samples.timeline_folder:generate",
+    "hnf": "ertools.benchmarks.hnf.sample:generate",
     "hopf": "ertools.samples.hopf:generate",
     "hppf": "ertools.samples.hppf:generate",
 }

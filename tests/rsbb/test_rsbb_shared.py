@@ -194,6 +194,9 @@ def test_score_leaves_and_yaml() -> None:
     }
     assert same_value(1, 1.0000001) and not same_value(True, 1) and not same_value("60.0%", "60%")
     assert same_value(float("nan"), float("nan")) and not same_value(None, 0)
+    dump = "!!python/object/new:geometry_msgs.msg._Pose2D.Pose2D\nstate: [0.5, 1.2, %r]\n"
+    assert same_value(dump % 0.28985748631983493, dump % 0.2898574863198349)
+    assert not same_value(dump % 0.28985, dump % 0.28995) and not same_value("1 out of 3", "1 of 3")
     text = score_yaml({"b": np.float64(0.5), "a": {"x": np.int64(2)}, "c": "1 out of 3"})
     assert text == "a:\n  x: 2\nb: 0.5\nc: 1 out of 3\n"
 
