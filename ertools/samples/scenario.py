@@ -71,8 +71,8 @@ SCENARIOS: dict[str, str] = {
     "stationary": "ertools.samples.stationary:generate",
     "timeline": "ertools.samples.timeline_folder:generate",
     "hnf": "ertools.benchmarks.hnf.sample:generate",
-    "hopf": "ertools.samples.hopf:generate",
-    "hppf": "ertools.samples.hppf:generate",
+    "hopf": "ertools.benchmarks.hopf.sample:generate",
+    "hppf": "ertools.benchmarks.hppf.sample:generate",
 }
 
 

@@ -8,17 +8,15 @@ from __future__ import annotations
 import logging
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ertools.benchmarks.base import Benchmark, Explanation, Input, Ranking, resolve_values
 from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS
 from ertools.benchmarks.hopf import config
 from ertools.benchmarks.hopf.config import DEFAULT_MAX_GAP_S, NAME, RULE_SETS, HopfOptions
-
-if TYPE_CHECKING:  # annotations only: the stages import NumPy and the readers when they run
-    from ertools.benchmarks.hopf.pipeline import HopfLogs
-    from ertools.benchmarks.hopf.result import HopfResult
-    from ertools.benchmarks.hopf.runs import HopfRuns
+from ertools.benchmarks.hopf.pipeline import HopfLogs, find_runs, load, score_runs
+from ertools.benchmarks.hopf.result import HopfResult
+from ertools.benchmarks.hopf.runs import HopfRuns
 
 SCRIPT_GROUP = "the RSBB script's behaviour (each difference can be undone)"
 
@@ -101,27 +99,6 @@ def make_options(given: Mapping[str, Any]) -> HopfOptions:
     return config.make_options(resolve_values(INPUTS, given))
 
 
-def load(bags: Sequence[Path], options: HopfOptions) -> HopfLogs:
-    """:func:`ertools.benchmarks.hopf.pipeline.load`."""
-    from ertools.benchmarks.hopf import pipeline  # lazy: NumPy and the bag readers, to score
-
-    return pipeline.load(bags, options)
-
-
-def find_runs(logs: HopfLogs, options: HopfOptions) -> HopfRuns:
-    """:func:`ertools.benchmarks.hopf.pipeline.find_runs`."""
-    from ertools.benchmarks.hopf import pipeline  # lazy: NumPy and the bag readers, to score
-
-    return pipeline.find_runs(logs, options)
-
-
-def score_runs(logs: HopfLogs, runs: HopfRuns, options: HopfOptions) -> HopfResult:
-    """:func:`ertools.benchmarks.hopf.pipeline.score_runs`."""
-    from ertools.benchmarks.hopf import pipeline  # lazy: NumPy and the bag readers, to score
-
-    return pipeline.score_runs(logs, runs, options)
-
-
 def notes(result: HopfResult) -> list[str]:
     """The intervals, the comparison with the run's own scores, what the scoring says and
     (``-v``) one line per goal."""
@@ -197,8 +174,8 @@ execution_time, in the result file's score form.""",
         text="pose_score (the mean pose score over the goals counted): higher is better",
     ),
     notes=notes,
-    figures="ertools.report.plots_hopf:figure_specs",
-    foxglove="ertools.report.foxglove.hopf:content",
+    figures="ertools.benchmarks.hopf.plots:figure_specs",
+    foxglove="ertools.benchmarks.hopf.foxglove:content",
     files=files,
     score_keys=frozenset({"class_accuracy", "instance_accuracy", "pose_score"}),
     values_2015={"rules": "2019"},

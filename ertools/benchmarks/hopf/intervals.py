@@ -1,15 +1,13 @@
 """Confidence intervals of HOPF's pose scores (docs/uncertainty.md, issue 28).
 
 The ground truth is one tf lookup: the table and the positioner, one interpolated sample each.
-Their mocap noise is measured around the lookups (the bodies stand still while the robot
-looks): per body, the scatter of successive samples' x, y and yaw within
-:data:`WINDOW_NS` of each lookup (pairs less than :data:`PAIR_NS` apart), sigma = 1.4826
-MAD(difference) / sqrt(2) (a difference cancels a slow drift; the median absolute deviation
-ignores the jump when the positioner is moved). A draw moves both bodies by that noise and re-computes the item's pose in the table
-frame to first order (the positioner's and the table's positions, and their yaws turning the
-item's offset and the item's position about the table's origin), then every pose score and
-the total, with :func:`ertools.benchmarks.hopf.formula.pose_terms` vectorised over the draws.
-The class and instance accuracies and the execution time carry no measurement noise.
+Each body's mocap noise is measured from its own track (:func:`ertools.rsbb.noise.mocap_noise`:
+robust second differences). A draw moves both bodies by that noise and re-computes the item's
+pose in the table frame to first order (the positioner's and the table's positions, and their
+yaws turning the item's offset and the item's position about the table's origin), then every
+pose score and the total, with :func:`ertools.benchmarks.hopf.formula.pose_terms` vectorised
+over the draws. The class and instance accuracies and the execution time carry no
+measurement noise.
 """
 
 from __future__ import annotations
@@ -20,81 +18,31 @@ import numpy as np
 
 from ertools.arrays import F64
 from ertools.benchmarks.common.interval_output import METHOD
-from ertools.benchmarks.common.uncertainty import (
-    MIN_INTERVAL_SAMPLES,
-    MOCAP_NOISE,
-    Source,
-    Uncertainty,
-    monte_carlo,
-)
+from ertools.benchmarks.common.uncertainty import MOCAP_NOISE, Source, Uncertainty, monte_carlo
 from ertools.benchmarks.hopf.config import CLIP_TRANSLATION_M, HopfOptions
 from ertools.benchmarks.hopf.formula import pose_terms
 from ertools.benchmarks.hopf.goals import Scored
 from ertools.benchmarks.hopf.result import HopfIntervals
+from ertools.rsbb.noise import DEFAULT_SIGMA_M, DEFAULT_SIGMA_RAD, MocapNoise, mocap_noise
 from ertools.rsbb.tf import TfTrack, euler_yaw
 
-#: The samples around each lookup the noise is measured on.
-WINDOW_NS = 1_000_000_000
-PAIR_NS = 50_000_000
-#: Where too few samples are around the lookups: one sample of a still marker set (0.3 mm per
-#: axis, 0.05 deg), as ertools states for the 2015 mocap (fbm1's default).
-DEFAULT_SIGMA_M = 3e-4
-DEFAULT_SIGMA_RAD = math.radians(0.05)
 
-
-def _scatter(track: TfTrack | None, moments: list[int]) -> tuple[F64, F64]:
-    """Successive differences of (x, y) and of yaw over the windows around ``moments``."""
-    if track is None or not moments:
-        return np.empty((0, 2)), np.empty(0)
-    dxy, dyaw = [], []
-    for t in moments:
-        lo = np.searchsorted(track.t_ns, t - WINDOW_NS, side="left")
-        hi = np.searchsorted(track.t_ns, t + WINDOW_NS, side="right")
-        if hi - lo < 2:
-            continue
-        close = np.diff(track.t_ns[lo:hi]) < PAIR_NS
-        yaw = np.unwrap(euler_yaw(track.quat_xyzw[lo:hi]))
-        dxy.append(np.diff(track.xyz[lo:hi, :2], axis=0)[close])
-        dyaw.append(np.diff(yaw)[close])
-    if not dxy:
-        return np.empty((0, 2)), np.empty(0)
-    return np.concatenate(dxy), np.concatenate(dyaw)
-
-
-def _sigma(bodies: tuple[TfTrack | None, ...], moments: list[int]) -> tuple[float, float, Source]:
-    """Per-body sigma of a position axis and of yaw, and the source as reported."""
-    pairs_xy, pairs_yaw = [], []
-    for track in bodies:
-        dxy, dyaw = _scatter(track, moments)
-        pairs_xy.append(dxy)
-        pairs_yaw.append(dyaw)
-    dxy = np.concatenate(pairs_xy)
-    dyaw = np.concatenate(pairs_yaw)
-    if dyaw.size < MIN_INTERVAL_SAMPLES:
-        note = (
-            f"only {dyaw.size} successive samples around the lookups: a still marker set's "
-            "stated noise"
-        )
-        return (
-            DEFAULT_SIGMA_M,
-            DEFAULT_SIGMA_RAD,
-            Source(MOCAP_NOISE, DEFAULT_SIGMA_M, "m", False, note),
-        )
-    s_m = robust_sigma(dxy.ravel())
-    s_rad = robust_sigma(dyaw)
+def _noise(bodies: tuple[TfTrack | None, ...]) -> tuple[list[MocapNoise], Source]:
+    """Each body's noise (a stated default for a body not in the log) and the source."""
+    noises = [
+        mocap_noise(b)
+        if b is not None
+        else MocapNoise(DEFAULT_SIGMA_M, DEFAULT_SIGMA_RAD, False, "no track: defaults")
+        for b in bodies
+    ]
+    rms = math.sqrt(sum(n.sigma_m**2 for n in noises) / len(noises))
     note = (
-        f"table and positioner, {dyaw.size} successive samples within "
-        f"{WINDOW_NS / 1e9:g} s of the lookups; yaw sigma {s_rad:.3g} rad"
+        "; ".join(n.note for n in noises)
+        + "; yaw sigma "
+        + ", ".join(f"{n.sigma_rad:.3g}" for n in noises)
+        + " rad"
     )
-    return s_m, s_rad, Source(MOCAP_NOISE, s_m, "m", True, note)
-
-
-def robust_sigma(differences: F64) -> float:
-    """The noise of samples whose successive ``differences`` are given: 1.4826 times their
-    median absolute deviation (a normal's sigma), over sqrt(2) (a difference of two)."""
-    d = np.asarray(differences, np.float64)
-    mad = float(np.median(np.abs(d - np.median(d))))
-    return 1.4826 * mad / math.sqrt(2.0)
+    return noises, Source(MOCAP_NOISE, rms, "m", all(n.measured for n in noises), note)
 
 
 def hopf_intervals(
@@ -113,10 +61,7 @@ def hopf_intervals(
     ]
     if options.draws <= 0 or not goals:
         return None
-    moments = [
-        g.truth.moment_ns for g in goals if g.truth is not None and g.truth.moment_ns is not None
-    ]
-    s_m, s_rad, source = _sigma(bodies, moments)
+    (table, positioner), source = _noise(bodies)
     answer = np.array(
         [g.answer.pose for g in goals if g.answer is not None and g.answer.pose is not None]
     )
@@ -146,9 +91,11 @@ def hopf_intervals(
             est = np.array([g.terms[5] for g in goals if g.terms is not None])
             out[:, :n] = est
         else:
-            d_pos = rng.normal(0.0, s_m, (draws, n, 2)) - rng.normal(0.0, s_m, (draws, n, 2))
-            d_pos_yaw = rng.normal(0.0, s_rad, (draws, n))
-            d_tab_yaw = rng.normal(0.0, s_rad, (draws, n))
+            d_pos = rng.normal(0.0, positioner.sigma_m, (draws, n, 2)) - rng.normal(
+                0.0, table.sigma_m, (draws, n, 2)
+            )
+            d_pos_yaw = rng.normal(0.0, positioner.sigma_rad, (draws, n))
+            d_tab_yaw = rng.normal(0.0, table.sigma_rad, (draws, n))
             turn_u = np.stack([-u[:, 1], u[:, 0]], axis=-1)
             turn_p = np.stack([-p[:, 1], p[:, 0]], axis=-1)
             xy = p + d_pos + d_pos_yaw[..., None] * turn_u - d_tab_yaw[..., None] * turn_p

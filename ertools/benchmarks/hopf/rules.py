@@ -121,8 +121,8 @@ VERSIONS = (
         SCRIPT_FILE,
         "00e3106",
         "2017-12-15",
-        "the Portugal event of December 2017 and the 2017-18 season (unchanged to 3d9b21f, "
-        "2018-05-02)",
+        "ERL @Home 2017-18 (an event in Portugal, week of 14 December 2017; unchanged to "
+        "3d9b21f, 2018-05-02)",
         "items from items_with_pose.yaml; 3 lookup attempts, then the referee moves the "
         "positioner; goal_<i> created first; manual_operation_N fields",
         "`--rules 2017`",
@@ -131,7 +131,7 @@ VERSIONS = (
         SCRIPT_FILE,
         "2bb8a41",
         "2019-04-08",
-        "the 2018-19 season",
+        "ERL @Home 2018-19",
         "the manual_operation_N fields dropped; the live score with a SCORE SUMMARY",
         "`--rules 2019`",
     ),

@@ -8,17 +8,15 @@ from __future__ import annotations
 import logging
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ertools.benchmarks.base import Benchmark, Explanation, Input, Ranking, resolve_values
 from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS
 from ertools.benchmarks.hppf import config
 from ertools.benchmarks.hppf.config import DEFAULT_MAX_GAP_S, NAME, RULE_SETS, HppfOptions
-
-if TYPE_CHECKING:  # annotations only: the stages import NumPy and the readers when they run
-    from ertools.benchmarks.hppf.pipeline import HppfLogs
-    from ertools.benchmarks.hppf.result import HppfResult
-    from ertools.benchmarks.hppf.runs import HppfRuns
+from ertools.benchmarks.hppf.pipeline import HppfLogs, find_runs, load, score_runs
+from ertools.benchmarks.hppf.result import HppfResult
+from ertools.benchmarks.hppf.runs import HppfRuns
 
 SCRIPT_GROUP = "the RSBB script's behaviour (each difference can be undone)"
 
@@ -73,27 +71,6 @@ INPUTS = (
 def make_options(given: Mapping[str, Any]) -> HppfOptions:
     """The values of :data:`INPUTS` -> :class:`HppfOptions`."""
     return config.make_options(resolve_values(INPUTS, given))
-
-
-def load(bags: Sequence[Path], options: HppfOptions) -> HppfLogs:
-    """:func:`ertools.benchmarks.hppf.pipeline.load`."""
-    from ertools.benchmarks.hppf import pipeline  # lazy: NumPy and the bag readers, to score
-
-    return pipeline.load(bags, options)
-
-
-def find_runs(logs: HppfLogs, options: HppfOptions) -> HppfRuns:
-    """:func:`ertools.benchmarks.hppf.pipeline.find_runs`."""
-    from ertools.benchmarks.hppf import pipeline  # lazy: NumPy and the bag readers, to score
-
-    return pipeline.find_runs(logs, options)
-
-
-def score_runs(logs: HppfLogs, runs: HppfRuns, options: HppfOptions) -> HppfResult:
-    """:func:`ertools.benchmarks.hppf.pipeline.score_runs`."""
-    from ertools.benchmarks.hppf import pipeline  # lazy: NumPy and the bag readers, to score
-
-    return pipeline.score_runs(logs, runs, options)
 
 
 def notes(result: HppfResult) -> list[str]:
@@ -169,8 +146,8 @@ score form.""",
         "is better",
     ),
     notes=notes,
-    figures="ertools.report.plots_hppf:figure_specs",
-    foxglove="ertools.report.foxglove.hppf:content",
+    figures="ertools.benchmarks.hppf.plots:figure_specs",
+    foxglove="ertools.benchmarks.hppf.foxglove:content",
     files=files,
     score_keys=frozenset({"Distance error", "% Recognized persons"}),
     values_2015={"rules": "2019"},

@@ -1,13 +1,10 @@
 """Confidence intervals of HPPF's position errors and Distance error (docs/uncertainty.md).
 
 The ground truth is one tf lookup of the cap's marker set after each answer. Its mocap noise
-is measured around those lookups (the person stands still while the robot looks): the scatter
-of successive samples' x and y within :data:`WINDOW_NS` of each lookup (pairs less than
-:data:`PAIR_NS` apart), sigma = 1.4826 MAD(difference) / sqrt(2): a difference cancels a slow
-drift, the median absolute deviation ignores the jump when a person leaves and the next
-enters. A draw moves each ground truth by that noise and re-computes the
-position errors (:func:`ertools.benchmarks.hppf.formula.position_errors`, vectorised over the
-draws) and the Distance error. The names and the execution time carry no measurement noise.
+is measured from its own track (:func:`ertools.rsbb.noise.mocap_noise`: robust second
+differences). A draw moves each ground truth by that noise and re-computes the position
+errors (:func:`ertools.benchmarks.hppf.formula.position_errors`, vectorised over the draws)
+and the Distance error. The names and the execution time carry no measurement noise.
 """
 
 from __future__ import annotations
@@ -18,49 +15,20 @@ import numpy as np
 
 from ertools.arrays import F64
 from ertools.benchmarks.common.interval_output import METHOD
-from ertools.benchmarks.common.uncertainty import (
-    MIN_INTERVAL_SAMPLES,
-    MOCAP_NOISE,
-    Source,
-    Uncertainty,
-    monte_carlo,
-)
+from ertools.benchmarks.common.uncertainty import MOCAP_NOISE, Source, Uncertainty, monte_carlo
 from ertools.benchmarks.hppf.config import HppfOptions
 from ertools.benchmarks.hppf.formula import position_errors
 from ertools.benchmarks.hppf.goals import Scored
 from ertools.benchmarks.hppf.result import DISTANCE_KEY, HppfIntervals
+from ertools.rsbb.noise import DEFAULT_SIGMA_M, mocap_noise
 from ertools.rsbb.tf import TfTrack
 
-WINDOW_NS = 1_000_000_000
-PAIR_NS = 50_000_000
-#: Where too few samples are around the lookups: a still marker set's noise (0.3 mm per axis).
-DEFAULT_SIGMA_M = 3e-4
 
-
-def _sigma(actor: TfTrack | None, moments: list[int]) -> tuple[float, Source]:
-    diffs = []
-    if actor is not None:
-        for t in moments:
-            lo = np.searchsorted(actor.t_ns, t - WINDOW_NS, side="left")
-            hi = np.searchsorted(actor.t_ns, t + WINDOW_NS, side="right")
-            if hi - lo >= 2:
-                close = np.diff(actor.t_ns[lo:hi]) < PAIR_NS
-                diffs.append(np.diff(actor.xyz[lo:hi, :2], axis=0)[close])
-    d = np.concatenate(diffs).ravel() if diffs else np.empty(0)
-    if d.size < MIN_INTERVAL_SAMPLES:
-        note = f"only {d.size} successive samples around the lookups: a stated noise"
-        return DEFAULT_SIGMA_M, Source(MOCAP_NOISE, DEFAULT_SIGMA_M, "m", False, note)
-    sigma = robust_sigma(d)
-    note = f"the cap, {d.size // 2} successive samples within {WINDOW_NS / 1e9:g} s of the lookups"
-    return sigma, Source(MOCAP_NOISE, sigma, "m", True, note)
-
-
-def robust_sigma(differences: F64) -> float:
-    """The per-axis noise of samples whose successive ``differences`` are given: 1.4826 times
-    their median absolute deviation (a normal's sigma), over sqrt(2) (a difference of two)."""
-    d = np.asarray(differences, np.float64)
-    mad = float(np.median(np.abs(d - np.median(d))))
-    return 1.4826 * mad / math.sqrt(2.0)
+def _sigma(actor: TfTrack | None) -> tuple[float, Source]:
+    if actor is None:
+        return DEFAULT_SIGMA_M, Source(MOCAP_NOISE, DEFAULT_SIGMA_M, "m", False, "no track")
+    noise = mocap_noise(actor)
+    return noise.sigma_m, Source(MOCAP_NOISE, noise.sigma_m, "m", noise.measured, noise.note)
 
 
 def hppf_intervals(
@@ -79,7 +47,7 @@ def hppf_intervals(
     ]
     if options.draws <= 0 or not rows:
         return None
-    sigma, source = _sigma(actor, [p.truth.moment_ns for p in rows if p.truth is not None])
+    sigma, source = _sigma(actor)
     truth = np.array([p.truth.xy for p in rows if p.truth is not None], np.float64)
     answer = np.array([p.answer.xy for p in rows if p.answer is not None], np.float64)
     total = scored.score.get(DISTANCE_KEY)

@@ -65,7 +65,7 @@ VERSIONS = (
         SCRIPT_FILE,
         "2bb8a41",
         "2019-04-08",
-        "the 2018-19 season (its only version)",
+        "ERL @Home 2018-19 (its only version)",
         "HPPF written: one goal per person of HPPF.yaml, names compared lower-cased, Distance "
         "error = sum / detected, the percentage over all the people, a goal without ground "
         "truth after its answer restarted",

@@ -15,6 +15,7 @@ then the referee stops during the sixth goal's first manual operation.
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import replace
 from pathlib import Path
@@ -25,6 +26,7 @@ import yaml
 from rsbb_replay.scenarios import at, hnf_scenario, still_body
 
 from ertools.benchmarks import registry
+from ertools.cli.main import main
 from ertools.samples.mocap import TrackingLoss
 from ertools.samples.rsbb import write_rsbb_run
 from ertools.samples.rsbb_scenario import Broadcast, Goal, ManualOperation, Save
@@ -183,3 +185,29 @@ def test_a_tracking_gap_leaves_the_goal_without_ground_truth(tmp_path: Path) -> 
     s = _score(bag, items, gt_gaps="interpolate").score
     assert s["goal_1"]["partial_score"]["pose_score"] == pytest.approx(0.5, abs=1e-9)
     assert _score(bag, items, max_gap=1.0).score["goal_1"]["status"] == "scored"
+
+
+def test_the_options_on_the_command_line(
+    run_files: tuple[Path, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    # each rule's option as typed restores the script's behaviour: the deviation lines go
+    bag, items = run_files
+    base = ["score", "hopf", str(bag), "--items", str(items), "--draws", "0", "--format", "json"]
+    restore = [
+        "--clip-translation",
+        "none",
+        "--single-wrap",
+        "--exact-names",
+        "--stopped-goals",
+        "2019",
+        "--gt-gaps",
+        "interpolate",
+    ]
+    assert main([*base, *restore]) == 0
+    out = capsys.readouterr()
+    score = json.loads(out.out)
+    assert score["goal_1"]["partial_score"]["pose_score"] == pytest.approx(0.25, abs=1e-9)
+    assert score["goal_2"]["partial_score"]["pose_score"] == pytest.approx(0.5, abs=1e-9)
+    printed = [ln for ln in out.err.splitlines() if "differs from 2019" in ln]
+    # what no single option restores: the answer without theta (only --rules 2019)
+    assert len(printed) == 1 and "[hopf.answer-fields]" in printed[0]

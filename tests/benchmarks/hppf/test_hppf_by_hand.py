@@ -12,6 +12,7 @@ its last save, goal 1's segment time and goal 0's totals: 0, ``0.0%``, 0.5.
 
 from __future__ import annotations
 
+import json
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -21,6 +22,7 @@ import yaml
 from rsbb_replay.scenarios import at, hnf_scenario, still_body
 
 from ertools.benchmarks import registry
+from ertools.cli.main import main
 from ertools.samples.mocap import TrackingLoss
 from ertools.samples.rsbb import write_rsbb_run
 from ertools.samples.rsbb_scenario import Broadcast, Goal, ManualOperation, Save
@@ -116,3 +118,17 @@ def test_a_tracking_gap_leaves_the_goal_without_ground_truth(tmp_path: Path) -> 
     assert "hppf.gt-gaps" in {d.rule.key for d in result.deviations}
     s = _score(bag, config, gt_gaps="interpolate").score
     assert s["goal_0"]["position_error"] == pytest.approx(0.5, abs=1e-9)
+
+
+def test_the_options_on_the_command_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bag, config = _files(tmp_path, gap=True)
+    argv = ["score", "hppf", str(bag), "--config", str(config), "--draws", "0", "--format", "json"]
+    assert main([*argv, "--exact-names", "--gt-gaps", "interpolate"]) == 0
+    out = capsys.readouterr()
+    score = json.loads(out.out)
+    assert score["goal_0"]["recognized"] is False
+    assert score["goal_0"]["position_error"] == pytest.approx(0.5, abs=1e-9)
+    printed = [ln for ln in out.err.splitlines() if "differs from 2019" in ln]
+    assert len(printed) == 1 and "[hppf.answer-fields]" in printed[0]
