@@ -38,6 +38,7 @@ RULE_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.trajectory.rules",
     "ertools.benchmarks.common.ending",
     "ertools.benchmarks.hnf.rules",
+    "ertools.benchmarks.hpff.rules",
     "ertools.benchmarks.hopf.rules",
     "ertools.benchmarks.hppf.rules",
 )
@@ -153,6 +154,7 @@ VERSION_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm2h.rules",
     "ertools.benchmarks.fbm3w.rules",
     "ertools.benchmarks.hnf.rules",
+    "ertools.benchmarks.hpff.rules",
     "ertools.benchmarks.hopf.rules",
     "ertools.benchmarks.hppf.rules",
 )

@@ -57,6 +57,11 @@ from ertools.samples.rsbb_scenario import (
 from ertools.samples.writer import BagWriter
 
 MS = 1_000_000
+#: The mocap node's /tf copy of a pose: stamped this after the pose topic's header (its own
+#: ``ros::Time::now()``) and recorded this after the pose message (what a script's tf listener
+#: holds: a benchmark's sample computes its live score from these).
+TF_STAMP_LAG_NS = 5_000
+TF_RECORD_LAG_NS = 40_000
 BMBOX_CALLER = "/rsbb/rsbb_bmbox"
 CORE_CALLER = "/rsbb/roah_rsbb_core"
 MOCAP_CALLER = "/rsbb/mocap_node"
@@ -260,8 +265,8 @@ def _write_tf(bag: BagWriter, sc: RsbbScenario) -> None:
                 callerid=MOCAP_CALLER,
             )
         bag.write_tf(
-            pub.t_record_ns + 40_000,
-            pub.t_header_ns + 5_000,
+            pub.t_record_ns + TF_RECORD_LAG_NS,
+            pub.t_header_ns + TF_STAMP_LAG_NS,
             MOCAP_PARENT,
             body.name,
             pub.xyz,

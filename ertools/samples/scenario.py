@@ -71,6 +71,7 @@ SCENARIOS: dict[str, str] = {
     "stationary": "ertools.samples.stationary:generate",
     "timeline": "ertools.samples.timeline_folder:generate",
     "hnf": "ertools.benchmarks.hnf.sample:generate",
+    "hpff": "ertools.benchmarks.hpff.sample:generate",
     "hopf": "ertools.benchmarks.hopf.sample:generate",
     "hppf": "ertools.benchmarks.hppf.sample:generate",
 }

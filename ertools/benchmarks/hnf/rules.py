@@ -117,7 +117,7 @@ VERSIONS = (
         "first RSBB version: the pose looked up (inline loop) until it succeeds; "
         "`atan2(sin, cos)` without `fabs`: negative errors beyond pi; poses written only "
         "when acquired; key `marker_to_robot_transform`",
-        "--rules 069fd1d",
+        "`--rules 069fd1d`",
     ),
     NodeVersion(
         FILE,
@@ -127,7 +127,7 @@ VERSIONS = (
         "the lookup helper (1 s attempts, no limit); `fabs` in the per-segment and total "
         "orientation; both poses always written (None when stopped); a stopped run has "
         "totals",
-        "--rules f594ff1",
+        "`--rules f594ff1`",
     ),
     NodeVersion(
         FILE,
@@ -135,7 +135,7 @@ VERSIONS = (
         "2017-11-07",
         "development (Enri2077/rsbb)",
         "a log message only",
-        "--rules f594ff1",
+        "`--rules f594ff1`",
     ),
     NodeVersion(
         FILE,
@@ -145,7 +145,7 @@ VERSIONS = (
         "5 attempts, then the referee's 'try again or skip' (`s`); `manual_operation` field; "
         "a stop during the lookup ends the script (no totals); key "
         "`markerset_to_robot_transform`",
-        "--rules 2017",
+        "`--rules 2017`",
     ),
     NodeVersion(
         FILE,
@@ -153,6 +153,6 @@ VERSIONS = (
         "2019-04-08",
         "ERL @Home 2018-19",
         "the `manual_operation` field removed; the live score's text with a `SCORE SUMMARY`",
-        "--rules 2019",
+        "`--rules 2019`",
     ),
 )

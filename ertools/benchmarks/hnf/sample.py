@@ -4,7 +4,9 @@ The robot's odometric centre drives between five waypoints (minimum-jerk arcs, z
 both ends) and stops a known small error away from each; its marker set sits 0.4 m above it,
 10 cm ahead and 5 cm to the left, turned -0.3 rad: the marker poses are the truth robot poses
 composed with the inverse of ``markerset_to_robot_transform`` (``transform-simbot.yaml``).
-The mocap adds noise (0.2 mm, 0.5 mrad) and timing jitter.
+The mocap adds noise (0.2 mm, 0.5 mrad) and timing jitter; it is on ``/tf`` only (the
+body's pose topics, which neither the script nor ertools reads, are left out to keep the
+sample small).
 
 - ``run_1``: goals 1, 2 and 5 reached; goal 3 times out (the robot still driving: the
   RefBox's 20 s goal timeout); goal 4 is reached but the marker set is lost for 7 s around the
@@ -38,7 +40,7 @@ from ertools.geometry import compose, invert, quat_from_yaw, wrap_angle
 from ertools.rsbb.py2 import to_sec
 from ertools.rsbb.tf import TfTrack, script_poses
 from ertools.samples.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
-from ertools.samples.rsbb import write_rsbb_run
+from ertools.samples.rsbb import TF_RECORD_LAG_NS, TF_STAMP_LAG_NS, write_rsbb_run
 from ertools.samples.rsbb_scenario import (
     Body,
     Broadcast,
@@ -294,8 +296,8 @@ def _run(outdir: Path, run: int, stop_at_goal: int | None, seed: int, t0: int) -
     published = TfTrack(
         "testbed_origin",
         "robot_markerset",
-        pub.t_header_ns,
-        pub.t_record_ns,
+        pub.t_header_ns + TF_STAMP_LAG_NS,
+        pub.t_record_ns + TF_RECORD_LAG_NS,
         pub.xyz,
         pub.quat_xyzw,
     )
@@ -347,7 +349,8 @@ def _run(outdir: Path, run: int, stop_at_goal: int | None, seed: int, t0: int) -
         ),
         saves=(Save(t_end + t0, score),),
         params=params,
-        bodies=(Body("robot_markerset", pub),),
+        # /tf only: the pose topics (the scripts and ertools read neither) would double the size
+        bodies=(Body("robot_markerset", pub, record_topics=False),),
         utc_offset_s=3600,
         tz_name="WEST",
     )

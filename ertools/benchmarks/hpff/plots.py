@@ -26,7 +26,7 @@ def distance_chart(result: Any) -> Chart:
         layers.append(
             Line(
                 t[ok],
-                s.distance[ok],
+                s.distance[ok] * MM,
                 COLOURS["blue"],
                 1.0,
                 label="following distance",
@@ -45,9 +45,9 @@ def distance_chart(result: Any) -> Chart:
                 label="not measured",
             )
         )
-    layers.append(RefLine(result.desired, "y", COLOURS["green"], label="desired distance"))
-    layers.append(RefLine(result.minimum, "y", "#8c8c8c", dash="dashed", label="range"))
-    layers.append(RefLine(result.maximum, "y", "#8c8c8c", dash="dashed"))
+    layers.append(RefLine(result.desired * MM, "y", COLOURS["green"], label="desired distance"))
+    layers.append(RefLine(result.minimum * MM, "y", "#8c8c8c", dash="dashed", label="range"))
+    layers.append(RefLine(result.maximum * MM, "y", "#8c8c8c", dash="dashed"))
     return Chart(
         tuple(layers),
         x=Axis(units.label("time from the benchmark's start", "time")),

@@ -90,6 +90,6 @@ VERSIONS = (
         "first version: 2 Hz samples after an 8 s settling sleep; deviation from 2.0 m, "
         "distance covered within 0.15-3.5 m, reliability text; a run fails outside "
         "goal_timeout +- 15 s; every run ends with the script's abort",
-        "--rules 2019",
+        "`--rules 2019`",
     ),
 )

@@ -29,6 +29,8 @@ LOGS = {
     "fbm2h": [SAMPLES / "fbm2h" / "log_fbm2h_mocap_2015-11-20-12-00-00_0.bag"],
     "fbm3w": [SAMPLES / "fbm3w" / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"],
     "trajectory": [SAMPLES / "robotlog" / "FBM2H_201511201200_homer.bag", SAMPLES / "robotlog"],
+    "hnf": [SAMPLES / "hnf" / "rsbb_logs" / "HNF" / "simbot" / "run_1_2019-04-10-14-31-06.bag"],
+    "hpff": [SAMPLES / "hpff" / "rsbb_logs" / "HPFF" / "simbot" / "run_1_2019-04-10-15-22-11.bag"],
 }
 # option, value -> what the one line must say
 NONSENSE = [

@@ -79,3 +79,31 @@ def test_2019_stopped_run_has_no_totals() -> None:
     score, err = _score(RUNS[1], "--rules", "2019")
     assert "position_accuracy[m]" not in score and score["segment_3"]["timeout"] is None
     assert "the referee stopped the run" in err
+
+
+def test_report_plot_and_foxglove(tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    ran = run(
+        [
+            "score",
+            "hnf",
+            str(RUNS[0]),
+            "--draws",
+            "20",
+            "--report",
+            str(out / "report"),
+            "--plot",
+            str(out / "hnf.png"),
+            "--foxglove",
+            str(out / "hnf.mcap"),
+        ]
+    )
+    assert ran.code == 0, ran.stderr
+    assert "interval: position_accuracy[m]" in ran.stderr
+    report = out / "report"
+    assert (report / "index.html").is_file() and (report / "segments.csv").is_file()
+    assert "segment_1" in (report / "score.yaml").read_text()
+    comparison = (report / "comparison.csv").read_text()
+    assert comparison.startswith("key,recomputed,live,file,live_agrees,file_agrees")
+    assert (out / "hnf.png").stat().st_size > 10_000
+    assert (out / "hnf.mcap").stat().st_size > 1_000

@@ -147,6 +147,46 @@ def test_the_cli_prints_the_score_form_and_says_what_differs(bag: Path) -> None:
     assert json_run.code == 0 and '"segment_1"' in json_run.stdout
 
 
+def test_each_option_restores_its_rule(bag: Path) -> None:
+    """The four options of the reading's rules together print what --rules 2019 prints."""
+    rules = ertools(["score", "hnf", str(bag), "--rules", "2019", "--draws", "0"])
+    each = ertools(
+        [
+            "score",
+            "hnf",
+            str(bag),
+            "--draws",
+            "0",
+            "--orientation-2019",
+            "--divisor",
+            "2019",
+            "--gt-gaps",
+            "interpolate",
+            "--score-format",
+            "2019",
+        ]
+    )
+    assert rules.code == each.code == 0 and each.stdout == rules.stdout
+    assert "differs from 2019" not in each.stderr
+
+
+def test_another_log_says_what_it_is(tmp_path: Path) -> None:
+    fbm2h = Path(__file__).resolve().parents[3] / "sample_bags" / "fbm2h"
+    ran = ertools(
+        [
+            "score",
+            "hnf",
+            str(fbm2h / "log_fbm2h_mocap_2015-11-20-12-00-00_0.bag"),
+            "--config",
+            str(tmp_path / "none.yaml"),
+            "--transform",
+            str(fbm2h / "transform-simbot.yaml"),
+        ]
+    )
+    errors = [line for line in ran.stderr.splitlines() if "error" in line]
+    assert ran.code in (1, 2) and len(errors) == 1 and "Traceback" not in ran.stderr
+
+
 def test_bad_input_one_line(bag: Path, tmp_path: Path) -> None:
     cases = []
     # a config that is not HNF's

@@ -11,11 +11,13 @@ texts exactly.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Any
 
 import pytest
 from hpff_runs import PROMPT, HpffRun, schedule, write_run
+from inprocess import run as ertools
 from rsbb_replay.scenarios import at
 
 from ertools.benchmarks.hpff import declare
@@ -79,8 +81,25 @@ def test_a_passing_run_with_dropouts(tmp_path: Path) -> None:
     keys = {d.rule.key for d in ours.deviations}
     assert {"hpff.sampling", "hpff.distance-plane", "hpff.duration-clock"} <= keys
     # the script's sampling and plane, one option each, give its numbers back
-    back = _score(run, sampling="script", distance_plane="actor", duration_clock="script")
-    _same(back.score, run.replay.score)
+    back = ertools(
+        [
+            "score",
+            "hpff",
+            str(run.bag),
+            "--draws",
+            "0",
+            "--format",
+            "json",
+            "--sampling",
+            "script",
+            "--distance-plane",
+            "actor",
+            "--duration-clock",
+            "script",
+        ]
+    )
+    assert back.code == 0, back.stderr
+    _same(json.loads(back.stdout), run.replay.score)
 
 
 def test_a_result_reported_early_fails(tmp_path: Path) -> None:
