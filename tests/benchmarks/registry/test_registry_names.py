@@ -23,6 +23,8 @@ OWN_PACKAGE = {
     "trajectory": "trajectory",
     "hnf": "hnf",
     "hpff": "hpff",
+    "hopf": "hopf",
+    "hppf": "hppf",
 }
 # Files (or folders, ending in /) allowed to name benchmarks, and why; each entry must say why.
 EXCEPTIONS: dict[str, str] = {
