@@ -319,6 +319,16 @@ def _warnings(logs: HopfLogs, runs: HopfRuns, scored: Scored) -> list[str]:
     return out
 
 
+def _team(logs: HopfLogs) -> tuple[str | None, str | None]:
+    """The team: the RSBB layout's folder (``rsbb_logs/<CODE>/<team>/``), else the result
+    file's ``benchmark_info.team``."""
+    if logs.side.place.team is not None:
+        return logs.side.place.team, "RSBB layout"
+    if logs.result_file is not None:
+        return logs.result_file.team, "result file"
+    return None, None
+
+
 def score_runs(logs: HopfLogs, runs: HopfRuns, options: HopfOptions) -> HopfResult:
     """The goals scored by the rules, compared with the run's live score and result file."""
     truths, validity = ground_truths(logs, runs, options)
@@ -362,6 +372,8 @@ def score_runs(logs: HopfLogs, runs: HopfRuns, options: HopfOptions) -> HopfResu
         deviations=tuple(_deviations(scored, truths, options)),
         failures=tuple(failures),
         provenance=Provenance(
+            team=_team(logs)[0],
+            team_source=_team(logs)[1],
             inputs=tuple(str(p) for p in logs.bags)
             + tuple(str(p) for p in (logs.side.items, logs.side.config, logs.side.result) if p),
             parameters=(
