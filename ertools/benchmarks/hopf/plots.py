@@ -39,7 +39,8 @@ def _colour(goal: Any) -> str:
 
 
 def _key() -> list[Layer]:
-    return [Bars(_EMPTY, _EMPTY, colours=(c,), label=text) for c, text in _QUALITIES]
+    """Legend entries (square markers: an empty bar layer would lose its colour)."""
+    return [Scatter(_EMPTY, _EMPTY, c, marker="s", label=text) for c, text in _QUALITIES]
 
 
 def scores_chart(result: Any) -> Chart:

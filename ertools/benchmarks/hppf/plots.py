@@ -40,9 +40,10 @@ def errors_chart(result: Any) -> Chart:
     if result.distance_error is not None:
         layers.append(RefLine(result.distance_error * MM, "y", "#000000", label="Distance error"))
     layers += [
-        Bars(_EMPTY, _EMPTY, colours=(_RIGHT,), label="name right"),
-        Bars(_EMPTY, _EMPTY, colours=(_WRONG,), label="name wrong"),
-        Bars(_EMPTY, _EMPTY, colours=(_NONE,), label="no answer / not scored"),
+        # legend entries (square markers: an empty bar layer would lose its colour)
+        Scatter(_EMPTY, _EMPTY, _RIGHT, marker="s", label="name right"),
+        Scatter(_EMPTY, _EMPTY, _WRONG, marker="s", label="name wrong"),
+        Scatter(_EMPTY, _EMPTY, _NONE, marker="s", label="no answer / not scored"),
     ]
     ticks = tuple((float(x), f"{p.index}: {p.person}") for x, p in zip(xs, passes, strict=True))
     return Chart(
