@@ -11,7 +11,8 @@ from ertools.benchmarks.base import Benchmark, Explanation, Input, Ranking, reso
 from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS, check_confidence
 from ertools.benchmarks.hnf.config import DEFAULT_MAX_GAP_S, RULE_SETS, HnfOptions, options_from
 from ertools.benchmarks.hnf.flow import HnfFlow
-from ertools.benchmarks.hnf.pipeline import HnfLogs, find_runs, load, score_runs
+from ertools.benchmarks.hnf.logs import HnfLogs
+from ertools.benchmarks.hnf.pipeline import find_runs, load, score_runs
 from ertools.benchmarks.hnf.result import HnfResult
 
 NAME = "hnf"

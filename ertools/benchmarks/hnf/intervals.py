@@ -11,7 +11,6 @@ swings the team transform's lever arm. Interpolating between two samples with we
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -24,13 +23,11 @@ from ertools.benchmarks.common.uncertainty import (
     monte_carlo,
 )
 from ertools.benchmarks.hnf.config import HnfOptions
+from ertools.benchmarks.hnf.logs import HnfLogs
 from ertools.benchmarks.hnf.result import ORIENTATION_KEY, POSITION_KEY, HnfSegment
 from ertools.geometry import wrap_angle
 from ertools.rsbb.noise import mocap_noise
 from ertools.rsbb.tf import TfTrack, duration_sec, link_at
-
-if TYPE_CHECKING:
-    from ertools.benchmarks.hnf.pipeline import HnfLogs
 
 METHOD = "Monte Carlo (parametric bootstrap, basic interval)"
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -19,6 +19,7 @@ from ertools.benchmarks.hnf.flow import HnfFlow, script_flow
 from ertools.benchmarks.hnf.formula import SegmentErrors, accuracies, segment_errors
 from ertools.benchmarks.hnf.intervals import hnf_intervals
 from ertools.benchmarks.hnf.listing import score_listing
+from ertools.benchmarks.hnf.logs import HnfLogs
 from ertools.benchmarks.hnf.result import HnfResult, HnfSegment, deviations_of
 from ertools.configs._yaml import parse_yaml
 from ertools.errors import ConfigError, UsageError
@@ -40,40 +41,6 @@ TRANSFORM_KEY = {
     "069fd1d": "marker_to_robot_transform",
     "f594ff1": "marker_to_robot_transform",
 }
-Transform = tuple[tuple[float, float, float], tuple[float, float, float, float]]
-
-
-@dataclass(frozen=True, eq=False)
-class HnfLogs:
-    """A run bag and what the script read.
-
-    Attributes:
-        bag: the run bag.
-        run: its RefBox/BmBox events and live scores.
-        body: the robot's marker set on ``/tf``.
-        stamps: the script's ``/robot`` lookups (their ``now``).
-        waypoints: the config's waypoints, values as typed (an integer stays one).
-        config_source: where the waypoints came from.
-        transform: the team transform as the script broadcast it.
-        transform_source: its file.
-        result_file: the run's result file (None: not found).
-        team: the team.
-        log_end_ns: the bag's last message.
-        warnings: what loading met (the config and the log's goals disagree...).
-    """
-
-    bag: Path
-    run: RsbbRun
-    body: TfTrack
-    stamps: I64
-    waypoints: tuple[tuple[Any, Any, Any], ...]
-    config_source: str
-    transform: Transform
-    transform_source: str
-    result_file: RsbbResult | None
-    team: str | None
-    log_end_ns: int
-    warnings: tuple[str, ...]
 
 
 def _waypoints(params: Any, where: str) -> tuple[tuple[Any, Any, Any], ...]:

@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from ertools import atomic
 from ertools.arrays import F64
 from ertools.geometry import compose, invert, quat_from_yaw, wrap_angle
 from ertools.rsbb.py2 import to_sec
@@ -389,8 +390,9 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     tdir.mkdir(parents=True, exist_ok=True)
     transform = tdir / f"transform-{TEAM}.yaml"
     pair = f"- {[float(v) for v in t_mr]}\n- {[float(v) for v in q_mr]}\n"
-    transform.write_text(
-        f"team_name: {TEAM}\nmarkerset_to_robot_transform: !!python/tuple\n{pair}", encoding="utf-8"
+    atomic.write_text(
+        transform,
+        f"team_name: {TEAM}\nmarkerset_to_robot_transform: !!python/tuple\n{pair}",
     )
     cdir = outdir / "rsbb_bmbox" / "scripts" / "benchmark_configs"
     cdir.mkdir(parents=True, exist_ok=True)
@@ -400,5 +402,5 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         "waypoints": WAYPOINTS,
         "goal_timeout": GOAL_TIMEOUT,
     }
-    config.write_text(yaml.safe_dump(params, default_flow_style=None), encoding="utf-8")
+    atomic.write_text(config, yaml.safe_dump(params, default_flow_style=None))
     return [*written, transform, config]

@@ -11,7 +11,8 @@ from ertools.benchmarks.base import Benchmark, Explanation, Input, Ranking, reso
 from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS, check_confidence
 from ertools.benchmarks.hpff.config import DEFAULT_MAX_GAP_S, RULE_SETS, HpffOptions, options_from
 from ertools.benchmarks.hpff.flow import HpffFlow
-from ertools.benchmarks.hpff.pipeline import HpffLogs, find_runs, load, score_runs
+from ertools.benchmarks.hpff.logs import HpffLogs
+from ertools.benchmarks.hpff.pipeline import find_runs, load, score_runs
 from ertools.benchmarks.hpff.result import HpffResult
 
 NAME = "hpff"

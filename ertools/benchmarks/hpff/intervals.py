@@ -10,8 +10,6 @@ basic interval removes the bias the draws show.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
 from ertools.arrays import F64
@@ -23,11 +21,9 @@ from ertools.benchmarks.common.uncertainty import (
     monte_carlo,
 )
 from ertools.benchmarks.hpff.config import HpffOptions
+from ertools.benchmarks.hpff.logs import HpffLogs
 from ertools.benchmarks.hpff.result import COVERED_KEY, DEVIATION_KEY, HpffSamples
 from ertools.rsbb.noise import mocap_noise
-
-if TYPE_CHECKING:
-    from ertools.benchmarks.hpff.pipeline import HpffLogs
 
 METHOD = "Monte Carlo (parametric bootstrap, basic interval)"
 

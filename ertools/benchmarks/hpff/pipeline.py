@@ -5,18 +5,17 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ertools.arrays import I64
 from ertools.benchmarks.base import notice
 from ertools.benchmarks.hpff.config import MARGIN_S, SCRIPT_COMMIT, HpffOptions
 from ertools.benchmarks.hpff.flow import HpffFlow, grid_flow, script_flow
 from ertools.benchmarks.hpff.formula import FAILED, Following, following
 from ertools.benchmarks.hpff.intervals import hpff_intervals
+from ertools.benchmarks.hpff.logs import HpffLogs
 from ertools.benchmarks.hpff.result import (
     COVERED_KEY,
     DEVIATION_KEY,
@@ -28,12 +27,12 @@ from ertools.benchmarks.hpff.result import (
 )
 from ertools.errors import ConfigError, UsageError
 from ertools.io import summary
-from ertools.rsbb.log import EndKind, RsbbRun, read_rsbb_run
+from ertools.rsbb.log import EndKind, read_rsbb_run
 from ertools.rsbb.py2 import to_sec
-from ertools.rsbb.results import RsbbResult, load_result
+from ertools.rsbb.results import load_result
 from ertools.rsbb.score import compare_scores
 from ertools.rsbb.sidefiles import find_side_files, read_side_yaml, script_transform
-from ertools.rsbb.tf import TfTrack, link_at, read_tf_tracks, script_poses
+from ertools.rsbb.tf import link_at, read_tf_tracks, script_poses
 from ertools.rsbb_states import BENCHMARKS
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
@@ -41,37 +40,6 @@ from ertools.timeutil import ns_to_s
 CODE = "HPFF"
 FRAME = BENCHMARKS[CODE].frames[0]  # /robot under /robot_markerset (both lookups)
 PARAMS = ("min_following_distance", "max_following_distance", "desired_following_distance")
-Transform = tuple[tuple[float, float, float], tuple[float, float, float, float]]
-
-
-@dataclass(frozen=True, eq=False)
-class HpffLogs:
-    """A run bag and what the script read.
-
-    Attributes:
-        bag: the run bag.
-        run: its events and live scores.
-        robot, person: the marker sets on ``/tf`` (``robot_markerset``, ``actor_markerset``).
-        stamps: the script's ``/robot`` lookups (relative and absolute alike).
-        params: the config's distances and ``goal_timeout`` (numbers as typed).
-        config_source, transform, transform_source: the side files as read.
-        result_file: the run's result file (None: not found).
-        team: the team.
-        log_end_ns: the bag's last message.
-    """
-
-    bag: Path
-    run: RsbbRun
-    robot: TfTrack
-    person: TfTrack
-    stamps: I64
-    params: dict[str, Any]
-    config_source: str
-    transform: Transform
-    transform_source: str
-    result_file: RsbbResult | None
-    team: str | None
-    log_end_ns: int
 
 
 def _params(data: Any, where: str) -> dict[str, Any]:

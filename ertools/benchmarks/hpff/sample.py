@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from ertools import atomic
 from ertools.arrays import F64
 from ertools.geometry import compose, invert, quat_from_yaw, rotate
 from ertools.rsbb.py2 import percent_py2, to_sec
@@ -297,11 +298,12 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     tdir.mkdir(parents=True, exist_ok=True)
     transform = tdir / f"transform-{TEAM}.yaml"
     pair = f"- {[float(v) for v in t_mr]}\n- {[float(v) for v in q_mr]}\n"
-    transform.write_text(
-        f"team_name: {TEAM}\nmarkerset_to_robot_transform: !!python/tuple\n{pair}", encoding="utf-8"
+    atomic.write_text(
+        transform,
+        f"team_name: {TEAM}\nmarkerset_to_robot_transform: !!python/tuple\n{pair}",
     )
     cdir = outdir / "rsbb_bmbox" / "scripts" / "benchmark_configs"
     cdir.mkdir(parents=True, exist_ok=True)
     config = cdir / "HPFF.yaml"
-    config.write_text(yaml.safe_dump(PARAMS, default_flow_style=False), encoding="utf-8")
+    atomic.write_text(config, yaml.safe_dump(PARAMS, default_flow_style=False))
     return [*written, transform, config]
