@@ -39,6 +39,8 @@ RULE_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.common.ending",
     "ertools.benchmarks.hnf.rules",
     "ertools.benchmarks.hpff.rules",
+    "ertools.benchmarks.hopf.rules",
+    "ertools.benchmarks.hppf.rules",
     "ertools.benchmarks.hgmf.rules",
 )
 
@@ -154,6 +156,8 @@ VERSION_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm3w.rules",
     "ertools.benchmarks.hnf.rules",
     "ertools.benchmarks.hpff.rules",
+    "ertools.benchmarks.hopf.rules",
+    "ertools.benchmarks.hppf.rules",
     "ertools.benchmarks.hgmf.rules",
 )
 

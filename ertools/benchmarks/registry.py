@@ -27,6 +27,8 @@ REGISTRY: dict[str, str] = {
     "trajectory": "ertools.benchmarks.trajectory.declare:BENCHMARK",
     "hnf": "ertools.benchmarks.hnf.declare:BENCHMARK",
     "hpff": "ertools.benchmarks.hpff.declare:BENCHMARK",
+    "hopf": "ertools.benchmarks.hopf.declare:BENCHMARK",
+    "hppf": "ertools.benchmarks.hppf.declare:BENCHMARK",
     "hgmf": "ertools.benchmarks.hgmf.declare:BENCHMARK",
     "hgtkmh": "ertools.benchmarks.referee.declare:HGTKMH",
     "hwv": "ertools.benchmarks.referee.declare:HWV",

@@ -31,6 +31,8 @@ LOGS = {
     "trajectory": [SAMPLES / "robotlog" / "FBM2H_201511201200_homer.bag", SAMPLES / "robotlog"],
     "hnf": [SAMPLES / "hnf" / "rsbb_logs" / "HNF" / "simbot" / "run_1_2019-04-10-14-31-06.bag"],
     "hpff": [SAMPLES / "hpff" / "rsbb_logs" / "HPFF" / "simbot" / "run_1_2019-04-10-15-22-11.bag"],
+    "hopf": [SAMPLES / "hopf" / "rsbb_logs" / "HOPF" / "simbot" / "run_1_2019-04-11-16-26-40.bag"],
+    "hppf": [SAMPLES / "hppf" / "rsbb_logs" / "HPPF" / "simbot" / "run_1_2019-04-11-17-26-40.bag"],
 }
 # An RSBB benchmark refuses the values before it reads anything: any run bag will do.
 RSBB_RUN = [SAMPLES / "hgmf" / "rsbb_logs" / "HGMF" / "simbot" / "run_1_2019-04-12-10-00-00.bag"]

@@ -23,6 +23,8 @@ OWN_PACKAGE = {
     "trajectory": "trajectory",
     "hnf": "hnf",
     "hpff": "hpff",
+    "hopf": "hopf",
+    "hppf": "hppf",
     "hgmf": "hgmf",
     "hgtkmh": "referee",
     "hwv": "referee",

@@ -1,0 +1,57 @@
+"""The HPPF sample run (``sample_bags/hppf``) scores as its answers (computed by the simulator
+from the noiseless truth), and ``--rules 2019`` on it equals the replayed script."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+from rsbb_fields import same
+from rsbb_replay import hppf as replay_hppf
+from rsbb_replay.fromlog import timeline_from_bag
+from rsbb_replay.world import World, run_script
+
+from ertools.cli.main import main
+
+SAMPLE = Path(__file__).parents[3] / "sample_bags" / "hppf"
+BAG = next(SAMPLE.glob("rsbb_logs/HPPF/*/run_*.bag"))
+ANSWERS = yaml.safe_load(BAG.with_name(BAG.name.replace(".bag", ".answers.yaml")).read_text())
+
+
+def _json(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[dict[str, Any], str]:
+    code = main(["score", "hppf", str(BAG), "--format", "json", "--draws", "0", *argv])
+    out = capsys.readouterr()
+    assert code == 0, out.err
+    return json.loads(out.out), out.err
+
+
+@pytest.mark.parametrize("rules", ["ertools", "2019"])
+def test_the_sample_scores_as_its_answers(capsys: pytest.CaptureFixture[str], rules: str) -> None:
+    score, err = _json(capsys, "--rules", rules)
+    expected = ANSWERS["expected"]["ertools" if rules == "ertools" else "rules_2019"]
+    tol = ANSWERS["tolerance"]["position"]["abs"]
+    assert score["Distance error"] == pytest.approx(expected["Distance error"], abs=tol)
+    assert score["Recognized persons"] == expected["Recognized persons"]
+    assert score["% Recognized persons"] == expected["% Recognized persons"]
+    assert score["execution_time"] == pytest.approx(expected["execution_time"], abs=1e-9)
+    for row in ANSWERS["truth"]["passes"]:
+        if "position_error" not in row:
+            continue
+        g = score[f"goal_{row['goal']}"]
+        assert g["position_error"] == pytest.approx(row["position_error"], abs=tol)
+        key = "recognized" if rules == "ertools" else "recognized_2019"
+        assert g["recognized"] is row[key]
+    assert "HPPF.yaml found in the RSBB layout" in err
+
+
+def test_the_sample_is_the_replayed_script(capsys: pytest.CaptureFixture[str]) -> None:
+    score, _ = _json(capsys, "--rules", "2019")
+    params = yaml.safe_load(next(SAMPLE.rglob("HPPF.yaml")).read_text())
+    oracle = run_script(World(timeline_from_bag(BAG, params, {})), replay_hppf.execute)
+    same(score, json.loads(json.dumps(oracle.score)))
+    # the restart, the dropout, the timeout and the stop are all there
+    happens = [row["happens"] for row in ANSWERS["truth"]["passes"]]
+    assert {"restart", "dropout", "timeout", "stop"} <= set(happens)
