@@ -194,7 +194,7 @@ def _stb(root: Path, team: str, t0: int) -> list[Path]:
         params={"goal_timeout": 30.0},
         referee_score=items,
     )
-    paths = write_rsbb_run(root, sc, compression="lz4")
+    paths = write_rsbb_run(root, sc, compression="bz2")
     return [paths.bag, paths.result]
 
 
@@ -212,7 +212,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     for k, team in enumerate(TEAMS):
         plan = RunPlan(team, 1, T0 + k * 3600 * S, HGMF_PLANS[team], objects=OBJECTS, seed=seed + k)
         scenario, truth = build(plan)
-        paths = write_rsbb_run(outdir, scenario, compression="lz4")
+        paths = write_rsbb_run(outdir, scenario, compression="bz2")
         written += [paths.bag, paths.result]
         answers = expected(truth, len(OBJECTS))
         hgmf_rows.append(
@@ -241,7 +241,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
                 start + round(seconds * S) + 4 * S,
                 referee_items(code, values),
             )
-            written.append(write_task_run(outdir, sc, compression="lz4"))
+            written.append(write_task_run(outdir, sc, compression="bz2"))
             a, p, d = tally(code, values)
             rows.append(
                 {

@@ -469,7 +469,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     """Write the sample run in the RSBB layout under ``outdir`` with its config and answers."""
     plan = RunPlan(**{**SAMPLE.__dict__, "seed": seed})
     scenario, truth = build(plan)
-    paths = write_rsbb_run(outdir, scenario, compression="lz4")
+    paths = write_rsbb_run(outdir, scenario, compression="bz2")
     config = write_config(outdir)
     answers = write_answers(
         paths.bag,
