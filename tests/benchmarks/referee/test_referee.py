@@ -163,3 +163,16 @@ def test_bad_input_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str
     code, _, err = _score(capsys, "hwv", str(bare))  # no HWV zone in its GUI messages
     (line,) = error_messages(err)
     assert code == 1 and "no /core/to_gui message shows HWV" in line
+
+
+@pytest.mark.parametrize("option", ["--plot", "--plots", "--foxglove"])
+def test_no_figures_or_foxglove_are_offered(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], option: str
+) -> None:
+    """Nothing is drawn from referee items: the option is refused before any work, not after
+    the score was written (an empty figure, a late --foxglove error)."""
+    bag = write_task_run(tmp_path, _task())
+    out = tmp_path / "score.json"
+    code = main(["score", "hgtkmh", str(bag), "-o", str(out), option, str(tmp_path / "x")])
+    assert code == 2 and not out.exists()
+    assert f"unrecognized arguments: {option}" in capsys.readouterr().err
