@@ -132,6 +132,49 @@ def test_a_2015_folder_beside_a_2019_one(tmp_path: Path) -> None:
     assert {e["benchmark"] for e in doc["executions"]} >= {"fbm2h", "hgmf", "hgtkmh"}
 
 
+# Each FBM sample's ranked value in ertools' reading, and the tolerance key of its answers.
+FBM_SAMPLES = {
+    "hnf": ("position_accuracy", "distance"),
+    "hpff": ("Average deviation from desired distance", "deviation"),
+    "hopf": ("pose_score", "pose"),
+    "hppf": ("Distance error", "position"),
+}
+
+
+def test_every_fbm_in_one_season(tmp_path: Path) -> None:
+    """The season with the HNF, HPFF, HOPF and HPPF samples' runs, side files and result files
+    merged into its layout: one draft places them all, each FBM gets its leaderboard, each
+    board's value is the best run's answer (from the sample's noiseless truth)."""
+    folder = tmp_path / "season"
+    for name in ("season2019", *FBM_SAMPLES):
+        # hnf and hpff share rsbb_etc/transforms/transform-simbot.yaml (the same file)
+        shutil.copytree(SAMPLES / name, folder, dirs_exist_ok=True)
+    manifest = tmp_path / "season.yaml"
+    assert main(["rescore", str(folder), "--init", str(manifest)]) == 0
+    draft = manifest.read_text(encoding="utf-8")
+    out = tmp_path / "results"
+    code = main(["rescore", str(folder), "--config", str(manifest), "--out", str(out), "-j", "1"])
+    assert code == 0
+    doc = json.loads((out / "results.json").read_text(encoding="utf-8"))
+    for name, (key, tol_key) in FBM_SAMPLES.items():
+        runs = sorted((SAMPLES / name / "rsbb_logs").glob("*/simbot/*.answers.yaml"))
+        answers = [yaml.safe_load(a.read_text(encoding="utf-8")) for a in runs]
+        values = [a["expected"]["ertools"][key] for a in answers]
+        board = _board(doc, name)
+        (row,) = board["rows"]
+        best = min(values) if board["lower_is_better"] else max(values)
+        assert row["team"] == "simbot"
+        assert row["value"] == pytest.approx(best, abs=answers[0]["tolerance"][tol_key]["abs"])
+        for bag in (SAMPLES / name / "rsbb_logs").glob("*/simbot/*.bag"):
+            assert bag.name in draft
+        for side in (SAMPLES / name / "results").glob("*/simbot/*.yaml"):
+            assert side.name in draft
+    scripted = [e for e in doc["executions"] if e["benchmark"] in FBM_SAMPLES]
+    # every run's live score found (HPFF's run 2, stopped while sampling, published an empty one)
+    assert len(scripted) == 6 and all(e["live_score"] is not None for e in scripted)
+    assert {b["benchmark"] for b in doc["leaderboards"]} >= {*FBM_SAMPLES, "hgmf", "hwv"}
+
+
 def test_timeline_shows_the_runs(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["timeline", str(SEASON), "--no-clock-check", "--format", "json"]) == 0
     data = json.loads(capsys.readouterr().out)
