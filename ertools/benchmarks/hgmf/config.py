@@ -18,7 +18,7 @@ from ertools.errors import UsageError
 
 NAME = "hgmf"
 CODE = "HGMF"
-TITLE = "HGMF (FBM6@Home)"
+TITLE = "HGMF (FBM6@Home 2019)"
 
 # fbm6_grasping_manipulation.py at 2bb8a41 (docs/hgmf.md): a grasp is a rise of more than
 # 3 cm (l. 270), checked by a 0.1 s timer (l. 176) whose tf wait lasts 0.1 s (l. 264); the
