@@ -47,6 +47,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from ertools import atomic
 from ertools.samples.mocap import MocapNoise, frame_times, simulate_mocap
 from ertools.samples.rsbb import write_rsbb_run
 from ertools.samples.rsbb_scenario import (
@@ -344,7 +345,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     config_path = outdir / "rsbb_bmbox" / "scripts" / "benchmark_configs" / "HOPF.yaml"
     for path, data in ((items_path, {"items": list(items.values())}), (config_path, PARAMS)):
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(yaml.safe_dump(data, default_flow_style=None), encoding="utf-8")
+        atomic.write_text(path, yaml.safe_dump(data, default_flow_style=None))
     answers = write_answers(
         paths.bag,
         benchmark="hopf",

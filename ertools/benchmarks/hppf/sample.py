@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from ertools import atomic
 from ertools.samples.mocap import MocapNoise, frame_times, simulate_mocap
 from ertools.samples.rsbb import write_rsbb_run
 from ertools.samples.rsbb_scenario import Body, Broadcast, Goal, ManualOperation, RsbbScenario, Save
@@ -222,7 +223,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     paths = write_rsbb_run(outdir, sc, compression="bz2")
     config = outdir / "rsbb_bmbox" / "scripts" / "benchmark_configs" / "HPPF.yaml"
     config.parent.mkdir(parents=True, exist_ok=True)
-    config.write_text(yaml.safe_dump(PARAMS, default_flow_style=None), encoding="utf-8")
+    atomic.write_text(config, yaml.safe_dump(PARAMS, default_flow_style=None))
     n = len(PEOPLE)
     answers = write_answers(
         paths.bag,
