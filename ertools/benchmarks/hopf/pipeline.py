@@ -13,7 +13,7 @@ import numpy as np
 
 from ertools.benchmarks.base import notice
 from ertools.benchmarks.hopf import rules
-from ertools.benchmarks.hopf.config import CODE, SCRIPT_TEXT, HopfOptions
+from ertools.benchmarks.hopf.config import CLIP_TRANSLATION_M, CODE, SCRIPT_TEXT, HopfOptions
 from ertools.benchmarks.hopf.goals import (
     GoalRecord,
     Scored,
@@ -212,7 +212,7 @@ def _deviations(
     clipped = [
         g.index
         for g in goals
-        if g.terms is not None and float(np.hypot(g.terms[0], g.terms[1])) > g.terms[3]
+        if g.terms is not None and float(np.hypot(g.terms[0], g.terms[1])) > CLIP_TRANSLATION_M
     ]
     if clipped and options.clip_translation:
         out.append(
