@@ -283,7 +283,9 @@ def test_the_live_score_names_the_benchmark(tmp_path: Path) -> None:
     check_code(replace(run, live=(placeholder,)), "HPFF")
 
 
-@pytest.mark.parametrize(("code", "other"), [("hnf", "hpff"), ("hpff", "hnf")])
+@pytest.mark.parametrize(
+    ("code", "other"), [("hnf", "hpff"), ("hpff", "hnf"), ("hopf", "hppf"), ("hppf", "hopf")]
+)
 def test_another_benchmarks_bag_outside_the_layout(tmp_path: Path, code: str, other: str) -> None:
     # outside rsbb_logs/<CODE>/ only the bag itself says what it is: one line, exit 1
     sample = next((SAMPLES / other).rglob("run_1_*.bag"))
