@@ -12,13 +12,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from inprocess import run as ertools
 from rsbb_replay.fromlog import timeline_from_bag
 from rsbb_replay.py2 import euler_yaw as replay_yaw
 from rsbb_replay.scenarios import MS, T0, at, hnf_scenario
 from rsbb_replay.tf2 import Buffer
+from stderr_text import joined_lines
 
 from ertools.errors import ConfigError
-from ertools.rsbb.log import read_rsbb_run
+from ertools.rsbb.log import check_code, logged_code, read_rsbb_run
 from ertools.rsbb.py2 import percent_py2, round_py2, str_py2, to_sec
 from ertools.rsbb.results import load_result, parse_live_score
 from ertools.rsbb.score import compare_scores, flatten, same_value, score_yaml
@@ -261,3 +263,37 @@ def test_script_transform_is_read_as_written(tmp_path: Path) -> None:
     evil = _touch(tmp_path / "evil.yaml", "x: !!python/object/apply:os.system [ls]\n")
     with pytest.raises(ConfigError):
         script_transform(evil)
+
+
+SAMPLES = Path(__file__).resolve().parents[2] / "sample_bags"
+
+
+def test_the_live_score_names_the_benchmark(tmp_path: Path) -> None:
+    run = read_rsbb_run(write_rsbb_run(tmp_path, hnf_scenario()).bag)
+    assert logged_code(run) == "HNF"
+    check_code(run, "HNF")
+    with pytest.raises(ConfigError, match=r"a HNF run .*not HPFF's: ertools score hnf"):
+        check_code(run, "HPFF")
+    # no live score, or the result object's placeholder (BenchmarkObjects.py l. 724) before
+    # the script's setup: nothing named, nothing refused
+    assert logged_code(replace(run, live=())) is None
+    info = {"benchmark_info": {"benchmark_code": "undefined"}, "score": {}}
+    placeholder = replace(run.live[0], result=info)
+    assert logged_code(replace(run, live=(placeholder,))) is None
+    check_code(replace(run, live=(placeholder,)), "HPFF")
+
+
+@pytest.mark.parametrize(
+    ("code", "other"), [("hnf", "hpff"), ("hpff", "hnf"), ("hopf", "hppf"), ("hppf", "hopf")]
+)
+def test_another_benchmarks_bag_outside_the_layout(tmp_path: Path, code: str, other: str) -> None:
+    # outside rsbb_logs/<CODE>/ only the bag itself says what it is: one line, exit 1
+    sample = next((SAMPLES / other).rglob("run_1_*.bag"))
+    bag = tmp_path / sample.name
+    bag.write_bytes(sample.read_bytes())
+    ran = ertools(["score", code, str(bag)])
+    assert ran.code == 1
+    assert joined_lines(ran.stderr) == [  # one message, wrapped past 200 characters
+        f"ertools: error: {bag}: this bag is a {other.upper()} run (its live score's "
+        f"benchmark_info), not {code.upper()}'s: ertools score {other}"
+    ]

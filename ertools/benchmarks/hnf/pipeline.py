@@ -24,7 +24,7 @@ from ertools.benchmarks.hnf.result import HnfResult, HnfSegment, deviations_of
 from ertools.configs._yaml import parse_yaml
 from ertools.errors import ConfigError, UsageError
 from ertools.io import summary
-from ertools.rsbb.log import EndKind, RsbbRun, read_rsbb_run
+from ertools.rsbb.log import EndKind, RsbbRun, check_code, read_rsbb_run
 from ertools.rsbb.results import RsbbResult, load_result
 from ertools.rsbb.score import compare_scores
 from ertools.rsbb.sidefiles import find_side_files, read_side_yaml, script_transform
@@ -110,6 +110,8 @@ def load(logs: Sequence[Path], options: HnfOptions) -> HnfLogs:
             f"{bag} is an {side.place.code} run (rsbb_logs/{side.place.code}/...): "
             f"ertools score {side.place.code.lower()}"
         )
+    run = read_rsbb_run(bag)
+    check_code(run, CODE)  # outside the layout, the live score names the benchmark
     result = load_result(side.result) if side.result is not None else None
     team = side.team or (result.team if result is not None else None)
     transform_path = side.transform
@@ -134,7 +136,6 @@ def load(logs: Sequence[Path], options: HnfOptions) -> HnfLogs:
             "the other spelling used"
         )
     waypoints, config_source = _config(options, side.config, result)
-    run = read_rsbb_run(bag)
     if run.t_start_ns is None:
         raise UsageError(
             f"{bag}: the benchmark never started (no EXECUTING_BENCHMARK): nothing to score"

@@ -13,7 +13,7 @@ import numpy as np
 
 from ertools.benchmarks.base import notice
 from ertools.benchmarks.hopf import rules
-from ertools.benchmarks.hopf.config import CODE, SCRIPT_TEXT, HopfOptions
+from ertools.benchmarks.hopf.config import CLIP_TRANSLATION_M, CODE, SCRIPT_TEXT, HopfOptions
 from ertools.benchmarks.hopf.goals import (
     GoalRecord,
     Scored,
@@ -29,7 +29,7 @@ from ertools.benchmarks.hopf.runs import HopfRuns, Iteration, find_iterations
 from ertools.errors import ConfigError
 from ertools.fidelity import Deviation
 from ertools.io import summary
-from ertools.rsbb.log import RsbbRun, read_rsbb_run
+from ertools.rsbb.log import RsbbRun, check_code, read_rsbb_run
 from ertools.rsbb.results import RsbbResult, load_result
 from ertools.rsbb.score import compare_scores
 from ertools.rsbb.sidefiles import SideFiles, find_side_files, read_side_yaml
@@ -128,6 +128,7 @@ def load(bags: Sequence[Path], options: HopfOptions) -> HopfLogs:
             f"the result file is a {result_file.code} run's, not HOPF's", path=result_file.path
         )
     run = read_rsbb_run(paths)
+    check_code(run, CODE)  # outside the layout, the live score names the benchmark
     params = script_params(side, run, result_file)
     items = _items(side, params, options)
     tracks = read_tf_tracks(paths)
@@ -212,7 +213,7 @@ def _deviations(
     clipped = [
         g.index
         for g in goals
-        if g.terms is not None and float(np.hypot(g.terms[0], g.terms[1])) > g.terms[3]
+        if g.terms is not None and float(np.hypot(g.terms[0], g.terms[1])) > CLIP_TRANSLATION_M
     ]
     if clipped and options.clip_translation:
         out.append(

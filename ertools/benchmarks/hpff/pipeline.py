@@ -27,7 +27,7 @@ from ertools.benchmarks.hpff.result import (
 )
 from ertools.errors import ConfigError, UsageError
 from ertools.io import summary
-from ertools.rsbb.log import EndKind, read_rsbb_run
+from ertools.rsbb.log import EndKind, check_code, read_rsbb_run
 from ertools.rsbb.py2 import to_sec
 from ertools.rsbb.results import load_result
 from ertools.rsbb.score import compare_scores
@@ -84,6 +84,8 @@ def load(logs: Sequence[Path], options: HpffOptions) -> HpffLogs:
             f"{bag} is an {side.place.code} run (rsbb_logs/{side.place.code}/...): "
             f"ertools score {side.place.code.lower()}"
         )
+    run = read_rsbb_run(bag)
+    check_code(run, CODE)  # outside the layout, the live score names the benchmark
     result = load_result(side.result) if side.result is not None else None
     team = side.team or (result.team if result is not None else None)
     transform_path = side.transform
@@ -110,7 +112,6 @@ def load(logs: Sequence[Path], options: HpffOptions) -> HpffLogs:
             "no HPFF.yaml beside the bag or in the RSBB layout, and no result file with the "
             "params: give --config HPFF.yaml or --result result_run_<n>_<date>.yaml"
         )
-    run = read_rsbb_run(bag)
     if run.t_start_ns is None:
         raise UsageError(f"{bag}: the benchmark never started (no EXECUTING_BENCHMARK)")
     tracks = read_tf_tracks(bag)

@@ -21,7 +21,7 @@ from ertools.benchmarks.hppf.runs import FlowError, HppfRuns, entered, walk
 from ertools.errors import ConfigError
 from ertools.fidelity import Deviation
 from ertools.io import summary
-from ertools.rsbb.log import RsbbRun, read_rsbb_run
+from ertools.rsbb.log import RsbbRun, check_code, read_rsbb_run
 from ertools.rsbb.results import RsbbResult, load_result
 from ertools.rsbb.score import compare_scores
 from ertools.rsbb.sidefiles import SideFiles, find_side_files, read_side_yaml
@@ -121,6 +121,7 @@ def load(bags: Sequence[Path], options: HppfOptions) -> HppfLogs:
             f"the result file is a {result_file.code} run's, not HPPF's", path=result_file.path
         )
     run = read_rsbb_run(paths)
+    check_code(run, CODE)  # outside the layout, the live score names the benchmark
     people, source = _people(side, run, result_file)
     tracks = read_tf_tracks(paths)
     origin = min(summary(p).start_ns for p in paths)
