@@ -29,6 +29,7 @@ from typing import Any
 
 import yaml
 
+from ertools import atomic
 from ertools.benchmarks.hgmf.sample import T0 as HGMF_T0
 from ertools.benchmarks.hgmf.sample import GoalPlan, RunPlan, build, expected, write_config
 from ertools.samples.rsbb import write_rsbb_run
@@ -205,7 +206,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     written.append(config)
     path = outdir / "rsbb_etc" / "config" / "benchmarks_description.yaml"
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(yaml.safe_dump(description(), sort_keys=False, width=100), encoding="utf-8")
+    atomic.write_text(path, yaml.safe_dump(description(), sort_keys=False, width=100))
     written.append(path)
     boards: dict[str, Any] = {}
     hgmf_rows = []
@@ -269,7 +270,8 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         "unranked": [],
     }
     answers_path = outdir / "answers.yaml"
-    answers_path.write_text(
+    atomic.write_text(
+        answers_path,
         yaml.safe_dump(
             {
                 "benchmark": "season2019",
@@ -285,7 +287,6 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
             sort_keys=False,
             width=100,
         ),
-        encoding="utf-8",
     )
     written.append(answers_path)
     return written

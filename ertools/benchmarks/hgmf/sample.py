@@ -34,6 +34,7 @@ import numpy as np
 import yaml
 from scipy.spatial.transform import Rotation, Slerp
 
+from ertools import atomic
 from ertools.rsbb_states import BENCHMARKS
 from ertools.samples.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
 from ertools.samples.rsbb import write_rsbb_run
@@ -461,7 +462,7 @@ def write_config(root: Path, objects: Sequence[dict[str, Any]] = OBJECTS) -> Pat
         "table_size": dict(TABLE_SIZE),
         "goal_timeout": GOAL_TIMEOUT_S,
     }
-    path.write_text(yaml.safe_dump(data, sort_keys=False), encoding="utf-8")
+    atomic.write_text(path, yaml.safe_dump(data, sort_keys=False))
     return path
 
 
