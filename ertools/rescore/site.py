@@ -33,6 +33,7 @@ from ertools.report import ranks, units
 from ertools.report.rank_plot import interval_plot
 from ertools.rescore import site_text as text
 from ertools.rescore.site_text import TEAM_UNKNOWN
+from ertools.rsbb.score import flatten
 
 SCHEMA_VERSION = 1
 TEMPLATE = "rescore_index.html.j2"
@@ -256,7 +257,9 @@ def _live_rows(executions: Sequence[dict[str, Any]], paths: text.Paths) -> list[
         live = _scalars(ex.get("live_score"))
         if not live:
             continue
-        score = _scalars(ex.get("score"))
+        # an RSBB live score's fields are dotted paths into the nested score (goal_1.pose_score)
+        recomputed = ex.get("score")
+        score = _scalars(flatten(recomputed) if isinstance(recomputed, dict) else None)
         why = {
             d.key: d
             for d in (text.difference(str(line)) for line in ex.get("live_differences") or [])
@@ -274,7 +277,7 @@ def _live_rows(executions: Sequence[dict[str, Any]], paths: text.Paths) -> list[
                 LiveRow(
                     execution=str(ex.get("id")),
                     team=_team(ex),
-                    field=key,
+                    field=units.without_unit(key),
                     live=text.with_unit(key, value),
                     recomputed=text.with_unit(key, score.get(key)),
                     difference=d.difference if d is not None else "",
