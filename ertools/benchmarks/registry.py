@@ -25,6 +25,15 @@ REGISTRY: dict[str, str] = {
     "fbm2h": "ertools.benchmarks.fbm2h.declare:BENCHMARK",
     "fbm3w": "ertools.benchmarks.fbm3w.declare:BENCHMARK",
     "trajectory": "ertools.benchmarks.trajectory.declare:BENCHMARK",
+    "hnf": "ertools.benchmarks.hnf.declare:BENCHMARK",
+    "hpff": "ertools.benchmarks.hpff.declare:BENCHMARK",
+    "hopf": "ertools.benchmarks.hopf.declare:BENCHMARK",
+    "hppf": "ertools.benchmarks.hppf.declare:BENCHMARK",
+    "hgmf": "ertools.benchmarks.hgmf.declare:BENCHMARK",
+    "hgtkmh": "ertools.benchmarks.referee.declare:HGTKMH",
+    "hwv": "ertools.benchmarks.referee.declare:HWV",
+    "hcfgac": "ertools.benchmarks.referee.declare:HCFGAC",
+    "stb": "ertools.benchmarks.referee.declare:STB",
 }
 
 

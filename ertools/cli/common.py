@@ -18,6 +18,7 @@ from ertools.benchmarks.base import BenchmarkResult
 from ertools.benchmarks.common.teams import with_team
 from ertools.cli.options import add_output, add_plots, add_report
 from ertools.cli.output import dump_json, note, write_text
+from ertools.fidelity import differs_line
 from ertools.report.figures import figure_specs, save_figures, save_one_file
 
 if TYPE_CHECKING:  # reached as attributes of the package, imported on first use
@@ -88,7 +89,7 @@ def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[
     for warning in result.warnings:
         note(f"warning: {warning}")
     for deviation in result.deviations:
-        note(f"differs from 2015: {deviation}")
+        note(differs_line(deviation))
     write_plots_option(result, args)
     report_dir: Path | None = getattr(args, "report", None)
     if report_dir is not None:

@@ -170,7 +170,10 @@ def add_benchmark_arguments(parser: argparse.ArgumentParser, name: str) -> None:
             target = groups[declared.group]
         _add_input(target, declared)
     names = {i.name for i in bench.inputs}
-    add_output_options(parser, team="team" not in names)
+    # a benchmark without figures or Foxglove content (the referee-scored ones) offers neither
+    add_output_options(
+        parser, plot=bool(bench.figures), foxglove=bool(bench.foxglove), team="team" not in names
+    )
 
 
 def _values(bench: registry.AnyBenchmark, args: argparse.Namespace) -> dict[str, Any]:
