@@ -36,7 +36,8 @@ TARGET = (93.0, 97.0)
 
 @dataclass(frozen=True)
 class Coverage:
-    """What the trials of one benchmark gave."""
+    """What the trials of one benchmark gave (``keys``: (scores, covered) per score key, run
+    and segment numbers replaced by ``*``)."""
 
     benchmark: str
     trials: int
@@ -46,6 +47,7 @@ class Coverage:
     unit_scale: float
     unit: str
     seconds: float
+    keys: tuple[tuple[str, int, int], ...] = ()
 
     @property
     def percent(self) -> float:
@@ -71,15 +73,30 @@ def coverage(rows: list[Row]) -> tuple[int, int, float]:
     return len(rows), covered, sum(hi - lo for _, _, lo, hi in rows)
 
 
-def _chunk(name: str, seeds: range, draws: int) -> tuple[int, int, float]:
-    """(scores, covered, summed width) of one benchmark's trials over ``seeds``."""
+def key_of(key: str) -> str:
+    """A score key with its run or segment number as ``*`` (``runs_details.*.distance_error``)."""
+    return ".".join("*" if part.isdigit() else part for part in key.split("."))
+
+
+Chunk = tuple[int, int, float, dict[str, tuple[int, int]]]
+
+
+def _chunk(name: str, seeds: range, draws: int) -> Chunk:
+    """(scores, covered, summed width, (scores, covered) per key) of one benchmark's trials
+    over ``seeds``."""
     module = importlib.import_module(MODULES[name])
     scores = covered = 0
     width = 0.0
+    keys: dict[str, tuple[int, int]] = {}
     for seed in seeds:
-        n, c, w = coverage(module.trial(seed, draws))
+        rows = module.trial(seed, draws)
+        n, c, w = coverage(rows)
         scores, covered, width = scores + n, covered + c, width + w
-    return scores, covered, width
+        for key, true, lo, hi in rows:
+            k = key_of(key)
+            total, inside = keys.get(k, (0, 0))
+            keys[k] = (total + 1, inside + int(lo <= true <= hi))
+    return scores, covered, width, keys
 
 
 def run_benchmark(
@@ -104,6 +121,11 @@ def run_benchmark(
     scores = sum(p[0] for p in parts)
     covered = sum(p[1] for p in parts)
     width = sum(p[2] for p in parts)
+    keys: dict[str, tuple[int, int]] = {}
+    for p in parts:
+        for k, (n, c) in p[3].items():
+            total, inside = keys.get(k, (0, 0))
+            keys[k] = (total + n, inside + c)
     scale, unit = UNITS.get(name, (1.0, ""))
     return Coverage(
         name,
@@ -114,6 +136,7 @@ def run_benchmark(
         scale,
         unit,
         time.perf_counter() - t0,
+        tuple((k, n, c) for k, (n, c) in keys.items()),
     )
 
 
@@ -130,7 +153,16 @@ def table(results: list[Coverage], draws: int) -> str:
             f"{r.mean_width * r.unit_scale:.4g} {r.unit} | {r.seconds:.0f} s |"
         )
     lines.append("")
-    lines.append(f"{draws} Monte Carlo draws per interval; seeds 0 to trials - 1.")
+    lines.append(f"{draws} Monte Carlo draws per interval; seeds 0 to trials - 1. Per score key:")
+    lines.append("")
+    lines.append("| benchmark | score key | scores | coverage |")
+    lines.append("|---|---|---:|---:|")
+    for r in results:
+        for key, n, c in r.keys:
+            pct = 100.0 * c / n if n else math.nan
+            ok = TARGET[0] <= pct <= TARGET[1]
+            flag = "" if ok else " (outside 93-97%)"
+            lines.append(f"| {r.benchmark} | `{key}` | {n} | {pct:.1f}% ({c}/{n}){flag} |")
     return "\n".join(lines)
 
 

@@ -5,6 +5,10 @@ python bench/extract.py bytes PATH              read the file's bytes
 python bench/extract.py ertools PATH TOPIC      ertools.io.reader.read_poses -> arrays
 python bench/extract.py rosbags PATH TOPIC      rosbags AnyReader, one message at a time
 python bench/extract.py inflate PATH            read and decompress every chunk, no decoding
+python bench/extract.py sources PATH BODY       the GT's three pose sources of BODY (its pose
+                                                topic, its pose2d topic by record time, its
+                                                /tf frame) in one read (read_pose_sources)
+python bench/extract.py each PATH BODY          the same three, one read_pose_source each
 """
 
 from __future__ import annotations
@@ -26,6 +30,15 @@ def main() -> None:
     elif mode == "inflate":
         from ertools.io.bulk import load_all_chunks
         from ertools.io.files import open_bag
+    elif mode in ("sources", "each"):
+        from ertools.io.reader import PoseSource, read_pose_source
+
+        body = sys.argv[3]
+        sources = [
+            PoseSource(topic=f"{body}/pose"),
+            PoseSource(topic=f"{body}/pose2d", time_source="record"),
+            PoseSource(frame=body.rsplit("/", 1)[-1]),
+        ]
     t0 = time.perf_counter()
     if mode == "bytes":
         n = 0
@@ -47,6 +60,13 @@ def main() -> None:
     elif mode == "inflate":
         with open_bag(path) as bag:
             n = load_all_chunks(bag)
+    elif mode == "sources":
+        from ertools.io.reader import read_pose_sources
+
+        n = sum(len(s) for s in read_pose_sources(path, sources))
+    elif mode == "each":
+        streams = [read_pose_source(path, s) for s in sources]  # kept, as one read keeps them
+        n = sum(len(s) for s in streams)
     else:
         raise SystemExit(f"unknown mode {mode}")
     done = time.perf_counter()

@@ -35,7 +35,7 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
 sys.path.insert(0, str(HERE))
 
-from data import GT_TOPIC, ROBOT_TOPIC, generate  # noqa: E402
+from data import GT_TOPIC, NS_BODY, ROBOT_TOPIC, generate  # noqa: E402
 from fbm_hour import FBM_SCENARIOS, hour_bag  # noqa: E402
 
 PY = sys.executable
@@ -271,6 +271,21 @@ def main() -> int:
                 [*ex, "rosbags", p, GT_TOPIC],
                 args.slow_runs,
             )
+    # issue 39: the GT hour's three pose sources (PoseStamped, Pose2D, /tf: 1.3 M messages)
+    for fmt, label in FORMATS.items():
+        if fmt != "gt_bz2":  # (bz2: the decompression is the read)
+            go(
+                f"sources_{fmt}",
+                f"ertools: GT's 3 pose sources, one read ({label})",
+                [*ex, "sources", str(paths[fmt]), NS_BODY],
+                args.runs,
+            )
+    go(
+        "each_gt",
+        "ertools: the same, one source at a time (ROS1)",
+        [*ex, "each", str(paths["gt"]), NS_BODY],
+        args.runs,
+    )
     for key, label in (("robot", "robot hour"), ("robot_fat", "robot hour + 16 KiB camera")):
         p = paths[key]
         go(
@@ -417,6 +432,13 @@ def main() -> int:
             ratios[f"fbm_{scenario}_beyond_extraction_s"] = extra
             text = f"ertools score {scenario} (hour log) beyond its pose extraction"
             print(f"  {text:<62} {extra:7.2f} s   (target < 1 s){a.note}")
+    for fmt, label in FORMATS.items():
+        m = results.get(f"sources_{fmt}")
+        if m and m.ok and m.inside_s is not None:
+            ratios[f"sources_inside_s_{fmt}"] = m.inside_s
+            text = f"GT hour's 3 pose sources in one read, inside, {label}"
+            target = "<= 0.1 s" if fmt == "gt" else "-"
+            print(f"  {text:<62} {m.inside_s:7.3f} s   (target {target}; {m.rss_mib:.0f} MiB)")
     for key in ("info_1000", "timeline_1000"):
         if key in results:
             print(f"  {results[key].name:<62} {results[key].wall_s:7.2f} s   (target <= 3 s)")

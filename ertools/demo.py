@@ -110,6 +110,24 @@ def competition_step(day: Path, out: Path) -> Step:
     )
 
 
+def season_steps(season: Path, out: Path) -> list[Step]:
+    """The sample 2019 season in the RSBB layout: its manifest drafted, then its results site
+    from the draft as written."""
+    manifest = out / "season2019.yaml"
+    return [
+        Step(
+            "draft of the sample 2019 season's manifest (the RSBB layout)",
+            ["rescore", str(season), "--init", str(manifest)],
+            None,
+        ),
+        Step(
+            "rescore of the sample 2019 season (FBM and task-benchmark leaderboards)",
+            ["rescore", str(season), "--config", str(manifest), "--out", str(out / "season")],
+            None,
+        ),
+    ]
+
+
 def make_competition(day: Path) -> None:
     """The sample competition in ``day`` (``python -m ertools.samples --competition DAY``),
     generated once: it is deterministic."""
@@ -127,10 +145,13 @@ def run(out: Path, samples: Path = SAMPLES) -> int:
     failed = 0
     make_competition(out / "competition")
     site = out / "rescore"
-    for step in [*steps(samples, out), competition_step(out / "competition", site)]:
+    (out / "season2019.yaml").unlink(missing_ok=True)  # a rerun drafts it again
+    season = season_steps(samples / "season2019", out)
+    for step in [*steps(samples, out), competition_step(out / "competition", site), *season]:
         print(f"== {step.title}: ertools {' '.join(step.argv)}", file=sys.stderr)
         if step.stdout_file is None:
-            target: Path | None = Path(step.argv[step.argv.index("--out") + 1]) / "index.html"
+            written = step.argv[step.argv.index("--out") + 1] if "--out" in step.argv else None
+            target: Path | None = None if written is None else Path(written) / "index.html"
             code = ertools_main(step.argv)
         else:
             target = out / step.stdout_file
@@ -150,12 +171,16 @@ def run(out: Path, samples: Path = SAMPLES) -> int:
             print(f"   {shown} (exit {code}, as planted: see the problems above)", file=sys.stderr)
         else:
             print(f"   {shown}", file=sys.stderr)
-    index = [p for p in sorted(out.glob("*/index.html")) if p.parent != site]
+    index = [p for p in sorted(out.glob("*/index.html")) if p.parent not in (site, out / "season")]
     print("\nReports written:", file=sys.stderr)
     for p in index:
         print(f"  {p}", file=sys.stderr)
     print(
         f"The sample competition's results site: {(site / 'index.html').resolve()}", file=sys.stderr
+    )
+    print(
+        f"The sample 2019 season's results site: {(out / 'season' / 'index.html').resolve()}",
+        file=sys.stderr,
     )
     print("Open it (or a report above) in a browser to start.", file=sys.stderr)
     for mcap in sorted(out.glob("*.mcap"))[:1]:

@@ -41,6 +41,11 @@ RULE_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm3w.rules",
     "ertools.benchmarks.trajectory.rules",
     "ertools.benchmarks.common.ending",
+    "ertools.benchmarks.hnf.rules",
+    "ertools.benchmarks.hpff.rules",
+    "ertools.benchmarks.hopf.rules",
+    "ertools.benchmarks.hppf.rules",
+    "ertools.benchmarks.hgmf.rules",
 )
 
 
@@ -57,6 +62,9 @@ class Rule:
         ertools: what ertools does by default, and why.
         option: the command-line option that restores 2015; empty where none can (then
             ``ertools`` says why).
+        season: the original the rule differs from: ``2015`` (the RoCKIn nodes, whose
+            behaviour ``node_2015`` describes) or ``2019``/``2017`` (an RSBB script of the ERL
+            @Home seasons, described in ``node_2015`` likewise).
     """
 
     key: str
@@ -66,6 +74,7 @@ class Rule:
     node_2015: str
     ertools: str
     option: str
+    season: str = "2015"
 
     def deviation(self, detail: str) -> Deviation:
         """The line to print for one result: ``detail`` says what differs in this result."""
@@ -108,7 +117,7 @@ class Deviation(str):
     def __new__(cls, rule: Rule, detail: str) -> Deviation:
         text = detail
         if rule.option and rule.option not in detail:
-            text += f"; {rule.option} restores 2015"
+            text += f"; {rule.option} restores {rule.season}"
         self = super().__new__(cls, f"{text} [{rule.key}]")
         self.rule = rule
         self.detail = detail
@@ -116,6 +125,14 @@ class Deviation(str):
 
     def __reduce__(self) -> tuple[type[Deviation], tuple[Rule, str]]:
         return (Deviation, (self.rule, self.detail))
+
+
+def differs_line(deviation: str) -> str:
+    """The line printed for a deviation: ``differs from 2015: ...`` (or the season its rule
+    names, ``differs from 2019: ...`` for the RSBB benchmarks)."""
+    rule = getattr(deviation, "rule", None)
+    season = rule.season if isinstance(rule, Rule) else "2015"
+    return f"differs from {season}: {deviation}"
 
 
 def all_rules() -> tuple[Rule, ...]:
@@ -141,6 +158,11 @@ VERSION_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm1.rules",
     "ertools.benchmarks.fbm2h.rules",
     "ertools.benchmarks.fbm3w.rules",
+    "ertools.benchmarks.hnf.rules",
+    "ertools.benchmarks.hpff.rules",
+    "ertools.benchmarks.hopf.rules",
+    "ertools.benchmarks.hppf.rules",
+    "ertools.benchmarks.hgmf.rules",
 )
 
 

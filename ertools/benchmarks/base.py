@@ -138,12 +138,15 @@ class Ranking:
     """How a leaderboard orders a benchmark's results (stated on the results page).
 
     ``key`` gives the number a result is ranked by (None: not ranked, e.g. nothing scored);
-    ``lower_is_better`` its direction; ``text`` the rule in words.
+    ``lower_is_better`` its direction; ``text`` the rule in words; ``columns``, when given,
+    what a leaderboard row shows beside it, from the result's JSON score: (header, value,
+    what the header means) per cell (a referee-scored benchmark's items).
     """
 
     key: Callable[[Any], float | None]
     lower_is_better: bool
     text: str
+    columns: Callable[[Mapping[str, Any]], Sequence[tuple[str, Any, str]]] | None = None
 
 
 @dataclass(frozen=True)

@@ -190,6 +190,14 @@ def _shape(audited: bool, simulated: bool) -> type[_Core]:
     return type(name, tuple(parts), {})
 
 
+def offers(bench: AnyBenchmark, part: str) -> bool:
+    """Whether ``bench`` has ``part`` (``figures`` or ``foxglove``): a Reported benchmark has
+    both, unless it is a record that leaves that field empty (the referee-scored ones)."""
+    if not isinstance(bench, Reported):
+        return False
+    return not isinstance(bench, _Core) or bool(getattr(bench.legacy, part))
+
+
 # By the record's id: the adapted object holds its record, so the id stays its own.
 _ADAPTED: dict[int, AnyBenchmark] = {}
 

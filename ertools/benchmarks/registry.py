@@ -49,6 +49,16 @@ ENTRIES: tuple[Entry, ...] = (
     Entry("fbm2h", ".fbm2h.declare", "FBM2@Home navigation: waypoint errors"),
     Entry("fbm3w", ".fbm3w.declare", "FBM3@Work trajectory following: path error"),
     Entry("trajectory", ".trajectory.declare", "robot log vs mocap ground truth, with clock audit"),
+    # The RSBB benchmarks (issue 38) are still LegacyBenchmark records (legacy.py adapts them).
+    Entry("hnf", ".hnf.declare", "HNF (FBM2@Home 2017-19) navigation: the RSBB script re-scored"),
+    Entry("hpff", ".hpff.declare", "HPFF (FBM5@Home 2019) person following: the RSBB script"),
+    Entry("hopf", ".hopf.declare", "HOPF object perception (RSBB 2017-19): 10 items"),
+    Entry("hppf", ".hppf.declare", "HPPF people perception (RSBB 2019): who each person is"),
+    Entry("hgmf", ".hgmf.declare", "HGMF (FBM6@Home 2019) grasping and manipulation"),
+    Entry("hgtkmh", ".referee.declare:HGTKMH", "HGTKMH: the referee's items, ERL-ranked"),
+    Entry("hwv", ".referee.declare:HWV", "HWV: the referee's items, ERL-ranked"),
+    Entry("hcfgac", ".referee.declare:HCFGAC", "HCFGAC: the referee's items, ERL-ranked"),
+    Entry("stb", ".referee.declare:STB", "STB: the referee's items, ERL-ranked"),
 )
 
 

@@ -16,6 +16,7 @@ from ertools.benchmarks.base import BenchmarkResult
 from ertools.benchmarks.common.teams import with_team
 from ertools.benchmarks.document import all_failed
 from ertools.cli.output import dump_json, note, write_text
+from ertools.fidelity import differs_line
 
 
 def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[Path]) -> int:
@@ -38,7 +39,7 @@ def emit_result(result: BenchmarkResult, args: argparse.Namespace, inputs: list[
     for warning in result.warnings:
         note(f"warning: {warning}")
     for deviation in result.deviations:
-        note(f"differs from 2015: {deviation}")
+        note(differs_line(deviation))
     write_plots_option(result, args)
     report_dir: Path | None = getattr(args, "report", None)
     if report_dir is not None:

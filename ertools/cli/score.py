@@ -17,6 +17,7 @@ from typing import Any
 
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import AnyBenchmark, Described, Input, Reported
+from ertools.benchmarks.legacy import offers
 from ertools.cli.command import Command, Delegate
 from ertools.cli.groups import add_group_arguments, run_group
 from ertools.cli.options import deprecation_note
@@ -148,7 +149,13 @@ def add_benchmark_arguments(parser: argparse.ArgumentParser, name: str) -> None:
             target = groups[declared.group]
         _add_input(target, declared)
     names = {i.name for i in bench.inputs}
-    add_output_options(parser, team="team" not in names)
+    # a benchmark without figures or Foxglove content (the referee-scored ones) offers neither
+    add_output_options(
+        parser,
+        plot=offers(bench, "figures"),
+        foxglove=offers(bench, "foxglove"),
+        team="team" not in names,
+    )
 
 
 def _bags_metavar(bench: AnyBenchmark) -> tuple[str | tuple[str, str], str]:

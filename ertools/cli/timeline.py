@@ -205,11 +205,36 @@ def to_table(timeline: Timeline, *, color: bool = False) -> str:
             # the same name twice (a copy on a USB stick): show the paths to tell them apart
             full = names.count(Path(pairing.path).name) > 1
             lines.append(_pairing_line(pairing, paint, full_path=full))
+    lines += _rsbb_lines(timeline, paint)
     if timeline.problems:
         lines += ["", paint(f"problems ({len(timeline.problems)}):", "bold")]
         for pr in timeline.problems:
             lines.append(paint(printable(f"  {pr.path}: {pr.problem}"), "warn"))
     return "\n".join(lines)
+
+
+def _rsbb_lines(timeline: Timeline, paint: _Paint) -> list[str]:
+    """The RSBB season layout: each run with its bag, result file and side files."""
+    if timeline.rsbb is None:
+        return []
+    out = ["", paint(f"RSBB runs ({len(timeline.rsbb.runs)}, docs/rsbb.md):", "bold")]
+    for r in timeline.rsbb.runs:
+        out.append(f"  {r.code:<7} {printable(r.team):<16} run {r.run:<3} bag {_name(r.bag)}")
+        out.append(f"{'':>32}result {_name(r.result)}")
+        side = [
+            (k, v)
+            for k, v in (("config", r.config), ("transform", r.transform), ("items", r.items))
+            if v is not None
+        ]
+        if side:
+            out.append(f"{'':>32}" + ", ".join(f"{k} {_name(v)}" for k, v in side))
+    for problem in timeline.rsbb.problems:
+        out.append(paint(f"  ! {printable(problem)}", "warn"))
+    return out
+
+
+def _name(path: str | None) -> str:
+    return "(none)" if path is None else printable(Path(path).name)
 
 
 def _pairing_line(p: Any, paint: _Paint, *, full_path: bool = False) -> str:

@@ -84,7 +84,7 @@ def _watch_parent(parent: int) -> None:
 # job (~600 modules, 1.3 s of CPU per scorer, measured on a day of the season: --jobs 2 paid
 # them twice where --jobs 1 paid them once). tests/rescore/test_rescore_children.py checks
 # that every lazy scipy import of ertools is here.
-SCORING_IMPORTS = ("scipy.spatial.transform", "scipy.interpolate", "scipy.stats")
+SCORING_IMPORTS = ("scipy.spatial.transform", "scipy.interpolate", "scipy.special")
 
 _warmed: set[str] = set()
 

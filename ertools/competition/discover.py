@@ -40,8 +40,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Literal
 
-from ertools.benchmarks.common.teams import TeamSource, resolve_team
-from ertools.timelines.build import bag_stem, split_name
+from ertools.benchmarks.common.teams import Team, TeamSource, resolve_team
+from ertools.timelines.build import bag_stem, rsbb_run, split_name
 from ertools.timelines.model import BagEntry, Pairing, Timeline
 from ertools.timeutil import NS_PER_S
 
@@ -252,9 +252,14 @@ def discover(timeline: Timeline, payload_teams: Mapping[str, str] | None = None)
             text = f"several robot logs overlap it; took {mine[0].path}, not {others}"
             notes.append(text)
             problems.append(Problem(log.path, "ambiguous", text))
-        team = resolve_team(
-            inputs=[paired.path] if paired is not None else [],
-            payload_team=payload_teams.get(log.path),
+        rsbb = rsbb_run(log.path)
+        team = (
+            Team(rsbb[1], "RSBB layout")
+            if rsbb is not None
+            else resolve_team(
+                inputs=[paired.path] if paired is not None else [],
+                payload_team=payload_teams.get(log.path),
+            )
         )
         if team is None:  # scored all the same; its row says the team is unknown
             text = "no team: no state payload or robot log names one (give it in the manifest)"
@@ -263,6 +268,8 @@ def discover(timeline: Timeline, payload_teams: Mapping[str, str] | None = None)
         gt = pairing.gt if pairing is not None else ()
         if log.path in rest:  # a GT-only recording: its own files are its GT
             gt, pairing = rest[log.path], None
+        elif rsbb is not None:  # an RSBB run bag records its own mocap (/tf)
+            gt, pairing = (), None
         elif not gt:
             text = "no GT file of its benchmark overlaps it"
             notes.append(text)

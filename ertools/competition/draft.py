@@ -30,6 +30,8 @@ from ertools.competition.found import Found, robot_benchmarks
 from ertools.competition.ledger import Claim, place_files, root_of
 from ertools.competition.site_text import TEAM_UNKNOWN
 from ertools.io.formats import regular_files
+from ertools.rsbb.layout import FileKind
+from ertools.timelines.build import rsbb_run
 from ertools.timeutil import NS_PER_S
 
 CONFIG_SUFFIXES = (".yaml", ".yml")
@@ -114,7 +116,22 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
         lines.append(f"  {name}:  # {bench.title}: {count} execution(s); teams {', '.join(teams)}")
         lines.append("    inputs:")
         file_inputs = [i for i in bench.inputs if i.kind in ("path", "paths") and not i.per_team]
+        mine = [e for e in executions if e.benchmark == name]
+        # an input every execution gives itself (an RSBB run's result file) is not the
+        # benchmark's: it is listed with each execution below
+        file_inputs = [
+            i
+            for i in file_inputs
+            if not mine or not all(i.name in found.values.get(e.bmbox_log, {}) for e in mine)
+        ]
         for k, declared in enumerate(file_inputs):
+            side = rsbb_side(found, name, declared.name)
+            if side is not None:
+                lines.append(
+                    f"      {declared.name}: {_yaml(_rel(side, base))}  # in the RSBB layout"
+                )
+                claims.append(Claim(str(side), "input", f"benchmarks.{name}.inputs"))
+                continue
             hits = guess(files, name, declared, first=k == 0)
             if hits:
                 note = "guessed from its name: check" + (
@@ -136,7 +153,9 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
             for team in teams:
                 entries = []
                 for declared in per_team:
-                    hits = guess(files, name, declared, first=False, team=team)
+                    side = rsbb_side(found, name, declared.name, team)
+                    hits = [side] if side is not None else []
+                    hits = hits or guess(files, name, declared, first=False, team=team)
                     if hits:
                         entries.append(
                             f"        {declared.name}: {_yaml(_rel(hits[0], base))}  "
@@ -193,6 +212,26 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
     return "\n".join(lines) + "\n"
 
 
+def rsbb_side(found: Found, benchmark: str, name: str, team: str | None = None) -> Path | None:
+    """The side file the RSBB layout holds for ``benchmark``'s input ``name`` (``config``,
+    ``items``, ``transform`` of ``team``, ``description``), None when it holds none."""
+    folder = found.timeline.rsbb
+    if folder is None:
+        return None
+    if name == "description":
+        kind = FileKind.DESCRIPTION.value
+        return next((Path(p).resolve() for k, p in folder.files if k == kind), None)
+    if name not in ("config", "items", "transform"):
+        return None
+    for run in folder.runs:
+        if run.code.lower() != benchmark or (team is not None and run.team != team):
+            continue
+        value = getattr(run, name)
+        if value is not None:
+            return Path(value).resolve()
+    return None
+
+
 def _rel_text(text: str, base: Path) -> str:
     """``text`` with the absolute paths under ``base`` relative to it (the draft's folder)."""
     prefix = str(base).rstrip("/") + "/"
@@ -217,8 +256,13 @@ def _listed_entry(
     bench = registry.get(e.benchmark)
     log = Path(e.bmbox_log).resolve()
     bags = [_rel(Path(p).resolve(), base) for p in (e.bmbox_log, *e.gt_files)]
+    what = (
+        "its RSBB run bag, and the result file its script wrote"
+        if rsbb_run(e.bmbox_log) is not None
+        else "the GT logger's log alone (no state topics)"
+    )
     out = [
-        f"  # {bench.title} at {_utc(e.start_ns)}: the GT logger's log alone (no state topics)",
+        f"  # {bench.title} at {_utc(e.start_ns)}: {what}",
         f"  - benchmark: {e.benchmark}",
         f"    team: {_yaml(e.team) if e.team else 'null  # TODO: ' + TEAM_UNKNOWN}",
         f"    bags: {json.dumps(bags)}",
@@ -229,6 +273,9 @@ def _listed_entry(
             words = [_rel(v, base) if isinstance(v, Path) else str(v) for v in value]
             out.append(f"      {key}: {json.dumps(words)}  # found beside the log")
             claims += [Claim(str(v), "input", e.id) for v in value if isinstance(v, Path)]
+        elif isinstance(value, Path):
+            out.append(f"      {key}: {_yaml(_rel(value, base))}  # the run's, in the RSBB layout")
+            claims.append(Claim(str(value), "input", e.id))
         else:
             out.append(f"      {key}: {_yaml(str(value))}  # the GT alone: runs found from motion")
     for declared in bench.inputs:

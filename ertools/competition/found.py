@@ -37,7 +37,9 @@ from ertools.io.clock import clock_check
 from ertools.io.formats import regular_files
 from ertools.progress import Reporter
 from ertools.report.timeline_page import write_timeline_page
-from ertools.timelines.model import Timeline
+from ertools.rsbb_states import BENCHMARKS
+from ertools.timelines.build import rsbb_run
+from ertools.timelines.model import RsbbFolder, Timeline
 from ertools.timelines.scan import scan
 
 if TYPE_CHECKING:
@@ -106,6 +108,8 @@ def payload_teams(timeline: Timeline, memo: FileMemo | None = None) -> dict[str,
     for entry in timeline.bags:
         if entry.kind != "benchmark" or not entry.readable or entry.copy_of is not None:
             continue
+        if rsbb_run(entry.path) is not None:  # its folder names the team
+            continue
         for namespace in entry.benchmarks:
             ns = namespace.lower()
             team = memo.get(
@@ -139,6 +143,8 @@ def find(
     kept: list[Execution] = []
     own: dict[str, Mapping[str, Any]] = {}
     pairings = {p.path: p for p in timeline.pairings}
+    results, rsbb_problems = rsbb_results(timeline.rsbb)
+    problems += rsbb_problems
     for e in discovery.executions:
         if e.benchmark not in known:
             problems.append(
@@ -152,6 +158,9 @@ def find(
         gt = tuple(Path(g).resolve() for g in e.gt_files)
         bags = (Path(e.bmbox_log).resolve(), *gt)
         values: Mapping[str, Any] = {}
+        result = results.get(str(Path(e.bmbox_log).resolve()))
+        if result is not None and _declares(e.benchmark, "result"):
+            values = own[e.bmbox_log] = {"result": Path(result)}
         if e.gt_only:
             proposed = _gt_only_values(e.benchmark, bags)
             if isinstance(proposed, str):
@@ -200,6 +209,48 @@ def find(
     return Found(
         tuple(scorings), tuple(problems), timeline, discovery, tuple(kept), own, files, folders
     )
+
+
+def rsbb_results(
+    folder: RsbbFolder | None,
+) -> tuple[dict[str, str], list[dict[str, Any]]]:
+    """Each RSBB run bag's result file (by the bag's absolute path), and a problem for each
+    result file without its bag and each scripted run's bag without its result file."""
+    if folder is None:
+        return {}, []
+    results: dict[str, str] = {}
+    problems: list[dict[str, Any]] = []
+    for r in folder.runs:
+        what = f"{r.code} run {r.run} of team {r.team}"
+        if r.bag is not None and r.result is not None:
+            results[str(Path(r.bag).resolve())] = str(Path(r.result).resolve())
+        elif r.result is not None:
+            problems.append(
+                {
+                    "kind": "unpaired",
+                    "path": str(Path(r.result).resolve()),
+                    "message": f"the result file of {what}: no run bag of it (rsbb_logs/"
+                    f"{r.code}/{r.team}/run_{r.run}_<date>.bag, started within 60 s)",
+                }
+            )
+        elif r.bag is not None and BENCHMARKS[r.code].scripted:
+            problems.append(
+                {
+                    "kind": "unpaired",
+                    "path": str(Path(r.bag).resolve()),
+                    "message": f"the run bag of {what}: no result file of it (results/{r.code}/"
+                    f"{r.team}/result_run_{r.run}_<date>.yaml): scored without the script's "
+                    "score to compare",
+                }
+            )
+    return results, problems
+
+
+def _declares(benchmark: str, name: str) -> bool:
+    """Whether a registered ``benchmark`` takes the input ``name``."""
+    if benchmark not in registry.names():
+        return False
+    return any(i.name == name for i in registry.get(benchmark).inputs)
 
 
 def _gt_only_values(benchmark: str, bags: Sequence[Path]) -> Mapping[str, Any] | str:

@@ -30,6 +30,7 @@ from ertools.benchmarks.scoring import score_execution
 from ertools.errors import ErtoolsError, transient_error, watching
 from ertools.progress import reporting
 from ertools.report.folder import _audit_inputs, write_report
+from ertools.rsbb.score import ScoreComparison
 from ertools.serialize import jsonable
 
 Status = Literal["scored", "unscoreable", "failed"]
@@ -248,8 +249,7 @@ def _score(job: Job) -> Outcome:
     warnings = tuple(str(w) for w in result.warnings)
     warnings += tuple(f"error: {f}" for f in result.failures)  # runs that failed, others scored
     audit = _live_audit(result, bags)
-    live_score = None
-    differences: tuple[str, ...] = ()
+    live_score, differences = _rsbb_live(result)
     if audit is not None:
         live_score = jsonable(audit.live_score)
         if audit.comparison is not None:
@@ -285,6 +285,21 @@ def _score(job: Job) -> Outcome:
         live_differences=differences,
         report=report,
     )
+
+
+def _rsbb_live(result: Any) -> tuple[Any, tuple[str, ...]]:
+    """An RSBB benchmark's live score (``/rsbb/current_benchmark_result``, flattened) and
+    where the recomputed score differs from it, from the result's own comparison; (None, ())
+    for a result without one."""
+    comparison = getattr(result, "comparison", None)
+    if not isinstance(comparison, ScoreComparison) or comparison.live_t_ns is None:
+        return None, ()
+    live = {k.key: k.live for k in comparison.keys if k.present[1]}
+    differences = tuple(
+        f"{k.key}: live {k.live!r} vs recomputed {k.recomputed!r}"
+        for k in comparison.differing("live")
+    )
+    return jsonable(live), differences
 
 
 def _live_audit(result: Any, bags: list[Path]) -> Any:

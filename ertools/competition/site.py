@@ -33,6 +33,7 @@ from ertools.errors import ConfigError
 from ertools.report import html as h
 from ertools.report import ranks
 from ertools.report.rank_plot import interval_plot
+from ertools.rsbb.score import flatten
 from ertools.views import units
 
 SCHEMA_VERSION = 1
@@ -64,6 +65,7 @@ class Standing:
     interval: str = "\u2014"  # the value's confidence interval, in the column's unit
     p_swap: str = "\u2014"  # P(swap with the team below), or why there is none
     tie: str = ""  # CSS: ``tied``, ``tied first``, ``tied last`` (the bracket's ends)
+    cells: tuple[str, ...] = ()  # the board's own columns (Ranking.columns), as shown
 
 
 @dataclass(frozen=True)
@@ -80,6 +82,26 @@ class Board:
     summary: str = ""  # ``1 of 3 adjacent order(s) supported by the data; tied: ...``
     plot: str = ""  # SVG text (ertools.report.rank_plot; every text in it escaped there)
     interval_column: str = ""  # ``95 % interval (mm)``; "" when no row has an interval
+    extra: tuple[tuple[str, str], ...] = ()  # its own columns: (header, what it means)
+
+
+def _cells(row: dict[str, Any], headers: Sequence[str]) -> tuple[str, ...]:
+    """A row's own columns (a referee's items) as shown: counts as they are, times to 0.1 s,
+    an em dash where the row has none."""
+    given = row.get("columns")
+    own: dict[str, Any] = given if isinstance(given, dict) else {}
+    out = []
+    for header in headers:
+        value = own.get(header)
+        if isinstance(value, bool):
+            out.append("yes" if value else "no")
+        elif isinstance(value, float):
+            out.append(f"{value:.1f}")
+        elif value is None:
+            out.append("\u2014")
+        else:
+            out.append(str(value))
+    return tuple(out)
 
 
 def _anchor(prefix: str, name: str) -> str:
@@ -236,7 +258,9 @@ def _live_rows(executions: Sequence[dict[str, Any]], paths: text.Paths) -> list[
         live = _scalars(ex.get("live_score"))
         if not live:
             continue
-        score = _scalars(ex.get("score"))
+        # an RSBB live score's fields are dotted paths into the nested score (goal_1.pose_score)
+        recomputed = ex.get("score")
+        score = _scalars(flatten(recomputed) if isinstance(recomputed, dict) else None)
         why = {
             d.key: d
             for d in (text.difference(str(line)) for line in ex.get("live_differences") or [])
@@ -254,7 +278,7 @@ def _live_rows(executions: Sequence[dict[str, Any]], paths: text.Paths) -> list[
                 LiveRow(
                     execution=str(ex.get("id")),
                     team=_team(ex),
-                    field=key,
+                    field=units.without_unit(key),
                     live=text.with_unit(key, value),
                     recomputed=text.with_unit(key, score.get(key)),
                     difference=d.difference if d is not None else "",
@@ -320,6 +344,12 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
         board, confidence = _stability(placed, by_id, rule, lower, lb.get("confidence"))
         standings = []
         keys = set()
+        extra = tuple(
+            (str(c.get("header")), str(c.get("description")))
+            for c in lb.get("columns") or []
+            if isinstance(c, dict)
+        )
+        headers = [h for h, _ in extra]
         for i, (rank, row) in enumerate(placed):
             ex = by_id.get(str(row.get("execution")))
             value = _number(row.get("value"))
@@ -343,6 +373,7 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
                     interval=_interval_text(key, place.interval if place else None),
                     p_swap=_p_text(place),
                     tie=_tie_class(placed, board, i),
+                    cells=_cells(row, headers),
                 )
             )
         unranked = []
@@ -359,6 +390,7 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
                     live=text.shown(None, None),
                     differs=False,
                     execution=report_link(ex, str(row.get("execution"))),
+                    cells=_cells(row, headers),
                 )
             )
         # One header for the column: the ranked key's name and unit when every row agrees.
@@ -399,6 +431,7 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
                 )
                 if with_intervals
                 else "",
+                extra=extra,
                 interval_column=(
                     f"{confidence * 100:g} % interval"
                     + (f" ({units.unit(spec[0])})" if spec else "")
@@ -479,7 +512,7 @@ def site_context(results: dict[str, Any], exists: Callable[[str], bool]) -> dict
         if isinstance(entry, dict):
             places[str(entry.get("place"))] = places.get(str(entry.get("place")), 0) + 1
     nav = [(b.anchor, b.title) for b in boards] + [
-        ("live", "Live 2015"),
+        ("live", "Live scores"),
         ("timeline", "Timeline"),
         ("problems", f"Problems ({len(problems)})"),
         ("deviations", "Deviations"),

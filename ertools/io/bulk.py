@@ -15,21 +15,28 @@ from collections.abc import Iterator, Sequence
 from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
+import numpy.typing as npt
 
-from ertools.arrays import I64
+from ertools.arrays import I64, U8
 from ertools.errors import BagError
 from ertools.io import pipeline
+from ertools.io.assemble import Assembler, Decoder, KnownSpans
 from ertools.io.bagfile import BagFile
-from ertools.io.decode.fast import FAST_TYPES, Decoded, LayoutMismatchError, decode, to_batch
-from ertools.io.decode.posebatch import PoseBatch, concat_batches
-from ertools.io.decode.uniform import Rows, decode_uniform
+from ertools.io.decode.fast import (
+    FAST_TYPES,
+    LayoutMismatchError,
+    decode_states,
+    is_state_definition,
+)
+from ertools.io.decode.posebatch import PoseBatch
 from ertools.io.mcap.index import McapIndex
-from ertools.io.model import TF_TYPES, Conn
+from ertools.io.model import Conn
 from ertools.io.pipeline import (
     Group,
     Located,
+    LocatedMany,
+    Request,
     Run,
-    ascending,
     joined,
     prefetched,
 )
@@ -46,91 +53,6 @@ if TYPE_CHECKING:
 log = logging.getLogger("ertools.io.bulk")
 
 
-class _Assembler:
-    """Collects per-chunk decoded rows into one batch in the reference order.
-
-    Types with one pose per message are written straight into preallocated arrays at their
-    reference positions (no concatenation, no sort); TF messages, which may hold several
-    transforms, are collected and ordered at the end.
-    """
-
-    def __init__(self, msgtype: str, count: int | None) -> None:
-        self.multi = msgtype in TF_TYPES or count is None
-        # sqlite rows of several storage files come file by file: merged by time at the end
-        self.by_time = count is None
-        n = 0 if self.multi or count is None else count
-        self.t_record = np.empty(n, dtype=np.int64)
-        self.t_header = np.empty(n, dtype=np.int64)
-        self.xyz = np.empty((n, 3))
-        self.quat = np.empty((n, 4))
-        self.frame_idx = np.zeros(n, dtype=np.int32)
-        self.child_idx = np.zeros(n, dtype=np.int32)
-        self.frames: dict[str, int] = {"": 0}
-        self.parts: list[tuple[I64, PoseBatch]] = []
-
-    def run_slice(self, pos: I64) -> slice | None:
-        """The rows at ``pos`` as a slice when they are consecutive and ascending (one
-        connection read in order): written as a block, or decoded in place."""
-        if self.multi or not len(pos):
-            return None
-        if int(pos[-1]) - int(pos[0]) == len(pos) - 1 and ascending(pos):
-            return slice(int(pos[0]), int(pos[-1]) + 1)
-        return None
-
-    def rows(self, at: slice) -> Rows:
-        """Where a decoder may write the rows ``at`` itself."""
-        return Rows(self.t_header[at], self.xyz[at], self.quat[at])
-
-    def wrote(self, at: slice, t_record: I64, dec: Decoded) -> None:
-        """Rows ``at`` were decoded in place (see :meth:`rows`): their record times and
-        frame names (types without a header are timed by record time, as in ``to_batch``)."""
-        self.t_record[at] = t_record
-        if not dec.has_header:
-            self.t_header[at] = t_record
-        self.frame_idx[at] = self.frames.setdefault(dec.frame_text or "", len(self.frames))
-        self.child_idx[at] = self.frames.setdefault(dec.child_text or "", len(self.frames))
-
-    def add(self, pos: I64, batch: PoseBatch) -> None:
-        """Decoded rows and the reference position of the message of each row."""
-        if self.multi:
-            self.parts.append((pos, batch))
-            return
-        remap = np.array(
-            [self.frames.setdefault(f, len(self.frames)) for f in batch.frames], np.int32
-        )
-        run = self.run_slice(pos)
-        # consecutive rows are written as a block (a copy, not a scatter)
-        at: slice | I64 = run if run is not None else pos
-        self.t_record[at] = batch.t_record
-        self.t_header[at] = batch.t_header
-        self.xyz[at] = batch.xyz
-        self.quat[at] = batch.quat_xyzw
-        self.frame_idx[at] = remap[batch.frame_idx]
-        self.child_idx[at] = remap[batch.child_idx]
-
-    def result(self) -> PoseBatch:
-        if not self.multi:
-            return PoseBatch(
-                self.t_record,
-                self.t_header,
-                self.xyz,
-                self.quat,
-                self.frame_idx,
-                self.child_idx,
-                tuple(self.frames),
-            )
-        if not self.parts:
-            return PoseBatch.empty()
-        batch = concat_batches([p[1] for p in self.parts])
-        pos = np.concatenate([p[0] for p in self.parts])
-        if len(pos) > 1 and np.any(pos[1:] < pos[:-1]):
-            batch = batch.take(np.argsort(pos, kind="stable"))
-        t = batch.t_record
-        if self.by_time and len(t) > 1 and np.any(t[1:] < t[:-1]):
-            batch = batch.take(np.argsort(t, kind="stable"))
-        return batch
-
-
 def mcap_index(bag: BagFile) -> McapIndex | None:
     """The MCAP index of a standalone MCAP file or of a rosbag2-mcap directory's storage
     files (decompressed when the bag is compressed file by file), None for other formats."""
@@ -139,62 +61,97 @@ def mcap_index(bag: BagFile) -> McapIndex | None:
     return McapIndex.of(bag)
 
 
-def _label(bag: BagFile, conns: Sequence[Conn]) -> str:
-    topic = conns[0].topic if conns else "?"
-    return f"reading {topic} from {bag.path.name}"
-
-
 def _mcap_runs(
-    bag: BagFile,
-    conns: Sequence[Conn],
-    lo: int | None,
-    hi: int | None,
-    progress: Reporter | None = None,
-) -> Located | None:
+    bag: BagFile, requests: Sequence[Request], progress: Reporter | None = None, hold: int = 0
+) -> LocatedMany | None:
     index = mcap_index(bag)
     if index is None:
         return None
-    plan = index.plan(conns, lo, hi)
-    count, load, weights = index.run_loader(plan)
-    compressed = any(c.compression for chunks in plan.chunks for c in chunks)
-
-    def load_run(k: int, scratch: list[Any]) -> Run:
-        pos, buf, start, length = load(k, scratch)
-        return pos, buf, start, length, plan.t_record[pos]
-
+    plans = index.plan_many(requests)
+    count, load, weights = index.run_loader(plans)
+    compressed = any(c.compression for plan in plans for chunks in plan.chunks for c in chunks)
+    topics = list(dict.fromkeys(c.topic for r in requests for c in r.conns))
     runs = prefetched(
         count,
-        load_run,
+        load,
         parallel=compressed,
         progress=progress,
         weights=weights,
-        label=_label(bag, conns),
+        label=f"reading {', '.join(topics) or '?'} from {bag.path.name}",
+        hold=hold,
     )
-    return Located(len(plan.t_record), runs)
+    return LocatedMany([len(p.t_record) for p in plans], runs, [p.t_record for p in plans])
 
 
-def _sqlite_runs(
-    bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None
-) -> Located | None:
-    batches = sqlite_rows(bag.path, conns, lo, hi)
-    if batches is None:
+def _one_by_one(count: int, located: Iterator[tuple[int, Run]]) -> Iterator[list[Run | None]]:
+    """Runs of several requests read one request after the other, as :class:`LocatedMany`
+    gives them (the other requests None)."""
+    for i, run in located:
+        out: list[Run | None] = [None] * count
+        out[i] = run
+        yield out
+
+
+def _sqlite_runs(bag: BagFile, requests: Sequence[Request]) -> LocatedMany | None:
+    found = [sqlite_rows(bag.path, r.conns, r.lo, r.hi) for r in requests]
+    if any(f is None for f in found):
         return None
 
-    def runs() -> Iterator[Run]:
-        done = 0
-        for buf, start, length, t_rec in batches:
-            yield np.arange(done, done + len(start), dtype=np.int64), buf, start, length, t_rec
-            done += len(start)
+    def runs() -> Iterator[tuple[int, Run]]:
+        for i, (req, batches) in enumerate(zip(requests, found, strict=True)):
+            assert batches is not None
+            cid = req.conns[0].id if req.conns else 0  # rosbag2: one connection per topic
+            done = 0
+            for buf, start, length, t_rec in batches:
+                pos = np.arange(done, done + len(start), dtype=np.int64)
+                conn = np.full(len(start), cid, dtype=np.int64)
+                yield i, Run(pos, buf, t_rec, conn, KnownSpans(buf, start, length))
+                done += len(start)
 
-    return Located(None, runs())
+    return LocatedMany([None] * len(requests), _one_by_one(len(requests), runs()))
 
 
-def _scanned_runs(bag: BagFile, conns: Sequence[Conn], lo: int | None, hi: int | None) -> Located:
+def _scanned_runs(bag: BagFile, requests: Sequence[Request]) -> LocatedMany:
     """Messages of an MCAP file its indexes do not cover, read record by record: the runs
     of copied message bytes the scan gives, so the same decoders apply."""
-    runs = list(cast("McapFile", bag).scanned_runs(conns, lo, hi))  # only scanned MCAP files
-    count = sum(len(r[0]) for r in runs)
-    return Located(count, iter([r[:5] for r in runs]))
+    mcap = cast("McapFile", bag)  # only scanned MCAP files
+    every = [list(mcap.scanned_runs(r.conns, r.lo, r.hi)) for r in requests]
+
+    def runs() -> Iterator[tuple[int, Run]]:
+        for i, found in enumerate(every):
+            for pos, buf, start, length, t_rec, cid in found:
+                yield i, Run(pos, buf, t_rec, cid, KnownSpans(buf, start, length))
+
+    counts: list[int | None] = [sum(len(r[0]) for r in found) for found in every]
+    return LocatedMany(counts, _one_by_one(len(requests), runs()))
+
+
+def locate_many(
+    bag: BagFile, requests: Sequence[Request], progress: Reporter | None = None, hold: int = 0
+) -> LocatedMany | None:
+    """The messages of each request (connections, record-time window), located in one pass
+    over the file's index and loaded in one pass over the chunks any of them touches; None
+    when the format has no bulk access (then the caller reads per message).
+
+    ROS1 and MCAP reads report the bytes of each group of chunks to ``progress`` (default:
+    the reporter made current by :func:`ertools.progress.reporting`, if any). A group's runs
+    stay valid until ``hold + 1`` more groups are asked for (see
+    :func:`ertools.io.pipeline.prefetched`).
+
+    Raises:
+        LayoutMismatchError: the file lacks the index records the bulk path needs.
+    """
+    if progress is None:
+        progress = current()
+    if bag.format in ("ros1", "ros1-active"):
+        return ros1_runs(cast("Ros1Bag", bag), requests, progress, hold)
+    if bag.format == "rosbag2-sqlite3":
+        return _sqlite_runs(bag, requests)
+    if getattr(bag, "scanned", False):
+        return _scanned_runs(bag, requests)
+    if bag.format in ("mcap", "rosbag2-mcap"):
+        return _mcap_runs(bag, requests, progress, hold)
+    return None
 
 
 def locate(
@@ -204,26 +161,10 @@ def locate(
     end_ns: int | None,
     progress: Reporter | None = None,
 ) -> Located | None:
-    """The messages of ``conns`` with record time in [start_ns, end_ns], or None when the
-    format has no bulk access (then the caller reads per message).
-
-    ROS1 and MCAP reads report the bytes of each group of chunks to ``progress`` (default:
-    the reporter made current by :func:`ertools.progress.reporting`, if any).
-
-    Raises:
-        LayoutMismatchError: the file lacks the index records the bulk path needs.
-    """
-    if progress is None:
-        progress = current()
-    if bag.format in ("ros1", "ros1-active"):
-        return ros1_runs(cast("Ros1Bag", bag), conns, start_ns, end_ns, progress)
-    if bag.format == "rosbag2-sqlite3":
-        return _sqlite_runs(bag, conns, start_ns, end_ns)
-    if getattr(bag, "scanned", False):
-        return _scanned_runs(bag, conns, start_ns, end_ns)
-    if bag.format in ("mcap", "rosbag2-mcap"):
-        return _mcap_runs(bag, conns, start_ns, end_ns, progress)
-    return None
+    """The messages of ``conns`` with record time in [start_ns, end_ns]: one request of
+    :func:`locate_many`."""
+    found = locate_many(bag, [Request(tuple(conns), start_ns, end_ns)], progress)
+    return None if found is None else found.only(0)
 
 
 def load_all_chunks(bag: BagFile, progress: Reporter | None = None) -> int:
@@ -276,10 +217,8 @@ def load_all_chunks(bag: BagFile, progress: Reporter | None = None) -> int:
     return total
 
 
-def try_fast_batch(
-    bag: BagFile, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
-) -> PoseBatch | None:
-    """Pose rows of ``conns`` decoded in bulk, or None when the fast path does not apply."""
+def _fast_type(bag: BagFile, conns: Sequence[Conn]) -> str | None:
+    """The pose type the bulk decoders read ``conns`` as, None (logged) when they do not."""
     types = {c.msgtype for c in conns}
     encodings = {c.encoding for c in conns}
     if len(types) != 1 or len(encodings) != 1 or next(iter(types)) not in FAST_TYPES:
@@ -289,34 +228,146 @@ def try_fast_batch(
             ", ".join(sorted(types)),
         )
         return None
-    msgtype = next(iter(types))
-    cdr = conns[0].encoding == "cdr"
+    return next(iter(types))
+
+
+def try_fast_batches(bag: BagFile, requests: Sequence[Request]) -> list[PoseBatch | None]:
+    """Pose rows of each request decoded in bulk, from one pass over the file; None for a
+    request the fast path does not apply to (the caller reads it per message)."""
+    out: list[PoseBatch | None] = [None] * len(requests)
+    kinds = [_fast_type(bag, r.conns) for r in requests]
+    mine = [i for i, k in enumerate(kinds) if k is not None]
+    if not mine:
+        return out
     try:
-        found = locate(bag, conns, start_ns, end_ns)
-        if found is not None:
-            # Decoded here, not on the loading threads: its many small NumPy calls hold the
-            # GIL, and two threads decoding were slower than one (measured).
-            out = _Assembler(msgtype, found.count)
-            for pos, buf, start, length, t_rec in found.runs:
-                # The usual case, consecutive rows: decoded straight into the result.
-                at = out.run_slice(pos)
-                into = out.rows(at) if at is not None else None
-                dec = decode_uniform(msgtype, cdr, buf, start, length, into=into)
-                if dec is not None and at is not None:
-                    out.wrote(at, t_rec, dec)
-                    continue
-                if dec is None:
-                    dec = decode(msgtype, cdr, buf, start, length)
-                out.add(pos[dec.msg_index], to_batch(buf, dec, t_rec))
-            return out.result()
+        found = locate_many(bag, [requests[i] for i in mine], hold=pipeline.lanes_for(len(mine)))
     except LayoutMismatchError as err:
-        log.info(
-            "%s: %s on %s not in the standard layout (%s); decoding per message",
-            bag.path,
-            msgtype,
-            conns[0].topic,
-            err,
+        log.info("%s: not read in bulk (%s); decoding per message", bag.path, err)
+        return out
+    if found is None:
+        log.info("%s: no bulk reader for %s files; decoding per message", bag.path, bag.format)
+        return out
+    times = found.times or [None] * len(mine)
+    assemblers = [
+        Assembler(cast(str, kinds[i]), n, t)
+        for i, n, t in zip(mine, found.counts, times, strict=True)
+    ]
+    decoders: list[Decoder | None] = [
+        Decoder(
+            cast(str, kinds[i]),
+            requests[i].conns[0].encoding == "cdr",
+            [c.id for c in requests[i].conns],
+            a,
         )
-        return None
-    log.info("%s: no bulk reader for %s files; decoding per message", bag.path, bag.format)
-    return None
+        for i, a in zip(mine, assemblers, strict=True)
+    ]
+    failed: list[LayoutMismatchError | None] = [None] * len(mine)
+
+    def decode_run(k: int, run: Run) -> None:
+        dec = decoders[k]
+        if dec is None or failed[k] is not None:
+            return
+        try:
+            dec.run(run)
+        except LayoutMismatchError as err:
+            failed[k] = err
+
+    # the requests side by side, each on a thread of its own (NumPy releases the GIL)
+    try:
+        pipeline.decoded_in_lanes(found.runs, decode_run, len(mine))
+    except LayoutMismatchError as err:
+        log.info("%s: not read in bulk (%s); decoding per message", bag.path, err)
+        return out
+    for k, why in enumerate(failed):
+        if why is not None:
+            log.info(
+                "%s: %s on %s not in the standard layout (%s); decoding per message",
+                bag.path,
+                kinds[mine[k]],
+                requests[mine[k]].conns[0].topic,
+                why,
+            )
+            decoders[k] = None
+    for k, i in enumerate(mine):
+        if decoders[k] is not None:
+            out[i] = assemblers[k].result()
+    return out
+
+
+def try_fast_batch(
+    bag: BagFile, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
+) -> PoseBatch | None:
+    """Pose rows of ``conns`` decoded in bulk, or None when the fast path does not apply."""
+    return try_fast_batches(bag, [Request(tuple(conns), start_ns, end_ns)])[0]
+
+
+States = tuple[npt.NDArray[np.int64], npt.NDArray[np.uint8], list[str]]
+
+
+def bulk_states(bag: BagFile, conns: list[Conn]) -> States | None:
+    """(record times, states, payloads) decoded in bulk, None when the layout is not the 2015
+    one or the format has no bulk access."""
+    return bulk_states_many(bag, [conns])[0]
+
+
+def bulk_states_many(bag: BagFile, topics: Sequence[list[Conn]]) -> list[States | None]:
+    """:func:`bulk_states` of several topics, from one pass over the file."""
+    out: list[States | None] = [None] * len(topics)
+    mine = [
+        i
+        for i, conns in enumerate(topics)
+        if len({c.encoding for c in conns}) == 1
+        and all(is_state_definition(c.msgdef) for c in conns)
+    ]
+    if not mine:
+        return out
+    try:
+        found = locate_many(bag, [Request(tuple(topics[i])) for i in mine])
+    except LayoutMismatchError as err:
+        log.info("%s: state topics not read in bulk (%s)", bag.path, err)
+        return out
+    if found is None:
+        return out
+    parts: list[list[tuple[I64, I64, U8, list[str]]] | None] = [[] for _ in mine]
+    try:
+        for runs in found.runs:
+            for k, run in enumerate(runs):
+                got = parts[k]
+                if run is None or got is None:
+                    continue
+                conns = topics[mine[k]]
+                try:
+                    start, length = run.spans()
+                    cdr = conns[0].encoding == "cdr"
+                    state, text = decode_states(run.buf, start, length, cdr)
+                except LayoutMismatchError as err:
+                    log.info(
+                        "%s: %s not in the 2015 state layout (%s)", bag.path, conns[0].topic, err
+                    )
+                    parts[k] = None
+                    continue
+                got.append((run.pos, run.t_record, state, text))
+    except LayoutMismatchError as err:
+        log.info("%s: state topics not read in bulk (%s)", bag.path, err)
+        return out
+    for k, i in enumerate(mine):
+        got = parts[k]
+        if got is not None:
+            out[i] = _ordered_states(got)
+    return out
+
+
+def _ordered_states(parts: list[tuple[I64, I64, U8, list[str]]]) -> States:
+    """The runs of one state topic in the reference order, then by record time."""
+    if not parts:
+        return np.empty(0, np.int64), np.empty(0, np.uint8), []
+    pos = np.concatenate([p[0] for p in parts])
+    t_all = np.concatenate([p[1] for p in parts])
+    payloads = [text for p in parts for text in p[3]]
+    order = np.argsort(pos, kind="stable")
+    t = t_all[order]
+    if len(t) > 1 and np.any(t[1:] < t[:-1]):
+        order = order[np.argsort(t, kind="stable")]
+        t = t_all[order]
+    states = np.concatenate([p[2] for p in parts])[order]
+    return t, states, [payloads[i] for i in order.tolist()]

@@ -265,7 +265,7 @@ class McapFile(BagFile):
                 yield by_id[int(cid[i])], int(t[i]), buf[a : a + int(length[i])].tobytes()
             return
         try:
-            found = McapIndex([self.path]).messages(conns, start_ns, end_ns)
+            found = McapIndex([self.path], by_id=True).messages(conns, start_ns, end_ns)
         except LayoutMismatchError as err:
             # indexes that do not answer for every message (padded message indexes): the
             # messages are read record by record, as a file without indexes is

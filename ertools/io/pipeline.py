@@ -3,7 +3,8 @@
 Reading a pose topic is three steps per group of chunks: read the bytes, decompress them, and
 decode the messages. File reads and lz4/zstd/bz2 decompression release the GIL, so worker
 threads load the next groups while the calling thread decodes the current one: on two cores a
-topic costs about the larger of decompressing and decoding, not their sum.
+topic costs about the larger of decompressing and decoding, not their sum. The topics of one
+read are decoded on lanes, a thread each (:func:`decoded_in_lanes`).
 
 Each group is loaded whole into one buffer (its chunks end to end) that is reused once the
 caller has moved on, so memory stays at a few groups whatever the size of the file, and fresh
@@ -16,15 +17,17 @@ import contextlib
 import mmap
 import os
 import threading
-from collections import deque
-from collections.abc import Callable, Iterator, Sequence
+from collections import Counter, deque
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, TypeVar
+from queue import SimpleQueue
+from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 import numpy as np
 
-from ertools.arrays import I64, U8
+from ertools.arrays import I64, U8, Bool
+from ertools.io.model import Conn
 
 if TYPE_CHECKING:
     from ertools.progress import Reporter
@@ -48,14 +51,16 @@ def prefetched(
     progress: Reporter | None = None,
     weights: Sequence[int] = (),
     label: str = "reading",
+    hold: int = 0,
 ) -> Iterator[T]:
     """``load(k, scratch)`` for k in 0..count-1, in order, computed ahead on worker threads.
 
     ``scratch`` is a slot: a list holding the bytearray ``load`` may fill (and grow, see
-    :func:`scratch_view`) and maps it read through (:func:`keep`); a result is valid until the
-    next one is asked for, after which its slot is reused. Without ``parallel`` (reads with
-    nothing to decompress: a second thread only competes with the decoder, measured) the
-    loads run in turn on the calling thread.
+    :func:`scratch_view`) and maps it read through (:func:`keep`); a result is valid until
+    ``hold + 1`` more are asked for (the caller may still be decoding the ``hold`` before the
+    one it holds), after which its slot is reused. Without ``parallel`` (reads with nothing
+    to decompress: a second thread only competes with the decoder, measured) the loads run in
+    turn on the calling thread.
 
     With ``progress``, ``weights[k]`` (the bytes load k reads from the file) is reported as
     each load is handed over, on the calling thread: one call per group of chunks.
@@ -66,16 +71,17 @@ def prefetched(
         report.task(label, sum(weights), "B")
     ahead = min(workers(), count) if parallel else 1
     if ahead <= 1:
-        scratch: list[Any] = []
+        turns: list[list[Any]] = [[] for _ in range(hold + 1)]
         for k in range(count):
-            got = load(k, scratch)
+            got = load(k, turns[k % len(turns)])
             if report is not None:
                 report.advance(weights[k])
             yield got
         return
 
-    # ahead groups in flight plus the one the caller holds: none shares a buffer.
-    slots: list[list[Any]] = [[] for _ in range(ahead + 1)]
+    # ahead groups in flight plus the one the caller holds and the ``hold`` before it: none
+    # shares a buffer.
+    slots: list[list[Any]] = [[] for _ in range(ahead + 1 + hold)]
     with ThreadPoolExecutor(ahead) as pool:
         pending = deque(pool.submit(load, k, slots[k % len(slots)]) for k in range(ahead))
         for k in range(count):
@@ -85,6 +91,91 @@ def prefetched(
             if report is not None:
                 report.advance(weights[k])
             yield got
+
+
+# Groups a lane of :func:`decoded_in_lanes` may lag behind the one being loaded.
+LANE_HOLD = 1
+
+
+def lanes_for(count: int) -> int:
+    """The ``hold`` a read of ``count`` requests passes to its loads: :data:`LANE_HOLD` when
+    :func:`decoded_in_lanes` runs them on lanes, else 0."""
+    return LANE_HOLD if count > 1 and workers() > 1 else 0
+
+
+def decoded_in_lanes(
+    groups: Iterable[Sequence[T | None]], decode: Callable[[int, T], None], count: int
+) -> None:
+    """``decode(i, item)`` for every item of every group, item i (request i's run) of each
+    group on lane i: a thread of its own that takes request i's runs in group order. The
+    requests of a group, and of the group before it, are so decoded side by side with no
+    wait for the slowest at every group: NumPy releases the GIL in its loops, and each
+    request has its own decoder and result. A group is asked for only once the group
+    :data:`LANE_HOLD` + 1 before it is decoded (its buffer is reused then: ``groups`` comes
+    from loads made with ``hold`` = :func:`lanes_for`).
+
+    The error raised is the one a single thread decoding the groups in turn, items in request
+    order, meets first (a load's error comes after the decoding errors of the groups before
+    it); no group after it is asked for.
+    """
+    if lanes_for(count) == 0:
+        for group in groups:
+            for i, item in enumerate(group):
+                if item is not None:
+                    decode(i, item)
+        return
+    cond = threading.Condition()
+    outstanding: Counter[int] = Counter()
+    errors: list[tuple[int, int, Exception]] = []
+    queues: list[SimpleQueue[tuple[int, T] | None]] = [SimpleQueue() for _ in range(count)]
+
+    def lane(i: int) -> None:
+        while (got := queues[i].get()) is not None:
+            k, item = got
+            try:
+                with cond:
+                    after = any(e[0] < k for e in errors)  # one thread had stopped before
+                if not after:
+                    decode(i, item)
+            except Exception as err:  # raised by the caller, in order
+                with cond:
+                    errors.append((k, i, err))
+            finally:
+                with cond:
+                    outstanding[k] -= 1
+                    cond.notify_all()
+
+    threads = [
+        threading.Thread(target=lane, args=(i,), daemon=True, name=f"ertools-lane-{i}")
+        for i in range(count)
+    ]
+    for thread in threads:
+        thread.start()
+    k = 0
+    try:
+        for group in groups:
+            for i, item in enumerate(group):
+                if item is not None:
+                    with cond:
+                        outstanding[k] += 1
+                    queues[i].put((k, item))
+            k += 1
+            reused = k - 1 - LANE_HOLD  # the group whose buffer the next load reuses
+            with cond:
+                while not errors and outstanding[reused]:
+                    cond.wait()
+                if errors:
+                    break
+    except Exception as err:  # a load's: after the lanes' errors of earlier groups
+        with cond:
+            errors.append((k, -1, err))
+    finally:
+        for q in queues:
+            q.put(None)
+        for thread in threads:
+            thread.join()
+    if errors:
+        raise min(errors, key=lambda e: (e[0], e[1]))[2]
 
 
 def scratch_view(scratch: list[Any], size: int) -> memoryview:
@@ -183,9 +274,54 @@ def group_positions(keys: I64) -> list[tuple[int, I64]]:
     return [(int(sorted_keys[a]), order[a:b]) for a, b in zip(starts, ends, strict=True)]
 
 
-# One run of messages: (reference positions, buffer, data starts, data lengths, record times).
-# The buffer is only valid until the next run is asked for (it may be reused).
-Run = tuple[I64, U8, I64, I64, I64]
+class Records(Protocol):
+    """Where the data of a run's messages lies in its buffer, found and checked by the format
+    that located them (ROS1 message records, MCAP message records, or spans known already)."""
+
+    def spans(self) -> tuple[I64, I64]:
+        """(data start, data length) of every message, each record checked (the general
+        path: any record layout the format allows; a damaged record raises BagError)."""
+        ...
+
+    def size_hint(self, i: int) -> int | None:
+        """The data length of message ``i`` as its record's head gives it, unchecked (what
+        :meth:`rows` is then asked for and checks); None when the head is unusual."""
+        ...
+
+    def rows(
+        self, idx: I64 | None, size: int, conn: int, member: Bool | None = None
+    ) -> tuple[U8, int] | None:
+        """The messages ``idx`` (None: all), all of connection ``conn``, as rows of one
+        gather: ``(rows, skip)``, each row the record's head (``skip`` bytes) then its
+        ``size`` data bytes, when every one of them is a record in the format's usual layout
+        whose data is ``size`` bytes long and whose head carries the time (and connection) it
+        was located by. None otherwise: the caller then goes through :meth:`spans`, which
+        handles (or refuses) every other case.
+
+        With ``member`` (``idx`` None), only the messages where it is True must be so; the
+        others are gathered as far as the width reaches (inside the buffer), unchecked."""
+        ...
+
+
+@dataclass(frozen=True, eq=False)
+class Run:
+    """The messages of one read in one group of chunks, in its reference order.
+
+    ``pos``: each message's reference position in the whole read; ``buf``: the group's bytes
+    (valid only until the next run of the same read is asked for: it may be reused);
+    ``t_record``: record times; ``conn``: each message's connection id; ``records``: how to
+    find each message's data in ``buf``; ``consecutive``: ``pos`` is known to be a range.
+    """
+
+    pos: I64
+    buf: U8
+    t_record: I64
+    conn: I64
+    records: Records
+    consecutive: bool = False
+
+    def spans(self) -> tuple[I64, I64]:
+        return self.records.spans()
 
 
 @dataclass(frozen=True)
@@ -199,3 +335,60 @@ class Located:
 
     count: int | None
     runs: Iterator[Run]
+
+
+@dataclass(frozen=True)
+class Request:
+    """One read of several sharing a pass over a file: some connections, and the record
+    time window [lo, hi] (None: open) of their messages."""
+
+    conns: tuple[Conn, ...]
+    lo: int | None = None
+    hi: int | None = None
+
+
+@dataclass(frozen=True)
+class LocatedMany:
+    """The messages of several requests located in one pass over a file's index.
+
+    ``counts[i]`` is request i's number of messages (None: unknown up front), ``times[i]``
+    their record times in the reference order when the index gives them up front; each item
+    of ``runs`` is one group of chunks loaded once, with one :class:`Run` per request (None
+    for a request with no message in that group).
+    """
+
+    counts: list[int | None]
+    runs: Iterator[list[Run | None]]
+    times: list[I64 | None] | None = None
+
+    def only(self, i: int) -> Located:
+        """Request ``i`` alone (the others' runs are skipped, their groups still loaded)."""
+
+        def runs() -> Iterator[Run]:
+            for group in self.runs:
+                run = group[i]
+                if run is not None:
+                    yield run
+
+        return Located(self.counts[i], runs())
+
+
+def window(requests: Sequence[Request]) -> tuple[int | None, int | None]:
+    """The record-time window covering every request's."""
+    los = [r.lo for r in requests if r.lo is not None]
+    his = [r.hi for r in requests if r.hi is not None]
+    lo = min(los) if los and len(los) == len(requests) else None
+    hi = max(his) if his and len(his) == len(requests) else None
+    return lo, hi
+
+
+def in_window(t: I64, lo: int | None, hi: int | None) -> Bool | None:
+    """Which of ``t`` lie in [lo, hi]; None when the window is open on both sides."""
+    if lo is None and hi is None:
+        return None
+    keep = np.ones(len(t), dtype=bool)
+    if lo is not None:
+        keep &= t >= lo
+    if hi is not None:
+        keep &= t <= hi
+    return keep

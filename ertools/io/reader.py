@@ -9,18 +9,17 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.errors import BagError, TopicError
 from ertools.io.bagfile import BagFile
-from ertools.io.bulk import locate, try_fast_batch
-from ertools.io.decode.fast import LayoutMismatchError, decode_states, is_state_definition
+from ertools.io.bulk import States, bulk_states_many, try_fast_batches
 from ertools.io.decode.posebatch import PoseBatch, batch_from_messages, concat_batches
-from ertools.io.decode.tf import Edge, chain_pose, frame_key
+from ertools.io.decode.tf import Edge, chain_pose, edges_overlap, split_edges
 from ertools.io.decode.typestore import Deserializer
 from ertools.io.files import open_bag
 from ertools.io.formats import bag_paths
@@ -33,7 +32,7 @@ from ertools.io.model import (
     PoseSource,
     RawMessage,
 )
-from ertools.io.pipeline import group_positions
+from ertools.io.pipeline import Request
 from ertools.states import MSG_TYPES, STATE_TOPIC_SUFFIXES, Machine
 from ertools.streams import MAX_FRAME_CHANGES, FrameChange, PoseStream, StateStream
 
@@ -88,11 +87,17 @@ def load_pose_batch(
 
     Tries the bulk decoder first; falls back to rosbags per message (logged at INFO).
     """
+    return load_pose_batches(bag, [Request(tuple(conns), start_ns, end_ns)])[0]
 
-    fast = try_fast_batch(bag, conns, start_ns, end_ns)
-    if fast is not None:
-        return fast
-    return slow_pose_batch(bag, conns, start_ns, end_ns)
+
+def load_pose_batches(bag: BagFile, requests: Sequence[Request]) -> list[PoseBatch]:
+    """:func:`load_pose_batch` of several requests, read in bulk from one pass over the file
+    (those the bulk decoder cannot read are read per message afterwards)."""
+    fast = try_fast_batches(bag, requests)
+    return [
+        b if b is not None else slow_pose_batch(bag, r.conns, r.lo, r.hi)
+        for b, r in zip(fast, requests, strict=True)
+    ]
 
 
 def slow_pose_batch(
@@ -141,7 +146,7 @@ def _batch_to_stream(batch: PoseBatch, msgtype: str, time_source: str, source: s
     frame = batch.frames[fi[0]] if len(fi) else ""
     child = batch.frames[ci[0]] if len(ci) else ""
     changes: tuple[FrameChange, ...] = ()
-    if len(fi) and (np.any(fi != fi[0]) or np.any(ci != ci[0])):
+    if len(fi) and (_varies(fi) or _varies(ci)):
         changes = _frame_changes(batch, t)
         used = {batch.frames[i] for i in np.unique(np.concatenate([fi, ci]))}
         log.warning(
@@ -152,6 +157,14 @@ def _batch_to_stream(batch: PoseBatch, msgtype: str, time_source: str, source: s
             child,
         )
     return PoseStream(t, batch.xyz, batch.quat_xyzw, frame, child, source, changes)
+
+
+def _varies(codes: npt.NDArray[np.int32]) -> bool:
+    """Whether the frame codes of a batch differ (a bulk read's codes of one frame pair are
+    one value broadcast: nothing to compare)."""
+    if codes.strides == (0,):
+        return False
+    return bool(np.any(codes != codes[0]))
 
 
 def _frame_changes(batch: PoseBatch, t: npt.NDArray[np.int64]) -> tuple[FrameChange, ...]:
@@ -195,56 +208,147 @@ def read_poses(
         TopicError: topic absent from every file (the message lists the pose topics there are),
             or not a pose type.
     """
-    if time_source not in ("header", "record"):
-        raise ValueError(f"time_source must be 'header' or 'record', not {time_source!r}")
+    return _read_sources(paths, [_TopicRead(topic, time_source)], start_ns, end_ns)[0]
+
+
+@dataclass(frozen=True)
+class _TopicRead:
+    """A pose topic read as a stream (:func:`read_poses`)."""
+
+    topic: str
+    time_source: str
+
+
+@dataclass(frozen=True)
+class _TfRead:
+    """A frame's pose from ``/tf`` and ``/tf_static`` (:func:`read_tf`)."""
+
+    parent: str
+    child: str
+
+
+def _read_sources(
+    paths: PathsLike,
+    reads: Sequence[_TopicRead | _TfRead],
+    start_ns: int | None,
+    end_ns: int | None,
+) -> list[PoseStream]:
+    """Pose topics and tf frames of the same files, each file read once for all of them (one
+    pass over its index and chunks, :func:`load_pose_batches`)."""
+    for r in reads:
+        if isinstance(r, _TopicRead) and r.time_source not in ("header", "record"):
+            raise ValueError(f"time_source must be 'header' or 'record', not {r.time_source!r}")
     plist = _paths(paths)
-    margin = HEADER_WINDOW_MARGIN_NS if time_source == "header" else 0
-    lo = None if start_ns is None else start_ns - margin
-    hi = None if end_ns is None else end_ns + margin
-    streams = []
-    for p in plist:
-        with open_bag(p) as bag:
-            conns = bag.topic_conns(topic)
-            if not conns:
-                continue
-            msgtype = _check_pose_conns(conns, topic, p)
-            batch = load_pose_batch(bag, conns, lo, hi)
-        source = f"{p}:{topic}"
-        stream = sort_poses(_batch_to_stream(batch, msgtype, time_source, source), source)
-        streams.append(stream.window(start_ns, end_ns))
-    if not streams:
-        raise _topic_error(plist, topic)
-    return merge_poses(streams, topic)
-
-
-def _tf_edges(
-    plist: list[Path], start_ns: int | None, end_ns: int | None
-) -> dict[tuple[str, str], Edge]:
+    parts: list[list[PoseStream]] = [[] for _ in reads]
     per_edge: dict[tuple[str, str], list[PoseStream]] = {}
     static_edges: set[tuple[str, str]] = set()
+    tf = any(isinstance(r, _TfRead) for r in reads)
     for p in plist:
         with open_bag(p) as bag:
-            for topic in TF_TOPICS:
-                conns = [c for c in bag.topic_conns(topic) if c.msgtype in TF_TYPES]
+            requests: list[Request] = []
+            topic_plan: list[tuple[int, int, str]] = []  # (read, request, msgtype)
+            for i, r in enumerate(reads):
+                if not isinstance(r, _TopicRead):
+                    continue
+                conns = bag.topic_conns(r.topic)
                 if not conns:
                     continue
-                static = topic == "/tf_static"
-                window = (None, None) if static else (start_ns, end_ns)
-                batch = load_pose_batch(bag, conns, *window)
-                frames = np.asarray([frame_key(f) for f in batch.frames], dtype=np.str_)
-                pairs = batch.frame_idx.astype(np.int64) * len(frames) + batch.child_idx
-                for code, rows in group_positions(pairs):
-                    key = (str(frames[code // len(frames)]), str(frames[code % len(frames)]))
-                    sub = batch.take(rows)
-                    s = PoseStream(sub.t_header, sub.xyz, sub.quat_xyzw, key[0], key[1], str(p))
-                    per_edge.setdefault(key, []).append(sort_poses(s, f"{p}:{topic} {key}"))
-                    if static or (any(c.latching for c in conns) and len(rows) == 1):
-                        static_edges.add(key)
-    edges = {}
-    for key, parts in per_edge.items():
-        merged = merge_poses(parts, f"tf {key[0]} -> {key[1]}")
+                msgtype = _check_pose_conns(conns, r.topic, p)
+                margin = HEADER_WINDOW_MARGIN_NS if r.time_source == "header" else 0
+                lo = None if start_ns is None else start_ns - margin
+                hi = None if end_ns is None else end_ns + margin
+                topic_plan.append((i, _want(requests, conns, lo, hi), msgtype))
+            tf_plan: list[tuple[str, list[Conn], tuple[int | None, int | None], list[int]]] = []
+            if tf:
+                lo = None if start_ns is None else start_ns - HEADER_WINDOW_MARGIN_NS
+                hi = None if end_ns is None else end_ns + HEADER_WINDOW_MARGIN_NS
+                for topic in TF_TOPICS:
+                    tf_conns = [c for c in bag.topic_conns(topic) if c.msgtype in TF_TYPES]
+                    if tf_conns:
+                        window = (None, None) if topic == "/tf_static" else (lo, hi)
+                        # One request per publisher: its transforms are one class to the
+                        # decoder and usually one edge, with no merge of the publishers'
+                        # messages to undo when the edges are split.
+                        wants = [_want(requests, [c], *window) for c in tf_conns]
+                        tf_plan.append((topic, tf_conns, window, wants))
+            batches = load_pose_batches(bag, requests)
+            shared = {k for _i, k, _t in topic_plan}
+            tf_found = []
+            for topic, tf_conns, window, wants in tf_plan:
+                tf_batches = [batches[k] for k in wants]
+                # (a topic read of the same request keeps the batch's rows)
+                owns = [k not in shared for k in wants]
+                if edges_overlap(tf_batches):
+                    # Publishers sharing an edge: their transforms are needed in the order of
+                    # one read of them all (each format orders ties its own way).
+                    tf_batches, owns = [load_pose_batch(bag, tf_conns, *window)], [True]
+                tf_found.append((topic, tf_conns, tf_batches, owns))
+        for i, k, msgtype in topic_plan:
+            r = reads[i]
+            assert isinstance(r, _TopicRead)
+            source = f"{p}:{r.topic}"
+            stream = _batch_to_stream(batches[k], msgtype, r.time_source, source)
+            parts[i].append(sort_poses(stream, source).window(start_ns, end_ns))
+        for topic, tf_conns, tf_batches, owns in tf_found:
+            for batch, own in zip(tf_batches, owns, strict=True):
+                _add_tf_edges(per_edge, static_edges, p, topic, tf_conns, batch, own)
+    edges: dict[tuple[str, str], Edge] = {}
+    for key, found in per_edge.items():
+        merged = merge_poses(found, f"tf {key[0]} -> {key[1]}")
         edges[key] = Edge(merged, key in static_edges or len(merged) == 1)
-    return edges
+    out = []
+    for r, found in zip(reads, parts, strict=True):
+        if isinstance(r, _TopicRead):
+            if not found:
+                raise _topic_error(plist, r.topic)
+            out.append(merge_poses(found, r.topic))
+        else:
+            out.append(_tf_chain(plist, edges, r.parent, r.child, start_ns, end_ns))
+    return out
+
+
+def _want(requests: list[Request], conns: Sequence[Conn], lo: int | None, hi: int | None) -> int:
+    """The index of the request for ``conns`` in [lo, hi] (added unless there already)."""
+    req = Request(tuple(conns), lo, hi)
+    if req not in requests:
+        requests.append(req)
+    return requests.index(req)
+
+
+def _add_tf_edges(
+    per_edge: dict[tuple[str, str], list[PoseStream]],
+    static_edges: set[tuple[str, str]],
+    path: Path,
+    topic: str,
+    conns: Sequence[Conn],
+    batch: PoseBatch,
+    own: bool,
+) -> None:
+    """The transforms of one tf topic of one file, split by (parent, child) edge (``own``: the
+    batch is this function's to consume)."""
+    static = topic == "/tf_static"
+    for key, count, s in split_edges(batch, str(path), own):
+        per_edge.setdefault(key, []).append(sort_poses(s, f"{path}:{topic} {key}"))
+        if static or (any(c.latching for c in conns) and count == 1):
+            static_edges.add(key)
+
+
+def _tf_chain(
+    plist: list[Path],
+    edges: dict[tuple[str, str], Edge],
+    parent: str,
+    child: str,
+    start_ns: int | None,
+    end_ns: int | None,
+) -> PoseStream:
+    if not edges:
+        raise _topic_error(plist, "/tf", "tf topic")
+    source = f"{plist[0]}:/tf" if len(plist) == 1 else f"{len(plist)} files:/tf"
+    try:
+        stream = chain_pose(edges, parent, child, source)
+    except TopicError as err:
+        raise TopicError(f"{err.message} (in {source})") from err
+    return stream.window(start_ns, end_ns)
 
 
 def read_tf(
@@ -265,18 +369,7 @@ def read_tf(
     Raises:
         TopicError: no tf topic, an unknown frame, or no chain between the frames.
     """
-    plist = _paths(paths)
-    lo = None if start_ns is None else start_ns - HEADER_WINDOW_MARGIN_NS
-    hi = None if end_ns is None else end_ns + HEADER_WINDOW_MARGIN_NS
-    edges = _tf_edges(plist, lo, hi)
-    if not edges:
-        raise _topic_error(plist, "/tf", "tf topic")
-    source = f"{plist[0]}:/tf" if len(plist) == 1 else f"{len(plist)} files:/tf"
-    try:
-        stream = chain_pose(edges, parent, child, source)
-    except TopicError as err:
-        raise TopicError(f"{err.message} (in {source})") from err
-    return stream.window(start_ns, end_ns)
+    return _read_sources(paths, [_TfRead(parent, child)], start_ns, end_ns)[0]
 
 
 def read_pose_source(
@@ -287,13 +380,32 @@ def read_pose_source(
     end_ns: int | None = None,
 ) -> PoseStream:
     """A pose topic, or a tf frame when ``source.topic`` is None or a tf topic."""
-    if source.topic is not None and source.topic not in TF_TOPICS:
-        return read_poses(
-            paths, source.topic, time_source=source.time_source, start_ns=start_ns, end_ns=end_ns
-        )
-    if not source.frame:
-        raise TopicError("a tf pose source needs a frame (the tf child frame)")
-    return read_tf(paths, source.parent, source.frame, start_ns=start_ns, end_ns=end_ns)
+    return read_pose_sources(paths, [source], start_ns=start_ns, end_ns=end_ns)[0]
+
+
+def read_pose_sources(
+    paths: PathsLike,
+    sources: Sequence[PoseSource],
+    *,
+    start_ns: int | None = None,
+    end_ns: int | None = None,
+) -> list[PoseStream]:
+    """Several pose sources of the same bags (:func:`read_pose_source` each), every file
+    read once for all of them: one pass over its index and one over the chunks any of them
+    touches (the GT hour's PoseStamped, Pose2D and /tf topics cost one read of the file).
+
+    Raises:
+        TopicError: a source not in the bags, as :func:`read_poses` and :func:`read_tf` say.
+    """
+    reads: list[_TopicRead | _TfRead] = []
+    for source in sources:
+        if source.topic is not None and source.topic not in TF_TOPICS:
+            reads.append(_TopicRead(source.topic, source.time_source))
+            continue
+        if not source.frame:
+            raise TopicError("a tf pose source needs a frame (the tf child frame)")
+        reads.append(_TfRead(source.parent, source.frame))
+    return _read_sources(paths, reads, start_ns, end_ns)
 
 
 def read_messages(
@@ -338,44 +450,6 @@ def _machine_of(topic: str, msgtype: str) -> Machine | None:
     return None
 
 
-def _bulk_states(
-    bag: BagFile, conns: list[Conn]
-) -> (
-    tuple[np.ndarray[Any, np.dtype[np.int64]], np.ndarray[Any, np.dtype[np.uint8]], list[str]]
-    | None
-):
-    """(record times, states, payloads) decoded in bulk, None when the layout is not the 2015
-    one or the format has no bulk access."""
-
-    if len({c.encoding for c in conns}) != 1 or not all(
-        is_state_definition(c.msgdef) for c in conns
-    ):
-        return None
-    try:
-        found = locate(bag, conns, None, None)
-        if found is None:
-            return None
-        pos_parts, t_parts, s_parts, payloads = [], [], [], []
-        for pos, buf, start, length, t_rec in found.runs:
-            state, text = decode_states(buf, start, length, conns[0].encoding == "cdr")
-            pos_parts.append(pos)
-            t_parts.append(t_rec)
-            s_parts.append(state)
-            payloads.extend(text)
-    except LayoutMismatchError as err:
-        log.info("%s: %s not in the 2015 state layout (%s)", bag.path, conns[0].topic, err)
-        return None
-    if not pos_parts:
-        return np.empty(0, np.int64), np.empty(0, np.uint8), []
-    pos = np.concatenate(pos_parts)
-    order = np.argsort(pos, kind="stable")
-    t = np.concatenate(t_parts)[order]
-    if len(t) > 1 and np.any(t[1:] < t[:-1]):
-        order = order[np.argsort(t, kind="stable")]
-        t = np.concatenate(t_parts)[order]
-    return t, np.concatenate(s_parts)[order], [payloads[i] for i in order.tolist()]
-
-
 def read_states(paths: PathsLike, topic: str) -> StateStream:
     """A BmBox/RefBox/Client state topic as (record time, state code, payload), time-ordered.
 
@@ -386,50 +460,68 @@ def read_states(paths: PathsLike, topic: str) -> StateStream:
     Raises:
         TopicError: topic absent, or not a state topic (no ``state``/``payload`` fields).
     """
-    plist = _paths(paths)
-    t_parts, s_parts, payloads = [], [], []
-    msgtype = ""
+    return _read_states(_paths(paths), [topic])[0]
+
+
+def _read_states(plist: list[Path], names: Sequence[str]) -> list[StateStream]:
+    """:func:`read_states` of several topics, each file read once for all of them."""
+    t_parts: list[list[npt.NDArray[np.int64]]] = [[] for _ in names]
+    s_parts: list[list[npt.NDArray[np.uint8]]] = [[] for _ in names]
+    payloads: list[list[str]] = [[] for _ in names]
+    msgtypes = [""] * len(names)
     for p in plist:
         with open_bag(p) as bag:
-            conns = bag.topic_conns(topic)
-            if not conns:
-                continue
-            msgtype = msgtype or conns[0].msgtype
-            if _machine_of(topic, conns[0].msgtype) is None:
-                raise TopicError(
-                    f"topic {topic} ({conns[0].msgtype}) is not a benchmark state topic "
-                    "(bmbox_state, refbox_state, client_state)",
-                    path=p,
-                )
-            bulk = _bulk_states(bag, conns)
-            if bulk is None:
-                deser = Deserializer(conns, p)
-                msgs = [(t, deser(raw, c)) for c, t, raw in bag.raw(conns)]
-                if msgs and not (hasattr(msgs[0][1], "state") and hasattr(msgs[0][1], "payload")):
+            present: list[tuple[int, list[Conn]]] = []
+            for i, topic in enumerate(names):
+                conns = bag.topic_conns(topic)
+                if not conns:
+                    continue
+                msgtypes[i] = msgtypes[i] or conns[0].msgtype
+                if _machine_of(topic, conns[0].msgtype) is None:
                     raise TopicError(
-                        f"topic {topic}: type {conns[0].msgtype} has no state/payload fields",
+                        f"topic {topic} ({conns[0].msgtype}) is not a benchmark state topic "
+                        "(bmbox_state, refbox_state, client_state)",
                         path=p,
                     )
-                bulk = (
-                    np.fromiter((t for t, _ in msgs), dtype=np.int64, count=len(msgs)),
-                    np.fromiter((int(m.state) for _, m in msgs), dtype=np.uint8, count=len(msgs)),
-                    [str(m.payload) for _, m in msgs],
-                )
-        t_parts.append(bulk[0])
-        s_parts.append(bulk[1])
-        payloads.extend(bulk[2])
-    if not t_parts:
-        raise _topic_error(plist, topic, "state topic")
-    machine = _machine_of(topic, msgtype)
-    assert machine is not None
-    t = np.concatenate(t_parts)
-    state = np.concatenate(s_parts)
-    if len(t) > 1 and np.any(t[1:] < t[:-1]):
-        log.warning("%s: messages from several files out of time order; sorted", topic)
-        order = np.argsort(t, kind="stable")
-        t, state, payloads = t[order], state[order], [payloads[i] for i in order.tolist()]
-    src = str(plist[0]) if len(plist) == 1 else ";".join(map(str, plist))
-    return StateStream(machine, t, state, tuple(payloads), topic, src)
+                present.append((i, conns))
+            bulks = bulk_states_many(bag, [conns for _i, conns in present])
+            for (i, conns), bulk in zip(present, bulks, strict=True):
+                if bulk is None:
+                    bulk = _slow_states(bag, conns, names[i], p)
+                t_parts[i].append(bulk[0])
+                s_parts[i].append(bulk[1])
+                payloads[i].extend(bulk[2])
+    out = []
+    for i, topic in enumerate(names):
+        if not t_parts[i]:
+            raise _topic_error(plist, topic, "state topic")
+        machine = _machine_of(topic, msgtypes[i])
+        assert machine is not None
+        t = np.concatenate(t_parts[i])
+        state = np.concatenate(s_parts[i])
+        texts = payloads[i]
+        if len(t) > 1 and np.any(t[1:] < t[:-1]):
+            log.warning("%s: messages from several files out of time order; sorted", topic)
+            order = np.argsort(t, kind="stable")
+            t, state, texts = t[order], state[order], [texts[k] for k in order.tolist()]
+        src = str(plist[0]) if len(plist) == 1 else ";".join(map(str, plist))
+        out.append(StateStream(machine, t, state, tuple(texts), topic, src))
+    return out
+
+
+def _slow_states(bag: BagFile, conns: list[Conn], topic: str, path: Path) -> States:
+    """A state topic of one file deserialized by rosbags, message by message."""
+    deser = Deserializer(conns, path)
+    msgs = [(t, deser(raw, c)) for c, t, raw in bag.raw(conns)]
+    if msgs and not (hasattr(msgs[0][1], "state") and hasattr(msgs[0][1], "payload")):
+        raise TopicError(
+            f"topic {topic}: type {conns[0].msgtype} has no state/payload fields", path=path
+        )
+    return (
+        np.fromiter((t for t, _ in msgs), dtype=np.int64, count=len(msgs)),
+        np.fromiter((int(m.state) for _, m in msgs), dtype=np.uint8, count=len(msgs)),
+        [str(m.payload) for _, m in msgs],
+    )
 
 
 def read_benchmark_states(paths: PathsLike, namespace: str) -> BenchmarkStates:
@@ -441,10 +533,14 @@ def read_benchmark_states(paths: PathsLike, namespace: str) -> BenchmarkStates:
     plist = _paths(paths)
     present = topics(plist)
     ns = "/" + namespace.strip("/")
-    found: dict[Machine, StateStream | None] = {}
+    wanted: dict[Machine, str] = {}
     for machine, suffixes in STATE_TOPIC_SUFFIXES.items():
         topic = next((f"{ns}/{s}" for s in suffixes if f"{ns}/{s}" in present), None)
-        found[machine] = None if topic is None else read_states(plist, topic)
+        if topic is not None:
+            wanted[machine] = topic
+    # the three topics from one pass over each file
+    streams = dict(zip(wanted, _read_states(plist, list(wanted.values())), strict=True))
+    found: dict[Machine, StateStream | None] = {m: streams.get(m) for m in STATE_TOPIC_SUFFIXES}
     if all(v is None for v in found.values()):
         log.info("no state topics of %s in %s", ns, plist[0])
     return BenchmarkStates(found[Machine.BMBOX], found[Machine.REFBOX], found[Machine.CLIENT])

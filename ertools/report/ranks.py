@@ -8,8 +8,9 @@ key ``K`` in a result, at the result's ``uncertainty.confidence``). The model, s
   is that side's half of the interval: ``sigma = (high - score) / z`` above the score and
   ``(score - low) / z`` below, ``z`` the two-sided normal quantile of the interval's
   confidence (1.96 at 95 %). A symmetric interval is one normal; a skewed Monte Carlo
-  interval keeps its skew where it matters, on the side facing the neighbour (a side the
-  interval does not reach, an interval wholly above its score, is no spread);
+  interval keeps its skew where it matters, on the side facing the neighbour. An interval
+  that does not hold its score (an older ertools wrote the trajectory's at the clock
+  offset the data fits, not the one scored) is not read: that row is not assessed;
 - the scores of two teams are independent (different executions, different mocap frames);
   an uncertainty source both share (the ``d_min`` of FBM3) moves both the same way and makes
   their difference *more* certain than this, so the model errs towards calling a tie;
@@ -29,13 +30,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from itertools import pairwise
 from statistics import NormalDist
 from typing import Any
 
 DEFAULT_CONFIDENCE = 0.95
 NO_INTERVAL = "no interval in this result"
+OUTSIDE_INTERVAL = "its interval does not hold its score (written by an older ertools)"
 NEXT_NO_INTERVAL = "the next has no interval"
 NOT_SCOREABLE = "unscoreable"
 NONE_EXPLAINED = (
@@ -54,6 +56,14 @@ class Contender:
     interval: tuple[float, float] | None = None
     confidence: float = DEFAULT_CONFIDENCE  # of ``interval``
     ident: str = ""  # the caller's own key (an execution), carried to the Standing
+    note: str = ""  # why ``interval`` is None, when it is not for want of one
+
+    def read(self) -> Contender:
+        """Itself, or without its interval (and saying so) when the interval does not hold
+        the score: the model reads the interval's sides around the score."""
+        if self.interval is None or self.interval[0] <= self.score <= self.interval[1]:
+            return self
+        return replace(self, interval=None, note=OUTSIDE_INTERVAL)
 
 
 @dataclass(frozen=True)
@@ -130,7 +140,7 @@ def stability(
     alpha_half = (1.0 - confidence) / 2.0
     z_value(confidence)  # validates
     sign = 1.0 if lower_is_better else -1.0
-    ordered = sorted(contenders, key=lambda c: sign * c.score)
+    ordered = sorted((c.read() for c in contenders), key=lambda c: sign * c.score)
     ranks: list[int] = []
     for i, c in enumerate(ordered):
         same = i > 0 and c.score == ordered[i - 1].score
@@ -170,7 +180,7 @@ def stability(
 
 def _note(ordered: Sequence[Contender], i: int) -> str:
     if ordered[i].interval is None:
-        return NO_INTERVAL
+        return ordered[i].note or NO_INTERVAL
     if i + 1 < len(ordered) and ordered[i + 1].interval is None:
         return NEXT_NO_INTERVAL
     return ""
@@ -286,7 +296,10 @@ def summary(standings: Sequence[Standing]) -> str:
     supported = len(pairs) - sum(joined) - unassessed
     parts = [f"{supported} of {len(pairs)} adjacent order(s) supported by the data"]
     if unassessed:
-        parts.append(f"{unassessed} not assessed ({NO_INTERVAL})")
+        why = NO_INTERVAL
+        if any(s.note == OUTSIDE_INTERVAL for s in standings):
+            why = f"{NO_INTERVAL}, or {OUTSIDE_INTERVAL}"
+        parts.append(f"{unassessed} not assessed ({why})")
     groups: dict[int, list[str]] = {}
     for s in standings:
         if s.tied:

@@ -8,5 +8,15 @@
 - :mod:`ertools.rsbb.layout`: a season folder's files recognised by their paths, results
   paired with their bags.
 
+What the benchmarks of 2017-19 share (each benchmark package uses them):
+
+- :mod:`ertools.rsbb.sidefiles`: a run's side files (config, team transform, items, result
+  file) given or found beside its bag;
+- :mod:`ertools.rsbb.tf`: ``/tf`` read once, the scripts' lookups as tf2 answered them, and
+  the lookup helper's attempts;
+- :mod:`ertools.rsbb.score`: the result file's ``score`` form, and a recomputed score compared
+  with the live score and the result file;
+- :mod:`ertools.rsbb.py2`: Python 2.7's ``round``, ``str`` and genpy's ``to_sec``.
+
 docs/rsbb.md describes the RSBB; the data it names are in :mod:`ertools.rsbb_states`.
 """

@@ -79,6 +79,23 @@ def _bag_time(stamp: str) -> datetime | None:
         return None
 
 
+def bag_name(name: str) -> tuple[int, datetime | None] | None:
+    """(run, local start time) of a run bag's file name ``run_<n>_<date>.bag[.active]`` in
+    any folder; None for another name."""
+    m = _BAG.match(name)
+    return None if m is None else (int(m.group(1)), _bag_time(m.group(2)))
+
+
+def result_name(name: str) -> tuple[int, datetime | None] | None:
+    """(run, local time) of a result file's name ``result_run_<n>_<date>.yaml`` in any folder;
+    None for another name."""
+    m = _RESULT.match(name)
+    if m is None:
+        return None
+    aware = parse_result_time(m.group(2))
+    return int(m.group(1)), None if aware is None else aware.replace(tzinfo=None)
+
+
 def _code_team(parts: tuple[str, ...], top: str) -> tuple[str, str] | None:
     """(code, team) from ``.../<top>/<CODE>/<team>/[<robot>/]<file>``; None if not so."""
     for k in range(len(parts) - 3, -1, -1):

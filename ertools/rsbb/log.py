@@ -21,7 +21,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import I64, U8
-from ertools.errors import TopicError
+from ertools.errors import ConfigError, TopicError
 from ertools.io.reader import read_messages, read_states, read_tf, topics
 from ertools.io.summary import summary
 from ertools.rsbb.results import LiveScore, parse_live_score
@@ -455,3 +455,29 @@ def read_rsbb_run(paths: PathsLike) -> RsbbRun:
     refbox = read_refbox_states(plist)
     bmbox = read_states(plist, BMBOX_STATE_TOPIC) if BMBOX_STATE_TOPIC in present else None
     return run_events(refbox, bmbox, read_timeouts(plist), read_live_scores(plist), _where(plist))
+
+
+def logged_code(run: RsbbRun) -> str | None:
+    """The benchmark the run's live scores name (``benchmark_info.benchmark_code``, set by
+    the script's setup before it published), None when none names one."""
+    for message in run.live:
+        info = message.result.get("benchmark_info") if message.result is not None else None
+        code = info.get("benchmark_code") if isinstance(info, dict) else None
+        if isinstance(code, str) and code not in ("", "undefined"):
+            return code
+    return None
+
+
+def check_code(run: RsbbRun, code: str) -> None:
+    """Refuse another benchmark's run bag (outside the RSBB layout, where its folder says).
+
+    Raises:
+        ConfigError: the live scores name another benchmark.
+    """
+    logged = logged_code(run)
+    if logged is not None and logged != code:
+        raise ConfigError(
+            f"this bag is a {logged} run (its live score's benchmark_info), not {code}'s: "
+            f"ertools score {logged.lower()}",
+            path=run.source,
+        )

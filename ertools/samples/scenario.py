@@ -43,6 +43,12 @@ SCENARIOS: dict[str, str] = {
     "robotlog": "ertools.benchmarks.trajectory.sample:generate",
     "stationary": "ertools.benchmarks.noise.sample:generate",
     "timeline": "ertools.samples.timeline_folder:generate",
+    "hnf": "ertools.benchmarks.hnf.sample:generate",
+    "hpff": "ertools.benchmarks.hpff.sample:generate",
+    "hopf": "ertools.benchmarks.hopf.sample:generate",
+    "hppf": "ertools.benchmarks.hppf.sample:generate",
+    "hgmf": "ertools.benchmarks.hgmf.sample:generate",
+    "season2019": "ertools.samples.season:generate",
 }
 
 

@@ -57,6 +57,11 @@ from ertools.simulator.rsbb_scenario import (
 from ertools.simulator.writer import BagWriter
 
 MS = 1_000_000
+#: The mocap node's /tf copy of a pose: stamped this after the pose topic's header (its own
+#: ``ros::Time::now()``) and recorded this after the pose message (what a script's tf listener
+#: holds: a benchmark's sample computes its live score from these).
+TF_STAMP_LAG_NS = 5_000
+TF_RECORD_LAG_NS = 40_000
 BMBOX_CALLER = "/rsbb/rsbb_bmbox"
 CORE_CALLER = "/rsbb/roah_rsbb_core"
 MOCAP_CALLER = "/rsbb/mocap_node"
@@ -165,7 +170,7 @@ def _sample(changes: Sequence[tuple[int, Any]], ticks: np.ndarray) -> list[Any]:
 # --- the bag ------------------------------------------------------------------------------------
 
 
-def _register_types(bag: BagWriter) -> None:
+def register_types(bag: BagWriter) -> None:
     """Add the RSBB message types to the writer's type store (once per store)."""
     from rosbags.typesys import get_types_from_msg  # lazy: rosbags, 100 ms
 
@@ -259,8 +264,8 @@ def _write_tf(bag: BagWriter, sc: RsbbScenario) -> None:
                 callerid=MOCAP_CALLER,
             )
         bag.write_tf(
-            pub.t_record_ns + 40_000,
-            pub.t_header_ns + 5_000,
+            pub.t_record_ns + TF_RECORD_LAG_NS,
+            pub.t_header_ns + TF_STAMP_LAG_NS,
             MOCAP_PARENT,
             body.name,
             pub.xyz,
@@ -307,61 +312,95 @@ def _take(pub: MocapPublished, idx: np.ndarray) -> MocapPublished:
     )
 
 
-def _write_gui(bag: BagWriter, sc: RsbbScenario) -> None:
-    """``/core/to_gui`` at 10 Hz with the run's zone and its referee items (final values)."""
-    if sc.referee_score is None:
-        return
-    groups: dict[str, list[dict[str, Any]]] = {}
-    for item in sc.referee_score:
-        groups.setdefault(str(item["group_name"]), []).append(item)
+@dataclass(frozen=True)
+class ZoneView:
+    """What the RefBox's GUI showed of a run's zone at one tick: its state text, its start and
+    stop buttons (stop enabled: the benchmark executing), its timer and the items' values (in
+    the order of the items given to :func:`write_gui`)."""
+
+    state: str = ""
+    stop_enabled: bool = False
+    start_enabled: bool = False
+    timer_ns: int = 0
+    values: tuple[int, ...] | None = None  # None: the items' own (final) values
+
+
+def write_gui(
+    bag: BagWriter,
+    ticks: np.ndarray,
+    code: str,
+    team: str,
+    run: int,
+    items: Sequence[dict[str, Any]],
+    views: Sequence[ZoneView],
+) -> None:
+    """``/core/to_gui`` at ``ticks`` (10 Hz), one zone: the run's, as ``views`` (one a tick)
+    show it, with the referee items (``group_name``, ``desc``, ``type``, ``current_value``)."""
     zgroup = bag.msgclass("roah_rsbb/ZoneScoreGroup")
-    scoring = [
-        zgroup(
-            group_name=name,
-            types=np.array([0 if i["type"] == "bool" else 1 for i in items], np.uint8),
-            descriptions=[str(i["desc"]) for i in items],
-            current_values=np.array([int(i["current_value"]) for i in items], np.int32),
-        )
-        for name, items in groups.items()
-    ]
     time_cls = bag.msgclass("builtin_interfaces/Time")
     dur_cls = bag.msgclass("builtin_interfaces/Duration")
-    zero_t, zero_d = time_cls(sec=0, nanosec=0), dur_cls(sec=0, nanosec=0)
-    zone = bag.msgclass("roah_rsbb/ZoneState")(
-        zone=f"Zone {sc.team}",
-        name=sc.code,
-        desc="",
-        code=sc.code,
-        timeout=zero_d,
-        team=sc.team,
-        round=1,
-        run=sc.run,
-        schedule=zero_t,
-        timer=zero_d,
-        state="",
-        benchmark_state="",
-        goal_state="",
-        manual_operation_state="",
-        bmscript_state="",
-        robot_state="",
-        manual_operation="",
-        run_selector_enabled=False,
-        connect_enabled=False,
-        disconnect_enabled=True,
-        start_enabled=False,
-        stop_enabled=False,
-        prev_enabled=False,
-        next_enabled=False,
-        omf=False,
-        omf_switches=np.zeros(0, np.uint8),
-        omf_damaged=0,
-        omf_complete=False,
-        log="",
-        online_data="",
-        scoring=scoring,
-    )
-    ticks = np.arange(sc.t_record_ns + 60 * MS, sc.t_disconnect_ns, STATE_PERIOD_NS, dtype=np.int64)
+    zone_cls = bag.msgclass("roah_rsbb/ZoneState")
     gui = bag.msgclass(CORE_TO_GUI_TYPE)
+    zero_t, zero_d = time_cls(sec=0, nanosec=0), dur_cls(sec=0, nanosec=0)
+    final = tuple(int(i["current_value"]) for i in items)
+
+    def scoring(values: tuple[int, ...]) -> list[Any]:
+        groups: dict[str, list[tuple[dict[str, Any], int]]] = {}
+        for item, value in zip(items, values, strict=True):
+            groups.setdefault(str(item["group_name"]), []).append((item, value))
+        return [
+            zgroup(
+                group_name=name,
+                types=np.array([0 if i["type"] == "bool" else 1 for i, _ in rows], np.uint8),
+                descriptions=[str(i["desc"]) for i, _ in rows],
+                current_values=np.array([v for _, v in rows], np.int32),
+            )
+            for name, rows in groups.items()
+        ]
+
+    def zone(view: ZoneView) -> Any:
+        secs, nsecs = divmod(int(view.timer_ns), 1_000_000_000)
+        return zone_cls(
+            zone=f"Zone {team}",
+            name=code,
+            desc="",
+            code=code,
+            timeout=zero_d,
+            team=team,
+            round=1,
+            run=run,
+            schedule=zero_t,
+            timer=dur_cls(sec=secs, nanosec=nsecs),
+            state=view.state,
+            benchmark_state="",
+            goal_state="",
+            manual_operation_state="",
+            bmscript_state="",
+            robot_state="",
+            manual_operation="",
+            run_selector_enabled=False,
+            connect_enabled=False,
+            disconnect_enabled=True,
+            start_enabled=view.start_enabled,
+            stop_enabled=view.stop_enabled,
+            prev_enabled=False,
+            next_enabled=False,
+            omf=False,
+            omf_switches=np.zeros(0, np.uint8),
+            omf_damaged=0,
+            omf_complete=False,
+            log="",
+            online_data="",
+            scoring=scoring(final if view.values is None else view.values),
+        )
+
+    zones: dict[ZoneView, Any] = {}  # a view repeats for many ticks: one message object each
+
+    def zone_of(view: ZoneView) -> Any:
+        if view not in zones:
+            zones[view] = zone(view)
+        return zones[view]
+
     msgs = [
         gui(
             clock=time_cls(sec=int(t // 1_000_000_000), nanosec=int(t % 1_000_000_000)),
@@ -369,8 +408,8 @@ def _write_gui(bag: BagWriter, sc: RsbbScenario) -> None:
             addr="",
             port="",
             active_robots=[],
-            benchmarking_robots=[sc.team],
-            zones=[zone],
+            benchmarking_robots=[team],
+            zones=[zone_of(view)],
             bm_server_status="",
             bm_server_status_color=2,
             record_server_status="",
@@ -382,10 +421,19 @@ def _write_gui(bag: BagWriter, sc: RsbbScenario) -> None:
             tablet_position_x=0.0,
             tablet_position_y=0.0,
         )
-        for t in ticks.tolist()
+        for t, view in zip(ticks.tolist(), views, strict=True)
     ]
     conn = bag.connection(CORE_TO_GUI_TOPIC, CORE_TO_GUI_TYPE, callerid=CORE_CALLER, latching=True)
     bag.write_many(conn, ticks, msgs)
+
+
+def _write_gui(bag: BagWriter, sc: RsbbScenario) -> None:
+    """``/core/to_gui`` at 10 Hz with the run's zone and its referee items (final values)."""
+    if sc.referee_score is None:
+        return
+    ticks = np.arange(sc.t_record_ns + 60 * MS, sc.t_disconnect_ns, STATE_PERIOD_NS, dtype=np.int64)
+    items = [dict(i) for i in sc.referee_score]
+    write_gui(bag, ticks, sc.code, sc.team, sc.run, items, [ZoneView()] * len(ticks))
 
 
 def _check(sc: RsbbScenario) -> None:
@@ -424,7 +472,7 @@ def write_rsbb_run(
     if result_path.exists():
         raise UsageError(f"{result_path} exists already; the simulator never overwrites")
     with BagWriter(bag_path, "ros1", compression=compression) as bag:
-        _register_types(bag)
+        register_types(bag)
         _write_states(bag, sc)
         _write_events(bag, sc)
         _write_tf(bag, sc)

@@ -30,6 +30,8 @@ from pathlib import Path
 from ertools.benchmarks.common.teams import parse_robot_log_name
 from ertools.io.formats import Unreadable
 from ertools.io.model import ClockCheck
+from ertools.rsbb.layout import FileKind
+from ertools.rsbb.layout import classify as rsbb_classify
 from ertools.timelines.model import (
     BagEntry,
     Kind,
@@ -98,11 +100,24 @@ def split_name(path: str | Path) -> tuple[str, int] | None:
     return group, int(match.group("index"))
 
 
+def rsbb_run(path: str | Path) -> tuple[str, str] | None:
+    """(code, team) of a run bag in the RSBB's layout (``rsbb_logs/<CODE>/<team>/run_<n>_...``),
+    None for any other file."""
+    found = rsbb_classify(path)
+    if found is None or found.kind is not FileKind.RUN_BAG or not found.code or not found.team:
+        return None
+    return found.code, found.team
+
+
 def logger_name(path: str | Path) -> str:
-    """The logger that wrote a file: its name without split index and recording date.
+    """The logger that wrote a file: its name without split index and recording date (an
+    RSBB run: ``<CODE> <team>``, the RSBB's recorder for that benchmark and team).
 
     One lane of the Gantt chart: the restarts of a logger stay on the same lane.
     """
+    run = rsbb_run(path)
+    if run is not None:
+        return f"{run[0]} {run[1]}"
     split = split_name(path)
     stem = split[0] if split is not None else bag_stem(path)
     return _DATE_RE.sub("", stem) or stem
@@ -150,7 +165,11 @@ def classify(topics: Iterable[TopicLike]) -> Kind:
 
 def benchmark_names(topics: Iterable[TopicLike], path: str | Path = "") -> tuple[str, ...]:
     """The benchmarks a bag belongs to: its topics' namespaces (``/fbm2h/...`` -> ``fbm2h``)
-    and, for a robot log, the benchmark its rockin_logger name gives (``FBM2H_...``)."""
+    and, for a robot log, the benchmark its rockin_logger name gives (``FBM2H_...``); an RSBB
+    run bag's code, from its folder (``rsbb_logs/HGMF/...`` -> ``hgmf``)."""
+    run = rsbb_run(path) if path else None
+    if run is not None:
+        return (run[0].lower(),)
     names = {
         t.name.split("/")[1].lower()
         for t in topics
@@ -266,7 +285,9 @@ def build_timeline(
                 s.format,
                 int(s.start_ns),
                 int(s.end_ns),
-                classify(s.topics),
+                # an RSBB run is its benchmark's log, scripted or not (a task benchmark's holds
+                # the RefBox's GUI messages only): its folder says so
+                "benchmark" if rsbb_run(path) is not None else classify(s.topics),
                 logger_name(path),
                 benchmarks=benchmark_names(s.topics, path),
             )
@@ -377,7 +398,8 @@ def _pairings(entries: Sequence[BagEntry], join_ns: int) -> tuple[Pairing, ...]:
     gt = [e for e in entries if e.kind == "gt"]
     pairings: list[Pairing] = []
     for e in entries:
-        if e.kind not in ("benchmark", "robot"):
+        # an RSBB run bag holds its own mocap (/tf): no GT logger's file is its ground truth
+        if e.kind not in ("benchmark", "robot") or rsbb_run(e.path) is not None:
             continue
         assert e.start_ns is not None and e.end_ns is not None
         overlapping = [

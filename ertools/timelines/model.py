@@ -162,13 +162,53 @@ class TimelineConfig:
 
 
 @dataclass(frozen=True)
+class RsbbRunFiles:
+    """One run of an RSBB season folder and its files (docs/rsbb.md, "What an RSBB run
+    writes"): the bag and result file paired by code, team, run and time, the side files
+    its script read. A missing file is None."""
+
+    code: str
+    team: str
+    run: int
+    bag: str | None
+    result: str | None
+    config: str | None = None
+    transform: str | None = None
+    items: str | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "code": self.code,
+            "team": self.team,
+            "run": self.run,
+            "bag": self.bag,
+            "result": self.result,
+            "config": self.config,
+            "transform": self.transform,
+            "items": self.items,
+        }
+
+
+@dataclass(frozen=True)
+class RsbbFolder:
+    """What the RSBB layout makes of the files under the paths: its runs, every file it
+    recognised (kind, path) and what a referee should look at."""
+
+    runs: tuple[RsbbRunFiles, ...]
+    files: tuple[tuple[str, str], ...]
+    problems: tuple[str, ...]
+
+
+@dataclass(frozen=True)
 class Timeline:
-    """The result of :func:`build_timeline` (bags ordered by start; unreadable ones last)."""
+    """The result of :func:`build_timeline` (bags ordered by start; unreadable ones last);
+    ``rsbb``: the RSBB season layout found under the paths, if any."""
 
     bags: tuple[BagEntry, ...]
     sessions: tuple[Session, ...]
     problems: tuple[Problem, ...]
     config: TimelineConfig = field(default_factory=TimelineConfig)
+    rsbb: RsbbFolder | None = None
 
     @property
     def readable_count(self) -> int:
@@ -220,6 +260,17 @@ class Timeline:
                 for s in self.sessions
             ],
             "problems": [{"path": p.path, "problem": p.problem} for p in self.problems],
+            **(
+                {
+                    "rsbb": {
+                        "runs": [r.to_dict() for r in self.rsbb.runs],
+                        "files": [{"kind": k, "path": p} for k, p in self.rsbb.files],
+                        "problems": list(self.rsbb.problems),
+                    }
+                }
+                if self.rsbb is not None
+                else {}
+            ),
         }
 
     def rows(self) -> list[dict[str, Any]]:

@@ -10,17 +10,19 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ertools.errors import ErtoolsError
 from ertools.io.clock import clock_check
-from ertools.io.formats import Found, Unreadable, find_bags
+from ertools.io.formats import Found, Unreadable, find_bags, regular_files
 from ertools.io.model import ClockCheck
 from ertools.io.summary import summary
 from ertools.progress import reporting
+from ertools.rsbb.layout import classify, pair_runs
 from ertools.timelines.build import build_timeline, split_name
-from ertools.timelines.model import Timeline, TimelineConfig
+from ertools.timelines.model import RsbbFolder, RsbbRunFiles, Timeline, TimelineConfig
 
 if TYPE_CHECKING:
     from ertools.io.model import BagSummary
@@ -118,7 +120,39 @@ def scan(
 
     found = find_bags(Path(p) for p in paths)
     with reporting(None):  # counted by bag and recording: the reads inside do not report
-        return _scan(found, config, check_clocks, progress, clock)
+        timeline = _scan(found, config, check_clocks, progress, clock)
+    return replace(timeline, rsbb=rsbb_folder([Path(p) for p in paths]))
+
+
+def rsbb_folder(paths: Sequence[Path]) -> RsbbFolder | None:
+    """The RSBB season layout of the files under ``paths`` (by their names and folders: no
+    file is opened), None when no run bag or result file is there."""
+    files, _problems = regular_files(paths)  # an unlistable folder: the scan's problem already
+    recognised = [f for f in (classify(p) for p in sorted(files)) if f is not None]
+    if not any(f.code is not None and f.run is not None for f in recognised):
+        return None
+    runs, problems = pair_runs(recognised)
+
+    def text(path: Path | None) -> str | None:
+        return None if path is None else str(path)
+
+    return RsbbFolder(
+        tuple(
+            RsbbRunFiles(
+                r.code,
+                r.team,
+                r.run,
+                None if r.bag is None else str(r.bag.path),
+                None if r.result is None else str(r.result.path),
+                text(r.config),
+                text(r.transform),
+                text(r.items),
+            )
+            for r in runs
+        ),
+        tuple((f.kind.value, str(f.path)) for f in recognised),
+        problems,
+    )
 
 
 def _scan(

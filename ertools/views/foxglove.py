@@ -30,6 +30,7 @@ from foxglove_schemas_protobuf.TextPrimitive_pb2 import TextPrimitive
 from google.protobuf.message import Message
 
 from ertools.arrays import F64, I64
+from ertools.fidelity import differs_line
 from ertools.serialize import jsonable
 
 WORLD = "world"  # the mocap frame every pose of a 2015 benchmark is in
@@ -217,7 +218,7 @@ def result_notes(out: Collected, result: Any, name: str) -> None:
     for w in result.warnings:
         log(out, t, WARNING, f"warning: {w}", name)
     for d in result.deviations:
-        log(out, t, INFO, f"differs from 2015: {d}", name)
+        log(out, t, INFO, differs_line(d), name)
     for f in result.failures:
         log(out, t, ERROR, f"error: {f}", name)
 

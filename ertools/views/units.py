@@ -87,6 +87,9 @@ def quantity_of(name: str) -> tuple[str, str] | None:
     A dotted key (``runs_details.0.distance_error``) is looked up by its last two parts
     (``robot_pose.theta``), then its last part.
     """
+    bracket = _BRACKET.fullmatch(name)
+    if bracket is not None:  # the RSBB's keys state their unit: position_accuracy[m]
+        return _BRACKET_UNITS[bracket.group(2)]
     last_two = ".".join(name.rsplit(".", 2)[-2:])
     if last_two in COLUMNS:
         return COLUMNS[last_two]
@@ -104,6 +107,15 @@ def quantity_of(name: str) -> tuple[str, str] | None:
 
 
 _BOUND = re.compile(r"(.+)_(interval|low|high)")
+_BRACKET = re.compile(r"(.+?) ?\[(m|rad|s)\]")
+_BRACKET_UNITS = {"m": ("length", "m"), "rad": ("angle", "rad"), "s": ("time", "s")}
+
+
+def without_unit(name: str) -> str:
+    """A key without the unit its name states (``position_accuracy[m]`` ->
+    ``position_accuracy``): the page shows the value in its display unit instead."""
+    bracket = _BRACKET.fullmatch(name)
+    return bracket.group(1) if bracket is not None else name
 
 
 def is_number(value: Any) -> bool:

@@ -57,7 +57,8 @@ def test_a_group_alone_shows_a_usage_naming_what_it_needs(
 ) -> None:
     assert main(["score"]) == 2
     err = capsys.readouterr().err
-    usage, error = err.splitlines()
+    # the error wraps past the CLI's line limit as the registry grows: one message again
+    usage, error = joined_lines(err)
     assert usage.startswith("usage: ertools score ")
     for needed in (*registry.names(), "BAG..."):
         assert needed in usage
@@ -114,7 +115,10 @@ TITLES = {
     "trajectory": "Offline trajectory benchmark",
 }
 NAMESPACES = {"trajectory": "rockin"}
-PAIRS = [(asked, log) for asked in registry.names() for log in registry.names() if asked != log]
+# The benchmarks whose logs their topics name (the RSBB benchmarks share /rsbb/...: their run
+# bags are told apart by their folder, rsbb_logs/<CODE>/, tests/benchmarks/hnf/).
+NAMED = [n for n in registry.names() if registry.get(n).log_namespace]
+PAIRS = [(asked, log) for asked in NAMED for log in NAMED if asked != log]
 
 
 @pytest.mark.parametrize(("asked", "log"), PAIRS)

@@ -51,11 +51,14 @@ def test_the_demo_lists_no_empty_output(
     def fake_main(argv: list[str]) -> int:
         if argv[0] in printed_by:
             print("some output")
+        if argv[0] == "rescore" and "--init" in argv:  # the season's manifest drafted
+            Path(argv[argv.index("--init") + 1]).write_text("version: 1\n")
+            return 0
         if argv[0] == "rescore":
             out = Path(argv[argv.index("--out") + 1])
             out.mkdir(parents=True)
             (out / "index.html").write_text("<html></html>")
-            return 1  # the planted problems
+            return 1 if Path(argv[1]).name == "competition" else 0  # the day's planted problems
         return 0
 
     monkeypatch.setattr(demo, "ertools_main", fake_main)
@@ -64,9 +67,10 @@ def test_the_demo_lists_no_empty_output(
     err = capsys.readouterr().err
     listed = [Path(line.split("-> ", 1)[1].split(" (exit")[0]) for line in err.splitlines()
               if "   -> " in line]  # fmt: skip
-    assert len(listed) == len(printed_by) + 1  # and the rescore site
+    assert len(listed) == len(printed_by) + 2  # and the two rescore sites
     assert "nothing on stdout" in err
     files = [p for p in listed if p.is_file()]
     assert files and all(p.stat().st_size > 0 for p in files)
     assert (tmp_path / "rescore" / "index.html") in files
+    assert (tmp_path / "season" / "index.html") in files
     assert not [p for p in tmp_path.rglob("*") if p.is_file() and p.stat().st_size == 0]

@@ -135,7 +135,8 @@ def test_version_rows_are_in_order_and_unique() -> None:
         seen.add((v.file, v.commit))
         assert v.date >= last.get(v.file, ""), f"{v.file}: {v.commit} out of date order"
         last[v.file] = v.date
-        competed = any(e in v.event for e in ("RoCKIn", "Lisbon", "Peccioli"))
+        # the 2015-17 RoCKIn/ERL competitions; the ERL @Home seasons 2017-19 (the RSBB scripts)
+        competed = any(e in v.event for e in ("RoCKIn", "Lisbon", "Peccioli", "ERL @Home"))
         assert competed or v.event.startswith("development"), v
         # a version no competition ran is restored by nothing, and says why
         assert competed or v.restores.startswith(("not restorable:", "`--rules")), v

@@ -13,9 +13,19 @@ from ertools.io.bagfile import BagFile, RawRecord
 from ertools.io.bulk import try_fast_batch
 from ertools.io.decode.posebatch import PoseBatch
 from ertools.io.files import RosbagsFile, open_bag
-from ertools.io.formats import detect_format
+from ertools.io.formats import detect_format, find_bags
 from ertools.io.model import Conn
 from ertools.io.reader import slow_pose_batch
+
+REPO = Path(__file__).resolve().parents[2]
+REAL_BAG = REPO / ".." / "shared" / "real_bags" / "log_fbm2h_mocap_2015-10-23-16-15-40_0.bag"
+
+
+def sample_bags() -> list[Path]:
+    """Every bag of sample_bags/ (none when the folder is absent)."""
+    folder = REPO / "sample_bags"
+    return list(find_bags([folder]).bags) if folder.is_dir() else []
+
 
 POSE_TOPICS = (
     "/fbm3w/robot_at_work/pose",

@@ -9,19 +9,21 @@ import pytest
 from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Writer
 
+from ertools.io.bulk import bulk_states
 from ertools.io.decode.typestore import Deserializer
 from ertools.io.files import open_bag
-from ertools.io.formats import find_bags
 from ertools.io.model import POSE_TYPES
-from ertools.io.reader import _bulk_states, read_poses, read_states, read_tf
+from ertools.io.reader import read_poses, read_states, read_tf
 from ertools.io.reader import topics as bag_topics
 from ertools.io.summary import summary
 from tests.helpers.fastpath import (
     POSE_TOPICS,
+    REAL_BAG,
     assert_same,
     fast_batch,
     reference_bag,
     reference_batch,
+    sample_bags,
 )
 
 
@@ -32,18 +34,9 @@ def test_fast_equals_rosbags(scene_bag: tuple[str, Path], topic: str) -> None:
     assert_same(fast_batch(path, topic), reference_batch(path, topic))
 
 
-REPO = Path(__file__).resolve().parents[2]
-REAL_BAG = REPO / ".." / "shared" / "real_bags" / "log_fbm2h_mocap_2015-10-23-16-15-40_0.bag"
-
-
-def _sample_bags() -> list[Path]:
-    folder = REPO / "sample_bags"
-    return list(find_bags([folder]).bags) if folder.is_dir() else []
-
-
 @pytest.mark.slow
-def test_fast_equals_rosbags_on_sample_bags() -> None:
-    bags = _sample_bags()
+def test_fast_equals_rosbags_onsample_bags() -> None:
+    bags = sample_bags()
     if not bags:
         pytest.skip("sample_bags/ is empty (run `make samples`)")
     checked = 0
@@ -120,7 +113,7 @@ def reference_states(path: Path, topic: str) -> tuple[list[int], list[int], list
 def test_bulk_states_equal_rosbags(scene_bag: tuple[str, Path], topic: str) -> None:
     _fmt, path = scene_bag
     with open_bag(path) as bag:
-        bulk = _bulk_states(bag, bag.topic_conns(topic))
+        bulk = bulk_states(bag, bag.topic_conns(topic))
     assert bulk is not None, "bulk state decoder did not apply"
     t, state, payload = reference_states(path, topic)
     assert bulk[0].tolist() == t and bulk[1].tolist() == state and bulk[2] == payload
@@ -128,7 +121,7 @@ def test_bulk_states_equal_rosbags(scene_bag: tuple[str, Path], topic: str) -> N
 
 @pytest.mark.slow
 def test_bulk_states_on_sample_and_real_bags() -> None:
-    bags = _sample_bags()
+    bags = sample_bags()
     if not bags:
         pytest.skip("sample_bags/ is empty (run `make samples`)")
     checked = 0
@@ -136,7 +129,7 @@ def test_bulk_states_on_sample_and_real_bags() -> None:
         for topic in summary(path).topics:
             if topic.msgtype.startswith("rockin_scoring/") and topic.count:
                 with open_bag(path) as bag:
-                    bulk = _bulk_states(bag, bag.topic_conns(topic.name))
+                    bulk = bulk_states(bag, bag.topic_conns(topic.name))
                 assert bulk is not None
                 t, state, payload = reference_states(path, topic.name)
                 assert bulk[0].tolist() == t and bulk[1].tolist() == state and bulk[2] == payload

@@ -14,6 +14,7 @@ import shutil
 import struct
 import threading
 import time
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -78,6 +79,111 @@ def test_prefetched_keeps_order_and_never_reuses_a_held_buffer(
         # The buffer handed out is still the caller's: nobody wrote into it.
         assert bytes(view) == bytes([k % 256]) * 64
     assert held == list(range(25))
+
+
+@pytest.mark.parametrize("parallel", [False, True])
+def test_prefetched_with_hold_keeps_the_groups_before_valid(
+    monkeypatch: pytest.MonkeyPatch, parallel: bool
+) -> None:
+    """With ``hold``, the ``hold`` groups before the one held are not written over either."""
+    monkeypatch.setattr(pipeline, "workers", lambda: 2)
+
+    def load(k: int, scratch: list[bytearray]) -> tuple[int, memoryview]:
+        time.sleep(0.001 * ((k * 5) % 3))
+        view = pipeline.scratch_view(scratch, 32)
+        view[:] = bytes([k % 256]) * 32
+        return k, view
+
+    held: list[tuple[int, memoryview]] = []
+    for k, view in pipeline.prefetched(20, load, parallel=parallel, hold=2):
+        held.append((k, view))
+        time.sleep(0.002)
+        for j, old in held[-3:]:
+            assert bytes(old) == bytes([j % 256]) * 32
+    assert [k for k, _v in held] == list(range(20))
+
+
+def _lane_groups(
+    count: int, slots: int, written: list[int]
+) -> Iterator[list[tuple[int, int, bytearray] | None]]:
+    """Groups of ``count`` items, each item (group, lane, the group's buffer); the buffers
+    rotate over ``slots`` as prefetched's do (a load writes its group's number into them)."""
+    buffers = [bytearray(8) for _ in range(slots)]
+    for k in range(12):
+        buf = buffers[k % slots]
+        buf[:] = bytes([k]) * 8
+        written.append(k)
+        yield [None if (k + i) % 5 == 4 else (k, i, buf) for i in range(count)]
+
+
+def test_lanes_decode_every_item_in_group_order_and_never_on_a_reused_buffer(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.setattr(pipeline, "workers", lambda: 2)
+    seen: dict[int, list[int]] = {i: [] for i in range(3)}
+    written: list[int] = []
+
+    def decode(i: int, item: tuple[int, int, bytearray]) -> None:
+        k, lane, buf = item
+        assert lane == i
+        time.sleep(0.001 * ((k * 3 + i) % 4))  # lanes fall behind one another
+        assert bytes(buf) == bytes([k]) * 8  # its group's bytes, not a later load's
+        seen[i].append(k)
+
+    groups = _lane_groups(3, pipeline.LANE_HOLD + 1, written)
+    pipeline.decoded_in_lanes(groups, decode, 3)
+    for i, ks in seen.items():
+        assert ks == [k for k in range(12) if (k + i) % 5 != 4]
+    assert written == list(range(12))
+    assert not [t for t in threading.enumerate() if t.name.startswith("ertools-lane")]
+
+
+@pytest.mark.parametrize(
+    ("failing", "first"),
+    [
+        ({(5, 0), (3, 2)}, (3, 2)),  # an earlier group's error on a later lane
+        ({(3, 1), (3, 0)}, (3, 0)),  # one group: the first lane's
+        ({(8, 2)}, (8, 2)),
+    ],
+)
+def test_lanes_raise_the_error_one_thread_meets_first(
+    monkeypatch: pytest.MonkeyPatch, failing: set[tuple[int, int]], first: tuple[int, int]
+) -> None:
+    monkeypatch.setattr(pipeline, "workers", lambda: 2)
+
+    def decode(i: int, item: tuple[int, int, bytearray]) -> None:
+        k = item[0]
+        time.sleep(0.001 * ((k + 2 * i) % 3))
+        if (k, i) in failing:
+            raise BagError(f"group {k} lane {i}")
+
+    with pytest.raises(BagError, match=f"group {first[0]} lane {first[1]}$"):
+        pipeline.decoded_in_lanes(_lane_groups(3, pipeline.LANE_HOLD + 1, []), decode, 3)
+    assert not [t for t in threading.enumerate() if t.name.startswith("ertools-lane")]
+
+
+def test_lanes_raise_a_load_error_after_the_errors_of_earlier_groups(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.setattr(pipeline, "workers", lambda: 2)
+
+    def groups() -> Iterator[list[int | None]]:
+        for k in range(10):
+            if k == 6:
+                raise BagError("load of group 6")
+            yield [k, k]
+
+    def decode_at(bad: int) -> Callable[[int, int], None]:
+        def decode(i: int, k: int) -> None:
+            if (k, i) == (bad, 1):
+                raise BagError(f"decode of group {k}")
+
+        return decode
+
+    with pytest.raises(BagError, match="load of group 6"):
+        pipeline.decoded_in_lanes(groups(), decode_at(99), 2)
+    with pytest.raises(BagError, match="decode of group 4"):
+        pipeline.decoded_in_lanes(groups(), decode_at(4), 2)
 
 
 def test_worker_error_reaches_the_caller_as_itself(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from ertools.io import bulk
+from ertools.io import assemble
 from ertools.io.decode.uniform import decode_uniform, layout_of
 from tests.helpers.bagmaker import FORMATS, Spec, bag_name, write
 from tests.helpers.fastpath import assert_same, fast_batch, reference_batch
@@ -131,18 +131,19 @@ def test_topic_with_a_different_frame_midway_matches_rosbags(fmt: str, tmp_path:
 def test_uniform_decoder_is_used_on_standard_topics(
     scene_bag: tuple[str, Path], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """On a logger's bag (one frame per topic) the one-gather decoder does the work, so the
-    fast-path tests against rosbags exercise it."""
+    """On a logger's bag (one frame per topic) the one-gather decoder does the work (each
+    connection's records gathered once, head and data), so the fast-path tests against
+    rosbags exercise it."""
     used: list[str] = []
-    real = bulk.decode_uniform
+    real = assemble.Decoder.fast
 
-    def spy(msgtype: str, *args: Any, **kwargs: Any) -> Any:
-        out = real(msgtype, *args, **kwargs)
-        if out is not None:
-            used.append(msgtype)
+    def spy(self: Any, *args: Any, **kwargs: Any) -> Any:
+        out = real(self, *args, **kwargs)
+        if out:
+            used.append(self.msgtype)
         return out
 
-    monkeypatch.setattr(bulk, "decode_uniform", spy)
+    monkeypatch.setattr(assemble.Decoder, "fast", spy)
     _fmt, path = scene_bag
     for topic in (
         "/fbm3w/robot_at_work/pose",

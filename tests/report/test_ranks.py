@@ -13,6 +13,7 @@ from ertools.report.rank_plot import LABEL, RIGHT, WIDTH, interval_plot
 from ertools.report.ranks import (
     NEXT_NO_INTERVAL,
     NO_INTERVAL,
+    OUTSIDE_INTERVAL,
     Contender,
     board_confidence,
     confidence_of,
@@ -142,6 +143,28 @@ def test_equal_values_and_missing_intervals() -> None:
     # Equal values without any interval are still tied: the rule itself ties them.
     same = stability([Contender("u", 1.0), Contender("v", 1.0)], lower_is_better=False)
     assert [s.marker for s in same] == ["=1", "=1"]
+
+
+def test_an_interval_that_does_not_hold_its_score_is_not_read() -> None:
+    """An older ertools wrote the trajectory's interval of the score at the fitted clock
+    offset: 146.6 mm with [17.42, 19.46]. Its sides around the score are no spread of it:
+    the row is not assessed (issue 39), the others are as without it."""
+    rows = [
+        Contender("old", 0.1466, (0.01742, 0.01946)),
+        Contender("a", 0.0174, (0.0173, 0.0176)),
+        Contender("b", 0.0180, (0.0178, 0.0182)),
+    ]
+    board = stability(rows, lower_is_better=True)
+    assert [s.name for s in board] == ["a", "b", "old"]
+    assert board[2].interval is None and board[2].note == OUTSIDE_INTERVAL
+    assert board[1].p_swap_next is None and board[1].note == NEXT_NO_INTERVAL
+    # a's and b's facing sides 0.2 and 0.2 mm, 0.6 mm apart: Phi(-0.6 / (0.2 sqrt 2) * 1.96)
+    sigma = math.hypot(0.0002, 0.0002) / Z95
+    assert board[0].p_swap_next == pytest.approx(phi(-0.0006 / sigma))
+    assert summary(board) == (
+        "1 of 2 adjacent order(s) supported by the data; 1 not assessed "
+        f"({NO_INTERVAL}, or {OUTSIDE_INTERVAL})"
+    )
 
 
 def test_tie_rule_is_the_difference_interval_containing_zero() -> None:

@@ -20,7 +20,9 @@ import pytest
 import yaml
 
 from ertools.cli.main import main
+from ertools.competition import site_text
 from ertools.report.folder import write_report
+from ertools.views import units
 from tests.helpers.report_fakes import fbm3w_like
 from tests.helpers.yaml_rounding import YAML_ROUNDING
 
@@ -267,3 +269,18 @@ def test_instants_read_as_utc(tmp_path: Path) -> None:
     )
     with (index.parent / "runs.csv").open(newline="") as fh:  # the CSV keeps epoch seconds
         assert [float(r["start_time"]) for r in csv.DictReader(fh)] == [1.4e9, 1.4e9 + 30.5]
+
+
+def test_rsbb_keys_state_their_unit() -> None:
+    """The RSBB scripts' keys carry their unit in brackets (HNF's ``position_accuracy[m]``,
+    HGMF's ``segment_time [s]``): shown in the page's units, the bracket dropped."""
+    assert site_text.with_unit("position_accuracy[m]", 0.05) == "50.00 mm"
+    assert site_text.with_unit("orientation_accuracy[rad]", math.pi / 4) == "45.00 deg"
+    assert site_text.with_unit("goal_1.segment_time [s]", 3.0) == "3.000 s"
+    assert units.without_unit("goal_1.segment_time [s]") == "goal_1.segment_time"
+    assert units.without_unit("Objects grasped") == "Objects grasped"
+    # HNF's live robot_pose, a PyYAML dump of a Pose2D: x, y in mm, theta in degrees
+    dump = "!!python/object/new:geometry_msgs.msg._Pose2D.Pose2D\nstate: [1.5, -0.25, 0.5]"
+    assert site_text.shown("segment_1.robot_pose", dump) == (
+        f"x 1500.00 mm, y -250.00 mm, theta {math.degrees(0.5):.2f} deg"
+    )

@@ -224,4 +224,6 @@ def test_sample_bags_folder_regenerates_but_for_float_rounding(tmp_path: Path) -
     ]
     assert not differ, f"regenerated files differ from sample_bags/: {differ[:10]}"
     total = sum(len(b) for b in fresh.values())
-    assert total < 15_500_000, f"sample_bags/ is {total} bytes"
+    # the budget of sample_bags/README.md (~17 MB): the 2015 logs and one RSBB sample per
+    # 2017-19 benchmark plus a season folder (issue 38), each RSBB bag bz2-compressed
+    assert total < 17_000_000, f"sample_bags/ is {total} bytes"

@@ -30,7 +30,7 @@ from ertools.errors import ErtoolsError
 from ertools.io.reader import read_benchmark_states
 from ertools.yamlin import load as load_yaml
 
-TeamSource = Literal["explicit", "payload", "log name", "transform"]
+TeamSource = Literal["explicit", "payload", "log name", "transform", "RSBB layout"]
 
 # What each source is, as reports print it ("homer (from --team)").
 SOURCE_TEXT: dict[str, str] = {
@@ -38,6 +38,7 @@ SOURCE_TEXT: dict[str, str] = {
     "payload": "a state payload",
     "log name": "the log's file name",
     "transform": "the FBM2H transform",
+    "RSBB layout": "the RSBB folder rsbb_logs/<CODE>/<team>/",
 }
 
 # rockin_logger (2015) named robot logs ${BENCHMARK}_${DATE}_${TEAMNAME}.bag, the benchmark

@@ -196,6 +196,9 @@ def basic_intervals(estimate: F64, draws: F64, confidence: float) -> tuple[F64, 
 
 # perturbed(rng, sources, n) -> (n, S) scores re-computed with only ``sources`` perturbed
 Perturbed = Callable[[np.random.Generator, frozenset[str], int], F64]
+# variance() -> (S,) variance of the scores with one source alone perturbed, computed without
+# random draws (a quadrature over the source's few dimensions)
+AloneVariance = Callable[[], F64]
 
 
 def monte_carlo(
@@ -207,14 +210,23 @@ def monte_carlo(
     seed: int = DEFAULT_SEED,
     confidence: float = DEFAULT_CONFIDENCE,
     nonnegative: bool = True,
+    alone_variance: Mapping[str, AloneVariance] | None = None,
 ) -> list[Interval | None]:
     """Intervals of ``S`` scores from draws with every source perturbed at once, and each
     source's share from draws with it alone.
+
+    ``alone_variance`` gives, for some sources, their variance alone without a pass of
+    draws. When one source is left without it, its variance is what the together pass's
+    variance leaves over the others' (exact for sources whose effects add up; the shares
+    say how the interval divides, not more), and no pass of draws is run for shares.
 
     Reproducible: the draws of each pass come from ``numpy.random.default_rng([seed, k])``,
     ``k`` = 0 for all sources together and 1.. for each source alone, whatever the order of
     the scores. ``nonnegative`` clips the low end at 0 for scores that cannot be negative
     (a distance): the truth is in the clipped interval whenever it was in the unclipped one.
+    Every interval holds its score (a referee reads it as that score's): where the basic
+    interval would lie wholly on one side of it (a bias larger than the spread: a score of
+    noise alone), it is widened to the score, which can only add coverage.
 
     Returns one Interval per score, None where the score is not finite or the draws do not
     give one.
@@ -228,22 +240,44 @@ def monte_carlo(
     low, high = basic_intervals(est, together.reshape(draws, est.size), confidence)
     variances: list[F64] = []
     if len(names) > 1:
-        for k, name in enumerate(names, start=1):
-            rng = np.random.default_rng([seed, k])
-            alone = np.asarray(perturbed(rng, frozenset((name,)), draws)).reshape(draws, est.size)
-            finite = np.sum(np.isfinite(alone), axis=0) >= 2
-            var = np.zeros(est.size)
-            if finite.any():
-                var[finite] = np.nanvar(alone[:, finite], axis=0)
-            variances.append(var)
+        given = dict(alone_variance or {})
+        missing = [n for n in names if n not in given]
+        by_name: dict[str, F64] = {n: np.asarray(f(), dtype=np.float64) for n, f in given.items()}
+        if len(missing) == 1:
+            rest = _nanvar(together.reshape(draws, est.size))
+            for name in names:
+                if name != missing[0]:
+                    rest = rest - by_name[name]
+            by_name[missing[0]] = np.maximum(rest, 0.0)
+        else:
+            for k, name in enumerate(names, start=1):
+                if name in by_name:
+                    continue
+                rng = np.random.default_rng([seed, k])
+                alone = perturbed(rng, frozenset((name,)), draws)
+                by_name[name] = _nanvar(np.asarray(alone).reshape(draws, est.size))
+        variances = [by_name[n] for n in names]
     out: list[Interval | None] = []
     for i in range(est.size):
         if not (math.isfinite(est[i]) and math.isfinite(low[i]) and math.isfinite(high[i])):
             out.append(None)
             continue
         lo = max(0.0, float(low[i])) if nonnegative else float(low[i])
-        out.append(Interval(lo, max(lo, float(high[i])), _shares(names, variances, i)))
+        hi = max(lo, float(high[i]))
+        # an interval holds its score: where the draws' bias is larger than their spread
+        # (a score all noise), the reflected interval would pass it; it reaches it instead
+        lo, hi = min(lo, float(est[i])), max(hi, float(est[i]))
+        out.append(Interval(lo, hi, _shares(names, variances, i)))
     return out
+
+
+def _nanvar(draws: F64) -> F64:
+    """(S,) variance of each column's finite draws (0 with fewer than two)."""
+    finite = np.sum(np.isfinite(draws), axis=0) >= 2
+    var = np.zeros(draws.shape[1])
+    if finite.any():
+        var[finite] = np.nanvar(draws[:, finite], axis=0)
+    return var
 
 
 def _shares(names: tuple[str, ...], variances: list[F64], i: int) -> tuple[tuple[str, float], ...]:

@@ -27,7 +27,8 @@ from sigma to sigma sqrt(2) at the 2015 values; the basic interval then over-cor
 bias (the calibration found every miss above the interval). Each draw's shift from the
 smoothed path's own score, added to the score, gives the basic interval.
 
-Each draw re-runs the whole Eq. (1) on the perturbed positions: the d_min subsampling (a
+Each draw re-runs the whole Eq. (1) on the perturbed positions
+(:mod:`~ertools.benchmarks.fbm3w.perturbed`): the d_min subsampling (a
 sequential rule: one pass over the samples, each step vectorised over the draws of all the
 runs side by side), the run frame from the perturbed reference and start, l/L and the mean
 distance. ``best_distance_error`` is the
@@ -39,11 +40,12 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from statistics import NormalDist
 
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import F64, Bool, IntArr
+from ertools.arrays import F64, IntArr
 from ertools.benchmarks.common.epsilon import NoiseResult
 from ertools.benchmarks.common.inputs import DEFAULT_C
 from ertools.benchmarks.common.uncertainty import (
@@ -57,23 +59,21 @@ from ertools.benchmarks.common.uncertainty import (
     too_few,
 )
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
-from ertools.benchmarks.fbm3w.formula import arc_fractions, frame_errors, kept_flags
+from ertools.benchmarks.fbm3w.perturbed import RunSamples, perturbed_runs
 from ertools.benchmarks.fbm3w.result import RunResult
 from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
-from ertools.benchmarks.fbm3w.shapes import Shape
 from ertools.streams import PoseStream
 
 # The coefficient of variation of a Rayleigh distance, sqrt(4/pi - 1): the spread of one
 # consecutive-pair distance around epsilon.
 RAYLEIGH_CV = math.sqrt(4.0 / math.pi - 1.0)
 DEFAULT_D_MIN_REL = 0.10
-# Draws x samples of one batch: bounds the memory of a long run (~8 bytes x a few arrays).
-BATCH_ELEMENTS = 2_000_000
-# Draws x samples of the runs whose d_min rule runs in one pass (padded to the longest): a
-# competition's four runs of ~600 samples x 400 draws in two passes, ~8 MB a pass, so that a
-# score's peak memory stays within 4 MB of the run-by-run pass it replaced.
-GROUP_ELEMENTS = 600_000
-METHOD = "Monte Carlo (parametric bootstrap around the smoothed path, basic interval)"
+METHOD = (
+    "Monte Carlo (parametric bootstrap around the smoothed path, basic interval; the shares: "
+    "d_min's variance alone at 16 stratified d_mins, the mocap noise's the rest)"
+)
+# d_mins at which the smoothed paths are scored for d_min's share (run_intervals)
+D_MIN_NODES = 16
 # Quadratic Savitzky-Golay weights over 9 samples, and the variance of noise left after it.
 SMOOTH = np.array([-21.0, 14.0, 39.0, 54.0, 59.0, 54.0, 39.0, 14.0, -21.0]) / 231.0
 HALF = len(SMOOTH) // 2
@@ -90,28 +90,6 @@ def smooth(xy: F64) -> F64:
     head = np.repeat(out[:1], HALF, axis=0)
     tail = np.repeat(out[-1:], HALF, axis=0)
     return np.concatenate([head, out, tail])
-
-
-@dataclass(frozen=True, eq=False)
-class RunSamples:
-    """What one scored run's Eq. (1) depends on.
-
-    Attributes:
-        xy: (N, 2) the measured positions of the path window (world).
-        source: (N,) index of the measurement each sample carries (a repeated pose carries
-            the one it repeats).
-        reference_xy: (2,) the measured reference position.
-        shape: the target.
-        center_xy, center_reference_xy: the smoothed path and reference the draws perturb
-            (None: the measured ones).
-    """
-
-    xy: F64
-    source: IntArr
-    reference_xy: F64
-    shape: Shape
-    center_xy: F64 | None = None
-    center_reference_xy: F64 | None = None
 
 
 @dataclass(frozen=True)
@@ -177,121 +155,6 @@ def noise_model(noise: NoiseResult | None, d_min: float) -> NoiseModel:
     return NoiseModel(sigma, 0.0, d_min, DEFAULT_D_MIN_REL, (mocap, dmin))
 
 
-def perturbed_errors(
-    run: RunSamples, sigmas: F64, d_mins: F64, rng: np.random.Generator, noisy: bool
-) -> F64:
-    """(D,) distance errors of one run with its positions perturbed by ``sigmas`` (D,) (when
-    ``noisy``) and subsampled with ``d_mins`` (D,); NaN where a draw cannot be scored."""
-    return perturbed_runs([run], sigmas, d_mins, rng, noisy)[:, 0]
-
-
-def perturbed_runs(
-    runs: Sequence[RunSamples],
-    sigmas: F64,
-    d_mins: F64,
-    rng: np.random.Generator,
-    noisy: bool,
-    *,
-    budget: int = BATCH_ELEMENTS,
-) -> F64:
-    """(D, R) distance errors of every run in every draw: column ``r`` is
-    :func:`perturbed_errors` of ``runs[r]``, with the noise drawn from ``rng`` in the same
-    order (run by run, each run's draws in batches of at most ``budget`` samples).
-
-    The d_min rule is one pass over the samples for as many runs (all their draws side by
-    side) as fit in :data:`GROUP_ELEMENTS` (or ``budget``, if smaller) padded samples.
-    """
-    d = sigmas.size
-    out = np.empty((d, len(runs)))
-    pieces = [
-        (col, lo, min(d, lo + batch))
-        for col, run in enumerate(runs)
-        for batch in [max(1, budget // max(len(run.xy), 1))]
-        for lo in range(0, d, batch)
-    ]
-    for group in _groups(pieces, [len(r.xy) for r in runs], min(budget, GROUP_ELEMENTS)):
-        # every piece's draws side by side, samples down the rows (shorter runs padded with
-        # NaN, never kept): the positions are drawn straight into these two arrays
-        lengths = [len(runs[col].xy) for col, _, _ in group]
-        edges = np.cumsum([0, *(hi - lo for _, lo, hi in group)])
-        xt = np.full((max(lengths), int(edges[-1])), np.nan)
-        yt = np.full_like(xt, np.nan)
-        views = [
-            (xt[:m, a:b].T, yt[:m, a:b].T, slice(a, b), m)
-            for a, b, m in zip(edges[:-1], edges[1:], lengths, strict=True)
-        ]
-        refs = [
-            _positions(runs[col], sigmas[lo:hi], rng, noisy, x, y)
-            for (col, lo, hi), (x, y, _, _) in zip(group, views, strict=True)
-        ]
-        kept = kept_flags(xt, yt, np.concatenate([d_mins[lo:hi] for _, lo, hi in group]))
-        for (col, lo, hi), (x, y, cols, m), (rx, ry) in zip(group, views, refs, strict=True):
-            out[lo:hi, col] = _eq1(x, y, kept[:m, cols].T, rx, ry, runs[col].shape)
-    return out
-
-
-def _groups(
-    pieces: list[tuple[int, int, int]], lengths: list[int], budget: int
-) -> list[list[tuple[int, int, int]]]:
-    """Consecutive (run, lo, hi) pieces grouped while the group's draws x its longest run
-    stay within ``budget`` (a piece alone may exceed it only with a single draw)."""
-    groups: list[list[tuple[int, int, int]]] = []
-    width = longest = 0
-    for piece in pieces:
-        col, lo, hi = piece
-        w, n = width + hi - lo, max(longest, lengths[col])
-        if groups and w * n <= budget:
-            groups[-1].append(piece)
-            width, longest = w, n
-        else:
-            groups.append([piece])
-            width, longest = hi - lo, lengths[col]
-    return groups
-
-
-def _positions(
-    run: RunSamples, sigmas: F64, rng: np.random.Generator, noisy: bool, x: F64, y: F64
-) -> tuple[F64, F64]:
-    """One run's perturbed sample positions written into ``x`` and ``y`` (D, N), and the
-    (D,) x and y of its reference; the noise of the samples drawn first (D, measurements,
-    2), then the reference's (D, 2)."""
-    d = sigmas.size
-    n = len(run.xy)
-    xy = run.xy if run.center_xy is None else run.center_xy
-    ref = run.reference_xy if run.center_reference_xy is None else run.center_reference_xy
-    if not noisy:
-        np.add(xy[None, :, 0], 0.0, out=x)
-        np.add(xy[None, :, 1], 0.0, out=y)
-        return np.full(d, ref[0] + 0.0), np.full(d, ref[1] + 0.0)
-    measured = int(run.source.max()) + 1 if n else 0
-    eps = rng.standard_normal((d, measured, 2))
-    if np.any(run.source != np.arange(n)):  # a repeated pose repeats its noise
-        eps = eps[:, run.source, :]
-    eps *= sigmas[:, None, None]
-    ref_eps = rng.standard_normal((d, 2)) * sigmas[:, None]
-    np.add(xy[None, :, 0], eps[:, :, 0], out=x)
-    np.add(xy[None, :, 1], eps[:, :, 1], out=y)
-    return ref[0] + ref_eps[:, 0], ref[1] + ref_eps[:, 1]
-
-
-def _eq1(x: F64, y: F64, kept: Bool, rx: F64, ry: F64, shape: Shape) -> F64:
-    """(D,) Eq. (1) of every draw (rows of ``x``, ``y``) from its kept flags, as
-    :func:`~ertools.benchmarks.fbm3w.formula.score_path` computes one: the kept points of all
-    draws laid end to end (row-major: each draw's start, always kept, first); NaN where a
-    draw cannot be scored."""
-    d = x.shape[0]
-    rows, cols = np.nonzero(kept)  # draw by draw (row-major), whatever the layout in memory
-    count = np.bincount(rows, minlength=d)
-    xk, yk = x[rows, cols], y[rows, cols]
-    l_norm, total = arc_fractions(xk, yk, count)
-    x0, y0 = x[:, 0], y[:, 0]
-    yaw = np.arctan2(y0 - ry, x0 - rx)
-    err = frame_errors(xk, yk, count, shape(l_norm), np.cos(yaw), np.sin(yaw))
-    out = np.bincount(rows, weights=err, minlength=d) / np.maximum(count, 1)
-    bad = (count < 2) | ~(total > 0) | ((x0 == rx) & (y0 == ry))
-    return np.where(bad, np.nan, out)
-
-
 def run_intervals(
     runs: Sequence[RunSamples | None],
     estimates: Sequence[float | None],
@@ -312,13 +175,17 @@ def run_intervals(
     est = [float(estimates[i]) for i in scored]  # type: ignore[arg-type]
     est.append(min(est))
 
-    # the smoothed paths' own scores: each draw's shift from them is added to the score
     chosen: list[RunSamples] = [r for i in scored if (r := runs[i]) is not None]
-    centers = perturbed_runs(
-        chosen, np.zeros(1), np.full(1, model.d_min), np.random.default_rng(0), False
-    )[0]
-    shift = np.asarray(est[:-1]) - centers
-    shift_best = est[-1] - float(np.min(centers))
+    # Columns that ride along in the draws' d_min pass (sigma 0: the smoothed paths as
+    # they are): the smoothed paths' own scores at d_min, from which each draw's shift is
+    # added to the score, and at D_MIN_NODES equally likely d_mins (the normal's quantiles
+    # at the midpoints of as many equal slices: a stratified draw of d_min's one
+    # dimension) for d_min's share, instead of a pass of draws of its own.
+    nodes = np.array([NormalDist().inv_cdf((k + 0.5) / D_MIN_NODES) for k in range(D_MIN_NODES)])
+    extra_d_mins = np.concatenate(
+        [[model.d_min], model.d_min * np.maximum(0.0, 1.0 + model.d_min_rel * nodes)]
+    )
+    along: dict[str, F64] = {}
 
     def perturbed(rng: np.random.Generator, sources: frozenset[str], n: int) -> F64:
         z_sigma = rng.standard_normal(n)
@@ -329,20 +196,51 @@ def run_intervals(
         d_mins = np.full(n, model.d_min)
         if D_MIN in sources:
             d_mins = model.d_min * np.maximum(0.0, 1.0 + model.d_min_rel * z_dmin)
-        out = np.empty((n, len(scored) + 1))
-        out[:, :-1] = perturbed_runs(chosen, sigmas, d_mins, rng, MOCAP_NOISE in sources)
+        raw = perturbed_runs(
+            chosen,
+            np.concatenate([sigmas, np.zeros(extra_d_mins.size)]),
+            np.concatenate([d_mins, extra_d_mins]),
+            rng,
+            MOCAP_NOISE in sources,
+        )
+        centers = raw[n]
+        shift = np.asarray(est[:-1]) - centers
+        shift_best = est[-1] - float(np.min(centers))
+        out = np.empty((raw.shape[0], len(scored) + 1))
         # the best run of each draw; NaN when one of its runs could not be scored
-        best = np.min(out[:, :-1], axis=1) + shift_best
-        out[:, :-1] += shift
-        out[:, -1] = best
-        return out
+        out[:, -1] = np.min(raw, axis=1) + shift_best
+        out[:, :-1] = raw + shift
+        along["d_min"] = _nanvar(out[n + 1 :])
+        return out[:n]
+
+    def d_min_alone() -> F64:
+        """The scores' variance with d_min alone perturbed (the stratified d_mins of the
+        together pass)."""
+        return along["d_min"]
 
     names = tuple(s.name for s in model.sources)
-    ivs = monte_carlo(est, perturbed, names, draws=draws, seed=seed, confidence=confidence)
+    # the mocap noise's share: what the together pass's variance leaves over d_min's
+    ivs = monte_carlo(
+        est,
+        perturbed,
+        names,
+        draws=draws,
+        seed=seed,
+        confidence=confidence,
+        alone_variance={D_MIN: d_min_alone},
+    )
     per_run: list[Interval | None] = [None] * len(runs)
     for col, i in enumerate(scored):
         per_run[i] = ivs[col]
     return per_run, ivs[-1]
+
+
+def _nanvar(values: F64) -> F64:
+    """(S,) variance of each column's finite values (0 with fewer than two)."""
+    var = np.zeros(values.shape[1])
+    finite = np.sum(np.isfinite(values), axis=0) >= 2
+    var[finite] = np.nanvar(values[:, finite], axis=0)
+    return var
 
 
 def uncertainty_block(

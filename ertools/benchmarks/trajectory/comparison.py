@@ -5,14 +5,15 @@ ertools differs from the 2015 script.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
+from dataclasses import replace
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import I64
 from ertools.benchmarks import registry
-from ertools.benchmarks.common.clocks import OffsetEstimate, estimate_offset
+from ertools.benchmarks.common.clocks import estimate_offset
 from ertools.benchmarks.common.hygiene import (
     drop_duplicates,
     drop_invalid,
@@ -20,20 +21,11 @@ from ertools.benchmarks.common.hygiene import (
     impossible_warning,
 )
 from ertools.benchmarks.common.inputs import IntervalSettings
-from ertools.benchmarks.common.interval_output import NO_INTERVALS
+from ertools.benchmarks.common.interval_output import NO_INTERVALS, ResultIntervals, shares_of
 from ertools.benchmarks.common.teams import parse_robot_log_name
-from ertools.benchmarks.common.uncertainty import Interval, few_warning
+from ertools.benchmarks.common.uncertainty import few_warning
 from ertools.benchmarks.common.validity import (
-    GAP as V_GAP,
-)
-from ertools.benchmarks.common.validity import (
-    OUTSIDE_WINDOW,
-    VALID,
-    Validity,
     from_codes,
-)
-from ertools.benchmarks.common.validity import (
-    TRACKING_LOST as V_TRACKING_LOST,
 )
 from ertools.benchmarks.trajectory.association import (
     COMPARED,
@@ -46,9 +38,15 @@ from ertools.benchmarks.trajectory.association import (
     associate_evo,
 )
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.fitted import at_fitted_offset, audit_warnings, estimates
 from ertools.benchmarks.trajectory.formula import Metrics, metrics
-from ertools.benchmarks.trajectory.intervals import Rescoring, trajectory_intervals
-from ertools.benchmarks.trajectory.result import TrajectoryResult
+from ertools.benchmarks.trajectory.intervals import (
+    FITTED_SUFFIX,
+    Rescoring,
+    mocap_sigma,
+    trajectory_intervals,
+)
+from ertools.benchmarks.trajectory.result import FittedScore, TrajectoryResult
 from ertools.benchmarks.trajectory.rules import (
     RULE_ASSOCIATION,
     RULE_BEFORE_GT,
@@ -58,6 +56,7 @@ from ertools.benchmarks.trajectory.rules import (
     RULE_UNSCOREABLE,
     RULE_YAW_WRAP,
 )
+from ertools.benchmarks.trajectory.validity import too_few, validity_codes
 from ertools.errors import ClockError, ScoringError
 from ertools.fidelity import Deviation
 from ertools.streams import PoseStream, Provenance, float_seconds
@@ -186,6 +185,10 @@ def score_streams(
                 ns_to_s(at),
                 at,
             )
+        return match_rows(part, at)
+
+    def match_rows(part: PoseStream, at: int | I64) -> Matched:
+        """:func:`associate`, row by row: ``at`` one offset, or one per pose."""
         return associate(
             PoseStream(
                 part.t_ns + at,
@@ -204,8 +207,18 @@ def score_streams(
             gt_order=config.gt_order,
         )
 
-    def rescore(rows: npt.NDArray[np.intp], shift_ns: int) -> Matched:
-        return match(logged.take(rows), offset_ns + shift_ns)
+    def rescoring(at: int) -> Rescoring:
+        """How the intervals' offset draws re-score the comparison around the offset ``at``:
+        all shifts in one association, except evo's (not row by row)."""
+
+        def rescore(rows: npt.NDArray[np.intp], shift_ns: int) -> Matched:
+            return match(logged.take(rows), at + shift_ns)
+
+        def rescore_shifted(rows: npt.NDArray[np.intp], shifts_ns: I64) -> Matched:
+            return match_rows(logged.take(rows), at + shifts_ns)
+
+        shifted = None if config.t_max_diff is not None else rescore_shifted
+        return Rescoring(logged.t_ns + at, rescore, shifted)
 
     matched = match(robot, offset_ns)
     if matched.robot_rows is not None and len(matched.robot_rows) != len(robot):
@@ -314,24 +327,47 @@ def score_streams(
             f"{matched.count(TRACKING_LOST)} robot pose(s) fall where mocap tracking was lost "
             "(repeated GT poses) and are not compared"
         )
-    notes.extend(_audit_warnings(audit, offset_ns))
-    few = few_warning(matched.count(COMPARED), "compared pose(s)", "the comparison")
-    if few is not None and m is not None:
-        notes.append(few)
     iv = NO_INTERVALS
+    fitted: FittedScore | None = None
     if m is not None:
+        sigma = mocap_sigma(timed) if intervals.enabled else None
         iv = trajectory_intervals(
             robot,
             timed,
             matched,
             audit,
-            _estimates(m),
+            estimates(m),
             association=config.association,
             offset_ns=offset_ns,
             settings=intervals,
-            rescoring=Rescoring(logged.t_ns + offset_ns, rescore),
+            rescoring=rescoring(offset_ns),
+            sigma=sigma,
         )
-        notes.extend(_outside_note(_estimates(m), iv.intervals, audit, offset_ns))
+        disagree = audit.offset_ns is not None and audit.disagrees_with(offset_ns)
+        if sigma is not None and audit.offset_ns is not None and disagree:
+            fitted = at_fitted_offset(
+                logged,
+                timed,
+                audit,
+                audit.offset_ns,
+                match,
+                rescoring,
+                config,
+                intervals,
+                sigma,
+            )
+        if fitted is not None and iv.uncertainty is not None:
+            shares = dict(iv.uncertainty.shares)
+            shares.update(
+                {f"{k}{FITTED_SUFFIX}": v for k, v in shares_of(fitted.intervals).items()}
+            )
+            why = dict(iv.uncertainty.withheld)
+            why.update({f"{k}{FITTED_SUFFIX}": v for k, v in fitted.withheld.items()})
+            iv = ResultIntervals(iv.intervals, replace(iv.uncertainty, shares=shares, withheld=why))
+    notes.extend(audit_warnings(audit, offset_ns, fitted))
+    few = few_warning(matched.count(COMPARED), "compared pose(s)", "the comparison")
+    if few is not None and m is not None:
+        notes.append(few)
     result = TrajectoryResult(
         robot_file=robot_file,
         robot_topic=robot_topic,
@@ -352,6 +388,7 @@ def score_streams(
         unscoreable_reason=problem,
         intervals=iv.intervals,
         uncertainty=iv.uncertainty,
+        fitted=fitted,
         provenance=Provenance(
             inputs=(robot_file, *gt_files),
             parameters=(
@@ -371,75 +408,6 @@ def score_streams(
     return result
 
 
-# A comparison is unscoreable when fewer than this fraction of the robot poses inside the GT
-# have a valid GT pose: the statistics would then describe a part of the run chosen by the
-# mocap's losses, not the run. A small number of valid pairs alone is no verdict: each pair is
-# a measurement, and few of them widen the confidence interval instead (docs/uncertainty.md).
-MIN_VALID_FRACTION = 0.5
-
-
-def validity_codes(matched: Matched, gt_start_ns: int) -> npt.NDArray[np.int8]:
-    """The validity reason of each robot pose from its association status.
-
-    A pose compared across a GT gap (``--gaps compare``) is a ``gap`` and one compared with the
-    first GT pose before the GT began (``--before-gt first``) is ``outside_window``: 2015 used
-    them, but no GT was measured at their moment.
-    """
-    s = matched.status
-    codes = np.full(s.shape, V_GAP, dtype=np.int8)  # GAP and evo's UNPAIRED
-    codes[s == COMPARED] = VALID
-    codes[s == TRACKING_LOST] = V_TRACKING_LOST
-    codes[(s == UNCOVERED) | ((s == COMPARED) & (matched.t_ns < gt_start_ns))] = OUTSIDE_WINDOW
-    codes[(s == COMPARED) & matched.across_gap] = V_GAP
-    return codes
-
-
-def too_few(validity: Validity) -> str | None:
-    """Why the valid pairs cannot support the statistics, or None."""
-    inside = validity.expected - int(validity.counts[OUTSIDE_WINDOW])
-    valid = validity.valid_samples
-    if valid < MIN_VALID_FRACTION * inside:
-        what = ", ".join(
-            f"{v} {k}" for k, v in validity.invalid_samples.items() if k != "outside_window"
-        )
-        return (
-            f"only {valid} of the {inside} robot poses inside the GT have a valid GT pose "
-            f"({what}); at least {MIN_VALID_FRACTION:.0%} are needed"
-        )
-    return None
-
-
-def _estimates(m: Metrics) -> dict[str, float]:
-    """The statistics by interval key (:data:`~ertools.benchmarks.trajectory.intervals.KEYS`)."""
-    out = {
-        "position_error": m.position_error,
-        "orientation_error": m.orientation_error,
-        "rmse": m.rmse,
-        "median": m.median,
-        "max": m.max,
-        "orientation_error_2015": m.orientation_error_2015,
-    }
-    out.update({f"percentiles.p{p:g}": v for p, v in m.percentiles})
-    return out
-
-
-def _audit_warnings(audit: OffsetEstimate, applied_ns: int) -> list[str]:
-    if audit.offset_ns is None:
-        return [f"clock audit: no offset estimate ({audit.note})"]
-    out = []
-    sigma = audit.uncertainty_ns or 0
-    if audit.disagrees_with(applied_ns):
-        out.append(
-            f"clock audit: the robot stamps fit the GT best shifted by "
-            f"{ns_to_s(audit.offset_ns):+.3f} +- {ns_to_s(sigma):.3f} s, but the score uses "
-            f"{ns_to_s(applied_ns):+.3f} s; check the clocks, or re-run with "
-            "--offset auto --apply-offset"
-        )
-    if audit.note:
-        out.append(f"clock audit: {audit.note}")
-    return out
-
-
 def _other_benchmark_gt(robot_file: str, gt_topic: str) -> list[str]:
     """A warning when the robot log's rockin_logger name names one benchmark and the GT topic
     lies under another's namespace (a folder of the other arena's mocap files given as
@@ -451,32 +419,6 @@ def _other_benchmark_gt(robot_file: str, gt_topic: str) -> list[str]:
     return [
         f"the robot log's name says {named.benchmark}, but the GT {gt_topic} is the "
         f"{registry.get(ns).title} arena's: check GT_PATH (or --gt-topic)"
-    ]
-
-
-def _outside_note(
-    estimates: Mapping[str, float],
-    intervals: Mapping[str, Interval | None],
-    audit: OffsetEstimate,
-    applied_ns: int,
-) -> list[str]:
-    """Why a score lies outside its own interval, when it does: the intervals are of the
-    score at the offset the data supports, centred there and not on the one applied (a
-    referee reading ``18.06 mm [17.79, 17.95]`` otherwise sees a contradiction)."""
-    if audit.offset_ns is None or audit.offset_ns == applied_ns:
-        return []
-    outside = [
-        k
-        for k, iv in intervals.items()
-        if iv is not None and "." not in k and not iv.contains(estimates[k])
-    ]
-    if not outside:
-        return []
-    shift = (audit.offset_ns - applied_ns) / 1e6
-    return [
-        f"{', '.join(outside)} outside {'its' if len(outside) == 1 else 'their'} interval: "
-        f"the intervals are of the score at the clock offset the data fits best ({shift:+.1f} "
-        "ms from the one applied); --offset auto --apply-offset scores there"
     ]
 
 

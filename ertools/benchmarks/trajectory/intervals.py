@@ -1,46 +1,31 @@
-"""Confidence intervals of the trajectory statistics (issue 28).
+"""Confidence intervals of the trajectory statistics (issues 28 and 39; the model and its
+derivations: docs/uncertainty.md, "Trajectory" and "Closed forms").
 
-Every statistic of :mod:`ertools.benchmarks.trajectory.formula` (the mean 3D distance, RMSE,
-median, max and percentiles, the orientation errors) is re-computed ``draws`` times with the GT
-side of each compared pair perturbed by two sources, vectorised over (draws, poses):
+Every statistic of :mod:`ertools.benchmarks.trajectory.formula` gets the interval of its
+value under two sources of uncertainty on the GT side of each compared pair:
 
-- ``mocap_noise``: each GT pose used carries the mocap's measurement noise, sigma per axis
-  measured from the GT stream itself: from its stationary phases as ``ertools noise
-  --stationary auto`` finds them (epsilon -> sigma), else from the second differences of the
-  moving stream (at 120 Hz the motion's own second difference is hundredths of a millimetre;
-  the noise's is sqrt(6) sigma: a robust MAD of them gives sigma), else a stated default. The
-  yaw's sigma likewise from the yaw's second differences. An interpolated GT pose mixes two
-  samples: its noise is sigma sqrt((1-a)^2 + a^2).
-- ``time_association``: the robot-to-GT clock offset is known to the standard error of the
-  least-squares offset, the robot's correlated error slid along the path by every lag
-  (:func:`offset_spread`): one offset error per draw, common to every pose, moves
-  each GT pose by the GT velocity times it. The offset is not a measurement of the truth
-  plus an error that a draw adds a second time: the true offset lies around the applied one
-  as the draws do, so the score at a drawn offset is itself a draw of the true score (with
-  ``--offset auto`` the applied offset minimises the error: every other offset, the true one
-  included, scores higher). Its draws are mirrored about the score before the engine's
-  reflection, and added to the measurement-like draws (their interaction neglected). At
-  each shift the comparison is re-scored by the score's own association and metrics
-  (:class:`Rescoring`, :func:`offset_effects`): a pose the shift moves into a tracking loss
-  or a GT gap leaves the comparison, one it moves out of them enters it, and one moved next
-  to a loss's stale sample is compared with it, all as the score at that offset would (no
-  linearisation: a GT velocity measured across a loss's repeated samples is not the
-  body's). With ``hold`` (2015) the
-  GT pose compared was measured up to one GT frame period before the robot's moment, with
-  ``nearest`` up to half a period either side: an extra lag drawn uniformly over the pose's
-  own frame period (the basic interval then removes the lag's bias). ``linear``
-  interpolates: no frame-period term.
+- ``mocap_noise``: sigma per axis (and the yaw's) measured from the GT stream itself
+  (:func:`mocap_sigma`: its stationary phases, else its second differences); an
+  interpolated GT pose mixes two samples: sigma sqrt((1-a)^2 + a^2).
+- ``time_association``: the clock offset, known to the standard error of the least-squares
+  offset (:func:`offset_spread`), one error per draw centred on the offset applied (the
+  interval is the score's; where the data fits another offset, the score there is reported
+  beside with its own). The score at a drawn offset is itself a draw of the true score: its
+  draws are mirrored about the score before the engine's reflection and added to the
+  measurement-like draws. The comparison is re-scored by the score's own association at a
+  grid of shifts (:class:`Rescoring`, :func:`offset_effects`), so that poses entering or
+  leaving a tracking loss or a GT gap are counted as the score at that offset would. With
+  ``hold`` or ``nearest``, also a lag uniform over the pose's own GT frame period.
 
-The interval is the engine's basic bootstrap: noise makes a distance longer on average (the
-RMSE of a perfect robot is sqrt(3) sigma, not 0) and the reflection removes the bias the draws
-show. The draws work in float64 (float32's sin, cos and arctan2 differ between CPUs: see
-:data:`CHUNK_ELEMENTS`) and in chunks of draws. A comparison of more than
-:data:`MAX_POSES` poses (an hour at 10 Hz is 36,000) draws on that many poses spread evenly
-over it: the offset's effect is the same on them as on all, the per-pose noise's spread in
-the mean-like statistics (mean, RMSE, orientation errors) is scaled by sqrt(thinned / all)
-(it averages over all the poses), and in the median, percentiles and max it is left as the
-thinned poses give it (wider: a conservative interval); the offset's grid re-scores at most
-as many robot poses, evenly spread. An hour's log costs a fraction of a second.
+The measurement-like part of the mean distance, the RMSE and the two circular means comes
+from their closed-form distribution (:mod:`ertools.benchmarks.common.closed_forms`, one draw
+of it per Monte Carlo draw); the max and the percentiles are drawn on the poses that can
+move them only (:mod:`ertools.benchmarks.common.draws`), the percentiles of a comparison of
+more than :data:`MAX_POSES` poses on that many spread evenly over it (conservative). The
+closed forms work in float64; the order statistics' draws in float32 with additions, products
+and square roots only, which give the same bits on every CPU (float32's sin, cos and arctan2
+do not: issue 36). A comparison of too few poses to measure the offset's spread gets no
+interval, with the reason (:func:`~ertools.benchmarks.common.uncertainty.too_few`).
 """
 
 from __future__ import annotations
@@ -52,8 +37,28 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import F64, IntArr
+from ertools.arrays import F64, I64, IntArr
 from ertools.benchmarks.common.clocks import MIN_POSES, OffsetEstimate
+from ertools.benchmarks.common.closed_forms import (
+    AngleMoments,
+    Raw,
+    angle_moments,
+    chi3_moments,
+    chi3_squared_moments,
+    circular_mean_moments,
+    lag_mixture,
+    lag_nodes,
+    mean_moments,
+    mix_angles,
+)
+from ertools.benchmarks.common.draws import (
+    BAND_SIGMAS,
+    Distances,
+    OrderStat,
+    draw_order_stats,
+    order_stats,
+    percentile_rows,
+)
 from ertools.benchmarks.common.epsilon import noise_from_stream
 from ertools.benchmarks.common.inputs import IntervalSettings
 from ertools.benchmarks.common.interval_output import (
@@ -74,29 +79,37 @@ from ertools.benchmarks.common.uncertainty import (
     too_few,
 )
 from ertools.benchmarks.trajectory.association import COMPARED, Matched
-from ertools.benchmarks.trajectory.formula import PERCENTILES, Metrics, metrics
+from ertools.benchmarks.trajectory.formula import PERCENTILES
 from ertools.errors import ErtoolsError
+from ertools.geometry import wrap_angle, yaw_from_quat
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
 
-METHOD_TRAJECTORY = f"{METHOD} (the clock offset's draws mirrored: a percentile interval)"
+METHOD_TRAJECTORY = (
+    f"{METHOD}; the noise and frame lag of the mean, RMSE and orientation errors from their "
+    "closed-form distribution, the max and percentiles from draws of the poses that can move "
+    "them; the clock offset's draws (centred on the offset applied) mirrored"
+)
 
 # A 2015 mocap marker set when nothing in the log measures it: 0.3 mm per axis, 0.05 deg.
 DEFAULT_SIGMA_M = 3e-4
 DEFAULT_SIGMA_RAD = math.radians(0.05)
 MIN_PAIRS = 50  # stationary pairs (or second differences) needed to measure sigma
 VELOCITY_HALF_SPAN = 5  # GT samples either side of a pose for its velocity (~40 ms at 120 Hz)
-# Draws x poses per chunk: ~50 MB of float64 positions. float64, not float32: NumPy's float32
-# sin, cos and arctan2 are its own SIMD code, one per instruction set (AVX-512, AVX2, SSE),
-# which differ by a float32 ulp (6e-8), and a quantile of such draws moved the intervals by
-# 6e-8 between CPUs (issue 36). The float64 ones differ by a float64 ulp at most: 1e-15.
-CHUNK_ELEMENTS = 2_000_000
-# Longer comparisons draw on this many evenly spread poses (module doc): an hour at 10 Hz
-# stays well under a second.
+# Longer comparisons draw their percentiles on this many evenly spread poses (module doc),
+# and re-score the offset's grid on MAX_GRID_POSES robot poses: the grid's statistics are
+# averages of per-pose changes that 1,000 poses spread over the log measure to a few percent
+# of the offset's effect (an hour at 10 Hz: 36,000 poses)
 MAX_POSES = 1500
-OFFSET_GRID = 81  # shifts the statistics are re-scored at, over OFFSET_SPAN sd either side
+MAX_GRID_POSES = 1000
+# Shifts the statistics are re-scored at, over OFFSET_SPAN sd either side: a step of 0.2 sd.
+# Near the best offset a statistic grows as the square of the shift, and the chord between
+# two shifts lies above it by at most a (0.2 sd)^2 / 4 = 1% of its value 1 sd away.
+OFFSET_GRID = 41
 OFFSET_SPAN = 4.0  # a draw beyond (1 in 16,000) takes the grid's end value
-SIGMA_BLOCKS, SIGMA_BLOCK = 20, 2000  # GT samples the noise is measured on, at most
+# GT samples the noise is measured on, at most: 10 runs of 2,000 (60,000 second differences
+# measure sigma to 0.5%, far below what the intervals can tell)
+SIGMA_BLOCKS, SIGMA_BLOCK = 10, 2000
 
 #: The scores with an interval, in the order of the result's keys (``percentiles.pNN`` nested).
 KEYS = (
@@ -108,8 +121,13 @@ KEYS = (
     *(f"percentiles.p{p:g}" for p in PERCENTILES),
     "orientation_error_2015",
 )
-# Statistics that average over the poses (their noise part shrinks as 1 / sqrt(poses)).
-MEAN_LIKE = [0, 1, 2, len(KEYS) - 1]
+#: The statistics that average over the poses: closed forms (module doc).
+MEAN_LIKE = (0, 1, 2, len(KEYS) - 1)
+#: The order statistics, drawn: (index in KEYS, percent; 100 for the max).
+ORDER_STATS = ((3, 50.0), (4, 100.0), *((5 + i, p) for i, p in enumerate(PERCENTILES)))
+#: The statistics reported at the fitted clock offset too, when the data fits another one.
+FITTED_KEYS = ("position_error", "orientation_error", "rmse", "median", "max")
+FITTED_SUFFIX = "_at_fitted_offset"
 
 
 @dataclass(frozen=True)
@@ -120,28 +138,15 @@ class Rescoring:
         t_ns: the robot poses as logged, stamped on the GT clock at the applied offset.
         associate: (rows of those poses, extra shift in ns) -> the score's own association
             of those poses at the applied offset plus the shift.
+        associate_shifted: (rows, one extra shift in ns per row) -> the same for rows each
+            at its own shift (rows may repeat), in one call; None where the association is
+            not row by row (evo's: its side that looks up depends on the counts), and
+            :func:`offset_effects` then calls ``associate`` once per shift.
     """
 
     t_ns: IntArr
     associate: Callable[[npt.NDArray[np.intp], int], Matched]
-
-
-def _statistics(m: Metrics | None) -> F64 | None:
-    """The statistics of :data:`KEYS` in order (None: no pose compared)."""
-    if m is None:
-        return None
-    pct = [v for _, v in m.percentiles]
-    return np.array(
-        [
-            m.position_error,
-            m.orientation_error,
-            m.rmse,
-            m.median,
-            m.max,
-            *pct,
-            m.orientation_error_2015,
-        ]
-    )
+    associate_shifted: Callable[[npt.NDArray[np.intp], I64], Matched] | None = None
 
 
 @dataclass(frozen=True)
@@ -180,13 +185,14 @@ def _second_differences(gt: PoseStream) -> tuple[F64, F64]:
 
 def _blocks(gt: PoseStream) -> PoseStream:
     """At most SIGMA_BLOCKS runs of SIGMA_BLOCK consecutive samples spread over ``gt``: an
-    hour of 120 Hz GT measures its noise as well as from 40,000 samples, 10 times faster."""
+    hour of 120 Hz GT measures its noise as well as from 20,000 samples, 20 times faster."""
     n = len(gt)
     if n <= SIGMA_BLOCKS * SIGMA_BLOCK:
         return gt
+    # the starts lie more than a block apart (n > the blocks' total): increasing indices
     starts = np.linspace(0, n - SIGMA_BLOCK, SIGMA_BLOCKS).astype(np.intp)
     index = (starts[:, None] + np.arange(SIGMA_BLOCK)[None, :]).reshape(-1)
-    return gt.take(np.unique(index))
+    return gt.take(index)
 
 
 def mocap_sigma(gt: PoseStream) -> MocapSigma:
@@ -226,10 +232,28 @@ def mocap_sigma(gt: PoseStream) -> MocapSigma:
     )
 
 
+def _fast_length(n: int) -> int:
+    """The smallest 2^a 3^b 5^c >= n: an FFT length as fast as a power of two, up to 1.6
+    times shorter."""
+    best = 1 << max(n - 1, 0).bit_length()
+    p5 = 1
+    while p5 < best:
+        p35 = p5
+        while p35 < best:
+            p = p35
+            while p < n:
+                p *= 2
+            best = min(best, p)
+            p35 *= 3
+        p5 *= 5
+    return best
+
+
 def offset_spread(
     r_xyz: F64, g_xyz: F64, vel: F64, audit: OffsetEstimate, offset_ns: int
 ) -> tuple[float, float]:
-    """(sd, centre) in seconds of the true clock offset around the one applied.
+    """(sd, disagreement) in seconds: the standard error of the clock offset, and how far
+    the clock audit's estimate lies from the offset applied.
 
     The least-squares offset is off by ``sum_i v_i . e_i / sum_i |v_i|^2`` (v the GT
     velocity at robot pose i, e the robot's error there). The poses' errors are not
@@ -246,28 +270,29 @@ def offset_spread(
     trial) the offset's actual error is 1.11 times it, as it is of the variance the
     simulator's own error model gives (the rest: the GT's stamping delay); the independent
     poses' sandwich error was 1.57 times too small. The clock audit's block bootstrap
-    (``clock_audit``) stays the audit's warning threshold. The centre is the audit's estimate
-    minus the offset applied (0 with ``--offset auto --apply-offset``): a given offset the
-    data disagrees with moves the interval, not the score.
+    (``clock_audit``) stays the audit's warning threshold. The disagreement is the audit's
+    estimate minus the offset applied (0 with ``--offset auto --apply-offset``); the
+    intervals are centred on the offset applied whatever it is (they are the score's), and
+    the score at the audit's offset gets its own (``*_at_fitted_offset``).
     """
     sv = float(np.sum(np.square(vel)))
     n = len(vel)
     if n < 3 or sv <= 0.0 or audit.offset_ns is None:
         return 0.0, 0.0
-    e = (r_xyz - g_xyz).astype(np.float64)
-    v = vel.astype(np.float64)
+    e = r_xyz - g_xyz
+    v = vel
     centre = (audit.offset_ns - offset_ns) / NS_PER_S
     if audit.disagrees_with(offset_ns):
         # scored at an offset the data disagrees with (``--offset 0`` on a robot 0.35 s
         # ahead), the errors hold v times that disagreement: the spread is the errors' at
-        # the offset the interval is centred on (left in, it made the sd 0.2 s there). Not
-        # done otherwise: removing an offset estimated from these same errors would take
-        # out the drift's projection whose variance this measures.
+        # the offset the data fits (left in, it made the sd 0.2 s there). Not done
+        # otherwise: removing an offset estimated from these same errors would take out the
+        # drift's projection whose variance this measures.
         e -= v * centre
     e -= e.mean(axis=0)
     # c(h) for every lag at once: zero-padded to a length >= 2n - 1, so the FFT's circular
     # correlation is the linear one; sum_h c(h)^2 = sum_f |C(f)|^2 / m (Parseval)
-    m = 1 << (2 * n - 1).bit_length()
+    m = _fast_length(2 * n - 1)
     cross = np.sum(np.conj(np.fft.rfft(v, m, axis=0)) * np.fft.rfft(e, m, axis=0), axis=1)
     power = np.abs(cross) ** 2
     # rfft keeps f = 0..m/2: every other frequency stands for its conjugate twin too
@@ -284,12 +309,37 @@ def _bracket(t: IntArr, q: IntArr) -> tuple[IntArr, IntArr]:
 
 def _rescored_rows(t_robot: IntArr, t_gt: IntArr, reach_s: float) -> npt.NDArray[np.intp]:
     """The robot poses the offset's grid re-scores: those the GT covers at some shift of the
-    grid, at most :data:`MAX_POSES` of them evenly spread (an hour's log: module doc)."""
+    grid, at most :data:`MAX_GRID_POSES` of them evenly spread (an hour's log)."""
     reach = round(reach_s * NS_PER_S) + 1
     rows = np.flatnonzero((t_robot >= t_gt[0] - reach) & (t_robot <= t_gt[-1] + reach))
-    if len(rows) > MAX_POSES:
-        rows = rows[np.unique(np.linspace(0, len(rows) - 1, MAX_POSES).round().astype(np.intp))]
+    if len(rows) > MAX_GRID_POSES:
+        pick = np.linspace(0, len(rows) - 1, MAX_GRID_POSES).round().astype(np.intp)
+        rows = rows[np.unique(pick)]
     return rows
+
+
+def grid_statistics(m: Matched, shifts: int) -> F64:
+    """(shifts, KEYS) statistics of an association of ``shifts`` blocks of rows (each block
+    the same poses at one shift), as :func:`~ertools.benchmarks.trajectory.formula.metrics`
+    computes them; NaN for a block with no pose compared."""
+    ok = (m.status == COMPARED).reshape(shifts, -1)
+    d = m.position_error.reshape(shifts, -1)
+    dyaw = m.yaw_error.reshape(shifts, -1)
+    raw = np.abs(m.yaw_diff_raw.reshape(shifts, -1))
+    count = ok.sum(axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = np.where(ok, d, 0.0).sum(axis=1) / count
+        rmse = np.sqrt(np.where(ok, d * d, 0.0).sum(axis=1) / count)
+    orient = np.arctan2(
+        np.where(ok, np.sin(dyaw), 0.0).sum(1), np.where(ok, np.cos(dyaw), 0.0).sum(1)
+    )
+    o2015 = np.arctan2(np.where(ok, np.sin(raw), 0.0).sum(1), np.where(ok, np.cos(raw), 0.0).sum(1))
+    ranked = np.sort(np.where(ok, d, np.inf), axis=1)
+    pct = [percentile_rows(ranked, count, p) for p in PERCENTILES]
+    top = percentile_rows(ranked, count, 100.0)
+    out = np.column_stack([mean, orient, rmse, pct[0], top, *pct, o2015])
+    out[count == 0] = np.nan
+    return np.asarray(out, dtype=np.float64)
 
 
 def offset_effects(rescoring: Rescoring, t_gt: IntArr, shifts_s: F64) -> F64:
@@ -297,17 +347,89 @@ def offset_effects(rescoring: Rescoring, t_gt: IntArr, shifts_s: F64) -> F64:
     (seconds), the comparison re-scored by the score's own association and metrics: a pose
     a shift moves into a tracking loss or a GT gap leaves the comparison, one it moves out
     of them enters it, next to a stale sample as the score at that offset would compare it
-    (0 where no pose would be compared: no score there)."""
+    (0 where no pose would be compared: no score there). All shifts in one association of
+    the rows repeated per shift where the association works row by row."""
     poses = _rescored_rows(rescoring.t_ns, t_gt, float(np.max(np.abs(shifts_s))))
-    ref = _statistics(metrics(rescoring.associate(poses, 0)))
-    out = np.zeros((len(shifts_s), len(KEYS)))
-    if ref is None:
+    shifts_ns = np.concatenate([[0], np.round(np.asarray(shifts_s) * NS_PER_S)]).astype(np.int64)
+    if rescoring.associate_shifted is not None:
+        rows = np.tile(poses, len(shifts_ns))
+        per_row = np.repeat(shifts_ns, len(poses))
+        stats = grid_statistics(rescoring.associate_shifted(rows, per_row), len(shifts_ns))
+    else:
+        stats = np.vstack(
+            [grid_statistics(rescoring.associate(poses, int(s)), 1) for s in shifts_ns]
+        )
+    ref, got = stats[0], stats[1:]
+    if not np.isfinite(ref[0]):
+        return np.zeros((len(shifts_s), len(KEYS)))
+    out = got - ref
+    out[~np.isfinite(got[:, 0])] = 0.0
+    return np.asarray(out, dtype=np.float64)
+
+
+@dataclass(frozen=True, eq=False)
+class PoseTerms:
+    """What the perturbed statistics of the compared poses depend on, per pose (float64).
+
+    Attributes:
+        error: (n, 3) robot minus GT position.
+        theta: (n,) wrapped yaw difference robot minus GT; raw: 2015's unwrapped one.
+        sigma, sigma_yaw: (n,) the noise of the GT pose used (interpolation averages two).
+        velocity, yaw_rate: (n, 3), (n,) of the GT around the pose.
+        period: (n,) the GT frame period around the pose, seconds.
+        lag: (low, high) of the frame lag in periods (hold: (-1, 0), nearest: (-0.5,
+            0.5)); None for ``linear``.
+    """
+
+    error: F64
+    theta: F64
+    raw: F64
+    sigma: F64
+    sigma_yaw: F64
+    velocity: F64
+    yaw_rate: F64
+    period: F64
+    lag: tuple[float, float] | None
+
+    def mean_like(self, noise: bool, lag: bool) -> list[Callable[[F64], F64]]:
+        """For each of :data:`MEAN_LIKE` (position error, orientation error, RMSE, 2015
+        orientation error): a function of standard normal draws z giving the statistic's
+        values under the sources (closed forms, module doc)."""
+        nodes = lag_nodes(*self.lag) if lag and self.lag is not None else np.zeros(1)
+        s = self.sigma if noise else np.zeros_like(self.sigma)
+        sy = self.sigma_yaw if noise else np.zeros_like(self.sigma_yaw)
+        dist: list[Raw] = []
+        square: list[Raw] = []
+        wrapped: list[AngleMoments] = []
+        unwrapped: list[AngleMoments] = []
+        for node in nodes:
+            shift = node * self.period
+            d = np.sqrt(np.sum(np.square(self.error - shift[:, None] * self.velocity), axis=1))
+            dist.append(chi3_moments(d, s))
+            square.append(chi3_squared_moments(d, s))
+            turn = shift * self.yaw_rate
+            wrapped.append(angle_moments(self.theta - turn, sy))
+            unwrapped.append(angle_moments(self.raw - turn, sy, unwrapped=True))
+        one = len(nodes) == 1
+        mean = mean_moments(dist[0] if one else lag_mixture(dist))
+        squares = mean_moments(square[0] if one else lag_mixture(square))
+        orient = circular_mean_moments(wrapped[0] if one else mix_angles(wrapped))
+        o2015 = circular_mean_moments(unwrapped[0] if one else mix_angles(unwrapped))
+
+        def rmse(z: F64) -> F64:
+            return np.asarray(np.sqrt(np.maximum(squares.draw(z), 0.0)), dtype=np.float64)
+
+        return [mean.draw, orient.draw, rmse, o2015.draw]
+
+    def bounds(self, noise: bool, lag: bool) -> F64:
+        """How far each pose's distance can move in any draw (module doc)."""
+        out = np.zeros(len(self.sigma))
+        if noise:
+            out += BAND_SIGMAS * self.sigma
+        if lag and self.lag is not None:
+            reach = max(abs(self.lag[0]), abs(self.lag[1])) * self.period
+            out += reach * np.sqrt(np.sum(self.velocity**2, axis=1))
         return out
-    for i, shift in enumerate(shifts_s):
-        got = _statistics(metrics(rescoring.associate(poses, round(float(shift) * NS_PER_S))))
-        if got is not None:
-            out[i] = got - ref
-    return out
 
 
 def trajectory_intervals(
@@ -321,12 +443,14 @@ def trajectory_intervals(
     offset_ns: int,
     settings: IntervalSettings,
     rescoring: Rescoring,
+    sigma: MocapSigma | None = None,
 ) -> ResultIntervals:
     """The intervals of the statistics ``estimates`` (by :data:`KEYS`) of a comparison.
 
     ``robot``: the robot stream whose row i is matched row i; ``gt``: the GT in time order;
-    ``offset_ns``: the offset the score applied; ``rescoring``: the score's association, which
-    the offset's draws re-score with.
+    ``offset_ns``: the offset the score applied, on which the offset's draws are centred;
+    ``rescoring``: the score's association, which the offset's draws re-score with;
+    ``sigma``: the GT's noise when already measured (:func:`mocap_sigma`).
     """
     ok = matched.status == COMPARED
     if not settings.enabled or not ok.any() or len(gt) < 2:
@@ -343,9 +467,7 @@ def trajectory_intervals(
         return withheld(KEYS, few, settings, METHOD_TRAJECTORY)
     q = matched.t_ns[ok]
     r_xyz = robot.xyz[ok]
-    r_yaw = robot.yaw[ok]
     g_xyz = matched.gt_xyz[ok]
-    g_yaw = matched.gt_yaw[ok]
     t = gt.t_ns
     k, k1 = _bracket(t, q)
     period = (t[k1] - t[k]) / NS_PER_S
@@ -358,113 +480,86 @@ def trajectory_intervals(
     hi = np.clip(k1 + VELOCITY_HALF_SPAN, 0, len(t) - 1)
     span = np.maximum((t[hi] - t[lo]).astype(np.float64) / NS_PER_S, 1e-9)
     vel = (gt.xyz[hi] - gt.xyz[lo]) / span[:, None]
-    yaw_rate = np.angle(np.exp(1j * (gt.yaw[hi] - gt.yaw[lo]))) / span
-    sig = mocap_sigma(gt)
+    # the yaw of the samples used only (an hour's GT holds 430,000)
+    turned = yaw_from_quat(gt.quat_xyzw[hi]) - yaw_from_quat(gt.quat_xyzw[lo])
+    yaw_rate = wrap_angle(turned) / span
+    sig = mocap_sigma(gt) if sigma is None else sigma
+    lag: tuple[float, float] | None = None
     if association == "linear":
         weight = np.sqrt((1.0 - a) ** 2 + a**2)
-        lag_lo, lag_hi = 0.0, 0.0
-    elif association == "hold":
-        weight = np.ones(len(q))
-        lag_lo, lag_hi = -1.0, 0.0
     else:
         weight = np.ones(len(q))
-        lag_lo, lag_hi = -0.5, 0.5
-    off_sigma, off_centre = offset_spread(r_xyz, g_xyz, vel, audit, offset_ns)
-    frame_term = lag_hi > lag_lo
-    raw0 = matched.yaw_diff_raw[ok]
+        lag = (-1.0, 0.0) if association == "hold" else (-0.5, 0.5)
+    off_sigma, _ = offset_spread(r_xyz, g_xyz, vel, audit, offset_ns)
+    terms = PoseTerms(
+        error=r_xyz - g_xyz,
+        theta=wrap_angle(robot.yaw[ok] - matched.gt_yaw[ok]),
+        raw=matched.yaw_diff_raw[ok],
+        sigma=sig.position * weight,
+        sigma_yaw=sig.yaw * weight,
+        velocity=vel,
+        yaw_rate=yaw_rate,
+        period=period,
+        lag=lag,
+    )
+    distances = Distances(terms.error, terms.sigma, terms.velocity, terms.period)
     n_all = len(q)
-    # An hour's log: the draws run on evenly thinned poses (module doc)
+    thinned = np.arange(n_all)
     if n_all > MAX_POSES:
-        keep = np.unique(np.linspace(0, n_all - 1, MAX_POSES).round().astype(np.intp))
-        r_xyz, r_yaw, g_xyz, g_yaw = r_xyz[keep], r_yaw[keep], g_xyz[keep], g_yaw[keep]
-        vel, yaw_rate, weight, period, raw0 = (
-            vel[keep],
-            yaw_rate[keep],
-            weight[keep],
-            period[keep],
-            raw0[keep],
-        )
-    else:
-        keep = np.arange(n_all)
-    n = len(r_yaw)
-    thin = math.sqrt(n / n_all)
+        thinned = np.unique(np.linspace(0, n_all - 1, MAX_POSES).round().astype(np.intp))
+    err = terms.error
+    d = np.sqrt(err[:, 0] ** 2 + err[:, 1] ** 2 + err[:, 2] ** 2)
     est = np.array([estimates[key] for key in KEYS])
-
-    def errors(gp: F64, gy: F64) -> F64:
-        """(draws, S) statistics of perturbed GT poses, as metrics() computes them."""
-        d = np.sqrt(np.sum(np.square(gp - r_xyz), axis=-1))
-        pi = math.pi
-        dyaw = np.abs(np.remainder(r_yaw - gy + pi, 2 * pi) - pi)
-        raw = np.abs(raw0 + (np.remainder(g_yaw - gy + pi, 2 * pi) - pi))
-        pct = np.percentile(d, PERCENTILES, axis=-1).T  # PERCENTILES[0] is the median
-        return np.column_stack(
-            [
-                d.mean(axis=-1),
-                np.arctan2(np.sin(dyaw).sum(axis=-1), np.cos(dyaw).sum(axis=-1)),
-                np.sqrt(np.mean(np.square(d), axis=-1)),
-                pct[:, 0],
-                d.max(axis=-1),
-                pct,
-                np.arctan2(np.sin(raw).sum(axis=-1), np.cos(raw).sum(axis=-1)),
-            ]
-        )
-
-    base = errors(g_xyz[None], g_yaw[None])[0]
-    # The offset's effect: the comparison re-scored by the score's own association and
-    # metrics at shifts of the offset (every robot pose inside the GT, compared or not: a
-    # shift moves a pose into a tracking loss or out of one, across a GT sample or next
-    # to a stale one, as the score at that offset would), on a grid the draws interpolate
-    grid = np.linspace(-OFFSET_SPAN, OFFSET_SPAN, OFFSET_GRID) * off_sigma + off_centre
+    # The offset's effect, centred on the offset applied: the comparison re-scored by the
+    # score's own association and metrics at shifts of it (every robot pose inside the GT,
+    # compared or not), on a grid the draws interpolate
+    grid = np.linspace(-OFFSET_SPAN, OFFSET_SPAN, OFFSET_GRID) * off_sigma
     on_grid = np.zeros((OFFSET_GRID, est.size))
     if off_sigma > 0.0:
         on_grid = offset_effects(rescoring, t, grid)
+    mean_cols = list(MEAN_LIKE)
+
+    closed: dict[tuple[bool, bool], list[Callable[[F64], F64]]] = {}
+    bands: dict[tuple[bool, bool], tuple[list[OrderStat], F64]] = {}
 
     def perturbed(rng: np.random.Generator, sources: frozenset[str], draws: int) -> F64:
         """Draws whose basic (reflected) interval is the interval wanted (module doc):
         measurement-like perturbations as re-computed scores, the offset's mirrored."""
-        chunk = max(1, CHUNK_ELEMENTS // max(n, 1))
         noise = MOCAP_NOISE in sources
         timing = TIME_ASSOCIATION in sources
+        frame = timing and lag is not None
         measured = np.zeros((draws, est.size))
+        z = rng.standard_normal((draws, len(mean_cols)))
+        if noise or frame:
+            key = (noise, frame)  # the same closed forms and bands in two passes
+            if key not in closed:
+                closed[key] = terms.mean_like(noise, frame)
+                bands[key] = order_stats(d, thinned, terms.bounds(noise, frame), ORDER_STATS)
+            for j, (col, value) in enumerate(zip(mean_cols, closed[key], strict=True)):
+                measured[:, col] = value(z[:, j]) - est[col]
+            stats, base = bands[key]
+            got = draw_order_stats(
+                stats, distances, rng, draws, noise=noise, lag=lag if frame else None
+            )
+            got -= base
+            for k, st in enumerate(stats):
+                for col in st.columns:
+                    measured[:, col] = got[:, k]
         offset = np.zeros((draws, est.size))
-        for start in range(0, draws, chunk):
-            m = min(chunk, draws - start)
-            rows = slice(start, start + m)
-            if noise or (timing and frame_term):
-                gp = np.broadcast_to(g_xyz, (m, n, 3)).copy()
-                gy = np.broadcast_to(g_yaw, (m, n)).copy()
-                if noise:
-                    # drawn in float32 (the stream the calibration was measured with;
-                    # seven digits of a noise sample are plenty), added in float64
-                    gp += rng.standard_normal((m, n, 3), dtype=np.float32) * (
-                        sig.position * weight[None, :, None]
-                    )
-                    gy += rng.standard_normal((m, n), dtype=np.float32) * (sig.yaw * weight)
-                if timing and frame_term:
-                    lag = rng.uniform(lag_lo, lag_hi, (m, n)) * period
-                    gp += lag[..., None] * vel
-                    gy += lag * yaw_rate
-                measured[rows] = errors(gp, gy) - base
-            if timing and off_sigma > 0.0:
-                shift = rng.standard_normal(m) * off_sigma + off_centre
-                # one shift for every pose: the statistics are a function of it alone,
-                # re-scored on the grid and interpolated (the grid's step, a tenth of the
-                # sd, is much finer than the draws' spread)
-                offset[rows] = np.column_stack(
-                    [np.interp(shift, grid, on_grid[:, j]) for j in range(est.size)]
-                )
-        if thin < 1.0:
-            # per-pose noise averages over all the poses of a mean-like statistic, not only
-            # over the thinned ones: its spread (not its bias) scales with sqrt(n / N)
-            bias = measured[:, MEAN_LIKE].mean(axis=0)
-            measured[:, MEAN_LIKE] = bias + (measured[:, MEAN_LIKE] - bias) * thin
+        if timing and off_sigma > 0.0:
+            shift = rng.standard_normal(draws) * off_sigma
+            # one shift for every pose: the statistics are a function of it alone,
+            # re-scored on the grid and interpolated (the grid's step, a tenth of the sd,
+            # is much finer than the draws' spread)
+            for j in range(est.size):
+                offset[:, j] = np.interp(shift, grid, on_grid[:, j])
         # mirrored: the offset is not a measurement of the truth plus an error that the
         # draws add again; the truth's offset is spread around the applied one as the draws
         # are, so the reflection of the basic interval must not apply to it
         return np.asarray(est + measured - offset, dtype=np.float64)
 
     sources = [MOCAP_NOISE]
-    if off_sigma > 0.0 or frame_term:
+    if off_sigma > 0.0 or lag is not None:
         sources.append(TIME_ASSOCIATION)
     got = monte_carlo(
         est,
@@ -483,20 +578,17 @@ def trajectory_intervals(
             parts.append(
                 f"clock offset sd {off_sigma * 1000:.3f} ms (standard error of the "
                 "least-squares offset, the robot's error slid along the path by every lag), "
-                f"centred {off_centre * 1000:+.3f} ms from the applied "
-                "one (the clock audit's estimate); mirrored: drawn as the truth's offset"
+                "centred on the offset applied; mirrored: drawn as the truth's offset"
             )
         else:
             parts.append(f"no offset estimate (clock audit: {audit.note or 'none'})")
-        if frame_term:
+        if lag is not None:
             med = float(np.median(period)) * 1000
             parts.append(
                 f"{association}: GT frame period {med:.2f} ms (lag uniform over "
-                f"[{lag_lo:g}, {lag_hi:g}] periods)"
+                f"[{lag[0]:g}, {lag[1]:g}] periods)"
             )
         src.append(Source(TIME_ASSOCIATION, off_sigma, "s", off_sigma > 0.0, "; ".join(parts)))
-    elif audit.uncertainty_s is None:
-        pass
     unc = Uncertainty(
         confidence=settings.confidence,
         method=METHOD_TRAJECTORY,

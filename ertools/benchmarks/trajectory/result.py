@@ -32,7 +32,7 @@ from ertools.benchmarks.trajectory.association import (
 )
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.benchmarks.trajectory.formula import Metrics
-from ertools.benchmarks.trajectory.intervals import KEYS
+from ertools.benchmarks.trajectory.intervals import FITTED_KEYS, FITTED_SUFFIX, KEYS
 from ertools.fidelity import Deviation
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import NS_PER_S, ns_to_s
@@ -40,6 +40,37 @@ from ertools.timeutil import NS_PER_S, ns_to_s
 # The summary table's statistics that get ``_low``/``_high`` columns (the percentiles have
 # their own table).
 INTERVAL_COLUMNS = tuple(k for k in KEYS if not k.startswith("percentiles."))
+
+
+@dataclass(frozen=True)
+class FittedScore:
+    """The statistics at the clock offset the audit fits, where the score used another one
+    the data disagrees with: what ``--offset auto --apply-offset`` would score, beside the
+    score (``<key>_at_fitted_offset`` and its interval).
+
+    Attributes:
+        offset_ns: the fitted offset.
+        metrics: the statistics there.
+        intervals: the intervals of :data:`~ertools.benchmarks.trajectory.intervals.
+            FITTED_KEYS` there, centred on that offset.
+        withheld: why a key of those has no interval (too few poses compared there).
+    """
+
+    offset_ns: int
+    metrics: Metrics
+    intervals: Mapping[str, Interval | None]
+    withheld: Mapping[str, str] = field(default_factory=dict)
+
+    def values(self) -> dict[str, float]:
+        m = self.metrics
+        every = {
+            "position_error": m.position_error,
+            "orientation_error": m.orientation_error,
+            "rmse": m.rmse,
+            "median": m.median,
+            "max": m.max,
+        }
+        return {k: every[k] for k in FITTED_KEYS}
 
 
 @dataclass(frozen=True, eq=False)
@@ -61,6 +92,8 @@ class TrajectoryResult(ResultBase):
             ``percentiles.p95``...; :mod:`ertools.benchmarks.trajectory.intervals`); empty
             with ``--draws 0``.
         uncertainty: how the intervals were obtained (None without intervals).
+        fitted: the statistics at the offset the clock audit fits, where the score used one
+            the data disagrees with (with intervals only; None otherwise).
     """
 
     robot_file: str
@@ -84,6 +117,7 @@ class TrajectoryResult(ResultBase):
     unscoreable_reason: str | None = None
     intervals: Mapping[str, Interval | None] = field(default_factory=dict)
     uncertainty: Uncertainty | None = None
+    fitted: FittedScore | None = None
 
     @property
     def nothing_scored(self) -> bool:
@@ -184,6 +218,8 @@ class TrajectoryResult(ResultBase):
             data["unscoreable_reason"] = self.unscoreable_reason
         if self.intervals:
             data = interval_keys(data, self.intervals)
+            if self.fitted is not None:
+                data = _with_fitted(data, self.fitted)
             if isinstance(data["percentiles"], dict):
                 pct = {k.split(".", 1)[1]: v for k, v in self.intervals.items() if "." in k}
                 data["percentiles"] = interval_keys(data["percentiles"], pct)
@@ -276,4 +312,40 @@ def notes(result: TrajectoryResult) -> list[str]:
         ScoreRow("max", m.max, iv.get("max"), 1000.0, "mm"),
         ScoreRow("orientation_error", m.orientation_error, iv.get("orientation_error"), 1.0, "rad"),
     ]
+    fit = result.fitted
+    if fit is not None:
+        # the score at the offset the data fits, beside the clock audit's warning
+        fi = fit.intervals
+        suffix = FITTED_SUFFIX
+        rows += [
+            ScoreRow(
+                f"position_error{suffix}",
+                fit.metrics.position_error,
+                fi.get("position_error"),
+                1000.0,
+                "mm",
+            ),
+            ScoreRow(
+                f"orientation_error{suffix}",
+                fit.metrics.orientation_error,
+                fi.get("orientation_error"),
+                1.0,
+                "rad",
+            ),
+        ]
     return interval_lines(rows, result.uncertainty)
+
+
+def _with_fitted(data: dict[str, Any], fitted: FittedScore) -> dict[str, Any]:
+    """``data`` with ``K_at_fitted_offset`` and its interval after ``K_interval`` for each
+    statistic of the fitted score."""
+    values = fitted.values()
+    out: dict[str, Any] = {}
+    for key, value in data.items():
+        out[key] = value
+        base = key.removesuffix("_interval")
+        if key.endswith("_interval") and base in values:
+            iv = fitted.intervals.get(base)
+            out[f"{base}{FITTED_SUFFIX}"] = values[base]
+            out[f"{base}{FITTED_SUFFIX}_interval"] = None if iv is None else iv.as_list()
+    return out

@@ -21,14 +21,99 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ertools.arrays import F64, I32, I64, Bool
 from ertools.errors import TopicError
 from ertools.geometry import compose, interpolate_poses, invert
+from ertools.io.decode.posebatch import PoseBatch
 from ertools.streams import PoseStream
 
 
 def frame_key(name: str) -> str:
     """Frame names as tf2 compares them (no leading slash)."""
     return name.lstrip("/")
+
+
+def _one_code(codes: I32) -> bool:
+    """Whether frame codes are one value broadcast (a bulk read of one frame pair)."""
+    return len(codes) > 0 and codes.strides == (0,)
+
+
+def edge_keys(batch: PoseBatch) -> set[tuple[str, str]]:
+    """The (parent, child) edges of a tf batch, frame names as tf2 compares them."""
+    if not len(batch):
+        return set()
+    frames = [frame_key(f) for f in batch.frames]
+    if _one_code(batch.frame_idx) and _one_code(batch.child_idx):
+        return {(frames[int(batch.frame_idx[0])], frames[int(batch.child_idx[0])])}
+    pairs = batch.frame_idx.astype(np.int64) * len(frames) + batch.child_idx
+    codes = np.flatnonzero(np.bincount(pairs, minlength=len(frames) ** 2)).tolist()
+    return {(frames[c // len(frames)], frames[c % len(frames)]) for c in codes}
+
+
+def edges_overlap(batches: list[PoseBatch]) -> bool:
+    """Whether two of the batches (a topic's publishers) hold the same edge."""
+    seen: set[tuple[str, str]] = set()
+    for batch in batches:
+        keys = edge_keys(batch)
+        if keys & seen:
+            return True
+        seen |= keys
+    return False
+
+
+def split_edges(
+    batch: PoseBatch, source: str, own: bool
+) -> list[tuple[tuple[str, str], int, PoseStream]]:
+    """The transforms of a tf batch as one stream per (parent, child) edge, with its number
+    of rows, in the order of the edges' frame codes. With ``own`` (the batch is the caller's
+    to consume) the edge of most rows (a body beside a static transform) is moved up in the
+    batch's own arrays rather than copied."""
+    frames = [frame_key(f) for f in batch.frames]
+    if _one_code(batch.frame_idx) and _one_code(batch.child_idx):
+        # one edge (a publisher of one transform): its rows are the batch's, nothing to split
+        key = (frames[int(batch.frame_idx[0])], frames[int(batch.child_idx[0])])
+        t, xyz, quat = batch.t_header, batch.xyz, batch.quat_xyzw
+        if not own:
+            t, xyz, quat = t.copy(), xyz.copy(), quat.copy()
+        return [(key, len(batch), PoseStream(t, xyz, quat, key[0], key[1], source))]
+    pairs = batch.frame_idx.astype(np.int64) * len(frames) + batch.child_idx
+    # a few (parent, child) pairs: one comparison each rather than a sort of every row
+    counts = np.bincount(pairs, minlength=len(frames) ** 2) if len(pairs) else pairs
+    codes = np.flatnonzero(counts).tolist()
+    biggest = max(codes, key=lambda c: int(counts[c])) if codes else -1
+    found: dict[int, tuple[I64, F64, F64]] = {}
+    for code in codes:
+        if code != biggest or not own:
+            rows = pairs == code
+            found[code] = (batch.t_header[rows], batch.xyz[rows], batch.quat_xyzw[rows])
+    if codes and own:
+        found[biggest] = _compacted(batch, pairs == biggest if len(codes) > 1 else None)
+    out = []
+    for code in codes:
+        key = (frames[code // len(frames)], frames[code % len(frames)])
+        t, xyz, quat = found[code]
+        out.append((key, int(counts[code]), PoseStream(t, xyz, quat, key[0], key[1], source)))
+    return out
+
+
+# Rows moved per step when an edge is compacted in place (a temporary of this many rows).
+_COMPACT_ROWS = 1 << 16
+
+
+def _compacted(batch: PoseBatch, keep: Bool | None) -> tuple[I64, F64, F64]:
+    """The stamps and poses of the rows ``keep`` (None: all), moved to the front of the
+    batch's own arrays a block at a time: the rows of a block are taken (whole rows at a time)
+    before any is written, and each row only moves forward, past rows already read."""
+    arrays = (batch.t_header, batch.xyz, batch.quat_xyzw)
+    if keep is None:
+        return arrays
+    rows = np.flatnonzero(keep)
+    for start in range(0, len(rows), _COMPACT_ROWS):
+        part = rows[start : start + _COMPACT_ROWS]
+        for a in arrays:
+            a[start : start + len(part)] = np.take(a, part, axis=0)
+    n = len(rows)
+    return batch.t_header[:n], batch.xyz[:n], batch.quat_xyzw[:n]
 
 
 @dataclass(frozen=True)

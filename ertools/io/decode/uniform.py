@@ -15,13 +15,13 @@ by field, which handles every layout the standard definitions allow.
 
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import I64, U8
-from ertools.geometry import quat_from_yaw
+from ertools.arrays import I64, U8, Bool
 from ertools.io.decode.fast import Decoded, gather
 
 # Odometry after its pose: pose covariance (36), twist (6), twist covariance (36) float64.
@@ -46,6 +46,7 @@ class Layout:
     fixed: tuple[tuple[int, int], ...]
     frame: str
     child: str | None
+    ref: bytes  # the message the layout was learnt from: the bytes ``fixed`` must repeat
 
 
 @dataclass(frozen=True, eq=False)
@@ -155,7 +156,7 @@ def layout_of(msgtype: str, cdr: bool, raw: bytes) -> Layout | None:
         start = b
     if start < len(raw):
         fixed.append((start, len(raw)))
-    return Layout(len(raw), stamp, values_at, values, tuple(fixed), frame, child)
+    return Layout(len(raw), stamp, values_at, values, tuple(fixed), frame, child, raw)
 
 
 def _column(rows: U8, offset: int, dtype: str, count: int = 1) -> npt.NDArray[np.generic]:
@@ -167,22 +168,108 @@ def _column(rows: U8, offset: int, dtype: str, count: int = 1) -> npt.NDArray[np
     return np.ndarray((n, count), dtype=dtype, buffer=rows, offset=offset, strides=(size, step))
 
 
-def _same_bytes(rows: U8, a: int, b: int) -> bool:
-    """Whether bytes [a, b) of every row equal those of the first row.
+def _words(lay: Layout) -> list[tuple[int, str, int]]:
+    """(offset, dtype, value) of the words that cover the layout's fixed ranges: 8 bytes, or
+    4, 2, 1 for shorter ranges; the last word overlaps the one before when a range is not a
+    multiple of it."""
+    out: list[tuple[int, str, int]] = []
+    for a, b in lay.fixed:
+        width = next(w for w in (8, 4, 2, 1) if w <= b - a)
+        starts = list(range(a, b - width + 1, width))
+        if starts[-1] != b - width:
+            starts.append(b - width)
+        out.extend(
+            (at, f"<u{width}", int.from_bytes(lay.ref[at : at + width], "little")) for at in starts
+        )
+    return out
 
-    Compared a word at a time (8 bytes, or 4, 2, 1 for shorter ranges; the last word
-    overlaps the one before when the range is not a multiple of it), so the cost is a few
-    strided reads per row, not one per byte.
+
+def same_structure(rows: U8, skip: int, lay: Layout, member: Bool | None = None) -> bool:
+    """Whether every row (a message from byte ``skip`` on; with ``member``, every row where
+    it is True) has the bytes of ``lay.ref`` where the layout's fixed ranges are (string
+    lengths and names, CDR header and padding, the TF transform count).
+
+    Compared a word at a time, so the cost is a few strided reads per row, not one per byte.
     """
-    width = next(w for w in (8, 4, 2, 1) if w <= b - a)
-    starts = list(range(a, b - width + 1, width))
-    if starts[-1] != b - width:
-        starts.append(b - width)  # the last word overlaps the one before
-    for at in starts:
-        col = _column(rows, at, f"<u{width}")
-        if not bool(np.all(col == col[0])):
-            return False
-    return True
+    if not len(rows):
+        return True
+    bad: Bool | None = None
+    for at, kind, want in _words(lay):
+        differs = _column(rows, skip + at, kind) != want
+        if member is None:
+            if bool(differs.any()):
+                return False
+        else:
+            bad = differs if bad is None else np.logical_or(bad, differs, out=bad)
+    return member is None or bad is None or not bool(np.any(bad & member))
+
+
+# Raw bytes are copied into float64 arrays as they are (one copy per row and block, faster
+# than field by field) only where float64 is little-endian in memory, as ROS1 and CDR store it.
+_RAW_COPY = np.dtype(np.float64).byteorder == "=" and sys.byteorder == "little"
+
+
+def _copy_floats(dst: npt.NDArray[np.float64], rows: U8, offset: int) -> None:
+    """``dst`` (n, k) float64 from the k little-endian float64 at ``offset`` of each row."""
+    n, k = dst.shape
+    if not n:
+        return
+    if _RAW_COPY and dst.flags.c_contiguous:
+        block = np.dtype((np.void, 8 * k))
+        width = rows.shape[1]
+        src = np.ndarray((n,), dtype=block, buffer=rows, offset=offset, strides=(width,))
+        dst.view(block).reshape(n)[...] = src
+    else:
+        dst[...] = _column(rows, offset, "<f8", k)
+
+
+def write_rows(rows: U8, skip: int, lay: Layout, out: Rows) -> None:
+    """Stamps and poses of every row (its message from byte ``skip`` on, in layout ``lay``,
+    checked with :func:`same_structure`) into ``out``. Types without a header get stamp 0
+    (their time is the record time)."""
+    if lay.stamp is not None:
+        sec_at, nsec_at, sec_type = lay.stamp
+        np.multiply(
+            _column(rows, skip + sec_at, sec_type), 1_000_000_000, out=out.t_header, dtype=np.int64
+        )
+        np.add(out.t_header, _column(rows, skip + nsec_at, "<u4"), out=out.t_header)
+        _copy_floats(out.xyz, rows, skip + lay.values_at)
+        _copy_floats(out.quat, rows, skip + lay.values_at + 24)
+    else:
+        out.t_header[...] = 0
+        values = _column(rows, skip + lay.values_at, "<f8", lay.values)
+        out.xyz[:, :2] = values[:, :2]
+        out.xyz[:, 2] = 0.0
+        # (rows of other messages, overwritten afterwards, may hold any bits: no warnings)
+        with np.errstate(all="ignore"):
+            # quat_from_yaw's own operations on the same contiguous input (the same bits),
+            # written into place rather than stacked
+            half = 0.5 * np.array(values[:, 2], dtype=np.float64)
+            out.quat[:, :2] = 0.0
+            out.quat[:, 2] = np.sin(half)
+            out.quat[:, 3] = np.cos(half)
+
+
+def decoded(lay: Layout, out: Rows) -> Decoded:
+    """The :class:`Decoded` of rows written by :func:`write_rows` (one frame name each)."""
+    n = len(out.t_header)
+    empty = np.zeros(n, dtype=np.int64)
+    child = None if lay.child is None else (empty, empty)
+    return Decoded(
+        np.arange(n, dtype=np.int64),
+        out.t_header,
+        out.xyz,
+        out.quat,
+        (empty, empty),
+        child,
+        has_header=lay.stamp is not None,
+        frame_text=lay.frame,
+        child_text=lay.child,
+    )
+
+
+def empty_rows(n: int) -> Rows:
+    return Rows(np.empty(n, np.int64), np.empty((n, 3)), np.empty((n, 4)))
 
 
 def decode_uniform(
@@ -204,37 +291,8 @@ def decode_uniform(
     if int(start.min()) < 0 or int(start.max()) + lay.size > len(buf):
         return None
     rows = gather(buf, start, lay.size)
-    if not all(_same_bytes(rows, a, b) for a, b in lay.fixed):
+    if not same_structure(rows, 0, lay):
         return None
-    out = (
-        into
-        if into is not None
-        else Rows(np.empty(n, np.int64), np.empty((n, 3)), np.empty((n, 4)))
-    )
-    values = _column(rows, lay.values_at, "<f8", lay.values)
-    if lay.stamp is not None:
-        sec_at, nsec_at, sec_type = lay.stamp
-        np.multiply(
-            _column(rows, sec_at, sec_type), 1_000_000_000, out=out.t_header, dtype=np.int64
-        )
-        np.add(out.t_header, _column(rows, nsec_at, "<u4"), out=out.t_header)
-        out.xyz[...] = values[:, :3]
-        out.quat[...] = values[:, 3:]
-    else:
-        out.t_header[...] = 0
-        out.xyz[:, :2] = values[:, :2]
-        out.xyz[:, 2] = 0.0
-        out.quat[...] = quat_from_yaw(np.array(values[:, 2], dtype=np.float64)).reshape(n, 4)
-    empty = np.zeros(n, dtype=np.int64)
-    child = None if lay.child is None else (empty, empty)
-    return Decoded(
-        np.arange(n, dtype=np.int64),
-        out.t_header,
-        out.xyz,
-        out.quat,
-        (empty, empty),
-        child,
-        has_header=lay.stamp is not None,
-        frame_text=lay.frame,
-        child_text=lay.child,
-    )
+    out = into if into is not None else empty_rows(n)
+    write_rows(rows, 0, lay, out)
+    return decoded(lay, out)

@@ -18,27 +18,35 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, BinaryIO
 
 import numpy as np
+import numpy.typing as npt
 
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
 from ertools.inputs import open_regular
 from ertools.io import pipeline
 from ertools.io.bagfile import BagFile
-from ertools.io.decode.fast import LayoutMismatchError, gather
+from ertools.io.decode.fast import LayoutMismatchError
 from ertools.io.decode.fast import read_at as read_fields
 from ertools.io.inflate import check_declared, inflate_into
 from ertools.io.mcap.crc import crc32
+from ertools.io.mcap.records import McapRecords
 from ertools.io.mcap.scan import SCAN, mcap_layout, scan_mcap
 from ertools.io.mcap.summary import decompress, file_size, read_summary
 from ertools.io.model import Conn
-from ertools.io.pipeline import Group, group_positions, pread, read_at, scratch_view
+from ertools.io.pipeline import (
+    Group,
+    Request,
+    Run,
+    group_positions,
+    in_window,
+    pread,
+    read_at,
+    scratch_view,
+    window,
+)
 
 if TYPE_CHECKING:
     from ertools.progress import Reporter
-
-# Op codes a chunk may hold (schema 0x03, channel 0x04, message 0x05), as a lookup table.
-_RECORD_STARTS = np.zeros(256, dtype=bool)
-_RECORD_STARTS[[3, 4, 5]] = True
 
 log = logging.getLogger("ertools.io.mcap.index")
 
@@ -92,15 +100,32 @@ class McapPlan:
     t_record: I64
     offset: I64
     key: I64  # file << 32 | chunk index
-    file: I64
     chunks: list[list[Any]]
+    channel: npt.NDArray[np.uint16]
+
+    def by_key(self) -> dict[int, slice | I64]:
+        """The messages of each chunk (by key): a slice of the plan when its messages are in
+        chunk order (one channel logged in time order), else their positions."""
+        key = self.key
+        if not len(key):
+            return {}
+        if bool(np.all(key[1:] >= key[:-1])):
+            cuts = np.flatnonzero(key[1:] != key[:-1]) + 1
+            starts = [0, *cuts.tolist()]
+            ends = [*cuts.tolist(), len(key)]
+            return {int(key[a]): slice(a, b) for a, b in zip(starts, ends, strict=True)}
+        return dict(group_positions(key))
 
 
 class McapIndex:
     """Chunk-level access to one or more MCAP files (a rosbag2 directory may hold several)."""
 
-    def __init__(self, files: list[Path]) -> None:
+    def __init__(self, files: list[Path], by_id: bool = False) -> None:
+        """``by_id``: a request's connections are the file's channels (a standalone MCAP
+        file), so a request wants exactly their ids; otherwise (rosbag2, one connection per
+        topic over several files) it wants every channel on their topics."""
         self.files = files
+        self.by_id = by_id
 
     @staticmethod
     def of(bag: BagFile) -> McapIndex | None:
@@ -108,20 +133,25 @@ class McapIndex:
         directory's files come from :func:`ertools.io.bulk.mcap_index`, which knows how
         the directory stores them)."""
         if bag.format == "mcap":
-            return McapIndex([bag.path])
+            return McapIndex([bag.path], by_id=True)
         return None
 
     def plan(self, conns: Sequence[Conn], lo: int | None, hi: int | None) -> McapPlan:
-        """Locate the messages of ``conns`` in [lo, hi] from the message indexes (no chunk data).
+        """Locate the messages of ``conns`` in [lo, hi]: one request of :meth:`plan_many`."""
+        return self.plan_many([Request(tuple(conns), lo, hi)])[0]
+
+    def plan_many(self, requests: Sequence[Request]) -> list[McapPlan]:
+        """Locate the messages of each request (connections, log-time window) from the message
+        indexes, each in its reference order, reading every message index once (no chunk data).
 
         Raises:
             BagError: damaged index.
             LayoutMismatchError: a file's indexes do not answer for every message (no summary,
                 no message indexes, channels only inside chunks...): the caller falls back.
         """
-
-        topics = {c.topic for c in conns}
-        sels: list[tuple[int, int, int, I64, I64]] = []  # file, chunk idx, chunk offset, t, off
+        lo, hi = window(requests)
+        # per request: file, chunk idx, chunk offset, t, off, channel of each run of entries
+        sels: list[list[tuple[int, int, int, I64, I64, int]]] = [[] for _ in requests]
         chunks_per_file: list[list[Any]] = []
         for fi, path in enumerate(self.files):
             layout = mcap_layout(path)
@@ -129,11 +159,18 @@ class McapIndex:
                 raise LayoutMismatchError(f"MCAP file {path.name}: {layout.why}")
             summary: Any = layout.summary
             with open_regular(path) as f:
-                channels = {cid for cid, ch in layout.channels.items() if ch.topic in topics}
+                # channel -> the requests that want it
+                wants: dict[int, list[int]] = {}
+                for ri, req in enumerate(requests):
+                    topics = {c.topic for c in req.conns}
+                    ids = {c.id for c in req.conns}
+                    for cid, ch in layout.channels.items():
+                        if (cid in ids) if self.by_id else (ch.topic in topics):
+                            wants.setdefault(cid, []).append(ri)
                 chunks = summary.chunk_indexes
                 chunks_per_file.append(chunks)
                 total_size = file_size(f)
-                planned = dict.fromkeys(channels, 0)  # messages per channel, for the statistics
+                planned = dict.fromkeys(wants, 0)  # messages per channel, for the statistics
                 for ci, chunk in enumerate(chunks):
                     if lo is not None and chunk.message_end_time < lo:
                         continue
@@ -152,7 +189,7 @@ class McapIndex:
                             "names a channel the summary section does not declare",
                             path=path,
                         )
-                    wanted = [c for c in channels if c in chunk.message_index_offsets]
+                    wanted = [c for c in wants if c in chunk.message_index_offsets]
                     if not wanted:
                         if chunk.message_index_length == 0 and chunk.uncompressed_size:
                             raise LayoutMismatchError("MCAP chunk without message indexes")
@@ -160,37 +197,16 @@ class McapIndex:
                     for cid in wanted:
                         offset = chunk.message_index_offsets[cid]
                         t, off = self._message_index(f, path, offset, cid, total_size, padded=False)
-                        if lo is not None or hi is not None:
-                            keep = np.ones(len(t), dtype=bool)
-                            if lo is not None:
-                                keep &= t >= lo
-                            if hi is not None:
-                                keep &= t <= hi
-                            t, off = t[keep], off[keep]
                         planned[cid] = planned.get(cid, 0) + len(t)
-                        if len(t):
-                            sels.append((fi, ci, int(chunk.chunk_start_offset), t, off))
+                        for ri in wants[cid]:
+                            keep = in_window(t, requests[ri].lo, requests[ri].hi)
+                            tk, ok = (t, off) if keep is None else (t[keep], off[keep])
+                            if len(tk):
+                                start = int(chunk.chunk_start_offset)
+                                sels[ri].append((fi, ci, start, tk, ok, cid))
             if lo is None and hi is None:
                 _check_counts(path, summary, planned)
-        if not sels:
-            e = np.empty(0, np.int64)
-            return McapPlan(e, e, e, e, chunks_per_file)
-        t_all = np.concatenate([s[3] for s in sels])
-        off_all = np.concatenate([s[4] for s in sels])
-        # file, chunk and chunk offset of every row: one repeat each, not an array per chunk
-        counts = np.array([len(s[3]) for s in sels], dtype=np.int64)
-        key = np.repeat(np.array([(s[0] << 32) + s[1] for s in sels], dtype=np.int64), counts)
-        file_all = key >> 32
-        # the mcap library's order: log time, then file, chunk position, record position. One
-        # channel logged in time order is in that order already: no sort (times that strictly
-        # increase need no other key).
-        if bool(np.all(t_all[1:] > t_all[:-1])):
-            return McapPlan(t_all, off_all, key, file_all, chunks_per_file)
-        cstart_all = np.repeat(np.array([s[2] for s in sels], dtype=np.int64), counts)
-        if _in_order(t_all, file_all, cstart_all, off_all):
-            return McapPlan(t_all, off_all, key, file_all, chunks_per_file)
-        order = np.lexsort((off_all, cstart_all, file_all, t_all))
-        return McapPlan(t_all[order], off_all[order], key[order], file_all[order], chunks_per_file)
+        return [_ordered(s, chunks_per_file) for s in sels]
 
     def all_chunks(self) -> list[tuple[Path, Any]]:
         """(file, chunk index record) of every chunk, in file order."""
@@ -203,55 +219,84 @@ class McapIndex:
         return out
 
     def run_loader(
-        self, plan: McapPlan
-    ) -> tuple[int, Callable[[int, list[Any]], tuple[I64, U8, I64, I64]], list[int]]:
+        self, plans: Sequence[McapPlan]
+    ) -> tuple[int, Callable[[int, list[Any]], list[Run | None]], list[int]]:
         """(number of groups, load, bytes) where ``load(k, scratch)`` decompresses the k-th
-        group of chunks (up to ``GROUP_BYTES`` uncompressed) into ``scratch`` and gives
-        (reference positions, bytes, data starts, data lengths) of the planned messages in
-        it, and ``bytes[k]`` is what that group reads from the file (its chunks' compressed
-        sizes, for progress). ``load`` may run on a worker thread (it opens the file
-        itself)."""
-        todo: list[list[tuple[int, I64]]] = []
+        group of chunks (up to ``GROUP_BYTES`` uncompressed; the chunks any plan needs) into
+        ``scratch`` and gives each plan's :class:`Run` of its messages in it (None when it
+        has none there), and ``bytes[k]`` is what that group reads from the file (its chunks'
+        compressed sizes, for progress). ``load`` may run on a worker thread (it opens the
+        file itself)."""
+        rows_of = [p.by_key() for p in plans]
+        keys = sorted({k for rows in rows_of for k in rows})
+        # a plan of one channel gives its runs that id broadcast (no array per run)
+        single = [
+            int(p.channel[0])
+            if len(p.channel) and bool(np.all(p.channel == p.channel[0]))
+            else None
+            for p in plans
+        ]
+        chunks_of = plans[0].chunks if plans else []
+        todo: list[list[int]] = []
         size = 0
-        for key, rows in group_positions(plan.key):
+        for key in keys:
             if not todo or size >= pipeline.GROUP_BYTES:
                 todo.append([])
                 size = 0
-            todo[-1].append((key, rows))
-            size += int(plan.chunks[key >> 32][key & 0xFFFFFFFF].uncompressed_size)
+            todo[-1].append(key)
+            size += int(chunks_of[key >> 32][key & 0xFFFFFFFF].uncompressed_size)
 
         def chunk_of(key: int) -> tuple[Path, Any]:
-            return self.files[key >> 32], plan.chunks[key >> 32][key & 0xFFFFFFFF]
+            return self.files[key >> 32], chunks_of[key >> 32][key & 0xFFFFFFFF]
 
-        def load(k: int, scratch: list[Any]) -> tuple[I64, U8, I64, I64]:
+        def load(k: int, scratch: list[Any]) -> list[Run | None]:
             part = todo[k]
-            buf, base, sizes = self._group_bytes([chunk_of(key) for key, _ in part], scratch)
-            rows = np.concatenate([r for _k, r in part])
-            which = np.concatenate([np.full(len(r), i) for i, (_k, r) in enumerate(part)])
-            path, first = chunk_of(part[0][0])
+            buf, base, sizes = self._group_bytes([chunk_of(key) for key in part], scratch)
+            path, first = chunk_of(part[0])
             where = f"in {path} in chunks from byte {first.chunk_start_offset}"
-            offsets = plan.offset[rows]
-            # a record inside its chunk: no earlier (here), no later (its end, checked below)
-            if len(offsets) and int(offsets.min()) < 0:
-                raise BagError(f"message index points outside its chunk {where}")
-            limit = base[which] + sizes[which]
-            start, length, log_time = _checked_records(buf, offsets + base[which], limit, where)
-            # The record's own log time must be the index's: a damaged index entry would
-            # otherwise give another record's data (or a wrong time) without a word.
-            if np.any(log_time != plan.t_record[rows]):
-                raise BagError(
-                    f"message index disagrees with the message records' log times {where}"
+            out: list[Run | None] = []
+            for plan, rows_by_key, one in zip(plans, rows_of, single, strict=True):
+                mine = [(i, rows_by_key[key]) for i, key in enumerate(part) if key in rows_by_key]
+                if not mine:
+                    out.append(None)
+                    continue
+                counts = [_count(r) for _i, r in mine]
+                which = np.repeat(np.array([i for i, _r in mine], dtype=np.int64), counts)
+                sel: slice | I64
+                first, last = mine[0][1], mine[-1][1]
+                if all(isinstance(r, slice) for _i, r in mine):
+                    # one range of the plan (its chunks' slices follow each other)
+                    assert isinstance(first, slice) and isinstance(last, slice)
+                    sel = slice(first.start, last.stop)
+                    rows = np.arange(first.start, last.stop, dtype=np.int64)
+                else:
+                    rows = np.concatenate([_positions(r) for _i, r in mine])
+                    sel = rows
+                offsets = plan.offset[sel]
+                # a record inside its chunk: no earlier (here), no later (its end, checked
+                # with the record)
+                if len(offsets) and int(offsets.min()) < 0:
+                    raise BagError(f"message index points outside its chunk {where}")
+                t = plan.t_record[sel]
+                channel = (
+                    plan.channel[sel].astype(np.int64)
+                    if one is None
+                    else np.broadcast_to(np.int64(one), t.shape)
                 )
-            return rows, buf, start, length
+                limit = base[which] + sizes[which]
+                records = McapRecords(buf, offsets + base[which], limit, t, channel, where)
+                consecutive = isinstance(sel, slice)
+                out.append(Run(rows, buf, t, channel, records, consecutive=consecutive))
+            return out
 
-        weights = [sum(int(chunk_of(key)[1].compressed_size) for key, _ in part) for part in todo]
+        weights = [sum(int(chunk_of(key)[1].compressed_size) for key in part) for part in todo]
         return len(todo), load, weights
 
     def messages(
         self, conns: Sequence[Conn], lo: int | None, hi: int | None
     ) -> list[tuple[int, int, int, bytes]]:
-        """(file index, channel id, log time, data) of every message on the topics of
-        ``conns`` in [lo, hi], in the reference order: the per-message path, through the same
+        """(file index, channel id, log time, data) of every message ``conns`` want (see
+        ``by_id``) in [lo, hi], in the reference order: the per-message path, through the same
         bounded chunk loads as the fast path (the ``mcap`` library's own decompression trusts
         a zstd frame's stated size, however large).
 
@@ -260,18 +305,23 @@ class McapIndex:
             LayoutMismatchError: as :meth:`plan`.
         """
         plan = self.plan(conns, lo, hi)
-        count, load, _weights = self.run_loader(plan)
+        count, load, _weights = self.run_loader([plan])
         n = len(plan.t_record)
         data: list[bytes] = [b""] * n
         channel = np.zeros(n, dtype=np.int64)
         scratch: list[Any] = []
         for k in range(count):
-            rows, buf, start, length = load(k, scratch)
+            run = load(k, scratch)[0]
+            if run is None:
+                continue
+            start, length = run.spans()
+            rows, buf = run.pos, run.buf
             # a record's channel id follows its op code and length
             channel[rows] = read_fields(buf, start - MESSAGE_FIXED, np.dtype("<u2"))
             for row, a, m in zip(rows.tolist(), start.tolist(), length.tolist(), strict=True):
                 data[row] = bytes(buf[a : a + m])
-        files, times, channels = plan.file.tolist(), plan.t_record.tolist(), channel.tolist()
+        files = (plan.key >> 32).tolist()
+        times, channels = plan.t_record.tolist(), channel.tolist()
         return list(zip(files, channels, times, data, strict=True))
 
     @staticmethod
@@ -447,39 +497,36 @@ class McapIndex:
         return start, length
 
 
-# A message record's head: op code (1), record length (8), channel id (2), sequence (4), log
-# time (8).
-_HEAD = 1 + 8 + 2 + 4 + 8
+def _count(rows: slice | I64) -> int:
+    return rows.stop - rows.start if isinstance(rows, slice) else len(rows)
 
 
-def _checked_records(buf: U8, off: I64, limit: I64, where: str) -> tuple[I64, I64, I64]:
-    """(data start, data length, log time) of the message records at ``off``, each checked
-    to be a message record that ends at ``limit`` (its chunk's end) or where another record a
-    chunk may hold (schema, channel, message) begins: a damaged record length would give a
-    message bytes that are not its own, where the mcap library loses the rest of the chunk.
+def _positions(rows: slice | I64) -> I64:
+    return np.arange(rows.start, rows.stop, dtype=np.int64) if isinstance(rows, slice) else rows
 
-    The heads are gathered once as raw bytes (one copy per record; a structured dtype
-    copies field by field, 4x slower) and the fields read as strided columns of them.
-    """
-    n = len(off)
-    if n and (int(off.min()) < 0 or int(off.max()) + _HEAD > len(buf)):
-        raise BagError(f"message index points outside its chunk {where}")
-    head = gather(buf, off, _HEAD)
-    if np.any(head[:, 0] != OP_MESSAGE):
-        raise BagError(f"message index points at a record that is no message {where}")
-    rlen = np.ndarray((n,), "<u8", buffer=head, offset=1, strides=(_HEAD,)).astype(np.int64)
-    start = off + 9 + MESSAGE_FIXED
-    length = rlen - MESSAGE_FIXED
-    end = start + length
-    if len(off) and (int(length.min()) < 0 or np.any(end > limit)):
-        raise BagError(f"message record cut off inside its chunk {where}")
-    # the byte after each record (clipped to the buffer: a record ending at its chunk's end,
-    # the buffer's last chunk included, needs no next record)
-    after = buf[np.minimum(end, len(buf) - 1)]
-    if not np.all(_RECORD_STARTS[after] | (end == limit)):
-        raise BagError(f"message record length runs into no record {where}")
-    log_time = np.ndarray((n,), "<u8", buffer=head, offset=15, strides=(_HEAD,))
-    return start, length, log_time.astype(np.int64)
+
+def _ordered(sels: list[tuple[int, int, int, I64, I64, int]], chunks: list[list[Any]]) -> McapPlan:
+    """One request's located messages in the mcap library's order: log time, then file,
+    chunk position, record position."""
+    if not sels:
+        e = np.empty(0, np.int64)
+        return McapPlan(e, e, e, chunks, np.empty(0, np.uint16))
+    t_all = np.concatenate([s[3] for s in sels])
+    off_all = np.concatenate([s[4] for s in sels])
+    # file, chunk and chunk offset of every row: one repeat each, not an array per chunk
+    counts = np.array([len(s[3]) for s in sels], dtype=np.int64)
+    key = np.repeat(np.array([(s[0] << 32) + s[1] for s in sels], dtype=np.int64), counts)
+    channel = np.repeat(np.array([s[5] for s in sels], dtype=np.uint16), counts)
+    # One channel logged in time order is in that order already: no sort (times that
+    # strictly increase need no other key).
+    if bool(np.all(t_all[1:] > t_all[:-1])):
+        return McapPlan(t_all, off_all, key, chunks, channel)
+    file_all = key >> 32
+    cstart_all = np.repeat(np.array([s[2] for s in sels], dtype=np.int64), counts)
+    if _in_order(t_all, file_all, cstart_all, off_all):
+        return McapPlan(t_all, off_all, key, chunks, channel)
+    order = np.lexsort((off_all, cstart_all, file_all, t_all))
+    return McapPlan(t_all[order], off_all[order], key[order], chunks, channel[order])
 
 
 def verify_mcap(path: Path, progress: Reporter | None = None) -> None:

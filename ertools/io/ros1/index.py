@@ -28,7 +28,9 @@ from ertools.io.bagfile import BagFile, RawRecord
 from ertools.io.decode.fast import LayoutMismatchError, gather, read_at
 from ertools.io.inflate import Allowance
 from ertools.io.model import Conn
+from ertools.io.pipeline import Request, window
 from ertools.io.ros1.check import rebuild_layout
+from ertools.io.ros1.entries import Ints, Selection, connection_entries, ordered
 from ertools.io.ros1.layout import (
     INDEX_DTYPE,
     MSG_HEADER_LEN,
@@ -37,16 +39,13 @@ from ertools.io.ros1.layout import (
     U32,
     Ros1Chunk,
     Ros1Layout,
-    cat_arrays,
     chunk_head,
     decompress,
     entries_from_index,
     fields_before,
     index_header,
-    joined_entries,
     nonzero_counts,
     op_word,
-    outside_chunk_info,
     read_layout,
     value_offsets,
 )
@@ -195,16 +194,19 @@ class Ros1Bag(BagFile):
         chunk: Ros1Chunk,
         wanted: Collection[int] | None,
         counts: dict[int, int] | None = None,
-    ) -> dict[int, bytes]:
+        view: memoryview | None = None,
+    ) -> dict[int, bytes | memoryview]:
         """conn -> raw (sec, nsec, offset) entries of one chunk, for the ``wanted`` connections
         (all when None), from the index-data records that follow the chunk; ``counts`` gets
-        every record's conn -> count (all connections)."""
+        every record's conn -> count (all connections). With ``view`` (of the mapped file),
+        the entries are slices of it, not copies."""
         if chunk.data_pos < 0:
             self.chunk_record(chunk)
         mm = self._mapped()
+        src = mm if view is None else view
         size = min(len(mm), self.layout.size)
         pos = chunk.data_pos + chunk.data_len
-        out: dict[int, bytes] = {}
+        out: dict[int, bytes | memoryview] = {}
         try:
             for _ in range(len(chunk.counts)):
                 if pos + 8 > size:
@@ -227,7 +229,7 @@ class Ros1Bag(BagFile):
                 if counts is not None:
                     counts[cid] = counts.get(cid, 0) + count
                 if wanted is None or cid in wanted:
-                    out[cid] = mm[data_pos : data_pos + dlen]
+                    out[cid] = src[data_pos : data_pos + dlen]
                 pos = data_pos + dlen
         except (RecordError, KeyError, struct_error, IndexError) as err:
             raise BagError(
@@ -257,12 +259,18 @@ class Ros1Bag(BagFile):
 
     def select(
         self, conns: Sequence[Conn], start_ns: int | None, end_ns: int | None
-    ) -> tuple[list[int], I64, npt.NDArray[np.integer[Any]], I64, I64]:
-        """Messages of ``conns`` in [start_ns, end_ns], in the reference order.
+    ) -> tuple[list[int], Ints, Ints, I64, Ints]:
+        """Messages of ``conns`` in [start_ns, end_ns], in the reference order: one request
+        of :meth:`select_many`."""
+        return self.select_many([Request(tuple(conns), start_ns, end_ns)])[0][:5]
 
-        Returns (chunk indices touched, chunk index per message, conn rank per message, record
-        time per message, record offset per message); only chunks whose span overlaps the
-        window and that hold one of ``conns`` are read.
+    def select_many(self, requests: Sequence[Request]) -> list[Selection]:
+        """The messages of each request (connections, record-time window), each in its
+        reference order, from one pass over the index: (chunk indices touched, chunk index per
+        message, conn rank per message, record time per message, record offset per message).
+
+        Only chunks whose span overlaps a request's window and that hold one of the requested
+        connections are read.
         """
         if self.layout.indexed:
             # A chunk info naming a connection the bag does not have is damaged: the chunk
@@ -271,79 +279,64 @@ class Ros1Bag(BagFile):
             unknown = sorted({cid for ch in self.layout.chunks for cid in ch.counts} - known)
             if unknown:
                 self._rescan(f"chunk info names connection {unknown[0]}, which the bag lacks")
-        rank = {c.id: i for i, c in enumerate(conns)}
-        raw: dict[int, list[bytes | tuple[I64, I64]]] = {cid: [] for cid in rank}
-        where: dict[int, list[tuple[int, int]]] = {cid: [] for cid in rank}
+        wanted = {c.id for r in requests for c in r.conns}
+        start_ns, end_ns = window(requests)
+        raw: dict[int, list[bytes | memoryview | tuple[I64, I64]]] = {cid: [] for cid in wanted}
+        where: dict[int, list[tuple[int, int]]] = {cid: [] for cid in wanted}
+        # the entries are sliced out of the mapped file, and copied once, joined per connection
+        indexed = any(c.entries is None for c in self.layout.chunks)
+        view = memoryview(self._mapped()) if indexed else None
+        try:
+            damage = self._gather_entries(start_ns, end_ns, wanted, raw, where, view)
+            if damage is None:
+                entries, damage = connection_entries(raw, where, self.layout)
+        finally:
+            raw.clear()  # (the slices of the map, before it is closed)
+            if view is not None:
+                view.release()
+            self._unmap()  # the index pages touched would otherwise stay in this process's RSS
+        if damage is not None:
+            self._rescan(damage)
+            return self.select_many(requests)
+        return [ordered(r, entries) for r in requests]
+
+    def _gather_entries(
+        self,
+        start_ns: int | None,
+        end_ns: int | None,
+        wanted: set[int],
+        raw: dict[int, list[bytes | memoryview | tuple[I64, I64]]],
+        where: dict[int, list[tuple[int, int]]],
+        view: memoryview | None,
+    ) -> str | None:
+        """Each wanted connection's raw entries into ``raw`` (and (chunk, count) of each into
+        ``where``) from the chunks overlapping [start_ns, end_ns]; why the index is damaged,
+        or None."""
         for ci, chunk in enumerate(self.layout.chunks):
             if start_ns is not None and chunk.end_ns < start_ns:
                 continue
             if end_ns is not None and chunk.start_ns > end_ns:
                 continue
             if chunk.entries is not None:  # a scanned bag: entries already decoded
-                for cid, (t, off) in chunk.entries.items():
-                    if cid in rank:
-                        raw[cid].append((t, off))
-                        where[cid].append((ci, len(t)))
+                for cid, entry in chunk.entries.items():
+                    if cid in wanted:
+                        raw[cid].append(entry)
+                        where[cid].append((ci, len(entry[0])))
                 continue
             # Every chunk's index-data headers are read, the planned chunks' and the others':
             # their connection ids and counts must be the chunk info's, which chose the chunks
             # (a damaged connection id or count there dropped a chunk from its connection's
             # read, or read another connection's entries, without a word).
             counts: dict[int, int] = {}
-            for cid, data in self._index_data(chunk, rank, counts).items():
+            for cid, data in self._index_data(chunk, wanted, counts, view).items():
                 raw[cid].append(data)
                 where[cid].append((ci, len(data) // INDEX_DTYPE.itemsize))
             if nonzero_counts(counts) != nonzero_counts(chunk.counts):
-                self._rescan(
+                return (
                     f"chunk at byte {chunk.pos}: the chunk info and the index data give "
                     "different connections or counts"
                 )
-                return self.select(conns, start_ns, end_ns)
-        self._unmap()  # the index pages touched would otherwise stay in this process's RSS
-        tt: list[I64] = []
-        oo: list[I64] = []
-        ck: list[I64] = []
-        rk: list[npt.NDArray[np.integer[Any]]] = []
-        for cid, r in rank.items():
-            if not raw[cid]:
-                continue
-            t, off = joined_entries(raw[cid])
-            if self.layout.indexed:
-                outside = outside_chunk_info(self.layout.chunks, cid, t, where[cid])
-                if outside is not None:
-                    self._rescan(outside)
-                    return self.select(conns, start_ns, end_ns)
-            c = np.repeat(
-                np.array([w[0] for w in where[cid]], dtype=np.int64),
-                np.array([w[1] for w in where[cid]], dtype=np.int64),
-            )
-            if start_ns is not None or end_ns is not None:
-                keep = np.ones(len(t), dtype=bool)
-                if start_ns is not None:
-                    keep &= t >= start_ns
-                if end_ns is not None:
-                    keep &= t <= end_ns
-                t, off, c = t[keep], off[keep], c[keep]
-            tt.append(t)
-            oo.append(off)
-            ck.append(c)
-            rk.append(np.full(len(t), r, dtype=np.int8 if len(rank) < 128 else np.int64))
-        if not tt or not sum(len(t) for t in tt):
-            e = np.empty(0, np.int64)
-            return [], e, e, e, e
-        t_all, c_all, o_all = cat_arrays(tt), cat_arrays(ck), cat_arrays(oo)
-        r_all = rk[0] if len(rk) == 1 else np.concatenate(rk)
-        # (np.unique would import numpy.ma, 10 ms of a whole command's start)
-        touched = np.flatnonzero(np.bincount(c_all, minlength=len(self.layout.chunks))).tolist()
-        # rosbags: per connection sorted by time (stable over chunk and index order), then a
-        # heap merge over connections in the order given (ties: the earlier connection).
-        # Entries are gathered connection by connection, each in chunk and index order, so
-        # ``seq`` keeps that order among equal times of one connection.
-        if len(rank) == 1 and np.all(t_all[1:] >= t_all[:-1]):
-            return touched, c_all, r_all, t_all, o_all  # one connection, already in order
-        seq = np.arange(len(t_all))
-        order = np.lexsort((seq, r_all, t_all))
-        return touched, c_all[order], r_all[order], t_all[order], o_all[order]
+        return None
 
     def _rescan(self, why: str) -> None:
         """Distrust the index from now on: rebuild the layout from the records themselves."""
@@ -526,20 +519,26 @@ class Ros1Bag(BagFile):
         the requested messages' bytes are held until yielded in order)."""
         if not conns:
             return
-        _touched, _chunk_of, rank_of, _t, _off = self.select(conns, start_ns, end_ns)
-        found = ros1_runs(self, conns, start_ns, end_ns, current())
-        out: list[tuple[int, int, bytes]] = []
-        for pos, buf, start, length, t_rec in found.runs:
-            data = buf.tobytes()
+        request = Request(tuple(conns), start_ns, end_ns)
+        by_id = {c.id: c for c in conns}
+        out: list[tuple[int, int, int, bytes]] = []
+        for run in ros1_runs(self, [request], current()).only(0).runs:
+            start, length = run.spans()
+            data = run.buf.tobytes()
             out.extend(
-                (p, t, data[a : a + n])
-                for p, t, a, n in zip(
-                    pos.tolist(), t_rec.tolist(), start.tolist(), length.tolist(), strict=True
+                (p, t, c, data[a : a + n])
+                for p, t, c, a, n in zip(
+                    run.pos.tolist(),
+                    run.t_record.tolist(),
+                    run.conn.tolist(),
+                    start.tolist(),
+                    length.tolist(),
+                    strict=True,
                 )
             )
         out.sort(key=lambda x: x[0])
-        for p, t, data in out:
-            yield conns[int(rank_of[p])], t, data
+        for _p, t, c, data in out:
+            yield by_id[c], t, data
 
     def verify(self, progress: Reporter | None = None) -> None:
         """Decompress every chunk and check that every indexed record is a message record

@@ -111,7 +111,7 @@ def conn_record(cid: int, topic: str, fields: dict[str, bytes]) -> Conn:
     )
 
 
-def entries_from_index(data: bytes) -> tuple[I64, I64]:
+def entries_from_index(data: bytes | memoryview) -> tuple[I64, I64]:
     arr = np.frombuffer(data, dtype=INDEX_DTYPE)
     # Computed in place: fresh memory is slow to fault in, and an hour's entries are 5 MB.
     t = np.multiply(arr["sec"], 1_000_000_000, dtype=np.int64)

@@ -93,6 +93,48 @@ def test_monte_carlo_width_matches_the_analytic_interval() -> None:
     assert shares["offset"] == pytest.approx(4 / 5, abs=0.02)
 
 
+def test_monte_carlo_shares_from_a_given_variance_and_the_remainder() -> None:
+    """The offset's variance given (4e-6), no pass of draws is run for shares: the noise's
+    share is what the together pass's variance leaves, 1e-6 of the 5e-6 (the same 1/5 and
+    4/5 as above, within the together pass's variance error: 20,000 draws, 1%)."""
+    truth = np.linspace(0.0, 1.0, 100)
+    f = _mean_score(truth, 0.01, 0.002)
+    calls: list[frozenset[str]] = []
+
+    def counted(rng: np.random.Generator, sources: frozenset[str], n: int) -> np.ndarray:
+        calls.append(sources)
+        return np.asarray(f(rng, sources, n))
+
+    (iv,) = monte_carlo(
+        [0.5],
+        counted,
+        ("noise", "offset"),
+        draws=20_000,
+        seed=3,
+        nonnegative=False,
+        alone_variance={"offset": lambda: np.array([4e-6])},
+    )
+    assert calls == [frozenset({"noise", "offset"})]
+    assert iv is not None
+    shares = iv.share_dict()
+    assert shares["noise"] == pytest.approx(1 / 5, abs=0.03)
+    assert shares["offset"] == pytest.approx(4 / 5, abs=0.03)
+
+
+def test_an_interval_reaches_its_score_when_the_bias_passes_the_spread() -> None:
+    """Draws biased by +5 with spread 1 about a score of 10: the basic interval is
+    [2 * 10 - q97.5, 2 * 10 - q2.5] = [3.04, 6.96], wholly below 10; it is widened to 10."""
+
+    def perturbed(rng: np.random.Generator, sources: frozenset[str], n: int) -> np.ndarray:
+        return (15.0 + rng.standard_normal(n)).reshape(n, 1)
+
+    (iv,) = monte_carlo([10.0], perturbed, ("noise",), draws=20_000, seed=1)
+    assert iv is not None
+    # 20,000 draws: the 97.5% quantile 16.96 known to ~0.02
+    assert iv.low == pytest.approx(20.0 - 16.96, abs=0.08)
+    assert iv.high == 10.0
+
+
 def test_monte_carlo_is_reproducible_and_seeded() -> None:
     f = _mean_score(np.ones(10), 0.1, 0.01)
     a = monte_carlo([1.0], f, ("noise", "offset"), draws=200, seed=5)

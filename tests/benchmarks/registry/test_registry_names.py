@@ -23,6 +23,15 @@ OWN_PACKAGE = {
     "fbm2h": "fbm2h",
     "fbm3w": "fbm3w",
     "trajectory": "trajectory",
+    "hnf": "hnf",
+    "hpff": "hpff",
+    "hopf": "hopf",
+    "hppf": "hppf",
+    "hgmf": "hgmf",
+    "hgtkmh": "referee",
+    "hwv": "referee",
+    "hcfgac": "referee",
+    "stb": "referee",
 }
 # Files (or folders, ending in /) allowed to name benchmarks, and why; each entry must say why.
 EXCEPTIONS: dict[str, str] = {

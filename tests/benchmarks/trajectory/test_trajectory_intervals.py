@@ -95,25 +95,44 @@ def _scored(capsys: pytest.CaptureFixture[str], *extra: str) -> tuple[dict, list
 
 
 @pytest.mark.slow
-def test_a_score_outside_its_interval_says_why(capsys: pytest.CaptureFixture[str]) -> None:
+def test_every_interval_holds_its_score_and_the_fitted_offset_has_its_own(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
     """The sample robot's clock runs 0.349 s ahead: scored at offset 0, its mean error is
-    147 mm, while the intervals are of the score at the offset the data supports (17 mm).
-    A referee is told so, not left with `146.58 mm [17.53, 18.33]`."""
+    147 mm. Its interval is that score's (the offset's uncertainty centred on the offset
+    applied), and the score at the offset the data fits, 17 mm, is reported beside it with
+    its own interval, equal to what ``--offset auto --apply-offset`` scores (issue 39)."""
     out, err = _scored(capsys)
-    outside = [
-        k for k in TOP_LEVEL if not out[f"{k}_interval"][0] <= out[k] <= out[f"{k}_interval"][1]
-    ]
-    assert outside  # the case exists: the clock offset not applied moves every interval
+    for k in TOP_LEVEL:
+        low, high = out[f"{k}_interval"]
+        assert low <= out[k] <= high, k
     shift_ms = out["clock_audit"]["estimated_offset"] * 1000
     assert shift_ms == pytest.approx(-349.0, abs=1.0)  # sample_bags/README.md: 0.35 s ahead
-    (note,) = [w for w in out["warnings"] if "outside" in w]
-    assert set(outside) <= set(note.split(" outside ")[0].split(", "))
-    assert f"({shift_ms:+.1f} ms from the one applied)" in note
+    keys = list(out)
+    for k in TOP_LEVEL:
+        fitted = f"{k}_at_fitted_offset"
+        assert keys.index(fitted) == keys.index(f"{k}_interval") + 1
+        low, high = out[f"{fitted}_interval"]
+        assert low <= out[fitted] <= high, fitted
+        assert fitted in out["uncertainty"]["shares"]
+    assert 0.140 < out["position_error"] < 0.150
+    assert 0.017 < out["position_error_at_fitted_offset"] < 0.018
+    (note,) = [w for w in out["warnings"] if "fit the GT best" in w]
+    assert "position_error_at_fitted_offset is 17.43 [" in note
     assert f"ertools: warning: {note}" in err
-    # scored at that offset, every score lies inside its interval and nothing is said
-    out, err = _scored(capsys, "--offset", "auto", "--apply-offset")
-    assert all(out[f"{k}_interval"][0] <= out[k] <= out[f"{k}_interval"][1] for k in TOP_LEVEL)
-    assert not [w for w in out["warnings"] if "outside" in w]
+    assert any(
+        line.startswith("ertools: interval: position_error_at_fitted_offset 17.43 mm [")
+        for line in err
+    )
+    # scored at that offset: the same numbers as the keys at the fitted offset, no such key
+    applied, _ = _scored(capsys, "--offset", "auto", "--apply-offset")
+    for k in TOP_LEVEL:
+        assert applied[k] == out[f"{k}_at_fitted_offset"]
+        assert applied[f"{k}_interval"] == out[f"{k}_at_fitted_offset_interval"]
+        assert f"{k}_at_fitted_offset" not in applied
+    # no intervals, no fitted keys: --draws 0 leaves the output as it was
+    bare, _ = _scored(capsys, "--draws", "0")
+    assert not [k for k in bare if "fitted" in k or k.endswith("_interval")]
 
 
 @pytest.mark.parametrize(("lap_s", "turn"), [(10.5, -1.0), (10.5, 1.0), (12.0, 1.0)])

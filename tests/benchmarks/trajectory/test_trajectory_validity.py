@@ -10,8 +10,9 @@ from typing import Any
 import numpy as np
 import pytest
 
-from ertools.benchmarks.trajectory.comparison import MIN_VALID_FRACTION, score_streams
+from ertools.benchmarks.trajectory.comparison import score_streams
 from ertools.benchmarks.trajectory.config import SETTINGS_2015, TrajectoryConfig
+from ertools.benchmarks.trajectory.validity import MIN_VALID_FRACTION
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
 from ertools.report.figures import figure_specs, render

@@ -1,0 +1,292 @@
+"""FBM3@Work's runs re-scored with perturbed positions, every Monte Carlo draw at once
+(issues 28 and 39): the 2015 d_min subsampling and Eq. (1) vectorised over the draws of all
+the runs side by side. What the draws perturb and why: :mod:`~ertools.benchmarks.fbm3w.
+intervals` and docs/uncertainty.md ("How the FBM3@Work draws are computed"). No IO here.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from ertools.arrays import F64, Bool, IntArr
+from ertools.benchmarks.common.draws import normal_pairs
+from ertools.benchmarks.fbm3w.shapes import Shape
+
+# Draws x samples of one batch: bounds the memory of a long run (~8 bytes x a few arrays).
+BATCH_ELEMENTS = 2_000_000
+# Draws x samples of the runs whose d_min rule runs in one pass (padded to the longest): a
+# competition's four runs of ~600 samples x 400 draws in one pass, float32 positions and
+# steps, ~13 MB.
+GROUP_ELEMENTS = 1_200_000
+TABLE = 4097  # targets the draws interpolate (target_table)
+BLOCK = 64  # samples of Eq. (1) computed at a time (_eq1): 64 x 400 draws, 200 kB an array
+
+
+@dataclass(frozen=True, eq=False)
+class RunSamples:
+    """What one scored run's Eq. (1) depends on.
+
+    Attributes:
+        xy: (N, 2) the measured positions of the path window (world).
+        source: (N,) index of the measurement each sample carries (a repeated pose carries
+            the one it repeats).
+        reference_xy: (2,) the measured reference position.
+        shape: the target.
+        center_xy, center_reference_xy: the smoothed path and reference the draws perturb
+            (None: the measured ones).
+    """
+
+    xy: F64
+    source: IntArr
+    reference_xy: F64
+    shape: Shape
+    center_xy: F64 | None = None
+    center_reference_xy: F64 | None = None
+
+
+def perturbed_errors(
+    run: RunSamples, sigmas: F64, d_mins: F64, rng: np.random.Generator, noisy: bool
+) -> F64:
+    """(D,) distance errors of one run with its positions perturbed by ``sigmas`` (D,) (when
+    ``noisy``) and subsampled with ``d_mins`` (D,); NaN where a draw cannot be scored."""
+    return perturbed_runs([run], sigmas, d_mins, rng, noisy)[:, 0]
+
+
+def perturbed_runs(
+    runs: Sequence[RunSamples],
+    sigmas: F64,
+    d_mins: F64,
+    rng: np.random.Generator,
+    noisy: bool,
+    *,
+    budget: int = BATCH_ELEMENTS,
+    antithetic: bool = True,
+) -> F64:
+    """(D, R) distance errors of every run in every draw (column ``r``: ``runs[r]``).
+
+    The runs' draws go side by side in groups (run by run, each run's draws in batches of
+    at most ``budget`` samples, as many as fit in :data:`GROUP_ELEMENTS` padded samples);
+    the d_min rule is one pass over the samples of a group. The noise of a group is drawn
+    from ``rng`` at once (when ``noisy``: :func:`~ertools.benchmarks.common.draws.
+    normal_pairs`), each draw's scaled by its sigma; a repeated pose takes the noise of the
+    sample it repeats. The positions are complex64
+    x + iy (one array and one operation for both coordinates, the distance ``abs``),
+    relative to each run's first (smoothed) sample: float32 parts resolve a run's metres to
+    0.1 um, against noise of 50 um and d_min of 330 um; lengths add up in float64.
+    """
+    d = sigmas.size
+    out = np.empty((d, len(runs)))
+    tables: dict[int, tuple[npt.NDArray[np.complex64], npt.NDArray[np.complex64]]] = {}
+    pieces = [
+        (col, lo, min(d, lo + batch))
+        for col, run in enumerate(runs)
+        for batch in [max(1, budget // max(len(run.xy), 1))]
+        for lo in range(0, d, batch)
+    ]
+    scratch = _Scratch(
+        max((min(len(runs[c].xy), BLOCK) * (hi - lo) for c, lo, hi in pieces), default=0)
+    )
+    for group in _groups(pieces, [len(r.xy) for r in runs], min(budget, GROUP_ELEMENTS)):
+        # every piece's draws side by side, samples down the rows (shorter runs padded with
+        # NaN, never kept): the positions are drawn straight into this array
+        lengths = [len(runs[col].xy) for col, _, _ in group]
+        edges = np.cumsum([0, *(hi - lo for _, lo, hi in group)])
+        width, longest = int(edges[-1]), max(lengths)
+        scale = np.concatenate([sigmas[lo:hi] for _, lo, hi in group]).astype(np.float32)
+        if noisy:
+            zt, ref_noise = normal_pairs(rng, longest, np.diff(edges), antithetic)
+            zt *= scale
+            ref_noise *= scale
+        else:
+            zt = np.zeros((longest, width), dtype=np.complex64)
+            ref_noise = np.zeros(width, dtype=np.complex64)
+        views = [
+            (zt[:m, a:b], slice(a, b), m)
+            for a, b, m in zip(edges[:-1], edges[1:], lengths, strict=True)
+        ]
+        refs = [
+            _positions(runs[col], z, ref_noise[cols])
+            for (col, _, _), (z, cols, _) in zip(group, views, strict=True)
+        ]
+        for _, cols, m in views:
+            zt[m:, cols] = np.nan  # padding: never kept
+        kept, cum = _subsample(zt, np.concatenate([d_mins[lo:hi] for _, lo, hi in group]))
+        for (col, lo, hi), (z, cols, m), ref in zip(group, views, refs, strict=True):
+            table = tables.get(col)
+            if table is None:
+                table = tables[col] = target_table(runs[col].shape)
+            out[lo:hi, col] = _eq1(z, kept[:m, cols], cum[:m, cols], ref, table, scratch)
+    return out
+
+
+def target_table(shape: Shape) -> tuple[npt.NDArray[np.complex64], npt.NDArray[np.complex64]]:
+    """The target x + iy at TABLE evenly spaced l in [0, 1] and each row's step to the next
+    (0 after the last), which the draws interpolate linearly (:func:`_eq1`): for the 2015
+    shapes within 2e-8 m of the curve (the sine's y'' = 2.6 m, times (1 / 4096)^2 / 8); a shape
+    given by points is exact but within 1 / 4096 of l around its corners."""
+    xy = shape(np.linspace(0.0, 1.0, TABLE))
+    t = (xy[:, 0] + 1j * xy[:, 1]).astype(np.complex64)
+    return t, np.diff(t, append=t[-1:]).astype(np.complex64)
+
+
+def _groups(
+    pieces: list[tuple[int, int, int]], lengths: list[int], budget: int
+) -> list[list[tuple[int, int, int]]]:
+    """Consecutive (run, lo, hi) pieces grouped while the group's draws x its longest run
+    stay within ``budget`` (a piece alone may exceed it only with a single draw)."""
+    groups: list[list[tuple[int, int, int]]] = []
+    width = longest = 0
+    for piece in pieces:
+        col, lo, hi = piece
+        w, n = width + hi - lo, max(longest, lengths[col])
+        if groups and w * n <= budget:
+            groups[-1].append(piece)
+            width, longest = w, n
+        else:
+            groups.append([piece])
+            width, longest = hi - lo, lengths[col]
+    return groups
+
+
+def origin_of(run: RunSamples) -> F64:
+    """The point the draws' positions are relative to: the run's first (smoothed) sample."""
+    xy = run.xy if run.center_xy is None else run.center_xy
+    return np.asarray(xy[0], dtype=np.float64)
+
+
+def _positions(
+    run: RunSamples, z: npt.NDArray[np.complex64], ref_noise: npt.NDArray[np.complex64]
+) -> npt.NDArray[np.complex128]:
+    """One run's sample positions put into ``z`` (N, D), which holds their noise, as x + iy
+    relative to :func:`origin_of` (a repeated pose repeats the noise of the sample it
+    repeats); the (D,) positions of its reference, whose noise is ``ref_noise``."""
+    origin = origin_of(run)
+    xy = (run.xy if run.center_xy is None else run.center_xy) - origin
+    ref = (
+        run.reference_xy if run.center_reference_xy is None else run.center_reference_xy
+    ) - origin
+    if np.any(run.source != np.arange(len(xy))):
+        z[:] = z[run.source]
+    z += (xy[:, 0] + 1j * xy[:, 1]).astype(np.complex64)[:, None]
+    return np.asarray(complex(ref[0], ref[1]) + ref_noise.astype(np.complex128))
+
+
+def _subsample(zt: npt.NDArray[np.complex64], d_mins: F64) -> tuple[Bool, npt.NDArray[np.float32]]:
+    """(N, W) kept flags of the 2015 d_min rule for the W draws side by side in the columns
+    of ``zt`` (N, W), each with its d_min, and the (N, W) length of the kept polyline up to
+    each sample (summed in float64 row by row, sequentially as the 2015 loop did; stored in
+    float32, 6e-8 relative): one pass over the samples, each step vectorised over every
+    draw (the rule is sequential within a draw). NaN is never kept."""
+    n, w = zt.shape
+    d_min = d_mins.astype(np.float32)
+    kept = np.zeros((n, w), dtype=bool)
+    kept[0] = True
+    cum = np.zeros((n, w), dtype=np.float32)
+    length = np.zeros(w)
+    last = zt[0].copy()
+    dz = np.empty(w, dtype=np.complex64)
+    parts = dz.view(np.float32)  # x, y, x, y...
+    dist = np.empty(w, dtype=np.float32)
+    for j in range(1, n):
+        # 2015: sqrt(dx**2 + dy**2) >= D_MIN against the last kept point, in place; in
+        # real arithmetic (IEEE: the same bits on every CPU, unlike NumPy's complex abs)
+        np.subtract(zt[j], last, out=dz)
+        np.multiply(parts, parts, out=parts)
+        np.add(parts[0::2], parts[1::2], out=dist)
+        np.sqrt(dist, out=dist)
+        k = np.greater_equal(dist, d_min, out=kept[j])
+        np.copyto(last, zt[j], where=k)
+        np.add(length, dist, out=length, where=k)  # a kept sample's step adds to the polyline
+        cum[j] = length
+    return kept, cum
+
+
+class _Scratch:
+    """Work arrays of :func:`_eq1`, allocated once for every piece of a call: fresh
+    arrays of megabytes cost more in page faults than the arithmetic on them."""
+
+    def __init__(self, size: int) -> None:
+        self.arrays = (
+            np.empty(size, dtype=np.float32),
+            np.empty(size, dtype=np.float32),
+            np.empty(size, dtype=np.float32),
+            np.empty(size, dtype=np.intp),
+            np.empty(size, dtype=np.complex64),
+            np.empty(size, dtype=np.complex64),
+        )
+
+    def shaped(self, m: int, w: int) -> tuple[Any, ...]:
+        n = m * w
+        return tuple(a[:n].reshape(m, w) for a in self.arrays)
+
+
+def _eq1(
+    z: npt.NDArray[np.complex64],
+    kept: Bool,
+    cum: npt.NDArray[np.float32],
+    ref: npt.NDArray[np.complex128],
+    table: tuple[npt.NDArray[np.complex64], npt.NDArray[np.complex64]],
+    scratch: _Scratch | None = None,
+) -> F64:
+    """Eq. (1) of every draw (column) from its kept flags and polyline lengths (as
+    :func:`~.path.score_path`), the target at l/L interpolated in ``table``
+    (:func:`target_table`); the errors are computed at every sample and summed where kept
+    (whole arrays: faster than gathering the kept points), :data:`BLOCK` samples at a time
+    in ``scratch``'s arrays (kept in the CPU's cache from one operation to the next)."""
+    m, w = z.shape
+    work = scratch if scratch is not None else _Scratch(min(m, BLOCK) * w)
+    total = cum[m - 1]
+    # l / L in table rows: cum <= total, so the row is at most the last (its step is 0)
+    scale = np.zeros_like(total)
+    np.divide(np.float32(TABLE - 1), total, out=scale, where=total > 0)
+    # the run frame: origin at the start, x along reference -> start: turned by -yaw
+    start = z[0]
+    axis = start.astype(np.complex128) - ref
+    norm = np.sqrt(axis.real**2 + axis.imag**2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        c, s = (axis.real / norm).astype(np.float32), (axis.imag / norm).astype(np.float32)
+    sums = np.zeros(w)
+    # real arithmetic on the complex arrays' x and y: NumPy's complex multiply and abs
+    # differ in the last bit between CPUs (AVX2 or not), its float add, multiply and sqrt
+    # do not
+    for lo in range(0, m, BLOCK):
+        hi = min(m, lo + BLOCK)
+        at, row, err, index, target, moved = work.shaped(hi - lo, w)
+        np.multiply(cum[lo:hi], scale, out=at)
+        np.floor(at, out=row)
+        at -= row
+        np.copyto(index, row, casting="unsafe")
+        np.take(table[0], index, out=target)
+        np.take(table[1], index, out=moved)
+        step = moved.view(np.float32).reshape(hi - lo, w, 2)
+        step *= at[..., None]
+        target += moved
+        np.subtract(z[lo:hi], start, out=moved)
+        mx, my = moved.real, moved.imag
+        tx, ty = target.real, target.imag
+        # run frame x = c mx + s my - tx, y = c my - s mx - ty, each into its own array
+        np.multiply(mx, c, out=at)
+        np.multiply(my, s, out=row)
+        at += row
+        at -= tx
+        np.multiply(my, c, out=row)
+        np.multiply(mx, s, out=err)
+        row -= err
+        row -= ty
+        np.multiply(at, at, out=at)
+        np.multiply(row, row, out=row)
+        np.add(at, row, out=err)
+        np.sqrt(err, out=err)
+        err *= kept[lo:hi]
+        if lo == 0:
+            err[0] = 0.0  # 2015 started its sum at the second kept point (row 0: the start)
+        sums += err.sum(axis=0, dtype=np.float64)
+    count = np.count_nonzero(kept, axis=0)
+    out = sums / np.maximum(count, 1)
+    bad = (count < 2) | ~(total > 0) | (axis == 0)
+    return np.asarray(np.where(bad, np.nan, out), dtype=np.float64)

@@ -1,0 +1,105 @@
+"""How an HGMF score is computed (the options, as data), the script's constants and
+:func:`make_options`, which turns the declared inputs' values into :class:`HgmfOptions`."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ertools.benchmarks.common.inputs import (
+    DEFAULT_CONFIDENCE,
+    DEFAULT_DRAWS,
+    DEFAULT_SEED,
+    check_confidence,
+)
+from ertools.errors import UsageError
+
+NAME = "hgmf"
+CODE = "HGMF"
+TITLE = "HGMF (FBM6@Home 2019)"
+
+# fbm6_grasping_manipulation.py at 2bb8a41 (docs/hgmf.md): a grasp is a rise of more than
+# 3 cm (l. 270), checked by a 0.1 s timer (l. 176) whose tf wait lasts 0.1 s (l. 264); the
+# target area is the table less 0.15 m on each side (l. 66-69).
+GRASP_RISE_M = 0.03
+CHECK_PERIOD_NS = 100_000_000
+CHECK_WAIT_NS = 100_000_000
+TABLE_MARGIN_M = 0.15
+# The frames the script reads: the object's marker set in the table's frame, and its own
+# broadcast at each lookup.
+TABLE = "table_origin"
+OBJECT_BODY = "actor_markerset"
+OBJECT_FRAME = "object"
+DEFAULT_MAX_GAP_S = 0.1
+
+SCRIPT_2019 = "fbm6_grasping_manipulation.py at rockin-robot-challenge/rsbb 2bb8a41 (ERL 2019)"
+RULE_SETS = ("ertools", "2019")
+
+
+@dataclass(frozen=True)
+class HgmfOptions:
+    """Everything ``ertools score hgmf`` can be told.
+
+    Attributes:
+        config: ``HGMF.yaml`` (the objects, the table); None: found beside the run in the
+            RSBB layout, else the result file's ``benchmark_info.params``.
+        result: the run's result file (its params, and the score to compare); None: found
+            beside the run.
+        rules: ``2019`` (every behaviour of the script at 2bb8a41) or ``ertools``.
+        restarted_goals_2019: a restarted goal counts in the divisor and the grasps.
+        grasp_timer: grasps checked at the script's inferred 10 Hz ticks (else every sample).
+        gaps_interpolate: lookups interpolate across any tracking gap (else ``max_gap_s``).
+        max_gap_s: the samples around a lookup may be at most this far apart.
+        confidence, draws, seed: the score intervals.
+    """
+
+    config: Path | None = None
+    result: Path | None = None
+    rules: str = "ertools"
+    restarted_goals_2019: bool = False
+    grasp_timer: bool = False
+    gaps_interpolate: bool = False
+    max_gap_s: float = DEFAULT_MAX_GAP_S
+    confidence: float = DEFAULT_CONFIDENCE
+    draws: int = DEFAULT_DRAWS
+    seed: int = DEFAULT_SEED
+
+    @property
+    def exact(self) -> bool:
+        """Every 2019 behaviour at once (the replay's numbers)."""
+        return self.restarted_goals_2019 and self.grasp_timer and self.gaps_interpolate
+
+
+def make_options(v: Mapping[str, Any]) -> HgmfOptions:
+    """The declared inputs' values (resolved, :func:`~ertools.benchmarks.base.resolve_values`)
+    -> :class:`HgmfOptions`; ``--rules 2019`` sets every 2019 behaviour.
+
+    Raises:
+        UsageError: options that contradict each other.
+    """
+    rules = v.get("rules") or "ertools"
+    script = rules == "2019"
+    chosen = {
+        "restarted_goals": v.get("restarted_goals"),
+        "grasp_sampling": v.get("grasp_sampling"),
+        "gt_gaps": v.get("gt_gaps"),
+    }
+    if script:
+        for key, value in chosen.items():
+            if value is not None and value not in ("2019", "timer", "interpolate"):
+                option = "--" + key.replace("_", "-")
+                raise UsageError(f"--rules 2019 sets {option} as the script did; not {value}")
+    return HgmfOptions(
+        config=v.get("config"),
+        result=v.get("result"),
+        rules=rules,
+        restarted_goals_2019=script or chosen["restarted_goals"] == "2019",
+        grasp_timer=script or chosen["grasp_sampling"] == "timer",
+        gaps_interpolate=script or chosen["gt_gaps"] == "interpolate",
+        max_gap_s=float(v.get("max_gap") or DEFAULT_MAX_GAP_S),
+        confidence=check_confidence(float(v.get("confidence") or DEFAULT_CONFIDENCE)),
+        draws=int(v.get("draws", DEFAULT_DRAWS)),
+        seed=int(v.get("seed", DEFAULT_SEED)),
+    )

@@ -1,0 +1,112 @@
+"""HNF's options: which reading of the script (``--rules``) and each rule's own option.
+
+NumPy-free: the declaration and the CLI's parser import it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ertools.errors import UsageError
+
+#: ``--rules``: ertools' reading, or a version of the script (docs/hnf.md, "2017-18").
+#: 2019 = rockin-robot-challenge/rsbb 2bb8a41; 2017 = Enri2077/rsbb 00e3106 (December 2017 to
+#: May 2018); f594ff1 (4 November to 15 December 2017); 069fd1d (2-4 November 2017).
+RULE_SETS = ("ertools", "2019", "2017", "f594ff1", "069fd1d")
+#: The script's commit each ``--rules`` value reproduces.
+SCRIPT_COMMITS = {
+    "2019": "2bb8a41",
+    "2017": "00e3106",
+    "f594ff1": "f594ff1",
+    "069fd1d": "069fd1d",
+}
+#: The season a script version served (the ``differs from`` lines of the default name 2019).
+SEASONS = {"2bb8a41": "2019", "00e3106": "2017", "f594ff1": "2017", "069fd1d": "2017"}
+
+#: Default largest interval between the mocap samples a pose is interpolated across (ertools'
+#: reading): 12 frames of the RSBB's 120 Hz OptiTrack; a body lost for longer is not measured.
+DEFAULT_MAX_GAP_S = 0.1
+
+
+@dataclass(frozen=True)
+class HnfOptions:
+    """How to score an HNF run.
+
+    Attributes:
+        config, transform, result: the side files given (None: found beside the bag).
+        team: the team (None: from the layout or the result file).
+        rules: one of :data:`RULE_SETS`.
+        script: the script's commit followed for the control flow (2bb8a41 by default: its
+            flow is 2019's; ertools' reading changes the arithmetic only).
+        orientation_2019: the totals from sin/cos of the unwrapped |dtheta| (the script's).
+        divisor_2019: the sums over every acquired pose divided by the completed goals.
+        stopped_2019: a run stopped before its last pose has no totals.
+        gaps_interpolate: tf's interpolation across any mocap gap (else refused beyond
+            ``max_gap_s``).
+        max_gap_s: the largest mocap interval a pose is interpolated across.
+        score_format_2019: target and robot poses as the script's YAML dumps (else mappings).
+        confidence, draws, seed: the intervals.
+    """
+
+    config: Path | None = None
+    transform: Path | None = None
+    result: Path | None = None
+    team: str | None = None
+    rules: str = "ertools"
+    script: str = "2bb8a41"
+    orientation_2019: bool = False
+    divisor_2019: bool = False
+    stopped_2019: bool = False
+    gaps_interpolate: bool = False
+    max_gap_s: float = DEFAULT_MAX_GAP_S
+    score_format_2019: bool = False
+    confidence: float = 0.95
+    draws: int = 0
+    seed: int = 0
+
+    @property
+    def faithful(self) -> bool:
+        """Every rule as a script had it (``--rules`` names a script version)."""
+        return self.rules != "ertools"
+
+
+def options_from(v: Mapping[str, Any]) -> HnfOptions:
+    """Options from resolved input values (:func:`ertools.benchmarks.base.resolve_values`).
+
+    Raises:
+        UsageError: a rule option that contradicts ``--rules``.
+    """
+    rules = str(v["rules"] or "ertools")
+    script = SCRIPT_COMMITS.get(rules, "2bb8a41")
+    faithful = rules != "ertools"
+    chosen = {
+        "--divisor": v["divisor"] not in (None, "2019"),
+        "--gt-gaps": v["gt_gaps"] not in (None, "interpolate"),
+        "--score-format": v["score_format"] not in (None, "2019"),
+    }
+    clash = [name for name, ertools_value in chosen.items() if ertools_value]
+    if faithful and clash:
+        raise UsageError(
+            f"--rules {rules} reproduces the script: {', '.join(clash)} would undo it; "
+            "give one or the other"
+        )
+    return HnfOptions(
+        config=v["config"],
+        transform=v["transform"],
+        result=v["result"],
+        team=v["team"],
+        rules=rules,
+        script=script,
+        orientation_2019=faithful or bool(v["orientation_2019"]),
+        divisor_2019=faithful or v["divisor"] == "2019",
+        stopped_2019=faithful,
+        gaps_interpolate=faithful or v["gt_gaps"] == "interpolate",
+        max_gap_s=float(v["max_gap"]),
+        score_format_2019=faithful or v["score_format"] == "2019",
+        confidence=float(v["confidence"]),
+        draws=int(v["draws"]),
+        seed=int(v["seed"]),
+    )

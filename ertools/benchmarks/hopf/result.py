@@ -1,0 +1,192 @@
+"""The HOPF result: the result file's ``score`` as the rules make it, one record per goal, the
+comparison with the scores the run left, and their YAML/JSON/CSV forms."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from ertools.benchmarks.base import Rows
+from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
+from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, uncertainty_rows
+from ertools.benchmarks.hopf.goals import GoalRecord
+from ertools.fidelity import Deviation
+from ertools.frames import tables_to_frames
+from ertools.rsbb.score import ScoreComparison, score_yaml
+from ertools.serialize import jsonable
+from ertools.streams import Provenance
+from ertools.timeutil import ns_to_s
+
+if TYPE_CHECKING:
+    import pandas as pd  # annotations only: pandas is imported by to_frames()
+
+
+@dataclass(frozen=True)
+class HopfIntervals:
+    """The intervals of the pose scores (the mocap noise of the ground truth).
+
+    Attributes:
+        total: of the total ``pose_score`` (None: none given).
+        goals: of each scored goal's pose score, by its ``i``.
+        uncertainty: how they were obtained.
+    """
+
+    total: Interval | None
+    goals: dict[int, Interval | None]
+    uncertainty: Uncertainty
+
+
+@dataclass(frozen=True, eq=False)
+class HopfResult:
+    """A scored HOPF run (implements ``BenchmarkResult``).
+
+    Attributes:
+        score: the result file's ``score`` by the rules (``--rules``: the script's last save).
+        goals: one record per iteration the run began.
+        rules: ``ertools`` or the script version reproduced (``2019``...).
+        crashed: why the script died on this run (``--rules``), None when it did not.
+        comparison: the score against the live score and the result file (None: neither).
+        intervals: the pose scores' intervals (None with ``--draws 0`` or nothing scored).
+        origin_ns: the bag's first message (table times count from it).
+        end: how the benchmark ended (``end``, ``stop``, ``global_timeout``, ``log_ends``).
+        notes: what the scoring says on stderr.
+    """
+
+    score: dict[str, Any]
+    goals: tuple[GoalRecord, ...]
+    rules: str = "ertools"
+    crashed: str | None = None
+    comparison: ScoreComparison | None = None
+    intervals: HopfIntervals | None = None
+    origin_ns: int | None = None
+    end: str = ""
+    notes: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
+    failures: tuple[str, ...] = ()
+    provenance: Provenance = field(default_factory=Provenance)
+    name: str = "hopf"
+
+    @property
+    def pose_score(self) -> float | None:
+        """The total pose score (the leaderboard's number)."""
+        value = self.score.get("pose_score")
+        return float(value) if isinstance(value, int | float) else None
+
+    @property
+    def nothing_scored(self) -> bool:
+        """No goal was scored and the data is at fault (no ground truth for any answer)."""
+        if any(g.status == "scored" for g in self.goals):
+            return False
+        return any(g.status == "unscoreable" for g in self.goals)
+
+    def _extras(self) -> dict[str, Any]:
+        iv = self.intervals
+        if iv is None:
+            return {}
+        return {
+            "pose_score_interval": None if iv.total is None else iv.total.as_list(),
+            "uncertainty": iv.uncertainty.to_dict(),
+        }
+
+    def to_dict(self) -> dict[str, Any]:
+        """The score (result-file form), then the intervals."""
+        data: dict[str, Any] = jsonable({**self.score, **self._extras()})
+        return data
+
+    def to_yaml(self) -> str:
+        """The score as the BmBox wrote it into the result file (keys sorted), then the
+        intervals."""
+        return score_yaml({**self.score, **self._extras()})
+
+    def interval_lines(self) -> list[str]:
+        """The stderr lines of the intervals."""
+        iv = self.intervals
+        if iv is None:
+            return []
+        rows = [ScoreRow("pose_score", self.pose_score, iv.total, 1.0, "")]
+        for g in self.goals:
+            if g.index in iv.goals and g.terms is not None:
+                rows.append(
+                    ScoreRow(f"goal_{g.index} pose_score", g.terms[5], iv.goals[g.index], 1.0, "")
+                )
+        return interval_lines(rows, iv.uncertainty)
+
+    def _rel(self, t: int | None) -> float | None:
+        return None if t is None or self.origin_ns is None else ns_to_s(t - self.origin_ns)
+
+    def tables(self) -> dict[str, Rows]:
+        """``goals`` (one row per iteration), ``summary``, ``comparison`` (one row per score
+        field, when there is something to compare with) and ``uncertainty``."""
+        rows: Rows = []
+        for g in self.goals:
+            truth = g.truth.pose if g.truth is not None and g.truth.pose is not None else None
+            ans = g.answer
+            terms = g.terms
+            iv = self.intervals.goals.get(g.index) if self.intervals is not None else None
+            rows.append(
+                {
+                    "goal": g.index,
+                    "status": g.status,
+                    "counted": g.counted,
+                    "item_id": None if g.item is None else g.item.id,
+                    "item_class": None if g.item is None else str(g.item.item_class),
+                    "item_instance": None if g.item is None else str(g.item.instance),
+                    "lookup_s": self._rel(None if g.truth is None else g.truth.moment_ns),
+                    "lookup_inferred": None if g.truth is None else g.truth.inferred,
+                    "gap_ms": None if g.truth is None else g.truth.gap_ns / 1e6,
+                    "start_s": self._rel(None if g.times is None else g.times.start_ns),
+                    "end_s": self._rel(None if g.times is None else g.times.end_ns),
+                    "segment_time_s": None if g.segment_ns is None else g.segment_ns / 1e9,
+                    "truth_x": None if truth is None else truth[0],
+                    "truth_y": None if truth is None else truth[1],
+                    "truth_theta": None if truth is None else truth[2],
+                    "answer_x": None if ans is None or ans.pose is None else ans.pose[0],
+                    "answer_y": None if ans is None or ans.pose is None else ans.pose[1],
+                    "answer_theta": None if ans is None or ans.pose is None else ans.pose[2],
+                    "answer_class": None if ans is None else _text(ans.item_class),
+                    "answer_instance": None if ans is None else _text(ans.instance),
+                    "class_ok": g.class_ok,
+                    "instance_ok": g.instance_ok,
+                    "x_err": None if terms is None else terms[0],
+                    "y_err": None if terms is None else terms[1],
+                    "w_err": None if terms is None else terms[2],
+                    "translation": None if terms is None else terms[3],
+                    "rotation": None if terms is None else terms[4],
+                    "pose_score": None if terms is None else terms[5],
+                    "pose_score_low": None if iv is None else iv.low,
+                    "pose_score_high": None if iv is None else iv.high,
+                    "problem": None if ans is None else ans.problem,
+                    "no_truth_reason": None if g.truth is None else g.truth.reason,
+                }
+            )
+        total = self.intervals.total if self.intervals is not None else None
+        summary: Rows = [
+            {
+                "rules": self.rules,
+                "class_accuracy": self.score.get("class_accuracy"),
+                "instance_accuracy": self.score.get("instance_accuracy"),
+                "pose_score": self.score.get("pose_score"),
+                "pose_score_low": None if total is None else total.low,
+                "pose_score_high": None if total is None else total.high,
+                "execution_time_s": self.score.get("execution_time"),
+                "goals": len(self.goals),
+                "counted": sum(g.counted for g in self.goals),
+                "end": self.end,
+                "crashed": self.crashed,
+            }
+        ]
+        out: dict[str, Rows] = {"goals": rows, "summary": summary}
+        if self.comparison is not None:
+            out["comparison"] = self.comparison.rows()
+        if self.intervals is not None:
+            out["uncertainty"] = uncertainty_rows(self.intervals.uncertainty)
+        return out
+
+    def to_frames(self) -> dict[str, pd.DataFrame]:
+        """Every table of :meth:`tables` as a pandas DataFrame."""
+        return tables_to_frames(self.tables())
+
+
+def _text(value: Any) -> str | None:
+    return None if value is None else str(value)

@@ -1,0 +1,94 @@
+"""HPFF's options: the script's reading (``--rules 2019``) or ertools', rule by rule.
+
+NumPy-free: the declaration and the CLI's parser import it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ertools.errors import UsageError
+
+RULE_SETS = ("ertools", "2019")
+SCRIPT_COMMIT = "2bb8a41"
+#: The script's sampling period and settling sleep (fbm5_person_following.py l. 96, 140).
+PERIOD_S = 0.5
+SETTLE_S = 8.0
+#: The duration rule's margin around goal_timeout (l. 151-153).
+MARGIN_S = 15.0
+#: ertools' reading: a body interpolated across at most this between its samples.
+DEFAULT_MAX_GAP_S = 0.1
+
+
+@dataclass(frozen=True)
+class HpffOptions:
+    """How to score an HPFF run.
+
+    Attributes:
+        config, transform, result, team: the side files (None: found beside the bag).
+        rules: ``ertools`` or ``2019``.
+        sampling_script: the script's own samples (its logged lookups) rather than a 2 Hz grid.
+        plane_actor: the distance in the cap's frame (the script's) rather than horizontal.
+        clock_script: the duration from the script's start to its loop's end rather than the
+            RefBox's goal start and end.
+        stopped_2019: a stopped run scores ``{}``.
+        max_gap_s: the widest mocap interval a body is interpolated across (grid sampling).
+        confidence, draws, seed: the intervals.
+    """
+
+    config: Path | None = None
+    transform: Path | None = None
+    result: Path | None = None
+    team: str | None = None
+    rules: str = "ertools"
+    sampling_script: bool = False
+    plane_actor: bool = False
+    clock_script: bool = False
+    stopped_2019: bool = False
+    max_gap_s: float = DEFAULT_MAX_GAP_S
+    confidence: float = 0.95
+    draws: int = 0
+    seed: int = 0
+
+    @property
+    def faithful(self) -> bool:
+        return self.rules == "2019"
+
+
+def options_from(v: Mapping[str, Any]) -> HpffOptions:
+    """Options from resolved input values.
+
+    Raises:
+        UsageError: a rule option that contradicts ``--rules 2019``.
+    """
+    rules = str(v["rules"] or "ertools")
+    faithful = rules == "2019"
+    undo = {
+        "--sampling": v["sampling"] == "grid",
+        "--distance-plane": v["distance_plane"] == "testbed",
+        "--duration-clock": v["duration_clock"] == "refbox",
+    }
+    clash = [name for name, given in undo.items() if given]
+    if faithful and clash:
+        raise UsageError(
+            f"--rules 2019 reproduces the script: {', '.join(clash)} would undo it; "
+            "give one or the other"
+        )
+    return HpffOptions(
+        config=v["config"],
+        transform=v["transform"],
+        result=v["result"],
+        team=v["team"],
+        rules=rules,
+        sampling_script=faithful or v["sampling"] == "script",
+        plane_actor=faithful or v["distance_plane"] == "actor",
+        clock_script=faithful or v["duration_clock"] == "script",
+        stopped_2019=faithful,
+        max_gap_s=float(v["max_gap"]),
+        confidence=float(v["confidence"]),
+        draws=int(v["draws"]),
+        seed=int(v["seed"]),
+    )

@@ -1,0 +1,1 @@
+"""HPPF (FBM4@Home 2019, people perception) re-scored from its RSBB run logs."""

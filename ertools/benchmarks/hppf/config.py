@@ -1,0 +1,90 @@
+"""How an HPPF score is computed (the options, as data), its defaults and the script version
+``--rules 2019`` reproduces.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ertools.benchmarks.common.inputs import (
+    DEFAULT_CONFIDENCE,
+    DEFAULT_DRAWS,
+    DEFAULT_SEED,
+    check_confidence,
+)
+from ertools.errors import UsageError
+
+NAME = "hppf"
+CODE = "HPPF"
+
+SCRIPTS = {"2019": "2bb8a41"}
+SCRIPT_TEXT = {
+    "2019": "fbm4_people_perception.py at rockin-robot-challenge/rsbb 2bb8a41 (2018-19 season)",
+}
+RULE_SETS = ("ertools", *SCRIPTS)
+
+#: The ground truth's samples may be this far apart around the lookup's moment (ertools' rule):
+#: the mocap runs at 100-120 Hz, so 0.1 s is several lost frames.
+DEFAULT_MAX_GAP_S = 0.1
+
+
+@dataclass(frozen=True)
+class HppfOptions:
+    """Everything ``ertools score hppf`` can be told.
+
+    Attributes:
+        config: ``HPPF.yaml`` (None: found, else the first live score's copy).
+        result: the run's result file (None: found beside the bag; the live comparison).
+        rules: ``ertools`` (the options below decide) or ``2019``.
+        exact_names: names compared lower-cased with their blanks, as the script.
+        script_answers: an incomplete answer kills the script, as it did (``--rules 2019``).
+        gt_gaps: ``refuse`` (no ground truth across a gap wider than ``max_gap_s``) or
+            ``interpolate`` (tf's interpolation, as the script).
+        max_gap_s: see ``gt_gaps``.
+        confidence, draws, seed: the Distance error's intervals.
+    """
+
+    config: Path | None = None
+    result: Path | None = None
+    rules: str = "ertools"
+    exact_names: bool = False
+    script_answers: bool = False
+    gt_gaps: str = "refuse"
+    max_gap_s: float = DEFAULT_MAX_GAP_S
+    confidence: float = DEFAULT_CONFIDENCE
+    draws: int = DEFAULT_DRAWS
+    seed: int = DEFAULT_SEED
+
+    @property
+    def script(self) -> str | None:
+        """The script commit reproduced whole (``--rules``), None for ertools' reading."""
+        return SCRIPTS.get(self.rules)
+
+
+def make_options(values: Mapping[str, Any]) -> HppfOptions:
+    """Resolved input values (:func:`ertools.benchmarks.base.resolve_values`) -> options.
+
+    Raises:
+        UsageError: options that exclude each other.
+    """
+    rules = values.get("rules") or "ertools"
+    script = rules != "ertools"
+    gaps = values.get("gt_gaps") or "refuse"
+    max_gap = values.get("max_gap")
+    if script and max_gap is not None:
+        raise UsageError("--max-gap applies to ertools' reading, not to --rules " + rules)
+    return HppfOptions(
+        config=values.get("config"),
+        result=values.get("result"),
+        rules=rules,
+        exact_names=bool(values.get("exact_names")) or script,
+        script_answers=script,
+        gt_gaps="interpolate" if script else gaps,
+        max_gap_s=DEFAULT_MAX_GAP_S if max_gap is None else float(max_gap),
+        confidence=check_confidence(values.get("confidence", DEFAULT_CONFIDENCE)),
+        draws=int(values.get("draws", DEFAULT_DRAWS)),
+        seed=int(values.get("seed", DEFAULT_SEED)),
+    )

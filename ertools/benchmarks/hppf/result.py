@@ -1,0 +1,183 @@
+"""The HPPF result: the result file's ``score`` as the rules make it, one record per pass of
+the script's loop, the comparison with the scores the run left, and their output forms."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+from ertools.benchmarks.base import Rows
+from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
+from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, uncertainty_rows
+from ertools.benchmarks.hppf.goals import PassRecord
+from ertools.fidelity import Deviation
+from ertools.frames import tables_to_frames
+from ertools.rsbb.score import ScoreComparison, score_yaml
+from ertools.serialize import jsonable
+from ertools.streams import Provenance
+from ertools.timeutil import ns_to_s
+
+if TYPE_CHECKING:
+    import pandas as pd  # annotations only: pandas is imported by to_frames()
+
+DISTANCE_KEY = "Distance error"
+
+
+@dataclass(frozen=True)
+class HppfIntervals:
+    """The intervals of the position errors and of the Distance error (the cap's mocap noise).
+
+    Attributes:
+        total: of ``Distance error`` (None: none given).
+        goals: of each goal's position error, by goal number.
+        uncertainty: how they were obtained.
+    """
+
+    total: Interval | None
+    goals: dict[int, Interval | None]
+    uncertainty: Uncertainty
+
+
+@dataclass(frozen=True, eq=False)
+class HppfResult:
+    """A scored HPPF run (implements ``BenchmarkResult``).
+
+    Attributes:
+        score: the result file's ``score`` by the rules (``--rules 2019``: the last save).
+        passes: one record per pass of the script's loop (a restarted goal has two).
+        people: the config's people (N).
+        rules: ``ertools`` or ``2019``.
+        crashed: why the script died on this run (``--rules``), None when it did not.
+        comparison: the score against the live score and the result file.
+        intervals: the position errors' intervals (None with ``--draws 0`` or none scored).
+        origin_ns: the bag's first message (table times count from it).
+        end: how the benchmark ended.
+        notes: what the scoring says on stderr.
+    """
+
+    score: dict[str, Any]
+    passes: tuple[PassRecord, ...]
+    people: tuple[str, ...] = ()
+    rules: str = "ertools"
+    crashed: str | None = None
+    comparison: ScoreComparison | None = None
+    intervals: HppfIntervals | None = None
+    origin_ns: int | None = None
+    end: str = ""
+    notes: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
+    failures: tuple[str, ...] = ()
+    provenance: Provenance = field(default_factory=Provenance)
+    name: str = "hppf"
+
+    @property
+    def distance_error(self) -> float | None:
+        """The Distance error (the leaderboard's number), None when nothing was detected."""
+        value = self.score.get(DISTANCE_KEY)
+        return float(value) if isinstance(value, int | float) else None
+
+    @property
+    def nothing_scored(self) -> bool:
+        """No position error and the data is at fault (no ground truth for any answer)."""
+        if any(p.position_error is not None for p in self.passes):
+            return False
+        return any(p.status == "unscoreable" for p in self.passes)
+
+    def _extras(self) -> dict[str, Any]:
+        iv = self.intervals
+        if iv is None:
+            return {}
+        return {
+            "Distance error interval": None if iv.total is None else iv.total.as_list(),
+            "uncertainty": iv.uncertainty.to_dict(),
+        }
+
+    def to_dict(self) -> dict[str, Any]:
+        """The score (result-file form), then the intervals."""
+        data: dict[str, Any] = jsonable({**self.score, **self._extras()})
+        return data
+
+    def to_yaml(self) -> str:
+        """The score as the BmBox wrote it into the result file (keys sorted), then the
+        intervals."""
+        return score_yaml({**self.score, **self._extras()})
+
+    def interval_lines(self) -> list[str]:
+        """The stderr lines of the intervals (millimetres)."""
+        iv = self.intervals
+        if iv is None:
+            return []
+        rows = [ScoreRow(DISTANCE_KEY, self.distance_error, iv.total, 1000.0, "mm")]
+        for p in self.passes:
+            if p.position_error is not None and p.index in iv.goals:
+                rows.append(
+                    ScoreRow(
+                        f"goal_{p.index} position_error",
+                        p.position_error,
+                        iv.goals[p.index],
+                        1000.0,
+                        "mm",
+                    )
+                )
+        return interval_lines(rows, iv.uncertainty)
+
+    def _rel(self, t: int | None) -> float | None:
+        return None if t is None or self.origin_ns is None else ns_to_s(t - self.origin_ns)
+
+    def tables(self) -> dict[str, Rows]:
+        """``goals`` (one row per pass), ``summary``, ``comparison`` and ``uncertainty``."""
+        rows: Rows = []
+        for p in self.passes:
+            it, a, t = p.iteration, p.answer, p.truth
+            iv = self.intervals.goals.get(p.index) if self.intervals is not None else None
+            rows.append(
+                {
+                    "goal": p.index,
+                    "person": p.person,
+                    "status": p.status,
+                    "retries": len(it.retries),
+                    "check_s": self._rel(it.check_ns),
+                    "start_s": self._rel(None if it.times is None else it.times.start_ns),
+                    "end_s": self._rel(None if it.times is None else it.times.end_ns),
+                    "segment_time_s": None if it.times is None else it.times.segment_ns / 1e9,
+                    "lookup_s": self._rel(it.truth_ns),
+                    "gap_ms": None if t is None else t.gap_ns / 1e6,
+                    "truth_x": None if t is None or t.xy is None else t.xy[0],
+                    "truth_y": None if t is None or t.xy is None else t.xy[1],
+                    "answer_x": None if a is None or a.xy is None else a.xy[0],
+                    "answer_y": None if a is None or a.xy is None else a.xy[1],
+                    "answer_name": None if a is None else a.name,
+                    "recognized": p.recognized,
+                    "position_error_m": p.position_error,
+                    "position_error_low": None if iv is None else iv.low,
+                    "position_error_high": None if iv is None else iv.high,
+                    "problem": None if a is None else a.problem,
+                    "no_truth_reason": None if t is None else t.reason,
+                }
+            )
+        total = self.intervals.total if self.intervals is not None else None
+        summary: Rows = [
+            {
+                "rules": self.rules,
+                "people": len(self.people),
+                "recognized": self.score.get("Recognized persons"),
+                "recognized_percent": self.score.get("% Recognized persons"),
+                "distance_error_m": self.distance_error,
+                "distance_error_low": None if total is None else total.low,
+                "distance_error_high": None if total is None else total.high,
+                "execution_time_s": self.score.get("execution_time"),
+                "end": self.end,
+                "crashed": self.crashed,
+            }
+        ]
+        out: dict[str, Rows] = {"goals": rows, "summary": summary}
+        if self.comparison is not None:
+            out["comparison"] = self.comparison.rows()
+        if self.intervals is not None:
+            out["uncertainty"] = uncertainty_rows(self.intervals.uncertainty)
+        return out
+
+    def to_frames(self) -> dict[str, pd.DataFrame]:
+        """Every table of :meth:`tables` as a pandas DataFrame."""
+        return tables_to_frames(self.tables())

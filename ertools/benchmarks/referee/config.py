@@ -1,0 +1,64 @@
+"""The referee-scored benchmarks' names and options (:class:`RefereeOptions`), and
+:func:`make_options`, which turns the declared inputs' values into them."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ertools.errors import UsageError
+from ertools.rsbb_states import BENCHMARKS, REFEREE_CODES
+
+#: Registry name -> RSBB code, for every benchmark the referee alone scores.
+CODES: dict[str, str] = {code.lower(): code for code in REFEREE_CODES}
+
+# The ERL order as one number (higher is better): achievements, then penalties, then time.
+# Exact as long as there are fewer than PENALTY_SCALE penalties and the time is below
+# TIME_SCALE / PENALTY_SCALE seconds (the RSBB's timeouts are 120 s and 600 s).
+PENALTY_SCALE = 1_000.0
+TIME_SCALE = 10_000_000.0
+
+
+def title(code: str) -> str:
+    """``HWV (Task Benchmark 2: Welcoming visitors)``."""
+    return f"{code} ({BENCHMARKS[code].name})"
+
+
+@dataclass(frozen=True)
+class RefereeOptions:
+    """Everything ``ertools score hgtkmh|hwv|hcfgac|stb`` can be told.
+
+    Attributes:
+        code: the RSBB code (``HWV``).
+        description: ``benchmarks_description.yaml`` (the items' groups, kinds and order);
+            None: the items as the log names them.
+        result: the run's result file (scripted benchmarks: its ``referee_score``).
+        team, run: the run's team and number; None: from the bag's RSBB folder and name,
+            else the only zone of the benchmark the log shows.
+    """
+
+    code: str
+    description: Path | None = None
+    result: Path | None = None
+    team: str | None = None
+    run: int | None = None
+
+
+def make_options(code: str, v: Mapping[str, Any]) -> RefereeOptions:
+    """The declared inputs' values (resolved) -> :class:`RefereeOptions`.
+
+    Raises:
+        UsageError: an unknown benchmark code.
+    """
+    if code not in BENCHMARKS:
+        raise UsageError(f"unknown RSBB benchmark {code!r}")
+    run = v.get("run")
+    return RefereeOptions(
+        code=code,
+        description=v.get("description"),
+        result=v.get("result"),
+        team=v.get("team") or None,
+        run=None if run is None else int(run),
+    )
