@@ -78,6 +78,7 @@ def field_path(monkeypatch: pytest.MonkeyPatch, general_path: None) -> None:
     monkeypatch.setattr(assemble, "layout_of", lambda *args, **kwargs: None)
 
 
+@pytest.mark.slow_cases("rosbag2-sqlite3", "rosbag2-mcap")
 def test_one_read_of_every_topic_equals_rosbags(
     scene_bag: tuple[str, Path], no_field_decoder: None
 ) -> None:
@@ -88,6 +89,12 @@ def test_one_read_of_every_topic_equals_rosbags(
         assert_same(batch, reference_batch(path, topic))
 
 
+@pytest.mark.slow_cases(
+    "rosbag2-sqlite3-general_path",
+    "rosbag2-sqlite3-field_path",
+    "rosbag2-mcap-general_path",
+    "rosbag2-mcap-field_path",
+)
 @pytest.mark.parametrize("mode", ["general_path", "field_path"])
 def test_general_and_field_paths_equal_the_one_gather_path(
     scene_bag: tuple[str, Path], mode: str, request: pytest.FixtureRequest
@@ -106,6 +113,7 @@ def _recorded_bags() -> list[Any]:
     return real + [pytest.param(p, id=p.name) for p in sample_bags()]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", _recorded_bags())
 def test_one_read_of_a_recorded_bag_equals_rosbags_and_the_general_path(
     path: Path, monkeypatch: pytest.MonkeyPatch
@@ -126,6 +134,7 @@ def test_one_read_of_a_recorded_bag_equals_rosbags_and_the_general_path(
         assert_same(a, reference_batch(path, topic))
 
 
+@pytest.mark.slow_cases("rosbag2-sqlite3", "rosbag2-mcap")
 def test_windows_cutting_chunks_in_one_read(scene_bag: tuple[str, Path], scene: Scene) -> None:
     """Each request of one read keeps its own window (the scene's 2000-byte chunks hold a few
     messages each, so every window edge falls inside a chunk)."""
@@ -214,6 +223,7 @@ def _odd_frames_spec(seed: int) -> Spec:
 ODD_TOPICS = ["/poses", "/pose2d", "/tf", "/odom"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", FORMATS)
 def test_odd_frames_mixed_connections_and_alignments_equal_rosbags(
     tmp_path: Path, fmt: str
@@ -226,6 +236,7 @@ def test_odd_frames_mixed_connections_and_alignments_equal_rosbags(
         assert_same(batch, ref)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("compression", ["none", "zstd", "lz4"])
 def test_mcap_chunk_compressions_equal_rosbags(
     tmp_path: Path, scene: Scene, compression: str
@@ -242,6 +253,7 @@ def test_mcap_chunk_compressions_equal_rosbags(
         assert_same(batch, reference_batch(path, topic))
 
 
+@pytest.mark.slow_cases("rosbag2-sqlite3", "rosbag2-mcap")
 def test_read_pose_sources_equals_one_source_at_a_time(
     scene_bag: tuple[str, Path], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -282,6 +294,7 @@ def test_read_pose_sources_names_the_missing_source(scene_bag: tuple[str, Path])
         eio.read_pose_sources(path, sources)
 
 
+@pytest.mark.slow_cases("rosbag2-sqlite3", "rosbag2-mcap")
 def test_state_topics_in_one_pass_equal_one_at_a_time(
     scene_bag: tuple[str, Path], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -373,6 +386,7 @@ def test_errors_of_requests_decoded_side_by_side_come_in_request_order(tmp_path:
 # --- property tests
 
 
+@pytest.mark.slow
 @settings(max_examples=200, deadline=None)
 @given(st.lists(st.lists(st.integers(0, 30), max_size=12), min_size=1, max_size=4), st.data())
 def test_merged_columns_are_a_stable_sort(parts: list[list[int]], data: st.DataObject) -> None:
@@ -443,6 +457,7 @@ def layouts(draw: st.DrawFn) -> tuple[Spec, str, int]:
     return s, fmt, draw(st.sampled_from([300, 2000, 100_000]))
 
 
+@pytest.mark.slow
 @settings(
     max_examples=25,
     deadline=None,

@@ -27,8 +27,8 @@ from ertools.io.ros1.check import check_ros1, rebuild_layout
 from ertools.io.ros1.layout import scan_layout
 from ertools.io.summary import summary as bag_summary
 from tests.helpers.bagmaker import Spec, write
+from tests.helpers.fastpath import REAL_BAG, sample_bags
 from tests.helpers.stderr_text import error_messages
-from tests.io.test_io_fastpath import REAL_BAG, _sample_bags
 
 T0 = 1_445_609_740_000_000_000
 DT = 10_000_000
@@ -129,7 +129,7 @@ def test_sound_bags_check_clean(tmp_path: Path, fmt: str) -> None:
 def test_sample_and_real_bags_check_clean() -> None:
 
     # (the samples include deliberately truncated bags: those already fail the summary)
-    bags = [p for p in _sample_bags() if p.suffix == ".bag" and not bag_summary(p).problems]
+    bags = [p for p in sample_bags() if p.suffix == ".bag" and not bag_summary(p).problems]
     if REAL_BAG.is_file():
         bags.append(REAL_BAG)
     if not bags:

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from ertools.benchmarks import registry
+from ertools.benchmarks.scoring import score_execution
 from tests.benchmarks.hopf.hopf_runs import STOPS, build, replay, write
 from tests.helpers.rsbb_fields import same
 
@@ -47,8 +48,8 @@ PLANS["stop_first"] = ["stop_mo1"]
 
 def _score(bag: Path, items: Path, config: Path, rules: str) -> Any:
     bench = registry.get("hopf")
-    opts = bench.make_options({"items": items, "config": config, "rules": rules, "draws": 0})
-    return bench.score([bag], opts)
+    values = {"items": items, "config": config, "rules": rules, "draws": 0}
+    return score_execution(bench, [bag], values).result
 
 
 @pytest.mark.parametrize("rules", ["2019", "2017", "2017-11"])

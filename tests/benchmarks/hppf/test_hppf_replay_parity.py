@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from ertools.benchmarks import registry
+from ertools.benchmarks.scoring import score_execution
 from tests.benchmarks.hppf.hppf_runs import STOPS, build, replay, write
 from tests.helpers.rsbb_fields import same
 
@@ -36,8 +37,8 @@ PLANS["stop_first"] = ["stop_enter"]
 
 def _score(bag: Path, config: Path, rules: str) -> Any:
     bench = registry.get("hppf")
-    opts = bench.make_options({"config": config, "rules": rules, "draws": 0})
-    return bench.score([bag], opts)
+    values = {"config": config, "rules": rules, "draws": 0}
+    return score_execution(bench, [bag], values).result
 
 
 @pytest.mark.parametrize("plan", sorted(PLANS))
