@@ -95,7 +95,7 @@ def preload_scoring() -> None:
         # (imported for what they leave in sys.modules: the scorers forked later inherit them)
         import scipy.interpolate  # lazy: scipy, 300 ms
         import scipy.spatial.transform  # lazy: scipy, 300 ms
-        import scipy.stats  # noqa: F401  # lazy: scipy, 300 ms
+        import scipy.special  # noqa: F401  # lazy: scipy, 300 ms
 
 
 def ertools_own(target: str) -> bool:
