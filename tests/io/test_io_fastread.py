@@ -19,14 +19,14 @@ from hypothesis import strategies as st
 from mcap.writer import CompressionType
 
 from ertools.errors import BagError, TopicError
-from ertools.io import assemble, bulk, reader, summary
-from ertools.io import reader as eio
+from ertools.io import assemble, bulk, reader
 from ertools.io.decode.posebatch import PoseBatch
 from ertools.io.files import open_bag
 from ertools.io.model import POSE_TYPES, PoseSource
 from ertools.io.pipeline import Request
 from ertools.io.ros1 import runs as ros1_runs
 from ertools.io.ros1.entries import merged_columns
+from ertools.io.summary import summary
 from tests.helpers.bagmaker import FORMATS, Spec, bag_name, write
 from tests.helpers.fastpath import (
     POSE_TOPICS,
@@ -266,7 +266,7 @@ def test_read_pose_sources_equals_one_source_at_a_time(
         PoseSource(frame="robot_at_work"),
         PoseSource(topic="/fbm3w/tfs", time_source="record"),
     ]
-    alone = [eio.read_pose_source(path, s) for s in sources]
+    alone = [reader.read_pose_source(path, s) for s in sources]
     passes: list[int] = []
     real = reader.try_fast_batches
 
@@ -275,7 +275,7 @@ def test_read_pose_sources_equals_one_source_at_a_time(
         return real(bag, requests)
 
     monkeypatch.setattr(reader, "try_fast_batches", spy)
-    together = eio.read_pose_sources(path, sources)
+    together = reader.read_pose_sources(path, sources)
     with open_bag(path) as bag:
         publishers = len(bag.topic_conns("/tf"))  # (two, but one in rosbag2)
     # one pass: three topics and each /tf publisher (for the frame; no /tf_static)
@@ -291,7 +291,7 @@ def test_read_pose_sources_names_the_missing_source(scene_bag: tuple[str, Path])
     _fmt, path = scene_bag
     sources = [PoseSource(topic="/fbm3w/robot_at_work/pose"), PoseSource(topic="/nope")]
     with pytest.raises(TopicError, match=r"/nope not in .* pose topics there: "):
-        eio.read_pose_sources(path, sources)
+        reader.read_pose_sources(path, sources)
 
 
 @pytest.mark.slow_cases("rosbag2-sqlite3", "rosbag2-mcap")
@@ -299,7 +299,7 @@ def test_state_topics_in_one_pass_equal_one_at_a_time(
     scene_bag: tuple[str, Path], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     _fmt, path = scene_bag
-    alone = [eio.read_states(path, t) for t in STATE_TOPICS]
+    alone = [reader.read_states(path, t) for t in STATE_TOPICS]
     passes: list[int] = []
     real = bulk.locate_many
 
@@ -308,7 +308,7 @@ def test_state_topics_in_one_pass_equal_one_at_a_time(
         return real(bag, requests, progress)
 
     monkeypatch.setattr(bulk, "locate_many", spy)
-    states = eio.read_benchmark_states(path, "fbm3w")
+    states = reader.read_benchmark_states(path, "fbm3w")
     assert passes == [2]  # the two state topics of the scene, one pass
     for a, b in zip(alone, (states.bmbox, states.refbox), strict=True):
         assert b is not None
@@ -353,9 +353,9 @@ def test_damaged_record_fails_alike_alone_and_in_one_read(tmp_path: Path, what: 
         data[at + 8 : at + 12] = struct.pack("<I", 1 << 20)
     path.write_bytes(bytes(data))
     with pytest.raises(BagError) as alone:
-        eio.read_poses(path, "/p")  # the 11th record, of the even ones
+        reader.read_poses(path, "/p")  # the 11th record, of the even ones
     with pytest.raises(BagError) as together:
-        eio.read_pose_sources(path, [PoseSource(topic="/p"), PoseSource(topic="/q")])
+        reader.read_pose_sources(path, [PoseSource(topic="/p"), PoseSource(topic="/q")])
     assert str(alone.value) == str(together.value)
     assert "chunk" in str(alone.value)
 
@@ -373,13 +373,13 @@ def test_errors_of_requests_decoded_side_by_side_come_in_request_order(tmp_path:
     errors = {}
     for topic in ("/p", "/q"):
         with pytest.raises(BagError) as alone:
-            eio.read_poses(path, topic)
+            reader.read_poses(path, topic)
         errors[topic] = str(alone.value)
     assert errors["/p"] != errors["/q"]
     for first, second in (("/p", "/q"), ("/q", "/p")):
         sources = [PoseSource(topic=first), PoseSource(topic=second)]
         with pytest.raises(BagError) as together:
-            eio.read_pose_sources(path, sources)
+            reader.read_pose_sources(path, sources)
         assert str(together.value) == errors[first]
 
 
@@ -536,7 +536,7 @@ def test_tf_frames_of_several_publishers_equal_rosbags(
 
     monkeypatch.setattr(reader, "load_pose_batch", spy)
     sources = [PoseSource(topic="/p"), *(PoseSource(frame=f) for f in ("robot", "other", "map"))]
-    streams = eio.read_pose_sources(path, sources)
+    streams = reader.read_pose_sources(path, sources)
     with open_bag(path) as bag:
         publishers = len(bag.topic_conns("/tf"))  # (one in rosbag2: nothing to share)
     assert again == ([2] if shared and publishers == 2 else [])
