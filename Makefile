@@ -70,8 +70,8 @@ pytest-simd-off: $(DEVSTAMP)
 
 test: lint typecheck pytest pytest-simd-off
 
-# The edit-test loop: lint and the tests that take under a second (the slow ones are listed in
-# tests/slow.txt and marked `slow` by tests/conftest.py).
+# The edit-test loop: lint and the tests that take under a second (the slow ones are marked
+# `slow` on the test: docs/qa.md).
 check: $(DEVSTAMP)
 	$(BIN)/ruff check ertools tests bench fuzz
 	$(BIN)/ruff format --check ertools tests bench fuzz

@@ -18,7 +18,7 @@ import sys
 
 CODE = """
 import sys, time
-from ertools.io import read_poses
+from ertools.io.reader import read_poses
 path, topic = sys.argv[1], sys.argv[2]
 read_poses(path, topic)
 w, c = time.perf_counter(), time.process_time()

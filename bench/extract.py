@@ -2,7 +2,7 @@
 (``inside_s``: the work itself, after the imports, which are timed apart as ``import_s``).
 
 python bench/extract.py bytes PATH              read the file's bytes
-python bench/extract.py ertools PATH TOPIC      ertools.io.read_poses -> arrays
+python bench/extract.py ertools PATH TOPIC      ertools.io.reader.read_poses -> arrays
 python bench/extract.py rosbags PATH TOPIC      rosbags AnyReader, one message at a time
 python bench/extract.py inflate PATH            read and decompress every chunk, no decoding
 python bench/extract.py sources PATH BODY       the GT's three pose sources of BODY (its pose
@@ -23,7 +23,7 @@ def main() -> None:
     mode, path = sys.argv[1], Path(sys.argv[2])
     t_import = time.perf_counter()
     if mode == "ertools":
-        from ertools.io import read_poses
+        from ertools.io.reader import read_poses
     elif mode == "rosbags":
         import numpy as np
         from rosbags.highlevel import AnyReader
@@ -31,7 +31,7 @@ def main() -> None:
         from ertools.io.bulk import load_all_chunks
         from ertools.io.files import open_bag
     elif mode in ("sources", "each"):
-        from ertools.io import PoseSource, read_pose_source
+        from ertools.io.reader import PoseSource, read_pose_source
 
         body = sys.argv[3]
         sources = [
@@ -61,7 +61,7 @@ def main() -> None:
         with open_bag(path) as bag:
             n = load_all_chunks(bag)
     elif mode == "sources":
-        from ertools.io import read_pose_sources  # lazy: not in ertools before issue 39
+        from ertools.io.reader import read_pose_sources
 
         n = sum(len(s) for s in read_pose_sources(path, sources))
     elif mode == "each":

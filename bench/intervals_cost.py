@@ -38,13 +38,13 @@ S = REPO / "sample_bags"
 # it from its own module since)
 ENTRY = {
     "trajectory": (
-        ("ertools.benchmarks.trajectory.scoring", "trajectory_intervals"),
-        ("ertools.benchmarks.trajectory.scoring", "mocap_sigma"),
+        ("ertools.benchmarks.trajectory.comparison", "trajectory_intervals"),
+        ("ertools.benchmarks.trajectory.comparison", "mocap_sigma"),
         ("ertools.benchmarks.trajectory.fitted", "trajectory_intervals"),
     ),
-    "fbm3w": (("ertools.benchmarks.fbm3w.benchmark", "with_intervals"),),
-    "fbm2h": (("ertools.benchmarks.fbm2h.benchmark", "with_intervals"),),
-    "fbm1": (("ertools.benchmarks.fbm1.benchmark", "fbm1_intervals"),),
+    "fbm3w": (("ertools.benchmarks.fbm3w.pipeline", "with_intervals"),),
+    "fbm2h": (("ertools.benchmarks.fbm2h.pipeline", "with_intervals"),),
+    "fbm1": (("ertools.benchmarks.fbm1.pipeline", "fbm1_intervals"),),
 }
 
 
@@ -193,9 +193,9 @@ def ensure_fbm1w(folder: Path) -> Path:
     if path.exists():
         return path
     from ertools.samples import fbm1  # lazy: only to write the log once
-    from ertools.samples.mocap import publish_environment, publish_mocap  # lazy: as above
-    from ertools.samples.statemachine import publish_states  # lazy: as above
-    from ertools.samples.writer import BagWriter  # lazy: as above
+    from ertools.simulator.mocap import publish_environment, publish_mocap  # lazy: as above
+    from ertools.simulator.statemachine import publish_states  # lazy: as above
+    from ertools.simulator.writer import BagWriter  # lazy: as above
 
     sim = fbm1.simulate(0)
     with BagWriter(path, "ros1") as bag:

@@ -18,7 +18,7 @@ from pathlib import Path
 from bagwrite import msgdef, typestore, write_mcap, write_ros1
 from data import GT_TOPIC, T0, gt_topics
 
-from ertools.io import read_poses
+from ertools.io.reader import read_poses
 from ertools.progress import Bar, reporting
 
 

@@ -4,7 +4,7 @@ tests/rescore/test_rescore_dask.py starts them), against `--jobs 2` on the same 
 season (issue 29 item 2: the fixed cost apart from the per-execution cost on a real cluster).
 
 A cluster's workers outlive a rescore: the first run into fresh workers pays their fixed cost
-(each worker's fork server, python -m ertools.rescore.children, and the first imports of each
+(each worker's fork server, python -m ertools.competition.children, and the first imports of each
 benchmark), the next runs only the client's connection and the executions. So the runs are:
 `--jobs 2`; the cluster on fresh workers; the cluster again (warm workers), each cold (an empty
 results folder), interleaved over ``--rounds`` rounds with fresh workers each round. CPU

@@ -1,11 +1,11 @@
 """A generated season for `make bench`: several competition days, more teams, >= 100 executions.
 
 Built on the sample competition (:mod:`ertools.samples.competition`): the same simulators
-(``ertools.samples.fbm1/fbm2h/fbm3w.simulate``), the same file writers (GT logger split every
-hour, one benchmark-manager log per execution, one robot log per execution) and the same
-folder layout, but ``DAYS`` days of ``SLOTS_PER_DAY`` executions each (FBM1H, FBM2H, FBM3W in
-turn, every 13 minutes from 09:05 UTC) by ten teams, and nothing broken on purpose: the
-benchmark measures throughput, the sample competition tests the problems.
+(``simulate`` of the FBM1, FBM2H and FBM3W ``sample`` modules), the same file writers (GT
+logger split every hour, one benchmark-manager log per execution, one robot log per execution)
+and the same folder layout, but ``DAYS`` days of ``SLOTS_PER_DAY`` executions each (FBM1H,
+FBM2H, FBM3W in turn, every 13 minutes from 09:05 UTC) by ten teams, and nothing broken on
+purpose: the benchmark measures throughput, the sample competition tests the problems.
 
     season/day<k>/gtlogger/log_mocap_<date>-08-59-58_<n>.bag
     season/day<k>/bmmanager/log_<benchmark>_<stamp>_0.bag
@@ -30,7 +30,9 @@ from typing import Any
 
 import numpy as np
 
-from ertools.samples import fbm1, fbm2h, fbm3w
+from ertools.benchmarks.fbm1 import sample as fbm1
+from ertools.benchmarks.fbm2h import sample as fbm2h
+from ertools.benchmarks.fbm3w import sample as fbm3w
 from ertools.samples.competition_files import (
     GtWindow,
     robot_poses,
@@ -41,8 +43,8 @@ from ertools.samples.competition_files import (
 
 # The one helper the sample competition keeps private: its FBM1 answer errors per team.
 from ertools.samples.competition_schedule import _fbm1_errors
-from ertools.samples.scenario import EPOCH_2015, log_name
-from ertools.samples.simulated import SimulatedRun
+from ertools.simulator.answers import EPOCH_2015, log_name
+from ertools.simulator.simulated import SimulatedRun
 
 NS = 1_000_000_000
 SEED = 2015_11_18

@@ -3,7 +3,7 @@
     python docs/build_api.py          # rewrites docs/api.md
     python docs/build_api.py --check  # exit 1 if the committed docs/api.md differs
 
-The page is the module's docstring, then each public function in ``ertools.api.ORDER``: its
+The page is the module's docstring, then each public function in ``ertools.API``: its
 signature and its docstring (whose examples run as doctests in ``make test``), then the
 inputs ``ertools.score`` takes for every benchmark of the registry.
 """
@@ -17,6 +17,7 @@ import sys
 import textwrap
 from pathlib import Path
 
+import ertools
 from ertools import api
 from ertools.benchmarks import registry
 
@@ -100,7 +101,7 @@ def api_markdown() -> str:
     intro = inspect.getdoc(api) or ""
     intro = re.sub(r":[a-z]+:`~?([^`]+)`", r"``\1``", intro)
     sections = [HEADER + intro.strip().replace("``", "`") + "\n"]
-    sections += [_section(name) for name in api.ORDER]
+    sections += [_section(name) for name in ertools.API]
     sections.append(_inputs())
     return re.sub(r"\n{3,}", "\n\n", "\n".join(sections))
 

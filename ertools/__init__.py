@@ -13,32 +13,26 @@ Everything else is private by convention and may change in any release
 
 from __future__ import annotations
 
-from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
-from ertools._callable import submodules
+from ertools._version import __version__
 
-__version__ = "0.1.0"
-
-# `ertools.audit`, `.timeline`, `.export` and `.rescore` are also packages: a package imported
-# sets its name on this module, so those four packages are themselves callable (their
-# __init__ makes them so) and each call runs the function of ertools.api.
-__all__ = [
+# The public names, once, in the order docs/api.md shows them.
+__all__ = [  # noqa: RUF022 (the docs' order, not alphabetical)
     "__version__",
-    "audit",
-    "export",
-    "figures",
     "info",
     "open_bag",
     "read_poses",
-    "rescore",
     "score",
+    "audit",
     "timeline",
+    "figures",
+    "export",
+    "rescore",
 ]
 API = tuple(__all__[1:])
-_PACKAGES = ("audit", "export", "rescore", "timeline")
 
-if TYPE_CHECKING:
+if TYPE_CHECKING:  # the same names for type checkers (tests/api: equal to API)
     from ertools.api import (
         audit,
         export,
@@ -53,16 +47,13 @@ if TYPE_CHECKING:
 
 
 def __getattr__(name: str) -> Any:
-    if name in _PACKAGES:
-        return import_module(f"ertools.{name}")
-    if name in API:
-        return getattr(import_module("ertools.api"), name)
-    # a private module reached as an attribute (`ertools.yamlout.dump`), imported on first use
-    return _submodule(name)
+    """A public function of ertools.api (PEP 562); any other name is an AttributeError."""
+    if name not in API:
+        raise AttributeError(f"module 'ertools' has no attribute {name!r}")
+    from ertools import api  # lazy: NumPy, the readers, the report: 300-700 ms
 
-
-_submodule = submodules(__name__)
+    return getattr(api, name)
 
 
 def __dir__() -> list[str]:
-    return sorted({*globals(), *API})
+    return sorted({"API", *__all__, *(name for name in globals() if name.startswith("__"))})

@@ -23,25 +23,26 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
-from ertools import atomic
-from ertools.audit.model import Audit
-from ertools.audit.rescore import ScoreInputs, audit_bag, infer_benchmark
+from ertools.atomic import write_text
+from ertools.auditing.model import Audit
+from ertools.auditing.recompute import ScoreInputs, audit_bag, infer_benchmark
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import rename_former
 from ertools.benchmarks.common.sources import read_source
 from ertools.benchmarks.common.spec import PoseSpec, TimeSource, parse_tf
-from ertools.benchmarks.common.which import refuse_other_benchmark
+from ertools.benchmarks.scoring import score_execution
+from ertools.competition.manifest import ManifestError, load_manifest
+from ertools.competition.run import rescore_competition
 from ertools.errors import ConfigError, UsageError
-from ertools.export.formats import FORMATS, format_poses
-from ertools.io import files, summary
+from ertools.exporting.formats import FORMATS, format_poses
+from ertools.io import files
+from ertools.io.summary import summary
 from ertools.parameters import checked, paths_list, value_of
 from ertools.report.figures import figure_specs
 from ertools.report.plots_audit import draw_timeline
 from ertools.report.plots_timeline import draw_gantt, timeline_figure
-from ertools.rescore.manifest import ManifestError, load_manifest
-from ertools.rescore.run import rescore_competition
-from ertools.timeline.model import Timeline
-from ertools.timeline.scan import scan
+from ertools.timelines.model import Timeline
+from ertools.timelines.scan import scan
 
 if TYPE_CHECKING:
     from ertools.benchmarks.base import BenchmarkResult
@@ -50,30 +51,6 @@ if TYPE_CHECKING:
     from ertools.streams import PoseStream
 
 PathLike = str | Path
-
-# The public names, in the order docs/api.md lists them.
-__all__ = [
-    "audit",
-    "export",
-    "figures",
-    "info",
-    "open_bag",
-    "read_poses",
-    "rescore",
-    "score",
-    "timeline",
-]
-ORDER = (
-    "info",
-    "open_bag",
-    "read_poses",
-    "score",
-    "audit",
-    "timeline",
-    "figures",
-    "export",
-    "rescore",
-)
 
 
 @checked
@@ -212,10 +189,7 @@ def score(name: str, bags: PathLike | Sequence[PathLike], **inputs: Any) -> Benc
     bag_list = paths_list(bags)
     if not bag_list:
         raise UsageError(f"give at least one bag (the log file) to score {name}")
-    refuse_other_benchmark(name, bag_list, values)
-    options = bench.make_options(values)
-    result: BenchmarkResult = bench.score(bag_list, options)
-    return result
+    return score_execution(bench, bag_list, values).result
 
 
 @checked
@@ -302,8 +276,7 @@ def figures(result: Any) -> list[Any]:
         >>> [type(f).__name__ for f in ertools.figures(t)]
         ['Figure', 'Figure']
     """
-    # lazy: matplotlib (~0.3 s) only when a figure is drawn
-    from matplotlib.figure import Figure
+    from matplotlib.figure import Figure  # lazy: matplotlib, 300 ms
 
     if isinstance(result, Timeline):
         day = Figure(figsize=(12, 4), layout="constrained")
@@ -351,7 +324,7 @@ def export(
         target = Path(out)
         if any(target.exists() and target.samefile(p) for p in paths_list(bags)):
             raise UsageError(f"out={target}: that is an input; ertools never overwrites its inputs")
-        atomic.write_text(target, text)
+        write_text(target, text)
     return text
 
 

@@ -12,9 +12,14 @@ import sys
 if __name__ == "__main__":
     # `python -m ertools.demo`: the module run under its own name, its imports included, inside
     # ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
-    from ertools import launch
+    from ertools.launch import run as launch
 
-    sys.exit(launch.run("ertools.demo:main", "python -m ertools.demo"))
+    def _start() -> object:
+        from ertools.demo import main  # lazy: in launch's Ctrl-C guard, 600 ms
+
+        return main()
+
+    sys.exit(launch(_start, "python -m ertools.demo"))
 
 import io
 from collections.abc import Iterator
@@ -22,8 +27,9 @@ from contextlib import redirect_stdout
 from dataclasses import dataclass
 from pathlib import Path
 
-from ertools import atomic
+from ertools.atomic import write_text
 from ertools.benchmarks import registry
+from ertools.benchmarks.base import Audited, Reported, Simulated
 from ertools.cli.main import main as ertools_main
 from ertools.samples.competition import DEFAULT_SEED, MANIFEST, write_competition
 
@@ -60,7 +66,7 @@ def steps(samples: Path, out: Path) -> Iterator[Step]:
     samples_by_name = {}
     for name in registry.names():
         bench = registry.get(name)
-        sample = bench.sample(samples) if bench.sample is not None else None
+        sample = bench.sample_args(samples) if isinstance(bench, Simulated) else None
         if sample is not None:
             samples_by_name[name] = list(sample)
     if not samples_by_name:
@@ -73,7 +79,7 @@ def steps(samples: Path, out: Path) -> Iterator[Step]:
     )
     for name, sample in samples_by_name.items():
         bench = registry.get(name)
-        foxglove = ["--foxglove", str(out / f"{name}.mcap")] if bench.foxglove else []
+        foxglove = ["--foxglove", str(out / f"{name}.mcap")] if isinstance(bench, Reported) else []
         yield Step(
             f"{bench.title} score",
             ["score", name, *sample, "--report", str(out / name), *foxglove],
@@ -86,7 +92,7 @@ def steps(samples: Path, out: Path) -> Iterator[Step]:
     )
     for name, sample in samples_by_name.items():
         bench = registry.get(name)
-        if bench.state_topics:
+        if isinstance(bench, Audited):
             yield Step(
                 f"audit of the {bench.title} benchmark",
                 ["audit", sample[0], "--format", "text", "--report", str(out / f"audit_{name}")],
@@ -153,7 +159,7 @@ def run(out: Path, samples: Path = SAMPLES) -> int:
             with redirect_stdout(printed):
                 code = ertools_main(step.argv)
             if printed.getvalue():  # nothing printed (its errors are above): no file
-                atomic.write_text(target, printed.getvalue())
+                write_text(target, printed.getvalue())
             else:
                 target.unlink(missing_ok=True)
                 target = None

@@ -18,21 +18,25 @@ if __name__ == "__main__":
     # `python -m ertools.fidelity`: the module run under its own name, its imports included, inside
     # ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
     # (the benchmark modules' Rule class is that module's, not __main__'s)
-    from ertools import launch
+    from ertools.launch import run as launch
 
-    sys.exit(launch.run("ertools.fidelity:main", "python -m ertools.fidelity"))
+    def _start() -> object:
+        from ertools.fidelity import main  # lazy: in launch's Ctrl-C guard, 10 ms
+
+        return main()
+
+    sys.exit(launch(_start, "python -m ertools.fidelity"))
 
 import importlib
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
-from ertools import atomic
+from ertools.atomic import write_text
 
 # Modules that declare Rule constants; the catalogue is what these hold, in this order.
 RULE_MODULES: tuple[str, ...] = (
     "ertools.benchmarks.fbm1.rules",
-    "ertools.benchmarks.fbm1.acquire",
     "ertools.benchmarks.fbm2h.rules",
     "ertools.benchmarks.fbm3w.rules",
     "ertools.benchmarks.trajectory.rules",
@@ -240,6 +244,6 @@ def main(argv: list[str] | None = None) -> int:
     text = path.read_text(encoding="utf-8")
     for table, begin, end in tables:
         text = replace_table(text, table, begin, end)
-    atomic.write_text(path, text)
+    write_text(path, text)
     print(f"wrote the version and rule tables of {path}")
     return 0

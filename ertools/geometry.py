@@ -294,8 +294,7 @@ class MeanPose:
 
 def mean_pose(xyz: F64, quat_xyzw: F64) -> MeanPose:
     """Average poses (positions arithmetically, rotations by the chordal L2 mean)."""
-    # lazy: scipy only where its rotations/statistics are needed (~0.3 s to import)
-    from scipy.spatial.transform import Rotation
+    from scipy.spatial.transform import Rotation  # lazy: scipy, 300 ms
 
     if len(xyz) == 0:
         raise ValueError("cannot average zero poses")

@@ -1,13 +1,14 @@
-"""Programs started from a shell: the ``ertools`` command and the ``python -m ertools...``
-modules, each a function run by :func:`run`.
+"""Programs started from a shell: the ``ertools`` command (ertools/__main__.py) and the
+``python -m ertools...`` modules, each a function run by :func:`run`.
 
 A Ctrl-C lands wherever the program is, often in its first moments, while NumPy or a command's
 modules are imported: Python's answer is a traceback of its import machinery, 30 to 70 lines.
 Here it is one line, ``PROGRAM: interrupted``, and exit status 130 (128 + SIGINT, what a shell
-shows for a program a Ctrl-C ended). The program's modules are imported inside :func:`run`, so
-that an interrupt during the imports is caught too; only Python's own start-up and this light
-module come before. A second Ctrl-C while the first is being answered (workers closed, files
-removed) ends the process at once, without a word.
+shows for a program a Ctrl-C ended). The program's modules are imported by the function that
+:func:`run` calls (a plain import inside it), so that an interrupt during the imports is caught
+too; only Python's own start-up and this light module come before. A second Ctrl-C while the
+first is being answered (workers closed, files removed) ends the process at once, without a
+word.
 """
 
 from __future__ import annotations
@@ -19,7 +20,6 @@ import sys
 import threading
 import time
 from collections.abc import Callable
-from importlib import import_module
 from types import FrameType
 from typing import Any
 
@@ -106,17 +106,16 @@ def interrupted(program: str) -> int:
     return INTERRUPTED
 
 
-def run(target: str, program: str) -> int:
-    """Import ``module:function`` and call it (no arguments; it reads ``sys.argv``); its exit
-    status, or :data:`INTERRUPTED` after one line when a Ctrl-C came at any moment, imports
-    included."""
+def run(start: Callable[[], object], program: str) -> int:
+    """Call ``start``, which imports the program's modules and runs it (it reads
+    ``sys.argv``); its exit status, or :data:`INTERRUPTED` after one line when a Ctrl-C came at
+    any moment, imports included."""
     hook = sys.unraisablehook
     try:
         if threading.current_thread() is threading.main_thread():
             signal.signal(signal.SIGINT, _on_interrupt)
             sys.unraisablehook = _unraisable(hook)
-        module, _, name = target.partition(":")
-        code = getattr(import_module(module), name)()
+        code = start()
     except KeyboardInterrupt:
         return interrupted(program)
     except Exception as err:  # an ImportError of NumPy's, say, made of the interrupt
@@ -129,8 +128,3 @@ def run(target: str, program: str) -> int:
         # done: a Ctrl-C while Python exits (its atexit work) ends it at once, no traceback
         signal.signal(signal.SIGINT, signal.SIG_DFL)
     return code if isinstance(code, int) else 0 if code is None else 1
-
-
-def main() -> int:
-    """The ``ertools`` console command (pyproject.toml's ``[project.scripts]``)."""
-    return run("ertools.cli.main:main", "ertools")

@@ -17,15 +17,14 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any, TypeVar, cast
 
-from ertools.audit.model import Audit
+from ertools.auditing.model import Audit
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Input
 from ertools.errors import UsageError
-from ertools.export.formats import FORMATS
-from ertools.timeline.model import Timeline
+from ertools.exporting.formats import FORMATS
+from ertools.timelines.model import Timeline
+from ertools.timeutil import MAX_SECONDS
 
-# The largest magnitude a number input may have (the CLI's rule, ertools.cli.main).
-_MAX_NUMBER = 4.6e9
 F = TypeVar("F", bound=Callable[..., Any])
 PathLike = str | Path
 
@@ -176,9 +175,9 @@ def value_of(declared: Input, value: Any) -> Any:
         )
     if declared.repeat:
         return [value]
-    if declared.kind == "float" and not (math.isfinite(value) and abs(value) < _MAX_NUMBER):
+    if declared.kind == "float" and not (math.isfinite(value) and abs(value) < MAX_SECONDS):
         raise UsageError(
-            f"{declared.name}={value}: give a finite number smaller than {_MAX_NUMBER:g} in size"
+            f"{declared.name}={value}: give a finite number smaller than {MAX_SECONDS:g} in size"
         )
     return value
 

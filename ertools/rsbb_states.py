@@ -2,7 +2,7 @@
 
 Read from ``rockin-robot-challenge/rsbb`` at ``2bb8a41`` and its October 2017 rewrite
 ``Enri2077/rsbb`` (docs/rsbb.md gives the sources line by line). Pure data: the reader
-(:mod:`ertools.rsbb`), the simulator (:mod:`ertools.samples.rsbb`) and the benchmarks share it.
+(:mod:`ertools.rsbb`), the simulator (:mod:`ertools.simulator.rsbb`) and the benchmarks share it.
 """
 
 from __future__ import annotations

@@ -6,10 +6,10 @@ An *answer* has three parts, each judged on its own:
   :func:`ertools.io.info.describe` (what ``ertools info`` prints), the official one lists the
   connections (channels) and counts the messages it iterates.
 - ``poses``: the ``PoseStamped`` topic as rows (record time, x, y, z, qx, qy, qz, qw);
-  ertools' is :func:`ertools.io.read_poses` (``time_source="record"``), the official one
+  ertools' is :func:`ertools.io.reader.read_poses` (``time_source="record"``), the official one
   deserializes every message with rosbags (definitions stored in the file).
 - ``tf``: ``world -> robot`` from ``/tf`` as rows (header stamp, translation, rotation);
-  ertools' is :func:`ertools.io.read_tf`.
+  ertools' is :func:`ertools.io.reader.read_tf`.
 
 Official readers: rosbags' ``AnyReader`` for ROS1, ``mcap``'s seeking reader for MCAP
 (it falls back to a linear read when the summary has no chunk indexes).
@@ -76,8 +76,8 @@ def _rows(t: list[int], v: list[list[float]]) -> Rows:
 def ertools_answer(path: Path) -> dict[str, Outcome | str]:
     """Each part as an Outcome, or the text of a traceback (a bug)."""
     from ertools.errors import BagError, ErtoolsError
-    from ertools.io import read_poses, read_tf
     from ertools.io.info import describe
+    from ertools.io.reader import read_poses, read_tf
 
     def summary() -> Summary:
         info = describe(path)

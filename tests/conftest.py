@@ -1,5 +1,6 @@
-"""Test-suite root: its presence puts ``tests/`` on ``sys.path`` (pytest's prepend import
-mode), so helpers shared by several test folders live in one module, ``tests/fakes.py``."""
+"""Test-suite root: fixtures and hooks for every test. ``tests`` is a package (pytest's
+``pythonpath`` puts the clone's root on ``sys.path``): a test imports what it shares with
+other folders as ``from tests.helpers.fakes import ...``."""
 
 import contextlib
 import dataclasses
@@ -57,23 +58,12 @@ def pytest_make_collect_report(collector: pytest.Collector) -> object:
 # Running in parallel (`make test`: pytest-xdist, --dist loadgroup)
 
 TESTS = Path(__file__).resolve().parent
-# Tests that measure time (a bound on seconds) or hold live sockets and processes: one xdist
-# group, so that they run one after another on one worker, never beside each other's load.
-TIMING = (
-    "core/test_cli_main.py::test_help_is_instant_and_imports_nothing_heavy",
-    "timeline/test_timeline_pictures.py::test_page_of_1000_bags_is_built_quickly",
-    "samples/test_samples_writer.py::test_bulk_write_speed",
-    "live/",
-    # a recording and its monitor side by side, on a deadline
-    "e2e/test_docs_commands.py::test_docs_commands_run_as_printed[live.md]",
-)
-
-
-def _slow() -> tuple[str, ...]:
-    """The node ids (or prefixes) of tests/slow.txt: tests that take a second or more."""
-    listed = TESTS / "slow.txt"
-    lines = listed.read_text(encoding="utf-8").splitlines() if listed.is_file() else []
-    return tuple(ln.split("#")[0].strip() for ln in lines if ln.split("#")[0].strip())
+# Tests that measure time (a bound on seconds) or hold live sockets and processes carry
+# `pytest.mark.xdist_group("timing")`: they run one after another on one worker, never beside
+# each other's load. Tests that take a second or more carry `pytest.mark.slow` (`make check`
+# leaves them out: docs/qa.md says which); where only some cases of a parametrised test are
+# slow, `pytest.mark.slow_cases("id", ...)` names them (a fixture's parameters cannot carry a
+# mark of their own).
 
 
 def _shares_a_module_fixture(item: pytest.Item) -> bool:
@@ -89,9 +79,10 @@ def _shares_a_module_fixture(item: pytest.Item) -> bool:
 def pytest_collection_modifyitems(
     config: pytest.Config, items: list[pytest.Item]
 ) -> Generator[None, None, None]:
-    """Marks the groups and the slow tests before xdist (and every other plugin) reads the
+    """Marks the groups and the slow cases before xdist (and every other plugin) reads the
     marks; after them, makes sure each grouped test's node id carries its group."""
     _mark(items)
+    _mark_slow_cases(config, items)
     yield
     if getattr(config.option, "loadgroup", False):  # an xdist worker under --dist loadgroup
         for item in items:
@@ -129,25 +120,40 @@ def _suffix_group(item: pytest.Item) -> None:
 
 
 def _mark(items: list[pytest.Item]) -> None:
-    slow = _slow()
     for item in items:
         path = Path(str(item.path)).resolve()
-        if not path.is_relative_to(TESTS):
-            continue
+        if not path.is_relative_to(TESTS) or item.get_closest_marker("xdist_group"):
+            continue  # a group written on the test wins
         rel = path.relative_to(TESTS).as_posix()
-        node = rel + item.nodeid[item.nodeid.index("::") :] if "::" in item.nodeid else rel
         closure = getattr(getattr(item, "_fixtureinfo", None), "names_closure", ())
-        if node.startswith(TIMING):
-            item.add_marker(pytest.mark.xdist_group("timing"))
-        elif "rescored_competition" in closure:
+        if "rescored_competition" in closure:
             # the modules reading it on one worker: the other would wait for it, idle
             item.add_marker(pytest.mark.xdist_group("rescored_competition"))
         elif _shares_a_module_fixture(item):
             # Its module's tests on one worker: the fixture (a rescored folder, a report) is
             # made once, not once on each worker that draws one of them.
             item.add_marker(pytest.mark.xdist_group(rel))
-        if node.startswith(slow):
+
+
+def _mark_slow_cases(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """``slow`` on the cases that a test's ``slow_cases`` mark names. When whole files were
+    collected (no ``path::test`` argument), a name that is no case of its test is an error:
+    a typo would otherwise put a slow case back into ``make check`` unnoticed."""
+    unmatched: dict[tuple[str, str], bool] = {}
+    for item in items:
+        mark = item.get_closest_marker("slow_cases")
+        if mark is None:
+            continue
+        case = getattr(getattr(item, "callspec", None), "id", None)
+        test = item.nodeid.partition("[")[0]
+        for name in mark.args:
+            unmatched.setdefault((test, name), True)
+        if case in mark.args:
             item.add_marker(pytest.mark.slow)
+            unmatched[(test, case)] = False
+    missing = [f"{test}[{name}]" for (test, name), left in unmatched.items() if left]
+    if missing and not any("::" in arg for arg in config.args):
+        raise pytest.UsageError(f"slow_cases names no case of its test: {', '.join(missing)}")
 
 
 @contextlib.contextmanager

@@ -1,9 +1,9 @@
 """Calibration of the FBM1 intervals: one simulated FBM1@Home execution per trial.
 
-The simulator (:func:`ertools.samples.fbm1.simulate`) draws the table, ten board placements,
-the items' transforms, the robot's answers and the mocap noise of both marker sets from the
-seed, and computes each run's true ground truth and score from the noiseless poses with 4x4
-matrices (``expected``). The item list the scorer is given is the one an acquisition would
+The simulator (:func:`ertools.benchmarks.fbm1.sample.simulate`) draws the table, ten board
+placements, the items' transforms, the robot's answers and the mocap noise of both marker sets
+from the seed, and computes each run's true ground truth and score from the noiseless poses
+with 4x4 matrices (``expected``). The item list the scorer is given is the one an acquisition would
 have written (``ertools acquire items``): each item's transform measured as the mean of
 ``ACQUIRE_SAMPLES`` noisy samples, with their spread, so the transform source is exercised as
 in real use. The noisy log is scored by the pure scorer :func:`~ertools.benchmarks.fbm1.
@@ -63,12 +63,12 @@ def _acquired(items: list[dict[str, Any]], rng: np.random.Generator) -> Any:
 
 def score(seed: int, draws: int) -> tuple[Any, Any]:
     """(the simulated execution, its score with intervals)."""
-    from ertools.benchmarks.common.interval_output import IntervalSettings
-    from ertools.benchmarks.fbm1.benchmark import score_fbm1
+    from ertools.benchmarks.common.inputs import IntervalSettings
     from ertools.benchmarks.fbm1.config import Fbm1Options
+    from ertools.benchmarks.fbm1.pipeline import score_fbm1
     from ertools.benchmarks.fbm1.runs import find_runs
-    from ertools.samples.fbm1 import item_list, simulate
-    from ertools.samples.statemachine import state_messages
+    from ertools.benchmarks.fbm1.sample import item_list, simulate
+    from ertools.simulator.statemachine import state_messages
     from ertools.states import Machine
     from ertools.streams import PoseStream, StateStream
 

@@ -1,9 +1,10 @@
-"""FBM2@Home calibration trial: the simulator's five-waypoint execution (ertools.samples.fbm2h:
-120 Hz mocap, 0.2 mm and 0.5 mrad of noise, one tracking loss while driving, a tilted marker
-set), its noisy marker stream scored as ``ertools score fbm2h`` scores it (``compute`` then
-``with_intervals``, the pure stages of ``score_found``; the reached moments are the logged
-ones: EXECUTING_GOAL to the Client's COMPLETED_GOAL), against the simulator's noiseless truth
-(``expected``: the stop poses against the waypoints, with the seed's formulas).
+"""FBM2@Home calibration trial: the simulator's five-waypoint execution
+(ertools.benchmarks.fbm2h.sample: 120 Hz mocap, 0.2 mm and 0.5 mrad of noise, one tracking
+loss while driving, a tilted marker set), its noisy marker stream scored as ``ertools score
+fbm2h`` scores it (``compute`` then ``with_intervals``, the pure stages of ``score_runs``; the
+reached moments are the logged ones: EXECUTING_GOAL to the Client's COMPLETED_GOAL), against
+the simulator's noiseless truth (``expected``: the stop poses against the waypoints, with the
+seed's formulas).
 
 The transform is acquired as the 2015 node did, from one mocap sample with the robot on the
 origin: the simulator's exact transform turned and shifted by one measurement's noise (the
@@ -16,12 +17,13 @@ import numpy as np
 import yaml
 from scipy.spatial.transform import Rotation
 
-from ertools.benchmarks.fbm2h.benchmark import compute, with_intervals
+from ertools.benchmarks.fbm2h import sample as sim_fbm2h
 from ertools.benchmarks.fbm2h.config import Fbm2hOptions
-from ertools.benchmarks.fbm2h.segments import ReachedMoments
-from ertools.configs.goal import parse_goal
+from ertools.benchmarks.fbm2h.goal import parse_goal
+from ertools.benchmarks.fbm2h.intervals import with_intervals
+from ertools.benchmarks.fbm2h.pipeline import compute
+from ertools.benchmarks.fbm2h.runs import ReachedMoments
 from ertools.configs.transform import MarkerTransform, parse_transform
-from ertools.samples import fbm2h as sim_fbm2h
 from ertools.streams import PoseStream
 
 

@@ -1,21 +1,21 @@
-"""FBM3@Work calibration trial: the simulator's five-run execution (ertools.samples.fbm3w:
-120 Hz mocap, 0.05 mm of noise per axis, one tracking loss, run 4 timed out), its noisy
-Pose2D stream scored as ``ertools score fbm3w`` scores it (``score_runs``, the noise measured
-from the stream's own stationary phases), against the noiseless truth the simulator computes
-with its own Eq. (1) loop (:func:`ertools.samples.fbm3w.eq1`, not the scorer's code) on the
-same published frames without their noise: the poses a noiseless mocap would have sent, the
-tracking loss of run 1 included (a lost frame is a validity question, item 2, not noise), in
-the same windows."""
+"""FBM3@Work calibration trial: the simulator's five-run execution
+(ertools.benchmarks.fbm3w.sample: 120 Hz mocap, 0.05 mm of noise per axis, one tracking loss,
+run 4 timed out), its noisy Pose2D stream scored as ``ertools score fbm3w`` scores it
+(``score_paths``, the noise measured from the stream's own stationary phases), against the
+noiseless truth the simulator computes with its own Eq. (1) loop
+(:func:`ertools.benchmarks.fbm3w.sample.eq1`, not the scorer's code) on the same published
+frames without their noise: the poses a noiseless mocap would have sent, the tracking loss of
+run 1 included (a lost frame is a validity question, item 2, not noise), in the same windows."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ertools.benchmarks.fbm3w.benchmark import score_runs
+from ertools.benchmarks.fbm3w import sample as sim_fbm3w
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
+from ertools.benchmarks.fbm3w.pipeline import score_paths
 from ertools.benchmarks.fbm3w.runs import RunWindow
-from ertools.configs.fbm3w import Fbm3wConfig
-from ertools.samples import fbm3w as sim_fbm3w
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.streams import PoseStream
 
 POSE2D_AFTER_NS = 20_000  # the simulator records pose2d 20 us after the pose
@@ -42,7 +42,7 @@ def trial(seed: int, draws: int) -> list[tuple[str, float, float, float]]:
         )
         for k, run in enumerate(sim.truth["runs"])
     ]
-    result = score_runs(
+    result = score_paths(
         poses,
         windows,
         Fbm3wConfig(),

@@ -1,18 +1,18 @@
 """Calibration of the trajectory intervals: one simulated robot log per trial.
 
-The simulator is the ``robotlog`` scenario (:mod:`ertools.samples.robotlog`): a robot drives
-an ellipse at 0.3 to 0.5 m/s for 38 s, logs its own estimate (truth + a bias, a slow drift
-and white noise) at 10 Hz on a clock running 0.35 s ahead of the GT's; the mocap publishes the
-noisy pose at 120 Hz in two files with a gap and two tracking losses. Everything is drawn from
-the seed. The log is scored as the sample is (``--offset auto --apply-offset``: the clock
-audit estimates the offset and the score uses it) by the pure scorer :func:`~ertools.
-benchmarks.trajectory.scoring.score_streams`, intervals included.
+The simulator is the ``robotlog`` scenario (:mod:`ertools.benchmarks.trajectory.sample`): a robot
+drives an ellipse at 0.3 to 0.5 m/s for 38 s, logs its own estimate (truth + a bias, a slow drift
+and white noise) at 10 Hz on a clock running 0.35 s ahead of the GT's; the mocap publishes the noisy
+pose at 120 Hz in two files with a gap and two tracking losses. Everything is drawn from the seed.
+The log is scored as the sample is (``--offset auto --apply-offset``: the clock audit estimates the
+offset and the score uses it) by the pure scorer :func:`~ertools.
+benchmarks.trajectory.comparison.score_streams`, intervals included.
 
 The true noiseless score is the score of the same log without the mocap's measurement noise
 (each message's pose minus the noise the simulator added, a repeat repeating its truth,
 stamped at its frame's true time rather than with the node's receive delay) on the true
 clock offset, computed by the simulator's own per-pose loop
-(:func:`ertools.samples.robotlog.expected_scores`): what the referee would get from a
+(:func:`ertools.benchmarks.trajectory.sample.expected_scores`): what the referee would get from a
 noiseless mocap and synchronised clocks. Not the robot's error against the continuous truth:
 what the log itself lacks (a pose compared across a tracking loss with a stale sample, the
 poses in a gap) is the log's, noiseless or not, and no interval of measurement noise covers
@@ -36,9 +36,9 @@ KEYS = ("position_error", "orientation_error", "rmse", "median", "max")
 def simulate(seed: int) -> tuple[Any, Any, Any]:
     """(robot stream, GT stream, truth of each robot pose: (xyz, yaw, estimated yaw))."""
     # lazy: the calibration imports fast; the simulator on demand
+    from ertools.benchmarks.trajectory import sample as rl
     from ertools.geometry import quat_from_yaw
-    from ertools.samples import robotlog as rl
-    from ertools.samples.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
+    from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
     from ertools.streams import PoseStream
 
     rng = np.random.default_rng(seed)
@@ -83,14 +83,14 @@ def simulate(seed: int) -> tuple[Any, Any, Any]:
 def robot_estimate(rng: np.random.Generator) -> tuple[Any, Any, Any, Any, Any]:
     """The robotlog robot's estimate, its error drawn anew per trial.
 
-    :func:`ertools.samples.robotlog.robot_estimate` fixes the error's bias and drift phase
-    (one sample log); a calibration over seeds must draw them, or every trial shares one
+    :func:`ertools.benchmarks.trajectory.sample.robot_estimate` fixes the error's bias and drift
+    phase (one sample log); a calibration over seeds must draw them, or every trial shares one
     error, correlated with the velocity in one fixed way, and the clock audit's offset error
     (which that correlation drives) would be the same systematic number in every trial.
     The sizes are the scenario's: a bias of |BIAS_XYZ|, a drift of DRIFT_AMPLITUDE over
     DRIFT_PERIOD_S, white noise NOISE_SIGMA, a yaw bias and noise.
     """
-    from ertools.samples import robotlog as rl
+    from ertools.benchmarks.trajectory import sample as rl
 
     n = int((rl.ROBOT_TO_S - rl.ROBOT_FROM_S) * rl.ROBOT_RATE_HZ) + 1
     period = round(rl.NS / rl.ROBOT_RATE_HZ)
@@ -114,9 +114,9 @@ def robot_estimate(rng: np.random.Generator) -> tuple[Any, Any, Any, Any, Any]:
 
 def true_scores(truth: Any) -> dict[str, float]:
     """The score of the same log without mocap noise, on the true clock offset, by the
-    simulator's own per-pose loop (:func:`ertools.samples.robotlog.expected_scores`: bisect,
-    hand-written interpolation; not the scorer under test)."""
-    from ertools.samples import robotlog as rl
+    simulator's own per-pose loop (:func:`ertools.benchmarks.trajectory.sample.expected_scores`:
+    bisect, hand-written interpolation; not the scorer under test)."""
+    from ertools.benchmarks.trajectory import sample as rl
 
     stamps, est_xyz, est_yaw, (gt_t, gt_xyz, gt_quat) = truth
     got = rl.expected_scores(
@@ -135,9 +135,9 @@ def true_scores(truth: Any) -> dict[str, float]:
 
 def score(seed: int, draws: int) -> tuple[Any, dict[str, float]]:
     """(the result with intervals, the true noiseless scores)."""
-    from ertools.benchmarks.common.interval_output import IntervalSettings
+    from ertools.benchmarks.common.inputs import IntervalSettings
+    from ertools.benchmarks.trajectory.comparison import score_streams
     from ertools.benchmarks.trajectory.config import TrajectoryConfig
-    from ertools.benchmarks.trajectory.scoring import score_streams
 
     robot, gt, truth = simulate(seed)
     config = TrajectoryConfig(auto_offset=True, apply_offset=True)

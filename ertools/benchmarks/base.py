@@ -1,11 +1,12 @@
-"""What a benchmark is: its declared inputs, how it finds runs and scores them, and what its
-result offers, so that ``score``, ``report``, ``audit`` and ``rescore`` treat every benchmark
-alike (the registry, :mod:`ertools.benchmarks.registry`, lists them).
+"""What a benchmark is: the :class:`Benchmark` protocol every benchmark implements (its
+:class:`Input` values become typed options, the logs are loaded, the runs found and scored
+into a frozen :class:`BenchmarkResult`), and the optional parts a benchmark may add
+(:class:`Described`, :class:`Reported`, :class:`Audited`, :class:`Discovered`,
+:class:`Simulated`), so that ``score``, ``report``, ``audit`` and ``rescore`` treat every
+benchmark alike (the registry, :mod:`ertools.benchmarks.registry`, lists them). Consumers ask
+for a part with ``isinstance``, never for a name.
 
-Every benchmark has the same shape: its bags and :class:`Input` values become typed options
-(:attr:`Benchmark.make_options`), the logs are loaded (:attr:`Benchmark.load`), the runs found
-(:attr:`Benchmark.find_runs`) and scored (:attr:`Benchmark.score_runs`) into a frozen
-:class:`BenchmarkResult`.
+NumPy-free: the command line builds its parsers from these declarations.
 """
 
 from __future__ import annotations
@@ -13,21 +14,18 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Generic, Literal, Protocol, TypeVar, runtime_checkable
+from typing import TYPE_CHECKING, Any, Literal, Protocol, TypeVar, runtime_checkable
 
-import numpy as np
-
-import ertools
 from ertools.errors import UsageError
 from ertools.progress import clear_current
+from ertools.timeutil import MAX_SECONDS
 
 if TYPE_CHECKING:  # annotations only: the registry (and `ertools score --help`) stays light
     import pandas as pd
 
-    import ertools.yamlout  # reached as an attribute of the package, imported on first use
-    from ertools.fidelity import Deviation
+    from ertools.fidelity import Deviation, Rule
     from ertools.streams import Provenance
 
 Rows = list[dict[str, Any]]
@@ -168,6 +166,9 @@ OptionsT = TypeVar("OptionsT")
 LoadedT = TypeVar("LoadedT")
 RunsT = TypeVar("RunsT")
 ResultT = TypeVar("ResultT", bound="BenchmarkResult")
+ResultT_co = TypeVar("ResultT_co", bound="BenchmarkResult", covariant=True)
+ResultT_contra = TypeVar("ResultT_contra", bound="BenchmarkResult", contravariant=True)
+OptionsT_contra = TypeVar("OptionsT_contra", contravariant=True)
 
 
 @runtime_checkable
@@ -175,7 +176,7 @@ class BenchmarkResult(Protocol):
     """A frozen result of one benchmark execution.
 
     Attributes:
-        name: the benchmark (``fbm3w``...), a key of ``ertools.benchmarks.registry.REGISTRY``.
+        name: the benchmark (``fbm3w``...), a name of ``ertools.benchmarks.registry``.
         warnings: things a referee should know (d_min below the noise, identity transform...).
         deviations: every place where ertools deliberately differs from the 2015 node.
         failures: runs/segments/items that could not be scored (the CLI then exits 1).
@@ -217,143 +218,55 @@ class BenchmarkResult(Protocol):
 
 def notice(message: str) -> None:
     """A human note on stderr (``ertools: message``), below any progress bar: what a
-    benchmark's :attr:`Benchmark.make_options` says about the values it was given (a
+    benchmark's :meth:`Benchmark.make_options` says about the values it was given (a
     deprecated spelling, a choice that differs from a node)."""
 
     clear_current()
     print(f"ertools: {message}", file=sys.stderr)
 
 
-def dump_yaml(data: Any) -> str:
-    """YAML as the 2015 nodes dumped it (block style, keys in insertion order), floats
-    rounded to 9 decimal places (:mod:`ertools.yamlout`)."""
-    # PyYAML (~25 ms) imported now, when YAML is written (JSON and text outputs do without it)
-    text: str = ertools.yamlout.dump(data)
-    return text
+@runtime_checkable
+class Benchmark(Protocol[OptionsT, LoadedT, RunsT, ResultT_co]):
+    """The part every benchmark has: its inputs and rules, and the four stages ``score``,
+    ``audit``, ``rescore`` and :func:`ertools.score` run (through
+    :func:`ertools.benchmarks.scoring.score_execution`): the values given -> options -> the
+    logs loaded -> the runs found -> the frozen result.
 
-
-def jsonable(value: Any) -> Any:
-    """Convert NumPy scalars/arrays and tuples inside ``value`` to plain JSON types."""
-
-    if isinstance(value, dict):
-        return {str(k): jsonable(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [jsonable(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return jsonable(value.tolist())
-    if isinstance(value, np.bool_):
-        return bool(value)
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.floating):
-        f = float(value)
-        return None if math.isnan(f) else f
-    if isinstance(value, float) and math.isnan(value):
-        return None
-    return value
-
-
-@dataclass(frozen=True)
-class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
-    """A benchmark: what ``score``, ``report``, ``audit`` and ``rescore`` need to know of it.
+    A benchmark's ``declare`` module defines a class that subclasses this protocol and the
+    optional parts it has (:class:`Described`, :class:`Reported`, :class:`Audited`,
+    :class:`Discovered`, :class:`Simulated`), so that mypy checks it, and names an instance
+    ``BENCHMARK``; each stage method calls the function of the same name in its ``config``
+    or ``pipeline`` module (docs/writing-a-benchmark.md).
 
     Attributes:
         name: the command name and registry key (``fbm3w``).
         title: the rulebook's name (``FBM3@Work``).
-        summary: one line for ``ertools score --help``.
-        example: one command line shown under the summary.
-        description: the ``ertools score NAME --help`` text.
-        epilog: examples and notes after the options in ``--help``.
-        bags_help: what the positional ``BAG...`` arguments are (default: log files).
-        logs_are_bags: its logs are ROS1 bags, rosbag2 bags or MCAP files, which the
-            manifest's ``--check`` verifies of every listed one; False for a benchmark that
-            reads other files.
-        logs_may_be_text: it also reads text trajectories (TUM, KITTI, EuRoC, ertools CSV),
-            which ``--check`` accepts beside bags.
-        inputs: every value it takes besides its bags (see :class:`Input`).
-        make_options: the values by :attr:`Input.name` (missing ones at their defaults) ->
-            validated options; raises :class:`~ertools.errors.UsageError` (exit 2) or
-            :class:`~ertools.errors.ConfigError` (a file's content, exit 1).
-        load: bags and options -> the logs read (poses, states, configs).
-        find_runs: the logs -> the runs (segments, items) to score.
-        score_runs: logs, runs, options -> the frozen result.
-        ranking: the leaderboard rule.
-        notes: extra stderr lines after a score (runs found by ``--runs auto``...).
-        figures: ``module:function`` drawing the result's figures (imported only for a report:
-            matplotlib is heavy), empty when it has none.
-        foxglove: ``module:function`` giving its Foxglove content, empty when it has none.
-        files: bags, options, result -> the input files a report lists and hashes (default:
-            the bags; e.g. the item list too, or the GT files a folder held).
-        bags_metavar: the positional arguments' placeholder: one name (``BAG``: one or more
-            bags) or two (``ROBOT_BAG``, ``GT_PATH``: the first, then any number of others).
-        score_keys: keys of its ``score.json`` that say a score is this benchmark's (a
-            score.json read without its result.json, ``ertools report``).
-        state_topics: its RefBox/BmBox/Client state topics are logged under ``/NAME/``
-            (``ertools audit`` can reconstruct it).
-        values_2015: the :class:`Input` values that restore every 2015 behaviour (the audit
-            compares the live score with the score recomputed with them); empty: none.
-        from_live: the audit's hook: the options made from the values given and the live
-            score (parsed) -> the options to rescore with and notes saying what was taken
-            from the live score (FBM2H: the transform the node used).
-        explanations: why a recomputed value may differ from the live one, by key (the
-            audit's comparison shows the first that matches a differing key).
-        sample: the sample logs' folder (``sample_bags/``) -> the arguments scoring this
-            benchmark on them (``make demo``); None, or a None result: no sample.
-        gt_only: a recording of the GT logger alone (its benchmark's topics, no state topics;
-            its files, the first holding the name) -> the input values that score it as an
-            execution (FBM2H: the timing file beside it; FBM3W: ``runs: auto``), or one line
-            saying why it cannot be one. None: such recordings are never executions.
-        namespace: the first part of its logs' topics (``/fbm2h/...``; default: ``name``),
-            by which a log given to the wrong benchmark is recognised; empty: none.
-        source_inputs: the inputs naming the logs' topics or frames: given, the user has
-            chosen them and the log is taken as it is.
+        inputs: every value it takes besides its logs (:class:`Input`).
+        rules: its :class:`~ertools.fidelity.Rule` constants (the catalogue of deviations).
     """
 
     name: str
     title: str
-    summary: str
-    example: str
-    description: str
-    epilog: str
     inputs: tuple[Input, ...]
-    make_options: Callable[[Mapping[str, Any]], OptionsT]
-    load: Callable[[Sequence[Path], OptionsT], LoadedT]
-    find_runs: Callable[[LoadedT, OptionsT], RunsT]
-    score_runs: Callable[[LoadedT, RunsT, OptionsT], ResultT]
-    ranking: Ranking
-    notes: Callable[[ResultT], Sequence[str]] | None = None
-    figures: str = ""
-    foxglove: str = ""
-    files: Callable[[Sequence[Path], OptionsT, ResultT], Sequence[Path]] | None = None
-    bags_metavar: str | tuple[str, str] = "BAG"
-    score_keys: frozenset[str] = frozenset()
-    state_topics: bool = False
-    values_2015: Mapping[str, Any] = field(default_factory=dict)
-    from_live: Callable[[OptionsT, Any], tuple[OptionsT, tuple[str, ...]]] | None = None
-    explanations: tuple[Explanation, ...] = ()
-    sample: Callable[[Path], Sequence[str] | None] | None = None
-    bags_help: str = "log file(s)"
-    gt_only: Callable[[Sequence[Path]], Mapping[str, Any] | str] | None = None
-    logs_are_bags: bool = True
-    logs_may_be_text: bool = False
-    namespace: str | None = None
-    source_inputs: tuple[str, ...] = ("topic", "tf", "namespace")
+    rules: tuple[Rule, ...]
 
-    @property
-    def log_namespace(self) -> str:
-        """The first part of its logs' topics (:attr:`namespace`, default the name)."""
-        return self.name if self.namespace is None else self.namespace
+    def make_options(self, values: Mapping[str, Any]) -> OptionsT:
+        """The values by :attr:`Input.name` (missing ones at their defaults) -> validated
+        options; raises :class:`~ertools.errors.UsageError` (exit 2) or
+        :class:`~ertools.errors.ConfigError` (a file's content, exit 1)."""
+        ...
 
-    def score(self, bags: Sequence[Path], options: OptionsT) -> ResultT:
-        """The whole shape: load -> find runs -> score."""
-        loaded = self.load(bags, options)
-        return self.score_runs(loaded, self.find_runs(loaded, options), options)
+    def load(self, logs: Sequence[Path], options: OptionsT) -> LoadedT:
+        """The logs read (poses, states, configs)."""
+        ...
 
-    def input_files(self, bags: Sequence[Path], options: OptionsT, result: ResultT) -> list[Path]:
-        """The files a report lists as this execution's inputs (:attr:`files`)."""
-        if self.files is None:
-            return list(bags)
-        return list(self.files(bags, options, result))
+    def find_runs(self, loaded: LoadedT, options: OptionsT) -> RunsT:
+        """The runs (segments, items) to score."""
+        ...
+
+    def score_runs(self, loaded: LoadedT, runs: RunsT, options: OptionsT) -> ResultT_co:
+        """The frozen result."""
+        ...
 
     def input(self, name: str) -> Input:
         """The declared input called ``name`` (KeyError when there is none)."""
@@ -361,6 +274,118 @@ class Benchmark(Generic[OptionsT, LoadedT, RunsT, ResultT]):
             if declared.name == name:
                 return declared
         raise KeyError(name)
+
+
+@runtime_checkable
+class Described(Protocol):
+    """Its help: ``ertools score NAME --help`` and the examples of ``make demo``.
+
+    Attributes:
+        example: one command line (``ertools score fbm3w run.bag --config fbm3w.yaml``).
+        description: the ``--help`` text above the options.
+        epilog: examples and notes after the options.
+        bags_help: what the positional log arguments are.
+        bags_metavar: their placeholder: one name (``BAG``: one or more logs) or two
+            (``ROBOT_BAG``, ``GT_PATH``: the first, then any number of others).
+    """
+
+    example: str
+    description: str
+    epilog: str
+    bags_help: str = "log file(s)"
+    bags_metavar: str | tuple[str, str] = "BAG"
+
+
+@runtime_checkable
+class Reported(Protocol[OptionsT_contra, ResultT_contra]):
+    """What a report shows of its results: notes, figures, a Foxglove file, the input files.
+
+    Attributes:
+        score_keys: keys of its ``score.json`` that say a score is this benchmark's (a
+            ``score.json`` read without its ``result.json`` by ``ertools report``).
+    """
+
+    score_keys: frozenset[str]
+
+    def notes(self, result: ResultT_contra) -> Sequence[str]:
+        """Extra stderr lines after a score (the runs ``--runs auto`` found...)."""
+        return ()
+
+    def figures(self, result: ResultT_contra) -> Sequence[Any]:
+        """The result's figures (:class:`ertools.views.spec.ChartSpec` or the report's
+        ``FigureSpec``), drawn only for a report or ``--plot``."""
+        ...
+
+    def foxglove(self, out: Any, result: ResultT_contra, *, limit: int) -> None:
+        """Add the result's Foxglove messages to ``out`` (a ``Collected``), streams thinned
+        to ``limit`` messages."""
+        ...
+
+    def input_files(
+        self, logs: Sequence[Path], options: OptionsT_contra, result: ResultT_contra
+    ) -> list[Path]:
+        """The files a report lists and hashes as this execution's inputs (the logs; the item
+        list too, or the GT files a folder held)."""
+        return list(logs)
+
+
+@runtime_checkable
+class Audited(Protocol[OptionsT]):
+    """Its state topics are logged under ``/NAME/`` (RefBox, BmBox, Client): ``ertools audit``
+    reconstructs an execution and compares the live score with the recomputed one.
+
+    Attributes:
+        values_2015: the :class:`Input` values that restore every 2015 behaviour (the audit
+            also recomputes with them); empty: none.
+        explanations: why a recomputed value may differ from the live one, by key.
+    """
+
+    values_2015: Mapping[str, Any]
+    explanations: tuple[Explanation, ...]
+
+    def from_live(self, options: OptionsT, live: Any) -> tuple[OptionsT, tuple[str, ...]]:
+        """The options to rescore with, given the live score (parsed), and notes saying what
+        was taken from it (FBM2H: the transform its node used)."""
+        return options, ()
+
+
+@runtime_checkable
+class Discovered(Protocol):
+    """It is found among other logs: a competition ranks it, a log given to another benchmark
+    is recognised as its.
+
+    Attributes:
+        ranking: the leaderboard rule.
+        log_namespace: the first part of its logs' topics (``/fbm2h/...``); empty: none.
+        logs_are_bags: its logs are bags or MCAP files (a manifest's ``--check`` opens them).
+        logs_may_be_text: it also reads text trajectories (TUM, KITTI, EuRoC, ertools CSV).
+        source_inputs: the inputs naming the logs' topics or frames: given, the user has
+            chosen them and the log is taken as it is.
+    """
+
+    ranking: Ranking
+    log_namespace: str
+    logs_are_bags: bool = True
+    logs_may_be_text: bool = False
+    source_inputs: tuple[str, ...] = ("topic", "tf", "namespace")
+
+    def gt_only(self, logs: Sequence[Path]) -> Mapping[str, Any] | str | None:
+        """A recording of the GT logger alone (its topics, no state topics) -> the input
+        values that score it as an execution (FBM2H: the timing file beside it), or one line
+        saying why it cannot be one; None: such recordings are never executions."""
+        return None
+
+
+@runtime_checkable
+class Simulated(Protocol):
+    """It has a simulated sample (``sample_bags/``, ``make demo``)."""
+
+    def sample_args(self, samples: Path) -> Sequence[str] | None:
+        """The arguments scoring it on the sample logs under ``samples`` (None: not there)."""
+        ...
+
+
+AnyBenchmark = Benchmark[Any, Any, Any, Any]
 
 
 def _one_value(declared: Input, value: Any) -> Any:
@@ -398,6 +423,8 @@ def _one_value(declared: Input, value: Any) -> Any:
         raise UsageError(f"{option} must be {what}, got {value!r}") from None
     if not math.isfinite(number):
         raise UsageError(f"{option} must be a finite number, got {value!r}")
+    if kind == "float" and abs(number) >= MAX_SECONDS:
+        raise UsageError(f"{option} {value}: give a number smaller than {MAX_SECONDS:g} in size")
     unit = f" {declared.unit}" if declared.unit else ""
     if declared.positive and number <= (declared.minimum or 0.0):
         bound = "positive" if not declared.minimum else f"> {declared.minimum:g}{unit}"
@@ -447,7 +474,7 @@ def tf_value(option: str, text: str | None) -> tuple[str, str] | None:
 def resolve_values(inputs: Sequence[Input], given: Mapping[str, Any]) -> dict[str, Any]:
     """Every declared input's value: ``given`` (by :attr:`Input.name`) checked against its
     declaration (kind, choices, minimum, positive), the others at their defaults. None
-    stands for "not given". The first half of every :attr:`Benchmark.make_options`.
+    stands for "not given". The first half of every :meth:`Benchmark.make_options`.
 
     Raises:
         UsageError: an unknown name, or a value that does not fit its declaration.

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from ertools.benchmarks.base import BenchmarkResult, jsonable
+from ertools.benchmarks.base import BenchmarkResult
+from ertools.serialize import jsonable
 
 
 def score_json(result: BenchmarkResult) -> dict[str, Any]:

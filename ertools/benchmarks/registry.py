@@ -1,58 +1,129 @@
-"""Every benchmark ertools scores, in one place: its name and where its :class:`Benchmark` is.
+"""Every benchmark ertools scores, in one place: one line each, naming the module that declares
+it, so that ``ertools score --help`` lists them all without importing any, and a command that
+scores one benchmark imports only that one's declaration.
 
-The CLI's ``score`` subcommands, ``report``, ``audit`` and ``rescore`` reach benchmarks only
-through this table. Entries name the module that declares the benchmark (``module:ATTRIBUTE``),
-imported on first use, so that ``ertools --help`` and a command that scores one benchmark
-import only what they run. Adding a benchmark is one package and one line here.
+An entry's ``target`` is a module (``.fbm3w.declare``: relative to ``ertools.benchmarks``; a
+plug-in outside ertools gives an absolute name) and optionally ``:ATTRIBUTE`` (default
+``BENCHMARK``): the object implementing :class:`~ertools.benchmarks.base.Benchmark`. Adding a
+benchmark is one package and one line here. ``python -m ertools.benchmarks.registry`` prints
+each entry with the file that declares it (what go-to-definition cannot follow).
 """
 
 from __future__ import annotations
 
+import sys
+from dataclasses import dataclass
 from importlib import import_module
+from importlib.util import find_spec
 from typing import TYPE_CHECKING, Any
 
+from ertools.benchmarks.legacy import LegacyBenchmark, adapt
 from ertools.errors import UsageError
 
 if TYPE_CHECKING:
-    # an annotation only: `ertools --help` lists the names without importing NumPy
-    from ertools.benchmarks.base import Benchmark
+    from ertools.benchmarks.base import AnyBenchmark
 
-    AnyBenchmark = Benchmark[Any, Any, Any, Any]
+PACKAGE = "ertools.benchmarks"
 
-REGISTRY: dict[str, str] = {
-    "fbm1h": "ertools.benchmarks.fbm1.declare:FBM1H",
-    "fbm1w": "ertools.benchmarks.fbm1.declare:FBM1W",
-    "fbm2h": "ertools.benchmarks.fbm2h.declare:BENCHMARK",
-    "fbm3w": "ertools.benchmarks.fbm3w.declare:BENCHMARK",
-    "trajectory": "ertools.benchmarks.trajectory.declare:BENCHMARK",
-    "hnf": "ertools.benchmarks.hnf.declare:BENCHMARK",
-    "hpff": "ertools.benchmarks.hpff.declare:BENCHMARK",
-    "hopf": "ertools.benchmarks.hopf.declare:BENCHMARK",
-    "hppf": "ertools.benchmarks.hppf.declare:BENCHMARK",
-    "hgmf": "ertools.benchmarks.hgmf.declare:BENCHMARK",
-    "hgtkmh": "ertools.benchmarks.referee.declare:HGTKMH",
-    "hwv": "ertools.benchmarks.referee.declare:HWV",
-    "hcfgac": "ertools.benchmarks.referee.declare:HCFGAC",
-    "stb": "ertools.benchmarks.referee.declare:STB",
-}
+
+@dataclass(frozen=True)
+class Entry:
+    """One registered benchmark: its name, where it is declared, one line of help."""
+
+    name: str
+    target: str
+    summary: str
+
+    @property
+    def absolute(self) -> str:
+        """``module:ATTRIBUTE`` with the module's absolute name (what a rescore job carries)."""
+        module, _, attribute = self.target.partition(":")
+        if module.startswith("."):
+            module = PACKAGE + module
+        return f"{module}:{attribute or 'BENCHMARK'}"
+
+
+ENTRIES: tuple[Entry, ...] = (
+    Entry("fbm1h", ".fbm1.declare:FBM1H", "FBM1@Home object perception"),
+    Entry("fbm1w", ".fbm1.declare:FBM1W", "FBM1@Work object perception"),
+    Entry("fbm2h", ".fbm2h.declare", "FBM2@Home navigation: waypoint errors"),
+    Entry("fbm3w", ".fbm3w.declare", "FBM3@Work trajectory following: path error"),
+    Entry("trajectory", ".trajectory.declare", "robot log vs mocap ground truth, with clock audit"),
+    # The RSBB benchmarks (issue 38) are still LegacyBenchmark records (legacy.py adapts them).
+    Entry("hnf", ".hnf.declare", "HNF (FBM2@Home 2017-19) navigation: the RSBB script re-scored"),
+    Entry("hpff", ".hpff.declare", "HPFF (FBM5@Home 2019) person following: the RSBB script"),
+    Entry("hopf", ".hopf.declare", "HOPF object perception (RSBB 2017-19): 10 items"),
+    Entry("hppf", ".hppf.declare", "HPPF people perception (RSBB 2019): who each person is"),
+    Entry("hgmf", ".hgmf.declare", "HGMF (FBM6@Home 2019) grasping and manipulation"),
+    Entry("hgtkmh", ".referee.declare:HGTKMH", "HGTKMH: the referee's items, ERL-ranked"),
+    Entry("hwv", ".referee.declare:HWV", "HWV: the referee's items, ERL-ranked"),
+    Entry("hcfgac", ".referee.declare:HCFGAC", "HCFGAC: the referee's items, ERL-ranked"),
+    Entry("stb", ".referee.declare:STB", "STB: the referee's items, ERL-ranked"),
+)
 
 
 def names() -> tuple[str, ...]:
     """The registered benchmark names, in the registry's order."""
-    return tuple(REGISTRY)
+    return tuple(e.name for e in ENTRIES)
+
+
+def entry(name: str) -> Entry:
+    """The entry called ``name``; an unknown name is a usage error listing the known ones."""
+    for e in ENTRIES:
+        if e.name == name:
+            return e
+    raise UsageError(f"unknown benchmark {name!r}: one of {', '.join(names())}")
+
+
+def target(name: str) -> str:
+    """The absolute ``module:ATTRIBUTE`` of the benchmark called ``name``."""
+    return entry(name).absolute
+
+
+def load(target: str) -> AnyBenchmark:
+    """The benchmark an absolute ``module:ATTRIBUTE`` names (a rescore job's), imported now."""
+    module, _, attribute = target.partition(":")
+    found: Any = getattr(import_module(module), attribute or "BENCHMARK")
+    if isinstance(found, LegacyBenchmark):
+        return adapt(found)
+    benchmark: AnyBenchmark = found
+    return benchmark
 
 
 def get(name: str) -> AnyBenchmark:
     """The benchmark called ``name``; an unknown name is a usage error listing the known ones."""
-    try:
-        target = REGISTRY[name]
-    except KeyError:
-        raise UsageError(f"unknown benchmark {name!r}: one of {', '.join(REGISTRY)}") from None
-    module_name, _, attribute = target.partition(":")
-    benchmark: AnyBenchmark = getattr(import_module(module_name), attribute)
-    return benchmark
+    return load(target(name))
 
 
 def for_result(result: Any) -> AnyBenchmark:
     """The benchmark a result belongs to (by its ``name``)."""
     return get(str(result.name))
+
+
+def warm(target: str, *, report: bool = False) -> None:
+    """Import now what scoring with the benchmark ``target`` names would import on first use:
+    its declaration, the ``pipeline`` beside it and, for a report, its ``plots`` and
+    ``foxglove`` (a rescore's server, before it forks its scorers: they inherit them)."""
+    module, _, attribute = target.partition(":")
+    found: Any = getattr(import_module(module), attribute or "BENCHMARK")
+    package = module.rpartition(".")[0]
+    wanted = [f"{package}.pipeline"]
+    if report:
+        wanted += [f"{package}.plots", f"{package}.foxglove"]
+        if isinstance(found, LegacyBenchmark):
+            wanted += [t.partition(":")[0] for t in (found.figures, found.foxglove) if t]
+    for name in wanted:
+        if find_spec(name) is not None:
+            import_module(name)
+
+
+def main() -> int:
+    """Each entry: name, summary, the file that declares it."""
+    for e in ENTRIES:
+        module = import_module(e.absolute.partition(":")[0])
+        print(f"{e.name:<12} {e.summary}\n{'':<12} {module.__file__}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

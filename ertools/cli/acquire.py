@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from ertools.cli.command import Command, Delegate
 from ertools.cli.groups import add_group_arguments, run_group
-from ertools.cli.main import Command
 
 MEMBERS: dict[str, Command] = {
     "transform": Command(
@@ -25,5 +25,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_group_arguments(parser, MEMBERS)
 
 
-def run(args: argparse.Namespace) -> int:
+def members() -> dict[str, Command]:
+    """The group's members (every group module has this function)."""
+    return MEMBERS
+
+
+def run(args: argparse.Namespace) -> int | Delegate:
     return run_group("acquire", MEMBERS, args)

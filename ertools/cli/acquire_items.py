@@ -16,9 +16,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ertools.benchmarks.common.sources import pose_source
+from ertools.benchmarks.document import all_failed
 from ertools.benchmarks.fbm1.acquire import AcquireOptions, acquire_items_bag
 from ertools.benchmarks.fbm1.config import BENCHMARKS
-from ertools.cli.common import all_failed
 from ertools.cli.options import (
     add_output,
     add_pose_source,
@@ -33,7 +33,7 @@ from ertools.errors import UsageError
 
 if TYPE_CHECKING:
     from ertools.benchmarks.common.spec import PoseSpec
-    from ertools.io import PoseSource
+    from ertools.io.model import PoseSource
 
 EPILOG = """examples:
   ertools acquire items items.bag --items fbm1h-vanilla.yaml -o fbm1h.yaml

@@ -12,9 +12,9 @@ import argparse
 import math
 from pathlib import Path
 
-from ertools import atomic
+from ertools.atomic import write_text as write_file
 from ertools.benchmarks.common.sources import read_source, topic
-from ertools.benchmarks.fbm2h.transform import acquire_transform, check_team_name
+from ertools.benchmarks.fbm2h.acquire import acquire_transform, check_team_name
 from ertools.cli.options import (
     add_out_dir,
     add_pose_source,
@@ -26,7 +26,7 @@ from ertools.cli.options import (
 from ertools.cli.output import note, write_text
 from ertools.configs.transform import team_transform_path, transform_yaml
 from ertools.errors import ConfigError
-from ertools.io import summary
+from ertools.io.summary import summary
 from ertools.streams import Interval
 from ertools.timeutil import resolve_time, s_to_ns
 
@@ -87,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
     text = transform_yaml(acq.transform)
     out.parent.mkdir(parents=True, exist_ok=True)
     write_text(text, None)
-    atomic.write_text(out, text)
+    write_file(out, text)
     how = "detected" if acq.detected else "given"
     note(
         f"window ({how}): {(acq.window.start_ns - bag_start) / 1e9:.3f} s to "

@@ -14,17 +14,12 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ertools import report
-from ertools.audit.rescore import ScoreInputs, audit_bag
+from ertools.auditing.recompute import ScoreInputs, audit_bag
 from ertools.benchmarks import registry
-from ertools.cli.common import (
-    add_output_options,
-    emit_result,
-    write_foxglove_option,
-    write_plots_option,
-)
+from ertools.cli.emit import emit_result, write_foxglove_option, write_plots_option
 from ertools.cli.options import non_negative_int, positive
 from ertools.cli.output import note, write_text
+from ertools.cli.result_options import add_output_options
 from ertools.timeutil import s_to_ns
 
 if TYPE_CHECKING:  # reached as an attribute of the package, imported on first use
@@ -121,8 +116,9 @@ def run(args: argparse.Namespace) -> int:
         for deviation in audit.deviations:
             note(f"differs from 2015: {deviation}")
         if args.report is not None:
-            # the report's pages and Jinja2 (~30 ms): imported now, for --report
-            index = report.folder.write_report(
+            from ertools.report.folder import write_report  # lazy: pages, Jinja2: 35-70 ms
+
+            index = write_report(
                 audit, args.report, inputs=bags, argv=getattr(args, "command_line", sys.argv)
             )
             note(f"wrote report {index}")

@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import argparse
 
-from ertools.benchmarks.base import dump_yaml
 from ertools.cli.options import add_output, port, positive, seconds
 from ertools.cli.output import dump_json, write_text
 from ertools.live.clock import query_sntp
+from ertools.serialize import dump_yaml
 
 EPILOG = """examples:
   ertools clock --server 192.168.1.1

@@ -16,6 +16,7 @@ import argparse
 from pathlib import Path
 
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.pairs import trajectory_pair
 from ertools.cli.options import (
     add_pose_source,
     add_time_source,
@@ -27,17 +28,17 @@ from ertools.cli.options import (
 )
 from ertools.cli.output import note, write_text
 from ertools.errors import UsageError
-from ertools.export.formats import FORMATS, format_poses, format_times
-from ertools.export.pairs import (
+from ertools.exporting.formats import FORMATS, format_poses, format_times
+from ertools.exporting.write import (
     KITTI_NEEDS_MATCHED,
     export_source,
     pair_paths,
     refuse_inputs,
-    trajectory_pair,
     write_pair,
 )
 from ertools.geometry import Association
-from ertools.io.text import INPUT_FORMATS, TextFormat, is_text_trajectory, read_text_poses
+from ertools.io.model import INPUT_FORMATS, TextFormat
+from ertools.io.text import is_text_trajectory, read_text_poses
 from ertools.timeutil import iso_utc, ns_to_s, s_to_ns
 
 EPILOG = """examples:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from ertools.cli.main import Command, run_command
+from ertools.cli.command import Command, Delegate
 
 
 def add_group_arguments(parser: argparse.ArgumentParser, members: dict[str, Command]) -> None:
@@ -25,12 +25,14 @@ def add_group_arguments(parser: argparse.ArgumentParser, members: dict[str, Comm
 
 
 def members_epilog(members: dict[str, Command]) -> str:
-    """The ``--help`` list of a group's members, each with its summary and an example."""
+    """The ``--help`` list of a group's members, each with its summary and an example (when
+    it has one: a benchmark's are in its own ``--help``)."""
     lines = ["members:"]
     width = max(len(n) for n in members)
     for name, cmd in members.items():
         lines.append(f"  {name:<{width}}  {cmd.summary}")
-        lines.append(f"  {'':<{width}}    e.g. {cmd.example}")
+        if cmd.example:
+            lines.append(f"  {'':<{width}}    e.g. {cmd.example}")
     return "\n".join(lines)
 
 
@@ -50,8 +52,8 @@ def _member_words(argv: list[str] | None, member: str, rest: list[str]) -> list[
     return rest
 
 
-def run_group(group: str, members: dict[str, Command], args: argparse.Namespace) -> int:
-    """Run the member's own parser on the remaining arguments."""
+def run_group(group: str, members: dict[str, Command], args: argparse.Namespace) -> int | Delegate:
+    """The member to run, its own parser on the remaining arguments (the dispatcher runs it)."""
 
     extra = ["-v"] * args.verbose + (["--debug"] if args.debug else [])
     extra += ["--quiet"] if args.quiet else []
@@ -60,4 +62,4 @@ def run_group(group: str, members: dict[str, Command], args: argparse.Namespace)
     if member not in members:  # argparse checked already; keeps mypy honest
         print(f"ertools: error: unknown {group} {member!r}", file=sys.stderr)
         return 2
-    return run_command(f"ertools {group} {member}", members[member].module, extra + rest)
+    return Delegate(f"ertools {group} {member}", members[member].module, extra + rest)

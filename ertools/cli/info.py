@@ -13,15 +13,15 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ertools.benchmarks.base import dump_yaml
-from ertools.cli.main import error_text, printable
 from ertools.cli.options import add_output
 from ertools.cli.output import dump_json, note, write_text
+from ertools.cli.text import error_text, printable
 from ertools.errors import BagError
 from ertools.io import info as bag_info
 from ertools.io.formats import find_bags
 from ertools.io.info import span_s
 from ertools.progress import reporting
+from ertools.serialize import dump_yaml
 from ertools.timeutil import iso_utc, ns_to_s
 
 if TYPE_CHECKING:

@@ -12,11 +12,10 @@ import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ertools.benchmarks.base import dump_yaml
+from ertools.benchmarks.common.epsilon import noise_from_stream
 from ertools.benchmarks.common.sources import read_source, tf, topic
 from ertools.benchmarks.fbm3w.config import DEFAULT_FRAME, DEFAULT_TOPIC, FALLBACK_TOPIC
-from ertools.benchmarks.noise.benchmark import noise_from_stream
-from ertools.cli.common import write_plots
+from ertools.cli.emit import write_plots
 from ertools.cli.options import (
     add_output,
     add_plots,
@@ -26,7 +25,8 @@ from ertools.cli.options import (
     positive,
 )
 from ertools.cli.output import dump_json, note, write_text
-from ertools.report.plots_noise import figure_specs
+from ertools.report.figures import figure_specs
+from ertools.serialize import dump_yaml
 
 if TYPE_CHECKING:
     from ertools.streams import PoseStream

@@ -8,7 +8,7 @@ The same idea has one spelling in every command (docs/cli.md lists them):
 - ``--format text|json|yaml|csv`` and ``--out/-o FILE``: :func:`add_output`;
 - ``--report DIR`` for a report folder: :func:`add_report`;
 - ``--plot FILE`` (the suffix picks the format, every figure in one file) and ``--plots DIR``
-  (one file per figure): :func:`add_plots`, written by :func:`ertools.cli.common.write_plots`;
+  (one file per figure): :func:`add_plots`, written by :func:`ertools.cli.emit.write_plots`;
 - durations are plain names in seconds (metavar ``S``): ``--max-gap``, ``--still-min``,
   ``--clock-tolerance``; never a ``-s``/``-duration`` suffix, never milliseconds;
 - an old spelling keeps working for one release and says so once on stderr

@@ -8,9 +8,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from ertools import atomic
-from ertools.benchmarks.base import jsonable
-from ertools.cli.main import error_text, printable
+from ertools.atomic import write_text as write_file
+from ertools.cli.text import error_text, printable
 from ertools.progress import clear_current
 
 
@@ -22,13 +21,13 @@ def write_text(text: str, output: Path | None) -> None:
         sys.stdout.write(text if text.endswith("\n") else text + "\n")
     else:
         output.parent.mkdir(parents=True, exist_ok=True)
-        atomic.write_text(output, text if text.endswith("\n") else text + "\n")
+        write_file(output, text if text.endswith("\n") else text + "\n")
         note(f"wrote {output}")
 
 
 def note(message: str) -> None:
     """A human note on stderr (stdout stays parseable), below any progress bar; an
-    ``error: ...`` note as every error is printed (:func:`ertools.cli.main.error_text`)."""
+    ``error: ...`` note as every error is printed (:func:`ertools.cli.text.error_text`)."""
 
     clear_current()
     if message.startswith("error: "):
@@ -38,4 +37,7 @@ def note(message: str) -> None:
 
 
 def dump_json(data: Any) -> str:
+    """``data`` as indented JSON (NumPy values as plain numbers, NaN as null)."""
+    from ertools.serialize import jsonable  # lazy: NumPy and PyYAML, 120 ms; not for --help
+
     return json.dumps(jsonable(data), indent=2, allow_nan=False)

@@ -15,17 +15,17 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from ertools import atomic
+from ertools.atomic import write_text
 from ertools.cli.output import note
+from ertools.competition.draft import draft_text
+from ertools.competition.found import find
+from ertools.competition.manifest import ManifestError, load_manifest
+from ertools.competition.parallel import default_jobs
+from ertools.competition.run import rescore_competition
 from ertools.errors import UsageError
-from ertools.rescore.draft import draft_text
-from ertools.rescore.found import find
-from ertools.rescore.manifest import ManifestError, load_manifest
-from ertools.rescore.parallel import default_jobs
-from ertools.rescore.run import rescore_competition
 
 if TYPE_CHECKING:
-    from ertools.rescore.jobs import Outcome
+    from ertools.competition.jobs import Outcome
 
 EPILOG = """examples:
   ertools rescore --config competition.yaml --out results/
@@ -160,7 +160,7 @@ def _init(args: argparse.Namespace) -> int:
     found = find(args.paths, progress=args.progress)
     text = draft_text(found, args.paths, args.init, args.command_line)
     args.init.parent.mkdir(parents=True, exist_ok=True)
-    atomic.write_text(args.init, text)
+    write_text(args.init, text)
     todo = sum("TODO" in line for line in text.splitlines())
     problems = sum(1 for p in found.problems if p.get("kind") != "no-team")
     note(

@@ -1,7 +1,8 @@
 """Recompute a benchmark score from its logs.
 
-NAME is the benchmark; each has its own inputs and options: `ertools score NAME --help`.
-The score goes to stdout (YAML, or --format json), notes and warnings to stderr.
+NAME is the benchmark; each has its own inputs, options and examples: `ertools score NAME
+--help` (e.g. ertools score fbm3w run.bag --config configs/fbm3w.yaml). The score goes to
+stdout (YAML, or --format json), notes and warnings to stderr.
 """
 
 # The members and their options are generated from each benchmark's declared inputs (the
@@ -15,13 +16,13 @@ from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks import registry
-from ertools.benchmarks.base import Input
-from ertools.benchmarks.common.which import refuse_other_benchmark
-from ertools.cli.common import add_output_options, all_failed, emit_result
-from ertools.cli.groups import add_group_arguments, members_epilog, run_group
-from ertools.cli.main import Command
+from ertools.benchmarks.base import AnyBenchmark, Described, Input, Reported
+from ertools.benchmarks.legacy import offers
+from ertools.cli.command import Command, Delegate
+from ertools.cli.groups import add_group_arguments, run_group
 from ertools.cli.options import deprecation_note
 from ertools.cli.output import note
+from ertools.cli.result_options import add_output_options
 from ertools.errors import UsageError
 
 GROUP_PROG = "ertools score"
@@ -30,25 +31,9 @@ _TYPES: dict[str, Any] = {"float": float, "int": int, "path": Path, "paths": Pat
 
 
 def members() -> dict[str, Command]:
-    """Every registered benchmark, as a member of the ``score`` group (this module)."""
-    out = {}
-    for name in registry.names():
-        bench = registry.get(name)
-        out[name] = Command(__name__, bench.summary, bench.example)
-    return out
-
-
-def __getattr__(name: str) -> Any:
-    """``MEMBERS``, as the other command groups have it, built on first use (it imports
-    every declaration)."""
-    if name == "MEMBERS":
-        return members()
-    raise AttributeError(name)
-
-
-def _unread_members() -> dict[str, Command]:
-    """The members by name only (summaries left empty: nothing imported)."""
-    return {name: Command(__name__, "", "") for name in registry.names()}
+    """Every registered benchmark, as a member of the ``score`` group (this module), from the
+    registry's lines: no benchmark is imported (every group module has this function)."""
+    return {e.name: Command(__name__, e.summary, "") for e in registry.ENTRIES}
 
 
 def _member(prog: str) -> str | None:
@@ -65,22 +50,15 @@ def describe(prog: str) -> tuple[str, str | None]:
     if name is None:
         return (__doc__ or "").strip(), None
     bench = registry.get(name)
+    if not isinstance(bench, Described):
+        return registry.entry(name).summary, None
     return bench.description, bench.epilog
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     name = _member(parser.prog)
     if name is None:
-        # The members' summaries import every declaration: only for --help, so that
-        # `ertools score NAME ...` imports only NAME's benchmark.
-        add_group_arguments(parser, _unread_members())
-        plain_help = parser.format_help
-
-        def format_help() -> str:
-            parser.epilog = members_epilog(members())
-            return plain_help()
-
-        parser.format_help = format_help  # type: ignore[method-assign]
+        add_group_arguments(parser, members())
     else:
         add_benchmark_arguments(parser, name)
 
@@ -149,17 +127,18 @@ def add_benchmark_arguments(parser: argparse.ArgumentParser, name: str) -> None:
     # A `with_file` choice takes words (`--reached timing FILE`): given before the bags it
     # swallows them, so none is required here and run() takes them back (see _bags).
     swallows = any(i.with_file for i in bench.inputs)
-    if isinstance(bench.bags_metavar, str):
+    metavar, bags_help = _bags_metavar(bench)
+    if isinstance(metavar, str):
         parser.add_argument(
             "bags",
             nargs="*" if swallows else "+",
             type=Path,
-            metavar=bench.bags_metavar,
-            help=bench.bags_help,
+            metavar=metavar,
+            help=bags_help,
         )
     else:  # the first bag, then any number of others (ROBOT_BAG [GT_PATH ...])
-        first, rest = bench.bags_metavar
-        parser.add_argument("bags", type=Path, metavar=first, help=bench.bags_help)
+        first, rest = metavar
+        parser.add_argument("bags", type=Path, metavar=first, help=bags_help)
         parser.add_argument("more_bags", type=Path, nargs="*", metavar=rest)
     groups: dict[str, Any] = {}
     for declared in bench.inputs:
@@ -172,11 +151,21 @@ def add_benchmark_arguments(parser: argparse.ArgumentParser, name: str) -> None:
     names = {i.name for i in bench.inputs}
     # a benchmark without figures or Foxglove content (the referee-scored ones) offers neither
     add_output_options(
-        parser, plot=bool(bench.figures), foxglove=bool(bench.foxglove), team="team" not in names
+        parser,
+        plot=offers(bench, "figures"),
+        foxglove=offers(bench, "foxglove"),
+        team="team" not in names,
     )
 
 
-def _values(bench: registry.AnyBenchmark, args: argparse.Namespace) -> dict[str, Any]:
+def _bags_metavar(bench: AnyBenchmark) -> tuple[str | tuple[str, str], str]:
+    """The placeholder of the log arguments and their help (:class:`Described`'s)."""
+    if isinstance(bench, Described):
+        return bench.bags_metavar, bench.bags_help
+    return Described.bags_metavar, Described.bags_help
+
+
+def _values(bench: AnyBenchmark, args: argparse.Namespace) -> dict[str, Any]:
     """The values given, by input name; an old spelling is said on stderr."""
     values: dict[str, Any] = {}
     for declared in bench.inputs:
@@ -205,7 +194,7 @@ def _values(bench: registry.AnyBenchmark, args: argparse.Namespace) -> dict[str,
     return values
 
 
-def _bags(bench: registry.AnyBenchmark, values: dict[str, Any], bags: Sequence[Path]) -> list[Path]:
+def _bags(bench: AnyBenchmark, values: dict[str, Any], bags: Sequence[Path]) -> list[Path]:
     """The bags, taken back from a ``with_file`` choice that swallowed them when it came
     first (``--reached timing FILE log.bag``)."""
     out = list(bags)
@@ -218,7 +207,8 @@ def _bags(bench: registry.AnyBenchmark, values: dict[str, Any], bags: Sequence[P
             out = [Path(w) for w in words[need:]]
             values[declared.name] = words[:need]
     if not out:
-        first = bench.bags_metavar if isinstance(bench.bags_metavar, str) else bench.bags_metavar[0]
+        metavar, _ = _bags_metavar(bench)
+        first = metavar if isinstance(metavar, str) else metavar[0]
         raise UsageError(
             f"give at least one {first} (the log file); `ertools score {bench.name} --help` "
             "shows how"
@@ -226,19 +216,25 @@ def _bags(bench: registry.AnyBenchmark, values: dict[str, Any], bags: Sequence[P
     return out
 
 
-def run(args: argparse.Namespace) -> int:
+def run(args: argparse.Namespace) -> int | Delegate:
     name: str | None = getattr(args, "benchmark", None)
     if name is None:
-        return run_group("score", _unread_members(), args)
+        return run_group("score", members(), args)
     bench = registry.get(name)
     values = _values(bench, args)
     given = args.bags if isinstance(args.bags, list) else [args.bags, *args.more_bags]
     bags = _bags(bench, values, given)
     args.bags = bags
-    refuse_other_benchmark(name, bags, values)
-    options = bench.make_options(values)
-    result = bench.score(bags, options)
-    if not all_failed(result):  # nothing scored: only the errors (emit_result)
-        for line in bench.notes(result) if bench.notes is not None else ():
-            note(line)
-    return emit_result(result, args, bench.input_files(bags, options, result))
+    from ertools.benchmarks.document import all_failed  # lazy: NumPy, the scorer, 250 ms
+    from ertools.benchmarks.scoring import score_execution  # lazy: 250 ms
+    from ertools.cli.emit import emit_result  # lazy: the report, 300 ms
+
+    scored = score_execution(bench, bags, values)  # what ertools.score calls
+    result = scored.result
+    inputs = list(bags)
+    if isinstance(bench, Reported):
+        if not all_failed(result):  # nothing scored: only the errors (emit_result)
+            for line in bench.notes(result):
+                note(line)
+        inputs = bench.input_files(bags, scored.options, result)
+    return emit_result(result, args, inputs)

@@ -15,18 +15,18 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
-from ertools.benchmarks.base import dump_yaml
-from ertools.cli.main import error_text, printable
 from ertools.cli.options import add_output, plot_file, seconds
 from ertools.cli.output import dump_json, note, write_text
+from ertools.cli.text import error_text, printable
 from ertools.csvsafe import spreadsheet_safe
 from ertools.report.plots_timeline import save_timeline_plot
-from ertools.timeline.model import KIND_LABELS, TimelineConfig
-from ertools.timeline.scan import scan
+from ertools.serialize import dump_yaml
+from ertools.timelines.model import KIND_LABELS, TimelineConfig
+from ertools.timelines.scan import scan
 from ertools.timeutil import iso_utc, s_to_ns
 
 if TYPE_CHECKING:
-    from ertools.timeline.model import Timeline
+    from ertools.timelines.model import Timeline
 
 EPILOG = """examples:
   ertools timeline bags/                         # table of every bag under bags/

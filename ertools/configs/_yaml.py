@@ -18,17 +18,15 @@ from typing import Any
 
 import yaml
 
-from ertools import yamlin
 from ertools.errors import ConfigError
 from ertools.inputs import read_regular_text, why_not
-from ertools.yamlin import Tags
+from ertools.yamlin import DuplicateKey, Tags
+from ertools.yamlin import load as load_yaml_text
 
 log = logging.getLogger("ertools.configs")
 
 # int64 nanoseconds hold ~9.2e18; a float beyond this cannot be a time, a length or a count
 MAX_NUMBER = 9.2e18
-# seconds: epoch seconds (~1.4e9 in 2015) and bag-relative ones; their nanoseconds fit int64
-MAX_SECONDS = 4.6e9
 
 
 def load_yaml(path: str | Path, what: str = "config", tags: Tags = "safe") -> Any:
@@ -51,7 +49,7 @@ def parse_yaml(text: str, source: str = "<string>", what: str = "YAML", tags: Ta
     duplicate keys refused); errors become one-line ``ConfigError``s naming the line."""
 
     try:
-        return yamlin.load(text, tags=tags)
+        return load_yaml_text(text, tags=tags)
     except RecursionError:  # the loader's depth limit comes first; called from deep, say so
         raise ConfigError(f"malformed {what}: nested too deep", path=source) from None
     except yaml.YAMLError as err:
@@ -64,9 +62,9 @@ def parse_payload(text: str, source: str, what: str = "payload", tags: Tags = "s
     and a rescore that refused it would drop a run the live score counted
     (docs/fidelity.md, "Payloads with a key given twice")."""
 
-    duplicates: list[yamlin.DuplicateKey] = []
+    duplicates: list[DuplicateKey] = []
     try:
-        data = yamlin.load(text, tags=tags, duplicates=duplicates)
+        data = load_yaml_text(text, tags=tags, duplicates=duplicates)
     except RecursionError:
         raise ConfigError(f"malformed {what}: nested too deep", path=source) from None
     except yaml.YAMLError as err:

@@ -35,7 +35,7 @@ import numpy.typing as npt
 from ertools.configs._yaml import check_radians, load_yaml, number
 from ertools.errors import ConfigError
 from ertools.geometry import invert
-from ertools.yamlout import yaml_float
+from ertools.serialize import yaml_float
 
 log = logging.getLogger("ertools.configs.transform")
 
@@ -287,8 +287,7 @@ def parse_transform(data: Any, source: str = "<transform>") -> MarkerTransform:
 
 
 def _check_inverse(tr: MarkerTransform, t_inv: Vec3, q_inv: Quat, source: str) -> None:
-    # lazy: scipy only where its rotations/statistics are needed (~0.3 s to import)
-    from scipy.spatial.transform import Rotation
+    from scipy.spatial.transform import Rotation  # lazy: scipy, 300 ms
 
     t_exp, q_exp = tr.inverse()
     dt = float(np.linalg.norm(np.subtract(t_exp, t_inv)))

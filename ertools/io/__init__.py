@@ -2,41 +2,6 @@
 
 ROS1 bags (indexed and ``.bag.active``), rosbag2 directories (sqlite3, mcap) and standalone
 MCAP files, decoded with the message definitions stored in each file. See ``docs/io.md``.
-Importing this package imports NumPy only; rosbags and mcap load on first use.
+The functions live in ertools.io.reader (read_poses, read_tf...), ertools.io.summary and
+ertools.io.model (the records); this package imports nothing.
 """
-
-from ertools.io.model import (
-    BagSummary,
-    BenchmarkStates,
-    PoseSource,
-    RawMessage,
-    TopicSummary,
-)
-from ertools.io.reader import (
-    read_benchmark_states,
-    read_messages,
-    read_pose_source,
-    read_pose_sources,
-    read_poses,
-    read_states,
-    read_tf,
-    topics,
-)
-from ertools.io.summary import summary
-
-__all__ = [
-    "BagSummary",
-    "BenchmarkStates",
-    "PoseSource",
-    "RawMessage",
-    "TopicSummary",
-    "read_benchmark_states",
-    "read_messages",
-    "read_pose_source",
-    "read_pose_sources",
-    "read_poses",
-    "read_states",
-    "read_tf",
-    "summary",
-    "topics",
-]

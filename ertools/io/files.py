@@ -45,8 +45,10 @@ ScannedRun = tuple[Any, Any, Any, Any, Any, Any]
 
 
 def _conn_from_rosbags(c: Any) -> Conn:
-    # lazy: rosbags only on the per-message path (~0.1 s to import)
-    from rosbags.interfaces import ConnectionExtRosbag1, MessageDefinitionFormat
+    from rosbags.interfaces import (  # lazy: rosbags, 100 ms
+        ConnectionExtRosbag1,
+        MessageDefinitionFormat,
+    )
 
     fmt = {MessageDefinitionFormat.MSG: "msg", MessageDefinitionFormat.IDL: "idl"}.get(
         c.msgdef.format, ""
@@ -88,13 +90,11 @@ class RosbagsFile(BagFile):
             if fmt != "ros1":
                 self._inflate = message_compression(read_metadata(path))
             if fmt == "ros1":
-                # lazy: rosbags only on the per-message path (~0.1 s to import)
-                from rosbags.rosbag1 import Reader as Reader1
+                from rosbags.rosbag1 import Reader as Reader1  # lazy: rosbags, 100 ms
 
                 self._reader: Any = Reader1(path)
             else:
-                # lazy: rosbags only on the per-message path (~0.1 s to import)
-                from rosbags.rosbag2 import Reader as Reader2
+                from rosbags.rosbag2 import Reader as Reader2  # lazy: rosbags, 100 ms
 
                 # A bag compressed file by file: the copies every other reader reads.
                 self._reader = Reader2(readable_dir(path))

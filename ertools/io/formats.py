@@ -17,10 +17,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ertools import yamlin
 from ertools.errors import BagError, shown
 from ertools.inputs import kind_of, open_regular, read_regular, why_not
 from ertools.io import budget
+from ertools.yamlin import DuplicateKeyError, YAMLError
+from ertools.yamlin import load as load_yaml
 
 ROS1_MAGIC = b"#ROSBAG V2.0\n"
 MCAP_MAGIC = b"\x89MCAP0\r\n"
@@ -223,7 +224,7 @@ def metadata_problem(err: Exception) -> str:
     """What is wrong with a ``metadata.yaml``, on one line and without its text: PyYAML's own
     message quotes the offending line, and the file may be anything (a symlink to a secret)."""
     mark = getattr(err, "problem_mark", None)
-    if isinstance(err, yamlin.DuplicateKeyError) and mark is not None:
+    if isinstance(err, DuplicateKeyError) and mark is not None:
         return f"a key given twice, at line {mark.line + 1}"  # its name is the file's text
     if mark is not None:
         problem = getattr(err, "problem", None) or "malformed YAML"
@@ -279,7 +280,7 @@ def load_metadata(path: Path) -> Any:
                 )
         elif isinstance(event, yaml.CollectionEndEvent):
             depth -= 1
-    return yamlin.load(text)
+    return load_yaml(text)
 
 
 def _rosbag2_storage(path: Path) -> str:
@@ -290,7 +291,7 @@ def _rosbag2_storage(path: Path) -> str:
             storage = str(data["rosbag2_bagfile_information"]["storage_identifier"])
         except OSError as err:
             raise BagError(f"unreadable metadata.yaml ({why_not(err)})", path=path) from err
-        except (yamlin.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
+        except (YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
             why = metadata_problem(err)
             raise BagError(
                 f"unreadable rosbag2 metadata.yaml ({why}); re-create it with `ros2 bag reindex`",

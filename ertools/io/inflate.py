@@ -77,7 +77,7 @@ def inflate_message(compression: str, data: bytes, where: str) -> Any:
     """
     if compression != "zstd":
         raise BagError(f"unsupported message compression {compression!r} {where}")
-    import zstandard  # lazy: a decompressor only for compressed messages
+    import zstandard  # lazy: zstandard, 6 ms
 
     try:
         size = zstandard.frame_content_size(data)
@@ -113,7 +113,7 @@ def _checked(compression: str, data: Any, size: int, where: str, what: str) -> I
     if compression == "bz2":
         make: Any = bz2.BZ2Decompressor
     elif compression == "lz4":
-        import lz4.frame  # lazy: a decompressor only for compressed chunks
+        import lz4.frame  # lazy: lz4, 7 ms
 
         make = lz4.frame.LZ4FrameDecompressor
     else:
@@ -155,7 +155,7 @@ def _verdict(compression: str, got: int, more: bool, size: int, where: str, what
 
 
 def _zstd(data: Any, out: memoryview) -> tuple[int, bool]:
-    import zstandard  # lazy: a decompressor only for compressed chunks
+    import zstandard  # lazy: zstandard, 6 ms
 
     # zstd's own frame header may state another size: reading into ``out`` bounds it anyway
     # (``decompress(max_output_size=)`` trusts the frame's size over its argument)
@@ -207,7 +207,7 @@ def inflate_file(
     """
     if compression != "zstd":
         raise BagError(f"unsupported file compression {compression!r} {where}")
-    import zstandard  # lazy: a decompressor only for file-compressed rosbag2 storage
+    import zstandard  # lazy: zstandard, 6 ms
 
     limit = min(budget.MAX_FILE_COPY_BYTES, budget.allowance(compressed_size))
     name = "MAX_FILE_COPY_BYTES" if limit == budget.MAX_FILE_COPY_BYTES else "MAX_INFLATE_PER_BYTE"

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any, Literal
 
-from ertools.streams import StateStream
+if TYPE_CHECKING:  # annotations only: options hold a PoseSource, and parsers build options
+    from ertools.streams import StateStream
 
 # Bag formats :func:`ertools.io.formats.detect_format` tells apart.
 FORMATS = ("ros1", "ros1-active", "rosbag2-sqlite3", "rosbag2-mcap", "mcap")
@@ -20,6 +21,12 @@ POSE_TYPES = (
     "tf2_msgs/TFMessage",
 )
 TF_TYPES = ("tf/tfMessage", "tf2_msgs/TFMessage")
+
+# Text trajectories ertools reads (:mod:`ertools.io.text`).
+TextFormat = Literal["tum", "kitti", "euroc", "csv"]
+TEXT_FORMATS: tuple[TextFormat, ...] = ("tum", "kitti", "euroc", "csv")
+# ``--input-format``: a text layout, or ``bag`` (ROS1, rosbag2, MCAP) to skip the sniffing.
+INPUT_FORMATS: tuple[str, ...] = (*TEXT_FORMATS, "bag")
 
 
 @dataclass(frozen=True)

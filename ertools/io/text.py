@@ -24,7 +24,7 @@ import io
 from dataclasses import dataclass
 from decimal import ROUND_HALF_EVEN, Decimal, InvalidOperation
 from pathlib import Path
-from typing import Literal, NoReturn
+from typing import NoReturn
 
 import numpy as np
 import numpy.typing as npt
@@ -32,12 +32,9 @@ import numpy.typing as npt
 from ertools.arrays import F64, I64
 from ertools.errors import BagError
 from ertools.inputs import open_regular, read_regular_text, why_not
+from ertools.io.model import TEXT_FORMATS, TextFormat
 from ertools.streams import PoseStream
 
-TextFormat = Literal["tum", "kitti", "euroc", "csv"]
-TEXT_FORMATS: tuple[TextFormat, ...] = ("tum", "kitti", "euroc", "csv")
-# ``--input-format``: a text layout, or ``bag`` (ROS1, rosbag2, MCAP) to skip the sniffing.
-INPUT_FORMATS: tuple[str, ...] = (*TEXT_FORMATS, "bag")
 CSV_HEADER = "t_ns,t_s,x,y,z,qx,qy,qz,qw,frame_id"
 # How many bytes the sniffer reads: a few comment lines and the first data row.
 _SNIFF_BYTES = 8192
@@ -291,8 +288,7 @@ def _int_ns(rows: _Rows, path: Path) -> I64:
 
 
 def _quat_from_matrices(rot: npt.NDArray[np.float64]) -> F64:
-    # lazy: scipy only where its rotations are needed (~0.3 s to import)
-    from scipy.spatial.transform import Rotation
+    from scipy.spatial.transform import Rotation  # lazy: scipy, 300 ms
 
     q: F64 = Rotation.from_matrix(rot).as_quat()
     return q

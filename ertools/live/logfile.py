@@ -16,7 +16,8 @@ import time
 from pathlib import Path
 from typing import IO, Any
 
-from ertools import __version__, atomic
+from ertools._version import __version__
+from ertools.atomic import hold
 from ertools.errors import BagError
 from ertools.live.rosmsg import MESSAGE_ENCODING, SCHEMA_ENCODING, Ros2Serializer
 
@@ -45,8 +46,7 @@ class LogFile:
         fsync: bool = False,
         chunk_size: int = 256 * 1024,
     ) -> None:
-        # lazy: the mcap library only when an MCAP file is read
-        from mcap.writer import CompressionType, Writer
+        from mcap.writer import CompressionType, Writer  # lazy: mcap, 100 ms
 
         if compression not in COMPRESSIONS:
             raise ValueError(f"compression {compression!r} not in {COMPRESSIONS}")
@@ -65,7 +65,7 @@ class LogFile:
             raise BagError(f"cannot create log file: {err.strerror or err}", path=path) from err
         # held from the first byte to the last (and released however the recorder ends):
         # `record --recover` refuses a file locked so (ertools.live.recover)
-        atomic.hold(self._stream.fileno())
+        hold(self._stream.fileno())
         self._writer: Any = Writer(self._stream, chunk_size=chunk_size, compression=kind)
         self._writer.start(profile="ros2", library=f"ertools {__version__} record")
         self._schemas: dict[str, int] = {}

@@ -33,7 +33,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ertools import __version__
+from ertools._version import __version__
 from ertools.configs.mocap import MocapConfig, RigidBodyConfig, normalize_namespace
 from ertools.errors import BagError, ConfigError, ErtoolsError
 from ertools.live.clock import query_sntp, unreachable_metadata

@@ -32,8 +32,7 @@ class Ros2Serializer:
     """Builds and serialises the three message types (the type store is loaded once)."""
 
     def __init__(self) -> None:
-        # lazy: rosbags only on the per-message path (~0.1 s to import)
-        from rosbags.typesys import Stores, get_typestore
+        from rosbags.typesys import Stores, get_typestore  # lazy: rosbags, 100 ms
 
         self._store: Any = get_typestore(Stores.ROS2_HUMBLE)
         t = self._store.types

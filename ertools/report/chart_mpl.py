@@ -1,4 +1,4 @@
-"""A :class:`~ertools.report.chart.Chart` drawn on a matplotlib ``Axes``: for the PNG and PDF
+"""A :class:`~ertools.views.chart.Chart` drawn on a matplotlib ``Axes``: for the PNG and PDF
 files a user asks for (``--plot fig.png``), and for notebooks (:func:`ertools.api.figures`).
 The reports' own figures are SVG written by :mod:`ertools.report.svg`; both show the same
 layers, labels and legend."""
@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from ertools.report.chart import (
+from ertools.views.chart import (
     Arrows,
     Band,
     Bars,

@@ -24,16 +24,20 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ertools import __version__, atomic, jsonin
+from ertools._version import __version__
+from ertools.atomic import write_text
 from ertools.benchmarks import registry
+from ertools.benchmarks.base import Discovered, Reported
 from ertools.benchmarks.common.teams import team_from_log_name
 from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ConfigError
 from ertools.inputs import read_regular_text, why_not
+from ertools.jsonin import loads as loads_json
 from ertools.report import html as h
-from ertools.report import ranks, units
+from ertools.report import ranks
 from ertools.report.folder import headline
 from ertools.report.rank_plot import interval_plot
+from ertools.views import units
 
 # Command-line options that choose where or how output is written, not what is scored.
 _OUTPUT_OPTIONS = frozenset(
@@ -54,7 +58,7 @@ _OUTPUT_FLAGS = frozenset({"-v", "--verbose", "-q", "--quiet"})
 _SOURCE_RANK = {"explicit": 0, "payload": 1, "log name": 2, "transform": 3}
 
 # Keys that identify a score that is no registered benchmark's (a benchmark declares its own:
-# :attr:`ertools.benchmarks.base.Benchmark.score_keys`) when no result.json says which it is.
+# ``score_keys`` of :class:`ertools.benchmarks.base.Reported`) when no result.json says which it is.
 _OTHER_SIGNATURES: tuple[tuple[str, frozenset[str]], ...] = (
     ("noise", frozenset({"epsilon", "suggested_d_min"})),
 )
@@ -117,7 +121,7 @@ def _options(argv: list[str], inputs: list[dict[str, Any]]) -> str:
 def _load_json(path: Path) -> Any:
     """A result's JSON; a key given twice is refused (the json module keeps the last)."""
     try:
-        return jsonin.loads(read_regular_text(path))  # a named pipe would block for ever
+        return loads_json(read_regular_text(path))  # a named pipe would block for ever
     except OSError as err:
         raise ConfigError(f"cannot read a result: {why_not(err)}", path=path) from err
     except (UnicodeDecodeError, ValueError) as err:
@@ -131,7 +135,11 @@ def _guess_benchmark(score: dict[str, Any]) -> str:
     if isinstance(said, str) and said in registry.names():
         return said
     keys = set(score)
-    declared = [(name, registry.get(name).score_keys) for name in registry.names()]
+    declared = [
+        (name, bench.score_keys)
+        for name in registry.names()
+        if isinstance(bench := registry.get(name), Reported)
+    ]
     for name, signature in (*declared, *_OTHER_SIGNATURES):
         if signature and signature <= keys:
             return name
@@ -310,14 +318,14 @@ def combine(
             }
         )
     text = json.dumps(_finite(flat), indent=2, allow_nan=False)
-    atomic.write_text(outdir / "results.json", text + "\n")
+    write_text(outdir / "results.json", text + "\n")
     table = [_csv_row(row) for row in flat]
     columns = list(dict.fromkeys(k for row in table for k in row))
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=columns)
     writer.writeheader()
     writer.writerows([{k: spreadsheet_safe(v) for k, v in row.items()} for row in table])
-    atomic.write_text(outdir / "results.csv", buffer.getvalue())
+    write_text(outdir / "results.csv", buffer.getvalue())
     of_runs = f" of {len(runs)} execution(s)" if len(runs) != len(entries) else ""
     subtitle = f"{len(entries)} result(s){of_runs}, combined by ertools {__version__}"
     index = outdir / "index.html"
@@ -330,7 +338,7 @@ def combine(
         benchmarks=benchmarks,
         teams=_by_team(runs, outdir),
     )
-    atomic.write_text(index, page)
+    write_text(index, page)
     return index
 
 
@@ -376,9 +384,10 @@ class Board:
 def _board(bench: str, group: list[Execution], chosen: float | None = None) -> Board:
     """The executions of ``bench`` ranked by the registry's rule for it, ties judged at the
     ``chosen`` confidence (default: the results' own)."""
-    if bench not in registry.names():
+    found = registry.get(bench) if bench in registry.names() else None
+    if not isinstance(found, Discovered):
         return Board(None, True, "", ranks.DEFAULT_CONFIDENCE, (), {})
-    ranking = registry.get(bench).ranking
+    ranking = found.ranking
     key = ranks.rule_key(ranking.text)
     contenders = []
     reasons: dict[int, str] = {}

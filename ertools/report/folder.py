@@ -12,7 +12,7 @@
 - ``result.json``: the metadata ``ertools report`` combines (benchmark, team, inputs, the
   headline numbers and the whole score).
 
-An :class:`~ertools.audit.model.Audit` is accepted as well: its recomputed score (when there
+An :class:`~ertools.auditing.model.Audit` is accepted as well: its recomputed score (when there
 is one) becomes the score of the folder, and ``audit.yaml``/``audit.json`` are added.
 """
 
@@ -27,18 +27,20 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
-from ertools import __version__, atomic
-from ertools.audit.analyse import audit_states
-from ertools.audit.model import Audit
+from ertools._version import __version__
+from ertools.atomic import write_text
+from ertools.auditing.analyse import audit_states
+from ertools.auditing.model import Audit
 from ertools.benchmarks import registry
-from ertools.benchmarks.base import BenchmarkResult, Rows, jsonable
+from ertools.benchmarks.base import Audited, BenchmarkResult, Rows
 from ertools.benchmarks.common.teams import team_from_log_name, team_from_transform_name
 from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ConfigError, ErtoolsError
-from ertools.io import read_benchmark_states
+from ertools.io.reader import read_benchmark_states
 from ertools.report import folder_page, plots_audit
-from ertools.report.figures import FigureSpec, figure_specs, save_figures
+from ertools.report.figures import FigureSpec, drawable, figure_specs, save_figures
 from ertools.report.records import FileRecord, csv_stem, file_record
+from ertools.serialize import jsonable
 
 log = logging.getLogger("ertools.report.folder")
 
@@ -60,7 +62,7 @@ def write_report(
     """Write the report folder of ``result`` into ``outdir``; returns the ``index.html`` path.
 
     Args:
-        result: any benchmark result, or an :class:`ertools.audit.model.Audit`.
+        result: any benchmark result, or an :class:`ertools.auditing.model.Audit`.
         outdir: the folder (created; files of the same names are overwritten).
         inputs: the bags the result was computed from (hashed, not modified).
         argv: the command line (shown; file arguments that are not inputs are the configs).
@@ -177,12 +179,13 @@ def _remove_stale(outdir: Path, names: set[str]) -> None:
 
 
 def _write(path: Path, text: str) -> None:
-    atomic.write_text(path, text if text.endswith("\n") else text + "\n")
+    write_text(path, text if text.endswith("\n") else text + "\n")
 
 
 def _audit_inputs(name: str, inputs: list[Path]) -> Any:
     """The audit of the bags' state topics, or None (no namespace, no topics, unreadable)."""
-    if name not in registry.names() or not registry.get(name).state_topics or not inputs:
+    bench = registry.get(name) if name in registry.names() else None
+    if not isinstance(bench, Audited) or not inputs:
         return None
 
     try:
@@ -323,7 +326,7 @@ def _write_tables(outdir: Path, tables: dict[str, Rows], *, prefix: str) -> list
         writer.writerow(columns)
         for row in rows:
             writer.writerow([_csv_cell(row.get(c)) for c in columns])
-        atomic.write_text(outdir / f"{safe}.csv", buffer.getvalue())
+        write_text(outdir / f"{safe}.csv", buffer.getvalue())
         names.append(f"{safe}.csv")
     return names
 
@@ -342,7 +345,7 @@ def _figures(
             log.warning("no figures for %s: %s", score.name, err)
             problems.append(f"no figures for {score.name}: {type(err).__name__}: {err}")
     if audit is not None:
-        specs += plots_audit.figure_specs(audit)
+        specs += [drawable(spec) for spec in plots_audit.figure_specs(audit)]
     out: list[tuple[Path, str]] = []
     for spec in specs:
         try:

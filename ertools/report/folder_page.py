@@ -12,9 +12,9 @@ from typing import Any
 from ertools.benchmarks.base import BenchmarkResult
 from ertools.benchmarks.common.teams import SOURCE_TEXT
 from ertools.report import html as h
-from ertools.report import units
 from ertools.report.records import FileRecord, csv_stem
 from ertools.timeutil import iso_utc, ns_to_s
+from ertools.views import units
 
 TABLE_MAX_ROWS = 200  # longer tables are in the CSV only
 TABLE_OPEN_ROWS = 30  # longer tables are folded in the page

@@ -18,8 +18,8 @@ from pathlib import PurePosixPath
 from typing import TYPE_CHECKING, Any
 from urllib.parse import quote
 
-from ertools.report import units
 from ertools.timeutil import iso_utc, s_to_ns
+from ertools.views import units
 
 if TYPE_CHECKING:
     import jinja2
@@ -39,7 +39,7 @@ def relative_href(path: str | None) -> str | None:
 
 def fmt(value: Any, quantity: str | None = None) -> str:
     """A cell's text: a float of a ``quantity`` (already in its display unit) at the decimals
-    its data resolves (:func:`ertools.report.units.fixed`), other floats with 6 significant
+    its data resolves (:func:`ertools.views.units.fixed`), other floats with 6 significant
     digits, NaN/None as an em dash."""
     if value is None:
         return "\u2014"
@@ -92,7 +92,7 @@ def table(
 ) -> Table:
     """A table of ``rows`` (dicts); columns are the union of their keys in order.
 
-    Numbers of a known quantity (:mod:`ertools.report.units`) are converted to their display
+    Numbers of a known quantity (:mod:`ertools.views.units`) are converted to their display
     unit and the header names it: ``distance_error`` in metres becomes ``distance_error (mm)``.
 
     Args:
@@ -166,7 +166,7 @@ class Figure:
 @cache
 def environment() -> jinja2.Environment:
     """The templates' environment: autoescaping on, undefined names are errors."""
-    import jinja2  # lazy: Jinja2 only when an HTML page is written
+    import jinja2  # lazy: Jinja2, 170 ms
 
     return jinja2.Environment(
         loader=jinja2.PackageLoader("ertools.report", "templates"),

@@ -1,6 +1,6 @@
 """The audit's figure: the three state machines over time, one lane each, as a
-:class:`~ertools.report.chart.Chart` (reports write it as SVG); the data comes from
-:class:`ertools.audit.model.Audit`.
+:class:`~ertools.views.chart.Chart` (reports write it as SVG); the data comes from
+:class:`ertools.auditing.model.Audit`.
 """
 
 from __future__ import annotations
@@ -9,11 +9,12 @@ from typing import Any
 
 import numpy as np
 
-from ertools.report import chart_mpl, units
-from ertools.report.chart import Axis, Chart, Layer, Rects, RefLine, Scatter, Span, Text
-from ertools.report.figures import FigureSpec, chart_spec
+from ertools.report import chart_mpl
 from ertools.states import Machine
 from ertools.timeutil import ns_to_s
+from ertools.views import units
+from ertools.views.chart import Axis, Chart, Layer, Rects, RefLine, Scatter, Span, Text
+from ertools.views.spec import ChartSpec
 
 _LANES = (Machine.CLIENT, Machine.REFBOX, Machine.BMBOX)  # bottom to top
 # Okabe & Ito's colour-blind-safe palette (2008), plus two greys that differ in lightness.
@@ -74,7 +75,7 @@ def state_colour(machine: Machine, state: str) -> str:
     return STATE_COLOURS[machine].get(state, UNKNOWN_COLOUR)
 
 
-def figure_specs(audit: Any) -> list[FigureSpec]:
+def figure_specs(audit: Any) -> list[ChartSpec]:
     """The timeline figure, when the audit has any state message."""
     if not audit.timeline:
         return []
@@ -82,7 +83,7 @@ def figure_specs(audit: Any) -> list[FigureSpec]:
     # Spans the page's width (a wide figure): wide enough that its fonts stay small there.
     width = min(18.0, max(13.0, span_s / 20.0))
     return [
-        chart_spec(
+        ChartSpec(
             "audit_timeline",
             "Benchmark state timeline",
             lambda size: timeline_chart(audit),

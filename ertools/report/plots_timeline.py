@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ertools import atomic
+from ertools.atomic import replacing
 from ertools.errors import UsageError
 from ertools.report.timeline_page import (
     display_names,
@@ -38,7 +38,7 @@ from ertools.report.timeline_style import (
     UNCOVERED_COLOR,
     lane_name,
 )
-from ertools.timeline.model import BagEntry, Session, Timeline
+from ertools.timelines.model import BagEntry, Session, Timeline
 
 PLOT_SUFFIXES = (".png", ".svg", ".html", ".htm")
 # Panels beyond this many would make a figure metres tall; the page shows every session.
@@ -66,8 +66,7 @@ def problem_numbers(timeline: Timeline) -> dict[str, int]:
 
 
 def _num(ns: int) -> float:
-    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
-    import matplotlib.dates as _mdates
+    import matplotlib.dates as _mdates  # lazy: matplotlib, 300 ms
 
     mdates: Any = _mdates  # partly untyped module
     value: float = mdates.date2num(np.datetime64(ns, "ns").astype("datetime64[us]"))
@@ -99,8 +98,7 @@ def draw_session(
         session: the session.
         numbers: the problem number of each bag (default :func:`problem_numbers`).
     """
-    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
-    import matplotlib.dates as _mdates
+    import matplotlib.dates as _mdates  # lazy: matplotlib, 300 ms
 
     mdates: Any = _mdates  # partly untyped module
     numbers = problem_numbers(timeline) if numbers is None else numbers
@@ -179,8 +177,7 @@ def legend_handles(
     kinds: Sequence[str], *, problems: bool, copies: bool, uncovered: bool
 ) -> list[Any]:
     """Legend entries drawn exactly as the bars are."""
-    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
-    from matplotlib.patches import Patch
+    from matplotlib.patches import Patch  # lazy: matplotlib, 300 ms
 
     handles: list[Any] = [
         Patch(facecolor=KIND_COLORS[k], edgecolor="#1d2430", linewidth=0.5, label=KIND_LABELS[k])
@@ -230,8 +227,7 @@ def problem_lines(timeline: Timeline, numbers: Mapping[str, int], width: int = 1
 def timeline_figure(timeline: Timeline) -> Any:
     """The figure: a legend, one panel per session (at most :data:`MAX_PANELS`), the list of
     numbered problems. Returns a ``matplotlib.figure.Figure``."""
-    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
-    from matplotlib.figure import Figure
+    from matplotlib.figure import Figure  # lazy: matplotlib, 300 ms
 
     numbers = problem_numbers(timeline)
     sessions = list(timeline.sessions[:MAX_PANELS])
@@ -257,8 +253,7 @@ def timeline_figure(timeline: Timeline) -> Any:
         ax = fig.add_subplot(grid[len(sessions), 0])
         ax.set_axis_off()
         ax.set_label("problems")
-        # lazy: matplotlib only when a figure is drawn
-        from matplotlib.transforms import blended_transform_factory
+        from matplotlib.transforms import blended_transform_factory  # lazy: matplotlib, 300 ms
 
         # From the figure's left edge, not the axes': the panels' lane labels widen the left
         # margin every row of the grid shares, which pushed the list off the right edge.
@@ -296,8 +291,7 @@ def draw_gantt(ax: Any, timeline: Timeline) -> None:
     Sessions of seconds are hairlines on a day-long axis: :func:`timeline_figure` draws one
     panel per session instead.
     """
-    # lazy: matplotlib only when a figure is drawn (~0.3 s to import)
-    import matplotlib.dates as _mdates
+    import matplotlib.dates as _mdates  # lazy: matplotlib, 300 ms
 
     mdates: Any = _mdates  # partly untyped module
     names = lanes(timeline)
@@ -354,6 +348,6 @@ def save_timeline_plot(timeline: Timeline, path: Path) -> Path:
         return write_timeline_page(timeline, path)
     fig = timeline_figure(timeline)
     path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic.replacing(path) as tmp:
+    with replacing(path) as tmp:
         fig.savefig(tmp, dpi=110)
     return path

@@ -1,4 +1,4 @@
-"""A :class:`~ertools.report.chart.Chart` as an SVG document, written straight from its arrays.
+"""A :class:`~ertools.views.chart.Chart` as an SVG document, written straight from its arrays.
 
 Pure: arrays in, text out, no matplotlib (a report's figure costs milliseconds, not the
 0.3 - 0.5 s of a matplotlib draw and savefig: docs/performance.md, issue 29). The layout is
@@ -23,7 +23,9 @@ from html import escape
 
 import numpy as np
 
-from ertools.report.chart import (
+from ertools.report.svg_marks import Scale, attr, layer_svg, swatch
+from ertools.views.chart import (
+    PIXELS_PER_INCH,
     Arrows,
     Band,
     Bars,
@@ -40,9 +42,7 @@ from ertools.report.chart import (
     floats,
     viridis,
 )
-from ertools.report.svg_marks import Scale, attr, layer_svg, swatch
 
-PIXELS_PER_INCH = 110  # the reports' PNGs were 110 dpi: the same pixel size for each figure
 FONT = "DejaVu Sans, Verdana, Arial, sans-serif"
 TICK_PX, LABEL_PX, TITLE_PX, LEGEND_PX = 11.0, 12.0, 13.0, 11.0
 # Average advance widths of DejaVu Sans in em: capitals and underscores are wider than

@@ -1,4 +1,4 @@
-"""The marks of an SVG chart: one :class:`~ertools.report.chart.Chart` layer as SVG elements
+"""The marks of an SVG chart: one :class:`~ertools.views.chart.Chart` layer as SVG elements
 in pixel coordinates, and its sample in the legend (:mod:`ertools.report.svg` lays out the axes
 around them). Each layer is one ``<g class="series">`` whose ``data-label`` is its legend text.
 """
@@ -11,7 +11,7 @@ from html import escape
 
 import numpy as np
 
-from ertools.report.chart import (
+from ertools.views.chart import (
     Arrows,
     Band,
     Bars,

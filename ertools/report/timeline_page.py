@@ -24,7 +24,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from ertools import atomic
+from ertools.atomic import write_text
 from ertools.report.timeline_assets import CSS, SCRIPT
 from ertools.report.timeline_style import (
     KIND_COLORS,
@@ -35,7 +35,7 @@ from ertools.report.timeline_style import (
     UNCOVERED_COLOR,
     lane_name,
 )
-from ertools.timeline.model import BagEntry, Session, Timeline
+from ertools.timelines.model import BagEntry, Session, Timeline
 from ertools.timeutil import NS_PER_S, iso_utc
 
 # Bags of one logger that overlap (a copy, a restarted logger) are stacked in rows of the
@@ -391,5 +391,5 @@ def timeline_page(timeline: Timeline, *, title: str = "ertools timeline") -> str
 def write_timeline_page(timeline: Timeline, path: Path, *, title: str | None = None) -> Path:
     """Write the page to ``path`` (folders created)."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    atomic.write_text(path, timeline_page(timeline, title=title or "ertools timeline"))
+    write_text(path, timeline_page(timeline, title=title or "ertools timeline"))
     return path

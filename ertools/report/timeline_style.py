@@ -10,7 +10,7 @@ carry a marker.
 from __future__ import annotations
 
 from ertools.benchmarks.common.teams import team_from_log_name
-from ertools.timeline.model import KIND_LABELS, BagEntry
+from ertools.timelines.model import KIND_LABELS, BagEntry
 
 KIND_COLORS: dict[str, str] = {
     "gt": "#0072B2",  # blue

@@ -19,7 +19,7 @@ import numpy as np
 
 from ertools.arrays import I64
 from ertools.errors import TopicError
-from ertools.io import read_messages, topics
+from ertools.io.reader import read_messages, topics
 from ertools.rsbb.referee import Item
 from ertools.rsbb_states import CORE_TO_GUI_TOPIC, STATE_PERIOD_NS
 

@@ -19,9 +19,14 @@ import sys
 if __name__ == "__main__":
     # `python -m ertools.samples`: the module run under its own name, its imports included,
     # inside ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
-    from ertools import launch
+    from ertools.launch import run as launch
 
-    sys.exit(launch.run("ertools.samples.__main__:program", "python -m ertools.samples"))
+    def _start() -> object:
+        from ertools.samples.__main__ import program  # lazy: in the Ctrl-C guard, 600 ms
+
+        return program()
+
+    sys.exit(launch(_start, "python -m ertools.samples"))
 
 import argparse
 import shutil
@@ -29,7 +34,7 @@ import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 
-from ertools import atomic
+from ertools.atomic import replace_folder
 from ertools.errors import ErtoolsError
 from ertools.samples.competition import DEFAULT_SEED, write_competition
 from ertools.samples.scenario import (
@@ -73,7 +78,7 @@ def generate(outdir: Path, names: Sequence[str], seed: int | None = None) -> dic
         except BaseException:
             shutil.rmtree(partial, ignore_errors=True)
             raise
-        atomic.replace_folder(partial, final)
+        replace_folder(partial, final)
         written[name] = [final / p.relative_to(partial) for p in paths]
     return written
 

@@ -50,9 +50,10 @@ from typing import Any
 import numpy as np
 import yaml
 
-from ertools import atomic
+from ertools.atomic import replace_folder
+from ertools.benchmarks.fbm1 import sample as fbm1
+from ertools.benchmarks.fbm2h import sample as fbm2h
 from ertools.errors import UsageError
-from ertools.samples import fbm1, fbm2h
 from ertools.samples.competition_files import (
     GtWindow,
     organiser_manifest,
@@ -72,11 +73,11 @@ from ertools.samples.competition_schedule import (
     simulate_slot,
 )
 from ertools.samples.competition_scores import expected_score, expected_trajectory
-from ertools.samples.mocap import pose_topic
-from ertools.samples.scenario import EPOCH_2015, log_name, to_plain
-from ertools.samples.simulated import SimulatedRun
-from ertools.samples.statemachine import state_messages
 from ertools.samples.timeline_folder import make_active
+from ertools.simulator.answers import EPOCH_2015, log_name, to_plain
+from ertools.simulator.mocap import pose_topic
+from ertools.simulator.simulated import SimulatedRun
+from ertools.simulator.statemachine import state_messages
 from ertools.states import BmBoxState, Machine
 
 NS = 1_000_000_000
@@ -366,5 +367,5 @@ def write_competition(outdir: Path, *, seed: int = DEFAULT_SEED) -> list[Path]:
     except BaseException:
         shutil.rmtree(partial, ignore_errors=True)
         raise
-    atomic.replace_folder(partial, outdir)
+    replace_folder(partial, outdir)
     return [outdir / p.relative_to(partial) for p in paths]

@@ -19,10 +19,10 @@ import numpy.typing as npt
 
 from ertools.arrays import I64
 from ertools.geometry import quat_from_yaw
-from ertools.samples.mocap import MocapPublished, publish_environment, publish_mocap
-from ertools.samples.simulated import SimulatedRun
-from ertools.samples.statemachine import publish_states
-from ertools.samples.writer import BagWriter
+from ertools.simulator.mocap import MocapPublished, publish_environment, publish_mocap
+from ertools.simulator.simulated import SimulatedRun
+from ertools.simulator.statemachine import publish_states
+from ertools.simulator.writer import BagWriter
 
 NS = 1_000_000_000
 TF_PERIOD_NS = 100_000_000  # the static world -> map at 10 Hz, as every 2015 logger had it

@@ -12,9 +12,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from ertools.samples import fbm1, fbm2h, fbm3w
-from ertools.samples.scenario import EPOCH_2015
-from ertools.samples.simulated import SimulatedRun
+from ertools.benchmarks.fbm1 import sample as fbm1
+from ertools.benchmarks.fbm2h import sample as fbm2h
+from ertools.benchmarks.fbm3w import sample as fbm3w
+from ertools.simulator.answers import EPOCH_2015
+from ertools.simulator.simulated import SimulatedRun
 
 NS = 1_000_000_000
 

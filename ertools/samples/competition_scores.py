@@ -14,10 +14,10 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from ertools.benchmarks.trajectory.sample import expected_scores
 from ertools.geometry import yaw_from_quat
-from ertools.samples.mocap import MocapPublished
-from ertools.samples.robotlog import expected_scores
-from ertools.samples.simulated import SimulatedRun
+from ertools.simulator.mocap import MocapPublished
+from ertools.simulator.simulated import SimulatedRun
 
 Fields = dict[str, Any]
 MAX_GAP_NS = 100_000_000  # the trajectory scorer's default --max-gap
@@ -136,9 +136,9 @@ def expected_trajectory(
 ) -> tuple[Fields, dict[str, dict[str, Any]]]:
     """What ``ertools score trajectory ROBOT GT... --offset <-header_offset>`` must report for a
     robot log: the plain per-pose loop of the ``robotlog`` scenario
-    (:func:`ertools.samples.robotlog.expected_scores`, linear association, 0.1 s max gap) over
-    the GT messages the GT files hold (every pub's messages recorded inside ``windows``, the
-    files' [start, end) record-time windows: other teams' runs in the same hour included)."""
+    (:func:`ertools.benchmarks.trajectory.sample.expected_scores`, linear association, 0.1 s max
+    gap) over the GT messages the GT files hold (every pub's messages recorded inside ``windows``,
+    the files' [start, end) record-time windows: other teams' runs in the same hour included)."""
     t, xyz, quat = poses
     parts = [
         (p, np.any([(p.t_record_ns >= a) & (p.t_record_ns < b) for a, b in windows], axis=0))

@@ -1,8 +1,8 @@
-"""The scenario registry and the answers-file convention of the simulated sample logs.
+"""The scenario registry of the simulated sample logs.
 
 A scenario is a function ``generate(outdir: Path, *, seed: int) -> list[Path]`` in its own
 module. It writes one or more logs into ``outdir`` (which exists and is empty) with
-:class:`ertools.samples.writer.BagWriter`, the answers a correct scorer must find next to each
+:class:`ertools.simulator.writer.BagWriter`, the answers a correct scorer must find next to each
 log, and any config YAML the scorer needs; it returns every path it wrote (files, or rosbag2
 directories). ``python -m ertools.samples OUTDIR`` runs each registered scenario into
 ``OUTDIR/<name>/``.
@@ -11,64 +11,37 @@ Rules for scenario authors:
 
 - Deterministic: every random draw from ``np.random.default_rng(seed)`` (or a child of it);
   no wall clock, no ``hash()`` of strings, no dict/set order that depends on the run. Use a
-  fixed epoch start (e.g. :data:`EPOCH_2015` + an offset): the logs look like 2015's.
+  fixed epoch start (e.g. :data:`ertools.simulator.answers.EPOCH_2015` + an offset): the
+  logs look like 2015's.
 - Small: each log <= ~2.5 MB, all of ``sample_bags/`` <= ~15 MB. One body at 120 Hz
   (PoseStamped + Pose2D + /tf) costs ~45 kB/s in an uncompressed ROS1 bag, so keep the
   mocap part under ~50 s per body (compress time: short manual operations, fast runs), and
   publish 120 Hz only for the bodies the benchmark needs.
 - Independent: compute ``expected`` from the noiseless truth with the seed manual's formulas,
   written out in the scenario module; never import ``ertools.benchmarks``.
-- Use :mod:`ertools.samples.mocap` for what the mocap node published,
-  :mod:`ertools.samples.statemachine` for the state topics, :func:`write_answers` here.
-
-Answers file ``<log stem>.answers.yaml`` (``<name>.bag`` -> ``<name>.answers.yaml``; a rosbag2
-directory ``<name>/`` -> ``<name>.answers.yaml`` beside it), top-level keys in this order:
-
-``benchmark``
-    ``fbm1h``, ``fbm1w``, ``fbm2h``, ``fbm3w``, or a non-benchmark kind (``stationary``,
-    ``robotlog``, ``timeline``).
-``bag``
-    The log's file name(s) relative to the answers file (a string or a list).
-``generator``
-    ``scenario``, ``seed`` and ``parameters`` (noise sigma, rates, latency, losses...).
-``truth``
-    What the simulation knows: run/segment windows as ``{start: <epoch s>, end: <epoch s>,
-    start_ns: <int>, end_ns: <int>}`` (:func:`window`), true poses, items, offsets...
-``expected``
-    The values a correct scorer must report (per run/segment/item and totals).
-``tolerance``
-    For each expected key (or group), ``{abs: <number>, why: <one line>}``.
-
-Numbers are plain YAML floats/ints (``to_plain`` converts NumPy values); times are given in
-epoch seconds *and* int64 ns so tests can compare either.
+- Use :mod:`ertools.simulator.mocap` for what the mocap node published,
+  :mod:`ertools.simulator.statemachine` for the state topics and
+  :func:`ertools.simulator.answers.write_answers` for the answers file (its conventions are
+  written there).
 """
 
 from __future__ import annotations
 
-import datetime as dt
 import importlib
-from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any, Protocol
-
-import numpy as np
-import yaml
+from typing import Protocol
 
 from ertools.benchmarks.fbm1.config import BENCHMARKS as FBM1
 from ertools.benchmarks.fbm2h.config import NAMESPACE as FBM2H
 from ertools.benchmarks.fbm3w.config import NAMESPACE as FBM3W
 from ertools.errors import UsageError
 
-# A Friday at the Lisbon 2015 RoCKIn competition (2015-11-20 10:00:00 UTC): the default
-# start of simulated logs.
-EPOCH_2015 = 1_448_013_600 * 1_000_000_000
-
 SCENARIOS: dict[str, str] = {
-    FBM3W: "ertools.samples.fbm3w:generate",
-    FBM2H: "ertools.samples.fbm2h:generate",
-    FBM1[0]: "ertools.samples.fbm1:generate",
-    "robotlog": "ertools.samples.robotlog:generate",
-    "stationary": "ertools.samples.stationary:generate",
+    FBM3W: "ertools.benchmarks.fbm3w.sample:generate",
+    FBM2H: "ertools.benchmarks.fbm2h.sample:generate",
+    FBM1[0]: "ertools.benchmarks.fbm1.sample:generate",
+    "robotlog": "ertools.benchmarks.trajectory.sample:generate",
+    "stationary": "ertools.benchmarks.noise.sample:generate",
     "timeline": "ertools.samples.timeline_folder:generate",
     "hnf": "ertools.benchmarks.hnf.sample:generate",
     "hpff": "ertools.benchmarks.hpff.sample:generate",
@@ -112,92 +85,6 @@ def load_scenario(name: str) -> Generate:
         raise ScenarioMissingError(f"scenario {name!r}: {module_name} has no function {func}()")
     generate: Generate = fn
     return generate
-
-
-def log_name(kind: str, start_ns: int, *, index: int = 0, suffix: str = ".bag") -> str:
-    """The 2015 logger's file name: ``log_<kind>_<YYYY-mm-dd-HH-MM-SS>_<index><suffix>`` (UTC).
-
-    E.g. ``log_name("fbm3w_mocap", EPOCH_2015)`` -> ``log_fbm3w_mocap_2015-11-20-10-00-00_0.bag``.
-    """
-
-    stamp = dt.datetime.fromtimestamp(start_ns // 1_000_000_000, tz=dt.UTC)
-    return f"log_{kind}_{stamp:%Y-%m-%d-%H-%M-%S}_{index}{suffix}"
-
-
-def answers_path(log: Path) -> Path:
-    """``x.bag`` / ``x.mcap`` / rosbag2 dir ``x`` -> ``x.answers.yaml`` in the same folder."""
-    name = log.name
-    for suffix in (".bag.active", ".bag", ".mcap"):
-        if name.endswith(suffix):
-            name = name[: -len(suffix)]
-            break
-    return log.with_name(f"{name}.answers.yaml")
-
-
-def window(start_ns: int, end_ns: int) -> dict[str, Any]:
-    """A time window for ``truth``: epoch seconds and ns."""
-    return {
-        "start": int(start_ns) / 1e9,
-        "end": int(end_ns) / 1e9,
-        "start_ns": int(start_ns),
-        "end_ns": int(end_ns),
-    }
-
-
-def tol(abs_: float, why: str) -> dict[str, Any]:
-    """A tolerance entry: ``{abs: ..., why: ...}``."""
-    return {"abs": float(abs_), "why": why}
-
-
-def to_plain(value: Any) -> Any:
-    """NumPy scalars/arrays, tuples and Paths -> plain YAML-safe Python values."""
-    if isinstance(value, Mapping):
-        return {str(k): to_plain(v) for k, v in value.items()}
-    if isinstance(value, np.ndarray):
-        return to_plain(value.tolist())
-    if isinstance(value, (list, tuple)):
-        return [to_plain(v) for v in value]
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, Path):
-        return value.name
-    if isinstance(value, float):
-        return float(value)
-    return value
-
-
-def write_answers(
-    log: Path | Sequence[Path],
-    *,
-    benchmark: str,
-    scenario: str,
-    seed: int,
-    parameters: Mapping[str, Any],
-    truth: Mapping[str, Any],
-    expected: Mapping[str, Any],
-    tolerance: Mapping[str, Any],
-) -> Path:
-    """Write ``<log stem>.answers.yaml`` beside ``log`` (the first log when several).
-
-    Key order is fixed (the convention above) and mapping order is kept, so the file is
-    byte-identical for identical inputs.
-    """
-
-    logs = [log] if isinstance(log, Path) else list(log)
-    if not logs:
-        raise ValueError("write_answers needs at least one log path")
-    doc = {
-        "benchmark": benchmark,
-        "bag": logs[0].name if len(logs) == 1 else [p.name for p in logs],
-        "generator": {"scenario": scenario, "seed": int(seed), "parameters": to_plain(parameters)},
-        "truth": to_plain(truth),
-        "expected": to_plain(expected),
-        "tolerance": to_plain(tolerance),
-    }
-    out = answers_path(logs[0])
-    text = yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=100)
-    out.write_text(text, encoding="utf-8")
-    return out
 
 
 def run_scenario(name: str, outdir: Path, *, seed: int) -> list[Path]:

@@ -29,13 +29,13 @@ from typing import Any
 
 import yaml
 
-from ertools import atomic
+from ertools.atomic import write_text
 from ertools.benchmarks.hgmf.sample import T0 as HGMF_T0
 from ertools.benchmarks.hgmf.sample import GoalPlan, RunPlan, build, expected, write_config
-from ertools.samples.rsbb import write_rsbb_run
-from ertools.samples.rsbb_scenario import Goal, RsbbScenario, Save
-from ertools.samples.rsbb_task import COMPLETED, STOPPED, TaskScenario, write_task_run
-from ertools.samples.scenario import tol
+from ertools.simulator.answers import tol
+from ertools.simulator.rsbb import write_rsbb_run
+from ertools.simulator.rsbb_scenario import Goal, RsbbScenario, Save
+from ertools.simulator.rsbb_task import COMPLETED, STOPPED, TaskScenario, write_task_run
 
 S = 1_000_000_000
 MS = 1_000_000
@@ -206,7 +206,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     written.append(config)
     path = outdir / "rsbb_etc" / "config" / "benchmarks_description.yaml"
     path.parent.mkdir(parents=True, exist_ok=True)
-    atomic.write_text(path, yaml.safe_dump(description(), sort_keys=False, width=100))
+    write_text(path, yaml.safe_dump(description(), sort_keys=False, width=100))
     written.append(path)
     boards: dict[str, Any] = {}
     hgmf_rows = []
@@ -270,7 +270,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         "unranked": [],
     }
     answers_path = outdir / "answers.yaml"
-    atomic.write_text(
+    write_text(
         answers_path,
         yaml.safe_dump(
             {

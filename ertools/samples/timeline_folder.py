@@ -14,7 +14,7 @@ Layout (times in seconds after :data:`T0`, the record times of each bag's first/
     old/log_fbm2h_mocap_<date>_0.bag               a GT bag truncated at 55 % of its bytes
 
 Every bag holds only topics whose record times the scenario sets, so each bag's span is known
-exactly. Answers (``expected``), computed here without ``ertools.timeline.build``:
+exactly. Answers (``expected``), computed here without ``ertools.timelines.build``:
 
 - ``bags``: per file (path relative to the folder): start, end (epoch s), kind;
 - ``overlaps``: per readable file, the files whose closed spans intersect its own (a plain
@@ -37,15 +37,15 @@ from pathlib import Path
 import numpy as np
 
 from ertools.arrays import I64
-from ertools.benchmarks.fbm2h.config import NAMESPACE as FBM2H
 from ertools.geometry import quat_from_yaw
-from ertools.samples.mocap import FRAME_NS
-from ertools.samples.scenario import EPOCH_2015, log_name, tol, write_answers
-from ertools.samples.writer import BagWriter
+from ertools.simulator.answers import EPOCH_2015, log_name, tol, write_answers
+from ertools.simulator.mocap import FRAME_NS
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
 NS = 1_000_000_000
 T0 = EPOCH_2015 + 5 * 3600 * NS  # 15:00 UTC
+FBM2H = "fbm2h"  # the namespace of the FBM2@Home logs this folder holds: data
 GT_TOPIC = "/fbm2h/robot_at_home/pose"
 WORK_TOPIC = "/fbm3w/robot_at_work/pose"
 ROBOT_TOPIC = "/rockin/homer/marker_pose"

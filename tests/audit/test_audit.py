@@ -5,52 +5,13 @@ from __future__ import annotations
 from dataclasses import replace
 
 import pytest
-from audit_streams import BEAT_NS, T0_NS, heartbeat
 
-from ertools.audit.analyse import audit_states, parse_payload
+from ertools.auditing.analyse import audit_states, parse_payload
 from ertools.states import BmBoxState as B
 from ertools.states import ClientState as C
 from ertools.states import Machine
 from ertools.states import RefBoxState as R
-
-GOAL = "goal:\n  waypoints:\n  - [1.0, 2.0, 0.5]\n"
-
-# An FBM2-like benchmark of two segments. Segment 1 contains an illegal transition
-# (EXECUTING_GOAL -> TRANSMITTING_GOAL at 12.0 s) and is ended by a RefBox timeout at 19.9 s;
-# the BmBox heartbeat is lost between 5.0 s and 7.0 s.
-BMBOX = [
-    (0.0, B.START, ""),
-    (1.0, B.WAITING_CLIENT, ""),
-    (2.0, B.READY, ""),
-    (3.0, B.TRANSMITTING_GOAL, GOAL),
-    (3.5, B.EXECUTING_GOAL, ""),
-    (4.0, B.WAITING_RESULT, ""),
-    (10.0, B.READY, ""),
-    (11.0, B.TRANSMITTING_GOAL, ""),
-    (11.5, B.EXECUTING_GOAL, ""),
-    (12.0, B.TRANSMITTING_GOAL, ""),
-    (12.5, B.EXECUTING_GOAL, ""),
-    (13.0, B.WAITING_RESULT, ""),
-    (20.0, B.END, ""),
-]
-REFBOX = [
-    (0.0, R.START, ""),
-    (0.5, R.WAITING_CLIENT, ""),
-    (1.5, R.READY, ""),
-    (3.0, R.EXECUTING_GOAL, ""),
-    (19.9, R.END, "timeout"),
-]
-CLIENT = [
-    (0.0, C.START, ""),
-    (0.5, C.CONNECTING, ""),
-    (1.5, C.READY, ""),
-    (2.5, C.WAITING_GOAL, ""),
-    (3.5, C.EXECUTING_GOAL, ""),
-    (9.8, C.COMPLETED_GOAL, "{int: 1}"),
-    (10.2, C.WAITING_GOAL, ""),
-    (11.5, C.EXECUTING_GOAL, ""),
-    (20.0, C.END, ""),
-]
+from tests.helpers.audit_streams import BEAT_NS, BMBOX, CLIENT, GOAL, REFBOX, T0_NS, heartbeat
 
 
 def _ns(seconds: float) -> int:

@@ -7,11 +7,11 @@ import json
 from pathlib import Path
 
 import pytest
-from fakes import FakeResult
-from stderr_text import error_messages
 
 from ertools.cli.main import main
 from ertools.report.folder import write_report
+from tests.helpers.fakes import FakeResult
+from tests.helpers.stderr_text import error_messages
 
 REAL = Path(__file__).resolve().parents[2] / ".." / "shared" / "real_bags"
 BAG = REAL / "log_fbm2h_mocap_2015-10-23-16-15-40_0.bag"

@@ -5,14 +5,14 @@ from __future__ import annotations
 import math
 
 import pytest
-from audit_streams import heartbeat
-from fakes import FakeResult
 
-from ertools.audit.analyse import audit_states
-from ertools.audit.compare import attach, compare_scores, flatten
+from ertools.auditing.analyse import audit_states
+from ertools.auditing.compare import attach, compare_scores, flatten
 from ertools.states import BmBoxState as B
 from ertools.states import Machine
 from ertools.streams import Provenance
+from tests.helpers.audit_streams import heartbeat
+from tests.helpers.fakes import FakeResult
 
 WRAP_DEV = "orientation errors are wrapped to [0, pi] (2015 used the unwrapped difference)"
 

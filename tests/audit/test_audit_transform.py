@@ -11,12 +11,14 @@ from dataclasses import replace
 from pathlib import Path
 
 import pytest
-from audit_samples import answers, sample_dir
 
-from ertools.audit.compare import IDENTITY_CAVEAT, POSE_KEYS, attach
-from ertools.audit.rescore import ScoreInputs, audit_bag, rescore
+from ertools.auditing.compare import IDENTITY_CAVEAT, POSE_KEYS, attach
+from ertools.auditing.recompute import ScoreInputs, audit_bag, rescore
 from ertools.cli.main import main
 from ertools.report.folder import write_report
+from tests.audit.audit_samples import answers, sample_dir
+
+pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module")

@@ -6,26 +6,17 @@ import json
 from pathlib import Path
 
 import pytest
-from audit_streams import T0_NS, heartbeat
-from stderr_text import error_messages, joined_lines
-from test_audit import BMBOX, CLIENT, REFBOX
 
 from ertools.cli.main import main
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 from ertools.states import Machine
-from ertools.streams import StateStream
-
-
-def _write_bag(path: Path, streams: list[StateStream]) -> Path:
-    with BagWriter(path, "ros1") as bag:
-        for s in streams:
-            bag.write_state(s.machine, s.topic, s.t_ns, [int(x) for x in s.state], list(s.payload))
-    return path
+from tests.helpers.audit_streams import BMBOX, CLIENT, REFBOX, T0_NS, heartbeat, write_bag
+from tests.helpers.stderr_text import error_messages, joined_lines
 
 
 @pytest.fixture
 def bag(tmp_path: Path) -> Path:
-    return _write_bag(
+    return write_bag(
         tmp_path / "fbm2h_states.bag",
         [
             heartbeat(Machine.BMBOX, BMBOX, 20.0, drop=(5.0, 7.0), topic="/fbm2h/bmbox_state"),
@@ -50,6 +41,7 @@ def test_audit_json_from_bag(bag: Path, capsys: pytest.CaptureFixture[str]) -> N
     assert [r["outcome"] for r in data["runs"].values()] == ["completed", "timeout"]
 
 
+@pytest.mark.slow
 def test_audit_text_report_and_strict(
     bag: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -92,7 +84,7 @@ SAMPLE_FBM2H = (
     ("option", "value", "named"),
     [
         # A topic the log does not have (a value no scorer takes, `--hits -5`, is a usage
-        # error of the parser, exit 2: tests/core/test_cli_vocabulary.py).
+        # error of the parser, exit 2: tests/cli/test_cli_vocabulary.py).
         ("--topic", "/no/such/topic", "/no/such/topic"),
     ],
 )
@@ -174,7 +166,7 @@ def test_missing_bag(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None
 def test_several_benchmarks_need_benchmark_option(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    bag = _write_bag(
+    bag = write_bag(
         tmp_path / "two.bag",
         [
             heartbeat(Machine.BMBOX, BMBOX, 20.0, topic="/fbm2h/bmbox_state"),

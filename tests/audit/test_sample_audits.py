@@ -7,14 +7,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from audit_samples import answers, sample_dir
 
-from ertools.audit.analyse import audit_states
-from ertools.audit.compare import attach, flatten
-from ertools.audit.model import Audit
-from ertools.audit.rescore import ScoreInputs, audit_bag, rescore
+from ertools.auditing.analyse import audit_states
+from ertools.auditing.compare import attach, flatten
+from ertools.auditing.model import Audit
+from ertools.auditing.recompute import ScoreInputs, audit_bag, rescore
 from ertools.cli.main import main
-from ertools.io import read_benchmark_states
+from ertools.io.reader import read_benchmark_states
+from tests.audit.audit_samples import answers, sample_dir
+
+pytestmark = pytest.mark.slow
 
 
 def _audit(folder: Path, ns: str) -> Audit:

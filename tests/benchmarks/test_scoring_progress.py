@@ -5,12 +5,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 import yaml
 
-from ertools.benchmarks.fbm1.benchmark import score_fbm1_bag
-from ertools.benchmarks.fbm3w.benchmark import score_fbm3w
-from ertools.configs.fbm3w import Fbm3wConfig
+from ertools.benchmarks import registry
+from ertools.benchmarks.fbm3w.pipeline import score_fbm3w
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
+from ertools.benchmarks.scoring import score_execution
 from ertools.progress import reporting
+
+pytestmark = pytest.mark.slow
 
 S = Path(__file__).resolve().parents[2] / "sample_bags"
 
@@ -54,7 +58,7 @@ def test_fbm1_reports_reads_then_runs() -> None:
     assert runs == 10
     rec = Recorder()
     with reporting(rec):
-        score_fbm1_bag([bag], S / "fbm1h/fbm1h.yaml")
+        score_execution(registry.get("fbm1h"), [bag], {"items": S / "fbm1h/fbm1h.yaml"})
     _check(rec, bag, runs, "/fbm1h/origin/pose")
 
 

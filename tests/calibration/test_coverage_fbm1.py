@@ -9,20 +9,16 @@ truth are independent noise components: each (run, component) is one Bernoulli t
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
-from scipy.stats import binom
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
-
+import pytest
 from calibration import fbm1
+from scipy.stats import binom
 
 TRIALS = 12
 DRAWS = 200
 KEYS = ("ground_truth.x", "ground_truth.y", "ground_truth.theta")
 
 
+@pytest.mark.slow
 def test_95_percent_intervals_cover_the_truth_95_percent_of_the_time() -> None:
     covered = total = 0
     for seed in range(TRIALS):

@@ -3,7 +3,11 @@ small number of simulated executions (``make calibrate`` runs 1,000)."""
 
 from __future__ import annotations
 
-from trials import coverage
+import pytest
+
+from tests.calibration.trials import coverage
+
+pytestmark = pytest.mark.slow
 
 TRIALS = 40
 DRAWS = 200

@@ -3,7 +3,11 @@ small number of simulated executions (``make calibrate`` runs 1,000)."""
 
 from __future__ import annotations
 
-from trials import coverage
+import pytest
+
+from tests.calibration.trials import coverage
+
+pytestmark = pytest.mark.slow
 
 # 24 executions (40 until the suite was made faster: 15 s of CPU, the suite's largest test
 # after the fuzz sample); seeds 0-23 cover 115 of their 120 scores.

@@ -9,14 +9,11 @@ compared moment, computed there with plain NumPy).
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
+import pytest
+from calibration import trajectory
 from scipy.stats import binom
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "bench"))
-
-from calibration import trajectory
+pytestmark = pytest.mark.slow
 
 TRIALS = 40
 DRAWS = 100

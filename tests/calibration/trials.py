@@ -3,12 +3,6 @@
 from __future__ import annotations
 
 import importlib
-import sys
-from pathlib import Path
-
-BENCH = Path(__file__).resolve().parents[2] / "bench"
-if str(BENCH) not in sys.path:
-    sys.path.insert(0, str(BENCH))
 
 
 def coverage(module_name: str, trials: int, draws: int) -> tuple[int, int, list[str]]:

@@ -36,7 +36,8 @@ from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Writer
 from rosbags.typesys import Stores, get_typestore
 
-from ertools.cli.main import COMMANDS, MAX_ERROR_LINE, main
+from ertools.cli.main import COMMANDS, main
+from ertools.cli.text import MAX_ERROR_LINE
 
 REPO = Path(__file__).resolve().parents[2]
 SAMPLES = REPO / "sample_bags"
@@ -414,6 +415,28 @@ def _bad_rosbag2(inputs: Inputs, kind: str) -> Path:
     return out
 
 
+@pytest.mark.slow_cases(
+    "acquire-items-truncated@-7",
+    "acquire-transform-truncated@-7",
+    "acquire-transform-truncated@0.81",
+    "export-pair-gt-truncated@-7",
+    "export-pair-gt-truncated@0.81",
+    "info-empty",
+    "info-missing",
+    "info-random",
+    "info-truncated@-7",
+    "info-truncated@0.004",
+    "score-fbm1h-truncated@-7",
+    "score-fbm1w-truncated@-7",
+    "score-fbm2h-truncated@-7",
+    "score-fbm2h-truncated@0.81",
+    "score-fbm3w-truncated@-7",
+    "score-fbm3w-truncated@0.81",
+    "score-trajectory-gt-truncated@-7",
+    "score-trajectory-gt-truncated@0.81",
+    "timeline-truncated@-7",
+    "timeline-truncated@0.81",
+)
 @pytest.mark.parametrize("bad", BAD_BAGS)
 @pytest.mark.parametrize("command", list(BAG_COMMANDS))
 def test_bad_bag(
@@ -638,6 +661,7 @@ def test_audit_bad_config_is_refused_unexecuted_even_when_only_warned(
     assert "Traceback" not in result.err and "evil.yaml" in result.err
 
 
+@pytest.mark.slow
 def test_short_items_order_keeps_the_payloads_of_later_runs(
     inputs: Inputs, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -1064,6 +1088,7 @@ def test_damaged_gt_file_is_named(inputs: Inputs, capsys: pytest.CaptureFixture[
     assert "outside the GT" in line and "damaged" in line
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "which,shift_s", [("fbm2h", 3.0), ("fbm2h", -0.4), ("fbm1h", -2.0), ("fbm1h", 0.5)]
 )
@@ -1097,6 +1122,7 @@ def test_mocap_clock_off_the_logger_clock(
         )
 
 
+@pytest.mark.slow
 def test_fbm3w_header_time_with_mocap_clock_off(
     inputs: Inputs, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -1239,6 +1265,7 @@ def test_unwritable_output_path(
     _check_error(result, 1, blocker.name)
 
 
+@pytest.mark.slow
 def test_report_onto_its_own_result_folder_is_refused(
     inputs: Inputs, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -1305,8 +1332,8 @@ def test_non_finite_number_option(
 def _every_command() -> Iterator[list[str]]:
     for name, cmd in COMMANDS.items():
         yield [name]
-        members = getattr(import_module(cmd.module), "MEMBERS", None)
-        for member in members or ():
+        members = getattr(import_module(cmd.module), "members", None)
+        for member in members() if members is not None else ():
             yield [name, member]
 
 

@@ -6,10 +6,10 @@ import shlex
 from pathlib import Path
 
 import pytest
-from test_readme import ROOT, console_blocks
 
 from ertools import demo
 from ertools.demo import steps
+from tests.e2e.test_readme import ROOT, console_blocks
 
 # Where the output goes is the demo's business, not a scoring option.
 OUTPUT_OPTIONS = frozenset(

@@ -11,8 +11,8 @@ ports). Commands that are only illustrations (placeholders, servers) live in ``t
 which this test does not run.
 
 The shell is a real bash; its ``ertools`` commands run in the test's own process
-(tests/shell_bridge.py), since what a page shows is their output, not their start-up. The pages
-of REAL_PROCESSES run every command as a process.
+(tests/helpers/shell_bridge.py), since what a page shows is their output, not their start-up.
+The pages of REAL_PROCESSES run every command as a process.
 """
 
 from __future__ import annotations
@@ -26,8 +26,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
-from shell_bridge import run_bash
-from stderr_text import joined_lines
+
+from tests.helpers.shell_bridge import run_bash
+from tests.helpers.stderr_text import joined_lines
 
 ROOT = Path(__file__).resolve().parents[2]
 SHARED = ROOT.parent / "shared"
@@ -36,7 +37,7 @@ FENCE = re.compile(r"^```(\w*)\n(.*?)^```", re.MULTILINE | re.DOTALL)
 MARK = "@@docs-command"
 # Pages whose commands run as processes of their own: a recording and its monitor side by side
 # (the bridge runs one command at a time). Every other page's `ertools` commands run in the
-# test's process, through the same bash (tests/shell_bridge.py).
+# test's process, through the same bash (tests/helpers/shell_bridge.py).
 REAL_PROCESSES = {"live.md"}
 
 
@@ -116,7 +117,14 @@ def test_shell_commands_in_docs_are_console_or_text_blocks() -> None:
                 pytest.fail(f"{page.name}: a ```{fence.group(1)} block holds $ commands")
 
 
-@pytest.mark.parametrize("name", pages())
+def _cases() -> list[object]:
+    # live.md records and monitors side by side on a deadline: in the timing group (conftest)
+    timing = pytest.mark.xdist_group("timing")
+    return [pytest.param(n, marks=timing) if n == "live.md" else n for n in pages()]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", _cases())
 def test_docs_commands_run_as_printed(name: str, tmp_path: Path) -> None:
     if not SHARED.is_dir():
         pytest.skip("../shared not present: the docs' commands read its real bags")
@@ -147,7 +155,7 @@ def test_docs_commands_run_as_printed(name: str, tmp_path: Path) -> None:
             check=False,
         )
         returncode, printed = proc.returncode, proc.stdout
-    else:  # the same shell, its `ertools` commands run in this process (tests/shell_bridge.py)
+    else:  # the same shell, its `ertools` commands in this process (tests/helpers/shell_bridge.py)
         returncode, printed, _ = run_bash("\n".join(lines), cwd=work, env=env, timeout=300)
     outputs: dict[int, list[str]] = {}
     current = -1

@@ -10,13 +10,13 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
-from stderr_text import error_messages
 
+from ertools.benchmarks.fbm3w.shapes import compile_expression
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
-from ertools.configs.shapes import compile_expression
 from ertools.errors import ConfigError
 from ertools.yamlin import MAX_DEPTH
+from tests.helpers.stderr_text import error_messages
 
 ROOT = Path(__file__).resolve().parents[2]
 FBM2H = ROOT / "sample_bags" / "fbm2h"
@@ -97,6 +97,7 @@ def test_a_hostile_number_is_one_line_naming_file_and_key(
     assert re.search(r"too large|not a finite|out of range|larger than", lines[0]), lines[0]
 
 
+@pytest.mark.slow
 def test_deep_nesting_is_refused_with_a_message(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

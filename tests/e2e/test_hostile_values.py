@@ -16,11 +16,11 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from edited_bags import edited_copy, poses_between
-from stderr_text import error_messages
 
 from ertools.caches import clear as clear_caches
 from ertools.cli.main import main
+from tests.e2e.edited_bags import edited_copy, poses_between
+from tests.helpers.stderr_text import error_messages
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"

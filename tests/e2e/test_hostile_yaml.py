@@ -15,13 +15,13 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
-from stderr_text import error_messages
 
+from ertools.benchmarks.fbm2h.goal import goal_from_payload
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_payload, parse_yaml
-from ertools.configs.goal import goal_from_payload
 from ertools.configs.mocap import load_mocap_config
 from ertools.errors import ConfigError
+from tests.helpers.stderr_text import error_messages
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"

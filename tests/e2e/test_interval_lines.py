@@ -11,9 +11,9 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from stderr_text import joined_lines
 
 from ertools.cli.main import main
+from tests.helpers.stderr_text import joined_lines
 
 SAMPLES = Path(__file__).resolve().parents[2] / "sample_bags"
 FBM2 = SAMPLES / "fbm2h"

@@ -23,7 +23,10 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from inprocess import run
+
+from tests.helpers.inprocess import run
+
+pytestmark = pytest.mark.slow  # whole module: make test only
 
 ROOT = Path(__file__).resolve().parents[2]
 README = ROOT / "README.md"

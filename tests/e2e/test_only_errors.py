@@ -13,9 +13,9 @@ from pathlib import Path
 
 import pytest
 import yaml
-from stderr_text import joined_lines
 
 from ertools.cli.main import main
+from tests.helpers.stderr_text import joined_lines
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"
@@ -91,6 +91,7 @@ def test_fbm1_every_run_failed(capsys: pytest.CaptureFixture[str]) -> None:
     only_errors(out, err, *(f"run {i}: item '{n}'" for i, n in enumerate(names, 1)))
 
 
+@pytest.mark.slow
 def test_fbm1_one_run_failed_keeps_the_others(capsys: pytest.CaptureFixture[str]) -> None:
     answers = yaml.safe_load(
         (FBM1H / "log_fbm1h_2015-11-20-12-00-00_0.answers.yaml").read_text(encoding="utf-8")

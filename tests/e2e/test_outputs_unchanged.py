@@ -4,11 +4,11 @@
 The recorded files are in ``tests/e2e/golden/``. A case runs a command (in the current
 vocabulary: only the spelling of options may change, never the output) and compares its stdout
 and the data files of its report folder with the recording: the same text, numbers each within
-what its quantity may move between CPUs (``tests/floats.py``: NumPy's and OpenBLAS's code
+what its quantity may move between CPUs (``tests/helpers/floats.py``: NumPy's and OpenBLAS's code
 differs in the last bits between instruction sets; YAML's 9-decimal values may move by one in
 the last digit), after normalisations: the temporary folder becomes ``<OUT>``, the repository
 ``<ROOT>`` and a report's ``generated`` time ``<TIME>`` and its recorded command line
-``<ARGV>``. The commands run in the test's process (tests/inprocess.py), in the temporary
+``<ARGV>``. The commands run in the test's process (tests/helpers/inprocess.py), in the temporary
 folder. Record again, only when an output is meant to change, with
 ``ERTOOLS_RECORD_GOLDEN=1 pytest tests/e2e/test_outputs_unchanged.py`` and say why in the
 commit; on an AVX-512 CPU prefix ``NPY_DISABLE_CPU_FEATURES="X86_V4 AVX512_ICL"`` (the AVX2
@@ -23,8 +23,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
-from floats import output_difference
-from inprocess import run
+
+from tests.helpers.floats import output_difference
+from tests.helpers.inprocess import run
+
+pytestmark = pytest.mark.slow
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"
@@ -113,7 +116,7 @@ def _normalise(text: str, out: Path) -> str:
 def _run(case: Case, out: Path) -> dict[str, str]:
     """The case's outputs by name: ``stdout`` and ``<folder>/<relative path>`` data files."""
     argv = [a.format(samples=SAMPLES, real=REAL, out=out) for a in case.argv]
-    ran = run(argv, cwd=out)  # in this process (tests/inprocess.py): the outputs are the point
+    ran = run(argv, cwd=out)  # in this process (tests/helpers/inprocess.py): outputs are the point
     assert ran.code in (0, 1), ran.stderr[-2000:]
     outputs = {"stdout": _normalise(ran.stdout, out), "exit": str(ran.code)}
     if case.folder is not None:
@@ -160,7 +163,7 @@ def test_outputs_equal_the_recording(case: Case, tmp_path: Path) -> None:
     assert golden, f"no recording for {case.name}: record with ERTOOLS_RECORD_GOLDEN=1"
     assert sorted(outputs) == sorted(golden), f"{case.name}: other files than recorded"
     for key, text in outputs.items():
-        # numbers within their quantity's tolerance across CPUs (tests/floats.py), the rest
+        # numbers within their quantity's tolerance across CPUs (tests/helpers/floats.py), the rest
         # exactly
         where = output_difference(text, golden[key], _format(case, key), key)
         assert where is None, f"{case.name}: {key} differs from the recording: {where}"

@@ -1,5 +1,5 @@
 """The README's console blocks, pasted as printed into one shell after the set-up commands
-(a real bash, whose ``ertools`` commands run in the test's process: tests/shell_bridge.py).
+(a real bash, whose ``ertools`` commands run in the test's process: tests/helpers/shell_bridge.py).
 
 Every ``$ `` line (with its ``\\`` continuations) runs in one bash session, in order, from a
 folder laid out as a clone is (``sample_bags/``, ``.venv``, ``../shared``) so that nothing is
@@ -15,7 +15,8 @@ import sys
 from pathlib import Path
 
 import pytest
-from shell_bridge import run_bash
+
+from tests.helpers.shell_bridge import run_bash
 
 ROOT = Path(__file__).resolve().parents[2]
 SHARED = ROOT.parent / "shared"
@@ -46,6 +47,7 @@ def test_console_blocks_parse_commands_continuations_and_output() -> None:
     assert console_blocks(text) == [(["a \\\n   --b", "c"], ["out: 1"])]
 
 
+@pytest.mark.slow
 def test_readme_tour_runs_as_printed(tmp_path: Path) -> None:
     if not SHARED.is_dir():
         pytest.skip("../shared not present: the tour scores its real bag")
@@ -60,7 +62,7 @@ def test_readme_tour_runs_as_printed(tmp_path: Path) -> None:
     env = {k: v for k, v in os.environ.items() if k not in ("VIRTUAL_ENV", "PYTHONPATH")}
     # The shell of a fresh terminal: ertools is on PATH only through the tour's activation.
     env["PATH"] = "/usr/local/bin:/usr/bin:/bin"
-    # a real bash; its `ertools` commands run in this process (tests/shell_bridge.py): the
+    # a real bash; its `ertools` commands run in this process (tests/helpers/shell_bridge.py): the
     # tour is about what they print
     code, stdout, stderr = run_bash(script, cwd=work, env=env, timeout=600, merge=False)
     assert code == 0, stderr[-2000:]

@@ -12,11 +12,11 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-import inprocess
 import pytest
-from stderr_text import error_messages
 
 from ertools.cli.main import main
+from tests.helpers import inprocess
+from tests.helpers.stderr_text import error_messages
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLES = ROOT / "sample_bags"

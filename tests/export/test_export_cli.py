@@ -8,9 +8,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from stderr_text import error_messages
 
 from ertools.cli.main import main
+from tests.helpers.stderr_text import error_messages
 
 REPO = Path(__file__).resolve().parents[2]
 ROBOTLOG = REPO / "sample_bags/robotlog"
@@ -112,6 +112,7 @@ def test_pair_errors_are_the_scores(tmp_path: Path, capsys: pytest.CaptureFixtur
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_pair_kitti_matched_rows_and_times(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

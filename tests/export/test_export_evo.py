@@ -18,7 +18,6 @@ position_error, rmse, median and max:
 from __future__ import annotations
 
 import json
-import sys
 from decimal import Decimal
 from pathlib import Path
 from typing import Any
@@ -34,8 +33,9 @@ from evo.core import metrics, sync
 from evo.core.sync_method import SyncMethod
 from evo.tools import file_interface
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "io"))
-from io_bagmaker import Spec, write
+from tests.helpers.bagmaker import Spec, write
+
+pytestmark = pytest.mark.slow
 
 REPO = Path(__file__).resolve().parents[2]
 ROBOTLOG = REPO / "sample_bags/robotlog"

@@ -2,15 +2,12 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))
-
-from io_bagmaker import FORMATS, bag_name, write
-from io_scene import Scene, make_scene
+from tests.helpers.bagmaker import FORMATS, bag_name, write
+from tests.helpers.scene import Scene, make_scene
 
 
 @pytest.fixture(scope="session")

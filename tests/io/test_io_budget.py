@@ -25,7 +25,22 @@ import lz4.frame
 import pytest
 import yaml
 import zstandard
-from hostile_files import (
+from mcap.reader import make_reader
+from mcap.writer import CompressionType
+from mcap.writer import Writer as McapWriter
+from rosbags.rosbag2 import Writer as Writer2
+from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
+
+from ertools.cli.main import main
+from ertools.errors import BagError
+from ertools.io import budget
+from ertools.io.files import open_bag
+from ertools.io.info import describe
+from ertools.io.reader import read_messages, read_poses, read_states
+from ertools.io.summary import summary as bag_summary
+from tests.helpers.bagmaker import build, typestore, write
+from tests.helpers.scene import Scene
+from tests.io.hostile_files import (
     McapChannel,
     McapChunk,
     Ros1Chunk,
@@ -40,20 +55,6 @@ from hostile_files import (
     u32,
     zstd_frame,
 )
-from io_bagmaker import build, typestore, write
-from io_scene import Scene
-from mcap.reader import make_reader
-from mcap.writer import CompressionType
-from mcap.writer import Writer as McapWriter
-from rosbags.rosbag2 import Writer as Writer2
-from rosbags.rosbag2.enums import CompressionFormat, CompressionMode
-
-import ertools.io as eio
-from ertools.cli.main import main
-from ertools.errors import BagError
-from ertools.io import budget
-from ertools.io.files import open_bag
-from ertools.io.info import describe
 
 T0 = 1_448_020_800 * 10**9  # the 2015 sample logs' start
 MiB = 1 << 20
@@ -110,6 +111,7 @@ def _ros1_bomb(path: Path, extra: int, compression: str = "bz2") -> Path:
     return ros1_bag(path, [conn], [chunk])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("compression", ["bz2", "lz4"])
 def test_a_ros1_chunk_that_inflates_past_its_declared_size_is_refused_there(
     tmp_path: Path, compression: str
@@ -127,7 +129,7 @@ def test_a_ros1_chunk_that_inflates_past_its_declared_size_is_refused_there(
     for read in (
         lambda: describe(bag),
         lambda: describe(bag, check=True),
-        lambda: eio.read_messages(bag, "/fbm3w/notes"),
+        lambda: read_messages(bag, "/fbm3w/notes"),
     ):
         with peak_memory() as peak:
             text = _refusal(read, f"more than the {declared} bytes its header declares")
@@ -136,6 +138,7 @@ def test_a_ros1_chunk_that_inflates_past_its_declared_size_is_refused_there(
         assert peak[0] < 16 * MiB, f"peak {peak[0] / MiB:.0f} MiB"
 
 
+@pytest.mark.slow
 def test_info_on_a_bz2_bomb_is_one_line_and_small_in_a_fresh_process(tmp_path: Path) -> None:
     """The whole command in its own process: its peak resident memory stays near the
     interpreter's (about 40 MB here), not the gigabyte the bomb holds. VmHWM, not ru_maxrss:
@@ -185,7 +188,7 @@ def test_a_ros1_chunk_declaring_more_than_the_chunk_budget_is_refused_unread(
     bag = ros1_bag(tmp_path / "big.bag", [conn], [Ros1Chunk([msg], "bz2", compress, declared)])
     with peak_memory() as peak:
         _refusal(
-            lambda: eio.read_messages(bag, "/fbm3w/notes"),
+            lambda: read_messages(bag, "/fbm3w/notes"),
             f"{declared} bytes uncompressed",
             "over the budget of 256 MiB",
             "MAX_CHUNK_BYTES",
@@ -225,12 +228,12 @@ def test_the_chunk_budget_just_under_and_just_over(
     monkeypatch.setattr(budget, "MAX_CHUNK_BYTES", 64 * 1024)
     make = _ros1_sized if fmt == "ros1" else _mcap_sized
     under, text = make(tmp_path / f"under.{fmt}", 64 * 1024, compression)
-    (msg,) = eio.read_messages(under, "/fbm3w/notes")
+    (msg,) = read_messages(under, "/fbm3w/notes")
     assert msg.msg.data == text and msg.t_ns == T0
     assert describe(under, check=True).check_problems == ()
     over, _text = make(tmp_path / f"over.{fmt}", 64 * 1024 + 1, compression)
     kind = "stored" if compression == "none" else "uncompressed"
-    for read in (lambda: eio.read_messages(over, "/fbm3w/notes"), lambda: describe(over)):
+    for read in (lambda: read_messages(over, "/fbm3w/notes"), lambda: describe(over)):
         _refusal(
             read,
             over.name,
@@ -264,10 +267,10 @@ def test_the_per_file_inflation_budget_just_under_and_just_over(
 
     under = make(tmp_path / f"under.{fmt}", 3)
     assert budget.allowance(under.stat().st_size) > 3 * 16 * 1024
-    assert len(eio.read_messages(under, "/fbm3w/notes")) == 3
+    assert len(read_messages(under, "/fbm3w/notes")) == 3
     over = make(tmp_path / f"over.{fmt}", 30)
     assert budget.allowance(over.stat().st_size) < 30 * 16 * 1024
-    for read in (lambda: eio.read_messages(over, "/fbm3w/notes"), lambda: describe(over)):
+    for read in (lambda: read_messages(over, "/fbm3w/notes"), lambda: describe(over)):
         _refusal(read, over.name, "MAX_INFLATE_PER_BYTE", "over the budget of")
 
 
@@ -284,11 +287,11 @@ def test_the_record_header_budget_just_under_and_just_over(
         return ros1_bag(path, [conn], [Ros1Chunk([(0, T0, string_payload("hi"))])])
 
     under = make(tmp_path / "under.bag", 4096)
-    (topic,) = eio.summary(under).topics
+    (topic,) = bag_summary(under).topics
     assert len(topic.name) == 4096 - 31
     over = make(tmp_path / "over.bag", 4097)
     _refusal(
-        lambda: eio.summary(over),
+        lambda: bag_summary(over),
         "over.bag",
         "record at byte",
         "a header of 4097 bytes",
@@ -299,6 +302,7 @@ def test_the_record_header_budget_just_under_and_just_over(
 # --- MCAP: a valid 16 MB chunk reads, a 2 GiB one is refused without inflating it ------------
 
 
+@pytest.mark.slow
 def test_a_valid_mcap_with_a_16_mb_chunk_reads(tmp_path: Path, scene: Scene) -> None:
     """Finding 13: one message of 16 MB (a 4000 x 4000 occupancy grid's data, zeros: zstd
     stores it in a few hundred bytes, 30,000 times smaller) was "damaged chunk record".
@@ -332,7 +336,7 @@ def test_a_valid_mcap_with_a_16_mb_chunk_reads(tmp_path: Path, scene: Scene) -> 
             "/fbm3w/map": 1,
             "/fbm3w/notes": 2,
         }
-    notes = eio.read_messages(path, "/fbm3w/notes")
+    notes = read_messages(path, "/fbm3w/notes")
     assert [m.msg.data for m in notes] == ["before", "after"]
     with open_bag(path) as bag:
         grid = [(t, data) for _c, t, data in bag.raw(bag.topic_conns("/fbm3w/map"))]
@@ -357,8 +361,8 @@ def test_a_2_gib_mcap_chunk_is_refused_without_inflating_it(tmp_path: Path) -> N
     for read in (
         lambda: describe(bomb),
         lambda: describe(bomb, check=True),
-        lambda: eio.read_messages(bomb, "/fbm3w/notes"),
-        lambda: eio.summary(bomb, exact=True),
+        lambda: read_messages(bomb, "/fbm3w/notes"),
+        lambda: bag_summary(bomb, exact=True),
     ):
         with peak_memory() as peak:
             _refusal(read, "bomb.mcap", "over the budget", "MAX_")
@@ -375,7 +379,7 @@ def test_an_mcap_chunk_whose_frame_says_more_than_its_record_stops_there(
     bomb = _mcap_bomb(tmp_path / "liar.mcap", 512 * MiB, declared=1024)
     for read in (
         lambda: describe(bomb, check=True),
-        lambda: eio.read_messages(bomb, "/fbm3w/notes"),
+        lambda: read_messages(bomb, "/fbm3w/notes"),
     ):
         with peak_memory() as peak:
             _refusal(read, "liar.mcap", "more than the 1024 bytes its header declares")
@@ -385,6 +389,7 @@ def test_an_mcap_chunk_whose_frame_says_more_than_its_record_stops_there(
 # --- rosbag2: metadata.yaml and storage files compressed whole ---------------------------------
 
 
+@pytest.mark.slow
 def test_metadata_size_and_nesting_just_under_and_just_over(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, scene: Scene
 ) -> None:
@@ -393,9 +398,9 @@ def test_metadata_size_and_nesting_just_under_and_just_over(
     text = meta.read_text()
     monkeypatch.setattr(budget, "MAX_METADATA_BYTES", len(text) + 100)
     meta.write_text(text + "#" * 99 + "\n")  # exactly the limit
-    assert eio.summary(good).message_count == len(scene.spec.msgs)
+    assert bag_summary(good).message_count == len(scene.spec.msgs)
     meta.write_text(text + "#" * 100 + "\n")
-    _refusal(lambda: eio.summary(good), "r2", "metadata.yaml", "MAX_METADATA_BYTES")
+    _refusal(lambda: bag_summary(good), "r2", "metadata.yaml", "MAX_METADATA_BYTES")
 
     def nested(depth: int) -> str:
         return text + "extra: " + "[" * depth + "]" * depth + "\n"
@@ -403,14 +408,15 @@ def test_metadata_size_and_nesting_just_under_and_just_over(
     monkeypatch.setattr(budget, "MAX_METADATA_BYTES", 1 << 20)
     # the document's own mapping is one level: 63 more fit in 64
     meta.write_text(nested(budget.MAX_NESTING - 1))
-    assert eio.summary(good).message_count == len(scene.spec.msgs)
+    assert bag_summary(good).message_count == len(scene.spec.msgs)
     meta.write_text(nested(budget.MAX_NESTING))
-    _refusal(lambda: eio.summary(good), "r2", "metadata.yaml at line", "MAX_NESTING")
+    _refusal(lambda: bag_summary(good), "r2", "metadata.yaml at line", "MAX_NESTING")
     # far deeper than PyYAML's recursion allows: still the one line, no RecursionError
     meta.write_text(nested(5000))
-    _refusal(lambda: eio.summary(good), "r2", "nested deeper")
+    _refusal(lambda: bag_summary(good), "r2", "nested deeper")
 
 
+@pytest.mark.slow
 def test_a_file_compressed_storage_copy_within_the_budget(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, scene: Scene
 ) -> None:
@@ -429,14 +435,14 @@ def test_a_file_compressed_storage_copy_within_the_budget(
         entry["path"] = storage.name + ".zstd"
     (zipped / "metadata.yaml").write_text(yaml.safe_dump(info))
     monkeypatch.setattr(budget, "MAX_FILE_COPY_BYTES", len(raw))
-    assert len(eio.read_poses(zipped, "/fbm3w/robot_at_work/pose")) == len(
-        eio.read_poses(good, "/fbm3w/robot_at_work/pose")
+    assert len(read_poses(zipped, "/fbm3w/robot_at_work/pose")) == len(
+        read_poses(good, "/fbm3w/robot_at_work/pose")
     )
     other = tmp_path / "zipped2"
     shutil.copytree(zipped, other)
     monkeypatch.setattr(budget, "MAX_FILE_COPY_BYTES", len(raw) - 1)
     _refusal(
-        lambda: eio.read_poses(other, "/fbm3w/robot_at_work/pose"),
+        lambda: read_poses(other, "/fbm3w/robot_at_work/pose"),
         storage.name + ".zstd",
         f"more than {len(raw) - 1} bytes uncompressed",
         "MAX_FILE_COPY_BYTES",
@@ -476,15 +482,15 @@ def test_message_type_nesting_just_under_and_just_over(tmp_path: Path) -> None:
     """rosbags builds its deserializers recursively, a level per nested type: 3,000 levels
     was a RecursionError (a traceback in the API, "unexpected" in the CLI)."""
     under = _nested_type_bag(tmp_path / "under.bag", budget.MAX_NESTING)
-    (msg,) = eio.read_messages(under, "/deep")
+    (msg,) = read_messages(under, "/deep")
     inner = msg.msg
     for _ in range(budget.MAX_NESTING - 1):
         inner = inner.a
     assert inner.x == 5
     over = _nested_type_bag(tmp_path / "over.bag", budget.MAX_NESTING + 1)
-    _refusal(lambda: eio.read_messages(over, "/deep"), "over.bag", "pkg/msg/A0", "MAX_NESTING")
+    _refusal(lambda: read_messages(over, "/deep"), "over.bag", "pkg/msg/A0", "MAX_NESTING")
     far = _nested_type_bag(tmp_path / "far.bag", 3000)
-    _refusal(lambda: eio.read_messages(far, "/deep"), "far.bag", "nested deeper")
+    _refusal(lambda: read_messages(far, "/deep"), "far.bag", "nested deeper")
 
 
 def test_a_recursive_message_type_is_refused(tmp_path: Path) -> None:
@@ -492,7 +498,7 @@ def test_a_recursive_message_type_is_refused(tmp_path: Path) -> None:
         0, "/loop", msgtype="pkg/Loop", definition="pkg/Loop[] children\nint32 x\n", md5="0" * 32
     )
     bag = ros1_bag(tmp_path / "loop.bag", [conn], [Ros1Chunk([(0, T0, u32(0) + u32(5))])])
-    _refusal(lambda: eio.read_messages(bag, "/loop"), "loop.bag", "its own type pkg/msg/Loop")
+    _refusal(lambda: read_messages(bag, "/loop"), "loop.bag", "its own type pkg/msg/Loop")
 
 
 # --- rosbag2 compressed message by message ----------------------------------------------------
@@ -520,11 +526,11 @@ def test_a_rosbag2_message_whose_frame_says_300_mib_is_refused_unread(
                 )
             conn = conns[topic]
             writer.write(conn, t, ts.serialize_cdr(build(ts, False, msgtype, v, seq), conn.msgtype))
-    states = eio.read_states(path, "/fbm3w/bmbox_state")
+    states = read_states(path, "/fbm3w/bmbox_state")
     assert len(states.t_ns) == sum(
         1 for ci, _t, _v in scene.spec.msgs if scene.spec.conns[ci][0] == "/fbm3w/bmbox_state"
     )
-    poses = eio.read_poses(path, "/fbm3w/robot_at_work/pose")
+    poses = read_poses(path, "/fbm3w/robot_at_work/pose")
     (db,) = path.glob("*.db3")
     with sqlite3.connect(db) as con:
         (topic_id,) = con.execute(
@@ -537,7 +543,7 @@ def test_a_rosbag2_message_whose_frame_says_300_mib_is_refused_unread(
         )
     with peak_memory() as peak:
         _refusal(
-            lambda: eio.read_states(path, "/fbm3w/bmbox_state"),
+            lambda: read_states(path, "/fbm3w/bmbox_state"),
             "r2",
             "/fbm3w/bmbox_state",
             f"{300 * MiB} bytes uncompressed",
@@ -546,4 +552,4 @@ def test_a_rosbag2_message_whose_frame_says_300_mib_is_refused_unread(
     # rosbags' reader and its generated deserializers take ~16 MiB of their own here; the
     # message would have been 300
     assert peak[0] < 64 * MiB
-    assert len(eio.read_poses(path, "/fbm3w/robot_at_work/pose")) == len(poses)
+    assert len(read_poses(path, "/fbm3w/robot_at_work/pose")) == len(poses)

@@ -7,29 +7,23 @@ from __future__ import annotations
 
 import logging
 import struct
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-import ertools.io as eio
 from ertools.errors import BagError
 from ertools.io.info import describe
-
-REPO = Path(__file__).resolve().parents[2]
-if str(REPO) not in sys.path:
-    sys.path.insert(0, str(REPO))
-
-from fuzz.judge import (  # noqa: E402
+from ertools.io.reader import read_poses
+from fuzz.judge import (
     Outcome,
     mcap_crc_evidence,
     misread,
     ros1_index_evidence,
     ros1_record_summary,
 )
-from fuzz.mutate import layout  # noqa: E402
-from fuzz.seeds import N_POSES, POSE_TOPIC, T0_NS, seed_bytes, suffix  # noqa: E402
+from fuzz.mutate import layout
+from fuzz.seeds import N_POSES, POSE_TOPIC, T0_NS, seed_bytes, suffix
 
 DT = 33_333_337  # ns between the seeds' poses (1/30 s, rounded as the formula does)
 TRUE_T = T0_NS + np.arange(N_POSES, dtype=np.int64) * DT
@@ -52,7 +46,7 @@ def damaged(tmp_path: Path, name: str, edits: list[tuple[int, bytes]]) -> Path:
 
 
 def assert_true_poses(path: Path) -> None:
-    rec = eio.read_poses(path, POSE_TOPIC, time_source="record")
+    rec = read_poses(path, POSE_TOPIC, time_source="record")
     np.testing.assert_array_equal(rec.t_ns, TRUE_T)
     np.testing.assert_allclose(rec.xyz[:, 0], TRUE_X, rtol=0, atol=1e-12)
 
@@ -82,7 +76,7 @@ def test_mcap_chunk_op_code_damaged_where_the_summary_indexes_a_chunk(tmp_path: 
     at, _n = site("mcap-lz4-nomsgindex", "chunk.opcode", 1)
     path = damaged(tmp_path, "mcap-lz4-nomsgindex", [(at, b"\xff")])
     with pytest.raises(BagError, match=r"indexes a chunk at byte .* where the records hold no"):
-        eio.read_poses(path, POSE_TOPIC)
+        read_poses(path, POSE_TOPIC)
 
 
 def test_mcap_records_after_a_footer_are_damage(tmp_path: Path) -> None:
@@ -90,7 +84,7 @@ def test_mcap_records_after_a_footer_are_damage(tmp_path: Path) -> None:
     at, _n = site("mcap-lz4-nomsgindex", "chunk.opcode", 4)
     path = damaged(tmp_path, "mcap-lz4-nomsgindex", [(at, b"\x02")])
     with pytest.raises(BagError, match="footer record ends at byte"):
-        eio.read_poses(path, POSE_TOPIC)
+        read_poses(path, POSE_TOPIC)
 
 
 def test_mcap_footer_before_damaged_magic_reads_as_finished(tmp_path: Path) -> None:
@@ -152,14 +146,14 @@ def test_ros1_record_conn_differing_from_its_index_entry_is_refused(tmp_path: Pa
     pose = next(s for s in conns if struct.unpack_from("<I", data, s.offset)[0] == 0)
     path = damaged(tmp_path, "ros1", [(pose.offset, struct.pack("<I", 1))])
     with pytest.raises(BagError, match="differs from its index entry"):
-        eio.read_poses(path, POSE_TOPIC)
+        read_poses(path, POSE_TOPIC)
 
 
 def test_ros1_two_connection_records_with_one_id_are_damage(tmp_path: Path) -> None:
     at, _n = site("ros1", "connection.conn", 1)
     path = damaged(tmp_path, "ros1", [(at, struct.pack("<I", 0))])
     with pytest.raises(BagError):
-        eio.read_poses(path, POSE_TOPIC)
+        read_poses(path, POSE_TOPIC)
 
 
 # --- the judge's evidence and verdict --------------------------------------------------------

@@ -1,4 +1,4 @@
-"""`ertools export` / ertools.export.formats: files read back with NumPy give the written
+"""`ertools export` / ertools.exporting.formats: files read back with NumPy give the written
 poses back.
 
 The expected values are the generator's (conftest.make_scene: stamps, positions, quaternions
@@ -18,12 +18,11 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-from io_scene import Scene
 from rosbags.highlevel import AnyReader
 
 from ertools.cli.main import main
 from ertools.errors import BagError
-from ertools.export.formats import (
+from ertools.exporting.formats import (
     format_csv,
     format_tum,
     rotation_matrices,
@@ -31,6 +30,7 @@ from ertools.export.formats import (
     write_poses,
 )
 from ertools.streams import PoseStream
+from tests.helpers.scene import Scene
 
 POSE = "/fbm3w/robot_at_work/pose"
 REPO = Path(__file__).resolve().parents[2]
@@ -63,6 +63,7 @@ def _quat_matrix(q: np.ndarray) -> np.ndarray:
     )
 
 
+@pytest.mark.slow_cases("rosbag2-mcap", "rosbag2-sqlite3")
 def test_tum_round_trip_every_format(
     scene: Scene, scene_bag: tuple[str, Path], tmp_path: Path
 ) -> None:
@@ -139,6 +140,7 @@ def _rosbags_poses(path: Path, topic: str) -> tuple[np.ndarray, np.ndarray, np.n
     return np.array(t, dtype=np.int64), np.array(xyz), np.array(q)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["tum", "csv"])
 def test_sample_bag_against_rosbags(
     fmt: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
@@ -160,6 +162,7 @@ def test_sample_bag_against_rosbags(
     np.testing.assert_allclose(v[:, 3:], q[order], rtol=0, atol=1e-12)
 
 
+@pytest.mark.slow
 @given(st.lists(st.integers(-(2**62), 2**62), min_size=1, max_size=50))
 def test_seconds_text_is_exact(ns: list[int]) -> None:
     text = seconds_text(np.array(ns, dtype=np.int64))
@@ -173,6 +176,7 @@ def test_seconds_text_by_hand() -> None:
                    "1448020800.000358104"]  # fmt: skip
 
 
+@pytest.mark.slow
 @given(
     st.lists(
         st.tuples(*[st.floats(allow_nan=False, allow_infinity=False, width=64)] * 7),

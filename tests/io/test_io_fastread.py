@@ -16,27 +16,27 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from io_bagmaker import FORMATS, Spec, bag_name, write
-from io_scene import DT, T0, Scene
 from mcap.writer import CompressionType
-from test_io_fastpath import (
-    POSE_TOPICS,
-    REAL_BAG,
-    _reference_bag,
-    _sample_bags,
-    assert_same,
-    reference_batch,
-)
 
-import ertools.io as eio
 from ertools.errors import BagError, TopicError
-from ertools.io import assemble, bulk, reader, summary
+from ertools.io import assemble, bulk, reader
 from ertools.io.decode.posebatch import PoseBatch
 from ertools.io.files import open_bag
 from ertools.io.model import POSE_TYPES, PoseSource
 from ertools.io.pipeline import Request
 from ertools.io.ros1 import runs as ros1_runs
 from ertools.io.ros1.entries import merged_columns
+from ertools.io.summary import summary
+from tests.helpers.bagmaker import FORMATS, Spec, bag_name, write
+from tests.helpers.fastpath import (
+    POSE_TOPICS,
+    REAL_BAG,
+    assert_same,
+    reference_bag,
+    reference_batch,
+    sample_bags,
+)
+from tests.helpers.scene import DT, T0, Scene
 
 STATE_TOPICS = ("/fbm3w/bmbox_state", "/fbm3w/refbox_state")
 
@@ -78,6 +78,7 @@ def field_path(monkeypatch: pytest.MonkeyPatch, general_path: None) -> None:
     monkeypatch.setattr(assemble, "layout_of", lambda *args, **kwargs: None)
 
 
+@pytest.mark.slow_cases("rosbag2-sqlite3", "rosbag2-mcap")
 def test_one_read_of_every_topic_equals_rosbags(
     scene_bag: tuple[str, Path], no_field_decoder: None
 ) -> None:
@@ -88,6 +89,12 @@ def test_one_read_of_every_topic_equals_rosbags(
         assert_same(batch, reference_batch(path, topic))
 
 
+@pytest.mark.slow_cases(
+    "rosbag2-sqlite3-general_path",
+    "rosbag2-sqlite3-field_path",
+    "rosbag2-mcap-general_path",
+    "rosbag2-mcap-field_path",
+)
 @pytest.mark.parametrize("mode", ["general_path", "field_path"])
 def test_general_and_field_paths_equal_the_one_gather_path(
     scene_bag: tuple[str, Path], mode: str, request: pytest.FixtureRequest
@@ -108,9 +115,10 @@ def _recorded_bags() -> list[Any]:
     """The real 2015 bag and every sample bag with a pose topic, each once (as pytest params);
     the state-only runs (referee-scored RSBB runs, a BmBox-only log) have nothing to read here."""
     real = [pytest.param(REAL_BAG, marks=pytest.mark.real, id="real-2015")]
-    return real + [pytest.param(p, id=p.name) for p in _sample_bags() if _pose_topics(p)]
+    return real + [pytest.param(p, id=p.name) for p in sample_bags() if _pose_topics(p)]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", _recorded_bags())
 def test_one_read_of_a_recorded_bag_equals_rosbags_and_the_general_path(
     path: Path, monkeypatch: pytest.MonkeyPatch
@@ -130,6 +138,7 @@ def test_one_read_of_a_recorded_bag_equals_rosbags_and_the_general_path(
         assert_same(a, reference_batch(path, topic))
 
 
+@pytest.mark.slow_cases("rosbag2-sqlite3", "rosbag2-mcap")
 def test_windows_cutting_chunks_in_one_read(scene_bag: tuple[str, Path], scene: Scene) -> None:
     """Each request of one read keeps its own window (the scene's 2000-byte chunks hold a few
     messages each, so every window edge falls inside a chunk)."""
@@ -218,6 +227,7 @@ def _odd_frames_spec(seed: int) -> Spec:
 ODD_TOPICS = ["/poses", "/pose2d", "/tf", "/odom"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", FORMATS)
 def test_odd_frames_mixed_connections_and_alignments_equal_rosbags(
     tmp_path: Path, fmt: str
@@ -230,6 +240,7 @@ def test_odd_frames_mixed_connections_and_alignments_equal_rosbags(
         assert_same(batch, ref)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("compression", ["none", "zstd", "lz4"])
 def test_mcap_chunk_compressions_equal_rosbags(
     tmp_path: Path, scene: Scene, compression: str
@@ -246,6 +257,7 @@ def test_mcap_chunk_compressions_equal_rosbags(
         assert_same(batch, reference_batch(path, topic))
 
 
+@pytest.mark.slow_cases("rosbag2-sqlite3", "rosbag2-mcap")
 def test_read_pose_sources_equals_one_source_at_a_time(
     scene_bag: tuple[str, Path], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -258,7 +270,7 @@ def test_read_pose_sources_equals_one_source_at_a_time(
         PoseSource(frame="robot_at_work"),
         PoseSource(topic="/fbm3w/tfs", time_source="record"),
     ]
-    alone = [eio.read_pose_source(path, s) for s in sources]
+    alone = [reader.read_pose_source(path, s) for s in sources]
     passes: list[int] = []
     real = reader.try_fast_batches
 
@@ -267,7 +279,7 @@ def test_read_pose_sources_equals_one_source_at_a_time(
         return real(bag, requests)
 
     monkeypatch.setattr(reader, "try_fast_batches", spy)
-    together = eio.read_pose_sources(path, sources)
+    together = reader.read_pose_sources(path, sources)
     with open_bag(path) as bag:
         publishers = len(bag.topic_conns("/tf"))  # (two, but one in rosbag2)
     # one pass: three topics and each /tf publisher (for the frame; no /tf_static)
@@ -283,14 +295,15 @@ def test_read_pose_sources_names_the_missing_source(scene_bag: tuple[str, Path])
     _fmt, path = scene_bag
     sources = [PoseSource(topic="/fbm3w/robot_at_work/pose"), PoseSource(topic="/nope")]
     with pytest.raises(TopicError, match=r"/nope not in .* pose topics there: "):
-        eio.read_pose_sources(path, sources)
+        reader.read_pose_sources(path, sources)
 
 
+@pytest.mark.slow_cases("rosbag2-sqlite3", "rosbag2-mcap")
 def test_state_topics_in_one_pass_equal_one_at_a_time(
     scene_bag: tuple[str, Path], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     _fmt, path = scene_bag
-    alone = [eio.read_states(path, t) for t in STATE_TOPICS]
+    alone = [reader.read_states(path, t) for t in STATE_TOPICS]
     passes: list[int] = []
     real = bulk.locate_many
 
@@ -299,7 +312,7 @@ def test_state_topics_in_one_pass_equal_one_at_a_time(
         return real(bag, requests, progress)
 
     monkeypatch.setattr(bulk, "locate_many", spy)
-    states = eio.read_benchmark_states(path, "fbm3w")
+    states = reader.read_benchmark_states(path, "fbm3w")
     assert passes == [2]  # the two state topics of the scene, one pass
     for a, b in zip(alone, (states.bmbox, states.refbox), strict=True):
         assert b is not None
@@ -344,9 +357,9 @@ def test_damaged_record_fails_alike_alone_and_in_one_read(tmp_path: Path, what: 
         data[at + 8 : at + 12] = struct.pack("<I", 1 << 20)
     path.write_bytes(bytes(data))
     with pytest.raises(BagError) as alone:
-        eio.read_poses(path, "/p")  # the 11th record, of the even ones
+        reader.read_poses(path, "/p")  # the 11th record, of the even ones
     with pytest.raises(BagError) as together:
-        eio.read_pose_sources(path, [PoseSource(topic="/p"), PoseSource(topic="/q")])
+        reader.read_pose_sources(path, [PoseSource(topic="/p"), PoseSource(topic="/q")])
     assert str(alone.value) == str(together.value)
     assert "chunk" in str(alone.value)
 
@@ -364,19 +377,20 @@ def test_errors_of_requests_decoded_side_by_side_come_in_request_order(tmp_path:
     errors = {}
     for topic in ("/p", "/q"):
         with pytest.raises(BagError) as alone:
-            eio.read_poses(path, topic)
+            reader.read_poses(path, topic)
         errors[topic] = str(alone.value)
     assert errors["/p"] != errors["/q"]
     for first, second in (("/p", "/q"), ("/q", "/p")):
         sources = [PoseSource(topic=first), PoseSource(topic=second)]
         with pytest.raises(BagError) as together:
-            eio.read_pose_sources(path, sources)
+            reader.read_pose_sources(path, sources)
         assert str(together.value) == errors[first]
 
 
 # --- property tests
 
 
+@pytest.mark.slow
 @settings(max_examples=200, deadline=None)
 @given(st.lists(st.lists(st.integers(0, 30), max_size=12), min_size=1, max_size=4), st.data())
 def test_merged_columns_are_a_stable_sort(parts: list[list[int]], data: st.DataObject) -> None:
@@ -447,6 +461,7 @@ def layouts(draw: st.DrawFn) -> tuple[Spec, str, int]:
     return s, fmt, draw(st.sampled_from([300, 2000, 100_000]))
 
 
+@pytest.mark.slow
 @settings(
     max_examples=25,
     deadline=None,
@@ -525,7 +540,7 @@ def test_tf_frames_of_several_publishers_equal_rosbags(
 
     monkeypatch.setattr(reader, "load_pose_batch", spy)
     sources = [PoseSource(topic="/p"), *(PoseSource(frame=f) for f in ("robot", "other", "map"))]
-    streams = eio.read_pose_sources(path, sources)
+    streams = reader.read_pose_sources(path, sources)
     with open_bag(path) as bag:
         publishers = len(bag.topic_conns("/tf"))  # (one in rosbag2: nothing to share)
     assert again == ([2] if shared and publishers == 2 else [])
@@ -541,7 +556,7 @@ def test_tf_frames_of_several_publishers_equal_rosbags(
 def test_a_request_of_one_publisher_reads_only_its_messages(tmp_path: Path, fmt: str) -> None:
     """One connection of a topic of several (an MCAP channel too, not the whole topic)."""
     path = write(bag_name(tmp_path, fmt), fmt, _publishers_spec(True), chunk_bytes=2500)
-    with open_bag(path) as bag, _reference_bag(path) as ref:
+    with open_bag(path) as bag, reference_bag(path) as ref:
         conns = bag.topic_conns("/tf")
         assert len(conns) == 2
         fast = bulk.try_fast_batches(bag, [Request((c,)) for c in conns])

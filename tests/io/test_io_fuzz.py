@@ -10,25 +10,19 @@ cover.
 from __future__ import annotations
 
 import logging
-import sys
 from collections import Counter
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from fuzz.judge import ertools_answer
-
-REPO = Path(__file__).resolve().parents[2]
-if str(REPO) not in sys.path:
-    sys.path.insert(0, str(REPO))
-
-from fuzz.judge import Outcome, judge_part, official_answer  # noqa: E402
-from fuzz.mutate import CATEGORIES, layout, mutate  # noqa: E402
-from fuzz.run import SEED_NAMES, run_cases  # noqa: E402
-from fuzz.seeds import N_POSES, POSE_TOPIC, SEEDS, T0_NS, seed_bytes, suffix  # noqa: E402
+from fuzz.judge import Outcome, ertools_answer, judge_part, official_answer
+from fuzz.mutate import CATEGORIES, layout, mutate
+from fuzz.run import SEED_NAMES, run_cases
+from fuzz.seeds import N_POSES, POSE_TOPIC, SEEDS, T0_NS, seed_bytes, suffix
 
 
+@pytest.mark.slow_cases("ros1")
 @pytest.mark.parametrize("name", list(SEEDS))
 def test_seed_files_read_the_same(
     tmp_path: Path, name: str, caplog: pytest.LogCaptureFixture
@@ -120,6 +114,7 @@ def test_the_judge_flags_wrong_answers() -> None:
 SAMPLE = [*range(100), *range(100, 500, 25)]
 
 
+@pytest.mark.slow
 def test_a_sample_of_mutants() -> None:
     """No traceback, no hang, CLI lines right, no disagreement."""
     results = run_cases(seed=1, indices=SAMPLE, jobs=2, timeout=20.0)
@@ -147,6 +142,7 @@ def test_a_sample_of_mutants() -> None:
     )
 
 
+@pytest.mark.slow
 def test_a_stalled_case_is_a_hang_and_the_next_case_runs(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("ERTOOLS_FUZZ_STALL", "1")
     results = run_cases(seed=1, indices=[0, 1, 2], jobs=1, timeout=3.0)

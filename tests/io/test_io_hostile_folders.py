@@ -12,7 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from ertools.cli.main import MAX_ERROR_LINE, main
+from ertools.cli.main import main
+from ertools.cli.text import MAX_ERROR_LINE
 from ertools.io.formats import find_bags, regular_files
 
 REPO = Path(__file__).resolve().parents[2]
@@ -91,6 +92,7 @@ def test_a_folder_really_unreadable(tmp_path: Path) -> None:
     assert [p.problem for p in found.problems] == ["folder skipped: permission denied"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("argv", "code", "kind"),
     [
@@ -159,6 +161,7 @@ def test_a_folder_deeper_than_the_path_limit_is_one_short_problem(tmp_path: Path
     assert len(f"{problem.path}: {problem.problem}") < 200
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("argv", "code", "kind"),
     [

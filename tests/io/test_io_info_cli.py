@@ -8,14 +8,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from io_bagmaker import write
-from io_scene import DT, Scene
-from stderr_text import joined_lines
-from test_io_summary import make_active
 
 from ertools.cli.main import main
 from ertools.errors import BagError
-from ertools.io import read_poses
+from ertools.io.reader import read_poses
+from tests.helpers.bagmaker import write
+from tests.helpers.scene import DT, Scene
+from tests.helpers.stderr_text import joined_lines
+from tests.io.test_io_summary import make_active
 
 POSE = "/fbm3w/robot_at_work/pose"
 
@@ -52,6 +52,7 @@ def test_info_json_every_format(
     }.get(fmt, fmt)
 
 
+@pytest.mark.slow
 def test_info_table_and_yaml(
     capsys: pytest.CaptureFixture[str], scene: Scene, tmp_path: Path
 ) -> None:
@@ -110,6 +111,7 @@ def test_empty_random_missing_and_empty_dir(
     one_error_line(err, "nobags", "holds no bags")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["ros1", "ros1-bz2", "mcap-cdr"])
 def test_truncated_anywhere(
     capsys: pytest.CaptureFixture[str], scene: Scene, tmp_path: Path, fmt: str
@@ -127,6 +129,7 @@ def test_truncated_anywhere(
         one_error_line(err, bad.name)
 
 
+@pytest.mark.slow
 def test_corrupted_chunk(capsys: pytest.CaptureFixture[str], scene: Scene, tmp_path: Path) -> None:
     good = write(tmp_path / "good.bag", "ros1-lz4", scene.spec, chunk_bytes=2000)
     data = bytearray(good.read_bytes())
@@ -159,6 +162,7 @@ def test_good_and_bad_together(
     one_error_line(err, "bad.bag")
 
 
+@pytest.mark.slow
 def test_corrupted_record_in_uncompressed_chunk(
     capsys: pytest.CaptureFixture[str], scene: Scene, tmp_path: Path
 ) -> None:

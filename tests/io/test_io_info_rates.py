@@ -12,10 +12,10 @@ import json
 from pathlib import Path
 
 import pytest
-from io_bagmaker import FORMATS, Spec, bag_name, write
-from io_scene import T0
 
 from ertools.cli.main import main
+from tests.helpers.bagmaker import FORMATS, Spec, bag_name, write
+from tests.helpers.scene import T0
 
 FRAME = 8_333_333  # 120 Hz
 MS = 1_000_000

@@ -21,10 +21,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import ertools.io as eio
 from ertools.cli.main import main
 from ertools.io.files import open_bag
 from ertools.io.summary import record_times
+from ertools.io.summary import summary as bag_summary
 
 SUITE = Path(
     os.environ.get("ERTOOLS_MCAP_CONFORMANCE")
@@ -144,13 +144,13 @@ def test_api_summary_and_messages(path: Path | None) -> None:
     want = expected(path)
     counts = {k: len(v) for k, v in want.per_topic.items()}
     for exact in (False, True):
-        s = eio.summary(path, exact=exact)
+        s = bag_summary(path, exact=exact)
         assert s.problems == ()
         assert s.message_count == want.count
         assert {t.name: t.count for t in s.topics if t.count} == counts
         if want.count:
             assert (s.start_ns, s.end_ns) == (want.first, want.last)
-    for t in eio.summary(path, exact=True).topics:
+    for t in bag_summary(path, exact=True).topics:
         if t.count:
             mine = want.per_topic[t.name]
             assert (t.first_ns, t.last_ns) == (mine[0], mine[-1])

@@ -15,14 +15,15 @@ from typing import Any
 
 import numpy as np
 import pytest
-from io_bagmaker import write
-from io_scene import Scene
 from mcap.writer import CompressionType, IndexType, Writer
 
-import ertools.io as eio
 from ertools.cli.main import main
 from ertools.io.mcap import scan as mcap_scan
+from ertools.io.reader import read_poses, read_states
 from ertools.io.summary import record_times
+from ertools.io.summary import summary as bag_summary
+from tests.helpers.bagmaker import write
+from tests.helpers.scene import Scene
 
 POSE = "/fbm3w/robot_at_work/pose"
 BMBOX = "/fbm3w/bmbox_state"
@@ -106,23 +107,26 @@ def without_summary(src: Path, dst: Path) -> Path:
 
 def check_reads(path: Path, scene: Scene) -> None:
     """Poses, states, counts and times of ``path`` are those written."""
-    poses = eio.read_poses(path, POSE)
+    poses = read_poses(path, POSE)
     np.testing.assert_array_equal(poses.xyz, scene.xyz)
     np.testing.assert_array_equal(poses.quat_xyzw, scene.quat)
     np.testing.assert_array_equal(poses.t_ns, scene.t_hdr)
-    states = eio.read_states(path, BMBOX)
+    states = read_states(path, BMBOX)
     # the scene logs the BmBox state i // 12 every 12th pose
     np.testing.assert_array_equal(states.state, np.arange(len(states.state)))
     assert len(states.state) == (scene.n + 11) // 12
     t_all = all_times(scene)
     for exact in (False, True):
-        s = eio.summary(path, exact=exact)
+        s = bag_summary(path, exact=exact)
         assert s.problems == ()
         assert {t.name: t.count for t in s.topics if t.count} == expected_counts(scene)
         assert (s.start_ns, s.end_ns) == (int(t_all.min()), int(t_all.max()))
     np.testing.assert_array_equal(record_times(path)[POSE], scene.t_rec)
 
 
+@pytest.mark.slow_cases(
+    "channels-only-in-chunks", "no-chunk-indexes", "no-message-indexes", "schemas-only-in-chunks"
+)
 @pytest.mark.parametrize("layout", LAYOUTS)
 def test_layout_read_exactly(
     layout: str,
@@ -147,6 +151,7 @@ def test_layout_read_exactly(
     assert bag["messages"] == len(scene.spec.msgs)
 
 
+@pytest.mark.slow
 def test_no_summary_section(
     tmp_path: Path, scene: Scene, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -253,6 +258,7 @@ def test_scan_finds_every_record(
     assert len(kept) == int((found.channel_id == 1).sum())
 
 
+@pytest.mark.slow
 def test_verbose_says_why_a_file_is_read_record_by_record(
     tmp_path: Path, scene: Scene, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -265,15 +271,16 @@ def test_verbose_says_why_a_file_is_read_record_by_record(
     assert "record by record" not in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_rosbag2_mcap_storage_without_summary(tmp_path: Path, scene: Scene) -> None:
     folder = write(tmp_path / "r2", "rosbag2-mcap", scene.spec)
     (storage,) = folder.glob("*.mcap")
     without_summary(storage, tmp_path / "bare.mcap").replace(storage)
-    s = eio.summary(folder, exact=True)
+    s = bag_summary(folder, exact=True)
     assert s.index == "metadata.yaml+scan" and s.problems == ()
     assert {t.name: t.count for t in s.topics if t.count} == expected_counts(scene)
     t_all = all_times(scene)
     assert (s.start_ns, s.end_ns) == (int(t_all.min()), int(t_all.max()))
-    poses = eio.read_poses(folder, POSE)  # rosbags' reader, as the fast path steps aside
+    poses = read_poses(folder, POSE)  # rosbags' reader, as the fast path steps aside
     np.testing.assert_array_equal(poses.xyz, scene.xyz)
     np.testing.assert_array_equal(poses.t_ns, scene.t_hdr)

@@ -19,17 +19,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_bagmaker import Spec, bag_name, write
-from io_scene import Scene
 from mcap.reader import make_reader
-from test_io_fastpath import POSE_TOPICS, assert_same, fast_batch, reference_batch
 
-import ertools.io as eio
 from ertools.errors import BagError, ErtoolsError
 from ertools.io import bulk, pipeline
 from ertools.io.files import open_bag
 from ertools.io.mcap.index import _in_order
+from ertools.io.reader import read_poses
 from ertools.io.ros1 import runs as ros1_runs
+from tests.helpers.bagmaker import Spec, bag_name, write
+from tests.helpers.fastpath import POSE_TOPICS, assert_same, fast_batch, reference_batch
+from tests.helpers.scene import Scene
 
 
 @pytest.fixture
@@ -47,6 +47,7 @@ def test_many_groups_on_worker_threads_equal_rosbags(
     assert_same(fast_batch(path, topic), reference_batch(path, topic))
 
 
+@pytest.mark.slow_cases("rosbag2-mcap", "rosbag2-sqlite3")
 def test_many_groups_with_a_window_equal_rosbags(
     scene_bag: tuple[str, Path], small_groups: None
 ) -> None:
@@ -202,6 +203,7 @@ def test_worker_error_reaches_the_caller_as_itself(monkeypatch: pytest.MonkeyPat
     assert not [t for t in threading.enumerate() if t.name.startswith("ThreadPoolExecutor")]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["ros1", "ros1-lz4", "ros1-bz2", "mcap-cdr"])
 def test_damaged_chunk_read_on_a_worker_is_one_ertools_error(
     tmp_path: Path, scene: Scene, fmt: str, small_groups: None
@@ -218,7 +220,7 @@ def test_damaged_chunk_read_on_a_worker_is_one_ertools_error(
             data[int(at)] ^= 0x5A
         path.write_bytes(bytes(data))
         try:
-            eio.read_poses(path, "/fbm3w/robot_at_work/pose")
+            read_poses(path, "/fbm3w/robot_at_work/pose")
         except ErtoolsError as err:
             assert str(err)
             raised += 1

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import struct
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -18,21 +17,20 @@ import pytest
 from mcap.reader import make_reader
 from rosbags.highlevel import AnyReader
 
-from ertools.benchmarks.trajectory.inputs import read_robot
+from ertools.benchmarks.trajectory.logs import read_robot
 from ertools.cli.main import main
 from ertools.errors import TopicError
-from ertools.io.info import describe
-from ertools.io.model import short_msgtype
-
-sys.path.insert(0, str(Path(__file__).parent))
-
-from io_bagmaker import FORMATS, Spec, bag_name, write
-from test_io_fastpath import assert_same, fast_batch, reference_batch
-
-import ertools.io as eio
 from ertools.io.decode.fast import decode
 from ertools.io.decode.uniform import decode_uniform, layout_of
-from ertools.io.model import POSE_TYPES, PoseSource
+from ertools.io.info import describe
+from ertools.io.model import POSE_TYPES, PoseSource, short_msgtype
+from ertools.io.reader import read_pose_source, read_poses
+from ertools.io.reader import topics as bag_topics
+from ertools.io.summary import summary as bag_summary
+from tests.helpers.bagmaker import FORMATS, Spec, bag_name, write
+from tests.helpers.fastpath import assert_same, fast_batch, reference_batch
+
+pytestmark = pytest.mark.slow
 
 T0 = 1_700_000_000_000_000_000
 N = 40
@@ -80,8 +78,8 @@ def typed_bag(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathF
 def test_every_pose_type_reads_back_exactly(typed_bag: Path, topic: str) -> None:
     _, t_rec, t_hdr, xyz, quat = truth()
     msgtype, child, frame = TOPICS[topic]
-    assert eio.topics(typed_bag)[topic] == msgtype
-    s = eio.read_poses(typed_bag, topic)
+    assert bag_topics(typed_bag)[topic] == msgtype
+    s = read_poses(typed_bag, topic)
     if msgtype == "geometry_msgs/Pose2D":
         np.testing.assert_array_equal(s.t_ns, t_rec)  # no header: always the record time
         np.testing.assert_array_equal(s.xyz[:, :2], xyz[:, :2])
@@ -92,14 +90,14 @@ def test_every_pose_type_reads_back_exactly(typed_bag: Path, topic: str) -> None
         np.testing.assert_array_equal(s.xyz, xyz)
         np.testing.assert_array_equal(s.quat_xyzw, quat)
         assert (s.frame_id, s.child_frame_id) == (frame, child)
-    rec = eio.read_poses(typed_bag, topic, time_source="record")
+    rec = read_poses(typed_bag, topic, time_source="record")
     np.testing.assert_array_equal(rec.t_ns, t_rec)
     # A window of the middle 10 samples (on the record time) keeps exactly those.
-    part = eio.read_poses(
+    part = read_poses(
         typed_bag, topic, time_source="record", start_ns=int(t_rec[10]), end_ns=int(t_rec[19])
     )
     np.testing.assert_array_equal(part.t_ns, t_rec[10:20])
-    src = eio.read_pose_source(typed_bag, PoseSource(topic=topic, time_source="record"))
+    src = read_pose_source(typed_bag, PoseSource(topic=topic, time_source="record"))
     np.testing.assert_array_equal(src.xyz, rec.xyz)
 
 
@@ -233,7 +231,7 @@ def test_summary_matches_the_official_reader(typed_bag: Path) -> None:
     assert (exact.start_ns, exact.end_ns) == (start, end)
     assert exact.message_count == sum(v[1] for v in topics.values())
     assert {t.name: (t.msgtype, t.count, t.first_ns, t.last_ns) for t in exact.topics} == topics
-    quick = eio.summary(path)  # from the chunk bounds: bag start and end still exact
+    quick = bag_summary(path)  # from the chunk bounds: bag start and end still exact
     assert (quick.start_ns, quick.end_ns) == (start, end)
     assert {t.name: (t.msgtype, t.count) for t in quick.topics} == {
         k: v[:2] for k, v in topics.items()

@@ -17,11 +17,7 @@ import time
 from pathlib import Path
 
 import pytest
-from io_bagmaker import bag_name, write
-from io_scene import Scene
 from mcap.reader import make_reader
-from stderr_text import error_messages
-from test_io_fastpath import fast_batch
 
 import ertools.progress
 from ertools.cli.main import main
@@ -30,6 +26,10 @@ from ertools.io.files import open_bag
 from ertools.io.info import describe
 from ertools.io.ros1.check import check_ros1
 from ertools.progress import Bar, reporting
+from tests.helpers.bagmaker import bag_name, write
+from tests.helpers.fastpath import fast_batch
+from tests.helpers.scene import Scene
+from tests.helpers.stderr_text import error_messages
 
 TOPIC = "/fbm3w/robot_at_work/pose"
 
@@ -49,7 +49,7 @@ class Recorder:
 
 @pytest.fixture(autouse=True)
 def wide(monkeypatch: pytest.MonkeyPatch) -> None:
-    # lines are cut to the terminal's width (tests/core/test_progress.py): these check labels
+    # lines are cut to the terminal's width (tests/progress/test_progress.py): these check labels
     monkeypatch.setenv("COLUMNS", "200")
 
 
@@ -222,6 +222,7 @@ def no_delay(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(ertools.progress, "DELAY_S", 0.0)
 
 
+@pytest.mark.slow
 def test_cli_no_bar_when_stderr_is_not_a_terminal(
     ros1_bag: Path, no_delay: None, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -230,6 +231,7 @@ def test_cli_no_bar_when_stderr_is_not_a_terminal(
     assert "\r" not in err and "\x1b" not in err and "[#" not in err
 
 
+@pytest.mark.slow_cases("False")
 @pytest.mark.parametrize("quiet", [False, True])
 def test_cli_bar_on_a_terminal_unless_quiet(
     ros1_bag: Path,
@@ -298,6 +300,7 @@ def _on_a_pty(argv: list[str], columns: int | None) -> tuple[int, bytes, str]:
 TRAJECTORY = ["score", "trajectory", "--robot-topic", "/odom", "--gt-topic", TOPIC]
 
 
+@pytest.mark.slow
 def test_cli_bar_through_a_real_pty(ros1_bag: Path) -> None:
     """The real thing: ``isatty`` answered by the system, output read off the terminal."""
     code, out, err = _on_a_pty([*TRAJECTORY, str(ros1_bag)], None)
@@ -311,6 +314,7 @@ def test_cli_bar_through_a_real_pty(ros1_bag: Path) -> None:
     assert all(line.startswith("ertools: ") for line in tail.split("\r\n") if line), tail
 
 
+@pytest.mark.slow
 def test_bar_appears_for_a_slow_read_only(scene: Scene, tmp_path: Path, small_groups: None) -> None:
     """Real clock, real delay: a read slowed to ~1 s shows the bar, a quick one shows none."""
 
@@ -406,6 +410,7 @@ def test_cli_info_counts_bags_not_the_reads_inside(
     assert f"ertools: reading indexes [{'#' * 24}] 9/9 bags" in shown
 
 
+@pytest.mark.slow
 def test_cli_bar_fits_a_narrow_terminal(ros1_bag: Path) -> None:
     # 60 columns, asked of the terminal itself: every redraw fits in 59 (no wrapped rows);
     # the rate goes first, then the middle of the label, the bar and amounts stay whole

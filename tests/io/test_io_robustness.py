@@ -8,12 +8,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_bagmaker import bag_name, write
-from io_scene import Scene
 
-import ertools.io as eio
 from ertools.errors import ErtoolsError
 from ertools.io.info import describe
+from ertools.io.reader import read_poses, read_states, read_tf
+from tests.helpers.bagmaker import bag_name, write
+from tests.helpers.scene import Scene
+
+pytestmark = pytest.mark.slow
 
 
 @pytest.mark.parametrize("fmt", ["ros1", "ros1-lz4", "mcap-cdr", "rosbag2-sqlite3"])
@@ -40,9 +42,9 @@ def test_cut_or_flipped_bytes_give_ertools_errors(
         target.write_bytes(bytes(data))
         with caplog.at_level(logging.CRITICAL, logger="ertools"):
             for read in (
-                lambda p=path: eio.read_poses(p, "/fbm3w/robot_at_work/pose"),
-                lambda p=path: eio.read_tf(p, "world", "robot_at_work"),
-                lambda p=path: eio.read_states(p, "/fbm3w/bmbox_state"),
+                lambda p=path: read_poses(p, "/fbm3w/robot_at_work/pose"),
+                lambda p=path: read_tf(p, "world", "robot_at_work"),
+                lambda p=path: read_states(p, "/fbm3w/bmbox_state"),
                 lambda p=path: describe(p, check=True),
             ):
                 try:

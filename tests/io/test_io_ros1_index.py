@@ -16,18 +16,19 @@ from typing import Any
 
 import numpy as np
 import pytest
-from io_bagmaker import Spec, write
 from rosbags.rosbag1 import Reader, Writer
 from rosbags.typesys import Stores, get_typestore
-from stderr_text import error_messages
-from test_io_fastpath import REAL_BAG, _sample_bags
 
-import ertools.io as eio
 from ertools import caches
 from ertools.cli.main import main
+from ertools.io.reader import read_poses
 from ertools.io.ros1 import layout
 from ertools.io.ros1.check import check_ros1, rebuild_layout
 from ertools.io.ros1.layout import scan_layout
+from ertools.io.summary import summary as bag_summary
+from tests.helpers.bagmaker import Spec, write
+from tests.helpers.fastpath import REAL_BAG, sample_bags
+from tests.helpers.stderr_text import error_messages
 
 T0 = 1_445_609_740_000_000_000
 DT = 10_000_000
@@ -109,11 +110,11 @@ def test_empty_bag_is_a_valid_bag(
         assert (bag["messages"], bag["start"], bag["end"], bag["problems"]) == (0, None, None, [])
         assert {t["name"]: t["type"] for t in bag["topics"]} == official
         assert all(t["count"] == 0 for t in bag["topics"])
-    s = eio.summary(path)
+    s = bag_summary(path)
     assert (s.message_count, s.start_ns, s.end_ns, s.indexed) == (0, 0, 0, True)
     assert check_ros1(path) == []
     if with_connection:
-        assert len(eio.read_poses(path, "/pose")) == 0
+        assert len(read_poses(path, "/pose")) == 0
 
 
 # --- info --check ------------------------------------------------------------------------------
@@ -124,10 +125,11 @@ def test_sound_bags_check_clean(tmp_path: Path, fmt: str) -> None:
     assert check_ros1(two_topic_bag(tmp_path / "b.bag", fmt)) == []
 
 
+@pytest.mark.slow
 def test_sample_and_real_bags_check_clean() -> None:
 
     # (the samples include deliberately truncated bags: those already fail the summary)
-    bags = [p for p in _sample_bags() if p.suffix == ".bag" and not eio.summary(p).problems]
+    bags = [p for p in sample_bags() if p.suffix == ".bag" and not bag_summary(p).problems]
     if REAL_BAG.is_file():
         bags.append(REAL_BAG)
     if not bags:
@@ -243,7 +245,7 @@ def test_fast_path_distrusts_an_index_that_contradicts_itself(
 ) -> None:
     path, _what = damaged(tmp_path, how)
     with caplog.at_level(logging.WARNING, logger="ertools"):
-        rec = eio.read_poses(path, "/pose", time_source="record")
+        rec = read_poses(path, "/pose", time_source="record")
     # the records' own times, not the index's
     np.testing.assert_array_equal(rec.t_ns, truth_record_times())
     np.testing.assert_array_equal(rec.xyz[:, 0], np.arange(N, dtype=np.float64))
@@ -259,7 +261,7 @@ def test_fast_path_distrusts_a_chunk_info_naming_an_unknown_connection(
     the last chunk dropped out of its real connection's read without a word."""
     path, _what = damaged(tmp_path, "info-conn")
     with caplog.at_level(logging.WARNING, logger="ertools"):
-        rec = eio.read_poses(path, "/pose", time_source="record")
+        rec = read_poses(path, "/pose", time_source="record")
     np.testing.assert_array_equal(rec.t_ns, truth_record_times())
     np.testing.assert_array_equal(rec.xyz[:, 0], np.arange(N, dtype=np.float64))
     warnings = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
@@ -275,7 +277,7 @@ def test_a_wider_chunk_span_contradicts_no_read(
 
     path, _what = damaged(tmp_path, how)
     with caplog.at_level(logging.WARNING, logger="ertools"):
-        rec = eio.read_poses(path, "/pose", time_source="record")
+        rec = read_poses(path, "/pose", time_source="record")
     np.testing.assert_array_equal(rec.t_ns, truth_record_times())
     assert not [r for r in caplog.records if r.levelno >= logging.WARNING]
     if how == "info-end":
@@ -290,7 +292,7 @@ def test_fast_path_on_a_sound_bag_warns_nothing(
 ) -> None:
     path = two_topic_bag(tmp_path / "b.bag")
     with caplog.at_level(logging.WARNING, logger="ertools"):
-        rec = eio.read_poses(path, "/pose", time_source="record")
+        rec = read_poses(path, "/pose", time_source="record")
     np.testing.assert_array_equal(rec.t_ns, truth_record_times())
     assert not [r for r in caplog.records if r.levelno >= logging.WARNING]
 
@@ -346,7 +348,7 @@ def test_a_header_claiming_an_empty_index_over_chunks_is_not_an_empty_bag(tmp_pa
     struct.pack_into("<I", raw, fields["chunk_count"][0], 0)
     path = tmp_path / "liar.bag"
     path.write_bytes(bytes(raw))
-    s = eio.summary(path)
+    s = bag_summary(path)
     assert (s.message_count, s.indexed) == (N + N // 3, False)
     assert s.problems
 
@@ -375,7 +377,7 @@ def test_a_scan_is_made_once_per_file_version(
     first = layout.read_layout(path)
     assert not first.indexed and sum(c.counts.get(0, 0) for c in first.chunks) == N
     assert layout.read_layout(path) is first
-    assert eio.summary(path).message_count == N + N // 3
+    assert bag_summary(path).message_count == N + N // 3
     assert len(scans) == 1
     # the recorder wrote on: another version of the file
     st = path.stat()

@@ -18,7 +18,9 @@ import pytest
 
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
+
+pytestmark = pytest.mark.slow
 
 BIN = Path(sys.executable).parent
 NS = 1_000_000_000

@@ -7,32 +7,42 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_bagmaker import Spec, bag_name, write
-from io_scene import DT, T0, Scene, make_scene
 from rosbags.rosbag1 import Writer
 
-import ertools.io as eio
 from ertools.errors import BagError, TopicError
+from ertools.io.model import PoseSource
+from ertools.io.reader import (
+    read_benchmark_states,
+    read_messages,
+    read_pose_source,
+    read_poses,
+    read_states,
+    read_tf,
+)
+from ertools.io.reader import topics as bag_topics
+from ertools.io.summary import summary as bag_summary
 from ertools.states import Machine
+from tests.helpers.bagmaker import Spec, bag_name, write
+from tests.helpers.scene import DT, T0, Scene, make_scene
 
 POSE = "/fbm3w/robot_at_work/pose"
 
 
 def test_pose_stamped_exact(scene: Scene, scene_bag: tuple[str, Path]) -> None:
     _, path = scene_bag
-    s = eio.read_poses(path, POSE)
+    s = read_poses(path, POSE)
     # Values went through float64 serialization unchanged: exact equality.
     np.testing.assert_array_equal(s.t_ns, scene.t_hdr)
     np.testing.assert_array_equal(s.xyz, scene.xyz)
     np.testing.assert_array_equal(s.quat_xyzw, scene.quat)
     assert s.frame_id == "world"
-    rec = eio.read_poses(path, POSE, time_source="record")
+    rec = read_poses(path, POSE, time_source="record")
     np.testing.assert_array_equal(rec.t_ns, scene.t_rec)
 
 
 def test_pose2d_record_time_and_yaw(scene: Scene, scene_bag: tuple[str, Path]) -> None:
     _, path = scene_bag
-    s = eio.read_poses(path, "/fbm3w/robot_at_work/pose2d")
+    s = read_poses(path, "/fbm3w/robot_at_work/pose2d")
     np.testing.assert_array_equal(s.t_ns, scene.t_rec + 100)
     np.testing.assert_array_equal(s.xyz[:, :2], scene.xyz[:, :2])
     assert np.all(s.xyz[:, 2] == 0.0)
@@ -43,7 +53,7 @@ def test_pose2d_record_time_and_yaw(scene: Scene, scene_bag: tuple[str, Path]) -
 @pytest.mark.parametrize("topic", ["/fbm3w/tfs", "/odom"])
 def test_transform_and_odometry(scene: Scene, scene_bag: tuple[str, Path], topic: str) -> None:
     _, path = scene_bag
-    s = eio.read_poses(path, topic)
+    s = read_poses(path, topic)
     np.testing.assert_array_equal(s.t_ns, scene.t_hdr)
     np.testing.assert_array_equal(s.xyz, scene.xyz)
     np.testing.assert_array_equal(s.quat_xyzw, scene.quat)
@@ -52,12 +62,12 @@ def test_transform_and_odometry(scene: Scene, scene_bag: tuple[str, Path], topic
 
 def test_tf_direct_and_chain(scene: Scene, scene_bag: tuple[str, Path]) -> None:
     _, path = scene_bag
-    direct = eio.read_tf(path, "world", "/robot_at_work")
+    direct = read_tf(path, "world", "/robot_at_work")
     np.testing.assert_array_equal(direct.t_ns, scene.t_hdr)
     np.testing.assert_array_equal(direct.xyz, scene.xyz)
     # map is (1, 2, 0) in world, identity rotation, published every 12th sample from the
     # first to sample 48: map -> robot = robot - (1, 2, 0) where both links exist.
-    chain = eio.read_tf(path, "map", "robot_at_work")
+    chain = read_tf(path, "map", "robot_at_work")
     first_map, last_map = scene.t_rec[0], scene.t_rec[48]
     inside = (scene.t_hdr >= first_map) & (scene.t_hdr <= last_map)
     np.testing.assert_array_equal(chain.t_ns, scene.t_hdr[inside])
@@ -68,9 +78,10 @@ def test_tf_direct_and_chain(scene: Scene, scene_bag: tuple[str, Path]) -> None:
     )
 
 
+@pytest.mark.slow_cases("rosbag2-mcap")
 def test_states_decode_from_stored_definitions(scene: Scene, scene_bag: tuple[str, Path]) -> None:
     _, path = scene_bag
-    states = eio.read_benchmark_states(path, "fbm3w")
+    states = read_benchmark_states(path, "fbm3w")
     assert states.client is None
     assert states.bmbox is not None and states.refbox is not None
     assert states.bmbox.machine is Machine.BMBOX
@@ -81,23 +92,24 @@ def test_states_decode_from_stored_definitions(scene: Scene, scene_bag: tuple[st
     np.testing.assert_array_equal(states.refbox.t_ns, scene.t_rec[idx] + 1)
 
 
+@pytest.mark.slow_cases("rosbag2-mcap", "rosbag2-sqlite3")
 def test_window_and_messages(scene: Scene, scene_bag: tuple[str, Path]) -> None:
     _, path = scene_bag
     lo, hi = int(scene.t_rec[10]), int(scene.t_rec[20])
-    rec = eio.read_poses(path, POSE, time_source="record", start_ns=lo, end_ns=hi)
+    rec = read_poses(path, POSE, time_source="record", start_ns=lo, end_ns=hi)
     np.testing.assert_array_equal(rec.t_ns, scene.t_rec[10:21])  # both ends inclusive
-    hdr = eio.read_poses(path, POSE, start_ns=int(scene.t_hdr[5]), end_ns=int(scene.t_hdr[7]))
+    hdr = read_poses(path, POSE, start_ns=int(scene.t_hdr[5]), end_ns=int(scene.t_hdr[7]))
     np.testing.assert_array_equal(hdr.xyz, scene.xyz[5:8])
-    msgs = eio.read_messages(path, "/chatter")
+    msgs = read_messages(path, "/chatter")
     assert msgs == []
-    raw = eio.read_messages(path, "/fbm3w/bmbox_state", start_ns=lo, end_ns=hi)
+    raw = read_messages(path, "/fbm3w/bmbox_state", start_ns=lo, end_ns=hi)
     assert [m.t_ns for m in raw] == [int(scene.t_rec[12])]
     assert raw[0].msg.payload == "payload 12"
 
 
 def test_topics(scene_bag: tuple[str, Path]) -> None:
     _, path = scene_bag
-    found = eio.topics(path)
+    found = bag_topics(path)
     assert found[POSE] == "geometry_msgs/PoseStamped"
     assert found["/tf"] == "tf2_msgs/TFMessage"
     assert found["/fbm3w/bmbox_state"] == "rockin_scoring/BmBoxState"
@@ -107,13 +119,14 @@ def test_topics(scene_bag: tuple[str, Path]) -> None:
 def test_unknown_topic_lists_pose_topics(scene_bag: tuple[str, Path]) -> None:
     _, path = scene_bag
     with pytest.raises(TopicError) as err:
-        eio.read_poses(path, "/nope")
+        read_poses(path, "/nope")
     text = str(err.value)
     assert "/nope" in text and POSE in text and "/odom" in text and "/chatter" not in text
     with pytest.raises(TopicError, match="not a pose type"):
-        eio.read_poses(path, "/chatter")
+        read_poses(path, "/chatter")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fmt", ["ros1", "mcap-cdr", "rosbag2-sqlite3"])
 def test_split_files_merge_in_time_order(
     tmp_path: Path, fmt: str, caplog: pytest.LogCaptureFixture
@@ -130,34 +143,34 @@ def test_split_files_merge_in_time_order(
     p1 = write(bag_name(tmp_path, fmt, "one"), fmt, a.spec)
     p2 = write(bag_name(tmp_path, fmt, "two"), fmt, shifted)
     with caplog.at_level(logging.WARNING, logger="ertools"):
-        s = eio.read_poses([p2, p1], POSE, time_source="record")
+        s = read_poses([p2, p1], POSE, time_source="record")
     np.testing.assert_array_equal(s.t_ns, np.concatenate([a.t_rec, b.t_rec + 30 * DT]))
     np.testing.assert_array_equal(s.xyz, np.concatenate([a.xyz, b.xyz]))
     assert "out of time order" in caplog.text
     # overlapping files: sorted and reported
     caplog.clear()
     with caplog.at_level(logging.WARNING, logger="ertools"):
-        s2 = eio.read_poses([p1, p1], POSE, time_source="record")
+        s2 = read_poses([p1, p1], POSE, time_source="record")
     assert "overlap" in caplog.text
     np.testing.assert_array_equal(s2.t_ns, np.repeat(a.t_rec, 2))
 
 
 def test_missing_and_broken_files(tmp_path: Path, scene: Scene) -> None:
     with pytest.raises(BagError, match="no such file"):
-        eio.read_poses(tmp_path / "missing.bag", POSE)
+        read_poses(tmp_path / "missing.bag", POSE)
     empty = tmp_path / "empty.bag"
     empty.write_bytes(b"")
     with pytest.raises(BagError, match="empty"):
-        eio.summary(empty)
+        bag_summary(empty)
     junk = tmp_path / "junk.bag"
     junk.write_bytes(np.random.default_rng(0).bytes(5000))
     with pytest.raises(BagError, match="not a ROS1 bag"):
-        eio.topics(junk)
+        bag_topics(junk)
     good = write(tmp_path / "good.bag", "ros1", scene.spec)
     cut = tmp_path / "cut.bag"
     cut.write_bytes(good.read_bytes()[: good.stat().st_size // 2])
     with pytest.raises(BagError) as err:
-        eio.read_poses(cut, POSE)
+        read_poses(cut, POSE)
     assert "cut.bag" in str(err.value)
 
 
@@ -169,12 +182,12 @@ def test_no_stored_definition(tmp_path: Path) -> None:
         )
         w.write(c, T0, b"\x02\x00\x00\x00\x00")
     with pytest.raises(BagError, match="no stored message definition"):
-        eio.read_states(path, "/fbm1h/bmbox_state")
+        read_states(path, "/fbm1h/bmbox_state")
 
 
 def test_pose_source(scene: Scene, scene_bag: tuple[str, Path]) -> None:
     _, path = scene_bag
-    by_topic = eio.read_pose_source(path, eio.PoseSource(topic=POSE))
-    by_tf = eio.read_pose_source(path, eio.PoseSource(frame="robot_at_work"))
+    by_topic = read_pose_source(path, PoseSource(topic=POSE))
+    by_tf = read_pose_source(path, PoseSource(frame="robot_at_work"))
     np.testing.assert_array_equal(by_topic.xyz, by_tf.xyz)
     assert by_tf.start_ns > T0

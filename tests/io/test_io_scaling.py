@@ -17,7 +17,12 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from hostile_files import (
+
+from ertools import caches
+from ertools.io.info import describe
+from ertools.io.reader import read_messages
+from ertools.io.summary import summary as bag_summary
+from tests.io.hostile_files import (
     McapChannel,
     McapChunk,
     Ros1Chunk,
@@ -28,9 +33,7 @@ from hostile_files import (
     u32,
 )
 
-import ertools.io as eio
-from ertools import caches
-from ertools.io.info import describe
+pytestmark = pytest.mark.slow
 
 T0 = 1_448_020_800 * 10**9
 SMALL, LARGE = 400, 1600
@@ -92,8 +95,8 @@ def many(tmp_path: Path, fmt: str, n: int, shape: str) -> Path:
 READS: dict[str, Callable[[Path], Any]] = {
     "info": describe,
     "info --check": lambda p: describe(p, check=True),
-    "summary": lambda p: eio.summary(p, exact=True),
-    "read one topic": lambda p: eio.read_messages(p, "/t0"),
+    "summary": lambda p: bag_summary(p, exact=True),
+    "read one topic": lambda p: read_messages(p, "/t0"),
 }
 
 

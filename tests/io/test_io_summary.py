@@ -8,13 +8,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from io_bagmaker import write
-from io_scene import Scene
 
-import ertools.io as eio
 from ertools.errors import BagError
+from ertools.io.reader import read_poses
 from ertools.io.ros1.layout import read_layout
 from ertools.io.summary import record_times
+from ertools.io.summary import summary as bag_summary
+from tests.helpers.bagmaker import write
+from tests.helpers.scene import Scene
 
 POSE = "/fbm3w/robot_at_work/pose"
 
@@ -29,7 +30,7 @@ def expected_counts(scene: Scene) -> dict[str, int]:
 
 def test_summary_counts_and_times(scene: Scene, scene_bag: tuple[str, Path]) -> None:
     fmt, path = scene_bag
-    s = eio.summary(path, exact=True)
+    s = bag_summary(path, exact=True)
     counts = expected_counts(scene)
     assert s.message_count == sum(counts.values())
     assert {t.name: t.count for t in s.topics if t.count} == counts
@@ -51,7 +52,7 @@ def test_summary_counts_and_times(scene: Scene, scene_bag: tuple[str, Path]) -> 
     compression = {"ros1-lz4": "lz4", "ros1-bz2": "bz2", "mcap-cdr": "lz4", "mcap-ros1": "lz4"}
     assert s.compression == compression.get(fmt, "none")
     # the quick summary bounds each topic by its chunks: never inside the true span
-    quick = eio.summary(path).topic(POSE)
+    quick = bag_summary(path).topic(POSE)
     assert quick is not None and quick.first_ns is not None and quick.last_ns is not None
     assert quick.first_ns <= scene.t_rec[0] and quick.last_ns >= scene.t_rec[-1]
     times = record_times(path)
@@ -71,11 +72,11 @@ def make_active(good: Path, out: Path) -> Path:
 def test_active_bag_is_scanned_and_readable(tmp_path: Path, scene: Scene) -> None:
     good = write(tmp_path / "g.bag", "ros1-lz4", scene.spec, chunk_bytes=2000)
     active = make_active(good, tmp_path / "rec.bag.active")
-    s = eio.summary(active)
+    s = bag_summary(active)
     assert s.format == "ros1-active" and not s.indexed
     assert any("not indexed" in p for p in s.problems)
     assert s.message_count == sum(expected_counts(scene).values())
-    poses = eio.read_poses(active, POSE)
+    poses = read_poses(active, POSE)
     np.testing.assert_array_equal(poses.xyz, scene.xyz)
 
 
@@ -84,13 +85,13 @@ def test_truncated_bag(tmp_path: Path, scene: Scene) -> None:
     data = good.read_bytes()
     cut = tmp_path / "cut.bag"
     cut.write_bytes(data[: int(len(data) * 0.6)])
-    s = eio.summary(cut)
+    s = bag_summary(cut)
     assert not s.indexed
     assert any("truncated" in p for p in s.problems)
     # Some but not all messages survive the cut, counted by the scan.
     assert 0 < s.message_count < sum(expected_counts(scene).values())
     with pytest.raises(BagError, match="truncated"):
-        eio.read_poses(cut, POSE)
+        read_poses(cut, POSE)
 
 
 def test_truncated_mcap(tmp_path: Path, scene: Scene, caplog: pytest.LogCaptureFixture) -> None:
@@ -98,13 +99,13 @@ def test_truncated_mcap(tmp_path: Path, scene: Scene, caplog: pytest.LogCaptureF
     data = good.read_bytes()
     cut = tmp_path / "cut.mcap"
     cut.write_bytes(data[: int(len(data) * 0.5)])
-    s = eio.summary(cut)
+    s = bag_summary(cut)
     assert not s.indexed and s.problems
     assert 0 < s.message_count < sum(expected_counts(scene).values())
     # A recorder killed mid-file leaves no summary: the complete messages are read, with a
     # warning (like a ROS1 .bag.active).
     with caplog.at_level(logging.WARNING, logger="ertools"):
-        poses = eio.read_poses(cut, POSE)
+        poses = read_poses(cut, POSE)
     assert "no summary section" in caplog.text
     k = len(poses)
     assert 0 < k < scene.n
@@ -117,7 +118,7 @@ def test_real_bag_summary() -> None:
     path = real / "log_fbm2h_mocap_2015-10-23-16-15-40_0.bag"
     if not path.exists():
         pytest.skip("../shared/real_bags not present")
-    s = eio.summary(path, exact=True)
+    s = bag_summary(path, exact=True)
     counts = {t.name: (t.msgtype, t.count, t.connections) for t in s.topics}
     # Figures from the README of ../shared/real_bags.
     assert counts["/fbm2h/robot_at_home/pose"] == ("geometry_msgs/PoseStamped", 6887, 1)
@@ -142,7 +143,7 @@ def test_active_bag_with_open_chunk(tmp_path: Path, scene: Scene) -> None:
     struct.pack_into("<I", data, last + 4 + hlen, 0)  # the size a recorder leaves: 0
     active = tmp_path / "open.bag.active"
     active.write_bytes(bytes(data[: last + 8 + hlen + dlen]))  # no index records after it
-    s = eio.summary(active)
+    s = bag_summary(active)
     assert s.format == "ros1-active" and not s.indexed
     assert s.message_count == sum(expected_counts(scene).values())
-    np.testing.assert_array_equal(eio.read_poses(active, POSE).xyz, scene.xyz)
+    np.testing.assert_array_equal(read_poses(active, POSE).xyz, scene.xyz)

@@ -14,13 +14,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from stderr_text import error_messages
 
 from ertools.cli.main import main
 from ertools.errors import BagError
-from ertools.export.formats import format_csv, format_tum
+from ertools.exporting.formats import format_csv, format_tum
 from ertools.io.text import _plain_decimal_ns, read_text_poses, sniff
 from ertools.streams import PoseStream
+from tests.helpers.stderr_text import error_messages
 
 REPO = Path(__file__).resolve().parents[2]
 EVO_DATA = REPO.parent / "shared" / "evo_testdata"
@@ -71,6 +71,7 @@ def test_tum_as_evo_reads_it() -> None:
     assert ours.t_ns.tolist() == [int(Decimal(r) * 10**9) for r in rows]
 
 
+@pytest.mark.slow
 def test_euroc_as_evo_reads_it() -> None:
     pytest.importorskip("evo", reason="evo is in the dev extra")
     # lazy: evo is the dev extra's (importorskip above) and takes ~1 s to import
@@ -86,6 +87,7 @@ def test_euroc_as_evo_reads_it() -> None:
     assert int(ours.t_ns[0]) == int(first)
 
 
+@pytest.mark.slow
 def test_kitti_as_evo_reads_it() -> None:
     pytest.importorskip("evo", reason="evo is in the dev extra")
     # lazy: evo is the dev extra's (importorskip above) and takes ~1 s to import
@@ -173,6 +175,7 @@ def test_input_format_forces_the_reader(tmp_path: Path, capsys: pytest.CaptureFi
     assert "not a ROS1 bag" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_export_converts_text(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     src = _evo_data("V102_groundtruth.csv")
     out = tmp_path / "v102.tum"
@@ -191,6 +194,7 @@ def test_text_has_no_record_time(tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert "TUM text trajectory: it has only its stamps" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_decimal_stamps_exact_on_random_text() -> None:
     """The vectorised decimal -> ns path against Python's Decimal, on random stamps with 0 to 9
     decimals, negative ones, and the forms it hands to Decimal (exponent, >9 decimals)."""

@@ -10,17 +10,17 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from io_bagmaker import Spec, write
-from io_scene import DT, T0, Scene
 from rosbags.rosbag1 import Writer
 
-import ertools.io as eio
 from ertools.errors import TopicError
 from ertools.geometry import compose
 from ertools.io.decode.tf import Edge, chain_pose
 from ertools.io.files import open_bag
+from ertools.io.reader import read_poses, read_tf
 from ertools.io.ros1.index import Ros1Bag
 from ertools.streams import PoseStream
+from tests.helpers.bagmaker import Spec, write
+from tests.helpers.scene import DT, T0, Scene
 
 
 def q_yaw(yaw: float) -> tuple[float, float, float, float]:
@@ -59,7 +59,7 @@ def test_origin_to_ref_board(tmp_path: Path, fmt: str, tf_type: str) -> None:
             ],
         )
     path = write(tmp_path / ("x.bag" if fmt == "ros1" else "x.mcap"), fmt, s)
-    out = eio.read_tf(path, "origin", "ref_board")
+    out = read_tf(path, "origin", "ref_board")
     # By hand: p_origin = R(-90deg) (p_world - (1, 0, 0)); R(-90deg) maps (a, b) to (b, -a).
     i = np.arange(n)
     expected = np.column_stack([np.ones(n), -(0.1 * i), np.full(n, 0.5)])
@@ -70,7 +70,7 @@ def test_origin_to_ref_board(tmp_path: Path, fmt: str, tf_type: str) -> None:
     np.testing.assert_allclose(
         np.abs(out.quat_xyzw @ np.array(q_yaw(-math.pi / 2))), 1.0, atol=1e-12
     )
-    back = eio.read_tf(path, "ref_board", "origin")
+    back = read_tf(path, "ref_board", "origin")
     assert len(back) == n  # the static link holds; the moving one gives the times
 
 
@@ -110,7 +110,7 @@ def test_chain_recomposes(
 def test_unknown_frame_lists_frames(scene_bag: tuple[str, Path]) -> None:
     _, path = scene_bag
     with pytest.raises(TopicError, match="robot_at_work"):
-        eio.read_tf(path, "world", "nowhere")
+        read_tf(path, "world", "nowhere")
 
 
 def test_window_reads_only_overlapping_chunks(tmp_path: Path, scene: Scene) -> None:
@@ -142,7 +142,7 @@ def test_non_standard_layout_falls_back(tmp_path: Path, caplog: pytest.LogCaptur
         for i in range(3):
             w.write(c, T0 + i, np.array([i, 2 * i, 0.5, 99.0]).tobytes())
     with caplog.at_level(logging.INFO, logger="ertools"):
-        s = eio.read_poses(path, "/odd")
+        s = read_poses(path, "/odd")
     assert "standard layout" in caplog.text
     np.testing.assert_array_equal(s.xyz[:, :2], [[0, 0], [1, 2], [2, 4]])
     np.testing.assert_array_equal(s.t_ns, T0 + np.arange(3))

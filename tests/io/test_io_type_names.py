@@ -13,8 +13,10 @@ import pytest
 from rosbags.rosbag2 import Reader, StoragePlugin, Writer
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
-import ertools.io as eio
 from ertools.io.model import long_msgtype, short_msgtype
+from ertools.io.reader import read_messages
+from ertools.io.reader import topics as bag_topics
+from ertools.io.summary import summary as bag_summary
 
 EVENT = "example_interfaces/srv/AddTwoInts_Event"
 TOPIC = "/add_two_ints/_service_event"
@@ -42,9 +44,9 @@ def test_service_event_types_keep_srv(tmp_path: Path, plugin: str) -> None:
     with Reader(bag) as reader:
         official = {c.topic: c.msgtype for c in reader.connections}
     assert official == {TOPIC: EVENT}
-    assert eio.topics(bag) == official
-    assert eio.summary(bag).topic(TOPIC).msgtype == EVENT  # type: ignore[union-attr]
-    msgs = eio.read_messages(bag, TOPIC)
+    assert bag_topics(bag) == official
+    assert bag_summary(bag).topic(TOPIC).msgtype == EVENT  # type: ignore[union-attr]
+    msgs = read_messages(bag, TOPIC)
     assert [(m.t_ns, m.msg.a, m.msg.b) for m in msgs] == [
         (1000, 0, 0),
         (1001, 1, 10),
@@ -53,7 +55,7 @@ def test_service_event_types_keep_srv(tmp_path: Path, plugin: str) -> None:
     assert {m.msgtype for m in msgs} == {EVENT}
     if plugin == "MCAP":
         mcap = next(bag.glob("*.mcap"))
-        assert eio.topics(mcap) == official  # the MCAP file alone, through its schema name
+        assert bag_topics(mcap) == official  # the MCAP file alone, through its schema name
 
 
 def test_short_and_long_names() -> None:

@@ -4,20 +4,16 @@ CDR serialization rules, exact values back, and a fallback whenever one message 
 from __future__ import annotations
 
 import struct
-import sys
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))
-
-from io_bagmaker import FORMATS, Spec, bag_name, write
-from test_io_fastpath import assert_same, fast_batch, reference_batch
-
 from ertools.io import assemble
 from ertools.io.decode.uniform import decode_uniform, layout_of
+from tests.helpers.bagmaker import FORMATS, Spec, bag_name, write
+from tests.helpers.fastpath import assert_same, fast_batch, reference_batch
 
 POSE = (1.5, -2.25, 0.125, 0.0, 0.0, 0.6, 0.8)
 
@@ -131,6 +127,7 @@ def test_topic_with_a_different_frame_midway_matches_rosbags(fmt: str, tmp_path:
     assert list(fast.frame_names()[[0, 25, 50]]) == ["world", "earth", "map"]
 
 
+@pytest.mark.slow_cases("ros1-bz2", "ros1-lz4", "ros1", "rosbag2-mcap", "rosbag2-sqlite3")
 def test_uniform_decoder_is_used_on_standard_topics(
     scene_bag: tuple[str, Path], monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -6,12 +6,15 @@ from pathlib import Path
 
 import pytest
 import yaml
-from stderr_text import error_messages
 
 from ertools.cli.main import main
 from ertools.live.tail import is_finished, read_complete
+from tests.helpers.stderr_text import error_messages
+
+pytestmark = pytest.mark.xdist_group("timing")
 
 
+@pytest.mark.slow
 def test_simulate_demo_records_and_summarises(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -7,11 +7,13 @@ import re
 
 import pytest
 import yaml
-from live_helpers import fake_sntp_server, free_udp_port
 
 from ertools.cli.main import main
 from ertools.errors import ClockError
 from ertools.live.clock import ns_to_ntp, ntp_to_ns, query_sntp
+from tests.live.live_helpers import fake_sntp_server, free_udp_port
+
+pytestmark = pytest.mark.xdist_group("timing")
 
 
 @pytest.mark.parametrize("offset", [2.5, -0.25, 0.0])
@@ -61,6 +63,7 @@ def test_cli_within_and_outside_tolerance(capsys: pytest.CaptureFixture[str]) ->
         assert abs(offset - 0.2) <= delay / 2 + 2e-6
 
 
+@pytest.mark.slow
 def test_cli_unreachable_is_one_line(capsys: pytest.CaptureFixture[str]) -> None:
     port = free_udp_port()  # nobody listens there
     code = main(["clock", "--server", "127.0.0.1", "--port", str(port), "--timeout", "0.3"])

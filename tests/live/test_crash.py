@@ -11,11 +11,13 @@ import time
 from pathlib import Path
 
 import pytest
-from live_helpers import free_udp_port, read_mcap
 
 from ertools.errors import BagError
 from ertools.live.simulate import SimulatedBody, SimulatedMotive
 from ertools.live.tail import is_finished, read_complete
+from tests.live.live_helpers import free_udp_port, read_mcap
+
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("timing")]
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -88,7 +90,7 @@ def test_ertools_io_reads_the_killed_file(
 ) -> None:
     io = pytest.importorskip("ertools.io", reason="ertools.io not built yet")
     if not hasattr(io, "read_poses"):
-        pytest.skip("ertools.io.read_poses not available yet")
+        pytest.skip("ertools.io.reader.read_poses not available yet")
     path, _, _ = killed_recording
     messages, _ = read_mcap(path)
     expected = [m for topic, _, m in messages if topic == "/fbm2h/robot_at_home/pose"]

@@ -9,6 +9,8 @@ import pytest
 from ertools.configs.mocap import load_mocap_config, normalize_namespace, parse_mocap_config
 from ertools.errors import ConfigError
 
+pytestmark = pytest.mark.xdist_group("timing")
+
 REPO = Path(__file__).resolve().parents[2]
 
 

@@ -17,6 +17,8 @@ from ertools.live.recorder import Recorder, RecordOptions
 from ertools.live.simulate import SimulatedBody, SimulatedMotive
 from ertools.live.tail import is_finished, read_complete
 
+pytestmark = pytest.mark.xdist_group("timing")
+
 CONFIG = parse_mocap_config(
     "rigid_bodies:\n"
     "  '3': {pose: robot_at_home/pose, child_frame_id: robot_at_home}\n"
@@ -25,6 +27,7 @@ CONFIG = parse_mocap_config(
 RATE = 200.0
 
 
+@pytest.mark.slow
 def test_monitor_follows_a_growing_recording(tmp_path: Path) -> None:
     options = RecordOptions(
         out_dir=tmp_path, name="mon", namespace="/fbm2h", group=None, port=0,
@@ -111,6 +114,7 @@ def unfinished(tmp_path: Path) -> Path:
     return out
 
 
+@pytest.mark.slow
 def test_stalled_file_warns_about_growth(unfinished: Path) -> None:
     wall = time.time()
     os.utime(unfinished, (wall, wall))
@@ -134,6 +138,7 @@ def test_stalled_file_warns_about_growth(unfinished: Path) -> None:
     assert "no log file is being written" in later.warnings[0] and "unfinished" in later.warnings[0]
 
 
+@pytest.mark.slow
 def test_several_files_and_no_file(unfinished: Path, tmp_path: Path) -> None:
     other = unfinished.with_name("log_y_2015-10-23-16-15-41_0.mcap")
     shutil.copy(unfinished, other)
@@ -159,6 +164,7 @@ def test_ros1_active_bag_growth(tmp_path: Path) -> None:
     assert check.warnings == (f"{bag.name} grew 50 B/s over the last 1.0 s, expected >= 100 B/s",)
 
 
+@pytest.mark.slow
 def test_cli_once_on_a_stalled_folder(unfinished: Path, capsys: pytest.CaptureFixture[str]) -> None:
     code = main(["monitor", str(unfinished.parent), "--once", "--interval", "0.2", "--bell"])
     captured = capsys.readouterr()

@@ -21,6 +21,8 @@ from ertools.live.natnet import (
     encode_frame,
 )
 
+pytestmark = pytest.mark.xdist_group("timing")
+
 
 def hand_built_31() -> bytes:
     """A NatNet 3.1 frame written field by field from the SDK description (not the encoder).
@@ -137,6 +139,7 @@ def test_every_truncation_is_undecodable(version: NatNetVersion) -> None:
             decode_frame(struct.pack("<hH", NAT_FRAMEOFDATA, len(body)) + body, version)
 
 
+@pytest.mark.slow
 def test_garbage_never_raises_anything_else() -> None:
     rng = random.Random(7)
     good = encode_frame(_frame(), NatNetVersion(4, 1), EXTRAS)

@@ -11,7 +11,6 @@ import time
 from pathlib import Path
 
 import pytest
-from live_helpers import fake_sntp_server, read_mcap
 from mcap.reader import make_reader
 
 from ertools.configs.mocap import parse_mocap_config
@@ -19,6 +18,9 @@ from ertools.live.natnet import FrameExtras, NatNetVersion, RigidBody, encode_fr
 from ertools.live.recorder import Recorder, RecordOptions, RecordSummary
 from ertools.live.simulate import SimulatedBody, SimulatedMotive, make_frame
 from ertools.live.tail import is_finished, read_complete
+from tests.live.live_helpers import fake_sntp_server, read_mcap
+
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("timing")]
 
 CONFIG = parse_mocap_config(
     """
@@ -219,7 +221,7 @@ def test_read_complete_agrees_with_mcap_reader(tmp_path: Path) -> None:
 def test_ertools_io_reads_the_recording(tmp_path: Path) -> None:
     io = pytest.importorskip("ertools.io", reason="ertools.io not built yet")
     if not hasattr(io, "read_poses"):
-        pytest.skip("ertools.io.read_poses not available yet")
+        pytest.skip("ertools.io.reader.read_poses not available yet")
     summary, motive, _ = run_recording(
         tmp_path, {"bodies": (SimulatedBody(3),), "n_frames": 30, "rate_hz": 100.0}
     )

@@ -5,12 +5,15 @@ from __future__ import annotations
 import struct
 from pathlib import Path
 
-from live_helpers import read_mcap
+import pytest
 
 from ertools.configs.mocap import parse_mocap_config
 from ertools.live.natnet import FrameOfData, NatNetVersion, RigidBody, encode_frame
 from ertools.live.recorder import Recorder, RecordOptions, record
 from ertools.live.tail import is_finished, read_complete
+from tests.live.live_helpers import read_mcap
+
+pytestmark = pytest.mark.xdist_group("timing")
 
 CONFIG = parse_mocap_config("rigid_bodies: {'3': {pose: robot/pose}}")
 V = NatNetVersion(3, 1)
@@ -56,6 +59,7 @@ def test_counters_follow_the_frame_numbers(tmp_path: Path) -> None:
     assert any("rigid body ID 9 is streamed but not configured" in line for line in lines)
 
 
+@pytest.mark.slow
 def test_record_function_without_data(tmp_path: Path) -> None:
     """The library call: no sender, a short duration: one closed, empty-but-valid file."""
 

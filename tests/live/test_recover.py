@@ -9,6 +9,7 @@ resembles) and `ertools info` read every message that was complete, and nothing 
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import signal
 import struct
@@ -26,6 +27,8 @@ from ertools.live.recover import RECOVERY_METADATA
 from ertools.live.rosmsg import Ros2Serializer
 from ertools.live.tail import is_finished
 
+pytestmark = pytest.mark.xdist_group("timing")
+
 TOPICS = ("/fbm2h/robot_at_home/pose2d", "/fbm2h/origin/pose2d")
 PER_FLUSH = 50  # messages between two flushes (a flush closes a chunk)
 FLUSHES = 4  # flushes before the kill
@@ -38,10 +41,9 @@ def message(i: int) -> tuple[str, int, tuple[float, float, float]]:
 
 WRITER = textwrap.dedent(
     """
-    import os, signal, sys
+    import os, signal
     from pathlib import Path
-    sys.path.insert(0, {tests!r})
-    from test_recover import FLUSHES, PER_FLUSH, message
+    from tests.live.test_recover import FLUSHES, PER_FLUSH, message
     from ertools.live.logfile import LogFile
     from ertools.live.rosmsg import POSE_2D, Ros2Serializer
 
@@ -62,8 +64,9 @@ WRITER = textwrap.dedent(
 def killed(tmp_path_factory: pytest.TempPathFactory) -> Path:
     folder = tmp_path_factory.mktemp("killed")
     path = folder / "log_fbm2h_mocap_2015-11-20-12-00-00_0.mcap"
-    script = WRITER.format(tests=str(Path(__file__).parent), path=str(path))
-    proc = subprocess.run([sys.executable, "-c", script], check=False)
+    script = WRITER.format(path=str(path))
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])}  # tests.live
+    proc = subprocess.run([sys.executable, "-c", script], env=env, check=False)
     assert proc.returncode == -signal.SIGKILL
     assert not is_finished(path)
     return path
@@ -93,6 +96,7 @@ def info_messages(path: Path, capsys: pytest.CaptureFixture[str]) -> tuple[int, 
     return code, int(bag["messages"]), err
 
 
+@pytest.mark.slow
 def test_a_killed_recording_made_whole(
     killed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -141,6 +145,7 @@ def chunk_ends(path: Path) -> list[int]:
     return ends
 
 
+@pytest.mark.slow_cases("mid-chunk")
 @pytest.mark.parametrize("where", ["mid-chunk", "after-chunk", "one-byte-into-next"])
 def test_a_cut_inside_a_record_keeps_the_complete_chunks(
     where: str, killed: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]

@@ -21,6 +21,8 @@ from ertools.errors import BagError
 from ertools.live.recover import recover
 from ertools.live.tail import is_finished
 
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("timing")]
+
 RECORDER = textwrap.dedent(
     """
     import sys, time
@@ -72,7 +74,7 @@ def test_recover_refuses_a_recording_being_written(tmp_path: Path) -> None:
         with contextlib.redirect_stderr(err):
             code = main(["record", "--recover", str(path)])
         assert code == 1
-        # one message (a long path puts its clauses on lines: ertools.cli.main.error_text)
+        # one message (a long path puts its clauses on lines: ertools.cli.text.error_text)
         assert "; ".join(line.strip() for line in err.getvalue().splitlines()) == (
             f"ertools: error: {path}: is being recorded (a recorder holds its lock); "
             "--recover is for a recording cut short"

@@ -9,7 +9,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from ertools.report.figures import DPI, FigureSpec, render, thin_path, thin_series
+from ertools.report.figures import DPI, FigureSpec, render
+from ertools.views.thinning import thin_path, thin_series
 
 matplotlib = pytest.importorskip("matplotlib")
 from matplotlib.figure import Figure  # noqa: E402
@@ -51,6 +52,7 @@ def _pixels(path: Path) -> np.ndarray:
     return np.asarray(imread(path))
 
 
+@pytest.mark.slow
 def test_render_draws_what_savefig_draws(tmp_path: Path) -> None:
     # Two specs of the same size one after the other: the second is drawn on the canvas the
     # first used, and nothing of the first (its colorbar, its twin axes) may remain.
@@ -84,6 +86,7 @@ def _hour(rng: np.random.Generator) -> np.ndarray:
     return xy
 
 
+@pytest.mark.slow
 def test_thin_path_keeps_what_the_figure_shows(tmp_path: Path) -> None:
     xy = _hour(np.random.default_rng(7))
     size = (7.0, 6.0)

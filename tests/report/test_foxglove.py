@@ -22,16 +22,16 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from foxglove_readback import ReadBack, read_back, stamp_ns
 from rosbags.highlevel import AnyReader
-from stderr_text import error_messages
 
-from ertools.benchmarks.fbm2h.benchmark import score_fbm2h
 from ertools.benchmarks.fbm2h.config import Fbm2hOptions
-from ertools.benchmarks.trajectory.benchmark import score as score_trajectory
+from ertools.benchmarks.fbm2h.pipeline import score_fbm2h
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.pipeline import score as score_trajectory
 from ertools.cli.main import main
-from ertools.report.foxglove import write_foxglove
+from ertools.report.foxglove.write import write_foxglove
+from tests.helpers.foxglove_readback import ReadBack, read_back, stamp_ns
+from tests.helpers.stderr_text import error_messages
 
 SAMPLES = Path(__file__).resolve().parents[2] / "sample_bags"
 FBM3W = SAMPLES / "fbm3w" / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
@@ -81,6 +81,7 @@ def check_common(fg: ReadBack, expected: dict[str, str], score: dict[str, Any]) 
 # --- FBM3W ------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_fbm3w(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "deep" / "fbm3w.mcap"  # parent folders are created
     score = run_json(["score", "fbm3w", str(FBM3W), "--foxglove", str(out)], capsys)
@@ -154,6 +155,7 @@ def test_fbm3w(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
 # --- FBM2H ------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_fbm2h(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "fbm2h.mcap"
     score = run_json(["score", "fbm2h", str(FBM2H), *FBM2H_ARGS, "--foxglove", str(out)], capsys)
@@ -265,6 +267,7 @@ def _stamps(path: Path, topic: str) -> list[int]:
     return out
 
 
+@pytest.mark.slow
 def test_trajectory(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "trajectory.mcap"
     argv = ["score", "trajectory", str(ROBOT), str(ROBOT.parent), "--offset", "auto"]
@@ -315,6 +318,7 @@ def test_trajectory(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert [m.pose.position.x for m in gt.messages] == result.gt_path.xyz[:, 0].tolist()
 
 
+@pytest.mark.slow
 def test_trajectory_streams_over_the_limit_are_decimated(tmp_path: Path) -> None:
     result = score_trajectory(ROBOT, [ROBOT.parent])
     n, compared = len(result.matched.t_ns), result.compared
@@ -334,6 +338,7 @@ def test_trajectory_streams_over_the_limit_are_decimated(tmp_path: Path) -> None
 # --- audit ------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_audit_of_fbm2h(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "audit.mcap"
     data = run_json(["audit", str(FBM2H), *FBM2H_ARGS, "--foxglove", str(out)], capsys)
@@ -369,6 +374,7 @@ def _one_error(argv: list[str], code: int, capsys: pytest.CaptureFixture[str]) -
     return lines[0]
 
 
+@pytest.mark.slow
 def test_unwritable_path(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     blocker = tmp_path / "file"
     blocker.write_text("not a folder")

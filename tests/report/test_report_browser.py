@@ -9,7 +9,6 @@ import base64
 import re
 import shutil
 import subprocess
-import sys
 import xml.etree.ElementTree as ET
 from html.parser import HTMLParser
 from pathlib import Path
@@ -17,19 +16,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 from matplotlib.image import imread
-from report_fakes import EVIL, fbm3w_like
 
-from ertools.audit.analyse import audit_states
-from ertools.audit.compare import attach
+from ertools.auditing.analyse import audit_states
+from ertools.auditing.compare import attach
 from ertools.report.folder import write_report
 from ertools.states import Machine
+from tests.helpers.audit_streams import BMBOX, CLIENT, REFBOX, heartbeat
+from tests.helpers.fakes import BROWSER, CHROMIUM_FLAGS
+from tests.helpers.report_fakes import EVIL, fbm3w_like
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "audit"))
-from audit_streams import heartbeat
-from fakes import BROWSER, CHROMIUM_FLAGS
-from test_audit import BMBOX, CLIENT, REFBOX
-
-pytestmark = pytest.mark.browser
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 FLAGS = list(CHROMIUM_FLAGS)
 # EXECUTING_GOAL in the timeline figure (ertools.report.plots_audit: Okabe-Ito's bluish

@@ -4,15 +4,12 @@ colour-blind readers too."""
 from __future__ import annotations
 
 import itertools
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
-import svg_figure
 from matplotlib.figure import Figure
 
-from ertools.audit.analyse import audit_states
+from ertools.auditing.analyse import audit_states
 from ertools.report import svg
 from ertools.report.plots_audit import (
     OKABE_ITO,
@@ -22,10 +19,8 @@ from ertools.report.plots_audit import (
     timeline_chart,
 )
 from ertools.states import STATE_ENUMS, Machine
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "audit"))
-from audit_streams import heartbeat
-from test_audit import BMBOX, CLIENT, REFBOX
+from tests.helpers import svg_figure
+from tests.helpers.audit_streams import BMBOX, CLIENT, REFBOX, heartbeat
 
 # Machado, Oliveira & Fernandes (2009), "A physiologically-based model for simulation of
 # color vision deficiency", Table 1, severity 1.0: matrices on linear RGB.
@@ -94,6 +89,7 @@ def test_a_phase_keeps_its_colour_across_lanes() -> None:
     assert bm["TRANSMITTING_SCORE"] == ref["RECEIVED_SCORE"]
 
 
+@pytest.mark.slow
 def test_timeline_bars_are_drawn_in_their_state_colour() -> None:
     audit = audit_states(
         heartbeat(Machine.BMBOX, BMBOX, 20.0),

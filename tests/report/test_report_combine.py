@@ -8,13 +8,13 @@ from pathlib import Path
 
 import pytest
 import yaml
-from report_fakes import FakeResult, fbm3w_like
 
+from ertools.benchmarks.fbm2h.sample import generate
 from ertools.cli.main import main
 from ertools.report.combine import load_entry
 from ertools.report.folder import write_report
-from ertools.samples.fbm2h import generate
 from ertools.streams import Provenance
+from tests.helpers.report_fakes import FakeResult, fbm3w_like
 
 
 @pytest.fixture
@@ -144,6 +144,7 @@ def test_same_inputs_are_one_execution(tmp_path: Path) -> None:
     assert "3 result(s) of 2 execution(s)" in page
 
 
+@pytest.mark.slow
 def test_the_fbm2h_sample_scored_twice_is_one_row(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -5,25 +5,20 @@ from __future__ import annotations
 import csv
 import hashlib
 import json
-import sys
 from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
-import svg_figure
 import yaml
-from report_fakes import EVIL, fbm3w_like
-from test_cli_audit import _write_bag
 
-from ertools.audit.analyse import audit_states
+from ertools.auditing.analyse import audit_states
 from ertools.errors import ConfigError
 from ertools.report.folder import write_report
 from ertools.report.records import sha256_file
 from ertools.states import Machine
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "audit"))
-from audit_streams import heartbeat
-from test_audit import BMBOX, CLIENT, REFBOX
+from tests.helpers import svg_figure
+from tests.helpers.audit_streams import BMBOX, CLIENT, REFBOX, heartbeat, write_bag
+from tests.helpers.report_fakes import EVIL, fbm3w_like
 
 BAG_BYTES = b"#ROSBAG V2.0\n" + bytes(range(256)) * 50
 
@@ -132,6 +127,7 @@ def test_sha256_of_a_rosbag2_directory(tmp_path: Path) -> None:
     assert sha256_file(d) == hashlib.sha256(lines.encode()).hexdigest()
 
 
+@pytest.mark.slow
 def test_audit_report_has_timeline_figure(tmp_path: Path) -> None:
     audit = audit_states(
         heartbeat(Machine.BMBOX, BMBOX, 20.0, drop=(5.0, 7.0)),
@@ -157,10 +153,11 @@ def test_audit_report_has_timeline_figure(tmp_path: Path) -> None:
     assert "EXECUTING_GOAL" in page and "TRANSMITTING_GOAL" in page
 
 
+@pytest.mark.slow
 def test_report_of_score_bag_includes_its_audit(tmp_path: Path) -> None:
     """A score report whose bag has the state topics audits them by itself."""
 
-    bag = _write_bag(
+    bag = write_bag(
         tmp_path / "fbm3w.bag",
         [heartbeat(Machine.BMBOX, BMBOX, 20.0, topic="/fbm3w/bmbox_state")],
     )

@@ -2,20 +2,14 @@
 
 from __future__ import annotations
 
-import sys
-from pathlib import Path
-
 import pandas as pd
 import pytest
-from report_fakes import fbm3w_like
 
-from ertools.audit.analyse import audit_states
+from ertools.auditing.analyse import audit_states
 from ertools.frames import rows_to_dataframe, tables_to_frames
 from ertools.states import Machine
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "audit"))
-from audit_streams import T0_NS, heartbeat
-from test_audit import BMBOX
+from tests.helpers.audit_streams import BMBOX, T0_NS, heartbeat
+from tests.helpers.report_fakes import fbm3w_like
 
 
 def test_epoch_column_becomes_utc_index() -> None:

@@ -17,12 +17,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import svg_figure
-from fakes import BROWSER, CHROMIUM_FLAGS
 from matplotlib.image import imread
 
 from ertools import api
 from ertools.report.folder import write_report
+from tests.helpers import svg_figure
+from tests.helpers.fakes import BROWSER, CHROMIUM_FLAGS
+
+pytestmark = pytest.mark.slow
 
 REPO = Path(__file__).resolve().parents[2]
 FBM3W = sorted((REPO / "sample_bags" / "fbm3w").glob("*.bag"))

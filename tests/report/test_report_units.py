@@ -18,13 +18,15 @@ from pathlib import Path
 
 import pytest
 import yaml
-from report_fakes import fbm3w_like
-from yaml_rounding import YAML_ROUNDING
 
 from ertools.cli.main import main
-from ertools.report import units
+from ertools.competition import site_text
 from ertools.report.folder import write_report
-from ertools.rescore import site_text
+from ertools.views import units
+from tests.helpers.report_fakes import fbm3w_like
+from tests.helpers.yaml_rounding import YAML_ROUNDING
+
+pytestmark = pytest.mark.slow
 
 ROOT = Path(__file__).resolve().parents[2]
 S = ROOT / "sample_bags"
@@ -190,7 +192,7 @@ def test_fbm2h_lengths_in_mm_and_angles_in_degrees(reports: dict[str, Path]) -> 
         details["0"]["dinstance_error"], rel=1e-12
     )
     seed = yaml.safe_load((folder / "score.yaml").read_text())
-    # metres; the YAML value is the JSON one written to 9 decimals (tests/yaml_rounding.py)
+    # metres; the YAML value is the JSON one written to 9 decimals (tests/helpers/yaml_rounding.py)
     assert abs(seed["position_accuracy"] - score["position_accuracy"]) <= YAML_ROUNDING
     assert seed["position_accuracy"] < 1.0
 

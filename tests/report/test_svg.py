@@ -1,5 +1,6 @@
 """The SVG writer of the reports' figures: charts built by hand, read back from the SVG text
-through the scale its own tick labels state (tests/svg_figure.py), never through the writer."""
+through the scale its own tick labels state (tests/helpers/svg_figure.py), never through the
+writer."""
 
 from __future__ import annotations
 
@@ -8,11 +9,10 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
-import svg_figure
 from matplotlib.figure import Figure
 
 from ertools.report import chart_mpl, svg
-from ertools.report.chart import (
+from ertools.views.chart import (
     Arrows,
     Axis,
     Band,
@@ -28,6 +28,7 @@ from ertools.report.chart import (
     Text,
     viridis,
 )
+from tests.helpers import svg_figure
 
 NS = svg_figure.NS
 
@@ -166,6 +167,7 @@ def test_matplotlib_draws_the_same_layers() -> None:
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["line", "interval", "gap"]
 
 
+@pytest.mark.slow
 def test_hostile_values_never_reach_the_svg() -> None:
     """Random charts of every layer with NaN, +-inf, empty arrays and values over twelve
     decades: well-formed SVG, and no NaN or infinity in any attribute (a browser would drop

@@ -39,7 +39,11 @@ class Competition:
 
 def use_toy_registry(monkeypatch: pytest.MonkeyPatch) -> None:
     """The registry holds the toy benchmark only (tests/rescore/rescore_toy.py)."""
-    monkeypatch.setattr(registry, "REGISTRY", {"toy": "rescore_toy:TOY"})
+    monkeypatch.setattr(
+        registry,
+        "ENTRIES",
+        (registry.Entry("toy", "tests.rescore.rescore_toy:TOY", "a toy benchmark"),),
+    )
 
 
 def write_offsets(comp_root: Path, offsets: dict[str, float]) -> None:

@@ -1,5 +1,5 @@
 """A toy benchmark registered only by the rescore tests: `ertools rescore` must score it with no
-change to ertools/rescore (adding a benchmark adds it to rescore).
+change to ertools/competition (adding a benchmark adds it to rescore).
 
 A toy "log" is a text file of numbers, one per line. The score of an execution is
 ``mean(numbers) * scale + offset`` (``mode: max``: the largest number instead of the mean), the
@@ -29,7 +29,7 @@ from typing import Any
 
 import yaml
 
-from ertools.benchmarks.base import Benchmark, Input, Ranking, Rows
+from ertools.benchmarks.base import Benchmark, Described, Discovered, Input, Ranking, Rows
 from ertools.errors import BagError, ConfigError, ScoringError, UsageError
 from ertools.fidelity import Deviation
 from ertools.io.formats import detect_format
@@ -128,23 +128,37 @@ def score_runs(loaded: list[float], runs: list[float], options: ToyOptions) -> T
     return ToyResult("toy", base * options.scale + offset, len(runs), offset)
 
 
-TOY = Benchmark(
-    name="toy",
-    title="Toy@Test",
-    summary="a toy benchmark for the rescore tests",
-    example="ertools score toy log.txt",
-    description="mean of the numbers times scale plus the team's offset",
-    epilog="",
-    bags_help="text files of numbers",
-    logs_are_bags=False,
-    inputs=(
+class Toy(Benchmark[ToyOptions, list[float], list[float], ToyResult], Described, Discovered):
+    """Registered as ``tests.rescore.rescore_toy:TOY`` (``rescore_toy:TOY`` by the scripts run
+    from its folder)."""
+
+    name = "toy"
+    title = "Toy@Test"
+    rules = ()
+    example = "ertools score toy log.txt"
+    description = "mean of the numbers times scale plus the team's offset"
+    epilog = ""
+    bags_help = "text files of numbers"
+    logs_are_bags = False
+    log_namespace = "toy"
+    inputs = (
         Input("transform", "path", "the team's offset file", per_team=True),
         Input("scale", "float", "a factor", default=1.0, positive=True),
         Input("mode", "choice", "mean or max", default="mean", choices=("mean", "max")),
-    ),
-    make_options=make_options,
-    load=load,
-    find_runs=find_runs,
-    score_runs=score_runs,
-    ranking=Ranking(key=lambda r: r.value, lower_is_better=True, text="the lowest value wins"),
-)
+    )
+    ranking = Ranking(key=lambda r: r.value, lower_is_better=True, text="the lowest value wins")
+
+    def make_options(self, values: Mapping[str, Any]) -> ToyOptions:
+        return make_options(values)
+
+    def load(self, logs: Sequence[Path], options: ToyOptions) -> list[float]:
+        return load(logs, options)
+
+    def find_runs(self, loaded: list[float], options: ToyOptions) -> list[float]:
+        return find_runs(loaded, options)
+
+    def score_runs(self, loaded: list[float], runs: list[float], options: ToyOptions) -> ToyResult:
+        return score_runs(loaded, runs, options)
+
+
+TOY = Toy()

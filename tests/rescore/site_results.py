@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import unquote, urlsplit
 
-from ertools.rescore import pipeline
+from ertools.competition import pipeline
 
 EVIL = "<script>alert('team')</script>"
 S = 1_000_000_000

@@ -1,4 +1,4 @@
-"""Execution discovery (ertools.rescore.discover) on the sample competition and by hand.
+"""Execution discovery (ertools.competition.discover) on the sample competition and by hand.
 
 The competition's answers.json says, from the generator's own bookkeeping (which file it
 wrote for which execution, when), what a correct discovery finds: every execution with its
@@ -13,14 +13,16 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from timeline.summaries import Summary, Topic
 
+from ertools.competition.discover import Discovery, _gt_only, discover
 from ertools.io.formats import Unreadable
-from ertools.rescore.discover import Discovery, _gt_only, discover
 from ertools.samples.competition_schedule import NO_ROBOT_LOG, TRUNCATED
-from ertools.timeline.build import build_timeline
-from ertools.timeline.model import BagEntry, Pairing
-from ertools.timeline.scan import scan
+from ertools.timelines.build import build_timeline
+from ertools.timelines.model import BagEntry, Pairing
+from ertools.timelines.scan import scan
+from tests.helpers.summaries import Summary, Topic
+
+pytestmark = pytest.mark.slow
 
 S = 1_000_000_000
 T0 = 1_448_013_600 * S  # 2015-11-20 10:00:00 UTC

@@ -1,4 +1,4 @@
-"""The scoring processes' fork server (ertools/rescore/children.py): a scorer never inherits a
+"""The scoring processes' fork server (ertools/competition/children.py): a scorer never inherits a
 lock held by another thread of the process that asked for it. (The command's server is a fork
 of it, its scorers the server's children, and all end with it: test_rescore_faults.py; a
 scorer that dies costs its job only: test_rescore_cli.py, test_rescore_dask.py.)"""
@@ -15,10 +15,10 @@ import textwrap
 from pathlib import Path
 
 import pytest
-from rescore_competition import LOGS, expected_value, make_competition
-from test_rescore_faults import DEADLINE_S, HOLD, TOY_RESCORE, ppid, wait_for
 
-from ertools.rescore.children import SCORING_IMPORTS
+from ertools.competition.children import SCORING_IMPORTS
+from tests.rescore.rescore_competition import LOGS, expected_value, make_competition
+from tests.rescore.test_rescore_faults import DEADLINE_S, HOLD, TOY_RESCORE, ppid, wait_for
 
 HERE = Path(__file__).parent
 ROOT = HERE.parents[1]
@@ -78,7 +78,7 @@ def test_a_lock_held_by_another_thread_is_not_inherited(
             from ertools.benchmarks import registry
             from ertools.cli.main import main
 
-            registry.REGISTRY = {"toy": "rescore_toy:TOY"}
+            registry.ENTRIES = (registry.Entry("toy", "rescore_toy:TOY", "a toy benchmark"),)
             held = threading.Event()
 
             def hold():
@@ -160,7 +160,7 @@ def test_a_server_that_cannot_fork_costs_each_job_its_row(tmp_path: Path) -> Non
             from ertools.benchmarks import registry
             from ertools.cli.main import main
 
-            registry.REGISTRY = {"toy": "rescore_toy:TOY"}
+            registry.ENTRIES = (registry.Entry("toy", "rescore_toy:TOY", "a toy benchmark"),)
             command, fork = os.getpid(), os.fork
 
             def refused():  # in the server only: the command forks the server itself

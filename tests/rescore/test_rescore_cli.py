@@ -14,7 +14,13 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from rescore_competition import (
+
+from ertools.benchmarks import registry
+from ertools.benchmarks.document import score_json
+from ertools.benchmarks.scoring import score_execution
+from ertools.cli.main import main
+from ertools.competition import cache
+from tests.rescore.rescore_competition import (
     LOGS,
     OFFSETS,
     expected_value,
@@ -22,11 +28,6 @@ from rescore_competition import (
     use_toy_registry,
     write_offsets,
 )
-
-from ertools.benchmarks import registry
-from ertools.benchmarks.document import score_json
-from ertools.cli.main import main
-from ertools.rescore import cache
 
 
 @pytest.fixture(autouse=True)
@@ -109,11 +110,13 @@ def test_score_is_the_score_commands_json(tmp_path: Path) -> None:
     toy = registry.get("toy")
     for ident, row in by_id(load(out)).items():
         team = LOGS[ident][0]
-        options = toy.make_options({"scale": 2.0, "transform": comp.transform(team)})
-        assert row["score"] == score_json(toy.score([comp.log(ident)], options))
+        values = {"scale": 2.0, "transform": comp.transform(team)}
+        result = score_execution(toy, [comp.log(ident)], values, check_logs=False).result
+        assert row["score"] == score_json(result)
         assert row["report"] is None
 
 
+@pytest.mark.slow
 def test_a_failure_costs_one_row(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     comp = make_competition(
         tmp_path / "comp",
@@ -234,6 +237,7 @@ class _Terminal(io.StringIO):
         return True
 
 
+@pytest.mark.slow
 def test_progress_bar_on_a_terminal(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     comp = make_competition(
         tmp_path / "comp",

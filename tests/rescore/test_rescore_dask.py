@@ -15,15 +15,24 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from rescore_competition import LOGS, expected_value, make_competition, use_toy_registry
 
 from ertools.cli.main import main
+from tests.rescore.rescore_competition import (
+    LOGS,
+    expected_value,
+    make_competition,
+    use_toy_registry,
+)
+
+pytestmark = pytest.mark.slow
 
 distributed = pytest.importorskip(
     "distributed", reason="needs the dask extra: pip install -e '.[dask]'"
 )
 
-HERE = Path(__file__).parent
+# the root of the clone: the workers import the toy the tests register from it
+# (tests.rescore.rescore_toy)
+ROOT = Path(__file__).resolve().parents[2]
 DASK = Path(sys.executable).with_name("dask")
 # fields that differ between two runs of the same work by nature
 VOLATILE = ("generated", "command", "options")
@@ -64,8 +73,7 @@ def cluster(tmp_path: Path) -> Iterator[str]:
     address = f"tcp://127.0.0.1:{port}"
     env = {
         **os.environ,
-        # the workers import the toy benchmark the test registers (tests/rescore/rescore_toy.py)
-        "PYTHONPATH": os.pathsep.join([str(HERE), os.environ.get("PYTHONPATH", "")]),
+        "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]),
     }
     common = ["--no-dashboard"]
     logs = (tmp_path / "dask.log").open("w")
@@ -154,8 +162,7 @@ def test_local_cluster(
         taken.bind(("", 8787))
         taken.listen()
     use_toy_registry(monkeypatch)
-    monkeypatch.syspath_prepend(str(HERE))
-    monkeypatch.setenv("PYTHONPATH", str(HERE))
+    monkeypatch.setenv("PYTHONPATH", str(ROOT))
     comp = make_competition(tmp_path / "comp")
     out = tmp_path / "out"
     code = main(

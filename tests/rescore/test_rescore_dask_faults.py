@@ -12,13 +12,19 @@ import sys
 from pathlib import Path
 
 import pytest
-from rescore_competition import make_competition
-from test_rescore_dask import DASK, HERE, free_port, worker_command
-from test_rescore_faults import HOLD, TOY_RESCORE, wait_for
+
+from tests.rescore.rescore_competition import make_competition
+from tests.rescore.test_rescore_dask import DASK, free_port, worker_command
+from tests.rescore.test_rescore_faults import HOLD, TOY_RESCORE, wait_for
+
+pytestmark = pytest.mark.slow
 
 distributed = pytest.importorskip(
     "distributed", reason="needs the dask extra: pip install -e '.[dask]'"
 )
+# the toy's folder: tests/rescore/toy_main.py registers it as `rescore_toy`, which the workers
+# import from there
+HERE = Path(__file__).parent
 
 
 def test_the_scheduler_lost_is_one_line(tmp_path: Path) -> None:

@@ -14,15 +14,16 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from fakes import BROWSER
-from site_results import Page, assert_links_resolve, expected_board
-from test_rescore_site_browser import chromium
 
 from ertools.benchmarks import registry
 from ertools.demo import make_competition
+from tests.helpers.fakes import BROWSER
+from tests.rescore.site_results import Page, assert_links_resolve, expected_board
+from tests.rescore.test_rescore_site_browser import chromium
 
 pytestmark = [
     pytest.mark.browser,
+    pytest.mark.slow,
     pytest.mark.skipif(BROWSER is None, reason="chromium not installed (apt-get install chromium)"),
 ]
 

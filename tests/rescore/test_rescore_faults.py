@@ -23,12 +23,17 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from rescore_competition import LOGS, expected_value, make_competition, use_toy_registry
 
 from ertools import atomic
 from ertools.cli.main import main
+from ertools.competition import cache
 from ertools.csvsafe import spreadsheet_safe
-from ertools.rescore import cache
+from tests.rescore.rescore_competition import (
+    LOGS,
+    expected_value,
+    make_competition,
+    use_toy_registry,
+)
 
 HERE = Path(__file__).parent
 TOY_MAIN = HERE / "toy_main.py"
@@ -96,12 +101,13 @@ def _dask_or_skip() -> None:
     pytest.importorskip("distributed", reason="needs the dask extra: pip install -e '.[dask]'")
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 @pytest.mark.parametrize("parallel", [["--jobs", "2"], ["--jobs", "2", "--scheduler", "local"]])
 def test_workers_end_when_the_command_is_killed(parallel: list[str], tmp_path: Path) -> None:
     """kill -9 of `rescore --jobs 2` (local workers, or a Dask LocalCluster) while both
     executions are being scored: every process it started ends too. What it started: one fork
-    server, a fork of the command (it had one thread then: ertools/rescore/children.py), and
+    server, a fork of the command (it had one thread then: ertools/competition/children.py), and
     the two scorers, the server's children."""
     if "--scheduler" in parallel:
         _dask_or_skip()
@@ -140,6 +146,7 @@ def test_workers_end_when_the_command_is_killed(parallel: list[str], tmp_path: P
                 os.kill(p, signal.SIGKILL)
 
 
+@pytest.mark.slow
 def test_a_second_rescore_into_the_same_folder_waits_for_the_first(tmp_path: Path) -> None:
     """Two rescores into one --out take turns: the second says who it waits for, then writes
     results identical to a run alone."""
@@ -205,6 +212,7 @@ def test_a_process_killed_inside_a_write_leaves_the_old_file_whole(tmp_path: Pat
     assert len(leftovers) == 1 and leftovers[0].startswith(".results.json.")
 
 
+@pytest.mark.slow
 def test_concurrent_writers_of_one_file_never_collide(tmp_path: Path) -> None:
     """Two processes rewriting results.json and results.csv 200 times each: every write
     succeeds and every read finds one whole file (the old shared `results.tmp` raced)."""

@@ -11,10 +11,10 @@ from pathlib import Path
 from urllib.parse import unquote
 
 import pytest
-from stderr_text import joined_lines
 
 from ertools.cli.main import main
-from ertools.rescore.site import write_site
+from ertools.competition.site import write_site
+from tests.helpers.stderr_text import joined_lines
 
 ROOT = Path(__file__).resolve().parents[2]
 FBM3W_BAG = ROOT / "sample_bags" / "fbm3w" / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
@@ -62,6 +62,7 @@ def test_check_verifies_every_listed_bag_is_a_bag(
     assert main(["rescore", "--config", str(good), "--check"]) == 0
 
 
+@pytest.mark.slow
 def test_a_symlinked_non_bag_leaks_nothing_into_any_output(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -112,6 +113,7 @@ def assert_relative_links(page: str) -> list[str]:
     return links
 
 
+@pytest.mark.slow
 def test_report_links_a_folder_named_like_a_url_as_a_relative_path(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -7,8 +7,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ertools.benchmarks import registry
-from ertools.rescore.ledger import Claim, account, place_files
-from ertools.rescore.site_text import (
+from ertools.competition.ledger import Claim, account, place_files
+from ertools.competition.site_text import (
     Paths,
     deviation_terms,
     difference,

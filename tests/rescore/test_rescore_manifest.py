@@ -5,13 +5,13 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from rescore_competition import make_competition, use_toy_registry
-from stderr_text import joined_lines
 
 from ertools.benchmarks import registry
 from ertools.cli.main import main
+from ertools.competition.manifest import ManifestError, load_manifest
 from ertools.errors import ConfigError
-from ertools.rescore.manifest import ManifestError, load_manifest
+from tests.helpers.stderr_text import joined_lines
+from tests.rescore.rescore_competition import make_competition, use_toy_registry
 
 
 @pytest.fixture(autouse=True)
@@ -135,9 +135,8 @@ def test_missing_manifest_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixt
 def test_a_choice_that_takes_a_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """FBM2H's `--reached timing FILE`: `[timing, FILE]` in a manifest, the file checked."""
 
-    monkeypatch.setattr(
-        registry, "REGISTRY", {"fbm2h": "ertools.benchmarks.fbm2h.declare:BENCHMARK"}
-    )
+    fbm2h = registry.Entry("fbm2h", ".fbm2h.declare", "FBM2@Home")  # besides the toy's
+    monkeypatch.setattr(registry, "ENTRIES", (fbm2h,))
     (tmp_path / "timing.yaml").write_text("[]\n")
     path = tmp_path / "competition.yaml"
     path.write_text("benchmarks:\n  fbm2h:\n    inputs: {reached: [timing, timing.yaml]}\n")

@@ -1,4 +1,4 @@
-"""What a rescore remembers of each log between runs (ertools.rescore.memo): a warm rerun
+"""What a rescore remembers of each log between runs (ertools.competition.memo): a warm rerun
 reads no log to discover the executions, finds what it found the first time, and reads again
 exactly the logs that changed."""
 
@@ -10,9 +10,9 @@ from typing import Any
 
 import pytest
 
-from ertools.rescore import found as found_module
-from ertools.rescore.found import find
-from ertools.rescore.memo import FileMemo
+from ertools.competition import found as found_module
+from ertools.competition.found import find
+from ertools.competition.memo import FileMemo
 
 
 def test_a_fact_is_computed_once_per_version_of_the_file(tmp_path: Path) -> None:
@@ -78,6 +78,7 @@ def _counting(monkeypatch: pytest.MonkeyPatch) -> dict[str, int]:
     return counts
 
 
+@pytest.mark.slow
 def test_a_warm_discovery_reads_no_log_and_finds_the_same(
     sample_competition: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -29,10 +29,12 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from fakes import BROWSER, CHROMIUM_FLAGS
 
 from ertools.cli.main import main
-from ertools.rescore.manifest import load_manifest
+from ertools.competition.manifest import load_manifest
+from tests.helpers.fakes import BROWSER, CHROMIUM_FLAGS
+
+pytestmark = pytest.mark.slow
 
 REPO = Path(__file__).resolve().parents[2]
 SAMPLES = REPO / "sample_bags"

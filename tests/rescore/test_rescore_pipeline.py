@@ -6,11 +6,22 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from rescore_competition import LOGS, expected_value, make_competition, use_toy_registry
 
 from ertools.benchmarks import registry
-from ertools.rescore.manifest import load_manifest
-from ertools.rescore.pipeline import Scoring, leaderboards, listed_executions, rescore, score_argv
+from ertools.competition.manifest import load_manifest
+from ertools.competition.pipeline import (
+    Scoring,
+    leaderboards,
+    listed_executions,
+    rescore,
+    score_argv,
+)
+from tests.rescore.rescore_competition import (
+    LOGS,
+    expected_value,
+    make_competition,
+    use_toy_registry,
+)
 
 
 @pytest.fixture(autouse=True)
@@ -129,8 +140,7 @@ def test_score_argv_is_the_score_command(tmp_path: Path) -> None:
         "--team",
         "x",
     ]
-    registry.REGISTRY["fbm2h"] = "ertools.benchmarks.fbm2h.declare:BENCHMARK"
-    fbm2h = registry.get("fbm2h")
+    fbm2h = registry.load("ertools.benchmarks.fbm2h.declare:BENCHMARK")
     values = {"reached": ("timing", Path("t.yaml")), "team": "homer", "orientation_2015": True}
     assert score_argv(fbm2h, [Path("r.bag")], values, "homer") == [
         "ertools",

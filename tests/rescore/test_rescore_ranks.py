@@ -21,10 +21,10 @@ import re
 from pathlib import Path
 
 import pytest
-from site_results import EVIL, Page, ranked_document, write_folder
 
-from ertools.rescore.pipeline import csv_text
-from ertools.rescore.site import write_site
+from ertools.competition.pipeline import csv_text
+from ertools.competition.site import write_site
+from tests.rescore.site_results import EVIL, Page, ranked_document, write_folder
 
 Z95 = 1.959963984540054
 

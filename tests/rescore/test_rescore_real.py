@@ -19,7 +19,7 @@ GOAL = REAL / "fbm2h_test_optitrackless_goal.yaml"
 TIMING = REAL / "log_fbm2h_mocap_2015-10-23-16-15-40_0_reached_waypoint_timing.yaml"
 IDENTITY = Path(__file__).resolve().parents[2] / "configs" / "transform-identity.yaml"
 
-pytestmark = pytest.mark.real
+pytestmark = [pytest.mark.real, pytest.mark.slow]
 
 
 def test_real_bag_scores_as_the_score_command(tmp_path: Path) -> None:

@@ -20,14 +20,14 @@ from typing import Any
 
 import pytest
 import yaml
-from rescore_competition import OFFSETS, SCALE, make_competition, use_toy_registry
 
 from ertools.cli.main import main
+from ertools.competition import pipeline
+from ertools.competition.jobs import Job, run_job
+from ertools.competition.memo import FileMemo
 from ertools.errors import BagError, ConfigError, transient_error, watching
 from ertools.io.formats import detect_format
-from ertools.rescore import pipeline
-from ertools.rescore.jobs import Job, run_job
-from ertools.rescore.memo import FileMemo
+from tests.rescore.rescore_competition import OFFSETS, SCALE, make_competition, use_toy_registry
 
 SAMPLES = Path(__file__).resolve().parents[2] / "sample_bags" / "fbm3w"
 FBM3W_BAG = SAMPLES / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
@@ -96,6 +96,7 @@ def around_scoring(monkeypatch: pytest.MonkeyPatch, before: Any, after: Any) -> 
 # --- finding 1: a file missing for a moment -------------------------------------------------
 
 
+@pytest.mark.slow
 def test_a_log_missing_for_a_moment_is_not_cached(
     fbm3w_day: tuple[Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -142,6 +143,7 @@ def test_a_missing_file_is_a_transient_error(tmp_path: Path) -> None:
         assert not BagError("corrupt bz2 chunk").transient
 
 
+@pytest.mark.slow
 def test_a_problem_of_the_moment_met_and_handled_is_not_cached(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -174,7 +176,7 @@ def test_an_unwritable_report_folder_is_not_cached(tmp_path: Path) -> None:
     job = Job(
         "toy-1",
         "toy",
-        "rescore_toy:TOY",
+        "tests.rescore.rescore_toy:TOY",
         None,
         (str(log),),
         report_dir=str(blocker / "report"),
@@ -219,6 +221,7 @@ def test_watching_sees_errors_handled_inside() -> None:
 # --- finding 2: a file replaced while it is scored ------------------------------------------
 
 
+@pytest.mark.slow
 def test_a_log_replaced_after_it_was_scored_keeps_the_scored_hash(
     fbm3w_day: tuple[Path, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -309,6 +312,7 @@ def test_check_names_an_execution_listed_twice(
     assert "2 listed executions" in lines[-1] and len(lines) == 2
 
 
+@pytest.mark.slow
 def test_an_execution_listed_many_times_is_scored_once(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -14,7 +14,9 @@ from typing import Any
 import pytest
 
 from ertools.cli.main import main
-from ertools.rescore.manifest import load_manifest
+from ertools.competition.manifest import load_manifest
+
+pytestmark = pytest.mark.slow
 
 SEED = 2015_11_20
 # robotto lost its USB key after its second FBM3W: nothing in the logs names the team of that

@@ -1,12 +1,12 @@
-"""The order executions go to the workers (ertools.rescore.schedule): one of each benchmark
+"""The order executions go to the workers (ertools.competition.schedule): one of each benchmark
 first to learn its cost, then the longest mean first; a day's last execution is a short one."""
 
 from __future__ import annotations
 
 import heapq
 
-from ertools.rescore.jobs import Job, Outcome
-from ertools.rescore.schedule import Schedule
+from ertools.competition.jobs import Job, Outcome
+from ertools.competition.schedule import Schedule
 
 
 def jobs(*benchmarks: str) -> list[Job]:

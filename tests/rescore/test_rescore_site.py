@@ -1,23 +1,19 @@
-"""The results site (ertools.rescore.site) from a hand-built results document."""
+"""The results site (ertools.competition.site) from a hand-built results document."""
 
 from __future__ import annotations
 
 import json
-import sys
 from pathlib import Path
 from typing import Any
 from urllib.parse import unquote, urlsplit
 
 import pytest
-from site_results import EVIL, Page, expected_board, results, write_folder
 
+from ertools.competition.site import ranked, write_site
 from ertools.errors import ConfigError
-from ertools.rescore.site import ranked, write_site
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "timeline"))
-from timeline_day import day_timeline
-
 from ertools.report.timeline_page import write_timeline_page
+from tests.helpers.timeline_day import day_timeline
+from tests.rescore.site_results import EVIL, Page, expected_board, results, write_folder
 
 
 def build(out: Path) -> tuple[dict[str, Any], Path]:

@@ -9,15 +9,19 @@ errors. Skipped, saying why, where Chromium is not installed (``apt-get install 
 from __future__ import annotations
 
 import subprocess
-import sys
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
-from fakes import BROWSER, CHROMIUM_FLAGS
 from matplotlib.image import imread
-from site_results import (
+
+from ertools.competition.site import write_site
+from ertools.report.timeline_page import write_timeline_page
+from ertools.report.timeline_style import KIND_COLORS
+from tests.helpers.fakes import BROWSER, CHROMIUM_FLAGS
+from tests.helpers.timeline_day import day_timeline
+from tests.rescore.site_results import (
     EVIL,
     Page,
     assert_links_resolve,
@@ -27,15 +31,9 @@ from site_results import (
     write_folder,
 )
 
-from ertools.report.timeline_page import write_timeline_page
-from ertools.report.timeline_style import KIND_COLORS
-from ertools.rescore.site import write_site
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "timeline"))
-from timeline_day import day_timeline
-
 pytestmark = [
     pytest.mark.browser,
+    pytest.mark.slow,
     pytest.mark.skipif(BROWSER is None, reason="chromium not installed (apt-get install chromium)"),
 ]
 

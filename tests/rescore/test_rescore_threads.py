@@ -1,6 +1,6 @@
 """Two rescorings at once in one process (issue 36, finding 16): ``ertools.rescore`` called from
 two threads, each into its own folder with two workers, share the process's fork server
-(ertools/rescore/children.py); neither may close what the other still uses, nor see the other's
+(ertools/competition/children.py); neither may close what the other still uses, nor see the other's
 warnings in its rows.
 
 The calls run in a script of their own (a library caller's process, as a notebook's): the first
@@ -18,7 +18,10 @@ import textwrap
 from pathlib import Path
 
 import pytest
-from rescore_competition import LOGS, OFFSETS, SCALE, expected_value, make_competition
+
+from tests.rescore.rescore_competition import LOGS, OFFSETS, SCALE, expected_value, make_competition
+
+pytestmark = pytest.mark.slow
 
 HERE = Path(__file__).parent
 ROUNDS = 3
@@ -32,11 +35,11 @@ from pathlib import Path
 sys.path.insert(0, sys.argv[1])
 from ertools.benchmarks import registry
 
-registry.REGISTRY = {"toy": "rescore_toy:TOY"}
+registry.ENTRIES = (registry.Entry("toy", "rescore_toy:TOY", "a toy benchmark"),)
 import logging
 
 import ertools
-from ertools.rescore import children
+from ertools.competition import children
 
 base, rounds, jobs = Path(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
 logging.getLogger("ertools").addHandler(logging.NullHandler())

@@ -4,12 +4,11 @@ of the tool."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
-from rescore_toy import TOY, ToyOptions, ToyResult
-
-from ertools.rescore.jobs import Job, run_job
+from ertools.competition.jobs import Job, run_job
+from tests.rescore.rescore_toy import Toy, ToyOptions, ToyResult
 
 REASON = "valid data covers only 61.0% of the window (12 tracking_lost); at least 90% is needed"
 
@@ -26,13 +25,22 @@ def _score_thin(loaded: list[float], runs: list[float], options: ToyOptions) -> 
     return ThinResult("thin", mean, len(runs), 0.0, unscoreable_reason=reason)
 
 
-THIN = replace(TOY, name="thin", score_runs=_score_thin)
+class Thin(Toy):
+    """The toy whose scorer says when its data is too thin."""
+
+    name = "thin"
+
+    def score_runs(self, loaded: list[float], runs: list[float], options: ToyOptions) -> ThinResult:
+        return _score_thin(loaded, runs, options)
+
+
+THIN = Thin()
 
 
 def _job(tmp_path: Path, numbers: str) -> Job:
     log = tmp_path / "thin.txt"
     log.write_text(numbers, encoding="utf-8")
-    return Job("thin-1", "thin", "test_rescore_unscoreable:THIN", "team", (str(log),))
+    return Job("thin-1", "thin", "tests.rescore.test_rescore_unscoreable:THIN", "team", (str(log),))
 
 
 def test_an_unscoreable_execution_is_a_verdict(tmp_path: Path) -> None:

@@ -4,15 +4,9 @@ left out, anything the results say is compared exactly."""
 from __future__ import annotations
 
 import copy
-import sys
-from pathlib import Path
 from typing import Any
 
-BENCH = Path(__file__).resolve().parents[2] / "bench"
-if str(BENCH) not in sys.path:
-    sys.path.insert(0, str(BENCH))
-
-from season_compare import comparable, compare, differences  # noqa: E402
+from season_compare import comparable, compare, differences
 
 
 def doc() -> dict[str, Any]:

@@ -5,13 +5,11 @@ benchmark as the only one registered, for the tests that run rescore as a proces
 from __future__ import annotations
 
 import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).parent))
 
 from ertools.benchmarks import registry
 from ertools.cli.main import main
 
 if __name__ == "__main__":
-    registry.REGISTRY = {"toy": "rescore_toy:TOY"}
+    # run as a script, whose folder (tests/rescore, rescore_toy's) heads sys.path
+    registry.ENTRIES = (registry.Entry("toy", "rescore_toy:TOY", "a toy benchmark"),)
     raise SystemExit(main(sys.argv[1:]))

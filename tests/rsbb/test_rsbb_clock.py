@@ -7,10 +7,10 @@ from __future__ import annotations
 from typing import Any
 
 import pytest
-from rsbb_replay.world import GoalObject, TGoal, Timeline, World
 
 from ertools.rsbb.clock import goal_times
 from ertools.rsbb.log import GoalEvent, GoalOutcome
+from tests.helpers.rsbb_replay.world import GoalObject, TGoal, Timeline, World
 
 S = 1_000_000_000
 T0 = 1_555_000_000 * S

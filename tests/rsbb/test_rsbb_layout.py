@@ -7,11 +7,11 @@ from datetime import datetime
 from pathlib import Path
 
 import pytest
-from rsbb_replay.scenarios import at, hnf_scenario
 
 from ertools.errors import UsageError
 from ertools.rsbb.layout import FileKind, classify, pair_runs, scan
-from ertools.samples.rsbb import write_rsbb_run
+from ertools.simulator.rsbb import write_rsbb_run
+from tests.helpers.rsbb_replay.scenarios import at, hnf_scenario
 
 
 def test_classify_run_bags_results_and_side_files() -> None:

@@ -7,10 +7,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from rsbb_replay.scenarios import MS, at, hnf_scenario
 
 from ertools.errors import TopicError
-from ertools.io import read_messages, topics
+from ertools.io.reader import read_messages, topics
 from ertools.rsbb.log import (
     EndKind,
     GoalOutcome,
@@ -20,9 +19,10 @@ from ertools.rsbb.log import (
     read_script_broadcasts,
 )
 from ertools.rsbb_states import BENCHMARKS, BMBOX_STATE_TOPIC, REFBOX_STATE_TOPIC, RefBoxState
-from ertools.samples.rsbb import write_rsbb_run
-from ertools.samples.rsbb_scenario import live_score_text, result_object
-from ertools.samples.writer import BagWriter
+from ertools.simulator.rsbb import write_rsbb_run
+from ertools.simulator.rsbb_scenario import live_score_text, result_object
+from ertools.simulator.writer import BagWriter
+from tests.helpers.rsbb_replay.scenarios import MS, at, hnf_scenario
 
 pytestmark = pytest.mark.slow  # each writes and reads a run bag (~0.5-1 s)
 

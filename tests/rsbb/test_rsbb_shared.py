@@ -12,12 +12,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from inprocess import run as ertools
-from rsbb_replay.fromlog import timeline_from_bag
-from rsbb_replay.py2 import euler_yaw as replay_yaw
-from rsbb_replay.scenarios import MS, T0, at, hnf_scenario
-from rsbb_replay.tf2 import Buffer
-from stderr_text import joined_lines
 
 from ertools.errors import ConfigError
 from ertools.rsbb.log import check_code, logged_code, read_rsbb_run
@@ -33,9 +27,15 @@ from ertools.rsbb.tf import (
     script_poses,
 )
 from ertools.rsbb_states import BENCHMARKS
-from ertools.samples.mocap import MocapNoise, frame_times, simulate_mocap
-from ertools.samples.rsbb import write_rsbb_run
-from ertools.samples.rsbb_scenario import Body, Broadcast
+from ertools.simulator.mocap import MocapNoise, frame_times, simulate_mocap
+from ertools.simulator.rsbb import write_rsbb_run
+from ertools.simulator.rsbb_scenario import Body, Broadcast
+from tests.helpers.inprocess import run as ertools
+from tests.helpers.rsbb_replay.fromlog import timeline_from_bag
+from tests.helpers.rsbb_replay.py2 import euler_yaw as replay_yaw
+from tests.helpers.rsbb_replay.scenarios import MS, T0, at, hnf_scenario
+from tests.helpers.rsbb_replay.tf2 import Buffer
+from tests.helpers.stderr_text import joined_lines
 
 S = 1_000_000_000
 TEAM = ((0.12, -0.05, 0.31), (0.0, 0.0, 0.38, 0.92))  # |q| = 0.9954: broadcast as written

@@ -6,9 +6,16 @@ import math
 
 import pytest
 
-from rsbb_replay.hand import MS, T0, S, yaw_quat
-from rsbb_replay.py2 import dump_none, dump_pose2d, euler_yaw, py2_round, py2_str, to_sec
-from rsbb_replay.tf2 import Buffer, TfError
+from tests.helpers.rsbb_replay.hand import MS, T0, S, yaw_quat
+from tests.helpers.rsbb_replay.py2 import (
+    dump_none,
+    dump_pose2d,
+    euler_yaw,
+    py2_round,
+    py2_str,
+    to_sec,
+)
+from tests.helpers.rsbb_replay.tf2 import Buffer, TfError
 
 
 def test_python2_round_rounds_ties_away_from_zero() -> None:

@@ -14,13 +14,13 @@ from pathlib import Path
 
 import pytest
 
-from ertools.samples.rsbb import write_rsbb_run
-from ertools.samples.rsbb_scenario import Broadcast, Goal, ManualOperation, Save
-from rsbb_replay import hgmf, hnf, hopf, hpff, hppf
-from rsbb_replay.fromlog import timeline_from_bag
-from rsbb_replay.py2 import dump_pose2d
-from rsbb_replay.scenarios import MS, at, hnf_scenario, still_body
-from rsbb_replay.world import World, run_script
+from ertools.simulator.rsbb import write_rsbb_run
+from ertools.simulator.rsbb_scenario import Broadcast, Goal, ManualOperation, Save
+from tests.helpers.rsbb_replay import hgmf, hnf, hopf, hpff, hppf
+from tests.helpers.rsbb_replay.fromlog import timeline_from_bag
+from tests.helpers.rsbb_replay.py2 import dump_pose2d
+from tests.helpers.rsbb_replay.scenarios import MS, at, hnf_scenario, still_body
+from tests.helpers.rsbb_replay.world import World, run_script
 
 pytestmark = pytest.mark.slow  # writes and reads a run bag (~0.6 s)
 

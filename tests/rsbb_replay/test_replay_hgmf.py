@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import pytest
 
-from rsbb_replay import hgmf
-from rsbb_replay.hand import MS, T0, S, body, steps, still
-from rsbb_replay.world import TGoal, Timeline, TManual, World, run_script
+from tests.helpers.rsbb_replay import hgmf
+from tests.helpers.rsbb_replay.hand import MS, T0, S, body, steps, still
+from tests.helpers.rsbb_replay.world import TGoal, Timeline, TManual, World, run_script
 
 OBJECTS = [{"id": 1, "description": "Brick"}, {"id": 2, "description": "Cube"}]
 PARAMS = {"objects": OBJECTS, "table_size": {"x": 1.0, "y": 1.5}, "goal_timeout": 120.0}

@@ -6,10 +6,10 @@ from math import atan2, cos, pi, sin
 
 import pytest
 
-from rsbb_replay import hnf
-from rsbb_replay.hand import MS, T0, S, body, steps, still
-from rsbb_replay.py2 import dump_none, dump_pose2d
-from rsbb_replay.world import TGoal, Timeline, TManual, World, run_script
+from tests.helpers.rsbb_replay import hnf
+from tests.helpers.rsbb_replay.hand import MS, T0, S, body, steps, still
+from tests.helpers.rsbb_replay.py2 import dump_none, dump_pose2d
+from tests.helpers.rsbb_replay.world import TGoal, Timeline, TManual, World, run_script
 
 IDENTITY = [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]]
 PARAMS = {"starting_pose": [0.0, 0.0, 0.0], "goal_timeout": 120.0}

@@ -10,9 +10,9 @@ from math import pi
 
 import pytest
 
-from rsbb_replay import hopf
-from rsbb_replay.hand import MS, T0, S, body, still
-from rsbb_replay.world import TGoal, Timeline, TManual, World, run_script
+from tests.helpers.rsbb_replay import hopf
+from tests.helpers.rsbb_replay.hand import MS, T0, S, body, still
+from tests.helpers.rsbb_replay.world import TGoal, Timeline, TManual, World, run_script
 
 ITEMS = [
     {

@@ -12,10 +12,10 @@ from collections.abc import Callable
 
 import pytest
 
-from rsbb_replay import hpff
-from rsbb_replay.hand import MS, T0, S, body, still
-from rsbb_replay.tf2 import Quat, Vec
-from rsbb_replay.world import TGoal, Timeline, World, run_script
+from tests.helpers.rsbb_replay import hpff
+from tests.helpers.rsbb_replay.hand import MS, T0, S, body, still
+from tests.helpers.rsbb_replay.tf2 import Quat, Vec
+from tests.helpers.rsbb_replay.world import TGoal, Timeline, World, run_script
 
 pytestmark = pytest.mark.slow  # runs of several hundred samples: seconds each
 

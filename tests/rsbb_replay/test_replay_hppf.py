@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import pytest
 
-from rsbb_replay import hppf
-from rsbb_replay.hand import MS, T0, S, body, still
-from rsbb_replay.world import TGoal, Timeline, TManual, World, run_script
+from tests.helpers.rsbb_replay import hppf
+from tests.helpers.rsbb_replay.hand import MS, T0, S, body, still
+from tests.helpers.rsbb_replay.world import TGoal, Timeline, TManual, World, run_script
 
 
 def _timeline(people: list[str], order: list[str]) -> Timeline:

@@ -20,12 +20,14 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from simd_paths import baseline_env
 
 from ertools.benchmarks.common.teams import parse_robot_log_name
 from ertools.cli.main import main
 from ertools.samples.__main__ import main as samples_main
 from ertools.samples.competition_schedule import MISSING_TRANSFORM, SCHEDULE, TRUNCATED
+from tests.helpers.simd_paths import baseline_env
+
+pytestmark = pytest.mark.slow
 
 SEED = 2015_11_20
 UNSCOREABLE = sorted(

@@ -9,7 +9,7 @@ import pytest
 from rosbags.highlevel import AnyReader
 
 from ertools.geometry import quat_from_yaw, yaw_from_quat
-from ertools.samples.mocap import (
+from ertools.simulator.mocap import (
     MocapNoise,
     TrackingLoss,
     frame_times,
@@ -19,7 +19,7 @@ from ertools.samples.mocap import (
     random_losses,
     simulate_mocap,
 )
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 
 T0 = 1_448_013_600_000_000_000
 
@@ -97,6 +97,7 @@ def test_random_losses_are_seeded_and_inside() -> None:
     assert all(t[120] <= x.t_ns <= t[-121] and 2 <= x.repeat_frames <= 6 for x in a)
 
 
+@pytest.mark.slow
 def test_published_topics(tmp_path: Path) -> None:
     t, xyz, quat = _circle(5.0)
     pub = simulate_mocap(t, xyz, quat, rng=np.random.default_rng(2))

@@ -14,17 +14,12 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from floats import FLOAT_ATOL, FLOAT_RTOL, same_text
 from rosbags.highlevel import AnyReader
 
 from ertools.samples.__main__ import main
-from ertools.samples.scenario import (
-    SCENARIOS,
-    ScenarioMissingError,
-    answers_path,
-    load_scenario,
-    log_name,
-)
+from ertools.samples.scenario import SCENARIOS, ScenarioMissingError, load_scenario
+from ertools.simulator.answers import answers_path, log_name
+from tests.helpers.floats import FLOAT_ATOL, FLOAT_RTOL, same_text
 
 REPO = Path(__file__).resolve().parents[2]
 SAMPLE_BAGS = REPO / "sample_bags"
@@ -38,6 +33,7 @@ def _files(root: Path) -> dict[str, bytes]:
     }
 
 
+@pytest.mark.slow
 def test_stationary_answers_match_the_bag(tmp_path: Path) -> None:
     paths = load_scenario("stationary")(tmp_path, seed=11)
     bag = next(p for p in paths if p.suffix == ".bag")
@@ -79,6 +75,7 @@ def test_stationary_answers_match_the_bag(tmp_path: Path) -> None:
     assert bag.stat().st_size < 2_600_000
 
 
+@pytest.mark.slow
 def test_stationary_is_byte_identical_on_rerun(tmp_path: Path) -> None:
     assert main([str(tmp_path / "a"), "--only", "stationary"]) == 0
     assert main([str(tmp_path / "b"), "--only", "stationary"]) == 0
@@ -89,6 +86,7 @@ def test_stationary_is_byte_identical_on_rerun(tmp_path: Path) -> None:
     assert _files(tmp_path / "c") != a
 
 
+@pytest.mark.slow
 def test_rerun_replaces_a_scenario_folder(tmp_path: Path) -> None:
     assert main([str(tmp_path), "--only", "stationary"]) == 0
     (tmp_path / "stationary" / "stale.txt").write_text("old")
@@ -97,13 +95,14 @@ def test_rerun_replaces_a_scenario_folder(tmp_path: Path) -> None:
     assert not list(tmp_path.glob(".*partial"))
 
 
+@pytest.mark.slow
 def test_missing_scenario_module_is_an_error_naming_it(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     monkeypatch.setitem(SCENARIOS, "ghost", "ertools.samples.no_such_module:generate")
     with pytest.raises(ScenarioMissingError, match="no_such_module"):
         load_scenario("ghost")
-    monkeypatch.setitem(SCENARIOS, "ghost", "ertools.samples.stationary:nope")
+    monkeypatch.setitem(SCENARIOS, "ghost", "ertools.benchmarks.noise.sample:nope")
     assert main([str(tmp_path), "--only", "stationary"]) == 0
     # argparse choices were built from SCENARIOS at call time, so "ghost" is accepted.
     assert main([str(tmp_path / "x"), "--only", "ghost", "stationary"]) == 1
@@ -193,6 +192,7 @@ def _differences(
     return found
 
 
+@pytest.mark.slow
 def test_sample_bags_folder_regenerates_but_for_float_rounding(tmp_path: Path) -> None:
     missing = []
     for name in SCENARIOS:

@@ -17,7 +17,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from simd_paths import baseline_env, unpinned_env
+import pytest
 
 from ertools.samples.scenario import SCENARIOS
 from ertools.samples.simd import (
@@ -28,6 +28,7 @@ from ertools.samples.simd import (
     pinned_env,
     pinned_targets,
 )
+from tests.helpers.simd_paths import baseline_env, unpinned_env
 
 
 def _generate(out: Path, env: dict[str, str]) -> dict[str, bytes]:
@@ -43,6 +44,7 @@ def _generate(out: Path, env: dict[str, str]) -> dict[str, bytes]:
     return {str(p.relative_to(out)): p.read_bytes() for p in sorted(out.rglob("*")) if p.is_file()}
 
 
+@pytest.mark.slow
 def test_the_samples_do_not_depend_on_numpys_simd_path(tmp_path: Path) -> None:
     as_run = _generate(tmp_path / "a", unpinned_env())
     baseline = _generate(tmp_path / "b", baseline_env())
@@ -87,6 +89,7 @@ def test_the_command_pins_numpy_and_openblas_once() -> None:
     }
 
 
+@pytest.mark.slow
 def test_the_printed_targets_leave_numpy_its_baseline() -> None:
     """``python -m ertools.samples.simd`` (the Makefile's value of the variable) switches off
     every dispatched target: NumPy, imported with it, reports none of them."""

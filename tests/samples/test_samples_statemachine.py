@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
 
-from ertools.samples.statemachine import Transition, machine_messages, publish_states
-from ertools.samples.writer import BagWriter
+from ertools.simulator.statemachine import Transition, machine_messages, publish_states
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 
 T0 = 1_448_013_600_000_000_000

@@ -13,8 +13,8 @@ from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Reader
 
 from ertools.errors import UsageError
-from ertools.samples.packing import pack_messages
-from ertools.samples.writer import FORMATS, BagWriter
+from ertools.simulator.packing import pack_messages
+from ertools.simulator.writer import FORMATS, BagWriter
 from ertools.states import MSG_TYPES, BmBoxState, ClientState, Machine
 
 T0 = 1_448_013_600_123_456_789
@@ -109,6 +109,7 @@ def _write_everything(path: Path, fmt: str) -> dict[str, object]:
     return {"t_hdr": t_hdr, "xyz": xyz, "quat": quat, "yaw": yaw}
 
 
+@pytest.mark.slow_cases("rosbag2-mcap")
 @pytest.mark.parametrize("fmt", FORMATS)
 def test_round_trip_every_format(tmp_path: Path, fmt: str) -> None:
     path = _path(tmp_path, fmt)
@@ -264,6 +265,8 @@ def test_ros2_compressed_round_trip(tmp_path: Path, fmt: str, compression: str) 
     assert xs == list(np.arange(2000.0))
 
 
+@pytest.mark.slow
+@pytest.mark.xdist_group("timing")
 def test_bulk_write_speed(tmp_path: Path) -> None:
     n = 100_000
     t = T0 + np.arange(n, dtype=np.int64) * 8_333_333

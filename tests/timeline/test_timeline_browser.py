@@ -14,15 +14,15 @@ from html.parser import HTMLParser
 from pathlib import Path
 
 import pytest
-from fakes import BROWSER, CHROMIUM_FLAGS
-from test_timeline_pictures import expected_day
-from timeline_day import EVIL, EVIL_IMG, S, day_timeline
 
 from ertools.report.timeline_page import write_timeline_page
-from ertools.timeline.model import Timeline
-from ertools.timeline.scan import scan
+from ertools.timelines.model import Timeline
+from ertools.timelines.scan import scan
+from tests.helpers.fakes import BROWSER, CHROMIUM_FLAGS
+from tests.helpers.timeline_day import EVIL, EVIL_IMG, S, day_timeline
+from tests.timeline.test_timeline_pictures import expected_day
 
-pytestmark = pytest.mark.browser
+pytestmark = [pytest.mark.browser, pytest.mark.slow]
 
 FLAGS = [
     *CHROMIUM_FLAGS,

@@ -12,22 +12,23 @@ from typing import Any
 
 import numpy as np
 import pytest
-from summaries import BAG_KEYS
 
-import ertools.timeline.scan as ts
+import ertools.timelines.scan as ts
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
 from ertools.io.formats import find_bags
 from ertools.io.model import ClockCheck
 from ertools.progress import reporting
-from ertools.samples.writer import BagWriter
-from ertools.timeline.scan import scan
+from ertools.simulator.writer import BagWriter
+from ertools.timelines.scan import scan
+from tests.helpers.summaries import BAG_KEYS
 
 
 def rel(root: Path, path: str) -> str:
     return str(Path(path).relative_to(root))
 
 
+@pytest.mark.slow
 def test_scan_matches_the_answers(folder: dict[str, Any]) -> None:
     root, ans = folder["root"], folder["answers"]
     tl = scan([root])
@@ -69,6 +70,7 @@ def test_pairings_match_the_answers(folder: dict[str, Any]) -> None:
             assert g == pytest.approx(e, abs=2e-3)  # grid step 1 ms, both ends
 
 
+@pytest.mark.slow
 def test_problems_match_the_answers(folder: dict[str, Any]) -> None:
     root, ans = folder["root"], folder["answers"]
     tl = scan([root])
@@ -124,6 +126,7 @@ def test_cli_csv_and_table(folder: dict[str, Any], capsys: pytest.CaptureFixture
     assert "sessions:" in out and "GT coverage" in out and "problems (" in out
 
 
+@pytest.mark.slow
 def test_cli_plot(
     folder: dict[str, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

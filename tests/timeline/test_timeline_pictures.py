@@ -19,13 +19,22 @@ import matplotlib.dates as mdates
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import to_hex
-from timeline_day import DAY0, EVIL, EVIL_IMG, SESSIONS, UNREADABLE, S, day_timeline, many_bags
 
 from ertools.cli.main import main
 from ertools.report.plots_timeline import timeline_figure
 from ertools.report.timeline_page import timeline_page
-from ertools.timeline.model import Timeline
-from ertools.timeline.scan import scan
+from ertools.timelines.model import Timeline
+from ertools.timelines.scan import scan
+from tests.helpers.timeline_day import (
+    DAY0,
+    EVIL,
+    EVIL_IMG,
+    SESSIONS,
+    UNREADABLE,
+    S,
+    day_timeline,
+    many_bags,
+)
 
 REAL = Path(__file__).resolve().parents[2] / ".." / "shared" / "real_bags"
 REAL_BAG = REAL / "log_fbm2h_mocap_2015-10-23-16-15-40_0.bag"
@@ -198,6 +207,8 @@ def test_page_of_the_real_bag() -> None:
     check_page(page, tl, [label], [REAL_BAG.name])
 
 
+@pytest.mark.slow
+@pytest.mark.xdist_group("timing")
 def test_page_of_1000_bags_is_built_quickly() -> None:
     tl = many_bags(1000)
     t = time.perf_counter()
@@ -219,6 +230,7 @@ def session_axes(fig: Any) -> dict[int, Any]:
     }
 
 
+@pytest.mark.slow
 def test_figure_has_one_panel_per_session_spanning_it() -> None:
     tl = day_timeline()
     fig = timeline_figure(tl)
@@ -239,6 +251,7 @@ def test_figure_has_one_panel_per_session_spanning_it() -> None:
     assert bar.get_width() / (hi - lo) == pytest.approx(8.0 / 8.8, abs=1e-6)
 
 
+@pytest.mark.slow
 def test_figure_colours_match_the_legend_and_problems_are_numbered() -> None:
     tl = day_timeline()
     fig = timeline_figure(tl)
@@ -298,6 +311,7 @@ def test_table_times_stay_on_one_line() -> None:
     assert len(spans) == 2 * (len(tl.sessions) + len(readable))  # start and end of each
 
 
+@pytest.mark.slow
 def test_figure_problem_list_fits_the_picture() -> None:
     """The numbered problems are listed within the picture, however wide the panels' lane
     labels make its left margin (the whole sample folder: a rosbag2 lane label of 42
@@ -319,6 +333,7 @@ def test_figure_problem_list_fits_the_picture() -> None:
 # --- the command line ------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_cli_plot_picks_the_format_by_suffix(folder: dict[str, Any], tmp_path: Path) -> None:
     page, png = tmp_path / "day.html", tmp_path / "day.png"
     argv = ["timeline", str(folder["root"]), "--plot", str(page), "--plot", str(png)]

@@ -5,11 +5,10 @@ from __future__ import annotations
 import json
 
 import pytest
-from summaries import BAG_KEYS, Summary, Topic
 
 from ertools.io.formats import Unreadable
 from ertools.io.model import ClockCheck
-from ertools.timeline.build import (
+from ertools.timelines.build import (
     benchmark_names,
     build_timeline,
     classify,
@@ -17,7 +16,8 @@ from ertools.timeline.build import (
     logger_name,
     split_name,
 )
-from ertools.timeline.model import TimelineConfig
+from ertools.timelines.model import TimelineConfig
+from tests.helpers.summaries import BAG_KEYS, Summary, Topic
 
 S = 1_000_000_000
 T0 = 1_448_013_600 * S

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ertools.benchmarks.common.inputs import EXACT_FLAG
 from ertools.fidelity import Deviation, NodeVersion, Rule
 from ertools.states import (
     BmBoxState,
@@ -34,13 +35,6 @@ from ertools.states import (
 )
 from ertools.streams import StateStream
 from ertools.timeutil import ns_to_s
-
-# The option every FBM benchmark has (``--2015`` / ``--rules 2015`` set it), and its help.
-EXACT_FLAG = "--exact-end-payloads"
-EXACT_HELP = (
-    "RefBox END payloads read as the 2015 BmBox compared them: only 'reason: timeout' and "
-    "'reason: stop' (the manual's bare timeout / halt then mean neither)"
-)
 
 RULE_END_PAYLOADS = Rule(
     key="all.end-payloads",
@@ -82,7 +76,7 @@ VERSIONS = (
         "any RefBox END moves WAITING_MANUAL_OPERATION to READY (l. 43-44) and "
         "ManualOperation() returns the RefBox payload (FBM1@Work's item): a stop during a "
         "manual operation ends the benchmark",
-        "every `--2015` and `--rules` (tests/bmbox2015.py replays it)",
+        "every `--2015` and `--rules` (tests/helpers/bmbox2015.py replays it)",
     ),
     NodeVersion(
         "src/rockin_scoring/FSM.py",
@@ -91,7 +85,7 @@ VERSIONS = (
         f"{_ALL_THREE} (its only version)",
         "an update its transition table refuses changes nothing (BmBox.py 133-142): a RefBox "
         "stop while a goal is sent leaves the node waiting in SendGoal()",
-        "every `--2015` and `--rules` (tests/bmbox2015.py replays it)",
+        "every `--2015` and `--rules` (tests/helpers/bmbox2015.py replays it)",
     ),
 )
 

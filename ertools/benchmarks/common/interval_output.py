@@ -14,14 +14,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from ertools.benchmarks.common.uncertainty import (
-    DEFAULT_CONFIDENCE,
-    DEFAULT_DRAWS,
-    DEFAULT_SEED,
-    Interval,
-    Uncertainty,
-    check_confidence,
-)
+from ertools.benchmarks.common.inputs import IntervalSettings
+from ertools.benchmarks.common.uncertainty import Interval, Uncertainty
 
 #: The method named in the ``uncertainty`` block and on stderr.
 METHOD = "Monte Carlo over the sources, basic (bias-correcting) bootstrap interval"
@@ -37,32 +31,6 @@ class ResultIntervals:
 
 
 NO_INTERVALS = ResultIntervals({}, None)
-
-
-@dataclass(frozen=True)
-class IntervalSettings:
-    """``--confidence``, ``--draws`` and ``--seed`` as one value (draws 0: no intervals)."""
-
-    draws: int = DEFAULT_DRAWS
-    seed: int = DEFAULT_SEED
-    confidence: float = DEFAULT_CONFIDENCE
-
-    @property
-    def enabled(self) -> bool:
-        return self.draws > 0
-
-    @staticmethod
-    def from_values(values: Mapping[str, Any]) -> IntervalSettings:
-        """From resolved input values (:data:`~ertools.benchmarks.common.uncertainty.
-        INTERVAL_INPUTS`); a level outside (0, 1) is a usage error."""
-        confidence = values.get("confidence")
-        draws = values.get("draws")
-        seed = values.get("seed")
-        return IntervalSettings(
-            DEFAULT_DRAWS if draws is None else int(draws),
-            DEFAULT_SEED if seed is None else int(seed),
-            check_confidence(DEFAULT_CONFIDENCE if confidence is None else float(confidence)),
-        )
 
 
 def withheld(

@@ -3,7 +3,8 @@
 A pose source is a pose topic (``--topic TOPIC``) or a tf frame pair (``--tf PARENT:CHILD``),
 read with a time source (``--time-source header|record``). :class:`PoseSpec` is what the
 command line gives (maybe nothing); :func:`choose_source` turns it, with the command's list
-of defaults, into the :class:`ertools.io.PoseSource` to read, and :func:`read_source` reads it.
+of defaults, into the :class:`ertools.io.model.PoseSource` to read, and :func:`read_source`
+reads it.
 Every command that reads poses goes through these two functions, so the rules below hold
 everywhere:
 
@@ -29,8 +30,8 @@ from ertools.benchmarks.common.spec import (
 )
 from ertools.benchmarks.common.spec import PoseSpec as PoseSpec  # noqa: PLC0414 (re-exported)
 from ertools.errors import TopicError
-from ertools.io import PoseSource, read_pose_source, topics
-from ertools.io.model import POSE_TYPES, TF_TYPES
+from ertools.io.model import POSE_TYPES, TF_TYPES, PoseSource
+from ertools.io.reader import read_pose_source, topics
 from ertools.streams import PoseStream
 
 log = logging.getLogger(__name__)
@@ -40,7 +41,7 @@ HEADERLESS_TYPES = ("geometry_msgs/Pose2D",)
 
 
 def pose_source(spec: PoseSpec) -> PoseSource:
-    """The reader's :class:`~ertools.io.PoseSource` of a spec (a topic, else the tf pair)."""
+    """The reader's :class:`~ertools.io.model.PoseSource` of a spec (a topic, else the tf pair)."""
     if spec.tf is not None:
         return PoseSource(topic=None, frame=spec.tf[1], parent=spec.tf[0])
     return PoseSource(topic=spec.topic, time_source=spec.time_source)

@@ -26,9 +26,9 @@ from typing import Any, Literal
 
 import yaml
 
-from ertools import yamlin
 from ertools.errors import ErtoolsError
-from ertools.io import read_benchmark_states
+from ertools.io.reader import read_benchmark_states
+from ertools.yamlin import load as load_yaml
 
 TeamSource = Literal["explicit", "payload", "log name", "transform", "RSBB layout"]
 
@@ -120,7 +120,7 @@ def team_from_payloads(payloads: Iterable[str]) -> str | None:
         if ":" not in text or not any(k in text for k in PAYLOAD_KEYS):
             continue
         try:
-            data = yamlin.load(text, duplicates=[])  # a name: read as the 2015 nodes did
+            data = load_yaml(text, duplicates=[])  # a name: read as the 2015 nodes did
         except yaml.YAMLError:
             continue
         if not isinstance(data, dict):

@@ -29,18 +29,12 @@ from typing import Any
 import numpy as np
 
 from ertools.arrays import F64
-from ertools.benchmarks.base import Input
-from ertools.errors import UsageError
-
-DEFAULT_CONFIDENCE = 0.95
-DEFAULT_DRAWS = 400
-DEFAULT_SEED = 0
-# The most draws an interval takes: 100,000 already take minutes on a sample log (the FBM3W
-# sample: 10 s at 4,000 draws, 90 s at 40,000), and a typo of 10**9 would run for days and
-# hold gigabytes of draws, so more is refused with this number.
-MAX_DRAWS = 100_000
-# numpy seeds any non-negative integer; results and reports carry the seed as an int64
-MAX_SEED = 2**63 - 1
+from ertools.benchmarks.common.inputs import (
+    DEFAULT_CONFIDENCE,
+    DEFAULT_DRAWS,
+    DEFAULT_SEED,
+    check_confidence,
+)
 
 # How many measured samples a score needs behind it (docs/uncertainty.md, "Too few samples").
 # An interval's width is measured from the samples themselves (the spread of the errors, the
@@ -58,50 +52,6 @@ MOCAP_NOISE = "mocap_noise"
 TIME_ASSOCIATION = "time_association"
 TRANSFORM = "transform"
 D_MIN = "d_min"
-
-#: The options every ``score`` command takes for its intervals (declared once, listed by each
-#: benchmark's declaration).
-INTERVAL_INPUTS = (
-    Input(
-        "confidence",
-        "float",
-        "confidence level of the score intervals (default 0.95)",
-        default=DEFAULT_CONFIDENCE,
-        minimum=0.0,
-        positive=True,
-        below=1.0,
-        metavar="LEVEL",
-        group="intervals",
-    ),
-    Input(
-        "draws",
-        "int",
-        f"Monte Carlo draws per interval source (default {DEFAULT_DRAWS}, at most {MAX_DRAWS}; "
-        "0: no intervals)",
-        default=DEFAULT_DRAWS,
-        minimum=0,
-        maximum=MAX_DRAWS,
-        metavar="N",
-        group="intervals",
-    ),
-    Input(
-        "seed",
-        "int",
-        f"seed of the Monte Carlo draws (default {DEFAULT_SEED}): same seed, same intervals",
-        default=DEFAULT_SEED,
-        minimum=0,
-        maximum=MAX_SEED,
-        metavar="N",
-        group="intervals",
-    ),
-)
-
-
-def check_confidence(confidence: float) -> float:
-    """``confidence`` if it is a level strictly between 0 and 1, else a usage error."""
-    if not (math.isfinite(confidence) and 0.0 < confidence < 1.0):
-        raise UsageError(f"--confidence {confidence}: give a level between 0 and 1, e.g. 0.95")
-    return confidence
 
 
 def z_value(confidence: float) -> float:

@@ -37,13 +37,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, I64, Bool, IntArr
-from ertools.benchmarks.base import FormerName, Input
 from ertools.benchmarks.common.hygiene import impossible_samples, rows_equal
 
 VALID = 0
@@ -82,30 +81,6 @@ STILL_M = 0.002
 # a recording (a few ms), well below any stretch in which a robot moves a measurable distance
 # at benchmark speeds (0.1 s at 0.3 m/s is 3 cm, which a straight chord still follows).
 DEFAULT_GAP_S = 0.1
-
-
-#: ``unscoreable``'s values: ``null`` (default: the verdict ``unscoreable``, no score, the
-#: reason given) or ``2015`` (scored from what is left, as the 2015 nodes did, with a warning).
-UNSCOREABLE_CHOICES = ("null", "2015")
-SCORE_AS_2015 = "2015"
-
-#: "Score unscoreable runs as 2015 did": one option, one meaning, one help text in every
-#: benchmark (``--unscoreable 2015``, manifest key and keyword ``unscoreable``); each benchmark
-#: lists it with its help group and its own former names (:func:`unscoreable_input`).
-UNSCOREABLE = Input(
-    "unscoreable",
-    "choice",
-    "a run (FBM2H: a segment; trajectory: the comparison) whose valid ground truth cannot "
-    "support a score (docs/uncertainty.md): unscoreable, null scores and the reason (null, "
-    "default), or 2015: scored from what is left, as the 2015 nodes did, with a warning",
-    choices=UNSCOREABLE_CHOICES,
-)
-
-
-def unscoreable_input(group: str, *former: FormerName) -> Input:
-    """:data:`UNSCOREABLE` in a benchmark's help ``group``, with the benchmark's former
-    spellings of it (``--unscoreable-runs 2015``, ``--score-unscoreable``)."""
-    return replace(UNSCOREABLE, group=group, former=former)
 
 
 @dataclass(frozen=True)

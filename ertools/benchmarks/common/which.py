@@ -2,7 +2,7 @@
 the command, rather than failing later on a pose topic it cannot find.
 
 A benchmark's logs have their topics under its namespace (``/fbm2h/...``, the robot's own log
-``/rockin/...``: :attr:`~ertools.benchmarks.base.Benchmark.log_namespace`). A log with none
+``/rockin/...``: ``log_namespace``, :class:`~ertools.benchmarks.base.Discovered`). A log with none
 under the benchmark asked for, and some under another registered one, is that one's log.
 """
 
@@ -13,8 +13,9 @@ from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks import registry
+from ertools.benchmarks.base import Described, Discovered
 from ertools.errors import ErtoolsError, UsageError
-from ertools.io import topics
+from ertools.io.reader import topics
 
 GT_USE = "ertools score trajectory ROBOT_BAG MOCAP..."
 
@@ -33,10 +34,12 @@ def other_benchmark(name: str, bag: Path, values: Mapping[str, Any]) -> str | No
     """The message when ``bag`` is plainly another benchmark's log, else None.
 
     None too when the user named the log's topics or frames (the benchmark's
-    :attr:`~ertools.benchmarks.base.Benchmark.source_inputs`: they know the log), or when
+    :attr:`~ertools.benchmarks.base.Discovered.source_inputs`: they know the log), or when
     the log cannot be read (the scorer then says why, as it would have).
     """
     bench = registry.get(name)
+    if not isinstance(bench, Discovered):  # it has no logs of its own to recognise
+        return None
     if any(values.get(i) not in (None, False, ()) for i in bench.source_inputs):
         return None
     try:
@@ -47,7 +50,8 @@ def other_benchmark(name: str, bag: Path, values: Mapping[str, Any]) -> str | No
         return None
     candidates = []
     for other in registry.names():
-        ns = registry.get(other).log_namespace
+        found = registry.get(other)
+        ns = found.log_namespace if isinstance(found, Discovered) else ""
         if other != name and ns in spaces:
             candidates.append((-spaces[ns], other, ns))
     if not candidates:
@@ -57,9 +61,10 @@ def other_benchmark(name: str, bag: Path, values: Mapping[str, Any]) -> str | No
         # benchmark's log, but the poses that go with one
         listed = ", ".join(f"/{ns}/..." for _, _, ns in sorted(candidates, key=lambda c: c[2]))
         what = f"this log holds the poses of several benchmarks ({listed}), as a mocap logger's"
-        if not isinstance(bench.bags_metavar, str):
+        metavar = bench.bags_metavar if isinstance(bench, Described) else "BAG"
+        if not isinstance(metavar, str):
             # a command of a robot log and its GT (ROBOT_BAG GT_PATH): the file is a GT_PATH
-            robot, gt = bench.bags_metavar
+            robot, gt = metavar
             return f"{what} file does; give it as {gt} after the {robot}: {GT_USE}"
         return (
             f"{what} file does; give it after the benchmark's own log (ertools score {name} "
@@ -78,9 +83,9 @@ def log_benchmark(bag: Path) -> str | None:
     except ErtoolsError:
         return None
     found = [
-        (-spaces[ns], name)
+        (-spaces[bench.log_namespace], name)
         for name in registry.names()
-        if (ns := registry.get(name).log_namespace) in spaces
+        if isinstance(bench := registry.get(name), Discovered) and bench.log_namespace in spaces
     ]
     return found[0][1] if len(found) == 1 else None
 

@@ -22,36 +22,21 @@ import numpy as np
 from ertools.benchmarks.common import motion
 from ertools.benchmarks.fbm1.gt import board_in_table, coverage_problem
 from ertools.benchmarks.fbm1.logs import read_body
+from ertools.benchmarks.fbm1.rules import RULE_ACQUIRE_WINDOW
 from ertools.configs.items import Item, ItemList, ItemSpread, load_items
 from ertools.errors import ConfigError, SegmentationError
-from ertools.fidelity import Deviation, Rule
+from ertools.fidelity import Deviation
 from ertools.geometry import invert, mean_pose
-from ertools.io import summary
+from ertools.io.summary import summary
 from ertools.streams import Interval, PoseStream, Provenance
 from ertools.timeutil import NS_PER_S, resolve_time
 
 if TYPE_CHECKING:
-    from ertools.io import PoseSource
+    from ertools.io.model import PoseSource
 
 # The look-ahead over which a still board must not move (long against mocap noise, short
 # against a referee's hand).
 LOOKAHEAD_NS = NS_PER_S // 4
-
-RULE_ACQUIRE_WINDOW = Rule(
-    key="fbm1.acquire-items",
-    benchmark="fbm1",
-    title="item transform acquisition",
-    rulebook="the transform from the board to each item is acquired with the mocap (seed 7.1.4)",
-    node_2015=(
-        "scripts/acquire_items (2015): one tf lookup of ref_board -> origin when the operator "
-        "pressed ENTER"
-    ),
-    ertools=(
-        "the mean over the item's still window, spread written beside it; no option: the "
-        "moments ENTER was pressed are not in the log"
-    ),
-    option="",
-)
 
 
 @dataclass(frozen=True)
@@ -103,7 +88,7 @@ class AcquireResult:
     @property
     def nothing_scored(self) -> bool:
         """Not one item acquired (each failed): the CLI prints only the failures, not the
-        vanilla list back (``ertools.cli.common.all_failed``)."""
+        vanilla list back (``ertools.benchmarks.document.all_failed``)."""
         return len(self.failures) >= len(self.items)
 
 

@@ -21,44 +21,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
 
 from ertools.benchmarks.common import motion
 from ertools.benchmarks.common.hygiene import drop_invalid
+from ertools.benchmarks.fbm1.config import GtOptions
 from ertools.configs.items import Item
 from ertools.geometry import compose, interpolate_poses, invert, mean_pose, yaw_from_quat
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
-
-GtMethod = Literal["window", "placed", "goal", "result"]
-GT_METHODS: tuple[str, ...] = ("window", "placed", "goal", "result")
-
-
-@dataclass(frozen=True)
-class GtOptions:
-    """How the ground truth of a run is measured.
-
-    Attributes:
-        method: ``window`` (mean over the stationary window before the goal), or one lookup
-            interpolated at a moment: ``result`` (the result arrived: the 2015 nodes),
-            ``placed`` (the placement confirmed: the 2016-17 @Home node), ``goal`` (the goal
-            was sent).
-        max_window_s: longest stationary window averaged.
-        still_m: a board sample further than this from the board's pose at the goal ends the
-            stationary window (metres; mocap noise is ~0.1 mm, a placement moves centimetres).
-        still_deg: the same for the rotation, degrees.
-        min_still_s: a shorter window is used but warned about (the board was still moving).
-        max_gap_s: a gap longer than this in either body's samples means tracking was lost.
-    """
-
-    method: GtMethod = "window"
-    max_window_s: float = 5.0
-    still_m: float = 0.005
-    still_deg: float = 1.0
-    min_still_s: float = 0.5
-    max_gap_s: float = 0.5
 
 
 @dataclass(frozen=True)
@@ -199,8 +171,7 @@ def stationary_tail(
     The final pose is the mean of the last 0.2 s, so one noisy last sample does not decide.
     A tracking gap longer than ``max_gap_ns`` ends the tail too: nobody saw the board then.
     """
-    # lazy: scipy only where its rotations/statistics are needed (~0.3 s to import)
-    from scipy.spatial.transform import Rotation
+    from scipy.spatial.transform import Rotation  # lazy: scipy, 300 ms
 
     if len(rel) == 0:
         return rel
@@ -228,8 +199,7 @@ def settled(tail: PoseStream) -> PoseStream:
     window, so anyone can average the same samples (a noisy sample later on stays, as any
     mocap sample of a still board).
     """
-    # lazy: scipy only where its rotations/statistics are needed (~0.3 s to import)
-    from scipy.spatial.transform import Rotation
+    from scipy.spatial.transform import Rotation  # lazy: scipy, 300 ms
 
     if len(tail) < 5:
         return tail

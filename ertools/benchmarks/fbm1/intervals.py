@@ -25,7 +25,7 @@ Two sources, both measured from the data where the data has them:
   no transform to be uncertain about. One item's transform error is shared by every run that
   presented it (drawn once per item, turned into each run's table frame).
 
-The draws re-compute the scores exactly as :mod:`ertools.benchmarks.fbm1.score` does, vectorised
+The draws re-compute the scores exactly as :mod:`ertools.benchmarks.fbm1.formula` does, vectorised
 over (draws, runs).
 """
 
@@ -38,10 +38,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ertools.arrays import F64
+from ertools.benchmarks.common.inputs import IntervalSettings
 from ertools.benchmarks.common.interval_output import (
     METHOD,
     NO_INTERVALS,
-    IntervalSettings,
     ResultIntervals,
     shares_of,
 )
@@ -54,15 +54,11 @@ from ertools.benchmarks.common.uncertainty import (
     monte_carlo,
     z_value,
 )
-from ertools.benchmarks.fbm1.gt import (
-    GroundTruthError,
-    GtOptions,
-    board_in_table,
-    measure_ground_truth,
-)
+from ertools.benchmarks.fbm1.config import GtOptions, ScoreRules
+from ertools.benchmarks.fbm1.formula import MAX_POSE_ERROR_2015
+from ertools.benchmarks.fbm1.gt import GroundTruthError, board_in_table, measure_ground_truth
 from ertools.benchmarks.fbm1.result import Fbm1RunResult
 from ertools.benchmarks.fbm1.runs import Fbm1Run
-from ertools.benchmarks.fbm1.score import MAX_POSE_ERROR_2015, ScoreRules
 from ertools.configs.items import IDENTITY_ROT, IDENTITY_TRANS, Item
 from ertools.geometry import compose, yaw_from_quat
 from ertools.streams import PoseStream
@@ -150,9 +146,9 @@ def run_noise(
     xy: F64, yaw: F64, *, lookup: bool, confidence: float, gt_yaw: float, rho: float
 ) -> RunNoise:
     """The noise of a ground truth measured on ``n`` still samples (module doc)."""
-    # lazy: scipy.special is imported with scipy.spatial, which the ground truth's rotations
-    # already need; scipy.stats (its t distribution) would add ~0.3 s of imports for this
-    from scipy.special import stdtrit
+    # scipy.special comes with scipy.spatial, which the ground truth's rotations already need;
+    # scipy.stats (its t distribution) would add ~0.3 s of imports for this
+    from scipy.special import stdtrit  # lazy: scipy.special, ~0 ms beside scipy.spatial
 
     n = len(yaw)
     if n < 3:
@@ -176,7 +172,7 @@ def _wrap_deg(angle: F64, legacy: bool) -> F64:
 
 
 def _terms(dist: F64, dtheta: F64, rules: ScoreRules) -> F64:
-    """The pose score 1 - t/2 - r/2 of :func:`ertools.benchmarks.fbm1.score.pose_errors`."""
+    """The pose score 1 - t/2 - r/2 of :func:`ertools.benchmarks.fbm1.formula.pose_errors`."""
     if rules.clip_above_diagonal:
         t = np.where(dist > MAX_POSE_ERROR_2015, 1.0, dist)
     else:

@@ -1,6 +1,6 @@
-"""FBM1 log reading: the item list, answers and state topics (``load``), then the runs and the
-table and board poses around them (``locate_runs``); ``read_body`` chooses where a body's poses
-come from."""
+"""FBM1 log reading: the item list, answers and state topics (:func:`read_logs`), and the table
+and board poses (:func:`read_body` chooses where a body's poses come from); what
+:func:`ertools.benchmarks.fbm1.pipeline.find_runs` finds in them (:class:`Fbm1Runs`)."""
 
 from __future__ import annotations
 
@@ -12,18 +12,17 @@ from typing import TYPE_CHECKING
 from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
 from ertools.benchmarks.fbm1.answers import ResultsFile, parse_results
 from ertools.benchmarks.fbm1.config import Fbm1Options
-from ertools.benchmarks.fbm1.runs import RunsFound, find_runs
+from ertools.benchmarks.fbm1.runs import RunsFound
 from ertools.configs._yaml import load_yaml
 from ertools.configs.items import ItemList, load_items
-from ertools.errors import ConfigError, SegmentationError, TopicError
-from ertools.io import read_benchmark_states, read_pose_source, read_tf, summary
-from ertools.io.clock import check_header_clock
+from ertools.errors import ConfigError, SegmentationError
 from ertools.io.model import BenchmarkStates
+from ertools.io.reader import read_benchmark_states, read_pose_source
+from ertools.io.summary import summary
 from ertools.streams import PoseStream
-from ertools.timeutil import NS_PER_S
 
 if TYPE_CHECKING:
-    from ertools.io import PoseSource
+    from ertools.io.model import PoseSource
 
 
 # Ground-truth methods that are one tf lookup, as the nodes made it: their poses come from /tf
@@ -65,7 +64,7 @@ def read_body(
 
 @dataclass(frozen=True, eq=False)
 class Fbm1Logs:
-    """What :func:`load` read: the log files, the item list, the answers file (if any), the
+    """What :func:`read_logs` read: the log files, the item list, the answers file (if any), the
     benchmark state streams and the log's first message time."""
 
     paths: tuple[Path, ...]
@@ -77,8 +76,9 @@ class Fbm1Logs:
 
 @dataclass(frozen=True, eq=False)
 class Fbm1Runs:
-    """What :func:`locate_runs` found: the runs, and the table and board poses around them
-    (read only there), with the node's item broadcasts when the ground truth needs them."""
+    """What :func:`ertools.benchmarks.fbm1.pipeline.find_runs` found: the runs, and the table
+    and board poses around them (read only there), with the node's item broadcasts when the
+    ground truth needs them."""
 
     found: RunsFound
     origin: PoseStream
@@ -86,7 +86,7 @@ class Fbm1Runs:
     item_tf: PoseStream | None
 
 
-def load(paths: Sequence[Path], options: Fbm1Options) -> Fbm1Logs:
+def read_logs(paths: Sequence[Path], options: Fbm1Options) -> Fbm1Logs:
     """Read the item list, the answers file and the state topics.
 
     Raises:
@@ -111,59 +111,3 @@ def load(paths: Sequence[Path], options: Fbm1Options) -> Fbm1Logs:
         )
     t0 = min(summary(p).start_ns for p in plist)
     return Fbm1Logs(plist, items, results, states, t0)
-
-
-def locate_runs(logs: Fbm1Logs, options: Fbm1Options) -> Fbm1Runs:
-    """The runs from the states, then the table and board poses around them.
-
-    Raises:
-        SegmentationError: no Client states and no results file (the answers are unknown).
-        TopicError: a body's poses are nowhere.
-        ClockError: header-stamped poses on another clock than the state messages.
-    """
-    ns = options.benchmark
-    plist = list(logs.paths)
-    states = logs.states
-    assert states.bmbox is not None
-    found = find_runs(
-        states.bmbox,
-        states.refbox,
-        states.client,
-        benchmark=ns,
-        items_order=list(options.items_order) if options.items_order is not None else None,
-        t0_ns=logs.t0_ns,
-        exact_2015=options.exact_end_payloads,
-    )
-    if states.client is None and logs.results is None:
-        # Scoring every run as unanswered would be a silent wrong score.
-        raise SegmentationError(
-            f"no /{ns}/client_state in the log: the robot's answers are unknown; "
-            "give them with --results FILE",
-            path=plist[0],
-        )
-    if not found.runs:
-        # nothing to score; a bare min() below would fail as a bug
-        raise SegmentationError(
-            f"/{ns}/bmbox_state: no run found (the benchmarking box sent no goal in "
-            f"{len(states.bmbox.t_ns)} state messages)",
-            path=plist[0],
-        )
-    # Read the bodies only around the runs (windowed reads touch only those chunks).
-    pad = round((options.gt.max_window_s + options.gt.max_gap_s + 2.0) * NS_PER_S)
-    lo = min(r.start_ns for r in found.runs) - pad
-    hi = max(r.end_ns for r in found.runs) + pad
-    src = options.sources
-    tf_first = options.gt.method in TF_LOOKUPS
-    origin = read_body(plist, src.origin, f"/{ns}/origin/pose", "origin", (lo, hi), tf_first)
-    board = read_body(plist, src.board, f"/{ns}/ref_board/pose", "ref_board", (lo, hi), tf_first)
-
-    for body, source in ((origin, src.origin), (board, src.board)):
-        if source is None or source.time_source == "header":
-            check_header_clock(plist, body, "state messages")
-    item_tf = None
-    if options.gt.method != "window":
-        try:
-            item_tf = read_tf(plist, "ref_board", "item", start_ns=lo, end_ns=hi)
-        except TopicError:
-            item_tf = None  # not logged: the state messages give the moments
-    return Fbm1Runs(found, origin, board, item_tf)

@@ -5,23 +5,26 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-from ertools.benchmarks.base import Rows, dump_yaml, jsonable
-from ertools.benchmarks.common.interval_output import as_list, interval_tables, low_high
+from ertools.benchmarks.base import Rows
+from ertools.benchmarks.common.interval_output import (
+    ScoreRow,
+    as_list,
+    interval_lines,
+    interval_tables,
+    low_high,
+)
 from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, interval_keys
 from ertools.benchmarks.common.validity import Validity, cell
 from ertools.benchmarks.fbm1.answers import Answer
+from ertools.benchmarks.fbm1.formula import PoseErrors, Totals
 from ertools.benchmarks.fbm1.gt import GroundTruth
-from ertools.benchmarks.fbm1.score import PoseErrors, Totals
+from ertools.benchmarks.results import ResultBase
 from ertools.configs.items import Item
 from ertools.fidelity import Deviation
-from ertools.frames import tables_to_frames
 from ertools.streams import Provenance
 from ertools.timeutil import NS_PER_S, ns_to_s
-
-if TYPE_CHECKING:
-    import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 
 @dataclass(frozen=True)
@@ -190,8 +193,9 @@ class Fbm1RunResult:
 
 
 @dataclass(frozen=True)
-class Fbm1Result:
-    """An FBM1@Home or FBM1@Work score (implements ``BenchmarkResult``).
+class Fbm1Result(ResultBase):
+    """An FBM1@Home or FBM1@Work score (implements ``BenchmarkResult``; ``to_dict``,
+    ``to_yaml``, ``to_frames`` from :class:`~ertools.benchmarks.results.ResultBase`).
 
     Attributes:
         name: ``fbm1h`` or ``fbm1w``.
@@ -227,7 +231,7 @@ class Fbm1Result:
     @property
     def nothing_scored(self) -> bool:
         """No run counted (scored, or without answer with score 0): no total is a number, so
-        the CLI prints only the failures (``ertools.cli.common.all_failed``)."""
+        the CLI prints only the failures (``ertools.benchmarks.document.all_failed``)."""
         return not any(r.status in ("scored", "no_answer") for r in self.runs)
 
     def validity_lines(self) -> list[str]:
@@ -259,7 +263,8 @@ class Fbm1Result:
             "pose_score": t.pose_score,
         }
 
-    def to_dict(self) -> dict[str, Any]:
+    def listing(self) -> dict[Any, Any]:
+        """The 2015 score (its four keys, as the node sent them) then the details."""
         out: dict[str, Any] = {**self.score()}
         if self.intervals:
             # after the four keys of the 2015 listing, which keep their order
@@ -282,17 +287,7 @@ class Fbm1Result:
                 out[key] = list(values)
         if self.uncertainty is not None:
             out["uncertainty"] = self.uncertainty.to_dict()
-        result: dict[str, Any] = jsonable(out)
-        return result
-
-    def to_yaml(self) -> str:
-        """The 2015 score (first four keys, as its node sent them) then the details."""
-        return dump_yaml(self.to_dict())
-
-    def to_frames(self) -> dict[str, pd.DataFrame]:
-        """Every table of :meth:`tables` as a pandas DataFrame, epoch times as a UTC index
-        (:func:`ertools.frames.tables_to_frames`)."""
-        return tables_to_frames(self.tables())
+        return out
 
     def tables(self) -> dict[str, Rows]:
         rows = []
@@ -329,3 +324,50 @@ def _with_intervals(
         if sub and isinstance(entry.get(section), dict):
             entry[section] = interval_keys(entry[section], sub)
     return interval_keys(entry, {k: v for k, v in mine.items() if "." not in k})
+
+
+def _fmt(value: object, spec: str) -> str:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "-"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    return format(value, spec)
+
+
+def notes(result: Fbm1Result) -> list[str]:
+    """The reference reproduced and the per-run table (stdout keeps the parseable score)."""
+    out = [f"reproducing: {result.reference}", f"{result.name}: {len(result.runs)} run(s)"]
+    out.append(
+        f"{'run':>3} {'item':<14} {'answer':<14} {'cls':>3} {'ins':>3} "
+        f"{'dx mm':>7} {'dy mm':>7} {'dth deg':>8} {'pose':>6} {'time s':>7}  status"
+    )
+    for r in result.runs:
+        e = r.errors
+        item = f"{r.item.id}:{r.item.instance}" if r.item else (r.item_text or "?")
+        ans = r.answer.item_instance if r.answer else "-"
+        out.append(
+            f"{r.index:>3} {item[:14]:<14} {ans[:14]:<14} {_fmt(r.class_ok, ''):>3} "
+            f"{_fmt(r.instance_ok, ''):>3} {_fmt(e.dx * 1000 if e else None, '7.1f'):>7} "
+            f"{_fmt(e.dy * 1000 if e else None, '7.1f'):>7} "
+            f"{_fmt(e.theta_error_deg if e else None, '8.2f'):>8} "
+            f"{_fmt(r.pose_score, '6.3f'):>6} {_fmt(r.execution_time_s, '7.2f'):>7}  {r.status}"
+        )
+    t = result.totals
+    out.append(
+        f"class_accuracy {_fmt(t.class_accuracy, '.3f')}  instance_accuracy "
+        f"{_fmt(t.instance_accuracy, '.3f')}  pose_score {_fmt(t.pose_score, '.4f')}  "
+        f"execution_time {t.execution_time:.2f} s"
+    )
+    if result.logged_score:
+        logged = ", ".join(f"{k} {v}" for k, v in result.logged_score.items())
+        out.append(f"the 2015 node sent: {logged}")
+    out += interval_lines(
+        [ScoreRow("pose_score", t.pose_score, result.intervals.get("pose_score"))],
+        result.uncertainty,
+    )
+    if result.uncertainty is not None:
+        out.append(
+            "interval: class_accuracy, instance_accuracy and execution_time are counts and "
+            "state times: no mocap noise enters them (no interval)"
+        )
+    return out

@@ -118,6 +118,35 @@ RULE_UNSCOREABLE = Rule(
     option="--unscoreable 2015",
 )
 
+RULE_ACQUIRE_WINDOW = Rule(
+    key="fbm1.acquire-items",
+    benchmark="fbm1",
+    title="item transform acquisition",
+    rulebook="the transform from the board to each item is acquired with the mocap (seed 7.1.4)",
+    node_2015=(
+        "scripts/acquire_items (2015): one tf lookup of ref_board -> origin when the operator "
+        "pressed ENTER"
+    ),
+    ertools=(
+        "the mean over the item's still window, spread written beside it; no option: the "
+        "moments ENTER was pressed are not in the log"
+    ),
+    option="",
+)
+
+# Every rule above, in the catalogue's order (ertools.benchmarks.fbm1.declare: the benchmark's
+# ``rules``).
+RULES = (
+    RULE_GT_MOMENT,
+    RULE_TRANS_CLIP,
+    RULE_THETA_WRAP,
+    RULE_NAMES,
+    RULE_ABORTED,
+    RULE_POSE_SOURCE,
+    RULE_UNSCOREABLE,
+    RULE_ACQUIRE_WINDOW,
+)
+
 # The versions of the FBM1 nodes (rows of the version table, ertools.fidelity.NodeVersion).
 _H = "scripts/fbm1h"
 VERSIONS = (

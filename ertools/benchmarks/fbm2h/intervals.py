@@ -39,30 +39,35 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ertools.arrays import F64
+from ertools.benchmarks.common.epsilon import noise_from_stream
+from ertools.benchmarks.common.hygiene import drop_invalid
 from ertools.benchmarks.common.phases import phase_pairs, stationary_phases
 from ertools.benchmarks.common.uncertainty import (
     MOCAP_NOISE,
     TIME_ASSOCIATION,
     TRANSFORM,
-    Interval,
     Source,
     Uncertainty,
     monte_carlo,
     sigma_from_epsilon,
 )
-from ertools.benchmarks.noise.benchmark import noise_from_stream
-from ertools.configs.transform import TransformSpread
+from ertools.benchmarks.fbm2h.config import Fbm2hOptions
+from ertools.benchmarks.fbm2h.formula import robot_poses_at
+from ertools.benchmarks.fbm2h.result import Fbm2hIntervals, Fbm2hResult
+from ertools.benchmarks.fbm2h.runs import ReachedMoments
+from ertools.configs.transform import MarkerTransform, TransformSpread
 from ertools.errors import ScoringError
-from ertools.geometry import quat_conjugate, quat_multiply, wrap_angle
+from ertools.geometry import quat_conjugate, quat_multiply, rotate, wrap_angle
 from ertools.streams import PoseStream
+from ertools.timeutil import s_to_ns
 
 METHOD = "Monte Carlo (parametric bootstrap, basic interval)"
-# The 2015 FBM2 log's still marker set (ertools/benchmarks/fbm2h/transform.py): ~0.8 mm per
+# The 2015 FBM2 log's still marker set (ertools/benchmarks/fbm2h/acquire.py): ~0.8 mm per
 # consecutive still pair (epsilon) and ~13 mrad RMS yaw.
 DEFAULT_EPSILON_M = 0.0008
 DEFAULT_SIGMA_YAW = 0.013
@@ -268,17 +273,6 @@ def perturbed_scores(
     return np.column_stack([position, accuracy, distance, orientation])
 
 
-@dataclass(frozen=True)
-class Fbm2hIntervals:
-    """The intervals of one result: accuracies, then per scored segment index."""
-
-    position: Interval | None
-    orientation: Interval | None
-    distance: dict[int, Interval | None]
-    angle: dict[int, Interval | None]
-    uncertainty: Uncertainty
-
-
 def intervals(
     m: Moments,
     indices: Sequence[int],
@@ -324,3 +318,75 @@ def intervals(
                 shares[f"details.segments_details.{i}.{key}"] = iv.share_dict()
     block = Uncertainty(confidence, METHOD, draws, seed, model.sources, shares)
     return Fbm2hIntervals(ivs[0], ivs[1], distance, angle, block)
+
+
+VELOCITY_FRAMES = 5
+
+
+def with_intervals(
+    result: Fbm2hResult,
+    marker: PoseStream,
+    transform: MarkerTransform,
+    moments: ReachedMoments,
+    options: Fbm2hOptions,
+) -> Fbm2hResult:
+    """``result`` with the intervals of its scores (:mod:`ertools.benchmarks.fbm2h.intervals`);
+    unchanged with ``--draws 0`` or nothing scored."""
+    ok = [s for s in result.segments if s.status == "ok" and s.robot is not None]
+    if options.draws <= 0 or not ok:
+        return result
+    marker, _ = drop_invalid(marker)
+    q = np.array([s.end_ns for s in ok], dtype=np.int64)
+    gap = s_to_ns(options.max_gap_s)
+    t_mr = transform.arrays()
+    identity = (np.zeros(3), np.array([0.0, 0.0, 0.0, 1.0]))
+    at_marker = robot_poses_at(marker, identity, q, gap)
+    robot = np.array([s.robot for s in ok], dtype=np.float64)
+    t = marker.t_ns
+    nearest = np.clip(np.searchsorted(t, q), 0, len(t) - 1)
+    lever = rotate(marker.quat_xyzw[nearest], np.broadcast_to(t_mr[0], (len(q), 3)).copy())
+    lo = np.clip(np.searchsorted(t, q, side="right") - 1, 0, len(t) - 1)
+    hi = np.clip(lo + 1, 0, len(t) - 1)
+    span = (t[hi] - t[lo]).astype(np.float64)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        w = np.where(span > 0, (q - t[lo]) / span, 0.0)
+    interpolated = robot_poses_at(marker, t_mr, q, gap).interpolated
+    averaging = np.where(interpolated, np.sqrt(w**2 + (1.0 - w) ** 2), 1.0)
+    dts = np.diff(t)
+    period = int(np.median(dts[dts > 0])) if np.any(dts > 0) else 0
+    velocity = np.zeros((len(q), 3))
+    if period > 0:
+        # over 5 frames each side: one frame's difference would read the noise as motion
+        base = VELOCITY_FRAMES * period
+        after = robot_poses_at(marker, t_mr, q + base, gap).xyyaw
+        before = robot_poses_at(marker, t_mr, q - base, gap).xyyaw
+        step = after - before
+        step[:, 2] = wrap_angle(step[:, 2])
+        velocity = np.nan_to_num(step / (2 * base / 1e9))
+    m = Moments(
+        robot=robot,
+        target=np.array([s.target for s in ok], dtype=np.float64),
+        lever=np.nan_to_num(lever),
+        heading=np.nan_to_num(at_marker.xyyaw[:, 2]),
+        averaging=averaging,
+        velocity=velocity,
+    )
+    indices = [s.index for s in ok]
+    estimates = [
+        result.position_accuracy,
+        result.orientation_accuracy,
+        *[s.distance_error for s in ok],
+        *[s.orientation_error for s in ok],
+    ]
+    found = intervals(
+        m,
+        indices,
+        estimates,
+        measure_model(marker, transform.spread),
+        orientation_2015=result.orientation_2015,
+        divide_by=len(result.segments) if result.unscored_2015 else len(ok),
+        draws=options.draws,
+        seed=options.seed,
+        confidence=options.confidence,
+    )
+    return replace(result, intervals=found)

@@ -1,5 +1,5 @@
 """FBM2@Home log reading: the configs and the marker set poses (``load``), then the reached
-moments from the states, a timing file or stops in the ground truth (``locate_runs``)."""
+moments from the states, a timing file or stops in the ground truth (``find_runs``)."""
 
 from __future__ import annotations
 
@@ -12,11 +12,11 @@ import numpy as np
 from ertools.benchmarks.common.hygiene import drop_invalid, impossible_warning
 from ertools.benchmarks.common.sources import PoseSpec, read_source, topic
 from ertools.benchmarks.common.sources import tf as tf_source
-from ertools.benchmarks.fbm2h import segments as seg
+from ertools.benchmarks.fbm2h import runs as seg
 from ertools.benchmarks.fbm2h.config import DEFAULT_TOPIC, TF_2015, Fbm2hOptions
-from ertools.benchmarks.fbm2h.segments import ReachedMoments
-from ertools.configs.goal import GoalList, goal_from_payload, load_goal
-from ertools.configs.timing import load_timing
+from ertools.benchmarks.fbm2h.goal import GoalList, goal_from_payload, load_goal
+from ertools.benchmarks.fbm2h.runs import ReachedMoments
+from ertools.benchmarks.fbm2h.timing import load_timing
 from ertools.configs.transform import (
     MarkerTransform,
     identity_transform,
@@ -25,9 +25,10 @@ from ertools.configs.transform import (
 )
 from ertools.errors import ConfigError, ScoringError, SegmentationError, TopicError
 from ertools.geometry import compose, yaw_from_quat
-from ertools.io import read_benchmark_states, summary
 from ertools.io.clock import check_header_clock
 from ertools.io.model import BenchmarkStates
+from ertools.io.reader import read_benchmark_states
+from ertools.io.summary import summary
 from ertools.streams import PoseStream
 from ertools.timeutil import s_to_ns
 
@@ -105,7 +106,7 @@ class Fbm2hLogs:
 
 @dataclass(frozen=True)
 class Fbm2hRuns:
-    """What :func:`locate_runs` found: the reached moments, the goal list they close (given,
+    """What :func:`find_runs` found: the reached moments, the goal list they close (given,
     or the one the BmBox sent), the waypoints not reached and why, and warnings."""
 
     moments: ReachedMoments
@@ -141,7 +142,7 @@ def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
     except TopicError:
         if not options.pose_2015 or spec.given:
             raise
-        # /tf without the marker set: the topic, said in the result (score_found).
+        # /tf without the marker set: the topic, said in the result (score_runs).
         marker = read_source(list(plist), spec, defaults, what="marker set poses")
     if len(marker) == 0:
         raise SegmentationError(f"{marker.source or plist[0]}: the marker set pose stream is empty")
@@ -203,7 +204,7 @@ def _stateless(bag: Path, options: Fbm2hOptions) -> str:
     )
 
 
-def locate_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
+def find_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
     """The reached moments: from the states, a timing file or stops in the ground truth.
 
     Raises:

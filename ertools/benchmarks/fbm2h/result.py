@@ -10,23 +10,34 @@ import numpy as np
 import numpy.typing as npt
 import yaml
 
-from ertools import yamlin
-from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
-from ertools.benchmarks.common.uncertainty import Interval, uncertainty_rows
+from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, uncertainty_rows
 from ertools.benchmarks.common.validity import GapOnPath, Validity, cell
-from ertools.benchmarks.fbm2h.intervals import Fbm2hIntervals
-from ertools.configs.goal import GoalList
+from ertools.benchmarks.fbm2h.goal import GoalList
 from ertools.configs.transform import MarkerTransform
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames
+from ertools.serialize import dump_yaml, jsonable
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
+from ertools.yamlin import load as load_yaml
 
 if TYPE_CHECKING:
     import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 Pose2 = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class Fbm2hIntervals:
+    """The intervals of one result: accuracies, then per scored segment index."""
+
+    position: Interval | None
+    orientation: Interval | None
+    distance: dict[int, Interval | None]
+    angle: dict[int, Interval | None]
+    uncertainty: Uncertainty
 
 
 @dataclass(frozen=True)
@@ -90,7 +101,7 @@ def _payload_value(payload: str) -> Any:
         return {}
 
     try:
-        value = yamlin.load(text, duplicates=[])  # shown as the 2015 node read it
+        value = load_yaml(text, duplicates=[])  # shown as the 2015 node read it
     except yaml.YAMLError:
         return payload
     return value if isinstance(value, dict) else payload

@@ -244,3 +244,13 @@ VERSIONS = (
         "`--rules 2017` (= `--rules 2015`)",
     ),
 )
+
+# Every rule above, in the catalogue's order (the benchmark's ``rules``).
+RULES = (
+    RULE_ORIENTATION_WRAP,
+    RULE_SEGMENT_CLOCK,
+    RULE_POSE_SOURCE,
+    RULE_POSE_MOMENT,
+    RULE_UNSCORED,
+    RULE_SCORE_FORMAT,
+)

@@ -26,10 +26,10 @@ from ertools.benchmarks.common.phases import (
     Track,
     protocol_track,
 )
-from ertools.benchmarks.fbm3w.path import subsample_d_min
+from ertools.benchmarks.fbm3w.formula import arc_fractions, frame_errors, subsample_d_min
 from ertools.benchmarks.fbm3w.runs import RunWindow
-from ertools.configs.fbm3w import Fbm3wConfig
-from ertools.configs.shapes import Shape
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
+from ertools.benchmarks.fbm3w.shapes import Shape
 from ertools.errors import ConfigError, SegmentationError
 from ertools.streams import PoseStream
 
@@ -75,17 +75,18 @@ def _match(path: F64, start: F64, ref: F64, shape: Shape, d_det: float) -> tuple
     kept = path[subsample_d_min(path, d_det)]
     if len(kept) < 2:
         return math.inf, math.inf
-    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(kept, axis=0).T))])
-    target = shape(cum / cum[-1])
+    one = np.array([len(kept)])
+    l_norm, _ = arc_fractions(kept[:, 0], kept[:, 1], one)
+    target = shape(l_norm)
     rel = kept - start
-    # least-squares rotation of rel onto target (2-D Kabsch about the fixed start)
+    # least-squares rotation of rel onto target (2-D Kabsch about the fixed start): the frame
+    # whose x axis is at -atan2(cross, dot) in the world
     cross = float(np.sum(rel[:, 0] * target[:, 1] - rel[:, 1] * target[:, 0]))
     dot = float(np.sum(rel[:, 0] * target[:, 0] + rel[:, 1] * target[:, 1]))
     errs = []
-    for yaw in (math.atan2(cross, dot), -math.atan2(*(start - ref)[::-1])):
-        c, s = math.cos(yaw), math.sin(yaw)
-        rot = np.column_stack([c * rel[:, 0] - s * rel[:, 1], s * rel[:, 0] + c * rel[:, 1]])
-        errs.append(float(np.mean(np.hypot(*(rot - target).T))))
+    for yaw in (-math.atan2(cross, dot), math.atan2(*(start - ref)[::-1])):
+        c, s = np.array([math.cos(yaw)]), np.array([math.sin(yaw)])
+        errs.append(float(np.mean(frame_errors(kept[:, 0], kept[:, 1], one, target, c, s))))
     return errs[0], errs[1]
 
 

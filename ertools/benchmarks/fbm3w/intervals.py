@@ -46,6 +46,8 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, IntArr
+from ertools.benchmarks.common.epsilon import NoiseResult
+from ertools.benchmarks.common.inputs import DEFAULT_C
 from ertools.benchmarks.common.uncertainty import (
     D_MIN,
     MOCAP_NOISE,
@@ -59,14 +61,12 @@ from ertools.benchmarks.common.uncertainty import (
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
 from ertools.benchmarks.fbm3w.perturbed import RunSamples, perturbed_runs
 from ertools.benchmarks.fbm3w.result import RunResult
-from ertools.benchmarks.noise.benchmark import NoiseResult
-from ertools.configs.fbm3w import Fbm3wConfig
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.streams import PoseStream
 
 # The coefficient of variation of a Rayleigh distance, sqrt(4/pi - 1): the spread of one
 # consecutive-pair distance around epsilon.
 RAYLEIGH_CV = math.sqrt(4.0 / math.pi - 1.0)
-DEFAULT_C = 3.0  # the seed's D_MIN = c * epsilon (7.3.2), for the default noise
 DEFAULT_D_MIN_REL = 0.10
 METHOD = (
     "Monte Carlo (parametric bootstrap around the smoothed path, basic interval; the shares: "

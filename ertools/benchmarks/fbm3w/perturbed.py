@@ -15,7 +15,7 @@ import numpy.typing as npt
 
 from ertools.arrays import F64, Bool, IntArr
 from ertools.benchmarks.common.draws import normal_pairs
-from ertools.configs.shapes import Shape
+from ertools.benchmarks.fbm3w.shapes import Shape
 
 # Draws x samples of one batch: bounds the memory of a long run (~8 bytes x a few arrays).
 BATCH_ELEMENTS = 2_000_000

@@ -6,7 +6,8 @@ import math
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
-from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.base import Rows
+from ertools.benchmarks.common.epsilon import NoiseResult
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
 from ertools.benchmarks.common.uncertainty import (
     Interval,
@@ -15,11 +16,11 @@ from ertools.benchmarks.common.uncertainty import (
     uncertainty_rows,
 )
 from ertools.benchmarks.common.validity import GapOnPath, Validity, cell, gaps_on_path
-from ertools.benchmarks.fbm3w.path import PathScore
+from ertools.benchmarks.fbm3w.formula import PathScore
 from ertools.benchmarks.fbm3w.runs import RunWindow
-from ertools.benchmarks.noise.benchmark import NoiseResult
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames
+from ertools.serialize import dump_yaml, jsonable
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
 
@@ -176,7 +177,7 @@ class Fbm3wResult:
     @property
     def nothing_scored(self) -> bool:
         """Every run failed (none scored, timed out, stopped or interrupted): the CLI prints
-        only the failures (``ertools.cli.common.all_failed``)."""
+        only the failures (``ertools.benchmarks.document.all_failed``)."""
         return all(r.status == "failed" for r in self.runs)
 
     @property

@@ -289,3 +289,16 @@ VERSIONS = (
         "`--2015`",
     ),
 )
+
+# Every rule above, in the catalogue's order (the benchmark's ``rules``).
+RULES = (
+    RULE_TIMEOUT_RUNS,
+    RULE_STOPPED_RUNS,
+    RULE_LIVE_CLOCK,
+    RULE_RUN_FINDING,
+    RULE_POSE_TOPIC,
+    RULE_D_MIN,
+    RULE_USER_SHAPES,
+    RULE_ARC_LENGTH,
+    RULE_UNSCOREABLE_RUNS,
+)

@@ -37,13 +37,13 @@ from ertools.benchmarks.common.ending import (
     log_cut,
     refbox_ends,
 )
-from ertools.configs._yaml import MAX_SECONDS, show
-from ertools.configs.fbm3w import Fbm3wConfig
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
+from ertools.configs._yaml import show
 from ertools.errors import ConfigError, SegmentationError
 from ertools.io.model import BenchmarkStates
 from ertools.states import BmBoxState, EndReason, end_reason
 from ertools.streams import StateStream
-from ertools.timeutil import ns_to_s, resolve_time
+from ertools.timeutil import MAX_SECONDS, ns_to_s, resolve_time
 
 # What a RefBox END payload does to the run it ends (ertools.states.end_reason).
 EARLY_END = {EndReason.TIMEOUT: "timeout", EndReason.STOP: "stopped"}

@@ -7,13 +7,15 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.base import Benchmark, Explanation, Input, Ranking, resolve_values
-from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS
+from ertools.benchmarks.base import Explanation, Input, Ranking, resolve_values
+from ertools.benchmarks.common.inputs import INTERVAL_INPUTS
 from ertools.benchmarks.hgmf import config
 from ertools.benchmarks.hgmf.config import CODE, DEFAULT_MAX_GAP_S, NAME, RULE_SETS, HgmfOptions
 from ertools.benchmarks.hgmf.flow import HgmfFlow
 from ertools.benchmarks.hgmf.pipeline import HgmfLogs, find_runs, load, score_runs
 from ertools.benchmarks.hgmf.result import HgmfResult
+from ertools.benchmarks.hgmf.rules import RULES
+from ertools.benchmarks.legacy import LegacyBenchmark
 
 SCRIPT = "the 2019 script (differences can be undone one by one)"
 
@@ -131,7 +133,8 @@ is printed in the result file's form; stderr compares it with the live score
 object of more than 3 cm over its height before the goal; the distance is the object's to its
 target in the table's plane, at the lookup after the goal."""
 
-BENCHMARK: Benchmark[HgmfOptions, HgmfLogs, HgmfFlow, HgmfResult] = Benchmark(
+BENCHMARK: LegacyBenchmark[HgmfOptions, HgmfLogs, HgmfFlow, HgmfResult] = LegacyBenchmark(
+    rules=RULES,
     name=NAME,
     title=config.TITLE,
     summary="HGMF (FBM6@Home 2019) grasping and manipulation: the RSBB script re-scored",

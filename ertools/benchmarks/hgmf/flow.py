@@ -17,11 +17,11 @@ from typing import Any
 
 import yaml
 
-from ertools import yamlin
 from ertools.arrays import I64
 from ertools.rsbb.clock import GoalTimes, goal_times
 from ertools.rsbb.log import EndKind, GoalEvent, RsbbRun
 from ertools.rsbb.tf import TfTrack, helper_lookup
+from ertools.yamlin import load
 
 ATTEMPTS = 3
 ATTEMPT_S = 1.0
@@ -85,7 +85,7 @@ def goal_payload(text: str | None) -> tuple[tuple[float, float] | None, int | No
     if text is None:
         return None, None
     try:
-        value: Any = yamlin.load(text)
+        value: Any = load(text)
     except yaml.YAMLError:
         return None, None
     if not (isinstance(value, list) and len(value) == 3):

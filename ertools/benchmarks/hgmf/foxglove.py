@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ertools.benchmarks.hgmf.result import HgmfResult
-from ertools.report.foxglove.messages import (
+from ertools.views.foxglove import (
     BLUE,
     GREEN,
     INFO,

@@ -22,7 +22,7 @@ from ertools.benchmarks.hgmf.intervals import hgmf_intervals
 from ertools.benchmarks.hgmf.listing import score_listing
 from ertools.benchmarks.hgmf.result import HgmfGoal, HgmfResult, deviations_of
 from ertools.errors import ConfigError, UsageError
-from ertools.io import summary
+from ertools.io.summary import summary
 from ertools.rsbb.log import RsbbRun, read_rsbb_run
 from ertools.rsbb.results import RsbbResult, load_result
 from ertools.rsbb.score import compare_scores

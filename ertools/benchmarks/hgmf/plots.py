@@ -1,7 +1,7 @@
 """HGMF figures: the object's path on the table with the targets and the measured positions,
 and its height over the table with each goal's grasp threshold.
 
-Each figure is a :class:`~ertools.report.chart.Chart` (lengths in mm, times in s), built for
+Each figure is a :class:`~ertools.views.chart.Chart` (lengths in mm, times in s), built for
 its size (the path thinned to its pixels); reports write it as SVG.
 """
 
@@ -12,9 +12,10 @@ from typing import Any
 import numpy as np
 
 from ertools.benchmarks.hgmf.config import GRASP_RISE_M
-from ertools.report import units
-from ertools.report.chart import COLOURS, Axis, Chart, Layer, Line, RefLine, Scatter, Span, Text
-from ertools.report.figures import FigureSpec, chart_spec, thin_path, thin_series
+from ertools.views import units
+from ertools.views.chart import COLOURS, Axis, Chart, Layer, Line, RefLine, Scatter, Span, Text
+from ertools.views.spec import ChartSpec
+from ertools.views.thinning import thin_path, thin_series
 
 MM = units.factor("length", "m")
 TABLE_SIZE = (7.0, 6.0)
@@ -86,16 +87,16 @@ def height_chart(result: Any, size: tuple[float, float] = HEIGHT_SIZE) -> Chart:
     )
 
 
-def figure_specs(result: Any) -> list[FigureSpec]:
+def figure_specs(result: Any) -> list[ChartSpec]:
     """The table and the height figures of an ``HgmfResult``."""
     return [
-        chart_spec(
+        ChartSpec(
             "hgmf_table",
             "HGMF: the object on the table, targets and measured positions",
             lambda size: table_chart(result, size),
             TABLE_SIZE,
         ),
-        chart_spec(
+        ChartSpec(
             "hgmf_height",
             "HGMF: the object's height (green: a grasp; red: the height before the goal + 3 cm)",
             lambda size: height_chart(result, size),

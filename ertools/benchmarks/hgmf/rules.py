@@ -78,3 +78,6 @@ VERSIONS = (
         "`--rules 2019`",
     ),
 )
+
+# what the registry carries (declare passes it as ``rules=``), in definition order
+RULES = (RULE_RESTARTED_GOALS, RULE_GRASP_SAMPLING, RULE_GT_GAPS)

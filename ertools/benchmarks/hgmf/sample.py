@@ -6,7 +6,7 @@ where the robot puts it (lifting it 10 cm on the way, or pushing it without lift
 the goal times out, and whether the object's tracking is lost around the lookup after the goal:
 for more than the helper's 3 attempts of 1 s (the script finds no position and runs the goal
 again) or for 0.3 s (tf interpolates across; ertools' default refuses it, ``hgmf.gt-gaps``).
-:func:`build` turns it into an :class:`~ertools.samples.rsbb_scenario.RsbbScenario`: the
+:func:`build` turns it into an :class:`~ertools.simulator.rsbb_scenario.RsbbScenario`: the
 manual operations and goals timed, the object's and the table's motion (the table turned
 0.4 rad, its top 0.75 m up), the script's ``/object`` broadcasts at its successful lookups,
 and its saves. The saves hold the 2019 script's score computed here as it did (the object
@@ -34,11 +34,12 @@ import numpy as np
 import yaml
 from scipy.spatial.transform import Rotation, Slerp
 
-from ertools import atomic
+from ertools.atomic import write_text
 from ertools.rsbb_states import BENCHMARKS
-from ertools.samples.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
-from ertools.samples.rsbb import write_rsbb_run
-from ertools.samples.rsbb_scenario import (
+from ertools.simulator.answers import tol, window, write_answers
+from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
+from ertools.simulator.rsbb import write_rsbb_run
+from ertools.simulator.rsbb_scenario import (
     Body,
     Broadcast,
     Goal,
@@ -46,7 +47,6 @@ from ertools.samples.rsbb_scenario import (
     RsbbScenario,
     Save,
 )
-from ertools.samples.scenario import tol, window, write_answers
 
 S = 1_000_000_000
 MS = 1_000_000
@@ -291,7 +291,7 @@ def _scenario(
             Body("actor_markerset", actor, record_topics=False),
         ),
     )
-    # what the script's tf saw: /tf stamps are the header stamps + 5 us (ertools.samples.rsbb)
+    # what the script's tf saw: /tf stamps are the header stamps + 5 us (ertools.simulator.rsbb)
     published = {
         "actor": (actor.t_header_ns + 5_000, actor.xyz, actor.quat_xyzw),
         "table": (table.t_header_ns + 5_000, table.xyz, table.quat_xyzw),
@@ -462,7 +462,7 @@ def write_config(root: Path, objects: Sequence[dict[str, Any]] = OBJECTS) -> Pat
         "table_size": dict(TABLE_SIZE),
         "goal_timeout": GOAL_TIMEOUT_S,
     }
-    atomic.write_text(path, yaml.safe_dump(data, sort_keys=False))
+    write_text(path, yaml.safe_dump(data, sort_keys=False))
     return path
 
 

@@ -7,13 +7,15 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.base import Benchmark, Explanation, Input, Ranking, resolve_values
-from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS, check_confidence
+from ertools.benchmarks.base import Explanation, Input, Ranking, resolve_values
+from ertools.benchmarks.common.inputs import INTERVAL_INPUTS, check_confidence
 from ertools.benchmarks.hnf.config import DEFAULT_MAX_GAP_S, RULE_SETS, HnfOptions, options_from
 from ertools.benchmarks.hnf.flow import HnfFlow
 from ertools.benchmarks.hnf.logs import HnfLogs
 from ertools.benchmarks.hnf.pipeline import find_runs, load, score_runs
 from ertools.benchmarks.hnf.result import HnfResult
+from ertools.benchmarks.hnf.rules import RULES
+from ertools.benchmarks.legacy import LegacyBenchmark
 
 NAME = "hnf"
 SCRIPT = "the 2019 script (differences can be undone one by one)"
@@ -165,7 +167,8 @@ rsbb_bmbox/scripts/benchmark_configs/, results/HNF/<team>/), each named on stder
 is printed in the result file's form; stderr compares it with the live score
 (/rsbb/current_benchmark_result) and the result file, field by field."""
 
-BENCHMARK: Benchmark[HnfOptions, HnfLogs, HnfFlow, HnfResult] = Benchmark(
+BENCHMARK: LegacyBenchmark[HnfOptions, HnfLogs, HnfFlow, HnfResult] = LegacyBenchmark(
+    rules=RULES,
     name=NAME,
     title="HNF (FBM2@Home 2017-19)",
     summary="HNF (FBM2@Home 2017-19) navigation: the RSBB script re-scored",

@@ -18,10 +18,10 @@ from typing import Any
 
 import yaml
 
-from ertools import yamlin
 from ertools.arrays import I64
 from ertools.rsbb.log import EndKind, GoalEvent, GoalOutcome, RsbbRun
 from ertools.rsbb.tf import TfTrack, helper_lookup
+from ertools.yamlin import load
 
 #: The referee's prompt when the pose could not be acquired (00e3106 and 2bb8a41).
 PROMPT_START = "The position of the robot markerset could not be acquired"
@@ -94,7 +94,7 @@ def parse_result(text: str | None) -> Any:
     if text is None:
         return None
     try:
-        return yamlin.load(text)
+        return load(text)
     except yaml.YAMLError:
         return text
 

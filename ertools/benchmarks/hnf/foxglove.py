@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ertools.benchmarks.hnf.result import HnfResult
-from ertools.report.foxglove.messages import (
+from ertools.views.foxglove import (
     BLUE,
     ERROR,
     GREEN,

@@ -23,7 +23,7 @@ from ertools.benchmarks.hnf.logs import HnfLogs
 from ertools.benchmarks.hnf.result import HnfResult, HnfSegment, deviations_of
 from ertools.configs._yaml import parse_yaml
 from ertools.errors import ConfigError, UsageError
-from ertools.io import summary
+from ertools.io.summary import summary
 from ertools.rsbb.log import EndKind, RsbbRun, check_code, read_rsbb_run
 from ertools.rsbb.results import RsbbResult, load_result
 from ertools.rsbb.score import compare_scores

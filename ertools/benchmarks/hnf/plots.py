@@ -1,5 +1,5 @@
 """HNF's figures: the marker set's track with the waypoints and the poses the script measured,
-and the errors per segment. Each a :class:`~ertools.report.chart.Chart` (lengths in mm,
+and the errors per segment. Each a :class:`~ertools.views.chart.Chart` (lengths in mm,
 angles in degrees), written as SVG by reports and as images by ``--plot``.
 """
 
@@ -9,8 +9,8 @@ from typing import Any
 
 import numpy as np
 
-from ertools.report import units
-from ertools.report.chart import (
+from ertools.views import units
+from ertools.views.chart import (
     COLOURS,
     Arrows,
     Axis,
@@ -22,7 +22,8 @@ from ertools.report.chart import (
     Scatter,
     Text,
 )
-from ertools.report.figures import FigureSpec, chart_spec, thin_path
+from ertools.views.spec import ChartSpec
+from ertools.views.thinning import thin_path
 
 ARROW = 0.25  # metres: the heading arrows
 MM = units.factor("length", "m")
@@ -105,17 +106,17 @@ def errors_chart(result: Any) -> Chart:
     )
 
 
-def figure_specs(result: Any) -> list[FigureSpec]:
+def figure_specs(result: Any) -> list[ChartSpec]:
     """The path and the errors figures of an ``HnfResult``."""
     reading = "the 2019 script" if result.rules != "ertools" else "ertools' reading"
     return [
-        chart_spec(
+        ChartSpec(
             "hnf_path",
             f"HNF: track, waypoints and measured poses (--rules {result.rules})",
             lambda size: path_chart(result, size),
             PATH_SIZE,
         ),
-        chart_spec(
+        ChartSpec(
             "hnf_errors",
             f"HNF errors per segment (dashed: accuracy; {reading})",
             lambda size: errors_chart(result),

@@ -156,3 +156,13 @@ VERSIONS = (
         "`--rules 2019`",
     ),
 )
+
+# what the registry carries (declare passes it as ``rules=``), in definition order
+RULES = (
+    RULE_ORIENTATION_WRAP,
+    RULE_DIVISOR,
+    RULE_SKIPPED,
+    RULE_STOPPED,
+    RULE_GT_GAPS,
+    RULE_SCORE_FORMAT,
+)

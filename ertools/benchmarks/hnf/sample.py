@@ -35,14 +35,15 @@ from typing import Any
 import numpy as np
 import yaml
 
-from ertools import atomic
 from ertools.arrays import F64
+from ertools.atomic import write_text
 from ertools.geometry import compose, invert, quat_from_yaw, wrap_angle
 from ertools.rsbb.py2 import to_sec
 from ertools.rsbb.tf import TfTrack, script_poses
-from ertools.samples.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
-from ertools.samples.rsbb import TF_RECORD_LAG_NS, TF_STAMP_LAG_NS, write_rsbb_run
-from ertools.samples.rsbb_scenario import (
+from ertools.simulator.answers import tol, write_answers
+from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
+from ertools.simulator.rsbb import TF_RECORD_LAG_NS, TF_STAMP_LAG_NS, write_rsbb_run
+from ertools.simulator.rsbb_scenario import (
     Body,
     Broadcast,
     Goal,
@@ -50,7 +51,6 @@ from ertools.samples.rsbb_scenario import (
     RsbbScenario,
     Save,
 )
-from ertools.samples.scenario import tol, write_answers
 
 S = 1_000_000_000
 MS = 1_000_000
@@ -390,7 +390,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     tdir.mkdir(parents=True, exist_ok=True)
     transform = tdir / f"transform-{TEAM}.yaml"
     pair = f"- {[float(v) for v in t_mr]}\n- {[float(v) for v in q_mr]}\n"
-    atomic.write_text(
+    write_text(
         transform,
         f"team_name: {TEAM}\nmarkerset_to_robot_transform: !!python/tuple\n{pair}",
     )
@@ -402,5 +402,5 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         "waypoints": WAYPOINTS,
         "goal_timeout": GOAL_TIMEOUT,
     }
-    atomic.write_text(config, yaml.safe_dump(params, default_flow_style=None))
+    write_text(config, yaml.safe_dump(params, default_flow_style=None))
     return [*written, transform, config]

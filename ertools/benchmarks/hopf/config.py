@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.common.uncertainty import (
+from ertools.benchmarks.common.inputs import (
     DEFAULT_CONFIDENCE,
     DEFAULT_DRAWS,
     DEFAULT_SEED,

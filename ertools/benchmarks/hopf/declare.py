@@ -10,13 +10,15 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.base import Benchmark, Explanation, Input, Ranking, resolve_values
-from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS
+from ertools.benchmarks.base import Explanation, Input, Ranking, resolve_values
+from ertools.benchmarks.common.inputs import INTERVAL_INPUTS
 from ertools.benchmarks.hopf import config
 from ertools.benchmarks.hopf.config import DEFAULT_MAX_GAP_S, NAME, RULE_SETS, HopfOptions
 from ertools.benchmarks.hopf.pipeline import HopfLogs, find_runs, load, score_runs
 from ertools.benchmarks.hopf.result import HopfResult
+from ertools.benchmarks.hopf.rules import RULES
 from ertools.benchmarks.hopf.runs import HopfRuns
+from ertools.benchmarks.legacy import LegacyBenchmark
 
 SCRIPT_GROUP = "the RSBB script's behaviour (each difference can be undone)"
 
@@ -150,7 +152,8 @@ is tf's lookup at the moment the script made it (its /item broadcast). --rules 2
 2017-11) reproduces the script at that commit, quirks included; the score is compared with the
 run's live score and result file on stderr."""
 
-BENCHMARK: Benchmark[HopfOptions, HopfLogs, HopfRuns, HopfResult] = Benchmark(
+BENCHMARK: LegacyBenchmark[HopfOptions, HopfLogs, HopfRuns, HopfResult] = LegacyBenchmark(
+    rules=RULES,
     name=NAME,
     title="HOPF (FBM1@Home 2017-19)",
     summary="HOPF object perception (RSBB 2017-19): class, instance and pose of 10 items",

@@ -15,7 +15,7 @@ import math
 
 from ertools.benchmarks.hopf.goals import GoalRecord
 from ertools.benchmarks.hopf.result import HopfResult
-from ertools.report.foxglove.messages import (
+from ertools.views.foxglove import (
     BLUE,
     GREEN,
     INFO,

@@ -28,7 +28,7 @@ from ertools.benchmarks.hopf.result import HopfResult
 from ertools.benchmarks.hopf.runs import HopfRuns, Iteration, find_iterations
 from ertools.errors import ConfigError
 from ertools.fidelity import Deviation
-from ertools.io import summary
+from ertools.io.summary import summary
 from ertools.rsbb.log import RsbbRun, check_code, read_rsbb_run
 from ertools.rsbb.results import RsbbResult, load_result
 from ertools.rsbb.score import compare_scores

@@ -1,6 +1,6 @@
 """HOPF figures: pose score per goal, the errors, ground truth vs answers on the table.
 
-Each figure is a :class:`~ertools.report.chart.Chart` (lengths in mm, angles in degrees).
+Each figure is a :class:`~ertools.views.chart.Chart` (lengths in mm, angles in degrees).
 """
 
 from __future__ import annotations
@@ -11,9 +11,9 @@ from typing import Any
 import numpy as np
 
 from ertools.benchmarks import registry
-from ertools.report import units
-from ertools.report.chart import Arrows, Axis, Bars, Chart, Layer, Line, RefLine, Scatter, Text
-from ertools.report.figures import FigureSpec, chart_spec
+from ertools.views import units
+from ertools.views.chart import Arrows, Axis, Bars, Chart, Layer, Line, RefLine, Scatter, Text
+from ertools.views.spec import ChartSpec
 
 _RIGHT = "#1b9e77"
 _WRONG_INSTANCE = "#e6ab02"
@@ -136,21 +136,21 @@ def table_chart(result: Any) -> Chart:
     )
 
 
-def figure_specs(result: Any) -> list[FigureSpec]:
+def figure_specs(result: Any) -> list[ChartSpec]:
     """The HOPF figures of a result (``HopfResult``)."""
     label = registry.get(result.name).title
     return [
-        chart_spec(
+        ChartSpec(
             f"{result.name}_pose_scores",
             f"{label}: pose score per goal",
             lambda size: scores_chart(result),
         ),
-        chart_spec(
+        ChartSpec(
             f"{result.name}_errors",
             f"{label}: translation and theta errors",
             lambda size: errors_chart(result),
         ),
-        chart_spec(
+        ChartSpec(
             f"{result.name}_table",
             f"{label}: ground truth (black) vs answers on the table",
             lambda size: table_chart(result),

@@ -136,3 +136,13 @@ VERSIONS = (
         "`--rules 2019`",
     ),
 )
+
+# what the registry carries (declare passes it as ``rules=``), in definition order
+RULES = (
+    RULE_TRANSLATION_CLIP,
+    RULE_THETA_WRAP,
+    RULE_NAMES,
+    RULE_STOPPED_GOAL,
+    RULE_ANSWER_FIELDS,
+    RULE_GT_GAPS,
+)

@@ -47,12 +47,13 @@ from typing import Any
 import numpy as np
 import yaml
 
-from ertools import atomic
+from ertools.atomic import write_text
 from ertools.rsbb.tf import TfTrack, script_poses
 from ertools.rsbb_states import MOCAP_PARENT
-from ertools.samples.mocap import MocapNoise, frame_times, simulate_mocap
-from ertools.samples.rsbb import TF_RECORD_LAG_NS, TF_STAMP_LAG_NS, write_rsbb_run
-from ertools.samples.rsbb_scenario import (
+from ertools.simulator.answers import tol, write_answers
+from ertools.simulator.mocap import MocapNoise, frame_times, simulate_mocap
+from ertools.simulator.rsbb import TF_RECORD_LAG_NS, TF_STAMP_LAG_NS, write_rsbb_run
+from ertools.simulator.rsbb_scenario import (
     Body,
     Broadcast,
     Goal,
@@ -60,7 +61,6 @@ from ertools.samples.rsbb_scenario import (
     RsbbScenario,
     Save,
 )
-from ertools.samples.scenario import tol, write_answers
 
 S = 1_000_000_000
 MS = 1_000_000
@@ -393,7 +393,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     config_path = outdir / "rsbb_bmbox" / "scripts" / "benchmark_configs" / "HOPF.yaml"
     for path, data in ((items_path, {"items": list(items.values())}), (config_path, PARAMS)):
         path.parent.mkdir(parents=True, exist_ok=True)
-        atomic.write_text(path, yaml.safe_dump(data, default_flow_style=None))
+        write_text(path, yaml.safe_dump(data, default_flow_style=None))
     answers = write_answers(
         paths.bag,
         benchmark="hopf",

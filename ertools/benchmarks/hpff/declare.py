@@ -7,13 +7,15 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.base import Benchmark, Explanation, Input, Ranking, resolve_values
-from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS, check_confidence
+from ertools.benchmarks.base import Explanation, Input, Ranking, resolve_values
+from ertools.benchmarks.common.inputs import INTERVAL_INPUTS, check_confidence
 from ertools.benchmarks.hpff.config import DEFAULT_MAX_GAP_S, RULE_SETS, HpffOptions, options_from
 from ertools.benchmarks.hpff.flow import HpffFlow
 from ertools.benchmarks.hpff.logs import HpffLogs
 from ertools.benchmarks.hpff.pipeline import find_runs, load, score_runs
 from ertools.benchmarks.hpff.result import HpffResult
+from ertools.benchmarks.hpff.rules import RULES
+from ertools.benchmarks.legacy import LegacyBenchmark
 
 NAME = "hpff"
 SCRIPT = "the 2019 script (differences can be undone one by one)"
@@ -148,7 +150,8 @@ The side files are found beside the bag or in the RSBB's folders, each named on 
 score is printed in the result file's form; stderr compares it with the live score and the
 result file, field by field."""
 
-BENCHMARK: Benchmark[HpffOptions, HpffLogs, HpffFlow, HpffResult] = Benchmark(
+BENCHMARK: LegacyBenchmark[HpffOptions, HpffLogs, HpffFlow, HpffResult] = LegacyBenchmark(
+    rules=RULES,
     name=NAME,
     title="HPFF (FBM5@Home 2019)",
     summary="HPFF (FBM5@Home 2019) person following: the RSBB script re-scored",

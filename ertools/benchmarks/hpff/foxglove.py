@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from ertools.benchmarks.hpff.result import HpffResult
-from ertools.report.foxglove.messages import (
+from ertools.views.foxglove import (
     ERROR,
     INFO,
     Collected,

@@ -26,7 +26,7 @@ from ertools.benchmarks.hpff.result import (
     nan_xy,
 )
 from ertools.errors import ConfigError, UsageError
-from ertools.io import summary
+from ertools.io.summary import summary
 from ertools.rsbb.log import EndKind, check_code, read_rsbb_run
 from ertools.rsbb.py2 import to_sec
 from ertools.rsbb.results import load_result

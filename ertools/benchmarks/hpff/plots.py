@@ -1,5 +1,5 @@
 """HPFF's figures: the following distance over the run with the desired distance and the
-range, and the robot's and the person's tracks. Each a :class:`~ertools.report.chart.Chart`."""
+range, and the robot's and the person's tracks. Each a :class:`~ertools.views.chart.Chart`."""
 
 from __future__ import annotations
 
@@ -7,9 +7,10 @@ from typing import Any
 
 import numpy as np
 
-from ertools.report import units
-from ertools.report.chart import COLOURS, Axis, Chart, Layer, Line, RefLine, Scatter
-from ertools.report.figures import FigureSpec, chart_spec, thin_path
+from ertools.views import units
+from ertools.views.chart import COLOURS, Axis, Chart, Layer, Line, RefLine, Scatter
+from ertools.views.spec import ChartSpec
+from ertools.views.thinning import thin_path
 
 MM = units.factor("length", "m")
 TRACK_SIZE = (7.0, 6.0)
@@ -74,17 +75,17 @@ def track_chart(result: Any, size: tuple[float, float] = TRACK_SIZE) -> Chart:
     )
 
 
-def figure_specs(result: Any) -> list[FigureSpec]:
+def figure_specs(result: Any) -> list[ChartSpec]:
     """The distance and the tracks figures of an ``HpffResult``."""
     verdict = "" if result.passed is None else ("; passed" if result.passed else "; failed")
     return [
-        chart_spec(
+        ChartSpec(
             "hpff_distance",
             f"HPFF following distance (--rules {result.rules}{verdict})",
             lambda size: distance_chart(result),
             (7.0, 4.5),
         ),
-        chart_spec(
+        ChartSpec(
             "hpff_tracks",
             "HPFF robot and person tracks",
             lambda size: track_chart(result, size),

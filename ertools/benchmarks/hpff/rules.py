@@ -93,3 +93,6 @@ VERSIONS = (
         "`--rules 2019`",
     ),
 )
+
+# what the registry carries (declare passes it as ``rules=``), in definition order
+RULES = (RULE_SAMPLING, RULE_PLANE, RULE_DURATION, RULE_STOPPED, RULE_RELIABILITY)

@@ -32,15 +32,15 @@ from typing import Any
 import numpy as np
 import yaml
 
-from ertools import atomic
 from ertools.arrays import F64
+from ertools.atomic import write_text
 from ertools.geometry import compose, invert, quat_from_yaw, rotate
 from ertools.rsbb.py2 import percent_py2, to_sec
 from ertools.rsbb.tf import TfTrack, script_poses
-from ertools.samples.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
-from ertools.samples.rsbb import TF_RECORD_LAG_NS, TF_STAMP_LAG_NS, write_rsbb_run
-from ertools.samples.rsbb_scenario import Body, Broadcast, Goal, RsbbScenario, Save
-from ertools.samples.scenario import tol, write_answers
+from ertools.simulator.answers import tol, write_answers
+from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
+from ertools.simulator.rsbb import TF_RECORD_LAG_NS, TF_STAMP_LAG_NS, write_rsbb_run
+from ertools.simulator.rsbb_scenario import Body, Broadcast, Goal, RsbbScenario, Save
 
 S = 1_000_000_000
 MS = 1_000_000
@@ -298,12 +298,12 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     tdir.mkdir(parents=True, exist_ok=True)
     transform = tdir / f"transform-{TEAM}.yaml"
     pair = f"- {[float(v) for v in t_mr]}\n- {[float(v) for v in q_mr]}\n"
-    atomic.write_text(
+    write_text(
         transform,
         f"team_name: {TEAM}\nmarkerset_to_robot_transform: !!python/tuple\n{pair}",
     )
     cdir = outdir / "rsbb_bmbox" / "scripts" / "benchmark_configs"
     cdir.mkdir(parents=True, exist_ok=True)
     config = cdir / "HPFF.yaml"
-    atomic.write_text(config, yaml.safe_dump(PARAMS, default_flow_style=False))
+    write_text(config, yaml.safe_dump(PARAMS, default_flow_style=False))
     return [*written, transform, config]

@@ -10,13 +10,15 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.base import Benchmark, Explanation, Input, Ranking, resolve_values
-from ertools.benchmarks.common.uncertainty import INTERVAL_INPUTS
+from ertools.benchmarks.base import Explanation, Input, Ranking, resolve_values
+from ertools.benchmarks.common.inputs import INTERVAL_INPUTS
 from ertools.benchmarks.hppf import config
 from ertools.benchmarks.hppf.config import DEFAULT_MAX_GAP_S, NAME, RULE_SETS, HppfOptions
 from ertools.benchmarks.hppf.pipeline import HppfLogs, find_runs, load, score_runs
 from ertools.benchmarks.hppf.result import HppfResult
+from ertools.benchmarks.hppf.rules import RULES
 from ertools.benchmarks.hppf.runs import HppfRuns
+from ertools.benchmarks.legacy import LegacyBenchmark
 
 SCRIPT_GROUP = "the RSBB script's behaviour (each difference can be undone)"
 
@@ -120,7 +122,8 @@ script made it (its /person broadcast after the answer). --rules 2019 reproduces
 quirks included (a missing theta kills it; its percentage text); the score is compared with
 the run's live score and result file on stderr."""
 
-BENCHMARK: Benchmark[HppfOptions, HppfLogs, HppfRuns, HppfResult] = Benchmark(
+BENCHMARK: LegacyBenchmark[HppfOptions, HppfLogs, HppfRuns, HppfResult] = LegacyBenchmark(
+    rules=RULES,
     name=NAME,
     title="HPPF (FBM4@Home 2019)",
     summary="HPPF people perception (RSBB 2019): who each person is and where",

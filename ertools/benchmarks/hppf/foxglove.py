@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from ertools.benchmarks.hppf.goals import PassRecord
 from ertools.benchmarks.hppf.result import HppfResult
-from ertools.report.foxglove.messages import (
+from ertools.views.foxglove import (
     BLUE,
     GREEN,
     INFO,

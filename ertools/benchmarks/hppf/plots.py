@@ -8,9 +8,9 @@ from typing import Any
 import numpy as np
 
 from ertools.benchmarks import registry
-from ertools.report import units
-from ertools.report.chart import Axis, Bars, Chart, Layer, Line, RefLine, Scatter, Text
-from ertools.report.figures import FigureSpec, chart_spec
+from ertools.views import units
+from ertools.views.chart import Axis, Bars, Chart, Layer, Line, RefLine, Scatter, Text
+from ertools.views.spec import ChartSpec
 
 _RIGHT = "#1b9e77"
 _WRONG = "#d95f02"
@@ -82,16 +82,16 @@ def area_chart(result: Any) -> Chart:
     )
 
 
-def figure_specs(result: Any) -> list[FigureSpec]:
+def figure_specs(result: Any) -> list[ChartSpec]:
     """The HPPF figures of a result (``HppfResult``)."""
     label = registry.get(result.name).title
     return [
-        chart_spec(
+        ChartSpec(
             f"{result.name}_position_errors",
             f"{label}: position error per goal",
             lambda size: errors_chart(result),
         ),
-        chart_spec(
+        ChartSpec(
             f"{result.name}_area",
             f"{label}: the people (black) vs the answers",
             lambda size: area_chart(result),

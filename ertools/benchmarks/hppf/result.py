@@ -6,13 +6,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from ertools.benchmarks.base import Rows, jsonable
+from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
 from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, uncertainty_rows
 from ertools.benchmarks.hppf.goals import PassRecord
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames
 from ertools.rsbb.score import ScoreComparison, score_yaml
+from ertools.serialize import jsonable
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
 

@@ -72,3 +72,6 @@ VERSIONS = (
         "`--rules 2019`",
     ),
 )
+
+# what the registry carries (declare passes it as ``rules=``), in definition order
+RULES = (RULE_ANSWER_FIELDS, RULE_NAMES, RULE_GT_GAPS)

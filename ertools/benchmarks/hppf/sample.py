@@ -40,13 +40,20 @@ from typing import Any
 import numpy as np
 import yaml
 
-from ertools import atomic
+from ertools.atomic import write_text
 from ertools.rsbb.tf import TfTrack, script_poses
 from ertools.rsbb_states import MOCAP_PARENT
-from ertools.samples.mocap import MocapNoise, frame_times, simulate_mocap
-from ertools.samples.rsbb import TF_RECORD_LAG_NS, TF_STAMP_LAG_NS, write_rsbb_run
-from ertools.samples.rsbb_scenario import Body, Broadcast, Goal, ManualOperation, RsbbScenario, Save
-from ertools.samples.scenario import tol, write_answers
+from ertools.simulator.answers import tol, write_answers
+from ertools.simulator.mocap import MocapNoise, frame_times, simulate_mocap
+from ertools.simulator.rsbb import TF_RECORD_LAG_NS, TF_STAMP_LAG_NS, write_rsbb_run
+from ertools.simulator.rsbb_scenario import (
+    Body,
+    Broadcast,
+    Goal,
+    ManualOperation,
+    RsbbScenario,
+    Save,
+)
 
 S = 1_000_000_000
 MS = 1_000_000
@@ -289,7 +296,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     paths = write_rsbb_run(outdir, sc, compression="bz2")
     config = outdir / "rsbb_bmbox" / "scripts" / "benchmark_configs" / "HPPF.yaml"
     config.parent.mkdir(parents=True, exist_ok=True)
-    atomic.write_text(config, yaml.safe_dump(PARAMS, default_flow_style=None))
+    write_text(config, yaml.safe_dump(PARAMS, default_flow_style=None))
     n = len(PEOPLE)
     answers = write_answers(
         paths.bag,

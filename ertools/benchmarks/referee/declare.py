@@ -9,11 +9,13 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.base import Benchmark, Input, Ranking, resolve_values
+from ertools.benchmarks.base import Input, Ranking, resolve_values
+from ertools.benchmarks.legacy import LegacyBenchmark
 from ertools.benchmarks.referee.config import CODES, RefereeOptions, make_options, title
 from ertools.benchmarks.referee.formula import leaderboard_columns
 from ertools.benchmarks.referee.pipeline import RefereeLogs, find_runs, load, score_runs
 from ertools.benchmarks.referee.result import RefereeResult
+from ertools.benchmarks.referee.rules import RULES
 
 INPUTS = (
     Input(
@@ -51,7 +53,7 @@ counts 0 or 1, a count item its value. The time is the time the benchmark execut
 state topic, else the GUI's stop button enabled, to 0.1 s)."""
 
 
-def _declare(name: str) -> Benchmark[RefereeOptions, RefereeLogs, RefereeLogs, RefereeResult]:
+def _declare(name: str) -> LegacyBenchmark[RefereeOptions, RefereeLogs, RefereeLogs, RefereeResult]:
     code = CODES[name]
 
     def options(given: Mapping[str, Any]) -> RefereeOptions:
@@ -61,7 +63,8 @@ def _declare(name: str) -> Benchmark[RefereeOptions, RefereeLogs, RefereeLogs, R
         bags = sorted((samples / "season2019" / "rsbb_logs" / code).glob("*/run_*.bag"))
         return [str(bags[0])] if bags else None
 
-    return Benchmark(
+    return LegacyBenchmark(
+        rules=RULES,
         name=name,
         title=title(code),
         summary=f"{code}: the referee's items of an ERL @Home run, ranked by the ERL rule",

@@ -18,7 +18,7 @@ from ertools.benchmarks.base import notice
 from ertools.benchmarks.referee.config import RefereeOptions
 from ertools.benchmarks.referee.result import RefereeResult
 from ertools.errors import ConfigError, TopicError, UsageError
-from ertools.io import topics
+from ertools.io.reader import topics
 from ertools.rsbb.layout import FileKind, classify
 from ertools.rsbb.log import EndKind, read_rsbb_run
 from ertools.rsbb.referee import (

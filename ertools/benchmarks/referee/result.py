@@ -5,12 +5,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.base import Rows
 from ertools.benchmarks.referee.config import PENALTY_SCALE, TIME_SCALE
 from ertools.benchmarks.referee.formula import erl_rank
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames
 from ertools.rsbb.referee import Item, Tally
+from ertools.serialize import dump_yaml, jsonable
 from ertools.streams import Provenance
 
 if TYPE_CHECKING:

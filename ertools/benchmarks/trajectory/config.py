@@ -1,20 +1,24 @@
-"""The settings of a trajectory comparison (:class:`TrajectoryConfig`) and what ``--2015``
-selects (:data:`SETTINGS_2015`).
+"""The options of ``ertools score trajectory``: its inputs (:data:`INPUTS`), the settings of a
+comparison (:class:`TrajectoryConfig`), what ``--2015`` selects (:data:`SETTINGS_2015`), and
+:func:`make_options`. NumPy-free: the command's parser imports it.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
-from ertools.errors import ConfigError
-from ertools.geometry import (
-    Association,
-)
-from ertools.timeutil import NS_PER_S
+from ertools.benchmarks.base import Input, resolve_values
+from ertools.benchmarks.common.inputs import INTERVAL_INPUTS, IntervalSettings, unscoreable_input
+from ertools.errors import ConfigError, UsageError
+from ertools.io.model import INPUT_FORMATS
+from ertools.timeutil import MAX_SECONDS, NS_PER_S, s_to_ns
+
+if TYPE_CHECKING:  # a Literal: this module stays NumPy-free (the parser imports it)
+    from ertools.geometry import Association
 
 ASSOCIATIONS: tuple[Association, ...] = ("linear", "nearest", "hold")
 
@@ -56,7 +60,7 @@ class TrajectoryConfig:
             ``max_gap_ns`` and the tracking-lost rule then do not apply. None: ertools' rule.
         unscoreable: a comparison with too few valid pairs is ``unscoreable``, its statistics
             null (``null``), or scored from them with a warning (``2015``); see
-            :mod:`ertools.benchmarks.trajectory.scoring`.
+            :mod:`ertools.benchmarks.trajectory.comparison`.
     """
 
     association: Association = "linear"
@@ -139,3 +143,246 @@ SETTINGS_2015: Mapping[str, str] = MappingProxyType(
         "unscoreable": "2015",
     }
 )
+
+
+@dataclass(frozen=True)
+class TrajectoryOptions:
+    """Everything ``ertools score trajectory`` can be told: how to compare (``config``) and
+    where the poses are.
+
+    Attributes:
+        config: association, gaps, offset, coverage (:class:`TrajectoryConfig`).
+        robot_topic: the robot's pose of its marker set (None: the one
+            ``/rockin/*/marker_pose``).
+        gt_topic: the mocap pose of that marker set (None: the one PoseStamped topic).
+        robot_time: ``header`` (message stamps) or ``record`` (the robot bag's record time).
+        gt_time: the same for the GT (``--time-source`` sets both).
+        input_format: ``tum``, ``kitti``, ``euroc``, ``csv`` or ``bag`` for every input
+            (``--input-format``); None: detected by content (:func:`ertools.io.text.sniff`).
+        intervals: level, draws and seed of the statistics' confidence intervals.
+    """
+
+    config: TrajectoryConfig = field(default_factory=TrajectoryConfig)
+    robot_topic: str | None = None
+    gt_topic: str | None = None
+    robot_time: str = "header"
+    gt_time: str = "header"
+    input_format: str | None = None
+    intervals: IntervalSettings = field(default_factory=IntervalSettings)
+
+
+LEGACY = "2015 behaviour (each difference can be undone)"
+
+INPUTS = (
+    Input(
+        "robot_topic",
+        "str",
+        "the robot's pose of its marker set (default: the one /rockin/*/marker_pose)",
+        metavar="TOPIC",
+    ),
+    Input(
+        "gt_topic",
+        "str",
+        "the mocap pose of that marker set (default: the one PoseStamped topic)",
+        metavar="TOPIC",
+    ),
+    Input(
+        "association",
+        "choice",
+        "GT pose at a robot time: interpolated (linear, default), nearest, or the last "
+        "before (hold, 2015)",
+        choices=ASSOCIATIONS,
+        group=LEGACY,
+    ),
+    Input(
+        "ties",
+        "choice",
+        "with --association hold, a robot pose stamped exactly at a GT sample is compared "
+        "with that sample (at, default) or the one before it (before, 2015)",
+        choices=TIES,
+        group=LEGACY,
+    ),
+    Input(
+        "gaps",
+        "choice",
+        "robot poses in GT gaps longer than --max-gap: not compared (skip, default) or "
+        "compared with the GT pose across the gap and counted (compare, 2015)",
+        choices=GAPS,
+        group=LEGACY,
+    ),
+    Input(
+        "before_gt",
+        "choice",
+        "robot poses before the first GT pose: uncovered (default: an error, or not scored "
+        "with --allow-partial) or compared with the first GT pose (first, 2015)",
+        choices=BEFORE_GT,
+        group=LEGACY,
+    ),
+    Input(
+        "gt_order",
+        "choice",
+        "GT files overlapping in time: their poses merged in time order (time, default) or "
+        "the files chained by start time and scanned forward (chain, 2015; needs "
+        "--association hold --ties before)",
+        choices=GT_ORDERS,
+        group=LEGACY,
+    ),
+    # too few valid pairs make the comparison unscoreable (docs/uncertainty.md)
+    unscoreable_input(LEGACY),
+    Input(
+        "as_2015",
+        "flag",
+        "compute what the 2015 script did: --association hold --ties before --gaps compare "
+        "--before-gt first --gt-order chain --unscoreable 2015 (2015's orientation error is "
+        "orientation_error_2015)",
+        flag="--2015",
+        group=LEGACY,
+    ),
+    Input(
+        "max_gap",
+        "float",
+        "a robot pose whose surrounding GT poses are further apart is in a GT gap "
+        "(default 0.1 s; see --gaps)",
+        default=0.1,
+        unit="s",
+        positive=True,
+    ),
+    Input(
+        "t_max_diff",
+        "float",
+        "pair as evo does (`evo_ape ... --t_max_diff S`, evo's default 0.01; implies "
+        "--association nearest): each pose of the shorter trajectory with the nearest stamp "
+        "of the other within S seconds; --max-gap and the tracking-lost rule do not apply",
+        unit="s",
+        minimum=0.0,
+    ),
+    Input(
+        "offset",
+        "str",
+        "shift the robot stamps by S seconds, or estimate the shift (auto)",
+        default="0",
+        metavar="S|auto",
+    ),
+    Input(
+        "apply_offset",
+        "flag",
+        "with --offset auto: score with the estimated offset (else it is only reported)",
+    ),
+    Input(
+        "offset_range",
+        "float",
+        "the clock audit searches offsets within +-S seconds (default 5)",
+        default=5.0,
+        unit="s",
+        positive=True,
+    ),
+    Input(
+        "allow_partial",
+        "flag",
+        "score the covered part when robot poses lie outside the GT",
+    ),
+    Input(
+        "robot_time_source",
+        "choice",
+        "robot pose time: message stamp (default) or the robot bag's record time (the GT "
+        "keeps --time-source)",
+        old_flags=("--robot-time",),
+        choices=("header", "record"),
+    ),
+    Input(
+        "time_source",
+        "choice",
+        "the time robot and GT poses are selected and paired by: header stamps (default; "
+        "simulation time in a sim bag, as evo uses) or record times",
+        choices=("header", "record"),
+    ),
+    Input(
+        "input_format",
+        "choice",
+        "read every input as this (default: detected by content): a TUM, KITTI (paired row "
+        "by row, as evo_ape kitti), EuRoC ground-truth or ertools CSV text trajectory, or a "
+        "bag",
+        choices=INPUT_FORMATS,
+    ),
+    *INTERVAL_INPUTS,
+)
+
+
+def _2015_options() -> str:
+    return " ".join(f"--{k.replace('_', '-')} {v}" for k, v in SETTINGS_2015.items())
+
+
+def _offset(text: str) -> float | None:
+    """Seconds, or None for ``auto``."""
+
+    if text == "auto":
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        raise UsageError(f"--offset takes seconds or 'auto', not {text!r}") from None
+    if not (math.isfinite(value) and abs(value) < MAX_SECONDS):
+        raise UsageError(
+            f"--offset {text}: give a finite number smaller than {MAX_SECONDS:g} s in size "
+            "or 'auto'"
+        )
+    return value
+
+
+def make_options(given: Mapping[str, Any]) -> TrajectoryOptions:
+    """The values of :data:`INPUTS` -> :class:`TrajectoryOptions`.
+
+    Raises:
+        UsageError: a value out of range, or options that contradict each other (exit 2).
+    """
+    v = resolve_values(INPUTS, given)
+    offset = _offset(v["offset"])
+    auto = offset is None
+    if v["apply_offset"] and not auto:
+        raise UsageError("--apply-offset needs --offset auto")
+    chosen = {
+        k: v[k] for k in ("association", "ties", "gaps", "before_gt", "gt_order", "unscoreable")
+    }
+    settings = {k: value for k, value in chosen.items() if value is not None}
+    if v["as_2015"]:
+        clash = [
+            f"--{k.replace('_', '-')} {value}"
+            for k, value in settings.items()
+            if SETTINGS_2015[k] != value
+        ]
+        if clash:
+            raise UsageError(f"--2015 sets {_2015_options()}; it cannot take {', '.join(clash)}")
+        settings = dict(SETTINGS_2015)
+    if v["t_max_diff"] is not None and "association" not in settings:
+        settings["association"] = "nearest"  # evo's pairing is a nearest-stamp one
+    if settings.get("ties") == "before" and settings.get("association") != "hold":
+        raise UsageError("--ties before needs --association hold")
+    try:
+        config = TrajectoryConfig(
+            **settings,
+            max_gap_ns=s_to_ns(v["max_gap"]),
+            offset_ns=0 if offset is None else s_to_ns(offset),
+            auto_offset=auto,
+            apply_offset=v["apply_offset"],
+            offset_range_ns=s_to_ns(v["offset_range"]),
+            allow_partial=v["allow_partial"],
+            t_max_diff=v["t_max_diff"],
+        )
+    except ConfigError as err:
+        raise UsageError(err.message) from None
+    both = v["time_source"]
+    robot_time = v["robot_time_source"]
+    if both is not None and robot_time is not None and both != robot_time:
+        raise UsageError(
+            f"--time-source {both} sets the robot's time too: it cannot take "
+            f"--robot-time-source {robot_time}"
+        )
+    return TrajectoryOptions(
+        config,
+        v["robot_topic"],
+        v["gt_topic"],
+        robot_time or both or "header",
+        both or "header",
+        v["input_format"],
+        IntervalSettings.from_values(v),
+    )

@@ -8,10 +8,11 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from ertools.benchmarks.common.clocks import OffsetEstimate
-from ertools.benchmarks.common.interval_output import IntervalSettings
+from ertools.benchmarks.common.inputs import IntervalSettings
 from ertools.benchmarks.common.validity import from_codes
 from ertools.benchmarks.trajectory.association import Matched
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.formula import Metrics, metrics
 from ertools.benchmarks.trajectory.intervals import (
     FITTED_KEYS,
     FITTED_SUFFIX,
@@ -19,7 +20,6 @@ from ertools.benchmarks.trajectory.intervals import (
     Rescoring,
     trajectory_intervals,
 )
-from ertools.benchmarks.trajectory.metrics import Metrics, metrics
 from ertools.benchmarks.trajectory.result import FittedScore
 from ertools.benchmarks.trajectory.validity import too_few, validity_codes
 from ertools.streams import PoseStream

@@ -1,7 +1,7 @@
 """Confidence intervals of the trajectory statistics (issues 28 and 39; the model and its
 derivations: docs/uncertainty.md, "Trajectory" and "Closed forms").
 
-Every statistic of :mod:`ertools.benchmarks.trajectory.metrics` gets the interval of its
+Every statistic of :mod:`ertools.benchmarks.trajectory.formula` gets the interval of its
 value under two sources of uncertainty on the GT side of each compared pair:
 
 - ``mocap_noise``: sigma per axis (and the yaw's) measured from the GT stream itself
@@ -59,10 +59,11 @@ from ertools.benchmarks.common.draws import (
     order_stats,
     percentile_rows,
 )
+from ertools.benchmarks.common.epsilon import noise_from_stream
+from ertools.benchmarks.common.inputs import IntervalSettings
 from ertools.benchmarks.common.interval_output import (
     METHOD,
     NO_INTERVALS,
-    IntervalSettings,
     ResultIntervals,
     shares_of,
     withheld,
@@ -77,9 +78,8 @@ from ertools.benchmarks.common.uncertainty import (
     sigma_from_epsilon,
     too_few,
 )
-from ertools.benchmarks.noise.benchmark import noise_from_stream
 from ertools.benchmarks.trajectory.association import COMPARED, Matched
-from ertools.benchmarks.trajectory.metrics import PERCENTILES
+from ertools.benchmarks.trajectory.formula import PERCENTILES
 from ertools.errors import ErtoolsError
 from ertools.geometry import wrap_angle, yaw_from_quat
 from ertools.streams import PoseStream
@@ -320,7 +320,7 @@ def _rescored_rows(t_robot: IntArr, t_gt: IntArr, reach_s: float) -> npt.NDArray
 
 def grid_statistics(m: Matched, shifts: int) -> F64:
     """(shifts, KEYS) statistics of an association of ``shifts`` blocks of rows (each block
-    the same poses at one shift), as :func:`~ertools.benchmarks.trajectory.metrics.metrics`
+    the same poses at one shift), as :func:`~ertools.benchmarks.trajectory.formula.metrics`
     computes them; NaN for a block with no pose compared."""
     ok = (m.status == COMPARED).reshape(shifts, -1)
     d = m.position_error.reshape(shifts, -1)

@@ -6,15 +6,21 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
-from ertools.benchmarks.base import Rows, dump_yaml, jsonable
+from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.clocks import OffsetEstimate
-from ertools.benchmarks.common.interval_output import interval_tables, low_high
+from ertools.benchmarks.common.interval_output import (
+    ScoreRow,
+    interval_lines,
+    interval_tables,
+    low_high,
+)
 from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, interval_keys
 from ertools.benchmarks.common.validity import Validity, cell
+from ertools.benchmarks.results import ResultBase
 from ertools.benchmarks.trajectory.association import (
     COMPARED,
     GAP,
@@ -25,15 +31,11 @@ from ertools.benchmarks.trajectory.association import (
     Matched,
 )
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.formula import Metrics
 from ertools.benchmarks.trajectory.intervals import FITTED_KEYS, FITTED_SUFFIX, KEYS
-from ertools.benchmarks.trajectory.metrics import Metrics
 from ertools.fidelity import Deviation
-from ertools.frames import tables_to_frames
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import NS_PER_S, ns_to_s
-
-if TYPE_CHECKING:
-    import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 # The summary table's statistics that get ``_low``/``_high`` columns (the percentiles have
 # their own table).
@@ -72,7 +74,7 @@ class FittedScore:
 
 
 @dataclass(frozen=True, eq=False)
-class TrajectoryResult:
+class TrajectoryResult(ResultBase):
     """A scored robot log (implements ``BenchmarkResult``).
 
     Attributes:
@@ -159,8 +161,9 @@ class TrajectoryResult:
         """Robot poses evo's association (``--t-max-diff``) left without a GT pose."""
         return self.matched.count(UNPAIRED)
 
-    def to_dict(self) -> dict[str, Any]:
-        """Scores, counts and the clock audit (the keys scripts depend on come first)."""
+    def listing(self) -> dict[Any, Any]:
+        """Scores, counts and the clock audit (the keys scripts depend on come first); the YAML
+        lists the same (the 2015 script printed two text lines)."""
         m = self.metrics
         a = self.audit
         data: dict[str, Any] = {
@@ -222,17 +225,7 @@ class TrajectoryResult:
                 data["percentiles"] = interval_keys(data["percentiles"], pct)
         if self.uncertainty is not None:
             data["uncertainty"] = self.uncertainty.to_dict()
-        out: dict[str, Any] = jsonable(data)
-        return out
-
-    def to_yaml(self) -> str:
-        """The same as :meth:`to_dict` as YAML (the 2015 script printed two text lines)."""
-        return dump_yaml(self.to_dict())
-
-    def to_frames(self) -> dict[str, pd.DataFrame]:
-        """Every table of :meth:`tables` as a pandas DataFrame, epoch times as a UTC index
-        (:func:`ertools.frames.tables_to_frames`)."""
-        return tables_to_frames(self.tables())
+        return data
 
     def tables(self) -> dict[str, Rows]:
         """``samples`` (one row per robot pose: the error series) and ``summary``."""
@@ -305,6 +298,42 @@ class TrajectoryResult:
 
 def _f(x: float) -> float | None:
     return None if np.isnan(x) else float(x)
+
+
+def notes(result: TrajectoryResult) -> list[str]:
+    """One stderr line per main statistic with its interval and the sources' shares."""
+    m = result.metrics
+    if m is None or result.uncertainty is None:
+        return []
+    iv = result.intervals
+    rows = [
+        ScoreRow("position_error", m.position_error, iv.get("position_error"), 1000.0, "mm"),
+        ScoreRow("rmse", m.rmse, iv.get("rmse"), 1000.0, "mm"),
+        ScoreRow("max", m.max, iv.get("max"), 1000.0, "mm"),
+        ScoreRow("orientation_error", m.orientation_error, iv.get("orientation_error"), 1.0, "rad"),
+    ]
+    fit = result.fitted
+    if fit is not None:
+        # the score at the offset the data fits, beside the clock audit's warning
+        fi = fit.intervals
+        suffix = FITTED_SUFFIX
+        rows += [
+            ScoreRow(
+                f"position_error{suffix}",
+                fit.metrics.position_error,
+                fi.get("position_error"),
+                1000.0,
+                "mm",
+            ),
+            ScoreRow(
+                f"orientation_error{suffix}",
+                fit.metrics.orientation_error,
+                fi.get("orientation_error"),
+                1.0,
+                "rad",
+            ),
+        ]
+    return interval_lines(rows, result.uncertainty)
 
 
 def _with_fitted(data: dict[str, Any], fitted: FittedScore) -> dict[str, Any]:

@@ -155,3 +155,16 @@ RULE_UNSCOREABLE = Rule(
     ),
     option="--unscoreable 2015",
 )
+
+# Every rule above, in the catalogue's order (the benchmark's ``rules``).
+RULES = (
+    RULE_ASSOCIATION,
+    RULE_TIES,
+    RULE_GAPS,
+    RULE_BEFORE_GT,
+    RULE_YAW_WRAP,
+    RULE_GT_OVERLAP,
+    RULE_INVALID_POSES,
+    RULE_ROBOT_STAMPS,
+    RULE_UNSCOREABLE,
+)

@@ -38,8 +38,7 @@ class Deserializer:
     """Deserialize raw messages of some connections with their stored definitions."""
 
     def __init__(self, conns: Sequence[Conn], path: Path) -> None:
-        # lazy: rosbags only on the per-message path (~0.1 s to import)
-        from rosbags.typesys import (
+        from rosbags.typesys import (  # lazy: rosbags, 100 ms
             Stores,
             TypesysError,
             get_types_from_idl,
@@ -80,8 +79,7 @@ class Deserializer:
 
     def __call__(self, raw: bytes | memoryview, conn: Conn) -> Any:
         """The message object of ``raw`` (a rosbags dataclass instance)."""
-        # lazy: rosbags only on the per-message path (~0.1 s to import)
-        from rosbags.serde import SerdeError
+        from rosbags.serde import SerdeError  # lazy: rosbags, 100 ms
 
         try:
             if conn.encoding == "ros1":

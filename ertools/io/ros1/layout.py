@@ -21,8 +21,8 @@ from typing import BinaryIO
 import numpy as np
 import numpy.typing as npt
 
-from ertools import caches
 from ertools.arrays import I64, U8
+from ertools.caches import register
 from ertools.errors import BagError
 from ertools.inputs import open_regular
 from ertools.io.decode.fast import read_at
@@ -147,7 +147,7 @@ def index_header(header: bytes) -> tuple[int, int, int, int] | None:
 # an hour-long ``.active`` file) and one command opens a file several times (its summary, its
 # states, its poses). A file that grew or changed has another key.
 _SCANNED: dict[tuple[str, int, int, int, int], Ros1Layout] = {}
-caches.register(_SCANNED.clear)
+register(_SCANNED.clear)
 
 
 def read_layout(path: Path) -> Ros1Layout:

@@ -15,13 +15,13 @@ from typing import Any
 import numpy as np
 import yaml
 
-from ertools import yamlin
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
 from ertools.inputs import check_regular, open_regular, why_not
 from ertools.io.formats import load_metadata, metadata_problem
 from ertools.io.inflate import inflate_file
 from ertools.io.model import Conn
+from ertools.yamlin import YAMLError
 
 ROWS_PER_BATCH = 100_000
 
@@ -34,7 +34,7 @@ def read_metadata(path: Path) -> dict[str, Any]:
         info = data["rosbag2_bagfile_information"]
     except OSError as err:
         raise BagError(f"unreadable metadata.yaml ({why_not(err)})", path=path) from err
-    except (yamlin.YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
+    except (YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
         raise BagError(f"unreadable metadata.yaml ({metadata_problem(err)})", path=path) from err
     if not isinstance(info, dict):
         raise BagError("metadata.yaml has no rosbag2_bagfile_information", path=path)

@@ -12,9 +12,10 @@ Topics:
 
 from __future__ import annotations
 
-from ertools.audit.model import Audit
-from ertools.report.foxglove import content_function
-from ertools.report.foxglove.messages import (
+from ertools.auditing.model import Audit
+from ertools.benchmarks import registry
+from ertools.benchmarks.base import Reported
+from ertools.views.foxglove import (
     INFO,
     WARNING,
     Collected,
@@ -71,10 +72,9 @@ def content(out: Collected, a: Audit, *, limit: int) -> None:
     for x in a.early_ends:
         run = "between runs" if x.run is None else f"run {x.run}"
         log(out, x.t_ns, WARNING, f"RefBox ended {run} early: {x.reason}", "audit")
-    if a.recomputed is not None:
-        fn = content_function(a.recomputed)
-        if fn is not None:
-            fn(out, a.recomputed, limit=limit)
+    bench = registry.for_result(a.recomputed) if a.recomputed is not None else None
+    if isinstance(bench, Reported):
+        bench.foxglove(out, a.recomputed, limit=limit)
     c = a.comparison
     if c is not None:
         log(

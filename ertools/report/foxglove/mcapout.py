@@ -6,9 +6,10 @@ import os
 from collections.abc import Sequence
 from pathlib import Path
 
-from ertools import __version__, atomic
+from ertools._version import __version__
+from ertools.atomic import replacing
 from ertools.errors import UsageError
-from ertools.report.foxglove.messages import Collected
+from ertools.views.foxglove import Collected
 
 
 def refuse_inputs(out: Path, inputs: Sequence[str | Path]) -> None:
@@ -32,13 +33,13 @@ def write_mcap(out: Collected, path: Path) -> None:
     Written to a temporary file beside ``path`` and renamed, so an interrupted export never
     leaves a half-written file under the name asked for.
     """
-    from mcap.writer import Writer  # lazy: the mcap library only when an MCAP file is read
+    from mcap.writer import Writer  # lazy: mcap, 100 ms
 
     order = sorted(range(len(out.messages)), key=lambda i: out.messages[i][0])
     path.parent.mkdir(parents=True, exist_ok=True)
     # a temporary of a unique name (ertools.atomic): a name chosen in advance follows a symlink
     # planted there, and two exports at once would write into the same file
-    with atomic.replacing(path) as tmp, tmp.open("r+b") as f:
+    with replacing(path) as tmp, tmp.open("r+b") as f:
         w = Writer(f)
         w.start(profile="", library=f"ertools {__version__}")
         schema_ids: dict[str, int] = {}

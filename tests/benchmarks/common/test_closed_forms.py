@@ -23,6 +23,8 @@ from ertools.benchmarks.common.closed_forms import (
 )
 from ertools.benchmarks.common.draws import order_band
 
+pytestmark = pytest.mark.slow  # whole module: make test only
+
 N = 400_000  # draws of one pose's term
 Z = 5.0  # standard errors allowed
 

@@ -5,21 +5,20 @@ than run for days with gigabytes of draws."""
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import pytest
-from stderr_text import error_messages
 
 import ertools
 from ertools.benchmarks import registry
-from ertools.benchmarks.common.uncertainty import MAX_DRAWS, MAX_SEED
-from ertools.cli.main import MAX_ERROR_LINE, main
+from ertools.benchmarks.common.inputs import MAX_DRAWS, MAX_SEED
+from ertools.cli.main import main
+from ertools.cli.text import MAX_ERROR_LINE
 from ertools.errors import UsageError
+from tests.helpers.bagmaker import Spec, write
+from tests.helpers.stderr_text import error_messages
 
 ROOT = Path(__file__).resolve().parents[3]
-sys.path.insert(0, str(ROOT / "tests" / "io"))
-from io_bagmaker import Spec, write  # noqa: E402
 
 SAMPLES = ROOT / "sample_bags"
 FBM1 = [SAMPLES / "fbm1h" / "log_fbm1h_2015-11-20-12-00-00_0.bag", "--items"]
@@ -96,6 +95,7 @@ def test_the_cap_is_in_the_help(capsys: pytest.CaptureFixture[str]) -> None:
         assert f"at most {MAX_DRAWS}" in " ".join(capsys.readouterr().out.split())
 
 
+@pytest.mark.slow
 def test_the_largest_seed_is_taken() -> None:
     """The cap is the int64 a result carries: the largest seed scores (and the Python API
     refuses the next one as the CLI does)."""

@@ -4,17 +4,15 @@ for a pose topic among none; a mocap logger's file of every arena is named so.""
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import pytest
-from stderr_text import joined_lines
 
 from ertools.cli.main import main
+from tests.helpers.bagmaker import Spec, write
+from tests.helpers.stderr_text import joined_lines
 
 ROOT = Path(__file__).resolve().parents[3]
-sys.path.insert(0, str(ROOT / "tests" / "io"))
-from io_bagmaker import Spec, write  # noqa: E402
 
 ITEMS = ROOT / "sample_bags" / "fbm1h" / "fbm1h.yaml"
 

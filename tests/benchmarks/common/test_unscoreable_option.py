@@ -15,15 +15,15 @@ import pytest
 
 from ertools.api import _values as api_values
 from ertools.benchmarks import registry
-from ertools.benchmarks.common.validity import UNSCOREABLE
+from ertools.benchmarks.common.inputs import UNSCOREABLE
 from ertools.cli import score as score_cli
 from ertools.cli.main import build_parser
-from ertools.rescore.manifest import load_manifest
+from ertools.competition.manifest import load_manifest
 
 # what each benchmark needs besides the option (make_options reads no file)
 # The 2015 benchmarks (their unscoreable GT has a 2015 reading); the RSBB ones have no such
 # option: their scripts read tf, whose interpolation is their own rule (hnf.gt-gaps).
-WITH_2015 = [n for n in registry.names() if registry.get(n).values_2015]
+WITH_2015 = [n for n in registry.names() if any(r.season == "2015" for r in registry.get(n).rules)]
 REQUIRED = {"fbm1h": ["--items", "items.yaml"], "fbm1w": ["--items", "items.yaml"]}
 # benchmark -> (former spelling on the command line, former manifest key, its value there)
 FORMER = {

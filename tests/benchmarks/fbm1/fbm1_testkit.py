@@ -16,9 +16,9 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from ertools.samples.mocap import MocapNoise, publish_mocap, simulate_mocap
-from ertools.samples.statemachine import Transition, publish_states
-from ertools.samples.writer import BagWriter
+from ertools.simulator.mocap import MocapNoise, publish_mocap, simulate_mocap
+from ertools.simulator.statemachine import Transition, publish_states
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
 from ertools.streams import PoseStream, StateStream
 

@@ -1,7 +1,7 @@
 """The FBM1 nodes of rockin-robot-challenge/benchmark_and_scoring_fbm, replayed over a log.
 
 Four versions, each read at its commit (``git show COMMIT:scripts/fbm1h``) and ported here
-statement by statement, over the BmBox replayed from the log (``tests/bmbox2015.py``); line
+statement by statement, over the BmBox replayed from the log (``tests/helpers/bmbox2015.py``); line
 numbers are those of the version named:
 
 - ``scripts/fbm1h`` at e373be0 (2015-10-30, the last 2015 change; RoCKIn 2015 Lisbon; its
@@ -40,7 +40,8 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import yaml
-from bmbox2015 import Blocked, BmBoxReplay, Msg
+
+from tests.helpers.bmbox2015 import Blocked, BmBoxReplay, Msg
 
 BENCHMARK_RUNS = 10
 # The versions: (script, commit).

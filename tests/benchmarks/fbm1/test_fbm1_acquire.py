@@ -17,8 +17,8 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from ertools.cli.main import main
 from ertools.configs.items import load_items
-from ertools.samples.mocap import MocapNoise, frame_times, publish_mocap, simulate_mocap
-from ertools.samples.writer import BagWriter
+from ertools.simulator.mocap import MocapNoise, frame_times, publish_mocap, simulate_mocap
+from ertools.simulator.writer import BagWriter
 
 S = 1_000_000_000
 T0 = 1_448_030_000 * S
@@ -96,6 +96,7 @@ def _check(path: Path) -> None:
         assert 5e-5 < item.spread.position_m < 1e-3
 
 
+@pytest.mark.slow
 def test_acquire_found_phases_round_trip(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -7,16 +7,23 @@ import math
 from pathlib import Path
 
 import pytest
-from fbm1_testkit import ITEMS_YAML, RunSpec, bodies, state_streams, write_bag, write_items
-from stderr_text import error_messages
 
 from ertools.benchmarks.fbm1.answers import parse_answer_payload
-from ertools.benchmarks.fbm1.benchmark import score_fbm1
+from ertools.benchmarks.fbm1.pipeline import score_fbm1
 from ertools.benchmarks.fbm1.runs import find_runs
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import ItemList, parse_items
 from ertools.states import Machine
+from tests.benchmarks.fbm1.fbm1_testkit import (
+    ITEMS_YAML,
+    RunSpec,
+    bodies,
+    state_streams,
+    write_bag,
+    write_items,
+)
+from tests.helpers.stderr_text import error_messages
 
 GOOD = RunSpec(
     "Place item 3 (b2) on the table",
@@ -88,6 +95,7 @@ def _cli(tmp_path: Path, capsys: pytest.CaptureFixture[str], bag: Path, *extra: 
     return code, out, err
 
 
+@pytest.mark.slow
 def test_cli_bad_payload_exit_1_other_run_scored(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -101,6 +109,7 @@ def test_cli_bad_payload_exit_1_other_run_scored(
     assert data["failures"] == ["run 1: answer theta is nan (client payload)"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("body", "start", "end", "message"),
     [
@@ -132,6 +141,7 @@ def test_cli_body_lost_during_a_run(
     assert data["runs"]["2"]["pose_score"] == pytest.approx(GOOD_SCORE, abs=1e-9)
 
 
+@pytest.mark.slow
 def test_board_lost_briefly_long_before_the_goal_shortens_the_window(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -159,6 +169,7 @@ def test_cli_body_missing_from_the_bag(
     assert f"/fbm1h/{body}/pose" in lines[0] and f"tf world:{body}" in lines[0]
 
 
+@pytest.mark.slow
 def test_results_file_replaces_payloads_and_bad_entry_fails_its_run(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -179,6 +190,7 @@ def test_results_file_replaces_payloads_and_bad_entry_fails_its_run(
     assert not math.isnan(data["pose_score"])
 
 
+@pytest.mark.slow
 def test_empty_payload_fixed_by_items_order(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -191,6 +203,7 @@ def test_empty_payload_fixed_by_items_order(
     assert json.loads(out)["runs"]["1"]["pose_score"] == pytest.approx(GOOD_SCORE, abs=1e-9)
 
 
+@pytest.mark.slow
 def test_bad_item_list_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     bag = write_bag(tmp_path / "x.bag", [GOOD])
     items = write_items(tmp_path / "vanilla.yaml", "items:\n- {class: a, id: 1, instance: a1}\n")
@@ -207,6 +220,7 @@ def test_numbers_yaml_reads_as_text_are_accepted() -> None:
     assert (a.x, a.y, a.theta_deg) == (0.4, 0.2, 10.0)
 
 
+@pytest.mark.slow
 def test_no_client_topic_needs_results(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     bag = write_bag(tmp_path / "noclient.bag", [GOOD], no_client=True)
     code, out, err = _cli(tmp_path, capsys, bag)

@@ -16,7 +16,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from fbm1_testkit import (
+from scipy.spatial.transform import Rotation
+
+from ertools.benchmarks.base import BenchmarkResult
+from ertools.benchmarks.fbm1.config import Fbm1Options, GtOptions, ScoreRules
+from ertools.benchmarks.fbm1.pipeline import score_fbm1
+from ertools.benchmarks.fbm1.result import Fbm1Result
+from ertools.benchmarks.fbm1.runs import find_runs
+from ertools.cli.main import main
+from ertools.configs._yaml import parse_yaml
+from ertools.configs.items import ItemList, parse_items
+from ertools.states import Machine
+from ertools.streams import PoseStream
+from tests.benchmarks.fbm1.fbm1_testkit import (
     ANSWER_S,
     EXEC_S,
     ITEMS_YAML,
@@ -26,21 +38,7 @@ from fbm1_testkit import (
     write_bag,
     write_items,
 )
-from scipy.spatial.transform import Rotation
-from yaml_rounding import assert_yaml_of
-
-from ertools.benchmarks.base import BenchmarkResult
-from ertools.benchmarks.fbm1.benchmark import score_fbm1
-from ertools.benchmarks.fbm1.config import Fbm1Options
-from ertools.benchmarks.fbm1.gt import GtOptions
-from ertools.benchmarks.fbm1.result import Fbm1Result
-from ertools.benchmarks.fbm1.runs import find_runs
-from ertools.benchmarks.fbm1.score import ScoreRules
-from ertools.cli.main import main
-from ertools.configs._yaml import parse_yaml
-from ertools.configs.items import ItemList, parse_items
-from ertools.states import Machine
-from ertools.streams import PoseStream
+from tests.helpers.yaml_rounding import assert_yaml_of
 
 RUNS = [
     RunSpec(
@@ -116,6 +114,7 @@ def test_accuracy_over_10_divides_accuracy_by_ten_at_home() -> None:
     assert totals.pose_score == pytest.approx((SCORE1 + SCORE2) / 2, abs=TOL)
 
 
+@pytest.mark.slow
 def test_hand_case_through_a_bag_and_the_cli(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

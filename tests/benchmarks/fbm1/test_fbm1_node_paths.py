@@ -1,10 +1,10 @@
 """``--rules 2015/2016/2017`` on every path of the FBM1 nodes, against their loops run as written.
 
 The nodes (``node_fbm1.py``, each ported statement by statement from its commit, over the
-BmBox replayed from the log, ``tests/bmbox2015.py``): ``scripts/fbm1h`` at e373be0 (RoCKIn 2015
-Lisbon, ``--rules 2015``), ``scripts/fbm1w`` at 7628309 (RoCKIn 2015 Lisbon, ``--rules 2015``),
-``scripts/fbm1h`` at 40ba68b (the Lisbon 2016 second local competition, ``--rules 2016``) and
-at 89dfa75 (the Lisbon 2017 major tournament, ``--rules 2017``).
+BmBox replayed from the log, ``tests/helpers/bmbox2015.py``): ``scripts/fbm1h`` at e373be0
+(RoCKIn 2015 Lisbon, ``--rules 2015``), ``scripts/fbm1w`` at 7628309 (RoCKIn 2015 Lisbon,
+``--rules 2015``), ``scripts/fbm1h`` at 40ba68b (the Lisbon 2016 second local competition,
+``--rules 2016``) and at 89dfa75 (the Lisbon 2017 major tournament, ``--rules 2017``).
 
 The logs are generated with the samples' writer, one per path: a normal benchmark of 10
 runs; a RefBox timeout at the 10th run (the loop ends by its count) and at the 7th (the node goes
@@ -29,15 +29,17 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from node_fbm1 import VERSIONS, fbm1_node
 from scipy.spatial.transform import Rotation
-from test_fbm1_nodes import read_log, tf_lookup
 
 from ertools.cli.main import main
-from ertools.samples.mocap import MocapNoise, publish_mocap, simulate_mocap
-from ertools.samples.statemachine import Transition, publish_states
-from ertools.samples.writer import BagWriter
+from ertools.simulator.mocap import MocapNoise, publish_mocap, simulate_mocap
+from ertools.simulator.statemachine import Transition, publish_states
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
+from tests.benchmarks.fbm1.node_fbm1 import VERSIONS, fbm1_node
+from tests.benchmarks.fbm1.test_fbm1_nodes import read_log, tf_lookup
+
+pytestmark = pytest.mark.slow
 
 S = 1_000_000_000
 MS = 1_000_000

@@ -38,10 +38,12 @@ from rosbags.highlevel import AnyReader
 from scipy.spatial.transform import Rotation
 
 from ertools.cli.main import main
-from ertools.samples.mocap import MocapNoise, publish_mocap, simulate_mocap
-from ertools.samples.statemachine import Transition, publish_states
-from ertools.samples.writer import BagWriter
+from ertools.simulator.mocap import MocapNoise, publish_mocap, simulate_mocap
+from ertools.simulator.statemachine import Transition, publish_states
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
+
+pytestmark = pytest.mark.slow
 
 TOL = 1e-12
 SAMPLE = Path(__file__).resolve().parents[3] / "sample_bags" / "fbm1h"

@@ -5,10 +5,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from fbm1_testkit import write_items
-from stderr_text import joined_lines
 
 from ertools.cli.main import main
+from tests.benchmarks.fbm1.fbm1_testkit import write_items
+from tests.helpers.stderr_text import joined_lines
 
 REAL = Path(__file__).resolve().parents[3] / ".." / "shared" / "real_bags"
 BAG = REAL / "log_fbm2h_mocap_2015-10-23-16-15-40_0.bag"

@@ -8,8 +8,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from ertools.benchmarks.fbm1.score import (
-    ScoreRules,
+from ertools.benchmarks.fbm1.config import ScoreRules
+from ertools.benchmarks.fbm1.formula import (
     names_match,
     pose_errors,
     rot_term,
@@ -39,6 +39,7 @@ def test_wrap(angle: float, fixed: float, legacy: float) -> None:
     assert wrap_deg(angle, legacy=True) == pytest.approx(legacy, abs=1e-9)
 
 
+@pytest.mark.slow
 @given(st.floats(-1e6, 1e6, allow_nan=False))
 def test_wrap_range(angle: float) -> None:
     w = wrap_deg(angle)
@@ -115,6 +116,7 @@ def test_totals_with_no_counted_run() -> None:
     assert t.class_accuracy is None and t.pose_score is None and t.execution_time == 0.0
 
 
+@pytest.mark.slow
 @given(
     st.floats(-2, 2),
     st.floats(-2, 2),

@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from fbm1_testkit import ITEMS_YAML, RunSpec, bodies, ns, state_streams
 
-from ertools.benchmarks.fbm1.benchmark import score_fbm1
+from ertools.benchmarks.fbm1.pipeline import score_fbm1
 from ertools.benchmarks.fbm1.runs import find_runs, parse_item_ref
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import parse_items
@@ -15,6 +14,7 @@ from ertools.states import ClientState as C
 from ertools.states import Machine
 from ertools.states import RefBoxState as R
 from ertools.streams import StateStream
+from tests.benchmarks.fbm1.fbm1_testkit import ITEMS_YAML, RunSpec, bodies, ns, state_streams
 
 
 def _stream(machine: Machine, rows: list[tuple[float, int, str]]) -> StateStream:

@@ -9,8 +9,10 @@ from typing import Any
 import pytest
 import yaml
 
+from ertools.benchmarks.fbm1.sample import generate
 from ertools.cli.main import main
-from ertools.samples.fbm1 import generate
+
+pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module")

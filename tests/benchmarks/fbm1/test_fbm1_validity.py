@@ -6,16 +6,23 @@ repeats counted."""
 from __future__ import annotations
 
 import numpy as np
-from fbm1_testkit import ITEMS_YAML, T0, RunSpec, S, bodies, run_start_s, state_streams
 
-from ertools.benchmarks.fbm1.benchmark import score_fbm1
-from ertools.benchmarks.fbm1.config import Fbm1Options
+from ertools.benchmarks.fbm1.config import Fbm1Options, ScoreRules
+from ertools.benchmarks.fbm1.pipeline import score_fbm1
 from ertools.benchmarks.fbm1.runs import find_runs
-from ertools.benchmarks.fbm1.score import ScoreRules
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import parse_items
 from ertools.states import Machine
 from ertools.streams import PoseStream
+from tests.benchmarks.fbm1.fbm1_testkit import (
+    ITEMS_YAML,
+    T0,
+    RunSpec,
+    S,
+    bodies,
+    run_start_s,
+    state_streams,
+)
 
 GOOD = RunSpec(
     "Place item 3 (b2) on the table",

@@ -6,12 +6,10 @@ import json
 from pathlib import Path
 
 import pytest
-import svg_figure
-from fbm1_testkit import ITEMS_YAML, RunSpec, bodies, state_streams, write_bag, write_items
 from matplotlib.figure import Figure
 
-from ertools.benchmarks.fbm1.benchmark import score_fbm1
 from ertools.benchmarks.fbm1.config import Fbm1Options
+from ertools.benchmarks.fbm1.pipeline import score_fbm1
 from ertools.benchmarks.fbm1.runs import find_runs
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
@@ -19,6 +17,15 @@ from ertools.configs.items import parse_items
 from ertools.report import svg
 from ertools.report.figures import figure_specs
 from ertools.states import Machine
+from tests.benchmarks.fbm1.fbm1_testkit import (
+    ITEMS_YAML,
+    RunSpec,
+    bodies,
+    state_streams,
+    write_bag,
+    write_items,
+)
+from tests.helpers import svg_figure
 
 # Item 3 sits 5 cm along x and y of the board; the board at (0.3, 0.2) unrotated, so the item
 # is at (0.35, 0.25) yaw 0; item 1 (0.1 m along x) at (0.4, 0.2).
@@ -32,6 +39,7 @@ WORK_RUNS = [
 ]
 
 
+@pytest.mark.slow
 def test_fbm1w_cli_uses_refbox_items(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     bag = write_bag(tmp_path / "work.bag", WORK_RUNS, namespace="fbm1w")
     items = write_items(tmp_path / "fbm1w.yaml")
@@ -47,6 +55,7 @@ def test_fbm1w_cli_uses_refbox_items(tmp_path: Path, capsys: pytest.CaptureFixtu
     assert "--gt result" in " ".join(data["deviations"])
 
 
+@pytest.mark.slow
 def test_fbm1w_items_order(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     runs = [RunSpec("", r.answer) for r in WORK_RUNS]  # nothing names the items in the log
     bag = write_bag(tmp_path / "work.bag", runs, namespace="fbm1w")

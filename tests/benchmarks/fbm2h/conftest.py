@@ -9,7 +9,7 @@ from typing import Any
 import pytest
 import yaml
 
-from ertools.samples.fbm2h import generate
+from ertools.benchmarks.fbm2h.sample import generate
 
 
 @dataclass(frozen=True)

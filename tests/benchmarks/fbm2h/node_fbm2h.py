@@ -5,7 +5,7 @@ rockin-robot-challenge/benchmark_and_scoring_fbm, read at the commit (``git show
 node of the Lisbon 2016 second local competition (40ba68b) and of the Lisbon 2017 major
 tournament (89dfa75); its arithmetic is 0e7a367's (2015-11-20, competition day one), which
 50b173b only made retry a tf lookup that timed out (line 152). The BmBox is
-``tests/bmbox2015.py``. This is ``main()`` (15-252) statement by statement:
+``tests/helpers/bmbox2015.py``. This is ``main()`` (15-252) statement by statement:
 
 - ``N = len(waypoints)``, ``i = 0`` (39-40): segments 0 to N-1;
 - ``benchmark.WaitClient()`` (94); ``while benchmark.Running() and not benchmark.Timeout() and
@@ -33,7 +33,7 @@ ended it (the Client's result, a RefBox ``reason: timeout`` or ``reason: stop``,
 end); the loop then ends on a timeout or a stop.
 
 The node's clock and poses come from the log: ``time.time()`` and ``rospy.Time.now()`` after a
-call are the record time of the BmBox message that ended it (``tests/bmbox2015.py``); tf is
+call are the record time of the BmBox message that ended it (``tests/helpers/bmbox2015.py``); tf is
 the logged ``world -> robot_at_home`` transforms by their stamps, interpolated with scipy (past
 the last stamp, a log that ends there: the last one, the closest the log gets). Nothing here
 imports ertools.
@@ -47,8 +47,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from bmbox2015 import Blocked, BmBoxReplay
 from scipy.spatial.transform import Rotation, Slerp
+
+from tests.helpers.bmbox2015 import Blocked, BmBoxReplay
 
 
 @dataclass

@@ -17,8 +17,8 @@ from scipy.stats import chi2
 from ertools.cli.main import main
 from ertools.configs.transform import SPREAD_KEY, load_transform, transform_yaml
 from ertools.errors import ConfigError
-from ertools.samples.mocap import MocapNoise, frame_times, publish_mocap, simulate_mocap
-from ertools.samples.writer import BagWriter
+from ertools.simulator.mocap import MocapNoise, frame_times, publish_mocap, simulate_mocap
+from ertools.simulator.writer import BagWriter
 
 T0 = 1_448_000_000 * 1_000_000_000
 # Truth: T_marker_robot (robot centre 0.85 m below the marker set, offset and turned).

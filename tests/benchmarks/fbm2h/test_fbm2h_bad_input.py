@@ -7,9 +7,9 @@ from typing import Any
 
 import pytest
 import yaml
-from stderr_text import error_messages
 
 from ertools.cli.main import main
+from tests.helpers.stderr_text import error_messages
 
 
 def _run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
@@ -38,6 +38,7 @@ def _one_error_line(err: str, *needles: str) -> None:
         assert needle in lines[0], lines[0]
 
 
+@pytest.mark.slow_cases("not-increasing")
 @pytest.mark.parametrize(
     ("edit", "needle"),
     [

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from ertools.benchmarks.fbm2h.goal import goal_from_payload, parse_goal
+from ertools.benchmarks.fbm2h.timing import parse_timing
 from ertools.configs._yaml import parse_yaml
-from ertools.configs.goal import goal_from_payload, parse_goal
-from ertools.configs.timing import parse_timing
 from ertools.configs.transform import (
     MarkerTransform,
     load_transform,
@@ -65,7 +65,7 @@ def test_transform_yaml_round_trip() -> None:
     tr = MarkerTransform("homer", "2015-11-20_10:00:00", (0.1, -0.2, -0.7), quat, "x")
     text = transform_yaml(tr)
     back = parse_transform(parse_yaml(text), "t.yaml")  # also checks the inverse written
-    # written to 9 decimals (ertools.yamlout): within half a unit of the 9th decimal (the
+    # written to 9 decimals (ertools.serialize): within half a unit of the 9th decimal (the
     # quaternion is normalised on reading, which moves it by ~1e-16)
     assert back.translation == pytest.approx(tr.translation, abs=5e-10 + 1e-15)
     assert back.quat_xyzw == pytest.approx(tr.quat_xyzw, abs=5e-10 + 1e-15)

@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from ertools.benchmarks.fbm2h.benchmark import compute
-from ertools.benchmarks.fbm2h.segments import from_states, unreached_reasons
+from ertools.benchmarks.fbm2h.goal import GoalList
+from ertools.benchmarks.fbm2h.pipeline import compute
+from ertools.benchmarks.fbm2h.runs import from_states, unreached_reasons
 from ertools.cli.main import main
-from ertools.configs.goal import GoalList
 from ertools.configs.transform import MarkerTransform
-from ertools.io import read_poses
-from ertools.samples.writer import BagWriter
+from ertools.io.reader import read_poses
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState as B
 from ertools.states import ClientState as C
 from ertools.states import Machine
@@ -210,6 +210,7 @@ def _frame_change_bag(path: Path) -> None:
         w.write_pose_stamped(topic, t[~first], t[~first], "optitrack", xyz[~first], quat[~first])
 
 
+@pytest.mark.slow
 def test_frame_id_change_is_warned_in_output_and_report(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

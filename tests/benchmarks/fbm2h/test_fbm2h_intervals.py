@@ -19,8 +19,9 @@ from ertools.benchmarks.common.uncertainty import (
     TRANSFORM,
     Source,
 )
-from ertools.benchmarks.fbm2h.benchmark import compute, with_intervals
+from ertools.benchmarks.fbm2h import sample as sim
 from ertools.benchmarks.fbm2h.config import Fbm2hOptions
+from ertools.benchmarks.fbm2h.goal import parse_goal
 from ertools.benchmarks.fbm2h.intervals import (
     DEFAULT_EPSILON_M,
     Model,
@@ -28,11 +29,11 @@ from ertools.benchmarks.fbm2h.intervals import (
     intervals,
     measure_model,
     perturbed_scores,
+    with_intervals,
 )
-from ertools.benchmarks.fbm2h.segments import ReachedMoments
-from ertools.configs.goal import parse_goal
+from ertools.benchmarks.fbm2h.pipeline import compute
+from ertools.benchmarks.fbm2h.runs import ReachedMoments
 from ertools.configs.transform import SPREAD_KEY, parse_transform
-from ertools.samples import fbm2h as sim
 from ertools.streams import PoseStream
 
 N = 20_000  # draws: the sd of a sample sd is 1/sqrt(2N) = 0.5% of it

@@ -42,6 +42,7 @@ def _same_score(a: dict[str, Any], b: dict[str, Any]) -> None:
     assert a["details"] == b["details"]
 
 
+@pytest.mark.slow
 def test_erl_rsbb_transform(
     fbm2h_sample: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -62,6 +63,7 @@ def test_erl_rsbb_transform(
     assert "erl-rsbb layout" in err
 
 
+@pytest.mark.slow
 def test_pose_dump_transform(
     fbm2h_sample: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -98,6 +100,7 @@ def test_python_objects_are_never_built(
     assert not marker.exists()
 
 
+@pytest.mark.slow
 def test_erl_rsbb_goal_config(
     fbm2h_sample: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

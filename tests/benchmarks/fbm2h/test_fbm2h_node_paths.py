@@ -3,7 +3,7 @@ written, on every path of its state machine; the default mode on the same logs.
 
 ``node_fbm2h.py`` ports ``scripts/fbm2h`` at 50b173b statement by statement (the RoCKIn 2015
 node; the same file ran the Lisbon 2016 and 2017 competitions, 40ba68b and 89dfa75) and
-replays it over the BmBox of each generated log (``tests/bmbox2015.py``), read back with
+replays it over the BmBox of each generated log (``tests/helpers/bmbox2015.py``), read back with
 rosbags (not ertools.io); the robot pose is tf ``world -> robot_at_home`` read the same way
 and interpolated with scipy. Each log is written with the samples' writer: a benchmark of four
 waypoints in which one thing happens: a normal end; the RefBox's ``reason: timeout`` or
@@ -28,18 +28,20 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from bmbox2015 import BmBoxReplay
-from node_fbm2h import Score2015, TfPoses, fbm2h_node
 from rosbags.highlevel import AnyReader
 from scipy.spatial.transform import Rotation
 
 from ertools.cli.main import main
-from ertools.samples.statemachine import Transition, publish_states
-from ertools.samples.writer import BagWriter
+from ertools.simulator.statemachine import Transition, publish_states
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState as B
 from ertools.states import ClientState as C
 from ertools.states import Machine
 from ertools.states import RefBoxState as R
+from tests.benchmarks.fbm2h.node_fbm2h import Score2015, TfPoses, fbm2h_node
+from tests.helpers.bmbox2015 import BmBoxReplay
+
+pytestmark = pytest.mark.slow
 
 S = 1_000_000_000
 MS = 1_000_000

@@ -5,12 +5,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from ertools.benchmarks.fbm2h.score import robot_poses_at, segment_errors
+from ertools.benchmarks.fbm2h.formula import robot_poses_at, segment_errors
 from ertools.streams import PoseStream
+
+pytestmark = pytest.mark.slow
 
 angles = st.floats(-math.pi, math.pi, allow_nan=False)
 coords = st.floats(-5.0, 5.0, allow_nan=False)

@@ -8,10 +8,10 @@ from typing import Any
 import numpy as np
 import pytest
 
-from ertools.benchmarks.fbm2h.benchmark import compute
-from ertools.benchmarks.fbm2h.score import segment_errors
-from ertools.benchmarks.fbm2h.segments import ReachedMoments, from_states, unreached_reasons
-from ertools.configs.goal import GoalList
+from ertools.benchmarks.fbm2h.formula import segment_errors
+from ertools.benchmarks.fbm2h.goal import GoalList
+from ertools.benchmarks.fbm2h.pipeline import compute
+from ertools.benchmarks.fbm2h.runs import ReachedMoments, from_states, unreached_reasons
 from ertools.configs.transform import MarkerTransform, identity_transform
 from ertools.errors import SegmentationError
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState

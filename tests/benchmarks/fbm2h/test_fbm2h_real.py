@@ -17,9 +17,9 @@ import pytest
 import yaml
 from rosbags.highlevel import AnyReader
 from scipy.spatial.transform import Rotation, Slerp
-from stderr_text import error_messages
 
 from ertools.cli.main import main
+from tests.helpers.stderr_text import error_messages
 
 REAL = Path(__file__).resolve().parents[3] / ".." / "shared" / "real_bags"
 BAG = REAL / "log_fbm2h_mocap_2015-10-23-16-15-40_0.bag"
@@ -27,7 +27,7 @@ TIMING = REAL / "log_fbm2h_mocap_2015-10-23-16-15-40_0_reached_waypoint_timing.y
 GOAL = REAL / "fbm2h_test_optitrackless_goal.yaml"
 IDENTITY = Path(__file__).resolve().parents[3] / "configs" / "transform-identity.yaml"
 
-pytestmark = pytest.mark.real
+pytestmark = [pytest.mark.real, pytest.mark.slow]
 
 
 @pytest.fixture(scope="module")

@@ -6,15 +6,18 @@ import math
 from pathlib import Path
 
 import numpy as np
-import svg_figure
+import pytest
 from matplotlib.figure import Figure
 
-from ertools.benchmarks.fbm2h.benchmark import compute
-from ertools.benchmarks.fbm2h.segments import ReachedMoments
-from ertools.configs.goal import GoalList
+from ertools.benchmarks.fbm2h.goal import GoalList
+from ertools.benchmarks.fbm2h.pipeline import compute
+from ertools.benchmarks.fbm2h.runs import ReachedMoments
 from ertools.configs.transform import identity_transform
 from ertools.report.figures import figure_specs, save_figures
 from ertools.streams import PoseStream
+from tests.helpers import svg_figure
+
+pytestmark = pytest.mark.slow
 
 S = 1_000_000_000
 

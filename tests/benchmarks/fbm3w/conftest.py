@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import pytest
-from fbm3w_kit import Sample, generate_sample
+
+from tests.benchmarks.fbm3w.fbm3w_kit import Sample, generate_sample
 
 
 @pytest.fixture(scope="session")

@@ -8,7 +8,7 @@ from typing import Any
 
 import yaml
 
-import ertools.samples.fbm3w as scenario
+import ertools.benchmarks.fbm3w.sample as scenario
 
 
 @dataclass(frozen=True)

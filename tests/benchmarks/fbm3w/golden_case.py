@@ -3,15 +3,15 @@
 from __future__ import annotations
 
 import numpy as np
-from fbm3w_synth import T0, one_run
 
-from ertools.benchmarks.fbm3w.benchmark import score_runs
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
+from ertools.benchmarks.fbm3w.pipeline import score_paths
 from ertools.benchmarks.fbm3w.result import Fbm3wResult
 from ertools.benchmarks.fbm3w.runs import RunWindow
-from ertools.configs.fbm3w import Fbm3wConfig
-from ertools.configs.shapes import builtin_shapes
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
+from ertools.benchmarks.fbm3w.shapes import builtin_shapes
 from ertools.streams import concatenate_poses
+from tests.benchmarks.fbm3w.fbm3w_synth import T0, one_run
 
 S = 1_000_000_000
 
@@ -39,7 +39,7 @@ def golden_result() -> Fbm3wResult:
     windows.append(RunWindow(2, "line", None, end + 1 * S, end + 4 * S, "timeout", "states"))
     # Listing 16's layout alone: no intervals (--draws 0); the interval keys are checked by
     # the CLI tests and the e2e golden outputs
-    return score_runs(
+    return score_paths(
         concatenate_poses(streams),
         windows,
         Fbm3wConfig(),

@@ -1,7 +1,7 @@
 """``scripts/fbm3w`` at 50b173b (2015-11-30), the FBM3@Work node of RoCKIn 2015, replayed.
 
 rockin-robot-challenge/benchmark_and_scoring_fbm, read at the commit (``git show
-50b173b:scripts/fbm3w``); line numbers are that file's. The BmBox is ``tests/bmbox2015.py``.
+50b173b:scripts/fbm3w``); line numbers are that file's. The BmBox is ``tests/helpers/bmbox2015.py``.
 This is ``main()`` (165-322) statement by statement, with the functions it calls:
 
 - ``BENCHMARK_RUNS = 5`` (17), ``D_MIN = 0.00033`` (20); the targets ``line_path`` (28-30:
@@ -31,7 +31,7 @@ This is ``main()`` (165-322) statement by statement, with the functions it calls
 - the best run: the first with the smallest ``distance_error`` (301-303).
 
 The node's clock and poses come from the log: ``time.time()`` after a call is the record time
-of the BmBox message that ended it (``tests/bmbox2015.py``); tf at ``Time(0)`` and the
+of the BmBox message that ended it (``tests/helpers/bmbox2015.py``); tf at ``Time(0)`` and the
 messages the subscription received are the pose2d messages by record time. Nothing here
 imports ertools.
 """
@@ -42,7 +42,7 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
-from bmbox2015 import Blocked, BmBoxReplay, Msg
+from tests.helpers.bmbox2015 import Blocked, BmBoxReplay, Msg
 
 BENCHMARK_RUNS = 5
 D_MIN = 0.00033

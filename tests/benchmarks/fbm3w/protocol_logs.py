@@ -1,6 +1,6 @@
 """FBM3@Work mocap logs written from the protocol (seed 7.3.3), not from the detector.
 
-Independent of ertools' simulator (``ertools.samples.fbm3w``) and of ``--runs auto``: the
+Independent of ertools' simulator (``ertools.benchmarks.fbm3w.sample``) and of ``--runs auto``: the
 shapes are written out again from the manual (Listing 15) and ``configs/fbm3w.yaml``, the
 motion from what the manual says a run is, and the detector's constants are not used.
 
@@ -27,7 +27,7 @@ import numpy.typing as npt
 import yaml
 from scipy.interpolate import CubicSpline
 
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 
 F64 = npt.NDArray[np.float64]
 I64 = npt.NDArray[np.int64]

@@ -7,10 +7,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-# golden_case sits beside this script: run as a script, its folder is sys.path[0]
-from golden_case import golden_result
-
 from ertools.cli.output import dump_json
+
+# golden_case sits beside this script: run as a script, its folder is sys.path[0]
+from tests.benchmarks.fbm3w.golden_case import golden_result
 
 HERE = Path(__file__).resolve().parent
 

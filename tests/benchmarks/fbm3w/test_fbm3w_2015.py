@@ -22,22 +22,23 @@ from typing import Any
 
 import numpy as np
 import pytest
-from fbm3w_kit import Sample
-from fbm3w_synth import place
-from test_fbm3w_runs import stream
 
-from ertools.benchmarks.fbm3w.benchmark import score_runs
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions, options_2015
+from ertools.benchmarks.fbm3w.pipeline import score_paths
 from ertools.benchmarks.fbm3w.runs import find_states
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.cli.main import main
-from ertools.configs.fbm3w import Fbm3wConfig
 from ertools.geometry import quat_from_yaw
-from ertools.io import BenchmarkStates, read_benchmark_states, read_poses
-from ertools.samples.writer import BagWriter
+from ertools.io.model import BenchmarkStates
+from ertools.io.reader import read_benchmark_states, read_poses
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState as B
 from ertools.states import Machine
 from ertools.states import RefBoxState as R
 from ertools.streams import PoseStream
+from tests.benchmarks.fbm3w.fbm3w_kit import Sample
+from tests.benchmarks.fbm3w.fbm3w_synth import place
+from tests.benchmarks.fbm3w.test_fbm3w_runs import stream
 
 S = 1_000_000_000
 D_MIN = 0.00033  # seed 7.3.4: hard-coded in the 2015 script
@@ -156,6 +157,7 @@ def _check(out: dict[str, Any], node: dict[str, Any]) -> None:
         assert got["execution_time"] == pytest.approx(d["execution_time"], abs=TOL)
 
 
+@pytest.mark.slow
 def test_sample_bag_2015_equals_the_node(
     fbm3w_sample: Sample, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -291,7 +293,7 @@ def _scenario(
 
 def _ertools(poses: PoseStream, states: BenchmarkStates, options: Fbm3wOptions) -> dict[str, Any]:
     windows = find_states(states, exact_2015=options.exact_end_payloads)
-    data: dict[str, Any] = score_runs(poses, windows, Fbm3wConfig(), options=options).to_dict()
+    data: dict[str, Any] = score_paths(poses, windows, Fbm3wConfig(), options=options).to_dict()
     return data
 
 
@@ -305,6 +307,7 @@ def _node(poses: PoseStream, bm: Transitions, rb: Transitions, specs: list[str])
 SEAM = (math.pi - 0.01, -math.pi + 0.01)
 
 
+@pytest.mark.slow_cases("-3.1315926535897933")
 @pytest.mark.parametrize("yaw", SEAM)
 def test_run_timing_out_midway_is_scored_and_can_be_best(yaw: float) -> None:
     common = {"path_s": 3.0, "origin": (1.2, 0.7), "yaw": yaw}
@@ -330,6 +333,7 @@ def test_run_timing_out_midway_is_scored_and_can_be_best(yaw: float) -> None:
     assert default["execution_time"] == pytest.approx(node["execution_time"], abs=TOL)
 
 
+@pytest.mark.slow
 def test_stopped_run_is_neither_scored_nor_timed() -> None:
     common = {"path_s": 4.0, "origin": (-0.4, 1.1), "yaw": 2.0}
     runs = [
@@ -352,6 +356,7 @@ def test_stopped_run_is_neither_scored_nor_timed() -> None:
     assert default["execution_time"] == pytest.approx(node["execution_time"] + stopped_s, abs=TOL)
 
 
+@pytest.mark.slow
 def test_2015_and_arc_length_contradict(
     fbm3w_sample: Sample, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -371,16 +376,17 @@ def test_frozen_reference_pose_is_warned() -> None:
     xyz = poses.xyz.copy()
     xyz[a:b] = xyz[a]
     frozen = PoseStream(poses.t_ns, xyz, poses.quat_xyzw, "world", "robot_at_work", "sim")
-    result = score_runs(frozen, windows, Fbm3wConfig(), bag_start_ns=0)
+    result = score_paths(frozen, windows, Fbm3wConfig(), bag_start_ns=0)
     lines = [w for w in result.warnings if "frozen" in w]
     assert len(lines) == 1
     assert lines[0].startswith("run 0: the pose at its reference time 2.000 s is frozen")
     assert f"{b - a} identical poses" in lines[0] and "(1.500-2.492 s" in lines[0]
     # Unfrozen, nothing is said.
-    plain = score_runs(poses, windows, Fbm3wConfig(), bag_start_ns=0)
+    plain = score_paths(poses, windows, Fbm3wConfig(), bag_start_ns=0)
     assert not [w for w in plain.warnings if "frozen" in w]
 
 
+@pytest.mark.slow
 def test_2015_uses_the_script_d_min_over_the_config(
     fbm3w_sample: Sample, tmp_path: Any, capsys: pytest.CaptureFixture[str]
 ) -> None:

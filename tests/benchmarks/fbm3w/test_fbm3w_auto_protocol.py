@@ -17,7 +17,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from protocol_logs import (
+
+from ertools.cli.main import main
+from tests.benchmarks.fbm3w.protocol_logs import (
     SHAPES,
     Log,
     by_arc_length,
@@ -26,9 +28,7 @@ from protocol_logs import (
     write_bag,
     write_config,
 )
-from stderr_text import error_messages
-
-from ertools.cli.main import main
+from tests.helpers.stderr_text import error_messages
 
 EDGE_TOLERANCE_S = 0.5
 
@@ -95,6 +95,7 @@ def _cut_bound(log: Log, k: int, run: dict[str, float]) -> float:
     return 3 * (d_s + d_e) + reach * d_s / max(baseline - d_s, 1e-3) + 1e-9
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("seed", "specs"), _cases())
 def test_auto_finds_the_generated_runs(
     seed: int, specs: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
@@ -106,6 +107,7 @@ def test_auto_finds_the_generated_runs(
     _check(log, specs, listed, tmp_path, capsys, on_shape=True)
 
 
+@pytest.mark.slow
 def test_the_hardest_corner(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """1 cm approaches, the most noise (1.3 mm), the shortest still phases (2-2.5 s) and 4
     dropouts, in a 3-run log."""
@@ -115,6 +117,7 @@ def test_the_hardest_corner(tmp_path: Path, capsys: pytest.CaptureFixture[str]) 
     _check(log, specs, specs, tmp_path, capsys, on_shape=True)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("pause", [0.8, 2.5])
 def test_a_robot_pausing_halfway_along_its_path(
     pause: float, tmp_path: Path, capsys: pytest.CaptureFixture[str]
@@ -127,6 +130,7 @@ def test_a_robot_pausing_halfway_along_its_path(
     _check(log, specs, specs, tmp_path, capsys, on_shape=True)
 
 
+@pytest.mark.slow_cases("line", "semi", "semi_ellipse", "spline")
 @pytest.mark.parametrize("spec", SHAPES)
 def test_a_shape_turned_from_the_approach_is_found(
     spec: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]

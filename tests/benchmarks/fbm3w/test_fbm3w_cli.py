@@ -8,14 +8,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from fbm3w_kit import Sample
-from fbm3w_synth import one_run
-from protocol_logs import generate, write_bag, write_config
-from stderr_text import error_messages
 
+from ertools.benchmarks.fbm3w.shapes import builtin_shapes
 from ertools.cli.main import main
-from ertools.configs.shapes import builtin_shapes
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
+from tests.benchmarks.fbm3w.fbm3w_kit import Sample
+from tests.benchmarks.fbm3w.fbm3w_synth import one_run
+from tests.benchmarks.fbm3w.protocol_logs import generate, write_bag, write_config
+from tests.helpers.stderr_text import error_messages
 
 
 def score(*args: str, draws: bool = False) -> int:
@@ -32,6 +32,7 @@ def one_line_error(err: str) -> str:
     return lines[0]
 
 
+@pytest.mark.slow
 def test_default_yaml_and_json(fbm3w_sample: Sample, capsys: pytest.CaptureFixture[str]) -> None:
     assert score(fbm3w_sample.bag, "--config", fbm3w_sample.config, draws=True) == 0
     out = yaml.safe_load(capsys.readouterr().out)
@@ -53,6 +54,7 @@ def test_default_yaml_and_json(fbm3w_sample: Sample, capsys: pytest.CaptureFixtu
     assert data["runs_details"]["4"]["status"] == "timeout"
 
 
+@pytest.mark.slow
 def test_sweep_plot_and_notes(
     fbm3w_sample: Sample, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -69,6 +71,7 @@ def test_sweep_plot_and_notes(
     ]
 
 
+@pytest.mark.slow
 def test_runs_file(
     fbm3w_sample: Sample, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -89,6 +92,7 @@ def test_runs_file(
     assert "missing key(s) reference, end" in one_line_error(capsys.readouterr().err)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("content", "expected"),
     [
@@ -113,6 +117,7 @@ def test_runs_file_messages(
     assert "file file" not in line
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "source", [["--topic", "/fbm3w/robot_at_work/pose"], ["--frame", "robot_at_work"]]
 )
@@ -134,6 +139,7 @@ def test_other_pose_sources(
         )
 
 
+@pytest.mark.slow
 def test_explicit_windows_and_auto_notes(
     fbm3w_sample: Sample, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -168,6 +174,7 @@ def test_bad_runs_fail_alone(fbm3w_sample: Sample, capsys: pytest.CaptureFixture
     assert len(errors) == 3 and "Traceback" not in captured.err
 
 
+@pytest.mark.slow
 def test_forbidden_shape_expression(
     fbm3w_sample: Sample, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -186,6 +193,7 @@ def test_forbidden_shape_expression(
     assert "run 0 (evil)" in one_line_error(captured.err)
 
 
+@pytest.mark.slow
 def test_user_shape_scores_like_the_builtin(
     fbm3w_sample: Sample, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -258,6 +266,7 @@ def _mocap_only_bag(path: Path) -> Path:
     return path
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("window", "where"),
     [

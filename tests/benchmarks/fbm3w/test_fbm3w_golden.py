@@ -9,10 +9,10 @@ from typing import Any
 
 import pytest
 import yaml
-from floats import YAML_UNIT, tree_difference
-from golden_case import golden_result
 
 from ertools.cli.output import dump_json
+from tests.benchmarks.fbm3w.golden_case import golden_result
+from tests.helpers.floats import YAML_UNIT, tree_difference
 
 GOLDEN = Path(__file__).resolve().parent / "golden"
 NUMBER = re.compile(r"-?\d+\.\d+(e-?\d+)?")
@@ -46,7 +46,7 @@ def test_yaml_matches_golden() -> None:
     # last place between NumPy/libm builds, so numbers are compared as values
     assert NUMBER.sub("<n>", text) == NUMBER.sub("<n>", golden)
     # each value within what its quantity may move between CPUs, and one in the ninth
-    # decimal (tests/floats.py: a value on a rounding boundary rounds either way)
+    # decimal (tests/helpers/floats.py: a value on a rounding boundary rounds either way)
     where = tree_difference(yaml.safe_load(text), yaml.safe_load(golden), rounded=YAML_UNIT)
     assert where is None, where
     # the YAML is the full-precision JSON rounded to 9 decimals, and nothing coarser

@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from ertools.benchmarks.common.epsilon import noise_statistics
 from ertools.benchmarks.common.uncertainty import D_MIN, MOCAP_NOISE
 from ertools.benchmarks.fbm3w.intervals import (
     RAYLEIGH_CV,
@@ -17,9 +18,8 @@ from ertools.benchmarks.fbm3w.intervals import (
     smooth,
 )
 from ertools.benchmarks.fbm3w.perturbed import RunSamples, perturbed_errors, perturbed_runs
-from ertools.benchmarks.noise.benchmark import noise_statistics
-from ertools.configs.shapes import builtin_shapes
-from ertools.samples.fbm3w import eq1, target
+from ertools.benchmarks.fbm3w.sample import eq1, target
+from ertools.benchmarks.fbm3w.shapes import builtin_shapes
 
 
 def _line_run(rng: np.random.Generator, sigma: float) -> tuple[np.ndarray, np.ndarray]:

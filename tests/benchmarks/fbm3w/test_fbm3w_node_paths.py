@@ -1,7 +1,7 @@
 """``--2015`` on every path of the RoCKIn 2015 FBM3@Work node, against its loop run as written.
 
 The node is ``scripts/fbm3w`` at 50b173b (2015-11-30), ported statement by statement in
-``node_fbm3w.py`` over the BmBox replayed from the log (``tests/bmbox2015.py``). It differs
+``node_fbm3w.py`` over the BmBox replayed from the log (``tests/helpers/bmbox2015.py``). It differs
 from the versions before it on these paths: 7942ea2 (2015-11-30) scores and times a run the
 RefBox timed out and goes on with the next run (before it: time added, no score, ``continue``
 with the same run number); 7942ea2 also replaced the 0.30/0.10 line and the semi-ellipse
@@ -27,14 +27,16 @@ from typing import Any
 
 import numpy as np
 import pytest
-from node_fbm3w import SPECS, fbm3w_node
 from rosbags.highlevel import AnyReader
-from test_fbm3w_2015 import _track
 
 from ertools.cli.main import main
-from ertools.samples.statemachine import Transition, publish_states
-from ertools.samples.writer import BagWriter
+from ertools.simulator.statemachine import Transition, publish_states
+from ertools.simulator.writer import BagWriter
 from ertools.states import BmBoxState, ClientState, Machine, RefBoxState
+from tests.benchmarks.fbm3w.node_fbm3w import SPECS, fbm3w_node
+from tests.benchmarks.fbm3w.test_fbm3w_2015 import _track
+
+pytestmark = pytest.mark.slow
 
 S = 1_000_000_000
 MS = 1_000_000

@@ -6,16 +6,24 @@ import math
 
 import numpy as np
 import pytest
-from fbm3w_synth import one_run, place
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ertools.benchmarks.fbm3w.benchmark import score_runs
+from ertools.benchmarks.fbm3w.auto_runs import _match
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
-from ertools.benchmarks.fbm3w.path import run_frame, score_path, subsample_d_min
-from ertools.configs.fbm3w import Fbm3wConfig
-from ertools.configs.shapes import builtin_shapes, parse_shape
+from ertools.benchmarks.fbm3w.formula import (
+    arc_fractions,
+    frame_errors,
+    kept_flags,
+    run_frame,
+    score_path,
+    subsample_d_min,
+)
+from ertools.benchmarks.fbm3w.pipeline import score_paths
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
+from ertools.benchmarks.fbm3w.shapes import builtin_shapes, parse_shape
 from ertools.errors import ScoringError
+from tests.benchmarks.fbm3w.fbm3w_synth import one_run, place
 
 # the path arithmetic is the subject, not the intervals: no Monte Carlo draws
 NO_DRAWS = Fbm3wOptions(draws=0)
@@ -52,6 +60,56 @@ def test_subsample_equals_the_sequential_rule(sigma: float) -> None:
     assert subsample_d_min(xy, 0.00033).tolist() == naive_subsample(xy, 0.00033)
 
 
+@pytest.mark.parametrize("sigma", [1e-5, 4e-4])
+def test_paths_side_by_side_keep_what_each_keeps_alone(sigma: float) -> None:
+    # the intervals' sweep (W columns at once) is the rule of one path, column by column;
+    # shorter paths are padded with NaN at the end, never kept
+    rng = np.random.default_rng(8)
+    n, w = 900, 6
+    x = rng.normal(0.0, sigma, (n, w)) + np.linspace(0.0, 0.05, n)[:, None]
+    y = rng.normal(0.0, sigma, (n, w))
+    x[700:, 2] = y[700:, 2] = np.nan
+    d_mins = np.array([0.00033, 0.0001, 0.00033, 0.001, 0.0, 0.00066])
+    flags = kept_flags(x, y, d_mins)
+    for k in range(w):
+        alone = naive_subsample(
+            np.column_stack([x[:, k], y[:, k]])[: 700 if k == 2 else n], d_mins[k]
+        )
+        assert np.flatnonzero(flags[:, k]).tolist() == alone
+        assert np.array_equal(
+            kept_flags(x[:, k : k + 1], y[:, k : k + 1], d_mins[k : k + 1])[:, 0], flags[:, k]
+        )
+
+
+def test_arc_fractions_and_frame_errors_by_hand() -> None:
+    # two kept paths end to end: 3-4-5 steps (L = 10) and one 1 m step
+    xk = np.array([0.0, 3.0, 3.0, 1.0, 1.0])
+    yk = np.array([0.0, 4.0, 9.0, 1.0, 2.0])
+    counts = np.array([3, 2])
+    l_norm, total = arc_fractions(xk, yk, counts)
+    assert l_norm.tolist() == [0.0, 0.5, 1.0, 0.0, 1.0]
+    assert total.tolist() == [10.0, 1.0]
+    # path 1 in a frame turned +90 degrees: its step (0, 1) is (1, 0) there; target (1, 0.5)
+    target = np.array([[9.0, 9.0], [3.0, 4.0], [3.0, 8.0], [7.0, 7.0], [1.0, 0.5]])
+    cos_yaw, sin_yaw = np.array([1.0, 0.0]), np.array([0.0, 1.0])
+    err = frame_errors(xk, yk, counts, target, cos_yaw, sin_yaw)
+    # each start counts 0; (3, 4) on target; (3, 9) is 1 from (3, 8); (1, 0) is 0.5 from (1, 0.5)
+    assert err == pytest.approx([0.0, 0.0, 1.0, 0.0, 0.5], abs=1e-15)
+
+
+def test_auto_runs_match_is_eq1_in_the_protocol_frame() -> None:
+    # --runs auto's protocol-frame error is the score's Eq. (1) on the same path and d_min
+    rng = np.random.default_rng(3)
+    shape = builtin_shapes()["semi_ellipse"].by_arc_length()
+    frame_pts = shape(np.linspace(0.0, 1.0, 400)) + rng.normal(0.0, 2e-4, (400, 2))
+    frame_pts[0] = 0.0
+    origin, yaw = (0.4, 0.3), -0.7
+    world = place(frame_pts, origin, yaw)
+    ref = place(np.array([[-0.1, 0.0]]), origin, yaw)[0]
+    _, e_frame = _match(world, world[0], ref, shape, 0.001)
+    assert e_frame == pytest.approx(score_path(world, ref, shape, 0.001).distance_error, rel=1e-12)
+
+
 def test_eq1_by_hand() -> None:
     shape = parse_shape("ten", {"x": "0.1*l", "y": "0"})
     frame_pts = np.array([[0.0, 0.0], [0.03, 0.004], [0.06, 0.004], [0.1, 0.0]])
@@ -77,14 +135,14 @@ def test_robot_exactly_on_target_scores_zero(name: str) -> None:
     shape = builtin_shapes()[name]
     path = shape(np.linspace(0.0, 1.0, 3000))
     stream, window = one_run(path, spec=name, yaw=-1.1, origin=(3.0, -4.0))
-    result = score_runs(stream, [window], Fbm3wConfig(), options=NO_DRAWS)
+    result = score_paths(stream, [window], Fbm3wConfig(), options=NO_DRAWS)
     # 0 up to the d_min quantisation: the last kept point may stop up to d_min short of the
     # end, which rescales l/L by < d_min / L and moves the compared target by < d_min
     assert result.runs[0].distance_error is not None
     assert result.runs[0].distance_error < 0.00033
     assert result.failures == ()
     # with d_min = 0 every sample is kept and the quantisation vanishes
-    exact = score_runs(stream, [window], Fbm3wConfig(), options=Fbm3wOptions(d_min=0.0, draws=0))
+    exact = score_paths(stream, [window], Fbm3wConfig(), options=Fbm3wOptions(d_min=0.0, draws=0))
     assert exact.runs[0].distance_error == pytest.approx(0.0, abs=1e-12)
 
 
@@ -92,14 +150,14 @@ def test_sine_scores_its_floor_unless_arc_length() -> None:
     shape = builtin_shapes()["spline"]
     path = shape(np.linspace(0.0, 1.0, 4000))
     stream, window = one_run(path, spec="spline")
-    result = score_runs(stream, [window], Fbm3wConfig(), options=NO_DRAWS)
+    result = score_paths(stream, [window], Fbm3wConfig(), options=NO_DRAWS)
     run = result.runs[0]
     # the 2015 sine is parametrised by x, not by length: a perfect robot scores its floor
     # (computed on 10001 samples; with 4000 the kept points fall elsewhere: ~0.1 mm apart)
     assert run.distance_error == pytest.approx(run.shape_floor, abs=2e-4)
     assert run.distance_error > 0.008
     assert any("not parametrised by arc length" in w for w in result.warnings)
-    fixed = score_runs(
+    fixed = score_paths(
         stream, [window], Fbm3wConfig(), options=Fbm3wOptions(arc_length=True, draws=0)
     )
     # arc-length target vs a path sampled uniformly in the shape's own parameter: 0 up to the
@@ -159,7 +217,7 @@ def test_long_path_is_warned() -> None:
         [np.zeros_like(u), np.sin(40 * np.pi * u)]
     )
     stream, window = one_run(zigzag)
-    result = score_runs(stream, [window], Fbm3wConfig(), options=NO_DRAWS)
+    result = score_paths(stream, [window], Fbm3wConfig(), options=NO_DRAWS)
     run = result.runs[0]
     assert run.score is not None and run.target_length is not None
     ratio = run.score.path_length / run.target_length

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from ertools.benchmarks.fbm3w.runs import find_states, find_windows, with_specs
-from ertools.configs.fbm3w import Fbm3wConfig
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.errors import SegmentationError
-from ertools.io import BenchmarkStates
+from ertools.io.model import BenchmarkStates
 from ertools.states import BmBoxState as B
 from ertools.states import Machine
 from ertools.states import RefBoxState as R
@@ -92,8 +92,8 @@ def test_stop_interrupt_and_log_end() -> None:
 def test_end_payloads_as_the_2015_bmbox_compared_them() -> None:
     """BmBox.py compares the whole payload: "reason: stop" stops, "reason: timeout" times
     out; by default the seed's "halt"/"timeout" mean the same (not under --exact-end-payloads:
-    tests/core/test_end_payloads.py); any other END payload meant neither to it (Running()
-    stayed true): the run is what the BmBox did, and a warning names the payload."""
+    tests/benchmarks/common/test_end_payloads.py); any other END payload meant neither to it
+    (Running() stayed true): the run is what the BmBox did, and a warning names the payload."""
     items = [(0.0, B.READY, ""), *run_items(1.0, "line")[:-1], (8.0, B.READY, ""), (8.3, B.END, "")]
     bm = stream(Machine.BMBOX, items)
     for payload, status in [

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import pytest
-from fbm3w_kit import Sample
 
-from ertools.benchmarks.fbm3w.benchmark import score_fbm3w
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions
-from ertools.configs.fbm3w import Fbm3wConfig
+from ertools.benchmarks.fbm3w.pipeline import score_fbm3w
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
+from tests.benchmarks.fbm3w.fbm3w_kit import Sample
 
 # the answers hold scores, not intervals: no Monte Carlo draws (draws=0 in every Fbm3wOptions)
 NO_DRAWS = Fbm3wOptions(draws=0)
@@ -17,6 +17,7 @@ def _tol(sample: Sample, key: str) -> float:
     return float(sample.answers["tolerance"][key]["abs"])
 
 
+@pytest.mark.slow_cases("states")
 @pytest.mark.parametrize("mode", ["states", "windows", "auto"])
 def test_each_run_matches_the_answers(fbm3w_sample: Sample, mode: str) -> None:
     windows = fbm3w_sample.windows() if mode == "windows" else ()
@@ -75,6 +76,7 @@ def test_states_mode_times_and_timeout(fbm3w_sample: Sample) -> None:
     )
 
 
+@pytest.mark.slow
 def test_rosbag2_mcap_copy_scores_the_same(fbm3w_sample: Sample) -> None:
     ros1 = score_fbm3w([fbm3w_sample.bag], Fbm3wConfig(), NO_DRAWS)
     mcap = score_fbm3w([fbm3w_sample.mcap], Fbm3wConfig(), NO_DRAWS)
@@ -82,6 +84,7 @@ def test_rosbag2_mcap_copy_scores_the_same(fbm3w_sample: Sample) -> None:
     assert mcap.to_dict() == ros1.to_dict()
 
 
+@pytest.mark.slow_cases("auto", "states")
 @pytest.mark.parametrize("mode", ["states", "windows", "auto"])
 def test_noiseless_recording_gives_the_answers_exactly(fbm3w_noiseless: Sample, mode: str) -> None:
     windows = fbm3w_noiseless.windows() if mode == "windows" else ()
@@ -100,6 +103,7 @@ def test_noiseless_recording_gives_the_answers_exactly(fbm3w_noiseless: Sample, 
             assert len(run.score.kept) == exp["kept_samples"]
 
 
+@pytest.mark.slow
 def test_auto_mode_reports_detected_times(fbm3w_sample: Sample) -> None:
     result = score_fbm3w([fbm3w_sample.bag], Fbm3wConfig(), Fbm3wOptions(draws=0, runs="auto"))
     truth = fbm3w_sample.answers["truth"]["runs"]

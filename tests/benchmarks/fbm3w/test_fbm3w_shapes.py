@@ -11,8 +11,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ertools.configs.fbm3w import DEFAULT_RUNS, load_fbm3w_config, parse_fbm3w_config
-from ertools.configs.shapes import builtin_shapes, compile_expression, parse_shape
+from ertools.benchmarks.fbm3w.settings import DEFAULT_RUNS, load_fbm3w_config, parse_fbm3w_config
+from ertools.benchmarks.fbm3w.shapes import builtin_shapes, compile_expression, parse_shape
 from ertools.errors import ConfigError
 
 L = np.linspace(0.0, 1.0, 11)
@@ -194,6 +194,7 @@ class _FloatConstants(ast.NodeTransformer):
         return ast.copy_location(call, node)
 
 
+@pytest.mark.slow
 @pytest.mark.filterwarnings("ignore::hypothesis.errors.HypothesisWarning")
 @settings(max_examples=150, deadline=None)
 @given(text=_expressions())

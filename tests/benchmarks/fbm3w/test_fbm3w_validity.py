@@ -10,18 +10,18 @@ from typing import Any
 
 import numpy as np
 import pytest
-from fbm3w_synth import FRAME_NS, T0, one_run
 
 from ertools.benchmarks.base import rename_former
-from ertools.benchmarks.fbm3w.benchmark import MAX_INNER_GAP_S, MIN_COVERAGE, score_runs
 from ertools.benchmarks.fbm3w.config import Fbm3wOptions, options_2015
 from ertools.benchmarks.fbm3w.declare import BENCHMARK
-from ertools.benchmarks.fbm3w.path import score_path
+from ertools.benchmarks.fbm3w.formula import score_path
+from ertools.benchmarks.fbm3w.pipeline import MAX_INNER_GAP_S, MIN_COVERAGE, score_paths
 from ertools.benchmarks.fbm3w.runs import RunWindow
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
+from ertools.benchmarks.fbm3w.shapes import builtin_shapes
 from ertools.cli.main import main
-from ertools.configs.fbm3w import Fbm3wConfig
-from ertools.configs.shapes import builtin_shapes
 from ertools.streams import PoseStream
+from tests.benchmarks.fbm3w.fbm3w_synth import FRAME_NS, T0, one_run
 
 STILL = 30
 PATH = 3000  # 25 s at 120 Hz
@@ -48,9 +48,10 @@ def _expected_score(stream: PoseStream, window: RunWindow) -> float:
     return score_path(stream.xyz[sel, :2], ref, shape, Fbm3wConfig().d_min).distance_error
 
 
+@pytest.mark.slow
 def test_a_clean_run_is_fully_covered() -> None:
     stream, window = _run()
-    run = score_runs(stream, [window], Fbm3wConfig(), bag_start_ns=0).runs[0]
+    run = score_paths(stream, [window], Fbm3wConfig(), bag_start_ns=0).runs[0]
     assert run.status == "scored"
     # noiseless still phases repeat their pose: 29 + 1 at the start (the path's first point
     # repeats the start phase), 30 at the end; neither hides a motion
@@ -65,7 +66,7 @@ def test_a_clean_run_is_fully_covered() -> None:
 def test_a_long_gap_mid_path_is_unscoreable() -> None:
     stream, window = _run()
     cut = _cut(stream, [(1000, 1072)])  # 72 frames: 73 frame periods without data
-    result = score_runs(cut, [window], Fbm3wConfig(), bag_start_ns=T0)
+    result = score_paths(cut, [window], Fbm3wConfig(), bag_start_ns=T0)
     run = result.runs[0]
     span_s = 73 * FRAME_NS / 1e9
     assert span_s > MAX_INNER_GAP_S
@@ -109,12 +110,13 @@ def test_a_long_gap_mid_path_is_unscoreable() -> None:
     ]
 
 
+@pytest.mark.slow
 def test_2015_scores_it_with_a_warning() -> None:
     stream, window = _run()
     cut = _cut(stream, [(1000, 1072)])
     options = options_2015(Fbm3wOptions())
     assert options.unscoreable_runs == "2015"
-    result = score_runs(cut, [window], Fbm3wConfig(), options=options, bag_start_ns=0)
+    result = score_paths(cut, [window], Fbm3wConfig(), options=options, bag_start_ns=0)
     run = result.runs[0]
     assert run.status == "scored"
     assert run.distance_error == _expected_score(cut, window)
@@ -136,7 +138,7 @@ def test_both_spellings_score_it_alike(capsys: pytest.CaptureFixture[str]) -> No
 
     def run(**given: str) -> Any:
         options = BENCHMARK.make_options(rename_former(BENCHMARK.inputs, given))
-        return score_runs(cut, [window], Fbm3wConfig(), options=options, bag_start_ns=0).runs[0]
+        return score_paths(cut, [window], Fbm3wConfig(), options=options, bag_start_ns=0).runs[0]
 
     assert run().status == "unscoreable"
     new = run(unscoreable="2015")
@@ -149,12 +151,13 @@ def test_both_spellings_score_it_alike(capsys: pytest.CaptureFixture[str]) -> No
     assert new.distance_error == old.distance_error == _expected_score(cut, window)
 
 
+@pytest.mark.slow
 def test_coverage_below_the_fraction_is_unscoreable() -> None:
     stream, window = _run()
     # 8 gaps of 0.45 s (54 frames, 55 periods each), each under MAX_INNER_GAP_S: 440 of
     # 3059 periods lost, 85.6% covered
     cuts = [(200 + 300 * k, 254 + 300 * k) for k in range(8)]
-    result = score_runs(_cut(stream, cuts), [window], Fbm3wConfig(), bag_start_ns=0)
+    result = score_paths(_cut(stream, cuts), [window], Fbm3wConfig(), bag_start_ns=0)
     run = result.runs[0]
     covered = 1 - 8 * 55 / (PATH + 2 * STILL - 1)
     assert covered < MIN_COVERAGE
@@ -164,7 +167,7 @@ def test_coverage_below_the_fraction_is_unscoreable() -> None:
     assert run.unscoreable_reason.startswith(f"valid data covers only {covered:.1%} of the window")
     # 4 such gaps leave 92.7%: scored, and with the same number as without the mask
     four = _cut(stream, cuts[:4])
-    ok = score_runs(four, [window], Fbm3wConfig(), bag_start_ns=0).runs[0]
+    ok = score_paths(four, [window], Fbm3wConfig(), bag_start_ns=0).runs[0]
     assert ok.status == "scored"
     assert ok.distance_error == _expected_score(four, window)
 
@@ -175,7 +178,7 @@ def test_a_tracking_loss_while_moving_is_lost_path() -> None:
     a = 2 * STILL + 1500
     xyz[a : a + 72] = xyz[a - 1]  # Motive repeats the last pose for 0.6 s while the robot moves
     frozen = PoseStream(stream.t_ns, xyz, stream.quat_xyzw, "world", "robot_at_work", "synthetic")
-    run = score_runs(frozen, [window], Fbm3wConfig(), bag_start_ns=0).runs[0]
+    run = score_paths(frozen, [window], Fbm3wConfig(), bag_start_ns=0).runs[0]
     assert run.status == "unscoreable"
     assert run.unscoreable_reason is not None
     assert "(tracking_lost," in run.unscoreable_reason
@@ -185,6 +188,7 @@ def test_a_tracking_loss_while_moving_is_lost_path() -> None:
 SAMPLE = Path(__file__).resolve().parents[3] / "sample_bags" / "fbm3w"
 
 
+@pytest.mark.slow
 def test_the_score_command_prints_validity(capsys: pytest.CaptureFixture[str]) -> None:
     bag = SAMPLE / "log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
     config = SAMPLE / "fbm3w.yaml"

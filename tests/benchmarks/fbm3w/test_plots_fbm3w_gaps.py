@@ -1,6 +1,6 @@
 """The FBM3@Work run figure draws the ground truth's gaps where they are on the path and says
 the run's valid fraction (issue 28): a noiseless synthetic line run with frames cut by hand, its
-figure read back from the SVG (tests/svg_figure.py) and compared with the generator's points
+figure read back from the SVG (tests/helpers/svg_figure.py) and compared with the generator's points
 either side of the hole."""
 
 from __future__ import annotations
@@ -9,16 +9,15 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import svg_figure
-from fbm3w_synth import one_run
 from matplotlib.image import imread
 
-from ertools.benchmarks.fbm3w.benchmark import score_runs
-from ertools.configs.fbm3w import Fbm3wConfig
-from ertools.configs.shapes import builtin_shapes
-from ertools.report import plots_fbm3w
-from ertools.report.figures import render, wrap_title
+from ertools.benchmarks.fbm3w.pipeline import score_paths
+from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
+from ertools.benchmarks.fbm3w.shapes import builtin_shapes
+from ertools.report.figures import figure_specs, render, wrap_title
 from ertools.report.folder import write_report
+from tests.benchmarks.fbm3w.fbm3w_synth import one_run
+from tests.helpers import svg_figure
 
 STILL = 30
 PATH = 3000
@@ -30,7 +29,7 @@ def _result(cut: tuple[int, int]) -> object:
     stream, window = one_run(builtin_shapes()["line"](L), still=STILL)
     keep = np.ones(len(stream), dtype=bool)
     keep[2 * STILL + cut[0] : 2 * STILL + cut[1]] = False
-    return score_runs(stream.take(keep), [window], Fbm3wConfig(), bag_start_ns=0)
+    return score_paths(stream.take(keep), [window], Fbm3wConfig(), bag_start_ns=0)
 
 
 def _line_mm(i: int) -> tuple[float, float]:
@@ -41,7 +40,7 @@ def _line_mm(i: int) -> tuple[float, float]:
 
 
 def _figure_named(result: object, name: str, path: Path) -> Path:
-    (spec,) = [s for s in plots_fbm3w.figure_specs(result) if s.name == name]
+    (spec,) = [s for s in figure_specs(result) if s.name == name]
     render(spec, path)
     return path
 
@@ -56,6 +55,7 @@ def _tolerance(fig: svg_figure.Figure) -> float:
     return max(abs(fig.scale("x")[0]), abs(fig.scale("y")[0]))
 
 
+@pytest.mark.slow
 def test_a_gap_is_drawn_between_the_samples_around_the_hole(tmp_path: Path) -> None:
     # 30 frames cut: 0.258 s, under the 0.5 s a path may cross, so the run is scored
     result = _result((1000, 1030))
@@ -94,6 +94,7 @@ def test_an_unscoreable_run_has_its_figure_and_verdict(tmp_path: Path) -> None:
     assert any(t.endswith("% valid") for t in runs.texts("label"))
 
 
+@pytest.mark.slow
 def test_matplotlib_draws_the_gaps_too(tmp_path: Path) -> None:
     for cut in ((1000, 1030), (1000, 1072)):
         path = _figure(_result(cut), tmp_path, "png")
@@ -103,7 +104,7 @@ def test_matplotlib_draws_the_gaps_too(tmp_path: Path) -> None:
 def test_png_titles_wrap_to_the_figure() -> None:
     # matplotlib does not wrap a title; an unscoreable reason is wider than the figure
     result = _result((1000, 1072))
-    (spec,) = [s for s in plots_fbm3w.figure_specs(result) if s.name == "fbm3w_run0"]
+    (spec,) = [s for s in figure_specs(result) if s.name == "fbm3w_run0"]
     lines = wrap_title(spec.title, spec.size[0]).splitlines()
     assert len(lines) > 1 and all(len(line) <= 80 for line in lines)
     assert " ".join(lines) == spec.title

@@ -7,9 +7,9 @@ import shutil
 from pathlib import Path
 
 import pytest
-from stderr_text import error_messages
 
 from ertools.cli.main import main
+from tests.helpers.stderr_text import error_messages
 
 pytestmark = pytest.mark.slow  # copies and reads the sample bag (~1 s each)
 

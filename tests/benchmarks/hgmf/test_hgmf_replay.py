@@ -14,14 +14,14 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from rsbb_replay import hgmf as replay
-from rsbb_replay.fromlog import timeline_from_bag
-from rsbb_replay.world import World, run_script
 
 from ertools.benchmarks.hgmf.sample import OBJECTS, SAMPLE, GoalPlan, RunPlan, build
 from ertools.cli.main import main
 from ertools.rsbb.score import flatten
-from ertools.samples.rsbb import write_rsbb_run
+from ertools.simulator.rsbb import write_rsbb_run
+from tests.helpers.rsbb_replay import hgmf as replay
+from tests.helpers.rsbb_replay.fromlog import timeline_from_bag
+from tests.helpers.rsbb_replay.world import World, run_script
 
 pytestmark = pytest.mark.slow  # each writes a run bag and scores it (~2 s)
 

@@ -15,14 +15,10 @@ from typing import Any
 
 import numpy as np
 import yaml
-from rsbb_replay import hnf as replay_hnf
-from rsbb_replay.fromlog import timeline_from_bag
-from rsbb_replay.scenarios import T0, at
-from rsbb_replay.world import ReplayResult, World, run_script
 
-from ertools.samples.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
-from ertools.samples.rsbb import write_rsbb_run
-from ertools.samples.rsbb_scenario import (
+from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
+from ertools.simulator.rsbb import write_rsbb_run
+from ertools.simulator.rsbb_scenario import (
     Body,
     Broadcast,
     Goal,
@@ -30,6 +26,10 @@ from ertools.samples.rsbb_scenario import (
     RsbbScenario,
     Save,
 )
+from tests.helpers.rsbb_replay import hnf as replay_hnf
+from tests.helpers.rsbb_replay.fromlog import timeline_from_bag
+from tests.helpers.rsbb_replay.scenarios import T0, at
+from tests.helpers.rsbb_replay.world import ReplayResult, World, run_script
 
 PROMPT = replay_hnf.PROMPT
 # markerset_to_robot_transform as a team's file writes it: 4 decimals, |q| = 0.99998

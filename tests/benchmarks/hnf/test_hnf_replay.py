@@ -20,13 +20,13 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from hnf_runs import HnfRun, goal, lookups, prompt, write_run
-from rsbb_replay.scenarios import at
 
 from ertools.benchmarks.hnf import declare
 from ertools.benchmarks.hnf.pipeline import find_runs, load, score_runs
 from ertools.rsbb.score import flatten
-from ertools.samples.mocap import TrackingLoss
+from ertools.simulator.mocap import TrackingLoss
+from tests.benchmarks.hnf.hnf_runs import HnfRun, goal, lookups, prompt, write_run
+from tests.helpers.rsbb_replay.scenarios import at
 
 pytestmark = pytest.mark.slow  # each run is written twice and replayed (~2 s)
 

@@ -11,7 +11,8 @@ from typing import Any
 
 import pytest
 import yaml
-from inprocess import run
+
+from tests.helpers.inprocess import run
 
 pytestmark = pytest.mark.slow  # four scores of two bags
 

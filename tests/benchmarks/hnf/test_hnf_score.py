@@ -14,15 +14,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from inprocess import run as ertools
-from rsbb_replay.scenarios import QUIET, T0, at
 
 from ertools.benchmarks.hnf import declare
 from ertools.benchmarks.hnf.pipeline import find_runs, load, score_runs
 from ertools.errors import ConfigError, UsageError
-from ertools.samples.mocap import frame_times, simulate_mocap
-from ertools.samples.rsbb import write_rsbb_run
-from ertools.samples.rsbb_scenario import Body, Broadcast, Goal, RsbbScenario, Save, still_pose
+from ertools.simulator.mocap import frame_times, simulate_mocap
+from ertools.simulator.rsbb import write_rsbb_run
+from ertools.simulator.rsbb_scenario import Body, Broadcast, Goal, RsbbScenario, Save, still_pose
+from tests.helpers.inprocess import run as ertools
+from tests.helpers.rsbb_replay.scenarios import QUIET, T0, at
 
 pytestmark = pytest.mark.slow  # writes a run bag
 

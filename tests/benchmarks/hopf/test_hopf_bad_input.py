@@ -8,10 +8,10 @@ from pathlib import Path
 
 import pytest
 import yaml
-from hopf_runs import build, write
-from stderr_text import error_messages
 
 from ertools.cli.main import main
+from tests.benchmarks.hopf.hopf_runs import build, write
+from tests.helpers.stderr_text import error_messages
 
 pytestmark = pytest.mark.slow  # writes a run bag
 

@@ -23,13 +23,14 @@ from typing import Any
 
 import pytest
 import yaml
-from rsbb_replay.scenarios import at, hnf_scenario, still_body
 
 from ertools.benchmarks import registry
+from ertools.benchmarks.scoring import score_execution
 from ertools.cli.main import main
-from ertools.samples.mocap import TrackingLoss
-from ertools.samples.rsbb import write_rsbb_run
-from ertools.samples.rsbb_scenario import Broadcast, Goal, ManualOperation, Save
+from ertools.simulator.mocap import TrackingLoss
+from ertools.simulator.rsbb import write_rsbb_run
+from ertools.simulator.rsbb_scenario import Broadcast, Goal, ManualOperation, Save
+from tests.helpers.rsbb_replay.scenarios import at, hnf_scenario, still_body
 
 pytestmark = pytest.mark.slow  # writes and reads a run bag
 
@@ -113,7 +114,7 @@ def run_files(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
 
 def _score(bag: Path, items: Path, **values: Any) -> Any:
     bench = registry.get("hopf")
-    return bench.score([bag], bench.make_options({"items": items, "draws": 0, **values}))
+    return score_execution(bench, [bag], {"items": items, "draws": 0, **values}).result
 
 
 def test_ertools_reading_by_hand(run_files: tuple[Path, Path]) -> None:

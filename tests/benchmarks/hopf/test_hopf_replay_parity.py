@@ -14,10 +14,11 @@ from typing import Any
 
 import numpy as np
 import pytest
-from hopf_runs import STOPS, build, replay, write
-from rsbb_fields import same
 
 from ertools.benchmarks import registry
+from ertools.benchmarks.scoring import score_execution
+from tests.benchmarks.hopf.hopf_runs import STOPS, build, replay, write
+from tests.helpers.rsbb_fields import same
 
 pytestmark = pytest.mark.slow  # writes and reads run bags (~1 s each)
 
@@ -47,8 +48,8 @@ PLANS["stop_first"] = ["stop_mo1"]
 
 def _score(bag: Path, items: Path, config: Path, rules: str) -> Any:
     bench = registry.get("hopf")
-    opts = bench.make_options({"items": items, "config": config, "rules": rules, "draws": 0})
-    return bench.score([bag], opts)
+    values = {"items": items, "config": config, "rules": rules, "draws": 0}
+    return score_execution(bench, [bag], values).result
 
 
 @pytest.mark.parametrize("rules", ["2019", "2017", "2017-11"])

@@ -10,14 +10,14 @@ from typing import Any
 
 import pytest
 import yaml
-from inprocess import run
 from mcap.reader import make_reader
-from rsbb_fields import same
-from rsbb_replay import hopf as replay_hopf
-from rsbb_replay.fromlog import timeline_from_bag
-from rsbb_replay.world import World, run_script
 
 from ertools.cli.main import main
+from tests.helpers.inprocess import run
+from tests.helpers.rsbb_fields import same
+from tests.helpers.rsbb_replay import hopf as replay_hopf
+from tests.helpers.rsbb_replay.fromlog import timeline_from_bag
+from tests.helpers.rsbb_replay.world import World, run_script
 
 SAMPLE = Path(__file__).parents[3] / "sample_bags" / "hopf"
 BAG = next(SAMPLE.glob("rsbb_logs/HOPF/*/run_*.bag"))

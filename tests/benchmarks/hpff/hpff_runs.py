@@ -13,14 +13,10 @@ from typing import Any
 
 import numpy as np
 import yaml
-from rsbb_replay import hpff as replay_hpff
-from rsbb_replay.fromlog import timeline_from_bag
-from rsbb_replay.scenarios import T0, at
-from rsbb_replay.world import ReplayResult, World, run_script
 
-from ertools.samples.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
-from ertools.samples.rsbb import write_rsbb_run
-from ertools.samples.rsbb_scenario import (
+from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
+from ertools.simulator.rsbb import write_rsbb_run
+from ertools.simulator.rsbb_scenario import (
     Body,
     Broadcast,
     Goal,
@@ -28,6 +24,10 @@ from ertools.samples.rsbb_scenario import (
     RsbbScenario,
     Save,
 )
+from tests.helpers.rsbb_replay import hpff as replay_hpff
+from tests.helpers.rsbb_replay.fromlog import timeline_from_bag
+from tests.helpers.rsbb_replay.scenarios import T0, at
+from tests.helpers.rsbb_replay.world import ReplayResult, World, run_script
 
 TEAM = ([0.1, 0.05, -0.4], [0.0, 0.0, -0.1494, 0.9888])  # as a team's file writes it
 PROMPT = "Failed to acquire pose of human or robot. Make sure they have detectable markersets."

@@ -16,13 +16,13 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from hpff_runs import PROMPT, HpffRun, schedule, write_run
-from inprocess import run as ertools
-from rsbb_replay.scenarios import at
 
 from ertools.benchmarks.hpff import declare
 from ertools.benchmarks.hpff.pipeline import find_runs, load, score_runs
-from ertools.samples.rsbb_scenario import Goal, ManualOperation
+from ertools.simulator.rsbb_scenario import Goal, ManualOperation
+from tests.benchmarks.hpff.hpff_runs import PROMPT, HpffRun, schedule, write_run
+from tests.helpers.inprocess import run as ertools
+from tests.helpers.rsbb_replay.scenarios import at
 
 pytestmark = pytest.mark.slow  # each run is written twice and replayed (~3 s)
 

@@ -14,15 +14,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from inprocess import run as ertools
-from rsbb_replay.scenarios import QUIET, T0, at
 
 from ertools.benchmarks.hpff import declare
 from ertools.benchmarks.hpff.pipeline import find_runs, load, score_runs
 from ertools.errors import ConfigError, UsageError
-from ertools.samples.mocap import TrackingLoss, frame_times, simulate_mocap
-from ertools.samples.rsbb import write_rsbb_run
-from ertools.samples.rsbb_scenario import Body, Goal, RsbbScenario, Save, still_pose
+from ertools.simulator.mocap import TrackingLoss, frame_times, simulate_mocap
+from ertools.simulator.rsbb import write_rsbb_run
+from ertools.simulator.rsbb_scenario import Body, Goal, RsbbScenario, Save, still_pose
+from tests.helpers.inprocess import run as ertools
+from tests.helpers.rsbb_replay.scenarios import QUIET, T0, at
 
 pytestmark = pytest.mark.slow  # writes a run bag
 

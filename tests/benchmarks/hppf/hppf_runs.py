@@ -26,13 +26,10 @@ from typing import Any
 
 import numpy as np
 import yaml
-from rsbb_replay import hppf as replay_hppf
-from rsbb_replay.fromlog import timeline_from_bag
-from rsbb_replay.world import ReplayResult, World, run_script
 
-from ertools.samples.mocap import MocapNoise, frame_times, simulate_mocap
-from ertools.samples.rsbb import write_rsbb_run
-from ertools.samples.rsbb_scenario import (
+from ertools.simulator.mocap import MocapNoise, frame_times, simulate_mocap
+from ertools.simulator.rsbb import write_rsbb_run
+from ertools.simulator.rsbb_scenario import (
     Body,
     Broadcast,
     Goal,
@@ -40,6 +37,9 @@ from ertools.samples.rsbb_scenario import (
     RsbbScenario,
     Save,
 )
+from tests.helpers.rsbb_replay import hppf as replay_hppf
+from tests.helpers.rsbb_replay.fromlog import timeline_from_bag
+from tests.helpers.rsbb_replay.world import ReplayResult, World, run_script
 
 S = 1_000_000_000
 MS = 1_000_000

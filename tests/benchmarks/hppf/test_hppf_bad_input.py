@@ -8,11 +8,11 @@ from pathlib import Path
 
 import pytest
 import yaml
-from hppf_runs import build, write
-from stderr_text import error_messages
 
 from ertools.cli.main import main
-from ertools.samples.rsbb import write_rsbb_run
+from ertools.simulator.rsbb import write_rsbb_run
+from tests.benchmarks.hppf.hppf_runs import build, write
+from tests.helpers.stderr_text import error_messages
 
 pytestmark = pytest.mark.slow  # writes a run bag
 

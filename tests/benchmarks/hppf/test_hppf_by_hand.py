@@ -19,13 +19,14 @@ from typing import Any
 
 import pytest
 import yaml
-from rsbb_replay.scenarios import at, hnf_scenario, still_body
 
 from ertools.benchmarks import registry
+from ertools.benchmarks.scoring import score_execution
 from ertools.cli.main import main
-from ertools.samples.mocap import TrackingLoss
-from ertools.samples.rsbb import write_rsbb_run
-from ertools.samples.rsbb_scenario import Broadcast, Goal, ManualOperation, Save
+from ertools.simulator.mocap import TrackingLoss
+from ertools.simulator.rsbb import write_rsbb_run
+from ertools.simulator.rsbb_scenario import Broadcast, Goal, ManualOperation, Save
+from tests.helpers.rsbb_replay.scenarios import at, hnf_scenario, still_body
 
 pytestmark = pytest.mark.slow  # writes and reads a run bag
 
@@ -82,7 +83,7 @@ def _files(folder: Path, gap: bool = False) -> tuple[Path, Path]:
 
 def _score(bag: Path, config: Path, **values: Any) -> Any:
     bench = registry.get("hppf")
-    return bench.score([bag], bench.make_options({"config": config, "draws": 0, **values}))
+    return score_execution(bench, [bag], {"config": config, "draws": 0, **values}).result
 
 
 def test_ertools_and_the_script_by_hand(tmp_path: Path) -> None:

@@ -13,10 +13,11 @@ from typing import Any
 
 import numpy as np
 import pytest
-from hppf_runs import STOPS, build, replay, write
-from rsbb_fields import same
 
 from ertools.benchmarks import registry
+from ertools.benchmarks.scoring import score_execution
+from tests.benchmarks.hppf.hppf_runs import STOPS, build, replay, write
+from tests.helpers.rsbb_fields import same
 
 pytestmark = pytest.mark.slow  # writes and reads run bags
 
@@ -36,8 +37,8 @@ PLANS["stop_first"] = ["stop_enter"]
 
 def _score(bag: Path, config: Path, rules: str) -> Any:
     bench = registry.get("hppf")
-    opts = bench.make_options({"config": config, "rules": rules, "draws": 0})
-    return bench.score([bag], opts)
+    values = {"config": config, "rules": rules, "draws": 0}
+    return score_execution(bench, [bag], values).result
 
 
 @pytest.mark.parametrize("plan", sorted(PLANS))

@@ -11,12 +11,14 @@ import numpy as np
 import pytest
 import yaml
 
-from ertools.benchmarks.noise.benchmark import noise_from_stream, noise_statistics
+from ertools.benchmarks.common.epsilon import noise_from_stream, noise_statistics
+from ertools.benchmarks.fbm3w import sample as fbm3w
+from ertools.benchmarks.noise.sample import generate
 from ertools.cli.main import main
 from ertools.errors import ScoringError
-from ertools.samples import fbm3w
-from ertools.samples.stationary import generate
 from ertools.streams import PoseStream
+
+pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module")

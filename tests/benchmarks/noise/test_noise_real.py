@@ -12,6 +12,8 @@ from rosbags.highlevel import AnyReader
 
 from ertools.cli.main import main
 
+pytestmark = pytest.mark.slow
+
 REAL = Path(__file__).resolve().parents[3] / ".." / "shared" / "real_bags"
 BAG = REAL / "log_fbm2h_mocap_2015-10-23-16-15-40_0.bag"
 TOPIC = "/fbm2h/robot_at_home/pose2d"

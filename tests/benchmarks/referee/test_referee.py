@@ -10,12 +10,12 @@ from pathlib import Path
 
 import pytest
 import yaml
-from rsbb_replay.scenarios import T0, at, hnf_scenario
-from stderr_text import error_messages
 
 from ertools.cli.main import main
-from ertools.samples.rsbb import write_rsbb_run
-from ertools.samples.rsbb_task import COMPLETED, STOPPED, TIMED_OUT, TaskScenario, write_task_run
+from ertools.simulator.rsbb import write_rsbb_run
+from ertools.simulator.rsbb_task import COMPLETED, STOPPED, TIMED_OUT, TaskScenario, write_task_run
+from tests.helpers.rsbb_replay.scenarios import T0, at, hnf_scenario
+from tests.helpers.stderr_text import error_messages
 
 pytestmark = pytest.mark.slow  # each writes and reads a run bag (~0.5 s)
 

@@ -7,7 +7,7 @@ from typing import Any
 import pytest
 import yaml
 
-from ertools.samples.robotlog import generate
+from ertools.benchmarks.trajectory.sample import generate
 
 
 @pytest.fixture(scope="session")

@@ -21,7 +21,7 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from node_2015 import tf_yaw
+from tests.benchmarks.trajectory.node_2015 import tf_yaw
 
 NS = 1_000_000_000
 

@@ -19,18 +19,18 @@ from typing import Any
 
 import numpy as np
 import pytest
-from node_2015 import EndOfBagError, Pose, score_2015, tf_yaw
 from rosbags.highlevel import AnyReader
-from stderr_text import error_messages
-from trajectory_helpers import read_back, write_gt, write_robot
 
 from ertools.benchmarks.trajectory.association import yaw_tf
+from ertools.benchmarks.trajectory.comparison import score_streams
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
-from ertools.benchmarks.trajectory.scoring import score_streams
 from ertools.cli.main import main
 from ertools.errors import ClockError
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 from ertools.streams import PoseStream
+from tests.benchmarks.trajectory.node_2015 import EndOfBagError, Pose, score_2015, tf_yaw
+from tests.benchmarks.trajectory.trajectory_helpers import read_back, write_gt, write_robot
+from tests.helpers.stderr_text import error_messages
 
 TOL = 1e-12
 ROOT = Path(__file__).resolve().parents[3]
@@ -78,6 +78,7 @@ def assert_same(ours: dict[str, Any], node: Any) -> None:
 # --- the sample bags ---------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("offset_s", [0.0, -0.35])
 def test_2015_on_the_sample_bags_equals_the_2015_script(
     offset_s: float, capsys: pytest.CaptureFixture[str]
@@ -93,6 +94,7 @@ def test_2015_on_the_sample_bags_equals_the_2015_script(
     assert ours["gap_poses"] == "compare" and ours["before_gt_poses"] == "first"
 
 
+@pytest.mark.slow
 def test_the_default_differs_from_2015_on_the_sample_and_says_so(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
@@ -108,6 +110,7 @@ def test_the_default_differs_from_2015_on_the_sample_and_says_so(
     assert "[trajectory.yaw-wrap]" in cap.err
 
 
+@pytest.mark.slow
 def test_gaps_compare_alone_on_the_sample(capsys: pytest.CaptureFixture[str]) -> None:
     """--association hold --gaps compare: the sample has no exact tie and no pose before the
     GT, so these two options alone already give the 2015 numbers."""
@@ -263,6 +266,7 @@ def _random_case(seed: int) -> tuple[list[Pose], list[Pose]]:
     return robot, gt
 
 
+@pytest.mark.slow_cases("3")
 @pytest.mark.parametrize("seed", range(8))
 def test_random_cases_equal_the_2015_script(seed: int) -> None:
     robot, gt = _random_case(seed)

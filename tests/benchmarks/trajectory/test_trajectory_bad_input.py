@@ -8,11 +8,11 @@ from typing import Any
 
 import numpy as np
 import pytest
-from stderr_text import error_messages
-from trajectory_helpers import write_gt, write_robot
 
+from ertools.benchmarks.trajectory.sample import GT_TOPIC, ROBOT_TOPIC
 from ertools.cli.main import main
-from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC
+from tests.benchmarks.trajectory.trajectory_helpers import write_gt, write_robot
+from tests.helpers.stderr_text import error_messages
 
 T0 = 1_448_013_600 * 1_000_000_000
 
@@ -27,6 +27,7 @@ def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> str:
     return lines[0]
 
 
+@pytest.mark.slow
 def test_robot_topic_missing(robotlog: dict[str, Any], capsys: pytest.CaptureFixture[str]) -> None:
     line = run(
         [
@@ -40,6 +41,7 @@ def test_robot_topic_missing(robotlog: dict[str, Any], capsys: pytest.CaptureFix
     assert "/rockin/adams/marker_pose" in line and ROBOT_TOPIC in line  # names what is there
 
 
+@pytest.mark.slow
 def test_gt_topic_missing(robotlog: dict[str, Any], capsys: pytest.CaptureFixture[str]) -> None:
     line = run(
         [str(robotlog["robot"]), *map(str, robotlog["gt"]), "--gt-topic", "/nope/pose"], capsys
@@ -71,6 +73,7 @@ def test_missing_robot_bag(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -
     assert "nope.bag" in line
 
 
+@pytest.mark.slow
 def test_gt_folder_without_bags(
     robotlog: dict[str, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

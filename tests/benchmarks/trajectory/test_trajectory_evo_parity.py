@@ -29,7 +29,7 @@ import pytest
 from ertools.benchmarks.trajectory.association import evo_matches
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 
 REPO = Path(__file__).resolve().parents[3]
 EVO_DATA = REPO.parent / "shared" / "evo_testdata"
@@ -87,6 +87,7 @@ def assert_same(ours: dict[str, Any], n: int, stats: dict[str, float]) -> None:
 EVO_LINE = ("--association", "nearest", "--t-max-diff", "0.01")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     ("gt", "robot"),
     [("groundtruth", "ORB-SLAM"), ("ORB-SLAM", "groundtruth"), ("groundtruth", "S-PTAM")],
@@ -105,6 +106,7 @@ def test_ros1_bag_as_evo_ape_bag(
     assert ours["compared"] + ours["unpaired"] + ours["uncovered"] == ours["robot_poses"]
 
 
+@pytest.mark.slow
 def test_tum_pair_as_evo_ape_tum(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     gt = _evo_data("freiburg1_xyz-groundtruth.txt")
     robot = _evo_data("freiburg1_xyz-rgbdslam.txt")
@@ -112,6 +114,7 @@ def test_tum_pair_as_evo_ape_tum(tmp_path: Path, capsys: pytest.CaptureFixture[s
     assert_same(ertools_json(capsys, str(robot), str(gt), *EVO_LINE), n, stats)
 
 
+@pytest.mark.slow
 def test_kitti_pair_as_evo_ape_kitti(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     gt = _evo_data("KITTI_00_gt.txt")
     robot = _evo_data("KITTI_00_ORB.txt")
@@ -170,6 +173,7 @@ def write_sim_bag(
         )
 
 
+@pytest.mark.slow
 def test_sim_time_mcap_as_evo_ape_bag2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     bag = tmp_path / "sim"
     write_sim_bag(bag)
@@ -183,6 +187,7 @@ def test_sim_time_mcap_as_evo_ape_bag2(tmp_path: Path, capsys: pytest.CaptureFix
     assert said and "paired by header stamps" in said[0]
 
 
+@pytest.mark.slow
 def test_sim_time_gt_in_another_bag(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """Robot and GT in two bags, both in simulation time: the GT file is found by the robot's
     record times (the files' spans), its poses read by header stamps; the pairs are those of
@@ -235,6 +240,7 @@ def test_time_source_contradiction(tmp_path: Path, capsys: pytest.CaptureFixture
     assert "--time-source header sets the robot's time too" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_t_max_diff_needs_nearest(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     bag = tmp_path / "sim"
     write_sim_bag(bag)
@@ -247,6 +253,7 @@ def test_t_max_diff_needs_nearest(tmp_path: Path, capsys: pytest.CaptureFixture[
     assert alone["association"] == "nearest" and alone["compared"] == spelt["compared"]
 
 
+@pytest.mark.slow
 def test_export_matched_gives_evo_pairs(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """`export --matched --t-max-diff` writes evo's pairs: evo_ape on them gives the same
     numbers as evo_ape on the bag itself."""

@@ -6,11 +6,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ertools.benchmarks.trajectory.comparison import score_streams
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
-from ertools.benchmarks.trajectory.scoring import score_streams
 from ertools.geometry import quat_from_yaw
-from ertools.io import read_poses
-from ertools.samples.writer import BagWriter
+from ertools.io.reader import read_poses
+from ertools.simulator.writer import BagWriter
 from ertools.streams import PoseStream
 
 S = 1_000_000_000

@@ -94,6 +94,7 @@ def _scored(capsys: pytest.CaptureFixture[str], *extra: str) -> tuple[dict, list
     return json.loads(captured.out), captured.err.splitlines()
 
 
+@pytest.mark.slow
 def test_every_interval_holds_its_score_and_the_fitted_offset_has_its_own(
     capsys: pytest.CaptureFixture[str],
 ) -> None:

@@ -26,15 +26,17 @@ import pytest
 from ertools.benchmarks.common.clocks import OffsetEstimate
 from ertools.benchmarks.common.interval_output import IntervalSettings
 from ertools.benchmarks.trajectory.association import COMPARED, associate
+from ertools.benchmarks.trajectory.formula import PERCENTILES, metrics
 from ertools.benchmarks.trajectory.intervals import (
     KEYS,
     Rescoring,
     mocap_sigma,
     trajectory_intervals,
 )
-from ertools.benchmarks.trajectory.metrics import PERCENTILES, metrics
 from ertools.geometry import quat_from_yaw, yaw_from_quat
 from ertools.streams import PoseStream
+
+pytestmark = pytest.mark.slow  # whole module: make test only
 
 T0 = 1_448_000_000 * 10**9
 DRAWS = 20_000

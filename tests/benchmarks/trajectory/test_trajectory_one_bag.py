@@ -15,17 +15,19 @@ from typing import Any
 import numpy as np
 import pytest
 from rosbags.rosbag1 import Reader
-from stderr_text import error_messages
-from test_trajectory_sample import check
-from trajectory_helpers import read_back
 
 from ertools.benchmarks.trajectory.association import COMPARED
-from ertools.benchmarks.trajectory.benchmark import score
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.pipeline import score
+from ertools.benchmarks.trajectory.sample import GT_TOPIC, ROBOT_TOPIC
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
-from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
+from tests.benchmarks.trajectory.test_trajectory_sample import check
+from tests.benchmarks.trajectory.trajectory_helpers import read_back
+from tests.helpers.stderr_text import error_messages
+
+pytestmark = pytest.mark.slow
 
 FORMATS = {"ros1": "bag", "mcap": "mcap"}
 

@@ -23,9 +23,9 @@ from ertools.benchmarks.trajectory.association import (
     UNCOVERED,
     associate,
 )
+from ertools.benchmarks.trajectory.comparison import check_increasing, score_streams
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
-from ertools.benchmarks.trajectory.metrics import metrics
-from ertools.benchmarks.trajectory.scoring import check_increasing, score_streams
+from ertools.benchmarks.trajectory.formula import metrics
 from ertools.errors import ClockError, ConfigError, ScoringError
 from ertools.geometry import quat_from_yaw
 from ertools.streams import PoseStream
@@ -220,6 +220,7 @@ def test_nothing_comparable_is_a_failure() -> None:
     assert d["position_error"] is None and d["compared"] == 0
 
 
+@pytest.mark.slow
 def test_coarse_scan_equals_a_direct_nearest_grid_computation() -> None:
     """The coarse scan's vectorised gather (NaN-padded grid, gaps marked per gap) against the
     definition written out per offset: mean distance to the GT interpolated at the nearest

@@ -10,15 +10,15 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from stderr_text import error_messages
-from trajectory_helpers import read_back, write_gt, yaw
 
-import ertools.benchmarks.trajectory.inputs as tr
-from ertools.benchmarks.trajectory.benchmark import score
+import ertools.benchmarks.trajectory.logs as tr
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
+from ertools.benchmarks.trajectory.pipeline import score
+from ertools.benchmarks.trajectory.sample import GT_TOPIC, ROBOT_TOPIC, expected_scores, truth_at
 from ertools.cli.main import main
-from ertools.io import read_poses
-from ertools.samples.robotlog import GT_TOPIC, ROBOT_TOPIC, expected_scores, truth_at
+from ertools.io.reader import read_poses
+from tests.benchmarks.trajectory.trajectory_helpers import read_back, write_gt, yaw
+from tests.helpers.stderr_text import error_messages
 
 KEYS = ("compared", "gaps", "tracking_lost", "uncovered")
 ERRORS = ("position_error", "orientation_error", "rmse", "median", "max")
@@ -89,6 +89,7 @@ def test_cli_json_has_the_documented_keys(
     assert out["association"] == "hold"
 
 
+@pytest.mark.slow
 def test_cli_yaml_and_plots(
     robot_cli: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -116,6 +117,7 @@ def _one_error_line(err: str) -> str:
     return lines[0]
 
 
+@pytest.mark.slow
 def test_robot_log_not_covered_by_gt(
     robotlog: dict[str, Any], capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -140,6 +142,7 @@ def test_robot_log_not_covered_by_gt(
     assert out["partial"] is True
 
 
+@pytest.mark.slow
 def test_overlapping_gt_files(
     robotlog: dict[str, Any], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -189,6 +192,7 @@ def test_overlapping_gt_files(
     assert len(out["gt_files"]) == 4
 
 
+@pytest.mark.slow
 def test_robot_record_time(
     robotlog: dict[str, Any], robot_cli: list[str], capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -220,6 +224,7 @@ def test_robot_record_time(
     check(out, exp, robotlog["answers"])
 
 
+@pytest.mark.slow
 def test_gt_read_is_one_read_equal_to_the_whole_cut(
     robotlog: dict[str, Any],
     tmp_path: Path,

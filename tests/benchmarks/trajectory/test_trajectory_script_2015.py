@@ -20,11 +20,11 @@ from typing import Any
 import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
-from script2015 import Bag, PoseStamped, Run, Time, run_2015
-from stderr_text import error_messages
 
 from ertools.cli.main import main
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
+from tests.benchmarks.trajectory.script2015 import Bag, PoseStamped, Run, Time, run_2015
+from tests.helpers.stderr_text import error_messages
 
 S = 1_000_000_000
 MS = 1_000_000

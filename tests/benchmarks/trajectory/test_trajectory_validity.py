@@ -9,16 +9,15 @@ from typing import Any
 
 import numpy as np
 import pytest
-import svg_figure
 
+from ertools.benchmarks.trajectory.comparison import score_streams
 from ertools.benchmarks.trajectory.config import SETTINGS_2015, TrajectoryConfig
-from ertools.benchmarks.trajectory.scoring import score_streams
 from ertools.benchmarks.trajectory.validity import MIN_VALID_FRACTION
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
-from ertools.report.figures import render
-from ertools.report.plots_trajectory import figure_specs
+from ertools.report.figures import figure_specs, render
 from ertools.streams import PoseStream
+from tests.helpers import svg_figure
 
 T0 = 1_448_013_600 * 1_000_000_000
 S = 1_000_000_000
@@ -95,6 +94,7 @@ def test_a_long_hole_is_unscoreable_unless_2015() -> None:
     assert held["position_error"] is not None
 
 
+@pytest.mark.slow
 def test_the_score_command_prints_validity(
     robotlog: dict[str, Any], capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -111,6 +111,7 @@ def test_the_score_command_prints_validity(
     assert again["position_error"] == data["position_error"]
 
 
+@pytest.mark.slow
 def test_the_error_figures_shade_the_hole(tmp_path: Path) -> None:
     robot, gt = _streams((1.05, 3.05))
     result = score_streams(robot, gt, TrajectoryConfig())

@@ -9,7 +9,7 @@ import numpy as np
 from rosbags.highlevel import AnyReader
 
 from ertools.geometry import quat_from_yaw
-from ertools.samples.writer import BagWriter
+from ertools.simulator.writer import BagWriter
 
 
 def read_back(path: Path, topic: str) -> tuple[list[int], list[list[float]], list[list[float]]]:

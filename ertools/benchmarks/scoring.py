@@ -1,0 +1,58 @@
+"""The one way a benchmark execution is scored: ``ertools score``, :func:`ertools.score`,
+``ertools audit`` (recomputing) and ``ertools rescore`` (each job) all call
+:func:`score_execution`, so that they score alike by construction."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ertools.benchmarks.base import AnyBenchmark, Audited, BenchmarkResult
+from ertools.benchmarks.common.which import refuse_other_benchmark
+
+
+@dataclass(frozen=True)
+class Scored:
+    """A scored execution: the result, the options it was scored with, and what was taken
+    from the live score (:meth:`~ertools.benchmarks.base.Audited.from_live`), one note each."""
+
+    result: BenchmarkResult
+    options: Any
+    said: tuple[str, ...] = ()
+
+
+def score_execution(
+    bench: AnyBenchmark,
+    logs: Sequence[Path],
+    values: Mapping[str, Any],
+    *,
+    live: Any = None,
+    check_logs: bool = True,
+) -> Scored:
+    """Score one execution: the values given (by input name) -> options -> logs loaded -> runs
+    found -> the result.
+
+    Args:
+        bench: the benchmark (:func:`ertools.benchmarks.registry.get`).
+        logs: its log files, in order.
+        values: the values of its inputs by name (missing ones at their defaults).
+        live: the live score (parsed) of an audited execution: the benchmark may take options
+            from it (FBM2H: the transform its node used).
+        check_logs: refuse a log that is plainly another benchmark's (a usage error naming
+            the command to run); an audit and a manifest have chosen the benchmark already.
+
+    Raises:
+        UsageError: a value that does not fit its input, or another benchmark's log.
+        ErtoolsError: unusable data or configuration.
+    """
+    if check_logs:
+        refuse_other_benchmark(bench.name, logs, values)
+    options = bench.make_options(values)
+    said: tuple[str, ...] = ()
+    if live is not None and isinstance(bench, Audited):
+        options, said = bench.from_live(options, live)
+    loaded = bench.load(logs, options)
+    result: BenchmarkResult = bench.score_runs(loaded, bench.find_runs(loaded, options), options)
+    return Scored(result, options, said)

@@ -1,0 +1,48 @@
+"""No run of 10 or more significant lines written twice inside ertools/ (issue 37): one rule
+in one place. Significant: not blank, a comment, an import or lone punctuation; white space
+folded. Exact copies only; copies with other names need a tool by hand (docs/qa.md)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from tests.architecture.archscan import ROOT, plant, ratchet, repeats
+
+# Pairs of files sharing a run today: the list only shrinks.
+ALLOWED = frozenset(
+    {
+        "ertools/rsbb_states.py ~ ertools/states.py",
+        # issue 38's RSBB packages, written in parallel on the old record (merged after issue
+        # 37's conversions): what they share goes to ertools/rsbb/ as they are converted
+        "ertools/benchmarks/fbm1/plots.py ~ ertools/benchmarks/hopf/plots.py",
+        "ertools/benchmarks/fbm2h/plots.py ~ ertools/benchmarks/hnf/plots.py",
+        "ertools/benchmarks/hgmf/result.py ~ ertools/benchmarks/hnf/result.py",
+        "ertools/benchmarks/hnf/declare.py ~ ertools/benchmarks/hpff/declare.py",
+        "ertools/benchmarks/hnf/pipeline.py ~ ertools/benchmarks/hpff/pipeline.py",
+        "ertools/benchmarks/hnf/sample.py ~ ertools/benchmarks/hpff/sample.py",
+        "ertools/benchmarks/hopf/declare.py ~ ertools/benchmarks/hppf/declare.py",
+        "ertools/benchmarks/hopf/goals.py ~ ertools/benchmarks/hppf/goals.py",
+        "ertools/benchmarks/hopf/result.py ~ ertools/benchmarks/hppf/result.py",
+        "ertools/benchmarks/hopf/sample.py ~ ertools/benchmarks/hppf/sample.py",
+    }
+)
+
+
+def test_no_new_repeated_run() -> None:
+    found = repeats(ROOT)
+    ratchet(set(found), ALLOWED, "runs of 10+ lines repeated (" + "; ".join(found.values()) + ")")
+
+
+def test_a_repeat_is_found_across_files_and_layouts(tmp_path: Path) -> None:
+    body = "".join(f"    x{i} = {i}\n" for i in range(10))
+    spaced = "".join(f"    x{i}  =  {i}\n\n    # note\n" for i in range(10))
+    nine = "".join(f"    x{i} = {i}\n" for i in range(9))
+    root = plant(
+        tmp_path,
+        {
+            "ertools/a.py": f"import os\ndef f():\n{body}",
+            "ertools/b.py": f"from sys import (\n    argv,\n)\ndef g():\n{spaced}",
+            "ertools/c.py": f"def h():\n{nine}    y = 1\n",
+        },
+    )
+    assert repeats(root) == {"ertools/a.py ~ ertools/b.py": "ertools/a.py:3-12 ~ ertools/b.py:5-32"}
