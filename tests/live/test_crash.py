@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from ertools.errors import BagError
+from ertools.io.reader import read_poses
 from ertools.live.simulate import SimulatedBody, SimulatedMotive
 from ertools.live.tail import is_finished, read_complete
 from tests.live.live_helpers import free_udp_port, read_mcap
@@ -88,14 +89,11 @@ def test_killed_file_is_readable_up_to_the_last_second(
 def test_ertools_io_reads_the_killed_file(
     killed_recording: tuple[Path, int, SimulatedMotive],
 ) -> None:
-    io = pytest.importorskip("ertools.io", reason="ertools.io not built yet")
-    if not hasattr(io, "read_poses"):
-        pytest.skip("ertools.io.reader.read_poses not available yet")
     path, _, _ = killed_recording
     messages, _ = read_mcap(path)
     expected = [m for topic, _, m in messages if topic == "/fbm2h/robot_at_home/pose"]
     try:
-        stream = io.read_poses(path, "/fbm2h/robot_at_home/pose")
+        stream = read_poses(path, "/fbm2h/robot_at_home/pose")
     except BagError as err:  # imperative xfail: runs the checks as soon as io can read it
         pytest.xfail(f"ertools.io cannot read an MCAP cut short yet: {err}")
     assert len(stream) == len(expected)

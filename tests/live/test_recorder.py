@@ -14,6 +14,7 @@ import pytest
 from mcap.reader import make_reader
 
 from ertools.configs.mocap import parse_mocap_config
+from ertools.io.reader import read_poses
 from ertools.live.natnet import FrameExtras, NatNetVersion, RigidBody, encode_frame
 from ertools.live.recorder import Recorder, RecordOptions, RecordSummary
 from ertools.live.simulate import SimulatedBody, SimulatedMotive, make_frame
@@ -219,13 +220,10 @@ def test_read_complete_agrees_with_mcap_reader(tmp_path: Path) -> None:
 
 
 def test_ertools_io_reads_the_recording(tmp_path: Path) -> None:
-    io = pytest.importorskip("ertools.io", reason="ertools.io not built yet")
-    if not hasattr(io, "read_poses"):
-        pytest.skip("ertools.io.reader.read_poses not available yet")
     summary, motive, _ = run_recording(
         tmp_path, {"bodies": (SimulatedBody(3),), "n_frames": 30, "rate_hz": 100.0}
     )
-    stream = io.read_poses(summary.files, "/fbm2h/robot_at_home/pose")
+    stream = read_poses(summary.files, "/fbm2h/robot_at_home/pose")
     sent = expected_poses(motive, 3)
     assert len(stream) == len(sent)
     assert [tuple(row) for row in stream.xyz] == [rb.position for rb in sent]
