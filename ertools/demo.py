@@ -29,7 +29,8 @@ from pathlib import Path
 
 from ertools.atomic import write_text
 from ertools.benchmarks import registry
-from ertools.benchmarks.base import Audited, Reported, Simulated
+from ertools.benchmarks.base import Audited, Simulated
+from ertools.benchmarks.legacy import offers
 from ertools.cli.main import main as ertools_main
 from ertools.samples.competition import DEFAULT_SEED, MANIFEST, write_competition
 
@@ -79,7 +80,8 @@ def steps(samples: Path, out: Path) -> Iterator[Step]:
     )
     for name, sample in samples_by_name.items():
         bench = registry.get(name)
-        foxglove = ["--foxglove", str(out / f"{name}.mcap")] if isinstance(bench, Reported) else []
+        # the referee-scored benchmarks draw nothing: `score` refuses --foxglove for them
+        foxglove = ["--foxglove", str(out / f"{name}.mcap")] if offers(bench, "foxglove") else []
         yield Step(
             f"{bench.title} score",
             ["score", name, *sample, "--report", str(out / name), *foxglove],

@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 from ertools import demo
+from ertools.cli.main import COMMANDS, build_parser
 from ertools.demo import steps
 from tests.e2e.test_readme import ROOT, console_blocks
 
@@ -74,3 +75,17 @@ def test_the_demo_lists_no_empty_output(
     assert (tmp_path / "rescore" / "index.html") in files
     assert (tmp_path / "season" / "index.html") in files
     assert not [p for p in tmp_path.rglob("*") if p.is_file() and p.stat().st_size == 0]
+
+
+def test_every_demo_step_parses(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Each step's command line is one the real parser takes (the referee-scored benchmarks
+    refuse --foxglove: the demo once passed it and failed three steps)."""
+    refused = []
+    for step in steps(ROOT / "sample_bags", tmp_path):
+        name = step.argv[0]
+        parser, _ = build_parser(f"ertools {name}", COMMANDS[name].module)
+        try:
+            parser.parse_args(step.argv[1:])
+        except SystemExit:
+            refused.append(" ".join(step.argv[:2]))
+    assert not refused, (refused, capsys.readouterr().err)
