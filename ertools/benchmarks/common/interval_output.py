@@ -141,6 +141,19 @@ def interval_lines(rows: Sequence[ScoreRow], uncertainty: Uncertainty | None) ->
     return [*out, sources_line(uncertainty)] if uncertainty.sources else out
 
 
+def score_table(rows: Sequence[ScoreRow]) -> list[dict[str, Any]]:
+    """The ``scores`` table of a report: each score in SI units with its interval's ends."""
+    return [
+        {
+            "score": r.name,
+            "value": r.value,
+            "low": None if r.interval is None else r.interval.low,
+            "high": None if r.interval is None else r.interval.high,
+        }
+        for r in rows
+    ]
+
+
 def interval_tables(
     intervals: Mapping[str, Interval | None], uncertainty: Uncertainty | None
 ) -> dict[str, list[dict[str, Any]]]:

@@ -9,7 +9,12 @@ from typing import TYPE_CHECKING, Any
 
 from ertools.arrays import F64, I64
 from ertools.benchmarks.base import Rows
-from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines, interval_tables
+from ertools.benchmarks.common.interval_output import (
+    ScoreRow,
+    interval_lines,
+    interval_tables,
+    score_table,
+)
 from ertools.benchmarks.common.uncertainty import Interval, Uncertainty
 from ertools.benchmarks.hgmf.config import GRASP_RISE_M, HgmfOptions
 from ertools.benchmarks.hgmf.flow import Attempt
@@ -182,20 +187,9 @@ class HgmfResult:
         """``goals`` (every attempt), ``scores`` (the average and its interval),
         ``comparison`` (each score field against the live score and the file) and the
         interval tables."""
-        scores = []
-        for row in self.score_rows():
-            iv = row.interval
-            scores.append(
-                {
-                    "score": row.name,
-                    "value": row.value,
-                    "low": None if iv is None else iv.low,
-                    "high": None if iv is None else iv.high,
-                }
-            )
         out: dict[str, Rows] = {
             "goals": [g.row(self.t_start_ns) for g in self.goals],
-            "scores": scores,
+            "scores": score_table(self.score_rows()),
             "comparison": self.comparison.rows(),
         }
         out.update(interval_tables(self.intervals, self.uncertainty))

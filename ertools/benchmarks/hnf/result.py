@@ -12,7 +12,12 @@ import numpy as np
 
 from ertools.arrays import F64, I64
 from ertools.benchmarks.base import Rows
-from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines, interval_tables
+from ertools.benchmarks.common.interval_output import (
+    ScoreRow,
+    interval_lines,
+    interval_tables,
+    score_table,
+)
 from ertools.benchmarks.common.uncertainty import Interval, Uncertainty
 from ertools.benchmarks.hnf.config import HnfOptions
 from ertools.benchmarks.hnf.flow import HnfFlow, SegmentFlow
@@ -173,20 +178,9 @@ class HnfResult:
     def tables(self) -> dict[str, Rows]:
         """``segments``, ``scores`` (the totals with their intervals), ``comparison`` (each
         score field against the live score and the file) and the interval tables."""
-        scores = []
-        for row in self.score_rows():
-            iv = row.interval
-            scores.append(
-                {
-                    "score": row.name,
-                    "value": row.value,
-                    "low": None if iv is None else iv.low,
-                    "high": None if iv is None else iv.high,
-                }
-            )
         out: dict[str, Rows] = {
             "segments": [s.row(self.t_start_ns) for s in self.segments],
-            "scores": scores,
+            "scores": score_table(self.score_rows()),
             "comparison": self.comparison.rows(),
         }
         out.update(interval_tables(self.intervals, self.uncertainty))
