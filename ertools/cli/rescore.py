@@ -23,6 +23,7 @@ from ertools.competition.manifest import ManifestError, load_manifest
 from ertools.competition.parallel import default_jobs
 from ertools.competition.run import rescore_competition
 from ertools.errors import UsageError
+from ertools.inputs import read_regular
 
 if TYPE_CHECKING:
     from ertools.competition.jobs import Outcome
@@ -33,6 +34,8 @@ EPILOG = """examples:
   ertools rescore logs/ --config competition.yaml --out results/ --scheduler tcp://10.0.0.5:8786
   ertools rescore --config competition.yaml --check
   ertools rescore logs/ --init competition.yaml
+  ertools rescore logs/ --out results/     # no manifest: drafted from the logs, kept as
+                                           # results/manifest.yaml
 
 --scheduler needs `pip install 'ertools[dask]'`; its workers must see the logs at the same paths
 (a shared file system): only paths and values go through the scheduler."""
@@ -89,8 +92,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     if args.init is not None:
         return _init(args)
-    if args.config is None:
-        raise UsageError("--config FILE is needed: the competition manifest (docs/rescore.md)")
+    if args.config is None and (not args.paths or args.out is None or args.check):
+        raise UsageError(
+            "--config FILE is needed: the competition manifest (docs/rescore.md); or give the "
+            "folders of logs and --out DIR to score them with a manifest drafted from them"
+        )
     if args.out is None and not args.check:
         raise UsageError("--out DIR is needed: where results.json and the reports go")
     if args.jobs is not None and args.jobs < 1:
@@ -98,6 +104,8 @@ def run(args: argparse.Namespace) -> int:
     for path in args.paths:
         if not path.exists():
             raise UsageError(f"{path}: no such file or folder")
+    if args.config is None:
+        args.config = _draft(args)
     try:
         manifest = load_manifest(args.config)
     except ManifestError as err:
@@ -145,6 +153,37 @@ def run(args: argparse.Namespace) -> int:
         note(f"wrote {path}")
     sys.stdout.flush()
     return 0 if counts["scored"] == len(rows) else 1
+
+
+DRAFTED = "manifest.yaml"
+
+
+def _draft(args: argparse.Namespace) -> Path:
+    """DIR/manifest.yaml drafted from the logs, as --init writes it. One the user edited is
+    never overwritten: a draft that differs from it is refused."""
+    found = find(args.paths, progress=args.progress)
+    if not found.executions:
+        raise UsageError(
+            f"no benchmark execution found under {', '.join(map(str, args.paths))}: "
+            "`ertools rescore PATH --init FILE` lists why each file is not one"
+        )
+    target: Path = args.out / DRAFTED
+    text = draft_text(found, args.paths, target, ["ertools", "rescore", *map(str, args.paths)])
+    if target.exists() and read_regular(target) != text.encode("utf-8"):
+        raise UsageError(
+            f"{target} exists and is not the manifest drafted from these logs: "
+            f"give --config {target} to score with it, or delete it"
+        )
+    args.out.mkdir(parents=True, exist_ok=True)
+    write_text(target, text)
+    todo = sum("TODO" in line for line in text.splitlines())
+    note(
+        f"no --config: wrote {target}, a manifest drafted from the logs "
+        f"({len(found.executions)} execution(s)"
+        + (f"; {todo} TODO line(s) left at their defaults" if todo else "")
+        + f"; edit it, then give --config {target})"
+    )
+    return target
 
 
 def _init(args: argparse.Namespace) -> int:

@@ -118,6 +118,37 @@ def test_the_site_shows_the_items(season: Any) -> None:
     assert '<th title="Achievements: carries out the command of phase 2">A4</th>' in page
 
 
+def test_one_command_from_the_folder_to_the_site(
+    season: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """No --config: the manifest is drafted from the logs, kept in the results folder, and the
+    site is the one of --init then --config; an edited draft is never overwritten."""
+    _, two_steps, draft = season
+    folder = tmp_path / "season2019"
+    shutil.copytree(SEASON, folder)
+    out = tmp_path / "results"
+    assert main(["rescore", str(folder), "--out", str(out), "-j", "1", "--no-reports"]) == 0
+    doc = json.loads((out / "results.json").read_text(encoding="utf-8"))
+    assert doc["leaderboards"] == two_steps["leaderboards"]
+    kept = out / "manifest.yaml"
+    assert doc["manifest"]["path"] == str(kept)
+    drafted, by_init = yaml.safe_load(kept.read_text(encoding="utf-8")), yaml.safe_load(draft)
+    assert [(e["benchmark"], e["team"]) for e in drafted["executions"]] == [
+        (e["benchmark"], e["team"]) for e in by_init["executions"]
+    ]
+    assert drafted["benchmarks"].keys() == by_init["benchmarks"].keys()
+    capsys.readouterr()
+
+    edited = kept.read_text(encoding="utf-8") + "# a referee's note\n"
+    kept.write_text(edited, encoding="utf-8")
+    assert main(["rescore", str(folder), "--out", str(out), "-j", "1", "--no-reports"]) == 2
+    err = capsys.readouterr().err
+    # one message (usage errors are wrapped at the terminal's width: this path is long)
+    assert err.startswith("ertools: error:") and err.count("ertools:") == 1
+    assert "is not the manifest drafted from these logs" in " ".join(err.split())
+    assert kept.read_text(encoding="utf-8") == edited
+
+
 def test_a_2015_folder_beside_a_2019_one(tmp_path: Path) -> None:
     shutil.copytree(SEASON, tmp_path / "season2019")
     shutil.copytree(SAMPLES / "fbm2h", tmp_path / "lisbon2015")
