@@ -25,7 +25,7 @@ from ertools.benchmarks.common.uncertainty import (
 )
 from ertools.benchmarks.hgmf.config import HgmfOptions
 from ertools.benchmarks.hgmf.result import AVERAGE_KEY, HgmfGoal
-from ertools.rsbb.noise import mocap_noise
+from ertools.rsbb.mocap_sigma import mocap_noise
 from ertools.rsbb.tf import TfTrack
 
 METHOD = "Monte Carlo (parametric bootstrap, basic interval)"

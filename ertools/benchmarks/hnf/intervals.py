@@ -26,7 +26,7 @@ from ertools.benchmarks.hnf.config import HnfOptions
 from ertools.benchmarks.hnf.logs import HnfLogs
 from ertools.benchmarks.hnf.result import ORIENTATION_KEY, POSITION_KEY, HnfSegment
 from ertools.geometry import wrap_angle
-from ertools.rsbb.noise import mocap_noise
+from ertools.rsbb.mocap_sigma import mocap_noise
 from ertools.rsbb.tf import TfTrack, duration_sec, link_at
 
 METHOD = "Monte Carlo (parametric bootstrap, basic interval)"

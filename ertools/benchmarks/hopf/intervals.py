@@ -23,7 +23,7 @@ from ertools.benchmarks.hopf.config import CLIP_TRANSLATION_M, HopfOptions
 from ertools.benchmarks.hopf.formula import pose_terms
 from ertools.benchmarks.hopf.goals import Scored
 from ertools.benchmarks.hopf.result import HopfIntervals
-from ertools.rsbb.noise import DEFAULT_SIGMA_M, DEFAULT_SIGMA_RAD, MocapNoise, mocap_noise
+from ertools.rsbb.mocap_sigma import DEFAULT_SIGMA_M, DEFAULT_SIGMA_RAD, MocapNoise, mocap_noise
 from ertools.rsbb.tf import TfTrack, euler_yaw
 
 

@@ -23,7 +23,7 @@ from ertools.benchmarks.common.uncertainty import (
 from ertools.benchmarks.hpff.config import HpffOptions
 from ertools.benchmarks.hpff.logs import HpffLogs
 from ertools.benchmarks.hpff.result import COVERED_KEY, DEVIATION_KEY, HpffSamples
-from ertools.rsbb.noise import mocap_noise
+from ertools.rsbb.mocap_sigma import mocap_noise
 
 METHOD = "Monte Carlo (parametric bootstrap, basic interval)"
 

@@ -20,7 +20,7 @@ from ertools.benchmarks.hppf.config import HppfOptions
 from ertools.benchmarks.hppf.formula import position_errors
 from ertools.benchmarks.hppf.goals import Scored
 from ertools.benchmarks.hppf.result import DISTANCE_KEY, HppfIntervals
-from ertools.rsbb.noise import DEFAULT_SIGMA_M, mocap_noise
+from ertools.rsbb.mocap_sigma import DEFAULT_SIGMA_M, mocap_noise
 from ertools.rsbb.tf import TfTrack
 
 
