@@ -386,9 +386,21 @@ class Discovered(Protocol):
         return None
 
 
+class Generate(Protocol):
+    """A simulated scenario: writes its logs, answers and configs into ``outdir`` (which exists
+    and is empty), every draw from ``seed``, and returns every path it wrote."""
+
+    def __call__(self, outdir: Path, *, seed: int) -> list[Path]: ...
+
+
 @runtime_checkable
 class Simulated(Protocol):
-    """It has a simulated sample (``sample_bags/``, ``make demo``)."""
+    """It has a simulated sample (``sample_bags/``, ``make demo``): the ``generate`` of the
+    ``sample`` module beside its declaration, reached with
+    :func:`ertools.benchmarks.registry.scenarios`."""
+
+    #: The folder of ``sample_bags/`` its scenario writes ("": the benchmark's name).
+    sample_folder: str = ""
 
     def sample_args(self, samples: Path) -> Sequence[str] | None:
         """The arguments scoring it on the sample logs under ``samples`` (None: not there)."""
