@@ -7,7 +7,8 @@ benchmarks_description.yaml`` (the referee items, in ertools' own words) and
 ``rsbb_bmbox/scripts/benchmark_configs/HGMF.yaml``. Teams ``simbot`` and ``homebot`` each ran:
 
 - HGMF (FBM6, scripted): simbot puts its three objects 2, 4 and 3 cm from their targets;
-  homebot 5 and 7 cm, one goal timed out (:mod:`ertools.benchmarks.hgmf.sample`);
+  homebot 5 and 7 cm, one goal timed out (written by HGMF's own simulator, its package's
+  ``sample`` module, reached through :func:`ertools.benchmarks.registry.scenarios`);
 - HGTKMH (task benchmark 1, referee-scored): both 5 achievements and 1 penalty, homebot 5 s
   faster: the time decides;
 - HWV (task benchmark 2): simbot 3 achievements; homebot 4, but it hit a visitor: disqualified;
@@ -25,13 +26,14 @@ least time; a disqualified run unranked).
 from __future__ import annotations
 
 from pathlib import Path
+from types import ModuleType
 from typing import Any
 
 import yaml
 
 from ertools.atomic import write_text
-from ertools.benchmarks.hgmf.sample import T0 as HGMF_T0
-from ertools.benchmarks.hgmf.sample import GoalPlan, RunPlan, build, expected, write_config
+from ertools.benchmarks import registry
+from ertools.errors import UsageError
 from ertools.simulator.answers import tol
 from ertools.simulator.rsbb import write_rsbb_run
 from ertools.simulator.rsbb_scenario import Goal, RsbbScenario, Save
@@ -41,7 +43,10 @@ S = 1_000_000_000
 MS = 1_000_000
 # Saturday 13 April 2019, 10:00:00 UTC: the day after the HGMF sample's run (no two sample
 # files share a name).
-T0 = HGMF_T0 + 24 * 3600 * S
+T0 = 1_555_149_600 * S
+# The folder of sample_bags/ that HGMF's scenario writes: its simulator builds the season's
+# HGMF runs too.
+HGMF = "hgmf"
 TEAMS = ("simbot", "homebot")
 OBJECTS = (
     {"id": 1, "description": "mug"},
@@ -151,18 +156,34 @@ def tally(code: str, values: tuple[int, ...]) -> tuple[int, int, bool]:
     return a, p, d
 
 
-HGMF_PLANS = {
-    "simbot": (
-        GoalPlan(1, (0.30, 0.40), (0.62, 1.05), (0.64, 1.05)),
-        GoalPlan(2, (0.70, 0.30), (0.40, 0.90), (0.40, 0.94)),
-        GoalPlan(3, (0.25, 1.10), (0.70, 0.50), (0.70, 0.53)),
-    ),
-    "homebot": (
-        GoalPlan(3, (0.30, 0.40), (0.62, 1.05), (0.67, 1.05)),
-        GoalPlan(1, (0.70, 0.30), (0.40, 0.90), None, lift=False),
-        GoalPlan(2, (0.25, 1.10), (0.70, 0.50), (0.70, 0.57)),
-    ),
-}
+def simulator(folder: str) -> ModuleType:
+    """The ``sample`` module of the benchmark whose scenario writes ``folder``, through the
+    registry (its plans and ``build``: the season's runs are the benchmark's own simulation).
+
+    Raises:
+        UsageError: no registered benchmark writes ``folder``.
+    """
+    for scenario in registry.scenarios():
+        if scenario.folder == folder:
+            return scenario.load()
+    raise UsageError(f"season2019: no registered benchmark simulates {folder!r} runs")
+
+
+def hgmf_plans(hgmf: ModuleType) -> dict[str, tuple[Any, ...]]:
+    """Each team's HGMF goals (HGMF's ``GoalPlan``: object, start, target, where it ends)."""
+    plan = hgmf.GoalPlan
+    return {
+        "simbot": (
+            plan(1, (0.30, 0.40), (0.62, 1.05), (0.64, 1.05)),
+            plan(2, (0.70, 0.30), (0.40, 0.90), (0.40, 0.94)),
+            plan(3, (0.25, 1.10), (0.70, 0.50), (0.70, 0.53)),
+        ),
+        "homebot": (
+            plan(3, (0.30, 0.40), (0.62, 1.05), (0.67, 1.05)),
+            plan(1, (0.70, 0.30), (0.40, 0.90), None, lift=False),
+            plan(2, (0.25, 1.10), (0.70, 0.50), (0.70, 0.57)),
+        ),
+    }
 
 
 def _stb(root: Path, team: str, t0: int) -> list[Path]:
@@ -201,8 +222,9 @@ def _stb(root: Path, team: str, t0: int) -> list[Path]:
 
 def generate(outdir: Path, *, seed: int) -> list[Path]:
     """Write the season folder into ``outdir`` and its answers (``answers.yaml``)."""
+    hgmf = simulator(HGMF)
     written: list[Path] = []
-    config = write_config(outdir, OBJECTS)
+    config = hgmf.write_config(outdir, OBJECTS)
     written.append(config)
     path = outdir / "rsbb_etc" / "config" / "benchmarks_description.yaml"
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -210,12 +232,13 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     written.append(path)
     boards: dict[str, Any] = {}
     hgmf_rows = []
+    plans = hgmf_plans(hgmf)
     for k, team in enumerate(TEAMS):
-        plan = RunPlan(team, 1, T0 + k * 3600 * S, HGMF_PLANS[team], objects=OBJECTS, seed=seed + k)
-        scenario, truth = build(plan)
+        plan = hgmf.RunPlan(team, 1, T0 + k * 3600 * S, plans[team], objects=OBJECTS, seed=seed + k)
+        scenario, truth = hgmf.build(plan)
         paths = write_rsbb_run(outdir, scenario, compression="bz2")
         written += [paths.bag, paths.result]
-        answers = expected(truth, len(OBJECTS))
+        answers = hgmf.expected(truth, len(OBJECTS))
         hgmf_rows.append(
             {
                 "team": team,

@@ -16,9 +16,6 @@ ALLOWED = frozenset(
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm1",
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm2h",
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm3w",
-        # the season sample builds HGMF runs with HGMF's simulator, as scenario.py does for
-        # 2015 (until samples use Simulated)
-        "ertools/samples/season.py: imports ertools.benchmarks.hgmf",
     }
 )
 
