@@ -12,6 +12,8 @@ benchmarks_description.yaml`` (the referee items, in ertools' own words) and
 - HGTKMH (task benchmark 1, referee-scored): both 5 achievements and 1 penalty, homebot 5 s
   faster: the time decides;
 - HWV (task benchmark 2): simbot 3 achievements; homebot 4, but it hit a visitor: disqualified;
+- HCFGAC (task benchmark 3): both 6 achievements; simbot 8 s faster but it dropped an object
+  (2 penalties against homebot's 1): the penalties decide;
 - STB (the scripted test benchmark, two goals): simbot only, its referee items in its result
   file.
 
@@ -94,6 +96,34 @@ ITEMS: dict[str, tuple[tuple[str, tuple[tuple[str, str], ...]], ...]] = {
         ),
         ("Disqualifying Behaviors", (("uint", "hits a visitor"),)),
     ),
+    "HCFGAC": (
+        (
+            "Achievements",
+            (
+                ("bool", "enters the room where Granny Annie waits"),
+                ("bool", "understands her command"),
+                ("uint", "operates each right device"),
+                ("uint", "finds each right object"),
+                ("uint", "brings her each right object"),
+            ),
+        ),
+        (
+            "Penalized Behaviors",
+            (
+                ("uint", "bumps into the furniture"),
+                ("uint", "drops an object"),
+                ("uint", "stops working"),
+            ),
+        ),
+        (
+            "Disqualifying Behaviors",
+            (
+                ("uint", "hits a person"),
+                ("uint", "damages an object it was asked to handle"),
+                ("uint", "damages the test bed"),
+            ),
+        ),
+    ),
     "STB": (
         ("Penalized Behaviors", (("uint", "bumps into the furniture or people"),)),
         ("Disqualifying Behaviors", (("uint", "hits people or the furniture"),)),
@@ -102,6 +132,7 @@ ITEMS: dict[str, tuple[tuple[str, tuple[tuple[str, str], ...]], ...]] = {
 NAMES = {
     "HGTKMH": "Task Benchmark 1: Getting to know my home",
     "HWV": "Task Benchmark 2: Welcoming visitors",
+    "HCFGAC": "Task Benchmark 3: Catering for Granny Annie's comfort",
     "HGMF": "Functionality Benchmark 6: Grasping and Manipulation Functionality",
     "STB": "Test Benchmark: Simple Test Benchmark",
 }
@@ -116,13 +147,19 @@ TASKS: dict[str, dict[str, tuple[tuple[int, ...], float]]] = {
         "simbot": ((1, 1, 0, 1, 0, 0, 0, 0, 0, 0, 0), 50.0),
         "homebot": ((1, 1, 1, 1, 0, 0, 0, 0, 0, 1, 1), 45.0),
     },
+    "HCFGAC": {
+        "simbot": ((1, 1, 2, 1, 1, 1, 1, 0, 0, 0, 0), 50.0),
+        "homebot": ((1, 1, 1, 2, 1, 0, 0, 1, 0, 0, 0), 58.0),
+    },
 }
+# How each task benchmark's runs end (the zone's state text after the last span).
+ENDS = {"HGTKMH": COMPLETED, "HWV": STOPPED, "HCFGAC": COMPLETED}
 
 
 def description() -> dict[str, Any]:
     """``benchmarks_description.yaml``: the benchmarks of the folder and their items."""
     entries = []
-    for code in ("STB", "HGTKMH", "HWV", "HGMF"):
+    for code in ("STB", "HGTKMH", "HWV", "HCFGAC", "HGMF"):
         entry: dict[str, Any] = {
             "code": code,
             "desc": NAMES[code],
@@ -260,7 +297,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
                 1,
                 t0,
                 ((start, start + round(seconds * S)),),
-                COMPLETED if c == 0 else STOPPED,
+                ENDS[code],
                 start + round(seconds * S) + 2 * S,
                 start + round(seconds * S) + 4 * S,
                 referee_items(code, values),
