@@ -29,8 +29,7 @@ from pathlib import Path
 
 from ertools.atomic import write_text
 from ertools.benchmarks import registry
-from ertools.benchmarks.base import Audited, Simulated
-from ertools.benchmarks.legacy import offers
+from ertools.benchmarks.base import Audited, Simulated, offers
 from ertools.cli.main import main as ertools_main
 from ertools.samples.competition import DEFAULT_SEED, MANIFEST, write_competition
 

@@ -303,9 +303,13 @@ class Reported(Protocol[OptionsT_contra, ResultT_contra]):
     Attributes:
         score_keys: keys of its ``score.json`` that say a score is this benchmark's (a
             ``score.json`` read without its ``result.json`` by ``ertools report``).
+        draws: which of ``figures`` and ``foxglove`` it has (:func:`offers`); one that draws
+            nothing (the referee-scored benchmarks) is offered neither ``--plot`` nor
+            ``--foxglove``.
     """
 
     score_keys: frozenset[str]
+    draws: frozenset[str] = frozenset({"figures", "foxglove"})
 
     def notes(self, result: ResultT_contra) -> Sequence[str]:
         """Extra stderr lines after a score (the runs ``--runs auto`` found...)."""
@@ -327,6 +331,12 @@ class Reported(Protocol[OptionsT_contra, ResultT_contra]):
         """The files a report lists and hashes as this execution's inputs (the logs; the item
         list too, or the GT files a folder held)."""
         return list(logs)
+
+
+def offers(bench: Any, part: str) -> bool:
+    """Whether ``bench`` has ``part`` (``figures`` or ``foxglove``): what ``score`` offers
+    (``--plot``, ``--foxglove``) and the demo asks for."""
+    return isinstance(bench, Reported) and part in bench.draws
 
 
 @runtime_checkable
@@ -376,9 +386,21 @@ class Discovered(Protocol):
         return None
 
 
+class Generate(Protocol):
+    """A simulated scenario: writes its logs, answers and configs into ``outdir`` (which exists
+    and is empty), every draw from ``seed``, and returns every path it wrote."""
+
+    def __call__(self, outdir: Path, *, seed: int) -> list[Path]: ...
+
+
 @runtime_checkable
 class Simulated(Protocol):
-    """It has a simulated sample (``sample_bags/``, ``make demo``)."""
+    """It has a simulated sample (``sample_bags/``, ``make demo``): the ``generate`` of the
+    ``sample`` module beside its declaration, reached with
+    :func:`ertools.benchmarks.registry.scenarios`."""
+
+    #: The folder of ``sample_bags/`` its scenario writes ("": the benchmark's name).
+    sample_folder: str = ""
 
     def sample_args(self, samples: Path) -> Sequence[str] | None:
         """The arguments scoring it on the sample logs under ``samples`` (None: not there)."""

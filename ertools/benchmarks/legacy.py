@@ -131,6 +131,7 @@ class _Reported(_Core, Reported[Any, Any]):
     def __init__(self, legacy: LegacyBenchmark[Any, Any, Any, Any]) -> None:
         super().__init__(legacy)
         self.score_keys = legacy.score_keys
+        self.draws = frozenset(p for p in ("figures", "foxglove") if getattr(legacy, p))
 
     def notes(self, result: Any) -> Sequence[str]:
         return () if self.legacy.notes is None else self.legacy.notes(result)
@@ -188,14 +189,6 @@ def _shape(audited: bool, simulated: bool) -> type[_Core]:
     parts += [_Simulated] if simulated else []
     name = "Legacy" + "".join(p.__name__.strip("_") for p in parts)
     return type(name, tuple(parts), {})
-
-
-def offers(bench: AnyBenchmark, part: str) -> bool:
-    """Whether ``bench`` has ``part`` (``figures`` or ``foxglove``): a Reported benchmark has
-    both, unless it is a record that leaves that field empty (the referee-scored ones)."""
-    if not isinstance(bench, Reported):
-        return False
-    return not isinstance(bench, _Core) or bool(getattr(bench.legacy, part))
 
 
 # By the record's id: the adapted object holds its record, so the id stays its own.

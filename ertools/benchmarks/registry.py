@@ -15,8 +15,11 @@ import sys
 from dataclasses import dataclass
 from importlib import import_module
 from importlib.util import find_spec
+from pathlib import Path
+from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
+from ertools.benchmarks.base import Generate, Simulated
 from ertools.benchmarks.legacy import LegacyBenchmark, adapt
 from ertools.errors import UsageError
 
@@ -115,6 +118,40 @@ def warm(target: str, *, report: bool = False) -> None:
     for name in wanted:
         if find_spec(name) is not None:
             import_module(name)
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A benchmark package's simulated scenario: the ``sample`` module beside its declaration
+    (``module``, absolute) and the folder of ``sample_bags/`` it writes."""
+
+    folder: str
+    module: str
+
+    def load(self) -> ModuleType:
+        """The sample module, imported now (for a sample built from a benchmark's runs)."""
+        return import_module(self.module)
+
+    def generate(self, outdir: Path, *, seed: int) -> list[Path]:
+        """Its :class:`~ertools.benchmarks.base.Generate`: the logs written into ``outdir``."""
+        generate: Generate = self.load().generate
+        return generate(outdir, seed=seed)
+
+
+def scenarios() -> tuple[Scenario, ...]:
+    """The scenario of every benchmark package with a ``sample`` module, once per package (the
+    first entry's: fbm1h for fbm1), in the registry's order; the folder is the benchmark's
+    ``sample_folder`` when :class:`~ertools.benchmarks.base.Simulated`, else its name. Imports
+    the declarations (light), not the simulators."""
+    found: dict[str, Scenario] = {}
+    for e in ENTRIES:
+        package = e.absolute.partition(":")[0].rpartition(".")[0]
+        if package in found or find_spec(f"{package}.sample") is None:
+            continue
+        bench = get(e.name)
+        folder = bench.sample_folder if isinstance(bench, Simulated) else ""
+        found[package] = Scenario(folder or e.name, f"{package}.sample")
+    return tuple(found.values())
 
 
 def main() -> int:

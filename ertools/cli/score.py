@@ -16,8 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks import registry
-from ertools.benchmarks.base import AnyBenchmark, Described, Input, Reported
-from ertools.benchmarks.legacy import offers
+from ertools.benchmarks.base import AnyBenchmark, Described, Input, Reported, offers
 from ertools.cli.command import Command, Delegate
 from ertools.cli.groups import add_group_arguments, run_group
 from ertools.cli.options import deprecation_note

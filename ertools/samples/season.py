@@ -7,10 +7,13 @@ benchmarks_description.yaml`` (the referee items, in ertools' own words) and
 ``rsbb_bmbox/scripts/benchmark_configs/HGMF.yaml``. Teams ``simbot`` and ``homebot`` each ran:
 
 - HGMF (FBM6, scripted): simbot puts its three objects 2, 4 and 3 cm from their targets;
-  homebot 5 and 7 cm, one goal timed out (:mod:`ertools.benchmarks.hgmf.sample`);
+  homebot 5 and 7 cm, one goal timed out (written by HGMF's own simulator, its package's
+  ``sample`` module, reached through :func:`ertools.benchmarks.registry.scenarios`);
 - HGTKMH (task benchmark 1, referee-scored): both 5 achievements and 1 penalty, homebot 5 s
   faster: the time decides;
 - HWV (task benchmark 2): simbot 3 achievements; homebot 4, but it hit a visitor: disqualified;
+- HCFGAC (task benchmark 3): both 6 achievements; simbot 8 s faster but it dropped an object
+  (2 penalties against homebot's 1): the penalties decide;
 - STB (the scripted test benchmark, two goals): simbot only, its referee items in its result
   file.
 
@@ -25,13 +28,14 @@ least time; a disqualified run unranked).
 from __future__ import annotations
 
 from pathlib import Path
+from types import ModuleType
 from typing import Any
 
 import yaml
 
 from ertools.atomic import write_text
-from ertools.benchmarks.hgmf.sample import T0 as HGMF_T0
-from ertools.benchmarks.hgmf.sample import GoalPlan, RunPlan, build, expected, write_config
+from ertools.benchmarks import registry
+from ertools.errors import UsageError
 from ertools.simulator.answers import tol
 from ertools.simulator.rsbb import write_rsbb_run
 from ertools.simulator.rsbb_scenario import Goal, RsbbScenario, Save
@@ -41,7 +45,10 @@ S = 1_000_000_000
 MS = 1_000_000
 # Saturday 13 April 2019, 10:00:00 UTC: the day after the HGMF sample's run (no two sample
 # files share a name).
-T0 = HGMF_T0 + 24 * 3600 * S
+T0 = 1_555_149_600 * S
+# The folder of sample_bags/ that HGMF's scenario writes: its simulator builds the season's
+# HGMF runs too.
+HGMF = "hgmf"
 TEAMS = ("simbot", "homebot")
 OBJECTS = (
     {"id": 1, "description": "mug"},
@@ -89,6 +96,34 @@ ITEMS: dict[str, tuple[tuple[str, tuple[tuple[str, str], ...]], ...]] = {
         ),
         ("Disqualifying Behaviors", (("uint", "hits a visitor"),)),
     ),
+    "HCFGAC": (
+        (
+            "Achievements",
+            (
+                ("bool", "enters the room where Granny Annie waits"),
+                ("bool", "understands her command"),
+                ("uint", "operates each right device"),
+                ("uint", "finds each right object"),
+                ("uint", "brings her each right object"),
+            ),
+        ),
+        (
+            "Penalized Behaviors",
+            (
+                ("uint", "bumps into the furniture"),
+                ("uint", "drops an object"),
+                ("uint", "stops working"),
+            ),
+        ),
+        (
+            "Disqualifying Behaviors",
+            (
+                ("uint", "hits a person"),
+                ("uint", "damages an object it was asked to handle"),
+                ("uint", "damages the test bed"),
+            ),
+        ),
+    ),
     "STB": (
         ("Penalized Behaviors", (("uint", "bumps into the furniture or people"),)),
         ("Disqualifying Behaviors", (("uint", "hits people or the furniture"),)),
@@ -97,6 +132,7 @@ ITEMS: dict[str, tuple[tuple[str, tuple[tuple[str, str], ...]], ...]] = {
 NAMES = {
     "HGTKMH": "Task Benchmark 1: Getting to know my home",
     "HWV": "Task Benchmark 2: Welcoming visitors",
+    "HCFGAC": "Task Benchmark 3: Catering for Granny Annie's comfort",
     "HGMF": "Functionality Benchmark 6: Grasping and Manipulation Functionality",
     "STB": "Test Benchmark: Simple Test Benchmark",
 }
@@ -111,13 +147,19 @@ TASKS: dict[str, dict[str, tuple[tuple[int, ...], float]]] = {
         "simbot": ((1, 1, 0, 1, 0, 0, 0, 0, 0, 0, 0), 50.0),
         "homebot": ((1, 1, 1, 1, 0, 0, 0, 0, 0, 1, 1), 45.0),
     },
+    "HCFGAC": {
+        "simbot": ((1, 1, 2, 1, 1, 1, 1, 0, 0, 0, 0), 50.0),
+        "homebot": ((1, 1, 1, 2, 1, 0, 0, 1, 0, 0, 0), 58.0),
+    },
 }
+# How each task benchmark's runs end (the zone's state text after the last span).
+ENDS = {"HGTKMH": COMPLETED, "HWV": STOPPED, "HCFGAC": COMPLETED}
 
 
 def description() -> dict[str, Any]:
     """``benchmarks_description.yaml``: the benchmarks of the folder and their items."""
     entries = []
-    for code in ("STB", "HGTKMH", "HWV", "HGMF"):
+    for code in ("STB", "HGTKMH", "HWV", "HCFGAC", "HGMF"):
         entry: dict[str, Any] = {
             "code": code,
             "desc": NAMES[code],
@@ -151,18 +193,34 @@ def tally(code: str, values: tuple[int, ...]) -> tuple[int, int, bool]:
     return a, p, d
 
 
-HGMF_PLANS = {
-    "simbot": (
-        GoalPlan(1, (0.30, 0.40), (0.62, 1.05), (0.64, 1.05)),
-        GoalPlan(2, (0.70, 0.30), (0.40, 0.90), (0.40, 0.94)),
-        GoalPlan(3, (0.25, 1.10), (0.70, 0.50), (0.70, 0.53)),
-    ),
-    "homebot": (
-        GoalPlan(3, (0.30, 0.40), (0.62, 1.05), (0.67, 1.05)),
-        GoalPlan(1, (0.70, 0.30), (0.40, 0.90), None, lift=False),
-        GoalPlan(2, (0.25, 1.10), (0.70, 0.50), (0.70, 0.57)),
-    ),
-}
+def simulator(folder: str) -> ModuleType:
+    """The ``sample`` module of the benchmark whose scenario writes ``folder``, through the
+    registry (its plans and ``build``: the season's runs are the benchmark's own simulation).
+
+    Raises:
+        UsageError: no registered benchmark writes ``folder``.
+    """
+    for scenario in registry.scenarios():
+        if scenario.folder == folder:
+            return scenario.load()
+    raise UsageError(f"season2019: no registered benchmark simulates {folder!r} runs")
+
+
+def hgmf_plans(hgmf: ModuleType) -> dict[str, tuple[Any, ...]]:
+    """Each team's HGMF goals (HGMF's ``GoalPlan``: object, start, target, where it ends)."""
+    plan = hgmf.GoalPlan
+    return {
+        "simbot": (
+            plan(1, (0.30, 0.40), (0.62, 1.05), (0.64, 1.05)),
+            plan(2, (0.70, 0.30), (0.40, 0.90), (0.40, 0.94)),
+            plan(3, (0.25, 1.10), (0.70, 0.50), (0.70, 0.53)),
+        ),
+        "homebot": (
+            plan(3, (0.30, 0.40), (0.62, 1.05), (0.67, 1.05)),
+            plan(1, (0.70, 0.30), (0.40, 0.90), None, lift=False),
+            plan(2, (0.25, 1.10), (0.70, 0.50), (0.70, 0.57)),
+        ),
+    }
 
 
 def _stb(root: Path, team: str, t0: int) -> list[Path]:
@@ -201,8 +259,9 @@ def _stb(root: Path, team: str, t0: int) -> list[Path]:
 
 def generate(outdir: Path, *, seed: int) -> list[Path]:
     """Write the season folder into ``outdir`` and its answers (``answers.yaml``)."""
+    hgmf = simulator(HGMF)
     written: list[Path] = []
-    config = write_config(outdir, OBJECTS)
+    config = hgmf.write_config(outdir, OBJECTS)
     written.append(config)
     path = outdir / "rsbb_etc" / "config" / "benchmarks_description.yaml"
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -210,12 +269,13 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     written.append(path)
     boards: dict[str, Any] = {}
     hgmf_rows = []
+    plans = hgmf_plans(hgmf)
     for k, team in enumerate(TEAMS):
-        plan = RunPlan(team, 1, T0 + k * 3600 * S, HGMF_PLANS[team], objects=OBJECTS, seed=seed + k)
-        scenario, truth = build(plan)
+        plan = hgmf.RunPlan(team, 1, T0 + k * 3600 * S, plans[team], objects=OBJECTS, seed=seed + k)
+        scenario, truth = hgmf.build(plan)
         paths = write_rsbb_run(outdir, scenario, compression="bz2")
         written += [paths.bag, paths.result]
-        answers = expected(truth, len(OBJECTS))
+        answers = hgmf.expected(truth, len(OBJECTS))
         hgmf_rows.append(
             {
                 "team": team,
@@ -237,7 +297,7 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
                 1,
                 t0,
                 ((start, start + round(seconds * S)),),
-                COMPLETED if c == 0 else STOPPED,
+                ENDS[code],
                 start + round(seconds * S) + 2 * S,
                 start + round(seconds * S) + 4 * S,
                 referee_items(code, values),

@@ -16,13 +16,6 @@ ALLOWED = frozenset(
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm1",
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm2h",
         "ertools/samples/scenario.py: imports ertools.benchmarks.fbm3w",
-        # issue 38's shared RSBB code, named after what it reads, not after a benchmark: a
-        # body's mocap noise (every RSBB package's intervals) and the referee's description
-        # file (the four referee-scored benchmarks); the season sample builds HGMF runs with
-        # HGMF's simulator, as scenario.py does for 2015 (until samples use Simulated)
-        "ertools/rsbb/noise.py: named after a benchmark",
-        "ertools/rsbb/referee.py: named after a benchmark",
-        "ertools/samples/season.py: imports ertools.benchmarks.hgmf",
     }
 )
 

@@ -51,7 +51,7 @@ def _board(doc: dict[str, Any], name: str) -> dict[str, Any]:
 def test_the_draft_places_every_run_result_and_side_file(season: Any) -> None:
     _, doc, draft = season
     manifest = yaml.safe_load(draft)
-    assert set(manifest["benchmarks"]) == {"hgmf", "hgtkmh", "hwv", "stb"}
+    assert set(manifest["benchmarks"]) == {"hgmf", "hgtkmh", "hwv", "hcfgac", "stb"}
     assert manifest["benchmarks"]["hgmf"]["inputs"]["config"].endswith("HGMF.yaml")
     assert manifest["benchmarks"]["hwv"]["inputs"]["description"].endswith(
         "rsbb_etc/config/benchmarks_description.yaml"
@@ -66,7 +66,7 @@ def test_the_draft_places_every_run_result_and_side_file(season: Any) -> None:
         elif path.startswith(("results/", "rsbb_etc/", "rsbb_bmbox/")):
             assert place == "input", path
     assert places["answers.yaml"] == "problem"  # the only file that is no run's
-    assert len(doc["executions"]) == 7 and all(e["status"] == "scored" for e in doc["executions"])
+    assert len(doc["executions"]) == 9 and all(e["status"] == "scored" for e in doc["executions"])
     # the folders name the teams; the draft lists the runs with a result file by name
     sources = {(e["benchmark"], e["team_source"]) for e in doc["executions"]}
     assert sources == {
@@ -74,6 +74,7 @@ def test_the_draft_places_every_run_result_and_side_file(season: Any) -> None:
         ("stb", "manifest"),
         ("hgtkmh", "RSBB layout"),
         ("hwv", "RSBB layout"),
+        ("hcfgac", "RSBB layout"),
     }
 
 
@@ -91,7 +92,7 @@ def test_the_fbm_leaderboard(season: Any, answers: dict[str, Any]) -> None:
     assert all(e["live_score"] and e["live_differences"] == [] for e in hgmf)
 
 
-@pytest.mark.parametrize("name", ["hgtkmh", "hwv", "stb"])
+@pytest.mark.parametrize("name", ["hgtkmh", "hwv", "hcfgac", "stb"])
 def test_the_task_leaderboards(season: Any, answers: dict[str, Any], name: str) -> None:
     _, doc, _ = season
     expected = answers["expected"]["leaderboards"][name]
@@ -116,6 +117,8 @@ def test_the_site_shows_the_items(season: Any) -> None:
     assert "HWV (Task Benchmark 2: Welcoming visitors): leaderboard" in page
     assert "homebot: disqualified (hits a visitor)" in page
     assert '<th title="Achievements: carries out the command of phase 2">A4</th>' in page
+    assert "HCFGAC (Task Benchmark 3: Catering for Granny Annie&#39;s Comfort): leaderboard" in page
+    assert '<th title="Penalized Behaviors: drops an object">P2</th>' in page
 
 
 def test_one_command_from_the_folder_to_the_site(
@@ -210,7 +213,7 @@ def test_timeline_shows_the_runs(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["timeline", str(SEASON), "--no-clock-check", "--format", "json"]) == 0
     data = json.loads(capsys.readouterr().out)
     runs = {(r["code"], r["team"]): r for r in data["rsbb"]["runs"]}
-    assert len(runs) == 7
+    assert len(runs) == 9
     assert runs[("HGMF", "simbot")]["result"].endswith(".yaml")
     assert runs[("HGMF", "simbot")]["config"].endswith("HGMF.yaml")
     assert runs[("HWV", "homebot")]["result"] is None  # a task benchmark: no script
@@ -220,8 +223,9 @@ def test_timeline_shows_the_runs(capsys: pytest.CaptureFixture[str]) -> None:
         ("hgmf",),
         ("hgtkmh",),
         ("hwv",),
+        ("hcfgac",),
         ("stb",),
     }
     assert main(["timeline", str(SEASON), "--no-clock-check"]) == 0
     text = capsys.readouterr().out
-    assert "RSBB runs (7, docs/rsbb.md):" in text and "no GT file covers it" not in text
+    assert "RSBB runs (9, docs/rsbb.md):" in text and "no GT file covers it" not in text

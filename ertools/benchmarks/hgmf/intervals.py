@@ -3,7 +3,7 @@ perturbed positions, all Monte Carlo draws at once ((draws, goals) arrays). No I
 
 The final lookups' moments are logged exactly (the script's broadcasts), so the only source
 is the mocap's own noise: the object's and the table's marker sets, each measured from its
-own track (:mod:`ertools.rsbb.noise`), added per axis. An interpolated position averages two
+own track (:mod:`ertools.rsbb.jitter`), added per axis. An interpolated position averages two
 samples' noise (a factor sqrt(w^2 + (1 - w)^2) <= 1): taking the full sigma keeps the
 interval on the safe side.
 """
@@ -25,7 +25,7 @@ from ertools.benchmarks.common.uncertainty import (
 )
 from ertools.benchmarks.hgmf.config import HgmfOptions
 from ertools.benchmarks.hgmf.result import AVERAGE_KEY, HgmfGoal
-from ertools.rsbb.noise import mocap_noise
+from ertools.rsbb.jitter import mocap_noise
 from ertools.rsbb.tf import TfTrack
 
 METHOD = "Monte Carlo (parametric bootstrap, basic interval)"

@@ -3,7 +3,7 @@ mocap samples, all Monte Carlo draws at once ((draws, segments) arrays). No IO.
 
 The lookup's moment is logged exactly (the script's broadcast), so the only source is the
 mocap's own noise (``mocap_noise``), measured from the marker set's track
-(:mod:`ertools.rsbb.noise`): the marker's position (normal, sigma per axis) and yaw; the yaw
+(:mod:`ertools.rsbb.jitter`): the marker's position (normal, sigma per axis) and yaw; the yaw
 swings the team transform's lever arm. Interpolating between two samples with weights w and
 1 - w averages their noise: sigma times sqrt(w^2 + (1 - w)^2).
 """
@@ -26,7 +26,7 @@ from ertools.benchmarks.hnf.config import HnfOptions
 from ertools.benchmarks.hnf.logs import HnfLogs
 from ertools.benchmarks.hnf.result import ORIENTATION_KEY, POSITION_KEY, HnfSegment
 from ertools.geometry import wrap_angle
-from ertools.rsbb.noise import mocap_noise
+from ertools.rsbb.jitter import mocap_noise
 from ertools.rsbb.tf import TfTrack, duration_sec, link_at
 
 METHOD = "Monte Carlo (parametric bootstrap, basic interval)"

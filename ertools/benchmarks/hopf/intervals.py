@@ -1,7 +1,7 @@
 """Confidence intervals of HOPF's pose scores (docs/uncertainty.md, issue 28).
 
 The ground truth is one tf lookup: the table and the positioner, one interpolated sample each.
-Each body's mocap noise is measured from its own track (:func:`ertools.rsbb.noise.mocap_noise`:
+Each body's mocap noise is measured from its own track (:func:`ertools.rsbb.jitter.mocap_noise`:
 robust second differences). A draw moves both bodies by that noise and re-computes the item's
 pose in the table frame to first order (the positioner's and the table's positions, and their
 yaws turning the item's offset and the item's position about the table's origin), then every
@@ -23,7 +23,7 @@ from ertools.benchmarks.hopf.config import CLIP_TRANSLATION_M, HopfOptions
 from ertools.benchmarks.hopf.formula import pose_terms
 from ertools.benchmarks.hopf.goals import Scored
 from ertools.benchmarks.hopf.result import HopfIntervals
-from ertools.rsbb.noise import DEFAULT_SIGMA_M, DEFAULT_SIGMA_RAD, MocapNoise, mocap_noise
+from ertools.rsbb.jitter import DEFAULT_SIGMA_M, DEFAULT_SIGMA_RAD, MocapNoise, mocap_noise
 from ertools.rsbb.tf import TfTrack, euler_yaw
 
 

@@ -2,7 +2,7 @@
 re-computed from perturbed mocap positions, all Monte Carlo draws at once. No IO.
 
 The only source is the mocap's noise (``mocap_noise``), measured from each body's own track
-(:mod:`ertools.rsbb.noise`): the robot's and the cap's positions perturbed per axis (the
+(:mod:`ertools.rsbb.jitter`): the robot's and the cap's positions perturbed per axis (the
 robot's sigma includes its marker set's yaw noise on the team transform's lever arm, folded in
 as a position sigma). The distance covered sums small steps, so noise biases it upwards; the
 basic interval removes the bias the draws show.
@@ -23,7 +23,7 @@ from ertools.benchmarks.common.uncertainty import (
 from ertools.benchmarks.hpff.config import HpffOptions
 from ertools.benchmarks.hpff.logs import HpffLogs
 from ertools.benchmarks.hpff.result import COVERED_KEY, DEVIATION_KEY, HpffSamples
-from ertools.rsbb.noise import mocap_noise
+from ertools.rsbb.jitter import mocap_noise
 
 METHOD = "Monte Carlo (parametric bootstrap, basic interval)"
 

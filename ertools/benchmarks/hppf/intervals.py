@@ -1,7 +1,7 @@
 """Confidence intervals of HPPF's position errors and Distance error (docs/uncertainty.md).
 
 The ground truth is one tf lookup of the cap's marker set after each answer. Its mocap noise
-is measured from its own track (:func:`ertools.rsbb.noise.mocap_noise`: robust second
+is measured from its own track (:func:`ertools.rsbb.jitter.mocap_noise`: robust second
 differences). A draw moves each ground truth by that noise and re-computes the position
 errors (:func:`ertools.benchmarks.hppf.formula.position_errors`, vectorised over the draws)
 and the Distance error. The names and the execution time carry no measurement noise.
@@ -20,7 +20,7 @@ from ertools.benchmarks.hppf.config import HppfOptions
 from ertools.benchmarks.hppf.formula import position_errors
 from ertools.benchmarks.hppf.goals import Scored
 from ertools.benchmarks.hppf.result import DISTANCE_KEY, HppfIntervals
-from ertools.rsbb.noise import DEFAULT_SIGMA_M, mocap_noise
+from ertools.rsbb.jitter import DEFAULT_SIGMA_M, mocap_noise
 from ertools.rsbb.tf import TfTrack
 
 

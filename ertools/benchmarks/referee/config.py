@@ -1,5 +1,6 @@
-"""The referee-scored benchmarks' names and options (:class:`RefereeOptions`), and
-:func:`make_options`, which turns the declared inputs' values into them."""
+"""The referee-scored benchmarks' names, inputs (the options of ``ertools score hgtkmh``...,
+the manifest keys) and options (:class:`RefereeOptions`), and :func:`make_options`, which
+turns the inputs' values into them. NumPy-free: the command's parser imports it."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ertools.benchmarks.base import Input, resolve_values
 from ertools.errors import UsageError
 from ertools.rsbb_states import BENCHMARKS, REFEREE_CODES
 
@@ -46,14 +48,34 @@ class RefereeOptions:
     run: int | None = None
 
 
-def make_options(code: str, v: Mapping[str, Any]) -> RefereeOptions:
-    """The declared inputs' values (resolved) -> :class:`RefereeOptions`.
+INPUTS = (
+    Input(
+        "description",
+        "path",
+        "rsbb_etc/config/benchmarks_description.yaml: the items' groups and order (default: "
+        "the items as the log names them)",
+        metavar="FILE",
+    ),
+    Input(
+        "result",
+        "path",
+        "the run's result file, whose referee_score is used when it has one (scripted "
+        "benchmarks; default: the RefBox's last values in /core/to_gui)",
+        metavar="FILE",
+    ),
+    Input("run", "int", "the run's number (default: from the bag's name)", minimum=0),
+)
+
+
+def make_options(code: str, given: Mapping[str, Any]) -> RefereeOptions:
+    """The values of :data:`INPUTS` -> :class:`RefereeOptions` of the benchmark ``code``.
 
     Raises:
-        UsageError: an unknown benchmark code.
+        UsageError: an unknown benchmark code, an unknown input or a value that does not fit.
     """
     if code not in BENCHMARKS:
         raise UsageError(f"unknown RSBB benchmark {code!r}")
+    v = resolve_values(INPUTS, given)
     run = v.get("run")
     return RefereeOptions(
         code=code,

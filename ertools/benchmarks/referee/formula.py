@@ -7,7 +7,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from ertools.benchmarks.referee.config import PENALTY_SCALE, TIME_SCALE
-from ertools.rsbb.referee import Tally, group_role
+from ertools.benchmarks.referee.items import Tally, group_role
 
 
 def erl_rank(t: Tally, seconds: float) -> float:

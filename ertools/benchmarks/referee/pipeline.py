@@ -16,21 +16,21 @@ from pathlib import Path
 
 from ertools.benchmarks.base import notice
 from ertools.benchmarks.referee.config import RefereeOptions
-from ertools.benchmarks.referee.result import RefereeResult
-from ertools.errors import ConfigError, TopicError, UsageError
-from ertools.io.reader import topics
-from ertools.rsbb.layout import FileKind, classify
-from ertools.rsbb.log import EndKind, read_rsbb_run
-from ertools.rsbb.referee import (
+from ertools.benchmarks.referee.items import (
     Item,
     items_from_result,
     load_descriptions,
     match_description,
     tally,
 )
+from ertools.benchmarks.referee.result import RefereeResult
+from ertools.benchmarks.referee.zone import ZoneSeries, read_zone
+from ertools.errors import ConfigError, TopicError, UsageError
+from ertools.io.reader import topics
+from ertools.rsbb.layout import FileKind, classify
+from ertools.rsbb.log import EndKind, read_rsbb_run
 from ertools.rsbb.results import load_result
 from ertools.rsbb.sidefiles import find_side_files, run_place
-from ertools.rsbb.zone import ZoneSeries, read_zone
 from ertools.rsbb_states import BENCHMARKS, REFBOX_STATE_TOPIC
 from ertools.streams import Provenance
 

@@ -8,9 +8,9 @@ from typing import TYPE_CHECKING, Any
 from ertools.benchmarks.base import Rows
 from ertools.benchmarks.referee.config import PENALTY_SCALE, TIME_SCALE
 from ertools.benchmarks.referee.formula import erl_rank
+from ertools.benchmarks.referee.items import Item, Tally
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames
-from ertools.rsbb.referee import Item, Tally
 from ertools.serialize import dump_yaml, jsonable
 from ertools.streams import Provenance
 

@@ -43,7 +43,7 @@ from ertools.benchmarks.trajectory.formula import Metrics, metrics
 from ertools.benchmarks.trajectory.intervals import (
     FITTED_SUFFIX,
     Rescoring,
-    mocap_sigma,
+    jitter,
     trajectory_intervals,
 )
 from ertools.benchmarks.trajectory.result import FittedScore, TrajectoryResult
@@ -330,7 +330,7 @@ def score_streams(
     iv = NO_INTERVALS
     fitted: FittedScore | None = None
     if m is not None:
-        sigma = mocap_sigma(timed) if intervals.enabled else None
+        sigma = jitter(timed) if intervals.enabled else None
         iv = trajectory_intervals(
             robot,
             timed,

@@ -68,6 +68,7 @@ class Trajectory(
     title = "Offline trajectory benchmark"
     inputs = INPUTS
     rules = RULES
+    sample_folder = "robotlog"  # Simulated: a robot's own log, GT folder beside it
     example = "ertools score trajectory robot.bag gt/ --robot-topic /rockin/homer/marker_pose"
     description = DESCRIPTION
     epilog = EPILOG
@@ -132,7 +133,7 @@ class Trajectory(
     def sample_args(self, samples: Path) -> Sequence[str] | None:
         """The sample robot log against the GT folder beside it, clock offset estimated and
         applied (``make demo``)."""
-        folder = samples / "robotlog"
+        folder = samples / self.sample_folder
         robots = sorted(folder.glob("FBM2H_*.bag"))
         if not robots:
             return None

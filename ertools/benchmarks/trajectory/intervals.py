@@ -5,7 +5,7 @@ Every statistic of :mod:`ertools.benchmarks.trajectory.formula` gets the interva
 value under two sources of uncertainty on the GT side of each compared pair:
 
 - ``mocap_noise``: sigma per axis (and the yaw's) measured from the GT stream itself
-  (:func:`mocap_sigma`: its stationary phases, else its second differences); an
+  (:func:`jitter`: its stationary phases, else its second differences); an
   interpolated GT pose mixes two samples: sigma sqrt((1-a)^2 + a^2).
 - ``time_association``: the clock offset, known to the standard error of the least-squares
   offset (:func:`offset_spread`), one error per draw centred on the offset applied (the
@@ -195,7 +195,7 @@ def _blocks(gt: PoseStream) -> PoseStream:
     return gt.take(index)
 
 
-def mocap_sigma(gt: PoseStream) -> MocapSigma:
+def jitter(gt: PoseStream) -> MocapSigma:
     """The GT's measurement noise, measured from the GT stream (module doc)."""
     gt = _blocks(gt)
     d2, y2 = _second_differences(gt)
@@ -450,7 +450,7 @@ def trajectory_intervals(
     ``robot``: the robot stream whose row i is matched row i; ``gt``: the GT in time order;
     ``offset_ns``: the offset the score applied, on which the offset's draws are centred;
     ``rescoring``: the score's association, which the offset's draws re-score with;
-    ``sigma``: the GT's noise when already measured (:func:`mocap_sigma`).
+    ``sigma``: the GT's noise when already measured (:func:`jitter`).
     """
     ok = matched.status == COMPARED
     if not settings.enabled or not ok.any() or len(gt) < 2:
@@ -483,7 +483,7 @@ def trajectory_intervals(
     # the yaw of the samples used only (an hour's GT holds 430,000)
     turned = yaw_from_quat(gt.quat_xyzw[hi]) - yaw_from_quat(gt.quat_xyzw[lo])
     yaw_rate = wrap_angle(turned) / span
-    sig = mocap_sigma(gt) if sigma is None else sigma
+    sig = jitter(gt) if sigma is None else sigma
     lag: tuple[float, float] | None = None
     if association == "linear":
         weight = np.sqrt((1.0 - a) ** 2 + a**2)

@@ -11,6 +11,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from ertools.benchmarks import registry
+from ertools.benchmarks.base import Audited, Described, Discovered, Reported, Simulated, offers
 from ertools.cli.main import main
 from ertools.simulator.rsbb import write_rsbb_run
 from ertools.simulator.rsbb_task import COMPLETED, STOPPED, TIMED_OUT, TaskScenario, write_task_run
@@ -176,3 +178,23 @@ def test_no_figures_or_foxglove_are_offered(
     code = main(["score", "hgtkmh", str(bag), "-o", str(out), option, str(tmp_path / "x")])
     assert code == 2 and not out.exists()
     assert f"unrecognized arguments: {option}" in capsys.readouterr().err
+
+
+SAMPLES = Path(__file__).resolve().parents[3] / "sample_bags"
+
+
+@pytest.mark.parametrize("name", ["hgtkmh", "hwv", "hcfgac", "stb"])
+def test_the_four_are_declared_on_the_protocols(name: str) -> None:
+    """Each is its own object of the parts it fills: described, reported (but drawing nothing),
+    ranked, simulated in the season sample; not audited (the referee's score is not
+    recomputed)."""
+    bench = registry.get(name)
+    assert all(isinstance(bench, p) for p in (Described, Reported, Discovered, Simulated))
+    assert not isinstance(bench, Audited)
+    assert not offers(bench, "figures") and not offers(bench, "foxglove")
+    assert offers(registry.get("fbm3w"), "figures") and offers(registry.get("fbm3w"), "foxglove")
+    assert bench.make_options({"run": 2}).code == name.upper()
+    assert isinstance(bench, Simulated)
+    # the season sample (committed) has runs of every referee-scored benchmark
+    args = bench.sample_args(SAMPLES)
+    assert args is not None and f"/rsbb_logs/{name.upper()}/" in Path(args[0]).as_posix()

@@ -15,7 +15,7 @@ from ertools.benchmarks.trajectory.association import associate
 from ertools.benchmarks.trajectory.intervals import (
     KEYS,
     Rescoring,
-    mocap_sigma,
+    jitter,
     offset_effects,
     offset_spread,
 )
@@ -38,7 +38,7 @@ def test_noise_of_a_moving_body_from_second_differences() -> None:
     xyz = np.column_stack([1.6 * np.cos(w * s), np.sin(w * s), 0.4 + 0 * s])
     yaw = np.arctan2(np.cos(w * s), -1.6 * np.sin(w * s))
     noisy = _stream(xyz + rng.normal(0.0, 2e-4, xyz.shape), yaw + rng.normal(0.0, 1e-3, s.size))
-    got = mocap_sigma(noisy)
+    got = jitter(noisy)
     # 36,000 second differences; the MAD's relative sd is ~1.7 / sqrt(36000) < 1%: 5% is wide
     assert got.position == pytest.approx(2e-4, rel=0.05)
     assert got.yaw == pytest.approx(1e-3, rel=0.05)
@@ -49,7 +49,7 @@ def test_noise_of_a_still_body_from_its_stationary_phase() -> None:
     rng = np.random.default_rng(3)
     n = 2400
     xyz = np.array([0.5, 0.2, 0.3]) + rng.normal(0.0, 3e-4, (n, 3))
-    got = mocap_sigma(_stream(xyz, np.zeros(n)))
+    got = jitter(_stream(xyz, np.zeros(n)))
     # epsilon / sqrt(pi) of 2,399 pairs: a few percent
     assert got.position == pytest.approx(3e-4, rel=0.08)
     assert "stationary" in got.note

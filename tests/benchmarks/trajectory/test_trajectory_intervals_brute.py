@@ -8,7 +8,7 @@ with robot pose i moves by sigma w_i per axis (w_i = sqrt((1 - a)^2 + a^2) of th
 interpolation's weight a, 1 for hold) and its yaw by sigma_yaw w_i; with hold by l_i v_i
 and l_i omega_i too, l_i uniform over [-1, 0] GT periods, v and omega the GT's velocity and
 yaw rate over 5 samples either side. sigma and sigma_yaw are those the scorer measured from
-the GT (``mocap_sigma``), so both sides draw the same noise. No clock offset source (the
+the GT (``jitter``), so both sides draw the same noise. No clock offset source (the
 audit has no estimate): its grid is tested in test_trajectory_intervals.py.
 
 Both sides take 20,000 draws: an interval end is a 2.5 % or 97.5 % quantile, known to
@@ -30,7 +30,7 @@ from ertools.benchmarks.trajectory.formula import PERCENTILES, metrics
 from ertools.benchmarks.trajectory.intervals import (
     KEYS,
     Rescoring,
-    mocap_sigma,
+    jitter,
     trajectory_intervals,
 )
 from ertools.geometry import quat_from_yaw, yaw_from_quat
@@ -83,7 +83,7 @@ def _brute(robot: PoseStream, gt: PoseStream, method: str) -> dict[str, tuple[fl
     v = (gt.xyz[hi] - gt.xyz[lo]) / span[:, None]
     gy = yaw_from_quat(gt.quat_xyzw)
     omega = np.angle(np.exp(1j * (gy[hi] - gy[lo]))) / span
-    sig = mocap_sigma(gt)
+    sig = jitter(gt)
     w = np.sqrt((1 - a) ** 2 + a**2) if method == "linear" else np.ones(len(q))
     rng = np.random.default_rng(99)
     n = len(q)
