@@ -10,9 +10,6 @@ from tests.architecture.archscan import ROOT, outside_benchmark_modules, plant, 
 
 ALLOWED = frozenset(
     {
-        "ertools/samples/scenario.py: imports ertools.benchmarks.fbm1",
-        "ertools/samples/scenario.py: imports ertools.benchmarks.fbm2h",
-        "ertools/samples/scenario.py: imports ertools.benchmarks.fbm3w",
         # issue 38's shared RSBB code, named after what it reads, not after a benchmark: a
         # body's mocap noise (every RSBB package's intervals) and the referee's description
         # file (the four referee-scored benchmarks); the season sample builds HGMF runs with

@@ -15,7 +15,6 @@ ALLOWED = frozenset(
     {
         "ertools/benchmarks/legacy.py: import_module outside the registry",
         "ertools/fidelity.py: import_module outside the registry",
-        "ertools/samples/scenario.py: import_module outside the registry",
     }
 )
 
