@@ -155,6 +155,14 @@ def scenarios() -> tuple[Scenario, ...]:
     return tuple(found.values())
 
 
+def package_module(name: str, module: str) -> ModuleType | None:
+    """The module ``module`` (``rules``...) of the package declaring the benchmark ``name``,
+    imported now; None when that package has none."""
+    package = entry(name).absolute.partition(":")[0].rpartition(".")[0]
+    wanted = f"{package}.{module}"
+    return import_module(wanted) if find_spec(wanted) is not None else None
+
+
 def main() -> int:
     """Each entry: name, summary, the file that declares it."""
     for e in ENTRIES:
