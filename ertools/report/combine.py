@@ -57,6 +57,7 @@ _OUTPUT_FLAGS = frozenset({"-v", "--verbose", "-q", "--quiet"})
 # Team sources, best first (ertools.benchmarks.common.teams.resolve_team's precedence).
 _SOURCE_RANK = {"explicit": 0, "payload": 1, "log name": 2, "transform": 3}
 
+
 @dataclass(frozen=True)
 class Entry:
     """One result as the combined page shows it."""
