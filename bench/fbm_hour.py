@@ -78,7 +78,7 @@ def sample_topics(bag: Path) -> list[Topic]:
 
 def hour_bag(scenario: str, folder: Path) -> tuple[Path, Path]:
     """(hour bag, sample folder with its configs) of one scenario, written once."""
-    from ertools.samples.scenario import DEFAULT_SEEDS, load_scenario
+    from ertools.samples.scenario import load_scenario, seed_of
 
     sample_dir = folder / scenario
     target = folder / f"{scenario}_hour.bag"
@@ -87,7 +87,7 @@ def hour_bag(scenario: str, folder: Path) -> tuple[Path, Path]:
     if sample_dir.exists():
         shutil.rmtree(sample_dir)
     sample_dir.mkdir(parents=True)
-    paths = load_scenario(scenario)(sample_dir, seed=DEFAULT_SEEDS[scenario])
+    paths = load_scenario(scenario)(sample_dir, seed=seed_of(scenario))
     bag = next(p for p in paths if p.suffix == ".bag")
     topics = sample_topics(bag)
     first = min(int(t.t_ns.min()) for t in topics)

@@ -52,6 +52,7 @@ ENTRIES: tuple[Entry, ...] = (
     Entry("fbm2h", ".fbm2h.declare", "FBM2@Home navigation: waypoint errors"),
     Entry("fbm3w", ".fbm3w.declare", "FBM3@Work trajectory following: path error"),
     Entry("trajectory", ".trajectory.declare", "robot log vs mocap ground truth, with clock audit"),
+    Entry("noise", ".noise.declare", "mocap noise of a stationary marker set, suggested d_min"),
     # The RSBB benchmarks (issue 38) are still LegacyBenchmark records (legacy.py adapts them).
     Entry("hnf", ".hnf.declare", "HNF (FBM2@Home 2017-19) navigation: the RSBB script re-scored"),
     Entry("hpff", ".hpff.declare", "HPFF (FBM5@Home 2019) person following: the RSBB script"),
@@ -152,6 +153,14 @@ def scenarios() -> tuple[Scenario, ...]:
         folder = bench.sample_folder if isinstance(bench, Simulated) else ""
         found[package] = Scenario(folder or e.name, f"{package}.sample")
     return tuple(found.values())
+
+
+def package_module(name: str, module: str) -> ModuleType | None:
+    """The module ``module`` (``rules``...) of the package declaring the benchmark ``name``,
+    imported now; None when that package has none."""
+    package = entry(name).absolute.partition(":")[0].rpartition(".")[0]
+    wanted = f"{package}.{module}"
+    return import_module(wanted) if find_spec(wanted) is not None else None
 
 
 def main() -> int:

@@ -10,26 +10,22 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import cast
 
-from ertools.benchmarks.common.epsilon import noise_from_stream
-from ertools.benchmarks.common.sources import read_source, tf, topic
-from ertools.benchmarks.fbm3w.config import DEFAULT_FRAME, DEFAULT_TOPIC, FALLBACK_TOPIC
+from ertools.benchmarks.common.epsilon import NoiseResult
+from ertools.benchmarks.noise.declare import BENCHMARK
+from ertools.benchmarks.scoring import score_execution
 from ertools.cli.emit import write_plots
 from ertools.cli.options import (
     add_output,
     add_plots,
     add_pose_source,
     add_time_source,
-    pose_spec,
     positive,
 )
 from ertools.cli.output import dump_json, note, write_text
 from ertools.report.figures import figure_specs
 from ertools.serialize import dump_yaml
-
-if TYPE_CHECKING:
-    from ertools.streams import PoseStream
 
 EPILOG = """examples:
   ertools noise log_fbm3w_noise.bag
@@ -74,19 +70,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     add_plots(parser, what="the histogram")
 
 
-def _poses(args: argparse.Namespace) -> PoseStream:
-    return read_source(
-        args.bags,
-        pose_spec(args),
-        (topic(DEFAULT_TOPIC), topic(FALLBACK_TOPIC), tf(DEFAULT_FRAME)),
-        what="marker set poses",
-        only_topic=True,
-    )
-
-
 def run(args: argparse.Namespace) -> int:
-    poses = _poses(args)
-    result = noise_from_stream(poses, stationary=args.stationary == "auto", bin=args.bin, c=args.c)
+    tf = None if args.tf is None else ":".join(args.tf)
+    values = {
+        "topic": args.topic,
+        "tf": tf,
+        "time_source": args.time_source,
+        "stationary": args.stationary,
+        "bin": args.bin,
+        "c": args.c,
+    }
+    # the stages of `ertools score noise`; this command prints the 2015 tool's text too
+    result = cast(NoiseResult, score_execution(BENCHMARK, args.bags, values).result)
     if args.format == "json":
         text = dump_json(result.to_dict())
     elif args.format == "yaml":

@@ -57,12 +57,6 @@ _OUTPUT_FLAGS = frozenset({"-v", "--verbose", "-q", "--quiet"})
 # Team sources, best first (ertools.benchmarks.common.teams.resolve_team's precedence).
 _SOURCE_RANK = {"explicit": 0, "payload": 1, "log name": 2, "transform": 3}
 
-# Keys that identify a score that is no registered benchmark's (a benchmark declares its own:
-# ``score_keys`` of :class:`ertools.benchmarks.base.Reported`) when no result.json says which it is.
-_OTHER_SIGNATURES: tuple[tuple[str, frozenset[str]], ...] = (
-    ("noise", frozenset({"epsilon", "suggested_d_min"})),
-)
-
 
 @dataclass(frozen=True)
 class Entry:
@@ -140,7 +134,7 @@ def _guess_benchmark(score: dict[str, Any]) -> str:
         for name in registry.names()
         if isinstance(bench := registry.get(name), Reported)
     ]
-    for name, signature in (*declared, *_OTHER_SIGNATURES):
+    for name, signature in declared:
         if signature and signature <= keys:
             return name
     return "unknown"

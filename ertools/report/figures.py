@@ -58,10 +58,6 @@ def figure_specs(result: Any) -> list[FigureSpec]:
     bench = registry.get(name) if name in registry.names() else None
     if isinstance(bench, Reported):
         specs = bench.figures(result)
-    elif name == "noise":  # not a registered benchmark (yet): `ertools noise`'s result
-        from ertools.benchmarks.noise.plots import figure_specs as noise_figures  # lazy: 300 ms
-
-        specs = noise_figures(result)
     return [drawable(spec) for spec in specs]
 
 

@@ -4,12 +4,13 @@
 instead (:mod:`ertools.samples.competition`): one day of logs at one venue and its
 ``answers.json``; DIR is replaced as a whole, like a scenario folder.
 
-Every registered scenario (:data:`ertools.samples.scenario.SCENARIOS`) is generated into
+Every scenario (:func:`ertools.samples.scenario.scenarios`: each benchmark's, through the
+registry, and the timeline folder and the season) is generated into
 ``OUTDIR/<name>/``, which is replaced as a whole (built in a folder of a unique name,
 ``OUTDIR/.<name>.XXXXXXXX.partial``, first, so a failure leaves the old folder in place).
 Without ``--seed`` each scenario uses its fixed
-default seed, so the output is byte-identical from run to run. A scenario whose module does
-not exist is an error naming it, before anything is written.
+default seed, so the output is byte-identical from run to run. An unknown scenario is an
+error naming it, before anything is written.
 """
 
 from __future__ import annotations
@@ -35,15 +36,10 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from ertools.atomic import replace_folder
+from ertools.benchmarks.base import Generate
 from ertools.errors import ErtoolsError
 from ertools.samples.competition import DEFAULT_SEED, write_competition
-from ertools.samples.scenario import (
-    DEFAULT_SEEDS,
-    SCENARIOS,
-    Generate,
-    ScenarioMissingError,
-    load_scenario,
-)
+from ertools.samples.scenario import ScenarioMissingError, load_scenario, scenarios, seed_of
 from ertools.samples.simd import rerun_pinned
 
 SIZE_BUDGET_BYTES = 2_600_000  # per log; sample_bags/ as a whole stays under ~15 MB
@@ -74,7 +70,7 @@ def generate(outdir: Path, names: Sequence[str], seed: int | None = None) -> dic
         # wins, with a whole folder)
         partial = Path(tempfile.mkdtemp(dir=outdir, prefix=f".{name}.", suffix=".partial"))
         try:
-            paths = gen(partial, seed=DEFAULT_SEEDS[name] if seed is None else seed)
+            paths = gen(partial, seed=seed_of(name) if seed is None else seed)
         except BaseException:
             shutil.rmtree(partial, ignore_errors=True)
             raise
@@ -99,7 +95,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="write the sample competition (a day of logs at one venue) into DIR instead",
     )
     parser.add_argument(
-        "--only", nargs="+", metavar="NAME", choices=list(SCENARIOS), help="scenarios to write"
+        "--only", nargs="+", metavar="NAME", choices=list(scenarios()), help="scenarios to write"
     )
     parser.add_argument("--seed", type=int, help="one seed for all (default: fixed per scenario)")
     args = parser.parse_args(argv)
@@ -109,7 +105,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _competition(args.competition, args.seed)
     if args.outdir is None:
         parser.error("give OUTDIR (or --competition DIR)")
-    names = list(args.only) if args.only else list(SCENARIOS)
+    names = list(args.only) if args.only else list(scenarios())
     try:
         written = generate(args.outdir, names, args.seed)
     except ErtoolsError as exc:

@@ -1,11 +1,14 @@
-"""The scenario registry of the simulated sample logs.
+"""The scenarios of the simulated sample logs: each benchmark's own (the ``sample`` module
+beside its declaration, reached through the registry:
+:func:`ertools.benchmarks.registry.scenarios`) and the two that are no one benchmark's (the
+timeline folder, the 2019 season).
 
-A scenario is a function ``generate(outdir: Path, *, seed: int) -> list[Path]`` in its own
-module. It writes one or more logs into ``outdir`` (which exists and is empty) with
-:class:`ertools.simulator.writer.BagWriter`, the answers a correct scorer must find next to each
-log, and any config YAML the scorer needs; it returns every path it wrote (files, or rosbag2
-directories). ``python -m ertools.samples OUTDIR`` runs each registered scenario into
-``OUTDIR/<name>/``.
+A scenario is a function ``generate(outdir: Path, *, seed: int) -> list[Path]``
+(:class:`ertools.benchmarks.base.Generate`). It writes one or more logs into ``outdir`` (which
+exists and is empty) with :class:`ertools.simulator.writer.BagWriter`, the answers a correct
+scorer must find next to each log, and any config YAML the scorer needs; it returns every path
+it wrote (files, or rosbag2 directories). ``python -m ertools.samples OUTDIR`` runs each
+scenario into ``OUTDIR/<name>/``.
 
 Rules for scenario authors:
 
@@ -18,7 +21,8 @@ Rules for scenario authors:
   mocap part under ~50 s per body (compress time: short manual operations, fast runs), and
   publish 120 Hz only for the bodies the benchmark needs.
 - Independent: compute ``expected`` from the noiseless truth with the seed manual's formulas,
-  written out in the scenario module; never import ``ertools.benchmarks``.
+  written out in the scenario module; never import the scorers (a benchmark's ``sample``
+  never imports its pipeline: the ``samples`` import contract).
 - Use :mod:`ertools.simulator.mocap` for what the mocap node published,
   :mod:`ertools.simulator.statemachine` for the state topics and
   :func:`ertools.simulator.answers.write_answers` for the answers file (its conventions are
@@ -27,72 +31,65 @@ Rules for scenario authors:
 
 from __future__ import annotations
 
-import importlib
-from pathlib import Path
-from typing import Protocol
+import zlib
 
-from ertools.benchmarks.fbm1.config import BENCHMARKS as FBM1
-from ertools.benchmarks.fbm2h.config import NAMESPACE as FBM2H
-from ertools.benchmarks.fbm3w.config import NAMESPACE as FBM3W
+from ertools.benchmarks import registry
+from ertools.benchmarks.base import Generate
 from ertools.errors import UsageError
+from ertools.samples import season, timeline_folder
 
-SCENARIOS: dict[str, str] = {
-    FBM3W: "ertools.benchmarks.fbm3w.sample:generate",
-    FBM2H: "ertools.benchmarks.fbm2h.sample:generate",
-    FBM1[0]: "ertools.benchmarks.fbm1.sample:generate",
-    "robotlog": "ertools.benchmarks.trajectory.sample:generate",
-    "stationary": "ertools.benchmarks.noise.sample:generate",
-    "timeline": "ertools.samples.timeline_folder:generate",
-    "hnf": "ertools.benchmarks.hnf.sample:generate",
-    "hpff": "ertools.benchmarks.hpff.sample:generate",
-    "hopf": "ertools.benchmarks.hopf.sample:generate",
-    "hppf": "ertools.benchmarks.hppf.sample:generate",
-    "hgmf": "ertools.benchmarks.hgmf.sample:generate",
-    "season2019": "ertools.samples.season:generate",
+# The scenarios that are no benchmark's: a folder of logs for `ertools timeline`, and a season
+# of RSBB runs for `ertools rescore` (after the benchmarks' own, in this order).
+OWN: dict[str, Generate] = {
+    "timeline": timeline_folder.generate,
+    "season2019": season.generate,
+}
+
+# The seed each folder of sample_bags/ was written with (fixed, so that `python -m
+# ertools.samples` reproduces it byte for byte); a scenario not listed takes seed_of(name).
+SEEDS: dict[str, int] = {
+    "fbm3w": 2015,
+    "fbm2h": 2016,
+    "fbm1h": 2017,
+    "robotlog": 2018,
+    "stationary": 2019,
+    "timeline": 2020,
+    "hnf": 2021,
+    "hpff": 2022,
+    "hopf": 2023,
+    "hppf": 2024,
+    "hgmf": 2025,
+    "season2019": 2026,
 }
 
 
-class Generate(Protocol):
-    """The signature every scenario's ``generate`` has."""
-
-    def __call__(self, outdir: Path, *, seed: int) -> list[Path]: ...
-
-
 class ScenarioMissingError(UsageError):
-    """A registered scenario whose module (or function) does not exist yet."""
+    """A scenario asked for that no benchmark's sample module and no own scenario writes."""
+
+
+def scenarios() -> dict[str, Generate]:
+    """Every scenario by folder name: the benchmarks' in the registry's order, then
+    :data:`OWN`. Imports the benchmarks' declarations, not their simulators."""
+    found: dict[str, Generate] = {s.folder: s.generate for s in registry.scenarios()}
+    clash = sorted(set(found) & set(OWN))
+    if clash:  # a programming error, caught by the tests
+        raise ValueError(f"scenario folders written twice: {', '.join(clash)}")
+    return found | OWN
+
+
+def seed_of(name: str) -> int:
+    """The default seed of scenario ``name``: :data:`SEEDS`, else one derived from the name
+    (CRC-32: the same on every run and machine, unlike ``hash()``)."""
+    return SEEDS.get(name, 2015 + zlib.crc32(name.encode("utf-8")) % 10_000)
 
 
 def load_scenario(name: str) -> Generate:
-    """The ``generate`` function of a registered scenario.
+    """The ``generate`` function of scenario ``name``.
 
     Raises:
-        UsageError: unknown name.
-        ScenarioMissingError: its module or function is not there.
+        ScenarioMissingError: no scenario has that name (the known ones listed).
     """
-    if name not in SCENARIOS:
-        raise UsageError(f"unknown scenario {name!r}; known: {', '.join(SCENARIOS)}")
-    module_name, _, func = SCENARIOS[name].partition(":")
-    try:
-        module = importlib.import_module(module_name)
-    except ModuleNotFoundError as exc:
-        if exc.name != module_name:
-            raise
-        raise ScenarioMissingError(
-            f"scenario {name!r}: module {module_name} does not exist (not written yet?)"
-        ) from None
-    fn = getattr(module, func, None)
-    if fn is None:
-        raise ScenarioMissingError(f"scenario {name!r}: {module_name} has no function {func}()")
-    generate: Generate = fn
-    return generate
-
-
-def run_scenario(name: str, outdir: Path, *, seed: int) -> list[Path]:
-    """Run one registered scenario into ``outdir`` (created) and return what it wrote."""
-    generate = load_scenario(name)
-    outdir.mkdir(parents=True, exist_ok=True)
-    return generate(outdir, seed=seed)
-
-
-# Per-scenario default seeds: fixed so `python -m ertools.samples` reproduces sample_bags/.
-DEFAULT_SEEDS: dict[str, int] = {name: 2015 + i for i, name in enumerate(SCENARIOS)}
+    known = scenarios()
+    if name not in known:
+        raise ScenarioMissingError(f"unknown scenario {name!r}; known: {', '.join(known)}")
+    return known[name]

@@ -8,16 +8,7 @@ from pathlib import Path
 
 from tests.architecture.archscan import ROOT, outside_benchmark_modules, plant, ratchet
 
-ALLOWED = frozenset(
-    {
-        # the noise figures, named until noise is a registered benchmark (it was an import of
-        # report.plots_noise, which drew noise results: the same edge, now visible)
-        "ertools/report/figures.py: imports ertools.benchmarks.noise",
-        "ertools/samples/scenario.py: imports ertools.benchmarks.fbm1",
-        "ertools/samples/scenario.py: imports ertools.benchmarks.fbm2h",
-        "ertools/samples/scenario.py: imports ertools.benchmarks.fbm3w",
-    }
-)
+ALLOWED: frozenset[str] = frozenset()
 
 
 def test_no_new_benchmark_module_outside_its_package() -> None:

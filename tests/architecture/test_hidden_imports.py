@@ -14,8 +14,6 @@ from tests.architecture.archscan import ROOT, hidden_imports, plant, ratchet
 ALLOWED = frozenset(
     {
         "ertools/benchmarks/legacy.py: import_module outside the registry",
-        "ertools/fidelity.py: import_module outside the registry",
-        "ertools/samples/scenario.py: import_module outside the registry",
     }
 )
 

@@ -117,7 +117,7 @@ TITLES = {
 NAMESPACES = {"trajectory": "rockin"}
 # The benchmarks whose logs their topics name (the RSBB benchmarks share /rsbb/...: their run
 # bags are told apart by their folder, rsbb_logs/<CODE>/, tests/benchmarks/hnf/).
-NAMED = [n for n in registry.names() if registry.get(n).log_namespace]
+NAMED = [n for n in registry.names() if getattr(registry.get(n), "log_namespace", "")]
 PAIRS = [(asked, log) for asked in NAMED for log in NAMED if asked != log]
 
 

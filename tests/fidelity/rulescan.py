@@ -1,7 +1,8 @@
 """Where ertools declares its rules, read from the source: the catalogue
-(:func:`ertools.fidelity.all_rules`) collects the ``Rule`` constants of the modules that
-``RULE_MODULES`` lists, so a rule made anywhere else (in a function, a list, a module not
-listed) would be missing from it, from the docs' table and from the checks on both.
+(:func:`ertools.benchmarks.catalogue.rules`) is each benchmark's ``rules``, its package's
+``RULES`` tuple, so a rule made anywhere else (in a function, a class, a list) or left out of
+its module's ``RULES`` would be missing from it, from the docs' table and from the checks on
+both.
 
 The scanner takes the folder holding ``ertools/`` so that a test can plant a bad module in a
 small tree and see it refused.
@@ -16,21 +17,6 @@ from pathlib import Path
 def _module_name(root: Path, path: Path) -> str:
     parts = path.relative_to(root).with_suffix("").parts
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
-
-
-def listed_modules(root: Path) -> tuple[str, ...]:
-    """``RULE_MODULES`` as ``ertools/fidelity.py`` under ``root`` writes it (a literal)."""
-    tree = ast.parse((root / "ertools" / "fidelity.py").read_text(encoding="utf-8"))
-    for node in tree.body:
-        if isinstance(node, ast.AnnAssign) and node.value is not None:
-            target, value = node.target, node.value
-        elif isinstance(node, ast.Assign) and len(node.targets) == 1:
-            target, value = node.targets[0], node.value
-        else:
-            continue
-        if isinstance(target, ast.Name) and target.id == "RULE_MODULES":
-            return tuple(ast.literal_eval(value))
-    raise AssertionError("ertools/fidelity.py has no literal RULE_MODULES")
 
 
 def _is_rule_call(node: ast.AST) -> bool:
@@ -65,31 +51,50 @@ def _where(tree: ast.Module, call: ast.AST) -> str:
     return found
 
 
+def _listed(tree: ast.Module) -> tuple[str, ...] | None:
+    """The names a module-level ``RULES = (A, B)`` (or ``RULES: ... = (...)``) lists; None
+    when the module has no such tuple of names."""
+    for stmt in tree.body:
+        if isinstance(stmt, ast.Assign) and len(stmt.targets) == 1:
+            target, value = stmt.targets[0], stmt.value
+        elif isinstance(stmt, ast.AnnAssign) and stmt.value is not None:
+            target, value = stmt.target, stmt.value
+        else:
+            continue
+        if isinstance(target, ast.Name) and target.id == "RULES" and isinstance(value, ast.Tuple):
+            return tuple(e.id for e in value.elts if isinstance(e, ast.Name))
+    return None
+
+
 def rule_declarations(root: Path) -> tuple[dict[str, tuple[str, ...]], set[str]]:
     """(module -> the names of its module-level ``Rule`` constants, problems): a ``Rule(...)``
-    that is not the whole value of a module-level assignment, constants in a module
-    ``RULE_MODULES`` does not list, and a listed module that declares none. Problems are
-    stable strings, without line numbers."""
-    listed = listed_modules(root)
+    that is not the whole value of a module-level assignment, a module whose constants its
+    ``RULES`` tuple does not list (or lists in another order), and a ``RULES`` naming what is
+    not one of its constants. Problems are stable strings, without line numbers."""
     constants: dict[str, tuple[str, ...]] = {}
     problems: set[str] = set()
     for path in sorted((root / "ertools").rglob("*.py")):
         rel = path.relative_to(root).as_posix()
         tree = ast.parse(path.read_text(encoding="utf-8"))
         found = [c for c in (_constant(stmt) for stmt in tree.body) if c is not None]
-        names = [name for name, _ in found]
+        names = tuple(name for name, _ in found)
         declared = {id(call) for _, call in found}
         for node in ast.walk(tree):
             if _is_rule_call(node) and id(node) not in declared:
                 problems.add(f"{rel}: a Rule made in {_where(tree, node)}, not a module constant")
-        module = _module_name(root, path)
-        if names:
-            constants[module] = tuple(names)
-            if module not in listed:
-                problems.add(f"{rel}: Rule constants in a module RULE_MODULES does not list")
-    problems |= {
-        f"RULE_MODULES lists {name}, which declares no Rule constant"
-        for name in listed
-        if name not in constants
-    }
+        if not names:
+            continue
+        constants[_module_name(root, path)] = names
+        listed = _listed(tree)
+        if listed is None:
+            problems.add(f"{rel}: Rule constants and no RULES tuple listing them")
+            continue
+        missing = [n for n in names if n not in listed]
+        if missing:
+            problems.add(f"{rel}: RULES leaves out {', '.join(missing)}")
+        strange = [n for n in listed if n not in names]
+        if strange:
+            problems.add(f"{rel}: RULES lists {', '.join(strange)}, not a Rule constant here")
+        if not missing and not strange and listed != names:
+            problems.add(f"{rel}: RULES lists its constants in another order than declared")
     return constants, problems

@@ -81,9 +81,9 @@ PROGRAMS = [
     ("module", "ertools.samples", ["--help"], "python -m ertools.samples", ["numpy", "yaml"]),
     (
         "module",
-        "ertools.fidelity",
+        "ertools.benchmarks.catalogue",
         [],
-        "python -m ertools.fidelity",
+        "python -m ertools.benchmarks.catalogue",
         ["ertools.benchmarks.fbm1.rules", "ertools.benchmarks.fbm3w.rules"],
     ),
     # the demo's output folder: never reached (interrupted before), in tmp_path all the same

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from ertools.samples.scenario import SCENARIOS
+from ertools.samples.scenario import scenarios
 from ertools.samples.simd import (
     BLAS_ENV,
     ENV,
@@ -49,7 +49,7 @@ def test_the_samples_do_not_depend_on_numpys_simd_path(tmp_path: Path) -> None:
     as_run = _generate(tmp_path / "a", unpinned_env())
     baseline = _generate(tmp_path / "b", baseline_env())
     assert as_run.keys() == baseline.keys()
-    assert {name.split("/")[0] for name in as_run} == set(SCENARIOS)
+    assert {name.split("/")[0] for name in as_run} == set(scenarios())
     differ = [name for name in as_run if as_run[name] != baseline[name]]
     assert not differ, f"bytes depend on NumPy's SIMD path: {differ}"
 

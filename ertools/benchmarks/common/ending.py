@@ -56,6 +56,9 @@ RULE_END_PAYLOADS = Rule(
     option=EXACT_FLAG,
 )
 
+# The rules of the BmBox every 2015 node imported (ertools.benchmarks.catalogue lists them).
+RULES = (RULE_END_PAYLOADS,)
+
 # The BmBox every node imports (rows of the version table, ertools.fidelity.NodeVersion).
 _ALL_THREE = "RoCKIn 2015 Lisbon; Lisbon 2016 second local; Lisbon 2017 major tournament"
 VERSIONS = (

@@ -27,7 +27,7 @@ from ertools.benchmarks.common.hygiene import (
     impossible_samples,
     impossible_warning,
 )
-from ertools.benchmarks.common.inputs import DEFAULT_C
+from ertools.benchmarks.common.inputs import DEFAULT_BIN, DEFAULT_C
 from ertools.benchmarks.common.phases import (
     DEFAULT_MIN_STILL_S,
     DEFAULT_STILL_SPEED,
@@ -43,7 +43,6 @@ from ertools.streams import PoseStream, Provenance
 if TYPE_CHECKING:
     import pandas as pd  # annotations only: pandas is imported by to_frames()
 
-DEFAULT_BIN = 0.00015  # the 2015 tool's D_INTERVAL
 PERCENTILES = (50, 95, 99)
 # Rows the 2015 tool printed (0 to 7.5 mm); longer tails are folded into one overflow row.
 HISTOGRAM_ROWS = 50
@@ -58,6 +57,7 @@ class NoiseResult:
         pairs: consecutive pairs considered (inside phases when ``stationary``).
         lost: pairs with identical poses (tracking lost).
         distances: (M,) distances of the pairs that differ, metres.
+        times_ns: (M,) the time of each such pair's second measurement.
         epsilon: mean of ``distances`` (NaN when there are none).
         percentiles: "50"/"95"/"99" -> metres.
         c: the factor of the suggested d_min.
@@ -82,6 +82,7 @@ class NoiseResult:
     deviations: tuple[Deviation, ...] = ()
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
+    times_ns: I64 = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
 
     @property
     def suggested_d_min(self) -> float:
@@ -209,6 +210,7 @@ def noise_statistics(
         raise ScoringError("no stationary phase found: nothing to measure the noise on")
     lost = int(np.sum(use & same))
     distances = step[use & ~same]
+    times = np.asarray(t_ns, dtype=np.int64)[1:][use & ~same]
     eps = float(distances.mean()) if distances.size else math.nan
     values = np.percentile(distances, PERCENTILES) if distances.size else [math.nan] * 3
     pct = {str(p): float(v) for p, v in zip(PERCENTILES, values, strict=True)}
@@ -227,6 +229,7 @@ def noise_statistics(
         stationary=stationary,
         phases=phases,
         duration_s=duration,
+        times_ns=times,
     )
 
 

@@ -27,6 +27,8 @@ MAX_SEED = 2**63 - 1
 # The seed's D_MIN = c * epsilon (7.3.2): the c of the suggested d_min (``ertools noise``) and
 # of FBM3@Work's default noise when a log has no still phase.
 DEFAULT_C = 3.0
+# The 2015 mocap_noise_statistics tool's D_INTERVAL: the bin of the noise histogram, metres.
+DEFAULT_BIN = 0.00015
 
 #: The options every ``score`` command takes for its intervals (declared once, listed by each
 #: benchmark's declaration).
