@@ -270,15 +270,18 @@ def score_table(
     counts = f"{runs} runs" + (f", evo {slow_runs}" if evo_ape else "")
     print(f"  (whole processes, page cache warm, rows interleaved; medians of {counts})")
     title = "command"
-    print(f"  {title:<74} {'wall s':>7} {'CPU s':>7} {'peak MiB':>9} {'evo_ape / it':>13}")
+    head = "evo_ape / it: wall, CPU"
+    print(f"  {title:<74} {'wall s':>7} {'CPU s':>7} {'peak MiB':>9} {head:>24}")
     evo = got.get("evo_ape")
     for key, m in got.items():
         ratio = ""
         if evo is not None and evo.ok and m.ok and key != "trajectory_window":
-            ratio = f"{evo.wall_s / m.wall_s:12.1f}x"
+            ratio = f"{evo.wall_s / m.wall_s:.1f}x"
+            if evo.cpu_s and m.cpu_s:
+                ratio += f", {evo.cpu_s / m.cpu_s:.1f}x"
         cpu = f"{m.cpu_s:7.3f}" if m.cpu_s is not None else "      -"
         flag = "" if m.ok else "  FAILED"
-        print(f"  {m.name:<74} {m.wall_s:7.3f} {cpu} {m.rss_mib:9.1f} {ratio:>13}{flag}")
+        print(f"  {m.name:<74} {m.wall_s:7.3f} {cpu} {m.rss_mib:9.1f} {ratio:>24}{flag}")
     if not evo_ape:
         print("  evo_ape: not installed (pip install 'ertools[bench]'), no ratio")
     default = got["trajectory"]
