@@ -6,6 +6,7 @@ bytes uint8 (:data:`U8`).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -39,3 +40,25 @@ def fresh(n: int, dtype: npt.DTypeLike) -> npt.NDArray[Any]:
     raw = np.empty(max(pages * HUGE_PAGE, 2 * HUGE_PAGE), np.uint8)
     skip = -raw.ctypes.data % HUGE_PAGE
     return raw[skip : skip + size].view(kind)
+
+
+def fresh_concat(parts: Sequence[npt.NDArray[Any]], dtype: npt.DTypeLike) -> npt.NDArray[Any]:
+    """``np.concatenate(parts)`` (1-d parts) as ``dtype``, into :func:`fresh` memory."""
+    out = fresh(sum(len(p) for p in parts), dtype)
+    at = 0
+    for part in parts:
+        out[at : at + len(part)] = part
+        at += len(part)
+    return out
+
+
+def fresh_repeat(
+    values: Sequence[int], counts: Sequence[int], dtype: npt.DTypeLike
+) -> npt.NDArray[Any]:
+    """``np.repeat(values, counts)`` as ``dtype``, into :func:`fresh` memory."""
+    out = fresh(sum(counts), dtype)
+    at = 0
+    for value, count in zip(values, counts, strict=True):
+        out[at : at + count] = value
+        at += count
+    return out

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ertools.arrays import HUGE_PAGE, fresh
+from ertools.arrays import HUGE_PAGE, fresh, fresh_concat, fresh_repeat
 
 
 @pytest.mark.parametrize(
@@ -42,3 +42,15 @@ def test_small_arrays_are_not_padded() -> None:
     a = fresh(1000, np.float64)
     assert a.base is None
     assert a.nbytes == 8000
+
+
+def test_fresh_concat_and_repeat_equal_numpys() -> None:
+    rng = np.random.default_rng(3)
+    parts = [rng.integers(-(2**62), 2**62, size=k) for k in (0, 1, 200_000, 7)]
+    joined = fresh_concat(parts, np.int64)
+    assert joined.dtype == np.int64
+    assert np.array_equal(joined, np.concatenate(parts))
+    values, counts = [3, 70_000, 2], [150_000, 0, 5]
+    repeated = fresh_repeat(values, counts, np.int32)
+    assert repeated.dtype == np.int32
+    assert np.array_equal(repeated, np.repeat(np.array(values, np.int32), counts))

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import I64, fresh
+from ertools.arrays import I64, fresh, fresh_repeat
 from ertools.io.pipeline import Request, in_window, workers
 from ertools.io.ros1.layout import (
     INDEX_DTYPE,
@@ -121,11 +121,7 @@ def connection_entries(
             outside = outside_chunk_info(layout.chunks, cid, t, where[cid])
             if outside is not None:
                 return outside
-        c = fresh(len(t), np.int32)
-        at = 0
-        for chunk, count in where[cid]:
-            c[at : at + count] = chunk
-            at += count
+        c = fresh_repeat([w[0] for w in where[cid]], [w[1] for w in where[cid]], np.int32)
         return t, off, c, words
 
     threads = min(workers(), len(cids))
