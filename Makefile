@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 DEVSTAMP := $(VENV)/.installed-dev
 DEMO_OUT ?= demo_output
 
-.PHONY: demo test check lint typecheck pytest pytest-simd-off bench calibrate fuzz samples notebooks clean
+.PHONY: demo test check lint typecheck pytest pytest-simd-off bench bench-score calibrate fuzz samples notebooks clean
 
 # pip -qq: errors only. pip 25+ passes on setuptools' notice about every editable install
 # (a "BuildBackendWarning: Editable installation" box), which a first `make demo` need not show.
@@ -79,9 +79,15 @@ check: $(DEVSTAMP)
 	$(PYTEST) -q -n $(PYTEST_JOBS) --dist loadgroup -m "not slow"
 
 bench: $(STAMP)
-	$(PIP) -e '.[dask]'  # the season's LocalCluster run
+	$(PIP) -e '.[dask,bench]'  # the season's LocalCluster run; evo, the baseline
 	$(BIN)/python -m compileall -q ertools
 	$(BIN)/python bench/run.py
+
+# Issue 39's table alone: `score trajectory` against `evo_ape bag`, and the 8-hour GT (~3 min).
+bench-score: $(STAMP)
+	$(PIP) -e '.[bench]'
+	$(BIN)/python -m compileall -q ertools
+	$(BIN)/python bench/run.py --score-only
 
 # Do the 95% score intervals cover the truth 95% of the time? 1,000 seeded simulated executions
 # per benchmark (bench/calibration/), the table written into docs/uncertainty.md.

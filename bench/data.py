@@ -22,6 +22,9 @@ GT_TOPIC = f"{NS_BODY}/pose"
 ROBOT_TOPIC = "/rockin/homer/marker_pose"
 PS, P2D, TFM = "geometry_msgs/PoseStamped", "geometry_msgs/Pose2D", "tf2_msgs/TFMessage"
 VERSION = 6  # bump to regenerate the cache
+LONG_VERSION = 1  # the same for the long GT (generate_long)
+LONG_HOURS = 8
+ROBOT_WINDOW_S = 20 * 60
 
 
 def trajectory(t_s: F64) -> tuple[F64, F64]:
@@ -195,4 +198,28 @@ def generate(folder: Path, small_bags: int = 1000) -> dict[str, Path]:
             target.unlink()
         write_ros1(target, gt_topics(start, 1.0, seed=100 + i))
     stamp.write_text(json.dumps({"version": VERSION}))
+    return paths
+
+
+def generate_long(folder: Path) -> dict[str, Path]:
+    """Write (or reuse) an 8-hour GT log (bench/data.py's hour, 8 times as long: 1.3 GB) and
+    a 20-minute robot log in its fifth hour: a robot's run scored against a day's mocap log,
+    of which only the window it spans is read."""
+    folder.mkdir(parents=True, exist_ok=True)
+    stamp = folder / "generated_long.json"
+    paths = {
+        "gt_long": folder / f"gt_{LONG_HOURS}_hours.bag",
+        "robot_window": folder / "robot_20_minutes.bag",
+    }
+    if stamp.exists() and json.loads(stamp.read_text()).get("version") == LONG_VERSION:
+        return paths
+    stamp.unlink(missing_ok=True)
+    gt = gt_topics(T0, LONG_HOURS * 3600, seed=11)
+    write_ros1(paths["gt_long"], gt)
+    check_readback(paths["gt_long"], gt)
+    del gt
+    robot = robot_topics(T0 + 4 * 3600 * NS, ROBOT_WINDOW_S, seed=12)
+    write_ros1(paths["robot_window"], robot)
+    check_readback(paths["robot_window"], robot)
+    stamp.write_text(json.dumps({"version": LONG_VERSION}))
     return paths

@@ -1,4 +1,4 @@
-"""Run one command and report its wall time and peak RSS as JSON (used by run.py).
+"""Run one command and report its wall time, CPU time and peak RSS as JSON (used by run.py).
 
 A process's peak RSS (``ru_maxrss``) includes the memory of whatever it was forked from until
 it execs, so run.py (large, after generating data) must not fork the measured commands
@@ -31,6 +31,7 @@ def main() -> int:
             {
                 "wall_s": wall,
                 "maxrss_kib": usage.ru_maxrss,
+                "cpu_s": usage.ru_utime + usage.ru_stime,
                 "exit": code,
                 "last_line": lines[-1] if lines else "",
             }

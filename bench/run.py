@@ -6,11 +6,17 @@ and as MCAP (zstd), a 10 Hz robot log of the same hour, and 1000 one-second GT b
 command runs several times as a whole process (page cache warm); the table shows the median
 wall time and the peak RSS of the process (``os.wait4``), then the ratios of issue 3.
 
+Issue 39's table: `ertools score trajectory` (default, and ``--draws 0``) against `evo_ape
+bag` on the same hour (the merged bag: evo reads both topics from one bag), and a 20-minute
+robot log against an 8-hour GT (1.3 GB), the rows interleaved run by run; ``--score-only``
+runs just that table (evo included; ``--quick`` leaves out the other slow baselines).
+
 Then (``--season yes``, the default) the `ertools rescore` season benchmark of
 bench/rescore_season.py: >= 100 executions cold with 1 and 2 workers, through a Dask
 LocalCluster and warm from the cache; ``--season only`` runs just that one.
 
-    .venv/bin/python bench/run.py [--runs N] [--quick] [--json FILE] [--season yes|no|only]
+    .venv/bin/python bench/run.py [--runs N] [--quick] [--score-only] [--json FILE]
+                                  [--season yes|no|only]
 
 Nothing here is a test: `make test` never runs it.
 """
@@ -35,7 +41,7 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
 sys.path.insert(0, str(HERE))
 
-from data import GT_TOPIC, NS_BODY, ROBOT_TOPIC, generate  # noqa: E402
+from data import GT_TOPIC, LONG_HOURS, NS_BODY, ROBOT_TOPIC, generate, generate_long  # noqa: E402
 from fbm_hour import FBM_SCENARIOS, hour_bag  # noqa: E402
 
 PY = sys.executable
@@ -59,11 +65,21 @@ class Measure:
     runs: int
     ok: bool
     note: str = ""
+    cpu_s: float | None = None
 
 
-def run_once(argv: list[str]) -> tuple[float, float, int, str]:
-    """(wall s, peak RSS MiB, exit status, last stdout line) of one whole process, started
-    by the small launcher ``measure.py`` (see there why)."""
+@dataclass
+class Once:
+    wall_s: float
+    rss_mib: float
+    exit: int
+    last_line: str
+    cpu_s: float
+
+
+def run_once(argv: list[str]) -> Once:
+    """Wall time, peak RSS, exit status, last stdout line and CPU time of one whole process,
+    started by the small launcher ``measure.py`` (see there why)."""
     done = subprocess.run(
         [PY, str(HERE / "measure.py"), *argv],
         capture_output=True,
@@ -72,11 +88,17 @@ def run_once(argv: list[str]) -> tuple[float, float, int, str]:
     )
     if done.returncode != 0 or not done.stdout.strip():
         sys.stderr.write(done.stderr.decode(errors="replace")[-2000:])
-        return float("nan"), float("nan"), 1, ""
+        return Once(float("nan"), float("nan"), 1, "", float("nan"))
     report = json.loads(done.stdout.decode().strip().splitlines()[-1])
     if report["exit"] != 0:
         sys.stderr.write(done.stderr.decode(errors="replace")[-2000:])
-    return report["wall_s"], report["maxrss_kib"] / 1024.0, report["exit"], report["last_line"]
+    return Once(
+        report["wall_s"],
+        report["maxrss_kib"] / 1024.0,
+        report["exit"],
+        report["last_line"],
+        report["cpu_s"],
+    )
 
 
 def measure(name: str, argv: list[str], runs: int, warm_up: bool = True) -> Measure:
@@ -86,12 +108,12 @@ def measure(name: str, argv: list[str], runs: int, warm_up: bool = True) -> Meas
         # This VM reclaims idle page cache (kdamond): one unmeasured run brings the files back.
         run_once(argv)
     for _ in range(runs):
-        wall, peak, code, out = run_once(argv)
-        ok &= code == 0
-        walls.append(wall)
-        rss.append(peak)
+        once = run_once(argv)
+        ok &= once.exit == 0
+        walls.append(once.wall_s)
+        rss.append(once.rss_mib)
         with contextlib.suppress(ValueError, KeyError, IndexError, TypeError):
-            inside.append(float(json.loads(out.strip().splitlines()[-1])["inside_s"]))
+            inside.append(float(json.loads(once.last_line.strip().splitlines()[-1])["inside_s"]))
     m = Measure(
         name,
         statistics.median(walls),
@@ -165,6 +187,116 @@ def fbm_scores(go: Any, runs: int, ex: list[str], ertools: list[str]) -> None:
         print(f"    hour log scores as the sample: {problem or 'yes'}")
 
 
+def trajectory_argv(ertools: list[str], robot: Path, gt: Path, *extra: str) -> list[str]:
+    return [
+        *ertools,
+        "score",
+        "trajectory",
+        str(robot),
+        str(gt),
+        "--robot-topic",
+        ROBOT_TOPIC,
+        "--gt-topic",
+        GT_TOPIC,
+        *extra,
+        "--format",
+        "json",
+    ]
+
+
+def interleaved(rows: list[tuple[str, str, list[str], int]]) -> dict[str, Measure]:
+    """Each row ``(key, name, argv, runs)`` run ``runs`` times as a whole process, the rows
+    taking turns (one run of each per round, after one unmeasured warm-up run each), so that
+    a change of the machine's load falls on every row alike; medians, peak RSS the largest."""
+    for _key, _name, argv, _runs in rows:
+        run_once(argv)
+    got: dict[str, list[Once]] = {key: [] for key, *_ in rows}
+    for r in range(max(runs for *_, runs in rows)):
+        for key, _name, argv, runs in rows:
+            if r < runs:
+                got[key].append(run_once(argv))
+    return {
+        key: Measure(
+            name,
+            statistics.median(o.wall_s for o in got[key]),
+            None,
+            max(o.rss_mib for o in got[key]),
+            runs,
+            all(o.exit == 0 for o in got[key]),
+            cpu_s=statistics.median(o.cpu_s for o in got[key]),
+        )
+        for key, name, _argv, runs in rows
+    }
+
+
+def score_table(
+    paths: dict[str, Path], runs: int, slow_runs: int, ertools: list[str]
+) -> dict[str, Measure]:
+    """Issue 39's table: `score trajectory` on the hour, default and ``--draws 0``, against
+    `evo_ape bag` on the same hour merged into one bag, and a 20-minute robot log against
+    the 8-hour GT; printed, and returned by key."""
+    print(f"\nissue 39: score trajectory against evo_ape (data: {paths['gt'].parent})", flush=True)
+    t0 = time.perf_counter()
+    long = generate_long(paths["gt"].parent)
+    print(f"  the {LONG_HOURS}-hour GT ready in {time.perf_counter() - t0:.1f} s", flush=True)
+    hour = trajectory_argv(ertools, paths["robot"], paths["gt"])
+    gt_mib = long["gt_long"].stat().st_size / 2**20
+    rows = [
+        ("trajectory", "ertools score trajectory, robot hour + GT hour", hour, runs),
+        (
+            "trajectory_draws0",
+            "  the same with --draws 0 (no intervals)",
+            trajectory_argv(ertools, paths["robot"], paths["gt"], "--draws", "0"),
+            runs,
+        ),
+        (
+            "trajectory_window",
+            f"ertools score trajectory, 20-min robot log + {LONG_HOURS}-hour GT ({gt_mib:.0f} MiB)",
+            trajectory_argv(ertools, long["robot_window"], long["gt_long"]),
+            runs,
+        ),
+    ]
+    evo_ape = shutil.which("evo_ape", path=str(BIN))
+    if evo_ape:
+        rows.append(
+            (
+                "evo_ape",
+                "evo_ape bag, the same hour (GT + robot topic merged in one bag)",
+                [evo_ape, "bag", str(paths["combined"]), GT_TOPIC, ROBOT_TOPIC],
+                slow_runs,
+            )
+        )
+    got = interleaved(rows)
+    counts = f"{runs} runs" + (f", evo {slow_runs}" if evo_ape else "")
+    print(f"  (whole processes, page cache warm, rows interleaved; medians of {counts})")
+    title = "command"
+    head = "evo_ape / it: wall, CPU"
+    print(f"  {title:<74} {'wall s':>7} {'CPU s':>7} {'peak MiB':>9} {head:>24}")
+    evo = got.get("evo_ape")
+    for key, m in got.items():
+        ratio = ""
+        if evo is not None and evo.ok and m.ok and key != "trajectory_window":
+            ratio = f"{evo.wall_s / m.wall_s:.1f}x"
+            if evo.cpu_s and m.cpu_s:
+                ratio += f", {evo.cpu_s / m.cpu_s:.1f}x"
+        cpu = f"{m.cpu_s:7.3f}" if m.cpu_s is not None else "      -"
+        flag = "" if m.ok else "  FAILED"
+        print(f"  {m.name:<74} {m.wall_s:7.3f} {cpu} {m.rss_mib:9.1f} {ratio:>24}{flag}")
+    if not evo_ape:
+        print("  evo_ape: not installed (pip install 'ertools[bench]'), no ratio")
+    default = got["trajectory"]
+    if evo is not None and evo.ok and default.ok:
+        ratio = evo.wall_s / default.wall_s
+        verdict = "met" if ratio >= 30 else "NOT met"
+        print(
+            f"  target: default >= 30x faster than evo_ape: {ratio:.1f}x, {verdict} "
+            f"(30x needs <= {evo.wall_s / 30:.3f} s)"
+        )
+    verdict = "met" if default.rss_mib <= 150 else "NOT met"
+    print(f"  target: default peak RSS <= 150 MiB: {default.rss_mib:.1f} MiB, {verdict}")
+    return got
+
+
 def machine() -> dict[str, str]:
     cpu = "unknown"
     try:
@@ -199,8 +331,21 @@ def main() -> int:
     parser.add_argument(
         "--slow-runs", type=int, default=3, help="runs per slow baseline (default 3)"
     )
-    parser.add_argument("--quick", action="store_true", help="skip the slow rosbags/evo baselines")
-    parser.add_argument("--json", type=Path, default=REPO / "build" / "bench" / "results.json")
+    parser.add_argument(
+        "--quick",
+        action="store_true",
+        help="skip the slow rosbags and evo_traj baselines (evo_ape stays: issue 39's table)",
+    )
+    parser.add_argument(
+        "--score-only",
+        action="store_true",
+        help="only issue 39's table: score trajectory against evo_ape (and the 8-hour GT)",
+    )
+    parser.add_argument(
+        "--json",
+        type=Path,
+        help="where the figures go (default build/bench/results.json, results_score.json)",
+    )
     parser.add_argument(
         "--season",
         choices=("yes", "no", "only"),
@@ -225,6 +370,10 @@ def main() -> int:
         f"machine: {info['nproc']} cores, {info['cpu']}, {info['memory']}, "
         f"Python {info['python']}, load average {info['load_average_at_start']}"
     )
+    if args.score_only:
+        got = score_table(paths, args.runs, args.slow_runs, [str(BIN / "ertools")])
+        write_json(args.json or folder / "results_score.json", info, sizes, got, {})
+        return 0
     title = "command (whole process, page cache warm)"
     print(f"  {title:<58} {'wall s':>8} {'inside':>8} {'peak MiB':>9}")
     ertools = [str(BIN / "ertools")]
@@ -315,48 +464,20 @@ def main() -> int:
     )
     if not tl.ok:
         tl.note = "ertools timeline failed or is not available"
-    traj = [
-        *ertools,
-        "score",
-        "trajectory",
-        str(paths["robot"]),
-        str(paths["gt"]),
-        "--robot-topic",
-        ROBOT_TOPIC,
-        "--gt-topic",
-        GT_TOPIC,
-        "--format",
-        "json",
-    ]
-    probe = subprocess.run(
-        [*ertools, "score", "trajectory", "--help"], capture_output=True, cwd=REPO, check=False
-    )
-    if probe.returncode == 0:
-        go("trajectory", "ertools score trajectory (robot hour + GT hour)", traj, args.runs)
-    else:
-        print("  ertools score trajectory: not available yet, skipped")
     fbm_scores(go, args.runs, ex, ertools)
-    evo_traj, evo_ape = (
-        shutil.which("evo_traj", path=str(BIN)),
-        shutil.which("evo_ape", path=str(BIN)),
-    )
+    evo_traj = shutil.which("evo_traj", path=str(BIN))
     if args.quick:
-        print("  evo: skipped (--quick)")
-    elif evo_traj and evo_ape:
+        print("  evo_traj: skipped (--quick)")
+    elif evo_traj:
         go(
             "evo_traj",
             "evo_traj bag (GT topic)",
             [evo_traj, "bag", str(paths["gt"]), GT_TOPIC],
             args.slow_runs,
         )
-        go(
-            "evo_ape",
-            "evo_ape bag (GT + robot topic, one bag)",
-            [evo_ape, "bag", str(paths["combined"]), GT_TOPIC, ROBOT_TOPIC],
-            args.slow_runs,
-        )
     else:
         print("  evo: not installed (pip install 'ertools[bench]'), skipped")
+    results.update(score_table(paths, args.runs, args.slow_runs, ertools))
 
     print("\nratios (targets of issue 3):")
     ratios: dict[str, float] = {}
@@ -446,8 +567,19 @@ def main() -> int:
         label = "peak memory of ertools score trajectory"
         peak = results["trajectory"].rss_mib
         print(f"  {label:<62} {peak:7.1f} MiB (target <= 150 MiB)")
-    args.json.parent.mkdir(parents=True, exist_ok=True)
-    args.json.write_text(
+    write_json(args.json or folder / "results.json", info, sizes, results, ratios)
+    return season() if args.season == "yes" else 0
+
+
+def write_json(
+    path: Path,
+    info: dict[str, str],
+    sizes: dict[str, int],
+    results: dict[str, Measure],
+    ratios: dict[str, float],
+) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(
         json.dumps(
             {
                 "machine": info,
@@ -458,8 +590,7 @@ def main() -> int:
             indent=2,
         )
     )
-    print(f"\nwrote {args.json}")
-    return season() if args.season == "yes" else 0
+    print(f"\nwrote {path}")
 
 
 def season() -> int:

@@ -17,7 +17,7 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import I32, I64, U8, Bool
+from ertools.arrays import I32, I64, U8, Bool, fresh
 from ertools.io.decode.fast import decode, gather, to_batch
 from ertools.io.decode.posebatch import PoseBatch, concat_batches
 from ertools.io.decode.uniform import (
@@ -49,12 +49,12 @@ class Assembler:
         n = 0 if count is None else count
         # the record times in the reference order, when the index gave them: not copied
         self.times_known = times is not None and len(times) == n
-        self.t_record = times if times is not None and self.times_known else np.empty(n, np.int64)
+        self.t_record = times if times is not None and self.times_known else fresh(n, np.int64)
         # a type without a header is timed by its record times: no array of its own
         self.headless = msgtype == "geometry_msgs/Pose2D"
-        self.t_header = np.empty(0 if self.headless else n, dtype=np.int64)
-        self.xyz = np.empty((n, 3))
-        self.quat = np.empty((n, 4))
+        self.t_header = fresh(0 if self.headless else n, np.int64)
+        self.xyz = fresh(3 * n, np.float64).reshape(n, 3)
+        self.quat = fresh(4 * n, np.float64).reshape(n, 4)
         # Frame codes: while every row written has the same (frame, child) pair (a logger's
         # topic), the arrays are not written (zeroed memory never touched costs no memory)
         # and the batch gets the pair broadcast; a second pair writes them out.

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 import numpy as np
 
-from ertools.arrays import I64, U8, Bool
+from ertools.arrays import HUGE_PAGE, I64, U8, Bool, fresh
 from ertools.io.model import Conn
 
 if TYPE_CHECKING:
@@ -55,7 +55,7 @@ def prefetched(
 ) -> Iterator[T]:
     """``load(k, scratch)`` for k in 0..count-1, in order, computed ahead on worker threads.
 
-    ``scratch`` is a slot: a list holding the bytearray ``load`` may fill (and grow, see
+    ``scratch`` is a slot: a list holding the buffer ``load`` may fill (and grow, see
     :func:`scratch_view`) and maps it read through (:func:`keep`); a result is valid until
     ``hold + 1`` more are asked for (the caller may still be decoding the ``hold`` before the
     one it holds), after which its slot is reused. Without ``parallel`` (reads with nothing
@@ -181,14 +181,17 @@ def decoded_in_lanes(
 def scratch_view(scratch: list[Any], size: int) -> memoryview:
     """The first ``size`` bytes of the reused buffer (grown when too small).
 
-    A slot is ``[bytearray, *maps]``: maps a load read through (``keep``) are released here,
-    when the slot is reused.
+    A slot is ``[buffer, *maps]`` (the buffer a uint8 array): maps a load read through
+    (``keep``) are released here, when the slot is reused.
     """
     release(scratch)
-    if not scratch:
-        scratch.append(bytearray(size))
-    elif len(scratch[0]) < size:
-        scratch[0] = bytearray(size)
+    if not scratch or len(scratch[0]) < size:
+        # not zero-filled, in huge pages, whole ones (fewer regrowths: groups vary in size)
+        buffer = fresh(-(-size // HUGE_PAGE) * HUGE_PAGE, np.uint8)
+        if scratch:
+            scratch[0] = buffer
+        else:
+            scratch.append(buffer)
     return memoryview(scratch[0])[:size]
 
 
@@ -196,7 +199,7 @@ def keep(scratch: list[Any], mapping: mmap.mmap) -> None:
     """Hold ``mapping`` in the slot until the slot is reused."""
     release(scratch)
     if not scratch:
-        scratch.append(bytearray(0))
+        scratch.append(np.empty(0, np.uint8))
     scratch.append(mapping)
 
 

@@ -9,7 +9,7 @@ measurements never repeat a float64 coordinate, so an equal row is a re-sent pos
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -110,15 +110,20 @@ def _all_valid(stream: PoseStream) -> bool:
     return True
 
 
-def drop_invalid(stream: PoseStream, *, jumps: bool = True) -> tuple[PoseStream, int]:
+def drop_invalid(
+    stream: PoseStream, *, jumps: bool = True, found: Impossible | None = None
+) -> tuple[PoseStream, int]:
     """The stream without samples whose position or orientation is not usable.
 
     NaN or infinite values, or a zero quaternion (a node publishing "no pose"), cannot be
     compared; neither can a pose no body took (:func:`impossible_samples`; ``jumps``: the
     jump test too, for a measured body, not a robot's own estimate, which may jump when it
     relocalises). Dropping them (and saying how many) beats a NaN or an absurd score.
+    ``found``: :func:`impossible_samples` of this stream, when the caller has it already.
     """
-    impossible = impossible_samples(stream.t_ns, stream.xyz, jumps=jumps)
+    impossible = (
+        found if found is not None else impossible_samples(stream.t_ns, stream.xyz, jumps=jumps)
+    )
     if _all_valid(stream) and not impossible.count:
         return stream, 0
     with np.errstate(over="ignore"):  # an overflowing norm is not finite: dropped below
@@ -201,12 +206,17 @@ def impossible_samples(t_ns: npt.NDArray[np.int64], xyz: F64, *, jumps: bool = T
     jump = np.zeros(n, dtype=bool)
     if not n:
         return Impossible(far, jump)
-    finite = np.isfinite(xyz).all(axis=1)
-    far[finite] = (np.abs(xyz[finite]) > MAX_COORD_M).any(axis=1)
+    # Column by column, and the usual stream (every sample finite and near) used as it is
+    # rather than gathered: the same values, without (N, 3) temporaries reduced over rows.
+    finite = _per_column(np.isfinite, xyz, np.logical_and)
+    if finite.all():
+        far = _per_column(lambda c: np.abs(c) > MAX_COORD_M, xyz, np.logical_or)
+    else:
+        far[finite] = (np.abs(xyz[finite]) > MAX_COORD_M).any(axis=1)
     ok = np.flatnonzero(finite & ~far)
     if ok.size:
         centre = np.median(xyz[ok[:: max(1, ok.size // _MEDIAN_SAMPLES)]], axis=0)
-        far[ok[row_norm(xyz[ok] - centre) > FAR_M]] = True
+        far[ok[row_norm(_rows(xyz, ok) - centre) > FAR_M]] = True
     if not jumps:
         return Impossible(far, jump)
     measured = finite & ~far
@@ -219,7 +229,7 @@ def impossible_samples(t_ns: npt.NDArray[np.int64], xyz: F64, *, jumps: bool = T
     dt = np.diff(t)
     positive = dt[dt > 0]
     period = int(np.median(positive)) if positive.size else 1
-    dist = row_norm(np.diff(xyz[ok], axis=0))
+    dist = row_norm(np.diff(_rows(xyz, ok), axis=0))
     speed = dist / (np.maximum(dt, max(period, 1)) / 1e9)
     big = (dist > JUMP_MIN_M) & (speed > MAX_SPEED_M_S)
     if not big.any():
@@ -233,6 +243,20 @@ def impossible_samples(t_ns: npt.NDArray[np.int64], xyz: F64, *, jumps: bool = T
     of = np.searchsorted(ok[at], np.arange(n), side="right")
     jump[:] = ~kept[of] & finite & ~far
     return Impossible(far, jump, steps)
+
+
+def _per_column(test: Callable[[F64], Bool], xyz: F64, combine: np.ufunc) -> Bool:
+    """``test(xyz).all(axis=1)`` (``combine`` logical_and) or ``.any(axis=1)`` (logical_or),
+    one column at a time."""
+    out = test(xyz[:, 0])
+    for k in range(1, xyz.shape[1]):
+        combine(out, test(xyz[:, k]), out=out)
+    return out
+
+
+def _rows(xyz: F64, idx: npt.NDArray[np.intp]) -> F64:
+    """``xyz[idx]`` for ascending distinct ``idx``; ``xyz`` itself when that is every row."""
+    return xyz if len(idx) == len(xyz) else xyz[idx]
 
 
 def _kept_stretches(
@@ -283,11 +307,17 @@ def _kept_stretches(
 
 
 def impossible_warning(
-    stream: PoseStream, origin_ns: int | None = None, *, jumps: bool = True
+    stream: PoseStream,
+    origin_ns: int | None = None,
+    *,
+    jumps: bool = True,
+    found: Impossible | None = None,
 ) -> str | None:
     """One warning line when ``stream`` holds impossible samples (left out of every score:
-    :func:`drop_invalid`, the validity masks) or steps no body can make, else None."""
-    found = impossible_samples(stream.t_ns, stream.xyz, jumps=jumps)
+    :func:`drop_invalid`, the validity masks) or steps no body can make, else None
+    (``found``: as for :func:`drop_invalid`)."""
+    if found is None:
+        found = impossible_samples(stream.t_ns, stream.xyz, jumps=jumps)
     if not found.count and not found.steps:
         return None
 

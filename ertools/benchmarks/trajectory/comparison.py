@@ -18,6 +18,7 @@ from ertools.benchmarks.common.hygiene import (
     drop_duplicates,
     drop_invalid,
     frame_change_warning,
+    impossible_samples,
     impossible_warning,
 )
 from ertools.benchmarks.common.inputs import IntervalSettings
@@ -115,8 +116,20 @@ def score_streams(
     notes = [*warnings, *_other_benchmark_gt(robot_file, gt_topic)]
     notes.extend(w for w in (frame_change_warning(gt), frame_change_warning(robot)) if w)
     # a robot's estimate may jump (relocalising): only the measured GT's jumps are impossible
-    found = (impossible_warning(gt), impossible_warning(robot, jumps=False))
-    notes.extend(w for w in found if w)
+    # (found once for the warnings and the drop below: an hour of GT's costs tens of ms)
+    streams = gt, robot
+    found = (
+        impossible_samples(gt.t_ns, gt.xyz),
+        impossible_samples(robot.t_ns, robot.xyz, jumps=False),
+    )
+    notes.extend(
+        w
+        for w in (
+            impossible_warning(gt, found=found[0]),
+            impossible_warning(robot, jumps=False, found=found[1]),
+        )
+        if w
+    )
     evo = config.t_max_diff is not None
     invalid: list[Deviation] = []
     if config.gt_order == "time" and not evo:
@@ -126,8 +139,9 @@ def score_streams(
             notes.append(
                 f"{dropped} GT sample(s) recorded twice (overlapping GT files) were used once"
             )
-    gt, bad_gt = drop_invalid(gt)
-    robot, bad_robot = drop_invalid(robot, jumps=False)
+    # (the GT without duplicates is another stream: its impossible samples found again)
+    gt, bad_gt = drop_invalid(gt, found=found[0] if gt is streams[0] else None)
+    robot, bad_robot = drop_invalid(robot, jumps=False, found=found[1])
     if bad_gt:
         notes.append(f"{bad_gt} GT sample(s) with NaN, zero-norm or impossible poses ignored")
     if bad_gt or bad_robot:

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Any, BinaryIO
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import I64, U8
+from ertools.arrays import I64, U8, fresh_concat, fresh_repeat
 from ertools.errors import BagError
 from ertools.inputs import open_regular
 from ertools.io import pipeline
@@ -511,12 +511,13 @@ def _ordered(sels: list[tuple[int, int, int, I64, I64, int]], chunks: list[list[
     if not sels:
         e = np.empty(0, np.int64)
         return McapPlan(e, e, e, chunks, np.empty(0, np.uint16))
-    t_all = np.concatenate([s[3] for s in sels])
-    off_all = np.concatenate([s[4] for s in sels])
-    # file, chunk and chunk offset of every row: one repeat each, not an array per chunk
+    # (into memory that comes in huge pages: an hour's columns are a few MB each)
+    t_all = fresh_concat([s[3] for s in sels], np.int64)
+    off_all = fresh_concat([s[4] for s in sels], np.int64)
+    # file, chunk and chunk offset of every row: one fill per chunk, not an array per chunk
     counts = np.array([len(s[3]) for s in sels], dtype=np.int64)
-    key = np.repeat(np.array([(s[0] << 32) + s[1] for s in sels], dtype=np.int64), counts)
-    channel = np.repeat(np.array([s[5] for s in sels], dtype=np.uint16), counts)
+    key = fresh_repeat([(s[0] << 32) + s[1] for s in sels], counts.tolist(), np.int64)
+    channel = fresh_repeat([s[5] for s in sels], counts.tolist(), np.uint16)
     # One channel logged in time order is in that order already: no sort (times that
     # strictly increase need no other key).
     if bool(np.all(t_all[1:] > t_all[:-1])):

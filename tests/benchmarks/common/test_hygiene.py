@@ -11,6 +11,7 @@ from ertools.benchmarks.common.hygiene import (
     drop_repeats,
     identical_poses,
     impossible_samples,
+    impossible_warning,
     repeated_positions,
     rows_equal,
     same_rows,
@@ -165,3 +166,22 @@ def test_drop_invalid_and_the_validity_codes_agree() -> None:
     assert dropped == 2 and len(kept) == 1198
     codes = sample_codes(t, xyz, quat).codes
     assert codes[100] == FAR and codes[600] == JUMP and int(np.count_nonzero(codes)) == 2
+
+
+def test_impossible_samples_found_once_serve_the_warning_and_the_drop() -> None:
+    """What the trajectory benchmark does with an hour of GT: the impossible samples found
+    once, given to both; the same warning and the same stream as each finding them again."""
+    t, xyz = _walk(1200, 0.5)
+    xyz[100] = [1e300, 0, 0]  # every value finite: found column by column
+    xyz[600, 1] += 1.0
+    stream = PoseStream(t, xyz, np.tile([0.0, 0.0, 0.0, 1.0], (1200, 1)), source="gt")
+    found = impossible_samples(t, xyz)
+    assert np.flatnonzero(found.far).tolist() == [100]
+    assert np.flatnonzero(found.jump).tolist() == [600]
+    warning = impossible_warning(stream, found=found)
+    assert warning is not None and warning == impossible_warning(stream)
+    kept, dropped = drop_invalid(stream, found=found)
+    again, dropped_again = drop_invalid(stream)
+    assert dropped == dropped_again == 2
+    assert np.array_equal(kept.t_ns, again.t_ns) and np.array_equal(kept.xyz, again.xyz)
+    assert np.array_equal(kept.t_ns, np.delete(t, [100, 600]))
