@@ -1,5 +1,6 @@
-"""How a HOPF score is computed (the options, as data), its defaults and the script versions
-``--rules`` reproduces. NumPy-free: the declaration and ``--help`` import it.
+"""How a HOPF score is computed: its inputs (the options of ``ertools score hopf``, the
+manifest keys), the options they make (every check in :func:`make_options`), the defaults and
+the script versions ``--rules`` reproduces. NumPy-free: the declaration and ``--help`` import it.
 """
 
 from __future__ import annotations
@@ -9,11 +10,20 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ertools.benchmarks.base import Input, resolve_values
 from ertools.benchmarks.common.inputs import (
     DEFAULT_CONFIDENCE,
     DEFAULT_DRAWS,
     DEFAULT_SEED,
+    INTERVAL_INPUTS,
     check_confidence,
+)
+from ertools.benchmarks.common.script_inputs import (
+    DEFAULT_MAX_GAP_S,
+    GT_GAPS,
+    MAX_GAP,
+    RESULT,
+    SCRIPT_GROUP,
 )
 from ertools.errors import UsageError
 
@@ -33,9 +43,6 @@ SCRIPT_TEXT = {
 }
 RULE_SETS = ("ertools", *SCRIPTS)
 
-#: The ground truth's samples may be this far apart around the lookup's moment (ertools' rule):
-#: the mocap runs at 100-120 Hz, so 0.1 s is several lost frames.
-DEFAULT_MAX_GAP_S = 0.1
 #: The translation term's clip (ertools' rule): 1 m, as the 2015 rulebook's FBM1.
 CLIP_TRANSLATION_M = 1.0
 
@@ -80,12 +87,68 @@ class HopfOptions:
         return SCRIPTS.get(self.rules)
 
 
-def make_options(values: Mapping[str, Any]) -> HopfOptions:
-    """Resolved input values (:func:`ertools.benchmarks.base.resolve_values`) -> options.
+INPUTS = (
+    Input(
+        "items",
+        "path",
+        "items_with_pose.yaml, the items the script drew from (default: beside the bag or in "
+        "the RSBB layout)",
+        metavar="FILE",
+    ),
+    Input(
+        "config",
+        "path",
+        "HOPF.yaml, the benchmark config (default: beside the bag, the layout, or the result "
+        "file's params)",
+        metavar="FILE",
+    ),
+    RESULT,
+    MAX_GAP,
+    Input(
+        "rules",
+        "choice",
+        "reproduce a script version whole: 2019 (rsbb 2bb8a41, 2018-19), 2017 (Enri2077/rsbb "
+        "00e3106, December 2017 to May 2018), 2017-11 (b5d91f4, November 2017); ertools "
+        "(default): the options of this group decide",
+        choices=RULE_SETS,
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "clip_translation",
+        "choice",
+        "the translation term: clipped at 1 m (default) or none (the script: pose scores below 0)",
+        choices=("1", "none"),
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "single_wrap", "flag", "wrap the theta error by one step, as the script", group=SCRIPT_GROUP
+    ),
+    Input(
+        "exact_names",
+        "flag",
+        "compare class and instance with their surrounding blanks, as the script",
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "stopped_goals",
+        "choice",
+        "ertools (default): totals over the goals answered or timed out; 2019: divided by the "
+        "goals begun, stale after a stop before a goal",
+        choices=("ertools", "2019"),
+        group=SCRIPT_GROUP,
+    ),
+    GT_GAPS,
+    *INTERVAL_INPUTS,
+)
+
+
+def make_options(given: Mapping[str, Any]) -> HopfOptions:
+    """The values of :data:`INPUTS` by name -> options (declared checks, then these).
 
     Raises:
-        UsageError: options that exclude each other.
+        UsageError: a bad value, or options that exclude each other.
     """
+    values = resolve_values(INPUTS, given)
     rules = values.get("rules") or "ertools"
     script = rules != "ertools"
     clip = values.get("clip_translation") or "1"

@@ -1,5 +1,6 @@
-"""How an HPPF score is computed (the options, as data), its defaults and the script version
-``--rules 2019`` reproduces.
+"""How an HPPF score is computed: its inputs (the options of ``ertools score hppf``, the
+manifest keys), the options they make (every check in :func:`make_options`), the defaults and
+the script version ``--rules 2019`` reproduces. NumPy-free: the declaration imports it.
 """
 
 from __future__ import annotations
@@ -9,11 +10,20 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ertools.benchmarks.base import Input, resolve_values
 from ertools.benchmarks.common.inputs import (
     DEFAULT_CONFIDENCE,
     DEFAULT_DRAWS,
     DEFAULT_SEED,
+    INTERVAL_INPUTS,
     check_confidence,
+)
+from ertools.benchmarks.common.script_inputs import (
+    DEFAULT_MAX_GAP_S,
+    GT_GAPS,
+    MAX_GAP,
+    RESULT,
+    SCRIPT_GROUP,
 )
 from ertools.errors import UsageError
 
@@ -25,10 +35,6 @@ SCRIPT_TEXT = {
     "2019": "fbm4_people_perception.py at rockin-robot-challenge/rsbb 2bb8a41 (2018-19 season)",
 }
 RULE_SETS = ("ertools", *SCRIPTS)
-
-#: The ground truth's samples may be this far apart around the lookup's moment (ertools' rule):
-#: the mocap runs at 100-120 Hz, so 0.1 s is several lost frames.
-DEFAULT_MAX_GAP_S = 0.1
 
 
 @dataclass(frozen=True)
@@ -64,12 +70,42 @@ class HppfOptions:
         return SCRIPTS.get(self.rules)
 
 
-def make_options(values: Mapping[str, Any]) -> HppfOptions:
-    """Resolved input values (:func:`ertools.benchmarks.base.resolve_values`) -> options.
+INPUTS = (
+    Input(
+        "config",
+        "path",
+        "HPPF.yaml, its people (default: beside the bag, the layout, or the run's first live "
+        "score)",
+        metavar="FILE",
+    ),
+    RESULT,
+    MAX_GAP,
+    Input(
+        "rules",
+        "choice",
+        "reproduce the script whole: 2019 (rsbb 2bb8a41, 2018-19); ertools (default): the "
+        "options of this group decide",
+        choices=RULE_SETS,
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "exact_names",
+        "flag",
+        "compare the names lower-cased with their surrounding blanks, as the script",
+        group=SCRIPT_GROUP,
+    ),
+    GT_GAPS,
+    *INTERVAL_INPUTS,
+)
+
+
+def make_options(given: Mapping[str, Any]) -> HppfOptions:
+    """The values of :data:`INPUTS` by name -> options (declared checks, then these).
 
     Raises:
-        UsageError: options that exclude each other.
+        UsageError: a bad value, or options that exclude each other.
     """
+    values = resolve_values(INPUTS, given)
     rules = values.get("rules") or "ertools"
     script = rules != "ertools"
     gaps = values.get("gt_gaps") or "refuse"
