@@ -8,22 +8,17 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 from ertools.benchmarks.base import Input, resolve_values
-from ertools.benchmarks.common.inputs import (
-    DEFAULT_CONFIDENCE,
-    DEFAULT_DRAWS,
-    DEFAULT_SEED,
-    INTERVAL_INPUTS,
-    check_confidence,
-)
+from ertools.benchmarks.common.inputs import INTERVAL_INPUTS
 from ertools.benchmarks.common.script_inputs import (
-    DEFAULT_MAX_GAP_S,
     GT_GAPS,
     MAX_GAP,
     RESULT,
     SCRIPT_GROUP,
+    ScriptOptions,
+    script_values,
 )
 from ertools.errors import UsageError
 
@@ -48,43 +43,27 @@ CLIP_TRANSLATION_M = 1.0
 
 
 @dataclass(frozen=True)
-class HopfOptions:
-    """Everything ``ertools score hopf`` can be told.
+class HopfOptions(ScriptOptions):
+    """Everything ``ertools score hopf`` can be told (:class:`ScriptOptions`, then these).
 
     Attributes:
         items: ``items_with_pose.yaml`` (None: found beside the bag in the RSBB layout).
         config: ``HOPF.yaml`` (None: the result file's ``benchmark_info.params``, or found).
-        result: the run's result file (None: found beside the bag; the live comparison).
-        rules: ``ertools`` (the options below decide) or a key of :data:`SCRIPTS`.
         clip_translation: t clipped at :data:`CLIP_TRANSLATION_M` (False: the script's t).
         single_wrap: theta error wrapped by one step, as the script.
         exact_names: class and instance compared with their blanks, as the script.
         stopped_goals_2019: totals divided by the goals begun, as the script (stale after a
             stop before a goal).
-        gt_gaps: ``refuse`` (no ground truth across a gap wider than ``max_gap_s``) or
-            ``interpolate`` (tf's interpolation, as the script).
-        max_gap_s: see ``gt_gaps``.
-        confidence, draws, seed: the score intervals.
     """
+
+    SCRIPTS: ClassVar[Mapping[str, str]] = SCRIPTS
 
     items: Path | None = None
     config: Path | None = None
-    result: Path | None = None
-    rules: str = "ertools"
     clip_translation: bool = True
     single_wrap: bool = False
     exact_names: bool = False
     stopped_goals_2019: bool = False
-    gt_gaps: str = "refuse"
-    max_gap_s: float = DEFAULT_MAX_GAP_S
-    confidence: float = DEFAULT_CONFIDENCE
-    draws: int = DEFAULT_DRAWS
-    seed: int = DEFAULT_SEED
-
-    @property
-    def script(self) -> str | None:
-        """The script commit reproduced whole (``--rules``), None for ertools' reading."""
-        return SCRIPTS.get(self.rules)
 
 
 INPUTS = (
@@ -155,19 +134,12 @@ def make_options(given: Mapping[str, Any]) -> HopfOptions:
     gaps = values.get("gt_gaps") or "refuse"
     if script and values.get("max_gap") is not None and gaps == "refuse":
         raise UsageError("--max-gap applies to ertools' reading, not to --rules " + rules)
-    max_gap = values.get("max_gap")
     return HopfOptions(
         items=values.get("items"),
         config=values.get("config"),
-        result=values.get("result"),
-        rules=rules,
         clip_translation=clip != "none" and not script,
         single_wrap=bool(values.get("single_wrap")) or script,
         exact_names=bool(values.get("exact_names")) or script,
         stopped_goals_2019=values.get("stopped_goals") == "2019" or script,
-        gt_gaps="interpolate" if script else gaps,
-        max_gap_s=DEFAULT_MAX_GAP_S if max_gap is None else float(max_gap),
-        confidence=check_confidence(values.get("confidence", DEFAULT_CONFIDENCE)),
-        draws=int(values.get("draws", DEFAULT_DRAWS)),
-        seed=int(values.get("seed", DEFAULT_SEED)),
+        **script_values(values),
     )
