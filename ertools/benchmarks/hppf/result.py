@@ -4,42 +4,22 @@ the script's loop, the comparison with the scores the run left, and their output
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any, ClassVar
 
 from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
-from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, uncertainty_rows
+from ertools.benchmarks.common.score_form import GoalIntervals, ScoreFormResult
 from ertools.benchmarks.hppf.goals import PassRecord
 from ertools.fidelity import Deviation
-from ertools.frames import tables_to_frames
-from ertools.rsbb.score import ScoreComparison, score_yaml
-from ertools.serialize import jsonable
+from ertools.rsbb.score import ScoreComparison
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
-
-if TYPE_CHECKING:
-    import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 DISTANCE_KEY = "Distance error"
 
 
-@dataclass(frozen=True)
-class HppfIntervals:
-    """The intervals of the position errors and of the Distance error (the cap's mocap noise).
-
-    Attributes:
-        total: of ``Distance error`` (None: none given).
-        goals: of each goal's position error, by goal number.
-        uncertainty: how they were obtained.
-    """
-
-    total: Interval | None
-    goals: dict[int, Interval | None]
-    uncertainty: Uncertainty
-
-
 @dataclass(frozen=True, eq=False)
-class HppfResult:
+class HppfResult(ScoreFormResult):
     """A scored HPPF run (implements ``BenchmarkResult``).
 
     Attributes:
@@ -61,7 +41,7 @@ class HppfResult:
     rules: str = "ertools"
     crashed: str | None = None
     comparison: ScoreComparison | None = None
-    intervals: HppfIntervals | None = None
+    intervals: GoalIntervals | None = None
     origin_ns: int | None = None
     end: str = ""
     notes: tuple[str, ...] = ()
@@ -70,6 +50,9 @@ class HppfResult:
     failures: tuple[str, ...] = ()
     provenance: Provenance = field(default_factory=Provenance)
     name: str = "hppf"
+
+    TOTAL: ClassVar[str] = DISTANCE_KEY
+    GOAL_SCORE: ClassVar[str] = "position_error"
 
     @property
     def distance_error(self) -> float | None:
@@ -83,25 +66,6 @@ class HppfResult:
         if any(p.position_error is not None for p in self.passes):
             return False
         return any(p.status == "unscoreable" for p in self.passes)
-
-    def _extras(self) -> dict[str, Any]:
-        iv = self.intervals
-        if iv is None:
-            return {}
-        return {
-            "Distance error interval": None if iv.total is None else iv.total.as_list(),
-            "uncertainty": iv.uncertainty.to_dict(),
-        }
-
-    def to_dict(self) -> dict[str, Any]:
-        """The score (result-file form), then the intervals."""
-        data: dict[str, Any] = jsonable({**self.score, **self._extras()})
-        return data
-
-    def to_yaml(self) -> str:
-        """The score as the BmBox wrote it into the result file (keys sorted), then the
-        intervals."""
-        return score_yaml({**self.score, **self._extras()})
 
     def interval_lines(self) -> list[str]:
         """The stderr lines of the intervals (millimetres)."""
@@ -171,13 +135,4 @@ class HppfResult:
                 "crashed": self.crashed,
             }
         ]
-        out: dict[str, Rows] = {"goals": rows, "summary": summary}
-        if self.comparison is not None:
-            out["comparison"] = self.comparison.rows()
-        if self.intervals is not None:
-            out["uncertainty"] = uncertainty_rows(self.intervals.uncertainty)
-        return out
-
-    def to_frames(self) -> dict[str, pd.DataFrame]:
-        """Every table of :meth:`tables` as a pandas DataFrame."""
-        return tables_to_frames(self.tables())
+        return self.closing_tables(rows, summary)
