@@ -8,7 +8,7 @@ run left, how the intervals were obtained.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 from ertools.benchmarks.base import Rows
@@ -20,7 +20,9 @@ from ertools.benchmarks.common.uncertainty import (
     uncertainty_rows,
 )
 from ertools.benchmarks.results import ResultBase
+from ertools.fidelity import Deviation
 from ertools.rsbb.score import ScoreComparison, score_yaml
+from ertools.streams import Provenance
 
 
 @dataclass(frozen=True)
@@ -52,17 +54,38 @@ def nested_intervals(
     return out
 
 
+@dataclass(frozen=True, eq=False)
 class ScoreFormResult(ResultBase):
-    """:meth:`listing` and :meth:`to_yaml` of a result in the score form; the benchmark's
-    result names its total (``TOTAL``) and where a goal's score stands under ``goal_<i>``
-    (``GOAL_SCORE``, dotted)."""
+    """What a scored run of an RSBB script holds besides its goals, and its :meth:`listing`
+    in the score form; the benchmark's result adds its goals and ``name``, and names its
+    total (``TOTAL``) and where a goal's score stands under ``goal_<i>`` (``GOAL_SCORE``).
+
+    Attributes:
+        score: the result file's ``score`` by the rules (``--rules``: the script's last save).
+        rules: ``ertools`` or the script version reproduced (``2019``...).
+        crashed: why the script died on this run (``--rules``), None when it did not.
+        comparison: the score against the live score and the result file (None: neither).
+        intervals: the scores' intervals (None with ``--draws 0`` or nothing scored).
+        origin_ns: the bag's first message (table times count from it).
+        end: how the benchmark ended (``end``, ``stop``, ``global_timeout``, ``log_ends``).
+        notes: what the scoring says on stderr.
+    """
 
     TOTAL: ClassVar[str]
     GOAL_SCORE: ClassVar[str]
 
     score: dict[str, Any]
-    intervals: GoalIntervals | None
-    comparison: ScoreComparison | None
+    rules: str = "ertools"
+    crashed: str | None = None
+    comparison: ScoreComparison | None = None
+    intervals: GoalIntervals | None = None
+    origin_ns: int | None = None
+    end: str = ""
+    notes: tuple[str, ...] = ()
+    warnings: tuple[str, ...] = ()
+    deviations: tuple[Deviation, ...] = ()
+    failures: tuple[str, ...] = ()
+    provenance: Provenance = field(default_factory=Provenance)
 
     def listing(self) -> dict[Any, Any]:
         """The score (result-file form), the intervals beside, then how they were obtained."""

@@ -3,48 +3,26 @@ comparison with the scores the run left, and their YAML/JSON/CSV forms."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
-from ertools.benchmarks.common.score_form import GoalIntervals, ScoreFormResult
+from ertools.benchmarks.common.score_form import ScoreFormResult
 from ertools.benchmarks.hopf.goals import GoalRecord
-from ertools.fidelity import Deviation
-from ertools.rsbb.score import ScoreComparison
-from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
 
 
 @dataclass(frozen=True, eq=False)
 class HopfResult(ScoreFormResult):
-    """A scored HOPF run (implements ``BenchmarkResult``).
+    """A scored HOPF run (implements ``BenchmarkResult``): :class:`ScoreFormResult`'s fields
+    (its intervals: the pose scores'), then these.
 
     Attributes:
-        score: the result file's ``score`` by the rules (``--rules``: the script's last save).
         goals: one record per iteration the run began.
-        rules: ``ertools`` or the script version reproduced (``2019``...).
-        crashed: why the script died on this run (``--rules``), None when it did not.
-        comparison: the score against the live score and the result file (None: neither).
-        intervals: the pose scores' intervals (None with ``--draws 0`` or nothing scored).
-        origin_ns: the bag's first message (table times count from it).
-        end: how the benchmark ended (``end``, ``stop``, ``global_timeout``, ``log_ends``).
-        notes: what the scoring says on stderr.
     """
 
-    score: dict[str, Any]
-    goals: tuple[GoalRecord, ...]
-    rules: str = "ertools"
-    crashed: str | None = None
-    comparison: ScoreComparison | None = None
-    intervals: GoalIntervals | None = None
-    origin_ns: int | None = None
-    end: str = ""
-    notes: tuple[str, ...] = ()
-    warnings: tuple[str, ...] = ()
-    deviations: tuple[Deviation, ...] = ()
-    failures: tuple[str, ...] = ()
-    provenance: Provenance = field(default_factory=Provenance)
+    goals: tuple[GoalRecord, ...] = ()
     name: str = "hopf"
 
     TOTAL: ClassVar[str] = "pose_score"

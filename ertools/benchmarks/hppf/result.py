@@ -3,16 +3,13 @@ the script's loop, the comparison with the scores the run left, and their output
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from dataclasses import dataclass
+from typing import ClassVar
 
 from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
-from ertools.benchmarks.common.score_form import GoalIntervals, ScoreFormResult
+from ertools.benchmarks.common.score_form import ScoreFormResult
 from ertools.benchmarks.hppf.goals import PassRecord
-from ertools.fidelity import Deviation
-from ertools.rsbb.score import ScoreComparison
-from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
 
 DISTANCE_KEY = "Distance error"
@@ -20,35 +17,16 @@ DISTANCE_KEY = "Distance error"
 
 @dataclass(frozen=True, eq=False)
 class HppfResult(ScoreFormResult):
-    """A scored HPPF run (implements ``BenchmarkResult``).
+    """A scored HPPF run (implements ``BenchmarkResult``): :class:`ScoreFormResult`'s fields
+    (its intervals: the position errors' and the Distance error's), then these.
 
     Attributes:
-        score: the result file's ``score`` by the rules (``--rules 2019``: the last save).
         passes: one record per pass of the script's loop (a restarted goal has two).
         people: the config's people (N).
-        rules: ``ertools`` or ``2019``.
-        crashed: why the script died on this run (``--rules``), None when it did not.
-        comparison: the score against the live score and the result file.
-        intervals: the position errors' intervals (None with ``--draws 0`` or none scored).
-        origin_ns: the bag's first message (table times count from it).
-        end: how the benchmark ended.
-        notes: what the scoring says on stderr.
     """
 
-    score: dict[str, Any]
-    passes: tuple[PassRecord, ...]
+    passes: tuple[PassRecord, ...] = ()
     people: tuple[str, ...] = ()
-    rules: str = "ertools"
-    crashed: str | None = None
-    comparison: ScoreComparison | None = None
-    intervals: GoalIntervals | None = None
-    origin_ns: int | None = None
-    end: str = ""
-    notes: tuple[str, ...] = ()
-    warnings: tuple[str, ...] = ()
-    deviations: tuple[Deviation, ...] = ()
-    failures: tuple[str, ...] = ()
-    provenance: Provenance = field(default_factory=Provenance)
     name: str = "hppf"
 
     TOTAL: ClassVar[str] = DISTANCE_KEY
