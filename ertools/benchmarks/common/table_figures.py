@@ -15,7 +15,7 @@ import numpy as np
 
 from ertools.benchmarks import registry
 from ertools.views import units
-from ertools.views.chart import Arrows, Axis, Chart, Layer, Line, Scatter, Text
+from ertools.views.chart import Arrows, Axis, Bars, Chart, Layer, Line, Scatter, Text
 from ertools.views.spec import ChartSpec
 
 # Colours by answer quality (colour-blind safe pairs).
@@ -46,6 +46,36 @@ def quality(answered: bool, class_ok: bool | None, instance_ok: bool | None) -> 
     if not class_ok:
         return WRONG_CLASS
     return RIGHT if instance_ok else WRONG_INSTANCE
+
+
+def errors_chart(
+    unit: str, ticks: Sequence[int], rows: Sequence[tuple[int, float, float]]
+) -> Chart:
+    """Translation error (left, mm, logarithmic beyond 10 mm) and theta error (right, deg)
+    per ``unit`` (run, goal); ``rows``: (number, translation error in m, |theta error| in
+    degrees) of those that have errors, ``ticks``: every number."""
+    xs = np.array([k for k, _, _ in rows], dtype=float)
+    trans_mm = np.array([t * MM for _, t, _ in rows])
+    theta = np.array([d for _, _, d in rows])
+    width = 0.4
+    top = max(180.0 * 1.05, *theta) if any(t > 20 for t in theta) else 20.0
+    return Chart(
+        (
+            Bars(xs - width / 2, trans_mm, width, ("#7570b3",), units.label("|dxy|", "length")),
+            Bars(
+                xs + width / 2,
+                theta,
+                width,
+                ("#e7298a",),
+                units.label("|dtheta|", "angle"),
+                side="right",
+            ),
+        ),
+        x=Axis(unit, ticks=tuple((float(k), str(k)) for k in ticks)),
+        y=Axis(units.label("translation error", "length"), include_zero=True, symlog=10.0),
+        right=Axis(units.label("theta error", "angle"), limits=(0.0, top)),
+        grid="y",
+    )
 
 
 def _arrow(x: float, y: float, yaw: float, colour: str) -> Arrows:

@@ -16,11 +16,11 @@ from ertools.benchmarks.common.table_figures import (
     MM,
     QUALITIES,
     Placed,
+    errors_chart,
     quality,
     table_chart,
     table_figures,
 )
-from ertools.views import units
 from ertools.views.chart import Axis, Bars, Chart, Layer, RefLine, Scatter, Text
 from ertools.views.spec import ChartSpec
 
@@ -57,31 +57,13 @@ def scores_chart(result: Any) -> Chart:
     )
 
 
-def errors_chart(result: Any) -> Chart:
-    """Translation error (left, mm, logarithmic beyond 10 mm) and theta error (right, deg)."""
-    runs = [r for r in result.runs if r.errors is not None]
-    xs = np.array([r.index for r in runs], dtype=float)
-    trans_mm = np.array([r.errors.trans_error_m * MM for r in runs])
-    theta = np.array([abs(r.errors.theta_error_deg) for r in runs])
-    width = 0.4
-    top = max(180.0 * 1.05, *theta) if any(t > 20 for t in theta) else 20.0
-    return Chart(
-        (
-            Bars(xs - width / 2, trans_mm, width, ("#7570b3",), units.label("|dxy|", "length")),
-            Bars(
-                xs + width / 2,
-                theta,
-                width,
-                ("#e7298a",),
-                units.label("|dtheta|", "angle"),
-                side="right",
-            ),
-        ),
-        x=Axis("run", ticks=tuple((float(r.index), str(r.index)) for r in result.runs)),
-        y=Axis(units.label("translation error", "length"), include_zero=True, symlog=10.0),
-        right=Axis(units.label("theta error", "angle"), limits=(0.0, top)),
-        grid="y",
-    )
+def _errors(result: Any) -> Chart:
+    rows = [
+        (r.index, r.errors.trans_error_m, abs(r.errors.theta_error_deg))
+        for r in result.runs
+        if r.errors is not None
+    ]
+    return errors_chart("run", [r.index for r in result.runs], rows)
 
 
 def _pose(answer: Any) -> tuple[float, float, float]:
@@ -112,4 +94,4 @@ def _table(result: Any) -> Chart:
 
 def figure_specs(result: Any) -> list[ChartSpec]:
     """The FBM1 figures of a result (``Fbm1Result``)."""
-    return table_figures(result, "run", (scores_chart, errors_chart, _table))
+    return table_figures(result, "run", (scores_chart, _errors, _table))

@@ -12,14 +12,13 @@ import numpy as np
 
 from ertools.benchmarks.common.table_figures import (
     EMPTY,
-    MM,
     QUALITIES,
     Placed,
+    errors_chart,
     quality,
     table_chart,
     table_figures,
 )
-from ertools.views import units
 from ertools.views.chart import Axis, Bars, Chart, Layer, RefLine, Scatter, Text
 from ertools.views.spec import ChartSpec
 
@@ -58,31 +57,13 @@ def scores_chart(result: Any) -> Chart:
     )
 
 
-def errors_chart(result: Any) -> Chart:
-    """Translation error (left, mm, logarithmic beyond 10 mm) and theta error (right, deg)."""
-    goals = [g for g in result.goals if g.terms is not None and math.isfinite(g.terms[0])]
-    xs = np.array([g.index for g in goals], dtype=float)
-    trans = np.array([math.hypot(g.terms[0], g.terms[1]) * MM for g in goals])
-    theta = np.array([abs(math.degrees(g.terms[2])) for g in goals])
-    width = 0.4
-    top = max(180.0 * 1.05, *theta) if any(t > 20 for t in theta) else 20.0
-    return Chart(
-        (
-            Bars(xs - width / 2, trans, width, ("#7570b3",), units.label("|dxy|", "length")),
-            Bars(
-                xs + width / 2,
-                theta,
-                width,
-                ("#e7298a",),
-                units.label("|dtheta|", "angle"),
-                side="right",
-            ),
-        ),
-        x=Axis("goal", ticks=tuple((float(g.index), str(g.index)) for g in result.goals)),
-        y=Axis(units.label("translation error", "length"), include_zero=True, symlog=10.0),
-        right=Axis(units.label("theta error", "angle"), limits=(0.0, top)),
-        grid="y",
-    )
+def _errors(result: Any) -> Chart:
+    rows = [
+        (g.index, math.hypot(g.terms[0], g.terms[1]), abs(math.degrees(g.terms[2])))
+        for g in result.goals
+        if g.terms is not None and math.isfinite(g.terms[0])
+    ]
+    return errors_chart("goal", [g.index for g in result.goals], rows)
 
 
 def _table(result: Any) -> Chart:
@@ -100,4 +81,4 @@ def _table(result: Any) -> Chart:
 
 def figure_specs(result: Any) -> list[ChartSpec]:
     """The HOPF figures of a result (``HopfResult``)."""
-    return table_figures(result, "goal", (scores_chart, errors_chart, _table))
+    return table_figures(result, "goal", (scores_chart, _errors, _table))
