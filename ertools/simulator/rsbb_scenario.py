@@ -135,6 +135,40 @@ class RsbbScenario:
         return self.t_connect_ns + 200 * MS
 
 
+def stopped_run(
+    code: str,
+    team: str,
+    times_ns: tuple[int, int, int],
+    *,
+    manual_operations: Sequence[ManualOperation],
+    goals: Sequence[Goal],
+    broadcasts: Sequence[Broadcast],
+    saves: Sequence[Save],
+    params: Any,
+    bodies: Sequence[Body],
+) -> RsbbScenario:
+    """Run 1 of ``team`` in the 2019 season (a sample run), connected, started and stopped
+    by the referee at ``times_ns``, who left a second after the stop."""
+    t_connect_ns, t_start_ns, t_stop_ns = times_ns
+    return RsbbScenario(
+        code=code,
+        team=team,
+        run=1,
+        season="2019",
+        t_connect_ns=t_connect_ns,
+        t_start_ns=t_start_ns,
+        t_end_ns=t_stop_ns,
+        end="stop",
+        t_disconnect_ns=t_stop_ns + 1_000 * MS,
+        manual_operations=tuple(manual_operations),
+        goals=tuple(goals),
+        broadcasts=tuple(broadcasts),
+        saves=tuple(saves),
+        params=params,
+        bodies=tuple(bodies),
+    )
+
+
 def local_time(sc: RsbbScenario, t_ns: int) -> datetime:
     """``t_ns`` in the RSBB machine's time zone."""
     zone = timezone(timedelta(seconds=sc.utc_offset_s), sc.tz_name)

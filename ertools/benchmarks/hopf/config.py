@@ -1,5 +1,6 @@
-"""How a HOPF score is computed (the options, as data), its defaults and the script versions
-``--rules`` reproduces. NumPy-free: the declaration and ``--help`` import it.
+"""How a HOPF score is computed: its inputs (the options of ``ertools score hopf``, the
+manifest keys), the options they make (every check in :func:`make_options`), the defaults and
+the script versions ``--rules`` reproduces. NumPy-free: the declaration and ``--help`` import it.
 """
 
 from __future__ import annotations
@@ -7,13 +8,17 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
-from ertools.benchmarks.common.inputs import (
-    DEFAULT_CONFIDENCE,
-    DEFAULT_DRAWS,
-    DEFAULT_SEED,
-    check_confidence,
+from ertools.benchmarks.base import Input, resolve_values
+from ertools.benchmarks.common.inputs import INTERVAL_INPUTS
+from ertools.benchmarks.common.script_inputs import (
+    GT_GAPS,
+    MAX_GAP,
+    RESULT,
+    SCRIPT_GROUP,
+    ScriptOptions,
+    script_values,
 )
 from ertools.errors import UsageError
 
@@ -33,78 +38,108 @@ SCRIPT_TEXT = {
 }
 RULE_SETS = ("ertools", *SCRIPTS)
 
-#: The ground truth's samples may be this far apart around the lookup's moment (ertools' rule):
-#: the mocap runs at 100-120 Hz, so 0.1 s is several lost frames.
-DEFAULT_MAX_GAP_S = 0.1
 #: The translation term's clip (ertools' rule): 1 m, as the 2015 rulebook's FBM1.
 CLIP_TRANSLATION_M = 1.0
 
 
 @dataclass(frozen=True)
-class HopfOptions:
-    """Everything ``ertools score hopf`` can be told.
+class HopfOptions(ScriptOptions):
+    """Everything ``ertools score hopf`` can be told (:class:`ScriptOptions`, then these).
 
     Attributes:
         items: ``items_with_pose.yaml`` (None: found beside the bag in the RSBB layout).
         config: ``HOPF.yaml`` (None: the result file's ``benchmark_info.params``, or found).
-        result: the run's result file (None: found beside the bag; the live comparison).
-        rules: ``ertools`` (the options below decide) or a key of :data:`SCRIPTS`.
         clip_translation: t clipped at :data:`CLIP_TRANSLATION_M` (False: the script's t).
         single_wrap: theta error wrapped by one step, as the script.
         exact_names: class and instance compared with their blanks, as the script.
         stopped_goals_2019: totals divided by the goals begun, as the script (stale after a
             stop before a goal).
-        gt_gaps: ``refuse`` (no ground truth across a gap wider than ``max_gap_s``) or
-            ``interpolate`` (tf's interpolation, as the script).
-        max_gap_s: see ``gt_gaps``.
-        confidence, draws, seed: the score intervals.
     """
+
+    SCRIPTS: ClassVar[Mapping[str, str]] = SCRIPTS
 
     items: Path | None = None
     config: Path | None = None
-    result: Path | None = None
-    rules: str = "ertools"
     clip_translation: bool = True
     single_wrap: bool = False
     exact_names: bool = False
     stopped_goals_2019: bool = False
-    gt_gaps: str = "refuse"
-    max_gap_s: float = DEFAULT_MAX_GAP_S
-    confidence: float = DEFAULT_CONFIDENCE
-    draws: int = DEFAULT_DRAWS
-    seed: int = DEFAULT_SEED
-
-    @property
-    def script(self) -> str | None:
-        """The script commit reproduced whole (``--rules``), None for ertools' reading."""
-        return SCRIPTS.get(self.rules)
 
 
-def make_options(values: Mapping[str, Any]) -> HopfOptions:
-    """Resolved input values (:func:`ertools.benchmarks.base.resolve_values`) -> options.
+INPUTS = (
+    Input(
+        "items",
+        "path",
+        "items_with_pose.yaml, the items the script drew from (default: beside the bag or in "
+        "the RSBB layout)",
+        metavar="FILE",
+    ),
+    Input(
+        "config",
+        "path",
+        "HOPF.yaml, the benchmark config (default: beside the bag, the layout, or the result "
+        "file's params)",
+        metavar="FILE",
+    ),
+    RESULT,
+    MAX_GAP,
+    Input(
+        "rules",
+        "choice",
+        "reproduce a script version whole: 2019 (rsbb 2bb8a41, 2018-19), 2017 (Enri2077/rsbb "
+        "00e3106, December 2017 to May 2018), 2017-11 (b5d91f4, November 2017); ertools "
+        "(default): the options of this group decide",
+        choices=RULE_SETS,
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "clip_translation",
+        "choice",
+        "the translation term: clipped at 1 m (default) or none (the script: pose scores below 0)",
+        choices=("1", "none"),
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "single_wrap", "flag", "wrap the theta error by one step, as the script", group=SCRIPT_GROUP
+    ),
+    Input(
+        "exact_names",
+        "flag",
+        "compare class and instance with their surrounding blanks, as the script",
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "stopped_goals",
+        "choice",
+        "ertools (default): totals over the goals answered or timed out; 2019: divided by the "
+        "goals begun, stale after a stop before a goal",
+        choices=("ertools", "2019"),
+        group=SCRIPT_GROUP,
+    ),
+    GT_GAPS,
+    *INTERVAL_INPUTS,
+)
+
+
+def make_options(given: Mapping[str, Any]) -> HopfOptions:
+    """The values of :data:`INPUTS` by name -> options (declared checks, then these).
 
     Raises:
-        UsageError: options that exclude each other.
+        UsageError: a bad value, or options that exclude each other.
     """
+    values = resolve_values(INPUTS, given)
     rules = values.get("rules") or "ertools"
     script = rules != "ertools"
     clip = values.get("clip_translation") or "1"
     gaps = values.get("gt_gaps") or "refuse"
     if script and values.get("max_gap") is not None and gaps == "refuse":
         raise UsageError("--max-gap applies to ertools' reading, not to --rules " + rules)
-    max_gap = values.get("max_gap")
     return HopfOptions(
         items=values.get("items"),
         config=values.get("config"),
-        result=values.get("result"),
-        rules=rules,
         clip_translation=clip != "none" and not script,
         single_wrap=bool(values.get("single_wrap")) or script,
         exact_names=bool(values.get("exact_names")) or script,
         stopped_goals_2019=values.get("stopped_goals") == "2019" or script,
-        gt_gaps="interpolate" if script else gaps,
-        max_gap_s=DEFAULT_MAX_GAP_S if max_gap is None else float(max_gap),
-        confidence=check_confidence(values.get("confidence", DEFAULT_CONFIDENCE)),
-        draws=int(values.get("draws", DEFAULT_DRAWS)),
-        seed=int(values.get("seed", DEFAULT_SEED)),
+        **script_values(values),
     )

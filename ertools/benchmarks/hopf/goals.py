@@ -16,12 +16,12 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import yaml
 
 from ertools.benchmarks.hopf.config import CLIP_TRANSLATION_M, HopfOptions
 from ertools.benchmarks.hopf.formula import PoseTerms, pose_terms, totals
 from ertools.benchmarks.hopf.items import HopfItem, HopfItems
 from ertools.benchmarks.hopf.runs import Iteration
+from ertools.rsbb.answers import is_number, parse_answer
 from ertools.rsbb.clock import GoalTimes, goal_times
 from ertools.rsbb.py2 import to_sec
 
@@ -84,30 +84,16 @@ class Answer:
     fatal: bool
 
 
-def _is_number(v: Any) -> bool:
-    if not isinstance(v, int | float):
-        return False
-    try:
-        float(v)
-    except OverflowError:
-        return False
-    return True
-
-
 def read_answer(text: str) -> Answer:
     """The answer's fields, and what the script would have made of them (l. 245-250)."""
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError:
-        return Answer(text, None, None, None, None, None, "the result is not YAML", True)
-    if not isinstance(data, dict):
-        what = "empty" if data is None else f"a {type(data).__name__}, not a mapping"
-        return Answer(text, data, None, None, None, None, f"the result is {what}", True)
+    data, refused = parse_answer(text)
+    if refused is not None:
+        return Answer(text, data, None, None, None, None, refused, True)
     missing = [k for k in ("x", "y", "theta", "class", "instance") if k not in data]
     item_class, instance = data.get("class"), data.get("instance")
     raw: tuple[Any, Any, Any] = (data.get("x"), data.get("y"), data.get("theta"))
     unreadable = [
-        k for k, v in zip(("x", "y", "theta"), raw, strict=True) if k in data and not _is_number(v)
+        k for k, v in zip(("x", "y", "theta"), raw, strict=True) if k in data and not is_number(v)
     ]
     problems = []
     if missing:

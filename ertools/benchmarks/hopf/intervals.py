@@ -18,11 +18,11 @@ import numpy as np
 
 from ertools.arrays import F64
 from ertools.benchmarks.common.interval_output import METHOD
+from ertools.benchmarks.common.score_form import GoalIntervals
 from ertools.benchmarks.common.uncertainty import MOCAP_NOISE, Source, Uncertainty, monte_carlo
 from ertools.benchmarks.hopf.config import CLIP_TRANSLATION_M, HopfOptions
 from ertools.benchmarks.hopf.formula import pose_terms
 from ertools.benchmarks.hopf.goals import Scored
-from ertools.benchmarks.hopf.result import HopfIntervals
 from ertools.rsbb.jitter import DEFAULT_SIGMA_M, DEFAULT_SIGMA_RAD, MocapNoise, mocap_noise
 from ertools.rsbb.tf import TfTrack, euler_yaw
 
@@ -47,7 +47,7 @@ def _noise(bodies: tuple[TfTrack | None, ...]) -> tuple[list[MocapNoise], Source
 
 def hopf_intervals(
     bodies: tuple[TfTrack | None, ...], scored: Scored, options: HopfOptions
-) -> HopfIntervals | None:
+) -> GoalIntervals | None:
     """The intervals of each scored goal's pose score and of the total (None with
     ``--draws 0`` or no scored goal); ``bodies``: the table's and the positioner's tracks."""
     goals = [
@@ -129,4 +129,4 @@ def hopf_intervals(
     uncertainty = Uncertainty(
         options.confidence, METHOD, options.draws, options.seed, (source,), shares
     )
-    return HopfIntervals(ivs[n], {g.index: ivs[k] for k, g in enumerate(goals)}, uncertainty)
+    return GoalIntervals(ivs[n], {g.index: ivs[k] for k, g in enumerate(goals)}, uncertainty)

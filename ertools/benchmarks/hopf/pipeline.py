@@ -29,10 +29,11 @@ from ertools.benchmarks.hopf.runs import HopfRuns, Iteration, find_iterations
 from ertools.errors import ConfigError
 from ertools.fidelity import Deviation
 from ertools.io.summary import summary
-from ertools.rsbb.log import RsbbRun, check_code, read_rsbb_run
-from ertools.rsbb.results import RsbbResult, load_result
+from ertools.rsbb.log import RsbbRun
+from ertools.rsbb.results import RsbbResult
+from ertools.rsbb.run_files import open_run
 from ertools.rsbb.score import compare_scores
-from ertools.rsbb.sidefiles import SideFiles, find_side_files, read_side_yaml
+from ertools.rsbb.sidefiles import SideFiles, read_side_yaml
 from ertools.rsbb.tf import TfTrack, TfTracks, read_tf_tracks, script_poses
 from ertools.rsbb_states import BENCHMARKS
 from ertools.streams import Provenance
@@ -105,30 +106,16 @@ def load(bags: Sequence[Path], options: HopfOptions) -> HopfLogs:
         ConfigError: a side file missing or unreadable, or another benchmark's result file.
         TopicError, BagError: not an RSBB run bag.
     """
-    paths = tuple(Path(b) for b in bags)
-    side = find_side_files(
-        paths[0],
+    opened = open_run(
+        bags,
         CODE,
         want=("config", "items", "result"),
+        say=notice,
         config=options.config,
         items=options.items,
         result=options.result,
     )
-    if side.place.code is not None and side.place.code != CODE:
-        raise ConfigError(
-            f"this bag is a {side.place.code} run (rsbb_logs/{side.place.code}/...), not "
-            f"HOPF's: ertools score {side.place.code.lower()}",
-            path=str(paths[0]),
-        )
-    for line in side.found:
-        notice(line)
-    result_file = load_result(side.result) if side.result is not None else None
-    if result_file is not None and result_file.code != CODE:
-        raise ConfigError(
-            f"the result file is a {result_file.code} run's, not HOPF's", path=result_file.path
-        )
-    run = read_rsbb_run(paths)
-    check_code(run, CODE)  # outside the layout, the live score names the benchmark
+    paths, side, result_file, run = opened.paths, opened.side, opened.result_file, opened.run
     params = script_params(side, run, result_file)
     items = _items(side, params, options)
     tracks = read_tf_tracks(paths)

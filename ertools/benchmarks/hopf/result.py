@@ -3,69 +3,30 @@ comparison with the scores the run left, and their YAML/JSON/CSV forms."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from dataclasses import dataclass
+from typing import Any, ClassVar
 
 from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
-from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, uncertainty_rows
+from ertools.benchmarks.common.score_form import ScoreFormResult
 from ertools.benchmarks.hopf.goals import GoalRecord
-from ertools.fidelity import Deviation
-from ertools.frames import tables_to_frames
-from ertools.rsbb.score import ScoreComparison, score_yaml
-from ertools.serialize import jsonable
-from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
-
-if TYPE_CHECKING:
-    import pandas as pd  # annotations only: pandas is imported by to_frames()
-
-
-@dataclass(frozen=True)
-class HopfIntervals:
-    """The intervals of the pose scores (the mocap noise of the ground truth).
-
-    Attributes:
-        total: of the total ``pose_score`` (None: none given).
-        goals: of each scored goal's pose score, by its ``i``.
-        uncertainty: how they were obtained.
-    """
-
-    total: Interval | None
-    goals: dict[int, Interval | None]
-    uncertainty: Uncertainty
 
 
 @dataclass(frozen=True, eq=False)
-class HopfResult:
-    """A scored HOPF run (implements ``BenchmarkResult``).
+class HopfResult(ScoreFormResult):
+    """A scored HOPF run (implements ``BenchmarkResult``): :class:`ScoreFormResult`'s fields
+    (its intervals: the pose scores'), then these.
 
     Attributes:
-        score: the result file's ``score`` by the rules (``--rules``: the script's last save).
         goals: one record per iteration the run began.
-        rules: ``ertools`` or the script version reproduced (``2019``...).
-        crashed: why the script died on this run (``--rules``), None when it did not.
-        comparison: the score against the live score and the result file (None: neither).
-        intervals: the pose scores' intervals (None with ``--draws 0`` or nothing scored).
-        origin_ns: the bag's first message (table times count from it).
-        end: how the benchmark ended (``end``, ``stop``, ``global_timeout``, ``log_ends``).
-        notes: what the scoring says on stderr.
     """
 
-    score: dict[str, Any]
-    goals: tuple[GoalRecord, ...]
-    rules: str = "ertools"
-    crashed: str | None = None
-    comparison: ScoreComparison | None = None
-    intervals: HopfIntervals | None = None
-    origin_ns: int | None = None
-    end: str = ""
-    notes: tuple[str, ...] = ()
-    warnings: tuple[str, ...] = ()
-    deviations: tuple[Deviation, ...] = ()
-    failures: tuple[str, ...] = ()
-    provenance: Provenance = field(default_factory=Provenance)
+    goals: tuple[GoalRecord, ...] = ()
     name: str = "hopf"
+
+    TOTAL: ClassVar[str] = "pose_score"
+    GOAL_SCORE: ClassVar[str] = "partial_score.pose_score"
 
     @property
     def pose_score(self) -> float | None:
@@ -79,25 +40,6 @@ class HopfResult:
         if any(g.status == "scored" for g in self.goals):
             return False
         return any(g.status == "unscoreable" for g in self.goals)
-
-    def _extras(self) -> dict[str, Any]:
-        iv = self.intervals
-        if iv is None:
-            return {}
-        return {
-            "pose_score_interval": None if iv.total is None else iv.total.as_list(),
-            "uncertainty": iv.uncertainty.to_dict(),
-        }
-
-    def to_dict(self) -> dict[str, Any]:
-        """The score (result-file form), then the intervals."""
-        data: dict[str, Any] = jsonable({**self.score, **self._extras()})
-        return data
-
-    def to_yaml(self) -> str:
-        """The score as the BmBox wrote it into the result file (keys sorted), then the
-        intervals."""
-        return score_yaml({**self.score, **self._extras()})
 
     def interval_lines(self) -> list[str]:
         """The stderr lines of the intervals."""
@@ -176,16 +118,7 @@ class HopfResult:
                 "crashed": self.crashed,
             }
         ]
-        out: dict[str, Rows] = {"goals": rows, "summary": summary}
-        if self.comparison is not None:
-            out["comparison"] = self.comparison.rows()
-        if self.intervals is not None:
-            out["uncertainty"] = uncertainty_rows(self.intervals.uncertainty)
-        return out
-
-    def to_frames(self) -> dict[str, pd.DataFrame]:
-        """Every table of :meth:`tables` as a pandas DataFrame."""
-        return tables_to_frames(self.tables())
+        return self.closing_tables(rows, summary)
 
 
 def _text(value: Any) -> str | None:

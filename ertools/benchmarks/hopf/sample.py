@@ -58,8 +58,8 @@ from ertools.simulator.rsbb_scenario import (
     Broadcast,
     Goal,
     ManualOperation,
-    RsbbScenario,
     Save,
+    stopped_run,
 )
 
 S = 1_000_000_000
@@ -371,20 +371,14 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     saves = _live_saves(per_goal, done, _track(table_body), _track(positioner))
     score = saves[-1].score
     saves.append(Save(stop_ns + 5 * MS, _copy(score)))
-    sc = RsbbScenario(
-        code="HOPF",
-        team=TEAM,
-        run=1,
-        season="2019",
-        t_connect_ns=T0,
-        t_start_ns=t_start,
-        t_end_ns=stop_ns,
-        end="stop",
-        t_disconnect_ns=stop_ns + S,
-        manual_operations=tuple(manual),
-        goals=tuple(goals),
-        broadcasts=tuple(broadcasts),
-        saves=tuple(saves),
+    sc = stopped_run(
+        "HOPF",
+        TEAM,
+        (T0, t_start, stop_ns),
+        manual_operations=manual,
+        goals=goals,
+        broadcasts=broadcasts,
+        saves=saves,
         params=PARAMS,
         bodies=(table_body, positioner),
     )

@@ -1,5 +1,6 @@
-"""How an HPPF score is computed (the options, as data), its defaults and the script version
-``--rules 2019`` reproduces.
+"""How an HPPF score is computed: its inputs (the options of ``ertools score hppf``, the
+manifest keys), the options they make (every check in :func:`make_options`), the defaults and
+the script version ``--rules 2019`` reproduces. NumPy-free: the declaration imports it.
 """
 
 from __future__ import annotations
@@ -7,13 +8,17 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
-from ertools.benchmarks.common.inputs import (
-    DEFAULT_CONFIDENCE,
-    DEFAULT_DRAWS,
-    DEFAULT_SEED,
-    check_confidence,
+from ertools.benchmarks.base import Input, resolve_values
+from ertools.benchmarks.common.inputs import INTERVAL_INPUTS
+from ertools.benchmarks.common.script_inputs import (
+    GT_GAPS,
+    MAX_GAP,
+    RESULT,
+    SCRIPT_GROUP,
+    ScriptOptions,
+    script_values,
 )
 from ertools.errors import UsageError
 
@@ -26,65 +31,67 @@ SCRIPT_TEXT = {
 }
 RULE_SETS = ("ertools", *SCRIPTS)
 
-#: The ground truth's samples may be this far apart around the lookup's moment (ertools' rule):
-#: the mocap runs at 100-120 Hz, so 0.1 s is several lost frames.
-DEFAULT_MAX_GAP_S = 0.1
-
 
 @dataclass(frozen=True)
-class HppfOptions:
-    """Everything ``ertools score hppf`` can be told.
+class HppfOptions(ScriptOptions):
+    """Everything ``ertools score hppf`` can be told (:class:`ScriptOptions`, then these).
 
     Attributes:
         config: ``HPPF.yaml`` (None: found, else the first live score's copy).
-        result: the run's result file (None: found beside the bag; the live comparison).
-        rules: ``ertools`` (the options below decide) or ``2019``.
         exact_names: names compared lower-cased with their blanks, as the script.
         script_answers: an incomplete answer kills the script, as it did (``--rules 2019``).
-        gt_gaps: ``refuse`` (no ground truth across a gap wider than ``max_gap_s``) or
-            ``interpolate`` (tf's interpolation, as the script).
-        max_gap_s: see ``gt_gaps``.
-        confidence, draws, seed: the Distance error's intervals.
     """
+
+    SCRIPTS: ClassVar[Mapping[str, str]] = SCRIPTS
 
     config: Path | None = None
-    result: Path | None = None
-    rules: str = "ertools"
     exact_names: bool = False
     script_answers: bool = False
-    gt_gaps: str = "refuse"
-    max_gap_s: float = DEFAULT_MAX_GAP_S
-    confidence: float = DEFAULT_CONFIDENCE
-    draws: int = DEFAULT_DRAWS
-    seed: int = DEFAULT_SEED
-
-    @property
-    def script(self) -> str | None:
-        """The script commit reproduced whole (``--rules``), None for ertools' reading."""
-        return SCRIPTS.get(self.rules)
 
 
-def make_options(values: Mapping[str, Any]) -> HppfOptions:
-    """Resolved input values (:func:`ertools.benchmarks.base.resolve_values`) -> options.
+INPUTS = (
+    Input(
+        "config",
+        "path",
+        "HPPF.yaml, its people (default: beside the bag, the layout, or the run's first live "
+        "score)",
+        metavar="FILE",
+    ),
+    RESULT,
+    MAX_GAP,
+    Input(
+        "rules",
+        "choice",
+        "reproduce the script whole: 2019 (rsbb 2bb8a41, 2018-19); ertools (default): the "
+        "options of this group decide",
+        choices=RULE_SETS,
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "exact_names",
+        "flag",
+        "compare the names lower-cased with their surrounding blanks, as the script",
+        group=SCRIPT_GROUP,
+    ),
+    GT_GAPS,
+    *INTERVAL_INPUTS,
+)
+
+
+def make_options(given: Mapping[str, Any]) -> HppfOptions:
+    """The values of :data:`INPUTS` by name -> options (declared checks, then these).
 
     Raises:
-        UsageError: options that exclude each other.
+        UsageError: a bad value, or options that exclude each other.
     """
+    values = resolve_values(INPUTS, given)
     rules = values.get("rules") or "ertools"
     script = rules != "ertools"
-    gaps = values.get("gt_gaps") or "refuse"
-    max_gap = values.get("max_gap")
-    if script and max_gap is not None:
+    if script and values.get("max_gap") is not None:
         raise UsageError("--max-gap applies to ertools' reading, not to --rules " + rules)
     return HppfOptions(
         config=values.get("config"),
-        result=values.get("result"),
-        rules=rules,
         exact_names=bool(values.get("exact_names")) or script,
         script_answers=script,
-        gt_gaps="interpolate" if script else gaps,
-        max_gap_s=DEFAULT_MAX_GAP_S if max_gap is None else float(max_gap),
-        confidence=check_confidence(values.get("confidence", DEFAULT_CONFIDENCE)),
-        draws=int(values.get("draws", DEFAULT_DRAWS)),
-        seed=int(values.get("seed", DEFAULT_SEED)),
+        **script_values(values),
     )

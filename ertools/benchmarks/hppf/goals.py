@@ -16,7 +16,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import yaml
 
 from ertools.benchmarks.hppf.config import HppfOptions
 from ertools.benchmarks.hppf.formula import (
@@ -26,6 +25,7 @@ from ertools.benchmarks.hppf.formula import (
     recognized_percent,
 )
 from ertools.benchmarks.hppf.runs import Iteration
+from ertools.rsbb.answers import is_number, parse_answer
 from ertools.rsbb.py2 import to_sec
 
 XY = tuple[float, float]
@@ -64,27 +64,13 @@ class Answer:
     fatal: bool
 
 
-def _is_number(v: Any) -> bool:
-    if not isinstance(v, int | float):
-        return False
-    try:
-        float(v)
-    except OverflowError:
-        return False
-    return True
-
-
 def read_answer(text: str) -> Answer:
     """The answer's fields, and whether the script would have died on them (l. 186-190)."""
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError:
-        return Answer(text, None, None, None, "the result is not YAML", True)
-    if not isinstance(data, dict):
-        what = "empty" if data is None else f"a {type(data).__name__}, not a mapping"
-        return Answer(text, None, None, None, f"the result is {what}", True)
+    data, refused = parse_answer(text)
+    if refused is not None:
+        return Answer(text, None, None, None, refused, True)
     missing = [k for k in ("x", "y", "theta", "person_name") if k not in data]
-    bad = [k for k in ("x", "y", "theta") if k in data and not _is_number(data[k])]
+    bad = [k for k in ("x", "y", "theta") if k in data and not is_number(data[k])]
     name = data.get("person_name")
     problems = []
     if missing:
@@ -94,7 +80,7 @@ def read_answer(text: str) -> Answer:
     if "person_name" in data and not isinstance(name, str):
         problems.append(f"person_name {name!r} is no text")
     fatal = bool(problems)
-    xy_ok = all(k in data and _is_number(data[k]) for k in ("x", "y"))
+    xy_ok = all(k in data and is_number(data[k]) for k in ("x", "y"))
     xy = (float(data["x"]), float(data["y"])) if xy_ok else None
     if xy is not None and not all(math.isfinite(v) for v in xy):
         problems.append("x or y is not finite")  # the script went on with it

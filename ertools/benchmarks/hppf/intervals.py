@@ -15,11 +15,12 @@ import numpy as np
 
 from ertools.arrays import F64
 from ertools.benchmarks.common.interval_output import METHOD
+from ertools.benchmarks.common.score_form import GoalIntervals
 from ertools.benchmarks.common.uncertainty import MOCAP_NOISE, Source, Uncertainty, monte_carlo
 from ertools.benchmarks.hppf.config import HppfOptions
 from ertools.benchmarks.hppf.formula import position_errors
 from ertools.benchmarks.hppf.goals import Scored
-from ertools.benchmarks.hppf.result import DISTANCE_KEY, HppfIntervals
+from ertools.benchmarks.hppf.result import DISTANCE_KEY
 from ertools.rsbb.jitter import DEFAULT_SIGMA_M, mocap_noise
 from ertools.rsbb.tf import TfTrack
 
@@ -33,7 +34,7 @@ def _sigma(actor: TfTrack | None) -> tuple[float, Source]:
 
 def hppf_intervals(
     actor: TfTrack | None, scored: Scored, options: HppfOptions
-) -> HppfIntervals | None:
+) -> GoalIntervals | None:
     """The intervals of each position error and of the Distance error (None with
     ``--draws 0`` or no position error)."""
     rows = [
@@ -80,4 +81,4 @@ def hppf_intervals(
     uncertainty = Uncertainty(
         options.confidence, METHOD, options.draws, options.seed, (source,), shares
     )
-    return HppfIntervals(ivs[n], {p.index: ivs[k] for k, p in enumerate(rows)}, uncertainty)
+    return GoalIntervals(ivs[n], {p.index: ivs[k] for k, p in enumerate(rows)}, uncertainty)

@@ -21,10 +21,11 @@ from ertools.benchmarks.hppf.runs import FlowError, HppfRuns, entered, walk
 from ertools.errors import ConfigError
 from ertools.fidelity import Deviation
 from ertools.io.summary import summary
-from ertools.rsbb.log import RsbbRun, check_code, read_rsbb_run
-from ertools.rsbb.results import RsbbResult, load_result
+from ertools.rsbb.log import RsbbRun
+from ertools.rsbb.results import RsbbResult
+from ertools.rsbb.run_files import open_run
 from ertools.rsbb.score import compare_scores
-from ertools.rsbb.sidefiles import SideFiles, find_side_files, read_side_yaml
+from ertools.rsbb.sidefiles import SideFiles, read_side_yaml
 from ertools.rsbb.tf import TfTrack, TfTracks, read_tf_tracks, script_poses
 from ertools.rsbb_states import BENCHMARKS
 from ertools.streams import Provenance
@@ -103,25 +104,15 @@ def load(bags: Sequence[Path], options: HppfOptions) -> HppfLogs:
         ConfigError: a side file missing or unreadable, or another benchmark's.
         TopicError, BagError: not an RSBB run bag.
     """
-    paths = tuple(Path(b) for b in bags)
-    side = find_side_files(
-        paths[0], CODE, want=("config", "result"), config=options.config, result=options.result
+    opened = open_run(
+        bags,
+        CODE,
+        want=("config", "result"),
+        say=notice,
+        config=options.config,
+        result=options.result,
     )
-    if side.place.code is not None and side.place.code != CODE:
-        raise ConfigError(
-            f"this bag is a {side.place.code} run (rsbb_logs/{side.place.code}/...), not "
-            f"HPPF's: ertools score {side.place.code.lower()}",
-            path=str(paths[0]),
-        )
-    for line in side.found:
-        notice(line)
-    result_file = load_result(side.result) if side.result is not None else None
-    if result_file is not None and result_file.code != CODE:
-        raise ConfigError(
-            f"the result file is a {result_file.code} run's, not HPPF's", path=result_file.path
-        )
-    run = read_rsbb_run(paths)
-    check_code(run, CODE)  # outside the layout, the live score names the benchmark
+    paths, side, result_file, run = opened.paths, opened.side, opened.result_file, opened.run
     people, source = _people(side, run, result_file)
     tracks = read_tf_tracks(paths)
     origin = min(summary(p).start_ns for p in paths)

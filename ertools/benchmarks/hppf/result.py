@@ -3,73 +3,34 @@ the script's loop, the comparison with the scores the run left, and their output
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from dataclasses import dataclass
+from typing import ClassVar
 
 from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
-from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, uncertainty_rows
+from ertools.benchmarks.common.score_form import ScoreFormResult
 from ertools.benchmarks.hppf.goals import PassRecord
-from ertools.fidelity import Deviation
-from ertools.frames import tables_to_frames
-from ertools.rsbb.score import ScoreComparison, score_yaml
-from ertools.serialize import jsonable
-from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
-
-if TYPE_CHECKING:
-    import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 DISTANCE_KEY = "Distance error"
 
 
-@dataclass(frozen=True)
-class HppfIntervals:
-    """The intervals of the position errors and of the Distance error (the cap's mocap noise).
-
-    Attributes:
-        total: of ``Distance error`` (None: none given).
-        goals: of each goal's position error, by goal number.
-        uncertainty: how they were obtained.
-    """
-
-    total: Interval | None
-    goals: dict[int, Interval | None]
-    uncertainty: Uncertainty
-
-
 @dataclass(frozen=True, eq=False)
-class HppfResult:
-    """A scored HPPF run (implements ``BenchmarkResult``).
+class HppfResult(ScoreFormResult):
+    """A scored HPPF run (implements ``BenchmarkResult``): :class:`ScoreFormResult`'s fields
+    (its intervals: the position errors' and the Distance error's), then these.
 
     Attributes:
-        score: the result file's ``score`` by the rules (``--rules 2019``: the last save).
         passes: one record per pass of the script's loop (a restarted goal has two).
         people: the config's people (N).
-        rules: ``ertools`` or ``2019``.
-        crashed: why the script died on this run (``--rules``), None when it did not.
-        comparison: the score against the live score and the result file.
-        intervals: the position errors' intervals (None with ``--draws 0`` or none scored).
-        origin_ns: the bag's first message (table times count from it).
-        end: how the benchmark ended.
-        notes: what the scoring says on stderr.
     """
 
-    score: dict[str, Any]
-    passes: tuple[PassRecord, ...]
+    passes: tuple[PassRecord, ...] = ()
     people: tuple[str, ...] = ()
-    rules: str = "ertools"
-    crashed: str | None = None
-    comparison: ScoreComparison | None = None
-    intervals: HppfIntervals | None = None
-    origin_ns: int | None = None
-    end: str = ""
-    notes: tuple[str, ...] = ()
-    warnings: tuple[str, ...] = ()
-    deviations: tuple[Deviation, ...] = ()
-    failures: tuple[str, ...] = ()
-    provenance: Provenance = field(default_factory=Provenance)
     name: str = "hppf"
+
+    TOTAL: ClassVar[str] = DISTANCE_KEY
+    GOAL_SCORE: ClassVar[str] = "position_error"
 
     @property
     def distance_error(self) -> float | None:
@@ -83,25 +44,6 @@ class HppfResult:
         if any(p.position_error is not None for p in self.passes):
             return False
         return any(p.status == "unscoreable" for p in self.passes)
-
-    def _extras(self) -> dict[str, Any]:
-        iv = self.intervals
-        if iv is None:
-            return {}
-        return {
-            "Distance error interval": None if iv.total is None else iv.total.as_list(),
-            "uncertainty": iv.uncertainty.to_dict(),
-        }
-
-    def to_dict(self) -> dict[str, Any]:
-        """The score (result-file form), then the intervals."""
-        data: dict[str, Any] = jsonable({**self.score, **self._extras()})
-        return data
-
-    def to_yaml(self) -> str:
-        """The score as the BmBox wrote it into the result file (keys sorted), then the
-        intervals."""
-        return score_yaml({**self.score, **self._extras()})
 
     def interval_lines(self) -> list[str]:
         """The stderr lines of the intervals (millimetres)."""
@@ -171,13 +113,4 @@ class HppfResult:
                 "crashed": self.crashed,
             }
         ]
-        out: dict[str, Rows] = {"goals": rows, "summary": summary}
-        if self.comparison is not None:
-            out["comparison"] = self.comparison.rows()
-        if self.intervals is not None:
-            out["uncertainty"] = uncertainty_rows(self.intervals.uncertainty)
-        return out
-
-    def to_frames(self) -> dict[str, pd.DataFrame]:
-        """Every table of :meth:`tables` as a pandas DataFrame."""
-        return tables_to_frames(self.tables())
+        return self.closing_tables(rows, summary)

@@ -51,8 +51,8 @@ from ertools.simulator.rsbb_scenario import (
     Broadcast,
     Goal,
     ManualOperation,
-    RsbbScenario,
     Save,
+    stopped_run,
 )
 
 S = 1_000_000_000
@@ -276,19 +276,13 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     manual, goals, casts, saves, score = ev.manual, ev.goals, ev.casts, ev.saves, ev.score
     truth_rows, errors, recognized, exec_ns = ev.truth_rows, ev.errors, ev.recognized, ev.exec_ns
     t_start, stop_ns = ev.t_start, ev.stop_ns
-    sc = RsbbScenario(
-        code="HPPF",
-        team=TEAM,
-        run=1,
-        season="2019",
-        t_connect_ns=T0,
-        t_start_ns=t_start,
-        t_end_ns=stop_ns,
-        end="stop",
-        t_disconnect_ns=stop_ns + S,
-        manual_operations=tuple(manual),
-        goals=tuple(goals),
-        broadcasts=tuple(casts),
+    sc = stopped_run(
+        "HPPF",
+        TEAM,
+        (T0, t_start, stop_ns),
+        manual_operations=manual,
+        goals=goals,
+        broadcasts=casts,
         saves=(*saves, Save(stop_ns + 5 * MS, _copy(score))),
         params=PARAMS,
         bodies=(cap,),
