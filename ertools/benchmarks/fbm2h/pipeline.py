@@ -1,8 +1,9 @@
 """FBM2@Home (navigation, seed 7.2): load -> find reached moments -> score -> result.
 
-:func:`score_runs` is the last stage of ``ertools score fbm2h``; :func:`compute` is the pure
-part (streams and configs in, result out) that tests call directly; reading the log and
-finding the reached moments is :mod:`ertools.benchmarks.fbm2h.logs`.
+The three stages ``load``, ``find_runs`` and ``score_runs`` (what ``ertools score fbm2h``
+runs); :func:`compute` is the pure part (streams and configs in, result out) that tests call
+directly; reading the log and finding the reached moments is
+:mod:`ertools.benchmarks.fbm2h.logs`.
 
 How 2015 scored (``scripts/fbm2h`` of ``benchmark_and_scoring_fbm``, final 2015 version): for
 each waypoint i (segment i, from 0), ``start_segment_time`` when the goal had been sent,
@@ -23,6 +24,7 @@ import logging
 import math
 from collections.abc import Sequence
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import numpy.typing as npt
@@ -41,7 +43,13 @@ from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, TF_2015, Fbm2hOpt
 from ertools.benchmarks.fbm2h.formula import robot_poses_at, segment_errors
 from ertools.benchmarks.fbm2h.goal import GoalList
 from ertools.benchmarks.fbm2h.intervals import with_intervals
-from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, invalid_warning
+from ertools.benchmarks.fbm2h.logs import (
+    Fbm2hLogs,
+    Fbm2hRuns,
+    find_moments,
+    invalid_warning,
+    read_logs,
+)
 from ertools.benchmarks.fbm2h.result import Fbm2hResult, SegmentResult
 from ertools.benchmarks.fbm2h.rules import (
     RULE_ORIENTATION_WRAP,
@@ -443,6 +451,16 @@ def _frozen_warnings(
             f"before (times from {since})"
         )
     return out
+
+
+def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
+    """The configs, the marker set poses and the states (:func:`logs.read_logs`)."""
+    return read_logs(paths, options)
+
+
+def find_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
+    """The reached moments (:func:`logs.find_moments`)."""
+    return find_moments(logs, options)
 
 
 def score_runs(logs: Fbm2hLogs, runs: Fbm2hRuns, options: Fbm2hOptions) -> Fbm2hResult:
