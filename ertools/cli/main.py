@@ -138,8 +138,7 @@ class _Parser(argparse.ArgumentParser):
 
 def command_module(name: str) -> ModuleType:
     """The module of a command (a :class:`Command`'s ``module``), imported now: each command
-    imports only what it runs, and ``ertools --help`` nothing of them. (Import times measured
-    with ``-X importtime`` on a loaded 2-core machine, after this module.)"""
+    imports only what it runs, and ``ertools --help`` nothing of them."""
     match name:
         case "ertools.cli.info":
             from ertools.cli import info  # lazy: only this command, 270 ms
