@@ -29,7 +29,6 @@ from types import ModuleType
 from typing import NoReturn
 
 from ertools._version import __version__
-from ertools.benchmarks.registry import names
 from ertools.cli.command import Command, Delegate
 from ertools.cli.text import error_text, one_line, printable
 from ertools.errors import ErtoolsError, UsageError
@@ -97,6 +96,8 @@ COMMANDS: dict[str, Command] = {
 
 
 def _top_level_help() -> str:
+    from ertools.benchmarks.registry import names  # lazy: the protocols, 10 ms: not --version
+
     width = max(len(name) for name in COMMANDS)
     lines = [
         "usage: ertools [-h] [-V] COMMAND [ARGS...]",
