@@ -33,7 +33,6 @@ from ertools.cli.command import Command, Delegate
 from ertools.cli.text import error_text, one_line, printable
 from ertools.errors import ErtoolsError, UsageError
 from ertools.progress import Bar, clear_current, reporting
-from ertools.timeutil import MAX_SECONDS
 
 COMMANDS: dict[str, Command] = {
     "info": Command("ertools.cli.info", "describe bags like `rosbag info`", "ertools info run.bag"),
@@ -294,6 +293,7 @@ def _refuse_overwriting_inputs(args: argparse.Namespace) -> None:
 
 def _check_numbers(args: argparse.Namespace) -> None:
     """A UsageError for a NaN, infinite or absurdly large number option (`--max-gap nan`)."""
+    from ertools.timeutil import MAX_SECONDS  # lazy: datetime, 3 ms: not for --version
 
     for name, value in vars(args).items():
         for v in value if isinstance(value, list | tuple) else [value]:
