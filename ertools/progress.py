@@ -7,8 +7,8 @@ bytes once per group of chunks (never per message), scoring reports runs.
 
 Only the command line makes a :class:`Bar`: one line on stderr, drawn only when stderr is a
 terminal and the work has lasted ``delay_s``, so short commands print nothing. It is ertools'
-own rather than tqdm's or rich's: both are new dependencies for one line of output, and
-importing them alone costs 25 ms (tqdm) and 32 ms (rich.progress) here (docs/io.md).
+own rather than tqdm's or rich's: both are new dependencies, and import costs, for one line
+of output (docs/io.md).
 """
 
 from __future__ import annotations

@@ -10,24 +10,10 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
-
-class BmBoxState(enum.IntEnum):
-    """``rsbb_benchmarking_messages/BmBoxState``: the seed's Listing 6 numbers, kept by the RSBB.
-
-    The RSBB BmBox never enters COMPLETED_MANUAL_OPERATION or TRANSMITTING_SCORE, and it
-    publishes its state at 10 Hz only (a transition is seen at the next tick).
-    """
-
-    START = 0
-    WAITING_CLIENT = 1
-    READY = 2
-    WAITING_MANUAL_OPERATION = 3
-    COMPLETED_MANUAL_OPERATION = 4
-    TRANSMITTING_GOAL = 5
-    EXECUTING_GOAL = 6
-    WAITING_RESULT = 7
-    TRANSMITTING_SCORE = 8
-    END = 9
+# ``rsbb_benchmarking_messages/BmBoxState`` keeps the seed's Listing 6 numbers: the 2015 enum,
+# written once. The RSBB BmBox never enters COMPLETED_MANUAL_OPERATION or TRANSMITTING_SCORE,
+# and it publishes its state at 10 Hz only (a transition is seen at the next tick).
+from ertools.states import BmBoxState as BmBoxState  # noqa: PLC0414 (re-exported)
 
 
 class RefBoxState(enum.IntEnum):

@@ -66,7 +66,7 @@ def score(seed: int, draws: int) -> tuple[Any, Any]:
     from ertools.benchmarks.common.inputs import IntervalSettings
     from ertools.benchmarks.fbm1.config import Fbm1Options
     from ertools.benchmarks.fbm1.pipeline import score_fbm1
-    from ertools.benchmarks.fbm1.runs import find_runs
+    from ertools.benchmarks.fbm1.runs import runs_from_states
     from ertools.benchmarks.fbm1.sample import item_list, simulate
     from ertools.simulator.statemachine import state_messages
     from ertools.states import Machine
@@ -80,7 +80,7 @@ def score(seed: int, draws: int) -> tuple[Any, Any]:
         streams[body] = PoseStream(pub.t_header_ns, pub.xyz, pub.quat_xyzw, "world", body)
     msgs = state_messages(sim.transitions, end_ns=sim.state_end_ns)
     states = {m: StateStream(m, s.t_ns, s.state, s.payload) for m, s in msgs.items()}
-    found = find_runs(
+    found = runs_from_states(
         states[Machine.BMBOX],
         states.get(Machine.REFBOX),
         states.get(Machine.CLIENT),

@@ -1,6 +1,8 @@
 """The one way a benchmark execution is scored: ``ertools score``, :func:`ertools.score`,
 ``ertools audit`` (recomputing) and ``ertools rescore`` (each job) all call
-:func:`score_execution`, so that they score alike by construction."""
+:func:`score_execution`, so that they score alike by construction; code that holds options
+already (``ertools export``'s trajectory pair, tests) runs the same stages with
+:func:`run_stages`."""
 
 from __future__ import annotations
 
@@ -9,7 +11,16 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ertools.benchmarks.base import AnyBenchmark, Audited, BenchmarkResult
+from ertools.benchmarks.base import (
+    AnyBenchmark,
+    Audited,
+    Benchmark,
+    BenchmarkResult,
+    LoadedT,
+    OptionsT,
+    ResultT,
+    RunsT,
+)
 from ertools.benchmarks.common.which import refuse_other_benchmark
 
 
@@ -53,6 +64,14 @@ def score_execution(
     said: tuple[str, ...] = ()
     if live is not None and isinstance(bench, Audited):
         options, said = bench.from_live(options, live)
-    loaded = bench.load(logs, options)
-    result: BenchmarkResult = bench.score_runs(loaded, bench.find_runs(loaded, options), options)
+    result: BenchmarkResult = run_stages(bench, logs, options)
     return Scored(result, options, said)
+
+
+def run_stages(
+    bench: Benchmark[OptionsT, LoadedT, RunsT, ResultT], logs: Sequence[Path], options: OptionsT
+) -> ResultT:
+    """The benchmark's three stages on options already made: logs loaded -> runs found ->
+    the result (what :func:`score_execution` runs after ``make_options``)."""
+    loaded = bench.load(logs, options)
+    return bench.score_runs(loaded, bench.find_runs(loaded, options), options)

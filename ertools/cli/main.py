@@ -29,12 +29,10 @@ from types import ModuleType
 from typing import NoReturn
 
 from ertools._version import __version__
-from ertools.benchmarks.registry import names
 from ertools.cli.command import Command, Delegate
 from ertools.cli.text import error_text, one_line, printable
 from ertools.errors import ErtoolsError, UsageError
 from ertools.progress import Bar, clear_current, reporting
-from ertools.timeutil import MAX_SECONDS
 
 COMMANDS: dict[str, Command] = {
     "info": Command("ertools.cli.info", "describe bags like `rosbag info`", "ertools info run.bag"),
@@ -97,6 +95,8 @@ COMMANDS: dict[str, Command] = {
 
 
 def _top_level_help() -> str:
+    from ertools.benchmarks.registry import names  # lazy: the protocols, 10 ms: not --version
+
     width = max(len(name) for name in COMMANDS)
     lines = [
         "usage: ertools [-h] [-V] COMMAND [ARGS...]",
@@ -138,8 +138,7 @@ class _Parser(argparse.ArgumentParser):
 
 def command_module(name: str) -> ModuleType:
     """The module of a command (a :class:`Command`'s ``module``), imported now: each command
-    imports only what it runs, and ``ertools --help`` nothing of them. (Import times measured
-    with ``-X importtime`` on a loaded 2-core machine, after this module.)"""
+    imports only what it runs, and ``ertools --help`` nothing of them."""
     match name:
         case "ertools.cli.info":
             from ertools.cli import info  # lazy: only this command, 270 ms
@@ -294,6 +293,7 @@ def _refuse_overwriting_inputs(args: argparse.Namespace) -> None:
 
 def _check_numbers(args: argparse.Namespace) -> None:
     """A UsageError for a NaN, infinite or absurdly large number option (`--max-gap nan`)."""
+    from ertools.timeutil import MAX_SECONDS  # lazy: datetime, 3 ms: not for --version
 
     for name, value in vars(args).items():
         for v in value if isinstance(value, list | tuple) else [value]:

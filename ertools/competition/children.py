@@ -1,9 +1,8 @@
 """Scoring processes: each forked from one single-threaded process, the fork server.
 
 A process forked from a multi-threaded one holds every lock another thread held at that
-instant, for ever: a LocalCluster whose workers were threads of ``rescore`` forked a scorer
-while the main thread wrote its progress line, and the scorer hung on the inherited lock for
-minutes (issue 29). The fork server has one thread when it forks. It is forked from
+instant, for ever (docs/rescore.md: a scorer forked from the threads of a LocalCluster hung
+on such a lock). The fork server has one thread when it forks. It is forked from
 ``rescore`` before any thread starts (:func:`forks_ready`); in a process that already has
 threads (a Dask worker, a notebook) it is a fresh interpreter instead
 (``python -m ertools.competition.children``). It keeps what a job loads on first use imported
@@ -81,8 +80,8 @@ def _watch_parent(parent: int) -> None:
 
 # What scoring imports only where it is used (each a `# lazy:` import, so that the command line
 # starts fast): imported by the server as it starts, or each scorer imports them on its first
-# job (~600 modules, 1.3 s of CPU per scorer, measured on a day of the season: --jobs 2 paid
-# them twice where --jobs 1 paid them once). tests/rescore/test_rescore_children.py checks
+# job (hundreds of modules, docs/performance.md: --jobs 2 paid them twice where --jobs 1 paid
+# them once). tests/rescore/test_rescore_children.py checks
 # that every lazy scipy import of ertools is here.
 SCORING_IMPORTS = ("scipy.spatial.transform", "scipy.interpolate", "scipy.special")
 

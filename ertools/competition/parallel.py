@@ -156,9 +156,9 @@ def run_dask(
 class DaskClient:
     """A Dask client being connected (a LocalCluster being started: its scheduler and worker
     threads) in a thread of its own, so that a run can start it before scanning the logs, and
-    close it while it writes the results: Dask's fixed costs (~1 s of CPU, importing
-    ``distributed`` and starting the cluster; docs/rescore.md) overlap the main process's own
-    work instead of adding to it.
+    close it while it writes the results: Dask's fixed costs (importing ``distributed`` and
+    starting the cluster; docs/rescore.md) overlap the main process's own work instead of
+    adding to it.
 
     ``distributed``'s log records are held from the start to the close and said in one line
     (:func:`_dask_logs_as_one_line`).

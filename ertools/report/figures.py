@@ -127,9 +127,8 @@ def _canvas_figure(size: tuple[float, float]) -> Any:
 def preload() -> None:
     """Import what writing a report's figures needs, without writing anything: for a process
     that forks the scoring processes (the fork server, :mod:`ertools.competition.children`), so
-    that each of them inherits it. The reports' figures are SVG charts
-    (no matplotlib since issue 29); one tiny chart is rendered so that the writer's code
-    paths ran once before the fork."""
+    that each of them inherits it. The reports' figures are SVG charts (no matplotlib); one
+    tiny chart is rendered so that the writer's code paths ran once before the fork."""
     svg.render(Chart((), note="0"), (1.0, 1.0), "0")
 
 

@@ -1,9 +1,12 @@
-"""Every dotted ``ertools.…`` name in the package, the docs and the README names something
-that exists (issue 37): a module, or an attribute of one. A rename that leaves a stale name in
-prose fails here, where a reader would otherwise follow it to nothing."""
+"""Every dotted ``ertools.…`` name in the package (its docstrings and comments included), the
+docs and the README names something that exists (issue 37): a module, or an attribute of one;
+and every path ``ertools/…`` names a file or folder (a ``*`` matching one at least). A rename
+that leaves a stale name in prose fails here, where a reader would otherwise follow it to
+nothing."""
 
 from __future__ import annotations
 
+import glob
 import importlib
 import re
 from pathlib import Path
@@ -14,6 +17,9 @@ from tests.architecture.archscan import ROOT, dotted_references, modules, ratche
 # (`ertools.Fbm3wRun`: capitalised, as no module is) and the MCAP metadata records of
 # `ertools live` (docs/live.md).
 NOT_PYTHON = re.compile(r"ertools\.[A-Z]\w*|ertools\.(recorder|clock)(\.stats)?")
+
+# A path in prose: `ertools/report/folder.py`, `ertools/benchmarks/`, `ertools/report/plots_*.py`.
+PATH = re.compile(r"(?<![\w./-])ertools/[\w*./-]*[\w*]")
 
 # Stale names today: the list only shrinks.
 ALLOWED: frozenset[str] = frozenset()
@@ -64,3 +70,33 @@ def test_a_stale_name_is_found() -> None:
     assert not resolves("ertools.errors.NoSuchError", names)
     assert not resolves("ertools.no_such_module", names)
     assert not resolves("ertools.errors.ErtoolsError.no_such_method", names)
+
+
+def stale_paths(root: Path) -> set[str]:
+    """``file: path`` of every ``ertools/…`` path in the package, docs and README that names no
+    file or folder under ``root``."""
+    out = set()
+    for path in texts(root):
+        for match in PATH.finditer(path.read_text(encoding="utf-8")):
+            named = match.group(0).rstrip(".")
+            if not glob.glob(glob.escape(str(root)) + "/" + named):
+                out.add(f"{path.relative_to(root).as_posix()}: {named}")
+    return out
+
+
+def test_no_stale_path() -> None:
+    assert not stale_paths(ROOT), "paths that name nothing:\n" + "\n".join(
+        sorted(stale_paths(ROOT))
+    )
+
+
+def test_a_stale_path_in_a_docstring_is_found(tmp_path: Path) -> None:
+    (tmp_path / "docs").mkdir()
+    (tmp_path / "README.md").write_text("see `ertools/a.py` and `ertools/b_*.py`.\n")
+    package = tmp_path / "ertools"
+    package.mkdir()
+    (package / "a.py").write_text(
+        '"""Moved to ertools/gone/c.py; see ertools/ and ertools/a.py."""\n'
+    )
+    (package / "b_1.py").write_text("")
+    assert stale_paths(tmp_path) == {"ertools/a.py: ertools/gone/c.py"}

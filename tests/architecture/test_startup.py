@@ -68,6 +68,8 @@ def test_the_top_level_help_and_version_import_no_numpy() -> None:
         assert "ertools.cli.main" in modules  # the probe sees the command's imports
         assert "numpy" not in modules, argv
         assert [p for p in packages().values() if loaded(modules, p)] == [], argv
+        if argv == ["--version"]:  # the version alone: not even the registry's protocols
+            assert loaded(modules, "ertools.benchmarks") == []
 
 
 def test_score_help_lists_every_benchmark_and_imports_none() -> None:

@@ -9,8 +9,6 @@ import pytest
 import yaml
 
 from ertools.benchmarks import registry
-from ertools.benchmarks.fbm3w.pipeline import score_fbm3w
-from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.benchmarks.scoring import score_execution
 from ertools.progress import reporting
 
@@ -45,7 +43,7 @@ def test_fbm3w_reports_reads_then_runs() -> None:
     answers = yaml.safe_load(bag.with_name(bag.stem + ".answers.yaml").read_text())
     rec = Recorder()
     with reporting(rec):
-        result = score_fbm3w([bag], Fbm3wConfig())
+        result = score_execution(registry.get("fbm3w"), [bag], {}).result
     assert len(answers["truth"]["runs"]) == 5  # the generator's runs_specifications
     assert len(result.runs) == 5
     _check(rec, bag, 5, "/fbm3w/robot_at_work/pose2d")  # the default pose source
@@ -65,4 +63,4 @@ def test_fbm1_reports_reads_then_runs() -> None:
 def test_no_reporter_nothing_reported() -> None:
     # the same call outside any reporting scope: the library stays silent (and still works)
     bag = S / "fbm3w/log_fbm3w_mocap_2015-11-20-12-00-00_0.bag"
-    assert len(score_fbm3w([bag], Fbm3wConfig()).runs) == 5
+    assert len(score_execution(registry.get("fbm3w"), [bag], {}).result.runs) == 5

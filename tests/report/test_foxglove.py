@@ -24,10 +24,8 @@ import pytest
 import yaml
 from rosbags.highlevel import AnyReader
 
-from ertools.benchmarks.fbm2h.config import Fbm2hOptions
-from ertools.benchmarks.fbm2h.pipeline import score_fbm2h
-from ertools.benchmarks.trajectory.config import TrajectoryConfig
-from ertools.benchmarks.trajectory.pipeline import score as score_trajectory
+from ertools.benchmarks import registry
+from ertools.benchmarks.scoring import score_execution
 from ertools.cli.main import main
 from ertools.report.foxglove.write import write_foxglove
 from tests.helpers.foxglove_readback import ReadBack, read_back, stamp_ns
@@ -180,10 +178,8 @@ def test_fbm2h(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
         assert (a.position.x, a.position.y) == (x, y)
         assert 2 * math.atan2(a.orientation.z, a.orientation.w) == pytest.approx(th, abs=EXACT)
     # The robot path: as many poses as the result's (decimated) path holds.
-    result = score_fbm2h(
-        [FBM2H],
-        Fbm2hOptions(goal=Path(FBM2H_ARGS[1]), transform=Path(FBM2H_ARGS[3])),
-    )
+    values = {"goal": Path(FBM2H_ARGS[1]), "transform": Path(FBM2H_ARGS[3])}
+    result = score_execution(registry.get("fbm2h"), [FBM2H], values).result
     robot = fg.topics["/fbm2h/robot"]
     assert robot.times == result.path_t_ns.tolist()
     assert len(fg.topics["/fbm2h/robot_path"].messages[0].poses) == len(result.path_t_ns)
@@ -308,9 +304,8 @@ def test_trajectory(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert len(pts) == 2 * score["compared"]
     assert np.linalg.norm(pts[0::2] - pts[1::2], axis=1) == pytest.approx(pe, abs=1e-12)
     # The GT poses: the result's GT path (the scorer's decimation), same config as the CLI.
-    result = score_trajectory(
-        ROBOT, [ROBOT.parent], TrajectoryConfig(auto_offset=True, apply_offset=True)
-    )
+    values = {"offset": "auto", "apply_offset": True}
+    result = score_execution(registry.get("trajectory"), [ROBOT, ROBOT.parent], values).result
     gt = fg.topics["/trajectory/gt"]
     assert gt.times == result.gt_path.t_ns.tolist()
     assert len(fg.topics["/trajectory/gt_path"].messages[0].poses) == len(result.gt_path)
@@ -320,7 +315,7 @@ def test_trajectory(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
 
 @pytest.mark.slow
 def test_trajectory_streams_over_the_limit_are_decimated(tmp_path: Path) -> None:
-    result = score_trajectory(ROBOT, [ROBOT.parent])
+    result = score_execution(registry.get("trajectory"), [ROBOT, ROBOT.parent], {}).result
     n, compared = len(result.matched.t_ns), result.compared
     written = write_foxglove(result, tmp_path / "t.mcap", limit=100)
     fg = read_back(tmp_path / "t.mcap")

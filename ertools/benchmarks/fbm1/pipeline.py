@@ -53,8 +53,7 @@ from ertools.benchmarks.fbm1.rules import (
     RULE_TRANS_CLIP,
     RULE_UNSCOREABLE,
 )
-from ertools.benchmarks.fbm1.runs import Fbm1Run, RunsFound
-from ertools.benchmarks.fbm1.runs import find_runs as runs_in_states
+from ertools.benchmarks.fbm1.runs import Fbm1Run, RunsFound, runs_from_states
 from ertools.benchmarks.fbm1.validity import body_mask, gt_validity
 from ertools.configs._yaml import parse_payload
 from ertools.configs.items import Item, ItemList
@@ -495,7 +494,7 @@ def find_runs(logs: Fbm1Logs, options: Fbm1Options) -> Fbm1Runs:
     plist = list(logs.paths)
     states = logs.states
     assert states.bmbox is not None
-    found = runs_in_states(
+    found = runs_from_states(
         states.bmbox,
         states.refbox,
         states.client,

@@ -173,7 +173,7 @@ def _bmbox_runs(bmbox: StateStream) -> tuple[list[Fbm1Run], str | None]:
     return runs, logged_score
 
 
-def find_runs(
+def runs_from_states(
     bmbox: StateStream,
     refbox: StateStream | None,
     client: StateStream | None,

@@ -108,14 +108,14 @@ class Fbm2h(
         return make_options(values)
 
     def load(self, logs: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
-        from ertools.benchmarks.fbm2h import logs as read  # lazy: NumPy, the readers, 250 ms
+        from ertools.benchmarks.fbm2h import pipeline  # lazy: NumPy, the readers, 250 ms
 
-        return read.load(logs, options)
+        return pipeline.load(logs, options)
 
     def find_runs(self, loaded: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
-        from ertools.benchmarks.fbm2h import logs as read  # lazy: NumPy, the readers, 250 ms
+        from ertools.benchmarks.fbm2h import pipeline  # lazy: NumPy, the readers, 250 ms
 
-        return read.find_runs(loaded, options)
+        return pipeline.find_runs(loaded, options)
 
     def score_runs(self, loaded: Fbm2hLogs, runs: Fbm2hRuns, options: Fbm2hOptions) -> Fbm2hResult:
         from ertools.benchmarks.fbm2h import pipeline  # lazy: NumPy, the readers, 250 ms

@@ -1,5 +1,7 @@
-"""FBM2@Home log reading: the configs and the marker set poses (``load``), then the reached
-moments from the states, a timing file or stops in the ground truth (``find_runs``)."""
+"""FBM2@Home log reading: the configs and the marker set poses (``read_logs``), then the
+reached moments from the states, a timing file or stops in the ground truth
+(``find_moments``); :mod:`ertools.benchmarks.fbm2h.pipeline`'s ``load`` and ``find_runs``
+call them."""
 
 from __future__ import annotations
 
@@ -115,7 +117,7 @@ class Fbm2hRuns:
     warnings: tuple[str, ...]
 
 
-def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
+def read_logs(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
     """Read the configs, the marker set poses and, for ``--reached states``, the states.
 
     Raises:
@@ -204,7 +206,7 @@ def _stateless(bag: Path, options: Fbm2hOptions) -> str:
     )
 
 
-def find_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
+def find_moments(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
     """The reached moments: from the states, a timing file or stops in the ground truth.
 
     Raises:

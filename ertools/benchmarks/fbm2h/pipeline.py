@@ -1,8 +1,9 @@
 """FBM2@Home (navigation, seed 7.2): load -> find reached moments -> score -> result.
 
-``score_fbm2h(paths, options)`` is what ``ertools score fbm2h`` runs; :func:`compute` is the
-pure part (streams and configs in, result out) that tests and notebooks can call directly;
-reading the log and finding the reached moments is :mod:`ertools.benchmarks.fbm2h.logs`.
+The three stages ``load``, ``find_runs`` and ``score_runs`` (what ``ertools score fbm2h``
+runs); :func:`compute` is the pure part (streams and configs in, result out) that tests call
+directly; reading the log and finding the reached moments is
+:mod:`ertools.benchmarks.fbm2h.logs`.
 
 How 2015 scored (``scripts/fbm2h`` of ``benchmark_and_scoring_fbm``, final 2015 version): for
 each waypoint i (segment i, from 0), ``start_segment_time`` when the goal had been sent,
@@ -42,7 +43,13 @@ from ertools.benchmarks.fbm2h.config import DEFAULT_MAX_GAP_S, TF_2015, Fbm2hOpt
 from ertools.benchmarks.fbm2h.formula import robot_poses_at, segment_errors
 from ertools.benchmarks.fbm2h.goal import GoalList
 from ertools.benchmarks.fbm2h.intervals import with_intervals
-from ertools.benchmarks.fbm2h.logs import Fbm2hLogs, Fbm2hRuns, find_runs, invalid_warning, load
+from ertools.benchmarks.fbm2h.logs import (
+    Fbm2hLogs,
+    Fbm2hRuns,
+    find_moments,
+    invalid_warning,
+    read_logs,
+)
 from ertools.benchmarks.fbm2h.result import Fbm2hResult, SegmentResult
 from ertools.benchmarks.fbm2h.rules import (
     RULE_ORIENTATION_WRAP,
@@ -446,6 +453,16 @@ def _frozen_warnings(
     return out
 
 
+def load(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hLogs:
+    """The configs, the marker set poses and the states (:func:`logs.read_logs`)."""
+    return read_logs(paths, options)
+
+
+def find_runs(logs: Fbm2hLogs, options: Fbm2hOptions) -> Fbm2hRuns:
+    """The reached moments (:func:`logs.find_moments`)."""
+    return find_moments(logs, options)
+
+
 def score_runs(logs: Fbm2hLogs, runs: Fbm2hRuns, options: Fbm2hOptions) -> Fbm2hResult:
     """Score the reached moments (:func:`compute`), with the provenance of the inputs."""
     provenance = Provenance(
@@ -499,9 +516,3 @@ def _is_tf_2015(marker: PoseStream) -> bool:
     """Whether the marker poses come from the 2015 node's source: /tf world -> robot_at_home."""
     from_tf = marker.source.rsplit(":", 1)[-1] in ("/tf", "/tf_static")
     return from_tf and (marker.frame_id, marker.child_frame_id) == TF_2015
-
-
-def score_fbm2h(paths: Sequence[Path], options: Fbm2hOptions) -> Fbm2hResult:
-    """Read the bags and configs, find the reached moments and score them."""
-    logs = load(paths, options)
-    return score_runs(logs, find_runs(logs, options), options)

@@ -42,10 +42,9 @@ def subsample_d_min(xy: F64, d_min: float) -> IntArr:
 
     The rule is sequential (each test is against the last *kept* point), so it cannot be one
     NumPy expression. After each kept point we test a few following samples as Python floats
-    (the common case while moving, about 0.3 us each) and, if none qualifies, search ahead in
-    NumPy windows that double in size (the common case while standing still). Each sample is
-    then examined O(1) times, in either form: about 0.3 s for 10^6 samples of pure jitter
-    above d_min, and well under that when most samples are skipped.
+    (the common case while moving) and, if none qualifies, search ahead in NumPy windows that
+    double in size (the common case while standing still). Each sample is then examined O(1)
+    times, in either form.
 
     Args:
         xy: (N, 2) positions in metres.

@@ -1,7 +1,8 @@
 """FBM3@Work trajectory following (seed 7.3): load -> find runs -> score -> result.
 
-:func:`score_fbm3w` reads bags through :mod:`ertools.io` and calls :func:`score_paths`, which
-is pure (pose stream + run windows + config -> :class:`Fbm3wResult`). The scoring itself is in
+:func:`load`, :func:`find_runs` and :func:`score_runs` are the stages (bags read through
+:mod:`ertools.io`); :func:`score_paths` is pure (pose stream + run windows + config ->
+:class:`Fbm3wResult`). The scoring itself is in
 :mod:`ertools.benchmarks.fbm3w.formula`, run finding in :mod:`ertools.benchmarks.fbm3w.runs`.
 """
 
@@ -174,21 +175,6 @@ def score_runs(logs: Fbm3wLogs, windows: Sequence[RunWindow], options: Fbm3wOpti
     t0 = int(logs.states.bmbox.t_ns[0])
     said = end_payload_deviation(logs.states.refbox, t0, exact_2015=options.exact_end_payloads)
     return result if said is None else replace(result, deviations=(*result.deviations, said))
-
-
-def score_fbm3w(
-    paths: Sequence[Path], config: Fbm3wConfig, options: Fbm3wOptions = Fbm3wOptions()
-) -> Fbm3wResult:
-    """Score an FBM3@Work benchmark from its bag(s) with ``config``: load -> locate the runs
-    -> score them.
-
-    Raises:
-        ErtoolsError: unreadable bags, no poses, no runs (a single run's problem is a failure
-            inside the result instead).
-    """
-    opts = replace(options, config=config)
-    logs = load(paths, opts)
-    return score_runs(logs, find_runs(logs, opts), opts)
 
 
 def _still(options: Fbm3wOptions) -> dict[str, float]:

@@ -19,9 +19,11 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ertools.benchmarks.common.hygiene import drop_duplicates, drop_invalid
+from ertools.benchmarks.scoring import run_stages
 from ertools.benchmarks.trajectory.association import COMPARED
+from ertools.benchmarks.trajectory.config import TrajectoryOptions
+from ertools.benchmarks.trajectory.declare import BENCHMARK
 from ertools.benchmarks.trajectory.logs import read_gt
-from ertools.benchmarks.trajectory.pipeline import score
 from ertools.errors import ClockError, ScoringError
 from ertools.geometry import interpolate_poses
 from ertools.io.text import is_text_trajectory, read_text_poses
@@ -67,26 +69,18 @@ def trajectory_pair(
 ) -> PairExport:
     """The robot and GT streams ``score trajectory`` compares with these settings.
 
-    The scoring itself runs (:func:`ertools.benchmarks.trajectory.pipeline.score`), so the files,
+    The scoring itself runs (:func:`ertools.benchmarks.scoring.run_stages`), so the files,
     topics, offset and association are exactly the ones of the score; the GT is then read
     again (the result keeps only a decimated copy) around the robot poses and cleaned the
     same way (samples recorded twice, NaN or zero quaternions dropped).
 
     Raises:
-        ScoringError: ``matched`` and no pose could be compared; the errors of ``score``.
+        ScoringError: ``matched`` and no pose could be compared; the errors of the score.
         ClockError: robot poses outside the GT without ``allow_partial``.
     """
 
-    result = score(
-        robot_bag,
-        gt_paths,
-        config,
-        robot_topic=robot_topic,
-        gt_topic=gt_topic,
-        robot_time=robot_time,
-        gt_time=gt_time,
-        input_format=input_format,
-    )
+    options = TrajectoryOptions(config, robot_topic, gt_topic, robot_time, gt_time, input_format)
+    result = run_stages(BENCHMARK, [Path(p) for p in (robot_bag, *gt_paths)], options)
     if result.uncovered and not config.allow_partial:
         # The score prints the covered part when the uncovered poses precede the GT (a
         # failure); files written for another tool would carry no such mark: refused.

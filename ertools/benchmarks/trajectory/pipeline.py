@@ -8,13 +8,13 @@ with p1 ("hold") and reported the mean 3D distance and atan2(sum sin|dyaw|, sum 
 Where ertools' default differs, one option restores each 2015 behaviour (the ``RULE_*``
 constants) and :meth:`TrajectoryConfig.of_2015` (``--2015``) all of them at once.
 
-Shape: load (robot stream, GT files selected by time overlap, read as one stream: ``inputs``)
--> associate (hold | nearest | linear, max-gap, tracking lost, coverage: ``association``) ->
-``metrics`` -> frozen :class:`~ertools.benchmarks.trajectory.result.TrajectoryResult`
-(``result``). The settings are in ``config``, the 2015 rules in ``rules``. The clock audit
+Shape: :func:`load` (robot stream, GT files selected by time overlap, read as one stream:
+``logs``) -> associate (hold | nearest | linear, max-gap, tracking lost, coverage:
+``association``) -> ``formula`` -> frozen
+:class:`~ertools.benchmarks.trajectory.result.TrajectoryResult` (``result``): :func:`score_runs`.
+The settings are in ``config``, the 2015 rules in ``rules``. The clock audit
 (:mod:`ertools.benchmarks.common.clocks`) runs every time.
-:func:`~ertools.benchmarks.trajectory.comparison.score_streams` is pure; :func:`score` is the IO
-edge.
+:func:`~ertools.benchmarks.trajectory.comparison.score_streams` is pure.
 """
 
 from __future__ import annotations
@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ertools.benchmarks.trajectory.comparison import score_streams
-from ertools.benchmarks.trajectory.config import TrajectoryConfig, TrajectoryOptions
+from ertools.benchmarks.trajectory.config import TrajectoryOptions
 from ertools.benchmarks.trajectory.logs import (
     find_gt_files,
     pick_gt_in_robot_bag,
@@ -338,24 +338,3 @@ def score_runs(logs: TrajectoryLogs, runs: None, options: TrajectoryOptions) -> 
         )
         result = replace(result, deviations=(*result.deviations, dev))
     return result
-
-
-def score(
-    robot_bag: str | Path,
-    gt_paths: Sequence[str | Path],
-    config: TrajectoryConfig | None = None,
-    *,
-    robot_topic: str | None = None,
-    gt_topic: str | None = None,
-    robot_time: str = "header",
-    gt_time: str = "header",
-    input_format: str | None = None,
-) -> TrajectoryResult:
-    """Score a robot log against the GT files (or folders of them) that cover it: load ->
-    compare (see :func:`load`, :func:`score_runs`)."""
-    options = TrajectoryOptions(
-        config or TrajectoryConfig(), robot_topic, gt_topic, robot_time, gt_time, input_format
-    )
-    logs = load([robot_bag, *gt_paths], options)
-    find_runs(logs, options)  # one run: the whole robot log
-    return score_runs(logs, None, options)

@@ -31,7 +31,7 @@ from ertools.benchmarks.common.ending import (
     log_cut,
     refbox_ends,
 )
-from ertools.benchmarks.fbm1.runs import find_runs
+from ertools.benchmarks.fbm1.runs import runs_from_states
 from ertools.benchmarks.fbm2h.runs import from_states
 from ertools.benchmarks.fbm3w.runs import find_states
 from ertools.io.model import BenchmarkStates
@@ -185,7 +185,7 @@ def test_the_forms_are_the_ones_the_sources_name() -> None:
 @pytest.mark.parametrize(("payload", "mode"), CASES, ids=IDS)
 def test_fbm1_reads_the_table(payload: str, mode: str) -> None:
     log = _log(payload)
-    found = find_runs(log.bmbox, log.refbox, log.client, t0_ns=T0, exact_2015=MODES[mode])
+    found = runs_from_states(log.bmbox, log.refbox, log.client, t0_ns=T0, exact_2015=MODES[mode])
     (run,) = found.runs
     want = _expected(payload, mode)
     assert run.ended_by == {T: "timeout", P: "stop"}.get(want)
@@ -246,7 +246,7 @@ def test_neither_means_the_run_goes_on_in_every_consumer(payload: str, mode: str
     want = _expected(payload, mode)
     early = want in (T, P)
     log = _log(payload, answered=True)
-    (run,) = find_runs(log.bmbox, log.refbox, log.client, t0_ns=T0, exact_2015=exact).runs
+    (run,) = runs_from_states(log.bmbox, log.refbox, log.client, t0_ns=T0, exact_2015=exact).runs
     assert (run.answer_payload is None) is early and (run.ended_by is not None) is early
     log = _log(payload, "fbm2h", answered=True)
     for clock in ("client", "bmbox"):

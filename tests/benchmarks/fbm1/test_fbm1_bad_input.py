@@ -10,7 +10,7 @@ import pytest
 
 from ertools.benchmarks.fbm1.answers import parse_answer_payload
 from ertools.benchmarks.fbm1.pipeline import score_fbm1
-from ertools.benchmarks.fbm1.runs import find_runs
+from ertools.benchmarks.fbm1.runs import runs_from_states
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import ItemList, parse_items
@@ -73,7 +73,9 @@ def test_bad_run_fails_alone(case: str) -> None:
     bad, message = BAD_CASES[case]
     runs = [bad, GOOD]
     streams = state_streams(runs)
-    found = find_runs(streams[Machine.BMBOX], streams[Machine.REFBOX], streams[Machine.CLIENT])
+    found = runs_from_states(
+        streams[Machine.BMBOX], streams[Machine.REFBOX], streams[Machine.CLIENT]
+    )
     origin, board = bodies(runs)
     result = score_fbm1(origin, board, found, _items())
     assert len(result.failures) == 1

@@ -22,7 +22,7 @@ from ertools.benchmarks.base import BenchmarkResult
 from ertools.benchmarks.fbm1.config import Fbm1Options, GtOptions, ScoreRules
 from ertools.benchmarks.fbm1.pipeline import score_fbm1
 from ertools.benchmarks.fbm1.result import Fbm1Result
-from ertools.benchmarks.fbm1.runs import find_runs
+from ertools.benchmarks.fbm1.runs import runs_from_states
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import ItemList, parse_items
@@ -74,7 +74,9 @@ def _items() -> ItemList:
 
 def _score(options: Fbm1Options | None = None) -> Fbm1Result:
     streams = state_streams(RUNS)
-    found = find_runs(streams[Machine.BMBOX], streams[Machine.REFBOX], streams[Machine.CLIENT])
+    found = runs_from_states(
+        streams[Machine.BMBOX], streams[Machine.REFBOX], streams[Machine.CLIENT]
+    )
     origin, board = bodies(RUNS)
     return score_fbm1(origin, board, found, _items(), options)
 
@@ -152,7 +154,9 @@ def test_moving_the_whole_world_changes_nothing(seed: int) -> None:
         return PoseStream(s.t_ns, rot.apply(s.xyz) + shift, r.as_quat(), s.frame_id)
 
     streams = state_streams(RUNS)
-    found = find_runs(streams[Machine.BMBOX], streams[Machine.REFBOX], streams[Machine.CLIENT])
+    found = runs_from_states(
+        streams[Machine.BMBOX], streams[Machine.REFBOX], streams[Machine.CLIENT]
+    )
     origin, board = bodies(RUNS)
     base = score_fbm1(origin, board, found, _items())
     other = score_fbm1(moved(origin), moved(board), found, _items())

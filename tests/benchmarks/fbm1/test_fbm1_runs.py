@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from ertools.benchmarks.fbm1.pipeline import score_fbm1
-from ertools.benchmarks.fbm1.runs import find_runs, parse_item_ref
+from ertools.benchmarks.fbm1.runs import parse_item_ref, runs_from_states
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import parse_items
 from ertools.states import BmBoxState as B
@@ -46,7 +46,7 @@ def test_home_runs_with_moments_and_answers() -> None:
         RunSpec("Place item 2 (b1) on the table", None, timeout=True),
     ]
     s = state_streams(runs)
-    found = find_runs(s[Machine.BMBOX], s[Machine.REFBOX], s[Machine.CLIENT])
+    found = runs_from_states(s[Machine.BMBOX], s[Machine.REFBOX], s[Machine.CLIENT])
     r1, r2 = found.runs
     assert (r1.start_ns, r1.placed_ns, r1.goal_ns) == (ns(10.0), ns(13.02), ns(14.0))
     assert (r1.executing_ns, r1.result_ns) == (ns(14.1), ns(16.1))
@@ -59,7 +59,9 @@ def test_home_runs_with_moments_and_answers() -> None:
 def test_work_item_from_refbox_payload() -> None:
     runs = [RunSpec("", "{x: 1}", refbox_payload="EM-01")]
     s = state_streams(runs)
-    found = find_runs(s[Machine.BMBOX], s[Machine.REFBOX], s[Machine.CLIENT], benchmark="fbm1w")
+    found = runs_from_states(
+        s[Machine.BMBOX], s[Machine.REFBOX], s[Machine.CLIENT], benchmark="fbm1w"
+    )
     ref = found.runs[0].item
     assert ref is not None and ref.instance == "EM-01" and ref.source == "refbox payload"
 
@@ -67,8 +69,10 @@ def test_work_item_from_refbox_payload() -> None:
 def test_home_prefers_bmbox_payload_work_prefers_refbox() -> None:
     runs = [RunSpec("Place item 1 (a1) on the table", "{x: 1}", refbox_payload="b1")]
     s = state_streams(runs)
-    home = find_runs(s[Machine.BMBOX], s[Machine.REFBOX], s[Machine.CLIENT])
-    work = find_runs(s[Machine.BMBOX], s[Machine.REFBOX], s[Machine.CLIENT], benchmark="fbm1w")
+    home = runs_from_states(s[Machine.BMBOX], s[Machine.REFBOX], s[Machine.CLIENT])
+    work = runs_from_states(
+        s[Machine.BMBOX], s[Machine.REFBOX], s[Machine.CLIENT], benchmark="fbm1w"
+    )
     assert home.runs[0].item.item_id == 1  # type: ignore[union-attr]
     assert work.runs[0].item.instance == "b1"  # type: ignore[union-attr]
 
@@ -99,7 +103,7 @@ def test_missing_short_ready_still_closes_the_run() -> None:
             (8.9, C.COMPLETED_GOAL, "{a: 2}"),
         ],
     )
-    found = find_runs(bm, None, cl)
+    found = runs_from_states(bm, None, cl)
     r1, r2 = found.runs
     assert r1.result_ns == ns(6.0) and r1.answer_payload == "{a: 1}"
     assert (r2.goal_ns, r2.executing_ns, r2.result_ns) == (ns(8.2), ns(8.2), ns(9.0))
@@ -117,14 +121,14 @@ def test_aborted_run_and_stop() -> None:
         ],
     )
     rb = _stream(Machine.REFBOX, [(1.0, R.READY, ""), (2.9, R.END, "reason: stop")])
-    found = find_runs(bm, rb, None)
+    found = runs_from_states(bm, rb, None)
     assert [r.status for r in found.runs] == ["aborted"]
 
 
 def test_items_order_overrides_and_warns_on_count() -> None:
     runs = [RunSpec("Place item 1 (a1) on the table", "{x: 1}")] * 2
     s = state_streams(runs)
-    found = find_runs(
+    found = runs_from_states(
         s[Machine.BMBOX], s[Machine.REFBOX], s[Machine.CLIENT], items_order=["3", "b1", "2"]
     )
     assert found.runs[0].item.item_id == 3  # type: ignore[union-attr]
@@ -146,7 +150,7 @@ def test_log_cut_during_a_run_is_the_run_stopped_there() -> None:
     s = state_streams(runs)
     # Cut the BmBox and Client logs at 15 s: the run's goal was sent at 14 s, no result.
     bm, cl = s[Machine.BMBOX].window(None, ns(15.0)), s[Machine.CLIENT].window(None, ns(15.0))
-    found = find_runs(bm, s[Machine.REFBOX].window(None, ns(15.0)), cl)
+    found = runs_from_states(bm, s[Machine.REFBOX].window(None, ns(15.0)), cl)
     origin, board = bodies(runs)
     result = score_fbm1(origin, board, found, parse_items(parse_yaml(ITEMS_YAML)))
     assert [(r.status, r.ended_by) for r in result.runs] == [("no_answer", "stop")]

@@ -9,7 +9,7 @@ import numpy as np
 
 from ertools.benchmarks.fbm1.config import Fbm1Options, ScoreRules
 from ertools.benchmarks.fbm1.pipeline import score_fbm1
-from ertools.benchmarks.fbm1.runs import find_runs
+from ertools.benchmarks.fbm1.runs import runs_from_states
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import parse_items
 from ertools.states import Machine
@@ -51,7 +51,9 @@ def _frozen(board: PoseStream, from_s: float, to_s: float) -> PoseStream:
 def _score(board_from_to: tuple[float, float], options: Fbm1Options | None = None):  # type: ignore[no-untyped-def]
     runs = [GOOD]
     streams = state_streams(runs)
-    found = find_runs(streams[Machine.BMBOX], streams[Machine.REFBOX], streams[Machine.CLIENT])
+    found = runs_from_states(
+        streams[Machine.BMBOX], streams[Machine.REFBOX], streams[Machine.CLIENT]
+    )
     origin, board = bodies(runs)
     origin, board = _noisy(origin, 1), _noisy(board, 2)
     b = run_start_s(0)

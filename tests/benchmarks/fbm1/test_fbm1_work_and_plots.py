@@ -10,7 +10,7 @@ from matplotlib.figure import Figure
 
 from ertools.benchmarks.fbm1.config import Fbm1Options
 from ertools.benchmarks.fbm1.pipeline import score_fbm1
-from ertools.benchmarks.fbm1.runs import find_runs
+from ertools.benchmarks.fbm1.runs import runs_from_states
 from ertools.cli.main import main
 from ertools.configs._yaml import parse_yaml
 from ertools.configs.items import parse_items
@@ -69,7 +69,7 @@ def test_fbm1w_items_order(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -
 
 def test_fbm1_figures_draw_the_answers() -> None:
     streams = state_streams(WORK_RUNS)
-    found = find_runs(
+    found = runs_from_states(
         streams[Machine.BMBOX], streams[Machine.REFBOX], streams[Machine.CLIENT], benchmark="fbm1w"
     )
     origin, board = bodies(WORK_RUNS)

@@ -2,15 +2,25 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+from typing import Any
+
 import pytest
 
-from ertools.benchmarks.fbm3w.config import Fbm3wOptions
-from ertools.benchmarks.fbm3w.pipeline import score_fbm3w
-from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
+from ertools.benchmarks import registry
+from ertools.benchmarks.scoring import score_execution
 from tests.benchmarks.fbm3w.fbm3w_kit import Sample
 
-# the answers hold scores, not intervals: no Monte Carlo draws (draws=0 in every Fbm3wOptions)
-NO_DRAWS = Fbm3wOptions(draws=0)
+
+def _score(bag: Path, **values: Any) -> Any:
+    """``ertools score fbm3w BAG`` with these inputs; the answers hold scores, not intervals:
+    no Monte Carlo draws."""
+    return score_execution(registry.get("fbm3w"), [bag], {"draws": 0, **values}).result
+
+
+def _runs(windows: tuple[tuple[str, float, float, float], ...]) -> list[str]:
+    """Windows as ``--run SPEC:REF_T:START_T:END_T`` texts (repr: the floats read back exactly)."""
+    return [f"{spec}:{ref!r}:{start!r}:{end!r}" for spec, ref, start, end in windows]
 
 
 def _tol(sample: Sample, key: str) -> float:
@@ -21,9 +31,7 @@ def _tol(sample: Sample, key: str) -> float:
 @pytest.mark.parametrize("mode", ["states", "windows", "auto"])
 def test_each_run_matches_the_answers(fbm3w_sample: Sample, mode: str) -> None:
     windows = fbm3w_sample.windows() if mode == "windows" else ()
-    result = score_fbm3w(
-        [fbm3w_sample.bag], Fbm3wConfig(), Fbm3wOptions(draws=0, runs=mode, windows=windows)
-    )
+    result = _score(fbm3w_sample.bag, runs=mode, run=_runs(windows))
     # the answers file justifies it: single noisy reference/start samples fix the run frame
     tol = _tol(fbm3w_sample, "distance_error")
     scored = [r for r in result.runs if r.distance_error is not None]
@@ -38,7 +46,7 @@ def test_each_run_matches_the_answers(fbm3w_sample: Sample, mode: str) -> None:
 
 def test_states_mode_equals_the_live_node(fbm3w_sample: Sample) -> None:
     """The scenario recomputes what the 2015 node saw (the published Pose2D messages)."""
-    result = score_fbm3w([fbm3w_sample.bag], Fbm3wConfig(), NO_DRAWS)
+    result = _score(fbm3w_sample.bag)
     live = fbm3w_sample.answers["expected"]["published"]
     tol = _tol(fbm3w_sample, "published")
     for run in result.runs[:4]:
@@ -52,7 +60,7 @@ def test_states_mode_equals_the_live_node(fbm3w_sample: Sample) -> None:
 
 
 def test_states_mode_times_and_timeout(fbm3w_sample: Sample) -> None:
-    result = score_fbm3w([fbm3w_sample.bag], Fbm3wConfig(), NO_DRAWS)
+    result = _score(fbm3w_sample.bag)
     assert len(result.runs) == 5
     assert all(r.window.mode == "states" for r in result.runs)
     tol = _tol(fbm3w_sample, "execution_time")
@@ -78,8 +86,8 @@ def test_states_mode_times_and_timeout(fbm3w_sample: Sample) -> None:
 
 @pytest.mark.slow
 def test_rosbag2_mcap_copy_scores_the_same(fbm3w_sample: Sample) -> None:
-    ros1 = score_fbm3w([fbm3w_sample.bag], Fbm3wConfig(), NO_DRAWS)
-    mcap = score_fbm3w([fbm3w_sample.mcap], Fbm3wConfig(), NO_DRAWS)
+    ros1 = _score(fbm3w_sample.bag)
+    mcap = _score(fbm3w_sample.mcap)
     # same messages in another container: identical numbers
     assert mcap.to_dict() == ros1.to_dict()
 
@@ -88,9 +96,7 @@ def test_rosbag2_mcap_copy_scores_the_same(fbm3w_sample: Sample) -> None:
 @pytest.mark.parametrize("mode", ["states", "windows", "auto"])
 def test_noiseless_recording_gives_the_answers_exactly(fbm3w_noiseless: Sample, mode: str) -> None:
     windows = fbm3w_noiseless.windows() if mode == "windows" else ()
-    result = score_fbm3w(
-        [fbm3w_noiseless.bag], Fbm3wConfig(), Fbm3wOptions(draws=0, runs=mode, windows=windows)
-    )
+    result = _score(fbm3w_noiseless.bag, runs=mode, run=_runs(windows))
     tol = _tol(fbm3w_noiseless, "distance_error_noiseless")
     for run in result.runs[:4]:
         exp = fbm3w_noiseless.expected_run(run.index)
@@ -105,7 +111,7 @@ def test_noiseless_recording_gives_the_answers_exactly(fbm3w_noiseless: Sample, 
 
 @pytest.mark.slow
 def test_auto_mode_reports_detected_times(fbm3w_sample: Sample) -> None:
-    result = score_fbm3w([fbm3w_sample.bag], Fbm3wConfig(), Fbm3wOptions(draws=0, runs="auto"))
+    result = _score(fbm3w_sample.bag, runs="auto")
     truth = fbm3w_sample.answers["truth"]["runs"]
     start_ns = fbm3w_sample.answers["truth"]["bag_start_ns"]
     for run in result.runs:
@@ -127,19 +133,13 @@ def test_auto_mode_reports_detected_times(fbm3w_sample: Sample) -> None:
         (r.spec, r.details()["reference_time"], r.details()["start_time"], r.details()["end_time"])
         for r in result.runs
     )
-    again = score_fbm3w(
-        [fbm3w_sample.bag], Fbm3wConfig(), Fbm3wOptions(draws=0, runs="windows", windows=given)
-    )
+    again = _score(fbm3w_sample.bag, runs="windows", run=_runs(given))
     assert [r.distance_error for r in again.runs] == [r.distance_error for r in result.runs]
     assert all(r.distance_error is not None for r in again.runs)
 
 
 def test_d_min_below_noise_is_warned(fbm3w_sample: Sample) -> None:
-    result = score_fbm3w(
-        [fbm3w_sample.bag],
-        Fbm3wConfig(),
-        Fbm3wOptions(draws=0, d_min=0.0002, sweep=(0.0002, 0.0005)),
-    )
+    result = _score(fbm3w_sample.bag, d_min=0.0002, d_min_sweep="0.0002:0.0005:2")
     eps = fbm3w_sample.answers["expected"]["noise"]["epsilon"]
     warning = next(w for w in result.warnings if "below the mocap noise" in w)
     assert "suggested d_min" in warning

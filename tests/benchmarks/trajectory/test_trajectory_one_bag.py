@@ -17,14 +17,12 @@ import pytest
 from rosbags.rosbag1 import Reader
 
 from ertools.benchmarks.trajectory.association import COMPARED
-from ertools.benchmarks.trajectory.config import TrajectoryConfig
-from ertools.benchmarks.trajectory.pipeline import score
 from ertools.benchmarks.trajectory.sample import GT_TOPIC, ROBOT_TOPIC
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
 from ertools.simulator.writer import BagWriter
 from tests.benchmarks.trajectory.test_trajectory_sample import check
-from tests.benchmarks.trajectory.trajectory_helpers import read_back
+from tests.benchmarks.trajectory.trajectory_helpers import read_back, score_trajectory
 from tests.helpers.stderr_text import error_messages
 
 pytestmark = pytest.mark.slow
@@ -83,17 +81,16 @@ NAMING = {"gt_files", "robot_file", "warnings"}
 def test_one_bag_equals_the_answers_and_the_two_bag_score(
     bags: dict[str, Path], robotlog: dict[str, Any], association: str
 ) -> None:
-    cfg = TrajectoryConfig(association=association)  # type: ignore[arg-type]
-    one = score(bags["both"], [], cfg).to_dict()
+    one = score_trajectory(bags["both"], [], association=association).to_dict()
     check(one, robotlog["answers"]["expected"]["offset_0"][association], robotlog["answers"])
     assert one["gt_files"] == [str(bags["both"])]
     assert one["robot_topic"] == ROBOT_TOPIC and one["gt_topic"] == GT_TOPIC  # both guessed
-    two = score(bags["robot"], [bags["gt"]], cfg).to_dict()
+    two = score_trajectory(bags["robot"], [bags["gt"]], association=association).to_dict()
     assert {k: v for k, v in one.items() if k not in NAMING} == {
         k: v for k, v in two.items() if k not in NAMING
     }
     # The same file given as its own GT path is the same mode.
-    same = score(bags["both"], [bags["both"]], cfg).to_dict()
+    same = score_trajectory(bags["both"], [bags["both"]], association=association).to_dict()
     assert same == one
 
 
@@ -172,7 +169,7 @@ def test_one_bag_agrees_with_evo_bag_mode(bags: dict[str, Path]) -> None:
     ref, est = sync.associate_trajectories(ref, est)
     ape = metrics.APE(metrics.PoseRelation.translation_part)
     ape.process_data((ref, est))
-    r = score(bags["both"], [], TrajectoryConfig(association="nearest"))
+    r = score_trajectory(bags["both"], [], association="nearest")
     assert len(ape.error) > r.compared  # evo also pairs the gap and tracking-lost poses
     compared_s = r.matched.t_ns[r.matched.status == COMPARED] / 1e9
     # Robot stamps are ~100 ms apart: 10 us picks each one out of evo's float seconds (whose

@@ -12,12 +12,15 @@ import pytest
 import yaml
 
 import ertools.benchmarks.trajectory.logs as tr
-from ertools.benchmarks.trajectory.config import TrajectoryConfig
-from ertools.benchmarks.trajectory.pipeline import score
 from ertools.benchmarks.trajectory.sample import GT_TOPIC, ROBOT_TOPIC, expected_scores, truth_at
 from ertools.cli.main import main
 from ertools.io.reader import read_poses
-from tests.benchmarks.trajectory.trajectory_helpers import read_back, write_gt, yaw
+from tests.benchmarks.trajectory.trajectory_helpers import (
+    read_back,
+    score_trajectory,
+    write_gt,
+    yaw,
+)
 from tests.helpers.stderr_text import error_messages
 
 KEYS = ("compared", "gaps", "tracking_lost", "uncovered")
@@ -34,7 +37,7 @@ def check(result: dict[str, Any], expected: dict[str, Any], answers: dict[str, A
 
 @pytest.mark.parametrize("association", ["hold", "nearest", "linear"])
 def test_each_association_without_offset(robotlog: dict[str, Any], association: str) -> None:
-    r = score(robotlog["robot"], [robotlog["dir"]], TrajectoryConfig(association=association))  # type: ignore[arg-type]
+    r = score_trajectory(robotlog["robot"], [robotlog["dir"]], association=association)
     answers = robotlog["answers"]
     check(r.to_dict(), answers["expected"]["offset_0"][association], answers)
     assert r.to_dict()["gt_files"] == [str(p) for p in robotlog["gt"]]
@@ -43,15 +46,15 @@ def test_each_association_without_offset(robotlog: dict[str, Any], association: 
 @pytest.mark.parametrize("association", ["hold", "nearest", "linear"])
 def test_each_association_with_the_true_offset(robotlog: dict[str, Any], association: str) -> None:
     answers = robotlog["answers"]
-    cfg = TrajectoryConfig(association=association, offset_ns=answers["truth"]["offset_ns"])  # type: ignore[arg-type]
-    r = score(robotlog["robot"], robotlog["gt"], cfg)
+    offset = repr(answers["truth"]["offset_s"])  # --offset S: seconds, read back exactly
+    r = score_trajectory(robotlog["robot"], robotlog["gt"], association=association, offset=offset)
     check(r.to_dict(), answers["expected"]["offset_true"][association], answers)
     assert r.to_dict()["offset"] == pytest.approx(answers["truth"]["offset_s"], abs=1e-9)
 
 
 def test_clock_audit_recovers_the_generator_offset(robotlog: dict[str, Any]) -> None:
     answers = robotlog["answers"]
-    r = score(robotlog["robot"], robotlog["gt"])
+    r = score_trajectory(robotlog["robot"], robotlog["gt"])
     audit = r.to_dict()["clock_audit"]
     truth = answers["truth"]["offset_s"]
     # Tolerance from the answers file (10 ms, justified there).
@@ -66,8 +69,8 @@ def test_clock_audit_recovers_the_generator_offset(robotlog: dict[str, Any]) -> 
 
 def test_apply_offset_scores_with_the_estimate(robotlog: dict[str, Any]) -> None:
     answers = robotlog["answers"]
-    cfg = TrajectoryConfig(auto_offset=True, apply_offset=True)
-    d = score(robotlog["robot"], robotlog["gt"], cfg).to_dict()
+    d = score_trajectory(robotlog["robot"], robotlog["gt"], offset="auto", apply_offset=True)
+    d = d.to_dict()
     assert d["offset"] == d["clock_audit"]["estimated_offset"]
     assert d["clock_audit"]["applied"] is True
     # Within 10 ms of the true offset the score is within a few mm of the true-offset score:

@@ -1,15 +1,25 @@
-"""Helpers of the trajectory tests: reading bags back without ertools.io, writing bad bags."""
+"""Helpers of the trajectory tests: scoring as ``ertools score trajectory`` does, reading bags
+back without ertools.io, writing bad bags."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from rosbags.highlevel import AnyReader
 
+from ertools.benchmarks import registry
+from ertools.benchmarks.scoring import score_execution
 from ertools.geometry import quat_from_yaw
 from ertools.simulator.writer import BagWriter
+
+
+def score_trajectory(robot: Path, gt_paths: Sequence[Path], **values: Any) -> Any:
+    """``ertools score trajectory ROBOT GT...`` with these inputs (by input name): its result."""
+    return score_execution(registry.get("trajectory"), [robot, *gt_paths], values).result
 
 
 def read_back(path: Path, topic: str) -> tuple[list[int], list[list[float]], list[list[float]]]:

@@ -1,0 +1,1 @@
+"""A toy benchmark, a complete package: what docs/writing-a-benchmark.md walks through."""
