@@ -81,7 +81,7 @@ def perturbed_runs(
     """
     d = sigmas.size
     out = np.empty((d, len(runs)))
-    tables: dict[int, npt.NDArray[np.complex128]] = {}
+    tables: dict[int, npt.NDArray[np.float32]] = {}
     pieces = [
         (col, lo, min(d, lo + batch))
         for col, run in enumerate(runs)
@@ -119,16 +119,14 @@ def perturbed_runs(
     return out
 
 
-def target_table(shape: Shape) -> npt.NDArray[np.complex128]:
-    """The target x + iy at TABLE evenly spaced l in [0, 1] and each row's step to the next
-    (0 after the last), which the draws interpolate linearly (:func:`_eq1`): for the 2015
-    shapes within 2e-8 m of the curve (the sine's y'' = 2.6 m, times (1 / 4096)^2 / 8); a shape
-    given by points is exact but within 1 / 4096 of l around its corners. Each row's two
-    complex64 numbers (the point, the step) are stored as one complex128, for one gather."""
-    xy = shape(np.linspace(0.0, 1.0, TABLE))
-    t = (xy[:, 0] + 1j * xy[:, 1]).astype(np.complex64)
-    pairs = np.column_stack([t, np.diff(t, append=t[-1:])]).astype(np.complex64)
-    return pairs.view(np.complex128)[:, 0]
+def target_table(shape: Shape) -> npt.NDArray[np.float32]:
+    """(4, TABLE) the target's x and y at TABLE evenly spaced l in [0, 1], and each row's
+    step to the next in x and y (0 after the last), which the draws interpolate linearly
+    (:func:`_eq1`): for the 2015 shapes within 2e-8 m of the curve (the sine's y'' = 2.6 m,
+    times (1 / 4096)^2 / 8); a shape given by points is exact but within 1 / 4096 of l
+    around its corners."""
+    xy = shape(np.linspace(0.0, 1.0, TABLE)).T.astype(np.float32)
+    return np.concatenate([xy, np.diff(xy, axis=1, append=xy[:, -1:])])
 
 
 def _groups(
@@ -265,13 +263,9 @@ class _Scratch:
     arrays of megabytes cost more in page faults than the arithmetic on them."""
 
     def __init__(self, size: int) -> None:
-        self.arrays = (
-            np.empty(size, dtype=np.float32),
-            np.empty(size, dtype=np.float32),
-            np.empty(size, dtype=np.float32),
+        self.arrays: tuple[npt.NDArray[Any], ...] = (
+            *(np.empty(size, dtype=np.float32) for _ in range(8)),
             np.empty(size, dtype=np.intp),
-            np.empty(size, dtype=np.complex128),
-            np.empty(size, dtype=np.complex64),
         )
 
     def shaped(self, m: int, w: int) -> tuple[Any, ...]:
@@ -284,7 +278,7 @@ def _eq1(
     kept: Bool,
     cum: npt.NDArray[np.float32],
     ref: npt.NDArray[np.complex128],
-    table: npt.NDArray[np.complex128],
+    table: npt.NDArray[np.float32],
     scratch: _Scratch | None = None,
 ) -> F64:
     """Eq. (1) of every draw (column) from its kept flags and polyline lengths (as
@@ -305,37 +299,39 @@ def _eq1(
     with np.errstate(invalid="ignore", divide="ignore"):
         c, s = (axis.real / norm).astype(np.float32), (axis.imag / norm).astype(np.float32)
     sums = np.zeros(w)
-    # real arithmetic on the complex arrays' x and y: NumPy's complex multiply and abs
-    # differ in the last bit between CPUs (AVX2 or not), its float add, multiply and sqrt
-    # do not
+    # real arithmetic on x and y, each in its own contiguous array (an operation on the
+    # complex arrays' strided parts costs several times one on contiguous ones): NumPy's
+    # complex multiply and abs differ in the last bit between CPUs (AVX2 or not), its float
+    # add, multiply and sqrt do not
+    zx, zy = z.real, z.imag
     for lo in range(0, m, BLOCK):
         hi = min(m, lo + BLOCK)
-        at, row, err, index, pair, moved = work.shaped(hi - lo, w)
+        at, row, tx, ty, sx, sy, mx, my, index = work.shaped(hi - lo, w)
         np.multiply(cum[lo:hi], scale, out=at)
         np.floor(at, out=row)
         at -= row
         np.copyto(index, row, casting="unsafe")
-        np.take(table, index, out=pair)
-        both = pair.view(np.complex64).reshape(hi - lo, w, 2)
-        target, step = both[..., 0], both[..., 1]
-        np.multiply(step.real, at, out=step.real)
-        np.multiply(step.imag, at, out=step.imag)
-        target += step
-        np.subtract(z[lo:hi], start, out=moved)
-        mx, my = moved.real, moved.imag
-        tx, ty = target.real, target.imag
-        # run frame x = c mx + s my - tx, y = c my - s mx - ty, each into its own array
+        # the target at l/L: its row plus the fraction of the step to the next
+        for plane, into in zip(table, (tx, ty, sx, sy), strict=True):
+            np.take(plane, index, out=into, mode="clip")
+        sx *= at
+        tx += sx
+        sy *= at
+        ty += sy
+        np.subtract(zx[lo:hi], start.real, out=mx)
+        np.subtract(zy[lo:hi], start.imag, out=my)
+        # run frame x = c mx + s my - tx, y = c my - s mx - ty
         np.multiply(mx, c, out=at)
         np.multiply(my, s, out=row)
         at += row
         at -= tx
         np.multiply(my, c, out=row)
-        np.multiply(mx, s, out=err)
-        row -= err
+        np.multiply(mx, s, out=sx)
+        row -= sx
         row -= ty
         np.multiply(at, at, out=at)
         np.multiply(row, row, out=row)
-        np.add(at, row, out=err)
+        err = np.add(at, row, out=sy)
         np.sqrt(err, out=err)
         err *= kept[lo:hi]
         if lo == 0:
