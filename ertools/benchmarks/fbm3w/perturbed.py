@@ -304,10 +304,17 @@ def _eq1(
     # complex multiply and abs differ in the last bit between CPUs (AVX2 or not), its float
     # add, multiply and sqrt do not
     zx, zy = z.real, z.imag
+    # a sample no draw keeps adds 0 to every sum (a robot standing still): left out, the
+    # rest of its block summed in the same order, to the same bits
+    active = np.flatnonzero(np.any(kept, axis=1))
     for lo in range(0, m, BLOCK):
         hi = min(m, lo + BLOCK)
-        at, row, tx, ty, sx, sy, mx, my, index = work.shaped(hi - lo, w)
-        np.multiply(cum[lo:hi], scale, out=at)
+        a, b = np.searchsorted(active, (lo, hi))
+        if a == b:
+            continue
+        rows: slice | IntArr = slice(lo, hi) if b - a == hi - lo else active[a:b]
+        at, row, tx, ty, sx, sy, mx, my, index = work.shaped(int(b - a), w)
+        np.multiply(cum[rows], scale, out=at)
         np.floor(at, out=row)
         at -= row
         np.copyto(index, row, casting="unsafe")
@@ -318,8 +325,8 @@ def _eq1(
         tx += sx
         sy *= at
         ty += sy
-        np.subtract(zx[lo:hi], start.real, out=mx)
-        np.subtract(zy[lo:hi], start.imag, out=my)
+        np.subtract(zx[rows], start.real, out=mx)
+        np.subtract(zy[rows], start.imag, out=my)
         # run frame x = c mx + s my - tx, y = c my - s mx - ty
         np.multiply(mx, c, out=at)
         np.multiply(my, s, out=row)
@@ -333,7 +340,7 @@ def _eq1(
         np.multiply(row, row, out=row)
         err = np.add(at, row, out=sy)
         np.sqrt(err, out=err)
-        err *= kept[lo:hi]
+        err *= kept[rows]
         if lo == 0:
             err[0] = 0.0  # 2015 started its sum at the second kept point (row 0: the start)
         sums += err.sum(axis=0, dtype=np.float64)

@@ -251,3 +251,17 @@ def test_fourfold_draws_score_as_independent_draws() -> None:
     for p in (2.5, 97.5):
         gap = abs(np.percentile(four, p) - np.percentile(one, p))
         assert gap < 5 * math.sqrt(1.0 + 4.0) * se_q * spread
+
+
+def test_samples_no_draw_keeps_are_left_out_of_eq1_exactly() -> None:
+    # The robot stands still for 150 samples mid-run (jitter far below d_min): no draw keeps
+    # them, Eq. (1) leaves those rows out (blocks partly and wholly skipped), and every draw
+    # still equals the seed's loop at its d_min.
+    u = np.concatenate([np.linspace(0.0, 0.4, 200), np.full(150, 0.4), np.linspace(0.4, 1, 200)])
+    xy = target("line", u) + np.random.default_rng(12).normal(0.0, 2e-6, (u.size, 2))
+    ref = np.array([-0.08, -0.024])
+    run = RunSamples(xy, np.arange(len(xy)), ref, builtin_shapes()["line"])
+    d_mins = np.array([0.00033, 0.0005, 0.0002])
+    got = perturbed_errors(run, np.zeros(3), d_mins, np.random.default_rng(0), noisy=False)
+    for g, d in zip(got, d_mins, strict=True):
+        assert g == pytest.approx(eq1(ref, xy, "line", float(d))[0], abs=ATOL)
