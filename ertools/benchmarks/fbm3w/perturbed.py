@@ -81,7 +81,7 @@ def perturbed_runs(
     """
     d = sigmas.size
     out = np.empty((d, len(runs)))
-    tables: dict[int, npt.NDArray[np.float32]] = {}
+    tables: dict[Shape, npt.NDArray[np.float32]] = {}  # runs of one shape share its table
     pieces = [
         (col, lo, min(d, lo + batch))
         for col, run in enumerate(runs)
@@ -112,9 +112,10 @@ def perturbed_runs(
             zt[m:, cols] = np.nan  # padding: never kept
         kept, cum = _subsample(zt, np.concatenate([d_mins[lo:hi] for _, lo, hi in group]))
         for (col, lo, hi), (z, cols, m), ref in zip(group, views, refs, strict=True):
-            table = tables.get(col)
+            shape = runs[col].shape
+            table = tables.get(shape)
             if table is None:
-                table = tables[col] = target_table(runs[col].shape)
+                table = tables[shape] = target_table(shape)
             out[lo:hi, col] = _eq1(z, kept[:m, cols], cum[:m, cols], ref, table, scratch)
     return out
 
