@@ -74,10 +74,10 @@ def perturbed_runs(
     from ``rng`` in turn (when ``noisy``: :func:`_noise`, each drawn noise used four ways
     unless not ``fourfold``), each draw's scaled by its sigma (a draw of sigma 0 takes no
     random numbers); a repeated pose takes the noise of the sample it repeats. The
-    positions are complex64
-    x + iy (one array and one operation for both coordinates, the distance ``abs``),
-    relative to each run's first (smoothed) sample: float32 parts resolve a run's metres to
-    0.1 um, against noise of 50 um and d_min of 330 um; lengths add up in float64.
+    positions are complex64 x + iy (one array for both coordinates: one subtraction per
+    step of the d_min rule), relative to each run's first (smoothed) sample: float32 parts
+    resolve a run's metres to 0.1 um, against noise of 50 um and d_min of 330 um; lengths
+    add up in float64.
     """
     d = sigmas.size
     out = np.empty((d, len(runs)))

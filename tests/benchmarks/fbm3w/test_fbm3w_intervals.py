@@ -265,3 +265,19 @@ def test_samples_no_draw_keeps_are_left_out_of_eq1_exactly() -> None:
     got = perturbed_errors(run, np.zeros(3), d_mins, np.random.default_rng(0), noisy=False)
     for g, d in zip(got, d_mins, strict=True):
         assert g == pytest.approx(eq1(ref, xy, "line", float(d))[0], abs=ATOL)
+
+
+def test_a_draw_of_sigma_zero_takes_no_random_numbers() -> None:
+    # Draw 1 of 9 has sigma 0 (a clipped sigma draw, or a smoothed path riding along): it is
+    # the positions as they are, and the other 8 take the documented noise in their order
+    # (2 drawn, used four ways: the first use falls on draws 0 and 2, not side by side).
+    xy, ref = _line_run(np.random.default_rng(13), 5e-5)
+    run = RunSamples(xy, np.arange(len(xy)), ref, builtin_shapes()["line"])
+    sigmas = np.array([1e-4, 0.0, 2e-4, 5e-5, 1.5e-4, 1e-4, 8e-5, 1.2e-4, 6e-5])
+    got = perturbed_errors(run, sigmas, np.full(9, 0.00033), np.random.default_rng(4), True)
+    noise, ref_noise = _standard_noise(np.random.default_rng(4), [len(xy)], [8])
+    at = [0, 2, 3, 4, 5, 6, 7, 8]
+    pos, refs = _draw_positions(run, noise, sigmas[at], ref_noise)
+    for k, col in enumerate(at):
+        assert got[col] == pytest.approx(eq1(refs[k], pos[k], "line", 0.00033)[0], abs=ATOL)
+    assert got[1] == pytest.approx(eq1(ref, xy, "line", 0.00033)[0], abs=ATOL)
