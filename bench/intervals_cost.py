@@ -1,5 +1,6 @@
-"""What the score intervals cost: each sample benchmark and the hour trajectory, scored by
-the default command, with the interval code's own CPU time beside the whole command's.
+"""What the score intervals cost: each sample benchmark of the README (the RSBB ones
+included) and the hour trajectory, scored by the default command, with the interval code's
+own CPU time beside the whole command's.
 
 Each case runs as a whole process, several times (page cache warm), by the child mode of
 this script: it wraps the benchmark's interval entry point with a CPU clock, runs the
@@ -45,6 +46,22 @@ ENTRY = {
     "fbm3w": (("ertools.benchmarks.fbm3w.pipeline", "with_intervals"),),
     "fbm2h": (("ertools.benchmarks.fbm2h.pipeline", "with_intervals"),),
     "fbm1": (("ertools.benchmarks.fbm1.pipeline", "fbm1_intervals"),),
+    # the RSBB benchmarks (ERL @Home 2017-19): each its intervals.py's entry point, seen
+    # from the pipeline that calls it
+    **{
+        name: ((f"ertools.benchmarks.{name}.pipeline", f"{name}_intervals"),)
+        for name in ("hnf", "hpff", "hopf", "hppf", "hgmf")
+    },
+}
+
+# the README's RSBB sample commands (its "Try it" block): one run bag each, side files found
+# in the RSBB layout beside it
+RSBB = {
+    "hnf": "hnf/rsbb_logs/HNF/simbot/run_1_2019-04-10-14-31-06.bag",
+    "hpff": "hpff/rsbb_logs/HPFF/simbot/run_1_2019-04-10-15-22-11.bag",
+    "hopf": "hopf/rsbb_logs/HOPF/simbot/run_1_2019-04-11-16-26-40.bag",
+    "hppf": "hppf/rsbb_logs/HPPF/simbot/run_1_2019-04-11-17-26-40.bag",
+    "hgmf": "hgmf/rsbb_logs/HGMF/simbot/run_1_2019-04-12-10-00-00.bag",
 }
 
 
@@ -103,6 +120,7 @@ def cases(hour: Path, fbm1w: Path) -> dict[str, tuple[str, list[str]]]:
                 str(robotlog),
             ],
         ),
+        **{name: (name, ["score", name, str(S / bag)]) for name, bag in RSBB.items()},
         "trajectory hour": (
             "trajectory",
             [

@@ -1,6 +1,5 @@
-"""Monte Carlo draws the intervals share (issue 39): standard normal noise in antithetic
-pairs, and the order statistics of perturbed distances drawn on only the values that can
-move them.
+"""Monte Carlo draws the intervals share (issue 39): the order statistics of perturbed
+distances drawn on only the values that can move them.
 
 Pure NumPy; every draw in float32 where the precision suffices (said at each function), in
 operations that give the same bits on every CPU (NumPy's float additions, products and square
@@ -14,7 +13,6 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import numpy.typing as npt
 
 from ertools.arrays import F64, IntArr
 
@@ -31,43 +29,6 @@ class Distances:
     sigma: F64
     velocity: F64
     period: F64
-
-
-def normal_pairs(
-    rng: np.random.Generator, rows: int, widths: IntArr, antithetic: bool
-) -> tuple[npt.NDArray[np.complex64], npt.NDArray[np.complex64]]:
-    """(rows, sum of widths) standard normal noise x + iy of samples and (sum of widths,) of
-    one more point per draw (FBM3's references), for pieces of draws side by side.
-
-    Drawn in float32 (x and y side by side read as one complex64 number): the samples'
-    (rows, draws, 2), then the references' (draws, 2). ``antithetic``: each piece's
-    second half of draws is the first half's noise negated (its first ceil(w / 2) draws
-    drawn, the rest their negatives in order): every draw is still exactly the model's,
-    the draws cost half the random numbers, and a score that grows with the noise one way
-    and shrinks the other (FBM3's runs: the correlation of f(z) and f(-z) measured -0.55
-    to -0.94 on the sample) has its quantiles no less precise than from independent draws.
-    A score even in the noise would count a pair as one draw.
-    """
-    total = int(np.sum(widths))
-    if not antithetic:
-        drawn = rng.standard_normal((rows, total, 2), dtype=np.float32)
-        refs = rng.standard_normal((total, 2), dtype=np.float32)
-        return drawn.view(np.complex64)[..., 0], refs.view(np.complex64)[:, 0].copy()
-    halves = [(int(w) + 1) // 2 for w in widths]
-    drawn = rng.standard_normal((rows, sum(halves), 2), dtype=np.float32)
-    refs = rng.standard_normal((sum(halves), 2), dtype=np.float32)
-    half = drawn.view(np.complex64)[..., 0]
-    half_ref = refs.view(np.complex64)[:, 0]
-    out = np.empty((rows, total), dtype=np.complex64)
-    out_ref = np.empty(total, dtype=np.complex64)
-    a = g = 0
-    for w, h in zip(widths.tolist(), halves, strict=True):
-        out[:, a : a + h] = half[:, g : g + h]
-        np.negative(half[:, g : g + w - h], out=out[:, a + h : a + w])
-        out_ref[a : a + h] = half_ref[g : g + h]
-        out_ref[a + h : a + w] = -half_ref[g : g + w - h]
-        a, g = a + w, g + h
-    return out, out_ref
 
 
 # Noise of more than this many sigma (chi with 3 degrees of freedom: P = 1e-10) is taken as

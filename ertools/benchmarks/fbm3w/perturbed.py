@@ -14,7 +14,6 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, Bool, IntArr
-from ertools.benchmarks.common.draws import normal_pairs
 from ertools.benchmarks.fbm3w.shapes import Shape
 
 # Draws x samples of one batch: bounds the memory of a long run (~8 bytes x a few arrays).
@@ -65,23 +64,24 @@ def perturbed_runs(
     noisy: bool,
     *,
     budget: int = BATCH_ELEMENTS,
-    antithetic: bool = True,
+    fourfold: bool = True,
 ) -> F64:
     """(D, R) distance errors of every run in every draw (column ``r``: ``runs[r]``).
 
     The runs' draws go side by side in groups (run by run, each run's draws in batches of
     at most ``budget`` samples, as many as fit in :data:`GROUP_ELEMENTS` padded samples);
-    the d_min rule is one pass over the samples of a group. The noise of a group is drawn
-    from ``rng`` at once (when ``noisy``: :func:`~ertools.benchmarks.common.draws.
-    normal_pairs`), each draw's scaled by its sigma; a repeated pose takes the noise of the
-    sample it repeats. The positions are complex64
-    x + iy (one array and one operation for both coordinates, the distance ``abs``),
-    relative to each run's first (smoothed) sample: float32 parts resolve a run's metres to
-    0.1 um, against noise of 50 um and d_min of 330 um; lengths add up in float64.
+    the d_min rule is one pass over the samples of a group. Each piece's noise is drawn
+    from ``rng`` in turn (when ``noisy``: :func:`_noise`, each drawn noise used four ways
+    unless not ``fourfold``), each draw's scaled by its sigma (a draw of sigma 0 takes no
+    random numbers); a repeated pose takes the noise of the sample it repeats. The
+    positions are complex64 x + iy (one array for both coordinates: one subtraction per
+    step of the d_min rule), relative to each run's first (smoothed) sample: float32 parts
+    resolve a run's metres to 0.1 um, against noise of 50 um and d_min of 330 um; lengths
+    add up in float64.
     """
     d = sigmas.size
     out = np.empty((d, len(runs)))
-    tables: dict[int, tuple[npt.NDArray[np.complex64], npt.NDArray[np.complex64]]] = {}
+    tables: dict[Shape, npt.NDArray[np.float32]] = {}  # runs of one shape share its table
     pieces = [
         (col, lo, min(d, lo + batch))
         for col, run in enumerate(runs)
@@ -97,41 +97,37 @@ def perturbed_runs(
         lengths = [len(runs[col].xy) for col, _, _ in group]
         edges = np.cumsum([0, *(hi - lo for _, lo, hi in group)])
         width, longest = int(edges[-1]), max(lengths)
-        scale = np.concatenate([sigmas[lo:hi] for _, lo, hi in group]).astype(np.float32)
-        if noisy:
-            zt, ref_noise = normal_pairs(rng, longest, np.diff(edges), antithetic)
-            zt *= scale
-            ref_noise *= scale
-        else:
-            zt = np.zeros((longest, width), dtype=np.complex64)
-            ref_noise = np.zeros(width, dtype=np.complex64)
+        zt = np.empty((longest, width), dtype=np.complex64)
         views = [
             (zt[:m, a:b], slice(a, b), m)
             for a, b, m in zip(edges[:-1], edges[1:], lengths, strict=True)
         ]
-        refs = [
-            _positions(runs[col], z, ref_noise[cols])
-            for (col, _, _), (z, cols, _) in zip(group, views, strict=True)
-        ]
-        for _, cols, m in views:
+        refs = []
+        for (col, lo, hi), (z, cols, m) in zip(group, views, strict=True):
+            scale = sigmas[lo:hi].astype(np.float32)
+            if not noisy:
+                scale[:] = 0.0
+            ref_noise = _noise(rng, z, scale, runs[col].source, fourfold)
+            refs.append(_positions(runs[col], z, ref_noise))
             zt[m:, cols] = np.nan  # padding: never kept
         kept, cum = _subsample(zt, np.concatenate([d_mins[lo:hi] for _, lo, hi in group]))
         for (col, lo, hi), (z, cols, m), ref in zip(group, views, refs, strict=True):
-            table = tables.get(col)
+            shape = runs[col].shape
+            table = tables.get(shape)
             if table is None:
-                table = tables[col] = target_table(runs[col].shape)
+                table = tables[shape] = target_table(shape)
             out[lo:hi, col] = _eq1(z, kept[:m, cols], cum[:m, cols], ref, table, scratch)
     return out
 
 
-def target_table(shape: Shape) -> tuple[npt.NDArray[np.complex64], npt.NDArray[np.complex64]]:
-    """The target x + iy at TABLE evenly spaced l in [0, 1] and each row's step to the next
-    (0 after the last), which the draws interpolate linearly (:func:`_eq1`): for the 2015
-    shapes within 2e-8 m of the curve (the sine's y'' = 2.6 m, times (1 / 4096)^2 / 8); a shape
-    given by points is exact but within 1 / 4096 of l around its corners."""
-    xy = shape(np.linspace(0.0, 1.0, TABLE))
-    t = (xy[:, 0] + 1j * xy[:, 1]).astype(np.complex64)
-    return t, np.diff(t, append=t[-1:]).astype(np.complex64)
+def target_table(shape: Shape) -> npt.NDArray[np.float32]:
+    """(4, TABLE) the target's x and y at TABLE evenly spaced l in [0, 1], and each row's
+    step to the next in x and y (0 after the last), which the draws interpolate linearly
+    (:func:`_eq1`): for the 2015 shapes within 2e-8 m of the curve (the sine's y'' = 2.6 m,
+    times (1 / 4096)^2 / 8); a shape given by points is exact but within 1 / 4096 of l
+    around its corners."""
+    xy = shape(np.linspace(0.0, 1.0, TABLE)).T.astype(np.float32)
+    return np.concatenate([xy, np.diff(xy, axis=1, append=xy[:, -1:])])
 
 
 def _groups(
@@ -159,19 +155,76 @@ def origin_of(run: RunSamples) -> F64:
     return np.asarray(xy[0], dtype=np.float64)
 
 
+# The four uses of one standard normal noise x + iy (docs/uncertainty.md, "How the FBM3@Work
+# draws are computed"): z, -z, iz = -y + ix and -iz = y - ix, each as (the source of the new
+# x and its sign, the source of the new y and its sign), 0: x, 1: y.
+FOURFOLD = (
+    ((0, 1.0), (1, 1.0)),
+    ((0, -1.0), (1, -1.0)),
+    ((1, -1.0), (0, 1.0)),
+    ((1, 1.0), (0, -1.0)),
+)
+
+
+def _noise(
+    rng: np.random.Generator,
+    out: npt.NDArray[np.complex64],
+    scale: npt.NDArray[np.float32],
+    source: IntArr,
+    fourfold: bool,
+) -> npt.NDArray[np.complex64]:
+    """Noise of one piece's draws written into ``out`` (m, w), x + iy of m samples in w
+    draws, each draw's scaled by its ``scale`` (w,); returns the (w,) noise of the
+    reference.
+
+    Only the draws of nonzero scale take random numbers (the others 0): with ``fourfold``
+    the first ceil(c / 4) of those c draws take standard normal noise z = x + iy (float32,
+    drawn as the samples' x (m, ceil(c / 4)), their y, then the reference's x and y), the
+    next as many -z, then iz, then -iz; otherwise each its own. A standard normal x + iy is
+    unchanged in distribution by a turn of the plane (its density depends on |z| only), so
+    each draw is exactly the model's, for a quarter of the random numbers. A repeated sample
+    (``source``) repeats the noise of the sample it carries.
+    """
+    m, w = out.shape
+    ref = np.zeros(w, dtype=np.complex64)
+    quiet = scale == 0
+    out[:, quiet] = 0.0
+    drawn_cols = np.flatnonzero(~quiet)
+    if drawn_cols.size == 0:
+        return ref
+    uses = FOURFOLD if fourfold else FOURFOLD[:1]
+    per = -(-drawn_cols.size // len(uses))
+    drawn = rng.standard_normal((2, m, per), dtype=np.float32)
+    drawn_ref = rng.standard_normal((2, per), dtype=np.float32)
+    if np.any(source != np.arange(m)):
+        drawn = drawn[:, source]
+    for k, axes in enumerate(uses):
+        cols = drawn_cols[k * per : (k + 1) * per]
+        if cols.size == 0:
+            break
+        sl = slice(int(cols[0]), int(cols[-1]) + 1)
+        together = sl.stop - sl.start == cols.size  # side by side: written in place
+        target = out[:, sl] if together else np.empty((m, cols.size), np.complex64)
+        for part, (axis, sign) in zip((target.real, target.imag), axes, strict=True):
+            np.multiply(drawn[axis, :, : cols.size], scale[cols] * np.float32(sign), out=part)
+        if not together:
+            out[:, cols] = target
+        ref.real[cols] = drawn_ref[axes[0][0], : cols.size] * scale[cols] * axes[0][1]
+        ref.imag[cols] = drawn_ref[axes[1][0], : cols.size] * scale[cols] * axes[1][1]
+    return ref
+
+
 def _positions(
     run: RunSamples, z: npt.NDArray[np.complex64], ref_noise: npt.NDArray[np.complex64]
 ) -> npt.NDArray[np.complex128]:
     """One run's sample positions put into ``z`` (N, D), which holds their noise, as x + iy
-    relative to :func:`origin_of` (a repeated pose repeats the noise of the sample it
-    repeats); the (D,) positions of its reference, whose noise is ``ref_noise``."""
+    relative to :func:`origin_of`; the (D,) positions of its reference, whose noise is
+    ``ref_noise``."""
     origin = origin_of(run)
     xy = (run.xy if run.center_xy is None else run.center_xy) - origin
     ref = (
         run.reference_xy if run.center_reference_xy is None else run.center_reference_xy
     ) - origin
-    if np.any(run.source != np.arange(len(xy))):
-        z[:] = z[run.source]
     z += (xy[:, 0] + 1j * xy[:, 1]).astype(np.complex64)[:, None]
     return np.asarray(complex(ref[0], ref[1]) + ref_noise.astype(np.complex128))
 
@@ -211,13 +264,9 @@ class _Scratch:
     arrays of megabytes cost more in page faults than the arithmetic on them."""
 
     def __init__(self, size: int) -> None:
-        self.arrays = (
-            np.empty(size, dtype=np.float32),
-            np.empty(size, dtype=np.float32),
-            np.empty(size, dtype=np.float32),
+        self.arrays: tuple[npt.NDArray[Any], ...] = (
+            *(np.empty(size, dtype=np.float32) for _ in range(8)),
             np.empty(size, dtype=np.intp),
-            np.empty(size, dtype=np.complex64),
-            np.empty(size, dtype=np.complex64),
         )
 
     def shaped(self, m: int, w: int) -> tuple[Any, ...]:
@@ -230,7 +279,7 @@ def _eq1(
     kept: Bool,
     cum: npt.NDArray[np.float32],
     ref: npt.NDArray[np.complex128],
-    table: tuple[npt.NDArray[np.complex64], npt.NDArray[np.complex64]],
+    table: npt.NDArray[np.float32],
     scratch: _Scratch | None = None,
 ) -> F64:
     """Eq. (1) of every draw (column) from its kept flags and polyline lengths (as
@@ -251,38 +300,48 @@ def _eq1(
     with np.errstate(invalid="ignore", divide="ignore"):
         c, s = (axis.real / norm).astype(np.float32), (axis.imag / norm).astype(np.float32)
     sums = np.zeros(w)
-    # real arithmetic on the complex arrays' x and y: NumPy's complex multiply and abs
-    # differ in the last bit between CPUs (AVX2 or not), its float add, multiply and sqrt
-    # do not
+    # real arithmetic on x and y, each in its own contiguous array (an operation on the
+    # complex arrays' strided parts costs several times one on contiguous ones): NumPy's
+    # complex multiply and abs differ in the last bit between CPUs (AVX2 or not), its float
+    # add, multiply and sqrt do not
+    zx, zy = z.real, z.imag
+    # a sample no draw keeps adds 0 to every sum (a robot standing still): left out, the
+    # rest of its block summed in the same order, to the same bits
+    active = np.flatnonzero(np.any(kept, axis=1))
     for lo in range(0, m, BLOCK):
         hi = min(m, lo + BLOCK)
-        at, row, err, index, target, moved = work.shaped(hi - lo, w)
-        np.multiply(cum[lo:hi], scale, out=at)
+        a, b = np.searchsorted(active, (lo, hi))
+        if a == b:
+            continue
+        rows: slice | IntArr = slice(lo, hi) if b - a == hi - lo else active[a:b]
+        at, row, tx, ty, sx, sy, mx, my, index = work.shaped(int(b - a), w)
+        np.multiply(cum[rows], scale, out=at)
         np.floor(at, out=row)
         at -= row
         np.copyto(index, row, casting="unsafe")
-        np.take(table[0], index, out=target)
-        np.take(table[1], index, out=moved)
-        step = moved.view(np.float32).reshape(hi - lo, w, 2)
-        step *= at[..., None]
-        target += moved
-        np.subtract(z[lo:hi], start, out=moved)
-        mx, my = moved.real, moved.imag
-        tx, ty = target.real, target.imag
-        # run frame x = c mx + s my - tx, y = c my - s mx - ty, each into its own array
+        # the target at l/L: its row plus the fraction of the step to the next
+        for plane, into in zip(table, (tx, ty, sx, sy), strict=True):
+            np.take(plane, index, out=into, mode="clip")
+        sx *= at
+        tx += sx
+        sy *= at
+        ty += sy
+        np.subtract(zx[rows], start.real, out=mx)
+        np.subtract(zy[rows], start.imag, out=my)
+        # run frame x = c mx + s my - tx, y = c my - s mx - ty
         np.multiply(mx, c, out=at)
         np.multiply(my, s, out=row)
         at += row
         at -= tx
         np.multiply(my, c, out=row)
-        np.multiply(mx, s, out=err)
-        row -= err
+        np.multiply(mx, s, out=sx)
+        row -= sx
         row -= ty
         np.multiply(at, at, out=at)
         np.multiply(row, row, out=row)
-        np.add(at, row, out=err)
+        err = np.add(at, row, out=sy)
         np.sqrt(err, out=err)
-        err *= kept[lo:hi]
+        err *= kept[rows]
         if lo == 0:
             err[0] = 0.0  # 2015 started its sum at the second kept point (row 0: the start)
         sums += err.sum(axis=0, dtype=np.float64)

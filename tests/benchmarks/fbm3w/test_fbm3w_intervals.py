@@ -57,21 +57,23 @@ def _draw_positions(
 
 
 def _standard_noise(
-    rng: np.random.Generator, rows: int, widths: list[int]
+    rng: np.random.Generator, rows: list[int], widths: list[int], ways: int = 4
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The documented order of the draws' noise (draws.normal_pairs, antithetic): per piece of
-    w draws its first ceil(w / 2) drawn, the rest their negatives; the samples' (rows,
-    halves, x and y) in float32, then the references' (halves, x and y)."""
-    halves = [(w + 1) // 2 for w in widths]
-    drawn = rng.standard_normal((rows, sum(halves), 2), dtype=np.float32)
-    refs = rng.standard_normal((sum(halves), 2), dtype=np.float32)
-    half = drawn[..., 0] + 1j * drawn[..., 1]
-    half_ref = refs[:, 0] + 1j * refs[:, 1]
-    cols, ref_cols, g = [], [], 0
-    for w, h in zip(widths, halves, strict=True):
-        cols += [half[:, g : g + h], -half[:, g : g + w - h]]
-        ref_cols += [half_ref[g : g + h], -half_ref[g : g + w - h]]
-        g += h
+    """The documented order of the draws' noise (perturbed._noise): piece after piece (rows
+    samples, w draws), its samples' x (rows, q), their y, then its reference's x and y, q =
+    ceil(w / 4), in float32; its first q draws take that noise z, the next -z, then iz =
+    -y + ix, then -iz (``ways`` 1: each draw its own). Returned as (max rows, sum of widths)
+    and (sum of widths,) complex, a shorter piece's missing rows 0."""
+    cols, ref_cols = [], []
+    for n, w in zip(rows, widths, strict=True):
+        q = -(-w // ways)
+        x, y = rng.standard_normal((2, n, q), dtype=np.float32)
+        rx, ry = rng.standard_normal((2, q), dtype=np.float32)
+        z, rz = x + 1j * y, rx + 1j * ry
+        turned = np.concatenate([z, -z, 1j * z, -1j * z][:ways], axis=1)[:, :w]
+        turned_ref = np.concatenate([rz, -rz, 1j * rz, -1j * rz][:ways])[:w]
+        cols.append(np.vstack([turned, np.zeros((max(rows) - n, w))]))
+        ref_cols.append(turned_ref)
     return (
         np.concatenate(cols, axis=1).astype(np.complex64),
         np.concatenate(ref_cols).astype(np.complex64),
@@ -97,13 +99,16 @@ def test_noisy_draws_match_the_seed_loop_on_the_same_positions() -> None:
     run = RunSamples(xy, np.arange(len(xy)), ref, shape)
     sigmas = np.array([1e-4, 2e-4, 5e-5])
     got = perturbed_errors(run, sigmas, np.full(3, 0.00033), np.random.default_rng(9), True)
-    noise, ref_noise = _standard_noise(np.random.default_rng(9), len(xy), [3])
+    noise, ref_noise = _standard_noise(np.random.default_rng(9), [len(xy)], [3])
     pos, refs = _draw_positions(run, noise, sigmas, ref_noise)
     for k in range(3):
         want = eq1(refs[k], pos[k], "line", 0.00033)[0]
         assert got[k] == pytest.approx(want, abs=ATOL)
-    # the third draw is the first's noise negated (antithetic): its own positions
-    assert np.allclose(pos[2] - xy, -(pos[0] - xy) * 5e-5 / 1e-4, atol=3e-8)
+    # the second draw is the first's noise negated, the third turned by 90 degrees (x, y ->
+    # -y, x), each its own sigma
+    first = (pos[0] - xy) / 1e-4
+    assert np.allclose((pos[1] - xy) / 2e-4, -first, atol=3e-4)
+    assert np.allclose((pos[2] - xy) / 5e-5, first[:, ::-1] * [-1, 1], atol=3e-4)
 
 
 def test_independent_draws_on_request() -> None:
@@ -111,13 +116,9 @@ def test_independent_draws_on_request() -> None:
     run = RunSamples(xy, np.arange(len(xy)), ref, builtin_shapes()["line"])
     sigmas = np.full(2, 1e-4)
     got = perturbed_runs(
-        [run], sigmas, np.full(2, 0.00033), np.random.default_rng(9), True, antithetic=False
+        [run], sigmas, np.full(2, 0.00033), np.random.default_rng(9), True, fourfold=False
     )[:, 0]
-    again = np.random.default_rng(9)
-    drawn = again.standard_normal((len(xy), 2, 2), dtype=np.float32)
-    refs = again.standard_normal((2, 2), dtype=np.float32)
-    noise = (drawn[..., 0] + 1j * drawn[..., 1]).astype(np.complex64)
-    ref_noise = (refs[:, 0] + 1j * refs[:, 1]).astype(np.complex64)
+    noise, ref_noise = _standard_noise(np.random.default_rng(9), [len(xy)], [2], ways=1)
     pos, r = _draw_positions(run, noise, sigmas, ref_noise)
     for k in range(2):
         assert got[k] == pytest.approx(eq1(r[k], pos[k], "line", 0.00033)[0], abs=ATOL)
@@ -180,7 +181,7 @@ def test_a_repeated_pose_repeats_its_noise_in_every_draw() -> None:
     run = RunSamples(xy, source, ref, builtin_shapes()["line"])
     sigmas = np.full(2, 1e-4)
     got = perturbed_errors(run, sigmas, np.full(2, 0.00033), np.random.default_rng(3), True)
-    noise, ref_noise = _standard_noise(np.random.default_rng(3), len(xy), [2])
+    noise, ref_noise = _standard_noise(np.random.default_rng(3), [len(xy)], [2])
     pos, refs = _draw_positions(run, noise, sigmas, ref_noise)
     for k in range(2):
         assert np.all(pos[k, 5:8] == pos[k, 4])
@@ -194,7 +195,7 @@ def test_runs_scored_in_one_pass_equal_the_seed_loop(budget: int) -> None:
     # one d_min pass (or split in groups and batches by a small budget): without noise each
     # column equals the seed's plain loop at its own d_min, however the draws are grouped;
     # with noise, in one group, equal to the loop on the positions drawn in the documented
-    # order (the group's pieces side by side, each antithetic).
+    # order (piece after piece, each drawn noise used four ways).
     line = builtin_shapes()["line"]
     runs = []
     for k, n in enumerate((400, 150, 260)):
@@ -215,11 +216,68 @@ def test_runs_scored_in_one_pass_equal_the_seed_loop(budget: int) -> None:
         return
     sigmas = np.array([1e-4, 5e-5, 2e-4, 1.5e-4])
     got = perturbed_runs(runs, sigmas, d_mins, np.random.default_rng(11), True, budget=budget)
-    longest = max(len(r.xy) for r in runs)
-    noise, ref_noise = _standard_noise(np.random.default_rng(11), longest, [4, 4, 4])
+    lengths = [len(r.xy) for r in runs]
+    noise, ref_noise = _standard_noise(np.random.default_rng(11), lengths, [4, 4, 4])
     for col, run in enumerate(runs):
         cols = slice(4 * col, 4 * col + 4)
         pos, refs = _draw_positions(run, noise[: len(run.xy), cols], sigmas, ref_noise[cols])
         for k in range(4):
             want = eq1(refs[k], pos[k], "line", float(d_mins[k]))
             assert got[k, col] == pytest.approx(want[0], abs=ATOL)
+
+
+def test_fourfold_draws_score_as_independent_draws() -> None:
+    # Each drawn noise used four ways (z, -z, iz, -iz) leaves every draw's distribution the
+    # model's: the distance errors of 4,000 draws have the mean, spread and 2.5% and 97.5%
+    # quantiles of 4,000 independent ones. Tolerances: 5 standard errors of a difference of
+    # two independent estimates (the fourfold ones' own standard error taken twice that of
+    # independent draws: their groups of four are correlated); a quantile's standard error
+    # from the normal's density at it, sqrt(p (1 - p) / n) / phi(z_p) times the spread.
+    # a run on the line itself: its score is the noise's alone, and grows with sigma
+    xy = target("line", np.linspace(0.0, 1.0, 400))
+    ref = np.array([-0.08, 0.0])  # the run frame's x axis: the world's
+    run = RunSamples(xy, np.arange(len(xy)), ref, builtin_shapes()["line"])
+    n = 4000
+    sigmas, d_mins = np.full(n, 1e-4), np.full(n, 0.00033)
+    four = perturbed_errors(run, sigmas, d_mins, np.random.default_rng(1), True)
+    one = perturbed_runs([run], sigmas, d_mins, np.random.default_rng(2), True, fourfold=False)
+    one = one[:, 0]
+    spread = float(np.std(one))
+    se = math.sqrt(1.0**2 + 2.0**2) * spread / math.sqrt(n)
+    assert abs(np.mean(four) - np.mean(one)) < 5 * se
+    assert abs(np.std(four) - spread) < 5 * se / math.sqrt(2)  # sd's se: sd / sqrt(2 n)
+    z = 1.959964
+    se_q = math.sqrt(0.025 * 0.975 / n) / (math.exp(-z * z / 2) / math.sqrt(2 * math.pi))
+    for p in (2.5, 97.5):
+        gap = abs(np.percentile(four, p) - np.percentile(one, p))
+        assert gap < 5 * math.sqrt(1.0 + 4.0) * se_q * spread
+
+
+def test_samples_no_draw_keeps_are_left_out_of_eq1_exactly() -> None:
+    # The robot stands still for 150 samples mid-run (jitter far below d_min): no draw keeps
+    # them, Eq. (1) leaves those rows out (blocks partly and wholly skipped), and every draw
+    # still equals the seed's loop at its d_min.
+    u = np.concatenate([np.linspace(0.0, 0.4, 200), np.full(150, 0.4), np.linspace(0.4, 1, 200)])
+    xy = target("line", u) + np.random.default_rng(12).normal(0.0, 2e-6, (u.size, 2))
+    ref = np.array([-0.08, -0.024])
+    run = RunSamples(xy, np.arange(len(xy)), ref, builtin_shapes()["line"])
+    d_mins = np.array([0.00033, 0.0005, 0.0002])
+    got = perturbed_errors(run, np.zeros(3), d_mins, np.random.default_rng(0), noisy=False)
+    for g, d in zip(got, d_mins, strict=True):
+        assert g == pytest.approx(eq1(ref, xy, "line", float(d))[0], abs=ATOL)
+
+
+def test_a_draw_of_sigma_zero_takes_no_random_numbers() -> None:
+    # Draw 1 of 9 has sigma 0 (a clipped sigma draw, or a smoothed path riding along): it is
+    # the positions as they are, and the other 8 take the documented noise in their order
+    # (2 drawn, used four ways: the first use falls on draws 0 and 2, not side by side).
+    xy, ref = _line_run(np.random.default_rng(13), 5e-5)
+    run = RunSamples(xy, np.arange(len(xy)), ref, builtin_shapes()["line"])
+    sigmas = np.array([1e-4, 0.0, 2e-4, 5e-5, 1.5e-4, 1e-4, 8e-5, 1.2e-4, 6e-5])
+    got = perturbed_errors(run, sigmas, np.full(9, 0.00033), np.random.default_rng(4), True)
+    noise, ref_noise = _standard_noise(np.random.default_rng(4), [len(xy)], [8])
+    at = [0, 2, 3, 4, 5, 6, 7, 8]
+    pos, refs = _draw_positions(run, noise, sigmas[at], ref_noise)
+    for k, col in enumerate(at):
+        assert got[col] == pytest.approx(eq1(refs[k], pos[k], "line", 0.00033)[0], abs=ATOL)
+    assert got[1] == pytest.approx(eq1(ref, xy, "line", 0.00033)[0], abs=ATOL)
