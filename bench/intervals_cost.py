@@ -158,6 +158,7 @@ def child(entry: str, argv: list[str]) -> None:
 
         return timed
 
+    wrapped = 0
     for module, name in ENTRY[entry]:
         try:
             mod = importlib.import_module(module)
@@ -165,11 +166,12 @@ def child(entry: str, argv: list[str]) -> None:
             continue
         if hasattr(mod, name):
             setattr(mod, name, timer(getattr(mod, name)))
+            wrapped += 1
     from ertools.cli.main import main  # lazy: after the wrapper is in place
 
     code = main([*argv, "--format", "json", "--out", "/dev/null"])
     total = time.process_time()
-    print(json.dumps({"exit": code, "interval_s": spent[0], "total_s": total}))
+    print(json.dumps({"exit": code, "interval_s": spent[0], "total_s": total, "wrapped": wrapped}))
 
 
 def run_child(entry: str, argv: list[str], code: Path | None = None) -> dict[str, float]:
@@ -190,6 +192,9 @@ def run_child(entry: str, argv: list[str], code: Path | None = None) -> dict[str
         sys.stderr.write(done.stderr.decode(errors="replace")[-2000:])
         raise SystemExit(f"failed: {' '.join(argv)}")
     report: dict[str, float] = json.loads(lines[-1])
+    if code is None and not report.get("wrapped"):
+        # a renamed entry point would otherwise measure 0 s of intervals, silently
+        raise SystemExit(f"{entry}: none of {ENTRY[entry]} exists: update ENTRY")
     return report
 
 
