@@ -16,14 +16,13 @@ from ertools.views.chart import (
     COLOURS,
     Arrows,
     Axis,
-    Bars,
     Chart,
     Layer,
     Line,
-    RefLine,
     Scatter,
     Text,
 )
+from ertools.views.pose_errors import pose_errors_chart
 from ertools.views.spec import ChartSpec
 from ertools.views.thinning import thin_path
 
@@ -88,40 +87,14 @@ def path_chart(result: Any, size: tuple[float, float] = PATH_SIZE) -> Chart:
 def errors_chart(result: Any) -> Chart:
     """Distance error (bars, left axis) and orientation error (right axis) per waypoint;
     dashed: the accuracies the benchmark counts against."""
-    idx = np.array([s.index for s in result.segments], dtype=float)
-    dist = np.array(
-        [np.nan if s.distance_error is None else s.distance_error for s in result.segments]
-    )
-    ori = np.array(
-        [np.nan if s.orientation_error is None else s.orientation_error for s in result.segments]
-    )
-    blue, orange = COLOURS["blue"], COLOURS["orange"]
-    layers: list[Layer] = [
-        Bars(idx - 0.2, dist * MM, 0.4, (blue,), "distance error"),
-        Bars(idx + 0.2, ori * DEG, 0.4, (orange,), "orientation error", side="right"),
-    ]
-    if result.position_accuracy is not None:
-        layers.append(RefLine(result.position_accuracy * MM, "y", blue, label="position accuracy"))
-    if result.orientation_accuracy is not None:
-        layers.append(
-            RefLine(
-                result.orientation_accuracy * DEG,
-                "y",
-                orange,
-                label="orientation accuracy",
-                side="right",
-            )
-        )
-    layers += [
-        Text(float(i), 0.0, "no score", COLOURS["red"], offset=(0.0, 3.0), anchor="middle")
-        for i in idx[np.isnan(dist)]
-    ]
-    return Chart(
-        tuple(layers),
-        x=Axis("waypoint", ticks=tuple((float(i), str(int(i))) for i in idx)),
-        y=Axis(units.label("distance error", "length"), colour=blue, include_zero=True),
-        right=Axis(units.label("orientation error", "angle"), colour=orange, include_zero=True),
-        grid="y",
+    segments = result.segments
+    return pose_errors_chart(
+        [s.index for s in segments],
+        [s.distance_error for s in segments],
+        [s.orientation_error for s in segments],
+        (result.position_accuracy, result.orientation_accuracy),
+        ["no score"] * len(segments),
+        "waypoint",
     )
 
 
