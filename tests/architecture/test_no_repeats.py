@@ -15,11 +15,6 @@ ALLOWED = frozenset(
         # issue 38's RSBB packages, written in parallel on the old record (merged after issue
         # 37's conversions): what they share goes to ertools/rsbb/ as they are converted
         "ertools/benchmarks/fbm1/plots.py ~ ertools/benchmarks/hopf/plots.py",
-        "ertools/benchmarks/fbm2h/plots.py ~ ertools/benchmarks/hnf/plots.py",
-        "ertools/benchmarks/hgmf/result.py ~ ertools/benchmarks/hnf/result.py",
-        "ertools/benchmarks/hnf/declare.py ~ ertools/benchmarks/hpff/declare.py",
-        "ertools/benchmarks/hnf/pipeline.py ~ ertools/benchmarks/hpff/pipeline.py",
-        "ertools/benchmarks/hnf/sample.py ~ ertools/benchmarks/hpff/sample.py",
         "ertools/benchmarks/hopf/declare.py ~ ertools/benchmarks/hppf/declare.py",
         "ertools/benchmarks/hopf/goals.py ~ ertools/benchmarks/hppf/goals.py",
         "ertools/benchmarks/hopf/result.py ~ ertools/benchmarks/hppf/result.py",
