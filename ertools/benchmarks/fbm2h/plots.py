@@ -14,7 +14,6 @@ from ertools.benchmarks.common import gaps
 from ertools.views import units
 from ertools.views.chart import (
     COLOURS,
-    Arrows,
     Axis,
     Chart,
     Layer,
@@ -22,25 +21,12 @@ from ertools.views.chart import (
     Scatter,
     Text,
 )
-from ertools.views.pose_errors import pose_errors_chart
 from ertools.views.spec import ChartSpec
 from ertools.views.thinning import thin_path
+from ertools.views.waypoints import pose_errors_chart, pose_layers
 
-ARROW = 0.25  # metres: length of the heading arrows on the path figure
 MM = units.factor("length", "m")
-DEG = units.factor("angle", "rad")
 PATH_SIZE = (7.0, 6.0)
-
-
-def _poses(xyt: np.ndarray, colour: str, label: str, marker: Any) -> list[Layer]:
-    """Markers at the poses and an arrow along each heading."""
-    x, y = xyt[:, 0] * MM, xyt[:, 1] * MM
-    return [
-        Scatter(x, y, colour, marker=marker, size=5.0, label=label),
-        Arrows(
-            x, y, x + np.cos(xyt[:, 2]) * ARROW * MM, y + np.sin(xyt[:, 2]) * ARROW * MM, colour
-        ),
-    ]
 
 
 def path_chart(result: Any, size: tuple[float, float] = PATH_SIZE) -> Chart:
@@ -53,12 +39,12 @@ def path_chart(result: Any, size: tuple[float, float] = PATH_SIZE) -> Chart:
             Line(path[:, 0] * MM, path[:, 1] * MM, "#8c8c8c", 1.0, label="robot path (GT)")
         )
     targets = np.array([s.target for s in result.segments], dtype=float).reshape(-1, 3)
-    layers += _poses(targets, COLOURS["blue"], "waypoint (target heading)", "o")
+    layers += pose_layers(targets, COLOURS["blue"], "waypoint (target heading)", "o")
     reached = np.array(
         [s.robot for s in result.segments if s.robot is not None], dtype=float
     ).reshape(-1, 3)
     if len(reached):
-        layers += _poses(reached, COLOURS["red"], "robot when reached", "x")
+        layers += pose_layers(reached, COLOURS["red"], "robot when reached", "x")
     layers += [
         Text(s.target[0] * MM, s.target[1] * MM, str(s.index), COLOURS["blue"], offset=(7.0, 7.0))
         for s in result.segments

@@ -12,32 +12,18 @@ import numpy as np
 from ertools.views import units
 from ertools.views.chart import (
     COLOURS,
-    Arrows,
     Axis,
     Chart,
     Layer,
     Line,
-    Scatter,
     Text,
 )
-from ertools.views.pose_errors import pose_errors_chart
 from ertools.views.spec import ChartSpec
 from ertools.views.thinning import thin_path
+from ertools.views.waypoints import pose_errors_chart, pose_layers
 
-ARROW = 0.25  # metres: the heading arrows
 MM = units.factor("length", "m")
-DEG = units.factor("angle", "rad")
 PATH_SIZE = (7.0, 6.0)
-
-
-def _poses(xyt: np.ndarray, colour: str, label: str, marker: Any) -> list[Layer]:
-    x, y = xyt[:, 0] * MM, xyt[:, 1] * MM
-    return [
-        Scatter(x, y, colour, marker=marker, size=5.0, label=label),
-        Arrows(
-            x, y, x + np.cos(xyt[:, 2]) * ARROW * MM, y + np.sin(xyt[:, 2]) * ARROW * MM, colour
-        ),
-    ]
 
 
 def path_chart(result: Any, size: tuple[float, float] = PATH_SIZE) -> Chart:
@@ -49,10 +35,10 @@ def path_chart(result: Any, size: tuple[float, float] = PATH_SIZE) -> Chart:
             Line(track[:, 0] * MM, track[:, 1] * MM, "#8c8c8c", 1.0, label="marker set (mocap)")
         )
     targets = np.array([[float(v) for v in w] for w in result.waypoints]).reshape(-1, 3)
-    layers += _poses(targets, COLOURS["blue"], "waypoint (target heading)", "o")
+    layers += pose_layers(targets, COLOURS["blue"], "waypoint (target heading)", "o")
     robot = np.array([s.robot for s in result.segments if s.measured], dtype=float).reshape(-1, 3)
     if len(robot):
-        layers += _poses(robot, COLOURS["red"], "robot at the script's lookup", "x")
+        layers += pose_layers(robot, COLOURS["red"], "robot at the script's lookup", "x")
     layers += [
         Text(float(w[0]) * MM, float(w[1]) * MM, str(k + 1), COLOURS["blue"], offset=(7.0, 7.0))
         for k, w in enumerate(result.waypoints)

@@ -1,18 +1,32 @@
-"""The figure of a navigation benchmark's errors per waypoint: the distance error (bars, left
-axis, mm) and the orientation error (bars, right axis, deg) of each, dashed lines at the
-accuracies they are counted against, and a word where a waypoint has no error."""
+"""What the figures of a navigation benchmark draw: poses with their headings (the waypoints,
+the robot where it was measured) and the errors per waypoint (the distance error in bars on
+the left axis, mm, the orientation error on the right, deg, dashed lines at the accuracies
+they are counted against, and a word where a waypoint has no error)."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
 from ertools.views import units
-from ertools.views.chart import COLOURS, Axis, Bars, Chart, Layer, RefLine, Text
+from ertools.views.chart import COLOURS, Arrows, Axis, Bars, Chart, Layer, RefLine, Scatter, Text
 
 MM = units.factor("length", "m")
 DEG = units.factor("angle", "rad")
+ARROW = 0.25  # metres: the length of a heading arrow
+
+
+def pose_layers(xyt: np.ndarray, colour: str, label: str, marker: Any) -> list[Layer]:
+    """Markers at the (x, y, heading) rows, in mm, and an arrow along each heading."""
+    x, y = xyt[:, 0] * MM, xyt[:, 1] * MM
+    return [
+        Scatter(x, y, colour, marker=marker, size=5.0, label=label),
+        Arrows(
+            x, y, x + np.cos(xyt[:, 2]) * ARROW * MM, y + np.sin(xyt[:, 2]) * ARROW * MM, colour
+        ),
+    ]
 
 
 def pose_errors_chart(
