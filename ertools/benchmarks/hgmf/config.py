@@ -19,7 +19,7 @@ from ertools.benchmarks.common.inputs import (
     INTERVAL_INPUTS,
     check_confidence,
 )
-from ertools.benchmarks.common.side_inputs import SCRIPT_GROUP, config_input, result_input
+from ertools.benchmarks.common.script_inputs import SCRIPT_GROUP, config_input, result_input
 from ertools.errors import UsageError
 
 NAME = "hgmf"

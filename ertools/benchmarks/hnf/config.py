@@ -13,14 +13,14 @@ from typing import Any
 
 from ertools.benchmarks.base import Input, resolve_values
 from ertools.benchmarks.common.inputs import INTERVAL_INPUTS, check_confidence
-from ertools.benchmarks.common.side_inputs import (
+from ertools.benchmarks.common.script_inputs import (
     SCRIPT_GROUP,
     TRANSFORM,
     config_input,
+    refuse_undoing,
     result_input,
     team_input,
 )
-from ertools.errors import UsageError
 
 #: ``--rules``: ertools' reading, or a version of the script (docs/hnf.md, "2017-18").
 #: 2019 = rockin-robot-challenge/rsbb 2bb8a41; 2017 = Enri2077/rsbb 00e3106 (December 2017 to
@@ -150,16 +150,14 @@ def make_options(given: Mapping[str, Any]) -> HnfOptions:
     rules = str(v["rules"] or "ertools")
     script = SCRIPT_COMMITS.get(rules, "2bb8a41")
     faithful = rules != "ertools"
-    chosen = {
-        "--divisor": v["divisor"] not in (None, "2019"),
-        "--gt-gaps": v["gt_gaps"] not in (None, "interpolate"),
-        "--score-format": v["score_format"] not in (None, "2019"),
-    }
-    clash = [name for name, ertools_value in chosen.items() if ertools_value]
-    if faithful and clash:
-        raise UsageError(
-            f"--rules {rules} reproduces the script: {', '.join(clash)} would undo it; "
-            "give one or the other"
+    if faithful:
+        refuse_undoing(
+            rules,
+            {
+                "--divisor": v["divisor"] not in (None, "2019"),
+                "--gt-gaps": v["gt_gaps"] not in (None, "interpolate"),
+                "--score-format": v["score_format"] not in (None, "2019"),
+            },
         )
     return HnfOptions(
         config=v["config"],

@@ -13,14 +13,14 @@ from typing import Any
 
 from ertools.benchmarks.base import Input, resolve_values
 from ertools.benchmarks.common.inputs import INTERVAL_INPUTS, check_confidence
-from ertools.benchmarks.common.side_inputs import (
+from ertools.benchmarks.common.script_inputs import (
     SCRIPT_GROUP,
     TRANSFORM,
     config_input,
+    refuse_undoing,
     result_input,
     team_input,
 )
-from ertools.errors import UsageError
 
 RULE_SETS = ("ertools", "2019")
 SCRIPT_COMMIT = "2bb8a41"
@@ -127,16 +127,14 @@ def make_options(given: Mapping[str, Any]) -> HpffOptions:
     check_confidence(v["confidence"])
     rules = str(v["rules"] or "ertools")
     faithful = rules == "2019"
-    undo = {
-        "--sampling": v["sampling"] == "grid",
-        "--distance-plane": v["distance_plane"] == "testbed",
-        "--duration-clock": v["duration_clock"] == "refbox",
-    }
-    clash = [name for name, given in undo.items() if given]
-    if faithful and clash:
-        raise UsageError(
-            f"--rules 2019 reproduces the script: {', '.join(clash)} would undo it; "
-            "give one or the other"
+    if faithful:
+        refuse_undoing(
+            rules,
+            {
+                "--sampling": v["sampling"] == "grid",
+                "--distance-plane": v["distance_plane"] == "testbed",
+                "--duration-clock": v["duration_clock"] == "refbox",
+            },
         )
     return HpffOptions(
         config=v["config"],

@@ -1,13 +1,18 @@
-"""The inputs of a benchmark scored from an ERL 2017-19 RSBB run bag that name its side files:
-the script's config, the team's transform, the run's result file and the team, each found in
-the RSBB's folder layout when not given (:func:`ertools.rsbb.sidefiles.find_side_files`).
+"""The inputs of a benchmark that re-scores an ERL 2017-19 RSBB script from its run bag: the
+side files (the script's config, the team's transform, the run's result file and the team,
+each found in the RSBB's folder layout when not given:
+:func:`ertools.rsbb.sidefiles.find_side_files`), and the refusal of a rule option that would
+undo what ``--rules`` reproduces.
 
 NumPy-free: the benchmarks' ``config`` modules list them for the command line's parser.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 from ertools.benchmarks.base import Input
+from ertools.errors import UsageError
 
 #: The help section of the options that undo ertools' readings of a 2019 script one by one.
 SCRIPT_GROUP = "the 2019 script (differences can be undone one by one)"
@@ -53,3 +58,18 @@ def team_input(code: str) -> Input:
         metavar="NAME",
         per_team=True,
     )
+
+
+def refuse_undoing(rules: str, undone: Mapping[str, bool]) -> None:
+    """Refuse the rule options (by their flag) that would undo what ``--rules RULES``
+    reproduces.
+
+    Raises:
+        UsageError: one or more of them is True.
+    """
+    clash = [flag for flag, undoes in undone.items() if undoes]
+    if clash:
+        raise UsageError(
+            f"--rules {rules} reproduces the script: {', '.join(clash)} would undo it; "
+            "give one or the other"
+        )
