@@ -11,7 +11,7 @@
 What the benchmarks of 2017-19 share (each benchmark package uses them):
 
 - :mod:`ertools.rsbb.sidefiles`: a run's side files (config, team transform, items, result
-  file) given or found beside its bag;
+  file) given or found beside its bag; :mod:`ertools.rsbb.opened`: a run bag opened with them;
 - :mod:`ertools.rsbb.tf`: ``/tf`` read once, the scripts' lookups as tf2 answered them, and
   the lookup helper's attempts;
 - :mod:`ertools.rsbb.score`: the result file's ``score`` form, and a recomputed score compared

@@ -80,11 +80,9 @@ def test_score_help_lists_every_benchmark_and_imports_none() -> None:
         assert loaded(modules, package) == [], name
 
 
-# Benchmarks still declared with the old record (benchmarks/legacy.py): their declaration
-# imports their scorers, so their parser loads NumPy. The list only shrinks (plan 37, S8b).
-# The RSBB benchmarks of issue 38 (merged on the old record): their declare imports their
-# pipeline at the top.
-HEAVY_DECLARES: frozenset[str] = frozenset({"hnf", "hpff", "hgmf"})
+# Benchmarks whose declaration imports their scorers (so their parser loads NumPy): none
+# since every benchmark is on the protocols; the list may not grow.
+HEAVY_DECLARES: frozenset[str] = frozenset()
 
 
 def test_a_benchmarks_help_imports_its_declaration_and_no_numpy() -> None:

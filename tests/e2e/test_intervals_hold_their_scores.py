@@ -62,6 +62,9 @@ ROBOT = ("sample_bags/robotlog/FBM2H_201511201200_homer.bag", "sample_bags/robot
 FBM2H = "sample_bags/fbm2h/log_fbm2h_mocap_2015-11-20-12-00-00_0"
 HOPF = "sample_bags/hopf/rsbb_logs/HOPF/simbot/run_1_2019-04-11-16-26-40.bag"
 HPPF = "sample_bags/hppf/rsbb_logs/HPPF/simbot/run_1_2019-04-11-17-26-40.bag"
+HNF = "sample_bags/hnf/rsbb_logs/HNF/simbot/run_1_2019-04-10-14-31-06.bag"
+HPFF = "sample_bags/hpff/rsbb_logs/HPFF/simbot/run_1_2019-04-10-15-22-11.bag"
+HGMF = "sample_bags/hgmf/rsbb_logs/HGMF/simbot/run_1_2019-04-12-10-00-00.bag"
 COMMANDS = [
     *readme_score_commands(),
     ["score", "fbm3w", "sample_bags/fbm3w/log_fbm3w_mocap_2015-11-20-12-00-00_0_mcap"],
@@ -82,6 +85,11 @@ COMMANDS = [
     # the RSBB scripts reproduced whole: their score form with the intervals beside
     *(["score", "hopf", HOPF, "--rules", rules] for rules in ("2019", "2017", "2017-11")),
     ["score", "hppf", HPPF, "--rules", "2019"],
+    # the scripts' readings keep their totals' intervals beside them, as --2015 does
+    ["score", "hnf", HNF, "--rules", "2019"],
+    ["score", "hnf", HNF, "--rules", "2017"],
+    ["score", "hpff", HPFF, "--rules", "2019"],
+    ["score", "hgmf", HGMF, "--rules", "2019"],
 ]
 
 
@@ -119,6 +127,8 @@ def check(document: Any, where: str, *, strict: bool = False) -> int:
 RSBB = {"hopf", "hnf", "hppf", "hpff", "hgmf"}
 # the RSBB benchmarks whose score form carries ``K_interval`` beside each score with one
 WALKED_RSBB = {"hopf", "hppf"}
+# RSBB benchmarks whose score form carries ``<total>_interval`` beside each total
+SCORE_FORM_INTERVALS = {"hnf", "hpff", "hgmf"}
 REFEREE = {"hgtkmh", "hwv", "hcfgac", "stb"}
 PRINTED = re.compile(r"^ertools: interval: (.+?) \S+( mm)? \[(\S+), (\S+)\]", re.MULTILINE)
 
@@ -172,11 +182,12 @@ def test_every_interval_holds_its_score(argv: list[str]) -> None:
     if argv[1] in REFEREE:
         return  # a referee's items and time: nothing measured, no interval
     if argv[1] in RSBB:
-        # stdout is the RSBB result file's ``score`` form, as the script wrote it: the
-        # intervals are the stderr lines (the --report tables hold the same numbers), and
-        # the score form's ``K_interval`` keys where the benchmark writes them
+        # stdout is the RSBB result file's ``score`` form, as the script wrote it, with the
+        # intervals beside their scores (``K_interval``); the stderr lines print the same
         assert check_printed(document, ran.stderr, " ".join(argv)) > 0, "no interval printed"
         if argv[1] not in WALKED_RSBB:
+            walked = check(document, " ".join(argv), strict=True)
+            assert argv[1] not in SCORE_FORM_INTERVALS or walked > 0, "no interval in the result"
             return
     # strictly inside: monte_carlo widens an interval whose draws' bias exceeds their spread
     # (a score that is mostly the noise's bias) to reach its score, which would hide draws

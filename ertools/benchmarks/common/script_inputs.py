@@ -1,7 +1,10 @@
 """The inputs of a benchmark that re-scores an ERL 2017-19 RSBB script's run alike, and the
-options they make: the run's result file to compare with, the script version reproduced whole
-(``--rules``), how the ground truth is looked up across a tracking gap (ertools refuses it;
-the script's tf interpolated) and the intervals.
+options they make: the side files (the script's config, the team's transform, the run's result
+file and the team, each found in the RSBB's folder layout when not given:
+:func:`ertools.rsbb.sidefiles.find_side_files`), the script version reproduced whole
+(``--rules``) and the refusal of a rule option that would undo it, how the ground truth is
+looked up across a tracking gap (ertools refuses it; the script's tf interpolated) and the
+intervals.
 
 NumPy-free: the benchmarks' ``config`` modules list them for the command line's parser.
 """
@@ -20,6 +23,7 @@ from ertools.benchmarks.common.inputs import (
     DEFAULT_SEED,
     check_confidence,
 )
+from ertools.errors import UsageError
 
 #: The help section of the options that undo ertools' readings of a script one by one.
 SCRIPT_GROUP = "the RSBB script's behaviour (each difference can be undone)"
@@ -96,3 +100,61 @@ def script_values(values: Mapping[str, Any]) -> dict[str, Any]:
         "draws": int(values.get("draws", DEFAULT_DRAWS)),
         "seed": int(values.get("seed", DEFAULT_SEED)),
     }
+
+
+TRANSFORM = Input(
+    "transform",
+    "path",
+    "transform-<team>.yaml (markerset_to_robot_transform); default: found beside the "
+    "bag or in rsbb_etc/transforms/",
+    metavar="FILE",
+    per_team=True,
+)
+
+
+def config_input(code: str, contents: str) -> Input:
+    """``--config``: the script's ``<CODE>.yaml``, holding ``contents`` (its keys, in words)."""
+    return Input(
+        "config",
+        "path",
+        f"{code}.yaml ({contents}); default: found beside the bag or in the RSBB layout, else "
+        "the result file's benchmark_info.params",
+        metavar="FILE",
+    )
+
+
+def result_input(code: str) -> Input:
+    """``--result``: the run's result file, which the recomputed score is compared with."""
+    return Input(
+        "result",
+        "path",
+        "the run's result_run_<n>_<date>.yaml, compared with the recomputed score; default: "
+        f"found beside the bag or in results/{code}/<team>/",
+        metavar="FILE",
+    )
+
+
+def team_input(code: str) -> Input:
+    """``--team``: whose transform and result file to look for."""
+    return Input(
+        "team",
+        "str",
+        f"the team (default: rsbb_logs/{code}/<team>/ of the bag, else the result file's)",
+        metavar="NAME",
+        per_team=True,
+    )
+
+
+def refuse_undoing(rules: str, undone: Mapping[str, bool]) -> None:
+    """Refuse the rule options (by their flag) that would undo what ``--rules RULES``
+    reproduces.
+
+    Raises:
+        UsageError: one or more of them is True.
+    """
+    clash = [flag for flag, undoes in undone.items() if undoes]
+    if clash:
+        raise UsageError(
+            f"--rules {rules} reproduces the script: {', '.join(clash)} would undo it; "
+            "give one or the other"
+        )

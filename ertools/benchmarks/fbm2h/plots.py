@@ -14,34 +14,19 @@ from ertools.benchmarks.common import gaps
 from ertools.views import units
 from ertools.views.chart import (
     COLOURS,
-    Arrows,
     Axis,
-    Bars,
     Chart,
     Layer,
     Line,
-    RefLine,
     Scatter,
     Text,
 )
 from ertools.views.spec import ChartSpec
 from ertools.views.thinning import thin_path
+from ertools.views.waypoints import pose_errors_chart, pose_layers
 
-ARROW = 0.25  # metres: length of the heading arrows on the path figure
 MM = units.factor("length", "m")
-DEG = units.factor("angle", "rad")
 PATH_SIZE = (7.0, 6.0)
-
-
-def _poses(xyt: np.ndarray, colour: str, label: str, marker: Any) -> list[Layer]:
-    """Markers at the poses and an arrow along each heading."""
-    x, y = xyt[:, 0] * MM, xyt[:, 1] * MM
-    return [
-        Scatter(x, y, colour, marker=marker, size=5.0, label=label),
-        Arrows(
-            x, y, x + np.cos(xyt[:, 2]) * ARROW * MM, y + np.sin(xyt[:, 2]) * ARROW * MM, colour
-        ),
-    ]
 
 
 def path_chart(result: Any, size: tuple[float, float] = PATH_SIZE) -> Chart:
@@ -54,12 +39,12 @@ def path_chart(result: Any, size: tuple[float, float] = PATH_SIZE) -> Chart:
             Line(path[:, 0] * MM, path[:, 1] * MM, "#8c8c8c", 1.0, label="robot path (GT)")
         )
     targets = np.array([s.target for s in result.segments], dtype=float).reshape(-1, 3)
-    layers += _poses(targets, COLOURS["blue"], "waypoint (target heading)", "o")
+    layers += pose_layers(targets, COLOURS["blue"], "waypoint (target heading)", "o")
     reached = np.array(
         [s.robot for s in result.segments if s.robot is not None], dtype=float
     ).reshape(-1, 3)
     if len(reached):
-        layers += _poses(reached, COLOURS["red"], "robot when reached", "x")
+        layers += pose_layers(reached, COLOURS["red"], "robot when reached", "x")
     layers += [
         Text(s.target[0] * MM, s.target[1] * MM, str(s.index), COLOURS["blue"], offset=(7.0, 7.0))
         for s in result.segments
@@ -88,40 +73,14 @@ def path_chart(result: Any, size: tuple[float, float] = PATH_SIZE) -> Chart:
 def errors_chart(result: Any) -> Chart:
     """Distance error (bars, left axis) and orientation error (right axis) per waypoint;
     dashed: the accuracies the benchmark counts against."""
-    idx = np.array([s.index for s in result.segments], dtype=float)
-    dist = np.array(
-        [np.nan if s.distance_error is None else s.distance_error for s in result.segments]
-    )
-    ori = np.array(
-        [np.nan if s.orientation_error is None else s.orientation_error for s in result.segments]
-    )
-    blue, orange = COLOURS["blue"], COLOURS["orange"]
-    layers: list[Layer] = [
-        Bars(idx - 0.2, dist * MM, 0.4, (blue,), "distance error"),
-        Bars(idx + 0.2, ori * DEG, 0.4, (orange,), "orientation error", side="right"),
-    ]
-    if result.position_accuracy is not None:
-        layers.append(RefLine(result.position_accuracy * MM, "y", blue, label="position accuracy"))
-    if result.orientation_accuracy is not None:
-        layers.append(
-            RefLine(
-                result.orientation_accuracy * DEG,
-                "y",
-                orange,
-                label="orientation accuracy",
-                side="right",
-            )
-        )
-    layers += [
-        Text(float(i), 0.0, "no score", COLOURS["red"], offset=(0.0, 3.0), anchor="middle")
-        for i in idx[np.isnan(dist)]
-    ]
-    return Chart(
-        tuple(layers),
-        x=Axis("waypoint", ticks=tuple((float(i), str(int(i))) for i in idx)),
-        y=Axis(units.label("distance error", "length"), colour=blue, include_zero=True),
-        right=Axis(units.label("orientation error", "angle"), colour=orange, include_zero=True),
-        grid="y",
+    segments = result.segments
+    return pose_errors_chart(
+        [s.index for s in segments],
+        [s.distance_error for s in segments],
+        [s.orientation_error for s in segments],
+        (result.position_accuracy, result.orientation_accuracy),
+        ["no score"] * len(segments),
+        "waypoint",
     )
 
 

@@ -1,5 +1,8 @@
-"""How an HGMF score is computed (the options, as data), the script's constants and
-:func:`make_options`, which turns the declared inputs' values into :class:`HgmfOptions`."""
+"""How an HGMF score is computed: its inputs, the options (as data), the script's constants
+and :func:`make_options`, which turns the inputs' values into :class:`HgmfOptions`.
+
+NumPy-free: the declaration and the CLI's parser import it.
+"""
 
 from __future__ import annotations
 
@@ -8,12 +11,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ertools.benchmarks.base import Input, resolve_values
 from ertools.benchmarks.common.inputs import (
     DEFAULT_CONFIDENCE,
     DEFAULT_DRAWS,
     DEFAULT_SEED,
+    INTERVAL_INPUTS,
     check_confidence,
 )
+from ertools.benchmarks.common.script_inputs import SCRIPT_GROUP, config_input, result_input
 from ertools.errors import UsageError
 
 NAME = "hgmf"
@@ -72,13 +78,61 @@ class HgmfOptions:
         return self.restarted_goals_2019 and self.grasp_timer and self.gaps_interpolate
 
 
-def make_options(v: Mapping[str, Any]) -> HgmfOptions:
-    """The declared inputs' values (resolved, :func:`~ertools.benchmarks.base.resolve_values`)
-    -> :class:`HgmfOptions`; ``--rules 2019`` sets every 2019 behaviour.
+INPUTS = (
+    config_input(CODE, "objects, table_size, goal_timeout"),
+    result_input(CODE),
+    Input(
+        "max_gap",
+        "float",
+        f"a position needs mocap samples at most S seconds apart around the lookup (default "
+        f"{DEFAULT_MAX_GAP_S:g})",
+        default=DEFAULT_MAX_GAP_S,
+        unit="s",
+        positive=True,
+    ),
+    Input(
+        "restarted_goals",
+        "choice",
+        "2019: a goal restarted after its final lookup failed still counts in the divisor and "
+        "the grasps (default ertools: the measured goals only)",
+        choices=("ertools", "2019"),
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "grasp_sampling",
+        "choice",
+        "timer: a grasp checked at the script's 10 Hz ticks, at tf's latest common time "
+        "(inferred); default samples: at every mocap sample of the object during the goal",
+        choices=("samples", "timer"),
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "gt_gaps",
+        "choice",
+        "interpolate: tf's position across any mocap gap (default limit: --max-gap)",
+        choices=("limit", "interpolate"),
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "rules",
+        "choice",
+        "2019: every behaviour of fbm6_grasping_manipulation.py at rockin-robot-challenge/rsbb "
+        "2bb8a41, field for field; ertools (default): the options above decide",
+        choices=RULE_SETS,
+        group=SCRIPT_GROUP,
+    ),
+    *INTERVAL_INPUTS,
+)
+
+
+def make_options(given: Mapping[str, Any]) -> HgmfOptions:
+    """The values of :data:`INPUTS` (missing ones at their defaults) -> :class:`HgmfOptions`;
+    ``--rules 2019`` sets every 2019 behaviour.
 
     Raises:
-        UsageError: options that contradict each other.
+        UsageError: a value out of range, or options that contradict each other.
     """
+    v = resolve_values(INPUTS, given)
     rules = v.get("rules") or "ertools"
     script = rules == "2019"
     chosen = {

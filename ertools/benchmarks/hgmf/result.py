@@ -4,18 +4,16 @@ with the run's own scores, the intervals, and what ertools' reading changed."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from dataclasses import dataclass
+from typing import Any
 
 from ertools.arrays import F64, I64
 from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import (
     ScoreRow,
-    interval_lines,
-    interval_tables,
     score_table,
 )
-from ertools.benchmarks.common.uncertainty import Interval, Uncertainty
+from ertools.benchmarks.common.totals_form import TotalsFormResult
 from ertools.benchmarks.hgmf.config import GRASP_RISE_M, HgmfOptions
 from ertools.benchmarks.hgmf.flow import Attempt
 from ertools.benchmarks.hgmf.rules import (
@@ -24,13 +22,7 @@ from ertools.benchmarks.hgmf.rules import (
     RULE_RESTARTED_GOALS,
 )
 from ertools.fidelity import Deviation
-from ertools.frames import tables_to_frames
-from ertools.rsbb.score import ScoreComparison, plain, score_yaml
-from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
-
-if TYPE_CHECKING:
-    import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 AVERAGE_KEY = "Avg distance error"
 
@@ -122,11 +114,11 @@ class HgmfGoal:
 
 
 @dataclass(frozen=True, eq=False)
-class HgmfResult:
-    """A scored HGMF run (implements ``BenchmarkResult``).
+class HgmfResult(TotalsFormResult):
+    """A scored HGMF run (implements ``BenchmarkResult``; its score, comparison, intervals and
+    outputs: :class:`TotalsFormResult`).
 
     Attributes:
-        score: the score in the result file's form (what ``to_yaml``/``to_dict`` give).
         goals: every goal the script sent, restarted ones too.
         objects: N, the config's objects.
         average: ``Avg distance error`` (None: not written).
@@ -134,12 +126,9 @@ class HgmfResult:
         rules: ``--rules``.
         t_start_ns: the benchmark's start (times in tables are seconds from it).
         stop_ns: the referee's stop or the global timeout, None when the script ended it.
-        comparison: the score against the live score and the result file.
-        intervals, uncertainty: the average's confidence interval (empty/None: none).
         track: the object's (t_ns, (x, y, z)) in the table's frame, thinned, for plots.
     """
 
-    score: dict[str, Any]
     goals: tuple[HgmfGoal, ...]
     objects: int
     average: float | None
@@ -148,14 +137,7 @@ class HgmfResult:
     rules: str
     t_start_ns: int
     stop_ns: int | None
-    comparison: ScoreComparison
-    intervals: dict[str, Interval | None]
-    uncertainty: Uncertainty | None
     track: tuple[I64, F64]
-    warnings: tuple[str, ...] = ()
-    deviations: tuple[Deviation, ...] = ()
-    failures: tuple[str, ...] = ()
-    provenance: Provenance = field(default_factory=Provenance)
     name: str = "hgmf"
 
     @property
@@ -163,40 +145,17 @@ class HgmfResult:
         completed = [g for g in self.goals if g.attempt.times.completed]
         return bool(completed) and not any(g.distance_error is not None for g in completed)
 
-    def to_dict(self) -> dict[str, Any]:
-        """The score mapping (JSON), the result file's form; with intervals, also
-        ``Avg distance error_interval`` and the ``uncertainty`` block (leaderboards read them)."""
-        out: dict[str, Any] = plain(self.score)
-        iv = self.intervals.get(AVERAGE_KEY)
-        if iv is not None and self.uncertainty is not None:
-            out[f"{AVERAGE_KEY}_interval"] = iv.as_list()
-            out["uncertainty"] = self.uncertainty.to_dict()
-        return out
-
-    def to_yaml(self) -> str:
-        """The score as the BmBox wrote it into the result file (keys sorted)."""
-        return score_yaml(self.score)
-
     def score_rows(self) -> list[ScoreRow]:
         return [ScoreRow(AVERAGE_KEY, self.average, self.intervals.get(AVERAGE_KEY))]
-
-    def interval_lines(self) -> list[str]:
-        return interval_lines(self.score_rows(), self.uncertainty)
 
     def tables(self) -> dict[str, Rows]:
         """``goals`` (every attempt), ``scores`` (the average and its interval),
         ``comparison`` (each score field against the live score and the file) and the
         interval tables."""
-        out: dict[str, Rows] = {
-            "goals": [g.row(self.t_start_ns) for g in self.goals],
-            "scores": score_table(self.score_rows()),
-            "comparison": self.comparison.rows(),
-        }
-        out.update(interval_tables(self.intervals, self.uncertainty))
-        return out
-
-    def to_frames(self) -> dict[str, pd.DataFrame]:
-        return tables_to_frames(self.tables())
+        return self.result_tables(
+            {"goals": [g.row(self.t_start_ns) for g in self.goals]},
+            score_table(self.score_rows()),
+        )
 
 
 def deviations_of(options: HgmfOptions, goals: Sequence[HgmfGoal]) -> tuple[Deviation, ...]:

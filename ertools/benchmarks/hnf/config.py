@@ -1,4 +1,5 @@
-"""HNF's options: which reading of the script (``--rules``) and each rule's own option.
+"""HNF's inputs and options: which reading of the script (``--rules``) and each rule's own
+option, and :func:`make_options`, every check of their values.
 
 NumPy-free: the declaration and the CLI's parser import it.
 """
@@ -10,7 +11,16 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ertools.errors import UsageError
+from ertools.benchmarks.base import Input, resolve_values
+from ertools.benchmarks.common.inputs import INTERVAL_INPUTS, check_confidence
+from ertools.benchmarks.common.script_inputs import (
+    SCRIPT_GROUP,
+    TRANSFORM,
+    config_input,
+    refuse_undoing,
+    result_input,
+    team_input,
+)
 
 #: ``--rules``: ertools' reading, or a version of the script (docs/hnf.md, "2017-18").
 #: 2019 = rockin-robot-challenge/rsbb 2bb8a41; 2017 = Enri2077/rsbb 00e3106 (December 2017 to
@@ -73,25 +83,81 @@ class HnfOptions:
         return self.rules != "ertools"
 
 
-def options_from(v: Mapping[str, Any]) -> HnfOptions:
-    """Options from resolved input values (:func:`ertools.benchmarks.base.resolve_values`).
+INPUTS = (
+    config_input("HNF", "waypoints, goal_timeout"),
+    TRANSFORM,
+    result_input("HNF"),
+    team_input("HNF"),
+    Input(
+        "max_gap",
+        "float",
+        f"a pose needs mocap samples at most S seconds apart around the lookup (default "
+        f"{DEFAULT_MAX_GAP_S:g})",
+        default=DEFAULT_MAX_GAP_S,
+        unit="s",
+        positive=True,
+    ),
+    Input(
+        "orientation_2019",
+        "flag",
+        "orientation accuracy from the unwrapped |dtheta| as the script summed it",
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "divisor",
+        "choice",
+        "2019: every acquired pose's error (timed-out goals too) divided by the completed "
+        "goals, a skipped waypoint counted (default ertools: the completed goals with a pose)",
+        choices=("ertools", "2019"),
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "gt_gaps",
+        "choice",
+        "interpolate: tf's pose across any mocap gap (default refuse: beyond --max-gap)",
+        choices=("refuse", "interpolate"),
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "score_format",
+        "choice",
+        "2019: target_pose and robot_pose as the script's YAML dumps (default ertools: "
+        "{x, y, theta})",
+        choices=("ertools", "2019"),
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "rules",
+        "choice",
+        "a script's every behaviour: 2019 (rockin-robot-challenge/rsbb 2bb8a41), 2017 "
+        "(Enri2077/rsbb 00e3106, December 2017 to May 2018), f594ff1 and 069fd1d (November "
+        "2017); ertools (default): the options above decide",
+        choices=RULE_SETS,
+        group=SCRIPT_GROUP,
+    ),
+    *INTERVAL_INPUTS,
+)
+
+
+def make_options(given: Mapping[str, Any]) -> HnfOptions:
+    """The values of :data:`INPUTS` (missing ones at their defaults) -> :class:`HnfOptions`.
 
     Raises:
-        UsageError: a rule option that contradicts ``--rules``.
+        UsageError: a value out of range, or a rule option that contradicts ``--rules``.
     """
+    v = resolve_values(INPUTS, given)
+    check_confidence(v["confidence"])
     rules = str(v["rules"] or "ertools")
     script = SCRIPT_COMMITS.get(rules, "2bb8a41")
     faithful = rules != "ertools"
-    chosen = {
-        "--divisor": v["divisor"] not in (None, "2019"),
-        "--gt-gaps": v["gt_gaps"] not in (None, "interpolate"),
-        "--score-format": v["score_format"] not in (None, "2019"),
-    }
-    clash = [name for name, ertools_value in chosen.items() if ertools_value]
-    if faithful and clash:
-        raise UsageError(
-            f"--rules {rules} reproduces the script: {', '.join(clash)} would undo it; "
-            "give one or the other"
+    if faithful:
+        refuse_undoing(
+            rules,
+            {
+                "--divisor": v["divisor"] not in (None, "2019"),
+                "--gt-gaps": v["gt_gaps"] not in (None, "interpolate"),
+                "--score-format": v["score_format"] not in (None, "2019"),
+            },
         )
     return HnfOptions(
         config=v["config"],

@@ -24,10 +24,11 @@ from ertools.benchmarks.hnf.result import HnfResult, HnfSegment, deviations_of
 from ertools.configs._yaml import parse_yaml
 from ertools.errors import ConfigError, UsageError
 from ertools.io.summary import summary
-from ertools.rsbb.log import EndKind, RsbbRun, check_code, read_rsbb_run
-from ertools.rsbb.results import RsbbResult, load_result
+from ertools.rsbb.log import EndKind, RsbbRun
+from ertools.rsbb.opened import open_run
+from ertools.rsbb.results import RsbbResult
 from ertools.rsbb.score import compare_scores
-from ertools.rsbb.sidefiles import find_side_files, read_side_yaml, script_transform
+from ertools.rsbb.sidefiles import read_side_yaml, script_transform
 from ertools.rsbb.tf import TfTrack, read_tf_tracks, script_poses
 from ertools.rsbb_states import BENCHMARKS
 from ertools.streams import Provenance
@@ -95,36 +96,11 @@ def load(logs: Sequence[Path], options: HnfOptions) -> HnfLogs:
             f"give one HNF run bag (rsbb_logs/HNF/<team>/run_<n>_<date>.bag), not {len(logs)}"
         )
     bag = Path(logs[0])
-    want = {"config", "transform", "result"}
-    side = find_side_files(
-        bag,
-        CODE,
-        want=want,
-        config=options.config,
-        transform=options.transform,
-        result=options.result,
-        team=options.team,
-    )
-    if side.place.code not in (None, CODE):
-        raise UsageError(
-            f"{bag} is an {side.place.code} run (rsbb_logs/{side.place.code}/...): "
-            f"ertools score {side.place.code.lower()}"
-        )
-    run = read_rsbb_run(bag)
-    check_code(run, CODE)  # outside the layout, the live score names the benchmark
-    result = load_result(side.result) if side.result is not None else None
-    team = side.team or (result.team if result is not None else None)
-    transform_path = side.transform
-    if transform_path is None and team is not None and side.team is None:
-        side = find_side_files(bag, CODE, want={"transform"}, team=team)
-        transform_path = side.transform
-    for line in side.found:
+    opened = open_run(bag, CODE, options)
+    for line in opened.found:
         notice(line)
-    if transform_path is None:
-        raise UsageError(
-            f"no transform-{team or '<team>'}.yaml beside the bag or in rsbb_etc/transforms/: "
-            "give --transform FILE (the team's markerset_to_robot_transform)"
-        )
+    run, result, team = opened.run, opened.result, opened.team
+    transform_path = opened.transform_file()
     warnings: list[str] = []
     key = TRANSFORM_KEY.get(options.script, "markerset_to_robot_transform")
     try:
@@ -135,7 +111,7 @@ def load(logs: Sequence[Path], options: HnfOptions) -> HnfLogs:
             f"{transform_path} has no {key} (the script at {options.script} read that key): "
             "the other spelling used"
         )
-    waypoints, config_source = _config(options, side.config, result)
+    waypoints, config_source = _config(options, opened.side.config, result)
     if run.t_start_ns is None:
         raise UsageError(
             f"{bag}: the benchmark never started (no EXECUTING_BENCHMARK): nothing to score"

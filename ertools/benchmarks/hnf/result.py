@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -14,11 +14,9 @@ from ertools.arrays import F64, I64
 from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import (
     ScoreRow,
-    interval_lines,
-    interval_tables,
     score_table,
 )
-from ertools.benchmarks.common.uncertainty import Interval, Uncertainty
+from ertools.benchmarks.common.totals_form import TotalsFormResult
 from ertools.benchmarks.hnf.config import HnfOptions
 from ertools.benchmarks.hnf.flow import HnfFlow, SegmentFlow
 from ertools.benchmarks.hnf.rules import (
@@ -30,13 +28,7 @@ from ertools.benchmarks.hnf.rules import (
     RULE_STOPPED,
 )
 from ertools.fidelity import Deviation
-from ertools.frames import tables_to_frames
-from ertools.rsbb.score import ScoreComparison, plain, score_yaml
-from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
-
-if TYPE_CHECKING:
-    import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 POSITION_KEY = "position_accuracy[m]"
 ORIENTATION_KEY = "orientation_accuracy[rad]"
@@ -110,11 +102,11 @@ class HnfSegment:
 
 
 @dataclass(frozen=True, eq=False)
-class HnfResult:
-    """A scored HNF run (implements ``BenchmarkResult``).
+class HnfResult(TotalsFormResult):
+    """A scored HNF run (implements ``BenchmarkResult``; its score, comparison, intervals and
+    outputs: :class:`TotalsFormResult`).
 
     Attributes:
-        score: the score in the result file's form (what ``to_yaml``/``to_dict`` give).
         segments: the waypoints the script got to.
         waypoints: every waypoint of the config.
         position_accuracy, orientation_accuracy: the totals (None: not computed).
@@ -122,12 +114,9 @@ class HnfResult:
         rules: ``--rules``; script: the commit whose control flow was followed.
         t_start_ns: the benchmark's start (times in tables are seconds from it).
         stop_ns: the referee's stop or the global timeout, None when the script ended it.
-        comparison: the score against the live score and the result file.
-        intervals, uncertainty: the totals' confidence intervals (empty/None: none).
         track: the marker set's (t_ns, (x, y)) thinned, for plots and Foxglove.
     """
 
-    score: dict[str, Any]
     segments: tuple[HnfSegment, ...]
     waypoints: tuple[tuple[Any, Any, Any], ...]
     position_accuracy: float | None
@@ -137,14 +126,7 @@ class HnfResult:
     script: str
     t_start_ns: int
     stop_ns: int | None
-    comparison: ScoreComparison
-    intervals: dict[str, Interval | None]
-    uncertainty: Uncertainty | None
     track: tuple[I64, F64]
-    warnings: tuple[str, ...] = ()
-    deviations: tuple[Deviation, ...] = ()
-    failures: tuple[str, ...] = ()
-    provenance: Provenance = field(default_factory=Provenance)
     name: str = "hnf"
 
     @property
@@ -155,15 +137,6 @@ class HnfResult:
     def execution_time(self) -> float:
         return float(sum(ns_to_s(s.flow.end_ns - s.flow.start_ns) for s in self.segments))
 
-    def to_dict(self) -> dict[str, Any]:
-        """The score mapping (JSON), the result file's form."""
-        out: dict[str, Any] = plain(self.score)
-        return out
-
-    def to_yaml(self) -> str:
-        """The score as the BmBox wrote it into the result file (keys sorted)."""
-        return score_yaml(self.score)
-
     def score_rows(self) -> list[ScoreRow]:
         return [
             ScoreRow(POSITION_KEY, self.position_accuracy, self.intervals.get(POSITION_KEY)),
@@ -172,22 +145,13 @@ class HnfResult:
             ),
         ]
 
-    def interval_lines(self) -> list[str]:
-        return interval_lines(self.score_rows(), self.uncertainty)
-
     def tables(self) -> dict[str, Rows]:
         """``segments``, ``scores`` (the totals with their intervals), ``comparison`` (each
         score field against the live score and the file) and the interval tables."""
-        out: dict[str, Rows] = {
-            "segments": [s.row(self.t_start_ns) for s in self.segments],
-            "scores": score_table(self.score_rows()),
-            "comparison": self.comparison.rows(),
-        }
-        out.update(interval_tables(self.intervals, self.uncertainty))
-        return out
-
-    def to_frames(self) -> dict[str, pd.DataFrame]:
-        return tables_to_frames(self.tables())
+        return self.result_tables(
+            {"segments": [s.row(self.t_start_ns) for s in self.segments]},
+            score_table(self.score_rows()),
+        )
 
 
 def deviations_of(

@@ -36,13 +36,13 @@ import numpy as np
 import yaml
 
 from ertools.arrays import F64
-from ertools.atomic import write_text
 from ertools.geometry import compose, invert, quat_from_yaw, wrap_angle
 from ertools.rsbb.py2 import to_sec
 from ertools.rsbb.tf import TfTrack, script_poses
 from ertools.simulator.answers import tol, write_answers
 from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
 from ertools.simulator.rsbb import TF_RECORD_LAG_NS, TF_STAMP_LAG_NS, write_rsbb_run
+from ertools.simulator.rsbb_files import write_script_config, write_team_transform
 from ertools.simulator.rsbb_scenario import (
     Body,
     Broadcast,
@@ -386,21 +386,11 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     """Write both runs and the side files into ``outdir`` (the RSBB's folder layout)."""
     written = _run(outdir, 1, None, seed, T0) + _run(outdir, 2, 2, seed, T0 + 600 * S)
     t_mr, q_mr = _team()
-    tdir = outdir / "rsbb_etc" / "transforms"
-    tdir.mkdir(parents=True, exist_ok=True)
-    transform = tdir / f"transform-{TEAM}.yaml"
-    pair = f"- {[float(v) for v in t_mr]}\n- {[float(v) for v in q_mr]}\n"
-    write_text(
-        transform,
-        f"team_name: {TEAM}\nmarkerset_to_robot_transform: !!python/tuple\n{pair}",
-    )
-    cdir = outdir / "rsbb_bmbox" / "scripts" / "benchmark_configs"
-    cdir.mkdir(parents=True, exist_ok=True)
-    config = cdir / "HNF.yaml"
+    transform = write_team_transform(outdir, TEAM, t_mr, q_mr)
     params = {
         "starting_pose": [0.0, 0.0, 0.0],
         "waypoints": WAYPOINTS,
         "goal_timeout": GOAL_TIMEOUT,
     }
-    write_text(config, yaml.safe_dump(params, default_flow_style=None))
+    config = write_script_config(outdir, "HNF", params, flow_style=None)
     return [*written, transform, config]

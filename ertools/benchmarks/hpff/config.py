@@ -1,4 +1,5 @@
-"""HPFF's options: the script's reading (``--rules 2019``) or ertools', rule by rule.
+"""HPFF's inputs and options: the script's reading (``--rules 2019``) or ertools', rule by
+rule, and :func:`make_options`, every check of their values.
 
 NumPy-free: the declaration and the CLI's parser import it.
 """
@@ -10,7 +11,16 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ertools.errors import UsageError
+from ertools.benchmarks.base import Input, resolve_values
+from ertools.benchmarks.common.inputs import INTERVAL_INPUTS, check_confidence
+from ertools.benchmarks.common.script_inputs import (
+    SCRIPT_GROUP,
+    TRANSFORM,
+    config_input,
+    refuse_undoing,
+    result_input,
+    team_input,
+)
 
 RULE_SETS = ("ertools", "2019")
 SCRIPT_COMMIT = "2bb8a41"
@@ -58,24 +68,73 @@ class HpffOptions:
         return self.rules == "2019"
 
 
-def options_from(v: Mapping[str, Any]) -> HpffOptions:
-    """Options from resolved input values.
+INPUTS = (
+    config_input("HPFF", "distances, goal_timeout"),
+    TRANSFORM,
+    result_input("HPFF"),
+    team_input("HPFF"),
+    Input(
+        "max_gap",
+        "float",
+        f"grid samples: a body interpolated across at most S seconds between its mocap samples "
+        f"(default {DEFAULT_MAX_GAP_S:g})",
+        default=DEFAULT_MAX_GAP_S,
+        unit="s",
+        positive=True,
+    ),
+    Input(
+        "sampling",
+        "choice",
+        "script: the script's own samples (its lookups; a lookup failed when the data came "
+        "0.2 s late) (default grid: every 0.5 s, both bodies interpolated)",
+        choices=("grid", "script"),
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "distance_plane",
+        "choice",
+        "actor: the distance in the cap's frame, as the script (default testbed: horizontal)",
+        choices=("testbed", "actor"),
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "duration_clock",
+        "choice",
+        "script: from the script's start to its loop's end (default refbox: the goal's start "
+        "to its end)",
+        choices=("refbox", "script"),
+        group=SCRIPT_GROUP,
+    ),
+    Input(
+        "rules",
+        "choice",
+        "2019: the script's every behaviour (rockin-robot-challenge/rsbb 2bb8a41, a stopped "
+        "run's score {}); ertools (default): the options above decide",
+        choices=RULE_SETS,
+        group=SCRIPT_GROUP,
+    ),
+    *INTERVAL_INPUTS,
+)
+
+
+def make_options(given: Mapping[str, Any]) -> HpffOptions:
+    """The values of :data:`INPUTS` (missing ones at their defaults) -> :class:`HpffOptions`.
 
     Raises:
-        UsageError: a rule option that contradicts ``--rules 2019``.
+        UsageError: a value out of range, or a rule option that contradicts ``--rules 2019``.
     """
+    v = resolve_values(INPUTS, given)
+    check_confidence(v["confidence"])
     rules = str(v["rules"] or "ertools")
     faithful = rules == "2019"
-    undo = {
-        "--sampling": v["sampling"] == "grid",
-        "--distance-plane": v["distance_plane"] == "testbed",
-        "--duration-clock": v["duration_clock"] == "refbox",
-    }
-    clash = [name for name, given in undo.items() if given]
-    if faithful and clash:
-        raise UsageError(
-            f"--rules 2019 reproduces the script: {', '.join(clash)} would undo it; "
-            "give one or the other"
+    if faithful:
+        refuse_undoing(
+            rules,
+            {
+                "--sampling": v["sampling"] == "grid",
+                "--distance-plane": v["distance_plane"] == "testbed",
+                "--duration-clock": v["duration_clock"] == "refbox",
+            },
         )
     return HpffOptions(
         config=v["config"],

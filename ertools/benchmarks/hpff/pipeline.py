@@ -27,11 +27,11 @@ from ertools.benchmarks.hpff.result import (
 )
 from ertools.errors import ConfigError, UsageError
 from ertools.io.summary import summary
-from ertools.rsbb.log import EndKind, check_code, read_rsbb_run
+from ertools.rsbb.log import EndKind
+from ertools.rsbb.opened import open_run
 from ertools.rsbb.py2 import to_sec
-from ertools.rsbb.results import load_result
 from ertools.rsbb.score import compare_scores
-from ertools.rsbb.sidefiles import find_side_files, read_side_yaml, script_transform
+from ertools.rsbb.sidefiles import read_side_yaml, script_transform
 from ertools.rsbb.tf import link_at, read_tf_tracks, script_poses
 from ertools.rsbb_states import BENCHMARKS
 from ertools.streams import Provenance
@@ -70,36 +70,12 @@ def load(logs: Sequence[Path], options: HpffOptions) -> HpffLogs:
             f"give one HPFF run bag (rsbb_logs/HPFF/<team>/run_<n>_<date>.bag), not {len(logs)}"
         )
     bag = Path(logs[0])
-    side = find_side_files(
-        bag,
-        CODE,
-        want={"config", "transform", "result"},
-        config=options.config,
-        transform=options.transform,
-        result=options.result,
-        team=options.team,
-    )
-    if side.place.code not in (None, CODE):
-        raise UsageError(
-            f"{bag} is an {side.place.code} run (rsbb_logs/{side.place.code}/...): "
-            f"ertools score {side.place.code.lower()}"
-        )
-    run = read_rsbb_run(bag)
-    check_code(run, CODE)  # outside the layout, the live score names the benchmark
-    result = load_result(side.result) if side.result is not None else None
-    team = side.team or (result.team if result is not None else None)
-    transform_path = side.transform
-    if transform_path is None and team is not None and side.team is None:
-        transform_path = find_side_files(bag, CODE, want={"transform"}, team=team).transform
-        if transform_path is not None:
-            notice(f"transform-{team}.yaml found for the result file's team: {transform_path}")
-    for line in side.found:
+    opened = open_run(bag, CODE, options)
+    for line in opened.found:
         notice(line)
-    if transform_path is None:
-        raise UsageError(
-            f"no transform-{team or '<team>'}.yaml beside the bag or in rsbb_etc/transforms/: "
-            "give --transform FILE (the team's markerset_to_robot_transform)"
-        )
+    run, result, team = opened.run, opened.result, opened.team
+    transform_path = opened.transform_file()
+    side = opened.side
     transform = script_transform(transform_path, ("markerset_to_robot_transform",))
     if side.config is not None:
         params = _params(read_side_yaml(side.config, "HPFF config"), str(side.config))

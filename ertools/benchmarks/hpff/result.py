@@ -3,15 +3,14 @@ comparison with the run's own scores, the intervals, and what ertools' reading c
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from dataclasses import dataclass
 
 import numpy as np
 
 from ertools.arrays import F64, I64, Bool
 from ertools.benchmarks.base import Rows
-from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines, interval_tables
-from ertools.benchmarks.common.uncertainty import Interval, Uncertainty
+from ertools.benchmarks.common.interval_output import ScoreRow
+from ertools.benchmarks.common.totals_form import TotalsFormResult
 from ertools.benchmarks.hpff.config import HpffOptions
 from ertools.benchmarks.hpff.formula import Following
 from ertools.benchmarks.hpff.rules import (
@@ -22,12 +21,6 @@ from ertools.benchmarks.hpff.rules import (
     RULE_STOPPED,
 )
 from ertools.fidelity import Deviation
-from ertools.frames import tables_to_frames
-from ertools.rsbb.score import ScoreComparison, plain, score_yaml
-from ertools.streams import Provenance
-
-if TYPE_CHECKING:
-    import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 DEVIATION_KEY = "Average deviation from desired distance"
 COVERED_KEY = "Distance covered while following"
@@ -56,23 +49,20 @@ class HpffSamples:
 
 
 @dataclass(frozen=True, eq=False)
-class HpffResult:
-    """A scored HPFF run (implements ``BenchmarkResult``).
+class HpffResult(TotalsFormResult):
+    """A scored HPFF run (implements ``BenchmarkResult``; its score, comparison, intervals and
+    outputs: :class:`TotalsFormResult`).
 
     Attributes:
-        score: the score in the result file's form (``to_yaml``/``to_dict``).
         samples, stats: the samples and their statistics (None: nothing was sampled).
         duration_s: the run's duration as the duration rule measures it (None: not measured).
         passed: the duration rule passed (None: not checked, the run stopped first).
         goal_timeout, desired, minimum, maximum: the config's values.
         t_start_ns: the benchmark's start (tables are in seconds from it).
         rules: ``--rules``.
-        comparison: the score against the live score and the result file.
-        intervals, uncertainty: the intervals of the deviation and the distance covered.
         tracks: the robot's and the person's (t_ns, (x, y)) thinned, for figures and Foxglove.
     """
 
-    score: dict[str, Any]
     samples: HpffSamples
     stats: Following | None
     duration_s: float | None
@@ -83,14 +73,7 @@ class HpffResult:
     maximum: float
     t_start_ns: int
     rules: str
-    comparison: ScoreComparison
-    intervals: dict[str, Interval | None]
-    uncertainty: Uncertainty | None
     tracks: tuple[tuple[I64, F64], tuple[I64, F64]]
-    warnings: tuple[str, ...] = ()
-    deviations: tuple[Deviation, ...] = ()
-    failures: tuple[str, ...] = ()
-    provenance: Provenance = field(default_factory=Provenance)
     name: str = "hpff"
 
     @property
@@ -101,22 +84,12 @@ class HpffResult:
     def average_deviation(self) -> float | None:
         return None if self.stats is None else self.stats.average_deviation
 
-    def to_dict(self) -> dict[str, Any]:
-        out: dict[str, Any] = plain(self.score)
-        return out
-
-    def to_yaml(self) -> str:
-        return score_yaml(self.score)
-
     def score_rows(self) -> list[ScoreRow]:
         covered = None if self.stats is None else float(self.stats.covered)
         return [
             ScoreRow(DEVIATION_KEY, self.average_deviation, self.intervals.get(DEVIATION_KEY)),
             ScoreRow(COVERED_KEY, covered, self.intervals.get(COVERED_KEY)),
         ]
-
-    def interval_lines(self) -> list[str]:
-        return interval_lines(self.score_rows(), self.uncertainty)
 
     def tables(self) -> dict[str, Rows]:
         """``samples`` (one row per sample), ``scores`` and ``comparison``."""
@@ -150,16 +123,7 @@ class HpffResult:
             for r in self.score_rows()
         ]
         scores.append({"score": "duration_s", "value": self.duration_s, "low": None, "high": None})
-        out: dict[str, Rows] = {
-            "samples": rows,
-            "scores": scores,
-            "comparison": self.comparison.rows(),
-        }
-        out.update(interval_tables(self.intervals, self.uncertainty))
-        return out
-
-    def to_frames(self) -> dict[str, pd.DataFrame]:
-        return tables_to_frames(self.tables())
+        return self.result_tables({"samples": rows}, scores)
 
 
 def deviations_of(

@@ -30,16 +30,15 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import yaml
 
 from ertools.arrays import F64
-from ertools.atomic import write_text
 from ertools.geometry import compose, invert, quat_from_yaw, rotate
 from ertools.rsbb.py2 import percent_py2, to_sec
 from ertools.rsbb.tf import TfTrack, script_poses
 from ertools.simulator.answers import tol, write_answers
 from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
 from ertools.simulator.rsbb import TF_RECORD_LAG_NS, TF_STAMP_LAG_NS, write_rsbb_run
+from ertools.simulator.rsbb_files import write_script_config, write_team_transform
 from ertools.simulator.rsbb_scenario import Body, Broadcast, Goal, RsbbScenario, Save
 
 S = 1_000_000_000
@@ -294,16 +293,6 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     """Write both runs and the side files into ``outdir`` (the RSBB's folder layout)."""
     written = _run(outdir, 1, None, seed, T0) + _run(outdir, 2, 20.0, seed, T0 + 900 * S)
     t_mr, q_mr = _team()
-    tdir = outdir / "rsbb_etc" / "transforms"
-    tdir.mkdir(parents=True, exist_ok=True)
-    transform = tdir / f"transform-{TEAM}.yaml"
-    pair = f"- {[float(v) for v in t_mr]}\n- {[float(v) for v in q_mr]}\n"
-    write_text(
-        transform,
-        f"team_name: {TEAM}\nmarkerset_to_robot_transform: !!python/tuple\n{pair}",
-    )
-    cdir = outdir / "rsbb_bmbox" / "scripts" / "benchmark_configs"
-    cdir.mkdir(parents=True, exist_ok=True)
-    config = cdir / "HPFF.yaml"
-    write_text(config, yaml.safe_dump(PARAMS, default_flow_style=False))
+    transform = write_team_transform(outdir, TEAM, t_mr, q_mr)
+    config = write_script_config(outdir, "HPFF", PARAMS, flow_style=False)
     return [*written, transform, config]
