@@ -20,7 +20,6 @@ from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Generate, Simulated
-from ertools.benchmarks.legacy import LegacyBenchmark, adapt
 from ertools.errors import UsageError
 
 if TYPE_CHECKING:
@@ -53,7 +52,6 @@ ENTRIES: tuple[Entry, ...] = (
     Entry("fbm3w", ".fbm3w.declare", "FBM3@Work trajectory following: path error"),
     Entry("trajectory", ".trajectory.declare", "robot log vs mocap ground truth, with clock audit"),
     Entry("noise", ".noise.declare", "mocap noise of a stationary marker set, suggested d_min"),
-    # The RSBB benchmarks (issue 38) are still LegacyBenchmark records (legacy.py adapts them).
     Entry("hnf", ".hnf.declare", "HNF (FBM2@Home 2017-19) navigation: the RSBB script re-scored"),
     Entry("hpff", ".hpff.declare", "HPFF (FBM5@Home 2019) person following: the RSBB script"),
     Entry("hopf", ".hopf.declare", "HOPF object perception (RSBB 2017-19): 10 items"),
@@ -87,10 +85,7 @@ def target(name: str) -> str:
 def load(target: str) -> AnyBenchmark:
     """The benchmark an absolute ``module:ATTRIBUTE`` names (a rescore job's), imported now."""
     module, _, attribute = target.partition(":")
-    found: Any = getattr(import_module(module), attribute or "BENCHMARK")
-    if isinstance(found, LegacyBenchmark):
-        return adapt(found)
-    benchmark: AnyBenchmark = found
+    benchmark: AnyBenchmark = getattr(import_module(module), attribute or "BENCHMARK")
     return benchmark
 
 
@@ -108,14 +103,12 @@ def warm(target: str, *, report: bool = False) -> None:
     """Import now what scoring with the benchmark ``target`` names would import on first use:
     its declaration, the ``pipeline`` beside it and, for a report, its ``plots`` and
     ``foxglove`` (a rescore's server, before it forks its scorers: they inherit them)."""
-    module, _, attribute = target.partition(":")
-    found: Any = getattr(import_module(module), attribute or "BENCHMARK")
+    module = target.partition(":")[0]
+    import_module(module)
     package = module.rpartition(".")[0]
     wanted = [f"{package}.pipeline"]
     if report:
         wanted += [f"{package}.plots", f"{package}.foxglove"]
-        if isinstance(found, LegacyBenchmark):
-            wanted += [t.partition(":")[0] for t in (found.figures, found.foxglove) if t]
     for name in wanted:
         if find_spec(name) is not None:
             import_module(name)

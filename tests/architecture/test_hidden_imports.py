@@ -8,14 +8,8 @@ from pathlib import Path
 
 from tests.architecture.archscan import ROOT, hidden_imports, plant, ratchet
 
-# legacy.py (the old benchmark record's "module:function" texts) goes when the last benchmark
-# is converted to the protocols (S8b); fidelity's rule modules and samples' scenarios become
-# the registry's parts. The list only shrinks.
-ALLOWED = frozenset(
-    {
-        "ertools/benchmarks/legacy.py: import_module outside the registry",
-    }
-)
+# None left (the old benchmark record went with the last conversion): none may come back.
+ALLOWED: frozenset[str] = frozenset()
 
 
 def test_no_new_hidden_import() -> None:

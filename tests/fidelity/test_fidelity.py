@@ -198,8 +198,7 @@ def test_rules_are_declared_at_module_level_and_reach_the_catalogue() -> None:
     assert all(id(r) in shared | carried for r in declared)
 
 
-# Benchmarks whose declaration does not carry its package's rules yet (the legacy adapter
-# gives none; plan 37, S8b declares them): the list only shrinks.
+# Benchmarks whose declaration does not carry its package's rules: none may be added.
 RULES_NOT_CARRIED: frozenset[str] = frozenset()
 
 
