@@ -89,17 +89,25 @@ def load(logs: Sequence[Path], options: HnfOptions) -> HnfLogs:
 
     Raises:
         UsageError: not one bag, or a side file nowhere to be found.
-        TopicError, BagError, ConfigError: unreadable inputs.
+        ConfigError: another benchmark's run or result file; unreadable inputs.
+        TopicError, BagError: unreadable inputs.
     """
     if len(logs) != 1:
         raise UsageError(
             f"give one HNF run bag (rsbb_logs/HNF/<team>/run_<n>_<date>.bag), not {len(logs)}"
         )
     bag = Path(logs[0])
-    opened = open_run(bag, CODE, options)
-    for line in opened.found:
-        notice(line)
-    run, result, team = opened.run, opened.result, opened.team
+    opened = open_run(
+        [bag],
+        CODE,
+        want=("config", "transform", "result"),
+        say=notice,
+        config=options.config,
+        transform=options.transform,
+        result=options.result,
+        team=options.team,
+    )
+    run, result, team = opened.run, opened.result_file, opened.team
     transform_path = opened.transform_file()
     warnings: list[str] = []
     key = TRANSFORM_KEY.get(options.script, "markerset_to_robot_transform")

@@ -30,8 +30,8 @@ from ertools.errors import ConfigError
 from ertools.fidelity import Deviation
 from ertools.io.summary import summary
 from ertools.rsbb.log import RsbbRun
+from ertools.rsbb.opened import open_run
 from ertools.rsbb.results import RsbbResult
-from ertools.rsbb.run_files import open_run
 from ertools.rsbb.score import compare_scores
 from ertools.rsbb.sidefiles import SideFiles, read_side_yaml
 from ertools.rsbb.tf import TfTrack, TfTracks, read_tf_tracks, script_poses

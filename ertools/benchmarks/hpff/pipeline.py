@@ -62,18 +62,26 @@ def load(logs: Sequence[Path], options: HpffOptions) -> HpffLogs:
     """Read the run bag and its side files (found ones named on stderr).
 
     Raises:
-        UsageError: not one bag, another benchmark's run, or a side file nowhere to be found.
-        TopicError, BagError, ConfigError: unreadable inputs.
+        UsageError: not one bag, or a side file nowhere to be found.
+        ConfigError: another benchmark's run or result file; unreadable inputs.
+        TopicError, BagError: unreadable inputs.
     """
     if len(logs) != 1:
         raise UsageError(
             f"give one HPFF run bag (rsbb_logs/HPFF/<team>/run_<n>_<date>.bag), not {len(logs)}"
         )
     bag = Path(logs[0])
-    opened = open_run(bag, CODE, options)
-    for line in opened.found:
-        notice(line)
-    run, result, team = opened.run, opened.result, opened.team
+    opened = open_run(
+        [bag],
+        CODE,
+        want=("config", "transform", "result"),
+        say=notice,
+        config=options.config,
+        transform=options.transform,
+        result=options.result,
+        team=options.team,
+    )
+    run, result, team = opened.run, opened.result_file, opened.team
     transform_path = opened.transform_file()
     side = opened.side
     transform = script_transform(transform_path, ("markerset_to_robot_transform",))
