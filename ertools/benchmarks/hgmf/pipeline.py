@@ -14,6 +14,7 @@ import numpy as np
 
 from ertools.arrays import I64
 from ertools.benchmarks.base import notice
+from ertools.benchmarks.common.interval_output import ResultIntervals
 from ertools.benchmarks.hgmf.checks import sample_heights, timer_heights, timer_ticks
 from ertools.benchmarks.hgmf.config import CODE, OBJECT_BODY, TABLE, HgmfOptions
 from ertools.benchmarks.hgmf.flow import Attempt, HgmfFlow, script_flow
@@ -273,8 +274,7 @@ def score_runs(logs: HgmfLogs, flow: HgmfFlow, options: HgmfOptions) -> HgmfResu
         t_start_ns=flow.t_start_ns,
         stop_ns=flow.stop_ns,
         comparison=comparison,
-        intervals=intervals,
-        uncertainty=uncertainty,
+        intervals=ResultIntervals(intervals, uncertainty),
         track=_path_of(logs.actor, logs.table),
         warnings=tuple(warnings),
         deviations=deviations_of(options, goals),

@@ -14,6 +14,7 @@ import numpy as np
 
 from ertools.arrays import I64
 from ertools.benchmarks.base import notice
+from ertools.benchmarks.common.interval_output import ResultIntervals
 from ertools.benchmarks.hnf.config import SEASONS, HnfOptions
 from ertools.benchmarks.hnf.flow import HnfFlow, script_flow
 from ertools.benchmarks.hnf.formula import SegmentErrors, accuracies, segment_errors
@@ -267,8 +268,7 @@ def score_runs(logs: HnfLogs, flow: HnfFlow, options: HnfOptions) -> HnfResult:
         t_start_ns=flow.t_start_ns,
         stop_ns=flow.stop_ns,
         comparison=comparison,
-        intervals=intervals,
-        uncertainty=uncertainty,
+        intervals=ResultIntervals(intervals, uncertainty),
         track=_path_of(logs.body),
         warnings=tuple(warnings),
         deviations=deviations_of(options, segments, flow),

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from ertools.benchmarks.base import notice
+from ertools.benchmarks.common.interval_output import ResultIntervals
 from ertools.benchmarks.hpff.config import MARGIN_S, SCRIPT_COMMIT, HpffOptions
 from ertools.benchmarks.hpff.flow import HpffFlow, grid_flow, script_flow
 from ertools.benchmarks.hpff.formula import FAILED, Following, following
@@ -252,8 +253,7 @@ def score_runs(logs: HpffLogs, flow: HpffFlow, options: HpffOptions) -> HpffResu
         t_start_ns=flow.t_start_ns,
         rules=options.rules,
         comparison=comparison,
-        intervals=intervals,
-        uncertainty=uncertainty,
+        intervals=ResultIntervals(intervals, uncertainty),
         tracks=tracks,
         warnings=tuple(warnings),
         deviations=deviations_of(options, stopped, passed is False),
