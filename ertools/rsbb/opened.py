@@ -8,6 +8,7 @@ from __future__ import annotations
 from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any, Protocol
 
 from ertools.errors import ConfigError, UsageError
 from ertools.rsbb.log import RsbbRun, check_code, read_rsbb_run
@@ -50,20 +51,31 @@ class OpenedRun:
         return self.transform
 
 
+class SideOptions(Protocol):
+    """The side files a benchmark's options name (None: look for it); ``transform``,
+    ``items`` and ``team`` are read too where the benchmark has them."""
+
+    @property
+    def config(self) -> Path | None: ...
+
+    @property
+    def result(self) -> Path | None: ...
+
+
+def _given(options: SideOptions, name: str) -> Any:
+    return getattr(options, name, None)  # transform, items, team: not every benchmark has them
+
+
 def open_run(
     bags: Sequence[Path],
     code: str,
+    given: SideOptions,
     *,
     want: Collection[str],
     say: Callable[[str], None],
-    config: Path | None = None,
-    transform: Path | None = None,
-    items: Path | None = None,
-    result: Path | None = None,
-    team: str | None = None,
 ) -> OpenedRun:
-    """The run of ``code`` in ``bags`` with the side files ``want`` (given, else found: each
-    found one is said through ``say`` before anything is read).
+    """The run of ``code`` in ``bags`` with the side files ``want`` (``given``, else found:
+    each found one is said through ``say`` before anything is read).
 
     Raises:
         ConfigError: another benchmark's bag (by its folder in the layout, else its live
@@ -75,11 +87,11 @@ def open_run(
         paths[0],
         code,
         want=want,
-        config=config,
-        transform=transform,
-        items=items,
-        result=result,
-        team=team,
+        config=given.config,
+        transform=_given(given, "transform"),
+        items=_given(given, "items"),
+        result=given.result,
+        team=_given(given, "team"),
     )
     if side.place.code is not None and side.place.code != code:
         raise ConfigError(

@@ -5,6 +5,7 @@ another benchmark's bag or result file is refused with one line naming both benc
 from __future__ import annotations
 
 import shutil
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -19,9 +20,19 @@ HPPF_RESULT = next((SAMPLES / "hppf" / "results" / "HPPF" / "simbot").glob("resu
 HNF_RESULT = next((SAMPLES / "hnf" / "results" / "HNF" / "simbot").glob("result_run_1_*.yaml"))
 
 
+@dataclass(frozen=True)
+class Given:
+    """A benchmark's side-file options, none of them given unless said."""
+
+    config: Path | None = None
+    result: Path | None = None
+    transform: Path | None = None
+    team: str | None = None
+
+
 def test_the_side_files_are_found_and_said() -> None:
     said: list[str] = []
-    opened = open_run([HOPF], "HOPF", want=("config", "items", "result"), say=said.append)
+    opened = open_run([HOPF], "HOPF", Given(), want=("config", "items", "result"), say=said.append)
     assert opened.paths == (HOPF,)
     assert opened.result_file is not None and opened.result_file.code == "HOPF"
     assert opened.team == "simbot" and opened.transform is None
@@ -40,7 +51,7 @@ def test_outside_the_layout_the_result_files_team_finds_the_transform(tmp_path: 
     transform = SAMPLES / "hnf" / "rsbb_etc" / "transforms" / "transform-simbot.yaml"
     shutil.copyfile(transform, tmp_path / transform.name)
     said: list[str] = []
-    opened = open_run([bag], "HNF", want=("transform", "result"), say=said.append)
+    opened = open_run([bag], "HNF", Given(), want=("transform", "result"), say=said.append)
     assert opened.side.team is None and opened.team == "simbot"
     assert opened.transform_file() == tmp_path / "transform-simbot.yaml"
     assert said == [
@@ -49,10 +60,19 @@ def test_outside_the_layout_the_result_files_team_finds_the_transform(tmp_path: 
     ]
 
 
+def test_a_given_team_and_transform_are_taken_as_given(tmp_path: Path) -> None:
+    transform = tmp_path / "mine.yaml"
+    transform.write_text("markerset_to_robot_transform: [[0, 0, 0], [0, 0, 0, 1]]\n")
+    said: list[str] = []
+    given = Given(transform=transform, team="homer")
+    opened = open_run([HNF], "HNF", given, want=("transform",), say=said.append)
+    assert opened.team == "homer" and opened.transform_file() == transform and said == []
+
+
 def test_a_missing_transform_is_refused_when_asked_for(tmp_path: Path) -> None:
     bag = tmp_path / HNF.name
     shutil.copyfile(HNF, bag)
-    opened = open_run([bag], "HNF", want=("transform",), say=print)
+    opened = open_run([bag], "HNF", Given(), want=("transform",), say=print)
     assert opened.team is None and opened.transform is None
     with pytest.raises(UsageError, match=r"^no transform-<team>\.yaml .*give --transform FILE"):
         opened.transform_file()
@@ -60,11 +80,11 @@ def test_a_missing_transform_is_refused_when_asked_for(tmp_path: Path) -> None:
 
 def test_another_benchmarks_result_file_is_refused() -> None:
     with pytest.raises(ConfigError, match=r": the result file is a HPPF run's, not HOPF's$"):
-        open_run([HOPF], "HOPF", want=("result",), say=print, result=HPPF_RESULT)
+        open_run([HOPF], "HOPF", Given(result=HPPF_RESULT), want=("result",), say=print)
 
 
 def test_another_benchmarks_bag_is_refused_before_anything_is_said() -> None:
     said: list[str] = []
     with pytest.raises(ConfigError, match=r"a HOPF run .*not HPPF's: ertools score hopf"):
-        open_run([HOPF], "HPPF", want=("config",), say=said.append)
+        open_run([HOPF], "HPPF", Given(), want=("config",), say=said.append)
     assert said == []

@@ -114,14 +114,7 @@ def load(logs: Sequence[Path], options: HgmfOptions) -> HgmfLogs:
             f"give one HGMF run bag (rsbb_logs/HGMF/<team>/run_<n>_<date>.bag), not {len(logs)}"
         )
     bag = Path(logs[0])
-    opened = open_run(
-        [bag],
-        CODE,
-        want=("config", "result"),
-        say=notice,
-        config=options.config,
-        result=options.result,
-    )
+    opened = open_run([bag], CODE, options, want=("config", "result"), say=notice)
     run, result = opened.run, opened.result_file
     objects, config_source = _config(options, opened.side.config, result)
     if run.t_start_ns is None:

@@ -98,16 +98,7 @@ def load(logs: Sequence[Path], options: HnfOptions) -> HnfLogs:
             f"give one HNF run bag (rsbb_logs/HNF/<team>/run_<n>_<date>.bag), not {len(logs)}"
         )
     bag = Path(logs[0])
-    opened = open_run(
-        [bag],
-        CODE,
-        want=("config", "transform", "result"),
-        say=notice,
-        config=options.config,
-        transform=options.transform,
-        result=options.result,
-        team=options.team,
-    )
+    opened = open_run([bag], CODE, options, want=("config", "transform", "result"), say=notice)
     run, result, team = opened.run, opened.result_file, opened.team
     transform_path = opened.transform_file()
     warnings: list[str] = []

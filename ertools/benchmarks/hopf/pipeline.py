@@ -106,15 +106,7 @@ def load(bags: Sequence[Path], options: HopfOptions) -> HopfLogs:
         ConfigError: a side file missing or unreadable, or another benchmark's result file.
         TopicError, BagError: not an RSBB run bag.
     """
-    opened = open_run(
-        bags,
-        CODE,
-        want=("config", "items", "result"),
-        say=notice,
-        config=options.config,
-        items=options.items,
-        result=options.result,
-    )
+    opened = open_run(bags, CODE, options, want=("config", "items", "result"), say=notice)
     paths, side, result_file, run = opened.paths, opened.side, opened.result_file, opened.run
     params = script_params(side, run, result_file)
     items = _items(side, params, options)

@@ -104,14 +104,7 @@ def load(bags: Sequence[Path], options: HppfOptions) -> HppfLogs:
         ConfigError: a side file missing or unreadable, or another benchmark's.
         TopicError, BagError: not an RSBB run bag.
     """
-    opened = open_run(
-        bags,
-        CODE,
-        want=("config", "result"),
-        say=notice,
-        config=options.config,
-        result=options.result,
-    )
+    opened = open_run(bags, CODE, options, want=("config", "result"), say=notice)
     paths, side, result_file, run = opened.paths, opened.side, opened.result_file, opened.run
     people, source = _people(side, run, result_file)
     tracks = read_tf_tracks(paths)
