@@ -284,7 +284,8 @@ def test_the_live_score_names_the_benchmark(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize(
-    ("code", "other"), [("hnf", "hpff"), ("hpff", "hnf"), ("hopf", "hppf"), ("hppf", "hopf")]
+    ("code", "other"),
+    [("hnf", "hpff"), ("hpff", "hnf"), ("hopf", "hppf"), ("hppf", "hopf"), ("hgmf", "hnf")],
 )
 def test_another_benchmarks_bag_outside_the_layout(tmp_path: Path, code: str, other: str) -> None:
     # outside rsbb_logs/<CODE>/ only the bag itself says what it is: one line, exit 1

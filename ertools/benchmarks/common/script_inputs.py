@@ -31,14 +31,6 @@ SCRIPT_GROUP = "the RSBB script's behaviour (each difference can be undone)"
 #: The mocap runs at 100-120 Hz, so 0.1 s is several lost frames (ertools' rule).
 DEFAULT_MAX_GAP_S = 0.1
 
-RESULT = Input(
-    "result",
-    "path",
-    "the run's result file result_run_<n>_<date>.yaml, compared with the recomputed score "
-    "(default: beside the bag or in the RSBB layout)",
-    metavar="FILE",
-)
-
 MAX_GAP = Input(
     "max_gap",
     "float",

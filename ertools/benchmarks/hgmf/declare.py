@@ -29,7 +29,8 @@ if TYPE_CHECKING:  # annotations only: the stages import NumPy and the readers
 def notes(result: HgmfResult) -> list[str]:
     """The comparison with the run's own scores, the interval, and the goals."""
     out = list(result.interval_lines())
-    out += result.comparison.summary()
+    if result.comparison is not None:
+        out += result.comparison.summary()
     if result.rules != "ertools":
         out.append(f"reproducing: {config.SCRIPT_2019} (--rules {result.rules})")
     for g in result.goals:

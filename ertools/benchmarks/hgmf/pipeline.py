@@ -14,6 +14,7 @@ import numpy as np
 
 from ertools.arrays import I64
 from ertools.benchmarks.base import notice
+from ertools.benchmarks.common.interval_output import ResultIntervals
 from ertools.benchmarks.hgmf.checks import sample_heights, timer_heights, timer_ticks
 from ertools.benchmarks.hgmf.config import CODE, OBJECT_BODY, TABLE, HgmfOptions
 from ertools.benchmarks.hgmf.flow import Attempt, HgmfFlow, script_flow
@@ -23,10 +24,11 @@ from ertools.benchmarks.hgmf.listing import score_listing
 from ertools.benchmarks.hgmf.result import HgmfGoal, HgmfResult, deviations_of
 from ertools.errors import ConfigError, UsageError
 from ertools.io.summary import summary
-from ertools.rsbb.log import RsbbRun, read_rsbb_run
-from ertools.rsbb.results import RsbbResult, load_result
+from ertools.rsbb.log import RsbbRun
+from ertools.rsbb.opened import open_run
+from ertools.rsbb.results import RsbbResult
 from ertools.rsbb.score import compare_scores
-from ertools.rsbb.sidefiles import find_side_files, read_side_yaml
+from ertools.rsbb.sidefiles import read_side_yaml
 from ertools.rsbb.tf import TfTrack, read_tf_tracks, script_poses
 from ertools.rsbb_states import BENCHMARKS
 from ertools.streams import Provenance
@@ -103,27 +105,18 @@ def load(logs: Sequence[Path], options: HgmfOptions) -> HgmfLogs:
     """Read the run bag and its side files (found ones named on stderr).
 
     Raises:
-        UsageError: not one bag, another benchmark's bag, or no config anywhere.
-        TopicError, BagError, ConfigError: unreadable inputs.
+        UsageError: not one bag, or no config anywhere.
+        ConfigError: another benchmark's bag or result file; unreadable inputs.
+        TopicError, BagError: unreadable inputs.
     """
     if len(logs) != 1:
         raise UsageError(
             f"give one HGMF run bag (rsbb_logs/HGMF/<team>/run_<n>_<date>.bag), not {len(logs)}"
         )
     bag = Path(logs[0])
-    side = find_side_files(
-        bag, CODE, want={"config", "result"}, config=options.config, result=options.result
-    )
-    if side.place.code not in (None, CODE):
-        raise UsageError(
-            f"{bag} is a {side.place.code} run (rsbb_logs/{side.place.code}/...): "
-            f"ertools score {side.place.code.lower()}"
-        )
-    for line in side.found:
-        notice(line)
-    result = load_result(side.result) if side.result is not None else None
-    objects, config_source = _config(options, side.config, result)
-    run = read_rsbb_run(bag)
+    opened = open_run([bag], CODE, options, want=("config", "result"), say=notice)
+    run, result = opened.run, opened.result_file
+    objects, config_source = _config(options, opened.side.config, result)
     if run.t_start_ns is None:
         raise UsageError(
             f"{bag}: the benchmark never started (no EXECUTING_BENCHMARK): nothing to score"
@@ -139,7 +132,7 @@ def load(logs: Sequence[Path], options: HgmfOptions) -> HgmfLogs:
         objects,
         config_source,
         result,
-        side.team or (result.team if result is not None else None),
+        opened.team,
         int(log_end),
     )
 
@@ -273,8 +266,7 @@ def score_runs(logs: HgmfLogs, flow: HgmfFlow, options: HgmfOptions) -> HgmfResu
         t_start_ns=flow.t_start_ns,
         stop_ns=flow.stop_ns,
         comparison=comparison,
-        intervals=intervals,
-        uncertainty=uncertainty,
+        intervals=ResultIntervals(intervals, uncertainty),
         track=_path_of(logs.actor, logs.table),
         warnings=tuple(warnings),
         deviations=deviations_of(options, goals),

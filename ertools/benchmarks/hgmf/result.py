@@ -13,7 +13,7 @@ from ertools.benchmarks.common.interval_output import (
     ScoreRow,
     score_table,
 )
-from ertools.benchmarks.common.totals_form import TotalsFormResult
+from ertools.benchmarks.common.score_form import ScoreFormResult
 from ertools.benchmarks.hgmf.config import GRASP_RISE_M, HgmfOptions
 from ertools.benchmarks.hgmf.flow import Attempt
 from ertools.benchmarks.hgmf.rules import (
@@ -114,9 +114,9 @@ class HgmfGoal:
 
 
 @dataclass(frozen=True, eq=False)
-class HgmfResult(TotalsFormResult):
+class HgmfResult(ScoreFormResult):
     """A scored HGMF run (implements ``BenchmarkResult``; its score, comparison, intervals and
-    outputs: :class:`TotalsFormResult`).
+    outputs: :class:`ScoreFormResult`).
 
     Attributes:
         goals: every goal the script sent, restarted ones too.
@@ -146,7 +146,7 @@ class HgmfResult(TotalsFormResult):
         return bool(completed) and not any(g.distance_error is not None for g in completed)
 
     def score_rows(self) -> list[ScoreRow]:
-        return [ScoreRow(AVERAGE_KEY, self.average, self.intervals.get(AVERAGE_KEY))]
+        return [ScoreRow(AVERAGE_KEY, self.average, self.interval(AVERAGE_KEY))]
 
     def tables(self) -> dict[str, Rows]:
         """``goals`` (every attempt), ``scores`` (the average and its interval),

@@ -28,7 +28,8 @@ if TYPE_CHECKING:  # annotations only: the stages import NumPy and the readers
 def notes(result: HnfResult) -> list[str]:
     """The comparison with the run's own scores, the intervals, and the segments."""
     out = list(result.interval_lines())
-    out += result.comparison.summary()
+    if result.comparison is not None:
+        out += result.comparison.summary()
     if result.rules != "ertools":
         out.append(f"reproducing: fbm2_navigation.py at {result.script} (--rules {result.rules})")
     for s in result.segments:

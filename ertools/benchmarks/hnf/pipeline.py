@@ -14,6 +14,7 @@ import numpy as np
 
 from ertools.arrays import I64
 from ertools.benchmarks.base import notice
+from ertools.benchmarks.common.interval_output import ResultIntervals
 from ertools.benchmarks.hnf.config import SEASONS, HnfOptions
 from ertools.benchmarks.hnf.flow import HnfFlow, script_flow
 from ertools.benchmarks.hnf.formula import SegmentErrors, accuracies, segment_errors
@@ -89,17 +90,16 @@ def load(logs: Sequence[Path], options: HnfOptions) -> HnfLogs:
 
     Raises:
         UsageError: not one bag, or a side file nowhere to be found.
-        TopicError, BagError, ConfigError: unreadable inputs.
+        ConfigError: another benchmark's run or result file; unreadable inputs.
+        TopicError, BagError: unreadable inputs.
     """
     if len(logs) != 1:
         raise UsageError(
             f"give one HNF run bag (rsbb_logs/HNF/<team>/run_<n>_<date>.bag), not {len(logs)}"
         )
     bag = Path(logs[0])
-    opened = open_run(bag, CODE, options)
-    for line in opened.found:
-        notice(line)
-    run, result, team = opened.run, opened.result, opened.team
+    opened = open_run([bag], CODE, options, want=("config", "transform", "result"), say=notice)
+    run, result, team = opened.run, opened.result_file, opened.team
     transform_path = opened.transform_file()
     warnings: list[str] = []
     key = TRANSFORM_KEY.get(options.script, "markerset_to_robot_transform")
@@ -259,8 +259,7 @@ def score_runs(logs: HnfLogs, flow: HnfFlow, options: HnfOptions) -> HnfResult:
         t_start_ns=flow.t_start_ns,
         stop_ns=flow.stop_ns,
         comparison=comparison,
-        intervals=intervals,
-        uncertainty=uncertainty,
+        intervals=ResultIntervals(intervals, uncertainty),
         track=_path_of(logs.body),
         warnings=tuple(warnings),
         deviations=deviations_of(options, segments, flow),

@@ -16,7 +16,7 @@ from ertools.benchmarks.common.interval_output import (
     ScoreRow,
     score_table,
 )
-from ertools.benchmarks.common.totals_form import TotalsFormResult
+from ertools.benchmarks.common.score_form import ScoreFormResult
 from ertools.benchmarks.hnf.config import HnfOptions
 from ertools.benchmarks.hnf.flow import HnfFlow, SegmentFlow
 from ertools.benchmarks.hnf.rules import (
@@ -102,9 +102,9 @@ class HnfSegment:
 
 
 @dataclass(frozen=True, eq=False)
-class HnfResult(TotalsFormResult):
+class HnfResult(ScoreFormResult):
     """A scored HNF run (implements ``BenchmarkResult``; its score, comparison, intervals and
-    outputs: :class:`TotalsFormResult`).
+    outputs: :class:`ScoreFormResult`).
 
     Attributes:
         segments: the waypoints the script got to.
@@ -139,10 +139,8 @@ class HnfResult(TotalsFormResult):
 
     def score_rows(self) -> list[ScoreRow]:
         return [
-            ScoreRow(POSITION_KEY, self.position_accuracy, self.intervals.get(POSITION_KEY)),
-            ScoreRow(
-                ORIENTATION_KEY, self.orientation_accuracy, self.intervals.get(ORIENTATION_KEY)
-            ),
+            ScoreRow(POSITION_KEY, self.position_accuracy, self.interval(POSITION_KEY)),
+            ScoreRow(ORIENTATION_KEY, self.orientation_accuracy, self.interval(ORIENTATION_KEY)),
         ]
 
     def tables(self) -> dict[str, Rows]:

@@ -17,12 +17,12 @@ import math
 import numpy as np
 
 from ertools.arrays import F64
-from ertools.benchmarks.common.interval_output import METHOD
-from ertools.benchmarks.common.score_form import GoalIntervals
+from ertools.benchmarks.common.interval_output import METHOD, NO_INTERVALS, ResultIntervals
 from ertools.benchmarks.common.uncertainty import MOCAP_NOISE, Source, Uncertainty, monte_carlo
 from ertools.benchmarks.hopf.config import CLIP_TRANSLATION_M, HopfOptions
 from ertools.benchmarks.hopf.formula import pose_terms
 from ertools.benchmarks.hopf.goals import Scored
+from ertools.benchmarks.hopf.result import TOTAL_KEY, goal_key
 from ertools.rsbb.jitter import DEFAULT_SIGMA_M, DEFAULT_SIGMA_RAD, MocapNoise, mocap_noise
 from ertools.rsbb.tf import TfTrack, euler_yaw
 
@@ -47,8 +47,8 @@ def _noise(bodies: tuple[TfTrack | None, ...]) -> tuple[list[MocapNoise], Source
 
 def hopf_intervals(
     bodies: tuple[TfTrack | None, ...], scored: Scored, options: HopfOptions
-) -> GoalIntervals | None:
-    """The intervals of each scored goal's pose score and of the total (None with
+) -> ResultIntervals:
+    """The intervals of each scored goal's pose score and of the total (none with
     ``--draws 0`` or no scored goal); ``bodies``: the table's and the positioner's tracks."""
     goals = [
         g
@@ -60,7 +60,7 @@ def hopf_intervals(
         and g.truth.pose is not None
     ]
     if options.draws <= 0 or not goals:
-        return None
+        return NO_INTERVALS
     (table, positioner), source = _noise(bodies)
     answer = np.array(
         [g.answer.pose for g in goals if g.answer is not None and g.answer.pose is not None]
@@ -129,4 +129,5 @@ def hopf_intervals(
     uncertainty = Uncertainty(
         options.confidence, METHOD, options.draws, options.seed, (source,), shares
     )
-    return GoalIntervals(ivs[n], {g.index: ivs[k] for k, g in enumerate(goals)}, uncertainty)
+    by_goal = {goal_key(g.index): ivs[k] for k, g in enumerate(goals)}
+    return ResultIntervals({TOTAL_KEY: ivs[n], **by_goal}, uncertainty)

@@ -30,8 +30,8 @@ from ertools.errors import ConfigError
 from ertools.fidelity import Deviation
 from ertools.io.summary import summary
 from ertools.rsbb.log import RsbbRun
+from ertools.rsbb.opened import open_run
 from ertools.rsbb.results import RsbbResult
-from ertools.rsbb.run_files import open_run
 from ertools.rsbb.score import compare_scores
 from ertools.rsbb.sidefiles import SideFiles, read_side_yaml
 from ertools.rsbb.tf import TfTrack, TfTracks, read_tf_tracks, script_poses
@@ -106,15 +106,7 @@ def load(bags: Sequence[Path], options: HopfOptions) -> HopfLogs:
         ConfigError: a side file missing or unreadable, or another benchmark's result file.
         TopicError, BagError: not an RSBB run bag.
     """
-    opened = open_run(
-        bags,
-        CODE,
-        want=("config", "items", "result"),
-        say=notice,
-        config=options.config,
-        items=options.items,
-        result=options.result,
-    )
+    opened = open_run(bags, CODE, options, want=("config", "items", "result"), say=notice)
     paths, side, result_file, run = opened.paths, opened.side, opened.result_file, opened.run
     params = script_params(side, run, result_file)
     items = _items(side, params, options)

@@ -7,31 +7,48 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from ertools.benchmarks.base import Rows
-from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
+from ertools.benchmarks.common.interval_output import ScoreRow
 from ertools.benchmarks.common.score_form import ScoreFormResult
 from ertools.benchmarks.hopf.goals import GoalRecord
 from ertools.timeutil import ns_to_s
 
+TOTAL_KEY = "pose_score"
 
-@dataclass(frozen=True, eq=False)
+
+def goal_key(index: int) -> str:
+    """The dotted score key of goal ``index``'s pose score (its interval's key)."""
+    return f"goal_{index}.partial_score.pose_score"
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
 class HopfResult(ScoreFormResult):
     """A scored HOPF run (implements ``BenchmarkResult``): :class:`ScoreFormResult`'s fields
     (its intervals: the pose scores'), then these.
 
     Attributes:
         goals: one record per iteration the run began.
+        rules: ``ertools`` or the script version reproduced (``2019``...).
+        crashed: why the script died on this run (``--rules``), None when it did not.
+        origin_ns: the bag's first message (table times count from it).
+        end: how the benchmark ended (``end``, ``stop``, ``global_timeout``, ``log_ends``).
+        notes: what the scoring says on stderr.
     """
 
     goals: tuple[GoalRecord, ...] = ()
+    rules: str = "ertools"
+    crashed: str | None = None
+    origin_ns: int | None = None
+    end: str = ""
+    notes: tuple[str, ...] = ()
     name: str = "hopf"
 
-    TOTAL: ClassVar[str] = "pose_score"
-    GOAL_SCORE: ClassVar[str] = "partial_score.pose_score"
+    INTERVALS_LAST: ClassVar[tuple[str, ...]] = (TOTAL_KEY,)
+    UNCERTAINTY_IN_YAML: ClassVar[bool] = True
 
     @property
     def pose_score(self) -> float | None:
         """The total pose score (the leaderboard's number)."""
-        value = self.score.get("pose_score")
+        value = self.score.get(TOTAL_KEY)
         return float(value) if isinstance(value, int | float) else None
 
     @property
@@ -41,18 +58,16 @@ class HopfResult(ScoreFormResult):
             return False
         return any(g.status == "unscoreable" for g in self.goals)
 
-    def interval_lines(self) -> list[str]:
-        """The stderr lines of the intervals."""
-        iv = self.intervals
-        if iv is None:
-            return []
-        rows = [ScoreRow("pose_score", self.pose_score, iv.total, 1.0, "")]
+    def score_rows(self) -> list[ScoreRow]:
+        """The total pose score, then each scored goal's, with their intervals."""
+        rows = [ScoreRow(TOTAL_KEY, self.pose_score, self.interval(TOTAL_KEY), 1.0, "")]
         for g in self.goals:
-            if g.index in iv.goals and g.terms is not None:
+            key = goal_key(g.index)
+            if key in self.intervals.intervals and g.terms is not None:
                 rows.append(
-                    ScoreRow(f"goal_{g.index} pose_score", g.terms[5], iv.goals[g.index], 1.0, "")
+                    ScoreRow(f"goal_{g.index} pose_score", g.terms[5], self.interval(key), 1.0, "")
                 )
-        return interval_lines(rows, iv.uncertainty)
+        return rows
 
     def _rel(self, t: int | None) -> float | None:
         return None if t is None or self.origin_ns is None else ns_to_s(t - self.origin_ns)
@@ -65,7 +80,7 @@ class HopfResult(ScoreFormResult):
             truth = g.truth.pose if g.truth is not None and g.truth.pose is not None else None
             ans = g.answer
             terms = g.terms
-            iv = self.intervals.goals.get(g.index) if self.intervals is not None else None
+            iv = self.interval(goal_key(g.index))
             rows.append(
                 {
                     "goal": g.index,
@@ -102,7 +117,7 @@ class HopfResult(ScoreFormResult):
                     "no_truth_reason": None if g.truth is None else g.truth.reason,
                 }
             )
-        total = self.intervals.total if self.intervals is not None else None
+        total = self.interval(TOTAL_KEY)
         summary: Rows = [
             {
                 "rules": self.rules,

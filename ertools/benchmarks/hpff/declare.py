@@ -28,7 +28,8 @@ if TYPE_CHECKING:  # annotations only: the stages import NumPy and the readers
 def notes(result: HpffResult) -> list[str]:
     """The intervals, the comparison with the run's own scores, the samples and the duration."""
     out = list(result.interval_lines())
-    out += result.comparison.summary()
+    if result.comparison is not None:
+        out += result.comparison.summary()
     if result.rules != "ertools":
         out.append("reproducing: fbm5_person_following.py at 2bb8a41 (--rules 2019)")
     s = result.stats

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from ertools.benchmarks.base import notice
+from ertools.benchmarks.common.interval_output import ResultIntervals
 from ertools.benchmarks.hpff.config import MARGIN_S, SCRIPT_COMMIT, HpffOptions
 from ertools.benchmarks.hpff.flow import HpffFlow, grid_flow, script_flow
 from ertools.benchmarks.hpff.formula import FAILED, Following, following
@@ -62,18 +63,17 @@ def load(logs: Sequence[Path], options: HpffOptions) -> HpffLogs:
     """Read the run bag and its side files (found ones named on stderr).
 
     Raises:
-        UsageError: not one bag, another benchmark's run, or a side file nowhere to be found.
-        TopicError, BagError, ConfigError: unreadable inputs.
+        UsageError: not one bag, or a side file nowhere to be found.
+        ConfigError: another benchmark's run or result file; unreadable inputs.
+        TopicError, BagError: unreadable inputs.
     """
     if len(logs) != 1:
         raise UsageError(
             f"give one HPFF run bag (rsbb_logs/HPFF/<team>/run_<n>_<date>.bag), not {len(logs)}"
         )
     bag = Path(logs[0])
-    opened = open_run(bag, CODE, options)
-    for line in opened.found:
-        notice(line)
-    run, result, team = opened.run, opened.result, opened.team
+    opened = open_run([bag], CODE, options, want=("config", "transform", "result"), say=notice)
+    run, result, team = opened.run, opened.result_file, opened.team
     transform_path = opened.transform_file()
     side = opened.side
     transform = script_transform(transform_path, ("markerset_to_robot_transform",))
@@ -244,8 +244,7 @@ def score_runs(logs: HpffLogs, flow: HpffFlow, options: HpffOptions) -> HpffResu
         t_start_ns=flow.t_start_ns,
         rules=options.rules,
         comparison=comparison,
-        intervals=intervals,
-        uncertainty=uncertainty,
+        intervals=ResultIntervals(intervals, uncertainty),
         tracks=tracks,
         warnings=tuple(warnings),
         deviations=deviations_of(options, stopped, passed is False),

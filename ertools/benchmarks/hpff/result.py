@@ -10,7 +10,7 @@ import numpy as np
 from ertools.arrays import F64, I64, Bool
 from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import ScoreRow
-from ertools.benchmarks.common.totals_form import TotalsFormResult
+from ertools.benchmarks.common.score_form import ScoreFormResult
 from ertools.benchmarks.hpff.config import HpffOptions
 from ertools.benchmarks.hpff.formula import Following
 from ertools.benchmarks.hpff.rules import (
@@ -49,9 +49,9 @@ class HpffSamples:
 
 
 @dataclass(frozen=True, eq=False)
-class HpffResult(TotalsFormResult):
+class HpffResult(ScoreFormResult):
     """A scored HPFF run (implements ``BenchmarkResult``; its score, comparison, intervals and
-    outputs: :class:`TotalsFormResult`).
+    outputs: :class:`ScoreFormResult`).
 
     Attributes:
         samples, stats: the samples and their statistics (None: nothing was sampled).
@@ -87,8 +87,8 @@ class HpffResult(TotalsFormResult):
     def score_rows(self) -> list[ScoreRow]:
         covered = None if self.stats is None else float(self.stats.covered)
         return [
-            ScoreRow(DEVIATION_KEY, self.average_deviation, self.intervals.get(DEVIATION_KEY)),
-            ScoreRow(COVERED_KEY, covered, self.intervals.get(COVERED_KEY)),
+            ScoreRow(DEVIATION_KEY, self.average_deviation, self.interval(DEVIATION_KEY)),
+            ScoreRow(COVERED_KEY, covered, self.interval(COVERED_KEY)),
         ]
 
     def tables(self) -> dict[str, Rows]:

@@ -15,9 +15,9 @@ from ertools.benchmarks.common.inputs import INTERVAL_INPUTS
 from ertools.benchmarks.common.script_inputs import (
     GT_GAPS,
     MAX_GAP,
-    RESULT,
     SCRIPT_GROUP,
     ScriptOptions,
+    result_input,
     script_values,
 )
 from ertools.errors import UsageError
@@ -57,7 +57,7 @@ INPUTS = (
         "score)",
         metavar="FILE",
     ),
-    RESULT,
+    result_input(CODE),
     MAX_GAP,
     Input(
         "rules",

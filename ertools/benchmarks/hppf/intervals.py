@@ -14,13 +14,12 @@ import math
 import numpy as np
 
 from ertools.arrays import F64
-from ertools.benchmarks.common.interval_output import METHOD
-from ertools.benchmarks.common.score_form import GoalIntervals
+from ertools.benchmarks.common.interval_output import METHOD, NO_INTERVALS, ResultIntervals
 from ertools.benchmarks.common.uncertainty import MOCAP_NOISE, Source, Uncertainty, monte_carlo
 from ertools.benchmarks.hppf.config import HppfOptions
 from ertools.benchmarks.hppf.formula import position_errors
 from ertools.benchmarks.hppf.goals import Scored
-from ertools.benchmarks.hppf.result import DISTANCE_KEY
+from ertools.benchmarks.hppf.result import DISTANCE_KEY, goal_key
 from ertools.rsbb.jitter import DEFAULT_SIGMA_M, mocap_noise
 from ertools.rsbb.tf import TfTrack
 
@@ -32,10 +31,8 @@ def _sigma(actor: TfTrack | None) -> tuple[float, Source]:
     return noise.sigma_m, Source(MOCAP_NOISE, noise.sigma_m, "m", noise.measured, noise.note)
 
 
-def hppf_intervals(
-    actor: TfTrack | None, scored: Scored, options: HppfOptions
-) -> GoalIntervals | None:
-    """The intervals of each position error and of the Distance error (None with
+def hppf_intervals(actor: TfTrack | None, scored: Scored, options: HppfOptions) -> ResultIntervals:
+    """The intervals of each position error and of the Distance error (none with
     ``--draws 0`` or no position error)."""
     rows = [
         p
@@ -47,7 +44,7 @@ def hppf_intervals(
         and p.answer.xy is not None
     ]
     if options.draws <= 0 or not rows:
-        return None
+        return NO_INTERVALS
     sigma, source = _sigma(actor)
     truth = np.array([p.truth.xy for p in rows if p.truth is not None], np.float64)
     answer = np.array([p.answer.xy for p in rows if p.answer is not None], np.float64)
@@ -81,4 +78,5 @@ def hppf_intervals(
     uncertainty = Uncertainty(
         options.confidence, METHOD, options.draws, options.seed, (source,), shares
     )
-    return GoalIntervals(ivs[n], {p.index: ivs[k] for k, p in enumerate(rows)}, uncertainty)
+    by_goal = {goal_key(p.index): ivs[k] for k, p in enumerate(rows)}
+    return ResultIntervals({DISTANCE_KEY: ivs[n], **by_goal}, uncertainty)

@@ -22,8 +22,8 @@ from ertools.errors import ConfigError
 from ertools.fidelity import Deviation
 from ertools.io.summary import summary
 from ertools.rsbb.log import RsbbRun
+from ertools.rsbb.opened import open_run
 from ertools.rsbb.results import RsbbResult
-from ertools.rsbb.run_files import open_run
 from ertools.rsbb.score import compare_scores
 from ertools.rsbb.sidefiles import SideFiles, read_side_yaml
 from ertools.rsbb.tf import TfTrack, TfTracks, read_tf_tracks, script_poses
@@ -104,14 +104,7 @@ def load(bags: Sequence[Path], options: HppfOptions) -> HppfLogs:
         ConfigError: a side file missing or unreadable, or another benchmark's.
         TopicError, BagError: not an RSBB run bag.
     """
-    opened = open_run(
-        bags,
-        CODE,
-        want=("config", "result"),
-        say=notice,
-        config=options.config,
-        result=options.result,
-    )
+    opened = open_run(bags, CODE, options, want=("config", "result"), say=notice)
     paths, side, result_file, run = opened.paths, opened.side, opened.result_file, opened.run
     people, source = _people(side, run, result_file)
     tracks = read_tf_tracks(paths)

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 from typing import ClassVar
 
 from ertools.benchmarks.base import Rows
-from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
+from ertools.benchmarks.common.interval_output import ScoreRow
 from ertools.benchmarks.common.score_form import ScoreFormResult
 from ertools.benchmarks.hppf.goals import PassRecord
 from ertools.timeutil import ns_to_s
@@ -15,7 +15,12 @@ from ertools.timeutil import ns_to_s
 DISTANCE_KEY = "Distance error"
 
 
-@dataclass(frozen=True, eq=False)
+def goal_key(index: int) -> str:
+    """The dotted score key of goal ``index``'s position error (its interval's key)."""
+    return f"goal_{index}.position_error"
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
 class HppfResult(ScoreFormResult):
     """A scored HPPF run (implements ``BenchmarkResult``): :class:`ScoreFormResult`'s fields
     (its intervals: the position errors' and the Distance error's), then these.
@@ -23,14 +28,24 @@ class HppfResult(ScoreFormResult):
     Attributes:
         passes: one record per pass of the script's loop (a restarted goal has two).
         people: the config's people (N).
+        rules: ``ertools`` or the script version reproduced (``2019``).
+        crashed: why the script died on this run (``--rules``), None when it did not.
+        origin_ns: the bag's first message (table times count from it).
+        end: how the benchmark ended (``end``, ``stop``, ``global_timeout``, ``log_ends``).
+        notes: what the scoring says on stderr.
     """
 
     passes: tuple[PassRecord, ...] = ()
     people: tuple[str, ...] = ()
+    rules: str = "ertools"
+    crashed: str | None = None
+    origin_ns: int | None = None
+    end: str = ""
+    notes: tuple[str, ...] = ()
     name: str = "hppf"
 
-    TOTAL: ClassVar[str] = DISTANCE_KEY
-    GOAL_SCORE: ClassVar[str] = "position_error"
+    INTERVALS_LAST: ClassVar[tuple[str, ...]] = (DISTANCE_KEY,)
+    UNCERTAINTY_IN_YAML: ClassVar[bool] = True
 
     @property
     def distance_error(self) -> float | None:
@@ -45,24 +60,24 @@ class HppfResult(ScoreFormResult):
             return False
         return any(p.status == "unscoreable" for p in self.passes)
 
-    def interval_lines(self) -> list[str]:
-        """The stderr lines of the intervals (millimetres)."""
-        iv = self.intervals
-        if iv is None:
-            return []
-        rows = [ScoreRow(DISTANCE_KEY, self.distance_error, iv.total, 1000.0, "mm")]
+    def score_rows(self) -> list[ScoreRow]:
+        """The Distance error, then each pass's position error, with their intervals (mm)."""
+        rows = [
+            ScoreRow(DISTANCE_KEY, self.distance_error, self.interval(DISTANCE_KEY), 1000.0, "mm")
+        ]
         for p in self.passes:
-            if p.position_error is not None and p.index in iv.goals:
+            key = goal_key(p.index)
+            if p.position_error is not None and key in self.intervals.intervals:
                 rows.append(
                     ScoreRow(
                         f"goal_{p.index} position_error",
                         p.position_error,
-                        iv.goals[p.index],
+                        self.interval(key),
                         1000.0,
                         "mm",
                     )
                 )
-        return interval_lines(rows, iv.uncertainty)
+        return rows
 
     def _rel(self, t: int | None) -> float | None:
         return None if t is None or self.origin_ns is None else ns_to_s(t - self.origin_ns)
@@ -72,7 +87,7 @@ class HppfResult(ScoreFormResult):
         rows: Rows = []
         for p in self.passes:
             it, a, t = p.iteration, p.answer, p.truth
-            iv = self.intervals.goals.get(p.index) if self.intervals is not None else None
+            iv = self.interval(goal_key(p.index))
             rows.append(
                 {
                     "goal": p.index,
@@ -98,7 +113,7 @@ class HppfResult(ScoreFormResult):
                     "no_truth_reason": None if t is None else t.reason,
                 }
             )
-        total = self.intervals.total if self.intervals is not None else None
+        total = self.interval(DISTANCE_KEY)
         summary: Rows = [
             {
                 "rules": self.rules,

@@ -216,7 +216,7 @@ def test_missing_side_files_and_wrong_bags(tmp_path: Path) -> None:
     other = tmp_path / "rsbb_logs" / "HPFF" / "homer" / lone.name
     other.parent.mkdir(parents=True)
     other.write_bytes(lone.read_bytes())
-    with pytest.raises(UsageError, match=r"is an HPFF run.*ertools score hpff"):
+    with pytest.raises(ConfigError, match=r"a HPFF run .*not HNF's: ertools score hpff"):
         load([other], declare.make_options({}))
     with pytest.raises(UsageError, match="give one HNF run bag"):
         load([lone, lone], declare.make_options({}))
