@@ -15,7 +15,8 @@ keep the sample small).
 The script's lookups (its ``/robot`` broadcasts) follow its schedule: the check 10 ms after the
 start, then from 8 s after the robot's start every 0.5 s a relative lookup 1 ms into the sample
 and an absolute one 6 ms later (201 ms when the relative failed). Its saves hold the 2019
-script's score computed from the published mocap with tf's arithmetic (:mod:`ertools.rsbb.tf`).
+script's score computed from the published mocap with tf's arithmetic
+(:mod:`ertools.simulator.tf_lookup`).
 
 Answers, from the noiseless truth: for ertools' reading (a 2 Hz grid from 8 s after the
 RefBox's goal start, horizontal distances, a sample measured where neither body's mocap has a
@@ -34,12 +35,12 @@ import numpy as np
 from ertools.arrays import F64
 from ertools.geometry import compose, invert, quat_from_yaw, rotate
 from ertools.rsbb.py2 import percent_py2, to_sec
-from ertools.rsbb.tf import TfTrack, script_poses
 from ertools.simulator.answers import tol, write_answers
 from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
-from ertools.simulator.rsbb import TF_RECORD_LAG_NS, TF_STAMP_LAG_NS, write_rsbb_run
+from ertools.simulator.rsbb import TF_STAMP_LAG_NS, write_rsbb_run
 from ertools.simulator.rsbb_files import write_script_config, write_team_transform
 from ertools.simulator.rsbb_scenario import Body, Broadcast, Goal, RsbbScenario, Save
+from ertools.simulator.tf_lookup import Link, lookup
 
 S = 1_000_000_000
 MS = 1_000_000
@@ -168,32 +169,18 @@ def _run(outdir: Path, run: int, stop_s: float | None, seed: int, t0: int) -> li
     team = (team_t, team_q)
     score: dict[str, Any] = {}
     if stop_s is None:
-        track = TfTrack(
-            "testbed_origin",
-            "robot_markerset",
-            robot_pub.t_header_ns + TF_STAMP_LAG_NS,
-            robot_pub.t_record_ns + TF_RECORD_LAG_NS,
-            robot_pub.xyz,
-            robot_pub.quat_xyzw,
-        )
-        person = TfTrack(
-            "testbed_origin",
-            "actor_markerset",
-            cap_pub.t_header_ns + TF_STAMP_LAG_NS,
-            cap_pub.t_record_ns + TF_RECORD_LAG_NS,
-            cap_pub.xyz,
-            cap_pub.quat_xyzw,
-        )
+        track = Link(robot_pub.t_header_ns + TF_STAMP_LAG_NS, robot_pub.xyz, robot_pub.quat_xyzw)
+        person = Link(cap_pub.t_header_ns + TF_STAMP_LAG_NS, cap_pub.xyz, cap_pub.quat_xyzw)
         ok = np.array([r >= 0 for r in rel])
         rel_ns = np.array(
             [t0 + round((r if r >= 0 else s) * S) for r, s in zip(rel, starts, strict=True)]
         )
-        relative = script_poses(track, rel_ns, team, reference=person)
-        absolute = script_poses(track, np.array([t0 + round(a * S) for a in ab]), team)
+        relative = [lookup(track, int(x), team, person).xyz for x in rel_ns]
+        absolute = [lookup(track, t0 + round(a * S), team).xyz for a in ab]
         score = _stats(
-            np.hypot(relative.x, relative.y),
+            np.hypot([p[0] for p in relative], [p[1] for p in relative]),
             ok,
-            np.column_stack([absolute.x, absolute.y]),
+            np.array([[p[0], p[1]] for p in absolute]),
             np.ones(len(ab), dtype=bool),
         )
     sc = RsbbScenario(
