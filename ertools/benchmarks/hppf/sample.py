@@ -41,11 +41,9 @@ import numpy as np
 import yaml
 
 from ertools.atomic import write_text
-from ertools.rsbb.tf import TfTrack, script_poses
-from ertools.rsbb_states import MOCAP_PARENT
 from ertools.simulator.answers import tol, write_answers
 from ertools.simulator.mocap import MocapNoise, frame_times, simulate_mocap
-from ertools.simulator.rsbb import TF_RECORD_LAG_NS, TF_STAMP_LAG_NS, write_rsbb_run
+from ertools.simulator.rsbb import TF_STAMP_LAG_NS, write_rsbb_run
 from ertools.simulator.rsbb_scenario import (
     Body,
     Broadcast,
@@ -54,6 +52,7 @@ from ertools.simulator.rsbb_scenario import (
     Save,
     stopped_run,
 )
+from ertools.simulator.tf_lookup import Link, lookup
 
 S = 1_000_000_000
 MS = 1_000_000
@@ -126,20 +125,13 @@ class _Events:
     stop_ns: int
 
 
-def _track(body: Body) -> TfTrack:
+def _track(body: Body) -> Link:
     """The cap's ``/tf`` link as the bag holds it (the tf copy's stamps and arrivals)."""
     pub = body.published
-    return TfTrack(
-        MOCAP_PARENT,
-        body.name,
-        pub.t_header_ns + TF_STAMP_LAG_NS,
-        pub.t_record_ns + TF_RECORD_LAG_NS,
-        pub.xyz,
-        pub.quat_xyzw,
-    )
+    return Link(pub.t_header_ns + TF_STAMP_LAG_NS, pub.xyz, pub.quat_xyzw)
 
 
-def _events(cap: TfTrack | None) -> _Events:
+def _events(cap: Link | None) -> _Events:
     """The passes in order. The live score takes the cap's pose as tf gave it at the
     ``/person`` broadcast after the answer (``cap``; None: where the person stands)."""
     manual: list[ManualOperation] = []
@@ -225,8 +217,8 @@ def _events(cap: TfTrack | None) -> _Events:
         errors.append(error)
         seen = where
         if cap is not None:
-            at = script_poses(cap, np.array([truth], np.int64), IDENTITY)
-            seen = (float(at.x[0]), float(at.y[0]))
+            at = lookup(cap, truth, IDENTITY)
+            seen = (at.xyz[0], at.xyz[1])
         x_err, y_err = said[0] - seen[0], said[1] - seen[1]
         live_errors.append(math.sqrt(x_err**2 + y_err**2))  # l. 196 of the script
         ok_2019 = name.lower() == person.lower()
@@ -314,7 +306,12 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
             },
         },
         tolerance={
-            "position": tol(1e-3, "the cap's mocap noise (0.2 mm per axis), a few sigma"),
+            "position": tol(
+                1e-3,
+                "the cap's mocap noise, 0.2 mm per axis, moves a position error by 0.2 mm "
+                "(sigma): 1 mm is 5 sigma; lookup time: none, the person stands still around "
+                "the /person lookup",
+            ),
             "execution_time": tol(1e-9, "the RefBox's messages are written at the given times"),
         },
     )
