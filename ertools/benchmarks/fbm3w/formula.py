@@ -11,10 +11,10 @@ As the 2015 node did (rockin_scoring/scripts/fbm3w, seed 7.3.1-7.3.3):
    ``l_i / L``; the start point counts with error 0;
 4. distance_error = sum of the errors / N, N the number of kept points.
 
-Written once for every caller: :func:`score_path` (one run), the intervals (every Monte Carlo
-draw side by side: :func:`kept_flags`, then :func:`arc_fractions` and :func:`frame_errors` on
-the kept points of all draws laid end to end) and ``--runs auto`` (a candidate move in two
-frames).
+The d_min rule is :func:`subsample_d_min`, for :func:`score_path` (one run), :func:`kept_flags`
+(paths side by side, column by column) and ``--runs auto`` (a candidate move in two frames,
+with :func:`arc_fractions` and :func:`frame_errors`). The intervals' float32 pass over all
+draws at once (``perturbed._subsample``) is its own copy of the rule.
 """
 
 from __future__ import annotations
