@@ -149,6 +149,30 @@ class Audit:
     def _rel(self, t_ns: int) -> float:
         return round(ns_to_s(t_ns - self.start_ns), 3)
 
+    def _silence(self, s: Silence, *, epoch: bool) -> dict[str, Any]:
+        """A silence's row; ``epoch`` adds its epoch start (``from_time``) for the tables."""
+        row: dict[str, Any] = {"machine": s.machine.value, "topic": s.topic}
+        if epoch:
+            row["from_time"] = ns_to_s(s.start_ns)
+        row["from"] = self._rel(s.start_ns)
+        row["to"] = self._rel(s.end_ns)
+        row["duration"] = ns_to_s(s.duration_ns)
+        row["state"] = s.state_name
+        row["until_log_end"] = s.trailing
+        return row
+
+    def _early_end(self, e: EarlyEnd, *, table: bool) -> dict[str, Any]:
+        """An early end's row: the table's leads with its epoch time and leaves out the
+        payload (its reason says it)."""
+        row: dict[str, Any] = {"time": ns_to_s(e.t_ns)} if table else {}
+        row["t"] = self._rel(e.t_ns)
+        row["reason"] = e.reason
+        if not table:
+            row["payload"] = e.payload
+        row["run"] = e.run
+        row["bmbox_state"] = e.bmbox_state
+        return row
+
     def to_dict(self) -> dict[str, Any]:
         """JSON-able: times as seconds from the first state message, plus epoch start."""
         out: dict[str, Any] = {
@@ -168,28 +192,8 @@ class Audit:
                 }
                 for x in self.illegal_transitions
             ],
-            "silences": [
-                {
-                    "machine": s.machine.value,
-                    "topic": s.topic,
-                    "from": self._rel(s.start_ns),
-                    "to": self._rel(s.end_ns),
-                    "duration": ns_to_s(s.duration_ns),
-                    "state": s.state_name,
-                    "until_log_end": s.trailing,
-                }
-                for s in self.silences
-            ],
-            "early_ends": [
-                {
-                    "t": self._rel(e.t_ns),
-                    "reason": e.reason,
-                    "payload": e.payload,
-                    "run": e.run,
-                    "bmbox_state": e.bmbox_state,
-                }
-                for e in self.early_ends
-            ],
+            "silences": [self._silence(s, epoch=False) for s in self.silences],
+            "early_ends": [self._early_end(e, table=False) for e in self.early_ends],
             "runs": {str(r.index): self._run_dict(r) for r in self.runs},
             "live_score": jsonable(self.live_score),
             "timeline": [self._entry_dict(e) for e in self.timeline],
@@ -335,29 +339,8 @@ class Audit:
                 }
                 for x in self.illegal_transitions
             ],
-            "silences": [
-                {
-                    "machine": s.machine.value,
-                    "topic": s.topic,
-                    "from_time": ns_to_s(s.start_ns),
-                    "from": self._rel(s.start_ns),
-                    "to": self._rel(s.end_ns),
-                    "duration": ns_to_s(s.duration_ns),
-                    "state": s.state_name,
-                    "until_log_end": s.trailing,
-                }
-                for s in self.silences
-            ],
-            "early_ends": [
-                {
-                    "time": ns_to_s(e.t_ns),
-                    "t": self._rel(e.t_ns),
-                    "reason": e.reason,
-                    "run": e.run,
-                    "bmbox_state": e.bmbox_state,
-                }
-                for e in self.early_ends
-            ],
+            "silences": [self._silence(s, epoch=True) for s in self.silences],
+            "early_ends": [self._early_end(e, table=True) for e in self.early_ends],
         }
         for row in tables["runs"]:
             row["states"] = " > ".join(row["states"])

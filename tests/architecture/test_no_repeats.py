@@ -30,3 +30,11 @@ def test_a_repeat_is_found_across_files_and_layouts(tmp_path: Path) -> None:
         },
     )
     assert repeats(root) == {"ertools/a.py ~ ertools/b.py": "ertools/a.py:3-12 ~ ertools/b.py:5-32"}
+
+
+def test_a_repeat_inside_one_file_is_found(tmp_path: Path) -> None:
+    # two functions of one module with the same 10-line body (as auditing/model.py's
+    # to_dict and tables had): one file, two places
+    body = "".join(f"    x{i} = {i}\n" for i in range(10))
+    root = plant(tmp_path, {"ertools/a.py": f"def f():\n{body}def g():\n    y = 0\n{body}"})
+    assert repeats(root) == {"ertools/a.py": "ertools/a.py:2-11 ~ ertools/a.py:14-23"}

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -34,14 +34,11 @@ from ertools.benchmarks.common.phases import (
     phase_pairs,
     stationary_phases,
 )
+from ertools.benchmarks.results import ResultBase
 from ertools.errors import ScoringError
 from ertools.fidelity import Deviation
-from ertools.frames import tables_to_frames
-from ertools.serialize import dump_yaml, jsonable
+from ertools.serialize import jsonable
 from ertools.streams import PoseStream, Provenance
-
-if TYPE_CHECKING:
-    import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 PERCENTILES = (50, 95, 99)
 # Rows the 2015 tool printed (0 to 7.5 mm); longer tails are folded into one overflow row.
@@ -49,7 +46,7 @@ HISTOGRAM_ROWS = 50
 
 
 @dataclass(frozen=True, eq=False)
-class NoiseResult:
+class NoiseResult(ResultBase):
     """Noise statistics; implements :class:`ertools.benchmarks.base.BenchmarkResult`.
 
     Attributes:
@@ -96,7 +93,7 @@ class NoiseResult:
         edges = np.arange(HISTOGRAM_ROWS, dtype=np.float64) * self.bin
         return edges, counts.astype(np.int64), int(np.sum(idx >= HISTOGRAM_ROWS))
 
-    def to_dict(self) -> dict[str, Any]:
+    def listing(self) -> dict[Any, Any]:
         """The JSON keys of the issue: samples, lost, epsilon, percentiles, suggested_d_min."""
         return {
             "samples": self.samples,
@@ -105,14 +102,6 @@ class NoiseResult:
             "percentiles": {k: _finite(v) for k, v in self.percentiles.items()},
             "suggested_d_min": _finite(self.suggested_d_min),
         }
-
-    def to_yaml(self) -> str:
-        return dump_yaml(jsonable(self.to_dict()))
-
-    def to_frames(self) -> dict[str, pd.DataFrame]:
-        """Every table of :meth:`tables` as a pandas DataFrame, epoch times as a UTC index
-        (:func:`ertools.frames.tables_to_frames`)."""
-        return tables_to_frames(self.tables())
 
     def tables(self) -> dict[str, Rows]:
         edges, counts, overflow = self.histogram()

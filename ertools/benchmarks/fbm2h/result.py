@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -15,16 +15,12 @@ from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
 from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, uncertainty_rows
 from ertools.benchmarks.common.validity import GapOnPath, Validity, cell
 from ertools.benchmarks.fbm2h.goal import GoalList
+from ertools.benchmarks.results import ResultBase
 from ertools.configs.transform import MarkerTransform
 from ertools.fidelity import Deviation
-from ertools.frames import tables_to_frames
-from ertools.serialize import dump_yaml, jsonable
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
 from ertools.yamlin import load as load_yaml
-
-if TYPE_CHECKING:
-    import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 Pose2 = tuple[float, float, float]
 
@@ -124,7 +120,7 @@ def _num(x: float | None) -> float | None:
 
 
 @dataclass(frozen=True, eq=False)
-class Fbm2hResult:
+class Fbm2hResult(ResultBase):
     """A scored FBM2@Home run (implements ``BenchmarkResult``).
 
     Attributes:
@@ -208,11 +204,9 @@ class Fbm2hResult:
             "timeout": bool(seg.timeout),
         }
 
-    def _listing(self, string_keys: bool) -> dict[str, Any]:
-        details = {
-            (str(s.index) if string_keys else s.index): self._segment_listing(s)
-            for s in self.segments
-        }
+    def listing(self) -> dict[Any, Any]:
+        """The Listing 13 score (segment indices as integer keys)."""
+        details = {s.index: self._segment_listing(s) for s in self.segments}
         out: dict[str, Any] = {
             "position_accuracy": _num(self.position_accuracy),
             "orientation_accuracy": _num(self.orientation_accuracy),
@@ -292,21 +286,6 @@ class Fbm2hResult:
                 ScoreRow(f"{name} orientation_error", s.orientation_error, angle, 1000.0, "mrad")
             )
         return interval_lines(rows, iv.uncertainty)
-
-    def to_yaml(self) -> str:
-        """The Listing 13 score."""
-        # Not through jsonable(): it would turn the integer segment keys into strings.
-        return dump_yaml(self._listing(string_keys=False))
-
-    def to_dict(self) -> dict[str, Any]:
-        """Same structure as the YAML, segment indices as string keys."""
-        data: dict[str, Any] = jsonable(self._listing(string_keys=True))
-        return data
-
-    def to_frames(self) -> dict[str, pd.DataFrame]:
-        """Every table of :meth:`tables` as a pandas DataFrame, epoch times as a UTC index
-        (:func:`ertools.frames.tables_to_frames`)."""
-        return tables_to_frames(self.tables())
 
     def tables(self) -> dict[str, Rows]:
         """``segments`` (one row per waypoint) and ``summary``."""

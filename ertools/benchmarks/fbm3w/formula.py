@@ -11,10 +11,10 @@ As the 2015 node did (rockin_scoring/scripts/fbm3w, seed 7.3.1-7.3.3):
    ``l_i / L``; the start point counts with error 0;
 4. distance_error = sum of the errors / N, N the number of kept points.
 
-Written once for every caller: :func:`score_path` (one run), the intervals (every Monte Carlo
-draw side by side: :func:`kept_flags`, then :func:`arc_fractions` and :func:`frame_errors` on
-the kept points of all draws laid end to end) and ``--runs auto`` (a candidate move in two
-frames).
+The d_min rule is :func:`subsample_d_min`, for :func:`score_path` (one run), :func:`kept_flags`
+(paths side by side, column by column) and ``--runs auto`` (a candidate move in two frames,
+with :func:`arc_fractions` and :func:`frame_errors`). The intervals' float32 pass over all
+draws at once (``perturbed._subsample``) is its own copy of the rule.
 """
 
 from __future__ import annotations
@@ -96,31 +96,13 @@ def kept_flags(x: F64, y: F64, d_mins: F64) -> Bool:
     """(N, W) flags of the d_min rule for W paths side by side in the columns of ``x``, ``y``
     (N, W), column w with ``d_mins[w]``; NaN (padding) is never kept.
 
-    The same comparison as :func:`subsample_d_min` (which one column takes): the rule is
-    sequential within a path, so the W paths advance together, one sample per step.
+    :func:`subsample_d_min` column by column (the rule is written once): a NaN sample is never
+    at least ``d_min`` from the last kept point, so padding is skipped as the rule stands.
     """
     n, w = x.shape
-    if w == 1:
-        flags = np.zeros((n, 1), dtype=bool)
-        flags[subsample_d_min(np.column_stack([x[:, 0], y[:, 0]]), float(d_mins[0])), 0] = True
-        return flags
     flags = np.zeros((n, w), dtype=bool)
-    flags[0] = True
-    lx = x[0].copy()
-    ly = y[0].copy()
-    dx = np.empty(w)
-    dy = np.empty(w)
-    for j in range(1, n):
-        # sqrt(dx*dx + dy*dy) >= d_min against the last kept point, in place (no temporaries)
-        np.subtract(x[j], lx, out=dx)
-        np.subtract(y[j], ly, out=dy)
-        np.multiply(dx, dx, out=dx)
-        np.multiply(dy, dy, out=dy)
-        np.add(dx, dy, out=dx)
-        np.sqrt(dx, out=dx)
-        k = np.greater_equal(dx, d_mins, out=flags[j])
-        np.copyto(lx, x[j], where=k)
-        np.copyto(ly, y[j], where=k)
+    for k in range(w):
+        flags[subsample_d_min(np.column_stack([x[:, k], y[:, k]]), float(d_mins[k])), k] = True
     return flags
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.epsilon import NoiseResult
@@ -18,14 +18,10 @@ from ertools.benchmarks.common.uncertainty import (
 from ertools.benchmarks.common.validity import GapOnPath, Validity, cell, gaps_on_path
 from ertools.benchmarks.fbm3w.formula import PathScore
 from ertools.benchmarks.fbm3w.runs import RunWindow
+from ertools.benchmarks.results import ResultBase
 from ertools.fidelity import Deviation
-from ertools.frames import tables_to_frames
-from ertools.serialize import dump_yaml, jsonable
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
-
-if TYPE_CHECKING:
-    import pandas as pd  # annotations only: pandas is imported by to_frames()
 
 # Listing 16 keys of one run, in the listing's order; ertools' extra keys follow them.
 RUN_KEYS = ("spec", "distance_error", "execution_time")
@@ -158,7 +154,7 @@ class RunResult:
 
 
 @dataclass(frozen=True, eq=False)
-class Fbm3wResult:
+class Fbm3wResult(ResultBase):
     """Implements :class:`ertools.benchmarks.base.BenchmarkResult` for FBM3@Work."""
 
     runs: tuple[RunResult, ...]
@@ -238,7 +234,8 @@ class Fbm3wResult:
             sum(x.end_ns - x.start_ns for x in w if x.start_ns is not None and x.end_ns is not None)
         )
 
-    def _score(self) -> dict[str, Any]:
+    def listing(self) -> dict[Any, Any]:
+        """Listing 16: best_distance_error, best_run, execution_time, runs_details {i: ...}."""
         out: dict[str, Any] = {
             "best_distance_error": self.best_distance_error,
             "best_run": self.best_run,
@@ -266,20 +263,6 @@ class Fbm3wResult:
             for r in self.runs
         ]
         return interval_lines([replace(r, scale=1000.0, unit="mm") for r in rows], self.uncertainty)
-
-    def to_dict(self) -> dict[str, Any]:
-        """Listing 16 nesting with string run keys (JSON)."""
-        data: dict[str, Any] = jsonable(self._score())
-        return data
-
-    def to_yaml(self) -> str:
-        """Listing 16: best_distance_error, best_run, execution_time, runs_details {i: ...}."""
-        return dump_yaml(_plain(self._score()))
-
-    def to_frames(self) -> dict[str, pd.DataFrame]:
-        """Every table of :meth:`tables` as a pandas DataFrame, epoch times as a UTC index
-        (:func:`ertools.frames.tables_to_frames`)."""
-        return tables_to_frames(self.tables())
 
     def tables(self) -> dict[str, Rows]:
         runs: Rows = []
@@ -356,10 +339,3 @@ def _sweep_cells(
     runs: tuple[RunResult, ...], k: int
 ) -> list[tuple[RunResult, tuple[float, float | None]]]:
     return [(r, r.sweep[k] if k < len(r.sweep) else (math.nan, None)) for r in runs]
-
-
-def _plain(value: Any) -> Any:
-    """JSON-able values but int keys kept (YAML's ``0:`` as in the 2015 score)."""
-    if isinstance(value, dict):
-        return {k if isinstance(k, int) else str(k): _plain(v) for k, v in value.items()}
-    return jsonable(value)

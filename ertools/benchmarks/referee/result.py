@@ -3,26 +3,22 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from ertools.benchmarks.base import Rows
 from ertools.benchmarks.referee.config import PENALTY_SCALE, TIME_SCALE
 from ertools.benchmarks.referee.formula import erl_rank
 from ertools.benchmarks.referee.items import Item, Tally
+from ertools.benchmarks.results import ResultBase
 from ertools.fidelity import Deviation
-from ertools.frames import tables_to_frames
-from ertools.serialize import dump_yaml, jsonable
 from ertools.streams import Provenance
-
-if TYPE_CHECKING:
-    import pandas as pd
 
 #: A run whose executing time is not in its log ranks as if it had taken this long.
 UNKNOWN_TIME_S = TIME_SCALE / PENALTY_SCALE - 1.0
 
 
 @dataclass(frozen=True)
-class RefereeResult:
+class RefereeResult(ResultBase):
     """One referee-scored run (implements ``BenchmarkResult``).
 
     Attributes:
@@ -65,7 +61,8 @@ class RefereeResult:
         seconds = self.seconds
         return erl_rank(self.tally, UNKNOWN_TIME_S if seconds is None else seconds)
 
-    def to_dict(self) -> dict[str, Any]:
+    def listing(self) -> dict[Any, Any]:
+        """The run's score: its tally, time, ERL rank and items."""
         out: dict[str, Any] = {
             "benchmark_code": self.code,
             "team": self.provenance.team or self.team,
@@ -84,9 +81,6 @@ class RefereeResult:
             "items_source": self.items_source,
         }
         return out
-
-    def to_yaml(self) -> str:
-        return dump_yaml(jsonable(self.to_dict()))
 
     def tables(self) -> dict[str, Rows]:
         return {
@@ -107,6 +101,3 @@ class RefereeResult:
                 }
             ],
         }
-
-    def to_frames(self) -> dict[str, pd.DataFrame]:
-        return tables_to_frames(self.tables())
