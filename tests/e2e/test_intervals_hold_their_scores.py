@@ -160,7 +160,17 @@ def test_the_walk_of_printed_intervals_finds_a_score_outside() -> None:
 def test_the_readme_commands_were_found() -> None:
     readme = readme_score_commands()
     benchmarks = {argv[1] for argv in readme}
-    assert benchmarks == {"fbm3w", "fbm2h", "fbm1h", "trajectory", *RSBB, "hwv", "hcfgac", "hgtkmh", "stb"}, readme
+    assert benchmarks == {
+        "fbm3w",
+        "fbm2h",
+        "fbm1h",
+        "trajectory",
+        *RSBB,
+        "hwv",
+        "hcfgac",
+        "hgtkmh",
+        "stb",
+    }, readme
 
 
 def test_the_walk_finds_an_interval_outside_its_score() -> None:
