@@ -35,7 +35,7 @@ import yaml
 from scipy.spatial.transform import Rotation, Slerp
 
 from ertools.atomic import write_text
-from ertools.rsbb_states import BENCHMARKS
+from ertools.benchmarks.hgmf.config import SCRIPT_FRAMES
 from ertools.simulator.answers import tol, window, write_answers
 from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
 from ertools.simulator.rsbb import write_rsbb_run
@@ -66,7 +66,7 @@ TABLE_XYZ = (1.2, -0.4, 0.75)
 TABLE_YAW = 0.4
 LIFT_M = 0.10
 NOISE = MocapNoise(sigma_m=2e-4, sigma_rad=2e-4)
-FRAME = BENCHMARKS[CODE].frames[0]
+FRAME = SCRIPT_FRAMES[0]
 
 
 @dataclass(frozen=True)

@@ -15,6 +15,8 @@ from ertools.rsbb_states import BENCHMARKS, REFEREE_CODES
 
 #: Registry name -> RSBB code, for every benchmark the referee alone scores.
 CODES: dict[str, str] = {code.lower(): code for code in REFEREE_CODES}
+#: The mocap bodies whose pose topics a run records, by code (2bb8a41: the STB's actor alone).
+MOCAP_BODIES: dict[str, tuple[str, ...]] = {"STB": ("actor_markerset",)}
 
 # The ERL order as one number (higher is better): achievements, then penalties, then time.
 # Exact as long as there are fewer than PENALTY_SCALE penalties and the time is below
