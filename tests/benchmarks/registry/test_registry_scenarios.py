@@ -32,7 +32,7 @@ def test_every_sample_module_is_a_scenario_once() -> None:
 
 def test_a_new_package_brings_its_scenario(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A package with a declaration, a sample module and one registry line: its scenario is
-    found, named by its ``sample_folder``, and writes what its ``generate`` writes; a package
+    found, named by its ``sample_folder``, seeded by its ``sample_seed``, and writes what its ``generate`` writes; a package
     without a sample module has none."""
     package = tmp_path / "pkg" / "simbench"
     package.mkdir(parents=True)
@@ -42,6 +42,7 @@ def test_a_new_package_brings_its_scenario(tmp_path: Path, monkeypatch: pytest.M
             """
             class Sim:
                 sample_folder = "simfolder"
+                sample_seed = 7
 
                 def sample_args(self, samples):
                     return None
@@ -72,7 +73,7 @@ def test_a_new_package_brings_its_scenario(tmp_path: Path, monkeypatch: pytest.M
     )
     monkeypatch.setattr(registry, "ENTRIES", (*registry.ENTRIES, *lines))
     found = [s for s in registry.scenarios() if not s.module.startswith("ertools.")]
-    assert found == [registry.Scenario("simfolder", "simbench.sample")]
+    assert found == [registry.Scenario("simfolder", "simbench.sample", 7)]
     out = tmp_path / "out"
     out.mkdir()
     assert found[0].generate(out, seed=21) == [out / "seed.txt"]
