@@ -425,6 +425,9 @@ class Simulated(Protocol):
     #: The seed its folder of ``sample_bags/`` was written with (fixed, so that ``python -m
     #: ertools.samples`` reproduces it byte for byte); 0: one derived from the folder's name.
     sample_seed: int = 0
+    #: Its ``sample`` module writes no scenario of its own but a part another composes (the
+    #: referee-scored runs of ``season2019``): :func:`ertools.benchmarks.registry.sample_parts`.
+    sample_part: bool = False
 
     def sample_args(self, samples: Path) -> Sequence[str] | None:
         """The arguments scoring it on the sample logs under ``samples`` (None: not there)."""

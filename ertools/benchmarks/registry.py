@@ -146,10 +146,24 @@ def scenarios() -> tuple[Scenario, ...]:
         if package in found or find_spec(f"{package}.sample") is None:
             continue
         bench = get(e.name)
+        if isinstance(bench, Simulated) and bench.sample_part:
+            continue
         folder, seed = (
             (bench.sample_folder, bench.sample_seed) if isinstance(bench, Simulated) else ("", 0)
         )
         found[package] = Scenario(folder or e.name, f"{package}.sample", seed)
+    return tuple(found.values())
+
+
+def sample_parts() -> tuple[ModuleType, ...]:
+    """The ``sample`` modules of the packages whose benchmarks declare ``sample_part`` (once
+    per package, in the registry's order), imported now: a scenario composes them."""
+    found: dict[str, ModuleType] = {}
+    for e in ENTRIES:
+        package = e.absolute.partition(":")[0].rpartition(".")[0]
+        bench = get(e.name)
+        if package not in found and isinstance(bench, Simulated) and bench.sample_part:
+            found[package] = import_module(f"{package}.sample")
     return tuple(found.values())
 
 

@@ -51,6 +51,8 @@ from ertools.simulator.rsbb_scenario import (
 S = 1_000_000_000
 MS = 1_000_000
 CODE = "HGMF"
+#: Its name in benchmarks_description.yaml (the season sample writes one).
+DESCRIPTION_NAME = "Functionality Benchmark 6: Grasping and Manipulation Functionality"
 TEAM = "simbot"
 # Friday 12 April 2019, 10:00:00 UTC: a day of the ERL Consumer 2019 season.
 T0 = 1_555_063_200 * S

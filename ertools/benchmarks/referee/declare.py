@@ -69,6 +69,7 @@ class Referee(
 
     inputs = INPUTS
     rules = RULES
+    sample_part = True  # Simulated: its runs are part of season2019 (samples/season.py)
     bags_help = "the run's bag (rsbb_logs/<CODE>/<team>/run_<n>_<date>.bag)"
     score_keys = frozenset({"erl_rank", "achievements", "penalized_behaviors"})
     draws: frozenset[str] = frozenset()

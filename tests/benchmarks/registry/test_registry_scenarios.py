@@ -32,8 +32,8 @@ def test_every_sample_module_is_a_scenario_once() -> None:
 
 def test_a_new_package_brings_its_scenario(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A package with a declaration, a sample module and one registry line: its scenario is
-    found, named by its ``sample_folder``, seeded by its ``sample_seed``, and writes what its ``generate`` writes; a package
-    without a sample module has none."""
+    found, named by its ``sample_folder``, seeded by its ``sample_seed``, and writes what its
+    ``generate`` writes; a package without a sample module has none."""
     package = tmp_path / "pkg" / "simbench"
     package.mkdir(parents=True)
     (package / "__init__.py").write_text("")
@@ -43,6 +43,7 @@ def test_a_new_package_brings_its_scenario(tmp_path: Path, monkeypatch: pytest.M
             class Sim:
                 sample_folder = "simfolder"
                 sample_seed = 7
+                sample_part = False
 
                 def sample_args(self, samples):
                     return None
