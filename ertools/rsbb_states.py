@@ -272,11 +272,6 @@ BENCHMARKS: dict[str, Benchmark] = {
     )
 }
 
-#: The functionality benchmarks a script scores from the logs (the ones ertools re-scores).
-SCORED_CODES = ("HOPF", "HNF", "HPPF", "HPFF", "HGMF")
-#: The benchmarks scored by the referee's items alone.
-REFEREE_CODES = ("HGTKMH", "HWV", "HCFGAC", "STB")
-
 # --- file names -------------------------------------------------------------------------------
 
 #: strftime of the result file's dates (BenchmarkObjects.py): local time and zone.

@@ -1,6 +1,6 @@
 """The referee-scored RSBB benchmarks as the registry sees them: one :class:`Referee` per code
-of :data:`~ertools.rsbb_states.REFEREE_CODES` (``hgtkmh``, ``hwv``, ``hcfgac``, ``stb``), the
-same inputs (``config``) and stages (``pipeline``) for each. NumPy-free: ``ertools score
+of :data:`~ertools.benchmarks.referee.config.REFEREE_CODES` (``hgtkmh``, ``hwv``, ``hcfgac``,
+``stb``), the same inputs (``config``) and stages (``pipeline``) for each. NumPy-free: ``ertools score
 hgtkmh``'s parser imports it.
 """
 
