@@ -1,7 +1,7 @@
 """The referee-scored RSBB benchmarks as the registry sees them: one :class:`Referee` per code
 of :data:`~ertools.benchmarks.referee.config.REFEREE_CODES` (``hgtkmh``, ``hwv``, ``hcfgac``,
-``stb``), the same inputs (``config``) and stages (``pipeline``) for each. NumPy-free: ``ertools score
-hgtkmh``'s parser imports it.
+``stb``), the same inputs (``config``) and stages (``pipeline``) for each. NumPy-free:
+``ertools score hgtkmh``'s parser imports it.
 """
 
 from __future__ import annotations
