@@ -14,15 +14,18 @@ ROOT = Path(__file__).resolve().parents[3]
 
 
 def test_every_sample_module_is_a_scenario_once() -> None:
-    """The packages holding a ``sample.py``, read from the tree, are the scenarios' modules;
-    each folder is one of ``sample_bags/`` (the trajectory's: ``robotlog``)."""
+    """The packages holding a ``sample.py``, read from the tree, are the scenarios' modules
+    and the parts a scenario composes (the referee's, in ``season2019``); each folder is one
+    of ``sample_bags/`` (the trajectory's: ``robotlog``)."""
     on_disk = sorted(
         f"ertools.benchmarks.{p.parent.name}.sample"
         for p in (ROOT / "ertools" / "benchmarks").glob("*/sample.py")
         if p.parent.name != "common"
     )
     found = registry.scenarios()
-    assert sorted(s.module for s in found) == on_disk
+    parts = [m.__name__ for m in registry.sample_parts()]
+    assert parts == ["ertools.benchmarks.referee.sample"]
+    assert sorted([s.module for s in found] + parts) == on_disk
     folders = [s.folder for s in found]
     assert len(set(folders)) == len(folders)
     assert {"fbm1h", "robotlog"} <= set(folders) and "fbm1w" not in folders
