@@ -240,83 +240,37 @@ class ScriptFrame:
 
 @dataclass(frozen=True)
 class Benchmark:
-    """One benchmark of ``benchmarks_description.yaml`` (2bb8a41).
+    """One benchmark of ``benchmarks_description.yaml`` (2bb8a41); what is its own (the frames
+    its script broadcasts, its mocap bodies, its seasons) is in its package's ``config``.
 
     Attributes:
         code: the RSBB code (folder names, result files).
         name: the description's name.
         scripted: whether a BmBox script scores it (a result file exists).
-        bodies: the mocap bodies whose pose topics its runs record.
-        frames: the frames its script broadcasts (2bb8a41).
-        seasons: the seasons in which a script for it existed.
     """
 
     code: str
     name: str
     scripted: bool
-    bodies: tuple[str, ...] = ()
-    frames: tuple[ScriptFrame, ...] = ()
-    seasons: tuple[str, ...] = ()
 
 
 BENCHMARKS: dict[str, Benchmark] = {
     b.code: b
     for b in (
-        Benchmark(
-            "HOPF",
-            "Functionality Benchmark 1: Object Perception Functionality",
-            True,
-            ("table_origin", "positioner_origin"),
-            (ScriptFrame("/item", "/positioner_origin", "/table_origin", 3, 1.0),),
-            ("2017", "2019"),
-        ),
-        Benchmark(
-            "HNF",
-            "Functionality Benchmark 2: Navigation Functionality",
-            True,
-            ("robot_markerset", "actor_markerset"),
-            (ScriptFrame("/robot", "/robot_markerset", "/testbed_origin", 5, 1.0),),
-            ("2017", "2019"),
-        ),
+        Benchmark("HOPF", "Functionality Benchmark 1: Object Perception Functionality", True),
+        Benchmark("HNF", "Functionality Benchmark 2: Navigation Functionality", True),
         Benchmark("HSUF", "Functionality Benchmark 3: Speech Understanding Functionality", False),
+        Benchmark("HPPF", "Functionality Benchmark 4: People Perception Functionality", True),
+        Benchmark("HPFF", "Functionality Benchmark 5: Person Following Functionality", True),
         Benchmark(
-            "HPPF",
-            "Functionality Benchmark 4: People Perception Functionality",
-            True,
-            ("actor_markerset",),
-            (ScriptFrame("/person", "/actor_markerset", "/testbed_origin", 3, 1.0),),
-            ("2019",),
-        ),
-        Benchmark(
-            "HPFF",
-            "Functionality Benchmark 5: Person Following Functionality",
-            True,
-            ("robot_markerset", "actor_markerset"),
-            (
-                ScriptFrame("/robot", "/robot_markerset", "/actor_markerset", 1, 0.2),
-                ScriptFrame("/robot", "/robot_markerset", "/testbed_origin", 1, 0.2),
-            ),
-            ("2019",),
-        ),
-        Benchmark(
-            "HGMF",
-            "Functionality Benchmark 6: Grasping and Manipulation Functionality",
-            True,
-            ("table_origin", "actor_markerset"),
-            (ScriptFrame("/object", "/actor_markerset", "/table_origin", 3, 1.0),),
-            ("2019",),
+            "HGMF", "Functionality Benchmark 6: Grasping and Manipulation Functionality", True
         ),
         Benchmark("HGTKMH", "Task Benchmark 1: Getting to know my home", False),
         Benchmark("HWV", "Task Benchmark 2: Welcoming visitors", False),
         Benchmark("HCFGAC", "Task Benchmark 3: Catering for Granny Annie's Comfort", False),
-        Benchmark("STB", "Test Benchmark: Simple Test Benchmark", True, ("actor_markerset",)),
+        Benchmark("STB", "Test Benchmark: Simple Test Benchmark", True),
     )
 }
-
-#: The functionality benchmarks a script scores from the logs (the ones ertools re-scores).
-SCORED_CODES = ("HOPF", "HNF", "HPPF", "HPFF", "HGMF")
-#: The benchmarks scored by the referee's items alone.
-REFEREE_CODES = ("HGTKMH", "HWV", "HCFGAC", "STB")
 
 # --- file names -------------------------------------------------------------------------------
 

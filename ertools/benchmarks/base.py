@@ -394,6 +394,27 @@ class Generate(Protocol):
 
 
 @runtime_checkable
+class SeasonItems(Protocol):
+    """Its RSBB runs (their code: its name in capitals) take the season's items file
+    (``items_with_pose.yaml``: HOPF's objects and their poses) beside their config; the season
+    layout attaches it to those runs alone (:func:`ertools.benchmarks.registry.season_items`)."""
+
+    season_items: bool
+
+
+@runtime_checkable
+class LiveText(Protocol):
+    """Its live score holds a value logged as text (HNF's ``robot_pose``: a Pose2D as PyYAML
+    dumped it) that a results page shows as numbers
+    (:func:`ertools.benchmarks.registry.live_numbers`)."""
+
+    def live_numbers(self, value: str) -> tuple[tuple[str, float], ...] | None:
+        """The numbers in ``value``, each with its quantity's key (``robot_pose.theta``);
+        None: not such a text."""
+        ...
+
+
+@runtime_checkable
 class Simulated(Protocol):
     """It has a simulated sample (``sample_bags/``, ``make demo``): the ``generate`` of the
     ``sample`` module beside its declaration, reached with
@@ -401,6 +422,12 @@ class Simulated(Protocol):
 
     #: The folder of ``sample_bags/`` its scenario writes ("": the benchmark's name).
     sample_folder: str = ""
+    #: The seed its folder of ``sample_bags/`` was written with (fixed, so that ``python -m
+    #: ertools.samples`` reproduces it byte for byte); 0: one derived from the folder's name.
+    sample_seed: int = 0
+    #: Its ``sample`` module writes no scenario of its own but a part another composes (the
+    #: referee-scored runs of ``season2019``): :func:`ertools.benchmarks.registry.sample_parts`.
+    sample_part: bool = False
 
     def sample_args(self, samples: Path) -> Sequence[str] | None:
         """The arguments scoring it on the sample logs under ``samples`` (None: not there)."""

@@ -19,7 +19,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
-from ertools.benchmarks.base import Generate, Simulated
+from ertools.benchmarks.base import Generate, LiveText, SeasonItems, Simulated
 from ertools.errors import UsageError
 
 if TYPE_CHECKING:
@@ -117,10 +117,12 @@ def warm(target: str, *, report: bool = False) -> None:
 @dataclass(frozen=True)
 class Scenario:
     """A benchmark package's simulated scenario: the ``sample`` module beside its declaration
-    (``module``, absolute) and the folder of ``sample_bags/`` it writes."""
+    (``module``, absolute), the folder of ``sample_bags/`` it writes and the benchmark's
+    ``sample_seed`` (0: none declared)."""
 
     folder: str
     module: str
+    seed: int = 0
 
     def load(self) -> ModuleType:
         """The sample module, imported now (for a sample built from a benchmark's runs)."""
@@ -135,7 +137,8 @@ class Scenario:
 def scenarios() -> tuple[Scenario, ...]:
     """The scenario of every benchmark package with a ``sample`` module, once per package (the
     first entry's: fbm1h for fbm1), in the registry's order; the folder is the benchmark's
-    ``sample_folder`` when :class:`~ertools.benchmarks.base.Simulated`, else its name. Imports
+    ``sample_folder`` (and seed ``sample_seed``) when
+    :class:`~ertools.benchmarks.base.Simulated`, else its name. Imports
     the declarations (light), not the simulators."""
     found: dict[str, Scenario] = {}
     for e in ENTRIES:
@@ -143,9 +146,46 @@ def scenarios() -> tuple[Scenario, ...]:
         if package in found or find_spec(f"{package}.sample") is None:
             continue
         bench = get(e.name)
-        folder = bench.sample_folder if isinstance(bench, Simulated) else ""
-        found[package] = Scenario(folder or e.name, f"{package}.sample")
+        if isinstance(bench, Simulated) and bench.sample_part:
+            continue
+        folder, seed = (
+            (bench.sample_folder, bench.sample_seed) if isinstance(bench, Simulated) else ("", 0)
+        )
+        found[package] = Scenario(folder or e.name, f"{package}.sample", seed)
     return tuple(found.values())
+
+
+def sample_parts() -> tuple[ModuleType, ...]:
+    """The ``sample`` modules of the packages whose benchmarks declare ``sample_part`` (once
+    per package, in the registry's order), imported now: a scenario composes them."""
+    found: dict[str, ModuleType] = {}
+    for e in ENTRIES:
+        package = e.absolute.partition(":")[0].rpartition(".")[0]
+        bench = get(e.name)
+        if package not in found and isinstance(bench, Simulated) and bench.sample_part:
+            found[package] = import_module(f"{package}.sample")
+    return tuple(found.values())
+
+
+def season_items() -> frozenset[str]:
+    """The RSBB codes (the names in capitals) whose runs take the season's items file: the
+    benchmarks that are :class:`~ertools.benchmarks.base.SeasonItems`."""
+    return frozenset(
+        e.name.upper()
+        for e in ENTRIES
+        if isinstance(bench := get(e.name), SeasonItems) and bench.season_items
+    )
+
+
+def live_numbers(value: str) -> tuple[tuple[str, float], ...] | None:
+    """The numbers of a live score's value some benchmark logs as text
+    (:class:`~ertools.benchmarks.base.LiveText`), with their quantities' keys; None: no
+    benchmark's."""
+    for e in ENTRIES:
+        bench = get(e.name)
+        if isinstance(bench, LiveText) and (found := bench.live_numbers(value)) is not None:
+            return found
+    return None
 
 
 def package_module(name: str, module: str) -> ModuleType | None:

@@ -51,22 +51,14 @@ def shown(key: str | None, value: Any) -> str:
             return "\u2014"
         if isinstance(value, bool):
             return "yes" if value else "no"
-        pose = _POSE_DUMP.search(str(value))
-        if pose is not None:  # HNF's live robot_pose: a Pose2D as PyYAML dumped it
-            x, y, theta = (float(pose.group(i)) for i in (1, 2, 3))
-            return (
-                f"x {with_unit('x', x)}, y {with_unit('y', y)}, "
-                f"theta {with_unit('robot_pose.theta', theta)}"
-            )
+        numbers = registry.live_numbers(str(value))
+        if numbers is not None:  # a benchmark's live value logged as text
+            return ", ".join(f"{k.rpartition('.')[2]} {with_unit(k, v)}" for k, v in numbers)
         return str(value)
     spec = units.quantity_of(key) if key else None
     if spec is None:  # counts, ratios, scores: 6 significant digits, at most 6 decimals
         return str(int(x)) if isinstance(value, int) else f"{round(x, 6):.6g}"
     return f"{x * units.factor(*spec):.{DECIMALS[spec[0]]}f}"
-
-
-_NUMBER = r"(-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?)"
-_POSE_DUMP = re.compile(rf"Pose2D\s+state: \[{_NUMBER}, {_NUMBER}, {_NUMBER}\]")
 
 
 def unit_of(key: str | None) -> str:

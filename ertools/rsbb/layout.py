@@ -14,7 +14,7 @@ from __future__ import annotations
 import enum
 import os
 import re
-from collections.abc import Iterable
+from collections.abc import Collection, Iterable
 from dataclasses import dataclass, field
 from datetime import datetime, timedelta
 from pathlib import Path, PurePath
@@ -168,7 +168,7 @@ class RunFiles:
         result: the result file, or None (no BmBox script, or it wrote none).
         config: the benchmark config (``<CODE>.yaml``) found in the folder, or None.
         transform: ``transform-<team>.yaml``, or None.
-        items: ``items_with_pose.yaml`` (HOPF only), or None.
+        items: ``items_with_pose.yaml`` (a benchmark's that takes it), or None.
     """
 
     code: str
@@ -227,10 +227,14 @@ def _side_files(
     )
 
 
-def pair_runs(files: Iterable[SeasonFile]) -> tuple[tuple[RunFiles, ...], tuple[str, ...]]:
+def pair_runs(
+    files: Iterable[SeasonFile], season_items: Collection[str] = ()
+) -> tuple[tuple[RunFiles, ...], tuple[str, ...]]:
     """Runs from recognised files: a result file and a bag of the same code, team and run
     whose times are within :data:`PAIR_TOLERANCE` go together (nearest first); the side files
-    are attached by code and team. Returns (runs, problems)."""
+    are attached by code and team, the items file to the runs of the codes in
+    ``season_items`` (the registry's :func:`~ertools.benchmarks.registry.season_items`).
+    Returns (runs, problems)."""
     items_all = list(files)
     problems: list[str] = []
     configs, transforms, items = _side_files(items_all, problems)
@@ -280,7 +284,7 @@ def pair_runs(files: Iterable[SeasonFile]) -> tuple[tuple[RunFiles, ...], tuple[
                     result,
                     configs.get(code),
                     transforms.get(team),
-                    items if code == "HOPF" else None,
+                    items if code in season_items else None,
                 )
             )
 
@@ -292,8 +296,9 @@ def pair_runs(files: Iterable[SeasonFile]) -> tuple[tuple[RunFiles, ...], tuple[
     return tuple(runs), tuple(problems)
 
 
-def scan(root: str | Path) -> SeasonLayout:
-    """List ``root`` recursively (symbolic links to folders not followed) and recognise it.
+def scan(root: str | Path, season_items: Collection[str] = ()) -> SeasonLayout:
+    """List ``root`` recursively (symbolic links to folders not followed) and recognise it
+    (``season_items``: as :func:`pair_runs`).
 
     Raises:
         UsageError: ``root`` is not a folder.
@@ -308,5 +313,5 @@ def scan(root: str | Path) -> SeasonLayout:
             f = classify(Path(folder) / name)
             if f is not None:
                 found.append(f)
-    runs, problems = pair_runs(found)
+    runs, problems = pair_runs(found, season_items)
     return SeasonLayout(base, tuple(sorted(found, key=lambda f: str(f.path))), runs, problems)

@@ -45,22 +45,9 @@ OWN: dict[str, Generate] = {
     "season2019": season.generate,
 }
 
-# The seed each folder of sample_bags/ was written with (fixed, so that `python -m
-# ertools.samples` reproduces it byte for byte); a scenario not listed takes seed_of(name).
-SEEDS: dict[str, int] = {
-    "fbm3w": 2015,
-    "fbm2h": 2016,
-    "fbm1h": 2017,
-    "robotlog": 2018,
-    "stationary": 2019,
-    "timeline": 2020,
-    "hnf": 2021,
-    "hpff": 2022,
-    "hopf": 2023,
-    "hppf": 2024,
-    "hgmf": 2025,
-    "season2019": 2026,
-}
+# The seeds the own scenarios' folders of sample_bags/ were written with (fixed, so that `python
+# -m ertools.samples` reproduces them byte for byte); a benchmark's is its `sample_seed`.
+SEEDS: dict[str, int] = {"timeline": 2020, "season2019": 2026}
 
 
 class ScenarioMissingError(UsageError):
@@ -78,9 +65,11 @@ def scenarios() -> dict[str, Generate]:
 
 
 def seed_of(name: str) -> int:
-    """The default seed of scenario ``name``: :data:`SEEDS`, else one derived from the name
-    (CRC-32: the same on every run and machine, unlike ``hash()``)."""
-    return SEEDS.get(name, 2015 + zlib.crc32(name.encode("utf-8")) % 10_000)
+    """The default seed of scenario ``name``: its benchmark's ``sample_seed`` or :data:`SEEDS`,
+    else one derived from the name (CRC-32: the same on every run and machine, unlike
+    ``hash()``)."""
+    declared = {s.folder: s.seed for s in registry.scenarios() if s.seed} | SEEDS
+    return declared.get(name, 2015 + zlib.crc32(name.encode("utf-8")) % 10_000)
 
 
 def load_scenario(name: str) -> Generate:

@@ -14,6 +14,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ertools.benchmarks import registry
 from ertools.errors import ErtoolsError
 from ertools.io.clock import clock_check
 from ertools.io.formats import Found, Unreadable, find_bags, regular_files
@@ -131,7 +132,7 @@ def rsbb_folder(paths: Sequence[Path]) -> RsbbFolder | None:
     recognised = [f for f in (classify(p) for p in sorted(files)) if f is not None]
     if not any(f.code is not None and f.run is not None for f in recognised):
         return None
-    runs, problems = pair_runs(recognised)
+    runs, problems = pair_runs(recognised, registry.season_items())
 
     def text(path: Path | None) -> str | None:
         return None if path is None else str(path)

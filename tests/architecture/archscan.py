@@ -316,6 +316,69 @@ def outside_benchmark_modules(root: Path) -> set[str]:
     return out
 
 
+# The shared modules of the RSBB layer: they read each benchmark's facts through its package
+# (config, declaration) or the registry, never by its code.
+RSBB_SHARED = ("ertools/rsbb/", "ertools/competition/", "ertools/samples/")
+RSBB_TABLE = "ertools/rsbb_states.py"
+
+
+def registered_codes(root: Path) -> frozenset[str]:
+    """The registry's names in capitals (``HNF``: an RSBB benchmark's code), read from the
+    ``Entry("name", ...)`` lines of ``ertools/benchmarks/registry.py``."""
+    tree = _parse(root / "ertools" / "benchmarks" / "registry.py")
+    return frozenset(
+        node.args[0].value.upper()
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Call)
+        and isinstance(node.func, ast.Name)
+        and node.func.id == "Entry"
+        and node.args
+        and isinstance(node.args[0], ast.Constant)
+        and isinstance(node.args[0].value, str)
+    )
+
+
+def _chosen_by(node: ast.AST) -> list[ast.AST]:
+    """The expressions ``node`` picks a case by: a comparison's operands (and the elements of
+    a tuple, list or set among them), a subscript's key, a dict's keys, a match value."""
+    if isinstance(node, ast.Compare):
+        operands = [node.left, *node.comparators]
+        return operands + [
+            e for o in operands if isinstance(o, ast.Tuple | ast.List | ast.Set) for e in o.elts
+        ]
+    if isinstance(node, ast.Subscript):
+        return [node.slice]
+    if isinstance(node, ast.Dict):
+        return [k for k in node.keys if k is not None]
+    if isinstance(node, ast.MatchValue):
+        return [node.value]
+    return []
+
+
+def benchmark_codes_in_shared(root: Path) -> set[str]:
+    """``file:line: why`` of every registered benchmark's code (the registry's name in
+    capitals) a shared RSBB module names: in ``ertools/rsbb/``, ``competition/`` and
+    ``samples/`` any string literal of one; in ``rsbb_states.py``, whose table is the RSBB's
+    own description (every code it knows: code, name, scripted), one chosen by (compared,
+    a subscript's or a dict's key, a match case)."""
+    codes = registered_codes(root)
+    out = set()
+    for path in sorted((root / "ertools").rglob("*.py")):
+        rel = path.relative_to(root).as_posix()
+        if rel == RSBB_TABLE:
+            candidates = [c for n in ast.walk(_parse(path)) for c in _chosen_by(n)]
+            why = "chooses by the code"
+        elif rel.startswith(RSBB_SHARED):
+            candidates = list(ast.walk(_parse(path)))
+            why = "names the code"
+        else:
+            continue
+        for node in candidates:
+            if isinstance(node, ast.Constant) and node.value in codes:
+                out.add(f"{rel}:{node.lineno}: {why} {node.value!r}")
+    return out
+
+
 _PUNCTUATION = re.compile(r"^[\[\](){},:]*$")
 
 

@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ertools.benchmarks.hnf.config import SCRIPT_FRAMES as HNF_FRAMES
 from ertools.errors import TopicError
 from ertools.io.reader import read_messages, topics
 from ertools.rsbb.log import (
@@ -18,7 +19,7 @@ from ertools.rsbb.log import (
     read_rsbb_run,
     read_script_broadcasts,
 )
-from ertools.rsbb_states import BENCHMARKS, BMBOX_STATE_TOPIC, REFBOX_STATE_TOPIC, RefBoxState
+from ertools.rsbb_states import BMBOX_STATE_TOPIC, REFBOX_STATE_TOPIC, RefBoxState
 from ertools.simulator.rsbb import write_rsbb_run
 from ertools.simulator.rsbb_scenario import live_score_text, result_object
 from ertools.simulator.writer import BagWriter
@@ -135,7 +136,7 @@ def test_referee_items_and_script_broadcasts(tmp_path: Path) -> None:
         ("Penalized Behaviors", "bumps", "uint", 1)
     ]
     assert read_referee_items(paths.bag, "HNF", "teamB", 1) is None
-    lookups = read_script_broadcasts(paths.bag, BENCHMARKS["HNF"].frames[0])
+    lookups = read_script_broadcasts(paths.bag, HNF_FRAMES[0])
     assert lookups.t_ns.tolist() == [at(10.01), at(21.01), at(40.01)]
 
 

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from ertools.benchmarks.hnf.config import SCRIPT_FRAMES as HNF_FRAMES
 from ertools.errors import ConfigError
 from ertools.rsbb.log import check_code, logged_code, read_rsbb_run
 from ertools.rsbb.py2 import percent_py2, round_py2, str_py2, to_sec
@@ -26,7 +27,6 @@ from ertools.rsbb.tf import (
     read_tf_tracks,
     script_poses,
 )
-from ertools.rsbb_states import BENCHMARKS
 from ertools.simulator.mocap import MocapNoise, frame_times, simulate_mocap
 from ertools.simulator.rsbb import write_rsbb_run
 from ertools.simulator.rsbb_scenario import Body, Broadcast
@@ -76,7 +76,7 @@ def moving_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[int
 def test_script_poses_are_tf2s_lookups(moving_run: tuple[Path, list[int]]) -> None:
     bag, moments = moving_run
     tracks = read_tf_tracks(bag)
-    assert tracks.broadcasts(BENCHMARKS["HNF"].frames[0]).tolist() == moments
+    assert tracks.broadcasts(HNF_FRAMES[0]).tolist() == moments
     robot = tracks.body("robot_markerset")
     actor = tracks.body("actor_markerset")
     t = np.asarray(moments, np.int64)

@@ -79,6 +79,7 @@ class Fbm1(
     """FBM1@Home or FBM1@Work: one class, two benchmarks (:data:`FBM1H`, :data:`FBM1W`)."""
 
     rules = RULES
+    sample_seed = 2017  # Simulated: sample_bags/ was written with it
     description = DESCRIPTION
     score_keys = frozenset({"class_accuracy", "instance_accuracy"})
     explanations = EXPLANATIONS

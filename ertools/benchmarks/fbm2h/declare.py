@@ -91,6 +91,7 @@ class Fbm2h(
     title = "FBM2@Home"
     inputs = INPUTS
     rules = RULES
+    sample_seed = 2016  # Simulated: sample_bags/ was written with it
     example = "ertools score fbm2h run.bag --goal goal.yaml --transform transform-homer.yaml"
     description = DESCRIPTION
     epilog = EPILOG

@@ -85,6 +85,7 @@ class Fbm3w(
     title = "FBM3@Work"
     inputs = INPUTS
     rules = RULES
+    sample_seed = 2015  # Simulated: sample_bags/ was written with it
     example = "ertools score fbm3w run.bag --config configs/fbm3w.yaml"
     description = DESCRIPTION
     epilog = EPILOG

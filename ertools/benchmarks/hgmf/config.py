@@ -21,9 +21,19 @@ from ertools.benchmarks.common.inputs import (
 )
 from ertools.benchmarks.common.script_inputs import SCRIPT_GROUP, config_input, result_input
 from ertools.errors import UsageError
+from ertools.rsbb_states import ScriptFrame
 
 NAME = "hgmf"
 CODE = "HGMF"
+
+#: The frames its script broadcasts (2bb8a41: ``benchmarks_description.yaml``'s tf helper).
+SCRIPT_FRAMES: tuple[ScriptFrame, ...] = (
+    ScriptFrame("/object", "/actor_markerset", "/table_origin", 3, 1.0),
+)
+#: The mocap bodies whose pose topics its runs record.
+MOCAP_BODIES = ("table_origin", "actor_markerset")
+#: The seasons in which a script for it existed.
+SCRIPT_SEASONS = ("2019",)
 TITLE = "HGMF (FBM6@Home 2019)"
 
 # fbm6_grasping_manipulation.py at 2bb8a41 (docs/hgmf.md): a grasp is a rise of more than

@@ -80,6 +80,7 @@ class Hgmf(
     title = config.TITLE
     inputs = INPUTS
     rules = RULES
+    sample_seed = 2025  # Simulated: sample_bags/ was written with it
     example = "ertools score hgmf rsbb_logs/HGMF/homer/run_1_2019-04-11-10-00-00.bag"
     description = DESCRIPTION
     epilog = EPILOG

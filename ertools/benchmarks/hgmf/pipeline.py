@@ -16,7 +16,7 @@ from ertools.arrays import I64
 from ertools.benchmarks.base import notice
 from ertools.benchmarks.common.interval_output import ResultIntervals
 from ertools.benchmarks.hgmf.checks import sample_heights, timer_heights, timer_ticks
-from ertools.benchmarks.hgmf.config import CODE, OBJECT_BODY, TABLE, HgmfOptions
+from ertools.benchmarks.hgmf.config import CODE, OBJECT_BODY, SCRIPT_FRAMES, TABLE, HgmfOptions
 from ertools.benchmarks.hgmf.flow import Attempt, HgmfFlow, script_flow
 from ertools.benchmarks.hgmf.formula import first_rise, planar_distance
 from ertools.benchmarks.hgmf.intervals import hgmf_intervals
@@ -30,10 +30,9 @@ from ertools.rsbb.results import RsbbResult
 from ertools.rsbb.score import compare_scores
 from ertools.rsbb.sidefiles import read_side_yaml
 from ertools.rsbb.tf import TfTrack, read_tf_tracks, script_poses
-from ertools.rsbb_states import BENCHMARKS
 from ertools.streams import Provenance
 
-FRAME = BENCHMARKS[CODE].frames[0]  # /object under /actor_markerset, in /table_origin
+FRAME = SCRIPT_FRAMES[0]  # /object under /actor_markerset, in /table_origin
 IDENTITY = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 
 

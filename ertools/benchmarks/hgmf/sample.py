@@ -35,7 +35,7 @@ import yaml
 from scipy.spatial.transform import Rotation, Slerp
 
 from ertools.atomic import write_text
-from ertools.rsbb_states import BENCHMARKS
+from ertools.benchmarks.hgmf.config import SCRIPT_FRAMES
 from ertools.simulator.answers import tol, window, write_answers
 from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
 from ertools.simulator.rsbb import write_rsbb_run
@@ -51,6 +51,8 @@ from ertools.simulator.rsbb_scenario import (
 S = 1_000_000_000
 MS = 1_000_000
 CODE = "HGMF"
+#: Its name in benchmarks_description.yaml (the season sample writes one).
+DESCRIPTION_NAME = "Functionality Benchmark 6: Grasping and Manipulation Functionality"
 TEAM = "simbot"
 # Friday 12 April 2019, 10:00:00 UTC: a day of the ERL Consumer 2019 season.
 T0 = 1_555_063_200 * S
@@ -66,7 +68,7 @@ TABLE_XYZ = (1.2, -0.4, 0.75)
 TABLE_YAW = 0.4
 LIFT_M = 0.10
 NOISE = MocapNoise(sigma_m=2e-4, sigma_rad=2e-4)
-FRAME = BENCHMARKS[CODE].frames[0]
+FRAME = SCRIPT_FRAMES[0]
 
 
 @dataclass(frozen=True)

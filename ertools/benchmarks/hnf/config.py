@@ -6,6 +6,7 @@ NumPy-free: the declaration and the CLI's parser import it.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,6 +22,7 @@ from ertools.benchmarks.common.script_inputs import (
     result_input,
     team_input,
 )
+from ertools.rsbb_states import ScriptFrame
 
 #: ``--rules``: ertools' reading, or a version of the script (docs/hnf.md, "2017-18").
 #: 2019 = rockin-robot-challenge/rsbb 2bb8a41; 2017 = Enri2077/rsbb 00e3106 (December 2017 to
@@ -35,6 +37,30 @@ SCRIPT_COMMITS = {
 }
 #: The season a script version served (the ``differs from`` lines of the default name 2019).
 SEASONS = {"2bb8a41": "2019", "00e3106": "2017", "f594ff1": "2017", "069fd1d": "2017"}
+
+#: The frames its script broadcasts (2bb8a41: ``benchmarks_description.yaml``'s tf helper).
+SCRIPT_FRAMES: tuple[ScriptFrame, ...] = (
+    ScriptFrame("/robot", "/robot_markerset", "/testbed_origin", 5, 1.0),
+)
+#: The mocap bodies whose pose topics its runs record.
+MOCAP_BODIES = ("robot_markerset", "actor_markerset")
+#: The seasons in which a script for it existed.
+SCRIPT_SEASONS = ("2017", "2019")
+
+_NUMBER = r"(-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?)"
+#: The live robot_pose as the RefBox logged it: a Pose2D as PyYAML dumped it.
+_POSE_DUMP = re.compile(rf"Pose2D\s+state: \[{_NUMBER}, {_NUMBER}, {_NUMBER}\]")
+
+
+def pose_dump(value: str) -> tuple[tuple[str, float], ...] | None:
+    """The x, y and theta of a live ``robot_pose`` dump, keyed by quantity; None: not one."""
+    pose = _POSE_DUMP.search(value)
+    if pose is None:
+        return None
+    return tuple(
+        (key, float(pose.group(i))) for i, key in enumerate(("x", "y", "robot_pose.theta"), 1)
+    )
+
 
 #: Default largest interval between the mocap samples a pose is interpolated across (ertools'
 #: reading): 12 frames of the RSBB's 120 Hz OptiTrack; a body lost for longer is not measured.

@@ -12,11 +12,12 @@ from ertools.benchmarks.base import (
     Benchmark,
     Described,
     Discovered,
+    LiveText,
     Ranking,
     Reported,
     Simulated,
 )
-from ertools.benchmarks.hnf.config import INPUTS, HnfOptions, make_options
+from ertools.benchmarks.hnf.config import INPUTS, HnfOptions, make_options, pose_dump
 from ertools.benchmarks.hnf.rules import RULES
 
 if TYPE_CHECKING:  # annotations only: the stages import NumPy and the readers
@@ -74,6 +75,7 @@ class Hnf(
     Described,
     Reported[HnfOptions, "HnfResult"],
     Discovered,
+    LiveText,
     Simulated,
 ):
     """HNF: the 2017-19 navigation script followed through its run bag and re-scored."""
@@ -82,6 +84,7 @@ class Hnf(
     title = "HNF (FBM2@Home 2017-19)"
     inputs = INPUTS
     rules = RULES
+    sample_seed = 2021  # Simulated: sample_bags/ was written with it
     example = "ertools score hnf rsbb_logs/HNF/homer/run_1_2019-04-10-14-31-06.bag"
     description = DESCRIPTION
     epilog = EPILOG
@@ -96,6 +99,9 @@ class Hnf(
     # the RSBB's topics have no benchmark namespace, and its frames are the script's own
     log_namespace = ""
     source_inputs: tuple[str, ...] = ()
+
+    def live_numbers(self, value: str) -> tuple[tuple[str, float], ...] | None:
+        return pose_dump(value)  # LiveText: the live robot_pose
 
     def make_options(self, values: Mapping[str, Any]) -> HnfOptions:
         return make_options(values)

@@ -15,7 +15,7 @@ import numpy as np
 from ertools.arrays import I64
 from ertools.benchmarks.base import notice
 from ertools.benchmarks.common.interval_output import ResultIntervals
-from ertools.benchmarks.hnf.config import SEASONS, HnfOptions
+from ertools.benchmarks.hnf.config import SCRIPT_FRAMES, SEASONS, HnfOptions
 from ertools.benchmarks.hnf.flow import HnfFlow, script_flow
 from ertools.benchmarks.hnf.formula import SegmentErrors, accuracies, segment_errors
 from ertools.benchmarks.hnf.intervals import hnf_intervals
@@ -31,12 +31,11 @@ from ertools.rsbb.results import RsbbResult
 from ertools.rsbb.score import compare_scores
 from ertools.rsbb.sidefiles import read_side_yaml, script_transform
 from ertools.rsbb.tf import TfTrack, read_tf_tracks, script_poses
-from ertools.rsbb_states import BENCHMARKS
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
 
 CODE = "HNF"
-FRAME = BENCHMARKS[CODE].frames[0]  # /robot under /robot_markerset, in /testbed_origin
+FRAME = SCRIPT_FRAMES[0]  # /robot under /robot_markerset, in /testbed_origin
 BODY = FRAME.parent.lstrip("/")
 # the transform's key the script at each commit read (renamed in 00e3106)
 TRANSFORM_KEY = {

@@ -21,9 +21,19 @@ from ertools.benchmarks.common.script_inputs import (
     script_values,
 )
 from ertools.errors import UsageError
+from ertools.rsbb_states import ScriptFrame
 
 NAME = "hopf"
 CODE = "HOPF"
+
+#: The frames its script broadcasts (2bb8a41: ``benchmarks_description.yaml``'s tf helper).
+SCRIPT_FRAMES: tuple[ScriptFrame, ...] = (
+    ScriptFrame("/item", "/positioner_origin", "/table_origin", 3, 1.0),
+)
+#: The mocap bodies whose pose topics its runs record.
+MOCAP_BODIES = ("table_origin", "positioner_origin")
+#: The seasons in which a script for it existed.
+SCRIPT_SEASONS = ("2017", "2019")
 
 #: The script versions ``--rules`` reproduces (docs/hopf.md, docs/fidelity.md's version table).
 SCRIPTS = {

@@ -10,7 +10,15 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ertools.benchmarks.base import Benchmark, Described, Discovered, Ranking, Reported, Simulated
+from ertools.benchmarks.base import (
+    Benchmark,
+    Described,
+    Discovered,
+    Ranking,
+    Reported,
+    SeasonItems,
+    Simulated,
+)
 from ertools.benchmarks.hopf.config import INPUTS, NAME, HopfOptions, make_options
 from ertools.benchmarks.hopf.rules import RULES
 
@@ -44,6 +52,7 @@ class Hopf(
     Described,
     Reported[HopfOptions, "HopfResult"],
     Discovered,
+    SeasonItems,
     Simulated,
 ):
     """HOPF: ten items shown to the robot, its answers against tf's lookup of each."""
@@ -52,6 +61,7 @@ class Hopf(
     title = "HOPF (FBM1@Home 2017-19)"
     inputs = INPUTS
     rules = RULES
+    sample_seed = 2023  # Simulated: sample_bags/ was written with it
     example = "ertools score hopf rsbb_logs/HOPF/teamA/run_1_<date>.bag"
     description = DESCRIPTION
     epilog = EPILOG
@@ -64,6 +74,7 @@ class Hopf(
     )
     log_namespace = ""
     source_inputs = ()
+    season_items = True  # SeasonItems: the objects shown and their poses
 
     def make_options(self, values: Mapping[str, Any]) -> HopfOptions:
         return make_options(values)

@@ -13,7 +13,13 @@ import numpy as np
 
 from ertools.benchmarks.base import notice
 from ertools.benchmarks.hopf import rules
-from ertools.benchmarks.hopf.config import CLIP_TRANSLATION_M, CODE, SCRIPT_TEXT, HopfOptions
+from ertools.benchmarks.hopf.config import (
+    CLIP_TRANSLATION_M,
+    CODE,
+    SCRIPT_FRAMES,
+    SCRIPT_TEXT,
+    HopfOptions,
+)
 from ertools.benchmarks.hopf.goals import (
     GoalRecord,
     Scored,
@@ -35,10 +41,9 @@ from ertools.rsbb.results import RsbbResult
 from ertools.rsbb.score import compare_scores
 from ertools.rsbb.sidefiles import SideFiles, read_side_yaml
 from ertools.rsbb.tf import TfTrack, TfTracks, read_tf_tracks, script_poses
-from ertools.rsbb_states import BENCHMARKS
 from ertools.streams import Provenance
 
-FRAME = BENCHMARKS[CODE].frames[0]  # /item under /positioner_origin, looked up in /table_origin
+FRAME = SCRIPT_FRAMES[0]  # /item under /positioner_origin, looked up in /table_origin
 POSITIONER = FRAME.parent.lstrip("/")
 TABLE = FRAME.reference.lstrip("/")
 

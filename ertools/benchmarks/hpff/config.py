@@ -21,8 +21,19 @@ from ertools.benchmarks.common.script_inputs import (
     result_input,
     team_input,
 )
+from ertools.rsbb_states import ScriptFrame
 
 RULE_SETS = ("ertools", "2019")
+
+#: The frames its script broadcasts (2bb8a41: ``benchmarks_description.yaml``'s tf helper).
+SCRIPT_FRAMES: tuple[ScriptFrame, ...] = (
+    ScriptFrame("/robot", "/robot_markerset", "/actor_markerset", 1, 0.2),
+    ScriptFrame("/robot", "/robot_markerset", "/testbed_origin", 1, 0.2),
+)
+#: The mocap bodies whose pose topics its runs record.
+MOCAP_BODIES = ("robot_markerset", "actor_markerset")
+#: The seasons in which a script for it existed.
+SCRIPT_SEASONS = ("2019",)
 SCRIPT_COMMIT = "2bb8a41"
 #: The script's sampling period and settling sleep (fbm5_person_following.py l. 96, 140).
 PERIOD_S = 0.5

@@ -78,6 +78,7 @@ class Hpff(
     title = "HPFF (FBM5@Home 2019)"
     inputs = INPUTS
     rules = RULES
+    sample_seed = 2022  # Simulated: sample_bags/ was written with it
     example = "ertools score hpff rsbb_logs/HPFF/homer/run_1_2019-04-10-15-02-11.bag"
     description = DESCRIPTION
     epilog = EPILOG

@@ -12,7 +12,7 @@ import numpy as np
 
 from ertools.benchmarks.base import notice
 from ertools.benchmarks.common.interval_output import ResultIntervals
-from ertools.benchmarks.hpff.config import MARGIN_S, SCRIPT_COMMIT, HpffOptions
+from ertools.benchmarks.hpff.config import MARGIN_S, SCRIPT_COMMIT, SCRIPT_FRAMES, HpffOptions
 from ertools.benchmarks.hpff.flow import HpffFlow, grid_flow, script_flow
 from ertools.benchmarks.hpff.formula import FAILED, Following, following
 from ertools.benchmarks.hpff.intervals import hpff_intervals
@@ -34,12 +34,11 @@ from ertools.rsbb.py2 import to_sec
 from ertools.rsbb.score import compare_scores
 from ertools.rsbb.sidefiles import read_side_yaml, script_transform
 from ertools.rsbb.tf import link_at, read_tf_tracks, script_poses
-from ertools.rsbb_states import BENCHMARKS
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
 
 CODE = "HPFF"
-FRAME = BENCHMARKS[CODE].frames[0]  # /robot under /robot_markerset (both lookups)
+FRAME = SCRIPT_FRAMES[0]  # /robot under /robot_markerset (both lookups)
 PARAMS = ("min_following_distance", "max_following_distance", "desired_following_distance")
 
 

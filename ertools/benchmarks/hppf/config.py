@@ -21,9 +21,19 @@ from ertools.benchmarks.common.script_inputs import (
     script_values,
 )
 from ertools.errors import UsageError
+from ertools.rsbb_states import ScriptFrame
 
 NAME = "hppf"
 CODE = "HPPF"
+
+#: The frames its script broadcasts (2bb8a41: ``benchmarks_description.yaml``'s tf helper).
+SCRIPT_FRAMES: tuple[ScriptFrame, ...] = (
+    ScriptFrame("/person", "/actor_markerset", "/testbed_origin", 3, 1.0),
+)
+#: The mocap bodies whose pose topics its runs record.
+MOCAP_BODIES = ("actor_markerset",)
+#: The seasons in which a script for it existed.
+SCRIPT_SEASONS = ("2019",)
 
 SCRIPTS = {"2019": "2bb8a41"}
 SCRIPT_TEXT = {

@@ -53,6 +53,7 @@ class Hppf(
     title = "HPPF (FBM4@Home 2019)"
     inputs = INPUTS
     rules = RULES
+    sample_seed = 2024  # Simulated: sample_bags/ was written with it
     example = "ertools score hppf rsbb_logs/HPPF/teamA/run_1_<date>.bag"
     description = DESCRIPTION
     epilog = EPILOG

@@ -13,7 +13,7 @@ import numpy as np
 
 from ertools.benchmarks.base import notice
 from ertools.benchmarks.hppf import rules
-from ertools.benchmarks.hppf.config import CODE, SCRIPT_TEXT, HppfOptions
+from ertools.benchmarks.hppf.config import CODE, SCRIPT_FRAMES, SCRIPT_TEXT, HppfOptions
 from ertools.benchmarks.hppf.goals import Scored, Truth, run_ertools, run_script
 from ertools.benchmarks.hppf.intervals import hppf_intervals
 from ertools.benchmarks.hppf.result import HppfResult
@@ -27,10 +27,9 @@ from ertools.rsbb.results import RsbbResult
 from ertools.rsbb.score import compare_scores
 from ertools.rsbb.sidefiles import SideFiles, read_side_yaml
 from ertools.rsbb.tf import TfTrack, TfTracks, read_tf_tracks, script_poses
-from ertools.rsbb_states import BENCHMARKS
 from ertools.streams import Provenance
 
-FRAME = BENCHMARKS[CODE].frames[0]  # /person under /actor_markerset, in /testbed_origin
+FRAME = SCRIPT_FRAMES[0]  # /person under /actor_markerset, in /testbed_origin
 ACTOR = FRAME.parent.lstrip("/")
 IDENTITY = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 #: The keys ertools' reading adds to a goal (the script never wrote them).

@@ -45,6 +45,7 @@ class Noise(
     title = "Mocap noise"
     inputs = INPUTS
     rules = RULES
+    sample_seed = 2019  # Simulated: sample_bags/ was written with it
     example = "ertools score noise stationary.bag --stationary auto"
     description = DESCRIPTION
     epilog = EPILOG

@@ -11,10 +11,14 @@ from typing import Any
 
 from ertools.benchmarks.base import Input, resolve_values
 from ertools.errors import UsageError
-from ertools.rsbb_states import BENCHMARKS, REFEREE_CODES
+from ertools.rsbb_states import BENCHMARKS
 
+#: The RSBB benchmarks scored by the referee's items alone.
+REFEREE_CODES = ("HGTKMH", "HWV", "HCFGAC", "STB")
 #: Registry name -> RSBB code, for every benchmark the referee alone scores.
 CODES: dict[str, str] = {code.lower(): code for code in REFEREE_CODES}
+#: The mocap bodies whose pose topics a run records, by code (2bb8a41: the STB's actor alone).
+MOCAP_BODIES: dict[str, tuple[str, ...]] = {"STB": ("actor_markerset",)}
 
 # The ERL order as one number (higher is better): achievements, then penalties, then time.
 # Exact as long as there are fewer than PENALTY_SCALE penalties and the time is below

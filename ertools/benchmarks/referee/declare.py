@@ -1,7 +1,7 @@
 """The referee-scored RSBB benchmarks as the registry sees them: one :class:`Referee` per code
-of :data:`~ertools.rsbb_states.REFEREE_CODES` (``hgtkmh``, ``hwv``, ``hcfgac``, ``stb``), the
-same inputs (``config``) and stages (``pipeline``) for each. NumPy-free: ``ertools score
-hgtkmh``'s parser imports it.
+of :data:`~ertools.benchmarks.referee.config.REFEREE_CODES` (``hgtkmh``, ``hwv``, ``hcfgac``,
+``stb``), the same inputs (``config``) and stages (``pipeline``) for each. NumPy-free:
+``ertools score hgtkmh``'s parser imports it.
 """
 
 from __future__ import annotations
@@ -69,6 +69,7 @@ class Referee(
 
     inputs = INPUTS
     rules = RULES
+    sample_part = True  # Simulated: its runs are part of season2019 (samples/season.py)
     bags_help = "the run's bag (rsbb_logs/<CODE>/<team>/run_<n>_<date>.bag)"
     score_keys = frozenset({"erl_rank", "achievements", "penalized_behaviors"})
     draws: frozenset[str] = frozenset()

@@ -68,6 +68,7 @@ class Trajectory(
     title = "Offline trajectory benchmark"
     inputs = INPUTS
     rules = RULES
+    sample_seed = 2018  # Simulated: sample_bags/ was written with it
     sample_folder = "robotlog"  # Simulated: a robot's own log, GT folder beside it
     example = "ertools score trajectory robot.bag gt/ --robot-topic /rockin/homer/marker_pose"
     description = DESCRIPTION

@@ -14,15 +14,18 @@ ROOT = Path(__file__).resolve().parents[3]
 
 
 def test_every_sample_module_is_a_scenario_once() -> None:
-    """The packages holding a ``sample.py``, read from the tree, are the scenarios' modules;
-    each folder is one of ``sample_bags/`` (the trajectory's: ``robotlog``)."""
+    """The packages holding a ``sample.py``, read from the tree, are the scenarios' modules
+    and the parts a scenario composes (the referee's, in ``season2019``); each folder is one
+    of ``sample_bags/`` (the trajectory's: ``robotlog``)."""
     on_disk = sorted(
         f"ertools.benchmarks.{p.parent.name}.sample"
         for p in (ROOT / "ertools" / "benchmarks").glob("*/sample.py")
         if p.parent.name != "common"
     )
     found = registry.scenarios()
-    assert sorted(s.module for s in found) == on_disk
+    parts = [m.__name__ for m in registry.sample_parts()]
+    assert parts == ["ertools.benchmarks.referee.sample"]
+    assert sorted([s.module for s in found] + parts) == on_disk
     folders = [s.folder for s in found]
     assert len(set(folders)) == len(folders)
     assert {"fbm1h", "robotlog"} <= set(folders) and "fbm1w" not in folders
@@ -32,8 +35,8 @@ def test_every_sample_module_is_a_scenario_once() -> None:
 
 def test_a_new_package_brings_its_scenario(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A package with a declaration, a sample module and one registry line: its scenario is
-    found, named by its ``sample_folder``, and writes what its ``generate`` writes; a package
-    without a sample module has none."""
+    found, named by its ``sample_folder``, seeded by its ``sample_seed``, and writes what its
+    ``generate`` writes; a package without a sample module has none."""
     package = tmp_path / "pkg" / "simbench"
     package.mkdir(parents=True)
     (package / "__init__.py").write_text("")
@@ -42,6 +45,8 @@ def test_a_new_package_brings_its_scenario(tmp_path: Path, monkeypatch: pytest.M
             """
             class Sim:
                 sample_folder = "simfolder"
+                sample_seed = 7
+                sample_part = False
 
                 def sample_args(self, samples):
                     return None
@@ -72,7 +77,7 @@ def test_a_new_package_brings_its_scenario(tmp_path: Path, monkeypatch: pytest.M
     )
     monkeypatch.setattr(registry, "ENTRIES", (*registry.ENTRIES, *lines))
     found = [s for s in registry.scenarios() if not s.module.startswith("ertools.")]
-    assert found == [registry.Scenario("simfolder", "simbench.sample")]
+    assert found == [registry.Scenario("simfolder", "simbench.sample", 7)]
     out = tmp_path / "out"
     out.mkdir()
     assert found[0].generate(out, seed=21) == [out / "seed.txt"]
