@@ -205,10 +205,37 @@ def find(
                     of=str(Path(e.bmbox_log).resolve()),
                 )
             )
+    scorings += _unreadable_runs(timeline, known, results)
     files, folders = list_files(paths)
     return Found(
         tuple(scorings), tuple(problems), timeline, discovery, tuple(kept), own, files, folders
     )
+
+
+def _unreadable_runs(
+    timeline: Timeline, known: set[str], results: Mapping[str, str]
+) -> list[Scoring]:
+    """An RSBB run bag that cannot be read, as an execution its place names (benchmark, team)
+    that is unscoreable, saying why: the referee sees the run rather than losing it."""
+    out: list[Scoring] = []
+    for entry in timeline.bags:
+        place = rsbb_run(entry.path)
+        if entry.readable or place is None or place[0].lower() not in known:
+            continue
+        path = Path(entry.path).resolve()
+        why = "; ".join(entry.problems) or "no message could be read"
+        result = results.get(str(path))
+        out.append(
+            Scoring(
+                benchmark=place[0].lower(),
+                team=place[1],
+                bags=(path,),
+                team_source="RSBB layout",
+                values={"result": Path(result)} if result is not None else {},
+                blockers=(f"its run bag {path} cannot be read: {why}",),
+            )
+        )
+    return out
 
 
 def rsbb_results(
