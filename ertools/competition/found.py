@@ -23,6 +23,7 @@ from ertools.benchmarks import registry
 from ertools.benchmarks.base import Described, Discovered
 from ertools.benchmarks.common.teams import read_payload_team
 from ertools.competition.discover import Discovery, Execution, discover
+from ertools.competition.jobs import one_line
 from ertools.competition.memo import (
     CLOCK,
     TEAM,
@@ -37,10 +38,13 @@ from ertools.io.clock import clock_check
 from ertools.io.formats import regular_files
 from ertools.progress import Reporter
 from ertools.report.timeline_page import write_timeline_page
+from ertools.rsbb.layout import classify as rsbb_classify
+from ertools.rsbb.results import parse_result_time
 from ertools.rsbb_states import BENCHMARKS
 from ertools.timelines.build import rsbb_run
 from ertools.timelines.model import RsbbFolder, Timeline
 from ertools.timelines.scan import scan
+from ertools.timeutil import NS_PER_S
 
 if TYPE_CHECKING:
     from ertools.io.model import BagSummary, ClockCheck
@@ -223,16 +227,24 @@ def _unreadable_runs(
         if entry.readable or place is None or place[0].lower() not in known:
             continue
         path = Path(entry.path).resolve()
-        why = "; ".join(entry.problems) or "no message could be read"
+        # the first problem only: the others are warnings of their own (one line each)
+        why = one_line(entry.problems[0] if entry.problems else "no message could be read")
         result = results.get(str(path))
+        # its time: the result file's name (the BmBox's setup, zone included), within 60 s of
+        # the bag's start; the bag's own name has its local time without the zone
+        named = None if result is None else rsbb_classify(result)
+        when = None if named is None or named.stamp is None else parse_result_time(named.stamp)
+        start_ns = None if when is None else int(when.timestamp()) * NS_PER_S
         out.append(
             Scoring(
                 benchmark=place[0].lower(),
                 team=place[1],
                 bags=(path,),
+                start_ns=start_ns,
+                end_ns=start_ns,
                 team_source="RSBB layout",
                 values={"result": Path(result)} if result is not None else {},
-                blockers=(f"its run bag {path} cannot be read: {why}",),
+                blockers=(f"its run bag cannot be read ({why})",),
             )
         )
     return out
