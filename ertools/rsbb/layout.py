@@ -214,11 +214,11 @@ class _SideFiles:
     """The side files by code (configs) and team (transforms), and the items; each run takes
     those of its own layout (under its root) first, others only when its layout has none."""
 
-    def __init__(self, files: Iterable[SeasonFile], problems: list[str]) -> None:
+    def __init__(self, files: Iterable[SeasonFile]) -> None:
         self.configs: dict[str, list[Path]] = {}
         self.transforms: dict[str, list[Path]] = {}
         self.items: list[Path] = []
-        self.problems = problems
+        self.problems: list[str] = []  # two files for one choice, each said once
         self._told: set[str] = set()
         for f in files:
             if f.kind is FileKind.BENCHMARK_CONFIG and f.code is not None:
@@ -247,7 +247,7 @@ def pair_runs(files: Iterable[SeasonFile]) -> tuple[tuple[RunFiles, ...], tuple[
     (:func:`layout_root`). Returns (runs, problems)."""
     items_all = list(files)
     problems: list[str] = []
-    side = _SideFiles(items_all, problems)
+    side = _SideFiles(items_all)
     groups: dict[tuple[str, str, int], tuple[list[SeasonFile], list[SeasonFile]]] = {}
     for f in items_all:
         if (
@@ -307,7 +307,7 @@ def pair_runs(files: Iterable[SeasonFile]) -> tuple[tuple[RunFiles, ...], tuple[
         return f.local_time if f is not None and f.local_time is not None else datetime.min
 
     runs.sort(key=lambda r: (r.code, r.team, when(r), r.run))
-    return tuple(runs), tuple(problems)
+    return tuple(runs), (*side.problems, *problems)
 
 
 def scan(root: str | Path) -> SeasonLayout:
