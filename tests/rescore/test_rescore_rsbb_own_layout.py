@@ -95,3 +95,24 @@ def test_a_truncated_run_bag_is_an_unscoreable_execution(
     places = {f["path"]: f["place"] for f in doc["files"]}
     result = next(p for p in places if p.startswith("results/HGMF/simbot/"))
     assert places[result] == "input"  # its result file is the run's, not unused
+
+
+def test_a_truncated_run_bag_without_its_result_has_no_1970_time(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    folder = tmp_path / "season2019"
+    shutil.copytree(SAMPLES / "season2019", folder)
+    bag = folder / "rsbb_logs/HGMF/simbot/run_1_2019-04-13-10-00-00.bag"
+    bag.write_bytes(bag.read_bytes()[: bag.stat().st_size // 2])
+    shutil.rmtree(folder / "results/HGMF/simbot")
+    out = tmp_path / "out"
+    assert main(["rescore", str(folder), "--out", str(out), "--no-reports", "-j", "1"]) == 1
+    doc: dict[str, Any] = json.loads((out / "results.json").read_text(encoding="utf-8"))
+    row = next(r for r in doc["executions"] if r["bags"][0].endswith(bag.name))
+    # no time anywhere (its bag holds no message, no result file names one): its id is its
+    # place in the list, never 1970-01-01
+    assert row["status"] == "unscoreable" and row["start_ns"] is None
+    assert re.fullmatch(r"hgmf-simbot-\d+", row["id"]), row["id"]
+    assert f"ertools: error: {row['id']}: unscoreable: its run bag cannot be read" in (
+        capsys.readouterr().err
+    )
