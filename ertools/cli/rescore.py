@@ -12,11 +12,13 @@ from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from ertools.atomic import write_text
 from ertools.cli.output import note
+from ertools.cli.text import one_line
 from ertools.competition.draft import draft_text
 from ertools.competition.found import find
 from ertools.competition.manifest import ManifestError, load_manifest
@@ -142,6 +144,10 @@ def run(args: argparse.Namespace) -> int:
         on_outcome=tell,
         on_wait=waiting,
     )
+    for problem in done.doc["problems"]:
+        # each execution's missing inputs are its error line; duplicates were warned of
+        if problem["kind"] not in ("missing-input", "duplicate-execution"):
+            _warn(problem)
     rows = done.doc["executions"]
     counts = {s: sum(r["status"] == s for r in rows) for s in ("scored", "unscoreable", "failed")}
     from_cache = sum(bool(r["cached"]) for r in rows)
@@ -156,6 +162,12 @@ def run(args: argparse.Namespace) -> int:
 
 
 DRAFTED = "manifest.yaml"
+
+
+def _warn(problem: Mapping[str, Any]) -> None:
+    """A problem of the logs (results.json's ``problems``) as one warning line: where, what."""
+    where = f"{problem['path']}: " if problem.get("path") else ""
+    note(f"warning: {where}{one_line(str(problem['message']))}")
 
 
 def _draft(args: argparse.Namespace) -> Path:
@@ -197,6 +209,8 @@ def _init(args: argparse.Namespace) -> int:
         if not path.exists():
             raise UsageError(f"{path}: no such file or folder")
     found = find(args.paths, progress=args.progress)
+    for problem in found.problems:
+        _warn(problem)
     text = draft_text(found, args.paths, args.init, args.command_line)
     args.init.parent.mkdir(parents=True, exist_ok=True)
     write_text(args.init, text)

@@ -30,8 +30,9 @@ from ertools.competition.found import Found, robot_benchmarks
 from ertools.competition.ledger import Claim, place_files, root_of
 from ertools.competition.site_text import TEAM_UNKNOWN
 from ertools.io.formats import regular_files
-from ertools.rsbb.layout import FileKind
+from ertools.rsbb.layout import FileKind, SeasonFile, layout_root
 from ertools.timelines.build import rsbb_run
+from ertools.timelines.model import RsbbRunFiles
 from ertools.timeutil import NS_PER_S
 
 CONFIG_SUFFIXES = (".yaml", ".yml")
@@ -154,12 +155,17 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
                 entries = []
                 for declared in per_team:
                     side = rsbb_side(found, name, declared.name, team)
+                    # the run's own layout first: a name elsewhere (another season) is a guess
                     hits = [side] if side is not None else []
+                    how = (
+                        "the runs', in their RSBB layout"
+                        if side is not None
+                        else "guessed from its name: check"
+                    )
                     hits = hits or guess(files, name, declared, first=False, team=team)
                     if hits:
                         entries.append(
-                            f"        {declared.name}: {_yaml(_rel(hits[0], base))}  "
-                            "# guessed from its name: check"
+                            f"        {declared.name}: {_yaml(_rel(hits[0], base))}  # {how}"
                         )
                         claims.append(Claim(str(hits[0]), "input", f"benchmarks.{name}.teams"))
                     else:
@@ -220,7 +226,10 @@ def rsbb_side(found: Found, benchmark: str, name: str, team: str | None = None) 
         return None
     if name == "description":
         kind = FileKind.DESCRIPTION.value
-        return next((Path(p).resolve() for k, p in folder.files if k == kind), None)
+        roots = [_run_root(r) for r in folder.runs if r.code.lower() == benchmark]
+        descriptions = [Path(p).resolve() for k, p in folder.files if k == kind]
+        own = [d for d in descriptions if any(r is not None and r in d.parents for r in roots)]
+        return next(iter(own or descriptions), None)
     if name not in ("config", "items", "transform"):
         return None
     for run in folder.runs:
@@ -230,6 +239,15 @@ def rsbb_side(found: Found, benchmark: str, name: str, team: str | None = None) 
         if value is not None:
             return Path(value).resolve()
     return None
+
+
+def _run_root(run: RsbbRunFiles) -> Path | None:
+    """The folder holding ``run``'s layout (its ``rsbb_logs/`` or ``results/``)."""
+    path = run.bag if run.bag is not None else run.result
+    kind = FileKind.RUN_BAG if run.bag is not None else FileKind.RESULT
+    if path is None:
+        return None
+    return layout_root(SeasonFile(Path(path).resolve(), kind, run.code, run.team))
 
 
 def _rel_text(text: str, base: Path) -> str:

@@ -23,6 +23,7 @@ from ertools.benchmarks import registry
 from ertools.benchmarks.base import Described, Discovered
 from ertools.benchmarks.common.teams import read_payload_team
 from ertools.competition.discover import Discovery, Execution, discover
+from ertools.competition.jobs import one_line
 from ertools.competition.memo import (
     CLOCK,
     TEAM,
@@ -37,10 +38,13 @@ from ertools.io.clock import clock_check
 from ertools.io.formats import regular_files
 from ertools.progress import Reporter
 from ertools.report.timeline_page import write_timeline_page
+from ertools.rsbb.layout import classify as rsbb_classify
+from ertools.rsbb.results import parse_result_time
 from ertools.rsbb_states import BENCHMARKS
 from ertools.timelines.build import rsbb_run
 from ertools.timelines.model import RsbbFolder, Timeline
 from ertools.timelines.scan import scan
+from ertools.timeutil import NS_PER_S
 
 if TYPE_CHECKING:
     from ertools.io.model import BagSummary, ClockCheck
@@ -205,10 +209,45 @@ def find(
                     of=str(Path(e.bmbox_log).resolve()),
                 )
             )
+    scorings += _unreadable_runs(timeline, known, results)
     files, folders = list_files(paths)
     return Found(
         tuple(scorings), tuple(problems), timeline, discovery, tuple(kept), own, files, folders
     )
+
+
+def _unreadable_runs(
+    timeline: Timeline, known: set[str], results: Mapping[str, str]
+) -> list[Scoring]:
+    """An RSBB run bag that cannot be read, as an execution its place names (benchmark, team)
+    that is unscoreable, saying why: the referee sees the run rather than losing it."""
+    out: list[Scoring] = []
+    for entry in timeline.bags:
+        place = rsbb_run(entry.path)
+        if entry.readable or place is None or place[0].lower() not in known:
+            continue
+        path = Path(entry.path).resolve()
+        # the first problem only: the others are warnings of their own (one line each)
+        why = one_line(entry.problems[0] if entry.problems else "no message could be read")
+        result = results.get(str(path))
+        # its time: the result file's name (the BmBox's setup, zone included), within 60 s of
+        # the bag's start; the bag's own name has its local time without the zone
+        named = None if result is None else rsbb_classify(result)
+        when = None if named is None or named.stamp is None else parse_result_time(named.stamp)
+        start_ns = None if when is None else int(when.timestamp()) * NS_PER_S
+        out.append(
+            Scoring(
+                benchmark=place[0].lower(),
+                team=place[1],
+                bags=(path,),
+                start_ns=start_ns,
+                end_ns=start_ns,
+                team_source="RSBB layout",
+                values={"result": Path(result)} if result is not None else {},
+                blockers=(f"its run bag cannot be read ({why})",),
+            )
+        )
+    return out
 
 
 def rsbb_results(

@@ -129,7 +129,8 @@ def _bags_span(bags: Sequence[Path]) -> tuple[int | None, int | None]:
             s = summary(bag)
         except (ErtoolsError, OSError, ValueError):
             continue
-        if s.start_ns is not None and s.end_ns is not None:
+        # a bag with no message (an unreadable RSBB run bag) has no time, not 1970's
+        if s.message_count and s.start_ns is not None and s.end_ns is not None:
             starts.append(int(s.start_ns))
             ends.append(int(s.end_ns))
     return (min(starts) if starts else None, max(ends) if ends else None)

@@ -199,32 +199,45 @@ class SeasonLayout:
     problems: tuple[str, ...] = field(default=())
 
 
-def _side_files(
-    files: Iterable[SeasonFile], problems: list[str]
-) -> tuple[dict[str, Path], dict[str, Path], Path | None]:
-    configs: dict[str, list[Path]] = {}
-    transforms: dict[str, list[Path]] = {}
-    items: list[Path] = []
-    for f in files:
-        if f.kind is FileKind.BENCHMARK_CONFIG and f.code is not None:
-            configs.setdefault(f.code, []).append(f.path)
-        elif f.kind is FileKind.TRANSFORM and f.team is not None:
-            transforms.setdefault(f.team, []).append(f.path)
-        elif f.kind is FileKind.ITEMS:
-            items.append(f.path)
+def layout_root(f: SeasonFile) -> Path | None:
+    """The folder holding a run bag's ``rsbb_logs/`` or a result file's ``results/`` (its
+    season's layout), None for other files."""
+    top = {FileKind.RUN_BAG: LOGS_DIR, FileKind.RESULT: RESULTS_DIR}.get(f.kind)
+    parts = f.path.parts
+    for k in range(len(parts) - 3, -1, -1):
+        if parts[k] == top and parts[k + 1 : k + 3] == (f.code, f.team):
+            return Path(*parts[:k]) if k else Path(parts[0])
+    return None
 
-    def one(what: str, paths: list[Path]) -> Path:
-        chosen = sorted(paths)
+
+class _SideFiles:
+    """The side files by code (configs) and team (transforms), and the items; each run takes
+    those of its own layout (under its root) first, others only when its layout has none."""
+
+    def __init__(self, files: Iterable[SeasonFile]) -> None:
+        self.configs: dict[str, list[Path]] = {}
+        self.transforms: dict[str, list[Path]] = {}
+        self.items: list[Path] = []
+        self.problems: list[str] = []  # two files for one choice, each said once
+        self._told: set[str] = set()
+        for f in files:
+            if f.kind is FileKind.BENCHMARK_CONFIG and f.code is not None:
+                self.configs.setdefault(f.code, []).append(f.path)
+            elif f.kind is FileKind.TRANSFORM and f.team is not None:
+                self.transforms.setdefault(f.team, []).append(f.path)
+            elif f.kind is FileKind.ITEMS:
+                self.items.append(f.path)
+
+    def one(self, what: str, paths: list[Path], root: Path | None) -> Path | None:
+        own = [p for p in paths if root is not None and root in p.parents]
+        chosen = sorted(own or paths)
         if len(chosen) > 1:
             others = ", ".join(map(str, chosen[1:]))
-            problems.append(f"{len(chosen)} files for {what}: {chosen[0]} used, not {others}")
-        return chosen[0]
-
-    return (
-        {c: one(f"{c}'s config", ps) for c, ps in configs.items()},
-        {t: one(f"team {t}'s transform", ps) for t, ps in transforms.items()},
-        one("the items (items_with_pose.yaml)", items) if items else None,
-    )
+            line = f"{len(chosen)} files for {what}: {chosen[0]} used, not {others}"
+            if line not in self._told:  # once, not once per run
+                self._told.add(line)
+                self.problems.append(line)
+        return chosen[0] if chosen else None
 
 
 def pair_runs(
@@ -232,12 +245,12 @@ def pair_runs(
 ) -> tuple[tuple[RunFiles, ...], tuple[str, ...]]:
     """Runs from recognised files: a result file and a bag of the same code, team and run
     whose times are within :data:`PAIR_TOLERANCE` go together (nearest first); the side files
-    are attached by code and team, the items file to the runs of the codes in
-    ``season_items`` (the registry's :func:`~ertools.benchmarks.registry.season_items`).
-    Returns (runs, problems)."""
+    are attached by code and team, those under the run's own layout root first
+    (:func:`layout_root`), the items file to the runs of the codes in ``season_items`` (the
+    registry's :func:`~ertools.benchmarks.registry.season_items`). Returns (runs, problems)."""
     items_all = list(files)
     problems: list[str] = []
-    configs, transforms, items = _side_files(items_all, problems)
+    side = _SideFiles(items_all)
     groups: dict[tuple[str, str, int], tuple[list[SeasonFile], list[SeasonFile]]] = {}
     for f in items_all:
         if (
@@ -275,6 +288,8 @@ def pair_runs(
                 problems.append(f"{result.path}: no run bag of {code} {team} run {run} beside it")
             elif result is None and scripted and bag is not None:
                 problems.append(f"{bag.path}: no result file of {code} {team} run {run}")
+            own = bag or result
+            root = None if own is None else layout_root(own)
             runs.append(
                 RunFiles(
                     code,
@@ -282,9 +297,11 @@ def pair_runs(
                     run,
                     bag,
                     result,
-                    configs.get(code),
-                    transforms.get(team),
-                    items if code in season_items else None,
+                    side.one(f"{code}'s config", side.configs.get(code, []), root),
+                    side.one(f"team {team}'s transform", side.transforms.get(team, []), root),
+                    side.one("the items (items_with_pose.yaml)", side.items, root)
+                    if code in season_items
+                    else None,
                 )
             )
 
@@ -293,7 +310,7 @@ def pair_runs(
         return f.local_time if f is not None and f.local_time is not None else datetime.min
 
     runs.sort(key=lambda r: (r.code, r.team, when(r), r.run))
-    return tuple(runs), tuple(problems)
+    return tuple(runs), (*side.problems, *problems)
 
 
 def scan(root: str | Path, season_items: Collection[str] = ()) -> SeasonLayout:
