@@ -809,8 +809,8 @@ TOPIC_CASES: dict[str, Callable[[Inputs], list[str]]] = {
 def test_wrong_topic(case: str, inputs: Inputs, capsys: pytest.CaptureFixture[str]) -> None:
     result = _run(TOPIC_CASES[case](inputs), capsys)
     if case in WRONG_BENCHMARK:
-        # A log of another benchmark is named for what it is: a usage error (exit 2).
-        line = _check_error(result, 2, "this looks like an")
+        # A log of another benchmark is named for what it is: unusable data (exit 1).
+        line = _check_error(result, 1, "this looks like an")
         assert line.endswith(f"ertools score {WRONG_BENCHMARK[case]}"), line
         return
     # Named: the topic or frame asked for, or (for a log of the wrong kind) the log itself.

@@ -21,9 +21,9 @@ from ertools.benchmarks.hgmf.formula import first_rise, planar_distance
 from ertools.benchmarks.hgmf.intervals import hgmf_intervals
 from ertools.benchmarks.hgmf.listing import score_listing
 from ertools.benchmarks.hgmf.result import HgmfGoal, HgmfResult, deviations_of
-from ertools.errors import ConfigError, UsageError
+from ertools.errors import ConfigError, SegmentationError, UsageError
 from ertools.io.summary import summary
-from ertools.rsbb.log import RsbbRun, read_rsbb_run
+from ertools.rsbb.log import RsbbRun, check_code, read_rsbb_run
 from ertools.rsbb.results import RsbbResult, load_result
 from ertools.rsbb.score import compare_scores
 from ertools.rsbb.sidefiles import find_side_files, read_side_yaml
@@ -93,7 +93,7 @@ def _config(
     if result is not None and isinstance(result.params, dict):
         where = f"{result.path} (benchmark_info.params)"
         return _objects(result.params, where), where
-    raise UsageError(
+    raise ConfigError(
         "no HGMF.yaml beside the bag or in the RSBB layout, and no result file with the "
         "params: give --config HGMF.yaml (its objects) or --result result_run_<n>_<date>.yaml"
     )
@@ -103,8 +103,10 @@ def load(logs: Sequence[Path], options: HgmfOptions) -> HgmfLogs:
     """Read the run bag and its side files (found ones named on stderr).
 
     Raises:
-        UsageError: not one bag, another benchmark's bag, or no config anywhere.
-        TopicError, BagError, ConfigError: unreadable inputs.
+        UsageError: not one bag.
+        ConfigError: another benchmark's bag, no config anywhere, an unreadable side file.
+        SegmentationError: the benchmark never started in the log.
+        TopicError, BagError: an unreadable bag.
     """
     if len(logs) != 1:
         raise UsageError(
@@ -115,17 +117,20 @@ def load(logs: Sequence[Path], options: HgmfOptions) -> HgmfLogs:
         bag, CODE, want={"config", "result"}, config=options.config, result=options.result
     )
     if side.place.code not in (None, CODE):
-        raise UsageError(
+        raise ConfigError(
             f"{bag} is a {side.place.code} run (rsbb_logs/{side.place.code}/...): "
             f"ertools score {side.place.code.lower()}"
         )
     for line in side.found:
         notice(line)
+    # the bag first: a file that is no bag (or another benchmark's) is said before a
+    # missing HGMF.yaml, which would send the referee looking for the wrong file
+    run = read_rsbb_run(bag)
+    check_code(run, CODE)  # outside the layout, the live score names the benchmark
     result = load_result(side.result) if side.result is not None else None
     objects, config_source = _config(options, side.config, result)
-    run = read_rsbb_run(bag)
     if run.t_start_ns is None:
-        raise UsageError(
+        raise SegmentationError(
             f"{bag}: the benchmark never started (no EXECUTING_BENCHMARK): nothing to score"
         )
     tracks = read_tf_tracks(bag)

@@ -25,7 +25,7 @@ from ertools.benchmarks.hpff.result import (
     deviations_of,
     nan_xy,
 )
-from ertools.errors import ConfigError, UsageError
+from ertools.errors import ConfigError, SegmentationError, UsageError
 from ertools.io.summary import summary
 from ertools.rsbb.log import EndKind
 from ertools.rsbb.opened import open_run
@@ -62,19 +62,29 @@ def load(logs: Sequence[Path], options: HpffOptions) -> HpffLogs:
     """Read the run bag and its side files (found ones named on stderr).
 
     Raises:
-        UsageError: not one bag, another benchmark's run, or a side file nowhere to be found.
-        TopicError, BagError, ConfigError: unreadable inputs.
+        UsageError: not one bag.
+        ConfigError: another benchmark's bag, a side file nowhere to be found or unreadable.
+        SegmentationError: the benchmark never started in the log.
+        TopicError, BagError: an unreadable bag.
     """
     if len(logs) != 1:
         raise UsageError(
             f"give one HPFF run bag (rsbb_logs/HPFF/<team>/run_<n>_<date>.bag), not {len(logs)}"
         )
     bag = Path(logs[0])
-    opened = open_run(bag, CODE, options)
+    # opened.py refuses another benchmark's bag and a missing transform as usage errors;
+    # both are about the files, not the command line: exit 1 (docs/cli.md, Exit status)
+    try:
+        opened = open_run(bag, CODE, options)
+    except UsageError as err:
+        raise ConfigError(str(err), transient=err.transient) from None
     for line in opened.found:
         notice(line)
     run, result, team = opened.run, opened.result, opened.team
-    transform_path = opened.transform_file()
+    try:
+        transform_path = opened.transform_file()
+    except UsageError as err:
+        raise ConfigError(str(err), transient=err.transient) from None
     side = opened.side
     transform = script_transform(transform_path, ("markerset_to_robot_transform",))
     if side.config is not None:
@@ -84,12 +94,12 @@ def load(logs: Sequence[Path], options: HpffOptions) -> HpffLogs:
         source = f"{result.path} (benchmark_info.params)"
         params = _params(result.params, source)
     else:
-        raise UsageError(
+        raise ConfigError(
             "no HPFF.yaml beside the bag or in the RSBB layout, and no result file with the "
             "params: give --config HPFF.yaml or --result result_run_<n>_<date>.yaml"
         )
     if run.t_start_ns is None:
-        raise UsageError(f"{bag}: the benchmark never started (no EXECUTING_BENCHMARK)")
+        raise SegmentationError(f"{bag}: the benchmark never started (no EXECUTING_BENCHMARK)")
     tracks = read_tf_tracks(bag)
     log_end = max(t.last_ns for t in summary(bag).topics if t.last_ns is not None)
     return HpffLogs(
