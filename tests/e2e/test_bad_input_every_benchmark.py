@@ -112,7 +112,7 @@ def test_a_truncated_log(name: str, tmp_path: Path, capsys: pytest.CaptureFixtur
     data = log.read_bytes()
     log.write_bytes(data[: len(data) // 2])
     line = _one_error(["score", name, str(log), *_args(sample, folder)], capsys)
-    assert str(log) in line, line
+    assert str(log) in line and "truncated" in line, line
 
 
 @pytest.mark.parametrize("name", list(SAMPLE))
