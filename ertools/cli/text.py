@@ -1,9 +1,7 @@
-"""The CLI's lines of text: control characters escaped, error messages on one line (or a few
-indented ones when long). Light: every command module and the dispatcher use it."""
+"""The CLI's lines of text: control characters escaped, every error message on one line.
+Light: every command module and the dispatcher use it."""
 
 from __future__ import annotations
-
-import textwrap
 
 # Control characters as escapes: a file name holding a newline (or an escape sequence) must
 # not start a line of its own in a command's output, nor drive the terminal.
@@ -26,39 +24,8 @@ def one_line(message: str) -> str:
     return " ".join(message.split())
 
 
-# The longest error line: what is wrong and where fits on it; the detail (frames found, the
-# topics there, what to try) goes to further lines, indented, at the message's "; ".
-MAX_ERROR_LINE = 200
-
-
-def _clauses(text: str) -> list[str]:
-    """``text`` split at each "; " outside brackets."""
-    parts, depth, start = [], 0, 0
-    for i, char in enumerate(text):
-        depth += (char in "([{") - (char in ")]}")
-        if depth == 0 and text.startswith("; ", i):
-            parts.append(text[start:i])
-            start = i + 2
-    return [*parts, text[start:]]
-
-
 def error_text(message: str) -> str:
-    """``ertools: error: MESSAGE`` as printed: one line when it fits in
-    :data:`MAX_ERROR_LINE` characters, else each further clause (after "; ") on a line of its
-    own indented by two spaces, and a clause still too long wrapped at words onto lines
-    indented by four."""
-    first = f"ertools: error: {printable(one_line(message))}"
-    if len(first) <= MAX_ERROR_LINE:
-        return first
-    clauses = _clauses(first)
-    lines = [clauses[0], *(f"  {c}" for c in clauses[1:])]
-    out: list[str] = []
-    for line in lines:
-        out += textwrap.wrap(
-            line,
-            MAX_ERROR_LINE,
-            subsequent_indent="    ",  # deeper than a clause: the same clause goes on
-            break_long_words=False,
-            break_on_hyphens=False,
-        ) or [line]
-    return "\n".join(out)
+    """``ertools: error: MESSAGE`` as printed: always one line (a line-oriented reader, a log
+    grep, a test, counts one error per line), however long; a third-party text's newlines (a
+    YAML parser's) are folded into it. The message's clauses stay joined with "; "."""
+    return f"ertools: error: {printable(one_line(message))}"

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from ertools.errors import ConfigError, UsageError
+from ertools.errors import ConfigError
 from ertools.rsbb.log import RsbbRun, check_code, read_rsbb_run
 from ertools.rsbb.results import RsbbResult, load_result
 from ertools.rsbb.sidefiles import SideFiles, find_side_files
@@ -40,10 +40,11 @@ class OpenedRun:
         """The team transform's file.
 
         Raises:
-            UsageError: none was given or found.
+            ConfigError: none was given or found (a file missing, not a command-line error:
+                exit 1, docs/cli.md).
         """
         if self.transform is None:
-            raise UsageError(
+            raise ConfigError(
                 f"no transform-{self.team or '<team>'}.yaml beside the bag or in "
                 "rsbb_etc/transforms/: give --transform FILE (the team's "
                 "markerset_to_robot_transform)"

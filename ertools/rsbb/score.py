@@ -175,7 +175,11 @@ class ScoreComparison:
                 else f"result file ({self.file})"
             )
             if not here:
-                out.append(f"{name}: none to compare with")
+                out.append(
+                    f"{name}: none to compare with"
+                    if against == "live"
+                    else "no result file: nothing to compare with"
+                )
                 continue
             diff = self.differing(against)
             if not diff:

@@ -1,5 +1,5 @@
-"""Reading ertools' stderr in tests: an error message longer than the CLI's line limit
-continues on indented lines (``ertools.cli.text.error_text``); here it is one line again."""
+"""Reading ertools' stderr in tests: each error message is one line as printed
+(``ertools.cli.text.error_text``); older helpers' indented continuations are joined here too."""
 
 from __future__ import annotations
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from ertools.errors import ConfigError, UsageError
+from ertools.errors import ConfigError
 from ertools.rsbb.opened import open_run
 
 SAMPLES = Path(__file__).parents[2] / "sample_bags"
@@ -74,7 +74,7 @@ def test_a_missing_transform_is_refused_when_asked_for(tmp_path: Path) -> None:
     shutil.copyfile(HNF, bag)
     opened = open_run([bag], "HNF", Given(), want=("transform",), say=print)
     assert opened.team is None and opened.transform is None
-    with pytest.raises(UsageError, match=r"^no transform-<team>\.yaml .*give --transform FILE"):
+    with pytest.raises(ConfigError, match=r"^no transform-<team>\.yaml .*give --transform FILE"):
         opened.transform_file()
 
 

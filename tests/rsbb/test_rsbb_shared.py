@@ -185,7 +185,10 @@ def test_score_comparison(tmp_path: Path) -> None:
         "reached_waypoints",
         "segment_1.segment_time[s]",
     )
-    assert compare_scores({"a": 1}, None, None).summary()[0].endswith("none to compare with")
+    assert compare_scores({"a": 1}, None, None).summary() == [
+        "live score (/rsbb/current_benchmark_result): none to compare with",
+        "no result file: nothing to compare with",  # not "result file (None)"
+    ]
 
 
 def test_score_leaves_and_yaml() -> None:

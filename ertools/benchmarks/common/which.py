@@ -14,7 +14,7 @@ from typing import Any
 
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Described, Discovered
-from ertools.errors import ErtoolsError, UsageError
+from ertools.errors import ConfigError, ErtoolsError
 from ertools.io.reader import topics
 
 GT_USE = "ertools score trajectory ROBOT_BAG MOCAP..."
@@ -91,9 +91,10 @@ def log_benchmark(bag: Path) -> str | None:
 
 
 def refuse_other_benchmark(name: str, bags: Sequence[Path], values: Mapping[str, Any]) -> None:
-    """A :class:`UsageError` when the first bag is plainly another benchmark's log."""
+    """A :class:`ConfigError` when the first bag is plainly another benchmark's log: exit 1, as
+    for an RSBB run bag of another benchmark (the file is wrong, not the command line)."""
     if not bags:
         return
     message = other_benchmark(name, bags[0], values)
     if message is not None:
-        raise UsageError(message, path=bags[0])
+        raise ConfigError(message, path=bags[0])

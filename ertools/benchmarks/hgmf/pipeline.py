@@ -22,7 +22,7 @@ from ertools.benchmarks.hgmf.formula import first_rise, planar_distance
 from ertools.benchmarks.hgmf.intervals import hgmf_intervals
 from ertools.benchmarks.hgmf.listing import score_listing
 from ertools.benchmarks.hgmf.result import HgmfGoal, HgmfResult, deviations_of
-from ertools.errors import ConfigError, UsageError
+from ertools.errors import ConfigError, SegmentationError, UsageError
 from ertools.io.summary import summary
 from ertools.rsbb.log import RsbbRun
 from ertools.rsbb.opened import open_run
@@ -94,7 +94,7 @@ def _config(
     if result is not None and isinstance(result.params, dict):
         where = f"{result.path} (benchmark_info.params)"
         return _objects(result.params, where), where
-    raise UsageError(
+    raise ConfigError(
         "no HGMF.yaml beside the bag or in the RSBB layout, and no result file with the "
         "params: give --config HGMF.yaml (its objects) or --result result_run_<n>_<date>.yaml"
     )
@@ -104,9 +104,11 @@ def load(logs: Sequence[Path], options: HgmfOptions) -> HgmfLogs:
     """Read the run bag and its side files (found ones named on stderr).
 
     Raises:
-        UsageError: not one bag, or no config anywhere.
-        ConfigError: another benchmark's bag or result file; unreadable inputs.
-        TopicError, BagError: unreadable inputs.
+        UsageError: not one bag.
+        ConfigError: another benchmark's bag or result file, no config anywhere, an
+            unreadable side file.
+        SegmentationError: the benchmark never started in the log.
+        TopicError, BagError: an unreadable bag.
     """
     if len(logs) != 1:
         raise UsageError(
@@ -117,7 +119,7 @@ def load(logs: Sequence[Path], options: HgmfOptions) -> HgmfLogs:
     run, result = opened.run, opened.result_file
     objects, config_source = _config(options, opened.side.config, result)
     if run.t_start_ns is None:
-        raise UsageError(
+        raise SegmentationError(
             f"{bag}: the benchmark never started (no EXECUTING_BENCHMARK): nothing to score"
         )
     tracks = read_tf_tracks(bag)

@@ -23,7 +23,7 @@ from ertools.benchmarks.hnf.listing import score_listing
 from ertools.benchmarks.hnf.logs import HnfLogs
 from ertools.benchmarks.hnf.result import HnfResult, HnfSegment, deviations_of
 from ertools.configs._yaml import parse_yaml
-from ertools.errors import ConfigError, UsageError
+from ertools.errors import ConfigError, SegmentationError, UsageError
 from ertools.io.summary import summary
 from ertools.rsbb.log import EndKind, RsbbRun
 from ertools.rsbb.opened import open_run
@@ -67,7 +67,7 @@ def _config(
     if result is not None and isinstance(result.params, dict):
         where = f"{result.path} (benchmark_info.params)"
         return _waypoints(result.params, where), where
-    raise UsageError(
+    raise ConfigError(
         "no HNF.yaml beside the bag or in the RSBB layout, and no result file with the "
         "params: give --config HNF.yaml (its waypoints) or --result result_run_<n>_<date>.yaml"
     )
@@ -88,9 +88,11 @@ def load(logs: Sequence[Path], options: HnfOptions) -> HnfLogs:
     """Read the run bag and its side files (found ones named on stderr).
 
     Raises:
-        UsageError: not one bag, or a side file nowhere to be found.
-        ConfigError: another benchmark's run or result file; unreadable inputs.
-        TopicError, BagError: unreadable inputs.
+        UsageError: not one bag.
+        ConfigError: another benchmark's bag or result file, a side file nowhere to be
+            found or unreadable.
+        SegmentationError: the benchmark never started in the log.
+        TopicError, BagError: an unreadable bag.
     """
     if len(logs) != 1:
         raise UsageError(
@@ -112,7 +114,7 @@ def load(logs: Sequence[Path], options: HnfOptions) -> HnfLogs:
         )
     waypoints, config_source = _config(options, opened.side.config, result)
     if run.t_start_ns is None:
-        raise UsageError(
+        raise SegmentationError(
             f"{bag}: the benchmark never started (no EXECUTING_BENCHMARK): nothing to score"
         )
     tracks = read_tf_tracks(bag)

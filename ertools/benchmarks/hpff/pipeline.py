@@ -26,7 +26,7 @@ from ertools.benchmarks.hpff.result import (
     deviations_of,
     nan_xy,
 )
-from ertools.errors import ConfigError, UsageError
+from ertools.errors import ConfigError, SegmentationError, UsageError
 from ertools.io.summary import summary
 from ertools.rsbb.log import EndKind
 from ertools.rsbb.opened import open_run
@@ -62,9 +62,11 @@ def load(logs: Sequence[Path], options: HpffOptions) -> HpffLogs:
     """Read the run bag and its side files (found ones named on stderr).
 
     Raises:
-        UsageError: not one bag, or a side file nowhere to be found.
-        ConfigError: another benchmark's run or result file; unreadable inputs.
-        TopicError, BagError: unreadable inputs.
+        UsageError: not one bag.
+        ConfigError: another benchmark's bag or result file, a side file nowhere to be
+            found or unreadable.
+        SegmentationError: the benchmark never started in the log.
+        TopicError, BagError: an unreadable bag.
     """
     if len(logs) != 1:
         raise UsageError(
@@ -83,12 +85,12 @@ def load(logs: Sequence[Path], options: HpffOptions) -> HpffLogs:
         source = f"{result.path} (benchmark_info.params)"
         params = _params(result.params, source)
     else:
-        raise UsageError(
+        raise ConfigError(
             "no HPFF.yaml beside the bag or in the RSBB layout, and no result file with the "
             "params: give --config HPFF.yaml or --result result_run_<n>_<date>.yaml"
         )
     if run.t_start_ns is None:
-        raise UsageError(f"{bag}: the benchmark never started (no EXECUTING_BENCHMARK)")
+        raise SegmentationError(f"{bag}: the benchmark never started (no EXECUTING_BENCHMARK)")
     tracks = read_tf_tracks(bag)
     log_end = max(t.last_ns for t in summary(bag).topics if t.last_ns is not None)
     return HpffLogs(

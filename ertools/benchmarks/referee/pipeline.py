@@ -84,7 +84,7 @@ def _where(bag: Path, options: RefereeOptions) -> tuple[str | None, int | None]:
     team, run = options.team, options.run
     if found is not None and found.kind is FileKind.RUN_BAG:
         if found.code != options.code:
-            raise UsageError(
+            raise ConfigError(
                 f"{bag} is a {found.code} run (its RSBB folder says so), not {options.code}: "
                 f"score it with `ertools score {str(found.code).lower()}`"
             )
@@ -113,7 +113,8 @@ def load(bags: Sequence[Path], options: RefereeOptions) -> RefereeLogs:
     """Read the run.
 
     Raises:
-        UsageError: more than one bag, or a bag of another benchmark.
+        UsageError: more than one bag.
+        ConfigError: a bag of another benchmark (exit 1: the file, not the command line).
         TopicError: no items anywhere (no result file's ``referee_score``, no GUI messages).
         ConfigError: an unreadable result or description file.
     """

@@ -45,6 +45,10 @@ def pick_robot_topic(s: BagSummary, topic: str | None) -> str:
     ]
     if len(cands) == 1:
         return cands[0]
+    if not s.topics and s.problems:
+        # a damaged file (cut short: its topics are in the lost index) is said for what it
+        # is, not as a log without a pose topic
+        raise BagError(f"{'; '.join(s.problems)}; re-copy the file", path=s.path)
     raise TopicError(
         f"{s.path}: give --robot-topic (found {len(cands)} /rockin/*/marker_pose topics; "
         f"pose topics there: {', '.join(_pose_topics(s)) or 'none'})"

@@ -211,7 +211,8 @@ def test_missing_side_files_and_wrong_bags(tmp_path: Path) -> None:
     flat.mkdir()
     lone = _bag(flat)
     (flat / "rsbb_etc" / "transforms" / "transform-homer.yaml").unlink()
-    with pytest.raises(UsageError, match=r"no transform-homer\.yaml"):
+    # a file missing or another benchmark's: exit 1 (ConfigError), not a usage error
+    with pytest.raises(ConfigError, match=r"no transform-homer\.yaml"):
         load([lone], declare.make_options({}))
     other = tmp_path / "rsbb_logs" / "HPFF" / "homer" / lone.name
     other.parent.mkdir(parents=True)

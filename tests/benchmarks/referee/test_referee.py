@@ -159,7 +159,7 @@ def test_bad_input_is_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str
     bag = write_task_run(tmp_path, _task())
     code, _, err = _score(capsys, "hwv", str(bag))  # an HGTKMH run given to hwv
     (line,) = error_messages(err)
-    assert code == 2 and "is a HGTKMH run" in line and "Traceback" not in err
+    assert code == 1 and "is a HGTKMH run" in line and "Traceback" not in err
     bare = tmp_path / "elsewhere.bag"
     bare.write_bytes(bag.read_bytes())
     code, _, err = _score(capsys, "hwv", str(bare))  # no HWV zone in its GUI messages
