@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
-from ertools.errors import ConfigError
+from ertools.errors import ConfigError, UsageError
 from ertools.rsbb.log import RsbbRun, check_code, read_rsbb_run
 from ertools.rsbb.results import RsbbResult, load_result
 from ertools.rsbb.sidefiles import SideFiles, find_side_files
@@ -118,3 +118,16 @@ def open_run(
     run = read_rsbb_run(paths)
     check_code(run, code)  # outside the layout, the live score names the benchmark
     return OpenedRun(paths, side, result_file, run, owner, path)
+
+
+def one_run_bag(logs: Sequence[Path], code: str) -> Path:
+    """The one run bag a script benchmark scores.
+
+    Raises:
+        UsageError: none or several were given.
+    """
+    if len(logs) != 1:
+        raise UsageError(
+            f"give one {code} run bag (rsbb_logs/{code}/<team>/run_<n>_<date>.bag), not {len(logs)}"
+        )
+    return Path(logs[0])

@@ -22,10 +22,10 @@ from ertools.benchmarks.hgmf.formula import first_rise, planar_distance
 from ertools.benchmarks.hgmf.intervals import hgmf_intervals
 from ertools.benchmarks.hgmf.listing import score_listing
 from ertools.benchmarks.hgmf.result import HgmfGoal, HgmfResult, deviations_of
-from ertools.errors import ConfigError, SegmentationError, UsageError
+from ertools.errors import ConfigError, SegmentationError
 from ertools.io.summary import summary
 from ertools.rsbb.log import RsbbRun
-from ertools.rsbb.opened import open_run
+from ertools.rsbb.opened import one_run_bag, open_run
 from ertools.rsbb.results import RsbbResult
 from ertools.rsbb.score import compare_scores
 from ertools.rsbb.sidefiles import read_side_yaml
@@ -110,11 +110,7 @@ def load(logs: Sequence[Path], options: HgmfOptions) -> HgmfLogs:
         SegmentationError: the benchmark never started in the log.
         TopicError, BagError: an unreadable bag.
     """
-    if len(logs) != 1:
-        raise UsageError(
-            f"give one HGMF run bag (rsbb_logs/HGMF/<team>/run_<n>_<date>.bag), not {len(logs)}"
-        )
-    bag = Path(logs[0])
+    bag = one_run_bag(logs, CODE)
     opened = open_run([bag], CODE, options, want=("config", "result"), say=notice)
     run, result = opened.run, opened.result_file
     objects, config_source = _config(options, opened.side.config, result)

@@ -26,10 +26,10 @@ from ertools.benchmarks.hpff.result import (
     deviations_of,
     nan_xy,
 )
-from ertools.errors import ConfigError, SegmentationError, UsageError
+from ertools.errors import ConfigError, SegmentationError
 from ertools.io.summary import summary
 from ertools.rsbb.log import EndKind
-from ertools.rsbb.opened import open_run
+from ertools.rsbb.opened import one_run_bag, open_run
 from ertools.rsbb.py2 import to_sec
 from ertools.rsbb.score import compare_scores
 from ertools.rsbb.sidefiles import read_side_yaml, script_transform
@@ -59,20 +59,17 @@ def _params(data: Any, where: str) -> dict[str, Any]:
 
 
 def load(logs: Sequence[Path], options: HpffOptions) -> HpffLogs:
-    """Read the run bag and its side files (found ones named on stderr).
+    """Read the run bag, the following parameters (HPFF.yaml, else the result file's params)
+    and the team transform; the side files found are named on stderr.
 
     Raises:
         UsageError: not one bag.
-        ConfigError: another benchmark's bag or result file, a side file nowhere to be
-            found or unreadable.
+        ConfigError: another benchmark's bag or result file; no parameters or transform
+            found, or one unreadable.
         SegmentationError: the benchmark never started in the log.
         TopicError, BagError: an unreadable bag.
     """
-    if len(logs) != 1:
-        raise UsageError(
-            f"give one HPFF run bag (rsbb_logs/HPFF/<team>/run_<n>_<date>.bag), not {len(logs)}"
-        )
-    bag = Path(logs[0])
+    bag = one_run_bag(logs, CODE)
     opened = open_run([bag], CODE, options, want=("config", "transform", "result"), say=notice)
     run, result, team = opened.run, opened.result_file, opened.team
     transform_path = opened.transform_file()
