@@ -12,6 +12,7 @@ field decoder (:mod:`ertools.io.decode.fast`) for the rest.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Sequence
 
 import numpy as np
@@ -67,6 +68,9 @@ class Assembler:
         self.filled = np.zeros(n if self.tf else 0, dtype=bool)
         self.frames: dict[str, int] = {"": 0}
         self.parts: list[tuple[I64, PoseBatch]] = []
+        # Two runs of one read may be written at once (a lone request on two lanes): their
+        # rows go to places of their own, the frame codes and parts they share under a lock.
+        self.lock = threading.Lock()
 
     @property
     def direct(self) -> bool:
@@ -98,7 +102,8 @@ class Assembler:
         if not self.direct:
             tmp = empty_rows(len(pos))
             write_rows(rows, skip, lay, tmp)
-            self.parts.append((pos, to_batch(rows, decoded(lay, tmp), t_record)))
+            with self.lock:
+                self.parts.append((pos, to_batch(rows, decoded(lay, tmp), t_record)))
             return
         at = self.at(pos, consecutive)
         if isinstance(at, slice) and not self.headless:
@@ -117,7 +122,8 @@ class Assembler:
             self.t_record[at] = t_record
         if lay.stamp is None and not self.headless:
             self.t_header[at] = t_record  # no header: timed by record time, as in to_batch
-        self._codes(at, self.code(lay.frame), self.code(lay.child))
+        with self.lock:
+            self._codes(at, self.code(lay.frame), self.code(lay.child))
         if self.tf:
             self.filled[at] = True
 
@@ -148,9 +154,11 @@ class Assembler:
         if not len(pos):
             return
         if not self.direct or not one_each:
-            self.parts.append((pos, batch))
+            with self.lock:
+                self.parts.append((pos, batch))
             return
-        remap = np.array([self.code(f) for f in batch.frames], np.int32)
+        with self.lock:
+            remap = np.array([self.code(f) for f in batch.frames], np.int32)
         at = self.at(pos)
         if not self.times_known:
             self.t_record[at] = batch.t_record
@@ -158,7 +166,8 @@ class Assembler:
             self.t_header[at] = batch.t_header
         self.xyz[at] = batch.xyz
         self.quat[at] = batch.quat_xyzw
-        self._codes(at, remap[batch.frame_idx], remap[batch.child_idx])
+        with self.lock:
+            self._codes(at, remap[batch.frame_idx], remap[batch.child_idx])
         if self.tf:
             self.filled[at] = True
 

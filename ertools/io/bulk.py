@@ -29,7 +29,6 @@ from ertools.io.decode.fast import (
     is_state_definition,
 )
 from ertools.io.decode.posebatch import PoseBatch
-from ertools.io.mcap.index import McapIndex
 from ertools.io.model import Conn
 from ertools.io.pipeline import (
     Group,
@@ -47,6 +46,7 @@ from ertools.progress import current
 if TYPE_CHECKING:
     # the readers call this module: their classes are annotations here, never imported
     from ertools.io.files import McapFile
+    from ertools.io.mcap.index import McapIndex
     from ertools.io.ros1.index import Ros1Bag
     from ertools.progress import Reporter
 
@@ -56,6 +56,10 @@ log = logging.getLogger("ertools.io.bulk")
 def mcap_index(bag: BagFile) -> McapIndex | None:
     """The MCAP index of a standalone MCAP file or of a rosbag2-mcap directory's storage
     files (decompressed when the bag is compressed file by file), None for other formats."""
+    if bag.format not in ("mcap", "rosbag2-mcap"):
+        return None
+    from ertools.io.mcap.index import McapIndex  # lazy: 5 ms, MCAP files only
+
     if bag.format == "rosbag2-mcap":
         return McapIndex([f for f in readable_files(bag.path) if f.suffix == ".mcap"])
     return McapIndex.of(bag)
@@ -239,8 +243,11 @@ def try_fast_batches(bag: BagFile, requests: Sequence[Request]) -> list[PoseBatc
     mine = [i for i, k in enumerate(kinds) if k is not None]
     if not mine:
         return out
+    # a lone request's runs are decoded on two lanes where their rows have fixed places
+    split = bag.format in ("ros1", "mcap")
     try:
-        found = locate_many(bag, [requests[i] for i in mine], hold=pipeline.lanes_for(len(mine)))
+        hold = pipeline.lanes_for(len(mine), split)
+        found = locate_many(bag, [requests[i] for i in mine], hold=hold)
     except LayoutMismatchError as err:
         log.info("%s: not read in bulk (%s); decoding per message", bag.path, err)
         return out
@@ -274,7 +281,8 @@ def try_fast_batches(bag: BagFile, requests: Sequence[Request]) -> list[PoseBatc
 
     # the requests side by side, each on a thread of its own (NumPy releases the GIL)
     try:
-        pipeline.decoded_in_lanes(found.runs, decode_run, len(mine))
+        split = split and all(a.direct for a in assemblers)
+        pipeline.decoded_in_lanes(found.runs, decode_run, len(mine), split)
     except LayoutMismatchError as err:
         log.info("%s: not read in bulk (%s); decoding per message", bag.path, err)
         return out

@@ -26,9 +26,6 @@ from ertools.io.bagfile import BagFile, RawRecord
 from ertools.io.decode.fast import LayoutMismatchError
 from ertools.io.formats import detect_format
 from ertools.io.inflate import inflate_message
-from ertools.io.mcap.index import McapIndex
-from ertools.io.mcap.scan import SCAN, mcap_layout, scan_mcap
-from ertools.io.mcap.summary import mcap_errors
 from ertools.io.model import Conn, short_msgtype
 from ertools.io.ros1.index import Ros1Bag
 from ertools.io.rosbag2.metadata import (
@@ -163,6 +160,9 @@ class McapFile(BagFile):
     """
 
     def __init__(self, path: Path) -> None:
+        from ertools.io.mcap.scan import SCAN, mcap_layout  # lazy: 5 ms, MCAP files only
+        from ertools.io.mcap.summary import mcap_errors  # lazy: 5 ms, MCAP files only
+
         self.path = path
         self.format = "mcap"
         self.unfinished = False
@@ -183,6 +183,8 @@ class McapFile(BagFile):
 
     def _scan(self, why: str) -> tuple[Conn, ...]:
         """Read every complete record (the summary's indexes do not answer for them all)."""
+        from ertools.io.mcap.scan import scan_mcap  # lazy: 5 ms, MCAP files only
+
         self.scanned = True
         log.info("%s: %s; reading the file record by record", self.path, why)
         found = scan_mcap(self.path)
@@ -213,6 +215,8 @@ class McapFile(BagFile):
         """The messages of ``conns`` in [start_ns, end_ns] of a file read record by record, as
         runs of (reference positions, bytes, data starts, data lengths, log times, channel
         ids): one more pass over the records that copies only these messages' bytes."""
+        from ertools.io.mcap.scan import scan_mcap  # lazy: 5 ms, MCAP files only
+
         found = scan_mcap(self.path, keep=frozenset(c.id for c in conns))
         if not found.payloads:
             return
@@ -264,6 +268,8 @@ class McapFile(BagFile):
                 a = int(start[i])
                 yield by_id[int(cid[i])], int(t[i]), buf[a : a + int(length[i])].tobytes()
             return
+        from ertools.io.mcap.index import McapIndex  # lazy: 5 ms, MCAP files only
+
         try:
             found = McapIndex([self.path], by_id=True).messages(conns, start_ns, end_ns)
         except LayoutMismatchError as err:

@@ -20,8 +20,6 @@ from typing import Any
 from ertools.errors import BagError, shown
 from ertools.inputs import kind_of, open_regular, read_regular, why_not
 from ertools.io import budget
-from ertools.yamlin import DuplicateKeyError, YAMLError
-from ertools.yamlin import load as load_yaml
 
 ROS1_MAGIC = b"#ROSBAG V2.0\n"
 MCAP_MAGIC = b"\x89MCAP0\r\n"
@@ -223,6 +221,8 @@ def bag_paths(paths: str | Path | list[str | Path] | tuple[str | Path, ...]) -> 
 def metadata_problem(err: Exception) -> str:
     """What is wrong with a ``metadata.yaml``, on one line and without its text: PyYAML's own
     message quotes the offending line, and the file may be anything (a symlink to a secret)."""
+    from ertools.yamlin import DuplicateKeyError  # lazy: PyYAML 10-20 ms, rosbag2 only
+
     mark = getattr(err, "problem_mark", None)
     if isinstance(err, DuplicateKeyError) and mark is not None:
         return f"a key given twice, at line {mark.line + 1}"  # its name is the file's text
@@ -236,6 +236,14 @@ def metadata_problem(err: Exception) -> str:
     return type(err).__name__
 
 
+def metadata_errors() -> tuple[type[Exception], ...]:
+    """What :func:`load_metadata` raises for a text that does not parse, and a metadata without
+    its keys (an ``except`` clause's: PyYAML is imported only when one is raised)."""
+    from ertools.yamlin import YAMLError  # lazy: PyYAML 10-20 ms, rosbag2 only
+
+    return (YAMLError, KeyError, TypeError, UnicodeDecodeError)
+
+
 def load_metadata(path: Path) -> Any:
     """The parsed ``metadata.yaml`` of the rosbag2 folder ``path``, read as any input is
     (a regular file, within :data:`~ertools.io.budget.MAX_METADATA_BYTES` and
@@ -247,6 +255,8 @@ def load_metadata(path: Path) -> Any:
         yaml.YAMLError, UnicodeDecodeError: it does not parse.
     """
     import yaml  # lazy: PyYAML (~25 ms) only for a rosbag2 folder's metadata.yaml
+
+    from ertools.yamlin import load as load_yaml  # lazy: PyYAML 10-20 ms, rosbag2 only
 
     meta = path / "metadata.yaml"
     raw = read_regular(meta, budget.MAX_METADATA_BYTES)
@@ -291,7 +301,7 @@ def _rosbag2_storage(path: Path) -> str:
             storage = str(data["rosbag2_bagfile_information"]["storage_identifier"])
         except OSError as err:
             raise BagError(f"unreadable metadata.yaml ({why_not(err)})", path=path) from err
-        except (YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
+        except metadata_errors() as err:
             why = metadata_problem(err)
             raise BagError(
                 f"unreadable rosbag2 metadata.yaml ({why}); re-create it with `ros2 bag reindex`",

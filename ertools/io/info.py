@@ -23,7 +23,8 @@ from ertools.io.mcap.index import verify_mcap
 from ertools.io.model import BagSummary
 from ertools.io.ros1.check import check_ros1
 from ertools.io.ros1.index import Ros1Bag
-from ertools.io.rosbag2.metadata import query, readable_files
+from ertools.io.rosbag2.metadata import readable_files
+from ertools.io.rosbag2.sqlite_storage import query
 from ertools.io.summary import CHUNK_SELF_CHECK, INDEX_SELF_CHECK, summary_and_times
 from ertools.timeutil import iso_utc, ns_to_s
 

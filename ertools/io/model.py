@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # annotations only: options hold a PoseSource, and parsers build options
     from ertools.streams import StateStream
@@ -21,12 +21,6 @@ POSE_TYPES = (
     "tf2_msgs/TFMessage",
 )
 TF_TYPES = ("tf/tfMessage", "tf2_msgs/TFMessage")
-
-# Text trajectories ertools reads (:mod:`ertools.io.text`).
-TextFormat = Literal["tum", "kitti", "euroc", "csv"]
-TEXT_FORMATS: tuple[TextFormat, ...] = ("tum", "kitti", "euroc", "csv")
-# ``--input-format``: a text layout, or ``bag`` (ROS1, rosbag2, MCAP) to skip the sniffing.
-INPUT_FORMATS: tuple[str, ...] = (*TEXT_FORMATS, "bag")
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 import numpy as np
 
 from ertools.arrays import HUGE_PAGE, I64, U8, Bool, fresh
+from ertools.io import mapguard
 from ertools.io.model import Conn
 
 if TYPE_CHECKING:
@@ -97,14 +98,17 @@ def prefetched(
 LANE_HOLD = 1
 
 
-def lanes_for(count: int) -> int:
+def lanes_for(count: int, split: bool = False) -> int:
     """The ``hold`` a read of ``count`` requests passes to its loads: :data:`LANE_HOLD` when
     :func:`decoded_in_lanes` runs them on lanes, else 0."""
-    return LANE_HOLD if count > 1 and workers() > 1 else 0
+    return LANE_HOLD if (count > 1 or (split and count == 1)) and workers() > 1 else 0
 
 
 def decoded_in_lanes(
-    groups: Iterable[Sequence[T | None]], decode: Callable[[int, T], None], count: int
+    groups: Iterable[Sequence[T | None]],
+    decode: Callable[[int, T], None],
+    count: int,
+    split: bool = False,
 ) -> None:
     """``decode(i, item)`` for every item of every group, item i (request i's run) of each
     group on lane i: a thread of its own that takes request i's runs in group order. The
@@ -114,24 +118,29 @@ def decoded_in_lanes(
     :data:`LANE_HOLD` + 1 before it is decoded (its buffer is reused then: ``groups`` comes
     from loads made with ``hold`` = :func:`lanes_for`).
 
+    With ``split`` (``decode`` may run on two groups of one request at once: its rows go to
+    places of their own), a lone request's groups alternate between two lanes, so one source
+    is decoded on two cores too.
+
     The error raised is the one a single thread decoding the groups in turn, items in request
     order, meets first (a load's error comes after the decoding errors of the groups before
     it); no group after it is asked for.
     """
-    if lanes_for(count) == 0:
+    if lanes_for(count, split) == 0:
         for group in groups:
             for i, item in enumerate(group):
                 if item is not None:
                     decode(i, item)
         return
+    lanes = count if count > 1 else 2
     cond = threading.Condition()
     outstanding: Counter[int] = Counter()
     errors: list[tuple[int, int, Exception]] = []
-    queues: list[SimpleQueue[tuple[int, T] | None]] = [SimpleQueue() for _ in range(count)]
+    queues: list[SimpleQueue[tuple[int, int, T] | None]] = [SimpleQueue() for _ in range(lanes)]
 
-    def lane(i: int) -> None:
-        while (got := queues[i].get()) is not None:
-            k, item = got
+    def lane(n: int) -> None:
+        while (got := queues[n].get()) is not None:
+            k, i, item = got
             try:
                 with cond:
                     after = any(e[0] < k for e in errors)  # one thread had stopped before
@@ -141,13 +150,16 @@ def decoded_in_lanes(
                 with cond:
                     errors.append((k, i, err))
             finally:
+                # the run is let go before waiting for the next: its buffer (a map) can then
+                # be closed when its slot is reused
+                del got, item
                 with cond:
                     outstanding[k] -= 1
                     cond.notify_all()
 
     threads = [
-        threading.Thread(target=lane, args=(i,), daemon=True, name=f"ertools-lane-{i}")
-        for i in range(count)
+        threading.Thread(target=lane, args=(n,), daemon=True, name=f"ertools-lane-{n}")
+        for n in range(lanes)
     ]
     for thread in threads:
         thread.start()
@@ -158,7 +170,7 @@ def decoded_in_lanes(
                 if item is not None:
                     with cond:
                         outstanding[k] += 1
-                    queues[i].put((k, item))
+                    queues[i if count > 1 else k % lanes].put((k, i, item))
             k += 1
             reused = k - 1 - LANE_HOLD  # the group whose buffer the next load reuses
             with cond:
@@ -195,16 +207,19 @@ def scratch_view(scratch: list[Any], size: int) -> memoryview:
     return memoryview(scratch[0])[:size]
 
 
-def keep(scratch: list[Any], mapping: mmap.mmap) -> None:
-    """Hold ``mapping`` in the slot until the slot is reused."""
+def keep(scratch: list[Any], mapping: mmap.mmap, path: object) -> None:
+    """Hold ``mapping`` (of ``path``) in the slot until the slot is reused; while it is
+    held, the file cut short ends the process in one error line (:mod:`mapguard`)."""
     release(scratch)
     if not scratch:
         scratch.append(np.empty(0, np.uint8))
+    mapguard.watch(mapping, path)
     scratch.append(mapping)
 
 
 def release(scratch: list[Any]) -> None:
     for old in scratch[1:]:
+        mapguard.unwatch(old)
         with contextlib.suppress(BufferError):  # a view still alive keeps it until collected
             old.close()
     del scratch[1:]

@@ -31,13 +31,10 @@ from ertools.errors import BagError
 from ertools.inputs import open_regular
 from ertools.io.decode.fast import LayoutMismatchError, gather
 from ertools.io.formats import detect_format
-from ertools.io.mcap.index import McapIndex
-from ertools.io.mcap.scan import SCAN, mcap_layout, scan_mcap
-from ertools.io.mcap.summary import mcap_errors
 from ertools.io.model import BagSummary, TopicSummary, short_msgtype
 from ertools.io.ros1.index import Ros1Bag
 from ertools.io.ros1.layout import read_layout
-from ertools.io.rosbag2.metadata import query, read_metadata, readable_files, storage_files
+from ertools.io.rosbag2.metadata import read_metadata, readable_files, storage_files
 
 log = logging.getLogger("ertools.io.summary")
 
@@ -238,6 +235,8 @@ def _mcap_scanned(
     """Topics of an MCAP file read record by record (chunks decompressed): the path for
     layouts the summary cannot answer for alone, exact for all of them."""
 
+    from ertools.io.mcap.scan import scan_mcap  # lazy: 5 ms, MCAP files only
+
     log.info("%s: %s; reading the file record by record", path, why)
     found = scan_mcap(path)
     problems = [found.problem] if found.problem else []
@@ -268,6 +267,8 @@ def _mcap_indexed(
 ) -> tuple[dict[str, tuple[str, int, int | None, int | None, int]], set[str], list[str], str]:
     """Topics from the summary: counts from the statistics, or from the message indexes when
     ``exact`` or when the summary has no statistics (then every message is counted)."""
+
+    from ertools.io.mcap.index import McapIndex  # lazy: 5 ms, MCAP files only
 
     summary = layout.summary
     spans: dict[int, list[int]] = {}
@@ -351,6 +352,7 @@ def _check_ends(
     Raises:
         BagError: an index entry and its record disagree.
     """
+    from ertools.io.mcap.index import McapIndex  # lazy: 5 ms, MCAP files only
 
     chunks: dict[int, np.ndarray] = {}
     with open_regular(path) as f:
@@ -390,6 +392,7 @@ def _mcap_file(
 ) -> tuple[dict[str, tuple[str, int, int | None, int | None, int]], set[str], list[str], str]:
     """(topics, chunk compressions, problems, index used) of one MCAP file, through its
     indexes where they answer for every message, else record by record."""
+    from ertools.io.mcap.scan import SCAN, mcap_layout  # lazy: 5 ms, MCAP files only
 
     layout = mcap_layout(path)
     if layout.index != SCAN:
@@ -411,6 +414,8 @@ def _mcap_file(
 
 def _mcap_version(path: Path) -> str:
     from mcap.reader import make_reader  # lazy: mcap, 90 ms
+
+    from ertools.io.mcap.summary import mcap_errors  # lazy: 5 ms, MCAP files only
 
     try:
         with open_regular(path) as f:
@@ -475,6 +480,8 @@ def _rosbag2(path: Path, fmt: str, exact: bool, times: Times | None = None) -> B
 
 
 def _sqlite_spans(files: list[Path]) -> dict[str, tuple[int, int]]:
+    from ertools.io.rosbag2.sqlite_storage import query  # lazy: sqlite3 1.5 ms, .db3 only
+
     out: dict[str, tuple[int, int]] = {}
     for db in files:
         rows = query(
@@ -547,6 +554,8 @@ def record_times(path: str | Path) -> dict[str, I64]:
         for file in [p] if fmt == "mcap" else _mcap_files(p):
             _mcap_file(file, True, parts)
     else:
+        from ertools.io.rosbag2.sqlite_storage import query  # lazy: sqlite3 1.5 ms, .db3 only
+
         for db in readable_files(p):
             rows = query(
                 db,

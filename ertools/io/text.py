@@ -32,7 +32,7 @@ import numpy.typing as npt
 from ertools.arrays import F64, I64
 from ertools.errors import BagError
 from ertools.inputs import open_regular, read_regular_text, why_not
-from ertools.io.model import TEXT_FORMATS, TextFormat
+from ertools.io.names import TEXT_FORMATS, TextFormat
 from ertools.streams import PoseStream
 
 CSV_HEADER = "t_ns,t_s,x,y,z,qx,qy,qz,qw,frame_id"

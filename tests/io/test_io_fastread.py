@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import itertools
 import struct
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -19,7 +20,7 @@ from hypothesis import strategies as st
 from mcap.writer import CompressionType
 
 from ertools.errors import BagError, TopicError
-from ertools.io import assemble, bulk, reader
+from ertools.io import assemble, bulk, pipeline, reader
 from ertools.io.decode.posebatch import PoseBatch
 from ertools.io.files import open_bag
 from ertools.io.model import POSE_TYPES, PoseSource
@@ -163,13 +164,18 @@ def test_windowed_reads_stay_windowed(
     """A read of two topics with two windows loads only chunks that overlap one of them."""
     path = write(tmp_path / "w.bag", "ros1", scene.spec, chunk_bytes=1500)
     loaded: list[int] = []
-    real = ros1_runs.chunk_group
+    copied, mapped = ros1_runs.chunk_group, ros1_runs.populated_group
 
     def spy(bag: Any, chunks: list[Any], scratch: list[Any]) -> Any:
         loaded.extend(c.pos for c in chunks)
-        return real(bag, chunks, scratch)
+        return copied(bag, chunks, scratch)
+
+    def spy_map(bag: Any, chunks: list[Any], scratch: list[Any]) -> Any:
+        loaded.extend(c.pos for c in chunks)
+        return mapped(bag, chunks, scratch)
 
     monkeypatch.setattr(ros1_runs, "chunk_group", spy)
+    monkeypatch.setattr(ros1_runs, "populated_group", spy_map)
     t = scene.t_rec
     windows: list[tuple[int | None, int | None]] = [
         (int(t[5]), int(t[9])),
@@ -325,7 +331,7 @@ def test_state_topics_in_one_pass_equal_one_at_a_time(
 # the general path refuses fails with its own message
 
 
-def _plain_bag(tmp_path: Path, n: int = 40) -> Path:
+def _plain_bag(tmp_path: Path, n: int = 40, chunk_bytes: int = 100_000) -> Path:
     s = Spec()
     pose = s.conn("/p", "geometry_msgs/PoseStamped")
     other = s.conn("/q", "geometry_msgs/PoseStamped")
@@ -333,7 +339,7 @@ def _plain_bag(tmp_path: Path, n: int = 40) -> Path:
         t = T0 + i * DT
         s.add(pose, t, stamp=t, frame="world", xyz=(i, 0, 0), q=(0, 0, 0, 1))
         s.add(other, t + 1, stamp=t, frame="map", xyz=(0, i, 0), q=(0, 0, 0, 1))
-    return write(tmp_path / "plain.bag", "ros1", s, chunk_bytes=100_000)
+    return write(tmp_path / "plain.bag", "ros1", s, chunk_bytes=chunk_bytes)
 
 
 def _record_time_fields(data: bytes) -> Iterator[int]:
@@ -385,6 +391,54 @@ def test_errors_of_requests_decoded_side_by_side_come_in_request_order(tmp_path:
         with pytest.raises(BagError) as together:
             reader.read_pose_sources(path, sources)
         assert str(together.value) == errors[first]
+
+
+@pytest.mark.parametrize("fmt", ["ros1", "mcap-cdr"])
+def test_a_lone_request_decoded_on_two_lanes_equals_rosbags(
+    tmp_path: Path, scene: Scene, monkeypatch: pytest.MonkeyPatch, fmt: str
+) -> None:
+    """One source of a read has its groups decoded on two lanes at once (their rows written
+    into one result side by side): the same rows as rosbags, /tf's two publishers too."""
+    path = write(bag_name(tmp_path, fmt, "s"), fmt, scene.spec, chunk_bytes=1500)
+    threads: set[str] = set()
+    real = assemble.Decoder.run
+
+    def spy(self: assemble.Decoder, run: Any) -> None:
+        threads.add(threading.current_thread().name)
+        real(self, run)
+
+    monkeypatch.setattr(assemble.Decoder, "run", spy)
+    monkeypatch.setattr(pipeline, "GROUP_BYTES", 3000)
+    monkeypatch.setattr(pipeline, "workers", lambda: 2)
+    for topic in ("/fbm3w/robot_at_work/pose", "/fbm3w/robot_at_work/pose2d", "/tf"):
+        threads.clear()
+        (batch,) = fast_many(path, [topic])
+        assert_same(batch, reference_batch(path, topic))
+        assert threads == {"ertools-lane-0", "ertools-lane-1"}
+
+
+def test_a_lone_request_on_two_lanes_raises_the_first_error(tmp_path: Path) -> None:
+    """Two damaged records of one topic in different groups, decoded on two lanes: the error
+    raised is the earlier group's, as one thread decoding the groups in turn raises it."""
+    path = _plain_bag(tmp_path, n=400, chunk_bytes=2000)
+    data = bytearray(path.read_bytes())
+    fields = list(_record_time_fields(bytes(data)))
+    at_early, at_late = fields[300], fields[700]  # /p records in different groups
+    data[at_early + 8 : at_early + 12] = struct.pack("<I", 1 << 20)
+    data[at_late : at_late + 4] = struct.pack("<I", 12345)
+    path.write_bytes(bytes(data))
+    mp = pytest.MonkeyPatch()
+    errors = []
+    try:
+        mp.setattr(pipeline, "GROUP_BYTES", 4000)
+        for cores in (1, 2):
+            mp.setattr(pipeline, "workers", lambda cores=cores: cores)
+            with pytest.raises(BagError) as err:
+                reader.read_poses(path, "/p")
+            errors.append(str(err.value))
+    finally:
+        mp.undo()
+    assert errors[0] == errors[1]
 
 
 # --- property tests

@@ -348,7 +348,7 @@ def test_a_reused_slot_releases_its_map(tmp_path: Path) -> None:
     with path.open("rb") as f:
         mm = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)
     slot: list[object] = []
-    pipeline.keep(slot, mm)
+    pipeline.keep(slot, mm, path)
     assert slot[1] is mm and not mm.closed
     pipeline.scratch_view(slot, 10)  # the slot is reused for a plain read
     assert mm.closed and len(slot) == 1

@@ -24,6 +24,7 @@ from ertools.cli.main import main
 from ertools.io.reader import read_poses
 from ertools.io.ros1 import layout
 from ertools.io.ros1.check import check_ros1, rebuild_layout
+from ertools.io.ros1.entries import kept
 from ertools.io.ros1.layout import scan_layout
 from ertools.io.summary import summary as bag_summary
 from tests.helpers.bagmaker import Spec, write
@@ -394,3 +395,20 @@ def test_a_scan_is_made_once_per_file_version(
     # an indexed bag is read from its index, never kept
     sound = two_topic_bag(tmp_path / "sound.bag")
     assert layout.read_layout(sound).indexed and len(scans) == 3
+
+
+def test_a_window_keeps_a_slice_where_it_keeps_one_stretch() -> None:
+    """What a window keeps of a connection's entries indexes them as its mask does: None
+    for all, a slice for one stretch (views, no copies), the mask otherwise."""
+    rng = np.random.default_rng(39)
+    values = np.arange(50) * 7
+    masks = [np.ones(50, bool), np.zeros(50, bool), np.arange(50) >= 20, np.arange(50) < 3]
+    masks += [(np.arange(50) >= a) & (np.arange(50) < b) for a, b in ((5, 6), (10, 40))]
+    masks += [rng.random(50) < p for p in (0.1, 0.5, 0.9)]
+    for mask in masks:
+        got = kept(mask)
+        assert np.array_equal(values if got is None else values[got], values[mask])
+        stretch = np.flatnonzero(mask)
+        one = not len(stretch) or bool(stretch[-1] - stretch[0] == len(stretch) - 1)
+        assert isinstance(got, slice) is (one and not bool(mask.all()))
+    assert kept(None) is None

@@ -27,7 +27,7 @@ from ertools.arrays import I64, U8
 from ertools.caches import register
 from ertools.errors import BagError
 from ertools.inputs import open_regular
-from ertools.io import budget
+from ertools.io import budget, mapguard
 from ertools.io.decode.fast import read_at
 from ertools.io.inflate import Allowance
 from ertools.io.mcap.crc import crc32
@@ -344,11 +344,13 @@ def scan_mcap(
         if size < len(MAGIC):
             raise BagError("truncated: the file ends inside its magic", path=path)
         mm = mmap.mmap(f.fileno(), size, access=mmap.ACCESS_READ)
+        mapguard.watch(mm, path)
     try:
         found = _scan(np.frombuffer(mm, dtype=np.uint8), path, keep, check_crc)
     finally:
         # everything handed out is a copy; a view still alive (an exception's frames) keeps
         # the map until it goes
+        mapguard.unwatch(mm)
         with contextlib.suppress(BufferError):
             mm.close()
     summary = mcap_layout(path).summary

@@ -138,6 +138,19 @@ def connection_entries(
     return entries, None
 
 
+def kept(mask: npt.NDArray[np.bool_] | None) -> slice | npt.NDArray[np.bool_] | None:
+    """What a window keeps of a connection's entries: None (all of them), a slice (one
+    stretch, as a window over time-ordered entries keeps: views, no copies), or the mask."""
+    if mask is None:
+        return None
+    where = np.flatnonzero(mask)
+    if len(where) == len(mask):
+        return None
+    if not len(where) or int(where[-1]) - int(where[0]) == len(where) - 1:
+        return slice(int(where[0]), int(where[-1]) + 1) if len(where) else slice(0, 0)
+    return mask
+
+
 def ordered(request: Request, entries: Entries) -> Selection:
     """One request's messages, in rosbags' order, from every wanted connection's entries."""
     rank = {c.id: i for i, c in enumerate(request.conns)}
@@ -150,7 +163,7 @@ def ordered(request: Request, entries: Entries) -> Selection:
         if cid not in entries:
             continue
         t, off, c, words = entries[cid]
-        keep = in_window(t, request.lo, request.hi)
+        keep = kept(in_window(t, request.lo, request.hi))
         if keep is not None:
             t, off, c = t[keep], off[keep], c[keep]
             words = None if words is None else words[keep]

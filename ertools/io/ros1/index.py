@@ -23,13 +23,12 @@ import numpy.typing as npt
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
 from ertools.inputs import open_regular
-from ertools.io import budget
+from ertools.io import budget, mapguard
 from ertools.io.bagfile import BagFile, RawRecord
 from ertools.io.decode.fast import LayoutMismatchError, gather, read_at
 from ertools.io.inflate import Allowance
 from ertools.io.model import Conn
 from ertools.io.pipeline import Request, window
-from ertools.io.ros1.check import rebuild_layout
 from ertools.io.ros1.entries import Ints, Selection, connection_entries, ordered
 from ertools.io.ros1.layout import (
     INDEX_DTYPE,
@@ -129,6 +128,7 @@ class Ros1Bag(BagFile):
         if self._mm is not None:
             # Only bytes copies leave the mapping; should a view be alive, it stays mapped
             # until that view is collected.
+            mapguard.unwatch(self._mm)
             with contextlib.suppress(BufferError):
                 self._mm.close()
             self._mm = None
@@ -187,6 +187,7 @@ class Ros1Bag(BagFile):
         system call per record (only the pages touched are read)."""
         if self._mm is None:
             self._mm = mmap.mmap(self.file.fileno(), 0, access=mmap.ACCESS_READ)
+            mapguard.watch(self._mm, self.path)
         return self._mm
 
     def _index_data(
@@ -347,6 +348,8 @@ class Ros1Bag(BagFile):
             self.path,
             why,
         )
+        from ertools.io.ros1.check import rebuild_layout  # lazy: 1.5 ms, damaged bags only
+
         self._unmap()
         layout = rebuild_layout(self.file, self.path, self.layout.size, _first_record(self), why)
         damage = [p for p in layout.problems if p != why]

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import itertools
 import mmap
+import os
 from collections.abc import Iterator, Sequence
 from io import BufferedReader
 from pathlib import Path
@@ -305,6 +306,8 @@ def ros1_runs(
         chunks = [bag.layout.chunks[c] for c in batch]
         if batch[0] in sparse:
             buf, base, sizes = mapped_group(bag, chunks, scratch)
+        elif mappable(bag, chunks):
+            buf, base, sizes = populated_group(bag, chunks, scratch)
         else:
             buf, base, sizes = chunk_group(bag, chunks, scratch)
         where = f"in {bag.path} in chunks at bytes {chunks[0].pos}..{chunks[-1].pos}"
@@ -346,20 +349,60 @@ def sparse_chunks(bag: IndexedBag, touched: list[int], counts: dict[int, int]) -
     return out
 
 
+def mappable(bag: IndexedBag, chunks: list[Ros1Chunk]) -> bool:
+    """Whether a dense group is read in place through a populated map rather than copied:
+    uncompressed chunks in file order of a closed bag, where the system can populate a map.
+    An ``.active`` file is being written (its chunks and index may change under a map): it is
+    read with positional reads."""
+    return (
+        bool(MAP_POPULATE)
+        and bag.layout.indexed
+        and not bag.path.name.endswith(".active")
+        and all(c.compression == "none" and c.data_pos >= 0 for c in chunks)
+        and all(b.data_pos > a.data_pos for a, b in itertools.pairwise(chunks))
+    )
+
+
+# Linux: a map's page table filled from the page cache when it is made, in one system call
+# (9 ms for the 159 MiB GT hour here, against 43 ms for copying its bytes out with `preadv`).
+MAP_POPULATE: int = getattr(mmap, "MAP_POPULATE", 0)
+
+
+def populated_group(bag: IndexedBag, chunks: list[Ros1Chunk], scratch: list[Any]) -> Group:
+    """Dense chunks (``mappable``) read in place: the stretch they span mapped read-only and
+    populated, so the decoder gathers its records straight from the page cache (no copy of
+    the chunks, no fresh buffer, no page fault per page)."""
+    return _mapped(bag, chunks, scratch, populate=True)
+
+
 def mapped_group(bag: IndexedBag, chunks: list[Ros1Chunk], scratch: list[Any]) -> Group:
     """Chunks read in place through a read-only map of the stretch they span: the pages
-    holding wanted records are read (with the kernel's usual read-ahead), the rest never.
+    holding wanted records are read (with the kernel's usual read-ahead), the rest never."""
+    return _mapped(bag, chunks, scratch, populate=False)
+
+
+def _mapped(
+    bag: IndexedBag, chunks: list[Ros1Chunk], scratch: list[Any], *, populate: bool
+) -> Group:
+    """The chunks' stretch of the file mapped read-only (``populate``: every page at once).
 
     The map is kept in ``scratch`` and released when that slot is next reused, so the
-    process holds one group's pages, not the file's.
+    process holds one group's pages, not the file's. A file shorter now than its index says
+    (cut since it was opened) is refused before it is mapped; one cut while mapped is
+    :mod:`ertools.io.mapguard`'s.
     """
     first = chunks[0].data_pos
     end = chunks[-1].data_pos + chunks[-1].data_len
     start = first - first % mmap.ALLOCATIONGRANULARITY
-    if end > bag.layout.size:
+    fd = bag.file.fileno()
+    if end > bag.layout.size or end > os.fstat(fd).st_size:
         raise BagError(f"chunks cut off by end of file at byte {first}", path=bag.path)
-    mm = mmap.mmap(bag.file.fileno(), end - start, offset=start, access=mmap.ACCESS_READ)
-    keep(scratch, mm)
+    if populate and MAP_POPULATE:
+        flags = mmap.MAP_SHARED | MAP_POPULATE
+        mm = mmap.mmap(fd, end - start, flags=flags, prot=mmap.PROT_READ, offset=start)
+    else:
+        mm = mmap.mmap(fd, end - start, offset=start, access=mmap.ACCESS_READ)
+    keep(scratch, mm, bag.path)
     base = np.array([c.data_pos - start for c in chunks], dtype=np.int64)
     sizes = np.array([c.data_len for c in chunks], dtype=np.int64)
     return np.frombuffer(mm, dtype=np.uint8), base, sizes

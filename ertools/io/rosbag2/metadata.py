@@ -1,29 +1,22 @@
 """rosbag2 directories: ``metadata.yaml`` (the summary), their storage files as readable files
 (:func:`readable_files`, the one place that decides it for every command) and bulk row access
-to sqlite3 storage."""
+to sqlite3 storage (:mod:`ertools.io.rosbag2.sqlite_storage`, imported only for it)."""
 
 from __future__ import annotations
 
 import atexit
 import shutil
-import sqlite3
 import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-import yaml
-
 from ertools.arrays import I64, U8
 from ertools.errors import BagError
-from ertools.inputs import check_regular, open_regular, why_not
-from ertools.io.formats import load_metadata, metadata_problem
+from ertools.inputs import open_regular, why_not
+from ertools.io.formats import load_metadata, metadata_errors, metadata_problem
 from ertools.io.inflate import inflate_file
 from ertools.io.model import Conn
-from ertools.yamlin import YAMLError
-
-ROWS_PER_BATCH = 100_000
 
 
 def read_metadata(path: Path) -> dict[str, Any]:
@@ -34,7 +27,7 @@ def read_metadata(path: Path) -> dict[str, Any]:
         info = data["rosbag2_bagfile_information"]
     except OSError as err:
         raise BagError(f"unreadable metadata.yaml ({why_not(err)})", path=path) from err
-    except (YAMLError, KeyError, TypeError, UnicodeDecodeError) as err:
+    except metadata_errors() as err:
         raise BagError(f"unreadable metadata.yaml ({metadata_problem(err)})", path=path) from err
     if not isinstance(info, dict):
         raise BagError("metadata.yaml has no rosbag2_bagfile_information", path=path)
@@ -125,6 +118,8 @@ def readable_dir(path: Path) -> Path:
     listed = info.get("files")
     if isinstance(listed, list) and len(listed) == len(files):
         plain["files"] = [dict(e, path=f.name) for e, f in zip(listed, files, strict=True)]
+    import yaml  # lazy: PyYAML, 10-20 ms, only for a compressed rosbag2 folder
+
     text = yaml.safe_dump({"rosbag2_bagfile_information": plain}, sort_keys=False)
     (out / "metadata.yaml").write_text(text, encoding="utf-8")
     _DECOMPRESSED[key] = out
@@ -156,34 +151,6 @@ def _decompressed(file: Path) -> Path:
     return out
 
 
-def _connect(db: Path) -> sqlite3.Connection:
-    # Read-only: an input file is never modified (not even a journal is created). sqlite
-    # opens the path itself: a named pipe there would block it, so the type is checked first.
-    try:
-        check_regular(db)
-    except OSError as err:
-        raise sqlite3.OperationalError(f"unable to open database file: {why_not(err)}") from err
-    return sqlite3.connect(f"{db.resolve().as_uri()}?mode=ro", uri=True)
-
-
-def query(db: Path, sql: str) -> list[Any]:
-    """All rows of one read-only query on a storage file.
-
-    Raises:
-        BagError: the file is not a readable sqlite3 database.
-    """
-    try:
-        con = _connect(db)
-    except sqlite3.Error as err:
-        raise BagError(f"cannot open sqlite3 storage ({err})", path=db) from err
-    try:
-        return con.execute(sql).fetchall()
-    except (sqlite3.Error, UnicodeDecodeError) as err:
-        raise BagError(f"damaged sqlite3 storage ({err})", path=db) from err
-    finally:
-        con.close()
-
-
 def sqlite_rows(
     path: Path, conns: Sequence[Conn], lo: int | None, hi: int | None
 ) -> Iterator[tuple[U8, I64, I64, I64]] | None:
@@ -196,42 +163,6 @@ def sqlite_rows(
         return None  # compressed message by message: rosbags decompresses each
     files = [f for f in readable_files(path, info) if f.suffix == ".db3"]
     topics = sorted({c.topic for c in conns})
-    return _rows(files, topics, lo, hi)
+    from ertools.io.rosbag2.sqlite_storage import topic_rows  # lazy: sqlite3 1.5 ms, .db3 only
 
-
-def _rows(
-    files: list[Path], topics: list[str], lo: int | None, hi: int | None
-) -> Iterator[tuple[U8, I64, I64, I64]]:
-    for db in files:
-        try:
-            con = _connect(db)
-        except sqlite3.Error as err:
-            raise BagError(f"cannot open sqlite3 storage ({err})", path=db) from err
-        try:
-            marks = ",".join("?" * len(topics))
-            ids = [
-                r[0] for r in con.execute(f"SELECT id FROM topics WHERE name IN ({marks})", topics)
-            ]
-            if not ids:
-                continue
-            marks = ",".join("?" * len(ids))
-            query = f"SELECT timestamp, data FROM messages WHERE topic_id IN ({marks})"
-            args: list[int] = list(ids)
-            if lo is not None:
-                query += " AND timestamp >= ?"
-                args.append(lo)
-            if hi is not None:
-                query += " AND timestamp <= ?"
-                args.append(hi)
-            cur = con.execute(query + " ORDER BY timestamp, id", args)
-            while rows := cur.fetchmany(ROWS_PER_BATCH):
-                t = np.fromiter((r[0] for r in rows), dtype=np.int64, count=len(rows))
-                lengths = np.fromiter((len(r[1]) for r in rows), dtype=np.int64, count=len(rows))
-                starts = np.zeros(len(rows), dtype=np.int64)
-                np.cumsum(lengths[:-1], out=starts[1:])
-                buf = np.frombuffer(b"".join(r[1] for r in rows), dtype=np.uint8)
-                yield buf, starts, lengths, t
-        except (sqlite3.Error, UnicodeDecodeError) as err:
-            raise BagError(f"damaged sqlite3 storage ({err})", path=db) from err
-        finally:
-            con.close()
+    return topic_rows(files, topics, lo, hi)
