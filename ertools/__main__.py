@@ -2,9 +2,15 @@
 ``python -m ertools``, both through ertools.launch (a Ctrl-C while the command's modules load is
 one line, exit status 130)."""
 
+import os
 import sys
 
 from ertools.launch import run
+
+# NumPy's OpenBLAS starts a thread per core when NumPy is imported, which then spins waiting for
+# work: on a 2-core machine ~60 ms of CPU and wall before a command reads its first byte
+# (docs/performance.md, "Start-up"). No command multiplies matrices large enough to share.
+BLAS_THREADS = "1"
 
 
 def _command() -> object:
@@ -15,6 +21,7 @@ def _command() -> object:
 
 def main() -> int:
     """The ``ertools`` console command."""
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", BLAS_THREADS)  # before NumPy's import
     return run(_command, "ertools")
 
 

@@ -6,8 +6,9 @@ bytes uint8 (:data:`U8`).
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -62,3 +63,90 @@ def fresh_repeat(
         out[at : at + count] = value
         at += count
     return out
+
+
+# np.median, np.percentile, np.quantile, np.nanquantile and np.unique import NumPy's masked
+# arrays (``numpy.ma``, ~9 ms of a command's start-up) for a check of their input; these give
+# the same numbers without.
+
+
+def median(values: npt.ArrayLike, axis: int | None = None) -> Any:
+    """``np.median(values, axis=axis)``: the middle value, or the mean of the two middle
+    values, NaN where a NaN is; the same bits."""
+    a = np.asarray(values)
+    if axis is None:
+        a, axis = a.ravel(), 0
+    n = a.shape[axis]
+    if n == 0:
+        return np.mean(a, axis=axis)  # NaN and "Mean of empty slice", as np.median
+    half = n // 2
+    middle = [half - 1, half] if n % 2 == 0 else [half]
+    nan_aware = a.dtype.kind in "fc"
+    # NaN sorts last: partitioning at the last place too puts one there when there is one
+    part = np.partition(a, [*middle, n - 1] if nan_aware else middle, axis=axis)
+    out = np.mean(np.take(part, middle, axis=axis), axis=axis)
+    if not nan_aware:
+        return out
+    last = np.take(part, n - 1, axis=axis)
+    nan = np.isnan(last)
+    if not nan.any():
+        return out
+    return last if np.ndim(out) == 0 else np.where(nan, last, out)
+
+
+def quantiles(values: npt.ArrayLike, q: npt.ArrayLike) -> F64:
+    """``np.quantile(values, q)`` of 1-d float values, NumPy's default (linear) method: at
+    ``(n - 1) q`` in the sorted values, interpolated between its two neighbours from the nearer
+    one; all NaN when a value is NaN. The same bits."""
+    a = np.array(values).ravel()  # a copy: partitioned in place
+    if a.dtype.kind != "f":
+        a = a.astype(np.float64)
+    n = len(a)
+    if n == 0:
+        raise IndexError("quantiles of no values")
+    at = (n - 1) * np.asarray(q, dtype=np.float64)
+    below = np.floor(at)
+    above = below + 1
+    # past the last value (q = 1), and before the first: that value itself
+    below[at >= n - 1] = above[at >= n - 1] = n - 1
+    below[at < 0] = above[at < 0] = 0
+    lo_at, hi_at = below.astype(np.intp), above.astype(np.intp)
+    a.partition(distinct(np.concatenate([[0, n - 1], lo_at, hi_at])))
+    lo, hi = a[lo_at], a[hi_at]
+    t = at - lo_at
+    step = hi - lo  # in the values' type, then float64 with t
+    out: F64 = np.where(t >= 0.5, hi - step * (1 - t), lo + step * t)
+    if np.isnan(a[n - 1]):
+        out[:] = np.nan
+    return out
+
+
+def percentiles(values: npt.ArrayLike, q: Sequence[float]) -> F64:
+    """``np.percentile(values, q)``: :func:`quantiles` at ``q / 100``."""
+    return quantiles(values, np.asarray(q, dtype=np.float64) / 100)
+
+
+def nanquantiles(values: npt.ArrayLike, q: Sequence[float]) -> F64:
+    """``np.nanquantile(values, q, axis=0)`` of a 2-d array: (len(q), columns), each column's
+    :func:`quantiles` of its values that are not NaN; NaN for a column of NaN only."""
+    a = np.asarray(values)
+    out = np.full((len(q), a.shape[1]), np.nan)
+    for col in range(a.shape[1]):  # a score per column: a few
+        kept = a[:, col][~np.isnan(a[:, col])]
+        if kept.size:
+            out[:, col] = quantiles(kept, q)
+        else:
+            warnings.warn("All-NaN slice encountered", RuntimeWarning, stacklevel=2)
+    return out
+
+
+Int = TypeVar("Int", bound=np.integer[Any])
+
+
+def distinct(values: npt.NDArray[Int]) -> npt.NDArray[Int]:
+    """``np.unique(values)`` of an integer array: its distinct values, sorted."""
+    s = np.sort(values, axis=None)
+    keep = np.empty(len(s), dtype=bool)
+    keep[:1] = True
+    np.not_equal(s[1:], s[:-1], out=keep[1:])
+    return s[keep]

@@ -11,11 +11,16 @@ by at most 5e-10; JSON keeps the full float64 for scripts that compare results m
 
 from __future__ import annotations
 
+import functools
+import json
 import math
-from typing import Any
+from collections.abc import Callable, Mapping
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
-import yaml
+
+if TYPE_CHECKING:
+    import yaml
 
 YAML_DECIMALS = 9
 
@@ -29,29 +34,52 @@ def _represent_float(dumper: yaml.SafeDumper, value: float) -> yaml.Node:
     return dumper.represent_float(yaml_float(float(value)))
 
 
-class Dumper(yaml.SafeDumper):
+@functools.cache
+def _dumper() -> type[yaml.SafeDumper]:
     """The safe dumper, taking ``str`` subclasses (``fidelity.Deviation``) as plain text and
-    writing floats (NumPy's too) rounded by :func:`yaml_float`. Subclass it to add
-    representers (a subclass copies the tables, so this one stays as it is)."""
+    writing floats (NumPy's too) rounded by :func:`yaml_float`."""
+    import yaml  # lazy: PyYAML, 10-20 ms, only for YAML output (JSON output needs none)
+
+    class Dumper(yaml.SafeDumper):
+        pass
+
+    Dumper.add_multi_representer(str, yaml.SafeDumper.represent_str)
+    Dumper.add_representer(float, _represent_float)  # the exact type's entry wins over multi
+    Dumper.add_multi_representer(float, _represent_float)
+    return Dumper
 
 
-Dumper.add_multi_representer(str, yaml.SafeDumper.represent_str)
-Dumper.add_representer(float, _represent_float)  # the exact type's entry wins over multi
-Dumper.add_multi_representer(float, _represent_float)
+Representer = Callable[[Any, Any], Any]
 
 
-def dump_yaml(data: Any, **options: Any) -> str:
+def dump_yaml(
+    data: Any, *, representers: Mapping[type, Representer] | None = None, **options: Any
+) -> str:
     """YAML as the 2015 nodes dumped it (block style, keys in insertion order unless
-    ``options`` say otherwise) through :class:`Dumper`: floats rounded to 9 decimals."""
+    ``options`` say otherwise) through the safe dumper, floats rounded to 9 decimals;
+    ``representers`` by type added to it for this text only (``yaml.add_representer``'s)."""
+    import yaml  # lazy: PyYAML, 10-20 ms, only for YAML output (JSON output needs none)
+
+    dumper = _dumper()
+    if representers:
+        # a subclass copies the tables on its first add: the shared dumper stays as it is
+        dumper = cast("type[yaml.SafeDumper]", type("Dumper", (dumper,), {}))
+        for kind, represent in representers.items():
+            dumper.add_representer(kind, represent)
     kwargs: dict[str, Any] = {
         "default_flow_style": False,
         "sort_keys": False,
         "allow_unicode": True,
+        "Dumper": dumper,
         **options,
     }
-    kwargs.setdefault("Dumper", Dumper)
     text: str = yaml.dump(data, **kwargs)
     return text
+
+
+def json_text(data: Any) -> str:
+    """``data`` as indented JSON (NumPy values as plain numbers, NaN as null)."""
+    return json.dumps(jsonable(data), indent=2, allow_nan=False)
 
 
 def jsonable(value: Any, *, string_keys: bool = True) -> Any:

@@ -20,7 +20,6 @@ from typing import TYPE_CHECKING, Any, Literal, Protocol, TypeVar, runtime_check
 
 from ertools.errors import UsageError
 from ertools.progress import clear_current
-from ertools.timeutil import MAX_SECONDS
 
 if TYPE_CHECKING:  # annotations only: the registry (and `ertools score --help`) stays light
     import pandas as pd
@@ -248,7 +247,12 @@ class Benchmark(Protocol[OptionsT, LoadedT, RunsT, ResultT_co]):
     name: str
     title: str
     inputs: tuple[Input, ...]
-    rules: tuple[Rule, ...]
+
+    @property
+    def rules(self) -> tuple[Rule, ...]:
+        """Its :class:`~ertools.fidelity.Rule` constants: a class attribute, or a property
+        that imports them when asked (not for a parser)."""
+        ...
 
     def make_options(self, values: Mapping[str, Any]) -> OptionsT:
         """The values by :attr:`Input.name` (missing ones at their defaults) -> validated
@@ -472,6 +476,8 @@ def _one_value(declared: Input, value: Any) -> Any:
         raise UsageError(f"{option} must be {what}, got {value!r}") from None
     if not math.isfinite(number):
         raise UsageError(f"{option} must be a finite number, got {value!r}")
+    from ertools.timeutil import MAX_SECONDS  # lazy: datetime, 1.4 ms: not for a parser
+
     if kind == "float" and abs(number) >= MAX_SECONDS:
         raise UsageError(f"{option} {value}: give a number smaller than {MAX_SECONDS:g} in size")
     unit = f" {declared.unit}" if declared.unit else ""

@@ -37,7 +37,7 @@ from ertools.exporting.write import (
     write_pair,
 )
 from ertools.geometry import Association
-from ertools.io.model import INPUT_FORMATS, TextFormat
+from ertools.io.names import INPUT_FORMATS, TextFormat
 from ertools.io.text import is_text_trajectory, read_text_poses
 from ertools.timeutil import iso_utc, ns_to_s, s_to_ns
 

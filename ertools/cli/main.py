@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import errno
-import logging
 import math
 import os
 import re
@@ -30,9 +29,9 @@ from typing import NoReturn
 
 from ertools._version import __version__
 from ertools.cli.command import Command, Delegate
-from ertools.cli.text import error_text, one_line, printable
+from ertools.cli.text import error_text, one_line
 from ertools.errors import ErtoolsError, UsageError
-from ertools.progress import Bar, clear_current, reporting
+from ertools.progress import Bar, reporting
 
 COMMANDS: dict[str, Command] = {
     "info": Command("ertools.cli.info", "describe bags like `rosbag info`", "ertools info run.bag"),
@@ -229,35 +228,6 @@ def build_parser(prog: str, module_name: str) -> tuple[argparse.ArgumentParser, 
     return parser, module
 
 
-def _configure_logging(verbose: int) -> None:
-    level = logging.WARNING if verbose == 0 else logging.INFO if verbose == 1 else logging.DEBUG
-
-    class _LowerLevel(logging.Formatter):
-        # "ertools: warning: ..." like the CLI's own notes (cli/output.note), not "WARNING";
-        # the record itself is left as is (other handlers may see it).
-        def formatMessage(self, record: logging.LogRecord) -> str:  # noqa: N802 (logging's)
-            record.message = printable(record.message)  # one line, whatever a path holds
-            return super().formatMessage(record)
-
-        def format(self, record: logging.LogRecord) -> str:
-            text = super().format(record)
-            head = f"ertools: {record.levelname}:"
-            return text.replace(head, head.lower(), 1)
-
-    class _BelowTheBar(logging.StreamHandler):  # type: ignore[type-arg]
-        # a message logged while a progress bar is drawn starts on a line of its own
-        def emit(self, record: logging.LogRecord) -> None:
-            clear_current()
-            super().emit(record)
-
-    handler = _BelowTheBar(sys.stderr)
-    handler.setFormatter(_LowerLevel("ertools: %(levelname)s: %(message)s"))
-    root = logging.getLogger("ertools")
-    root.handlers[:] = [handler]
-    root.setLevel(level)
-    root.propagate = False
-
-
 # Options naming what a command writes; every other path option or argument is an input.
 OUTPUT_OPTIONS = {
     "output": "-o/--output",
@@ -315,7 +285,9 @@ def run_command(prog: str, module_name: str, argv: Sequence[str]) -> int:
     # The command as run, for report provenance (sys.argv is wrong when called in-process).
     args.command_line = [*prog.split(), *argv]
     args.argv = list(argv)  # a group hands its member the words after the member's name
-    _configure_logging(args.verbose)
+    from ertools.cli.logs import configure_logging  # lazy: logging, ~5 ms: not for a parser
+
+    configure_logging(args.verbose)
     bar = _progress_bar(args)
     try:
         _check_numbers(args)

@@ -3,12 +3,10 @@ progress bar. Light on purpose: every command imports it."""
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 from typing import Any
 
-from ertools.atomic import write_text as write_file
 from ertools.cli.text import error_text, printable
 from ertools.progress import clear_current
 
@@ -20,6 +18,8 @@ def write_text(text: str, output: Path | None) -> None:
         clear_current()
         sys.stdout.write(text if text.endswith("\n") else text + "\n")
     else:
+        from ertools.atomic import write_text as write_file  # lazy: tempfile, 2 ms: --out only
+
         output.parent.mkdir(parents=True, exist_ok=True)
         write_file(output, text if text.endswith("\n") else text + "\n")
         note(f"wrote {output}")
@@ -38,6 +38,6 @@ def note(message: str) -> None:
 
 def dump_json(data: Any) -> str:
     """``data`` as indented JSON (NumPy values as plain numbers, NaN as null)."""
-    from ertools.serialize import jsonable  # lazy: NumPy and PyYAML, 120 ms; not for --help
+    from ertools.serialize import json_text  # lazy: NumPy, 60 ms; not for --help
 
-    return json.dumps(jsonable(data), indent=2, allow_nan=False)
+    return json_text(data)

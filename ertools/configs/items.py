@@ -21,7 +21,7 @@ import yaml
 
 from ertools.configs._yaml import load_yaml, number
 from ertools.errors import ConfigError
-from ertools.serialize import Dumper, dump_yaml
+from ertools.serialize import dump_yaml
 
 Vec3 = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
@@ -244,12 +244,10 @@ def items_to_data(items: Sequence[Item], *, with_spread: bool = True) -> dict[st
 def items_to_yaml(items: Sequence[Item], *, with_spread: bool = True) -> str:
     """Listing 9 text: block style, quaternion and translation as flow lists as in 2015."""
 
-    class _Dumper(Dumper):
-        """Floats to 9 decimals (ertools.serialize), number lists in flow style."""
-
     def _flow_list(dumper: yaml.SafeDumper, data: list[Any]) -> yaml.Node:
         flow = all(isinstance(v, int | float) for v in data)
         return dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=flow)
 
-    _Dumper.add_representer(list, _flow_list)
-    return dump_yaml(items_to_data(items, with_spread=with_spread), Dumper=_Dumper)
+    # floats to 9 decimals (ertools.serialize), number lists in flow style
+    data = items_to_data(items, with_spread=with_spread)
+    return dump_yaml(data, representers={list: _flow_list})

@@ -6,6 +6,7 @@ the machine's speed."""
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -32,6 +33,12 @@ print(json.dumps({"code": code, "modules": sorted(sys.modules)}))
 
 # Heavy for any command that does not draw, tabulate or write HTML (issue 39).
 HEAVY = ("scipy", "matplotlib", "pandas", "jinja2")
+# What `score trajectory --format json` does not use, each 2 to 20 ms of its start-up (issue 39
+# item 2, docs/performance.md "Start-up"): PyYAML (YAML output, config files, rosbag2
+# metadata), the MCAP readers (a ROS1 bag here), the ROS1 record scan of damaged bags, NumPy's
+# masked arrays (np.median, np.percentile, np.unique import them: ertools.arrays has their own),
+# sqlite3 (rosbag2 storage).
+NOT_FOR_JSON = ("yaml", "ertools.io.mcap", "ertools.io.ros1.check", "numpy.ma", "sqlite3")
 
 
 def imported(*argv: str) -> tuple[int, set[str]]:
@@ -105,10 +112,74 @@ def test_scoring_a_trajectory_imports_nothing_heavy_and_no_other_benchmark() -> 
     code, modules = imported("score", "trajectory", str(robot), str(ROBOTLOG), "--format", "json")
     assert code == 0
     assert [m for m in HEAVY if m in modules] == []
+    assert [m for m in NOT_FOR_JSON if m in modules] == []
     own = packages()["trajectory"]
     others = {p for p in packages().values() if p != own}
     assert {p for p in others if loaded(modules, p)} == set()
     assert loaded(modules, "ertools.report") == []  # nothing asked for a report or a figure
+
+
+# Builds one command's parser, then prints every module imported (no json: it would be one).
+PARSER_PROBE = """
+import sys
+from ertools.cli.main import build_parser
+build_parser(sys.argv[1], sys.argv[2])
+print(" ".join(sorted(sys.modules)))
+"""
+
+# All the ertools modules the parser of `score trajectory` imports (issue 39 item 2: 30 ms or
+# less, docs/performance.md "The parser of `score trajectory`"). The list may shrink, not grow:
+# each module more is its import time and its dataclasses (~0.6 ms each) on every `--help`.
+TRAJECTORY_PARSER = frozenset(
+    {
+        "ertools",
+        "ertools._version",
+        "ertools.benchmarks",
+        "ertools.benchmarks.base",
+        "ertools.benchmarks.common",
+        "ertools.benchmarks.common.inputs",
+        "ertools.benchmarks.common.spec",
+        "ertools.benchmarks.registry",
+        "ertools.benchmarks.trajectory",
+        "ertools.benchmarks.trajectory.declare",
+        "ertools.benchmarks.trajectory.inputs",
+        "ertools.cli",
+        "ertools.cli.command",
+        "ertools.cli.groups",
+        "ertools.cli.main",
+        "ertools.cli.options",
+        "ertools.cli.output",
+        "ertools.cli.result_options",
+        "ertools.cli.score",
+        "ertools.cli.text",
+        "ertools.errors",
+        "ertools.io",
+        "ertools.io.names",
+        "ertools.progress",
+    }
+)
+# Standard-library modules the parser no longer imports, each 1.5 - 7 ms of its time (they may
+# not be imported lazily: the ertools module that needs them is): logging (cli/logs.py, after
+# parsing), json (serialize.json_text), tempfile (ertools.atomic, for --out), datetime
+# (ertools.timeutil, for a number's bound once given).
+NOT_FOR_THE_PARSER = ("logging", "json", "tempfile", "datetime")
+
+
+def test_the_trajectory_parser_imports_only_what_it_needs() -> None:
+    done = subprocess.run(
+        [sys.executable, "-c", PARSER_PROBE, "ertools score trajectory", "ertools.cli.score"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
+    )
+    modules = set(done.stdout.split())
+    assert "ertools.benchmarks.trajectory.declare" in modules  # the probe built that parser
+    own = {m for m in modules if m == "ertools" or m.startswith("ertools.")}
+    assert sorted(own - TRAJECTORY_PARSER) == []
+    assert [m for m in NOT_FOR_THE_PARSER if m in modules] == []
+    assert "numpy" not in modules
 
 
 def test_python_m_ertools_is_the_command() -> None:
@@ -121,3 +192,31 @@ def test_python_m_ertools_is_the_command() -> None:
         check=False,
     )
     assert (done.returncode, done.stdout.strip()) == (0, f"ertools {__version__}")
+
+
+# The console command's environment once it has started, printed after `ertools --version`.
+ENV_PROBE = """
+import os, sys
+from ertools.__main__ import main
+sys.argv = ["ertools", "--version"]
+main()
+print(os.environ.get("OPENBLAS_NUM_THREADS"))
+"""
+
+
+@pytest.mark.parametrize(("given", "used"), [(None, "1"), ("3", "3")])
+def test_the_command_starts_one_blas_thread_unless_told(given: str | None, used: str) -> None:
+    # OpenBLAS starts its threads when NumPy is imported: ~50 ms of CPU on 2 cores
+    env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_NUM_THREADS"}
+    if given is not None:
+        env["OPENBLAS_NUM_THREADS"] = given
+    done = subprocess.run(
+        [sys.executable, "-c", ENV_PROBE],
+        cwd=ROOT,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
+    )
+    assert done.stdout.split() == ["ertools", __version__, used]

@@ -9,7 +9,8 @@ import time
 
 import pytest
 
-from ertools.cli.main import COMMANDS, _configure_logging, main
+from ertools.cli.logs import configure_logging
+from ertools.cli.main import COMMANDS, main
 from ertools.cli.output import note
 
 
@@ -52,7 +53,7 @@ def test_library_warnings_read_like_the_cli_notes(capsys: pytest.CaptureFixture[
     root = logging.getLogger("ertools")
     saved = (root.handlers[:], root.level, root.propagate)
     try:
-        _configure_logging(1)
+        configure_logging(1)
         logging.getLogger("ertools.somewhere").warning("%d files overlap", 2)
         logging.getLogger("ertools.somewhere").info("reading")
         note("warning: a note")

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ertools.arrays import F64, IntArr
+from ertools.arrays import F64, IntArr, distinct
 
 CHUNK_ELEMENTS = 4_000_000  # draws x values per chunk of the order statistics' draws
 
@@ -93,7 +93,15 @@ def order_stats(
     percents = sorted({p for _, p in wanted})
     for percent in percents:
         columns = tuple(c for c, p in wanted if p == percent)
-        pool = np.arange(len(d)) if percent == 100.0 else thinned
+        if percent == 100.0:
+            # the max: the values that can reach it, as order_band keeps them, unsorted
+            top = float(np.max(d))
+            reach = float(np.max(bounds))
+            keep = np.flatnonzero(d + bounds >= top - reach)
+            out.append(OrderStat(columns, keep, len(keep) - 1, len(keep) - 1, 0.0))
+            base.append(top)
+            continue
+        pool = thinned
         values = d[pool]
         n = len(values)
         h = (n - 1) * percent / 100.0
@@ -128,7 +136,7 @@ def draw_order_stats(
     |e + s z|^2 = (|e| + s r)^2 + 2 s^2 E, the same distribution. A lag l moves the other end
     by l v: |e - l v|^2 = |e|^2 - 2 l e.v + l^2 |v|^2.
     """
-    union = np.unique(np.concatenate([s.poses for s in stats]))
+    union = distinct(np.concatenate([s.poses for s in stats]))
     cols = [np.searchsorted(union, s.poses) for s in stats]
     e, v = terms.error[union], terms.velocity[union]
     # sums of three written out: one order of additions on every CPU

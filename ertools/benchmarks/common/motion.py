@@ -29,7 +29,7 @@ from typing import Literal
 
 import numpy as np
 
-from ertools.arrays import F64, I64, Bool
+from ertools.arrays import F64, I64, Bool, median
 from ertools.geometry import wrap_angle
 from ertools.streams import Interval
 
@@ -53,7 +53,7 @@ def moving_mean(values: F64, half: int) -> F64:
 def sample_half_window(t_ns: I64, window_s: float) -> int:
     """Samples either side of a ``window_s`` window at the median rate (at least 1)."""
     dt = np.diff(t_ns)
-    median_dt = float(np.median(dt)) if len(dt) else 0.0
+    median_dt = float(median(dt)) if len(dt) else 0.0
     rate = 1e9 / median_dt if median_dt > 0 else _FALLBACK_RATE_HZ
     return max(1, round(window_s * rate / 2))
 

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ertools.arrays import F64, I64, Bool
+from ertools.arrays import F64, I64, Bool, median
 from ertools.benchmarks.common import motion
 
 DEFAULT_STILL_SPEED = 0.004  # m/s
@@ -161,7 +161,7 @@ def noise_sigma(t_ns: I64, xy: F64) -> float:
     if len(t) < 3:
         return 0.0
     dt = np.diff(t)
-    med = float(np.median(dt))
+    med = float(median(dt))
     even = (np.abs(dt[1:] - med) <= 0.25 * med) & (np.abs(dt[:-1] - med) <= 0.25 * med)
     step = np.diff(p, axis=0)
     moved = np.any(step != 0.0, axis=1)
@@ -169,7 +169,7 @@ def noise_sigma(t_ns: I64, xy: F64) -> float:
     d2 = (p[2:] - 2.0 * p[1:-1] + p[:-2])[ok]
     if len(d2) == 0:
         return 0.0
-    return float(np.median(np.abs(d2)) / 0.6745 / math.sqrt(6.0))
+    return float(median(np.abs(d2)) / 0.6745 / math.sqrt(6.0))
 
 
 def _half_window(sigma: float, rate_hz: float, speed: float) -> float:
@@ -236,7 +236,7 @@ def protocol_track(
     p = np.asarray(xy, dtype=np.float64)
     n = len(t)
     dt = np.diff(t)
-    rate = 1e9 / float(np.median(dt)) if n > 1 and np.median(dt) > 0 else 120.0
+    rate = 1e9 / float(median(dt)) if n > 1 and median(dt) > 0 else 120.0
     sigma = noise_sigma(t, p)
     half = _half_window(sigma, rate, speed)
     empty = np.empty((0, 2))

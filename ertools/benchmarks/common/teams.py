@@ -24,11 +24,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
-import yaml
-
 from ertools.errors import ErtoolsError
 from ertools.io.reader import read_benchmark_states
-from ertools.yamlin import load as load_yaml
 
 TeamSource = Literal["explicit", "payload", "log name", "transform", "RSBB layout"]
 
@@ -115,6 +112,9 @@ def team_from_payloads(payloads: Iterable[str]) -> str | None:
     Payloads that are not YAML mappings (``timeout``, a free-text operation) are skipped;
     scanning stops at the first name found.
     """
+    import yaml  # lazy: PyYAML, 10-20 ms, only for the payloads of state topics
+
+    from ertools.yamlin import load as load_yaml  # lazy: PyYAML 10-20 ms, payloads only
 
     for text in dict.fromkeys(payloads):  # 10 Hz state topics repeat each payload
         if ":" not in text or not any(k in text for k in PAYLOAD_KEYS):

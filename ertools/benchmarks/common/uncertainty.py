@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from ertools.arrays import F64
+from ertools.arrays import F64, nanquantiles
 from ertools.benchmarks.common.inputs import (
     DEFAULT_CONFIDENCE,
     DEFAULT_DRAWS,
@@ -186,9 +186,10 @@ def basic_intervals(estimate: F64, draws: F64, confidence: float) -> tuple[F64, 
     a = (1.0 - check_confidence(confidence)) / 2.0
     low = np.full(est.shape, np.nan)
     high = np.full(est.shape, np.nan)
-    ok = np.sum(np.isfinite(d), axis=0) >= 2
+    finite = np.isfinite(d)
+    ok = np.sum(finite, axis=0) >= 2
     if ok.any():
-        q = np.nanquantile(d[:, ok], [a, 1.0 - a], axis=0)
+        q = nanquantiles(d[:, ok], [a, 1.0 - a])
         low[ok] = 2.0 * est[ok] - q[1]
         high[ok] = 2.0 * est[ok] - q[0]
     return low, high

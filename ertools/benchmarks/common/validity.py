@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import F64, I64, Bool, IntArr
+from ertools.arrays import F64, I64, Bool, IntArr, median
 from ertools.benchmarks.common.hygiene import impossible_samples, rows_equal
 
 VALID = 0
@@ -323,7 +323,7 @@ def median_period_ns(t_ns: I64) -> int:
     """The median positive interval of ``t_ns`` (0 when there is none)."""
     dt = np.diff(t_ns)
     dt = dt[dt > 0]
-    return int(np.median(dt)) if dt.size else 0
+    return int(median(dt)) if dt.size else 0
 
 
 def summarise(

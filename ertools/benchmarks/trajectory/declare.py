@@ -17,12 +17,13 @@ from ertools.benchmarks.base import (
     Reported,
     Simulated,
 )
-from ertools.benchmarks.trajectory.config import INPUTS, TrajectoryOptions, make_options
-from ertools.benchmarks.trajectory.rules import RULES
+from ertools.benchmarks.trajectory.inputs import INPUTS
 
 if TYPE_CHECKING:  # annotations only: the stages import NumPy and the readers
+    from ertools.benchmarks.trajectory.config import TrajectoryOptions
     from ertools.benchmarks.trajectory.pipeline import TrajectoryLogs
     from ertools.benchmarks.trajectory.result import TrajectoryResult
+    from ertools.fidelity import Rule
 
 DESCRIPTION = """Compare a robot's own pose log with the mocap ground truth (2015 offline
 trajectory benchmark).
@@ -56,9 +57,9 @@ error.
 
 
 class Trajectory(
-    Benchmark[TrajectoryOptions, "TrajectoryLogs", None, "TrajectoryResult"],
+    Benchmark["TrajectoryOptions", "TrajectoryLogs", None, "TrajectoryResult"],
     Described,
-    Reported[TrajectoryOptions, "TrajectoryResult"],
+    Reported["TrajectoryOptions", "TrajectoryResult"],
     Discovered,
     Simulated,
 ):
@@ -67,7 +68,6 @@ class Trajectory(
     name = "trajectory"
     title = "Offline trajectory benchmark"
     inputs = INPUTS
-    rules = RULES
     sample_seed = 2018  # Simulated: sample_bags/ was written with it
     sample_folder = "robotlog"  # Simulated: a robot's own log, GT folder beside it
     example = "ertools score trajectory robot.bag gt/ --robot-topic /rockin/homer/marker_pose"
@@ -88,7 +88,17 @@ class Trajectory(
     logs_may_be_text = True
     source_inputs = ("robot_topic", "gt_topic")
 
+    @property
+    def rules(self) -> tuple[Rule, ...]:
+        from ertools.benchmarks.trajectory.rules import RULES  # lazy: fidelity, 1.5 ms
+
+        return RULES
+
     def make_options(self, values: Mapping[str, Any]) -> TrajectoryOptions:
+        from ertools.benchmarks.trajectory.config import (  # lazy: 2 dataclasses, 1.5 ms
+            make_options,
+        )
+
         return make_options(values)
 
     def load(self, logs: Sequence[Path], options: TrajectoryOptions) -> TrajectoryLogs:

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ertools.arrays import median
 from ertools.errors import BagError, ClockError, ErtoolsError, TopicError
 from ertools.io.files import open_bag
 from ertools.io.formats import NO_SUCH, find_bags
@@ -98,7 +99,7 @@ def read_robot_clocks(path: str, topic: str, time_source: str) -> tuple[PoseStre
             path=path,
         )
     t = batch.t_header if time_source == "header" else batch.t_record
-    gap = int(np.median(batch.t_header - batch.t_record)) if len(batch) else 0
+    gap = int(median(batch.t_header - batch.t_record)) if len(batch) else 0
     return PoseStream(t, batch.xyz, batch.quat_xyzw, source=f"{path}:{topic}"), gap
 
 
