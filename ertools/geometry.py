@@ -110,6 +110,12 @@ def _unit(q: F64) -> F64:
     return np.asarray(q / row_norm(q)[..., None], dtype=np.float64)
 
 
+def _unit_in_place(q: F64) -> F64:
+    """:func:`_unit` of a new float64 array, written over it."""
+    q /= row_norm(q)[..., None]
+    return q
+
+
 def quat_multiply(q1: F64, q2: F64) -> F64:
     """Hamilton product q1 * q2 of (..., 4) quaternions (x, y, z, w), broadcasting."""
     x1, y1, z1, w1 = np.moveaxis(np.asarray(q1, dtype=np.float64), -1, 0)
@@ -169,11 +175,16 @@ def slerp(q0: F64, q1: F64, alpha: F64) -> F64:
     Takes the shorter arc (q and -q are the same rotation); falls back to normalised linear
     interpolation where the two are within 1e-6 rad, where sin(theta) would lose precision.
     """
+    # The unit quaternions are new arrays: the rest works in them rather than in new (N, 4)
+    # arrays (an hour's poses are megabytes of fresh memory each).
     q0 = _unit(q0)
     q1 = _unit(q1)
     a = np.asarray(alpha, dtype=np.float64)[..., None]
     dot = row_dot(q0, q1)[..., None]
-    q1 = np.where(dot < 0.0, -q1, q1)
+    shape = np.broadcast_shapes(q1.shape, dot.shape)
+    if q1.shape != shape:
+        q1 = np.broadcast_to(q1, shape).copy()
+    np.negative(q1, out=q1, where=dot < 0.0)
     dot = np.abs(dot)
     theta = np.arccos(np.clip(dot, -1.0, 1.0))
     sin_theta = np.sin(theta)
@@ -181,7 +192,9 @@ def slerp(q0: F64, q1: F64, alpha: F64) -> F64:
     safe = np.where(close, 1.0, sin_theta)
     w0 = np.where(close, 1.0 - a, np.sin((1.0 - a) * theta) / safe)
     w1 = np.where(close, a, np.sin(a * theta) / safe)
-    return _unit(w0 * q0 + w1 * q1)
+    mixed = w0 * q0
+    mixed += w1 * q1
+    return _unit_in_place(mixed)
 
 
 @dataclass(frozen=True, eq=False)
@@ -263,7 +276,10 @@ def interpolate_poses(
     # Outside the stream, clamp to the end sample.
     alpha = np.where(lo < 0, 1.0, np.where(hi >= n, 0.0, alpha))
     xyz_lo = _rows(stream.xyz, lo_c)
-    xyz = xyz_lo + alpha[:, None] * (_rows(stream.xyz, hi_c) - xyz_lo)
+    xyz = _rows(stream.xyz, hi_c)  # lo + alpha (hi - lo), in the gathered rows
+    xyz -= xyz_lo
+    xyz *= alpha[:, None]
+    xyz += xyz_lo
     quat = slerp(_rows(stream.quat_xyzw, lo_c), _rows(stream.quat_xyzw, hi_c), alpha)
     return Interpolated(xyz, quat, lo, hi, gap, inside)
 

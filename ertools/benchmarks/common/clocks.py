@@ -23,6 +23,7 @@ Pure NumPy: streams in, a frozen :class:`OffsetEstimate` out.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -139,7 +140,9 @@ def _evaluate(
     # quotient of 0 <= a <= b stays in [0, 1].
     x_lo = np.take(gt.xyz, lo_c, axis=0)  # take: whole rows, twice as fast as x[i]
     diff = np.take(gt.xyz, hi_c, axis=0) - x_lo
-    return _Eval(valid, x_lo + alpha[:, None] * diff, lo_c, hi_c, diff, span)
+    at = diff * alpha[:, None]  # in place after: one (N, 3) temporary fewer, same sums
+    at += x_lo
+    return _Eval(valid, at, lo_c, hi_c, diff, span)
 
 
 def _velocity(gt: PoseStream, ev: _Eval, max_gap_ns: int) -> F64:
@@ -209,11 +212,34 @@ def _coarse_scan(
     grid = _grid(gt, step, n_grid, max_gap_ns, pad)
     base += pad
     pos = robot_xyz.T.astype(np.float32)
-    costs = np.full(len(offsets), np.inf)
-    counts = np.zeros(len(offsets), dtype=np.int64)
+    pruned = _pruned_costs(grid, base, shifts, pos)
+    if pruned is not None:
+        return pruned
+    costs, counts, _ = _grid_costs(grid, base, shifts, pos, np.arange(len(offsets)))
+    return _enough(costs, counts, counts.max())
+
+
+def _enough(costs: F64, counts: I64, most: int) -> F64:
+    """The costs of offsets that compare at least half the most poses any offset compares
+    (an offset leaving few poses inside the GT could win by chance); inf for the others."""
+    return np.where(counts >= max(MIN_POSES, int(0.5 * most)), costs, np.inf)
+
+
+def _grid_costs(
+    grid: npt.NDArray[np.float32],
+    base: I64,
+    shifts: I64,
+    pos: npt.NDArray[np.float32],
+    which: IntArr,
+) -> tuple[F64, I64, F64]:
+    """Mean distance, poses compared and largest distance at the offsets ``which``, each
+    offset's row of poses on its own (the same numbers whichever offsets are costed)."""
+    costs = np.full(len(which), np.inf)
+    counts = np.zeros(len(which), dtype=np.int64)
+    largest = np.zeros(len(which))
     block = max(1, 200_000 // max(len(base), 1))  # ~0.8 MB of float32 per axis and block
-    for lo in range(0, len(offsets), block):  # blocks of offsets x all poses, vectorised
-        idx = shifts[lo : lo + block, None] + base[None, :]
+    for lo in range(0, len(which), block):  # blocks of offsets x all poses, vectorised
+        idx = shifts[which[lo : lo + block], None] + base[None, :]
         dist = _squared_distances(grid, idx, pos)
         np.sqrt(dist, out=dist)
         missing = np.isnan(dist)
@@ -223,8 +249,87 @@ def _coarse_scan(
         with np.errstate(invalid="ignore", divide="ignore"):
             costs[lo : lo + block] = np.where(cnt > 0, total / np.maximum(cnt, 1), np.inf)
         counts[lo : lo + block] = cnt
-    enough = counts >= max(MIN_POSES, int(0.5 * counts.max()))
-    return np.where(enough, costs, np.inf)
+        largest[lo : lo + block] = dist.max(axis=1)
+    return costs, counts, largest
+
+
+# The coarse scan costs one offset in this many first, then only the offsets that the
+# distances found can leave near the best.
+COARSE_FIRST_EVERY = 4
+# Relative error allowed for a cost or a distance of float32 sums: a float32 sum of the
+# thousands of poses errs by ~1e-6 pairwise, 2e-4 at worst one after the other.
+_COST_MARGIN = 1e-3
+
+
+def _pruned_costs(
+    grid: npt.NDArray[np.float32], base: I64, shifts: I64, pos: npt.NDArray[np.float32]
+) -> F64 | None:
+    """:func:`_coarse_scan`'s costs where an offset can be the best or fit almost as well
+    (:func:`estimate_offset`: within 10 % + 1 mm of it), inf elsewhere; None: the case is
+    not one of those shown below, cost every offset.
+
+    One offset in :data:`COARSE_FIRST_EVERY` is costed first. A pose's distance changes by at
+    most its grid point's move between two offsets, and no move between neighbouring grid
+    points exceeds the largest step of the grid: from the costs found, each other offset's
+    cost has a lower bound, and where that bound exceeds the best found by more than 10 % +
+    1 mm, the offset can be neither the best nor a rival (nor make a rival's neighbour look
+    lower), and is left out. Shown when every grid point the scan reads between the first
+    and the last valid one is valid (no gap), the robot positions are finite and the poses
+    in time order: each offset then compares the poses of one range.
+    """
+    n_off = len(shifts)
+    if n_off < 3 * COARSE_FIRST_EVERY or len(base) < MIN_POSES:
+        return None
+    if not (np.all(np.diff(base) >= 0) and np.all(np.diff(shifts) > 0)):
+        return None
+    if not np.isfinite(pos).all():
+        return None
+    lo, hi = int(base[0] + shifts[0]), int(base[-1] + shifts[-1])
+    used = grid[:, lo : hi + 1]
+    valid = np.flatnonzero(~np.isnan(used).any(axis=0))
+    if valid.size < 2 or valid[-1] - valid[0] + 1 != valid.size:
+        return None
+    first, last = lo + int(valid[0]), lo + int(valid[-1])
+    inside = used[:, valid[0] : valid[-1] + 1]
+    # the poses each offset compares: those whose shifted grid point is valid, a range
+    start = np.searchsorted(base, first - shifts, side="left")
+    stop = np.searchsorted(base, last - shifts, side="right")
+    counts = np.maximum(stop - start, 0)
+    every = np.arange(n_off)
+    sampled = every[::COARSE_FIRST_EVERY]
+    if sampled[-1] != n_off - 1:  # and the last (np.union1d would import numpy.ma: 10 ms)
+        sampled = np.append(sampled, n_off - 1)
+    got, got_counts, largest = _grid_costs(grid, base, shifts, pos, sampled)
+    if not np.array_equal(got_counts, counts[sampled]):
+        return None
+    costs = np.full(n_off, np.inf)
+    costs[sampled] = got
+    costs = _enough(costs, counts, int(counts.max()))
+    best = float(costs[sampled].min())
+    # the largest move between neighbouring grid points (float32 differences: rounded up)
+    moves = [np.diff(inside[k]) for k in range(3)]
+    step = math.sqrt(sum(max(float(d.max()), -float(d.min())) ** 2 for d in moves)) * (1 + 1e-6)
+    if not (np.isfinite(best) and np.isfinite(got[got_counts > 0]).all() and math.isfinite(step)):
+        return None  # nothing compared, or float32 overflowed: no bound shown
+    limit = (best * 1.1 + 1e-3) * (1 + 1e-9)
+    bound = np.full(n_off, -np.inf)
+    at = np.searchsorted(sampled, every)
+    for near in (sampled[np.maximum(at - 1, 0)], sampled[np.minimum(at, len(sampled) - 1)]):
+        k = np.searchsorted(sampled, near)
+        both = np.maximum(np.minimum(stop, stop[near]) - np.maximum(start, start[near]), 0)
+        gone = counts[near] - both  # poses the sampled offset compares and this one not
+        moved = np.abs(shifts - shifts[near]).astype(np.float64) * step
+        with np.errstate(invalid="ignore", divide="ignore"):
+            total = got[k] * got_counts[k] * (1 - _COST_MARGIN)
+            total -= gone * largest[k] * (1 + _COST_MARGIN) + both * moved
+            low = total * (1 - _COST_MARGIN) / counts
+        bound = np.maximum(bound, np.where((got_counts[k] > 0) & (counts > 0), low, -np.inf))
+    enough = np.isfinite(_enough(np.zeros(n_off), counts, int(counts.max())))
+    need = enough & (bound <= limit)
+    need[sampled] = False
+    if need.any():
+        costs[need] = _grid_costs(grid, base, shifts, pos, np.flatnonzero(need))[0]
+    return costs
 
 
 def _squared_distances(
@@ -255,7 +360,9 @@ def _grid(
     padding and at grid points strictly inside a GT gap longer than ``max_gap_ns``.
     """
     t = gt.t_ns
-    grid = np.full((3, n_grid + 2 * pad), np.nan, dtype=np.float32)
+    grid = np.empty((3, n_grid + 2 * pad), dtype=np.float32)  # every point written below
+    grid[:, :pad] = np.nan
+    grid[:, pad + n_grid :] = np.nan
     # Chunk by chunk, each against the GT samples around it: the temporaries stay small and
     # in cache (an hour's whole-grid np.interp allocated ~30 MB). Every grid point gets the
     # same two samples and the same arithmetic as in one call over everything.
@@ -292,7 +399,7 @@ def _scan(
     """Mean distance at each offset with exact interpolation, all offsets in one evaluation."""
     shape = (len(offsets), len(robot_t))
     queries = (offsets[:, None] + robot_t[None, :]).ravel()  # offset-major
-    ev = _evaluate(gt, queries, max_gap_ns, _around_window(gt.t_ns, robot_t, offsets))
+    ev = _evaluate(gt, queries, max_gap_ns, _around_window(gt.t_ns, robot_t, offsets, queries))
     if len(ev.gt_xyz) == queries.size:
         dist = row_norm(robot_xyz - ev.gt_xyz.reshape(*shape, 3))
     else:
@@ -301,18 +408,24 @@ def _scan(
         dist.ravel()[ev.valid] = row_norm(np.take(robot_xyz, pose, axis=0) - ev.gt_xyz)
     valid = ev.valid.reshape(shape)
     counts = valid.sum(axis=1)
-    costs = np.full(len(offsets), np.inf)
-    for i in np.flatnonzero(counts):
-        # Each offset's mean over its own compared poses, summed as one array of them.
-        costs[i] = float(dist[i][valid[i]].mean())
+    if len(ev.gt_xyz) == queries.size:
+        costs = dist.mean(axis=1)  # each row summed as one array, as below
+    else:
+        costs = np.full(len(offsets), np.inf)
+        for i in np.flatnonzero(counts):
+            # Each offset's mean over its own compared poses, summed as one array of them.
+            costs[i] = float(dist[i][valid[i]].mean())
     # An offset that leaves few poses inside the GT could win by chance: require at least
     # half of the best coverage any offset achieves.
     enough = counts >= max(MIN_POSES, int(0.5 * counts.max()))
     return np.where(enough, costs, np.inf), counts
 
 
-def _around_window(t: I64, robot_t: I64, offsets: I64) -> tuple[IntArr, IntArr] | None:
-    """:func:`~ertools.geometry.bracket` of ``offsets[:, None] + robot_t[None, :]``, flattened.
+def _around_window(
+    t: I64, robot_t: I64, offsets: I64, queries: I64 | None = None
+) -> tuple[IntArr, IntArr] | None:
+    """:func:`~ertools.geometry.bracket` of ``offsets[:, None] + robot_t[None, :]``, flattened
+    (``queries``, if the caller has them already).
 
     The offsets span a few tens of ms, so each pose's queries fall among a handful of GT
     samples: counting the ones at or before each query there is ~5x cheaper than a binary
@@ -322,8 +435,11 @@ def _around_window(t: I64, robot_t: I64, offsets: I64) -> tuple[IntArr, IntArr] 
     width = np.searchsorted(t, robot_t + offsets.max(), side="right") - first
     if width.max() > 16:
         return None
-    queries = offsets[:, None] + robot_t[None, :]
-    right = np.broadcast_to(first, queries.shape).copy()
+    shape = (len(offsets), len(robot_t))
+    if queries is None:
+        queries = (offsets[:, None] + robot_t[None, :]).ravel()
+    queries = queries.reshape(shape)
+    right = np.broadcast_to(first, shape).copy()
     for w in range(int(width.max())):
         # Beyond its window a pose counts nothing (those samples lie after every query).
         cand = np.where(w < width, t.take(np.minimum(first + w, len(t) - 1)), MAX_NS)
@@ -338,6 +454,7 @@ def estimate_offset(
     search_range_ns: int = 5 * NS_PER_S,
     max_gap_ns: int = NS_PER_S // 10,
     seed: int = 0,
+    at_zero: tuple[float, int] | None = None,
 ) -> OffsetEstimate:
     """Estimate the offset to add to ``robot`` stamps to align them with ``gt``.
 
@@ -347,9 +464,16 @@ def estimate_offset(
         search_range_ns: search offsets within +- this.
         max_gap_ns: GT samples further apart than this are not interpolated across.
         seed: of the bootstrap's random generator (the result is deterministic).
+        at_zero: the mean distance and the poses compared with no offset, where the caller
+            compared them already by the same rule (``gt`` linearly interpolated, not across
+            more than ``max_gap_ns``); used when no GT sample repeats the one before it.
     """
-    gt = drop_repeats(gt)
-    at_zero = _mean_error(robot.t_ns, robot.xyz, gt, 0, max_gap_ns) if len(gt) >= 2 else None
+    measured = drop_repeats(gt)
+    if len(measured) < 2:
+        at_zero = None
+    elif at_zero is None or measured is not gt:
+        at_zero = _mean_error(robot.t_ns, robot.xyz, measured, 0, max_gap_ns)
+    gt = measured
     zero = None if at_zero is None or at_zero[1] == 0 else at_zero[0]
 
     def none(note: str, used: int = 0) -> OffsetEstimate:

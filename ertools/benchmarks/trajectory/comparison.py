@@ -175,14 +175,6 @@ def score_streams(
                 "overlapping): scanned in that order as 2015 did, which warned 'poses out of "
                 "order: result may be invalid' (--gt-order chain)"
             )
-    audit = estimate_offset(
-        robot, timed, search_range_ns=config.offset_range_ns, max_gap_ns=config.max_gap_ns
-    )
-    offset_ns = config.offset_ns
-    if config.auto_offset and config.apply_offset:
-        if audit.offset_ns is None:
-            raise ClockError(f"{where}: cannot apply the estimated clock offset: {audit.note}")
-        offset_ns = audit.offset_ns
     logged = robot  # the robot poses as logged (evo's association may repeat some)
 
     def match(part: PoseStream, at: int) -> Matched:
@@ -232,9 +224,27 @@ def score_streams(
             return match_rows(logged.take(rows), at + shifts_ns)
 
         shifted = None if config.t_max_diff is not None else rescore_shifted
-        return Rescoring(logged.t_ns + at, rescore, shifted)
+        gap = None if shifted is None else config.max_gap_ns
+        return Rescoring(logged.t_ns + at, rescore, shifted, gap)
 
-    matched = match(robot, offset_ns)
+    # With the offset known beforehand the score associates first: at no offset its pairs are
+    # the clock audit's own (the same robot and GT poses, interpolated by the same rule), and
+    # the audit takes their mean distance instead of pairing the poses once more.
+    applied = config.auto_offset and config.apply_offset
+    first = None if applied else match(robot, config.offset_ns)
+    audit = estimate_offset(
+        robot,
+        timed,
+        search_range_ns=config.offset_range_ns,
+        max_gap_ns=config.max_gap_ns,
+        at_zero=None if first is None else _audit_pairs(first, config),
+    )
+    offset_ns = config.offset_ns
+    if applied:
+        if audit.offset_ns is None:
+            raise ClockError(f"{where}: cannot apply the estimated clock offset: {audit.note}")
+        offset_ns = audit.offset_ns
+    matched = match(robot, offset_ns) if first is None else first
     if matched.robot_rows is not None and len(matched.robot_rows) != len(robot):
         # A robot pose in two of evo's pairs is two rows; the result's robot stream too.
         robot = robot.take(matched.robot_rows)
@@ -420,6 +430,27 @@ def score_streams(
         ),
     )
     return result
+
+
+def _audit_pairs(matched: Matched, config: TrajectoryConfig) -> tuple[float, int] | None:
+    """The clock audit's mean distance with no offset and its pose count, from the score's
+    association where it pairs exactly as the audit does: no offset, linear interpolation
+    in time order, nothing compared across a gap, held or before the GT (the audit then
+    checks that no GT sample repeats the one before it: none is tracking-lost)."""
+    same_rule = (
+        config.offset_ns == 0
+        and config.association == "linear"
+        and config.ties == "at"
+        and config.gaps == "skip"
+        and config.before_gt == "uncovered"
+        and config.gt_order == "time"
+        and config.t_max_diff is None
+    )
+    if not same_rule:
+        return None
+    ok = matched.status == COMPARED
+    used = int(np.count_nonzero(ok))
+    return (float(matched.position_error[ok].mean()), used) if used else (float("inf"), 0)
 
 
 def _other_benchmark_gt(robot_file: str, gt_topic: str) -> list[str]:

@@ -49,6 +49,28 @@ def test_repeats_by_hand() -> None:
     assert np.array_equal(np.delete(s.t_ns, 8), once.t_ns)
 
 
+def test_a_repeat_needs_all_three_coordinates_equal() -> None:
+    """x repeating alone is no repeat; -0.0 equals 0.0 and NaN equals nothing (IEEE)."""
+    nan = np.nan
+    xyz = np.array(
+        [
+            [1.0, 2.0, 3.0],
+            [1.0, 2.0, 4.0],  # z moved
+            [1.0, 5.0, 4.0],  # y moved
+            [1.0, 5.0, 4.0],  # repeat of 2
+            [-0.0, 5.0, 4.0],
+            [0.0, 5.0, 4.0],  # repeat of 4
+            [0.0, nan, 4.0],
+            [0.0, nan, 4.0],
+            [nan, 1.0, 1.0],
+            [nan, 1.0, 1.0],
+        ]
+    )
+    t = np.arange(10, dtype=np.int64) * 8_333_333
+    s = PoseStream(t, xyz, np.tile([0.0, 0.0, 0.0, 1.0], (10, 1)))
+    assert np.flatnonzero(repeated_positions(s)).tolist() == [2, 4]
+
+
 def test_short_streams_have_no_repeats() -> None:
     s = _stream()
     one = s.take(slice(0, 1))
