@@ -35,12 +35,13 @@ S = REPO / "sample_bags"
 
 # the interval code of each benchmark: (module, attribute) wrapped by a CPU clock (a module
 # or attribute a version does not have is skipped: the trajectory's noise is measured inside
-# trajectory_intervals before issue 39, beside it after; the score at the fitted offset calls
-# it from its own module since)
+# trajectory_intervals before issue 39, beside it after, as mocap_sigma and then jitter; the
+# score at the fitted offset calls it from its own module since)
 ENTRY = {
     "trajectory": (
         ("ertools.benchmarks.trajectory.comparison", "trajectory_intervals"),
         ("ertools.benchmarks.trajectory.comparison", "mocap_sigma"),
+        ("ertools.benchmarks.trajectory.comparison", "jitter"),
         ("ertools.benchmarks.trajectory.fitted", "trajectory_intervals"),
     ),
     "fbm3w": (("ertools.benchmarks.fbm3w.pipeline", "with_intervals"),),
@@ -215,7 +216,7 @@ def ensure_fbm1w(folder: Path) -> Path:
     path = folder / "log_fbm1w_2015-11-20-12-00-00_0.bag"
     if path.exists():
         return path
-    from ertools.samples import fbm1  # lazy: only to write the log once
+    from ertools.benchmarks.fbm1 import sample as fbm1  # lazy: only to write the log once
     from ertools.simulator.mocap import publish_environment, publish_mocap  # lazy: as above
     from ertools.simulator.statemachine import publish_states  # lazy: as above
     from ertools.simulator.writer import BagWriter  # lazy: as above

@@ -33,26 +33,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import F64, I64, IntArr
+from ertools.arrays import F64, I64, IntArr, distinct, median
 from ertools.benchmarks.common.clocks import MIN_POSES, OffsetEstimate
-from ertools.benchmarks.common.closed_forms import (
-    AngleMoments,
-    Raw,
-    angle_moments,
-    chi3_moments,
-    chi3_squared_moments,
-    circular_mean_moments,
-    lag_mixture,
-    lag_nodes,
-    mean_moments,
-    mix_angles,
-)
 from ertools.benchmarks.common.draws import (
-    BAND_SIGMAS,
     Distances,
     OrderStat,
     draw_order_stats,
@@ -80,6 +68,10 @@ from ertools.benchmarks.common.uncertainty import (
 )
 from ertools.benchmarks.trajectory.association import COMPARED, Matched
 from ertools.benchmarks.trajectory.formula import PERCENTILES
+from ertools.benchmarks.trajectory.spread import offset_spread
+from ertools.benchmarks.trajectory.steady import clear_of_losses
+from ertools.benchmarks.trajectory.steady import effects as steady_effects
+from ertools.benchmarks.trajectory.terms import PoseTerms
 from ertools.errors import ErtoolsError
 from ertools.geometry import wrap_angle, yaw_from_quat
 from ertools.streams import PoseStream
@@ -102,14 +94,17 @@ VELOCITY_HALF_SPAN = 5  # GT samples either side of a pose for its velocity (~40
 # of the offset's effect (an hour at 10 Hz: 36,000 poses)
 MAX_POSES = 1500
 MAX_GRID_POSES = 1000
+# Longer comparisons without a frame lag take the yaw's closed-form moments from the poses
+# near a fold and this many of the others (:meth:`PoseTerms.thinned_mean_like`)
+MAX_CLOSED = 4000
 # Shifts the statistics are re-scored at, over OFFSET_SPAN sd either side: a step of 0.2 sd.
 # Near the best offset a statistic grows as the square of the shift, and the chord between
 # two shifts lies above it by at most a (0.2 sd)^2 / 4 = 1% of its value 1 sd away.
 OFFSET_GRID = 41
 OFFSET_SPAN = 4.0  # a draw beyond (1 in 16,000) takes the grid's end value
-# GT samples the noise is measured on, at most: 10 runs of 2,000 (60,000 second differences
-# measure sigma to 0.5%, far below what the intervals can tell)
-SIGMA_BLOCKS, SIGMA_BLOCK = 10, 2000
+# GT samples the noise is measured on, at most: 5 runs of 2,000 (30,000 second differences
+# measure sigma to 1 %, far below what 400 draws can tell: their quantiles move by ~7 %)
+SIGMA_BLOCKS, SIGMA_BLOCK = 5, 2000
 
 #: The scores with an interval, in the order of the result's keys (``percentiles.pNN`` nested).
 KEYS = (
@@ -142,11 +137,14 @@ class Rescoring:
             at its own shift (rows may repeat), in one call; None where the association is
             not row by row (evo's: its side that looks up depends on the counts), and
             :func:`offset_effects` then calls ``associate`` once per shift.
+        max_gap_ns: the GT pair span the association calls a gap; None: never modelled
+            (:mod:`~ertools.benchmarks.trajectory.steady`), always re-scored.
     """
 
     t_ns: IntArr
     associate: Callable[[npt.NDArray[np.intp], int], Matched]
     associate_shifted: Callable[[npt.NDArray[np.intp], I64], Matched] | None = None
+    max_gap_ns: int | None = None
 
 
 @dataclass(frozen=True)
@@ -161,8 +159,8 @@ class MocapSigma:
 
 def _mad_sigma(d2: F64) -> float:
     """sigma of the noise from second differences (each sqrt(6) sigma): 1.4826 MAD."""
-    med = np.median(d2)
-    return float(1.4826 * np.median(np.abs(d2 - med)) / math.sqrt(6.0))
+    med = median(d2)
+    return float(1.4826 * median(np.abs(d2 - med)) / math.sqrt(6.0))
 
 
 def _second_differences(gt: PoseStream) -> tuple[F64, F64]:
@@ -185,7 +183,7 @@ def _second_differences(gt: PoseStream) -> tuple[F64, F64]:
 
 def _blocks(gt: PoseStream) -> PoseStream:
     """At most SIGMA_BLOCKS runs of SIGMA_BLOCK consecutive samples spread over ``gt``: an
-    hour of 120 Hz GT measures its noise as well as from 20,000 samples, 20 times faster."""
+    hour of 120 Hz GT measures its noise from 10,000 samples, 40 times faster."""
     n = len(gt)
     if n <= SIGMA_BLOCKS * SIGMA_BLOCK:
         return gt
@@ -232,74 +230,6 @@ def jitter(gt: PoseStream) -> MocapSigma:
     )
 
 
-def _fast_length(n: int) -> int:
-    """The smallest 2^a 3^b 5^c >= n: an FFT length as fast as a power of two, up to 1.6
-    times shorter."""
-    best = 1 << max(n - 1, 0).bit_length()
-    p5 = 1
-    while p5 < best:
-        p35 = p5
-        while p35 < best:
-            p = p35
-            while p < n:
-                p *= 2
-            best = min(best, p)
-            p35 *= 3
-        p5 *= 5
-    return best
-
-
-def offset_spread(
-    r_xyz: F64, g_xyz: F64, vel: F64, audit: OffsetEstimate, offset_ns: int
-) -> tuple[float, float]:
-    """(sd, disagreement) in seconds: the standard error of the clock offset, and how far
-    the clock audit's estimate lies from the offset applied.
-
-    The least-squares offset is off by ``sum_i v_i . e_i / sum_i |v_i|^2`` (v the GT
-    velocity at robot pose i, e the robot's error there). The poses' errors are not
-    independent (a robot's estimate drifts over seconds), and how much a drift moves that sum
-    depends on how it lines up with the path's velocity, which turns over a lap. The sd takes
-    that from the log itself: the error series slid along the path by every lag h is as
-    likely an alignment as the one logged (a stationary error, independent of where the path
-    turns), so the variance of the sum is that of the cross-correlation over the lags,
-    ``sum_h c(h)^2 / n`` with ``c(h) = sum_i v_i . e_(i+h)`` (e centred; all lags, no
-    window: a window keeps the lags over which a lap's drift projection adds up and drops
-    those over which it cancels, which is why a Newey-West sum overshoots 1.25 to 4 times).
-    For independent errors it is the sandwich standard error. On the simulator
-    (``bench/calibration/trajectory.py``: a bias, a 13 s drift and white noise, drawn anew per
-    trial) the offset's actual error is 1.11 times it, as it is of the variance the
-    simulator's own error model gives (the rest: the GT's stamping delay); the independent
-    poses' sandwich error was 1.57 times too small. The clock audit's block bootstrap
-    (``clock_audit``) stays the audit's warning threshold. The disagreement is the audit's
-    estimate minus the offset applied (0 with ``--offset auto --apply-offset``); the
-    intervals are centred on the offset applied whatever it is (they are the score's), and
-    the score at the audit's offset gets its own (``*_at_fitted_offset``).
-    """
-    sv = float(np.sum(np.square(vel)))
-    n = len(vel)
-    if n < 3 or sv <= 0.0 or audit.offset_ns is None:
-        return 0.0, 0.0
-    e = r_xyz - g_xyz
-    v = vel
-    centre = (audit.offset_ns - offset_ns) / NS_PER_S
-    if audit.disagrees_with(offset_ns):
-        # scored at an offset the data disagrees with (``--offset 0`` on a robot 0.35 s
-        # ahead), the errors hold v times that disagreement: the spread is the errors' at
-        # the offset the data fits (left in, it made the sd 0.2 s there). Not done
-        # otherwise: removing an offset estimated from these same errors would take out the
-        # drift's projection whose variance this measures.
-        e -= v * centre
-    e -= e.mean(axis=0)
-    # c(h) for every lag at once: zero-padded to a length >= 2n - 1, so the FFT's circular
-    # correlation is the linear one; sum_h c(h)^2 = sum_f |C(f)|^2 / m (Parseval)
-    m = _fast_length(2 * n - 1)
-    cross = np.sum(np.conj(np.fft.rfft(v, m, axis=0)) * np.fft.rfft(e, m, axis=0), axis=1)
-    power = np.abs(cross) ** 2
-    # rfft keeps f = 0..m/2: every other frequency stands for its conjugate twin too
-    total = float(power[0] + power[-1] + 2.0 * np.sum(power[1:-1])) / m
-    return math.sqrt(total / n) / sv, centre
-
-
 def _bracket(t: IntArr, q: IntArr) -> tuple[IntArr, IntArr]:
     """The GT samples k <= q < k+1 (clipped to the stream)."""
     n = len(t)
@@ -314,7 +244,7 @@ def _rescored_rows(t_robot: IntArr, t_gt: IntArr, reach_s: float) -> npt.NDArray
     rows = np.flatnonzero((t_robot >= t_gt[0] - reach) & (t_robot <= t_gt[-1] + reach))
     if len(rows) > MAX_GRID_POSES:
         pick = np.linspace(0, len(rows) - 1, MAX_GRID_POSES).round().astype(np.intp)
-        rows = rows[np.unique(pick)]
+        rows = rows[distinct(pick)]
     return rows
 
 
@@ -367,69 +297,16 @@ def offset_effects(rescoring: Rescoring, t_gt: IntArr, shifts_s: F64) -> F64:
     return np.asarray(out, dtype=np.float64)
 
 
-@dataclass(frozen=True, eq=False)
-class PoseTerms:
-    """What the perturbed statistics of the compared poses depend on, per pose (float64).
-
-    Attributes:
-        error: (n, 3) robot minus GT position.
-        theta: (n,) wrapped yaw difference robot minus GT; raw: 2015's unwrapped one.
-        sigma, sigma_yaw: (n,) the noise of the GT pose used (interpolation averages two).
-        velocity, yaw_rate: (n, 3), (n,) of the GT around the pose.
-        period: (n,) the GT frame period around the pose, seconds.
-        lag: (low, high) of the frame lag in periods (hold: (-1, 0), nearest: (-0.5,
-            0.5)); None for ``linear``.
-    """
-
-    error: F64
-    theta: F64
-    raw: F64
-    sigma: F64
-    sigma_yaw: F64
-    velocity: F64
-    yaw_rate: F64
-    period: F64
-    lag: tuple[float, float] | None
-
-    def mean_like(self, noise: bool, lag: bool) -> list[Callable[[F64], F64]]:
-        """For each of :data:`MEAN_LIKE` (position error, orientation error, RMSE, 2015
-        orientation error): a function of standard normal draws z giving the statistic's
-        values under the sources (closed forms, module doc)."""
-        nodes = lag_nodes(*self.lag) if lag and self.lag is not None else np.zeros(1)
-        s = self.sigma if noise else np.zeros_like(self.sigma)
-        sy = self.sigma_yaw if noise else np.zeros_like(self.sigma_yaw)
-        dist: list[Raw] = []
-        square: list[Raw] = []
-        wrapped: list[AngleMoments] = []
-        unwrapped: list[AngleMoments] = []
-        for node in nodes:
-            shift = node * self.period
-            d = np.sqrt(np.sum(np.square(self.error - shift[:, None] * self.velocity), axis=1))
-            dist.append(chi3_moments(d, s))
-            square.append(chi3_squared_moments(d, s))
-            turn = shift * self.yaw_rate
-            wrapped.append(angle_moments(self.theta - turn, sy))
-            unwrapped.append(angle_moments(self.raw - turn, sy, unwrapped=True))
-        one = len(nodes) == 1
-        mean = mean_moments(dist[0] if one else lag_mixture(dist))
-        squares = mean_moments(square[0] if one else lag_mixture(square))
-        orient = circular_mean_moments(wrapped[0] if one else mix_angles(wrapped))
-        o2015 = circular_mean_moments(unwrapped[0] if one else mix_angles(unwrapped))
-
-        def rmse(z: F64) -> F64:
-            return np.asarray(np.sqrt(np.maximum(squares.draw(z), 0.0)), dtype=np.float64)
-
-        return [mean.draw, orient.draw, rmse, o2015.draw]
-
-    def bounds(self, noise: bool, lag: bool) -> F64:
-        """How far each pose's distance can move in any draw (module doc)."""
-        out = np.zeros(len(self.sigma))
-        if noise:
-            out += BAND_SIGMAS * self.sigma
-        if lag and self.lag is not None:
-            reach = max(abs(self.lag[0]), abs(self.lag[1])) * self.period
-            out += reach * np.sqrt(np.sum(self.velocity**2, axis=1))
-        return out
+def _part_variance(parts: Mapping[str, F64], name: str) -> F64:
+    """(scores,) variance of each column of the source ``name``'s part of the draws (its
+    finite values; 0 with fewer than two)."""
+    part = parts[name]
+    finite = np.isfinite(part)
+    out = np.zeros(part.shape[1])
+    ok = finite.sum(axis=0) >= 2
+    if ok.any():
+        out[ok] = np.nanvar(np.where(finite, part, np.nan)[:, ok], axis=0)
+    return out
 
 
 def trajectory_intervals(
@@ -470,18 +347,22 @@ def trajectory_intervals(
     g_xyz = matched.gt_xyz[ok]
     t = gt.t_ns
     k, k1 = _bracket(t, q)
-    period = (t[k1] - t[k]) / NS_PER_S
+    tk = np.take(t, k)
+    gap = np.take(t, k1) - tk
+    period = gap / NS_PER_S
     # A pose compared across a GT gap (--gaps compare, 2015) is held up to the gap's length:
     # that is the log's gap (a validity matter, reported), not the frame period's lag
-    period = np.minimum(period, 1.5 * np.median(period))
-    a = np.clip((q - t[k]) / np.maximum(t[k1] - t[k], 1), 0.0, 1.0)
+    period = np.minimum(period, 1.5 * median(period))
+    a = np.clip((q - tk) / np.maximum(gap, 1), 0.0, 1.0)
     # GT velocity and yaw rate around each pose, over ~VELOCITY_HALF_SPAN samples either side
     lo = np.clip(k - VELOCITY_HALF_SPAN, 0, len(t) - 1)
     hi = np.clip(k1 + VELOCITY_HALF_SPAN, 0, len(t) - 1)
     span = np.maximum((t[hi] - t[lo]).astype(np.float64) / NS_PER_S, 1e-9)
-    vel = (gt.xyz[hi] - gt.xyz[lo]) / span[:, None]
+    # rows gathered by take (a fancy index of rows costs twice as much)
+    vel = (np.take(gt.xyz, hi, axis=0) - np.take(gt.xyz, lo, axis=0)) / span[:, None]
     # the yaw of the samples used only (an hour's GT holds 430,000)
-    turned = yaw_from_quat(gt.quat_xyzw[hi]) - yaw_from_quat(gt.quat_xyzw[lo])
+    quat = gt.quat_xyzw
+    turned = yaw_from_quat(np.take(quat, hi, axis=0)) - yaw_from_quat(np.take(quat, lo, axis=0))
     yaw_rate = wrap_angle(turned) / span
     sig = jitter(gt) if sigma is None else sigma
     lag: tuple[float, float] | None = None
@@ -506,7 +387,8 @@ def trajectory_intervals(
     n_all = len(q)
     thinned = np.arange(n_all)
     if n_all > MAX_POSES:
-        thinned = np.unique(np.linspace(0, n_all - 1, MAX_POSES).round().astype(np.intp))
+        # steps over 1: the rounded picks are distinct and increasing
+        thinned = np.linspace(0, n_all - 1, MAX_POSES).round().astype(np.intp)
     err = terms.error
     d = np.sqrt(err[:, 0] ** 2 + err[:, 1] ** 2 + err[:, 2] ** 2)
     est = np.array([estimates[key] for key in KEYS])
@@ -515,12 +397,22 @@ def trajectory_intervals(
     # compared or not), on a grid the draws interpolate
     grid = np.linspace(-OFFSET_SPAN, OFFSET_SPAN, OFFSET_GRID) * off_sigma
     on_grid = np.zeros((OFFSET_GRID, est.size))
+    gap_ns = rescoring.max_gap_ns
     if off_sigma > 0.0:
-        on_grid = offset_effects(rescoring, t, grid)
+        # where no pose crosses a loss within reach: the GT's motion on every pose
+        modelled = None
+        reach_ns = round(grid[-1] * NS_PER_S) + 1
+        linear = association == "linear" and gap_ns is not None
+        if linear and clear_of_losses(
+            q, matched.status, matched.t_ns, t, gt.xyz, k, reach_ns, gap_ns or 0
+        ):
+            modelled = steady_effects(terms, thinned, grid, ORDER_STATS, est.size, MEAN_LIKE)
+        on_grid = offset_effects(rescoring, t, grid) if modelled is None else modelled
     mean_cols = list(MEAN_LIKE)
 
     closed: dict[tuple[bool, bool], list[Callable[[F64], F64]]] = {}
     bands: dict[tuple[bool, bool], tuple[list[OrderStat], F64]] = {}
+    own: dict[str, F64] = {}  # each source's own part of the draws, where they add
 
     def perturbed(rng: np.random.Generator, sources: frozenset[str], draws: int) -> F64:
         """Draws whose basic (reflected) interval is the interval wanted (module doc):
@@ -533,7 +425,8 @@ def trajectory_intervals(
         if noise or frame:
             key = (noise, frame)  # the same closed forms and bands in two passes
             if key not in closed:
-                closed[key] = terms.mean_like(noise, frame)
+                full = (float(est[1]), float(est[-1]))
+                closed[key] = terms.thinned_mean_like(noise, frame, full, MAX_CLOSED)
                 bands[key] = order_stats(d, thinned, terms.bounds(noise, frame), ORDER_STATS)
             for j, (col, value) in enumerate(zip(mean_cols, closed[key], strict=True)):
                 measured[:, col] = value(z[:, j]) - est[col]
@@ -553,6 +446,8 @@ def trajectory_intervals(
             # is much finer than the draws' spread)
             for j in range(est.size):
                 offset[:, j] = np.interp(shift, grid, on_grid[:, j])
+        if noise and timing and not frame:
+            own[MOCAP_NOISE], own[TIME_ASSOCIATION] = measured, offset
         # mirrored: the offset is not a measurement of the truth plus an error that the
         # draws add again; the truth's offset is spread around the applied one as the draws
         # are, so the reflection of the basic interval must not apply to it
@@ -561,6 +456,11 @@ def trajectory_intervals(
     sources = [MOCAP_NOISE]
     if off_sigma > 0.0 or lag is not None:
         sources.append(TIME_ASSOCIATION)
+    # without a frame lag the noise and the offset are independent parts of each draw:
+    # a source's draws alone are its part of the draws of both (no pass for the shares)
+    alone = None
+    if lag is None and len(sources) == 2:
+        alone = {name: partial(_part_variance, own, name) for name in sources}
     got = monte_carlo(
         est,
         perturbed,
@@ -569,6 +469,7 @@ def trajectory_intervals(
         seed=settings.seed,
         confidence=settings.confidence,
         nonnegative=True,
+        alone_variance=alone,
     )
     intervals = dict(zip(KEYS, got, strict=True))
     src = [Source(MOCAP_NOISE, sig.position, "m", sig.measured, sig.note)]
@@ -583,7 +484,7 @@ def trajectory_intervals(
         else:
             parts.append(f"no offset estimate (clock audit: {audit.note or 'none'})")
         if lag is not None:
-            med = float(np.median(period)) * 1000
+            med = float(median(period)) * 1000
             parts.append(
                 f"{association}: GT frame period {med:.2f} ms (lag uniform over "
                 f"[{lag[0]:g}, {lag[1]:g}] periods)"

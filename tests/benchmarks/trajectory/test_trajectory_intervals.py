@@ -17,8 +17,8 @@ from ertools.benchmarks.trajectory.intervals import (
     Rescoring,
     jitter,
     offset_effects,
-    offset_spread,
 )
+from ertools.benchmarks.trajectory.spread import offset_spread
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
 from ertools.streams import PoseStream
