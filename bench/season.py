@@ -40,9 +40,6 @@ from ertools.samples.competition_files import (
     write_gt_file,
     write_robot_log,
 )
-
-# The one helper the sample competition keeps private: its FBM1 answer errors per team.
-from ertools.samples.competition_schedule import _fbm1_errors
 from ertools.simulator.answers import EPOCH_2015, log_name
 from ertools.simulator.simulated import SimulatedRun
 
@@ -116,7 +113,10 @@ def simulate(
     if slot.benchmark == "fbm1h":
         scale, wrong = knobs[f"fbm1h/{slot.team}"]
         return fbm1.simulate(
-            seed, start_ns=slot.start_ns, answer_errors=_fbm1_errors(scale, wrong), items=items
+            seed,
+            start_ns=slot.start_ns,
+            answer_errors=fbm1.answer_errors(scale, wrong),
+            items=items,
         )
     if slot.benchmark == "fbm2h":
         scale, t, rpy = knobs[f"fbm2h/{slot.team}"]

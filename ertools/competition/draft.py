@@ -26,13 +26,12 @@ from typing import Any
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Input
 from ertools.competition.discover import Execution
-from ertools.competition.found import Found, robot_benchmarks
+from ertools.competition.found import Found, robot_benchmarks, run_root, run_side_file
 from ertools.competition.ledger import Claim, place_files, root_of
 from ertools.competition.site_text import TEAM_UNKNOWN
 from ertools.io.formats import regular_files
-from ertools.rsbb.layout import FileKind, SeasonFile, layout_root
+from ertools.rsbb.layout import FileKind
 from ertools.timelines.build import rsbb_run
-from ertools.timelines.model import RsbbRunFiles
 from ertools.timeutil import NS_PER_S
 
 CONFIG_SUFFIXES = (".yaml", ".yml")
@@ -100,7 +99,24 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
         'title: ""  # TODO: the competition, as the results page shows it',
         "benchmarks:",
     ]
+    # side files that differ between the runs' layouts, by run bag: given per execution
+    run_values: dict[str, dict[str, Path]] = {}
+    # runs whose layout has none of a side file several other folders have: not listed (so
+    # unscoreable until the organiser names it), by run bag: the input and the candidates
+    unsure_runs: dict[str, list[str]] = {}
     by_benchmark: dict[str, list[str]] = {}
+
+    def per_run(benchmark: str, name: str, team: str | None = None) -> str | None:
+        """The draft's note when ``name`` is given run by run (recorded above), else None."""
+        split, unsure = rsbb_split(found, benchmark, name, team)
+        if not (split or unsure):
+            return None
+        for log, path in split.items():
+            run_values.setdefault(log, {})[name] = path
+        for log, cands in unsure.items():
+            unsure_runs.setdefault(log, []).append(_candidates(name, cands, base))
+        return f"# {name}: {_split_note(split, unsure, base)}"
+
     for e in executions:
         teams = by_benchmark.setdefault(e.benchmark, [])
         if e.team is not None and e.team not in teams:
@@ -126,6 +142,9 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
             if not mine or not all(i.name in found.values.get(e.bmbox_log, {}) for e in mine)
         ]
         for k, declared in enumerate(file_inputs):
+            if (note := per_run(name, declared.name)) is not None:
+                lines.append(f"      {note}")
+                continue
             side = rsbb_side(found, name, declared.name)
             if side is not None:
                 lines.append(
@@ -154,6 +173,9 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
             for team in teams:
                 entries = []
                 for declared in per_team:
+                    if (note := per_run(name, declared.name, team)) is not None:
+                        entries.append(f"        {note}")
+                        continue
                     side = rsbb_side(found, name, declared.name, team)
                     # the run's own layout first: a name elsewhere (another season) is a guess
                     hits = [side] if side is not None else []
@@ -189,13 +211,21 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
             "the options; a GT topic when the GT files hold several)"
         )
         lines += [f"      # {part}" for part in textwrap.wrap(text, 88)]
+
     # GT-only recordings (scored with their own values: a timing file...) are listed, so the
     # organiser sees how each is scored; others with no team get a commented entry to name them.
-    listed = [e for e in executions if e.bmbox_log in found.values]
-    unnamed = [e for e in executions if e.team is None and e.bmbox_log not in found.values]
+    def own(e: Execution) -> dict[str, Any]:
+        return {**found.values.get(e.bmbox_log, {}), **run_values.get(_key(e.bmbox_log), {})}
+
+    def is_listed(e: Execution) -> bool:
+        key = _key(e.bmbox_log)
+        return key not in unsure_runs and (e.bmbox_log in found.values or key in run_values)
+
+    listed = [e for e in executions if is_listed(e)]
+    unnamed = [e for e in executions if e.team is None and not is_listed(e)]
     lines.append("executions:" + ("" if unnamed or listed else " []"))
     for e in listed:
-        lines += _listed_entry(e, found.values[e.bmbox_log], files, base, claims)
+        lines += _listed_entry(e, own(e), files, base, claims)
     for e in unnamed:
         bags = [_rel(Path(p).resolve(), base) for p in (e.bmbox_log, *e.gt_files)]
         lines += [
@@ -206,6 +236,23 @@ def draft_text(found: Found, paths: Sequence[Path], target: Path, command: Seque
             "  #   team: TODO",
             f"  #   bags: {json.dumps(bags)}",
         ]
+    for e in executions:
+        if (todo := unsure_runs.get(_key(e.bmbox_log))) is None:
+            continue
+        bags = [_rel(Path(p).resolve(), base) for p in (e.bmbox_log, *e.gt_files)]
+        lines += [
+            f"  # {e.benchmark} at {_utc(e.start_ns)}: its RSBB layout lacks side files that "
+            "several folders hold: unscoreable until named. TODO: uncomment, name them:",
+            f"  # - benchmark: {e.benchmark}",
+            f"  #   team: {e.team}",
+            f"  #   bags: {json.dumps(bags)}",
+            "  #   inputs:",
+        ]
+        for key, value in own(e).items():
+            if isinstance(value, Path):
+                lines.append(f"  #     {key}: {_yaml(_rel(value, base))}")
+                claims.append(Claim(str(value), "input", e.id))
+        lines += [f"  #     {line}" for line in todo]
     lines += ["", "# The executions found (benchmark log, team and where its name came from):"]
     for e in executions:
         team = f"{e.team} (from {e.team_source})" if e.team else "no team"
@@ -226,7 +273,7 @@ def rsbb_side(found: Found, benchmark: str, name: str, team: str | None = None) 
         return None
     if name == "description":
         kind = FileKind.DESCRIPTION.value
-        roots = [_run_root(r) for r in folder.runs if r.code.lower() == benchmark]
+        roots = [run_root(r) for r in folder.runs if r.code.lower() == benchmark]
         descriptions = [Path(p).resolve() for k, p in folder.files if k == kind]
         own = [d for d in descriptions if any(r is not None and r in d.parents for r in roots)]
         return next(iter(own or descriptions), None)
@@ -241,13 +288,49 @@ def rsbb_side(found: Found, benchmark: str, name: str, team: str | None = None) 
     return None
 
 
-def _run_root(run: RsbbRunFiles) -> Path | None:
-    """The folder holding ``run``'s layout (its ``rsbb_logs/`` or ``results/``)."""
-    path = run.bag if run.bag is not None else run.result
-    kind = FileKind.RUN_BAG if run.bag is not None else FileKind.RESULT
-    if path is None:
-        return None
-    return layout_root(SeasonFile(Path(path).resolve(), kind, run.code, run.team))
+def rsbb_split(
+    found: Found, benchmark: str, name: str, team: str | None = None
+) -> tuple[dict[str, Path], dict[str, tuple[Path, ...]]]:
+    """Each run's side file for ``benchmark``'s input ``name`` (of ``team``'s runs, per-team)
+    by its run bag, and the runs whose file cannot be told (several elsewhere, none in its
+    layout), when one slot for all of them would be wrong; else two empty mappings."""
+    folder = found.timeline.rsbb
+    if folder is None:
+        return {}, {}
+    sure: dict[str, Path] = {}
+    unsure: dict[str, tuple[Path, ...]] = {}
+    for run in folder.runs:
+        if run.bag is None or run.code.lower() != benchmark:
+            continue
+        if team is not None and run.team != team:
+            continue
+        side = run_side_file(folder, run, name)
+        if isinstance(side, tuple):
+            unsure[_key(run.bag)] = side
+        elif side is not None:
+            sure[_key(run.bag)] = side
+    if unsure or len(set(sure.values())) > 1:
+        return sure, unsure
+    return {}, {}
+
+
+def _split_note(
+    split: Mapping[str, Path], unsure: Mapping[str, tuple[Path, ...]], base: Path
+) -> str:
+    files = sorted({_rel(p, base) for p in split.values()})
+    note = f"each run its own layout's ({', '.join(files)}): under executions: below"
+    for bag, candidates in unsure.items():
+        named = ", ".join(_rel(c, base) for c in candidates)
+        note += f"; TODO: {_rel(Path(bag), base)}: none in its layout, several elsewhere ({named})"
+    return note
+
+
+def _candidates(name: str, candidates: Sequence[Path], base: Path) -> str:
+    return f"{name}: TODO  # one of {', '.join(_rel(c, base) for c in candidates)}"
+
+
+def _key(bag: str) -> str:
+    return str(Path(bag).resolve())
 
 
 def _rel_text(text: str, base: Path) -> str:

@@ -38,11 +38,12 @@ from ertools.io.clock import clock_check
 from ertools.io.formats import regular_files
 from ertools.progress import Reporter
 from ertools.report.timeline_page import write_timeline_page
+from ertools.rsbb.layout import FileKind, SeasonFile, layout_root
 from ertools.rsbb.layout import classify as rsbb_classify
 from ertools.rsbb.results import parse_result_time
 from ertools.rsbb_states import BENCHMARKS
 from ertools.timelines.build import rsbb_run
-from ertools.timelines.model import RsbbFolder, Timeline
+from ertools.timelines.model import RsbbFolder, RsbbRunFiles, Timeline
 from ertools.timelines.scan import scan
 from ertools.timeutil import NS_PER_S
 
@@ -148,7 +149,7 @@ def find(
     own: dict[str, Mapping[str, Any]] = {}
     pairings = {p.path: p for p in timeline.pairings}
     results, rsbb_problems = rsbb_results(timeline.rsbb)
-    problems += rsbb_problems
+    problems += rsbb_problems + unsure_side_files(timeline.rsbb)
     for e in discovery.executions:
         if e.benchmark not in known:
             problems.append(
@@ -283,6 +284,75 @@ def rsbb_results(
                 }
             )
     return results, problems
+
+
+# A run's side-file inputs and the kind of file each is in the RSBB layout.
+SIDE_KINDS = {
+    "config": FileKind.BENCHMARK_CONFIG,
+    "items": FileKind.ITEMS,
+    "transform": FileKind.TRANSFORM,
+    "description": FileKind.DESCRIPTION,
+}
+
+
+def run_root(run: RsbbRunFiles) -> Path | None:
+    """The folder holding ``run``'s layout (its ``rsbb_logs/`` or ``results/``)."""
+    path = run.bag if run.bag is not None else run.result
+    kind = FileKind.RUN_BAG if run.bag is not None else FileKind.RESULT
+    if path is None:
+        return None
+    return layout_root(SeasonFile(Path(path).resolve(), kind, run.code, run.team))
+
+
+def run_side_file(
+    folder: RsbbFolder, run: RsbbRunFiles, name: str
+) -> Path | tuple[Path, ...] | None:
+    """``run``'s side file for the input ``name``: its own layout's, else the only one
+    elsewhere; the candidates when there are several elsewhere (nothing tells which is the
+    run's); None when there is none (or the run takes none: items of another benchmark)."""
+    kind = SIDE_KINDS.get(name)
+    if kind is None or (name != "description" and getattr(run, name) is None):
+        return None
+    candidates = []
+    for k, p in folder.files:
+        if k != kind.value:
+            continue
+        f = rsbb_classify(p)
+        if kind is FileKind.TRANSFORM and (f is None or f.team != run.team):
+            continue
+        if kind is FileKind.BENCHMARK_CONFIG and (f is None or f.code != run.code):
+            continue
+        candidates.append(Path(p).resolve())
+    root = run_root(run)
+    own = sorted(c for c in candidates if root is not None and root in c.parents)
+    if own or len(candidates) == 1:
+        return (own or candidates)[0]
+    return tuple(sorted(candidates)) or None
+
+
+def unsure_side_files(folder: RsbbFolder | None) -> list[dict[str, Any]]:
+    """An ``ambiguous`` problem for each run whose layout has no side file it takes while
+    several other folders have one (the run is scored only once the manifest names one)."""
+    out: list[dict[str, Any]] = []
+    if folder is None:
+        return out
+    for run in folder.runs:
+        if run.bag is None:
+            continue
+        for name in SIDE_KINDS:
+            side = run_side_file(folder, run, name)
+            if not isinstance(side, tuple) or not _declares(run.code.lower(), name):
+                continue
+            out.append(
+                {
+                    "kind": "ambiguous",
+                    "path": str(Path(run.bag).resolve()),
+                    "message": f"{run.code} run {run.run} of team {run.team}: no {name} in its "
+                    f"RSBB layout and {len(side)} elsewhere ({', '.join(map(str, side))}): "
+                    f"name the run's in the manifest (executions[].inputs.{name})",
+                }
+            )
+    return out
 
 
 def _declares(benchmark: str, name: str) -> bool:

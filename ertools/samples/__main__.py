@@ -10,7 +10,10 @@ registry, and the timeline folder and the season) is generated into
 ``OUTDIR/.<name>.XXXXXXXX.partial``, first, so a failure leaves the old folder in place).
 Without ``--seed`` each scenario uses its fixed
 default seed, so the output is byte-identical from run to run. An unknown scenario is an
-error naming it, before anything is written.
+error naming it, before anything is written. A scenario's answers about its folder as a
+whole (the season's: an organiser's folder holds no answers) are written beside it,
+``OUTDIR/<name>.answers.yaml`` (:func:`~ertools.simulator.answers.answers_path` of the
+folder), and move with it.
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ if __name__ == "__main__":
     sys.exit(launch(_start, "python -m ertools.samples"))
 
 import argparse
+import os
 import shutil
 import tempfile
 from collections.abc import Sequence
@@ -41,6 +45,7 @@ from ertools.errors import ErtoolsError
 from ertools.samples.competition import DEFAULT_SEED, write_competition
 from ertools.samples.scenario import ScenarioMissingError, load_scenario, scenarios, seed_of
 from ertools.samples.simd import rerun_pinned
+from ertools.simulator.answers import answers_path
 
 SIZE_BUDGET_BYTES = 2_600_000  # per log; sample_bags/ as a whole stays under ~15 MB
 
@@ -69,13 +74,19 @@ def generate(outdir: Path, names: Sequence[str], seed: int | None = None) -> dic
         # a folder of a unique name: two runs at once each build their own (the last rename
         # wins, with a whole folder)
         partial = Path(tempfile.mkdtemp(dir=outdir, prefix=f".{name}.", suffix=".partial"))
+        beside = answers_path(partial)
         try:
             paths = gen(partial, seed=seed_of(name) if seed is None else seed)
         except BaseException:
             shutil.rmtree(partial, ignore_errors=True)
+            beside.unlink(missing_ok=True)
             raise
         replace_folder(partial, final)
-        written[name] = [final / p.relative_to(partial) for p in paths]
+        if beside.exists():  # after its folder: a failure above leaves the old pair
+            os.replace(beside, answers_path(final))
+        written[name] = [
+            answers_path(final) if p == beside else final / p.relative_to(partial) for p in paths
+        ]
     return written
 
 

@@ -17,8 +17,9 @@ benchmarks_description.yaml`` (the referee items, in ertools' own words) and
 - STB (the scripted test benchmark, two goals): simbot only, its referee items in its result
   file.
 
-The task runs are shortened (tens of seconds, not ten minutes). ``answers.yaml`` at the
-folder's root holds the leaderboards a correct rescore gives, computed here from the plans:
+The task runs are shortened (tens of seconds, not ten minutes). ``season2019.answers.yaml``
+beside the folder (not in it: an organiser's folder holds no answers, and rescore would list it
+as unused) holds the leaderboards a correct rescore gives, computed here from the plans:
 HGMF's average distances from the noiseless truth, the task benchmarks' tallies and times
 (the GUI's stop button is sampled at 10 Hz from 0.36 s after the connect: the times are the
 planned ones exactly), ranked by the ERL rule (most achievements, then fewest penalties, then
@@ -36,7 +37,7 @@ import yaml
 from ertools.atomic import write_text
 from ertools.benchmarks import registry
 from ertools.errors import UsageError
-from ertools.simulator.answers import tol
+from ertools.simulator.answers import answers_path, tol
 from ertools.simulator.rsbb import write_rsbb_run
 
 S = 1_000_000_000
@@ -93,7 +94,8 @@ def hgmf_plans(hgmf: ModuleType) -> dict[str, tuple[Any, ...]]:
 
 
 def generate(outdir: Path, *, seed: int) -> list[Path]:
-    """Write the season folder into ``outdir`` and its answers (``answers.yaml``)."""
+    """Write the season folder into ``outdir`` and its answers beside it
+    (:func:`~ertools.simulator.answers.answers_path` of ``outdir``)."""
     hgmf = simulator(HGMF)
     written: list[Path] = []
     config = hgmf.write_config(outdir, OBJECTS)
@@ -124,9 +126,9 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     runs, referee_boards = referee.write_runs(outdir, T0 + 2 * 3600 * S, TEAMS)
     written += runs
     boards |= referee_boards
-    answers_path = outdir / "answers.yaml"
+    answers_file = answers_path(outdir)
     write_text(
-        answers_path,
+        answers_file,
         yaml.safe_dump(
             {
                 "benchmark": "season2019",
@@ -143,5 +145,5 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
             width=100,
         ),
     )
-    written.append(answers_path)
+    written.append(answers_file)
     return written

@@ -73,6 +73,11 @@ def tol(abs_: float, why: str) -> dict[str, Any]:
     return {"abs": float(abs_), "why": why}
 
 
+def given_tol(tolerance: Mapping[str, Any], key: str) -> dict[str, Any]:
+    """The tolerance entry ``tolerance[key]`` (an answers file's), as :func:`tol` makes one."""
+    return tol(tolerance[key]["abs"], tolerance[key]["why"])
+
+
 def to_plain(value: Any) -> Any:
     """NumPy scalars/arrays, tuples and Paths -> plain YAML-safe Python values."""
     if isinstance(value, Mapping):

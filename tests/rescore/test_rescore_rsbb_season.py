@@ -40,7 +40,8 @@ def season(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, dict[str, An
 
 @pytest.fixture(scope="module")
 def answers() -> dict[str, Any]:
-    data: dict[str, Any] = yaml.safe_load((SEASON / "answers.yaml").read_text(encoding="utf-8"))
+    text = (SAMPLES / "season2019.answers.yaml").read_text(encoding="utf-8")
+    data: dict[str, Any] = yaml.safe_load(text)
     return data
 
 
@@ -65,7 +66,9 @@ def test_the_draft_places_every_run_result_and_side_file(season: Any) -> None:
             assert place == "execution", path
         elif path.startswith(("results/", "rsbb_etc/", "rsbb_bmbox/")):
             assert place == "input", path
-    assert places["answers.yaml"] == "problem"  # the only file that is no run's
+    # the answers are beside the folder, as an organiser's folder holds none: no problem
+    assert all(place != "problem" for place in places.values()), places
+    assert doc["problems"] == []
     assert len(doc["executions"]) == 9 and all(e["status"] == "scored" for e in doc["executions"])
     # the folders name the teams; the draft lists the runs with a result file by name
     sources = {(e["benchmark"], e["team_source"]) for e in doc["executions"]}
@@ -229,3 +232,17 @@ def test_timeline_shows_the_runs(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["timeline", str(SEASON), "--no-clock-check"]) == 0
     text = capsys.readouterr().out
     assert "RSBB runs (9, docs/rsbb.md):" in text and "no GT file covers it" not in text
+
+
+def test_the_sample_season_rescores_in_one_command_without_a_warning(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # the README's command on the committed folder: what an organiser has, nothing unused
+    out = tmp_path / "out"
+    code = main(["rescore", str(SEASON), "--out", str(out), "--no-reports", "-j", "1"])
+    assert code == 0
+    err = capsys.readouterr().err
+    assert "warning" not in err, err
+    doc: dict[str, Any] = json.loads((out / "results.json").read_text(encoding="utf-8"))
+    assert doc["problems"] == []
+    assert len(doc["executions"]) == 9

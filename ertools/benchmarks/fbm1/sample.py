@@ -34,6 +34,7 @@ rules (``totals_2015``: accuracies over 10, unclipped 1.2 m).
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -43,7 +44,14 @@ import yaml
 from scipy.spatial.transform import Rotation
 
 from ertools.arrays import F64
-from ertools.simulator.answers import EPOCH_2015, log_name, tol, window, write_answers
+from ertools.simulator.answers import (
+    EPOCH_2015,
+    given_tol,
+    log_name,
+    tol,
+    window,
+    write_answers,
+)
 from ertools.simulator.mocap import (
     MocapNoise,
     frame_times,
@@ -417,3 +425,63 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         tolerance=sim.tolerance,
     )
     return [bag_path, items_path, answers]
+
+
+# The sample competition's part (ertools.samples.competition_schedule): per team, the scale of
+# the pose errors of runs 1-6 and the runs (1-based) answered with a wrong class.
+COMPETITION_TEAMS: dict[str, tuple[float, tuple[int, ...]]] = {
+    "homer": (1.0, ()),
+    "socrob": (1.8, (2, 3)),
+    "skuba": (0.5, (1,)),
+}
+
+
+def answer_errors(
+    scale: float, wrong: tuple[int, ...]
+) -> tuple[tuple[bool, bool, float, float, float], ...]:
+    """The default answers with runs 1-6's pose errors scaled and some classes wrong (runs 7-9
+    keep their seam and clip cases)."""
+    out = []
+    for k, (cls, inst, dx, dy, dth) in enumerate(ANSWER_ERRORS):
+        if k < 6:
+            dx, dy, dth = dx * scale, dy * scale, dth * scale
+        if k + 1 in wrong:
+            cls = inst = False
+        out.append((cls, inst, dx, dy, dth))
+    return tuple(out)
+
+
+def competition_run(
+    team: str, attempt: int, seed: int, start_ns: int, items: list[dict[str, Any]]
+) -> SimulatedRun:
+    """``team``'s execution in the sample competition (its knobs above; the day's items)."""
+    scale, wrong = COMPETITION_TEAMS[team]
+    return simulate(seed, start_ns=start_ns, answer_errors=answer_errors(scale, wrong), items=items)
+
+
+def competition_score(
+    exp: Mapping[str, Any], tolerance: Mapping[str, Any]
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The fields of ``ertools score ... --format json`` a competition execution must show
+    (from its ``expected``) and their tolerances (its ``tolerance``'s), by dotted path."""
+    score: dict[str, Any] = {}
+    tols: dict[str, Any] = {}
+    exact = tol(0, "counts are exact")
+    pose = given_tol(tolerance, "pose_score")
+    timing = given_tol(tolerance, "execution_time")
+    totals = exp["totals"]
+    for key, t in (
+        ("class_accuracy", exact),
+        ("instance_accuracy", exact),
+        ("pose_score", pose),
+        ("execution_time", timing),
+    ):
+        score[key], tols[key] = totals[key], t
+    for run in exp["runs"]:
+        k = f"runs.{run['run']}"
+        score[f"{k}.status"], tols[f"{k}.status"] = run["status"], exact
+        for key in ("class_correct", "instance_correct"):
+            score[f"{k}.{key}"], tols[f"{k}.{key}"] = bool(run[key]), exact
+        score[f"{k}.pose_score"], tols[f"{k}.pose_score"] = run["pose_score"], pose
+        score[f"{k}.execution_time"], tols[f"{k}.execution_time"] = run["execution_time"], timing
+    return score, tols

@@ -37,6 +37,7 @@ numbered from 0, the ``dinstance_error`` spelling, the unwrapped orientation for
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -45,7 +46,14 @@ import yaml
 from scipy.spatial.transform import Rotation, Slerp
 
 from ertools.arrays import F64
-from ertools.simulator.answers import EPOCH_2015, log_name, tol, window, write_answers
+from ertools.simulator.answers import (
+    EPOCH_2015,
+    given_tol,
+    log_name,
+    tol,
+    window,
+    write_answers,
+)
 from ertools.simulator.mocap import (
     MocapNoise,
     MocapPublished,
@@ -495,3 +503,61 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         tolerance=sim.tolerance,
     )
     return [bag_path, goal_path, transform_path, timing_path, answers]
+
+
+# The sample competition's part (ertools.samples.competition_schedule): per team, the scale
+# of its stop errors and its marker mount (t, rpy of T_marker_robot).
+COMPETITION_TEAMS: dict[str, tuple[float, tuple[float, ...], tuple[float, ...]]] = {
+    "homer": (0.6, (0.10, 0.03, -0.78), (0.0, 0.01, 0.45)),
+    "socrob": (1.0, MARKER_TO_ROBOT_T, MARKER_TO_ROBOT_RPY),
+    "skuba": (1.5, (-0.05, 0.0, -0.92), (0.015, 0.0, -1.2)),
+}
+
+
+def competition_run(
+    team: str, attempt: int, seed: int, start_ns: int, items: list[dict[str, Any]]
+) -> SimulatedRun:
+    """``team``'s execution in the sample competition (its knobs above)."""
+    scale, t, rpy = COMPETITION_TEAMS[team]
+    errors = tuple((dx * scale, dy * scale, dth * scale) for dx, dy, dth in STOP_ERRORS)
+    return simulate(
+        seed,
+        start_ns=start_ns,
+        team=team,
+        stop_errors=errors,
+        marker_to_robot_t=(t[0], t[1], t[2]),
+        marker_to_robot_rpy=(rpy[0], rpy[1], rpy[2]),
+        transform_stamp="2015-11-20_08:40:00",
+    )
+
+
+def competition_score(
+    exp: Mapping[str, Any], tolerance: Mapping[str, Any]
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The fields of ``ertools score ... --format json`` a competition execution must show
+    (from its ``expected``) and their tolerances (its ``tolerance``'s), by dotted path."""
+    dist = given_tol(tolerance, "distance_error")
+    orient = given_tol(tolerance, "orientation_error")
+    timing = given_tol(tolerance, "segment_time")
+    score: dict[str, Any] = {
+        "position_accuracy": exp["position_accuracy"],
+        "orientation_accuracy": exp["orientation_accuracy"],
+        "execution_time": exp["execution_time"],
+        "timeout_segments": exp["timeout_segments"],
+    }
+    tols: dict[str, Any] = {
+        # a mean of errors each within the per-segment tolerance stays within it
+        "position_accuracy": dist,
+        "orientation_accuracy": orient,
+        "execution_time": timing,
+        "timeout_segments": tol(0, "counts are exact"),
+    }
+    for k, seg in enumerate(exp["segments"]):
+        path = f"details.segments_details.{k}"
+        for key, value, t in (
+            ("dinstance_error", seg["distance_error"], dist),
+            ("orientation_error", seg["orientation_error"], orient),
+            ("segment_time", seg["segment_time"], timing),
+        ):
+            score[f"{path}.{key}"], tols[f"{path}.{key}"] = value, t
+    return score, tols

@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -45,7 +45,14 @@ import yaml
 
 from ertools.arrays import F64
 from ertools.geometry import quat_from_yaw
-from ertools.simulator.answers import EPOCH_2015, log_name, tol, window, write_answers
+from ertools.simulator.answers import (
+    EPOCH_2015,
+    given_tol,
+    log_name,
+    tol,
+    window,
+    write_answers,
+)
 from ertools.simulator.mocap import (
     MocapNoise,
     TrackingLoss,
@@ -465,3 +472,56 @@ def _still_phases(t: npt.NDArray[np.int64], xy: F64) -> list[tuple[int, int]]:
         if b > a:
             out.append((int(t[a]), int(t[b])))
     return out
+
+
+# The sample competition's part (ertools.samples.competition_schedule): per team, the scale
+# of its path deviation amplitude, per attempt.
+COMPETITION_TEAMS: dict[str, tuple[float, float]] = {
+    "b-it-bots": (1.1, 1.3),
+    "robotto": (1.7, 2.2),
+}
+
+
+def competition_run(
+    team: str, attempt: int, seed: int, start_ns: int, items: list[dict[str, Any]]
+) -> SimulatedRun:
+    """``team``'s ``attempt``-th execution in the sample competition (its knobs above)."""
+    scale = COMPETITION_TEAMS[team][attempt - 1]
+    return simulate(seed, start_ns=start_ns, amplitude=tuple(a * scale for a in AMPLITUDE))
+
+
+def competition_score(
+    exp: Mapping[str, Any], tolerance: Mapping[str, Any]
+) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The fields of ``ertools score ... --format json`` a competition execution must show
+    (from its ``expected``) and their tolerances (its ``tolerance``'s), by dotted path."""
+    dist = given_tol(tolerance, "distance_error")
+    timing = given_tol(tolerance, "execution_time")
+    errors = sorted(
+        float(r["distance_error"])
+        for r in exp["runs_details"].values()
+        if r["distance_error"] is not None
+    )
+    if len(errors) > 1 and errors[1] - errors[0] <= 2 * dist["abs"]:
+        raise ValueError(f"best run ambiguous within the tolerance: {errors[:2]}")
+    score: dict[str, Any] = {
+        "best_run": exp["best_run"],
+        "best_distance_error": exp["best_distance_error"],
+        "execution_time": exp["execution_time"],
+    }
+    tols: dict[str, Any] = {
+        "best_run": tol(0, "the best run's margin over the next exceeds twice the tolerance"),
+        "best_distance_error": dist,
+        "execution_time": timing,
+    }
+    for k, run in exp["runs_details"].items():
+        path = f"runs_details.{k}"
+        score[f"{path}.distance_error"] = run["distance_error"]
+        tols[f"{path}.distance_error"] = (
+            dist if run["distance_error"] is not None else tol(0, "a timed-out run has none")
+        )
+        score[f"{path}.execution_time"], tols[f"{path}.execution_time"] = (
+            run["execution_time"],
+            timing,
+        )
+    return score, tols
