@@ -14,10 +14,11 @@ import numpy.typing as npt
 
 from ertools.arrays import F64, I64, U8
 from ertools.geometry import yaw_from_quat
-from ertools.states import Machine, state_name
 
 if TYPE_CHECKING:
     import pandas as pd
+
+    from ertools.states import Machine
 
 
 def _window_slice(t_ns: I64, start_ns: int | None, end_ns: int | None) -> slice:
@@ -217,6 +218,8 @@ class StateStream:
     def to_dataframe(self) -> pd.DataFrame:
         """state (int), state_name and payload, indexed by a UTC DatetimeIndex named ``time``."""
         import pandas as pd  # lazy: pandas only for DataFrames (~0.2 s to import)
+
+        from ertools.states import state_name  # lazy: 5 enums, 2 ms, only for state names
 
         index = pd.DatetimeIndex(pd.to_datetime(self.t_ns, unit="ns", utc=True), name="time")
         return pd.DataFrame(

@@ -10,7 +10,6 @@ too many (a bz2 stream a few hundred bytes long may hold gigabytes of zeros).
 
 from __future__ import annotations
 
-import bz2
 from collections.abc import Callable, Iterator
 from typing import Any, BinaryIO, Protocol, TypeVar
 
@@ -111,6 +110,8 @@ def inflate_into(
 def _checked(compression: str, data: Any, size: int, where: str, what: str) -> Iterator[bytes]:
     """The pieces of a bz2 or lz4 stream, exactly ``size`` bytes in all (or a BagError)."""
     if compression == "bz2":
+        import bz2  # lazy: bz2, 1 ms, only for a bz2-compressed chunk
+
         make: Any = bz2.BZ2Decompressor
     elif compression == "lz4":
         import lz4.frame  # lazy: lz4, 7 ms

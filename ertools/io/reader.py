@@ -11,6 +11,7 @@ import logging
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
@@ -33,8 +34,10 @@ from ertools.io.model import (
     RawMessage,
 )
 from ertools.io.pipeline import Request
-from ertools.states import MSG_TYPES, STATE_TOPIC_SUFFIXES, Machine
 from ertools.streams import MAX_FRAME_CHANGES, FrameChange, PoseStream, StateStream
+
+if TYPE_CHECKING:
+    from ertools.states import Machine
 
 log = logging.getLogger("ertools.io.reader")
 
@@ -440,6 +443,8 @@ def read_messages(
 
 
 def _machine_of(topic: str, msgtype: str) -> Machine | None:
+    from ertools.states import MSG_TYPES, STATE_TOPIC_SUFFIXES  # lazy: 5 enums, 2 ms, states only
+
     for machine, name in MSG_TYPES.items():
         if msgtype == name:
             return machine
@@ -530,6 +535,8 @@ def read_benchmark_states(paths: PathsLike, namespace: str) -> BenchmarkStates:
     A machine whose topic is in none of the files is None. The BmBox topic is looked up as
     ``bmbox_state`` and as the seed's misspelt ``bbbox_state``.
     """
+    from ertools.states import STATE_TOPIC_SUFFIXES, Machine  # lazy: 5 enums, 2 ms, states only
+
     plist = _paths(paths)
     present = topics(plist)
     ns = "/" + namespace.strip("/")

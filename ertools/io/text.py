@@ -19,10 +19,8 @@ A bad value is one line naming its row (the file's line number) and column.
 
 from __future__ import annotations
 
-import csv
 import io
 from dataclasses import dataclass
-from decimal import ROUND_HALF_EVEN, Decimal, InvalidOperation
 from pathlib import Path
 from typing import NoReturn
 
@@ -260,6 +258,8 @@ def _plain_decimal_ns(tokens: list[str]) -> tuple[I64, npt.NDArray[np.bool_]]:
 def _decimal_ns(rows: _Rows, path: Path) -> I64:
     """The first column, decimal seconds, as int64 ns exactly (integer arithmetic; half to
     even past the 9th decimal, exponents via Decimal)."""
+    from decimal import ROUND_HALF_EVEN, Decimal, InvalidOperation  # lazy: decimal, 1 ms, text only
+
     tokens = _first_cells(rows)
     out, plain = _plain_decimal_ns(tokens)
     for r in np.flatnonzero(~plain).tolist():  # exponents, long fractions: rare
@@ -340,6 +340,8 @@ def read_text_poses(path: str | Path, fmt: TextFormat | None = None) -> PoseStre
 def _csv_frame(path: Path) -> str:
     """The frame_id of ertools' CSV (one value repeated): read with the csv module, which
     undoes the RFC 4180 quoting the writer applied."""
+    import csv  # lazy: csv, 1 ms, only to read a CSV export back
+
     with io.TextIOWrapper(open_regular(path), encoding="utf-8", newline="") as f:
         reader = csv.reader(f)
         next(reader, None)

@@ -37,8 +37,26 @@ HEAVY = ("scipy", "matplotlib", "pandas", "jinja2")
 # item 2, docs/performance.md "Start-up"): PyYAML (YAML output, config files, rosbag2
 # metadata), the MCAP readers (a ROS1 bag here), the ROS1 record scan of damaged bags, NumPy's
 # masked arrays (np.median, np.percentile, np.unique import them: ertools.arrays has their own),
-# sqlite3 (rosbag2 storage).
-NOT_FOR_JSON = ("yaml", "ertools.io.mcap", "ertools.io.ros1.check", "numpy.ma", "sqlite3")
+# sqlite3 (rosbag2 storage). Then standard-library modules, each ~1-3 ms with what it imports,
+# used where they are needed (a `# lazy:` import): statistics (z_value; it imports fractions
+# and decimal), tempfile (rosbag2's file-compressed storage), csv and decimal (text
+# trajectories), shutil with lzma (argparse's width; bz2 too, but the sample logs are bz2
+# chunks), and the 2015 state enums (ertools.states: only state topics).
+NOT_FOR_JSON = (
+    "yaml",
+    "ertools.io.mcap",
+    "ertools.io.ros1.check",
+    "numpy.ma",
+    "sqlite3",
+    "statistics",
+    "fractions",
+    "tempfile",
+    "csv",
+    "decimal",
+    "shutil",
+    "lzma",
+    "ertools.states",
+)
 
 
 def imported(*argv: str) -> tuple[int, set[str]]:
@@ -161,8 +179,9 @@ TRAJECTORY_PARSER = frozenset(
 # Standard-library modules the parser no longer imports, each 1.5 - 7 ms of its time (they may
 # not be imported lazily: the ertools module that needs them is): logging (cli/logs.py, after
 # parsing), json (serialize.json_text), tempfile (ertools.atomic, for --out), datetime
-# (ertools.timeutil, for a number's bound once given).
-NOT_FOR_THE_PARSER = ("logging", "json", "tempfile", "datetime")
+# (ertools.timeutil, for a number's bound once given); shutil with bz2, lzma and zlib, 2 ms
+# (argparse's formatter asks it the terminal's width: cli.main's _Formatter asks os).
+NOT_FOR_THE_PARSER = ("logging", "json", "tempfile", "datetime", "shutil")
 
 
 def test_the_trajectory_parser_imports_only_what_it_needs() -> None:

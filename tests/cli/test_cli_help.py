@@ -4,12 +4,14 @@ given to the wrong benchmark named for what it is."""
 
 from __future__ import annotations
 
+import argparse
 import re
 from pathlib import Path
 
 import pytest
 
 from ertools.benchmarks import registry
+from ertools.cli import main as main_module
 from ertools.cli.main import COMMANDS, main
 from ertools.cli.text import error_text
 from tests.helpers.bagmaker import Spec, write
@@ -181,3 +183,22 @@ def test_the_readme_shows_that_message_as_printed(
     err = capsys.readouterr().err
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     assert f"```text\n$ ertools score fbm2h {bag}\n{err}```" in readme
+
+
+@pytest.mark.parametrize("columns", [None, "57", "0", "wide"])
+def test_help_wraps_at_the_width_argparse_would_use(
+    columns: str | None, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # cli.main's formatter asks os for the width instead of shutil (2 ms of start-up): the help
+    # must wrap where argparse's own formatter, which asks shutil, wraps it
+    if columns is None:
+        monkeypatch.delenv("COLUMNS", raising=False)
+    else:
+        monkeypatch.setenv("COLUMNS", columns)
+    ours = _help(["score", "trajectory"], capsys)
+    with monkeypatch.context() as m:
+        m.setattr(main_module, "_Formatter", argparse.RawDescriptionHelpFormatter)
+        theirs = _help(["score", "trajectory"], capsys)
+    assert ours == theirs
+    if columns == "57":  # options' help wrapped at 55 columns, not the default 78
+        assert max(len(line) for line in ours.splitlines() if line.startswith("  -")) <= 55

@@ -5,8 +5,6 @@ to sqlite3 storage (:mod:`ertools.io.rosbag2.sqlite_storage`, imported only for 
 from __future__ import annotations
 
 import atexit
-import shutil
-import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -47,6 +45,9 @@ _SCRATCH: list[Path] = []
 
 def _scratch() -> Path:
     if not _SCRATCH:
+        import shutil  # lazy: shutil pulls bz2, lzma (2 ms), only for a file-compressed bag
+        import tempfile  # lazy: tempfile pulls random (1.5 ms), only for this
+
         folder = Path(tempfile.mkdtemp(prefix="ertools-rosbag2-"))
         atexit.register(shutil.rmtree, folder, True)
         _SCRATCH.append(folder)
