@@ -239,3 +239,32 @@ def test_the_command_starts_one_blas_thread_unless_told(given: str | None, used:
         check=True,
     )
     assert done.stdout.split() == ["ertools", __version__, used]
+
+
+# What the console command leaves for Python's exit (`ertools --version`): frozen objects and
+# the collector's settings.
+EXIT_PROBE = """
+import gc, sys
+from ertools.__main__ import main
+sys.argv = ["ertools", "--version"]
+code = main()
+print(code, gc.get_freeze_count(), len(gc.get_objects()), gc.get_threshold()[0])
+"""
+
+
+def test_the_command_leaves_no_heap_for_the_exits_garbage_collection() -> None:
+    # Python's exit collects every generation, the frozen objects excepted: 40 ms after an
+    # hour's score (docs/performance.md, "Exit"); the run collects every 100,000 new objects
+    done = subprocess.run(
+        [sys.executable, "-c", EXIT_PROBE],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
+    )
+    code, frozen, left, threshold = done.stdout.split()[-4:]
+    assert code == "0"
+    assert int(frozen) > 1000  # the modules' objects, at least
+    assert int(left) < 100  # what the exit's collections would scan
+    assert int(threshold) == 100_000  # Python's default is 700
