@@ -230,20 +230,32 @@ def _matched(
     across = inside & (gap_ns > max_gap_ns)
     if gaps == "skip":
         status[across] = GAP
-    same = has_pair & same_rows(gt.xyz, fi, si)
-    status[(status == COMPARED) & same] = TRACKING_LOST
+    # tracking lost: the pair's positions equal; x compared first (a moving body's x rarely
+    # repeats), the whole rows only where it does
+    gx = gt.xyz[:, 0]
+    maybe = np.flatnonzero(has_pair & (gx.take(fi) == gx.take(si)))
+    if maybe.size:
+        same = np.zeros(len(q), dtype=bool)
+        same[maybe] = same_rows(gt.xyz, fi[maybe], si[maybe])
+        status[(status == COMPARED) & same] = TRACKING_LOST
     ok = status == COMPARED
+    every = bool(ok.all())
 
-    gt_yaw = np.where(ok, yaw_from_quat(gt_quat_at), np.nan)
+    def compared(values: F64) -> F64:
+        """``values`` where compared, NaN elsewhere (as they are when every pose is)."""
+        return values if every else np.where(ok, values, np.nan)
+
+    gt_yaw = compared(yaw_from_quat(gt_quat_at))
     robot_yaw = yaw_from_quat(robot.quat_xyzw)
-    pos_err = np.where(ok, row_norm(robot.xyz - gt_xyz_at), np.nan)
+    pos_err = compared(row_norm(robot.xyz - gt_xyz_at))
     # gt_xyz_at is this association's own array: NaN written into it where not compared
     # rather than into a copy (megabytes of fresh memory on an hour's poses)
     gt_xyz = gt_xyz_at
-    if not ok.all():
+    if not every:
         gt_xyz[~ok] = np.nan
-    yaw_err = np.abs(wrap_angle(np.where(ok, robot_yaw - gt_yaw, np.nan)))
-    raw = np.where(ok, yaw_tf(robot.quat_xyzw) - yaw_tf(gt_quat_at), np.nan)
+    yaw_err = wrap_angle(compared(robot_yaw - gt_yaw))
+    np.abs(yaw_err, out=yaw_err)
+    raw = compared(yaw_tf(robot.quat_xyzw) - yaw_tf(gt_quat_at))
     return Matched(
         q, status, gt_xyz, gt_yaw, pos_err, yaw_err, raw, ties_n, across, int(early.sum())
     )
