@@ -51,6 +51,10 @@ class Matched:
             alone (None for the other associations).
         robot_rows: with :func:`associate_evo`, the robot pose of each row (a robot pose
             that evo pairs with two GT poses is two rows); None: row i is robot pose i.
+        gt_lo: (N,) with :func:`associate` over GT in time order, the last GT sample at or
+            before each row's time (-1 before the first): its binary search, kept for the
+            intervals (:func:`~ertools.benchmarks.trajectory.intervals.trajectory_intervals`,
+            given the same GT); None: not kept.
     """
 
     t_ns: I64
@@ -65,6 +69,7 @@ class Matched:
     before_gt: int
     gt_quat_xyzw: F64 | None = None
     robot_rows: npt.NDArray[np.intp] | None = None
+    gt_lo: npt.NDArray[np.intp] | None = None
 
     def count(self, status: int) -> int:
         return int(np.count_nonzero(self.status == status))
@@ -149,6 +154,7 @@ def associate(
         ties_n,
         max_gap_ns,
         gaps,
+        gt_lo=interp.lo,
     )
 
 
@@ -222,8 +228,10 @@ def _matched(
     ties_n: int,
     max_gap_ns: int,
     gaps: Gaps,
+    gt_lo: npt.NDArray[np.intp] | None = None,
 ) -> Matched:
-    """Statuses and errors from the GT pose chosen for each robot pose."""
+    """Statuses and errors from the GT pose chosen for each robot pose (``gt_lo``: kept,
+    :class:`Matched`)."""
     q = robot.t_ns
     status = np.full(len(q), COMPARED, dtype=np.uint8)
     status[~inside] = UNCOVERED
@@ -232,8 +240,9 @@ def _matched(
         status[across] = GAP
     # tracking lost: the pair's positions equal; x compared first (a moving body's x rarely
     # repeats), the whole rows only where it does
-    gx = gt.xyz[:, 0]
-    maybe = np.flatnonzero(has_pair & (gx.take(fi) == gx.take(si)))
+    # (taken from the flat array: a column's take would copy the whole strided column)
+    flat = np.ravel(gt.xyz)
+    maybe = np.flatnonzero(has_pair & (flat.take(3 * fi) == flat.take(3 * si)))
     if maybe.size:
         same = np.zeros(len(q), dtype=bool)
         same[maybe] = same_rows(gt.xyz, fi[maybe], si[maybe])
@@ -257,7 +266,17 @@ def _matched(
     np.abs(yaw_err, out=yaw_err)
     raw = compared(yaw_tf(robot.quat_xyzw) - yaw_tf(gt_quat_at))
     return Matched(
-        q, status, gt_xyz, gt_yaw, pos_err, yaw_err, raw, ties_n, across, int(early.sum())
+        q,
+        status,
+        gt_xyz,
+        gt_yaw,
+        pos_err,
+        yaw_err,
+        raw,
+        ties_n,
+        across,
+        int(early.sum()),
+        gt_lo=gt_lo,
     )
 
 

@@ -353,7 +353,12 @@ def trajectory_intervals(
     r_xyz = compared(robot.xyz)
     g_xyz = compared(matched.gt_xyz)
     t = gt.t_ns
-    k, k1 = _bracket(t, q)
+    if matched.gt_lo is not None and len(matched.gt_lo) == len(matched.t_ns):
+        # the association's own search over this GT: its bracket, as _bracket finds it
+        k = np.clip(compared(matched.gt_lo), 0, max(len(t) - 2, 0))
+        k1 = np.minimum(k + 1, len(t) - 1)
+    else:
+        k, k1 = _bracket(t, q)
     tk = np.take(t, k)
     gap = np.take(t, k1) - tk
     period = gap / NS_PER_S
