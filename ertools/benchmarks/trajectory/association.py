@@ -55,6 +55,8 @@ class Matched:
             before each row's time (-1 before the first): its binary search, kept for the
             intervals (:func:`~ertools.benchmarks.trajectory.intervals.trajectory_intervals`,
             given the same GT); None: not kept.
+        yaw_diff: (N,) wrap(yaw_robot - yaw_gt), signed (``yaw_error`` is its absolute
+            value), kept by :func:`associate` for the intervals; None: not kept.
     """
 
     t_ns: I64
@@ -70,6 +72,7 @@ class Matched:
     gt_quat_xyzw: F64 | None = None
     robot_rows: npt.NDArray[np.intp] | None = None
     gt_lo: npt.NDArray[np.intp] | None = None
+    yaw_diff: F64 | None = None
 
     def count(self, status: int) -> int:
         return int(np.count_nonzero(self.status == status))
@@ -262,8 +265,8 @@ def _matched(
     gt_xyz = gt_xyz_at
     if not every:
         gt_xyz[~ok] = np.nan
-    yaw_err = wrap_angle(compared(robot_yaw - gt_yaw))
-    np.abs(yaw_err, out=yaw_err)
+    yaw_diff = wrap_angle(compared(robot_yaw - gt_yaw))
+    yaw_err = np.abs(yaw_diff)
     raw = compared(yaw_tf(robot.quat_xyzw) - yaw_tf(gt_quat_at))
     return Matched(
         q,
@@ -277,6 +280,7 @@ def _matched(
         across,
         int(early.sum()),
         gt_lo=gt_lo,
+        yaw_diff=yaw_diff,
     )
 
 

@@ -387,11 +387,15 @@ def trajectory_intervals(
         weight = np.ones(len(q))
         lag = (-1.0, 0.0) if association == "hold" else (-0.5, 0.5)
     off_sigma, _ = offset_spread(r_xyz, g_xyz, vel, audit, offset_ns)
+    if matched.yaw_diff is not None:
+        theta = compared(matched.yaw_diff)  # the association's: the same yaws, subtracted
+    else:
+        theta = wrap_angle(compared(robot.yaw) - compared(matched.gt_yaw))
     # the association's distances: the same sums of squares of the same errors, in order
     d = compared(matched.position_error)
     terms = PoseTerms(
         error=r_xyz - g_xyz,
-        theta=wrap_angle(compared(robot.yaw) - compared(matched.gt_yaw)),
+        theta=theta,
         raw=compared(matched.yaw_diff_raw),
         sigma=sig.position * weight,
         sigma_yaw=sig.yaw * weight,
