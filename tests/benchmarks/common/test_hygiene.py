@@ -4,10 +4,12 @@ whose repeats are known, and against the plain ``np.all(a == b, axis=1)`` they r
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 
 from ertools.benchmarks.common.hygiene import (
+    _all_valid,
     drop_duplicates,
     drop_invalid,
     drop_repeats,
@@ -215,10 +217,6 @@ def test_the_all_valid_shortcut_decides_nothing_near_the_limits() -> None:
     """Quaternions near the shortcut's limits (squared norms 1e-17 and 1e300) and one whose
     squares overflow go to the exact test (a norm above 1e-9 whose square is finite),
     silently; its answer is the one kept. One well inside (1e149) takes the shortcut."""
-    import warnings
-
-    from ertools.benchmarks.common.hygiene import _all_valid
-
     base = _stream()
     cases = ((1e-150, 1, False), (3e-9, 0, False), (1e149, 0, True), (1e151, 0, False))
     for scale, dropped, shortcut in (*cases, (1e200, 1, False)):
