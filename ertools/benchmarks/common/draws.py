@@ -23,12 +23,13 @@ CHUNK_ELEMENTS = 4_000_000  # draws x values per chunk of the order statistics' 
 class Distances:
     """The values whose order statistics are drawn: errors e (n, 3) between two ends, the
     noise of one end (sigma per axis, (n,)), its velocity (n, 3) and frame period (n,) for
-    a lag."""
+    a lag; ``distance``, |e| (n,), when the caller has it (None: computed here)."""
 
     error: F64
     sigma: F64
     velocity: F64
     period: F64
+    distance: F64 | None = None
 
 
 # Noise of more than this many sigma (chi with 3 degrees of freedom: P = 1e-10) is taken as
@@ -140,7 +141,10 @@ def draw_order_stats(
     cols = [np.searchsorted(union, s.poses) for s in stats]
     e, v = terms.error[union], terms.velocity[union]
     # sums of three written out: one order of additions on every CPU
-    d = np.sqrt(e[:, 0] ** 2 + e[:, 1] ** 2 + e[:, 2] ** 2).astype(np.float32)
+    if terms.distance is None:
+        d = np.sqrt(e[:, 0] ** 2 + e[:, 1] ** 2 + e[:, 2] ** 2).astype(np.float32)
+    else:
+        d = terms.distance[union].astype(np.float32)
     s = terms.sigma[union].astype(np.float32)
     ev = (e[:, 0] * v[:, 0] + e[:, 1] * v[:, 1] + e[:, 2] * v[:, 2]).astype(np.float32)
     vv = (v[:, 0] ** 2 + v[:, 1] ** 2 + v[:, 2] ** 2).astype(np.float32)

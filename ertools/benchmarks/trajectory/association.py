@@ -51,6 +51,12 @@ class Matched:
             alone (None for the other associations).
         robot_rows: with :func:`associate_evo`, the robot pose of each row (a robot pose
             that evo pairs with two GT poses is two rows); None: row i is robot pose i.
+        gt_lo: (N,) with :func:`associate` over GT in time order, the last GT sample at or
+            before each row's time (-1 before the first): its binary search, kept for the
+            intervals (:func:`~ertools.benchmarks.trajectory.intervals.trajectory_intervals`,
+            given the same GT); None: not kept.
+        yaw_diff: (N,) wrap(yaw_robot - yaw_gt), signed (``yaw_error`` is its absolute
+            value), kept by :func:`associate` for the intervals; None: not kept.
     """
 
     t_ns: I64
@@ -65,6 +71,8 @@ class Matched:
     before_gt: int
     gt_quat_xyzw: F64 | None = None
     robot_rows: npt.NDArray[np.intp] | None = None
+    gt_lo: npt.NDArray[np.intp] | None = None
+    yaw_diff: F64 | None = None
 
     def count(self, status: int) -> int:
         return int(np.count_nonzero(self.status == status))
@@ -149,6 +157,7 @@ def associate(
         ties_n,
         max_gap_ns,
         gaps,
+        gt_lo=interp.lo,
     )
 
 
@@ -222,30 +231,56 @@ def _matched(
     ties_n: int,
     max_gap_ns: int,
     gaps: Gaps,
+    gt_lo: npt.NDArray[np.intp] | None = None,
 ) -> Matched:
-    """Statuses and errors from the GT pose chosen for each robot pose."""
+    """Statuses and errors from the GT pose chosen for each robot pose (``gt_lo``: kept,
+    :class:`Matched`)."""
     q = robot.t_ns
     status = np.full(len(q), COMPARED, dtype=np.uint8)
     status[~inside] = UNCOVERED
     across = inside & (gap_ns > max_gap_ns)
     if gaps == "skip":
         status[across] = GAP
-    same = has_pair & same_rows(gt.xyz, fi, si)
-    status[(status == COMPARED) & same] = TRACKING_LOST
+    # tracking lost: the pair's positions equal; x compared first (a moving body's x rarely
+    # repeats), the whole rows only where it does
+    # (taken from the flat array: a column's take would copy the whole strided column)
+    flat = np.ravel(gt.xyz)
+    maybe = np.flatnonzero(has_pair & (flat.take(3 * fi) == flat.take(3 * si)))
+    if maybe.size:
+        same = np.zeros(len(q), dtype=bool)
+        same[maybe] = same_rows(gt.xyz, fi[maybe], si[maybe])
+        status[(status == COMPARED) & same] = TRACKING_LOST
     ok = status == COMPARED
+    every = bool(ok.all())
 
-    gt_yaw = np.where(ok, yaw_from_quat(gt_quat_at), np.nan)
+    def compared(values: F64) -> F64:
+        """``values`` where compared, NaN elsewhere (as they are when every pose is)."""
+        return values if every else np.where(ok, values, np.nan)
+
+    gt_yaw = compared(yaw_from_quat(gt_quat_at))
     robot_yaw = yaw_from_quat(robot.quat_xyzw)
-    pos_err = np.where(ok, row_norm(robot.xyz - gt_xyz_at), np.nan)
+    pos_err = compared(row_norm(robot.xyz - gt_xyz_at))
     # gt_xyz_at is this association's own array: NaN written into it where not compared
     # rather than into a copy (megabytes of fresh memory on an hour's poses)
     gt_xyz = gt_xyz_at
-    if not ok.all():
+    if not every:
         gt_xyz[~ok] = np.nan
-    yaw_err = np.abs(wrap_angle(np.where(ok, robot_yaw - gt_yaw, np.nan)))
-    raw = np.where(ok, yaw_tf(robot.quat_xyzw) - yaw_tf(gt_quat_at), np.nan)
+    yaw_diff = wrap_angle(compared(robot_yaw - gt_yaw))
+    yaw_err = np.abs(yaw_diff)
+    raw = compared(yaw_tf(robot.quat_xyzw) - yaw_tf(gt_quat_at))
     return Matched(
-        q, status, gt_xyz, gt_yaw, pos_err, yaw_err, raw, ties_n, across, int(early.sum())
+        q,
+        status,
+        gt_xyz,
+        gt_yaw,
+        pos_err,
+        yaw_err,
+        raw,
+        ties_n,
+        across,
+        int(early.sum()),
+        gt_lo=gt_lo,
+        yaw_diff=yaw_diff,
     )
 
 

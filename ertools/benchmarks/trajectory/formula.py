@@ -40,9 +40,11 @@ def metrics(m: Matched) -> Metrics | None:
     ok = m.status == COMPARED
     if not ok.any():
         return None
-    d = m.position_error[ok]
-    dyaw = m.yaw_error[ok]
-    raw = np.abs(m.yaw_diff_raw[ok])
+    # every pose compared (the usual comparison): the arrays as they are, not gathered copies
+    every = bool(ok.all())
+    d = m.position_error if every else m.position_error[ok]
+    dyaw = m.yaw_error if every else m.yaw_error[ok]
+    raw = np.abs(m.yaw_diff_raw if every else m.yaw_diff_raw[ok])
     pct = percentiles(d, PERCENTILES)
     return Metrics(
         position_error=float(d.mean()),

@@ -34,6 +34,7 @@ import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import partial
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -342,11 +343,23 @@ def trajectory_intervals(
     if few is not None:
         # a null interval with the reason, not one of the mocap noise alone
         return withheld(KEYS, few, settings, METHOD_TRAJECTORY)
-    q = matched.t_ns[ok]
-    r_xyz = robot.xyz[ok]
-    g_xyz = matched.gt_xyz[ok]
+    every = bool(ok.all())
+
+    def compared(a: npt.NDArray[Any]) -> npt.NDArray[Any]:
+        # the usual comparison compares every pose: its arrays as they are, not gathered
+        # copies (read only below)
+        return a if every else a[ok]
+
+    q = compared(matched.t_ns)
+    r_xyz = compared(robot.xyz)
+    g_xyz = compared(matched.gt_xyz)
     t = gt.t_ns
-    k, k1 = _bracket(t, q)
+    if matched.gt_lo is not None and len(matched.gt_lo) == len(matched.t_ns):
+        # the association's own search over this GT: its bracket, as _bracket finds it
+        k = np.clip(compared(matched.gt_lo), 0, max(len(t) - 2, 0))
+        k1 = np.minimum(k + 1, len(t) - 1)
+    else:
+        k, k1 = _bracket(t, q)
     tk = np.take(t, k)
     gap = np.take(t, k1) - tk
     period = gap / NS_PER_S
@@ -359,7 +372,10 @@ def trajectory_intervals(
     hi = np.clip(k1 + VELOCITY_HALF_SPAN, 0, len(t) - 1)
     span = np.maximum((t[hi] - t[lo]).astype(np.float64) / NS_PER_S, 1e-9)
     # rows gathered by take (a fancy index of rows costs twice as much)
-    vel = (np.take(gt.xyz, hi, axis=0) - np.take(gt.xyz, lo, axis=0)) / span[:, None]
+    # (and the differences and quotients written into the first gathered array)
+    vel = np.take(gt.xyz, hi, axis=0)
+    vel -= np.take(gt.xyz, lo, axis=0)
+    vel /= span[:, None]
     # the yaw of the samples used only (an hour's GT holds 430,000)
     quat = gt.quat_xyzw
     turned = yaw_from_quat(np.take(quat, hi, axis=0)) - yaw_from_quat(np.take(quat, lo, axis=0))
@@ -372,25 +388,30 @@ def trajectory_intervals(
         weight = np.ones(len(q))
         lag = (-1.0, 0.0) if association == "hold" else (-0.5, 0.5)
     off_sigma, _ = offset_spread(r_xyz, g_xyz, vel, audit, offset_ns)
+    if matched.yaw_diff is not None:
+        theta = compared(matched.yaw_diff)  # the association's: the same yaws, subtracted
+    else:
+        theta = wrap_angle(compared(robot.yaw) - compared(matched.gt_yaw))
+    # the association's distances: the same sums of squares of the same errors, in order
+    d = compared(matched.position_error)
     terms = PoseTerms(
         error=r_xyz - g_xyz,
-        theta=wrap_angle(robot.yaw[ok] - matched.gt_yaw[ok]),
-        raw=matched.yaw_diff_raw[ok],
+        theta=theta,
+        raw=compared(matched.yaw_diff_raw),
         sigma=sig.position * weight,
         sigma_yaw=sig.yaw * weight,
         velocity=vel,
         yaw_rate=yaw_rate,
         period=period,
         lag=lag,
+        distance=d,
     )
-    distances = Distances(terms.error, terms.sigma, terms.velocity, terms.period)
+    distances = Distances(terms.error, terms.sigma, terms.velocity, terms.period, d)
     n_all = len(q)
     thinned = np.arange(n_all)
     if n_all > MAX_POSES:
         # steps over 1: the rounded picks are distinct and increasing
         thinned = np.linspace(0, n_all - 1, MAX_POSES).round().astype(np.intp)
-    err = terms.error
-    d = np.sqrt(err[:, 0] ** 2 + err[:, 1] ** 2 + err[:, 2] ** 2)
     est = np.array([estimates[key] for key in KEYS])
     # The offset's effect, centred on the offset applied: the comparison re-scored by the
     # score's own association and metrics at shifts of it (every robot pose inside the GT,

@@ -93,8 +93,8 @@ def clear_of_losses(
     # at most one GT sample crossed either side
     if np.any(q - tt[:, 0] <= reach_ns) or np.any(tt[:, 3] - q <= reach_ns):
         return False
-    span = np.diff(tt, axis=1)
-    if np.any(span[:, 0] > max_gap_ns) or np.any(span[:, 2] > max_gap_ns):
+    # the pairs (k-1, k) and (k+1, k+2) only: (k, k+1) is the pose's own, checked already
+    if np.any(tt[:, 1] - tt[:, 0] > max_gap_ns) or np.any(tt[:, 3] - tt[:, 2] > max_gap_ns):
         return False
     # tracking lost: a pair of equal positions, as the association finds them; the pairs
     # whose x repeat first (a column gathered, not rows), their whole rows then
@@ -105,7 +105,7 @@ def clear_of_losses(
 
 class Moving(Protocol):
     """Per compared pose: the error (n, 3), the GT's velocity (n, 3) and yaw rate (n,),
-    the wrapped and 2015 yaw differences (n,)."""
+    the wrapped and 2015 yaw differences (n,), and the error's norms (n,)."""
 
     @property
     def error(self) -> F64: ...
@@ -117,6 +117,7 @@ class Moving(Protocol):
     def theta(self) -> F64: ...
     @property
     def raw(self) -> F64: ...
+    def norms(self) -> F64: ...
 
 
 def effects(
@@ -140,7 +141,7 @@ def effects(
     n = len(error)
     a = error[:, 0] * velocity[:, 0] + error[:, 1] * velocity[:, 1] + error[:, 2] * velocity[:, 2]
     b = velocity[:, 0] ** 2 + velocity[:, 1] ** 2 + velocity[:, 2] ** 2
-    d = np.sqrt(error[:, 0] ** 2 + error[:, 1] ** 2 + error[:, 2] ** 2)
+    d = poses.norms()
     move = reach * np.sqrt(b)
 
     def exact(rows: IntArr) -> F64:

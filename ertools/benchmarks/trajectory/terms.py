@@ -39,6 +39,8 @@ class PoseTerms:
         period: (n,) the GT frame period around the pose, seconds.
         lag: (low, high) of the frame lag in periods (hold: (-1, 0), nearest: (-0.5,
             0.5)); None for ``linear``.
+        distance: (n,) |error| when the caller has it (the association's distances, the
+            same bits); None: computed from ``error`` where needed.
     """
 
     error: F64
@@ -50,6 +52,14 @@ class PoseTerms:
     yaw_rate: F64
     period: F64
     lag: tuple[float, float] | None
+    distance: F64 | None = None
+
+    def norms(self) -> F64:
+        """(n,) |error|: ``distance``, or the square root of the squares summed in order."""
+        if self.distance is not None:
+            return self.distance
+        e = self.error
+        return np.asarray(np.sqrt(e[:, 0] ** 2 + e[:, 1] ** 2 + e[:, 2] ** 2), dtype=np.float64)
 
     def take(self, rows: npt.NDArray[np.intp]) -> PoseTerms:
         """The terms of the poses ``rows``."""
@@ -67,6 +77,7 @@ class PoseTerms:
             yaw_rate=pick(self.yaw_rate),
             period=pick(self.period),
             lag=self.lag,
+            distance=None if self.distance is None else pick(self.distance),
         )
 
     def mean_like(self, noise: bool, lag: bool) -> list[Callable[[F64], F64]]:
@@ -92,7 +103,7 @@ class PoseTerms:
             return self.mean_like(noise, lag)
         s = self.sigma if noise else np.zeros_like(self.sigma)
         sy = self.sigma_yaw if noise else np.zeros_like(self.sigma_yaw)
-        d = np.sqrt(np.sum(np.square(self.error), axis=1))
+        d = self.norms()
         mean = mean_moments(chi3_moments(d, s))
         squares = mean_moments(chi3_squared_moments(d, s))
         orient = _circular(self.theta, sy, False, count, full[0])

@@ -3,9 +3,13 @@ whose repeats are known, and against the plain ``np.all(a == b, axis=1)`` they r
 
 from __future__ import annotations
 
+import math
+import warnings
+
 import numpy as np
 
 from ertools.benchmarks.common.hygiene import (
+    _all_valid,
     drop_duplicates,
     drop_invalid,
     drop_repeats,
@@ -207,3 +211,24 @@ def test_impossible_samples_found_once_serve_the_warning_and_the_drop() -> None:
     assert dropped == dropped_again == 2
     assert np.array_equal(kept.t_ns, again.t_ns) and np.array_equal(kept.xyz, again.xyz)
     assert np.array_equal(kept.t_ns, np.delete(t, [100, 600]))
+
+
+def test_the_all_valid_shortcut_decides_nothing_near_the_limits() -> None:
+    """Quaternions near the shortcut's limits (squared norms 1e-17 and 1e300) and one whose
+    squares overflow go to the exact test (a norm above 1e-9 whose square is finite),
+    silently; its answer is the one kept. One well inside (1e149) takes the shortcut."""
+    base = _stream()
+    cases = ((1e-150, 1, False), (3e-9, 0, False), (1e149, 0, True), (1e151, 0, False))
+    for scale, dropped, shortcut in (*cases, (1e200, 1, False)):
+        quat = base.quat_xyzw.copy()
+        quat[6] *= scale
+        stream = PoseStream(base.t_ns, base.xyz, quat)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            assert _all_valid(stream) == shortcut
+            kept, count = drop_invalid(stream, jumps=False)
+        with np.errstate(over="ignore"):
+            norm = math.sqrt(float(np.sum(quat[6] ** 2)))
+        assert count == dropped == int(not (math.isfinite(norm) and norm > 1e-9))
+        assert len(kept) == 10 - dropped
+    assert _all_valid(base)

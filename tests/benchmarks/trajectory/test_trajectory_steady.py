@@ -79,7 +79,12 @@ def test_the_motion_gives_the_association_s_own_effects() -> None:
     vel, rate, _ = _velocity(gt, m.t_ns)
     theta = wrap_angle(robot.yaw - m.gt_yaw)
     poses = SimpleNamespace(
-        error=robot.xyz - m.gt_xyz, velocity=vel, yaw_rate=rate, theta=theta, raw=m.yaw_diff_raw
+        error=robot.xyz - m.gt_xyz,
+        velocity=vel,
+        yaw_rate=rate,
+        theta=theta,
+        raw=m.yaw_diff_raw,
+        norms=lambda: np.linalg.norm(robot.xyz - m.gt_xyz, axis=1),
     )
     shifts = np.linspace(-4, 4, 41) * 0.003  # +-12 ms, under two GT frames either side
     got = effects(poses, np.arange(len(robot)), shifts, ORDER_STATS, len(KEYS), MEAN_LIKE)
@@ -209,7 +214,12 @@ def test_the_series_for_a_small_reach_against_the_association() -> None:
     vel, rate, _ = _velocity(gt, m.t_ns)
     theta = wrap_angle(robot.yaw - m.gt_yaw)
     poses = SimpleNamespace(
-        error=robot.xyz - m.gt_xyz, velocity=vel, yaw_rate=rate, theta=theta, raw=m.yaw_diff_raw
+        error=robot.xyz - m.gt_xyz,
+        velocity=vel,
+        yaw_rate=rate,
+        theta=theta,
+        raw=m.yaw_diff_raw,
+        norms=lambda: np.linalg.norm(robot.xyz - m.gt_xyz, axis=1),
     )
     shifts = np.linspace(-4, 4, 41) * 0.0003
     d = np.sqrt(np.sum((robot.xyz - m.gt_xyz) ** 2, axis=1))
