@@ -569,6 +569,35 @@ def _around_window(
     return bracket(t, queries.ravel(), right.ravel())
 
 
+# Moves by one sample of each query's place before a binary search is cheaper (a move costs
+# ~1/3 of a search of an hour's GT)
+NEAR_STEPS = 3
+
+
+def _right_near(t: I64, query: I64, right: IntArr | None) -> IntArr:
+    """``np.searchsorted(t, query, side="right")``, moved there from ``right``, that of
+    nearby queries (None: a binary search).
+
+    Every place moves by one sample per round towards its own (up while the sample there is
+    at or before the query, down while the one before it is after), and a round that moves
+    none proves every place right; after :data:`NEAR_STEPS` moving rounds, the binary search.
+    """
+    if right is None or len(right) != len(query):
+        return np.searchsorted(t, query, side="right")
+    n = len(t)
+    right = right.copy()
+    for _ in range(NEAR_STEPS + 1):
+        up = t.take(np.minimum(right, n - 1)) <= query
+        up &= right < n
+        down = t.take(np.maximum(right - 1, 0)) > query
+        down &= right > 0
+        if not (up.any() or down.any()):
+            return right
+        right += up
+        right -= down
+    return np.searchsorted(t, query, side="right")
+
+
 def estimate_offset(
     robot: PoseStream,
     gt: PoseStream,
@@ -632,9 +661,13 @@ def estimate_offset(
         return none("the robot poses do not overlap the GT near the best coarse offset")
     offset = float(fine[int(np.argmin(fine_costs))])
 
-    # 3. Gauss-Newton on the squared distances
+    # 3. Gauss-Newton on the squared distances; each step moves the queries by less than a
+    # millisecond, so each search starts from the previous one's places
+    right = None
     for _ in range(5):
-        ev = _evaluate(gt, robot.t_ns + round(offset), max_gap_ns)
+        query = robot.t_ns + round(offset)
+        right = _right_near(gt.t_ns, query, right)
+        ev = _evaluate(gt, query, max_gap_ns, bracket(gt.t_ns, query, right))
         v = _velocity(gt, ev, max_gap_ns)
         r = _valid_rows(robot.xyz, ev) - ev.gt_xyz
         vv = float(np.sum(v * v))
@@ -645,7 +678,10 @@ def estimate_offset(
         if abs(step_s) < 1e-6:
             break
     offset_ns = round(offset)
-    ev = _evaluate(gt, robot.t_ns + offset_ns, max_gap_ns)
+    query = robot.t_ns + offset_ns
+    ev = _evaluate(
+        gt, query, max_gap_ns, bracket(gt.t_ns, query, _right_near(gt.t_ns, query, right))
+    )
     used = len(ev.gt_xyz)
     if used < MIN_POSES:
         return none("too few robot poses overlap the GT at the estimated offset", used)

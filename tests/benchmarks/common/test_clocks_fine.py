@@ -87,3 +87,22 @@ def test_window_distances_are_the_plain_ones_to_the_bit(
     assert np.array_equal(got[1], want[1])
     assert np.array_equal(got[0], want[0], equal_nan=True)
     assert got[0].flags.c_contiguous  # the means sum each row as one array
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    st.lists(st.integers(0, 50), min_size=2, max_size=60),
+    st.lists(st.integers(-300, 3000), min_size=1, max_size=40),
+    st.integers(-40, 40),
+    st.booleans(),
+)
+def test_places_moved_from_nearby_queries_are_the_binary_searchs(
+    gaps: list[int], stamps: list[int], shift: int, fresh: bool
+) -> None:
+    """From the places of queries shifted by ``shift`` (one sample or many, repeated stamps,
+    queries before and after the samples), the moved places are searchsorted's."""
+    t = np.cumsum(np.array(gaps, dtype=np.int64))
+    query = np.sort(np.array(stamps, dtype=np.int64))
+    before = None if fresh else np.searchsorted(t, query - shift, side="right")
+    got = clocks._right_near(t, query, before)
+    assert np.array_equal(got, np.searchsorted(t, query, side="right"))
