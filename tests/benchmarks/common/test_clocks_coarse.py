@@ -145,10 +145,8 @@ def test_the_audit_is_the_full_scans(case: tuple[PoseStream, PoseStream], second
     full = pytest.MonkeyPatch()
     with full.context() as patch:
         patch.setattr(clocks, "_pruned_costs", lambda *args: None)
-        patch.setattr(clocks, "_window_distances", lambda *args: None)
-        patch.setattr(
-            clocks, "_right_near", lambda t, q, right: np.searchsorted(t, q, side="right")
-        )
+        patch.setattr(clocks, "window_distances", lambda *args: None)
+        patch.setattr(clocks, "right_near", lambda t, q, right: np.searchsorted(t, q, side="right"))
         plain = estimate_offset(robot, gt, search_range_ns=seconds * 1000 * MS)
     assert dataclasses.astuple(fast) == dataclasses.astuple(plain)
 

@@ -10,7 +10,7 @@ import numpy as np
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from ertools.benchmarks.common import clocks
+from ertools.benchmarks.common import clock_queries, clocks
 from ertools.benchmarks.common.clocks import FINE_STEP_NS, MIN_POSES
 from ertools.benchmarks.common.hygiene import drop_repeats
 from ertools.streams import PoseStream
@@ -81,8 +81,8 @@ def test_window_distances_are_the_plain_ones_to_the_bit(
             t[j] = t[j - 1]  # still non-decreasing: the stamp before is at most t[j]
         gt = PoseStream(t, gt.xyz, gt.quat_xyzw, gt.frame_id, gt.child_frame_id)
     offsets = -60 * MS + np.arange(-20, 21, dtype=np.int64) * step_ms * MS
-    got = clocks._window_distances(robot.t_ns, robot.xyz, gt, offsets, max_gap_ms * MS)
-    want = clocks._plain_distances(robot.t_ns, robot.xyz, gt, offsets, max_gap_ms * MS)
+    got = clock_queries.window_distances(robot.t_ns, robot.xyz, gt, offsets, max_gap_ms * MS)
+    want = clock_queries.plain_distances(robot.t_ns, robot.xyz, gt, offsets, max_gap_ms * MS)
     assert got is not None
     assert np.array_equal(got[1], want[1])
     assert np.array_equal(got[0], want[0], equal_nan=True)
@@ -104,5 +104,5 @@ def test_places_moved_from_nearby_queries_are_the_binary_searchs(
     t = np.cumsum(np.array(gaps, dtype=np.int64))
     query = np.sort(np.array(stamps, dtype=np.int64))
     before = None if fresh else np.searchsorted(t, query - shift, side="right")
-    got = clocks._right_near(t, query, before)
+    got = clock_queries.right_near(t, query, before)
     assert np.array_equal(got, np.searchsorted(t, query, side="right"))
