@@ -139,9 +139,10 @@ def window_distances(
     query's segment is the count of window samples at or before it: each sample's first
     offset reaching it is one ``searchsorted`` over the offsets, and a cumulative sum of
     those counts gives every query's. The arithmetic per query is :func:`evaluate`'s and
-    ``row_norm``'s, operation for operation; a query exactly on a GT stamp (whose samples
-    around follow another rule) is evaluated by :func:`evaluate` itself. None: offsets not
-    increasing, or a window wider than :data:`WINDOW_MAX_SAMPLES`.
+    ``row_norm``'s, operation for operation. A query exactly on a GT stamp takes that sample
+    alone, as :func:`evaluate` does (its bracket's two samples are the one); on a repeated
+    GT stamp :func:`evaluate` itself computes it. None: offsets not increasing, or a window
+    wider than :data:`WINDOW_MAX_SAMPLES`.
     """
     n_off, n_pose = len(offsets), len(robot_t)
     t = gt.t_ns
@@ -270,7 +271,8 @@ def right_near(t: I64, query: I64, right: IntArr | None) -> IntArr:
 
     Every place moves by one sample per round towards its own (up while the sample there is
     at or before the query, down while the one before it is after), and a round that moves
-    none proves every place right; after :data:`NEAR_STEPS` moving rounds, the binary search.
+    none proves every place right; when :data:`NEAR_STEPS` + 1 rounds all moved some place,
+    the binary search.
     """
     if right is None or len(right) != len(query):
         return np.searchsorted(t, query, side="right")
