@@ -30,6 +30,14 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, I64, IntArr
+from ertools.benchmarks.common.clock_queries import (
+    evaluate,
+    plain_distances,
+    right_near,
+    valid_rows,
+    velocity,
+    window_distances,
+)
 from ertools.benchmarks.common.hygiene import drop_repeats
 from ertools.geometry import bracket, row_dot, row_norm
 from ertools.streams import PoseStream
@@ -48,7 +56,6 @@ MIN_POSES = 20
 MIN_RMS_SPEED = 0.02  # m/s: below this the robot stood still and no offset is observable
 BOOTSTRAP_DRAWS = 500
 BLOCK_NS = 5 * NS_PER_S
-MAX_NS = np.iinfo(np.int64).max
 
 
 @dataclass(frozen=True)
@@ -93,98 +100,14 @@ class OffsetEstimate:
         return abs(self.offset_ns - applied_ns) > max(3 * sigma, MATTERS_NS)
 
 
-@dataclass(frozen=True, eq=False)
-class _Eval:
-    """GT positions at shifted robot times, where they are usable.
-
-    Attributes:
-        valid: (N,) which queries have a usable GT position.
-        gt_xyz: (valid.sum(), 3) the GT positions at the valid queries only.
-        lo, hi: (valid.sum(),) the GT samples around each valid query.
-        diff: (valid.sum(), 3) GT position at ``hi`` minus at ``lo``.
-        span_ns: (valid.sum(),) GT time at ``hi`` minus at ``lo``.
-    """
-
-    valid: npt.NDArray[np.bool_]
-    gt_xyz: F64
-    lo: IntArr
-    hi: IntArr
-    diff: F64
-    span_ns: I64
-
-
-def _evaluate(
-    gt: PoseStream,
-    query_ns: I64,
-    max_gap_ns: int,
-    around: tuple[IntArr, IntArr] | None = None,
-) -> _Eval:
-    """GT at the queries (``around``: their :func:`~ertools.geometry.bracket`, if known)."""
-    t = gt.t_ns
-    n = len(t)
-    lo, hi = bracket(t, query_ns) if around is None else around
-    inside = (lo >= 0) & (hi < n)
-    all_inside = bool(inside.all())
-    lo_c = lo if all_inside else np.clip(lo, 0, n - 1)
-    hi_c = hi if all_inside else np.clip(hi, 0, n - 1)
-    t_lo = t.take(lo_c)
-    span = t.take(hi_c) - t_lo
-    valid = inside & (span <= max_gap_ns)
-    q = query_ns
-    if not valid.all():  # only the usable queries are worth interpolating
-        keep = np.flatnonzero(valid)
-        lo_c, hi_c, t_lo, span, q = lo_c[keep], hi_c[keep], t_lo[keep], span[keep], q[keep]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        alpha = np.where(span > 0, (q - t_lo).astype(np.float64) / span, 0.0)
-    # No clip to [0, 1]: a valid query lies between its two samples, and the rounded
-    # quotient of 0 <= a <= b stays in [0, 1].
-    x_lo = np.take(gt.xyz, lo_c, axis=0)  # take: whole rows, twice as fast as x[i]
-    diff = np.take(gt.xyz, hi_c, axis=0) - x_lo
-    at = diff * alpha[:, None]  # in place after: one (N, 3) temporary fewer, same sums
-    at += x_lo
-    return _Eval(valid, at, lo_c, hi_c, diff, span)
-
-
-def _velocity(gt: PoseStream, ev: _Eval, max_gap_ns: int) -> F64:
-    """(valid.sum(), 3) GT velocity at the valid queries, m/s.
-
-    Of the segment around the query; at an exact hit, of the segment after it. Segments
-    longer than the max gap (or of no duration) give no usable velocity: 0.
-    """
-    n = len(gt)
-    seg_lo = np.minimum(ev.lo, max(n - 2, 0))
-    seg_hi = np.minimum(seg_lo + 1, n - 1)
-    # Between two samples the segment is (lo, hi), already subtracted: only exact hits need
-    # other samples.
-    num, seg_ns = ev.diff, ev.span_ns
-    other = np.flatnonzero((seg_lo != ev.lo) | (seg_hi != ev.hi))
-    if other.size:
-        a, b = seg_lo[other], seg_hi[other]
-        num, seg_ns = num.copy(), seg_ns.copy()
-        num[other] = gt.xyz[b] - gt.xyz[a]
-        seg_ns[other] = gt.t_ns[b] - gt.t_ns[a]
-    dt = seg_ns.astype(np.float64) / NS_PER_S
-    with np.errstate(invalid="ignore", divide="ignore"):
-        vel = num / dt[:, None]
-    unusable = ~((dt > 0) & (seg_ns <= max_gap_ns))
-    if unusable.any():
-        vel[unusable] = 0.0
-    return np.asarray(vel, dtype=np.float64)
-
-
-def _valid_rows(xyz: F64, ev: _Eval) -> F64:
-    """The rows of ``xyz`` at the evaluation's valid queries (no copy when all are valid)."""
-    return xyz if len(ev.gt_xyz) == len(xyz) else xyz[ev.valid]
-
-
 def _mean_error(
     robot_t: I64, robot_xyz: F64, gt: PoseStream, offset_ns: int, max_gap_ns: int
 ) -> tuple[float, int]:
-    ev = _evaluate(gt, robot_t + offset_ns, max_gap_ns)
+    ev = evaluate(gt, robot_t + offset_ns, max_gap_ns)
     used = len(ev.gt_xyz)
     if used == 0:
         return float("inf"), 0
-    d = row_norm(_valid_rows(robot_xyz, ev) - ev.gt_xyz)
+    d = row_norm(valid_rows(robot_xyz, ev) - ev.gt_xyz)
     return float(d.mean()), used
 
 
@@ -397,18 +320,13 @@ def _scan(
     robot_t: I64, robot_xyz: F64, gt: PoseStream, offsets: I64, max_gap_ns: int
 ) -> tuple[F64, I64]:
     """Mean distance at each offset with exact interpolation, all offsets in one evaluation."""
-    shape = (len(offsets), len(robot_t))
-    queries = (offsets[:, None] + robot_t[None, :]).ravel()  # offset-major
-    ev = _evaluate(gt, queries, max_gap_ns, _around_window(gt.t_ns, robot_t, offsets, queries))
-    if len(ev.gt_xyz) == queries.size:
-        dist = row_norm(robot_xyz - ev.gt_xyz.reshape(*shape, 3))
+    found = window_distances(robot_t, robot_xyz, gt, offsets, max_gap_ns)
+    if found is not None:
+        dist, valid = found
     else:
-        dist = np.full(shape, np.nan)
-        pose = np.flatnonzero(ev.valid) % len(robot_t)
-        dist.ravel()[ev.valid] = row_norm(np.take(robot_xyz, pose, axis=0) - ev.gt_xyz)
-    valid = ev.valid.reshape(shape)
+        dist, valid = plain_distances(robot_t, robot_xyz, gt, offsets, max_gap_ns)
     counts = valid.sum(axis=1)
-    if len(ev.gt_xyz) == queries.size:
+    if counts.sum() == dist.size:
         costs = dist.mean(axis=1)  # each row summed as one array, as below
     else:
         costs = np.full(len(offsets), np.inf)
@@ -419,32 +337,6 @@ def _scan(
     # half of the best coverage any offset achieves.
     enough = counts >= max(MIN_POSES, int(0.5 * counts.max()))
     return np.where(enough, costs, np.inf), counts
-
-
-def _around_window(
-    t: I64, robot_t: I64, offsets: I64, queries: I64 | None = None
-) -> tuple[IntArr, IntArr] | None:
-    """:func:`~ertools.geometry.bracket` of ``offsets[:, None] + robot_t[None, :]``, flattened
-    (``queries``, if the caller has them already).
-
-    The offsets span a few tens of ms, so each pose's queries fall among a handful of GT
-    samples: counting the ones at or before each query there is ~5x cheaper than a binary
-    search per query. None when a window holds too many samples for that to pay.
-    """
-    first = np.searchsorted(t, robot_t + offsets.min(), side="right")
-    width = np.searchsorted(t, robot_t + offsets.max(), side="right") - first
-    if width.max() > 16:
-        return None
-    shape = (len(offsets), len(robot_t))
-    if queries is None:
-        queries = (offsets[:, None] + robot_t[None, :]).ravel()
-    queries = queries.reshape(shape)
-    right = np.broadcast_to(first, shape).copy()
-    for w in range(int(width.max())):
-        # Beyond its window a pose counts nothing (those samples lie after every query).
-        cand = np.where(w < width, t.take(np.minimum(first + w, len(t) - 1)), MAX_NS)
-        right += cand <= queries
-    return bracket(t, queries.ravel(), right.ravel())
 
 
 def estimate_offset(
@@ -510,11 +402,15 @@ def estimate_offset(
         return none("the robot poses do not overlap the GT near the best coarse offset")
     offset = float(fine[int(np.argmin(fine_costs))])
 
-    # 3. Gauss-Newton on the squared distances
+    # 3. Gauss-Newton on the squared distances; each step moves the queries by less than a
+    # millisecond, so each search starts from the previous one's places
+    right = None
     for _ in range(5):
-        ev = _evaluate(gt, robot.t_ns + round(offset), max_gap_ns)
-        v = _velocity(gt, ev, max_gap_ns)
-        r = _valid_rows(robot.xyz, ev) - ev.gt_xyz
+        query = robot.t_ns + round(offset)
+        right = right_near(gt.t_ns, query, right)
+        ev = evaluate(gt, query, max_gap_ns, bracket(gt.t_ns, query, right))
+        v = velocity(gt, ev, max_gap_ns)
+        r = valid_rows(robot.xyz, ev) - ev.gt_xyz
         vv = float(np.sum(v * v))
         if vv <= 0:
             break
@@ -523,12 +419,13 @@ def estimate_offset(
         if abs(step_s) < 1e-6:
             break
     offset_ns = round(offset)
-    ev = _evaluate(gt, robot.t_ns + offset_ns, max_gap_ns)
+    query = robot.t_ns + offset_ns
+    ev = evaluate(gt, query, max_gap_ns, bracket(gt.t_ns, query, right_near(gt.t_ns, query, right)))
     used = len(ev.gt_xyz)
     if used < MIN_POSES:
         return none("too few robot poses overlap the GT at the estimated offset", used)
-    v = _velocity(gt, ev, max_gap_ns)
-    r = _valid_rows(robot.xyz, ev) - ev.gt_xyz
+    v = velocity(gt, ev, max_gap_ns)
+    r = valid_rows(robot.xyz, ev) - ev.gt_xyz
     t_used = robot.t_ns[ev.valid]
     rms_speed = _rms_speed(t_used, ev.gt_xyz)
     if rms_speed < MIN_RMS_SPEED:

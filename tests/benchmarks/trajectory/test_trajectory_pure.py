@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from ertools.benchmarks.common import clocks as clock_offset
+from ertools.benchmarks.common.clock_queries import around_window
 from ertools.benchmarks.common.clocks import (
     GRID_NS,
     MIN_POSES,
-    _around_window,
     _coarse_scan,
     estimate_offset,
 )
@@ -276,13 +276,13 @@ def test_fine_scan_window_search_equals_binary_searches() -> None:
     t = np.array([0, 8, 17, 25, 25, 33, 42, 50, 58], dtype=np.int64) * MS
     robot_t = np.array([-30, 0, 12, 25, 41, 57, 70], dtype=np.int64) * MS
     offsets = np.arange(-20, 21, dtype=np.int64) * MS
-    around = _around_window(t, robot_t, offsets)
+    around = around_window(t, robot_t, offsets)
     assert around is not None
     q = (offsets[:, None] + robot_t[None, :]).ravel()
     assert np.array_equal(around[0], np.searchsorted(t, q, side="right") - 1)
     assert np.array_equal(around[1], np.searchsorted(t, q, side="left"))
     dense = np.arange(0, 100, dtype=np.int64) * MS  # 1 kHz: 41 samples per 40 ms window
-    assert _around_window(dense, robot_t, offsets) is None
+    assert around_window(dense, robot_t, offsets) is None
 
 
 def test_coarse_grid_in_chunks_equals_one_interpolation(monkeypatch: pytest.MonkeyPatch) -> None:
