@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from types import SimpleNamespace
+from typing import Any
 
 import numpy as np
 import pytest
@@ -70,22 +71,27 @@ def _reassociated(robot: PoseStream, gt: PoseStream, shifts: np.ndarray) -> np.n
     return offset_effects(Rescoring(robot.t_ns, rescore), gt.t_ns, shifts)
 
 
+def _associated_terms(robot: PoseStream, gt: PoseStream, m: Any) -> SimpleNamespace:
+    """The per-pose terms `effects` reads, from the association ``m`` of ``robot`` with the
+    noiseless ``gt`` and the GT's exact motion at the robot's stamps."""
+    vel, rate, _ = _velocity(gt, m.t_ns)
+    return SimpleNamespace(
+        error=robot.xyz - m.gt_xyz,
+        velocity=vel,
+        yaw_rate=rate,
+        theta=wrap_angle(robot.yaw - m.gt_yaw),
+        raw=m.yaw_diff_raw,
+        norms=lambda: np.linalg.norm(robot.xyz - m.gt_xyz, axis=1),
+    )
+
+
 def test_the_motion_gives_the_association_s_own_effects() -> None:
     rng = np.random.default_rng(4)
     gt = _gt(40.0)
     robot = _robot(380, rng)
     m = associate(robot, gt, "linear", 100_000_000)
     assert np.all(m.status == COMPARED)
-    vel, rate, _ = _velocity(gt, m.t_ns)
-    theta = wrap_angle(robot.yaw - m.gt_yaw)
-    poses = SimpleNamespace(
-        error=robot.xyz - m.gt_xyz,
-        velocity=vel,
-        yaw_rate=rate,
-        theta=theta,
-        raw=m.yaw_diff_raw,
-        norms=lambda: np.linalg.norm(robot.xyz - m.gt_xyz, axis=1),
-    )
+    poses = _associated_terms(robot, gt, m)
     shifts = np.linspace(-4, 4, 41) * 0.003  # +-12 ms, under two GT frames either side
     got = effects(poses, np.arange(len(robot)), shifts, ORDER_STATS, len(KEYS), MEAN_LIKE)
     assert got is not None
@@ -211,19 +217,10 @@ def test_the_series_for_a_small_reach_against_the_association() -> None:
     gt = _gt(40.0)
     robot = _robot(380, rng)
     m = associate(robot, gt, "linear", 100_000_000)
-    vel, rate, _ = _velocity(gt, m.t_ns)
-    theta = wrap_angle(robot.yaw - m.gt_yaw)
-    poses = SimpleNamespace(
-        error=robot.xyz - m.gt_xyz,
-        velocity=vel,
-        yaw_rate=rate,
-        theta=theta,
-        raw=m.yaw_diff_raw,
-        norms=lambda: np.linalg.norm(robot.xyz - m.gt_xyz, axis=1),
-    )
+    poses = _associated_terms(robot, gt, m)
     shifts = np.linspace(-4, 4, 41) * 0.0003
     d = np.sqrt(np.sum((robot.xyz - m.gt_xyz) ** 2, axis=1))
-    reach = 0.0012 * np.sqrt(np.sum(vel**2, axis=1))
+    reach = 0.0012 * np.sqrt(np.sum(poses.velocity**2, axis=1))
     assert np.mean(d > 10 * reach) > 0.5  # the series, not the exact path, for most poses
     got = effects(poses, np.arange(len(robot)), shifts, ORDER_STATS, len(KEYS), MEAN_LIKE)
     assert got is not None
