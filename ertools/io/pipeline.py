@@ -424,12 +424,14 @@ class LocatedMany:
     ``counts[i]`` is request i's number of messages (None: unknown up front), ``times[i]``
     their record times in the reference order when the index gives them up front; each item
     of ``runs`` is one group of chunks loaded once, with one :class:`Run` per request (None
-    for a request with no message in that group).
+    for a request with no message in that group); ``groups`` is how many there are, when
+    known up front.
     """
 
     counts: list[int | None]
     runs: Iterator[list[Run | None]]
     times: list[I64 | None] | None = None
+    groups: int | None = None
 
     def only(self, i: int) -> Located:
         """Request ``i`` alone (the others' runs are skipped, their groups still loaded)."""
