@@ -84,7 +84,7 @@ def _mcap_runs(
         label=f"reading {', '.join(topics) or '?'} from {bag.path.name}",
         hold=hold,
     )
-    return LocatedMany([len(p.t_record) for p in plans], runs, [p.t_record for p in plans])
+    return LocatedMany([len(p.t_record) for p in plans], runs, [p.t_record for p in plans], count)
 
 
 def _one_by_one(count: int, located: Iterator[tuple[int, Run]]) -> Iterator[list[Run | None]]:
@@ -279,9 +279,11 @@ def try_fast_batches(bag: BagFile, requests: Sequence[Request]) -> list[PoseBatc
         except LayoutMismatchError as err:
             failed[k] = err
 
-    # the requests side by side, each on a thread of its own (NumPy releases the GIL)
+    # the requests side by side, each on a thread of its own (NumPy releases the GIL); a
+    # lone request's groups on two lanes, unless it has one group (the robot's hour: the
+    # calling thread decodes it, rather than start two threads and wait for one)
     try:
-        split = split and all(a.direct for a in assemblers)
+        split = split and all(a.direct for a in assemblers) and found.groups != 1
         pipeline.decoded_in_lanes(found.runs, decode_run, len(mine), split)
     except LayoutMismatchError as err:
         log.info("%s: not read in bulk (%s); decoding per message", bag.path, err)

@@ -19,10 +19,9 @@ import os
 import threading
 from collections import Counter, deque
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from queue import SimpleQueue
-from typing import TYPE_CHECKING, Any, Protocol, TypeVar
+from typing import TYPE_CHECKING, Any, Generic, Protocol, TypeVar, cast
 
 import numpy as np
 
@@ -83,15 +82,68 @@ def prefetched(
     # ahead groups in flight plus the one the caller holds and the ``hold`` before it: none
     # shares a buffer.
     slots: list[list[Any]] = [[] for _ in range(ahead + 1 + hold)]
-    with ThreadPoolExecutor(ahead) as pool:
-        pending = deque(pool.submit(load, k, slots[k % len(slots)]) for k in range(ahead))
+    # Loads taken in order by ``ahead`` threads (plain threads: concurrent.futures would
+    # import logging, traceback and more for a queue and a result each).
+    tasks: SimpleQueue[_Load[T] | None] = SimpleQueue()
+
+    def work() -> None:
+        while (task := tasks.get()) is not None:
+            task.run(load)
+            del task  # (its result is the caller's: no reference kept while waiting)
+
+    threads = [
+        threading.Thread(target=work, daemon=True, name=f"ertools-load-{n}") for n in range(ahead)
+    ]
+    for thread in threads:
+        thread.start()
+    try:
+        pending: deque[_Load[T]] = deque()
+        for k in range(ahead):
+            pending.append(_Load(k, slots[k % len(slots)]))
+            tasks.put(pending[-1])
         for k in range(count):
             got = pending.popleft().result()
             if k + ahead < count:
-                pending.append(pool.submit(load, k + ahead, slots[(k + ahead) % len(slots)]))
+                pending.append(_Load(k + ahead, slots[(k + ahead) % len(slots)]))
+                tasks.put(pending[-1])
             if report is not None:
                 report.advance(weights[k])
             yield got
+    finally:
+        # loads in flight finish before their buffers can be let go (and no thread outlives
+        # the read)
+        for _thread in threads:
+            tasks.put(None)
+        for thread in threads:
+            thread.join()
+
+
+class _Load(Generic[T]):
+    """Load ``k`` into ``scratch`` on a loading thread: its result, or the error it raised,
+    once done."""
+
+    def __init__(self, k: int, scratch: list[Any]) -> None:
+        self.k, self.scratch = k, scratch
+        self.done = threading.Event()
+        self.value: T | None = None
+        self.error: BaseException | None = None
+
+    def run(self, load: Callable[[int, list[Any]], T]) -> None:
+        try:
+            self.value = load(self.k, self.scratch)
+        except BaseException as err:  # raised by the caller (as itself)
+            self.error = err
+        finally:
+            self.done.set()
+
+    def result(self) -> T:
+        self.done.wait()
+        if self.error is not None:
+            try:
+                raise self.error
+            finally:
+                self.error = None  # (no cycle through the traceback's frames)
+        return cast(T, self.value)
 
 
 # Groups a lane of :func:`decoded_in_lanes` may lag behind the one being loaded.
@@ -372,12 +424,14 @@ class LocatedMany:
     ``counts[i]`` is request i's number of messages (None: unknown up front), ``times[i]``
     their record times in the reference order when the index gives them up front; each item
     of ``runs`` is one group of chunks loaded once, with one :class:`Run` per request (None
-    for a request with no message in that group).
+    for a request with no message in that group); ``groups`` is how many there are, when
+    known up front.
     """
 
     counts: list[int | None]
     runs: Iterator[list[Run | None]]
     times: list[I64 | None] | None = None
+    groups: int | None = None
 
     def only(self, i: int) -> Located:
         """Request ``i`` alone (the others' runs are skipped, their groups still loaded)."""

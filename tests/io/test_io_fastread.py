@@ -417,6 +417,29 @@ def test_a_lone_request_decoded_on_two_lanes_equals_rosbags(
         assert threads == {"ertools-lane-0", "ertools-lane-1"}
 
 
+@pytest.mark.parametrize("fmt", ["ros1", "mcap-cdr"])
+def test_a_lone_request_of_one_group_is_decoded_on_the_calling_thread(
+    tmp_path: Path, scene: Scene, monkeypatch: pytest.MonkeyPatch, fmt: str
+) -> None:
+    """A source whose chunks make one group (a robot's log) starts no lane: the calling
+    thread decodes it, to the same rows as rosbags."""
+    path = write(bag_name(tmp_path, fmt, "s"), fmt, scene.spec, chunk_bytes=1500)
+    threads: list[str] = []
+    real = assemble.Decoder.run
+
+    def spy(self: assemble.Decoder, run: Any) -> None:
+        threads.append(threading.current_thread().name)
+        real(self, run)
+
+    monkeypatch.setattr(assemble.Decoder, "run", spy)
+    monkeypatch.setattr(pipeline, "workers", lambda: 2)
+    for topic in ("/fbm3w/robot_at_work/pose", "/fbm3w/robot_at_work/pose2d", "/tf"):
+        threads.clear()
+        (batch,) = fast_many(path, [topic])
+        assert_same(batch, reference_batch(path, topic))
+        assert threads == [threading.main_thread().name]
+
+
 def test_a_lone_request_on_two_lanes_raises_the_first_error(tmp_path: Path) -> None:
     """Two damaged records of one topic in different groups, decoded on two lanes: the error
     raised is the earlier group's, as one thread decoding the groups in turn raises it."""

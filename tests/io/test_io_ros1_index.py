@@ -392,9 +392,49 @@ def test_a_scan_is_made_once_per_file_version(
     caches.clear()
     layout.read_layout(path)
     assert len(scans) == 3
-    # an indexed bag is read from its index, never kept
+    # an indexed bag is read from its index, never scanned
     sound = two_topic_bag(tmp_path / "sound.bag")
     assert layout.read_layout(sound).indexed and len(scans) == 3
+
+
+def test_an_index_is_read_once_per_file_version_and_handed_out_as_copies(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A command reads a bag's index for its summary and again to read its poses: the index
+    is parsed once per file version (again once the file changes, and after
+    ``ertools.caches.clear()``), and every caller gets chunks of its own, none of them read
+    yet, whatever an earlier reader filled in."""
+
+    path = two_topic_bag(tmp_path / "b.bag")
+    # the chunk records by the independent walker: op 5 is a chunk
+    chunk_pos = [pos for pos, op, *_ in records(path.read_bytes()) if op == 5]
+    parsed: list[Path] = []
+    real = layout._read_layout
+
+    def counted(f: Any, p: Path, size: int) -> layout.Ros1Layout:
+        parsed.append(p)
+        return real(f, p, size)
+
+    monkeypatch.setattr(layout, "_read_layout", counted)
+    caches.clear()
+    first = layout.read_layout(path)
+    assert [c.pos for c in first.chunks] == chunk_pos and len(chunk_pos) > 1
+    assert bag_summary(path).message_count == N + N // 3
+    poses = read_poses(path, "/pose")
+    assert len(parsed) == 1 and len(poses) == N
+    second = layout.read_layout(path)
+    assert len(parsed) == 1 and second is not first
+    assert [c.pos for c in second.chunks] == chunk_pos
+    assert all(a is not b for a, b in zip(first.chunks, second.chunks, strict=True))
+    # the summary and the read filled in the chunks they read, not the copies handed out
+    assert all(c.data_pos == -1 and c.compression == "" for c in second.chunks)
+    st = path.stat()
+    os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000))
+    layout.read_layout(path)
+    assert len(parsed) == 2
+    caches.clear()
+    layout.read_layout(path)
+    assert len(parsed) == 3
 
 
 def test_a_window_keeps_a_slice_where_it_keeps_one_stretch() -> None:

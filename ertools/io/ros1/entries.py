@@ -6,14 +6,13 @@ connections.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import I64, fresh, fresh_repeat
-from ertools.io.pipeline import Request, in_window, workers
+from ertools.io.pipeline import Request, in_window, prefetched
 from ertools.io.ros1.layout import (
     INDEX_DTYPE,
     Ros1Layout,
@@ -124,12 +123,8 @@ def connection_entries(
         c = fresh_repeat([w[0] for w in where[cid]], [w[1] for w in where[cid]], np.int32)
         return t, off, c, words
 
-    threads = min(workers(), len(cids))
-    if threads > 1:
-        with ThreadPoolExecutor(threads) as pool:
-            found = list(pool.map(one, cids))
-    else:
-        found = [one(cid) for cid in cids]
+    # (one connection, or a single core: on the calling thread)
+    found = list(prefetched(len(cids), lambda k, _scratch: one(cids[k])))
     entries: Entries = {}
     for cid, got in zip(cids, found, strict=True):
         if isinstance(got, str):

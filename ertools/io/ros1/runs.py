@@ -324,7 +324,7 @@ def ros1_runs(
         label=_label(requests, bag.path),
         hold=hold,
     )
-    return LocatedMany([len(s[3]) for s in sels], runs, [s[3] for s in sels])
+    return LocatedMany([len(s[3]) for s in sels], runs, [s[3] for s in sels], len(todo))
 
 
 # Wanted records further apart than this on average are read in place (mapped) rather than
