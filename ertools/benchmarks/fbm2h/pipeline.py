@@ -32,8 +32,8 @@ import numpy.typing as npt
 from ertools.benchmarks.common.arena import check_in_arena
 from ertools.benchmarks.common.frozen import frozen_around
 from ertools.benchmarks.common.hygiene import drop_invalid, frame_change_warning
+from ertools.benchmarks.common.path_gaps import GapOnPath
 from ertools.benchmarks.common.validity import (
-    GapOnPath,
     Validity,
     sample_codes,
     span_lost,
