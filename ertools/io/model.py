@@ -168,14 +168,3 @@ def long_msgtype(msgtype: str) -> str:
     if len(parts) == 2:
         return f"{parts[0]}/msg/{parts[1]}"
     return msgtype
-
-
-@dataclass(frozen=True)
-class ClockCheck:
-    """Record time minus header stamp (median over a few messages) of one pose topic."""
-
-    path: str
-    topic: str
-    offset_ns: int
-    samples: int
-    error: str = ""  # the first messages could not be read (damaged data)
