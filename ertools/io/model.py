@@ -1,9 +1,10 @@
-"""Plain records the reader layer hands out: summaries, pose sources, raw messages."""
+"""Plain records the reader layer hands out: summaries, pose sources, state streams,
+connections."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # annotations only: options hold a PoseSource, and parsers build options
     from ertools.streams import StateStream
@@ -111,16 +112,6 @@ class BenchmarkStates:
     bmbox: StateStream | None
     refbox: StateStream | None
     client: StateStream | None
-
-
-@dataclass(frozen=True)
-class RawMessage:
-    """One deserialized message (rosbags' message object) with its record time."""
-
-    t_ns: int
-    msg: Any
-    topic: str = ""
-    msgtype: str = ""
 
 
 @dataclass(frozen=True)
