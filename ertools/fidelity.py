@@ -4,16 +4,20 @@ Every ``differs from 2015:`` line ertools prints is a :class:`Deviation` made fr
 :class:`Rule` declared as a module-level constant next to the code that applies it, so a
 referee who reads the line can find the rule (its key), what the 2015 node did and the option
 that brings the 2015 behaviour back. Beside them, each benchmark's ``VERSIONS`` lists the
-versions of its node files (:class:`NodeVersion`: commit, date, the competition it served, what
-moved a score, the option that reproduces it). The catalogue of them all comes from the
-registry (:mod:`ertools.benchmarks.catalogue`, which generates ``docs/fidelity.md``'s two
-tables with the functions here).
+versions of its node files (:class:`ertools.node_versions.NodeVersion`: commit, date, the
+competition it served, what moved a score, the option that reproduces it). The catalogue of
+them all comes from the registry (:mod:`ertools.benchmarks.catalogue`, which generates
+``docs/fidelity.md``'s two tables with the functions here).
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # the rows of version_table, made by each benchmark's rules
+    from ertools.node_versions import NodeVersion
 
 
 @dataclass(frozen=True)
@@ -46,29 +50,6 @@ class Rule:
     def deviation(self, detail: str) -> Deviation:
         """The line to print for one result: ``detail`` says what differs in this result."""
         return Deviation(self, detail)
-
-
-@dataclass(frozen=True)
-class NodeVersion:
-    """One version of a node file of rockin-robot-challenge/benchmark_and_scoring_fbm: a row of
-    the version table (``docs/fidelity.md``), read at its commit.
-
-    Attributes:
-        file: the file in that repository (``scripts/fbm2h``, ``src/rockin_scoring/BmBox.py``).
-        commit: the short commit hash.
-        date: the commit date (YYYY-MM-DD).
-        event: the competition it served (RoCKIn 2015 Lisbon, the Lisbon 2016 second local,
-            the Lisbon 2017 major tournament), or ``development``.
-        changes: every change since the file's previous row that moves a score.
-        restores: the option reproducing it, or ``not restorable:`` and why.
-    """
-
-    file: str
-    commit: str
-    date: str
-    event: str
-    changes: str
-    restores: str
 
 
 class Deviation(str):

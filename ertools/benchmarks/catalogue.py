@@ -33,12 +33,12 @@ from ertools.fidelity import (
     END,
     VERSIONS_BEGIN,
     VERSIONS_END,
-    NodeVersion,
     Rule,
     markdown_table,
     replace_table,
     version_table,
 )
+from ertools.node_versions import NodeVersion
 
 #: The 2015 BmBox's: its rules and the versions of its files (``BmBox.py``, ``FSM.py``).
 SHARED_RULES: tuple[Rule, ...] = ending.RULES

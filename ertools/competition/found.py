@@ -48,7 +48,8 @@ from ertools.timelines.scan import scan
 from ertools.timeutil import NS_PER_S
 
 if TYPE_CHECKING:
-    from ertools.io.model import BagSummary, ClockCheck
+    from ertools.io.clock import ClockCheck
+    from ertools.io.model import BagSummary
 
 ROBOT_BAG = "ROBOT_BAG"
 TIMELINE_PAGE = "timeline.html"

@@ -22,7 +22,7 @@ from typing import Any
 from ertools._version import __version__
 from ertools.atomic import write_text
 from ertools.errors import watching
-from ertools.io.model import ClockCheck
+from ertools.io.clock import ClockCheck
 
 MEMO_VERSION = 1
 CLOCK = "clock"

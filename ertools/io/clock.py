@@ -11,19 +11,31 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ertools.errors import ClockError, ErtoolsError
 from ertools.io.files import open_bag
-from ertools.io.model import BagSummary, ClockCheck
+from ertools.io.model import BagSummary
 from ertools.io.reader import load_pose_batch
 from ertools.io.summary import summary
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
 
 log = logging.getLogger("ertools.io.clock")
+
+
+@dataclass(frozen=True)
+class ClockCheck:
+    """Record time minus header stamp (median over a few messages) of one pose topic."""
+
+    path: str
+    topic: str
+    offset_ns: int
+    samples: int
+    error: str = ""  # the first messages could not be read (damaged data)
 
 
 # Types whose header stamp the clock check compares with the record time, best first: the

@@ -1,9 +1,10 @@
-"""Plain records the reader layer hands out: summaries, pose sources, raw messages."""
+"""Plain records the reader layer hands out: summaries, pose sources, state streams,
+connections."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # annotations only: options hold a PoseSource, and parsers build options
     from ertools.streams import StateStream
@@ -114,16 +115,6 @@ class BenchmarkStates:
 
 
 @dataclass(frozen=True)
-class RawMessage:
-    """One deserialized message (rosbags' message object) with its record time."""
-
-    t_ns: int
-    msg: Any
-    topic: str = ""
-    msgtype: str = ""
-
-
-@dataclass(frozen=True)
 class Conn:
     """One connection (ROS1), rosbag2 topic or MCAP channel.
 
@@ -168,14 +159,3 @@ def long_msgtype(msgtype: str) -> str:
     if len(parts) == 2:
         return f"{parts[0]}/msg/{parts[1]}"
     return msgtype
-
-
-@dataclass(frozen=True)
-class ClockCheck:
-    """Record time minus header stamp (median over a few messages) of one pose topic."""
-
-    path: str
-    topic: str
-    offset_ns: int
-    samples: int
-    error: str = ""  # the first messages could not be read (damaged data)

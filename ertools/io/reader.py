@@ -1,4 +1,5 @@
-"""The public reading functions: pose, tf and state streams, raw messages, topics.
+"""The public reading functions: pose, tf and state streams, topics (every message of a topic as
+a Python object is :mod:`ertools.io.messages`').
 
 Every function takes one path or a list (a logger's split files), reads each file, and merges
 the results in time order. Pose topics go through the bulk NumPy decoder where the format and
@@ -31,7 +32,6 @@ from ertools.io.model import (
     BenchmarkStates,
     Conn,
     PoseSource,
-    RawMessage,
 )
 from ertools.io.pipeline import Request
 from ertools.streams import MAX_FRAME_CHANGES, FrameChange, PoseStream, StateStream
@@ -50,7 +50,8 @@ HEADER_WINDOW_MARGIN_NS = 60 * 1_000_000_000
 TF_TOPICS = ("/tf", "/tf_static")
 
 
-def _paths(paths: PathsLike) -> list[Path]:
+def path_list(paths: PathsLike) -> list[Path]:
+    """The bag files of one path or a list (a logger's split files), as the readers take them."""
     if isinstance(paths, (str, Path)):
         return bag_paths(paths)
     return bag_paths(list(paths))
@@ -59,7 +60,7 @@ def _paths(paths: PathsLike) -> list[Path]:
 def topics(paths: PathsLike) -> dict[str, str]:
     """topic -> message type (``pkg/Type``) over all files, sorted by topic."""
     out: dict[str, str] = {}
-    for p in _paths(paths):
+    for p in path_list(paths):
         with open_bag(p) as bag:
             for c in bag.connections:
                 out.setdefault(c.topic, c.msgtype)
@@ -71,7 +72,7 @@ def _pose_topic_list(found: dict[str, str]) -> str:
     return ", ".join(names) if names else "none"
 
 
-def _topic_error(paths: list[Path], topic: str, what: str = "pose topic") -> TopicError:
+def topic_error(paths: list[Path], topic: str, what: str = "pose topic") -> TopicError:
     """The unknown-topic error: lists the pose topics there are (or all topics when the
     caller was not after poses)."""
     found = topics(paths)
@@ -241,7 +242,7 @@ def _read_sources(
     for r in reads:
         if isinstance(r, _TopicRead) and r.time_source not in ("header", "record"):
             raise ValueError(f"time_source must be 'header' or 'record', not {r.time_source!r}")
-    plist = _paths(paths)
+    plist = path_list(paths)
     parts: list[list[PoseStream]] = [[] for _ in reads]
     per_edge: dict[tuple[str, str], list[PoseStream]] = {}
     static_edges: set[tuple[str, str]] = set()
@@ -303,7 +304,7 @@ def _read_sources(
     for r, found in zip(reads, parts, strict=True):
         if isinstance(r, _TopicRead):
             if not found:
-                raise _topic_error(plist, r.topic)
+                raise topic_error(plist, r.topic)
             out.append(merge_poses(found, r.topic))
         else:
             out.append(_tf_chain(plist, edges, r.parent, r.child, start_ns, end_ns))
@@ -345,7 +346,7 @@ def _tf_chain(
     end_ns: int | None,
 ) -> PoseStream:
     if not edges:
-        raise _topic_error(plist, "/tf", "tf topic")
+        raise topic_error(plist, "/tf", "tf topic")
     source = f"{plist[0]}:/tf" if len(plist) == 1 else f"{len(plist)} files:/tf"
     try:
         stream = chain_pose(edges, parent, child, source)
@@ -411,37 +412,6 @@ def read_pose_sources(
     return _read_sources(paths, reads, start_ns, end_ns)
 
 
-def read_messages(
-    paths: PathsLike, topic: str, *, start_ns: int | None = None, end_ns: int | None = None
-) -> list[RawMessage]:
-    """Every message of ``topic`` deserialized by rosbags, with record times, time-ordered.
-
-    The general fallback for any type (one Python object per message: not for long pose
-    streams; use :func:`read_poses` there).
-    """
-    plist = _paths(paths)
-    out: list[RawMessage] = []
-    found = False
-    for p in plist:
-        with open_bag(p) as bag:
-            conns = bag.topic_conns(topic)
-            if not conns:
-                continue
-            found = True
-            deser = Deserializer(conns, p)
-            out.extend(
-                RawMessage(t, deser(raw, c), topic, c.msgtype)
-                for c, t, raw in bag.raw(conns, start_ns, end_ns)
-            )
-    if not found:
-        raise _topic_error(plist, topic, "topic")
-    times = np.array([m.t_ns for m in out], dtype=np.int64)
-    if len(times) > 1 and np.any(times[1:] < times[:-1]):
-        log.warning("%s: messages from several files out of time order; sorted", topic)
-        out = [out[i] for i in np.argsort(times, kind="stable")]
-    return out
-
-
 def _machine_of(topic: str, msgtype: str) -> Machine | None:
     from ertools.states import MSG_TYPES, STATE_TOPIC_SUFFIXES  # lazy: 5 enums, 2 ms, states only
 
@@ -465,7 +435,7 @@ def read_states(paths: PathsLike, topic: str) -> StateStream:
     Raises:
         TopicError: topic absent, or not a state topic (no ``state``/``payload`` fields).
     """
-    return _read_states(_paths(paths), [topic])[0]
+    return _read_states(path_list(paths), [topic])[0]
 
 
 def _read_states(plist: list[Path], names: Sequence[str]) -> list[StateStream]:
@@ -499,7 +469,7 @@ def _read_states(plist: list[Path], names: Sequence[str]) -> list[StateStream]:
     out = []
     for i, topic in enumerate(names):
         if not t_parts[i]:
-            raise _topic_error(plist, topic, "state topic")
+            raise topic_error(plist, topic, "state topic")
         machine = _machine_of(topic, msgtypes[i])
         assert machine is not None
         t = np.concatenate(t_parts[i])
@@ -537,7 +507,7 @@ def read_benchmark_states(paths: PathsLike, namespace: str) -> BenchmarkStates:
     """
     from ertools.states import STATE_TOPIC_SUFFIXES, Machine  # lazy: 5 enums, 2 ms, states only
 
-    plist = _paths(paths)
+    plist = path_list(paths)
     present = topics(plist)
     ns = "/" + namespace.strip("/")
     wanted: dict[Machine, str] = {}

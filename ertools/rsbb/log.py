@@ -4,9 +4,9 @@ The RefBox state topic says when each goal was requested, started and ended and 
 result, when each manual operation was asked and what the referee answered, and how the
 benchmark ended; ``/timeout`` tells a goal's timeout from an empty result; the BmBox state
 topic carries the goal requests (its payloads); the live score topic the script's saves. The
-messages are decoded with the definitions stored in the bag (:func:`ertools.io.reader.read_messages`
-and :func:`ertools.io.reader.read_states`); the streams are NumPy arrays and the events are derived
-from their changes, not from every message.
+messages are decoded with the definitions stored in the bag
+(:func:`ertools.io.messages.read_messages` and :func:`ertools.io.reader.read_states`); the
+streams are NumPy arrays and the events are derived from their changes, not from every message.
 """
 
 from __future__ import annotations
@@ -22,7 +22,8 @@ import numpy.typing as npt
 
 from ertools.arrays import I64, U8
 from ertools.errors import ConfigError, TopicError
-from ertools.io.reader import read_messages, read_states, read_tf, topics
+from ertools.io.messages import read_messages
+from ertools.io.reader import read_states, read_tf, topics
 from ertools.io.summary import summary
 from ertools.rsbb.results import LiveScore, parse_live_score
 from ertools.rsbb_states import (

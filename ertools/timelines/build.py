@@ -28,8 +28,8 @@ from itertools import pairwise
 from pathlib import Path
 
 from ertools.benchmarks.common.teams import parse_robot_log_name
+from ertools.io.clock import ClockCheck
 from ertools.io.formats import Unreadable
-from ertools.io.model import ClockCheck
 from ertools.rsbb.layout import FileKind
 from ertools.rsbb.layout import classify as rsbb_classify
 from ertools.timelines.model import (

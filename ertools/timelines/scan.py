@@ -16,9 +16,8 @@ from typing import TYPE_CHECKING
 
 from ertools.benchmarks import registry
 from ertools.errors import ErtoolsError
-from ertools.io.clock import clock_check
+from ertools.io.clock import ClockCheck, clock_check
 from ertools.io.formats import Found, Unreadable, find_bags, regular_files
-from ertools.io.model import ClockCheck
 from ertools.io.summary import summary
 from ertools.progress import reporting
 from ertools.rsbb.layout import classify, pair_runs

@@ -36,7 +36,8 @@ from ertools.errors import BagError
 from ertools.io import budget
 from ertools.io.files import open_bag
 from ertools.io.info import describe
-from ertools.io.reader import read_messages, read_poses, read_states
+from ertools.io.messages import read_messages
+from ertools.io.reader import read_poses, read_states
 from ertools.io.summary import summary as bag_summary
 from tests.helpers.bagmaker import build, typestore, write
 from tests.helpers.scene import Scene

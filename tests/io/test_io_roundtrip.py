@@ -10,10 +10,10 @@ import pytest
 from rosbags.rosbag1 import Writer
 
 from ertools.errors import BagError, TopicError
+from ertools.io.messages import read_messages
 from ertools.io.model import PoseSource
 from ertools.io.reader import (
     read_benchmark_states,
-    read_messages,
     read_pose_source,
     read_poses,
     read_states,

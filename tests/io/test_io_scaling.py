@@ -20,7 +20,7 @@ import pytest
 
 from ertools import caches
 from ertools.io.info import describe
-from ertools.io.reader import read_messages
+from ertools.io.messages import read_messages
 from ertools.io.summary import summary as bag_summary
 from tests.io.hostile_files import (
     McapChannel,

@@ -13,8 +13,8 @@ import pytest
 from rosbags.rosbag2 import Reader, StoragePlugin, Writer
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
+from ertools.io.messages import read_messages
 from ertools.io.model import long_msgtype, short_msgtype
-from ertools.io.reader import read_messages
 from ertools.io.reader import topics as bag_topics
 from ertools.io.summary import summary as bag_summary
 

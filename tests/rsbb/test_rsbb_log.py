@@ -10,7 +10,8 @@ import pytest
 
 from ertools.benchmarks.hnf.config import SCRIPT_FRAMES as HNF_FRAMES
 from ertools.errors import TopicError
-from ertools.io.reader import read_messages, topics
+from ertools.io.messages import read_messages
+from ertools.io.reader import topics
 from ertools.rsbb.log import (
     EndKind,
     GoalOutcome,

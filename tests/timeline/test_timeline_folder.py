@@ -16,8 +16,8 @@ import pytest
 import ertools.timelines.scan as ts
 from ertools.cli.main import main
 from ertools.geometry import quat_from_yaw
+from ertools.io.clock import ClockCheck
 from ertools.io.formats import find_bags
-from ertools.io.model import ClockCheck
 from ertools.progress import reporting
 from ertools.simulator.writer import BagWriter
 from ertools.timelines.scan import scan

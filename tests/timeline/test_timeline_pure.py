@@ -6,8 +6,8 @@ import json
 
 import pytest
 
+from ertools.io.clock import ClockCheck
 from ertools.io.formats import Unreadable
-from ertools.io.model import ClockCheck
 from ertools.timelines.build import (
     benchmark_names,
     build_timeline,

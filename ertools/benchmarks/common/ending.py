@@ -22,7 +22,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ertools.benchmarks.common.inputs import EXACT_FLAG
-from ertools.fidelity import Deviation, NodeVersion, Rule
+from ertools.fidelity import Deviation, Rule
+from ertools.node_versions import NodeVersion
 from ertools.states import (
     BmBoxState,
     EndReason,
@@ -59,7 +60,7 @@ RULE_END_PAYLOADS = Rule(
 # The rules of the BmBox every 2015 node imported (ertools.benchmarks.catalogue lists them).
 RULES = (RULE_END_PAYLOADS,)
 
-# The BmBox every node imports (rows of the version table, ertools.fidelity.NodeVersion).
+# The BmBox every node imports (rows of the version table, ertools.node_versions.NodeVersion).
 _ALL_THREE = "RoCKIn 2015 Lisbon; Lisbon 2016 second local; Lisbon 2017 major tournament"
 VERSIONS = (
     NodeVersion(

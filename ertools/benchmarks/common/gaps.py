@@ -2,7 +2,7 @@
 invalid spans on a time axis, and the valid fraction in words for a figure's title.
 
 A gap on a path is drawn from the last valid sample before it to the first valid one after it
-(:class:`~ertools.benchmarks.common.validity.GapOnPath`), with a marker at each end: dashed
+(:class:`~ertools.benchmarks.common.path_gaps.GapOnPath`), with a marker at each end: dashed
 where the robot may have moved unmeasured (the straight chord is all the score knows of that
 stretch), dotted for a tracking loss of a robot that stood still (no motion hidden). A gap at
 the window's edge has one measured end: only its marker is drawn. One line per kind, broken

@@ -3,7 +3,8 @@
 Every sample gets one int8 reason code (:data:`REASONS`), computed for a whole stream at once
 (:func:`sample_codes`), then summarised over a scored window (:func:`summarise`): the fraction
 of valid samples, the count of each invalid reason and the invalid spans (where the valid data
-stops and starts again, for the tables and the path plots). The benchmarks turn it into a
+stops and starts again, for the tables and, through
+:mod:`ertools.benchmarks.common.path_gaps`, the path plots). The benchmarks turn it into a
 verdict: :func:`coverage_problem` (FBM3W's path), :func:`valid_near` (FBM2H's reached moments),
 :func:`unmeasured` (FBM1's ground-truth moment), the share of valid pairs (the trajectory); a
 run whose valid data cannot support a score is ``unscoreable`` with the reason, never scored
@@ -485,53 +486,6 @@ def valid_near(mask: SampleMask, at_ns: I64, tolerance_ns: int) -> Bool:
         near = np.minimum(near, np.abs(ok[i - 1] - at))
     out: Bool = near <= tolerance_ns
     return out
-
-
-@dataclass(frozen=True)
-class GapOnPath:
-    """An invalid span where a path plot draws it.
-
-    Attributes:
-        start_s, end_s: its ends in seconds from the origin the result counts time from.
-        reason: as :attr:`InvalidSpan.reason`.
-        start_xy, end_xy: the plot-frame (x, y) of the valid samples at its ends, None where it
-            touches the window's edge (nothing was measured on that side).
-        lost: whether the tracked point may have moved unmeasured in it (:func:`lost_spans`);
-            False for a tracking loss of a point that stood still.
-    """
-
-    start_s: float
-    end_s: float
-    reason: str
-    start_xy: tuple[float, float] | None
-    end_xy: tuple[float, float] | None
-    lost: bool = True
-
-
-def gaps_on_path(
-    validity: Validity, xy: F64 | None, origin_ns: int, still_m: float = STILL_M
-) -> tuple[GapOnPath, ...]:
-    """The spans of ``validity`` with their (x, y) ends in ``xy``, the window's samples in the
-    plot's frame (row 0 = the window's first sample; a rotation of the window's world (x, y)
-    keeps the distances that decide ``lost``)."""
-    lost = set(lost_spans(validity, xy, still_m))
-
-    def at(i: int) -> tuple[float, float] | None:
-        if xy is None or i < 0 or i >= len(xy):
-            return None
-        return (float(xy[i, 0]), float(xy[i, 1]))
-
-    return tuple(
-        GapOnPath(
-            (s.start_ns - origin_ns) / 1e9,
-            (s.end_ns - origin_ns) / 1e9,
-            s.reason,
-            at(s.before),
-            at(s.after),
-            s in lost,
-        )
-        for s in validity.spans
-    )
 
 
 def cell(invalid: Mapping[str, int]) -> str:

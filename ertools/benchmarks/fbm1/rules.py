@@ -5,7 +5,8 @@ says, what the node did, what ertools does and why, the option restoring 2015).
 
 from __future__ import annotations
 
-from ertools.fidelity import NodeVersion, Rule
+from ertools.fidelity import Rule
+from ertools.node_versions import NodeVersion
 
 NODE_SOURCE = "scripts/fbm1h (e373be0), scripts/fbm1w (7628309): RoCKIn 2015"
 
@@ -147,7 +148,7 @@ RULES = (
     RULE_ACQUIRE_WINDOW,
 )
 
-# The versions of the FBM1 nodes (rows of the version table, ertools.fidelity.NodeVersion).
+# The versions of the FBM1 nodes (rows of the version table, ertools.node_versions.NodeVersion).
 _H = "scripts/fbm1h"
 VERSIONS = (
     NodeVersion(

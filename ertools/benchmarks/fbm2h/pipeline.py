@@ -30,9 +30,10 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.benchmarks.common.arena import check_in_arena
-from ertools.benchmarks.common.hygiene import drop_invalid, frame_change_warning, frozen_around
+from ertools.benchmarks.common.frozen import frozen_around
+from ertools.benchmarks.common.hygiene import drop_invalid, frame_change_warning
+from ertools.benchmarks.common.path_gaps import GapOnPath
 from ertools.benchmarks.common.validity import (
-    GapOnPath,
     Validity,
     sample_codes,
     span_lost,
@@ -431,7 +432,7 @@ def _frozen_warnings(
 
     The threshold is ``--gt-tolerance``: a frozen stretch longer than the gap ertools accepts hides
     a tracking loss of the size it refuses (see
-    :data:`ertools.benchmarks.common.hygiene.FROZEN_MIN_S`).
+    :data:`ertools.benchmarks.common.frozen.FROZEN_MIN_S`).
     """
 
     if not len(moments):

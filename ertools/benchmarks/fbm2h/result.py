@@ -12,8 +12,9 @@ import yaml
 
 from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
+from ertools.benchmarks.common.path_gaps import GapOnPath
 from ertools.benchmarks.common.uncertainty import Interval, Uncertainty, uncertainty_rows
-from ertools.benchmarks.common.validity import GapOnPath, Validity, cell
+from ertools.benchmarks.common.validity import Validity, cell
 from ertools.benchmarks.fbm2h.goal import GoalList
 from ertools.benchmarks.results import ResultBase
 from ertools.configs.transform import MarkerTransform

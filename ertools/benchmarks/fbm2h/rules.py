@@ -5,7 +5,8 @@ says, what the node did, what ertools does and why, the option restoring 2015).
 
 from __future__ import annotations
 
-from ertools.fidelity import NodeVersion, Rule
+from ertools.fidelity import Rule
+from ertools.node_versions import NodeVersion
 
 NODE_SOURCE = "scripts/fbm2h (50b173b, RoCKIn 2015; unchanged in 2016-17)"
 
@@ -115,7 +116,8 @@ RULE_SCORE_FORMAT = Rule(
 )
 
 # The versions of scripts/fbm2h since its rewrite (rows of the version table,
-# ertools.fidelity.NodeVersion); the RoCKIn Camp 2015 node before it became old_fbm2h (a59151c).
+# ertools.node_versions.NodeVersion); the RoCKIn Camp 2015 node before it became old_fbm2h
+# (a59151c).
 _F = "scripts/fbm2h"
 _DEV = "not restorable: a development version, run in no competition"
 VERSIONS = (

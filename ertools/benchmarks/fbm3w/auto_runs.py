@@ -19,17 +19,12 @@ import numpy.typing as npt
 
 from ertools.arrays import F64
 from ertools.benchmarks.common.motion import moving_mean
-from ertools.benchmarks.common.phases import (
-    DEFAULT_MIN_STILL_S,
-    DEFAULT_STILL_SPEED,
-    Phase,
-    Track,
-    protocol_track,
-)
+from ertools.benchmarks.common.phases import DEFAULT_MIN_STILL_S, DEFAULT_STILL_SPEED, Phase
 from ertools.benchmarks.fbm3w.formula import arc_fractions, frame_errors, subsample_d_min
 from ertools.benchmarks.fbm3w.runs import RunWindow
 from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.benchmarks.fbm3w.shapes import Shape
+from ertools.benchmarks.fbm3w.track import Track, protocol_track
 from ertools.errors import ConfigError, SegmentationError
 from ertools.streams import PoseStream
 
@@ -101,7 +96,7 @@ def find_auto(
 
     A run is: still at the reference, a move to the start, still at the start, the path,
     still at the end. The still phases come from
-    :func:`~ertools.benchmarks.common.phases.protocol_track` (noise-sized window, hysteresis,
+    :func:`~ertools.benchmarks.fbm3w.track.protocol_track` (noise-sized window, hysteresis,
     dropouts bridged). Every move j >= 1 (and up to :data:`AUTO_MAX_SPAN` moves joined across
     short pauses) is a candidate path for each run's shape, matched with Eq. (1) on the
     smoothed positions (see :func:`_match`); it is acceptable when its best-rotation error is

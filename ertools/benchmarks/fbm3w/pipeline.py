@@ -23,9 +23,9 @@ from ertools.benchmarks.common.epsilon import (
     NoiseResult,
     noise_from_stream,
 )
+from ertools.benchmarks.common.frozen import frozen_warnings
 from ertools.benchmarks.common.hygiene import (
     frame_change_warning,
-    frozen_warnings,
     identical_poses,
     impossible_warning,
 )

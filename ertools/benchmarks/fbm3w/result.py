@@ -9,13 +9,14 @@ from typing import Any
 from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.epsilon import NoiseResult
 from ertools.benchmarks.common.interval_output import ScoreRow, interval_lines
+from ertools.benchmarks.common.path_gaps import GapOnPath, gaps_on_path
 from ertools.benchmarks.common.uncertainty import (
     Interval,
     Uncertainty,
     split_interval,
     uncertainty_rows,
 )
-from ertools.benchmarks.common.validity import GapOnPath, Validity, cell, gaps_on_path
+from ertools.benchmarks.common.validity import Validity, cell
 from ertools.benchmarks.fbm3w.formula import PathScore
 from ertools.benchmarks.fbm3w.runs import RunWindow
 from ertools.benchmarks.results import ResultBase

@@ -6,7 +6,8 @@ says, what the node did, what ertools does and why, the option restoring 2015).
 from __future__ import annotations
 
 from ertools.benchmarks.fbm3w.config import DEFAULT_FRAME, DEFAULT_TOPIC, FALLBACK_TOPIC
-from ertools.fidelity import NodeVersion, Rule
+from ertools.fidelity import Rule
+from ertools.node_versions import NodeVersion
 
 NODE_SOURCE = "scripts/fbm3w (50b173b, RoCKIn 2015)"
 
@@ -144,7 +145,7 @@ RULE_UNSCOREABLE_RUNS = Rule(
     option="--unscoreable 2015",
 )
 
-# The versions of scripts/fbm3w (rows of the version table, ertools.fidelity.NodeVersion).
+# The versions of scripts/fbm3w (rows of the version table, ertools.node_versions.NodeVersion).
 _F = "scripts/fbm3w"
 _DEV = "not restorable: a development version, run in no competition"
 _DRAFT = "not restorable: no score computed"

@@ -4,7 +4,8 @@
 
 from __future__ import annotations
 
-from ertools.fidelity import NodeVersion, Rule
+from ertools.fidelity import Rule
+from ertools.node_versions import NodeVersion
 
 SCRIPT = "rsbb_bmbox/scripts/benchmark_scripts/fbm6_grasping_manipulation.py"
 SOURCE = f"{SCRIPT} (rockin-robot-challenge/rsbb 2bb8a41, ERL 2019)"

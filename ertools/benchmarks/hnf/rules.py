@@ -5,7 +5,8 @@ the script (docs/hnf.md; the version table of docs/fidelity.md).
 
 from __future__ import annotations
 
-from ertools.fidelity import NodeVersion, Rule
+from ertools.fidelity import Rule
+from ertools.node_versions import NodeVersion
 
 SCRIPT = "fbm2_navigation.py (rockin-robot-challenge/rsbb 2bb8a41)"
 FILE = "rsbb_bmbox/scripts/benchmark_scripts/fbm2_navigation.py"

@@ -7,7 +7,8 @@ The ``node_2015`` field of a Rule holds what the *script* did: here the 2019 scr
 
 from __future__ import annotations
 
-from ertools.fidelity import NodeVersion, Rule
+from ertools.fidelity import Rule
+from ertools.node_versions import NodeVersion
 
 SCRIPT = "fbm1_objects_perception.py (rsbb 2bb8a41)"
 SCRIPT_FILE = "rsbb_bmbox/scripts/benchmark_scripts/fbm1_objects_perception.py"
@@ -104,7 +105,7 @@ RULE_GT_GAPS = Rule(
     season="2019",
 )
 
-# The versions of the script (rows of the version table, ertools.fidelity.NodeVersion).
+# The versions of the script (rows of the version table, ertools.node_versions.NodeVersion).
 VERSIONS = (
     NodeVersion(
         SCRIPT_FILE,

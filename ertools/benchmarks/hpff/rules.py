@@ -3,7 +3,8 @@
 
 from __future__ import annotations
 
-from ertools.fidelity import NodeVersion, Rule
+from ertools.fidelity import Rule
+from ertools.node_versions import NodeVersion
 
 SCRIPT = "fbm5_person_following.py (rockin-robot-challenge/rsbb 2bb8a41)"
 FILE = "rsbb_bmbox/scripts/benchmark_scripts/fbm5_person_following.py"

@@ -7,7 +7,8 @@ The ``node_2015`` field of a Rule holds what the *script* did: here the 2019 scr
 
 from __future__ import annotations
 
-from ertools.fidelity import NodeVersion, Rule
+from ertools.fidelity import Rule
+from ertools.node_versions import NodeVersion
 
 SCRIPT = "fbm4_people_perception.py (rsbb 2bb8a41)"
 SCRIPT_FILE = "rsbb_bmbox/scripts/benchmark_scripts/fbm4_people_perception.py"

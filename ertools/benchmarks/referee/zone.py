@@ -20,7 +20,8 @@ import numpy as np
 from ertools.arrays import I64
 from ertools.benchmarks.referee.items import Item
 from ertools.errors import TopicError
-from ertools.io.reader import read_messages, topics
+from ertools.io.messages import read_messages
+from ertools.io.reader import topics
 from ertools.rsbb_states import CORE_TO_GUI_TOPIC, STATE_PERIOD_NS
 
 PathsLike = str | Path | Sequence[str | Path]

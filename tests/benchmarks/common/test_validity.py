@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from ertools.benchmarks.common.path_gaps import gaps_on_path
 from ertools.benchmarks.common.validity import (
     CLOCK_JUMP,
     NAN,
@@ -15,7 +16,6 @@ from ertools.benchmarks.common.validity import (
     VALID,
     coverage,
     coverage_problem,
-    gaps_on_path,
     lost_spans,
     sample_codes,
     summarise,

@@ -1,4 +1,4 @@
-"""The still-phase detector of ``--runs auto`` (common.phases.protocol_track) on tracks with
+"""The still-phase detector of ``--runs auto`` (fbm3w.track.protocol_track) on tracks with
 known motion."""
 
 from __future__ import annotations
@@ -6,12 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ertools.benchmarks.common.phases import (
-    noise_sigma,
-    protocol_track,
-    stationary_phases,
-    window_speed,
-)
+from ertools.benchmarks.common.phases import stationary_phases
+from ertools.benchmarks.fbm3w.track import noise_sigma, protocol_track, window_speed
 
 FRAME_NS = 8_333_333  # 120 Hz
 

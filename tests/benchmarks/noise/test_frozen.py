@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ertools.benchmarks.common.hygiene import FrozenSpan, frozen_around
+from ertools.benchmarks.common.frozen import FrozenSpan, frozen_around
 from ertools.streams import PoseStream
 
 FRAME = 8_333_333  # 120 Hz

@@ -18,7 +18,8 @@ from typing import Any
 
 import yaml
 
-from ertools.io.reader import read_messages, topics
+from ertools.io.messages import read_messages
+from ertools.io.reader import topics
 from tests.helpers.rsbb_replay.tf2 import Buffer, frame
 from tests.helpers.rsbb_replay.world import TGoal, Timeline, TManual
 
