@@ -101,12 +101,12 @@ def drop_duplicates(gt: PoseStream) -> tuple[PoseStream, int]:
 CHECK_ROWS = 1 << 14  # rows per chunk of the all-valid check: its buffers stay in cache
 
 
-def _all_valid(stream: PoseStream) -> bool:
+def _all_valid(stream: PoseStream, *, finite_xyz: bool = False) -> bool:
     """Whether :func:`drop_invalid` keeps every sample, shown cheaply or not at all.
 
     Squared quaternion norms (squares summed by column) far from both limits (NaN fails the
-    comparisons too) and finite positions, chunk by chunk so that the temporaries stay in
-    cache. False sends the stream to the exact per-sample test.
+    comparisons too) and finite positions (``finite_xyz``: shown already), chunk by chunk so
+    that the temporaries stay in cache. False sends the stream to the exact per-sample test.
     """
     q, xyz = stream.quat_xyzw, stream.xyz
     if q.ndim != 2 or q.shape[1] != 4 or not q.flags.c_contiguous:
@@ -124,7 +124,8 @@ def _all_valid(stream: PoseStream) -> bool:
                 sq += part[:, k]
         # margins over drop_invalid's limits: whatever the order the squares are summed in,
         # a norm passing here passes there (a stream failing here goes to the exact test)
-        if not (np.isfinite(xyz[rows]).all() and sq.min() > 2e-17 and sq.max() < 5e299):
+        finite = finite_xyz or bool(np.isfinite(xyz[rows]).all())
+        if not (finite and sq.min() > 2e-17 and sq.max() < 5e299):
             return False
     return True
 
@@ -143,7 +144,8 @@ def drop_invalid(
     impossible = (
         found if found is not None else impossible_samples(stream.t_ns, stream.xyz, jumps=jumps)
     )
-    if _all_valid(stream) and not impossible.count:
+    # the bounds of impossible_samples showed every coordinate finite: not tested again
+    if _all_valid(stream, finite_xyz=impossible.bounded) and not impossible.count:
         return stream, 0
     with np.errstate(over="ignore"):  # an overflowing norm is not finite: dropped below
         norm = row_norm(stream.quat_xyzw)
@@ -201,11 +203,14 @@ class Impossible:
             :data:`EXCURSION_MAX_S`.
         steps: the jumps that bound no such stretch: the data on one side is wrong, which
             cannot be told (their samples stay valid; the warning says where).
+        bounded: every coordinate was shown finite and within :data:`MAX_COORD_M` (the
+            bounds pass found nothing to test sample by sample); False: not shown.
     """
 
     far: Bool
     jump: Bool
     steps: tuple[Jump, ...] = ()
+    bounded: bool = False
 
     @property
     def count(self) -> int:
@@ -224,7 +229,7 @@ def impossible_samples(t_ns: npt.NDArray[np.int64], xyz: F64, *, jumps: bool = T
     far = np.zeros(n, dtype=bool)
     jump = np.zeros(n, dtype=bool)
     if not n or _all_possible(xyz, jumps=jumps):
-        return Impossible(far, jump)
+        return Impossible(far, jump, bounded=True)
     # Column by column, and the usual stream (every sample finite and near) used as it is
     # rather than gathered: the same values, without (N, 3) temporaries reduced over rows.
     finite = _per_column(np.isfinite, xyz, np.logical_and)

@@ -232,3 +232,25 @@ def test_the_all_valid_shortcut_decides_nothing_near_the_limits() -> None:
         assert count == dropped == int(not (math.isfinite(norm) and norm > 1e-9))
         assert len(kept) == 10 - dropped
     assert _all_valid(base)
+
+
+def test_bounded_means_every_coordinate_finite_and_drop_invalid_agrees() -> None:
+    """``Impossible.bounded`` (drop_invalid then skips the positions' finiteness) is set only
+    where the bounds pass saw every coordinate finite and within MAX_COORD_M; with or without
+    ``found``, drop_invalid drops the same samples, NaN and infinite positions included."""
+    t, xyz = _walk(1200, 0.5)
+    quat = np.tile([0.0, 0.0, 0.0, 1.0], (1200, 1))
+    cases = {"clean": None, "nan": np.nan, "inf": np.inf, "-inf": -np.inf, "huge": 2e8}
+    for name, bad in cases.items():
+        pos = xyz.copy()
+        if bad is not None:
+            pos[700, 2] = bad
+        found = impossible_samples(t, pos)
+        assert found.bounded == (name == "clean")
+        assert found.bounded == bool(np.isfinite(pos).all() and np.abs(pos).max() <= 1e8)
+        stream = PoseStream(t, pos, quat)
+        kept, dropped = drop_invalid(stream, found=found)
+        plain, dropped_plain = drop_invalid(stream)
+        assert dropped == dropped_plain == (0 if bad is None else 1)
+        assert np.array_equal(kept.t_ns, plain.t_ns)
+        assert len(kept) == 1200 - dropped
