@@ -238,3 +238,24 @@ def test_geometry_import_does_not_load_scipy() -> None:
     code = "import sys, ertools.geometry; print('scipy.spatial' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+def _plain_wrap(a: np.ndarray) -> np.ndarray:
+    return np.asarray((a + np.pi) % (2.0 * np.pi) - np.pi)
+
+
+@settings(max_examples=200, deadline=None)
+@given(arrays(np.float64, st.integers(0, 40), elements=st.floats(width=64)))
+def test_wrap_angle_is_the_remainder_to_the_bit(a: np.ndarray) -> None:
+    """wrap_angle divides only the angles outside [-pi, pi): the same bits as the remainder
+    of every angle, NaN, infinities, -0 and the bounds included."""
+    edges = np.array([0.0, -0.0, np.pi, -np.pi, 2 * np.pi, -2 * np.pi, 3 * np.pi, np.nan])
+    edges = np.concatenate([edges, np.nextafter(edges, np.inf), np.nextafter(edges, -np.inf)])
+    for values in (a, edges, np.concatenate([a, edges]).reshape(-1, 1)):
+        with np.errstate(invalid="ignore"):
+            got, want = wrap_angle(values), _plain_wrap(values)
+        assert got.shape == want.shape and got.dtype == np.float64
+        same = (got == want) & (np.signbit(got) == np.signbit(want))
+        assert (same | (np.isnan(got) & np.isnan(want))).all()
+    assert float(wrap_angle(4.0)) == float(_plain_wrap(np.float64(4.0)))
+    assert wrap_angle(4.0).shape == ()
