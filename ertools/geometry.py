@@ -195,14 +195,24 @@ def slerp(q0: F64, q1: F64, alpha: F64) -> F64:
     shape = np.broadcast_shapes(q1.shape, dot.shape)
     if q1.shape != shape:
         q1 = np.broadcast_to(q1, shape).copy()
-    np.negative(q1, out=q1, where=dot < 0.0)
+    # the few rows on the other hemisphere negated by index: a masked ufunc (``where=``)
+    # costs more than a whole arithmetic pass
+    flip = dot[..., 0] < 0.0
+    if flip.any():
+        q1[flip] = -q1[flip]
     dot = np.abs(dot)
     theta = np.arccos(np.clip(dot, -1.0, 1.0))
     sin_theta = np.sin(theta)
     close = sin_theta < 1e-6
-    safe = np.where(close, 1.0, sin_theta)
-    w0 = np.where(close, 1.0 - a, np.sin((1.0 - a) * theta) / safe)
-    w1 = np.where(close, a, np.sin(a * theta) / safe)
+    w0 = np.sin((1.0 - a) * theta)
+    w1 = np.sin(a * theta)
+    if close.any():
+        safe = np.where(close, 1.0, sin_theta)
+        w0 = np.where(close, 1.0 - a, w0 / safe)
+        w1 = np.where(close, a, w1 / safe)
+    else:  # no pair too close for the sine's ratio (the usual): no selection
+        w0 /= sin_theta
+        w1 /= sin_theta
     mixed = w0 * q0
     mixed += w1 * q1
     return _unit_in_place(mixed)

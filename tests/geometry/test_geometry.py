@@ -259,3 +259,46 @@ def test_wrap_angle_is_the_remainder_to_the_bit(a: np.ndarray) -> None:
         assert (same | (np.isnan(got) & np.isnan(want))).all()
     assert float(wrap_angle(4.0)) == float(_plain_wrap(np.float64(4.0)))
     assert wrap_angle(4.0).shape == ()
+
+
+def _plain_slerp(q0: np.ndarray, q1: np.ndarray, alpha: np.ndarray) -> np.ndarray:
+    """slerp as first written: a masked negation and both branches selected by np.where."""
+    q0 = q0 / np.linalg.norm(q0, axis=-1)[..., None]
+    q1 = q1 / np.linalg.norm(q1, axis=-1)[..., None]
+    a = np.asarray(alpha, dtype=np.float64)[..., None]
+    dot = np.sum(q0 * q1, axis=-1)[..., None]
+    q1 = np.broadcast_to(q1, np.broadcast_shapes(q1.shape, dot.shape)).copy()
+    np.negative(q1, out=q1, where=dot < 0.0)
+    theta = np.arccos(np.clip(np.abs(dot), -1.0, 1.0))
+    sin_theta = np.sin(theta)
+    close = sin_theta < 1e-6
+    safe = np.where(close, 1.0, sin_theta)
+    w0 = np.where(close, 1.0 - a, np.sin((1.0 - a) * theta) / safe)
+    w1 = np.where(close, a, np.sin(a * theta) / safe)
+    mixed = w0 * q0 + w1 * q1
+    return np.asarray(mixed / np.linalg.norm(mixed, axis=-1)[..., None])
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    arrays(np.float64, (12, 4), elements=st.floats(-1, 1)),
+    arrays(np.float64, (12, 4), elements=st.floats(-1e-7, 1e-7)),
+    arrays(np.float64, (12,), elements=st.floats(0, 1)),
+    st.integers(0, 2**12 - 1),
+    st.integers(0, 2**12 - 1),
+)
+def test_slerp_is_the_plain_version_to_the_bit(
+    q0: np.ndarray, nudge: np.ndarray, alpha: np.ndarray, flips: int, near: int
+) -> None:
+    """slerp negates only the rows on the other hemisphere and selects the near-pair branch
+    only when there is one: the same bits as the plain version, on pairs far apart, nearly
+    equal (within 1e-6 rad) or equal, on either hemisphere, and broadcast."""
+    assume(bool((np.linalg.norm(q0, axis=1) > 0.1).all()))
+    rows = np.arange(12)
+    q1 = np.where(((near >> rows) & 1)[:, None] == 1, q0 + nudge, q0[::-1])
+    q1 = np.where(((flips >> rows) & 1)[:, None] == 1, -q1, q1)
+    assume(bool((np.linalg.norm(q1, axis=1) > 0.1).all()))
+    for args in ((q0, q1, alpha), (q0[0], q1, alpha), (q0, q1[3], alpha[5]), (q0[2], q1[2], 0.3)):
+        got, want = slerp(*args), _plain_slerp(*args)
+        assert got.shape == want.shape
+        assert np.array_equal(got, want)
