@@ -11,7 +11,14 @@ import numpy as np
 import numpy.typing as npt
 import pytest
 
-from ertools.arrays import distinct, median, nanquantiles, percentiles, quantiles
+from ertools.arrays import (
+    distinct,
+    median,
+    nanquantiles,
+    percentiles,
+    percentiles_and_median,
+    quantiles,
+)
 
 
 def test_by_hand() -> None:
@@ -54,6 +61,11 @@ def test_the_same_bits_as_numpy(seed: int) -> None:
     q = [50.0, 90.0, 95.0, 99.0, *rng.uniform(0, 100, 4), 0.0, 100.0]
     for a in (cases[0], np.round(cases[0], 1), cases[2].ravel(), with_nan.ravel()):
         np.testing.assert_array_equal(percentiles(a, q), np.percentile(a, q))
+        if a.dtype == np.float64:  # one partition for both: each as NumPy's
+            both, middle = percentiles_and_median(a, q)
+            np.testing.assert_array_equal(both, np.percentile(a, q))
+            np.testing.assert_array_equal(middle, np.median(a))
+            assert type(middle) is type(np.median(a))
         fractions = np.asarray(q) / 100 + rng.uniform(-1e-3, 1e-3, len(q))
         fractions = np.clip(fractions, 0.0, 1.0)
         np.testing.assert_array_equal(quantiles(a, fractions), np.quantile(a, fractions))
