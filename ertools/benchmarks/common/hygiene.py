@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import F64, Bool, median
+from ertools.arrays import F64, Bool, distinct, median
 from ertools.geometry import row_norm
 from ertools.streams import MAX_FRAME_CHANGES, PoseStream
 from ertools.timeutil import iso_utc
@@ -228,7 +228,7 @@ def impossible_samples(t_ns: npt.NDArray[np.int64], xyz: F64, *, jumps: bool = T
     n = len(t_ns)
     far = np.zeros(n, dtype=bool)
     jump = np.zeros(n, dtype=bool)
-    if not n or _all_possible(xyz, jumps=jumps):
+    if not n or _all_possible(t_ns, xyz, jumps=jumps):
         return Impossible(far, jump, bounded=True)
     # Column by column, and the usual stream (every sample finite and near) used as it is
     # rather than gathered: the same values, without (N, 3) temporaries reduced over rows.
@@ -275,14 +275,15 @@ _SQRT3_MARGIN = math.sqrt(3.0) * (1.0 + 1e-9)
 BOUND_ROWS = 1 << 14  # rows per chunk of the bounds: the differences stay in cache
 
 
-def _all_possible(xyz: F64, *, jumps: bool) -> bool:
+def _all_possible(t_ns: npt.NDArray[np.int64], xyz: F64, *, jumps: bool) -> bool:
     """Whether no sample can be far or a jump, shown from bounds in one pass over ``xyz``.
 
     Every coordinate within [lo, hi] (so are the medians): no sample is further than
     sqrt(3) (hi - lo) from the centre. Every coordinate moving by at most ``step`` between
     consecutive rows: no two consecutive measured samples (repeats between them equal the
-    first) are more than sqrt(3) step apart, never a jump. False: not shown (NaN, infinite,
-    far or fast samples), and the exact test decides.
+    first) are more than sqrt(3) step apart, never a jump; where some move more, the rows
+    that do may still be too slow for one (:func:`_slow_steps`). False: not shown (NaN,
+    infinite, far or fast samples), and the exact test decides.
     """
     if not xyz.flags.c_contiguous or xyz.ndim != 2 or xyz.shape[1] != 3:
         return False
@@ -301,7 +302,32 @@ def _all_possible(xyz: F64, *, jumps: bool) -> bool:
         if jumps and end > start:
             d = np.subtract(flat[start:end], flat[start - 3 : end - 3], out=buf[: end - start])
             step = max(step, float(d.max()), -float(d.min()))
-    return (hi - lo) * _SQRT3_MARGIN <= FAR_M and step * _SQRT3_MARGIN <= JUMP_MIN_M
+    if (hi - lo) * _SQRT3_MARGIN > FAR_M:
+        return False
+    return step * _SQRT3_MARGIN <= JUMP_MIN_M or _slow_steps(t_ns, xyz)
+
+
+def _slow_steps(t_ns: npt.NDArray[np.int64], xyz: F64) -> bool:
+    """Whether no row moving a coordinate by more than JUMP_MIN_M / sqrt(3) from the row before
+    can be a jump, for finite positions near each other (:func:`_all_possible`): a GT with
+    tracking gaps, or blocks taken out of a stream, moves far between rows far apart in time.
+
+    With stamps in order, the time from the last measured sample to a row is at least the
+    time from the row before it (the repeats between them equal that sample), so each such
+    row is no jump when sqrt(3) times its largest coordinate move, over its time from the
+    row before, is below :data:`MAX_SPEED_M_S` (by a margin far above the rounding).
+    False: not shown (stamps out of order, equal stamps, or a fast move).
+    """
+    t = t_ns
+    if len(t) != len(xyz) or not bool(np.all(t[1:] >= t[:-1])):
+        return False
+    flat = xyz.reshape(-1)
+    moved = np.abs(flat[3:] - flat[:-3]) * _SQRT3_MARGIN > JUMP_MIN_M
+    rows = distinct(np.flatnonzero(moved) // 3 + 1)  # a row moved from the row before it
+    dt = (t[rows] - t[rows - 1]).astype(np.float64)
+    step = np.abs(xyz[rows] - xyz[rows - 1]).max(axis=1)
+    fast = step * (_SQRT3_MARGIN * 1e9) > MAX_SPEED_M_S * (1.0 - 1e-9) * dt
+    return not bool(fast.any())
 
 
 def _per_column(test: Callable[[F64], Bool], xyz: F64, combine: np.ufunc) -> Bool:
