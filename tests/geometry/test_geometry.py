@@ -26,6 +26,7 @@ from ertools.geometry import (
     row_norm,
     slerp,
     transform_points,
+    unwrap_angles,
     wrap_angle,
     yaw_from_quat,
 )
@@ -302,3 +303,20 @@ def test_slerp_is_the_plain_version_to_the_bit(
         got, want = slerp(*args), _plain_slerp(*args)
         assert got.shape == want.shape
         assert np.array_equal(got, want)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    arrays(np.float64, st.integers(0, 40), elements=st.floats(-20.0, 20.0)),
+    arrays(np.float64, st.integers(0, 40), elements=st.floats(width=64)),
+)
+def test_unwrap_angles_is_numpys_to_the_bit(small: np.ndarray, anything: np.ndarray) -> None:
+    """unwrap_angles skips the remainders np.unwrap discards: the same bits as np.unwrap on
+    tracks with steps below, at and above pi, NaN and infinities included."""
+    track = np.concatenate([small, np.cumsum(np.full(5, np.pi)), [0.0, np.pi, 0.0, -np.pi]])
+    for values in (small, anything, track, np.array([1.0]), np.zeros(0)):
+        with np.errstate(invalid="ignore"):
+            got, want = unwrap_angles(values), np.unwrap(values)
+        assert got.dtype == want.dtype and got.shape == want.shape
+        same = (got == want) & (np.signbit(got) == np.signbit(want))
+        assert (same | (np.isnan(got) & np.isnan(want))).all()

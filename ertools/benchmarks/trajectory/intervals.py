@@ -74,7 +74,7 @@ from ertools.benchmarks.trajectory.steady import clear_of_losses
 from ertools.benchmarks.trajectory.steady import effects as steady_effects
 from ertools.benchmarks.trajectory.terms import PoseTerms
 from ertools.errors import ErtoolsError
-from ertools.geometry import wrap_angle, yaw_from_quat
+from ertools.geometry import unwrap_angles, wrap_angle, yaw_from_quat
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
 
@@ -177,7 +177,7 @@ def _second_differences(gt: PoseStream) -> tuple[F64, F64]:
     # equal spacing (within 25%): a gap is not a second difference of the motion
     ok &= np.abs(dt[1:] - dt[:-1]) <= 0.25 * np.maximum(dt[1:], 1)
     d2 = (xyz[2:] - 2.0 * xyz[1:-1] + xyz[:-2])[ok]
-    yaw = np.unwrap(gt.yaw)
+    yaw = unwrap_angles(gt.yaw)
     y2 = (yaw[2:] - 2.0 * yaw[1:-1] + yaw[:-2])[ok]
     return d2.reshape(-1), y2
 
