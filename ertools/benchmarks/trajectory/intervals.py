@@ -49,6 +49,7 @@ from ertools.benchmarks.common.draws import (
     percentile_rows,
 )
 from ertools.benchmarks.common.epsilon import noise_from_stream
+from ertools.benchmarks.common.hygiene import rows_equal
 from ertools.benchmarks.common.inputs import IntervalSettings
 from ertools.benchmarks.common.interval_output import (
     METHOD,
@@ -171,7 +172,7 @@ def _second_differences(gt: PoseStream) -> tuple[F64, F64]:
     if len(gt) < 3:
         return np.zeros(0), np.zeros(0)
     fresh = np.ones(len(gt), dtype=bool)
-    fresh[1:] = np.any(xyz[1:] != xyz[:-1], axis=1)
+    fresh[1:] = ~rows_equal(xyz[1:], xyz[:-1])  # by column: no (N, 3) reduced over rows
     dt = np.diff(gt.t_ns)
     ok = fresh[2:] & fresh[1:-1] & fresh[:-2]
     # equal spacing (within 25%): a gap is not a second difference of the motion
