@@ -81,6 +81,10 @@ def median(values: npt.ArrayLike, axis: int | None = None) -> Any:
         return np.mean(a, axis=axis)  # NaN and "Mean of empty slice", as np.median
     half = n // 2
     middle = [half - 1, half] if n % 2 == 0 else [half]
+    if a.ndim == 1 and _orderable(a):
+        part = a.copy()
+        _select(part, middle)
+        return np.mean(np.take(part, middle, axis=axis), axis=axis)
     nan_aware = a.dtype.kind in "fc"
     # NaN sorts last: partitioning at the last place too puts one there when there is one
     part = np.partition(a, [*middle, n - 1] if nan_aware else middle, axis=axis)
@@ -98,6 +102,19 @@ def quantiles(values: npt.ArrayLike, q: npt.ArrayLike) -> F64:
     """``np.quantile(values, q)`` of 1-d float values, NumPy's default (linear) method: at
     ``(n - 1) q`` in the sorted values, interpolated between its two neighbours from the nearer
     one; all NaN when a value is NaN. The same bits."""
+    return _quantiles(values, q, with_median=False)[0]
+
+
+def percentiles_and_median(values: npt.ArrayLike, q: Sequence[float]) -> tuple[F64, Any]:
+    """(:func:`percentiles`, :func:`median`) of 1-d float64 values, the same bits as each, from
+    one partition of one copy instead of two."""
+    return _quantiles(values, np.asarray(q, dtype=np.float64) / 100, with_median=True)
+
+
+def _quantiles(values: npt.ArrayLike, q: npt.ArrayLike, *, with_median: bool) -> tuple[F64, Any]:
+    """:func:`quantiles`, and with ``with_median`` :func:`median` of float64 values (the
+    middle values are order statistics: the same values wherever else the copy is
+    partitioned), else None."""
     a = np.array(values).ravel()  # a copy: partitioned in place
     if a.dtype.kind != "f":
         a = a.astype(np.float64)
@@ -111,14 +128,45 @@ def quantiles(values: npt.ArrayLike, q: npt.ArrayLike) -> F64:
     below[at >= n - 1] = above[at >= n - 1] = n - 1
     below[at < 0] = above[at < 0] = 0
     lo_at, hi_at = below.astype(np.intp), above.astype(np.intp)
-    a.partition(distinct(np.concatenate([[0, n - 1], lo_at, hi_at])))
+    half = n // 2
+    middle = ([half - 1, half] if n % 2 == 0 else [half]) if with_median else []
+    places = np.concatenate([lo_at, hi_at, middle]).astype(np.intp)
+    orderable = _orderable(a)
+    if orderable:
+        _select(a, distinct(places).tolist())
+    else:
+        a.partition(distinct(np.concatenate([[0, n - 1], places])))
     lo, hi = a[lo_at], a[hi_at]
     t = at - lo_at
     step = hi - lo  # in the values' type, then float64 with t
     out: F64 = np.where(t >= 0.5, hi - step * (1 - t), lo + step * t)
-    if np.isnan(a[n - 1]):
+    mid = np.mean(a[middle]) if with_median else None  # as median: the mean of the middle
+    if not orderable and np.isnan(a[n - 1]):
         out[:] = np.nan
-    return out
+        mid = a[n - 1] if with_median else None  # median's NaN, the last value
+    return out, mid
+
+
+def _orderable(a: npt.NDArray[Any]) -> bool:
+    """Whether the values of ``a`` that sort equal have equal bits (integers, or floats with
+    no NaN and no -0.0): each order statistic is then one bit pattern, however the array was
+    partitioned to find it."""
+    if a.dtype.kind in "iu":
+        return True
+    if a.dtype.kind != "f":
+        return False
+    return not (np.isnan(a).any() or (np.signbit(a) & (a == 0)).any())
+
+
+def _select(a: npt.NDArray[Any], places: Sequence[int]) -> None:
+    """Partition ``a`` (1-d) in place so that each of the increasing ``places`` holds its
+    order statistic: one partition per place, over the part after the place before (NumPy's
+    partition given several places at once takes several times as long: 0.56 against
+    0.07 ms for the two middle places of 36,000 values)."""
+    start = 0
+    for k in places:
+        a[start:].partition(k - start)
+        start = k + 1
 
 
 def percentiles(values: npt.ArrayLike, q: Sequence[float]) -> F64:

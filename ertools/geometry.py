@@ -36,10 +36,39 @@ class TimedPoses(Protocol):
     def quat_xyzw(self) -> F64: ...
 
 
+_TWO_PI = 2.0 * np.pi
+
+
 def wrap_angle(angle: F64 | float) -> F64:
-    """Angles wrapped to [-pi, pi)."""
+    """Angles wrapped to [-pi, pi): ``(angle + pi) % (2 pi) - pi``, bit for bit."""
     a = np.asarray(angle, dtype=np.float64)
-    return np.asarray((a + np.pi) % (2.0 * np.pi) - np.pi, dtype=np.float64)
+    out = np.add(a, np.pi, out=np.empty(a.shape))
+    flat = out.reshape(-1)
+    # x % (2 pi) is x itself for x in [0, 2 pi) (and NaN for NaN): only the others are
+    # divided, np.remainder costing as much as ten additions
+    outside = np.flatnonzero((flat < 0.0) | (flat >= _TWO_PI))
+    if outside.size:
+        flat[outside] %= _TWO_PI
+    flat -= np.pi
+    return out
+
+
+def unwrap_angles(angles: F64) -> F64:
+    """``np.unwrap(angles)`` of 1-d angles (steps of pi or more taken the other way round),
+    bit for bit: the remainders of the steps below pi, which np.unwrap computes and then sets
+    to no correction, are not computed (np.remainder costs as much as ten additions)."""
+    p = np.asarray(angles, dtype=np.float64)
+    dd = np.diff(p)
+    correct = np.zeros(len(dd))
+    big = np.flatnonzero(~(np.abs(dd) < np.pi))  # NaN too, as np.unwrap
+    if big.size:
+        d = dd[big]
+        step = np.mod(d - -np.pi, _TWO_PI) + -np.pi
+        step[(step == -np.pi) & (d > 0)] = np.pi  # a step of exactly pi keeps its sign
+        correct[big] = step - d
+    out = p.copy()
+    out[1:] = p[1:] + correct.cumsum()
+    return out
 
 
 def angle_error(a: F64 | float, b: F64 | float) -> F64:
@@ -184,14 +213,24 @@ def slerp(q0: F64, q1: F64, alpha: F64) -> F64:
     shape = np.broadcast_shapes(q1.shape, dot.shape)
     if q1.shape != shape:
         q1 = np.broadcast_to(q1, shape).copy()
-    np.negative(q1, out=q1, where=dot < 0.0)
+    # the few rows on the other hemisphere negated by index: a masked ufunc (``where=``)
+    # costs more than a whole arithmetic pass
+    flip = dot[..., 0] < 0.0
+    if flip.any():
+        q1[flip] = -q1[flip]
     dot = np.abs(dot)
     theta = np.arccos(np.clip(dot, -1.0, 1.0))
     sin_theta = np.sin(theta)
     close = sin_theta < 1e-6
-    safe = np.where(close, 1.0, sin_theta)
-    w0 = np.where(close, 1.0 - a, np.sin((1.0 - a) * theta) / safe)
-    w1 = np.where(close, a, np.sin(a * theta) / safe)
+    w0 = np.sin((1.0 - a) * theta)
+    w1 = np.sin(a * theta)
+    if close.any():
+        safe = np.where(close, 1.0, sin_theta)
+        w0 = np.where(close, 1.0 - a, w0 / safe)
+        w1 = np.where(close, a, w1 / safe)
+    else:  # no pair too close for the sine's ratio (the usual): no selection
+        w0 /= sin_theta
+        w1 /= sin_theta
     mixed = w0 * q0
     mixed += w1 * q1
     return _unit_in_place(mixed)

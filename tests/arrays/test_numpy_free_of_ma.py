@@ -11,7 +11,14 @@ import numpy as np
 import numpy.typing as npt
 import pytest
 
-from ertools.arrays import distinct, median, nanquantiles, percentiles, quantiles
+from ertools.arrays import (
+    distinct,
+    median,
+    nanquantiles,
+    percentiles,
+    percentiles_and_median,
+    quantiles,
+)
 
 
 def test_by_hand() -> None:
@@ -54,6 +61,11 @@ def test_the_same_bits_as_numpy(seed: int) -> None:
     q = [50.0, 90.0, 95.0, 99.0, *rng.uniform(0, 100, 4), 0.0, 100.0]
     for a in (cases[0], np.round(cases[0], 1), cases[2].ravel(), with_nan.ravel()):
         np.testing.assert_array_equal(percentiles(a, q), np.percentile(a, q))
+        if a.dtype == np.float64:  # one partition for both: each as NumPy's
+            both, middle = percentiles_and_median(a, q)
+            np.testing.assert_array_equal(both, np.percentile(a, q))
+            np.testing.assert_array_equal(middle, np.median(a))
+            assert type(middle) is type(np.median(a))
         fractions = np.asarray(q) / 100 + rng.uniform(-1e-3, 1e-3, len(q))
         fractions = np.clip(fractions, 0.0, 1.0)
         np.testing.assert_array_equal(quantiles(a, fractions), np.quantile(a, fractions))
@@ -80,3 +92,28 @@ def test_they_import_no_masked_arrays() -> None:
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert "'numpy.ma'" not in done.stdout and "'numpy'" in done.stdout
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_one_place_at_a_time_gives_numpys_bits(seed: int) -> None:
+    """median and the quantiles partition at one place at a time where equal values have
+    equal bits, and as NumPy does where not (NaN, or -0.0 next to 0.0): NumPy's bits, the
+    sign of a zero included, on values with many ties, both zeros, integers and NaN."""
+    rng = np.random.default_rng(100 + seed)
+    n = int(rng.integers(1, 3000))
+    ties = np.round(rng.normal(size=n), 1)
+    zeros = ties * rng.choice([0.0, 1.0], size=n)  # +0.0 and -0.0 (negative times 0)
+    with_nan = ties.copy()
+    with_nan[rng.integers(0, n)] = np.nan
+    q = [50.0, 90.0, 95.0, 99.0, *rng.uniform(0, 100, 3), 0.0, 100.0]
+    for a in (rng.normal(size=n), ties, np.abs(ties), zeros, with_nan, rng.integers(-9, 9, n)):
+        ours, theirs = median(a), np.median(a)
+        np.testing.assert_array_equal(ours, theirs)
+        assert np.signbit(ours) == np.signbit(theirs)
+        got, want = percentiles(a, q), np.percentile(a, q)
+        np.testing.assert_array_equal(got, want)
+        assert (np.signbit(got) == np.signbit(want)).all()
+        if a.dtype == np.float64:
+            both, middle = percentiles_and_median(a, q)
+            np.testing.assert_array_equal(both, want)
+            np.testing.assert_array_equal(middle, theirs)

@@ -26,6 +26,7 @@ from ertools.geometry import (
     row_norm,
     slerp,
     transform_points,
+    unwrap_angles,
     wrap_angle,
     yaw_from_quat,
 )
@@ -238,3 +239,84 @@ def test_geometry_import_does_not_load_scipy() -> None:
     code = "import sys, ertools.geometry; print('scipy.spatial' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+def _plain_wrap(a: np.ndarray) -> np.ndarray:
+    return np.asarray((a + np.pi) % (2.0 * np.pi) - np.pi)
+
+
+@settings(max_examples=200, deadline=None)
+@given(arrays(np.float64, st.integers(0, 40), elements=st.floats(width=64)))
+def test_wrap_angle_is_the_remainder_to_the_bit(a: np.ndarray) -> None:
+    """wrap_angle divides only the angles outside [-pi, pi): the same bits as the remainder
+    of every angle, NaN, infinities, -0 and the bounds included."""
+    edges = np.array([0.0, -0.0, np.pi, -np.pi, 2 * np.pi, -2 * np.pi, 3 * np.pi, np.nan])
+    edges = np.concatenate([edges, np.nextafter(edges, np.inf), np.nextafter(edges, -np.inf)])
+    for values in (a, edges, np.concatenate([a, edges]).reshape(-1, 1)):
+        with np.errstate(invalid="ignore"):
+            got, want = wrap_angle(values), _plain_wrap(values)
+        assert got.shape == want.shape and got.dtype == np.float64
+        same = (got == want) & (np.signbit(got) == np.signbit(want))
+        assert (same | (np.isnan(got) & np.isnan(want))).all()
+    assert float(wrap_angle(4.0)) == float(_plain_wrap(np.float64(4.0)))
+    assert wrap_angle(4.0).shape == ()
+
+
+def _plain_slerp(q0: np.ndarray, q1: np.ndarray, alpha: np.ndarray) -> np.ndarray:
+    """slerp as first written: a masked negation and both branches selected by np.where."""
+    q0 = q0 / np.linalg.norm(q0, axis=-1)[..., None]
+    q1 = q1 / np.linalg.norm(q1, axis=-1)[..., None]
+    a = np.asarray(alpha, dtype=np.float64)[..., None]
+    dot = np.sum(q0 * q1, axis=-1)[..., None]
+    q1 = np.broadcast_to(q1, np.broadcast_shapes(q1.shape, dot.shape)).copy()
+    np.negative(q1, out=q1, where=dot < 0.0)
+    theta = np.arccos(np.clip(np.abs(dot), -1.0, 1.0))
+    sin_theta = np.sin(theta)
+    close = sin_theta < 1e-6
+    safe = np.where(close, 1.0, sin_theta)
+    w0 = np.where(close, 1.0 - a, np.sin((1.0 - a) * theta) / safe)
+    w1 = np.where(close, a, np.sin(a * theta) / safe)
+    mixed = w0 * q0 + w1 * q1
+    return np.asarray(mixed / np.linalg.norm(mixed, axis=-1)[..., None])
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    arrays(np.float64, (12, 4), elements=st.floats(-1, 1)),
+    arrays(np.float64, (12, 4), elements=st.floats(-1e-7, 1e-7)),
+    arrays(np.float64, (12,), elements=st.floats(0, 1)),
+    st.integers(0, 2**12 - 1),
+    st.integers(0, 2**12 - 1),
+)
+def test_slerp_is_the_plain_version_to_the_bit(
+    q0: np.ndarray, nudge: np.ndarray, alpha: np.ndarray, flips: int, near: int
+) -> None:
+    """slerp negates only the rows on the other hemisphere and selects the near-pair branch
+    only when there is one: the same bits as the plain version, on pairs far apart, nearly
+    equal (within 1e-6 rad) or equal, on either hemisphere, and broadcast."""
+    assume(bool((np.linalg.norm(q0, axis=1) > 0.1).all()))
+    rows = np.arange(12)
+    q1 = np.where(((near >> rows) & 1)[:, None] == 1, q0 + nudge, q0[::-1])
+    q1 = np.where(((flips >> rows) & 1)[:, None] == 1, -q1, q1)
+    assume(bool((np.linalg.norm(q1, axis=1) > 0.1).all()))
+    for args in ((q0, q1, alpha), (q0[0], q1, alpha), (q0, q1[3], alpha[5]), (q0[2], q1[2], 0.3)):
+        got, want = slerp(*args), _plain_slerp(*args)
+        assert got.shape == want.shape
+        assert np.array_equal(got, want)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    arrays(np.float64, st.integers(0, 40), elements=st.floats(-20.0, 20.0)),
+    arrays(np.float64, st.integers(0, 40), elements=st.floats(width=64)),
+)
+def test_unwrap_angles_is_numpys_to_the_bit(small: np.ndarray, anything: np.ndarray) -> None:
+    """unwrap_angles skips the remainders np.unwrap discards: the same bits as np.unwrap on
+    tracks with steps below, at and above pi, NaN and infinities included."""
+    track = np.concatenate([small, np.cumsum(np.full(5, np.pi)), [0.0, np.pi, 0.0, -np.pi]])
+    for values in (small, anything, track, np.array([1.0]), np.zeros(0)):
+        with np.errstate(invalid="ignore"):
+            got, want = unwrap_angles(values), np.unwrap(values)
+        assert got.dtype == want.dtype and got.shape == want.shape
+        same = (got == want) & (np.signbit(got) == np.signbit(want))
+        assert (same | (np.isnan(got) & np.isnan(want))).all()

@@ -243,7 +243,8 @@ def noise_from_stream(
         # no measurement: left out as a frame the mocap never sent (a gap of one frame)
         poses = poses.take(~(impossible.far | impossible.jump))
     xy = poses.xyz[:, :2]
-    if len(poses) and not np.isfinite(xy).all(axis=1).any():
+    # (bounded: every position was shown finite already)
+    if len(poses) and not impossible.bounded and not np.isfinite(xy).all(axis=1).any():
         # Said here, where the file and topic are known: noise_statistics would only find
         # "no usable pair" without saying why.
         where = poses.source or "the pose stream"

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from ertools.arrays import F64, Bool, median
+from ertools.arrays import F64, Bool, distinct, median
 from ertools.geometry import row_norm
 from ertools.streams import MAX_FRAME_CHANGES, PoseStream
 from ertools.timeutil import iso_utc
@@ -102,12 +102,12 @@ def drop_duplicates(gt: PoseStream) -> tuple[PoseStream, int]:
 CHECK_ROWS = 1 << 14  # rows per chunk of the all-valid check: its buffers stay in cache
 
 
-def _all_valid(stream: PoseStream) -> bool:
+def _all_valid(stream: PoseStream, *, finite_xyz: bool = False) -> bool:
     """Whether :func:`drop_invalid` keeps every sample, shown cheaply or not at all.
 
     Squared quaternion norms (squares summed by column) far from both limits (NaN fails the
-    comparisons too) and finite positions, chunk by chunk so that the temporaries stay in
-    cache. False sends the stream to the exact per-sample test.
+    comparisons too) and finite positions (``finite_xyz``: shown already), chunk by chunk so
+    that the temporaries stay in cache. False sends the stream to the exact per-sample test.
     """
     q, xyz = stream.quat_xyzw, stream.xyz
     if q.ndim != 2 or q.shape[1] != 4 or not q.flags.c_contiguous:
@@ -125,7 +125,8 @@ def _all_valid(stream: PoseStream) -> bool:
                 sq += part[:, k]
         # margins over drop_invalid's limits: whatever the order the squares are summed in,
         # a norm passing here passes there (a stream failing here goes to the exact test)
-        if not (np.isfinite(xyz[rows]).all() and sq.min() > 2e-17 and sq.max() < 5e299):
+        finite = finite_xyz or bool(np.isfinite(xyz[rows]).all())
+        if not (finite and sq.min() > 2e-17 and sq.max() < 5e299):
             return False
     return True
 
@@ -144,7 +145,8 @@ def drop_invalid(
     impossible = (
         found if found is not None else impossible_samples(stream.t_ns, stream.xyz, jumps=jumps)
     )
-    if _all_valid(stream) and not impossible.count:
+    # the bounds of impossible_samples showed every coordinate finite: not tested again
+    if _all_valid(stream, finite_xyz=impossible.bounded) and not impossible.count:
         return stream, 0
     with np.errstate(over="ignore"):  # an overflowing norm is not finite: dropped below
         norm = row_norm(stream.quat_xyzw)
@@ -202,11 +204,14 @@ class Impossible:
             :data:`EXCURSION_MAX_S`.
         steps: the jumps that bound no such stretch: the data on one side is wrong, which
             cannot be told (their samples stay valid; the warning says where).
+        bounded: every coordinate was shown finite and within :data:`MAX_COORD_M` (the
+            bounds pass found nothing to test sample by sample); False: not shown.
     """
 
     far: Bool
     jump: Bool
     steps: tuple[Jump, ...] = ()
+    bounded: bool = False
 
     @property
     def count(self) -> int:
@@ -224,8 +229,8 @@ def impossible_samples(t_ns: npt.NDArray[np.int64], xyz: F64, *, jumps: bool = T
     n = len(t_ns)
     far = np.zeros(n, dtype=bool)
     jump = np.zeros(n, dtype=bool)
-    if not n or _all_possible(xyz, jumps=jumps):
-        return Impossible(far, jump)
+    if not n or _all_possible(t_ns, xyz, jumps=jumps):
+        return Impossible(far, jump, bounded=True)
     # Column by column, and the usual stream (every sample finite and near) used as it is
     # rather than gathered: the same values, without (N, 3) temporaries reduced over rows.
     finite = _per_column(np.isfinite, xyz, np.logical_and)
@@ -271,14 +276,15 @@ _SQRT3_MARGIN = math.sqrt(3.0) * (1.0 + 1e-9)
 BOUND_ROWS = 1 << 14  # rows per chunk of the bounds: the differences stay in cache
 
 
-def _all_possible(xyz: F64, *, jumps: bool) -> bool:
+def _all_possible(t_ns: npt.NDArray[np.int64], xyz: F64, *, jumps: bool) -> bool:
     """Whether no sample can be far or a jump, shown from bounds in one pass over ``xyz``.
 
     Every coordinate within [lo, hi] (so are the medians): no sample is further than
     sqrt(3) (hi - lo) from the centre. Every coordinate moving by at most ``step`` between
     consecutive rows: no two consecutive measured samples (repeats between them equal the
-    first) are more than sqrt(3) step apart, never a jump. False: not shown (NaN, infinite,
-    far or fast samples), and the exact test decides.
+    first) are more than sqrt(3) step apart, never a jump; where some move more, the rows
+    that do may still be too slow for one (:func:`_slow_steps`). False: not shown (NaN,
+    infinite, far or fast samples), and the exact test decides.
     """
     if not xyz.flags.c_contiguous or xyz.ndim != 2 or xyz.shape[1] != 3:
         return False
@@ -297,7 +303,32 @@ def _all_possible(xyz: F64, *, jumps: bool) -> bool:
         if jumps and end > start:
             d = np.subtract(flat[start:end], flat[start - 3 : end - 3], out=buf[: end - start])
             step = max(step, float(d.max()), -float(d.min()))
-    return (hi - lo) * _SQRT3_MARGIN <= FAR_M and step * _SQRT3_MARGIN <= JUMP_MIN_M
+    if (hi - lo) * _SQRT3_MARGIN > FAR_M:
+        return False
+    return step * _SQRT3_MARGIN <= JUMP_MIN_M or _slow_steps(t_ns, xyz)
+
+
+def _slow_steps(t_ns: npt.NDArray[np.int64], xyz: F64) -> bool:
+    """Whether no row moving a coordinate by more than JUMP_MIN_M / sqrt(3) from the row before
+    can be a jump, for finite positions near each other (:func:`_all_possible`): a GT with
+    tracking gaps, or blocks taken out of a stream, moves far between rows far apart in time.
+
+    With stamps in order, the time from the last measured sample to a row is at least the
+    time from the row before it (the repeats between them equal that sample), so each such
+    row is no jump when sqrt(3) times its largest coordinate move, over its time from the
+    row before, is below :data:`MAX_SPEED_M_S` (by a margin far above the rounding).
+    False: not shown (stamps out of order, equal stamps, or a fast move).
+    """
+    t = t_ns
+    if len(t) != len(xyz) or not bool(np.all(t[1:] >= t[:-1])):
+        return False
+    flat = xyz.reshape(-1)
+    moved = np.abs(flat[3:] - flat[:-3]) * _SQRT3_MARGIN > JUMP_MIN_M
+    rows = distinct(np.flatnonzero(moved) // 3 + 1)  # a row moved from the row before it
+    dt = (t[rows] - t[rows - 1]).astype(np.float64)
+    step = np.abs(xyz[rows] - xyz[rows - 1]).max(axis=1)
+    fast = step * (_SQRT3_MARGIN * 1e9) > MAX_SPEED_M_S * (1.0 - 1e-9) * dt
+    return not bool(fast.any())
 
 
 def _per_column(test: Callable[[F64], Bool], xyz: F64, combine: np.ufunc) -> Bool:

@@ -257,8 +257,9 @@ def _matched(
         """``values`` where compared, NaN elsewhere (as they are when every pose is)."""
         return values if every else np.where(ok, values, np.nan)
 
-    gt_yaw = compared(yaw_from_quat(gt_quat_at))
-    robot_yaw = yaw_from_quat(robot.quat_xyzw)
+    gt_yaw_at, gt_yaw_tf = _yaws(gt_quat_at)
+    robot_yaw, robot_yaw_tf = _yaws(robot.quat_xyzw)
+    gt_yaw = compared(gt_yaw_at)
     pos_err = compared(row_norm(robot.xyz - gt_xyz_at))
     # gt_xyz_at is this association's own array: NaN written into it where not compared
     # rather than into a copy (megabytes of fresh memory on an hour's poses)
@@ -267,7 +268,7 @@ def _matched(
         gt_xyz[~ok] = np.nan
     yaw_diff = wrap_angle(compared(robot_yaw - gt_yaw))
     yaw_err = np.abs(yaw_diff)
-    raw = compared(yaw_tf(robot.quat_xyzw) - yaw_tf(gt_quat_at))
+    raw = compared(robot_yaw_tf - gt_yaw_tf)
     return Matched(
         q,
         status,
@@ -393,11 +394,30 @@ def yaw_tf(quat_xyzw: F64) -> F64:
     """
     q = np.asarray(quat_xyzw, dtype=np.float64)
     x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    with np.errstate(invalid="ignore", divide="ignore"):  # as in the arithmetic below
+        return _yaw_tf(q, x * y + z * w, y * y + z * z)
+
+
+def _yaws(quat_xyzw: F64) -> tuple[F64, F64]:
+    """(:func:`~ertools.geometry.yaw_from_quat`, :func:`yaw_tf`) of the same quaternions, bit
+    for bit, their common products computed once: yaw_from_quat's ``w * z + x * y`` is tf's
+    ``x * y + z * w`` (IEEE addition and multiplication commute exactly), ``y * y + z * z``
+    both's."""
+    q = np.asarray(quat_xyzw, dtype=np.float64)
+    x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    xy_zw = x * y + z * w
+    yy_zz = y * y + z * z
+    yaw = np.asarray(np.arctan2(2.0 * xy_zw, 1.0 - 2.0 * yy_zz))
+    return yaw, _yaw_tf(q, xy_zw, yy_zz)
+
+
+def _yaw_tf(q: F64, xy_zw: F64, yy_zz: F64) -> F64:
+    """:func:`yaw_tf` of ``q``, given its ``x * y + z * w`` and ``y * y + z * z``."""
     n = np.einsum("...i,...i->...", q, q)
     with np.errstate(invalid="ignore", divide="ignore"):  # a zero quaternion: set to 0 below
         s = 2.0 / n
-        m00 = 1.0 - (y * y + z * z) * s
-        m10 = (x * y + z * w) * s
+        m00 = 1.0 - yy_zz * s
+        m10 = xy_zw * s
     out = np.arctan2(m10, m00)
     # tf: identity below _EPS of squared norm; yaw 0 where cos(pitch) (the norm of the
     # matrix's first column in x, y) is at most _EPS. Squares compared: no square root.

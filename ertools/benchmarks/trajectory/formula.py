@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ertools.arrays import median, percentiles
+from ertools.arrays import percentiles_and_median
 from ertools.benchmarks.trajectory.association import COMPARED, Matched
 
 PERCENTILES = (50.0, 90.0, 95.0, 99.0)
@@ -45,12 +45,12 @@ def metrics(m: Matched) -> Metrics | None:
     d = m.position_error if every else m.position_error[ok]
     dyaw = m.yaw_error if every else m.yaw_error[ok]
     raw = np.abs(m.yaw_diff_raw if every else m.yaw_diff_raw[ok])
-    pct = percentiles(d, PERCENTILES)
+    pct, middle = percentiles_and_median(d, PERCENTILES)  # one partition for both
     return Metrics(
         position_error=float(d.mean()),
         orientation_error=float(np.arctan2(np.sin(dyaw).sum(), np.cos(dyaw).sum())),
         rmse=float(np.sqrt(np.mean(d * d))),
-        median=float(median(d)),
+        median=float(middle),
         max=float(d.max()),
         percentiles=tuple((p, float(v)) for p, v in zip(PERCENTILES, pct, strict=True)),
         orientation_error_2015=float(np.arctan2(np.sin(raw).sum(), np.cos(raw).sum())),

@@ -49,6 +49,7 @@ from ertools.benchmarks.common.draws import (
     percentile_rows,
 )
 from ertools.benchmarks.common.epsilon import noise_from_stream
+from ertools.benchmarks.common.hygiene import rows_equal
 from ertools.benchmarks.common.inputs import IntervalSettings
 from ertools.benchmarks.common.interval_output import (
     METHOD,
@@ -74,7 +75,7 @@ from ertools.benchmarks.trajectory.steady import clear_of_losses
 from ertools.benchmarks.trajectory.steady import effects as steady_effects
 from ertools.benchmarks.trajectory.terms import PoseTerms
 from ertools.errors import ErtoolsError
-from ertools.geometry import wrap_angle, yaw_from_quat
+from ertools.geometry import unwrap_angles, wrap_angle, yaw_from_quat
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
 
@@ -171,13 +172,13 @@ def _second_differences(gt: PoseStream) -> tuple[F64, F64]:
     if len(gt) < 3:
         return np.zeros(0), np.zeros(0)
     fresh = np.ones(len(gt), dtype=bool)
-    fresh[1:] = np.any(xyz[1:] != xyz[:-1], axis=1)
+    fresh[1:] = ~rows_equal(xyz[1:], xyz[:-1])  # by column: no (N, 3) reduced over rows
     dt = np.diff(gt.t_ns)
     ok = fresh[2:] & fresh[1:-1] & fresh[:-2]
     # equal spacing (within 25%): a gap is not a second difference of the motion
     ok &= np.abs(dt[1:] - dt[:-1]) <= 0.25 * np.maximum(dt[1:], 1)
     d2 = (xyz[2:] - 2.0 * xyz[1:-1] + xyz[:-2])[ok]
-    yaw = np.unwrap(gt.yaw)
+    yaw = unwrap_angles(gt.yaw)
     y2 = (yaw[2:] - 2.0 * yaw[1:-1] + yaw[:-2])[ok]
     return d2.reshape(-1), y2
 

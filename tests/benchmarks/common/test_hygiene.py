@@ -5,9 +5,13 @@ from __future__ import annotations
 
 import math
 import warnings
+from unittest.mock import patch
 
 import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
+from ertools.benchmarks.common import hygiene
 from ertools.benchmarks.common.hygiene import (
     _all_valid,
     drop_duplicates,
@@ -232,3 +236,74 @@ def test_the_all_valid_shortcut_decides_nothing_near_the_limits() -> None:
         assert count == dropped == int(not (math.isfinite(norm) and norm > 1e-9))
         assert len(kept) == 10 - dropped
     assert _all_valid(base)
+
+
+def test_bounded_means_every_coordinate_finite_and_drop_invalid_agrees() -> None:
+    """``Impossible.bounded`` (drop_invalid then skips the positions' finiteness) is set only
+    where the bounds pass saw every coordinate finite and within MAX_COORD_M; with or without
+    ``found``, drop_invalid drops the same samples, NaN and infinite positions included."""
+    t, xyz = _walk(1200, 0.5)
+    quat = np.tile([0.0, 0.0, 0.0, 1.0], (1200, 1))
+    cases = {"clean": None, "nan": np.nan, "inf": np.inf, "-inf": -np.inf, "huge": 2e8}
+    for name, bad in cases.items():
+        pos = xyz.copy()
+        if bad is not None:
+            pos[700, 2] = bad
+        found = impossible_samples(t, pos)
+        assert found.bounded == (name == "clean")
+        assert found.bounded == bool(np.isfinite(pos).all() and np.abs(pos).max() <= 1e8)
+        stream = PoseStream(t, pos, quat)
+        kept, dropped = drop_invalid(stream, found=found)
+        plain, dropped_plain = drop_invalid(stream)
+        assert dropped == dropped_plain == (0 if bad is None else 1)
+        assert np.array_equal(kept.t_ns, plain.t_ns)
+        assert len(kept) == 1200 - dropped
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.integers(2, 60),
+    st.integers(0, 2**32 - 1),
+    st.sampled_from([0.0, 0.05, 0.3, 2.0, 50.0]),
+    st.sampled_from([0.0, 0.2, 0.5]),
+    st.booleans(),
+)
+def test_the_slow_steps_shortcut_finds_what_the_exact_test_finds(
+    n: int, seed: int, leap_m: float, repeat_share: float, shuffle: bool
+) -> None:
+    """Streams whose rows move far between some rows (leaps, tracking gaps of any length,
+    equal stamps, repeats, stamps out of order): impossible_samples with its shortcuts finds
+    the same far samples, jumps and steps as its exact test alone (the shortcut taken or not),
+    and says bounded only when it took one."""
+    rng = np.random.default_rng(seed)
+    dt = rng.choice([0, DT, DT, DT, 3 * DT, 60 * DT, 10**9, 30 * 10**9], size=n)
+    t = T0 + np.cumsum(dt).astype(np.int64)
+    if shuffle:
+        t[rng.integers(0, n)] -= 2 * DT
+    xyz = np.cumsum(rng.normal(0.0, 0.01, (n, 3)), axis=0)
+    leaps = rng.random(n) < 0.2
+    xyz += np.cumsum(leaps[:, None] * rng.normal(0.0, leap_m, (n, 3)), axis=0)
+    for i in np.flatnonzero(rng.random(n) < repeat_share):
+        if i:
+            xyz[i] = xyz[i - 1]
+    for jumps in (True, False):
+        found = impossible_samples(t, xyz, jumps=jumps)
+        with patch.object(hygiene, "_all_possible", lambda *a, **k: False):
+            exact = impossible_samples(t, xyz, jumps=jumps)
+        assert np.array_equal(found.far, exact.far) and np.array_equal(found.jump, exact.jump)
+        assert found.steps == exact.steps
+        assert not exact.bounded
+        if found.bounded:
+            assert not exact.count and not exact.steps
+
+
+def test_blocks_far_apart_in_time_take_the_shortcut() -> None:
+    """Blocks of a stream taken seconds apart (the noise's blocks) move metres between blocks,
+    slowly: no jump, shown without the exact test; a leap within a block is one."""
+    t, xyz = _walk(1200, 0.5)
+    rows = np.concatenate([np.arange(k, k + 100) for k in (0, 500, 1000)])
+    assert impossible_samples(t[rows], xyz[rows]).bounded
+    fast = xyz[rows].copy()
+    fast[150:] += 1.0  # a 1 m step within the second block: a jump
+    found = impossible_samples(t[rows], fast)
+    assert not found.bounded and found.steps

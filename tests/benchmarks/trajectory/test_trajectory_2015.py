@@ -21,11 +21,12 @@ import numpy as np
 import pytest
 from rosbags.highlevel import AnyReader
 
-from ertools.benchmarks.trajectory.association import yaw_tf
+from ertools.benchmarks.trajectory.association import _yaws, yaw_tf
 from ertools.benchmarks.trajectory.comparison import score_streams
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.cli.main import main
 from ertools.errors import ClockError
+from ertools.geometry import yaw_from_quat
 from ertools.simulator.writer import BagWriter
 from ertools.streams import PoseStream
 from tests.benchmarks.trajectory.node_2015 import EndOfBagError, Pose, score_2015, tf_yaw
@@ -547,3 +548,39 @@ def test_yaw_tf_equals_tf_s_arithmetic() -> None:
     ours = yaw_tf(q)
     want = [tf_yaw(row.tolist()) for row in q]
     assert ours == pytest.approx(want, abs=1e-12, rel=0)
+
+
+def _plain_yaw_tf(q: np.ndarray) -> np.ndarray:
+    """yaw_tf as first written, its products inside the one expression."""
+    x, y, z, w = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    n = np.einsum("...i,...i->...", q, q)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s = 2.0 / n
+        m00 = 1.0 - (y * y + z * z) * s
+        m10 = (x * y + z * w) * s
+    eps = float(np.finfo(np.float64).eps) * 4.0
+    flat = (n < eps) | (m00 * m00 + m10 * m10 <= eps * eps)
+    return np.asarray(np.where(flat, 0.0, np.arctan2(m10, m00)))
+
+
+def test_both_yaws_at_once_are_each_to_the_bit() -> None:
+    """The association's yaws from shared products are yaw_from_quat's and tf's, bit for bit,
+    on quaternions of any norm and pitch, gimbal lock, zero and near-zero ones."""
+    rng = np.random.default_rng(5)
+    q = rng.normal(size=(5000, 4)) * rng.uniform(1e-3, 1e3, (5000, 1))
+    special = np.array(
+        [
+            [0.0, 0.0, 0.0, 0.0],
+            [0.0, math.sqrt(0.5), 0.0, math.sqrt(0.5)],
+            [0.0, 0.0, 1.0, 1e-17],
+            [0.0, 0.0, -1.0, 1e-17],
+            [1e-10, -2e-10, 3e-10, 1e-10],
+            [0.5, -0.5, 0.5, -0.5],
+        ]
+    )
+    q = np.vstack([q, special])
+    yaw, tf = _yaws(q)
+    assert np.array_equal(yaw, yaw_from_quat(q))
+    assert np.array_equal(tf, _plain_yaw_tf(q))
+    assert np.array_equal(yaw_tf(q), _plain_yaw_tf(q))
+    assert np.array_equal(_yaws(q[7])[1], _plain_yaw_tf(q[7]))
