@@ -24,7 +24,7 @@ Pure NumPy: streams in, a frozen :class:`OffsetEstimate` out.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import numpy.typing as npt
@@ -360,16 +360,48 @@ def estimate_offset(
             compared them already by the same rule (``gt`` linearly interpolated, not across
             more than ``max_gap_ns``); used when no GT sample repeats the one before it.
     """
+    found, pending = search_offset(
+        robot,
+        gt,
+        search_range_ns=search_range_ns,
+        max_gap_ns=max_gap_ns,
+        seed=seed,
+        zero_given=at_zero is not None,
+    )
+    return with_zero(found, at_zero) if pending and at_zero is not None else found
+
+
+def with_zero(found: OffsetEstimate, at_zero: tuple[float, int]) -> OffsetEstimate:
+    """``found`` (from :func:`search_offset`, which said the mean distance with no offset was
+    pending) with that distance taken from ``at_zero``: the mean and the poses compared."""
+    return replace(found, mean_error_at_zero=None if at_zero[1] == 0 else at_zero[0])
+
+
+def search_offset(
+    robot: PoseStream,
+    gt: PoseStream,
+    *,
+    search_range_ns: int = 5 * NS_PER_S,
+    max_gap_ns: int = NS_PER_S // 10,
+    seed: int = 0,
+    zero_given: bool = False,
+) -> tuple[OffsetEstimate, bool]:
+    """:func:`estimate_offset`, its mean distance with no offset left to the caller where the
+    caller compares the poses at no offset by the same rule (``zero_given``; it may do so at
+    the same time, on another thread): the estimate, and whether that distance is pending
+    (then :func:`with_zero` fills it in; when a GT sample repeats the one before it, the
+    audit measures it on the GT without the repeats itself).
+    """
     measured = drop_repeats(gt)
-    if len(measured) < 2:
-        at_zero = None
-    elif at_zero is None or measured is not gt:
+    pending = zero_given and len(measured) >= 2 and measured is gt
+    at_zero = None
+    if len(measured) >= 2 and not pending:
         at_zero = _mean_error(robot.t_ns, robot.xyz, measured, 0, max_gap_ns)
     gt = measured
     zero = None if at_zero is None or at_zero[1] == 0 else at_zero[0]
 
-    def none(note: str, used: int = 0) -> OffsetEstimate:
-        return OffsetEstimate(None, None, search_range_ns, used, None, zero, note)
+    def none(note: str, used: int = 0) -> tuple[OffsetEstimate, bool]:
+        return OffsetEstimate(None, None, search_range_ns, used, None, zero, note), pending
 
     if len(gt) < 2 or len(robot) < MIN_POSES:
         return none(f"too few poses to estimate a clock offset (robot {len(robot)}, GT {len(gt)})")
@@ -439,9 +471,10 @@ def estimate_offset(
     if not np.isfinite(sigma):
         # Too few blocks for the bootstrap (a short log, or stamps 1 s apart as KITTI's rows).
         return none("too few poses for the offset's uncertainty", used)
-    return OffsetEstimate(
+    estimate = OffsetEstimate(
         offset_ns, round(sigma * NS_PER_S), search_range_ns, used, mean_err, zero, "; ".join(notes)
     )
+    return estimate, pending
 
 
 def _rms_speed(t_ns: I64, xyz: F64) -> float:

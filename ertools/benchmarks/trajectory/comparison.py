@@ -13,7 +13,7 @@ import numpy.typing as npt
 
 from ertools.arrays import I64
 from ertools.benchmarks import registry
-from ertools.benchmarks.common.clocks import estimate_offset
+from ertools.benchmarks.common.clocks import OffsetEstimate, search_offset, with_zero
 from ertools.benchmarks.common.hygiene import (
     drop_duplicates,
     drop_invalid,
@@ -60,6 +60,7 @@ from ertools.benchmarks.trajectory.rules import (
 from ertools.benchmarks.trajectory.validity import too_few, validity_codes
 from ertools.errors import ClockError, ScoringError
 from ertools.fidelity import Deviation
+from ertools.io.pipeline import alongside
 from ertools.streams import PoseStream, Provenance, float_seconds
 from ertools.timeutil import iso_utc, ns_to_s
 
@@ -227,18 +228,30 @@ def score_streams(
         gap = None if shifted is None else config.max_gap_ns
         return Rescoring(logged.t_ns + at, rescore, shifted, gap)
 
-    # With the offset known beforehand the score associates first: at no offset its pairs are
-    # the clock audit's own (the same robot and GT poses, interpolated by the same rule), and
-    # the audit takes their mean distance instead of pairing the poses once more.
+    # With the offset known beforehand the score associates while the clock audit searches on
+    # a second core; at no offset the score's pairs are the audit's own (the same robot and GT
+    # poses, interpolated by the same rule), and the audit takes their mean distance
+    # afterwards instead of pairing the poses once more.
     applied = config.auto_offset and config.apply_offset
-    first = None if applied else match(robot, config.offset_ns)
-    audit = estimate_offset(
-        robot,
-        timed,
-        search_range_ns=config.offset_range_ns,
-        max_gap_ns=config.max_gap_ns,
-        at_zero=None if first is None else _audit_pairs(first, config),
-    )
+
+    def audited() -> tuple[OffsetEstimate, bool]:
+        return search_offset(
+            robot,
+            timed,
+            search_range_ns=config.offset_range_ns,
+            max_gap_ns=config.max_gap_ns,
+            zero_given=not applied and _same_rule(config),
+        )
+
+    with alongside(audited, parallel=not applied) as audit_of:
+        first = None if applied else match(robot, config.offset_ns)
+        # the GT's noise, for the intervals: measured meanwhile too (wasted only when the
+        # comparison has no statistics)
+        sigma = jitter(timed) if intervals.enabled and first is not None else None
+        audit, pending = audit_of()
+    pairs = None if first is None else _audit_pairs(first, config)
+    if pending and pairs is not None:
+        audit = with_zero(audit, pairs)
     offset_ns = config.offset_ns
     if applied:
         if audit.offset_ns is None:
@@ -354,7 +367,8 @@ def score_streams(
     iv = NO_INTERVALS
     fitted: FittedScore | None = None
     if m is not None:
-        sigma = jitter(timed) if intervals.enabled else None
+        if sigma is None and intervals.enabled:
+            sigma = jitter(timed)
         iv = trajectory_intervals(
             robot,
             timed,
@@ -437,7 +451,17 @@ def _audit_pairs(matched: Matched, config: TrajectoryConfig) -> tuple[float, int
     association where it pairs exactly as the audit does: no offset, linear interpolation
     in time order, nothing compared across a gap, held or before the GT (the audit then
     checks that no GT sample repeats the one before it: none is tracking-lost)."""
-    same_rule = (
+    if not _same_rule(config):
+        return None
+    ok = matched.status == COMPARED
+    used = int(np.count_nonzero(ok))
+    return (float(matched.position_error[ok].mean()), used) if used else (float("inf"), 0)
+
+
+def _same_rule(config: TrajectoryConfig) -> bool:
+    """Whether the score pairs the poses as the clock audit does at no offset
+    (:func:`_audit_pairs`)."""
+    return (
         config.offset_ns == 0
         and config.association == "linear"
         and config.ties == "at"
@@ -446,11 +470,6 @@ def _audit_pairs(matched: Matched, config: TrajectoryConfig) -> tuple[float, int
         and config.gt_order == "time"
         and config.t_max_diff is None
     )
-    if not same_rule:
-        return None
-    ok = matched.status == COMPARED
-    used = int(np.count_nonzero(ok))
-    return (float(matched.position_error[ok].mean()), used) if used else (float("inf"), 0)
 
 
 def _other_benchmark_gt(robot_file: str, gt_topic: str) -> list[str]:
