@@ -39,7 +39,13 @@ Group = tuple[U8, I64, I64]
 
 
 def workers() -> int:
-    """Threads that load ahead of the decoder (one per core; none on a single core)."""
+    """Threads that load ahead of the decoder (one per core; none on a single core).
+
+    The cores this process may run on, not the machine's: pinned to one core (``taskset``,
+    a container's cpuset) a second thread only competes with the first.
+    """
+    if hasattr(os, "sched_getaffinity"):  # Linux; elsewhere the machine's count
+        return len(os.sched_getaffinity(0)) or 1
     return os.cpu_count() or 1
 
 
