@@ -210,11 +210,17 @@ def _pruned_costs(
         return None
     lo, hi = int(base[0] + shifts[0]), int(base[-1] + shifts[-1])
     used = grid[:, lo : hi + 1]
-    valid = np.flatnonzero(~np.isnan(used).any(axis=0))
-    if valid.size < 2 or valid[-1] - valid[0] + 1 != valid.size:
+    # the first and the last valid point, and none invalid between (no index array: an
+    # hour's is 3 MB of fresh memory)
+    invalid = np.isnan(used[0])
+    invalid |= np.isnan(used[1])
+    invalid |= np.isnan(used[2])
+    v0 = int(np.argmin(invalid))
+    v1 = len(invalid) - 1 - int(np.argmin(invalid[::-1]))
+    if invalid[v0] or v1 - v0 < 1 or invalid[v0 : v1 + 1].any():
         return None
-    first, last = lo + int(valid[0]), lo + int(valid[-1])
-    inside = used[:, valid[0] : valid[-1] + 1]
+    first, last = lo + v0, lo + v1
+    inside = used[:, v0 : v1 + 1]
     # the poses each offset compares: those whose shifted grid point is valid, a range
     start = np.searchsorted(base, first - shifts, side="left")
     stop = np.searchsorted(base, last - shifts, side="right")
