@@ -309,7 +309,13 @@ def _grid(
     # Mark the invalid points per gap (a handful) instead of locating every grid point in
     # the GT. The first grid point is the first GT sample; it is judged by the first GT
     # interval, as it always was.
-    gaps = np.flatnonzero(np.diff(t) > max_gap_ns)
+    # in blocks: an hour's whole np.diff was 3.5 MB of fresh memory (~1000 page faults)
+    gaps = np.concatenate(
+        [
+            np.flatnonzero(np.diff(t[i : i + GRID_CHUNK + 1]) > max_gap_ns) + i
+            for i in range(0, len(t) - 1, GRID_CHUNK)
+        ]
+    )
     if gaps.size:
         grid_t = t[0] + np.arange(n_grid, dtype=np.int64) * step
         marks = np.zeros(n_grid + 1, dtype=np.int64)
