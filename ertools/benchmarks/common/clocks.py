@@ -238,9 +238,14 @@ def _pruned_costs(
     costs[sampled] = got
     costs = _enough(costs, counts, int(counts.max()))
     best = float(costs[sampled].min())
-    # the largest move between neighbouring grid points (float32 differences: rounded up)
-    moves = [np.diff(inside[k]) for k in range(3)]
-    step = math.sqrt(sum(max(float(d.max()), -float(d.min())) ** 2 for d in moves)) * (1 + 1e-6)
+    # the largest move between neighbouring grid points (float32 differences: rounded up),
+    # the three axes' differences in one buffer (an hour's three were 4.3 MB of fresh memory)
+    moves: list[float] = []
+    d = np.empty(inside.shape[1] - 1, dtype=np.float32)
+    for axis in range(3):
+        np.subtract(inside[axis, 1:], inside[axis, :-1], out=d)  # np.diff
+        moves.append(max(float(d.max()), -float(d.min())))
+    step = math.sqrt(sum(m**2 for m in moves)) * (1 + 1e-6)
     if not (np.isfinite(best) and np.isfinite(got[got_counts > 0]).all() and math.isfinite(step)):
         return None  # nothing compared, or float32 overflowed: no bound shown
     limit = (best * 1.1 + 1e-3) * (1 + 1e-9)
