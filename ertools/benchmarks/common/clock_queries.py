@@ -123,6 +123,9 @@ def plain_distances(
     return dist, ev.valid.reshape(shape)
 
 
+# Table rows window_distances gathers at once (64 bytes each: 0.5 MB)
+BLOCK_ROWS = 8192
+
 # GT samples within one pose's span of fine offsets above which the window tables of
 # window_distances would grow past the plain evaluation's cost (40 ms at 120 Hz: 5)
 WINDOW_MAX_SAMPLES = 64
@@ -181,32 +184,42 @@ def window_distances(
     seg = np.cumsum(marks).reshape(n_pose, n_off + 1)[:, :n_off]
     # offset-major, C order: the means below sum each row as before
     idx = np.ascontiguousarray(seg.T).ravel()
-    rows = np.take(table.reshape(-1, 8), idx, axis=0)
     shape = (n_off, n_pose)
-    # the query's stamp minus its segment's start, exact in int64
-    rel = rows.view(np.int64)[:, 0].reshape(shape) + offsets[:, None]
-    span = rows.view(np.int64)[:, 1].reshape(shape)
     used = np.ones((n_pose, w_max + 1), dtype=bool)  # the segments some query reads
     used[:, 1:] = ~beyond
     if seg_ok[used].all():
         valid = np.ones(shape, dtype=bool)
     else:
         valid = seg_ok.ravel().take(idx).reshape(shape)
+    rel = np.empty(shape, dtype=np.int64)
     sq = np.empty(shape)
-    g = np.empty(shape)
-    # invalid queries (their span 0 or beyond the GT) compute garbage, masked below
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        # span > 0 off the stamps: the quotient evaluate takes there
-        alpha = rel.astype(np.float64) / span
-        for k in range(3):
-            np.multiply(rows[:, 5 + k].reshape(shape), alpha, out=g)
-            g += rows[:, 2 + k].reshape(shape)
-            np.subtract(robot_xyz[:, k], g, out=g)
-            if k == 0:
-                np.multiply(g, g, out=sq)
-            else:
-                g *= g
-                sq += g
+    rows_table = table.reshape(-1, 8)
+    # A few offsets at a time: their gathered rows (~0.5 MB) stay in cache for the seven
+    # strided passes over them below (all of an hour's at once, 8 MB, were read from memory
+    # seven times: ~40 % slower). Element by element the same arithmetic.
+    block = max(1, BLOCK_ROWS // n_pose)
+    for o0 in range(0, n_off, block):
+        o1 = min(o0 + block, n_off)
+        rows = np.take(rows_table, idx[o0 * n_pose : o1 * n_pose], axis=0)
+        part = (o1 - o0, n_pose)
+        # the query's stamp minus its segment's start, exact in int64
+        np.add(rows.view(np.int64)[:, 0].reshape(part), offsets[o0:o1, None], out=rel[o0:o1])
+        span = rows.view(np.int64)[:, 1].reshape(part)
+        out = sq[o0:o1]
+        g = np.empty(part)
+        # invalid queries (their span 0 or beyond the GT) compute garbage, masked below
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            # span > 0 off the stamps: the quotient evaluate takes there
+            alpha = rel[o0:o1].astype(np.float64) / span
+            for k in range(3):
+                np.multiply(rows[:, 5 + k].reshape(part), alpha, out=g)
+                g += rows[:, 2 + k].reshape(part)
+                np.subtract(robot_xyz[:, k], g, out=g)
+                if k == 0:
+                    np.multiply(g, g, out=out)
+                else:
+                    g *= g
+                    out += g
     dist = np.sqrt(sq, out=sq)
     hit = np.flatnonzero(rel == 0)
     if hit.size:

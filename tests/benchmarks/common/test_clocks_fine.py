@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
@@ -64,13 +65,18 @@ def test_fine_costs_are_the_plain_means(case: tuple[PoseStream, PoseStream]) -> 
     st.sampled_from([1, 3, 7]),
     st.lists(st.integers(1, 10**6), max_size=4),
     st.sampled_from([30, 100]),
+    st.sampled_from([1, 500, clock_queries.BLOCK_ROWS]),
 )
 def test_window_distances_are_the_plain_ones_to_the_bit(
-    case: tuple[PoseStream, PoseStream], step_ms: int, repeat: list[int], max_gap_ms: int
+    case: tuple[PoseStream, PoseStream],
+    step_ms: int,
+    repeat: list[int],
+    max_gap_ms: int,
+    block_rows: int,
 ) -> None:
     """The per-pose tables give every query the distance and validity of its own evaluation,
     bit for bit: on GT stamps (whole ms here, as the robot's), on repeated stamps (two GT
-    poses at one time), in gaps, outside the GT."""
+    poses at one time), in gaps, outside the GT; whichever offsets are computed together."""
     gt, robot = case
     gt = drop_repeats(gt)
     assume(len(gt) >= 3)
@@ -81,7 +87,9 @@ def test_window_distances_are_the_plain_ones_to_the_bit(
             t[j] = t[j - 1]  # still non-decreasing: the stamp before is at most t[j]
         gt = PoseStream(t, gt.xyz, gt.quat_xyzw, gt.frame_id, gt.child_frame_id)
     offsets = -60 * MS + np.arange(-20, 21, dtype=np.int64) * step_ms * MS
-    got = clock_queries.window_distances(robot.t_ns, robot.xyz, gt, offsets, max_gap_ms * MS)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(clock_queries, "BLOCK_ROWS", block_rows)
+        got = clock_queries.window_distances(robot.t_ns, robot.xyz, gt, offsets, max_gap_ms * MS)
     want = clock_queries.plain_distances(robot.t_ns, robot.xyz, gt, offsets, max_gap_ms * MS)
     assert got is not None
     assert np.array_equal(got[1], want[1])
