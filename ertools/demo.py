@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import sys
 
+from ertools.frozen_dataclass import frozen_dataclass
+
 if __name__ == "__main__":
     # `python -m ertools.demo`: the module run under its own name, its imports included, inside
     # ertools.launch's guard (a Ctrl-C while they load: one line, exit 130)
@@ -24,7 +26,6 @@ if __name__ == "__main__":
 import io
 from collections.abc import Iterator
 from contextlib import redirect_stdout
-from dataclasses import dataclass
 from pathlib import Path
 
 from ertools.atomic import write_text
@@ -36,7 +37,7 @@ from ertools.samples.competition import DEFAULT_SEED, MANIFEST, write_competitio
 SAMPLES = Path(__file__).resolve().parent.parent / "sample_bags"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Step:
     """One command of the demo and the file its stdout goes to (None: it prints nothing on
     stdout, its outputs are files of its own)."""

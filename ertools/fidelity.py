@@ -13,14 +13,15 @@ them all comes from the registry (:mod:`ertools.benchmarks.catalogue`, which gen
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+from ertools.frozen_dataclass import frozen_dataclass
 
 if TYPE_CHECKING:  # the rows of version_table, made by each benchmark's rules
     from ertools.node_versions import NodeVersion
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Rule:
     """One rule on which the rulebook, the 2015 node and ertools' default may disagree.
 

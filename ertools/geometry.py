@@ -8,13 +8,13 @@ products, rotations and SLERP are closed-form NumPy (no Euler angles anywhere); 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Literal, Protocol
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, I64, IntArr
+from ertools.frozen_dataclass import frozen_dataclass
 
 Association = Literal["linear", "nearest", "hold"]
 
@@ -236,7 +236,7 @@ def slerp(q0: F64, q1: F64, alpha: F64) -> F64:
     return _unit_in_place(mixed)
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Interpolated:
     """Poses of a stream evaluated at query times.
 
@@ -328,7 +328,7 @@ def _rows(a: F64, index: IntArr) -> F64:
     return np.take(a, index, axis=0)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class MeanPose:
     """The average of a stationary set of poses and how much they spread.
 

@@ -5,10 +5,10 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from ertools.frozen_dataclass import frozen_dataclass
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class NodeVersion:
     """One version of a node file of rockin-robot-challenge/benchmark_and_scoring_fbm: a row of
     the version table (``docs/fidelity.md``), read at its commit.

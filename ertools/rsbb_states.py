@@ -8,7 +8,8 @@ Read from ``rockin-robot-challenge/rsbb`` at ``2bb8a41`` and its October 2017 re
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass
+
+from ertools.frozen_dataclass import frozen_dataclass
 
 # ``rsbb_benchmarking_messages/BmBoxState`` keeps the seed's Listing 6 numbers: the 2015 enum,
 # written once. The RSBB BmBox never enters COMPLETED_MANUAL_OPERATION or TRANSMITTING_SCORE,
@@ -75,7 +76,7 @@ REFBOX_FIELDS: tuple[tuple[str, str], ...] = (
 )
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class MessageSpec:
     """A ROS1 message definition as data: constants (type, name, value), then fields."""
 
@@ -219,7 +220,7 @@ def body_pose2d_topic(body: str) -> str:
     return f"{NAMESPACE}/{body}/pose2d"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ScriptFrame:
     """A frame a benchmark script broadcasts on /tf at each successful lookup.
 
@@ -238,7 +239,7 @@ class ScriptFrame:
     timeout_s: float
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Benchmark:
     """One benchmark of ``benchmarks_description.yaml`` (2bb8a41); what is its own (the frames
     its script broadcasts, its mocap bodies, its seasons) is in its package's ``config``.

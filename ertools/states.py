@@ -7,7 +7,8 @@ only what all benchmarks and the audit share.
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass
+
+from ertools.frozen_dataclass import frozen_dataclass
 
 
 class Machine(enum.Enum):
@@ -160,7 +161,7 @@ class EndReason(enum.Enum):
         return self in (EndReason.TIMEOUT, EndReason.STOP)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class EndPayloadForm:
     """One RefBox END payload the 2015 code or the seed names, and where.
 

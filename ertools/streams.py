@@ -6,13 +6,13 @@ Readers produce them, scorers consume them; nothing here touches a file.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, I64, U8
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import yaw_from_quat
 
 if TYPE_CHECKING:
@@ -28,7 +28,7 @@ def _window_slice(t_ns: I64, start_ns: int | None, end_ns: int | None) -> slice:
     return slice(lo, max(lo, hi))
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class FrameChange:
     """The parent or child frame name of a pose topic changing between two messages.
 
@@ -49,7 +49,7 @@ class FrameChange:
 MAX_FRAME_CHANGES = 100
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class PoseStream:
     """A time series of 6-DoF poses of ``child_frame_id`` in ``frame_id``.
 
@@ -161,7 +161,7 @@ def float_seconds(stream: PoseStream) -> F64:
     return out
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class StateStream:
     """The messages of one state topic: (t_ns, state, payload) per message.
 
@@ -232,7 +232,7 @@ class StateStream:
         )
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Interval:
     """A closed time interval [start_ns, end_ns]."""
 
@@ -244,7 +244,7 @@ class Interval:
         return self.end_ns - self.start_ns
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Provenance:
     """What a result was computed from, for reports and audits.
 

@@ -19,7 +19,6 @@ state payloads), so that its limits are set once:
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any, Literal
 
 import yaml
@@ -29,6 +28,8 @@ from yaml.constructor import ConstructorError
 from yaml.events import AliasEvent
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
+from ertools.frozen_dataclass import frozen_dataclass
+
 __all__ = ["MAX_DEPTH", "DuplicateKey", "DuplicateKeyError", "SafeLoader", "YAMLError", "load"]
 
 MAX_DEPTH = 64
@@ -36,7 +37,7 @@ Tags = Literal["safe", "tuples", "plain"]
 _MERGE = "tag:yaml.org,2002:merge"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class DuplicateKey:
     """A key given twice in one mapping: the key as shown, and the lines (1-based) of both."""
 

@@ -9,12 +9,13 @@ tables, text), so that none of them needs another to describe its result.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Rows
 from ertools.fidelity import Deviation
 from ertools.frames import tables_to_frames
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.serialize import dump_yaml, jsonable
 from ertools.states import Machine
 from ertools.streams import Provenance
@@ -26,7 +27,7 @@ if TYPE_CHECKING:
     from ertools.benchmarks.base import BenchmarkResult
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class TimelineEntry:
     """One state (or payload) of one machine, from its first message to the next change."""
 
@@ -43,7 +44,7 @@ class TimelineEntry:
         return self.end_ns - self.start_ns
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class IllegalTransition:
     """A BmBox transition not in :data:`ertools.states.BMBOX_TRANSITIONS`."""
 
@@ -53,7 +54,7 @@ class IllegalTransition:
     allowed: tuple[str, ...]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Silence:
     """A gap in a state topic's heartbeat longer than the threshold."""
 
@@ -69,7 +70,7 @@ class Silence:
         return self.end_ns - self.start_ns
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class EarlyEnd:
     """The RefBox ended the benchmark (seed 6.4: payload ``timeout`` or ``halt``)."""
 
@@ -80,7 +81,7 @@ class EarlyEnd:
     bmbox_state: str  # the BmBox state at that moment
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class AuditRun:
     """One run (FBM1, FBM3) or segment (FBM2) as the BmBox went through it."""
 
@@ -100,7 +101,7 @@ class AuditRun:
         return self.end_ns - self.start_ns
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Audit:
     """The audit of one benchmark execution. Implements the BenchmarkResult protocol.
 
@@ -360,7 +361,7 @@ def _short(value: Any) -> str:
     return _one_line("" if value is None else str(value), 14)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ScoreLine:
     """One leaf of the score: the live value, the recomputed one, and why they differ."""
 
@@ -372,7 +373,7 @@ class ScoreLine:
     explanation: str = ""
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ScoreComparison:
     """Live vs recomputed score of one benchmark execution."""
 

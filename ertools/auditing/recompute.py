@@ -5,7 +5,7 @@ behind ``ertools audit`` (:func:`audit_bag`: read the state topics, audit them, 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, fields
+from dataclasses import fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -17,6 +17,7 @@ from ertools.benchmarks.base import AnyBenchmark, Audited
 from ertools.benchmarks.common.which import log_benchmark
 from ertools.benchmarks.scoring import score_execution
 from ertools.errors import BagError, ErtoolsError, ScoringError, UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.reader import read_benchmark_states, topics
 from ertools.states import STATE_TOPIC_SUFFIXES
 
@@ -28,7 +29,7 @@ if TYPE_CHECKING:
 # Recomputing
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ScoreInputs:
     """The scoring inputs an audit passes through to the benchmark's scorer.
 

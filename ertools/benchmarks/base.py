@@ -14,11 +14,11 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal, Protocol, TypeVar, runtime_checkable
 
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.progress import clear_current
 
 if TYPE_CHECKING:  # annotations only: the registry (and `ertools score --help`) stays light
@@ -32,7 +32,7 @@ Rows = list[dict[str, Any]]
 InputKind = Literal["path", "paths", "float", "int", "str", "choice", "flag"]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class FormerName:
     """A former name of an input, still accepted with a one-line deprecation note naming the
     new spelling: the option ``--`` + name (``-`` for ``_``), the manifest key and the keyword
@@ -58,7 +58,7 @@ class FormerName:
         return self.value if value is True else None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Input:
     """One value a benchmark takes besides its bags, declared once: it is the command-line option
     of ``ertools score NAME``, the key of the competition manifest and a row of the report's
@@ -132,7 +132,7 @@ class Input:
         return self.flag or "--" + self.name.replace("_", "-")
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Ranking:
     """How a leaderboard orders a benchmark's results (stated on the results page).
 
@@ -148,7 +148,7 @@ class Ranking:
     columns: Callable[[Mapping[str, Any]], Sequence[tuple[str, Any, str]]] | None = None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Explanation:
     """Why a recomputed value may differ from the live one (``ertools audit``).
 

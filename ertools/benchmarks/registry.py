@@ -12,7 +12,6 @@ each entry with the file that declares it (what go-to-definition cannot follow).
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
 from importlib import import_module
 from importlib.util import find_spec
 from pathlib import Path
@@ -21,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import Generate, LiveText, SeasonItems, Simulated
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 
 if TYPE_CHECKING:
     from ertools.benchmarks.base import AnyBenchmark
@@ -28,7 +28,7 @@ if TYPE_CHECKING:
 PACKAGE = "ertools.benchmarks"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Entry:
     """One registered benchmark: its name, where it is declared, one line of help."""
 
@@ -114,7 +114,7 @@ def warm(target: str, *, report: bool = False) -> None:
             import_module(name)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Scenario:
     """A benchmark package's simulated scenario: the ``sample`` module beside its declaration
     (``module``, absolute), the folder of ``sample_bags/`` it writes and the benchmark's

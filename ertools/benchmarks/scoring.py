@@ -7,7 +7,6 @@ already (``ertools export``'s trajectory pair, tests) runs the same stages with
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -22,9 +21,10 @@ from ertools.benchmarks.base import (
     RunsT,
 )
 from ertools.benchmarks.common.which import refuse_other_benchmark
+from ertools.frozen_dataclass import frozen_dataclass
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Scored:
     """A scored execution: the result, the options it was scored with, and what was taken
     from the live score (:meth:`~ertools.benchmarks.base.Audited.from_live`), one note each."""

@@ -4,10 +4,11 @@ member handed back to it (``ertools score fbm3w``)."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+
+from ertools.frozen_dataclass import frozen_dataclass
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Command:
     """A command: the module that implements it, a summary and an example."""
 
@@ -16,7 +17,7 @@ class Command:
     example: str
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Delegate:
     """What a command group's ``run`` returns: its member to run with the words after the
     member's name, which the dispatcher parses and runs as a command of its own."""

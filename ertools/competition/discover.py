@@ -37,10 +37,10 @@ from __future__ import annotations
 import datetime as dt
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Literal
 
 from ertools.benchmarks.common.teams import Team, TeamSource, resolve_team
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.timelines.build import bag_stem, rsbb_run, split_name
 from ertools.timelines.model import BagEntry, Pairing, Timeline
 from ertools.timeutil import NS_PER_S
@@ -85,7 +85,7 @@ _FILE_PROBLEMS: tuple[tuple[str, ProblemKind], ...] = (
 )
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Problem:
     """One thing wrong, about one file (``path``) or one execution (its benchmark log)."""
 
@@ -94,7 +94,7 @@ class Problem:
     message: str
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Execution:
     """One benchmark execution and the logs that belong to it.
 
@@ -132,7 +132,7 @@ class Execution:
         return f"{self.benchmark}-{self.team or 'unknown'}-{stamp:%Y%m%dT%H%M%S}"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Discovery:
     """What :func:`discover` found: executions by start time, and every problem."""
 

@@ -14,7 +14,7 @@ folders is listed too, for the ledger (:mod:`ertools.competition.ledger`).
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -34,6 +34,7 @@ from ertools.competition.memo import (
     team_json_valid,
 )
 from ertools.competition.pipeline import Scoring
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.clock import clock_check
 from ertools.io.formats import regular_files
 from ertools.progress import Reporter
@@ -55,7 +56,7 @@ ROBOT_BAG = "ROBOT_BAG"
 TIMELINE_PAGE = "timeline.html"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Found:
     """The logs' scorings, problems (results.json's ``problems``) and timeline.
 

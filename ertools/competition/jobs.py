@@ -17,7 +17,7 @@ import threading
 import time
 import traceback
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Any, Literal
 
@@ -28,6 +28,7 @@ from ertools.benchmarks.common.teams import with_team
 from ertools.benchmarks.document import all_failed, score_json
 from ertools.benchmarks.scoring import score_execution
 from ertools.errors import ErtoolsError, transient_error, watching
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.progress import reporting
 from ertools.report.folder import _audit_inputs, write_report
 from ertools.rsbb.score import ScoreComparison
@@ -36,7 +37,7 @@ from ertools.serialize import jsonable
 Status = Literal["scored", "unscoreable", "failed"]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Job:
     """One execution to score.
 
@@ -62,7 +63,7 @@ class Job:
     argv: tuple[str, ...] = ()
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Outcome:
     """What scoring one job gave (everything JSON-able, for the cache and the row)."""
 

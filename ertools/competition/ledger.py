@@ -17,15 +17,16 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
+
+from ertools.frozen_dataclass import frozen_dataclass
 
 PLACES = ("execution", "gt", "robot-log", "input", "problem")
 TIMING_SUFFIX = "_reached_waypoint_timing.yaml"
 UNUSED = "unused"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Claim:
     """``path`` (absolute) has this place; ``owner`` is the execution it belongs to."""
 
@@ -36,7 +37,7 @@ class Claim:
     reason: str | None = None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Entry:
     """One file of the folder and its place (``path`` relative to the folder)."""
 

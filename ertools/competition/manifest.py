@@ -30,7 +30,7 @@ from __future__ import annotations
 import hashlib
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 from datetime import UTC, date, datetime
 from pathlib import Path
 from typing import Any
@@ -39,6 +39,7 @@ from ertools.benchmarks import registry
 from ertools.benchmarks.base import Benchmark, Discovered, Input, rename_former
 from ertools.configs._yaml import number, parse_yaml, show
 from ertools.errors import BagError, ConfigError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.inputs import read_regular
 from ertools.io.formats import detect_format
 from ertools.io.text import sniff
@@ -62,7 +63,7 @@ class ManifestError(ConfigError):
         super().__init__(f"{count} in the manifest: " + "; ".join(self.problems), path=path)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ListedExecution:
     """An execution the manifest lists by hand: its benchmark, team, bags and own values."""
 
@@ -75,7 +76,7 @@ class ListedExecution:
     values: Mapping[str, Any]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class BenchmarkEntry:
     """One benchmark's values for every team (``values``) and per team (``teams``)."""
 
@@ -84,7 +85,7 @@ class BenchmarkEntry:
     teams: Mapping[str, Mapping[str, Any]]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Manifest:
     """A validated manifest; paths are absolute (resolved from the manifest's folder)."""
 

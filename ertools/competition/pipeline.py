@@ -14,7 +14,7 @@ import json
 import logging
 import re
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -40,6 +40,7 @@ from ertools.competition.site import write_site
 from ertools.competition.site_text import TEAM_UNKNOWN
 from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ErtoolsError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.summary import summary
 from ertools.progress import Reporter
 from ertools.timeutil import NS_PER_S, iso_utc
@@ -69,7 +70,7 @@ CSV_COLUMNS = (
 _UNSAFE = re.compile(r"[^A-Za-z0-9_.-]+")
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Scoring:
     """One score to compute, wherever it was found (listed in the manifest, discovered in the
     logs): a benchmark execution, or a robot's own log compared with the GT (``of``: the id of
@@ -92,7 +93,7 @@ class Scoring:
     of: str | None = None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Planned:
     """An execution, its job and its row's fixed part."""
 

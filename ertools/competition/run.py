@@ -14,7 +14,6 @@ import logging
 import os
 from collections.abc import Callable, Sequence
 from contextlib import AbstractContextManager, nullcontext
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -28,6 +27,7 @@ from ertools.competition.memo import FileMemo
 from ertools.competition.parallel import early_dask
 from ertools.competition.pipeline import listed_executions, rescore, write_results
 from ertools.errors import ConfigError
+from ertools.frozen_dataclass import frozen_dataclass
 
 log = logging.getLogger(__name__)
 
@@ -37,7 +37,7 @@ if TYPE_CHECKING:
     from ertools.progress import Reporter
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Rescored:
     """The results document (``results.json``) and the files written."""
 

@@ -22,7 +22,6 @@ import math
 import os
 import re
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -30,6 +29,7 @@ from ertools.atomic import write_text
 from ertools.competition import site_text as text
 from ertools.competition.site_text import TEAM_UNKNOWN
 from ertools.errors import ConfigError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.report import html as h
 from ertools.report import ranks
 from ertools.report.rank_plot import interval_plot
@@ -43,7 +43,7 @@ _IMAGE_SUFFIXES = frozenset({".png", ".svg", ".jpg", ".jpeg", ".gif", ".webp"})
 STATUS_LEVEL = {"scored": "ok", "unscoreable": "warn", "failed": "bad"}
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Link:
     """A relative link inside the site's folder; ``href`` None when the target is missing."""
 
@@ -51,7 +51,7 @@ class Link:
     href: str | None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Standing:
     """One row of a leaderboard as shown."""
 
@@ -68,7 +68,7 @@ class Standing:
     cells: tuple[str, ...] = ()  # the board's own columns (Ranking.columns), as shown
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Board:
     anchor: str
     title: str
@@ -232,7 +232,7 @@ def _scalars(score: Any) -> dict[str, Any]:
     return {k: v for k, v in score.items() if v is None or isinstance(v, bool | int | float | str)}
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class LiveRow:
     """One field of a live 2015 score beside the recomputed one (``status``: ``differs``,
     ``not-recomputed`` or ``same``: the row's CSS class)."""

@@ -14,10 +14,10 @@ import math
 import os
 import re
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from ertools.benchmarks import registry
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.views import units
 
 # What an execution no log and no manifest entry names a team for is called, on the page and
@@ -157,7 +157,7 @@ def deviation_terms(text: str) -> str:
     return text
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Difference:
     """One ``live_differences`` line as shown: numbers in display units, and why."""
 
@@ -200,7 +200,7 @@ def difference(line: str) -> Difference:
     )
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Grouped:
     """A warning said once for a benchmark, with the executions it concerns."""
 

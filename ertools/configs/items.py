@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +20,7 @@ import yaml
 
 from ertools.configs._yaml import load_yaml, number
 from ertools.errors import ConfigError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.serialize import dump_yaml
 
 Vec3 = tuple[float, float, float]
@@ -30,7 +30,7 @@ IDENTITY_TRANS: Vec3 = (0.0, 0.0, 0.0)
 IDENTITY_ROT: Quat = (0.0, 0.0, 0.0, 1.0)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ItemSpread:
     """How much a measured item transform varied over its acquisition window.
 
@@ -49,7 +49,7 @@ class ItemSpread:
     end_s: float
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Item:
     """One FBM1 item.
 
@@ -74,7 +74,7 @@ class Item:
         return self.trans is not None and self.rot is not None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ItemList:
     """An item list and where it came from."""
 

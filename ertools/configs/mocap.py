@@ -19,19 +19,19 @@ network settings.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ertools.configs._yaml import load_yaml, parse_yaml
 from ertools.errors import ConfigError
+from ertools.frozen_dataclass import frozen_dataclass
 
 DEFAULT_GROUP = "224.0.0.1"  # seed 4.1: "The correct multicast IP to use is 224.0.0.1"
 DEFAULT_DATA_PORT = 1511  # NatNet's data port
 DEFAULT_COMMAND_PORT = 1510
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RigidBodyConfig:
     """One tracked rigid body: where its pose goes.
 
@@ -66,7 +66,7 @@ class RigidBodyConfig:
         return resolve_topic(self.pose2d, namespace)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class MocapConfig:
     """The whole config: bodies by ID plus the optional network defaults."""
 

@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -34,6 +33,7 @@ import numpy.typing as npt
 
 from ertools.configs._yaml import check_radians, load_yaml, number
 from ertools.errors import ConfigError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import invert
 from ertools.serialize import yaml_float
 
@@ -56,7 +56,7 @@ Quat = tuple[float, float, float, float]
 SPREAD_KEY = "acquisition_spread"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class TransformSpread:
     """The spread of the marker poses an acquisition averaged (one standard deviation each).
 
@@ -83,7 +83,7 @@ class TransformSpread:
         return (p[0] / root, p[1] / root, p[2] / root), (r[0] / root, r[1] / root, r[2] / root)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class MarkerTransform:
     """T_marker_robot and where it came from.
 

@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ertools.errors import ClockError, ErtoolsError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.files import open_bag
 from ertools.io.model import BagSummary
 from ertools.io.reader import load_pose_batch
@@ -27,7 +27,7 @@ from ertools.timeutil import NS_PER_S
 log = logging.getLogger("ertools.io.clock")
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ClockCheck:
     """Record time minus header stamp (median over a few messages) of one pose topic."""
 

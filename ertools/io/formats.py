@@ -13,11 +13,11 @@ import os
 import re
 import stat
 from collections.abc import Iterable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ertools.errors import BagError, shown
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.inputs import kind_of, open_regular, read_regular, why_not
 from ertools.io import budget
 
@@ -28,7 +28,7 @@ BAG_SUFFIXES = (".bag", ".bag.active", ".mcap")
 NO_BAGS = "directory holds no bags (.bag, .bag.active, .mcap or rosbag2 folders)"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Unreadable:
     """A path that gave no bag, or could not be summarised, with the one-line reason."""
 
@@ -36,7 +36,7 @@ class Unreadable:
     problem: str
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Found:
     """Bags found under the given paths (sorted), and paths that gave none."""
 

@@ -11,13 +11,14 @@ only way to find a corrupted chunk).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ertools.errors import BagError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.formats import detect_format
 from ertools.io.mcap.index import verify_mcap
 from ertools.io.model import BagSummary
@@ -40,7 +41,7 @@ MIN_RATE_MESSAGES = 10
 MIN_RATE_SPAN_NS = 1_000_000_000
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class BagInfo:
     """A summary plus the median message rate of every topic (None: too few messages or too
     short a span to state one, see :func:`median_rate`)."""

@@ -6,11 +6,11 @@ state streams, decoded to arrays, are :mod:`ertools.io.reader`'s.
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.decode.typestore import Deserializer
 from ertools.io.files import open_bag
 from ertools.io.reader import PathsLike, path_list, topic_error
@@ -18,7 +18,7 @@ from ertools.io.reader import PathsLike, path_list, topic_error
 log = logging.getLogger("ertools.io.messages")
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RawMessage:
     """One deserialized message (rosbags' message object) with its record time."""
 

@@ -3,8 +3,9 @@ connections."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+from ertools.frozen_dataclass import frozen_dataclass
 
 if TYPE_CHECKING:  # annotations only: options hold a PoseSource, and parsers build options
     from ertools.streams import StateStream
@@ -24,7 +25,7 @@ POSE_TYPES = (
 TF_TYPES = ("tf/tfMessage", "tf2_msgs/TFMessage")
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class TopicSummary:
     """One topic of a bag, from the file's index.
 
@@ -45,7 +46,7 @@ class TopicSummary:
     connections: int
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class BagSummary:
     """What a bag holds, read from its own index (no message data).
 
@@ -87,7 +88,7 @@ class BagSummary:
         return next((t for t in self.topics if t.name == name), None)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class PoseSource:
     """Where a pose stream comes from: a pose topic, or a tf frame.
 
@@ -105,7 +106,7 @@ class PoseSource:
     time_source: str = "header"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class BenchmarkStates:
     """The three state streams of one benchmark namespace; None where a topic is absent."""
 
@@ -114,7 +115,7 @@ class BenchmarkStates:
     client: StateStream | None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Conn:
     """One connection (ROS1), rosbag2 topic or MCAP channel.
 

@@ -19,13 +19,13 @@ import os
 import threading
 from collections import Counter, deque
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from dataclasses import dataclass
 from queue import SimpleQueue
 from typing import TYPE_CHECKING, Any, Generic, Protocol, TypeVar, cast
 
 import numpy as np
 
 from ertools.arrays import HUGE_PAGE, I64, U8, Bool, fresh
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io import mapguard
 from ertools.io.model import Conn
 
@@ -379,7 +379,7 @@ class Records(Protocol):
         ...
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Run:
     """The messages of one read in one group of chunks, in its reference order.
 
@@ -400,7 +400,7 @@ class Run:
         return self.records.spans()
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Located:
     """Messages of some connections located from a file's index, in the reference order.
 
@@ -413,7 +413,7 @@ class Located:
     runs: Iterator[Run]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Request:
     """One read of several sharing a pass over a file: some connections, and the record
     time window [lo, hi] (None: open) of their messages."""
@@ -423,7 +423,7 @@ class Request:
     hi: int | None = None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class LocatedMany:
     """The messages of several requests located in one pass over a file's index.
 

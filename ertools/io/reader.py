@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -18,6 +17,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.errors import BagError, TopicError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.bagfile import BagFile
 from ertools.io.bulk import States, bulk_states_many, try_fast_batches
 from ertools.io.decode.posebatch import PoseBatch, batch_from_messages, concat_batches
@@ -215,7 +215,7 @@ def read_poses(
     return _read_sources(paths, [_TopicRead(topic, time_source)], start_ns, end_ns)[0]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class _TopicRead:
     """A pose topic read as a stream (:func:`read_poses`)."""
 
@@ -223,7 +223,7 @@ class _TopicRead:
     time_source: str
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class _TfRead:
     """A frame's pose from ``/tf`` and ``/tf_static`` (:func:`read_tf`)."""
 

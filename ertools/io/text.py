@@ -20,7 +20,6 @@ A bad value is one line naming its row (the file's line number) and column.
 from __future__ import annotations
 
 import io
-from dataclasses import dataclass
 from pathlib import Path
 from typing import NoReturn
 
@@ -29,6 +28,7 @@ import numpy.typing as npt
 
 from ertools.arrays import F64, I64
 from ertools.errors import BagError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.inputs import open_regular, read_regular_text, why_not
 from ertools.io.names import TEXT_FORMATS, TextFormat
 from ertools.streams import PoseStream
@@ -45,7 +45,7 @@ _COLUMNS: dict[TextFormat, tuple[str, ...]] = {
 }
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class _Rows:
     """The data rows of a text file (stripped) and their 1-based line numbers."""
 

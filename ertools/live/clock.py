@@ -20,9 +20,9 @@ import socket
 import struct
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 
 from ertools.errors import ClockError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.timeutil import iso_utc
 
 NTP_PORT = 123
@@ -47,7 +47,7 @@ def ntp_to_ns(seconds: int, fraction: int) -> int:
     return (seconds - NTP_UNIX_DELTA_S) * 1_000_000_000 + ((fraction * 1_000_000_000) >> 32)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ClockCheck:
     """The result of one SNTP exchange.
 

@@ -22,6 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.live.tail import McapTail, is_finished
 
 PATTERNS = ("*.mcap", "*.bag.active")
@@ -41,7 +42,7 @@ def _size(path: Path) -> int:
         return 0
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class MonitorOptions:
     """What counts as healthy (see the module doc)."""
 
@@ -59,7 +60,7 @@ class MonitorOptions:
         return self.stale_s if self.stale_s is not None else max(3.0 * self.interval_s, 5.0)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class MonitorCheck:
     """One look at the folder."""
 

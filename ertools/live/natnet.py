@@ -30,6 +30,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from ertools.frozen_dataclass import frozen_dataclass
+
 NAT_FRAMEOFDATA = 7
 HEADER = struct.Struct("<hH")
 _I32 = struct.Struct("<i")
@@ -93,7 +95,7 @@ LAYOUTS: tuple[NatNetVersion, ...] = (
 )
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RigidBody:
     """One rigid body of a frame, in Motive's world frame (metres, quaternion x y z w)."""
 
@@ -108,7 +110,7 @@ class RigidBody:
         return bool(self.params & TRACKING_VALID)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class FrameOfData:
     """The parts of a NAT_FRAMEOFDATA packet a logger needs.
 
@@ -129,7 +131,7 @@ class FrameOfData:
     params: int = 0
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class FrameExtras:
     """The sections a logger skips, for the encoder (to test that skipping finds the bodies).
 

@@ -30,12 +30,13 @@ import sys
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 
 from ertools._version import __version__
 from ertools.configs.mocap import MocapConfig, RigidBodyConfig, normalize_namespace
 from ertools.errors import BagError, ConfigError, ErtoolsError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.live.clock import query_sntp, unreachable_metadata
 from ertools.live.logfile import LogFile, log_file_name
 from ertools.live.natnet import (
@@ -57,7 +58,7 @@ UP_AXES = ("z", "y")
 OTHER_MESSAGE_IDS = frozenset({0, 1, 2, 3, 4, 5, 6, 8, 9, 10, 100})
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RecordOptions:
     """How and where to record.
 
@@ -115,7 +116,7 @@ class RecordOptions:
             raise ConfigError(f"NatNet {self.natnet_version} is not supported (3.x and 4.x are)")
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RecordSummary:
     """What a recording produced."""
 
@@ -128,7 +129,7 @@ class RecordSummary:
     natnet_version: str = "unknown"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class _Route:
     """Where one body's pose goes (resolved once, channels per file)."""
 

@@ -17,19 +17,19 @@ from __future__ import annotations
 import contextlib
 import os
 import shutil
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ertools._version import __version__
 from ertools.atomic import hold, replacing
 from ertools.errors import BagError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.live.tail import is_finished, read_complete
 
 RECOVERY_METADATA = "ertools_recovery"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Recovered:
     """What :func:`recover` did."""
 

@@ -16,6 +16,7 @@ import threading
 import time
 from dataclasses import dataclass, field
 
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.live.natnet import (
     TRACKING_VALID,
     FrameExtras,
@@ -33,7 +34,7 @@ def f32(value: float) -> float:
     return float(_F32.unpack(_F32.pack(value))[0])
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class SimulatedBody:
     """A rigid body on a circle of ``radius`` around (cx, cy) at height ``z``.
 

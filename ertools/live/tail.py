@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ertools.errors import BagError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.inputs import open_regular
 from ertools.io.inflate import inflate
 
@@ -41,7 +42,7 @@ def is_finished(path: Path) -> bool:
         return False
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class TailMessage:
     topic: str
     log_time_ns: int
@@ -183,7 +184,7 @@ class McapTail:
             q = body + rlen
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class CompleteRead:
     """What :func:`read_complete` found: messages, whether the file was closed, bytes lost."""
 

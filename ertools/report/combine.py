@@ -20,7 +20,7 @@ import io
 import json
 import math
 import os
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +31,7 @@ from ertools.benchmarks.base import Discovered, Reported
 from ertools.benchmarks.common.teams import team_from_log_name
 from ertools.csvsafe import spreadsheet_safe
 from ertools.errors import ConfigError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.inputs import read_regular_text, why_not
 from ertools.jsonin import loads as loads_json
 from ertools.report import html as h
@@ -58,7 +59,7 @@ _OUTPUT_FLAGS = frozenset({"-v", "--verbose", "-q", "--quiet"})
 _SOURCE_RANK = {"explicit": 0, "payload": 1, "log name": 2, "transform": 3}
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Entry:
     """One result as the combined page shows it."""
 
@@ -80,7 +81,7 @@ class Entry:
     score: dict[str, Any] = field(default_factory=dict)  # the whole score (for its intervals)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Execution:
     """The results of one execution (same inputs): ``main`` is shown, ``others`` listed."""
 
@@ -351,7 +352,7 @@ def _finite(value: Any) -> Any:
     return value
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Board:
     """A benchmark's executions ranked by its rule, with their rank stability
     (:mod:`ertools.report.ranks`); ``key`` None when the benchmark has no ranking rule or

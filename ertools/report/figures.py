@@ -12,7 +12,6 @@ from __future__ import annotations
 import textwrap
 import threading
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -21,12 +20,13 @@ import numpy as np
 from ertools.atomic import replacing, write_text
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Reported
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.report import chart_mpl, svg
 from ertools.views.chart import PIXELS_PER_INCH, Chart
 from ertools.views.spec import ChartSpec
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class FigureSpec:
     """One figure: a file stem, a title, a size and a function drawing on one Axes; for a
     figure built as a :class:`Chart`, ``chart`` builds it for a size in inches (``draw`` then

@@ -12,12 +12,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from functools import cache
 from pathlib import PurePosixPath
 from typing import TYPE_CHECKING, Any
 from urllib.parse import quote
 
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.timeutil import iso_utc, s_to_ns
 from ertools.views import units
 
@@ -58,20 +58,20 @@ def _utc(seconds: float) -> str:
     return iso_utc(s_to_ns(seconds)).replace("+00:00", "Z")
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Cell:
     text: str
     css: str = ""
     pre: bool = False  # multi-line text, shown in a <pre> block
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Row:
     cells: tuple[Cell, ...]
     css: str | None = None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Table:
     """A table as the ``table`` macro draws it: headers with units, formatted cells."""
 
@@ -156,7 +156,7 @@ def key_values(pairs: Sequence[tuple[str, Any]], *, caption: str | None = None) 
     return Table(("metric", "value"), tuple(rows), caption)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Figure:
     src: str  # relative path beside the page, or a data URI
     caption: str

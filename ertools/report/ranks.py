@@ -30,10 +30,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from itertools import pairwise
 from statistics import NormalDist
 from typing import Any
+
+from ertools.frozen_dataclass import frozen_dataclass
 
 DEFAULT_CONFIDENCE = 0.95
 NO_INTERVAL = "no interval in this result"
@@ -47,7 +49,7 @@ NONE_EXPLAINED = (
 )
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Contender:
     """One entry of a leaderboard: a score and, when the result has one, its interval."""
 
@@ -66,7 +68,7 @@ class Contender:
         return replace(self, interval=None, note=OUTSIDE_INTERVAL)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Standing:
     """A :class:`Contender` placed: its rank by the values (competition ranking: equal values
     share a rank), the probability it swaps with the next one, and its group of teams the

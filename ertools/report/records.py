@@ -5,14 +5,15 @@ from __future__ import annotations
 
 import hashlib
 import re
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+
+from ertools.frozen_dataclass import frozen_dataclass
 
 _CHUNK = 1 << 20
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class FileRecord:
     """An input or config file as the report records it."""
 

@@ -13,12 +13,11 @@ the stop.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.log import GoalEvent, GoalOutcome
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class GoalTimes:
     """A goal as the script saw it.
 

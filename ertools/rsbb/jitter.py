@@ -11,10 +11,10 @@ of consecutive samples one frame apart count (a gap breaks the spacing).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.tf import TfTrack, euler_yaw
 
 #: Stated when a track has too few evenly spaced samples: OptiTrack's sub-millimetre noise on
@@ -24,7 +24,7 @@ DEFAULT_SIGMA_RAD = 5e-3
 MIN_TRIPLES = 100
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class MocapNoise:
     """Per-axis position sigma (m), yaw sigma (rad), measured or a stated default."""
 

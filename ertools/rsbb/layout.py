@@ -15,11 +15,12 @@ import enum
 import os
 import re
 from collections.abc import Collection, Iterable
-from dataclasses import dataclass, field
+from dataclasses import field
 from datetime import datetime, timedelta
 from pathlib import Path, PurePath
 
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.results import parse_result_time
 from ertools.rsbb_states import BENCHMARKS, LOGS_DIR, RESULTS_DIR
 
@@ -41,7 +42,7 @@ class FileKind(enum.Enum):
     MOCAP_LOG = "mocap log"  # log_mocap_<date>[_<k>].bag (the optional continuous logger)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class SeasonFile:
     """One recognised file.
 
@@ -158,7 +159,7 @@ def classify(path: str | PurePath) -> SeasonFile | None:
     return None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RunFiles:
     """One run's files: its bag and result file (either may be missing) and its side files.
 
@@ -181,7 +182,7 @@ class RunFiles:
     items: Path | None = None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class SeasonLayout:
     """A season folder's recognised files and its runs.
 

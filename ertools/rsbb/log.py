@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import enum
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +21,7 @@ import numpy.typing as npt
 
 from ertools.arrays import I64, U8
 from ertools.errors import ConfigError, TopicError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.messages import read_messages
 from ertools.io.reader import read_states, read_tf, topics
 from ertools.io.summary import summary
@@ -48,7 +48,7 @@ BMBOX_LEAD_NS = 200_000_000
 GUI_WINDOW_NS = 1_000_000_000
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class RefBoxStream:
     """``/rsbb/bmbox/refbox_state``: per message the three sub-machines' states and payloads.
 
@@ -163,7 +163,7 @@ def read_live_scores(paths: PathsLike) -> tuple[LiveScore, ...]:
     )
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RefereeItem:
     """One referee item as the RefBox showed it (``/core/to_gui``, the zone's ``scoring``)."""
 
@@ -236,7 +236,7 @@ class GoalOutcome(enum.Enum):
     UNFINISHED = "unfinished"  # the log ends during the goal
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class GoalEvent:
     """One goal of a run.
 
@@ -262,7 +262,7 @@ class GoalEvent:
     request: str | None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ManualOperationEvent:
     """One manual operation: the request's text and the referee's answer.
 
@@ -299,7 +299,7 @@ _END_KINDS = {
 }
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RsbbRun:
     """An RSBB run bag's streams and events.
 

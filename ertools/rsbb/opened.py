@@ -6,17 +6,17 @@ refused, the result file loaded and the run's events read."""
 from __future__ import annotations
 
 from collections.abc import Callable, Collection, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Protocol
 
 from ertools.errors import ConfigError, UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.log import RsbbRun, check_code, read_rsbb_run
 from ertools.rsbb.results import RsbbResult, load_result
 from ertools.rsbb.sidefiles import SideFiles, find_side_files
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class OpenedRun:
     """A run's bag (or its split files) and its side files.
 

@@ -9,7 +9,6 @@ plain strings and lists; any other Python tag is refused, nothing is ever constr
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 from typing import Any
@@ -17,6 +16,7 @@ from typing import Any
 import yaml
 
 from ertools.errors import ConfigError
+from ertools.frozen_dataclass import frozen_dataclass
 
 #: The line that separates the 2019 live score's result from its totals.
 SUMMARY_MARK = "\n\nSCORE SUMMARY:\n"
@@ -64,7 +64,7 @@ def load_rsbb_yaml(text: str, where: str) -> Any:
         raise ConfigError(f"{where}: not readable RSBB YAML{line}: {problem}") from err
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RsbbResult:
     """One ``result_run_<n>_<date>.yaml``.
 
@@ -140,7 +140,7 @@ def load_result(path: str | Path) -> RsbbResult:
     return _result_from(load_rsbb_yaml(text, str(p)), str(p))
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class LiveScore:
     """One ``/rsbb/current_benchmark_result`` message.
 

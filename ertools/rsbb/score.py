@@ -15,12 +15,12 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import yaml
 
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.results import LiveScore, RsbbResult
 
 #: Two numbers within this are the same score: 1 um, 1 urad, 1 us; above the round-off of a
@@ -94,7 +94,7 @@ def same_value(a: Any, b: Any, abs_tol: float = SCORE_ABS_TOL) -> bool:
     return type(a) is type(b) and bool(a == b)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class KeyComparison:
     """One score field in the recomputed, live and file scores.
 
@@ -132,7 +132,7 @@ def _cell(value: Any, present: bool) -> Any:
     return value if isinstance(value, bool | int | float | str) or value is None else repr(value)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ScoreComparison:
     """The recomputed score against the run's own.
 

@@ -14,13 +14,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection
-from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 from typing import Any
 
 from ertools.configs._yaml import load_yaml
 from ertools.errors import ConfigError, UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.layout import PAIR_TOLERANCE, FileKind, bag_name, classify, result_name
 from ertools.rsbb_states import LOGS_DIR, RESULTS_DIR
 
@@ -33,7 +33,7 @@ ITEMS_DIRS = ("rsbb_etc/objects_informations", "objects_informations", ".")
 ITEMS_NAME = "items_with_pose.yaml"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RunPlace:
     """Where a run bag sits: its code, team, run and start from the RSBB's names.
 
@@ -69,7 +69,7 @@ def run_place(bag: str | Path) -> RunPlace:
     return RunPlace(path, None, None, None, None, None)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class SideFiles:
     """A run's side files (None: given by nobody and not found).
 

@@ -22,13 +22,14 @@ This module gives:
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 
 import numpy as np
 
 from ertools.arrays import F64, I64, Bool
 from ertools.errors import TopicError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.bagfile import BagFile
 from ertools.io.files import open_bag
 from ertools.io.model import TF_TYPES
@@ -49,7 +50,7 @@ def tf_frame(name: str) -> str:
     return name.lstrip("/")
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class TfTrack:
     """One tf link's samples, sorted by header stamp.
 
@@ -86,7 +87,7 @@ class TfTrack:
         return int(self._first_arrival[k]) if k < len(self) else None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class TfTracks:
     """A run bag's ``/tf``: every link by (parent, child) and the script's broadcasts."""
 
@@ -245,7 +246,7 @@ def euler_yaw(q: F64) -> F64:
     return np.asarray(np.where(ok & (cy > EULER_EPS), np.arctan2(m10, m00), 0.0))
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class LinkAt:
     """A link evaluated at moments as tf2 does (:func:`link_at`).
 
@@ -297,7 +298,7 @@ def link_at(track: TfTrack, t_ns: I64) -> LinkAt:
     return LinkAt(np.asarray(xyz), quat, np.asarray(inside), np.asarray(gap, dtype=np.int64))
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class ScriptPoses:
     """The script's frame looked up at moments (:func:`script_poses`).
 
@@ -357,7 +358,7 @@ def script_poses(
 # --- the helper's attempts ------------------------------------------------------------------
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HelperOutcome:
     """What one call of the helper did (:func:`helper_lookup`).
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, fields, replace
+from dataclasses import fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import I64
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import quat_from_yaw
 from ertools.simulator.mocap import MocapPublished, publish_environment, publish_mocap
 from ertools.simulator.simulated import SimulatedRun
@@ -32,7 +33,7 @@ ROBOT_NOISE_M = 0.003
 STATUS_PERIOD_NS = NS
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class GtWindow:
     """One split file of the GT logger: record times in [start_ns, end_ns)."""
 

@@ -11,18 +11,18 @@ module's (``COMPETITION_TEAMS``, ``competition_run``), reached through the regis
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 from ertools.benchmarks import registry
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.simulator.answers import EPOCH_2015
 from ertools.simulator.simulated import SimulatedRun
 
 NS = 1_000_000_000
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Slot:
     """One execution of the day's schedule."""
 

@@ -36,12 +36,12 @@ Example::
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, I64, Bool
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import normalize_quat, yaw_from_quat
 from ertools.simulator.writer import BagWriter
 
@@ -49,7 +49,7 @@ MOCAP_RATE_HZ = 120.0
 FRAME_NS = 8_333_333  # 1/120 s, as the 2015 Motive setup streamed
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class MocapNoise:
     """Measurement and timing noise of the simulated mocap node (SI units, ns)."""
 
@@ -62,7 +62,7 @@ class MocapNoise:
     latency_spike_ns: int = 3_000_000
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class TrackingLoss:
     """Tracking lost at the first frame with time >= ``t_ns``: repeats, then a gap."""
 
@@ -71,7 +71,7 @@ class TrackingLoss:
     gap_frames: int = 0
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class MocapPublished:
     """The messages one rigid body produced (N published frames).
 

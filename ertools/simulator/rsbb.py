@@ -16,7 +16,6 @@ The scenario's scores are given, never computed here: the simulator knows no sco
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +23,7 @@ import numpy as np
 import yaml
 
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb_states import (
     BMBOX_STATE_TOPIC,
     BMBOX_STATE_TYPE,
@@ -67,7 +67,7 @@ CORE_CALLER = "/rsbb/roah_rsbb_core"
 MOCAP_CALLER = "/rsbb/mocap_node"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RunPaths:
     """The files one simulated run wrote."""
 
@@ -312,7 +312,7 @@ def _take(pub: MocapPublished, idx: np.ndarray) -> MocapPublished:
     )
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ZoneView:
     """What the RefBox's GUI showed of a run's zone at one tick: its state text, its start and
     stop buttons (stop enabled: the benchmark executing), its timer and the items' values (in

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import copy
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 from datetime import datetime, timedelta, timezone
 from typing import Any
 
@@ -18,6 +18,7 @@ import numpy as np
 import yaml
 
 from ertools.arrays import F64
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb_states import (
     END_DESCRIPTION_OTHER,
     END_DESCRIPTIONS,
@@ -29,7 +30,7 @@ from ertools.simulator.mocap import MocapPublished
 MS = 1_000_000
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ManualOperation:
     """The referee asked ``request`` at ``t_request_ns`` and answered ``answer`` at
     ``t_done_ns`` (None: not completed, the benchmark stopped first)."""
@@ -40,7 +41,7 @@ class ManualOperation:
     answer: str = ""
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Goal:
     """One goal: requested, started by the robot (None: never), ended (None: the benchmark
     stopped first) with ``outcome`` ``result`` (``result`` the robot's string) or ``timeout``.
@@ -55,7 +56,7 @@ class Goal:
     result: str = ""
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Broadcast:
     """One tf broadcast by the script: ``child`` under ``parent`` stamped ``t_ns`` (its
     lookup's ``now``), recorded 1 ms later. Frames are spelt as the script spells them."""
@@ -67,7 +68,7 @@ class Broadcast:
     quat_xyzw: tuple[float, float, float, float]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Save:
     """A ``save_and_publish_score()`` at ``t_ns`` with the score then."""
 
@@ -75,7 +76,7 @@ class Save:
     score: dict[str, Any]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Body:
     """A mocap body as the mocap node published it; ``record_topics``: its pose topics are in
     the bag (the benchmark's ``record_topics``), else only /tf."""
@@ -85,7 +86,7 @@ class Body:
     record_topics: bool = True
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RsbbScenario:
     """One run, timed (int64 ns since the epoch).
 

@@ -12,7 +12,6 @@ out; the map. :func:`write_task_run` writes it at
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 from typing import Any
@@ -20,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb_states import BAG_TIME_FORMAT, LOGS_DIR, STATE_PERIOD_NS, TIMEOUT_TOPIC
 from ertools.simulator.mocap import simple_map
 from ertools.simulator.rsbb import CORE_CALLER, ZoneView, register_types, write_gui
@@ -34,7 +34,7 @@ TIMED_OUT = "Stopped due to timeout!"
 WAITING = "Waiting for the referee's start"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class TaskScenario:
     """One task-benchmark run, timed (int64 ns since the epoch).
 

@@ -11,14 +11,14 @@ into the benchmark manager's logs, mocap into the GT logger's hourly files.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.simulator.mocap import MocapPublished
 from ertools.simulator.statemachine import Transition
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class SimulatedRun:
     """A benchmark execution as the simulator knows it.
 

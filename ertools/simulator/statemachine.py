@@ -21,19 +21,19 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import I64
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.simulator.writer import BagWriter
 from ertools.states import BMBOX_TRANSITIONS, STATE_ENUMS, BmBoxState, Machine, state_topic
 
 HEARTBEAT_NS = 100_000_000  # 10 Hz
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Transition:
     """A machine enters ``state`` (an enum member or code) with ``payload`` at ``t_ns``."""
 
@@ -43,7 +43,7 @@ class Transition:
     payload: str = ""
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class StateMessages:
     """The messages one machine published: record times, state codes, payloads."""
 

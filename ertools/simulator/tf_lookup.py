@@ -14,18 +14,18 @@ from __future__ import annotations
 import bisect
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
 from ertools.arrays import F64, I64
+from ertools.frozen_dataclass import frozen_dataclass
 
 Vec = tuple[float, float, float]
 Quat = tuple[float, float, float, float]
 _EPS = 4.0 * float(np.finfo(np.float64).eps)  # tf.transformations' _EPS
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Link:
     """One mocap body as tf had it: header stamps (sorted), translations, rotations."""
 
@@ -34,7 +34,7 @@ class Link:
     quat_xyzw: F64
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Looked:
     """A lookup's result: the frame's position and rotation, and its yaw."""
 

@@ -49,6 +49,7 @@ import numpy.typing as npt
 
 from ertools.arrays import I64, U8
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.simulator.packing import (
     Field,
     as_bytes,
@@ -72,7 +73,7 @@ _LOG_LEVELS_ROS2 = {"DEBUG": 10, "INFO": 20, "WARN": 30, "ERROR": 40, "FATAL": 5
 # --------------------------------------------------------------------------- the writer
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Connection:
     """A handle returned by :meth:`BagWriter.connection`."""
 

@@ -8,10 +8,11 @@ the summaries; the report draws it.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Any, Literal, Protocol
 
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.timeutil import NS_PER_S, ns_to_s
 
 Kind = Literal["gt", "benchmark", "robot", "other", "unreadable"]
@@ -66,7 +67,7 @@ class SummaryLike(Protocol):
     def problems(self) -> Sequence[str]: ...
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class BagEntry:
     """One bag in the timeline (``start_ns`` is None when it could not be read)."""
 
@@ -94,7 +95,7 @@ class BagEntry:
         return self.start_ns is not None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Pairing:
     """A benchmark or robot log and the GT files that cover it.
 
@@ -118,7 +119,7 @@ class Pairing:
     other_benchmark: tuple[str, ...] = ()
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Session:
     """A chain of overlapping bags (each overlaps at least one other of the chain)."""
 
@@ -133,13 +134,13 @@ class Session:
         return self.end_ns - self.start_ns
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Problem:
     path: str
     problem: str
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class TimelineConfig:
     """Thresholds of the checks.
 
@@ -161,7 +162,7 @@ class TimelineConfig:
     coverage_join_ns: int = NS_PER_S // 10
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RsbbRunFiles:
     """One run of an RSBB season folder and its files (docs/rsbb.md, "What an RSBB run
     writes"): the bag and result file paired by code, team, run and time, the side files
@@ -189,7 +190,7 @@ class RsbbRunFiles:
         }
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RsbbFolder:
     """What the RSBB layout makes of the files under the paths: its runs, every file it
     recognised (kind, path) and what a referee should look at."""
@@ -199,7 +200,7 @@ class RsbbFolder:
     problems: tuple[str, ...]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Timeline:
     """The result of :func:`build_timeline` (bags ordered by start; unreadable ones last);
     ``rsbb``: the RSBB season layout found under the paths, if any."""

@@ -11,11 +11,13 @@ palette (matplotlib's ``tab:`` colours, so PNG and SVG figures read the same).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
+
+from ertools.frozen_dataclass import frozen_dataclass
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -53,7 +55,7 @@ def _has_none(values: object) -> bool:
     return isinstance(values, list | tuple) and any(v is None for v in values)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Line:
     """A polyline through (x, y); a NaN in either breaks it. ``marker`` draws each vertex."""
 
@@ -68,7 +70,7 @@ class Line:
     side: Side = "left"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Scatter:
     """Markers at (x, y), one colour or coloured by ``values`` on the chart's colour scale."""
 
@@ -82,7 +84,7 @@ class Scatter:
     side: Side = "left"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Arrows:
     """Arrows from (x0, y0) to (x1, y1), in data units (a heading drawn as a short arrow)."""
 
@@ -95,7 +97,7 @@ class Arrows:
     label: str | None = None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Span:
     """A shaded span over the whole height (``axis="x"``: lo <= x <= hi) or the whole width
     (``axis="y"``) of the axes: a gap in the data, an interval of time, a tolerance."""
@@ -109,7 +111,7 @@ class Span:
     side: Side = "left"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Band:
     """A shaded band between ``lo(x)`` and ``hi(x)`` (a confidence band); NaN breaks it."""
 
@@ -122,7 +124,7 @@ class Band:
     side: Side = "left"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ErrorBars:
     """A value with its interval at each point: a marker at (x, y) and a bar from ``lo`` to
     ``hi`` (absolute bounds, not offsets) along ``axis`` (``"y"``: vertical bars); a NaN bound
@@ -142,7 +144,7 @@ class ErrorBars:
     side: Side = "left"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Bars:
     """Vertical bars of ``height`` at ``x`` (``width`` in data units); NaN draws no bar."""
 
@@ -154,7 +156,7 @@ class Bars:
     side: Side = "left"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Rects:
     """Rectangles from (x0, y0) to (x1, y1) in data units: the bars of a Gantt chart, a
     state's span on its lane. ``hatch`` fills them with diagonal lines instead (a silence);
@@ -171,7 +173,7 @@ class Rects:
     side: Side = "left"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RefLine:
     """A line across the axes at ``value``: vertical for ``axis="x"``, horizontal for
     ``"y"``; with ``lo``/``hi`` only from ``lo`` to ``hi`` along the other axis."""
@@ -187,7 +189,7 @@ class RefLine:
     side: Side = "left"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Text:
     """A label at a data point, moved by ``offset`` pixels (right, up)."""
 
@@ -203,7 +205,7 @@ class Text:
 Layer = Line | Scatter | Arrows | Span | Band | ErrorBars | Bars | Rects | RefLine | Text
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Axis:
     """One axis: its label (with its unit), explicit ticks if any (position, text), and the
     colour of its label (an axis that belongs to one series on a two-scale chart)."""
@@ -216,7 +218,7 @@ class Axis:
     symlog: float | None = None  # linear within +-symlog of 0, logarithmic beyond
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ColourScale:
     """The scale :class:`Scatter` ``values`` are coloured on (viridis), drawn as a bar."""
 
@@ -225,7 +227,7 @@ class ColourScale:
     hi: float
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Chart:
     """Everything one figure shows, in drawing order."""
 

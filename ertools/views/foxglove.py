@@ -31,6 +31,7 @@ from google.protobuf.message import Message
 
 from ertools.arrays import F64, I64
 from ertools.fidelity import differs_line
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.serialize import jsonable
 
 WORLD = "world"  # the mocap frame every pose of a 2015 benchmark is in
@@ -46,7 +47,7 @@ WHITE = (1.0, 1.0, 1.0, 1.0)
 INFO, WARNING, ERROR = Log.Level.INFO, Log.Level.WARNING, Log.Level.ERROR
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Channel:
     """One topic's schema: name, schema encoding and bytes, message encoding."""
 
@@ -121,7 +122,7 @@ def descriptor_set(desc: Any) -> bytes:
     return _DESCRIPTOR_SETS[name]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class JsonSchema:
     """A JSON schema of ertools' own: a title and ``name -> JSON type`` of its fields.
 

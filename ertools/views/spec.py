@@ -5,12 +5,12 @@ matplotlib, is :mod:`ertools.report.figures`' job."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.views.chart import Chart
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ChartSpec:
     """One figure: ``build(size)`` makes its :class:`Chart` for a ``size`` in inches."""
 

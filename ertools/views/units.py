@@ -11,13 +11,13 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
 from typing import Any
 
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.timeutil import EPOCH_THRESHOLD_S
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Quantity:
     """A kind of number: the unit shown and the factor from each source unit to it."""
 

@@ -9,12 +9,11 @@ places of queries from those of nearby ones (Gauss-Newton steps) instead of sear
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, I64, IntArr
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import bracket, row_norm
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
@@ -22,7 +21,7 @@ from ertools.timeutil import NS_PER_S
 MAX_NS = np.iinfo(np.int64).max
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Evaluation:
     """GT positions at shifted robot times, where they are usable.
 

@@ -24,7 +24,7 @@ Pure NumPy: streams in, a frozen :class:`OffsetEstimate` out.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 import numpy.typing as npt
@@ -39,6 +39,7 @@ from ertools.benchmarks.common.clock_queries import (
     window_distances,
 )
 from ertools.benchmarks.common.hygiene import drop_repeats
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import bracket, row_dot, row_norm
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
@@ -60,7 +61,7 @@ BOOTSTRAP_DRAWS = 500
 BLOCK_NS = 5 * NS_PER_S
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class OffsetEstimate:
     """The clock audit of a robot log against GT.
 

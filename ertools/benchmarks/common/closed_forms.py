@@ -26,11 +26,11 @@ the few arguments where it is not 1 to double precision. Cubes are products, not
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from ertools.arrays import F64
+from ertools.frozen_dataclass import frozen_dataclass
 
 SQRT_2_PI = math.sqrt(2.0 / math.pi)
 INV_SQRT_2PI = 1.0 / math.sqrt(2.0 * math.pi)
@@ -56,7 +56,7 @@ def _big_phi(x: F64) -> F64:
     return np.asarray(0.5 * (1.0 + _erf(np.asarray(x) / math.sqrt(2.0))), dtype=np.float64)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Raw:
     """Raw moments E[X], E[X^2], E[X^3] of per-pose terms (arrays of one shape): averaging
     them over a lag's nodes gives the moments of the mixture."""
@@ -158,7 +158,7 @@ def lag_nodes(low: float, high: float, count: int = LAG_NODES) -> F64:
     return np.asarray(low + (x + 1.0) / 2.0 * (high - low), dtype=np.float64)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class SumMoments:
     """Mean, variance and skewness of a statistic that sums independent per-pose terms."""
 
@@ -185,7 +185,7 @@ def mean_moments(raw: Raw) -> SumMoments:
     return SumMoments(float(np.sum(mean)) / n, v, skew)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class AngleMoments:
     """Per-pose moments of a = sin|x| (wrapped; 2015: sign(x) sin x unwrapped) and
     b = cos x for a noisy angle x, summed by :func:`circular_mean_moments`."""

@@ -10,16 +10,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
 from ertools.arrays import F64, IntArr, distinct
+from ertools.frozen_dataclass import frozen_dataclass
 
 CHUNK_ELEMENTS = 4_000_000  # draws x values per chunk of the order statistics' draws
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Distances:
     """The values whose order statistics are drawn: errors e (n, 3) between two ends, the
     noise of one end (sigma per axis, (n,)), its velocity (n, 3) and frame period (n,) for
@@ -70,7 +70,7 @@ def percentile_rows(values: F64, count: IntArr, percent: float) -> F64:
     return np.asarray(a + (h - lo) * (b - a), dtype=np.float64)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class OrderStat:
     """One order statistic to draw: its columns (in the caller's scores: one statistic may
     be two, the median and p50), the values that can move it (indices) and its ranks among

@@ -19,10 +19,9 @@ Shared by the FBM scorers (FBM1, FBM2@Home, FBM3@Work):
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from ertools.benchmarks.common.inputs import EXACT_FLAG
 from ertools.fidelity import Deviation, Rule
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.node_versions import NodeVersion
 from ertools.states import (
     BmBoxState,
@@ -97,7 +96,7 @@ VERSIONS = (
 _FINISHED = (BmBoxState.TRANSMITTING_SCORE, BmBoxState.END)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RefBoxEnd:
     """One RefBox END: when (the first message of its stretch), its payload, its meaning."""
 

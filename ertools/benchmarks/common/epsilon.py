@@ -15,7 +15,7 @@ gives an estimate.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from typing import Any
 
 import numpy as np
@@ -37,6 +37,7 @@ from ertools.benchmarks.common.phases import (
 from ertools.benchmarks.results import ResultBase
 from ertools.errors import ScoringError
 from ertools.fidelity import Deviation
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.serialize import jsonable
 from ertools.streams import PoseStream, Provenance
 
@@ -45,7 +46,7 @@ PERCENTILES = (50, 95, 99)
 HISTOGRAM_ROWS = 50
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class NoiseResult(ResultBase):
     """Noise statistics; implements :class:`ertools.benchmarks.base.BenchmarkResult`.
 

@@ -8,12 +8,12 @@ run edges); the repeat test itself is :func:`ertools.benchmarks.common.hygiene.i
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.benchmarks.common.hygiene import identical_poses
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.streams import PoseStream
 
 # Identical poses lasting longer than this around a scored moment are reported. Real mocap
@@ -24,7 +24,7 @@ from ertools.streams import PoseStream
 FROZEN_MIN_S = 0.1
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class FrozenSpan:
     """A run of identical poses (position and orientation repeated exactly).
 

@@ -12,12 +12,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, Bool, distinct, median
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import row_norm
 from ertools.streams import MAX_FRAME_CHANGES, PoseStream
 from ertools.timeutil import iso_utc
@@ -178,7 +178,7 @@ EXCURSION_MAX_S = 0.5
 _MEDIAN_SAMPLES = 10_000  # the centre from at most this many samples (a median is robust)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Jump:
     """A move between two consecutive measured samples faster than any robot.
 
@@ -193,7 +193,7 @@ class Jump:
     speed_m_s: float
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Impossible:
     """The samples of a stream no body can have taken.
 

@@ -9,11 +9,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any
 
 from ertools.benchmarks.base import FormerName, Input
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 
 DEFAULT_CONFIDENCE = 0.95
 DEFAULT_DRAWS = 400
@@ -75,7 +76,7 @@ def check_confidence(confidence: float) -> float:
     return confidence
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class IntervalSettings:
     """``--confidence``, ``--draws`` and ``--seed`` as one value (draws 0: no intervals)."""
 

@@ -11,17 +11,17 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from ertools.benchmarks.common.inputs import IntervalSettings
 from ertools.benchmarks.common.uncertainty import Interval, Uncertainty
+from ertools.frozen_dataclass import frozen_dataclass
 
 #: The method named in the ``uncertainty`` block and on stderr.
 METHOD = "Monte Carlo over the sources, basic (bias-correcting) bootstrap interval"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ResultIntervals:
     """The intervals of one result, by score key (dotted for nested ones), and how they were
     obtained (None without intervals)."""
@@ -75,7 +75,7 @@ METHOD_NAME = "Monte Carlo"
 MAX_LINE = 200
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ScoreRow:
     """One score to print with its interval: ``value`` and the interval in SI units, shown
     times ``scale`` in ``unit`` (``1000.0``, ``mm``)."""

@@ -5,13 +5,12 @@ figures; the layers themselves are :mod:`ertools.benchmarks.common.gaps`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 from ertools.arrays import F64
 from ertools.benchmarks.common.validity import STILL_M, Validity, lost_spans
+from ertools.frozen_dataclass import frozen_dataclass
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class GapOnPath:
     """An invalid span where a path plot draws it.
 

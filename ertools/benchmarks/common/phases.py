@@ -19,12 +19,12 @@ this module keeps the FBM3 defaults and the :class:`Phase` records.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from ertools.arrays import F64, I64, Bool
 from ertools.benchmarks.common import motion
+from ertools.frozen_dataclass import frozen_dataclass
 
 DEFAULT_STILL_SPEED = 0.004  # m/s
 DEFAULT_MIN_STILL_S = 0.5
@@ -33,7 +33,7 @@ DEFAULT_WINDOW_S = 0.2
 MAX_GAP_S = 0.5
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Phase:
     """Samples ``first..last`` (inclusive indices) and their times."""
 

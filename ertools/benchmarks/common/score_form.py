@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from abc import abstractmethod
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any, ClassVar
 
 from ertools.benchmarks.base import Rows
@@ -27,6 +27,7 @@ from ertools.benchmarks.common.interval_output import (
 from ertools.benchmarks.common.uncertainty import Interval, interval_keys, uncertainty_rows
 from ertools.benchmarks.results import ResultBase
 from ertools.fidelity import Deviation
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.score import ScoreComparison, plain, score_yaml
 from ertools.streams import Provenance
 
@@ -45,7 +46,7 @@ def nested_intervals(
     return out
 
 
-@dataclass(frozen=True, eq=False, kw_only=True)
+@frozen_dataclass(eq=False, kw_only=True)
 class ScoreFormResult(ResultBase):
     """The part of a result in a result file's ``score`` form that every such benchmark has;
     the benchmark's result adds its records and ``name``, its :meth:`score_rows` and

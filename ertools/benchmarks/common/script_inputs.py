@@ -12,7 +12,6 @@ NumPy-free: the benchmarks' ``config`` modules list them for the command line's 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -24,6 +23,7 @@ from ertools.benchmarks.common.inputs import (
     check_confidence,
 )
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 
 #: The help section of the options that undo ertools' readings of a script one by one.
 SCRIPT_GROUP = "the RSBB script's behaviour (each difference can be undone)"
@@ -48,7 +48,7 @@ GT_GAPS = Input(
 )
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ScriptOptions:
     """The options every such benchmark has (its own options dataclass adds its rules).
 

@@ -6,10 +6,10 @@ options without loading numpy or the readers (``ertools noise --help`` stays ins
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Literal
 
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 
 TimeSource = Literal["header", "record"]
 TIME_SOURCES: tuple[TimeSource, ...] = ("header", "record")
@@ -33,7 +33,7 @@ def parse_tf(text: str) -> tuple[str, str]:
     return parent, child
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class PoseSpec:
     """A pose source as the command line gives it.
 

@@ -20,11 +20,11 @@ from __future__ import annotations
 import dataclasses
 import re
 from collections.abc import Iterable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
 from ertools.errors import ErtoolsError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.reader import read_benchmark_states
 
 TeamSource = Literal["explicit", "payload", "log name", "transform", "RSBB layout"]
@@ -55,7 +55,7 @@ PAYLOAD_KEYS = ("team", "team_name", "robot_info")
 NO_TEAM = frozenset({"", "identity"})
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RobotLogName:
     """What a rockin_logger file name says: the benchmark (``fbm2h``) and, when the name has
     them, the date digits and the team."""
@@ -132,7 +132,7 @@ def team_from_payloads(payloads: Iterable[str]) -> str | None:
     return None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Team:
     """A result's team and where the name came from."""
 

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 import numpy as np
@@ -34,6 +34,7 @@ from ertools.benchmarks.common.inputs import (
     DEFAULT_SEED,
     check_confidence,
 )
+from ertools.frozen_dataclass import frozen_dataclass
 
 # How many measured samples a score needs behind it (docs/uncertainty.md, "Too few samples").
 # An interval's width is measured from the samples themselves (the spread of the errors, the
@@ -71,7 +72,7 @@ def sigma_from_epsilon(epsilon: float) -> float:
     return epsilon / math.sqrt(math.pi)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Source:
     """One source of uncertainty and the value used for it.
 
@@ -99,7 +100,7 @@ class Source:
         }
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Interval:
     """A confidence interval of one score, and each source's share of it."""
 
@@ -117,7 +118,7 @@ class Interval:
         return dict(self.shares)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Uncertainty:
     """The ``uncertainty`` block of a result: how its intervals were obtained.
 

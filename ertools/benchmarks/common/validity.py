@@ -38,13 +38,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, I64, Bool, IntArr, median
 from ertools.benchmarks.common.hygiene import impossible_samples, rows_equal
+from ertools.frozen_dataclass import frozen_dataclass
 
 VALID = 0
 TRACKING_LOST = 1
@@ -84,7 +84,7 @@ STILL_M = 0.002
 DEFAULT_GAP_S = 0.1
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class SampleMask:
     """The reason code of every sample of a stream.
 
@@ -152,7 +152,7 @@ def last_measured(ok: Bool, i: int) -> int:
     return int(before[-1]) if before.size else -1
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class InvalidSpan:
     """A stretch of the window without valid data longer than the gap threshold.
 
@@ -189,7 +189,7 @@ class InvalidSpan:
         }
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Validity:
     """Validity of the samples in one scored window (a run, a segment, an item, a trajectory).
 

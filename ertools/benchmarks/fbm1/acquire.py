@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -26,6 +26,7 @@ from ertools.benchmarks.fbm1.rules import RULE_ACQUIRE_WINDOW
 from ertools.configs.items import Item, ItemList, ItemSpread, load_items
 from ertools.errors import ConfigError, SegmentationError
 from ertools.fidelity import Deviation
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import invert, mean_pose
 from ertools.io.summary import summary
 from ertools.streams import Interval, PoseStream, Provenance
@@ -39,7 +40,7 @@ if TYPE_CHECKING:
 LOOKAHEAD_NS = NS_PER_S // 4
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class AcquireOptions:
     """Stationary-phase detection and window trimming.
 
@@ -62,7 +63,7 @@ class AcquireOptions:
     max_gap_s: float = 0.5
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class AcquireResult:
     """The acquired item list and how it was measured.
 

@@ -9,16 +9,16 @@ from __future__ import annotations
 
 import contextlib
 import math
-from dataclasses import dataclass
 from typing import Any
 
 from ertools.configs._yaml import parse_payload
 from ertools.errors import ConfigError, ScoringError
+from ertools.frozen_dataclass import frozen_dataclass
 
 ANSWER_FIELDS = ("item_class", "item_instance", "x", "y", "theta")
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Answer:
     """One robot answer.
 
@@ -78,7 +78,7 @@ def parse_answer_payload(payload: str, where: str) -> Answer:
     return answer_from_mapping(data, where, "client payload")
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ResultsFile:
     """Answers kept outside the log: by run index (1-based) and/or by item id."""
 

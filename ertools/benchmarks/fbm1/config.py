@@ -9,7 +9,7 @@ it.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from pathlib import Path
 from typing import Any, Literal
 
@@ -22,6 +22,7 @@ from ertools.benchmarks.common.inputs import (
     unscoreable_input,
 )
 from ertools.errors import ConfigError, UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.model import PoseSource
 
 BENCHMARKS = ("fbm1h", "fbm1w")
@@ -60,7 +61,7 @@ GtMethod = Literal["window", "placed", "goal", "result"]
 GT_METHODS: tuple[str, ...] = ("window", "placed", "goal", "result")
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class GtOptions:
     """How the ground truth of a run is measured.
 
@@ -85,7 +86,7 @@ class GtOptions:
     max_gap_s: float = 0.5
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ScoreRules:
     """Which node behaviours to reproduce (all False: ertools' rules; see the module doc)."""
 
@@ -114,7 +115,7 @@ class ScoreRules:
         return ScoreRules(False, True, True, True, True, score_unscoreable=True)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class BodySources:
     """Where the table and board poses come from (the 2015 topics when None)."""
 
@@ -122,7 +123,7 @@ class BodySources:
     board: PoseSource | None = None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Fbm1Options:
     """Everything that changes an FBM1 score besides the inputs.
 

@@ -26,9 +26,9 @@ restores; ``Fbm1Options.for_rules`` selects those of one node):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 from ertools.benchmarks.fbm1.config import ScoreRules
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.timeutil import ns_to_s
 
 # The @Home nodes played at most this many runs; the 2016-17 one divided the accuracies by it.
@@ -37,7 +37,7 @@ BENCHMARK_RUNS_HOME = 10
 MAX_POSE_ERROR_2015 = math.sqrt(2.0)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class PoseErrors:
     """The pose part of one run's score.
 
@@ -116,7 +116,7 @@ def names_match(answer: str, truth: str, rules: ScoreRules) -> bool:
     return answer == truth if rules.exact_names else answer.strip() == truth.strip()
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Totals:
     """The four numbers of the 2015 score and what they were divided by."""
 

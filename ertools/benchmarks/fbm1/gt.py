@@ -20,7 +20,6 @@ ends when the goal is sent and reports their spread (``method="window"``).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -28,12 +27,13 @@ from ertools.benchmarks.common import motion
 from ertools.benchmarks.common.hygiene import drop_invalid
 from ertools.benchmarks.fbm1.config import GtOptions
 from ertools.configs.items import Item
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import compose, interpolate_poses, invert, mean_pose, yaw_from_quat
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class GroundTruth:
     """The item's pose in the table frame for one run.
 

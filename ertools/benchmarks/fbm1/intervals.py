@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
@@ -60,6 +60,7 @@ from ertools.benchmarks.fbm1.gt import GroundTruthError, board_in_table, measure
 from ertools.benchmarks.fbm1.result import Fbm1RunResult
 from ertools.benchmarks.fbm1.runs import Fbm1Run
 from ertools.configs.items import IDENTITY_ROT, IDENTITY_TRANS, Item
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import compose, yaw_from_quat
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
@@ -74,7 +75,7 @@ GT_KEYS = ("x", "y", "theta")
 ERROR_KEYS = ("x", "y", "translation", "theta")
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RunNoise:
     """The measured mocap noise of one run's ground truth.
 

@@ -5,7 +5,6 @@ and board poses (:func:`read_body` chooses where a body's poses come from); what
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -16,6 +15,7 @@ from ertools.benchmarks.fbm1.runs import RunsFound
 from ertools.configs._yaml import load_yaml
 from ertools.configs.items import ItemList, load_items
 from ertools.errors import ConfigError, SegmentationError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.model import BenchmarkStates
 from ertools.io.reader import read_benchmark_states, read_pose_source
 from ertools.io.summary import summary
@@ -62,7 +62,7 @@ def read_body(
     )
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Fbm1Logs:
     """What :func:`read_logs` read: the log files, the item list, the answers file (if any), the
     benchmark state streams and the log's first message time."""
@@ -74,7 +74,7 @@ class Fbm1Logs:
     t0_ns: int
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Fbm1Runs:
     """What :func:`ertools.benchmarks.fbm1.pipeline.find_runs` found: the runs, and the table
     and board poses around them (read only there), with the node's item broadcasts when the

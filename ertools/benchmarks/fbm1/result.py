@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 from ertools.benchmarks.base import Rows
@@ -23,11 +23,12 @@ from ertools.benchmarks.fbm1.gt import GroundTruth
 from ertools.benchmarks.results import ResultBase
 from ertools.configs.items import Item
 from ertools.fidelity import Deviation
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.streams import Provenance
 from ertools.timeutil import NS_PER_S, ns_to_s
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Fbm1RunResult:
     """One run: what was shown, what the robot said, the ground truth and the score.
 
@@ -192,7 +193,7 @@ class Fbm1RunResult:
         }
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Fbm1Result(ResultBase):
     """An FBM1@Home or FBM1@Work score (implements ``BenchmarkResult``; ``to_dict``,
     ``to_yaml``, ``to_frames`` from :class:`~ertools.benchmarks.results.ResultBase`).

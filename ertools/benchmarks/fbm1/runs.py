@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 from ertools.benchmarks.common.ending import (
     cut_warning,
@@ -32,6 +32,7 @@ from ertools.benchmarks.common.ending import (
     refbox_ends,
 )
 from ertools.fidelity import Deviation
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.states import BmBoxState, ClientState, EndReason, RefBoxState
 from ertools.streams import StateStream
 
@@ -41,7 +42,7 @@ _EXECUTING_STATES = (BmBoxState.EXECUTING_GOAL, BmBoxState.WAITING_RESULT)
 _PLACE_RE = re.compile(r"^\s*place\s+item\s+(\d+)\s*\((.*)\)\s*on\s+the\s+table\s*$", re.I)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ItemRef:
     """What a run's manual-operation payload (or ``--items-order``) says was presented."""
 
@@ -51,7 +52,7 @@ class ItemRef:
     source: str  # "bmbox payload", "refbox payload", "--items-order"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Fbm1Run:
     """One presented item, with the moments the 2015 node acted on (int64 ns).
 
@@ -89,7 +90,7 @@ class Fbm1Run:
         return "answered" if self.answer_payload is not None else "no_answer"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RunsFound:
     """The runs of a benchmark and what the state log said besides."""
 

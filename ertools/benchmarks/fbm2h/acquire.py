@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
 from datetime import UTC, datetime
 
 import numpy as np
@@ -25,6 +24,7 @@ from ertools.benchmarks.fbm2h.config import StopParams
 from ertools.benchmarks.fbm2h.runs import detect_stops
 from ertools.configs.transform import MarkerTransform, TransformSpread
 from ertools.errors import ConfigError, SegmentationError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import (
     MeanPose,
     invert,
@@ -47,7 +47,7 @@ SPREAD_WARN_RAD = 0.05
 ORIGIN_WARN_M = 0.5
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class TransformAcquisition:
     """An acquired transform and how it was obtained.
 

@@ -6,7 +6,7 @@ once). NumPy-free: the command's parser imports it.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -22,6 +22,7 @@ from ertools.benchmarks.common.inputs import (
     unscoreable_input,
 )
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 
 if TYPE_CHECKING:  # annotations only: the transform's module is NumPy
     from ertools.configs.transform import MarkerTransform
@@ -44,7 +45,7 @@ NODES = {
 RULE_SETS = ("ertools", *NODES)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class StopParams:
     """Thresholds of the ``auto`` stop detector.
 
@@ -66,7 +67,7 @@ class StopParams:
     radius: float = 0.5
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Fbm2hOptions:
     """Everything ``ertools score fbm2h`` can be told.
 

@@ -6,16 +6,15 @@ marker-to-robot transform, the waypoints and the moments in, numbers out.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ertools.arrays import F64, I64, Bool
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import angle_error, compose, interpolate_poses, yaw_from_quat
 from ertools.streams import PoseStream
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class PosesAt:
     """Robot poses evaluated at query moments.
 
@@ -74,7 +73,7 @@ def robot_poses_at(
     return PosesAt(xyyaw, ok, np.minimum(d_lo, d_hi).astype(np.int64), both)
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Errors:
     """Per-segment errors and their aggregates.
 

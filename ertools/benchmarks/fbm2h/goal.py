@@ -9,7 +9,6 @@ benchmark config (``benchmark_configs/HNF.yaml``: ``starting_pose``, ``waypoints
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -18,11 +17,12 @@ import numpy.typing as npt
 
 from ertools.configs._yaml import check_radians, load_yaml, number, parse_payload
 from ertools.errors import ConfigError
+from ertools.frozen_dataclass import frozen_dataclass
 
 Pose2 = tuple[float, float, float]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class GoalList:
     """Waypoints to visit in order, as (x [m], y [m], theta [rad]) in the testbed frame.
 

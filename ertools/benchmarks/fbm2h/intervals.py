@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
@@ -62,6 +62,7 @@ from ertools.benchmarks.fbm2h.result import Fbm2hIntervals, Fbm2hResult
 from ertools.benchmarks.fbm2h.runs import ReachedMoments
 from ertools.configs.transform import MarkerTransform, TransformSpread
 from ertools.errors import ScoringError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import quat_conjugate, quat_multiply, rotate, wrap_angle
 from ertools.streams import PoseStream
 from ertools.timeutil import s_to_ns
@@ -75,7 +76,7 @@ MAD_TO_SIGMA = 1.4826
 MIN_PAIRS = 10
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Moments:
     """What the perturbed scorer needs of the K scored segments.
 
@@ -96,7 +97,7 @@ class Moments:
     velocity: F64
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Model:
     """The sources' sizes. ``transform_sd``: the transform's standard errors (offset x, y;
     tilt x, y; yaw) in the marker frame; None: one mocap measurement's (``sigma``,

@@ -6,7 +6,6 @@ call them."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +25,7 @@ from ertools.configs.transform import (
     team_transform_path,
 )
 from ertools.errors import ConfigError, ScoringError, SegmentationError, TopicError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import compose, yaw_from_quat
 from ertools.io.clock import check_header_clock
 from ertools.io.model import BenchmarkStates
@@ -90,7 +90,7 @@ def _compare_goal(goal: GoalList, payload: str, topic: str) -> str | None:
     return None
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Fbm2hLogs:
     """What :func:`load` read: the bags, the transform, the goal list given (if any), the
     marker set poses (invalid ones dropped), the log's span and, when the reached moments
@@ -106,7 +106,7 @@ class Fbm2hLogs:
     states: BenchmarkStates | None = None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Fbm2hRuns:
     """What :func:`find_runs` found: the reached moments, the goal list they close (given,
     or the one the BmBox sent), the waypoints not reached and why, and warnings."""

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 import numpy as np
@@ -19,6 +19,7 @@ from ertools.benchmarks.fbm2h.goal import GoalList
 from ertools.benchmarks.results import ResultBase
 from ertools.configs.transform import MarkerTransform
 from ertools.fidelity import Deviation
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
 from ertools.yamlin import load as load_yaml
@@ -26,7 +27,7 @@ from ertools.yamlin import load as load_yaml
 Pose2 = tuple[float, float, float]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Fbm2hIntervals:
     """The intervals of one result: accuracies, then per scored segment index."""
 
@@ -37,7 +38,7 @@ class Fbm2hIntervals:
     uncertainty: Uncertainty
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class SegmentResult:
     """One segment: from the previous waypoint (or the start) to waypoint ``index``.
 
@@ -120,7 +121,7 @@ def _num(x: float | None) -> float | None:
     return None if x is None or (isinstance(x, float) and math.isnan(x)) else float(x)
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Fbm2hResult(ResultBase):
     """A scored FBM2@Home run (implements ``BenchmarkResult``).
 

@@ -20,7 +20,7 @@ Three sources, one result (:class:`ReachedMoments`):
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 
 import numpy as np
 import numpy.typing as npt
@@ -31,6 +31,7 @@ from ertools.benchmarks.common.ending import end_payload_deviation, end_payload_
 from ertools.benchmarks.fbm2h.config import StopParams
 from ertools.errors import SegmentationError
 from ertools.fidelity import Deviation
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.states import BmBoxState, ClientState, EndReason, RefBoxState, end_reason
 from ertools.streams import StateStream
 from ertools.timeutil import ns_to_s
@@ -41,7 +42,7 @@ CLOCKS = ("client", "bmbox")
 _KINDS = {EndReason.TIMEOUT: "timeout", EndReason.STOP: "stop"}
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class EarlyEnd:
     """Why the benchmark stopped before segment ``segment`` was completed.
 
@@ -77,7 +78,7 @@ class EarlyEnd:
         return "the benchmark ended without a RefBox reason"
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class ReachedMoments:
     """Start and reached (end) time of each segment that was driven.
 

@@ -13,7 +13,6 @@ as everywhere in ertools). ``p(k+1)`` closes segment ``k`` and opens segment ``k
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -22,12 +21,13 @@ import numpy.typing as npt
 
 from ertools.configs._yaml import load_yaml, number
 from ertools.errors import ConfigError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.timeutil import MAX_SECONDS, resolve_time
 
 KEY = "reached_waypoint_timing"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ReachedTiming:
     """The moments of a timing file, in file order.
 

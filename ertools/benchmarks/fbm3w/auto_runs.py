@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
@@ -26,6 +25,7 @@ from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.benchmarks.fbm3w.shapes import Shape
 from ertools.benchmarks.fbm3w.track import Track, protocol_track
 from ertools.errors import ConfigError, SegmentationError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.streams import PoseStream
 
 # Still time kept at each side of an auto-detected path: the edge of a move is where the
@@ -46,7 +46,7 @@ AUTO_SMOOTH_S = 0.1
 AUTO_DETECT_SIGMAS = 6.0
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class _Candidate:
     """Moves ``first..last`` (between still phases ``first`` and ``last + 1``) as one path."""
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 from ertools.benchmarks.base import FormerName, Input, resolve_values, tf_value
@@ -26,6 +26,7 @@ from ertools.benchmarks.common.inputs import (
     unscoreable_input,
 )
 from ertools.errors import ConfigError, UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 
 if TYPE_CHECKING:  # annotations only: the config file's shapes are NumPy
     from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
@@ -40,7 +41,7 @@ RUN_MODES = ("states", "windows", "auto")
 Window = tuple[str, float, float, float]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Fbm3wOptions:
     """How to score (the CLI's options, as data).
 

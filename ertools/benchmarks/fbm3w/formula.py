@@ -20,13 +20,13 @@ draws at once (``perturbed._subsample``) is its own copy of the rule.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from ertools.arrays import F64, Bool, IntArr
 from ertools.benchmarks.fbm3w.shapes import Shape
 from ertools.errors import ErtoolsError, ScoringError
+from ertools.frozen_dataclass import frozen_dataclass
 
 # Samples probed one by one after each kept point before switching to a vectorised search:
 # while the end effector moves, the next kept sample is usually within a few samples (cheap
@@ -149,7 +149,7 @@ def frame_errors(xk: F64, yk: F64, counts: IntArr, target: F64, cos_yaw: F64, si
     return a
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RunFrame:
     """The 2015 run frame in world coordinates: origin at the start, x along ref -> start."""
 
@@ -189,7 +189,7 @@ def run_frame(reference_xy: F64, start_xy: F64, *, as_2015: bool = False) -> Run
     return RunFrame((float(start[0]), float(start[1])), math.atan2(dy, dx))
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class PathScore:
     """Eq. (1) for one run.
 

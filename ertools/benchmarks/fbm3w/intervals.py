@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from statistics import NormalDist
 
 import numpy as np
@@ -62,6 +62,7 @@ from ertools.benchmarks.fbm3w.config import Fbm3wOptions
 from ertools.benchmarks.fbm3w.perturbed import RunSamples, perturbed_runs
 from ertools.benchmarks.fbm3w.result import RunResult
 from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.streams import PoseStream
 
 # The coefficient of variation of a Rayleigh distance, sqrt(4/pi - 1): the spread of one
@@ -92,7 +93,7 @@ def smooth(xy: F64) -> F64:
     return np.concatenate([head, out, tail])
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class NoiseModel:
     """The sources' sizes: sigma per axis (m), its relative standard error, d_min (m) and
     d_min's relative standard deviation."""

@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 from ertools.benchmarks.common.sources import PoseSpec, read_source, tf, topic
@@ -14,6 +13,7 @@ from ertools.benchmarks.fbm3w.config import (
     FALLBACK_TOPIC,
     Fbm3wOptions,
 )
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.model import BenchmarkStates
 from ertools.streams import PoseStream
 
@@ -37,7 +37,7 @@ def read_fbm3w_poses(paths: Sequence[Path], options: Fbm3wOptions) -> PoseStream
     return read_source(paths, spec, defaults, what="end-effector poses")
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Fbm3wLogs:
     """What :func:`~ertools.benchmarks.fbm3w.pipeline.load` read: the bags, their end-effector
     poses, span and topics, the run mode and, for ``states``, the benchmark state streams."""

@@ -7,7 +7,6 @@ intervals` and docs/uncertainty.md ("How the FBM3@Work draws are computed"). No 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -15,6 +14,7 @@ import numpy.typing as npt
 
 from ertools.arrays import F64, Bool, IntArr
 from ertools.benchmarks.fbm3w.shapes import Shape
+from ertools.frozen_dataclass import frozen_dataclass
 
 # Draws x samples of one batch: bounds the memory of a long run (~8 bytes x a few arrays).
 BATCH_ELEMENTS = 2_000_000
@@ -26,7 +26,7 @@ TABLE = 4097  # targets the draws interpolate (target_table)
 BLOCK = 64  # samples of Eq. (1) computed at a time (_eq1): 64 x 400 draws, 200 kB an array
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class RunSamples:
     """What one scored run's Eq. (1) depends on.
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import field, replace
 from typing import Any
 
 from ertools.benchmarks.base import Rows
@@ -21,6 +21,7 @@ from ertools.benchmarks.fbm3w.formula import PathScore
 from ertools.benchmarks.fbm3w.runs import RunWindow
 from ertools.benchmarks.results import ResultBase
 from ertools.fidelity import Deviation
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.streams import Provenance
 from ertools.timeutil import ns_to_s
 
@@ -28,7 +29,7 @@ from ertools.timeutil import ns_to_s
 RUN_KEYS = ("spec", "distance_error", "execution_time")
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class RunResult:
     """One run: where it was found, and its score or why it has none.
 
@@ -154,7 +155,7 @@ class RunResult:
         return out
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Fbm3wResult(ResultBase):
     """Implements :class:`ertools.benchmarks.base.BenchmarkResult` for FBM3@Work."""
 

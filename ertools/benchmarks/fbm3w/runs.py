@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -40,6 +40,7 @@ from ertools.benchmarks.common.ending import (
 from ertools.benchmarks.fbm3w.settings import Fbm3wConfig
 from ertools.configs._yaml import show
 from ertools.errors import ConfigError, SegmentationError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.model import BenchmarkStates
 from ertools.states import BmBoxState, EndReason, end_reason
 from ertools.streams import StateStream
@@ -52,7 +53,7 @@ EARLY_END = {EndReason.TIMEOUT: "timeout", EndReason.STOP: "stopped"}
 END_SLACK_NS = 1_000_000_000
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RunWindow:
     """One run as found in the logs.
 

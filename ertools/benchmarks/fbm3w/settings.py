@@ -15,13 +15,14 @@ whole benchmark: the runs that name it fail with the shape's error, the other ru
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import field
 from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks.fbm3w.shapes import Shape, builtin_shapes, parse_shape
 from ertools.configs._yaml import load_yaml, show
 from ertools.errors import ConfigError
+from ertools.frozen_dataclass import frozen_dataclass
 
 # The 2015 script's threshold (rockin_scoring/scripts/fbm3w, Lisbon 2015: "reasonable with a
 # smoothing value of 15").
@@ -30,7 +31,7 @@ DEFAULT_D_MIN = 0.00033
 DEFAULT_RUNS: tuple[str, ...] = ("line", "spline", "line", "spline", "line")
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Fbm3wConfig:
     """A validated FBM3@Work config.
 

@@ -27,7 +27,6 @@ from __future__ import annotations
 import ast
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -35,6 +34,7 @@ import numpy as np
 from ertools.arrays import F64
 from ertools.configs._yaml import MAX_NUMBER, show
 from ertools.errors import ConfigError
+from ertools.frozen_dataclass import frozen_dataclass
 
 Curve = Callable[[F64], F64]
 
@@ -49,7 +49,7 @@ _DENSE = 4097
 ORIGIN_TOLERANCE_M = 1e-6
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Shape:
     """A named target path.
 

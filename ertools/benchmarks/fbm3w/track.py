@@ -9,7 +9,6 @@ hysteresis, and places the edges of each move between still phases.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -21,6 +20,7 @@ from ertools.benchmarks.common.phases import (
     MAX_GAP_S,
     Phase,
 )
+from ertools.frozen_dataclass import frozen_dataclass
 
 # A real FBM3 log has 0.3-1.3 mm of jitter from frame to frame at 120 Hz, tracking dropouts of
 # a few hundred ms and robots that follow a 10 cm path at well under 1 cm/s. A 0.2 s window
@@ -54,7 +54,7 @@ _MIN_MOVE_SIGMAS = 6.0
 _JOIN_WITHIN_S = 2.0
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Track:
     """A position track cut into the protocol's still phases and the moves between them.
 

@@ -11,12 +11,11 @@ times (when the script's listener had them), as the replays' World does.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ertools.arrays import F64, I64, Bool
 from ertools.benchmarks.hgmf.config import CHECK_PERIOD_NS, CHECK_WAIT_NS
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.tf import TfTrack, script_poses
 
 IDENTITY = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
@@ -25,7 +24,7 @@ CACHE_NS = 10_000_000_000
 _NEVER = np.iinfo(np.int64).max
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Heights:
     """The object's height in the table's frame at some moments.
 

@@ -7,7 +7,6 @@ NumPy-free: the declaration and the CLI's parser import it.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +20,7 @@ from ertools.benchmarks.common.inputs import (
 )
 from ertools.benchmarks.common.script_inputs import SCRIPT_GROUP, config_input, result_input
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb_states import ScriptFrame
 
 NAME = "hgmf"
@@ -54,7 +54,7 @@ SCRIPT_2019 = "fbm6_grasping_manipulation.py at rockin-robot-challenge/rsbb 2bb8
 RULE_SETS = ("ertools", "2019")
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HgmfOptions:
     """Everything ``ertools score hgmf`` can be told.
 

@@ -12,12 +12,12 @@ the script's ``/object`` broadcasts), as :mod:`ertools.rsbb.clock` and
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import yaml
 
 from ertools.arrays import I64
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.clock import GoalTimes, goal_times
 from ertools.rsbb.log import EndKind, GoalEvent, RsbbRun
 from ertools.rsbb.tf import TfTrack, helper_lookup
@@ -29,7 +29,7 @@ PLACE_START = "Place the "
 PLACE_END = " on the table, with MoCap markers attached."
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Attempt:
     """One goal the script sent (goal ``index`` of the score; a restarted goal's attempts
     share it).
@@ -57,7 +57,7 @@ class Attempt:
     restarted: bool
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HgmfFlow:
     """The script's run through the log.
 

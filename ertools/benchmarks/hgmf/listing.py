@@ -6,20 +6,21 @@ positions and the object; then the totals (l. 180-259).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 from ertools.benchmarks.hgmf.config import HgmfOptions
 from ertools.benchmarks.hgmf.flow import HgmfFlow
 from ertools.benchmarks.hgmf.formula import grasp_text, object_text, position_text, to_sec
 from ertools.benchmarks.hgmf.result import HgmfGoal
+from ertools.frozen_dataclass import frozen_dataclass
 
 GRASPED = "Objects grasped"
 AVERAGE = "Avg distance error"
 EXECUTION_TIME = "execution_time"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Listing:
     """The score mapping and its totals.
 

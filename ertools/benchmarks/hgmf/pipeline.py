@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +22,7 @@ from ertools.benchmarks.hgmf.intervals import hgmf_intervals
 from ertools.benchmarks.hgmf.listing import score_listing
 from ertools.benchmarks.hgmf.result import HgmfGoal, HgmfResult, deviations_of
 from ertools.errors import ConfigError, SegmentationError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.summary import summary
 from ertools.rsbb.log import RsbbRun
 from ertools.rsbb.opened import one_run_bag, open_run
@@ -36,7 +36,7 @@ FRAME = SCRIPT_FRAMES[0]  # /object under /actor_markerset, in /table_origin
 IDENTITY = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HgmfObject:
     """One object of ``HGMF.yaml``: its id (an integer) and description."""
 
@@ -44,7 +44,7 @@ class HgmfObject:
     description: str
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class HgmfLogs:
     """A run bag and what the script read.
 

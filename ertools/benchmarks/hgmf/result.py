@@ -4,7 +4,6 @@ with the run's own scores, the intervals, and what ertools' reading changed."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 from ertools.arrays import F64, I64
@@ -22,12 +21,13 @@ from ertools.benchmarks.hgmf.rules import (
     RULE_RESTARTED_GOALS,
 )
 from ertools.fidelity import Deviation
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.timeutil import ns_to_s
 
 AVERAGE_KEY = "Avg distance error"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HgmfGoal:
     """One goal the script sent, as scored.
 
@@ -113,7 +113,7 @@ class HgmfGoal:
         }
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class HgmfResult(ScoreFormResult):
     """A scored HGMF run (implements ``BenchmarkResult``; its score, comparison, intervals and
     outputs: :class:`ScoreFormResult`).

@@ -36,6 +36,7 @@ from scipy.spatial.transform import Rotation, Slerp
 
 from ertools.atomic import write_text
 from ertools.benchmarks.hgmf.config import SCRIPT_FRAMES
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.simulator.answers import tol, window, write_answers
 from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
 from ertools.simulator.rsbb import write_rsbb_run
@@ -71,7 +72,7 @@ NOISE = MocapNoise(sigma_m=2e-4, sigma_rad=2e-4)
 FRAME = SCRIPT_FRAMES[0]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class GoalPlan:
     """One goal: the object (id) placed at ``start`` (table frame), its ``target``; the robot
     puts it at ``final`` (None: the goal times out, the object pushed by ``push``); ``lift``:
@@ -91,7 +92,7 @@ class GoalPlan:
     then_final: tuple[float, float] | None = None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RunPlan:
     """A run: its team and number, its goals in order, and the object the referee was placing
     when he stopped the run (None: the script ends it)."""

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +21,7 @@ from ertools.benchmarks.common.script_inputs import (
     result_input,
     team_input,
 )
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb_states import ScriptFrame
 
 #: ``--rules``: ertools' reading, or a version of the script (docs/hnf.md, "2017-18").
@@ -67,7 +67,7 @@ def pose_dump(value: str) -> tuple[tuple[str, float], ...] | None:
 DEFAULT_MAX_GAP_S = 0.1
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HnfOptions:
     """How to score an HNF run.
 

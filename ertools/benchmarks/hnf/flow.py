@@ -13,12 +13,12 @@ events; the poses are computed afterwards, vectorised (:mod:`ertools.benchmarks.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import yaml
 
 from ertools.arrays import I64
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.log import EndKind, GoalEvent, GoalOutcome, RsbbRun
 from ertools.rsbb.tf import TfTrack, helper_lookup
 from ertools.yamlin import load
@@ -29,7 +29,7 @@ ATTEMPTS = 5
 ATTEMPT_S = 1.0
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class SegmentFlow:
     """What the script did for waypoint ``index`` (0-based; the score's ``segment_<index+1>``).
 
@@ -62,7 +62,7 @@ class SegmentFlow:
     interrupted: bool
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HnfFlow:
     """The script's run through the log.
 

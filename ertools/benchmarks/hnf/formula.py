@@ -10,15 +10,14 @@ unwrapped; ertools' reading wraps it to [-pi, pi] first. The sums run in the scr
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ertools.arrays import F64, Bool
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import wrap_angle
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class SegmentErrors:
     """Per-segment errors (M,) of the segments with a pose.
 

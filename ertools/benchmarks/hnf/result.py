@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -28,13 +27,14 @@ from ertools.benchmarks.hnf.rules import (
     RULE_STOPPED,
 )
 from ertools.fidelity import Deviation
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.timeutil import ns_to_s
 
 POSITION_KEY = "position_accuracy[m]"
 ORIENTATION_KEY = "orientation_accuracy[rad]"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HnfSegment:
     """One waypoint as scored.
 
@@ -101,7 +101,7 @@ class HnfSegment:
         }
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class HnfResult(ScoreFormResult):
     """A scored HNF run (implements ``BenchmarkResult``; its score, comparison, intervals and
     outputs: :class:`ScoreFormResult`).

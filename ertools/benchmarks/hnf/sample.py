@@ -28,7 +28,6 @@ and ``2019`` (every pose's error / completed goals; sin/cos of the unwrapped dif
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +35,7 @@ import numpy as np
 import yaml
 
 from ertools.arrays import F64
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import compose, invert, quat_from_yaw, wrap_angle
 from ertools.rsbb.py2 import to_sec
 from ertools.simulator.answers import tol, write_answers
@@ -89,7 +89,7 @@ def _min_jerk(tau: F64) -> F64:
     return np.asarray(10 * t**3 - 15 * t**4 + 6 * t**5)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class _Leg:
     t0_ns: int
     t1_ns: int
@@ -128,7 +128,7 @@ def _marker(robot: F64) -> tuple[F64, F64]:
     )
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class _Plan:
     """One run's timeline: goals (request, start, end, outcome), lookups, prompts, end."""
 

@@ -6,7 +6,6 @@ the script versions ``--rules`` reproduces. NumPy-free: the declaration and ``--
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -21,6 +20,7 @@ from ertools.benchmarks.common.script_inputs import (
     script_values,
 )
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb_states import ScriptFrame
 
 NAME = "hopf"
@@ -52,7 +52,7 @@ RULE_SETS = ("ertools", *SCRIPTS)
 CLIP_TRANSLATION_M = 1.0
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HopfOptions(ScriptOptions):
     """Everything ``ertools score hopf`` can be told (:class:`ScriptOptions`, then these).
 

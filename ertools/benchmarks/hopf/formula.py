@@ -17,14 +17,14 @@ divided by the divisor the rules give (the script: the goals begun).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from ertools.arrays import F64
+from ertools.frozen_dataclass import frozen_dataclass
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class PoseTerms:
     """Per goal (n,): the pose errors and the terms of the pose score."""
 
@@ -73,7 +73,7 @@ def running_sum(values: F64) -> float:
     return float(np.cumsum(v)[-1]) if v.size else 0.0
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Totals:
     """The run's totals (None: nothing to divide)."""
 

@@ -12,7 +12,6 @@ from __future__ import annotations
 import copy
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -21,6 +20,7 @@ from ertools.benchmarks.hopf.config import CLIP_TRANSLATION_M, HopfOptions
 from ertools.benchmarks.hopf.formula import PoseTerms, pose_terms, totals
 from ertools.benchmarks.hopf.items import HopfItem, HopfItems
 from ertools.benchmarks.hopf.runs import Iteration
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.answers import is_number, parse_answer
 from ertools.rsbb.clock import GoalTimes, goal_times
 from ertools.rsbb.py2 import to_sec
@@ -30,7 +30,7 @@ N_GOALS = 10  # the script's N (l. 54)
 NOT_EXECUTED = "not executed"  # 2017's text of a manual operation the stop cut short
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Truth:
     """A goal's ground truth: the item (x, y, yaw) in the table frame at ``moment_ns``, or
     None with the reason.
@@ -60,7 +60,7 @@ def script_goal(it: Iteration, stop_ns: int | None) -> GoalTimes | None:
     return goal_times(it.goal, clock, stop_ns)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Answer:
     """A goal's result string read as the BmBox read it (``yaml.load``).
 
@@ -109,7 +109,7 @@ def read_answer(text: str) -> Answer:
     return Answer(text, data, pose, raw if pose_ok else None, item_class, instance, problem, fatal)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class GoalRecord:
     """One iteration as scored.
 
@@ -144,7 +144,7 @@ class GoalRecord:
         return None if self.times is None else self.times.segment_ns
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Scored:
     """The score mapping as the rules make it, the goals, and what the script would have done.
 

@@ -10,17 +10,17 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ertools.configs._yaml import load_yaml
 from ertools.errors import ConfigError
+from ertools.frozen_dataclass import frozen_dataclass
 
 Scalar = str | int | float | bool
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HopfItem:
     """One item.
 
@@ -40,7 +40,7 @@ class HopfItem:
     rot: tuple[float, float, float, float]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HopfItems:
     """An items file."""
 

@@ -5,7 +5,6 @@ goals scored by the rules (:func:`load`, :func:`find_runs`, :func:`score_runs`).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -34,6 +33,7 @@ from ertools.benchmarks.hopf.result import HopfResult
 from ertools.benchmarks.hopf.runs import HopfRuns, Iteration, find_iterations
 from ertools.errors import ConfigError
 from ertools.fidelity import Deviation
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.summary import summary
 from ertools.rsbb.log import RsbbRun
 from ertools.rsbb.opened import open_run
@@ -48,7 +48,7 @@ POSITIONER = FRAME.parent.lstrip("/")
 TABLE = FRAME.reference.lstrip("/")
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HopfLogs:
     """A HOPF run's bag and side files, read.
 

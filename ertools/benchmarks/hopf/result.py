@@ -3,13 +3,13 @@ comparison with the scores the run left, and their YAML/JSON/CSV forms."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import ScoreRow
 from ertools.benchmarks.common.score_form import ScoreFormResult
 from ertools.benchmarks.hopf.goals import GoalRecord
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.timeutil import ns_to_s
 
 TOTAL_KEY = "pose_score"
@@ -20,7 +20,7 @@ def goal_key(index: int) -> str:
     return f"goal_{index}.partial_score.pose_score"
 
 
-@dataclass(frozen=True, eq=False, kw_only=True)
+@frozen_dataclass(eq=False, kw_only=True)
 class HopfResult(ScoreFormResult):
     """A scored HOPF run (implements ``BenchmarkResult``): :class:`ScoreFormResult`'s fields
     (its intervals: the pose scores'), then these.

@@ -10,12 +10,11 @@ between the placement and the removal is the ground truth's moment.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ertools.arrays import I64
 from ertools.benchmarks.hopf.items import REMOVE_TEXT, RETRY_PREFIX, placed_id
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.log import GoalEvent, ManualOperationEvent, RsbbRun
 
 # A lookup's ``now`` precedes the RefBox message the script's clock is read from by a few ms
@@ -24,7 +23,7 @@ from ertools.rsbb.log import GoalEvent, ManualOperationEvent, RsbbRun
 LOOKUP_SLACK_NS = 50_000_000
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Iteration:
     """One iteration of the script's loop (one item shown).
 
@@ -54,7 +53,7 @@ class Iteration:
         return last.t_done_ns
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HopfRuns:
     """The iterations of a run and what did not fit the script's flow."""
 

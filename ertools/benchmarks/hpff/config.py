@@ -7,7 +7,6 @@ NumPy-free: the declaration and the CLI's parser import it.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -21,6 +20,7 @@ from ertools.benchmarks.common.script_inputs import (
     result_input,
     team_input,
 )
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb_states import ScriptFrame
 
 RULE_SETS = ("ertools", "2019")
@@ -44,7 +44,7 @@ MARGIN_S = 15.0
 DEFAULT_MAX_GAP_S = 0.1
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HpffOptions:
     """How to score an HPFF run.
 

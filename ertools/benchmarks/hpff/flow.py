@@ -11,12 +11,11 @@ arithmetic (``0.5 - elapsed.to_sec()`` slept, rounded to nanoseconds by ``rospy.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ertools.arrays import I64
 from ertools.benchmarks.hpff.config import PERIOD_S, SETTLE_S
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.log import EndKind, GoalEvent, GoalOutcome, RsbbRun
 from ertools.rsbb.py2 import to_sec
 from ertools.rsbb.tf import TfTrack, helper_lookup
@@ -25,7 +24,7 @@ PROMPT_START = "Failed to acquire pose of human or robot"
 NS = 1_000_000_000
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class HpffFlow:
     """The samples of a run and the moments around them.
 

@@ -9,17 +9,16 @@ the reliability ``str(round(100 - 100 F / (S + F), 1)) + '%'`` (Python 2) and a 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ertools.arrays import F64, Bool
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.py2 import percent_py2
 
 FAILED = "Benchmark failed: finished prematurely or took too long"
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Following:
     """The statistics of a run's samples.
 

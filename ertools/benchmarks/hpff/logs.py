@@ -3,11 +3,11 @@ mocap, and the side files as the script read them."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ertools.arrays import I64
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.log import RsbbRun
 from ertools.rsbb.results import RsbbResult
 from ertools.rsbb.tf import TfTrack
@@ -15,7 +15,7 @@ from ertools.rsbb.tf import TfTrack
 Transform = tuple[tuple[float, float, float], tuple[float, float, float, float]]
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class HpffLogs:
     """A run bag and what the script read.
 

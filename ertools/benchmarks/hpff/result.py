@@ -3,8 +3,6 @@ comparison with the run's own scores, the intervals, and what ertools' reading c
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ertools.arrays import F64, I64, Bool
@@ -21,13 +19,14 @@ from ertools.benchmarks.hpff.rules import (
     RULE_STOPPED,
 )
 from ertools.fidelity import Deviation
+from ertools.frozen_dataclass import frozen_dataclass
 
 DEVIATION_KEY = "Average deviation from desired distance"
 COVERED_KEY = "Distance covered while following"
 RELIABILITY_KEY = "Benchmark reliability"
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class HpffSamples:
     """The run's samples as scored.
 
@@ -48,7 +47,7 @@ class HpffSamples:
     person_xy: F64
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class HpffResult(ScoreFormResult):
     """A scored HPFF run (implements ``BenchmarkResult``; its score, comparison, intervals and
     outputs: :class:`ScoreFormResult`).

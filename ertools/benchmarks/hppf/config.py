@@ -6,7 +6,6 @@ the script version ``--rules 2019`` reproduces. NumPy-free: the declaration impo
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -21,6 +20,7 @@ from ertools.benchmarks.common.script_inputs import (
     script_values,
 )
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb_states import ScriptFrame
 
 NAME = "hppf"
@@ -42,7 +42,7 @@ SCRIPT_TEXT = {
 RULE_SETS = ("ertools", *SCRIPTS)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HppfOptions(ScriptOptions):
     """Everything ``ertools score hppf`` can be told (:class:`ScriptOptions`, then these).
 

@@ -12,7 +12,6 @@ from __future__ import annotations
 import copy
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -25,13 +24,14 @@ from ertools.benchmarks.hppf.formula import (
     recognized_percent,
 )
 from ertools.benchmarks.hppf.runs import Iteration
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.answers import is_number, parse_answer
 from ertools.rsbb.py2 import to_sec
 
 XY = tuple[float, float]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Truth:
     """The cap's (x, y) in the testbed frame at the lookup after a goal, or None with the
     reason (``gap_ns``: the widest spacing of the samples used around the moment)."""
@@ -42,7 +42,7 @@ class Truth:
     reason: str | None = None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Answer:
     """A goal's result string read as the BmBox read it (``yaml.load``).
 
@@ -94,7 +94,7 @@ def read_answer(text: str) -> Answer:
     )
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class PassRecord:
     """One pass of the loop as scored.
 
@@ -122,7 +122,7 @@ class PassRecord:
     recognized: bool | None = None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Scored:
     """The score mapping as the rules make it, the passes, and what the script would have done.
 

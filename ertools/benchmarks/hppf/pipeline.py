@@ -5,7 +5,6 @@ events, the goals scored by the rules (:func:`load`, :func:`find_runs`, :func:`s
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +19,7 @@ from ertools.benchmarks.hppf.result import HppfResult
 from ertools.benchmarks.hppf.runs import FlowError, HppfRuns, entered, walk
 from ertools.errors import ConfigError
 from ertools.fidelity import Deviation
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.summary import summary
 from ertools.rsbb.log import RsbbRun
 from ertools.rsbb.opened import open_run
@@ -36,7 +36,7 @@ IDENTITY = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 EXTRA_GOAL_KEYS = ("status", "answer_problem", "unscoreable_reason")
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HppfLogs:
     """An HPPF run's bag and side files, read.
 

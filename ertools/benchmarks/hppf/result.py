@@ -3,13 +3,13 @@ the script's loop, the comparison with the scores the run left, and their output
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import ClassVar
 
 from ertools.benchmarks.base import Rows
 from ertools.benchmarks.common.interval_output import ScoreRow
 from ertools.benchmarks.common.score_form import ScoreFormResult
 from ertools.benchmarks.hppf.goals import PassRecord
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.timeutil import ns_to_s
 
 DISTANCE_KEY = "Distance error"
@@ -20,7 +20,7 @@ def goal_key(index: int) -> str:
     return f"goal_{index}.position_error"
 
 
-@dataclass(frozen=True, eq=False, kw_only=True)
+@frozen_dataclass(eq=False, kw_only=True)
 class HppfResult(ScoreFormResult):
     """A scored HPPF run (implements ``BenchmarkResult``): :class:`ScoreFormResult`'s fields
     (its intervals: the position errors' and the Distance error's), then these.

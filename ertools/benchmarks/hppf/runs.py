@@ -12,9 +12,9 @@ restarted by the script: the same goal number, a new draw.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 from ertools.arrays import I64
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.clock import GoalTimes, goal_times
 from ertools.rsbb.log import GoalEvent, ManualOperationEvent, RsbbRun
 from ertools.rsbb.tf import TfTrack, helper_lookup
@@ -41,7 +41,7 @@ def retry_text(person: str) -> str:
     )
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Iteration:
     """One pass of the script's loop.
 
@@ -70,7 +70,7 @@ class Iteration:
     cut: str | None = None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class HppfRuns:
     """The passes of a run, the people of the config, and what did not fit the flow."""
 

@@ -33,7 +33,6 @@ goal's time taken out).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -41,6 +40,7 @@ import numpy as np
 import yaml
 
 from ertools.atomic import write_text
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.simulator.answers import tol, write_answers
 from ertools.simulator.mocap import MocapNoise, frame_times, simulate_mocap
 from ertools.simulator.rsbb import TF_STAMP_LAG_NS, write_rsbb_run
@@ -107,7 +107,7 @@ def _text(xy: tuple[float, float]) -> str:
     return f"({xy[0]:.2f}, {xy[1]:.2f})"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class _Events:
     """The run's events and saves, and the answers' noiseless truth."""
 

@@ -4,13 +4,13 @@ the histogram bin and the factor of the suggested d_min (NumPy-free: the parsers
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
 from ertools.benchmarks.base import Input, resolve_values, tf_value
 from ertools.benchmarks.common.inputs import DEFAULT_BIN, DEFAULT_C
 from ertools.benchmarks.common.spec import DEFAULT_TIME_SOURCE, TIME_SOURCES, PoseSpec
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 
 # The 2015 noise recordings are of FBM3@Work's marker set: its topics and tf frame, in the
 # order FBM3@Work prefers them (noise sits below the benchmarks that use it: not imported).
@@ -60,7 +60,7 @@ INPUTS = (
 )
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class NoiseOptions:
     """What ``ertools noise`` (or ``ertools score noise``) measures: the pose source, whether
     only the still phases count, the histogram bin (m) and the c of ``d_min = c * epsilon``."""

@@ -5,12 +5,12 @@ turns the inputs' values into them. NumPy-free: the command's parser imports it.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ertools.benchmarks.base import Input, resolve_values
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb_states import BENCHMARKS
 
 #: The RSBB benchmarks scored by the referee's items alone.
@@ -32,7 +32,7 @@ def title(code: str) -> str:
     return f"{code} ({BENCHMARKS[code].name})"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RefereeOptions:
     """Everything ``ertools score hgtkmh|hwv|hcfgac|stb`` can be told.
 

@@ -15,11 +15,11 @@ from __future__ import annotations
 
 import enum
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from ertools.errors import ConfigError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.rsbb.results import load_rsbb_yaml
 
 
@@ -45,7 +45,7 @@ def group_role(group: str) -> Role:
     return Role.OTHER
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class ItemSpec:
     """One item as the description file declares it."""
 
@@ -54,7 +54,7 @@ class ItemSpec:
     desc: str
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Item:
     """One item with the value the referee gave it."""
 
@@ -68,7 +68,7 @@ class Item:
         return group_role(self.group)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Description:
     """One benchmark of ``benchmarks_description.yaml``.
 
@@ -195,7 +195,7 @@ def match_description(
     return tuple(out), tuple(notes)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Tally:
     """The items added up by role (ertools' reading of the ERL rule).
 

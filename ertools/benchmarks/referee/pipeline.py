@@ -11,7 +11,6 @@ messages (the time the stop button was enabled).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 from ertools.benchmarks.base import notice
@@ -26,6 +25,7 @@ from ertools.benchmarks.referee.items import (
 from ertools.benchmarks.referee.result import RefereeResult
 from ertools.benchmarks.referee.zone import ZoneSeries, read_zone
 from ertools.errors import ConfigError, TopicError, UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.reader import topics
 from ertools.rsbb.layout import FileKind, classify
 from ertools.rsbb.log import EndKind, read_rsbb_run
@@ -44,7 +44,7 @@ _END_TEXT = {
 }
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RefereeLogs:
     """What a run's files say.
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 from ertools.benchmarks.base import Rows
@@ -11,13 +11,14 @@ from ertools.benchmarks.referee.formula import erl_rank
 from ertools.benchmarks.referee.items import Item, Tally
 from ertools.benchmarks.results import ResultBase
 from ertools.fidelity import Deviation
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.streams import Provenance
 
 #: A run whose executing time is not in its log ranks as if it had taken this long.
 UNKNOWN_TIME_S = TIME_SCALE / PENALTY_SCALE - 1.0
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class RefereeResult(ResultBase):
     """One referee-scored run (implements ``BenchmarkResult``).
 

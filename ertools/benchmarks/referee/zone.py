@@ -12,7 +12,6 @@ after a stop: the RefBox resumes its timer); the moments are the messages', to 0
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +19,7 @@ import numpy as np
 from ertools.arrays import I64
 from ertools.benchmarks.referee.items import Item
 from ertools.errors import TopicError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.messages import read_messages
 from ertools.io.reader import topics
 from ertools.rsbb_states import CORE_TO_GUI_TOPIC, STATE_PERIOD_NS
@@ -27,7 +27,7 @@ from ertools.rsbb_states import CORE_TO_GUI_TOPIC, STATE_PERIOD_NS
 PathsLike = str | Path | Sequence[str | Path]
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class ZoneSeries:
     """The run's zone in each ``/core/to_gui`` message that shows it.
 

@@ -7,8 +7,6 @@ Also :func:`yaw_tf`, the yaw as the 2015 script computed it (tf.transformations'
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import numpy.typing as npt
 
@@ -16,6 +14,7 @@ from ertools.arrays import F64, I64, U8
 from ertools.benchmarks.common.hygiene import same_rows
 from ertools.benchmarks.trajectory.inputs import BeforeGt, Gaps, GtOrder, Ties
 from ertools.errors import ScoringError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import (
     Association,
     interpolate_poses,
@@ -30,7 +29,7 @@ COMPARED, GAP, TRACKING_LOST, UNCOVERED, UNPAIRED = 0, 1, 2, 3, 4
 STATUS_NAMES = ("compared", "gap", "tracking_lost", "uncovered", "unpaired")
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Matched:
     """Robot poses and their GT counterparts.
 

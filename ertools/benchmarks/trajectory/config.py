@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
@@ -30,13 +30,14 @@ from ertools.benchmarks.trajectory.inputs import (
     Unscoreable,
 )
 from ertools.errors import ConfigError, UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.timeutil import MAX_SECONDS, NS_PER_S, s_to_ns
 
 if TYPE_CHECKING:  # a Literal: this module stays NumPy-free (the parser imports it)
     from ertools.geometry import Association
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class TrajectoryConfig:
     """How to compare.
 
@@ -147,7 +148,7 @@ SETTINGS_2015: Mapping[str, str] = MappingProxyType(
 )
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class TrajectoryOptions:
     """Everything ``ertools score trajectory`` can be told: how to compare (``config``) and
     where the poses are.

@@ -4,17 +4,16 @@ orientation error (wrapped, and as the 2015 script computed it).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ertools.arrays import percentiles_and_median
 from ertools.benchmarks.trajectory.association import COMPARED, Matched
+from ertools.frozen_dataclass import frozen_dataclass
 
 PERCENTILES = (50.0, 90.0, 95.0, 99.0)
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Metrics:
     """Errors over the compared poses.
 

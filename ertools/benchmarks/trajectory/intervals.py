@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
 from functools import partial
 from typing import Any
 
@@ -75,6 +74,7 @@ from ertools.benchmarks.trajectory.steady import clear_of_losses
 from ertools.benchmarks.trajectory.steady import effects as steady_effects
 from ertools.benchmarks.trajectory.terms import PoseTerms
 from ertools.errors import ErtoolsError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import unwrap_angles, wrap_angle, yaw_from_quat
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
@@ -127,7 +127,7 @@ FITTED_KEYS = ("position_error", "orientation_error", "rmse", "median", "max")
 FITTED_SUFFIX = "_at_fitted_offset"
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Rescoring:
     """How the score associated the robot poses, for the offset's draws to re-score with.
 
@@ -149,7 +149,7 @@ class Rescoring:
     max_gap_ns: int | None = None
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class MocapSigma:
     """The GT's noise: per-axis position sigma (m), yaw sigma (rad), and how it was found."""
 

@@ -12,7 +12,6 @@ association, so evo's nearest-time association pairs them one to one and its APE
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -25,6 +24,7 @@ from ertools.benchmarks.trajectory.config import TrajectoryOptions
 from ertools.benchmarks.trajectory.declare import BENCHMARK
 from ertools.benchmarks.trajectory.logs import read_gt
 from ertools.errors import ClockError, ScoringError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import interpolate_poses
 from ertools.io.text import is_text_trajectory, read_text_poses
 from ertools.streams import PoseStream
@@ -38,7 +38,7 @@ if TYPE_CHECKING:
 RAW_GT_MARGIN_NS = 1_000_000_000
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class PairExport:
     """The robot and GT streams of a trajectory comparison, ready to write.
 

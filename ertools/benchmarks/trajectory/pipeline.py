@@ -20,7 +20,7 @@ The settings are in ``config``, the 2015 rules in ``rules``. The clock audit
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from itertools import pairwise
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -42,6 +42,7 @@ from ertools.benchmarks.trajectory.logs import (
 from ertools.benchmarks.trajectory.result import TrajectoryResult
 from ertools.benchmarks.trajectory.rules import RULE_GT_OVERLAP
 from ertools.errors import ClockError, ScoringError, UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.summary import summary
 from ertools.io.text import is_text_trajectory, read_text_poses
 from ertools.streams import PoseStream
@@ -51,7 +52,7 @@ if TYPE_CHECKING:
     from ertools.io.model import BagSummary
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class TrajectoryLogs:
     """What :func:`load` read: the robot stream and the GT stream read from the GT files
     chosen (by time overlap), with their topics, warnings and damaged GT files."""

@@ -5,7 +5,7 @@ JSON/YAML/text and the CSV tables.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import field
 from typing import Any
 
 import numpy as np
@@ -34,6 +34,7 @@ from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.benchmarks.trajectory.formula import Metrics
 from ertools.benchmarks.trajectory.intervals import FITTED_KEYS, FITTED_SUFFIX, KEYS
 from ertools.fidelity import Deviation
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.streams import PoseStream, Provenance
 from ertools.timeutil import NS_PER_S, ns_to_s
 
@@ -42,7 +43,7 @@ from ertools.timeutil import NS_PER_S, ns_to_s
 INTERVAL_COLUMNS = tuple(k for k in KEYS if not k.startswith("percentiles."))
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class FittedScore:
     """The statistics at the clock offset the audit fits, where the score used another one
     the data disagrees with: what ``--offset auto --apply-offset`` would score, beside the
@@ -73,7 +74,7 @@ class FittedScore:
         return {k: every[k] for k in FITTED_KEYS}
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class TrajectoryResult(ResultBase):
     """A scored robot log (implements ``BenchmarkResult``).
 

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
@@ -25,9 +24,10 @@ from ertools.benchmarks.common.closed_forms import (
     mix_angles,
 )
 from ertools.benchmarks.common.draws import BAND_SIGMAS
+from ertools.frozen_dataclass import frozen_dataclass
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class PoseTerms:
     """What the perturbed statistics of the compared poses depend on, per pose (float64).
 

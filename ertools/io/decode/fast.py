@@ -15,13 +15,13 @@ give up, and the caller falls back to rosbags' deserializer.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, I32, I64, U8
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import quat_from_yaw
 from ertools.io.decode.posebatch import STAMPED_TYPES, PoseBatch
 
@@ -148,7 +148,7 @@ def decode_strings(buf: U8, start: I64, length: I64) -> tuple[I32, tuple[str, ..
     return codes, tuple(names)
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Decoded:
     """Columns decoded from one buffer (rows in message order, TF transforms expanded)."""
 

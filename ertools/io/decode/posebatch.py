@@ -8,13 +8,13 @@ A TF message with several transforms gives one row per transform, in message ord
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import F64, I32, I64
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import quat_from_yaw
 from ertools.io.model import short_msgtype
 
@@ -28,7 +28,7 @@ STAMPED_TYPES = (
 )
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class PoseBatch:
     """Poses of one topic in reading order.
 

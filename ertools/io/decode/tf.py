@@ -17,12 +17,12 @@ is static the most frequent moving link of the chain gives the time base instead
 from __future__ import annotations
 
 from collections import deque
-from dataclasses import dataclass
 
 import numpy as np
 
 from ertools.arrays import F64, I32, I64, Bool
 from ertools.errors import TopicError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import compose, interpolate_poses, invert
 from ertools.io.decode.posebatch import PoseBatch
 from ertools.streams import PoseStream
@@ -116,7 +116,7 @@ def _compacted(batch: PoseBatch, keep: Bool | None) -> tuple[I64, F64, F64]:
     return batch.t_header[:n], batch.xyz[:n], batch.quat_xyzw[:n]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Edge:
     """One parent -> child link as published, with whether it is static."""
 
@@ -124,7 +124,7 @@ class Edge:
     static: bool
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class _Step:
     edge: Edge
     inverted: bool

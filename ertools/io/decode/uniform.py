@@ -16,12 +16,12 @@ by field, which handles every layout the standard definitions allow.
 from __future__ import annotations
 
 import sys
-from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
 from ertools.arrays import I64, U8, Bool
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io.decode.fast import Decoded, gather
 
 # Odometry after its pose: pose covariance (36), twist (6), twist covariance (36) float64.
@@ -30,7 +30,7 @@ _ODOM_TAIL = 36 + 6 + 36
 _COVARIANCE = 36
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Layout:
     """Where the fields of every message of a topic are, relative to the message start.
 
@@ -49,7 +49,7 @@ class Layout:
     ref: bytes  # the message the layout was learnt from: the bytes ``fixed`` must repeat
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class Rows:
     """Preallocated result rows a decoder writes into (header stamps, positions, orientations)."""
 

@@ -13,7 +13,6 @@ import logging
 import os
 import struct
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, BinaryIO
 
@@ -22,6 +21,7 @@ import numpy.typing as npt
 
 from ertools.arrays import I64, U8, fresh_concat, fresh_repeat
 from ertools.errors import BagError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.inputs import open_regular
 from ertools.io import pipeline
 from ertools.io.bagfile import BagFile
@@ -93,7 +93,7 @@ def _in_order(*keys: I64) -> bool:
     return True
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class McapPlan:
     """Messages located from the message indexes, in the reference order."""
 

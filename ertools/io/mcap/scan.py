@@ -26,6 +26,7 @@ import numpy as np
 from ertools.arrays import I64, U8
 from ertools.caches import register
 from ertools.errors import BagError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.inputs import open_regular
 from ertools.io import budget, mapguard
 from ertools.io.decode.fast import read_at
@@ -63,7 +64,7 @@ class _CutError(Exception):
 PayloadRun = tuple[U8, I64, I64, I64]
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class McapRecords:
     """What a record-by-record read of an MCAP file found.
 
@@ -433,7 +434,7 @@ def _scan(buf: U8, path: Path, keep: frozenset[int], check_crc: bool) -> McapRec
     )
 
 
-@dataclass(frozen=True, eq=False)
+@frozen_dataclass(eq=False)
 class McapLayout:
     """Which path reads an MCAP file exactly.
 

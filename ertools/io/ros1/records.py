@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import re
 import struct
-from dataclasses import dataclass
 from typing import BinaryIO
 
 from ertools.errors import BagError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.io import budget
 
 OP_MSG = 0x02
@@ -80,7 +80,7 @@ def op_of(fields: dict[str, bytes]) -> int:
     return op[0]
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Record:
     """A record read from a file: its position, header fields and where its data lies."""
 

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -22,6 +21,7 @@ from ertools.auditing.model import Audit
 from ertools.benchmarks import registry
 from ertools.benchmarks.base import Reported
 from ertools.errors import UsageError
+from ertools.frozen_dataclass import frozen_dataclass
 from ertools.report.foxglove.mcapout import refuse_inputs, write_mcap
 from ertools.serialize import jsonable
 from ertools.views.foxglove import Collected
@@ -31,7 +31,7 @@ from ertools.views.foxglove import Collected
 STREAM_LIMIT = 50_000
 
 
-@dataclass(frozen=True)
+@frozen_dataclass
 class Written:
     """What was written: the file, and message counts by topic."""
 
