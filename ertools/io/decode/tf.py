@@ -126,6 +126,8 @@ class Edge:
 
 @frozen_dataclass
 class _Step:
+    """One link of a chain, walked as stored or backwards."""
+
     edge: Edge
     inverted: bool
 
