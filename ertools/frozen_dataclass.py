@@ -16,6 +16,7 @@ import inspect
 import sys
 from _thread import get_ident
 from collections.abc import Callable
+from types import CellType, CodeType, FunctionType
 from typing import Any, TypeVar, cast, dataclass_transform, overload
 
 _C = TypeVar("_C", bound=type)
@@ -108,60 +109,107 @@ def _refuse_init_vars(cls: type, fields: tuple[dataclasses.Field[Any], ...]) -> 
             raise TypeError(f"{cls.__qualname__}.{name}: frozen_dataclass has no InitVar")
 
 
+# A body line of ``__init__``: the field's value is its parameter ("arg"), its factory's
+# product unless the parameter is given ("either"), or its factory's product ("make").
+_Line = tuple[str, int]
+# The shape of an ``__init__``: its body lines (each with its parameter's index, or -1), the
+# number of positional and keyword-only parameters, whether ``__post_init__`` is called.
+_Shape = tuple[tuple[_Line, ...], int, int, bool]
+_TEMPLATES: dict[_Shape, CodeType] = {}
+
+
 def _init(cls: type, fields: tuple[dataclasses.Field[Any], ...]) -> Callable[..., None]:
-    """Compile ``__init__`` from the source ``dataclass(frozen=True)`` writes for it."""
+    """``__init__`` as ``dataclass(frozen=True)`` writes it: the same parameters, defaults,
+    annotations and body, from a template compiled once per shape (classes of the same shape
+    differ only in names, which the template's code object takes over)."""
     self_name = "__dataclass_self__" if "self" in {f.name for f in fields} else "self"
-    scope: dict[str, Any] = {
-        "__dataclass_builtins_object__": object,
-        "_HAS_DEFAULT_FACTORY": _HAS_FACTORY,
-    }
-    positional: list[str] = []
-    keyword: list[str] = []
-    body: list[str] = []
+    params = [f for f in fields if f.init and not f.kw_only]
+    keyword = [f for f in fields if f.init and f.kw_only]
+    signature = params + keyword
     seen_default = False
+    for f in params:
+        if _has_default(f):
+            seen_default = True
+        elif seen_default:
+            raise TypeError(f"non-default argument {f.name!r} follows default argument")
+    index = {f.name: i for i, f in enumerate(signature)}
+    lines: list[_Line] = []
+    values: dict[str, Any] = {"__dataclass_builtins_object__": object}
+    attributes: list[str] = []
     for f in fields:
-        scope[f"_type_{f.name}"] = f.type
-        has_default = f.default is not dataclasses.MISSING
-        has_factory = f.default_factory is not dataclasses.MISSING
-        if f.init:
-            if has_default or has_factory:
-                seen_default = seen_default or not f.kw_only
-            elif seen_default and not f.kw_only:
-                raise TypeError(f"non-default argument {f.name!r} follows default argument")
-            default = ""
-            if has_factory:
-                default = "=_HAS_DEFAULT_FACTORY"
-            elif has_default:
-                scope[f"_dflt_{f.name}"] = f.default
-                default = f"=_dflt_{f.name}"
-            (keyword if f.kw_only else positional).append(f"{f.name}:_type_{f.name}{default}")
-        if has_factory:
-            scope[f"_dflt_{f.name}"] = f.default_factory
-            value = f"_dflt_{f.name}()"
-            if f.init:
-                value = f"{value} if {f.name} is _HAS_DEFAULT_FACTORY else {f.name}"
-        elif f.init:
-            value = f.name
-        else:
+        factory = f.default_factory is not dataclasses.MISSING
+        if not (f.init or factory):
             continue  # the class attribute holds the default, as with ``dataclass``
-        body.append(f"__dataclass_builtins_object__.__setattr__({self_name},{f.name!r},{value})")
-    if hasattr(cls, "__post_init__"):
-        body.append(f"{self_name}.__post_init__()")
-    params = [self_name, *positional, *(["*", *keyword] if keyword else [])]
-    inner = "\n".join(f"  {line}" for line in body or ["pass"])
-    source = (
-        f"def __create_fn__({', '.join(scope)}):\n"
-        f" def __init__({', '.join(params)}) -> None:\n{inner}\n"
-        " return __init__"
+        kind = "arg" if not factory else "either" if f.init else "make"
+        lines.append((kind, index[f.name] if f.init else -1))
+        if factory:
+            values[f"_f{len(attributes)}"] = f.default_factory
+            values["_HAS_DEFAULT_FACTORY"] = _HAS_FACTORY
+        attributes.append(f.name)
+    shape: _Shape = (tuple(lines), len(params), len(keyword), hasattr(cls, "__post_init__"))
+    template = _TEMPLATES.get(shape)
+    if template is None:
+        template = _TEMPLATES[shape] = _template(shape)
+    names = {f"@{j}": name for j, name in enumerate(attributes)}
+    code = template.replace(
+        co_varnames=(
+            self_name,
+            *(f.name for f in signature),
+            *template.co_varnames[1 + len(signature) :],
+        ),
+        co_consts=tuple(names.get(c, c) if isinstance(c, str) else c for c in template.co_consts),
+        co_qualname=f"{cls.__qualname__}.__init__",
     )
     module = sys.modules.get(cls.__module__)
-    namespace: dict[str, Any] = {}
-    # dont_inherit: this module's ``from __future__ import annotations`` would turn the
-    # parameters' annotations into the strings "_type_<name>".
-    code = compile(source, "<string>", "exec", dont_inherit=True)
-    exec(code, module.__dict__ if module else {}, namespace)
-    init: Callable[..., None] = namespace["__create_fn__"](**scope)
+    init = FunctionType(
+        code,
+        module.__dict__ if module else {},
+        "__init__",
+        tuple(_default(f) for f in params if _has_default(f)) or None,
+        tuple(CellType(values[name]) for name in code.co_freevars),
+    )
+    init.__kwdefaults__ = {f.name: _default(f) for f in keyword if _has_default(f)} or None
+    init.__annotations__ = {f.name: f.type for f in signature} | {"return": None}
     return init
+
+
+def _has_default(f: dataclasses.Field[Any]) -> bool:
+    return f.default is not dataclasses.MISSING or f.default_factory is not dataclasses.MISSING
+
+
+def _default(f: dataclasses.Field[Any]) -> Any:
+    return _HAS_FACTORY if f.default_factory is not dataclasses.MISSING else f.default
+
+
+def _template(shape: _Shape) -> CodeType:
+    """The code of an ``__init__`` of ``shape``: parameters ``_p<i>``, attribute names
+    ``"@<j>"`` (no identifier is spelt so), factories ``_f<j>``, in the closure the standard
+    library's source gives it."""
+    lines, positional, keyword, post_init = shape
+    params = ["self", *(f"_p{i}" for i in range(positional))]
+    if keyword:
+        params += ["*", *(f"_p{positional + i}" for i in range(keyword))]
+    body = []
+    for j, (kind, i) in enumerate(lines):
+        value = {
+            "arg": f"_p{i}",
+            "either": f"_f{j}() if _p{i} is _HAS_DEFAULT_FACTORY else _p{i}",
+            "make": f"_f{j}()",
+        }[kind]
+        body.append(f"__dataclass_builtins_object__.__setattr__(self,'@{j}',{value})")
+    if post_init:
+        body.append("self.__post_init__()")
+    factories = [f"_f{j}" for j, (kind, _) in enumerate(lines) if kind != "arg"]
+    outer = ["__dataclass_builtins_object__", "_HAS_DEFAULT_FACTORY", *factories]
+    inner = "\n".join(f"  {line}" for line in body or ["pass"])
+    source = (
+        f"def __create_fn__({', '.join(outer)}):\n"
+        f" def __init__({', '.join(params)}):\n{inner}\n"
+        " return __init__"
+    )
+    module = compile(source, "<string>", "exec", dont_inherit=True)
+    create = next(c for c in module.co_consts if isinstance(c, CodeType))
+    return next(c for c in create.co_consts if isinstance(c, CodeType))
 
 
 def _repr(names: tuple[str, ...]) -> Callable[[Any], str]:
