@@ -43,8 +43,11 @@ from ertools.benchmarks.trajectory.fitted import at_fitted_offset, audit_warning
 from ertools.benchmarks.trajectory.formula import Metrics, metrics
 from ertools.benchmarks.trajectory.intervals import (
     FITTED_SUFFIX,
+    Finish,
+    MocapSigma,
     Rescoring,
     jitter,
+    prepare_intervals,
     trajectory_intervals,
 )
 from ertools.benchmarks.trajectory.result import FittedScore, TrajectoryResult
@@ -80,6 +83,38 @@ def check_increasing(robot: PoseStream, where: str) -> None:
             f"{iso_utc(int(robot.t_ns[i - 1]))} ({bad.size} such place(s)); "
             "fix the robot's clock or use --robot-time-source record"
         )
+
+
+def _prepared(
+    robot: PoseStream,
+    gt: PoseStream,
+    first: Matched | None,
+    config: TrajectoryConfig,
+    intervals: IntervalSettings,
+    sigma: MocapSigma | None,
+) -> tuple[Metrics | None, Finish | None] | None:
+    """The statistics of the association ``first`` and the intervals' part the clock audit
+    does not decide (:func:`prepare_intervals`), while the audit runs: None where the score
+    will use another association or robot stream (evo's pairs may repeat robot poses), or
+    where an error came up, which the comparison then meets where it always did."""
+    if first is None or first.robot_rows is not None:
+        return None
+    try:
+        m = metrics(first)
+        if m is None or sigma is None:
+            return m, None
+        finish = prepare_intervals(
+            robot,
+            gt,
+            first,
+            estimates(m),
+            association=config.association,
+            settings=intervals,
+            sigma=sigma,
+        )
+    except Exception:
+        return None
+    return m, finish
 
 
 def _decimate(stream: PoseStream, limit: int = 5000) -> PoseStream:
@@ -245,9 +280,10 @@ def score_streams(
 
     with alongside(audited, parallel=not applied) as audit_of:
         first = None if applied else match(robot, config.offset_ns)
-        # the GT's noise, for the intervals: measured meanwhile too (wasted only when the
-        # comparison has no statistics)
+        # the GT's noise and what else the intervals need that the audit does not decide:
+        # computed meanwhile too (wasted only when the comparison has no statistics)
         sigma = jitter(timed) if intervals.enabled and first is not None else None
+        prepared = _prepared(robot, timed, first, config, intervals, sigma)
         audit, pending = audit_of()
     pairs = None if first is None else _audit_pairs(first, config)
     if pending and pairs is not None:
@@ -307,7 +343,7 @@ def score_streams(
                 + (" (--t-max-diff: as evo, no error)" if evo and not config.allow_partial else "")
             )
 
-    m = metrics(matched)
+    m = prepared[0] if prepared is not None and matched is first else metrics(matched)
     validity = from_codes(
         validity_codes(matched, int(timed.t_ns[0])),
         matched.t_ns,
@@ -369,18 +405,21 @@ def score_streams(
     if m is not None:
         if sigma is None and intervals.enabled:
             sigma = jitter(timed)
-        iv = trajectory_intervals(
-            robot,
-            timed,
-            matched,
-            audit,
-            estimates(m),
-            association=config.association,
-            offset_ns=offset_ns,
-            settings=intervals,
-            rescoring=rescoring(offset_ns),
-            sigma=sigma,
-        )
+        if prepared is not None and prepared[1] is not None and matched is first:
+            iv = prepared[1](audit, offset_ns, rescoring(offset_ns))
+        else:
+            iv = trajectory_intervals(
+                robot,
+                timed,
+                matched,
+                audit,
+                estimates(m),
+                association=config.association,
+                offset_ns=offset_ns,
+                settings=intervals,
+                rescoring=rescoring(offset_ns),
+                sigma=sigma,
+            )
         disagree = audit.offset_ns is not None and audit.disagrees_with(offset_ns)
         if sigma is not None and audit.offset_ns is not None and disagree:
             fitted = at_fitted_offset(

@@ -331,9 +331,32 @@ def trajectory_intervals(
     ``rescoring``: the score's association, which the offset's draws re-score with;
     ``sigma``: the GT's noise when already measured (:func:`jitter`).
     """
+    finish = prepare_intervals(
+        robot, gt, matched, estimates, association=association, settings=settings, sigma=sigma
+    )
+    return finish(audit, offset_ns, rescoring)
+
+
+# (the clock audit, the offset applied, the score's association) -> the intervals
+Finish = Callable[[OffsetEstimate, int, Rescoring], ResultIntervals]
+
+
+def prepare_intervals(
+    robot: PoseStream,
+    gt: PoseStream,
+    matched: Matched,
+    estimates: Mapping[str, float],
+    *,
+    association: str,
+    settings: IntervalSettings,
+    sigma: MocapSigma | None = None,
+) -> Finish:
+    """:func:`trajectory_intervals` in two steps: now, what the clock audit does not decide
+    (the GT's motion at each pose, the noise's closed forms and bands), which a caller may
+    compute while the audit runs on another core; the function returned does the rest."""
     ok = matched.status == COMPARED
     if not settings.enabled or not ok.any() or len(gt) < 2:
-        return NO_INTERVALS
+        return lambda *_: NO_INTERVALS
     few = too_few(
         int(ok.sum()),
         "compared pose(s)",
@@ -343,7 +366,8 @@ def trajectory_intervals(
     )
     if few is not None:
         # a null interval with the reason, not one of the mocap noise alone
-        return withheld(KEYS, few, settings, METHOD_TRAJECTORY)
+        nulls = withheld(KEYS, few, settings, METHOD_TRAJECTORY)
+        return lambda *_: nulls
     every = bool(ok.all())
 
     def compared(a: npt.NDArray[Any]) -> npt.NDArray[Any]:
@@ -388,7 +412,6 @@ def trajectory_intervals(
     else:
         weight = np.ones(len(q))
         lag = (-1.0, 0.0) if association == "hold" else (-0.5, 0.5)
-    off_sigma, _ = offset_spread(r_xyz, g_xyz, vel, audit, offset_ns)
     if matched.yaw_diff is not None:
         theta = compared(matched.yaw_diff)  # the association's: the same yaws, subtracted
     else:
@@ -414,110 +437,123 @@ def trajectory_intervals(
         # steps over 1: the rounded picks are distinct and increasing
         thinned = np.linspace(0, n_all - 1, MAX_POSES).round().astype(np.intp)
     est = np.array([estimates[key] for key in KEYS])
-    # The offset's effect, centred on the offset applied: the comparison re-scored by the
-    # score's own association and metrics at shifts of it (every robot pose inside the GT,
-    # compared or not), on a grid the draws interpolate
-    grid = np.linspace(-OFFSET_SPAN, OFFSET_SPAN, OFFSET_GRID) * off_sigma
-    on_grid = np.zeros((OFFSET_GRID, est.size))
-    gap_ns = rescoring.max_gap_ns
-    if off_sigma > 0.0:
-        # where no pose crosses a loss within reach: the GT's motion on every pose
-        modelled = None
-        reach_ns = round(grid[-1] * NS_PER_S) + 1
-        linear = association == "linear" and gap_ns is not None
-        if linear and clear_of_losses(
-            q, matched.status, matched.t_ns, t, gt.xyz, k, reach_ns, gap_ns or 0
-        ):
-            modelled = steady_effects(terms, thinned, grid, ORDER_STATS, est.size, MEAN_LIKE)
-        on_grid = offset_effects(rescoring, t, grid) if modelled is None else modelled
     mean_cols = list(MEAN_LIKE)
-
     closed: dict[tuple[bool, bool], list[Callable[[F64], F64]]] = {}
     bands: dict[tuple[bool, bool], tuple[list[OrderStat], F64]] = {}
-    own: dict[str, F64] = {}  # each source's own part of the draws, where they add
 
-    def perturbed(rng: np.random.Generator, sources: frozenset[str], draws: int) -> F64:
-        """Draws whose basic (reflected) interval is the interval wanted (module doc):
-        measurement-like perturbations as re-computed scores, the offset's mirrored."""
-        noise = MOCAP_NOISE in sources
-        timing = TIME_ASSOCIATION in sources
-        frame = timing and lag is not None
-        measured = np.zeros((draws, est.size))
-        z = rng.standard_normal((draws, len(mean_cols)))
-        if noise or frame:
-            key = (noise, frame)  # the same closed forms and bands in two passes
-            if key not in closed:
-                full = (float(est[1]), float(est[-1]))
-                closed[key] = terms.thinned_mean_like(noise, frame, full, MAX_CLOSED)
-                bands[key] = order_stats(d, thinned, terms.bounds(noise, frame), ORDER_STATS)
-            for j, (col, value) in enumerate(zip(mean_cols, closed[key], strict=True)):
-                measured[:, col] = value(z[:, j]) - est[col]
-            stats, base = bands[key]
-            got = draw_order_stats(
-                stats, distances, rng, draws, noise=noise, lag=lag if frame else None
-            )
-            got -= base
-            for k, st in enumerate(stats):
-                for col in st.columns:
-                    measured[:, col] = got[:, k]
-        offset = np.zeros((draws, est.size))
-        if timing and off_sigma > 0.0:
-            shift = rng.standard_normal(draws) * off_sigma
-            # one shift for every pose: the statistics are a function of it alone,
-            # re-scored on the grid and interpolated (the grid's step, a tenth of the sd,
-            # is much finer than the draws' spread)
-            for j in range(est.size):
-                offset[:, j] = np.interp(shift, grid, on_grid[:, j])
-        if noise and timing and not frame:
-            own[MOCAP_NOISE], own[TIME_ASSOCIATION] = measured, offset
-        # mirrored: the offset is not a measurement of the truth plus an error that the
-        # draws add again; the truth's offset is spread around the applied one as the draws
-        # are, so the reflection of the basic interval must not apply to it
-        return np.asarray(est + measured - offset, dtype=np.float64)
+    def closed_and_bands(key: tuple[bool, bool]) -> None:
+        """The closed forms of the mean-like statistics and the bands of the order statistics
+        with the sources ``key`` (noise, frame lag) perturbed (no draw in them), once."""
+        if key not in closed:
+            full = (float(est[1]), float(est[-1]))
+            closed[key] = terms.thinned_mean_like(*key, full, MAX_CLOSED)
+            bands[key] = order_stats(d, thinned, terms.bounds(*key), ORDER_STATS)
 
-    sources = [MOCAP_NOISE]
-    if off_sigma > 0.0 or lag is not None:
-        sources.append(TIME_ASSOCIATION)
-    # without a frame lag the noise and the offset are independent parts of each draw:
-    # a source's draws alone are its part of the draws of both (no pass for the shares)
-    alone = None
-    if lag is None and len(sources) == 2:
-        alone = {name: partial(_part_variance, own, name) for name in sources}
-    got = monte_carlo(
-        est,
-        perturbed,
-        sources,
-        draws=settings.draws,
-        seed=settings.seed,
-        confidence=settings.confidence,
-        nonnegative=True,
-        alone_variance=alone,
-    )
-    intervals = dict(zip(KEYS, got, strict=True))
-    src = [Source(MOCAP_NOISE, sig.position, "m", sig.measured, sig.note)]
-    if TIME_ASSOCIATION in sources:
-        parts = []
+    # those of the pass with every source: the noise, and the frame lag where there is one
+    closed_and_bands((True, lag is not None))
+
+    def finish(audit: OffsetEstimate, offset_ns: int, rescoring: Rescoring) -> ResultIntervals:
+        off_sigma, _ = offset_spread(r_xyz, g_xyz, vel, audit, offset_ns)
+        # The offset's effect, centred on the offset applied: the comparison re-scored by the
+        # score's own association and metrics at shifts of it (every robot pose inside the GT,
+        # compared or not), on a grid the draws interpolate
+        grid = np.linspace(-OFFSET_SPAN, OFFSET_SPAN, OFFSET_GRID) * off_sigma
+        on_grid = np.zeros((OFFSET_GRID, est.size))
+        gap_ns = rescoring.max_gap_ns
         if off_sigma > 0.0:
-            parts.append(
-                f"clock offset sd {off_sigma * 1000:.3f} ms (standard error of the "
-                "least-squares offset, the robot's error slid along the path by every lag), "
-                "centred on the offset applied; mirrored: drawn as the truth's offset"
-            )
-        else:
-            parts.append(f"no offset estimate (clock audit: {audit.note or 'none'})")
-        if lag is not None:
-            med = float(median(period)) * 1000
-            parts.append(
-                f"{association}: GT frame period {med:.2f} ms (lag uniform over "
-                f"[{lag[0]:g}, {lag[1]:g}] periods)"
-            )
-        src.append(Source(TIME_ASSOCIATION, off_sigma, "s", off_sigma > 0.0, "; ".join(parts)))
-    unc = Uncertainty(
-        confidence=settings.confidence,
-        method=METHOD_TRAJECTORY,
-        draws=settings.draws,
-        seed=settings.seed,
-        sources=tuple(src),
-        shares=shares_of(intervals),
-    )
-    return ResultIntervals(intervals, unc)
+            # where no pose crosses a loss within reach: the GT's motion on every pose
+            modelled = None
+            reach_ns = round(grid[-1] * NS_PER_S) + 1
+            linear = association == "linear" and gap_ns is not None
+            if linear and clear_of_losses(
+                q, matched.status, matched.t_ns, t, gt.xyz, k, reach_ns, gap_ns or 0
+            ):
+                modelled = steady_effects(terms, thinned, grid, ORDER_STATS, est.size, MEAN_LIKE)
+            on_grid = offset_effects(rescoring, t, grid) if modelled is None else modelled
+
+        own: dict[str, F64] = {}  # each source's own part of the draws, where they add
+
+        def perturbed(rng: np.random.Generator, sources: frozenset[str], draws: int) -> F64:
+            """Draws whose basic (reflected) interval is the interval wanted (module doc):
+            measurement-like perturbations as re-computed scores, the offset's mirrored."""
+            noise = MOCAP_NOISE in sources
+            timing = TIME_ASSOCIATION in sources
+            frame = timing and lag is not None
+            measured = np.zeros((draws, est.size))
+            z = rng.standard_normal((draws, len(mean_cols)))
+            if noise or frame:
+                key = (noise, frame)  # the same closed forms and bands in two passes
+                closed_and_bands(key)
+                for j, (col, value) in enumerate(zip(mean_cols, closed[key], strict=True)):
+                    measured[:, col] = value(z[:, j]) - est[col]
+                stats, base = bands[key]
+                got = draw_order_stats(
+                    stats, distances, rng, draws, noise=noise, lag=lag if frame else None
+                )
+                got -= base
+                for k, st in enumerate(stats):
+                    for col in st.columns:
+                        measured[:, col] = got[:, k]
+            offset = np.zeros((draws, est.size))
+            if timing and off_sigma > 0.0:
+                shift = rng.standard_normal(draws) * off_sigma
+                # one shift for every pose: the statistics are a function of it alone,
+                # re-scored on the grid and interpolated (the grid's step, a tenth of the sd,
+                # is much finer than the draws' spread)
+                for j in range(est.size):
+                    offset[:, j] = np.interp(shift, grid, on_grid[:, j])
+            if noise and timing and not frame:
+                own[MOCAP_NOISE], own[TIME_ASSOCIATION] = measured, offset
+            # mirrored: the offset is not a measurement of the truth plus an error that the
+            # draws add again; the truth's offset is spread around the applied one as the draws
+            # are, so the reflection of the basic interval must not apply to it
+            return np.asarray(est + measured - offset, dtype=np.float64)
+
+        sources = [MOCAP_NOISE]
+        if off_sigma > 0.0 or lag is not None:
+            sources.append(TIME_ASSOCIATION)
+        # without a frame lag the noise and the offset are independent parts of each draw:
+        # a source's draws alone are its part of the draws of both (no pass for the shares)
+        alone = None
+        if lag is None and len(sources) == 2:
+            alone = {name: partial(_part_variance, own, name) for name in sources}
+        got = monte_carlo(
+            est,
+            perturbed,
+            sources,
+            draws=settings.draws,
+            seed=settings.seed,
+            confidence=settings.confidence,
+            nonnegative=True,
+            alone_variance=alone,
+        )
+        intervals = dict(zip(KEYS, got, strict=True))
+        src = [Source(MOCAP_NOISE, sig.position, "m", sig.measured, sig.note)]
+        if TIME_ASSOCIATION in sources:
+            parts = []
+            if off_sigma > 0.0:
+                parts.append(
+                    f"clock offset sd {off_sigma * 1000:.3f} ms (standard error of the "
+                    "least-squares offset, the robot's error slid along the path by every lag), "
+                    "centred on the offset applied; mirrored: drawn as the truth's offset"
+                )
+            else:
+                parts.append(f"no offset estimate (clock audit: {audit.note or 'none'})")
+            if lag is not None:
+                med = float(median(period)) * 1000
+                parts.append(
+                    f"{association}: GT frame period {med:.2f} ms (lag uniform over "
+                    f"[{lag[0]:g}, {lag[1]:g}] periods)"
+                )
+            src.append(Source(TIME_ASSOCIATION, off_sigma, "s", off_sigma > 0.0, "; ".join(parts)))
+        unc = Uncertainty(
+            confidence=settings.confidence,
+            method=METHOD_TRAJECTORY,
+            draws=settings.draws,
+            seed=settings.seed,
+            sources=tuple(src),
+            shares=shares_of(intervals),
+        )
+        return ResultIntervals(intervals, unc)
+
+    return finish

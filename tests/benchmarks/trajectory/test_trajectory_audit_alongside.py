@@ -146,3 +146,54 @@ def test_the_scores_error_while_the_audit_runs(monkeypatch: pytest.MonkeyPatch) 
     assert "lie outside the GT" in said[0] and "--allow-partial" in said[0]
     me = threading.get_ident()
     assert finished[0] != me and finished[1] == me
+
+
+@pytest.mark.parametrize(
+    "config",
+    [
+        {},
+        {"association": "hold"},
+        {"association": "nearest"},
+        {"association": "nearest", "t_max_diff": 0.01},
+    ],
+    ids=["default", "hold", "nearest", "evo"],
+)
+def test_the_intervals_prepared_during_the_audit_are_the_serial_ones(
+    monkeypatch: pytest.MonkeyPatch, config: dict[str, Any]
+) -> None:
+    """The statistics and the intervals' part the audit does not decide, computed while the
+    audit runs, give the result of computing them afterwards, to the bit; evo's pairs (which
+    may repeat robot poses) are left to afterwards."""
+    monkeypatch.setattr(pipeline, "workers", lambda: 2)
+    prepare = comparison.prepare_intervals
+    calls: list[int] = []
+
+    def spy(*args: Any, **kwargs: Any) -> Any:
+        calls.append(1)
+        return prepare(*args, **kwargs)
+
+    monkeypatch.setattr(comparison, "prepare_intervals", spy)
+    gt, robot = streams()
+    early = score_streams(robot, gt, TrajectoryConfig(**config), intervals=DRAWS)
+    assert calls == ([] if "t_max_diff" in config else [1])
+    monkeypatch.setattr(comparison, "_prepared", lambda *args: None)
+    late = score_streams(robot, gt, TrajectoryConfig(**config), intervals=DRAWS)
+    assert json.dumps(early.to_dict(), sort_keys=True) == json.dumps(late.to_dict(), sort_keys=True)
+    assert early.to_dict()["position_error_interval"] is not None
+
+
+def test_an_error_while_preparing_is_met_where_it_always_was(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A failure of the early part is not raised during the audit: the comparison computes the
+    intervals afterwards, as a serial run does (here: with the same numbers)."""
+    monkeypatch.setattr(pipeline, "workers", lambda: 2)
+
+    def failing(*args: Any, **kwargs: Any) -> Any:
+        raise ValueError("not during the audit")
+
+    gt, robot = streams()
+    want = score_streams(robot, gt, TrajectoryConfig(), intervals=DRAWS).to_dict()
+    monkeypatch.setattr(comparison, "prepare_intervals", failing)
+    got = score_streams(robot, gt, TrajectoryConfig(), intervals=DRAWS).to_dict()
+    assert json.dumps(got, sort_keys=True) == json.dumps(want, sort_keys=True)
