@@ -76,6 +76,7 @@ from ertools.benchmarks.trajectory.terms import PoseTerms
 from ertools.errors import ErtoolsError
 from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import unwrap_angles, wrap_angle, yaw_from_quat
+from ertools.io.pipeline import alongside
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
 
@@ -458,76 +459,83 @@ def prepare_intervals(
         # score's own association and metrics at shifts of it (every robot pose inside the GT,
         # compared or not), on a grid the draws interpolate
         grid = np.linspace(-OFFSET_SPAN, OFFSET_SPAN, OFFSET_GRID) * off_sigma
-        on_grid = np.zeros((OFFSET_GRID, est.size))
-        gap_ns = rescoring.max_gap_ns
-        if off_sigma > 0.0:
+
+        def grid_effects() -> F64:
+            if off_sigma <= 0.0:
+                return np.zeros((OFFSET_GRID, est.size))
+            gap_ns = rescoring.max_gap_ns
             # where no pose crosses a loss within reach: the GT's motion on every pose
-            modelled = None
             reach_ns = round(grid[-1] * NS_PER_S) + 1
             linear = association == "linear" and gap_ns is not None
             if linear and clear_of_losses(
                 q, matched.status, matched.t_ns, t, gt.xyz, k, reach_ns, gap_ns or 0
             ):
                 modelled = steady_effects(terms, thinned, grid, ORDER_STATS, est.size, MEAN_LIKE)
-            on_grid = offset_effects(rescoring, t, grid) if modelled is None else modelled
+                if modelled is not None:
+                    return modelled
+            return offset_effects(rescoring, t, grid)
 
-        own: dict[str, F64] = {}  # each source's own part of the draws, where they add
+        # the grid re-scored on a second core while each pass's noise draws are made here
+        # (they come first in a pass; its offset draws wait for the grid)
+        with alongside(grid_effects, parallel=off_sigma > 0.0) as on_grid_of:
+            own: dict[str, F64] = {}  # each source's own part of the draws, where they add
 
-        def perturbed(rng: np.random.Generator, sources: frozenset[str], draws: int) -> F64:
-            """Draws whose basic (reflected) interval is the interval wanted (module doc):
-            measurement-like perturbations as re-computed scores, the offset's mirrored."""
-            noise = MOCAP_NOISE in sources
-            timing = TIME_ASSOCIATION in sources
-            frame = timing and lag is not None
-            measured = np.zeros((draws, est.size))
-            z = rng.standard_normal((draws, len(mean_cols)))
-            if noise or frame:
-                key = (noise, frame)  # the same closed forms and bands in two passes
-                closed_and_bands(key)
-                for j, (col, value) in enumerate(zip(mean_cols, closed[key], strict=True)):
-                    measured[:, col] = value(z[:, j]) - est[col]
-                stats, base = bands[key]
-                got = draw_order_stats(
-                    stats, distances, rng, draws, noise=noise, lag=lag if frame else None
-                )
-                got -= base
-                for k, st in enumerate(stats):
-                    for col in st.columns:
-                        measured[:, col] = got[:, k]
-            offset = np.zeros((draws, est.size))
-            if timing and off_sigma > 0.0:
-                shift = rng.standard_normal(draws) * off_sigma
-                # one shift for every pose: the statistics are a function of it alone,
-                # re-scored on the grid and interpolated (the grid's step, a tenth of the sd,
-                # is much finer than the draws' spread)
-                for j in range(est.size):
-                    offset[:, j] = np.interp(shift, grid, on_grid[:, j])
-            if noise and timing and not frame:
-                own[MOCAP_NOISE], own[TIME_ASSOCIATION] = measured, offset
-            # mirrored: the offset is not a measurement of the truth plus an error that the
-            # draws add again; the truth's offset is spread around the applied one as the draws
-            # are, so the reflection of the basic interval must not apply to it
-            return np.asarray(est + measured - offset, dtype=np.float64)
+            def perturbed(rng: np.random.Generator, sources: frozenset[str], draws: int) -> F64:
+                """Draws whose basic (reflected) interval is the interval wanted (module doc):
+                measurement-like perturbations as re-computed scores, the offset's mirrored."""
+                noise = MOCAP_NOISE in sources
+                timing = TIME_ASSOCIATION in sources
+                frame = timing and lag is not None
+                measured = np.zeros((draws, est.size))
+                z = rng.standard_normal((draws, len(mean_cols)))
+                if noise or frame:
+                    key = (noise, frame)  # the same closed forms and bands in two passes
+                    closed_and_bands(key)
+                    for j, (col, value) in enumerate(zip(mean_cols, closed[key], strict=True)):
+                        measured[:, col] = value(z[:, j]) - est[col]
+                    stats, base = bands[key]
+                    got = draw_order_stats(
+                        stats, distances, rng, draws, noise=noise, lag=lag if frame else None
+                    )
+                    got -= base
+                    for k, st in enumerate(stats):
+                        for col in st.columns:
+                            measured[:, col] = got[:, k]
+                offset = np.zeros((draws, est.size))
+                if timing and off_sigma > 0.0:
+                    on_grid = on_grid_of()
+                    shift = rng.standard_normal(draws) * off_sigma
+                    # one shift for every pose: the statistics are a function of it alone,
+                    # re-scored on the grid and interpolated (the grid's step, a tenth of the sd,
+                    # is much finer than the draws' spread)
+                    for j in range(est.size):
+                        offset[:, j] = np.interp(shift, grid, on_grid[:, j])
+                if noise and timing and not frame:
+                    own[MOCAP_NOISE], own[TIME_ASSOCIATION] = measured, offset
+                # mirrored: the offset is not a measurement of the truth plus an error that the
+                # draws add again; the truth's offset is spread around the applied one as the draws
+                # are, so the reflection of the basic interval must not apply to it
+                return np.asarray(est + measured - offset, dtype=np.float64)
 
-        sources = [MOCAP_NOISE]
-        if off_sigma > 0.0 or lag is not None:
-            sources.append(TIME_ASSOCIATION)
-        # without a frame lag the noise and the offset are independent parts of each draw:
-        # a source's draws alone are its part of the draws of both (no pass for the shares)
-        alone = None
-        if lag is None and len(sources) == 2:
-            alone = {name: partial(_part_variance, own, name) for name in sources}
-        got = monte_carlo(
-            est,
-            perturbed,
-            sources,
-            draws=settings.draws,
-            seed=settings.seed,
-            confidence=settings.confidence,
-            nonnegative=True,
-            alone_variance=alone,
-        )
-        intervals = dict(zip(KEYS, got, strict=True))
+            sources = [MOCAP_NOISE]
+            if off_sigma > 0.0 or lag is not None:
+                sources.append(TIME_ASSOCIATION)
+            # without a frame lag the noise and the offset are independent parts of each draw:
+            # a source's draws alone are its part of the draws of both (no pass for the shares)
+            alone = None
+            if lag is None and len(sources) == 2:
+                alone = {name: partial(_part_variance, own, name) for name in sources}
+            got = monte_carlo(
+                est,
+                perturbed,
+                sources,
+                draws=settings.draws,
+                seed=settings.seed,
+                confidence=settings.confidence,
+                nonnegative=True,
+                alone_variance=alone,
+            )
+            intervals = dict(zip(KEYS, got, strict=True))
         src = [Source(MOCAP_NOISE, sig.position, "m", sig.measured, sig.note)]
         if TIME_ASSOCIATION in sources:
             parts = []
