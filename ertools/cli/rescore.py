@@ -71,7 +71,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
         "-j",
         type=int,
         metavar="N",
-        help="local worker processes (default: the CPU count; 1: in this process)",
+        help="local worker processes (default: the cores this process may use; 1: in this process)",
     )
     parser.add_argument(
         "--scheduler",

@@ -32,13 +32,16 @@ from ertools.competition.children import (
 from ertools.competition.jobs import Job, Outcome, run_job
 from ertools.competition.schedule import Schedule
 from ertools.errors import ConfigError
+from ertools.io.pipeline import workers
 
 OnDone = Callable[[Outcome], None]
 log = logging.getLogger(__name__)
 
 
 def default_jobs() -> int:
-    return os.cpu_count() or 1
+    """Local worker processes without ``--jobs``: the cores this process may run on (under
+    ``taskset`` or a container's cpuset, not the machine's: more would only compete)."""
+    return workers()
 
 
 def run_jobs(
