@@ -89,21 +89,20 @@ def _prepared(
     robot: PoseStream,
     gt: PoseStream,
     first: Matched | None,
+    m: Metrics | None,
     config: TrajectoryConfig,
     intervals: IntervalSettings,
     sigma: MocapSigma | None,
-) -> tuple[Metrics | None, Finish | None] | None:
-    """The statistics of the association ``first`` and the intervals' part the clock audit
-    does not decide (:func:`prepare_intervals`), while the audit runs: None where the score
-    will use another association or robot stream (evo's pairs may repeat robot poses), or
-    where an error came up, which the comparison then meets where it always did."""
-    if first is None or first.robot_rows is not None:
+) -> Finish | None:
+    """The intervals' part the clock audit does not decide (:func:`prepare_intervals`) of the
+    association ``first`` with the statistics ``m``, while the audit runs: None where the
+    score will compare another robot stream (evo's pairs may repeat robot poses), has no
+    statistics or intervals, or where an error came up, which the comparison then meets
+    where it always did."""
+    if first is None or first.robot_rows is not None or m is None or sigma is None:
         return None
     try:
-        m = metrics(first)
-        if m is None or sigma is None:
-            return m, None
-        finish = prepare_intervals(
+        return prepare_intervals(
             robot,
             gt,
             first,
@@ -114,7 +113,6 @@ def _prepared(
         )
     except Exception:
         return None
-    return m, finish
 
 
 def _decimate(stream: PoseStream, limit: int = 5000) -> PoseStream:
@@ -283,7 +281,8 @@ def score_streams(
         # the GT's noise and what else the intervals need that the audit does not decide:
         # computed meanwhile too (wasted only when the comparison has no statistics)
         sigma = jitter(timed) if intervals.enabled and first is not None else None
-        prepared = _prepared(robot, timed, first, config, intervals, sigma)
+        m = None if first is None else metrics(first)
+        finish = _prepared(robot, timed, first, m, config, intervals, sigma)
         audit, pending = audit_of()
     pairs = None if first is None else _audit_pairs(first, config)
     if pending and pairs is not None:
@@ -343,7 +342,8 @@ def score_streams(
                 + (" (--t-max-diff: as evo, no error)" if evo and not config.allow_partial else "")
             )
 
-    m = prepared[0] if prepared is not None and matched is first else metrics(matched)
+    if first is None:
+        m = metrics(matched)
     validity = from_codes(
         validity_codes(matched, int(timed.t_ns[0])),
         matched.t_ns,
@@ -405,8 +405,8 @@ def score_streams(
     if m is not None:
         if sigma is None and intervals.enabled:
             sigma = jitter(timed)
-        if prepared is not None and prepared[1] is not None and matched is first:
-            iv = prepared[1](audit, offset_ns, rescoring(offset_ns))
+        if finish is not None:
+            iv = finish(audit, offset_ns, rescoring(offset_ns))
         else:
             iv = trajectory_intervals(
                 robot,
