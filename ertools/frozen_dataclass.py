@@ -55,7 +55,7 @@ def frozen_dataclass(
 
 
 def _make(cls: type[Any], *, eq: bool, kw_only: bool) -> type[Any]:
-    own = cls.__dict__
+    own = dict(cls.__dict__)  # what the class defines itself, before ``dataclasses`` adds to it
     for name in _REFUSED:
         if name in own:
             raise TypeError(f"Cannot overwrite attribute {name} in class {cls.__name__}")
