@@ -31,8 +31,8 @@ from ertools.competition.children import (
 )
 from ertools.competition.jobs import Job, Outcome, run_job
 from ertools.competition.schedule import Schedule
+from ertools.cores import workers
 from ertools.errors import ConfigError
-from ertools.io.pipeline import workers
 
 OnDone = Callable[[Outcome], None]
 log = logging.getLogger(__name__)

@@ -352,13 +352,3 @@ def test_a_reused_slot_releases_its_map(tmp_path: Path) -> None:
     assert slot[1] is mm and not mm.closed
     pipeline.scratch_view(slot, 10)  # the slot is reused for a plain read
     assert mm.closed and len(slot) == 1
-
-
-@pytest.mark.skipif(not hasattr(os, "sched_getaffinity"), reason="n/a: no CPU affinity here")
-def test_workers_count_the_cores_the_process_may_use(monkeypatch: pytest.MonkeyPatch) -> None:
-    # pinned to one core of many (taskset, a container's cpuset): no thread to compete
-    monkeypatch.setattr(os, "cpu_count", lambda: 8)
-    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {3})
-    assert pipeline.workers() == 1
-    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 5})
-    assert pipeline.workers() == 2

@@ -61,9 +61,9 @@ from ertools.benchmarks.trajectory.rules import (
     RULE_YAW_WRAP,
 )
 from ertools.benchmarks.trajectory.validity import too_few, validity_codes
+from ertools.cores import alongside
 from ertools.errors import ClockError, ScoringError
 from ertools.fidelity import Deviation
-from ertools.io.pipeline import alongside
 from ertools.streams import PoseStream, Provenance, float_seconds
 from ertools.timeutil import iso_utc, ns_to_s
 

@@ -73,10 +73,10 @@ from ertools.benchmarks.trajectory.spread import offset_spread
 from ertools.benchmarks.trajectory.steady import clear_of_losses
 from ertools.benchmarks.trajectory.steady import effects as steady_effects
 from ertools.benchmarks.trajectory.terms import PoseTerms
+from ertools.cores import alongside
 from ertools.errors import ErtoolsError
 from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import unwrap_angles, wrap_angle, yaw_from_quat
-from ertools.io.pipeline import alongside
 from ertools.streams import PoseStream
 from ertools.timeutil import NS_PER_S
 

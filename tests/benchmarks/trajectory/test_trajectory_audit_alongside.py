@@ -12,13 +12,13 @@ from typing import Any
 import numpy as np
 import pytest
 
+from ertools import cores as cores_module
 from ertools.benchmarks.common.inputs import IntervalSettings
 from ertools.benchmarks.trajectory import comparison
 from ertools.benchmarks.trajectory.comparison import score_streams
 from ertools.benchmarks.trajectory.config import TrajectoryConfig
 from ertools.errors import ClockError
 from ertools.geometry import quat_from_yaw
-from ertools.io import pipeline
 from ertools.streams import PoseStream
 
 MS = 1_000_000
@@ -51,7 +51,7 @@ def streams() -> tuple[PoseStream, PoseStream]:
 
 def scored(monkeypatch: pytest.MonkeyPatch, cores: int, **config: Any) -> tuple[str, list[int]]:
     """The result's JSON with ``cores`` cores, and the threads the audit's search ran on."""
-    monkeypatch.setattr(pipeline, "workers", lambda: cores)
+    monkeypatch.setattr(cores_module, "workers", lambda: cores)
     searched = comparison.search_offset
     ran_on: list[int] = []
 
@@ -105,7 +105,7 @@ def test_the_mean_distance_at_no_offset_is_the_generators(
 
 
 def test_an_error_of_the_audit_reaches_the_caller(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(pipeline, "workers", lambda: 2)
+    monkeypatch.setattr(cores_module, "workers", lambda: 2)
     ran_on: list[int] = []
 
     def failing(*args: Any, **kwargs: Any) -> Any:
@@ -137,7 +137,7 @@ def test_the_scores_error_while_the_audit_runs(monkeypatch: pytest.MonkeyPatch) 
     late = PoseStream(robot.t_ns + 30 * 1_000 * MS, robot.xyz, robot.quat_xyzw, "world", "robot")
     said = []
     for cores in (2, 1):
-        monkeypatch.setattr(pipeline, "workers", lambda cores=cores: cores)
+        monkeypatch.setattr(cores_module, "workers", lambda cores=cores: cores)
         with pytest.raises(ClockError) as caught:
             score_streams(late, gt, TrajectoryConfig(), intervals=DRAWS)
         said.append(str(caught.value))
@@ -164,7 +164,7 @@ def test_the_intervals_prepared_during_the_audit_are_the_serial_ones(
     """The statistics and the intervals' part the audit does not decide, computed while the
     audit runs, give the result of computing them afterwards, to the bit; evo's pairs (which
     may repeat robot poses) are left to afterwards."""
-    monkeypatch.setattr(pipeline, "workers", lambda: 2)
+    monkeypatch.setattr(cores_module, "workers", lambda: 2)
     prepare = comparison.prepare_intervals
     calls: list[int] = []
 
@@ -187,7 +187,7 @@ def test_an_error_while_preparing_is_met_where_it_always_was(
 ) -> None:
     """A failure of the early part is not raised during the audit: the comparison computes the
     intervals afterwards, as a serial run does (here: with the same numbers)."""
-    monkeypatch.setattr(pipeline, "workers", lambda: 2)
+    monkeypatch.setattr(cores_module, "workers", lambda: 2)
 
     def failing(*args: Any, **kwargs: Any) -> Any:
         raise ValueError("not during the audit")

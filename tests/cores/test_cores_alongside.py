@@ -9,9 +9,9 @@ import time
 
 import pytest
 
+from ertools import cores as cores_module
+from ertools.cores import alongside
 from ertools.errors import ClockError, ScoringError
-from ertools.io import pipeline
-from ertools.io.pipeline import alongside
 
 
 def helpers() -> list[threading.Thread]:
@@ -20,7 +20,7 @@ def helpers() -> list[threading.Thread]:
 
 @pytest.fixture
 def two_cores(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(pipeline, "workers", lambda: 2)
+    monkeypatch.setattr(cores_module, "workers", lambda: 2)
 
 
 @pytest.mark.usefixtures("two_cores")
@@ -108,7 +108,7 @@ def test_an_interrupt_in_the_block_is_not_replaced() -> None:
 def test_one_core_or_serial_runs_the_task_first_on_the_calling_thread(
     monkeypatch: pytest.MonkeyPatch, cores: int, parallel: bool
 ) -> None:
-    monkeypatch.setattr(pipeline, "workers", lambda: cores)
+    monkeypatch.setattr(cores_module, "workers", lambda: cores)
     events: list[tuple[str, int]] = []
 
     def task() -> str:
@@ -126,7 +126,7 @@ def test_one_core_or_serial_runs_the_task_first_on_the_calling_thread(
 def test_one_core_raises_the_tasks_error_before_the_block(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    monkeypatch.setattr(pipeline, "workers", lambda: 1)
+    monkeypatch.setattr(cores_module, "workers", lambda: 1)
     entered: list[bool] = []
 
     def task() -> int:
