@@ -21,6 +21,14 @@ directory ``<name>/`` -> ``<name>.answers.yaml`` beside it), top-level keys in t
 
 Numbers are plain YAML floats/ints (``to_plain`` converts NumPy values); times are given in
 epoch seconds *and* int64 ns so tests can compare either.
+
+A folder laid out as an organiser's (the RSBB's ``rsbb_logs/<CODE>/<team>/run_<n>_<date>.bag``)
+holds no answers: ``ertools rescore`` of it would list a file in it as not a log. Its runs'
+answers are one file beside it, ``<folder>.answers.yaml`` (:func:`answers_path` of the folder,
+:func:`write_layout_answers`), top-level keys ``benchmark``, ``bag`` (every run bag, relative
+to the folder), ``generator`` (``scenario``, ``seed``) and ``runs``: per run bag (the same
+relative path) its ``parameters``, ``truth``, ``expected`` and ``tolerance``.
+:func:`read_answers` reads a log's answers in the first shape wherever they are.
 """
 
 from __future__ import annotations
@@ -32,6 +40,8 @@ from typing import Any
 
 import numpy as np
 import yaml
+
+from ertools.frozen_dataclass import frozen_dataclass
 
 # A Friday at the Lisbon 2015 RoCKIn competition (2015-11-20 10:00:00 UTC): the default
 # start of simulated logs.
@@ -127,3 +137,81 @@ def write_answers(
     text = yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=100)
     out.write_text(text, encoding="utf-8")
     return out
+
+
+@frozen_dataclass
+class RunAnswers:
+    """One run's answers in a layout's answers file (:func:`write_layout_answers`)."""
+
+    bag: Path
+    parameters: Mapping[str, Any]
+    truth: Mapping[str, Any]
+    expected: Mapping[str, Any]
+    tolerance: Mapping[str, Any]
+
+
+def write_layout_answers(
+    folder: Path, runs: Sequence[RunAnswers], *, benchmark: str, scenario: str, seed: int
+) -> Path:
+    """Write the answers of the runs laid out under ``folder`` beside it, as
+    ``<folder>.answers.yaml`` (:func:`answers_path` of ``folder``), byte-identical for
+    identical inputs; each run bag must lie under ``folder``."""
+
+    if not runs:
+        raise ValueError("write_layout_answers needs at least one run")
+    # relative to the folder, not to the answers file: the samples' generator writes into a
+    # folder of a temporary name that is renamed afterwards
+    bags = [run.bag.relative_to(folder).as_posix() for run in runs]
+    doc = {
+        "benchmark": benchmark,
+        "bag": bags,
+        "generator": {"scenario": scenario, "seed": int(seed)},
+        "runs": {
+            bag: {
+                "parameters": to_plain(run.parameters),
+                "truth": to_plain(run.truth),
+                "expected": to_plain(run.expected),
+                "tolerance": to_plain(run.tolerance),
+            }
+            for bag, run in zip(bags, runs, strict=True)
+        },
+    }
+    out = answers_path(folder)
+    text = yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=100)
+    out.write_text(text, encoding="utf-8")
+    return out
+
+
+def read_answers(log: Path) -> dict[str, Any]:
+    """The answers of ``log``: its own answers file beside it, else its run's in the answers
+    file beside the folder that holds it (:func:`write_layout_answers`), in a log's shape
+    (``bag`` relative to that folder).
+
+    Raises:
+        FileNotFoundError: no answers file names ``log``.
+    """
+
+    own = answers_path(log)
+    if own.is_file():
+        doc: dict[str, Any] = yaml.safe_load(own.read_text(encoding="utf-8"))
+        return doc
+    for folder in log.parents:
+        if not folder.name:  # "." or "/": nothing beside it
+            break
+        beside = answers_path(folder)
+        if not beside.is_file():
+            continue
+        layout = yaml.safe_load(beside.read_text(encoding="utf-8"))
+        bag = log.relative_to(folder).as_posix()
+        run = layout.get("runs", {}).get(bag)
+        if run is None:
+            continue
+        return {
+            "benchmark": layout["benchmark"],
+            "bag": bag,
+            "generator": {**layout["generator"], "parameters": run["parameters"]},
+            "truth": run["truth"],
+            "expected": run["expected"],
+            "tolerance": run["tolerance"],
+        }
+    raise FileNotFoundError(f"{log}: no answers file beside it or beside a folder holding it")

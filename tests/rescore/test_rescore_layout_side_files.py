@@ -27,7 +27,7 @@ markerset_to_robot_transform: !!python/tuple
 
 def _layout(folder: Path, run: int, transform: str | None) -> None:
     """``folder``: the sample HNF layout with only its run ``run`` (bag and result file)."""
-    shutil.copytree(SAMPLES / "hnf", folder, ignore=shutil.ignore_patterns("*.answers.yaml"))
+    shutil.copytree(SAMPLES / "hnf", folder)  # its answers are beside it, not in it
     for path in [*folder.glob("rsbb_logs/HNF/simbot/*"), *folder.glob("results/HNF/simbot/*")]:
         if not path.name.startswith((f"run_{run}_", f"result_run_{run}_")):
             path.unlink()

@@ -15,6 +15,7 @@ import yaml
 
 from ertools.cli.main import main
 from ertools.rsbb.layout import classify, pair_runs
+from ertools.simulator.answers import read_answers
 
 pytestmark = pytest.mark.slow  # scores whole folders (~20 s each)
 
@@ -55,9 +56,7 @@ def test_a_2015_folder_beside_rsbb_ones_gives_hnf_no_transform(tmp_path: Path) -
     run = next(
         r for r in doc["executions"] if r["benchmark"] == "hnf" and HNF_RUN_1 in r["bags"][0]
     )
-    answers = yaml.safe_load(
-        (SAMPLES / f"hnf/rsbb_logs/HNF/simbot/{HNF_RUN_1}.answers.yaml").read_text("utf-8")
-    )
+    answers = read_answers(SAMPLES / f"hnf/rsbb_logs/HNF/simbot/{HNF_RUN_1}.bag")
     # the generator's truth: stops against waypoints with the run's own marker offset; its
     # tolerance is the simulated mocap noise (0.2 mm per axis), so 1 mm
     expected = answers["expected"]["ertools"]["position_accuracy"]

@@ -17,9 +17,9 @@ ertools' scorer.
 3 cm from its target; goal_1 timed out (pushed, never lifted); goal_2 placed, its final lookup
 lost for 3.5 s (restarted), then placed 5 cm off with 0.3 s of tracking lost around the
 lookup; the referee stops the run while the fourth object is being placed. Answers
-(``expected``), from the noiseless truth: per goal the segment time, outcome, grasp and
-distance; the 2019 totals (Avg over 3 completed goals, 3 grasps counted) and ertools' (the
-one measured goal).
+(``expected``; in ``<folder>.answers.yaml`` beside the layout folder, not in it), from the
+noiseless truth: per goal the segment time, outcome, grasp and distance; the 2019 totals (Avg
+over 3 completed goals, 3 grasps counted) and ertools' (the one measured goal).
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ from scipy.spatial.transform import Rotation, Slerp
 from ertools.atomic import write_text
 from ertools.benchmarks.hgmf.config import SCRIPT_FRAMES
 from ertools.frozen_dataclass import frozen_dataclass
-from ertools.simulator.answers import tol, window, write_answers
+from ertools.simulator.answers import RunAnswers, tol, window, write_layout_answers
 from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
 from ertools.simulator.rsbb import write_rsbb_run
 from ertools.simulator.rsbb_scenario import (
@@ -470,16 +470,14 @@ def write_config(root: Path, objects: Sequence[dict[str, Any]] = OBJECTS) -> Pat
 
 
 def generate(outdir: Path, *, seed: int) -> list[Path]:
-    """Write the sample run in the RSBB layout under ``outdir`` with its config and answers."""
+    """Write the sample run in the RSBB layout under ``outdir`` with its config, and its answers
+    beside ``outdir`` (:func:`~ertools.simulator.answers.write_layout_answers`)."""
     plan = RunPlan(**{**SAMPLE.__dict__, "seed": seed})
     scenario, truth = build(plan)
     paths = write_rsbb_run(outdir, scenario, compression="bz2")
     config = write_config(outdir)
-    answers = write_answers(
+    run = RunAnswers(
         paths.bag,
-        benchmark="hgmf",
-        scenario="hgmf",
-        seed=seed,
         parameters={
             "table": {"xyz": list(TABLE_XYZ), "yaw": TABLE_YAW},
             "lift_m": LIFT_M,
@@ -499,4 +497,6 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         expected=expected(truth, len(plan.objects)),
         tolerance=TOLERANCE,
     )
+    # beside the layout, not in it: rescore would list it as a file that is not a log
+    answers = write_layout_answers(outdir, [run], benchmark="hgmf", scenario="hgmf", seed=seed)
     return [paths.bag, paths.result, config, answers]

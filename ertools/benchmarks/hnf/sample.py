@@ -19,10 +19,11 @@ The script's lookups (its ``/robot`` broadcasts) are 12 ms after each goal's end
 took them; its saves (the live score and the result file) hold the 2019 script's score
 computed from the published mocap with tf's arithmetic (:mod:`ertools.simulator.tf_lookup`).
 
-Answers (``<bag stem>.answers.yaml``), from the noiseless truth at the lookup moments: per
-segment the robot pose, ``distance_error``, ``orientation_error`` (wrapped; the 2019 per-segment
-value is the same), and the totals of both readings: ``ertools`` (completed goals with a pose)
-and ``2019`` (every pose's error / completed goals; sin/cos of the unwrapped difference).
+Answers (in ``<folder>.answers.yaml`` beside the layout folder, not in it, per run bag), from
+the noiseless truth at the lookup moments: per segment the robot pose, ``distance_error``,
+``orientation_error`` (wrapped; the 2019 per-segment value is the same), and the totals of both
+readings: ``ertools`` (completed goals with a pose) and ``2019`` (every pose's error /
+completed goals; sin/cos of the unwrapped difference).
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ from ertools.arrays import F64
 from ertools.frozen_dataclass import frozen_dataclass
 from ertools.geometry import compose, invert, quat_from_yaw, wrap_angle
 from ertools.rsbb.py2 import to_sec
-from ertools.simulator.answers import tol, write_answers
+from ertools.simulator.answers import RunAnswers, tol, write_layout_answers
 from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
 from ertools.simulator.rsbb import TF_STAMP_LAG_NS, write_rsbb_run
 from ertools.simulator.rsbb_files import write_script_config, write_team_transform
@@ -284,7 +285,9 @@ def _answers(plan: _Plan, robot_at: Any, t0: int) -> dict[str, Any]:
     return out
 
 
-def _run(outdir: Path, run: int, stop_at_goal: int | None, seed: int, t0: int) -> list[Path]:
+def _run(
+    outdir: Path, run: int, stop_at_goal: int | None, seed: int, t0: int
+) -> tuple[list[Path], RunAnswers]:
     rng = np.random.default_rng([seed, run])
     plan = _plan(stop_at_goal)
     t_end = plan.end[1]
@@ -353,11 +356,8 @@ def _run(outdir: Path, run: int, stop_at_goal: int | None, seed: int, t0: int) -
     def robot_at(at: int) -> F64:
         return np.asarray(_robot(np.array([at - t0], np.int64), (0.0, 0.0, 0.0), plan.legs)[0])
 
-    answers = write_answers(
+    answers = RunAnswers(
         paths.bag,
-        benchmark="hnf",
-        scenario="hnf",
-        seed=seed,
         parameters={
             "team": TEAM,
             "run": run,
@@ -382,12 +382,18 @@ def _run(outdir: Path, run: int, stop_at_goal: int | None, seed: int, t0: int) -
             ),
         },
     )
-    return [paths.bag, paths.result, answers]
+    return [paths.bag, paths.result], answers
 
 
 def generate(outdir: Path, *, seed: int) -> list[Path]:
-    """Write both runs and the side files into ``outdir`` (the RSBB's folder layout)."""
-    written = _run(outdir, 1, None, seed, T0) + _run(outdir, 2, 2, seed, T0 + 600 * S)
+    """Write both runs and the side files into ``outdir`` (the RSBB's folder layout), and
+    their answers beside it (:func:`~ertools.simulator.answers.write_layout_answers`)."""
+    written_1, answers_1 = _run(outdir, 1, None, seed, T0)
+    written_2, answers_2 = _run(outdir, 2, 2, seed, T0 + 600 * S)
+    # beside the layout, not in it: rescore would list it as a file that is not a log
+    answers = write_layout_answers(
+        outdir, [answers_1, answers_2], benchmark="hnf", scenario="hnf", seed=seed
+    )
     t_mr, q_mr = _team()
     transform = write_team_transform(outdir, TEAM, t_mr, q_mr)
     params = {
@@ -396,4 +402,4 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
         "goal_timeout": GOAL_TIMEOUT,
     }
     config = write_script_config(outdir, "HNF", params, flow_style=None)
-    return [*written, transform, config]
+    return [*written_1, *written_2, transform, config, answers]

@@ -30,7 +30,8 @@ items_with_pose.yaml`` and ``rsbb_bmbox/scripts/benchmark_configs/HOPF.yaml``, s
 2019 script's score computed here as the RSBB did, the item's pose from the published mocap at
 the ``/item`` broadcast (tf's interpolation): ``--rules 2019`` agrees with it field for field.
 
-Answers (``expected``), computed here from the noiseless truth in the plane (the table, the
+Answers (``expected``; in ``<folder>.answers.yaml`` beside the layout folder, not in it),
+computed here from the noiseless truth in the plane (the table, the
 positioner and the item turn about z only): per goal the item's pose in the table frame
 (table^-1 * positioner * item), the answer, the errors, t, r and the pose score under the 2019
 script's rules (t unclipped, one wrap step, exact names) and ertools' (t clipped at 1 m,
@@ -48,7 +49,7 @@ import numpy as np
 import yaml
 
 from ertools.atomic import write_text
-from ertools.simulator.answers import tol, write_answers
+from ertools.simulator.answers import RunAnswers, tol, write_layout_answers
 from ertools.simulator.mocap import MocapNoise, frame_times, simulate_mocap
 from ertools.simulator.rsbb import TF_STAMP_LAG_NS, write_rsbb_run
 from ertools.simulator.rsbb_scenario import (
@@ -254,7 +255,8 @@ def _track(body: Body) -> Link:
 
 
 def generate(outdir: Path, *, seed: int) -> list[Path]:
-    """Write the run (bag, result file, side files) and its answers into ``outdir``."""
+    """Write the run (bag, result file, side files) into ``outdir`` and its answers beside it
+    (:func:`~ertools.simulator.answers.write_layout_answers`)."""
     rng = np.random.default_rng(seed)
     items = {i["id"]: i for i in _items()}
     manual: list[ManualOperation] = []
@@ -376,11 +378,8 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     for path, data in ((items_path, {"items": list(items.values())}), (config_path, PARAMS)):
         path.parent.mkdir(parents=True, exist_ok=True)
         write_text(path, yaml.safe_dump(data, default_flow_style=None))
-    answers = write_answers(
+    run = RunAnswers(
         paths.bag,
-        benchmark="hopf",
-        scenario="hopf",
-        seed=seed,
         parameters={
             "team": TEAM,
             "table": list(TABLE),
@@ -403,6 +402,8 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
             "accuracy": tol(1e-12, "counts divided by counts"),
         },
     )
+    # beside the layout, not in it: rescore would list it as a file that is not a log
+    answers = write_layout_answers(outdir, [run], benchmark="hopf", scenario="hopf", seed=seed)
     return [paths.bag, paths.result, items_path, config_path, answers]
 
 

@@ -18,7 +18,8 @@ and an absolute one 6 ms later (201 ms when the relative failed). Its saves hold
 script's score computed from the published mocap with tf's arithmetic
 (:mod:`ertools.simulator.tf_lookup`).
 
-Answers, from the noiseless truth: for ertools' reading (a 2 Hz grid from 8 s after the
+Answers (in ``<folder>.answers.yaml`` beside the layout folder, not in it, per run bag),
+from the noiseless truth: for ertools' reading (a 2 Hz grid from 8 s after the
 RefBox's goal start, horizontal distances, a sample measured where neither body's mocap has a
 gap over 0.1 s around it) and for the 2019 script (its samples, distances in the cap's frame):
 the samples, the average deviation, the distance covered, the reliability, the duration.
@@ -35,7 +36,7 @@ import numpy as np
 from ertools.arrays import F64
 from ertools.geometry import compose, invert, quat_from_yaw, rotate
 from ertools.rsbb.py2 import percent_py2, to_sec
-from ertools.simulator.answers import tol, write_answers
+from ertools.simulator.answers import RunAnswers, tol, write_layout_answers
 from ertools.simulator.mocap import MocapNoise, TrackingLoss, frame_times, simulate_mocap
 from ertools.simulator.rsbb import TF_STAMP_LAG_NS, write_rsbb_run
 from ertools.simulator.rsbb_files import write_script_config, write_team_transform
@@ -146,7 +147,9 @@ def _schedule(start_s: float, end_s: float) -> tuple[list[float], list[float], l
     return starts, rel, ab
 
 
-def _run(outdir: Path, run: int, stop_s: float | None, seed: int, t0: int) -> list[Path]:
+def _run(
+    outdir: Path, run: int, stop_s: float | None, seed: int, t0: int
+) -> tuple[list[Path], RunAnswers]:
     rng = np.random.default_rng([seed, run])
     request, start = 3.0, 3.6
     timeout_end = request + PARAMS["goal_timeout"]
@@ -214,19 +217,18 @@ def _run(outdir: Path, run: int, stop_s: float | None, seed: int, t0: int) -> li
         tz_name="WEST",
     )
     paths = write_rsbb_run(outdir, sc, compression="bz2")
-    return [paths.bag, paths.result, _answers(paths.bag, run, seed, t0, starts, rel, ab, stop_s)]
+    return [paths.bag, paths.result], _answers(paths.bag, run, t0, starts, rel, ab, stop_s)
 
 
 def _answers(
     bag: Path,
     run: int,
-    seed: int,
     t0: int,
     starts: list[float],
     rel: list[float],
     ab: list[float],
     stop_s: float | None,
-) -> Path:
+) -> RunAnswers:
     grid_end = stop_s if stop_s is not None else 3.0 + PARAMS["goal_timeout"]
     grid = np.arange(3.6 + 8.0, grid_end - 1e-9, 0.5)
     g_ns = t0 + np.round(grid * S).astype(np.int64)
@@ -260,11 +262,8 @@ def _answers(
             ),
             "duration": to_sec(round((starts[-1] + 0.5 - 3.6) * S)),
         }
-    return write_answers(
+    return RunAnswers(
         bag,
-        benchmark="hpff",
-        scenario="hpff",
-        seed=seed,
         parameters={"team": TEAM, "run": run, **PARAMS, "cap_lost": list(CAP_LOST), "stop": stop_s},
         truth={"radius": RADIUS, "speed": SPEED, "lag_s": LAG_S, "cap_tilt": CAP_TILT},
         expected=expected,
@@ -289,9 +288,15 @@ def _answers(
 
 
 def generate(outdir: Path, *, seed: int) -> list[Path]:
-    """Write both runs and the side files into ``outdir`` (the RSBB's folder layout)."""
-    written = _run(outdir, 1, None, seed, T0) + _run(outdir, 2, 20.0, seed, T0 + 900 * S)
+    """Write both runs and the side files into ``outdir`` (the RSBB's folder layout), and
+    their answers beside it (:func:`~ertools.simulator.answers.write_layout_answers`)."""
+    written_1, answers_1 = _run(outdir, 1, None, seed, T0)
+    written_2, answers_2 = _run(outdir, 2, 20.0, seed, T0 + 900 * S)
+    # beside the layout, not in it: rescore would list it as a file that is not a log
+    answers = write_layout_answers(
+        outdir, [answers_1, answers_2], benchmark="hpff", scenario="hpff", seed=seed
+    )
     t_mr, q_mr = _team()
     transform = write_team_transform(outdir, TEAM, t_mr, q_mr)
     config = write_script_config(outdir, "HPFF", PARAMS, flow_style=False)
-    return [*written, transform, config]
+    return [*written_1, *written_2, transform, config, answers]

@@ -23,7 +23,8 @@ stands in the area. The live score and the result file are the 2019 script's sco
 here as the RSBB did, the cap's pose from the published mocap at the ``/person`` broadcast
 after the answer: ``--rules 2019`` agrees with them field for field.
 
-Answers (``expected``), from the noiseless truth: each goal's position error (the answer
+Answers (``expected``; in ``<folder>.answers.yaml`` beside the layout folder, not in it),
+from the noiseless truth: each goal's position error (the answer
 minus where the person stands), the name right under both readings, and the totals: Distance
 error over the three goals detected, Recognized persons and its percentage over the five
 people (``40.0%`` for the script, ``60.0%`` for ertools), execution_time (the restarted
@@ -41,7 +42,7 @@ import yaml
 
 from ertools.atomic import write_text
 from ertools.frozen_dataclass import frozen_dataclass
-from ertools.simulator.answers import tol, write_answers
+from ertools.simulator.answers import RunAnswers, tol, write_layout_answers
 from ertools.simulator.mocap import MocapNoise, frame_times, simulate_mocap
 from ertools.simulator.rsbb import TF_STAMP_LAG_NS, write_rsbb_run
 from ertools.simulator.rsbb_scenario import (
@@ -261,7 +262,8 @@ def _events(cap: Link | None) -> _Events:
 
 
 def generate(outdir: Path, *, seed: int) -> list[Path]:
-    """Write the run (bag, result file, config) and its answers into ``outdir``."""
+    """Write the run (bag, result file, config) into ``outdir`` and its answers beside it
+    (:func:`~ertools.simulator.answers.write_layout_answers`)."""
     rng = np.random.default_rng(seed)
     cap = _body(_events(None).spans, rng)  # the spans do not depend on the cap's noise
     ev = _events(_track(cap))
@@ -284,11 +286,8 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
     config.parent.mkdir(parents=True, exist_ok=True)
     write_text(config, yaml.safe_dump(PARAMS, default_flow_style=None))
     n = len(PEOPLE)
-    answers = write_answers(
+    run = RunAnswers(
         paths.bag,
-        benchmark="hppf",
-        scenario="hppf",
-        seed=seed,
         parameters={"team": TEAM, "people": PEOPLE, "sigma_m": NOISE.sigma_m},
         truth={"passes": truth_rows},
         expected={
@@ -315,6 +314,8 @@ def generate(outdir: Path, *, seed: int) -> list[Path]:
             "execution_time": tol(1e-9, "the RefBox's messages are written at the given times"),
         },
     )
+    # beside the layout, not in it: rescore would list it as a file that is not a log
+    answers = write_layout_answers(outdir, [run], benchmark="hppf", scenario="hppf", seed=seed)
     return [paths.bag, paths.result, config, answers]
 
 

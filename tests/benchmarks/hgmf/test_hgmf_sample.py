@@ -11,9 +11,9 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-import yaml
 
 from ertools.cli.main import main
+from ertools.simulator.answers import read_answers
 
 pytestmark = pytest.mark.slow  # scores the sample twice (~3 s)
 
@@ -22,9 +22,7 @@ SAMPLE = Path(__file__).resolve().parents[3] / "sample_bags" / "hgmf"
 
 @pytest.fixture(scope="module")
 def answers() -> dict[str, Any]:
-    (path,) = sorted(SAMPLE.glob("rsbb_logs/HGMF/*/*.answers.yaml"))
-    data: dict[str, Any] = yaml.safe_load(path.read_text(encoding="utf-8"))
-    return data
+    return read_answers(_bag())  # hgmf.answers.yaml beside the layout folder
 
 
 def _bag() -> Path:

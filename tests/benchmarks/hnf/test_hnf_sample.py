@@ -10,8 +10,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-import yaml
 
+from ertools.simulator.answers import read_answers
 from tests.helpers.inprocess import run
 
 pytestmark = pytest.mark.slow  # four scores of two bags
@@ -21,9 +21,7 @@ RUNS = sorted((ROOT / "rsbb_logs" / "HNF" / "simbot").glob("run_*.bag"))
 
 
 def _answers(bag: Path) -> dict[str, Any]:
-    text = bag.with_name(bag.name.removesuffix(".bag") + ".answers.yaml").read_text()
-    data: dict[str, Any] = yaml.safe_load(text)
-    return data
+    return read_answers(bag)  # hnf.answers.yaml beside the layout folder
 
 
 def _score(bag: Path, *extra: str) -> tuple[dict[str, Any], str]:

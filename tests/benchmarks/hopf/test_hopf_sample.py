@@ -13,6 +13,7 @@ import yaml
 from mcap.reader import make_reader
 
 from ertools.cli.main import main
+from ertools.simulator.answers import read_answers
 from tests.helpers.inprocess import run
 from tests.helpers.rsbb_fields import same
 from tests.helpers.rsbb_replay import hopf as replay_hopf
@@ -21,7 +22,7 @@ from tests.helpers.rsbb_replay.world import World, run_script
 
 SAMPLE = Path(__file__).parents[3] / "sample_bags" / "hopf"
 BAG = next(SAMPLE.glob("rsbb_logs/HOPF/*/run_*.bag"))
-ANSWERS = yaml.safe_load(BAG.with_name(BAG.name.replace(".bag", ".answers.yaml")).read_text())
+ANSWERS = read_answers(BAG)  # hopf.answers.yaml beside the layout folder
 
 
 def _json(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[dict[str, Any], str]:

@@ -10,8 +10,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-import yaml
 
+from ertools.simulator.answers import read_answers
 from tests.helpers.inprocess import run
 
 pytestmark = pytest.mark.slow  # four scores of two bags
@@ -23,10 +23,7 @@ COVERED = "Distance covered while following"
 
 
 def _answers(bag: Path) -> dict[str, Any]:
-    data: dict[str, Any] = yaml.safe_load(
-        bag.with_name(bag.name.removesuffix(".bag") + ".answers.yaml").read_text()
-    )
-    return data
+    return read_answers(bag)  # hpff.answers.yaml beside the layout folder
 
 
 def _score(bag: Path, *extra: str) -> tuple[dict[str, Any], str]:
