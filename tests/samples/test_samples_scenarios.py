@@ -20,7 +20,13 @@ from ertools.benchmarks import registry
 from ertools.samples import scenario
 from ertools.samples.__main__ import main
 from ertools.samples.scenario import ScenarioMissingError, load_scenario, scenarios, seed_of
-from ertools.simulator.answers import answers_path, log_name
+from ertools.simulator.answers import (
+    RunAnswers,
+    answers_path,
+    log_name,
+    read_answers,
+    write_layout_answers,
+)
 from tests.helpers.floats import FLOAT_ATOL, FLOAT_RTOL, same_text
 
 REPO = Path(__file__).resolve().parents[2]
@@ -137,6 +143,31 @@ def test_log_name_is_the_2015_logger_pattern() -> None:
     )
     assert answers_path(Path("d/x.bag")) == Path("d/x.answers.yaml")
     assert answers_path(Path("d/x_rosbag2")) == Path("d/x_rosbag2.answers.yaml")
+
+
+def test_a_layouts_answers_are_beside_it_and_read_per_run(tmp_path: Path) -> None:
+    folder = tmp_path / "hnf"
+    bags = [folder / f"rsbb_logs/HNF/simbot/run_{n}_x.bag" for n in (1, 2)]
+    runs = [
+        RunAnswers(bag, parameters={"run": n}, truth={}, expected={"n": n}, tolerance={})
+        for n, bag in enumerate(bags, 1)
+    ]
+    out = write_layout_answers(folder, runs, benchmark="hnf", scenario="hnf", seed=5)
+    assert out == tmp_path / "hnf.answers.yaml" and not folder.exists()  # nothing in it
+    doc = yaml.safe_load(out.read_text(encoding="utf-8"))
+    assert list(doc) == ["benchmark", "bag", "generator", "runs"]
+    assert doc["bag"] == [f"rsbb_logs/HNF/simbot/run_{n}_x.bag" for n in (1, 2)]
+    # a run's answers in a log's own shape, wherever the bag is given from
+    assert read_answers(bags[1]) == {
+        "benchmark": "hnf",
+        "bag": "rsbb_logs/HNF/simbot/run_2_x.bag",
+        "generator": {"scenario": "hnf", "seed": 5, "parameters": {"run": 2}},
+        "truth": {},
+        "expected": {"n": 2},
+        "tolerance": {},
+    }
+    with pytest.raises(FileNotFoundError, match=r"run_3_x\.bag: no answers file"):
+        read_answers(bags[0].with_name("run_3_x.bag"))
 
 
 def _close(a: Any, b: Any, where: str) -> list[str]:
