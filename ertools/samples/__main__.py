@@ -10,8 +10,9 @@ registry, and the timeline folder and the season) is generated into
 ``OUTDIR/.<name>.XXXXXXXX.partial``, first, so a failure leaves the old folder in place).
 Without ``--seed`` each scenario uses its fixed
 default seed, so the output is byte-identical from run to run. An unknown scenario is an
-error naming it, before anything is written. A scenario's answers about its folder as a
-whole (the season's: an organiser's folder holds no answers) are written beside it,
+error naming it, before anything is written. The answers of a scenario written in the RSBB's
+layout (the season's, and each single-benchmark RSBB sample's: an organiser's folder holds no
+answers, and ``ertools rescore`` would list one as not a log) are written beside its folder,
 ``OUTDIR/<name>.answers.yaml`` (:func:`~ertools.simulator.answers.answers_path` of the
 folder), and move with it.
 """

@@ -26,7 +26,8 @@ Rules for scenario authors:
 - Use :mod:`ertools.simulator.mocap` for what the mocap node published,
   :mod:`ertools.simulator.statemachine` for the state topics and
   :func:`ertools.simulator.answers.write_answers` for the answers file (its conventions are
-  written there).
+  written there); a scenario in the RSBB's layout
+  :func:`~ertools.simulator.answers.write_layout_answers`, beside its folder, not in it.
 """
 
 from __future__ import annotations
