@@ -28,6 +28,7 @@ from ertools.inputs import open_regular
 from ertools.io.decode.fast import read_at
 from ertools.io.inflate import Allowance, inflate
 from ertools.io.model import Conn, short_msgtype
+from ertools.io.ros1.chunk_infos import read_chunk_infos
 from ertools.io.ros1.records import (
     MAGIC_LEN,
     OP_BAG_HEADER,
@@ -250,6 +251,9 @@ def _read_layout(f: BinaryIO, path: Path, size: int) -> Ros1Layout:
         if chunk_count == 0 and conn_count and index_pos > head.end:
             # records between the header and the index, but no chunk to find them by
             raise RecordError("the bag header counts no chunks before its index", MAGIC_LEN)
+        found = read_chunk_infos(f, pos, size, chunk_count)
+        if found is not None:
+            return Ros1Layout(path, size, True, conns, [Ros1Chunk(*info) for info in found])
         chunks = []
         for _ in range(chunk_count):
             rec, data = read_record(f, pos, size, with_data=True)
