@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 import yaml
 
+from ertools.atomic import write_text
 from ertools.frozen_dataclass import frozen_dataclass
 
 # A Friday at the Lisbon 2015 RoCKIn competition (2015-11-20 10:00:00 UTC): the default
@@ -133,10 +134,7 @@ def write_answers(
         "expected": to_plain(expected),
         "tolerance": to_plain(tolerance),
     }
-    out = answers_path(logs[0])
-    text = yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=100)
-    out.write_text(text, encoding="utf-8")
-    return out
+    return _dump(doc, answers_path(logs[0]))
 
 
 @frozen_dataclass
@@ -176,10 +174,12 @@ def write_layout_answers(
             for bag, run in zip(bags, runs, strict=True)
         },
     }
-    out = answers_path(folder)
-    text = yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=100)
-    out.write_text(text, encoding="utf-8")
-    return out
+    return _dump(doc, answers_path(folder))
+
+
+def _dump(doc: Mapping[str, Any], out: Path) -> Path:
+    """``doc`` as YAML at ``out``, keys in the order given, written whole (temp + rename)."""
+    return write_text(out, yaml.safe_dump(doc, sort_keys=False, default_flow_style=None, width=100))
 
 
 def read_answers(log: Path) -> dict[str, Any]:
