@@ -70,13 +70,70 @@ def test_mcap_summary_failing_its_crc_is_read_record_by_record(
     assert (pose.count, pose.first_ns, pose.last_ns) == (N_POSES, TRUE_T[0], TRUE_T[-1])
 
 
-def test_mcap_chunk_op_code_damaged_where_the_summary_indexes_a_chunk(tmp_path: Path) -> None:
-    """No message indexes (read record by record): the second chunk's op code read as an
-    unknown record would drop its messages; the summary's chunk index says a chunk is there."""
+@pytest.mark.parametrize(
+    ("op", "message"),
+    [
+        # a metadata index's op code: a record kind a scan steps over
+        (b"\x0d", r"indexes a chunk at byte .* where the records hold no"),
+        # a private op code: the record's shape names it a chunk before the summary does
+        (b"\xff", r"unknown op code \(0xff\) and the shape of a chunk"),
+    ],
+)
+def test_mcap_chunk_op_code_damaged_where_the_summary_indexes_a_chunk(
+    tmp_path: Path, op: bytes, message: str
+) -> None:
+    """No message indexes (read record by record): the second chunk's op code read as a
+    record the scan skips would drop its messages; the summary's chunk index says a chunk is
+    there."""
     at, _n = site("mcap-lz4-nomsgindex", "chunk.opcode", 1)
-    path = damaged(tmp_path, "mcap-lz4-nomsgindex", [(at, b"\xff")])
-    with pytest.raises(BagError, match=r"indexes a chunk at byte .* where the records hold no"):
+    path = damaged(tmp_path, "mcap-lz4-nomsgindex", [(at, op)])
+    with pytest.raises(BagError, match=message):
         read_poses(path, POSE_TOPIC)
+
+
+def test_mcap_chunk_op_code_damaged_with_the_summary_damaged_too(tmp_path: Path) -> None:
+    """The first chunk's op code damaged (6 -> 0x8f, a private record's) and the summary's
+    CRC too (fuzz seed 10, case 3487): nothing indexes the chunk, yet its record has a
+    chunk's exact shape; skipping it as the specification's unknown record lost a pose."""
+    at, _n = site("mcap-zstd-nostats", "chunk.opcode", 0)
+    crc_at, _ = site("mcap-zstd-nostats", "footer.summary_crc")
+    data = seed_bytes("mcap-zstd-nostats")
+    assert data[at] == 0x06
+    bad_crc = bytes([data[crc_at] ^ 0xFF])
+    path = damaged(tmp_path, "mcap-zstd-nostats", [(at, b"\x8f"), (crc_at, bad_crc)])
+    with pytest.raises(BagError, match=rf"record at byte {at} has an unknown op code \(0x8f\)"):
+        describe(path)
+    with pytest.raises(BagError, match="the shape of a chunk"):
+        read_poses(path, POSE_TOPIC)
+
+
+def _private_record(op: int, body: bytes) -> bytes:
+    return bytes([op]) + struct.pack("<Q", len(body)) + body
+
+
+@pytest.mark.parametrize(
+    "body",
+    [
+        b"team notes",
+        # a chunk's fixed fields and a compression the format names, but a records length
+        # that does not end the record
+        struct.pack("<QQQII", 1, 2, 3, 0, 4) + b"zstd" + struct.pack("<Q", 100) + b"x" * 7,
+        # the lengths fit, the compression is no chunk's
+        struct.pack("<QQQII", 1, 2, 3, 0, 3) + b"lzo" + struct.pack("<Q", 2) + b"xy",
+    ],
+)
+def test_mcap_private_records_are_still_skipped(tmp_path: Path, body: bytes) -> None:
+    """A record of a private op code (0x80-0xFF) that is not shaped like a chunk is skipped,
+    as the specification has readers do: every pose is read."""
+    data = seed_bytes("mcap-nosummary")
+    at, _n = site("mcap-nosummary", "chunk.opcode", 0)
+    crc_at, n = site("mcap-nosummary", "data_end.data_section_crc")
+    out = bytearray(data[:at] + _private_record(0x80, body) + data[at:])
+    shift = len(out) - len(data)
+    out[crc_at + shift : crc_at + shift + n] = bytes(n)  # 0: the data section's CRC unknown
+    path = tmp_path / f"private{suffix('mcap-nosummary')}"
+    path.write_bytes(bytes(out))
+    assert_true_poses(path)
 
 
 def test_mcap_records_after_a_footer_are_damage(tmp_path: Path) -> None:
@@ -211,3 +268,4 @@ def test_misread_needs_evidence_and_the_undamaged_answer() -> None:
     moved = Outcome(True, (t, v + 1e-6))
     assert misread("poses", verdict, rows, rows, "summary CRC")[0] == "misread"
     assert misread("poses", verdict, moved, rows, "summary CRC") == verdict
+

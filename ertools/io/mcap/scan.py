@@ -31,10 +31,12 @@ from ertools.inputs import open_regular
 from ertools.io import budget, mapguard
 from ertools.io.decode.fast import read_at
 from ertools.io.inflate import Allowance
+from ertools.io.mcap.bodies import CHUNK_HEAD, U64, CutError, channel, chunk_shaped, schema
 from ertools.io.mcap.crc import crc32
 from ertools.io.mcap.summary import decompress, read_summary
 
 MAGIC = b"\x89MCAP0\r\n"
+OP_HEADER = 0x01
 OP_FOOTER = 0x02
 OP_SCHEMA = 0x03
 OP_CHANNEL = 0x04
@@ -49,15 +51,7 @@ INDEXED = "summary+message-indexes"
 SCAN = "scan"
 
 _HEAD = struct.Struct("<BQ")
-_CHUNK = struct.Struct("<QQQII")  # start, end, uncompressed size, crc, compression length
-_U16 = struct.Struct("<H")
-_U32 = struct.Struct("<I")
-_U64 = struct.Struct("<Q")
 MESSAGE_FIXED = 2 + 4 + 8 + 8
-
-
-class _CutError(Exception):
-    """A record runs past the end of what holds it (file or chunk)."""
 
 
 # One run of kept message payloads: (bytes, data starts, data lengths, message ordinals).
@@ -121,7 +115,7 @@ class _Sink:
             )
         length = read_at(buf, at + 1, np.dtype("<u8")).astype(np.int64)
         if int(length.min()) < MESSAGE_FIXED:
-            raise _CutError
+            raise CutError
         cids = read_at(buf, at + 9, np.dtype("<u2")).astype(np.int64)
         times = read_at(buf, at + 15, np.dtype("<u8"))
         if int(times.max()) > np.iinfo(np.int64).max:
@@ -140,45 +134,6 @@ class _Sink:
                 idx = np.repeat(start - base, size) + np.arange(int(size.sum()), dtype=np.int64)
                 self.payloads.append((buf[idx], base, size, mine + self.count))
         self.count += len(at)
-
-
-def _string(buf: Any, at: int, end: int) -> tuple[str, int]:
-    (n,) = _U32.unpack_from(buf, at)
-    at += 4
-    if at + n > end:
-        raise _CutError
-    return bytes(buf[at : at + n]).decode("utf-8"), at + n
-
-
-def _schema(buf: Any, at: int, end: int) -> Any:
-    from mcap.records import Schema  # lazy: mcap, 20 ms
-
-    (sid,) = _U16.unpack_from(buf, at)
-    name, at = _string(buf, at + 2, end)
-    encoding, at = _string(buf, at, end)
-    (n,) = _U32.unpack_from(buf, at)
-    if at + 4 + n > end:
-        raise _CutError
-    return Schema(id=sid, name=name, encoding=encoding, data=bytes(buf[at + 4 : at + 4 + n]))
-
-
-def _channel(buf: Any, at: int, end: int) -> Any:
-    from mcap.records import Channel  # lazy: mcap, 20 ms
-
-    cid, sid = struct.unpack_from("<HH", buf, at)
-    topic, at = _string(buf, at + 4, end)
-    encoding, at = _string(buf, at, end)
-    (n,) = _U32.unpack_from(buf, at)
-    at += 4
-    stop = at + n
-    if stop > end:
-        raise _CutError
-    metadata = {}
-    while at < stop:
-        key, at = _string(buf, at, stop)
-        value, at = _string(buf, at, stop)
-        metadata[key] = value
-    return Channel(id=cid, schema_id=sid, topic=topic, message_encoding=encoding, metadata=metadata)
 
 
 # Bytes searched for record starts at a time: bounded memory for the candidate arrays.
@@ -259,12 +214,12 @@ def _walk(buf: Any, pos: int, end: int, sink: _Sink, top: bool) -> int:
                 continue
             run = 0
         if pos + 9 > end:
-            raise _CutError
+            raise CutError
         op, n = head(buf, pos)
         body: int = pos + 9
         stop: int = body + n
         if stop > end or stop < body:
-            raise _CutError
+            raise CutError
         if op == OP_MESSAGE:
             sink.messages(buf, np.array([pos], dtype=np.int64))
             run += 1
@@ -279,10 +234,10 @@ def _walk(buf: Any, pos: int, end: int, sink: _Sink, top: bool) -> int:
 def _record(buf: Any, op: int, body: int, stop: int, sink: _Sink, top: bool) -> bool:
     """One record other than a message; True when it is the footer (the end of the file)."""
     if op == OP_CHANNEL:
-        ch = _channel(buf, body, stop)
+        ch = channel(buf, body, stop)
         sink.channels.setdefault(ch.id, ch)
     elif op == OP_SCHEMA:
-        sc = _schema(buf, body, stop)
+        sc = schema(buf, body, stop)
         if sc.id:
             sink.schemas.setdefault(sc.id, sc)
     elif op == OP_CHUNK:
@@ -294,17 +249,27 @@ def _record(buf: Any, op: int, body: int, stop: int, sink: _Sink, top: bool) -> 
         return True
     elif op == OP_DATA_END and top:
         sink.data_end = True
+    elif top and not OP_HEADER <= op <= OP_DATA_END and chunk_shaped(buf, body, stop):
+        # The specification has readers skip a record of an unknown op code; one shaped
+        # exactly like a chunk is a chunk whose op code is damaged (found by fuzzing, with the
+        # summary that would have named it damaged too): skipping it drops its messages.
+        raise BagError(
+            f"damaged MCAP file: the record at byte {body - 9} has an unknown op code "
+            f"(0x{op:02x}) and the shape of a chunk: a damaged op code, which would drop the "
+            "chunk's messages",
+            path=sink.path,
+        )
     return False
 
 
 def _chunk(buf: Any, at: int, end: int, sink: _Sink) -> None:
-    _t0, _t1, usize, crc, clen = _CHUNK.unpack_from(buf, at)
-    at += _CHUNK.size
+    _t0, _t1, usize, crc, clen = CHUNK_HEAD.unpack_from(buf, at)
+    at += CHUNK_HEAD.size
     compression = bytes(buf[at : at + clen]).decode("ascii", "replace")
-    (nbytes,) = _U64.unpack_from(buf, at + clen)
+    (nbytes,) = U64.unpack_from(buf, at + clen)
     at += clen + 8
     if at + nbytes > end:
-        raise _CutError
+        raise CutError
     where = f"in {sink.path} at byte {at}"
     if compression:
         sink.allowance.add(usize, f"at byte {at}", "MCAP chunk")
@@ -319,7 +284,7 @@ def _chunk(buf: Any, at: int, end: int, sink: _Sink) -> None:
     sink.chunks += 1
     records = np.frombuffer(inner, dtype=np.uint8)
     if _walk(records, 0, len(records), sink, top=False) != len(records):
-        raise _CutError
+        raise CutError
 
 
 def scan_mcap(
@@ -407,7 +372,7 @@ def _scan(buf: U8, path: Path, keep: frozenset[int], check_crc: bool) -> McapRec
                 "before the end of the file",
                 path=path,
             )
-    except (_CutError, struct.error, UnicodeDecodeError) as err:
+    except (CutError, struct.error, UnicodeDecodeError) as err:
         why = "a record runs past the end of the file or of its chunk"
         if isinstance(err, UnicodeDecodeError):
             why = "a name that is not UTF-8"
@@ -499,7 +464,7 @@ def _layout(path: Path) -> McapLayout:
         if any(not c.message_index_offsets and c.uncompressed_size for c in chunks):
             return _scan_layout(summary, "chunks without message indexes")
         f.seek(size - len(MAGIC) - FOOTER_SIZE)
-        (data_end,) = _U64.unpack_from(f.read(FOOTER_SIZE), 9)
+        (data_end,) = U64.unpack_from(f.read(FOOTER_SIZE), 9)
         gaps = _gaps(chunks, data_end)
         if gaps is None:
             return _scan_layout(summary, "chunk indexes that overlap or point outside the data")
@@ -507,7 +472,7 @@ def _layout(path: Path) -> McapLayout:
         for a, b in gaps:
             try:
                 at = _walk_loose(f.fileno(), a, b, sink)
-            except (_CutError, struct.error, UnicodeDecodeError):
+            except (CutError, struct.error, UnicodeDecodeError):
                 at = -1
             if sink.count or sink.chunks:
                 what = (
@@ -551,11 +516,11 @@ def _walk_loose(fd: int, pos: int, end: int, sink: _Sink) -> int:
     while pos < end:
         head = os.pread(fd, 9, pos)
         if len(head) < 9:
-            raise _CutError
+            raise CutError
         op, n = _HEAD.unpack(head)
         stop: int = pos + 9 + n
         if stop > end:
-            raise _CutError
+            raise CutError
         if op == OP_MESSAGE:
             sink.count += 1
             return stop
@@ -565,7 +530,7 @@ def _walk_loose(fd: int, pos: int, end: int, sink: _Sink) -> int:
         if op in (OP_SCHEMA, OP_CHANNEL):
             record = np.frombuffer(os.pread(fd, 9 + n, pos), dtype=np.uint8)
             if len(record) != 9 + n:
-                raise _CutError
+                raise CutError
             _walk(record, 0, len(record), sink, top=False)
         pos = stop
     return pos
