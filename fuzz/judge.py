@@ -499,6 +499,39 @@ def misread(
     return "misread", f"official reader read damaged bytes ({evidence}): {detail}"
 
 
+def misread_but_for(
+    part: str,
+    verdict: tuple[str, str],
+    ert: Outcome | str,
+    truth: Outcome,
+    alone: Outcome,
+    rest: Outcome,
+    evidence: str,
+    where: int,
+) -> tuple[str, str]:
+    """A ``disagree`` of a mutant of several changes turned ``misread`` when ``evidence``
+    shows the official reader read damaged bytes, the change at byte ``where`` alone makes it
+    answer other than the undamaged file (``alone``: the damage it misreads), and without
+    that change it answers exactly as ertools did (``rest``: the other changes, a pose's bytes
+    say, ertools read as they are). ertools then read past the damage the official reader
+    misread; every other verdict as it was."""
+    v, detail = verdict
+    if v != "disagree" or not evidence or isinstance(ert, str) or not ert.ok:
+        return verdict
+    if not (truth.ok and alone.ok and rest.ok):
+        return verdict
+    if _same(part, alone.value, truth.value) or not _same(part, ert.value, rest.value):
+        return verdict
+    return "misread", (
+        f"official reader read damaged bytes ({evidence}); without the change at byte "
+        f"{where} it reads what ertools read: {detail}"
+    )
+
+
+def _same(part: str, a: Any, b: Any) -> bool:
+    return bool(a == b) if part == "summary" else _same_rows(a, b)
+
+
 def _show(value: Any) -> str:
     if isinstance(value, dict):
         return repr(value)

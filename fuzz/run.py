@@ -56,6 +56,7 @@ def run_case(seed: int, index: int, workdir: Path, keep: Path | None = None) -> 
         judge_part,
         mcap_crc_evidence,
         misread,
+        misread_but_for,
         official_answer,
         ros1_index_evidence,
         worst,
@@ -73,9 +74,10 @@ def run_case(seed: int, index: int, workdir: Path, keep: Path | None = None) -> 
     ert = ertools_answer(path)
     off = official_answer(path)
     parts = {p: judge_part(p, ert[p], off[p], [truth[p]]) for p in PARTS}
-    if len(mutant.edits) > 1 and any(v == "disagree" for v, _ in parts.values()):
+    several = len(mutant.edits) > 1 and any(v == "disagree" for v, _ in parts.values())
+    alone = []
+    if several:
         # several changes: also accept what the official reader reads with each one alone
-        alone = []
         for at, new in mutant.edits:
             one = bytearray(seed_data)
             one[at : at + len(new)] = new
@@ -93,6 +95,25 @@ def run_case(seed: int, index: int, workdir: Path, keep: Path | None = None) -> 
         else:
             evidence = ros1_index_evidence(path, truth["summary"])
         parts = {p: misread(p, parts[p], ert[p], truth[p], evidence) for p in PARTS}
+        if several and evidence:
+            # one change damaged what the official reader trusts, another the bytes of a
+            # message: ertools' answer is the official reader's without the first
+            for k, (at, _new) in enumerate(mutant.edits):
+                if not any(v == "disagree" for v, _ in parts.values()):
+                    break
+                rest = bytearray(seed_data)
+                for j, (at2, new2) in enumerate(mutant.edits):
+                    if j != k:
+                        rest[at2 : at2 + len(new2)] = new2
+                others = workdir / f"others{suffix(name)}"
+                others.write_bytes(bytes(rest))
+                without = official_answer(others)
+                parts = {
+                    p: misread_but_for(
+                        p, parts[p], ert[p], truth[p], alone[k][p], without[p], evidence, at
+                    )
+                    for p in PARTS
+                }
     verdict = worst([v for v, _ in parts.values()])
     owner = ""
     if verdict == "disagree":

@@ -19,6 +19,7 @@ from fuzz.judge import (
     Outcome,
     mcap_crc_evidence,
     misread,
+    misread_but_for,
     ros1_index_evidence,
     ros1_record_summary,
 )
@@ -269,3 +270,29 @@ def test_misread_needs_evidence_and_the_undamaged_answer() -> None:
     assert misread("poses", verdict, rows, rows, "summary CRC")[0] == "misread"
     assert misread("poses", verdict, moved, rows, "summary CRC") == verdict
 
+
+def test_misread_but_for_one_change_needs_all_three_answers() -> None:
+    """Fuzz seed 10, case 3310 in small: one change damaged a ROS1 index (the official
+    reader then drops 5 of 30 transforms), another a transform's bytes. ertools' 30 rows, one
+    damaged, are the official reader's answer without the index change."""
+    t = np.arange(30, dtype=np.int64)
+    v = np.zeros((30, 7))
+    truth = Outcome(True, (t, v))
+    payload_hit = v.copy()
+    payload_hit[7, 0] = 4.0
+    ert = Outcome(True, (t, payload_hit))
+    index_alone = Outcome(True, (t[:25], v[:25]))  # the index change alone: 5 rows dropped
+    without_index = Outcome(True, (t, payload_hit))  # every other change: the damaged row
+    verdict = ("disagree", "ertools 30 rows != official 25 rows")
+    ev = "only the index is damaged"
+    got = misread_but_for("tf", verdict, ert, truth, index_alone, without_index, ev, 10882)
+    assert got[0] == "misread" and "byte 10882" in got[1]
+    # no evidence; the change alone does not make the official reader err; ertools' rows
+    # are not the official reader's without the change; not a disagreement
+    assert misread_but_for("tf", verdict, ert, truth, index_alone, without_index, "", 1) == verdict
+    assert misread_but_for("tf", verdict, ert, truth, truth, without_index, ev, 1) == verdict
+    assert misread_but_for("tf", verdict, ert, truth, index_alone, truth, ev, 1) == verdict
+    refused = ("refused", "x")
+    assert misread_but_for("tf", refused, ert, truth, index_alone, without_index, ev, 1) == refused
+    failed = Outcome(False, why="UnicodeDecodeError")
+    assert misread_but_for("tf", verdict, ert, truth, index_alone, failed, ev, 1) == verdict
