@@ -214,6 +214,23 @@ def test_ros1_two_connection_records_with_one_id_are_damage(tmp_path: Path) -> N
         read_poses(path, POSE_TOPIC)
 
 
+@pytest.mark.parametrize("name", ["ros1", "ros1-bz2"])
+def test_ros1_connection_record_without_its_type_is_damage(tmp_path: Path, name: str) -> None:
+    """The index's connection record of /robot/status with its field name damaged (`type=`
+    -> `tYpe=`, fuzz seed 11, case 3811): the topic was summarised with no type and read
+    without a word. Now a scan gives the type from the chunks' own connection records, and a
+    read refuses the damaged index."""
+    data = seed_bytes(name)
+    at = data.rindex(b"type=std_msgs/String")  # the index section's copy: the last one
+    path = damaged(tmp_path, name, [(at + 1, b"Y")])
+    info = describe(path)
+    assert info.summary.index == "scan"
+    status = next(t for t in info.summary.topics if t.name == "/robot/status")
+    assert status.msgtype == "std_msgs/String"
+    with pytest.raises(BagError, match="connection record without a type field at byte"):
+        read_poses(path, POSE_TOPIC)
+
+
 # --- the judge's evidence and verdict --------------------------------------------------------
 
 

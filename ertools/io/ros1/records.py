@@ -168,6 +168,10 @@ def connection_fields(record: Record, data: bytes) -> tuple[int, str, dict[str, 
         msgtype = fields.get("type", b"").decode("utf-8")
     except UnicodeDecodeError as err:
         raise RecordError(f"connection topic or type is not UTF-8 ({err})", record.pos) from err
+    if "type" not in fields:
+        # every writer names the type; without it the topic reads as of no type at all (a
+        # damaged field name, found by fuzzing: `tYpe=`), where rosbags refuses the bag
+        raise RecordError("connection record without a type field", record.pos)
     if msgtype and not _TYPE_NAME.fullmatch(msgtype):
         # ROS type names are package/Name, each starting with a letter: another name is a
         # damaged byte (rosbags then fails on the definition), not a type the bag holds
