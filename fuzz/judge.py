@@ -115,14 +115,17 @@ def _pose_row(msg: Any) -> list[float]:
     return [p.x, p.y, p.z, q.x, q.y, q.z, q.w]
 
 
-def _tf_rows(msg: Any, t: list[int], v: list[list[float]]) -> None:
+def _tf_rows(msg: Any, t: list[int], v: list[list[float]], ros1: bool) -> None:
     for tr in msg.transforms:
         if (
             tr.header.frame_id.lstrip("/") == TF_PARENT
             and tr.child_frame_id.lstrip("/") == TF_CHILD
         ):
             s = tr.header.stamp
-            t.append(int(s.sec) * 1_000_000_000 + int(s.nanosec))
+            # ROS1's time is uint32 seconds; rosbags gives ROS2's int32 (a damaged high bit
+            # reads as 1947 instead of 2083)
+            sec = int(s.sec) % (1 << 32) if ros1 else int(s.sec)
+            t.append(sec * 1_000_000_000 + int(s.nanosec))
             a, q = tr.transform.translation, tr.transform.rotation
             v.append([a.x, a.y, a.z, q.x, q.y, q.z, q.w])
 
@@ -148,13 +151,19 @@ def _decoded(
         v: list[list[float]] = []
         for topic, ty, _t, raw in msgs:
             if topic == TF_TOPIC and ty in ("tf2_msgs/TFMessage", "tf/tfMessage"):
-                _tf_rows(decode(raw, ty), t, v)
+                _tf_rows(decode(raw, ty), t, v, _ros1_encoded(raw))
         if not t:
             raise LookupError("no world -> robot transform")
         out["tf"] = Outcome(True, _rows(t, v))
     except Exception as err:
         out["tf"] = Outcome(False, why=f"{type(err).__name__}: {err}")
     return out
+
+
+def _ros1_encoded(raw: Any) -> bool:
+    """Whether a message is in ROS1's serialisation: a ROS1 bag's bytes, or an MCAP item
+    (schema, encoding, bytes) of the ``ros1`` encoding."""
+    return not isinstance(raw, tuple) or raw[1] == "ros1"
 
 
 def _read_ros1(path: Path, topic: str | None) -> tuple[Summary, dict[str, Outcome]]:

@@ -17,9 +17,11 @@ from ertools.io.info import describe
 from ertools.io.reader import read_poses
 from fuzz.judge import (
     Outcome,
+    ertools_answer,
     mcap_crc_evidence,
     misread,
     misread_but_for,
+    official_answer,
     ros1_index_evidence,
     ros1_record_summary,
 )
@@ -313,3 +315,21 @@ def test_misread_but_for_one_change_needs_all_three_answers() -> None:
     assert misread_but_for("tf", refused, ert, truth, index_alone, without_index, ev, 1) == refused
     failed = Outcome(False, why="UnicodeDecodeError")
     assert misread_but_for("tf", verdict, ert, truth, index_alone, failed, ev, 1) == verdict
+
+
+def test_judge_reads_ros1_time_as_unsigned_seconds(tmp_path: Path) -> None:
+    """Fuzz seed 17, case 8790: a transform's stamp with the high bit of its seconds flipped.
+    ROS1's time is uint32 seconds (2083 here, as ertools reads it); rosbags gives ROS2's
+    int32 (1947). The official answer is taken as the format defines it: both readers agree."""
+    data = seed_bytes("ros1")
+    marker = b"\x05\x00\x00\x00world\x05\x00\x00\x00robot"  # a transform's frame names
+    starts = [i for i in range(len(data)) if data.startswith(marker, i)]
+    at = starts[12] - 5  # the high byte of the stamp's seconds, before the frame id
+    (sec,) = struct.unpack_from("<I", data, at - 3)
+    path = damaged(tmp_path, "ros1", [(at, bytes([data[at] ^ 0x80]))])
+    official = official_answer(path)["tf"]
+    ours = ertools_answer(path)["tf"]
+    assert isinstance(ours, Outcome) and official.ok and ours.ok
+    t, _v = official.value
+    assert int(t.max()) // 1_000_000_000 == sec + (1 << 31)
+    np.testing.assert_array_equal(np.sort(t), np.sort(ours.value[0]))
