@@ -518,12 +518,12 @@ def misread_but_for(
     evidence: str,
     where: int,
 ) -> tuple[str, str]:
-    """A ``disagree`` of a mutant of several changes turned ``misread`` when ``evidence``
-    shows the official reader read damaged bytes, the change at byte ``where`` alone makes it
-    answer other than the undamaged file (``alone``: the damage it misreads), and without
-    that change it answers exactly as ertools did (``rest``: the other changes, a pose's bytes
-    say, ertools read as they are). ertools then read past the damage the official reader
-    misread; every other verdict as it was."""
+    """A ``disagree`` of a mutant of several changes turned ``misread`` when the change at
+    byte ``where`` is damage the official reader misreads: ``evidence`` shows it on the file
+    with that change alone, where the official reader answers other than the undamaged file
+    (``alone``); and without that change the official reader answers exactly as ertools did
+    (``rest``: the other changes, a pose's bytes say, ertools read as they are). ertools then
+    read past the damage the official reader misread; every other verdict as it was."""
     v, detail = verdict
     if v != "disagree" or not evidence or isinstance(ert, str) or not ert.ok:
         return verdict

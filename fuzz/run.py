@@ -45,6 +45,22 @@ SEED_NAMES = tuple(SEEDS)
 CLI_EVERY = 25  # one case in CLI_EVERY also runs `ertools info` and `ertools noise`
 
 
+def _applied(
+    seed_data: bytes, edits: list[tuple[int, bytes]], which: set[int], workdir: Path, name: str
+) -> Path:
+    """The seed file with only the changes ``which`` (indices into ``edits``) applied,
+    written to ``workdir``."""
+    from fuzz.seeds import suffix
+
+    data = bytearray(seed_data)
+    for k, (at, new) in enumerate(edits):
+        if k in which:
+            data[at : at + len(new)] = new
+    path = workdir / f"part{suffix(name)}"
+    path.write_bytes(bytes(data))
+    return path
+
+
 def run_case(seed: int, index: int, workdir: Path, keep: Path | None = None) -> dict[str, Any]:
     """Mutate, read with both readers, judge. Returns the verdict record of the case."""
     import numpy as np
@@ -75,17 +91,21 @@ def run_case(seed: int, index: int, workdir: Path, keep: Path | None = None) -> 
     off = official_answer(path)
     parts = {p: judge_part(p, ert[p], off[p], [truth[p]]) for p in PARTS}
     several = len(mutant.edits) > 1 and any(v == "disagree" for v, _ in parts.values())
-    alone = []
+    alone: list[dict[str, Any]] = []
+    left_out: list[dict[str, Any]] = []
     if several:
-        # several changes: also accept what the official reader reads with each one alone
-        for at, new in mutant.edits:
-            one = bytearray(seed_data)
-            one[at : at + len(new)] = new
-            single = workdir / f"single{suffix(name)}"
-            single.write_bytes(bytes(one))
-            alone.append(official_answer(single))
+        # several changes: also accept what the official reader reads with each one alone,
+        # and with each one left out (one byte breaks the official reader, others change a
+        # pose both would read)
+        for k in range(len(mutant.edits)):
+            alone.append(official_answer(_applied(seed_data, mutant.edits, {k}, workdir, name)))
+            rest = set(range(len(mutant.edits))) - {k}
+            left_out.append(official_answer(_applied(seed_data, mutant.edits, rest, workdir, name)))
         parts = {
-            p: judge_part(p, ert[p], off[p], [truth[p], *(a[p] for a in alone)]) for p in PARTS
+            p: judge_part(
+                p, ert[p], off[p], [truth[p], *(a[p] for a in alone), *(w[p] for w in left_out)]
+            )
+            for p in PARTS
         }
     if any(v == "disagree" for v, _ in parts.values()):
         # the official reader read damaged bytes as sound (an MCAP CRC fails; a ROS1 index
@@ -95,25 +115,26 @@ def run_case(seed: int, index: int, workdir: Path, keep: Path | None = None) -> 
         else:
             evidence = ros1_index_evidence(path, truth["summary"])
         parts = {p: misread(p, parts[p], ert[p], truth[p], evidence) for p in PARTS}
-        if several and evidence:
-            # one change damaged what the official reader trusts, another the bytes of a
-            # message: ertools' answer is the official reader's without the first
-            for k, (at, _new) in enumerate(mutant.edits):
-                if not any(v == "disagree" for v, _ in parts.values()):
-                    break
-                rest = bytearray(seed_data)
-                for j, (at2, new2) in enumerate(mutant.edits):
-                    if j != k:
-                        rest[at2 : at2 + len(new2)] = new2
-                others = workdir / f"others{suffix(name)}"
-                others.write_bytes(bytes(rest))
-                without = official_answer(others)
-                parts = {
-                    p: misread_but_for(
-                        p, parts[p], ert[p], truth[p], alone[k][p], without[p], evidence, at
-                    )
-                    for p in PARTS
-                }
+    if several and any(v == "disagree" for v, _ in parts.values()):
+        # one change damaged what the official reader trusts (shown on the file with that
+        # change alone), another the bytes of a message: ertools' answer is the official
+        # reader's without the first
+        for k, (at, _new) in enumerate(mutant.edits):
+            if not any(v == "disagree" for v, _ in parts.values()):
+                break
+            single = _applied(seed_data, mutant.edits, {k}, workdir, name)
+            if name.startswith("mcap"):
+                shown = mcap_crc_evidence(single)
+            else:
+                shown = ros1_index_evidence(single, truth["summary"])
+            if not shown:
+                continue
+            parts = {
+                p: misread_but_for(
+                    p, parts[p], ert[p], truth[p], alone[k][p], left_out[k][p], shown, at
+                )
+                for p in PARTS
+            }
     verdict = worst([v for v, _ in parts.values()])
     owner = ""
     if verdict == "disagree":

@@ -18,7 +18,7 @@ import pytest
 
 from fuzz.judge import Outcome, ertools_answer, judge_part, official_answer
 from fuzz.mutate import CATEGORIES, layout, mutate
-from fuzz.run import SEED_NAMES, run_cases
+from fuzz.run import SEED_NAMES, run_case, run_cases
 from fuzz.seeds import N_POSES, POSE_TOPIC, SEEDS, T0_NS, seed_bytes, suffix
 
 
@@ -149,3 +149,27 @@ def test_a_stalled_case_is_a_hang_and_the_next_case_runs(monkeypatch: pytest.Mon
     assert [r["index"] for r in results] == [0, 1, 2]
     assert results[1]["verdict"] == "hang"
     assert results[0]["verdict"] != "hang" and results[2]["verdict"] != "hang"
+
+
+# Disagreements `make fuzz` found with other seeds than 1 (docs/qa.md, "Seeds 10 to 21"), each
+# settled by a reader or a judge change: (seed, case, its verdict since).
+FOUND_ELSEWHERE = [
+    (10, 3310, "misread"),  # an index change rosbags misread beside a transform's bytes
+    (10, 3487, "refused"),  # an MCAP chunk op code and the summary's CRC damaged
+    (11, 3811, "refused"),  # a ROS1 connection record without its type field
+    (12, 721, "refused"),
+    (13, 7411, "refused"),
+    (17, 1260, "agree"),  # a ROS1 stamp's seconds past 2**31: uint32 for both readers
+    (17, 8790, "agree"),
+    (18, 3020, "misread"),  # an index change, and a record's connection damaged too
+    (19, 3432, "salvaged"),  # rosbags fails on a definition; lz4 payload bytes changed twice
+]
+
+
+@pytest.mark.parametrize(("seed", "index", "verdict"), FOUND_ELSEWHERE)
+def test_cases_other_seeds_found(
+    tmp_path: Path, caplog: pytest.LogCaptureFixture, seed: int, index: int, verdict: str
+) -> None:
+    with caplog.at_level(logging.CRITICAL, logger="ertools"):
+        rec = run_case(seed, index, tmp_path)
+    assert rec["verdict"] == verdict, rec
