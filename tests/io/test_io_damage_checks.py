@@ -233,6 +233,32 @@ def test_ros1_connection_record_without_its_type_is_damage(tmp_path: Path, name:
         read_poses(path, POSE_TOPIC)
 
 
+def test_ros1_records_outside_their_chunk_info_and_index_are_damage(tmp_path: Path) -> None:
+    """Fuzz seed 22, case 4042: a damaged lz4 byte repeated into the time of every record of
+    the last chunk (+71 days), and a chunk info naming a connection the bag lacks (so the
+    index is rescanned). The index entries lie outside the records' span, which alone would
+    make them the damaged side; the chunk info's span holds them and not the records: the
+    records are the damage, and the read is refused instead of returning shifted poses."""
+    data = seed_bytes("ros1")
+    last = max(
+        struct.unpack_from("<Q", data, s.offset)[0]
+        for s in layout(data).sites
+        if s.name == "chunk_info.chunk_pos"
+    )
+    shift = 6_160_384  # seconds
+    edits = [
+        (s.offset, struct.pack("<I", struct.unpack_from("<I", data, s.offset)[0] + shift))
+        for s in layout(data).sites
+        if s.name == "chunk.message.time" and s.offset > last
+    ]
+    assert len(edits) >= 2
+    conn_at, _n = site("ros1", "chunk_info.entry_conn", 0)
+    edits.append((conn_at, struct.pack("<I", 84)))
+    path = damaged(tmp_path, "ros1", edits)
+    with pytest.raises(BagError, match="a message record's time differs from its index entry"):
+        read_poses(path, POSE_TOPIC)
+
+
 # --- the judge's evidence and verdict --------------------------------------------------------
 
 

@@ -484,6 +484,16 @@ def _compare_chunk(
             )
 
 
+def _info_span(rec: records.Record, data: bytes, spans: dict[int, tuple[int, int]]) -> None:
+    """The time span a chunk-info record gives its chunk, into ``spans`` (none when the
+    record does not read: the rebuild does without it)."""
+    try:
+        cpos, start, end, _counts = records.chunk_info(rec, data)
+    except (records.RecordError, KeyError, IndexError, struct.error):
+        return
+    spans[cpos] = (start, end)
+
+
 def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ros1Layout:
     """The layout of a closed bag rebuilt from its records, for a reader that stopped trusting
     the index: record times and offsets come from the message records themselves; the
@@ -497,6 +507,7 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
     found: list[tuple[int, str, int, int, int, list[tuple[I64, I64]]]] = []
     problems = [why]
     allowance = Allowance(size, str(path))
+    spans: dict[int, tuple[int, int]] = {}  # chunk position -> the chunk info's time span
     try:
         while pos < size:
             rec, data = records.read_record(
@@ -512,7 +523,9 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
             elif rec.op == OP_CONNECTION:
                 cid, topic, cf = records.connection_fields(rec, data)
                 conns.setdefault(cid, conn_record(cid, topic, cf))
-            elif rec.op != OP_CHUNK_INFO:
+            elif rec.op == OP_CHUNK_INFO:
+                _info_span(rec, data, spans)
+            else:
                 raise records.RecordError(f"record of op {rec.op} outside a chunk", pos)
             pos = rec.end
     except (records.RecordError, KeyError, IndexError, struct.error):
@@ -540,7 +553,13 @@ def rebuild_layout(f: BinaryIO, path: Path, size: int, pos: int, why: str) -> Ro
             hit = recs.msg_off[k] == hint_off
             differ = hint_t[hit][recs.msg_time[k[hit]] != hint_t[hit]]
             lo, hi = int(recs.msg_time.min()), int(recs.msg_time.max())
-            if np.any((differ >= lo) & (differ <= hi)):
+            # the chunk info's span, where it holds every differing entry and not the
+            # chunk's records, is a second witness: the records' times are the damage (a
+            # damaged lz4 byte repeated into every record's time, found by fuzzing)
+            a, b = spans.get(cpos, (hi + 1, lo - 1))
+            if np.any((differ >= lo) & (differ <= hi)) or (
+                len(differ) and bool(np.all((differ >= a) & (differ <= b))) and (lo < a or hi > b)
+            ):
                 problems.append(
                     f"chunk at byte {cpos}: a message record's time differs from its index entry"
                 )
