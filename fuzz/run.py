@@ -39,7 +39,7 @@ REPO = HERE.parent
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-from fuzz.seeds import SEEDS  # noqa: E402
+from fuzz.seeds import SEEDS, suffix  # noqa: E402
 
 SEED_NAMES = tuple(SEEDS)
 CLI_EVERY = 25  # one case in CLI_EVERY also runs `ertools info` and `ertools noise`
@@ -50,8 +50,6 @@ def _applied(
 ) -> Path:
     """The seed file with only the changes ``which`` (indices into ``edits``) applied,
     written to ``workdir``."""
-    from fuzz.seeds import suffix
-
     data = bytearray(seed_data)
     for k, (at, new) in enumerate(edits):
         if k in which:
@@ -59,6 +57,21 @@ def _applied(
     path = workdir / f"part{suffix(name)}"
     path.write_bytes(bytes(data))
     return path
+
+
+def _disagrees(parts: dict[str, tuple[str, str]]) -> bool:
+    return any(v == "disagree" for v, _ in parts.values())
+
+
+def _evidence(name: str, path: Path, summary: Any) -> str:
+    """Evidence that the official reader read damaged bytes of ``path`` as sound (an MCAP
+    CRC fails; a ROS1 index contradicts the bag's intact records, ``summary`` the undamaged
+    file's); '' when there is none."""
+    from fuzz.judge import mcap_crc_evidence, ros1_index_evidence
+
+    if name.startswith("mcap"):
+        return mcap_crc_evidence(path)
+    return ros1_index_evidence(path, summary)
 
 
 def run_case(seed: int, index: int, workdir: Path, keep: Path | None = None) -> dict[str, Any]:
@@ -70,15 +83,13 @@ def run_case(seed: int, index: int, workdir: Path, keep: Path | None = None) -> 
         cli_check,
         ertools_answer,
         judge_part,
-        mcap_crc_evidence,
         misread,
         misread_but_for,
         official_answer,
-        ros1_index_evidence,
         worst,
     )
     from fuzz.mutate import mutate
-    from fuzz.seeds import seed_bytes, suffix
+    from fuzz.seeds import seed_bytes
 
     name = SEED_NAMES[index % len(SEED_NAMES)]
     rng = np.random.default_rng([seed, index])
@@ -90,7 +101,7 @@ def run_case(seed: int, index: int, workdir: Path, keep: Path | None = None) -> 
     ert = ertools_answer(path)
     off = official_answer(path)
     parts = {p: judge_part(p, ert[p], off[p], [truth[p]]) for p in PARTS}
-    several = len(mutant.edits) > 1 and any(v == "disagree" for v, _ in parts.values())
+    several = len(mutant.edits) > 1 and _disagrees(parts)
     alone: list[dict[str, Any]] = []
     left_out: list[dict[str, Any]] = []
     if several:
@@ -107,26 +118,19 @@ def run_case(seed: int, index: int, workdir: Path, keep: Path | None = None) -> 
             )
             for p in PARTS
         }
-    if any(v == "disagree" for v, _ in parts.values()):
-        # the official reader read damaged bytes as sound (an MCAP CRC fails; a ROS1 index
-        # contradicts the bag's intact records) and ertools gave the undamaged answer
-        if name.startswith("mcap"):
-            evidence = mcap_crc_evidence(path)
-        else:
-            evidence = ros1_index_evidence(path, truth["summary"])
+    if _disagrees(parts):
+        # the official reader read damaged bytes as sound and ertools gave the undamaged answer
+        evidence = _evidence(name, path, truth["summary"])
         parts = {p: misread(p, parts[p], ert[p], truth[p], evidence) for p in PARTS}
-    if several and any(v == "disagree" for v, _ in parts.values()):
+    if several and _disagrees(parts):
         # one change damaged what the official reader trusts (shown on the file with that
         # change alone), another the bytes of a message: ertools' answer is the official
         # reader's without the first
         for k, (at, _new) in enumerate(mutant.edits):
-            if not any(v == "disagree" for v, _ in parts.values()):
+            if not _disagrees(parts):
                 break
             single = _applied(seed_data, mutant.edits, {k}, workdir, name)
-            if name.startswith("mcap"):
-                shown = mcap_crc_evidence(single)
-            else:
-                shown = ros1_index_evidence(single, truth["summary"])
+            shown = _evidence(name, single, truth["summary"])
             if not shown:
                 continue
             parts = {
@@ -236,7 +240,7 @@ _TRUTH: dict[str, Any] = {}
 def _truth(name: str, workdir: Path) -> Any:
     """The official answer on the undamaged seed file (what a partial read must stay within)."""
     from fuzz.judge import official_answer
-    from fuzz.seeds import seed_bytes, suffix
+    from fuzz.seeds import seed_bytes
 
     if name not in _TRUTH:
         path = workdir / f"seed{suffix(name)}"
